@@ -1,0 +1,1 @@
+"""ENI (ETG.2100 XML and Googol INI) configuration model, readers, writer and layout."""
