@@ -1,0 +1,139 @@
+"""Virtual EtherCAT IO: digital/analog terminals and a modular coupler (ETG.5001 style).
+
+An IO slave's process data is whatever its PDO mapping says (from the ENI).
+The *field side* is what a scenario touches: outputs the master wrote are read
+with :meth:`IoSlave.get_output`, inputs are set with :meth:`IoSlave.set_input`,
+and :meth:`IoSlave.wire` connects an output bit to an input bit (a wire on the
+terminal block), so a raw-data write comes back as an input one cycle later.
+
+A modular coupler maps module ``n``'s inputs at ``0x6000 + 0x10*n`` and its
+outputs at ``0x7000 + 0x10*n`` (ETG.5001.1 modular device profile); the
+Googol coupler of manual figure 5-4 (IBM337 + DI16/DO16/AI4/AO4) is one.
+:meth:`IoSlave.modules` groups the mapped objects that way.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from eni.bits import get_bits, set_bits
+from eni.model import Direction, Identity, Pdo
+
+from .slave import AlState, VirtualSlave
+
+_SIGNED_TYPES = {"SINT", "INT", "DINT", "LINT", "INT8", "INT16", "INT32", "INT64"}
+
+
+@dataclass(frozen=True, slots=True)
+class IoPoint:
+    """One mapped object inside the slave's own rx (OUT) or tx (IN) buffer."""
+
+    direction: Direction
+    index: int
+    subindex: int
+    bit: int  # offset inside rx/tx
+    bits: int
+    name: str
+    signed: bool
+
+
+class IoSlave(VirtualSlave):
+    """A generic IO slave driven by its PDO mapping.
+
+    Outputs only reach the field while the slave is in OP (in SAFEOP the
+    outputs stay in their safe state: all zero), as ETG.1000.6 requires.
+    """
+
+    def __init__(
+        self,
+        position: int,
+        name: str,
+        identity: Identity,
+        *,
+        rx_pdos: Sequence[Pdo] = (),
+        tx_pdos: Sequence[Pdo] = (),
+    ) -> None:
+        self.rx_pdos = tuple(rx_pdos)
+        self.tx_pdos = tuple(tx_pdos)
+        super().__init__(position, name, identity)
+        self.points: dict[tuple[Direction, int, int], IoPoint] = {}
+        for direction, pdos in ((Direction.OUT, self.rx_pdos), (Direction.IN, self.tx_pdos)):
+            bit = 0
+            for pdo in pdos:
+                for e in pdo.entries:
+                    if not e.is_padding:
+                        self.points.setdefault(
+                            (direction, e.index, e.subindex),
+                            IoPoint(direction, e.index, e.subindex, bit, e.bit_len, e.name,
+                                    e.data_type.upper() in _SIGNED_TYPES),
+                        )
+                    bit += e.bit_len
+        self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
+        self.field_outputs = bytearray(len(self.rx))  # what the terminals drive
+        self._wires: list[tuple[int, int]] = []  # (output bit, input bit) in rx/tx numbering
+
+    def pdo_sizes(self) -> tuple[int, int]:
+        return (sum(p.bit_len for p in self.rx_pdos), sum(p.bit_len for p in self.tx_pdos))
+
+    # --- field side -----------------------------------------------------------
+    def point(self, direction: Direction, index: int, subindex: int) -> IoPoint:
+        try:
+            return self.points[(direction, index, subindex)]
+        except KeyError:
+            kind = "output" if direction == Direction.OUT else "input"
+            raise KeyError(
+                f"slave {self.position} ({self.name}) maps no {kind} 0x{index:04X}:{subindex:02X}"
+            ) from None
+
+    def get_output(self, index: int, subindex: int) -> int:
+        """The value the terminal drives for an output object (0 unless in OP)."""
+        p = self.point(Direction.OUT, index, subindex)
+        return get_bits(self.field_outputs, p.bit, p.bits, signed=p.signed)
+
+    def set_input(self, index: int, subindex: int, value: int) -> None:
+        """Set what the terminal reads on an input object (reported from the next cycle)."""
+        p = self.point(Direction.IN, index, subindex)
+        set_bits(self.field_inputs, p.bit, p.bits, int(value))
+
+    def get_output_bit(self, bit: int) -> bool:
+        return bool(get_bits(self.field_outputs, bit, 1))
+
+    def set_input_bit(self, bit: int, on: bool) -> None:
+        set_bits(self.field_inputs, bit, 1, int(bool(on)))
+
+    def wire(self, out_bit: int, in_bit: int) -> None:
+        """Connect output bit ``out_bit`` (rx numbering) to input bit ``in_bit`` (tx numbering)."""
+        if not 0 <= out_bit < len(self.rx) * 8:
+            raise ValueError(f"slave {self.position}: no output bit {out_bit}")
+        if not 0 <= in_bit < len(self.tx) * 8:
+            raise ValueError(f"slave {self.position}: no input bit {in_bit}")
+        self._wires.append((out_bit, in_bit))
+
+    def wire_objects(self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None) -> None:
+        """Wire a whole output object to an input object (bit for bit)."""
+        po = self.point(Direction.OUT, *out)
+        pi = self.point(Direction.IN, *inp)
+        n = min(po.bits, pi.bits) if bits is None else bits
+        for k in range(n):
+            self.wire(po.bit + k, pi.bit + k)
+
+    def modules(self) -> dict[int, list[IoPoint]]:
+        """Mapped objects grouped by ETG.5001 module number (0x6000/0x7000 + 0x10*n)."""
+        out: dict[int, list[IoPoint]] = {}
+        for p in self.points.values():
+            if 0x6000 <= p.index < 0x8000:
+                n = (p.index & 0x0FFF) >> 4
+                out.setdefault(n, []).append(p)
+        return out
+
+    # --- cycle ------------------------------------------------------------------
+    def step(self, t_ns: int, dt_ns: int) -> None:
+        if self.al_state == AlState.OP:
+            self.field_outputs[:] = self.rx
+        else:
+            self.field_outputs[:] = bytes(len(self.field_outputs))
+        for ob, ib in self._wires:
+            set_bits(self.field_inputs, ib, 1, get_bits(self.field_outputs, ob, 1))
+        if self.al_state >= AlState.SAFEOP:
+            self.tx[:] = self.field_inputs

@@ -1,0 +1,68 @@
+"""The ``gtecat`` command: one module per verb, each with ``add_parser`` and ``run``.
+
+Errors print one line (``error: ...``) and exit 1; ``--debug`` shows the traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from eni.errors import GtecatError
+
+#: verb modules under gtecat.cli, in help order
+COMMANDS = ("demo_cmd", "map_cmd", "eni_cmd", "bus_cmd", "run_cmd", "serve_cmd")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="gtecat",
+        description="EtherCAT master emulator with virtual CiA-402 drives and the GT_* API.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"gtecat {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        try:
+            mod = importlib.import_module(f"gtecat.cli.{name}")
+        except ModuleNotFoundError as e:
+            if e.name != f"gtecat.cli.{name}":
+                raise
+            continue
+        before = set(sub.choices)
+        mod.add_parser(sub)
+        for verb in set(sub.choices) - before:
+            if sub.choices[verb].get_default("func") is None:
+                sub.choices[verb].set_defaults(func=mod.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None) or not hasattr(args, "func"):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except KeyboardInterrupt:
+        return 130
+    except (GtecatError, OSError) as e:
+        if args.debug:
+            raise
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    except Exception as e:  # noqa: BLE001 - one clear line, never a traceback by default
+        if args.debug:
+            raise
+        print(f"error: internal error: {type(e).__name__}: {e} (run with --debug for details)",
+              file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

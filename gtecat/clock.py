@@ -1,0 +1,165 @@
+"""Controller time: the three clock modes of DESIGN.md ("Time").
+
+* ``lockstep`` - nothing moves until :meth:`Clock.advance` (unit tests).
+* ``auto`` - virtual time; every GT call costs ``call_latency_ns`` of it, so
+  unmodified polling loops terminate, deterministically and fast.
+* ``realtime`` - a background thread runs cycles against the wall clock; GT
+  calls hold :attr:`Clock.lock` so they are atomic with respect to a cycle.
+
+Time is integer nanoseconds.  The clock does not know what a cycle does: the
+owner passes ``run_cycle`` (one bus + controller cycle).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from enum import Enum
+
+
+class ClockMode(str, Enum):
+    LOCKSTEP = "lockstep"
+    AUTO = "auto"
+    REALTIME = "realtime"
+
+
+@dataclass
+class CycleStats:
+    """Wall-clock cycle statistics (realtime mode): period and jitter in ns."""
+
+    cycles: int = 0
+    overruns: int = 0
+    periods_ns: list[int] = field(default_factory=list)
+    max_samples: int = 100_000
+
+    def add(self, period_ns: int) -> None:
+        self.cycles += 1
+        if len(self.periods_ns) < self.max_samples:
+            self.periods_ns.append(period_ns)
+
+
+class Clock:
+    """Counts controller time and decides when cycles run."""
+
+    def __init__(
+        self,
+        run_cycle: Callable[[], None],
+        *,
+        cycle_ns: int = 1_000_000,
+        mode: ClockMode | str = ClockMode.AUTO,
+        call_latency_ns: int = 50_000,
+    ) -> None:
+        if cycle_ns <= 0:
+            raise ValueError("cycle time must be positive")
+        self.mode = ClockMode(mode)
+        self.cycle_ns = int(cycle_ns)
+        self.call_latency_ns = int(call_latency_ns)
+        self._run_cycle = run_cycle
+        self.now_ns = 0  # controller time since power-on
+        self.cycles = 0
+        self._pending_ns = 0  # auto mode: latency accumulated since the last cycle
+        self.lock = threading.RLock()
+        self.stats = CycleStats()
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+
+    # --- virtual time ------------------------------------------------------
+    def cycle(self) -> None:
+        """Run exactly one cycle and count its time."""
+        self._run_cycle()
+        self.cycles += 1
+        self.now_ns += self.cycle_ns
+
+    def advance_ns(self, ns: int) -> int:
+        """Let ``ns`` of controller time pass (lockstep/auto); returns cycles run."""
+        if self.mode is ClockMode.REALTIME:
+            self._sleep(max(0, ns) / 1e9)
+            return 0
+        self._pending_ns += int(ns)
+        n = 0
+        while self._pending_ns >= self.cycle_ns:
+            self._pending_ns -= self.cycle_ns
+            self.cycle()
+            n += 1
+        return n
+
+    def advance(self, ms: float) -> int:
+        return self.advance_ns(round(ms * 1_000_000))
+
+    def on_call(self) -> None:
+        """A GT call happened: in ``auto`` mode it costs virtual latency."""
+        if self.mode is ClockMode.AUTO and self.call_latency_ns:
+            self.advance_ns(self.call_latency_ns)
+
+    def run_until(self, pred: Callable[[], bool], timeout_ms: float) -> bool:
+        """Run whole cycles until ``pred()`` holds or ``timeout_ms`` passes."""
+        if self.mode is ClockMode.REALTIME:
+            deadline = time.monotonic() + timeout_ms / 1000
+            while time.monotonic() < deadline:
+                with self.lock:
+                    if pred():
+                        return True
+                self._sleep(self.cycle_ns / 1e9)
+            with self.lock:
+                return pred()
+        budget = round(timeout_ms * 1_000_000)
+        spent = 0
+        while not pred():
+            if spent >= budget:
+                return False
+            self.cycle()
+            spent += self.cycle_ns
+        return True
+
+    def _sleep(self, seconds: float) -> None:
+        """Sleep with the cycle lock released, so the cycle thread keeps running."""
+        owned = self.lock._is_owned()  # type: ignore[attr-defined]
+        if owned:
+            self.lock.release()
+        try:
+            time.sleep(seconds)
+        finally:
+            if owned:
+                self.lock.acquire()
+
+    @property
+    def now_ms(self) -> int:
+        return self.now_ns // 1_000_000
+
+    # --- realtime ----------------------------------------------------------
+    def start_realtime(self) -> None:
+        if self.mode is not ClockMode.REALTIME or self._thread is not None:
+            return
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._realtime_loop, name="gtecat-cycle",
+                                        daemon=True)
+        self._thread.start()
+
+    def stop_realtime(self) -> None:
+        if self._thread is None:
+            return
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self._thread = None
+
+    def _realtime_loop(self) -> None:
+        period = self.cycle_ns
+        next_t = time.perf_counter_ns() + period
+        last = None
+        while not self._stop.is_set():
+            now = time.perf_counter_ns()
+            if now < next_t:
+                time.sleep((next_t - now) / 1e9)
+                continue
+            if last is not None:
+                self.stats.add(now - last)
+            last = now
+            with self.lock:
+                self.cycle()
+            next_t += period
+            if time.perf_counter_ns() > next_t:
+                # missed a whole period: count it and re-phase instead of bursting
+                self.stats.overruns += 1
+                next_t = time.perf_counter_ns() + period

@@ -1,0 +1,350 @@
+"""GT bus calls: open/close, EtherCAT bring-up, raw PDO data, EtherCAT IO, SDO, clock, version.
+
+Manual chapter 5 (5.2.2.1 communication, 5.2.2.4 PDO raw data, 5.2.2.5
+EtherCAT IO, examples 5-1, 5-4, 5-5) and chapter 13 entries 7, 11-14, 33, 44,
+45, 56, 78-80, 84, 96, 104, 129, 136.
+
+Decisions where the manual is silent:
+
+* ``GT_InitEcatComm`` reads the ENI, scans, compares and brings the slaves to
+  SAFEOP before it returns (so -8/-9/-10 come back from it, as the manual
+  lists); OP follows a few cycles later, so ``GT_IsEcatReady`` first reports 0
+  and the manual's polling loop (example 5-5) is meaningful.
+* ``GT_StartEcatComm`` returns 1 until the bus is ready (the manual: motion
+  instructions only after it succeeds).
+* Raw data and EtherCAT IO before ``GT_InitEcatComm`` return 1 ("check the
+  EtherCAT communication", manual entries 44/104); out-of-range offsets or
+  sizes return 7 and change nothing.
+* ``GT_EcatIOReadInput`` may read any byte of the slave's region (outputs then
+  inputs, manual 5.2.2.5); ``GT_EcatIOWriteOutput`` only its output bytes.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from typing import Any
+
+from drives.abort import SdoAbort
+from drives.slave import AlState
+
+from .. import __version__
+from ..controller import Controller, Options
+from ..errors import BusError, CommandError, ParameterError
+from . import _core
+from ._core import (
+    SESSION,
+    check_range,
+    fail,
+    gt_function,
+    load_bytes,
+    store,
+    store_bytes,
+)
+
+
+class TSlaveInfo(ctypes.Structure):
+    """What ``GT_GetEcatSlaveInfo`` reports for one slave.
+
+    The vendor header's layout is not public; this is ours, documented here:
+    bus position, identity (ETG.1000.6 0x1018 / ESI), AL state (1 INIT, 2 PREOP,
+    4 SAFEOP, 8 OP), the GT axes it carries, and its GT raw region.
+    """
+
+    _fields_ = [
+        ("position", ctypes.c_short),
+        ("vendorId", ctypes.c_uint32),
+        ("productCode", ctypes.c_uint32),
+        ("revisionNo", ctypes.c_uint32),
+        ("serialNo", ctypes.c_uint32),
+        ("state", ctypes.c_short),
+        ("axisCount", ctypes.c_short),
+        ("firstAxis", ctypes.c_short),
+        ("outputBytes", ctypes.c_ushort),
+        ("inputBytes", ctypes.c_ushort),
+        ("pdoOffset", ctypes.c_ushort),
+        ("name", ctypes.c_char * 64),
+    ]
+
+
+# --- controller -----------------------------------------------------------------------
+@gt_function
+def GT_Open(channel: int = 0, param: int = 1, *, eni: str | None = None,
+            machine: Any = None, clock: str | None = None, backend: str | None = None,
+            iface: str | None = None, cycle_ms: float | None = None,
+            call_latency_us: float = 50.0, log: str | None = None,
+            bus: str | None = None, op_delay_cycles: int = 10) -> int:
+    """Open the (emulated) controller.  Keyword options override ``GTECAT_*``."""
+    if 1 in SESSION.controllers:
+        fail(_core.CMD_OPEN, "the controller is already open (GT_Open called twice; "
+             "call GT_Close first)")
+    SESSION.controllers[1] = Controller(Options(
+        eni=eni, machine=machine, clock=clock, backend=backend, iface=iface,
+        cycle_ms=cycle_ms, call_latency_us=call_latency_us, log=log, bus=bus,
+        op_delay_cycles=op_delay_cycles,
+    ))
+    return 0
+
+
+@gt_function
+def GT_Close() -> int:
+    ctl = SESSION.controllers.pop(1, None)
+    if ctl is not None:
+        ctl.close()
+    return 0
+
+
+@gt_function
+def GT_Reset(ctl: Controller) -> int:
+    """Reset the controller: clock from 0, axis resources to their defaults (table 4-4)."""
+    ctl.reset_clock()
+    for hook in getattr(ctl, "on_reset", []):
+        hook(ctl)
+    return 0
+
+
+@gt_function
+def GT_GetClock(ctl: Controller, pClock: Any, pLoop: Any = None) -> int:
+    """Controller milliseconds since ``GT_Reset`` (manual 11.4); pLoop = cycles run."""
+    store(pClock, ctl.clock_ms() & 0xFFFFFFFF)
+    store(pLoop, ctl.clock.cycles & 0xFFFFFFFF)
+    return 0
+
+
+@gt_function
+def GT_GetVersion(ctl: Controller, pVersion: Any) -> int:
+    text = f"gtecat {__version__} emulated iDEABOX ({ctl.options.backend})".encode()
+    store_bytes(pVersion, text + b"\0")
+    return 0
+
+
+# --- EtherCAT bring-up ------------------------------------------------------------------------
+@gt_function
+def GT_InitEcatComm(ctl: Controller) -> int:
+    """0 ok; -8 slaves differ from the ENI; -9 no ENI; -10 no slave found (entry 79)."""
+    ctl.init_ecat()
+    return 0
+
+
+@gt_function
+def GT_StartEcatComm(ctl: Controller) -> int:
+    ctl.start_ecat()
+    return 0
+
+
+@gt_function
+def GT_TerminateEcatComm(ctl: Controller) -> int:
+    ctl.terminate_ecat()
+    return 0
+
+
+@gt_function
+def GT_IsEcatReady(ctl: Controller, pStatus: Any) -> int:
+    """*pStatus = 1 once every slave is in OP with a good working counter (entry 80)."""
+    store(pStatus, 1 if ctl.ready else 0)
+    return 0
+
+
+@gt_function
+def GT_GetEcatSlaves(ctl: Controller, pSlaveCnt: Any, pIoSlaveCnt: Any = None) -> int:
+    """One pointer (manual): online slaves.  Two (vendor header): motion slaves, IO slaves."""
+    m = ctl.master
+    if m is None:
+        online, motion, io = 0, 0, 0
+    else:
+        states = m.refresh_states()
+        online = sum(1 for s in states if s not in (AlState.NONE,))
+        motion = sum(1 for s in m.layout.slaves if s.channels)
+        io = len(m.layout.slaves) - motion
+    if pIoSlaveCnt is None:
+        store(pSlaveCnt, online)
+    else:
+        store(pSlaveCnt, motion)
+        store(pIoSlaveCnt, io)
+    return 0
+
+
+@gt_function
+def GT_GetMcEcatAxisNum(ctl: Controller, pNum: Any) -> int:
+    store(pNum, len(ctl.layout.axes) if ctl.layout is not None else 0)
+    return 0
+
+
+@gt_function
+def GT_GetEcatPdoLength(ctl: Controller, pLength: Any) -> int:
+    """Total length in bytes of the GT raw PDO image (outputs + inputs of every slave)."""
+    m = ctl.require_master()
+    store(pLength, m.image.size)
+    return 0
+
+
+@gt_function
+def GT_GetEcatSlaveInfo(ctl: Controller, slave: int, pInfo: Any) -> int:
+    m = ctl.require_master()
+    slave = check_range("slave", slave, 0, len(m.layout.slaves) - 1)
+    sl = m.layout.slaves[slave]
+    cfg = m.layout.config.slaves[slave]
+    state = m.refresh_states()[slave]
+    info = TSlaveInfo(
+        position=slave, vendorId=cfg.identity.vendor_id, productCode=cfg.identity.product_code,
+        revisionNo=cfg.identity.revision_no, serialNo=cfg.identity.serial_no, state=int(state),
+        axisCount=len(sl.axes), firstAxis=sl.axes[0] if sl.axes else 0,
+        outputBytes=sl.out_bytes, inputBytes=sl.in_bytes, pdoOffset=sl.gt_offset,
+        name=cfg.name.encode("utf-8", "replace")[:63],
+    )
+    store_bytes(pInfo, bytes(info))
+    return 0
+
+
+# --- raw PDO data (5.2.2.4) -----------------------------------------------------------------
+def _image(ctl: Controller):
+    m = ctl.master
+    if m is None or not m.opened:
+        raise CommandError("EtherCAT communication is not established (call GT_InitEcatComm "
+                           "and wait for GT_IsEcatReady)")
+    return m.image
+
+
+@gt_function
+def GT_GetEcatRawData(ctl: Controller, offset: int, size: int, pValue: Any) -> int:
+    image = _image(ctl)
+    data = image.read_raw(int(offset), int(size))
+    store_bytes(pValue, data)
+    return 0
+
+
+@gt_function
+def GT_SetEcatRawData(ctl: Controller, offset: int, size: int, pValue: Any) -> int:
+    image = _image(ctl)
+    image.check_range(int(offset), int(size))
+    image.write_raw(int(offset), load_bytes(pValue, int(size)))
+    return 0
+
+
+# --- EtherCAT IO (5.2.2.5) ------------------------------------------------------------------------
+def _region(ctl: Controller, slave: int, offset: int, size: int) -> tuple[Any, int]:
+    image = _image(ctl)
+    slaves = image.layout.slaves
+    slave = check_range("slave", slave, 0, len(slaves) - 1)
+    sl = slaves[slave]
+    if offset < 0 or size < 0 or offset + size > sl.gt_size:
+        raise ParameterError(
+            f"slave {slave} ({sl.name}): offset={offset} size={size} outside its "
+            f"{sl.gt_size}-byte region ({sl.out_bytes} output + {sl.in_bytes} input bytes)"
+        )
+    return image, sl.gt_offset + offset
+
+
+@gt_function
+def GT_EcatIOReadInput(ctl: Controller, slave: int, offset: int, nSize: int, pValue: Any) -> int:
+    image, raw = _region(ctl, int(slave), int(offset), int(nSize))
+    store_bytes(pValue, image.read_raw(raw, int(nSize)))
+    return 0
+
+
+@gt_function
+def GT_EcatIOWriteOutput(ctl: Controller, slave: int, offset: int, nSize: int,
+                         pValue: Any) -> int:
+    image, raw = _region(ctl, int(slave), int(offset), int(nSize))
+    image.write_raw(raw, load_bytes(pValue, int(nSize)))
+    return 0
+
+
+@gt_function
+def GT_EcatIOBitWriteOutput(ctl: Controller, slave: int, offset: int, bit: int,
+                            value: int) -> int:
+    """Set one output bit: byte ``offset`` of the slave's region, ``bit`` 0..7 (vendor header)."""
+    bit = check_range("bit", bit, 0, 7)
+    image, raw = _region(ctl, int(slave), int(offset), 1)
+    cur = image.read_raw(raw, 1)[0]
+    new = (cur | (1 << bit)) if value else (cur & ~(1 << bit))
+    image.write_raw(raw, bytes([new & 0xFF]))
+    return 0
+
+
+@gt_function
+def GT_EcatIOSynch(ctl: Controller) -> int:
+    """Wait until the outputs written so far have been exchanged with the slaves.
+
+    The vendor header has it without documentation; here it runs the clock to
+    the end of the next bus cycle (virtual clocks) so the outputs are on the
+    bus and inputs read afterwards are fresh.
+    """
+    _image(ctl)
+    ctl.clock.advance_ns(ctl.clock.cycle_ns)
+    return 0
+
+
+# --- SDO (entries 13, 14) --------------------------------------------------------------------------
+@gt_function
+def GT_EcatSDODownload(ctl: Controller, slave_position: int, index: int, subindex: int,
+                       pData: Any, data_size: int, pAbort_code: Any = None) -> int:
+    m = ctl.require_master()
+    check_range("index", index, 0, 0xFFFF)
+    check_range("subindex", subindex, 0, 0xFF)
+    data = load_bytes(pData, check_range("data_size", data_size, 0, 1 << 20))
+    store(pAbort_code, 0)
+    try:
+        m.sdo_download(int(slave_position), int(index), int(subindex), data)
+    except SdoAbort as e:
+        store(pAbort_code, int(e.code))
+        raise
+    return 0
+
+
+@gt_function
+def GT_EcatSDOUpload(ctl: Controller, slave_position: int, index: int, subindex: int,
+                     pTarget: Any, target_size: int, pResult_size: Any = None,
+                     pAbort_code: Any = None) -> int:
+    m = ctl.require_master()
+    check_range("index", index, 0, 0xFFFF)
+    check_range("subindex", subindex, 0, 0xFF)
+    target_size = check_range("target_size", target_size, 0, 1 << 20)
+    store(pAbort_code, 0)
+    try:
+        data = m.sdo_upload(int(slave_position), int(index), int(subindex))
+    except SdoAbort as e:
+        store(pAbort_code, int(e.code))
+        raise
+    if len(data) > target_size:
+        store(pResult_size, len(data))
+        raise ParameterError(
+            f"0x{index:04X}:{subindex:02X} holds {len(data)} bytes, target_size is {target_size}"
+        )
+    store_bytes(pTarget, data)
+    store(pResult_size, len(data))
+    return 0
+
+
+# --- emulator-only helpers -------------------------------------------------------------------------------
+@gt_function
+def GTE_Wait(ctl: Controller, ms: float) -> int:
+    """Let ``ms`` of controller time pass, in any clock mode (DESIGN.md)."""
+    ctl.wait_ms(float(ms))
+    return 0
+
+
+def GTE_GetLastError() -> str:
+    """The reason of the last non-zero return ("" if none)."""
+    e = _core.last_error()
+    return "" if e is None else f"{e.function} returned {e.code}: {e.reason}"
+
+
+def GTE_Controller(core: int = 1) -> Controller:
+    """The open controller (the Pythonic API) for scenarios and tests."""
+    return SESSION.controller(core)
+
+
+def GTE_Slave(slave: int, core: int = 1):
+    """The virtual slave at ``slave`` (emulated backend): its field side for scenarios."""
+    ctl = SESSION.controller(core)
+    backend = ctl.backend
+    if backend is None or not hasattr(backend, "slaves"):
+        raise BusError("no emulated bus is open (GT_InitEcatComm first)")
+    try:
+        return backend.slaves[slave]
+    except IndexError:
+        raise ParameterError(f"no slave {slave}") from None
+
+
+GT_EcatSDOupload = GT_EcatSDOUpload  # the manual's prototype spells it so
+GTN_EcatSDOupload = _core.REGISTRY["GTN_EcatSDOUpload"]
