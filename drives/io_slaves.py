@@ -65,8 +65,15 @@ class IoSlave(VirtualSlave):
                     if not e.is_padding:
                         self.points.setdefault(
                             (direction, e.index, e.subindex),
-                            IoPoint(direction, e.index, e.subindex, bit, e.bit_len, e.name,
-                                    e.data_type.upper() in _SIGNED_TYPES),
+                            IoPoint(
+                                direction,
+                                e.index,
+                                e.subindex,
+                                bit,
+                                e.bit_len,
+                                e.name,
+                                e.data_type.upper() in _SIGNED_TYPES,
+                            ),
                         )
                     bit += e.bit_len
         self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
@@ -110,7 +117,9 @@ class IoSlave(VirtualSlave):
             raise ValueError(f"slave {self.position}: no input bit {in_bit}")
         self._wires.append((out_bit, in_bit))
 
-    def wire_objects(self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None) -> None:
+    def wire_objects(
+        self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None
+    ) -> None:
         """Wire a whole output object to an input object (bit for bit)."""
         po = self.point(Direction.OUT, *out)
         pi = self.point(Direction.IN, *inp)

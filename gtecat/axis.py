@@ -2,7 +2,7 @@
 
 One :class:`Axis` per GT axis (1-based, counting CiA-402 channels in bus
 order, DESIGN.md).  It owns the channel's controlword while the controller
-drives it: every cycle it writes 6040h and, when the drive is enabled in
+drives it: it writes 6040h whenever its command changes and, when the drive is enabled in
 cyclic synchronous position mode, the planned position to 607Ah - "a planned
 position every cycle", as the real controller does.
 
@@ -28,15 +28,28 @@ from .errors import CommandError
 from .image import EntryAccess, ProcessImage
 
 OBJECT_NAMES = {
-    0x603F: "error code", 0x6040: "controlword", 0x6041: "statusword",
-    0x6060: "modes of operation", 0x6061: "modes of operation display",
-    0x6064: "position actual value", 0x606C: "velocity actual value",
-    0x6071: "target torque", 0x6077: "torque actual value", 0x6078: "current actual value",
-    0x607A: "target position", 0x60B8: "touch probe function", 0x60B9: "touch probe status",
-    0x60BA: "touch probe 1 positive edge", 0x60BB: "touch probe 1 negative edge",
-    0x60BC: "touch probe 2 positive edge", 0x60BD: "touch probe 2 negative edge",
-    0x60F4: "following error actual value", 0x60FD: "digital inputs",
-    0x60FE: "digital outputs", 0x60FF: "target velocity", 0x20F2: "analog input 1",
+    0x603F: "error code",
+    0x6040: "controlword",
+    0x6041: "statusword",
+    0x6060: "modes of operation",
+    0x6061: "modes of operation display",
+    0x6064: "position actual value",
+    0x606C: "velocity actual value",
+    0x6071: "target torque",
+    0x6077: "torque actual value",
+    0x6078: "current actual value",
+    0x607A: "target position",
+    0x60B8: "touch probe function",
+    0x60B9: "touch probe status",
+    0x60BA: "touch probe 1 positive edge",
+    0x60BB: "touch probe 1 negative edge",
+    0x60BC: "touch probe 2 positive edge",
+    0x60BD: "touch probe 2 negative edge",
+    0x60F4: "following error actual value",
+    0x60FD: "digital inputs",
+    0x60FE: "digital outputs",
+    0x60FF: "target velocity",
+    0x20F2: "analog input 1",
     0x20F9: "analog input 2",
 }
 
@@ -94,9 +107,14 @@ _ENABLE_STEP = {
 class AxisIo:
     """Typed access to the mapped objects of one channel, SDO for the rest."""
 
-    def __init__(self, image: ProcessImage, layout: Layout, ref: AxisRef,
-                 sdo_upload: Callable[[int, int, int], bytes] | None = None,
-                 sdo_download: Callable[[int, int, int, bytes], None] | None = None) -> None:
+    def __init__(
+        self,
+        image: ProcessImage,
+        layout: Layout,
+        ref: AxisRef,
+        sdo_upload: Callable[[int, int, int], bytes] | None = None,
+        sdo_download: Callable[[int, int, int, bytes], None] | None = None,
+    ) -> None:
         self.ref = ref
         self.slave = ref.slave
         self.channel = ref.channel
@@ -186,6 +204,7 @@ class Axis:
         self.prf_pos = 0.0  # planned position, pulses
         self.drive_offset = 0  # drive counts at planned position 0
         self.cw = 0  # controlword the controller sends
+        self._cw_sent = -1
         self.servo_on = False
         self.csp_follow = True  # write 607A from prf_pos while enabled in CSP
         self.timing = ServoTiming()
@@ -233,8 +252,11 @@ class Axis:
         """Before the exchange: hooks plan, then controlword and 607A go out."""
         for h in self.pre_hooks:
             h(self, t_ns, dt_ns)
-        if self._cw_acc is not None:
+        if self._cw_acc is not None and self.cw != self._cw_sent:
+            # the controller writes 6040h when it changes its command, so a user's raw
+            # write of the controlword (GT_SetEcatRawData) stands until then
             self._cw_acc.set(self.cw)
+            self._cw_sent = self.cw
         if self._tp_acc is not None:
             if self.servo_on and self.csp_follow and self.mode_cmd == 8:
                 self._tp_acc.set(self.pulses_to_counts(self.prf_pos))
@@ -264,5 +286,9 @@ class Axis:
 
     def request_disable(self) -> None:
         self.servo_on = False
-        self.cw = 0x0006 if self.state in (PdsState.OPERATION_ENABLED, PdsState.SWITCHED_ON,
-                                           PdsState.READY_TO_SWITCH_ON) else 0x0000
+        self.cw = (
+            0x0006
+            if self.state
+            in (PdsState.OPERATION_ENABLED, PdsState.SWITCHED_ON, PdsState.READY_TO_SWITCH_ON)
+            else 0x0000
+        )

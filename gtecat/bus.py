@@ -39,17 +39,27 @@ class CycleResult:
 
 
 def _transition(a: AlState, b: AlState) -> str:
-    letter = {AlState.INIT: "I", AlState.PREOP: "P", AlState.SAFEOP: "S", AlState.OP: "O",
-              AlState.BOOT: "B"}
+    letter = {
+        AlState.INIT: "I",
+        AlState.PREOP: "P",
+        AlState.SAFEOP: "S",
+        AlState.OP: "O",
+        AlState.BOOT: "B",
+    }
     return letter[a] + letter[b]
 
 
 class Master:
     """One EtherCAT master on one backend."""
 
-    def __init__(self, layout: Layout, backend: Backend, *,
-                 log: Callable[[str], None] = lambda _m: None,
-                 op_delay_cycles: int = 10) -> None:
+    def __init__(
+        self,
+        layout: Layout,
+        backend: Backend,
+        *,
+        log: Callable[[str], None] = lambda _m: None,
+        op_delay_cycles: int = 10,
+    ) -> None:
         self.layout = layout
         self.backend = backend
         self.image = ProcessImage(layout)
@@ -81,9 +91,11 @@ class Master:
         expected = self.layout.config.slaves
         for cfg, got in zip(expected, found, strict=False):
             e, g = cfg.identity, got.identity
-            for what, a, b in (("vendor id", e.vendor_id, g.vendor_id),
-                               ("product code", e.product_code, g.product_code),
-                               ("revision", e.revision_no, g.revision_no)):
+            for what, a, b in (
+                ("vendor id", e.vendor_id, g.vendor_id),
+                ("product code", e.product_code, g.product_code),
+                ("revision", e.revision_no, g.revision_no),
+            ):
                 if a and a != b:
                     raise ConfigMismatch(
                         f"slave {cfg.position}: ENI expects {cfg.name!r} {what} 0x{a:08X}, "
@@ -92,8 +104,11 @@ class Master:
         if len(found) != len(expected):
             raise ConfigMismatch(
                 f"ENI lists {len(expected)} slaves, the bus has {len(found)}"
-                + (f" (first missing: slave {len(found)} {expected[len(found)].name!r})"
-                   if len(found) < len(expected) else "")
+                + (
+                    f" (first missing: slave {len(found)} {expected[len(found)].name!r})"
+                    if len(found) < len(expected)
+                    else ""
+                )
             )
         self.opened = True
         self._walk(AlState.PREOP)
@@ -117,8 +132,10 @@ class Master:
             code = self.backend.request_state(pos, target)
             if code:
                 state, _ = self.backend.state(pos)
-                msg = (f"slave {pos} ({cfg.name}): {tr} refused, AL status code "
-                       f"0x{int(code):04X} {_code_name(code)}; stays in {state.name}")
+                msg = (
+                    f"slave {pos} ({cfg.name}): {tr} refused, AL status code "
+                    f"0x{int(code):04X} {_code_name(code)}; stays in {state.name}"
+                )
                 self.log(msg)
                 self.error = msg
                 raise StateError(msg, expected=target, actual=state, slave=pos)
@@ -135,9 +152,11 @@ class Master:
             try:
                 self._run_init_cmd(pos, cmd)
             except GtecatError as e:
-                msg = (f"slave {pos} ({cfg.name}): InitCmd {transition} "
-                       f"0x{cmd.index:04X}:{cmd.subindex:02X} "
-                       f"{cmd.comment or ''} failed: {e}").replace("  ", " ")
+                msg = (
+                    f"slave {pos} ({cfg.name}): InitCmd {transition} "
+                    f"0x{cmd.index:04X}:{cmd.subindex:02X} "
+                    f"{cmd.comment or ''} failed: {e}"
+                ).replace("  ", " ")
                 self.log(msg)
                 self.error = msg
                 raise StateError(msg, expected=transition, slave=pos) from e
@@ -146,8 +165,7 @@ class Master:
         if cmd.upload:
             self.backend.sdo_upload(pos, cmd.index, cmd.subindex, cmd.complete_access)
         else:
-            self.backend.sdo_download(pos, cmd.index, cmd.subindex, cmd.data,
-                                      cmd.complete_access)
+            self.backend.sdo_download(pos, cmd.index, cmd.subindex, cmd.data, cmd.complete_access)
 
     def request_op(self) -> None:
         """SO InitCmds and the OP request (made automatically after the delay)."""
@@ -208,13 +226,15 @@ class Master:
         return self.states
 
     # --- mailbox ------------------------------------------------------------------------
-    def sdo_upload(self, pos: int, index: int, subindex: int,
-                   complete_access: bool = False) -> bytes:
+    def sdo_upload(
+        self, pos: int, index: int, subindex: int, complete_access: bool = False
+    ) -> bytes:
         self._check_slave(pos)
         return self.backend.sdo_upload(pos, index, subindex, complete_access)
 
-    def sdo_download(self, pos: int, index: int, subindex: int, data: bytes,
-                     complete_access: bool = False) -> None:
+    def sdo_download(
+        self, pos: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
         self._check_slave(pos)
         self.backend.sdo_download(pos, index, subindex, data, complete_access)
 

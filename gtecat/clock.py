@@ -16,10 +16,10 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 
 
-class ClockMode(str, Enum):
+class ClockMode(StrEnum):
     LOCKSTEP = "lockstep"
     AUTO = "auto"
     REALTIME = "realtime"
@@ -133,8 +133,9 @@ class Clock:
         if self.mode is not ClockMode.REALTIME or self._thread is not None:
             return
         self._stop.clear()
-        self._thread = threading.Thread(target=self._realtime_loop, name="gtecat-cycle",
-                                        daemon=True)
+        self._thread = threading.Thread(
+            target=self._realtime_loop, name="gtecat-cycle", daemon=True
+        )
         self._thread.start()
 
     def stop_realtime(self) -> None:

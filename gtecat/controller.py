@@ -77,8 +77,12 @@ class Controller:
                 f"backend {self.options.backend!r} unknown; use emulated or pysoem"
             )
         cycle_ns = round((self.options.cycle_ms or 1.0) * 1_000_000)
-        self.clock = Clock(self._cycle, cycle_ns=cycle_ns, mode=mode,
-                           call_latency_ns=round(self.options.call_latency_us * 1000))
+        self.clock = Clock(
+            self._cycle,
+            cycle_ns=cycle_ns,
+            mode=mode,
+            call_latency_ns=round(self.options.call_latency_us * 1000),
+        )
         self._cycle_fixed = self.options.cycle_ms is not None
         self.log = MasterLog(self.options.log, clock_ms=lambda: self.clock.now_ms)
         self.machine = self._load_machine(self.options.machine)
@@ -130,13 +134,13 @@ class Controller:
         backend = self._make_backend()
         if self.master is not None:
             self.terminate_ecat()
-        master = Master(layout, backend, log=self.log,
-                        op_delay_cycles=self.options.op_delay_cycles)
+        master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
         self.layout, self.backend, self.master = layout, backend, master
         self.started = False
         self.axes = {
-            ref.axis: Axis(ref.axis, AxisIo(master.image, layout, ref,
-                                            master.sdo_upload, master.sdo_download))
+            ref.axis: Axis(
+                ref.axis, AxisIo(master.image, layout, ref, master.sdo_upload, master.sdo_download)
+            )
             for ref in layout.axes
         }
         self._axis_list = list(self.axes.values())
@@ -219,7 +223,8 @@ class Controller:
             if not self.axes:
                 raise ParameterError(
                     f"axis {n}: no EtherCAT axis exists (bus not initialised or no CiA-402 "
-                    "slave in the ENI)")
+                    "slave in the ENI)"
+                )
             raise ParameterError(f"axis {n} out of range 1..{max(self.axes)}")
         return ax
 

@@ -24,8 +24,14 @@ class NoSlavesError(BusError):
 class StateError(BusError):
     """A slave is not in the state a request needs."""
 
-    def __init__(self, message: str, *, expected: object = None, actual: object = None,
-                 slave: int | None = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        *,
+        expected: object = None,
+        actual: object = None,
+        slave: int | None = None,
+    ) -> None:
         super().__init__(message)
         self.expected = expected
         self.actual = actual

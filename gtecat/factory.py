@@ -16,8 +16,9 @@ from drives.slave import VirtualSlave
 from eni.layout import Layout
 
 
-def build_slave(layout: Layout, position: int,
-                machine: MachineDescription | None = None) -> VirtualSlave:
+def build_slave(
+    layout: Layout, position: int, machine: MachineDescription | None = None
+) -> VirtualSlave:
     machine = machine or MachineDescription()
     sl = layout.slaves[position]
     cfg = layout.config.slaves[position]
@@ -31,12 +32,15 @@ def build_slave(layout: Layout, position: int,
             for k in range(channels)
         ]
         return Cia402Drive(
-            cfg.position, cfg.name, cfg.identity,
-            rx_pdos=cfg.rx_pdos, tx_pdos=cfg.tx_pdos,
-            channels=channels, machines=machines,
+            cfg.position,
+            cfg.name,
+            cfg.identity,
+            rx_pdos=cfg.rx_pdos,
+            tx_pdos=cfg.tx_pdos,
+            channels=channels,
+            machines=machines,
         )
-    return IoSlave(cfg.position, cfg.name, cfg.identity,
-                   rx_pdos=cfg.rx_pdos, tx_pdos=cfg.tx_pdos)
+    return IoSlave(cfg.position, cfg.name, cfg.identity, rx_pdos=cfg.rx_pdos, tx_pdos=cfg.tx_pdos)
 
 
 def build_slaves(layout: Layout, machine: MachineDescription | None = None) -> list[VirtualSlave]:

@@ -95,13 +95,25 @@ class ProcessImage:
         for s in layout.slaves:
             if s.out_bytes:
                 self.segments.append(
-                    Segment(s.position, Direction.OUT, s.gt_offset, s.out_bytes,
-                            s.out_logical_bit or 0, s.out_bits)
+                    Segment(
+                        s.position,
+                        Direction.OUT,
+                        s.gt_offset,
+                        s.out_bytes,
+                        s.out_logical_bit or 0,
+                        s.out_bits,
+                    )
                 )
             if s.in_bytes:
                 self.segments.append(
-                    Segment(s.position, Direction.IN, s.gt_offset + s.out_bytes, s.in_bytes,
-                            s.in_logical_bit or 0, s.in_bits)
+                    Segment(
+                        s.position,
+                        Direction.IN,
+                        s.gt_offset + s.out_bytes,
+                        s.in_bytes,
+                        s.in_logical_bit or 0,
+                        s.in_bits,
+                    )
                 )
         self.aligned = all(seg.aligned for seg in self.segments)
         # raw byte k -> index in self.buffer (aligned case) and "is an output byte"

@@ -55,13 +55,15 @@ class Backend(ABC):
         """The working counter of a healthy cycle with every slave in OP."""
 
     @abstractmethod
-    def sdo_upload(self, position: int, index: int, subindex: int,
-                   complete_access: bool = False) -> bytes:
+    def sdo_upload(
+        self, position: int, index: int, subindex: int, complete_access: bool = False
+    ) -> bytes:
         """CoE SDO upload; raises :class:`drives.abort.SdoAbort`."""
 
     @abstractmethod
-    def sdo_download(self, position: int, index: int, subindex: int, data: bytes,
-                     complete_access: bool = False) -> None:
+    def sdo_download(
+        self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
         """CoE SDO download; raises :class:`drives.abort.SdoAbort`."""
 
     def close(self) -> None:  # noqa: B027 - optional hook

@@ -24,9 +24,12 @@ from .base import Backend, FoundSlave
 class EmulatedBackend(Backend):
     name = "emulated"
 
-    def __init__(self, machine: MachineDescription | None = None,
-                 slaves: list[VirtualSlave] | None = None,
-                 hardware: Layout | None = None) -> None:
+    def __init__(
+        self,
+        machine: MachineDescription | None = None,
+        slaves: list[VirtualSlave] | None = None,
+        hardware: Layout | None = None,
+    ) -> None:
         """``hardware``: the layout of the virtual hardware when it differs from the
         master's ENI (to test what a mismatch does); default: the ENI itself."""
         self.machine = machine or MachineDescription()
@@ -113,17 +116,20 @@ class EmulatedBackend(Backend):
             self._clients[position] = client
         return client
 
-    def sdo_upload(self, position: int, index: int, subindex: int,
-                   complete_access: bool = False) -> bytes:
+    def sdo_upload(
+        self, position: int, index: int, subindex: int, complete_access: bool = False
+    ) -> bytes:
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
         return self._client(position).upload(index, subindex, complete_access=complete_access)
 
-    def sdo_download(self, position: int, index: int, subindex: int, data: bytes,
-                     complete_access: bool = False) -> None:
+    def sdo_download(
+        self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
-        self._client(position).download(index, subindex, bytes(data),
-                                        complete_access=complete_access)
+        self._client(position).download(
+            index, subindex, bytes(data), complete_access=complete_access
+        )

@@ -56,11 +56,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"error: {e}", file=sys.stderr)
         return 1
-    except Exception as e:  # noqa: BLE001 - one clear line, never a traceback by default
+    except Exception as e:  # one clear line, never a traceback by default
         if args.debug:
             raise
-        print(f"error: internal error: {type(e).__name__}: {e} (run with --debug for details)",
-              file=sys.stderr)
+        print(
+            f"error: internal error: {type(e).__name__}: {e} (run with --debug for details)",
+            file=sys.stderr,
+        )
         return 1
 
 

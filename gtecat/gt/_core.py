@@ -151,7 +151,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         except TypeError as e:
             rc = CMD_PARAM
             _record(name, rc, f"bad arguments: {e}")
-        except Exception as e:  # noqa: BLE001 - the GT layer never raises
+        except Exception as e:  # the GT layer never raises
             rc = code_for(e)
             if rc == CMD_NO_RESPONSE:
                 log.error("%s: internal error\n%s", name, traceback.format_exc())

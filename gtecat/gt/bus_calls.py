@@ -66,22 +66,43 @@ class TSlaveInfo(ctypes.Structure):
     ]
 
 
-# --- controller -----------------------------------------------------------------------
+# --- controller ----------
 @gt_function
-def GT_Open(channel: int = 0, param: int = 1, *, eni: str | None = None,
-            machine: Any = None, clock: str | None = None, backend: str | None = None,
-            iface: str | None = None, cycle_ms: float | None = None,
-            call_latency_us: float = 50.0, log: str | None = None,
-            bus: str | None = None, op_delay_cycles: int = 10) -> int:
+def GT_Open(
+    channel: int = 0,
+    param: int = 1,
+    *,
+    eni: str | None = None,
+    machine: Any = None,
+    clock: str | None = None,
+    backend: str | None = None,
+    iface: str | None = None,
+    cycle_ms: float | None = None,
+    call_latency_us: float = 50.0,
+    log: str | None = None,
+    bus: str | None = None,
+    op_delay_cycles: int = 10,
+) -> int:
     """Open the (emulated) controller.  Keyword options override ``GTECAT_*``."""
     if 1 in SESSION.controllers:
-        fail(_core.CMD_OPEN, "the controller is already open (GT_Open called twice; "
-             "call GT_Close first)")
-    SESSION.controllers[1] = Controller(Options(
-        eni=eni, machine=machine, clock=clock, backend=backend, iface=iface,
-        cycle_ms=cycle_ms, call_latency_us=call_latency_us, log=log, bus=bus,
-        op_delay_cycles=op_delay_cycles,
-    ))
+        fail(
+            _core.CMD_OPEN,
+            "the controller is already open (GT_Open called twice; call GT_Close first)",
+        )
+    SESSION.controllers[1] = Controller(
+        Options(
+            eni=eni,
+            machine=machine,
+            clock=clock,
+            backend=backend,
+            iface=iface,
+            cycle_ms=cycle_ms,
+            call_latency_us=call_latency_us,
+            log=log,
+            bus=bus,
+            op_delay_cycles=op_delay_cycles,
+        )
+    )
     return 0
 
 
@@ -185,22 +206,31 @@ def GT_GetEcatSlaveInfo(ctl: Controller, slave: int, pInfo: Any) -> int:
     cfg = m.layout.config.slaves[slave]
     state = m.refresh_states()[slave]
     info = TSlaveInfo(
-        position=slave, vendorId=cfg.identity.vendor_id, productCode=cfg.identity.product_code,
-        revisionNo=cfg.identity.revision_no, serialNo=cfg.identity.serial_no, state=int(state),
-        axisCount=len(sl.axes), firstAxis=sl.axes[0] if sl.axes else 0,
-        outputBytes=sl.out_bytes, inputBytes=sl.in_bytes, pdoOffset=sl.gt_offset,
+        position=slave,
+        vendorId=cfg.identity.vendor_id,
+        productCode=cfg.identity.product_code,
+        revisionNo=cfg.identity.revision_no,
+        serialNo=cfg.identity.serial_no,
+        state=int(state),
+        axisCount=len(sl.axes),
+        firstAxis=sl.axes[0] if sl.axes else 0,
+        outputBytes=sl.out_bytes,
+        inputBytes=sl.in_bytes,
+        pdoOffset=sl.gt_offset,
         name=cfg.name.encode("utf-8", "replace")[:63],
     )
     store_bytes(pInfo, bytes(info))
     return 0
 
 
-# --- raw PDO data (5.2.2.4) -----------------------------------------------------------------
+# --- raw PDO data (5.2.2.4) ----------
 def _image(ctl: Controller):
     m = ctl.master
     if m is None or not m.opened:
-        raise CommandError("EtherCAT communication is not established (call GT_InitEcatComm "
-                           "and wait for GT_IsEcatReady)")
+        raise CommandError(
+            "EtherCAT communication is not established (call GT_InitEcatComm "
+            "and wait for GT_IsEcatReady)"
+        )
     return m.image
 
 
@@ -220,7 +250,7 @@ def GT_SetEcatRawData(ctl: Controller, offset: int, size: int, pValue: Any) -> i
     return 0
 
 
-# --- EtherCAT IO (5.2.2.5) ------------------------------------------------------------------------
+# --- EtherCAT IO (5.2.2.5) ----------
 def _region(ctl: Controller, slave: int, offset: int, size: int) -> tuple[Any, int]:
     image = _image(ctl)
     slaves = image.layout.slaves
@@ -242,16 +272,14 @@ def GT_EcatIOReadInput(ctl: Controller, slave: int, offset: int, nSize: int, pVa
 
 
 @gt_function
-def GT_EcatIOWriteOutput(ctl: Controller, slave: int, offset: int, nSize: int,
-                         pValue: Any) -> int:
+def GT_EcatIOWriteOutput(ctl: Controller, slave: int, offset: int, nSize: int, pValue: Any) -> int:
     image, raw = _region(ctl, int(slave), int(offset), int(nSize))
     image.write_raw(raw, load_bytes(pValue, int(nSize)))
     return 0
 
 
 @gt_function
-def GT_EcatIOBitWriteOutput(ctl: Controller, slave: int, offset: int, bit: int,
-                            value: int) -> int:
+def GT_EcatIOBitWriteOutput(ctl: Controller, slave: int, offset: int, bit: int, value: int) -> int:
     """Set one output bit: byte ``offset`` of the slave's region, ``bit`` 0..7 (vendor header)."""
     bit = check_range("bit", bit, 0, 7)
     image, raw = _region(ctl, int(slave), int(offset), 1)
@@ -274,10 +302,17 @@ def GT_EcatIOSynch(ctl: Controller) -> int:
     return 0
 
 
-# --- SDO (entries 13, 14) --------------------------------------------------------------------------
+# --- SDO (entries 13, 14) ----------
 @gt_function
-def GT_EcatSDODownload(ctl: Controller, slave_position: int, index: int, subindex: int,
-                       pData: Any, data_size: int, pAbort_code: Any = None) -> int:
+def GT_EcatSDODownload(
+    ctl: Controller,
+    slave_position: int,
+    index: int,
+    subindex: int,
+    pData: Any,
+    data_size: int,
+    pAbort_code: Any = None,
+) -> int:
     m = ctl.require_master()
     check_range("index", index, 0, 0xFFFF)
     check_range("subindex", subindex, 0, 0xFF)
@@ -292,9 +327,16 @@ def GT_EcatSDODownload(ctl: Controller, slave_position: int, index: int, subinde
 
 
 @gt_function
-def GT_EcatSDOUpload(ctl: Controller, slave_position: int, index: int, subindex: int,
-                     pTarget: Any, target_size: int, pResult_size: Any = None,
-                     pAbort_code: Any = None) -> int:
+def GT_EcatSDOUpload(
+    ctl: Controller,
+    slave_position: int,
+    index: int,
+    subindex: int,
+    pTarget: Any,
+    target_size: int,
+    pResult_size: Any = None,
+    pAbort_code: Any = None,
+) -> int:
     m = ctl.require_master()
     check_range("index", index, 0, 0xFFFF)
     check_range("subindex", subindex, 0, 0xFF)
@@ -315,7 +357,7 @@ def GT_EcatSDOUpload(ctl: Controller, slave_position: int, index: int, subindex:
     return 0
 
 
-# --- emulator-only helpers -------------------------------------------------------------------------------
+# --- emulator-only helpers ----------
 @gt_function
 def GTE_Wait(ctl: Controller, ms: float) -> int:
     """Let ``ms`` of controller time pass, in any clock mode (DESIGN.md)."""
