@@ -39,15 +39,6 @@ Window = tuple[float, float]
 
 
 @dataclass(frozen=True, slots=True)
-class Edge:
-    """A signal edge crossed during one cycle's travel."""
-
-    position: float  # exact machine position of the edge
-    rising: bool  # signal goes inactive -> active in the direction of travel
-    fraction: float  # where in the cycle's travel (0..1] the edge lies
-
-
-@dataclass(frozen=True, slots=True)
 class AxisMachine:
     """Mechanics around one axis (see the module docstring for the keys)."""
 
@@ -74,13 +65,8 @@ class AxisMachine:
     def probe_active(self, probe: int, pos: float) -> bool:
         return _in_windows(self.probe1 if probe == 1 else self.probe2, pos)
 
-    # --- edges crossed between two samples ---------------------------------
-    def home_edges(self, p0: float, p1: float) -> list[Edge]:
-        return _window_edges(self.home_switch, p0, p1)
-
-    def probe_edges(self, probe: int, p0: float, p1: float) -> list[Edge]:
-        return _window_edges(self.probe1 if probe == 1 else self.probe2, p0, p1)
-
+    # --- index pulses crossed between two samples ----------------------------
+    # (exact edges of the switch windows: drives/signal_edges.py)
     def index_positions(self, p0: float, p1: float) -> list[float]:
         """Index pulse positions in the half-open travel ``(p0, p1]`` (or ``[p1, p0)``),
         in the order they are met."""
@@ -102,10 +88,6 @@ class AxisMachine:
             out.reverse()
         return out
 
-    def index_edges(self, p0: float, p1: float) -> list[Edge]:
-        span = p1 - p0
-        return [Edge(x, True, (x - p0) / span) for x in self.index_positions(p0, p1)]
-
     @property
     def travel(self) -> tuple[float, float]:
         """The usable travel: between the limit switches (or +-1e12 counts)."""
@@ -116,29 +98,6 @@ class AxisMachine:
 
 def _in_windows(windows: Iterable[Window], pos: float) -> bool:
     return any(lo <= pos < hi for lo, hi in windows)
-
-
-def _window_edges(windows: Iterable[Window], p0: float, p1: float) -> list[Edge]:
-    """Edges of ``[low, high)`` windows crossed moving from p0 to p1, in order."""
-    if p0 == p1:
-        return []
-    span = p1 - p0
-    edges: list[Edge] = []
-    for lo, hi in windows:
-        for b in (lo, hi):
-            # the level changes between p0 and p1 when b lies strictly inside the travel
-            # in the half-open sense of the window: moving +, level at x is [lo<=x<hi]
-            crossed = (p0 < b <= p1) if span > 0 else (p1 < b <= p0)
-            if not crossed:
-                continue
-            before = lo <= p0 < hi
-            after_pos = b if span > 0 else b - 1e-9
-            after = lo <= after_pos < hi
-            if before == after:
-                continue
-            edges.append(Edge(float(b), after, (b - p0) / span))
-    edges.sort(key=lambda e: e.fraction)
-    return edges
 
 
 @dataclass(frozen=True, slots=True)

@@ -14,17 +14,6 @@ def test_levels_and_defaults():
     assert AxisMachine().travel == (-1e12, 1e12)
 
 
-def test_edges_exact_inside_a_cycle():
-    m = AxisMachine(home_switch=((10, 20),))
-    (e,) = m.home_edges(8, 12)
-    assert (e.position, e.rising, e.fraction) == (10, True, 0.5)
-    (e,) = m.home_edges(22, 18)
-    assert (e.position, e.rising) == (20, True)
-    (e,) = m.home_edges(12, 8)
-    assert (e.position, e.rising) == (10, False)
-    assert m.home_edges(12, 18) == []
-
-
 def test_index_positions_repeat_every_revolution():
     m = AxisMachine(index_offset=250, counts_per_rev=1000)
     assert m.index_positions(0, 2500) == [250, 1250, 2250]
