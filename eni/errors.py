@@ -44,6 +44,8 @@ class EniError(GtecatError):
             where = f"line {self.line}: "
         who = ""
         if self.slave is not None:
-            who = f"slave {self.slave}" + (f" ({self.slave_name})" if self.slave_name else "") + ": "
+            who = (
+                f"slave {self.slave}" + (f" ({self.slave_name})" if self.slave_name else "") + ": "
+            )
         elem = f"{self.element}: " if self.element else ""
         return f"{where}{who}{elem}{self.message}"

@@ -1,0 +1,121 @@
+"""Read a ``Gecat.eni`` of either family, told apart by content (DESIGN.md "Configuration files").
+
+* ETG.2100 ENI XML: root element ``EtherCATConfig`` (:mod:`eni.xml_reader`);
+* Googol's INI-style file: ``[CommonInfo]`` / ``[SlaveStart]`` sections
+  (:mod:`eni.googol_reader`);
+* ``EncryptedEtherCATConfig`` (TwinCAT's encrypted ENI) is refused: its
+  content cannot be read without the vendor's key.
+
+Both file names and extensions are meaningless here (the real controller calls
+both ``Gecat.eni``); only the bytes decide.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+from .errors import EniError
+from .googol_reader import read_googol
+from .model import EniConfig
+from .xml_reader import read_xml
+from .xmltree import parse_xml
+
+_GOOGOL = re.compile(rb"^\s*\[\s*(CommonInfo|SlaveStart|SlaveIndex|MasterInfo)\s*\]", re.I | re.M)
+_ROOT = re.compile(rb"<\s*(?:[A-Za-z_][\w.-]*:)?([A-Za-z_][\w.-]*)")
+
+
+def _head_bytes(data: bytes | str) -> bytes:
+    if isinstance(data, str):
+        return data[:8192].encode("utf-8", "replace")
+    head = data[:8192]
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 with BOM
+        try:
+            return data[:16384].decode("utf-16").encode("utf-8", "replace")[:8192]
+        except UnicodeDecodeError:
+            return head
+    return head
+
+
+def _root_tag(head: bytes) -> bytes | None:
+    """Name of the first element, skipping the declaration, comments and PIs."""
+    i = 0
+    n = len(head)
+    while i < n:
+        j = head.find(b"<", i)
+        if j < 0:
+            return None
+        if head.startswith(b"<?", j):
+            k = head.find(b"?>", j)
+            i = n if k < 0 else k + 2
+            continue
+        if head.startswith(b"<!--", j):
+            k = head.find(b"-->", j)
+            i = n if k < 0 else k + 3
+            continue
+        if head.startswith(b"<!", j):  # DOCTYPE: let the parser refuse it with its line
+            k = head.find(b">", j)
+            i = n if k < 0 else k + 1
+            continue
+        m = _ROOT.match(head, j)
+        return m.group(1) if m else None
+    return None
+
+
+def detect_format(data: bytes | str) -> str:
+    """``"xml"``, ``"googol"``, ``"encrypted"`` or ``"unknown"``."""
+    head = _head_bytes(data)
+    stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if stripped.startswith(b"<"):
+        tag = _root_tag(stripped)
+        if tag == b"EncryptedEtherCATConfig":
+            return "encrypted"
+        if tag == b"EtherCATConfig":
+            return "xml"
+        if tag is None and b"EtherCATConfig" in stripped:
+            return "xml"
+        return "unknown"
+    if _GOOGOL.search(head):
+        return "googol"
+    return "unknown"
+
+
+def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
+    """Parse configuration text/bytes; ``source`` names it in error messages."""
+    fmt = detect_format(text)
+    if fmt == "xml":
+        root = parse_xml(text, source)
+        if root.tag == "EncryptedEtherCATConfig":
+            fmt = "encrypted"
+        elif root.tag != "EtherCATConfig":
+            raise EniError(
+                f"root element is <{root.tag}>, not <EtherCATConfig>", file=source, line=root.line
+            )
+        else:
+            return read_xml(root, source)
+    if fmt == "encrypted":
+        raise EniError(
+            "this is an EncryptedEtherCATConfig (an encrypted ENI); export it unencrypted "
+            "from the configuration tool",
+            file=source,
+        )
+    if fmt == "googol":
+        return read_googol(text, source)
+    raise EniError(
+        "not an ENI: neither ETG.2100 XML (<EtherCATConfig>) nor a Googol INI Gecat.eni "
+        "([CommonInfo]/[SlaveStart] sections)",
+        file=source,
+    )
+
+
+def read_eni(path: str | os.PathLike[str]) -> EniConfig:
+    """Read and parse a configuration file (either family)."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise EniError(f"cannot read the file: {exc.strerror or exc}", file=str(p)) from None
+    if not data.strip():
+        raise EniError("the file is empty", file=str(p))
+    return parse_eni(data, str(p))

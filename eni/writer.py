@@ -1,0 +1,237 @@
+"""Write an :class:`EniConfig` as ETG.2100 ENI XML (``EtherCATConfig``).
+
+The file holds what :mod:`eni.xml_reader` reads, in the element order of the
+ETG.2100 schema, so ``read(write(cfg)) == cfg`` for every configuration the
+topology builder makes (source and lines aside):
+
+* ``Config/Master/Info``;
+* per slave ``Info`` (name, addresses, identity), ``ProcessData`` with
+  ``Send``/``Recv`` (bit areas in the zero-based logical images), one ``SmN``
+  per sync manager with its ``Pdo`` assignment list, the assigned
+  ``TxPdo``/``RxPdo`` with their entries (``Sm`` attribute set), and
+  ``Mailbox/CoE/InitCmds`` for slaves with a mailbox;
+* ``Cyclic`` (cycle time in microseconds and one LRW command over both images);
+* ``ProcessImage`` with ``ByteSize`` and one ``Variable`` per mapped entry.
+
+Register-level InitCmds (FMMU, SM setup) are not written: the emulated master
+derives them from the process data, as the readers never need them.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable
+from pathlib import Path
+
+from .model import Direction, EniConfig, InitCmd, Pdo, Slave, Variable
+
+LRW = 12  # ETG.1000.4 Table 9: logical read/write
+LOGICAL_BASE = 0x10000000
+# sync manager defaults (ETG.1000.4 6.7, what ESC-based slaves use)
+_SM_DEFAULT = {
+    Direction.OUT: (0x1100, 0x64),  # start address, control byte: 3-buffer, write, watchdog
+    Direction.IN: (0x1400, 0x20),  # 3-buffer, read
+}
+_MBX = ((0x1000, 128), (0x1080, 128))
+
+
+def _hex(v: int, width: int = 4) -> str:
+    return f"#x{v:0{width}x}"
+
+
+def _sub(parent: ET.Element, tag: str, text: object | None = None, **attrib: str) -> ET.Element:
+    el = ET.SubElement(parent, tag, attrib)
+    if text is not None:
+        el.text = str(text)
+    return el
+
+
+def _slave_variables(cfg: EniConfig) -> list[Variable]:
+    """The ProcessImage variables to write: the model's own, else one per stated entry."""
+    if cfg.variables:
+        return list(cfg.variables)
+    out: list[Variable] = []
+    for d in (Direction.IN, Direction.OUT):
+        for s in cfg.slaves:
+            for p in s.rx_pdos if d == Direction.OUT else s.tx_pdos:
+                for e in p.entries:
+                    if not e.is_padding and e.logical_bit is not None:
+                        out.append(
+                            Variable(
+                                f"{s.name}.{p.name}.{e.name}",
+                                d,
+                                e.logical_bit,
+                                e.bit_len,
+                                e.data_type,
+                            )
+                        )
+    return out
+
+
+def _pdo_xml(parent: ET.Element, p: Pdo, sm: int) -> None:
+    el = _sub(
+        parent,
+        "RxPdo" if p.direction == Direction.OUT else "TxPdo",
+        Fixed="1" if p.fixed else "0",
+        Sm=str(sm),
+    )
+    _sub(el, "Index", _hex(p.index))
+    _sub(el, "Name", p.name)
+    for e in p.entries:
+        ent = _sub(el, "Entry")
+        _sub(ent, "Index", _hex(e.index))
+        if not e.is_padding or e.subindex:
+            _sub(ent, "SubIndex", e.subindex)
+        _sub(ent, "BitLen", e.bit_len)
+        if e.name:
+            _sub(ent, "Name", e.name)
+        if e.data_type:
+            _sub(ent, "DataType", e.data_type)
+
+
+def _sm_of(p: Pdo) -> int:
+    if p.sm is not None:
+        return p.sm
+    return 2 if p.direction == Direction.OUT else 3
+
+
+def _process_data(parent: ET.Element, s: Slave) -> None:
+    pd = _sub(parent, "ProcessData")
+    for tag, area in (("Send", s.outputs), ("Recv", s.inputs)):
+        if area is not None:
+            a = _sub(pd, tag)
+            _sub(a, "BitStart", area.bit_start)
+            _sub(a, "BitLength", area.bit_len)
+    by_sm: dict[int, list[Pdo]] = {}
+    for p in (*s.rx_pdos, *s.tx_pdos):
+        by_sm.setdefault(_sm_of(p), []).append(p)
+    for sm in sorted(by_sm):
+        pdos = by_sm[sm]
+        d = pdos[0].direction
+        smel = _sub(pd, f"Sm{sm}")
+        _sub(smel, "Type", "Outputs" if d == Direction.OUT else "Inputs")
+        _sub(smel, "DefaultSize", (sum(p.bit_len for p in pdos) + 7) // 8)
+        start, control = _SM_DEFAULT[d]
+        _sub(smel, "StartAddress", _hex(start))
+        _sub(smel, "ControlByte", _hex(control, 2))
+        _sub(smel, "Enable", 1)
+        for p in pdos:
+            _sub(smel, "Pdo", _hex(p.index))
+    for p in s.tx_pdos:
+        _pdo_xml(pd, p, _sm_of(p))
+    for p in s.rx_pdos:
+        _pdo_xml(pd, p, _sm_of(p))
+
+
+def _init_cmd(parent: ET.Element, c: InitCmd) -> None:
+    attrs = {"Fixed": "1"}
+    if c.complete_access:
+        attrs["CompleteAccess"] = "1"
+    el = _sub(parent, "InitCmd", **attrs)
+    for t in c.transitions:
+        _sub(el, "Transition", t)
+    if c.comment:
+        _sub(el, "Comment", c.comment)
+    _sub(el, "Timeout", c.timeout_ms)
+    _sub(el, "Ccs", 2 if c.upload else 1)
+    _sub(el, "Index", _hex(c.index))
+    _sub(el, "SubIndex", c.subindex)
+    if c.data:
+        _sub(el, "Data", c.data.hex())
+
+
+def _mailbox(parent: ET.Element, s: Slave) -> None:
+    mb = _sub(parent, "Mailbox", DataLinkLayer="true")
+    for tag, (start, length) in zip(("Send", "Recv"), _MBX, strict=True):
+        el = _sub(mb, tag)
+        _sub(el, "Start", _hex(start))
+        _sub(el, "Length", length)
+    _sub(mb, "Protocol", "CoE")
+    coe = _sub(mb, "CoE")
+    if s.init_cmds:
+        cmds = _sub(coe, "InitCmds")
+        for c in s.init_cmds:
+            _init_cmd(cmds, c)
+
+
+def _wkc(slaves: Iterable[Slave]) -> int:
+    """Expected LRW working counter: +2 per slave written, +1 per slave read (ETG.1000.4)."""
+    return sum((2 if s.outputs else 0) + (1 if s.inputs else 0) for s in slaves)
+
+
+def to_xml(cfg: EniConfig) -> ET.Element:
+    root = ET.Element(
+        "EtherCATConfig",
+        {
+            "Version": "1.3",
+            "xmlns:xsi": "http://www.w3.org/2001/XMLSchema-instance",
+            "xsi:noNamespaceSchemaLocation": "EtherCATConfig.xsd",
+        },
+    )
+    config = _sub(root, "Config")
+    master = _sub(config, "Master")
+    info = _sub(master, "Info")
+    _sub(info, "Name", cfg.master_name or "gtecat")
+    _sub(info, "Destination", "ffffffffffff")
+    _sub(info, "Source", "000000000000")
+    _sub(info, "EtherType", "a488")
+    for s in cfg.slaves:
+        sel = _sub(config, "Slave")
+        si = _sub(sel, "Info")
+        _sub(si, "Name", s.name)
+        _sub(si, "PhysAddr", s.phys_addr)
+        _sub(si, "AutoIncAddr", s.auto_inc_addr)
+        _sub(si, "VendorId", _hex(s.identity.vendor_id, 8))
+        _sub(si, "ProductCode", _hex(s.identity.product_code, 8))
+        _sub(si, "RevisionNo", _hex(s.identity.revision_no, 8))
+        _sub(si, "SerialNo", s.identity.serial_no)
+        if s.rx_pdos or s.tx_pdos or s.outputs or s.inputs:
+            _process_data(sel, s)
+        if s.mailbox or s.init_cmds:
+            _mailbox(sel, s)
+    if cfg.cycle_time_ns is not None:
+        cyc = _sub(config, "Cyclic")
+        us = cfg.cycle_time_ns / 1000
+        _sub(cyc, "CycleTime", int(us) if us == int(us) else us)
+        frame = _sub(cyc, "Frame")
+        cmd = _sub(frame, "Cmd")
+        _sub(cmd, "State", "SAFEOP")
+        _sub(cmd, "State", "OP")
+        _sub(cmd, "Comment", "process data")
+        _sub(cmd, "Cmd", LRW)
+        _sub(cmd, "Addr", LOGICAL_BASE)
+        _sub(cmd, "DataLength", max(cfg.outputs_bytes, cfg.inputs_bytes))
+        _sub(cmd, "Cnt", _wkc(cfg.slaves))
+        _sub(cmd, "InputOffs", 0)
+        _sub(cmd, "OutputOffs", 0)
+    pi = _sub(config, "ProcessImage")
+    variables = _slave_variables(cfg)
+    for tag, d, size in (
+        ("Inputs", Direction.IN, cfg.inputs_bytes),
+        ("Outputs", Direction.OUT, cfg.outputs_bytes),
+    ):
+        part = _sub(pi, tag)
+        _sub(part, "ByteSize", size)
+        for v in variables:
+            if v.direction != d:
+                continue
+            ve = _sub(part, "Variable")
+            _sub(ve, "Name", v.name)
+            if v.data_type:
+                _sub(ve, "DataType", v.data_type)
+            _sub(ve, "BitSize", v.bit_size)
+            _sub(ve, "BitOffs", v.bit_offset)
+    return root
+
+
+def write_eni(cfg: EniConfig) -> str:
+    """The ENI XML text of ``cfg`` (UTF-8 declared, two-space indented)."""
+    root = to_xml(cfg)
+    ET.indent(root, space="  ")
+    body = ET.tostring(root, encoding="unicode")
+    return '<?xml version="1.0" encoding="utf-8"?>\n<!-- written by gtecat -->\n' + body + "\n"
+
+
+def write_eni_file(cfg: EniConfig, path: str | os.PathLike[str]) -> None:
+    Path(path).write_text(write_eni(cfg), encoding="utf-8")

@@ -1,0 +1,122 @@
+"""A small, safe XML element tree that remembers the line of every element.
+
+ENI errors must name the line (DESIGN.md "Errors"), which
+``xml.etree.ElementTree`` does not keep, and an ENI must never make us read
+another file: this parser is expat (the same engine ElementTree uses) with
+every document type declaration refused, so no DTD, no internal or external
+entity is ever expanded ("billion laughs" and XXE are impossible by
+construction).  Namespace prefixes are dropped from tags and attribute names:
+ETG.2100 files come with and without them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from xml.parsers import expat
+
+from .errors import EniError
+
+
+class Node:
+    """One element: local tag name, attributes, children, text and source line."""
+
+    __slots__ = ("attrib", "children", "line", "tag", "text")
+
+    def __init__(self, tag: str, attrib: dict[str, str], line: int) -> None:
+        self.tag = tag
+        self.attrib = attrib
+        self.children: list[Node] = []
+        self.text = ""
+        self.line = line
+
+    def find(self, tag: str) -> Node | None:
+        """First child named ``tag`` (``a/b`` walks down), or None."""
+        node: Node | None = self
+        for part in tag.split("/"):
+            assert node is not None
+            node = next((c for c in node.children if c.tag == part), None)
+            if node is None:
+                return None
+        return node
+
+    def findall(self, tag: str) -> list[Node]:
+        """Children named ``tag`` (``a/b`` collects every ``b`` under every ``a``)."""
+        *head, last = tag.split("/")
+        parents = [self]
+        for part in head:
+            parents = [c for p in parents for c in p.children if c.tag == part]
+        return [c for p in parents for c in p.children if c.tag == last]
+
+    def findtext(self, tag: str) -> str | None:
+        """Stripped text of the first child named ``tag``, None when absent."""
+        node = self.find(tag)
+        return None if node is None else node.text.strip()
+
+    def iter(self) -> Iterator[Node]:
+        yield self
+        for c in self.children:
+            yield from c.iter()
+
+    def __repr__(self) -> str:
+        return f"<Node {self.tag} line {self.line}>"
+
+
+def _local(name: str) -> str:
+    return name.rpartition(":")[2]
+
+
+class _Refused(Exception):
+    pass
+
+
+def parse_xml(data: bytes | str, source: str) -> Node:
+    """Parse a whole document; any error becomes an :class:`EniError` with its line."""
+    parser = expat.ParserCreate()
+    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    parser.buffer_text = True
+    stack: list[Node] = []
+    texts: list[list[str]] = []
+    root: list[Node] = []
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        node = Node(_local(tag), {_local(k): v for k, v in attrs.items()}, parser.CurrentLineNumber)
+        if stack:
+            stack[-1].children.append(node)
+        else:
+            root.append(node)
+        stack.append(node)
+        texts.append([])
+
+    def end(tag: str) -> None:
+        node = stack.pop()
+        node.text = "".join(texts.pop())
+
+    def chars(data: str) -> None:
+        if texts:
+            texts[-1].append(data)
+
+    def refuse_doctype(*_args: object) -> None:
+        raise _Refused(
+            "DOCTYPE declarations are not accepted in an ENI (no DTD, no entities are resolved)"
+        )
+
+    def refuse_entity(*_args: object) -> None:
+        raise _Refused("entity declarations and references are not accepted in an ENI")
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = chars
+    parser.StartDoctypeDeclHandler = refuse_doctype
+    parser.EntityDeclHandler = refuse_entity
+    parser.ExternalEntityRefHandler = refuse_entity  # type: ignore[assignment]
+    parser.UnparsedEntityDeclHandler = refuse_entity
+    try:
+        parser.Parse(data, True)
+    except _Refused as exc:
+        raise EniError(str(exc), file=source, line=parser.CurrentLineNumber) from None
+    except expat.ExpatError as exc:
+        msg = expat.errors.messages.get(exc.code, str(exc)) if exc.code else str(exc)
+        raise EniError(f"malformed XML: {msg}", file=source, line=exc.lineno) from None
+    if not root:
+        raise EniError("empty XML document", file=source)
+    return root[0]

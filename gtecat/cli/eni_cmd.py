@@ -1,0 +1,61 @@
+"""``gtecat eni new TOPOLOGY.toml -o OUT.eni``: write an ETG.2100 ENI from a short topology.
+
+The topology format is documented in :mod:`eni.topology` (servo drives with a
+chosen PDO mapping, multi-axis modules, DI/DO terminals, couplers with
+DI/DO/AI/AO modules).  The file written reads back to the same model
+(:mod:`eni.writer`); ``gtecat map`` shows its offsets.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from eni.errors import GtecatError
+from eni.layout import build_layout
+from eni.topology import load_topology
+from eni.writer import write_eni
+
+
+def add_parser(subparsers: Any) -> None:
+    p = subparsers.add_parser("eni", help="ENI tools (write an ENI from a topology)")
+    sub = p.add_subparsers(dest="eni_command", metavar="COMMAND")
+    new = sub.add_parser(
+        "new",
+        help="write an ETG.2100 ENI from a TOML topology",
+        description="Write an ETG.2100 ENI XML file from a TOML topology "
+        "(format: see eni/topology.py or examples/*.toml).",
+    )
+    new.add_argument("topology", help="topology TOML file")
+    new.add_argument("-o", "--output", help="ENI file to write (default: standard output)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if getattr(args, "eni_command", None) != "new":
+        print("error: usage: gtecat eni new TOPOLOGY.toml [-o OUT.eni]", file=sys.stderr)
+        return 1
+    try:
+        cfg = load_topology(args.topology)
+        text = write_eni(cfg)
+        layout = build_layout(cfg)
+    except GtecatError as exc:
+        if getattr(args, "debug", False):
+            raise
+        print("error: " + " ".join(str(exc).split()), file=sys.stderr)
+        return 1
+    if not args.output or args.output == "-":
+        sys.stdout.write(text)
+        return 0
+    try:
+        Path(args.output).write_text(text, encoding="utf-8")
+    except OSError as exc:
+        print(f"error: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    print(
+        f"wrote {args.output}: {len(cfg.slaves)} slaves, {len(layout.axes)} axes, "
+        f"GT raw image {layout.gt_raw_bytes} bytes"
+    )
+    return 0
