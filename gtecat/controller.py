@@ -64,6 +64,9 @@ class Options:
 class Controller:
     """One core: clock, master and the per-cycle hooks of the axis layer."""
 
+    #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
+    bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
+
     def __init__(self, options: Options | None = None) -> None:
         self.options = (options or Options()).resolved()
         try:
@@ -122,7 +125,8 @@ class Controller:
         path = self.eni_path()
         if not path.is_file():
             raise NoEniError(
-                f"no ENI file at {path.resolve()} (set GTECAT_ENI or pass eni=... to GT_Open)"
+                f"no ENI file at {path.resolve()} "
+                "(pass --eni or eni=... to GT_Open, or set GTECAT_ENI)"
             )
         try:
             config = read_eni(path)
@@ -145,7 +149,7 @@ class Controller:
         }
         self._axis_list = list(self.axes.values())
         master.open()
-        for hook in self.on_bus_up:
+        for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
             hook(self)
         return master
 

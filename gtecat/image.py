@@ -119,12 +119,19 @@ class ProcessImage:
         # raw byte k -> index in self.buffer (aligned case) and "is an output byte"
         self._raw_index = np.zeros(self.size, dtype=np.intp)
         self._raw_is_out = np.zeros(self.size, dtype=bool)
+        # bits of a raw byte that belong to the slave (its last byte may be partly padding)
+        self._raw_mask = np.zeros(self.size, dtype=np.uint8)
+        self._full_bytes = True
         for seg in self.segments:
             base = 0 if seg.direction == Direction.OUT else self.outputs_bytes
             start = base + (seg.logical_bit >> 3)
             sl = slice(seg.raw_offset, seg.raw_offset + seg.raw_bytes)
             self._raw_index[sl] = np.arange(start, start + seg.raw_bytes)
             self._raw_is_out[sl] = seg.direction == Direction.OUT
+            self._raw_mask[sl] = 0xFF
+            if seg.bit_len & 7:
+                self._raw_mask[seg.raw_offset + seg.raw_bytes - 1] = (1 << (seg.bit_len & 7)) - 1
+                self._full_bytes = False
 
     # --- GT raw view (manual 5.2.2.4) -------------------------------------------
     def check_range(self, offset: int, size: int) -> None:
@@ -138,7 +145,10 @@ class ProcessImage:
         """Bytes ``offset .. offset+size`` of the GT raw image (outputs and inputs)."""
         self.check_range(offset, size)
         if self.aligned:
-            return self.buffer[self._raw_index[offset : offset + size]].tobytes()
+            data = self.buffer[self._raw_index[offset : offset + size]]
+            if not self._full_bytes:
+                data &= self._raw_mask[offset : offset + size]
+            return data.tobytes()
         return bytes(self._slow_raw()[offset : offset + size])
 
     def write_raw(self, offset: int, data: bytes) -> None:
@@ -152,9 +162,12 @@ class ProcessImage:
                 "bytes can be written"
             )
         if self.aligned:
-            self.buffer[self._raw_index[offset : offset + size]] = np.frombuffer(
-                bytes(data), dtype=np.uint8
-            )
+            idx = self._raw_index[offset : offset + size]
+            new = np.frombuffer(bytes(data), dtype=np.uint8)
+            if not self._full_bytes:
+                mask = self._raw_mask[offset : offset + size]
+                new = (self.buffer[idx] & ~mask) | (new & mask)
+            self.buffer[idx] = new
             return
         raw = self._slow_raw()
         raw[offset : offset + size] = data

@@ -16,6 +16,7 @@ import importlib
 import json
 import sys
 import time
+from dataclasses import replace
 from ctypes import c_ubyte
 from pathlib import Path
 
@@ -31,7 +32,10 @@ def _bus(eni: Path, *, plain: bool):
     from gtecat.backends.emulated import EmulatedBackend
     from gtecat.bus import Master
 
-    layout = build_layout(read_eni(eni))
+    cfg = read_eni(eni)
+    if plain:  # plain PDO slaves have no mailbox: drop the CoE InitCmds
+        cfg = replace(cfg, slaves=tuple(replace(s, init_cmds=()) for s in cfg.slaves))
+    layout = build_layout(cfg)
     slaves = None
     if plain:
         slaves = [

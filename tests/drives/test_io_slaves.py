@@ -1,0 +1,74 @@
+"""Virtual IO slaves: field side, wiring, ETG.5001 modules, outputs safe below OP."""
+
+from __future__ import annotations
+
+import pytest
+
+from drives.io_slaves import IoSlave
+from drives.slave import AlState, AlStatusCode
+from eni.model import Direction, Identity, Pdo, PdoEntry
+
+
+def _coupler() -> IoSlave:
+    rx = (
+        Pdo(
+            0x1600,
+            Direction.OUT,
+            (PdoEntry(0x7010, 1, 16, "DO16", "UINT"), PdoEntry(0x7030, 1, 16, "AO1", "INT")),
+        ),
+    )
+    tx = (
+        Pdo(
+            0x1A00,
+            Direction.IN,
+            (PdoEntry(0x6000, 1, 16, "DI16", "UINT"), PdoEntry(0x6020, 1, 16, "AI1", "INT")),
+        ),
+    )
+    s = IoSlave(0, "coupler", Identity(1, 2), rx_pdos=rx, tx_pdos=tx)
+    for st in (AlState.PREOP, AlState.SAFEOP, AlState.OP):
+        assert s.request_state(st) == AlStatusCode.NO_ERROR
+    return s
+
+
+def test_outputs_reach_the_field_only_in_op():
+    s = _coupler()
+    s.rx[:] = b"\x34\x12\xff\xff"
+    s.step(0, 1_000_000)
+    assert s.get_output(0x7010, 1) == 0x1234 and s.get_output(0x7030, 1) == -1
+    s.request_state(AlState.SAFEOP)
+    s.step(0, 1_000_000)
+    assert s.get_output(0x7010, 1) == 0  # safe state below OP (ETG.1000.6)
+
+
+def test_inputs_and_wires():
+    s = _coupler()
+    s.set_input(0x6020, 1, -300)
+    s.wire_objects((0x7010, 1), (0x6000, 1))
+    s.rx[0:2] = b"\x0f\x00"
+    s.step(0, 1_000_000)
+    assert bytes(s.tx) == b"\x0f\x00" + (-300).to_bytes(2, "little", signed=True)
+
+
+def test_modules_grouped_by_etg5001_index():
+    s = _coupler()
+    groups = {n: sorted(p.index for p in pts) for n, pts in s.modules().items()}
+    assert groups == {0: [0x6000], 1: [0x7010], 2: [0x6020], 3: [0x7030]}
+
+
+def test_unmapped_objects_and_bad_bits_are_clear_errors():
+    s = _coupler()
+    with pytest.raises(KeyError, match="maps no input 0x6010:01"):
+        s.set_input(0x6010, 1, 1)
+    with pytest.raises(ValueError, match="no output bit 32"):
+        s.wire(32, 0)
+
+
+def test_al_state_machine_refuses_illegal_transitions():
+    s = IoSlave(0, "io", Identity(1, 2))
+    assert s.request_state(AlState.OP) == AlStatusCode.INVALID_REQUESTED_STATE_CHANGE
+    assert s.al_state == AlState.INIT and s.al_error
+    assert s.request_state(AlState.BOOT) == AlStatusCode.BOOTSTRAP_NOT_SUPPORTED
+    assert s.request_state(AlState.PREOP) == AlStatusCode.NO_ERROR and not s.al_error
+    s.expected_sizes = (8, 0)  # the master expects an output byte the slave doesn't map
+    assert s.request_state(AlState.SAFEOP) == AlStatusCode.INVALID_OUTPUT_CONFIGURATION
+    assert s.al_state == AlState.PREOP
