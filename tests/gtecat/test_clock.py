@@ -16,8 +16,9 @@ def test_lockstep_runs_only_when_advanced():
 
 def test_auto_charges_every_call():
     ran = []
-    c = Clock(lambda: ran.append(1), cycle_ns=1_000_000, mode=ClockMode.AUTO,
-              call_latency_ns=50_000)
+    c = Clock(
+        lambda: ran.append(1), cycle_ns=1_000_000, mode=ClockMode.AUTO, call_latency_ns=50_000
+    )
     for _ in range(19):
         c.on_call()
     assert ran == []
