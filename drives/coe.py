@@ -1,0 +1,431 @@
+"""Mailbox, CoE and SDO wire formats (ETG.1000.4 5.5, ETG.1000.6 5.6) and an SDO client.
+
+The same bytes travel through the in-process backend (``VirtualSlave.mailbox``)
+and, later, through sync managers 0/1 of the wire-level ESC: a whole mailbox
+message is the 6-byte mailbox header followed by ``length`` bytes of service
+data.  For CoE that is the 2-byte CoE header and the SDO frame.
+
+Bit fields are declared most significant bit first (construct's ``BitStruct``
+order) and read as "bits 7..0" of the byte the standard draws.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import IntEnum
+
+from construct import (
+    BitsInteger,
+    BitStruct,
+    Bytes,
+    ByteSwapped,
+    Const,
+    Flag,
+    GreedyBytes,
+    Int8ul,
+    Int16ul,
+    Int32ul,
+    Struct,
+    this,
+)
+
+from drives.abort import SdoAbort, SdoAbortCode
+
+MAILBOX_HEADER_SIZE = 6
+COE_HEADER_SIZE = 2
+#: default mailbox (SM0/SM1) size of the virtual slaves, bytes
+DEFAULT_MAILBOX_SIZE = 128
+
+
+class MailboxType(IntEnum):
+    """Mailbox header ``Type`` (ETG.1000.4 Table 29)."""
+
+    ERR = 0x0
+    AOE = 0x1
+    EOE = 0x2
+    COE = 0x3
+    FOE = 0x4
+    SOE = 0x5
+    VOE = 0xF
+
+
+class MailboxError(IntEnum):
+    """Detail of a mailbox error reply (ETG.1000.4 Table 30)."""
+
+    SYNTAX = 0x01
+    UNSUPPORTED_PROTOCOL = 0x02
+    INVALID_CHANNEL = 0x03
+    SERVICE_NOT_SUPPORTED = 0x04
+    INVALID_HEADER = 0x05
+    SIZE_TOO_SHORT = 0x06
+    NO_MORE_MEMORY = 0x07
+    INVALID_SIZE = 0x08
+
+
+class CoeService(IntEnum):
+    """CoE header ``Service`` (ETG.1000.6 Table 29)."""
+
+    EMERGENCY = 1
+    SDO_REQUEST = 2
+    SDO_RESPONSE = 3
+    TXPDO = 4
+    RXPDO = 5
+    TXPDO_REMOTE_REQUEST = 6
+    RXPDO_REMOTE_REQUEST = 7
+    SDO_INFORMATION = 8
+
+
+class Ccs(IntEnum):
+    """Client command specifier, bits 7..5 of an SDO request (ETG.1000.6 5.6.2)."""
+
+    DOWNLOAD_SEGMENT = 0
+    INITIATE_DOWNLOAD = 1
+    INITIATE_UPLOAD = 2
+    UPLOAD_SEGMENT = 3
+    ABORT = 4
+
+
+class Scs(IntEnum):
+    """Server command specifier, bits 7..5 of an SDO response (ETG.1000.6 5.6.2)."""
+
+    UPLOAD_SEGMENT = 0
+    DOWNLOAD_SEGMENT = 1
+    INITIATE_UPLOAD = 2
+    INITIATE_DOWNLOAD = 3
+    ABORT = 4
+
+
+# --- ETG.1000.4 Table 29: mailbox header ------------------------------------
+MailboxHeader = Struct(
+    "length" / Int16ul,  # bytes of service data after this header
+    "address" / Int16ul,  # station address of the source (master -> slave) or 0
+    "bits"
+    / BitStruct(
+        "priority" / BitsInteger(2),  # byte 4 bits 7..6
+        "channel" / BitsInteger(6),  # byte 4 bits 5..0
+        "reserved" / BitsInteger(1),  # byte 5 bit 7
+        "counter" / BitsInteger(3),  # byte 5 bits 6..4: 1..7, 0 = unused
+        "type" / BitsInteger(4),  # byte 5 bits 3..0: MailboxType
+    ),
+)
+
+MailboxMessage = Struct("header" / MailboxHeader, "data" / Bytes(this.header.length))
+
+# --- ETG.1000.4 Table 30: mailbox error reply (Type = ERR) --------------------
+MailboxErrorReply = Struct("type" / Const(1, Int16ul), "detail" / Int16ul)
+
+# --- ETG.1000.6 Table 29 (CoE header): 16 bits little endian ------------------
+CoeHeader = ByteSwapped(
+    BitStruct(
+        "service" / BitsInteger(4),  # bits 15..12: CoeService
+        "reserved" / BitsInteger(3),  # bits 11..9
+        "number" / BitsInteger(9),  # bits 8..0: PDO number (0 for SDO)
+    )
+)
+
+# --- ETG.1000.6 5.6.2.1-5.6.2.2: initiate command byte -------------------------
+SdoInitiateCommand = BitStruct(
+    "command" / BitsInteger(3),  # Ccs / Scs
+    "complete_access" / Flag,  # bit 4
+    "size" / BitsInteger(2),  # bits 3..2: 4 - data bytes (expedited)
+    "expedited" / Flag,  # bit 1
+    "size_indicator" / Flag,  # bit 0
+)
+
+# --- ETG.1000.6 5.6.2.3/5.6.2.5: segment command byte ---------------------------
+SdoSegmentCommand = BitStruct(
+    "command" / BitsInteger(3),  # Ccs / Scs
+    "toggle" / Flag,  # bit 4
+    "seg_size" / BitsInteger(3),  # bits 3..1: 7 - data bytes when fewer than 7
+    "last" / Flag,  # bit 0: 1 = no more segments follow
+)
+
+#: expedited download request/response, upload request, download response (10 bytes)
+SdoExpedited = Struct(
+    "cmd" / SdoInitiateCommand,
+    "index" / Int16ul,
+    "subindex" / Int8ul,
+    "data" / Bytes(4),
+)
+
+#: normal (non-expedited) initiate download request / upload response
+SdoNormal = Struct(
+    "cmd" / SdoInitiateCommand,
+    "index" / Int16ul,
+    "subindex" / Int8ul,
+    "complete_size" / Int32ul,
+    "data" / GreedyBytes,
+)
+
+#: download/upload segment request and response
+SdoSegment = Struct("cmd" / SdoSegmentCommand, "data" / GreedyBytes)
+
+#: abort transfer (ETG.1000.6 5.6.2.7): command byte 0x80
+SdoAbortFrame = Struct(
+    "cmd" / Const(0x80, Int8ul),
+    "index" / Int16ul,
+    "subindex" / Int8ul,
+    "code" / Int32ul,
+)
+
+#: bytes of SDO data after the mailbox header, the CoE header and the 8-byte initiate frame
+INITIATE_OVERHEAD = MAILBOX_HEADER_SIZE + COE_HEADER_SIZE + 8
+#: ... after the headers and the segment command byte
+SEGMENT_OVERHEAD = MAILBOX_HEADER_SIZE + COE_HEADER_SIZE + 1
+
+
+# --- building and parsing helpers -------------------------------------------------
+def build_mailbox(
+    data: bytes, *, counter: int, mbx_type: MailboxType = MailboxType.COE, address: int = 0
+) -> bytes:
+    header = MailboxHeader.build(
+        {
+            "length": len(data),
+            "address": address,
+            "bits": {
+                "priority": 0,
+                "channel": 0,
+                "reserved": 0,
+                "counter": counter & 7,
+                "type": int(mbx_type),
+            },
+        }
+    )
+    return header + data
+
+
+def build_coe(service: CoeService, sdo: bytes, *, counter: int) -> bytes:
+    """A whole mailbox message carrying one CoE service."""
+    coe = CoeHeader.build({"service": int(service), "reserved": 0, "number": 0})
+    return build_mailbox(coe + sdo, counter=counter)
+
+
+def initiate_cmd(
+    command: int,
+    *,
+    complete_access: bool = False,
+    expedited: bool = False,
+    size: int = 0,
+    size_indicator: bool = False,
+) -> dict:
+    return {
+        "command": command,
+        "complete_access": complete_access,
+        "size": size,
+        "expedited": expedited,
+        "size_indicator": size_indicator,
+    }
+
+
+def segment_cmd(command: int, *, toggle: bool, seg_size: int = 0, last: bool = False) -> dict:
+    return {"command": command, "toggle": toggle, "seg_size": seg_size, "last": last}
+
+
+def build_abort(index: int, subindex: int, code: int) -> bytes:
+    return SdoAbortFrame.build({"index": index, "subindex": subindex, "code": int(code)})
+
+
+def pad_segment(data: bytes) -> tuple[bytes, int]:
+    """Segments carry at least 7 data bytes; returns (padded data, unused byte count)."""
+    if len(data) >= 7:
+        return data, 0
+    return data + bytes(7 - len(data)), 7 - len(data)
+
+
+@dataclass(frozen=True, slots=True)
+class ParsedMailbox:
+    counter: int
+    mbx_type: int
+    data: bytes  # service data after the mailbox header
+
+
+def parse_mailbox(message: bytes) -> ParsedMailbox:
+    """Split a whole mailbox message; raises ValueError when it is cut short."""
+    if len(message) < MAILBOX_HEADER_SIZE:
+        raise ValueError(f"mailbox message of {len(message)} bytes is shorter than its header")
+    hdr = MailboxHeader.parse(message[:MAILBOX_HEADER_SIZE])
+    end = MAILBOX_HEADER_SIZE + hdr.length
+    if len(message) < end:
+        raise ValueError(f"mailbox header says {hdr.length} bytes, message has {len(message) - 6}")
+    return ParsedMailbox(hdr.bits.counter, hdr.bits.type, bytes(message[MAILBOX_HEADER_SIZE:end]))
+
+
+def next_counter(counter: int) -> int:
+    """Mailbox counters run 1..7 and skip 0 (ETG.1000.4 5.5)."""
+    return 1 if counter >= 7 else counter + 1
+
+
+# --- client -------------------------------------------------------------------------
+class SdoClient:
+    """The master side of SDO: upload/download through whole mailbox messages.
+
+    ``transfer`` sends one mailbox message and returns the slave's answer (for
+    a virtual slave it is exactly ``slave.mailbox``).  Expedited transfer is used
+    up to 4 bytes, normal transfer up to what one mailbox holds, segmented
+    transfer beyond (ETG.1000.6 5.6.2).  An abort answer raises
+    :class:`~drives.abort.SdoAbort` with the slave's code.
+    """
+
+    def __init__(
+        self,
+        transfer: Callable[[bytes], bytes | None],
+        *,
+        mailbox_size: int = DEFAULT_MAILBOX_SIZE,
+    ) -> None:
+        if mailbox_size < INITIATE_OVERHEAD + 4:
+            raise ValueError(f"mailbox of {mailbox_size} bytes cannot carry an SDO")
+        self._transfer = transfer
+        self.mailbox_size = mailbox_size
+        self.counter = 0
+
+    # --- plumbing -----------------------------------------------------------
+    def _exchange(self, sdo: bytes, index: int, subindex: int) -> bytes:
+        self.counter = next_counter(self.counter)
+        answer = self._transfer(build_coe(CoeService.SDO_REQUEST, sdo, counter=self.counter))
+        if answer is None:
+            raise SdoAbort(SdoAbortCode.SDO_PROTOCOL_TIMED_OUT, index, subindex, "no answer")
+        try:
+            mbx = parse_mailbox(answer)
+        except ValueError as e:
+            raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, str(e)) from None
+        if mbx.mbx_type == MailboxType.ERR:
+            detail = "mailbox error"
+            if len(mbx.data) >= 4:
+                code = MailboxErrorReply.parse(mbx.data[:4]).detail
+                try:
+                    detail = f"mailbox error {MailboxError(code).name}"
+                except ValueError:
+                    detail = f"mailbox error 0x{code:04X}"
+            raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, detail)
+        if mbx.mbx_type != MailboxType.COE or len(mbx.data) < COE_HEADER_SIZE + 1:
+            raise SdoAbort(
+                SdoAbortCode.GENERAL_ERROR,
+                index,
+                subindex,
+                f"unexpected mailbox type {mbx.mbx_type}",
+            )
+        coe = CoeHeader.parse(mbx.data[:COE_HEADER_SIZE])
+        if coe.service != CoeService.SDO_RESPONSE:
+            raise SdoAbort(
+                SdoAbortCode.GENERAL_ERROR, index, subindex, f"unexpected CoE service {coe.service}"
+            )
+        body = mbx.data[COE_HEADER_SIZE:]
+        if body[0] == 0x80:
+            if len(body) < 8:
+                raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, "short abort frame")
+            ab = SdoAbortFrame.parse(body[:8])
+            raise SdoAbort(ab.code, ab.index, ab.subindex)
+        return body
+
+    def _expect(self, body: bytes, scs: Scs, index: int, subindex: int) -> None:
+        if body[0] >> 5 != scs:
+            raise SdoAbort(
+                SdoAbortCode.COMMAND_SPECIFIER_INVALID,
+                index,
+                subindex,
+                f"answer 0x{body[0]:02X} is not {scs.name}",
+            )
+
+    # --- services -----------------------------------------------------------
+    def upload(self, index: int, subindex: int, complete_access: bool = False) -> bytes:
+        req = SdoExpedited.build(
+            {
+                "cmd": initiate_cmd(Ccs.INITIATE_UPLOAD, complete_access=complete_access),
+                "index": index,
+                "subindex": subindex,
+                "data": bytes(4),
+            }
+        )
+        body = self._exchange(req, index, subindex)
+        self._expect(body, Scs.INITIATE_UPLOAD, index, subindex)
+        if len(body) < 8:
+            raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, "short upload answer")
+        cmd = SdoInitiateCommand.parse(body[:1])
+        if cmd.expedited:
+            n = 4 - cmd.size if cmd.size_indicator else 4
+            return bytes(body[4 : 4 + n])
+        resp = SdoNormal.parse(body)
+        total = resp.complete_size
+        data = bytearray(resp.data[:total])
+        toggle = False
+        while len(data) < total:
+            seg_req = SdoSegment.build(
+                {"cmd": segment_cmd(Ccs.UPLOAD_SEGMENT, toggle=toggle), "data": bytes(7)}
+            )
+            body = self._exchange(seg_req, index, subindex)
+            self._expect(body, Scs.UPLOAD_SEGMENT, index, subindex)
+            seg = SdoSegment.parse(body)
+            if seg.cmd.toggle != toggle:
+                raise SdoAbort(SdoAbortCode.TOGGLE_BIT_NOT_ALTERNATED, index, subindex)
+            chunk = seg.data
+            if seg.cmd.last and len(chunk) == 7:
+                chunk = chunk[: 7 - seg.cmd.seg_size]
+            data += chunk
+            if seg.cmd.last:
+                break
+            toggle = not toggle
+        if len(data) != total:
+            raise SdoAbort(
+                SdoAbortCode.LENGTH_MISMATCH,
+                index,
+                subindex,
+                f"{len(data)} bytes received, {total} announced",
+            )
+        return bytes(data)
+
+    def download(
+        self, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
+        data = bytes(data)
+        if 0 < len(data) <= 4:
+            req = SdoExpedited.build(
+                {
+                    "cmd": initiate_cmd(
+                        Ccs.INITIATE_DOWNLOAD,
+                        complete_access=complete_access,
+                        expedited=True,
+                        size=4 - len(data),
+                        size_indicator=True,
+                    ),
+                    "index": index,
+                    "subindex": subindex,
+                    "data": data.ljust(4, b"\x00"),
+                }
+            )
+            body = self._exchange(req, index, subindex)
+            self._expect(body, Scs.INITIATE_DOWNLOAD, index, subindex)
+            return
+        first_max = self.mailbox_size - INITIATE_OVERHEAD
+        first, rest = data[:first_max], data[first_max:]
+        req = SdoNormal.build(
+            {
+                "cmd": initiate_cmd(
+                    Ccs.INITIATE_DOWNLOAD, complete_access=complete_access, size_indicator=True
+                ),
+                "index": index,
+                "subindex": subindex,
+                "complete_size": len(data),
+                "data": first,
+            }
+        )
+        body = self._exchange(req, index, subindex)
+        self._expect(body, Scs.INITIATE_DOWNLOAD, index, subindex)
+        seg_max = self.mailbox_size - SEGMENT_OVERHEAD
+        toggle = False
+        while rest:
+            chunk, rest = rest[:seg_max], rest[seg_max:]
+            padded, unused = pad_segment(chunk)
+            seg = SdoSegment.build(
+                {
+                    "cmd": segment_cmd(
+                        Ccs.DOWNLOAD_SEGMENT, toggle=toggle, seg_size=unused, last=not rest
+                    ),
+                    "data": padded,
+                }
+            )
+            body = self._exchange(seg, index, subindex)
+            self._expect(body, Scs.DOWNLOAD_SEGMENT, index, subindex)
+            if bool(body[0] & 0x10) != toggle:
+                raise SdoAbort(SdoAbortCode.TOGGLE_BIT_NOT_ALTERNATED, index, subindex)
+            toggle = not toggle
