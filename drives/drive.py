@@ -101,6 +101,9 @@ class DriveSettings:
     """What differs between real drives (see the module docstring for each policy)."""
 
     supported_modes: tuple[int, ...] = tuple(int(m) for m in DEFAULT_MODES)
+    #: 6060h at power-on.  8 (CSP) like Googol's GTHD, whose default mapping (manual
+    #: figure 5-2) has no 6060h yet runs under the controller's CSP set-points
+    initial_mode: int = 8
     homing_methods: tuple[int, ...] = DEFAULT_HOMING_METHODS
     mode_latency_cycles: int = 1
     #: 6061h while a mode change is pending (Festo shows -1); None = the old mode
@@ -192,7 +195,7 @@ class Channel:
         self.controlword = 0
         self.statusword = 0
         self.error_code_value = 0
-        self.mode_req = 0  # 6060h
+        self.mode_req = s.initial_mode  # 6060h (taken like any request, after the latency)
         self.mode = 0  # the active mode
         self.mode_display = 0  # 6061h
         self.target_position = 0

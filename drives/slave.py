@@ -117,7 +117,8 @@ class VirtualSlave:
         return 0, 0
 
     def mailbox(self, request: bytes) -> bytes | None:
-        """Handle one mailbox service payload (CoE header + service data)."""
+        """Handle one whole mailbox message (6-byte mailbox header + service data, ETG.1000.6
+        Table 29) and return the whole response, or None when there is nothing to answer."""
         return None
 
     def on_state_change(self, old: AlState, new: AlState) -> AlStatusCode:

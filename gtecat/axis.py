@@ -215,6 +215,10 @@ class Axis:
         self._mode_acc = io.get(0x6060)
         self._disp_acc = io.get(0x6061)
         self.mode_cmd = 8  # what we believe 6060 is (CSP until told otherwise)
+        if self._mode_acc is not None:
+            # the controller runs its axes in CSP: a mapped 6060h starts at 8, not at 0
+            # ("no mode"), which would leave the drive deaf to 607Ah
+            self._mode_acc.set(self.mode_cmd)
         self.pre_hooks: list[Callable[[Axis, int, int], None]] = []
         self.post_hooks: list[Callable[[Axis, int, int], None]] = []
 
