@@ -1,0 +1,143 @@
+"""``gtecat serve --eni FILE [--machine FILE] --iface IFACE``: slaves on a real wire.
+
+Builds the virtual slaves of the ENI exactly as the emulated backend does
+(:func:`gtecat.factory.build_slaves`, same drives, same machine description),
+puts them behind software ESCs and answers EtherCAT frames on ``IFACE`` until
+Ctrl-C or SIGTERM.  Any master (SOEM/pysoem, TwinCAT, IgH, acontis) on the
+other end of the wire sees a chain of real-looking slaves.  Needs root or
+CAP_NET_RAW.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import signal
+import sys
+from pathlib import Path
+from types import FrameType
+
+log = logging.getLogger("gtecat.serve")
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "serve",
+        help="serve the ENI's virtual slaves on a network interface (raw EtherCAT frames)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _arguments(p)
+    p.set_defaults(func=run)
+    return p
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--eni", required=True, type=Path, help="ENI file (ETG.2100 XML or Googol INI)")
+    p.add_argument("--machine", type=Path, help="machine description (TOML)")
+    p.add_argument("--iface", required=True, help="network interface, e.g. one end of a veth pair")
+    p.add_argument(
+        "--step",
+        choices=("frame", "cycle"),
+        default="frame",
+        help="step the slaves once per process-data frame (default) or on a timer",
+    )
+    p.add_argument(
+        "--cycle-us", type=int, help="slave cycle for --step cycle (default: ENI, else 1000)"
+    )
+    p.add_argument(
+        "--sm-watchdog",
+        action="store_true",
+        help="an expired SM watchdog drops the slave to SAFEOP+error 001Bh (as real drives do)",
+    )
+    p.add_argument(
+        "--busy-poll",
+        action="store_true",
+        help="spin on the socket instead of sleeping (lowest latency)",
+    )
+    p.add_argument("--rt-priority", type=int, metavar="N", help="run under SCHED_FIFO priority N")
+    p.add_argument("--duration", type=float, help="stop after this many seconds")
+    p.add_argument("--stats-json", type=Path, help="write counters and latency here on exit")
+    p.add_argument("-v", "--verbose", action="store_true", help="log what the slaves do")
+
+
+def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool = False):
+    # -> tuple[Chain, EniConfig]
+    """The ENI's slaves behind ESCs (what ``serve`` puts on the wire)."""
+    from drives.esc import Chain
+    from drives.machine import MachineDescription, load_machine
+    from eni.layout import build_layout
+    from eni.reader import read_eni
+    from gtecat.factory import build_slaves
+
+    config = read_eni(eni)
+    layout = build_layout(config)
+    desc = load_machine(machine) if machine else MachineDescription()
+    slaves = build_slaves(layout, desc)
+    chain = Chain(slaves, watchdog_trips=watchdog_trips)
+    return chain, config
+
+
+def run(args: argparse.Namespace) -> int:
+    from gtecat.serve import WireServer, interface_is_up, realtime_priority
+
+    if args.verbose:
+        logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+    chain, config = build_chain(args.eni, args.machine, watchdog_trips=args.sm_watchdog)
+    cycle_ns = (args.cycle_us * 1000) if args.cycle_us else (config.cycle_time_ns or 1_000_000)
+    if interface_is_up(args.iface) is False:
+        print(f"warning: interface {args.iface} is down", file=sys.stderr)
+    server = WireServer(
+        chain, args.iface, step_mode=args.step, cycle_ns=cycle_ns, busy_poll=args.busy_poll
+    )
+    if args.rt_priority:
+        realtime_priority(args.rt_priority)
+
+    def _stop(signum: int, _frame: FrameType | None) -> None:
+        server.stop.set()
+
+    old = {s: signal.signal(s, _stop) for s in (signal.SIGINT, signal.SIGTERM)}
+
+    def _ready() -> None:
+        names = ", ".join(f"{s.position}:{s.name}" for s in chain.slaves)
+        print(f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}); ready", flush=True)
+
+    try:
+        server.serve(ready=_ready, duration_s=args.duration)
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+        server.close()
+        report = server.report()
+        if args.stats_json:
+            args.stats_json.write_text(json.dumps(report, indent=2) + "\n")
+        lat = report["latency"]
+        print(
+            f"gtecat serve: stopped after {report['elapsed_s']} s, "
+            f"{report['sent']} frames answered, {report['chain']['dropped']} dropped, "
+            f"latency p50 {lat.get('p50_us', 0):.1f} us",
+            flush=True,
+        )
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point for ``python -m gtecat.cli.serve_cmd`` (same options as ``gtecat serve``)."""
+    from eni.errors import GtecatError
+
+    parser = argparse.ArgumentParser(prog="gtecat serve", description=__doc__)
+    _arguments(parser)
+    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    args = parser.parse_args(argv)
+    try:
+        return run(args)
+    except GtecatError as exc:
+        if args.debug:
+            raise
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,309 @@
+"""``gtecat serve``: virtual slaves answering a real master on a network interface.
+
+A :class:`WireServer` owns a raw ``AF_PACKET`` socket bound to EtherType 88A4h
+on one interface (one end of a veth pair in tests, a spare NIC in a lab) and a
+:class:`drives.esc.Chain`.  Its loop, single-threaded so the slaves never need
+locks:
+
+1. receive a frame (``recv_into`` a preallocated buffer, no copies);
+2. let the chain process it in place and send it straight back - the answer
+   leaves before any slave work, so the frame-in -> frame-out latency is the
+   ESC emulation alone;
+3. then do the slave side: mailbox requests and answers (:meth:`Chain.service`),
+   and the slaves' cycle.
+
+When the slaves step (``step_mode``):
+
+* ``"frame"`` (default): once per received frame that carried process data (an
+  FMMU took part), with ``dt`` = wall time since the previous step, clamped to
+  ``max_dt_ns``.  The slaves run at the master's cycle, whatever it is, like a
+  drive synchronised to SM2 events.  A master that splits its image over several
+  frames steps the slaves once per frame with the real (short) ``dt`` between
+  them; ``min_gap_ns`` can merge such bursts into one step.  The inputs a
+  frame returns are those of the previous step: one cycle of delay, as on a real
+  bus.
+* ``"cycle"``: on a wall-clock timer every ``cycle_ns`` (the ENI cycle time),
+  independent of the master, like a drive in free run.
+
+Between frames the loop checks the sync manager watchdogs and stops within
+``poll_s`` of :attr:`stop` being set (Ctrl-C / SIGTERM in the CLI).  Malformed
+frames are counted and dropped by the chain; nothing a frame contains can end
+the loop.  ``busy_poll`` spins instead of sleeping in ``poll`` (one core at
+100 %, no wake-up latency); :func:`realtime_priority` asks for SCHED_FIFO.
+"""
+
+from __future__ import annotations
+
+import errno
+import gc
+import logging
+import os
+import select
+import socket
+import threading
+import time
+from array import array
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from drives.esc import Chain
+from drives.esc.frames import ETHERTYPE_ECAT
+from eni.errors import GtecatError
+
+log = logging.getLogger(__name__)
+
+
+class WireError(GtecatError):
+    """The network side cannot be used (no interface, no rights)."""
+
+
+class LatencyRecorder:
+    """Frame-in -> frame-out times of the last ``size`` frames, in nanoseconds."""
+
+    def __init__(self, size: int = 1 << 16) -> None:
+        self.samples = array("q", bytes(8 * size))
+        self.size = size
+        self.count = 0
+
+    def add(self, ns: int) -> None:
+        self.samples[self.count % self.size] = ns
+        self.count += 1
+
+    def summary(self) -> dict[str, float]:
+        n = min(self.count, self.size)
+        if not n:
+            return {"count": 0}
+        data = sorted(self.samples[:n])
+
+        def pct(p: float) -> float:
+            return data[min(n - 1, int(p * n))] / 1000.0
+
+        return {
+            "count": self.count,
+            "mean_us": sum(data) / n / 1000.0,
+            "p50_us": pct(0.50),
+            "p90_us": pct(0.90),
+            "p99_us": pct(0.99),
+            "max_us": data[-1] / 1000.0,
+        }
+
+
+@dataclass(slots=True)
+class ServeStats:
+    received: int = 0
+    sent: int = 0
+    steps: int = 0
+    send_errors: int = 0
+    receive_errors: int = 0
+    internal_errors: int = 0
+    started_ns: int = 0
+    stopped_ns: int = 0
+    latency: LatencyRecorder = field(default_factory=LatencyRecorder)
+
+
+def open_raw_socket(iface: str) -> socket.socket:
+    """A raw socket receiving and sending EtherCAT frames on ``iface``."""
+    try:
+        sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETHERTYPE_ECAT))
+    except PermissionError as exc:
+        raise WireError(
+            "raw sockets need root or CAP_NET_RAW (try sudo, or "
+            "setcap cap_net_raw+ep on the python binary)"
+        ) from exc
+    try:
+        sock.bind((iface, ETHERTYPE_ECAT))
+    except OSError as exc:
+        sock.close()
+        if exc.errno in (errno.ENODEV, errno.ENXIO):
+            raise WireError(f"no network interface {iface!r}") from exc
+        raise WireError(f"cannot bind to {iface!r}: {exc.strerror}") from exc
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+    except OSError:
+        pass
+    sock.setblocking(False)
+    return sock
+
+
+def realtime_priority(priority: int) -> None:
+    """Run this process under SCHED_FIFO ``priority`` (1-99); needs root or CAP_SYS_NICE."""
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except (OSError, AttributeError, ValueError) as exc:
+        raise WireError(f"cannot set SCHED_FIFO priority {priority}: {exc}") from exc
+
+
+def interface_is_up(iface: str) -> bool | None:
+    """``True``/``False`` from sysfs; ``None`` when it cannot tell."""
+    try:
+        with open(f"/sys/class/net/{iface}/operstate") as fh:
+            state = fh.read().strip()
+    except OSError:
+        return None
+    return state in ("up", "unknown")
+
+
+class WireServer:
+    """A chain of virtual slaves served on one interface until :attr:`stop` is set."""
+
+    def __init__(
+        self,
+        chain: Chain,
+        iface: str,
+        *,
+        step_mode: str = "frame",
+        cycle_ns: int = 1_000_000,
+        max_dt_ns: int = 100_000_000,
+        min_gap_ns: int = 0,
+        poll_s: float = 0.02,
+        busy_poll: bool = False,
+        clock: Callable[[], int] = time.monotonic_ns,
+        sock: socket.socket | None = None,
+    ) -> None:
+        if step_mode not in ("frame", "cycle"):
+            raise ValueError(f"step_mode must be 'frame' or 'cycle', not {step_mode!r}")
+        if cycle_ns <= 0:
+            raise ValueError("cycle_ns must be positive")
+        self.chain = chain
+        self.iface = iface
+        self.step_mode = step_mode
+        self.cycle_ns = cycle_ns
+        self.max_dt_ns = max_dt_ns
+        self.min_gap_ns = min_gap_ns
+        self.poll_s = poll_s
+        self.busy_poll = busy_poll
+        self.clock = clock
+        self.stop = threading.Event()
+        self.stats = ServeStats()
+        self._sock = sock
+        self._t0 = 0
+        self._last_step: int | None = None
+
+    # --- slave cycle -----------------------------------------------------------------------
+    def _step(self, now: int) -> None:
+        last = self._last_step
+        dt = self.cycle_ns if last is None else min(max(now - last, 0), self.max_dt_ns)
+        self._last_step = now
+        self.chain.step(now - self._t0, dt)
+        self.stats.steps += 1
+
+    # --- the loop --------------------------------------------------------------------------
+    def serve(
+        self, ready: Callable[[], None] | None = None, duration_s: float | None = None
+    ) -> None:
+        """Serve until :attr:`stop` is set or ``duration_s`` has passed."""
+        sock = self._sock or open_raw_socket(self.iface)
+        self._sock = sock
+        sock.setblocking(False)
+        chain, stats, clock = self.chain, self.stats, self.clock
+        buf = bytearray(2048)
+        view = memoryview(buf)
+        recv_into, send = sock.recv_into, sock.send
+        poller = select.poll()
+        poller.register(sock.fileno(), select.POLLIN)
+        self._t0 = stats.started_ns = clock()
+        deadline = None if duration_s is None else self._t0 + int(duration_s * 1e9)
+        next_cycle = self._t0 + self.cycle_ns
+        next_poll = self._t0
+        frame_mode = self.step_mode == "frame"
+        latency = stats.latency
+        gc.collect()
+        gc.freeze()  # what exists now is never scanned again: no long collector pauses
+        if ready is not None:
+            ready()
+        try:
+            while not self.stop.is_set():
+                now = clock()
+                if deadline is not None and now >= deadline:
+                    break
+                timeout_ms = 0 if self.busy_poll else int(self.poll_s * 1000)
+                if not frame_mode and timeout_ms:
+                    timeout_ms = max(0, min(timeout_ms, (next_cycle - now + 999_999) // 1_000_000))
+                if not poller.poll(timeout_ms):
+                    now = clock()
+                else:
+                    while True:
+                        try:
+                            n = recv_into(buf)
+                        except BlockingIOError:
+                            break
+                        except InterruptedError:
+                            continue
+                        except OSError as exc:
+                            self._receive_failed(exc)
+                            break
+                        t_in = clock()
+                        stats.received += 1
+                        if chain.process(buf, n, t_in):
+                            try:
+                                send(view[:n])
+                                stats.sent += 1
+                            except OSError as exc:
+                                stats.send_errors += 1
+                                if stats.send_errors <= 5:
+                                    log.warning("send failed: %s", exc)
+                            now = clock()
+                            latency.add(now - t_in)
+                            self._guarded(chain.service)
+                            if frame_mode and chain.process_data:
+                                last = self._last_step
+                                if last is None or t_in - last >= self.min_gap_ns:
+                                    self._guarded(self._step, t_in)
+                        else:
+                            now = clock()
+                if not frame_mode:
+                    while now >= next_cycle:
+                        self._guarded(self._step, next_cycle)
+                        next_cycle += self.cycle_ns
+                        if now - next_cycle > 100 * self.cycle_ns:  # fell far behind: resync
+                            next_cycle = now + self.cycle_ns
+                if now >= next_poll:
+                    self._guarded(chain.poll, now)
+                    next_poll = now + 5_000_000
+        finally:
+            stats.stopped_ns = clock()
+            poller.unregister(sock.fileno())
+            view.release()
+
+    def _guarded(self, fn: Callable[..., object], *args: object) -> None:
+        """Slave-side work: a bug there is logged and counted, the loop goes on."""
+        try:
+            fn(*args)
+        except Exception:
+            self.stats.internal_errors += 1
+            if self.stats.internal_errors <= 10:
+                log.exception("error in %s; the chain keeps running", getattr(fn, "__name__", fn))
+
+    def _receive_failed(self, exc: OSError) -> None:
+        if exc.errno in (errno.ENODEV, errno.ENXIO):
+            raise WireError(f"interface {self.iface!r} disappeared") from exc
+        self.stats.receive_errors += 1  # e.g. ENETDOWN while the link is down: wait for it
+        if self.stats.receive_errors <= 5:
+            log.warning("receive failed: %s", exc)
+        time.sleep(self.poll_s)
+
+    def close(self) -> None:
+        if self._sock is not None:
+            self._sock.close()
+            self._sock = None
+
+    def report(self) -> dict[str, object]:
+        """Counters and latency, for ``--stats-json`` and the benchmark."""
+        s = self.stats
+        elapsed = max((s.stopped_ns or self.clock()) - s.started_ns, 1) / 1e9
+        return {
+            "iface": self.iface,
+            "slaves": len(self.chain),
+            "step_mode": self.step_mode,
+            "elapsed_s": round(elapsed, 3),
+            "received": s.received,
+            "sent": s.sent,
+            "send_errors": s.send_errors,
+            "receive_errors": s.receive_errors,
+            "internal_errors": s.internal_errors,
+            "steps": s.steps,
+            "frames_per_s": round(s.sent / elapsed, 1),
+            "chain": self.chain.stats.as_dict(),
+            "latency": s.latency.summary(),
+            "pid": os.getpid(),
+        }

@@ -1,0 +1,212 @@
+"""Benchmark ``gtecat serve`` against SOEM (pysoem) on a veth pair; prints JSON.
+
+    sudo python tools/bench_wire.py [--eni examples/manual_fig5_2.eni] [--cycles 20000]
+
+Measures, with the slaves behind a real kernel network path:
+
+* ``cycles_per_s``: process-data cycles (``send_processdata`` +
+  ``receive_processdata``, one LRW frame each, plus the DC FRMW with ``--dc``)
+  pysoem completes back to back, and the master-side round trip per cycle;
+* ``server_latency_us``: inside the server, frame received -> answer sent
+  (the ESC emulation alone, from the server's ``--stats-json``);
+* ``paced``: a run at a fixed period (default 1 ms, busy-waited) counting cycles
+  whose working counter was wrong or whose answer came late.
+
+The veth pair is created and deleted here unless ``--master-if``/``--slave-if``
+name an existing pair.  Needs root (veth, raw sockets).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import secrets
+import select
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def percentiles(samples_ns: list[int]) -> dict[str, float]:
+    if not samples_ns:
+        return {}
+    data = sorted(samples_ns)
+    n = len(data)
+
+    def pct(p: float) -> float:
+        return round(data[min(n - 1, int(p * n))] / 1000.0, 1)
+
+    return {
+        "mean": round(sum(data) / n / 1000.0, 1),
+        "p50": pct(0.5),
+        "p90": pct(0.9),
+        "p99": pct(0.99),
+        "max": round(data[-1] / 1000.0, 1),
+    }
+
+
+@contextlib.contextmanager
+def veth_pair(master_if: str | None, slave_if: str | None) -> Iterator[tuple[str, str]]:
+    if master_if and slave_if:
+        yield master_if, slave_if
+        return
+    tag = secrets.token_hex(3)
+    m, s = f"gbm{tag}", f"gbs{tag}"
+    subprocess.run(
+        ["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True, timeout=10
+    )
+    try:
+        for name in (m, s):
+            subprocess.run(["ip", "link", "set", name, "up"], check=True, timeout=10)
+        yield m, s
+    finally:
+        subprocess.run(["ip", "link", "del", m], capture_output=True, timeout=10)
+
+
+@contextlib.contextmanager
+def server(eni: Path, iface: str, stats: Path, extra: list[str]) -> Iterator[subprocess.Popen]:
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "gtecat",
+            "serve",
+            "--eni",
+            str(eni),
+            "--iface",
+            iface,
+            "--stats-json",
+            str(stats),
+            *extra,
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert proc.stdout is not None
+        ready, _, _ = select.select([proc.stdout], [], [], 30)
+        line = proc.stdout.readline() if ready else ""
+        if "ready" not in line:
+            raise SystemExit(f"gtecat serve did not start: {line!r}")
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGTERM)
+        try:
+            proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate(timeout=10)
+
+
+def bring_to_op(master, dc: bool) -> None:
+    import pysoem
+
+    if master.config_init() <= 0:
+        raise SystemExit("pysoem found no slaves")
+    master.config_map()
+    if dc:
+        master.config_dc()
+    if master.state_check(pysoem.SAFEOP_STATE, 2_000_000) != pysoem.SAFEOP_STATE:
+        raise SystemExit("the chain did not reach SAFEOP")
+    master.state = pysoem.OP_STATE
+    master.send_processdata()
+    master.receive_processdata(5000)
+    master.write_state()
+    deadline = time.monotonic() + 5
+    while master.state_check(pysoem.OP_STATE, 10_000) != pysoem.OP_STATE:
+        master.send_processdata()
+        master.receive_processdata(5000)
+        if time.monotonic() > deadline:
+            raise SystemExit("the chain did not reach OP")
+
+
+def run_cycles(master, n: int, period_ns: int = 0) -> dict[str, object]:
+    expected = master.expected_wkc
+    rtt: list[int] = []
+    bad = late = 0
+    clock = time.perf_counter_ns
+    start = next_t = clock()
+    for _ in range(n):
+        if period_ns:
+            while clock() < next_t:
+                pass
+            next_t += period_ns
+        t0 = clock()
+        master.send_processdata()
+        wkc = master.receive_processdata(2000)
+        t1 = clock()
+        rtt.append(t1 - t0)
+        bad += wkc != expected
+        if period_ns and t1 - t0 > period_ns:
+            late += 1
+    elapsed = (clock() - start) / 1e9
+    out: dict[str, object] = {
+        "cycles": n,
+        "elapsed_s": round(elapsed, 3),
+        "cycles_per_s": round(n / elapsed, 1),
+        "wkc_errors": bad,
+        "rtt_us": percentiles(rtt),
+    }
+    if period_ns:
+        out["period_us"] = period_ns / 1000
+        out["late"] = late
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--eni", type=Path, default=ROOT / "examples" / "manual_fig5_2.eni")
+    p.add_argument("--cycles", type=int, default=20000, help="back-to-back cycles")
+    p.add_argument("--paced-cycles", type=int, default=2000, help="cycles at --period-us")
+    p.add_argument("--period-us", type=int, default=1000)
+    p.add_argument("--dc", action="store_true", help="configure DC (adds the FRMW datagram)")
+    p.add_argument("--master-if")
+    p.add_argument("--slave-if")
+    p.add_argument("--serve-arg", action="append", default=[], help="extra gtecat serve option")
+    p.add_argument("--json", type=Path, help="also write the result here")
+    args = p.parse_args(argv)
+    if os.geteuid() != 0 and not (args.master_if and args.slave_if):
+        raise SystemExit("needs root to create the veth pair (or pass --master-if/--slave-if)")
+    import pysoem
+
+    result: dict[str, object] = {"eni": str(args.eni), "dc": args.dc}
+    with tempfile.TemporaryDirectory() as tmp, veth_pair(args.master_if, args.slave_if) as (m, s):
+        stats = Path(tmp) / "stats.json"
+        with server(args.eni, s, stats, args.serve_arg):
+            master = pysoem.Master()
+            master.open(m)
+            try:
+                bring_to_op(master, args.dc)
+                result["slaves"] = len(master.slaves)
+                result["expected_wkc"] = master.expected_wkc
+                run_cycles(master, 500)  # warm up
+                result["max_rate"] = run_cycles(master, args.cycles)
+                if args.paced_cycles:
+                    result["paced"] = run_cycles(master, args.paced_cycles, args.period_us * 1000)
+            finally:
+                master.state = pysoem.INIT_STATE
+                master.write_state()
+                master.close()
+        report = json.loads(stats.read_text())
+        result["server_latency_us"] = report["latency"]
+        result["server"] = {k: report[k] for k in ("received", "sent", "steps", "chain")}
+    text = json.dumps(result, indent=2)
+    print(text)
+    if args.json:
+        args.json.write_text(text + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
