@@ -306,12 +306,16 @@ class SdoClient:
                 f"unexpected mailbox type {mbx.mbx_type}",
             )
         coe = CoeHeader.parse(mbx.data[:COE_HEADER_SIZE])
-        if coe.service != CoeService.SDO_RESPONSE:
+        body = mbx.data[COE_HEADER_SIZE:]
+        is_abort = body[0] == 0x80 and coe.service in (
+            CoeService.SDO_REQUEST,  # what ETG.1000.6 / SOES / IgH send
+            CoeService.SDO_RESPONSE,  # tolerated: some slaves label aborts so
+        )
+        if coe.service != CoeService.SDO_RESPONSE and not is_abort:
             raise SdoAbort(
                 SdoAbortCode.GENERAL_ERROR, index, subindex, f"unexpected CoE service {coe.service}"
             )
-        body = mbx.data[COE_HEADER_SIZE:]
-        if body[0] == 0x80:
+        if is_abort:
             if len(body) < 8:
                 raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, "short abort frame")
             ab = SdoAbortFrame.parse(body[:8])

@@ -110,8 +110,11 @@ class SdoServer:
 
     # --- framing ---------------------------------------------------------------
     def _respond(self, sdo: bytes) -> bytes:
+        """Frame an SDO answer.  An abort travels as CoE service 2 "SDO request"
+        (ETG.1000.6 Table 40; SOEM and IgH recognise an abort only that way)."""
         self.counter = next_counter(self.counter)
-        return build_coe(CoeService.SDO_RESPONSE, sdo, counter=self.counter)
+        service = CoeService.SDO_REQUEST if sdo[:1] == b"\x80" else CoeService.SDO_RESPONSE
+        return build_coe(service, sdo, counter=self.counter)
 
     def _mailbox_error(self, detail: MailboxError) -> bytes:
         self.counter = next_counter(self.counter)

@@ -200,25 +200,6 @@ def mailbox_error(detail: MailboxError) -> bytes:
     )
 
 
-def _abort_as_request(answer: bytes) -> bytes:
-    """An SDO abort travels with CoE service 2, "SDO request" (ETG.1000.6 Table 40).
-
-    SOEM and IgH recognise an abort only that way (SOEM takes an abort labelled
-    "SDO response" for a normal upload answer).  Answers that label it 3 are
-    relabelled here, so the wire is right whatever the SDO server does.
-    """
-    if (
-        len(answer) >= 9
-        and answer[5] & 0x0F == MailboxType.COE
-        and answer[7] >> 4 == 3
-        and answer[8] == 0x80
-    ):
-        buf = bytearray(answer)
-        buf[7] = (buf[7] & 0x0F) | 0x20
-        return bytes(buf)
-    return answer
-
-
 # --- which register bytes a master may write, and with which bits ----------------------------
 _WMASK = bytearray(REGISTER_SPACE)
 
@@ -773,7 +754,7 @@ class Esc:
         if answer is None and mtype != MailboxType.COE:
             answer = mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL)
         if answer:
-            self._mbx_queue.append(_abort_as_request(bytes(answer)))
+            self._mbx_queue.append(bytes(answer))
 
     def _put_mailbox(self, sm: SyncManager, answer: bytes) -> None:
         if len(answer) > sm.length:

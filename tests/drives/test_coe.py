@@ -77,7 +77,8 @@ def test_abort_frame_bytes() -> None:
     wire = Wire(SdoServer(blob_od()))
     with pytest.raises(SdoAbort):
         SdoClient(wire).upload(0x5555, 7)
-    assert wire.received[0][6:] == bytes.fromhex("0030 80 5555 07 00000206".replace(" ", ""))
+    # CoE service 2 "SDO request" carries an abort (ETG.1000.6 Table 40; SOEM, IgH)
+    assert wire.received[0][6:] == bytes.fromhex("0020 80 5555 07 00000206".replace(" ", ""))
 
 
 @given(

@@ -298,22 +298,6 @@ def test_a_length_beyond_the_buffer_is_an_invalid_size() -> None:
     assert (esc.read(0x1080, 128) or b"")[6:10] == struct.pack("<HH", 1, 0x08)
 
 
-def test_aborts_leave_as_sdo_requests() -> None:
-    esc, _ = make()
-    preop(esc)
-
-    def labelled_response(request: bytes) -> bytes:
-        return struct.pack("<HHBBHBHBI", 10, 0, 0, 3, 3 << 12, 0x80, 0x6000, 0, 0x06020000)
-
-    esc.slave.mailbox = labelled_response  # type: ignore[method-assign]
-    req = sdo_upload_request(0x6000, 0)
-    esc.write(0x1000, req + bytes(128 - len(req)))
-    esc.service()
-    answer = esc.read(0x1080, 128) or b""
-    assert answer[7] >> 4 == 2 and answer[8] == 0x80
-    assert struct.unpack_from("<I", answer, 12)[0] == 0x06020000
-
-
 def test_a_slave_exception_becomes_a_mailbox_error_not_a_crash() -> None:
     esc, _ = make()
     preop(esc)
