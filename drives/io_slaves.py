@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from eni.bits import get_bits, set_bits
 from eni.model import Direction, Identity, Pdo
 
-from .slave import AlState, VirtualSlave
+from .slave import AlState, AlStatusCode, VirtualSlave
 
 _SIGNED_TYPES = {"SINT", "INT", "DINT", "LINT", "INT8", "INT16", "INT32", "INT64"}
 
@@ -146,3 +146,90 @@ class IoSlave(VirtualSlave):
             set_bits(self.field_inputs, ib, 1, get_bits(self.field_outputs, ob, 1))
         if self.al_state >= AlState.SAFEOP:
             self.tx[:] = self.field_inputs
+
+
+class CoeIoSlave(IoSlave):
+    """An IO slave with a CoE mailbox (an ETG.5001 coupler, an analog terminal...).
+
+    Same object dictionary, PDO mapping/assignment objects (1600h-/1A00h-,
+    1C12h/1C13h) and SDO server as the CiA-402 drive, so the CoE InitCmds an ENI
+    carries for such a slave (acontis clears and re-assigns 1C12h/1C13h) work as
+    on the real device.  The field side keeps the point layout of the mapping the
+    master finally configured (recomputed at PREOP -> SAFEOP).  Mapped objects
+    that the slave does not describe are held as PDO placeholders; their SDO
+    upload reads what the process data holds last.
+    """
+
+    has_mailbox = True
+
+    def __init__(
+        self,
+        position: int,
+        name: str,
+        identity: Identity,
+        *,
+        rx_pdos: Sequence[Pdo] = (),
+        tx_pdos: Sequence[Pdo] = (),
+        device_type: int = 0x00001389,  # ETG.5001 modular device profile
+        mailbox_size: int = 128,
+    ) -> None:
+        from .od import Access, DataType, ObjectDictionary, Variable
+        from .pdo_mapping import PdoMapping
+        from .sdo_server import SdoServer
+
+        self.od = ObjectDictionary()
+        self.od.add_var(0x1000, "Device type", DataType.UINT32, Access.RO, default=device_type)
+        self.od.add_var(0x1008, "Device name", DataType.VISIBLE_STRING, Access.CONST, default=name)
+        self.od.add_record(
+            0x1018,
+            "Identity",
+            [
+                Variable(0x1018, k, n, DataType.UINT32, Access.RO, default=v)
+                for k, n, v in (
+                    (1, "Vendor ID", identity.vendor_id),
+                    (2, "Product code", identity.product_code),
+                    (3, "Revision number", identity.revision_no),
+                    (4, "Serial number", identity.serial_no),
+                )
+            ],
+        )
+        self.mapping = PdoMapping(self.od, rx_pdos, tx_pdos)
+        self.sdo = SdoServer(self.od, mailbox_size=mailbox_size)
+        super().__init__(position, name, identity, rx_pdos=rx_pdos, tx_pdos=tx_pdos)
+
+    def pdo_sizes(self) -> tuple[int, int]:
+        return self.mapping.sizes()
+
+    def mailbox(self, request: bytes) -> bytes | None:
+        return self.sdo.handle(request, self.al_state)
+
+    def on_state_change(self, old: AlState, new: AlState) -> AlStatusCode:
+        if old == AlState.PREOP and new == AlState.SAFEOP:
+            self._relayout()
+        return AlStatusCode.NO_ERROR
+
+    def _relayout(self) -> None:
+        """Field-side points from the mapping the master configured."""
+        points: dict[tuple[Direction, int, int], IoPoint] = {}
+        for direction in (Direction.OUT, Direction.IN):
+            bit = 0
+            for index, sub, bits in self.mapping.entries(direction):
+                if index > 0x0007:  # not a gap (CiA 301 dummy types)
+                    old = self.points.get((direction, index, sub))
+                    points.setdefault(
+                        (direction, index, sub),
+                        IoPoint(
+                            direction,
+                            index,
+                            sub,
+                            bit,
+                            bits,
+                            old.name if old else "",
+                            old.signed if old else False,
+                        ),
+                    )
+                bit += bits
+        self.points = points
+        rx_bits, tx_bits = self.mapping.sizes()
+        self.field_outputs = bytearray((rx_bits + 7) // 8)
+        self.field_inputs = bytearray((tx_bits + 7) // 8)

@@ -3,17 +3,19 @@
 A slave that maps a CiA-402 controlword/statusword pair per channel becomes a
 :class:`drives.drive.Cia402Drive` with one channel per GT axis (its mechanics
 from the machine description, by GT axis number); every other slave becomes a
-:class:`drives.io_slaves.IoSlave` driven by its mapping.  The drives' initial
+:class:`drives.io_slaves.IoSlave` driven by its mapping (a
+:class:`drives.io_slaves.CoeIoSlave` when the ENI gives it a mailbox).  The drives' initial
 PDO mapping is what the ENI lists; the ENI's CoE InitCmds are then applied by
 the master through the mailbox, as on a real bus.
 """
 
 from __future__ import annotations
 
-from drives.io_slaves import IoSlave
+from drives.io_slaves import CoeIoSlave, IoSlave
 from drives.machine import MachineDescription
 from drives.slave import VirtualSlave
 from eni.layout import Layout
+from eni.model import InitCmd
 
 
 def build_slave(
@@ -40,9 +42,62 @@ def build_slave(
             channels=channels,
             machines=machines,
         )
-    return IoSlave(cfg.position, cfg.name, cfg.identity, rx_pdos=cfg.rx_pdos, tx_pdos=cfg.tx_pdos)
+    cls = CoeIoSlave if cfg.mailbox else IoSlave
+    return cls(cfg.position, cfg.name, cfg.identity, rx_pdos=cfg.rx_pdos, tx_pdos=cfg.tx_pdos)
+
+
+def adopt_init_cmd_objects(slave: VirtualSlave, cmds: tuple[InitCmd, ...]) -> list[str]:
+    """Give a virtual slave the objects its ENI's CoE InitCmds write but it lacks.
+
+    An ENI made for a real device configures that device's own parameters
+    (vendor objects such as 0x8000:xx settings).  The virtual slave takes them
+    as plain read-write parameters of the written size, so the bring-up works
+    and an SDO upload reads the value back; the slave's behaviour ignores them.
+    Mapping and assignment objects are never invented.  Returns what was added.
+    """
+    od = getattr(slave, "od", None)
+    if od is None:
+        return []
+    from drives.od import Access, DataType, ObjectCode, OdObject, Variable
+
+    added = []
+    sizes = {1: DataType.UINT8, 2: DataType.UINT16, 4: DataType.UINT32, 8: DataType.UINT64}
+    for cmd in cmds:
+        if cmd.upload or 0x1600 <= cmd.index < 0x1C00 or cmd.index in (0x1C12, 0x1C13):
+            continue
+        sub = 0 if cmd.complete_access else cmd.subindex
+        if od.find(cmd.index, sub) is not None:
+            continue
+        dtype = sizes.get(len(cmd.data), DataType.OCTET_STRING)
+        default: object = 0 if dtype != DataType.OCTET_STRING else bytes(len(cmd.data))
+        var = Variable(
+            cmd.index,
+            sub,
+            f"0x{cmd.index:04X}:{sub:02X} (from the ENI)",
+            dtype,
+            Access.RW,
+            default=default,
+        )
+        obj = od.objects.get(cmd.index)
+        if obj is None:
+            code = ObjectCode.VAR if sub == 0 else ObjectCode.RECORD
+            obj = od.add_object(OdObject(cmd.index, var.name, code))
+            if sub:
+                obj.add(
+                    Variable(
+                        cmd.index, 0, "Number of entries", DataType.UINT8, Access.RO, default=sub
+                    )
+                )
+        elif 0 in obj.subs and sub > 0 and obj.subs[0].getter is None:
+            obj.subs[0].value = max(int(obj.subs[0].value), sub)
+        obj.add(var)
+        added.append(f"0x{cmd.index:04X}:{sub:02X}")
+    return added
 
 
 def build_slaves(layout: Layout, machine: MachineDescription | None = None) -> list[VirtualSlave]:
     """One virtual slave per ENI slave, in bus order."""
-    return [build_slave(layout, i, machine) for i in range(len(layout.slaves))]
+    slaves = [build_slave(layout, i, machine) for i in range(len(layout.slaves))]
+    for slave, cfg in zip(slaves, layout.config.slaves, strict=True):
+        adopt_init_cmd_objects(slave, cfg.init_cmds)
+    return slaves
