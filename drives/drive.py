@@ -655,6 +655,8 @@ class Channel:
         if self.psm.fault():
             self.error_code_value = code
             self._transition(13)
+            # CiA 301 7.2.7 / ETG.1000.6 5.6.4: an emergency telegram with 603Fh and 1001h
+            self.drive.emit_emergency(code, 0x01, bytes([self.k, 0, 0, 0, 0]))
 
     def step(self, t_ns: int, dt_ns: int, dt: float, cw_valid: bool) -> None:
         self.cycle += 1

@@ -12,6 +12,8 @@ exactly the slave's region of the GT raw image (manual 5.2.2.4).
 
 from __future__ import annotations
 
+from collections import deque
+from dataclasses import dataclass
 from enum import IntEnum
 
 from eni.model import Identity
@@ -85,6 +87,15 @@ _ALLOWED: dict[AlState, frozenset[AlState]] = {
 }
 
 
+@dataclass(frozen=True, slots=True)
+class Emergency:
+    """A CoE emergency (ETG.1000.6 5.6.4, CiA 301 7.2.7): error code, register, 5 data bytes."""
+
+    code: int
+    register: int
+    data: bytes = bytes(5)
+
+
 class VirtualSlave:
     """Base of every virtual slave.
 
@@ -110,6 +121,12 @@ class VirtualSlave:
         self.outputs_valid = False
         #: set by the master to what the ENI expects, checked at PREOP -> SAFEOP
         self.expected_sizes: tuple[int, int] | None = None
+        #: emergencies not yet fetched by the master (bounded like a mailbox queue)
+        self.emergencies: deque[Emergency] = deque(maxlen=32)
+
+    def emit_emergency(self, code: int, register: int, data: bytes = bytes(5)) -> None:
+        """Queue a CoE emergency; the master fetches it (and logs it like IgH does)."""
+        self.emergencies.append(Emergency(code, register, bytes(data[:5]).ljust(5, b"\0")))
 
     # --- hooks -------------------------------------------------------------
     def pdo_sizes(self) -> tuple[int, int]:

@@ -69,6 +69,7 @@ class Master:
         self.last = CycleResult(0, 0)
         self.wkc_errors = 0
         self.cycles = 0
+        self.emergency_count = 0
         self.opened = False
         self.target = AlState.INIT
         self._op_countdown = -1
@@ -205,6 +206,12 @@ class Master:
             self.wkc_errors += 1
             if self.wkc_errors == 1 or self.wkc_errors % 1000 == 0:
                 self.log(f"Working counter changed to {wkc}/{expected}.")
+        for pos, emcy in self.backend.emergencies():
+            self.emergency_count += 1
+            self.log(
+                f"WARNING {pos}: CoE EMERGENCY 0x{emcy.code:04X} 0x{emcy.register:02X} "
+                f"{emcy.data.hex(' ')}"
+            )
         for hook in self.on_cycle:
             hook(self)
         return self.last

@@ -66,5 +66,9 @@ class Backend(ABC):
     ) -> None:
         """CoE SDO download; raises :class:`drives.abort.SdoAbort`."""
 
+    def emergencies(self) -> list[tuple[int, object]]:
+        """CoE emergencies received since the last call: ``(position, Emergency)``."""
+        return []
+
     def close(self) -> None:  # noqa: B027 - optional hook
         """Release the bus."""

@@ -100,6 +100,13 @@ class EmulatedBackend(Backend):
                 wkc += 1
         return wkc
 
+    def emergencies(self) -> list[tuple[int, object]]:
+        out = []
+        for slave in self.slaves:
+            while slave.emergencies:
+                out.append((slave.position, slave.emergencies.popleft()))
+        return out
+
     def expected_wkc(self) -> int:
         return sum(2 * (o is not None) + (i is not None) for _, o, i in self._plan)
 

@@ -182,6 +182,8 @@ def test_forced_following_error_faults_and_a_reset_clears_it():
     off = _map_offsets(FULL)[(0, 0x6041, 0)]
     gt.GT_GetEcatRawData(off, 2, byref(sw))
     assert sw.value & 0x4F == 0x08  # fault
+    # the drive's CoE emergency is in the master log, as IgH writes it
+    assert any("CoE EMERGENCY 0x8611" in line for line in gt.GTE_Controller().log.lines)
     assert gt.GT_AxisOn(1) == 1 and "0x8611" in gt.GTE_GetLastError()
     # fault reset through raw data: 0 then a rising edge of bit 7 (cia402-facts 1.3)
     cw_off = _map_offsets(FULL)[(0, 0x6040, 0)]
