@@ -202,6 +202,10 @@ class Master:
             self._op_countdown -= 1
             if self._op_countdown < 0:
                 self.request_op()
+        elif self.target == AlState.OP and self.last.ok and not self.all_op():
+            # the working counter is whole again (a slave came back and the backend
+            # recovered it): take the states as they are now
+            self.refresh_states()
         elif self.target == AlState.OP and self.all_op() and not self.last.ok:
             self.wkc_errors += 1
             if self.wkc_errors == 1 or self.wkc_errors % 1000 == 0:

@@ -89,9 +89,13 @@ class Clock:
         return self.advance_ns(round(ms * 1_000_000))
 
     def on_call(self) -> None:
-        """A GT call happened: in ``auto`` mode it costs virtual latency."""
+        """A GT call happened: in ``auto`` mode it costs virtual latency; in ``realtime``
+        the caller yields the interpreter, so a tight polling loop cannot starve the
+        cycle thread (the call itself ran with the cycle lock held)."""
         if self.mode is ClockMode.AUTO and self.call_latency_ns:
             self.advance_ns(self.call_latency_ns)
+        elif self.mode is ClockMode.REALTIME:
+            time.sleep(0)
 
     def run_until(self, pred: Callable[[], bool], timeout_ms: float) -> bool:
         """Run whole cycles until ``pred()`` holds or ``timeout_ms`` passes."""

@@ -50,8 +50,13 @@ class Options:
         return Options(
             eni=self.eni or env.get("GTECAT_ENI") or "Gecat.eni",
             machine=self.machine if self.machine is not None else env.get("GTECAT_MACHINE"),
-            clock=(self.clock or env.get("GTECAT_CLOCK") or "auto").lower(),
-            backend=(self.backend or env.get("GTECAT_BACKEND") or "emulated").lower(),
+            backend=(backend := (self.backend or env.get("GTECAT_BACKEND") or "emulated").lower()),
+            # a real NIC needs cycles on the wall clock: realtime unless asked otherwise
+            clock=(
+                self.clock
+                or env.get("GTECAT_CLOCK")
+                or ("realtime" if backend == "pysoem" else "auto")
+            ).lower(),
             iface=self.iface or env.get("GTECAT_IFACE"),
             cycle_ms=self.cycle_ms,
             call_latency_us=self.call_latency_us,
@@ -157,7 +162,7 @@ class Controller:
         if self.options.backend == "pysoem":
             from .backends.pysoem_backend import PysoemBackend  # optional extra
 
-            return PysoemBackend(self.options.iface)
+            return PysoemBackend(self.options.iface, log=self.log)
         from .backends.emulated import EmulatedBackend
 
         hardware = None

@@ -371,6 +371,13 @@ def GTE_GetLastError() -> str:
     return "" if e is None else f"{e.function} returned {e.code}: {e.reason}"
 
 
+def GTE_GetCycleStats(core: int = 1) -> dict:
+    """Cycle period, jitter (p50/p99/max), overruns and working-counter errors so far."""
+    from ..backends.cycle_stats import cycle_stats
+
+    return cycle_stats(SESSION.controller(core))
+
+
 def GTE_Controller(core: int = 1) -> Controller:
     """The open controller (the Pythonic API) for scenarios and tests."""
     return SESSION.controller(core)

@@ -597,12 +597,6 @@ def test_backend_cycle_stats_are_collected():
     assert len(backend.stats.rtt_samples()) == backend.stats.cycles
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bus.Master.refresh_states() (GT_GetEcatSlaves during an outage) records the lost "
-    "slave as NONE and nothing refreshes it once the working counter is good again, so "
-    "GT_IsEcatReady stays 0; fix belongs in gtecat/bus.py (reported to the lead)",
-)
 def test_ready_returns_after_recovery_even_if_states_were_read_during_the_outage():
     master, backend, devices, _ = make_bus()
     backend.check_interval_ms = 5
