@@ -111,24 +111,22 @@ class Mechanics:
         v = (demand - e1 - p) / dt
         lim = self.amax * dt
         limited = False
+        # closing speed on the (moving) demand that still lets the axis brake onto it
+        # within the acceleration limit (exact for the discrete cycle, _closing_speed)
+        dist = demand - p
+        vstop = _closing_speed(abs(dist), lim, dt)
+        if dist > 0.0 and v > vff + vstop:
+            v, limited = vff + vstop, True
+        elif dist < 0.0 and v < vff - vstop:
+            v, limited = vff - vstop, True
         dv = v - v0
-        if dv > lim or dv < -lim:
-            limited = True
-            # closing speed on the (moving) demand that still lets the axis brake onto it
-            # (discrete braking: stepping v·dt per cycle, v²/2a + v·dt/2 must fit in dist)
-            dist = demand - p
-            half = 0.5 * lim
-            vstop = math.sqrt(half * half + 2.0 * self.amax * abs(dist)) - half
-            if dist > 0.0 and v > vff + vstop:
-                v = vff + vstop
-            elif dist < 0.0 and v < vff - vstop:
-                v = vff - vstop
-            dv = v - v0
-            if dv > lim:
-                v = v0 + lim
-            elif dv < -lim:
-                v = v0 - lim
-            # never run past the demand (a cycle longer than the last one brakes less finely)
+        if dv > lim:
+            v, limited = v0 + lim, True
+        elif dv < -lim:
+            v, limited = v0 - lim, True
+        if limited:
+            # landing: never run past the demand (with the exact braking curve this only
+            # bites when a cycle is longer than the one before it)
             if dist > 0.0 and v * dt > dist:
                 v = dist / dt
             elif dist < 0.0 and v * dt < dist:
@@ -178,3 +176,28 @@ class Mechanics:
 
     def stopped(self, threshold: float) -> bool:
         return -threshold < self.vel < threshold
+
+
+def _closing_speed(dist: float, lim: float, dt: float) -> float:
+    """The highest speed to step with now and still stop exactly ``dist`` ahead.
+
+    Discrete braking: after stepping ``v`` for one cycle the speed can drop by at
+    most ``lim`` per cycle, so the least distance left to cover is
+    ``dt * sum(max(v - j*lim, 0) for j >= 1)``.  With ``m = floor(v / lim)`` that is
+    ``dt * (m*v - lim*m*(m+1)/2)``; solving ``v*dt + that <= dist`` per segment ``m``
+    gives the exact bound, so landing never needs more than 6083h allows.
+    """
+    if dist <= 0.0 or lim <= 0.0:
+        return 0.0
+    d = dist / dt
+    half = 0.5 * lim
+    m = int((math.sqrt(half * half + 2.0 * lim * d) - half) // lim)  # continuous estimate
+    for _ in range(8):
+        v = (d + lim * m * (m + 1) / 2.0) / (m + 1)
+        if v < m * lim and m > 0:
+            m -= 1
+        elif v >= (m + 1) * lim:
+            m += 1
+        else:
+            return v
+    return min(v, d)
