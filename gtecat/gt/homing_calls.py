@@ -1,0 +1,497 @@
+"""GT homing and touch-probe calls of EtherCAT axes, and the emulator's machine position.
+
+Manual 5.2.2.2 (homing), 5.2.2.3 (touch probe), examples 5-2 and 5-3, chapter 13
+entries 43, 73, 103, 112, 123, 124, 130, 133.  The controller only sets parameters,
+switches the mode, starts, reads the status and stops; the drive does the rest
+(``drives/homing.py``, ``drives/touch_probe.py``).
+
+Objects travel by PDO when the ENI maps them, else by SDO.  The manual grants the
+SDO fallback for 6060h/6061h (5.2.2.2); here it also covers the homing parameters
+(6098h, 6099h:01/02, 609Ah, 607Ch, which are SDO objects on most drives) and the
+touch-probe objects 60B8h-60BDh, so the figure 5-2 bus (which maps only
+6040/607A/6041/6064/60FD) can still home and probe.  Return 1 then means the SDO
+failed too; the reason names the object and the abort code.  6041h must be mapped
+(it defines the axis).
+
+Decisions where the manual is silent:
+
+* **Units** (entry 103: "the drive's user units"): ``speed1``/``speed2`` go to
+  6099h:01/02 in drive counts/s, ``acc`` to 609Ah in counts/s², ``offset`` to 607Ch
+  in drive counts - not pulses (``GT_SetPosScale`` does not apply).  Values are
+  rounded to integers; a negative, non-finite or too large value returns 7, and
+  so does a zero speed or acceleration for a method that searches (all but 35/37).
+* **probeFunction** (entry 103: only for probe-based methods, which are
+  vendor-specific; the virtual drive has none): a non-zero value is written to
+  60B8h with the other parameters, so a drive whose method uses a touch probe finds
+  it armed; 0 leaves 60B8h as it is.
+* **GT_SetHomingMode(axis, mode)** writes 6060h and waits (at most
+  :data:`_MODE_TIMEOUT_MS` of controller time, python-canopen's bound) until 6061h
+  shows the mode; 1 if it does not.  Leaving homing mode while the drive still moves
+  first lets it come to rest: a search that has not found the home point is
+  interrupted (CW4 low), one that has finishes its move onto it.  Entering CSP takes the
+  actual position as the planned position, so the axis never jumps.  Asking for the mode
+  the drive already shows does nothing (example 5-2 asks on every scan once homed).
+  1 while the controller is planning a motion (entry 112).
+* **GT_StartEcatHoming** checks the three conditions of 5.2.2.2 (drive in operation
+  enabled, 6061h = 6, parameters set by ``GT_SetEcatHomingPrm`` since the bus came
+  up), then raises CW4 (clearing it for one cycle first when it is still high from a
+  previous run, so the drive sees a rising edge) and returns once the drive has
+  answered the start, so a status read right after it is never stale (cia402-facts
+  §7 pitfall 2).
+* **GT_StopEcatHoming** drops CW4, which CiA 402 defines as "interrupt homing": the
+  drive decelerates at 609Ah and reports "interrupted" (status 1) once stopped.  It
+  returns after the command has gone out, without waiting for the stop.
+* **GT_GetEcatHomingStatus**: bit 0 = SW10 (done: at rest), bit 1 = SW12 (home
+  point found), bit 2 = SW13 (error), so 0 in progress, 1 interrupted or not
+  started, 2 found and moving onto it, 3 completed (example 5-2), 4 error while
+  moving, 5 error at rest.  Outside homing mode the bits mean other things, so the
+  call reports the last value read in homing mode (1 before any homing).
+* **GT_SetTouchProbeFunction** sends ``ProbePrm`` to 60B8h as a 16-bit pattern
+  (a negative ``short`` is taken bit for bit).  Bits 2-3 / 10-11, "reserved" in
+  entry 123, select the source as ETG.6010 defines (00 probe input, 01 encoder
+  index).  Both set calls return once the drive shows the enable bits in 60B9h.
+* **GT_SetTouchProbeFunctionEx** constants (the vendor header's values are not
+  public; these are ours, the 60B8h bit patterns): ``ECAT_PROBE_TRIGGER_TYPE_FIRST_EVENT``
+  0, ``..._CONTINUES`` 1 (bit 1); ``ECAT_PROBE_TRIGGER_LEVEL_POS`` 1, ``..._NEG`` 2,
+  ``..._DUL`` 3 (bits 5:4).  The source is the probe input.
+* **GT_GetTouchProbeStatus** reports 60B9h as the drive has it: the manual's bits
+  0-2 and 8-10 (entry 73) and the drive's toggle bits, which flip on every new
+  capture in continuous mode: bit 6 probe 1 rising (GTHD, example 5-3), bit 7
+  probe 1 falling, bit 14 probe 2 rising, bit 15 probe 2 falling.  A NULL (None)
+  pointer skips that object.
+* **GTE_GetMachinePos(axis, pValue)** (emulator only): where the mechanics really
+  are, in machine counts (what a scale on the machine reads), unaffected by homing.
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from dataclasses import dataclass
+from enum import IntFlag
+from typing import Any
+
+from drives.abort import SdoAbort
+
+from ..axis import Axis, PdsState
+from ..controller import Controller
+from ..errors import CommandError, ParameterError
+from ._core import check_range, gt_function, store
+from .axis_calls import ECAT_MODES, bus_axis
+
+# --- constants of GT_SetTouchProbeFunctionEx (entry 124) ------------------------------------
+ECAT_PROBE_TRIGGER_TYPE_FIRST_EVENT = 0
+ECAT_PROBE_TRIGGER_TYPE_CONTINUES = 1
+ECAT_PROBE_TRIGGER_LEVEL_POS = 1
+ECAT_PROBE_TRIGGER_LEVEL_NEG = 2
+ECAT_PROBE_TRIGGER_LEVEL_DUL = 3
+
+_HOMING_MODE = 6
+_CSP_MODE = 8
+_CW_HOMING_START = 0x0010  # CW4 in homing mode (cia402-facts §3.1)
+_CW_HALT = 0x0100  # CW8
+_SW10, _SW12, _SW13 = 1 << 10, 1 << 12, 1 << 13
+_SW_HOMING = _SW10 | _SW12 | _SW13
+_SW_NOT_STARTED = _SW10  # "homing interrupted or not started"
+
+#: controller time GT_SetHomingMode waits for 6061h (python-canopen's 0.5 s)
+_MODE_TIMEOUT_MS = 500.0
+#: controller time leaving homing mode waits for a moving drive to stop
+_STOP_TIMEOUT_MS = 10_000.0
+#: controller time GT_StartEcatHoming waits for the drive to answer CW4
+_START_TIMEOUT_MS = 50.0
+#: controller time the probe set calls wait for 60B9h to show the enable bits
+_PROBE_TIMEOUT_MS = 20.0
+_METHODS_WITHOUT_MOTION = (35, 37)
+
+
+class ProbeStatus(IntFlag):
+    """60B9h as GT_GetTouchProbeStatus reports it (entry 73 and the drive's toggle bits)."""
+
+    PROBE1_ENABLED = 1 << 0
+    PROBE1_RISE_STORED = 1 << 1
+    PROBE1_FALL_STORED = 1 << 2
+    PROBE1_RISE_TOGGLE = 1 << 6
+    PROBE1_FALL_TOGGLE = 1 << 7
+    PROBE2_ENABLED = 1 << 8
+    PROBE2_RISE_STORED = 1 << 9
+    PROBE2_FALL_STORED = 1 << 10
+    PROBE2_RISE_TOGGLE = 1 << 14
+    PROBE2_FALL_TOGGLE = 1 << 15
+
+
+@dataclass(slots=True)
+class _AxisHoming:
+    """What the controller remembers about one axis's homing (lives as long as the axis)."""
+
+    params_set: bool = False
+    last_status: int = 1  # "interrupted or not started" until a homing status is read
+
+
+_STATE: weakref.WeakKeyDictionary[Axis, _AxisHoming] = weakref.WeakKeyDictionary()
+
+
+def _state(ax: Axis) -> _AxisHoming:
+    st = _STATE.get(ax)
+    if st is None:
+        st = _STATE[ax] = _AxisHoming()
+    return st
+
+
+# --- object access: PDO if mapped, else SDO ---------------------------------------------------
+def _read(ax: Axis, index: int, subindex: int, size: int, signed: bool) -> int:
+    try:
+        return ax.io.read_or_sdo(index, subindex, size, signed)
+    except SdoAbort as e:
+        raise CommandError(
+            f"axis {ax.number}: 0x{ax.io.index(index):04X}:{subindex:02X} is not mapped as PDO "
+            f"and the SDO upload failed: {e}"
+        ) from None
+
+
+def _write(ax: Axis, index: int, subindex: int, value: int, size: int) -> None:
+    try:
+        ax.io.write_or_sdo(index, subindex, value, size)
+    except SdoAbort as e:
+        raise CommandError(
+            f"axis {ax.number}: writing {value} to 0x{ax.io.index(index):04X}:{subindex:02X} "
+            f"failed: {e}"
+        ) from None
+
+
+def _statusword(ax: Axis) -> int:
+    """6041h, which must be mapped (return 1 naming it, entry 43)."""
+    return ax.io.read(0x6041)
+
+
+def homing_status_bits(statusword: int) -> int:
+    """SW10/SW12/SW13 -> GT homing status bits 0/1/2 (module docstring)."""
+    return (
+        (1 if statusword & _SW10 else 0)
+        | (2 if statusword & _SW12 else 0)
+        | (4 if statusword & _SW13 else 0)
+    )
+
+
+def _wait_cycles(ctl: Controller, n: int = 1) -> None:
+    """Let ``n`` whole bus cycles run, so what was written has been exchanged."""
+    c0 = ctl.clock.cycles
+    ctl.clock.run_until(lambda: ctl.clock.cycles >= c0 + n, (n + 2) * ctl.clock.cycle_ns / 1e6)
+
+
+def _homing_moving(ax: Axis) -> bool:
+    """The drive is in a homing procedure that has not come to rest."""
+    if ax.state != PdsState.OPERATION_ENABLED:
+        return False
+    return not _statusword(ax) & _SW10
+
+
+# --- the Pythonic layer -----------------------------------------------------------------------
+def set_homing_mode(ctl: Controller, ax: Axis, mode: int) -> None:
+    """Switch the drive's mode of operation (6060h) and wait for 6061h (GT_SetHomingMode)."""
+    if mode not in ECAT_MODES:
+        raise ParameterError(f"mode {mode} is not one of {ECAT_MODES} (manual entry 112)")
+    was = ax.mode_cmd
+    if mode == was and _mode_display(ax) == mode:
+        return  # already there (example 5-2 calls it on every scan once homed)
+    if getattr(ax, "moving", False):
+        raise CommandError(
+            f"axis {ax.number} is planning a motion: call GT_Stop first (manual entry 112)"
+        )
+    if was == _HOMING_MODE and mode != _HOMING_MODE:
+        if _mode_display(ax) == _HOMING_MODE:
+            _settle_homing(ctl, ax)
+        _state(ax).last_status = homing_status_bits(_statusword(ax))
+    if mode != was:
+        ax.cw &= ~(_CW_HOMING_START | _CW_HALT)
+    if mode == _CSP_MODE:
+        ax.sync_to_actual()  # the planned position starts where the axis stands
+    _write(ax, 0x6060, 0, mode, 1)
+    ax.mode_cmd = mode
+    if not ctl.clock.run_until(lambda: _mode_display(ax) == mode, _MODE_TIMEOUT_MS):
+        raise CommandError(
+            f"axis {ax.number}: 6061h still shows mode {_mode_display(ax)} "
+            f"{_MODE_TIMEOUT_MS:g} ms after 6060h = {mode} was written"
+        )
+    if mode == _CSP_MODE:
+        ax.sync_to_actual()
+
+
+def _mode_display(ax: Axis) -> int:
+    return _read(ax, 0x6061, 0, 1, True)
+
+
+def _settle_homing(ctl: Controller, ax: Axis) -> None:
+    """Before leaving homing mode, let the axis come to rest.
+
+    A search that has not found the home point is interrupted (CW4 low); one that has
+    (SW12) finishes its short move onto the home point, so the axis ends where 6064h
+    reads the home offset.
+    """
+    if not _homing_moving(ax):
+        return
+    if not _statusword(ax) & _SW12:
+        ax.cw &= ~_CW_HOMING_START
+    if not ctl.clock.run_until(lambda: not _homing_moving(ax), _STOP_TIMEOUT_MS):
+        raise CommandError(
+            f"axis {ax.number}: the homing drive did not report standstill (SW10) within "
+            f"{_STOP_TIMEOUT_MS:g} ms; mode not changed"
+        )
+
+
+def set_homing_parameters(
+    ax: Axis,
+    method: int,
+    speed1: float,
+    speed2: float,
+    acc: float,
+    offset: int,
+    probe_function: int,
+) -> None:
+    """GT_SetEcatHomingPrm: 6098h, 6099h:01/02, 609Ah, 607Ch (and 60B8h when non-zero)."""
+    method = check_range("method", method, -128, 127)
+    offset = check_range("offset", offset, -(1 << 31), (1 << 31) - 1)
+    probe_function = check_range("probeFunction", probe_function, 0, 0xFFFF)
+    searches = method not in _METHODS_WITHOUT_MOTION
+    values = [
+        _unsigned32(name, v, positive=searches)
+        for name, v in (("speed1", speed1), ("speed2", speed2), ("acc", acc))
+    ]
+    if ax.mode_cmd == _HOMING_MODE and ax.cw & _CW_HOMING_START and _homing_moving(ax):
+        raise CommandError(
+            f"axis {ax.number} is homing: stop it (GT_StopEcatHoming) before changing "
+            "its parameters"
+        )
+    st = _state(ax)
+    st.params_set = False
+    _write(ax, 0x6098, 0, method, 1)
+    _write(ax, 0x6099, 1, values[0], 4)
+    _write(ax, 0x6099, 2, values[1], 4)
+    _write(ax, 0x609A, 0, values[2], 4)
+    _write(ax, 0x607C, 0, offset, 4)
+    if probe_function:
+        _write(ax, 0x60B8, 0, probe_function, 2)
+    st.params_set = True
+
+
+def _unsigned32(name: str, value: float, *, positive: bool) -> int:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={value!r} is not a number") from None
+    if not math.isfinite(v) or v < 0 or round(v) > 0xFFFFFFFF:
+        raise ParameterError(f"{name}={value!r} out of range 0..4294967295 (drive units)")
+    if positive and round(v) == 0:
+        raise ParameterError(f"{name}={value!r}: a homing search needs a non-zero {name}")
+    return round(v)
+
+
+def start_homing(ctl: Controller, ax: Axis) -> None:
+    """GT_StartEcatHoming: the three conditions of 5.2.2.2, then a rising CW4."""
+    state = ax.state
+    if state != PdsState.OPERATION_ENABLED:
+        raise CommandError(
+            f"axis {ax.number}: the drive is not servo-enabled (state {state.name}); "
+            "call GT_AxisOn first (manual 5.2.2.2 condition 1)"
+        )
+    shown = _mode_display(ax)
+    if shown != _HOMING_MODE:
+        raise CommandError(
+            f"axis {ax.number}: 6061h shows mode {shown}, not homing (6); call "
+            "GT_SetHomingMode(axis, 6) first (manual 5.2.2.2 condition 2)"
+        )
+    if not _state(ax).params_set:
+        raise CommandError(
+            f"axis {ax.number}: homing parameters not set; call GT_SetEcatHomingPrm first "
+            "(manual 5.2.2.2 condition 3)"
+        )
+    if ax.cw & _CW_HOMING_START and _homing_moving(ax):
+        raise CommandError(
+            f"axis {ax.number} is already homing; GT_StopEcatHoming first to start afresh"
+        )
+    ax.mode_cmd = _HOMING_MODE
+    if ax.cw & (_CW_HOMING_START | _CW_HALT):
+        ax.cw &= ~(_CW_HOMING_START | _CW_HALT)
+        _wait_cycles(ctl)  # the drive must see CW4 low before it can see it rise
+    ax.cw |= _CW_HOMING_START
+    c0 = ctl.clock.cycles
+
+    def answered() -> bool:
+        return ctl.clock.cycles > c0 and _statusword(ax) & _SW_HOMING != _SW_NOT_STARTED
+
+    if not ctl.clock.run_until(answered, _START_TIMEOUT_MS):
+        raise CommandError(
+            f"axis {ax.number}: the drive did not start homing within {_START_TIMEOUT_MS:g} ms "
+            f"of CW4 rising (statusword 0x{_statusword(ax):04X})"
+        )
+
+
+def stop_homing(ctl: Controller, ax: Axis) -> None:
+    """GT_StopEcatHoming: CW4 low (CiA 402 "interrupt homing"), sent this cycle."""
+    if ax.cw & _CW_HOMING_START:
+        ax.cw &= ~_CW_HOMING_START
+        _wait_cycles(ctl)
+
+
+def homing_status(ax: Axis) -> int:
+    """GT_GetEcatHomingStatus's value (module docstring); the polling hot path."""
+    st = _STATE.get(ax) or _state(ax)
+    if ax.mode_cmd == _HOMING_MODE:
+        sw = ax.statusword if ax.io.get(0x6041) is not None else _statusword(ax)
+        st.last_status = homing_status_bits(sw)
+    return st.last_status
+
+
+def set_probe_function(ctl: Controller, ax: Axis, function: int) -> None:
+    """Write 60B8h and wait until 60B9h shows the enable bits (both probe set calls)."""
+    function &= 0xFFFF
+    _write(ax, 0x60B8, 0, function, 2)
+    mask = ProbeStatus.PROBE1_ENABLED | ProbeStatus.PROBE2_ENABLED  # = 60B8h bits 0 and 8
+    enables = function & mask
+    if not ctl.clock.run_until(
+        lambda: _read(ax, 0x60B9, 0, 2, False) & mask == enables, _PROBE_TIMEOUT_MS
+    ):
+        raise CommandError(
+            f"axis {ax.number}: 60B9h does not show the probe enable bits of 60B8h = "
+            f"0x{function:04X} within {_PROBE_TIMEOUT_MS:g} ms"
+        )
+
+
+def probe_function_ex(
+    enable1: int, type1: int, level1: int, enable2: int, type2: int, level2: int
+) -> int:
+    """The 60B8h word GT_SetTouchProbeFunctionEx describes (source: probe input)."""
+    word = 0
+    for shift, (n, en, typ, lev) in (
+        (0, (1, enable1, type1, level1)),
+        (8, (2, enable2, type2, level2)),
+    ):
+        en = check_range(f"Probe{n}Enable", en, 0, 1)
+        if not en:
+            continue
+        typ = check_range(f"Probe{n}TriggerType", typ, 0, 1)
+        lev = check_range(f"Probe{n}TriggerLevel", lev, 1, 3)
+        word |= (1 | typ << 1 | lev << 4) << shift
+    return word
+
+
+def machine_position(ctl: Controller, ax: Axis) -> float:
+    """Where the axis's mechanics are (emulated backend only), machine counts."""
+    slaves = getattr(ctl.backend, "slaves", None)
+    if slaves is None:
+        raise CommandError(
+            f"axis {ax.number}: the machine position exists only on the emulated backend "
+            f"(this bus runs on {ctl.options.backend})"
+        )
+    channel = slaves[ax.io.slave].channel(ax.io.channel)
+    return float(channel.machine_position)
+
+
+# --- the GT functions ---------------------------------------------------------------------------
+@gt_function
+def GT_SetHomingMode(ctl: Controller, axis: int, mode: int) -> int:
+    """Switch the drive's mode of operation, e.g. 6 homing, 8 CSP (entry 112)."""
+    set_homing_mode(ctl, bus_axis(ctl, axis), check_range("mode", mode, -128, 127))
+    return 0
+
+
+@gt_function
+def GT_SetEcatHomingPrm(
+    ctl: Controller,
+    axis: int,
+    method: int,
+    speed1: float,
+    speed2: float,
+    acc: float,
+    offset: int,
+    probeFunction: int,
+) -> int:
+    """Homing method, speeds, acceleration, home offset and probe function (entry 103)."""
+    set_homing_parameters(bus_axis(ctl, axis), method, speed1, speed2, acc, offset, probeFunction)
+    return 0
+
+
+@gt_function
+def GT_StartEcatHoming(ctl: Controller, axis: int) -> int:
+    """Start homing: 1 unless servo on, mode homing and parameters set (entry 130)."""
+    start_homing(ctl, bus_axis(ctl, axis))
+    return 0
+
+
+@gt_function
+def GT_StopEcatHoming(ctl: Controller, axis: int) -> int:
+    """Interrupt homing (CW4 low); the drive stops at 609Ah (entry 133)."""
+    stop_homing(ctl, bus_axis(ctl, axis))
+    return 0
+
+
+@gt_function
+def GT_GetEcatHomingStatus(ctl: Controller, axis: int, pHomingStatus: Any) -> int:
+    """Bit 0 done, bit 1 success, bit 2 error (entry 43); 3 = homed."""
+    store(pHomingStatus, homing_status(bus_axis(ctl, axis)))
+    return 0
+
+
+@gt_function
+def GT_SetTouchProbeFunction(ctl: Controller, axis: int, ProbePrm: int) -> int:
+    """Write the 60B8h bit pattern (entry 123)."""
+    prm = check_range("ProbePrm", ProbePrm, -0x8000, 0xFFFF)
+    set_probe_function(ctl, bus_axis(ctl, axis), prm)
+    return 0
+
+
+@gt_function
+def GT_SetTouchProbeFunctionEx(
+    ctl: Controller,
+    axis: int,
+    Probe1Enable: int,
+    Probe1TriggerType: int,
+    Probe1TriggerLevel: int,
+    Probe2Enable: int,
+    Probe2TriggerType: int,
+    Probe2TriggerLevel: int,
+) -> int:
+    """The probe function by description, ``ECAT_PROBE_TRIGGER_*`` constants (entry 124)."""
+    ax = bus_axis(ctl, axis)
+    word = probe_function_ex(
+        Probe1Enable,
+        Probe1TriggerType,
+        Probe1TriggerLevel,
+        Probe2Enable,
+        Probe2TriggerType,
+        Probe2TriggerLevel,
+    )
+    set_probe_function(ctl, ax, word)
+    return 0
+
+
+@gt_function
+def GT_GetTouchProbeStatus(
+    ctl: Controller,
+    axis: int,
+    probeStatus: Any,
+    probe1RiseValue: Any = None,
+    probe1FallValue: Any = None,
+    probe2RiseValue: Any = None,
+    probe2FallValue: Any = None,
+) -> int:
+    """60B9h and the captured positions 60BAh-60BDh (entry 73)."""
+    ax = bus_axis(ctl, axis)
+    if probeStatus is not None:
+        store(probeStatus, _read(ax, 0x60B9, 0, 2, False))
+    for index, ptr in (
+        (0x60BA, probe1RiseValue),
+        (0x60BB, probe1FallValue),
+        (0x60BC, probe2RiseValue),
+        (0x60BD, probe2FallValue),
+    ):
+        if ptr is not None:
+            store(ptr, _read(ax, index, 0, 4, True))
+    return 0
+
+
+@gt_function
+def GTE_GetMachinePos(ctl: Controller, axis: int, pValue: Any) -> int:
+    """Emulator only: the true position of the axis's mechanics, machine counts."""
+    store(pValue, machine_position(ctl, bus_axis(ctl, axis)))
+    return 0
