@@ -113,7 +113,7 @@ def main() -> int:
     ctl12 = bench_controller_12_axes(secs)
     if ctl12 is not None:
         out["cycles_per_s_12_axes_controller_moving"] = round(ctl12)
-    for name in ("bench_drive", "bench_homing", "bench_motion"):
+    for name in ("bench_drive", "bench_homing", "bench_homing_gt", "bench_motion"):
         try:
             mod = importlib.import_module(f"tools.{name}")
         except ModuleNotFoundError:

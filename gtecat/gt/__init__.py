@@ -31,6 +31,8 @@ for _name in _MODULES:
             raise
         continue
     for _k, _v in vars(_mod).items():
+        if _k.startswith("_"):
+            continue
         if _k.startswith(("GT_", "GTN_", "GTE_", "T")) or _k.isupper():
             globals()[_k] = _v
 
