@@ -192,6 +192,19 @@ class VirtualSlave:
                 return AlStatusCode.INVALID_INPUT_CONFIGURATION
         return AlStatusCode.NO_ERROR
 
+    def watchdog_expired(self) -> None:
+        """The process-data (SM) watchdog ran out: no outputs for its time (ETG.1000.4 6.3).
+
+        The slave leaves OP for SAFEOP with the error flag and AL status code 0x001B,
+        as ESCs do when the master stops sending (a cable pulled).
+        """
+        if self.al_state == AlState.OP:
+            old = self.al_state
+            self.on_state_change(old, AlState.SAFEOP)
+            self.al_state = AlState.SAFEOP
+            self.outputs_valid = False
+            self._refuse(AlStatusCode.SYNC_MANAGER_WATCHDOG)
+
     def _refuse(self, code: AlStatusCode) -> AlStatusCode:
         self.al_error = True
         self.al_status_code = code

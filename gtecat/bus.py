@@ -70,6 +70,9 @@ class Master:
         self.wkc_errors = 0
         self.cycles = 0
         self.emergency_count = 0
+        self._wkc_bad = False
+        #: cycles between recovery attempts while the working counter is short
+        self.recover_every = 100
         self.opened = False
         self.target = AlState.INIT
         self._op_countdown = -1
@@ -206,10 +209,18 @@ class Master:
             # the working counter is whole again (a slave came back and the backend
             # recovered it): take the states as they are now
             self.refresh_states()
-        elif self.target == AlState.OP and self.all_op() and not self.last.ok:
+        elif self.target == AlState.OP and not self.last.ok:
             self.wkc_errors += 1
-            if self.wkc_errors == 1 or self.wkc_errors % 1000 == 0:
+            if not self._wkc_bad:
+                self._wkc_bad = True
+                self.error = f"working counter {wkc}/{expected}: a slave does not answer"
                 self.log(f"Working counter changed to {wkc}/{expected}.")
+            if self.cycles % self.recover_every == 0:
+                self.recover()
+        if self._wkc_bad and self.last.ok and self.all_op():
+            self._wkc_bad = False
+            self.error = ""
+            self.log(f"Working counter changed to {wkc}/{expected}. All slaves are in OP mode.")
         for pos, emcy in self.backend.emergencies():
             self.emergency_count += 1
             self.log(
@@ -219,6 +230,47 @@ class Master:
         for hook in self.on_cycle:
             hook(self)
         return self.last
+
+    def recover(self) -> None:
+        """Bring back slaves that answer again but fell below OP (acknowledge, re-walk).
+
+        Like an IgH master after a cable is plugged back: the slave's error is
+        acknowledged, its InitCmds are applied again on the way up, and it is
+        asked for OP.  Slaves that still do not answer are left for the next try.
+        """
+        for cfg in self.layout.config.slaves:
+            pos = cfg.position
+            try:
+                state, code = self.backend.state(pos)
+            except GtecatError:
+                self.states[pos] = AlState.NONE
+                continue
+            self.states[pos] = state
+            if state == AlState.OP:
+                continue
+            self.log(
+                f"Slave {pos}: state {state.name}"
+                + (f" + ERROR 0x{int(code):04X}" if code else "")
+                + "; recovering."
+            )
+            try:
+                if code:
+                    self.backend.request_state(pos, state)  # acknowledge the error
+                for target in (AlState.PREOP, AlState.SAFEOP, AlState.OP):
+                    cur, _ = self.backend.state(pos)
+                    if cur >= target:
+                        continue
+                    tr = _transition(cur, target)
+                    if cur >= AlState.PREOP:
+                        self._init_cmds(pos, tr)
+                    if self.backend.request_state(pos, target):
+                        raise StateError(f"slave {pos}: {tr} refused", slave=pos)
+                    if target == AlState.PREOP:
+                        self._init_cmds(pos, tr)
+                self.states[pos] = AlState.OP
+                self.log(f"Slave {pos}: back in OP.")
+            except GtecatError as e:
+                self.error = str(e)
 
     def all_op(self) -> bool:
         return all(s == AlState.OP for s in self.states)

@@ -40,6 +40,9 @@ class EmulatedBackend(Backend):
         self.image: ProcessImage | None = None
         #: positions unplugged by a scenario (GTE_ helpers): no answer, no WKC
         self.unplugged: set[int] = set()
+        #: process-data watchdog of the slaves (ESC default 100 ms)
+        self.watchdog_ns = 100_000_000
+        self._silent_ns: dict[int, int] = {}
         self._clients: dict[int, object] = {}
 
     def open(self, layout: Layout, image: ProcessImage) -> None:
@@ -66,6 +69,15 @@ class EmulatedBackend(Backend):
             raise BusError(f"slave {position} does not answer")
         return self.slaves[position]
 
+    def unplug(self, position: int) -> None:
+        """Cut the cable in front of ``position`` (a scenario's comm loss)."""
+        self.unplugged.add(position)
+        self._silent_ns[position] = 0
+
+    def replug(self, position: int) -> None:
+        self.unplugged.discard(position)
+        self._silent_ns.pop(position, None)
+
     def scan(self) -> list[FoundSlave]:
         found = []
         for s in self.slaves:
@@ -88,6 +100,12 @@ class EmulatedBackend(Backend):
         unplugged = self.unplugged
         for slave, out, inp in self._plan:
             if unplugged and slave.position in unplugged:
+                # powered but cut off: it keeps running; its watchdog notices the silence
+                silent = self._silent_ns.get(slave.position, 0) + dt_ns
+                self._silent_ns[slave.position] = silent
+                if silent >= self.watchdog_ns:
+                    slave.watchdog_expired()
+                slave.step(t_ns, dt_ns)
                 continue
             st = slave.al_state
             if out is not None:

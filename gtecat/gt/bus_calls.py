@@ -371,6 +371,34 @@ def GTE_GetLastError() -> str:
     return "" if e is None else f"{e.function} returned {e.code}: {e.reason}"
 
 
+@gt_function
+def GTE_UnplugSlave(ctl: Controller, slave: int) -> int:
+    """Emulated bus: pull the cable in front of ``slave`` (it and the slaves behind it
+    stop answering; their process-data watchdogs run out after 100 ms)."""
+    backend = _emulated(ctl)
+    slave = check_range("slave", slave, 0, len(backend.slaves) - 1)
+    for pos in range(slave, len(backend.slaves)):
+        backend.unplug(pos)
+    return 0
+
+
+@gt_function
+def GTE_ReplugSlave(ctl: Controller, slave: int) -> int:
+    """Emulated bus: plug the cable back; the master recovers the slaves to OP."""
+    backend = _emulated(ctl)
+    slave = check_range("slave", slave, 0, len(backend.slaves) - 1)
+    for pos in range(slave, len(backend.slaves)):
+        backend.replug(pos)
+    return 0
+
+
+def _emulated(ctl: Controller):
+    backend = ctl.backend
+    if backend is None or not hasattr(backend, "unplug"):
+        raise CommandError("only the emulated bus can unplug slaves (GT_InitEcatComm first)")
+    return backend
+
+
 def GTE_GetCycleStats(core: int = 1) -> dict:
     """Cycle period, jitter (p50/p99/max), overruns and working-counter errors so far."""
     from ..backends.cycle_stats import cycle_stats
