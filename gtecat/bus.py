@@ -215,7 +215,7 @@ class Master:
                 self._wkc_bad = True
                 self.error = f"working counter {wkc}/{expected}: a slave does not answer"
                 self.log(f"Working counter changed to {wkc}/{expected}.")
-            if self.cycles % self.recover_every == 0:
+            if self.cycles % self.recover_every == 0 and not self.backend.recovers_itself:
                 self.recover()
         if self._wkc_bad and self.last.ok and self.all_op():
             self._wkc_bad = False

@@ -29,6 +29,9 @@ class FoundSlave:
 
 class Backend(ABC):
     name = "abstract"
+    #: the backend brings lost slaves back itself (SOEM's recover/reconfig); otherwise the
+    #: master re-walks them (:meth:`gtecat.bus.Master.recover`)
+    recovers_itself = False
 
     @abstractmethod
     def open(self, layout: Layout, image: ProcessImage) -> None:

@@ -192,6 +192,8 @@ def _link_state(iface: str) -> str | None:
 class PysoemBackend(Backend):
     """The bus on a network interface, through pysoem (SOEM)."""
 
+    recovers_itself = True  # check_and_recover(): SOEM re-addresses and reconfigures
+
     name = "pysoem"
 
     def __init__(
