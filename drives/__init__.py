@@ -1,1 +1,1 @@
-"""Virtual EtherCAT slaves: CiA-402 drives, IO slaves, their mechanics, object dictionary and CoE."""
+"""Virtual EtherCAT slaves: CiA-402 drives, IO, mechanics, object dictionary and CoE."""

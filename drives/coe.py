@@ -195,6 +195,12 @@ def build_mailbox(
     return header + data
 
 
+def mailbox_error(detail: MailboxError, *, counter: int = 0) -> bytes:
+    """A whole mailbox error reply (type 0, service 0001h, detail; ETG.1000.6 5.4)."""
+    data = MailboxErrorReply.build({"detail": int(detail)})
+    return build_mailbox(data, counter=counter, mbx_type=MailboxType.ERR)
+
+
 def build_coe(service: CoeService, sdo: bytes, *, counter: int) -> bytes:
     """A whole mailbox message carrying one CoE service."""
     coe = CoeHeader.build({"service": int(service), "reserved": 0, "number": 0})

@@ -29,7 +29,6 @@ from drives.coe import (
     CoeHeader,
     CoeService,
     MailboxError,
-    MailboxErrorReply,
     MailboxType,
     Scs,
     SdoExpedited,
@@ -38,8 +37,8 @@ from drives.coe import (
     SdoSegment,
     build_abort,
     build_coe,
-    build_mailbox,
     initiate_cmd,
+    mailbox_error,
     next_counter,
     pad_segment,
     parse_mailbox,
@@ -118,8 +117,7 @@ class SdoServer:
 
     def _mailbox_error(self, detail: MailboxError) -> bytes:
         self.counter = next_counter(self.counter)
-        data = MailboxErrorReply.build({"detail": int(detail)})
-        return build_mailbox(data, counter=self.counter, mbx_type=MailboxType.ERR)
+        return mailbox_error(detail, counter=self.counter)
 
     # --- SDO ---------------------------------------------------------------------
     def _sdo(self, body: bytes, al_state: AlState) -> bytes | None:

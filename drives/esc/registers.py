@@ -54,10 +54,9 @@ from collections import deque
 from collections.abc import Callable
 from enum import IntEnum
 
-from construct import Int8ul, Int16ul, Struct
-
 from eni.bits import get_bits, set_bits
 
+from ..coe import MailboxError, MailboxType, mailbox_error
 from ..slave import AlState, AlStatusCode, VirtualSlave
 
 log = logging.getLogger(__name__)
@@ -147,57 +146,6 @@ class EepromStatus:
     WRITE_ENABLE_ERROR = 0x4000
     BUSY = 0x8000
     ERROR_MASK = 0x7800
-
-
-class MailboxType(IntEnum):
-    """Mailbox header type nibble (ETG.1000.6 Table 29)."""
-
-    ERR = 0x0
-    AOE = 0x1
-    EOE = 0x2
-    COE = 0x3
-    FOE = 0x4
-    SOE = 0x5
-    VOE = 0xF
-
-
-class MailboxError(IntEnum):
-    """Detail codes of a mailbox error reply (ETG.1000.6, the table after Table 29)."""
-
-    SYNTAX = 0x01
-    UNSUPPORTED_PROTOCOL = 0x02
-    INVALID_CHANNEL = 0x03
-    SERVICE_NOT_SUPPORTED = 0x04
-    INVALID_HEADER = 0x05
-    SIZE_TOO_SHORT = 0x06
-    NO_MORE_MEMORY = 0x07
-    INVALID_SIZE = 0x08
-
-
-#: the 6-byte mailbox header (ETG.1000.6 Table 29): type in the low nibble of the
-#: last byte, the counter in bits 4-6
-MailboxHeader = Struct(
-    "length" / Int16ul,
-    "address" / Int16ul,
-    "channel_priority" / Int8ul,
-    "type_cnt" / Int8ul,
-)
-#: mailbox error reply: header (type 0), service 0001h, detail code
-MailboxErrorReply = Struct(
-    "header" / MailboxHeader,
-    "service" / Int16ul,
-    "detail" / Int16ul,
-)
-
-
-def mailbox_error(detail: MailboxError) -> bytes:
-    return MailboxErrorReply.build(
-        {
-            "header": {"length": 4, "address": 0, "channel_priority": 0, "type_cnt": 0},
-            "service": 1,
-            "detail": int(detail),
-        }
-    )
 
 
 # --- which register bytes a master may write, and with which bits ----------------------------
