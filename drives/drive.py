@@ -71,7 +71,15 @@ from drives.modes import (
     stop_ramp,
     supported_bits,
 )
-from drives.od import Access, DataType, ObjectCode, ObjectDictionary, PdoDir, Variable
+from drives.od import (
+    Access,
+    DataType,
+    ObjectCode,
+    ObjectDictionary,
+    PdoDir,
+    Variable,
+    add_identity,
+)
 from drives.pdo_mapping import PdoMapping
 from drives.sdo_server import SdoServer
 from drives.slave import AlState, AlStatusCode, VirtualSlave
@@ -937,22 +945,7 @@ class Cia402Drive(VirtualSlave):
             Access.CONST,
             default=s.software_version,
         )
-        od.add_record(
-            0x1018,
-            "Identity",
-            [
-                Variable(0x1018, 1, "Vendor ID", d.UINT32, Access.RO, default=identity.vendor_id),
-                Variable(
-                    0x1018, 2, "Product code", d.UINT32, Access.RO, default=identity.product_code
-                ),
-                Variable(
-                    0x1018, 3, "Revision number", d.UINT32, Access.RO, default=identity.revision_no
-                ),
-                Variable(
-                    0x1018, 4, "Serial number", d.UINT32, Access.RO, default=identity.serial_no
-                ),
-            ],
-        )
+        add_identity(od, identity)
 
     def _error_register(self) -> int:
         return 1 if any(ch.error_code_value for ch in self.channels) else 0

@@ -173,26 +173,14 @@ class CoeIoSlave(IoSlave):
         device_type: int = 0x00001389,  # ETG.5001 modular device profile
         mailbox_size: int = 128,
     ) -> None:
-        from .od import Access, DataType, ObjectDictionary, Variable
+        from .od import Access, DataType, ObjectDictionary, add_identity
         from .pdo_mapping import PdoMapping
         from .sdo_server import SdoServer
 
         self.od = ObjectDictionary()
         self.od.add_var(0x1000, "Device type", DataType.UINT32, Access.RO, default=device_type)
         self.od.add_var(0x1008, "Device name", DataType.VISIBLE_STRING, Access.CONST, default=name)
-        self.od.add_record(
-            0x1018,
-            "Identity",
-            [
-                Variable(0x1018, k, n, DataType.UINT32, Access.RO, default=v)
-                for k, n, v in (
-                    (1, "Vendor ID", identity.vendor_id),
-                    (2, "Product code", identity.product_code),
-                    (3, "Revision number", identity.revision_no),
-                    (4, "Serial number", identity.serial_no),
-                )
-            ],
-        )
+        add_identity(self.od, identity)
         self.mapping = PdoMapping(self.od, rx_pdos, tx_pdos)
         self.sdo = SdoServer(self.od, mailbox_size=mailbox_size)
         super().__init__(position, name, identity, rx_pdos=rx_pdos, tx_pdos=tx_pdos)

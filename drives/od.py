@@ -541,3 +541,20 @@ class ObjectDictionary:
         if sub0_writable:
             assert count is not None
             self._write(sub0, sub0.encode(count), al_state)
+
+
+def add_identity(od: ObjectDictionary, identity: Any) -> OdObject:
+    """1018h identity (CiA 301 7.5.2.26): vendor id, product code, revision, serial number."""
+    return od.add_record(
+        0x1018,
+        "Identity",
+        [
+            Variable(0x1018, k, name, DataType.UINT32, Access.RO, default=value)
+            for k, name, value in (
+                (1, "Vendor ID", identity.vendor_id),
+                (2, "Product code", identity.product_code),
+                (3, "Revision number", identity.revision_no),
+                (4, "Serial number", identity.serial_no),
+            )
+        ],
+    )
