@@ -9,14 +9,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import struct
 
+from drives.machine import MachineError
 from drives.slave import AlState
 from eni.model import Direction
 from eni.numbers import parse_int
 
 from ..controller import Controller, Options
-from ..errors import BusError, ParameterError
+from ..errors import BusError, ConfigMismatch, ParameterError
 
 TYPES = {  # --type name -> (struct code, size)
     "bool": ("?", 1),
@@ -69,20 +71,36 @@ def run(args: argparse.Namespace) -> int:  # the dispatcher's fallback
 
 
 def open_bus(args: argparse.Namespace) -> Controller:
-    ctl = Controller(
-        Options(
-            eni=args.eni,
-            machine=args.machine,
-            clock="lockstep",
-            backend=args.backend,
-            iface=args.iface,
-            log="",
+    """Bring the bus up as GT_Open + GT_InitEcatComm would (lockstep; realtime on pysoem)."""
+    backend = args.backend or os.environ.get("GTECAT_BACKEND") or "emulated"
+    try:
+        ctl = Controller(
+            Options(
+                eni=args.eni,
+                machine=args.machine,
+                # a real bus must cycle on the wall clock (docs/hardware.md)
+                clock="realtime" if backend == "pysoem" else "lockstep",
+                backend=args.backend,
+                iface=args.iface,
+                log="",
+            )
         )
-    )
-    ctl.init_ecat()
-    if not ctl.clock.run_until(lambda: ctl.ready, 2000):
-        err = ctl.master.error if ctl.master else ""
-        raise BusError(f"the bus did not reach OP{': ' + err if err else ''}")
+    except MachineError as e:
+        raise MachineError(f"{e} (--machine FILE or GTECAT_MACHINE; or leave it out)") from None
+    try:
+        ctl.init_ecat()
+        if not ctl.clock.run_until(lambda: ctl.ready, 2000):
+            err = ctl.master.error if ctl.master else ""
+            raise BusError(f"the bus did not reach OP{': ' + err if err else ''}")
+    except ConfigMismatch as e:
+        ctl.close()
+        raise ConfigMismatch(
+            f"{e}; the ENI does not describe this bus: export it again from the "
+            "configuration tool for this machine, or check the cabling order"
+        ) from None
+    except BaseException:
+        ctl.close()
+        raise
     return ctl
 
 
@@ -181,8 +199,10 @@ def run_pdos(args: argparse.Namespace) -> int:
 def run_sdo(args: argparse.Namespace) -> int:
     try:
         index, sub = parse_int(args.index), parse_int(args.subindex)
-    except ValueError as e:
-        raise ParameterError(str(e)) from None
+    except ValueError:
+        raise ParameterError(
+            f"sdo: INDEX and SUB must be numbers, e.g. 0x6041 0 (got {args.index} {args.subindex})"
+        ) from None
     if args.action == "download":
         if args.value is None or args.type is None:
             raise ParameterError("sdo download needs VALUE and --type")

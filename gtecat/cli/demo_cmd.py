@@ -10,6 +10,7 @@ probe, a Trap move) and writes ``demo.csv`` and ``demo.png``.
 from __future__ import annotations
 
 import argparse
+import time
 from ctypes import byref, c_short, c_ulong, c_ushort
 from importlib import resources
 from pathlib import Path
@@ -41,10 +42,14 @@ def demo_files(out: Path) -> tuple[Path, Path]:
 
 
 def say(gt, text: str) -> None:
-    """One log line, stamped with the controller clock (GT_GetClock)."""
+    """One log entry, stamped with the controller clock (GT_GetClock)."""
     clock = c_ulong()
     gt.GT_GetClock(byref(clock))
-    print(f"[{clock.value:>6} ms] {text}")
+    print(f"[{clock.value:>6} ms] {text}", flush=True)
+
+
+def _entry(gt, first: str, *more: str) -> None:
+    say(gt, "\n".join([first, *(" " * 12 + m for m in more)]))
 
 
 def _check(gt, rc: int, what: str) -> None:
@@ -57,12 +62,19 @@ def run(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     eni, machine = demo_files(out)
+    wall = time.perf_counter()
     gt.GT_Close()
     _check(
         gt, gt.GT_Open(eni=str(eni), machine=str(machine), log=str(out / "Gecat.log")), "GT_Open"
     )
+    print(
+        "gtecat demo: the manual's figure 5-2 bus (2 servo drives, 2 IO slaves), emulated.\n"
+        "Each entry: [controller time] what happened, then the GT calls and their return "
+        "codes (0 = ok).",
+        flush=True,
+    )
     try:
-        say(gt, f"GT_Open: emulated iDEABOX, ENI {eni} (manual figure 5-2: 2 drives, 2 IO slaves)")
+        _entry(gt, f"GT_Open = 0: ENI {eni}, machine {machine}")
         _check(gt, gt.GT_InitEcatComm(), "GT_InitEcatComm")
         status, polls = c_short(), 0
         while True:
@@ -72,12 +84,16 @@ def run(args: argparse.Namespace) -> int:
                 break
             if polls > 100_000:
                 raise BusError("the bus never reached OP: " + gt.GTE_GetLastError())
-        say(gt, f"GT_InitEcatComm = 0; GT_IsEcatReady reported 1 after {polls} polls (example 5-5)")
         _check(gt, gt.GT_StartEcatComm(), "GT_StartEcatComm")
         n, axes = c_short(), c_short()
         gt.GT_GetEcatSlaves(byref(n))
         gt.GT_GetMcEcatAxisNum(byref(axes))
-        say(gt, f"GT_StartEcatComm = 0: {n.value} slaves online, {axes.value} EtherCAT axes")
+        _entry(
+            gt,
+            f"bus up: {n.value} slaves in OP, {axes.value} EtherCAT axes (manual example 5-5)",
+            f"GT_InitEcatComm = 0; GT_IsEcatReady reported 1 after {polls} polls; "
+            "GT_StartEcatComm = 0",
+        )
 
         io = gt.GTE_Slave(2)
         for bit in range(16):
@@ -85,29 +101,42 @@ def run(args: argparse.Namespace) -> int:
         word = c_ushort(0x1234)
         _check(gt, gt.GT_SetEcatRawData(32, 2, byref(word)), "GT_SetEcatRawData")
         gt.GT_EcatIOSynch()
-        say(
+        _entry(
             gt,
-            f"GT_SetEcatRawData(32, 2, 0x{word.value:04X}) -> slave 2 outputs "
+            "raw data: 0x1234 written at GT raw offset 32, IO slave 2's outputs (manual 5.2.2.4)",
+            f"GT_SetEcatRawData(32, 2, 0x{word.value:04X}) = 0; slave 2 drives "
             f"0x7000:01 = 0x{io.get_output(0x7000, 1):02X}, "
             f"0x7000:02 = 0x{io.get_output(0x7000, 2):02X}",
         )
         gt.GTE_Wait(2)
         back = c_ushort()
         _check(gt, gt.GT_GetEcatRawData(34, 2, byref(back)), "GT_GetEcatRawData")
-        say(
+        _entry(
             gt,
-            f"GT_GetEcatRawData(34, 2) = 0x{back.value:04X}: the wired inputs came back "
-            "(manual 5.2.2.4: slave 2 DI at byte 34)",
+            "raw data: the outputs, wired to slave 2's inputs, read back at offset 34",
+            f"GT_GetEcatRawData(34, 2) = 0: 0x{back.value:04X}",
         )
         bad = gt.GT_SetEcatRawData(34, 2, byref(word))
-        say(gt, f"GT_SetEcatRawData(34, 2) = {bad}: {gt.GTE_GetLastError().split(': ', 1)[1]}")
+        _entry(
+            gt,
+            "raw data: a write to input bytes is refused and changes nothing",
+            f"GT_SetEcatRawData(34, 2) = {bad}: "
+            + gt.GTE_GetLastError().split(": ", 1)[1].split(";")[0],
+        )
         try:
             from . import demo_axes
         except ImportError:
             demo_axes = None
+        problems: list[str] = []
         if demo_axes is not None:
-            demo_axes.run(gt, say, out, plot=not args.no_plot)
+            problems = demo_axes.run(gt, say, out, plot=not args.no_plot).problems()
+        virtual = gt.GTE_Controller().clock.now_ns / 1e9
     finally:
         gt.GT_Close()
-    print(f"master log: {out / 'Gecat.log'}")
+    print(
+        f"done: {virtual:.2f} s of controller time in {time.perf_counter() - wall:.2f} s; "
+        f"master log {out / 'Gecat.log'}"
+    )
+    if problems:
+        raise BusError("the demo did not go as planned: " + "; ".join(problems))
     return 0

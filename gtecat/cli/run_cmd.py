@@ -1,8 +1,13 @@
 """``gtecat run SCRIPT.py``: run a user's GT script with chosen emulator settings.
 
 The options become the ``GTECAT_*`` environment the script's ``GT_Open`` reads, so the
-script itself needs no change.  ``--trace`` records signals every cycle once the bus is
-up (see :mod:`gtecat.recorder` for the names) and writes ``<stem>.csv`` and ``<stem>.png``.
+script itself needs no change (the environment is restored afterwards).  ``--trace``
+records signals every cycle once the bus is up (see :mod:`gtecat.recorder` for the
+names) and writes ``<stem>.csv`` and ``<stem>.png``.  On a terminal a status line shows
+controller time against wall time while the script runs.
+
+The script's own exit code is the command's; an exception in the script prints its
+traceback (the script's frames only) and exits 1.
 """
 
 from __future__ import annotations
@@ -12,90 +17,251 @@ import os
 import runpy
 import sys
 import time
+import traceback
+from collections.abc import Callable
 from pathlib import Path
+from typing import TextIO
+
+from eni.errors import GtecatError
 
 from ..controller import Controller
 from ..errors import ParameterError
 
+ENV = ("GTECAT_ENI", "GTECAT_MACHINE", "GTECAT_CLOCK", "GTECAT_BACKEND", "GTECAT_IFACE")
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("run", help="run a GT script under the emulator")
-    p.add_argument("script", help="Python script using `from gtecat import gt`")
-    p.add_argument("args", nargs="*", help="arguments for the script (after --)")
+
+def _add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--eni", help="configuration file (GTECAT_ENI)")
     p.add_argument("--machine", help="machine description TOML (GTECAT_MACHINE)")
     p.add_argument("--clock", choices=("auto", "lockstep", "realtime"), help="GTECAT_CLOCK")
     p.add_argument("--backend", choices=("emulated", "pysoem"), help="GTECAT_BACKEND")
     p.add_argument("--iface", help="network interface for pysoem (GTECAT_IFACE)")
-    p.add_argument("--trace", help="comma-separated signals, e.g. axis1.prf,axis1.enc,0:0x6041:0")
+    p.add_argument(
+        "--trace",
+        help="comma-separated signals recorded every cycle, e.g. "
+        "axis1.prf,axis1.enc,axis1.err,0:0x6041:0 (see `gtecat map` for SLAVE:INDEX:SUB)",
+    )
     p.add_argument("--trace-out", default=None, help="output stem (default: the script's name)")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no status line on stderr")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "run",
+        help="run a GT script under the emulator",
+        description="Run SCRIPT.py (which uses `from gtecat import gt`) with the given "
+        "emulator settings.  Options may come before or after the script; the script's "
+        "own arguments follow it (after `--` when they look like options).",
+    )
+    _add_options(p)
+    p.add_argument("script", help="Python script using `from gtecat import gt`")
+    p.add_argument("args", nargs=argparse.REMAINDER, help="arguments for the script")
     p.set_defaults(func=run)
 
 
-class _Progress:
-    """One status line on stderr (a tty only): controller time against wall time."""
+def split_arguments(args: argparse.Namespace) -> list[str]:
+    """Take ``run`` options written after the script out of ``args.args``.
 
-    def __init__(self, enabled: bool) -> None:
-        self.enabled = enabled and sys.stderr.isatty()
-        self.t0 = time.perf_counter()
-        self.last = 0.0
+    ``gtecat run s.py --trace x -- -v`` and ``gtecat run --trace x s.py -v`` both give
+    the script ``["-v"]``; ``gtecat run s.py a b`` gives it ``["a", "b"]``.
+    """
+    rest = list(args.args)
+    if rest and rest[0] == "--":
+        return rest[1:]
+    if not rest or not rest[0].startswith("--"):
+        return rest
+    cut = rest.index("--") if "--" in rest else len(rest)
+    opts = argparse.ArgumentParser(prog="gtecat run SCRIPT", add_help=False)
+    _add_options(opts)
+    extra, unknown = opts.parse_known_args(rest[:cut])
+    if unknown:
+        raise ParameterError(
+            f"run: {' '.join(unknown)} after the script is not a run option; give the "
+            "script's own arguments after `--` (gtecat run SCRIPT [options] -- ARGS)"
+        )
+    for k, v in vars(extra).items():
+        if v not in (None, False):
+            setattr(args, k, v)
+    return rest[cut + 1 :]
+
+
+class Progress:
+    """One status line (a terminal only): controller time, wall time and their ratio.
+
+    The total length of a script's run is unknown, so this is a live counter rather
+    than a bar: it answers "is it still going, and how fast?".  The line is erased
+    before anything the script prints (:meth:`guard`) and when the run ends, so the
+    script's own output reads as without it.
+    """
+
+    SPIN = "|/-\\"
+    ERASE = "\r\033[K"
+
+    def __init__(
+        self,
+        enabled: bool,
+        stream: TextIO | None = None,
+        wall: Callable[[], float] = time.perf_counter,
+        every_s: float = 0.25,
+    ) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = enabled and self.stream.isatty()
+        self.wall = wall
+        self.every_s = every_s
+        self.t0 = wall()
+        self.last = self.t0
+        self.shown = 0
+        self.visible = False
 
     def __call__(self, ctl: Controller) -> None:
         if not self.enabled:
             return
-        now = time.perf_counter()
-        if now - self.last < 0.25:
+        now = self.wall()
+        if now - self.last < self.every_s:
             return
         self.last = now
         virt = ctl.clock.now_ns / 1e9
-        bar = "#" * (int(virt) % 20 + 1)
-        sys.stderr.write(
-            f"\r  {bar:<20} {virt:8.2f} s controller time, {now - self.t0:6.1f} s wall"
+        wall = now - self.t0
+        ratio = f"{virt / wall:7.1f}x real time" if wall > 0 else ""
+        self.shown += 1
+        self.stream.write(
+            f"{self.ERASE}  {self.SPIN[self.shown % 4]} {virt:9.2f} s controller time, "
+            f"{ctl.clock.cycles:>9} cycles, {wall:6.1f} s wall {ratio}"
         )
-        sys.stderr.flush()
+        self.stream.flush()
+        self.visible = True
+
+    def clear(self) -> None:
+        if self.visible:
+            self.stream.write(self.ERASE)
+            self.stream.flush()
+            self.visible = False
 
     def done(self) -> None:
-        if self.enabled:
-            sys.stderr.write("\n")
+        self.clear()
+
+    def guard(self, out: TextIO) -> TextIO:
+        """``out`` wrapped so that each write first erases the status line."""
+        return _Erasing(out, self) if self.enabled else out
+
+
+class _Erasing:
+    """A text stream that erases the progress line before writing (see Progress.guard)."""
+
+    def __init__(self, inner: TextIO, progress: Progress) -> None:
+        self._inner = inner
+        self._progress = progress
+
+    def write(self, text: str) -> int:
+        if text:
+            self._progress.clear()
+        return self._inner.write(text)
+
+    def __getattr__(self, name: str):
+        return getattr(self._inner, name)
+
+
+class _TraceFailed(BaseException):
+    """A ``--trace`` signal that does not exist on this bus: stops the script.
+
+    A BaseException, so the GT layer (which turns every Exception into a return
+    code) lets it through to :func:`run`.
+    """
+
+
+def _script_traceback(e: BaseException, script: Path) -> str:
+    """The traceback from the script's first frame on (runpy and gtecat.cli frames dropped)."""
+    tb = traceback.TracebackException.from_exception(e)
+    frames = tb.stack
+    first = next(
+        (i for i, f in enumerate(frames) if Path(f.filename).resolve() == script.resolve()), 0
+    )
+    tb.stack = traceback.StackSummary.from_list(frames[first:])
+    return "".join(tb.format())
 
 
 def run(args: argparse.Namespace) -> int:
+    script_args = split_arguments(args)
     script = Path(args.script)
     if not script.is_file():
-        raise ParameterError(f"script {script} not found")
-    env = {
+        raise ParameterError(
+            f"script {script} not found"
+            + (" (that is a folder)" if script.is_dir() else f" (working directory {Path.cwd()})")
+        )
+    options = {
         "GTECAT_ENI": args.eni,
         "GTECAT_MACHINE": args.machine,
         "GTECAT_CLOCK": args.clock,
         "GTECAT_BACKEND": args.backend,
         "GTECAT_IFACE": args.iface,
     }
-    for k, v in env.items():
+    for k in ("GTECAT_ENI", "GTECAT_MACHINE"):
+        v = options[k]
+        if v and not Path(v).is_file():
+            what = "ENI" if k == "GTECAT_ENI" else "machine description"
+            raise ParameterError(f"{what} {v} not found (--{k[7:].lower()})")
+    specs = [s.strip() for s in (args.trace or "").split(",") if s.strip()]
+    saved_env = {k: os.environ.get(k) for k in ENV}
+    saved_argv = sys.argv
+    for k, v in options.items():
         if v:
             os.environ[k] = str(Path(v).resolve()) if k in ("GTECAT_ENI", "GTECAT_MACHINE") else v
     recorders = []
-    progress = _Progress(not args.no_progress)
-    specs = [s for s in (args.trace or "").split(",") if s.strip()]
+    progress = Progress(not args.no_progress)
 
     def attach(ctl: Controller) -> None:
         if specs:
             from ..recorder import Recorder
 
-            recorders.append(Recorder(ctl, specs).start())
+            try:
+                recorders.append(Recorder(ctl, specs).start())
+            except GtecatError as e:
+                raise _TraceFailed(str(e)) from None
         ctl.sample.append(lambda _t: progress(ctl))
 
     Controller.bus_up_hooks.append(attach)
-    sys.argv = [str(script), *args.args]
+    saved_streams = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = progress.guard(sys.stdout), progress.guard(sys.stderr)
+    sys.argv = [str(script), *script_args]
+    saved_path = list(sys.path)
+    sys.path.insert(0, str(script.resolve().parent))  # as `python SCRIPT` does: its imports
     rc = 0
     try:
         runpy.run_path(str(script), run_name="__main__")
     except SystemExit as e:
         rc = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+        if isinstance(e.code, str):
+            print(e.code, file=sys.stderr)
+    except _TraceFailed as e:
+        raise ParameterError(
+            f"--trace: {e}; the script was stopped at GT_InitEcatComm "
+            "(`gtecat map ENI` lists what each slave maps)"
+        ) from None
+    except Exception as e:  # the user's own bug: show where, in their script
+        progress.done()
+        sys.stderr.write(_script_traceback(e, script))
+        print(f"error: {script} raised {type(e).__name__}: {e}", file=sys.stderr)
+        rc = 1
     finally:
         Controller.bus_up_hooks.remove(attach)
         progress.done()
+        sys.stdout, sys.stderr = saved_streams
+        sys.argv = saved_argv
+        sys.path[:] = saved_path
+        for k, v in saved_env.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+        from ..gt import GT_Close
+
+        GT_Close()  # a script that forgot it: stop a realtime thread, flush the log
     stem = Path(args.trace_out) if args.trace_out else script.with_suffix("")
+    if specs and not any(rec.n for rec in recorders):
+        print(
+            "trace: nothing recorded (the script never brought the bus up with GT_InitEcatComm)",
+            file=sys.stderr,
+        )
     for i, rec in enumerate(recorders):
         base = stem if i == 0 else stem.with_name(f"{stem.name}_{i}")
         if rec.n == 0:

@@ -1,0 +1,1 @@
+"""Tests of the documentation (tutorial pages run)."""

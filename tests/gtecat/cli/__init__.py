@@ -1,0 +1,1 @@
+"""CLI tests: demo, run, slaves/pdos/sdo, newcomer errors (issue 8)."""

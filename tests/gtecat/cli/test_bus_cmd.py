@@ -1,0 +1,139 @@
+"""``gtecat slaves | pdos | sdo`` on the emulated figure 5-2 bus (issue 8 deliver 3)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import EXAMPLES
+
+from .conftest import Cli
+
+FIG52 = str(EXAMPLES / "manual_fig5_2.eni")
+
+
+# --- slaves ----------------------------------------------------------------------------------
+def test_slaves_json_is_a_list_with_one_object_per_slave(cli: Cli) -> None:
+    rc, out, err = cli("slaves", "--eni", FIG52, "--json")
+    assert rc == 0 and err == ""
+    rows = json.loads(out)
+    assert isinstance(rows, list) and len(rows) == 4
+    assert [r["position"] for r in rows] == [0, 1, 2, 3]
+    assert [r["state"] for r in rows] == ["OP"] * 4
+    assert [r["axes"] for r in rows] == [[1], [2], [], []]
+    assert [(r["gt_offset"], r["gt_size"]) for r in rows] == [(0, 16), (16, 16), (32, 4), (36, 4)]
+    assert [r["name"] for r in rows] == ["GTHD 0", "GTHD 1", "IO 2", "IO 3"]
+    for r in rows:
+        assert set(r) >= {"position", "state", "name", "vendor_id", "product_code", "revision"}
+        assert isinstance(r["vendor_id"], int) and r["vendor_id"] > 0
+
+
+def test_slaves_table_has_a_row_per_slave(cli: Cli) -> None:
+    rc, out, _ = cli("slaves", "--eni", FIG52)
+    assert rc == 0
+    lines = out.splitlines()
+    assert lines[0].split()[:3] == ["pos", "state", "vendor"]
+    assert len(lines) == 5
+    assert lines[1].split()[0:2] == ["0", "OP"] and lines[1].rstrip().endswith("GTHD 0")
+    assert "32+4" in lines[3] and lines[3].split()[5] == "-"  # IO 2: no axis
+
+
+def test_slaves_finds_gecat_eni_in_the_working_directory_like_gt_open(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    shutil.copy(EXAMPLES / "manual_fig5_4.eni", tmp_path / "Gecat.eni")
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = cli("slaves", "--json")
+    assert rc == 0 and len(json.loads(out)) == 1, err
+    monkeypatch.setenv("GTECAT_ENI", FIG52)
+    rc, out, _ = cli("slaves", "--json")
+    assert rc == 0 and len(json.loads(out)) == 4
+
+
+# --- pdos ------------------------------------------------------------------------------------
+def test_pdos_json_lists_the_assigned_pdos_and_entries(cli: Cli) -> None:
+    rc, out, _ = cli("pdos", "--eni", FIG52, "--json")
+    assert rc == 0
+    slaves = json.loads(out)
+    assert [s["position"] for s in slaves] == [0, 1, 2, 3]
+    drive = slaves[0]["pdos"]
+    assert [(p["dir"], p["index"]) for p in drive] == [("out", 0x1600), ("in", 0x1A00)]
+    assert [(e["index"], e["bits"]) for e in drive[0]["entries"]] == [(0x6040, 16), (0x607A, 32)]
+    assert [e["index"] for e in drive[1]["entries"]] == [0x6041, 0x6064, 0x60FD]
+
+
+def test_pdos_table(cli: Cli) -> None:
+    rc, out, _ = cli("pdos", "--eni", FIG52)
+    assert rc == 0
+    assert "=== slave 0: GTHD 0" in out
+    assert "SM2: RxPDO 0x1600" in out and "SM3: TxPDO 0x1A00" in out
+    assert '0x6041:00, 16 bit, UINT   "Statusword"' in out
+    assert out.count("=== slave") == 4
+
+
+# --- sdo -------------------------------------------------------------------------------------
+def test_sdo_upload_raw_and_typed(cli: Cli) -> None:
+    rc, out, _ = cli("sdo", "upload", "0", "0x1018", "1", "--eni", FIG52)
+    assert rc == 0 and out.strip().endswith("(4 bytes)")
+    rc, out, _ = cli("sdo", "upload", "0", "0x1018", "1", "--type", "uint32", "--eni", FIG52)
+    assert rc == 0
+    _, js, _ = cli("slaves", "--eni", FIG52, "--json")
+    assert int(out) == json.loads(js)[0]["vendor_id"]  # 1018h:01 is the vendor id
+
+
+def test_sdo_upload_json(cli: Cli) -> None:
+    rc, out, _ = cli(
+        "sdo", "upload", "1", "0x6041", "0", "--type", "uint16", "--json", "--eni", FIG52
+    )
+    assert rc == 0
+    r = json.loads(out)
+    assert (r["slave"], r["index"], r["subindex"]) == (1, 0x6041, 0)
+    assert len(r["bytes"]) == 4 and r["value"] == int.from_bytes(
+        bytes.fromhex(r["bytes"]), "little"
+    )
+
+
+def test_sdo_download_is_silent_on_success(cli: Cli) -> None:
+    rc, out, err = cli("sdo", "download", "0", "0x6060", "0", "6", "--type", "int8", "--eni", FIG52)
+    assert (rc, out, err) == (0, "", "")
+    rc, out, _ = cli(
+        "sdo", "download", "0", "0x607C", "0", "-1000", "--type", "int32", "--json", "--eni", FIG52
+    )
+    assert rc == 0 and json.loads(out) == {"ok": True}
+
+
+@pytest.mark.parametrize(
+    ("argv", "code", "text"),
+    [
+        (("download", "0", "0x6041", "0", "6", "--type", "uint16"), "0x06010002", "read-only"),
+        (("upload", "0", "0x2FFF", "0"), "0x06020000", "does not exist"),
+        (("upload", "0", "0x1018", "9"), "0x06090011", "ubindex"),
+    ],
+)
+def test_sdo_abort_prints_the_cia301_code_in_one_line(
+    cli: Cli, argv: tuple[str, ...], code: str, text: str
+) -> None:
+    rc, out, err = cli("sdo", *argv, "--eni", FIG52)
+    assert rc == 1 and out == ""
+    assert err.count("\n") == 1 and err.startswith("error: ")
+    assert code in err and text in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "text"),
+    [
+        (("upload", "2", "0x1018", "1"), "has no CoE mailbox"),
+        (("upload", "7", "0x1018", "1"), "no slave 7: the bus has slaves 0..3"),
+        (("download", "0", "0x6060", "0", "300", "--type", "int8"), "does not fit int8"),
+        (("download", "0", "0x6060", "0"), "needs VALUE and --type"),
+        (("upload", "0", "0x60zz", "0"), "must be numbers"),
+        (("upload", "0", "0x6041", "0", "--type", "uint32"), "has 2 bytes, uint32 needs 4"),
+    ],
+)
+def test_sdo_bad_requests_are_one_clear_line(cli: Cli, argv: tuple[str, ...], text: str) -> None:
+    rc, out, err = cli("sdo", *argv, "--eni", FIG52)
+    assert rc == 1 and out == ""
+    assert err.count("\n") == 1 and text in err and "Traceback" not in err

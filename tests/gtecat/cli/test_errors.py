@@ -1,0 +1,196 @@
+"""Errors a newcomer meets (issue 8 deliver 5): one clear line, what to do next, no traceback.
+
+Each error is provoked twice where it can be: from the command line (``error: ...``,
+exit 1) and from a script through the GT calls (a return code, and
+``gt.GTE_GetLastError()`` saying why).
+"""
+
+from __future__ import annotations
+
+import shutil
+from ctypes import byref, c_long, c_short
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from tests.conftest import EXAMPLES
+from tests.gtecat.gt.conftest import bring_up
+
+from .conftest import Cli
+
+FIG52 = str(EXAMPLES / "manual_fig5_2.eni")
+OTHER_BUS = str(EXAMPLES / "twelve_axes.eni")
+
+
+def _one_line_error(rc: int, out: str, err: str) -> str:
+    assert rc == 1 and out == ""
+    assert err.startswith("error: ") and err.count("\n") == 1, err
+    assert "Traceback" not in err
+    return err
+
+
+def _last_error_line() -> str:
+    text = gt.GTE_GetLastError()
+    assert text and "\n" not in text and "Traceback" not in text
+    return text
+
+
+# --- missing ENI --------------------------------------------------------------------------------
+@pytest.mark.parametrize("verb", [("slaves",), ("pdos",), ("sdo", "upload", "0", "0x1018", "1")])
+def test_cli_without_any_eni_says_where_it_looked_and_how_to_give_one(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, verb: tuple[str, ...]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    err = _one_line_error(*cli(*verb))
+    assert f"no ENI file at {tmp_path / 'Gecat.eni'}" in err
+    assert "--eni" in err and "GTECAT_ENI" in err
+
+
+def test_gt_without_any_eni_returns_minus_9_with_the_remedy(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert gt.GT_Open(log="") == 0
+    assert gt.GT_InitEcatComm() == -9  # entry 79: no ENI
+    text = _last_error_line()
+    assert "Gecat.eni" in text and "GTECAT_ENI" in text
+
+
+# --- wrong path ---------------------------------------------------------------------------------
+def test_cli_wrong_eni_path_names_the_absolute_path(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    err = _one_line_error(*cli("slaves", "--eni", "confg/Gecat.eni"))
+    assert str(tmp_path / "confg" / "Gecat.eni") in err
+    err = _one_line_error(*cli("map", "confg/Gecat.eni"))
+    assert "confg/Gecat.eni" in err and "No such file" in err
+
+
+def test_cli_wrong_machine_path(cli: Cli, tmp_path: Path) -> None:
+    err = _one_line_error(*cli("slaves", "--eni", FIG52, "--machine", "nope.toml"))
+    assert "nope.toml" in err and "not found" in err and "--machine" in err
+    script = tmp_path / "s.py"
+    script.write_text("print('ran')\n")
+    err = _one_line_error(*cli("run", str(script), "--machine", "nope.toml"))
+    assert err == "error: machine description nope.toml not found (--machine)\n"
+
+
+def test_gt_wrong_machine_path_returns_7_at_gt_open() -> None:
+    assert gt.GT_Open(eni=FIG52, machine="nope.toml", log="") == 7
+    assert "nope.toml: machine description not found" in _last_error_line()
+
+
+def test_cli_a_file_that_is_not_an_eni(cli: Cli, tmp_path: Path) -> None:
+    bad = tmp_path / "Gecat.eni"
+    bad.write_text("hello\n")
+    err = _one_line_error(*cli("slaves", "--eni", str(bad)))
+    assert "not an ENI" in err and "EtherCATConfig" in err
+
+
+def test_gt_wrong_path_returns_minus_9(tmp_path: Path) -> None:
+    assert gt.GT_Open(eni=str(tmp_path / "typo.eni"), log="") == 0
+    assert gt.GT_InitEcatComm() == -9
+    assert "typo.eni" in _last_error_line()
+
+
+# --- slave mismatch -----------------------------------------------------------------------------
+def test_cli_slave_mismatch_names_the_slave_and_the_remedy(
+    cli: Cli, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("GTECAT_BUS", OTHER_BUS)  # the emulated hardware is another machine
+    err = _one_line_error(*cli("slaves", "--eni", FIG52))
+    assert "slave 2: ENI expects 'IO 2' product code" in err
+    assert "export it again" in err and "cabling" in err
+
+
+def test_gt_slave_mismatch_returns_minus_8_naming_the_slave() -> None:
+    assert gt.GT_Open(eni=FIG52, bus=OTHER_BUS, log="") == 0
+    assert gt.GT_InitEcatComm() == -8  # entry 79
+    text = _last_error_line()
+    assert "slave 2" in text and "product code" in text and "'IO 2'" in text
+
+
+def test_gt_missing_slave_names_the_first_missing_one(tmp_path: Path) -> None:
+    shutil.copy(EXAMPLES / "manual_fig5_4.eni", tmp_path / "one.eni")
+    assert gt.GT_Open(eni=FIG52, bus=str(tmp_path / "one.eni"), log="") == 0
+    assert gt.GT_InitEcatComm() == -8
+    assert "slave 0" in _last_error_line()
+
+
+# --- unmapped object ----------------------------------------------------------------------------
+def test_gt_unmapped_object_returns_1_naming_the_object() -> None:
+    bring_up()
+    pe = c_long()
+    assert gt.GT_GetEcatAxisPE(1, byref(pe)) == 1  # 60F4h is not in figure 5-2's mapping
+    text = _last_error_line()
+    assert "0x60F4:00" in text and "following error" in text and "not mapped" in text
+    ai = c_short()
+    assert gt.GT_GetEcatAxisAI(2, 1, byref(ai)) == 1
+    assert "0x20F2:00" in _last_error_line()
+
+
+def test_cli_unmapped_trace_signal(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    script = tmp_path / "s.py"
+    script.write_text(
+        "from gtecat import gt\ngt.GT_Open(log='')\nprint(gt.GT_InitEcatComm())\ngt.GT_Close()\n"
+    )
+    rc, _, err = cli("run", str(script), "--eni", FIG52, "--trace", "axis2.mode")
+    assert rc == 1 and "0x6061:00" in err and "not mapped" in err and "gtecat map" in err
+    assert err.count("\n") == 1
+
+
+def test_cli_unknown_trace_entry(cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    script = tmp_path / "s.py"
+    script.write_text("from gtecat import gt\ngt.GT_Open(log='')\ngt.GT_InitEcatComm()\n")
+    rc, _, err = cli("run", str(script), "--eni", FIG52, "--trace", "2:0x7000:9")
+    assert rc == 1 and "slave 2 maps no 0x7000:09" in err and err.count("\n") == 1
+
+
+# --- axis not enabled ---------------------------------------------------------------------------
+@pytest.mark.skipif(not hasattr(gt, "GT_StartEcatHoming"), reason="homing calls not landed")
+def test_gt_homing_an_axis_that_is_not_enabled_says_call_gt_axison() -> None:
+    bring_up()
+    assert gt.GT_SetHomingMode(1, 6) == 0
+    assert gt.GT_SetEcatHomingPrm(1, 3, 5000, 3000, 100000, 0, 0) == 0
+    assert gt.GT_StartEcatHoming(1) == 1
+    text = _last_error_line()
+    assert "not servo-enabled" in text and "call GT_AxisOn first" in text
+
+
+@pytest.mark.skipif(
+    not all(hasattr(gt, n) for n in ("GT_PrfTrap", "GT_SetPos", "GT_SetVel", "GT_Update")),
+    reason="Trap calls not landed",
+)
+def test_gt_moving_an_axis_that_is_not_enabled_is_refused_with_a_reason() -> None:
+    bring_up()
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = 0.5, 0.5
+    assert gt.GT_PrfTrap(1) == 0
+    assert gt.GT_SetTrapPrm(1, byref(prm)) == 0
+    assert gt.GT_SetPos(1, 10000) == 0 and gt.GT_SetVel(1, 10) == 0
+    assert gt.GT_Update(1) == 1
+    text = _last_error_line()
+    assert "axis 1" in text and "GT_AxisOn" in text
+
+
+def test_gt_axis_that_does_not_exist() -> None:
+    bring_up()
+    assert gt.GT_AxisOn(5) == 7
+    assert "axis 5 out of range 1..2" in _last_error_line()
+
+
+# --- order of calls -----------------------------------------------------------------------------
+def test_gt_calls_before_gt_open_and_before_the_bus_is_up() -> None:
+    assert gt.GT_InitEcatComm() == -1
+    assert "call GT_Open first" in _last_error_line()
+    assert gt.GT_Open(eni=FIG52, log="") == 0
+    assert gt.GT_GetEcatRawData(0, 2, (c_short * 1)()) == 1
+    assert "call GT_InitEcatComm" in _last_error_line()
+    assert gt.GT_AxisOn(1) == 7  # no axes before the bus is read
+    assert "bus not initialised" in _last_error_line()
