@@ -103,11 +103,13 @@ class Master:
                 if a and a != b:
                     raise ConfigMismatch(
                         f"slave {cfg.position}: ENI expects {cfg.name!r} {what} 0x{a:08X}, "
-                        f"bus has 0x{b:08X} ({got.name or 'unnamed'})"
+                        f"bus has 0x{b:08X} ({got.name or 'unnamed'}); export the ENI again "
+                        "for this bus or check the cabling order"
                     )
         if len(found) != len(expected):
             raise ConfigMismatch(
-                f"ENI lists {len(expected)} slaves, the bus has {len(found)}"
+                f"ENI lists {len(expected)} slaves, the bus has {len(found)} "
+                "(check the cabling and power, or export the ENI again for this bus)"
                 + (
                     f" (first missing: slave {len(found)} {expected[len(found)].name!r})"
                     if len(found) < len(expected)

@@ -55,7 +55,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
         return 1
     print(
-        f"wrote {args.output}: {len(cfg.slaves)} slaves, {len(layout.axes)} axes, "
+        f"wrote {args.output}: {_count(len(cfg.slaves), 'slave')}, "
+        f"{_count(len(layout.axes), 'axis', 'axes')}, "
         f"GT raw image {layout.gt_raw_bytes} bytes"
     )
     return 0
+
+
+def _count(n: int, one: str, many: str | None = None) -> str:
+    return f"{n} {one if n == 1 else (many or one + 's')}"
