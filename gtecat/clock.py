@@ -133,6 +133,11 @@ class Clock:
         return self.now_ns // 1_000_000
 
     # --- realtime ----------------------------------------------------------
+    @property
+    def threaded(self) -> bool:
+        """A cycle thread runs (realtime): callers must hold :attr:`lock`."""
+        return self._thread is not None
+
     def start_realtime(self) -> None:
         if self.mode is not ClockMode.REALTIME or self._thread is not None:
             return

@@ -132,7 +132,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     ``None``/0 on success.  Registers ``GT_x`` and its ``GTN_x`` twin.
     """
     name = fn.__name__
-    params = list(inspect.signature(fn).parameters)
+    signature = inspect.signature(fn)
+    params = list(signature.parameters)
     needs_ctl = bool(params) and params[0] == "ctl"
 
     def call(core: int, args: tuple, kwargs: dict) -> int:
@@ -140,7 +141,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         try:
             if needs_ctl:
                 ctl = SESSION.controller(core)
-                with ctl.clock.lock:
+                if ctl.clock.threaded:
+                    with ctl.clock.lock:  # atomic with respect to the cycle thread
+                        rc = fn(ctl, *args, **kwargs)
+                else:
                     rc = fn(ctl, *args, **kwargs)
             else:
                 rc = fn(*args, **kwargs)
@@ -149,8 +153,15 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             rc = r.code
             _record(name, rc, str(r))
         except TypeError as e:
-            rc = CMD_PARAM
-            _record(name, rc, f"bad arguments: {e}")
+            try:  # the caller's arguments do not fit the prototype: 7; else a bug inside
+                signature.bind(*((None,) if needs_ctl else ()), *args, **kwargs)
+            except TypeError:
+                rc = CMD_PARAM
+                _record(name, rc, f"bad arguments: {e}")
+            else:
+                rc = CMD_NO_RESPONSE
+                log.error("%s: internal error\n%s", name, traceback.format_exc())
+                _record(name, rc, f"internal error in the emulator: TypeError: {e}")
         except Exception as e:  # the GT layer never raises
             rc = code_for(e)
             if rc == CMD_NO_RESPONSE:
