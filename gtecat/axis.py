@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import Any
 
 from eni.layout import AxisRef, Layout
 
@@ -221,6 +222,14 @@ class Axis:
             self._mode_acc.set(self.mode_cmd)
         self.pre_hooks: list[Callable[[Axis, int, int], None]] = []
         self.post_hooks: list[Callable[[Axis, int, int], None]] = []
+        #: the axis's motion resources (gtecat.resources.AxisResources), set at bus up
+        self.motion: Any = None
+
+    @property
+    def moving(self) -> bool:
+        """The profile is planning a motion (GT_GetSts bit 10); False without resources."""
+        m = self.motion
+        return m is not None and m.moving
 
     # --- feedback ------------------------------------------------------------------
     @property

@@ -27,6 +27,7 @@ from .bus import Master
 from .clock import Clock, ClockMode
 from .errors import BusError, NoEniError, ParameterError
 from .masterlog import MasterLog
+from .resources import install as install_resources
 
 
 @dataclass
@@ -153,6 +154,7 @@ class Controller:
             for ref in layout.axes
         }
         self._axis_list = list(self.axes.values())
+        install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)
         master.open()
         for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
             hook(self)

@@ -180,6 +180,9 @@ def GT_SetPosScale(ctl: Controller, axis: int, scale: int) -> int:
     scale = check_range("scale", scale, 0, 16)
     if getattr(ax, "moving", False):
         raise CommandError(f"axis {axis} is moving: call GT_Stop first (entry 117)")
+    if ax.motion is not None:
+        ax.motion.set_pos_scale(scale)  # the planned position and 607Ah stay where they are
+        return 0
     actual = ax.actual_counts() if ax.io.get(0x6064) is not None else None
     ax.pos_scale = scale
     if actual is not None and not ax.servo_on:
