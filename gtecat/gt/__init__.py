@@ -21,6 +21,7 @@ _MODULES = (
     "motion_calls",
     "status_calls",
     "mode_calls",
+    "motion_ext_calls",
 )
 
 for _name in _MODULES:
