@@ -144,7 +144,8 @@ class AxisIo:
             raise ObjectNotMapped(
                 f"axis {self.ref.axis}: object 0x{self.index(index):04X}:{subindex:02X} "
                 f"({OBJECT_NAMES.get(index, 'object')}) is not mapped as PDO in the ENI "
-                f"(slave {self.slave})"
+                f"(slave {self.slave}); map it in your configuration tool and export the ENI "
+                "again (`gtecat map FILE.eni` shows what is mapped)"
             )
         return acc
 
@@ -242,10 +243,7 @@ class Axis:
 
     def actual_counts(self) -> int:
         if self._pos_acc is None:
-            raise ObjectNotMapped(
-                f"axis {self.number}: object 0x{self.io.index(0x6064):04X}:00 "
-                "(position actual value) is not mapped as PDO in the ENI"
-            )
+            self.io.require(0x6064)  # raises ObjectNotMapped with the full message
         return self._pos_acc.get()
 
     def counts_to_pulses(self, counts: float) -> float:

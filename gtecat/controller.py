@@ -220,7 +220,7 @@ class Controller:
         for f in self.post_cycle:
             f(t, dt)
         for f in self.sample:
-            f(t)
+            f(t + dt)  # stamped when the cycle's values become visible (= GT_GetClock after it)
 
     # --- axes -----------------------------------------------------------------------------
     def axis(self, n: int) -> Axis:

@@ -10,7 +10,9 @@ A signal is named by a short spec:
   the true mechanical position (emulated drives only).
 
 Samples are taken after every cycle (``Controller.sample`` hook), so a trace
-is exactly what the bus carried, cycle by cycle.  The buffer grows by doubling
+is exactly what the bus carried, cycle by cycle; each row is stamped with the
+controller time at the end of its cycle, the time ``GT_GetClock`` and the
+``pClock`` of ``GT_GetPrfPos`` report for the same values.  The buffer grows by doubling
 (amortised O(1) per sample, one numpy row write).
 """
 

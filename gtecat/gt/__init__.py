@@ -8,6 +8,7 @@ manual's codes and ``GTE_GetLastError()`` says why.
 
 from __future__ import annotations
 
+import ctypes
 import importlib
 
 from ._core import REGISTRY
@@ -24,6 +25,18 @@ _MODULES = (
     "motion_ext_calls",
 )
 
+
+def _is_public(name: str, value: object) -> bool:
+    """What the stable surface exports: functions, structures, constants (DESIGN.md)."""
+    if name.startswith("_"):
+        return False
+    if name.startswith(("GT_", "GTN_", "GTE_")):
+        return True
+    if name.startswith("T") and isinstance(value, type) and issubclass(value, ctypes.Structure):
+        return True  # TTrapPrm, TJogPrm, TSlaveInfo ...
+    return name.isupper() and len(name) > 1 and isinstance(value, int | float | str)
+
+
 for _name in _MODULES:
     try:
         _mod = importlib.import_module(f"{__name__}.{_name}")
@@ -32,9 +45,7 @@ for _name in _MODULES:
             raise
         continue
     for _k, _v in vars(_mod).items():
-        if _k.startswith("_"):
-            continue
-        if _k.startswith(("GT_", "GTN_", "GTE_", "T")) or _k.isupper():
+        if _is_public(_k, _v):
             globals()[_k] = _v
 
 globals().update(REGISTRY)
