@@ -92,6 +92,11 @@ def _value(kind: str, raw: str) -> Value:
 def _decode(data: bytes | str) -> str:
     if isinstance(data, str):
         return data.lstrip("\ufeff")
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):  # Windows "Unicode" (UTF-16 with BOM)
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError:
+            pass  # not really UTF-16: fall through to the byte encodings
     for enc in ("utf-8-sig", "gb18030"):
         try:
             return data.decode(enc)
@@ -166,6 +171,13 @@ def read_googol(data: bytes | str, source: str) -> EniConfig:
     """Build the model from a Googol INI ``Gecat.eni`` (see module doc)."""
     glob, blocks = _tokenise(_decode(data), source)
     declared = _int_item(glob.get("slaveindex", []), "slavenum")
+    if declared is None and not blocks:
+        # an explicit slavenum=0 is an empty bus; saying nothing at all is a broken file
+        raise EniError(
+            "no [SlaveStart] blocks and no [SlaveIndex] slavenum: the file describes no bus "
+            "(truncated, or not written by the Googol configuration tool?)",
+            file=source,
+        )
     if declared is not None and declared != len(blocks):
         it = _first(glob["slaveindex"], "slavenum")
         raise EniError(

@@ -131,7 +131,11 @@ class Layout:
         return self._axes.get(axis)
 
     def to_json(self) -> dict[str, Any]:
-        """The ``gtecat map --json`` document (DESIGN.md "The stable surface")."""
+        """The ``gtecat map --json`` document (DESIGN.md "The stable surface").
+
+        ``axis`` is the slave's first GT axis (the schema's key); ``axes`` adds all
+        of them, so a multi-axis module (0x6040+0x800*k) shows every channel's axis.
+        """
         slaves = []
         for s in self.slaves:
             slaves.append(
@@ -139,6 +143,8 @@ class Layout:
                     "position": s.position,
                     "name": s.name,
                     "axis": s.axes[0] if s.axes else None,
+                    # every GT axis of the slave (a multi-axis module has several)
+                    "axes": list(s.axes),
                     "gt_offset": s.gt_offset,
                     "gt_size": s.gt_size,
                     "entries": [

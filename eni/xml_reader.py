@@ -10,9 +10,10 @@ EC-Engineer and Elmo write it:
   sync managers ``SmN`` with their ``Pdo`` assignment lists, and the
   ``RxPdo``/``TxPdo`` descriptions.  Only PDOs assigned to a sync manager (in a
   ``SmN/Pdo`` list or by an ``Sm`` attribute) count; the others are
-  alternatives the tool offered.  Direction comes from RxPdo (outputs) /
-  TxPdo (inputs), never from the SM number (terminals without mailbox put
-  process data on SM0/SM1);
+  alternatives the tool offered.  Where an SM has a list, the list decides
+  (an ``Sm`` attribute copied from the ESI onto an unlisted alternative does
+  not).  Direction comes from RxPdo (outputs) / TxPdo (inputs), never from
+  the SM number (terminals without mailbox put process data on SM0/SM1);
 * ``Slave/Mailbox/CoE/InitCmds/InitCmd``: the SDOs the master writes at a
   state transition (``Ccs`` 1 download, 2 upload);
 * ``Config/Cyclic/CycleTime`` (microseconds) and ``Config/ProcessImage``
@@ -63,6 +64,8 @@ class _Ctx:
     source: str
     slave: int | None = None
     slave_name: str | None = None
+    #: slave name -> bus positions, to spot names that ProcessImage variables cannot tell apart
+    positions_by_name: dict[str, list[int]] = field(default_factory=dict)
 
     def error(self, message: str, node: Node | None, element: str | None = None) -> EniError:
         return EniError(
@@ -151,6 +154,9 @@ def read_xml(root: Node, source: str) -> EniConfig:
     variables, sizes, var_index = _process_image(ctx, config)
 
     slaves: list[Slave] = []
+    for pos, snode in enumerate(config.findall("Slave")):
+        name = snode.findtext("Info/Name") or f"Slave {pos}"
+        ctx.positions_by_name.setdefault(name, []).append(pos)
     for pos, snode in enumerate(config.findall("Slave")):
         ctx.slave, ctx.slave_name = pos, None
         slaves.append(_slave(ctx, snode, pos, var_index))
@@ -373,8 +379,13 @@ def _assigned_pdos(ctx: _Ctx, pd: Node) -> dict[Direction, list[_PdoXml] | None]
             p = matches[0]
             if id(p) not in placed:
                 placed[id(p)] = (sm_no, rank, p.doc_order)
+    # A sync manager with an SmN/Pdo list is assigned by that list alone: it is what the
+    # master writes to 0x1C12/0x1C13 and sizes the SM from.  An ``Sm`` attribute naming such
+    # an SM on a PDO the list leaves out is the default SM the ESI gave that alternative
+    # (tools that copy RxPdo/TxPdo elements from the ESI keep it), not an assignment.
+    listed_sms = {sm_no for sm_no, _kind, listed in sm_lists if listed}
     for p in described:
-        if p.sm_attr is not None and id(p) not in placed:
+        if p.sm_attr is not None and id(p) not in placed and p.sm_attr not in listed_sms:
             placed[id(p)] = (p.sm_attr, 1 << 30, p.doc_order)
     by_dir: dict[Direction, list[_PdoXml] | None] = {}
     for d in Direction:
@@ -429,7 +440,10 @@ def _pdo(ctx: _Ctx, node: Node, order: int) -> _PdoXml:
             raise ctx.error(f"BitLen {bits} is not positive", enode, eelem)
         if not 0 <= eidx <= 0xFFFF or not 0 <= sub <= 0xFF:
             raise ctx.error("object address out of range", enode, eelem)
-        entries.append(PdoEntry(eidx, sub, bits, enode.findtext("Name") or "", dtype))
+        if eidx == 0:  # a gap: tools may name it ("__unused"), it still maps nothing
+            entries.append(PdoEntry(0, 0, bits))
+        else:
+            entries.append(PdoEntry(eidx, sub, bits, enode.findtext("Name") or "", dtype))
         lines.append(enode.line)
     return _PdoXml(
         node,
@@ -484,6 +498,21 @@ def _direction(
                 var = var_index.claim(d, names, want)
                 if var is not None:
                     where = f"{p.node.tag} #x{p.index:04X}/Entry {fmt_index(e.index, e.subindex)}"
+                    namesakes = ctx.positions_by_name.get(slave_name, [])
+                    if area is None and len(namesakes) > 1:
+                        # variables are found by "<slave>.<pdo>.<entry>": with no Send/Recv
+                        # to check them against, the namesakes' offsets could be swapped
+                        raise EniError(
+                            f"slaves {', '.join(map(str, namesakes))} share the name "
+                            f"{slave_name!r} and the file gives no {tag} area, so the "
+                            f"ProcessImage variable {var.name!r} cannot be told apart; give "
+                            "the slaves distinct names or Send/Recv BitStart",
+                            file=ctx.source,
+                            line=var_index.lines.get(id(var)),
+                            slave=ctx.slave,
+                            slave_name=ctx.slave_name,
+                            element=where,
+                        )
                     if var.bit_size != e.bit_len:
                         raise EniError(
                             f"ProcessImage variable {var.name!r} is {var.bit_size} bits but the "

@@ -11,6 +11,8 @@ ETG.2100 files come with and without them.
 
 from __future__ import annotations
 
+import codecs
+import re
 from collections.abc import Iterator
 from xml.parsers import expat
 
@@ -61,6 +63,45 @@ class Node:
         return f"<Node {self.tag} line {self.line}>"
 
 
+_DECL_ENCODING = re.compile(rb"^\s*<\?xml[^>]*?\bencoding\s*=\s*[\"']([A-Za-z0-9._:-]+)[\"']")
+#: what expat decodes itself (XML 1.0 section 4.3.3 requires UTF-8 and UTF-16)
+_EXPAT_NATIVE = {"utf_8", "utf_16", "iso8859_1", "latin_1", "ascii"}
+#: GB2312 files written on Windows routinely hold GBK characters; GB18030 reads both
+_SUPERSET = {"gb2312": "gb18030", "gbk": "gb18030"}
+
+
+def _decoded(data: bytes, source: str) -> bytes | str:
+    """Decode a document whose declared encoding expat cannot handle (``GB2312``, ``Shift_JIS``).
+
+    Chinese configuration tools write ``encoding="GB2312"``; expat only knows
+    UTF-8/UTF-16/ISO-8859-1/ASCII (and refuses multi-byte codecs through
+    pyexpat), so Python's codec decodes it and expat gets text.
+    """
+    if data.startswith((b"\xef\xbb\xbf", b"\xff\xfe", b"\xfe\xff")):
+        return data  # a BOM decides, as XML 1.0 appendix F says
+    m = _DECL_ENCODING.match(data[:512])
+    if m is None:
+        return data
+    declared = m.group(1).decode("ascii")
+    try:
+        name = codecs.lookup(declared).name.replace("-", "_")
+    except LookupError:
+        raise EniError(
+            f"unknown encoding {declared!r} in the XML declaration", file=source, line=1
+        ) from None
+    if name in _EXPAT_NATIVE or name.startswith("utf_16"):
+        return data
+    try:
+        return data.decode(_SUPERSET.get(name, name))
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise EniError(
+            f"byte 0x{data[exc.start]:02X} is not valid {declared} (the declared encoding)",
+            file=source,
+            line=line,
+        ) from None
+
+
 def _local(name: str) -> str:
     return name.rpartition(":")[2]
 
@@ -71,6 +112,8 @@ class _Refused(Exception):
 
 def parse_xml(data: bytes | str, source: str) -> Node:
     """Parse a whole document; any error becomes an :class:`EniError` with its line."""
+    if isinstance(data, bytes):
+        data = _decoded(data, source)
     parser = expat.ParserCreate()
     parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
     parser.buffer_text = True
@@ -117,6 +160,8 @@ def parse_xml(data: bytes | str, source: str) -> Node:
     except expat.ExpatError as exc:
         msg = expat.errors.messages.get(exc.code, str(exc)) if exc.code else str(exc)
         raise EniError(f"malformed XML: {msg}", file=source, line=exc.lineno) from None
+    except (ValueError, LookupError) as exc:  # an encoding pyexpat cannot use
+        raise EniError(f"cannot decode the XML: {exc}", file=source, line=1) from None
     if not root:
         raise EniError("empty XML document", file=source)
     return root[0]

@@ -43,11 +43,18 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="machine-readable output")
 
 
+def _file(p: argparse.ArgumentParser) -> None:
+    # ``gtecat slaves x.eni`` reads like ``gtecat map x.eni``; --eni says the same
+    p.add_argument("file", nargs="?", help="configuration file (same as --eni)")
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("slaves", help="list the slaves: position, state, identity, axes")
+    _file(p)
     _common(p)
     p.set_defaults(func=run_slaves)
     p = sub.add_parser("pdos", help="show each slave's sync managers, PDOs and entries")
+    _file(p)
     _common(p)
     p.set_defaults(func=run_pdos)
     p = sub.add_parser("sdo", help="SDO upload / download")
@@ -76,7 +83,7 @@ def open_bus(args: argparse.Namespace) -> Controller:
     try:
         ctl = Controller(
             Options(
-                eni=args.eni,
+                eni=args.eni or getattr(args, "file", None),
                 machine=args.machine,
                 # a real bus must cycle on the wall clock (docs/hardware.md)
                 clock="realtime" if backend == "pysoem" else "lockstep",

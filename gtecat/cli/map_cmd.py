@@ -104,8 +104,13 @@ def render_table(layout: Layout, label: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def render_json(layout: Layout) -> str:
-    return json.dumps(layout.to_json(), indent=2, ensure_ascii=False) + "\n"
+def _utf_stdout() -> bool:
+    return (getattr(sys.stdout, "encoding", "") or "").lower().replace("-", "").startswith("utf")
+
+
+def render_json(layout: Layout, *, ascii_only: bool = False) -> str:
+    """The DESIGN.md document; ``ascii_only`` escapes names (``\\uXXXX``) for non-UTF consoles."""
+    return json.dumps(layout.to_json(), indent=2, ensure_ascii=ascii_only) + "\n"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -116,6 +121,9 @@ def run(args: argparse.Namespace) -> int:
             raise
         print("error: " + " ".join(str(exc).split()), file=sys.stderr)
         return 1
-    out = render_json(layout) if args.json else render_table(layout, args.file)
+    if args.json:
+        out = render_json(layout, ascii_only=not _utf_stdout())
+    else:
+        out = render_table(layout, args.file)
     sys.stdout.write(out)
     return 0

@@ -132,7 +132,8 @@ def test_to_json_schema() -> None:
     assert set(doc) == {"slaves", "gt_raw_bytes", "outputs_bytes", "inputs_bytes"}
     assert doc["gt_raw_bytes"] == 5 and doc["outputs_bytes"] == 3 and doc["inputs_bytes"] == 2
     a, b = doc["slaves"]
-    assert set(a) == {"position", "name", "axis", "gt_offset", "gt_size", "entries"}
+    assert set(a) == {"position", "name", "axis", "axes", "gt_offset", "gt_size", "entries"}
+    assert (a["axes"], b["axes"]) == ([1], [])
     assert (a["axis"], a["gt_offset"], a["gt_size"], b["axis"], b["gt_offset"]) == (
         1,
         0,
