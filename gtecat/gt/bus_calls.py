@@ -265,17 +265,36 @@ def _region(ctl: Controller, slave: int, offset: int, size: int) -> tuple[Any, i
 
 
 @gt_function
-def GT_EcatIOReadInput(ctl: Controller, slave: int, offset: int, nSize: int, pValue: Any) -> int:
-    image, raw = _region(ctl, int(slave), int(offset), int(nSize))
-    store_bytes(pValue, image.read_raw(raw, int(nSize)))
+def GT_EcatIOReadInput(
+    ctl: Controller, slave: int, offset: int, nSize: int, pValue: Any, *more: Any
+) -> int:
+    """Entry 11.  The 5-argument spelling of the manual's 5.2.2.5 text,
+    ``GT_EcatIOReadInput(core, slave, offset, nSize, pValue)``, is accepted too."""
+    slave, offset, nSize, pValue = _io_args(slave, offset, nSize, pValue, more)
+    image, raw = _region(ctl, slave, offset, nSize)
+    store_bytes(pValue, image.read_raw(raw, nSize))
     return 0
 
 
 @gt_function
-def GT_EcatIOWriteOutput(ctl: Controller, slave: int, offset: int, nSize: int, pValue: Any) -> int:
-    image, raw = _region(ctl, int(slave), int(offset), int(nSize))
-    image.write_raw(raw, load_bytes(pValue, int(nSize)))
+def GT_EcatIOWriteOutput(
+    ctl: Controller, slave: int, offset: int, nSize: int, pValue: Any, *more: Any
+) -> int:
+    """Entry 12; the 5-argument spelling with the core first is accepted as for ReadInput."""
+    slave, offset, nSize, pValue = _io_args(slave, offset, nSize, pValue, more)
+    image, raw = _region(ctl, slave, offset, nSize)
+    image.write_raw(raw, load_bytes(pValue, nSize))
     return 0
+
+
+def _io_args(a: Any, b: Any, c: Any, d: Any, more: tuple) -> tuple[int, int, int, Any]:
+    """(slave, offset, size, buffer) from the 4-argument prototype or the 5-argument text form."""
+    if not more:
+        return int(a), int(b), int(c), d
+    if len(more) > 1:
+        raise ParameterError(f"{4 + len(more)} arguments; the prototype takes 4 (or core + 4)")
+    check_range("core", a, 1, 1)
+    return int(b), int(c), int(d), more[0]
 
 
 @gt_function

@@ -52,3 +52,8 @@ FOLLOW_SEGMENT_NORMAL = 0
 FOLLOW_SEGMENT_EVEN = 1
 FOLLOW_SEGMENT_STOP = 2
 FOLLOW_SEGMENT_CONTINUE = 3
+
+# --- GT_Open channels ------------------------------------------------------------------------
+#: GT_Open(CHANNEL_PCI_ECATCH) as in manual example 5-5.  The vendor header's value is not
+#: public; the emulator ignores the channel, so any value opens the (emulated) controller.
+CHANNEL_PCI_ECATCH = 1

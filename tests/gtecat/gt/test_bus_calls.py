@@ -20,7 +20,7 @@ from .conftest import bring_up
 
 def test_example_5_5_c_initialisation_sequence():
     """Example 5-5: GT_Open, GT_InitEcatComm, wait for GT_IsEcatReady, start, reset."""
-    assert gt.GT_Open(0, 1, eni=str(EXAMPLES / "manual_fig5_2.eni"), log="") == 0
+    assert gt.GT_Open(gt.CHANNEL_PCI_ECATCH, eni=str(EXAMPLES / "manual_fig5_2.eni"), log="") == 0
     assert gt.GT_InitEcatComm() == 0
     status = c_short(0)
     polls = 0
@@ -149,6 +149,10 @@ def test_example_5_4_ethercat_io_on_the_coupler():
     # the GTN twin with the EtherCAT core first, as 5.2.2.5 writes it
     assert gt.GTN_EcatIOReadInput(1, 0, 14, 2, byref(w_input)) == 0
     assert gt.GTN_EcatIOReadInput(2, 0, 14, 2, byref(w_input)) == 7
+    # the manual's 5.2.2.5 text spells it with the core first: GT_EcatIOReadInput(1, 0, 14, 2, ...)
+    assert gt.GT_EcatIOReadInput(1, 0, 14, 2, byref(w_input)) == 0 and w_input.value == 0xBEEF
+    assert gt.GT_EcatIOWriteOutput(1, 0, 2, 2, byref(w_out)) == 0
+    assert gt.GT_EcatIOReadInput(2, 0, 14, 2, byref(w_input)) == 7  # no core 2
     # outside the slave's 24-byte region, or writing its inputs: 7
     assert gt.GT_EcatIOReadInput(0, 23, 2, byref(w_input)) == 7
     assert gt.GT_EcatIOWriteOutput(0, 12, 2, byref(w_out)) == 7
