@@ -157,7 +157,9 @@ class CoeIoSlave(IoSlave):
     on the real device.  The field side keeps the point layout of the mapping the
     master finally configured (recomputed at PREOP -> SAFEOP).  Mapped objects
     that the slave does not describe are held as PDO placeholders; their SDO
-    upload reads what the process data holds last.
+    upload reads what the process data holds last (outputs: the master's last
+    RxPDO, inputs: the last TxPDO), as a real terminal's object does
+    (ETG.5001: the mapped 0x6000/0x7000 objects *are* the process data).
     """
 
     has_mailbox = True
@@ -184,9 +186,26 @@ class CoeIoSlave(IoSlave):
         self.mapping = PdoMapping(self.od, rx_pdos, tx_pdos)
         self.sdo = SdoServer(self.od, mailbox_size=mailbox_size)
         super().__init__(position, name, identity, rx_pdos=rx_pdos, tx_pdos=tx_pdos)
+        self._link_process_data()
 
     def pdo_sizes(self) -> tuple[int, int]:
         return self.mapping.sizes()
+
+    def _link_process_data(self) -> None:
+        """Placeholders of mapped objects read (and write) their bits of ``rx``/``tx``.
+
+        Read at SDO time, so the cycle pays nothing; the buffers are looked up on
+        every access because a new mapping reallocates them.
+        """
+        for p in self.points.values():
+            var = self.od.find(p.index, p.subindex)
+            if var is None or not var.placeholder:
+                continue
+            if p.direction == Direction.OUT:
+                var.getter = lambda p=p: get_bits(self.rx, p.bit, p.bits)
+                var.setter = lambda v, p=p: set_bits(self.rx, p.bit, p.bits, int(v))
+            else:
+                var.getter = lambda p=p: get_bits(self.tx, p.bit, p.bits)
 
     def mailbox(self, request: bytes) -> bytes | None:
         return self.sdo.handle(request, self.al_state)
@@ -221,3 +240,4 @@ class CoeIoSlave(IoSlave):
         rx_bits, tx_bits = self.mapping.sizes()
         self.field_outputs = bytearray((rx_bits + 7) // 8)
         self.field_inputs = bytearray((tx_bits + 7) // 8)
+        self._link_process_data()

@@ -4,7 +4,9 @@ One :class:`Axis` per GT axis (1-based, counting CiA-402 channels in bus
 order, DESIGN.md).  It owns the channel's controlword while the controller
 drives it: it writes 6040h whenever its command changes and, when the drive is enabled in
 cyclic synchronous position mode, the planned position to 607Ah - "a planned
-position every cycle", as the real controller does.
+position every cycle", as the real controller does.  With the servo off 607Ah
+holds the actual position, so enabling or coming back to CSP never jumps; only
+with the drive enabled in profile position mode is 607Ah the application's.
 
 Objects are addressed as for channel 0 (``0x6064``); :class:`AxisIo` adds
 ``0x800 * channel``.  A GT function that needs an object that is not mapped
@@ -23,6 +25,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any
 
+from eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from eni.layout import AxisRef, Layout
 
 from .errors import CommandError
@@ -53,6 +56,12 @@ OBJECT_NAMES = {
     0x20F2: "analog input 1",
     0x20F9: "analog input 2",
 }
+
+
+#: 6060h = 1, profile position: the one mode besides CSP in which the drive uses 607Ah
+_PROFILE_POSITION = 1
+#: end of the CiA-402 profile area of a multi-axis module (channel k's objects at +0x800*k)
+_PROFILE_END = 0x6000 + CHANNEL_STRIDE * MAX_CHANNELS
 
 
 class ObjectNotMapped(CommandError):
@@ -131,15 +140,38 @@ class AxisIo:
             return index + 0x800 * self.channel
         return index
 
+    def channel0_index(self, index: int) -> int | None:
+        """``index`` as channel 0 numbers it, or None when it is another channel's object.
+
+        Both numberings name this channel's profile objects (0x6841 is channel 1's
+        statusword, so is 0x6041 on channel 1's axis); a profile object of another
+        channel (0x7041 on channel 1) is not this axis's, whatever the module maps.
+        """
+        if not 0x6000 <= index < _PROFILE_END:
+            return index
+        k, offset = divmod(index - 0x6000, CHANNEL_STRIDE)
+        if k == 0 or k == self.channel:
+            return 0x6000 + offset
+        return None
+
     def get(self, index: int, subindex: int = 0) -> EntryAccess | None:
         key = (index, subindex)
         if key not in self._cache:
-            p = self._layout.axis_entry(self.ref.axis, index, subindex)
+            base = self.channel0_index(index)
+            p = None if base is None else self._layout.axis_entry(self.ref.axis, base, subindex)
             self._cache[key] = self._image.access(p) if p is not None else None
         return self._cache[key]
 
     def require(self, index: int, subindex: int = 0) -> EntryAccess:
         acc = self.get(index, subindex)
+        if acc is None and self.channel0_index(index) is None:
+            k = (index - 0x6000) // CHANNEL_STRIDE
+            own = self.index(0x6000 + (index - 0x6000) % CHANNEL_STRIDE)
+            raise ObjectNotMapped(
+                f"axis {self.ref.axis}: object 0x{index:04X}:{subindex:02X} belongs to channel "
+                f"{k} of slave {self.slave}, and axis {self.ref.axis} is its channel "
+                f"{self.channel}; ask for 0x{own:04X} (or the channel-0 number)"
+            )
         if acc is None:
             raise ObjectNotMapped(
                 f"axis {self.ref.axis}: object 0x{self.index(index):04X}:{subindex:02X} "
@@ -269,10 +301,13 @@ class Axis:
             self._cw_acc.set(self.cw)
             self._cw_sent = self.cw
         if self._tp_acc is not None:
-            if self.servo_on and self.csp_follow and self.mode_cmd == 8:
-                self._tp_acc.set(self.pulses_to_counts(self.prf_pos))
-            elif not self.servo_on or self.mode_cmd != 8:
-                # outside CSP keep 607A on the actual position so enabling never jumps
+            if self.servo_on and self.mode_cmd == 8:
+                if self.csp_follow:
+                    self._tp_acc.set(self.pulses_to_counts(self.prf_pos))
+            elif not self.servo_on or self.mode_cmd != _PROFILE_POSITION:
+                # elsewhere 607A stays on the actual position, so enabling or coming back
+                # to CSP never jumps; in profile position mode 607A is the application's
+                # target (GT_SetEcatRawData), which the drive takes on CW4
                 if self._pos_acc is not None:
                     self._tp_acc.set(self._pos_acc.get())
 

@@ -529,9 +529,11 @@ class Esc:
             if out.start < inp.end and inp.start < out.end:
                 return AlStatusCode.INVALID_MAILBOX_CONFIGURATION
         if current == AlState.PREOP and target == AlState.SAFEOP:
+            # the buffers the data path uses (first enabled process-data SM per direction);
+            # a stale extra SM a master left enabled (SOEM clears only SM0-3) is not counted
             rx_bits, tx_bits = self.slave.pdo_sizes()
-            out_len = sum(s.length for s in self.sms if not s.mailbox and s.ecat_writes)
-            in_len = sum(s.length for s in self.sms if not s.mailbox and not s.ecat_writes)
+            out_len = self.outputs_sm.length if self.outputs_sm is not None else 0
+            in_len = self.inputs_sm.length if self.inputs_sm is not None else 0
             if out_len != (rx_bits + 7) // 8:
                 return AlStatusCode.INVALID_OUTPUT_CONFIGURATION
             if in_len != (tx_bits + 7) // 8:

@@ -33,6 +33,8 @@ TYPES = {  # --type name -> (struct code, size)
     "float": ("f", 4),
     "double": ("d", 8),
 }
+#: CiA 301 VISIBLE_STRING (0x0009): device name 1008h, versions 1009h/100Ah
+STRING = "string"
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -66,8 +68,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--type",
         default=None,
-        choices=sorted(TYPES),
+        choices=sorted([*TYPES, STRING]),
         help="data type (upload default: raw hex; download: required)",
+    )
+    p.epilog = (
+        "On the emulated bus every command starts a fresh bus: a download lasts for that "
+        "command only (use a script and `gtecat run` for sequences)."
     )
     _common(p)
     p.set_defaults(func=run_sdo)
@@ -101,6 +107,8 @@ def open_bus(args: argparse.Namespace) -> Controller:
             raise BusError(f"the bus did not reach OP{': ' + err if err else ''}")
     except ConfigMismatch as e:
         ctl.close()
+        if "export" in str(e):  # the master already says what to do
+            raise
         raise ConfigMismatch(
             f"{e}; the ENI does not describe this bus: export it again from the "
             "configuration tool for this machine, or check the cabling order"
@@ -203,6 +211,22 @@ def run_pdos(args: argparse.Namespace) -> int:
     return 0
 
 
+def _encode(text: str, type_name: str) -> bytes:
+    """VALUE as the bytes of ``--type`` (little endian, CiA 301); a bad value is one line."""
+    if type_name == STRING:
+        return text.encode("utf-8")
+    code, _size = TYPES[type_name]
+    try:
+        v: float | int = float(text) if code in "fd" else parse_int(text)
+    except ValueError:
+        kind = "a number" if code in "fd" else "an integer (e.g. 10, -3, 0x1F)"
+        raise ParameterError(f"VALUE {text!r} is not {kind} for --type {type_name}") from None
+    try:
+        return struct.pack("<" + code, v)
+    except struct.error as e:
+        raise ParameterError(f"{text} does not fit {type_name}: {e}") from None
+
+
 def run_sdo(args: argparse.Namespace) -> int:
     try:
         index, sub = parse_int(args.index), parse_int(args.subindex)
@@ -213,12 +237,7 @@ def run_sdo(args: argparse.Namespace) -> int:
     if args.action == "download":
         if args.value is None or args.type is None:
             raise ParameterError("sdo download needs VALUE and --type")
-        code, _size = TYPES[args.type]
-        v: float | int = float(args.value) if code in "fd" else parse_int(args.value)
-        try:
-            data = struct.pack("<" + code, v)
-        except struct.error as e:
-            raise ParameterError(f"{args.value} does not fit {args.type}: {e}") from None
+        data = _encode(args.value, args.type)
     ctl = open_bus(args)
     try:
         if args.action == "upload":
@@ -232,7 +251,9 @@ def run_sdo(args: argparse.Namespace) -> int:
             print(json.dumps({"ok": True}))
         return 0
     value: object = raw.hex(" ")
-    if args.type:
+    if args.type == STRING:
+        value = raw.rstrip(b"\0").decode("utf-8", errors="backslashreplace")
+    elif args.type:
         code, size = TYPES[args.type]
         if len(raw) < size:
             raise ParameterError(

@@ -18,7 +18,10 @@ Decisions where the manual is silent:
 * ``GT_GetEcatEncPos`` reports 6064h as the drive counts it (no scaling);
   ``GT_SetPosScale`` affects the controller's own positions.
 * ``GT_GetEcatAxisPdoData(axis, object, pData, subindex=0)`` copies the mapped
-  entry's bytes (little endian, the entry's size rounded up to bytes).
+  entry's bytes (little endian, the entry's size rounded up to bytes).  On a
+  multi-axis module ``object`` may be numbered as for channel 0 (0x6064) or as
+  the axis's own channel (0x6864 on channel 1); another channel's object is
+  refused (1), never read.
 """
 
 from __future__ import annotations
@@ -200,7 +203,7 @@ def GT_GetPosScale(ctl: Controller, axis: int, pScale: Any) -> int:
 def GT_GetEcatAxisPdoData(
     ctl: Controller, axis: int, object: int, pData: Any, subindex: int = 0
 ) -> int:
-    """Any mapped object of the axis by index (channel-0 numbering, e.g. 0x6064)."""
+    """Any mapped object of the axis by index (0x6064, or its channel's own 0x6864)."""
     ax = bus_axis(ctl, axis)
     check_range("object", object, 0, 0xFFFF)
     acc = ax.io.require(int(object), int(subindex))

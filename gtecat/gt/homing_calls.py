@@ -49,7 +49,10 @@ Decisions where the manual is silent:
 * **GT_SetTouchProbeFunction** sends ``ProbePrm`` to 60B8h as a 16-bit pattern
   (a negative ``short`` is taken bit for bit).  Bits 2-3 / 10-11, "reserved" in
   entry 123, select the source as ETG.6010 defines (00 probe input, 01 encoder
-  index).  Both set calls return once the drive shows the enable bits in 60B9h.
+  index).  Both set calls return once the drive has taken the new 60B8h (at least one
+  exchange after the write) and shows its enable bits in 60B9h, so a status read right
+  after is not stale and two successive calls are two values on the wire (the ETG.6010
+  re-arm, edge bit 4 off then on, needs the drive to see the 0).
 * **GT_SetTouchProbeFunctionEx** constants (the vendor header's values are not
   public; these are ours, the 60B8h bit patterns): ``ECAT_PROBE_TRIGGER_TYPE_FIRST_EVENT``
   0, ``..._CONTINUES`` 1 (bit 1); ``ECAT_PROBE_TRIGGER_LEVEL_POS`` 1, ``..._NEG`` 2,
@@ -346,6 +349,7 @@ def set_probe_function(ctl: Controller, ax: Axis, function: int) -> None:
     """Write 60B8h and wait until 60B9h shows the enable bits (both probe set calls)."""
     function &= 0xFFFF
     _write(ax, 0x60B8, 0, function, 2)
+    _wait_cycles(ctl)  # the drive takes 60B8h in the next exchange (module docstring)
     mask = ProbeStatus.PROBE1_ENABLED | ProbeStatus.PROBE2_ENABLED  # = 60B8h bits 0 and 8
     enables = function & mask
     if not ctl.clock.run_until(

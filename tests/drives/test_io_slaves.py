@@ -72,3 +72,27 @@ def test_al_state_machine_refuses_illegal_transitions():
     s.expected_sizes = (8, 0)  # the master expects an output byte the slave doesn't map
     assert s.request_state(AlState.SAFEOP) == AlStatusCode.INVALID_OUTPUT_CONFIGURATION
     assert s.al_state == AlState.PREOP
+
+
+def test_coe_io_slave_sdo_reads_the_process_data_of_mapped_objects():
+    """ETG.5001: a module's mapped 0x7000/0x6000 objects are its process data, by SDO too."""
+    from drives.abort import SdoAbort, SdoAbortCode
+    from drives.coe import SdoClient
+    from drives.io_slaves import CoeIoSlave
+
+    ref = _coupler()
+    s = CoeIoSlave(0, "coupler", Identity(1, 2), rx_pdos=ref.rx_pdos, tx_pdos=ref.tx_pdos)
+    for st in (AlState.PREOP, AlState.SAFEOP, AlState.OP):  # PS recomputes the layout
+        assert s.request_state(st) == AlStatusCode.NO_ERROR
+    sdo = SdoClient(s.mailbox)
+    s.rx[:] = b"\x34\x12\xfb\xff"  # the master's outputs: DO16 0x1234, AO1 -5
+    s.set_input(0x6000, 1, 0xBEEF)
+    s.step(0, 1_000_000)
+    assert sdo.upload(0x7010, 1) == b"\x34\x12"
+    assert sdo.upload(0x7030, 1) == b"\xfb\xff"
+    assert sdo.upload(0x6000, 1) == b"\xef\xbe"
+    sdo.download(0x7010, 1, b"\x01\x00")  # an output set by SDO is what the slave then holds
+    assert sdo.upload(0x7010, 1) == b"\x01\x00" and s.rx[:2] == b"\x01\x00"
+    with pytest.raises(SdoAbort) as err:
+        sdo.download(0x6000, 1, b"\x00\x00")  # inputs are read-only
+    assert err.value.code == SdoAbortCode.WRITE_OF_READ_ONLY

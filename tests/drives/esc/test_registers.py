@@ -143,6 +143,17 @@ def test_safeop_checks_the_process_data_sms(out_len: int, in_len: int, code: int
     assert status == (0x04 if code == 0 else 0x12)
 
 
+def test_a_stale_extra_sm_left_enabled_does_not_fail_the_safeop_check() -> None:
+    # SOEM's config_init clears SM0-3 only; an SM4/SM5 another master (or stray frames)
+    # left enabled is not one of the buffers the slave serves, so it must not count.
+    esc, _ = make()
+    assert esc.write(Reg.SM0 + 32, sm_bytes(0x1800, 0x2E, 0x20, 1))  # SM4: a stale input SM
+    assert esc.write(Reg.SM0 + 40, sm_bytes(0x1900, 0x13, 0x64, 1))  # SM5: a stale output SM
+    configure(esc)
+    request(esc, AlState.PREOP)
+    assert request(esc, AlState.SAFEOP) == (0x04, 0)
+
+
 def test_an_error_must_be_acknowledged_before_going_up() -> None:
     esc, _ = make()
     configure(esc, 5, 10)

@@ -96,6 +96,18 @@ def test_sdo_upload_json(cli: Cli) -> None:
     )
 
 
+def test_sdo_string_type_reads_the_device_name(cli: Cli) -> None:
+    rc, raw, _ = cli("sdo", "upload", "0", "0x1008", "0", "--eni", FIG52)
+    assert rc == 0 and raw.strip().endswith("bytes)")
+    rc, out, _ = cli("sdo", "upload", "0", "0x1008", "0", "--type", "string", "--eni", FIG52)
+    assert rc == 0
+    assert out.strip().encode().hex(" ") == raw.split("  (")[0].strip()  # the same bytes, as text
+    rc, out, err = cli(
+        "sdo", "download", "0", "0x1008", "0", "X", "--type", "string", "--eni", FIG52
+    )
+    assert (rc, out) == (1, "") and "0x06010002" in err  # the name is read-only: its abort
+
+
 def test_sdo_download_is_silent_on_success(cli: Cli) -> None:
     rc, out, err = cli("sdo", "download", "0", "0x6060", "0", "6", "--type", "int8", "--eni", FIG52)
     assert (rc, out, err) == (0, "", "")
@@ -131,6 +143,9 @@ def test_sdo_abort_prints_the_cia301_code_in_one_line(
         (("download", "0", "0x6060", "0"), "needs VALUE and --type"),
         (("upload", "0", "0x60zz", "0"), "must be numbers"),
         (("upload", "0", "0x6041", "0", "--type", "uint32"), "has 2 bytes, uint32 needs 4"),
+        # a value that is not a number is the user's mistake, not an internal error
+        (("download", "0", "0x6060", "0", "abc", "--type", "int8"), "VALUE 'abc' is not an int"),
+        (("download", "0", "0x6060", "0", "1,5", "--type", "float"), "VALUE '1,5' is not a num"),
     ],
 )
 def test_sdo_bad_requests_are_one_clear_line(cli: Cli, argv: tuple[str, ...], text: str) -> None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from ctypes import byref, c_long, c_short, c_ubyte, c_uint32, c_ulong, c_ushort
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32, c_ulong, c_ushort
 
 import pytest
 
@@ -193,3 +193,59 @@ def test_forced_following_error_faults_and_a_reset_clears_it():
     gt.GT_GetEcatRawData(off, 2, byref(sw))
     assert sw.value & 0x4F == 0x40  # switch on disabled
     assert gt.GT_AxisOn(1) == 0, gt.GTE_GetLastError()
+
+
+def test_pdo_data_of_a_module_channel_never_reads_another_channel():
+    """A 4-axis module (channel k at +0x800*k): axis 6 is channel 1 of slave 4.
+
+    Its statusword is 0x6041 in channel-0 numbering and 0x6841 in its own; 0x7041 is
+    channel 2's (axis 7), so asking axis 6 for it returns 1 instead of axis 7's value.
+    """
+    bring_up("twelve_axes.eni")
+    assert gt.GT_AxisOn(7) == 0  # channel 2 enabled, channel 1 not: different statuswords
+    own, zero = (c_ubyte * 2)(), (c_ubyte * 2)()
+    assert gt.GT_GetEcatAxisPdoData(6, 0x6841, own) == 0
+    assert gt.GT_GetEcatAxisPdoData(6, 0x6041, zero) == 0
+    assert bytes(own) == bytes(zero)
+    assert int.from_bytes(bytes(own), "little") & 0x4F == 0x40  # switch on disabled
+    other = (c_ubyte * 2)()
+    assert gt.GT_GetEcatAxisPdoData(6, 0x7041, other) == 1
+    assert "channel 2" in gt.GTE_GetLastError() and "0x6841" in gt.GTE_GetLastError()
+    assert gt.GT_GetEcatAxisPdoData(7, 0x7041, other) == 0
+    assert int.from_bytes(bytes(other), "little") & 0x6F == 0x27  # operation enabled
+
+
+def test_profile_position_through_raw_data_keeps_the_application_target():
+    """PP (6060h = 1) with 607Ah and the set-point handshake written by GT_SetEcatRawData:
+    the controller leaves 607Ah to the application while the drive is enabled outside CSP
+    (it used to overwrite it with 6064h every cycle, so a PP move never went anywhere)."""
+    bring_up(FULL, clock="lockstep")
+    offsets = _map_offsets(FULL)
+    assert gt.GT_AxisOn(1) == 0, gt.GTE_GetLastError()
+    assert gt.GT_SetEcatAxisMode(1, 1) == 0
+    gt.GTE_Wait(3)
+    abort = c_uint32()
+    for index, value in ((0x6081, 100_000), (0x6083, 1_000_000), (0x6084, 1_000_000)):
+        data = (c_ubyte * 4)(*value.to_bytes(4, "little"))
+        assert gt.GT_EcatSDODownload(0, index, 0, data, 4, byref(abort)) == 0
+    target, cw = offsets[(0, 0x607A, 0)], offsets[(0, 0x6040, 0)]
+    sw = c_ushort()
+    assert gt.GT_SetEcatRawData(target, 4, byref(c_long(20_000))) == 0
+    assert gt.GT_SetEcatRawData(cw, 2, byref(c_ushort(0x001F))) == 0  # new set-point
+    gt.GTE_Wait(2)
+    gt.GT_GetEcatRawData(offsets[(0, 0x6041, 0)], 2, byref(sw))
+    assert sw.value & 0x1000  # SW12: set-point acknowledged
+    assert gt.GT_SetEcatRawData(cw, 2, byref(c_ushort(0x000F))) == 0
+    gt.GTE_Wait(400)
+    pos, tp = c_long(), c_long()
+    gt.GT_GetEcatRawData(target, 4, byref(tp))
+    assert gt.GT_GetEcatEncPos(1, byref(pos)) == 0
+    assert (tp.value, pos.value) == (20_000, 20_000)
+    gt.GT_GetEcatRawData(offsets[(0, 0x6041, 0)], 2, byref(sw))
+    assert sw.value & 0x0400  # SW10: target reached
+    # back to CSP: the planned position is where PP left the axis, no jump
+    assert gt.GT_SetEcatAxisMode(1, 8) == 0
+    gt.GTE_Wait(5)
+    prf = c_double()
+    assert gt.GT_GetPrfPos(1, byref(prf)) == 0 and prf.value == 20_000
+    assert gt.GT_GetEcatEncPos(1, byref(pos)) == 0 and pos.value == 20_000

@@ -134,6 +134,44 @@ def test_first_event_keeps_the_first_capture_until_rearmed() -> None:
     assert sts & 0b11 == 0b11 and abs(vals[0] - RISING[3]) <= 1
 
 
+@pytest.mark.parametrize("eni", ["homing_probe.eni", "manual_fig5_2.eni"])
+def test_rearm_by_the_edge_bit_in_lockstep(eni: str) -> None:
+    """ETG.6010 re-arm: 60B8h bit 4 off, then on.  In lockstep no time passes between the
+    two calls, so each set call must let the drive take its value (else the 0 never reaches
+    the wire and the probe stays stored); the status read right after is the new one."""
+    machine = MachineDescription(
+        {1: AxisMachine(probe1=((10000.0, 10300.0), (20000.0, 20300.0)))}, "two marks"
+    )
+    bring_up(eni, machine=machine, clock="lockstep")
+    assert gt.GT_AxisOn(1) == 0
+    assert gt.GT_SetTouchProbeFunction(1, 0x0011) == 0
+    prm = gt.TTrapPrm(acc=5.0, dec=5.0)
+
+    def move(target: int) -> None:
+        for call in (
+            gt.GT_PrfTrap(1),
+            gt.GT_SetTrapPrm(1, byref(prm)),
+            gt.GT_SetPos(1, target),
+            gt.GT_SetVel(1, 50.0),
+            gt.GT_Update(1),
+        ):
+            assert call == 0, gt.GTE_GetLastError()
+        sts = c_long()
+        while gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & (1 << 10):
+            gt.GTE_Wait(1)
+
+    move(15000)
+    sts, vals = probe_status(1)
+    assert sts & 0b11 == 0b11 and vals[0] == 10000
+    assert gt.GT_SetTouchProbeFunction(1, 0x0001) == 0  # rising edge off: bit 1 cleared
+    assert probe_status(1)[0] & 0b11 == 0b01
+    assert gt.GT_SetTouchProbeFunction(1, 0x0011) == 0  # on again: armed
+    assert probe_status(1)[0] & 0b11 == 0b01
+    move(25000)
+    sts, vals = probe_status(1)
+    assert sts & 0b11 == 0b11 and vals[0] == 20000
+
+
 def test_probe_2_both_edges_by_description() -> None:
     marks = [(-3000.7, -2500.2), (-9000.4, -8000.9)]
     m = MachineDescription({1: AxisMachine(position=0, probe2=marks)})
