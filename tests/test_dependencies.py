@@ -11,7 +11,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-FORBIDDEN = {"eni": {"drives", "gtecat", "tools"}, "drives": {"gtecat", "tools"}, "gtecat": {"tools"}}
+FORBIDDEN = {
+    "eni": {"drives", "gtecat", "tools"},
+    "drives": {"gtecat", "tools"},
+    "gtecat": {"tools"},
+}
 
 
 def _imports(path: Path) -> set[str]:

@@ -16,8 +16,8 @@ import importlib
 import json
 import sys
 import time
-from dataclasses import replace
 from ctypes import c_ubyte
+from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
