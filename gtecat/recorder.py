@@ -53,8 +53,10 @@ def _axis_getter(ctl: Controller, n: int, what: str) -> Getter:
     if what == "mode":
         return ax.io.require(0x6061).get
     # machine: the emulated drive's true mechanical position
+    from .backends.emulated import EmulatedBackend
+
     backend = ctl.backend
-    slaves = getattr(backend, "slaves", None)
+    slaves = backend.slaves if isinstance(backend, EmulatedBackend) else None
     if slaves is None:
         raise ParameterError(f"axis{n}.machine needs the emulated backend")
     channel = slaves[ax.io.slave].channel(ax.io.channel)

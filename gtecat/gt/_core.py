@@ -209,8 +209,10 @@ def store(ptr: Any, value: Any) -> None:
         return
     t = _target(ptr)
     if isinstance(t, ctypes._SimpleCData):
-        t.value = value
-    elif isinstance(t, ctypes._Pointer | ctypes.Array | np.ndarray):
+        t.value = _fit(type(t), value)
+    elif isinstance(t, ctypes._Pointer | ctypes.Array):
+        t[0] = _fit(t._type_, value)
+    elif isinstance(t, np.ndarray):
         t[0] = value
     elif isinstance(t, list):
         if t:
@@ -225,6 +227,22 @@ def store(ptr: Any, value: Any) -> None:
         raise ParameterError(f"argument of type {type(ptr).__name__} is not a writable pointer")
 
 
+_FLOAT_TYPES = (ctypes.c_float, ctypes.c_double, ctypes.c_longdouble)
+
+
+def _fit(ctype: Any, value: Any) -> Any:
+    """A value for a ctypes slot: a float into an integer type (``c_long`` where the
+    prototype has ``double *``) is rounded, as a C conversion of the value would be."""
+    if (
+        isinstance(value, float)
+        and isinstance(ctype, type)
+        and issubclass(ctype, ctypes._SimpleCData)
+    ):
+        if not issubclass(ctype, _FLOAT_TYPES) and ctype._type_ not in "?cuzZPO":
+            return round(value)
+    return value
+
+
 def store_array(ptr: Any, values: list[Any]) -> None:
     """Write ``values`` into an array argument (ctypes array, numpy, list, pointer)."""
     if ptr is None:
@@ -233,7 +251,7 @@ def store_array(ptr: Any, values: list[Any]) -> None:
     if isinstance(t, ctypes._SimpleCData):
         if len(values) > 1:
             raise ParameterError(f"count {len(values)} needs an array, got a single value")
-        t.value = values[0]
+        t.value = _fit(type(t), values[0])
         return
     if isinstance(t, ctypes.Array | np.ndarray | list | ctypes._Pointer):
         if not isinstance(t, ctypes._Pointer) and len(t) < len(values):
@@ -241,8 +259,9 @@ def store_array(ptr: Any, values: list[Any]) -> None:
                 t.extend([0] * (len(values) - len(t)))
             else:
                 raise ParameterError(f"array of {len(t)} too small for {len(values)} values")
+        elem = getattr(t, "_type_", None)
         for i, v in enumerate(values):
-            t[i] = v
+            t[i] = _fit(elem, v)
         return
     raise ParameterError(f"argument of type {type(ptr).__name__} is not a writable array")
 

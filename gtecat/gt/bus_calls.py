@@ -412,8 +412,10 @@ def GTE_ReplugSlave(ctl: Controller, slave: int) -> int:
 
 
 def _emulated(ctl: Controller):
+    from ..backends.emulated import EmulatedBackend
+
     backend = ctl.backend
-    if backend is None or not hasattr(backend, "unplug"):
+    if not isinstance(backend, EmulatedBackend):
         raise CommandError("only the emulated bus can unplug slaves (GT_InitEcatComm first)")
     return backend
 
@@ -433,9 +435,14 @@ def GTE_Controller(core: int = 1) -> Controller:
 def GTE_Slave(slave: int, core: int = 1):
     """The virtual slave at ``slave`` (emulated backend): its field side for scenarios."""
     ctl = SESSION.controller(core)
+    from ..backends.emulated import EmulatedBackend
+
     backend = ctl.backend
-    if backend is None or not hasattr(backend, "slaves"):
-        raise BusError("no emulated bus is open (GT_InitEcatComm first)")
+    if not isinstance(backend, EmulatedBackend):
+        raise BusError(
+            "no emulated bus is open (GT_InitEcatComm first; virtual slaves exist "
+            "only on the emulated backend)"
+        )
     try:
         return backend.slaves[slave]
     except IndexError:

@@ -381,7 +381,9 @@ def probe_function_ex(
 
 def machine_position(ctl: Controller, ax: Axis) -> float:
     """Where the axis's mechanics are (emulated backend only), machine counts."""
-    slaves = getattr(ctl.backend, "slaves", None)
+    from ..backends.emulated import EmulatedBackend
+
+    slaves = ctl.backend.slaves if isinstance(ctl.backend, EmulatedBackend) else None
     if slaves is None:
         raise CommandError(
             f"axis {ax.number}: the machine position exists only on the emulated backend "

@@ -240,3 +240,27 @@ def test_master_log_reads_like_the_real_one():
     assert "Scanning bus" in text
     assert "Slave states: PREOP" in text
     assert "All slaves are in OP mode" in text
+
+
+def test_integer_pointers_for_double_results_get_rounded_values():
+    """C code passing ``long *`` where the prototype has ``double *`` gets the value
+    converted, not an internal error (ctypes refuses a float in a c_long)."""
+    bring_up()
+    gt.GTE_Controller().axis(1).prf_pos = 12.6
+    as_long, arr = ctypes.c_long(), (ctypes.c_long * 2)()
+    assert gt.GT_GetPrfPos(1, byref(as_long)) == 0, gt.GTE_GetLastError()
+    assert gt.GT_GetPrfPos(1, arr, 1) == 0
+    assert isinstance(as_long.value, int) and list(arr)[1] == 0
+
+
+def test_emulator_only_helpers_refuse_other_backends_with_a_reason():
+    bring_up()
+    ctl = gt.GTE_Controller()
+    real, ctl.backend = ctl.backend, object()  # stands in for a non-emulated backend
+    try:
+        pos = ctypes.c_double()
+        assert gt.GTE_GetMachinePos(1, byref(pos)) == 1
+        assert "emulated" in gt.GTE_GetLastError()
+        assert gt.GTE_UnplugSlave(1) == 1 and "emulated" in gt.GTE_GetLastError()
+    finally:
+        ctl.backend = real
