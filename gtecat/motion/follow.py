@@ -62,7 +62,7 @@ from enum import IntEnum
 from ..errors import CommandError, ParameterError
 from . import checks
 from .fifo import FOLLOW_MEMORY_SIZES, FifoPair, fifo_index
-from .master import MasterSource, MasterSpec, MasterType, direction, passed
+from .master import MasterSource, SlavePlanner, passed
 from .stop import StopKind, StopRamp
 
 _IDLE, _WAIT, _MOVE, _STOP = 0, 1, 2, 3
@@ -115,35 +115,32 @@ class _Seg:
     k: float
 
 
-class FollowPlanner:
+class FollowPlanner(SlavePlanner):
     """One slave profile in Follow mode."""
+
+    MODE = "Follow"
 
     __slots__ = (
         "_T",
         "_acc",
         "_carry",
-        "_dir",
         "_fifos",
         "_i",
         "_loop",
         "_loops_done",
         "_m_prev",
-        "_master",
         "_origin",
         "_pos",
         "_r",
         "_s0",
         "_sd",
         "_segs",
-        "_source",
-        "_state",
         "_stop",
         "_switch",
         "_trigger",
         "_vel",
         "_x",
         "_x0",
-        "profile",
         "stopping",
     )
 
@@ -155,13 +152,10 @@ class FollowPlanner:
         pos: float = 0.0,
         source: MasterSource | None = None,
     ) -> None:
-        self.profile = profile
+        self._init_master(profile, dir, source)
         self._T = checks.positive("cycle_ms", cycle_ms)
         self._stop = StopRamp(self._T)
-        self._dir = direction(dir)
         self._fifos: FifoPair[FollowPoint] = FifoPair(FOLLOW_MEMORY_SIZES, "Follow")
-        self._master: MasterSpec | None = None
-        self._source = source
         self._loop = 1
         self._loops_done = 0
         self._trigger = FollowTrigger()
@@ -174,44 +168,6 @@ class FollowPlanner:
         self.hold(pos)
 
     # ------------------------------------------------------------ settings
-    @property
-    def direction(self) -> int:
-        """GT_PrfFollow ``dir``: 0 both ways, 1 positive, -1 negative master motion."""
-        return self._dir
-
-    def set_direction(self, dir: object) -> None:
-        """GT_PrfFollow on a profile already in Follow mode: only the same ``dir`` is accepted."""
-        d = direction(dir)
-        self._require_idle("GT_PrfFollow")
-        if d != self._dir:
-            raise CommandError(
-                f"GT_PrfFollow: the profile is in Follow mode with dir {self._dir}, not {d}; "
-                "switch to another mode first"
-            )
-
-    @property
-    def master(self) -> MasterSpec | None:
-        """GT_GetFollowMaster (None until GT_SetFollowMaster)."""
-        return self._master
-
-    def set_master(
-        self,
-        index: object,
-        type: object = MasterType.PROFILE,
-        item: object = 0,
-        source: MasterSource | None = None,
-    ) -> None:
-        """GT_SetFollowMaster; ``source`` is the position the controller resolved for it."""
-        spec = MasterSpec.checked(self.profile, index, type, item)
-        self._require_idle("GT_SetFollowMaster")
-        self._master = spec
-        if source is not None:
-            self._source = source
-
-    def bind_master(self, source: MasterSource) -> None:
-        """Attach the master position source (the controller's resolution of the master)."""
-        self._source = source
-
     @property
     def loop(self) -> int:
         """Passes GT_SetFollowLoop asked for (< 1 = endless)."""
@@ -431,10 +387,6 @@ class FollowPlanner:
         return self._pos, self._vel, self._acc
 
     # ------------------------------------------------------------ internals
-    def _require_idle(self, what: str) -> None:
-        if self._state != _IDLE:
-            raise CommandError(f"{what}: the profile is moving; call GT_Stop first")
-
     def _follow(self) -> None:
         """Slave position for the current master travel ``_x``."""
         x = self._x

@@ -30,32 +30,29 @@ from __future__ import annotations
 
 from ..errors import CommandError, ParameterError
 from . import checks
-from .master import MasterSource, MasterSpec, MasterType, direction, passed
+from .master import MasterSource, SlavePlanner, passed
 from .stop import StopKind, StopRamp
 
 _IDLE, _MOVE, _STOP = 0, 1, 2
 
 
-class GearPlanner:
+class GearPlanner(SlavePlanner):
     """One slave profile in Gear mode."""
+
+    MODE = "Gear"
 
     __slots__ = (
         "_T",
         "_acc",
         "_cl",
-        "_dir",
         "_m_prev",
-        "_master",
         "_pos",
         "_r0",
         "_r1",
         "_ratio",
-        "_source",
-        "_state",
         "_stop",
         "_vel",
         "_x",
-        "profile",
         "stopping",
     )
 
@@ -67,12 +64,9 @@ class GearPlanner:
         pos: float = 0.0,
         source: MasterSource | None = None,
     ) -> None:
-        self.profile = profile
+        self._init_master(profile, dir, source)
         self._T = checks.positive("cycle_ms", cycle_ms)
         self._stop = StopRamp(self._T)
-        self._dir = direction(dir)
-        self._master: MasterSpec | None = None
-        self._source = source
         self._ratio: tuple[int, int, int] | None = None
         self._r0 = self._r1 = 0.0
         self._cl = self._x = 0.0
@@ -80,44 +74,6 @@ class GearPlanner:
         self.hold(pos)
 
     # ------------------------------------------------------------ settings
-    @property
-    def direction(self) -> int:
-        """GT_PrfGear ``dir``: 0 both ways, 1 positive, -1 negative master motion."""
-        return self._dir
-
-    def set_direction(self, dir: object) -> None:
-        """GT_PrfGear on a profile already in Gear mode: only the same ``dir`` is accepted."""
-        d = direction(dir)
-        self._require_idle("GT_PrfGear")
-        if d != self._dir:
-            raise CommandError(
-                f"GT_PrfGear: the profile is in Gear mode with dir {self._dir}, not {d}; "
-                "switch to another mode first"
-            )
-
-    @property
-    def master(self) -> MasterSpec | None:
-        """GT_GetGearMaster (None until GT_SetGearMaster)."""
-        return self._master
-
-    def set_master(
-        self,
-        index: object,
-        type: object = MasterType.PROFILE,
-        item: object = 0,
-        source: MasterSource | None = None,
-    ) -> None:
-        """GT_SetGearMaster; ``source`` is the position the controller resolved for it."""
-        spec = MasterSpec.checked(self.profile, index, type, item)
-        self._require_idle("GT_SetGearMaster")
-        self._master = spec
-        if source is not None:
-            self._source = source
-
-    def bind_master(self, source: MasterSource) -> None:
-        """Attach the master position source (the controller's resolution of the master)."""
-        self._source = source
-
     @property
     def ratio(self) -> tuple[int, int, int] | None:
         """GT_GetGearRatio ``(masterEven, slaveEven, masterSlope)``; None until set."""
@@ -232,10 +188,6 @@ class GearPlanner:
         return self._pos, self._vel, self._acc
 
     # ------------------------------------------------------------ internals
-    def _require_idle(self, what: str) -> None:
-        if self._state != _IDLE:
-            raise CommandError(f"{what}: the profile is moving; call GT_Stop first")
-
     def _begin_clutch(self, r_from: float, r_to: float, length: float) -> None:
         self._r0, self._r1 = r_from, r_to
         self._x = 0.0

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
 
-from ..errors import ParameterError
+from ..errors import CommandError, ParameterError
 from . import checks
 
 MasterSource = Callable[[], float]
@@ -88,3 +88,62 @@ def passed(delta: float, dir: int) -> float:
     if dir < 0:
         return delta if delta < 0.0 else 0.0
     return delta
+
+
+class SlavePlanner:
+    """What Gear and Follow share: the follow direction and the master choice.
+
+    Subclasses set :attr:`MODE` (``"Gear"`` / ``"Follow"``, for the GT names in
+    messages) and keep ``_state`` with ``_IDLE == 0`` when standing.
+    """
+
+    __slots__ = ("_dir", "_master", "_source", "_state", "profile")
+    MODE = ""
+
+    def _init_master(self, profile: int | None, dir: object, source: MasterSource | None) -> None:
+        self.profile = profile
+        self._dir = direction(dir)
+        self._master: MasterSpec | None = None
+        self._source = source
+
+    @property
+    def direction(self) -> int:
+        """GT_PrfGear / GT_PrfFollow ``dir``: 0 both ways, 1 positive, -1 negative master motion."""
+        return self._dir
+
+    def set_direction(self, dir: object) -> None:
+        """GT_Prf<mode> on a profile already in this mode: only the same ``dir`` is accepted."""
+        d = direction(dir)
+        self._require_idle(f"GT_Prf{self.MODE}")
+        if d != self._dir:
+            raise CommandError(
+                f"GT_Prf{self.MODE}: the profile is in {self.MODE} mode with dir {self._dir}, "
+                f"not {d}; switch to another mode first"
+            )
+
+    @property
+    def master(self) -> MasterSpec | None:
+        """GT_Get<mode>Master (None until GT_Set<mode>Master)."""
+        return self._master
+
+    def set_master(
+        self,
+        index: object,
+        type: object = MasterType.PROFILE,
+        item: object = 0,
+        source: MasterSource | None = None,
+    ) -> None:
+        """GT_Set<mode>Master; ``source`` is the position the controller resolved for it."""
+        spec = MasterSpec.checked(self.profile, index, type, item)
+        self._require_idle(f"GT_Set{self.MODE}Master")
+        self._master = spec
+        if source is not None:
+            self._source = source
+
+    def bind_master(self, source: MasterSource) -> None:
+        """Attach the master position source (the controller's resolution of the master)."""
+        self._source = source
+
+    def _require_idle(self, what: str) -> None:
+        if self._state != 0:
+            raise CommandError(f"{what}: the profile is moving; call GT_Stop first")
