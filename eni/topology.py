@@ -9,8 +9,10 @@ Format (every key optional unless marked)::
     kind = "servo"                # required: "servo" | "io" | "coupler" | "generic"
     name = "Drive 0"              # default "<kind> <position>"
     vendor_id = 0x47544543        # identity; default 0x47544543 ("GTEC", the emulator's own)
-    product_code = 0x00010001     # default per kind: servo 0x00010001, io 0x00020001,
-    revision = 0                  #   coupler 0x00030001, generic 0x00040001
+    product_code = 0x00010001     # default per kind: servo 0x00010001, coupler 0x00030001;
+    revision = 0                  #   without a mailbox (io, generic) 0x0002xxxx / 0x0004xxxx,
+                                  #   xxxx a code of the PDO layout, so different devices
+                                  #   never share an identity (SOEM caches SII per identity)
     mailbox = true                # CoE mailbox; default true for servo and coupler
     init_cmds = true              # write CoE InitCmds that assign (and, for configurable
                                   # PDOs, map) the PDOs at PREOP->SAFEOP; default true for servo
@@ -57,6 +59,7 @@ from __future__ import annotations
 import os
 import re
 import tomllib
+import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -240,6 +243,17 @@ def _known(where: _Where, table: Mapping[str, Any], allowed: set[str], element: 
         raise where.error(f"unknown key(s) {', '.join(unknown)}", element)
 
 
+def _layout_code(rx: Sequence[Pdo], tx: Sequence[Pdo]) -> int:
+    """A 16-bit code of a process-data layout (CRC-32 of its entries, folded), never 0."""
+    text = ";".join(
+        f"{p.direction}:{p.index:04X}:"
+        + ",".join(f"{e.index:04X}.{e.subindex:02X}.{e.bit_len}" for e in p.entries)
+        for p in (*rx, *tx)
+    )
+    crc = zlib.crc32(text.encode("ascii"))
+    return ((crc >> 16) ^ crc) & 0xFFFF or 1
+
+
 def _int(where: _Where, table: Mapping[str, Any], key: str, default: int) -> int:
     value = table.get(key, default)
     try:
@@ -262,12 +276,6 @@ def _slave(where: _Where, pos: int, t: Mapping[str, Any]) -> Slave:
     name = _text(where, t.get("name", ""), "name") or f"{kind} {pos}"
     where.name = name
     _known(where, t, _COMMON | _KIND_KEYS[kind], f"[[slave]] {kind}")
-    identity = Identity(
-        vendor_id=_int(where, t, "vendor_id", GTEC_VENDOR_ID),
-        product_code=_int(where, t, "product_code", _PRODUCT[kind]),
-        revision_no=_int(where, t, "revision", 0),
-        serial_no=_int(where, t, "serial", 0),
-    )
     if kind == "servo":
         rx, tx = _servo(where, t)
     elif kind == "io":
@@ -282,6 +290,18 @@ def _slave(where: _Where, pos: int, t: Mapping[str, Any]) -> Slave:
         if "tx" in t or "tx_pdos" in t:
             tx = _pdos(where, t, Direction.IN)
     mailbox = _bool(where, t, "mailbox", kind in ("servo", "coupler"))
+    default_product = _PRODUCT[kind]
+    if not mailbox:
+        # a master without CoE learns the process data from the SII, and SOEM reuses the SII of
+        # an earlier slave with the same identity: devices whose process data differ must
+        # not share a product code (as real catalogue devices don't)
+        default_product = (default_product & 0xFFFF0000) | _layout_code(rx, tx)
+    identity = Identity(
+        vendor_id=_int(where, t, "vendor_id", GTEC_VENDOR_ID),
+        product_code=_int(where, t, "product_code", default_product),
+        revision_no=_int(where, t, "revision", 0),
+        serial_no=_int(where, t, "serial", 0),
+    )
     want_cmds = _bool(where, t, "init_cmds", kind == "servo")
     if want_cmds and not mailbox:
         raise where.error("init_cmds need a mailbox (mailbox = true)", "init_cmds")
