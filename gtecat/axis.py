@@ -22,9 +22,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from enum import IntEnum
 from typing import Any
 
+from drives.cia402 import State as PdsState
+from drives.cia402 import decode_state as _decode_state
 from eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from eni.layout import AxisRef, Layout
 
@@ -68,42 +69,15 @@ class ObjectNotMapped(CommandError):
     """The object a GT function needs is not in the axis's PDO mapping (return 1)."""
 
 
-class PdsState(IntEnum):
-    """CiA-402 power drive states as decoded from 6041h (cia402-facts 1.2)."""
-
-    NOT_READY = 0
-    SWITCH_ON_DISABLED = 1
-    READY_TO_SWITCH_ON = 2
-    SWITCHED_ON = 3
-    OPERATION_ENABLED = 4
-    QUICK_STOP_ACTIVE = 5
-    FAULT_REACTION_ACTIVE = 6
-    FAULT = 7
-
-
 def decode_state(sw: int) -> PdsState:
-    """Statusword -> state with the standard masks (0x4F / 0x6F)."""
-    s4f = sw & 0x4F
-    if s4f == 0x00:
-        return PdsState.NOT_READY
-    if s4f == 0x40:
-        return PdsState.SWITCH_ON_DISABLED
-    if s4f == 0x0F:
-        return PdsState.FAULT_REACTION_ACTIVE
-    if s4f == 0x08:
-        return PdsState.FAULT
-    s6f = sw & 0x6F
-    return {
-        0x21: PdsState.READY_TO_SWITCH_ON,
-        0x23: PdsState.SWITCHED_ON,
-        0x27: PdsState.OPERATION_ENABLED,
-        0x07: PdsState.QUICK_STOP_ACTIVE,
-    }.get(s6f, PdsState.NOT_READY)
+    """Statusword -> state with the standard masks (the drive's own decoder, cia402-facts
+    1.2); a statusword matching no pattern reads as not ready to switch on."""
+    return _decode_state(sw) or PdsState.NOT_READY_TO_SWITCH_ON
 
 
 # controlword the controller sends to move one step towards operation enabled
 _ENABLE_STEP = {
-    PdsState.NOT_READY: 0x0000,
+    PdsState.NOT_READY_TO_SWITCH_ON: 0x0000,
     PdsState.SWITCH_ON_DISABLED: 0x0006,  # shutdown -> ready to switch on
     PdsState.READY_TO_SWITCH_ON: 0x0007,  # switch on
     PdsState.SWITCHED_ON: 0x000F,  # enable operation
