@@ -224,6 +224,26 @@ def initiate_cmd(
     }
 
 
+def build_initiate(
+    command: int, index: int, subindex: int, data: bytes = b"", *, complete_access: bool = False
+) -> bytes:
+    """An 8-byte initiate frame (ETG.1000.6 5.6.2.1-4): expedited with ``data`` (1-4 bytes)
+    and its size indicated, or without data (an upload request, a download answer)."""
+    if data:
+        cmd = initiate_cmd(
+            command,
+            complete_access=complete_access,
+            expedited=True,
+            size=4 - len(data),
+            size_indicator=True,
+        )
+    else:
+        cmd = initiate_cmd(command, complete_access=complete_access)
+    return SdoExpedited.build(
+        {"cmd": cmd, "index": index, "subindex": subindex, "data": bytes(data).ljust(4, b"\x00")}
+    )
+
+
 def segment_cmd(command: int, *, toggle: bool, seg_size: int = 0, last: bool = False) -> dict:
     return {"command": command, "toggle": toggle, "seg_size": seg_size, "last": last}
 
@@ -339,14 +359,7 @@ class SdoClient:
 
     # --- services -----------------------------------------------------------
     def upload(self, index: int, subindex: int, complete_access: bool = False) -> bytes:
-        req = SdoExpedited.build(
-            {
-                "cmd": initiate_cmd(Ccs.INITIATE_UPLOAD, complete_access=complete_access),
-                "index": index,
-                "subindex": subindex,
-                "data": bytes(4),
-            }
-        )
+        req = build_initiate(Ccs.INITIATE_UPLOAD, index, subindex, complete_access=complete_access)
         body = self._exchange(req, index, subindex)
         self._expect(body, Scs.INITIATE_UPLOAD, index, subindex)
         if len(body) < 8:
@@ -389,19 +402,8 @@ class SdoClient:
     ) -> None:
         data = bytes(data)
         if 0 < len(data) <= 4:
-            req = SdoExpedited.build(
-                {
-                    "cmd": initiate_cmd(
-                        Ccs.INITIATE_DOWNLOAD,
-                        complete_access=complete_access,
-                        expedited=True,
-                        size=4 - len(data),
-                        size_indicator=True,
-                    ),
-                    "index": index,
-                    "subindex": subindex,
-                    "data": data.ljust(4, b"\x00"),
-                }
+            req = build_initiate(
+                Ccs.INITIATE_DOWNLOAD, index, subindex, data, complete_access=complete_access
             )
             body = self._exchange(req, index, subindex)
             self._expect(body, Scs.INITIATE_DOWNLOAD, index, subindex)

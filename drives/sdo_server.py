@@ -37,6 +37,7 @@ from drives.coe import (
     SdoSegment,
     build_abort,
     build_coe,
+    build_initiate,
     initiate_cmd,
     mailbox_error,
     next_counter,
@@ -146,20 +147,7 @@ class SdoServer:
         index, subindex, ca = req.index, req.subindex, req.cmd.complete_access
         data = self.od.upload(index, subindex, complete_access=ca)
         if len(data) <= 4 and data:
-            return SdoExpedited.build(
-                {
-                    "cmd": initiate_cmd(
-                        Scs.INITIATE_UPLOAD,
-                        complete_access=ca,
-                        expedited=True,
-                        size=4 - len(data),
-                        size_indicator=True,
-                    ),
-                    "index": index,
-                    "subindex": subindex,
-                    "data": data.ljust(4, b"\x00"),
-                }
-            )
+            return build_initiate(Scs.INITIATE_UPLOAD, index, subindex, data, complete_access=ca)
         first_max = self.mailbox_size - INITIATE_OVERHEAD
         first, rest = data[:first_max], data[first_max:]
         if rest:
@@ -227,14 +215,7 @@ class SdoServer:
                 self.od.download(
                     index, subindex, req.data[:total], complete_access=ca, al_state=al_state
                 )
-        return SdoExpedited.build(
-            {
-                "cmd": initiate_cmd(Scs.INITIATE_DOWNLOAD, complete_access=ca),
-                "index": index,
-                "subindex": subindex,
-                "data": bytes(4),
-            }
-        )
+        return build_initiate(Scs.INITIATE_DOWNLOAD, index, subindex, complete_access=ca)
 
     def _download_segment(self, body: bytes, al_state: AlState) -> bytes:
         state = self._download
