@@ -37,6 +37,7 @@ class EmulatedBackend(Backend):
         self.slaves: list[VirtualSlave] = list(slaves) if slaves is not None else []
         self._given = slaves is not None
         self._plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
+        self._expected = 0
         self.image: ProcessImage | None = None
         #: positions unplugged by a scenario (GTE_ helpers): no answer, no WKC
         self.unplugged: set[int] = set()
@@ -63,6 +64,8 @@ class EmulatedBackend(Backend):
             if sl is not None:
                 slave.expected_sizes = (sl.out_bits, sl.in_bits)
             self._plan.append((slave, out, inp))
+        # ETG.1000.4 LRW: +2 per slave with outputs, +1 per slave with inputs (fixed per bus)
+        self._expected = sum(2 * (o is not None) + (i is not None) for _, o, i in self._plan)
 
     def _slave(self, position: int) -> VirtualSlave:
         if position in self.unplugged or not 0 <= position < len(self.slaves):
@@ -126,7 +129,7 @@ class EmulatedBackend(Backend):
         return out
 
     def expected_wkc(self) -> int:
-        return sum(2 * (o is not None) + (i is not None) for _, o, i in self._plan)
+        return self._expected
 
     # --- mailbox -----------------------------------------------------------------
     def _client(self, position: int):  # -> drives.coe.SdoClient
