@@ -14,12 +14,13 @@ Googol coupler of manual figure 5-4 (IBM337 + DI16/DO16/AI4/AO4) is one.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 from eni.bits import get_bits, set_bits
 from eni.model import Direction, Identity, Pdo
 
+from .pdo_mapping import is_gap
 from .slave import AlState, AlStatusCode, VirtualSlave
 
 _SIGNED_TYPES = {"SINT", "INT", "DINT", "LINT", "INT8", "INT16", "INT32", "INT64"}
@@ -36,6 +37,24 @@ class IoPoint:
     bits: int
     name: str
     signed: bool
+
+
+def _place(
+    layout: Iterable[tuple[Direction, Iterable[tuple[int, int, int, str, bool]]]],
+) -> dict[tuple[Direction, int, int], IoPoint]:
+    """Field-side points from mapped entries ``(index, sub, bits, name, signed)`` in mapping
+    order per direction: each at its bit inside rx/tx; gaps (index 0..7) take room only."""
+    points: dict[tuple[Direction, int, int], IoPoint] = {}
+    for direction, entries in layout:
+        bit = 0
+        for index, sub, bits, name, signed in entries:
+            if not is_gap(index):
+                points.setdefault(
+                    (direction, index, sub),
+                    IoPoint(direction, index, sub, bit, bits, name, signed),
+                )
+            bit += bits
+    return points
 
 
 class IoSlave(VirtualSlave):
@@ -57,25 +76,17 @@ class IoSlave(VirtualSlave):
         self.rx_pdos = tuple(rx_pdos)
         self.tx_pdos = tuple(tx_pdos)
         super().__init__(position, name, identity)
-        self.points: dict[tuple[Direction, int, int], IoPoint] = {}
-        for direction, pdos in ((Direction.OUT, self.rx_pdos), (Direction.IN, self.tx_pdos)):
-            bit = 0
-            for pdo in pdos:
-                for e in pdo.entries:
-                    if not e.is_padding:
-                        self.points.setdefault(
-                            (direction, e.index, e.subindex),
-                            IoPoint(
-                                direction,
-                                e.index,
-                                e.subindex,
-                                bit,
-                                e.bit_len,
-                                e.name,
-                                e.data_type.upper() in _SIGNED_TYPES,
-                            ),
-                        )
-                    bit += e.bit_len
+        self.points = _place(
+            (
+                d,
+                [
+                    (e.index, e.subindex, e.bit_len, e.name, e.data_type.upper() in _SIGNED_TYPES)
+                    for pdo in pdos
+                    for e in pdo.entries
+                ],
+            )
+            for d, pdos in ((Direction.OUT, self.rx_pdos), (Direction.IN, self.tx_pdos))
+        )
         self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
         self.field_outputs = bytearray(len(self.rx))  # what the terminals drive
         self._wires: list[tuple[int, int]] = []  # (output bit, input bit) in rx/tx numbering
@@ -217,25 +228,15 @@ class CoeIoSlave(IoSlave):
 
     def _relayout(self) -> None:
         """Field-side points from the mapping the master configured."""
-        points: dict[tuple[Direction, int, int], IoPoint] = {}
-        for direction in (Direction.OUT, Direction.IN):
-            bit = 0
-            for index, sub, bits in self.mapping.entries(direction):
-                if index > 0x0007:  # not a gap (CiA 301 dummy types)
-                    old = self.points.get((direction, index, sub))
-                    points.setdefault(
-                        (direction, index, sub),
-                        IoPoint(
-                            direction,
-                            index,
-                            sub,
-                            bit,
-                            bits,
-                            old.name if old else "",
-                            old.signed if old else False,
-                        ),
-                    )
-                bit += bits
+
+        def entries(d: Direction) -> list[tuple[int, int, int, str, bool]]:
+            out = []
+            for index, sub, bits in self.mapping.entries(d):
+                old = self.points.get((d, index, sub))
+                out.append((index, sub, bits, old.name if old else "", bool(old and old.signed)))
+            return out
+
+        points = _place((d, entries(d)) for d in (Direction.OUT, Direction.IN))
         self.points = points
         rx_bits, tx_bits = self.mapping.sizes()
         self.field_outputs = bytearray((rx_bits + 7) // 8)
