@@ -29,8 +29,8 @@ def _bus(eni: Path, *, plain: bool):
     from drives.io_slaves import IoSlave
     from eni.layout import build_layout
     from eni.reader import read_eni
-    from gtecat.backends.emulated import EmulatedBackend
-    from gtecat.bus import Master
+    from gtecat.master.backends.emulated import EmulatedBackend
+    from gtecat.master.bus import Master
 
     cfg = read_eni(eni)
     if plain:  # plain PDO slaves have no mailbox: drop the CoE InitCmds

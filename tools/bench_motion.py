@@ -12,7 +12,7 @@ import argparse
 import json
 import time
 
-from gtecat.motion import JogParams, JogPlanner, TrapParams, TrapPlanner
+from gtecat.controller.motion import JogParams, JogPlanner, TrapParams, TrapPlanner
 
 
 def _trap(smooth_time: int, repeat: int) -> tuple[float, int]:

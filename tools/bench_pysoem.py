@@ -7,7 +7,7 @@
 Without ``--iface`` it creates a veth pair (unique names, always deleted) and
 runs ``gtecat serve`` with the ENI's virtual slaves on the far end.  The
 controller runs the whole GT stack in ``realtime`` clock mode (the cycle
-thread of :mod:`gtecat.clock`), every CiA-402 axis enabled so each cycle also
+thread of :mod:`gtecat.master.clock`), every CiA-402 axis enabled so each cycle also
 writes set-points.  Statistics are reset once the bus is ready, so bring-up
 is not counted; the output is one JSON object (:func:`cycle_stats` plus the
 server's frame latency and the machine).
@@ -88,7 +88,7 @@ def bare_loop(seconds: float, cycle_ns: int) -> dict:
     overrun and re-phase when a whole period is missed), so the difference to
     the bus run is what the stack and the wire add.
     """
-    from gtecat.backends.cycle_stats import summarize_periods
+    from gtecat.master.backends.cycle_stats import summarize_periods
 
     periods: list[int] = []
     overruns = 0
@@ -116,8 +116,8 @@ def bare_loop(seconds: float, cycle_ns: int) -> dict:
 
 def run(args: argparse.Namespace) -> dict:
     from gtecat import gt
-    from gtecat.backends.cycle_stats import cycle_stats
-    from gtecat.clock import CycleStats
+    from gtecat.master.backends.cycle_stats import cycle_stats
+    from gtecat.master.clock import CycleStats
 
     out: dict = {
         "machine": {

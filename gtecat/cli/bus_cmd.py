@@ -17,7 +17,7 @@ from drives.slave import AlState
 from eni.model import Direction
 from eni.numbers import parse_int
 
-from ..controller import Controller, Options
+from ..controller.core import Controller, Options
 from ..errors import BusError, ConfigMismatch, ParameterError
 
 TYPES = {  # --type name -> (struct code, size)

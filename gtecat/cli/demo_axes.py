@@ -20,7 +20,7 @@ bus (two GTHD drives, two IO slaves) with ``gtecat/data/demo_machine.toml``:
    at the manual's offset 6.
 
 A step whose ``GT_*`` functions this build lacks is skipped with a line saying so.
-Everything is recorded every cycle (:class:`gtecat.recorder.Recorder`) and written to
+Everything is recorded every cycle (:class:`gtecat.controller.recorder.Recorder`) and written to
 ``demo.csv`` and ``demo.png``.
 """
 
@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..recorder import Recorder, signal
+from ..controller.recorder import Recorder, signal
 
 Say = Callable[[Any, str], None]
 

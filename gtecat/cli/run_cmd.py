@@ -2,7 +2,7 @@
 
 The options become the ``GTECAT_*`` environment the script's ``GT_Open`` reads, so the
 script itself needs no change (the environment is restored afterwards).  ``--trace``
-records signals every cycle once the bus is up (see :mod:`gtecat.recorder` for the
+records signals every cycle once the bus is up (see :mod:`gtecat.controller.recorder` for the
 names) and writes ``<stem>.csv`` and ``<stem>.png``.  On a terminal a status line shows
 controller time against wall time while the script runs.
 
@@ -24,7 +24,7 @@ from typing import TextIO
 
 from eni.errors import GtecatError
 
-from ..controller import Controller
+from ..controller.core import Controller
 from ..errors import ParameterError
 
 ENV = ("GTECAT_ENI", "GTECAT_MACHINE", "GTECAT_CLOCK", "GTECAT_BACKEND", "GTECAT_IFACE")
@@ -211,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
 
     def attach(ctl: Controller) -> None:
         if specs:
-            from ..recorder import Recorder
+            from ..controller.recorder import Recorder
 
             try:
                 recorders.append(Recorder(ctl, specs).start())

@@ -1,7 +1,7 @@
 """``gtecat serve --eni FILE [--machine FILE] --iface IFACE``: slaves on a real wire.
 
 Builds the virtual slaves of the ENI exactly as the emulated backend does
-(:func:`gtecat.factory.build_slaves`, same drives, same machine description),
+(:func:`gtecat.master.factory.build_slaves`, same drives, same machine description),
 puts them behind software ESCs and answers EtherCAT frames on ``IFACE`` until
 Ctrl-C or SIGTERM.  Any master (SOEM/pysoem, TwinCAT, IgH, acontis) on the
 other end of the wire sees a chain of real-looking slaves.  Needs root or
@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 from types import FrameType
 
-log = logging.getLogger("gtecat.serve")
+log = logging.getLogger("gtecat.wire.serve")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -69,7 +69,7 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
     from drives.machine import MachineDescription, load_machine
     from eni.layout import build_layout
     from eni.reader import read_eni
-    from gtecat.factory import build_slaves
+    from gtecat.master.factory import build_slaves
 
     config = read_eni(eni)
     layout = build_layout(config)
@@ -80,7 +80,7 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
 
 
 def run(args: argparse.Namespace) -> int:
-    from gtecat.serve import WireServer, interface_is_up, realtime_priority
+    from gtecat.wire.serve import WireServer, interface_is_up, realtime_priority
 
     if args.verbose:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")

@@ -1,6 +1,6 @@
 """The GT layer's machinery: return codes, the last-error ring, pointer arguments, GTN twins.
 
-Every ``GT_*`` function is a thin wrapper over :class:`gtecat.controller.Controller`.
+Every ``GT_*`` function is a thin wrapper over :class:`gtecat.controller.core.Controller`.
 :func:`gt_function` turns exceptions into the manual's return codes through
 one table (manual table 3-1) and keeps the reason (SOEM's error ring), so a GT
 function never raises.  Pointer arguments accept what ctypes code passes:
@@ -26,7 +26,7 @@ from drives.abort import SdoAbort
 from drives.machine import MachineError
 from eni.errors import EniError, GtecatError
 
-from ..controller import Controller
+from ..controller.core import Controller
 from ..errors import (
     BusError,
     CommandError,

@@ -28,8 +28,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..axis import Axis, PdsState
-from ..controller import Controller
+from ..controller.axis import Axis, PdsState
+from ..controller.core import Controller
 from ..errors import BusError, CommandError, ParameterError
 from ._core import check_range, gt_function, store, store_bytes
 

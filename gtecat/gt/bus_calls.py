@@ -28,7 +28,7 @@ from drives.abort import SdoAbort
 from drives.slave import AlState
 
 from .. import __version__
-from ..controller import Controller, Options
+from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
 from . import _core
 from ._core import (
@@ -412,7 +412,7 @@ def GTE_ReplugSlave(ctl: Controller, slave: int) -> int:
 
 
 def _emulated(ctl: Controller):
-    from ..backends.emulated import EmulatedBackend
+    from ..master.backends.emulated import EmulatedBackend
 
     backend = ctl.backend
     if not isinstance(backend, EmulatedBackend):
@@ -422,7 +422,7 @@ def _emulated(ctl: Controller):
 
 def GTE_GetCycleStats(core: int = 1) -> dict:
     """Cycle period, jitter (p50/p99/max), overruns and working-counter errors so far."""
-    from ..backends.cycle_stats import cycle_stats
+    from ..master.backends.cycle_stats import cycle_stats
 
     return cycle_stats(SESSION.controller(core))
 
@@ -435,7 +435,7 @@ def GTE_Controller(core: int = 1) -> Controller:
 def GTE_Slave(slave: int, core: int = 1):
     """The virtual slave at ``slave`` (emulated backend): its field side for scenarios."""
     ctl = SESSION.controller(core)
-    from ..backends.emulated import EmulatedBackend
+    from ..master.backends.emulated import EmulatedBackend
 
     backend = ctl.backend
     if not isinstance(backend, EmulatedBackend):

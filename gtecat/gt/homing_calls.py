@@ -76,8 +76,8 @@ from typing import Any
 
 from drives.abort import SdoAbort
 
-from ..axis import Axis, PdsState
-from ..controller import Controller
+from ..controller.axis import Axis, PdsState
+from ..controller.core import Controller
 from ..errors import CommandError, ParameterError
 from ._core import check_range, gt_function, store
 from .axis_calls import ECAT_MODES, bus_axis
@@ -381,7 +381,7 @@ def probe_function_ex(
 
 def machine_position(ctl: Controller, ax: Axis) -> float:
     """Where the axis's mechanics are (emulated backend only), machine counts."""
-    from ..backends.emulated import EmulatedBackend
+    from ..master.backends.emulated import EmulatedBackend
 
     slaves = ctl.backend.slaves if isinstance(ctl.backend, EmulatedBackend) else None
     if slaves is None:

@@ -2,7 +2,7 @@
 
 Manual 6.3.2, 7.1-7.3, 8.2, 11.6 and chapter 13 entries 26-32, 46-47, 55, 59,
 62-65, 74, 77, 88, 90, 105, 113, 115, 118, 125, 127, 131, 135, 137, 138.  The
-work is done by :mod:`gtecat.resources`; these wrappers check arguments and turn
+work is done by :mod:`gtecat.controller.resources`; these wrappers check arguments and turn
 the manual's pointer and ``count`` forms into Python.
 
 Return 1 (with a reason), as chapter 13 lists, when:
@@ -37,11 +37,11 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from .. import motion
-from ..controller import Controller
+from ..controller import motion
+from ..controller.core import Controller
+from ..controller.profile import PrfMode
+from ..controller.resources import AxisResources, axes_in_mask, axis_resources, axis_span
 from ..errors import CommandError, ParameterError
-from ..profile import PrfMode
-from ..resources import AxisResources, axes_in_mask, axis_resources, axis_span
 from ._core import _target, check_range, gt_function, store, store_array
 from .structs import TJogPrm, TTrapPrm
 

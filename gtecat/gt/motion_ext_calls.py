@@ -1,10 +1,10 @@
 """GT calls of the FIFO and master/slave modes: PT (7.4), electronic gear (7.5), Follow (7.6).
 
 Chapter 13 entries 19-24, 48-51, 53-54, 66-68, 86-87, 89, 92-95, 106-111,
-119-120.  The planners (:mod:`gtecat.motion.pt`, :mod:`~gtecat.motion.gear`,
-:mod:`~gtecat.motion.follow`) hold the semantics; these wrappers put them in the
-profile's mode slot (:meth:`gtecat.profile.Profile.enter`), resolve a master
-choice to a per-cycle position (:func:`gtecat.resources.position_source`) and
+119-120.  The planners (:mod:`gtecat.controller.motion.pt`, :mod:`~gtecat.controller.motion.gear`,
+:mod:`~gtecat.controller.motion.follow`) hold the semantics; these wrappers put them in the
+profile's mode slot (:meth:`gtecat.controller.profile.Profile.enter`), resolve a master
+choice to a per-cycle position (:func:`gtecat.controller.resources.position_source`) and
 turn the pointer, ``mask`` and ``option`` forms into Python.
 
 Return 1 (with a reason), as chapter 13 lists, when:
@@ -58,15 +58,15 @@ import math
 from numbers import Real
 from typing import Any, TypeVar, cast
 
-from ..controller import Controller
+from ..controller.core import Controller
+from ..controller.motion import checks
+from ..controller.motion.follow import FollowPlanner
+from ..controller.motion.gear import GearPlanner
+from ..controller.motion.master import MasterSource, MasterSpec, MasterType, direction
+from ..controller.motion.pt import PtMode, PtPlanner
+from ..controller.profile import PrfMode
+from ..controller.resources import AxisResources, axes_in_mask, axis_resources, position_source
 from ..errors import CommandError, ParameterError
-from ..motion import checks
-from ..motion.follow import FollowPlanner
-from ..motion.gear import GearPlanner
-from ..motion.master import MasterSource, MasterSpec, MasterType, direction
-from ..motion.pt import PtMode, PtPlanner
-from ..profile import PrfMode
-from ..resources import AxisResources, axes_in_mask, axis_resources, position_source
 from ._core import gt_function, store
 from .constants import (
     FOLLOW_MASTER_PROFILE,

@@ -3,8 +3,9 @@
 Manual chapters 4 (configuration: 4.3-4.6, table 4-4), 6 (status, table 6-2),
 9 (limits, alarm, stops), 11.7 (in-position band) and chapter 13 entries 2, 3,
 8, 15-18, 25, 60, 69-71, 81-83, 91, 98, 116, 121, 122.  The semantics live in
-:mod:`gtecat.resources` (cycle, flags, GT_ClrSts), :mod:`gtecat.safety`,
-:mod:`gtecat.encoder`, :mod:`gtecat.scale` and :mod:`gtecat.config_file`.
+:mod:`gtecat.controller.resources` (cycle, flags, GT_ClrSts), :mod:`gtecat.controller.safety`,
+:mod:`gtecat.controller.encoder`, :mod:`gtecat.controller.scale` and
+:mod:`gtecat.controller.config_file`.
 
 Decisions where the manual is silent:
 
@@ -20,7 +21,7 @@ Decisions where the manual is silent:
 * GT_SetAxisBand(axis, band, time): band > 0 switches the in-position check on,
   band 0 off; negative values are 7.  GT_GetAxisBand gives (0, 0) after GT_Reset.
 * GT_ProfileScale / GT_EncScale / GT_SetPosScale: 1 while the profile moves;
-  the axis values and the drive do not jump (:mod:`gtecat.scale`).
+  the axis values and the drive do not jump (:mod:`gtecat.controller.scale`).
 """
 
 from __future__ import annotations
@@ -28,12 +29,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from .. import motion, safety
-from ..config_file import apply_config, read_config
-from ..controller import Controller
+from ..controller import motion, safety
+from ..controller.config_file import apply_config, read_config
+from ..controller.core import Controller
+from ..controller.resources import AxisResources, axis_resources, clear_status
+from ..controller.scale import Scale
 from ..errors import BusError, CommandError, ParameterError
-from ..resources import AxisResources, axis_resources, clear_status
-from ..scale import Scale
 from ._core import check_range, gt_function, load_bytes, store
 from .constants import MC_LIMIT_NEGATIVE, MC_LIMIT_POSITIVE
 from .motion_calls import _read_many, long_arg, real_arg

@@ -1,9 +1,9 @@
 """The manual's examples 7-3 to 7-8 as scripts (examples/), run in the lockstep clock and checked
 sample by sample against independently integrated plans, plus the shapes their figures show.
 
-References: PT velocity pieces of 7.4.2 (``tests/gtecat/motion/test_pt.py``), the gear's area
-under the ratio in master travel (``test_gear.py``) and the Follow ratio curve of 7.6.2 (5)
-(``test_follow.py``) - each written from the manual's text, not from the planners.
+References: PT velocity pieces of 7.4.2 (``tests/gtecat/controller/motion/test_pt.py``), the
+gear's area under the ratio in master travel (``test_gear.py``) and the Follow ratio curve of
+7.6.2 (5) (``test_follow.py``) - each written from the manual's text, not from the planners.
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ import pytest
 
 from gtecat import gt
 from tests.conftest import EXAMPLES
-from tests.gtecat.motion.test_follow import cam, cam_at
-from tests.gtecat.motion.test_gear import clutch_reference, jog
-from tests.gtecat.motion.test_pt import integrate, velocity_pieces
+from tests.gtecat.controller.motion.test_follow import cam, cam_at
+from tests.gtecat.controller.motion.test_gear import clutch_reference, jog
+from tests.gtecat.controller.motion.test_pt import integrate, velocity_pieces
 
 MOVING = 1 << 10
 PN, PE, PS = gt.PT_SEGMENT_NORMAL, gt.PT_SEGMENT_EVEN, gt.PT_SEGMENT_STOP

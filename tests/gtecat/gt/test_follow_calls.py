@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from gtecat import gt
-from tests.gtecat.motion.test_follow import cam, cam_at
+from tests.gtecat.controller.motion.test_follow import cam, cam_at
 
 from .conftest import bring_up
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from gtecat import gt
-from tests.gtecat.motion.test_gear import clutch_reference
+from tests.gtecat.controller.motion.test_gear import clutch_reference
 
 from .conftest import bring_up
 

@@ -17,9 +17,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
-from gtecat.recorder import Recorder
+from gtecat.controller.recorder import Recorder
 from tests.conftest import EXAMPLES
-from tests.gtecat.motion.reference import Trapezoid
+from tests.gtecat.controller.motion.reference import Trapezoid
 
 from .conftest import bring_up
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import EXAMPLES
-from tests.gtecat.motion.reference import Trapezoid
+from tests.gtecat.controller.motion.reference import Trapezoid
 
 SERVO, MOVING, ARRIVED, POS_LIMIT = 1 << 9, 1 << 10, 1 << 11, 1 << 5
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from gtecat import gt
-from tests.gtecat.motion.test_pt import integrate, velocity_pieces
+from tests.gtecat.controller.motion.test_pt import integrate, velocity_pieces
 
 from .conftest import bring_up
 

@@ -1,0 +1,253 @@
+"""The controller: one emulated iDEABOX core (bus master, clock, axes, recorder).
+
+This is the Pythonic API the ``GT_*`` functions are a thin layer over: methods
+return values and raise typed exceptions.  Options come from the caller, then
+the ``GTECAT_*`` environment (DESIGN.md "The stable surface"), then defaults.
+
+Every cycle runs in this order (STYLE.md "Cycle"): the axes write their
+outputs (``pre_cycle`` hooks) -> the master exchanges the process image (each
+slave steps) -> the axes read their inputs (``post_cycle`` hooks) -> the
+recorder samples -> the clock advances.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from drives.machine import MachineDescription, load_machine
+from eni.errors import EniError
+from eni.layout import Layout, build_layout
+from eni.reader import read_eni
+
+from ..errors import BusError, NoEniError, ParameterError
+from ..master.bus import Master
+from ..master.clock import Clock, ClockMode
+from ..master.masterlog import MasterLog
+from .axis import Axis, AxisIo
+from .resources import install as install_resources
+
+
+@dataclass
+class Options:
+    """How a controller is opened (explicit > ``GTECAT_*`` environment > default)."""
+
+    eni: str | None = None
+    machine: str | MachineDescription | None = None
+    clock: str | None = None
+    backend: str | None = None
+    iface: str | None = None
+    cycle_ms: float | None = None
+    call_latency_us: float = 50.0
+    log: str | None = None
+    op_delay_cycles: int = 10
+    #: ENI describing the emulated hardware when it differs from ``eni`` (GTECAT_BUS)
+    bus: str | None = None
+
+    def resolved(self) -> Options:
+        env = os.environ
+        return Options(
+            eni=self.eni or env.get("GTECAT_ENI") or "Gecat.eni",
+            machine=self.machine if self.machine is not None else env.get("GTECAT_MACHINE"),
+            backend=(backend := (self.backend or env.get("GTECAT_BACKEND") or "emulated").lower()),
+            # a real NIC needs cycles on the wall clock: realtime unless asked otherwise
+            clock=(
+                self.clock
+                or env.get("GTECAT_CLOCK")
+                or ("realtime" if backend == "pysoem" else "auto")
+            ).lower(),
+            iface=self.iface or env.get("GTECAT_IFACE"),
+            cycle_ms=self.cycle_ms,
+            call_latency_us=self.call_latency_us,
+            log=self.log if self.log is not None else env.get("GTECAT_LOG", "Gecat.log"),
+            op_delay_cycles=self.op_delay_cycles,
+            bus=self.bus or env.get("GTECAT_BUS"),
+        )
+
+
+class Controller:
+    """One core: clock, master and the per-cycle hooks of the axis layer."""
+
+    #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
+    bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
+
+    def __init__(self, options: Options | None = None) -> None:
+        self.options = (options or Options()).resolved()
+        try:
+            mode = ClockMode(self.options.clock)
+        except ValueError:
+            raise ParameterError(
+                f"clock mode {self.options.clock!r} unknown; use auto, lockstep or realtime"
+            ) from None
+        if self.options.backend not in ("emulated", "pysoem"):
+            raise ParameterError(
+                f"backend {self.options.backend!r} unknown; use emulated or pysoem"
+            )
+        cycle_ns = round((self.options.cycle_ms or 1.0) * 1_000_000)
+        self.clock = Clock(
+            self._cycle,
+            cycle_ns=cycle_ns,
+            mode=mode,
+            call_latency_ns=round(self.options.call_latency_us * 1000),
+        )
+        self._cycle_fixed = self.options.cycle_ms is not None
+        self.log = MasterLog(self.options.log, clock_ms=lambda: self.clock.now_ms)
+        self.machine = self._load_machine(self.options.machine)
+        self.layout: Layout | None = None
+        self.master: Master | None = None
+        self.backend = None
+        self.started = False
+        self.reset_ns = 0
+        self.pre_cycle: list[Callable[[int, int], None]] = []
+        self.post_cycle: list[Callable[[int, int], None]] = []
+        self.sample: list[Callable[[int], None]] = []
+        #: GT axes (1-based) once the bus is up
+        self.axes: dict[int, Axis] = {}
+        self._axis_list: list[Axis] = []
+        self.on_bus_up: list[Callable[[Controller], None]] = []
+        self.on_reset: list[Callable[[Controller], None]] = []
+        if mode is ClockMode.REALTIME:
+            self.clock.start_realtime()
+
+    @staticmethod
+    def _load_machine(m: str | MachineDescription | None) -> MachineDescription:
+        if isinstance(m, MachineDescription):
+            return m
+        if not m:
+            return MachineDescription()
+        return load_machine(m)
+
+    # --- bus --------------------------------------------------------------------------
+    def eni_path(self) -> Path:
+        return Path(self.options.eni or "Gecat.eni")
+
+    def init_ecat(self) -> Master:
+        """Read the ENI, open the backend, scan, compare, bring slaves to SAFEOP.
+
+        OP follows after a few cycles; :attr:`ready` tells when.
+        """
+        path = self.eni_path()
+        if not path.is_file():
+            raise NoEniError(
+                f"no ENI file at {path.resolve()} "
+                "(pass --eni or eni=... to GT_Open, or set GTECAT_ENI)"
+            )
+        try:
+            config = read_eni(path)
+        except EniError:
+            raise
+        layout = build_layout(config)
+        if not self._cycle_fixed and config.cycle_time_ns:
+            self.clock.cycle_ns = int(config.cycle_time_ns)
+        backend = self._make_backend()
+        if self.master is not None:
+            self.terminate_ecat()
+        master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
+        self.layout, self.backend, self.master = layout, backend, master
+        self.started = False
+        self.axes = {
+            ref.axis: Axis(
+                ref.axis, AxisIo(master.image, layout, ref, master.sdo_upload, master.sdo_download)
+            )
+            for ref in layout.axes
+        }
+        self._axis_list = list(self.axes.values())
+        install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)
+        master.open()
+        for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
+            hook(self)
+        return master
+
+    def _make_backend(self):
+        if self.options.backend == "pysoem":
+            from ..master.backends.pysoem_backend import PysoemBackend  # optional extra
+
+            return PysoemBackend(self.options.iface, log=self.log)
+        from ..master.backends.emulated import EmulatedBackend
+
+        hardware = None
+        if self.options.bus:
+            bus_path = Path(self.options.bus)
+            if not bus_path.is_file():
+                raise NoEniError(f"hardware description {bus_path} not found (GTECAT_BUS)")
+            hardware = build_layout(read_eni(bus_path))
+        return EmulatedBackend(self.machine, hardware=hardware)
+
+    def require_master(self) -> Master:
+        if self.master is None or not self.master.opened:
+            raise BusError("EtherCAT communication is not initialised (call GT_InitEcatComm)")
+        return self.master
+
+    @property
+    def ready(self) -> bool:
+        return self.master is not None and self.master.ready
+
+    def start_ecat(self) -> None:
+        """GT_StartEcatComm: start bus motion control; the bus must be in OP."""
+        m = self.require_master()
+        if not m.ready:
+            raise BusError(
+                "EtherCAT communication is not fully established yet "
+                f"({m.error or 'slaves not yet in OP'}); poll GT_IsEcatReady until it reports 1"
+            )
+        self.started = True
+
+    def terminate_ecat(self) -> None:
+        if self.master is not None:
+            self.master.terminate()
+            self.backend.close()
+        self.started = False
+
+    def close(self) -> None:
+        self.clock.stop_realtime()
+        self.terminate_ecat()
+        self.log.close()
+
+    # --- the cycle --------------------------------------------------------------------------
+    def _cycle(self) -> None:
+        t = self.clock.now_ns
+        dt = self.clock.cycle_ns
+        for f in self.pre_cycle:
+            f(t, dt)
+        for ax in self._axis_list:
+            ax.pre(t, dt)
+        if self.master is not None:
+            self.master.cycle(t, dt)
+        for ax in self._axis_list:
+            ax.post(t, dt)
+        for f in self.post_cycle:
+            f(t, dt)
+        for f in self.sample:
+            f(t + dt)  # stamped when the cycle's values become visible (= GT_GetClock after it)
+
+    # --- axes -----------------------------------------------------------------------------
+    def axis(self, n: int) -> Axis:
+        """GT axis ``n`` (1-based); ParameterError (7) when it does not exist."""
+        try:
+            n = int(n)
+        except (TypeError, ValueError):
+            raise ParameterError(f"axis={n!r} is not an integer") from None
+        ax = self.axes.get(n)
+        if ax is None:
+            if not self.axes:
+                raise ParameterError(
+                    f"axis {n}: no EtherCAT axis exists (bus not initialised or no CiA-402 "
+                    "slave in the ENI)"
+                )
+            raise ParameterError(f"axis {n} out of range 1..{max(self.axes)}")
+        return ax
+
+    # --- time -------------------------------------------------------------------------------
+    def reset_clock(self) -> None:
+        self.reset_ns = self.clock.now_ns
+
+    def clock_ms(self) -> int:
+        return (self.clock.now_ns - self.reset_ns) // 1_000_000
+
+    def wait_ms(self, ms: float) -> None:
+        """GTE_Wait: let ``ms`` of controller time pass, in any clock mode."""
+        if ms < 0:
+            raise ParameterError("wait time must be >= 0")
+        self.clock.advance(ms)

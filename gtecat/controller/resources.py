@@ -1,0 +1,718 @@
+"""The resources of one GT axis (manual chapter 4) and what they do every cycle.
+
+:class:`AxisResources` joins the profile (planner and motion mode), the axis
+(equivalent scaling, limits, alarm, following error, in-position band, status
+word) and the encoder of one EtherCAT axis, and runs them in the controller's
+cycle (``Axis.pre_hooks`` / ``Axis.post_hooks``):
+
+* **pre** (before the exchange): while the servo is on and the drive is in CSP
+  (6060h = 8), the planner gives this cycle's sample; the axis planned position
+  (``Axis.prf_pos``, written to 607Ah) is its scaled value.
+* **post** (after the exchange, the drive's answer in hand): drive state and
+  alarm, encoder, limits, following error, stop inputs, in-position band.
+
+Positions, from the planner to the drive and back (all doubles)::
+
+    profile P --ProfileScale--> axis planned A --2**PosScale, offset--> 607Ah counts
+    6064h counts --2**-PosScale, EncSns--> encoder E --EncScale--> axis encoder AE
+
+``GT_GetAxisError`` = A - AE; the following-error check, the in-position band
+and the soft limits use the axis values.  Decisions where the manual is silent:
+
+* **Servo off, or the drive in another mode** (homing, CSV...): the planned
+  position follows the drive (A := 6064h, P follows A), so enabling or coming
+  back to CSP never jumps; a motion in progress is dropped.  Entering another
+  mode also drops the offsets GT_ZeroPos / GT_SetEncPos / GT_SynchAxisPos made:
+  after a homing run the controller's positions are the drive's (6064h), as at
+  power-on and after GT_Reset.
+* **Alarm** (9.3), with the alarm enabled: bit 1 latches, the servo is switched
+  off (6040h disable) and the motion planning stops at once (the planner holds
+  where the drive is).  A drive that leaves *operation enabled* on its own
+  (fault with the alarm off, communication loss) also switches the servo off,
+  without a flag.
+* **Limits** (9.2): a hardware switch (60FDh) or the planned position past a
+  soft limit latches bit 5/6; a motion toward that side is stopped with the
+  abrupt-stop deceleration (decAbruptStop) and refused until GT_ClrSts; motion
+  away is allowed.
+* **Following error** (bit 4): ``|A - AE| > GT_SetPosErr`` while the servo is on
+  in CSP latches bit 4 and stops the motion abruptly; the servo stays on.  Like
+  an alarm or a stop input, it refuses every new motion until GT_ClrSts.
+* **Stop inputs** (bits 7/8, configuration file extension): while the input is
+  active the flag latches and the profile stops smoothly / abruptly.
+* **GT_ClrSts** clears a latched flag only when its cause is gone (chapter 6):
+  no drive alarm (alarm off, or the drive not in fault), the following error
+  back within the limit, off the limit switch and inside the soft limit, the
+  stop input inactive.  On a bus axis it first tries to reset a faulted drive:
+  it waits until the fault reaction is over, sends a rising edge of 6040h bit 7
+  and waits (at most :data:`FAULT_RESET_TIMEOUT_MS`) for the drive to leave
+  FAULT - which it does only when the fault's cause is gone.  The drive is then
+  *switch on disabled*: GT_AxisOn enables it again.  GT_ClrSts returns 0 either
+  way; a flag whose cause persists simply stays set.
+* **GT_Reset**: the servo is switched off, motion dropped, every setting back
+  to table 4-4, the flags cleared (and set again at once when their cause is
+  there), positions taken from the drive.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from typing import Protocol
+
+from ..errors import BusError, CommandError, ParameterError
+from ..master.clock import Clock
+from ..master.image import EntryAccess
+from .axis import Axis, PdsState
+from .axis_status import BLOCKING, LATCHED, AxisStatus, InPosition
+from .encoder import Encoder
+from .motion import JogParams, TrapParams
+from .motion.stop import StopKind
+from .profile import PrfMode, Profile
+from .safety import LIMIT_NEGATIVE_BIT, LIMIT_POSITIVE_BIT, Safety
+from .scale import AffineLink, Scale
+
+
+class Controller(Protocol):
+    """What the resources need of the controller core (which imports this module)."""
+
+    axes: dict[int, Axis]
+    on_reset: list[Callable[[Controller], None]]
+    clock: Clock
+
+    def axis(self, n: int) -> Axis: ...
+
+
+CSP = 8
+_SW_FAULT = 0x0008  # 6041h bit 3: fault (set in FAULT and FAULT REACTION ACTIVE)
+_SW_STATE_MASK, _SW_ENABLED = 0x6F, 0x27
+_CW_FAULT_RESET = 0x0080
+#: controller time GT_ClrSts waits for a fault reaction to end, then for the reset to act
+FAULT_REACTION_TIMEOUT_MS = 500.0
+FAULT_RESET_TIMEOUT_MS = 20.0
+#: GT_SetPos range (chapter 13 entry 115)
+POS_LIMIT = 1073741823
+
+_ALARM = int(AxisStatus.ALARM)
+_POS_ERROR = int(AxisStatus.POS_ERROR)
+_POS_LIMIT = int(AxisStatus.POSITIVE_LIMIT)
+_NEG_LIMIT = int(AxisStatus.NEGATIVE_LIMIT)
+_SMOOTH = int(AxisStatus.SMOOTH_STOP)
+_ABRUPT = int(AxisStatus.ABRUPT_STOP)
+_BLOCKING = int(BLOCKING)
+_FLAG_TEXT = {
+    _ALARM: "drive alarm (bit 1)",
+    _POS_ERROR: "following error over the limit (bit 4)",
+    _SMOOTH: "smooth-stop input (bit 7)",
+    _ABRUPT: "abrupt-stop input (bit 8)",
+}
+
+
+class AxisResources:
+    """Profile, encoder, scaling, safety and status of one GT axis (the Pythonic layer)."""
+
+    def __init__(self, ctl: Controller, ax: Axis) -> None:
+        self.ctl = ctl
+        self.ax = ax
+        self.number = ax.number
+        self.cycle_ms = ctl.clock.cycle_ns / 1e6
+        self.profile = Profile(ax.number, self.cycle_ms)
+        self.encoder = Encoder(self.cycle_ms)
+        self.prf_link = AffineLink()
+        self.enc_link = AffineLink()
+        self.safety = Safety.defaults(ax.number)
+        self.band = InPosition()
+        self.latched = 0
+        io = ax.io
+        self._sw = io.get(0x6041)
+        self._act = io.get(0x6064)
+        self._cmd = io.get(0x607A)
+        self._alarm_sw = self._sw
+        self._pos_din = self._neg_din = io.get(0x60FD)
+        self._smooth_in: EntryAccess | None = None
+        self._smooth_mask = 0
+        self._abrupt_in: EntryAccess | None = None
+        self._abrupt_mask = 0
+        self._csp = ax.mode_cmd == CSP
+        self._a_last = ax.prf_pos
+        ax.pre_hooks.append(self._pre)
+        ax.post_hooks.append(self._post)
+        ax.motion = self
+
+    # --- wiring --------------------------------------------------------------------------
+    def bind_inputs(self) -> None:
+        """Resolve the alarm / limit / stop inputs (axis numbers) to PDO entries."""
+        s = self.safety
+        axes = self.ctl.axes
+
+        def entry(axis: int | None, index: int):
+            if axis is None or axis not in axes:
+                return None
+            return axes[axis].io.get(index)
+
+        self._alarm_sw = entry(s.alarm_input, 0x6041)
+        self._pos_din = entry(s.positive_input, 0x60FD)
+        self._neg_din = entry(s.negative_input, 0x60FD)
+        self._smooth_in = self._abrupt_in = None
+        if s.smooth_stop_input is not None:
+            self._smooth_in = entry(s.smooth_stop_input.axis, 0x60FD)
+            self._smooth_mask = 1 << s.smooth_stop_input.bit
+        if s.abrupt_stop_input is not None:
+            self._abrupt_in = entry(s.abrupt_stop_input.axis, 0x60FD)
+            self._abrupt_mask = 1 << s.abrupt_stop_input.bit
+
+    # --- positions -----------------------------------------------------------------------
+    @property
+    def unit(self) -> float:
+        """Pulses per drive count (GT_SetPosScale)."""
+        return 1.0 / (1 << self.ax.pos_scale)
+
+    @property
+    def prf_pos(self) -> float:
+        return self.profile.planner.pos
+
+    @property
+    def prf_vel(self) -> float:
+        return self.profile.planner.vel
+
+    @property
+    def prf_acc(self) -> float:
+        return self.profile.planner.acc
+
+    @property
+    def axis_prf_pos(self) -> float:
+        return self.ax.prf_pos
+
+    @property
+    def axis_prf_vel(self) -> float:
+        return self.prf_link.ratio * self.profile.planner.vel
+
+    @property
+    def axis_prf_acc(self) -> float:
+        return self.prf_link.ratio * self.profile.planner.acc
+
+    @property
+    def enc_pos(self) -> float:
+        return self.encoder.pos
+
+    @property
+    def axis_enc_pos(self) -> float:
+        return self.enc_link.axis(self.encoder.pos)
+
+    @property
+    def axis_enc_vel(self) -> float:
+        return self.enc_link.ratio * self.encoder.vel
+
+    @property
+    def axis_enc_acc(self) -> float:
+        return self.enc_link.ratio * self.encoder.acc
+
+    @property
+    def axis_error(self) -> float:
+        """GT_GetAxisError: axis planned - axis encoder position, pulse."""
+        return self.ax.prf_pos - self.enc_link.axis(self.encoder.pos)
+
+    @property
+    def moving(self) -> bool:
+        return not self.profile.planner.done
+
+    @property
+    def driving(self) -> bool:
+        """The controller sends the plan: servo on and the drive in CSP."""
+        return self.ax.servo_on and self.ax.mode_cmd == CSP
+
+    def status(self) -> int:
+        """GT_GetSts's 32-bit word (table 6-2)."""
+        s = self.latched
+        if self.ax.servo_on:
+            s |= AxisStatus.SERVO_ON
+        if not self.profile.planner.done:
+            s |= AxisStatus.MOVING  # and never in position (11.7: "规划运动...立即清 0")
+        elif self.band.arrived:
+            s |= AxisStatus.ARRIVED
+        return int(s)
+
+    def _raw_source(self) -> int | None:
+        acc = self._act if self.encoder.external else self._cmd
+        if acc is None:
+            acc = self._cmd if self.encoder.external else self._act
+        return acc.get() if acc is not None else None
+
+    # --- the cycle -----------------------------------------------------------------------
+    def _pre(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
+        if ax.prf_pos != self._a_last:
+            # someone else set the planned position (GT_AxisOn, homing, a raw test):
+            # the profile follows, incrementally (11.6)
+            self._a_last = ax.prf_pos
+            self.profile.hold(self.prf_link.source(ax.prf_pos))
+        if ax.servo_on and ax.mode_cmd == CSP:
+            planner = self.profile.planner
+            if not planner.done and self.profile.active:
+                pos = planner.step()[0]
+                a = self.prf_link.axis(pos)
+                ax.prf_pos = a
+                self._a_last = a
+
+    def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
+        safety = self.safety
+        sw = self._sw.get() if self._sw is not None else 0
+        # --- the drive: alarm, enable lost
+        if safety.active and safety.alarm_on and self._alarm_sw is not None:
+            if self._alarm_sw.get() & _SW_FAULT:
+                self.latched |= _ALARM
+                if ax.servo_on:
+                    ax.request_disable()
+        if ax.servo_on and sw & _SW_STATE_MASK != _SW_ENABLED:
+            ax.request_disable()  # the drive dropped out of operation enabled by itself
+        csp = ax.mode_cmd == CSP
+        if csp != self._csp:
+            self._csp = csp
+            if not csp:
+                self._rebase()
+        # --- not driving: the plan follows the drive
+        if not (ax.servo_on and csp) and self._act is not None:
+            a = (self._act.get() - ax.drive_offset) / (1 << ax.pos_scale)
+            ax.prf_pos = a
+            self._a_last = a
+            planner = self.profile.planner
+            p = self.prf_link.source(a)
+            if p != planner.pos or not planner.done:
+                planner.hold(p)
+        # --- encoder
+        raw = self._raw_source()
+        if raw is not None:
+            self.encoder.sample(raw, 1.0 / (1 << ax.pos_scale))
+        if not safety.active:
+            return
+        a = ax.prf_pos
+        err = a - self.enc_link.axis(self.encoder.pos)
+        latched = self.latched
+        # --- limits: hardware switches, soft limits
+        if (
+            safety.positive_on
+            and self._pos_din is not None
+            and self._pos_din.get() & LIMIT_POSITIVE_BIT
+        ) or a > safety.soft_positive:
+            latched |= _POS_LIMIT
+        if (
+            safety.negative_on
+            and self._neg_din is not None
+            and self._neg_din.get() & LIMIT_NEGATIVE_BIT
+        ) or a < safety.soft_negative:
+            latched |= _NEG_LIMIT
+        # --- following error
+        if ax.servo_on and csp and not -safety.pos_err <= err <= safety.pos_err:
+            latched |= _POS_ERROR
+        # --- stop inputs
+        if self._smooth_in is not None and self._smooth_in.get() & self._smooth_mask:
+            latched |= _SMOOTH
+        if self._abrupt_in is not None and self._abrupt_in.get() & self._abrupt_mask:
+            latched |= _ABRUPT
+        self.latched = latched
+        # --- reactions
+        planner = self.profile.planner
+        if latched and not planner.done:
+            v = self.prf_link.ratio * planner.vel
+            if (
+                latched & (_POS_ERROR | _ABRUPT)
+                or (latched & _POS_LIMIT and v > 0.0)
+                or (latched & _NEG_LIMIT and v < 0.0)
+            ):
+                self.profile.stop(abrupt=True)
+            elif latched & _SMOOTH and planner.stopping == StopKind.NONE:
+                self.profile.stop(abrupt=False)
+        band = self.band
+        if band.band > 0:
+            band.update(t_ns, planner.done, err)
+
+    def _rebase(self) -> None:
+        """Positions from the drive again (another drive mode, GT_Reset): offsets dropped."""
+        ax = self.ax
+        ax.drive_offset = 0
+        self.prf_link.synch()
+        self.enc_link.synch()
+        raw = self._raw_source()
+        if raw is not None:
+            self.encoder.rebase(raw, self.unit)
+        if self._act is not None:
+            a = self._act.get() / (1 << ax.pos_scale)
+            ax.prf_pos = a
+            self._a_last = a
+        self.profile.hold(self.prf_link.source(ax.prf_pos))
+
+    # --- causes of the latched flags -------------------------------------------------------
+    def causes(self) -> int:
+        """The flags whose cause is present now (what GT_ClrSts cannot clear)."""
+        s = self.safety
+        out = 0
+        if s.alarm_on and self._alarm_sw is not None and self._alarm_sw.get() & _SW_FAULT:
+            out |= _ALARM
+        a = self.ax.prf_pos
+        if (
+            s.positive_on and self._pos_din is not None and self._pos_din.get() & LIMIT_POSITIVE_BIT
+        ) or a > s.soft_positive:
+            out |= _POS_LIMIT
+        if (
+            s.negative_on and self._neg_din is not None and self._neg_din.get() & LIMIT_NEGATIVE_BIT
+        ) or a < s.soft_negative:
+            out |= _NEG_LIMIT
+        if self.driving and abs(self.axis_error) > s.pos_err:
+            out |= _POS_ERROR
+        if self._smooth_in is not None and self._smooth_in.get() & self._smooth_mask:
+            out |= _SMOOTH
+        if self._abrupt_in is not None and self._abrupt_in.get() & self._abrupt_mask:
+            out |= _ABRUPT
+        return out
+
+    def drive_faulted(self) -> bool:
+        return self.ax.state in (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
+
+    # --- commands: modes and parameters ----------------------------------------------------
+    def prf_trap(self) -> None:
+        """GT_PrfTrap."""
+        self._require_profile("GT_PrfTrap")
+        self.profile.enter(PrfMode.TRAP)
+
+    def prf_jog(self) -> None:
+        """GT_PrfJog."""
+        self._require_profile("GT_PrfJog")
+        self.profile.enter(PrfMode.JOG)
+
+    def set_trap_prm(self, prm: TrapParams) -> None:
+        p = self.profile
+        p.require_mode("GT_SetTrapPrm", PrfMode.TRAP)
+        p.require_idle("GT_SetTrapPrm")
+        p.trap_prm = prm
+
+    def set_jog_prm(self, prm: JogParams) -> None:
+        p = self.profile
+        p.require_mode("GT_SetJogPrm", PrfMode.JOG)
+        p.require_idle("GT_SetJogPrm")
+        p.jog_prm = prm
+
+    def set_target(self, pos: int) -> None:
+        """GT_SetPos (Trap): the target of the next GT_Update."""
+        self.profile.require_mode("GT_SetPos", PrfMode.TRAP)
+        if not -POS_LIMIT <= pos <= POS_LIMIT:
+            raise ParameterError(f"pos={pos} out of range [-1073741823, 1073741823] (entry 115)")
+        self.profile.trap_target = pos
+
+    def set_vel(self, vel: float) -> None:
+        """GT_SetVel: Trap speed (> 0) or signed Jog speed, pulse/ms, for the next GT_Update."""
+        p = self.profile
+        p.require_mode("GT_SetVel", PrfMode.TRAP, PrfMode.JOG)
+        if p.mode == PrfMode.TRAP:
+            if not vel > 0.0:
+                raise ParameterError(f"vel={vel!r}: a Trap speed must be > 0 pulse/ms")
+            p.trap_vel = vel
+        else:
+            p.jog_vel = vel
+
+    def get_vel(self) -> float:
+        p = self.profile
+        p.require_mode("GT_GetVel", PrfMode.TRAP, PrfMode.JOG)
+        return p.trap_vel if p.mode == PrfMode.TRAP else p.jog_vel
+
+    def _require_profile(self, what: str) -> None:
+        if not self.profile.active:
+            raise CommandError(
+                f"{what}: profile {self.number} is not active (configuration file 'active = 0')"
+            )
+        self.profile.require_idle(what)
+
+    # --- commands: motion ----------------------------------------------------------------------
+    def check_motion(self, what: str, direction: float = 0.0) -> None:
+        """What every start of a motion needs (GT_Update, and GT_PtStart / GT_GearStart /
+        GT_FollowStart later): profile active, no blocking flag, servo on, drive in CSP, not
+        toward a triggered limit.  ``direction``: sign of the motion in profile units (0 =
+        unknown or both ways).  CommandError naming the first condition that fails."""
+        n = self.number
+        if not self.profile.active:
+            raise CommandError(f"{what}: profile {n} is not active (configuration file)")
+        blocked = self.latched & _BLOCKING
+        if blocked:
+            flags = ", ".join(t for f, t in _FLAG_TEXT.items() if blocked & f)
+            raise CommandError(f"{what}: axis {n} has {flags} set; remove the cause and GT_ClrSts")
+        ax = self.ax
+        if not ax.servo_on:
+            raise CommandError(
+                f"{what}: axis {n} is not servo-enabled (GT_GetSts bit 9 = 0); call GT_AxisOn first"
+            )
+        if ax.mode_cmd != CSP:
+            raise CommandError(
+                f"{what}: axis {n}'s drive is in mode {ax.mode_cmd}, not cyclic synchronous "
+                "position (8); switch back with GT_SetHomingMode(axis, 8) or "
+                "GT_SetEcatAxisMode(axis, 8)"
+            )
+        direction *= self.prf_link.ratio
+        if direction > 0.0 and self.latched & _POS_LIMIT:
+            raise CommandError(
+                f"{what}: axis {n}'s positive limit is triggered (GT_GetSts bit 5): motion in "
+                "the positive direction is refused; move away and call GT_ClrSts"
+            )
+        if direction < 0.0 and self.latched & _NEG_LIMIT:
+            raise CommandError(
+                f"{what}: axis {n}'s negative limit is triggered (GT_GetSts bit 6): motion in "
+                "the negative direction is refused; move away and call GT_ClrSts"
+            )
+
+    def check_update(self) -> None:
+        """Every condition GT_Update needs for this axis; CommandError naming the first failing."""
+        p = self.profile
+        if p.mode not in (PrfMode.TRAP, PrfMode.JOG):
+            raise CommandError(
+                f"GT_Update: axis {self.number} is in {p.mode.name.capitalize()} mode; GT_Update "
+                "starts Trap and Jog motions only (GT_PrfTrap / GT_PrfJog)"
+            )
+        if p.mode == PrfMode.TRAP:
+            direction = p.trap_target - p.planner.pos
+        else:
+            direction = p.jog_vel
+        self.check_motion("GT_Update", direction)
+        if p.mode == PrfMode.TRAP and not p.trap_vel > 0.0:
+            raise CommandError(
+                f"GT_Update: axis {self.number} has no Trap speed; call GT_SetVel first"
+            )
+
+    def start(self) -> None:
+        """GT_Update for this axis (after :meth:`check_update`): start, or change on the fly."""
+        p = self.profile
+        if p.mode == PrfMode.TRAP:
+            trap = p.trap
+            if not trap.done and trap.stopping == StopKind.NONE:
+                trap.update(p.trap_target, p.trap_vel)
+            else:
+                trap.start(trap.pos, p.trap_target, p.trap_vel, p.trap_prm, trap.vel)
+        else:
+            jog = p.jog
+            if not jog.done and jog.stopping == StopKind.NONE:
+                jog.update(p.jog_vel)
+            else:
+                jog.start(jog.pos, p.jog_vel, p.jog_prm, jog.vel)
+
+    def stop(self, abrupt: bool) -> None:
+        """GT_Stop for this axis."""
+        self.profile.stop(abrupt)
+
+    # --- commands: positions -------------------------------------------------------------------
+    def set_prf_pos(self, pos: float) -> None:
+        """GT_SetPrfPos: the profile position becomes ``pos``; the axis keeps its value (11.6)."""
+        self.profile.require_idle("GT_SetPrfPos (entry 118: not while moving)")
+        self.profile.redefine(pos)
+        self.prf_link.anchor(pos, self.ax.prf_pos)
+
+    def set_enc_pos(self, pos: float) -> None:
+        """GT_SetEncPos: the encoder reading becomes ``pos``; the axis encoder keeps its value."""
+        here = self.axis_enc_pos
+        self.encoder.set_pos(pos)
+        self.enc_link.anchor(pos, here)
+
+    def _shift_axis(self, new: float) -> None:
+        """Redefine the axis planned position without moving the drive (607Ah stays)."""
+        ax = self.ax
+        counts = ax.pulses_to_counts(ax.prf_pos)
+        ax.prf_pos = new
+        ax.drive_offset = counts - round(new * (1 << ax.pos_scale))
+        self._a_last = new
+
+    def zero_pos(self) -> None:
+        """GT_ZeroPos: planned and actual positions 0 (profile, axis, encoder, axis encoder)."""
+        self.profile.require_idle("GT_ZeroPos")
+        self._shift_axis(0.0)
+        self.prf_link.synch()
+        self.profile.redefine(0.0)
+        self.encoder.set_pos(0.0)
+        self.enc_link.synch()
+
+    def synch_axis_pos(self) -> None:
+        """GT_SynchAxisPos: axis planned := scaled profile, axis encoder := scaled encoder."""
+        self._shift_axis(self.prf_link.ratio * self.profile.planner.pos)
+        self.prf_link.synch()
+        self.enc_link.synch()
+
+    def set_profile_scale(self, scale: Scale) -> None:
+        self.profile.require_idle("GT_ProfileScale")
+        self.prf_link.set_scale(scale, self.profile.planner.pos)
+
+    def set_enc_scale(self, scale: Scale) -> None:
+        self.profile.require_idle("GT_EncScale")
+        self.enc_link.set_scale(scale, self.encoder.pos)
+
+    def set_pos_scale(self, scale: int) -> None:
+        """GT_SetPosScale: a new count exponent - the pulse becomes 2**scale drive counts.
+
+        Every position of the axis is re-expressed in the new pulse (planned, profile,
+        encoder, their offsets: all multiplied by 2**(old - new), exactly); the drive
+        keeps its set-point, nothing moves.
+        """
+        self.profile.require_idle("GT_SetPosScale (entry 117)")
+        ax = self.ax
+        f = 2.0 ** (ax.pos_scale - scale)
+        ax.pos_scale = scale
+        if f == 1.0:
+            return
+        ax.prf_pos *= f  # the same drive counts: round(A * 2**scale) + drive_offset
+        self._a_last = ax.prf_pos
+        self.prf_link.offset *= f
+        self.enc_link.offset *= f
+        self.encoder.set_pos(self.encoder.pos * f)
+        self.profile.redefine(self.profile.planner.pos * f)
+
+    def set_encoder_source(self, external: bool) -> None:
+        """GT_EncOn (external: 6064h) / GT_EncOff (pulse counter: 607Ah)."""
+        enc = self.encoder
+        if enc.external == external:
+            return
+        enc.external = external
+        raw = self._raw_source()
+        if raw is not None:
+            enc.resync(raw)
+
+    # --- status ----------------------------------------------------------------------------------
+    def clear_flags(self) -> None:
+        """The flag part of GT_ClrSts (after any drive fault reset)."""
+        self.latched &= self.causes()
+
+    def reset(self) -> None:
+        """GT_Reset: table 4-4 for every resource of this axis."""
+        ax = self.ax
+        if ax.servo_on:
+            ax.request_disable()
+        self.safety = Safety.defaults(self.number)
+        self.bind_inputs()
+        self.band.reset()
+        self.prf_link.reset()
+        self.enc_link.reset()
+        self.encoder.reset()
+        self.latched = 0
+        self._rebase()
+        self.profile.reset(self.profile.planner.pos)
+
+
+# --- the controller side -----------------------------------------------------------------
+def install(ctl: Controller) -> None:
+    """Create every axis's resources (bus up) and hook GT_Reset once per controller."""
+    for ax in ctl.axes.values():
+        AxisResources(ctl, ax)
+    for ax in ctl.axes.values():
+        ax.motion.bind_inputs()
+    if _reset_all not in ctl.on_reset:
+        ctl.on_reset.append(_reset_all)
+
+
+def _reset_all(ctl: Controller) -> None:
+    for ax in ctl.axes.values():
+        res = getattr(ax, "motion", None)
+        if res is not None:
+            res.reset()
+
+
+def axis_resources(ctl: Controller, n: int) -> AxisResources:
+    """The resources of GT axis ``n``: BusError (1) before the bus is up, 7 when out of range."""
+    if not ctl.axes:
+        raise BusError(
+            f"axis {n}: no EtherCAT axis yet (call GT_InitEcatComm; the ENI must hold a "
+            "CiA-402 drive)"
+        )
+    ax = ctl.axis(n)
+    res = getattr(ax, "motion", None)
+    if res is None:
+        raise BusError(f"axis {n} has no motion resources (bus not brought up by GT_InitEcatComm)")
+    return res
+
+
+def axis_span(
+    ctl: Controller, first: int, count: int, limit: int | None = None
+) -> list[AxisResources]:
+    """Axes ``first .. first+count-1`` (the ``count`` argument form of chapter 13)."""
+    try:
+        first, count = int(first), int(count)
+    except (TypeError, ValueError):
+        raise ParameterError(f"axis={first!r}, count={count!r} must be integers") from None
+    if count < 1:
+        raise ParameterError(f"count={count} must be >= 1")
+    if limit is not None and count > limit:
+        raise ParameterError(f"count={count}: at most {limit} at once")
+    return [axis_resources(ctl, n) for n in range(first, first + count)]
+
+
+def axes_in_mask(ctl: Controller, mask: int, strict: bool) -> list[AxisResources]:
+    """Axes whose bit is set in ``mask`` (bit 0 = axis 1); ``strict``: a missing one is 7."""
+    try:
+        m = int(mask)
+    except (TypeError, ValueError):
+        raise ParameterError(f"mask={mask!r} is not an integer") from None
+    out = []
+    n = 1
+    m &= 0xFFFFFFFF
+    while m:
+        if m & 1:
+            if n in ctl.axes:
+                out.append(axis_resources(ctl, n))
+            elif strict:
+                axis_resources(ctl, n)  # raises with the reason
+        m >>= 1
+        n += 1
+    return out
+
+
+def position_source(ctl: Controller, kind: int, index: int, item: int = 0) -> Callable[[], float]:
+    """A master position for Gear / Follow (GT_SetGearMaster, GT_SetFollowMaster, 7.5.2):
+    ``kind`` 1 encoder ``index``, 2 profile ``index`` (planned), 3 axis ``index`` (``item`` 0
+    its planned, 1 its encoder position).  Axes are stepped in number order, so a master
+    numbered below its slave is read in the same cycle."""
+    res = axis_resources(ctl, index)
+    if kind == 1:
+        return lambda: res.encoder.pos
+    if kind == 2:
+        return lambda: res.profile.planner.pos
+    if kind == 3:
+        if item == 0:
+            return lambda: res.ax.prf_pos
+        return lambda: res.enc_link.axis(res.encoder.pos)
+    raise ParameterError(f"master type {kind}: 1 encoder, 2 profile or 3 axis")
+
+
+def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:
+    """GT_ClrSts: reset faulted drives (bounded), then clear the flags whose cause is gone."""
+    axes = list(axes)
+    faulted = [r for r in axes if r.drive_faulted()]
+    if faulted:
+        _fault_reset(ctl, faulted)
+    for r in axes:
+        r.clear_flags()
+
+
+def _fault_reset(ctl: Controller, faulted: list[AxisResources]) -> None:
+    clock = ctl.clock
+    clock.run_until(
+        lambda: all(r.ax.state != PdsState.FAULT_REACTION_ACTIVE for r in faulted),
+        FAULT_REACTION_TIMEOUT_MS,
+    )
+    for r in faulted:
+        r.ax.servo_on = False
+        r.ax.cw = 0x0000
+    _run_cycles(ctl, 1)  # the drive sees bit 7 low ...
+    for r in faulted:
+        if r.ax.state == PdsState.FAULT:
+            r.ax.cw = _CW_FAULT_RESET  # ... then rising (transition 15)
+    clock.run_until(
+        lambda: not any(r.ax.state == PdsState.FAULT for r in faulted), FAULT_RESET_TIMEOUT_MS
+    )
+    for r in faulted:
+        r.ax.cw = 0x0000
+
+
+def _run_cycles(ctl: Controller, n: int) -> None:
+    c0 = ctl.clock.cycles
+    ctl.clock.run_until(lambda: ctl.clock.cycles >= c0 + n, (n + 2) * ctl.clock.cycle_ns / 1e6)
+
+
+__all__ = [
+    "LATCHED",
+    "AxisResources",
+    "axes_in_mask",
+    "axis_resources",
+    "axis_span",
+    "clear_status",
+    "install",
+    "position_source",
+]

@@ -1,0 +1,77 @@
+"""The backend seam: the only place that knows where the slaves are.
+
+The master (:mod:`gtecat.master.bus`) talks to a :class:`Backend`; the emulated
+backend has the virtual slaves in-process, the pysoem backend has a NIC.  A
+cycle returns what happened (the working counter is data, as in ethercrab's
+``TxRxResponse``); the master decides what a bad WKC means.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+from drives.slave import AlState, AlStatusCode
+from eni.layout import Layout
+from eni.model import Identity
+
+from ..image import ProcessImage
+
+
+@dataclass(frozen=True, slots=True)
+class FoundSlave:
+    """What a bus scan reports for one position."""
+
+    position: int
+    identity: Identity
+    name: str = ""
+
+
+class Backend(ABC):
+    name = "abstract"
+    #: the backend brings lost slaves back itself (SOEM's recover/reconfig); otherwise the
+    #: master re-walks them (:meth:`gtecat.master.bus.Master.recover`)
+    recovers_itself = False
+
+    @abstractmethod
+    def open(self, layout: Layout, image: ProcessImage) -> None:
+        """Attach to the bus described by ``layout``; ``image`` is the master's image."""
+
+    @abstractmethod
+    def scan(self) -> list[FoundSlave]:
+        """The slaves present, in bus order."""
+
+    @abstractmethod
+    def request_state(self, position: int, state: AlState) -> AlStatusCode:
+        """Ask one slave for an AL state; the code the slave answered (0 = done)."""
+
+    @abstractmethod
+    def state(self, position: int) -> tuple[AlState, AlStatusCode]:
+        """A slave's current AL state and status code."""
+
+    @abstractmethod
+    def exchange(self, t_ns: int, dt_ns: int) -> int:
+        """One process-data cycle: outputs out, inputs in; returns the working counter."""
+
+    @abstractmethod
+    def expected_wkc(self) -> int:
+        """The working counter of a healthy cycle with every slave in OP."""
+
+    @abstractmethod
+    def sdo_upload(
+        self, position: int, index: int, subindex: int, complete_access: bool = False
+    ) -> bytes:
+        """CoE SDO upload; raises :class:`drives.abort.SdoAbort`."""
+
+    @abstractmethod
+    def sdo_download(
+        self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
+        """CoE SDO download; raises :class:`drives.abort.SdoAbort`."""
+
+    def emergencies(self) -> list[tuple[int, object]]:
+        """CoE emergencies received since the last call: ``(position, Emergency)``."""
+        return []
+
+    def close(self) -> None:  # noqa: B027 - optional hook
+        """Release the bus."""

@@ -1,0 +1,163 @@
+"""The in-process backend: virtual slaves exchanged by an FMMU in software.
+
+Each cycle copies every slave's output area of the logical image into its
+RxPDO buffer, steps the slave, and copies its TxPDO buffer back into the input
+area (ETG.1000.4 logical addressing done by the ESC in real life).  The working
+counter follows ETG.1000.4 for one LRW: +2 per slave whose outputs were written
+(OP), +1 per slave whose inputs were read (SAFEOP and OP).  Mailbox traffic is
+real CoE: whole mailbox messages built by :class:`drives.coe.SdoClient` and
+answered by the slave's own SDO server.
+"""
+
+from __future__ import annotations
+
+from drives.machine import MachineDescription
+from drives.slave import AlState, AlStatusCode, VirtualSlave
+from eni.layout import Layout
+from eni.model import Direction
+
+from ...errors import BusError
+from ..image import ProcessImage, Segment
+from .base import Backend, FoundSlave
+
+
+class EmulatedBackend(Backend):
+    name = "emulated"
+
+    def __init__(
+        self,
+        machine: MachineDescription | None = None,
+        slaves: list[VirtualSlave] | None = None,
+        hardware: Layout | None = None,
+    ) -> None:
+        """``hardware``: the layout of the virtual hardware when it differs from the
+        master's ENI (to test what a mismatch does); default: the ENI itself."""
+        self.machine = machine or MachineDescription()
+        self.hardware = hardware
+        self.slaves: list[VirtualSlave] = list(slaves) if slaves is not None else []
+        self._given = slaves is not None
+        self._plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
+        self._expected = 0
+        self.image: ProcessImage | None = None
+        #: positions unplugged by a scenario (GTE_ helpers): no answer, no WKC
+        self.unplugged: set[int] = set()
+        #: process-data watchdog of the slaves (ESC default 100 ms)
+        self.watchdog_ns = 100_000_000
+        self._silent_ns: dict[int, int] = {}
+        self._clients: dict[int, object] = {}
+
+    def open(self, layout: Layout, image: ProcessImage) -> None:
+        from ..factory import build_slaves
+
+        if not self._given:
+            self.slaves = build_slaves(self.hardware or layout, self.machine)
+        self.image = image
+        self._clients = {}
+        segs: dict[tuple[int, Direction], Segment] = {
+            (s.slave, s.direction): s for s in image.segments
+        }
+        self._plan = []
+        for slave in self.slaves:
+            out = segs.get((slave.position, Direction.OUT))
+            inp = segs.get((slave.position, Direction.IN))
+            sl = layout.slaves[slave.position] if slave.position < len(layout.slaves) else None
+            if sl is not None:
+                slave.expected_sizes = (sl.out_bits, sl.in_bits)
+            self._plan.append((slave, out, inp))
+        # ETG.1000.4 LRW: +2 per slave with outputs, +1 per slave with inputs (fixed per bus)
+        self._expected = sum(2 * (o is not None) + (i is not None) for _, o, i in self._plan)
+
+    def _slave(self, position: int) -> VirtualSlave:
+        if position in self.unplugged or not 0 <= position < len(self.slaves):
+            raise BusError(f"slave {position} does not answer")
+        return self.slaves[position]
+
+    def unplug(self, position: int) -> None:
+        """Cut the cable in front of ``position`` (a scenario's comm loss)."""
+        self.unplugged.add(position)
+        self._silent_ns[position] = 0
+
+    def replug(self, position: int) -> None:
+        self.unplugged.discard(position)
+        self._silent_ns.pop(position, None)
+
+    def scan(self) -> list[FoundSlave]:
+        found = []
+        for s in self.slaves:
+            if s.position in self.unplugged:
+                break  # the chain ends at the first missing slave
+            found.append(FoundSlave(s.position, s.identity, s.name))
+        return found
+
+    def request_state(self, position: int, state: AlState) -> AlStatusCode:
+        return self._slave(position).request_state(state)
+
+    def state(self, position: int) -> tuple[AlState, AlStatusCode]:
+        s = self._slave(position)
+        return s.al_state, s.al_status_code
+
+    def exchange(self, t_ns: int, dt_ns: int) -> int:
+        image = self.image
+        assert image is not None
+        wkc = 0
+        unplugged = self.unplugged
+        for slave, out, inp in self._plan:
+            if unplugged and slave.position in unplugged:
+                # powered but cut off: it keeps running; its watchdog notices the silence
+                silent = self._silent_ns.get(slave.position, 0) + dt_ns
+                self._silent_ns[slave.position] = silent
+                if silent >= self.watchdog_ns:
+                    slave.watchdog_expired()
+                slave.step(t_ns, dt_ns)
+                continue
+            st = slave.al_state
+            if out is not None:
+                image.to_slave(out, slave.rx)
+                if st == AlState.OP:
+                    wkc += 2
+            slave.step(t_ns, dt_ns)
+            if inp is not None and st >= AlState.SAFEOP:
+                image.from_slave(inp, slave.tx)
+                wkc += 1
+        return wkc
+
+    def emergencies(self) -> list[tuple[int, object]]:
+        out = []
+        for slave in self.slaves:
+            while slave.emergencies:
+                out.append((slave.position, slave.emergencies.popleft()))
+        return out
+
+    def expected_wkc(self) -> int:
+        return self._expected
+
+    # --- mailbox -----------------------------------------------------------------
+    def _client(self, position: int):  # -> drives.coe.SdoClient
+        from drives.coe import SdoClient
+
+        slave = self._slave(position)
+        if not slave.has_mailbox:
+            raise BusError(f"slave {position} ({slave.name}) has no CoE mailbox")
+        client = self._clients.get(position)
+        if client is None:
+            client = SdoClient(slave.mailbox)
+            self._clients[position] = client
+        return client
+
+    def sdo_upload(
+        self, position: int, index: int, subindex: int, complete_access: bool = False
+    ) -> bytes:
+        slave = self._slave(position)
+        if slave.al_state < AlState.PREOP:
+            raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
+        return self._client(position).upload(index, subindex, complete_access=complete_access)
+
+    def sdo_download(
+        self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
+        slave = self._slave(position)
+        if slave.al_state < AlState.PREOP:
+            raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
+        self._client(position).download(
+            index, subindex, bytes(data), complete_access=complete_access
+        )

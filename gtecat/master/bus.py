@@ -1,0 +1,317 @@
+"""The EtherCAT master: bring-up, cyclic exchange, working counter, mailbox.
+
+Bring-up follows ETG.1000.6 / ETG.2100 the way an IgH-style master does it:
+scan, compare what answered with the ENI (vendor, product, revision), INIT ->
+PREOP (CoE InitCmds of transition ``IP``), PREOP -> SAFEOP (``PS``: PDO
+assignment/mapping and start-up parameters; the slave checks its sync-manager
+sizes), then, once cyclic data flows, SAFEOP -> OP (``SO``).  A slave that
+rejects an InitCmd or a transition stays below OP and the reason is logged and
+kept in :attr:`Master.error`.
+
+The OP request is made ``op_delay_cycles`` cycles after SAFEOP is reached
+(the real master waits for the DC clocks and the first valid inputs), so
+``GT_IsEcatReady`` polling loops see 0 before 1, as on the real controller.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from drives.slave import AlState, AlStatusCode
+from eni.errors import GtecatError
+from eni.layout import Layout
+from eni.model import InitCmd
+
+from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
+from .backends.base import Backend
+from .image import ProcessImage
+
+
+@dataclass
+class CycleResult:
+    wkc: int
+    expected: int
+
+    @property
+    def ok(self) -> bool:
+        return self.wkc == self.expected
+
+
+def _transition(a: AlState, b: AlState) -> str:
+    letter = {
+        AlState.INIT: "I",
+        AlState.PREOP: "P",
+        AlState.SAFEOP: "S",
+        AlState.OP: "O",
+        AlState.BOOT: "B",
+    }
+    return letter[a] + letter[b]
+
+
+class Master:
+    """One EtherCAT master on one backend."""
+
+    def __init__(
+        self,
+        layout: Layout,
+        backend: Backend,
+        *,
+        log: Callable[[str], None] = lambda _m: None,
+        op_delay_cycles: int = 10,
+    ) -> None:
+        self.layout = layout
+        self.backend = backend
+        self.image = ProcessImage(layout)
+        self.log = log
+        self.op_delay_cycles = op_delay_cycles
+        self.error: str = ""  # why the bus is not (or no longer) fully up
+        self.last = CycleResult(0, 0)
+        self.wkc_errors = 0
+        self.cycles = 0
+        self.emergency_count = 0
+        self._wkc_bad = False
+        #: cycles between recovery attempts while the working counter is short
+        self.recover_every = 100
+        self.opened = False
+        self.target = AlState.INIT
+        self._op_countdown = -1
+        self.states: list[AlState] = [AlState.INIT] * len(layout.slaves)
+        self.on_cycle: list[Callable[[Master], None]] = []  # recorders etc.
+
+    # --- bring-up ------------------------------------------------------------------
+    def open(self) -> None:
+        """Scan, compare with the ENI and bring every slave to SAFEOP.
+
+        Raises :class:`NoSlavesError` (GT -10), :class:`ConfigMismatch` (GT -8) or
+        :class:`BusError` with the reason.
+        """
+        self.log("Scanning bus.")
+        self.backend.open(self.layout, self.image)
+        found = self.backend.scan()
+        if not found:
+            raise NoSlavesError("no slave answered the scan; check the cabling / interface")
+        self.log(f"Found {len(found)} slaves.")
+        expected = self.layout.config.slaves
+        for cfg, got in zip(expected, found, strict=False):
+            e, g = cfg.identity, got.identity
+            for what, a, b in (
+                ("vendor id", e.vendor_id, g.vendor_id),
+                ("product code", e.product_code, g.product_code),
+                ("revision", e.revision_no, g.revision_no),
+            ):
+                if a and a != b:
+                    raise ConfigMismatch(
+                        f"slave {cfg.position}: ENI expects {cfg.name!r} {what} 0x{a:08X}, "
+                        f"bus has 0x{b:08X} ({got.name or 'unnamed'}); export the ENI again "
+                        "for this bus or check the cabling order"
+                    )
+        if len(found) != len(expected):
+            raise ConfigMismatch(
+                f"ENI lists {len(expected)} slaves, the bus has {len(found)} "
+                "(check the cabling and power, or export the ENI again for this bus)"
+                + (
+                    f" (first missing: slave {len(found)} {expected[len(found)].name!r})"
+                    if len(found) < len(expected)
+                    else ""
+                )
+            )
+        self.opened = True
+        self._walk(AlState.PREOP)
+        self._walk(AlState.SAFEOP)
+        self.target = AlState.OP
+        self._op_countdown = self.op_delay_cycles
+        self.log("Slave states: SAFEOP")
+
+    def _walk(self, target: AlState) -> None:
+        """Move every slave from its state to ``target`` (one step), with InitCmds."""
+        for cfg in self.layout.config.slaves:
+            pos = cfg.position
+            cur, _ = self.backend.state(pos)
+            if cur == target:
+                continue
+            tr = _transition(cur, target)
+            # CoE InitCmds run where the mailbox works: before the request for
+            # PS/SO, after reaching PREOP for IP.
+            if cur >= AlState.PREOP:
+                self._init_cmds(pos, tr)
+            code = self.backend.request_state(pos, target)
+            if code:
+                state, _ = self.backend.state(pos)
+                msg = (
+                    f"slave {pos} ({cfg.name}): {tr} refused, AL status code "
+                    f"0x{int(code):04X} {_code_name(code)}; stays in {state.name}"
+                )
+                self.log(msg)
+                self.error = msg
+                raise StateError(msg, expected=target, actual=state, slave=pos)
+            if target == AlState.PREOP:
+                self._init_cmds(pos, tr)
+            self.states[pos] = target
+        self.log(f"Slave states: {target.name}")
+
+    def _init_cmds(self, pos: int, transition: str) -> None:
+        cfg = self.layout.config.slaves[pos]
+        for cmd in cfg.init_cmds:
+            if transition not in cmd.transitions:
+                continue
+            try:
+                self._run_init_cmd(pos, cmd)
+            except GtecatError as e:
+                msg = (
+                    f"slave {pos} ({cfg.name}): InitCmd {transition} "
+                    f"0x{cmd.index:04X}:{cmd.subindex:02X} "
+                    f"{cmd.comment or ''} failed: {e}"
+                ).replace("  ", " ")
+                self.log(msg)
+                self.error = msg
+                raise StateError(msg, expected=transition, slave=pos) from e
+
+    def _run_init_cmd(self, pos: int, cmd: InitCmd) -> None:
+        if cmd.upload:
+            self.backend.sdo_upload(pos, cmd.index, cmd.subindex, cmd.complete_access)
+        else:
+            self.backend.sdo_download(pos, cmd.index, cmd.subindex, cmd.data, cmd.complete_access)
+
+    def request_op(self) -> None:
+        """SO InitCmds and the OP request (made automatically after the delay)."""
+        try:
+            self._walk(AlState.OP)
+            self.log("All slaves are in OP mode.")
+            self.error = ""
+        except GtecatError as e:
+            self.error = str(e)
+
+    def terminate(self) -> None:
+        """Every slave back to INIT (GT_TerminateEcatComm)."""
+        for cfg in self.layout.config.slaves:
+            try:
+                self.backend.request_state(cfg.position, AlState.INIT)
+                self.states[cfg.position] = AlState.INIT
+            except GtecatError:
+                pass
+        self.target = AlState.INIT
+        self._op_countdown = -1
+        self.log("Slave states: INIT")
+        self.opened = False
+
+    # --- cycle -----------------------------------------------------------------------
+    def cycle(self, t_ns: int, dt_ns: int) -> CycleResult:
+        if not self.opened:
+            return self.last
+        wkc = self.backend.exchange(t_ns, dt_ns)
+        self.cycles += 1
+        expected = self.backend.expected_wkc() if self.target == AlState.OP else wkc
+        self.last = CycleResult(wkc, expected)
+        if self._op_countdown >= 0:
+            self._op_countdown -= 1
+            if self._op_countdown < 0:
+                self.request_op()
+        elif self.target == AlState.OP and self.last.ok and not self.all_op():
+            # the working counter is whole again (a slave came back and the backend
+            # recovered it): take the states as they are now
+            self.refresh_states()
+        elif self.target == AlState.OP and not self.last.ok:
+            self.wkc_errors += 1
+            if not self._wkc_bad:
+                self._wkc_bad = True
+                self.error = f"working counter {wkc}/{expected}: a slave does not answer"
+                self.log(f"Working counter changed to {wkc}/{expected}.")
+            if self.cycles % self.recover_every == 0 and not self.backend.recovers_itself:
+                self.recover()
+        if self._wkc_bad and self.last.ok and self.all_op():
+            self._wkc_bad = False
+            self.error = ""
+            self.log(f"Working counter changed to {wkc}/{expected}. All slaves are in OP mode.")
+        for pos, emcy in self.backend.emergencies():
+            self.emergency_count += 1
+            self.log(
+                f"WARNING {pos}: CoE EMERGENCY 0x{emcy.code:04X} 0x{emcy.register:02X} "
+                f"{emcy.data.hex(' ')}"
+            )
+        for hook in self.on_cycle:
+            hook(self)
+        return self.last
+
+    def recover(self) -> None:
+        """Bring back slaves that answer again but fell below OP (acknowledge, re-walk).
+
+        Like an IgH master after a cable is plugged back: the slave's error is
+        acknowledged, its InitCmds are applied again on the way up, and it is
+        asked for OP.  Slaves that still do not answer are left for the next try.
+        """
+        for cfg in self.layout.config.slaves:
+            pos = cfg.position
+            try:
+                state, code = self.backend.state(pos)
+            except GtecatError:
+                self.states[pos] = AlState.NONE
+                continue
+            self.states[pos] = state
+            if state == AlState.OP:
+                continue
+            self.log(
+                f"Slave {pos}: state {state.name}"
+                + (f" + ERROR 0x{int(code):04X}" if code else "")
+                + "; recovering."
+            )
+            try:
+                if code:
+                    self.backend.request_state(pos, state)  # acknowledge the error
+                for target in (AlState.PREOP, AlState.SAFEOP, AlState.OP):
+                    cur, _ = self.backend.state(pos)
+                    if cur >= target:
+                        continue
+                    tr = _transition(cur, target)
+                    if cur >= AlState.PREOP:
+                        self._init_cmds(pos, tr)
+                    if self.backend.request_state(pos, target):
+                        raise StateError(f"slave {pos}: {tr} refused", slave=pos)
+                    if target == AlState.PREOP:
+                        self._init_cmds(pos, tr)
+                self.states[pos] = AlState.OP
+                self.log(f"Slave {pos}: back in OP.")
+            except GtecatError as e:
+                self.error = str(e)
+
+    def all_op(self) -> bool:
+        return all(s == AlState.OP for s in self.states)
+
+    @property
+    def ready(self) -> bool:
+        """All slaves in OP and the last cycle's working counter as expected."""
+        return self.opened and self.all_op() and self.last.ok and self.last.expected > 0
+
+    def refresh_states(self) -> list[AlState]:
+        for cfg in self.layout.config.slaves:
+            try:
+                self.states[cfg.position], _ = self.backend.state(cfg.position)
+            except GtecatError:
+                self.states[cfg.position] = AlState.NONE
+        return self.states
+
+    # --- mailbox ------------------------------------------------------------------------
+    def sdo_upload(
+        self, pos: int, index: int, subindex: int, complete_access: bool = False
+    ) -> bytes:
+        self._check_slave(pos)
+        return self.backend.sdo_upload(pos, index, subindex, complete_access)
+
+    def sdo_download(
+        self, pos: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
+        self._check_slave(pos)
+        self.backend.sdo_download(pos, index, subindex, data, complete_access)
+
+    def _check_slave(self, pos: int) -> None:
+        if not self.opened:
+            raise BusError("EtherCAT communication is not initialised (call GT_InitEcatComm)")
+        if not 0 <= pos < len(self.layout.slaves):
+            raise BusError(f"no slave {pos}: the bus has slaves 0..{len(self.layout.slaves) - 1}")
+
+
+def _code_name(code: int) -> str:
+    try:
+        return AlStatusCode(code).name.lower().replace("_", " ")
+    except ValueError:
+        return "vendor specific"

@@ -1,0 +1,1 @@
+"""``gtecat serve``: the ENI's virtual slaves on a real or virtual NIC (the ESC is drives.esc)."""

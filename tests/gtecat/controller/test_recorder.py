@@ -1,0 +1,52 @@
+"""The recorder (issue 2 item 6): chosen image variables every cycle into a numpy buffer."""
+
+from __future__ import annotations
+
+from ctypes import byref, c_ushort
+
+import pytest
+
+from gtecat import gt
+from gtecat.controller.recorder import Recorder
+from gtecat.errors import ParameterError
+from tests.gtecat.gt.conftest import bring_up
+
+
+@pytest.fixture(autouse=True)
+def _closed():
+    gt.GT_Close()
+    yield
+    gt.GT_Close()
+
+
+def test_records_every_cycle_what_the_bus_carried(tmp_path):
+    bring_up()
+    ctl = gt.GTE_Controller()
+    io = gt.GTE_Slave(2)
+    for bit in range(8):
+        io.wire(bit, bit)
+    rec = Recorder(ctl, ["2:0x7000:1", "2:0x6000:1", "axis1.sw"]).start()
+    n0 = ctl.clock.cycles
+    for v in range(1, 6):
+        gt.GT_SetEcatRawData(32, 1, byref(c_ushort(v)))
+        gt.GTE_Wait(1)
+    gt.GTE_Wait(3)
+    rec.stop()
+    assert rec.n == ctl.clock.cycles - n0  # one row per cycle
+    assert list(rec.column("2:0x7000:1")[-1:]) == [5]
+    # the input follows the output one cycle later (the wire is read at the next step)
+    out, inp = rec.column("2:0x7000:1"), rec.column("2:0x6000:1")
+    assert set(inp[1:]) <= set(out[:-1]) | {0}
+    assert rec.data[1, 0] - rec.data[0, 0] == pytest.approx(1.0)
+    csv_file = rec.to_csv(tmp_path / "t.csv")
+    assert csv_file.read_text().splitlines()[0] == "time_ms,2:0x7000:1,2:0x6000:1,axis1.sw"
+    png = rec.plot(tmp_path / "t.png")
+    assert png.stat().st_size > 1000
+
+
+def test_unknown_signal_is_a_clear_error():
+    bring_up()
+    with pytest.raises(ParameterError, match="maps no 0x7000:09"):
+        Recorder(gt.GTE_Controller(), ["2:0x7000:9"])
+    with pytest.raises(ParameterError, match="unknown signal"):
+        Recorder(gt.GTE_Controller(), ["nonsense"])
