@@ -37,3 +37,45 @@ def test_packages_import_only_downwards(package):
         if wrong:
             bad.append(f"{path.relative_to(ROOT)} imports {', '.join(sorted(wrong))}")
     assert not bad, "\n".join(bad)
+
+
+def _gtecat_imports(path: Path) -> set[str]:
+    """Absolute ``gtecat.X`` subpackages a module imports (relative imports resolved)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    pkg = list(path.relative_to(ROOT).with_suffix("").parts)
+    pkg = pkg[:-1]  # the module's package ( __init__ counts as its own package's module)
+    out: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg[: len(pkg) - (node.level - 1)]
+                mod = [*base, *(node.module.split(".") if node.module else [])]
+            else:
+                mod = (node.module or "").split(".")
+            if mod == ["gtecat"]:
+                out.update(a.name for a in node.names)  # from .. import controller
+            elif mod[:1] == ["gtecat"]:
+                out.add(mod[1])
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                parts = a.name.split(".")
+                if parts[0] == "gtecat" and len(parts) > 1:
+                    out.add(parts[1])
+    return out
+
+
+#: inside gtecat/ (DESIGN.md "Layout inside gtecat/"): the master knows nothing of the layers above
+INNER_FORBIDDEN = {
+    "master": {"controller", "gt", "cli", "native", "programs", "wire"},
+    "controller": {"gt", "cli", "native", "wire"},
+}
+
+
+@pytest.mark.parametrize("sub", sorted(INNER_FORBIDDEN))
+def test_gtecat_subpackages_import_only_downwards(sub):
+    bad = []
+    for path in sorted((ROOT / "gtecat" / sub).rglob("*.py")):
+        wrong = _gtecat_imports(path) & INNER_FORBIDDEN[sub]
+        if wrong:
+            bad.append(f"{path.relative_to(ROOT)} imports gtecat.{', '.join(sorted(wrong))}")
+    assert not bad, "\n".join(bad)
