@@ -20,8 +20,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from drives.abort import SdoAbort
 from drives.machine import MachineError
 from eni.errors import EniError, GtecatError
@@ -35,6 +33,8 @@ from ..errors import (
     NoSlavesError,
     ParameterError,
 )
+from .args import Ref, binder, core_arg
+from .table import FUNCTIONS, Proto
 
 log = logging.getLogger("gtecat.gt")
 
@@ -127,41 +127,42 @@ class _Refusal(Exception):
 def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     """Make ``fn`` a GT function: never raises, returns a code, costs a host call.
 
-    ``fn`` receives the core's :class:`Controller` as its first argument (or
-    nothing when it is declared with ``needs_controller = False``) and returns
-    ``None``/0 on success.  Registers ``GT_x`` and its ``GTN_x`` twin.
+    The function table (:mod:`gtecat.gt.table`) must declare ``fn``'s name: its
+    arguments are checked and converted from the table (:mod:`gtecat.gt.args`)
+    before ``fn`` runs.  ``fn`` receives the core's :class:`Controller` first
+    when its first parameter is ``ctl``, then the table's parameters in order,
+    and returns ``None``/0 on success.  Registers ``GT_x`` and its ``GTN_x``
+    twin (``GTE_`` helpers get none).
     """
     name = fn.__name__
-    signature = inspect.signature(fn)
-    params = list(signature.parameters)
+    proto = FUNCTIONS.get(name)
+    if proto is None:
+        raise RuntimeError(f"{name} is not in the function table (gtecat/gt/table.py)")
+    params = list(inspect.signature(fn).parameters)
     needs_ctl = bool(params) and params[0] == "ctl"
+    bind = binder(proto, fn)
 
-    def call(core: int, args: tuple, kwargs: dict) -> int:
+    def call(core: Any, args: tuple, kwargs: dict) -> int:
         ctl = None
         try:
+            if core is not _ONE:
+                core = core_arg(core)
+            else:
+                core = 1
+            values, extra = bind(args, kwargs)
             if needs_ctl:
                 ctl = SESSION.controller(core)
                 if ctl.clock.threaded:
                     with ctl.clock.lock:  # atomic with respect to the cycle thread
-                        rc = fn(ctl, *args, **kwargs)
+                        rc = fn(ctl, *values, **extra)
                 else:
-                    rc = fn(ctl, *args, **kwargs)
+                    rc = fn(ctl, *values, **extra)
             else:
-                rc = fn(*args, **kwargs)
+                rc = fn(*values, **extra)
             rc = 0 if rc is None else int(rc)
         except _Refusal as r:
             rc = r.code
             _record(name, rc, str(r))
-        except TypeError as e:
-            try:  # the caller's arguments do not fit the prototype: 7; else a bug inside
-                signature.bind(*((None,) if needs_ctl else ()), *args, **kwargs)
-            except TypeError:
-                rc = CMD_PARAM
-                _record(name, rc, f"bad arguments: {e}")
-            else:
-                rc = CMD_NO_RESPONSE
-                log.error("%s: internal error\n%s", name, traceback.format_exc())
-                _record(name, rc, f"internal error in the emulator: TypeError: {e}")
         except Exception as e:  # the GT layer never raises
             rc = code_for(e)
             if rc == CMD_NO_RESPONSE:
@@ -169,7 +170,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 _record(name, rc, f"internal error in the emulator: {type(e).__name__}: {e}")
             else:
                 _record(name, rc, str(e))
-        if ctl is None:
+        if ctl is None and isinstance(core, int):
             ctl = SESSION.controllers.get(core)
         if ctl is not None:
             ctl.clock.on_call()
@@ -177,19 +178,41 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     @functools.wraps(fn)
     def gt(*args: Any, **kwargs: Any) -> int:
-        return call(1, args, kwargs)
+        return call(_ONE, args, kwargs)
 
-    def gtn(core: int, *args: Any, **kwargs: Any) -> int:
-        return call(int(core), args, kwargs)
-
-    if needs_ctl:
-        sig = inspect.signature(fn)
-        gt.__signature__ = sig.replace(parameters=list(sig.parameters.values())[1:])  # type: ignore[attr-defined]
-    gtn.__name__ = "GTN_" + name[3:]
-    gtn.__doc__ = f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+    gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
+    gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt
-    REGISTRY[gtn.__name__] = gtn
+    if proto.gtn:
+
+        def gtn(*args: Any, **kwargs: Any) -> int:
+            if args:
+                return call(args[0], args[1:], kwargs)
+            return call(kwargs.pop("core", None), (), kwargs)
+
+        gtn.__name__ = "GTN_" + name[3:]
+        gtn.__doc__ = f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+        gtn.prototype = proto  # type: ignore[attr-defined]
+        REGISTRY[gtn.__name__] = gtn
     return gt
+
+
+_ONE = object()  # GT_x: core 1 without a check
+
+
+def _signature(proto: Proto, fn: Callable[..., Any]) -> inspect.Signature:
+    """The Python signature shown by help(): the table's parameters and defaults, then the
+    implementation's keyword-only options (GT_Open's ``eni=...``)."""
+    out = []
+    for p in proto.params:
+        try:
+            d = p.default_value()
+        except KeyError:
+            d = inspect.Parameter.empty
+        out.append(inspect.Parameter(p.name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=d))
+    kw = inspect.Parameter.KEYWORD_ONLY
+    out += [q for q in inspect.signature(fn).parameters.values() if q.kind is kw]
+    return inspect.Signature(out)
 
 
 def last_error() -> LastError | None:
@@ -197,143 +220,45 @@ def last_error() -> LastError | None:
 
 
 # --- pointer arguments ---------------------------------------------------------------------
-def _target(ptr: Any) -> Any:
-    if type(ptr).__name__ == "CArgObject":
-        return ptr._obj
-    return ptr
+# The binder (gtecat.gt.args) has turned every pointer argument into a Ref (or None for an
+# optional NULL); these are the implementations' ways to use them.
+def store(ptr: Ref | None, value: Any) -> None:
+    """``*ptr = value`` (None = an optional NULL pointer: nothing is written)."""
+    if ptr is not None:
+        ptr.store_values([value])
 
 
-def store(ptr: Any, value: Any) -> None:
-    """``*ptr = value`` for whatever pointer-like thing the caller passed (None = NULL)."""
-    if ptr is None:
-        return
-    t = _target(ptr)
-    if isinstance(t, ctypes._SimpleCData):
-        t.value = _fit(type(t), value)
-    elif isinstance(t, ctypes._Pointer | ctypes.Array):
-        t[0] = _fit(t._type_, value)
-    elif isinstance(t, np.ndarray):
-        t[0] = value
-    elif isinstance(t, list):
-        if t:
-            t[0] = value
-        else:
-            t.append(value)
-    elif isinstance(t, ctypes.Structure):
-        raise ParameterError(f"expected a pointer to a number, got a {type(t).__name__}")
-    elif hasattr(t, "value"):
-        t.value = value
-    else:
-        raise ParameterError(f"argument of type {type(ptr).__name__} is not a writable pointer")
+def store_array(ptr: Ref | None, values: list[Any]) -> None:
+    """``ptr[0..n-1] = values``; refused when the memory behind ``ptr`` is smaller."""
+    if ptr is not None:
+        ptr.store_values(values)
 
 
-_FLOAT_TYPES = (ctypes.c_float, ctypes.c_double, ctypes.c_longdouble)
+def load(ptr: Ref) -> Any:
+    """``*ptr``."""
+    return ptr.load_values(1)[0]
 
 
-def _fit(ctype: Any, value: Any) -> Any:
-    """A value for a ctypes slot: a float into an integer type (``c_long`` where the
-    prototype has ``double *``) is rounded, as a C conversion of the value would be."""
-    if (
-        isinstance(value, float)
-        and isinstance(ctype, type)
-        and issubclass(ctype, ctypes._SimpleCData)
-    ):
-        if not issubclass(ctype, _FLOAT_TYPES) and ctype._type_ not in "?cuzZPO":
-            return round(value)
-    return value
-
-
-def store_array(ptr: Any, values: list[Any]) -> None:
-    """Write ``values`` into an array argument (ctypes array, numpy, list, pointer)."""
-    if ptr is None:
-        return
-    t = _target(ptr)
-    if isinstance(t, ctypes._SimpleCData):
-        if len(values) > 1:
-            raise ParameterError(f"count {len(values)} needs an array, got a single value")
-        t.value = _fit(type(t), values[0])
-        return
-    if isinstance(t, ctypes.Array | np.ndarray | list | ctypes._Pointer):
-        if not isinstance(t, ctypes._Pointer) and len(t) < len(values):
-            if isinstance(t, list):
-                t.extend([0] * (len(values) - len(t)))
-            else:
-                raise ParameterError(f"array of {len(t)} too small for {len(values)} values")
-        elem = getattr(t, "_type_", None)
-        for i, v in enumerate(values):
-            t[i] = _fit(elem, v)
-        return
-    raise ParameterError(f"argument of type {type(ptr).__name__} is not a writable array")
-
-
-def load(ptr: Any) -> Any:
-    """``*ptr`` (or the value itself when a plain number is passed)."""
-    t = _target(ptr)
-    if isinstance(t, ctypes._SimpleCData):
-        return t.value
-    if isinstance(t, ctypes._Pointer | ctypes.Array | np.ndarray | list):
-        return t[0]
-    return t
-
-
-def store_bytes(ptr: Any, data: bytes) -> None:
+def store_bytes(ptr: Ref | None, data: bytes) -> None:
     """Copy raw bytes into a buffer argument (``unsigned char *pValue``)."""
     if ptr is None:
         raise ParameterError("pValue is NULL")
-    t = _target(ptr)
-    n = len(data)
-    if isinstance(t, ctypes._SimpleCData | ctypes.Array | ctypes.Structure):
-        if ctypes.sizeof(t) < n:
-            raise ParameterError(f"buffer of {ctypes.sizeof(t)} bytes too small for {n} bytes")
-        ctypes.memmove(ctypes.addressof(t), data, n)
-        return
-    if isinstance(t, ctypes._Pointer):
-        ctypes.memmove(t, data, n)
-        return
-    if isinstance(t, bytearray | memoryview):
-        if len(t) < n:
-            raise ParameterError(f"buffer of {len(t)} bytes too small for {n} bytes")
-        t[:n] = data
-        return
-    if isinstance(t, np.ndarray):
-        view = t.reshape(-1).view(np.uint8)
-        if view.size < n:
-            raise ParameterError(f"buffer of {view.size} bytes too small for {n} bytes")
-        view[:n] = np.frombuffer(data, dtype=np.uint8)
-        return
-    if isinstance(t, list):
-        t[:n] = list(data)
-        return
-    raise ParameterError(f"argument of type {type(ptr).__name__} is not a writable buffer")
+    ptr.store_bytes(data)
 
 
-def load_bytes(ptr: Any, n: int) -> bytes:
+def load_bytes(ptr: Ref | None, n: int) -> bytes:
     """Read ``n`` bytes from a buffer argument (``unsigned char *pValue``)."""
     if ptr is None:
         raise ParameterError("pValue is NULL")
-    t = _target(ptr)
-    if isinstance(t, bytes | bytearray | memoryview):
-        if len(t) < n:
-            raise ParameterError(f"buffer of {len(t)} bytes shorter than size {n}")
-        return bytes(t[:n])
-    if isinstance(t, ctypes._SimpleCData | ctypes.Array | ctypes.Structure):
-        if ctypes.sizeof(t) < n:
-            raise ParameterError(f"buffer of {ctypes.sizeof(t)} bytes shorter than size {n}")
-        return ctypes.string_at(ctypes.addressof(t), n)
-    if isinstance(t, ctypes._Pointer):
-        return ctypes.string_at(t, n)
-    if isinstance(t, np.ndarray):
-        b = t.reshape(-1).view(np.uint8)
-        if b.size < n:
-            raise ParameterError(f"buffer of {b.size} bytes shorter than size {n}")
-        return b[:n].tobytes()
-    if isinstance(t, list):
-        if len(t) < n:
-            raise ParameterError(f"buffer of {len(t)} bytes shorter than size {n}")
-        return bytes(int(v) & 0xFF for v in t[:n])
-    if isinstance(t, int) and n <= 8:
-        return (t & ((1 << (8 * n)) - 1)).to_bytes(n, "little")
-    raise ParameterError(f"argument of type {type(ptr).__name__} is not a readable buffer")
+    return ptr.load_bytes(n)
+
+
+def struct_arg(ptr: Ref | None, cls: type[ctypes.Structure], name: str) -> ctypes.Structure:
+    """The structure behind ``byref(s)``, ``pointer(s)``, ``s`` itself or a big enough buffer
+    (a caller's own class with the vendor layout works: the memory is viewed as ``cls``)."""
+    if ptr is None:
+        raise ParameterError(f"{name} is NULL")
+    return ptr.struct(cls)
 
 
 def check_range(name: str, value: int, lo: int, hi: int) -> int:

@@ -32,7 +32,6 @@ the profile at ``k · cycle``.
 
 from __future__ import annotations
 
-import ctypes
 import math
 from collections.abc import Callable
 from typing import Any
@@ -42,25 +41,13 @@ from ..controller.core import Controller
 from ..controller.profile import PrfMode
 from ..controller.resources import AxisResources, axes_in_mask, axis_resources, axis_span
 from ..errors import CommandError, ParameterError
-from ._core import _target, check_range, gt_function, store, store_array
+from ._core import check_range, gt_function, store, store_array, struct_arg
 from .structs import TJogPrm, TTrapPrm
 
 _MAX_ENCODERS_PER_CALL = 8
 
 
 # --- argument helpers ---------------------------------------------------------------------
-def struct_arg(ptr: Any, cls: type[ctypes.Structure], name: str) -> ctypes.Structure:
-    """The structure behind ``byref(s)``, ``pointer(s)`` or ``s`` itself."""
-    if ptr is None:
-        raise ParameterError(f"{name} is NULL")
-    t = _target(ptr)
-    if isinstance(t, ctypes._Pointer):
-        t = t.contents
-    if not isinstance(t, cls):
-        raise ParameterError(f"{name} must point to a {cls.__name__}, got {type(t).__name__}")
-    return t
-
-
 def real_arg(name: str, value: Any) -> float:
     try:
         x = float(value)

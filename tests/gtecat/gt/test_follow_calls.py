@@ -236,11 +236,13 @@ def test_settings_round_trip_defaults_and_memory():
     assert gt.GTN_FollowSpace(1, 2, byref(mem), 0) == 0 and mem.value == 512
 
 
-def test_float_master_points_within_1e6_of_a_pulse_are_taken_as_it():
+def test_a_float_master_segment_is_7_the_prototype_takes_a_long():
+    """long masterSegment (entry 20): a float is refused, as ctypes refuses it for the DLL."""
     up()
     assert gt.GT_PrfFollow(2) == 0
-    assert gt.GT_FollowData(2, 0.1 * 3 * 10000, 100.5) == 0, gt.GTE_GetLastError()
+    rc_reason(gt.GT_FollowData(2, 0.1 * 3 * 10000, 100.5), 7, "masterSegment", "integer")
     rc_reason(gt.GT_FollowData(2, 4000.5, 200), 7, "masterSegment")
+    assert gt.GT_FollowData(2, round(0.1 * 3 * 10000), 100.5) == 0, gt.GTE_GetLastError()
 
 
 # --- return codes ------------------------------------------------------------------------------

@@ -241,9 +241,10 @@ def test_drive_following_error_fault_raises_the_alarm():
     """The drive's own following-error window (6065h) trips: an alarm, not bit 4."""
     up()
     on()
-    assert gt.GT_SetPosErr(1, 2147483648) == 0
+    assert gt.GT_SetPosErr(1, 2147483648) == 7  # long is 32 bits (entry 116)
+    assert gt.GT_SetPosErr(1, 2147483647) == 0
     err = c_long()
-    assert gt.GT_GetPosErr(1, byref(err)) == 0 and err.value == 2147483648
+    assert gt.GT_GetPosErr(1, byref(err)) == 0 and err.value == 2147483647
     window = (c_ubyte * 4)(*(30).to_bytes(4, "little"))  # 6065h = 30 counts
     assert gt.GT_EcatSDODownload(0, 0x6065, 0, window, 4) == 0
     assert trap(1, 100000, 60, 500) == 0  # far beyond what the motor can accelerate

@@ -1,0 +1,534 @@
+"""Argument handling of every GT function, compiled from the function table.
+
+One binder per function (:func:`binder`) turns what the caller passed into
+checked values before the implementation runs, the same way for every
+function (issue "the API boundary"):
+
+* integer parameters take ints (numpy ints, ctypes integers, bools as C
+  would); a float is accepted only where the C parameter is a ``double``;
+  nan, inf, None and text are refused; a value outside the C type (``long``
+  is the vendor's 32 bits) or the table's range is refused - never truncated;
+* a pointer becomes a :class:`Ref`: the memory it points into is resolved to
+  the ctypes object that owns it (``byref``, ``pointer``, ``cast``, arrays,
+  ``create_string_buffer``, structures), so a write never goes past what that
+  object owns; too small is refused with both sizes; a raw integer address is
+  refused (its size cannot be known); Python containers (list, bytearray,
+  memoryview, numpy arrays, bytes for inputs) work too;
+* optional pointers accept ``None``, ``0`` and NULL ctypes pointers (they
+  reach the implementation as ``None``); a required one given NULL is refused;
+* parameter names as the manual writes them work as keywords;
+* text parameters (``char *pFile``) take ``str``, ``bytes``, ``c_char_p`` or a
+  char buffer and reach the implementation as ``str``.
+
+Every refusal is a :class:`~gtecat.errors.ParameterError` (return code 7) that
+names the parameter, what was given and what is legal.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import inspect
+import math
+import numbers
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from . import structs
+from .table import SCALARS, Param, Proto
+
+_CArgObject = type(ctypes.byref(ctypes.c_int()))
+_SIMPLE = ctypes._SimpleCData
+_POINTER = ctypes._Pointer
+_NOT_NUMERIC = "?zZPOcu"  # ctypes codes of bool, char*, wchar*, void*, py_object, char, wchar
+_FLOAT_CODES = "fdg"
+
+
+def _struct_types() -> dict[str, type[ctypes.Structure]]:
+    from .bus_calls import TSlaveInfo  # defined beside its function
+
+    out = {n: getattr(structs, n) for n in structs.__all__}
+    out["TSlaveInfo"] = TSlaveInfo
+    return out
+
+
+class Ref:
+    """A checked pointer argument: the memory behind it and how much of it there is.
+
+    ``addr``/``nbytes`` describe ctypes memory (``elem`` its element type, None
+    for plain bytes); ``py`` holds a Python container instead.
+    """
+
+    __slots__ = ("_keep", "addr", "elem", "name", "nbytes", "py")
+
+    def __init__(
+        self,
+        name: str,
+        *,
+        addr: int = 0,
+        nbytes: int = 0,
+        elem: Any = None,
+        keep: Any = None,
+        py: Any = None,
+    ) -> None:
+        self.name, self.addr, self.nbytes, self.elem, self._keep, self.py = (
+            name,
+            addr,
+            nbytes,
+            elem,
+            keep,
+            py,
+        )
+
+    # --- sizes ----------------------------------------------------------------------------
+    def capacity(self) -> int:
+        """Elements of ``elem`` behind the pointer (bytes for a byte buffer)."""
+        if self.py is not None:
+            if isinstance(self.py, np.ndarray):
+                return self.py.size
+            return len(self.py)
+        size = ctypes.sizeof(self.elem) if self.elem is not None else 1
+        return self.nbytes // size
+
+    def byte_capacity(self) -> int:
+        if self.py is not None:
+            if isinstance(self.py, np.ndarray):
+                return self.py.nbytes
+            if isinstance(self.py, list):
+                return len(self.py)
+            return memoryview(self.py).nbytes
+        return self.nbytes
+
+    def growable(self) -> bool:
+        return isinstance(self.py, list)
+
+    # --- values ---------------------------------------------------------------------------
+    def store_values(self, values: list[Any]) -> None:
+        n = len(values)
+        if self.py is not None:
+            t = self.py
+            if isinstance(t, list):
+                if len(t) < n:
+                    t.extend([0] * (n - len(t)))
+                t[:n] = values
+                return
+            if isinstance(t, np.ndarray):
+                flat = t.reshape(-1)
+                if flat.size < n:
+                    raise ParameterError(f"{self.name}: array of {flat.size} too small for {n}")
+                flat[:n] = values
+                return
+            raise ParameterError(f"{self.name}: a byte buffer cannot take numbers")
+        have = self.capacity()
+        if have < n:
+            raise ParameterError(
+                f"{self.name}: {self.nbytes} bytes behind the pointer hold {have} "
+                f"{_elem_name(self.elem)}, {n} needed"
+            )
+        elem = self.elem
+        if elem is None or not issubclass(elem, _SIMPLE) or elem._type_ in _NOT_NUMERIC:
+            raise ParameterError(f"{self.name}: points to {_elem_name(elem)}, not to numbers")
+        size = ctypes.sizeof(elem)
+        for i, v in enumerate(values):
+            elem.from_address(self.addr + i * size).value = fit(elem, v)
+
+    def load_values(self, n: int) -> list[Any]:
+        if self.py is not None:
+            t = self.py
+            if isinstance(t, np.ndarray):
+                t = t.reshape(-1)
+            if len(t) < n:
+                raise ParameterError(f"{self.name}: {len(t)} element(s), {n} needed")
+            return [t[i] for i in range(n)]
+        if self.capacity() < n:
+            raise ParameterError(f"{self.name}: {self.capacity()} element(s), {n} needed")
+        elem = self.elem
+        if elem is None or not issubclass(elem, _SIMPLE):
+            return list(ctypes.string_at(self.addr, n))
+        size = ctypes.sizeof(elem)
+        return [elem.from_address(self.addr + i * size).value for i in range(n)]
+
+    # --- bytes ------------------------------------------------------------------------------
+    def store_bytes(self, data: bytes) -> None:
+        n = len(data)
+        have = self.byte_capacity()
+        if have < n and not self.growable():
+            raise ParameterError(f"{self.name}: buffer of {have} bytes too small for {n} bytes")
+        if self.py is None:
+            ctypes.memmove(self.addr, data, n)
+            return
+        t = self.py
+        if isinstance(t, list):
+            if len(t) < n:
+                t.extend([0] * (n - len(t)))
+            t[:n] = list(data)
+        elif isinstance(t, np.ndarray):
+            t.reshape(-1).view(np.uint8)[:n] = np.frombuffer(data, dtype=np.uint8)
+        else:
+            memoryview(t).cast("B")[:n] = data
+
+    def load_bytes(self, n: int) -> bytes:
+        have = self.byte_capacity()
+        if have < n:
+            raise ParameterError(f"{self.name}: buffer of {have} bytes shorter than size {n}")
+        if self.py is None:
+            return ctypes.string_at(self.addr, n)
+        t = self.py
+        if isinstance(t, list):
+            try:
+                return bytes(int(v) & 0xFF for v in t[:n])
+            except (TypeError, ValueError):
+                raise ParameterError(f"{self.name}: list holds non-integers") from None
+        if isinstance(t, np.ndarray):
+            return t.reshape(-1).view(np.uint8)[:n].tobytes()
+        return bytes(memoryview(t).cast("B")[:n])
+
+    def struct(self, cls: type[ctypes.Structure]) -> ctypes.Structure:
+        """The memory seen as ``cls`` (the caller's own same-layout class works too)."""
+        need = ctypes.sizeof(cls)
+        if self.byte_capacity() < need:
+            raise ParameterError(
+                f"{self.name}: {self.byte_capacity()} bytes behind the pointer, "
+                f"a {cls.__name__} needs {need}"
+            )
+        if self.py is None:
+            return cls.from_address(self.addr)
+        if isinstance(self.py, bytes):
+            return cls.from_buffer_copy(self.py)
+        try:
+            return cls.from_buffer(self.py)
+        except (TypeError, ValueError) as e:
+            raise ParameterError(f"{self.name}: cannot view as {cls.__name__}: {e}") from None
+
+
+def _elem_name(elem: Any) -> str:
+    if elem is None:
+        return "bytes"
+    return getattr(elem, "__name__", str(elem))
+
+
+def fit(ctype: Any, value: Any) -> Any:
+    """A value for a ctypes slot: a float into an integer type (``c_long`` where the
+    prototype has ``double *``) is rounded, as a C conversion of the value would be."""
+    if isinstance(value, float) and ctype._type_ not in _FLOAT_CODES:
+        if not math.isfinite(value):
+            return 0
+        return round(value)
+    return value
+
+
+# --- resolving pointers --------------------------------------------------------------------------
+def _null(value: Any) -> bool:
+    if value is None or value is False:
+        return True
+    if isinstance(value, int) and not isinstance(value, bool) and value == 0:
+        return True
+    if isinstance(value, _POINTER):
+        return not bool(value)
+    if isinstance(value, ctypes.c_void_p | ctypes.c_char_p | ctypes.c_wchar_p):
+        return value.value is None
+    return False
+
+
+def _owner(objects: Any, addr: int) -> Any:
+    """The ctypes object among ``objects`` (a pointer's keep-alive tree) holding ``addr``."""
+    stack = [objects]
+    seen = 0
+    while stack and seen < 1000:
+        o = stack.pop()
+        seen += 1
+        if isinstance(o, dict):
+            stack.extend(o.values())
+        elif isinstance(o, ctypes._CData):
+            try:
+                start = ctypes.addressof(o)
+            except TypeError:
+                continue
+            if start <= addr < start + ctypes.sizeof(o):
+                return o
+            b = getattr(o, "_objects", None)
+            if b:
+                stack.append(b)
+    return None
+
+
+def _element_type(obj: Any) -> Any:
+    if isinstance(obj, ctypes.Array):
+        t = obj._type_
+        while issubclass(t, ctypes.Array):
+            t = t._type_
+        return t
+    return type(obj)
+
+
+def resolve(name: str, value: Any) -> Ref:
+    """A :class:`Ref` for a non-NULL pointer-like argument (ParameterError if none fits)."""
+    if isinstance(value, _CArgObject):
+        obj = value._obj
+        addr = ctypes.memmove(value, value, 0)
+        start = ctypes.addressof(obj)
+        nbytes = start + ctypes.sizeof(obj) - addr
+        if not 0 <= addr - start <= ctypes.sizeof(obj):
+            raise ParameterError(f"{name}: byref offset outside its object")
+        return Ref(name, addr=addr, nbytes=nbytes, elem=_element_type(obj), keep=obj)
+    if isinstance(value, _POINTER):
+        addr = ctypes.cast(value, ctypes.c_void_p).value or 0
+        owner = _owner(getattr(value, "_objects", None), addr)
+        if owner is None:
+            raise ParameterError(
+                f"{name}: the pointer leads into memory that no Python object owns, so its "
+                "size cannot be checked; pass byref(x), pointer(x) or an array"
+            )
+        nbytes = ctypes.addressof(owner) + ctypes.sizeof(owner) - addr
+        return Ref(name, addr=addr, nbytes=nbytes, elem=value._type_, keep=owner)
+    if isinstance(value, ctypes.Array | ctypes.Structure | ctypes.Union):
+        return Ref(
+            name,
+            addr=ctypes.addressof(value),
+            nbytes=ctypes.sizeof(value),
+            elem=_element_type(value),
+            keep=value,
+        )
+    if isinstance(value, _SIMPLE):
+        if value._type_ in "zZP":
+            raise ParameterError(
+                f"{name}: a {type(value).__name__} is a pointer value; pass a buffer "
+                "(create_string_buffer) or byref(x)"
+            )
+        return Ref(
+            name,
+            addr=ctypes.addressof(value),
+            nbytes=ctypes.sizeof(value),
+            elem=type(value),
+            keep=value,
+        )
+    if isinstance(value, np.ndarray):
+        if not value.flags.c_contiguous:
+            raise ParameterError(f"{name}: numpy array must be C-contiguous")
+        return Ref(name, py=value)
+    if isinstance(value, list | bytearray | memoryview | bytes):
+        return Ref(name, py=value)
+    if isinstance(value, bool | int):
+        raise ParameterError(
+            f"{name}={value!r}: a raw address is not accepted (its size cannot be checked); "
+            "pass byref(x), pointer(x) or an array"
+        )
+    raise ParameterError(f"{name}: a {type(value).__name__} is not a pointer argument")
+
+
+# --- scalars --------------------------------------------------------------------------------------
+def _integer(p: Param, value: Any) -> int:
+    v = value
+    if isinstance(v, _SIMPLE) and v._type_ not in "zZPO":
+        v = v.value
+        if isinstance(v, bytes) and len(v) == 1:
+            v = v[0]
+    if isinstance(v, bool | np.bool_):
+        return int(v)
+    if isinstance(v, numbers.Integral):
+        v = int(v)
+    elif isinstance(v, float | np.floating):
+        raise ParameterError(f"{p.name}={value!r}: an integer is needed ({p.ctype}), not a float")
+    else:
+        raise ParameterError(f"{p.name}={value!r}: an integer is needed ({p.ctype})")
+    _, lo, hi, _ = SCALARS[p.ctype]
+    if p.mask:
+        lo = min(lo, -(1 << 31))
+        hi = max(hi, (1 << 32) - 1)
+    if not lo <= v <= hi:
+        raise ParameterError(f"{p.name}={v} out of range {lo}..{hi} ({p.ctype})")
+    if p.lo is not None and not p.lo <= v <= p.hi:  # type: ignore[operator]
+        raise ParameterError(f"{p.name}={v} out of range {p.lo:g}..{p.hi:g}")
+    if p.mask and v < 0:
+        v &= 0xFFFFFFFF
+    return v
+
+
+def _real(p: Param, value: Any) -> float:
+    v = value
+    if isinstance(v, _SIMPLE) and v._type_ not in "zZPOc":
+        v = v.value
+    if isinstance(v, bool | np.bool_ | numbers.Real) and not isinstance(v, str):
+        try:
+            x = float(v)
+        except (OverflowError, ValueError, TypeError):
+            raise ParameterError(f"{p.name}={value!r} is not a number") from None
+    else:
+        raise ParameterError(f"{p.name}={value!r}: a number is needed (double)")
+    if not math.isfinite(x):
+        raise ParameterError(f"{p.name}={value!r} must be finite")
+    if p.lo is not None and not p.lo <= x <= p.hi:  # type: ignore[operator]
+        raise ParameterError(f"{p.name}={x:g} out of range {p.lo:g}..{p.hi:g}")
+    return x
+
+
+_TEXT_MAX = 4096
+
+
+def _text(p: Param, value: Any) -> str:
+    v = value
+    if isinstance(v, ctypes.c_char_p | ctypes.c_wchar_p):
+        v = v.value
+    elif isinstance(v, ctypes.Array) and v._type_ in (ctypes.c_char, ctypes.c_wchar):
+        v = v.value
+    elif isinstance(v, _CArgObject | _POINTER | ctypes.Array):
+        ref = resolve(p.name, v)  # read what the buffer owns, up to its NUL
+        v = ref.load_bytes(min(ref.byte_capacity(), _TEXT_MAX)).split(b"\0", 1)[0]
+    if hasattr(v, "__fspath__"):
+        v = str(v.__fspath__())
+    if isinstance(v, bytes | bytearray):
+        v = bytes(v).split(b"\0", 1)[0]
+        try:
+            v = v.decode("utf-8")
+        except UnicodeDecodeError:
+            v = v.decode("gbk", "replace")  # Chinese Windows paths
+    if not isinstance(v, str):
+        raise ParameterError(f"{p.name}={value!r}: text is needed (char *)")
+    if "\0" in v:
+        v = v.split("\0", 1)[0]
+    if len(v) > _TEXT_MAX:
+        raise ParameterError(f"{p.name}: text of {len(v)} characters, at most {_TEXT_MAX}")
+    return v
+
+
+# --- the binder ----------------------------------------------------------------------------------
+Converter = Callable[[Any], Any]
+
+
+def _converter(p: Param) -> Converter:
+    if p.pointer and p.text and p.direction == "in":
+        return lambda v: None if v is None and p.optional else _text(p, v)
+    if p.pointer:
+
+        def conv(v: Any) -> Any:
+            if _null(v):
+                if p.optional:
+                    return None
+                raise ParameterError(f"{p.name} is NULL; this pointer is required")
+            return resolve(p.name, v)
+
+        return conv
+    if p.is_float:
+        return lambda v: _real(p, v)
+    return lambda v: _integer(p, v)
+
+
+def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tuple[list, dict]]:
+    """``bind(args, kwargs) -> (positional, extra keywords)`` for ``impl`` per ``proto``.
+
+    The implementation receives the table's parameters positionally, converted;
+    keyword-only parameters of ``impl`` that the table does not know (GT_Open's
+    ``eni=...``) pass through as keywords.
+    """
+    params = proto.params
+    names = [p.name for p in params]
+    index = {n: i for i, n in enumerate(names)}
+    convs = [_converter(p) for p in params]
+    defaults: list[Any] = []
+    for p in params:
+        try:
+            defaults.append(p.default_value())
+        except KeyError:  # an optional pointer left out is NULL (Python callers omit them)
+            defaults.append(None if p.optional else _MISSING)
+    sig = inspect.signature(impl)
+    impl_names = [
+        n for n, q in sig.parameters.items() if q.kind is not q.KEYWORD_ONLY and n != "ctl"
+    ]
+    aliases = {a: names[i] for i, a in enumerate(impl_names[: len(names)]) if a != names[i]}
+    extra_kw = {n for n, q in sig.parameters.items() if q.kind is q.KEYWORD_ONLY}
+    counted = [
+        (i, index[p.count] if isinstance(p.count, str) else None, p.count)
+        for i, p in enumerate(params)
+        if p.pointer and not p.text
+    ]
+    n_params = len(params)
+    core_first = proto.core_first_form
+
+    def bind(args: tuple, kwargs: dict) -> tuple[list, dict]:
+        if core_first and len(args) == n_params + 1:
+            # manual 5.2.2.5 prints GT_EcatIOReadInput(core, slave, ...): the core first
+            core = _integer(_CORE, args[0])
+            if core != 1:
+                raise ParameterError(f"core={core}: the EtherCAT core is 1")
+            args = args[1:]
+        if len(args) > n_params:
+            raise ParameterError(
+                f"{len(args)} arguments given; {proto.name} takes {n_params} "
+                f"({', '.join(names) or 'none'})"
+            )
+        values = list(args) + [_MISSING] * (n_params - len(args))
+        extra = {}
+        for k, v in kwargs.items():
+            i = index.get(k)
+            if i is None and k in aliases:
+                i = index[aliases[k]]
+            if i is None:
+                if k in extra_kw:
+                    extra[k] = v
+                    continue
+                raise ParameterError(
+                    f"{proto.name} has no parameter {k!r} (it takes {', '.join(names)})"
+                )
+            if values[i] is not _MISSING:
+                raise ParameterError(f"{proto.name}: {k} given twice")
+            values[i] = v
+        out = []
+        for i in range(n_params):
+            v = values[i]
+            if v is _MISSING:
+                v = defaults[i]
+                if v is _MISSING:
+                    raise ParameterError(
+                        f"bad arguments: {names[i]} is missing ({proto.name} takes "
+                        f"{', '.join(names)})"
+                    )
+                if v is None:
+                    out.append(None)
+                    continue
+            out.append(convs[i](v))
+        for i, ci, count in counted:
+            ref = out[i]
+            if ref is None:
+                continue
+            n = out[ci] if ci is not None else count
+            if not isinstance(n, int) or n <= 0:
+                continue
+            _check_room(params[i], ref, n)
+        return out, extra
+
+    return bind
+
+
+def _check_room(p: Param, ref: Ref, n: int) -> None:
+    """Refuse a pointer that cannot hold the ``n`` elements the call moves."""
+    if p.ctype in ("unsigned char", "char") or p.is_struct:
+        if p.is_struct:
+            return  # sized when viewed as the structure
+        have = ref.byte_capacity()
+        if have < n and not (ref.growable() and p.direction == "out"):
+            raise ParameterError(f"{p.name}: buffer of {have} bytes, the call moves {n}")
+        return
+    have = ref.capacity()
+    if have < n and not (ref.growable() and p.direction == "out"):
+        raise ParameterError(
+            f"{p.name}: room for {have} value(s) behind the pointer, the call needs {n}"
+        )
+
+
+class _Missing:
+    def __repr__(self) -> str:
+        return "<missing>"
+
+
+_MISSING: Any = _Missing()
+_CORE = Param("core", "short")
+
+
+def core_arg(value: Any) -> int:
+    """The ``short core`` of a ``GTN_*`` call, checked like any argument."""
+    return _integer(_CORE, value)
+
+
+__all__ = ["Ref", "binder", "core_arg", "fit", "resolve"]
