@@ -42,6 +42,7 @@ from .table import SCALARS, Param, Proto
 _CArgObject = type(ctypes.byref(ctypes.c_int()))
 _SIMPLE = ctypes._SimpleCData
 _POINTER = ctypes._Pointer
+_CDATA = ctypes._SimpleCData.__mro__[1]  # ctypes._CData, the base of every ctypes instance
 _NOT_NUMERIC = "?zZPOcu"  # ctypes codes of bool, char*, wchar*, void*, py_object, char, wchar
 _FLOAT_CODES = "fdg"
 
@@ -241,7 +242,7 @@ def _owner(objects: Any, addr: int) -> Any:
         seen += 1
         if isinstance(o, dict):
             stack.extend(o.values())
-        elif isinstance(o, ctypes._CData):
+        elif isinstance(o, _CDATA):
             try:
                 start = ctypes.addressof(o)
             except TypeError:
