@@ -236,18 +236,17 @@ def _null(value: Any) -> bool:
 def _owner(objects: Any, addr: int) -> Any:
     """The ctypes object among ``objects`` (a pointer's keep-alive tree) holding ``addr``."""
     stack = [objects]
-    seen = 0
-    while stack and seen < 1000:
+    seen: set[int] = set()
+    while stack and len(seen) < 1000:
         o = stack.pop()
-        seen += 1
+        if id(o) in seen:
+            continue
+        seen.add(id(o))
         if isinstance(o, dict):
             stack.extend(o.values())
         elif isinstance(o, _CDATA):
-            try:
-                start = ctypes.addressof(o)
-            except TypeError:
-                continue
-            if start <= addr < start + ctypes.sizeof(o):
+            start = ctypes.addressof(o)
+            if start <= addr < start + ctypes.sizeof(o) and not isinstance(o, _POINTER):
                 return o
             b = getattr(o, "_objects", None)
             if b:
@@ -275,7 +274,9 @@ def resolve(name: str, value: Any) -> Ref:
             raise ParameterError(f"{name}: byref offset outside its object")
         return Ref(name, addr=addr, nbytes=nbytes, elem=_element_type(obj), keep=obj)
     if isinstance(value, _POINTER):
-        addr = ctypes.cast(value, ctypes.c_void_p).value or 0
+        addr = (
+            ctypes.memmove(value, value, 0) or 0
+        )  # the pointer's value, without cast()'s side effects
         owner = _owner(getattr(value, "_objects", None), addr)
         if owner is None:
             raise ParameterError(
