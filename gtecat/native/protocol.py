@@ -1,0 +1,185 @@
+"""The controller protocol: one request and one reply per GT call, over a stream socket.
+
+Both ends are generated from the function table (:mod:`gtecat.gt.table`): the C stubs
+of ``libgts.so`` (:mod:`gtecat.native.stubs`) encode a call the way this module reads
+it, and the controller (:mod:`gtecat.native.server`) decodes it with the plan below.
+The two ends run on one machine, so numbers travel little-endian in the client's own
+C sizes (``long`` is the client's ``long``, announced in the hello).
+
+Every message is a frame: ``u32 length`` then ``length`` bytes of body.
+
+Client -> controller, first message of a connection (``HELLO``)::
+
+    u8 type = 1, 3 pad, u16 protocol version, u16 sizeof(long), char digest[16]
+
+``digest`` names the table, the protocol and the structure layouts the library was
+built from; the controller refuses a library built from another table (reply status 1
+with the reason).  Reply (``HELLO_REPLY``): ``i16 status, u16 text length, text``.
+
+A call (``CALL``)::
+
+    u8 type = 2, u8 gtn (1: GTN_x, the core is checked; 0: GT_x / GTE_x),
+    u16 function id (index in :data:`FUNCTION_NAMES`), i16 core,
+    then every parameter in prototype order:
+      integer scalar: i64            double: f64
+      pointer: i32 size, then ``size`` bytes: the memory behind the pointer
+        (in, inout and out alike, so bytes a call leaves alone come back unchanged);
+        size -1 = NULL, -2 = size unknown (``out[?]``: the call decides),
+        -3 = larger than :data:`MAX_POINTER_BYTES` (refused by the call's room check)
+      text (``char *`` in): i32 size with the NUL, the bytes
+
+Reply (``REPLY``)::
+
+    i16 return code, u16 number of out blocks, u16 error text length,
+    per non-NULL out/inout pointer in prototype order: u32 size, bytes,
+    then the error text (UTF-8; only when the code is not 0 and the call said why)
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from enum import IntEnum
+from functools import cache
+
+from ..gt.table import FUNCTIONS, PROTOTYPES, Param, Proto
+from . import cdecl
+
+PROTOCOL_VERSION = 1
+
+FRAME = struct.Struct("<I")
+HELLO = struct.Struct("<B3xHH16s")
+HELLO_REPLY = struct.Struct("<hH")
+CALL = struct.Struct("<BBHh")
+REPLY = struct.Struct("<hHH")
+I64 = struct.Struct("<q")
+F64 = struct.Struct("<d")
+PTR = struct.Struct("<i")
+BLOCK = struct.Struct("<I")
+
+MSG_HELLO = 1
+MSG_CALL = 2
+
+PTR_NULL = -1
+PTR_UNKNOWN = -2
+PTR_TOO_BIG = -3
+
+#: the largest pointer block a client sends (a bigger count is refused as out of room)
+MAX_POINTER_BYTES = 16 << 20
+#: the largest frame either end accepts
+MAX_FRAME = MAX_POINTER_BYTES * 4
+
+
+class Kind(IntEnum):
+    """How one parameter travels (the C stubs use the same numbers)."""
+
+    INT = 0
+    DOUBLE = 1
+    IN = 2
+    OUT = 3
+    INOUT = 4
+    TEXT = 5
+    OUT_ANY = 6  #: ``out[?]``: the call decides how many bytes it writes
+
+
+@dataclass(frozen=True, slots=True)
+class ArgPlan:
+    """One parameter of a function as the wire carries it."""
+
+    param: Param
+    kind: Kind
+    count: int  #: fixed element count (pointers; 0 when ``count_arg`` says)
+    count_arg: int  #: index of the parameter holding the count, -1 if fixed
+
+    @property
+    def carries_back(self) -> bool:
+        return self.kind in (Kind.OUT, Kind.INOUT, Kind.OUT_ANY)
+
+
+@dataclass(frozen=True, slots=True)
+class FunctionPlan:
+    name: str
+    fid: int
+    proto: Proto
+    args: tuple[ArgPlan, ...]
+    #: why the call cannot travel (a structure with pointers), None when it can
+    unsupported: str | None = None
+
+
+def _kind(p: Param) -> Kind:
+    if not p.pointer:
+        return Kind.DOUBLE if p.is_float else Kind.INT
+    if p.text and p.direction == "in":
+        return Kind.TEXT
+    if p.count == 0:
+        return Kind.OUT_ANY
+    return {"in": Kind.IN, "out": Kind.OUT, "inout": Kind.INOUT}[p.direction]
+
+
+def _plan(proto: Proto, fid: int) -> FunctionPlan:
+    index = {p.name: i for i, p in enumerate(proto.params)}
+    args = []
+    unsupported = None
+    for p in proto.params:
+        kind = _kind(p)
+        if isinstance(p.count, str):
+            count, count_arg = 0, index[p.count]
+        else:
+            count, count_arg = int(p.count), -1
+        args.append(ArgPlan(p, kind, count, count_arg))
+        if p.pointer and p.is_struct:
+            try:
+                cls = cdecl.structure(p.ctype)
+            except KeyError:
+                raise cdecl.CDeclError(
+                    f"{proto.name}: the table names structure {p.ctype}, but gtecat.gt "
+                    "exports no ctypes structure of that name"
+                ) from None
+            if cdecl.has_pointers(cls):
+                unsupported = (
+                    f"{proto.name}: {p.ctype} holds pointers, which mean nothing in the "
+                    "controller process; not available through libgts"
+                )
+    return FunctionPlan(proto.name, fid, proto, tuple(args), unsupported)
+
+
+#: function ids: the table's names in sorted order
+FUNCTION_NAMES: tuple[str, ...] = tuple(sorted(FUNCTIONS))
+
+
+@cache
+def plans() -> tuple[FunctionPlan, ...]:
+    return tuple(_plan(FUNCTIONS[n], i) for i, n in enumerate(FUNCTION_NAMES))
+
+
+@cache
+def table_digest() -> str:
+    """16 hex digits naming the table, this protocol and the structure layouts."""
+    return cdecl.digest(PROTOTYPES, str(PROTOCOL_VERSION), cdecl.layout_text())
+
+
+__all__ = [
+    "BLOCK",
+    "CALL",
+    "F64",
+    "FRAME",
+    "FUNCTION_NAMES",
+    "HELLO",
+    "HELLO_REPLY",
+    "I64",
+    "MAX_FRAME",
+    "MAX_POINTER_BYTES",
+    "MSG_CALL",
+    "MSG_HELLO",
+    "PROTOCOL_VERSION",
+    "PTR",
+    "PTR_NULL",
+    "PTR_TOO_BIG",
+    "PTR_UNKNOWN",
+    "REPLY",
+    "ArgPlan",
+    "FunctionPlan",
+    "Kind",
+    "plans",
+    "table_digest",
+]
