@@ -67,21 +67,18 @@ class Ref:
     def __init__(
         self,
         name: str,
-        *,
         addr: int = 0,
         nbytes: int = 0,
         elem: Any = None,
         keep: Any = None,
         py: Any = None,
     ) -> None:
-        self.name, self.addr, self.nbytes, self.elem, self._keep, self.py = (
-            name,
-            addr,
-            nbytes,
-            elem,
-            keep,
-            py,
-        )
+        self.name = name
+        self.addr = addr
+        self.nbytes = nbytes
+        self.elem = elem
+        self._keep = keep
+        self.py = py
 
     # --- sizes ----------------------------------------------------------------------------
     def capacity(self) -> int:
@@ -107,6 +104,15 @@ class Ref:
 
     # --- values ---------------------------------------------------------------------------
     def store_values(self, values: list[Any]) -> None:
+        keep = self._keep
+        if (
+            len(values) == 1
+            and type(keep) is self.elem
+            and self.nbytes == ctypes.sizeof(keep)
+            and keep._type_ not in _NOT_NUMERIC
+        ):
+            keep.value = fit(self.elem, values[0])  # byref(x) / x itself: the common case
+            return
         n = len(values)
         if self.py is not None:
             t = self.py
@@ -233,6 +239,15 @@ def _null(value: Any) -> bool:
     return False
 
 
+_memmove = ctypes.memmove
+_sizeof = ctypes.sizeof
+
+
+def _address(arg: Any) -> int:
+    """Where ``byref(x[, offset])`` or a ctypes pointer points (memmove of 0 bytes returns it)."""
+    return _memmove(arg, arg, 0) or 0
+
+
 def _owner(objects: Any, addr: int) -> Any:
     """The ctypes object among ``objects`` (a pointer's keep-alive tree) holding ``addr``."""
     stack = [objects]
@@ -267,7 +282,7 @@ def resolve(name: str, value: Any) -> Ref:
     """A :class:`Ref` for a non-NULL pointer-like argument (ParameterError if none fits)."""
     if isinstance(value, _CArgObject):
         obj = value._obj
-        addr = ctypes.memmove(value, value, 0)
+        addr = _address(value)
         start = ctypes.addressof(obj)
         nbytes = start + ctypes.sizeof(obj) - addr
         if not 0 <= addr - start <= ctypes.sizeof(obj):
@@ -399,22 +414,59 @@ def _text(p: Param, value: Any) -> str:
 Converter = Callable[[Any], Any]
 
 
+def _int_converter(p: Param) -> Converter:
+    """The integer check of ``p`` with its bounds precomputed; plain ints take the fast path."""
+    _, lo, hi, _ = SCALARS[p.ctype]
+    if p.mask:
+        lo, hi = min(lo, -(1 << 31)), max(hi, (1 << 32) - 1)
+    if p.lo is not None:
+        lo, hi = max(lo, int(p.lo)), min(hi, int(p.hi))  # type: ignore[arg-type]
+    mask = p.mask
+
+    def conv(v: Any) -> int:
+        if type(v) is int and lo <= v <= hi:
+            return v & 0xFFFFFFFF if mask and v < 0 else v
+        return _integer(p, v)
+
+    return conv
+
+
+def _pointer_converter(p: Param) -> Converter:
+    name, optional = p.name, p.optional
+
+    def conv(v: Any) -> Any:
+        if type(v) is _CArgObject:  # byref(x): the common case
+            obj = v._obj
+            addr = _address(v)
+            start = ctypes.addressof(obj)
+            size = ctypes.sizeof(obj)
+            if start <= addr <= start + size:
+                elem = obj._type_ if isinstance(obj, ctypes.Array) else type(obj)
+                if isinstance(elem, type) and issubclass(elem, ctypes.Array):
+                    elem = _element_type(obj)
+                return Ref(name, addr, start + size - addr, elem, obj)
+        if _null(v):
+            if optional:
+                return None
+            raise ParameterError(f"{name} is NULL; this pointer is required")
+        return resolve(name, v)
+
+    return conv
+
+
 def _converter(p: Param) -> Converter:
     if p.pointer and p.text and p.direction == "in":
         return lambda v: None if v is None and p.optional else _text(p, v)
     if p.pointer:
-
-        def conv(v: Any) -> Any:
-            if _null(v):
-                if p.optional:
-                    return None
-                raise ParameterError(f"{p.name} is NULL; this pointer is required")
-            return resolve(p.name, v)
-
-        return conv
+        return _pointer_converter(p)
     if p.is_float:
-        return lambda v: _real(p, v)
-    return lambda v: _integer(p, v)
+        return lambda v: (
+            v if type(v) is float and -_INF < v < _INF and p.lo is None else _real(p, v)
+        )
+    return _int_converter(p)
+
+
+_INF = float("inf")
 
 
 def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tuple[list, dict]]:
@@ -440,15 +492,28 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
     ]
     aliases = {a: names[i] for i, a in enumerate(impl_names[: len(names)]) if a != names[i]}
     extra_kw = {n for n, q in sig.parameters.items() if q.kind is q.KEYWORD_ONLY}
+    # pointers whose room is checked after conversion: counted by another argument, or by a
+    # fixed count; a byref() of one scalar holds one element by construction
     counted = [
         (i, index[p.count] if isinstance(p.count, str) else None, p.count)
         for i, p in enumerate(params)
-        if p.pointer and not p.text
+        if p.pointer and not p.text and p.count != 0
     ]
     n_params = len(params)
     core_first = proto.core_first_form
 
-    def bind(args: tuple, kwargs: dict) -> tuple[list, dict]:
+    tails = [tuple(defaults[n:]) for n in range(n_params + 1)]
+    first_missing = [
+        next((i for i in range(n, n_params) if defaults[i] is _MISSING), None)
+        for n in range(n_params + 1)
+    ]
+
+    def missing(i: int) -> ParameterError:
+        return ParameterError(
+            f"bad arguments: {names[i]} is missing ({proto.name} takes {', '.join(names)})"
+        )
+
+    def slow(args: tuple, kwargs: dict) -> tuple[list, dict]:
         if core_first and len(args) == n_params + 1:
             # manual 5.2.2.5 prints GT_EcatIOReadInput(core, slave, ...): the core first
             core = _integer(_CORE, args[0])
@@ -476,28 +541,33 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
             if values[i] is not _MISSING:
                 raise ParameterError(f"{proto.name}: {k} given twice")
             values[i] = v
-        out = []
         for i in range(n_params):
-            v = values[i]
-            if v is _MISSING:
-                v = defaults[i]
-                if v is _MISSING:
-                    raise ParameterError(
-                        f"bad arguments: {names[i]} is missing ({proto.name} takes "
-                        f"{', '.join(names)})"
-                    )
-                if v is None:
-                    out.append(None)
-                    continue
-            out.append(convs[i](v))
+            if values[i] is _MISSING:
+                values[i] = defaults[i]
+                if values[i] is _MISSING:
+                    raise missing(i)
+        return values, extra
+
+    def bind(args: tuple, kwargs: dict) -> tuple[list, dict]:
+        n = len(args)
+        extra: dict = {}
+        if kwargs or n > n_params:
+            values, extra = slow(args, kwargs)
+        elif n == n_params:
+            values = args
+        else:
+            if first_missing[n] is not None:
+                raise missing(first_missing[n])
+            values = args + tails[n]
+        out = [c(v) for c, v in zip(convs, values)]  # noqa: B905 - one value per parameter
         for i, ci, count in counted:
             ref = out[i]
-            if ref is None:
-                continue
-            n = out[ci] if ci is not None else count
-            if not isinstance(n, int) or n <= 0:
-                continue
-            _check_room(params[i], ref, n)
+            if ref is not None:
+                k = out[ci] if ci is not None else count
+                if k == 1 and ref.elem is type(ref._keep) and ref.nbytes == _sizeof(ref.elem):
+                    continue  # byref(x) of one scalar
+                if type(k) is int and k > 0:
+                    _check_room(params[i], ref, k)
         return out, extra
 
     return bind
