@@ -11,9 +11,11 @@ order) and read as "bits 7..0" of the byte the standard draws.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import TypeVar
 
 from construct import (
     BitsInteger,
@@ -21,6 +23,7 @@ from construct import (
     Bytes,
     ByteSwapped,
     Const,
+    ConstructError,
     Flag,
     GreedyBytes,
     Int8ul,
@@ -31,6 +34,8 @@ from construct import (
 )
 
 from drives.abort import SdoAbort, SdoAbortCode
+
+log = logging.getLogger(__name__)
 
 MAILBOX_HEADER_SIZE = 6
 COE_HEADER_SIZE = 2
@@ -283,14 +288,57 @@ def next_counter(counter: int) -> int:
 
 
 # --- client -------------------------------------------------------------------------
+#: largest object an upload accepts, bytes; a larger announced size ends in 0x05040005
+DEFAULT_MAX_SDO_SIZE = 4 * 1024 * 1024
+#: a segment frame carries at least 7 data bytes, padded (ETG.1000.6 5.6.2.3-5.6.2.6:
+#: mailbox length >= 0x0A); the segment count cap of an upload is derived from it
+MIN_SEGMENT_DATA = 7
+
+_T = TypeVar("_T")
+
+
+class _SlaveAborted(Exception):
+    """The slave sent an abort frame: the transfer is over on both sides, nothing to send."""
+
+    def __init__(self, abort: SdoAbort) -> None:
+        super().__init__(str(abort))
+        self.abort = abort
+
+
 class SdoClient:
     """The master side of SDO: upload/download through whole mailbox messages.
 
-    ``transfer`` sends one mailbox message and returns the slave's answer (for
-    a virtual slave it is exactly ``slave.mailbox``).  Expedited transfer is used
-    up to 4 bytes, normal transfer up to what one mailbox holds, segmented
-    transfer beyond (ETG.1000.6 5.6.2).  An abort answer raises
-    :class:`~drives.abort.SdoAbort` with the slave's code.
+    ``transfer`` sends one mailbox message and returns the slave's answer, or
+    None when there is none (for a virtual slave it is exactly ``slave.mailbox``).
+    Expedited transfer is used up to 4 bytes, normal transfer up to what one
+    mailbox holds, segmented transfer beyond (ETG.1000.6 5.6.2).
+
+    Every failure is an :class:`~drives.abort.SdoAbort`, whatever the slave sends:
+
+    - an abort frame from the slave raises its code, index and subindex;
+    - no answer is 0x05040000 (SDO protocol timed out); a mailbox error reply,
+      another mailbox type or CoE service, a cut-short frame or an answer for
+      another object is 0x08000000 (general error); an answer with the wrong
+      command specifier is 0x05040001; a segment with the wrong toggle bit is
+      0x05030000; a finished upload whose length differs from the announced
+      one is 0x06070010.
+
+    An upload is bounded, so a slave cannot keep the master busy for ever:
+
+    - the size the initiate response announces must not exceed ``max_size``
+      (default :data:`DEFAULT_MAX_SDO_SIZE`, 4 MiB), else 0x05040005 (out of
+      memory) before any segment is requested;
+    - a transfer that makes no progress ends with 0x05040000: a non-last
+      segment without data, a non-last segment that carries the data past the
+      announced size, or more segments than ``ceil(remaining / 7) + 1`` (each
+      non-last segment carries at least :data:`MIN_SEGMENT_DATA` bytes; one
+      more allows an empty last segment).
+
+    So an upload takes at most ``ceil(max_size / 7) + 3`` exchanges and a
+    download ``ceil(len(data) / segment room) + 2``.  When the client itself
+    ends a transfer it sends an abort request with the code it raises
+    (ETG.1000.6 5.6.2.7, CiA 301 "abort SDO transfer"); that request is not
+    answered and a failure to send it is only logged.
     """
 
     def __init__(
@@ -298,54 +346,83 @@ class SdoClient:
         transfer: Callable[[bytes], bytes | None],
         *,
         mailbox_size: int = DEFAULT_MAILBOX_SIZE,
+        max_size: int = DEFAULT_MAX_SDO_SIZE,
     ) -> None:
         if mailbox_size < INITIATE_OVERHEAD + 4:
             raise ValueError(f"mailbox of {mailbox_size} bytes cannot carry an SDO")
+        if max_size < 0:
+            raise ValueError(f"max_size {max_size} is negative")
         self._transfer = transfer
         self.mailbox_size = mailbox_size
+        self.max_size = max_size
         self.counter = 0
 
+    # --- services -----------------------------------------------------------
+    def upload(self, index: int, subindex: int, complete_access: bool = False) -> bytes:
+        """The object's bytes (the whole object with ``complete_access``)."""
+        return self._run(self._upload, index, subindex, complete_access)
+
+    def download(
+        self, index: int, subindex: int, data: bytes, complete_access: bool = False
+    ) -> None:
+        """Write ``data`` to the object (the whole object with ``complete_access``)."""
+        self._run(self._download, index, subindex, complete_access, bytes(data))
+
+    def _run(self, service: Callable[..., _T], index: int, subindex: int, *args: object) -> _T:
+        """Run one service; a client-detected failure also aborts the transfer at the slave."""
+        try:
+            return service(index, subindex, *args)
+        except _SlaveAborted as e:
+            raise e.abort from None
+        except SdoAbort as e:
+            self._send_abort(index, subindex, e.code)
+            raise
+
     # --- plumbing -----------------------------------------------------------
+    def _send_abort(self, index: int, subindex: int, code: int) -> None:
+        self.counter = next_counter(self.counter)
+        message = build_coe(
+            CoeService.SDO_REQUEST, build_abort(index, subindex, code), counter=self.counter
+        )
+        try:
+            self._transfer(message)  # not answered (ETG.1000.6 5.6.2.7)
+        except Exception as e:  # the abort being raised matters more than this one
+            log.warning("abort request for 0x%04X:%02X not sent: %s", index, subindex, e)
+
     def _exchange(self, sdo: bytes, index: int, subindex: int) -> bytes:
+        """One request, the SDO frame of its answer (at least one byte)."""
+
+        def fail(detail: str) -> SdoAbort:
+            return SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, detail)
+
         self.counter = next_counter(self.counter)
         answer = self._transfer(build_coe(CoeService.SDO_REQUEST, sdo, counter=self.counter))
         if answer is None:
             raise SdoAbort(SdoAbortCode.SDO_PROTOCOL_TIMED_OUT, index, subindex, "no answer")
         try:
-            mbx = parse_mailbox(answer)
+            mbx = parse_mailbox(bytes(answer))
         except ValueError as e:
-            raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, str(e)) from None
+            raise fail(str(e)) from None
         if mbx.mbx_type == MailboxType.ERR:
-            detail = "mailbox error"
-            if len(mbx.data) >= 4:
-                code = MailboxErrorReply.parse(mbx.data[:4]).detail
-                try:
-                    detail = f"mailbox error {MailboxError(code).name}"
-                except ValueError:
-                    detail = f"mailbox error 0x{code:04X}"
-            raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, detail)
-        if mbx.mbx_type != MailboxType.COE or len(mbx.data) < COE_HEADER_SIZE + 1:
-            raise SdoAbort(
-                SdoAbortCode.GENERAL_ERROR,
-                index,
-                subindex,
-                f"unexpected mailbox type {mbx.mbx_type}",
-            )
+            raise fail(_mailbox_error_text(mbx.data))
+        if mbx.mbx_type != MailboxType.COE:
+            raise fail(f"answer has mailbox type {mbx.mbx_type}, not CoE")
+        if len(mbx.data) < COE_HEADER_SIZE + 1:
+            raise fail(f"CoE answer of {len(mbx.data)} bytes carries no SDO frame")
         coe = CoeHeader.parse(mbx.data[:COE_HEADER_SIZE])
         body = mbx.data[COE_HEADER_SIZE:]
         is_abort = body[0] == 0x80 and coe.service in (
             CoeService.SDO_REQUEST,  # what ETG.1000.6 / SOES / IgH send
             CoeService.SDO_RESPONSE,  # tolerated: some slaves label aborts so
         )
-        if coe.service != CoeService.SDO_RESPONSE and not is_abort:
-            raise SdoAbort(
-                SdoAbortCode.GENERAL_ERROR, index, subindex, f"unexpected CoE service {coe.service}"
-            )
         if is_abort:
-            if len(body) < 8:
-                raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, "short abort frame")
-            ab = SdoAbortFrame.parse(body[:8])
-            raise SdoAbort(ab.code, ab.index, ab.subindex)
+            if len(body) < SdoAbortFrame.sizeof():
+                raise fail(f"abort frame of {len(body)} bytes, 8 expected")
+            ab = SdoAbortFrame.parse(body[: SdoAbortFrame.sizeof()])
+            raise _SlaveAborted(SdoAbort(ab.code, ab.index, ab.subindex))
+        if coe.service != CoeService.SDO_RESPONSE:
+            service = _enum_name(CoeService, coe.service)
+            raise fail(f"answer has CoE service {service}, not SDO_RESPONSE")
         return body
 
     def _expect(self, body: bytes, scs: Scs, index: int, subindex: int) -> None:
@@ -357,22 +434,48 @@ class SdoClient:
                 f"answer 0x{body[0]:02X} is not {scs.name}",
             )
 
-    # --- services -----------------------------------------------------------
-    def upload(self, index: int, subindex: int, complete_access: bool = False) -> bytes:
+    def _initiate_answer(self, body: bytes, scs: Scs, index: int, subindex: int) -> None:
+        """Check an initiate answer: command specifier, length and the object it is for."""
+        self._expect(body, scs, index, subindex)
+        if len(body) < 8:
+            raise SdoAbort(
+                SdoAbortCode.GENERAL_ERROR,
+                index,
+                subindex,
+                f"{scs.name} answer of {len(body)} bytes, 8 expected",
+            )
+        echo = (int.from_bytes(body[1:3], "little"), body[3])
+        if echo != (index, subindex):
+            raise SdoAbort(
+                SdoAbortCode.GENERAL_ERROR,
+                index,
+                subindex,
+                f"{scs.name} answer is for 0x{echo[0]:04X}:{echo[1]:02X}",
+            )
+
+    def _upload(self, index: int, subindex: int, complete_access: bool) -> bytes:
         req = build_initiate(Ccs.INITIATE_UPLOAD, index, subindex, complete_access=complete_access)
         body = self._exchange(req, index, subindex)
-        self._expect(body, Scs.INITIATE_UPLOAD, index, subindex)
-        if len(body) < 8:
-            raise SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, "short upload answer")
+        self._initiate_answer(body, Scs.INITIATE_UPLOAD, index, subindex)
         cmd = SdoInitiateCommand.parse(body[:1])
         if cmd.expedited:
             n = 4 - cmd.size if cmd.size_indicator else 4
             return bytes(body[4 : 4 + n])
         resp = SdoNormal.parse(body)
         total = resp.complete_size
+        if total > self.max_size:
+            raise SdoAbort(
+                SdoAbortCode.OUT_OF_MEMORY,
+                index,
+                subindex,
+                f"{total} bytes announced, at most {self.max_size} accepted",
+            )
         data = bytearray(resp.data[:total])
+        if len(data) == total:
+            return bytes(data)
+        max_segments = -(-(total - len(data)) // MIN_SEGMENT_DATA) + 1
         toggle = False
-        while len(data) < total:
+        for n_seg in range(1, max_segments + 1):
             seg_req = SdoSegment.build(
                 {"cmd": segment_cmd(Ccs.UPLOAD_SEGMENT, toggle=toggle), "data": bytes(7)}
             )
@@ -380,33 +483,56 @@ class SdoClient:
             self._expect(body, Scs.UPLOAD_SEGMENT, index, subindex)
             seg = SdoSegment.parse(body)
             if seg.cmd.toggle != toggle:
-                raise SdoAbort(SdoAbortCode.TOGGLE_BIT_NOT_ALTERNATED, index, subindex)
+                raise SdoAbort(
+                    SdoAbortCode.TOGGLE_BIT_NOT_ALTERNATED,
+                    index,
+                    subindex,
+                    f"segment {n_seg} has toggle {int(seg.cmd.toggle)}, {int(toggle)} expected",
+                )
             chunk = seg.data
             if seg.cmd.last and len(chunk) == 7:
                 chunk = chunk[: 7 - seg.cmd.seg_size]
-            data += chunk
             if seg.cmd.last:
-                break
+                data += chunk
+                if len(data) != total:
+                    raise SdoAbort(
+                        SdoAbortCode.LENGTH_MISMATCH,
+                        index,
+                        subindex,
+                        f"{len(data)} bytes received, {total} announced",
+                    )
+                return bytes(data)
+            if not chunk:
+                raise SdoAbort(
+                    SdoAbortCode.SDO_PROTOCOL_TIMED_OUT,
+                    index,
+                    subindex,
+                    f"segment {n_seg} is empty and not the last: no progress",
+                )
+            if len(data) + len(chunk) > total:
+                raise SdoAbort(
+                    SdoAbortCode.SDO_PROTOCOL_TIMED_OUT,
+                    index,
+                    subindex,
+                    f"segment {n_seg} brings {len(data) + len(chunk)} bytes"
+                    f" and is not the last, {total} announced",
+                )
+            data += chunk
             toggle = not toggle
-        if len(data) != total:
-            raise SdoAbort(
-                SdoAbortCode.LENGTH_MISMATCH,
-                index,
-                subindex,
-                f"{len(data)} bytes received, {total} announced",
-            )
-        return bytes(data)
+        raise SdoAbort(
+            SdoAbortCode.SDO_PROTOCOL_TIMED_OUT,
+            index,
+            subindex,
+            f"no last segment after {max_segments} segments ({len(data)} of {total} bytes)",
+        )
 
-    def download(
-        self, index: int, subindex: int, data: bytes, complete_access: bool = False
-    ) -> None:
-        data = bytes(data)
+    def _download(self, index: int, subindex: int, complete_access: bool, data: bytes) -> None:
         if 0 < len(data) <= 4:
             req = build_initiate(
                 Ccs.INITIATE_DOWNLOAD, index, subindex, data, complete_access=complete_access
             )
             body = self._exchange(req, index, subindex)
-            self._expect(body, Scs.INITIATE_DOWNLOAD, index, subindex)
+            self._initiate_answer(body, Scs.INITIATE_DOWNLOAD, index, subindex)
             return
         first_max = self.mailbox_size - INITIATE_OVERHEAD
         first, rest = data[:first_max], data[first_max:]
@@ -422,10 +548,12 @@ class SdoClient:
             }
         )
         body = self._exchange(req, index, subindex)
-        self._expect(body, Scs.INITIATE_DOWNLOAD, index, subindex)
+        self._initiate_answer(body, Scs.INITIATE_DOWNLOAD, index, subindex)
         seg_max = self.mailbox_size - SEGMENT_OVERHEAD
         toggle = False
-        while rest:
+        n_seg = 0
+        while rest:  # bounded by our own data: one segment per seg_max bytes
+            n_seg += 1
             chunk, rest = rest[:seg_max], rest[seg_max:]
             padded, unused = pad_segment(chunk)
             seg = SdoSegment.build(
@@ -439,5 +567,30 @@ class SdoClient:
             body = self._exchange(seg, index, subindex)
             self._expect(body, Scs.DOWNLOAD_SEGMENT, index, subindex)
             if bool(body[0] & 0x10) != toggle:
-                raise SdoAbort(SdoAbortCode.TOGGLE_BIT_NOT_ALTERNATED, index, subindex)
+                raise SdoAbort(
+                    SdoAbortCode.TOGGLE_BIT_NOT_ALTERNATED,
+                    index,
+                    subindex,
+                    f"answer to segment {n_seg} has toggle {int(not toggle)}, {int(toggle)} sent",
+                )
             toggle = not toggle
+
+
+def _enum_name(enum: type[IntEnum], value: int, digits: int = 0) -> str:
+    """The member's name, or the number (in hex with ``digits``) when there is none."""
+    try:
+        return enum(value).name
+    except ValueError:
+        return f"0x{value:0{digits}X}" if digits else str(value)
+
+
+def _mailbox_error_text(data: bytes) -> str:
+    """What a mailbox error reply (ETG.1000.4 Table 30) says, however malformed."""
+    if len(data) < MailboxErrorReply.sizeof():
+        return f"mailbox error reply of {len(data)} bytes"
+    try:
+        reply = MailboxErrorReply.parse(data[: MailboxErrorReply.sizeof()])
+    except ConstructError:
+        service = int.from_bytes(data[:2], "little")
+        return f"mailbox error reply with service 0x{service:04X}, not 0x0001"
+    return f"mailbox error {_enum_name(MailboxError, reply.detail, 4)}"
