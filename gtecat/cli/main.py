@@ -14,7 +14,16 @@ from collections.abc import Sequence
 from eni.errors import GtecatError
 
 #: verb modules under gtecat.cli, in help order
-COMMANDS = ("demo_cmd", "map_cmd", "eni_cmd", "bus_cmd", "run_cmd", "serve_cmd")
+COMMANDS = (
+    "demo_cmd",
+    "map_cmd",
+    "eni_cmd",
+    "bus_cmd",
+    "run_cmd",
+    "serve_cmd",
+    "controller_cmd",
+    "lib_cmd",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,122 @@
+"""``gtecat controller [--listen unix:/path]``: one virtual controller for native clients.
+
+Runs the controller (bus, clock, axes, field side) of the ``GTECAT_*`` environment (or
+the options) and serves it over a Unix socket to any number of clients: programs
+linked with ``libgts.so`` (``GTECAT_CONTROLLER=unix:/path``), Python code loading it
+through ctypes, other tools.  The first client's ``GT_Open`` opens the controller;
+calls are served one at a time.  In ``auto`` clock mode the controller keeps its time
+at or ahead of wall time (the wall floor, docs/native.md), so programs that sleep
+between polls see their sleeps pass; ``--no-wall-floor`` (GTECAT_WALL_FLOOR=0) keeps
+pure, deterministic ``auto``.
+
+``libgts.so`` starts a private one of these by itself on ``GT_Open`` when
+``GTECAT_CONTROLLER`` is not set; it ends with the program.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import signal
+import sys
+import tempfile
+from pathlib import Path
+from types import FrameType
+
+
+def default_address() -> str:
+    base = os.environ.get("XDG_RUNTIME_DIR") or tempfile.gettempdir()
+    return f"unix:{Path(base) / f'gtecat-{os.getuid()}' / 'controller.sock'}"
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "controller",
+        help="run a virtual controller for libgts / ctypes clients (Unix socket)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "--listen",
+        metavar="ADDR",
+        help=f"unix:/path (or unix:@name, Linux abstract); default {default_address()}",
+    )
+    p.add_argument("--eni", help="configuration file (else GTECAT_ENI, else ./Gecat.eni)")
+    p.add_argument("--machine", help="machine description TOML (else GTECAT_MACHINE)")
+    p.add_argument("--clock", choices=("auto", "lockstep", "realtime"), help="else GTECAT_CLOCK")
+    p.add_argument("--backend", choices=("emulated", "pysoem"), help="else GTECAT_BACKEND")
+    p.add_argument("--iface", help="network interface for pysoem (else GTECAT_IFACE)")
+    p.add_argument(
+        "--no-wall-floor",
+        action="store_true",
+        help="auto clock without the wall floor: controller time moves only by call latency "
+        "and waits (deterministic; programs that sleep see no time pass)",
+    )
+    # set by libgts when it starts a private controller
+    p.add_argument("--ready-fd", type=int, help=argparse.SUPPRESS)
+    p.add_argument("--lifeline-fd", type=int, help=argparse.SUPPRESS)
+    p.add_argument("--private", action="store_true", help=argparse.SUPPRESS)
+    p.set_defaults(func=run)
+
+
+def _wall_floor(args: argparse.Namespace) -> bool:
+    if args.no_wall_floor:
+        return False
+    env = os.environ.get("GTECAT_WALL_FLOOR", "1").strip().lower()
+    return env not in ("0", "off", "no", "false")
+
+
+def _close_inherited(keep: set[int]) -> None:
+    """A private controller holds none of the program's descriptors (sockets, files)."""
+    try:
+        fds = [int(n) for n in os.listdir("/proc/self/fd")]
+    except OSError:
+        fds = list(range(3, 256))
+    for fd in fds:
+        if fd > 2 and fd not in keep:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..native.server import Server
+
+    if args.private:
+        _close_inherited({fd for fd in (args.ready_fd, args.lifeline_fd) if fd is not None})
+    address = args.listen or default_address()
+    if not args.listen:
+        Path(address[5:]).parent.mkdir(mode=0o700, exist_ok=True)
+    options = {
+        k: v
+        for k, v in (
+            ("eni", args.eni),
+            ("machine", args.machine),
+            ("clock", args.clock),
+            ("backend", args.backend),
+            ("iface", args.iface),
+        )
+        if v is not None
+    }
+    server = Server(
+        address,
+        open_options=options,
+        wall_floor=_wall_floor(args),
+        lifeline_fd=args.lifeline_fd,
+        remove_dir=args.private,
+    )
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        server.stop()
+
+    signal.signal(signal.SIGTERM, stop)
+    if args.private:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is for the program; it ends us
+    if args.ready_fd is not None:
+        with contextlib.suppress(OSError):
+            os.write(args.ready_fd, b"ready\n")
+            os.close(args.ready_fd)
+    else:
+        print(f"gtecat controller listening on {address}", file=sys.stderr, flush=True)
+    server.serve_forever()
+    return 0

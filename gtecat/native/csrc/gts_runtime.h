@@ -1,0 +1,43 @@
+/* gts_runtime.h - what the generated stubs of libgts need from its transport.
+ *
+ * Hand-written, small and function-independent: every GT_x / GTN_x stub (generated
+ * from the function table into gts_stubs.c) fills an array of gte_arg and calls
+ * gte_invoke with its gte_function descriptor; gts_runtime.c does the rest.
+ */
+#ifndef GTECAT_GTS_RUNTIME_H
+#define GTECAT_GTS_RUNTIME_H
+
+#include "gts_wire.h"
+
+/* one parameter: how it travels (GTE_K_*), and for pointers how many bytes */
+typedef struct gte_param {
+    unsigned char kind;     /* GTE_K_* */
+    signed char count_arg;  /* index of the parameter holding the element count, -1: fixed */
+    unsigned int elem;      /* sizeof one element (pointers) */
+    long count;             /* fixed element count when count_arg is -1 */
+} gte_param;
+
+typedef struct gte_function {
+    const char *name;       /* GT_x (GTE_x) as the table writes it */
+    unsigned short id;      /* the protocol's function id */
+    unsigned char nparams;
+    unsigned char flags;    /* GTE_F_* */
+    const gte_param *params;
+} gte_function;
+
+enum { GTE_F_OPEN = 1, GTE_F_CLOSE = 2 };
+
+typedef union gte_arg {
+    long long i;
+    double d;
+    const void *p;
+} gte_arg;
+
+/* Marshal one call, send it to the controller, copy the out-pointers back, return the code.
+ * gtn: 1 for GTN_x (the core is checked), 0 for GT_x / GTE_x. */
+short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a);
+
+/* the interpreter that built the library (generated beside the stubs) */
+extern const char gte_default_python[];
+
+#endif

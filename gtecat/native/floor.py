@@ -1,0 +1,82 @@
+"""The wall floor: controller time served to native clients never falls behind wall time.
+
+C and C++ programs wait with ``Sleep()``/``usleep()`` between polls (the vendor demo
+polls ``GTN_IsEcatReady`` every 500 ms, up to 100 times).  Pure ``auto`` time moves
+only when a call charges its virtual latency, so such a program would see almost no
+time pass while it sleeps.  With the floor, over every interval between two looks
+(before each call and on every idle tick of the controller) controller time advances
+at least as much as wall time did; calls still charge their latency on top, so a
+tight polling loop runs far ahead of the wall, as in ``auto``.  Controller time is
+therefore never behind the wall over any stretch, and a program's ``usleep(500000)``
+lets at least 500 ms of bus cycles run.
+
+Work per look is bounded (``budget_s`` of wall time), so a call arriving after a long
+sleep is served promptly; a debt left over is paid on the next looks.  A bus whose
+cycles cost more than their period cannot keep up: the debt then grows (the floor
+cannot make a slow machine fast; ``realtime`` would overrun the same way).
+
+The floor is for ``auto`` only: ``lockstep`` stays fully manual and ``realtime``
+already runs on the wall clock.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from ..master.clock import Clock, ClockMode
+
+
+class WallFloor:
+    """Keeps one clock at or ahead of wall time, interval by interval."""
+
+    def __init__(
+        self,
+        clock: Clock,
+        *,
+        wall_ns: Callable[[], int] = time.monotonic_ns,
+        budget_s: float = 0.02,
+    ) -> None:
+        self.clock = clock
+        self._wall_ns = wall_ns
+        self.budget_s = budget_s
+        self._wall_last = wall_ns()
+        self._virt_last = self._virtual()
+        self.debt_ns = 0  #: wall time not yet matched by controller time
+
+    @property
+    def active(self) -> bool:
+        return self.clock.mode is ClockMode.AUTO
+
+    def _virtual(self) -> int:
+        # time already charged but not yet run as a cycle counts as passed
+        return self.clock.now_ns + getattr(self.clock, "_pending_ns", 0)
+
+    def look(self) -> int:
+        """Advance the clock to cover the wall time since the last look; returns cycles run."""
+        wall = self._wall_ns()
+        virt = self._virtual()
+        need = self.debt_ns + (wall - self._wall_last) - (virt - self._virt_last)
+        self._wall_last = wall
+        cycles = 0
+        if need > 0 and self.active:
+            step = self.clock.cycle_ns
+            deadline = time.perf_counter() + self.budget_s
+            while need > 0:
+                n = min(need, step)
+                cycles += self.clock.advance_ns(n)
+                need -= n
+                if time.perf_counter() > deadline:
+                    break
+        self.debt_ns = max(0, need) if self.active else 0
+        self._virt_last = self._virtual()
+        return cycles
+
+    def idle_timeout(self) -> float:
+        """Seconds an idle controller may wait before the next look."""
+        if not self.active:
+            return 1.0
+        return 0.0 if self.debt_ns > 0 else self.clock.cycle_ns / 1e9
+
+
+__all__ = ["WallFloor"]

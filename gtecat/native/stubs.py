@@ -1,0 +1,120 @@
+"""The C client stubs of ``libgts.so``, generated from the function table.
+
+Two files: ``gts_wire.h`` (the protocol's numbers, from :mod:`gtecat.native.protocol`)
+and ``gts_stubs.c``: per table line a parameter descriptor and the exported
+``GT_x`` / ``GTN_x`` (or ``GTE_x``) functions, each of which only fills an argument
+array and calls ``gte_invoke`` (``csrc/gts_runtime.c``, hand-written, does the rest).
+"""
+
+from __future__ import annotations
+
+from .. import __version__
+from ..gt.table import Proto
+from .protocol import (
+    MAX_FRAME,
+    MAX_POINTER_BYTES,
+    MSG_CALL,
+    MSG_HELLO,
+    PROTOCOL_VERSION,
+    PTR_NULL,
+    PTR_TOO_BIG,
+    PTR_UNKNOWN,
+    FunctionPlan,
+    Kind,
+    plans,
+    table_digest,
+)
+
+
+def render_wire_h() -> str:
+    lines = [
+        f"/* gts_wire.h - protocol numbers of gtecat {__version__}; generated from",
+        " * gtecat/native/protocol.py by gtecat.native.stubs: do not edit. */",
+        "#ifndef GTECAT_GTS_WIRE_H",
+        "#define GTECAT_GTS_WIRE_H",
+        f"#define GTE_PROTOCOL_VERSION {PROTOCOL_VERSION}",
+        f'#define GTE_TABLE_DIGEST "{table_digest()}"',
+        f"#define GTE_MSG_HELLO {MSG_HELLO}",
+        f"#define GTE_MSG_CALL {MSG_CALL}",
+        f"#define GTE_PTR_NULL ({PTR_NULL})",
+        f"#define GTE_PTR_UNKNOWN ({PTR_UNKNOWN})",
+        f"#define GTE_PTR_TOO_BIG ({PTR_TOO_BIG})",
+        f"#define GTE_MAX_POINTER_BYTES {MAX_POINTER_BYTES}LL",
+        f"#define GTE_MAX_FRAME {MAX_FRAME}u",
+    ]
+    lines += [f"#define GTE_K_{k.name} {int(k)}" for k in Kind]
+    lines += ["#endif", ""]
+    return "\n".join(lines)
+
+
+def _elem(plan_arg) -> str:
+    p = plan_arg.param
+    return f"sizeof({p.ctype})" if p.pointer else "0"
+
+
+def _descriptor(plan: FunctionPlan) -> list[str]:
+    name = plan.name
+    flags = {"GT_Open": "GTE_F_OPEN", "GT_Close": "GTE_F_CLOSE"}.get(name, "0")
+    out = []
+    if plan.args:
+        out.append(f"static const gte_param P_{name}[] = {{")
+        for a in plan.args:
+            out.append(
+                f"    {{GTE_K_{a.kind.name}, {a.count_arg}, {_elem(a)}, {a.count}}},"
+                f"  /* {a.param.name} */"
+            )
+        out.append("};")
+    params = f"P_{name}" if plan.args else "NULL"
+    out.append(
+        f"static const gte_function F_{name} = "
+        f'{{"{name}", {plan.fid}, {len(plan.args)}, {flags}, {params}}};'
+    )
+    return out
+
+
+def _body(plan: FunctionPlan, gtn: bool) -> list[str]:
+    proto: Proto = plan.proto
+    out = ["{"]
+    if plan.args:
+        out.append(f"    gte_arg a[{len(plan.args)}];")
+        for i, a in enumerate(plan.args):
+            p = a.param
+            if p.pointer:
+                out.append(f"    a[{i}].p = {p.name};")
+            elif a.kind is Kind.DOUBLE:
+                out.append(f"    a[{i}].d = {p.name};")
+            else:
+                out.append(f"    a[{i}].i = (long long){p.name};")
+        args = "a"
+    else:
+        args = "NULL"
+    core = "core" if gtn else "1"
+    out.append(f"    return gte_invoke(&F_{proto.name}, {int(gtn)}, {core}, {args});")
+    out.append("}")
+    return out
+
+
+def render_stubs(python: str) -> str:
+    """``gts_stubs.c``; ``python`` is the interpreter a private controller runs on."""
+    esc = python.replace("\\", "\\\\").replace('"', '\\"')
+    lines = [
+        f"/* gts_stubs.c - the GT functions of gtecat {__version__} (table {table_digest()});",
+        " * generated from gtecat/gt/table.py by gtecat.native.stubs: do not edit. */",
+        "#include <stddef.h>",
+        '#include "gts.h"',
+        '#include "gts_runtime.h"',
+        "",
+        f'const char gte_default_python[] = "{esc}";',
+        "",
+    ]
+    for plan in plans():
+        proto = plan.proto
+        lines += _descriptor(plan)
+        lines += [proto.c_signature(defaults=False).replace("()", "(void)"), *_body(plan, False)]
+        if proto.gtn:
+            lines += [proto.c_signature(defaults=False, core=True), *_body(plan, True)]
+        lines.append("")
+    return "\n".join(lines)
+
+
+__all__ = ["render_stubs", "render_wire_h"]
