@@ -36,7 +36,7 @@ static pthread_mutex_t g_mu = PTHREAD_MUTEX_INITIALIZER;
 static int g_fd = -1;              /* connection to the controller */
 static pid_t g_fd_pid;             /* process that made it (a forked child reconnects) */
 static char g_addr[300];           /* unix:/path of the connection */
-static int g_private;              /* g_addr is a controller this library started */
+static char g_private_addr[300];   /* unix:/path of the controller this library started */
 static pid_t g_child;              /* that controller's pid */
 static int g_lifeline = -1;        /* its lifeline: EOF when this process ends */
 static char g_lost[1300];          /* why the connection was lost ("" if it was not) */
@@ -387,7 +387,7 @@ static int start_private(const char *fname)
         return -1;
     }
     g_lifeline = life[1];
-    g_private = 1;
+    snprintf(g_private_addr, sizeof g_private_addr, "%s", addr);
     if (connect_to(addr, fname, now_ms() + start_ms) < 0)
         return -1;
     return 0;
@@ -405,10 +405,8 @@ static int ensure_open(const char *fname)
     const char *named = getenv("GTECAT_CONTROLLER");
     if (named && *named)
         return connect_to(named, fname, deadline);
-    if (g_private && g_addr[0]) {
-        char addr[sizeof g_addr];
-        snprintf(addr, sizeof addr, "%s", g_addr);
-        if (kill(g_child, 0) == 0 && connect_to(addr, fname, deadline) == 0)
+    if (g_private_addr[0] && g_child > 0) {
+        if (kill(g_child, 0) == 0 && connect_to(g_private_addr, fname, deadline) == 0)
             return 0;
         child_fate();
     }
@@ -441,6 +439,8 @@ static short invoke_locked(const gte_function *f, int gtn, short core, const gte
         if (ensure_open(f->name) < 0)
             return CMD_COMM;
     } else if (g_fd < 0 || g_fd_pid != getpid()) {
+        if ((f->flags & GTE_F_CLOSE) && g_fd < 0)
+            return 0; /* closing what is not open: nothing to do (as in Python) */
         if (g_fd >= 0 && g_fd_pid != getpid()) {
             close(g_fd); /* forked child: reconnect to the same controller */
             g_fd = -1;
@@ -614,6 +614,13 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
 {
     pthread_mutex_lock(&g_mu);
     short rc = invoke_locked(f, gtn, core, a);
+    if ((f->flags & GTE_F_CLOSE) && g_fd >= 0 && g_fd_pid == getpid()) {
+        /* GT_Close ends this connection; a private controller lives on until the
+         * program ends, so the next GT_Open finds it again */
+        close(g_fd);
+        g_fd = -1;
+        g_lost[0] = '\0';
+    }
     pthread_mutex_unlock(&g_mu);
     return rc;
 }

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import shlex
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -25,3 +29,60 @@ def gts_h(tmp_path: Path) -> Path:
     path = d / "gts.h"
     path.write_text(header.render(), encoding="utf-8")
     return path
+
+
+ROOT = Path(__file__).resolve().parents[3]
+FIG5_2 = ROOT / "examples" / "manual_fig5_2.eni"
+C_DIR = Path(__file__).resolve().parent / "c"
+
+
+@pytest.fixture(scope="session")
+def libgts():
+    """The built library (a missing compiler is a skip that says so)."""
+    from gtecat.native.build import NativeBuildError, ensure_built
+
+    try:
+        return ensure_built()
+    except NativeBuildError as e:
+        pytest.skip(f"libgts cannot be built here: {e}")
+
+
+def tool_path() -> str:
+    """PATH with this interpreter's directory first, so ``python3`` is the one with gtecat."""
+    return os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
+
+
+def native_env(**extra: str) -> dict[str, str]:
+    """The environment of a native client: the manual's figure 5-2 bus, auto clock, no
+    controller named (the library starts its own)."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env.update(PATH=tool_path(), GTECAT_ENI=str(FIG5_2), GTECAT_CLOCK="auto", GTECAT_LOG="")
+    env.update(extra)
+    return env
+
+
+def compile_client(src: Path, out: Path, compiler: str) -> Path:
+    """Compile exactly as a user would: ``gcc prog.c $(python3 -m gtecat lib --cflags --libs)``."""
+    flags = "$(python3 -m gtecat lib --cflags --libs)"
+    cmd = f"{compiler} {shlex.quote(str(src))} {flags} -o {shlex.quote(str(out))}"
+    r = subprocess.run(
+        ["bash", "-c", cmd], capture_output=True, text=True, env={**os.environ, "PATH": tool_path()}
+    )
+    assert r.returncode == 0, f"{cmd}\n{r.stderr}"
+    assert "warning" not in r.stderr, r.stderr
+    return out
+
+
+def run_client(exe: Path, *args: str, env: dict[str, str], cwd: Path, timeout: float = 180):
+    r = subprocess.run(
+        [str(exe), *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=timeout
+    )
+    return r, parse_lines(r.stdout)
+
+
+def parse_lines(text: str) -> dict[str, str]:
+    out = {}
+    for line in text.splitlines():
+        key, _, value = line.partition(" ")
+        out[key] = value
+    return out

@@ -1,0 +1,149 @@
+"""C and C++ programs linked with libgts, compiled exactly as a user would and run with
+nothing started before: ``GT_Open`` starts a private controller that ends with them."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from .conftest import (
+    C_DIR,
+    ROOT,
+    compile_client,
+    native_env,
+    needs_cc,
+    needs_cxx,
+    run_client,
+)
+
+pytestmark = needs_cc
+
+
+@pytest.fixture(scope="module")
+def gtn_sequence(libgts, tmp_path_factory):
+    out = tmp_path_factory.mktemp("c") / "gtn_sequence"
+    return compile_client(C_DIR / "gtn_sequence.c", out, "gcc")
+
+
+@pytest.fixture(scope="module")
+def clock_probe(libgts, tmp_path_factory):
+    out = tmp_path_factory.mktemp("c") / "clock_probe"
+    return compile_client(C_DIR / "clock_probe.c", out, "gcc")
+
+
+def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
+    r, v = run_client(gtn_sequence, env=native_env(), cwd=tmp_path)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert v["done"] == "1", r.stdout + r.stderr
+    # bring-up, polled with usleep as the vendor demo does
+    assert (v["open"], v["init"], v["ready"], v["start"]) == ("0", "0", "1", "0")
+    assert int(v["ready_polls"]) < 100
+    # a 200 ms usleep lets at least 200 ms of controller time pass (the wall floor)
+    assert int(v["slept_ms"]) >= 200
+    # raw data: slave 2's outputs at 32 read back; its inputs at 34 cannot be written
+    assert (v["raw_write"], v["raw_read"], v["raw_back"]) == ("0", "0", str(0x3CA5))
+    assert v["raw_write_inputs"] == "7"
+    assert (v["pdo_length_rc"], v["pdo_length"]) == ("0", "40")
+    # servo on, Trap move: planned and encoder positions reach the target
+    assert (v["clrsts"], v["axis_on"], v["enabled"]) == ("0", "0", "1")
+    for k in ("prftrap", "gettrap", "settrap", "setvel", "setpos", "update"):
+        assert v[k] == "0", k
+    assert int(v["move_polls"]) < 1000
+    assert (v["getprfpos"], v["getencpos"]) == ("0", "0")
+    assert v["prfpos"] == "20000"
+    assert v["encpos"] == "20000"
+    assert (v["ecatencpos_rc"], v["ecatencpos"]) == ("0", "20000")
+    # SDO: a good upload, then the abort code of an object that does not exist
+    assert (v["sdo_up"], v["sdo_size"], v["sdo_abort"]) == ("0", "2", "0")
+    assert v["sdo_bad"] == "1"
+    assert int(v["sdo_bad_abort"]) == 0x06020000
+    assert "0x06020000" in v["sdo_bad_reason"]
+    assert v["sdo_nulls"] == "0"
+    assert (v["sdo_down"], v["sdo_down_abort"]) == ("0", "0")
+    # NULL: optional pointers are fine, a required one is 7 with the reason
+    assert v["null_optional"] == "0"
+    assert v["null_required"] == "7"
+    assert "pSts is NULL" in v["null_required_reason"]
+    assert (v["slaves_one_ptr"], v["slaves"]) == ("0", "4")
+    # bad values: the codes Python gives
+    assert v["bad_axis"] == "7"
+    assert v["bad_core"] == "7"
+    assert "core 7" in v["bad_core_reason"]
+    assert v["bad_count"] == "7"
+    assert v["sts_two"] == "0"
+    assert v["version_rc"] == "0"
+    assert v["version"].startswith("gtecat ")
+    assert v["last_error_null"] == "7"
+    # GT_Close detaches: -1 until the next GT_Open, which finds the controller again
+    assert (v["close"], v["after_close"]) == ("0", "-1")
+    assert "GT_Open" in v["after_close_reason"]
+    assert (v["reopen"], v["reopen_sts"]) == ("0", "0")
+
+
+def test_the_private_controller_ends_with_the_program(gtn_sequence, tmp_path):
+    before = _controllers()
+    r, v = run_client(gtn_sequence, env=native_env(), cwd=tmp_path)
+    assert v.get("done") == "1", r.stdout + r.stderr
+    deadline = time.monotonic() + 10
+    while _controllers() - before and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not (_controllers() - before)
+
+
+def _controllers() -> set[int]:
+    import os
+
+    out = set()
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            cmd = open(f"/proc/{pid}/cmdline", "rb").read().split(b"\0")
+        except OSError:
+            continue
+        if b"controller" in cmd and b"--private" in cmd and b"gtecat" in cmd:
+            out.add(int(pid))
+    return out
+
+
+def test_auto_with_the_wall_floor(clock_probe, tmp_path):
+    r, v = run_client(clock_probe, env=native_env(), cwd=tmp_path)
+    assert v.get("open") == "0", r.stdout + r.stderr
+    assert int(v["sleep_ms"]) >= 300  # controller time never falls behind the wall
+    assert int(v["wait_ms"]) >= 100
+    assert int(v["poll2000_ms"]) >= 100  # 2000 calls x 50 us of virtual latency
+
+
+def test_deterministic_auto_without_the_floor(clock_probe, tmp_path):
+    r, v = run_client(clock_probe, env=native_env(GTECAT_WALL_FLOOR="0"), cwd=tmp_path)
+    assert v.get("open") == "0", r.stdout + r.stderr
+    assert int(v["sleep_ms"]) <= 1  # only the GetClock call's latency
+    assert 100 <= int(v["wait_ms"]) <= 101
+    assert 100 <= int(v["poll2000_ms"]) <= 101
+
+
+def test_lockstep_from_c(clock_probe, tmp_path):
+    r, v = run_client(clock_probe, env=native_env(GTECAT_CLOCK="lockstep"), cwd=tmp_path)
+    assert v.get("open") == "0", r.stdout + r.stderr
+    assert v["sleep_ms"] == "0"
+    assert v["wait_ms"] == "100"
+    assert v["poll2000_ms"] == "0"
+
+
+def test_a_missing_python_is_a_clear_error(clock_probe, tmp_path):
+    env = native_env(GTECAT_PYTHON=str(tmp_path / "no-python"))
+    r, _ = run_client(clock_probe, env=env, cwd=tmp_path, timeout=60)
+    assert r.returncode == 1
+    assert "open -1" in r.stdout
+
+
+@needs_cxx
+def test_seed_002_shaped_cpp_program(libgts, tmp_path):
+    exe = compile_client(ROOT / "examples" / "native" / "motion_demo.cpp", tmp_path / "demo", "g++")
+    r, v = run_client(exe, env=native_env(), cwd=tmp_path)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert v["axes"] == "2 enabled 1"
+    assert v["home"] == "status 3"
+    assert v["moved"] == "prf 30000 enc 30000"
+    assert v["done"] == ""
