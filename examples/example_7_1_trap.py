@@ -7,7 +7,8 @@ deceleration 0.125 pulse/ms² and a 25 ms smoothing time: 200 ms up, 600 ms at
 speed, 400 ms down, each corner rounded over 25 ms - 1325 ms in all.
 :func:`plc_prg` is the manual's program (its VAR block is :class:`PlcVars`),
 called once per millisecond of controller time; the configuration file is
-``test.cfg`` beside this script (alarms and limits off, docs/config_file.md).
+``test.cfg`` beside this script, in the vendor tool's format (every axis's alarm and
+limit inputs "none", index -1; docs/config_file.md).
 """
 
 # ruff: noqa: N815  (the PLC variables keep the manual's names)

@@ -1,70 +1,440 @@
-"""GT_LoadConfig's configuration file: the options of manual 4.3 as a small text format.
+"""GT_LoadConfig's configuration file: the ``*.cfg`` the vendor's tool writes (manual 4.3-4.4).
 
-The vendor's tool (MCT2008) writes a binary-opaque ``*.cfg``; its format is not
-public, so gtecat reads its own, documented here and in ``docs/config_file.md``::
+The vendor's Motion Controller Toolkit (MCT2008) saves its "controller
+configuration" as plain INI text, one ``[kindN]`` section per controller
+resource and ``key=value`` lines, values decimal, ``0x`` hex or floats::
 
-    # a comment (also ';'); blank lines are ignored
-    [axis 1]                      # or [axis1]: GT axis 1
-    active = 1                    # 4.3.1 item 9: 0 = no status or safety checks
-    profile_scale = 1 1           # alpha beta, GT_ProfileScale (4.3.1 item 2)
-    encoder_scale = 1 1           # alpha beta, GT_EncScale (item 3)
-    alarm = on                    # GT_AlarmOn / GT_AlarmOff (item 4)
-    alarm_input = 1               # whose drive fault is the alarm: an axis number, or none
-    positive_limit = on           # GT_LmtsOn / GT_LmtsOff(axis, MC_LIMIT_POSITIVE) (item 5)
-    positive_limit_input = 1      # whose 60FDh bit 1: an axis number, or none
-    negative_limit = on           # (item 6)
-    negative_limit_input = 1      # whose 60FDh bit 0
-    smooth_stop_input = none      # extension (items 7-8 are "配置无效"): AXIS:BIT of 60FDh
-    abrupt_stop_input = none      #   e.g. 1:2 = axis 1's home switch input
-    soft_limit = 2147483647 -2147483648   # extension: GT_SetSoftLimit positive negative
-    pos_err = 32767               # extension: GT_SetPosErr
-    axis_band = 0 0               # extension: GT_SetAxisBand band time
+    [profile1]                  [axis1]                      [limitPositive1]
+    active=1                    active=1                     active=1
+    decSmoothStop=1.000000      alarmType=2                  reverse=0
+    decAbruptStop=1000.000000   alarmIndex=1                 filterTime=3
+                                limitPositiveType=0 ...
+                                prfMap=0x1  prfMapAlpha1=1 ...
 
-    [encoder 1]
-    active = 1                    # 4.3.2 item 6: 0 = the reading is frozen
-    reverse = 0                   # GT_EncSns bit (item 2)
-    source = external             # external (GT_EncOn, 6064h) or pulse (GT_EncOff, 607Ah)
+Real files are in ``../shared/fixtures/googol/*.cfg``; ``docs/config_file.md`` is the
+user's reference.  :data:`SCHEMA` declares every section and key; what each does
+on an EtherCAT axis (axis/profile/encoder N = GT axis N, 4.3):
 
-    [profile 1]
-    active = 1                    # 4.3.3 item 4: 0 = GT_Update refused
-    smooth_stop_dec = 1           # GT_SetStopDec, pulse/ms² (item 2)
-    abrupt_stop_dec = 1000        # (item 3)
+* ``[profileN]`` ``active`` (4.3.3 item 4: 0 = no motion starts), ``decSmoothStop`` /
+  ``decAbruptStop`` (GT_SetStopDec, pulse/ms², (0, 32767]).
+* ``[axisN]`` ``active`` (4.3.1 item 9: 0 = no status, limit, alarm or following-error
+  checks); ``prfMap`` / ``encMap`` (bit N-1: profile / encoder N feeds the axis - on a bus
+  axis N is fed by profile N and encoder N, so any other map is refused);
+  ``prfMapAlpha1/Beta1`` (GT_ProfileScale) and ``encMapAlpha1/Beta1`` (GT_EncScale) scale
+  that first (only) mapped source; ``...Alpha2/Beta2`` would scale a second one and are
+  read and unused.  The inputs ``alarm``, ``limitPositive``, ``limitNegative``,
+  ``smoothStop``, ``abruptStop`` each name a ``...Type`` (an ``MC_*`` resource type) and
+  an ``...Index``: **-1 is "none"** - the tool's "none" choice.  (The manual's own
+  ``test.cfg`` of examples 6-1, 7-1, 7-2, 9-1, "配置文件取消了各轴的报警和限位", writes
+  index -1 for every alarm and limit while its ``[alarmN]`` / ``[limitPositiveN]`` stay
+  active; its ``servo.cfg`` writes the axis number where they are wired.)  GT_AlarmOn/Off
+  and GT_LmtsOn/Off then return 1, as chapter 13 says ("配置文件...配置了报警无效").
+* Input sources on a bus: ``MC_LIMIT_POSITIVE`` (0) N = 60FDh bit 1 of axis N,
+  ``MC_LIMIT_NEGATIVE`` (1) N = 60FDh bit 0, ``MC_HOME`` (3) N = 60FDh bit 2,
+  ``MC_ALARM`` (2) N = 6041h bit 3 (drive fault) of axis N.  ``MC_GPI`` (4),
+  ``MC_ARRIVE`` (5), ``MC_MPG`` (6) are the card's own terminals: no input here (noted in
+  the master log unless the index is -1, which is what the tool writes for the stop
+  inputs, "配置无效").
+* ``[limitPositiveN]`` / ``[limitNegativeN]`` / ``[homeN]`` / ``[alarmN]``: ``active``
+  is the GT_LmtsOn/Off (GT_AlarmOn/Off) state of the axes that take this input (a stop
+  input whose source is not active is none); ``reverse=1`` inverts the input (a
+  normally-closed switch: a limit is triggered while 60FDh's bit is 0; an alarm while the
+  drive is *not* in fault - noted in the log, it is rarely what a bus axis wants);
+  ``filterTime`` is the card's input debounce (MCT writes 3): on a bus the drive
+  debounces its own inputs and the master samples 60FDh / 6041h once a cycle, so the
+  value is stored (:func:`vendor_settings`) and filters nothing again.  The drive's own
+  homing (6098h) reads its home switch itself: ``[homeN] reverse`` matters only where
+  a home input is a limit or stop source here.
+* ``[encoderN]`` ``active`` (4.3.2 item 6: 0 = reading frozen); ``reverse``: the tool
+  writes 1, the vendor's reset state ("系统复位后，默认为编码器计数方向取反", entry 18,
+  table 4-4), which on a bus axis is "count as the drive reports 6064h" - the emulator's
+  reset state (:mod:`gtecat.controller.encoder`); ``reverse=0`` makes the encoder count
+  the other way.  ``captureSource`` (4.3.2 item 3 "脉冲计数源"): 0 = external encoder
+  (GT_EncOn, 6064h), 1 = pulse counter (GT_EncOff, 607Ah).  ``captureHomeSense`` /
+  ``captureIndexSense`` ("配置无效", capture is the drive's touch probe here) and
+  ``filterType`` (the card's quadrature input filter) are stored.
+* ``[controlN]``: the card's servo loop; on a bus the drive closes the loop.  Only
+  ``errorLimit`` means something here: GT_SetPosErr(N) - unless that section says
+  ``active=0``.  The PID filters and smoothing are stored.
+* ``[dacN]``, ``[stepN]``, ``[gpoN]``, ``[gpiN]``, ``[enableN]``, ``[clearN]``,
+  ``[arriveN]``, ``[mpgN]``: pulse-card terminals (analogue out, pulse out, card IO, servo
+  enable, alarm clear, in-position, hand wheel).  On a bus the drive gets 607Ah, enable and
+  fault reset are 6040h, IO is ``GT_EcatIO*``: read, checked, stored, and named once in
+  the master log.
 
-Rules: keys and ``on``/``off`` (also 1/0, true/false, yes/no) are
-case-insensitive; a key left out keeps the controller's current setting (after
-GT_Reset: table 4-4); sections for axes the bus does not have are read and
-ignored (a file written for an 8-axis machine loads on a 2-axis bus); an
-unknown section or key, a bad value or a duplicate is an error naming the file
-and line (GT_LoadConfig returns 7) and nothing is applied.  An input set to
-``none`` cannot be switched by GT_AlarmOn/Off or GT_LmtsOn/Off (they return 1,
-as chapter 13 describes).  As 4.4 says, call GT_ClrSts after loading so that
-flags latched under the old configuration are re-evaluated.
+Rules: sections and keys are case-insensitive (the Windows INI functions are); comment
+lines start with ``;`` or ``#``, text after one on a line is a comment too; blank lines,
+CRLF / CR line ends, a UTF-8 BOM and GBK comments are fine.  A key left out keeps the
+controller's current setting (GT_Reset: table 4-4).  Sections for resources the bus does
+not have (axes 5-8 of an 8-axis file on a 4-axis bus) are checked and noted in the log.
+An unknown section or key, a malformed or out-of-range value, a duplicate key or section
+is :class:`ConfigFileError` (GT_LoadConfig 7) naming ``file:line`` and the key as written,
+and nothing is applied.  As 4.4 says, call GT_ClrSts after loading.
+
+gtecat's own earlier format (``[axis 1]``, ``alarm = off``, ``smooth_stop_dec = 2``,
+``soft_limit``...) is still read for one release, with a deprecation line in the master
+log; a file is taken for it when a section header has a space before its number or a key
+only that format has appears (:func:`is_legacy`).  Its reader is :func:`parse_legacy`.
 """
 
 from __future__ import annotations
 
 import re
+import weakref
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ParameterError
 from .motion import STOP_DEC_MAX, StopDecel
-from .safety import POS_ERR_MAX, StopInput
+from .safety import LIMIT_NEGATIVE_BIT, LIMIT_POSITIVE_BIT, POS_ERR_MAX, StopInput
 from .scale import Scale
 
 if TYPE_CHECKING:
     from .core import Controller
+    from .resources import AxisResources
 
 
 class ConfigFileError(ParameterError):
     """A configuration file that cannot be used (GT_LoadConfig returns 7)."""
 
 
-_SECTION = re.compile(r"^\[\s*(axis|encoder|profile)\s*(\d+)\s*\]$", re.IGNORECASE)
+# --- resource types (vendor header, gt.constants; the controller does not import gt) ------------
+MC_NONE = -1
+MC_LIMIT_POSITIVE = 0
+MC_LIMIT_NEGATIVE = 1
+MC_ALARM = 2
+MC_HOME = 3
+MC_GPI = 4
+MC_ARRIVE = 5
+MC_MPG = 6
+
+_SW_FAULT = 0x0008  # 6041h bit 3
+#: a bus input: section kind of its settings, PDO object, bit
+BUS_INPUTS: dict[int, tuple[str, int, int]] = {
+    MC_LIMIT_POSITIVE: ("limitPositive", 0x60FD, 1),
+    MC_LIMIT_NEGATIVE: ("limitNegative", 0x60FD, 0),
+    MC_HOME: ("home", 0x60FD, 2),
+    MC_ALARM: ("alarm", 0x6041, 3),
+}
+#: the card's own input terminals: no EtherCAT counterpart
+CARD_INPUTS = {MC_GPI: "gpi", MC_ARRIVE: "arrive", MC_MPG: "mpg"}
+_INPUT_TYPES = (MC_NONE, *BUS_INPUTS, *CARD_INPUTS)
+_SECTION_NUMBER_MAX = 0x7FFF
+_VALUE_CHARS_MAX = 40
+
+
+# --- values -------------------------------------------------------------------------------------
+_INT_RE = re.compile(r"[+-]?(?:0[xX][0-9a-fA-F]+|\d+)")
+_REAL_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _number(v: str) -> int | float:
+    if len(v) > _VALUE_CHARS_MAX:
+        raise ValueError(f"{len(v)} characters is not a number")
+    if _INT_RE.fullmatch(v):
+        sign = -1 if v[0] == "-" else 1
+        body = v.lstrip("+-")
+        return sign * (int(body, 16) if body[:2].lower() == "0x" else int(body, 10))
+    if _REAL_RE.fullmatch(v):
+        return float(v)
+    raise ValueError("not a number (decimal, 0x hex or a float)")
+
+
+def integer(v: str) -> int:
+    """Decimal, ``0x`` hex, or a float with an integral value (``1.000000``)."""
+    x = _number(v)
+    if isinstance(x, float):
+        if not x.is_integer():
+            raise ValueError("not an integer")
+        x = int(x)
+    return x
+
+
+def _ranged(lo: int, hi: int, what: str = "") -> Callable[[str], int]:
+    def parse(v: str) -> int:
+        x = integer(v)
+        if not lo <= x <= hi:
+            raise ValueError(f"{x} out of range {lo}..{hi}{what}")
+        return x
+
+    return parse
+
+
+def flag(v: str) -> bool:
+    x = integer(v)
+    if x not in (0, 1):
+        raise ValueError(f"{x} is not 0 or 1")
+    return bool(x)
+
+
+def real(v: str) -> float:
+    return float(_number(v))
+
+
+def stop_dec(v: str) -> float:
+    x = real(v)
+    if not 0 < x <= STOP_DEC_MAX:
+        raise ValueError(f"{x:g} not in (0, 32767] pulse/ms²")
+    return x
+
+
+def input_type(v: str) -> int:
+    x = integer(v)
+    if x not in _INPUT_TYPES:
+        raise ValueError(
+            f"type {x} is not a digital input: MC_NONE -1, MC_LIMIT_POSITIVE 0, "
+            "MC_LIMIT_NEGATIVE 1, MC_ALARM 2, MC_HOME 3, MC_GPI 4, MC_ARRIVE 5, MC_MPG 6"
+        )
+    return x
+
+
+def input_index(v: str) -> int:
+    x = integer(v)
+    if x != -1 and not 1 <= x <= _SECTION_NUMBER_MAX:
+        raise ValueError(f"index {x}: -1 (none) or a resource number 1..32767")
+    return x
+
+
+_mask = _ranged(0, 0xFFFFFFFF)
+_short = _ranged(-0x8000, 0x7FFF)
+_scale_part = _ranged(-0x7FFF, 0x7FFF)  # checked with its partner by Scale
+_error_limit = _ranged(1, POS_ERR_MAX, " pulse (GT_SetPosErr)")
+_capture_source = _ranged(0, 1, " (0 external encoder, 1 pulse counter)")
+_filter_time = _ranged(0, 0x7FFF)
+
+Parser = Callable[[str], Any]
+_INPUT_KEYS: dict[str, Parser] = {"active": flag, "reverse": flag, "filterTime": _filter_time}
+_OUTPUT_KEYS: dict[str, Parser] = {
+    "active": flag,
+    "axis": _short,
+    "axisItem": _short,
+    "reverse": flag,
+}
+
+#: every section kind and its keys, as the vendor spells them, with the value parser
+SCHEMA: dict[str, dict[str, Parser]] = {
+    "profile": {"active": flag, "decSmoothStop": stop_dec, "decAbruptStop": stop_dec},
+    "axis": {
+        "active": flag,
+        **{
+            f"{role}{part}": parse
+            for role in ("alarm", "limitPositive", "limitNegative", "smoothStop", "abruptStop")
+            for part, parse in (("Type", input_type), ("Index", input_index))
+        },
+        "prfMap": _mask,
+        "encMap": _mask,
+        **{
+            f"{m}Map{ab}{k}": _scale_part
+            for m in ("prf", "enc")
+            for k in (1, 2)
+            for ab in ("Alpha", "Beta")
+        },
+    },
+    "encoder": {
+        "active": flag,
+        "reverse": flag,
+        "filterType": _short,
+        "captureSource": _capture_source,
+        "captureHomeSense": flag,
+        "captureIndexSense": flag,
+    },
+    "control": {
+        "active": flag,
+        "axis": _short,
+        "encoder1": _short,
+        "encoder2": _short,
+        "errorLimit": _error_limit,
+        **{f"filterType{k}": _short for k in (1, 2, 3, 4)},
+        "encoderSmooth": _short,
+        "controlSmooth": _short,
+    },
+    "dac": {"active": flag, "control": _short, "reverse": flag, "bias": _short, "limit": _short},
+    "step": {"active": flag, "axis": _short, "mode": _short, "parameter": _short, "reverse": flag},
+    "gpo": _OUTPUT_KEYS,
+    "enable": _OUTPUT_KEYS,
+    "clear": _OUTPUT_KEYS,
+    "gpi": _INPUT_KEYS,
+    "limitPositive": _INPUT_KEYS,
+    "limitNegative": _INPUT_KEYS,
+    "home": _INPUT_KEYS,
+    "alarm": _INPUT_KEYS,
+    "arrive": _INPUT_KEYS,
+    "mpg": _INPUT_KEYS,
+}
+#: pulse-card terminals without an EtherCAT counterpart (read, checked, stored, logged)
+CARD_ONLY = ("dac", "step", "gpo", "gpi", "enable", "clear", "arrive", "mpg")
+#: resources numbered like the bus axes (a number past the last axis: noted in the log)
+PER_AXIS = (
+    "profile",
+    "axis",
+    "encoder",
+    "control",
+    "limitPositive",
+    "limitNegative",
+    "home",
+    "alarm",
+)
+
+_KINDS = {k.lower(): k for k in SCHEMA}
+_KEYS = {kind: {k.lower(): k for k in keys} for kind, keys in SCHEMA.items()}
+
+
+# --- the vendor format: model and reader ---------------------------------------------------------
+@dataclass(frozen=True, slots=True)
+class Setting:
+    """One ``key=value`` line: the value parsed, the key as written, its line."""
+
+    value: Any
+    key: str
+    line: int
+
+
+@dataclass(slots=True)
+class VendorSection:
+    kind: str  # as SCHEMA spells it
+    number: int
+    line: int
+    header: str  # as written, e.g. "axis1"
+    settings: dict[str, Setting] = field(default_factory=dict)
+
+    def values(self) -> dict[str, Any]:
+        return {k: s.value for k, s in self.settings.items()}
+
+
+@dataclass(slots=True)
+class VendorConfig:
+    """A parsed vendor ``*.cfg``: ``sections[(kind, number)]``."""
+
+    path: Path
+    sections: dict[tuple[str, int], VendorSection] = field(default_factory=dict)
+
+    def get(self, kind: str, number: int) -> dict[str, Any]:
+        s = self.sections.get((kind, number))
+        return s.values() if s is not None else {}
+
+    def numbers(self, kind: str) -> list[int]:
+        return sorted(n for k, n in self.sections if k == kind)
+
+
+_HEADER_RE = re.compile(r"\[\s*([A-Za-z]+)(\d+)\s*\]")
+
+
+_COMMENT = re.compile(r"[;#]")
+
+
+def _lines(text: str) -> Iterable[tuple[int, str]]:
+    """(line number, text without comment), comment-only and blank lines dropped."""
+    split = _COMMENT.split
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = split(raw, 1)[0].strip()
+        if line:
+            yield lineno, line
+
+
+def _error(path: Path, lineno: int, msg: str) -> ConfigFileError:
+    return ConfigFileError(f"{path}:{lineno}: {msg}")
+
+
+def parse_vendor(text: str, path: Path | str = "<text>") -> VendorConfig:
+    """Parse the vendor format; ConfigFileError naming ``path:line`` and the key as written."""
+    path = Path(path)
+    cfg = VendorConfig(path)
+    current: VendorSection | None = None
+    for lineno, line in _lines(text):
+        if line[0] == "[":
+            m = _HEADER_RE.fullmatch(line)
+            kind = _KINDS.get(m.group(1).lower()) if m else None
+            if m is None or kind is None:
+                raise _error(
+                    path,
+                    lineno,
+                    f"unknown section {line}; a section is a resource and its number, one of "
+                    + ", ".join(f"[{k}N]" for k in SCHEMA),
+                )
+            number = int(m.group(2))
+            if not 1 <= number <= _SECTION_NUMBER_MAX:
+                raise _error(
+                    path, lineno, f"section {line}: the number must be 1..{_SECTION_NUMBER_MAX}"
+                )
+            first = cfg.sections.get((kind, number))
+            if first is not None:
+                raise _error(
+                    path, lineno, f"section {line} appears twice (first at line {first.line})"
+                )
+            current = VendorSection(kind, number, lineno, line[1:-1].strip())
+            cfg.sections[(kind, number)] = current
+            continue
+        if "=" not in line:
+            raise _error(path, lineno, f"{line!r} is neither [section] nor key=value")
+        if current is None:
+            raise _error(path, lineno, f"{line!r} before any [section]")
+        written, _, value = line.partition("=")
+        written, value = written.strip(), value.strip()
+        key = _KEYS[current.kind].get(written.lower())
+        if key is None:
+            raise _error(
+                path,
+                lineno,
+                f"unknown key {written!r} in [{current.header}] "
+                f"(known: {', '.join(SCHEMA[current.kind])})",
+            )
+        first_setting = current.settings.get(key)
+        if first_setting is not None:
+            raise _error(
+                path,
+                lineno,
+                f"{written!r} given twice in [{current.header}] (first at line "
+                f"{first_setting.line})",
+            )
+        try:
+            parsed = SCHEMA[current.kind][key](value)
+        except ValueError as e:
+            raise _error(path, lineno, f"{written}={value!r} in [{current.header}]: {e}") from None
+        current.settings[key] = Setting(parsed, written, lineno)
+    for section in cfg.sections.values():
+        _check_section(section, path)
+    return cfg
+
+
+def _check_section(s: VendorSection, path: Path) -> None:
+    """What one key cannot check alone: the axis's maps and alpha/beta pairs."""
+    if s.kind != "axis":
+        return
+    n = s.number
+    own = 1 << (n - 1)
+    for m, what in (("prf", "profile"), ("enc", "encoder")):
+        st = s.settings.get(f"{m}Map")
+        if st is not None and st.value != own:
+            raise ConfigFileError(
+                f"{path}:{st.line}: {st.key}={st.value:#x} in [{s.header}]: on a bus, axis {n} "
+                f"takes {what} {n} alone ({st.key}={own:#x}); mapping other {what}s is not "
+                "supported"
+            )
+        alpha, beta = s.settings.get(f"{m}MapAlpha1"), s.settings.get(f"{m}MapBeta1")
+        if alpha is None and beta is None:
+            continue
+        if alpha is None or beta is None:
+            given = alpha or beta
+            assert given is not None
+            missing = f"{m}MapBeta1" if beta is None else f"{m}MapAlpha1"
+            raise ConfigFileError(
+                f"{path}:{given.line}: {given.key} in [{s.header}] needs {missing} too"
+            )
+        try:
+            Scale(alpha.value, beta.value)
+        except ParameterError as e:
+            raise ConfigFileError(
+                f"{path}:{beta.line}: {alpha.key}={alpha.value}, {beta.key}={beta.value} in "
+                f"[{s.header}]: {e}"
+            ) from None
+
+
+# --- gtecat's earlier format (deprecated; read for one release) --------------------------------
+_LEGACY_SECTION = re.compile(r"^\[\s*(axis|encoder|profile)\s*(\d+)\s*\]$", re.IGNORECASE)
 _ON = {"on": True, "1": True, "true": True, "yes": True}
 _OFF = {"off": False, "0": False, "false": False, "no": False}
-_UNSET = object()
 
 
 @dataclass
@@ -77,7 +447,7 @@ class Section:
 
 @dataclass
 class Config:
-    """A parsed configuration file: ``sections[(kind, number)]`` with typed values."""
+    """A parsed file of gtecat's earlier format: ``sections[(kind, number)]``."""
 
     path: Path
     sections: dict[tuple[str, int], Section] = field(default_factory=dict)
@@ -87,7 +457,6 @@ class Config:
         return s.values if s is not None else {}
 
 
-# --- value parsers ----------------------------------------------------------------------------
 def _switch(v: str) -> bool:
     low = v.lower()
     if low in _ON:
@@ -174,7 +543,7 @@ def _band(v: str) -> tuple[int, int]:
     return band, time
 
 
-KEYS: dict[str, dict[str, Any]] = {
+LEGACY_KEYS: dict[str, dict[str, Any]] = {
     "axis": {
         "active": _switch,
         "profile_scale": _scale,
@@ -194,11 +563,26 @@ KEYS: dict[str, dict[str, Any]] = {
     "encoder": {"active": _switch, "reverse": _switch, "source": _source},
     "profile": {"active": _switch, "smooth_stop_dec": _dec, "abrupt_stop_dec": _dec},
 }
+_LEGACY_ONLY = {k for keys in LEGACY_KEYS.values() for k in keys} - {"active", "reverse"}
+_SPACED_HEADER = re.compile(r"\[\s*[A-Za-z_]+\s+\d+\s*\]")
+_KEY_RE = re.compile(r"([^=\[\s]+)\s*=")
 
 
-# --- reading ----------------------------------------------------------------------------------
-def parse_config(text: str, path: Path | str = "<text>") -> Config:
-    """Parse the text of a configuration file (errors name ``path`` and the line)."""
+def is_legacy(text: str) -> bool:
+    """gtecat's earlier format: ``[axis 1]`` (a space before the number) or one of its keys."""
+    for _, line in _lines(text):
+        if line.startswith("["):
+            if _SPACED_HEADER.fullmatch(line):
+                return True
+            continue
+        m = _KEY_RE.match(line)
+        if m and m.group(1).lower() in _LEGACY_ONLY:
+            return True
+    return False
+
+
+def parse_legacy(text: str, path: Path | str = "<text>") -> Config:
+    """Parse gtecat's earlier format (errors name ``path`` and the line)."""
     path = Path(path)
     cfg = Config(path)
     current: Section | None = None
@@ -211,7 +595,7 @@ def parse_config(text: str, path: Path | str = "<text>") -> Config:
             return ConfigFileError(f"{path}:{lineno}: {msg}")
 
         if line.startswith("["):
-            m = _SECTION.match(line)
+            m = _LEGACY_SECTION.match(line)
             if not m:
                 raise fail(f"{line!r} is not a section [axis N], [encoder N] or [profile N]")
             kind, number = m.group(1).lower(), int(m.group(2))
@@ -227,11 +611,11 @@ def parse_config(text: str, path: Path | str = "<text>") -> Config:
             raise fail("a key before any [section]")
         key, value = (p.strip() for p in line.split("=", 1))
         key = key.lower()
-        parser = KEYS[current.kind].get(key)
+        parser = LEGACY_KEYS[current.kind].get(key)
         if parser is None:
             raise fail(
                 f"unknown key {key!r} in [{current.kind} {current.number}] "
-                f"(known: {', '.join(KEYS[current.kind])})"
+                f"(known: {', '.join(LEGACY_KEYS[current.kind])})"
             )
         if key in current.values:
             raise fail(f"{key!r} given twice in [{current.kind} {current.number}]")
@@ -242,21 +626,314 @@ def parse_config(text: str, path: Path | str = "<text>") -> Config:
     return cfg
 
 
-def read_config(path: str | Path) -> Config:
+# --- reading ------------------------------------------------------------------------------------
+def parse_config(text: str, path: Path | str = "<text>") -> VendorConfig | Config:
+    """Parse either format (told apart by :func:`is_legacy`)."""
+    text = text.lstrip("\ufeff").rstrip("\x1a")  # a BOM; a DOS end-of-file mark
+    if is_legacy(text):
+        return parse_legacy(text, path)
+    return parse_vendor(text, path)
+
+
+def decode(data: bytes) -> str:
+    """The file's text: UTF-8 (with or without BOM) or UTF-16 with BOM, else GBK (the
+    vendor tool's Chinese Windows), else Latin-1; values are ASCII, so only comments
+    can suffer."""
+    if data.startswith(b"\xef\xbb\xbf"):
+        return data[3:].decode("utf-8", "replace")
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):  # Notepad's "Unicode"
+        return data.decode("utf-16", "replace")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        pass
+    try:
+        return data.decode("gbk")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+def read_config(path: str | Path) -> VendorConfig | Config:
     """Read and parse a configuration file; ConfigFileError (7) when missing or bad."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        data = p.read_bytes()
     except FileNotFoundError:
         raise ConfigFileError(f"configuration file {p} not found (cwd {Path.cwd()})") from None
-    except (OSError, UnicodeDecodeError) as e:
+    except (OSError, ValueError) as e:
         raise ConfigFileError(f"configuration file {p} cannot be read: {e}") from None
-    return parse_config(text, p)
+    return parse_config(decode(data), p)
 
 
-# --- applying ---------------------------------------------------------------------------------
-def apply_config(ctl: Controller, cfg: Config) -> None:
-    """Apply ``cfg`` to the controller's axes (the caller checked that none moves)."""
+# --- what a vendor file leaves on the controller --------------------------------------------------
+@dataclass
+class _State:
+    """Vendor settings loaded since GT_Reset, merged (a later file overrides key by key)."""
+
+    axes: tuple[int, ...]
+    values: dict[tuple[str, int], dict[str, Any]] = field(default_factory=dict)
+
+
+_STATES: weakref.WeakKeyDictionary[Any, _State] = weakref.WeakKeyDictionary()
+
+
+def _axes_id(ctl: Controller) -> tuple[int, ...]:
+    return tuple(id(ax) for ax in ctl.axes.values())
+
+
+def _state(ctl: Controller) -> _State:
+    st = _STATES.get(ctl)
+    if st is None or st.axes != _axes_id(ctl):  # none yet, or the bus was brought up anew
+        st = _STATES[ctl] = _State(_axes_id(ctl))
+    if _forget not in ctl.on_reset:
+        ctl.on_reset.append(_forget)
+    return st
+
+
+def _forget(ctl: Controller) -> None:
+    """GT_Reset: every resource back to table 4-4, the loaded settings forgotten."""
+    _STATES.pop(ctl, None)
+
+
+def vendor_settings(ctl: Controller) -> dict[tuple[str, int], dict[str, Any]]:
+    """Every vendor-format value loaded since GT_Reset, by ``(kind, number)`` - also those
+    that act on nothing here (filter times, card terminals): ``[("limitPositive", 1)]
+    ["filterTime"]``.  A copy."""
+    st = _STATES.get(ctl)
+    if st is None or st.axes != _axes_id(ctl):
+        return {}
+    return {k: dict(v) for k, v in st.values.items()}
+
+
+# --- applying a vendor file -----------------------------------------------------------------------
+class SensedInput:
+    """A bus input seen through the configuration: ``get()`` gives ``mask_out`` while the
+    source bit (``mask_in`` of the PDO entry) is active, inverted when ``reverse``; it stands
+    where :class:`AxisResources` reads a raw 6041h / 60FDh entry."""
+
+    __slots__ = ("entry", "mask_in", "mask_out", "reverse")
+
+    def __init__(self, entry: Any, mask_in: int, mask_out: int, reverse: bool) -> None:
+        self.entry = entry
+        self.mask_in = mask_in
+        self.mask_out = mask_out
+        self.reverse = reverse
+
+    def get(self) -> int:
+        return self.mask_out if bool(self.entry.get() & self.mask_in) != self.reverse else 0
+
+
+@dataclass(frozen=True, slots=True)
+class _Role:
+    """One input of an axis: its keys, its Safety fields, where AxisResources reads it."""
+
+    name: str  # for the log
+    key: str  # [axisN] key prefix
+    natural: int | None  # the type Safety's axis-number input stands for (None: stop input)
+    input_attr: str  # Safety field: axis number (or StopInput)
+    on_attr: str | None  # Safety field switched by GT_AlarmOn/Off, GT_LmtsOn/Off
+    entry_attr: str  # AxisResources attribute holding the entry
+    mask_out: int | None  # what AxisResources tests (None: the stop input's mask)
+
+
+_ROLES = (
+    _Role("alarm", "alarm", MC_ALARM, "alarm_input", "alarm_on", "_alarm_sw", _SW_FAULT),
+    _Role(
+        "positive limit",
+        "limitPositive",
+        MC_LIMIT_POSITIVE,
+        "positive_input",
+        "positive_on",
+        "_pos_din",
+        LIMIT_POSITIVE_BIT,
+    ),
+    _Role(
+        "negative limit",
+        "limitNegative",
+        MC_LIMIT_NEGATIVE,
+        "negative_input",
+        "negative_on",
+        "_neg_din",
+        LIMIT_NEGATIVE_BIT,
+    ),
+    _Role("smooth stop", "smoothStop", None, "smooth_stop_input", None, "_smooth_in", None),
+    _Role("abrupt stop", "abruptStop", None, "abrupt_stop_input", None, "_abrupt_in", None),
+)
+_BIT_TYPE = {bit: t for t, (_, obj, bit) in BUS_INPUTS.items() if obj == 0x60FD}
+_Source = tuple[int, int]  # (MC_* type, index); index -1 = none
+
+
+def _current_source(res: AxisResources, role: _Role) -> _Source | None:
+    """The source the axis has now when no vendor file named one (None: leave it alone)."""
+    value = getattr(res.safety, role.input_attr)
+    if value is None:
+        return (MC_NONE, -1)
+    if role.natural is not None:
+        return (role.natural, value)
+    if value.bit in _BIT_TYPE:
+        return (_BIT_TYPE[value.bit], value.axis)
+    return None  # an earlier-format AXIS:BIT stop input of another bit: kept as it is
+
+
+def apply_vendor(ctl: Controller, cfg: VendorConfig) -> None:
+    """Apply a vendor ``*.cfg`` to the bus axes (the caller checked that none moves)."""
+    st = _state(ctl)
+    for (kind, n), section in cfg.sections.items():
+        st.values.setdefault((kind, n), {}).update(section.values())
+    notes: list[str] = []
+    for n, ax in sorted(ctl.axes.items()):
+        res: AxisResources = ax.motion
+        p = cfg.get("profile", n)
+        if "active" in p:
+            res.profile.active = p["active"]
+        if "decSmoothStop" in p or "decAbruptStop" in p:
+            d = res.profile.stop_dec
+            res.profile.stop_dec = StopDecel(
+                p.get("decSmoothStop", d.smooth), p.get("decAbruptStop", d.abrupt)
+            )
+        a = cfg.get("axis", n)
+        if "active" in a:
+            res.safety.active = a["active"]
+        if "prfMapAlpha1" in a:
+            res.set_profile_scale(Scale(a["prfMapAlpha1"], a["prfMapBeta1"]))
+        if "encMapAlpha1" in a:
+            res.set_enc_scale(Scale(a["encMapAlpha1"], a["encMapBeta1"]))
+        e = cfg.get("encoder", n)
+        if "active" in e:
+            res.encoder.active = e["active"]
+        if "reverse" in e:
+            res.encoder.sense = 1 if e["reverse"] else -1  # 1: the reset state (module doc)
+        if "captureSource" in e:
+            res.set_encoder_source(e["captureSource"] == 0)
+        c = cfg.get("control", n)
+        if "errorLimit" in c and c.get("active", True):
+            res.safety.set_pos_err(c["errorLimit"])
+    _wire_inputs(ctl, cfg, st, notes)
+    _log_vendor(ctl, cfg, notes)
+
+
+def _wire_inputs(ctl: Controller, cfg: VendorConfig, st: _State, notes: list[str]) -> None:
+    """Alarm, limit and stop inputs of every axis from the merged settings; senses last."""
+    sensed: list[tuple[AxisResources, _Role, Any, int, bool]] = []
+    for n, ax in sorted(ctl.axes.items()):
+        res: AxisResources = ax.motion
+        merged = st.values.get(("axis", n), {})
+        here = cfg.get("axis", n)
+        for role in _ROLES:
+            tkey, ikey = f"{role.key}Type", f"{role.key}Index"
+            current = _current_source(res, role)
+            if current is None and tkey not in merged and ikey not in merged:
+                continue
+            base = current or (MC_NONE, -1)
+            kind_t = merged.get(tkey, base[0])
+            index = merged.get(ikey, base[1])
+            changed = tkey in here or ikey in here
+            s = res.safety
+            if index == -1 or kind_t == MC_NONE:
+                setattr(s, role.input_attr, None)
+                continue
+            if kind_t in CARD_INPUTS:
+                setattr(s, role.input_attr, None)
+                notes.append(
+                    f"axis {n} {role.name} = {CARD_INPUTS[kind_t]}{index}, a card terminal: none"
+                )
+                continue
+            kind, obj, bit = BUS_INPUTS[kind_t]
+            settings = st.values.get((kind, index), {})
+            active = settings.get("active", True)
+            reverse = settings.get("reverse", False)
+            if role.on_attr is None:  # a stop input: an inactive source is no input
+                if not active:
+                    setattr(s, role.input_attr, None)
+                    continue
+                setattr(s, role.input_attr, StopInput(index, bit))
+            else:
+                setattr(s, role.input_attr, index)
+                if changed or "active" in cfg.get(kind, index):
+                    setattr(s, role.on_attr, active)
+            if index not in ctl.axes:
+                notes.append(f"axis {n} {role.name} = {kind}{index}: no axis {index} on this bus")
+            elif ctl.axes[index].io.get(obj) is None:
+                notes.append(
+                    f"axis {n} {role.name} = {kind}{index}: axis {index} maps no 0x{obj:04X}"
+                )
+            elif reverse or (kind_t != role.natural if role.natural is not None else obj != 0x60FD):
+                sensed.append((res, role, ctl.axes[index].io.get(obj), bit, reverse))
+                if reverse and kind_t == MC_ALARM:
+                    notes.append(
+                        f"axis {n} {role.name} = alarm{index} reverse=1: active while drive "
+                        f"{index} is not in fault"
+                    )
+    for ax in ctl.axes.values():
+        ax.motion.bind_inputs()
+    for res, role, entry, bit, reverse in sensed:
+        if not hasattr(res, role.entry_attr):  # AxisResources renamed it: fail loudly in tests
+            raise AttributeError(f"AxisResources has no {role.entry_attr}")
+        out = role.mask_out if role.mask_out is not None else 1 << bit
+        setattr(res, role.entry_attr, SensedInput(entry, 1 << bit, out, reverse))
+
+
+def _ranges(numbers: Iterable[int]) -> str:
+    """1,2,3,5 -> '1-3,5'."""
+    out: list[str] = []
+    run: list[int] = []
+    for n in sorted(numbers):
+        if run and n == run[-1] + 1:
+            run.append(n)
+            continue
+        if run:
+            out.append(f"{run[0]}-{run[-1]}" if len(run) > 1 else str(run[0]))
+        run = [n]
+    if run:
+        out.append(f"{run[0]}-{run[-1]}" if len(run) > 1 else str(run[0]))
+    return ",".join(out)
+
+
+def _log_vendor(ctl: Controller, cfg: VendorConfig, notes: list[str]) -> None:
+    name = cfg.path.name
+    axes = sorted(ctl.axes)
+    ctl.log(
+        f"GT_LoadConfig {name}: {len(cfg.sections)} sections read, applied to axes {_ranges(axes)}"
+    )
+    ignored = [f"[{k}{_ranges(cfg.numbers(k))}]" for k in CARD_ONLY if cfg.numbers(k)]
+    if cfg.numbers("control"):
+        ignored.append(f"[control{_ranges(cfg.numbers('control'))}] but errorLimit")
+    if ignored:
+        ctl.log(
+            f"GT_LoadConfig {name}: pulse-card resources without an EtherCAT counterpart, "
+            f"accepted and ignored: {' '.join(ignored)}"
+        )
+    missing = [
+        f"[{k}{_ranges(beyond)}]"
+        for k in PER_AXIS
+        if (beyond := [n for n in cfg.numbers(k) if n not in ctl.axes])
+    ]
+    if missing:
+        ctl.log(
+            f"GT_LoadConfig {name}: this bus has axes {_ranges(axes)}; accepted and not "
+            f"applied: {' '.join(missing)}"
+        )
+    if notes:
+        ctl.log(f"GT_LoadConfig {name}: inputs: {'; '.join(notes)}")
+
+
+# --- applying -------------------------------------------------------------------------------------
+def apply_config(ctl: Controller, cfg: VendorConfig | Config) -> None:
+    """Apply a parsed file of either format (the caller checked that no axis moves)."""
+    if isinstance(cfg, VendorConfig):
+        apply_vendor(ctl, cfg)
+    else:
+        apply_legacy(ctl, cfg)
+
+
+def apply_legacy(ctl: Controller, cfg: Config) -> None:
+    """Apply a file of gtecat's earlier format; a deprecation line in the master log."""
+    ctl.log(
+        f"GT_LoadConfig {cfg.path.name}: gtecat's own configuration format is deprecated and "
+        "will not be read after the next release; write the vendor's *.cfg format "
+        "(docs/config_file.md)"
+    )
+    _STATES.pop(ctl, None)  # its inputs replace any a vendor file set
     for n, ax in ctl.axes.items():
         res = ax.motion
         a = cfg.get("axis", n)
