@@ -23,6 +23,39 @@ def library_path(*, force_build: bool = False) -> Path:
     return ensure_built(force=force_build).library
 
 
+def cdll():
+    """``ctypes.CDLL`` of libgts with every function's ``argtypes``/``restype`` set from the
+    function table: pointers as ``c_void_p`` (so ``0`` works as NULL, as with the vendor
+    DLL on 32-bit Windows), scalars in their C types, ``short`` returns.
+
+    A plain ``ctypes.CDLL(library_path())`` works too; without argtypes, pass ``None``
+    (not ``0``) for a NULL pointer, since ctypes passes a bare ``0`` as a 32-bit int.
+    """
+    import ctypes
+
+    from ..gt.table import FUNCTIONS, SCALARS
+
+    lib = ctypes.CDLL(str(library_path()))
+
+    def ctype(p):
+        if p.pointer:
+            return ctypes.c_void_p
+        return getattr(ctypes, SCALARS[p.ctype][0])
+
+    for proto in FUNCTIONS.values():
+        types = [ctype(p) for p in proto.params]
+        names = [(proto.name, types)]
+        if proto.gtn:
+            names.append(("GTN_" + proto.name[3:], [ctypes.c_short, *types]))
+        for name, argtypes in names:
+            fn = getattr(lib, name)
+            fn.argtypes = argtypes
+            fn.restype = ctypes.c_short
+    lib.GTE_GetLastError.argtypes = [ctypes.c_char_p, ctypes.c_short]
+    lib.GTE_GetLastError.restype = ctypes.c_short
+    return lib
+
+
 def include_dir() -> Path:
     """The directory holding ``gts.h`` (built with the library)."""
     from .build import ensure_built
@@ -30,4 +63,4 @@ def include_dir() -> Path:
     return ensure_built().include_dir
 
 
-__all__ = ["include_dir", "library_path"]
+__all__ = ["cdll", "include_dir", "library_path"]

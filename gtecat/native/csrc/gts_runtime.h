@@ -35,9 +35,14 @@ typedef union gte_arg {
 
 /* Marshal one call, send it to the controller, copy the out-pointers back, return the code.
  * gtn: 1 for GTN_x (the core is checked), 0 for GT_x / GTE_x. */
-short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a);
+#if defined(__GNUC__)
+#define GTE_INTERNAL __attribute__((visibility("hidden")))
+#else
+#define GTE_INTERNAL
+#endif
+GTE_INTERNAL short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a);
 
 /* the interpreter that built the library (generated beside the stubs) */
-extern const char gte_default_python[];
+GTE_INTERNAL extern const char gte_default_python[];
 
 #endif
