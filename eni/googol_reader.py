@@ -24,6 +24,9 @@ order and keyed by ``name``, never by ``ParamN``.  Items:
 The reader is tolerant of what hand edits do (case, spaces, CRLF, comments,
 blank lines, unknown sections and keys) and strict about what changes the
 image (counts and lists that disagree raise :class:`EniError` with the line).
+Every number it uses is checked against its range in :mod:`eni.limits`
+(``cycletime0`` 0 means "not given", as the tool writes it with DC off; any
+other value must lie in 31.25 us .. 1 s).
 The logical image is ours to lay out: slaves in order, each slave's outputs
 byte-aligned in the output image, its inputs likewise in the input image.
 """
@@ -36,6 +39,25 @@ from dataclasses import dataclass, field
 
 from .check import check_config
 from .errors import EniError
+from .limits import (
+    CYCLE_NS,
+    ENABLED,
+    ENTRY_BITS,
+    ENTRY_POS,
+    IDENTITY,
+    INDEX,
+    NSERVO,
+    PDO_COUNT,
+    POSITION,
+    SDO_SIZE,
+    SERVO_TYPE,
+    SLAVE_COUNT,
+    SM,
+    SUBINDEX,
+    SYNC_DIR,
+    Limit,
+    sdo_value,
+)
 from .model import (
     Direction,
     EniConfig,
@@ -46,7 +68,7 @@ from .model import (
     ProcessDataArea,
     Slave,
 )
-from .numbers import fmt_index
+from .numbers import TooLong, fmt_index, parse_int, shown
 
 _SECTION = re.compile(r"^\[\s*([^\]]*?)\s*\]\s*$")
 _LINE = re.compile(r"^(?:[^=]*=)?\s*name\s*=\s*(?P<name>[^,]*?)\s*(?P<rest>,.*)?$", re.I)
@@ -58,6 +80,14 @@ _SYNC_PDO = re.compile(r"^slave_sync(\d+)_pdo$", re.I)
 _SYNC_ENTRY = re.compile(r"^slave_sync(\d+)_pdo_entry$", re.I)
 
 Value = int | float | str
+#: stands for a number with more digits than any field holds (:data:`eni.numbers.MAX_DIGITS`):
+#: every range refuses it, and the error shows the text as written
+_BEYOND = 1 << 256
+#: a value checked after the ones it depends on (a start SDO value, by its size)
+_ANY = Limit(-_BEYOND, _BEYOND, "checked with its size")
+_ON = ("enabled", ENABLED)
+#: a slave_iomap gap (index 0) may carry any length an entry may
+_MAP_BITS = Limit(0, ENTRY_BITS.hi, ENTRY_BITS.why)
 
 
 @dataclass
@@ -65,6 +95,8 @@ class _Item:
     name: str
     values: list[Value]
     line: int
+    #: the values as written, for error messages
+    raw: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -81,12 +113,14 @@ def _value(kind: str, raw: str) -> Value:
         return v
     if k == "FLOAT":
         return float(v)
-    if k == "HEX":
-        return int(v[2:] if v.lower().startswith(("0x", "#x")) else v, 16)
+    sign, digits = (v[0], v[1:]) if v[:1] in ("-", "+") else ("", v)
+    if k == "HEX" and not digits.lower().startswith(("0x", "#x")):
+        digits = "0x" + digits
     # DWORD, WORD, BYTE, INT...: decimal, tolerating a hex spelling
-    if v.lower().startswith(("0x", "#x")):
-        return int(v[2:], 16)
-    return int(v, 10)
+    try:
+        return parse_int(sign + digits)
+    except TooLong:
+        return -_BEYOND if sign == "-" else _BEYOND
 
 
 def _decode(data: bytes | str) -> str:
@@ -131,24 +165,26 @@ def _tokenise(text: str, source: str) -> tuple[dict[str, list[_Item]], list[_Blo
         if m is None:
             if section.startswith("slave"):
                 raise EniError(
-                    f"cannot read line {line!r} (expected name=...,Section=...,Value=...)",
+                    f"cannot read line {shown(line)} (expected name=...,Section=...,Value=...)",
                     file=source,
                     line=lineno,
                     element=f"[{section}]",
                 )
             continue  # unknown syntax in a section we do not use
         values: list[Value] = []
+        raws: list[str] = []
         for pm in _PAIR.finditer(m.group("rest") or ""):
             try:
                 values.append(_value(pm.group("t"), pm.group("v")))
+                raws.append(pm.group("v").strip())
             except ValueError:
                 raise EniError(
-                    f"value {pm.group('v')!r} is not a valid {pm.group('t').strip()}",
+                    f"value {shown(pm.group('v'))} is not a valid {shown(pm.group('t'))}",
                     file=source,
                     line=lineno,
                     element=f"[{section}] {m.group('name')}",
                 ) from None
-        item = _Item(m.group("name").strip().lower(), values, lineno)
+        item = _Item(m.group("name").strip().lower(), values, lineno, raws)
         if current is not None and section != "slaveend":
             current.sections.setdefault(section, []).append(item)
         else:
@@ -160,17 +196,48 @@ def _first(items: list[_Item], name: str) -> _Item | None:
     return next((i for i in items if i.name == name), None)
 
 
-def _int_item(items: list[_Item], name: str) -> int | None:
+Fail = Callable[[str, int | None, str], EniError]
+
+
+def _checked(item: _Item, k: int, limit: Limit, what: str, fail: Fail, element: str) -> int:
+    """Value ``k`` of ``item``, an integer inside ``limit`` (:mod:`eni.limits`)."""
+    v = item.values[k]
+    raw = item.raw[k] if k < len(item.raw) else str(v)
+    if not isinstance(v, int):
+        raise fail(f"{what} {shown(raw)} is not an integer: legal is {limit}", item.line, element)
+    try:
+        return limit.check(v, what, raw)
+    except ValueError as exc:
+        raise fail(str(exc), item.line, element) from None
+
+
+def _int_item(items: list[_Item], name: str, limit: Limit, fail: Fail, section: str) -> int | None:
+    """The first value of item ``name`` (None when absent or empty), checked."""
     it = _first(items, name)
-    if it is None or not it.values or not isinstance(it.values[0], int):
+    if it is None or not it.values:
         return None
-    return it.values[0]
+    return _checked(it, 0, limit, name, fail, f"[{section}] {name}")
+
+
+def _or_not_given(fail: Fail) -> Fail:
+    def or_zero(msg: str, line: int | None, element: str) -> EniError:
+        return fail(f"{msg}, or 0 for not given", line, element)
+
+    return or_zero
+
+
+def _global_fail(source: str) -> Fail:
+    def fail(msg: str, line: int | None, element: str) -> EniError:
+        return EniError(msg, file=source, line=line, element=element)
+
+    return fail
 
 
 def read_googol(data: bytes | str, source: str) -> EniConfig:
     """Build the model from a Googol INI ``Gecat.eni`` (see module doc)."""
     glob, blocks = _tokenise(_decode(data), source)
-    declared = _int_item(glob.get("slaveindex", []), "slavenum")
+    gfail = _global_fail(source)
+    declared = _int_item(glob.get("slaveindex", []), "slavenum", SLAVE_COUNT, gfail, "SlaveIndex")
     if declared is None and not blocks:
         # an explicit slavenum=0 is an empty bus; saying nothing at all is a broken file
         raise EniError(
@@ -190,7 +257,9 @@ def read_googol(data: bytes | str, source: str) -> EniConfig:
     parsed: list[tuple[int, Slave]] = []
     cycle_ns: int | None = None
     for order, block in enumerate(blocks):
-        pos = _int_item(block.sections.get("slavestart", []), "position")
+        pos = _int_item(
+            block.sections.get("slavestart", []), "position", POSITION, gfail, "SlaveStart"
+        )
         slave, cycle = _slave(block, order if pos is None else pos, order, source)
         parsed.append((order if pos is None else pos, slave))
         if cycle_ns is None and cycle:
@@ -260,54 +329,68 @@ def read_googol(data: bytes | str, source: str) -> EniConfig:
     return cfg
 
 
-def _ints(item: _Item, n: int, source: str, who: dict[str, object]) -> list[int]:
-    vals = item.values
-    if len(vals) < n or not all(isinstance(v, int) for v in vals[:n]):
-        raise EniError(
-            f"{item.name} needs {n} integer values, found {vals!r}",
-            file=source,
-            line=item.line,
-            element=item.name,
-            **who,
-        )  # type: ignore[arg-type]
-    return [int(v) for v in vals]
+def _ints(
+    item: _Item, fields: tuple[tuple[str, Limit], ...], fail: Fail, section: str, optional: int = 0
+) -> list[int]:
+    """The values of ``item`` named and checked by ``fields`` (the last ``optional`` may lack)."""
+    element = f"[{section}] {item.name}"
+    n = len(fields) - optional
+    if len(item.values) < n:
+        names = ", ".join(what for what, _ in fields[:n])
+        found = ", ".join(shown(r) for r in item.raw[:8])
+        raise fail(
+            f"{item.name} needs {n} integer values ({names}), found [{found}]", item.line, element
+        )
+    return [
+        _checked(item, k, limit, what, fail, element)
+        for k, (what, limit) in enumerate(fields)
+        if k < len(item.values)
+    ]
 
 
 def _slave(block: _Block, pos: int, order: int, source: str) -> tuple[Slave, int | None]:
     info = block.sections.get("slave_info", [])
     name_item = _first(info, "slavename")
     name = str(name_item.values[0]) if name_item and name_item.values else f"Slave {pos}"
-    who: dict[str, object] = {"slave": pos, "slave_name": name}
 
     def err(msg: str, line: int | None, element: str) -> EniError:
         return EniError(msg, file=source, line=line, slave=pos, slave_name=name, element=element)
 
-    vid = _int_item(info, "vid")
-    pcode = _int_item(info, "pcode")
+    vid = _int_item(info, "vid", IDENTITY, err, "slave_info")
+    pcode = _int_item(info, "pcode", IDENTITY, err, "slave_info")
     if vid is None or pcode is None:
         raise err(
             "slave_info has no vid/pcode (vendor id and product code)",
             block.section_lines.get("slave_info", block.line),
             "[slave_info]",
         )
-    stype = _int_item(info, "type")
-    nservo = _int_item(info, "nservo")
-    revision = _int_item(info, "revision") or _int_item(info, "revisionno") or 0
+    stype = _int_item(info, "type", SERVO_TYPE, err, "slave_info")
+    nservo = _int_item(info, "nservo", NSERVO, err, "slave_info")
+    revision = (
+        _int_item(info, "revision", IDENTITY, err, "slave_info")
+        or _int_item(info, "revisionno", IDENTITY, err, "slave_info")
+        or 0
+    )
 
     # sync managers: sm -> direction (1 outputs, 2 inputs) and PDO count
     syncs: dict[int, tuple[Direction, int, int]] = {}
     for it in block.sections.get("slave_sync", []):
         if it.name != "syncitem":
             continue
-        sm, dcode, npdo = _ints(it, 3, source, who)[:3]
-        if dcode not in (1, 2):
-            raise err(
-                f"sync manager {sm} direction {dcode} is neither 1 (outputs) nor 2 (inputs)",
-                it.line,
-                "[slave_sync] syncitem",
-            )
+        sm, dcode, npdo = _ints(
+            it,
+            (("sync manager", SM), ("direction", SYNC_DIR), ("PDO count", PDO_COUNT)),
+            err,
+            "slave_sync",
+        )
         syncs[sm] = (Direction.OUT if dcode == 1 else Direction.IN, npdo, it.line)
-    pdo_sections = {int(m.group(1)): sec for sec in block.sections if (m := _SYNC_PDO.match(sec))}
+    pdo_sections: dict[int, str] = {}
+    for sec in block.sections:
+        if m := _SYNC_PDO.match(sec):
+            try:
+                pdo_sections[SM.parse(m.group(1), "sync manager")] = sec
+            except ValueError as exc:
+                raise err(str(exc), block.section_lines.get(sec), "[slave_syncN_PDO]") from None
     for sm in pdo_sections:
         if sm not in syncs and sm in (2, 3):  # tolerate a missing slave_sync: SM2 out, SM3 in
             syncs[sm] = (Direction.OUT if sm == 2 else Direction.IN, -1, 0)
@@ -329,20 +412,25 @@ def _slave(block: _Block, pos: int, order: int, source: str) -> tuple[Slave, int
             )
         entries: list[tuple[PdoEntry, bool]] = []
         for it in eitems:
-            vals = _ints(it, 3, source, who)
+            vals = _ints(
+                it,
+                (("index", INDEX), ("subindex", SUBINDEX), ("bit length", ENTRY_BITS), _ON),
+                err,
+                esec,
+                optional=1,
+            )
             index, sub, bits = vals[:3]
-            if bits <= 0 or not 0 <= index <= 0xFFFF or not 0 <= sub <= 0xFF:
-                raise err(
-                    f"entry {fmt_index(index & 0xFFFF, sub & 0xFF)} with {bits} bits is "
-                    "not a valid mapping",
-                    it.line,
-                    f"[{esec}] entryitem",
-                )
             enabled = len(vals) < 4 or vals[3] != 0
             entries.append((PdoEntry(index, sub, bits), enabled))
         cursor = 0
         for it in pitems:
-            vals = _ints(it, 2, source, who)
+            vals = _ints(
+                it,
+                (("PDO index", INDEX), ("entry count", PDO_COUNT), ("first entry", ENTRY_POS), _ON),
+                err,
+                psec,
+                optional=2,
+            )
             pindex, count = vals[0], vals[1]
             first = vals[2] if len(vals) > 2 else cursor
             enabled = len(vals) < 4 or vals[3] != 0
@@ -366,13 +454,13 @@ def _slave(block: _Block, pos: int, order: int, source: str) -> tuple[Slave, int
     for it in block.sections.get("slave_startsdo", []):
         if it.name != "startitem":
             continue
-        index, sub, size, value = _ints(it, 4, source, who)[:4]
-        if not 1 <= size <= 8:
-            raise err(
-                f"start SDO {fmt_index(index, sub)} size {size} is not 1..8 bytes",
-                it.line,
-                "[slave_startsdo] startitem",
-            )
+        index, sub, size = _ints(
+            it,
+            (("index", INDEX), ("subindex", SUBINDEX), ("size", SDO_SIZE), ("value", _ANY)),
+            err,
+            "slave_startsdo",
+        )[:3]
+        value = _checked(it, 3, sdo_value(size), "value", err, "[slave_startsdo] startitem")
         init_cmds.append(
             InitCmd(
                 ("PS",),
@@ -385,8 +473,12 @@ def _slave(block: _Block, pos: int, order: int, source: str) -> tuple[Slave, int
 
     cycle = None
     for it in block.sections.get("slave_dc", []):
-        if it.name == "cycletime0" and it.values and isinstance(it.values[0], int):
-            cycle = it.values[0] or None
+        if it.name == "cycletime0" and it.values:
+            # 0 is "not given" (the tool writes it with DC off); else 31.25 us .. 1 s
+            if it.values[0] != 0:
+                cycle = _checked(
+                    it, 0, CYCLE_NS, "cycletime0", _or_not_given(err), "[slave_dc] cycletime0"
+                )
             break
 
     slave = Slave(
@@ -404,9 +496,7 @@ def _slave(block: _Block, pos: int, order: int, source: str) -> tuple[Slave, int
     return slave, cycle
 
 
-def _check_iomap(
-    block: _Block, rx: list[Pdo], tx: list[Pdo], err: Callable[[str, int | None, str], EniError]
-) -> None:
+def _check_iomap(block: _Block, rx: list[Pdo], tx: list[Pdo], err: Fail) -> None:
     """``slave_iomap`` lists the outputs then the inputs (GT raw order): it must agree."""
     items = [i for i in block.sections.get("slave_iomap", []) if i.name == "mapitem"]
     if not items:
@@ -416,12 +506,13 @@ def _check_iomap(
     ]
     listed: list[tuple[tuple[int, int, int], int]] = []
     for it in items:
-        vals = it.values
-        if len(vals) < 3 or not all(isinstance(v, int) for v in vals[:3]):
-            raise err(
-                f"mapitem needs 3 integer values, found {vals!r}", it.line, "[slave_iomap] mapitem"
-            )
-        key = (int(vals[0]), int(vals[1]), int(vals[2]))
+        vals = _ints(
+            it,
+            (("index", INDEX), ("subindex", SUBINDEX), ("bit length", _MAP_BITS)),
+            err,
+            "slave_iomap",
+        )
+        key = (vals[0], vals[1], vals[2])
         if key[0] != 0:
             listed.append((key, it.line))
     for k, (key, line) in enumerate(listed):

@@ -30,11 +30,16 @@ def _head_bytes(data: bytes | str) -> bytes:
     if isinstance(data, str):
         return data[:8192].encode("utf-8", "replace")
     head = data[:8192]
-    if head.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 with BOM
-        try:
-            return data[:16384].decode("utf-16").encode("utf-8", "replace")[:8192]
-        except UnicodeDecodeError:
-            return head
+    for bom, codec, width in (
+        (b"\x00\x00\xfe\xff", "utf-32-be", 4),
+        (b"\xff\xfe\x00\x00", "utf-32-le", 4),
+        (b"\xff\xfe", "utf-16-le", 2),
+        (b"\xfe\xff", "utf-16-be", 2),
+    ):
+        if head.startswith(bom):
+            # decode whole code units only (the cut may fall inside a character)
+            part = data[len(bom) : len(bom) + 4096 * width]
+            return part.decode(codec, "replace").encode("utf-8", "replace")[:8192]
     return head
 
 

@@ -76,6 +76,7 @@ from .datatypes import (
     type_bits,
 )
 from .errors import EniError
+from .limits import cycle_ns_from_us
 from .model import (
     Direction,
     EniConfig,
@@ -141,6 +142,10 @@ def build_config(data: Mapping[str, Any], source: str = "<topology>") -> EniConf
         raise where.error(
             f"cycle_time_us must be a positive number, not {cycle_us!r}", "cycle_time_us"
         )
+    try:
+        cycle_ns = cycle_ns_from_us(cycle_us, "cycle_time_us")
+    except ValueError as exc:
+        raise where.error(str(exc), "cycle_time_us") from None
     tables = data.get("slave", [])
     if not isinstance(tables, list) or not all(isinstance(t, Mapping) for t in tables):
         raise where.error("'slave' must be an array of tables ([[slave]])", "slave")
@@ -153,7 +158,7 @@ def build_config(data: Mapping[str, Any], source: str = "<topology>") -> EniConf
             source=source,
             format="xml",
             slaves=tuple(slaves),
-            cycle_time_ns=round(cycle_us * 1000),
+            cycle_time_ns=cycle_ns,
             master_name=_text(where, data.get("master", "gtecat"), "master") or "gtecat",
         )
     )

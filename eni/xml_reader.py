@@ -37,6 +37,23 @@ from dataclasses import dataclass, field, replace
 from .check import check_config
 from .datatypes import CIA402_OBJECTS, type_bits
 from .errors import EniError
+from .limits import (
+    AUTO_INC_ADDR,
+    BIT_LENGTH,
+    BIT_OFFSET,
+    CCS,
+    ENTRY_BITS,
+    IDENTITY,
+    IMAGE_BYTES,
+    INDEX,
+    PHYS_ADDR,
+    SM,
+    SUBINDEX,
+    TIMEOUT_MS,
+    Limit,
+    check_span,
+    cycle_ns_from_us,
+)
 from .model import (
     Direction,
     EniConfig,
@@ -48,7 +65,7 @@ from .model import (
     Slave,
     Variable,
 )
-from .numbers import fmt_index, parse_hex_bytes, parse_int
+from .numbers import fmt_index, parse_hex_bytes
 from .xmltree import Node
 
 _SM_TAG = re.compile(r"^Sm(\d+)$")
@@ -81,20 +98,32 @@ class _Ctx:
         self,
         node: Node,
         tag: str,
+        limit: Limit,
         *,
         required: bool = False,
         default: int | None = None,
         element: str | None = None,
     ) -> int | None:
+        """The integer in child ``tag``, checked against ``limit`` (:mod:`eni.limits`)."""
         child = node.find(tag)
         if child is None or not child.text.strip():
             if required:
                 raise self.error(f"missing <{tag}>", node, element or node.tag)
             return default
         try:
-            return parse_int(child.text)
+            return limit.parse(child.text, tag)
         except ValueError as exc:
             raise self.error(str(exc), child, element or tag) from None
+
+    def int_attr(self, node: Node, name: str, limit: Limit, element: str) -> int | None:
+        """The integer in attribute ``name`` (None when absent or empty), checked."""
+        text = node.attrib.get(name, "")
+        if not text.strip():
+            return None
+        try:
+            return limit.parse(text, name)
+        except ValueError as exc:
+            raise self.error(str(exc), node, element) from None
 
 
 @dataclass
@@ -197,18 +226,17 @@ def read_xml(root: Node, source: str) -> EniConfig:
 
 
 def _cycle_time(ctx: _Ctx, config: Node) -> int | None:
+    """``Cyclic/CycleTime`` (us) in ns; absent or empty is "not given", 0 is refused.
+
+    The legal range is 31.25 us .. 1 s (:data:`eni.limits.CYCLE_NS`).
+    """
     for cyc in config.findall("Cyclic"):
         node = cyc.find("CycleTime")
         if node is not None and node.text.strip():
             try:
-                us = float(node.text.strip()) if "." in node.text else parse_int(node.text)
+                return cycle_ns_from_us(node.text, "CycleTime")
             except ValueError as exc:
                 raise ctx.error(str(exc), node, "Cyclic/CycleTime") from None
-            if us <= 0:
-                raise ctx.error(
-                    f"cycle time {node.text.strip()} us is not positive", node, "Cyclic/CycleTime"
-                )
-            return round(us * 1000)
     return None
 
 
@@ -226,15 +254,21 @@ def _process_image(
             continue
         d = Direction.IN if part.tag == "Inputs" else Direction.OUT
         bs = part.find("ByteSize")
-        sizes[d] = (ctx.int_of(part, "ByteSize", element=f"ProcessImage/{part.tag}/ByteSize"), bs)
+        byte_size = ctx.int_of(
+            part, "ByteSize", IMAGE_BYTES, element=f"ProcessImage/{part.tag}/ByteSize"
+        )
+        sizes[d] = (byte_size, bs)
         for vnode in part.findall("Variable"):
             elem = f"ProcessImage/{part.tag}/Variable"
             name = vnode.findtext("Name") or ""
-            size = ctx.int_of(vnode, "BitSize", required=True, element=elem)
-            offs = ctx.int_of(vnode, "BitOffs", required=True, element=elem)
+            size = ctx.int_of(vnode, "BitSize", BIT_LENGTH, required=True, element=elem)
+            offs = ctx.int_of(vnode, "BitOffs", BIT_OFFSET, required=True, element=elem)
             assert size is not None and offs is not None
-            if size < 0 or offs < 0:
-                raise ctx.error(f"negative BitSize/BitOffs for {name!r}", vnode, elem)
+            # no check against ByteSize: TwinCAT lists variables (InfoData) past its image
+            try:
+                check_span(offs, size, f"variable {name!r}")
+            except ValueError as exc:
+                raise ctx.error(str(exc), vnode, elem) from None
             var = Variable(name, d, offs, size, vnode.findtext("DataType") or "")
             variables.append(var)
             index.by_name.setdefault((d, name), []).append(var)
@@ -248,17 +282,18 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
         raise ctx.error("slave has no <Info>", snode, "Slave")
     name = info.findtext("Name") or f"Slave {pos}"
     ctx.slave_name = name
-    vendor = ctx.int_of(info, "VendorId", required=True, element="Info/VendorId")
-    product = ctx.int_of(info, "ProductCode", required=True, element="Info/ProductCode")
+    vendor = ctx.int_of(info, "VendorId", IDENTITY, required=True, element="Info/VendorId")
+    product = ctx.int_of(info, "ProductCode", IDENTITY, required=True, element="Info/ProductCode")
     assert vendor is not None and product is not None
     identity = Identity(
         vendor_id=vendor,
         product_code=product,
-        revision_no=ctx.int_of(info, "RevisionNo", default=0) or 0,
-        serial_no=ctx.int_of(info, "SerialNo", default=0) or 0,
+        revision_no=ctx.int_of(info, "RevisionNo", IDENTITY, default=0) or 0,
+        serial_no=ctx.int_of(info, "SerialNo", IDENTITY, default=0) or 0,
     )
-    phys = ctx.int_of(info, "PhysAddr", default=0) or 0
-    auto_inc = ctx.int_of(info, "AutoIncAddr", default=0) or 0
+    phys = ctx.int_of(info, "PhysAddr", PHYS_ADDR, default=0) or 0
+    # the 16-bit register value: "-1" and "65535" are the same auto-increment address
+    auto_inc = (ctx.int_of(info, "AutoIncAddr", AUTO_INC_ADDR, default=0) or 0) & 0xFFFF
 
     rx: tuple[Pdo, ...] = ()
     tx: tuple[Pdo, ...] = ()
@@ -297,13 +332,14 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
 def _area(ctx: _Ctx, pd: Node, tag: str) -> _Area | None:
     found: list[_Area] = []
     for node in pd.findall(tag):
-        start = ctx.int_of(node, "BitStart", required=True, element=f"ProcessData/{tag}")
-        length = ctx.int_of(node, "BitLength", required=True, element=f"ProcessData/{tag}")
+        elem = f"ProcessData/{tag}"
+        start = ctx.int_of(node, "BitStart", BIT_OFFSET, required=True, element=elem)
+        length = ctx.int_of(node, "BitLength", BIT_LENGTH, required=True, element=elem)
         assert start is not None and length is not None
-        if start < 0 or length < 0:
-            raise ctx.error(
-                f"negative BitStart/BitLength ({start}, {length})", node, f"ProcessData/{tag}"
-            )
+        try:
+            check_span(start, length, tag)
+        except ValueError as exc:
+            raise ctx.error(str(exc), node, elem) from None
         if length:
             found.append(_Area(start, length, node))
     if not found:
@@ -335,19 +371,23 @@ def _assigned_pdos(ctx: _Ctx, pd: Node) -> dict[Direction, list[_PdoXml] | None]
     for node in pd.children:
         m = _SM_TAG.match(node.tag)
         if m:
-            sm_no = int(m.group(1))
-        elif node.tag == "Sm" and ("No" in node.attrib or "Index" in node.attrib):
             try:
-                sm_no = parse_int(node.attrib.get("No", node.attrib.get("Index", "")))
+                sm_no = SM.parse(m.group(1), "sync manager")
             except ValueError as exc:
                 raise ctx.error(str(exc), node, "ProcessData/Sm") from None
+        elif node.tag == "Sm" and ("No" in node.attrib or "Index" in node.attrib):
+            attr = "No" if "No" in node.attrib else "Index"
+            no = ctx.int_attr(node, attr, SM, "ProcessData/Sm")
+            if no is None:
+                raise ctx.error(f"empty {attr} attribute", node, "ProcessData/Sm")
+            sm_no = no
         else:
             continue
         kind = (node.findtext("Type") or "").lower()
         listed = []
         for p in node.findall("Pdo"):
             try:
-                listed.append((parse_int(p.text), p))
+                listed.append((INDEX.parse(p.text, "PDO index"), p))
             except ValueError as exc:
                 raise ctx.error(str(exc), p, f"Sm{sm_no}/Pdo") from None
         sm_lists.append((sm_no, kind, listed))
@@ -413,33 +453,24 @@ class _Unassigned(list):  # type: ignore[type-arg]
 def _pdo(ctx: _Ctx, node: Node, order: int) -> _PdoXml:
     direction = Direction.OUT if node.tag == "RxPdo" else Direction.IN
     elem = node.tag
-    index = ctx.int_of(node, "Index", required=True, element=elem)
+    index = ctx.int_of(node, "Index", INDEX, required=True, element=elem)
     assert index is not None
     elem = f"{node.tag} #x{index:04X}"
-    sm_attr = None
-    if node.attrib.get("Sm", "").strip():
-        try:
-            sm_attr = parse_int(node.attrib["Sm"])
-        except ValueError as exc:
-            raise ctx.error(str(exc), node, elem) from None
+    sm_attr = ctx.int_attr(node, "Sm", SM, elem)
     entries: list[PdoEntry] = []
     lines: list[int] = []
     for enode in node.findall("Entry"):
-        eidx = ctx.int_of(enode, "Index", required=True, element=f"{elem}/Entry")
+        eidx = ctx.int_of(enode, "Index", INDEX, required=True, element=f"{elem}/Entry")
         assert eidx is not None
-        sub = ctx.int_of(enode, "SubIndex", default=0, element=f"{elem}/Entry") or 0
+        sub = ctx.int_of(enode, "SubIndex", SUBINDEX, default=0, element=f"{elem}/Entry") or 0
         eelem = f"{elem}/Entry {fmt_index(eidx, sub)}"
         dtype = enode.findtext("DataType") or ""
-        bits = ctx.int_of(enode, "BitLen", element=eelem)
+        bits = ctx.int_of(enode, "BitLen", ENTRY_BITS, element=eelem)
         if bits is None:
             bits = type_bits(dtype) if dtype else None
             if bits is None:
                 why = f"unknown data type {dtype!r}" if dtype else "no data type"
                 raise ctx.error(f"entry has no BitLen and {why}", enode, eelem)
-        if bits <= 0:
-            raise ctx.error(f"BitLen {bits} is not positive", enode, eelem)
-        if not 0 <= eidx <= 0xFFFF or not 0 <= sub <= 0xFF:
-            raise ctx.error("object address out of range", enode, eelem)
         if eidx == 0:  # a gap: tools may name it ("__unused"), it still maps nothing
             entries.append(PdoEntry(0, 0, bits))
         else:
@@ -673,12 +704,10 @@ def _init_cmd(ctx: _Ctx, node: Node) -> InitCmd:
     )
     if not transitions:
         raise ctx.error("InitCmd without <Transition>", node, elem)
-    index = ctx.int_of(node, "Index", required=True, element=elem)
-    sub = ctx.int_of(node, "SubIndex", default=0, element=elem) or 0
+    index = ctx.int_of(node, "Index", INDEX, required=True, element=elem)
+    sub = ctx.int_of(node, "SubIndex", SUBINDEX, default=0, element=elem) or 0
     assert index is not None
-    ccs = ctx.int_of(node, "Ccs", default=1, element=elem)
-    if ccs not in (1, 2):
-        raise ctx.error(f"Ccs {ccs} is neither 1 (download) nor 2 (upload)", node, elem)
+    ccs = ctx.int_of(node, "Ccs", CCS, default=1, element=elem)
     data_node = node.find("Data")
     data = b""
     if data_node is not None and data_node.text.strip():
@@ -694,6 +723,6 @@ def _init_cmd(ctx: _Ctx, node: Node) -> InitCmd:
         data=data,
         complete_access=_bool(ca),
         comment=node.findtext("Comment") or "",
-        timeout_ms=ctx.int_of(node, "Timeout", default=0, element=elem) or 0,
+        timeout_ms=ctx.int_of(node, "Timeout", TIMEOUT_MS, default=0, element=elem) or 0,
         upload=ccs == 2,
     )

@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from xml.parsers import expat
 
 from .errors import EniError
+from .numbers import shown
 
 
 class Node:
@@ -63,43 +64,72 @@ class Node:
         return f"<Node {self.tag} line {self.line}>"
 
 
-_DECL_ENCODING = re.compile(rb"^\s*<\?xml[^>]*?\bencoding\s*=\s*[\"']([A-Za-z0-9._:-]+)[\"']")
+_DECL_ENCODING = re.compile(rb"^\s*<\?xml[^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
 #: what expat decodes itself (XML 1.0 section 4.3.3 requires UTF-8 and UTF-16)
 _EXPAT_NATIVE = {"utf_8", "utf_16", "iso8859_1", "latin_1", "ascii"}
 #: GB2312 files written on Windows routinely hold GBK characters; GB18030 reads both
 _SUPERSET = {"gb2312": "gb18030", "gbk": "gb18030"}
+#: byte order marks, longest first (a UTF-32-LE BOM starts like UTF-16-LE's)
+_BOMS = (
+    (b"\x00\x00\xfe\xff", "utf-32"),
+    (b"\xff\xfe\x00\x00", "utf-32"),
+    (b"\xef\xbb\xbf", "utf-8-sig"),
+    (b"\xff\xfe", "utf-16"),
+    (b"\xfe\xff", "utf-16"),
+)
+
+
+def _decode(data: bytes, codec: str, what: str, source: str) -> str:
+    try:
+        return data.decode(codec)
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise EniError(
+            f"byte 0x{data[exc.start]:02X} is not valid {what}", file=source, line=line
+        ) from None
+    except UnicodeError as exc:  # codecs that refuse without a position (punycode, undefined)
+        raise EniError(f"the text is not valid {what}: {exc}", file=source, line=1) from None
 
 
 def _decoded(data: bytes, source: str) -> bytes | str:
-    """Decode a document whose declared encoding expat cannot handle (``GB2312``, ``Shift_JIS``).
+    """Decode a document whose encoding expat cannot handle (``GB2312``, ``Shift_JIS``).
 
+    A byte order mark decides over the declaration (XML 1.0 appendix F).
+    Otherwise the declaration decides, and only a text encoding is accepted:
+    ``encoding="rot13"`` or ``"base64"`` (Python codecs that are not
+    bytes-to-text) and names Python does not know are refused with the name.
     Chinese configuration tools write ``encoding="GB2312"``; expat only knows
     UTF-8/UTF-16/ISO-8859-1/ASCII (and refuses multi-byte codecs through
     pyexpat), so Python's codec decodes it and expat gets text.
     """
-    if data.startswith((b"\xef\xbb\xbf", b"\xff\xfe", b"\xfe\xff")):
-        return data  # a BOM decides, as XML 1.0 appendix F says
+    for bom, codec in _BOMS:
+        if data.startswith(bom):
+            return _decode(data, codec, f"{codec.upper()} (the byte order mark)", source)
     m = _DECL_ENCODING.match(data[:512])
     if m is None:
         return data
-    declared = m.group(1).decode("ascii")
+    declared = m.group(1).decode("ascii", "replace")
     try:
-        name = codecs.lookup(declared).name.replace("-", "_")
-    except LookupError:
+        info = codecs.lookup(declared)
+    except (LookupError, ValueError):  # ValueError: a NUL in the name
+        info = None
+    if info is None or not getattr(info, "_is_text_encoding", True):
+        what = "unknown encoding" if info is None else "not a text encoding:"
         raise EniError(
-            f"unknown encoding {declared!r} in the XML declaration", file=source, line=1
-        ) from None
-    if name in _EXPAT_NATIVE or name.startswith("utf_16"):
-        return data
-    try:
-        return data.decode(_SUPERSET.get(name, name))
-    except UnicodeDecodeError as exc:
-        line = data.count(b"\n", 0, exc.start) + 1
-        raise EniError(
-            f"byte 0x{data[exc.start]:02X} is not valid {declared} (the declared encoding)",
+            f"{what} {shown(declared)} in the XML declaration; the encoding must be a "
+            "text encoding such as UTF-8, UTF-16 or GB2312",
             file=source,
-            line=line,
-        ) from None
+            line=1,
+        )
+    name = info.name.replace("-", "_")
+    if name in _EXPAT_NATIVE:  # "UTF-16" without a BOM: expat tells the byte order from "<"
+        return data
+    return _decode(
+        data,
+        _SUPERSET.get(name, name),
+        f"{shown(declared, quote=False)} (the declared encoding)",
+        source,
+    )
 
 
 def _local(name: str) -> str:
@@ -161,7 +191,7 @@ def parse_xml(data: bytes | str, source: str) -> Node:
         msg = expat.errors.messages.get(exc.code, str(exc)) if exc.code else str(exc)
         raise EniError(f"malformed XML: {msg}", file=source, line=exc.lineno) from None
     except (ValueError, LookupError) as exc:  # an encoding pyexpat cannot use
-        raise EniError(f"cannot decode the XML: {exc}", file=source, line=1) from None
+        raise EniError(f"cannot decode the XML: {shown(str(exc))}", file=source, line=1) from None
     if not root:
         raise EniError("empty XML document", file=source)
     return root[0]
