@@ -8,8 +8,8 @@ and the program sends two periods (LOOP_TIMES).  One segment goes out per PLC
 scan while GT_PtSpace reports room: the data fill FIFO1 then FIFO2, the motion
 starts when both are full, and every time the controller has used up a FIFO it
 clears it and the program refills it - 7.4.2 (4).  The times are computed in
-seconds as the manual does (``ttime*1000``); GT_PtData takes a value within
-1e-6 of a whole millisecond as that millisecond.
+seconds as the manual does (``ttime*1000``) and rounded to the ``long`` time GT_PtData takes,
+as the conversion of the manual's LREAL expression to the DINT parameter does.
 """
 
 # ruff: noqa: N815  (the PLC variables keep the manual's names)
@@ -102,10 +102,10 @@ def plc_prg(v: PlcVars) -> None:
             v.pos += 1000 * (v.vel + v.velPre) * DELTA / 2  # displacement of the segment
             v.velPre = v.vel
             if v.ttime < v.loop * T:
-                v.rtn = gt.GT_PtData(v.Axis, v.pos, v.ttime * 1000, gt.PT_SEGMENT_NORMAL, 0)
+                v.rtn = gt.GT_PtData(v.Axis, v.pos, round(v.ttime * 1000), gt.PT_SEGMENT_NORMAL, 0)
                 commandhandler("GT_PtData", v.rtn)
             else:  # end of a period: back to 0 with a STOP segment
-                v.rtn = gt.GT_PtData(v.Axis, 0, v.loop * T * 1000, gt.PT_SEGMENT_STOP, 0)
+                v.rtn = gt.GT_PtData(v.Axis, 0, round(v.loop * T * 1000), gt.PT_SEGMENT_STOP, 0)
                 commandhandler("GT_PtData", v.rtn)
                 v.pos = 0.0
                 v.ttime = v.loop * T
