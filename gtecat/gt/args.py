@@ -102,6 +102,17 @@ class Ref:
     def growable(self) -> bool:
         return isinstance(self.py, list)
 
+    def readonly(self) -> bool:
+        """Memory the call cannot write (``bytes``, a read-only memoryview or numpy array)."""
+        t = self.py
+        if isinstance(t, bytes):
+            return True
+        if isinstance(t, memoryview):
+            return t.readonly
+        if isinstance(t, np.ndarray):
+            return not t.flags.writeable
+        return False
+
     # --- values ---------------------------------------------------------------------------
     def store_values(self, values: list[Any]) -> None:
         keep = self._keep
@@ -125,7 +136,12 @@ class Ref:
                 flat = t.reshape(-1)
                 if flat.size < n:
                     raise ParameterError(f"{self.name}: array of {flat.size} too small for {n}")
-                flat[:n] = values
+                try:
+                    flat[:n] = values
+                except (OverflowError, TypeError, ValueError) as e:  # narrower than the C type
+                    raise ParameterError(
+                        f"{self.name}: {values[:4]} do not fit a {t.dtype} array: {e}"
+                    ) from None
                 return
             raise ParameterError(f"{self.name}: a byte buffer cannot take numbers")
         have = self.capacity()
@@ -432,7 +448,7 @@ def _int_converter(p: Param) -> Converter:
 
 
 def _pointer_converter(p: Param) -> Converter:
-    name, optional = p.name, p.optional
+    name, optional, writes = p.name, p.optional, p.direction != "in"
 
     def conv(v: Any) -> Any:
         if type(v) is _CArgObject:  # byref(x): the common case
@@ -449,7 +465,13 @@ def _pointer_converter(p: Param) -> Converter:
             if optional:
                 return None
             raise ParameterError(f"{name} is NULL; this pointer is required")
-        return resolve(name, v)
+        ref = resolve(name, v)
+        if writes and ref.readonly():
+            raise ParameterError(
+                f"{name}: a read-only {type(v).__name__} cannot take what the call writes; "
+                "pass a bytearray, a writable array or a ctypes object"
+            )
+        return ref
 
     return conv
 
