@@ -147,6 +147,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         try:
             if core is not _ONE:
                 core = core_arg(core)
+                if not needs_ctl and core != 1:  # GTN_Open/GTN_Close: no other core exists
+                    raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
                 core = 1
             values, extra = bind(args, kwargs)
