@@ -120,6 +120,7 @@ class Ref:
             len(values) == 1
             and type(keep) is self.elem
             and self.nbytes == ctypes.sizeof(keep)
+            and isinstance(keep, _SIMPLE)  # byref(a structure) is refused below
             and keep._type_ not in _NOT_NUMERIC
         ):
             keep.value = fit(self.elem, values[0])  # byref(x) / x itself: the common case
