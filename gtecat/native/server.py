@@ -28,6 +28,7 @@ import contextlib
 import ctypes
 import logging
 import os
+import select
 import selectors
 import socket
 import threading
@@ -65,6 +66,12 @@ from .protocol import (
 
 log = logging.getLogger("gtecat.native.server")
 
+#: a client that sends half a frame, or stops reading replies, this long is dropped
+IO_TIMEOUT_S = 10.0
+#: how long the server keeps serving one client before it looks at the others
+#: (GTECAT_SERVER_SPIN_US; see Server._readable)
+DEFAULT_SPIN_US = 0
+
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
 
 
@@ -95,49 +102,65 @@ def _elem(ctype: str, long_size: int) -> Any:
     return cdecl.structure(ctype)
 
 
-@dataclass(slots=True)
+_INT, _DOUBLE, _TEXT, _ANY, _BUF = range(5)
+_i64 = I64.unpack_from
+_f64 = F64.unpack_from
+_ptr = PTR.unpack_from
+
+
 class _Decoder:
-    """One function's request layout for one client ``long`` size."""
+    """One function's request layout for one client ``long`` size, compiled once."""
 
-    plan: FunctionPlan
-    elems: tuple[Any, ...]
-    fn_gt: Any
-    fn_gtn: Any
+    __slots__ = ("_arrays", "fn_gt", "fn_gtn", "plan", "steps")
 
-    @classmethod
-    def make(cls, plan: FunctionPlan, long_size: int) -> _Decoder:
-        elems = tuple(
-            _elem(a.param.ctype, long_size) if a.param.pointer else None for a in plan.args
-        )
-        gt = _core.REGISTRY.get(plan.name)
-        gtn = _core.REGISTRY.get("GTN_" + plan.name[3:]) if plan.proto.gtn else None
-        return cls(plan, elems, gt, gtn)
+    def __init__(self, plan: FunctionPlan, long_size: int) -> None:
+        self.plan = plan
+        steps = []
+        for a in plan.args:
+            if a.kind is Kind.INT:
+                steps.append((_INT, None, 0, False, a.param.name))
+            elif a.kind is Kind.DOUBLE:
+                steps.append((_DOUBLE, None, 0, False, a.param.name))
+            else:
+                code = {Kind.TEXT: _TEXT, Kind.OUT_ANY: _ANY}.get(a.kind, _BUF)
+                elem = _elem(a.param.ctype, long_size)
+                steps.append((code, elem, ctypes.sizeof(elem), a.carries_back, a.param.name))
+        self.steps = tuple(steps)
+        self._arrays: dict[tuple[Any, int], Any] = {}
+        self.fn_gt = _core.REGISTRY.get(plan.name)
+        self.fn_gtn = _core.REGISTRY.get("GTN_" + plan.name[3:]) if plan.proto.gtn else None
+
+    def _array(self, elem: Any, n: int) -> Any:
+        key = (elem, n)
+        t = self._arrays.get(key)
+        if t is None:
+            t = self._arrays[key] = elem * n
+        return t
 
     def decode(self, body: memoryview, pos: int) -> tuple[list[Any], list[Any]]:
         """(arguments for the GT function, out-buffers in order; None for NULL)."""
         args: list[Any] = []
         backs: list[Any] = []
         end = len(body)
-        for a, elem in zip(self.plan.args, self.elems, strict=True):
-            k = a.kind
-            if k is Kind.INT:
-                args.append(I64.unpack_from(body, pos)[0])
+        for code, elem, esize, back, name in self.steps:
+            if code == _INT:
+                args.append(_i64(body, pos)[0])
                 pos += 8
                 continue
-            if k is Kind.DOUBLE:
-                args.append(F64.unpack_from(body, pos)[0])
+            if code == _DOUBLE:
+                args.append(_f64(body, pos)[0])
                 pos += 8
                 continue
-            (size,) = PTR.unpack_from(body, pos)
+            size = _ptr(body, pos)[0]
             pos += 4
             if size == PTR_NULL:
                 args.append(None)
-                if a.carries_back:
+                if back:
                     backs.append(None)
                 continue
             if size == PTR_UNKNOWN:
-                if k is not Kind.OUT_ANY:
-                    raise ProtocolError(f"{self.plan.name}: size unknown for {a.param.name}")
+                if code != _ANY:
+                    raise ProtocolError(f"{self.plan.name}: size unknown for {name}")
                 buf: Any = []  # grows to what the call writes
                 args.append(buf)
                 backs.append(buf)
@@ -145,21 +168,20 @@ class _Decoder:
             if size == PTR_TOO_BIG:
                 size, data = 0, b""
             elif size < 0 or pos + size > end:
-                raise ProtocolError(f"{self.plan.name}: bad size {size} for {a.param.name}")
+                raise ProtocolError(f"{self.plan.name}: bad size {size} for {name}")
             else:
                 data = body[pos : pos + size]
                 pos += size
-            if k is Kind.TEXT:
+            if code == _TEXT:
                 args.append(bytes(data))
                 continue
             raw = bytearray(data)
-            esize = ctypes.sizeof(elem)
             if size % esize:
-                arr: Any = (ctypes.c_ubyte * size).from_buffer(raw)
+                arr: Any = self._array(ctypes.c_ubyte, size).from_buffer(raw)
             else:
-                arr = (elem * (size // esize)).from_buffer(raw)
+                arr = self._array(elem, size // esize).from_buffer(raw)
             args.append(arr)
-            if a.carries_back:
+            if back:
                 backs.append(raw)
         if pos != end:
             raise ProtocolError(f"{self.plan.name}: {end - pos} bytes left after the arguments")
@@ -177,15 +199,17 @@ class _Client:
 
 
 def _reply(rc: int, backs: list[Any], text: str) -> bytes:
-    blocks = []
+    parts = []
+    n = 0
     for b in backs:
         if b is None:
             continue
         data = bytes(b) if not isinstance(b, list) else bytes(int(v) & 0xFF for v in b)
-        blocks.append(BLOCK.pack(len(data)))
-        blocks.append(data)
-    t = text.encode("utf-8", "replace")[:4000]
-    body = REPLY.pack(rc, len(blocks) // 2, len(t)) + b"".join(blocks) + t
+        parts.append(BLOCK.pack(len(data)))
+        parts.append(data)
+        n += 1
+    t = text.encode("utf-8", "replace")[:4000] if text else b""
+    body = REPLY.pack(rc, n, len(t)) + b"".join(parts) + t
     return FRAME.pack(len(body)) + body
 
 
@@ -200,11 +224,15 @@ class Server:
         wall_floor: bool = True,
         lifeline_fd: int | None = None,
         remove_dir: bool = False,
+        spin_us: float | None = None,
     ) -> None:
         self.address = address
         self.path = socket_path(address)
         self.open_options = dict(open_options or {})
         self.wall_floor = wall_floor
+        if spin_us is None:
+            spin_us = float(os.environ.get("GTECAT_SERVER_SPIN_US", DEFAULT_SPIN_US))
+        self.spin_s = max(0.0, spin_us) / 1e6
         self.lock = threading.RLock()
         self.calls = 0
         self._floor: WallFloor | None = None
@@ -313,8 +341,7 @@ class Server:
             sock, _ = self._listener.accept()
         except BlockingIOError:
             return
-        sock.setblocking(True)
-        sock.settimeout(10.0)  # a client that stops reading its reply cannot stall the others
+        sock.setblocking(False)
         client = _Client(sock, peer=f"fd {sock.fileno()}")
         self._clients[sock] = client
         self._sel.register(sock, selectors.EVENT_READ, client)
@@ -326,36 +353,96 @@ class Server:
         c.sock.close()
 
     def _readable(self, c: _Client) -> None:
-        try:
-            data = c.sock.recv(1 << 16)
-        except OSError:
-            data = b""
-        if not data:
-            self._drop(c)
-            return
+        """Serve what ``c`` sent; then, for ``spin_s``, serve its next request at once
+        (a client polling in a loop sends it within microseconds; answering it without
+        a round through the selector, and without either side falling asleep, roughly
+        halves the round trip)."""
+        sock = c.sock
+        deadline = 0.0
+        while True:
+            try:
+                data = sock.recv(1 << 16)
+            except BlockingIOError:
+                if not self.spin_s:
+                    return
+                now = time.perf_counter()
+                if not deadline:
+                    deadline = now + self.spin_s
+                if now >= deadline:
+                    return
+                continue
+            except OSError:
+                data = b""
+            if not data:
+                self._drop(c)
+                return
+            deadline = 0.0
+            if not self._frames(c, data):
+                return
+
+    def _frames(self, c: _Client, data: bytes) -> bool:
+        """Answer every whole frame in the client's buffer; False once it is dropped."""
         buf = c.buf
+        if not buf and len(data) >= 4 and FRAME.unpack_from(data, 0)[0] == len(data) - 4:
+            # the usual case: exactly one whole request
+            try:
+                self._send(c.sock, self._message(c, memoryview(data)[4:]))
+            except (ProtocolError, OSError) as e:
+                log.info("client %s: %s; connection closed", c.peer, e)
+                self._drop(c)
+                return False
+            return True
         buf += data
         try:
             while len(buf) >= 4:
                 (n,) = FRAME.unpack_from(buf, 0)
                 if n > MAX_FRAME:
                     raise ProtocolError(f"frame of {n} bytes")
-                while len(buf) < 4 + n:  # the rest of the frame is on its way
-                    more = c.sock.recv(max(4 + n - len(buf), 1 << 16))
-                    if not more:
-                        self._drop(c)
-                        return
-                    buf += more
+                if len(buf) < 4 + n:
+                    self._wait_rest(c, 4 + n)
                 body = memoryview(bytes(buf[4 : 4 + n]))
                 del buf[: 4 + n]
-                reply = self._message(c, body)
-                c.sock.sendall(reply)
+                self._send(c.sock, self._message(c, body))
         except ProtocolError as e:
             log.warning("client %s: %s; connection closed", c.peer, e)
             self._drop(c)
+            return False
         except OSError as e:
             log.info("client %s: %s; connection closed", c.peer, e)
             self._drop(c)
+            return False
+        return True
+
+    @staticmethod
+    def _wait_rest(c: _Client, need: int) -> None:
+        """The rest of a frame is on its way: read it (OSError after 10 s without it)."""
+        buf = c.buf
+        deadline = time.monotonic() + IO_TIMEOUT_S
+        while len(buf) < need:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([c.sock], [], [], left)[0]:
+                raise OSError("a frame cut short (no more bytes within 10 s)")
+            more = c.sock.recv(max(need - len(buf), 1 << 16))
+            if not more:
+                raise OSError("the connection closed inside a frame")
+            buf += more
+
+    @staticmethod
+    def _send(sock: socket.socket, data: bytes) -> None:
+        """Send a reply; a client that stops reading for 10 s is dropped (OSError)."""
+        view = memoryview(data)
+        deadline = 0.0
+        while view:
+            try:
+                view = view[sock.send(view) :]
+                continue
+            except BlockingIOError:
+                pass
+            if not deadline:
+                deadline = time.monotonic() + IO_TIMEOUT_S
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([], [sock], [], left)[1]:
+                raise OSError("the client does not read its replies")
 
     # --- messages ------------------------------------------------------------------------
     def _message(self, c: _Client, body: memoryview) -> bytes:
@@ -374,7 +461,7 @@ class Server:
             table = plans()
             if fid >= len(table):
                 raise ProtocolError(f"function id {fid} unknown")
-            dec = c.decoders[fid] = _Decoder.make(table[fid], c.long_size)
+            dec = c.decoders[fid] = _Decoder(table[fid], c.long_size)
         args, backs = dec.decode(body, CALL.size)
         with self.lock:
             rc, text = self._call(c, dec, bool(gtn), core, args)

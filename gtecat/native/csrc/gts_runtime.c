@@ -128,9 +128,37 @@ static int send_all(int fd, const unsigned char *p, size_t n, long long deadline
     return 0;
 }
 
+/* How long a call spins for its reply before it sleeps in poll (GTECAT_SPIN_US,
+ * default 0: never spin).  The controller usually answers within tens of
+ * microseconds; waking a sleeping thread costs about as much again, more in a VM. */
+static long spin_ns(void)
+{
+    static long cached = -1;
+    if (cached < 0) {
+        const char *v = getenv("GTECAT_SPIN_US");
+        long us = 0;
+        if (v && *v) {
+            char *end;
+            long x = strtol(v, &end, 10);
+            if (*end == '\0' && x >= 0)
+                us = x;
+        }
+        cached = us * 1000;
+    }
+    return cached;
+}
+
+static long long now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
+}
+
 /* 0 ok; -1 error (errno); -2 the peer closed the connection */
 static int recv_all(int fd, unsigned char *p, size_t n, long long deadline)
 {
+    long long spin_until = 0;
     while (n) {
         ssize_t r = recv(fd, p, n, MSG_DONTWAIT);
         if (r > 0) {
@@ -143,6 +171,14 @@ static int recv_all(int fd, unsigned char *p, size_t n, long long deadline)
         if (errno == EINTR)
             continue;
         if (errno == EAGAIN || errno == EWOULDBLOCK) {
+            long spin = spin_ns();
+            if (spin > 0) {
+                long long t = now_ns();
+                if (!spin_until)
+                    spin_until = t + spin;
+                if (t < spin_until)
+                    continue;
+            }
             if (wait_fd(fd, POLLIN, deadline) < 0)
                 return -1;
             continue;

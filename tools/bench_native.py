@@ -1,0 +1,150 @@
+"""Round trip of one ``GT_GetSts`` from C through libgts and the controller; prints JSON.
+
+    python tools/bench_native.py [--calls 20000] [--clock auto|lockstep|realtime]
+                                 [--eni examples/manual_fig5_2.eni] [--no-wall-floor]
+
+A C program (compiled here with ``$(python3 -m gtecat lib --cflags --libs)``) opens a
+private controller, brings the bus up, enables axis 1 and then times each of
+``--calls`` calls of ``GT_GetSts(1, &sts, 1, NULL)`` with ``clock_gettime``.  In
+``auto`` every call charges 50 us of virtual latency, so one call in twenty also runs a
+bus cycle: that is the tail (p99); ``lockstep`` shows the bare round trip.
+Quality bar (issue 13): p50 <= 30 us, p99 <= 200 us.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+PROGRAM = r"""
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include <unistd.h>
+#include "gts.h"
+
+static long long ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (long long)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+int main(int argc, char **argv)
+{
+    int n = argc > 1 ? atoi(argv[1]) : 20000;
+    short st = 0;
+    if (GT_Open(0, 1) || GT_InitEcatComm())
+        return 2;
+    for (int i = 0; i < 2000 && !st; i++) {
+        GT_IsEcatReady(&st);
+        if (!st) {
+            GTE_Wait(1);
+        }
+    }
+    GT_StartEcatComm();
+    GT_AxisOn(1);
+    GTE_Wait(20);
+    long sts = 0;
+    for (int i = 0; i < 200; i++)
+        GT_GetSts(1, &sts, 1, NULL); /* warm up */
+    long long *d = malloc(sizeof *d * (size_t)n);
+    long long start = ns();
+    for (int i = 0; i < n; i++) {
+        long long t0 = ns();
+        if (GT_GetSts(1, &sts, 1, NULL) != 0)
+            return 3;
+        d[i] = ns() - t0;
+    }
+    long long total = ns() - start;
+    unsigned long clock_ms = 0;
+    GT_GetClock(&clock_ms, NULL);
+    printf("%lld %lu\n", total, clock_ms);
+    for (int i = 0; i < n; i++)
+        printf("%lld\n", d[i]);
+    GT_Close();
+    return 0;
+}
+"""
+
+
+def percentiles(samples_ns: list[int]) -> dict[str, float]:
+    data = sorted(samples_ns)
+    n = len(data)
+
+    def pct(p: float) -> float:
+        return round(data[min(n - 1, int(p * n))] / 1000.0, 1)
+
+    return {
+        "mean": round(sum(data) / n / 1000.0, 1),
+        "p50": pct(0.5),
+        "p90": pct(0.9),
+        "p99": pct(0.99),
+        "max": round(data[-1] / 1000.0, 1),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--calls", type=int, default=20000)
+    ap.add_argument("--clock", default="auto", choices=("auto", "lockstep", "realtime"))
+    ap.add_argument("--eni", default=str(ROOT / "examples" / "manual_fig5_2.eni"))
+    ap.add_argument("--no-wall-floor", action="store_true")
+    args = ap.parse_args(argv)
+
+    from gtecat.native.build import ensure_built
+
+    build = ensure_built()
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "bench.c"
+        exe = Path(tmp) / "bench"
+        src.write_text(PROGRAM)
+        subprocess.run(
+            ["cc", "-O2", str(src), *build.cflags(), *build.libs(), "-o", str(exe)], check=True
+        )
+        env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+        env.update(GTECAT_ENI=args.eni, GTECAT_CLOCK=args.clock, GTECAT_LOG="")
+        if args.no_wall_floor:
+            env["GTECAT_WALL_FLOOR"] = "0"
+        r = subprocess.run(
+            [str(exe), str(args.calls)], capture_output=True, text=True, env=env, cwd=tmp
+        )
+    if r.returncode != 0:
+        print(r.stderr, file=sys.stderr)
+        return 1
+    lines = r.stdout.split()
+    total_ns, clock_ms = int(lines[0]), int(lines[1])
+    samples = [int(x) for x in lines[2:]]
+    stats = percentiles(samples)
+    result = {
+        "call": "GT_GetSts(1, &sts, 1, NULL) from C",
+        "clock": args.clock,
+        "wall_floor": not args.no_wall_floor and args.clock == "auto",
+        "calls": len(samples),
+        "round_trip_us": stats,
+        "calls_per_s": round(len(samples) / (total_ns / 1e9)),
+        "controller_ms_at_end": clock_ms,
+        "target": {"p50_us": 30, "p99_us": 200},
+        "meets_target": stats["p50"] <= 30 and stats["p99"] <= 200,
+        "machine": {
+            "cpus": os.cpu_count(),
+            "load": os.getloadavg()[0],
+            "python": sys.version.split()[0],
+            "platform": platform.platform(),
+        },
+    }
+    print(json.dumps(result, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
