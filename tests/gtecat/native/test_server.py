@@ -1,0 +1,181 @@
+"""The controller's protocol, spoken by a test client built from the same plans as libgts."""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import random
+import socket
+import struct
+
+import pytest
+
+from gtecat import gt
+from gtecat.gt import _core
+from gtecat.gt.table import SCALARS
+from gtecat.native import cdecl, protocol
+from gtecat.native.server import Server
+
+from .conftest import FIG5_2
+from .wire_client import WireClient
+
+
+@pytest.fixture
+def served(tmp_path):
+    """This process's gt session, bus up, served on a socket."""
+    gt.GT_Close()
+    assert gt.GT_Open(eni=str(FIG5_2), clock="lockstep", log="") == 0
+    assert gt.GT_InitEcatComm() == 0
+    gt.GTE_Wait(50)
+    address = f"unix:{tmp_path}/s.sock"
+    with Server(address, wall_floor=False) as server:
+        yield server, address
+    gt.GT_Close()
+
+
+def test_calls_before_gt_open_return_minus_1(served):
+    _, address = served
+    c = WireClient(address)
+    rc, blocks, text = c.call("GT_GetSts", 1, 8, 1, None)
+    assert rc == -1
+    assert "GT_Open" in text
+    assert c.call("GT_Open", 0, 1)[0] == 0  # attaches to the open controller
+    rc, blocks, _ = c.call("GT_GetSts", 1, 8, 1, None)
+    assert rc == 0 and len(blocks) == 1
+    assert c.call("GT_Close")[0] == 0
+    assert c.call("GT_GetSts", 1, 8, 1, None)[0] == -1
+    c.close()
+
+
+def test_a_library_of_another_table_is_refused(served):
+    _, address = served
+    c = WireClient(address, digest="0123456789abcdef")
+    assert c.hello_status == 1
+    assert "another gtecat" in c.hello_text
+    with pytest.raises((ConnectionError, OSError)):
+        c.call("GT_Open", 0, 1)  # calls before a good hello close the connection
+
+
+def test_a_malformed_request_closes_only_that_connection(served):
+    _, address = served
+    good = WireClient(address)
+    assert good.call("GT_Open", 0, 1)[0] == 0
+    bad = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    bad.settimeout(5)
+    bad.connect(address[5:])
+    bad.sendall(struct.pack("<I", 3) + b"\x07xx")
+    assert bad.recv(10) == b""  # closed
+    assert good.call("GT_GetSts", 1, 8, 1, None)[0] == 0
+
+
+def test_out_bytes_the_call_does_not_write_come_back_unchanged(served):
+    _, address = served
+    c = WireClient(address)
+    c.call("GT_Open", 0, 1)
+    target = b"\xee" * 8
+    rc, blocks, _ = c.call("GT_EcatSDOUpload", 0, 0x6041, 0, target, 8, 8, 8)
+    assert rc == 0
+    data, size, abort = blocks
+    assert abort == bytes(8)
+    assert struct.unpack("<Q", size)[0] == 2
+    assert data[2:] == b"\xee" * 6  # only the object's 2 bytes were written
+
+
+def test_size_unknown_pointer_gets_what_the_call_wrote(served):
+    _, address = served
+    c = WireClient(address)
+    c.call("GT_Open", 0, 1)
+    rc, blocks, _ = c.call("GT_GetEcatAxisPdoData", 1, 0x6064, "?", 0)
+    assert rc == 0
+    assert len(blocks[0]) == 4  # 6064h is a DINT
+
+
+def test_several_clients_are_served_in_turn(served):
+    _, address = served
+    clients = [WireClient(address) for _ in range(4)]
+    for c in clients:
+        assert c.call("GT_Open", 0, 1)[0] == 0
+    assert clients[0].call("GT_SetEcatRawData", 32, 1, b"\x42")[0] == 0
+    for c in clients:
+        rc, blocks, _ = c.call("GT_GetEcatRawData", 32, 1, 1)
+        assert (rc, blocks[0]) == (0, b"\x42")
+
+
+# --- the same codes as Python ---------------------------------------------------------------
+_SKIP = {
+    "GT_Open", "GT_Close", "GT_Reset", "GT_InitEcatComm", "GT_TerminateEcatComm",
+    "GT_LoadConfig", "GTE_Wait", "GTE_UnplugSlave", "GTE_ReplugSlave", "GT_EcatIOSynch",
+}  # fmt: skip
+_INTS = (0, 1, 2, -1, 3, 99, 40000, 1 << 31, -(1 << 33))
+_REALS = (0.0, 1.5, -3.0, math.nan, math.inf, 1e300)
+
+
+def _elem(ctype: str):
+    if ctype in SCALARS:
+        return getattr(ctypes, SCALARS[ctype][0])
+    return cdecl.structure(ctype)
+
+
+def _case(plan, rnd: random.Random):
+    """(python args, wire args) for one random call."""
+    counts = {a.count_arg for a in plan.args if a.count_arg >= 0}
+    scalars = []
+    for i, a in enumerate(plan.args):
+        if a.kind is protocol.Kind.INT:
+            scalars.append(rnd.choice((0, 1, 2, -1)) if i in counts else rnd.choice(_INTS))
+        elif a.kind is protocol.Kind.DOUBLE:
+            scalars.append(rnd.choice(_REALS))
+        else:
+            scalars.append(None)
+    py, wire = [], []
+    for a, v in zip(plan.args, scalars, strict=True):
+        if a.kind in (protocol.Kind.INT, protocol.Kind.DOUBLE):
+            if a.kind is protocol.Kind.INT and a.param.ctype in SCALARS:
+                _, lo, hi, _ = SCALARS[a.param.ctype]
+                if a.param.ctype in ("short", "unsigned short", "unsigned char", "char"):
+                    v = max(lo, min(hi, v))  # C narrows to the type before the call
+            py.append(v)
+            wire.append(v)
+            continue
+        if rnd.random() < 0.15:
+            py.append(None)
+            wire.append(None)
+            continue
+        if a.kind is protocol.Kind.TEXT:
+            py.append(b"x.cfg")
+            wire.append(b"x.cfg\0")
+            continue
+        if a.kind is protocol.Kind.OUT_ANY:
+            py.append((ctypes.c_ubyte * 8)())
+            wire.append("?")
+            continue
+        n = scalars[a.count_arg] if a.count_arg >= 0 else a.count
+        n = max(int(n), 0)
+        elem = _elem(a.param.ctype)
+        py.append((elem * max(n, 1))() if n else (elem * 0)())
+        wire.append(ctypes.sizeof(elem) * n)
+    return py, wire
+
+
+def test_bad_input_gets_the_python_codes(served):
+    _, address = served
+    c = WireClient(address)
+    c.call("GT_Open", 0, 1)
+    rnd = random.Random(13)
+    checked = 0
+    for plan in protocol.plans():
+        if plan.name in _SKIP or plan.unsupported:
+            continue
+        fn = _core.REGISTRY[plan.name]
+        for _ in range(12):
+            py, wire = _case(plan, rnd)
+            want = fn(*py)
+            got, _, text = c.call(plan.name, *wire)
+            assert got == want, (plan.name, py, wire, text, gt.GTE_GetLastError())
+            checked += 1
+            if plan.proto.gtn:
+                core = rnd.choice((1, 1, 0, 2, -5))
+                want = _core.REGISTRY["GTN_" + plan.name[3:]](core, *py)
+                got, _, text = c.call("GTN_" + plan.name[3:], *wire, core=core)
+                assert got == want, ("GTN", core, plan.name, py, wire, text)
+    assert checked > 1000
