@@ -1,0 +1,88 @@
+"""Building libgts lazily, the `gtecat lib` verb, and a machine without a C compiler."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from gtecat.cli.main import main
+from gtecat.native import build
+
+from .conftest import needs_cc
+
+
+@needs_cc
+def test_lib_flags(libgts, capsys):
+    assert main(["lib", "--cflags", "--libs"]) == 0
+    words = capsys.readouterr().out.split()
+    assert words == [
+        f"-I{libgts.include_dir}",
+        f"-L{libgts.lib_dir}",
+        f"-Wl,-rpath,{libgts.lib_dir}",
+        "-lgts",
+    ]
+    assert main(["lib", "--path"]) == 0
+    assert capsys.readouterr().out.strip() == str(libgts.library)
+    assert libgts.library.is_file()
+    assert (libgts.include_dir / "gts.h").is_file()
+
+
+@needs_cc
+def test_the_cache_is_per_version_and_per_sources(libgts):
+    from gtecat import __version__
+
+    assert libgts.root.parent == build.cache_root() / __version__
+    assert build.ensure_built().root == libgts.root  # built once
+
+
+@needs_cc
+def test_a_fresh_cache_builds_on_first_use(tmp_path, monkeypatch):
+    monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
+    b = build.ensure_built()
+    assert b.library.is_file()
+    assert str(b.root).startswith(str(tmp_path / "cache"))
+    from gtecat import native
+
+    assert native.library_path() == b.library
+
+
+def test_no_compiler_is_a_clear_error(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("CC", str(tmp_path / "no-cc"))
+    monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
+    with pytest.raises(build.NativeBuildError, match="not found"):
+        build.ensure_built()
+    assert main(["lib", "--cflags"]) == 1
+    assert "error:" in capsys.readouterr().err
+    monkeypatch.delenv("CC")
+    monkeypatch.setenv("PATH", str(tmp_path))
+    with pytest.raises(build.NativeBuildError, match="no C compiler"):
+        build.ensure_built()
+
+
+def test_the_header_prints_without_a_build(capsys):
+    assert main(["lib", "--header"]) == 0
+    assert "short GT_GetSts(short axis, long *pSts" in capsys.readouterr().out
+
+
+def test_importing_gtecat_needs_no_compiler(tmp_path):
+    """pip install works without cc: nothing is compiled until the library is asked for."""
+    code = "import gtecat.native, gtecat.native.server, gtecat.gt; print('ok')"
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env={"PATH": str(tmp_path), "GTECAT_CACHE_DIR": str(tmp_path / "c")},
+    )
+    assert r.stdout.strip() == "ok", r.stderr
+    assert not (tmp_path / "c").exists()
+
+
+def test_csrc_is_package_data():
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[3]
+    cfg = tomllib.loads((root / "pyproject.toml").read_text())
+    assert "native/csrc/*" in cfg["tool"]["setuptools"]["package-data"]["gtecat"]
