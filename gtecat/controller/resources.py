@@ -32,8 +32,30 @@ and the soft limits use the axis values.  Decisions where the manual is silent:
   without a flag.
 * **Limits** (9.2): a hardware switch (60FDh) or the planned position past a
   soft limit latches bit 5/6; a motion toward that side is stopped with the
-  abrupt-stop deceleration (decAbruptStop) and refused until GT_ClrSts; motion
-  away is allowed.
+  abrupt-stop deceleration (decAbruptStop, GT_SetStopDec, 1000 pulse/ms² by
+  table 4-4) and refused until GT_ClrSts; motion away is allowed.  A switch is
+  seen in the inputs after the exchange, so its stop starts from that cycle's
+  sample.
+* **Soft limit, same cycle** (9.2.2: "限位触发以后使用急停加速度紧急停止"; example
+  9-1: the motion passes the limit, the limit triggers, the motion stops): the
+  planned position is checked as the planner gives it, before it goes out.  The
+  cycle whose sample passes a soft limit while moving toward it (positive: above
+  ``positive`` and above the previous sample; negative alike) starts the emergency
+  stop *where the plan crosses the limit*, inside that cycle: at the crossing
+  (fraction ``f`` of the cycle after the previous sample, speed ``v``; between the
+  two samples the plan is the cubic Hermite curve through both, see
+  :func:`~gtecat.controller.safety.limit_crossing`) a constant-deceleration ramp at
+  decAbruptStop (GT_SetStopDec; 1000 pulse/ms² by table 4-4) takes over, and this
+  cycle already sends that ramp's point ``(1 - f)`` of a cycle after the crossing
+  (:func:`~gtecat.controller.motion.stop.ramp_through`).  So the plan comes to rest
+  at exactly ``limit + v·|v| / (2·decAbruptStop)`` - past the limit by the stopping
+  distance from the crossing speed, never by one more cycle of travel - and
+  however the samples fall.  A limit lying exactly on a sample is crossed at the
+  start of the next cycle (``f = 0``, ``v`` that sample's speed); a limit set
+  behind a moving axis, from the previous sample.  Bit 5/6 (table 6-2) is set in
+  that same cycle.  A planner already braking at decAbruptStop
+  (GT_Stop, an earlier trigger) keeps its ramp; one passing the limit while
+  moving away from it, or standing, is not stopped.
 * **Following error** (bit 4): ``|A - AE| > GT_SetPosErr`` while the servo is on
   in CSP latches bit 4 and stops the motion abruptly; the servo stays on.  Like
   an alarm or a stop input, it refuses every new motion until GT_ClrSts.
@@ -64,10 +86,10 @@ from ..master.image import EntryAccess
 from .axis import Axis, PdsState
 from .axis_status import BLOCKING, LATCHED, AxisStatus, InPosition
 from .encoder import Encoder
-from .motion import JogParams, TrapParams
-from .motion.stop import StopKind
+from .motion import JogParams, Planner, TrapParams
+from .motion.stop import StopKind, ramp_through
 from .profile import PrfMode, Profile
-from .safety import LIMIT_NEGATIVE_BIT, LIMIT_POSITIVE_BIT, Safety
+from .safety import LIMIT_NEGATIVE_BIT, LIMIT_POSITIVE_BIT, Safety, limit_crossing
 from .scale import AffineLink, Scale
 
 
@@ -246,10 +268,41 @@ class AxisResources:
         if ax.servo_on and ax.mode_cmd == CSP:
             planner = self.profile.planner
             if not planner.done and self.profile.active:
-                pos = planner.step()[0]
-                a = self.prf_link.axis(pos)
+                p0, v0 = planner.pos, planner.vel
+                a = self.prf_link.axis(planner.step()[0])
+                s = self.safety
+                if (a > s.soft_positive or a < s.soft_negative) and s.active:
+                    a = self._soft_limit_stop(planner, p0, v0, a)
                 ax.prf_pos = a
                 self._a_last = a
+
+    def _soft_limit_stop(self, planner: Planner, p0: float, v0: float, a: float) -> float:
+        """This cycle's sample ``a`` passed a soft limit: the emergency stop starts in it.
+
+        The module docstring ("Soft limit, same cycle") gives the rule; ``(p0, v0)``
+        is the previous sample (profile units).  Returns this cycle's axis planned
+        position.
+        """
+        link = self.prf_link
+        a0 = link.axis(p0)
+        s = self.safety
+        if a > s.soft_positive and a > a0:
+            self.latched |= _POS_LIMIT
+            level = s.soft_positive
+        elif a < s.soft_negative and a < a0:
+            self.latched |= _NEG_LIMIT
+            level = s.soft_negative
+        else:
+            return a  # past it, not moving toward it: the flag latches after the exchange
+        if planner.stopping == StopKind.ABRUPT:
+            return a  # already braking at decAbruptStop
+        level_p = link.source(level)
+        f, p, v = limit_crossing(p0, v0, planner.pos, planner.vel, level_p, self.cycle_ms)
+        dec = self.profile.stop_dec.abrupt
+        planner.stop(dec, True, origin=ramp_through(p, v, dec, f * self.cycle_ms))
+        if not planner.done:
+            planner.step()
+        return link.axis(planner.pos)
 
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
         safety = self.safety

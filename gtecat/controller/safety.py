@@ -14,6 +14,8 @@ Manual chapter 9 and 4.3.1; the cycle that applies them is in
   input ("将轴 2 的限位信号配给轴 1"): an input number is an axis number.
 * **Soft limits** (软限位, 9.2, entry 121): positive 0x7FFFFFFF and negative
   0x80000000 by default, which no planned position passes (disabled, "没有触发的").
+  The emergency stop starts where the plan crosses the limit, inside the cycle
+  (:func:`limit_crossing`; the rule is in :mod:`gtecat.controller.resources`).
 * **Following-error limit** (GT_SetPosErr, entry 116): in pulses, range
   (0, 2147483648]; default 32767 pulses, which the manual leaves open (the
   drive's own following-error window 6065h still guards the motor).
@@ -25,6 +27,7 @@ Manual chapter 9 and 4.3.1; the cycle that applies them is in
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ..errors import ParameterError
@@ -36,6 +39,52 @@ POS_ERR_DEFAULT = 32767
 
 LIMIT_POSITIVE_BIT = 1 << 1  # 60FDh bit 1 (CiA 402: positive limit switch)
 LIMIT_NEGATIVE_BIT = 1 << 0  # 60FDh bit 0 (negative limit switch)
+
+
+def limit_crossing(
+    p0: float, v0: float, p1: float, v1: float, level: float, cycle_ms: float
+) -> tuple[float, float, float]:
+    """When, where and how fast the plan passes ``level`` between two samples.
+
+    ``(p0, v0)`` is the previous sample, ``(p1, v1)`` the one a cycle later, which is
+    past ``level``.  Between them the plan is taken as the cubic Hermite curve through
+    both positions with both velocities: exact wherever the planner's piece is a
+    polynomial of degree 3 at most across the cycle (constant acceleration: Trap, Jog at
+    its limits, PT; smoothTime's linear acceleration), within ``|Δacc|·cycle`` of the
+    speed where a piece boundary falls inside the cycle (the speed is then held to the
+    faster of the two samples, which the curve overshoots at an acceleration jump, e.g.
+    where a Trap reaches its speed).  Returns ``(f, p, v)``: the
+    crossing ``f·cycle_ms`` after the previous sample at ``p = level``, and the speed
+    there (0 if the curve reaches ``level`` without moving on past it); when ``p0`` is
+    already at or past ``level`` (a limit lying exactly on a sample, a limit set
+    behind the axis) ``(0, p0, v0)``.
+    """
+    side = 1.0 if p1 > level else -1.0
+    if (p0 - level) * side >= 0.0:
+        return 0.0, p0, v0 if v0 * side > 0.0 else 0.0
+    d0, d1, m0, m1 = p0 - level, p1 - level, v0 * cycle_ms, v1 * cycle_ms
+
+    def h(f: float) -> float:  # Hermite curve - level
+        g = 1.0 - f
+        return g * g * ((1.0 + 2.0 * f) * d0 + f * m0) + f * f * ((3.0 - 2.0 * f) * d1 - g * m1)
+
+    lo, hi = 0.0, 1.0  # h(lo) on p0's side, h(hi) past level
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if h(mid) * side > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    f = hi
+    v = (
+        6.0 * f * (1.0 - f) * (p1 - p0)
+        + (1.0 - f) * (1.0 - 3.0 * f) * m0
+        + f * (3.0 * f - 2.0) * m1
+    ) / cycle_ms
+    if v * side <= 0.0:
+        return f, level, 0.0
+    top = max(abs(v0), abs(v1))  # the curve overshoots where the acceleration jumps
+    return f, level, v if abs(v) <= top else math.copysign(top, v)
 
 
 @dataclass(slots=True)

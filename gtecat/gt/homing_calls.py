@@ -37,15 +37,44 @@ Decisions where the manual is silent:
   up), then raises CW4 (clearing it for one cycle first when it is still high from a
   previous run, so the drive sees a rising edge) and returns once the drive has
   answered the start, so a status read right after it is never stale (cia402-facts
-  §7 pitfall 2).
+  §7 pitfall 2).  That starts a *run*, which the status below follows.
 * **GT_StopEcatHoming** drops CW4, which CiA 402 defines as "interrupt homing": the
-  drive decelerates at 609Ah and reports "interrupted" (status 1) once stopped.  It
-  returns after the command has gone out, without waiting for the stop.
-* **GT_GetEcatHomingStatus**: bit 0 = SW10 (done: at rest), bit 1 = SW12 (home
-  point found), bit 2 = SW13 (error), so 0 in progress, 1 interrupted or not
-  started, 2 found and moving onto it, 3 completed (example 5-2), 4 error while
-  moving, 5 error at rest.  Outside homing mode the bits mean other things, so the
-  call reports the last value read in homing mode (1 before any homing).
+  drive decelerates at 609Ah and reports "interrupted" once stopped (status 5, below).
+  It returns after the command has gone out, without waiting for the stop.
+* **GT_GetEcatHomingStatus** (manual entry 43: bit 0 "homing finished", bit 1
+  "finished successfully", bit 2 "error") takes only three values, so that the
+  vendor's own loop ``do { GT_GetEcatHomingStatus(axis, &st); } while (st == 0);``
+  followed by "anything but 3 is an error" (its Qt demo, example 5-2's ``= 3``)
+  is right on every path:
+
+  - **0** (:data:`HOMING_IN_PROGRESS`) exactly while a run started by
+    GT_StartEcatHoming is active: from the start (also the cycles before the drive
+    has seen CW4: statusword still "not started", SW10 alone) until the drive
+    stands, SW10 = 1.  "Home point found, still moving onto it" (SW12 = 1,
+    SW10 = 0), an error still braking (SW13 = 1, SW10 = 0) and an interrupt still
+    braking are all 0.
+  - **3** (:data:`HOMING_DONE`): the run ended with SW10 = SW12 = 1, SW13 = 0
+    (CiA 402 "homing procedure completed successfully"; the home point found and
+    reached).
+  - **5** (:data:`HOMING_FAILED`, finished + error): every other end - SW13 (a
+    homing error), interrupted (GT_StopEcatHoming, GT_SetHomingMode to another mode
+    before the home point was found, the drive answering SW10 alone), the drive
+    leaving *operation enabled* (servo off, fault, GT_Reset) or homing mode
+    (GT_SetEcatAxisMode) during the run, or no answer to the start.  The result is
+    the drive's verdict: a GT_StopEcatHoming after the home point was found ends 3
+    when the drive then reports SW10 = SW12 = 1 (the position is defined).
+
+  Between runs the call reports the last run's result, in any mode (the bits of
+  6041h mean other things outside homing mode); **before any run** (since the bus
+  came up) it reports **5**: 0 would hang the vendor loop for ever when the
+  application polls without starting, 3 would claim a home the drive never found,
+  and 5 - "finished, not successfully" - says what is true: this axis is not
+  homed, which the demo's error branch reports.  A start that GT_StartEcatHoming
+  refuses (return 1) starts no run and leaves the last result.  The run is
+  followed every cycle after the exchange (an axis post-cycle hook), so its result
+  never depends on when, or whether, the application polls; the drive's answer to
+  CW4 is the first statusword exchanged after it (the virtual drives answer in
+  that very exchange).
 * **GT_SetTouchProbeFunction** sends ``ProbePrm`` to 60B8h as a 16-bit pattern
   (a negative ``short`` is taken bit for bit).  Bits 2-3 / 10-11, "reserved" in
   entry 123, select the source as ETG.6010 defines (00 probe input, 01 encoder
@@ -96,6 +125,12 @@ _CW_HALT = 0x0100  # CW8
 _SW10, _SW12, _SW13 = 1 << 10, 1 << 12, 1 << 13
 _SW_HOMING = _SW10 | _SW12 | _SW13
 _SW_NOT_STARTED = _SW10  # "homing interrupted or not started"
+_SW_DONE = _SW10 | _SW12  # "homing procedure completed successfully"
+
+#: GT_GetEcatHomingStatus values (manual entry 43; module docstring)
+HOMING_IN_PROGRESS = 0
+HOMING_DONE = 3  # bit 0 finished | bit 1 successfully
+HOMING_FAILED = 5  # bit 0 finished | bit 2 error
 
 #: controller time GT_SetHomingMode waits for 6061h (python-canopen's 0.5 s)
 _MODE_TIMEOUT_MS = 500.0
@@ -128,7 +163,35 @@ class _AxisHoming:
     """What the controller remembers about one axis's homing (lives as long as the axis)."""
 
     params_set: bool = False
-    last_status: int = 1  # "interrupted or not started" until a homing status is read
+    #: a run started by GT_StartEcatHoming has not ended yet (status 0)
+    active: bool = False
+    #: the drive has answered this run's CW4 (statusword no longer "not started")
+    answered: bool = False
+    #: the last run's result, reported between runs (5 before any run)
+    result: int = HOMING_FAILED
+
+    def begin(self) -> None:
+        self.active, self.answered = True, False
+
+    def end(self, result: int) -> None:
+        self.active = False
+        self.result = result
+
+    def post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
+        """Post-cycle hook: follow an active run with the drive's answer of this cycle."""
+        if not self.active:
+            return
+        if ax.mode_cmd != _HOMING_MODE or ax.state != PdsState.OPERATION_ENABLED:
+            self.end(HOMING_FAILED)  # the drive no longer runs the procedure
+            return
+        sw = ax.statusword
+        if sw & _SW_HOMING != _SW_NOT_STARTED:
+            self.answered = True
+        status = homing_status_value(
+            sw, waiting=not self.answered and bool(ax.cw & _CW_HOMING_START)
+        )
+        if status != HOMING_IN_PROGRESS:
+            self.end(status)
 
 
 _STATE: weakref.WeakKeyDictionary[Axis, _AxisHoming] = weakref.WeakKeyDictionary()
@@ -138,6 +201,7 @@ def _state(ax: Axis) -> _AxisHoming:
     st = _STATE.get(ax)
     if st is None:
         st = _STATE[ax] = _AxisHoming()
+        ax.post_hooks.append(st.post)
     return st
 
 
@@ -167,13 +231,20 @@ def _statusword(ax: Axis) -> int:
     return ax.io.read(0x6041)
 
 
-def homing_status_bits(statusword: int) -> int:
-    """SW10/SW12/SW13 -> GT homing status bits 0/1/2 (module docstring)."""
-    return (
-        (1 if statusword & _SW10 else 0)
-        | (2 if statusword & _SW12 else 0)
-        | (4 if statusword & _SW13 else 0)
-    )
+def homing_status_value(statusword: int, waiting: bool = False) -> int:
+    """What a homing-mode statusword means for an active run: 0, 3 or 5 (module docstring).
+
+    ``waiting``: the drive has not answered CW4 yet, so SW10 alone ("not started")
+    is the state before the start, not an interrupt.
+    """
+    if not statusword & _SW10:
+        return HOMING_IN_PROGRESS  # moving: searching, onto the home point, braking
+    bits = statusword & _SW_HOMING
+    if bits == _SW_DONE:
+        return HOMING_DONE
+    if bits == _SW_NOT_STARTED and waiting:
+        return HOMING_IN_PROGRESS
+    return HOMING_FAILED
 
 
 def _wait_cycles(ctl: Controller, n: int = 1) -> None:
@@ -201,10 +272,8 @@ def set_homing_mode(ctl: Controller, ax: Axis, mode: int) -> None:
         raise CommandError(
             f"axis {ax.number} is planning a motion: call GT_Stop first (manual entry 112)"
         )
-    if was == _HOMING_MODE and mode != _HOMING_MODE:
-        if _mode_display(ax) == _HOMING_MODE:
-            _settle_homing(ctl, ax)
-        _state(ax).last_status = homing_status_bits(_statusword(ax))
+    if was == _HOMING_MODE and mode != _HOMING_MODE and _mode_display(ax) == _HOMING_MODE:
+        _settle_homing(ctl, ax)  # an active run ends here, with the drive at rest
     if mode != was:
         ax.cw &= ~(_CW_HOMING_START | _CW_HALT)
     if mode == _CSP_MODE:
@@ -313,16 +382,19 @@ def start_homing(ctl: Controller, ax: Axis) -> None:
             f"axis {ax.number} is already homing; GT_StopEcatHoming first to start afresh"
         )
     ax.mode_cmd = _HOMING_MODE
+    st = _state(ax)
     if ax.cw & (_CW_HOMING_START | _CW_HALT):
         ax.cw &= ~(_CW_HOMING_START | _CW_HALT)
         _wait_cycles(ctl)  # the drive must see CW4 low before it can see it rise
     ax.cw |= _CW_HOMING_START
+    st.begin()
     c0 = ctl.clock.cycles
 
     def answered() -> bool:
-        return ctl.clock.cycles > c0 and _statusword(ax) & _SW_HOMING != _SW_NOT_STARTED
+        return ctl.clock.cycles > c0 and (st.answered or not st.active)
 
     if not ctl.clock.run_until(answered, _START_TIMEOUT_MS):
+        st.end(HOMING_FAILED)
         raise CommandError(
             f"axis {ax.number}: the drive did not start homing within {_START_TIMEOUT_MS:g} ms "
             f"of CW4 rising (statusword 0x{_statusword(ax):04X})"
@@ -337,12 +409,12 @@ def stop_homing(ctl: Controller, ax: Axis) -> None:
 
 
 def homing_status(ax: Axis) -> int:
-    """GT_GetEcatHomingStatus's value (module docstring); the polling hot path."""
-    st = _STATE.get(ax) or _state(ax)
-    if ax.mode_cmd == _HOMING_MODE:
-        sw = ax.statusword if ax.io.get(0x6041) is not None else _statusword(ax)
-        st.last_status = homing_status_bits(sw)
-    return st.last_status
+    """GT_GetEcatHomingStatus's value, 0, 3 or 5 (module docstring); the polling hot path."""
+    st = _STATE.get(ax)
+    if st is None:
+        _statusword(ax)  # 6041h must be mapped (return 1 naming it, entry 43)
+        return HOMING_FAILED  # no run since the bus came up: not homed
+    return HOMING_IN_PROGRESS if st.active else st.result
 
 
 def set_probe_function(ctl: Controller, ax: Axis, function: int) -> None:
@@ -433,7 +505,7 @@ def GT_StopEcatHoming(ctl: Controller, axis: int) -> int:
 
 @gt_function
 def GT_GetEcatHomingStatus(ctl: Controller, axis: int, pHomingStatus: Any) -> int:
-    """Bit 0 done, bit 1 success, bit 2 error (entry 43); 3 = homed."""
+    """0 homing, 3 homed, 5 failed or not homed (entry 43: bit 0 done, 1 success, 2 error)."""
     store(pHomingStatus, homing_status(bus_axis(ctl, axis)))
     return 0
 

@@ -348,12 +348,24 @@ class FollowPlanner(SlavePlanner):
             raise CommandError(f"GT_FollowSwitch: the target FIFO {target} holds no data")
         self._switch = True
 
-    def stop(self, dec: float, abrupt: bool = False) -> None:
-        """GT_Stop: the slave brakes with ``dec`` and no longer follows the master."""
-        if self._state == _IDLE:
-            return
+    def stop(
+        self, dec: float, abrupt: bool = False, origin: tuple[float, float] | None = None
+    ) -> None:
+        """GT_Stop: the slave brakes with ``dec`` and no longer follows the master.
+
+        ``origin``: brake from this ``(pos, vel)``, taken as the state at the previous
+        sample, instead of from the current output; the next ``step()`` gives the ramp
+        one cycle after it.  The soft-limit stop of 9.2.2 replaces the sample that passed
+        the limit so (:mod:`gtecat.controller.resources`), also when the planner
+        finished in that step.
+        """
+        if origin is None:
+            if self._state == _IDLE:
+                return
+            origin = (self._pos, self._vel)
         self._switch = False
-        self._stop.start(self._pos, self._vel, dec)
+        self._stop.start(origin[0], origin[1], dec)
+        self._pos, self._vel = origin
         self._state = _STOP
         self.stopping = StopKind.ABRUPT if abrupt else StopKind.SMOOTH
         if self._stop.done:

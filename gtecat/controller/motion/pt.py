@@ -334,11 +334,23 @@ class PtPlanner:
         self._state = _MOVE
         self.stopping = StopKind.NONE
 
-    def stop(self, dec: float, abrupt: bool = False) -> None:
-        """GT_Stop: brake from the current output with ``dec``."""
-        if self._state == _IDLE:
-            return
-        self._stop.start(self._pos, self._vel, dec)
+    def stop(
+        self, dec: float, abrupt: bool = False, origin: tuple[float, float] | None = None
+    ) -> None:
+        """GT_Stop: brake from the current output with ``dec``.
+
+        ``origin``: brake from this ``(pos, vel)``, taken as the state at the previous
+        sample, instead of from the current output; the next ``step()`` gives the ramp
+        one cycle after it.  The soft-limit stop of 9.2.2 replaces the sample that passed
+        the limit so (:mod:`gtecat.controller.resources`), also when the planner
+        finished in that step.
+        """
+        if origin is None:
+            if self._state == _IDLE:
+                return
+            origin = (self._pos, self._vel)
+        self._stop.start(origin[0], origin[1], dec)
+        self._pos, self._vel = origin
         self._abandon()
         self._state = _STOP
         self.stopping = StopKind.ABRUPT if abrupt else StopKind.SMOOTH

@@ -58,6 +58,21 @@ def stop_distance(vel: float, dec: float) -> float:
     return vel * abs(vel) / (2.0 * dec)
 
 
+def ramp_through(pos: float, vel: float, dec: float, before: float) -> tuple[float, float]:
+    """The state ``before`` ms earlier on the braking ramp (``dec``) that passes ``(pos, vel)``.
+
+    A :class:`StopRamp` started from the returned ``(pos0, vel0)`` is at ``(pos, vel)``
+    ``before`` ms later and comes to rest at ``pos + stop_distance(vel, dec)``: how a
+    stop that begins between two samples (the soft-limit stop of 9.2.2) is sampled on
+    the controller's cycle grid.  ``vel == 0``: ``(pos, 0)``, a ramp that is already over.
+    """
+    if vel == 0.0:
+        return pos, 0.0
+    a = -dec if vel > 0.0 else dec
+    v0 = vel - a * before
+    return pos - before * (v0 + 0.5 * a * before), v0
+
+
 class StopRamp:
     """Constant-deceleration ramp from ``(pos, vel)`` to standstill, one sample per cycle.
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import importlib.util
 import sys
-from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32, c_ushort
 from pathlib import Path
 
 import pytest
@@ -42,6 +42,8 @@ tx = ["0x6041:0:16", "0x6064:0:32", "0x6061:0:8"]
 SPEED1, SPEED2, ACC = 50_000, 5_000, 1_000_000  # counts/s, counts/s, counts/s²
 LIMITS = {"negative_limit": -20000, "positive_limit": 20000}
 INDEX = {"counts_per_rev": 4000, "index_offset": 700}
+SW10, SW12, SW13 = 1 << 10, 1 << 12, 1 << 13
+_NO_MOTION = (35, 37)  # methods that home on the current position, without motion
 
 # --- machines and hand-computed home points -----------------------------------------------
 # family: (switch layout, starts, {method: home point per start})
@@ -144,6 +146,12 @@ def enc_pos(axis: int) -> int:
     return p.value
 
 
+def statusword(axis: int) -> int:
+    sw = c_ushort()
+    assert gt.GT_GetEcatAxisPdoData(axis, 0x6041, byref(sw)) == 0, gt.GTE_GetLastError()
+    return sw.value
+
+
 def status(axis: int) -> int:
     s = c_short()
     assert gt.GT_GetEcatHomingStatus(axis, byref(s)) == 0, gt.GTE_GetLastError()
@@ -169,7 +177,37 @@ def wait_done(axis: int, limit_ms: int = 20_000) -> int:
     raise AssertionError(f"axis {axis}: homing not done within {limit_ms} ms")
 
 
+# --- the vendor's polling loop (manual entry 43) -----------------------------------------------
+# The vendor's Qt demo: do { GT_GetEcatHomingStatus(axis, &st); } while (st == 0); then any
+# st != 3 is an error and the homing is aborted.  Manual entry 43 allows only 0 (in progress),
+# 3 (finished successfully) and 5 (finished with an error) on that path.
+ERROR_CASES = [
+    # method 3 with no home switch runs into the positive limit, where it may not reverse
+    ("no home switch", {}, (0, 5000), 3),
+    # method 6 with no home switch runs into the negative limit
+    ("no negative home switch", {}, (0, -5000), 6),
+]
+
+
+def vendor_loop(axes: range, limit_ms: int = 20_000) -> dict[int, list[int]]:
+    """Run the demo's loop on every axis at once, one poll per ms; the values each one saw."""
+    seen: dict[int, list[int]] = {a: [] for a in axes}
+    pending = set(axes)
+    for _ in range(limit_ms):
+        for a in sorted(pending):
+            s = status(a)
+            if not seen[a] or seen[a][-1] != s:
+                seen[a].append(s)
+            if s != 0:  # } while (st == 0);
+                pending.discard(a)
+        if not pending:
+            return seen
+        gt.GTE_Wait(1)
+    raise AssertionError(f"the vendor loop never ended on axes {sorted(pending)}: {seen}")
+
+
 # --- one test per method, all starts of its family at once (one axis per start) --------------
+# and the vendor's polling loop on each of them (manual entry 43): 0 ... 0 3, never 1/2/4
 @pytest.mark.parametrize(("family", "method"), CASES, ids=[f"{f}-{m}" for f, m in CASES])
 def test_home_point_matches_the_method_table(five_axes: Path, family: str, method: int) -> None:
     layout, starts, table = FAMILIES[family]
@@ -178,11 +216,14 @@ def test_home_point_matches_the_method_table(five_axes: Path, family: str, metho
     axes = range(1, len(starts) + 1)
     for a in axes:
         start(a, method, offset)
+    seen = vendor_loop(axes)
+    expected = [3] if method in _NO_MOTION else [0, 3]  # 35/37 are done at the start
     for a, home in zip(axes, table[method], strict=True):
-        assert wait_done(a) == 3, f"axis {a} from {starts[a - 1]}: {gt.GTE_GetLastError()}"
+        assert seen[a] == expected, f"axis {a} from {starts[a - 1]}: {gt.GTE_GetLastError()}"
         assert machine_pos(a) == pytest.approx(home, abs=1.0), f"start {starts[a - 1]}"
     gt.GTE_Wait(50)
     for a, home in zip(axes, table[method], strict=True):
+        assert status(a) == 3  # and it stays the result
         assert machine_pos(a) == pytest.approx(home, abs=1e-3)  # at rest on the home point
         assert enc_pos(a) == offset  # 6064 = machine - home + 607C
 
@@ -244,7 +285,7 @@ def test_example_5_2_stop_branch_interrupts_and_returns_to_csp_without_a_jump() 
     assert not v.xHoming and v.rtn == 0
     stopped = machine_pos(1)
     assert 84000 < stopped < 86000
-    assert status(1) == 1  # interrupted (reported from the last homing status)
+    assert status(1) == 5  # interrupted: finished, not homed (manual entry 43)
     gt.GTE_Wait(300)
     assert machine_pos(1) == pytest.approx(stopped, abs=0.5)  # 607Ah holds whole counts
     mode = c_short()
@@ -276,19 +317,22 @@ def test_switching_to_csp_mid_search_interrupts_waits_and_holds(five_axes: Path)
     assert gt.GT_SetHomingMode(1, 8) == 0, gt.GTE_GetLastError()
     stood = machine_pos(1)
     assert 5000 < stood < 12000
-    assert status(1) == 1  # interrupted
+    assert status(1) == 5  # interrupted: not homed
     for _ in range(20):
         gt.GTE_Wait(5)
         assert machine_pos(1) == pytest.approx(stood, abs=0.5)
 
 
 def test_switching_to_csp_after_the_home_point_was_found_finishes_on_it(five_axes: Path) -> None:
-    """Status 2 (home found, moving onto it): GT_SetHomingMode(axis, 8) lets it arrive."""
+    """Home found, moving onto it (SW12, not SW10): still 0; GT_SetHomingMode(axis, 8) lets
+    it arrive, and the run ends 3."""
     bring_up(str(five_axes), machine=machine((0,)), clock="lockstep")
     start(1, 34, offset=-9)
-    while status(1) == 0:
+    while not statusword(1) & SW12:
+        assert status(1) == 0
         gt.GTE_Wait(1)
-    assert status(1) == 2
+    assert statusword(1) & (SW10 | SW12 | SW13) == SW12
+    assert status(1) == 0  # CiA "homing attained, target not reached": in progress
     assert machine_pos(1) > 700  # past the index pulse, braking to come back
     assert gt.GT_SetHomingMode(1, 8) == 0
     assert status(1) == 3
@@ -327,18 +371,21 @@ def test_stop_homing_interrupts_at_the_homing_deceleration(five_axes: Path) -> N
         gt.GTE_Wait(1)
         if status(1) != 0:
             break
-    assert status(1) == 1  # interrupted at rest
+    assert status(1) == 5  # interrupted at rest: finished, not homed
     # braking from 5000 counts/s at 1e6 counts/s² takes 12.5 counts
     assert 10 < machine_pos(1) - before < 25
     assert machine_pos(1) < 700  # the index pulse was never reached
 
 
 # --- status bits: consistent from the first cycle after CW4 rises ------------------------------
-def test_status_right_after_start_is_in_progress_then_2_then_3(five_axes: Path) -> None:
+def test_status_right_after_start_is_in_progress_then_3(five_axes: Path) -> None:
+    """Manual entry 43: 0 from the very first read after the start until done, then 3;
+    5 before any start (not homed: the vendor loop must neither hang nor see success)."""
     bring_up(str(five_axes), machine=machine((0,)), clock="lockstep")
+    assert status(1) == 5  # never started
     assert gt.GT_AxisOn(1) == 0
     assert gt.GT_SetHomingMode(1, 6) == 0
-    assert status(1) == 1  # not started
+    assert status(1) == 5  # not started
     assert gt.GT_SetEcatHomingPrm(1, 34, SPEED1, SPEED2, ACC, 0, 0) == 0
     assert gt.GT_StartEcatHoming(1) == 0
     seen = [status(1)]  # no time passes in lockstep: the very next read
@@ -348,7 +395,7 @@ def test_status_right_after_start_is_in_progress_then_2_then_3(five_axes: Path) 
     assert seen[0] == 0
     assert seen[-1] == 3
     collapsed = [s for i, s in enumerate(seen) if i == 0 or s != seen[i - 1]]
-    assert collapsed == [0, 2, 3]  # in progress, home found (moving onto it), completed
+    assert collapsed == [0, 3]  # in progress (also while moving onto the home point), done
 
 
 def test_homing_can_be_started_again_after_completion(five_axes: Path) -> None:
@@ -368,15 +415,17 @@ def test_homing_error_when_the_switch_is_never_found(five_axes: Path) -> None:
     """Method 3 without a home switch runs into PL, where it may not reverse: SW13."""
     bring_up(str(five_axes), machine=machine((0,)))
     start(1, 3)
-    seen = set()
+    seen, braking = set(), False
     for _ in range(5000):
         s = status(1)
         seen.add(s)
+        braking |= statusword(1) & (SW10 | SW13) == SW13 and s == 0
         if s & 1:
             break
         gt.GTE_Wait(1)
     assert s == 5  # done (at rest) with an error
-    assert 4 in seen  # error while still braking
+    assert seen == {0, 5}
+    assert braking  # SW13 while still braking reads 0: the result comes with standstill
     assert machine_pos(1) >= 20000  # it went as far as the positive limit
     assert gt.GT_SetHomingMode(1, 8) == 0
     assert status(1) == 5
@@ -397,7 +446,7 @@ def test_start_refused_with_reasons_and_does_nothing(five_axes: Path) -> None:
     assert "GT_SetEcatHomingPrm" in gt.GTE_GetLastError()
     assert not ax.cw & 0x10
     gt.GTE_Wait(100)
-    assert machine_pos(1) == 0.0 and status(1) == 1
+    assert machine_pos(1) == 0.0 and status(1) == 5  # refused starts start no run
     assert gt.GT_SetEcatHomingPrm(1, 34, SPEED1, SPEED2, ACC, 0, 0) == 0
     assert gt.GT_StartEcatHoming(1) == 0
     assert gt.GT_StartEcatHoming(1) == 1  # already homing
@@ -471,3 +520,89 @@ def test_machine_position_helper_errors() -> None:
     bring_up(machine=machine((2500.5, -3)))
     assert machine_pos(1) == 2500.5 and machine_pos(2) == -3.0
     assert gt.GTE_GetMachinePos(3, byref(c_double())) == 7
+
+
+def test_vendor_loop_on_the_figure_5_2_bus_by_sdo() -> None:
+    bring_up(machine=machine((0, 2000)), clock="lockstep")
+    start(1, 34)
+    start(2, 33)
+    assert vendor_loop(range(1, 3)) == {1: [0, 3], 2: [0, 3]}
+
+
+@pytest.mark.parametrize(
+    ("layout", "starts", "method"),
+    [c[1:] for c in ERROR_CASES],
+    ids=[c[0] for c in ERROR_CASES],
+)
+def test_vendor_loop_sees_0_then_5_on_a_homing_error(
+    five_axes: Path, layout: dict, starts: tuple, method: int
+) -> None:
+    """Manual entry 43: a homing error (SW13) reads 0 until the drive stands, then 5."""
+    axes = {
+        n: AxisMachine(position=float(s), **{**INDEX, **LIMITS, **layout})
+        for n, s in enumerate(starts, 1)
+    }
+    bring_up(str(five_axes), machine=MachineDescription(axes), clock="lockstep")
+    for a in range(1, len(starts) + 1):
+        start(a, method)
+    seen = vendor_loop(range(1, len(starts) + 1))
+    assert all(s == [0, 5] for s in seen.values()), seen
+    assert all(statusword(a) & SW13 for a in seen)
+
+
+def test_vendor_do_while_loop_terminates_in_auto_clock(five_axes: Path) -> None:
+    """The loop exactly as the demo writes it: no wait, each call costs virtual latency."""
+    bring_up(str(five_axes), machine=machine((0,)))
+    start(1, 34)
+    st, seen = c_short(), []
+    while True:  # do { GT_GetEcatHomingStatus(axis, &st); } while (st == 0);
+        assert gt.GT_GetEcatHomingStatus(1, byref(st)) == 0
+        seen.append(st.value)
+        if st.value != 0 or len(seen) > 1_000_000:
+            break
+    assert set(seen[:-1]) == {0} and seen[-1] == 3
+    assert machine_pos(1) == pytest.approx(700, abs=1.0)
+
+
+def test_never_started_reads_5_so_the_vendor_loop_ends_without_success(five_axes: Path) -> None:
+    """Before any start, in any mode: 5 (not homed), neither 0 (would hang) nor 3 (a lie)."""
+    bring_up(str(five_axes), machine=machine((0,)), clock="lockstep")
+    assert status(1) == 5
+    assert gt.GT_AxisOn(1) == 0 and status(1) == 5
+    assert gt.GT_SetHomingMode(1, 6) == 0 and status(1) == 5
+    assert gt.GT_SetEcatHomingPrm(1, 34, SPEED1, SPEED2, ACC, 0, 0) == 0
+    gt.GTE_Wait(10)
+    assert status(1) == 5  # parameters alone start nothing
+    assert gt.GT_StopEcatHoming(1) == 0 and status(1) == 5  # nor does a stop
+
+
+@pytest.mark.parametrize("how", ["stop", "axis off", "axis mode 8", "homing mode 8"])
+def test_a_run_ended_from_outside_reads_5(five_axes: Path, how: str) -> None:
+    """GT_StopEcatHoming, servo off, another mode: the vendor loop ends with 5, never hangs."""
+    bring_up(str(five_axes), machine=machine((0,), home_switch=[(15000, 30000)]), clock="lockstep")
+    start(1, 3)
+    gt.GTE_Wait(100)  # searching for the switch
+    assert status(1) == 0
+    calls = {
+        "stop": lambda: gt.GT_StopEcatHoming(1),
+        "axis off": lambda: gt.GT_AxisOff(1),
+        "axis mode 8": lambda: gt.GT_SetEcatAxisMode(1, 8),
+        "homing mode 8": lambda: gt.GT_SetHomingMode(1, 8),
+    }
+    assert calls[how]() == 0, gt.GTE_GetLastError()
+    seen = vendor_loop(range(1, 2), limit_ms=1000)[1]
+    assert seen in ([0, 5], [5])
+    gt.GTE_Wait(50)
+    assert status(1) == 5
+
+
+def test_a_second_run_reads_0_until_done_again(five_axes: Path) -> None:
+    """A restart after a completed run: the old 3 never shows before the drive has answered."""
+    bring_up(str(five_axes), machine=machine((0,)), clock="lockstep")
+    start(1, 34)
+    assert vendor_loop(range(1, 2)) == {1: [0, 3]}
+    assert gt.GT_SetEcatHomingPrm(1, 2, SPEED1, SPEED2, ACC, 0, 0) == 0
+    assert gt.GT_StartEcatHoming(1) == 0
+    assert vendor_loop(range(1, 2)) == {1: [0, 3]}
+    gt.GTE_Wait(50)
+    assert machine_pos(1) == pytest.approx(16700, abs=1e-3)  # PL, first index left of it
