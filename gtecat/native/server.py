@@ -492,9 +492,11 @@ class Server:
         plan = dec.plan
         name = plan.name
         self.calls += 1
-        if name == "GT_Open":
-            return self._open(c, gtn, core, args)
-        if name == "GT_Close":
+        if name in ("GT_Open", "GT_Close"):
+            if gtn and core != 1:  # the Python twin refuses it (7) before doing anything
+                return _invoke(dec.fn_gtn, (core, *args))
+            if name == "GT_Open":
+                return self._open(c, gtn, core, args)
             c.opened = False
             return 0, ""
         if not c.opened:
@@ -507,14 +509,7 @@ class Server:
         floor = self._current_floor()
         if floor is not None:
             floor.look()
-        errors = _core.SESSION.errors
-        before = errors[-1] if errors else None
-        rc = fn(core, *args) if gtn else fn(*args)
-        text = ""
-        if rc != 0 and errors and errors[-1] is not before:
-            e = errors[-1]
-            text = f"{e.function} returned {e.code}: {e.reason}"
-        return rc, text
+        return _invoke(fn, (core, *args) if gtn else args)
 
     def _open(self, c: _Client, gtn: bool, core: int, args: list[Any]) -> tuple[int, str]:
         if 1 not in _core.SESSION.controllers:
@@ -540,6 +535,17 @@ class Server:
             self._floor = WallFloor(ctl.clock)
         floor = self._floor
         return floor if floor is not None and floor.active else None
+
+
+def _invoke(fn: Any, args: Any) -> tuple[int, str]:
+    """Call a GT function; its code and, when it is not 0, the reason it recorded."""
+    errors = _core.SESSION.errors
+    before = errors[-1] if errors else None
+    rc = fn(*args)
+    if rc != 0 and errors and errors[-1] is not before:
+        e = errors[-1]
+        return rc, f"{e.function} returned {e.code}: {e.reason}"
+    return rc, ""
 
 
 def wait_for(address: str, timeout_s: float = 10.0) -> None:
