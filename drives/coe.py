@@ -14,7 +14,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
-from enum import IntEnum
+from enum import IntEnum, IntFlag
 from typing import TypeVar
 
 from construct import (
@@ -173,6 +173,93 @@ SdoAbortFrame = Struct(
     "subindex" / Int8ul,
     "code" / Int32ul,
 )
+
+
+class SdoInfoOpcode(IntEnum):
+    """SDO Information service opcodes (ETG.1000.6 5.6.3, Table 43)."""
+
+    GET_OD_LIST_REQUEST = 0x01
+    GET_OD_LIST_RESPONSE = 0x02
+    GET_OBJECT_DESCRIPTION_REQUEST = 0x03
+    GET_OBJECT_DESCRIPTION_RESPONSE = 0x04
+    GET_ENTRY_DESCRIPTION_REQUEST = 0x05
+    GET_ENTRY_DESCRIPTION_RESPONSE = 0x06
+    SDO_INFO_ERROR_REQUEST = 0x07
+
+
+class OdListType(IntEnum):
+    """Get OD List request ``ListType`` (ETG.1000.6 5.6.3.3.1)."""
+
+    LENGTHS = 0x00  # the number of objects in each of the lists 1..5
+    ALL = 0x01
+    RXPDO_MAPPABLE = 0x02
+    TXPDO_MAPPABLE = 0x03
+    DEVICE_REPLACEMENT = 0x04  # stored for device replacement (backup)
+    STARTUP = 0x05  # startup parameters (settings)
+
+
+class ValueInfo(IntFlag):
+    """Get Entry Description ``ValueInfo``: which optional parts follow (ETG.1000.6 5.6.3.5)."""
+
+    UNIT_TYPE = 0x08
+    DEFAULT_VALUE = 0x10
+    MINIMUM_VALUE = 0x20
+    MAXIMUM_VALUE = 0x40
+
+
+# --- ETG.1000.6 5.6.3.2 (SDO Information header), after the CoE header ----------------
+SdoInfoHeader = Struct(
+    "op"
+    / BitStruct(
+        "incomplete" / Flag,  # bit 7: more fragments follow
+        "opcode" / BitsInteger(7),  # SdoInfoOpcode
+    ),
+    "reserved" / Int8ul,
+    "fragments_left" / Int16ul,
+)
+SDO_INFO_HEADER_SIZE = 4
+
+#: Get Object Description response data (ETG.1000.6 5.6.3.5.2), the name fills the rest
+ObjectDescription = Struct(
+    "index" / Int16ul,
+    "data_type" / Int16ul,
+    "max_subindex" / Int8ul,
+    "object_code" / Int8ul,
+    "name" / GreedyBytes,
+)
+
+#: Get Entry Description request data (ETG.1000.6 5.6.3.6.1)
+EntryDescriptionRequest = Struct("index" / Int16ul, "subindex" / Int8ul, "value_info" / Int8ul)
+
+#: Get Entry Description response data (ETG.1000.6 5.6.3.6.2): unit/default/min/max as
+#: ``value_info`` announces them, then the name, both in ``rest``
+EntryDescription = Struct(
+    "index" / Int16ul,
+    "subindex" / Int8ul,
+    "value_info" / Int8ul,
+    "data_type" / Int16ul,
+    "bit_length" / Int16ul,
+    "object_access" / Int16ul,
+    "rest" / GreedyBytes,
+)
+
+#: SDO Info error request data (ETG.1000.6 5.6.3.7): an SDO abort code
+SdoInfoError = Struct("code" / Int32ul)
+
+
+def build_sdo_info(
+    opcode: SdoInfoOpcode, data: bytes, *, counter: int, fragments_left: int = 0
+) -> bytes:
+    """A whole mailbox message carrying one SDO Information fragment."""
+    header = SdoInfoHeader.build(
+        {
+            "op": {"incomplete": fragments_left > 0, "opcode": int(opcode)},
+            "reserved": 0,
+            "fragments_left": fragments_left,
+        }
+    )
+    return build_coe(CoeService.SDO_INFORMATION, header + data, counter=counter)
+
 
 #: bytes of SDO data after the mailbox header, the CoE header and the 8-byte initiate frame
 INITIATE_OVERHEAD = MAILBOX_HEADER_SIZE + COE_HEADER_SIZE + 8

@@ -113,6 +113,33 @@ class ObjectCode(IntEnum):
     RECORD = 9
 
 
+class ObjectAccess(IntFlag):
+    """Access word of a Get Entry Description response (ETG.1000.6 5.6.3.6.2)."""
+
+    READ_PREOP = 0x0001
+    READ_SAFEOP = 0x0002
+    READ_OP = 0x0004
+    WRITE_PREOP = 0x0008
+    WRITE_SAFEOP = 0x0010
+    WRITE_OP = 0x0020
+    RXPDO_MAPPABLE = 0x0040
+    TXPDO_MAPPABLE = 0x0080
+    BACKUP = 0x0100
+    SETTINGS = 0x0200
+
+
+_READ_ALL = ObjectAccess.READ_PREOP | ObjectAccess.READ_SAFEOP | ObjectAccess.READ_OP
+_WRITE_IN = {
+    AlState.INIT: ObjectAccess.WRITE_PREOP,
+    AlState.PREOP: ObjectAccess.WRITE_PREOP,
+    AlState.SAFEOP: ObjectAccess.WRITE_SAFEOP,
+    AlState.OP: ObjectAccess.WRITE_OP,
+}
+#: data type index of the standard records (CiA 301 Table 44, ETG.1000.6 Table 64)
+PDO_MAPPING_TYPE = 0x0021
+IDENTITY_TYPE = 0x0023
+
+
 #: AL states in which PDO mapping (16xx/1Axx) and assignment (1C12/1C13) may be written.
 #: INIT is included because masters write them before the slave reports PREOP (ETG.2100 IP
 #: init commands); a slave in SAFEOP/OP refuses with 0x08000022.
@@ -273,6 +300,33 @@ class Variable:
             return len(self.encode(self.get()))
         return self.info.size
 
+    @property
+    def bit_length(self) -> int:
+        """Bits of the entry, as SDO Information describes it (strings: their room)."""
+        if self.info.is_string:
+            return 8 * max(self.max_size, self.sdo_size)
+        return (
+            self.pdo_bits
+            if self.data_type is DataType.BOOL or self.placeholder
+            else (8 * self.info.size)
+        )
+
+    @property
+    def object_access(self) -> ObjectAccess:
+        """Read/write rights per AL state and PDO mappability (ETG.1000.6 5.6.3.6.2)."""
+        bits = _READ_ALL if self.access.readable else ObjectAccess(0)
+        if self.access.writable:
+            if self.write_states is None:
+                bits |= ObjectAccess.WRITE_PREOP | ObjectAccess.WRITE_SAFEOP | ObjectAccess.WRITE_OP
+            else:
+                for state in self.write_states:
+                    bits |= _WRITE_IN.get(state, ObjectAccess(0))
+        if self.pdo & PdoDir.RX:
+            bits |= ObjectAccess.RXPDO_MAPPABLE
+        if self.pdo & PdoDir.TX:
+            bits |= ObjectAccess.TXPDO_MAPPABLE
+        return bits
+
 
 class OdObject:
     """One index: a VAR (only subindex 0) or an ARRAY/RECORD (subindex 0 = count)."""
@@ -297,6 +351,32 @@ class OdObject:
     def entries(self) -> list[Variable]:
         """Subindex 1.. in order (the part complete access carries after SI0)."""
         return [self.subs[k] for k in sorted(self.subs) if k != 0]
+
+    @property
+    def max_subindex(self) -> int:
+        """Highest subindex (what SI0 counts for an array or record; 0 for a variable)."""
+        if self.code is ObjectCode.VAR:
+            return 0
+        return max(self.subs, default=0)
+
+    @property
+    def data_type(self) -> int:
+        """Data type index of the object (Get Object Description).
+
+        A variable's own type, an array's element type, the standard record types for
+        1018h and the PDO mappings, and for another record the type of its first entry.
+        """
+        if self.code is ObjectCode.VAR:
+            var = self.subs.get(0)
+            return int(var.data_type) if var is not None else 0
+        if self.index == 0x1018:
+            return IDENTITY_TYPE
+        if 0x1600 <= self.index < 0x1800 or 0x1A00 <= self.index < 0x1C00:
+            return PDO_MAPPING_TYPE
+        entries = self.entries()
+        if entries:
+            return int(entries[0].data_type)
+        return int(DataType.UINT8)
 
 
 class ObjectDictionary:

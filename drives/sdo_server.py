@@ -7,6 +7,12 @@ exception becomes 0x08000000 (general error) and a log line, so a bug in a
 hook never reaches the master as a traceback (python-canopen's
 ``SdoServer.on_request`` does the same).
 
+CoE service 8, SDO Information (ETG.1000.6 5.6.3), lists and describes the
+dictionary (:mod:`drives.sdo_info`); an answer longer than one mailbox leaves
+here as several messages: :meth:`SdoServer.handle` returns the first and
+:meth:`SdoServer.next_message` the others, one per call, as the ESC frees its
+send mailbox.  A new request drops fragments not yet fetched.
+
 Mailbox problems that are not SDO problems (cut-short message, another
 mailbox protocol, another CoE service) get a mailbox error reply
 (ETG.1000.4 Table 30).  Requests are not de-duplicated by their counter: the
@@ -17,6 +23,7 @@ would answer a fresh client with a stale response.
 from __future__ import annotations
 
 import logging
+from collections import deque
 from dataclasses import dataclass
 
 from drives.abort import SdoAbort, SdoAbortCode
@@ -38,6 +45,7 @@ from drives.coe import (
     build_abort,
     build_coe,
     build_initiate,
+    build_sdo_info,
     initiate_cmd,
     mailbox_error,
     next_counter,
@@ -46,6 +54,7 @@ from drives.coe import (
     segment_cmd,
 )
 from drives.od import ObjectDictionary
+from drives.sdo_info import SdoInformation, fragments
 from drives.slave import AlState
 
 log = logging.getLogger(__name__)
@@ -78,6 +87,8 @@ class SdoServer:
         self.counter = 0
         self._upload: _Upload | None = None
         self._download: _Download | None = None
+        self.info = SdoInformation(od)
+        self._pending: deque[bytes] = deque()
 
     # --- entry point ------------------------------------------------------------
     def handle(self, message: bytes, al_state: AlState = AlState.PREOP) -> bytes | None:
@@ -91,6 +102,9 @@ class SdoServer:
         if len(mbx.data) < COE_HEADER_SIZE + 1:
             return self._mailbox_error(MailboxError.SIZE_TOO_SHORT)
         coe = CoeHeader.parse(mbx.data[:COE_HEADER_SIZE])
+        self._pending.clear()
+        if coe.service == CoeService.SDO_INFORMATION:
+            return self._information(mbx.data[COE_HEADER_SIZE:])
         if coe.service != CoeService.SDO_REQUEST:
             return self._mailbox_error(MailboxError.SERVICE_NOT_SUPPORTED)
         body = mbx.data[COE_HEADER_SIZE:]
@@ -107,6 +121,22 @@ class SdoServer:
         if answer is None:
             return None
         return self._respond(answer)
+
+    def next_message(self) -> bytes | None:
+        """The next fragment of a multi-message answer, or None when there is none."""
+        return self._pending.popleft() if self._pending else None
+
+    # --- SDO Information ---------------------------------------------------------
+    def _information(self, body: bytes) -> bytes:
+        opcode, payloads = self.info.handle(body)
+        parts = [frag for payload in payloads for frag in fragments(payload, self.mailbox_size)]
+        messages = []
+        for k, part in enumerate(parts):
+            self.counter = next_counter(self.counter)
+            left = len(parts) - 1 - k
+            messages.append(build_sdo_info(opcode, part, counter=self.counter, fragments_left=left))
+        self._pending.extend(messages[1:])
+        return messages[0]
 
     # --- framing ---------------------------------------------------------------
     def _respond(self, sdo: bytes) -> bytes:

@@ -138,6 +138,15 @@ class VirtualSlave:
         Table 29) and return the whole response, or None when there is nothing to answer."""
         return None
 
+    def mailbox_next(self) -> bytes | None:
+        """The next message of an answer that takes several (SDO Information fragments).
+
+        Asked for each time the master has read the previous message; None when the
+        answer is complete.  The default serves the slave's SDO server, if it has one.
+        """
+        next_message = getattr(getattr(self, "sdo", None), "next_message", None)
+        return next_message() if next_message is not None else None
+
     def on_state_change(self, old: AlState, new: AlState) -> AlStatusCode:
         """Called before a transition is accepted; a non-zero code refuses it."""
         return AlStatusCode.NO_ERROR

@@ -276,6 +276,8 @@ class Chain:
                     log.exception("slave %d (%s): step failed", esc.position, slave.name)
             esc.load_inputs()
             esc.sync_al()
+            if slave.emergencies:
+                esc.collect_emergencies()
 
     def poll(self, now_ns: int | None = None) -> None:
         """Watchdogs, and slave state changes made outside a step."""
@@ -283,6 +285,8 @@ class Chain:
         for esc in self.escs:
             esc.check_watchdog(now)
             esc.sync_al()
+            if esc.slave.emergencies:
+                esc.collect_emergencies()
 
 
 def _physical(kind: int, esc: Esc, ado: int, buf: bytearray, d0: int, d1: int) -> int:

@@ -34,6 +34,15 @@ What the registers do, and where it is specified:
   refused; the access to the last byte completes/frees it; repeat request via the
   activate register bit 1, acknowledged in PDI control bit 1) and buffered mode
   (process data; the write of the last byte hands the outputs to the slave).
+  The firmware behind the mailbox (ETG.1000.4 5.5, as the ETG slave stack does
+  it): a message whose non-zero counter equals the previous message's is a
+  repeat - a master resending a frame whose answer came late - and is not
+  executed again (the answer it already got stays; a lost answer is served
+  again through the SM1 repeat request); the counter memory is cleared when the
+  mailbox starts (INIT).  Answers of several messages (SDO Information
+  fragments) go out one by one as the master reads them; CoE emergencies the
+  slave raises (``slave.emergencies``) are queued as CoE service 1 messages
+  from PREOP on.
 * 0900h-0935h DC: receive times latched by a write to 0900h, 64-bit system time at
   0910h (a write there is the drift compensation: the local copy locks onto
   it), offset 0920h, delay 0928h, difference 092Ch; 0980h-09A7h sync registers are
@@ -56,7 +65,7 @@ from enum import IntEnum
 
 from eni.bits import get_bits, set_bits
 
-from ..coe import MailboxError, MailboxType, mailbox_error
+from ..coe import CoeService, MailboxError, MailboxType, build_coe, mailbox_error
 from ..slave import AlState, AlStatusCode, VirtualSlave
 
 log = logging.getLogger(__name__)
@@ -297,10 +306,18 @@ class Esc:
         self.mbx_out_sm: SyncManager | None = None  # master -> slave (SM0)
         self.mbx_in_sm: SyncManager | None = None  # slave -> master (SM1)
         self._sm_keys: list[tuple[int, ...]] = [()] * N_SM
-        self._mbx_queue: deque[bytes] = deque(maxlen=32)
+        self._mbx_queue: deque[bytes] = deque()
         self._mbx_last: bytes = b""
         self._mbx_cnt = 0
         self._mbx_in_pending = False
+        #: counter of the last mailbox message taken (0: none since the mailbox started)
+        self._mbx_write_counter = 0
+        #: the slave may have further messages of its last answer (``mailbox_next``)
+        self._mbx_more = False
+        #: mailbox messages not executed because they repeated the previous counter
+        self.mailbox_repeats = 0
+        #: answers and emergencies dropped because the queue was full
+        self.mailbox_overflows = 0
         self._eeprom_busy_until = 0
         self._dc_base = (position + 1) * 123_456_789
         self._dc_correction = 0
@@ -562,6 +579,8 @@ class Esc:
         if new == AlState.INIT:
             self._mbx_queue.clear()
             self._mbx_in_pending = False
+            self._mbx_more = False
+            self._mbx_write_counter = 0
             for sm in self.sms:
                 if sm.mailbox:
                     self._set_full(sm, False)
@@ -614,7 +633,10 @@ class Esc:
         self.sms = sms
         self.outputs_sm = next((s for s in sms if not s.mailbox and s.ecat_writes), None)
         self.inputs_sm = next((s for s in sms if not s.mailbox and not s.ecat_writes), None)
-        self.mbx_out_sm = next((s for s in sms if s.mailbox and s.ecat_writes), None)
+        mbx_out = next((s for s in sms if s.mailbox and s.ecat_writes), None)
+        if mbx_out is not self.mbx_out_sm:
+            self._mbx_write_counter = 0  # a mailbox set up anew starts a new counter sequence
+        self.mbx_out_sm = mbx_out
         self.mbx_in_sm = next((s for s in sms if s.mailbox and not s.ecat_writes), None)
         self._apply_pdi_sm_state()
         if self.slave.al_state >= AlState.SAFEOP:
@@ -641,7 +663,7 @@ class Esc:
 
     def _mailbox_read_done(self, sm: SyncManager) -> None:
         self._set_full(sm, False)
-        if self._mbx_queue:
+        if self._mbx_queue or self._mbx_more:
             self.on_pending(self)
 
     def _buffer_written(self, sm: SyncManager) -> None:
@@ -679,21 +701,64 @@ class Esc:
             self._mbx_in_pending = False
             msg = bytes(self.mem[sm.start : sm.end])
             self._set_full(sm, False)
-            self._handle(msg)
+            self._take(msg)
         elif self._mbx_in_pending:
             self._mbx_in_pending = False
         out = self.mbx_in_sm
-        if self._mbx_queue and out is not None and not out.full and not out.pdi_off:
+        if out is None or out.full or out.pdi_off:
+            return
+        if not self._mbx_queue and self._mbx_more:
+            try:
+                more = self.slave.mailbox_next()
+            except Exception:
+                log.exception("slave %d (%s): mailbox_next failed", self.position, self.slave.name)
+                self.errors += 1
+                more = None
+            if more:
+                self._mbx_queue.append(bytes(more))
+            else:
+                self._mbx_more = False
+        if self._mbx_queue:
             self._put_mailbox(out, self._mbx_queue.popleft())
+
+    #: answers and emergencies a slave may have waiting for the master
+    MAILBOX_QUEUE_LIMIT = 64
+
+    def _queue(self, message: bytes) -> None:
+        if len(self._mbx_queue) >= self.MAILBOX_QUEUE_LIMIT:
+            self.mailbox_overflows += 1
+            if self.mailbox_overflows <= 5:
+                log.warning(
+                    "slave %d (%s): mailbox queue full, message dropped",
+                    self.position,
+                    self.slave.name,
+                )
+            return
+        self._mbx_queue.append(message)
+
+    def _take(self, msg: bytes) -> None:
+        """A mailbox message the master wrote: run it unless it repeats the last one."""
+        counter = (msg[5] >> 4) & 0x07 if len(msg) >= 6 else 0
+        if counter and counter == self._mbx_write_counter:
+            self.mailbox_repeats += 1
+            log.info(
+                "slave %d (%s): mailbox message with counter %d repeated, not executed again",
+                self.position,
+                self.slave.name,
+                counter,
+            )
+            return
+        self._mbx_write_counter = counter
+        self._handle(msg)
 
     def _handle(self, msg: bytes) -> None:
         length = _U16.unpack_from(msg, 0)[0]
         mtype = msg[5] & 0x0F
         if length + 6 > len(msg):
-            self._mbx_queue.append(mailbox_error(MailboxError.INVALID_SIZE))
+            self._queue(mailbox_error(MailboxError.INVALID_SIZE))
             return
         if not self.slave.has_mailbox:
-            self._mbx_queue.append(mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL))
+            self._queue(mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL))
             return
         try:
             answer = self.slave.mailbox(msg[: 6 + length])
@@ -704,7 +769,29 @@ class Esc:
         if answer is None and mtype != MailboxType.COE:
             answer = mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL)
         if answer:
-            self._mbx_queue.append(bytes(answer))
+            self._queue(bytes(answer))
+            self._mbx_more = True
+
+    def collect_emergencies(self) -> None:
+        """The slave's pending CoE emergencies into the send queue (ETG.1000.6 5.6.4)."""
+        slave = self.slave
+        pending = slave.emergencies
+        if not pending:
+            return
+        if (
+            not slave.has_mailbox
+            or slave.al_state < AlState.PREOP
+            or slave.al_state == AlState.BOOT
+        ):
+            pending.clear()  # no mailbox to carry them: a real slave loses them too
+            return
+        while pending:
+            emcy = pending.popleft()
+            body = struct.pack("<HB", emcy.code & 0xFFFF, emcy.register & 0xFF) + bytes(
+                emcy.data[:5]
+            ).ljust(5, b"\0")
+            self._queue(build_coe(CoeService.EMERGENCY, body, counter=0))
+        self.on_pending(self)
 
     def _put_mailbox(self, sm: SyncManager, answer: bytes) -> None:
         if len(answer) > sm.length:

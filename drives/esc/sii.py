@@ -362,7 +362,8 @@ def sii_info_for(slave: object, *, mailbox_size: int = 128) -> SiiInfo:
     Identity and name come from the slave; the PDO categories from its
     ``rx_pdos``/``tx_pdos`` (the mapping the ENI assigned) or, when it has
     none, from a stand-in of ``pdo_sizes()``; CoE details from an optional
-    ``coe_details`` attribute (default: SDO, PDO assign and PDO config); the
+    ``coe_details`` attribute (default: SDO, SDO Information, PDO assign and PDO
+    config); the
     mailbox size from the slave's SDO server (``slave.sdo.mailbox_size``) when
     it has one, since that is the size it segments its answers to.
     """
@@ -380,7 +381,10 @@ def sii_info_for(slave: object, *, mailbox_size: int = 128) -> SiiInfo:
             getattr(
                 slave,
                 "coe_details",
-                CoeDetails.SDO | CoeDetails.PDO_ASSIGN | CoeDetails.PDO_CONFIG,
+                CoeDetails.SDO
+                | CoeDetails.SDO_INFO
+                | CoeDetails.PDO_ASSIGN
+                | CoeDetails.PDO_CONFIG,
             )
         )
         protocols = MailboxProtocol.COE

@@ -210,7 +210,8 @@ def test_client_abort_is_not_answered() -> None:
         (b"\x01\x02", 0x06),  # shorter than a header
         (build_mailbox(b"\x00\x20", counter=1)[:7], 0x06),  # cut short
         (build_mailbox(b"abcd", counter=1, mbx_type=MailboxType.FOE), 0x02),
-        (build_coe(CoeService.SDO_INFORMATION, b"\x01\x00\x00\x00", counter=1), 0x04),
+        # SDO Information is served (test_sdo_info.py); remote PDO requests are not
+        (build_coe(CoeService.TXPDO_REMOTE_REQUEST, b"\x01\x00\x00\x00", counter=1), 0x04),
     ],
 )
 def test_mailbox_error_replies(message: bytes, detail: int) -> None:

@@ -281,8 +281,8 @@ def test_link_counter_runs_1_to_7() -> None:
     esc, _ = make()
     preop(esc)
     counters = []
-    for _ in range(9):
-        req = sdo_upload_request(0x2000, 0)
+    for k in range(9):
+        req = sdo_upload_request(0x2000, 0, counter=k % 7 + 1)  # a master counts 1..7
         esc.write(0x1000, req + bytes(128 - len(req)))
         esc.service()
         counters.append(((esc.read(0x1080, 128) or b"\0" * 6)[5] >> 4) & 7)

@@ -71,7 +71,9 @@ def test_categories_end_with_ffff_and_string_one_is_the_name() -> None:
     strings = dict(iter_categories(raw))[Category.STRINGS]
     assert strings[1] == len("Drive Name") and strings[2:12] == b"Drive Name"
     general = dict(iter_categories(raw))[Category.GENERAL]
-    assert general[5] == CoeDetails.SDO | CoeDetails.PDO_ASSIGN | CoeDetails.PDO_CONFIG
+    assert general[5] == (
+        CoeDetails.SDO | CoeDetails.SDO_INFO | CoeDetails.PDO_ASSIGN | CoeDetails.PDO_CONFIG
+    )
 
 
 def test_sm_layout_with_and_without_mailbox() -> None:

@@ -1,0 +1,256 @@
+"""The firmware behind SM0/SM1: repeated messages, multi-message answers, emergencies.
+
+The requests are hand-written bytes (ETG.1000.4 5.5 mailbox header, ETG.1000.6
+5.6.3 SDO Information), not built with drives.coe, so a codec bug cannot hide
+on both sides.
+"""
+
+from __future__ import annotations
+
+import struct
+
+from drives.drive import Cia402Drive
+from drives.esc.registers import Esc, FrameTime, Reg
+from drives.esc.sii import build_sii, sii_info_for
+from drives.slave import AlState
+from eni.model import Direction, Identity, Pdo, PdoEntry
+from tests.drives.esc.mini import MiniSlave, sdo_upload_request
+from tests.drives.esc.test_registers import configure, make, request
+
+SM0, SM1, SIZE = 0x1000, 0x1080, 128
+
+
+def preop(esc: Esc) -> None:
+    configure(esc)
+    assert request(esc, AlState.PREOP) == (AlState.PREOP, 0)
+
+
+def write_mailbox(esc: Esc, msg: bytes) -> bool:
+    return esc.write(SM0, msg + bytes(SIZE - len(msg)))
+
+
+def read_mailbox(esc: Esc) -> bytes | None:
+    """What a master's FPRD of the whole SM1 buffer returns (None: empty, no WKC)."""
+    return esc.read(SM1, SIZE)
+
+
+def upload_value(answer: bytes) -> int:
+    assert answer[5] & 0x0F == 3 and answer[8] & 0xE0 == 0x40, answer[:12].hex()
+    size = 4 - ((answer[8] >> 2) & 3)
+    return int.from_bytes(answer[12 : 12 + size], "little")
+
+
+# --- item 1: a repeated mailbox write runs once -------------------------------------------------
+def test_a_resent_write_with_the_same_counter_runs_once() -> None:
+    """SOEM resends an FPWR of SM0 whose answer frame came late: the slave must not answer
+    twice, or every later SDO answer is one behind (issue 16, item 1)."""
+    esc, _ = make()
+    preop(esc)
+    slave = esc.slave
+    assert isinstance(slave, MiniSlave)
+    first = sdo_upload_request(0x1000, 0, counter=3)
+    assert write_mailbox(esc, first)
+    esc.service()  # the firmware took it; SM0 is empty again
+    assert write_mailbox(esc, first)  # the resent frame: accepted by the ESC (WKC 1) ...
+    esc.service()
+    assert len(slave.requests) == 1  # ... but not executed again
+    assert esc.mailbox_repeats == 1
+    assert upload_value(read_mailbox(esc) or b"") == 0x00020192
+    esc.service()
+    assert read_mailbox(esc) is None  # one request, one answer
+    # the next request gets its own answer, not the previous one
+    assert write_mailbox(esc, sdo_upload_request(0x2000, 0, counter=4))
+    esc.service()
+    assert upload_value(read_mailbox(esc) or b"") == 0x1234
+
+
+def test_counter_zero_and_a_new_counter_always_run() -> None:
+    esc, _ = make()
+    preop(esc)
+    slave = esc.slave
+    assert isinstance(slave, MiniSlave)
+    for counter in (0, 0, 5, 6, 5):
+        assert write_mailbox(esc, sdo_upload_request(0x2000, 0, counter=counter))
+        esc.service()
+        assert read_mailbox(esc) is not None
+    assert len(slave.requests) == 5 and esc.mailbox_repeats == 0
+
+
+def test_the_counter_memory_starts_again_with_the_mailbox() -> None:
+    """A new master session (INIT, mailbox set up again) may start with the counter the
+    previous session ended with."""
+    esc, _ = make()
+    preop(esc)
+    slave = esc.slave
+    assert isinstance(slave, MiniSlave)
+    assert write_mailbox(esc, sdo_upload_request(0x2000, 0, counter=1))
+    esc.service()
+    assert read_mailbox(esc) is not None
+    assert request(esc, AlState.INIT) == (AlState.INIT, 0)
+    assert request(esc, AlState.PREOP) == (AlState.PREOP, 0)
+    assert write_mailbox(esc, sdo_upload_request(0x2000, 0, counter=1))
+    esc.service()
+    assert read_mailbox(esc) is not None
+    assert len(slave.requests) == 2
+
+
+def test_a_lost_answer_comes_again_on_the_repeat_request() -> None:
+    esc, _ = make()
+    preop(esc)
+    assert write_mailbox(esc, sdo_upload_request(0x2000, 0, counter=2))
+    esc.service()
+    first = read_mailbox(esc)
+    assert first is not None  # read, but say the frame carrying it was lost
+    activate = (esc.read(Reg.SM0 + 8 + 6, 1) or b"\0")[0]
+    esc.write(Reg.SM0 + 8 + 6, bytes([activate ^ 0x02]))  # toggle the repeat request
+    pdi = (esc.read(Reg.SM0 + 8 + 7, 1) or b"\0")[0]
+    assert pdi & 0x02 == (activate ^ 0x02) & 0x02  # acknowledged
+    assert read_mailbox(esc) == first
+
+
+# --- a real drive: SDO Information and emergencies ----------------------------------------------
+def drive_esc() -> Esc:
+    rx = (Pdo(0x1600, Direction.OUT, (PdoEntry(0x6040, 0, 16), PdoEntry(0x607A, 0, 32))),)
+    tx = (
+        Pdo(
+            0x1A00,
+            Direction.IN,
+            (PdoEntry(0x6041, 0, 16), PdoEntry(0x6064, 0, 32), PdoEntry(0x60FD, 0, 32)),
+        ),
+    )
+    drive = Cia402Drive(0, "GTHD", Identity(0x0000_0A1B, 0x0000_0001, 1), rx_pdos=rx, tx_pdos=tx)
+    esc = Esc(drive, build_sii(sii_info_for(drive)), frame_time=FrameTime(0))
+    configure(esc)
+    assert request(esc, AlState.PREOP) == (AlState.PREOP, 0)
+    return esc
+
+
+def info_request(opcode: int, data: bytes, counter: int) -> bytes:
+    body = struct.pack("<HBBH", 8 << 12, opcode, 0, 0) + data  # CoE service 8, info header
+    return struct.pack("<HHBB", len(body), 0, 0, 3 | counter << 4) + body
+
+
+def info_answers(esc: Esc, msg: bytes) -> list[bytes]:
+    """Send one request and read every fragment the slave puts into SM1."""
+    assert write_mailbox(esc, msg)
+    out = []
+    for _ in range(100):
+        esc.service()
+        got = read_mailbox(esc)
+        if got is None:
+            break
+        length = struct.unpack_from("<H", got)[0]
+        out.append(got[: 6 + length])
+        if not got[8] & 0x80:  # Incomplete clear: the last fragment
+            break
+    return out
+
+
+def test_get_od_list_is_fragmented_with_fragments_left() -> None:
+    esc = drive_esc()
+    frames = info_answers(esc, info_request(0x01, struct.pack("<H", 1), counter=1))
+    assert len(frames) > 1, "a drive's dictionary does not fit one 128-byte mailbox"
+    indices: list[int] = []
+    for k, f in enumerate(frames):
+        assert f[5] & 0x0F == 3 and struct.unpack_from("<H", f, 6)[0] >> 12 == 8
+        opcode, left = f[8], struct.unpack_from("<H", f, 10)[0]
+        assert opcode & 0x7F == 0x02
+        assert left == len(frames) - 1 - k
+        assert bool(opcode & 0x80) == (left > 0)
+        data = f[12:]
+        if k == 0:
+            assert struct.unpack_from("<H", data)[0] == 1  # list type echoed first
+            data = data[2:]
+        indices += struct.unpack(f"<{len(data) // 2}H", data)
+    drive = esc.slave
+    assert isinstance(drive, Cia402Drive)
+    assert indices == sorted(o.index for o in drive.od)
+    assert {0x1000, 0x1018, 0x1600, 0x1A00, 0x6040, 0x6041, 0x607A} <= set(indices)
+
+
+def test_get_od_list_lengths_and_pdo_lists() -> None:
+    esc = drive_esc()
+    (lengths,) = info_answers(esc, info_request(0x01, struct.pack("<H", 0), counter=1))
+    counts = struct.unpack_from("<H5H", lengths, 12)
+    assert counts[0] == 0 and counts[1] > counts[2] > 0 and counts[3] > 0
+    rx = info_answers(esc, info_request(0x01, struct.pack("<H", 2), counter=2))
+    rx_indices = [i for f in rx for i in struct.unpack(f"<{(len(f) - 12) // 2}H", f[12:])]
+    assert 0x6040 in rx_indices[1:] and 0x6041 not in rx_indices[1:]
+
+
+def test_object_and_entry_description() -> None:
+    esc = drive_esc()
+    (obj,) = info_answers(esc, info_request(0x03, struct.pack("<H", 0x1018), counter=1))
+    assert obj[8] == 0x04
+    index, dtype, max_sub, code = struct.unpack_from("<HHBB", obj, 12)
+    length = struct.unpack_from("<H", obj)[0]
+    assert (index, dtype, max_sub, code) == (0x1018, 0x0023, 4, 9)
+    assert obj[18 : 6 + length] == b"Identity"  # the name is the rest, unpadded
+    (entry,) = info_answers(esc, info_request(0x05, struct.pack("<HBB", 0x6040, 0, 7), counter=2))
+    assert entry[8] == 0x06
+    index, sub, vinfo, dtype, bits, access = struct.unpack_from("<HBBHHH", entry, 12)
+    assert (index, sub, dtype, bits) == (0x6040, 0, 0x0006, 16)
+    assert vinfo & 0x78 == 0  # SOEM asks for none of unit/default/min/max
+    assert access & 0x0007 == 0x0007 and access & 0x0038 == 0x0038  # read/write in every state
+    assert access & 0x0040 and not access & 0x0080  # RxPDO mappable only
+    length = struct.unpack_from("<H", entry)[0]
+    assert entry[22 : 6 + length].lower().startswith(b"controlword")
+    (ro,) = info_answers(esc, info_request(0x05, struct.pack("<HBB", 0x1018, 1, 0), counter=3))
+    assert struct.unpack_from("<H", ro, 20)[0] & 0x003F == 0x0007  # read-only
+    (mx,) = info_answers(esc, info_request(0x05, struct.pack("<HBB", 0x6041, 0, 0x60), counter=4))
+    assert mx[15] == 0x60 and struct.unpack_from("<HH", mx, 22) == (0, 0xFFFF)  # min, max
+
+
+def test_sdo_info_errors_carry_the_abort_code() -> None:
+    esc = drive_esc()
+    cases = [
+        (info_request(0x03, struct.pack("<H", 0x5555), 1), 0x06020000),
+        (info_request(0x05, struct.pack("<HBB", 0x6040, 9, 0), 2), 0x06090011),
+        (info_request(0x7E, b"", 3), 0x05040001),
+    ]
+    for msg, code in cases:
+        (err,) = info_answers(esc, msg)
+        assert err[8] & 0x7F == 0x07
+        assert struct.unpack_from("<I", err, 12)[0] == code
+
+
+def test_a_new_request_drops_unread_fragments() -> None:
+    esc = drive_esc()
+    assert write_mailbox(esc, info_request(0x01, struct.pack("<H", 1), counter=1))
+    esc.service()
+    assert read_mailbox(esc) is not None  # first fragment only
+    assert write_mailbox(esc, sdo_upload_request(0x1018, 1, counter=2))
+    for _ in range(3):
+        esc.service()
+    answer = read_mailbox(esc) or b""
+    assert struct.unpack_from("<H", answer, 6)[0] >> 12 in (3, 8)
+    if struct.unpack_from("<H", answer, 6)[0] >> 12 == 8:  # one fragment was already queued
+        esc.service()
+        answer = read_mailbox(esc) or b""
+    assert upload_value(answer) == 0x0A1B
+
+
+def test_a_fault_sends_a_coe_emergency() -> None:
+    esc = drive_esc()
+    drive = esc.slave
+    assert isinstance(drive, Cia402Drive)
+    code = drive.channel(0).inject_fault("following_error")
+    drive.step(0, 1_000_000)
+    esc.collect_emergencies()
+    esc.service()
+    msg = read_mailbox(esc)
+    assert msg is not None
+    assert msg[5] & 0x0F == 3 and struct.unpack_from("<H", msg, 6)[0] >> 12 == 1
+    assert struct.unpack_from("<HB", msg, 8) == (code, 0x01)
+
+
+def test_emergencies_are_dropped_without_a_mailbox_state() -> None:
+    esc = drive_esc()
+    assert request(esc, AlState.INIT) == (AlState.INIT, 0)
+    esc.slave.emit_emergency(0x8611, 0x01)
+    esc.collect_emergencies()
+    esc.service()
+    assert not esc.slave.emergencies
+    assert request(esc, AlState.PREOP) == (AlState.PREOP, 0)
+    esc.service()
+    assert read_mailbox(esc) is None

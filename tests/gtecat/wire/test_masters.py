@@ -1,0 +1,153 @@
+"""``gtecat serve`` against masters nobody here wrote the slaves for.
+
+* a raw-socket master written in the test (:mod:`.rawmaster`) reproduces what
+  real masters do that once went wrong: SOEM resending a mailbox write whose
+  answer was late, SDO Information with fragments, emergencies, the SII read
+  back whole;
+* pysoem (SOEM) lists the object dictionary and sees an emergency;
+* KickCAT and ebpfcat from PyPI, where they install (skipped with the reason
+  otherwise).
+
+Each test module gets its own veth pair and server; every wait is bounded.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import struct
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from tests.gtecat.wire.rawmaster import (
+    RawMaster,
+    SdoAbortSeen,
+    ServeProcess,
+    veth_pair,
+    why_not_root,
+)
+
+pytestmark = pytest.mark.wire
+
+ROOT = Path(__file__).resolve().parents[3]
+FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
+TWELVE = ROOT / "examples" / "twelve_axes.eni"
+TWINCAT = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
+
+_REASON = why_not_root()
+if _REASON:
+    pytest.skip(_REASON, allow_module_level=True)
+
+
+@contextlib.contextmanager
+def served(eni: Path, tmp: Path, *extra: str) -> Iterator[tuple[str, ServeProcess]]:
+    try:
+        pair = veth_pair()
+        master_if, slave_if = pair.__enter__()
+    except OSError as exc:
+        pytest.skip(str(exc))
+    try:
+        server = ServeProcess(eni, slave_if, tmp / "stats.json", *extra, cwd=ROOT)
+        try:
+            yield master_if, server
+        finally:
+            assert server.stop() == 0, server.output
+    finally:
+        pair.__exit__(None, None, None)
+
+
+@pytest.fixture(scope="module")
+def fig52(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[str, ServeProcess]]:
+    with served(FIG52, tmp_path_factory.mktemp("fig52")) as it:
+        yield it
+
+
+@pytest.fixture
+def raw(fig52: tuple[str, ServeProcess]) -> Iterator[RawMaster]:
+    with RawMaster(fig52[0]) as master:
+        yield master
+
+
+def preop_drive(master: RawMaster) -> tuple[int, tuple[int, int, int, int]]:
+    stations = master.scan()
+    assert len(stations) == 4
+    sm = master.setup_mailbox(stations[0])
+    assert master.request_state(stations[0], 2) == (2, 0)
+    return stations[0], sm
+
+
+def u32(data: bytes) -> int:
+    return struct.unpack("<I", data[:4])[0]
+
+
+# --- item 1: a resent mailbox write -------------------------------------------------------------
+def test_a_resent_mailbox_write_is_executed_once(raw: RawMaster) -> None:
+    """SOEM resends an FPWR of SM0 (same frame, same index, same mailbox counter) when its
+    answer is late; the slave must not answer twice (issue 16, item 1)."""
+    station, sm = preop_drive(raw)
+    request = raw.mailbox_message(station, 3, struct.pack("<HBHB4x", 2 << 12, 0x40, 0x1018, 1))
+    frame = raw.frame(5, 0x42, station, sm[0], request.ljust(sm[1], b"\0"))  # FPWR
+    raw.send_raw(frame)
+    first = raw.receive(0x42, time.monotonic() + 1)
+    assert first is not None and first.wkc == 1
+    deadline = time.monotonic() + 1  # the firmware takes the message: SM0 empties
+    while raw.fprd(station, 0x0805, 1).data[0] & 0x08:
+        assert time.monotonic() < deadline
+    raw.send_raw(frame)  # the resend of the "late" frame
+    second = raw.receive(0x42, time.monotonic() + 1)
+    assert second is not None and second.wkc == 1  # the ESC takes the write ...
+    answer = raw.mbx_read(station, sm)
+    assert answer is not None and answer[8] == 0x43, answer  # expedited upload of 4 bytes
+    vendor = u32(answer[12:])
+    assert raw.mbx_read(station, sm, timeout=0.1) is None  # ... and the firmware answers once
+    product = raw.sdo_upload(station, sm, 0x1018, 2)
+    # the answers are not one behind: 1018:01 is the vendor id the SII states
+    assert vendor == raw.sii_word(station, 0x08) | raw.sii_word(station, 0x09) << 16
+    assert u32(product) == raw.sii_word(station, 0x0A) | raw.sii_word(station, 0x0B) << 16
+
+
+# --- item 3: SDO Information --------------------------------------------------------------------
+def test_sdo_information_lists_and_describes_the_dictionary(raw: RawMaster) -> None:
+    station, sm = preop_drive(raw)
+    words = raw.sii_word(station, 0x1C)
+    assert words & 0x04  # CoE
+    frags = raw.sdo_info(station, sm, 0x01, struct.pack("<H", 1))
+    assert len(frags) > 1  # the list does not fit one mailbox: fragments, counted down
+    data = b"".join(frags)
+    assert struct.unpack_from("<H", data)[0] == 1
+    indices = list(struct.unpack(f"<{len(data) // 2 - 1}H", data[2:]))
+    assert indices == sorted(indices) and {0x1000, 0x1018, 0x6040, 0x6041} <= set(indices)
+    (desc,) = raw.sdo_info(station, sm, 0x03, struct.pack("<H", 0x6041))
+    index, dtype, max_sub, code = struct.unpack_from("<HHBB", desc)
+    assert (index, dtype, max_sub, code) == (0x6041, 0x0006, 0, 7)
+    assert desc[6:].lower().startswith(b"statusword")
+    (entry,) = raw.sdo_info(station, sm, 0x05, struct.pack("<HBB", 0x6041, 0, 0x07))
+    index, sub, _vi, dtype, bits, access = struct.unpack_from("<HBBHHH", entry)
+    assert (index, sub, dtype, bits) == (0x6041, 0, 0x0006, 16)
+    assert access & 0x0007 == 0x0007 and not access & 0x0038 and access & 0x0080
+    (err,) = raw.sdo_info(station, sm, 0x03, struct.pack("<H", 0x5555))
+    assert u32(err) == 0x06020000
+    with pytest.raises(SdoAbortSeen) as abort:
+        raw.sdo_upload(station, sm, 0x5555, 0)
+    assert abort.value.code == 0x06020000
+
+
+def test_pysoem_reads_the_object_dictionary(fig52: tuple[str, ServeProcess]) -> None:
+    pysoem = pytest.importorskip("pysoem")
+    master = pysoem.Master()
+    master.open(fig52[0])
+    try:
+        assert master.config_init() == 4
+        drive = master.slaves[0]
+        od = drive.od
+        by_index = {obj.index: obj for obj in od}
+        assert {0x1000, 0x1018, 0x6040, 0x6041, 0x607A} <= set(by_index)
+        assert by_index[0x1018].name == b"Identity" and by_index[0x1018].object_code == 9
+        names = [e.name for e in by_index[0x1018].entries]
+        assert b"Vendor ID" in names
+        assert by_index[0x6041].data_type == pysoem.ECT_UNSIGNED16
+        assert struct.unpack("<I", drive.sdo_read(0x1018, 1))[0] == drive.man
+    finally:
+        master.close()
