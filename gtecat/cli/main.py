@@ -16,6 +16,7 @@ from eni.errors import GtecatError
 #: verb modules under gtecat.cli, in help order
 COMMANDS = (
     "demo_cmd",
+    "example_cmd",
     "map_cmd",
     "eni_cmd",
     "bus_cmd",
@@ -23,6 +24,7 @@ COMMANDS = (
     "serve_cmd",
     "controller_cmd",
     "lib_cmd",
+    "compile_cmd",
 )
 
 

@@ -23,6 +23,7 @@ _MODULES = (
     "status_calls",
     "mode_calls",
     "motion_ext_calls",
+    "program_calls",
 )
 
 

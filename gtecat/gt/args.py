@@ -479,7 +479,7 @@ def _pointer_converter(p: Param) -> Converter:
 
 def _converter(p: Param) -> Converter:
     if p.pointer and p.text and p.direction == "in":
-        return lambda v: None if v is None and p.optional else _text(p, v)
+        return lambda v: None if p.optional and _null(v) else _text(p, v)
     if p.pointer:
         return _pointer_converter(p)
     if p.is_float:
