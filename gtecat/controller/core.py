@@ -45,6 +45,8 @@ class Options:
     op_delay_cycles: int = 10
     #: ENI describing the emulated hardware when it differs from ``eni`` (GTECAT_BUS)
     bus: str | None = None
+    #: the MRAM store file (GTECAT_MRAM; default Gecat.mram beside the log, manual 11.8)
+    mram: str | None = None
 
     def resolved(self) -> Options:
         env = os.environ
@@ -64,6 +66,7 @@ class Options:
             log=self.log if self.log is not None else env.get("GTECAT_LOG", "Gecat.log"),
             op_delay_cycles=self.op_delay_cycles,
             bus=self.bus or env.get("GTECAT_BUS"),
+            mram=self.mram or env.get("GTECAT_MRAM"),
         )
 
 

@@ -82,6 +82,7 @@ def GT_Open(
     log: str | None = None,
     bus: str | None = None,
     op_delay_cycles: int = 10,
+    mram: str | None = None,
 ) -> int:
     """Open the (emulated) controller.  Keyword options override ``GTECAT_*``."""
     if 1 in SESSION.controllers:
@@ -101,6 +102,7 @@ def GT_Open(
             log=log,
             bus=bus,
             op_delay_cycles=op_delay_cycles,
+            mram=mram,
         )
     )
     return 0
