@@ -103,6 +103,9 @@ class Controller:
         self.backend = None
         self.started = False
         self.reset_ns = 0
+        #: run first in a cycle, before its time is read: motion programs, whose GT calls
+        #: may themselves wait for cycles (GT_AxisOn), so the cycle then starts later
+        self.before_cycle: list[Callable[[], None]] = []
         self.pre_cycle: list[Callable[[int, int], None]] = []
         self.post_cycle: list[Callable[[int, int], None]] = []
         self.sample: list[Callable[[int], None]] = []
@@ -210,6 +213,8 @@ class Controller:
 
     # --- the cycle --------------------------------------------------------------------------
     def _cycle(self) -> None:
+        for g in self.before_cycle:
+            g()
         t = self.clock.now_ns
         dt = self.clock.cycle_ns
         for f in self.pre_cycle:
