@@ -17,9 +17,10 @@ What the registers do, and where it is specified:
   ETG.1000.6 6.4): the request goes to :meth:`VirtualSlave.request_state`; a
   pending error (status bit 4) must be acknowledged (control bit 4) before a
   request for the same or a higher state is taken; lower states are always taken.
-  The ESC itself checks what a slave's firmware checks: valid mailbox SMs for
+  A slave with a mailbox has firmware, which checks valid mailbox SMs for
   INIT -> PREOP (16h) and process data SM lengths against the current mapping
-  for PREOP -> SAFEOP (1Dh outputs, 1Eh inputs).
+  for PREOP -> SAFEOP (1Dh outputs, 1Eh inputs); a bare ESC without one checks
+  nothing (device emulation: AL status follows AL control).
 * 0200h/0210h ECAT event mask/request (AL status change, SM mailbox full), OR-ed
   into every datagram's IRQ field.
 * 0300h-0313h error counters (any write clears them).
@@ -300,6 +301,9 @@ class Esc:
         self.eeprom_busy_ns = eeprom_busy_ns
         self.mem = bytearray(MEMORY_SIZE)
         self.sms: list[SyncManager] = []
+        #: lowest address any enabled SM covers (SMs may sit in register space: an
+        #: EL2008's output SM is the digital output register 0F00h)
+        self._sm_floor = REGISTER_SPACE
         self.fmmus: list[Fmmu] = []
         self.outputs_sm: SyncManager | None = None
         self.inputs_sm: SyncManager | None = None
@@ -347,6 +351,7 @@ class Esc:
         _U32.pack_into(m, Reg.DL_CONTROL, 0x00000001)
         _U16.pack_into(m, Reg.AL_CONTROL, int(AlState.INIT))
         m[Reg.PDI_CONTROL] = self.sii[0] if self.sii else 0x05
+        m[Reg.ESC_CONFIG] = self.sii[1] if len(self.sii) > 1 else 0x00
         _U16.pack_into(m, Reg.WD_DIVIDER, 0x09C2)  # 100 us
         _U16.pack_into(m, Reg.WD_TIME_PDI, 1000)
         _U16.pack_into(m, Reg.WD_TIME_PD, 1000)  # 100 ms
@@ -408,7 +413,7 @@ class Esc:
         end = addr + n
         if end > MEMORY_SIZE or addr < 0:
             return None
-        if end > REGISTER_SPACE:
+        if end > self._sm_floor:
             hit = None
             for sm in self.sms:
                 if sm.start < end and addr < sm.end:
@@ -421,11 +426,13 @@ class Esc:
                     else:
                         hit.append(sm)
             if hit:
-                data = bytes(self.mem[addr:end])
+                data = bytes(self.mem[addr:end]) if addr >= REGISTER_SPACE else None
+                if data is None:
+                    data = self._reg_read(addr, end)
                 for sm in hit:
                     if sm.mailbox and addr < sm.end <= end:
                         self._mailbox_read_done(sm)
-                return data if addr >= REGISTER_SPACE else self._reg_read(addr, end)
+                return data
             if addr >= REGISTER_SPACE:
                 return bytes(self.mem[addr:end])
         return self._reg_read(addr, end)
@@ -446,7 +453,7 @@ class Esc:
         end = addr + n
         if end > MEMORY_SIZE or addr < 0:
             return False
-        if end > REGISTER_SPACE:
+        if end > self._sm_floor:
             hit = None
             for sm in self.sms:
                 if sm.start < end and addr < sm.end:
@@ -460,6 +467,8 @@ class Esc:
                         hit.append(sm)
             if addr >= REGISTER_SPACE:
                 self.mem[addr:end] = data
+            elif end <= REGISTER_SPACE:
+                self._reg_write(addr, bytes(data))
             else:
                 self._reg_write(addr, bytes(data[: REGISTER_SPACE - addr]))
                 self.mem[REGISTER_SPACE:end] = data[REGISTER_SPACE - addr :]
@@ -538,7 +547,15 @@ class Esc:
         self.sync_al()
 
     def _firmware_check(self, current: AlState, target: int) -> AlStatusCode:
-        """What a slave's firmware checks before it takes a transition."""
+        """What a slave's firmware checks before it takes a transition.
+
+        Only a slave with a microcontroller behind its ESC has firmware; that is a
+        slave with a mailbox.  A bare ESC (an EL1xxx/EL2xxx terminal: digital I/O
+        PDI, device emulation) takes every state the master requests and checks no
+        SM layout: TwinCAT writes an EL2008's output SM only at SAFEOP -> OP.
+        """
+        if not self.slave.has_mailbox:
+            return AlStatusCode.NO_ERROR
         if current == AlState.INIT and target == AlState.PREOP and self.slave.has_mailbox:
             out, inp = self.mbx_out_sm, self.mbx_in_sm
             if out is None or inp is None or out.length < 8 or inp.length < 8:
@@ -631,6 +648,7 @@ class Esc:
                 m[Reg.SM0 + 8 * n + 5] = 0
             self._sm_keys[n] = key
         self.sms = sms
+        self._sm_floor = min([REGISTER_SPACE, *(sm.start for sm in sms)])
         self.outputs_sm = next((s for s in sms if not s.mailbox and s.ecat_writes), None)
         self.inputs_sm = next((s for s in sms if not s.mailbox and not s.ecat_writes), None)
         mbx_out = next((s for s in sms if s.mailbox and s.ecat_writes), None)

@@ -356,22 +356,54 @@ def _synthetic_pdos(direction: Direction, bits: int) -> tuple[Pdo, ...]:
     return (Pdo(index, direction, tuple(entries)),)
 
 
+def _mapped_pdos(slave: object, direction: Direction) -> tuple[Pdo, ...] | None:
+    """The PDOs the slave's CoE mapping assigns now (1C12h/1C13h and 16xx/1Axx), with the
+    names and types its object dictionary gives; None for a slave without such a mapping."""
+    mapping = getattr(slave, "mapping", None)
+    od = getattr(slave, "od", None)
+    if mapping is None or od is None or not hasattr(mapping, "assigned"):
+        return None
+    pdos = []
+    for pdo_index in mapping.assigned(direction):
+        obj = od.objects.get(pdo_index)
+        entries = []
+        count = int(obj.subs[0].get()) if obj is not None and 0 in obj.subs else 0
+        for k in range(1, count + 1):
+            value = int(obj.subs[k].get()) if obj is not None and k in obj.subs else 0
+            index, sub, bits = value >> 16, (value >> 8) & 0xFF, value & 0xFF
+            target = od.find(index, sub) if index else None
+            name = "" if target is None or target.placeholder else target.name
+            dtype = "" if target is None else _DATA_TYPE_NAMES.get(int(target.data_type), "")
+            entries.append(PdoEntry(index, sub, bits, name, dtype))
+        pdos.append(Pdo(pdo_index, direction, tuple(entries), obj.name if obj else ""))
+    return tuple(pdos)
+
+
 def sii_info_for(slave: object, *, mailbox_size: int = 128) -> SiiInfo:
     """The SII of a :class:`~drives.slave.VirtualSlave`.
 
-    Identity and name come from the slave; the PDO categories from its
-    ``rx_pdos``/``tx_pdos`` (the mapping the ENI assigned) or, when it has
-    none, from a stand-in of ``pdo_sizes()``; CoE details from an optional
-    ``coe_details`` attribute (default: SDO, SDO Information, PDO assign and PDO
-    config); the
+    Identity and name come from the slave; the PDO categories from the mapping
+    its CoE objects assign (``slave.mapping``: a drive's 6040h/607Ah and
+    6041h/6064h/60FDh with their names), else from its ``rx_pdos``/``tx_pdos``
+    (the mapping the ENI assigned), else from a stand-in of ``pdo_sizes()``;
+    CoE details from an optional ``coe_details`` attribute (default: SDO, SDO
+    Information, PDO assign and PDO config); the
     mailbox size from the slave's SDO server (``slave.sdo.mailbox_size``) when
     it has one, since that is the size it segments its answers to.
     """
     rx_bits, tx_bits = slave.pdo_sizes()  # type: ignore[attr-defined]
     # the SDO server segments its answers to its own mailbox size: the SMs must match it
     mailbox_size = int(getattr(getattr(slave, "sdo", None), "mailbox_size", mailbox_size))
-    rx_pdos = tuple(getattr(slave, "rx_pdos", ()) or ()) or _synthetic_pdos(Direction.OUT, rx_bits)
-    tx_pdos = tuple(getattr(slave, "tx_pdos", ()) or ()) or _synthetic_pdos(Direction.IN, tx_bits)
+    rx_pdos = _mapped_pdos(slave, Direction.OUT)
+    if rx_pdos is None:
+        rx_pdos = tuple(getattr(slave, "rx_pdos", ()) or ()) or _synthetic_pdos(
+            Direction.OUT, rx_bits
+        )
+    tx_pdos = _mapped_pdos(slave, Direction.IN)
+    if tx_pdos is None:
+        tx_pdos = tuple(getattr(slave, "tx_pdos", ()) or ()) or _synthetic_pdos(
+            Direction.IN, tx_bits
+        )
     has_mailbox = bool(getattr(slave, "has_mailbox", False))
     rx_bytes, tx_bytes = (rx_bits + 7) // 8, (tx_bits + 7) // 8
     sms = default_layout(has_mailbox, rx_bytes, tx_bytes, mailbox_size)
@@ -391,6 +423,9 @@ def sii_info_for(slave: object, *, mailbox_size: int = 128) -> SiiInfo:
     else:
         fmmus = (FmmuUsage.OUTPUTS, FmmuUsage.INPUTS)
         coe, protocols = CoeDetails(0), MailboxProtocol(0)
+    # a slave with a mailbox has a microcontroller on a 16-bit asynchronous PDI (05h); one
+    # without is a bare ESC: digital I/O PDI (04h) with device emulation (0141h bit 0)
+    pdi_control = 0x0005 if has_mailbox else 0x0104
     channels = getattr(slave, "channels", 0)
     if not isinstance(channels, int):
         channels = len(channels)
@@ -407,6 +442,7 @@ def sii_info_for(slave: object, *, mailbox_size: int = 128) -> SiiInfo:
         fmmus=fmmus,
         rx_pdos=rx_pdos,
         tx_pdos=tx_pdos,
+        pdi_control=pdi_control,
         ds402_channels=channels,
     )
 

@@ -64,18 +64,24 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool = False):
     # -> tuple[Chain, EniConfig]
-    """The ENI's slaves behind ESCs (what ``serve`` puts on the wire)."""
+    """The ENI's slaves behind ESCs (what ``serve`` puts on the wire), each with the SII
+    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.wire.eni_wire`)."""
     from drives.esc import Chain
     from drives.machine import MachineDescription, load_machine
     from eni.layout import build_layout
     from eni.reader import read_eni
     from gtecat.master.factory import build_slaves
+    from gtecat.wire.eni_wire import read_wire, sii_for
 
     config = read_eni(eni)
     layout = build_layout(config)
     desc = load_machine(machine) if machine else MachineDescription()
     slaves = build_slaves(layout, desc)
-    chain = Chain(slaves, watchdog_trips=watchdog_trips)
+    wire = read_wire(eni) or [None] * len(slaves)
+    if len(wire) != len(slaves):
+        wire = [None] * len(slaves)
+    sii = [sii_for(slave, w) for slave, w in zip(slaves, wire, strict=True)]
+    chain = Chain(slaves, sii=sii, watchdog_trips=watchdog_trips)
     return chain, config
 
 

@@ -203,3 +203,17 @@ def test_build_parse_round_trip(vendor, product, revision, name, rx, tx, mailbox
         ]
         assert [p.sm for p in mine] == [p.sm for p in theirs]
     assert back.extra["checksum"] == back.extra["crc"]
+
+
+# --- issue 16, item 5: the SII lists the mapping the slave really has ---------------------------
+def test_a_drive_sii_lists_its_real_mapping_with_names() -> None:
+    from tests.drives.esc.test_mailbox import drive_esc
+
+    esc = drive_esc()
+    info = parse_sii(bytes(esc.sii))
+    rx = [(e.index, e.subindex, e.bit_len, e.name) for p in info.rx_pdos for e in p.entries]
+    tx = [(e.index, e.subindex, e.bit_len) for p in info.tx_pdos for e in p.entries]
+    assert rx == [(0x6040, 0, 16, "Controlword"), (0x607A, 0, 32, "Target position")]
+    assert tx == [(0x6041, 0, 16), (0x6064, 0, 32), (0x60FD, 0, 32)]
+    assert [p.index for p in info.rx_pdos] == [0x1600] and info.rx_pdos[0].sm == 2
+    assert info.coe_details & CoeDetails.SDO_INFO

@@ -151,3 +151,42 @@ def test_pysoem_reads_the_object_dictionary(fig52: tuple[str, ServeProcess]) -> 
         assert struct.unpack("<I", drive.sdo_read(0x1018, 1))[0] == drive.man
     finally:
         master.close()
+
+
+# --- item 5: the SII read back over the wire ----------------------------------------------------
+def _crc8(data: bytes) -> int:
+    crc = 0xFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x07) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc
+
+
+def test_the_sii_lists_the_drive_mapping_and_the_eni_sm_layout(raw: RawMaster) -> None:
+    stations = raw.scan()
+    sii = raw.sii(stations[0])
+    assert sii[14] == _crc8(sii[:14])
+    cats: dict[int, bytes] = {}
+    pos = 128
+    while pos + 4 <= len(sii):
+        ctype, words = struct.unpack_from("<HH", sii, pos)
+        if ctype == 0xFFFF:
+            break
+        cats[ctype] = sii[pos + 4 : pos + 4 + 2 * words]
+        pos += 4 + 2 * words
+    sms = [struct.unpack_from("<HHBBBB", cats[41], 8 * k) for k in range(len(cats[41]) // 8)]
+    assert [(s[0], s[2], s[5]) for s in sms] == [
+        (0x1000, 0x26, 1),
+        (0x1080, 0x22, 2),
+        (0x1100, 0x64, 3),
+        (0x1400, 0x20, 4),
+    ]
+    tx = cats[50]
+    n_entries = tx[2]
+    assert [struct.unpack_from("<H", tx, 8 + 8 * k)[0] for k in range(n_entries)] == [
+        0x6041,
+        0x6064,
+        0x60FD,
+    ]
+    assert cats[30][5] & 0x02  # CoE details: SDO Information
