@@ -190,3 +190,45 @@ def test_the_sii_lists_the_drive_mapping_and_the_eni_sm_layout(raw: RawMaster) -
         0x60FD,
     ]
     assert cats[30][5] & 0x02  # CoE details: SDO Information
+
+
+# --- CoE emergencies on the wire ----------------------------------------------------------------
+def test_pysoem_sees_the_emergency_of_a_faulting_drive(tmp_path: Path) -> None:
+    pysoem = pytest.importorskip("pysoem")
+    with served(FIG52, tmp_path) as (master_if, _server):
+        master = pysoem.Master()
+        master.open(master_if)
+        try:
+            assert master.config_init() == 4
+            master.config_map()
+            drive = master.slaves[0]
+            seen: list = []
+            drive.add_emergency_callback(seen.append)
+            drive.sdo_write(0x6065, 0, struct.pack("<I", 10))  # following error window, counts
+            drive.sdo_write(0x6066, 0, struct.pack("<H", 0))  # ... and its timeout, ms
+            assert master.state_check(pysoem.SAFEOP_STATE, 2_000_000) == pysoem.SAFEOP_STATE
+            master.state = pysoem.OP_STATE
+            master.write_state()
+            deadline = time.monotonic() + 5
+            while master.state_check(pysoem.OP_STATE, 10_000) != pysoem.OP_STATE:
+                master.send_processdata()
+                master.receive_processdata(50_000)
+                assert time.monotonic() < deadline, "no OP"
+            start = struct.unpack_from("<i", drive.input, 2)[0]
+            for cw in (0x0006, 0x0007, 0x000F) + (0x000F,) * 10:
+                drive.output = struct.pack("<Hi", cw, start)
+                master.send_processdata()
+                master.receive_processdata(50_000)
+            drive.output = struct.pack("<Hi", 0x000F, start + 1_000_000)  # far beyond the window
+            deadline = time.monotonic() + 5
+            while not seen and time.monotonic() < deadline:
+                master.send_processdata()
+                master.receive_processdata(50_000)
+                drive.mbx_receive()  # SOEM hands an emergency in the mailbox to the callback
+            assert seen, "no emergency reached the master"
+            assert (seen[0].error_code, seen[0].error_reg) == (0x8611, 0x01)
+            assert struct.unpack_from("<H", drive.input)[0] & 0x0008  # fault (reaction) bit
+        finally:
+            master.state = pysoem.INIT_STATE
+            master.write_state()
+            master.close()
