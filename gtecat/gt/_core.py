@@ -81,7 +81,8 @@ class _Session:
 
     def __init__(self) -> None:
         self.controllers: dict[int, Controller] = {}
-        self.errors: deque[LastError] = deque(maxlen=64)
+        self.errors: deque[LastError] = deque(maxlen=64)  # the recent failures, oldest first
+        self.last: LastError | None = None  # the most recent call's failure; None after a 0
 
     def controller(self, core: int = 1) -> Controller:
         c = self.controllers.get(core)
@@ -110,7 +111,8 @@ def _record(name: str, code: int, reason: str) -> None:
     c = SESSION.controllers.get(1)
     if c is not None:
         ms = c.clock_ms()
-    SESSION.errors.append(LastError(name, code, reason, ms))
+    SESSION.last = LastError(name, code, reason, ms)
+    SESSION.errors.append(SESSION.last)
 
 
 def fail(code: int, reason: str) -> int:
@@ -144,6 +146,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
         ctl = None
+        before = SESSION.last
         try:
             if core is not _ONE:
                 core = core_arg(core)
@@ -162,6 +165,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             else:
                 rc = fn(*values, **extra)
             rc = 0 if rc is None else int(rc)
+            if rc == 0:
+                SESSION.last = None  # GTE_GetLastError speaks of the most recent call only
+            elif SESSION.last is before:  # no reason recorded by a call made inside
+                _record(name, rc, "no reason given")
         except _Refusal as r:
             rc = r.code
             _record(name, rc, str(r))
@@ -218,7 +225,12 @@ def _signature(proto: Proto, fn: Callable[..., Any]) -> inspect.Signature:
 
 
 def last_error() -> LastError | None:
-    return SESSION.errors[-1] if SESSION.errors else None
+    """Why the most recent GT call returned non-zero; None when it returned 0.
+
+    Per call, like a return code: every GT function that returns 0 clears it, so the
+    reason never belongs to an older call.  ``SESSION.errors`` keeps the recent failures.
+    """
+    return SESSION.last
 
 
 # --- pointer arguments ---------------------------------------------------------------------

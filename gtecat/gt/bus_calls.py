@@ -387,7 +387,11 @@ def GTE_Wait(ctl: Controller, ms: float) -> int:
 
 
 def GTE_GetLastError() -> str:
-    """The reason of the last non-zero return ("" if none)."""
+    """Why the most recent GT call returned non-zero, as ``NAME returned CODE: reason``.
+
+    "" when that call returned 0: every call that succeeds clears it (per call, like the
+    return code itself), so read it right after the call that failed.
+    """
     e = _core.last_error()
     return "" if e is None else f"{e.function} returned {e.code}: {e.reason}"
 

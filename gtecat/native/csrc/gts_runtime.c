@@ -642,6 +642,8 @@ connected:;
         g_err[keep] = '\0';
     } else if (rc != 0) {
         set_err("%s returned %d", f->name, rc);
+    } else {
+        g_err[0] = '\0'; /* per call, as in Python: a call that returns 0 clears it */
     }
     return rc;
 }

@@ -195,3 +195,26 @@ def test_gt_calls_before_gt_open_and_before_the_bus_is_up() -> None:
     assert "call GT_InitEcatComm" in _last_error_line()
     assert gt.GT_AxisOn(1) == 7  # no axes before the bus is read
     assert "bus not initialised" in _last_error_line()
+
+
+# --- last-error semantics -----------------------------------------------------------------------
+def test_the_last_error_is_per_call_a_success_clears_it() -> None:
+    """GTE_GetLastError speaks of the most recent GT call only, like its return code."""
+    assert gt.GT_InitEcatComm() == -1
+    assert gt.GTE_GetLastError().startswith("GT_InitEcatComm returned -1: ")
+    assert gt.GTE_GetLastError() == gt.GTE_GetLastError()  # reading it is not a call
+    assert gt.GT_Open(eni=FIG52, log="") == 0
+    assert gt.GTE_GetLastError() == ""  # GT_Open succeeded: no old reason left over
+    assert gt.GT_AxisOn(9) == 7
+    assert gt.GTE_GetLastError().startswith("GT_AxisOn returned 7: axis 9")
+    ms = c_long()
+    assert gt.GT_GetClock(byref(ms)) == 0
+    assert gt.GTE_GetLastError() == ""
+
+
+def test_the_reason_is_said_once() -> None:
+    """The text carries the function and code once; callers print it as it is."""
+    assert gt.GT_Open(eni=FIG52, log="") == 0
+    assert gt.GT_AxisOn(9) == 7
+    text = gt.GTE_GetLastError()
+    assert text.count("returned") == 1 and text.count("GT_AxisOn") == 1
