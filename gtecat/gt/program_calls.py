@@ -88,7 +88,7 @@ def runtime(ctl: Controller, create: bool = True) -> threads.ProgramRuntime | No
     if rt is None and create:
         rt = threads.ProgramRuntime(_caller(ctl), _speed_from_env())
         _RUNTIMES[ctl] = rt
-        ctl.pre_cycle.append(_cycle_hook(ctl, rt))
+        ctl.before_cycle.append(_cycle_hook(ctl, rt))
         ctl.on_reset.append(_reset_hook(rt))
     return rt
 
@@ -113,14 +113,18 @@ def _caller(ctl: Controller):
 def _cycle_hook(ctl: Controller, rt: threads.ProgramRuntime):
     clock_ref = weakref.ref(ctl.clock)
 
-    def hook(t_ns: int, dt_ns: int) -> None:
+    def now() -> int:
+        clock = clock_ref()
+        return clock.now_ns if clock is not None else 0
+
+    def hook() -> None:
         clock = clock_ref()
         if clock is None:
             return
         saved = clock.call_latency_ns
         clock.call_latency_ns = 0  # a GT call from a program is no host round trip
         try:
-            rt.step(t_ns, dt_ns)
+            rt.step(clock.now_ns, clock.cycle_ns, now)
         finally:
             clock.call_latency_ns = saved
 
@@ -313,8 +317,8 @@ def GTE_GetThreadError(ctl: Controller, thread: int, pText: Any) -> int:
 def _mram(ctl: Controller) -> mram.Mram:
     m = _MRAMS.get(ctl)
     if m is None:
-        path = getattr(ctl.options, "mram", None) or os.environ.get("GTECAT_MRAM")
-        m = mram.Mram(mram.MramStore(path or mram.default_path(ctl.options.log)))
+        path = ctl.options.mram or mram.default_path(ctl.options.log)  # option > GTECAT_MRAM
+        m = mram.Mram(mram.MramStore(path))
         _MRAMS[ctl] = m
         m_ref = weakref.ref(m)
 

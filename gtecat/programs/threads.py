@@ -15,8 +15,9 @@ not survive a power cycle, 10.3.4).  It holds:
   a page another thread holds returns 1); a running or paused thread cannot be
   rebound (1).
 
-**Time.**  Every controller cycle (a ``pre_cycle`` hook, before the axes plan, so
-a ``GT_Update`` from a program starts in that cycle) grants ``speed`` x cycle
+**Time.**  Every controller cycle (a ``before_cycle`` hook: first in the cycle,
+before the axes plan, so a ``GT_Update`` from a program starts in that cycle) grants
+``speed`` x cycle
 instructions (default 100 per millisecond, 10.2; fractions carry over while a
 thread runs).  The running threads share them round robin, one instruction each
 in turn, so two threads' consecutive instructions may be interleaved (the 10.2
@@ -24,7 +25,11 @@ note) and each instruction is atomic.  Every instruction costs one slot: an
 assignment, an operation, a cast, a jump, a return, a GT call (which runs inside
 the controller, without the host call latency).  ``GT_Delay(ms)`` costs one slot
 and then the thread sleeps ``ms`` of controller time.  A thread started by
-``GT_RunThread`` executes from the next cycle.
+``GT_RunThread`` executes from the next cycle.  A GT function that waits for cycles
+of its own (``GT_AxisOn`` waits until the drive is enabled) holds the program
+processor like any instruction: the cycles it runs execute no other instruction,
+and the cycle's remaining instructions are spent.  (In the ``realtime`` clock mode
+such a call cannot get its cycles from inside the cycle thread and times out.)
 
 **Status** (``TThreadSts``): ``run`` 1 running (sleeping in ``GT_Delay`` included),
 2 paused, 0 otherwise (never run, returned, stopped, failed); ``error`` the return
@@ -155,6 +160,7 @@ class ProgramRuntime:
         self._credit = 0.0
         self._next = 0  # round robin: the thread to serve first
         self._steps: list[_Step] = []
+        self._busy = False
         self._lines: list[int] = []
 
     # --- download ---------------------------------------------------------------------------
@@ -346,8 +352,22 @@ class ProgramRuntime:
         area[at : at + len(words)] = words
 
     # --- the scheduler ----------------------------------------------------------------------
-    def step(self, now_ns: int, dt_ns: int) -> int:
-        """One controller cycle of program execution; returns the instructions run."""
+    def step(self, now_ns: int, dt_ns: int, clock: Callable[[], int] | None = None) -> int:
+        """One controller cycle of program execution; returns the instructions run.
+
+        ``clock`` reads the controller time: a GT call that waited for cycles of its
+        own (GT_AxisOn) ends this cycle's execution, and the cycles it ran execute no
+        program instruction (``_busy``: one instruction at a time).
+        """
+        if self._busy:
+            return 0
+        self._busy = True
+        try:
+            return self._step(now_ns, dt_ns, clock)
+        finally:
+            self._busy = False
+
+    def _step(self, now_ns: int, dt_ns: int, clock: Callable[[], int] | None) -> int:
         self.now_ns = now_ns
         threads = self.threads
         ready = [th for th in threads if th.state is ThreadState.RUNNING]
@@ -371,6 +391,8 @@ class ProgramRuntime:
                 budget -= 1
                 done += 1
                 last = th
+                if clock is not None and clock() != now_ns:
+                    budget = 0  # the call waited: its cycles are spent
                 if th.state is ThreadState.RUNNING and th.wake_ns <= now_ns:
                     keep.append(th)
             runnable = keep
