@@ -165,12 +165,18 @@ class Ref:
                 t = t.reshape(-1)
             if len(t) < n:
                 raise ParameterError(f"{self.name}: {len(t)} element(s), {n} needed")
-            return [t[i] for i in range(n)]
+            out = [t[i] for i in range(n)]
+            for v in out:
+                if not isinstance(v, numbers.Real | np.bool_):  # ["x"], [None], [1j]
+                    raise ParameterError(f"{self.name}: holds {v!r}, not a number")
+            return out
         if self.capacity() < n:
             raise ParameterError(f"{self.name}: {self.capacity()} element(s), {n} needed")
         elem = self.elem
         if elem is None or not issubclass(elem, _SIMPLE):
             return list(ctypes.string_at(self.addr, n))
+        if elem._type_ in _NOT_NUMERIC:  # create_string_buffer for a short *, as store_values
+            raise ParameterError(f"{self.name}: points to {_elem_name(elem)}, not to numbers")
         size = ctypes.sizeof(elem)
         return [elem.from_address(self.addr + i * size).value for i in range(n)]
 
