@@ -16,6 +16,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from drives.machine import MachineDescription, load_machine
 from eni.errors import EniError
@@ -28,6 +29,9 @@ from ..master.clock import Clock, ClockMode
 from ..master.masterlog import MasterLog
 from .axis import Axis, AxisIo
 from .resources import install as install_resources
+
+if TYPE_CHECKING:
+    from .card import Card
 
 
 @dataclass
@@ -45,6 +49,8 @@ class Options:
     op_delay_cycles: int = 10
     #: ENI describing the emulated hardware when it differs from ``eni`` (GTECAT_BUS)
     bus: str | None = None
+    #: a pulse card instead of a bus, ``gts:N`` (GTECAT_CARD; :mod:`gtecat.controller.card`)
+    card: str | None = None
     #: the MRAM store file (GTECAT_MRAM; default Gecat.mram beside the log, manual 11.8)
     mram: str | None = None
 
@@ -66,6 +72,7 @@ class Options:
             log=self.log if self.log is not None else env.get("GTECAT_LOG", "Gecat.log"),
             op_delay_cycles=self.op_delay_cycles,
             bus=self.bus or env.get("GTECAT_BUS"),
+            card=self.card or env.get("GTECAT_CARD") or None,
             mram=self.mram or env.get("GTECAT_MRAM"),
         )
 
@@ -114,6 +121,12 @@ class Controller:
         self._axis_list: list[Axis] = []
         self.on_bus_up: list[Callable[[Controller], None]] = []
         self.on_reset: list[Callable[[Controller], None]] = []
+        #: the pulse card this controller is (None: an EtherCAT master)
+        self.card: Card | None = None
+        if self.options.card:
+            from .card import open_card
+
+            open_card(self, self.options.card)
         if mode is ClockMode.REALTIME:
             self.clock.start_realtime()
 

@@ -24,6 +24,7 @@ from drives.abort import SdoAbort
 from drives.machine import MachineError
 from eni.errors import EniError, GtecatError
 
+from ..controller.card import refused
 from ..controller.core import Controller
 from ..errors import (
     BusError,
@@ -143,6 +144,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     params = list(inspect.signature(fn).parameters)
     needs_ctl = bool(params) and params[0] == "ctl"
     bind = binder(proto, fn)
+    card_refused = refused(name)
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
         ctl = None
@@ -157,6 +159,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             values, extra = bind(args, kwargs)
             if needs_ctl:
                 ctl = SESSION.controller(core)
+                if card_refused and ctl.card is not None:  # an EtherCAT function on a card
+                    raise CommandError(ctl.card.refusal(name))
                 if ctl.clock.threaded:
                     with ctl.clock.lock:  # atomic with respect to the cycle thread
                         rc = fn(ctl, *values, **extra)

@@ -83,8 +83,12 @@ def GT_Open(
     bus: str | None = None,
     op_delay_cycles: int = 10,
     mram: str | None = None,
+    card: str | None = None,
 ) -> int:
-    """Open the (emulated) controller.  Keyword options override ``GTECAT_*``."""
+    """Open the (emulated) controller.  Keyword options override ``GTECAT_*``.
+
+    ``card="gts:4"`` (GTECAT_CARD) opens a GTS pulse card with 4 axes instead of an
+    EtherCAT master (:mod:`gtecat.controller.card`)."""
     if 1 in SESSION.controllers:
         fail(
             _core.CMD_OPEN,
@@ -103,6 +107,7 @@ def GT_Open(
             bus=bus,
             op_delay_cycles=op_delay_cycles,
             mram=mram,
+            card=card,
         )
     )
     return 0
