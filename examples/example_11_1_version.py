@@ -27,7 +27,7 @@ TABLE_11_3 = re.compile(rb"\d{3} ?\d{6} ?\d{3} ?\d{6}")
 
 def commandhandler(command: str, rtn: int) -> None:
     if rtn != 0:
-        LOG.append(f"{command} = {rtn}: {gt.GTE_GetLastError()}")
+        LOG.append(gt.GTE_GetLastError() or f"{command} = {rtn}")
 
 
 def plc_prg() -> tuple[int, bytes | None]:

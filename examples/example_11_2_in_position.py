@@ -32,7 +32,7 @@ MOVING, ARRIVED = 1 << 10, 1 << 11
 
 def commandhandler(command: str, rtn: int) -> None:
     if rtn != 0:
-        LOG.append(f"{command} = {rtn}: {gt.GTE_GetLastError()}")
+        LOG.append(gt.GTE_GetLastError() or f"{command} = {rtn}")
 
 
 @dataclass

@@ -24,7 +24,7 @@ MOVE = 1000
 
 def commandhandler(command: str, rtn: int) -> None:
     if rtn != 0:
-        LOG.append(f"{command} = {rtn}: {gt.GTE_GetLastError()}")
+        LOG.append(gt.GTE_GetLastError() or f"{command} = {rtn}")
 
 
 def plc_prg() -> int:

@@ -103,7 +103,7 @@ def bring_up(**options: object) -> None:
 
 def check(rtn: int, what: str) -> None:
     if rtn != 0:
-        raise SystemExit(f"{what} returned {rtn}: {gt.GTE_GetLastError()}")
+        raise SystemExit(gt.GTE_GetLastError() or f"{what} returned {rtn}")
 
 
 def run(speed: int = SPEED, max_scans: int = 60_000, **options: object) -> dict[str, object]:

@@ -39,7 +39,7 @@ PI = 3.1415926
 
 def commandhandler(command: str, rtn: int) -> None:
     if rtn != 0:
-        LOG.append(f"{command} = {rtn}: {gt.GTE_GetLastError()}")
+        LOG.append(gt.GTE_GetLastError() or f"{command} = {rtn}")
 
 
 @dataclass

@@ -1,13 +1,13 @@
-// A C++ motion program in the shape of seed 002 (a Qt application's `Motion` helper class
-// for a Googol card): static wrappers around the GT_* calls, an axis enum, status decoding,
+// A C++ motion program in the shape of a typical Qt application's `Motion` helper class
+// for a Googol card: static wrappers around the GT_* calls, an axis enum, status decoding,
 // homing, point-to-point moves - compiled unchanged against gtecat's gts.h / libgts.so:
 //
 //     g++ motion_demo.cpp $(python3 -m gtecat lib --cflags --libs) -o motion_demo
-//     GTECAT_ENI=examples/manual_fig5_2.eni ./motion_demo
+//     GTECAT_ENI=manual_fig5_2.eni ./motion_demo
 //
 // Nothing needs to be started first: GT_Open starts a private controller that ends with
 // the program.  With GTECAT_CONTROLLER=unix:/path it attaches to a running one instead
-// (tests/gtecat/native/test_example_motion_demo.py drives the machine meanwhile).
+// (a test can then drive the machine's field side meanwhile).
 //
 // Arguments: [home_method] [watch_ms].  home_method is the CiA 402 method (default 37:
 // the current position is home); watch_ms > 0 adds a long move that the program watches
@@ -212,7 +212,7 @@ short Motion::home(Axis axis, short method)
     std::printf("home status %d\n", status);
     if (status != HOMING_DONE)
         return 1;
-    return report("GT_ZeroPos", GT_ZeroPos(short(axis)));  // as seed 002 does after homing
+    return report("GT_ZeroPos", GT_ZeroPos(short(axis)));  // as such programs do after homing
 }
 
 int main(int argc, char **argv)

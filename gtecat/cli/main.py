@@ -17,6 +17,7 @@ from eni.errors import GtecatError
 COMMANDS = (
     "demo_cmd",
     "example_cmd",
+    "example_cmd",
     "map_cmd",
     "eni_cmd",
     "bus_cmd",
