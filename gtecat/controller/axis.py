@@ -214,6 +214,11 @@ class Axis:
         self.cw = 0  # controlword the controller sends
         self._cw_sent = -1
         self.servo_on = False
+        #: why the controller cannot reach this axis's slave ("" while it can; comm loss,
+        #: :mod:`gtecat.controller.core`), and the reason of the last loss, kept until
+        #: GT_ClrSts with the slave back (GT_AxisOn is refused until then)
+        self.link_lost = ""
+        self.link_alarm = ""
         self.csp_follow = True  # write 607A from prf_pos while enabled in CSP
         self.timing = ServoTiming()
         self._cw_acc = io.get(0x6040)
@@ -303,6 +308,16 @@ class Axis:
             return True
         self.cw = _ENABLE_STEP[st]
         return False
+
+    def lose_link(self, reason: str) -> None:
+        """The slave stopped exchanging process data: servo off, controlword 0.
+
+        Controlword 0 (disable voltage) waits in the image, so a drive that comes back
+        is switched off, never enabled again by a stale "enable operation".
+        """
+        self.link_lost = self.link_alarm = reason
+        self.servo_on = False
+        self.cw = 0x0000
 
     def request_disable(self) -> None:
         self.servo_on = False

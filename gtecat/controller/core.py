@@ -6,8 +6,35 @@ the ``GTECAT_*`` environment (DESIGN.md "The stable surface"), then defaults.
 
 Every cycle runs in this order (STYLE.md "Cycle"): the axes write their
 outputs (``pre_cycle`` hooks) -> the master exchanges the process image (each
-slave steps) -> the axes read their inputs (``post_cycle`` hooks) -> the
-recorder samples -> the clock advances.
+slave steps) -> the axes of slaves the master found offline are stopped ->
+the axes read their inputs (``post_cycle`` hooks) -> the recorder samples ->
+the clock advances.
+
+Decisions where the manual is silent:
+
+* **Bring-up state.**  :attr:`Controller.init_error` keeps why the last
+  ``GT_InitEcatComm`` failed (None after a success, before any and after
+  ``GT_TerminateEcatComm``), so ``GT_IsEcatReady`` can say why it will never
+  report 1 (:mod:`gtecat.gt.bus_calls`).  :attr:`Controller.started` is set by
+  ``GT_StartEcatComm`` (entry 129) and cleared by a new init or a terminate.
+* **Comm loss.**  An axis whose slave is in ``Master.offline``
+  (:mod:`gtecat.master.bus`: it stopped answering, or fell below OP, while the
+  bus should be in OP) is stopped in the cycle the master finds out: servo off
+  (table 6-2 bit 9 clear, controlword 0 = disable voltage, so the drive comes
+  back switched off, never enabled by itself), the motion dropped at once (the
+  drive cannot be reached, so no ramp: the planned position takes the last
+  encoder value and follows it, bit 10 clear, no runaway) and the drive alarm
+  flag latched (bit 1: "the drive of the axis is in alarm" is what a user must
+  see; a drive that cannot be reached is treated as one in alarm, whatever
+  GT_AlarmOn/Off say, since the controller detects it, not the drive's alarm
+  signal).  No other bit is set: bit 4 cannot trigger, the plan follows the
+  encoder; bits 7/8 name IO inputs.  While the slave stays offline the flag
+  cannot be cleared (GT_ClrSts keeps it, GT_Reset sets it again at once) and
+  GT_AxisOn returns 1 naming the slave.  Once the slave is back in OP:
+  GT_ClrSts (resets the drive fault the loss caused, clears bit 1), then
+  GT_AxisOn; before GT_ClrSts, GT_AxisOn returns 1 saying so.  Axes of other
+  slaves keep running.  The master confirms a loss after 10 ms of short working
+  counter, so one lost frame does not stop a machine.
 """
 
 from __future__ import annotations
@@ -28,6 +55,7 @@ from ..master.bus import Master
 from ..master.clock import Clock, ClockMode
 from ..master.masterlog import MasterLog
 from .axis import Axis, AxisIo
+from .axis_status import AxisStatus
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -109,6 +137,9 @@ class Controller:
         self.master: Master | None = None
         self.backend = None
         self.started = False
+        #: why the last GT_InitEcatComm failed (None: it succeeded, or none was made)
+        self.init_error: Exception | None = None
+        self._links_down = False  # some axis's slave was offline at the last cycle
         self.reset_ns = 0
         #: run first in a cycle, before its time is read: motion programs, whose GT calls
         #: may themselves wait for cycles (GT_AxisOn), so the cycle then starts later
@@ -145,8 +176,17 @@ class Controller:
     def init_ecat(self) -> Master:
         """Read the ENI, open the backend, scan, compare, bring slaves to SAFEOP.
 
-        OP follows after a few cycles; :attr:`ready` tells when.
+        OP follows after a few cycles; :attr:`ready` tells when.  A failure is kept in
+        :attr:`init_error` (and raised).
         """
+        self.init_error = None
+        try:
+            return self._init_ecat()
+        except Exception as e:
+            self.init_error = e
+            raise
+
+    def _init_ecat(self) -> Master:
         path = self.eni_path()
         if not path.is_file():
             raise NoEniError(
@@ -173,7 +213,10 @@ class Controller:
             for ref in layout.axes
         }
         self._axis_list = list(self.axes.values())
+        self._links_down = False
         install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)
+        if _relatch_link_alarms not in self.on_reset:
+            self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
         master.open()
         for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
             hook(self)
@@ -218,6 +261,7 @@ class Controller:
             self.master.terminate()
             self.backend.close()
         self.started = False
+        self.init_error = None
 
     def close(self) -> None:
         self.clock.stop_realtime()
@@ -236,12 +280,35 @@ class Controller:
             ax.pre(t, dt)
         if self.master is not None:
             self.master.cycle(t, dt)
+            if self.master.offline or self._links_down:
+                self._watch_links(self.master.offline)
         for ax in self._axis_list:
             ax.post(t, dt)
         for f in self.post_cycle:
             f(t, dt)
         for f in self.sample:
             f(t + dt)  # stamped when the cycle's values become visible (= GT_GetClock after it)
+
+    def _watch_links(self, offline: dict[int, str]) -> None:
+        """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
+        while they are offline; mark the others reachable again."""
+        down = False
+        for ax in self._axis_list:
+            reason = offline.get(ax.io.slave, "")
+            if reason:
+                down = True
+                if not ax.link_lost:
+                    self.log(
+                        f"Axis {ax.number}: {reason}; motion stopped, servo off, "
+                        "alarm set (GT_GetSts bit 1)."
+                    )
+                ax.lose_link(reason)
+                if ax.motion is not None:
+                    ax.motion.latched |= AxisStatus.ALARM
+            elif ax.link_lost:
+                ax.link_lost = ""  # reachable again; bit 1 stays until GT_ClrSts
+                self.log(f"Axis {ax.number}: slave {ax.io.slave} back; GT_ClrSts, GT_AxisOn.")
+        self._links_down = down
 
     # --- axes -----------------------------------------------------------------------------
     def axis(self, n: int) -> Axis:
@@ -272,3 +339,13 @@ class Controller:
         if ms < 0:
             raise ParameterError("wait time must be >= 0")
         self.clock.advance(ms)
+
+
+def _relatch_link_alarms(ctl: Controller) -> None:
+    """GT_Reset: bit 1 of an axis whose slave is still offline is set again at once."""
+    for ax in ctl.axes.values():
+        if ax.link_lost:
+            if ax.motion is not None:
+                ax.motion.latched |= AxisStatus.ALARM
+        else:
+            ax.link_alarm = ""

@@ -15,6 +15,17 @@ Decisions where the manual is silent:
   the alarm first (GT_ClrSts), as the manual's return-1 text says.  Before
   enabling, the planned position is set to the actual one so the drive does
   not jump (pitfall 4 of cia402-facts).
+* ``GT_AxisOn`` needs ``GT_StartEcatComm`` (entry 129: "only after this call
+  succeeds may the other motion instructions be called"): before it, 1 with the
+  reason.  It is the one gate the other motion instructions need: every start of
+  a planner (GT_Update, GT_PtStart, GT_GearStart, GT_FollowStart) requires the
+  servo on, and GT_StartEcatHoming a drive in *operation enabled* (5.2.2.2), which
+  only GT_AxisOn gives.  Calls that read or configure (GT_GetSts, GT_GetEcat*, the
+  profile and safety settings, SDO, raw data) work from GT_InitEcatComm on, as
+  bring-up code needs them before it starts motion control.
+* ``GT_AxisOn`` after a comm loss (:mod:`gtecat.controller.core`): 1 naming the
+  slave while it is offline, and 1 until GT_ClrSts once it is back (bit 1 is
+  latched; entry 5 return 1: "check whether the drive has an alarm").
 * ``GT_GetEcatEncPos`` reports 6064h as the drive counts it (no scaling);
   ``GT_SetPosScale`` affects the controller's own positions.
 * ``GT_GetEcatAxisPdoData(axis, object, pData, subindex=0)`` copies the mapped
@@ -48,6 +59,21 @@ def bus_axis(ctl: Controller, axis: int) -> Axis:
 
 def axis_on(ctl: Controller, ax: Axis) -> None:
     """Walk the drive to operation enabled (bounded), then own its set-point."""
+    if not ctl.started:
+        raise CommandError(
+            f"axis {ax.number}: motion control is not started; call GT_StartEcatComm once "
+            "GT_IsEcatReady reports 1 (manual entry 129: motion instructions only after it)"
+        )
+    if ax.link_lost:
+        raise CommandError(
+            f"axis {ax.number}: {ax.link_lost}; check the slave and its cable, then "
+            "GT_ClrSts and GT_AxisOn once it is back"
+        )
+    if ax.link_alarm:
+        raise CommandError(
+            f"axis {ax.number}: alarm after a communication loss ({ax.link_alarm}), "
+            "GT_GetSts bit 1; the slave is back: call GT_ClrSts first"
+        )
     if not ctl.ready:
         raise BusError(f"axis {ax.number}: the bus is not in OP (poll GT_IsEcatReady first)")
     if getattr(ax, "moving", False):

@@ -10,11 +10,31 @@ Decisions where the manual is silent:
   SAFEOP before it returns (so -8/-9/-10 come back from it, as the manual
   lists); OP follows a few cycles later, so ``GT_IsEcatReady`` first reports 0
   and the manual's polling loop (example 5-5) is meaningful.
-* ``GT_StartEcatComm`` returns 1 until the bus is ready (the manual: motion
-  instructions only after it succeeds).
+* ``GT_IsEcatReady`` returns 1 (with ``*pStatus = 0``) while no
+  ``GT_InitEcatComm`` is in effect: before any, after one that failed (the
+  reason repeats the init's code and reason: -8/-9/-10 and why) and after
+  ``GT_TerminateEcatComm``.  Entry 80 lists no such case, but a status of 0
+  means "not yet", and the README's polling loop (``while GT_IsEcatReady(&s)
+  == 0 && s != 1``) would wait forever for a bus that will never come; a
+  non-zero return ends it with the reason.  (Example 5-5's C loop, ``while
+  (status != 1 || rtn != 0)``, spins on any non-zero return, as it would on the
+  vendor's controller: it does not check GT_InitEcatComm's result.)  While an
+  initialised bus is not (or no longer) fully up - OP not yet reached, a slave
+  lost and being recovered - it returns 0 with status 0, as before: that state
+  passes.
+* ``GT_StartEcatComm`` returns 1 until the bus is ready; ``GT_AxisOn`` (and so
+  every motion, :mod:`gtecat.gt.axis_calls`) returns 1 until it succeeded (entry 129).
 * Raw data and EtherCAT IO before ``GT_InitEcatComm`` return 1 ("check the
   EtherCAT communication", manual entries 44/104); out-of-range offsets or
   sizes return 7 and change nothing.
+* After a comm loss (:attr:`Master.offline <gtecat.master.bus.Master.offline>`:
+  a slave that stopped answering, or fell below OP, while the bus should be in
+  OP) ``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` whose bytes touch that
+  slave's region, and ``GT_EcatIOReadInput`` / ``GT_EcatIOWriteOutput`` /
+  ``GT_EcatIOBitWriteOutput`` on that slave, return 1 naming the slave (entries
+  11/12: "check the slave is connected", 44/104: "check the EtherCAT
+  communication") and change nothing: the bytes there are the last ones received,
+  not the slave's.  Checked after the range (7 first).  Other slaves' bytes work.
 * ``GT_EcatIOReadInput`` may read any byte of the slave's region (outputs then
   inputs, manual 5.2.2.5); ``GT_EcatIOWriteOutput`` only its output bytes.
 """
@@ -148,7 +168,10 @@ def GT_GetVersion(ctl: Controller, pVersion: Any) -> int:
 # --- EtherCAT bring-up ------------------------------------------------------------------------
 @gt_function
 def GT_InitEcatComm(ctl: Controller) -> int:
-    """0 ok; -8 slaves differ from the ENI; -9 no ENI; -10 no slave found (entry 79)."""
+    """0 ok; -8 slaves differ from the ENI; -9 no ENI; -10 no slave found (entry 79).
+
+    A failure is kept (``Controller.init_error``): GT_IsEcatReady then returns 1 with it.
+    """
     ctl.init_ecat()
     return 0
 
@@ -167,8 +190,24 @@ def GT_TerminateEcatComm(ctl: Controller) -> int:
 
 @gt_function
 def GT_IsEcatReady(ctl: Controller, pStatus: Any) -> int:
-    """*pStatus = 1 once every slave is in OP with a good working counter (entry 80)."""
+    """*pStatus = 1 once every slave is in OP with a good working counter (entry 80).
+
+    1 (status 0) while no GT_InitEcatComm is in effect (module docstring).
+    """
+    e = ctl.init_error
+    if e is not None:  # the last init failed (a bus of an earlier one may still run)
+        store(pStatus, 0)
+        raise CommandError(
+            f"GT_InitEcatComm failed ({_core.code_for(e)}: {e}); the bus will not "
+            "come up: fix the cause and call GT_InitEcatComm again"
+        )
     store(pStatus, 1 if ctl.ready else 0)
+    m = ctl.master
+    if m is None or not m.opened:
+        raise CommandError(
+            "EtherCAT communication is not initialised: call GT_InitEcatComm first"
+            + (" (it was terminated by GT_TerminateEcatComm)" if m is not None else "")
+        )
     return 0
 
 
@@ -241,10 +280,45 @@ def _image(ctl: Controller):
     return m.image
 
 
+def _require_online(ctl: Controller, slaves: Any, what: str) -> None:
+    """1 naming the first of ``slaves`` the master has found offline (comm loss)."""
+    m = ctl.master
+    offline = m.offline if m is not None else {}
+    if not offline:
+        return
+    for pos in slaves:
+        reason = offline.get(pos)
+        if reason:
+            raise CommandError(
+                f"{reason}: {what} (the bytes there are the last received); check the "
+                "slave, its cable and the EtherCAT communication"
+            )
+
+
+def _raw_slaves(image: Any, offset: int, size: int) -> list[int]:
+    """Slaves whose GT raw region shares a byte with ``[offset, offset + size)``."""
+    end = offset + size
+    return [
+        sl.position
+        for sl in image.layout.slaves
+        if sl.gt_size and sl.gt_offset < end and offset < sl.gt_offset + sl.gt_size
+    ]
+
+
+def _touches_inputs(image: Any, offset: int, size: int) -> bool:
+    end = offset + size
+    return any(
+        sl.in_bytes and sl.gt_offset + sl.out_bytes < end and offset < sl.gt_offset + sl.gt_size
+        for sl in image.layout.slaves
+    )
+
+
 @gt_function
 def GT_GetEcatRawData(ctl: Controller, offset: int, size: int, pValue: Any) -> int:
     image = _image(ctl)
-    data = image.read_raw(int(offset), int(size))
+    offset, size = int(offset), int(size)
+    data = image.read_raw(offset, size)
+    _require_online(ctl, _raw_slaves(image, offset, size), "its process data is not exchanged")
     store_bytes(pValue, data)
     return 0
 
@@ -252,13 +326,19 @@ def GT_GetEcatRawData(ctl: Controller, offset: int, size: int, pValue: Any) -> i
 @gt_function
 def GT_SetEcatRawData(ctl: Controller, offset: int, size: int, pValue: Any) -> int:
     image = _image(ctl)
-    image.check_range(int(offset), int(size))
-    image.write_raw(int(offset), load_bytes(pValue, int(size)))
+    offset, size = int(offset), int(size)
+    image.check_range(offset, size)
+    touched = _raw_slaves(image, offset, size)
+    if not _touches_inputs(image, offset, size):  # else write_raw refuses it (7 first)
+        _require_online(ctl, touched, "its outputs would not arrive")
+    image.write_raw(offset, load_bytes(pValue, size))
     return 0
 
 
 # --- EtherCAT IO (5.2.2.5) ----------
-def _region(ctl: Controller, slave: int, offset: int, size: int) -> tuple[Any, int]:
+def _region(
+    ctl: Controller, slave: int, offset: int, size: int, write: bool = False
+) -> tuple[Any, int]:
     image = _image(ctl)
     slaves = image.layout.slaves
     slave = check_range("slave", slave, 0, len(slaves) - 1)
@@ -268,6 +348,8 @@ def _region(ctl: Controller, slave: int, offset: int, size: int) -> tuple[Any, i
             f"slave {slave} ({sl.name}): offset={offset} size={size} outside its "
             f"{sl.gt_size}-byte region ({sl.out_bytes} output + {sl.in_bytes} input bytes)"
         )
+    if not (write and offset + size > sl.out_bytes):  # input bytes: write_raw says 7
+        _require_online(ctl, (slave,), "its process data is not exchanged")
     return image, sl.gt_offset + offset
 
 
@@ -289,7 +371,7 @@ def GT_EcatIOWriteOutput(
 ) -> int:
     """Entry 12; the 5-argument spelling with the core first is accepted as for ReadInput."""
     slave, offset, nSize, pValue = _io_args(slave, offset, nSize, pValue, more)
-    image, raw = _region(ctl, slave, offset, nSize)
+    image, raw = _region(ctl, slave, offset, nSize, write=True)
     image.write_raw(raw, load_bytes(pValue, nSize))
     return 0
 
@@ -308,7 +390,7 @@ def _io_args(a: Any, b: Any, c: Any, d: Any, more: tuple) -> tuple[int, int, int
 def GT_EcatIOBitWriteOutput(ctl: Controller, slave: int, offset: int, bit: int, value: int) -> int:
     """Set one output bit: byte ``offset`` of the slave's region, ``bit`` 0..7 (vendor header)."""
     bit = check_range("bit", bit, 0, 7)
-    image, raw = _region(ctl, int(slave), int(offset), 1)
+    image, raw = _region(ctl, int(slave), int(offset), 1, write=True)
     cur = image.read_raw(raw, 1)[0]
     new = (cur | (1 << bit)) if value else (cur & ~(1 << bit))
     image.write_raw(raw, bytes([new & 0xFF]))

@@ -13,6 +13,10 @@ Decisions where the manual is silent:
   skipped (the manual's examples clear 8 axes, ``GT_ClrSts(1, 8)``, whatever is
   connected); it returns 0 even when a flag stays set because its cause
   persists.  Every other call returns 7 for an axis that does not exist.
+* GT_ClrSts on an axis whose slave is offline (comm loss, :mod:`gtecat.controller.core`)
+  leaves its flags as they are (bit 1's cause persists; no drive fault reset is
+  tried on a drive that cannot be reached).  Once the slave is back it resets
+  the fault the loss caused, clears bit 1 and lets GT_AxisOn enable again.
 * Configuration calls act at once on what the controller watches; a flag
   latched under the old setting stays until GT_ClrSts, which is why 4.5.3 says
   a configuration "takes effect" after GT_ClrSts (example 4-3).
@@ -63,7 +67,10 @@ def GT_ClrSts(ctl: Controller, axis: int, count: int = 1) -> int:
         raise ParameterError(
             f"GT_ClrSts: none of axes {first}..{first + n - 1} exists (1..{max(ctl.axes)})"
         )
-    clear_status(ctl, axes)
+    reachable = [r for r in axes if not r.ax.link_lost]
+    clear_status(ctl, reachable)
+    for r in reachable:
+        r.ax.link_alarm = ""
     return 0
 
 

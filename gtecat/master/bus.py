@@ -11,6 +11,15 @@ kept in :attr:`Master.error`.
 The OP request is made ``op_delay_cycles`` cycles after SAFEOP is reached
 (the real master waits for the DC clocks and the first valid inputs), so
 ``GT_IsEcatReady`` polling loops see 0 before 1, as on the real controller.
+
+Comm loss: once the bus has been asked for OP, a working counter short for
+:attr:`Master.loss_confirm_ns` (10 ms) in a row makes the master read every
+slave's AL state; a slave that does not answer, or is below OP, is *offline*
+(:attr:`Master.offline`: position -> reason) until a later state read finds
+it in OP again.  One lost frame, or a short stall of the wire, is not a loss:
+only a slave that is still silent (or out of OP) when asked counts.  The
+controller stops the axes of offline slaves and the GT layer refuses process
+data that touches them (:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
 """
 
 from __future__ import annotations
@@ -77,6 +86,14 @@ class Master:
         self.target = AlState.INIT
         self._op_countdown = -1
         self.states: list[AlState] = [AlState.INIT] * len(layout.slaves)
+        self._codes: list[int] = [0] * len(layout.slaves)
+        #: slaves out of the process-data exchange although the bus should be in OP:
+        #: position -> reason ("slave 1 (Drive) does not answer"); empty while all is well
+        self.offline: dict[int, str] = {}
+        #: a short working counter this long in a row is a loss worth a state read
+        self.loss_confirm_ns = 10_000_000
+        self._bad_ns = 0
+        self._op_requested = False  # the OP walk ran: from now on below OP is offline
         self.on_cycle: list[Callable[[Master], None]] = []  # recorders etc.
 
     # --- bring-up ------------------------------------------------------------------
@@ -175,12 +192,14 @@ class Master:
 
     def request_op(self) -> None:
         """SO InitCmds and the OP request (made automatically after the delay)."""
+        self._op_requested = True
         try:
             self._walk(AlState.OP)
             self.log("All slaves are in OP mode.")
             self.error = ""
         except GtecatError as e:
             self.error = str(e)
+            self.refresh_states()
 
     def terminate(self) -> None:
         """Every slave back to INIT (GT_TerminateEcatComm)."""
@@ -192,6 +211,8 @@ class Master:
                 pass
         self.target = AlState.INIT
         self._op_countdown = -1
+        self._op_requested = False
+        self.offline = {}
         self.log("Slave states: INIT")
         self.opened = False
 
@@ -217,8 +238,15 @@ class Master:
                 self._wkc_bad = True
                 self.error = f"working counter {wkc}/{expected}: a slave does not answer"
                 self.log(f"Working counter changed to {wkc}/{expected}.")
-            if self.cycles % self.recover_every == 0 and not self.backend.recovers_itself:
+            bad, self._bad_ns = self._bad_ns, self._bad_ns + dt_ns
+            confirmed = self._bad_ns >= self.loss_confirm_ns  # not one lost frame
+            periodic = confirmed and self.cycles % self.recover_every == 0
+            if periodic and not self.backend.recovers_itself:
                 self.recover()
+            elif periodic or bad < self.loss_confirm_ns <= self._bad_ns:
+                self.refresh_states()  # who is gone (comm loss, module docstring)
+        if self.last.ok:
+            self._bad_ns = 0
         if self._wkc_bad and self.last.ok and self.all_op():
             self._wkc_bad = False
             self.error = ""
@@ -247,7 +275,7 @@ class Master:
             except GtecatError:
                 self.states[pos] = AlState.NONE
                 continue
-            self.states[pos] = state
+            self.states[pos], self._codes[pos] = state, int(code)
             if state == AlState.OP:
                 continue
             self.log(
@@ -269,10 +297,11 @@ class Master:
                         raise StateError(f"slave {pos}: {tr} refused", slave=pos)
                     if target == AlState.PREOP:
                         self._init_cmds(pos, tr)
-                self.states[pos] = AlState.OP
+                self.states[pos], self._codes[pos] = AlState.OP, 0
                 self.log(f"Slave {pos}: back in OP.")
             except GtecatError as e:
                 self.error = str(e)
+        self._update_offline()
 
     def all_op(self) -> bool:
         return all(s == AlState.OP for s in self.states)
@@ -283,12 +312,36 @@ class Master:
         return self.opened and self.all_op() and self.last.ok and self.last.expected > 0
 
     def refresh_states(self) -> list[AlState]:
-        for cfg in self.layout.config.slaves:
-            try:
-                self.states[cfg.position], _ = self.backend.state(cfg.position)
-            except GtecatError:
-                self.states[cfg.position] = AlState.NONE
+        """Read every slave's AL state (NONE: no answer); updates :attr:`offline`."""
+        for pos, got in enumerate(self.backend.states(len(self.states))):
+            self.states[pos], self._codes[pos] = got if got is not None else (AlState.NONE, 0)
+        self._update_offline()
         return self.states
+
+    def _update_offline(self) -> None:
+        if not self._op_requested:
+            return
+        offline: dict[int, str] = {}
+        for pos, state in enumerate(self.states):
+            if state == AlState.OP:
+                continue
+            name = self.layout.config.slaves[pos].name
+            if state == AlState.NONE:
+                why = "does not answer"
+            else:
+                code = self._codes[pos]
+                why = f"is in {state.name}" + (
+                    f" + ERROR 0x{code:04X} {_code_name(code)}" if code else ""
+                )
+            offline[pos] = f"slave {pos} ({name}) {why}"
+        if offline.keys() != self.offline.keys():
+            gone = sorted(offline.keys() - self.offline.keys())
+            back = sorted(self.offline.keys() - offline.keys())
+            if gone:
+                self.log("Lost: " + "; ".join(offline[p] for p in gone) + ".")
+            if back:
+                self.log("Back in process data: slaves " + ", ".join(map(str, back)) + ".")
+        self.offline = offline
 
     # --- mailbox ------------------------------------------------------------------------
     def sdo_upload(

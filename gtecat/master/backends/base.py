@@ -12,6 +12,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 from drives.slave import AlState, AlStatusCode
+from eni.errors import GtecatError
 from eni.layout import Layout
 from eni.model import Identity
 
@@ -48,6 +49,17 @@ class Backend(ABC):
     @abstractmethod
     def state(self, position: int) -> tuple[AlState, AlStatusCode]:
         """A slave's current AL state and status code."""
+
+    def states(self, count: int) -> list[tuple[AlState, AlStatusCode] | None]:
+        """AL state and status code of slaves ``0 .. count-1``; None for one that does not
+        answer.  Backends that read every state in one go (SOEM's ``read_state``) override it."""
+        out: list[tuple[AlState, AlStatusCode] | None] = []
+        for pos in range(count):
+            try:
+                out.append(self.state(pos))
+            except GtecatError:
+                out.append(None)
+        return out
 
     @abstractmethod
     def exchange(self, t_ns: int, dt_ns: int) -> int:

@@ -353,6 +353,22 @@ class PysoemBackend(Backend):
             raise BusError(f"slave {position} reports an invalid AL state 0x{raw:02X}") from None
         return state, _al_code(int(s.al_status))  # type: ignore[return-value]
 
+    def states(self, count: int) -> list[tuple[AlState, AlStatusCode] | None]:
+        """Every slave's state from one ``read_state`` (a state of 0: no answer)."""
+        if self.master is None:
+            return [None] * count
+        self.master.read_state()
+        out: list[tuple[AlState, AlStatusCode] | None] = []
+        for pos in range(count):
+            raw = int(self.slaves[pos].state) if pos < len(self.slaves) else 0
+            try:
+                state = AlState(raw & STATE_MASK) if raw & STATE_MASK else None
+            except ValueError:
+                state = None
+            code = int(self.slaves[pos].al_status) if state is not None else 0
+            out.append(None if state is None else (state, _al_code(code)))  # type: ignore[arg-type]
+        return out
+
     def request_state(self, position: int, state: AlState) -> AlStatusCode:
         target = AlState(state)
         self._slave(position)

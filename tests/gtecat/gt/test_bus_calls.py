@@ -40,7 +40,9 @@ def test_example_5_5_c_initialisation_sequence():
 def test_example_5_1_status_before_and_after():
     assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), log="", clock="lockstep") == 0
     st = c_short(7)
-    assert gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 0
+    # before any GT_InitEcatComm: 1 with the reason, so a polling loop ends
+    assert gt.GT_IsEcatReady(byref(st)) == 1 and st.value == 0
+    assert "call GT_InitEcatComm" in gt.GTE_GetLastError()
     assert gt.GT_InitEcatComm() == 0
     assert gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 0
     assert gt.GT_StartEcatComm() == 1  # not yet in OP: motion control cannot start
@@ -105,7 +107,8 @@ def test_raw_out_of_range_returns_7_and_changes_nothing(offset, size):
     gt.GT_GetEcatRawData(0, 40, before)
     buf = (c_ubyte * 64)(*([0xFF] * 64))
     assert gt.GT_SetEcatRawData(offset, size, buf) == 7
-    assert "outside" in gt.GTE_GetLastError()
+    reason = gt.GTE_GetLastError()
+    assert "outside" in reason or "out of range 0..65535" in reason, reason
     assert gt.GT_GetEcatRawData(offset, size, buf) == 7
     after = (c_ubyte * 40)()
     gt.GT_GetEcatRawData(0, 40, after)

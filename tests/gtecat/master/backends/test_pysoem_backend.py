@@ -616,3 +616,38 @@ def test_ready_returns_after_recovery_even_if_states_were_read_during_the_outage
     ready = _run(master, 40, t0=200_000_000)
     assert master.last.ok
     assert ready[-1]
+
+
+def test_a_lost_slave_is_offline_after_10_ms_of_short_working_counter_and_back_after():
+    """Master.offline (comm loss, gtecat.master.bus): one read_state tells who is gone."""
+    master, _backend, devices, lines = make_bus()
+    bring_up(master)
+    devices[2].present = False
+    _run(master, 9)
+    assert master.offline == {}  # 9 ms: not yet a loss
+    _run(master, 2, t0=110_000_000)
+    assert master.offline == {2: "slave 2 (Bits C) does not answer"}
+    assert any("Lost: slave 2 (Bits C) does not answer" in x for x in lines)
+    devices[2].present = True
+    devices[2].vs.request_state(AlState.INIT)
+    ready = _run(master, 200, t0=200_000_000)
+    assert ready[-1] and master.offline == {}
+    assert any("Back in process data: slaves 2" in x for x in lines)
+
+
+def test_a_short_stall_of_the_wire_is_not_a_loss():
+    master, _backend, devices, _ = make_bus()
+    bring_up(master)
+    devices[1].present = False
+    _run(master, 5)  # 5 lost cycles, then the slave answers again
+    devices[1].present = True
+    _run(master, 20, t0=200_000_000)
+    assert master.offline == {}
+
+
+def test_backend_states_reads_every_slave_at_once():
+    master, backend, devices, _ = make_bus()
+    bring_up(master)
+    devices[3].present = False
+    got = backend.states(4)
+    assert [g[0] if g else None for g in got] == [AlState.OP, AlState.OP, AlState.OP, None]

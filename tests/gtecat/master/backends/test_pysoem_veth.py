@@ -17,7 +17,7 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Iterator
-from ctypes import byref, c_short
+from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from pathlib import Path
 
 import pytest
@@ -292,6 +292,9 @@ def test_no_slave_on_the_wire_is_minus_10(veth):
     try:
         assert gt.GT_InitEcatComm() == -10
         assert veth[0] in gt.GTE_GetLastError()
+        status = c_short(7)  # the README's polling loop ends: 1 with the init's reason
+        assert gt.GT_IsEcatReady(byref(status)) == 1 and status.value == 0
+        assert "GT_InitEcatComm failed (-10" in gt.GTE_GetLastError()
     finally:
         gt.GT_Close()
 
@@ -315,3 +318,82 @@ def test_other_slaves_than_the_eni_is_minus_8(veth, machine):
     finally:
         gt.GT_Close()
         r.stop()
+
+
+ALARM, SERVO_ON, MOVING = 1 << 1, 1 << 9, 1 << 10
+
+
+def _sts(gt, axis: int) -> int:
+    s = c_long()
+    assert gt.GT_GetSts(axis, byref(s)) == 0
+    return s.value
+
+
+def _pos(gt, fn: str, axis: int) -> float:
+    v = c_double()
+    assert getattr(gt, fn)(axis, byref(v)) == 0
+    return v.value
+
+
+def _move(gt, axis: int, target: int, vel: float = 50.0) -> None:
+    prm = gt.TTrapPrm()
+    assert gt.GT_PrfTrap(axis) == 0
+    assert gt.GT_GetTrapPrm(axis, byref(prm)) == 0
+    prm.acc, prm.dec, prm.smoothTime = 0.5, 0.5, 0
+    assert gt.GT_SetTrapPrm(axis, byref(prm)) == 0
+    assert gt.GT_SetPos(axis, target) == 0 and gt.GT_SetVel(axis, vel) == 0
+    assert gt.GT_Update(1 << (axis - 1)) == 0, gt.GTE_GetLastError()
+
+
+def test_bus_lost_mid_move_stops_the_axes_and_they_recover(veth, runner):
+    """Issue 12 item 4 on the wire: the slave runner dies during a Trap move."""
+    from gtecat import gt
+
+    gt.GT_Close()
+    assert (
+        gt.GT_Open(
+            eni=str(EXAMPLES / "manual_fig5_2.eni"),
+            backend="pysoem",
+            iface=veth[0],
+            clock="realtime",
+            log="",
+        )
+        == 0
+    )
+    wait = scenario_common.wait_until
+    try:
+        r: dict = {}
+        assert scenario_common.bring_up(gt, r), r
+        for a in (1, 2):
+            assert gt.GT_AxisOn(a) == 0, gt.GTE_GetLastError()
+            _move(gt, a, round(_pos(gt, "GT_GetEncPos", a)) + 1_000_000)
+        assert wait(gt, lambda: _pos(gt, "GT_GetEncPos", 1) > 3000 + 1000, ms=3000)
+        runner.stop()
+        lost = lambda: all(  # noqa: E731
+            _sts(gt, a) & ALARM and not _sts(gt, a) & (SERVO_ON | MOVING) for a in (1, 2)
+        )
+        assert wait(gt, lost, ms=2000), [_sts(gt, a) for a in (1, 2)]
+        for a in (1, 2):
+            frozen = _pos(gt, "GT_GetEncPos", a)
+            assert _pos(gt, "GT_GetPrfPos", a) == frozen  # the plan sits on the encoder
+        gt.GTE_Wait(200)
+        for a in (1, 2):  # no runaway
+            assert _pos(gt, "GT_GetPrfPos", a) == _pos(gt, "GT_GetEncPos", a)
+        buf = (c_ubyte * 4)()
+        assert gt.GT_EcatIOReadInput(2, 0, 4, buf) == 1
+        assert "slave 2 (" in gt.GTE_GetLastError()
+        assert gt.GT_GetEcatRawData(0, 2, buf) == 1
+        assert "slave 0 (" in gt.GTE_GetLastError()
+        assert gt.GT_AxisOn(1) == 1 and "slave 0 (" in gt.GTE_GetLastError()
+        runner.start()
+        assert _wait_ready(gt, 1, 10_000), "\n".join(gt.GTE_Controller().log.lines[-10:])
+        assert gt.GT_EcatIOReadInput(2, 0, 4, buf) == 0
+        assert gt.GT_ClrSts(1, 2) == 0
+        assert not _sts(gt, 1) & ALARM and not _sts(gt, 2) & ALARM
+        assert gt.GT_AxisOn(1) == 0, gt.GTE_GetLastError()
+        start = round(_pos(gt, "GT_GetEncPos", 1))
+        _move(gt, 1, start + 20_000)
+        assert wait(gt, lambda: not _sts(gt, 1) & MOVING, ms=10_000)
+        assert wait(gt, lambda: abs(_pos(gt, "GT_GetEncPos", 1) - start - 20_000) <= 2, ms=500)
+    finally:
+        gt.GT_Close()
