@@ -754,13 +754,14 @@ class _Compiler:
             )
         if dst is not None and dst.type is not VarType.INT:
             raise _Error(line, f"{name} returns its return code, an int: {dst.text} is double")
-        operands = [dst.operand() if dst is not None else Operand.none()]
-        consts: dict[str, _Value] = {}
-        for p, a in zip(params, args, strict=True):
-            op, v = self.argument(scope, name, p, a, line, consts)
-            operands.append(op)
+        known: dict[str, _Value] = {}
+        ops: list[Operand | None] = [None] * len(params)
+        for k in sorted(range(len(params)), key=lambda k: params[k].pointer):  # scalars first:
+            op, v = self.argument(scope, name, params[k], args[k], line, known)  # counts size
+            ops[k] = op  # the pointers' room
             if v is not None:
-                consts[p.name] = v
+                known[params[k].name] = v
+        operands = [dst.operand() if dst is not None else Operand.none(), *ops]
         index = self.strings.setdefault(name, len(self.strings))
         self.emit(Op.CALL, line, target=index, operands=operands)
 
