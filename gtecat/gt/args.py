@@ -115,6 +115,14 @@ class Ref:
 
     # --- values ---------------------------------------------------------------------------
     def store_values(self, values: list[Any]) -> None:
+        try:
+            self._store_values(values)
+        except ParameterError as e:
+            if str(e).startswith("the value"):
+                raise ParameterError(f"{self.name}: {e}") from None
+            raise
+
+    def _store_values(self, values: list[Any]) -> None:
         keep = self._keep
         if (
             len(values) == 1
@@ -239,13 +247,36 @@ def _elem_name(elem: Any) -> str:
     return getattr(elem, "__name__", str(elem))
 
 
+_INT_BOUNDS: dict[Any, tuple[int, int]] = {}
+
+
 def fit(ctype: Any, value: Any) -> Any:
     """A value for a ctypes slot: a float into an integer type (``c_long`` where the
-    prototype has ``double *``) is rounded, as a C conversion of the value would be."""
-    if isinstance(value, float) and ctype._type_ not in _FLOAT_CODES:
+    prototype has ``double *``) is rounded, as a C conversion of the value would be; an
+    integer that the slot cannot hold (``byref(c_ubyte())`` for a status word) is refused
+    rather than cut down to a silently wrong value."""
+    code = ctype._type_
+    if code in _FLOAT_CODES:
+        return value
+    if isinstance(value, float):
         if not math.isfinite(value):
             return 0
-        return round(value)
+        value = round(value)
+    if isinstance(value, int) and code in "bBhHiIlLqQ":
+        bounds = _INT_BOUNDS.get(ctype)
+        if bounds is None:
+            bits = 8 * ctypes.sizeof(ctype)
+            bounds = (
+                (0, (1 << bits) - 1)
+                if code.isupper()
+                else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+            )
+            _INT_BOUNDS[ctype] = bounds
+        if not bounds[0] <= value <= bounds[1]:
+            raise ParameterError(
+                f"the value {value} does not fit the {ctype.__name__} behind the pointer "
+                f"({bounds[0]}..{bounds[1]}); pass the prototype's type"
+            )
     return value
 
 
