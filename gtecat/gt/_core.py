@@ -14,6 +14,7 @@ import ctypes
 import functools
 import inspect
 import logging
+import os
 import traceback
 from collections import deque
 from collections.abc import Callable
@@ -84,10 +85,19 @@ class _Session:
         self.controllers: dict[int, Controller] = {}
         self.errors: deque[LastError] = deque(maxlen=64)  # the recent failures, oldest first
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
+        #: the controller process this session is attached to (``GT_Open(controller=...)``
+        #: or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process
+        self.remote: Any = None
 
     def controller(self, core: int = 1) -> Controller:
         c = self.controllers.get(core)
         if c is None:
+            if self.remote is not None:
+                raise NotOpen(
+                    f"this session is attached to the controller at {self.remote.address}; "
+                    "its Python objects stay in that process (the field side over the "
+                    "socket: gtecat.native.client.field(), docs/native.md)"
+                )
             if core != 1 and 1 in self.controllers:
                 raise ParameterError(f"core {core} does not exist; the EtherCAT core is 1")
             raise NotOpen("the controller is not open: call GT_Open first")
@@ -145,19 +155,26 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     needs_ctl = bool(params) and params[0] == "ctl"
     bind = binder(proto, fn)
     card_refused = refused(name)
+    opens = name == "GT_Open"
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
         ctl = None
         before = SESSION.last
+        gtn = core is not _ONE
         try:
-            if core is not _ONE:
+            address = _attach_address(kwargs) if opens else ""
+            if gtn:
                 core = core_arg(core)
                 if not needs_ctl and core != 1:  # GTN_Open/GTN_Close: no other core exists
                     raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
                 core = 1
             values, extra = bind(args, kwargs)
-            if needs_ctl:
+            if address or SESSION.remote is not None:  # attached: the controller process runs it
+                from ..native.client import remote_call
+
+                rc = remote_call(SESSION, name, gtn, core, values, extra, address)
+            elif needs_ctl:
                 ctl = SESSION.controller(core)
                 if card_refused and ctl.card is not None:  # an EtherCAT function on a card
                     raise CommandError(ctl.card.refusal(name))
@@ -211,6 +228,18 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
 
 _ONE = object()  # GT_x: core 1 without a check
+
+
+def _attach_address(kwargs: dict) -> str:
+    """GT_Open's ``controller=`` (taken out of ``kwargs``), else ``GTECAT_CONTROLLER``: the
+    controller process to attach to; "" (or ``"local"``) runs the controller in this process."""
+    address = kwargs.pop("controller", None)
+    if address is None:
+        address = os.environ.get("GTECAT_CONTROLLER", "")
+    if not isinstance(address, str | os.PathLike):
+        raise ParameterError(f"controller={address!r}: an address is needed, e.g. unix:/path")
+    address = os.fspath(address).strip()
+    return "" if address == "local" else address
 
 
 def _signature(proto: Proto, fn: Callable[..., Any]) -> inspect.Signature:

@@ -516,7 +516,8 @@ class Server:
             errors = _core.SESSION.errors
             before = errors[-1] if errors else None
             opener = _core.REGISTRY["GT_Open"]
-            rc = opener(*args, **self.open_options)
+            # "local": this process is the controller, whatever GTECAT_CONTROLLER says
+            rc = opener(*args, controller="local", **self.open_options)
             if rc != 0:
                 e = errors[-1] if errors and errors[-1] is not before else None
                 return rc, (f"GT_Open returned {rc}: {e.reason}" if e else "")
