@@ -24,6 +24,7 @@ _MODULES = (
     "mode_calls",
     "motion_ext_calls",
     "program_calls",
+    "crd_calls",
 )
 
 

@@ -1,0 +1,192 @@
+"""Segment geometry of a coordinate system: lines, arcs and helices in 1-4 coordinates.
+
+Every motion segment knows its start and end (coordinate vectors in profile
+pulses, doubles), its length ``length`` along the path and ``point(s)`` for a
+path distance ``0 <= s <= length``.  ``point(length)`` is the target exactly as
+given (no rounding, no accumulated error): a segment ends where it was asked to.
+
+* :class:`Line`: ``p0 + (p1 - p0)·s/L``; every point lies on the line.
+* :class:`Arc`: a circular arc in the plane of two coordinates (XY, YZ or ZX,
+  the angle counted from the first toward the second), optionally with a third
+  coordinate moving linearly with the angle (a helix).  The radius is the
+  start radius; when the end lies off that circle by a rounding (at most
+  :data:`RADIUS_TOL` pulse) the radius changes linearly with the angle so the
+  end is still exact.  ``s`` maps to the angle linearly (constant speed on the
+  arc).  ``circleDir`` 0 is clockwise, 1 counter-clockwise (vendor header).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ...errors import ParameterError
+
+#: how far the end of an arc may lie off the circle through its start (pulse)
+RADIUS_TOL = 1.0
+PLANES = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}
+CW, CCW = 0, 1
+
+Vec = tuple[float, ...]
+
+
+def _norm(v: Sequence[float]) -> float:
+    return math.sqrt(sum(x * x for x in v))
+
+
+@dataclass(frozen=True, slots=True)
+class Line:
+    start: Vec
+    end: Vec
+
+    @property
+    def length(self) -> float:
+        return _norm([b - a for a, b in zip(self.start, self.end, strict=True)])
+
+    def point(self, s: float) -> Vec:
+        ln = self.length
+        if s >= ln or ln == 0.0:
+            return self.end
+        u = max(s, 0.0) / ln
+        return tuple(a + (b - a) * u for a, b in zip(self.start, self.end, strict=True))
+
+    def tangent(self, at_end: bool) -> Vec:
+        ln = self.length
+        return tuple((b - a) / ln for a, b in zip(self.start, self.end, strict=True))
+
+
+@dataclass(frozen=True, slots=True)
+class Arc:
+    start: Vec
+    end: Vec
+    center: tuple[float, float]  #: absolute, in the plane's two coordinates
+    plane: tuple[int, int]
+    sweep: float  #: signed angle (radian), positive counter-clockwise
+    axis3: int | None = None  #: the helix's linear coordinate
+
+    @property
+    def r0(self) -> float:
+        i, j = self.plane
+        return math.hypot(self.start[i] - self.center[0], self.start[j] - self.center[1])
+
+    @property
+    def r1(self) -> float:
+        i, j = self.plane
+        return math.hypot(self.end[i] - self.center[0], self.end[j] - self.center[1])
+
+    @property
+    def theta0(self) -> float:
+        i, j = self.plane
+        return math.atan2(self.start[j] - self.center[1], self.start[i] - self.center[0])
+
+    @property
+    def rise(self) -> float:
+        return 0.0 if self.axis3 is None else self.end[self.axis3] - self.start[self.axis3]
+
+    @property
+    def length(self) -> float:
+        planar = abs(self.sweep) * 0.5 * (self.r0 + self.r1)
+        return math.hypot(planar, self.rise)
+
+    def point(self, s: float) -> Vec:
+        ln = self.length
+        if s >= ln or ln == 0.0:
+            return self.end
+        u = max(s, 0.0) / ln
+        i, j = self.plane
+        r = self.r0 + (self.r1 - self.r0) * u
+        th = self.theta0 + self.sweep * u
+        out = list(self.start)
+        out[i] = self.center[0] + r * math.cos(th)
+        out[j] = self.center[1] + r * math.sin(th)
+        if self.axis3 is not None:
+            k = self.axis3
+            out[k] = self.start[k] + self.rise * u
+        return tuple(out)
+
+    def tangent(self, at_end: bool) -> Vec:
+        i, j = self.plane
+        th = self.theta0 + (self.sweep if at_end else 0.0)
+        r = self.r1 if at_end else self.r0
+        sgn = 1.0 if self.sweep > 0 else -1.0
+        t = [0.0] * len(self.start)
+        w = abs(self.sweep) * r
+        t[i], t[j] = -math.sin(th) * sgn * w, math.cos(th) * sgn * w
+        if self.axis3 is not None:
+            t[self.axis3] = self.rise
+        n = _norm(t) or 1.0
+        return tuple(x / n for x in t)
+
+
+def arc_center(
+    start: Vec, end: Vec, plane: tuple[int, int], radius: float, direction: int
+) -> tuple[float, float]:
+    """Centre of the arc of ``radius`` from ``start`` to ``end`` (GT_ArcXYR and kin).
+
+    ``radius > 0``: the arc of at most 180°, ``< 0``: the longer one (vendor
+    convention).  ParameterError when the chord is longer than the diameter
+    or start and end coincide (a full circle needs a centre: GT_ArcXYC).
+    """
+    i, j = plane
+    x0, y0, x1, y1 = start[i], start[j], end[i], end[j]
+    dx, dy = x1 - x0, y1 - y0
+    d = math.hypot(dx, dy)
+    rad = abs(radius)
+    if radius == 0.0 or d == 0.0:
+        raise ParameterError(
+            f"radius={radius}: an arc by radius needs start != end and radius != 0 "
+            "(a full circle takes the centre form, GT_ArcXYC)"
+        )
+    if d > 2.0 * rad + RADIUS_TOL:
+        raise ParameterError(f"radius={radius}: the chord ({d:.3f} pulse) exceeds the diameter")
+    h = math.sqrt(max(rad * rad - 0.25 * d * d, 0.0))
+    nx, ny = -dy / d, dx / d  # left of the chord
+    side = 1.0 if direction == CCW else -1.0
+    if radius < 0.0:
+        side = -side
+    return 0.5 * (x0 + x1) + side * h * nx, 0.5 * (y0 + y1) + side * h * ny
+
+
+def make_arc(
+    start: Vec,
+    end: Vec,
+    center: tuple[float, float],
+    plane: tuple[int, int],
+    direction: int,
+    axis3: int | None = None,
+    prefer_major: bool | None = None,
+) -> Arc:
+    """An :class:`Arc` from ``start`` to ``end`` around the absolute ``center``.
+
+    End on start: a full turn.  ``prefer_major`` (radius form) picks the sweep
+    when start and end are diametrically opposite within rounding.
+    """
+    if direction not in (CW, CCW):
+        raise ParameterError(f"circleDir={direction}: 0 (clockwise) or 1 (counter-clockwise)")
+    i, j = plane
+    r0 = math.hypot(start[i] - center[0], start[j] - center[1])
+    r1 = math.hypot(end[i] - center[0], end[j] - center[1])
+    if r0 == 0.0:
+        raise ParameterError("the arc's centre lies on its start point (radius 0)")
+    if abs(r1 - r0) > RADIUS_TOL:
+        raise ParameterError(
+            f"the end lies {abs(r1 - r0):.3f} pulse off the circle through the start "
+            f"(radius {r0:.3f}); at most {RADIUS_TOL} is accepted"
+        )
+    t0 = math.atan2(start[j] - center[1], start[i] - center[0])
+    t1 = math.atan2(end[j] - center[1], end[i] - center[0])
+    tau = 2.0 * math.pi
+    same = start[i] == end[i] and start[j] == end[j]
+    if direction == CCW:
+        sweep = tau if same else (t1 - t0) % tau
+    else:
+        sweep = -tau if same else -((t0 - t1) % tau)
+    if not same and abs(sweep) < 1e-12:
+        sweep = tau if direction == CCW else -tau
+    if prefer_major is not None and abs(abs(sweep) - math.pi) < 1e-9:
+        pass  # half circle: either reading is the same arc
+    return Arc(tuple(start), tuple(end), center, plane, sweep, axis3)
+
+
+Segment = Line | Arc

@@ -1,0 +1,547 @@
+"""Coordinate systems (坐标系) of one core: segment FIFOs, vector speed, look-ahead, stops.
+
+A :class:`CoordSystem` maps 1-4 coordinates (X, Y, Z, A) onto profiles
+(``TCrdPrm.profile[k] = c``: profile ``k+1`` is coordinate ``c``, 0 = none,
+as the vendor's examples write ``profile[0] = 1; /* 规划器1对应到X轴 */``).
+:meth:`CoordSystem.configure` puts each mapped profile into interpolation
+mode (``PrfMode.INTERPOLATION``) with an :class:`AxisSlot` planner, so the
+axis layer samples, stops and holds it like any mode's planner.  The system
+itself advances once per cycle in the controller's ``pre_cycle`` hook, before
+the axes take their samples, and writes each slot's position.
+
+Decisions where the manual is silent:
+
+* **Origin**: ``setOriginFlag = 0`` puts the origin at the profiles' planned
+  positions when GT_SetCrdPrm is called; ``1`` at ``originPos[c-1]`` for
+  coordinate ``c`` (profile pulses).  Coordinates are profile positions minus
+  the origin.
+* **FIFOs** 0 and 1 hold :data:`FIFO_SIZE` entries each; a segment's start is the
+  previous entry's end (or the system's position when the FIFO is empty), so
+  GT_ArcXYC's relative centre is known when it is pushed.  GT_CrdStart
+  ``option`` bit ``n-1`` picks FIFO 1 for system ``n``.  A start runs the FIFO to
+  its end; entries pushed while it runs are run too.
+* **Speed**: ``synVel``/``synAcc`` above synVelMax/synAccMax are cut to them;
+  each segment is a :class:`~.velocity.Trapezoid` from the speed the previous one
+  ended with.  Its exit speed is decided when it starts: ``velEnd`` (capped by
+  this and the next segment's synVel) when the next motion segment is already in
+  the FIFO, else 0; and never more than the next segment can stop from.  With
+  look-ahead (GT_InitLookAhead) ``velEnd`` is not used: the exit speed is the
+  largest the next ``n`` segments allow, where a corner whose unit tangents differ
+  by ``d`` passes at ``accMax·T/|d|`` and an arc at ``sqrt(accMax·r)``, and the
+  path stops at the end of the window.
+* **Override** (GT_SetOverride, 0..2): the path time runs at that ratio (speed ×
+  ratio, acceleration × ratio²).
+* **Stops**: a stop of any axis of the system (GT_Stop, a limit, the following
+  error, a stop input) stops the whole system along its path with GT_SetCrdStopDec's
+  smooth or abrupt deceleration (defaults 1 and 1000 pulse/ms², as table 4-4 for a
+  profile); the rest of the FIFO is dropped.  A hold (servo off, alarm, another drive
+  mode) drops the motion at once; the other axes stand where they are.  A soft
+  limit passed in a cycle starts the path stop from that cycle's sample.
+* **Segments counted** by GT_CrdStatus: every FIFO entry finished since GT_CrdStart
+  (lines, arcs, BufIO, BufDelay, BufMove alike).
+* **GT_BufIO** records ``(doType, doMask, doValue)`` in :attr:`CoordSystem.outputs`
+  (value per doType) when the path reaches it: the EtherCAT core has no GPO
+  register of its own.  **GT_BufMove** starts a Trap move of an axis outside the
+  system; ``modal = 1`` waits until it stands.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ...errors import CommandError, ParameterError
+from ..motion.stop import StopDecel, StopKind
+from ..profile import PrfMode
+from .path import Arc, Segment
+from .velocity import Trapezoid
+
+CRD_COUNT = 2
+FIFO_SIZE = 4096
+DIM_MAX = 4
+OVERRIDE_MAX = 2.0
+
+
+@dataclass(frozen=True, slots=True)
+class CrdParams:
+    dimension: int
+    profile: tuple[int, ...]  #: 8 entries: coordinate of profile k+1 (0 = none)
+    syn_vel_max: float
+    syn_acc_max: float
+    even_time: int = 0
+    set_origin: int = 0
+    origin: tuple[float, ...] = (0.0,) * 8
+
+    def axes(self) -> list[int]:
+        """Profile number of each coordinate, X first."""
+        out = [0] * self.dimension
+        for k, c in enumerate(self.profile):
+            if c:
+                out[c - 1] = k + 1
+        return out
+
+
+@dataclass(slots=True)
+class Motion:
+    geom: Segment
+    vel: float
+    acc: float
+    vel_end: float
+
+
+@dataclass(slots=True)
+class Delay:
+    ms: float
+
+
+@dataclass(slots=True)
+class BufIO:
+    do_type: int
+    mask: int
+    value: int
+
+
+@dataclass(slots=True)
+class BufMove:
+    axis: int
+    pos: int
+    vel: float
+    acc: float
+    modal: int
+    run: Callable[[], Callable[[], bool]] = field(repr=False, default=lambda: lambda: True)
+
+
+Entry = Motion | Delay | BufIO | BufMove
+
+
+@dataclass(slots=True)
+class LookAhead:
+    T: float
+    acc_max: float
+    n: int
+
+
+class AxisSlot:
+    """The planner of a profile in interpolation mode: its coordinate of one system."""
+
+    def __init__(self, crd: CoordSystem, coord: int, pos: float) -> None:
+        self.crd = crd
+        self.coord = coord
+        self._pos = pos
+        self._vel = 0.0
+        self._acc = 0.0
+        self.stopping = StopKind.NONE
+
+    @property
+    def done(self) -> bool:
+        return not self.crd.running
+
+    @property
+    def pos(self) -> float:
+        return self._pos
+
+    @property
+    def vel(self) -> float:
+        return self._vel
+
+    @property
+    def acc(self) -> float:
+        return self._acc
+
+    def step(self) -> tuple[float, float, float]:
+        return self._pos, self._vel, self._acc  # the system advanced in pre_cycle
+
+    def stop(self, dec: float, abrupt: bool = False, origin: Any = None) -> None:
+        self.crd.stop(abrupt)
+
+    def hold(self, pos: float) -> None:
+        self._pos, self._vel, self._acc = pos, 0.0, 0.0
+        if self.crd.running:
+            self.crd.abort()
+
+    def sample(self, pos: float, vel: float, acc: float) -> None:
+        self._pos, self._vel, self._acc = pos, vel, acc
+        self.stopping = self.crd.stopping
+
+
+class CoordSystem:
+    """One coordinate system: parameters, two FIFOs, the running path."""
+
+    def __init__(self, number: int, cycle_ms: Callable[[], float]) -> None:
+        self.number = number
+        self._cycle_ms = cycle_ms
+        self.reset()
+
+    def reset(self) -> None:
+        self.prm: CrdParams | None = None
+        self.slots: list[AxisSlot] = []
+        self.origin: list[float] = []
+        self.fifos: tuple[deque[Entry], deque[Entry]] = (deque(), deque())
+        self.tails: list[tuple[float, ...] | None] = [None, None]
+        self.look: list[LookAhead | None] = [None, None]
+        self.stop_dec = StopDecel()
+        self.override = 1.0
+        self.outputs: dict[int, int] = {}
+        self.io_log: list[tuple[int, int, int]] = []
+        self._idle()
+        self.segments_done = [0, 0]
+
+    def _idle(self) -> None:
+        self.running = False
+        self.fifo = 0
+        self.stopping = StopKind.NONE
+        self.entry: Entry | None = None
+        self.plan: Trapezoid | None = None
+        self.t = 0.0
+        self.s = 0.0
+        self.speed = 0.0
+        self.stop_acc = 0.0
+        self.waiting: Callable[[], bool] | None = None
+
+    # --- configuration ----------------------------------------------------------------
+    def configure(self, prm: CrdParams, profiles: dict[int, Any]) -> None:
+        """GT_SetCrdPrm: ``profiles`` maps profile number -> its Profile (all at rest)."""
+        if self.running:
+            raise CommandError(f"coordinate system {self.number} is moving")
+        axes = prm.axes()
+        for n in axes:
+            profiles[n].require_idle("GT_SetCrdPrm")
+        slots = []
+        origin = []
+        for c, n in enumerate(axes):
+            p = profiles[n]
+            pos = p.planner.pos
+            slot = AxisSlot(self, c, pos)
+            p.enter(PrfMode.INTERPOLATION, planner=slot)
+            slots.append(slot)
+            origin.append(prm.origin[c] if prm.set_origin else pos)
+        self.prm, self.slots, self.origin = prm, slots, origin
+        self.fifos[0].clear()
+        self.fifos[1].clear()
+        self.tails = [None, None]
+
+    def require_prm(self, what: str) -> CrdParams:
+        if self.prm is None:
+            raise CommandError(
+                f"{what}: coordinate system {self.number} has no parameters; call GT_SetCrdPrm"
+            )
+        return self.prm
+
+    def position(self) -> tuple[float, ...]:
+        """The coordinates now (profile positions minus the origin)."""
+        return tuple(s.pos - o for s, o in zip(self.slots, self.origin, strict=True))
+
+    # --- the FIFOs ----------------------------------------------------------------------
+    def _fifo(self, fifo: int) -> deque[Entry]:
+        if fifo not in (0, 1):
+            raise ParameterError(f"fifo={fifo}: 0 or 1")
+        return self.fifos[fifo]
+
+    def space(self, fifo: int) -> int:
+        return FIFO_SIZE - len(self._fifo(fifo))
+
+    def tail(self, fifo: int) -> tuple[float, ...]:
+        """Where the next segment of ``fifo`` starts."""
+        t = self.tails[fifo] if self._fifo(fifo) or self._runs(fifo) else None
+        return t if t is not None else self.position()
+
+    def _runs(self, fifo: int) -> bool:
+        return self.running and self.fifo == fifo
+
+    def push(self, entry: Entry, fifo: int) -> None:
+        q = self._fifo(fifo)
+        if len(q) >= FIFO_SIZE:
+            raise CommandError(f"FIFO {fifo} of coordinate system {self.number} is full")
+        if isinstance(entry, Motion):
+            self.tails[fifo] = entry.geom.end
+        elif not q and not self._runs(fifo):
+            self.tails[fifo] = self.position()
+        q.append(entry)
+
+    def clear(self, fifo: int) -> None:
+        if self._runs(fifo):
+            raise CommandError(
+                f"GT_CrdClear: FIFO {fifo} of coordinate system {self.number} is running"
+            )
+        self._fifo(fifo).clear()
+        self.tails[fifo] = None
+
+    def motion_params(self, vel: float, acc: float, vel_end: float) -> tuple[float, float, float]:
+        prm = self.require_prm("segment")
+        if not (math.isfinite(vel) and vel > 0.0):
+            raise ParameterError(f"synVel={vel}: must be > 0")
+        if not (math.isfinite(acc) and acc > 0.0):
+            raise ParameterError(f"synAcc={acc}: must be > 0")
+        if not (math.isfinite(vel_end) and vel_end >= 0.0):
+            raise ParameterError(f"velEnd={vel_end}: must be >= 0")
+        vel = min(vel, prm.syn_vel_max)
+        return vel, min(acc, prm.syn_acc_max), min(vel_end, vel)
+
+    # --- start, stop --------------------------------------------------------------------
+    def start(self, fifo: int) -> None:
+        q = self._fifo(fifo)
+        if not q:
+            raise CommandError(
+                f"GT_CrdStart: FIFO {fifo} of coordinate system {self.number} holds no segment"
+            )
+        self._idle()
+        self.running, self.fifo = True, fifo
+        self.segments_done[fifo] = 0
+        self.speed = 0.0
+        self._next(0.0)
+
+    def stop(self, abrupt: bool) -> None:
+        if not self.running or self.stopping == StopKind.ABRUPT:
+            return
+        self.stopping = StopKind.ABRUPT if abrupt else StopKind.SMOOTH
+        self.stop_acc = self.stop_dec.for_kind(abrupt)
+        self.waiting = None
+        if not isinstance(self.entry, Motion) or self.speed <= 0.0:
+            self._end_stop()
+
+    def abort(self) -> None:
+        self._drop_fifo()
+        self._finish()
+        for s in self.slots:
+            s._vel = s._acc = 0.0
+
+    def _drop_fifo(self) -> None:
+        self.fifos[self.fifo].clear()
+        self.tails[self.fifo] = None
+
+    def _end_stop(self) -> None:
+        self._drop_fifo()
+        self._finish()
+
+    def _finish(self) -> None:
+        fifo = self.fifo
+        done = self.segments_done
+        self._idle()
+        self.fifo = fifo
+        self.segments_done = done
+
+    # --- the cycle ----------------------------------------------------------------------
+    def step(self) -> None:
+        if not self.running:
+            return
+        cyc = self._cycle_ms()
+        before = [s._pos for s in self.slots]
+        if self.stopping != StopKind.NONE:
+            self._step_stop(cyc * max(self.override, 1e-3))
+        else:
+            self._advance(cyc * self.override)
+        self._sample_point()
+        for slot, old in zip(self.slots, before, strict=True):
+            v = (slot._pos - old) / cyc
+            slot.sample(slot._pos, v, (v - slot._vel) / cyc)
+        if not self.running:
+            for slot in self.slots:
+                slot._vel = slot._acc = 0.0
+                slot.stopping = StopKind.NONE
+
+    def _advance(self, dt: float) -> None:
+        self.t += dt
+        while self.running:
+            e = self.entry
+            if self.waiting is not None:
+                if not self.waiting():
+                    self.t = 0.0
+                    return
+                self.waiting = None
+                self._done_entry(0.0)
+                continue
+            if isinstance(e, Motion):
+                plan = self.plan
+                if self.t < plan.duration:
+                    self.s = plan.s(self.t)
+                    self.speed = plan.v(self.t)
+                    return
+                self._done_entry(self.t - plan.duration)
+                continue
+            if isinstance(e, Delay):
+                if self.t < e.ms:
+                    return
+                self._done_entry(self.t - e.ms)
+                continue
+            return
+
+    def _done_entry(self, leftover: float) -> None:
+        e = self.entry
+        if isinstance(e, Motion):
+            self.s = e.geom.length
+            self.speed = self.plan.v_end
+            self._sample_point_of(e, e.geom.length)
+        self.segments_done[self.fifo] += 1
+        self._next(leftover)
+
+    def _next(self, leftover: float) -> None:
+        """Take the next FIFO entry with ``leftover`` ms of this cycle already spent in it."""
+        q = self.fifos[self.fifo]
+        while q:
+            e = q.popleft()
+            self.entry, self.t = e, leftover
+            if isinstance(e, Motion):
+                if e.geom.length <= 0.0:
+                    self.segments_done[self.fifo] += 1
+                    continue
+                self.s = 0.0
+                self.plan = Trapezoid(
+                    e.geom.length,
+                    self.speed,
+                    self._vmax(e),
+                    self._exit_speed(e),
+                    e.acc,
+                    float(self.prm.even_time) if self.prm else 0.0,
+                )
+                return
+            self.speed = 0.0
+            if isinstance(e, Delay):
+                return
+            if isinstance(e, BufIO):
+                old = self.outputs.get(e.do_type, 0)
+                self.outputs[e.do_type] = (old & ~e.mask) | (e.value & e.mask)
+                self.io_log.append((e.do_type, e.mask, e.value))
+                self.segments_done[self.fifo] += 1
+                continue
+            if isinstance(e, BufMove):
+                done = e.run()
+                if e.modal:
+                    self.waiting = done
+                    return
+                self.segments_done[self.fifo] += 1
+                continue
+        # the FIFO ran out: the path ends here (the last segment's exit speed was 0)
+        self.entry = None
+        self._finish()
+
+    def _vmax(self, e: Motion) -> float:
+        la = self.look[self.fifo]
+        v = e.vel
+        if la is not None and isinstance(e.geom, Arc):
+            v = min(v, math.sqrt(la.acc_max * max(e.geom.r0, 1e-9)))
+        return v
+
+    def _exit_speed(self, e: Motion) -> float:
+        q = self.fifos[self.fifo]
+        la = self.look[self.fifo]
+        window: list[Motion] = []
+        for nxt in q:
+            if not isinstance(nxt, Motion):
+                if isinstance(nxt, BufIO):
+                    continue
+                break  # a delay or a modal move: the path stops before it
+            if nxt.geom.length <= 0.0:
+                continue
+            window.append(nxt)
+            if len(window) >= (la.n if la is not None else 1):
+                break
+        if not window:
+            return 0.0
+        chain = [e, *window]
+        # corner limits between chain[k] and chain[k+1]
+        limits = []
+        for k in range(len(chain) - 1):
+            a, b = chain[k], chain[k + 1]
+            lim = min(self._vmax(a), self._vmax(b))
+            if la is None:
+                lim = min(lim, a.vel_end)
+            else:
+                ta, tb = a.geom.tangent(True), b.geom.tangent(False)
+                d = math.sqrt(sum((x - y) ** 2 for x, y in zip(ta, tb, strict=True)))
+                if d > 1e-9:
+                    lim = min(lim, la.acc_max * la.T / d)
+            limits.append(lim)
+        w = 0.0  # speed at the end of the window
+        for k in range(len(chain) - 1, 0, -1):
+            seg = chain[k]
+            w = min(limits[k - 1], math.sqrt(w * w + 2.0 * seg.acc * seg.geom.length))
+        return w
+
+    def _step_stop(self, dt: float) -> None:
+        """Brake along the path: the constant-deceleration ramp's distance this cycle, through
+        as many queued segments as it takes (entries other than motion are skipped)."""
+        v0 = self.speed
+        dec = self.stop_acc
+        v1 = max(v0 - dec * dt, 0.0)
+        tb = (v0 - v1) / dec
+        ds = v0 * tb - 0.5 * dec * tb * tb
+        self.speed = v1
+        q = self.fifos[self.fifo]
+        e = self.entry
+        s = self.s + ds
+        while isinstance(e, Motion) and s > e.geom.length:
+            s -= e.geom.length
+            nxt = None
+            while q:
+                cand = q.popleft()
+                if isinstance(cand, Motion) and cand.geom.length > 0.0:
+                    nxt = cand
+                    break
+            if nxt is None:  # the path ends before the ramp: stop at its end
+                s = e.geom.length
+                self.speed = 0.0
+                break
+            self._sample_point_of(e, e.geom.length)
+            self.segments_done[self.fifo] += 1
+            self.entry = e = nxt
+        self.s = s
+        if self.speed <= 0.0:
+            self._sample_point()
+            if isinstance(e, Motion) and s >= e.geom.length:
+                self.segments_done[self.fifo] += 1
+            self._end_stop()
+
+    def _sample_point(self) -> None:
+        e = self.entry
+        if isinstance(e, Motion):
+            self._sample_point_of(e, self.s)
+
+    def _sample_point_of(self, e: Motion, s: float) -> None:
+        p = e.geom.point(s)
+        for slot, o, x in zip(self.slots, self.origin, p, strict=True):
+            slot._pos = o + x
+
+    def vector_speed(self) -> float:
+        return self.speed * self.override if self.running else 0.0
+
+
+class CrdBank:
+    """The coordinate systems of one controller, stepped in its ``pre_cycle`` hook."""
+
+    def __init__(self, ctl: Any) -> None:
+        self.ctl = ctl
+        cyc = lambda: ctl.clock.cycle_ns / 1e6  # noqa: E731
+        self.systems = {n: CoordSystem(n, cyc) for n in range(1, CRD_COUNT + 1)}
+        ctl.pre_cycle.append(self._pre)
+        ctl.on_reset.append(self._reset)
+
+    def _pre(self, t_ns: int, dt_ns: int) -> None:
+        for c in self.systems.values():
+            if c.running:
+                c.step()
+
+    def _reset(self, ctl: Any) -> None:
+        for c in self.systems.values():
+            c.reset()
+
+    def get(self, n: Any) -> CoordSystem:
+        try:
+            k = int(n)
+        except (TypeError, ValueError):
+            raise ParameterError(f"crd={n!r} is not an integer") from None
+        c = self.systems.get(k)
+        if c is None:
+            raise ParameterError(f"crd={k}: coordinate systems are 1..{CRD_COUNT}")
+        return c
+
+
+def bank(ctl: Any) -> CrdBank:
+    """The controller's coordinate systems (made on first use)."""
+    b = getattr(ctl, "crd_bank", None)
+    if b is None:
+        b = CrdBank(ctl)
+        ctl.crd_bank = b
+    return b
