@@ -33,7 +33,7 @@ LOG: list[str] = []
 
 def commandhandler(command: str, rtn: int) -> None:
     if rtn != 0:
-        LOG.append(f"{command} = {rtn}: {gt.GTE_GetLastError()}")
+        LOG.append(gt.GTE_GetLastError() or f"{command} = {rtn}")
 
 
 @dataclass

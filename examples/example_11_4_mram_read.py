@@ -26,7 +26,7 @@ WordBuf = c_short * 16
 
 def commandhandler(command: str, rtn: int) -> None:
     if rtn != 0:
-        LOG.append(f"{command} = {rtn}: {gt.GTE_GetLastError()}")
+        LOG.append(gt.GTE_GetLastError() or f"{command} = {rtn}")
 
 
 class RTrig:

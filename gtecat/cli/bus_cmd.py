@@ -8,17 +8,17 @@ closes.  Human tables by default, ``--json`` for scripts.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import struct
 
-from drives.machine import MachineError
 from drives.slave import AlState
 from eni.model import Direction
 from eni.numbers import parse_int
 
-from ..controller.core import Controller, Options
-from ..errors import BusError, ConfigMismatch, ParameterError
+from ..errors import ParameterError
+from . import output
+from .busview import Bus, add_bus_options, open_bus
+
+__all__ = ["open_bus"]
 
 TYPES = {  # --type name -> (struct code, size)
     "bool": ("?", 1),
@@ -35,14 +35,34 @@ TYPES = {  # --type name -> (struct code, size)
 }
 #: CiA 301 VISIBLE_STRING (0x0009): device name 1008h, versions 1009h/100Ah
 STRING = "string"
+#: CiA 301 data type name (the dictionary's) -> --type name
+FROM_DICTIONARY = {
+    "BOOL": "bool",
+    "INT8": "int8",
+    "UINT8": "uint8",
+    "INT16": "int16",
+    "UINT16": "uint16",
+    "INT32": "int32",
+    "UINT32": "uint32",
+    "INT64": "int64",
+    "UINT64": "uint64",
+    "REAL32": "float",
+    "VISIBLE_STRING": STRING,
+}
 
+SDO_EPILOG = """\
+OBJECT is an index (0x6041), an index:subindex (0x6041:00) or an object's name
+("Statusword"; emulated bus). Without --type the type comes from the slave's
+object dictionary (emulated bus), else the value prints as raw bytes.
 
-def _common(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--eni", help="configuration file (default: $GTECAT_ENI or ./Gecat.eni)")
-    p.add_argument("--machine", help="machine description TOML ($GTECAT_MACHINE)")
-    p.add_argument("--backend", choices=("emulated", "pysoem"), help="($GTECAT_BACKEND)")
-    p.add_argument("--iface", help="network interface for pysoem ($GTECAT_IFACE)")
-    p.add_argument("--json", action="store_true", help="machine-readable output")
+examples:
+  gtecat sdo upload -p 0 0x1018:01                 vendor id of slave 0
+  gtecat sdo upload 0 Statusword                   by name
+  gtecat sdo download -p 0 0x6060 0 8              modes of operation := 8 (CSP)
+  gtecat sdo upload 0 0x6502 0 --type uint32 --backend pysoem --iface eth0
+
+On the emulated bus every command starts a fresh bus: a download lasts for that
+command only (use a script and `gtecat run` for sequences)."""
 
 
 def _file(p: argparse.ArgumentParser) -> None:
@@ -51,31 +71,44 @@ def _file(p: argparse.ArgumentParser) -> None:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("slaves", help="list the slaves: position, state, identity, axes")
+    p = sub.add_parser(
+        "slaves",
+        help="list the slaves: position, state, identity, axes",
+        description="List the slaves of the bus: position, AL state, identity, axes, GT raw "
+        "region.",
+        epilog="examples:\n  gtecat slaves manual_fig5_2.eni\n  gtecat slaves -p 2 --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     _file(p)
-    _common(p)
+    add_bus_options(p)
     p.set_defaults(func=run_slaves)
-    p = sub.add_parser("pdos", help="show each slave's sync managers, PDOs and entries")
+    p = sub.add_parser(
+        "pdos",
+        help="show each slave's sync managers, PDOs and entries",
+        epilog="examples:\n  gtecat pdos manual_fig5_2.eni\n  gtecat pdos -p 0 --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     _file(p)
-    _common(p)
+    add_bus_options(p)
     p.set_defaults(func=run_pdos)
-    p = sub.add_parser("sdo", help="SDO upload / download")
+    p = sub.add_parser(
+        "sdo",
+        help="SDO upload / download",
+        usage="gtecat sdo {upload,download} [-p POSITION | SLAVE] OBJECT [SUB] [VALUE] [options]",
+        epilog=SDO_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("action", choices=("upload", "download"))
-    p.add_argument("slave", type=int)
-    p.add_argument("index", help="object index, e.g. 0x6041")
-    p.add_argument("subindex", help="subindex, e.g. 0")
-    p.add_argument("value", nargs="?", help="value to download")
+    p.add_argument(
+        "words", nargs="+", metavar="ARG", help="[SLAVE] OBJECT [SUB] [VALUE] (see below)"
+    )
     p.add_argument(
         "--type",
         default=None,
         choices=sorted([*TYPES, STRING]),
-        help="data type (upload default: raw hex; download: required)",
+        help="data type (default: the dictionary's on the emulated bus, else raw bytes)",
     )
-    p.epilog = (
-        "On the emulated bus every command starts a fresh bus: a download lasts for that "
-        "command only (use a script and `gtecat run` for sequences)."
-    )
-    _common(p)
+    add_bus_options(p)
     p.set_defaults(func=run_sdo)
 
 
@@ -83,57 +116,21 @@ def run(args: argparse.Namespace) -> int:  # the dispatcher's fallback
     return int(args.func(args))
 
 
-def open_bus(args: argparse.Namespace) -> Controller:
-    """Bring the bus up as GT_Open + GT_InitEcatComm would (lockstep; realtime on pysoem)."""
-    backend = args.backend or os.environ.get("GTECAT_BACKEND") or "emulated"
-    try:
-        ctl = Controller(
-            Options(
-                eni=args.eni or getattr(args, "file", None),
-                machine=args.machine,
-                # a real bus must cycle on the wall clock (docs/hardware.md)
-                clock="realtime" if backend == "pysoem" else "lockstep",
-                backend=args.backend,
-                iface=args.iface,
-                log="",
-            )
-        )
-    except MachineError as e:
-        raise MachineError(f"{e} (--machine FILE or GTECAT_MACHINE; or leave it out)") from None
-    try:
-        ctl.init_ecat()
-        if not ctl.clock.run_until(lambda: ctl.ready, 2000):
-            err = ctl.master.error if ctl.master else ""
-            raise BusError(f"the bus did not reach OP{': ' + err if err else ''}")
-    except ConfigMismatch as e:
-        ctl.close()
-        if "export" in str(e):  # the master already says what to do
-            raise
-        raise ConfigMismatch(
-            f"{e}; the ENI does not describe this bus: export it again from the "
-            "configuration tool for this machine, or check the cabling order"
-        ) from None
-    except BaseException:
-        ctl.close()
-        raise
-    return ctl
-
-
 def _hex(v: int, w: int = 8) -> str:
     return f"0x{v:0{w}X}"
 
 
 def run_slaves(args: argparse.Namespace) -> int:
-    ctl = open_bus(args)
-    try:
-        m = ctl.master
+    with Bus(args) as bus:
+        m = bus.master
         states = m.refresh_states()
         rows = []
-        for sl, cfg, st in zip(m.layout.slaves, m.layout.config.slaves, states, strict=True):
+        for pos in bus.positions():
+            sl, cfg = m.layout.slaves[pos], m.layout.config.slaves[pos]
             rows.append(
                 {
                     "position": sl.position,
-                    "state": AlState(st).name,
+                    "state": AlState(states[pos]).name,
                     "name": cfg.name,
                     "vendor_id": cfg.identity.vendor_id,
                     "product_code": cfg.identity.product_code,
@@ -143,10 +140,8 @@ def run_slaves(args: argparse.Namespace) -> int:
                     "gt_size": sl.gt_size,
                 }
             )
-    finally:
-        ctl.close()
     if args.json:
-        print(json.dumps(rows, indent=2))
+        output.print_json(rows)
         return 0
     print(
         f"{'pos':>3}  {'state':<6} {'vendor':<10} {'product':<10} {'rev':<10} "
@@ -163,11 +158,11 @@ def run_slaves(args: argparse.Namespace) -> int:
 
 
 def run_pdos(args: argparse.Namespace) -> int:
-    ctl = open_bus(args)
-    try:
-        cfg = ctl.master.layout.config
+    with Bus(args) as bus:
+        cfg = bus.layout.config
         out = []
-        for s in cfg.slaves:
+        for pos in bus.positions():
+            s = cfg.slaves[pos]
             pdos = []
             for d, plist in ((Direction.OUT, s.rx_pdos), (Direction.IN, s.tx_pdos)):
                 for p in plist:
@@ -190,10 +185,8 @@ def run_pdos(args: argparse.Namespace) -> int:
                         }
                     )
             out.append({"position": s.position, "name": s.name, "pdos": pdos})
-    finally:
-        ctl.close()
     if args.json:
-        print(json.dumps(out, indent=2))
+        output.print_json(out)
         return 0
     for s in out:
         print(f"=== slave {s['position']}: {s['name']}")
@@ -227,51 +220,152 @@ def _encode(text: str, type_name: str) -> bytes:
         raise ParameterError(f"{text} does not fit {type_name}: {e}") from None
 
 
-def run_sdo(args: argparse.Namespace) -> int:
+def _number(text: str, what: str, high: int) -> int:
     try:
-        index, sub = parse_int(args.index), parse_int(args.subindex)
+        v = parse_int(text)
     except ValueError:
         raise ParameterError(
-            f"sdo: INDEX and SUB must be numbers, e.g. 0x6041 0 (got {args.index} {args.subindex})"
+            f"sdo: {what} {text!r} is not a number: INDEX and SUB must be numbers, "
+            "e.g. 0x6041 0 (or an object's name on the emulated bus)"
         ) from None
-    if args.action == "download":
-        if args.value is None or args.type is None:
-            raise ParameterError("sdo download needs VALUE and --type")
-        data = _encode(args.value, args.type)
-    ctl = open_bus(args)
+    if not 0 <= v <= high:
+        raise ParameterError(f"sdo: {what} {text} out of range 0..0x{high:X}")
+    return v
+
+
+def _is_number(text: str) -> bool:
     try:
-        if args.action == "upload":
-            raw = ctl.master.sdo_upload(args.slave, index, sub)
+        parse_int(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _split_words(args: argparse.Namespace) -> tuple[int, str, str | None, str | None]:
+    """``[SLAVE] OBJECT [SUB] [VALUE]`` -> (slave, object, sub, value)."""
+    words = list(args.words)
+    if args.position is None:
+        if not words or not _is_number(words[0]):
+            raise ParameterError(
+                "sdo: give the slave first (gtecat sdo upload 0 0x6041 0) or with -p POSITION"
+            )
+        slave = parse_int(words.pop(0))
+    else:
+        slave = args.position
+    if not words:
+        raise ParameterError("sdo: give the object, e.g. 0x6041 0, 0x6041:00 or Statusword")
+    obj = words.pop(0)
+    sub: str | None = None
+    if ":" in obj and _is_number(obj.split(":", 1)[0]):
+        obj, sub = obj.split(":", 1)
+    want = 1 if args.action == "download" else 0
+    if sub is None and (len(words) > want or (words and _is_number(obj))):
+        sub = words.pop(0)  # a numeric INDEX is followed by its SUB (IgH's order)
+    value = words.pop(0) if args.action == "download" and words else None
+    if words:
+        raise ParameterError(f"sdo {args.action}: unexpected {' '.join(words)}")
+    return slave, obj, sub, value
+
+
+def _lookup(bus: Bus, slave: int, obj: str, sub: str | None) -> tuple[int, int, object]:
+    """(index, subindex, dictionary entry or None) for OBJECT [SUB]."""
+    od = None
+    if bus.emulated:
+        try:
+            od = bus.od(slave)
+        except Exception:  # an IO slave without CoE: the SDO itself says so
+            od = None
+    if _is_number(obj):
+        index = _number(obj, "INDEX", 0xFFFF)
+        subindex = 0 if sub is None else _number(sub, "SUB", 0xFF)
+        var = od.find(index, subindex) if od is not None else None
+        return index, subindex, var
+    if od is None:
+        raise ParameterError(
+            f"sdo: {obj!r} is not a number; names are looked up in the emulated slave's "
+            "dictionary only: give the index, e.g. 0x6041 0"
+        )
+    wanted = obj.casefold()
+    subindex = None if sub is None else _number(sub, "SUB", 0xFF)
+    hits = []
+    for o in od:
+        subs = [o.subs[k] for k in sorted(o.subs)]
+        if o.name.casefold() == wanted:
+            if subindex is None and len(subs) > 1:
+                raise ParameterError(
+                    f"sdo: {obj!r} is 0x{o.index:04X} with subindexes "
+                    f"{', '.join(str(v.subindex) for v in subs)}: give SUB"
+                )
+            hits += [v for v in subs if subindex is None or v.subindex == subindex]
         else:
-            ctl.master.sdo_download(args.slave, index, sub, data)
-    finally:
-        ctl.close()
+            hits += [
+                v
+                for v in subs
+                if v.name.casefold() == wanted and (subindex is None or v.subindex == subindex)
+            ]
+    if not hits:
+        raise ParameterError(
+            f"sdo: slave {slave} has no object called {obj!r} (`gtecat sdos -p {slave}` lists them)"
+        )
+    if len({(v.index, v.subindex) for v in hits}) > 1:
+        where = ", ".join(output.hex_addr(v.index, v.subindex) for v in hits[:5])
+        raise ParameterError(f"sdo: {obj!r} names {where}: give the index")
+    v = hits[0]
+    return v.index, v.subindex, v
+
+
+def run_sdo(args: argparse.Namespace) -> int:
+    slave, obj, sub, value_text = _split_words(args)
+    if _is_number(obj):  # bad numbers are refused before the bus starts
+        _number(obj, "INDEX", 0xFFFF)
+        if sub is not None:
+            _number(sub, "SUB", 0xFF)
+    if args.action == "download" and value_text is None:
+        raise ParameterError("sdo download needs VALUE (and --type where the type is unknown)")
+    if args.action == "download" and args.type:
+        data = _encode(value_text or "", args.type)
+    with Bus(args) as bus:
+        bus.check(slave)
+        index, subindex, var = _lookup(bus, slave, obj, sub)
+        type_name = args.type
+        if type_name is None and var is not None:
+            type_name = FROM_DICTIONARY.get(var.data_type.name)
+        if args.action == "download":
+            if type_name is None:
+                raise ParameterError(
+                    f"sdo download: the type of {output.hex_addr(index, subindex)} is unknown "
+                    f"here; give --type ({', '.join(sorted(TYPES))}, string)"
+                )
+            if not args.type:
+                data = _encode(value_text or "", type_name)
+            bus.master.sdo_download(slave, index, subindex, data)
+        else:
+            raw = bus.master.sdo_upload(slave, index, subindex)
     if args.action == "download":
         if args.json:
-            print(json.dumps({"ok": True}))
+            output.print_json({"ok": True})
         return 0
     value: object = raw.hex(" ")
-    if args.type == STRING:
+    if type_name == STRING:
         value = raw.rstrip(b"\0").decode("utf-8", errors="backslashreplace")
-    elif args.type:
-        code, size = TYPES[args.type]
+    elif type_name:
+        code, size = TYPES[type_name]
         if len(raw) < size:
             raise ParameterError(
-                f"0x{index:04X}:{sub:02X} has {len(raw)} bytes, {args.type} needs {size}"
+                f"{output.hex_addr(index, subindex)} has {len(raw)} bytes, {type_name} needs {size}"
             )
         value = struct.unpack_from("<" + code, raw)[0]
     if args.json:
-        print(
-            json.dumps(
-                {
-                    "slave": args.slave,
-                    "index": index,
-                    "subindex": sub,
-                    "bytes": raw.hex(),
-                    "value": value,
-                }
-            )
-        )
+        out = {"slave": slave, "index": index, "subindex": subindex, "bytes": raw.hex()}
+        out["value"] = value
+        if var is not None:
+            out["name"] = var.name
+            out["type"] = var.data_type.name
+        output.print_json(out)
+    elif isinstance(value, int) and not isinstance(value, bool) and type_name:
+        print(f"{value}  (0x{raw[: TYPES[type_name][1]][::-1].hex().upper()}, {type_name})")
+    elif type_name:
+        print(value)
     else:
-        print(value if args.type else f"{value}  ({len(raw)} bytes)")
+        print(f"{value}  ({len(raw)} bytes)")
     return 0

@@ -26,7 +26,10 @@ def add_parser(subparsers: Any) -> None:
         "new",
         help="write an ETG.2100 ENI from a TOML topology",
         description="Write an ETG.2100 ENI XML file from a TOML topology "
-        "(format: see eni/topology.py or examples/*.toml).",
+        "(format: docs/reference/topology.md; `gtecat example manual_fig5_2` writes one).",
+        epilog="examples:\n  gtecat eni new manual_fig5_2.toml -o manual_fig5_2.eni\n"
+        "  gtecat eni new my_bus.toml | gtecat map /dev/stdin",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     new.add_argument("topology", help="topology TOML file")
     new.add_argument("-o", "--output", help="ENI file to write (default: standard output)")

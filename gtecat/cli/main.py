@@ -17,10 +17,17 @@ from eni.errors import GtecatError
 COMMANDS = (
     "demo_cmd",
     "example_cmd",
-    "example_cmd",
     "map_cmd",
     "eni_cmd",
     "bus_cmd",
+    "sdos_cmd",
+    "states_cmd",
+    "reg_cmd",
+    "sii_cmd",
+    "data_cmd",
+    "cstruct_cmd",
+    "graph_cmd",
+    "ifaces_cmd",
     "run_cmd",
     "serve_cmd",
     "controller_cmd",
@@ -51,7 +58,20 @@ def build_parser() -> argparse.ArgumentParser:
         for verb in set(sub.choices) - before:
             if sub.choices[verb].get_default("func") is None:
                 sub.choices[verb].set_defaults(func=mod.run)
+            _debug_anywhere(sub.choices[verb])
     return parser
+
+
+def _debug_anywhere(p: argparse.ArgumentParser) -> None:
+    """``gtecat VERB ... --debug`` works as ``gtecat --debug VERB ...`` does."""
+    if "--debug" not in p._option_string_actions:
+        p.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+        )
+    for action in p._actions:  # nested verbs: gtecat eni new ... --debug
+        if isinstance(action, argparse._SubParsersAction):
+            for child in set(action.choices.values()):
+                _debug_anywhere(child)
 
 
 def _tolerant_streams() -> None:

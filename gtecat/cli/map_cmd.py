@@ -1,9 +1,9 @@
 """``gtecat map FILE.eni``: the IO-mapping table a user needs to compute raw-data offsets.
 
-One row per mapped entry: slave, direction, PDO, ``index:sub``, name, type,
-bits, logical offset (``byte.bit`` in its direction's ENI image) and GT raw
-offset (``byte.bit`` as ``GT_GetEcatRawData``/``GT_SetEcatRawData`` address it,
-manual 5.2.2.4).  ``--json`` prints the DESIGN.md schema instead.
+One row per mapped entry: slave, direction, PDO, index:sub, name, type,
+bits, logical offset (byte.bit in its direction's ENI image) and GT raw
+offset (byte.bit as GT_GetEcatRawData/GT_SetEcatRawData address it,
+manual 5.2.2.4).  --json prints the same as JSON (docs/reference/cli.md).
 """
 
 from __future__ import annotations
@@ -26,9 +26,12 @@ def add_parser(subparsers: Any) -> None:
         "map",
         help="print the process-image map (logical and GT raw offsets) of an ENI",
         description=__doc__.split("\n\n")[1] if __doc__ else None,
+        epilog="examples:\n  gtecat map manual_fig5_2.eni\n  gtecat map --eni Gecat.eni --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("file", help="ENI file (ETG.2100 XML or Googol INI Gecat.eni)")
-    p.add_argument("--json", action="store_true", help="print the JSON schema of DESIGN.md")
+    p.add_argument("file", nargs="?", help="ENI file (ETG.2100 XML or Googol INI Gecat.eni)")
+    p.add_argument("--eni", help="the same as FILE (default: $GTECAT_ENI or ./Gecat.eni)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of the table")
     p.set_defaults(func=run)
 
 
@@ -114,6 +117,11 @@ def render_json(layout: Layout, *, ascii_only: bool = False) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    import os
+
+    from .busview import eni_argument
+
+    args.file = eni_argument(args) or os.environ.get("GTECAT_ENI") or "Gecat.eni"
     try:
         layout = build_layout(read_eni(args.file))
     except GtecatError as exc:

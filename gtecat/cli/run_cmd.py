@@ -6,6 +6,10 @@ records signals every cycle once the bus is up (see :mod:`gtecat.controller.reco
 names) and writes ``<stem>.csv`` and ``<stem>.png``.  On a terminal a status line shows
 controller time against wall time while the script runs.
 
+Precedence: an option given on the command line wins over the same argument of the script's
+own ``GT_Open(eni=..., ...)`` (a note on stderr says so, once per option); the script's
+arguments win over the ``GTECAT_*`` environment, which wins over the defaults.
+
 The script's own exit code is the command's; an exception in the script prints its
 traceback (the script's frames only) and exits 1.
 """
@@ -45,6 +49,21 @@ def _add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no status line on stderr")
 
 
+EPILOG = """\
+Options given here win over the script's own GT_Open(eni=..., machine=..., clock=...,
+backend=..., iface=...) arguments; a note on stderr names each one replaced.
+
+examples:
+  gtecat run first_script.py --eni manual_fig5_2.eni
+  gtecat run home.py --machine machine.toml --trace axis1.enc,axis1.sw,0:0x60FD:0
+  gtecat run my_machine.py --clock realtime --backend pysoem --iface eth0
+
+signals for --trace: axisN.prf (planned, pulse), .enc (6064h, counts), .err (planned - actual),
+.vel (planned velocity, pulse/ms), .encvel (encoder velocity, counts/ms), .sw (6041h bits),
+.cw (6040h bits), .mode (6061h), .state (the CiA-402 state), .machine (true position);
+SLAVE:INDEX:SUB for any mapped PDO entry (`gtecat map FILE.eni` lists them)."""
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "run",
@@ -52,6 +71,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Run SCRIPT.py (which uses `from gtecat import gt`) with the given "
         "emulator settings.  Options may come before or after the script; the script's "
         "own arguments follow it (after `--` when they look like options).",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     _add_options(p)
     p.add_argument("script", help="Python script using `from gtecat import gt`")
@@ -180,14 +201,83 @@ def _script_traceback(e: BaseException, script: Path) -> str:
     return "".join(tb.format())
 
 
-def run(args: argparse.Namespace) -> int:
-    script_args = split_arguments(args)
-    script = Path(args.script)
+def check_script(script: Path) -> None:
+    """Refuse what is not a Python script before anything runs (one line, no traceback)."""
     if not script.is_file():
         raise ParameterError(
             f"script {script} not found"
             + (" (that is a folder)" if script.is_dir() else f" (working directory {Path.cwd()})")
         )
+    source = script.read_bytes()
+    if b"\0" in source:
+        raise ParameterError(
+            f"{script} is not a Python script (it holds NUL bytes: a binary file?); "
+            "gtecat run takes a .py file that uses `from gtecat import gt`"
+        )
+    try:
+        compile(source, str(script), "exec", dont_inherit=True)
+    except SyntaxError as e:
+        where = f" at line {e.lineno}" if e.lineno else ""
+        raise ParameterError(
+            f"{script} is not valid Python: {e.msg}{where} (`python3 {script}` shows where)"
+        ) from None
+    except ValueError as e:  # an encoding the source cannot be read in
+        raise ParameterError(f"{script} cannot be read as Python source: {e}") from None
+
+
+def check_trace_out(stem: Path) -> None:
+    """The folder the traces go to must exist before the script runs, not after."""
+    folder = stem.parent
+    if not folder.is_dir():
+        raise ParameterError(
+            f"--trace-out {stem}: the folder {folder} does not exist; create it or choose another"
+        )
+    if not os.access(folder, os.W_OK):
+        raise ParameterError(f"--trace-out {stem}: the folder {folder} is not writable")
+
+
+#: GT_Open keyword -> environment variable; the command line's value wins over the script's
+OPEN_OPTIONS = {
+    "eni": "GTECAT_ENI",
+    "machine": "GTECAT_MACHINE",
+    "clock": "GTECAT_CLOCK",
+    "backend": "GTECAT_BACKEND",
+    "iface": "GTECAT_IFACE",
+}
+
+
+def _same(key: str, a: object, b: str) -> bool:
+    if key in ("eni", "machine") and isinstance(a, str | os.PathLike):
+        return Path(a).resolve() == Path(b).resolve()
+    return str(a) == b
+
+
+def overriding_open(
+    real: Callable[..., int], forced: dict[str, str], noted: set[str], *, core_first: bool
+) -> Callable[..., int]:
+    """``GT_Open`` (or ``GTN_Open``) whose ``forced`` keywords are the command line's."""
+
+    def gt_open(*a: object, **kw: object) -> int:
+        for key, value in forced.items():
+            given = kw.get(key)
+            if given is not None and not _same(key, given, value) and key not in noted:
+                noted.add(key)
+                print(
+                    f"gtecat run: --{key} {value} replaces the script's GT_Open({key}={given!r})",
+                    file=sys.stderr,
+                )
+            kw[key] = value
+        return real(*a, **kw)
+
+    gt_open.__name__ = "GTN_Open" if core_first else "GT_Open"
+    gt_open.__doc__ = real.__doc__
+    return gt_open
+
+
+def run(args: argparse.Namespace) -> int:
+    script_args = split_arguments(args)
+    script = Path(args.script)
+    check_script(script)
     options = {
         "GTECAT_ENI": args.eni,
         "GTECAT_MACHINE": args.machine,
@@ -197,10 +287,20 @@ def run(args: argparse.Namespace) -> int:
     }
     for k in ("GTECAT_ENI", "GTECAT_MACHINE"):
         v = options[k]
+        what = "ENI" if k == "GTECAT_ENI" else "machine description"
+        if v and Path(v).is_dir():
+            raise ParameterError(f"{what} {v} is a folder, not a file (--{k[7:].lower()})")
         if v and not Path(v).is_file():
-            what = "ENI" if k == "GTECAT_ENI" else "machine description"
             raise ParameterError(f"{what} {v} not found (--{k[7:].lower()})")
     specs = [s.strip() for s in (args.trace or "").split(",") if s.strip()]
+    stem = Path(args.trace_out) if args.trace_out else script.with_suffix("")
+    if specs:
+        check_trace_out(stem)
+    forced = {
+        key: str(Path(v).resolve()) if key in ("eni", "machine") else v
+        for key, env in OPEN_OPTIONS.items()
+        if (v := options[env])
+    }
     saved_env = {k: os.environ.get(k) for k in ENV}
     saved_argv = sys.argv
     for k, v in options.items():
@@ -219,6 +319,12 @@ def run(args: argparse.Namespace) -> int:
                 raise _TraceFailed(str(e)) from None
         ctl.sample.append(lambda _t: progress(ctl))
 
+    from .. import gt as gt_module
+
+    real_open, real_gtn_open = gt_module.GT_Open, gt_module.GTN_Open
+    noted: set[str] = set()
+    gt_module.GT_Open = overriding_open(real_open, forced, noted, core_first=False)
+    gt_module.GTN_Open = overriding_open(real_gtn_open, forced, noted, core_first=True)
     Controller.bus_up_hooks.append(attach)
     saved_streams = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = progress.guard(sys.stdout), progress.guard(sys.stderr)
@@ -244,6 +350,7 @@ def run(args: argparse.Namespace) -> int:
         rc = 1
     finally:
         Controller.bus_up_hooks.remove(attach)
+        gt_module.GT_Open, gt_module.GTN_Open = real_open, real_gtn_open
         progress.done()
         sys.stdout, sys.stderr = saved_streams
         sys.argv = saved_argv
@@ -256,7 +363,6 @@ def run(args: argparse.Namespace) -> int:
         from ..gt import GT_Close
 
         GT_Close()  # a script that forgot it: stop a realtime thread, flush the log
-    stem = Path(args.trace_out) if args.trace_out else script.with_suffix("")
     if specs and not any(rec.n for rec in recorders):
         print(
             "trace: nothing recorded (the script never brought the bus up with GT_InitEcatComm)",
@@ -266,7 +372,12 @@ def run(args: argparse.Namespace) -> int:
         base = stem if i == 0 else stem.with_name(f"{stem.name}_{i}")
         if rec.n == 0:
             continue
-        csv_path = rec.to_csv(base.with_suffix(".csv"))
-        png_path = rec.plot(base.with_suffix(".png"), title=f"{script.name}: {', '.join(specs)}")
+        try:
+            csv_path = rec.to_csv(base.with_suffix(".csv"))
+            png_path = rec.plot(base.with_suffix(".png"), title=f"{script.name}")
+        except OSError as e:
+            raise ParameterError(
+                f"--trace-out {stem}: cannot write the trace: {e.strerror or e}"
+            ) from None
         print(f"trace: {rec.n} cycles -> {csv_path}, {png_path}")
     return rc

@@ -1,11 +1,13 @@
-"""``gtecat serve --eni FILE [--machine FILE] --iface IFACE``: slaves on a real wire.
+"""gtecat serve --eni FILE [--machine FILE] --iface IFACE: slaves on a real wire.
 
-Builds the virtual slaves of the ENI exactly as the emulated backend does
-(:func:`gtecat.master.factory.build_slaves`, same drives, same machine description),
-puts them behind software ESCs and answers EtherCAT frames on ``IFACE`` until
-Ctrl-C or SIGTERM.  Any master (SOEM/pysoem, TwinCAT, IgH, acontis) on the
-other end of the wire sees a chain of real-looking slaves.  Needs root or
-CAP_NET_RAW.
+Builds the virtual slaves of the ENI exactly as the emulated backend does (same drives,
+same machine description), puts them behind software ESCs and answers EtherCAT frames on
+IFACE until Ctrl-C or SIGTERM.  Any master (SOEM/pysoem, TwinCAT, IgH, acontis) on the
+other end of the wire sees a chain of real-looking slaves.  Needs root or CAP_NET_RAW.
+
+examples:
+  gtecat serve --eni manual_fig5_2.eni --iface veth1
+  gtecat serve --eni Gecat.eni --machine machine.toml --iface enp3s0 --duration 60
 """
 
 from __future__ import annotations
@@ -90,6 +92,12 @@ def run(args: argparse.Namespace) -> int:
 
     if args.verbose:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+    if not Path("/sys/class/net", args.iface).exists() and Path("/sys/class/net").is_dir():
+        from eni.errors import GtecatError
+
+        raise GtecatError(
+            f"no network interface {args.iface!r}: `gtecat ifaces` lists the ones this machine has"
+        )
     chain, config = build_chain(args.eni, args.machine, watchdog_trips=args.sm_watchdog)
     cycle_ns = (args.cycle_us * 1000) if args.cycle_us else (config.cycle_time_ns or 1_000_000)
     if interface_is_up(args.iface) is False:
@@ -105,7 +113,10 @@ def run(args: argparse.Namespace) -> int:
 
     old = {s: signal.signal(s, _stop) for s in (signal.SIGINT, signal.SIGTERM)}
 
+    served = []
+
     def _ready() -> None:
+        served.append(True)
         names = ", ".join(f"{s.position}:{s.name}" for s in chain.slaves)
         print(f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}); ready", flush=True)
 
@@ -119,12 +130,13 @@ def run(args: argparse.Namespace) -> int:
         if args.stats_json:
             args.stats_json.write_text(json.dumps(report, indent=2) + "\n")
         lat = report["latency"]
-        print(
-            f"gtecat serve: stopped after {report['elapsed_s']} s, "
-            f"{report['sent']} frames answered, {report['chain']['dropped']} dropped, "
-            f"latency p50 {lat.get('p50_us', 0):.1f} us",
-            flush=True,
-        )
+        if served:  # a server that never started has nothing to report
+            print(
+                f"gtecat serve: stopped after {report['elapsed_s']} s, "
+                f"{report['sent']} frames answered, {report['chain']['dropped']} dropped, "
+                f"latency p50 {lat.get('p50_us', 0):.1f} us",
+                flush=True,
+            )
     return 0
 
 

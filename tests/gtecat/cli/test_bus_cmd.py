@@ -75,13 +75,25 @@ def test_pdos_table(cli: Cli) -> None:
 
 
 # --- sdo -------------------------------------------------------------------------------------
-def test_sdo_upload_raw_and_typed(cli: Cli) -> None:
+def test_sdo_upload_typed_from_the_dictionary_with_hex_beside(cli: Cli) -> None:
     rc, out, _ = cli("sdo", "upload", "0", "0x1018", "1", "--eni", FIG52)
-    assert rc == 0 and out.strip().endswith("(4 bytes)")
-    rc, out, _ = cli("sdo", "upload", "0", "0x1018", "1", "--type", "uint32", "--eni", FIG52)
-    assert rc == 0
     _, js, _ = cli("slaves", "--eni", FIG52, "--json")
-    assert int(out) == json.loads(js)[0]["vendor_id"]  # 1018h:01 is the vendor id
+    vendor = json.loads(js)[0]["vendor_id"]  # 1018h:01 is the vendor id
+    assert rc == 0 and out == f"{vendor}  (0x{vendor:08X}, uint32)\n"
+    rc, out, _ = cli("sdo", "upload", "0", "0x1018", "1", "--type", "uint32", "--eni", FIG52)
+    assert rc == 0 and out.split()[0] == str(vendor)
+    # IgH's spelling: -p POSITION, and INDEX:SUB in one word
+    assert cli("sdo", "upload", "-p", "0", "0x1018:01", "--eni", FIG52)[1] == out
+
+
+def test_sdo_upload_by_name(cli: Cli) -> None:
+    rc, out, _ = cli("sdo", "upload", "0", "Statusword", "--eni", FIG52)
+    assert rc == 0 and out.endswith("(0x0650, uint16)\n")
+    rc, out, _ = cli("sdo", "upload", "-p", "1", "vendor id", "--eni", FIG52)
+    assert rc == 0 and out.startswith("1196705091 ")
+    rc, out, err = cli("sdo", "upload", "0", "Identity", "--eni", FIG52)
+    assert rc == 1 and "0x1018 with subindexes 0, 1, 2, 3, 4: give SUB" in err
+    assert cli("sdo", "upload", "0", "Identity", "2", "--eni", FIG52)[1].startswith("65537 ")
 
 
 def test_sdo_upload_json(cli: Cli) -> None:
@@ -91,21 +103,27 @@ def test_sdo_upload_json(cli: Cli) -> None:
     assert rc == 0
     r = json.loads(out)
     assert (r["slave"], r["index"], r["subindex"]) == (1, 0x6041, 0)
+    assert (r["name"], r["type"]) == ("Statusword", "UINT16")
     assert len(r["bytes"]) == 4 and r["value"] == int.from_bytes(
         bytes.fromhex(r["bytes"]), "little"
     )
 
 
 def test_sdo_string_type_reads_the_device_name(cli: Cli) -> None:
-    rc, raw, _ = cli("sdo", "upload", "0", "0x1008", "0", "--eni", FIG52)
-    assert rc == 0 and raw.strip().endswith("bytes)")
-    rc, out, _ = cli("sdo", "upload", "0", "0x1008", "0", "--type", "string", "--eni", FIG52)
-    assert rc == 0
-    assert out.strip().encode().hex(" ") == raw.split("  (")[0].strip()  # the same bytes, as text
+    rc, out, _ = cli("sdo", "upload", "0", "0x1008", "0", "--eni", FIG52)
+    assert rc == 0 and out == "gtecat virtual CiA-402 servo drive\n"  # VISIBLE_STRING
+    rc, typed, _ = cli("sdo", "upload", "0", "0x1008", "0", "--type", "string", "--eni", FIG52)
+    assert typed == out
     rc, out, err = cli(
         "sdo", "download", "0", "0x1008", "0", "X", "--type", "string", "--eni", FIG52
     )
     assert (rc, out) == (1, "") and "0x06010002" in err  # the name is read-only: its abort
+
+
+def test_sdo_download_takes_the_type_from_the_dictionary(cli: Cli) -> None:
+    assert cli("sdo", "download", "0", "0x6060", "0", "6", "--eni", FIG52) == (0, "", "")
+    rc, _, err = cli("sdo", "download", "0", "0x6060", "0", "300", "--eni", FIG52)
+    assert rc == 1 and "does not fit int8" in err
 
 
 def test_sdo_download_is_silent_on_success(cli: Cli) -> None:
@@ -140,8 +158,12 @@ def test_sdo_abort_prints_the_cia301_code_in_one_line(
         (("upload", "2", "0x1018", "1"), "has no CoE mailbox"),
         (("upload", "7", "0x1018", "1"), "no slave 7: the bus has slaves 0..3"),
         (("download", "0", "0x6060", "0", "300", "--type", "int8"), "does not fit int8"),
-        (("download", "0", "0x6060", "0"), "needs VALUE and --type"),
-        (("upload", "0", "0x60zz", "0"), "must be numbers"),
+        (("download", "0", "0x6060", "0"), "needs VALUE"),
+        (("upload", "0", "0x60zz", "0"), "no object called '0x60zz'"),
+        (("upload", "0", "0x6041", "300"), "SUB 300 out of range 0..0xFF"),
+        (("upload", "0", "0x16041", "0"), "INDEX 0x16041 out of range 0..0xFFFF"),
+        (("upload", "0", "0x6041", "0", "7"), "unexpected 7"),
+        (("upload", "x", "0x6041", "0"), "give the slave first"),
         (("upload", "0", "0x6041", "0", "--type", "uint32"), "has 2 bytes, uint32 needs 4"),
         # a value that is not a number is the user's mistake, not an internal error
         (("download", "0", "0x6060", "0", "abc", "--type", "int8"), "VALUE 'abc' is not an int"),

@@ -218,3 +218,60 @@ def test_the_reason_is_said_once() -> None:
     assert gt.GT_AxisOn(9) == 7
     text = gt.GTE_GetLastError()
     assert text.count("returned") == 1 and text.count("GT_AxisOn") == 1
+
+
+# --- the cases a new user met outside the repository --------------------------------------------
+def test_run_a_binary_or_broken_script_is_one_line(cli: Cli, tmp_path: Path) -> None:
+    binary = tmp_path / "binary.py"
+    binary.write_bytes(b"\x7fELF\x02\x01\x01\x00\x00\x00")
+    err = _one_line_error(*cli("run", str(binary)))
+    assert "is not a Python script" in err and "NUL bytes" in err
+    broken = tmp_path / "broken.py"
+    broken.write_text("print(1\n")
+    err = _one_line_error(*cli("run", str(broken)))
+    assert "is not valid Python" in err and "line 1" in err and "python3" in err
+
+
+def test_trace_out_into_a_missing_folder_is_refused_before_the_run(
+    cli: Cli, tmp_path: Path
+) -> None:
+    script = tmp_path / "s.py"
+    script.write_text("print('ran')\n")
+    err = _one_line_error(*cli("run", str(script), "--trace", "axis1.prf", "--trace-out",
+                               str(tmp_path / "nope" / "x")))  # fmt: skip
+    assert f"the folder {tmp_path / 'nope'} does not exist" in err  # and 'ran' never printed
+
+
+def test_sdo_subindex_out_of_range_is_one_line(cli: Cli) -> None:
+    err = _one_line_error(*cli("sdo", "upload", "0", "0x6041", "300", "--eni", FIG52))
+    assert "SUB 300 out of range 0..0xFF" in err and "internal" not in err
+
+
+def test_an_eni_that_is_a_folder(cli: Cli, tmp_path: Path) -> None:
+    shutil.copy(EXAMPLES / "manual_fig5_4.eni", tmp_path / "bus.eni")
+    err = _one_line_error(*cli("slaves", "--eni", str(tmp_path)))
+    assert "is a folder, not an ENI file (it holds bus.eni)" in err
+    assert f"--eni {tmp_path / 'bus.eni'}" in err
+    err = _one_line_error(*cli("map", str(tmp_path)))
+    assert "is a folder" in err
+    script = tmp_path / "s.py"
+    script.write_text("print('ran')\n")
+    err = _one_line_error(*cli("run", str(script), "--eni", str(tmp_path)))
+    assert "is a folder, not a file (--eni)" in err
+
+
+def test_an_emulated_bus_without_slaves_does_not_speak_of_cabling(cli: Cli, tmp_path: Path) -> None:
+    (tmp_path / "empty.toml").write_text("cycle_time_us = 1000\n")
+    assert cli("eni", "new", str(tmp_path / "empty.toml"), "-o", str(tmp_path / "e.eni"))[0] == 0
+    err = _one_line_error(*cli("slaves", "--eni", str(tmp_path / "e.eni")))
+    assert "describes no slaves" in err and "cabling" not in err
+
+
+def test_serve_on_a_missing_interface_says_so_first(cli: Cli) -> None:
+    err = _one_line_error(*cli("serve", "--eni", FIG52, "--iface", "gtecat-missing0"))
+    assert "no network interface 'gtecat-missing0'" in err and "gtecat ifaces" in err
+
+
+def test_debug_works_after_the_verb_too(cli: Cli, tmp_path: Path) -> None:
+    with pytest.raises(Exception, match="no ENI file"):
+        cli("slaves", "--eni", str(tmp_path / "x.eni"), "--debug")

@@ -182,3 +182,12 @@ def test_the_first_script_runs_with_only_the_installed_package(
     )  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert run.stdout == (EXAMPLES / "first_script.expected.txt").read_text()
+
+
+def test_no_example_prints_the_reason_with_a_second_prefix() -> None:
+    """GTE_GetLastError() already says "GT_X returned N: ..."; adding it again doubles it."""
+    import re
+
+    doubled = re.compile(r"(returned|=) \{rtn\}: \{gt\.GTE_GetLastError\(\)\}")
+    for path in EXAMPLES.rglob("*.py"):
+        assert not doubled.search(path.read_text(encoding="utf-8")), path.name

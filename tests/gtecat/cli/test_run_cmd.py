@@ -228,3 +228,59 @@ def test_progress_line_during_a_long_run(
     # controller time only grows from one status line to the next
     shown = [float(x.split(" s controller")[0].split()[-1]) for x in lines]
     assert shown == sorted(shown) and shown[-1] >= 2.0
+
+
+# --- precedence: the command line over the script's GT_Open over GTECAT_* ------------------------
+PRECEDENCE = textwrap.dedent(
+    """
+    from ctypes import byref, c_short
+    from gtecat import gt
+
+    gt.GT_Open(eni=ENI, clock="auto", log="")
+    gt.GT_InitEcatComm()
+    n = c_short()
+    gt.GT_GetEcatSlaves(byref(n))
+    print("slaves", n.value, "clock", gt.GTE_Controller().clock.mode)
+    gt.GT_Close()
+    """
+)
+
+
+def _precedence(tmp_path: Path) -> Path:
+    path = tmp_path / "own_open.py"
+    path.write_text(PRECEDENCE.replace("ENI", repr(FIG52)))
+    return path
+
+
+def test_command_line_options_win_over_the_scripts_gt_open_with_a_note(
+    cli: Cli, tmp_path: Path
+) -> None:
+    script = _precedence(tmp_path)
+    one = str(EXAMPLES / "manual_fig5_4.eni")
+    rc, out, err = cli("run", str(script), "--eni", one, "--clock", "lockstep")
+    assert rc == 0 and out == "slaves 1 clock lockstep\n"
+    assert err.splitlines() == [
+        f"gtecat run: --eni {Path(one).resolve()} replaces the script's GT_Open(eni={FIG52!r})",
+        "gtecat run: --clock lockstep replaces the script's GT_Open(clock='auto')",
+    ]
+
+
+def test_without_options_the_script_wins_over_the_environment_silently(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("GTECAT_ENI", str(EXAMPLES / "manual_fig5_4.eni"))
+    rc, out, err = cli("run", str(_precedence(tmp_path)))
+    assert (rc, out, err) == (0, "slaves 4 clock auto\n", "")
+
+
+def test_the_same_value_as_the_script_needs_no_note(cli: Cli, tmp_path: Path) -> None:
+    rc, out, err = cli("run", str(_precedence(tmp_path)), "--eni", FIG52)
+    assert (rc, out, err) == (0, "slaves 4 clock auto\n", "")
+
+
+def test_gt_open_is_restored_after_the_run(cli: Cli, tmp_path: Path) -> None:
+    from gtecat import gt
+
+    before = gt.GT_Open
+    cli("run", str(_precedence(tmp_path)), "--eni", FIG52)
+    assert gt.GT_Open is before

@@ -1,0 +1,124 @@
+"""``gtecat sdos [-p POSITION]``: each slave's CoE object dictionary, with current values.
+
+Like IgH's ``ethercat sdos``: one line per entry, with its index and subindex, CiA 301
+data type, access right, whether it can be PDO-mapped (RxPDO/TxPDO), name and the value it
+holds now (decimal and hex). On the emulated bus this is the virtual slave's own dictionary.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..errors import BusError
+from . import output
+from .busview import Bus, add_bus_options
+
+EPILOG = """\
+examples:
+  gtecat sdos -p 0 --eni manual_fig5_2.eni         slave 0's dictionary
+  gtecat sdos -p 0 --grep homing                   entries whose name says "homing"
+  gtecat sdos --json > od.json"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "sdos",
+        help="list the CoE object dictionary (index, sub, name, type, access, value)",
+        description=__doc__.split("\n\n", 1)[1] if __doc__ else None,
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("file", nargs="?", help="configuration file (same as --eni)")
+    p.add_argument("--grep", metavar="TEXT", help="only entries whose name contains TEXT")
+    p.add_argument("--no-values", action="store_true", help="do not read the values")
+    add_bus_options(p)
+    p.set_defaults(func=run)
+
+
+def _value(var: Any) -> tuple[Any, str | None]:
+    """(value for JSON, hex of the value's bytes) of one entry."""
+    if not var.access.readable:
+        return None, None
+    try:
+        value = var.get()
+        raw = var.encode(value)
+    except Exception:  # a getter that needs a running drive: show no value, not an error
+        return None, None
+    if isinstance(value, bytes):
+        value = value.hex(" ")
+    if isinstance(value, float):
+        value = round(value, 6)
+    return value, raw.hex()
+
+
+def _pdo(var: Any) -> str:
+    names = [n for n, bit in (("RxPDO", 1), ("TxPDO", 2)) if int(var.pdo) & bit]
+    return ",".join(names) or "-"
+
+
+def entries(bus: Bus, position: int, *, values: bool = True, grep: str | None = None) -> list:
+    rows = []
+    od = bus.od(position)
+    for obj in od:
+        for k in sorted(obj.subs):
+            var = obj.subs[k]
+            name = var.name if var.name == obj.name or k == 0 else f"{obj.name}: {var.name}"
+            if grep and grep.casefold() not in name.casefold():
+                continue
+            value, raw = _value(var) if values else (None, None)
+            rows.append(
+                {
+                    "position": position,
+                    "index": var.index,
+                    "subindex": var.subindex,
+                    "name": name,
+                    "type": var.data_type.name,
+                    "bits": var.bit_length,
+                    "access": var.access.name,
+                    "pdo": _pdo(var),
+                    "value": value,
+                    "hex": raw,
+                }
+            )
+    return rows
+
+
+def _shown(row: dict[str, Any]) -> str:
+    v, raw = row["value"], row["hex"]
+    if v is None:
+        return "-"
+    if isinstance(v, int) and raw is not None and row["type"] not in ("BOOL",):
+        return f"{v} (0x{bytes.fromhex(raw)[::-1].hex().upper()})"
+    if row["type"] == "VISIBLE_STRING":
+        return repr(v)
+    return str(v)
+
+
+def run(args: argparse.Namespace) -> int:
+    rows = []
+    with Bus(args) as bus:
+        for pos in bus.positions():
+            try:
+                rows += entries(bus, pos, values=not args.no_values, grep=args.grep)
+            except BusError:
+                if args.position is not None:
+                    raise
+                continue  # an IO terminal without CoE: nothing to list
+    if args.json:
+        output.print_json(rows)
+        return 0
+    columns: list[output.Column] = [
+        ("position", "pos"),
+        ("index", "index:sub"),
+        ("type", "type"),
+        ("access", "access"),
+        ("pdo", "pdo"),
+        ("name", "name"),
+        ("value", "value"),
+    ]
+    shown = [
+        dict(r, index=output.hex_addr(r["index"], r["subindex"]), value=_shown(r)) for r in rows
+    ]
+    output.print_table(shown, columns)
+    return 0
