@@ -32,7 +32,7 @@ from ..controller.profile import PrfMode
 from ..controller.resources import axis_resources
 from ..errors import CommandError, ParameterError
 from ._core import gt_function, store, store_array, struct_arg
-from .crd_structs import TCrdPrm
+from .crd_structs import CRD_FIFO_MAX, CRD_MAX, INTERPOLATION_AXIS_MAX, TCrdPrm
 
 
 def _crd(ctl: Controller, crd: int) -> CoordSystem:
@@ -504,3 +504,6 @@ def GT_InitLookAhead(ctl, crd, fifo, T, accMax, n, pLookAheadBuf=None) -> int:
         raise CommandError(f"GT_InitLookAhead: FIFO {fifo} of coordinate system {crd} is running")
     c.look[int(fifo)] = LookAhead(t, a, int(n))
     return 0
+
+
+__all__ = ["CRD_FIFO_MAX", "CRD_MAX", "INTERPOLATION_AXIS_MAX"]

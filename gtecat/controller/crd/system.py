@@ -30,7 +30,7 @@ Decisions where the manual is silent:
   by ``d`` passes at ``accMax·T/|d|`` and an arc at ``sqrt(accMax·r)``, and the
   path stops at the end of the window.
 * **Override** (GT_SetOverride, 0..2): the path time runs at that ratio (speed ×
-  ratio, acceleration × ratio²).
+  ratio, acceleration × ratio²); a GT_BufDelay still lasts its milliseconds.
 * **Stops**: a stop of any axis of the system (GT_Stop, a limit, the following
   error, a stop input) stops the whole system along its path with GT_SetCrdStopDec's
   smooth or abrupt deceleration (defaults 1 and 1000 pulse/ms², as table 4-4 for a
@@ -361,10 +361,11 @@ class CoordSystem:
                     return
                 self._done_entry(self.t - plan.duration)
                 continue
-            if isinstance(e, Delay):
-                if self.t < e.ms:
+            if isinstance(e, Delay):  # controller time: path time x override
+                span = e.ms * self.override
+                if self.t < span or (span <= 0.0 and self.override <= 0.0):
                     return
-                self._done_entry(self.t - e.ms)
+                self._done_entry(self.t - span)
                 continue
             return
 
