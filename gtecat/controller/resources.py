@@ -415,6 +415,15 @@ class AxisResources:
             out |= _ABRUPT
         return out
 
+    def limit_input(self, positive: bool) -> bool | None:
+        """The level of the positive (negative) limit input as wired - a configuration
+        file's ``reverse`` applied - whether GT_LmtsOn/Off has it on or off; None when the
+        input is none (configuration file index -1).  Smart homing reads it."""
+        acc = self._pos_din if positive else self._neg_din
+        if acc is None:
+            return None
+        return bool(acc.get() & (LIMIT_POSITIVE_BIT if positive else LIMIT_NEGATIVE_BIT))
+
     def drive_faulted(self) -> bool:
         return self.ax.state in (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
 

@@ -19,6 +19,8 @@ _MODULES = (
     "structs",
     "axis_calls",
     "homing_calls",
+    "home_calls",
+    "io_calls",
     "motion_calls",
     "status_calls",
     "mode_calls",

@@ -79,3 +79,7 @@ class TCompileInfo(ctypes.Structure):
 from .crd_structs import TCrdData, TCrdPrm  # noqa: E402 - coordinated motion (issue 19)
 
 __all__ = ["TCompileInfo", "TCrdData", "TCrdPrm", "TJogPrm", "TThreadSts", "TTrapPrm", "TVarInfo"]
+
+from .home_structs import THomePrm, THomeStatus  # noqa: E402 - smart home (issue 14)
+
+__all__ += ["THomePrm", "THomeStatus"]

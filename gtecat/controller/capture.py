@@ -1,0 +1,337 @@
+"""Position capture of one encoder (GT_SetCaptureMode & co.): home, index (Z) and probe edges.
+
+One :class:`CaptureUnit` per encoder (encoder N = axis N).  Every cycle, after the axis
+has read its inputs and sampled its encoder, the unit collects the edges its inputs made
+during the cycle (:attr:`CaptureUnit.edges`: which signal, became active or inactive, the
+encoder value at the edge) and, while a capture mode is armed, latches the first edge
+that matches it: ``GT_GetCaptureStatus`` then reports status 1 and that value until
+``GT_ClearCaptureStatus`` (which re-arms the same mode) or a new ``GT_SetCaptureMode``.
+Smart homing (:mod:`gtecat.controller.smart_home`) uses the same units and the same edges.
+
+Where the edges come from, and how exact they are:
+
+* **On a GTS card** (:mod:`gtecat.master.card`) the card's latch hardware sees the home
+  input, the index pulse and the probe input (probe 1 of the machine description) together
+  with the encoder: the card backend reports each edge with the fraction ``f`` of the
+  cycle at which the mechanics crossed it, and the captured value is the encoder value
+  at that instant, ``enc_now - (1 - f) * step`` (``step`` = the encoder's change during
+  the cycle).  The motor moves linearly within a cycle, so this is the encoder count at
+  the switch edge: within 1 count (the encoder reads whole counts).
+* **On an EtherCAT axis** the controller sees what the drive sends.  The home switch is
+  60FDh bit 2, sampled once per cycle: an edge lies somewhere in the cycle's travel,
+  and the unit reports the middle of it, ``enc_now - step / 2`` - within half a cycle's
+  travel (``|v| * T / 2``: 25 counts at 50 pulse/ms and 1 ms).  The index and the probe
+  input are latched by the drive's touch probe 1 (60B8h source "zero impulse" for the
+  index, "probe input" for the probe; continuous mode, new values told by the 60B9h
+  toggle bits 6/7, values 60BAh/60BBh): exact to the count like the card.  The touch
+  probe objects are used as PDO when mapped, else by SDO (read every cycle while the
+  capture is armed: fine on the emulated bus; on a real bus map 60B8h/60B9h/60BAh).  A
+  drive without touch probe makes ``GT_SetCaptureMode(..., CAPTURE_INDEX)`` return 1.
+  Arming the touch probe takes two cycles (60B8h off, then on).  An application's own
+  ``GT_SetTouchProbeFunction`` and an armed capture share probe 1: the last writer wins.
+
+Edge senses (``GT_SetCaptureSense(encoder, mode, sense)``, THomePrm ``edge``): the
+vendor's 0 = falling edge, 1 = rising edge, of the card's terminal.  The card's inputs are
+active low (a triggered sensor pulls the line low), so **0 captures where the input
+becomes active** (the switch is reached) and **1 where it becomes inactive** (the switch
+is left); 0 is the reset state, as a vendor configuration file writes it
+(``captureHomeSense=0``).  An index pulse has no width: both senses capture it.  A
+``[homeN] reverse=1`` of the configuration file swaps active and inactive of the home
+input (a normally-closed sensor).
+
+Values are in encoder units (``GT_GetEncPos``), rounded to the ``long`` the API returns.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from drives.abort import SdoAbort
+from eni.errors import GtecatError
+
+from ..errors import CommandError, ParameterError
+from .axis import Axis
+
+if TYPE_CHECKING:
+    from .resources import AxisResources
+
+CAPTURE_NONE = 0
+CAPTURE_HOME = 1
+CAPTURE_INDEX = 2
+CAPTURE_PROBE = 3
+MODES = (CAPTURE_NONE, CAPTURE_HOME, CAPTURE_INDEX, CAPTURE_PROBE)
+MODE_NAMES = {CAPTURE_HOME: "home", CAPTURE_INDEX: "index", CAPTURE_PROBE: "probe"}
+_SIGNALS = {"home": CAPTURE_HOME, "index": CAPTURE_INDEX, "probe": CAPTURE_PROBE}
+
+_HOME_BIT = 1 << 2  # 60FDh bit 2
+# 60B8h probe 1: enable | continuous | source (bits 3:2) | rising (4) | falling (5)
+_TP_INDEX = 0x0001 | 0x0002 | 0x0004 | 0x0010
+_TP_PROBE = 0x0001 | 0x0002 | 0x0010 | 0x0020
+_TOGGLE_RISE, _TOGGLE_FALL = 1 << 6, 1 << 7
+
+
+@dataclass(frozen=True, slots=True)
+class SeenEdge:
+    """One edge an input of the encoder made in the last cycle."""
+
+    signal: int  #: CAPTURE_HOME / CAPTURE_INDEX / CAPTURE_PROBE
+    active: bool  #: the input became active (the switch was reached)
+    pos: float  #: encoder value at the edge
+    exact: bool  #: latched by hardware (card, touch probe), not estimated from samples
+
+
+def _wrap32(d: int) -> int:
+    return (d + 0x8000_0000) % 0x1_0000_0000 - 0x8000_0000
+
+
+class CaptureUnit:
+    """The capture of encoder ``number`` (the module docstring says what it sees)."""
+
+    def __init__(self, ctl: Any, res: AxisResources) -> None:
+        self.ctl = ctl
+        self.res = res
+        self.number = res.number
+        self.ax: Axis = res.ax
+        io = self.ax.io
+        self._din = io.get(0x60FD)
+        self._act = io.get(0x6064)
+        card = getattr(ctl, "card", None)
+        self._card_edges: dict[int, list] | None = card.backend.edges if card else None
+        self.home_reverse = False
+        # touch probe (EtherCAT axes): the 60B8h value wanted, what was written, phase
+        self._tp_want = 0
+        self._tp_sent = 0
+        self._tp_pending = False
+        self._tp_seen = 0
+        self._tp_error = ""
+        self.reset_settings()
+        self.edges: list[SeenEdge] = []
+        self.step = 0.0
+        self._home_prev = self.home_level()
+        self.ax.post_hooks.append(self._post)
+
+    # --- settings --------------------------------------------------------------------------
+    def reset_settings(self) -> None:
+        """GT_Reset: no capture, status 0, every sense 0 (falling edge: switch reached)."""
+        self.mode = CAPTURE_NONE
+        self.status = 0
+        self.value = 0
+        self.pos = 0.0
+        self.sense = {CAPTURE_HOME: 0, CAPTURE_INDEX: 0, CAPTURE_PROBE: 0}
+        self._edge: int | None = None
+        self._accept: Callable[[float], bool] | None = None
+        if self._tp_want or self._tp_sent:
+            try:
+                self._want_probe(0)
+            except CommandError:
+                pass  # the drive is gone: nothing to switch off
+
+    def refresh_wiring(self) -> None:
+        """Take ``[homeN] reverse`` from the configuration file loaded last."""
+        from .config_file import vendor_settings
+
+        home = vendor_settings(self.ctl).get(("home", self.number), {})
+        reverse = bool(home.get("reverse", False))
+        if reverse != self.home_reverse:
+            self.home_reverse = reverse
+            self._home_prev = self.home_level()
+
+    @property
+    def on_card(self) -> bool:
+        return self._card_edges is not None
+
+    def available(self, mode: int) -> str:
+        """Why ``mode`` cannot be captured here ("" when it can)."""
+        if mode == CAPTURE_HOME and self._din is None:
+            return (
+                f"encoder {self.number}: the home input 60FDh is not mapped as PDO on axis "
+                f"{self.number}; map it in the ENI"
+            )
+        if mode in (CAPTURE_INDEX, CAPTURE_PROBE) and not self.on_card:
+            if self._act is None:
+                return f"encoder {self.number}: 6064h is not mapped; no position to capture"
+            if self._tp_error:
+                return self._tp_error
+        return ""
+
+    def arm(
+        self,
+        mode: int,
+        edge: int | None = None,
+        accept: Callable[[float], bool] | None = None,
+    ) -> None:
+        """GT_SetCaptureMode: wait for the next ``mode`` edge (status 0).
+
+        ``edge`` overrides the mode's sense (THomePrm ``edge``); ``accept`` filters the
+        captured position (smart homing: an index beyond the home).  CommandError when
+        the axis cannot capture ``mode`` (the touch probe of an EtherCAT drive is armed
+        at once, so a drive without one fails here)."""
+        if mode not in MODES:
+            raise ParameterError(
+                f"mode={mode}: capture modes are 0 none, 1 CAPTURE_HOME, 2 CAPTURE_INDEX, "
+                "3 CAPTURE_PROBE"
+            )
+        why = self.available(mode)
+        if why:
+            raise CommandError(why)
+        self.refresh_wiring()
+        self.mode = mode
+        self.status = 0
+        self._edge = edge
+        self._accept = accept
+        if not self.on_card:
+            self._want_probe(
+                _TP_INDEX if mode == CAPTURE_INDEX else _TP_PROBE if mode == CAPTURE_PROBE else 0
+            )
+
+    def clear(self) -> None:
+        """GT_ClearCaptureStatus: status 0, the mode armed again."""
+        self.status = 0
+
+    def set_sense(self, mode: int, sense: int) -> None:
+        if mode not in MODE_NAMES:
+            raise ParameterError(f"mode={mode}: 1 CAPTURE_HOME, 2 CAPTURE_INDEX or 3 CAPTURE_PROBE")
+        if sense not in (0, 1):
+            raise ParameterError(f"sense={sense}: 0 (falling edge) or 1 (rising edge)")
+        self.sense[mode] = sense
+
+    # --- levels -----------------------------------------------------------------------------
+    def home_level(self) -> bool:
+        """The home input is active now (sampled 60FDh bit 2, ``reverse`` applied)."""
+        if self._din is None:
+            return False
+        return bool(self._din.get() & _HOME_BIT) != self.home_reverse
+
+    @property
+    def enc(self) -> float:
+        """The encoder value of this cycle."""
+        return self.res.encoder.pos
+
+    # --- the cycle ---------------------------------------------------------------------------
+    def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
+        enc = self.res.encoder
+        step = enc.vel * self.res.cycle_ms if enc.active else 0.0
+        self.step = step
+        now = enc.pos
+        out: list[SeenEdge] = []
+        card = self._card_edges
+        if card is not None:
+            rev = self.home_reverse
+            for e in card.get(self.number, ()):
+                signal = _SIGNALS[e.signal]
+                active = e.rising != rev if signal == CAPTURE_HOME else e.rising
+                out.append(SeenEdge(signal, active, now - (1.0 - e.fraction) * step, True))
+            self._home_prev = self.home_level()
+        else:
+            level = self.home_level()
+            if level != self._home_prev:
+                self._home_prev = level
+                out.append(SeenEdge(CAPTURE_HOME, level, now - 0.5 * step, False))
+            if self._tp_want or self._tp_sent:
+                self._touch_probe(out, now)
+        self.edges = out
+        if out and self.mode and not self.status:
+            self._latch(out)
+
+    def _latch(self, edges: list[SeenEdge]) -> None:
+        mode = self.mode
+        sense = self._edge if self._edge is not None else self.sense[mode]
+        want_active = sense == 0
+        for e in edges:
+            if e.signal != mode:
+                continue
+            if mode != CAPTURE_INDEX and e.active != want_active:
+                continue
+            if self._accept is not None and not self._accept(e.pos):
+                continue
+            self.status = 1
+            self.pos = e.pos
+            self.value = round(e.pos)
+            return
+
+    # --- touch probe 1 of an EtherCAT drive ------------------------------------------------------
+    def _want_probe(self, function: int) -> None:
+        if function == self._tp_want and not self._tp_pending:
+            return
+        self._tp_want = function
+        try:
+            self._write_tp(0)  # off first: the drive arms on the enable edge
+            self._tp_pending = function != 0
+        except (SdoAbort, GtecatError) as e:
+            self._tp_want = 0
+            self._tp_error = (
+                f"encoder {self.number}: the drive's touch probe (60B8h) cannot be used: {e}"
+            )
+            raise CommandError(self._tp_error) from None
+
+    def _write_tp(self, value: int) -> None:
+        self.ax.io.write_or_sdo(0x60B8, 0, value, 2)
+        self._tp_sent = value
+
+    def _touch_probe(self, out: list[SeenEdge], now: float) -> None:
+        io = self.ax.io
+        try:
+            if self._tp_pending:
+                self._write_tp(self._tp_want)
+                self._tp_pending = False
+                self._tp_seen = io.read_or_sdo(0x60B9, 0, 2)
+                return
+            if not self._tp_sent:
+                return
+            status = io.read_or_sdo(0x60B9, 0, 2)
+            changed = (status ^ self._tp_seen) & (_TOGGLE_RISE | _TOGGLE_FALL)
+            self._tp_seen = status
+            if not changed:
+                return
+            raw_now = self._act.get() if self._act is not None else 0
+            unit = self.res.unit * self.res.encoder.sense
+            signal = CAPTURE_INDEX if self._tp_want == _TP_INDEX else CAPTURE_PROBE
+            for bit, index, active in ((_TOGGLE_RISE, 0x60BA, True), (_TOGGLE_FALL, 0x60BB, False)):
+                if changed & bit:
+                    latched = io.read_or_sdo(index, 0, 4, signed=True)
+                    pos = now + unit * _wrap32(latched - raw_now)
+                    out.append(SeenEdge(signal, active, pos, True))
+        except (SdoAbort, GtecatError) as e:  # never let a field error escape the cycle
+            self._tp_error = f"encoder {self.number}: touch probe read failed: {e}"
+            self._tp_want = self._tp_sent = 0
+            self._tp_pending = False
+
+
+# --- the controller side -------------------------------------------------------------------------
+_UNITS: weakref.WeakKeyDictionary[Any, CaptureUnit] = weakref.WeakKeyDictionary()
+_HOOKED: weakref.WeakSet[Any] = weakref.WeakSet()
+
+
+def capture_unit(ctl: Any, encoder: int) -> CaptureUnit:
+    """The capture of ``encoder`` (= axis), made on first use; 7 when there is no such axis."""
+    from .resources import axis_resources
+
+    res = axis_resources(ctl, encoder)
+    unit = _UNITS.get(res)
+    if unit is None:
+        unit = _UNITS[res] = CaptureUnit(ctl, res)
+    if ctl not in _HOOKED:
+        _HOOKED.add(ctl)
+        ctl.on_reset.append(_reset_units)
+    return unit
+
+
+def _reset_units(ctl: Any) -> None:
+    for ax in ctl.axes.values():
+        unit = _UNITS.get(ax.motion) if ax.motion is not None else None
+        if unit is not None:
+            unit.reset_settings()
+
+
+__all__ = [
+    "CAPTURE_HOME",
+    "CAPTURE_INDEX",
+    "CAPTURE_NONE",
+    "CAPTURE_PROBE",
+    "CaptureUnit",
+    "SeenEdge",
+    "capture_unit",
+]

@@ -1,0 +1,769 @@
+"""Smart homing (GT_GoHome): the controller's own search for the home of an axis.
+
+Not the drive's homing (6098h methods, :mod:`drives.homing`): here the controller moves
+the axis in Trap mode, watches its limit inputs and captures home / index edges with its
+own capture (:mod:`gtecat.controller.capture`), on any axis - a GTS card's pulse axis or an
+EtherCAT drive in CSP.  The facts are the vendor header's (``THomePrm``, ``THomeStatus``,
+``HOME_MODE_*``, ``HOME_STAGE_*``, ``HOME_ERROR_*``: ``../shared/reference/gts-header-facts.md``
+"Smart home"); what each mode does is seed 002's description of the GTS manual.  Units are
+the Trap mode's: pulse, pulse/ms, pulse/ms².
+
+Every move is a Trap move of the axis's profile with ``acc``, ``dec`` and ``smoothTime`` of
+THomePrm; searches run at ``velHigh`` ("Home 搜索速度"), the final approach at ``velLow``
+("Index 搜索速度").  ``d`` is ``moveDir``; a search distance of 0 is 805306367 pulses (the
+vendor header: "0 表示搜索距离为 805306367"), i.e. unlimited.  Every search ends standing:
+once its event is seen the axis stops with ``dec`` (a limit stops it abruptly through the
+limit check as usual), so what it captured lies behind it.
+
+Modes (stages in brackets):
+
+* **10 limit**: fast in ``d`` to the limit [10], stop [11]; back by ``escapeStep`` (again
+  while the limit is still active) [13]; slowly in ``d`` until the limit triggers again
+  [15]: that position is the capture; stop [16].
+* **11 limit + home**: limit [10, 11]; then the home search in ``-d`` from the limit [20].
+* **12 limit + index**: limit [10, 11]; then slowly in ``indexDir`` (which must differ
+  from ``moveDir``) to the first index pulse [30].
+* **13 limit + home + index**: limit [10, 11], home in ``-d`` [20], back to the captured
+  home [25], then slowly in ``indexDir`` to the first index pulse beyond the home [30].
+* **20 home**: the home search in ``d`` [20].
+* **22 home + index**: home [20], back to it [25], first index beyond it in ``indexDir`` [30].
+* **30 index**: fast in ``d`` to the first index pulse [30] (seed 002: "fast with capture
+  armed until the index pulse"); a limit on the way turns the search round once.
+* **40 forced home**: the trigger - GPI ``triggerIndex`` (1..16), or the axis's home input
+  when -1 - is sampled by the controller instead of latched: fast in ``d`` until it is
+  active [40] (a limit first turns the search round once, as in mode 20), stop, slowly
+  back in ``-d`` until it is inactive again [45]: the middle of that cycle's travel is the
+  capture (within ``velLow * T / 2``).
+* **41 forced home + index**: 40, back to the capture, then the first index beyond it in
+  ``indexDir`` [30].
+
+Then **go home** [80]: to ``targetPos = capturePos + homeOffset`` at ``velLow``; the axis
+stands there in Trap mode [100, run 0].  Positions are not zeroed (``GT_ZeroPos`` after,
+as seed 002 does).  ``capturePos`` is the encoder value of the capture (of the trigger's
+encoder); the target is a profile position: profile and encoder are taken to count the
+same pulses (GT_ZeroPos makes them agree; GT_ProfileScale/GT_EncScale 1:1).
+
+**The home search** [20] (modes 11, 13, 20, 22) moves fast in its direction with the home
+capture armed for ``edge`` (0: where the switch is reached, 1: where it is left; the
+capture module says why).  Starting *on* the switch with ``edge`` 0 it first leaves the
+switch backwards [1], so it always captures the same physical edge.  In modes 20/22 a
+limit reached before the home turns the search round: back over the whole switch, stop,
+and search again in ``d`` [20 throughout], so the capture is the same edge from either
+side of the switch; a second limit, or no home within ``searchHomeDistance``, is
+``HOME_ERROR_NO_HOME``.  In modes 11/13 the search starts from a limit and the other limit
+ends it with that error.  ``triggerIndex`` -1 = this axis's home input and encoder;
+``k`` = those of axis ``k`` (modes 11..30).
+
+**The index search** [30] arms the index capture (``searchIndexDistance``); an index found
+"beyond the home" must lie past the captured home in ``indexDir`` (found from the home
+position, not from where the axis stopped after the home).  No index within the distance
+(or a limit first) is ``HOME_ERROR_NO_INDEX``; an axis that cannot capture the index (an
+EtherCAT drive without touch probe) ``HOME_ERROR_SET_CAPTURE_INDEX`` at GT_GoHome.
+
+**Limits.**  A limit the search reaches latches GT_GetSts bit 5/6 as any limit does and
+stops the axis abruptly (with GT_LmtsOff the search sees the input anyway and stops with
+``dec``).  A search that starts on the limit it looks for has reached it at once (the limit
+modes go on with the escape, the home and index searches turn).  Before every move toward
+one side the search clears that side's limit flag if its cause is gone (the axis left the
+switch), whoever raised it, and at the end the flags it raised itself, as seed 002's
+``GT_ClrSts`` in its polling loop would; other latched flags (alarm, following error, stop
+inputs) refuse the search with ``HOME_ERROR_STOP`` / ``_ALARM``, as they refuse GT_Update
+(the vendor's demo calls GT_ClrSts first: "无清除状态会导致回零失败").  A limit mode on an
+axis whose limit input in ``moveDir`` is *none* (a configuration file's index -1) is
+refused with ``HOME_ERROR_HOME_MODE``: it could never end.
+
+**Errors** end the homing (the axis is stopped with ``dec``; ``run`` drops once it stands;
+``stage`` stays where it failed): 1 not in Trap mode, 2 servo off (at the start or on the
+way), 3 drive alarm, 4 stopped by someone else (GT_Stop, a stop input, the following
+error) or a search refused by a latched flag, 5 another motion command or a limit where
+none belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input
+to capture, 8 no home (or no limit in mode 10) within the distance, 9 the index cannot be
+captured, 10 no index.  GT_GoHome returns 1 with the reason when it refuses to start (the
+status says the same); 7 for a parameter out of range.
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from collections.abc import Callable, Generator
+from dataclasses import dataclass, fields, replace
+from enum import IntEnum
+from typing import Any
+
+from ..errors import CommandError, ParameterError
+from .axis_status import AxisStatus
+from .capture import CAPTURE_HOME, CAPTURE_INDEX, CaptureUnit, capture_unit
+from .digital_io import GPIO_COUNT, digital_io
+from .motion import StopKind, TrapParams
+from .motion.trap import SMOOTH_TIME_MAX
+from .profile import PrfMode
+from .resources import AxisResources, axis_resources
+
+
+class HomeMode(IntEnum):
+    LIMIT = 10
+    LIMIT_HOME = 11
+    LIMIT_INDEX = 12
+    LIMIT_HOME_INDEX = 13
+    HOME = 20
+    HOME_INDEX = 22
+    INDEX = 30
+    FORCED_HOME = 40
+    FORCED_HOME_INDEX = 41
+
+
+class Stage(IntEnum):
+    IDLE = 0
+    START = 1
+    SEARCH_LIMIT = 10
+    SEARCH_LIMIT_STOP = 11
+    SEARCH_LIMIT_ESCAPE = 13
+    SEARCH_LIMIT_RETURN = 15
+    SEARCH_LIMIT_RETURN_STOP = 16
+    SEARCH_HOME = 20
+    SEARCH_HOME_RETURN = 25
+    SEARCH_INDEX = 30
+    SEARCH_GPI = 40
+    SEARCH_GPI_RETURN = 45
+    GO_HOME = 80
+    END = 100
+
+
+class HomeError(IntEnum):
+    NONE = 0
+    NOT_TRAP_MODE = 1
+    DISABLE = 2
+    ALARM = 3
+    STOP = 4
+    STAGE = 5
+    HOME_MODE = 6
+    SET_CAPTURE_HOME = 7
+    NO_HOME = 8
+    SET_CAPTURE_INDEX = 9
+    NO_INDEX = 10
+
+
+#: what a search distance of 0 means (the vendor header)
+UNLIMITED = 805306367
+#: escape steps tried before the limit counts as stuck
+MAX_ESCAPES = 100
+LIMIT_MODES = (HomeMode.LIMIT, HomeMode.LIMIT_HOME, HomeMode.LIMIT_INDEX, HomeMode.LIMIT_HOME_INDEX)
+HOME_MODES = (HomeMode.LIMIT_HOME, HomeMode.LIMIT_HOME_INDEX, HomeMode.HOME, HomeMode.HOME_INDEX)
+INDEX_MODES = (
+    HomeMode.LIMIT_INDEX,
+    HomeMode.LIMIT_HOME_INDEX,
+    HomeMode.HOME_INDEX,
+    HomeMode.INDEX,
+    HomeMode.FORCED_HOME_INDEX,
+)
+FORCED_MODES = (HomeMode.FORCED_HOME, HomeMode.FORCED_HOME_INDEX)
+_LONG = (-(1 << 31), (1 << 31) - 1)
+_POS, _NEG = int(AxisStatus.POSITIVE_LIMIT), int(AxisStatus.NEGATIVE_LIMIT)
+_ALARM = int(AxisStatus.ALARM)
+
+
+@dataclass(frozen=True, slots=True)
+class HomeParams:
+    """THomePrm as plain data (field names of the header, in its order); the defaults
+    are what GT_GetHomePrm reports after GT_Reset (the header leaves them open)."""
+
+    mode: int = HomeMode.HOME
+    moveDir: int = 1  # noqa: N815 - the header's names
+    indexDir: int = 1  # noqa: N815
+    edge: int = 0
+    triggerIndex: int = -1  # noqa: N815
+    velHigh: float = 10.0  # noqa: N815
+    velLow: float = 1.0  # noqa: N815
+    acc: float = 1.0
+    dec: float = 1.0
+    smoothTime: int = 0  # noqa: N815
+    homeOffset: int = 0  # noqa: N815
+    searchHomeDistance: int = 0  # noqa: N815
+    searchIndexDistance: int = 0  # noqa: N815
+    escapeStep: int = 1000  # noqa: N815
+
+    def check(self, axes: int) -> None:
+        """ParameterError (GT_GoHome 7) naming the first field out of range; the mode is
+        checked by :meth:`SmartHome.start` (HOME_ERROR_HOME_MODE)."""
+        if self.moveDir not in (-1, 1):
+            raise ParameterError(f"moveDir={self.moveDir}: -1 (negative) or 1 (positive)")
+        if self.indexDir not in (-1, 1):
+            raise ParameterError(f"indexDir={self.indexDir}: -1 (negative) or 1 (positive)")
+        if self.edge not in (0, 1):
+            raise ParameterError(f"edge={self.edge}: 0 (falling edge) or 1 (rising edge)")
+        if self.mode in FORCED_MODES:
+            if self.triggerIndex != -1 and not 1 <= self.triggerIndex <= GPIO_COUNT:
+                raise ParameterError(
+                    f"triggerIndex={self.triggerIndex}: -1 (the axis's home input) or a GPI "
+                    f"1..{GPIO_COUNT} in the forced-home modes"
+                )
+        elif self.triggerIndex != -1 and not 1 <= self.triggerIndex <= axes:
+            raise ParameterError(
+                f"triggerIndex={self.triggerIndex}: -1 (this axis) or an encoder 1..{axes}"
+            )
+        for name in ("velHigh", "velLow", "acc"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0.0):
+                raise ParameterError(f"{name}={v!r} must be > 0")
+        if not (math.isfinite(self.dec) and self.dec >= 0.0):
+            raise ParameterError(f"dec={self.dec!r} must be >= 0 (0: the same as acc)")
+        if not 0 <= self.smoothTime <= SMOOTH_TIME_MAX:
+            raise ParameterError(f"smoothTime={self.smoothTime}: 0..{SMOOTH_TIME_MAX} ms")
+        for name in ("searchHomeDistance", "searchIndexDistance"):
+            if getattr(self, name) < 0:
+                raise ParameterError(f"{name}={getattr(self, name)} must be >= 0 (0: unlimited)")
+        if self.mode == HomeMode.LIMIT and self.escapeStep <= 0:
+            raise ParameterError(f"escapeStep={self.escapeStep}: the limit mode needs it > 0")
+        if self.mode == HomeMode.LIMIT_INDEX and self.indexDir == self.moveDir:
+            raise ParameterError(
+                "indexDir must differ from moveDir in the limit + index mode (the index is "
+                "searched away from the limit)"
+            )
+
+    def trap(self) -> TrapParams:
+        return TrapParams(self.acc, self.dec, 0.0, int(self.smoothTime))
+
+
+@dataclass(slots=True)
+class HomeStatus:
+    """THomeStatus as plain data."""
+
+    run: int = 0
+    stage: int = Stage.IDLE
+    error: int = HomeError.NONE
+    capturePos: int = 0  # noqa: N815
+    targetPos: int = 0  # noqa: N815
+
+
+class HomeRefused(CommandError):
+    """GT_GoHome cannot start (return 1); ``error`` is what THomeStatus reports."""
+
+    def __init__(self, error: HomeError, reason: str) -> None:
+        super().__init__(reason)
+        self.error = error
+
+
+class _Abort(Exception):
+    def __init__(self, error: HomeError, reason: str) -> None:
+        super().__init__(reason)
+        self.error = error
+
+
+_Steps = Generator[None, None, Any]
+
+
+class SmartHome:
+    """The smart homing of one axis (module docstring)."""
+
+    def __init__(self, ctl: Any, res: AxisResources) -> None:
+        self.ctl = ctl
+        self.res = res
+        self.number = res.number
+        self.unit = capture_unit(ctl, res.number)  # the axis's own encoder and capture
+        self.reset()
+
+    def reset(self) -> None:
+        """GT_Reset: default parameters, status idle, no homing."""
+        self.params = HomeParams()
+        self.status = HomeStatus()
+        self.reason = ""
+        self._gen: _Steps | None = None
+        self._failing = False
+        self._before = 0
+        self._raised = 0
+        self._expect: int | None = None
+
+    @property
+    def running(self) -> bool:
+        return self._gen is not None
+
+    # --- GT_GoHome ------------------------------------------------------------------------------
+    def start(self, prm: HomeParams) -> None:
+        """Start homing with ``prm`` (already range-checked); HomeRefused when it cannot."""
+        if self.running:
+            raise CommandError(
+                f"axis {self.number} is homing (stage {self.status.stage}); wait until "
+                "GT_GetHomeStatus reports run 0 (or GT_Stop it)"
+            )
+        prm.check(len(self.ctl.axes))
+        res = self.res
+        if res.moving:
+            raise CommandError(f"axis {self.number} is moving: GT_Stop it first")
+        self.params = prm
+        st = self.status = HomeStatus()
+        try:
+            mode = HomeMode(prm.mode)
+        except ValueError:
+            self._refuse(
+                HomeError.HOME_MODE,
+                f"mode={prm.mode} is no smart-home mode (10, 11, 12, 13, 20, 22, 30, 40, 41)",
+            )
+        if res.profile.mode != PrfMode.TRAP:
+            self._refuse(
+                HomeError.NOT_TRAP_MODE,
+                f"axis {self.number} is in {res.profile.mode.name.capitalize()} mode; call "
+                "GT_PrfTrap first",
+            )
+        if not res.ax.servo_on:
+            self._refuse(HomeError.DISABLE, f"axis {self.number} is off; call GT_AxisOn first")
+        if res.latched & _ALARM:
+            self._refuse(HomeError.ALARM, f"axis {self.number} has its alarm flag set (bit 1)")
+        if mode in LIMIT_MODES and res.limit_input(prm.moveDir > 0) is None:
+            side = "positive" if prm.moveDir > 0 else "negative"
+            self._refuse(
+                HomeError.HOME_MODE,
+                f"mode {int(mode)} searches the {side} limit, and axis {self.number} has no "
+                f"{side} limit input (configuration file index -1)",
+            )
+        trigger = self._trigger_unit(prm, mode)
+        if mode in HOME_MODES or (mode in FORCED_MODES and prm.triggerIndex == -1):
+            why = trigger.available(CAPTURE_HOME)
+            if why:
+                self._refuse(HomeError.SET_CAPTURE_HOME, why)
+        if mode in INDEX_MODES:
+            try:  # an EtherCAT drive's touch probe answers now or never
+                trigger.arm(CAPTURE_INDEX)
+                trigger.arm(0)
+            except CommandError as e:
+                self._refuse(HomeError.SET_CAPTURE_INDEX, str(e))
+        self._trigger = trigger
+        self._mode = mode
+        self._trap = prm.trap()
+        self._before = res.latched
+        self._raised = 0
+        self._failing = False
+        self._expect = None
+        self.reason = ""
+        st.run, st.stage = 1, Stage.START
+        self._gen = self._run()
+        _register(self.ctl, self)
+
+    def _refuse(self, error: HomeError, reason: str) -> None:
+        self.status = HomeStatus(0, Stage.IDLE, error)
+        self.reason = reason
+        raise HomeRefused(error, f"GT_GoHome on axis {self.number}: {reason}")
+
+    def _trigger_unit(self, prm: HomeParams, mode: HomeMode) -> CaptureUnit:
+        if mode in FORCED_MODES or prm.triggerIndex == -1:
+            return self.unit
+        return capture_unit(self.ctl, prm.triggerIndex)
+
+    # --- the cycle ----------------------------------------------------------------------------
+    def cycle(self) -> None:
+        """After every cycle (all axes have read their inputs)."""
+        if self._gen is None:
+            return
+        res = self.res
+        if self._failing:
+            if res.profile.planner.done or not res.ax.servo_on:
+                self._gen = None
+                self.status.run = 0
+            return
+        self._raised |= res.latched & (_POS | _NEG) & ~self._before
+        error = self._watch()
+        if error is not None:
+            self._fail(*error)
+            return
+        try:
+            next(self._gen)
+        except StopIteration:
+            self._finish()
+        except _Abort as a:
+            self._fail(a.error, str(a))
+
+    def _watch(self) -> tuple[HomeError, str] | None:
+        res = self.res
+        if not res.ax.servo_on:
+            return HomeError.DISABLE, f"axis {self.number} was switched off"
+        if res.latched & _ALARM:
+            return HomeError.ALARM, f"axis {self.number}: drive alarm (GT_GetSts bit 1)"
+        if res.profile.mode != PrfMode.TRAP:
+            return HomeError.NOT_TRAP_MODE, f"axis {self.number} left Trap mode"
+        return None
+
+    def _fail(self, error: HomeError, reason: str) -> None:
+        self.status.error = int(error)
+        self.reason = reason
+        trap = self.res.profile.trap
+        if self.res.profile.planner is trap and not trap.done and trap.stopping == StopKind.NONE:
+            trap.stop(self._trap.dec)
+        self._failing = True
+        if self.res.profile.planner.done or not self.res.ax.servo_on:
+            self._gen = None
+            self.status.run = 0
+        self.ctl.log(f"Axis {self.number}: smart home error {int(error)}: {reason}")
+
+    def _finish(self) -> None:
+        st = self.status
+        st.stage, st.run = Stage.END, 0
+        self._gen = None
+        self._clear_raised(self._raised)
+        self.res.profile.trap_target = round(self.res.profile.trap.pos)
+
+    # --- the modes ----------------------------------------------------------------------------
+    def _run(self) -> _Steps:
+        p, mode, st = self.params, self._mode, self.status
+        d = p.moveDir
+        if mode in LIMIT_MODES:
+            yield from self._find_limit(d)
+            if mode == HomeMode.LIMIT:
+                cap = yield from self._limit_return(d)
+            elif mode == HomeMode.LIMIT_HOME:
+                cap = yield from self._search_home(-d, turn=False)
+            elif mode == HomeMode.LIMIT_INDEX:
+                cap = yield from self._search_index(p.indexDir, p.velLow)
+            else:
+                home = yield from self._search_home(-d, turn=False)
+                cap = yield from self._index_beyond(home, Stage.SEARCH_HOME_RETURN)
+        elif mode == HomeMode.HOME:
+            cap = yield from self._search_home(d, turn=True)
+        elif mode == HomeMode.HOME_INDEX:
+            home = yield from self._search_home(d, turn=True)
+            cap = yield from self._index_beyond(home, Stage.SEARCH_HOME_RETURN)
+        elif mode == HomeMode.INDEX:
+            cap = yield from self._search_index(d, p.velHigh, turn=True)
+        else:
+            cap = yield from self._search_gpi(d)
+            if mode == HomeMode.FORCED_HOME_INDEX:
+                cap = yield from self._index_beyond(cap, Stage.SEARCH_INDEX)
+        st.capturePos = _long(round(cap))
+        st.targetPos = _long(st.capturePos + p.homeOffset)
+        st.stage = Stage.GO_HOME
+        yield from self._goto(st.targetPos, p.velLow)
+
+    def _find_limit(self, d: int) -> _Steps:
+        p, st = self.params, self.status
+        st.stage = Stage.SEARCH_LIMIT
+        if not self.res.limit_input(d > 0):  # not on it already
+            why, _ = yield from self._leg(d, p.searchHomeDistance or UNLIMITED, p.velHigh)
+            if why != "limit":
+                raise _Abort(
+                    HomeError.NO_HOME, f"no limit within searchHomeDistance={p.searchHomeDistance}"
+                )
+        st.stage = Stage.SEARCH_LIMIT_STOP
+        yield from self._stop()
+
+    def _limit_return(self, d: int) -> _Steps:
+        p, st = self.params, self.status
+        st.stage = Stage.SEARCH_LIMIT_ESCAPE
+        escaped = 0
+        for _ in range(MAX_ESCAPES):
+            why, _ = yield from self._leg(-d, p.escapeStep, p.velHigh)
+            if why != "end":
+                raise _Abort(HomeError.STAGE, "the other limit while escaping from the limit")
+            escaped += p.escapeStep
+            if not self.res.limit_input(d > 0):
+                break
+        else:
+            raise _Abort(
+                HomeError.STAGE,
+                f"still on the limit after {MAX_ESCAPES} x escapeStep={p.escapeStep}",
+            )
+        st.stage = Stage.SEARCH_LIMIT_RETURN
+        why, pos = yield from self._leg(d, escaped + p.escapeStep, p.velLow)
+        if why != "limit":
+            raise _Abort(HomeError.NO_HOME, "the limit did not trigger again on the way back")
+        st.capturePos = _long(round(pos))
+        st.stage = Stage.SEARCH_LIMIT_RETURN_STOP
+        yield from self._stop()
+        return pos
+
+    def _search_home(self, d: int, turn: bool) -> _Steps:
+        p, st, unit = self.params, self.status, self._trigger
+        unit.refresh_wiring()
+        dist = p.searchHomeDistance or UNLIMITED
+        if p.edge == 0 and unit.home_level():
+            st.stage = Stage.START  # on the switch: leave it first, backwards
+            why, _ = yield from self._leg(
+                -d, dist, p.velHigh, lambda: not unit.home_level() or None
+            )
+            if why != "event":
+                raise _Abort(HomeError.NO_HOME, "the axis did not get off the home switch")
+            yield from self._stop()
+        st.stage = Stage.SEARCH_HOME
+        for attempt in (0, 1):
+            self._arm(unit, CAPTURE_HOME, p.edge)
+            why, pos = yield from self._leg(
+                d, dist, p.velHigh, lambda: unit.pos if unit.status else None
+            )
+            if why == "event":
+                st.capturePos = _long(round(pos))
+                yield from self._stop()
+                return pos
+            if why == "limit" and turn and attempt == 0:
+                yield from self._stop()  # the home is behind: back over the whole switch
+                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit))
+                if why != "event":
+                    raise _Abort(HomeError.NO_HOME, "no home switch between the limits")
+                yield from self._stop()
+                continue
+            break
+        where = "a limit came first" if why == "limit" else f"searchHomeDistance={dist}"
+        raise _Abort(HomeError.NO_HOME, f"no home ({where})")
+
+    def _passed(self, unit: CaptureUnit) -> Callable[[], bool | None]:
+        seen = [unit.home_level()]
+
+        def passed() -> bool | None:
+            for e in unit.edges:
+                if e.signal != CAPTURE_HOME:
+                    continue
+                if e.active:
+                    seen[0] = True
+                elif seen[0]:
+                    return True
+            if unit.home_level():
+                seen[0] = True
+            return None
+
+        return passed
+
+    def _search_index(
+        self, d: int, vel: float, after: float | None = None, turn: bool = False
+    ) -> _Steps:
+        p, st, unit = self.params, self.status, self._trigger
+        st.stage = Stage.SEARCH_INDEX
+        dist = p.searchIndexDistance or UNLIMITED
+        for attempt in (0, 1):
+            accept = None if after is None else _beyond(after, d)
+            self._arm(unit, CAPTURE_INDEX, None, accept)
+            if not unit.on_card:
+                yield  # the drive's touch probe arms in two cycles (60B8h off, on)
+                yield
+            why, pos = yield from self._leg(d, dist, vel, lambda: unit.pos if unit.status else None)
+            if why == "event":
+                st.capturePos = _long(round(pos))
+                yield from self._stop()
+                return pos
+            if why == "limit" and turn and attempt == 0:
+                yield from self._stop()
+                d = -d
+                continue
+            break
+        where = "a limit came first" if why == "limit" else f"searchIndexDistance={dist}"
+        raise _Abort(HomeError.NO_INDEX, f"no index pulse ({where})")
+
+    def _index_beyond(self, home: float, stage: Stage) -> _Steps:
+        """Back to the captured home, then the first index beyond it in indexDir."""
+        p = self.params
+        self.status.stage = stage
+        yield from self._goto(round(home), p.velLow)
+        return (yield from self._search_index(p.indexDir, p.velLow, after=home))
+
+    def _search_gpi(self, d: int) -> _Steps:
+        p, st, unit = self.params, self.status, self.unit
+        if p.triggerIndex == -1:
+            unit.refresh_wiring()
+            level: Callable[[], bool] = unit.home_level
+        else:
+            io, k = digital_io(self.ctl), p.triggerIndex
+            level = lambda: io.gpi_level(k)  # noqa: E731
+        dist = p.searchHomeDistance or UNLIMITED
+        st.stage = Stage.SEARCH_GPI
+        for attempt in (0, 1):
+            if level():
+                break
+            why, _ = yield from self._leg(d, dist, p.velHigh, lambda: level() or None)
+            if why == "event":
+                break
+            if why != "limit" or attempt:
+                raise _Abort(HomeError.NO_HOME, "the trigger did not become active")
+            yield from self._stop()  # behind: back over the whole active zone, then again
+            why, _ = yield from self._leg(-d, dist, p.velHigh, _passed_level(level))
+            if why != "event":
+                raise _Abort(HomeError.NO_HOME, "the trigger is not active between the limits")
+            yield from self._stop()
+        yield from self._stop()
+        st.stage = Stage.SEARCH_GPI_RETURN
+
+        def gone() -> float | None:
+            return None if level() else unit.enc - 0.5 * unit.step
+
+        why, pos = yield from self._leg(-d, dist, p.velLow, gone)
+        if why != "event":
+            raise _Abort(HomeError.NO_HOME, "the trigger did not become inactive on the way back")
+        st.capturePos = _long(round(pos))
+        yield from self._stop()
+        return pos
+
+    # --- moves --------------------------------------------------------------------------------
+    def _arm(self, unit: CaptureUnit, mode: int, edge: int | None, accept=None) -> None:
+        try:
+            unit.arm(mode, edge, accept)
+        except CommandError as e:
+            error = (
+                HomeError.SET_CAPTURE_HOME if mode == CAPTURE_HOME else HomeError.SET_CAPTURE_INDEX
+            )
+            raise _Abort(error, str(e)) from None
+
+    def _begin(self, d: int, target: int, vel: float) -> None:
+        """Start a Trap move toward ``target`` (direction ``d``), as GT_Update would."""
+        self._clear_raised(_POS if d > 0 else _NEG)
+        res = self.res
+        try:
+            res.check_motion("GT_GoHome", d)
+        except CommandError as e:
+            if not res.ax.servo_on:
+                raise _Abort(HomeError.DISABLE, str(e)) from None
+            if res.latched & _ALARM:
+                raise _Abort(HomeError.ALARM, str(e)) from None
+            raise _Abort(HomeError.STOP, str(e)) from None
+        trap = res.profile.trap
+        trap.start(trap.pos, target, vel, self._trap, trap.vel)
+        self._expect = target
+
+    def _leg(
+        self, d: int, distance: float, vel: float, watch: Callable[[], Any] | None = None
+    ) -> _Steps:
+        """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
+        position) when the limit in ``d`` is reached, or ("end", None)."""
+        trap = self.res.profile.trap
+        if self.res.limit_input(d > 0):  # standing on that limit already: reached at once
+            return "limit", self.unit.enc
+        self._begin(d, _long(round(trap.pos + d * distance)), vel)
+        bit = _POS if d > 0 else _NEG
+        before = self.res.latched & bit
+        while True:
+            yield
+            if watch is not None:
+                value = watch()
+                if value is not None:
+                    return "event", value
+            if self.res.limit_input(d > 0) or self.res.latched & bit & ~before:
+                return "limit", self.unit.enc - 0.5 * self.unit.step
+            self._check_plan(trap)
+            if trap.done:
+                return "end", None
+
+    def _check_plan(self, trap: Any) -> None:
+        if trap.stopping != StopKind.NONE:
+            raise _Abort(
+                HomeError.STOP,
+                f"axis {self.number} was stopped (GT_Stop, a stop input or the following error)",
+            )
+        if trap.target != self._expect:
+            raise _Abort(HomeError.STAGE, f"another motion command moved axis {self.number}")
+
+    def _stop(self) -> _Steps:
+        """Come to a stand with ``dec`` (Trap re-planned to the stopping point)."""
+        trap = self.res.profile.trap
+        if not trap.done and trap.stopping == StopKind.NONE:
+            v, dec = trap.vel, self._trap.dec
+            reach = v * abs(v) / (2.0 * dec) + v * self._trap.smooth_time / 2.0
+            x = trap.pos + reach
+            target = math.ceil(x) if v > 0 else math.floor(x)
+            trap.update(target=target)
+            self._expect = target
+        while not trap.done:
+            yield
+
+    def _goto(self, target: int, vel: float) -> _Steps:
+        trap = self.res.profile.trap
+        if trap.pos == target:
+            return
+        d = 1 if target > trap.pos else -1
+        self._begin(d, target, vel)
+        bit = _POS if d > 0 else _NEG
+        before = self.res.latched & bit
+        while True:
+            yield
+            if self.res.limit_input(d > 0) or self.res.latched & bit & ~before:
+                raise _Abort(HomeError.STAGE, f"a limit on the way to {target}")
+            self._check_plan(trap)
+            if trap.done:
+                return
+
+    def _clear_raised(self, bits: int) -> None:
+        """Clear the limit flags (of ``bits``) whose cause is gone (module docstring)."""
+        res = self.res
+        flags = res.latched & bits
+        if flags:
+            res.latched &= ~(flags & ~res.causes())
+
+
+def _passed_level(level: Callable[[], bool]) -> Callable[[], bool | None]:
+    """True once a sampled input has been active and is inactive again."""
+    seen = [False]
+
+    def passed() -> bool | None:
+        if level():
+            seen[0] = True
+            return None
+        return True if seen[0] else None
+
+    return passed
+
+
+def _beyond(home: float, d: int) -> Callable[[float], bool]:
+    return lambda x: (x - home) * d > 0.0
+
+
+def _long(v: int) -> int:
+    return max(_LONG[0], min(_LONG[1], int(v)))
+
+
+# --- the controller side ----------------------------------------------------------------------
+_HOMES: weakref.WeakKeyDictionary[AxisResources, SmartHome] = weakref.WeakKeyDictionary()
+_RUNNING: weakref.WeakKeyDictionary[Any, list[SmartHome]] = weakref.WeakKeyDictionary()
+
+
+def smart_home(ctl: Any, axis: int) -> SmartHome:
+    """The smart homing of ``axis`` (made on first use)."""
+    res = axis_resources(ctl, axis)
+    home = _HOMES.get(res)
+    if home is None:
+        home = _HOMES[res] = SmartHome(ctl, res)
+    if ctl not in _RUNNING:
+        _RUNNING[ctl] = []
+        ref = weakref.ref(ctl)
+        ctl.post_cycle.append(lambda t, dt: _cycle(ref()))
+        ctl.on_reset.append(_reset)
+    return home
+
+
+def _register(ctl: Any, home: SmartHome) -> None:
+    running = _RUNNING[ctl]
+    if home not in running:
+        running.append(home)
+
+
+def _cycle(ctl: Any) -> None:
+    if ctl is None:
+        return
+    running = _RUNNING.get(ctl)
+    if not running:
+        return
+    for home in list(running):
+        home.cycle()
+        if not home.running:
+            running.remove(home)
+
+
+def _reset(ctl: Any) -> None:
+    for ax in ctl.axes.values():
+        home = _HOMES.get(ax.motion) if ax.motion is not None else None
+        if home is not None:
+            home.reset()
+    if ctl in _RUNNING:
+        _RUNNING[ctl].clear()
+
+
+def params_from_fields(values: dict[str, Any]) -> HomeParams:
+    """HomeParams from THomePrm's fields (extra fields such as pads are ignored)."""
+    names = {f.name for f in fields(HomeParams)}
+    return replace(HomeParams(), **{k: v for k, v in values.items() if k in names})
+
+
+__all__ = [
+    "UNLIMITED",
+    "HomeError",
+    "HomeMode",
+    "HomeParams",
+    "HomeRefused",
+    "HomeStatus",
+    "SmartHome",
+    "Stage",
+    "params_from_fields",
+    "smart_home",
+]

@@ -1,0 +1,199 @@
+"""GT digital IO of the card: GT_GetDi, GT_GetDiRaw, GT_SetDo, GT_SetDoBit, GT_GetDo, GTE_SetGpi.
+
+The GTS vendor header's IO functions.  ``diType`` / ``doType`` are the ``MC_*`` resource
+types; bit ``i`` of a value is terminal ``i + 1`` (axis ``i + 1`` for the per-axis ones).
+They work on both personalities (a card's axes and EtherCAT axes alike); what each type
+reads or drives:
+
+* ``MC_LIMIT_POSITIVE`` / ``MC_LIMIT_NEGATIVE`` / ``MC_HOME``: 60FDh bits 1 / 0 / 2 of each
+  axis - on a card its terminals, from the machine description.  ``MC_ALARM``: the
+  axis's amplifier (drive) is in fault.  ``MC_ARRIVE``: its in-position output (6041h
+  bit 10).  ``MC_GPI``: the 16 general-purpose inputs (``GTE_SetGpi`` sets them).
+  ``MC_MPG``: 0 (no hand wheel).  An axis that maps no 60FDh reads 0.
+* ``GT_GetDi`` gives the levels with the configuration file's ``reverse`` of that
+  terminal applied (``[limitPositiveN]``, ``[limitNegativeN]``, ``[homeN]``, ``[alarmN]``,
+  ``[gpiN]``), 1 = active; ``GT_GetDiRaw`` the levels as the terminals see them.  The vendor
+  card's terminals are active low; here 1 always means active (triggered).
+* ``MC_ENABLE``: the servo-enable outputs: ``GT_SetDo`` switches each axis on or off as
+  ``GT_AxisOn`` / ``GT_AxisOff`` do (a bit already in that state changes nothing; the
+  first axis that cannot be switched on makes the call return 1 with its reason).
+  ``MC_CLEAR``: the alarm-clear outputs: a rising bit resets that axis's faulted drive
+  (as GT_ClrSts does, without clearing the status flags).  ``MC_GPO``: the 16
+  general-purpose outputs, a register ``GT_GetDo`` reads back.  1 = on.
+* ``GT_SetDoBit(doType, doIndex, value)``: one terminal, ``doIndex`` from 1.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from ..controller.axis import PdsState
+from ..controller.config_file import vendor_settings
+from ..controller.core import Controller
+from ..controller.digital_io import GPIO_COUNT, digital_io
+from ..controller.resources import _fault_reset
+from ..errors import ParameterError
+from ._core import check_range, gt_function, store
+from .axis_calls import axis_off, axis_on
+from .constants import (
+    MC_ALARM,
+    MC_ARRIVE,
+    MC_CLEAR,
+    MC_ENABLE,
+    MC_GPI,
+    MC_GPO,
+    MC_HOME,
+    MC_LIMIT_NEGATIVE,
+    MC_LIMIT_POSITIVE,
+    MC_MPG,
+)
+
+_SW_FAULT = 0x0008
+_SW_TARGET = 0x0400
+#: per-axis inputs: type -> (object, bit, configuration section)
+_AXIS_INPUTS: dict[int, tuple[int, int, str]] = {
+    MC_LIMIT_POSITIVE: (0x60FD, 1 << 1, "limitPositive"),
+    MC_LIMIT_NEGATIVE: (0x60FD, 1 << 0, "limitNegative"),
+    MC_HOME: (0x60FD, 1 << 2, "home"),
+    MC_ALARM: (0x6041, _SW_FAULT, "alarm"),
+    MC_ARRIVE: (0x6041, _SW_TARGET, "arrive"),
+}
+_DI_TYPES = (*_AXIS_INPUTS, MC_GPI, MC_MPG)
+_DO_TYPES = (MC_ENABLE, MC_CLEAR, MC_GPO)
+
+
+def _reversed(ctl: Controller, kind: str) -> Callable[[int], bool]:
+    settings = vendor_settings(ctl)
+    return lambda n: bool(settings.get((kind, n), {}).get("reverse", False))
+
+
+def read_di(ctl: Controller, di_type: int, raw: bool) -> int:
+    t = check_range("diType", di_type, -1, 0x7FFF)
+    if t not in _DI_TYPES:
+        raise ParameterError(
+            f"diType={t}: one of MC_LIMIT_POSITIVE 0, MC_LIMIT_NEGATIVE 1, MC_ALARM 2, "
+            "MC_HOME 3, MC_GPI 4, MC_ARRIVE 5, MC_MPG 6"
+        )
+    if t == MC_MPG:
+        return 0
+    if t == MC_GPI:
+        value = digital_io(ctl).gpi
+        if not raw:
+            rev = _reversed(ctl, "gpi")
+            value ^= sum(1 << (k - 1) for k in range(1, GPIO_COUNT + 1) if rev(k))
+        return value
+    index, mask, kind = _AXIS_INPUTS[t]
+    rev = _reversed(ctl, kind) if not raw else (lambda n: False)
+    value = 0
+    for n, ax in ctl.axes.items():
+        if not 1 <= n <= 32:
+            continue
+        acc = ax.io.get(index)
+        level = bool(acc.get() & mask) if acc is not None else False
+        if level != rev(n):
+            value |= 1 << (n - 1)
+    return value
+
+
+@gt_function
+def GT_GetDi(ctl: Controller, diType: int, pValue: Any) -> int:
+    """The inputs of type ``diType``, 1 = active (the module docstring)."""
+    store(pValue, _signed32(read_di(ctl, diType, raw=False)))
+    return 0
+
+
+@gt_function
+def GT_GetDiRaw(ctl: Controller, diType: int, pValue: Any) -> int:
+    """The inputs of type ``diType`` before the configuration's ``reverse``."""
+    store(pValue, _signed32(read_di(ctl, diType, raw=True)))
+    return 0
+
+
+def _do_type(do_type: int) -> int:
+    t = check_range("doType", do_type, -1, 0x7FFF)
+    if t not in _DO_TYPES:
+        raise ParameterError(f"doType={t}: one of MC_ENABLE 10, MC_CLEAR 11, MC_GPO 12")
+    return t
+
+
+def write_do(ctl: Controller, do_type: int, value: int) -> None:
+    t = _do_type(do_type)
+    v = int(value) & 0xFFFFFFFF
+    io = digital_io(ctl)
+    if t == MC_GPO:
+        io.set_gpo(v)
+        return
+    if t == MC_CLEAR:
+        rising = v & ~io.clear
+        io.clear = v & 0xFFFF
+        faulted = [
+            ax.motion
+            for n, ax in sorted(ctl.axes.items())
+            if 1 <= n <= 32
+            and rising >> (n - 1) & 1
+            and ax.motion is not None
+            and ax.state in (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
+        ]
+        if faulted:
+            _fault_reset(ctl, faulted)
+        return
+    for n, ax in sorted(ctl.axes.items()):  # MC_ENABLE
+        if not 1 <= n <= 32:
+            continue
+        on = bool(v >> (n - 1) & 1)
+        if on and not ax.servo_on:
+            axis_on(ctl, ax)
+        elif not on and ax.servo_on:
+            axis_off(ctl, ax)
+
+
+def read_do(ctl: Controller, do_type: int) -> int:
+    t = _do_type(do_type)
+    io = digital_io(ctl)
+    if t == MC_GPO:
+        return io.gpo
+    if t == MC_CLEAR:
+        return io.clear
+    return sum(1 << (n - 1) for n, ax in ctl.axes.items() if 1 <= n <= 32 and ax.servo_on)
+
+
+@gt_function
+def GT_SetDo(ctl: Controller, doType: int, value: int) -> int:
+    write_do(ctl, doType, value)
+    return 0
+
+
+@gt_function
+def GT_SetDoBit(ctl: Controller, doType: int, doIndex: int, value: int) -> int:
+    """One output, ``doIndex`` from 1 (an axis for MC_ENABLE / MC_CLEAR)."""
+    t = _do_type(doType)
+    top = GPIO_COUNT if t == MC_GPO else 32
+    i = check_range("doIndex", doIndex, 1, top)
+    if t != MC_GPO and i not in ctl.axes:
+        raise ParameterError(f"doIndex={i}: no axis {i} on this controller")
+    bit = 1 << (i - 1)
+    now = read_do(ctl, t)
+    write_do(ctl, t, now | bit if value else now & ~bit)
+    return 0
+
+
+@gt_function
+def GT_GetDo(ctl: Controller, doType: int, pValue: Any) -> int:
+    store(pValue, _signed32(read_do(ctl, doType)))
+    return 0
+
+
+@gt_function
+def GTE_SetGpi(ctl: Controller, gpi: int, value: int) -> int:
+    """Emulator only: general-purpose input ``gpi`` (1..16) becomes active (1) or not (0)."""
+    digital_io(ctl).set_gpi(int(gpi), bool(value))
+    return 0
+
+
+def _signed32(v: int) -> int:
+    v &= 0xFFFFFFFF
+    return v - (1 << 32) if v >= 1 << 31 else v
+
+
+__all__ = ["GTE_SetGpi", "GT_GetDi", "GT_GetDiRaw", "GT_GetDo", "GT_SetDo", "GT_SetDoBit"]
