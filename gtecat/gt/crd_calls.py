@@ -32,6 +32,7 @@ from ..controller.profile import PrfMode
 from ..controller.resources import axis_resources
 from ..errors import CommandError, ParameterError
 from ._core import gt_function, store, store_array, struct_arg
+from .constants import MC_GPO
 from .crd_structs import CRD_FIFO_MAX, CRD_MAX, INTERPOLATION_AXIS_MAX, TCrdPrm
 
 
@@ -357,10 +358,20 @@ def GT_HelixXYCZ(
 # --- buffered operations ----------------------------------------------------------------------
 @gt_function
 def GT_BufIO(ctl, crd, doType, doMask, doValue, fifo=0) -> int:
-    """Set outputs when the path reaches this point (see the crd docstring: recorded)."""
+    """Set the ``doMask`` bits of ``doType`` to ``doValue`` when the path reaches this point
+    (MC_GPO: the general-purpose outputs of GT_SetDo; other types are recorded only)."""
     c = _crd(ctl, crd)
     c.require_prm("GT_BufIO")
-    c.push(BufIO(int(doType), int(doMask), int(doValue)), fifo)
+    t, mask, value = int(doType), int(doMask), int(doValue)
+    apply = None
+    if t == MC_GPO:
+
+        def apply(m: int, v: int) -> None:
+            from .io_calls import read_do, write_do
+
+            write_do(ctl, MC_GPO, (read_do(ctl, MC_GPO) & ~m) | (v & m))
+
+    c.push(BufIO(t, mask, value, apply=apply), fifo)
     return 0
 
 

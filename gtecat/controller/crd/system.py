@@ -39,9 +39,10 @@ Decisions where the manual is silent:
   limit passed in a cycle starts the path stop from that cycle's sample.
 * **Segments counted** by GT_CrdStatus: every FIFO entry finished since GT_CrdStart
   (lines, arcs, BufIO, BufDelay, BufMove alike).
-* **GT_BufIO** records ``(doType, doMask, doValue)`` in :attr:`CoordSystem.outputs`
-  (value per doType) when the path reaches it: the EtherCAT core has no GPO
-  register of its own.  **GT_BufMove** starts a Trap move of an axis outside the
+* **GT_BufIO** records ``(doType, doMask, doValue)`` in :attr:`CoordSystem.io_log`
+  and :attr:`CoordSystem.outputs` (value per doType) when the path reaches it; for
+  ``MC_GPO`` it also sets the masked bits of the general-purpose outputs (what
+  GT_SetDo / GT_GetDo use).  **GT_BufMove** starts a Trap move of an axis outside the
   system; ``modal = 1`` waits until it stands.
 """
 
@@ -102,6 +103,7 @@ class BufIO:
     do_type: int
     mask: int
     value: int
+    apply: Callable[[int, int], None] | None = field(repr=False, default=None)
 
 
 @dataclass(slots=True)
@@ -405,6 +407,8 @@ class CoordSystem:
                 old = self.outputs.get(e.do_type, 0)
                 self.outputs[e.do_type] = (old & ~e.mask) | (e.value & e.mask)
                 self.io_log.append((e.do_type, e.mask, e.value))
+                if e.apply is not None:
+                    e.apply(e.mask, e.value)
                 self.segments_done[self.fifo] += 1
                 continue
             if isinstance(e, BufMove):

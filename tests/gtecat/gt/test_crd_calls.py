@@ -205,3 +205,35 @@ def test_buffered_delay_io_and_override():
     # two rest-to-rest lines at half speed (acc a quarter) plus the delay
     one = 1000 / 5.0 + 5.0 / 0.25
     assert len(rows) == pytest.approx(2 * one + 50, abs=2)
+
+
+def test_helix_and_bufio_on_the_pulse_card():
+    assert gt.GT_Open(card="gts:4", clock="lockstep", log="") == 0, gt.GTE_GetLastError()
+    for a in (1, 2, 3):
+        assert gt.GT_AxisOn(a) == 0, gt.GTE_GetLastError()
+    gt.GTE_Wait(20)
+    prm = gt.TCrdPrm()
+    prm.dimension, prm.synVelMax, prm.synAccMax = 3, 50.0, 1.0
+    prm.profile[0], prm.profile[1], prm.profile[2] = 1, 2, 3
+    assert gt.GT_SetCrdPrm(1, byref(prm)) == 0, gt.GTE_GetLastError()
+    # one full ccw turn of radius 1000 around (1000, 0) while Z rises 3000
+    assert gt.GT_HelixXYCZ(1, 0, 0, 3000, 1000.0, 0.0, 1, 20.0, 0.5) == 0, gt.GTE_GetLastError()
+    assert gt.GT_BufIO(1, gt.MC_GPO, 0x0F, 0x05) == 0
+    assert gt.GT_CrdStart(1, 0) == 0, gt.GTE_GetLastError()
+    L = math.hypot(2 * math.pi * 1000, 3000)
+    n = 0
+    while status()[0]:
+        gt.GTE_Wait(1)
+        n += 1
+        x, y, z = prf(1), prf(2), prf(3)
+        assert abs(math.hypot(x - 1000, y) - 1000) <= 0.5
+        phi = math.atan2(y, x - 1000) - math.pi  # from the start angle (pi), ccw
+        assert z == pytest.approx(3000 * ((phi % (2 * math.pi)) / (2 * math.pi)), abs=1e-6) or (
+            z in (0.0, 3000.0)
+        )
+    assert n == math.ceil(L / 20.0 + 20.0 / 0.5)
+    pos = (c_double * 3)()
+    assert gt.GT_GetCrdPos(1, pos) == 0 and list(pos) == [0.0, 0.0, 3000.0]
+    assert status() == (0, 2)
+    do = c_int32()
+    assert gt.GT_GetDo(gt.MC_GPO, byref(do)) == 0 and do.value & 0x0F == 0x05
