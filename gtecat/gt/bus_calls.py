@@ -160,9 +160,30 @@ def GT_GetClock(ctl: Controller, pClock: Any, pLoop: Any = None) -> int:
 
 @gt_function
 def GT_GetVersion(ctl: Controller, pVersion: Any) -> int:
-    text = f"gtecat {__version__} emulated iDEABOX ({ctl.options.backend})".encode()
-    store_bytes(pVersion, text + b"\0")
+    """The firmware version in table 11-3's form ``aaa bbbbbb ccc dddddd`` (entry 78).
+
+    Firmware 1 is gtecat's version (0.1.0 -> ``010``) and build date, firmware 2 the same
+    (the emulator is one piece).  Two ways to receive it, as real client code does: a
+    caller's buffer (entry 78's ``char *pVersion``), or the address of a ``char *``
+    (example 11-1's ``ADR(pVersion)`` / the vendor header's ``char **``): it is set to a
+    NUL-terminated string that stays valid for the life of the process.
+    """
+    if pVersion.elem is ctypes.c_char_p and pVersion.nbytes >= ctypes.sizeof(ctypes.c_void_p):
+        ctypes.c_void_p.from_address(pVersion.addr).value = ctypes.addressof(_VERSION_TEXT)
+        return 0
+    store_bytes(pVersion, _VERSION_TEXT.raw)
     return 0
+
+
+def _version_text() -> bytes:
+    digits = "".join(f"{int(p) % 10}" for p in [*__version__.split("."), "0", "0"][:3])
+    fw = f"{digits} {RELEASE_DATE}"
+    return f"{fw} {fw}".encode()
+
+
+#: build date of this release, yymmdd (table 11-3)
+RELEASE_DATE = "261201"
+_VERSION_TEXT = ctypes.create_string_buffer(_version_text())
 
 
 # --- EtherCAT bring-up ------------------------------------------------------------------------

@@ -151,7 +151,7 @@ def test_get_version_into_an_offset_buffer_writes_only_its_text(bus):
     assert gt.GT_GetVersion(byref(buf, 8)) == 0
     data = bytes(buf)
     text, _, rest = data[8:].partition(b"\0")
-    assert data[:8] == b"\xa5" * 8 and text.startswith(b"gtecat")
+    assert data[:8] == b"\xa5" * 8 and text.startswith(b"010 ")
     assert rest == b"\xa5" * len(rest)  # nothing after the NUL
     s = create_string_buffer(64)
     assert gt.GT_GetVersion(s) == 0 and s.value == text

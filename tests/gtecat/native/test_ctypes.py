@@ -114,7 +114,7 @@ def test_the_vendor_sequence_through_ctypes(lib, env):
         assert lib.GT_GetSts(1, byref(sts), 1, None) == 0
         version = create_string_buffer(64)
         assert lib.GT_GetVersion(version) == 0
-        assert version.value.startswith(b"gtecat ")
+        assert version.value == b"010 261201 010 261201"  # table 11-3
     finally:
         assert lib.GT_Close() == 0
     assert lib.GT_GetSts(1, byref(sts), 1, None) == -1
