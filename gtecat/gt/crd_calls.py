@@ -434,6 +434,8 @@ def GT_CrdStart(ctl: Controller, mask: int, option: int) -> int:
         fifo = opt >> (c.number - 1) & 1
         if not c.fifos[fifo]:
             raise CommandError(f"{what}: FIFO {fifo} holds no segment")
+        first = next((e for e in c.fifos[fifo] if isinstance(e, Motion)), None)
+        heading = first.geom.tangent(False) if first is not None and first.geom.length else None
         for n, slot in zip(prm.axes(), c.slots, strict=True):
             res = axis_resources(ctl, n)
             if res.profile.planner is not slot:
@@ -441,7 +443,7 @@ def GT_CrdStart(ctl: Controller, mask: int, option: int) -> int:
                     f"{what}: profile {n} left interpolation mode ({res.profile.mode.name}); "
                     "call GT_SetCrdPrm again"
                 )
-            res.check_motion(what)
+            res.check_motion(what, heading[slot.coord] if heading is not None else 0.0)
         plan.append((c, fifo))
     for c, fifo in plan:
         c.start(fifo)
