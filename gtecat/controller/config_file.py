@@ -50,7 +50,10 @@ on an EtherCAT axis (axis/profile/encoder N = GT axis N, 4.3):
   table 4-4), which on a bus axis is "count as the drive reports 6064h" - the emulator's
   reset state (:mod:`gtecat.controller.encoder`); ``reverse=0`` makes the encoder count
   the other way.  ``captureSource`` (4.3.2 item 3 "脉冲计数源"): 0 = external encoder
-  (GT_EncOn, 6064h), 1 = pulse counter (GT_EncOff, 607Ah).  ``captureHomeSense`` /
+  (GT_EncOn, 6064h), 1 = pulse counter (GT_EncOff, 607Ah).  The pulse counter counts the
+  pulses the controller sends, whatever ``reverse`` says: the tool writes ``reverse=0``
+  beside ``captureSource=1`` and ``reverse=1`` beside ``captureSource=0`` (both fixtures,
+  every axis), and on the vendor's card both count with the profile.  ``captureHomeSense`` /
   ``captureIndexSense`` ("配置无效", capture is the drive's touch probe here) and
   ``filterType`` (the card's quadrature input filter) are stored.
 * ``[controlN]``: the card's servo loop; on a bus the drive closes the loop.  Only
@@ -801,10 +804,11 @@ def apply_vendor(ctl: Controller, cfg: VendorConfig) -> None:
         e = cfg.get("encoder", n)
         if "active" in e:
             res.encoder.active = e["active"]
-        if "reverse" in e:
-            res.encoder.sense = 1 if e["reverse"] else -1  # 1: the reset state (module doc)
         if "captureSource" in e:
             res.set_encoder_source(e["captureSource"] == 0)
+        if "reverse" in e:
+            # 1: the reset state (module doc); the pulse counter counts what is sent
+            res.encoder.sense = 1 if e["reverse"] or not res.encoder.external else -1
         c = cfg.get("control", n)
         if "errorLimit" in c and c.get("active", True):
             res.safety.set_pos_err(c["errorLimit"])

@@ -69,8 +69,13 @@ switch), whoever raised it, and at the end the flags it raised itself, as seed 0
 ``GT_ClrSts`` in its polling loop would; other latched flags (alarm, following error, stop
 inputs) refuse the search with ``HOME_ERROR_STOP`` / ``_ALARM``, as they refuse GT_Update
 (the vendor's demo calls GT_ClrSts first: "无清除状态会导致回零失败").  A limit mode on an
-axis whose limit input in ``moveDir`` is *none* (a configuration file's index -1) is
-refused with ``HOME_ERROR_HOME_MODE``: it could never end.
+axis whose limit input in ``moveDir`` is *none* (a configuration file's index -1 takes it
+away from the limit check: no stop, no bit 5/6) reads the axis's own limit terminal
+(60FDh of the axis; on a card its terminal N) and stops there with ``dec``, with a line in
+the master log: the vendor's own test.cfg (``../shared/fixtures/googol/smarthome_test.cfg``)
+wires none to axes 2-4, and seed 002's limit homing on them must still find the switch
+the machine has.  Only an axis with no limit terminal at all (no 60FDh) is refused with
+``HOME_ERROR_HOME_MODE``: that search could never end.
 
 **Errors** end the homing (the axis is stopped with ``dec``; ``run`` drops once it stands;
 ``stage`` stays where it failed): 1 not in Trap mode, 2 servo off (at the start or on the
@@ -161,6 +166,7 @@ FORCED_MODES = (HomeMode.FORCED_HOME, HomeMode.FORCED_HOME_INDEX)
 _LONG = (-(1 << 31), (1 << 31) - 1)
 _POS, _NEG = int(AxisStatus.POSITIVE_LIMIT), int(AxisStatus.NEGATIVE_LIMIT)
 _ALARM = int(AxisStatus.ALARM)
+_LIMIT_POS_BIT, _LIMIT_NEG_BIT = 1 << 1, 1 << 0  # 60FDh
 
 
 @dataclass(frozen=True, slots=True)
@@ -261,6 +267,7 @@ class SmartHome:
         self.res = res
         self.number = res.number
         self.unit = capture_unit(ctl, res.number)  # the axis's own encoder and capture
+        self._din = res.ax.io.get(0x60FD)
         self.reset()
 
     def reset(self) -> None:
@@ -309,12 +316,18 @@ class SmartHome:
             self._refuse(HomeError.DISABLE, f"axis {self.number} is off; call GT_AxisOn first")
         if res.latched & _ALARM:
             self._refuse(HomeError.ALARM, f"axis {self.number} has its alarm flag set (bit 1)")
-        if mode in LIMIT_MODES and res.limit_input(prm.moveDir > 0) is None:
+        if mode in LIMIT_MODES and self._limit(prm.moveDir) is None:
             side = "positive" if prm.moveDir > 0 else "negative"
             self._refuse(
                 HomeError.HOME_MODE,
                 f"mode {int(mode)} searches the {side} limit, and axis {self.number} has no "
-                f"{side} limit input (configuration file index -1)",
+                f"{side} limit input (no 60FDh)",
+            )
+        if mode in LIMIT_MODES and res.limit_input(prm.moveDir > 0) is None:
+            side = "positive" if prm.moveDir > 0 else "negative"
+            self.ctl.log(
+                f"Axis {self.number}: GT_GoHome mode {int(mode)} reads the axis's own {side} "
+                "limit terminal: the configuration file wired none to the axis"
             )
         trigger = self._trigger_unit(prm, mode)
         if mode in HOME_MODES or (mode in FORCED_MODES and prm.triggerIndex == -1):
@@ -435,7 +448,7 @@ class SmartHome:
     def _find_limit(self, d: int) -> _Steps:
         p, st = self.params, self.status
         st.stage = Stage.SEARCH_LIMIT
-        if not self.res.limit_input(d > 0):  # not on it already
+        if not self._limit(d):  # not on it already
             why, _ = yield from self._leg(d, p.searchHomeDistance or UNLIMITED, p.velHigh)
             if why != "limit":
                 raise _Abort(
@@ -453,7 +466,7 @@ class SmartHome:
             if why != "end":
                 raise _Abort(HomeError.STAGE, "the other limit while escaping from the limit")
             escaped += p.escapeStep
-            if not self.res.limit_input(d > 0):
+            if not self._limit(d):
                 break
         else:
             raise _Abort(
@@ -619,7 +632,7 @@ class SmartHome:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
         position) when the limit in ``d`` is reached, or ("end", None)."""
         trap = self.res.profile.trap
-        if self.res.limit_input(d > 0):  # standing on that limit already: reached at once
+        if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc
         self._begin(d, _long(round(trap.pos + d * distance)), vel)
         bit = _POS if d > 0 else _NEG
@@ -630,7 +643,7 @@ class SmartHome:
                 value = watch()
                 if value is not None:
                     return "event", value
-            if self.res.limit_input(d > 0) or self.res.latched & bit & ~before:
+            if self._limit(d) or self.res.latched & bit & ~before:
                 return "limit", self.unit.enc - 0.5 * self.unit.step
             self._check_plan(trap)
             if trap.done:
@@ -668,11 +681,22 @@ class SmartHome:
         before = self.res.latched & bit
         while True:
             yield
-            if self.res.limit_input(d > 0) or self.res.latched & bit & ~before:
+            if self._limit(d) or self.res.latched & bit & ~before:
                 raise _Abort(HomeError.STAGE, f"a limit on the way to {target}")
             self._check_plan(trap)
             if trap.done:
                 return
+
+    def _limit(self, d: int) -> bool | None:
+        """The limit input in direction ``d``: as wired (module docstring, "Limits"), else
+        the axis's own terminal (60FDh bit 1 / 0); None when there is neither."""
+        level = self.res.limit_input(d > 0)
+        if level is not None:
+            return level
+        din = self._din
+        if din is None:
+            return None
+        return bool(din.get() & (_LIMIT_POS_BIT if d > 0 else _LIMIT_NEG_BIT))
 
     def _clear_raised(self, bits: int) -> None:
         """Clear the limit flags (of ``bits``) whose cause is gone (module docstring)."""

@@ -301,11 +301,16 @@ class Proto:
         return self.name.startswith("GT_")
 
     def c_signature(self, *, defaults: bool, core: bool = False) -> str:
-        """The prototype for ``gts.h`` (``core``: the ``GTN_`` twin)."""
+        """The prototype for ``gts.h`` (``core``: the ``GTN_`` twin).
+
+        An input text (``str``) is ``const char *`` where the vendor writes ``char *``: the
+        same ABI, and C++ callers passing a string literal (``GT_LoadConfig("GTS800.cfg")``,
+        seed 002) compile without ISO C++'s string-constant warning."""
         name = ("GTN_" + self.name[3:]) if core else self.name
         parts = ["short core"] if core else []
         for p in self.params:
-            s = f"{p.ctype} *{p.name}" if p.pointer else f"{p.ctype} {p.name}"
+            ctype = f"const {p.ctype}" if p.text and p.direction == "in" else p.ctype
+            s = f"{ctype} *{p.name}" if p.pointer else f"{ctype} {p.name}"
             if defaults and p.default is not None:
                 s += f"={p.default}"
             parts.append(s)

@@ -53,7 +53,13 @@ def _expected(functions, *, defaults: bool) -> dict[str, list[tuple[str, str, st
     out = {}
     for proto in functions.values():
         ps = [
-            (p.ctype + (" *" if p.pointer else ""), p.name, p.default if defaults else None)
+            (
+                ("const " if p.text and p.direction == "in" else "")  # input text: const char *
+                + p.ctype
+                + (" *" if p.pointer else ""),
+                p.name,
+                p.default if defaults else None,
+            )
             for p in proto.params
         ]
         out[proto.name] = ps
