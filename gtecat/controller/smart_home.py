@@ -33,7 +33,8 @@ Modes (stages in brackets):
   when -1 - is sampled by the controller instead of latched: fast in ``d`` until it is
   active [40] (a limit first turns the search round once, as in mode 20), stop, slowly
   back in ``-d`` until it is inactive again [45]: the middle of that cycle's travel is the
-  capture (within ``velLow * T / 2``).
+  capture (within ``velLow * T / 2``).  The active zone must be longer than the stopping
+  distance ``velHigh² / (2·dec)``, so the axis stops inside it.
 * **41 forced home + index**: 40, back to the capture, then the first index beyond it in
   ``indexDir`` [30].
 
@@ -312,10 +313,10 @@ class SmartHome:
                 f"axis {self.number} is in {res.profile.mode.name.capitalize()} mode; call "
                 "GT_PrfTrap first",
             )
-        if not res.ax.servo_on:
-            self._refuse(HomeError.DISABLE, f"axis {self.number} is off; call GT_AxisOn first")
         if res.latched & _ALARM:
             self._refuse(HomeError.ALARM, f"axis {self.number} has its alarm flag set (bit 1)")
+        if not res.ax.servo_on:
+            self._refuse(HomeError.DISABLE, f"axis {self.number} is off; call GT_AxisOn first")
         if mode in LIMIT_MODES and self._limit(prm.moveDir) is None:
             side = "positive" if prm.moveDir > 0 else "negative"
             self._refuse(
@@ -387,10 +388,10 @@ class SmartHome:
 
     def _watch(self) -> tuple[HomeError, str] | None:
         res = self.res
+        if res.latched & _ALARM:  # before the servo: an alarm switches it off too
+            return HomeError.ALARM, f"axis {self.number}: drive alarm (GT_GetSts bit 1)"
         if not res.ax.servo_on:
             return HomeError.DISABLE, f"axis {self.number} was switched off"
-        if res.latched & _ALARM:
-            return HomeError.ALARM, f"axis {self.number}: drive alarm (GT_GetSts bit 1)"
         if res.profile.mode != PrfMode.TRAP:
             return HomeError.NOT_TRAP_MODE, f"axis {self.number} left Trap mode"
         return None
@@ -621,6 +622,8 @@ class SmartHome:
                 raise _Abort(HomeError.DISABLE, str(e)) from None
             if res.latched & _ALARM:
                 raise _Abort(HomeError.ALARM, str(e)) from None
+            if res.latched & (_POS if d > 0 else _NEG):  # a target in the limit (go home)
+                raise _Abort(HomeError.STAGE, str(e)) from None
             raise _Abort(HomeError.STOP, str(e)) from None
         trap = res.profile.trap
         trap.start(trap.pos, target, vel, self._trap, trap.vel)
