@@ -20,7 +20,12 @@ from eni.writer import write_eni
 
 
 def add_parser(subparsers: Any) -> None:
-    p = subparsers.add_parser("eni", help="ENI tools (write an ENI from a topology)")
+    p = subparsers.add_parser(
+        "eni",
+        help="ENI tools (write an ENI from a topology)",
+        epilog="examples:\n  gtecat eni new manual_fig5_2.toml -o manual_fig5_2.eni",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     sub = p.add_subparsers(dest="eni_command", metavar="COMMAND")
     new = sub.add_parser(
         "new",

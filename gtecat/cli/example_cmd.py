@@ -118,7 +118,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "example",
         help="list the shipped examples, or write one into a folder",
-        description=__doc__.split("\n\n", 1)[1] if __doc__ else None,
+        description=output.describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("name", nargs="?", help="example to write (a unique prefix is enough)")

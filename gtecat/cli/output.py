@@ -99,3 +99,12 @@ def emit(args: argparse.Namespace, rows: Any, columns: Sequence[Column]) -> int:
     else:
         print_table(rows, columns)
     return 0
+
+
+def describe(doc: str | None) -> str | None:
+    """A module docstring as ``--help`` text: without its title line and reST markup."""
+    if not doc:
+        return None
+    parts = doc.split("\n\n", 1)
+    body = parts[1] if len(parts) > 1 else parts[0]
+    return body.replace("``", "").strip()

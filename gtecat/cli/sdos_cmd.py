@@ -25,7 +25,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "sdos",
         help="list the CoE object dictionary (index, sub, name, type, access, value)",
-        description=__doc__.split("\n\n", 1)[1] if __doc__ else None,
+        description=output.describe(__doc__),
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

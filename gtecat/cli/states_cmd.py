@@ -1,0 +1,89 @@
+"""``gtecat states [-p POSITION] [STATE]``: show the slaves' AL states, or request one.
+
+Like IgH's ``ethercat states``: without STATE, each slave's AL state and status code; with
+STATE (INIT, PREOP, SAFEOP, OP, BOOT) the master requests it of every slave (or of the one
+``-p`` names) and shows where each one ended and why it refused, if it did. On the emulated
+bus the change lasts for this command only.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from drives.slave import AlState, AlStatusCode
+
+from ..errors import ParameterError
+from . import output
+from .busview import Bus, add_bus_options
+
+EPILOG = """\
+examples:
+  gtecat states manual_fig5_2.eni                 every slave's state
+  gtecat states -p 0 PREOP --eni manual_fig5_2.eni"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "states",
+        help="show the slaves' AL states, or request one (INIT, PREOP, SAFEOP, OP, BOOT)",
+        description=output.describe(__doc__),
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("state", nargs="?", type=str.upper, help="state to request")
+    add_bus_options(p)
+    p.set_defaults(func=run)
+
+
+def _code_name(code: int) -> str:
+    try:
+        return AlStatusCode(code).name
+    except ValueError:
+        return f"0x{code:04X}"
+
+
+def run(args: argparse.Namespace) -> int:
+    target = None
+    if args.state:
+        try:
+            target = AlState[args.state]
+        except KeyError:
+            raise ParameterError(
+                f"no AL state {args.state!r}: give INIT, PREOP, SAFEOP, OP or BOOT"
+            ) from None
+    rows = []
+    with Bus(args) as bus:
+        backend = bus.ctl.backend
+        for pos in bus.positions():
+            before, _ = backend.state(pos)
+            refused = None
+            if target is not None:
+                code = backend.request_state(pos, target)
+                if int(code):
+                    refused = _code_name(int(code))
+            state, code = backend.state(pos)
+            rows.append(
+                {
+                    "position": pos,
+                    "name": bus.layout.slaves[pos].name,
+                    "before": AlState(before).name,
+                    "state": AlState(state).name,
+                    "status_code": int(code),
+                    "status": _code_name(int(code)) if int(code) else "",
+                    "refused": refused,
+                }
+            )
+    if args.json:
+        output.print_json(rows)
+        return 0
+    cols: list[output.Column] = [("position", "pos"), ("state", "state"), ("status", "AL status")]
+    if target is not None:
+        cols.insert(1, ("before", "was"))
+    cols.append(("name", "name"))
+    output.print_table(rows, cols)
+    bad = [r for r in rows if r["refused"]]
+    if bad:
+        raise ParameterError(
+            "; ".join(f"slave {r['position']} refused {target.name}: {r['refused']}" for r in bad)
+        )
+    return 0
