@@ -7,8 +7,12 @@ Measures, with the slaves behind a real kernel network path:
 * ``cycles_per_s``: process-data cycles (``send_processdata`` +
   ``receive_processdata``, one LRW frame each, plus the DC FRMW with ``--dc``)
   pysoem completes back to back, and the master-side round trip per cycle;
-* ``server_latency_us``: inside the server, frame received -> answer sent
-  (the ESC emulation alone, from the server's ``--stats-json``);
+* ``server_latency_us``: inside the server, frame in -> frame out: from the
+  kernel's receive timestamp (time spent waiting in the socket counts) to the
+  return of ``send`` (from the server's ``--stats-json``); with
+  ``server_processing_us`` (user-space receive -> send called: the ESC
+  emulation alone) and ``server_send_us`` (the send syscall, which on a veth
+  pair includes the delivery to the master's socket);
 * ``paced``: a run at a fixed period (default 1 ms, busy-waited) counting cycles
   whose working counter was wrong or whose answer came late.
 
@@ -200,7 +204,14 @@ def main(argv: list[str] | None = None) -> int:
                 master.close()
         report = json.loads(stats.read_text())
         result["server_latency_us"] = report["latency"]
-        result["server"] = {k: report[k] for k in ("received", "sent", "steps", "chain")}
+        result["server_latency_from"] = report.get("latency_from", "recv")
+        result["server_processing_us"] = report.get("processing", {})
+        result["server_send_us"] = report.get("send", {})
+        result["server"] = {
+            k: report[k]
+            for k in ("received", "sent", "steps", "answered_in_step", "chain")
+            if k in report
+        }
     text = json.dumps(result, indent=2)
     print(text)
     if args.json:

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 from ..slave import VirtualSlave
 from .frames import Command, walk
-from .registers import Esc, FrameTime
+from .registers import Esc, FrameTime, LogicalPlan
 from .sii import SiiInfo, build_sii, sii_info_for
 
 log = logging.getLogger(__name__)
@@ -80,6 +80,76 @@ class ChainStats:
         return {k: getattr(self, k) for k in self.__slots__}  # type: ignore[attr-defined]
 
 
+class _Fast:
+    """A cyclic logical datagram answered from a snapshot, its writes applied after the send.
+
+    Eligible when every ESC's part is a :class:`LogicalPlan`, every read comes from
+    a buffered input SM (whose memory only the slave side changes, at
+    :meth:`Esc.load_inputs`), reads do not overlap in the datagram, and no ESC
+    writes bytes an earlier ESC's read put into the datagram.  Then the answer
+    is: keep the datagram's output bytes, put the input snapshot in, add the
+    WKC - a few slice copies whatever the number of slaves - and the outputs
+    reach the ESCs (SM buffers, watchdog, the slaves' ``rx``) in
+    :meth:`Chain.flush`, before anything else looks at them.
+    """
+
+    __slots__ = ("parts", "runs", "sources", "w0", "w1", "wkc")
+
+    def __init__(self, parts: list[LogicalPlan], wkc: int) -> None:
+        self.parts = parts
+        self.wkc = wkc
+        writes = [(f0, f1) for part in parts for f0, f1, _p0, _p1 in part.writes]
+        self.w0 = min((f0 for f0, _ in writes), default=0)
+        self.w1 = max((f1 for _, f1 in writes), default=0)
+        reads = sorted(
+            (f0, f1, part.mem, p0, p1) for part in parts for f0, f1, p0, p1 in part.reads
+        )
+        runs: list[list] = []  # [f0, f1, [(mem, p0, p1), ...]]
+        for f0, f1, mem, p0, p1 in reads:
+            if runs and runs[-1][1] == f0:
+                runs[-1][1] = f1
+                runs[-1][2].append((mem, p0, p1))
+            else:
+                runs.append([f0, f1, [(mem, p0, p1)]])
+        self.sources = [(f0, f1, tuple(src)) for f0, f1, src in runs]
+        self.runs: list[tuple[int, int, bytes]] = []
+        self.refresh()
+
+    def refresh(self) -> None:
+        self.runs = [
+            (f0, f1, b"".join(mem[p0:p1] for mem, p0, p1 in src)) for f0, f1, src in self.sources
+        ]
+
+    @staticmethod
+    def eligible(parts: list[LogicalPlan | Esc]) -> bool:
+        if not parts or any(type(p) is not LogicalPlan for p in parts):
+            return False
+        read_so_far: list[tuple[int, int]] = []
+        for part in parts:
+            assert isinstance(part, LogicalPlan)
+            for f0, f1, _p0, _p1 in part.writes:
+                if any(r0 < f1 and f0 < r1 for r0, r1 in read_so_far):
+                    return False
+            for f0, f1, p0, p1 in part.reads:
+                if any(r0 < f1 and f0 < r1 for r0, r1 in read_so_far):
+                    return False  # two reads of one byte: the general path's order decides
+                sms = [sm for sm in part.esc.sms if sm.start <= p0 and p1 <= sm.end]
+                if not sms or sms[0].ecat_writes or sms[0].mailbox:
+                    return False  # plain RAM: a master's write may change it in between
+                read_so_far.append((f0, f1))
+        return True
+
+    def apply(self, saved: bytes) -> None:
+        """The kept output bytes into the ESCs (writes, then the SMs they complete)."""
+        w0 = self.w0
+        for part in self.parts:
+            mem = part.mem
+            for f0, f1, p0, p1 in part.writes:
+                mem[p0:p1] = saved[f0 - w0 : f1 - w0]
+            for handler, sm in part.done:
+                handler(sm)
+
+
 class Chain:
     """Virtual slaves behind ESCs, in bus order."""
 
@@ -118,6 +188,9 @@ class Chain:
             )
             esc.on_station_change = self._stations_changed
             esc.on_fmmu_change = self._fmmus_changed
+            esc.on_sm_change = self._sms_changed
+            esc.on_irq_mask_change = self._irq_masks_changed
+            esc.on_inputs = self._inputs_loaded
             esc.on_pending = self._add_pending
             self.escs.append(esc)
             self.sii_info.append(info)
@@ -126,7 +199,18 @@ class Chain:
         self.process_data = False
         self._stations: dict[int, list[Esc]] | None = None
         self._lmap: list[tuple[int, int, Esc]] | None = None
+        #: compiled logical datagrams: (cmd, address, length) -> per-ESC copy plans, or
+        #: None for a shape that takes the general path
+        self._plans: dict[tuple[int, int, int], list[LogicalPlan | Esc]] = {}
+        self._fast: dict[tuple[int, int, int], _Fast | None] = {}
+        #: answers given from snapshots whose output bytes still go to the ESCs:
+        #: (plan, output bytes, frame time), applied by :meth:`flush`
+        self._deferred: list[tuple[_Fast, bytes, int]] = []
+        #: an input SM changed since the snapshots were taken
+        self._inputs_changed = False
         self._pending: list[Esc] = []
+        #: ESCs whose event mask lets an event into the IRQ field (most masters set none)
+        self._irq_escs: list[Esc] = []
 
     @property
     def slaves(self) -> list[VirtualSlave]:
@@ -141,6 +225,44 @@ class Chain:
 
     def _fmmus_changed(self, _esc: Esc) -> None:
         self._lmap = None
+        self._forget_plans()
+
+    def _irq_masks_changed(self, _esc: Esc) -> None:
+        self._irq_escs = [e for e in self.escs if e.mem[0x0200] or e.mem[0x0201]]
+
+    def _sms_changed(self, _esc: Esc) -> None:
+        if self._plans:
+            self._forget_plans()
+
+    def _forget_plans(self) -> None:
+        if self._deferred:
+            self.flush()
+        self._plans.clear()
+        self._fast.clear()
+
+    def _inputs_loaded(self, _esc: Esc) -> None:
+        self._inputs_changed = True
+
+    def refresh_snapshots(self) -> None:
+        """Input snapshots of the cyclic datagrams after the slaves' inputs changed."""
+        self._inputs_changed = False
+        for fast in self._fast.values():
+            if fast is not None:
+                fast.refresh()
+
+    def flush(self) -> None:
+        """Outputs of answered datagrams into the ESCs (and the slaves' ``rx``)."""
+        deferred, self._deferred = self._deferred, []
+        if not deferred:
+            return
+        ft = self.ft
+        now = ft.t_ns
+        try:
+            for fast, saved, t_ns in deferred:
+                ft.t_ns = t_ns
+                fast.apply(saved)
+        finally:
+            ft.t_ns = now
 
     def _add_pending(self, esc: Esc) -> None:
         if esc not in self._pending:
@@ -194,15 +316,18 @@ class Chain:
     def exchange(self, frame: bytes) -> bytes | None:
         """Process a copy of ``frame``; the answer, or ``None`` when it was dropped."""
         buf = bytearray(frame)
-        return bytes(buf) if self.process(buf) else None
+        answered = self.process(buf)
+        self.flush()
+        return bytes(buf) if answered else None
 
     def _datagrams(self, buf: bytearray, offsets: list[int]) -> None:
         escs = self.escs
         count = len(escs)
         irq = 0
-        for esc in escs:
+        for esc in self._irq_escs:
             irq |= esc.event_irq
         u16_unpack, u16_pack = _U16.unpack_from, _U16.pack_into
+        ft_ns = self.ft.t_ns
         for off in offsets:
             cmd = buf[off]
             dlen = u16_unpack(buf, off + 6)[0] & 0x07FF
@@ -211,20 +336,44 @@ class Chain:
             if irq:
                 u16_pack(buf, off + 8, u16_unpack(buf, off + 8)[0] | irq)
             wkc = 0
+            if self._deferred and cmd not in _L:
+                self.flush()  # a register access sees the outputs answered before it
             if cmd in _L:
                 laddr = _U32.unpack_from(buf, off + 2)[0]
-                lmap = self._lmap if self._lmap is not None else self._logical_map()
-                lend = laddr + dlen
-                hit: list[Esc] = []
-                for ls, le, esc in lmap:
-                    if ls < lend and laddr < le and (not hit or hit[-1] is not esc):
-                        hit.append(esc)
-                if hit:
+                key = (cmd, laddr, dlen)
+                fast = self._fast.get(key, False)
+                if fast:
+                    if self._inputs_changed:
+                        self.refresh_snapshots()
+                    self._deferred.append((fast, bytes(buf[d0 + fast.w0 : d0 + fast.w1]), ft_ns))
+                    for f0, f1, snap in fast.runs:
+                        buf[d0 + f0 : d0 + f1] = snap
+                    self.process_data = True
+                    wkc = fast.wkc
+                    if wkc:
+                        u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
+                    continue
+                if self._deferred:
+                    self.flush()
+                plan = self._plans.get(key, False)
+                if plan is False:
+                    plan = self._compile(cmd, laddr, dlen)
+                if plan:
                     self.process_data = True
                     with memoryview(buf) as mv:
                         data = mv[d0:d1]
-                        for esc in hit:
-                            wkc += esc.logical(cmd, laddr, data)
+                        for part in plan:
+                            if part.__class__ is LogicalPlan:  # inline LogicalPlan.run
+                                mem = part.mem  # type: ignore[union-attr]
+                                for f0, f1, p0, p1 in part.writes:  # type: ignore[union-attr]
+                                    mem[p0:p1] = data[f0:f1]
+                                for handler, sm in part.done:  # type: ignore[union-attr]
+                                    handler(sm)
+                                for f0, f1, p0, p1 in part.reads:  # type: ignore[union-attr]
+                                    data[f0:f1] = mem[p0:p1]
+                                wkc += part.wkc  # type: ignore[union-attr]
+                            else:
+                                wkc += part.logical(cmd, laddr, data)  # type: ignore[union-attr]
                         data.release()
             elif cmd in _FP:
                 adp, ado = _U16.unpack_from(buf, off + 2)[0], u16_unpack(buf, off + 4)[0]
@@ -257,15 +406,46 @@ class Chain:
             if wkc:
                 u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
 
+    def _compile(self, cmd: int, laddr: int, dlen: int) -> list[LogicalPlan | Esc]:
+        """The ESCs a logical datagram hits, each as a copy plan where it can be one."""
+        lmap = self._lmap if self._lmap is not None else self._logical_map()
+        lend = laddr + dlen
+        hit: list[Esc] = []
+        for ls, le, esc in lmap:
+            if ls < lend and laddr < le and (not hit or hit[-1] is not esc):
+                hit.append(esc)
+        parts: list[LogicalPlan | Esc] = []
+        for esc in hit:
+            plan = esc.logical_plan(cmd, laddr, dlen)
+            parts.append(esc if plan is None else plan)
+        if len(self._plans) > 256:  # a master that sends ever new shapes: keep it bounded
+            self._forget_plans()
+        key = (cmd, laddr, dlen)
+        self._plans[key] = parts
+        if _Fast.eligible(parts):
+            self._fast[key] = _Fast(parts, sum(p.wkc for p in parts))  # type: ignore[misc]
+        else:
+            self._fast[key] = None
+        return parts
+
     # --- the slaves' side ----------------------------------------------------------------------
     def service(self) -> None:
         """Mailbox work the last frames left (requests to slaves, answers to SM1)."""
+        if self._deferred:
+            self.flush()
         while self._pending:
             esc = self._pending.pop(0)
             esc.service()
 
-    def step(self, t_ns: int, dt_ns: int) -> None:
-        """One cycle of every slave: outputs are in ``rx``; refresh the input buffers."""
+    def step(self, t_ns: int, dt_ns: int, between: Callable[[], object] | None = None) -> None:
+        """One cycle of every slave: outputs are in ``rx``; refresh the input buffers.
+
+        ``between`` runs after each slave's step: the serve loop answers a frame that
+        arrived meanwhile instead of letting it wait for the whole chain (a frame
+        answered from the snapshots sees the previous cycle's inputs of every slave).
+        """
+        if self._deferred:
+            self.flush()
         for esc in self.escs:
             slave = esc.slave
             try:
@@ -278,10 +458,16 @@ class Chain:
             esc.sync_al()
             if slave.emergencies:
                 esc.collect_emergencies()
+            if between is not None:
+                between()
+        if self._inputs_changed:
+            self.refresh_snapshots()  # here, so the next frame's answer need not
 
     def poll(self, now_ns: int | None = None) -> None:
         """Watchdogs, and slave state changes made outside a step."""
         now = self.clock() if now_ns is None else now_ns
+        if self._deferred:
+            self.flush()
         for esc in self.escs:
             esc.check_watchdog(now)
             esc.sync_al()

@@ -225,11 +225,13 @@ class SyncManager:
         "num",
         "pdi_off",
         "start",
+        "status_addr",
         "watchdog",
     )
 
     def __init__(self, num: int, start: int, length: int, control: int) -> None:
         self.num = num
+        self.status_addr = Reg.SM0 + 8 * num + 5
         self.start = start
         self.length = length
         self.end = start + length
@@ -238,10 +240,6 @@ class SyncManager:
         self.watchdog = bool(control & SM_WATCHDOG)
         self.full = False
         self.pdi_off = False
-
-    @property
-    def status_addr(self) -> int:
-        return Reg.SM0 + 8 * self.num + 5
 
 
 class Fmmu:
@@ -261,6 +259,43 @@ class Fmmu:
         self.read = bool(ftype & 1)
         self.write = bool(ftype & 2)
         self.aligned = (lsb & 7) == 0 and (leb & 7) == 7 and (psb & 7) == 0
+
+
+class LogicalPlan:
+    """One ESC's part of a logical datagram, as byte copies (:meth:`Esc.logical_plan`).
+
+    The chain runs it inline: ``writes`` (datagram offset, end, physical start,
+    end) into ``mem``, then ``done`` (the SMs whose last byte was written, with the
+    ESC's handler), then ``reads`` back into the datagram; ``wkc`` is the increment.
+    """
+
+    __slots__ = ("done", "esc", "mem", "reads", "wkc", "writes")
+
+    def __init__(
+        self,
+        esc: Esc,
+        writes: tuple[tuple[int, int, int, int], ...],
+        done: tuple[SyncManager, ...],
+        reads: tuple[tuple[int, int, int, int], ...],
+        wkc: int,
+    ) -> None:
+        self.esc = esc
+        self.mem = esc.mem
+        self.writes = writes
+        self.done = tuple((esc._buffer_written, sm) for sm in done)
+        self.reads = reads
+        self.wkc = wkc
+
+    def run(self, data: memoryview) -> int:
+        """Writes first, then reads, like :meth:`Esc.logical`; the WKC increment."""
+        mem = self.mem
+        for f0, f1, p0, p1 in self.writes:
+            mem[p0:p1] = data[f0:f1]
+        for handler, sm in self.done:
+            handler(sm)
+        for f0, f1, p0, p1 in self.reads:
+            data[f0:f1] = mem[p0:p1]
+        return self.wkc
 
 
 class FrameTime:
@@ -329,10 +364,17 @@ class Esc:
         self._wd_expired = False
         self._id_request = False
         self._state_seen = slave.al_state
+        self._op = slave.al_state == AlState.OP
         self._outputs_since_op = False
         #: set by the chain: the station address / FMMUs changed, PDI work is pending
         self.on_station_change: Callable[[Esc], None] = _noop
         self.on_fmmu_change: Callable[[Esc], None] = _noop
+        #: the slave side wrote an input SM (:meth:`load_inputs`): snapshots are stale
+        self.on_inputs: Callable[[Esc], None] = _noop
+        #: the ECAT event mask (0200h) was written: the chain tracks who can raise IRQs
+        self.on_irq_mask_change: Callable[[Esc], None] = _noop
+        #: SM configuration or PDI (de)activation changed: compiled datagram plans are stale
+        self.on_sm_change: Callable[[Esc], None] = _noop
         self.on_pending: Callable[[Esc], None] = _noop
         self.errors = 0
         self._reset_registers()
@@ -496,6 +538,8 @@ class Esc:
         # side effects, in register order
         if addr < 0x0012 and end > 0x0010:
             self.on_station_change(self)
+        if addr < 0x0202 and end > 0x0200:
+            self.on_irq_mask_change(self)
         if addr < 0x0104 and end > 0x0103:
             self.on_station_change(self)  # alias enable changed FP matching
         if addr < 0x0122 and end > 0x0120:
@@ -581,6 +625,7 @@ class Esc:
         if state != self._state_seen:
             self._enter_state(self._state_seen, state)
             self._state_seen = state
+        self._op = state == AlState.OP
         status = int(state) | (0x10 if slave.al_error else 0)
         code = int(slave.al_status_code)
         if self._id_request and not slave.al_error:
@@ -620,6 +665,7 @@ class Esc:
             sm.pdi_off = off
             a = Reg.SM0 + 8 * sm.num + 7
             self.mem[a] = (self.mem[a] & ~SM_PDI_DEACTIVATE) | (SM_PDI_DEACTIVATE if off else 0)
+        self.on_sm_change(self)
 
     # --- sync managers -------------------------------------------------------------------------
     def _decode_sms(self) -> None:
@@ -692,14 +738,15 @@ class Esc:
             return
         # buffered outputs: the slave gets them now
         rx = self.slave.rx
-        n = min(len(rx), sm.length)
-        rx[:n] = self.mem[sm.start : sm.start + n]
-        self.mem[sm.status_addr] |= SM_STATUS_IRQ_WRITE
+        n = sm.length if sm.length <= len(rx) else len(rx)
+        mem = self.mem
+        rx[:n] = mem[sm.start : sm.start + n]
+        mem[sm.status_addr] |= SM_STATUS_IRQ_WRITE
         self._wd_last = self.ft.t_ns
         if self._wd_expired:
             self._wd_expired = False
-            self.mem[Reg.WD_STATUS_PD] |= 0x01
-        if self.slave.al_state == AlState.OP:
+            mem[Reg.WD_STATUS_PD] |= 0x01
+        if self._op:
             self._outputs_since_op = True
             self.slave.outputs_valid = True
 
@@ -710,6 +757,7 @@ class Esc:
             tx = self.slave.tx
             n = min(len(tx), sm.length)
             self.mem[sm.start : sm.start + n] = tx[:n]
+            self.on_inputs(self)
 
     # --- mailbox (the slave's side of SM0/SM1) -------------------------------------------------
     def service(self) -> None:
@@ -863,6 +911,48 @@ class Esc:
                 if f.read and f.lstart < lend and laddr < f.lend:
                     read |= self._fmmu_read(f, laddr, data)
         return (1 if read else 0) + ((2 if command == 12 else 1) if wrote else 0)
+
+    def logical_plan(self, command: int, laddr: int, n: int) -> LogicalPlan | None:
+        """:meth:`logical` for one datagram shape, as plain copies (None: not plain).
+
+        A master sends the same cyclic datagram every cycle; when every FMMU it
+        hits here is byte aligned and lands wholly in an active buffered SM of the
+        right direction, or in plain process RAM, :meth:`logical` reduces to byte
+        copies and the SMs whose last byte is written.  The chain keeps the plan
+        until an FMMU, an SM or the AL state changes.
+        """
+        lend = laddr + n
+        writes: list[tuple[int, int, int, int]] = []
+        reads: list[tuple[int, int, int, int]] = []
+        done: list[SyncManager] = []
+        for f in self.fmmus:
+            if not (f.lstart < lend and laddr < f.lend):
+                continue
+            if not f.aligned:
+                return None
+            lo, hi = max(f.lstart, laddr), min(f.lend, lend)
+            p0 = f.pstart + (lo - f.lstart)
+            p1 = p0 + (hi - lo)
+            if p0 < REGISTER_SPACE or p1 > MEMORY_SIZE:
+                return None
+            sms = [sm for sm in self.sms if sm.start < p1 and p0 < sm.end]
+            if len(sms) > 1 or any(sm.mailbox or sm.pdi_off for sm in sms):
+                return None
+            sm = sms[0] if sms else None
+            if sm is not None and (sm.start > p0 or sm.end < p1):
+                return None
+            if f.write and command != 10:
+                if sm is not None and not sm.ecat_writes:
+                    return None
+                writes.append((lo - laddr, hi - laddr, p0, p1))
+                if sm is not None and p0 < sm.end <= p1:
+                    done.append(sm)
+            if f.read and command != 11:
+                if sm is not None and sm.ecat_writes:
+                    return None  # an FMMU reading an output SM: refused, the general path
+                reads.append((lo - laddr, hi - laddr, p0, p1))
+        wkc = (1 if reads else 0) + ((2 if command == 12 else 1) if writes else 0)
+        return LogicalPlan(self, tuple(writes), tuple(done), tuple(reads), wkc)
 
     def _fmmu_write(self, f: Fmmu, laddr: int, data: bytearray | memoryview) -> bool:
         if f.aligned:

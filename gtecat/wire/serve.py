@@ -25,6 +25,16 @@ When the slaves step (``step_mode``):
 * ``"cycle"``: on a wall-clock timer every ``cycle_ns`` (the ENI cycle time),
   independent of the master, like a drive in free run.
 
+Latency: the cyclic datagram is answered from input snapshots and its outputs
+reach the slaves after the send (:class:`drives.esc.chain.Chain`); the slaves'
+step answers a frame that arrives meanwhile between two slaves; the garbage
+collector runs between frames, never inside one; sends bypass the qdisc.  The
+recorded latency is honest: from the kernel's receive timestamp (SO_TIMESTAMPNS,
+so time the frame waited in the socket counts) to the return of ``send``;
+``processing`` (user-space receive -> send called) and ``send`` (the syscall,
+which on a veth pair includes delivering the frame to the peer's socket) are
+recorded apart.
+
 Between frames the loop checks the sync manager watchdogs and stops within
 ``poll_s`` of :attr:`stop` being set (Ctrl-C / SIGTERM in the CLI).  Malformed
 frames are counted and dropped by the chain; nothing a frame contains can end
@@ -40,6 +50,7 @@ import logging
 import os
 import select
 import socket
+import struct
 import threading
 import time
 from array import array
@@ -96,9 +107,26 @@ class ServeStats:
     send_errors: int = 0
     receive_errors: int = 0
     internal_errors: int = 0
+    #: frames answered between two slaves' steps
+    answered_in_step: int = 0
     started_ns: int = 0
     stopped_ns: int = 0
+    #: kernel receive timestamp (or user-space receive) -> send returned
     latency: LatencyRecorder = field(default_factory=LatencyRecorder)
+    #: user-space receive -> send called (the ESC emulation alone)
+    processing: LatencyRecorder = field(default_factory=LatencyRecorder)
+    #: the send syscall
+    send: LatencyRecorder = field(default_factory=LatencyRecorder)
+    #: whether ``latency`` starts at the kernel's receive timestamps
+    kernel_timestamps: bool = False
+
+
+SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
+SCM_TIMESTAMPNS = SO_TIMESTAMPNS
+SOL_PACKET = getattr(socket, "SOL_PACKET", 263)  # linux/socket.h
+PACKET_QDISC_BYPASS = 20  # linux/if_packet.h
+_TIMESPEC = struct.Struct("@qq")
+_ANC_SIZE = socket.CMSG_SPACE(_TIMESPEC.size) if hasattr(socket, "CMSG_SPACE") else 0
 
 
 def open_raw_socket(iface: str) -> socket.socket:
@@ -119,6 +147,10 @@ def open_raw_socket(iface: str) -> socket.socket:
         raise WireError(f"cannot bind to {iface!r}: {exc.strerror}") from exc
     try:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+    except OSError:
+        pass
+    try:  # answers go straight to the driver, not through the queueing discipline
+        sock.setsockopt(SOL_PACKET, PACKET_QDISC_BYPASS, 1)
     except OSError:
         pass
     sock.setblocking(False)
@@ -178,13 +210,17 @@ class WireServer:
         self._sock = sock
         self._t0 = 0
         self._last_step: int | None = None
+        #: a process-data frame was answered inside a step: one more step follows it
+        self._step_due = False
+        self._answered_in_this_step = False
 
     # --- slave cycle -----------------------------------------------------------------------
-    def _step(self, now: int) -> None:
+    def _step(self, now: int, between: Callable[[], None] | None = None) -> None:
+        self._answered_in_this_step = False
         last = self._last_step
         dt = self.cycle_ns if last is None else min(max(now - last, 0), self.max_dt_ns)
         self._last_step = now
-        self.chain.step(now - self._t0, dt)
+        self.chain.step(now - self._t0, dt, between)
         self.stats.steps += 1
 
     # --- the loop --------------------------------------------------------------------------
@@ -198,17 +234,70 @@ class WireServer:
         chain, stats, clock = self.chain, self.stats, self.clock
         buf = bytearray(2048)
         view = memoryview(buf)
-        recv_into, send = sock.recv_into, sock.send
+        send = sock.send
+        receive = self._receiver(sock, view)
         poller = select.poll()
         poller.register(sock.fileno(), select.POLLIN)
+        poll = poller.poll
         self._t0 = stats.started_ns = clock()
         deadline = None if duration_s is None else self._t0 + int(duration_s * 1e9)
         next_cycle = self._t0 + self.cycle_ns
         next_poll = self._t0
         frame_mode = self.step_mode == "frame"
-        latency = stats.latency
+        latency, processing, send_time = stats.latency, stats.processing, stats.send
+
+        def answer(in_step: bool) -> bool:
+            """Receive, process and answer one frame; False when none was waiting."""
+            try:
+                n, t_kernel = receive()
+            except BlockingIOError:
+                return False
+            except InterruptedError:
+                return True
+            except OSError as exc:
+                self._receive_failed(exc)
+                return False
+            t_in = clock()
+            stats.received += 1
+            if not chain.process(buf, n, t_in):
+                return True
+            t_send = clock()
+            try:
+                send(view[:n])
+                stats.sent += 1
+            except OSError as exc:
+                stats.send_errors += 1
+                if stats.send_errors <= 5:
+                    log.warning("send failed: %s", exc)
+            t_out = clock()
+            latency.add(t_out - (t_kernel or t_in))
+            processing.add(t_send - t_in)
+            send_time.add(t_out - t_send)
+            if in_step:
+                stats.answered_in_step += 1
+                self._step_due |= frame_mode and chain.process_data
+                return True
+            self._guarded(chain.service)
+            if frame_mode and chain.process_data:
+                last = self._last_step
+                if last is None or t_in - last >= self.min_gap_ns:
+                    self._guarded(self._step, t_in, between)
+                    if self._step_due:  # process data answered during the step: its step
+                        self._step_due = False
+                        self._guarded(chain.service)
+                        self._guarded(self._step, clock(), between)
+            return True
+
+        def between() -> None:
+            # one frame per step at most: a master sending back to back must neither keep
+            # the step from finishing nor take every answer out of the step rhythm
+            if not self._answered_in_this_step and poll(0) and answer(True):
+                self._answered_in_this_step = True
+
         gc.collect()
         gc.freeze()  # what exists now is never scanned again: no long collector pauses
+        gc_was_enabled = gc.isenabled()
+        gc.disable()  # young objects are collected between frames (below), never inside one
         if ready is not None:
             ready()
         try:
@@ -219,51 +308,64 @@ class WireServer:
                 timeout_ms = 0 if self.busy_poll else int(self.poll_s * 1000)
                 if not frame_mode and timeout_ms:
                     timeout_ms = max(0, min(timeout_ms, (next_cycle - now + 999_999) // 1_000_000))
-                if not poller.poll(timeout_ms):
-                    now = clock()
-                else:
-                    while True:
-                        try:
-                            n = recv_into(buf)
-                        except BlockingIOError:
-                            break
-                        except InterruptedError:
-                            continue
-                        except OSError as exc:
-                            self._receive_failed(exc)
-                            break
-                        t_in = clock()
-                        stats.received += 1
-                        if chain.process(buf, n, t_in):
-                            try:
-                                send(view[:n])
-                                stats.sent += 1
-                            except OSError as exc:
-                                stats.send_errors += 1
-                                if stats.send_errors <= 5:
-                                    log.warning("send failed: %s", exc)
-                            now = clock()
-                            latency.add(now - t_in)
-                            self._guarded(chain.service)
-                            if frame_mode and chain.process_data:
-                                last = self._last_step
-                                if last is None or t_in - last >= self.min_gap_ns:
-                                    self._guarded(self._step, t_in)
-                        else:
-                            now = clock()
+                if poll(timeout_ms):
+                    while answer(False):
+                        pass
+                now = clock()
                 if not frame_mode:
                     while now >= next_cycle:
-                        self._guarded(self._step, next_cycle)
+                        self._guarded(self._step, next_cycle, between)
                         next_cycle += self.cycle_ns
                         if now - next_cycle > 100 * self.cycle_ns:  # fell far behind: resync
                             next_cycle = now + self.cycle_ns
                 if now >= next_poll:
                     self._guarded(chain.poll, now)
-                    next_poll = now + 5_000_000
+                    gc.collect(0)
+                    self._sync_clocks()
+                    next_poll = clock() + 5_000_000
         finally:
+            if gc_was_enabled:
+                gc.enable()
             stats.stopped_ns = clock()
             poller.unregister(sock.fileno())
             view.release()
+
+    # --- receive, with the kernel's timestamp when there is one ------------------------
+    _realtime_offset = 0
+
+    def _sync_clocks(self) -> None:
+        if self.stats.kernel_timestamps:
+            self._realtime_offset = time.clock_gettime_ns(time.CLOCK_REALTIME) - self.clock()
+
+    def _receiver(self, sock: socket.socket, view: memoryview) -> Callable[[], tuple[int, int]]:
+        """``receive() -> (bytes, kernel receive time on our clock or 0)``."""
+        stamps = self.clock is time.monotonic_ns and _ANC_SIZE > 0
+        if stamps:
+            try:
+                sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+            except OSError:
+                stamps = False
+        self.stats.kernel_timestamps = stamps
+        if not stamps:
+            recv_into = sock.recv_into
+
+            def plain() -> tuple[int, int]:
+                return recv_into(view), 0
+
+            return plain
+        self._sync_clocks()
+        recvmsg_into, unpack = sock.recvmsg_into, _TIMESPEC.unpack
+        bufs = [view]
+
+        def stamped() -> tuple[int, int]:
+            n, anc, _flags, _addr = recvmsg_into(bufs, _ANC_SIZE)
+            for level, kind, data in anc:
+                if level == socket.SOL_SOCKET and kind == SCM_TIMESTAMPNS:
+                    sec, nsec = unpack(data[: _TIMESPEC.size])
+                    return n, sec * 1_000_000_000 + nsec - self._realtime_offset
+            return n, 0
+
+        return stamped
 
     def _guarded(self, fn: Callable[..., object], *args: object) -> None:
         """Slave-side work: a bug there is logged and counted, the loop goes on."""
@@ -302,8 +404,12 @@ class WireServer:
             "receive_errors": s.receive_errors,
             "internal_errors": s.internal_errors,
             "steps": s.steps,
+            "answered_in_step": s.answered_in_step,
             "frames_per_s": round(s.sent / elapsed, 1),
             "chain": self.chain.stats.as_dict(),
             "latency": s.latency.summary(),
+            "latency_from": "kernel receive timestamp" if s.kernel_timestamps else "recv",
+            "processing": s.processing.summary(),
+            "send": s.send.summary(),
             "pid": os.getpid(),
         }
