@@ -61,6 +61,12 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rt-priority", type=int, metavar="N", help="run under SCHED_FIFO priority N")
     p.add_argument("--duration", type=float, help="stop after this many seconds")
     p.add_argument("--stats-json", type=Path, help="write counters and latency here on exit")
+    p.add_argument(
+        "--pcap",
+        type=Path,
+        metavar="FILE",
+        help="write every frame received and answered to FILE (classic pcap, for Wireshark)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log what the slaves do")
 
 
@@ -102,8 +108,16 @@ def run(args: argparse.Namespace) -> int:
     cycle_ns = (args.cycle_us * 1000) if args.cycle_us else (config.cycle_time_ns or 1_000_000)
     if interface_is_up(args.iface) is False:
         print(f"warning: interface {args.iface} is down", file=sys.stderr)
+    from gtecat.wire.pcap import PcapWriter
+
+    pcap = PcapWriter(args.pcap) if args.pcap else None
     server = WireServer(
-        chain, args.iface, step_mode=args.step, cycle_ns=cycle_ns, busy_poll=args.busy_poll
+        chain,
+        args.iface,
+        step_mode=args.step,
+        cycle_ns=cycle_ns,
+        busy_poll=args.busy_poll,
+        pcap=pcap,
     )
     if args.rt_priority:
         realtime_priority(args.rt_priority)

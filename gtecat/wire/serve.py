@@ -61,6 +61,8 @@ from drives.esc import Chain
 from drives.esc.frames import ETHERTYPE_ECAT
 from eni.errors import GtecatError
 
+from .pcap import PcapWriter
+
 log = logging.getLogger(__name__)
 
 
@@ -191,6 +193,7 @@ class WireServer:
         busy_poll: bool = False,
         clock: Callable[[], int] = time.monotonic_ns,
         sock: socket.socket | None = None,
+        pcap: PcapWriter | None = None,
     ) -> None:
         if step_mode not in ("frame", "cycle"):
             raise ValueError(f"step_mode must be 'frame' or 'cycle', not {step_mode!r}")
@@ -207,6 +210,8 @@ class WireServer:
         self.clock = clock
         self.stop = threading.Event()
         self.stats = ServeStats()
+        #: every frame received and every answer sent, when set (``--pcap``)
+        self.pcap = pcap
         self._sock = sock
         self._t0 = 0
         self._last_step: int | None = None
@@ -245,6 +250,8 @@ class WireServer:
         next_poll = self._t0
         frame_mode = self.step_mode == "frame"
         latency, processing, send_time = stats.latency, stats.processing, stats.send
+        pcap = self.pcap
+        self._sync_clocks()
 
         def answer(in_step: bool) -> bool:
             """Receive, process and answer one frame; False when none was waiting."""
@@ -259,7 +266,10 @@ class WireServer:
                 return False
             t_in = clock()
             stats.received += 1
+            request = bytes(view[:n]) if pcap is not None else b""
             if not chain.process(buf, n, t_in):
+                if pcap is not None:
+                    pcap.write(request, self._wall(t_kernel or t_in))
                 return True
             t_send = clock()
             try:
@@ -273,6 +283,9 @@ class WireServer:
             latency.add(t_out - (t_kernel or t_in))
             processing.add(t_send - t_in)
             send_time.add(t_out - t_send)
+            if pcap is not None:
+                pcap.write(request, self._wall(t_kernel or t_in))
+                pcap.write(view[:n], self._wall(t_send))
             if in_step:
                 stats.answered_in_step += 1
                 self._step_due |= frame_mode and chain.process_data
@@ -326,6 +339,8 @@ class WireServer:
         finally:
             if gc_was_enabled:
                 gc.enable()
+            if pcap is not None:
+                pcap.flush()
             stats.stopped_ns = clock()
             poller.unregister(sock.fileno())
             view.release()
@@ -334,8 +349,12 @@ class WireServer:
     _realtime_offset = 0
 
     def _sync_clocks(self) -> None:
-        if self.stats.kernel_timestamps:
+        if self.stats.kernel_timestamps or self.pcap is not None:
             self._realtime_offset = time.clock_gettime_ns(time.CLOCK_REALTIME) - self.clock()
+
+    def _wall(self, t: int) -> int:
+        """Our clock -> wall-clock ns (pcap timestamps)."""
+        return t + self._realtime_offset
 
     def _receiver(self, sock: socket.socket, view: memoryview) -> Callable[[], tuple[int, int]]:
         """``receive() -> (bytes, kernel receive time on our clock or 0)``."""
@@ -388,6 +407,8 @@ class WireServer:
         if self._sock is not None:
             self._sock.close()
             self._sock = None
+        if self.pcap is not None:
+            self.pcap.close()
 
     def report(self) -> dict[str, object]:
         """Counters and latency, for ``--stats-json`` and the benchmark."""
