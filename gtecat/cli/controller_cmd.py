@@ -47,6 +47,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--clock", choices=("auto", "lockstep", "realtime"), help="else GTECAT_CLOCK")
     p.add_argument("--backend", choices=("emulated", "pysoem"), help="else GTECAT_BACKEND")
     p.add_argument("--iface", help="network interface for pysoem (else GTECAT_IFACE)")
+    p.add_argument("--card", help="a GTS pulse card, gts:N, instead of a bus (else GTECAT_CARD)")
     p.add_argument(
         "--no-wall-floor",
         action="store_true",
@@ -95,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
             ("clock", args.clock),
             ("backend", args.backend),
             ("iface", args.iface),
+            ("card", args.card),
         )
         if v is not None
     }
