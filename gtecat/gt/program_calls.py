@@ -101,11 +101,14 @@ def _caller(ctl: Controller):
         c = ref()
         if c is None or _core.SESSION.controllers.get(1) is not c:
             return _core.CMD_COMM, "the controller running the program is closed"
-        rc = _core.REGISTRY[name](*args)
-        if rc == 0:
-            return 0, ""
-        e = _core.last_error()
-        return rc, (e.reason if e is not None and e.function == name else "")
+        host_last = _core.SESSION.last  # the host's GTE_GetLastError is not the program's
+        try:
+            rc = _core.REGISTRY[name](*args)
+            e = _core.last_error()
+            reason = e.reason if rc != 0 and e is not None and e.function == name else ""
+        finally:
+            _core.SESSION.last = host_last
+        return rc, reason
 
     return call
 
