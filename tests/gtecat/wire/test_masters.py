@@ -60,7 +60,7 @@ def served(eni: Path, tmp: Path, *extra: str) -> Iterator[tuple[str, ServeProces
 
 @pytest.fixture(scope="module")
 def fig52(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[str, ServeProcess]]:
-    with served(FIG52, tmp_path_factory.mktemp("fig52")) as it:
+    with served(FIG52, tmp_path_factory.mktemp("fig52"), "--rt-priority", "10") as it:
         yield it
 
 
@@ -232,3 +232,99 @@ def test_pysoem_sees_the_emergency_of_a_faulting_drive(tmp_path: Path) -> None:
             master.state = pysoem.INIT_STATE
             master.write_state()
             master.close()
+
+
+# --- KickCAT and ebpfcat (PyPI) -------------------------------------------------------------------
+def test_kickcat_maps_reads_the_dictionary_and_runs_in_op(fig52: tuple[str, ServeProcess]) -> None:
+    kickcat = pytest.importorskip(
+        "kickcat", reason="kickcat is not installed (pip install kickcat)"
+    )
+    from datetime import timedelta
+
+    link = kickcat.create_link(fig52[0], "")
+    link.set_timeout(timedelta(milliseconds=10))
+    bus = kickcat.Bus(link)
+    bus.init(0.1)
+    assert [s.address for s in bus.slaves()] == [1001, 1002, 1003, 1004]
+    bus.create_mapping()
+    slaves = bus.slaves()  # after the mapping: the slaves as configured
+    assert [(s.input_size, s.output_size) for s in slaves] == [(10, 6), (10, 6), (2, 2), (2, 2)]
+    drive = slaves[0]
+    vendor = bus.read_sdo(drive, 0x1018, 1, kickcat.Access.PARTIAL, 4, 1.0)
+    assert struct.unpack("<I", vendor)[0] == eni_vendor()
+    name, _ = bus.read_object_description(drive, 0x1018)
+    assert name == "Identity"
+    entry, text = bus.read_entry_description(drive, 0x6041, 0)
+    assert entry == "Statusword" and "TxPDO" in text
+    bus.request_state(kickcat.State.SAFE_OP)
+    bus.wait_for_state(kickcat.State.SAFE_OP, 2.0)
+    bus.request_state(kickcat.State.OPERATIONAL)
+    bus.wait_for_state(kickcat.State.OPERATIONAL, 2.0, bus.process_data)
+    for _ in range(100):
+        bus.process_data()  # raises on a wrong working counter
+    assert all(bus.get_state(s) == kickcat.State.OPERATIONAL for s in slaves)
+    status = struct.unpack_from("<H", drive.input_data)[0]
+    assert status & 0x004F == 0x0040  # SWITCH ON DISABLED: a CiA-402 drive after power-on
+
+
+def eni_vendor() -> int:
+    from eni.reader import read_eni
+
+    return read_eni(FIG52).slaves[0].identity.vendor_id
+
+
+def test_ebpfcat_initialises_lists_the_dictionary_and_cycles(
+    fig52: tuple[str, ServeProcess],
+) -> None:
+    pytest.importorskip("ebpfcat", reason="ebpfcat is not installed (pip install ebpfcat)")
+    import asyncio
+
+    from ebpfcat.ethercat import ECCmd, EtherCat, MachineState, Terminal
+
+    def signed(address: int) -> int:  # ebpfcat packs the low address word as a signed short
+        address &= 0xFFFF
+        return address - 0x10000 if address >= 0x8000 else address
+
+    async def session() -> tuple[dict, list, bytes]:
+        ec = EtherCat(fig52[0])
+        await ec.connect()
+        assert await ec.count() == 4
+        terms = [Terminal(ec) for _ in range(4)]
+        for i, t in enumerate(terms):
+            await asyncio.wait_for(t.initialize(-i, 1001 + i), 5)
+        drive = terms[0]
+        await drive.to_operational(MachineState.PRE_OPERATIONAL)
+        assert (await drive.sdo_read(0x1008, 0)).startswith(b"GTHD")
+        od = await asyncio.wait_for(drive.read_ODlist(), 30)
+        areas = []
+        for t in terms:
+            out = ec.get_fmmu_addr()
+            inp = ec.get_fmmu_addr()
+            await t.map_fmmu(out, True).__aenter__()
+            await t.map_fmmu(inp, False).__aenter__()
+            areas.append((out, inp))
+
+        async def cycle(outputs: bool) -> list[bytes]:
+            got = []
+            for t, (out, inp) in zip(terms, areas, strict=True):
+                if outputs:
+                    data = bytes(t.pdo_out_sz)
+                    await ec.roundtrip(ECCmd.LWR, signed(out), out >> 16, data=data)
+                got.append(await ec.roundtrip(ECCmd.LRD, signed(inp), inp >> 16, data=t.pdo_in_sz))
+            return got
+
+        for t in terms:
+            await t.to_operational(MachineState.SAFE_OPERATIONAL)
+        await cycle(False)
+        for t in terms:
+            await t.to_operational(MachineState.OPERATIONAL)
+        for _ in range(50):
+            inputs = await cycle(True)  # raises EtherCatError on a zero working counter
+        states = [await t.get_state() for t in terms]
+        return od, states, inputs[0]
+
+    od, states, drive_inputs = asyncio.run(asyncio.wait_for(session(), 90))
+    assert {0x1000, 0x1018, 0x6040, 0x6041} <= set(od)
+    assert od[0x1018].name == "Identity" and od[0x1018].entries[1].name == "Vendor ID"
+    assert [s[0] for s in states] == [MachineState.OPERATIONAL] * 4
+    assert len(drive_inputs) == 10
