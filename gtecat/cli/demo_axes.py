@@ -96,6 +96,8 @@ TRACE = (
     "axis2.machine",
     "1:0x60FD:0",
     "3:0x7000:1",
+    "axis1.mode",  # 6061h: from the drive (figure 5-2 does not map it)
+    "axis2.mode",
 )
 
 
@@ -487,6 +489,7 @@ def _bit_rows(rec: Recorder) -> list[tuple[str, np.ndarray, str]]:
         c = _COLORS[a]
         rows += [
             (f"ax{a} operation enabled", (sw & 0x6F) == 0x27, c),
+            (f"ax{a} SW10 target reached", (sw >> 10 & 1) == 1, c),
             (f"ax{a} SW12 homing attained / CSP following", (sw >> 12 & 1) == 1, c),
         ]
         if np.any(sw >> 13 & 1):
@@ -502,6 +505,35 @@ def _bit_rows(rec: Recorder) -> list[tuple[str, np.ndarray, str]]:
     return rows
 
 
+def _bands(ax: Any, rec: Recorder, t: np.ndarray) -> None:
+    """Per axis: the CiA-402 state (from 6041h) and the mode (6061h) as labelled bands."""
+    from ..controller.recorder import MODE_NAMES, STATE_NAMES, state_of
+    from ..controller.trace_plot import STATE_COLORS, _segments
+
+    lanes = []
+    for a in (1, 2):
+        sw = rec.column(f"axis{a}.sw").astype(np.int64)
+        lanes.append((f"axis {a} CiA-402 state", np.array([state_of(int(w)) for w in sw]),
+                      STATE_NAMES, STATE_COLORS))  # fmt: skip
+        mode_colors = {"CSP": "#c7e9c0", "homing": "#fdd0a2", "no mode": "0.9"}
+        lanes.append((f"axis {a} mode (6061h)", rec.column(f"axis{a}.mode").astype(np.int64),
+                      MODE_NAMES, mode_colors))  # fmt: skip
+    span = max(float(t[-1] - t[0]), 1e-9) if len(t) else 1.0
+    n = len(lanes)
+    for j, (_label, values, names, colors) in enumerate(lanes):
+        y = n - 1 - j
+        for a, b, v in _segments(values):
+            text = names.get(v, str(v))
+            x0, x1 = t[a], t[min(b, len(t) - 1)]
+            ax.axvspan(x0, x1, ymin=(y + 0.12) / n, ymax=(y + 0.88) / n,
+                       color=colors.get(text, "0.8"), lw=0)  # fmt: skip
+            if x1 - x0 > 0.07 * span:
+                ax.text((x0 + x1) / 2, y + 0.5, text, ha="center", va="center", fontsize=7)
+    ax.set_ylim(0, n)
+    ax.set_yticks([n - 1 - j + 0.5 for j in range(n)])
+    ax.set_yticklabels([lane[0] for lane in lanes], fontsize=8)
+
+
 def plot_demo(rec: Recorder, path: Path, run: DemoRun) -> Path:
     """demo.png: position, velocity, following error, drive and IO bits, events, vs time."""
     import matplotlib
@@ -513,13 +545,14 @@ def plot_demo(rec: Recorder, path: Path, run: DemoRun) -> Path:
     t = t_ms / 1000.0
     rows = _bit_rows(rec)
     fig, axs = plt.subplots(
-        4,
+        5,
         1,
-        figsize=(12, 13),
+        figsize=(12, 15),
         sharex=True,
-        gridspec_kw={"height_ratios": [3, 2, 2, 0.32 * len(rows)]},
+        gridspec_kw={"height_ratios": [3, 2, 2, 1.6, 0.32 * len(rows)]},
     )
-    pos, vel, err, bits = axs
+    pos, vel, err, bands, bits = axs
+    _bands(bands, rec, t)
     jump = 4 * max(TRAP_VEL, max(p.speed1 for p in HOMING) / 1000.0)
     for a in (1, 2):
         c = _COLORS[a]

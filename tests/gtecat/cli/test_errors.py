@@ -140,8 +140,8 @@ def test_cli_unmapped_trace_signal(
     script.write_text(
         "from gtecat import gt\ngt.GT_Open(log='')\nprint(gt.GT_InitEcatComm())\ngt.GT_Close()\n"
     )
-    rc, _, err = cli("run", str(script), "--eni", FIG52, "--trace", "axis2.mode")
-    assert rc == 1 and "0x6061:00" in err and "not mapped" in err and "gtecat map" in err
+    rc, _, err = cli("run", str(script), "--eni", FIG52, "--trace", "1:0x6061:0")
+    assert rc == 1 and "slave 1 maps no 0x6061:00" in err and "gtecat map" in err
     assert err.count("\n") == 1
 
 

@@ -129,10 +129,10 @@ def test_an_unknown_trace_signal_stops_with_one_line(
     cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.chdir(tmp_path)
-    rc, out, err = cli("run", str(_script(tmp_path)), "--eni", FIG52, "--trace", "axis1.mode")
+    rc, out, err = cli("run", str(_script(tmp_path)), "--eni", FIG52, "--trace", "0:0x6061:0")
     assert rc == 1
     assert err.count("\n") == 1
-    assert "--trace: axis 1: object 0x6061:00" in err and "not mapped" in err
+    assert "--trace: slave 0 maps no 0x6061:00" in err
     assert "gtecat map" in err  # what to do next
     assert "axis on" not in out  # the script stopped at GT_InitEcatComm
 
@@ -284,3 +284,47 @@ def test_gt_open_is_restored_after_the_run(cli: Cli, tmp_path: Path) -> None:
     before = gt.GT_Open
     cli("run", str(_precedence(tmp_path)), "--eni", FIG52)
     assert gt.GT_Open is before
+
+
+def test_axis_mode_and_state_come_from_the_drive_when_not_mapped(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Figure 5-2 maps no 6061h: the emulated drive's own value is recorded."""
+    monkeypatch.chdir(tmp_path)
+    spec = "axis1.mode,axis1.state,axis1.vel,axis1.encvel,axis1.sw"
+    rc, _, err = cli("run", str(_script(tmp_path)), "--eni", FIG52, "--trace", spec)
+    assert rc == 0, err
+    rows = list(csv.DictReader((tmp_path / "machine_test.csv").open()))
+    assert rows[-1]["axis1.mode"] == "8"  # CSP once the drive is configured
+    assert rows[-1]["axis1.state"] == "4"  # operation enabled (after GT_AxisOn)
+    assert (tmp_path / "machine_test.png").stat().st_size > 10_000
+
+
+def test_trace_plot_layout_bits_bands_and_value_groups() -> None:
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from gtecat.controller import recorder as r
+    from gtecat.controller.trace_plot import layout
+
+    t = np.arange(6, dtype=float)
+    sw = [0x0250, 0x0250, 0x0231, 0x0233, 0x0237, 0x1637]
+    data = np.column_stack([t, t * 10, t * 9, sw, [8] * 6])
+    rec = SimpleNamespace(
+        data=data,
+        names=["axis1.prf", "axis1.enc", "axis1.sw", "axis1.mode"],
+        kinds=[
+            r.Kind("value", "pulse"),
+            r.Kind("value", "counts"),
+            r.Kind("bits", bits=r.SW_BITS),
+            r.Kind("mode"),
+        ],
+    )
+    panels, bands, rows = layout(rec)
+    assert [g for g, _ in panels] == ["position"]  # prf and enc share one panel
+    assert [b[0] for b in bands] == ["axis1 CiA-402 state", "axis1.mode (6061h)"]
+    assert list(bands[0][1]) == [1, 1, 2, 3, 4, 4]  # disabled, ready, switched on, enabled
+    names = [row[0] for row in rows]
+    assert "axis1.sw 2: operation enabled" in names and "axis1.sw 10: target reached" in names
+    assert not any("fault" in n for n in names)  # a bit never set gets no row
