@@ -99,6 +99,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--clock", default="auto", choices=("auto", "lockstep", "realtime"))
     ap.add_argument("--eni", default=str(ROOT / "examples" / "manual_fig5_2.eni"))
     ap.add_argument("--no-wall-floor", action="store_true")
+    ap.add_argument(
+        "--spin-us", type=int, default=None, help="GTECAT_SPIN_US: the client spins for its reply"
+    )
+    ap.add_argument(
+        "--server-spin-us",
+        type=int,
+        default=None,
+        help="GTECAT_SERVER_SPIN_US: the controller spins for the next request",
+    )
     args = ap.parse_args(argv)
 
     from gtecat.native.build import ensure_built
@@ -115,6 +124,10 @@ def main(argv: list[str] | None = None) -> int:
         env.update(GTECAT_ENI=args.eni, GTECAT_CLOCK=args.clock, GTECAT_LOG="")
         if args.no_wall_floor:
             env["GTECAT_WALL_FLOOR"] = "0"
+        if args.spin_us is not None:
+            env["GTECAT_SPIN_US"] = str(args.spin_us)
+        if args.server_spin_us is not None:
+            env["GTECAT_SERVER_SPIN_US"] = str(args.server_spin_us)
         r = subprocess.run(
             [str(exe), str(args.calls)], capture_output=True, text=True, env=env, cwd=tmp
         )
@@ -129,6 +142,10 @@ def main(argv: list[str] | None = None) -> int:
         "call": "GT_GetSts(1, &sts, 1, NULL) from C",
         "clock": args.clock,
         "wall_floor": not args.no_wall_floor and args.clock == "auto",
+        "spin_us": {
+            "client": env.get("GTECAT_SPIN_US"),
+            "server": env.get("GTECAT_SERVER_SPIN_US"),
+        },
         "calls": len(samples),
         "round_trip_us": stats,
         "calls_per_s": round(len(samples) / (total_ns / 1e9)),

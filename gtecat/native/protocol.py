@@ -1,4 +1,4 @@
-"""The controller protocol: one request and one reply per GT call, over a stream socket.
+"""The controller protocol: one request and one reply per GT call, over a Unix socket.
 
 Both ends are generated from the function table (:mod:`gtecat.gt.table`): the C stubs
 of ``libgts.so`` (:mod:`gtecat.native.stubs`) encode a call the way this module reads
@@ -6,7 +6,11 @@ it, and the controller (:mod:`gtecat.native.server`) decodes it with the plan be
 The two ends run on one machine, so numbers travel little-endian in the client's own
 C sizes (``long`` is the client's ``long``, announced in the hello).
 
-Every message is a frame: ``u32 length`` then ``length`` bytes of body.
+Every message is a frame: ``u32 length`` then ``length`` bytes of body.  On Linux the
+socket is ``SOCK_SEQPACKET``: a frame travels as records of at most :data:`CHUNK` bytes
+(nearly always one, so one ``recv`` takes a whole request or reply, and record
+boundaries cost no extra reads); elsewhere it is ``SOCK_STREAM`` with the same frames.
+A receiver always offers at least :data:`CHUNK` bytes of room to a read.
 
 Client -> controller, first message of a connection (``HELLO``)::
 
@@ -33,19 +37,37 @@ Reply (``REPLY``)::
     i16 return code, u16 number of out blocks, u16 error text length,
     per non-NULL out/inout pointer in prototype order: u32 size, bytes,
     then the error text (UTF-8; only when the code is not 0 and the call said why)
+
+The field side and the bus (``FIELD``, :mod:`gtecat.native.field`): what a test or an
+inspection verb asks of the controller beyond the GT API (inject a drive fault, set a
+machine input, read the slaves, record a trace)::
+
+    u8 type = 3, then UTF-8 JSON {"op": name, "args": [...]}
+
+Reply (``FIELD_REPLY``): ``i16 status (0 ok, 1 refused), then UTF-8 JSON``: the result,
+or the reason as a JSON string.
 """
 
 from __future__ import annotations
 
+import ctypes
+import socket
 import struct
+import sys
 from dataclasses import dataclass
 from enum import IntEnum
 from functools import cache
+from typing import Any
 
-from ..gt.table import FUNCTIONS, PROTOTYPES, Param, Proto
+from ..gt.table import FUNCTIONS, PROTOTYPES, SCALARS, Param, Proto
 from . import cdecl
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
+
+#: one record per message where the system has them (Linux), a byte stream elsewhere
+SOCKET_TYPE = socket.SOCK_SEQPACKET if sys.platform.startswith("linux") else socket.SOCK_STREAM
+#: the largest record one send makes (well inside the default socket buffer)
+CHUNK = 1 << 16
 
 FRAME = struct.Struct("<I")
 HELLO = struct.Struct("<B3xHH16s")
@@ -57,8 +79,11 @@ F64 = struct.Struct("<d")
 PTR = struct.Struct("<i")
 BLOCK = struct.Struct("<I")
 
+FIELD_REPLY = struct.Struct("<h")
+
 MSG_HELLO = 1
 MSG_CALL = 2
+MSG_FIELD = 3
 
 PTR_NULL = -1
 PTR_UNKNOWN = -2
@@ -143,6 +168,30 @@ def _plan(proto: Proto, fid: int) -> FunctionPlan:
     return FunctionPlan(proto.name, fid, proto, tuple(args), unsupported)
 
 
+def element_type(ctype: str, long_size: int) -> Any:
+    """The ctypes element behind a pointer of C type ``ctype`` for a client whose
+    ``long`` has ``long_size`` bytes (a structure: gt's ctypes structure)."""
+    if ctype in ("long", "unsigned long"):
+        signed = ctype == "long"
+        return {
+            4: ctypes.c_int32 if signed else ctypes.c_uint32,
+            8: ctypes.c_int64 if signed else ctypes.c_uint64,
+        }[long_size]
+    if ctype in SCALARS:
+        return getattr(ctypes, SCALARS[ctype][0])
+    return cdecl.structure(ctype)
+
+
+def socket_path(address: str) -> str:
+    """``unix:/path``, ``/path`` or ``unix:@name`` (Linux abstract) -> the AF_UNIX address."""
+    addr = address[5:] if address.startswith("unix:") else address
+    if not addr:
+        raise ValueError(f"controller address {address!r} names no socket")
+    if addr.startswith("@"):
+        return "\0" + addr[1:]
+    return addr
+
+
 #: function ids: the table's names in sorted order
 FUNCTION_NAMES: tuple[str, ...] = tuple(sorted(FUNCTIONS))
 
@@ -150,6 +199,11 @@ FUNCTION_NAMES: tuple[str, ...] = tuple(sorted(FUNCTIONS))
 @cache
 def plans() -> tuple[FunctionPlan, ...]:
     return tuple(_plan(FUNCTIONS[n], i) for i, n in enumerate(FUNCTION_NAMES))
+
+
+@cache
+def plans_by_name() -> dict[str, FunctionPlan]:
+    return {p.name: p for p in plans()}
 
 
 @cache
@@ -161,7 +215,9 @@ def table_digest() -> str:
 __all__ = [
     "BLOCK",
     "CALL",
+    "CHUNK",
     "F64",
+    "FIELD_REPLY",
     "FRAME",
     "FUNCTION_NAMES",
     "HELLO",
@@ -170,6 +226,7 @@ __all__ = [
     "MAX_FRAME",
     "MAX_POINTER_BYTES",
     "MSG_CALL",
+    "MSG_FIELD",
     "MSG_HELLO",
     "PROTOCOL_VERSION",
     "PTR",
@@ -177,9 +234,13 @@ __all__ = [
     "PTR_TOO_BIG",
     "PTR_UNKNOWN",
     "REPLY",
+    "SOCKET_TYPE",
     "ArgPlan",
     "FunctionPlan",
     "Kind",
+    "element_type",
     "plans",
+    "plans_by_name",
+    "socket_path",
     "table_digest",
 ]

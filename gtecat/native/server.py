@@ -26,41 +26,49 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import json
 import logging
 import os
 import select
-import selectors
 import socket
+import struct
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from eni.errors import GtecatError
+
 from ..gt import _core
-from ..gt.table import SCALARS
-from . import cdecl
+from . import field as field_ops
 from .floor import WallFloor
 from .protocol import (
     BLOCK,
     CALL,
+    CHUNK,
     F64,
+    FIELD_REPLY,
     FRAME,
     HELLO,
     HELLO_REPLY,
     I64,
     MAX_FRAME,
     MSG_CALL,
+    MSG_FIELD,
     MSG_HELLO,
     PROTOCOL_VERSION,
     PTR,
     PTR_NULL,
     PTR_TOO_BIG,
     PTR_UNKNOWN,
-    REPLY,
+    SOCKET_TYPE,
     FunctionPlan,
     Kind,
+    element_type,
     plans,
+    socket_path,
     table_digest,
 )
 
@@ -75,116 +83,131 @@ DEFAULT_SPIN_US = 0
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
 
 
-def socket_path(address: str) -> str:
-    """``unix:/path``, ``/path`` or ``unix:@name`` (Linux abstract) -> the AF_UNIX address."""
-    addr = address[5:] if address.startswith("unix:") else address
-    if not addr:
-        raise ValueError(f"controller address {address!r} names no socket")
-    if addr.startswith("@"):
-        return "\0" + addr[1:]
-    return addr
-
-
 class ProtocolError(Exception):
     """A client sent something this protocol does not allow; its connection is closed."""
 
 
-def _elem(ctype: str, long_size: int) -> Any:
-    """The ctypes element behind a pointer of C type ``ctype`` for this client."""
-    if ctype in ("long", "unsigned long"):
-        signed = ctype == "long"
-        return {
-            4: ctypes.c_int32 if signed else ctypes.c_uint32,
-            8: ctypes.c_int64 if signed else ctypes.c_uint64,
-        }[long_size]
-    if ctype in SCALARS:
-        return getattr(ctypes, SCALARS[ctype][0])
-    return cdecl.structure(ctype)
-
-
-_INT, _DOUBLE, _TEXT, _ANY, _BUF = range(5)
 _i64 = I64.unpack_from
 _f64 = F64.unpack_from
 _ptr = PTR.unpack_from
+_byref = ctypes.byref
+
+Step = Callable[[Any, int, list, list], int]
+
+
+def _int_step(body: Any, pos: int, args: list, backs: list) -> int:
+    args.append(_i64(body, pos)[0])
+    return pos + 8
+
+
+def _double_step(body: Any, pos: int, args: list, backs: list) -> int:
+    args.append(_f64(body, pos)[0])
+    return pos + 8
+
+
+def _text_step(fname: str, name: str) -> Step:
+    def step(body: Any, pos: int, args: list, backs: list) -> int:
+        size = _ptr(body, pos)[0]
+        pos += 4
+        if size == PTR_NULL:
+            args.append(None)
+            return pos
+        if size < 0 or pos + size > len(body):
+            raise ProtocolError(f"{fname}: bad size {size} for {name}")
+        args.append(bytes(body[pos : pos + size]))
+        return pos + size
+
+    return step
+
+
+def _pointer_step(fname: str, name: str, elem: Any, back: bool, any_size: bool) -> Step:
+    """One pointer parameter: its bytes become a ctypes object of the client's size, passed
+    as ``byref`` (the binder's fast path); a single element (``&sts``) is the usual case."""
+    one = ctypes.sizeof(elem)
+    copy_one = elem.from_buffer_copy
+    types: dict[int, Any] = {}
+
+    def array(size: int) -> Any:
+        t = types.get(size)
+        if t is None:
+            t = types[size] = elem * (size // one) if size % one == 0 else ctypes.c_ubyte * size
+        return t
+
+    def step(body: Any, pos: int, args: list, backs: list) -> int:
+        size = _ptr(body, pos)[0]
+        pos += 4
+        if size == one and pos + one <= len(body):
+            obj = copy_one(body, pos)
+            args.append(_byref(obj))
+            if back:
+                backs.append(obj)
+            return pos + one
+        if size == PTR_NULL:
+            args.append(None)
+            if back:
+                backs.append(None)
+            return pos
+        if size == PTR_UNKNOWN:
+            if not any_size:
+                raise ProtocolError(f"{fname}: size unknown for {name}")
+            buf: list = []  # grows to what the call writes
+            args.append(buf)
+            backs.append(buf)
+            return pos
+        if size == PTR_TOO_BIG:
+            obj = array(0)()  # refused by the call's room check
+        elif size < 0 or pos + size > len(body):
+            raise ProtocolError(f"{fname}: bad size {size} for {name}")
+        else:
+            obj = array(size).from_buffer_copy(body, pos) if size else array(0)()
+            pos += size
+        args.append(_byref(obj))
+        if back:
+            backs.append(obj)
+        return pos
+
+    return step
 
 
 class _Decoder:
-    """One function's request layout for one client ``long`` size, compiled once."""
+    """One function's request layout for one client ``long`` size, compiled once into a
+    step per parameter."""
 
-    __slots__ = ("_arrays", "fn_gt", "fn_gtn", "plan", "steps")
+    __slots__ = ("fn_gt", "fn_gtn", "plan", "steps")
 
     def __init__(self, plan: FunctionPlan, long_size: int) -> None:
         self.plan = plan
-        steps = []
+        steps: list[Step] = []
         for a in plan.args:
+            p = a.param
             if a.kind is Kind.INT:
-                steps.append((_INT, None, 0, False, a.param.name))
+                steps.append(_int_step)
             elif a.kind is Kind.DOUBLE:
-                steps.append((_DOUBLE, None, 0, False, a.param.name))
+                steps.append(_double_step)
+            elif a.kind is Kind.TEXT:
+                steps.append(_text_step(plan.name, p.name))
             else:
-                code = {Kind.TEXT: _TEXT, Kind.OUT_ANY: _ANY}.get(a.kind, _BUF)
-                elem = _elem(a.param.ctype, long_size)
-                steps.append((code, elem, ctypes.sizeof(elem), a.carries_back, a.param.name))
+                elem = element_type(p.ctype, long_size)
+                steps.append(
+                    _pointer_step(plan.name, p.name, elem, a.carries_back, a.kind is Kind.OUT_ANY)
+                )
         self.steps = tuple(steps)
-        self._arrays: dict[tuple[Any, int], Any] = {}
         self.fn_gt = _core.REGISTRY.get(plan.name)
         self.fn_gtn = _core.REGISTRY.get("GTN_" + plan.name[3:]) if plan.proto.gtn else None
 
-    def _array(self, elem: Any, n: int) -> Any:
-        key = (elem, n)
-        t = self._arrays.get(key)
-        if t is None:
-            t = self._arrays[key] = elem * n
-        return t
-
-    def decode(self, body: memoryview, pos: int) -> tuple[list[Any], list[Any]]:
+    def decode(self, body: Any, pos: int) -> tuple[list[Any], list[Any]]:
         """(arguments for the GT function, out-buffers in order; None for NULL)."""
         args: list[Any] = []
         backs: list[Any] = []
-        end = len(body)
-        for code, elem, esize, back, name in self.steps:
-            if code == _INT:
-                args.append(_i64(body, pos)[0])
-                pos += 8
-                continue
-            if code == _DOUBLE:
-                args.append(_f64(body, pos)[0])
-                pos += 8
-                continue
-            size = _ptr(body, pos)[0]
-            pos += 4
-            if size == PTR_NULL:
-                args.append(None)
-                if back:
-                    backs.append(None)
-                continue
-            if size == PTR_UNKNOWN:
-                if code != _ANY:
-                    raise ProtocolError(f"{self.plan.name}: size unknown for {name}")
-                buf: Any = []  # grows to what the call writes
-                args.append(buf)
-                backs.append(buf)
-                continue
-            if size == PTR_TOO_BIG:
-                size, data = 0, b""
-            elif size < 0 or pos + size > end:
-                raise ProtocolError(f"{self.plan.name}: bad size {size} for {name}")
-            else:
-                data = body[pos : pos + size]
-                pos += size
-            if code == _TEXT:
-                args.append(bytes(data))
-                continue
-            raw = bytearray(data)
-            if size % esize:
-                arr: Any = self._array(ctypes.c_ubyte, size).from_buffer(raw)
-            else:
-                arr = self._array(elem, size // esize).from_buffer(raw)
-            args.append(arr)
-            if back:
-                backs.append(raw)
-        if pos != end:
-            raise ProtocolError(f"{self.plan.name}: {end - pos} bytes left after the arguments")
+        try:
+            for step in self.steps:
+                pos = step(body, pos, args, backs)
+        except (struct.error, ValueError) as e:
+            raise ProtocolError(f"{self.plan.name}: a request cut short ({e})") from None
+        if pos != len(body):
+            raise ProtocolError(
+                f"{self.plan.name}: {len(body) - pos} bytes left after the arguments"
+            )
         return args, backs
 
 
@@ -196,21 +219,73 @@ class _Client:
     long_size: int = 0  # 0 until the hello
     opened: bool = False
     decoders: dict[int, _Decoder] = field(default_factory=dict)
+    field: field_ops.Context | None = None  # its traces
+
+
+_REPLY_HEAD = struct.Struct("<IhHH")  # FRAME + REPLY
+_REPLY_OK = _REPLY_HEAD.pack(6, 0, 0, 0)
+_BLOCK = BLOCK.pack
 
 
 def _reply(rc: int, backs: list[Any], text: str) -> bytes:
-    parts = []
+    t = text.encode("utf-8", "replace")[:4000] if text else b""
+    if not backs:
+        return _REPLY_OK if rc == 0 and not t else _REPLY_HEAD.pack(6 + len(t), rc, 0, len(t)) + t
+    parts = [b""]
     n = 0
+    total = 6 + len(t)
     for b in backs:
         if b is None:
             continue
-        data = bytes(b) if not isinstance(b, list) else bytes(int(v) & 0xFF for v in b)
-        parts.append(BLOCK.pack(len(data)))
+        data = bytes(b) if type(b) is not list else bytes(int(v) & 0xFF for v in b)
+        parts.append(_BLOCK(len(data)))
         parts.append(data)
         n += 1
-    t = text.encode("utf-8", "replace")[:4000] if text else b""
-    body = REPLY.pack(rc, n, len(t)) + b"".join(parts) + t
-    return FRAME.pack(len(body)) + body
+        total += 4 + len(data)
+    parts[0] = _REPLY_HEAD.pack(total, rc, n, len(t))
+    parts.append(t)
+    return b"".join(parts)
+
+
+def _jsonable(v: Any) -> Any:
+    """What json cannot write itself: numpy numbers and arrays, enums, dataclasses, bytes."""
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    if isinstance(v, bytes | bytearray):
+        return bytes(v).hex()
+    if hasattr(v, "__dataclass_fields__"):
+        import dataclasses
+
+        return dataclasses.asdict(v)
+    return str(v)
+
+
+class _Poller:
+    """epoll where there is one (Linux), poll elsewhere: fd -> readable."""
+
+    def __init__(self) -> None:
+        self._ep = select.epoll() if hasattr(select, "epoll") else None
+        self._p = None if self._ep is not None else select.poll()
+
+    def register(self, fd: int) -> None:
+        if self._ep is not None:
+            self._ep.register(fd, select.EPOLLIN)
+        else:
+            self._p.register(fd, select.POLLIN)  # type: ignore[union-attr]
+
+    def unregister(self, fd: int) -> None:
+        with contextlib.suppress(OSError, KeyError, ValueError):
+            (self._ep or self._p).unregister(fd)  # type: ignore[union-attr]
+
+    def poll(self, timeout_s: float | None) -> list[tuple[int, int]]:
+        if self._ep is not None:
+            return self._ep.poll(-1 if timeout_s is None else timeout_s)
+        ms = None if timeout_s is None else int(timeout_s * 1000)
+        return self._p.poll(ms)  # type: ignore[union-attr]
+
+    def close(self) -> None:
+        if self._ep is not None:
+            self._ep.close()
 
 
 class Server:
@@ -242,15 +317,16 @@ class Server:
         self._stop = threading.Event()
         self._wake_r, self._wake_w = os.pipe()
         self._thread: threading.Thread | None = None
-        self._clients: dict[socket.socket, _Client] = {}
-        self._sel = selectors.DefaultSelector()
+        self._clients: dict[int, _Client] = {}  # by file descriptor
+        self._decoders: dict[tuple[int, int], _Decoder] = {}  # (long size, fid)
+        self._poller = _Poller()
         self._listener = self._listen()
 
     # --- socket ------------------------------------------------------------------------
     def _listen(self) -> socket.socket:
-        s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        s = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
         if not self.path.startswith("\0") and os.path.exists(self.path):
-            probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+            probe = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
             try:
                 probe.connect(self.path)
             except OSError:
@@ -270,32 +346,34 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
-        sel = self._sel
-        sel.register(self._listener, selectors.EVENT_READ, "accept")
-        sel.register(self._wake_r, selectors.EVENT_READ, "wake")
+        poller = self._poller
+        listen_fd = self._listener.fileno()
+        poller.register(listen_fd)
+        poller.register(self._wake_r)
         if self._lifeline is not None:
-            sel.register(self._lifeline, selectors.EVENT_READ, "lifeline")
+            poller.register(self._lifeline)
+        clients = self._clients
         try:
             while not self._stop.is_set():
                 floor = self._current_floor()
                 timeout = floor.idle_timeout() if floor is not None else None
-                events = sel.select(timeout)
+                events = poller.poll(timeout)
                 if not events and floor is not None:
                     with self.lock:
                         floor.look()
                     continue
-                for key, _ in events:
-                    what = key.data
-                    if what == "accept":
+                for fd, _ in events:
+                    c = clients.get(fd)
+                    if c is not None:
+                        self._readable(c)
+                    elif fd == listen_fd:
                         self._accept()
-                    elif what == "wake":
+                    elif fd == self._wake_r:
                         os.read(self._wake_r, 64)
-                    elif what == "lifeline":
-                        if not os.read(self._lifeline, 64):  # type: ignore[arg-type]
+                    elif fd == self._lifeline:
+                        if not os.read(self._lifeline, 64):
                             log.info("the program that started this controller has ended")
                             self._stop.set()
-                    else:
-                        self._readable(what)
         finally:
             self._cleanup()
 
@@ -324,7 +402,7 @@ class Server:
         for c in list(self._clients.values()):
             self._drop(c)
         with contextlib.suppress(Exception):
-            self._sel.close()
+            self._poller.close()
         self._listener.close()
         if not self.path.startswith("\0"):
             with contextlib.suppress(OSError):
@@ -343,25 +421,27 @@ class Server:
             return
         sock.setblocking(False)
         client = _Client(sock, peer=f"fd {sock.fileno()}")
-        self._clients[sock] = client
-        self._sel.register(sock, selectors.EVENT_READ, client)
+        self._clients[sock.fileno()] = client
+        self._poller.register(sock.fileno())
 
     def _drop(self, c: _Client) -> None:
-        self._clients.pop(c.sock, None)
-        with contextlib.suppress(Exception):
-            self._sel.unregister(c.sock)
+        if self._clients.pop(c.sock.fileno(), None) is not None:
+            self._poller.unregister(c.sock.fileno())
+        if c.field is not None:
+            with self.lock:
+                c.field.stop_traces()
         c.sock.close()
 
     def _readable(self, c: _Client) -> None:
         """Serve what ``c`` sent; then, for ``spin_s``, serve its next request at once
         (a client polling in a loop sends it within microseconds; answering it without
-        a round through the selector, and without either side falling asleep, roughly
-        halves the round trip)."""
-        sock = c.sock
+        a round through the poller, and without either side falling asleep, saves the
+        wake-up)."""
+        recv = c.sock.recv
         deadline = 0.0
         while True:
             try:
-                data = sock.recv(1 << 16)
+                data = recv(CHUNK)
             except BlockingIOError:
                 if not self.spin_s:
                     return
@@ -383,17 +463,12 @@ class Server:
     def _frames(self, c: _Client, data: bytes) -> bool:
         """Answer every whole frame in the client's buffer; False once it is dropped."""
         buf = c.buf
-        if not buf and len(data) >= 4 and FRAME.unpack_from(data, 0)[0] == len(data) - 4:
-            # the usual case: exactly one whole request
-            try:
-                self._send(c.sock, self._message(c, memoryview(data)[4:]))
-            except (ProtocolError, OSError) as e:
-                log.info("client %s: %s; connection closed", c.peer, e)
-                self._drop(c)
-                return False
-            return True
-        buf += data
         try:
+            if not buf and len(data) >= 4 and FRAME.unpack_from(data, 0)[0] == len(data) - 4:
+                # the usual case: exactly one whole request in one record
+                self._send(c.sock, self._message(c, memoryview(data)[4:]))
+                return True
+            buf += data
             while len(buf) >= 4:
                 (n,) = FRAME.unpack_from(buf, 0)
                 if n > MAX_FRAME:
@@ -422,19 +497,28 @@ class Server:
             left = deadline - time.monotonic()
             if left <= 0 or not select.select([c.sock], [], [], left)[0]:
                 raise OSError("a frame cut short (no more bytes within 10 s)")
-            more = c.sock.recv(max(need - len(buf), 1 << 16))
+            more = c.sock.recv(max(need - len(buf), CHUNK))
             if not more:
                 raise OSError("the connection closed inside a frame")
             buf += more
 
     @staticmethod
     def _send(sock: socket.socket, data: bytes) -> None:
-        """Send a reply; a client that stops reading for 10 s is dropped (OSError)."""
-        view = memoryview(data)
+        """Send a reply in records of at most CHUNK bytes; a client that stops reading for
+        10 s is dropped (OSError)."""
+        n = 0
+        if len(data) <= CHUNK:  # the usual case: one record, sent at once
+            try:
+                n = sock.send(data)
+            except BlockingIOError:
+                n = 0
+            if n == len(data):
+                return
+        view = memoryview(data)[n:]
         deadline = 0.0
         while view:
             try:
-                view = view[sock.send(view) :]
+                view = view[sock.send(view[:CHUNK]) :]
                 continue
             except BlockingIOError:
                 pass
@@ -449,25 +533,36 @@ class Server:
         if not body:
             raise ProtocolError("empty frame")
         kind = body[0]
+        if kind == MSG_CALL and c.long_size:
+            _, gtn, fid, core = CALL.unpack_from(body, 0)
+            dec = c.decoders.get(fid)
+            if dec is None:
+                dec = c.decoders[fid] = self._decoder(c.long_size, fid)
+            args, backs = dec.decode(body, CALL.size)
+            with self.lock:
+                rc, text = self._call(c, dec, gtn, core, args)
+            return _reply(rc, backs, text)
         if kind == MSG_HELLO:
             return self._hello(c, body)
-        if kind != MSG_CALL:
-            raise ProtocolError(f"message type {kind}")
-        if not c.long_size:
+        if kind == MSG_FIELD:
+            return self._field(c, body)
+        if kind == MSG_CALL:
             raise ProtocolError("a call before the hello")
-        _, gtn, fid, core = CALL.unpack_from(body, 0)
-        dec = c.decoders.get(fid)
+        raise ProtocolError(f"message type {kind}")
+
+    def _decoder(self, long_size: int, fid: int) -> _Decoder:
+        key = (long_size, fid)
+        dec = self._decoders.get(key)
         if dec is None:
             table = plans()
             if fid >= len(table):
                 raise ProtocolError(f"function id {fid} unknown")
-            dec = c.decoders[fid] = _Decoder(table[fid], c.long_size)
-        args, backs = dec.decode(body, CALL.size)
-        with self.lock:
-            rc, text = self._call(c, dec, bool(gtn), core, args)
-        return _reply(rc, backs, text)
+            dec = self._decoders[key] = _Decoder(table[fid], long_size)
+        return dec
 
     def _hello(self, c: _Client, body: memoryview) -> bytes:
+        if len(body) < HELLO.size:
+            raise ProtocolError("a hello cut short")
         _, version, long_size, digest = HELLO.unpack_from(body, 0)
         status, text = 0, ""
         if version != PROTOCOL_VERSION or digest.decode("ascii", "replace") != table_digest():
@@ -486,12 +581,60 @@ class Server:
         out = HELLO_REPLY.pack(status, len(t)) + t
         return FRAME.pack(len(out)) + out
 
+    def _field(self, c: _Client, body: memoryview) -> bytes:
+        """A field-side or bus operation (:mod:`gtecat.native.field`)."""
+        try:
+            req = json.loads(bytes(body[1:]).decode("utf-8"))
+            op, args = str(req["op"]), list(req.get("args", []))
+        except (ValueError, KeyError, TypeError) as e:
+            raise ProtocolError(f"a field request that is not JSON {{op, args}}: {e}") from None
+        status, result = 0, None
+        with self.lock:
+            ctl = _core.SESSION.controllers.get(1)
+            if ctl is None:
+                status, result = 1, "the controller is not open yet (no client has called GT_Open)"
+            else:
+                if c.field is None or c.field.ctl is not ctl:
+                    if c.field is not None:
+                        c.field.stop_traces()
+                    c.field = field_ops.Context(ctl)
+                try:
+                    result = field_ops.run(c.field, op, args)
+                except GtecatError as e:
+                    status, result = 1, str(e)
+                except Exception as e:  # a field operation never takes the controller down
+                    log.exception("field operation %s failed", op)
+                    status, result = 1, f"internal error in the emulator: {type(e).__name__}: {e}"
+        text = json.dumps(result, default=_jsonable).encode("utf-8")
+        out = FIELD_REPLY.pack(status) + text
+        return FRAME.pack(len(out)) + out
+
     def _call(
-        self, c: _Client, dec: _Decoder, gtn: bool, core: int, args: list[Any]
+        self, c: _Client, dec: _Decoder, gtn: int, core: int, args: list[Any]
     ) -> tuple[int, str]:
         plan = dec.plan
-        name = plan.name
         self.calls += 1
+        if not c.opened or plan.name in ("GT_Open", "GT_Close"):
+            return self._open_close(c, dec, gtn, core, args)
+        if plan.unsupported:
+            return _core.CMD_ERROR, plan.unsupported
+        fn = dec.fn_gtn if gtn else dec.fn_gt
+        if fn is None:
+            return _core.CMD_NO_RESPONSE, f"{plan.name}: not implemented by this gtecat"
+        if self.wall_floor:
+            floor = self._current_floor()
+            if floor is not None:
+                floor.look()
+        rc = fn(core, *args) if gtn else fn(*args)
+        if rc == 0:
+            return 0, ""
+        e = _core.SESSION.last
+        return rc, (f"{e.function} returned {e.code}: {e.reason}" if e is not None else "")
+
+    def _open_close(
+        self, c: _Client, dec: _Decoder, gtn: int, core: int, args: list[Any]
+    ) -> tuple[int, str]:
+        name = dec.plan.name
         if name in ("GT_Open", "GT_Close"):
             if gtn and core != 1:  # the Python twin refuses it (7) before doing anything
                 return _invoke(dec.fn_gtn, (core, *args))
@@ -499,27 +642,15 @@ class Server:
                 return self._open(c, gtn, core, args)
             c.opened = False
             return 0, ""
-        if not c.opened:
-            return _core.CMD_COMM, f"{name} returned -1: {NOT_OPEN}"
-        if plan.unsupported:
-            return _core.CMD_ERROR, plan.unsupported
-        fn = dec.fn_gtn if gtn else dec.fn_gt
-        if fn is None:
-            return _core.CMD_NO_RESPONSE, f"{name}: not implemented by this gtecat"
-        floor = self._current_floor()
-        if floor is not None:
-            floor.look()
-        return _invoke(fn, (core, *args) if gtn else args)
+        return _core.CMD_COMM, f"{name} returned -1: {NOT_OPEN}"
 
-    def _open(self, c: _Client, gtn: bool, core: int, args: list[Any]) -> tuple[int, str]:
+    def _open(self, c: _Client, gtn: int, core: int, args: list[Any]) -> tuple[int, str]:
         if 1 not in _core.SESSION.controllers:
-            errors = _core.SESSION.errors
-            before = errors[-1] if errors else None
             opener = _core.REGISTRY["GT_Open"]
             # "local": this process is the controller, whatever GTECAT_CONTROLLER says
             rc = opener(*args, controller="local", **self.open_options)
             if rc != 0:
-                e = errors[-1] if errors and errors[-1] is not before else None
+                e = _core.SESSION.last
                 return rc, (f"GT_Open returned {rc}: {e.reason}" if e else "")
         c.opened = True
         return 0, ""
@@ -540,11 +671,9 @@ class Server:
 
 def _invoke(fn: Any, args: Any) -> tuple[int, str]:
     """Call a GT function; its code and, when it is not 0, the reason it recorded."""
-    errors = _core.SESSION.errors
-    before = errors[-1] if errors else None
     rc = fn(*args)
-    if rc != 0 and errors and errors[-1] is not before:
-        e = errors[-1]
+    e = _core.SESSION.last
+    if rc != 0 and e is not None:
         return rc, f"{e.function} returned {e.code}: {e.reason}"
     return rc, ""
 
@@ -554,7 +683,7 @@ def wait_for(address: str, timeout_s: float = 10.0) -> None:
     path = socket_path(address)
     deadline = time.monotonic() + timeout_s
     while True:
-        s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        s = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
         try:
             s.connect(path)
             return

@@ -8,9 +8,12 @@ array and calls ``gte_invoke`` (``csrc/gts_runtime.c``, hand-written, does the r
 
 from __future__ import annotations
 
+import socket
+
 from .. import __version__
 from ..gt.table import Proto
 from .protocol import (
+    CHUNK,
     MAX_FRAME,
     MAX_POINTER_BYTES,
     MSG_CALL,
@@ -19,11 +22,14 @@ from .protocol import (
     PTR_NULL,
     PTR_TOO_BIG,
     PTR_UNKNOWN,
+    SOCKET_TYPE,
     FunctionPlan,
     Kind,
     plans,
     table_digest,
 )
+
+_SOCKET_NAMES = {socket.SOCK_SEQPACKET: "SOCK_SEQPACKET", socket.SOCK_STREAM: "SOCK_STREAM"}
 
 
 def render_wire_h() -> str:
@@ -41,6 +47,8 @@ def render_wire_h() -> str:
         f"#define GTE_PTR_TOO_BIG ({PTR_TOO_BIG})",
         f"#define GTE_MAX_POINTER_BYTES {MAX_POINTER_BYTES}LL",
         f"#define GTE_MAX_FRAME {MAX_FRAME}u",
+        f"#define GTE_CHUNK {CHUNK}u",
+        f"#define GTE_SOCKET_TYPE {_SOCKET_NAMES[SOCKET_TYPE]}",
     ]
     lines += [f"#define GTE_K_{k.name} {int(k)}" for k in Kind]
     lines += ["#endif", ""]

@@ -107,10 +107,12 @@ static int wait_fd(int fd, short ev, long long deadline)
     }
 }
 
+/* send one message: records of at most GTE_CHUNK bytes (SOCK_SEQPACKET keeps each whole) */
 static int send_all(int fd, const unsigned char *p, size_t n, long long deadline)
 {
     while (n) {
-        ssize_t w = send(fd, p, n, MSG_NOSIGNAL | MSG_DONTWAIT);
+        size_t part = n > GTE_CHUNK ? GTE_CHUNK : n;
+        ssize_t w = send(fd, p, part, MSG_NOSIGNAL | MSG_DONTWAIT);
         if (w > 0) {
             p += w;
             n -= (size_t)w;
@@ -155,15 +157,30 @@ static long long now_ns(void)
     return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
 }
 
-/* 0 ok; -1 error (errno); -2 the peer closed the connection */
-static int recv_all(int fd, unsigned char *p, size_t n, long long deadline)
+/* Receive one message (frame header included) into g_buf, always offering a read at least
+ * GTE_CHUNK bytes of room, so one recv takes a whole record (SOCK_SEQPACKET; usually the
+ * whole reply).  0 ok with *total = 4 + body; -1 error (errno); -2 the peer closed. */
+static int recv_msg(int fd, size_t *total, long long deadline)
 {
+    size_t got = 0, need = 4;
     long long spin_until = 0;
-    while (n) {
-        ssize_t r = recv(fd, p, n, MSG_DONTWAIT);
+    while (got < need) {
+        if (reserve(got + GTE_CHUNK) < 0) {
+            errno = ENOMEM;
+            return -1;
+        }
+        ssize_t r = recv(fd, g_buf + got, g_cap - got, MSG_DONTWAIT);
         if (r > 0) {
-            p += r;
-            n -= (size_t)r;
+            got += (size_t)r;
+            if (need == 4 && got >= 4) {
+                uint32_t body;
+                memcpy(&body, g_buf, 4);
+                if (body > GTE_MAX_FRAME) {
+                    errno = EPROTO;
+                    return -1;
+                }
+                need = 4 + (size_t)body;
+            }
             continue;
         }
         if (r == 0)
@@ -185,6 +202,7 @@ static int recv_all(int fd, unsigned char *p, size_t n, long long deadline)
         }
         return -1;
     }
+    *total = need;
     return 0;
 }
 
@@ -255,19 +273,20 @@ static int hello(int fd, const char *fname, long long deadline)
                 strerror(errno));
         return -1;
     }
-    unsigned char head[8];
-    int r = recv_all(fd, head, 8, deadline);
-    if (r < 0) {
+    size_t total = 0;
+    int r = recv_msg(fd, &total, deadline);
+    if (r < 0 || total < 8) {
         set_err("%s returned -1: the controller at %s did not answer the greeting (%s)", fname,
-                g_addr, r == -2 ? "connection closed" : strerror(errno));
+                g_addr, r == -2 ? "connection closed" : r < 0 ? strerror(errno) : "too short");
         return -1;
     }
-    int16_t status = get_i16(head + 4);
-    uint16_t tlen = get_u16(head + 6);
+    int16_t status = get_i16(g_buf + 4);
+    uint16_t tlen = get_u16(g_buf + 6);
     char text[1024];
     size_t keep = tlen < sizeof text - 1 ? tlen : sizeof text - 1;
-    if (tlen && recv_all(fd, (unsigned char *)text, keep, deadline) < 0)
-        keep = 0;
+    if (keep > total - 8)
+        keep = total - 8;
+    memcpy(text, g_buf + 8, keep);
     text[keep] = '\0';
     if (status != 0) {
         set_err("%s returned -1: the controller at %s refused this library: %s", fname, g_addr,
@@ -286,7 +305,7 @@ static int connect_to(const char *addr, const char *fname, long long deadline)
         set_err("%s returned -1: controller address '%s' is not unix:/path", fname, addr);
         return -1;
     }
-    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    int fd = socket(AF_UNIX, GTE_SOCKET_TYPE | SOCK_CLOEXEC, 0);
     if (fd < 0) {
         set_err("%s returned -1: socket: %s", fname, strerror(errno));
         return -1;
@@ -579,8 +598,8 @@ connected:;
         return CMD_COMM;
     }
     /* ---- reply ---- */
-    unsigned char head[4 + 6];
-    int r = recv_all(g_fd, head, sizeof head, deadline);
+    size_t total = 0;
+    int r = recv_msg(g_fd, &total, deadline);
     if (r < 0) {
         char why[1024];
         if (r == -2)
@@ -596,21 +615,14 @@ connected:;
         set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
         return CMD_COMM;
     }
-    uint32_t body = get_u32(head);
-    if (body < 6 || body > GTE_MAX_FRAME || reserve(body) < 0) {
+    if (total < 4 + 6) {
         drop("a malformed reply");
         set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
         return CMD_COMM;
     }
-    short rc = get_i16(head + 4);
-    uint16_t nblocks = get_u16(head + 6), nerr = get_u16(head + 8);
-    size_t rest = body - 6;
-    if (rest && recv_all(g_fd, g_buf, rest, deadline) < 0) {
-        drop("a reply cut short");
-        set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
-        return CMD_COMM;
-    }
-    const unsigned char *q = g_buf, *end = g_buf + rest;
+    short rc = get_i16(g_buf + 4);
+    uint16_t nblocks = get_u16(g_buf + 6), nerr = get_u16(g_buf + 8);
+    const unsigned char *q = g_buf + 10, *end = g_buf + total;
     unsigned used = 0;
     for (int i = 0; i < f->nparams && used < nblocks; i++) {
         const gte_param *p = &f->params[i];

@@ -63,7 +63,7 @@ def test_a_malformed_request_closes_only_that_connection(served):
     _, address = served
     good = WireClient(address)
     assert good.call("GT_Open", 0, 1)[0] == 0
-    bad = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    bad = socket.socket(socket.AF_UNIX, protocol.SOCKET_TYPE)
     bad.settimeout(5)
     bad.connect(address[5:])
     bad.sendall(struct.pack("<I", 3) + b"\x07xx")

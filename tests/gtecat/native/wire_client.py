@@ -7,14 +7,14 @@ import socket
 from typing import Any
 
 from gtecat.native import protocol as p
-from gtecat.native.server import socket_path
+from gtecat.native.protocol import socket_path
 
 _LONG = ctypes.sizeof(ctypes.c_long)
 
 
 class WireClient:
     def __init__(self, address: str, *, digest: str | None = None) -> None:
-        self.sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        self.sock = socket.socket(socket.AF_UNIX, p.SOCKET_TYPE)
         self.sock.settimeout(10)
         self.sock.connect(socket_path(address))
         d = (digest or p.table_digest()).encode()
@@ -23,19 +23,19 @@ class WireClient:
         self.by_name = {pl.name: pl for pl in p.plans()}
 
     def _send(self, body: bytes) -> bytes:
-        self.sock.sendall(p.FRAME.pack(len(body)) + body)
-        head = self._recv(4)
-        (n,) = p.FRAME.unpack(head)
-        return self._recv(n)
-
-    def _recv(self, n: int) -> bytes:
+        data = p.FRAME.pack(len(body)) + body
+        for i in range(0, len(data), p.CHUNK):  # records of at most CHUNK bytes
+            self.sock.sendall(data[i : i + p.CHUNK])
         out = b""
-        while len(out) < n:
-            chunk = self.sock.recv(n - len(out))
+        need = 4
+        while len(out) < need:
+            chunk = self.sock.recv(max(p.CHUNK, need - len(out)))
             if not chunk:
                 raise ConnectionError("controller closed the connection")
             out += chunk
-        return out
+            if need == 4 and len(out) >= 4:
+                need = 4 + p.FRAME.unpack_from(out, 0)[0]
+        return out[4:need]
 
     def _hello(self, digest: bytes) -> tuple[int, str]:
         body = self._send(p.HELLO.pack(p.MSG_HELLO, p.PROTOCOL_VERSION, _LONG, digest))
