@@ -16,9 +16,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from gtecat import gt  # noqa: E402
+from gtecat import gt
 
 ROOT = Path(__file__).resolve().parents[1]
 
