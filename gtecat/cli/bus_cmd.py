@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import argparse
 import struct
+from types import SimpleNamespace
 
-from drives.slave import AlState
-from eni.model import Direction
 from eni.numbers import parse_int
 
 from ..errors import ParameterError
+from ..native.field import pdo_rows, slave_rows
 from . import output
 from .busview import Bus, add_bus_options, open_bus
 
@@ -62,12 +62,29 @@ examples:
   gtecat sdo upload 0 0x6502 0 --type uint32 --backend pysoem --iface eth0
 
 On the emulated bus every command starts a fresh bus: a download lasts for that
-command only (use a script and `gtecat run` for sequences)."""
+command only (use a script and `gtecat run` for sequences), unless --controller
+names a running controller (`gtecat controller`): then it reads and writes that
+one's bus, by index (names need a bus of the command's own)."""
 
 
 def _file(p: argparse.ArgumentParser) -> None:
     # ``gtecat slaves x.eni`` reads like ``gtecat map x.eni``; --eni says the same
     p.add_argument("file", nargs="?", help="configuration file (same as --eni)")
+
+
+def _controller(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--controller",
+        metavar="ADDR",
+        help="read the bus of a running controller (unix:/path of `gtecat controller`, "
+        "GTECAT_CONTROLLER of a program) instead of opening one",
+    )
+
+
+def _field(args: argparse.Namespace):
+    from ..native.client import Field
+
+    return Field.connect(args.controller)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -81,6 +98,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     _file(p)
     add_bus_options(p)
+    _controller(p)
     p.set_defaults(func=run_slaves)
     p = sub.add_parser(
         "pdos",
@@ -90,6 +108,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     _file(p)
     add_bus_options(p)
+    _controller(p)
     p.set_defaults(func=run_pdos)
     p = sub.add_parser(
         "sdo",
@@ -109,6 +128,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="data type (default: the dictionary's on the emulated bus, else raw bytes)",
     )
     add_bus_options(p)
+    _controller(p)
     p.set_defaults(func=run_sdo)
 
 
@@ -121,25 +141,12 @@ def _hex(v: int, w: int = 8) -> str:
 
 
 def run_slaves(args: argparse.Namespace) -> int:
-    with Bus(args) as bus:
-        m = bus.master
-        states = m.refresh_states()
-        rows = []
-        for pos in bus.positions():
-            sl, cfg = m.layout.slaves[pos], m.layout.config.slaves[pos]
-            rows.append(
-                {
-                    "position": sl.position,
-                    "state": AlState(states[pos]).name,
-                    "name": cfg.name,
-                    "vendor_id": cfg.identity.vendor_id,
-                    "product_code": cfg.identity.product_code,
-                    "revision": cfg.identity.revision_no,
-                    "axes": list(sl.axes),
-                    "gt_offset": sl.gt_offset,
-                    "gt_size": sl.gt_size,
-                }
-            )
+    if args.controller:
+        with _field(args) as f:
+            rows = f.slaves(args.position)
+    else:
+        with Bus(args) as bus:
+            rows = slave_rows(bus.master, bus.positions())
     if args.json:
         output.print_json(rows)
         return 0
@@ -158,33 +165,12 @@ def run_slaves(args: argparse.Namespace) -> int:
 
 
 def run_pdos(args: argparse.Namespace) -> int:
-    with Bus(args) as bus:
-        cfg = bus.layout.config
-        out = []
-        for pos in bus.positions():
-            s = cfg.slaves[pos]
-            pdos = []
-            for d, plist in ((Direction.OUT, s.rx_pdos), (Direction.IN, s.tx_pdos)):
-                for p in plist:
-                    pdos.append(
-                        {
-                            "dir": "out" if d == Direction.OUT else "in",
-                            "sm": p.sm,
-                            "index": p.index,
-                            "name": p.name,
-                            "entries": [
-                                {
-                                    "index": e.index,
-                                    "subindex": e.subindex,
-                                    "bits": e.bit_len,
-                                    "name": e.name,
-                                    "type": e.data_type,
-                                }
-                                for e in p.entries
-                            ],
-                        }
-                    )
-            out.append({"position": s.position, "name": s.name, "pdos": pdos})
+    if args.controller:
+        with _field(args) as f:
+            out = f.pdos(args.position)
+    else:
+        with Bus(args) as bus:
+            out = pdo_rows(bus.layout.config, bus.positions())
     if args.json:
         output.print_json(out)
         return 0
@@ -322,8 +308,10 @@ def run_sdo(args: argparse.Namespace) -> int:
             _number(sub, "SUB", 0xFF)
     if args.action == "download" and value_text is None:
         raise ParameterError("sdo download needs VALUE (and --type where the type is unknown)")
-    if args.action == "download" and args.type:
-        data = _encode(value_text or "", args.type)
+    data = _encode(value_text or "", args.type) if args.action == "download" and args.type else b""
+    if args.controller:
+        index, subindex, var, type_name, raw = _sdo_remote(args, slave, obj, sub, value_text, data)
+        return _sdo_print(args, slave, index, subindex, var, type_name, raw)
     with Bus(args) as bus:
         bus.check(slave)
         index, subindex, var = _lookup(bus, slave, obj, sub)
@@ -339,8 +327,51 @@ def run_sdo(args: argparse.Namespace) -> int:
             if not args.type:
                 data = _encode(value_text or "", type_name)
             bus.master.sdo_download(slave, index, subindex, data)
+            raw = b""
         else:
             raw = bus.master.sdo_upload(slave, index, subindex)
+    return _sdo_print(args, slave, index, subindex, var, type_name, raw)
+
+
+def _sdo_remote(
+    args: argparse.Namespace, slave: int, obj: str, sub: str | None, text: str | None, data: bytes
+) -> tuple[int, int, object, str | None, bytes]:
+    """``sdo --controller``: the running controller's bus does the transfer."""
+    if not _is_number(obj):
+        raise ParameterError(
+            f"sdo --controller: give the index, e.g. 0x6041 0 ({obj!r} is looked up by name "
+            "only in a bus of this command's own)"
+        )
+    index = _number(obj, "INDEX", 0xFFFF)
+    subindex = 0 if sub is None else _number(sub, "SUB", 0xFF)
+    with _field(args) as f:
+        entry = f.sdo_entry(slave, index, subindex)
+        var = (
+            SimpleNamespace(name=entry["name"], data_type=SimpleNamespace(name=entry["type"]))
+            if entry
+            else None
+        )
+        type_name = args.type or (FROM_DICTIONARY.get(entry["type"]) if entry else None)
+        if args.action == "download":
+            if type_name is None:
+                raise ParameterError(
+                    f"sdo download: the type of {output.hex_addr(index, subindex)} is unknown "
+                    f"here; give --type ({', '.join(sorted(TYPES))}, string)"
+                )
+            f.sdo_download(slave, index, subindex, data or _encode(text or "", type_name))
+            return index, subindex, var, type_name, b""
+        return index, subindex, var, type_name, f.sdo_upload(slave, index, subindex)
+
+
+def _sdo_print(
+    args: argparse.Namespace,
+    slave: int,
+    index: int,
+    subindex: int,
+    var: object,
+    type_name: str | None,
+    raw: bytes,
+) -> int:
     if args.action == "download":
         if args.json:
             output.print_json({"ok": True})
