@@ -43,7 +43,8 @@ What the registers do, and where it is specified:
   mailbox starts (INIT).  Answers of several messages (SDO Information
   fragments) go out one by one as the master reads them; CoE emergencies the
   slave raises (``slave.emergencies``) are queued as CoE service 1 messages
-  from PREOP on.
+  from PREOP on; FoE is answered by :mod:`drives.foe` (reads of the files in
+  ``esc.foe.files``, "not found" otherwise, writes refused: no firmware update).
 * 0900h-0935h DC: receive times latched by a write to 0900h, 64-bit system time at
   0910h (a write there is the drift compensation: the local copy locks onto
   it), offset 0920h, delay 0928h, difference 092Ch; 0980h-09A7h sync registers are
@@ -67,6 +68,7 @@ from enum import IntEnum
 from eni.bits import get_bits, set_bits
 
 from ..coe import CoeService, MailboxError, MailboxType, build_coe, mailbox_error
+from ..foe import FoeServer
 from ..slave import AlState, AlStatusCode, VirtualSlave
 
 log = logging.getLogger(__name__)
@@ -353,6 +355,10 @@ class Esc:
         self._mbx_write_counter = 0
         #: the slave may have further messages of its last answer (``mailbox_next``)
         self._mbx_more = False
+        #: FoE of the firmware: files offered for reading, writes (firmware updates) refused
+        self.foe = FoeServer(
+            mailbox_size=int(getattr(getattr(slave, "sdo", None), "mailbox_size", 128))
+        )
         #: mailbox messages not executed because they repeated the previous counter
         self.mailbox_repeats = 0
         #: answers and emergencies dropped because the queue was full
@@ -825,6 +831,11 @@ class Esc:
             return
         if not self.slave.has_mailbox:
             self._queue(mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL))
+            return
+        if mtype == MailboxType.FOE and getattr(self.slave, "foe", None) is None:
+            answer = self.foe.handle(msg[: 6 + length])  # the firmware's FoE (drives.foe)
+            if answer:
+                self._queue(answer)
             return
         try:
             answer = self.slave.mailbox(msg[: 6 + length])

@@ -419,7 +419,7 @@ def sii_info_for(slave: object, *, mailbox_size: int = 128) -> SiiInfo:
                 | CoeDetails.PDO_CONFIG,
             )
         )
-        protocols = MailboxProtocol.COE
+        protocols = MailboxProtocol.COE | MailboxProtocol.FOE  # FoE: drives.foe
     else:
         fmmus = (FmmuUsage.OUTPUTS, FmmuUsage.INPUTS)
         coe, protocols = CoeDetails(0), MailboxProtocol(0)

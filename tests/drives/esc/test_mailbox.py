@@ -254,3 +254,47 @@ def test_emergencies_are_dropped_without_a_mailbox_state() -> None:
     assert request(esc, AlState.PREOP) == (AlState.PREOP, 0)
     esc.service()
     assert read_mailbox(esc) is None
+
+
+# --- FoE: what firmware-update code paths probe -------------------------------------------------
+def foe(opcode: int, value: int, rest: bytes, counter: int) -> bytes:
+    body = struct.pack("<BBI", opcode, 0, value) + rest
+    return struct.pack("<HHBB", len(body), 0, 0, 4 | counter << 4) + body
+
+
+def foe_answer(esc: Esc, msg: bytes) -> bytes | None:
+    assert write_mailbox(esc, msg)
+    esc.service()
+    got = read_mailbox(esc)
+    if got is None:
+        return None
+    assert got[5] & 0x0F == 4, got[:8].hex()
+    return got[: 6 + struct.unpack_from("<H", got)[0]]
+
+
+def test_foe_reads_a_small_file_in_acknowledged_packets() -> None:
+    esc = drive_esc()
+    content = bytes(range(256)) * 2  # 512 bytes: 5 packets of 116, the last one short
+    esc.foe.files["log.txt"] = content
+    got, counter = b"", 1
+    answer = foe_answer(esc, foe(1, 0, b"log.txt", counter))
+    packet = 1
+    while answer is not None:
+        opcode, _, number = struct.unpack_from("<BBI", answer, 6)
+        assert (opcode, number) == (3, packet)
+        chunk = answer[12:]
+        got += chunk
+        counter = counter % 7 + 1
+        answer = foe_answer(esc, foe(4, number, b"", counter))
+        packet += 1
+        if len(chunk) < SIZE - 12:
+            assert answer is None  # the ack of the short packet ends the read
+    assert got == content
+
+
+def test_foe_refuses_unknown_files_and_firmware_writes() -> None:
+    esc = drive_esc()
+    for opcode, counter, code in ((1, 1, 0x8001), (2, 2, 0x8002)):
+        answer = foe_answer(esc, foe(opcode, 0, b"firmware.efw", counter))
+        assert answer is not None
+        assert struct.unpack_from("<BBI", answer, 6) == (5, 0, code)

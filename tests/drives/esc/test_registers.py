@@ -292,7 +292,7 @@ def test_link_counter_runs_1_to_7() -> None:
 def test_unknown_protocol_gets_a_mailbox_error() -> None:
     esc, _ = make()
     preop(esc)
-    msg = struct.pack("<HHBB", 4, 0, 0, MailboxType.FOE) + bytes(4)
+    msg = struct.pack("<HHBB", 4, 0, 0, MailboxType.EOE) + bytes(4)  # EoE: not offered
     esc.write(0x1000, msg + bytes(128 - len(msg)))
     esc.service()
     answer = esc.read(0x1080, 128) or b""

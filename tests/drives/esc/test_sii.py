@@ -45,7 +45,7 @@ def test_identity_and_mailbox_sit_where_soem_reads_them() -> None:
     assert _dword(raw, 0x0E) == 1234
     assert _dword(raw, 0x18) == (128 << 16) | 0x1000  # SM0 offset + size
     assert _dword(raw, 0x1A) == (128 << 16) | 0x1080  # SM1 offset + size
-    assert _word(raw, 0x1C) == MailboxProtocol.COE
+    assert _word(raw, 0x1C) == MailboxProtocol.COE | MailboxProtocol.FOE
     assert _word(raw, 0x3F) == 1  # version
 
 
