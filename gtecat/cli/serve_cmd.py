@@ -62,6 +62,13 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=float, help="stop after this many seconds")
     p.add_argument("--stats-json", type=Path, help="write counters and latency here on exit")
     p.add_argument(
+        "--foe-file",
+        action="append",
+        default=[],
+        metavar="NAME=PATH",
+        help="offer PATH as file NAME for FoE reads on every slave with a mailbox (repeatable)",
+    )
+    p.add_argument(
         "--pcap",
         type=Path,
         metavar="FILE",
@@ -94,6 +101,7 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
 
 
 def run(args: argparse.Namespace) -> int:
+    from eni.errors import GtecatError
     from gtecat.wire.serve import WireServer, interface_is_up, realtime_priority
 
     if args.verbose:
@@ -105,6 +113,17 @@ def run(args: argparse.Namespace) -> int:
             f"no network interface {args.iface!r}: `gtecat ifaces` lists the ones this machine has"
         )
     chain, config = build_chain(args.eni, args.machine, watchdog_trips=args.sm_watchdog)
+    for spec in args.foe_file:
+        name, sep, path = spec.partition("=")
+        if not sep or not name:
+            raise GtecatError(f"--foe-file {spec!r}: expected NAME=PATH")
+        try:
+            content = Path(path).read_bytes()
+        except OSError as exc:
+            raise GtecatError(f"--foe-file {spec!r}: {exc.strerror}") from None
+        for esc in chain.escs:
+            if esc.slave.has_mailbox:
+                esc.foe.files[name] = content
     cycle_ns = (args.cycle_us * 1000) if args.cycle_us else (config.cycle_time_ns or 1_000_000)
     if interface_is_up(args.iface) is False:
         print(f"warning: interface {args.iface} is down", file=sys.stderr)

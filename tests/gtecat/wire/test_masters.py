@@ -34,6 +34,7 @@ pytestmark = pytest.mark.wire
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
 TWELVE = ROOT / "examples" / "twelve_axes.eni"
+FOE_FILE = b"gtecat virtual drive log\n" * 20  # 480 bytes: several FoE packets
 TWINCAT = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
 
 _REASON = why_not_root()
@@ -60,7 +61,10 @@ def served(eni: Path, tmp: Path, *extra: str) -> Iterator[tuple[str, ServeProces
 
 @pytest.fixture(scope="module")
 def fig52(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[str, ServeProcess]]:
-    with served(FIG52, tmp_path_factory.mktemp("fig52"), "--rt-priority", "10") as it:
+    tmp = tmp_path_factory.mktemp("fig52")
+    (tmp / "log.txt").write_bytes(FOE_FILE)
+    extra = ("--rt-priority", "10", "--foe-file", f"log.txt={tmp / 'log.txt'}")
+    with served(FIG52, tmp, *extra) as it:
         yield it
 
 
@@ -328,3 +332,20 @@ def test_ebpfcat_initialises_lists_the_dictionary_and_cycles(
     assert od[0x1018].name == "Identity" and od[0x1018].entries[1].name == "Vendor ID"
     assert [s[0] for s in states] == [MachineState.OPERATIONAL] * 4
     assert len(drive_inputs) == 10
+
+
+def test_pysoem_foe_reads_a_file_and_gets_not_found_for_another(
+    fig52: tuple[str, ServeProcess],
+) -> None:
+    pysoem = pytest.importorskip("pysoem")
+    master = pysoem.Master()
+    master.open(fig52[0])
+    try:
+        assert master.config_init() == 4
+        drive = master.slaves[0]
+        drive.state = pysoem.PREOP_STATE
+        assert drive.foe_read("log.txt", 0, 4096) == FOE_FILE
+        # SOEM ends the read on the FoE error 8001h (not found) and pysoem returns nothing
+        assert drive.foe_read("firmware.efw", 0, 4096) == b""
+    finally:
+        master.close()
