@@ -68,6 +68,24 @@ short GT_SetDataPage(short page /*0..31*/);
 
 
 @cache
+def gtn_prototype(proto: Any) -> Any:
+    """The prototype of ``GTN_x``: ``GT_x``'s with ``short core`` first."""
+    from ..gt.table import Param, Proto
+
+    params = (Param("core", "short"), *proto.params)
+    return Proto("GTN_" + proto.name[3:], params, by_name={p.name: p for p in params})
+
+
+def prototype(name: str) -> Any:
+    """The prototype a program's call of ``name`` was compiled against."""
+    from ..gt.table import FUNCTIONS
+
+    if name.startswith("GTN_"):
+        return gtn_prototype(builtins().get("GT_" + name[4:]) or FUNCTIONS["GT_" + name[4:]])
+    return builtins().get(name) or FUNCTIONS[name]
+
+
+@cache
 def builtins() -> dict[str, Any]:
     from ..gt.table import parse  # lazy: gtecat.gt imports this package
 
@@ -78,7 +96,15 @@ class Catalog:
     """What the compiler needs to know of GT functions: prototypes and structures."""
 
     def lookup(self, name: str) -> tuple[Any | None, str]:
-        """``(prototype, "")`` when a program may call ``name``, else ``(None, why)``."""
+        """``(prototype, "")`` when a program may call ``name``, else ``(None, why)``.
+
+        A ``GTN_x`` twin is callable where ``GT_x`` is, with ``short core`` first.
+        """
+        if name.startswith("GTN_"):
+            proto, why = self.lookup("GT_" + name[4:])
+            if proto is None:
+                return None, why.replace("GT_" + name[4:], name, 1)
+            return gtn_prototype(proto), ""
         b = builtins().get(name)
         if b is not None:
             return b, ""
@@ -113,4 +139,12 @@ class Catalog:
         return cls
 
 
-__all__ = ["BUILTIN_PROTOTYPES", "HOST_ONLY", "TABLE_10_2", "Catalog", "builtins"]
+__all__ = [
+    "BUILTIN_PROTOTYPES",
+    "HOST_ONLY",
+    "TABLE_10_2",
+    "Catalog",
+    "builtins",
+    "gtn_prototype",
+    "prototype",
+]

@@ -45,12 +45,12 @@ from __future__ import annotations
 
 import ctypes
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Any
 
 from . import fixed
-from .gtcalls import builtins
+from .gtcalls import prototype
 from .model import (
     PAGE_WORDS,
     PAGES,
@@ -603,7 +603,9 @@ class ProgramRuntime:
                 th.pc = nxt
 
             return set_page
-        proto = builtins().get(name) or _table_prototype(name)
+        if name.startswith("GTN_") and name[4:] in ("Delay", "SetDataPage"):
+            return self._link_call("GT_" + name[4:], replace(ins, operands=(dst, *args[1:])), nxt)
+        proto = prototype(name)
         makers = [self._arg_maker(p, o, proto) for p, o in zip(proto.params, args, strict=True)]
         call = self.call
 
@@ -736,12 +738,6 @@ def _fit_field(cls: Any, name: str, v: float | int) -> float | int:
         if fname == name:
             return _fit(ftype, v)
     return v
-
-
-def _table_prototype(name: str) -> Any:
-    from ..gt.table import FUNCTIONS
-
-    return FUNCTIONS[name]
 
 
 def _lt(a: int, b: int) -> int:

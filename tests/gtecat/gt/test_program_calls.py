@@ -623,3 +623,28 @@ def test_program_calls_leave_the_hosts_last_error_alone(tmp_path):
     assert gt.GT_Bind(0, 0, 1) == 1  # running; the call's latency runs the program's calls
     assert "running" in gt.GTE_GetLastError()
     assert get_value(-1, var(None, "c"))[0] >= 5
+
+
+def test_programs_call_the_gtn_twins_too(tmp_path):
+    open_bare()
+    gt.GTE_Wait(3)
+    src = """\
+int t;
+int f()
+{
+    int loop;
+    GTN_Delay(1, 5);
+    GTN_GetClock(1, &t, &loop);
+    return 0;
+}
+"""
+    load(tmp_path, src)
+    gt.GT_Bind(0, fun_id("f"), 0)
+    gt.GT_RunThread(0)
+    wait_idle((0,))
+    assert status(0).error == 0, thread_error(0)
+    assert get_value(-1, var(None, "t")) == [8.0]
+    bad = tmp_path / "bad.c"
+    bad.write_text("int f()\n{\n    GTN_Open(1, 0, 1);\n    return 0;\n}\n")
+    assert gt.GT_Compile(str(bad), byref(gt.TCompileInfo())) == 1
+    assert "GTN_Open belongs to the host" in gt.GTE_GetLastError()
