@@ -31,6 +31,28 @@ def add_bus_options(p: argparse.ArgumentParser, *, position: bool = True) -> Non
     output.add_json(p)
 
 
+def check_toml_kind(path: str | os.PathLike[str] | None, want: str) -> None:
+    """Refuse a topology given as a machine description and the other way round."""
+    if not path or not Path(path).is_file() or Path(path).suffix.lower() != ".toml":
+        return
+    import tomllib
+
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return  # the reader itself says what is wrong
+    if want == "machine" and "slave" in data and "axis" not in data:
+        raise ParameterError(
+            f"{path} is a topology ([[slave]] tables: a bus for `gtecat eni new`), not a machine "
+            "description ([axis.N] tables: switches, index, probe marks)"
+        )
+    if want == "topology" and "axis" in data and "slave" not in data:
+        raise ParameterError(
+            f"{path} is a machine description ([axis.N] tables, for --machine), not a topology "
+            "([[slave]] tables, what `gtecat eni new` writes an ENI from)"
+        )
+
+
 def eni_argument(args: argparse.Namespace) -> str | None:
     eni = getattr(args, "eni", None) or getattr(args, "file", None)
     if eni and Path(eni).is_dir():
@@ -47,6 +69,7 @@ def open_bus(args: argparse.Namespace) -> Controller:
     """Bring the bus up as GT_Open + GT_InitEcatComm would (lockstep; realtime on pysoem)."""
     backend = args.backend or os.environ.get("GTECAT_BACKEND") or "emulated"
     eni = eni_argument(args)
+    check_toml_kind(args.machine, "machine")
     try:
         ctl = Controller(
             Options(

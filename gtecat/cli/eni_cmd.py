@@ -45,6 +45,9 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "eni_command", None) != "new":
         print("error: usage: gtecat eni new TOPOLOGY.toml [-o OUT.eni]", file=sys.stderr)
         return 1
+    from .busview import check_toml_kind
+
+    check_toml_kind(args.topology, "topology")
     try:
         cfg = load_topology(args.topology)
         text = write_eni(cfg)

@@ -292,6 +292,9 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(f"{what} {v} is a folder, not a file (--{k[7:].lower()})")
         if v and not Path(v).is_file():
             raise ParameterError(f"{what} {v} not found (--{k[7:].lower()})")
+    from .busview import check_toml_kind
+
+    check_toml_kind(options["GTECAT_MACHINE"], "machine")
     specs = [s.strip() for s in (args.trace or "").split(",") if s.strip()]
     stem = Path(args.trace_out) if args.trace_out else script.with_suffix("")
     if specs:

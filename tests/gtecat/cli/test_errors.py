@@ -275,3 +275,15 @@ def test_serve_on_a_missing_interface_says_so_first(cli: Cli) -> None:
 def test_debug_works_after_the_verb_too(cli: Cli, tmp_path: Path) -> None:
     with pytest.raises(Exception, match="no ENI file"):
         cli("slaves", "--eni", str(tmp_path / "x.eni"), "--debug")
+
+
+def test_topology_and_machine_description_are_not_confused(cli: Cli, tmp_path: Path) -> None:
+    topology = str(EXAMPLES / "manual_fig5_2.toml")
+    machine = str(EXAMPLES / "homing_probe_machine.toml")
+    err = _one_line_error(*cli("slaves", "--eni", FIG52, "--machine", topology))
+    assert "is a topology ([[slave]] tables" in err and "not a machine description" in err
+    script = tmp_path / "s.py"
+    script.write_text("print('ran')\n")
+    assert "is a topology" in _one_line_error(*cli("run", str(script), "--machine", topology))
+    err = _one_line_error(*cli("eni", "new", machine, "-o", str(tmp_path / "x.eni")))
+    assert "is a machine description ([axis.N] tables" in err and "not a topology" in err
