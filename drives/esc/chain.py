@@ -139,7 +139,7 @@ class _Fast:
                 read_so_far.append((f0, f1))
         return True
 
-    def apply(self, saved: bytes) -> None:
+    def apply(self, saved: bytes | bytearray) -> None:
         """The kept output bytes into the ESCs (writes, then the SMs they complete)."""
         w0 = self.w0
         for part in self.parts:
@@ -189,7 +189,7 @@ class Chain:
             esc.on_station_change = self._stations_changed
             esc.on_fmmu_change = self._fmmus_changed
             esc.on_sm_change = self._sms_changed
-            esc.on_irq_mask_change = self._irq_masks_changed
+            esc.on_irq_change = self._irq_changed
             esc.on_inputs = self._inputs_loaded
             esc.on_pending = self._add_pending
             self.escs.append(esc)
@@ -204,13 +204,13 @@ class Chain:
         self._plans: dict[tuple[int, int, int], list[LogicalPlan | Esc]] = {}
         self._fast: dict[tuple[int, int, int], _Fast | None] = {}
         #: answers given from snapshots whose output bytes still go to the ESCs:
-        #: (plan, output bytes, frame time), applied by :meth:`flush`
-        self._deferred: list[tuple[_Fast, bytes, int]] = []
+        #: (plan, a copy of the output bytes, frame time), applied by :meth:`flush`
+        self._deferred: list[tuple[_Fast, bytearray, int]] = []
         #: an input SM changed since the snapshots were taken
         self._inputs_changed = False
         self._pending: list[Esc] = []
-        #: ESCs whose event mask lets an event into the IRQ field (most masters set none)
-        self._irq_escs: list[Esc] = []
+        #: OR of every ESC's unmasked event requests (what each datagram's IRQ field gets)
+        self._irq = 0
 
     @property
     def slaves(self) -> list[VirtualSlave]:
@@ -227,8 +227,11 @@ class Chain:
         self._lmap = None
         self._forget_plans()
 
-    def _irq_masks_changed(self, _esc: Esc) -> None:
-        self._irq_escs = [e for e in self.escs if e.mem[0x0200] or e.mem[0x0201]]
+    def _irq_changed(self, _esc: Esc) -> None:
+        irq = 0
+        for esc in self.escs:
+            irq |= esc.event_irq
+        self._irq = irq
 
     def _sms_changed(self, _esc: Esc) -> None:
         if self._plans:
@@ -323,9 +326,7 @@ class Chain:
     def _datagrams(self, buf: bytearray, offsets: list[int]) -> None:
         escs = self.escs
         count = len(escs)
-        irq = 0
-        for esc in self._irq_escs:
-            irq |= esc.event_irq
+        irq = self._irq
         u16_unpack, u16_pack = _U16.unpack_from, _U16.pack_into
         ft_ns = self.ft.t_ns
         for off in offsets:
@@ -345,7 +346,7 @@ class Chain:
                 if fast:
                     if self._inputs_changed:
                         self.refresh_snapshots()
-                    self._deferred.append((fast, bytes(buf[d0 + fast.w0 : d0 + fast.w1]), ft_ns))
+                    self._deferred.append((fast, buf[d0 + fast.w0 : d0 + fast.w1], ft_ns))
                     for f0, f1, snap in fast.runs:
                         buf[d0 + f0 : d0 + f1] = snap
                     self.process_data = True

@@ -377,8 +377,9 @@ class Esc:
         self.on_fmmu_change: Callable[[Esc], None] = _noop
         #: the slave side wrote an input SM (:meth:`load_inputs`): snapshots are stale
         self.on_inputs: Callable[[Esc], None] = _noop
-        #: the ECAT event mask (0200h) was written: the chain tracks who can raise IRQs
-        self.on_irq_mask_change: Callable[[Esc], None] = _noop
+        #: the unmasked event requests changed: the chain keeps their OR for the IRQ field
+        self.on_irq_change: Callable[[Esc], None] = _noop
+        self._irq = 0
         #: SM configuration or PDI (de)activation changed: compiled datagram plans are stale
         self.on_sm_change: Callable[[Esc], None] = _noop
         self.on_pending: Callable[[Esc], None] = _noop
@@ -414,6 +415,7 @@ class Esc:
         self.set_topology(self.position, self.chain_length)
         self.sync_al()
         self.mem[0x0210] = 0  # power-on is no AL status event
+        self._irq_update()
 
     def _load_alias(self) -> None:
         if len(self.sii) >= 10:
@@ -448,8 +450,15 @@ class Esc:
     @property
     def event_irq(self) -> int:
         """Event request bits the master unmasked (what goes into the IRQ field)."""
+        return self._irq
+
+    def _irq_update(self) -> None:
+        """Event request (0210h) or mask (0200h) changed: the chain ORs the new value."""
         m = self.mem
-        return (m[0x0210] | m[0x0211] << 8) & (m[0x0200] | m[0x0201] << 8)
+        irq = (m[0x0210] | m[0x0211] << 8) & (m[0x0200] | m[0x0201] << 8)
+        if irq != self._irq:
+            self._irq = irq
+            self.on_irq_change(self)
 
     def peek(self, addr: int, n: int) -> bytes:
         """Raw memory, no side effects (tests, tools)."""
@@ -493,6 +502,7 @@ class Esc:
         data = bytes(self.mem[addr:end])
         if addr < 0x0132 and end > 0x0130 and self.mem[0x0210] & EVENT_AL_STATUS:
             self.mem[0x0210] &= ~EVENT_AL_STATUS & 0xFF  # reading AL status acknowledges the event
+            self._irq_update()
         return data
 
     def write(self, addr: int, data: bytes | bytearray | memoryview) -> bool:
@@ -545,7 +555,7 @@ class Esc:
         if addr < 0x0012 and end > 0x0010:
             self.on_station_change(self)
         if addr < 0x0202 and end > 0x0200:
-            self.on_irq_mask_change(self)
+            self._irq_update()
         if addr < 0x0104 and end > 0x0103:
             self.on_station_change(self)  # alias enable changed FP matching
         if addr < 0x0122 and end > 0x0120:
@@ -642,6 +652,7 @@ class Esc:
             m[Reg.AL_STATUS] = status
             _U16.pack_into(m, Reg.AL_STATUS_CODE, code)
             m[0x0210] |= EVENT_AL_STATUS
+            self._irq_update()
 
     def _enter_state(self, old: AlState, new: AlState) -> None:
         if new == AlState.INIT:
@@ -723,6 +734,7 @@ class Esc:
         bit = 1 << (4 + sm.num)  # ECAT event request mirrors the SM interrupt
         req = _U16.unpack_from(self.mem, Reg.EVENT_REQUEST)[0]
         _U16.pack_into(self.mem, Reg.EVENT_REQUEST, (req | bit) if full else (req & ~bit))
+        self._irq_update()
 
     def _repeat(self, sm: SyncManager, repeat_bit: int) -> None:
         """Mailbox repeat request: put the last answer back and acknowledge (ETG.1000.4)."""

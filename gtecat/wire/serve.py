@@ -295,7 +295,9 @@ class WireServer:
                 last = self._last_step
                 if last is None or t_in - last >= self.min_gap_ns:
                     self._guarded(self._step, t_in, between)
-                    if self._step_due:  # process data answered during the step: its step
+                    for _ in range(8):  # process data answered during a step: its own step
+                        if not self._step_due:
+                            break
                         self._step_due = False
                         self._guarded(chain.service)
                         self._guarded(self._step, clock(), between)
