@@ -1,0 +1,52 @@
+"""The table property test through libgts (issue 13 quality bar): bad input from C - NULL
+pointers, out-of-range values, an unknown core - gets the codes Python gives, for every
+function of the table, in a child process (``fuzz_lib_worker.py`` says what is generated
+and what each pair of calls must satisfy).  A crash or a hang fails the test with the
+child's output, never the test run."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from gtecat.gt import _core
+from gtecat.native import protocol
+
+from .conftest import ROOT, needs_cc
+from .fuzz_lib_worker import SKIP
+
+pytestmark = needs_cc
+EXAMPLES = 15  # per function: GT_x and its GTN_x twin (a random core) with the same arguments
+TIMEOUT_S = 600
+
+
+def test_bad_input_through_the_library_gets_the_python_codes(libgts):
+    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
+    cmd = [sys.executable, "-m", "tests.gtecat.native.fuzz_lib_worker", "--examples"]
+    try:
+        r = subprocess.run(
+            [*cmd, str(EXAMPLES)],
+            cwd=ROOT,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+        )
+    except subprocess.TimeoutExpired as e:
+        pytest.fail(f"the library fuzz still ran after {TIMEOUT_S} s:\n{(e.stdout or '')[-3000:]}")
+    out = r.stdout + r.stderr
+    if r.returncode < 0:
+        pytest.fail(f"the library fuzz crashed (signal {-r.returncode}):\n{out[-3000:]}")
+    failures = [ln for ln in out.splitlines() if ln.startswith("FAIL")]
+    assert r.returncode == 0, "\n".join(failures)[-6000:] or out[-3000:]
+    done = {ln.split()[1] for ln in out.splitlines() if ln.startswith("ok ")}
+    eligible = {
+        p.name
+        for p in protocol.plans()
+        if p.name not in SKIP and not p.unsupported and p.name in _core.REGISTRY
+    }
+    assert done == eligible, sorted(eligible - done)
