@@ -81,6 +81,8 @@ class Options:
     card: str | None = None
     #: the MRAM store file (GTECAT_MRAM; default Gecat.mram beside the log, manual 11.8)
     mram: str | None = None
+    #: a pcap of the frames the emulated bus stands for (GTECAT_PCAP; gtecat.wire.pcap)
+    pcap: str | None = None
 
     def resolved(self) -> Options:
         env = os.environ
@@ -102,6 +104,7 @@ class Options:
             bus=self.bus or env.get("GTECAT_BUS"),
             card=self.card or env.get("GTECAT_CARD") or None,
             mram=self.mram or env.get("GTECAT_MRAM"),
+            pcap=self.pcap or env.get("GTECAT_PCAP") or None,
         )
 
 
@@ -235,7 +238,7 @@ class Controller:
             if not bus_path.is_file():
                 raise NoEniError(f"hardware description {bus_path} not found (GTECAT_BUS)")
             hardware = build_layout(read_eni(bus_path))
-        return EmulatedBackend(self.machine, hardware=hardware)
+        return EmulatedBackend(self.machine, hardware=hardware, pcap=self.options.pcap)
 
     def require_master(self) -> Master:
         if self.master is None or not self.master.opened:

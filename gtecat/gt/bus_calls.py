@@ -104,8 +104,11 @@ def GT_Open(
     op_delay_cycles: int = 10,
     mram: str | None = None,
     card: str | None = None,
+    pcap: str | None = None,
 ) -> int:
     """Open the (emulated) controller.  Keyword options override ``GTECAT_*``.
+
+    ``pcap="bus.pcap"`` (GTECAT_PCAP) writes the frames the emulated bus stands for.
 
     ``card="gts:4"`` (GTECAT_CARD) opens a GTS pulse card with 4 axes instead of an
     EtherCAT master (:mod:`gtecat.controller.card`)."""
@@ -128,6 +131,7 @@ def GT_Open(
             op_delay_cycles=op_delay_cycles,
             mram=mram,
             card=card,
+            pcap=pcap,
         )
     )
     return 0

@@ -30,10 +30,13 @@ _RECORD = struct.Struct("<IIII")
 class PcapWriter:
     """Append Ethernet frames with their wall-clock time to a pcap file."""
 
-    def __init__(self, path: str | Path, *, buffering: int = 1 << 16) -> None:
+    def __init__(self, path: str | Path, *, buffering: int = 1 << 16, append: bool = False) -> None:
+        """``append``: add to a capture this writer's format started (no second header)."""
         self.path = Path(path)
-        self._fh: BinaryIO | None = open(self.path, "wb", buffering=buffering)
-        self._fh.write(_GLOBAL.pack(MAGIC_NS, 2, 4, 0, 0, SNAPLEN, LINKTYPE_ETHERNET))
+        resume = append and self.path.is_file() and self.path.stat().st_size >= _GLOBAL.size
+        self._fh: BinaryIO | None = open(self.path, "ab" if resume else "wb", buffering=buffering)
+        if not resume:
+            self._fh.write(_GLOBAL.pack(MAGIC_NS, 2, 4, 0, 0, SNAPLEN, LINKTYPE_ETHERNET))
         self.frames = 0
 
     def write(self, frame: bytes | bytearray | memoryview, t_ns: int | None = None) -> None:
@@ -87,3 +90,122 @@ def read_pcap(path: str | Path) -> list[tuple[int, bytes]]:
         out.append((sec * 1_000_000_000 + frac * scale, data[pos : pos + cap]))
         pos += cap
     return out
+
+
+class BusCapture:
+    """The frames a real master would exchange with the emulated bus, into a pcap.
+
+    The in-process backend exchanges no frames; for a capture it describes each
+    of its operations as the frames SOEM would send for it and the answers a
+    chain of ESCs would return (ETG.1000.4 datagrams, built by
+    :func:`drives.esc.frames.encode_frame`):
+
+    * a scan: ``BRD 0000h`` answered with the slave count as WKC;
+    * a state request: ``FPWR 0120h`` (AL control) then ``FPRD 0130h`` (AL status,
+      code);
+    * a cycle: one ``LRW`` over the logical image (outputs, then inputs: SOEM's
+      non-overlapped map at logical address 0), answered with the inputs and the WKC;
+    * a mailbox exchange: ``FPWR`` of the request into SM0 (1000h), ``FPRD`` of the
+      SM1 status (080Dh) and ``FPRD`` of the answer from SM1 (1080h).
+
+    Stations are 1001h + position, as SOEM assigns them.  Timestamps follow the
+    bus's clock (virtual in the ``auto``/``lockstep`` modes) from the wall-clock
+    time the capture started; frames without a bus time of their own come 1 us
+    after the previous one.
+    """
+
+    #: captures this process started: a bus opened again (GT_InitEcatComm after
+    #: GT_TerminateEcatComm) continues its file instead of starting it over
+    _started: set[Path] = set()  # noqa: RUF012 - process-wide on purpose
+
+    def __init__(self, path: str | Path, *, mailbox_size: int = 128) -> None:
+        from drives.esc.frames import MASTER_MAC
+
+        key = Path(path).resolve()
+        self.writer = PcapWriter(path, append=key in BusCapture._started)
+        BusCapture._started.add(key)
+        self.mailbox_size = mailbox_size
+        self._src = MASTER_MAC
+        self._answer_src = bytes([MASTER_MAC[0] | 0x02]) + MASTER_MAC[1:]
+        self._wall0 = time.time_ns()
+        self._bus0: int | None = None
+        self._last = self._wall0
+        self._index = 0
+
+    # --- time -----------------------------------------------------------------
+    def _stamp(self, t_ns: int | None) -> int:
+        if t_ns is not None:
+            if self._bus0 is None:
+                self._bus0 = t_ns
+            t = self._wall0 + (t_ns - self._bus0)
+            self._last = max(t, self._last + 1_000)
+        else:
+            self._last += 1_000
+        return self._last
+
+    # --- one request/answer pair ----------------------------------------------
+    def _pair(
+        self,
+        command: int,
+        adp: int,
+        ado: int,
+        request: bytes,
+        answer: bytes,
+        wkc: int,
+        t_ns: int | None = None,
+    ) -> None:
+        from drives.esc.frames import Datagram, encode_frame
+
+        self._index = (self._index + 1) & 0xFF
+        n = self._count_adp(command, adp)
+        sent = Datagram(command, adp & 0xFFFF, ado & 0xFFFF, request, self._index)
+        back = Datagram(command, n & 0xFFFF, ado & 0xFFFF, answer, self._index, wkc=wkc)
+        self.writer.write(encode_frame([sent], src=self._src), self._stamp(t_ns))
+        self.writer.write(encode_frame([back], src=self._answer_src), self._stamp(None))
+        if self.writer.frames % 2048 == 0:
+            self.writer.flush()  # a capture read while the bus runs is mostly complete
+
+    _slaves = 0
+
+    def _count_adp(self, command: int, adp: int) -> int:
+        # auto-increment and broadcast commands come back with ADP + number of slaves
+        return adp + self._slaves if command in (1, 2, 3, 7, 8, 9, 13) else adp
+
+    # --- what the backend does ------------------------------------------------
+    def scan(self, count: int) -> None:
+        self._slaves = count
+        self._pair(7, 0, 0x0000, bytes(1), b"\x11", count)
+
+    def state(self, position: int, requested: int, state: int, code: int, error: bool) -> None:
+        station = 0x1001 + position
+        self._pair(
+            5, station, 0x0120, struct.pack("<H", requested), struct.pack("<H", requested), 1
+        )
+        status = struct.pack("<HHH", state | (0x10 if error else 0), 0, code)
+        self._pair(4, station, 0x0130, bytes(6), status, 1)
+
+    def cycle(self, t_ns: int, image: bytes, outputs_bytes: int, wkc: int) -> None:
+        request = bytes(image[:outputs_bytes]) + bytes(len(image) - outputs_bytes)
+        self._pair(12, 0, 0, request, bytes(image), wkc, t_ns)
+
+    def mailbox(self, position: int, request: bytes, answer: bytes | None) -> None:
+        station, size = 0x1001 + position, self.mailbox_size
+        self._pair(
+            5,
+            station,
+            0x1000,
+            request[:size].ljust(size, b"\0"),
+            request[:size].ljust(size, b"\0"),
+            1,
+        )
+        if answer is None:
+            self._pair(4, station, 0x080D, bytes(1), b"\x00", 1)
+            return
+        self._pair(4, station, 0x080D, bytes(1), b"\x08", 1)
+        self._pair(4, station, 0x1080, bytes(size), answer[:size].ljust(size, b"\0"), 1)
+
+    def flush(self) -> None:
+        self.writer.flush()
+
+    def close(self) -> None:
+        self.writer.close()

@@ -6,7 +6,9 @@ area (ETG.1000.4 logical addressing done by the ESC in real life).  The working
 counter follows ETG.1000.4 for one LRW: +2 per slave whose outputs were written
 (OP), +1 per slave whose inputs were read (SAFEOP and OP).  Mailbox traffic is
 real CoE: whole mailbox messages built by :class:`drives.coe.SdoClient` and
-answered by the slave's own SDO server.
+answered by the slave's own SDO server.  With ``pcap`` (``GTECAT_PCAP``) the
+frames a real master would have exchanged are written to a capture
+(:class:`gtecat.wire.pcap.BusCapture`).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ class EmulatedBackend(Backend):
         machine: MachineDescription | None = None,
         slaves: list[VirtualSlave] | None = None,
         hardware: Layout | None = None,
+        pcap: str | None = None,
     ) -> None:
         """``hardware``: the layout of the virtual hardware when it differs from the
         master's ENI (to test what a mismatch does); default: the ENI itself."""
@@ -45,6 +48,11 @@ class EmulatedBackend(Backend):
         self.watchdog_ns = 100_000_000
         self._silent_ns: dict[int, int] = {}
         self._clients: dict[int, object] = {}
+        self.capture = None
+        if pcap:
+            from ...wire.pcap import BusCapture
+
+            self.capture = BusCapture(pcap)
 
     def open(self, layout: Layout, image: ProcessImage) -> None:
         from ..factory import build_slaves
@@ -87,10 +95,18 @@ class EmulatedBackend(Backend):
             if s.position in self.unplugged:
                 break  # the chain ends at the first missing slave
             found.append(FoundSlave(s.position, s.identity, s.name))
+        if self.capture is not None:
+            self.capture.scan(len(found))
         return found
 
     def request_state(self, position: int, state: AlState) -> AlStatusCode:
-        return self._slave(position).request_state(state)
+        slave = self._slave(position)
+        code = slave.request_state(state)
+        if self.capture is not None:
+            self.capture.state(
+                position, int(state), int(slave.al_state), int(slave.al_status_code), slave.al_error
+            )
+        return code
 
     def state(self, position: int) -> tuple[AlState, AlStatusCode]:
         s = self._slave(position)
@@ -119,6 +135,8 @@ class EmulatedBackend(Backend):
             if inp is not None and st >= AlState.SAFEOP:
                 image.from_slave(inp, slave.tx)
                 wkc += 1
+        if self.capture is not None:
+            self.capture.cycle(t_ns, bytes(image.view), image.outputs_bytes, wkc)
         return wkc
 
     def emergencies(self) -> list[tuple[int, object]]:
@@ -140,9 +158,23 @@ class EmulatedBackend(Backend):
             raise BusError(f"slave {position} ({slave.name}) has no CoE mailbox")
         client = self._clients.get(position)
         if client is None:
-            client = SdoClient(slave.mailbox)
+            transfer = slave.mailbox
+            capture = self.capture
+            if capture is not None:
+
+                def transfer(request: bytes, mailbox=slave.mailbox) -> bytes | None:
+                    answer = mailbox(request)
+                    capture.mailbox(position, request, answer)
+                    return answer
+
+            client = SdoClient(transfer)
             self._clients[position] = client
         return client
+
+    def close(self) -> None:
+        if self.capture is not None:
+            self.capture.close()
+            self.capture = None
 
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False

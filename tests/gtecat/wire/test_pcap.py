@@ -95,3 +95,46 @@ def test_serve_captures_a_pysoem_session_tshark_decodes(tmp_path: Path) -> None:
     assert len(lrw) >= 100  # requests and answers of the cycles
     text = tshark_check(pcap)
     assert "LRW" in text and "Mailbox" in text
+
+
+# --- the emulated backend: the frames a real master would have exchanged --------------------------
+def _wkc(frame: bytes) -> int:
+    length = struct.unpack_from("<H", frame, 22)[0] & 0x07FF  # the first datagram's length
+    return struct.unpack_from("<H", frame, 26 + length)[0]
+
+
+def test_emulated_bus_capture_decodes_without_malformed(tmp_path: Path) -> None:
+    import ctypes
+
+    from gtecat import gt
+
+    pcap = tmp_path / "emulated.pcap"
+    log = str(tmp_path / "g.log")
+    assert gt.GT_Open(eni=str(FIG52), clock="lockstep", log=log, pcap=str(pcap)) == 0
+    try:
+        assert gt.GT_InitEcatComm() == 0
+        status = ctypes.c_short()
+        for _ in range(200):
+            gt.GTE_Wait(10)
+            if gt.GT_IsEcatReady(ctypes.byref(status)) == 0 and status.value == 1:
+                break
+        assert status.value == 1
+        buf = (ctypes.c_ubyte * 4)()
+        size = ctypes.c_uint32()
+        assert gt.GT_EcatSDOUpload(0, 0x1018, 1, buf, 4, ctypes.byref(size)) == 0
+        gt.GTE_Wait(20)
+    finally:
+        gt.GT_Close()
+    records = read_pcap(pcap)
+    frames = [f for _, f in records]
+    assert [f[16] for f in frames[:2]] == [7, 7]  # the scan: BRD out, BRD back
+    assert _wkc(frames[1]) == 4
+    sent = [f for f in frames if not f[6] & 0x02]
+    answered = [f for f in frames if f[6] & 0x02]
+    assert len(sent) == len(answered) and len(frames) > 100
+    commands = {f[16] for f in frames}
+    assert {12, 5, 4} <= commands  # LRW cycles, state and mailbox writes, reads
+    assert _wkc([f for f in answered if f[16] == 12][-2]) == 12  # in OP: 4 x (2 + 1)
+    upload = [f for f in sent if f[16] == 5 and struct.unpack_from("<H", f, 20)[0] == 0x1000]
+    assert upload and upload[-1][26 + 6 + 2] == 0x40  # an SDO upload request in SM0
+    tshark_check(pcap)
