@@ -71,7 +71,7 @@ ops = st.one_of(
 )
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(st.lists(ops, min_size=1, max_size=25))
 def test_plans_and_the_general_path_agree(sequence: list) -> None:
     fast, mf = configured(False)
@@ -122,7 +122,7 @@ cyclic_ops = st.one_of(
 )
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(st.lists(cyclic_ops, min_size=1, max_size=40))
 def test_repeated_cyclic_frames_agree_with_the_general_path(sequence: list) -> None:
     fast, mf = configured(False)
