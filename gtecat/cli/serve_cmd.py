@@ -127,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
     cycle_ns = (args.cycle_us * 1000) if args.cycle_us else (config.cycle_time_ns or 1_000_000)
     if interface_is_up(args.iface) is False:
         print(f"warning: interface {args.iface} is down", file=sys.stderr)
-    from gtecat.wire.pcap import PcapWriter
+    from gtecat.master.pcap import PcapWriter
 
     pcap = PcapWriter(args.pcap) if args.pcap else None
     server = WireServer(

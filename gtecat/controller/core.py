@@ -81,7 +81,7 @@ class Options:
     card: str | None = None
     #: the MRAM store file (GTECAT_MRAM; default Gecat.mram beside the log, manual 11.8)
     mram: str | None = None
-    #: a pcap of the frames the emulated bus stands for (GTECAT_PCAP; gtecat.wire.pcap)
+    #: a pcap of the frames the emulated bus stands for (GTECAT_PCAP; gtecat.master.pcap)
     pcap: str | None = None
 
     def resolved(self) -> Options:

@@ -61,7 +61,7 @@ from drives.esc import Chain
 from drives.esc.frames import ETHERTYPE_ECAT
 from eni.errors import GtecatError
 
-from .pcap import PcapWriter
+from ..master.pcap import PcapWriter
 
 log = logging.getLogger(__name__)
 

@@ -8,7 +8,7 @@ counter follows ETG.1000.4 for one LRW: +2 per slave whose outputs were written
 real CoE: whole mailbox messages built by :class:`drives.coe.SdoClient` and
 answered by the slave's own SDO server.  With ``pcap`` (``GTECAT_PCAP``) the
 frames a real master would have exchanged are written to a capture
-(:class:`gtecat.wire.pcap.BusCapture`).
+(:class:`gtecat.master.pcap.BusCapture`).
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ class EmulatedBackend(Backend):
         self._clients: dict[int, object] = {}
         self.capture = None
         if pcap:
-            from ...wire.pcap import BusCapture
+            from ..pcap import BusCapture
 
             self.capture = BusCapture(pcap)
 

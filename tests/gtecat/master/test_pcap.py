@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from gtecat.wire.pcap import MAGIC_NS, PcapWriter, read_pcap
+from gtecat.master.pcap import MAGIC_NS, PcapWriter, read_pcap
 
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
