@@ -557,7 +557,7 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
     counted = [
         (i, index[p.count] if isinstance(p.count, str) else None, p.count)
         for i, p in enumerate(params)
-        if p.pointer and not p.text and p.count != 0
+        if p.pointer and not p.text and not p.is_struct and p.count != 0  # structs: when viewed
     ]
     n_params = len(params)
     core_first = proto.core_first_form
@@ -634,16 +634,17 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
 
 
 def _check_room(p: Param, ref: Ref, n: int) -> None:
-    """Refuse a pointer that cannot hold the ``n`` elements the call moves."""
-    if p.ctype in ("unsigned char", "char") or p.is_struct:
-        if p.is_struct:
-            return  # sized when viewed as the structure
+    """Refuse a pointer that cannot hold the ``n`` elements the call moves (bytes for a
+    ``char`` buffer); a list grows for an output."""
+    if ref.growable() and p.direction == "out":
+        return
+    if p.ctype in ("unsigned char", "char"):
         have = ref.byte_capacity()
-        if have < n and not (ref.growable() and p.direction == "out"):
+        if have < n:
             raise ParameterError(f"{p.name}: buffer of {have} bytes, the call moves {n}")
         return
     have = ref.capacity()
-    if have < n and not (ref.growable() and p.direction == "out"):
+    if have < n:
         raise ParameterError(
             f"{p.name}: room for {have} value(s) behind the pointer, the call needs {n}"
         )
