@@ -56,6 +56,7 @@ from ..master.clock import Clock, ClockMode
 from ..master.masterlog import MasterLog
 from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
+from .bank import AxisBank
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -83,6 +84,8 @@ class Options:
     mram: str | None = None
     #: a pcap of the frames the emulated bus stands for (GTECAT_PCAP; gtecat.master.pcap)
     pcap: str | None = None
+    #: the vectorised axis bank: auto | on | off (GTECAT_BANK; gtecat.controller.bank)
+    bank: str | None = None
 
     def resolved(self) -> Options:
         env = os.environ
@@ -105,6 +108,7 @@ class Options:
             card=self.card or env.get("GTECAT_CARD") or None,
             mram=self.mram or env.get("GTECAT_MRAM"),
             pcap=self.pcap or env.get("GTECAT_PCAP") or None,
+            bank=(self.bank or env.get("GTECAT_BANK") or "auto").lower(),
         )
 
 
@@ -122,6 +126,8 @@ class Controller:
             raise ParameterError(
                 f"clock mode {self.options.clock!r} unknown; use auto, lockstep or realtime"
             ) from None
+        if self.options.bank not in ("auto", "on", "off"):
+            raise ParameterError(f"bank={self.options.bank!r} unknown; use auto, on or off")
         if self.options.backend not in ("emulated", "pysoem"):
             raise ParameterError(
                 f"backend {self.options.backend!r} unknown; use emulated or pysoem"
@@ -153,6 +159,11 @@ class Controller:
         #: GT axes (1-based) once the bus is up
         self.axes: dict[int, Axis] = {}
         self._axis_list: list[Axis] = []
+        #: the axes the scalar cycle runs (all but the ones the bank runs)
+        self._run_axes: list[Axis] = []
+        #: the vectorised axis bank (None: off, or no bus yet)
+        self.bank: AxisBank | None = None
+        self.resources: dict = {}
         self.on_bus_up: list[Callable[[Controller], None]] = []
         self.on_reset: list[Callable[[Controller], None]] = []
         #: the pulse card this controller is (None: an EtherCAT master)
@@ -216,11 +227,15 @@ class Controller:
             for ref in layout.axes
         }
         self._axis_list = list(self.axes.values())
+        self._run_axes = self._axis_list
+        self.bank = None
         self._links_down = False
         install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)
         if _relatch_link_alarms not in self.on_reset:
             self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
         master.open()
+        if self.options.bank != "off" and self.options.backend == "emulated":
+            self.bank = AxisBank(self, self.options.bank)
         for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
             hook(self)
         return master
@@ -260,6 +275,10 @@ class Controller:
         self.started = True
 
     def terminate_ecat(self) -> None:
+        if self.bank is not None:
+            self.bank.release_all()
+            self.bank = None
+            self._run_axes = self._axis_list
         if self.master is not None:
             self.master.terminate()
             self.backend.close()
@@ -277,15 +296,19 @@ class Controller:
             g()
         t = self.clock.now_ns
         dt = self.clock.cycle_ns
+        bank = self.bank
+        if bank is not None:
+            bank.cycle(t, dt)  # the axes it runs, whole; the ones it lets go run below
         for f in self.pre_cycle:
             f(t, dt)
-        for ax in self._axis_list:
+        run = self._run_axes
+        for ax in run:
             ax.pre(t, dt)
         if self.master is not None:
             self.master.cycle(t, dt)
             if self.master.offline or self._links_down:
                 self._watch_links(self.master.offline)
-        for ax in self._axis_list:
+        for ax in run:
             ax.post(t, dt)
         for f in self.post_cycle:
             f(t, dt)

@@ -78,7 +78,7 @@ and the soft limits use the axis values.  Decisions where the manual is silent:
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import Protocol
+from typing import Any, Protocol
 
 from ..errors import BusError, CommandError, ParameterError
 from ..master.clock import Clock
@@ -155,6 +155,10 @@ class AxisResources:
         self._abrupt_mask = 0
         self._csp = ax.mode_cmd == CSP
         self._a_last = ax.prf_pos
+        #: the axis bank running this axis (gtecat.controller.bank), and its row there; while
+        #: set, the readers below answer from the bank
+        self.bank: Any = None
+        self.bank_row = 0
         ax.pre_hooks.append(self._pre)
         ax.post_hooks.append(self._post)
         ax.motion = self
@@ -189,51 +193,69 @@ class AxisResources:
 
     @property
     def prf_pos(self) -> float:
-        return self.profile.planner.pos
+        b = self.bank
+        return b.value("prf_p", self.bank_row) if b is not None else self.profile.planner.pos
 
     @property
     def prf_vel(self) -> float:
-        return self.profile.planner.vel
+        b = self.bank
+        return b.value("prf_v", self.bank_row) if b is not None else self.profile.planner.vel
 
     @property
     def prf_acc(self) -> float:
-        return self.profile.planner.acc
+        b = self.bank
+        return b.value("prf_a", self.bank_row) if b is not None else self.profile.planner.acc
 
     @property
     def axis_prf_pos(self) -> float:
-        return self.ax.prf_pos
+        b = self.bank
+        return b.value("a_last", self.bank_row) if b is not None else self.ax.prf_pos
 
     @property
     def axis_prf_vel(self) -> float:
-        return self.prf_link.ratio * self.profile.planner.vel
+        return self.prf_link.ratio * self.prf_vel
 
     @property
     def axis_prf_acc(self) -> float:
-        return self.prf_link.ratio * self.profile.planner.acc
+        return self.prf_link.ratio * self.prf_acc
 
     @property
     def enc_pos(self) -> float:
-        return self.encoder.pos
+        b = self.bank
+        return b.value("enc_pos", self.bank_row) if b is not None else self.encoder.pos
+
+    @property
+    def enc_vel(self) -> float:
+        b = self.bank
+        return b.value("enc_vel", self.bank_row) if b is not None else self.encoder.vel
+
+    @property
+    def enc_acc(self) -> float:
+        b = self.bank
+        return b.value("enc_acc", self.bank_row) if b is not None else self.encoder.acc
 
     @property
     def axis_enc_pos(self) -> float:
-        return self.enc_link.axis(self.encoder.pos)
+        return self.enc_link.axis(self.enc_pos)
 
     @property
     def axis_enc_vel(self) -> float:
-        return self.enc_link.ratio * self.encoder.vel
+        return self.enc_link.ratio * self.enc_vel
 
     @property
     def axis_enc_acc(self) -> float:
-        return self.enc_link.ratio * self.encoder.acc
+        return self.enc_link.ratio * self.enc_acc
 
     @property
     def axis_error(self) -> float:
         """GT_GetAxisError: axis planned - axis encoder position, pulse."""
-        return self.ax.prf_pos - self.enc_link.axis(self.encoder.pos)
+        return self.axis_prf_pos - self.enc_link.axis(self.enc_pos)
 
     @property
     def moving(self) -> bool:
+        b = self.bank
+        if b is not None:
+            return b.value("moving", self.bank_row)
         return not self.profile.planner.done
 
     @property
@@ -243,6 +265,9 @@ class AxisResources:
 
     def status(self) -> int:
         """GT_GetSts's 32-bit word (table 6-2)."""
+        b = self.bank
+        if b is not None:
+            return b.value("sts", self.bank_row)
         s = self.latched
         if self.ax.servo_on:
             s |= AxisStatus.SERVO_ON
@@ -652,8 +677,8 @@ class AxisResources:
 # --- the controller side -----------------------------------------------------------------
 def install(ctl: Controller) -> None:
     """Create every axis's resources (bus up) and hook GT_Reset once per controller."""
-    for ax in ctl.axes.values():
-        AxisResources(ctl, ax)
+    #: GT axis -> its resources (read without touching the Axis, which the bank may guard)
+    ctl.resources = {n: AxisResources(ctl, ax) for n, ax in ctl.axes.items()}
     for ax in ctl.axes.values():
         ax.motion.bind_inputs()
     if _reset_all not in ctl.on_reset:
@@ -669,6 +694,10 @@ def _reset_all(ctl: Controller) -> None:
 
 def axis_resources(ctl: Controller, n: int) -> AxisResources:
     """The resources of GT axis ``n``: BusError (1) before the bus is up, 7 when out of range."""
+    if type(n) is int:
+        res = getattr(ctl, "resources", {}).get(n)
+        if res is not None and ctl.axes.get(n) is res.ax:
+            return res
     if not ctl.axes:
         raise BusError(
             f"axis {n}: no EtherCAT axis yet (call GT_InitEcatComm; the ENI must hold a "

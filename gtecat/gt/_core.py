@@ -26,6 +26,7 @@ from drives.machine import MachineError
 from eni.errors import EniError, GtecatError
 
 from ..controller.card import refused
+from ..controller.bank import BANK_READS
 from ..controller.core import Controller
 from ..errors import (
     BusError,
@@ -156,6 +157,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     bind = binder(proto, fn)
     card_refused = refused(name)
     opens = name == "GT_Open"
+    bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
         ctl = None
@@ -178,6 +180,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 ctl = SESSION.controller(core)
                 if card_refused and ctl.card is not None:  # an EtherCAT function on a card
                     raise CommandError(ctl.card.refusal(name))
+                bank = ctl.bank
+                if bank is not None and not bank_read:
+                    bank.before_call(name, proto, values)  # the axes it names go back first
                 if ctl.clock.threaded:
                     with ctl.clock.lock:  # atomic with respect to the cycle thread
                         rc = fn(ctl, *values, **extra)

@@ -247,7 +247,7 @@ def GT_GetEncVel(
 ) -> int:
     """Encoder velocity, pulse/ms (entry 47; at most 8 at once)."""
     return _read_many(
-        ctl, encoder, pValue, count, pClock, lambda r: r.encoder.vel, _MAX_ENCODERS_PER_CALL
+        ctl, encoder, pValue, count, pClock, lambda r: r.enc_vel, _MAX_ENCODERS_PER_CALL
     )
 
 

@@ -528,6 +528,8 @@ class CrdBank:
             if c.running:
                 c.step()
 
+    _pre.bank_safe = True  # type: ignore[attr-defined]  # touches interpolating axes only
+
     def _reset(self, ctl: Any) -> None:
         for c in self.systems.values():
             c.reset()

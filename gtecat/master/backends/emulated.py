@@ -48,6 +48,9 @@ class EmulatedBackend(Backend):
         self.watchdog_ns = 100_000_000
         self._silent_ns: dict[int, int] = {}
         self._clients: dict[int, object] = {}
+        #: positions whose slaves the controller's axis bank runs (gtecat.controller.bank):
+        #: they answer (working counter) but are not stepped here
+        self.claimed: set[int] = set()
         self.capture = None
         if pcap:
             from ..pcap import BusCapture
@@ -117,7 +120,11 @@ class EmulatedBackend(Backend):
         assert image is not None
         wkc = 0
         unplugged = self.unplugged
+        claimed = self.claimed
         for slave, out, inp in self._plan:
+            if claimed and slave.position in claimed:
+                wkc += 2 * (out is not None) + (inp is not None)  # in OP, stepped by the bank
+                continue
             if unplugged and slave.position in unplugged:
                 # powered but cut off: it keeps running; its watchdog notices the silence
                 silent = self._silent_ns.get(slave.position, 0) + dt_ns

@@ -1,0 +1,742 @@
+"""The vectorised axis bank: the common servo cycle of many axes as numpy rows (issue 17).
+
+Per axis and cycle the scalar objects cost 15-25 µs of Python (planner, axis layer,
+drive state machine, mechanics, PDO codec, status and limit checks).  Most axes of a
+machine spend most cycles in one state: servo on, drive in CSP, Trap move or holding,
+no flag latched.  :class:`AxisBank` runs exactly that state for every such axis at
+once - the Trap samples (:func:`~gtecat.controller.motion.trap_table.trap_table`), the
+axis layer's 607Ah, the drive (:class:`drives.csp_bank.CspBank`), the encoder, the soft
+and hardware limits, the following error, the in-position band and the GT_GetSts word -
+and reads/writes the process image as array views.
+
+**The scalar objects stay the reference.**  An axis is *claimed* only while it is in
+that state (:meth:`AxisBank._eligible` lists every condition) and *released* - its
+state written back into its objects exactly as if they had run every cycle themselves -
+before anything else may look at or change them:
+
+* any GT function except the bank-aware readers (:data:`BANK_READS`) releases the
+  axis it names (or every axis when it names several, a mask or none) before it runs;
+* a cycle in which a claimed axis would leave the state (a limit, the following
+  error, a new sample past a soft limit, a raw write to its slave's outputs, the
+  drive's own following-error window) releases it *before* that cycle, so the scalar
+  code runs that cycle and every later one until the axis is back in the common state;
+* the field side (a fault injected, the machine moved, an SDO to the drive) releases
+  the slave through :attr:`drives.drive.Cia402Drive.on_touch`;
+* per-cycle hooks the bank does not know (a recorder, motion programs, smart homing)
+  and axes in Gear/Follow mode (they read other axes every cycle) turn it off.
+
+Claimed axes are re-examined whenever a GT call or a release happened, else every
+:data:`RECHECK_CYCLES` cycles.  A multi-axis drive is claimed with all its channels.
+
+Decisions: ``GTECAT_BANK`` / ``GT_Open(bank=...)`` = ``auto`` (default: used when the
+bus has at least :data:`AUTO_MIN_AXES` CiA-402 axes, the measured crossover), ``on``
+(any bus; the differential tests use it) or ``off``.  The results are bit-identical
+to the scalar path (same float operations in the same order; ``tests/gtecat/
+controller/test_bank.py`` compares planned and actual positions, statuswords and GT
+status cycle by cycle).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from drives.csp_bank import CW_ENABLED, CspBank, claimable
+from drives.drive import Cia402Drive
+from drives.slave import AlState
+from eni.datatypes import CHANNEL_STRIDE
+from eni.model import Direction
+
+from .axis_status import AxisStatus
+from .motion.stop import StopKind
+from .motion.trap import _IDLE, _MOVE, TrapPlanner
+from .motion.trap_table import advance, trap_table
+from .profile import PrfMode
+
+if TYPE_CHECKING:
+    from .core import Controller
+
+#: the crossover: below this many axes the scalar path is as fast (tools/bench_scaling.py)
+AUTO_MIN_AXES = 4
+#: cycles between two looks for axes to claim when nothing else happened
+RECHECK_CYCLES = 16
+#: samples of a Trap move computed at once (a table per axis)
+TABLE = 256
+
+#: TxPDO objects the bank computes (channel-0 numbers -> CspBank output names)
+COMPUTED_TX = {
+    0x6041: "statusword",
+    0x6062: "position_demand",
+    0x6064: "position_actual",
+    0x606C: "velocity_actual",
+    0x6074: "torque_demand",
+    0x6077: "torque_actual",
+    0x6078: "current_actual",
+    0x60F4: "following_error_actual",
+    0x60FD: "digital_inputs",
+}
+#: TxPDO objects that cannot change while an axis is in the bank's state
+CONSTANT_TX = {0x603F, 0x6061, 0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, 0x1001, 0x20F2, 0x20F9}
+CONSTANT_TX |= set(range(0x60D1, 0x60D9))
+_DTYPES = {(8, False): "<u1", (8, True): "<i1", (16, False): "<u2", (16, True): "<i2"}
+_DTYPES |= {(32, False): "<u4", (32, True): "<i4"}
+
+#: GT functions whose implementations read a claimed axis through the bank itself
+BANK_READS = frozenset(
+    {
+        "GT_GetSts",
+        "GT_GetPrfPos",
+        "GT_GetPrfVel",
+        "GT_GetPrfAcc",
+        "GT_GetEncPos",
+        "GT_GetEncVel",
+        "GT_GetEncAcc",
+        "GT_GetAxisPrfPos",
+        "GT_GetAxisPrfVel",
+        "GT_GetAxisPrfAcc",
+        "GT_GetAxisEncPos",
+        "GT_GetAxisEncVel",
+        "GT_GetAxisEncAcc",
+        "GT_GetAxisError",
+        "GT_GetPrfMode",
+        "GT_GetEcatRawData",
+        "GT_SetEcatRawData",
+        "GT_GetClock",
+        "GT_GetClockHighPrecision",
+        "GTE_Wait",
+        "GTE_GetLastError",
+        "GT_GetVersion",
+        "GT_IsEcatReady",
+    }
+)
+_SERVO_ON, _MOVING, _ARRIVED = (
+    int(AxisStatus.SERVO_ON),
+    int(AxisStatus.MOVING),
+    int(AxisStatus.ARRIVED),
+)
+_HALF, _WRAP = 1 << 31, 1 << 32
+
+
+# --- guards: a claimed axis's objects give themselves back when anything touches them ---------
+class _Bypass:
+    on = False
+
+
+_OWNER: dict[int, tuple[AxisBank, int]] = {}  # id(object) -> (bank, group index)
+_GUARDS: dict[type, type] = {}
+_get, _set = object.__getattribute__, object.__setattr__
+
+
+def _wake(obj: object) -> None:
+    entry = _OWNER.get(id(obj))
+    if entry is not None:
+        bank, gi = entry
+        bank._release_groups([bank.groups[gi]])
+        bank._reindex()
+
+
+def _guard_class(cls: type) -> type:
+    """``cls`` whose every attribute access first releases the object from its bank."""
+    g = _GUARDS.get(cls)
+    if g is None:
+
+        def __getattribute__(self: Any, name: str) -> Any:  # noqa: N807
+            if not _Bypass.on:
+                _wake(self)
+            return _get(self, name)
+
+        def __setattr__(self: Any, name: str, value: Any) -> None:  # noqa: N807
+            if not _Bypass.on:
+                _wake(self)
+            _set(self, name, value)
+
+        g = type(
+            cls.__name__,
+            (cls,),
+            {
+                "__slots__": (),
+                "__getattribute__": __getattribute__,
+                "__setattr__": __setattr__,
+                "__module__": cls.__module__,
+                "__qualname__": cls.__qualname__,
+            },
+        )
+        _GUARDS[cls] = g
+    return g
+
+
+@dataclass
+class _Group:
+    """One slave (all its channels are claimed together)."""
+
+    position: int
+    drive: Cia402Drive
+    rows: list[int]
+    rx_bytes: np.ndarray  # buffer indices of its output bytes, 607Ah excluded
+    claimed: bool = False
+
+
+class AxisBank:
+    """The claimed axes of one controller and their cycle (module docstring)."""
+
+    def __init__(self, ctl: Controller, mode: str = "auto") -> None:
+        self.ctl = ctl
+        self.mode = mode
+        self.built = False
+        self.groups: list[_Group] = []
+        self.dirty = True
+        self._countdown = 0
+        self.n = 0
+        self.alive = np.zeros(0, bool)
+        self.n_alive = 0
+        self._lists: dict[str, list[Any]] = {}
+        self.disabled_reason = ""
+
+    # --- structure ------------------------------------------------------------------------
+    def _build(self) -> None:
+        """Rows for every axis whose slave the bank can run (mapping and backend)."""
+        self.built = True
+        ctl = self.ctl
+        master, backend = ctl.master, ctl.backend
+        if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
+            self.disabled_reason = "not the emulated backend on the ENI's own hardware"
+            return
+        if backend.capture is not None:
+            self.disabled_reason = "a pcap is written"
+            return
+        layout, image = ctl.layout, master.image
+        if len(layout.axes) < (AUTO_MIN_AXES if self.mode == "auto" else 1):
+            self.disabled_reason = f"fewer than {AUTO_MIN_AXES} axes"
+            return
+        by_slave: dict[int, list[Any]] = {}
+        for ref in layout.axes:
+            by_slave.setdefault(ref.slave, []).append(ref)
+        axes, chans, groups = [], [], []
+        tx: dict[str, list[tuple[int, int, int, str]]] = {}
+        a607: list[tuple[int, int]] = []
+        for pos, refs in by_slave.items():
+            slave = backend.slaves[pos] if pos < len(backend.slaves) else None
+            if not isinstance(slave, Cia402Drive) or len(slave.channels) != len(refs):
+                continue
+            sl = layout.slaves[pos]
+            ok, rows = True, []
+            g_tx: list[tuple[int, int, int, str]] = []
+            g_607a: list[tuple[int, int]] = []
+            rx_idx: list[int] = []
+            row_of = {ref.channel: len(axes) + k for k, ref in enumerate(refs)}
+            for e in sl.entries:
+                if e.is_padding:
+                    continue
+                k, base = divmod(e.index - 0x6000, CHANNEL_STRIDE)
+                base += 0x6000
+                if not 0x6000 <= e.index < 0x6000 + CHANNEL_STRIDE * 8:
+                    k, base = 0, e.index
+                if e.logical_bit & 7 or (e.bits, e.signed) not in _DTYPES:
+                    ok = False
+                    break
+                byte = e.logical_bit >> 3
+                if e.direction == Direction.OUT:
+                    if base == 0x607A and e.subindex == 0 and k in row_of:
+                        g_607a.append((row_of[k], byte))
+                    else:
+                        rx_idx.extend(range(byte, byte + e.bits // 8))
+                elif base in COMPUTED_TX and e.subindex == 0 and k in row_of:
+                    dt = _DTYPES[(e.bits, e.signed)]
+                    g_tx.append((row_of[k], image.outputs_bytes + byte, e.bits // 8, dt))
+                    g_tx[-1] = (*g_tx[-1][:3], dt + "|" + COMPUTED_TX[base])
+                elif base not in CONSTANT_TX:
+                    ok = False
+                    break
+            if not ok or len(g_607a) != len(refs):
+                continue
+            for ref in refs:
+                rows.append(len(axes))
+                axes.append(ctl.axes[ref.axis])
+                chans.append(slave.channels[ref.channel])
+            for r, off, size, key in g_tx:
+                tx.setdefault(key, []).append((r, off, size, key))
+            a607 += g_607a
+            groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp)))
+        if not axes:
+            self.disabled_reason = "no drive the bank can run (mapping)"
+            return
+        self.groups = groups
+        self.group_of = [0] * len(axes)
+        for gi, g in enumerate(groups):
+            for r in g.rows:
+                self.group_of[r] = gi
+        self.axes = axes
+        self.res = [ax.motion for ax in axes]
+        n = self.n = len(axes)
+        self.csp = CspBank(chans)
+        self.alive = np.zeros(n, bool)
+        # image addresses: (row, first byte in the buffer, bytes, value) per PDO entry
+        self._plc = [(r, b, 4, "target") for r, b in a607]
+        self._plc += [
+            (r, off, size, key.split("|")[1]) for lst in tx.values() for r, off, size, key in lst
+        ]
+        z, zi = np.zeros, np.zeros
+        # controller-side state and constants
+        self.unit2 = z(n)  # 2**PosScale
+        self.unit = z(n)  # 2**-PosScale
+        self.drive_offset = zi(n, np.int64)
+        self.prf_ratio, self.prf_off = z(n), z(n)
+        self.enc_ratio, self.enc_off = z(n), z(n)
+        self.soft_pos, self.soft_neg = z(n), z(n)
+        self.hw_mask = zi(n, np.int64)  # 60FDh bits of the limit switches the axis watches
+        self.pos_err = z(n)
+        self.external = zi(n, bool)
+        self.sense = zi(n, np.int64)
+        self.enc_prev = zi(n, np.int64)
+        self.enc_pos, self.enc_vel, self.enc_acc = z(n), z(n), z(n)
+        self.band, self.hold_ns = z(n), zi(n, np.int64)
+        self.since = zi(n, np.int64)
+        self.arrived = zi(n, bool)
+        self.prf_p, self.prf_v, self.prf_a = z(n), z(n), z(n)
+        self.a_last = z(n)
+        self.moving = zi(n, bool)
+        self.taken = zi(n, np.int64)  # samples taken since the claim
+        self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
+        self.ended = zi(n, bool)
+        self.t_p, self.t_v, self.t_a = z((n, TABLE + 1)), z((n, TABLE + 1)), z((n, TABLE + 1))
+        self.base = np.arange(n, dtype=np.int64) * (TABLE + 1)
+        self.t_idx = self.base.copy()  # table index of each row's last sample
+        self.t_len = zi(n, np.int64)  # valid samples in the table
+        self.t_cur = zi(n, np.int64)  # next sample to take
+        self.t_end = zi(n, np.int64)  # index of the end sample (or -1)
+        self.T = ctl.clock.cycle_ns / 1e6
+        self._reindex()
+
+    def _reindex(self) -> None:
+        """Image addresses and run lists of the claimed rows (after a claim or release)."""
+        alive = self.alive
+        self.n_alive = int(alive.sum())
+        self.any_prf_link = bool(np.count_nonzero((self.prf_ratio != 1.0) | (self.prf_off != 0.0)))
+        self.any_enc_link = bool(np.count_nonzero((self.enc_ratio != 1.0) | (self.enc_off != 0.0)))
+        self.any_drive_offset = bool(np.count_nonzero(self.drive_offset))
+        self.all_external = bool(self.external.all())
+        self.any_sense = bool(np.count_nonzero(self.sense != 1))
+        self.any_band = bool(np.count_nonzero(self.band > 0))
+        self.band_dirty = True
+        plc = [p for p in self._plc if alive[p[0]]]
+        names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
+        self._extra = names
+        col = {"target": 0, "position_actual": 1, "digital_inputs": 2}
+        col |= {name: 3 + k for k, name in enumerate(names)}
+        n = self.n
+        self._img_src = np.array([col[name] * n + r for r, _, _, name in plc], np.intp)
+        self._img_dst = np.array([off + j for _, off, size, _ in plc for j in range(size)], np.intp)
+        self._img_bytes = np.array(
+            [4 * i + j for i, (_, _, size, _) in enumerate(plc) for j in range(size)], np.intp
+        )
+        self.n_moving = int(np.count_nonzero(self.moving & alive))
+        self._refill_in = 0  # look for tables to fill at the next cycle
+        self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
+        rx = [g.rx_bytes for g in self.groups if g.claimed]
+        self._rx_idx = np.concatenate(rx) if rx else np.zeros(0, np.intp)
+        buf = self.ctl.master.image.buffer
+        self._rx_ref = buf.take(self._rx_idx).tobytes()
+        claimed = {g.position for g in self.groups if g.claimed}
+        self.ctl.backend.claimed = claimed
+        banked = {id(self.axes[r]) for r in range(self.n) if alive[r]}
+        self.ctl._run_axes = [ax for ax in self.ctl._axis_list if id(ax) not in banked]
+        self._lists.clear()
+
+    # --- when the bank may run ----------------------------------------------------------------
+    def _global_reason(self) -> str:
+        ctl = self.ctl
+        m = ctl.master
+        if m is None or not m.opened or not m.ready:
+            return "bus not in OP"
+        if ctl.before_cycle or ctl.post_cycle or ctl.sample:
+            return "per-cycle hooks (recorder, programs, smart homing)"
+        if any(not getattr(f, "bank_safe", False) for f in ctl.pre_cycle):
+            return "per-cycle hooks"
+        if ctl.backend.unplugged:
+            return "a slave is unplugged"
+        for res in ctl.resources.values():  # never the Axis objects: they may be guarded
+            if res.profile.mode in (PrfMode.GEAR, PrfMode.FOLLOW):
+                return "an axis follows another (Gear/Follow)"
+        return ""
+
+    def _eligible(self, r: int) -> bool:
+        """The scalar state the bank reproduces (module docstring)."""
+        ax = self.axes[r]
+        res = self.res[r]
+        if res is None:
+            return False
+        if not (ax.servo_on and ax.mode_cmd == 8 and ax.csp_follow) or ax.link_lost:
+            return False
+        if ax.cw != CW_ENABLED or ax._cw_sent != CW_ENABLED:
+            return False
+        if len(ax.pre_hooks) != 1 or len(ax.post_hooks) != 1 or not res._csp:
+            return False
+        if res.latched or ax.prf_pos != res._a_last:
+            return False
+        prof = res.profile
+        pl = prof.planner
+        if not prof.active or prof.mode != PrfMode.TRAP or pl is not prof.trap:
+            return False
+        if not isinstance(pl, TrapPlanner) or pl.stopping != StopKind.NONE:
+            return False
+        if pl._mode not in (_IDLE, _MOVE):
+            return False
+        enc = res.encoder
+        if not (enc._primed and enc.active):
+            return False
+        s = res.safety
+        n = ax.number
+        if s.alarm_input not in (n, None) or s.smooth_stop_input or s.abrupt_stop_input:
+            return False
+        if s.positive_input not in (n, None) or s.negative_input not in (n, None):
+            return False
+        if res._pos_din is not ax.io.get(0x60FD) and res._pos_din is not None:
+            return False
+        return not claimable(self.csp.channels[r])
+
+    def refresh(self) -> None:
+        """Claim every slave whose axes are all eligible; drop all when the bank cannot run."""
+        self.dirty = False
+        self._countdown = RECHECK_CYCLES
+        if not self.built:
+            self._build()
+        if not self.n:
+            return
+        reason = self._global_reason()
+        if reason:
+            if self.n_alive:
+                self.release_all()
+            return
+        changed = False
+        for g in self.groups:
+            if g.claimed:
+                continue
+            if g.drive.al_state != AlState.OP:
+                continue
+            if not all(self._eligible(r) for r in g.rows):
+                continue
+            changed |= self._claim(g)
+        if changed:
+            self._reindex()
+
+    def _claim(self, g: _Group) -> bool:
+        # the slave decoded exactly what is in the image (no raw write since its last step)
+        sl = self.ctl.layout.slaves[g.position]
+        if sl.out_bytes:
+            start = (sl.out_logical_bit or 0) >> 3
+            now = self.ctl.master.image.buffer[start : start + sl.out_bytes].tobytes()
+            if now != bytes(g.drive.rx[: sl.out_bytes]):
+                return False
+        for r in g.rows:
+            self.csp.load(r)
+            self._load(r)
+        g.claimed = True
+        gi = self.groups.index(g)
+        for obj in self._guarded_objects(g):
+            _OWNER[id(obj)] = (self, gi)
+            _set(obj, "__class__", _guard_class(type(obj)))
+        return True
+
+    def _guarded_objects(self, g: _Group) -> list[object]:
+        """The objects of a group's axes that nobody may touch while the bank runs them."""
+        out: list[object] = []
+        for r in g.rows:
+            res = self.res[r]
+            out += [self.csp.channels[r], self.axes[r], res.profile.planner, res.encoder]
+            out.append(res.band)
+        return out
+        g.drive.on_touch = self._touched
+
+    def _load(self, r: int) -> None:
+        ax, res = self.axes[r], self.res[r]
+        self.alive[r] = True
+        res.bank, res.bank_row = self, r
+        s = ax.pos_scale
+        self.unit2[r] = float(1 << s)
+        self.unit[r] = 1.0 / (1 << s)
+        self.drive_offset[r] = ax.drive_offset
+        self.prf_ratio[r], self.prf_off[r] = res.prf_link.ratio, res.prf_link.offset
+        self.enc_ratio[r], self.enc_off[r] = res.enc_link.ratio, res.enc_link.offset
+        sf = res.safety
+        on = sf.active
+        self.soft_pos[r] = sf.soft_positive if on else np.inf
+        self.soft_neg[r] = sf.soft_negative if on else -np.inf
+        self.hw_mask[r] = (2 if on and sf.positive_on and res._pos_din is not None else 0) | (
+            1 if on and sf.negative_on and res._neg_din is not None else 0
+        )
+        self.pos_err[r] = sf.pos_err if on else np.inf
+        enc = res.encoder
+        self.external[r] = enc.external
+        self.sense[r] = enc.sense
+        self.enc_prev[r] = enc._prev
+        self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
+        b = res.band
+        self.band[r], self.hold_ns[r] = b.band, b._hold_ns
+        self.since[r] = -1 if b._since is None else b._since
+        self.arrived[r] = b.arrived
+        pl = res.profile.planner
+        self.a_last[r] = ax.prf_pos
+        moving = pl._mode == _MOVE
+        self.moving[r] = moving
+        self.taken[r] = 0
+        self.k0[r] = pl._k
+        self.ended[r] = False
+        self.t_cur[r] = 0
+        # the last sample so far sits in slot TABLE (moving: the first cycle fills the
+        # table) or in slot 0, the hold slot of a row at rest
+        slot = TABLE if moving else 0
+        self.t_p[r, slot], self.t_v[r, slot], self.t_a[r, slot] = pl._pos, pl._vel, pl._acc
+        self.t_idx[r] = self.base[r] + slot
+        if moving:
+            self.t_len[r], self.t_end[r] = 0, -1
+        else:
+            self.t_len[r], self.t_end[r] = 1, 0
+
+    def _refill(self, r: int) -> None:
+        pl = self.res[r].profile.planner
+        _Bypass.on = True
+        try:
+            p, v, a, end = trap_table(pl, TABLE, int(self.k0[r] + self.taken[r]))
+        finally:
+            _Bypass.on = False
+        m = len(p)
+        self.t_p[r, :m], self.t_v[r, :m], self.t_a[r, :m] = p, v, a
+        self.t_len[r] = m
+        self.t_cur[r] = 0
+        self.t_end[r] = end if end < TABLE else -1
+
+    # --- release ---------------------------------------------------------------------------------
+    def release_all(self) -> None:
+        if self.n_alive:
+            self._release_groups([g for g in self.groups if g.claimed])
+            self._reindex()
+
+    def release_axis(self, axis: int) -> None:
+        for r in range(self.n):
+            if self.alive[r] and self.axes[r].number == axis:
+                self._release_groups([self.groups[self.group_of[r]]])
+                self._reindex()
+                return
+
+    def _release_groups(self, groups: list[_Group]) -> None:
+        """Write the rows' committed state back into their objects; they leave the bank."""
+        rows = [r for g in groups for r in g.rows]
+        self._materialise()
+        for g in groups:
+            for obj in self._guarded_objects(g):
+                _OWNER.pop(id(obj), None)
+                cls = type(obj)
+                if cls in _GUARDS.values():
+                    _set(obj, "__class__", cls.__mro__[1])
+            g.claimed = False
+        self.csp.store(rows)
+        for r in rows:
+            self._store(r)
+        self.dirty = True
+
+    def _store(self, r: int) -> None:
+        ax, res = self.axes[r], self.res[r]
+        self.alive[r] = False
+        res.bank = None
+        a = float(self.a_last[r])
+        ax.prf_pos = a
+        res._a_last = a
+        enc = res.encoder
+        prev = int(self.enc_prev[r])
+        enc._prev = ((prev + _HALF) & 0xFFFFFFFF) - _HALF  # the 32-bit value the object holds
+        enc.pos, enc.vel, enc.acc = (
+            float(self.enc_pos[r]),
+            float(self.enc_vel[r]),
+            float(self.enc_acc[r]),
+        )
+        b = res.band
+        since = int(self.since[r])
+        b._since = None if since < 0 else since
+        b.arrived = bool(self.arrived[r])
+        pl = res.profile.planner
+        last = (float(self.prf_p[r]), float(self.prf_v[r]), float(self.prf_a[r]))
+        if pl._mode == _MOVE:
+            advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
+
+    # --- the GT boundary ------------------------------------------------------------------------
+    def before_call(self, name: str, proto: Any, values: tuple) -> None:
+        """A GT function is about to run: release what it may look at or change."""
+        self.dirty = True
+        if not self.n_alive:
+            return
+        params = proto.params
+        if params and params[0].name in ("axis", "profile", "encoder") and values:
+            if not any(p.name == "count" for p in params):
+                try:
+                    self.release_axis(int(values[0]))
+                    return
+                except (TypeError, ValueError):
+                    pass
+        self.release_all()
+
+    # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
+    def value(self, name: str, r: int) -> Any:
+        lst = self._lists.get(name)
+        if lst is None:
+            lst = self._lists[name] = self._make_list(name)
+        return lst[r]
+
+    def _make_list(self, name: str) -> list[Any]:
+        if name == "sts":
+            sts = np.where(self.moving, _MOVING, np.where(self.arrived, _ARRIVED, 0))
+            return (sts | _SERVO_ON).tolist()
+        if name == "axis_enc":
+            return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
+        if name == "moving":
+            return self.moving.tolist()
+        if name in ("prf_p", "prf_v", "prf_a"):
+            self._materialise()
+        return getattr(self, name).tolist()
+
+    @staticmethod
+    def _link(x: np.ndarray, ratio: np.ndarray, off: np.ndarray) -> np.ndarray:
+        """:meth:`AffineLink.axis` for every row (the same three cases)."""
+        one = ratio == 1.0
+        return np.where(one, np.where(off != 0.0, x + off, x), ratio * x + off)
+
+    # --- the cycle -------------------------------------------------------------------------
+    def cycle(self, t_ns: int, dt_ns: int) -> None:
+        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        self._countdown -= 1
+        if self.dirty or self._countdown <= 0:
+            self.refresh()
+        if not self.n_alive:
+            return
+        self._lists.clear()
+        buf = self.ctl.master.image.buffer
+        # 1. raw writes to a claimed slave's outputs: back to the scalar drive first
+        if self._rx_ref and buf.take(self._rx_idx).tobytes() != self._rx_ref:
+            self._release_changed(buf)
+            if not self.n_alive:
+                return
+        # 2. this cycle's planner samples (a row at rest reads its hold slot)
+        moving, cur = self.moving, self.t_cur
+        self._refill_in -= 1
+        if self.n_moving and self._refill_in <= 0:
+            need = moving & (cur >= self.t_len)
+            if np.count_nonzero(need):
+                self._materialise()
+                for r in np.nonzero(need)[0].tolist():
+                    self._refill(r)
+            left = (self.t_len - cur)[moving]
+            self._refill_in = int(left.min()) if len(left) else TABLE
+        idx = self.base + cur
+        prf_p = self.t_p.take(idx)
+        ended = cur == self.t_end
+        a = self._link(prf_p, self.prf_ratio, self.prf_off) if self.any_prf_link else prf_p
+        # 3. 607Ah (Axis.pulses_to_counts, int32 like the PDO entry) and the drives
+        counts = np.rint(a * self.unit2 if self.any_scale else a).astype(np.int64)
+        if self.any_drive_offset:
+            counts += self.drive_offset
+        target = counts.astype(np.int32)
+        csp = self.csp
+        state, events = csp.step(target, dt_ns * 1e-9)
+        pa = csp.output("position_actual", state)
+        din = csp.output("digital_inputs", state)
+        # 4. encoder (Encoder.sample; a 32-bit difference, as the object wraps it)
+        raw = pa if self.all_external else np.where(self.external, pa, target)
+        d = (raw - self.enc_prev).astype(np.int32)
+        step = (self.sense * d if self.any_sense else d) * self.unit
+        enc_pos = self.enc_pos + step
+        enc_vel = step / self.T
+        enc_acc = (enc_vel - self.enc_vel) / self.T
+        # 5. limit switches (the controller latches them, the drive reacts), soft limits
+        # and the following error: each latches a flag, so the row leaves before this cycle
+        enc_axis = (
+            self._link(enc_pos, self.enc_ratio, self.enc_off) if self.any_enc_link else enc_pos
+        )
+        err = a - enc_axis
+        hit = a > self.soft_pos
+        if din is not csp._din_zero:
+            hit |= (din & 3) != 0
+        hit |= a < self.soft_neg
+        hit |= np.abs(err) > self.pos_err
+        if events is not None:
+            hit |= events
+        # 6. the in-position band (bit 11)
+        standing = (ended | ~moving) if self.any_band else None
+        if self.any_band and (self.band_dirty or np.count_nonzero(standing & (self.band > 0))):
+            # (moving rows keep since = -1, arrived = False: nothing to do while all move)
+            self.band_dirty = False
+            on = self.band > 0
+            inb = on & standing & (-self.band <= err) & (err <= self.band)
+            since = np.where(inb, np.where(self.since < 0, t_ns, self.since), -1)
+            since = np.where(on, since, self.since)
+            arr = inb & (self.arrived | (t_ns - since >= self.hold_ns))
+            arrived = np.where(on, arr, self.arrived)
+        else:
+            since, arrived = self.since, self.arrived
+        # 7. rows leaving: back to the scalar objects before this cycle
+        if self.n_alive != self.n:
+            hit &= self.alive
+        if np.count_nonzero(hit):
+            gs = {self.group_of[r] for r in np.nonzero(hit)[0].tolist()}
+            self._release_groups([self.groups[g] for g in gs])
+            self._reindex()
+            if not self.n_alive:
+                return
+        fin = ended & moving
+        any_fin = bool(np.count_nonzero(fin))
+        if self.n_alive == self.n:
+            csp.commit(state, din, None)
+            self.a_last, self.t_idx = a, idx
+            self.enc_prev, self.enc_pos, self.enc_vel, self.enc_acc = raw, enc_pos, enc_vel, enc_acc
+            self.since, self.arrived = since, arrived
+            self.taken += moving
+            if any_fin:
+                self.ended |= fin
+                cur += moving & ~ended
+                moving &= ~ended
+                self.n_moving = int(np.count_nonzero(moving))
+            else:
+                cur += moving
+        else:
+            keep = self.alive
+            csp.commit(state, din, keep)
+            for name, value in (
+                ("a_last", a),
+                ("t_idx", idx),
+                ("enc_prev", raw),
+                ("enc_pos", enc_pos),
+                ("enc_vel", enc_vel),
+                ("enc_acc", enc_acc),
+                ("since", since),
+                ("arrived", arrived),
+            ):
+                getattr(self, name)[keep] = value[keep]
+            mk = moving & keep
+            self.taken += mk
+            self.ended |= fin & keep
+            cur += mk & ~ended
+            moving &= ~(fin & keep)
+            self.n_moving = int(np.count_nonzero(moving))
+        # 8. the image: 607Ah out, the drives' TxPDO in, in one scatter
+        cols = [target, pa, din]
+        for name in self._extra:
+            cols.append(csp.output(name, state))
+        vals = np.concatenate(cols).take(self._img_src)
+        buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
+
+    def _materialise(self) -> None:
+        """The planned speed and acceleration of the last samples (kept as table indices)."""
+        idx = self.t_idx
+        self.prf_v = self.t_v.take(idx)
+        self.prf_a = self.t_a.take(idx)
+        self.prf_p = self.t_p.take(idx)
+
+    def _release_changed(self, buf: np.ndarray) -> None:
+        changed = []
+        now = buf[self._rx_idx]
+        diff = set(self._rx_idx[now != self._rx_ref].tolist())
+        for g in self.groups:
+            if g.claimed and diff.intersection(g.rx_bytes.tolist()):
+                changed.append(g)
+        self._release_groups(changed)
+        self._reindex()
