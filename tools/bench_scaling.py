@@ -1,7 +1,7 @@
 """Real-time factor against the number of axes (1..128), idle, moving and homing, as JSON.
 
     python tools/bench_scaling.py [--axes 1,12,64] [--states idle,moving] [--seconds 1.5]
-    python tools/bench_scaling.py --plot docs/performance.png --table docs/performance_table.md
+    python tools/bench_scaling.py --plot docs/performance.png --table docs/performance.md
 
 Each (axes, state) point opens a fresh controller on a generated bus of N single-axis
 CSP drives (:mod:`tools.gen_axes_eni`) with the lockstep clock, brings it up with
@@ -330,8 +330,33 @@ def bench_scaling(
     return out
 
 
+BEGIN, END = "<!-- bench_scaling table: begin -->", "<!-- bench_scaling table: end -->"
+
+
+def _provenance() -> str:
+    """When, at which commit and under what load the figures were taken."""
+    import subprocess
+
+    try:
+        rev = subprocess.run(
+            ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            check=False,
+        ).stdout.strip()
+    except OSError:
+        rev = ""
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
+    when = time.strftime("%Y-%m-%d %H:%M")
+    return f"Measured {when} at commit `{rev or '?'}`, {os.cpu_count()} CPUs, load average {load}."
+
+
 def write_table(results: Sequence[Mapping[str, Any]], path: str | Path) -> None:
-    """A markdown table: one row per axis count, µs per cycle and real-time factor per state."""
+    """A markdown table: one row per axis count, µs per cycle and real-time factor per state.
+
+    When ``path`` holds the :data:`BEGIN` / :data:`END` markers (``docs/performance.md``),
+    only the text between them is replaced; otherwise the file is the table alone.
+    """
     states = [s for s in STATES if any(r["state"] == s for r in results)]
     by = {(r["axes"], r["state"]): r for r in results}
     head = "| axes | " + " | ".join(f"{s} µs/cycle | {s} RTF" for s in states) + " |"
@@ -347,10 +372,15 @@ def write_table(results: Sequence[Mapping[str, Any]], path: str | Path) -> None:
                 cells += [f"{r['us_per_cycle']:.0f}", f"{r['rtf']:.2f}×"]
         rows.append(f"| {n} | " + " | ".join(cells) + " |")
     errors = sorted({r["error"] for r in results if "error" in r})
-    text = "\n".join(rows) + "\n"
+    text = _provenance() + "\n\n" + "\n".join(rows) + "\n"
     if errors:
         text += "\nn/a: " + "; ".join(errors) + "\n"
-    Path(path).write_text(text, encoding="utf-8")
+    p = Path(path)
+    old = p.read_text(encoding="utf-8") if p.exists() else ""
+    head, sep, rest = old.partition(BEGIN)
+    if sep and END in rest:
+        text = head + BEGIN + "\n" + text + END + rest.partition(END)[2]
+    p.write_text(text, encoding="utf-8")
 
 
 def write_plot(results: Sequence[Mapping[str, Any]], path: str | Path, title: str = "") -> None:
@@ -372,7 +402,7 @@ def write_plot(results: Sequence[Mapping[str, Any]], path: str | Path, title: st
     right.set_ylabel("real-time factor (controller ms per wall ms)")
     for target, label in ((20, "12 axes ≥ 20×"), (10, "64 axes ≥ 10×"), (5, "128 axes ≥ 5×")):
         right.axhline(target, color="grey", lw=0.6, ls=":")
-        right.annotate(label, (1, target), fontsize=7, color="grey", va="bottom")
+        right.annotate(label, (AXES[-1], target), fontsize=7, color="grey", va="bottom", ha="right")
     right.axhline(1, color="red", lw=0.8, ls="--")
     for ax in (left, right):
         ax.set_xscale("log", base=2)
@@ -382,7 +412,11 @@ def write_plot(results: Sequence[Mapping[str, Any]], path: str | Path, title: st
         ax.grid(True, which="both", lw=0.3)
         ax.legend()
     fig.suptitle(title or "gtecat, lockstep clock, CSP drives, GT API")
-    fig.tight_layout()
+    errors = [r for r in results if "error" in r]
+    fig.tight_layout(rect=(0, 0.05 if errors else 0, 1, 1))
+    if errors:
+        why = str(errors[0]["error"]).partition(" - ")[0]
+        fig.text(0.5, 0.01, f"{len(errors)} points not measured: {why}", ha="center", fontsize=7)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

@@ -60,6 +60,12 @@ def test_table_and_plot(tmp_path: Path) -> None:
     text = (tmp_path / "t.md").read_text(encoding="utf-8")
     assert "| 1 | 50 | 20.00× | 62 | 16.00× |" in text
     assert "| 64 | n/a | n/a | n/a | n/a |" in text and "core 2 missing" in text
+    page = tmp_path / "page.md"
+    page.write_text(f"# title\n{bench_scaling.BEGIN}\nold\n{bench_scaling.END}\ntail\n")
+    write_table(results, page)
+    text = page.read_text(encoding="utf-8")
+    assert text.startswith("# title\n") and text.endswith(f"{bench_scaling.END}\ntail\n")
+    assert "old" not in text and "| 64 | n/a |" in text
     write_plot(results, tmp_path / "p.png")
     assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
 
