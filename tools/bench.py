@@ -1,12 +1,22 @@
 """gtecat benchmarks: prints one JSON object with every figure the issues ask for.
 
-    python3 tools/bench.py            # all
-    python3 tools/bench.py --quick    # fewer repetitions
+    python3 tools/bench.py                  # all
+    python3 tools/bench.py --quick          # fewer repetitions
+    python3 tools/bench.py --issue17        # only the issue-17 figures (--seconds 1.5)
 
 Figures: ENI read of a 64-slave file; emulated bus cycles per wall second on the
 manual's figure 5-2 topology (bus only: drives replaced by plain PDO slaves;
 and with full CiA-402 drives) and on the 12-axis example; the cost of one
 ``GT_GetEcatRawData`` call; plus what each part's own bench module reports.
+
+``issue_17`` holds the figures of issue 17, measured side by side in this run on
+generated buses of single-axis CSP drives (:mod:`tools.bench_scaling`, lockstep
+clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
+``ok``: real-time factors of 12 axes moving in Trap, 64 axes (odd axes moving, even
+ones holding), 128 axes moving; 12 axes homing (method 17) and 12 axes in PT
+(reported); ``GT_GetSts`` against building its argument, interleaved; the RSS of a
+fresh process with a 128-axis controller open and moving.  A figure that cannot be
+measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
 
 from __future__ import annotations
@@ -14,9 +24,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
-from ctypes import c_ubyte
+from collections.abc import Mapping
+from ctypes import byref, c_long, c_ubyte
 from dataclasses import replace
 from pathlib import Path
 
@@ -90,11 +104,136 @@ def bench_controller_12_axes(seconds: float) -> float | None:
     return mod.cycles_per_second(seconds)
 
 
+def _figure(
+    r: Mapping[str, object], key: str, target: float, *, at_most: bool = False
+) -> dict[str, object]:
+    """``r`` with its target and pass/fail on ``r[key]`` (an ``error``: not ok)."""
+    v = r.get(key)
+    ok = isinstance(v, int | float) and (v <= target if at_most else v >= target)
+    return {**r, "target": target, "ok": ok}
+
+
+def bench_get_sts(seconds: float = 1.0, block: int = 200) -> dict[str, object]:
+    """µs per ``GT_GetSts(1, p)`` and per ``p = byref(c_long())``, in alternating blocks
+    of ``block`` of each on an open 12-axis controller; ratio of the medians."""
+    from gtecat import gt
+    from tools.bench_scaling import BenchError, bring_up, gtn
+    from tools.gen_axes_eni import write_axes_eni
+
+    with tempfile.TemporaryDirectory() as tmp:
+        try:
+            bring_up(write_axes_eni(12, Path(tmp) / "axes12.eni"), 12)
+            for a in range(1, 13):
+                gtn("AxisOn", a)
+        except BenchError as exc:
+            gt.GT_Close()
+            return {"error": str(exc)}
+        get_sts, clock = gt.GT_GetSts, time.perf_counter
+        held = c_long()
+        p = byref(held)
+        args, calls = [], []
+        t_end = clock() + seconds
+        rng = range(block)
+        while clock() < t_end:
+            t0 = clock()
+            for _ in rng:
+                s = c_long()
+                p = byref(s)
+            t1 = clock()
+            for _ in rng:
+                get_sts(1, p)
+            t2 = clock()
+            args.append((t1 - t0) / block)
+            calls.append((t2 - t1) / block)
+        gt.GT_Close()
+    arg_us, call_us = statistics.median(args) * 1e6, statistics.median(calls) * 1e6
+    return {
+        "gt_get_sts_us": round(call_us, 3),
+        "argument_us": round(arg_us, 3),
+        "ratio": round(call_us / arg_us, 2),
+        "blocks": len(args),
+    }
+
+
+def _rss() -> dict[str, float]:
+    """VmRSS and VmHWM of this process in MB (``ru_maxrss`` where /proc is absent)."""
+    out: dict[str, float] = {}
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key in ("VmRSS", "VmHWM"):
+                out[f"{key}_mb"] = round(int(value.split()[0]) / 1024, 1)
+    except OSError:
+        import resource
+
+        out["VmHWM_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
+    out.setdefault("VmRSS_mb", out.get("VmHWM_mb", 0.0))
+    return out
+
+
+def rss_child(n: int, seconds: float) -> int:
+    """In this (fresh) process: ``n`` axes open and moving in Trap; print the RSS."""
+    from tools.bench_scaling import run_bus
+
+    r = run_bus(n, dict.fromkeys(range(1, n + 1), "moving"), seconds=seconds, repeat=1, after=_rss)
+    print(json.dumps(r))
+    return 0
+
+
+def bench_rss(n: int = 128, seconds: float = 0.5) -> dict[str, object]:
+    """The RSS of a fresh Python process with an ``n``-axis controller open and moving."""
+    cmd = [sys.executable, __file__, "--rss-child", str(n), "--seconds", str(seconds)]
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600)
+    if p.returncode != 0:
+        return {"error": (p.stderr.strip().splitlines() or ["rss child failed"])[-1]}
+    r = json.loads(p.stdout.strip().splitlines()[-1])
+    return {"axes": n, "state": "moving", **r}
+
+
+def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
+    """The issue-17 figures, measured one after the other in this run."""
+    from tools.bench_scaling import run_bus
+
+    def rtf(n: int, plan: dict[int, str], target: float | None, what: str) -> dict[str, object]:
+        r = {"axes": n, "what": what, **run_bus(n, plan, seconds=seconds, repeat=repeat)}
+        return r if target is None else _figure(r, "rtf", target)
+
+    def every(n: int, state: str) -> dict[int, str]:
+        return dict.fromkeys(range(1, n + 1), state)
+
+    half = {a: "moving" if a % 2 else "idle" for a in range(1, 65)}
+    out: dict[str, object] = {
+        "rtf_12_axes_trap": rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
+        "rtf_64_axes_32_trap_32_holding": rtf(
+            64, half, 10, "odd axes moving in Trap, even axes enabled and holding"
+        ),
+        "rtf_128_axes_trap": rtf(128, every(128, "moving"), 5, "all 128 moving in Trap"),
+        "rtf_12_axes_homing_17": rtf(12, every(12, "homing"), None, "drive homing method 17"),
+        "rtf_12_axes_pt": rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
+        "gt_get_sts_vs_argument": _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
+        "rss_128_axes_moving": _figure(
+            bench_rss(128, min(seconds, 1.0)), "VmHWM_mb", 150, at_most=True
+        ),
+    }
+    out["ok"] = all(isinstance(v, dict) and v.get("ok", True) for v in out.values())
+    return out
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--issue17", action="store_true", help="only the issue-17 figures")
+    ap.add_argument("--seconds", type=float, help="wall seconds per issue-17 figure (1.5)")
+    ap.add_argument("--repeat", type=int, default=3, help="windows per real-time factor")
+    ap.add_argument("--rss-child", type=int, metavar="AXES", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.rss_child:
+        return rss_child(args.rss_child, args.seconds or 0.5)
     secs = 0.5 if args.quick else 2.0
+    secs17 = args.seconds or (0.6 if args.quick else 1.5)
+    if args.issue17:
+        print(json.dumps({"issue_17": issue17(secs17, args.repeat)}, indent=2))
+        return 0
     out: dict[str, object] = {}
     try:
         from tools.bench_eni import bench_read
@@ -121,6 +260,7 @@ def main() -> int:
         fn = getattr(mod, "summary", None)
         if fn is not None:
             out[name.removeprefix("bench_")] = fn(quick=args.quick)
+    out["issue_17"] = issue17(secs17, args.repeat)
     print(json.dumps(out, indent=2))
     return 0
 

@@ -1,0 +1,468 @@
+"""Real-time factor against the number of axes (1..128), idle, moving and homing, as JSON.
+
+    python tools/bench_scaling.py [--axes 1,12,64] [--states idle,moving] [--seconds 1.5]
+    python tools/bench_scaling.py --plot docs/performance.png --table docs/performance.md
+
+Each (axes, state) point opens a fresh controller on a generated bus of N single-axis
+CSP drives (:mod:`tools.gen_axes_eni`) with the lockstep clock, brings it up with
+``GT_InitEcatComm`` / ``GT_IsEcatReady`` / ``GT_StartEcatComm``, enables every axis and
+puts it in the state, then lets controller time pass with ``GTE_Wait`` and counts the
+1 ms cycles per wall second (best of ``--repeat`` windows).  States:
+
+* ``idle``: enabled and holding (``GT_AxisOn``, nothing planned);
+* ``moving``: Trap, smoothTime 25, every axis a move far longer than the measurement;
+* ``homing``: drive homing method 17 (negative limit switch) through
+  ``GT_SetHomingMode`` / ``GT_SetEcatHomingPrm`` / ``GT_StartEcatHoming``; the machine
+  description puts each axis's negative limit a billion counts away, so the search
+  outlasts the measurement.
+
+Everything goes through the public GT API, axis by axis through :func:`core_axis`
+and the ``GTN_*`` functions: the real ``GT_Update(long mask)`` reaches 32 axes per
+core, so bus axis 33..64 is axis 1..32 of core 2, 65..96 of core 3, 97..128 of core 4
+(issue 17 item 4).  A point whose core does not exist is reported with an ``error``
+and no figures, never measured some other way.  ``--addressing flat`` keeps every
+axis on core 1 instead (what the emulator accepted before issue 17: idle and homing
+beyond axis 32 work, a Trap start there does not, as ``GT_Update`` takes 32 bits);
+the JSON says which addressing ran.  ``tools/bench.py`` builds on :func:`run_bus`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Mapping, Sequence
+from ctypes import byref, c_long, c_short, c_ulong
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from tools.gen_axes_eni import write_axes_eni  # noqa: E402
+
+AXES = (1, 2, 4, 8, 12, 16, 32, 64, 96, 128)
+STATES = ("idle", "moving", "homing")
+AXES_PER_CORE = 32
+#: axes per core that :func:`core_axis` uses; ``--addressing flat`` puts every axis on
+#: core 1 (the emulator's own extension before issue 17: no GT_Update beyond axis 32)
+ADDRESSING = {"cores": AXES_PER_CORE, "flat": 1 << 16}
+_per_core = AXES_PER_CORE
+STS_SERVO_ON = 1 << 9  # GT_GetSts bits (manual table 6-1)
+STS_MOVING = 1 << 10
+STS_ALARM = 1 << 1
+HOMING_METHOD = 17  # CiA 402: search the negative limit switch
+HOMING_IN_PROGRESS = 0
+FAR = 1_000_000_000.0  # counts to the negative limit: the homing search never ends here
+WARM_UP_MS = 50
+CHUNK_MS = 20
+
+
+class BenchError(RuntimeError):
+    """A GT call of the set-up failed; the message names it and gives its reason."""
+
+
+class CoreUnavailable(BenchError):
+    """An axis beyond 32 needs a core (``GTN_*(2, ...)``) the controller does not have."""
+
+
+def core_axis(a: int) -> tuple[int, int]:
+    """Bus axis ``a`` (1-based) as (core, axis on that core): 32 axes per core."""
+    if a < 1:
+        raise ValueError(f"axis must be >= 1, not {a}")
+    return (a - 1) // _per_core + 1, (a - 1) % _per_core + 1
+
+
+def set_addressing(mode: str) -> None:
+    """``cores`` (32 axes per core, the default) or ``flat`` (every axis on core 1)."""
+    global _per_core
+    _per_core = ADDRESSING[mode]
+
+
+def _gt() -> Any:
+    from gtecat import gt
+
+    return gt
+
+
+def _ok(rc: int, what: str, core: int = 1) -> None:
+    if rc == 0:
+        return
+    reason = _gt().GTE_GetLastError() or f"{what} returned {rc}"
+    if core > 1 and f"core {core}" in reason:
+        raise CoreUnavailable(
+            f"{what}: {reason} - bus axes beyond {AXES_PER_CORE} are reached through "
+            f"core {core} (GTN_*({core}, axis)), which this controller does not offer yet "
+            "(issue 17 item 4); nothing was measured"
+        )
+    raise BenchError(f"{what}: {reason}")
+
+
+def gtn(name: str, a: int, *args: Any) -> None:
+    """Call ``GTN_<name>(core, local_axis, *args)`` for bus axis ``a``; raise on non-zero."""
+    core, local = core_axis(a)
+    fn: Callable[..., int] = getattr(_gt(), "GTN_" + name)
+    _ok(fn(core, local, *args), f"GTN_{name}({core}, {local}) for bus axis {a}", core)
+
+
+def update(axes: Sequence[int]) -> None:
+    """``GTN_Update(core, mask)`` once per core for the bus axes given."""
+    masks: dict[int, int] = {}
+    for a in axes:
+        core, local = core_axis(a)
+        masks[core] = masks.get(core, 0) | 1 << (local - 1)
+    for core, mask in sorted(masks.items()):
+        _ok(_gt().GTN_Update(core, mask), f"GTN_Update({core}, {mask:#x})", core)
+
+
+def status(a: int) -> int:
+    """``GTN_GetSts`` of bus axis ``a``."""
+    sts = c_long()
+    gtn("GetSts", a, byref(sts))
+    return sts.value
+
+
+def homing_status(a: int) -> int:
+    """``GTN_GetEcatHomingStatus`` of bus axis ``a``."""
+    st = c_short()
+    gtn("GetEcatHomingStatus", a, byref(st))
+    return st.value
+
+
+def machine(n: int) -> Any:
+    """Every axis at 0 with a negative limit switch :data:`FAR` counts away."""
+    from drives.machine import AxisMachine, MachineDescription
+
+    return MachineDescription({a: AxisMachine(negative_limit=-FAR) for a in range(1, n + 1)})
+
+
+def bring_up(eni: Path, n: int) -> None:
+    """Open the controller on ``eni`` (lockstep clock) and take the bus to OP."""
+    gt = _gt()
+    gt.GT_Close()
+    _ok(gt.GT_Open(eni=str(eni), machine=machine(n), clock="lockstep", log=""), "GT_Open")
+    _ok(gt.GT_InitEcatComm(), "GT_InitEcatComm")
+    ready = c_short()
+    for _ in range(10_000):
+        if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+            break
+        gt.GTE_Wait(1)
+    else:
+        raise BenchError("the bus did not become ready in 10 s of controller time")
+    _ok(gt.GT_StartEcatComm(), "GT_StartEcatComm")
+
+
+def start_trap(axes: Sequence[int]) -> None:
+    """Every axis a Trap move (smoothTime 25) far longer than any measurement."""
+    gt = _gt()
+    for a in axes:
+        prm = gt.TTrapPrm()
+        prm.acc, prm.dec, prm.velStart, prm.smoothTime = 0.5, 0.5, 0, 25
+        gtn("PrfTrap", a)
+        gtn("SetTrapPrm", a, byref(prm))
+        gtn("SetPos", a, (-1) ** a * 50_000_000)
+        gtn("SetVel", a, 20 + a % 12)
+    update(axes)
+
+
+def start_homing(axes: Sequence[int]) -> None:
+    """Drive homing method 17 on every axis (5000 / 1000 counts/s, 100000 counts/s²)."""
+    for a in axes:
+        gtn("SetHomingMode", a, 6)
+        gtn("SetEcatHomingPrm", a, HOMING_METHOD, 5000, 1000, 100000, 0, 0)
+    for a in axes:
+        gtn("StartEcatHoming", a)
+
+
+def start_pt(axes: Sequence[int], points: int = 400) -> None:
+    """PT, static FIFO, endless loop over a table of ``points`` 10 ms segments (a there
+    and back ramp of 20000 pulses), on every axis."""
+    gt = _gt()
+    for a in axes:
+        gtn("PrfPt", a, gt.PT_MODE_STATIC)
+        gtn("PtClear", a, 0)
+        gtn("SetPtLoop", a, 0)
+        space = c_short()
+        gtn("PtSpace", a, byref(space), 0)
+        half = min(points, space.value) // 2
+        for k in range(1, 2 * half + 1):
+            pos = 20000.0 * (k if k <= half else 2 * half - k) / half
+            gtn("PtData", a, pos, 10 * k, gt.PT_SEGMENT_NORMAL, 0)
+    masks: dict[int, int] = {}
+    for a in axes:
+        core, local = core_axis(a)
+        masks[core] = masks.get(core, 0) | 1 << (local - 1)
+    for core, mask in sorted(masks.items()):
+        _ok(gt.GTN_PtStart(core, mask, 0), f"GTN_PtStart({core}, {mask:#x})", core)
+
+
+STARTERS: dict[str, Callable[[Sequence[int]], None]] = {
+    "moving": start_trap,
+    "homing": start_homing,
+    "pt": start_pt,
+}
+
+
+def check(plan: Mapping[int, str]) -> None:
+    """Raise unless every axis is still in its planned state."""
+    bad = []
+    for a, state in plan.items():
+        sts = status(a)
+        ok = bool(sts & STS_SERVO_ON) and not sts & STS_ALARM
+        if state == "idle":
+            ok = ok and not sts & STS_MOVING
+        elif state == "homing":
+            ok = ok and homing_status(a) == HOMING_IN_PROGRESS
+        else:
+            ok = ok and bool(sts & STS_MOVING)
+        if not ok:
+            bad.append(f"{a} ({state}, sts {sts:#x})")
+    if bad:
+        raise BenchError(f"{len(bad)} axes left their state: {', '.join(bad[:8])}")
+
+
+def _clock() -> tuple[int, int]:
+    clk, loop = c_ulong(), c_ulong()
+    _ok(_gt().GT_GetClock(byref(clk), byref(loop)), "GT_GetClock")
+    return clk.value, loop.value
+
+
+def measure(seconds: float, repeat: int) -> dict[str, float]:
+    """Let controller time pass for ``repeat`` windows of ``seconds / repeat`` wall
+    seconds each; the fastest window's cycles per wall second and controller
+    milliseconds per wall millisecond."""
+    gt = _gt()
+    window = seconds / max(1, repeat)
+    best: tuple[float, float] = (0.0, 0.0)
+    for _ in range(max(1, repeat)):
+        ms0, loop0 = _clock()
+        t0 = time.perf_counter()
+        while True:
+            gt.GTE_Wait(CHUNK_MS)
+            el = time.perf_counter() - t0
+            if el >= window:
+                break
+        ms1, loop1 = _clock()
+        cps = (loop1 - loop0) / el
+        if cps > best[0]:
+            best = (cps, (ms1 - ms0) / 1000 / el)
+    return {"cycles_per_s": best[0], "rtf": best[1]}
+
+
+def run_bus(
+    n: int,
+    plan: Mapping[int, str],
+    *,
+    seconds: float = 1.5,
+    repeat: int = 3,
+    eni_dir: str | Path | None = None,
+    after: Callable[[], dict[str, Any]] | None = None,
+) -> dict[str, Any]:
+    """Bring up ``n`` axes, put axis ``a`` in ``plan[a]`` (missing: ``idle``), measure.
+
+    Returns cycles_per_s, rtf, us_per_cycle, us_per_axis, bringup_s, and whatever
+    ``after()`` adds (called with the controller still open); ``error`` instead of
+    the figures when an axis cannot be addressed or set up.
+    """
+    full = {a: plan.get(a, "idle") for a in range(1, n + 1)}
+    gt = _gt()
+    with tempfile.TemporaryDirectory(dir=eni_dir) as tmp:
+        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        t0 = time.perf_counter()
+        try:
+            bring_up(eni, n)
+            for a in full:
+                gtn("AxisOn", a)
+            for state, start in STARTERS.items():
+                axes = [a for a, s in full.items() if s == state]
+                if axes:
+                    start(axes)
+            gt.GTE_Wait(WARM_UP_MS)
+            check(full)
+            bring_s = time.perf_counter() - t0
+            m = measure(seconds, repeat)
+            check(full)
+            extra = after() if after is not None else {}
+        except BenchError as exc:
+            return {"error": str(exc)}
+        finally:
+            gt.GT_Close()
+    us = 1e6 / m["cycles_per_s"]
+    return {
+        "cycles_per_s": round(m["cycles_per_s"], 1),
+        "rtf": round(m["rtf"], 3),
+        "us_per_cycle": round(us, 2),
+        "us_per_axis": round(us / n, 3),
+        "bringup_s": round(bring_s, 3),
+        **extra,
+    }
+
+
+def bench_point(n: int, state: str, *, seconds: float = 1.5, repeat: int = 3) -> dict[str, Any]:
+    """One (axes, state) point: every axis in ``state``."""
+    if state not in STATES:
+        raise ValueError(f"state must be one of {', '.join(STATES)}, not {state!r}")
+    r = run_bus(n, dict.fromkeys(range(1, n + 1), state), seconds=seconds, repeat=repeat)
+    addressing = "cores" if _per_core == AXES_PER_CORE else "flat"
+    return {"axes": n, "state": state, **r, "addressing": addressing}
+
+
+def bench_scaling(
+    axes: Sequence[int] = AXES,
+    states: Sequence[str] = STATES,
+    *,
+    seconds: float = 1.5,
+    repeat: int = 3,
+    progress: Callable[[dict[str, Any]], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Every point of ``axes`` x ``states``."""
+    out = []
+    for n in axes:
+        for state in states:
+            r = bench_point(n, state, seconds=seconds, repeat=repeat)
+            if progress is not None:
+                progress(r)
+            out.append(r)
+    return out
+
+
+BEGIN, END = "<!-- bench_scaling table: begin -->", "<!-- bench_scaling table: end -->"
+
+
+def _provenance() -> str:
+    """When, at which commit and under what load the figures were taken."""
+    import subprocess
+
+    try:
+        rev = subprocess.run(
+            ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            check=False,
+        ).stdout.strip()
+    except OSError:
+        rev = ""
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
+    when = time.strftime("%Y-%m-%d %H:%M")
+    return f"Measured {when} at commit `{rev or '?'}`, {os.cpu_count()} CPUs, load average {load}."
+
+
+def write_table(results: Sequence[Mapping[str, Any]], path: str | Path) -> None:
+    """A markdown table: one row per axis count, µs per cycle and real-time factor per state.
+
+    When ``path`` holds the :data:`BEGIN` / :data:`END` markers (``docs/performance.md``),
+    only the text between them is replaced; otherwise the file is the table alone.
+    """
+    states = [s for s in STATES if any(r["state"] == s for r in results)]
+    by = {(r["axes"], r["state"]): r for r in results}
+    head = "| axes | " + " | ".join(f"{s} µs/cycle | {s} RTF" for s in states) + " |"
+    rule = "|---:|" + "---:|---:|" * len(states)
+    rows = [head, rule]
+    for n in sorted({r["axes"] for r in results}):
+        cells = []
+        for s in states:
+            r = by.get((n, s))
+            if r is None or "error" in r:
+                cells += ["n/a", "n/a"]
+            else:
+                cells += [f"{r['us_per_cycle']:.0f}", f"{r['rtf']:.2f}×"]
+        rows.append(f"| {n} | " + " | ".join(cells) + " |")
+    errors = sorted({r["error"] for r in results if "error" in r})
+    text = _provenance() + "\n\n" + "\n".join(rows) + "\n"
+    if errors:
+        text += "\nn/a: " + "; ".join(errors) + "\n"
+    p = Path(path)
+    old = p.read_text(encoding="utf-8") if p.exists() else ""
+    head, sep, rest = old.partition(BEGIN)
+    if sep and END in rest:
+        text = head + BEGIN + "\n" + text + END + rest.partition(END)[2]
+    p.write_text(text, encoding="utf-8")
+
+
+def write_plot(results: Sequence[Mapping[str, Any]], path: str | Path, title: str = "") -> None:
+    """µs per cycle and real-time factor against axes, log-log, one line per state."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for s in STATES:
+        pts = sorted((r["axes"], r) for r in results if r["state"] == s and "error" not in r)
+        if not pts:
+            continue
+        xs = [n for n, _ in pts]
+        left.plot(xs, [r["us_per_cycle"] for _, r in pts], "o-", label=s)
+        right.plot(xs, [r["rtf"] for _, r in pts], "o-", label=s)
+    left.set_ylabel("µs per 1 ms cycle")
+    right.set_ylabel("real-time factor (controller ms per wall ms)")
+    for target, label in ((20, "12 axes ≥ 20×"), (10, "64 axes ≥ 10×"), (5, "128 axes ≥ 5×")):
+        right.axhline(target, color="grey", lw=0.6, ls=":")
+        right.annotate(label, (AXES[-1], target), fontsize=7, color="grey", va="bottom", ha="right")
+    right.axhline(1, color="red", lw=0.8, ls="--")
+    for ax in (left, right):
+        ax.set_xscale("log", base=2)
+        ax.set_yscale("log")
+        ax.set_xlabel("axes")
+        ax.set_xticks(AXES, [str(a) for a in AXES], fontsize=7)
+        ax.grid(True, which="both", lw=0.3)
+        ax.legend()
+    fig.suptitle(title or "gtecat, lockstep clock, CSP drives, GT API")
+    errors = [r for r in results if "error" in r]
+    fig.tight_layout(rect=(0, 0.05 if errors else 0, 1, 1))
+    if errors:
+        why = str(errors[0]["error"]).partition(" - ")[0]
+        fig.text(0.5, 0.01, f"{len(errors)} points not measured: {why}", ha="center", fontsize=7)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _ints(text: str) -> list[int]:
+    return [int(x) for x in text.split(",") if x]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--axes", type=_ints, default=list(AXES), help="e.g. 1,12,64")
+    ap.add_argument("--states", default=",".join(STATES), help="idle,moving,homing")
+    ap.add_argument("--seconds", type=float, default=1.5, help="wall seconds per point")
+    ap.add_argument("--repeat", type=int, default=3, help="windows per point (best counts)")
+    ap.add_argument(
+        "--addressing",
+        choices=sorted(ADDRESSING),
+        default="cores",
+        help="cores: axes 33+ on GTN_*(2..4, ...) (default); flat: all on core 1",
+    )
+    ap.add_argument("--plot", metavar="FILE.png")
+    ap.add_argument("--table", metavar="FILE.md")
+    ap.add_argument("--json", metavar="FILE.json", help="also write the results here")
+    args = ap.parse_args(argv)
+    states = [s for s in args.states.split(",") if s]
+    set_addressing(args.addressing)
+
+    def progress(r: dict[str, Any]) -> None:
+        print(json.dumps(r), file=sys.stderr, flush=True)
+
+    results = bench_scaling(
+        args.axes, states, seconds=args.seconds, repeat=args.repeat, progress=progress
+    )
+    text = json.dumps(results, indent=1)
+    print(text)
+    if args.json:
+        Path(args.json).write_text(text + "\n", encoding="utf-8")
+    title = f"gtecat, lockstep, {os.cpu_count()} CPUs, best of {args.repeat} windows"
+    if args.addressing != "cores":
+        title += f", {args.addressing} addressing"
+    if args.plot:
+        write_plot(results, args.plot, title)
+    if args.table:
+        write_table(results, args.table)
+    return 1 if any("error" in r for r in results) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
