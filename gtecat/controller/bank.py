@@ -193,6 +193,8 @@ class AxisBank:
         self.n_alive = 0
         self._lists: dict[str, list[Any]] = {}
         self.disabled_reason = ""
+        #: axis-cycles the bank ran (statistics; the differential tests check it worked)
+        self.rows_run = 0
 
     # --- structure ------------------------------------------------------------------------
     def _build(self) -> None:
@@ -268,6 +270,7 @@ class AxisBank:
             for r in g.rows:
                 self.group_of[r] = gi
         self.axes = axes
+        self._row_of = {id(ax): r for r, ax in enumerate(axes)}
         self.res = [ax.motion for ax in axes]
         n = self.n = len(axes)
         self.csp = CspBank(chans)
@@ -513,12 +516,11 @@ class AxisBank:
             self._release_groups([g for g in self.groups if g.claimed])
             self._reindex()
 
-    def release_axis(self, axis: int) -> None:
-        for r in range(self.n):
-            if self.alive[r] and self.axes[r].number == axis:
-                self._release_groups([self.groups[self.group_of[r]]])
-                self._reindex()
-                return
+    def release_axis_object(self, ax: Any) -> None:
+        r = self._row_of.get(id(ax))
+        if r is not None and self.alive[r]:
+            self._release_groups([self.groups[self.group_of[r]]])
+            self._reindex()
 
     def _release_groups(self, groups: list[_Group]) -> None:
         """Write the rows' committed state back into their objects; they leave the bank."""
@@ -561,19 +563,20 @@ class AxisBank:
             advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
 
     # --- the GT boundary ------------------------------------------------------------------------
-    def before_call(self, name: str, proto: Any, values: tuple) -> None:
-        """A GT function is about to run: release what it may look at or change."""
+    def before_call(self, ctl: Any, proto: Any, values: tuple) -> None:
+        """A GT function is about to run on ``ctl`` (the core, or a view of a core beyond
+        32 axes): release what it may look at or change."""
         self.dirty = True
         if not self.n_alive:
             return
         params = proto.params
         if params and params[0].name in ("axis", "profile", "encoder") and values:
             if not any(p.name == "count" for p in params):
-                try:
-                    self.release_axis(int(values[0]))
+                n = values[0]
+                ax = ctl.axes.get(n) if type(n) is int else None
+                if ax is not None:
+                    self.release_axis_object(ax)
                     return
-                except (TypeError, ValueError):
-                    pass
         self.release_all()
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
@@ -717,6 +720,7 @@ class AxisBank:
             cur += mk & ~ended
             moving &= ~(fin & keep)
             self.n_moving = int(np.count_nonzero(moving))
+        self.rows_run += self.n_alive
         # 8. the image: 607Ah out, the drives' TxPDO in, in one scatter
         cols = [target, pa, din]
         for name in self._extra:

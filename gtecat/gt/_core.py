@@ -28,6 +28,7 @@ from eni.errors import EniError, GtecatError
 from ..controller.card import refused
 from ..controller.bank import BANK_READS
 from ..controller.core import Controller
+from ..controller.core_view import AXES_PER_CORE, CoreView
 from ..errors import (
     BusError,
     CommandError,
@@ -92,6 +93,8 @@ class _Session:
 
     def controller(self, core: int = 1) -> Controller:
         c = self.controllers.get(core)
+        if c is None and core > 1 and 1 in self.controllers:
+            c = self._core_view(core)
         if c is None:
             if self.remote is not None:
                 raise NotOpen(
@@ -100,9 +103,23 @@ class _Session:
                     "socket: gtecat.native.client.field(), docs/native.md)"
                 )
             if core != 1 and 1 in self.controllers:
-                raise ParameterError(f"core {core} does not exist; the EtherCAT core is 1")
+                n = len(self.controllers[1].axes)
+                cores = max(1, (n + AXES_PER_CORE - 1) // AXES_PER_CORE)
+                raise ParameterError(
+                    f"core {core} does not exist: the bus has {n} axes, cores 1..{cores} "
+                    f"({AXES_PER_CORE} axes per core; core 1 is the EtherCAT core)"
+                )
             raise NotOpen("the controller is not open: call GT_Open first")
         return c
+
+    def _core_view(self, core: int) -> Any:
+        """Core ``core`` > 1: bus axes 32·(core-1)+1 .. 32·core (gtecat.controller.core_view)."""
+        base = self.controllers[1]
+        views = self.__dict__.setdefault("views", {})
+        view = views.get(core)
+        if view is None or view._base is not base:
+            view = views[core] = CoreView(base, core)
+        return view if view.exists else None
 
 
 SESSION = _Session()
@@ -182,7 +199,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     raise CommandError(ctl.card.refusal(name))
                 bank = ctl.bank
                 if bank is not None and not bank_read:
-                    bank.before_call(name, proto, values)  # the axes it names go back first
+                    bank.before_call(ctl, proto, values)  # the axes it names go back first
                 if ctl.clock.threaded:
                     with ctl.clock.lock:  # atomic with respect to the cycle thread
                         rc = fn(ctl, *values, **extra)

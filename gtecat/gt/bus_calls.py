@@ -105,8 +105,12 @@ def GT_Open(
     mram: str | None = None,
     card: str | None = None,
     pcap: str | None = None,
+    bank: str | None = None,
 ) -> int:
     """Open the (emulated) controller.  Keyword options override ``GTECAT_*``.
+
+    ``bank="auto" | "on" | "off"`` (GTECAT_BANK): the vectorised axis bank
+    (:mod:`gtecat.controller.bank`; results are the same either way, only faster).
 
     ``pcap="bus.pcap"`` (GTECAT_PCAP) writes the frames the emulated bus stands for.
 
@@ -132,6 +136,7 @@ def GT_Open(
             mram=mram,
             card=card,
             pcap=pcap,
+            bank=bank,
         )
     )
     return 0
