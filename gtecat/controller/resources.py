@@ -114,6 +114,11 @@ FAULT_RESET_TIMEOUT_MS = 20.0
 POS_LIMIT = 1073741823
 
 _ALARM = int(AxisStatus.ALARM)
+_SERVO_ON, _MOVING, _ARRIVED = (
+    int(AxisStatus.SERVO_ON),
+    int(AxisStatus.MOVING),
+    int(AxisStatus.ARRIVED),
+)
 _POS_ERROR = int(AxisStatus.POS_ERROR)
 _POS_LIMIT = int(AxisStatus.POSITIVE_LIMIT)
 _NEG_LIMIT = int(AxisStatus.NEGATIVE_LIMIT)
@@ -268,14 +273,14 @@ class AxisResources:
         b = self.bank
         if b is not None:
             return b.value("sts", self.bank_row)
-        s = self.latched
+        s = int(self.latched)
         if self.ax.servo_on:
-            s |= AxisStatus.SERVO_ON
+            s |= _SERVO_ON
         if not self.profile.planner.done:
-            s |= AxisStatus.MOVING  # and never in position (11.7: "规划运动...立即清 0")
+            s |= _MOVING  # and never in position (11.7: "规划运动...立即清 0")
         elif self.band.arrived:
-            s |= AxisStatus.ARRIVED
-        return int(s)
+            s |= _ARRIVED
+        return s
 
     def _raw_source(self) -> int | None:
         acc = self._act if self.encoder.external else self._cmd

@@ -25,8 +25,8 @@ from drives.abort import SdoAbort
 from drives.machine import MachineError
 from eni.errors import EniError, GtecatError
 
-from ..controller.card import refused
 from ..controller.bank import BANK_READS
+from ..controller.card import refused
 from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE, CoreView
 from ..errors import (
@@ -38,6 +38,7 @@ from ..errors import (
     ParameterError,
 )
 from .args import Ref, binder, core_arg
+from .fast import READERS, fast_reader
 from .table import FUNCTIONS, Proto
 
 log = logging.getLogger("gtecat.gt")
@@ -232,6 +233,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     def gt(*args: Any, **kwargs: Any) -> int:
         return call(_ONE, args, kwargs)
 
+    if name in READERS:  # the common shape answered up front (gtecat.gt.fast)
+        slow = gt
+        gt = functools.wraps(fn)(fast_reader(name, slow, SESSION))
+        gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt

@@ -27,9 +27,9 @@ def trap_table(
     (``(target, 0, 0)``, after which the planner is done), or ``n`` when the move goes on.
     """
     assert pl._mode == _MOVE
-    T = pl._T
+    cyc = pl._T
     k0 = pl._k if k0 is None else k0
-    t = np.arange(k0 + 1, k0 + n + 1, dtype=np.int64) * T
+    t = np.arange(k0 + 1, k0 + n + 1, dtype=np.int64) * cyc
     t_done = pl._t_done
     thr = t_done - _EPS_T * (1.0 + t_done * 1e-3)
     past = np.nonzero(t >= thr)[0]

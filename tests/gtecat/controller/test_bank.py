@@ -188,7 +188,7 @@ def test_bank_matches_the_scalar_path_cycle_by_cycle(tmp_path: Path, actions) ->
     machine = _machine_file(tmp_path)
     actions = [*actions, (150, ("clear",))]
     ref, ref_codes, ref_rows = _run(actions, machine, "off")
-    got, got_codes, got_rows = _run(actions, machine, "on")
+    got, got_codes, _ = _run(actions, machine, "on")
     assert ref_rows == 0
     assert got_codes == ref_codes
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):

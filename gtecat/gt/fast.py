@@ -1,0 +1,108 @@
+"""The GT fast path (issue 17 item 3): the common getters in a handful of Python calls.
+
+A polling loop (``do { GT_GetSts(axis, &sts); } while (sts & 0x400);``) spends most of
+its wall time in the GT layer: the table binder (:mod:`gtecat.gt.args`) checks and
+resolves every argument generically.  For the readers below the one shape nearly every
+caller uses - ``(int axis, byref(c_long()) or a ctypes array)`` with ``count`` 1 and no
+``pClock``, on the in-process controller - is recognised up front and answered from the
+axis resources directly (or from the axis bank, :mod:`gtecat.controller.bank`); every other
+shape, and anything the fast test is unsure of, takes the table path unchanged, so the
+return codes and reasons stay the table's.  The fast answer is the table path's answer:
+``tests/gtecat/gt/test_fast.py`` compares both over generated arguments.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Callable
+from typing import Any
+
+from ..controller.resources import AxisResources
+from ..master.clock import ClockMode
+
+_CArg = type(ctypes.byref(ctypes.c_int()))
+_memmove = ctypes.memmove
+_NO: Any = object()  # an argument the caller did not pass
+_addressof = ctypes.addressof
+
+
+_status = AxisResources.status
+_LOCKSTEP = ClockMode.LOCKSTEP
+
+
+def _attr(name: str) -> Callable[[Any], float]:
+    def get(r: Any) -> float:
+        return float(getattr(r, name))
+
+    return get
+
+
+_INTS = frozenset({ctypes.c_int32, ctypes.c_long, ctypes.c_int64, ctypes.c_longlong})
+_DOUBLE = frozenset({ctypes.c_double})
+
+#: function -> (value of one axis's resources, the ctypes types *pValue may have: ``long`` is
+#: the vendor's 32 bits, and a Python caller's ``c_long()`` is 64 bits on Linux; both work)
+READERS: dict[str, tuple[Callable[[Any], Any], frozenset]] = {
+    "GT_GetSts": (_status, _INTS),
+    "GT_GetPrfPos": (_attr("prf_pos"), _DOUBLE),
+    "GT_GetPrfVel": (_attr("prf_vel"), _DOUBLE),
+    "GT_GetPrfAcc": (_attr("prf_acc"), _DOUBLE),
+    "GT_GetAxisPrfPos": (_attr("axis_prf_pos"), _DOUBLE),
+    "GT_GetAxisPrfVel": (_attr("axis_prf_vel"), _DOUBLE),
+    "GT_GetAxisEncPos": (_attr("axis_enc_pos"), _DOUBLE),
+    "GT_GetAxisEncVel": (_attr("axis_enc_vel"), _DOUBLE),
+    "GT_GetAxisError": (_attr("axis_error"), _DOUBLE),
+    "GT_GetEncPos": (_attr("enc_pos"), _DOUBLE),
+    "GT_GetEncVel": (_attr("enc_vel"), _DOUBLE),
+}
+
+
+def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[..., int]:
+    """``slow`` (the table-checked GT function) with the fast path in front of it."""
+    get, ctypes_ok = READERS[name]
+    array_types: dict[type, bool] = {}
+
+    def is_array(tp: type) -> bool:
+        ok = array_types.get(tp)
+        if ok is None:
+            ok = array_types[tp] = (
+                issubclass(tp, ctypes.Array) and tp._type_ in ctypes_ok and tp._length_ >= 1
+            )
+        return ok
+
+    def gt(
+        n: Any = _NO, p: Any = _NO, count: Any = _NO, pClock: Any = _NO, *extra: Any, **kw: Any
+    ) -> int:
+        ctl = session.controllers.get(1)
+        if (
+            type(n) is not int
+            or extra
+            or kw
+            or ctl is None
+            or (count is not _NO and count != 1)
+            or (pClock is not _NO and pClock is not None)
+            or session.remote is not None
+        ):
+            return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
+        res = ctl.resources.get(n)
+        tp = type(p)
+        clock = ctl.clock
+        if res is not None and clock._thread is None:
+            if tp is _CArg:
+                obj = p._obj
+                if type(obj) in ctypes_ok and _memmove(p, p, 0) == _addressof(obj):
+                    obj.value = get(res)
+                    session.last = None
+                    if clock.mode is not _LOCKSTEP:
+                        clock.on_call()
+                    return 0
+            elif is_array(tp):
+                p[0] = get(res)
+                session.last = None
+                if clock.mode is not _LOCKSTEP:
+                    clock.on_call()
+                return 0
+        return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+
+    gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
+    return gt

@@ -1,0 +1,132 @@
+"""The GT fast path (gtecat.gt.fast) answers exactly as the table path does (issue 17 item 3).
+
+Every reader is called with generated argument shapes - byref of each integer/double type,
+byref with an offset, arrays, pointers, wrong types, out-of-range axes, count and pClock
+given or not, keywords - once through the public function (fast path in front) and once
+through its table path (``.slow``); return code, written value and GTE_GetLastError agree.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from ctypes import byref
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from gtecat import gt
+from gtecat.gt.fast import READERS
+
+ENI = Path(__file__).resolve().parents[3] / "examples" / "twelve_axes.eni"
+
+
+@pytest.fixture
+def moving_bus():
+    """After the directory's autouse fixture closed any controller: a bus with 3 axes moving."""
+    gt.GT_Close()
+    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="") == 0
+    assert gt.GT_InitEcatComm() == 0
+    gt.GTE_Wait(60)
+    assert gt.GT_StartEcatComm() == 0
+    for a in (1, 2, 5):
+        assert gt.GT_AxisOn(a) == 0
+        prm = gt.TTrapPrm()
+        prm.acc, prm.dec, prm.smoothTime = 0.5, 0.5, 10
+        gt.GT_PrfTrap(a)
+        gt.GT_SetTrapPrm(a, byref(prm))
+        gt.GT_SetPos(a, 90_000 * a)
+        gt.GT_SetVel(a, 10)
+    gt.GT_Update(0b10011)
+    gt.GTE_Wait(300)
+    yield
+    gt.GT_Close()
+
+
+TYPES = [ctypes.c_int32, ctypes.c_long, ctypes.c_int16, ctypes.c_double, ctypes.c_float]
+shape = st.sampled_from(["byref", "byref_offset", "array", "array1", "pointer", "obj", "int"])
+
+
+def _arg(kind: str, t: type):
+    if kind == "byref":
+        o = t()
+        return o, byref(o)
+    if kind == "byref_offset":
+        o = (t * 3)()
+        return o, byref(o, ctypes.sizeof(t))
+    if kind == "array":
+        o = (t * 4)()
+        return o, o
+    if kind == "array1":
+        o = (t * 1)()
+        return o, o
+    if kind == "pointer":
+        o = t()
+        return o, ctypes.pointer(o)
+    if kind == "obj":
+        o = t()
+        return o, o
+    return None, 12345
+
+
+def _value(o):
+    if o is None:
+        return None
+    if isinstance(o, ctypes.Array):
+        return [o[i] for i in range(len(o))]
+    return o.value
+
+
+@settings(
+    max_examples=150,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    name=st.sampled_from(sorted(READERS)),
+    axis=st.one_of(st.integers(-2, 14), st.just(1.0), st.just("1"), st.just(True)),
+    kind=shape,
+    t=st.sampled_from(TYPES),
+    count=st.sampled_from([None, 1, 2, 0]),
+    clock=st.booleans(),
+)
+def test_fast_path_answers_as_the_table(moving_bus, name, axis, kind, t, count, clock) -> None:
+    fast = getattr(gt, name)
+    results = []
+    for fn in (fast, fast.slow):
+        o, p = _arg(kind, t)
+        args = [axis, p]
+        if count is not None or clock:
+            args.append(1 if count is None else count)
+        clk = ctypes.c_uint32()
+        if clock:
+            args.append(byref(clk))
+        rc = fn(*args)
+        results.append((rc, _value(o), gt.GTE_GetLastError() if rc else "", clk.value))
+    assert results[0] == results[1]
+    assert results[0][0] != -1, "the controller must be open"
+
+
+def test_fast_path_is_taken_for_the_common_shape(moving_bus) -> None:
+    """The common shape costs a handful of calls (counted with a profiler, not timed)."""
+    import cProfile
+    import pstats
+
+    s = ctypes.c_long()
+    pr = cProfile.Profile()
+    pr.enable()
+    for _ in range(100):
+        gt.GT_GetSts(1, byref(s))
+    pr.disable()
+    calls = pstats.Stats(pr).total_calls
+    assert calls / 100 <= 9, calls / 100  # byref, the wrapper, status, the bank row
+    assert s.value & 0x600 == 0x600  # servo on, moving
+
+
+def test_keywords_and_gtn_take_the_table_path(moving_bus) -> None:
+    a, b = ctypes.c_double(), ctypes.c_double()
+    assert gt.GT_GetPrfPos(profile=2, pValue=byref(a)) == 0
+    assert gt.GTN_GetPrfPos(1, 2, byref(b)) == 0
+    assert a.value == b.value != 0.0
