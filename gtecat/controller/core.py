@@ -301,7 +301,7 @@ class Controller:
             bank.cycle(t, dt)  # the axes it runs, whole; the ones it lets go run below
         for f in self.pre_cycle:
             f(t, dt)
-        run = self._run_axes
+        run = self._axis_list if bank is None else self._run_axes
         for ax in run:
             ax.pre(t, dt)
         if self.master is not None:
