@@ -443,8 +443,9 @@ def read_sii(eeprom_read: Any) -> bytes:
     w = _SII_HEADER_WORDS
     while w + 1 < _SII_MAX_WORDS:
         kind = word(w)
-        if kind == _SII_END:
-            return bytes(words[: 2 * (w + 1)])
+        if kind == _SII_END:  # kept with its size word: a category header is two words
+            word(w + 1)
+            return bytes(words[: 2 * (w + 2)])
         w += 2 + word(w + 1)
     return bytes(words[: 2 * _SII_MAX_WORDS])
 
