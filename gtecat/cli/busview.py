@@ -19,9 +19,9 @@ from typing import Any
 
 from drives.machine import MachineError
 
-from ..controller.core import Controller, Options
+from ..controller.core import Controller, Options, folder_message
 from ..controller.inspect import view
-from ..errors import BusError, ConfigMismatch, NoSlavesError, ParameterError
+from ..errors import BusError, ConfigMismatch, ParameterError
 from . import output
 
 
@@ -71,12 +71,7 @@ def check_toml_kind(path: str | os.PathLike[str] | None, want: str) -> None:
 def eni_argument(args: argparse.Namespace) -> str | None:
     eni = getattr(args, "eni", None) or getattr(args, "file", None)
     if eni and Path(eni).is_dir():
-        inside = sorted(p.name for p in Path(eni).iterdir() if p.suffix.lower() == ".eni")
-        hint = f" (it holds {', '.join(inside)})" if inside else ""
-        raise ParameterError(
-            f"{eni} is a folder, not an ENI file{hint}: give the file, e.g. --eni "
-            f"{Path(eni) / (inside[0] if inside else 'Gecat.eni')}"
-        )
+        raise ParameterError(folder_message(Path(eni), "give the file, e.g. --eni"))
     return eni
 
 
@@ -111,15 +106,6 @@ def open_bus(args: argparse.Namespace) -> Controller:
         raise ConfigMismatch(
             f"{e}; the ENI does not describe this bus: export it again from the "
             "configuration tool for this machine, or check the cabling order"
-        ) from None
-    except NoSlavesError:
-        ctl.close()
-        if backend != "emulated":
-            raise
-        path = ctl.eni_path()
-        raise NoSlavesError(
-            f"{path} describes no slaves, so the emulated bus is empty: use the ENI your "
-            "configuration tool exported for the machine (`gtecat map FILE` shows its slaves)"
         ) from None
     except BaseException:
         ctl.close()
