@@ -37,6 +37,7 @@ from ..errors import (
 )
 from .args import Ref, binder, core_arg
 from .table import FUNCTIONS, Proto
+from .units import with_units
 
 log = logging.getLogger("gtecat.gt")
 
@@ -210,6 +211,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     def gt(*args: Any, **kwargs: Any) -> int:
         return call(_ONE, args, kwargs)
 
+    gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt
@@ -221,7 +223,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             return call(kwargs.pop("core", None), (), kwargs)
 
         gtn.__name__ = "GTN_" + name[3:]
-        gtn.__doc__ = f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+        gtn.__doc__ = with_units(
+            name, f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+        )
         gtn.prototype = proto  # type: ignore[attr-defined]
         REGISTRY[gtn.__name__] = gtn
     return gt
