@@ -3,7 +3,7 @@
 Like IgH's ``ethercat states``: without STATE, each slave's AL state and status code; with
 STATE (INIT, PREOP, SAFEOP, OP, BOOT) the master requests it of every slave (or of the one
 ``-p`` names) and shows where each one ended and why it refused, if it did. On the emulated
-bus the change lasts for this command only.
+bus the change lasts for this command only, on a running controller (--controller) it stays.
 """
 
 from __future__ import annotations
