@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import argparse
 import struct
-from types import SimpleNamespace
+from typing import Any
 
 from eni.numbers import parse_int
 
 from ..errors import ParameterError
-from ..native.field import pdo_rows, slave_rows
 from . import output
-from .busview import Bus, add_bus_options, open_bus
+from .busview import add_bus_options, bus_view, open_bus
 
 __all__ = ["open_bus"]
 
@@ -52,39 +51,25 @@ FROM_DICTIONARY = {
 
 SDO_EPILOG = """\
 OBJECT is an index (0x6041), an index:subindex (0x6041:00) or an object's name
-("Statusword"; emulated bus). Without --type the type comes from the slave's
-object dictionary (emulated bus), else the value prints as raw bytes.
+("Statusword"; looked up in the emulated slave's dictionary). Without --type the
+type comes from that dictionary, else the value prints as raw bytes.
 
 examples:
   gtecat sdo upload -p 0 0x1018:01                 vendor id of slave 0
   gtecat sdo upload 0 Statusword                   by name
   gtecat sdo download -p 0 0x6060 0 8              modes of operation := 8 (CSP)
   gtecat sdo upload 0 0x6502 0 --type uint32 --backend pysoem --iface eth0
+  gtecat sdo upload 0 Statusword --controller unix:/tmp/ctl.sock
 
 On the emulated bus every command starts a fresh bus: a download lasts for that
-command only (use a script and `gtecat run` for sequences), unless --controller
-names a running controller (`gtecat controller`): then it reads and writes that
-one's bus, by index (names need a bus of the command's own)."""
+command only (use a script and `gtecat run` for sequences), unless --controller (or
+GTECAT_CONTROLLER) names a running controller (`gtecat controller`): then it reads
+and writes that one's bus."""
 
 
 def _file(p: argparse.ArgumentParser) -> None:
     # ``gtecat slaves x.eni`` reads like ``gtecat map x.eni``; --eni says the same
     p.add_argument("file", nargs="?", help="configuration file (same as --eni)")
-
-
-def _controller(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--controller",
-        metavar="ADDR",
-        help="read the bus of a running controller (unix:/path of `gtecat controller`, "
-        "GTECAT_CONTROLLER of a program) instead of opening one",
-    )
-
-
-def _field(args: argparse.Namespace):
-    from ..native.client import Field
-
-    return Field.connect(args.controller)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -98,7 +83,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     _file(p)
     add_bus_options(p)
-    _controller(p)
     p.set_defaults(func=run_slaves)
     p = sub.add_parser(
         "pdos",
@@ -108,7 +92,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     _file(p)
     add_bus_options(p)
-    _controller(p)
     p.set_defaults(func=run_pdos)
     p = sub.add_parser(
         "sdo",
@@ -128,7 +111,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="data type (default: the dictionary's on the emulated bus, else raw bytes)",
     )
     add_bus_options(p)
-    _controller(p)
     p.set_defaults(func=run_sdo)
 
 
@@ -141,12 +123,8 @@ def _hex(v: int, w: int = 8) -> str:
 
 
 def run_slaves(args: argparse.Namespace) -> int:
-    if args.controller:
-        with _field(args) as f:
-            rows = f.slaves(args.position)
-    else:
-        with Bus(args) as bus:
-            rows = slave_rows(bus.master, bus.positions())
+    with bus_view(args) as bus:
+        rows = bus.slaves(args.position)
     if args.json:
         output.print_json(rows)
         return 0
@@ -165,12 +143,8 @@ def run_slaves(args: argparse.Namespace) -> int:
 
 
 def run_pdos(args: argparse.Namespace) -> int:
-    if args.controller:
-        with _field(args) as f:
-            out = f.pdos(args.position)
-    else:
-        with Bus(args) as bus:
-            out = pdo_rows(bus.layout.config, bus.positions())
+    with bus_view(args) as bus:
+        out = bus.pdos(args.position)
     if args.json:
         output.print_json(out)
         return 0
@@ -253,51 +227,14 @@ def _split_words(args: argparse.Namespace) -> tuple[int, str, str | None, str | 
     return slave, obj, sub, value
 
 
-def _lookup(bus: Bus, slave: int, obj: str, sub: str | None) -> tuple[int, int, object]:
-    """(index, subindex, dictionary entry or None) for OBJECT [SUB]."""
-    od = None
-    if bus.emulated:
-        try:
-            od = bus.od(slave)
-        except Exception:  # an IO slave without CoE: the SDO itself says so
-            od = None
+def _lookup(bus: Any, slave: int, obj: str, sub: str | None) -> tuple[int, int, dict[str, Any]]:
+    """(index, subindex, the dictionary's {name, type} or {}) of OBJECT [SUB]."""
     if _is_number(obj):
         index = _number(obj, "INDEX", 0xFFFF)
         subindex = 0 if sub is None else _number(sub, "SUB", 0xFF)
-        var = od.find(index, subindex) if od is not None else None
-        return index, subindex, var
-    if od is None:
-        raise ParameterError(
-            f"sdo: {obj!r} is not a number; names are looked up in the emulated slave's "
-            "dictionary only: give the index, e.g. 0x6041 0"
-        )
-    wanted = obj.casefold()
-    subindex = None if sub is None else _number(sub, "SUB", 0xFF)
-    hits = []
-    for o in od:
-        subs = [o.subs[k] for k in sorted(o.subs)]
-        if o.name.casefold() == wanted:
-            if subindex is None and len(subs) > 1:
-                raise ParameterError(
-                    f"sdo: {obj!r} is 0x{o.index:04X} with subindexes "
-                    f"{', '.join(str(v.subindex) for v in subs)}: give SUB"
-                )
-            hits += [v for v in subs if subindex is None or v.subindex == subindex]
-        else:
-            hits += [
-                v
-                for v in subs
-                if v.name.casefold() == wanted and (subindex is None or v.subindex == subindex)
-            ]
-    if not hits:
-        raise ParameterError(
-            f"sdo: slave {slave} has no object called {obj!r} (`gtecat sdos -p {slave}` lists them)"
-        )
-    if len({(v.index, v.subindex) for v in hits}) > 1:
-        where = ", ".join(output.hex_addr(v.index, v.subindex) for v in hits[:5])
-        raise ParameterError(f"sdo: {obj!r} names {where}: give the index")
-    v = hits[0]
-    return v.index, v.subindex, v
+        return index, subindex, bus.sdo_entry(slave, index, subindex)
+    found = bus.sdo_find(slave, obj, None if sub is None else _number(sub, "SUB", 0xFF))
+    return found["index"], found["subindex"], {"name": found["name"], "type": found["type"]}
 
 
 def run_sdo(args: argparse.Namespace) -> int:
@@ -309,58 +246,20 @@ def run_sdo(args: argparse.Namespace) -> int:
     if args.action == "download" and value_text is None:
         raise ParameterError("sdo download needs VALUE (and --type where the type is unknown)")
     data = _encode(value_text or "", args.type) if args.action == "download" and args.type else b""
-    if args.controller:
-        index, subindex, var, type_name, raw = _sdo_remote(args, slave, obj, sub, value_text, data)
-        return _sdo_print(args, slave, index, subindex, var, type_name, raw)
-    with Bus(args) as bus:
-        bus.check(slave)
-        index, subindex, var = _lookup(bus, slave, obj, sub)
-        type_name = args.type
-        if type_name is None and var is not None:
-            type_name = FROM_DICTIONARY.get(var.data_type.name)
+    with bus_view(args) as bus:
+        index, subindex, entry = _lookup(bus, slave, obj, sub)
+        type_name = args.type or FROM_DICTIONARY.get(entry.get("type", ""))
+        raw = b""
         if args.action == "download":
             if type_name is None:
                 raise ParameterError(
                     f"sdo download: the type of {output.hex_addr(index, subindex)} is unknown "
                     f"here; give --type ({', '.join(sorted(TYPES))}, string)"
                 )
-            if not args.type:
-                data = _encode(value_text or "", type_name)
-            bus.master.sdo_download(slave, index, subindex, data)
-            raw = b""
+            bus.sdo_download(slave, index, subindex, data or _encode(value_text or "", type_name))
         else:
-            raw = bus.master.sdo_upload(slave, index, subindex)
-    return _sdo_print(args, slave, index, subindex, var, type_name, raw)
-
-
-def _sdo_remote(
-    args: argparse.Namespace, slave: int, obj: str, sub: str | None, text: str | None, data: bytes
-) -> tuple[int, int, object, str | None, bytes]:
-    """``sdo --controller``: the running controller's bus does the transfer."""
-    if not _is_number(obj):
-        raise ParameterError(
-            f"sdo --controller: give the index, e.g. 0x6041 0 ({obj!r} is looked up by name "
-            "only in a bus of this command's own)"
-        )
-    index = _number(obj, "INDEX", 0xFFFF)
-    subindex = 0 if sub is None else _number(sub, "SUB", 0xFF)
-    with _field(args) as f:
-        entry = f.sdo_entry(slave, index, subindex)
-        var = (
-            SimpleNamespace(name=entry["name"], data_type=SimpleNamespace(name=entry["type"]))
-            if entry
-            else None
-        )
-        type_name = args.type or (FROM_DICTIONARY.get(entry["type"]) if entry else None)
-        if args.action == "download":
-            if type_name is None:
-                raise ParameterError(
-                    f"sdo download: the type of {output.hex_addr(index, subindex)} is unknown "
-                    f"here; give --type ({', '.join(sorted(TYPES))}, string)"
-                )
-            f.sdo_download(slave, index, subindex, data or _encode(text or "", type_name))
-            return index, subindex, var, type_name, b""
-        return index, subindex, var, type_name, f.sdo_upload(slave, index, subindex)
+            raw = bus.sdo_upload(slave, index, subindex)
+    return _sdo_print(args, slave, index, subindex, entry, type_name, raw)
 
 
 def _sdo_print(
@@ -368,7 +267,7 @@ def _sdo_print(
     slave: int,
     index: int,
     subindex: int,
-    var: object,
+    entry: dict[str, Any],
     type_name: str | None,
     raw: bytes,
 ) -> int:
@@ -389,9 +288,9 @@ def _sdo_print(
     if args.json:
         out = {"slave": slave, "index": index, "subindex": subindex, "bytes": raw.hex()}
         out["value"] = value
-        if var is not None:
-            out["name"] = var.name
-            out["type"] = var.data_type.name
+        if entry:
+            out["name"] = entry["name"]
+            out["type"] = entry["type"]
         output.print_json(out)
     elif isinstance(value, int) and not isinstance(value, bool) and type_name:
         print(f"{value}  (0x{raw[: TYPES[type_name][1]][::-1].hex().upper()}, {type_name})")

@@ -1,23 +1,27 @@
-"""The bus as the inspection verbs see it: opened the way ``GT_Open`` would, one slave at a
-time by ``-p POSITION``, with what each backend can show (object dictionary, ESC registers,
-SII).
+"""The bus as the inspection verbs see it: opened the way ``GT_Open`` would, or a running
+controller's, one slave at a time by ``-p POSITION``.
 
 ``--eni`` (or ``GTECAT_ENI``, else ``./Gecat.eni``), ``--machine``, ``--backend`` and
 ``--iface`` mean what they mean for ``GT_Open``. On the emulated bus every command starts a
-fresh bus and stops it when done; ``--backend pysoem --iface NIC`` talks to a real one.
+fresh bus and stops it when done; ``--backend pysoem --iface NIC`` talks to a real one;
+``--controller ADDR`` (or ``GTECAT_CONTROLLER``) reads and changes a running controller's
+bus. What a verb asks of the bus is :class:`gtecat.controller.inspect.BusView` either way.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from drives.machine import MachineError
 
-from ..controller.core import Controller, Options
-from ..errors import BusError, ConfigMismatch, NoSlavesError, ParameterError
+from ..controller.core import Controller, Options, folder_message
+from ..controller.inspect import view
+from ..errors import BusError, ConfigMismatch, ParameterError
 from . import output
 
 
@@ -29,6 +33,17 @@ def add_bus_options(p: argparse.ArgumentParser, *, position: bool = True) -> Non
     if position:
         output.add_position(p)
     output.add_json(p)
+    add_controller(p)
+
+
+def add_controller(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--controller",
+        metavar="ADDR",
+        help="show the bus of a running controller (unix:/path of `gtecat controller`; "
+        "default $GTECAT_CONTROLLER unless a configuration file is named) instead of "
+        "opening one",
+    )
 
 
 def check_toml_kind(path: str | os.PathLike[str] | None, want: str) -> None:
@@ -56,12 +71,7 @@ def check_toml_kind(path: str | os.PathLike[str] | None, want: str) -> None:
 def eni_argument(args: argparse.Namespace) -> str | None:
     eni = getattr(args, "eni", None) or getattr(args, "file", None)
     if eni and Path(eni).is_dir():
-        inside = sorted(p.name for p in Path(eni).iterdir() if p.suffix.lower() == ".eni")
-        hint = f" (it holds {', '.join(inside)})" if inside else ""
-        raise ParameterError(
-            f"{eni} is a folder, not an ENI file{hint}: give the file, e.g. --eni "
-            f"{Path(eni) / (inside[0] if inside else 'Gecat.eni')}"
-        )
+        raise ParameterError(folder_message(Path(eni), "give the file, e.g. --eni"))
     return eni
 
 
@@ -97,122 +107,37 @@ def open_bus(args: argparse.Namespace) -> Controller:
             f"{e}; the ENI does not describe this bus: export it again from the "
             "configuration tool for this machine, or check the cabling order"
         ) from None
-    except NoSlavesError:
-        ctl.close()
-        if backend != "emulated":
-            raise
-        path = ctl.eni_path()
-        raise NoSlavesError(
-            f"{path} describes no slaves, so the emulated bus is empty: use the ENI your "
-            "configuration tool exported for the machine (`gtecat map FILE` shows its slaves)"
-        ) from None
     except BaseException:
         ctl.close()
         raise
     return ctl
 
 
-class Bus:
-    """``with Bus(args) as bus:`` an opened bus, closed afterwards."""
+def controller_address(args: argparse.Namespace) -> str | None:
+    """The running controller a verb reads: ``--controller``; else ``GTECAT_CONTROLLER``
+    unless a configuration file was named on the command line (or it says ``local``)."""
+    if getattr(args, "controller", None):
+        return str(args.controller)
+    if getattr(args, "eni", None) or getattr(args, "file", None):
+        return None
+    env = os.environ.get("GTECAT_CONTROLLER", "").strip()
+    return env if env and env != "local" else None
 
-    def __init__(self, args: argparse.Namespace) -> None:
-        self.args = args
-        self.ctl = open_bus(args)
-        self.master = self.ctl.master
-        self.layout = self.master.layout
-        self._escs: dict[int, Any] = {}
 
-    def __enter__(self) -> Bus:
-        return self
+@contextlib.contextmanager
+def bus_view(args: argparse.Namespace) -> Iterator[Any]:
+    """``with bus_view(args) as bus:`` the bus a verb shows: a bus of its own (a
+    :class:`~gtecat.controller.inspect.BusView`, closed afterwards) or a running controller
+    (a :class:`~gtecat.native.client.Field`, whose methods are the view's, run there)."""
+    address = controller_address(args)
+    if address:
+        from ..native.client import Field
 
-    def __exit__(self, *exc: object) -> None:
-        self.ctl.close()
-
-    @property
-    def count(self) -> int:
-        return len(self.layout.slaves)
-
-    def check(self, position: int) -> int:
-        if not 0 <= position < self.count:
-            raise ParameterError(
-                f"no slave {position}: the bus has slaves 0..{self.count - 1}"
-                if self.count
-                else f"no slave {position}: the bus has none"
-            )
-        return position
-
-    def positions(self) -> list[int]:
-        """``-p POSITION`` or every slave."""
-        p = getattr(self.args, "position", None)
-        return [self.check(p)] if p is not None else list(range(self.count))
-
-    # --- what the backend can show ------------------------------------------------------------
-    @property
-    def emulated(self) -> bool:
-        from ..master.backends.emulated import EmulatedBackend
-
-        return isinstance(self.ctl.backend, EmulatedBackend)
-
-    def virtual(self, position: int, what: str) -> Any:
-        """The in-process slave at ``position`` (emulated bus only)."""
-        if not self.emulated:
-            raise BusError(
-                f"{what} needs the emulated bus (this is {type(self.ctl.backend).__name__})"
-            )
-        return self.ctl.backend.slaves[self.check(position)]
-
-    def pysoem_slave(self, position: int) -> Any:
-        m = getattr(self.ctl.backend, "master", None)
-        if m is None:
-            raise BusError("the pysoem master is not open")
-        return m.slaves[self.check(position)]
-
-    def od(self, position: int) -> Any:
-        """The object dictionary of ``position`` (the emulated slave's own)."""
-        slave = self.virtual(position, "listing the object dictionary")
-        od = getattr(slave, "od", None)
-        if od is None:
-            raise BusError(f"slave {position} ({slave.name}) has no CoE object dictionary")
-        return od
-
-    def esc(self, position: int) -> Any:
-        """The emulated slave's EtherCAT slave controller: registers and SII EEPROM."""
-        if position not in self._escs:
-            from drives.esc.registers import Esc
-            from drives.esc.sii import build_sii, sii_info_for
-
-            slave = self.virtual(position, "ESC registers and the SII")
-            self._escs[position] = Esc(
-                slave, build_sii(sii_info_for(slave)), position=position, chain_length=self.count
-            )
-        esc = self._escs[position]
-        esc.sync_al()
-        return esc
-
-    def reg_read(self, position: int, address: int, size: int) -> bytes:
-        if self.emulated:
-            data = self.esc(position).read(address, size)
-            if data is None:
-                raise BusError(f"slave {position}: 0x{address:04X}+{size} is not readable")
-            return bytes(data)
-        s = self.pysoem_slave(position)
-        return bytes(s._fprd(address, size))
-
-    def reg_write(self, position: int, address: int, data: bytes) -> None:
-        if self.emulated:
-            if not self.esc(position).write(address, data):
-                raise BusError(f"slave {position}: 0x{address:04X}+{len(data)} is not writable")
-            return
-        self.pysoem_slave(position)._fpwr(address, data)
-
-    def sii(self, position: int) -> bytes:
-        if self.emulated:
-            return bytes(self.esc(position).sii)
-        s = self.pysoem_slave(position)
-        words = []
-        for w in range(0, 2048, 2):  # 4 KiB at most; stop at the end category
-            chunk = bytes(s.eeprom_read(w))
-            words.append(chunk)
-            if w >= 0x40 and chunk[:2] == b"\xff\xff":
-                break
-        return b"".join(words)
+        with Field.connect(address) as f:
+            yield f
+        return
+    ctl = open_bus(args)
+    try:
+        yield view(ctl)
+    finally:
+        ctl.close()

@@ -3,17 +3,16 @@
 Like IgH's ``ethercat data``: the bytes of the image, here in the GT raw view (each slave's
 outputs then inputs, the offsets GT_GetEcatRawData takes) as a hex dump per slave, with
 ``--entries`` one line per PDO entry and its value. ``--json`` for scripts; ``--cycles N``
-lets N cycles pass after the bus reached OP before the image is read.
+lets N cycles pass after the bus reached OP before the image is read (on a running
+controller none by default: the image as it holds it now).
 """
 
 from __future__ import annotations
 
 import argparse
 
-from eni.model import Direction
-
 from . import output
-from .busview import Bus, add_bus_options
+from .busview import add_bus_options, bus_view, controller_address
 
 EPILOG = """\
 examples:
@@ -31,7 +30,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("file", nargs="?", help="configuration file (same as --eni)")
     p.add_argument("--entries", action="store_true", help="one line per PDO entry, decoded")
-    p.add_argument("--cycles", type=int, default=1, help="cycles to run first (default 1)")
+    p.add_argument(
+        "--cycles",
+        type=int,
+        help="cycles to run first (default 1; 0 on a running controller: its image as it is)",
+    )
     add_bus_options(p)
     p.set_defaults(func=run)
 
@@ -45,39 +48,11 @@ def _dump(data: bytes, start: int) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    with Bus(args) as bus:
-        bus.ctl.wait_ms(max(0, args.cycles) * bus.ctl.clock.cycle_ns / 1e6)
-        image = bus.master.image
-        slaves = []
-        for pos in bus.positions():
-            s = bus.layout.slaves[pos]
-            region = _region(bus, pos)
-            entries = []
-            for p in s.entries:
-                if p.is_padding:
-                    continue
-                value = image.access(p).get()
-                entries.append(
-                    {
-                        "dir": "out" if p.direction == Direction.OUT else "in",
-                        "index": p.index,
-                        "subindex": p.subindex,
-                        "name": p.name,
-                        "bits": p.bits,
-                        "gt_bit": p.gt_bit,
-                        "value": value,
-                    }
-                )
-            slaves.append(
-                {
-                    "position": pos,
-                    "name": s.name,
-                    "gt_offset": s.gt_offset,
-                    "gt_size": s.gt_size,
-                    "bytes": region.hex(),
-                    "entries": entries,
-                }
-            )
+    cycles = args.cycles
+    if cycles is None:  # a bus of its own has not cycled yet; a running one has
+        cycles = 0 if controller_address(args) else 1
+    with bus_view(args) as bus:
+        slaves = bus.data(args.position, max(0, cycles))
     if args.json:
         output.print_json(slaves)
         return 0
@@ -109,27 +84,3 @@ def run(args: argparse.Namespace) -> int:
         else:
             print("\n".join(_dump(bytes.fromhex(s["bytes"]), s["gt_offset"])) or "  (empty)")
     return 0
-
-
-def _region(bus: Bus, pos: int) -> bytes:
-    """Slave ``pos``'s GT raw region: its outputs then its inputs, read entry by entry."""
-    s = bus.layout.slaves[pos]
-    out = bytearray(s.gt_size)
-    image = bus.master.image
-    for p in s.entries:
-        if p.is_padding:
-            continue
-        value = image.access(p).get()
-        if isinstance(value, float):
-            import struct
-
-            raw = struct.pack("<f" if p.bits == 32 else "<d", value)
-            start = p.gt_bit // 8 - s.gt_offset
-            out[start : start + len(raw)] = raw
-            continue
-        v = int(value) & ((1 << p.bits) - 1)
-        rel = p.gt_bit - s.gt_offset * 8
-        for b in range(p.bits):
-            if v >> b & 1:
-                out[(rel + b) // 8] |= 1 << ((rel + b) % 8)
-    return bytes(out)

@@ -12,19 +12,20 @@ import os
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
+from eni.graph import render as render_graph
 from eni.layout import build_layout
 from eni.reader import read_eni
 
 from ..errors import ParameterError
 from . import output
-from .busview import eni_argument
+from .busview import add_controller, controller_address, eni_argument
 
 EPILOG = """\
 examples:
   gtecat graph manual_fig5_2.eni > bus.dot
-  gtecat graph manual_fig5_2.eni --png bus.png      (needs Graphviz's dot)"""
+  gtecat graph manual_fig5_2.eni --png bus.png      (needs Graphviz's dot)
+  gtecat graph --controller unix:/tmp/ctl.sock       the bus of a running controller"""
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -38,44 +39,24 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("file", nargs="?", help="ENI file (default: $GTECAT_ENI or ./Gecat.eni)")
     p.add_argument("--eni", help="the same as FILE")
     p.add_argument("--png", metavar="FILE", help="draw the graph into FILE with Graphviz dot")
+    add_controller(p)
     p.set_defaults(func=run)
-
-
-def _q(text: str) -> str:
-    return text.replace("\\", "\\\\").replace('"', '\\"')
 
 
 def render(path: str) -> str:
     config = read_eni(path)
-    layout = build_layout(config)
-    lines = [
-        "digraph bus {",
-        "    rankdir=LR;",
-        '    node [shape=box, fontname="Helvetica", fontsize=10];',
-        f'    master [label="master\\n{_q(Path(path).name)}", shape=ellipse];',
-    ]
-    previous = "master"
-    for s, cfg in zip(layout.slaves, config.slaves, strict=True):
-        i = cfg.identity
-        axes = ", ".join(str(a) for a in s.axes)
-        what = (f"axis {axes}" if len(s.axes) == 1 else f"axes {axes}") if s.axes else "IO"
-        label = (
-            f"{s.position}: {_q(s.name)}\\n"
-            f"vendor 0x{i.vendor_id:08X} product 0x{i.product_code:08X}\\n"
-            f"{what}; GT raw {s.gt_offset}+{s.gt_size}"
-        )
-        style = ", style=rounded" if s.axes else ""
-        lines.append(f'    slave{s.position} [label="{label}"{style}];')
-        port = "OUT" if previous == "master" else ""
-        lines.append(f'    {previous} -> slave{s.position} [label="{port}"];')
-        previous = f"slave{s.position}"
-    lines.append("}")
-    return "\n".join(lines) + "\n"
+    return render_graph(config, build_layout(config))
 
 
 def run(args: argparse.Namespace) -> int:
-    path = eni_argument(args) or os.environ.get("GTECAT_ENI") or "Gecat.eni"
-    dot = render(path)
+    address = controller_address(args)
+    if address:
+        from ..native.client import Field
+
+        with Field.connect(address) as f:
+            dot = f.graph()
+    else:
+        dot = render(eni_argument(args) or os.environ.get("GTECAT_ENI") or "Gecat.eni")
     if not args.png:
         sys.stdout.write(dot)
         return 0

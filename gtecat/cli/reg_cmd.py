@@ -16,7 +16,7 @@ from eni.numbers import parse_int
 
 from ..errors import ParameterError
 from . import output
-from .busview import Bus, add_bus_options
+from .busview import add_bus_options, bus_view
 
 EPILOG = """\
 examples:
@@ -78,8 +78,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         size = _number(args.value, "SIZE", 0x1000) if args.value else 2
     rows = []
-    with Bus(args) as bus:
-        for pos in bus.positions():
+    with bus_view(args) as bus:
+        for pos in bus.positions(args.position):
             if args.action == "write":
                 bus.reg_write(pos, address, data)
                 raw = bus.reg_read(pos, address, len(data))

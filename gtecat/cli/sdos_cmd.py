@@ -10,9 +10,8 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ..errors import BusError
 from . import output
-from .busview import Bus, add_bus_options
+from .busview import add_bus_options, bus_view
 
 EPILOG = """\
 examples:
@@ -36,54 +35,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _value(var: Any) -> tuple[Any, str | None]:
-    """(value for JSON, hex of the value's bytes) of one entry."""
-    if not var.access.readable:
-        return None, None
-    try:
-        value = var.get()
-        raw = var.encode(value)
-    except Exception:  # a getter that needs a running drive: show no value, not an error
-        return None, None
-    if isinstance(value, bytes):
-        value = value.hex(" ")
-    if isinstance(value, float):
-        value = round(value, 6)
-    return value, raw.hex()
-
-
-def _pdo(var: Any) -> str:
-    names = [n for n, bit in (("RxPDO", 1), ("TxPDO", 2)) if int(var.pdo) & bit]
-    return ",".join(names) or "-"
-
-
-def entries(bus: Bus, position: int, *, values: bool = True, grep: str | None = None) -> list:
-    rows = []
-    od = bus.od(position)
-    for obj in od:
-        for k in sorted(obj.subs):
-            var = obj.subs[k]
-            name = var.name if var.name == obj.name or k == 0 else f"{obj.name}: {var.name}"
-            if grep and grep.casefold() not in name.casefold():
-                continue
-            value, raw = _value(var) if values else (None, None)
-            rows.append(
-                {
-                    "position": position,
-                    "index": var.index,
-                    "subindex": var.subindex,
-                    "name": name,
-                    "type": var.data_type.name,
-                    "bits": var.bit_length,
-                    "access": var.access.name,
-                    "pdo": _pdo(var),
-                    "value": value,
-                    "hex": raw,
-                }
-            )
-    return rows
-
-
 def _shown(row: dict[str, Any]) -> str:
     v, raw = row["value"], row["hex"]
     if v is None:
@@ -96,15 +47,8 @@ def _shown(row: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    rows = []
-    with Bus(args) as bus:
-        for pos in bus.positions():
-            try:
-                rows += entries(bus, pos, values=not args.no_values, grep=args.grep)
-            except BusError:
-                if args.position is not None:
-                    raise
-                continue  # an IO terminal without CoE: nothing to list
+    with bus_view(args) as bus:
+        rows = bus.sdos(args.position, not args.no_values, args.grep)
     if args.json:
         output.print_json(rows)
         return 0

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from . import output
-from .busview import Bus, add_bus_options
+from .busview import add_bus_options, bus_view
 
 EPILOG = """\
 examples:
@@ -80,8 +80,8 @@ def run(args: argparse.Namespace) -> int:
     if args.output and args.position is None:
         raise ParameterError("sii read --output needs -p POSITION: one slave per file")
     result = []
-    with Bus(args) as bus:
-        for pos in bus.positions():
+    with bus_view(args) as bus:
+        for pos in bus.positions(args.position):
             raw = bus.sii(pos)
             if args.output:
                 Path(args.output).write_bytes(raw)

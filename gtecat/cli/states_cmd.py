@@ -3,18 +3,18 @@
 Like IgH's ``ethercat states``: without STATE, each slave's AL state and status code; with
 STATE (INIT, PREOP, SAFEOP, OP, BOOT) the master requests it of every slave (or of the one
 ``-p`` names) and shows where each one ended and why it refused, if it did. On the emulated
-bus the change lasts for this command only.
+bus the change lasts for this command only, on a running controller (--controller) it stays.
 """
 
 from __future__ import annotations
 
 import argparse
 
-from drives.slave import AlState, AlStatusCode
+from drives.slave import AlState
 
 from ..errors import ParameterError
 from . import output
-from .busview import Bus, add_bus_options
+from .busview import add_bus_options, bus_view
 
 EPILOG = """\
 examples:
@@ -35,13 +35,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _code_name(code: int) -> str:
-    try:
-        return AlStatusCode(code).name
-    except ValueError:
-        return f"0x{code:04X}"
-
-
 def run(args: argparse.Namespace) -> int:
     target = None
     if args.state:
@@ -51,28 +44,8 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(
                 f"no AL state {args.state!r}: give INIT, PREOP, SAFEOP, OP or BOOT"
             ) from None
-    rows = []
-    with Bus(args) as bus:
-        backend = bus.ctl.backend
-        for pos in bus.positions():
-            before, _ = backend.state(pos)
-            refused = None
-            if target is not None:
-                code = backend.request_state(pos, target)
-                if int(code):
-                    refused = _code_name(int(code))
-            state, code = backend.state(pos)
-            rows.append(
-                {
-                    "position": pos,
-                    "name": bus.layout.slaves[pos].name,
-                    "before": AlState(before).name,
-                    "state": AlState(state).name,
-                    "status_code": int(code),
-                    "status": _code_name(int(code)) if int(code) else "",
-                    "refused": refused,
-                }
-            )
+    with bus_view(args) as bus:
+        rows = bus.states(args.position, target.name if target is not None else None)
     if args.json:
         output.print_json(rows)
         return 0

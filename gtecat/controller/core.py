@@ -202,6 +202,10 @@ class Controller:
 
     def _init_ecat(self) -> Master:
         path = self.eni_path()
+        if path.is_dir():
+            raise NoEniError(
+                folder_message(path, "name the file in GT_Open(eni=...) or GTECAT_ENI, e.g.")
+            )
         if not path.is_file():
             raise NoEniError(
                 f"no ENI file at {path.resolve()} "
@@ -365,6 +369,17 @@ class Controller:
         if ms < 0:
             raise ParameterError("wait time must be >= 0")
         self.clock.advance(ms)
+
+
+def folder_message(path: Path, how: str) -> str:
+    """Why a folder is no ENI, naming the ENI files it holds (one text for GT and CLI):
+    ``how`` is followed by the file to give instead."""
+    inside = sorted(p.name for p in path.iterdir() if p.suffix.lower() == ".eni")
+    hint = f" (it holds {', '.join(inside)})" if inside else ""
+    return (
+        f"{path} is a folder, not an ENI file{hint}; {how} "
+        f"{path / (inside[0] if inside else 'Gecat.eni')}"
+    )
 
 
 def _relatch_link_alarms(ctl: Controller) -> None:

@@ -40,6 +40,7 @@ from ..errors import (
 from .args import Ref, binder, core_arg
 from .fast import READERS, fast_reader
 from .table import FUNCTIONS, Proto
+from .units import with_units
 
 log = logging.getLogger("gtecat.gt")
 
@@ -233,9 +234,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     def gt(*args: Any, **kwargs: Any) -> int:
         return call(_ONE, args, kwargs)
 
+    gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     if name in READERS:  # the common shape answered up front (gtecat.gt.fast)
         slow = gt
-        gt = functools.wraps(fn)(fast_reader(name, slow, SESSION))
+        gt = functools.wraps(slow)(fast_reader(name, slow, SESSION))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
@@ -248,7 +250,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             return call(kwargs.pop("core", None), (), kwargs)
 
         gtn.__name__ = "GTN_" + name[3:]
-        gtn.__doc__ = f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+        gtn.__doc__ = with_units(
+            name, f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+        )
         gtn.prototype = proto  # type: ignore[attr-defined]
         REGISTRY[gtn.__name__] = gtn
     return gt

@@ -107,7 +107,7 @@ class Master:
         self.backend.open(self.layout, self.image)
         found = self.backend.scan()
         if not found:
-            raise NoSlavesError("no slave answered the scan; check the cabling / interface")
+            raise NoSlavesError(self.backend.empty_scan())
         self.log(f"Found {len(found)} slaves.")
         expected = self.layout.config.slaves
         for cfg, got in zip(expected, found, strict=False):

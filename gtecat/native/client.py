@@ -462,7 +462,10 @@ class Field:
     def call(self, op: str, *args: Any) -> Any:
         return self.connection.field(op, *args)
 
-    # the bus
+    # the bus: gtecat.controller.inspect.BusView's methods, same names and results
+    def positions(self, position: int | None = None) -> list[int]:
+        return self.call("positions", position)
+
     def slaves(self, position: int | None = None) -> list[dict[str, Any]]:
         return self.call("slaves", position)
 
@@ -477,6 +480,35 @@ class Field:
 
     def sdo_entry(self, slave: int, index: int, subindex: int) -> dict[str, str]:
         return self.call("sdo_entry", slave, index, subindex)
+
+    def sdo_find(self, slave: int, name: str, subindex: int | None = None) -> dict[str, Any]:
+        return self.call("sdo_find", slave, name, subindex)
+
+    def sdos(
+        self, position: int | None = None, values: bool = True, grep: str | None = None
+    ) -> list[dict[str, Any]]:
+        return self.call("sdos", position, values, grep)
+
+    def states(self, position: int | None = None, target: str | None = None) -> list[dict]:
+        return self.call("states", position, target)
+
+    def reg_read(self, position: int, address: int, size: int) -> bytes:
+        return bytes.fromhex(self.call("reg_read", position, address, size))
+
+    def reg_write(self, position: int, address: int, data: bytes) -> None:
+        self.call("reg_write", position, address, bytes(data).hex())
+
+    def sii(self, position: int) -> bytes:
+        return bytes.fromhex(self.call("sii", position))
+
+    def data(self, position: int | None = None, cycles: int = 0) -> list[dict[str, Any]]:
+        return self.call("data", position, cycles)
+
+    def cstruct(self, prefix: str = "", position: int | None = None) -> str:
+        return self.call("cstruct", prefix, position)
+
+    def graph(self) -> str:
+        return self.call("graph")
 
     # drives
     def inject_fault(self, slave: int, kind: str | int, channel: int = 0) -> int:

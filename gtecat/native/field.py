@@ -7,8 +7,12 @@ function per operation (:data:`OPS`); the controller runs them under its call lo
 (:mod:`gtecat.native.server`, message ``FIELD``) and :class:`gtecat.native.client.Field`
 is their Python face.  Arguments and results are plain JSON values (bytes as hex text).
 
-* the bus, as the inspection verbs show it: :func:`slaves`, :func:`pdos`,
-  :func:`sdo_upload`, :func:`sdo_download` (``gtecat slaves|pdos|sdo --controller``);
+* the bus, as the inspection verbs show it (``gtecat VERB --controller``): :func:`positions`,
+  :func:`slaves`, :func:`pdos`, :func:`sdo_upload`, :func:`sdo_download`, :func:`sdo_entry`,
+  :func:`sdo_find`, :func:`sdos`, :func:`states`, :func:`reg_read`, :func:`reg_write`,
+  :func:`sii`, :func:`data`, :func:`cstruct`, :func:`graph`; each is the method of the same
+  name of :class:`gtecat.controller.inspect.BusView`, which a verb calls itself on a bus of
+  its own, so both ways print the same;
 * the field side of the emulated bus, what a test does to the machine: a drive fault
   (:func:`inject_fault`, :func:`clear_injected_fault`), the mechanics pushed
   (:func:`set_machine_position`), an analog input, an IO terminal's input
@@ -17,9 +21,6 @@ is their Python face.  Arguments and results are plain JSON values (bytes as hex
 * traces: :func:`trace_start` / :func:`trace_read` / :func:`trace_stop` record signals
   every cycle in the controller (the specs of :mod:`gtecat.controller.recorder`); a
   client's traces stop when it disconnects.
-
-:func:`slave_rows` and :func:`pdo_rows` are also what ``gtecat slaves|pdos`` print for
-a bus of their own, so both ways show the same rows.
 """
 
 from __future__ import annotations
@@ -28,74 +29,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from drives.slave import AlState
-from eni.model import Direction
-
 from ..controller.core import Controller
+from ..controller.inspect import BusView, check_position, pdo_rows, slave_rows, view
 from ..errors import BusError, ParameterError
-
-
-# --- rows shared with the inspection verbs -----------------------------------------------------
-def check_position(count: int, position: int) -> int:
-    if not 0 <= position < count:
-        raise ParameterError(
-            f"no slave {position}: the bus has slaves 0..{count - 1}"
-            if count
-            else f"no slave {position}: the bus has none"
-        )
-    return position
-
-
-def slave_rows(master: Any, positions: Sequence[int]) -> list[dict[str, Any]]:
-    """One row per slave: position, AL state, identity, axes, GT raw region."""
-    states = master.refresh_states()
-    rows = []
-    for pos in positions:
-        sl, cfg = master.layout.slaves[pos], master.layout.config.slaves[pos]
-        rows.append(
-            {
-                "position": sl.position,
-                "state": AlState(states[pos]).name,
-                "name": cfg.name,
-                "vendor_id": cfg.identity.vendor_id,
-                "product_code": cfg.identity.product_code,
-                "revision": cfg.identity.revision_no,
-                "axes": list(sl.axes),
-                "gt_offset": sl.gt_offset,
-                "gt_size": sl.gt_size,
-            }
-        )
-    return rows
-
-
-def pdo_rows(config: Any, positions: Sequence[int]) -> list[dict[str, Any]]:
-    """Per slave its assigned PDOs (sync manager, direction) and their entries."""
-    out = []
-    for pos in positions:
-        s = config.slaves[pos]
-        pdos = []
-        for d, plist in ((Direction.OUT, s.rx_pdos), (Direction.IN, s.tx_pdos)):
-            for p in plist:
-                pdos.append(
-                    {
-                        "dir": "out" if d == Direction.OUT else "in",
-                        "sm": p.sm,
-                        "index": p.index,
-                        "name": p.name,
-                        "entries": [
-                            {
-                                "index": e.index,
-                                "subindex": e.subindex,
-                                "bits": e.bit_len,
-                                "name": e.name,
-                                "type": e.data_type,
-                            }
-                            for e in p.entries
-                        ],
-                    }
-                )
-        out.append({"position": s.position, "name": s.name, "pdos": pdos})
-    return out
 
 
 # --- the operations ----------------------------------------------------------------------------
@@ -121,18 +57,6 @@ OPS: dict[str, Op] = {}
 def _op(fn: Op) -> Op:
     OPS[fn.__name__] = fn
     return fn
-
-
-def _master(ctx: Context) -> Any:
-    m = ctx.ctl.master
-    if m is None:
-        raise BusError("the bus is not up yet (GT_InitEcatComm first)")
-    return m
-
-
-def _positions(ctx: Context, position: int | None) -> list[int]:
-    n = len(_master(ctx).layout.slaves)
-    return [check_position(n, int(position))] if position is not None else list(range(n))
 
 
 def _virtual(ctx: Context, slave: int) -> Any:
@@ -164,47 +88,95 @@ def _io(ctx: Context, slave: int) -> Any:
     return s
 
 
+def _view(ctx: Context) -> BusView:
+    if ctx.ctl.master is None:
+        raise BusError("the bus is not up yet (GT_InitEcatComm first)")
+    return view(ctx.ctl)
+
+
+@_op
+def positions(ctx: Context, position: int | None = None) -> list[int]:
+    """``[position]`` (checked) or every slave's."""
+    return _view(ctx).positions(position)
+
+
 @_op
 def slaves(ctx: Context, position: int | None = None) -> list[dict[str, Any]]:
-    return slave_rows(_master(ctx), _positions(ctx, position))
+    return _view(ctx).slaves(position)
 
 
 @_op
 def pdos(ctx: Context, position: int | None = None) -> list[dict[str, Any]]:
-    return pdo_rows(_master(ctx).layout.config, _positions(ctx, position))
-
-
-def _od_entry(ctx: Context, slave: int, index: int, subindex: int) -> dict[str, str]:
-    """The emulated slave's dictionary name and type of an object ({} if unknown)."""
-    try:
-        od = getattr(_virtual(ctx, slave), "od", None)
-    except BusError:
-        return {}
-    var = od.find(index, subindex) if od is not None else None
-    return {"name": var.name, "type": var.data_type.name} if var is not None else {}
+    return _view(ctx).pdos(position)
 
 
 @_op
 def sdo_upload(ctx: Context, slave: int, index: int, subindex: int) -> dict[str, Any]:
     """{"bytes": hex, "name"/"type": the dictionary's, where the emulated slave has one}."""
-    m = _master(ctx)
-    check_position(len(m.layout.slaves), int(slave))
-    raw = m.sdo_upload(int(slave), int(index), int(subindex))
-    return {"bytes": raw.hex(), **_od_entry(ctx, slave, index, subindex)}
+    v = _view(ctx)
+    raw = v.sdo_upload(slave, index, subindex)
+    return {"bytes": raw.hex(), **v.sdo_entry(slave, index, subindex)}
 
 
 @_op
 def sdo_download(ctx: Context, slave: int, index: int, subindex: int, data: str) -> None:
-    m = _master(ctx)
-    check_position(len(m.layout.slaves), int(slave))
-    m.sdo_download(int(slave), int(index), int(subindex), bytes.fromhex(data))
+    _view(ctx).sdo_download(slave, index, subindex, bytes.fromhex(data))
 
 
 @_op
 def sdo_entry(ctx: Context, slave: int, index: int, subindex: int) -> dict[str, str]:
     """The dictionary's name and type of an object ({} when the slave has no dictionary)."""
-    check_position(len(_master(ctx).layout.slaves), int(slave))
-    return _od_entry(ctx, slave, index, subindex)
+    return _view(ctx).sdo_entry(slave, index, subindex)
+
+
+@_op
+def sdo_find(ctx: Context, slave: int, name: str, subindex: int | None = None) -> dict[str, Any]:
+    """The object called ``name`` in the slave's dictionary: {index, subindex, name, type}."""
+    return _view(ctx).sdo_find(slave, str(name), None if subindex is None else int(subindex))
+
+
+@_op
+def sdos(
+    ctx: Context, position: int | None = None, values: bool = True, grep: str | None = None
+) -> list[dict[str, Any]]:
+    return _view(ctx).sdos(position, bool(values), grep)
+
+
+@_op
+def states(ctx: Context, position: int | None = None, target: str | None = None) -> list[dict]:
+    return _view(ctx).states(position, target)
+
+
+@_op
+def reg_read(ctx: Context, position: int, address: int, size: int) -> str:
+    """The bytes (hex) of an ESC register range."""
+    return _view(ctx).reg_read(position, address, size).hex()
+
+
+@_op
+def reg_write(ctx: Context, position: int, address: int, data: str) -> None:
+    _view(ctx).reg_write(position, address, bytes.fromhex(data))
+
+
+@_op
+def sii(ctx: Context, position: int) -> str:
+    """The slave's SII (hex)."""
+    return _view(ctx).sii(position).hex()
+
+
+@_op
+def data(ctx: Context, position: int | None = None, cycles: int = 0) -> list[dict[str, Any]]:
+    return _view(ctx).data(position, int(cycles))
+
+
+@_op
+def cstruct(ctx: Context, prefix: str = "", position: int | None = None) -> str:
+    return _view(ctx).cstruct(str(prefix), position)
+
+
+@_op
+def graph(ctx: Context) -> str:
+    return _view(ctx).graph()
 
 
 @_op

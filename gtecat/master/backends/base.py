@@ -42,6 +42,10 @@ class Backend(ABC):
     def scan(self) -> list[FoundSlave]:
         """The slaves present, in bus order."""
 
+    def empty_scan(self) -> str:
+        """Why a scan found no slave, and what to do (GT_InitEcatComm -10's reason)."""
+        return "no slave answered the scan; check the cabling / interface"
+
     @abstractmethod
     def request_state(self, position: int, state: AlState) -> AlStatusCode:
         """Ask one slave for an AL state; the code the slave answered (0 = done)."""

@@ -52,6 +52,7 @@ class EmulatedBackend(Backend):
         #: they answer (working counter) but are not stepped here
         self.claimed: set[int] = set()
         self.capture = None
+        self._source = ""  # the file the virtual slaves come from
         if pcap:
             from ..pcap import BusCapture
 
@@ -62,6 +63,7 @@ class EmulatedBackend(Backend):
 
         if not self._given:
             self.slaves = build_slaves(self.hardware or layout, self.machine)
+        self._source = (self.hardware or layout).config.source
         self.image = image
         self._clients = {}
         segs: dict[tuple[int, Direction], Segment] = {
@@ -101,6 +103,20 @@ class EmulatedBackend(Backend):
         if self.capture is not None:
             self.capture.scan(len(found))
         return found
+
+    def empty_scan(self) -> str:
+        """There is no cable here: the file lists no slaves, or slave 0 was unplugged."""
+        if self.slaves and 0 in self.unplugged:
+            return (
+                "slave 0 is unplugged (a scenario cut the emulated cable in front of it), so "
+                "no slave answers the scan: replug it (GTE_ReplugSlave(0))"
+            )
+        what = "the hardware description" if self.hardware is not None else "the ENI"
+        return (
+            f"{what} {self._source or '(no file)'} lists no slaves, so the emulated bus is "
+            "empty: use the ENI your configuration tool exported for the machine, or add "
+            "slaves to it (`gtecat map FILE` shows a file's slaves)"
+        )
 
     def request_state(self, position: int, state: AlState) -> AlStatusCode:
         slave = self._slave(position)

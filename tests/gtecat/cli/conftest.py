@@ -23,6 +23,7 @@ def _clean(monkeypatch: pytest.MonkeyPatch):
         "GTECAT_IFACE",
         "GTECAT_BUS",
         "GTECAT_LOG",
+        "GTECAT_CONTROLLER",
     ):
         monkeypatch.delenv(k, raising=False)
     gt.GT_Close()

@@ -264,7 +264,7 @@ def test_an_emulated_bus_without_slaves_does_not_speak_of_cabling(cli: Cli, tmp_
     (tmp_path / "empty.toml").write_text("cycle_time_us = 1000\n")
     assert cli("eni", "new", str(tmp_path / "empty.toml"), "-o", str(tmp_path / "e.eni"))[0] == 0
     err = _one_line_error(*cli("slaves", "--eni", str(tmp_path / "e.eni")))
-    assert "describes no slaves" in err and "cabling" not in err
+    assert "lists no slaves, so the emulated bus is empty" in err and "cabling" not in err
 
 
 def test_serve_on_a_missing_interface_says_so_first(cli: Cli) -> None:

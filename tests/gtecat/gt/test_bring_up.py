@@ -54,6 +54,36 @@ def test_no_eni_minus_9_then_is_ready_returns_1_with_the_init_reason(tmp_path, m
     assert rc == 0 and polls > 0
 
 
+def test_an_eni_path_that_is_a_folder_says_so_and_names_the_file_inside(tmp_path):
+    shutil.copy(EXAMPLES / "manual_fig5_4.eni", tmp_path / "bus.eni")
+    assert gt.GT_Open(eni=str(tmp_path), log="", clock="lockstep") == 0
+    assert gt.GT_InitEcatComm() == -9
+    reason = gt.GTE_GetLastError()
+    assert f"{tmp_path} is a folder, not an ENI file (it holds bus.eni)" in reason
+    assert str(tmp_path / "bus.eni") in reason and "no ENI file" not in reason
+
+
+def _empty_eni(tmp_path) -> str:
+    from gtecat.cli.main import main
+
+    (tmp_path / "empty.toml").write_text("cycle_time_us = 1000\n")
+    assert main(["eni", "new", str(tmp_path / "empty.toml"), "-o", str(tmp_path / "e.eni")]) == 0
+    return str(tmp_path / "e.eni")
+
+
+@pytest.mark.parametrize("where", ["eni", "bus"])
+def test_an_emulated_bus_without_slaves_is_minus_10_naming_the_file_not_a_cable(tmp_path, where):
+    empty = _empty_eni(tmp_path)
+    # the ENI itself lists no slaves, or the hardware description (GTECAT_BUS) does
+    opts = {"eni": empty} if where == "eni" else {"eni": FIG52, "bus": empty}
+    assert gt.GT_Open(log="", clock="lockstep", **opts) == 0
+    assert gt.GT_InitEcatComm() == -10
+    reason = gt.GTE_GetLastError()
+    what = "the ENI" if where == "eni" else "the hardware description"
+    assert f"{what} {empty} lists no slaves, so the emulated bus is empty" in reason
+    assert "exported for the machine" in reason and "cabling" not in reason
+
+
 def test_mismatch_minus_8_then_is_ready_returns_1_naming_the_slave():
     assert gt.GT_Open(eni=FIG52, bus=str(EXAMPLES / "twelve_axes.eni"), log="") == 0
     assert gt.GT_InitEcatComm() == -8

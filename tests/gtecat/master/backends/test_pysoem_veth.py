@@ -11,6 +11,7 @@ CAP_NET_ADMIN + CAP_NET_RAW); skipped with the reason otherwise.
 from __future__ import annotations
 
 import itertools
+import json
 import os
 import select
 import shutil
@@ -397,3 +398,49 @@ def test_bus_lost_mid_move_stops_the_axes_and_they_recover(veth, runner):
         assert wait(gt, lambda: abs(_pos(gt, "GT_GetEncPos", 1) - start - 20_000) <= 2, ms=500)
     finally:
         gt.GT_Close()
+
+
+# --- the inspection verbs through pysoem: ESC registers (FPRD/FPWR) and the SII (EEPROM) -----
+def _verb(capsys, *argv: str) -> tuple[int, str, str]:
+    from gtecat.cli.main import main
+
+    capsys.readouterr()
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_reg_and_sii_through_pysoem_read_what_the_emulated_bus_shows(veth, runner, capsys):
+    eni = str(EXAMPLES / "manual_fig5_2.eni")
+    wire = ("--eni", eni, "--backend", "pysoem", "--iface", veth[0])
+    for argv in (("reg", "read", "-p", "0", "0x0130"), ("reg", "read", "0x0000", "8")):
+        rc, out, err = _verb(capsys, *argv, *wire, "--json")
+        assert rc == 0, err
+        rows = json.loads(out)
+        rc, local, err = _verb(capsys, *argv, "--eni", eni, "--json")
+        assert rc == 0, err
+        assert rows == json.loads(local), argv  # AL status OP; ESC type, revision, counts
+    assert rows[0]["value"] & 0xFF == 0x11  # the virtual ESC's type
+
+    rc, out, err = _verb(capsys, "sii", "read", *wire, "--json")
+    assert rc == 0, err
+    rc, local, _ = _verb(capsys, "sii", "read", "--eni", eni, "--json")
+    wire_rows, own = json.loads(out), json.loads(local)
+
+    # the SII is read up to its end category; `gtecat serve` places the IO
+    # terminals' sync managers where the ENI's ProcessData/SmN says, the emulated bus where
+    # the default layout does (so their PDOs name other SMs): every other field is the same
+    def same(row: dict) -> dict:
+        pdos = [{k: v for k, v in p.items() if k != "sm"} for p in row["pdos"]]
+        return {k: v for k, v in row.items() if k not in ("bytes", "sync_managers")} | {
+            "pdos": pdos
+        }
+
+    for w, o in zip(wire_rows, own, strict=True):
+        assert same(w) == same(o)
+        assert w["bytes"] > 0x80  # the header and the categories, not a fixed 4 KiB
+    assert [w["sync_managers"] for w in wire_rows[:2]] == [o["sync_managers"] for o in own[:2]]
+    assert [r["name"] for r in wire_rows] == ["GTHD 0", "GTHD 1", "IO 2", "IO 3"]
+
+    rc, out, err = _verb(capsys, "reg", "write", "-p", "1", "0x0F10", "0x5AA5", *wire)
+    assert rc == 0 and "a5 5a" in out, (out, err)  # written by FPWR, read back by FPRD
