@@ -39,6 +39,9 @@ Decisions where the manual is silent:
   limit passed in a cycle starts the path stop from that cycle's sample.
 * **Segments counted** by GT_CrdStatus: every FIFO entry finished since GT_CrdStart
   (lines, arcs, BufIO, BufDelay, BufMove alike).
+* **A segment's own speed plan** (``Motion.speed_plan``, the pulse-card compat layers):
+  the segment runs that plan (base pulses, :mod:`.base_pulse`) instead of the trapezoid;
+  it gets the entry speed and the previous segment's plan, and decides its exit speed.
 * **GT_BufIO** records ``(doType, doMask, doValue)`` in :attr:`CoordSystem.io_log`
   and :attr:`CoordSystem.outputs` (value per doType) when the path reaches it; for
   ``MC_GPO`` it also sets the masked bits of the general-purpose outputs (what
@@ -91,6 +94,10 @@ class Motion:
     vel: float
     acc: float
     vel_end: float
+    #: the segment's own speed plan instead of the trapezoid: called as
+    #: ``speed_plan(geom, entry_speed, previous_plan)`` when the segment starts (the
+    #: pulse-card compat layers: :class:`~.base_pulse.BaseSpeed`)
+    speed_plan: Callable[[Segment, float, Any], Any] | None = field(repr=False, default=None)
 
 
 @dataclass(slots=True)
@@ -196,7 +203,7 @@ class CoordSystem:
         self.fifo = 0
         self.stopping = StopKind.NONE
         self.entry: Entry | None = None
-        self.plan: Trapezoid | None = None
+        self.plan: Any = None  # Trapezoid, or a segment's own speed plan
         self.t = 0.0
         self.s = 0.0
         self.speed = 0.0
@@ -391,6 +398,9 @@ class CoordSystem:
                     self.segments_done[self.fifo] += 1
                     continue
                 self.s = 0.0
+                if e.speed_plan is not None:
+                    self.plan = e.speed_plan(e.geom, self.speed, self.plan)
+                    return
                 self.plan = Trapezoid(
                     e.geom.length,
                     self.speed,
