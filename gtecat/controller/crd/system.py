@@ -142,11 +142,13 @@ class AxisSlot:
         self._pos = pos
         self._vel = 0.0
         self._acc = 0.0
+        self._fresh = False  # a sample the axis has not taken yet (the path's last one)
         self.stopping = StopKind.NONE
 
     @property
     def done(self) -> bool:
-        return not self.crd.running
+        # the cycle the path ends in still sends its end point to the axis
+        return not self.crd.running and not self._fresh
 
     @property
     def pos(self) -> float:
@@ -161,6 +163,7 @@ class AxisSlot:
         return self._acc
 
     def step(self) -> tuple[float, float, float]:
+        self._fresh = False
         return self._pos, self._vel, self._acc  # the system advanced in pre_cycle
 
     def stop(self, dec: float, abrupt: bool = False, origin: Any = None) -> None:
@@ -168,11 +171,13 @@ class AxisSlot:
 
     def hold(self, pos: float) -> None:
         self._pos, self._vel, self._acc = pos, 0.0, 0.0
+        self._fresh = False
         if self.crd.running:
             self.crd.abort()
 
     def sample(self, pos: float, vel: float, acc: float) -> None:
         self._pos, self._vel, self._acc = pos, vel, acc
+        self._fresh = True
         self.stopping = self.crd.stopping
 
 

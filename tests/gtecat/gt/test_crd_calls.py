@@ -263,3 +263,15 @@ def test_helix_and_bufio_on_the_pulse_card():
     assert status() == (0, 2)
     do = c_int32()
     assert gt.GT_GetDo(gt.MC_GPO, byref(do)) == 0 and do.value & 0x0F == 0x05
+
+
+def test_the_axes_are_sent_the_end_point_of_the_path():
+    """The cycle a path ends in still sends its end to the drives (GT_GetAxisPrfPos)."""
+    up()
+    assert gt.GT_LnXY(1, 12_345, -6_789, 20.0, 0.5) == 0
+    run_path()
+    gt.GTE_Wait(2)
+    for axis, want in ((1, 12_345.0), (2, -6_789.0)):
+        p = c_double()
+        assert gt.GT_GetAxisPrfPos(axis, byref(p)) == 0
+        assert p.value == want
