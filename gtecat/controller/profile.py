@@ -5,7 +5,8 @@ time, exactly one motion mode (7.1: "每一个轴在任一时刻只能处在一�
 one planner in :attr:`Profile.planner`.  Any object following
 :class:`gtecat.controller.motion.Planner` (``step/stop/hold/done/pos/vel/acc/stopping``)
 plugs in: Trap and Jog are built here; the PT, Gear and Follow GT wrappers put
-their planners in the same slot with :meth:`Profile.enter`.
+their planners in the same slot with :meth:`Profile.enter`, and so do the pulse-card
+compat layers (:mod:`gtecat.compat`) with the T/S-curve drive planner in ``CARD_DRIVE``.
 
 A mode changes only while the profile stands still (7.1: "在设置或切换运动模式时，要保证
 轴处于规划静止状态"); the new planner starts held at the current position.
@@ -39,6 +40,9 @@ class PrfMode(IntEnum):
     FOLLOW = 4
     INTERPOLATION = 5
     PVT = 6
+    #: not a manual mode: the pulse-card drive of the compat layers (seeds 003/004,
+    #: :mod:`gtecat.controller.motion.scurve`), what GT_GetPrfMode reports for such an axis
+    CARD_DRIVE = 16
 
 
 DEFAULT_TRAP = TrapParams(acc=0.1, dec=0.1, vel_start=0.0, smooth_time=0)

@@ -44,6 +44,8 @@ from ..errors import CommandError, ParameterError
 from ._core import check_range, gt_function, store, store_array, struct_arg
 from .structs import TJogPrm, TTrapPrm
 
+#: GT_Stop mask/option bit of coordinate system 1 (entry 131: bit 12 crd 1, bit 13 crd 2)
+CRD_STOP_BIT = 12
 _MAX_ENCODERS_PER_CALL = 8
 
 
@@ -190,11 +192,23 @@ def GT_Update(ctl: Controller, mask: int) -> int:
 
 @gt_function
 def GT_Stop(ctl: Controller, mask: int, option: int) -> int:
-    """Stop the axes in ``mask``: option bit 0 smooth (decSmoothStop), 1 abrupt (entry 131)."""
+    """Stop the axes and coordinate systems in ``mask`` (entry 131).
+
+    Bits 0-11 are axes 1-12, bits 12 and 13 coordinate systems 1 and 2 (the entry's
+    table); the same ``option`` bit set is an abrupt stop (decAbruptStop, or the
+    system's GT_SetCrdStopDec abrupt deceleration), clear a smooth one.  A stopped
+    system brakes along its path and drops the rest of its FIFO.
+    """
     m = long_arg("mask", mask)
     opt = long_arg("option", option)
-    for r in axes_in_mask(ctl, m & 0xFFF, strict=False):  # bits 12/13: coordinate systems
+    for r in axes_in_mask(ctl, m & 0xFFF, strict=False):
         r.stop(bool(opt >> (r.number - 1) & 1))
+    crds = getattr(ctl, "crd_bank", None)
+    if crds is not None:
+        for n, c in crds.systems.items():
+            bit = CRD_STOP_BIT + n - 1
+            if m >> bit & 1:
+                c.stop(bool(opt >> bit & 1))
     return 0
 
 

@@ -39,6 +39,9 @@ Decisions where the manual is silent:
   limit passed in a cycle starts the path stop from that cycle's sample.
 * **Segments counted** by GT_CrdStatus: every FIFO entry finished since GT_CrdStart
   (lines, arcs, BufIO, BufDelay, BufMove alike).
+* **A segment's own speed plan** (``Motion.speed_plan``, the pulse-card compat layers):
+  the segment runs that plan (base pulses, :mod:`.base_pulse`) instead of the trapezoid;
+  it gets the entry speed and the previous segment's plan, and decides its exit speed.
 * **GT_BufIO** records ``(doType, doMask, doValue)`` in :attr:`CoordSystem.io_log`
   and :attr:`CoordSystem.outputs` (value per doType) when the path reaches it; for
   ``MC_GPO`` it also sets the masked bits of the general-purpose outputs (what
@@ -91,6 +94,10 @@ class Motion:
     vel: float
     acc: float
     vel_end: float
+    #: the segment's own speed plan instead of the trapezoid: called as
+    #: ``speed_plan(geom, entry_speed, previous_plan)`` when the segment starts (the
+    #: pulse-card compat layers: :class:`~.base_pulse.BaseSpeed`)
+    speed_plan: Callable[[Segment, float, Any], Any] | None = field(repr=False, default=None)
 
 
 @dataclass(slots=True)
@@ -135,11 +142,13 @@ class AxisSlot:
         self._pos = pos
         self._vel = 0.0
         self._acc = 0.0
+        self._fresh = False  # a sample the axis has not taken yet (the path's last one)
         self.stopping = StopKind.NONE
 
     @property
     def done(self) -> bool:
-        return not self.crd.running
+        # the cycle the path ends in still sends its end point to the axis
+        return not self.crd.running and not self._fresh
 
     @property
     def pos(self) -> float:
@@ -154,6 +163,7 @@ class AxisSlot:
         return self._acc
 
     def step(self) -> tuple[float, float, float]:
+        self._fresh = False
         return self._pos, self._vel, self._acc  # the system advanced in pre_cycle
 
     def stop(self, dec: float, abrupt: bool = False, origin: Any = None) -> None:
@@ -161,11 +171,13 @@ class AxisSlot:
 
     def hold(self, pos: float) -> None:
         self._pos, self._vel, self._acc = pos, 0.0, 0.0
+        self._fresh = False
         if self.crd.running:
             self.crd.abort()
 
     def sample(self, pos: float, vel: float, acc: float) -> None:
         self._pos, self._vel, self._acc = pos, vel, acc
+        self._fresh = True
         self.stopping = self.crd.stopping
 
 
@@ -196,7 +208,7 @@ class CoordSystem:
         self.fifo = 0
         self.stopping = StopKind.NONE
         self.entry: Entry | None = None
-        self.plan: Trapezoid | None = None
+        self.plan: Any = None  # Trapezoid, or a segment's own speed plan
         self.t = 0.0
         self.s = 0.0
         self.speed = 0.0
@@ -391,6 +403,9 @@ class CoordSystem:
                     self.segments_done[self.fifo] += 1
                     continue
                 self.s = 0.0
+                if e.speed_plan is not None:
+                    self.plan = e.speed_plan(e.geom, self.speed, self.plan)
+                    return
                 self.plan = Trapezoid(
                     e.geom.length,
                     self.speed,

@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Protocol
 
 from .jog import JogParams, JogPlanner
+from .scurve import SCurveParams, SCurvePlanner
 from .stop import STOP_DEC_MAX, StopDecel, StopKind, StopRamp, ramp_through, stop_distance
 from .trap import SMOOTH_TIME_MAX, TrapParams, TrapPlanner, raw_plan
 
@@ -44,6 +45,8 @@ __all__ = [
     "JogParams",
     "JogPlanner",
     "Planner",
+    "SCurveParams",
+    "SCurvePlanner",
     "StopDecel",
     "StopKind",
     "StopRamp",

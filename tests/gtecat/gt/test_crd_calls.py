@@ -172,6 +172,32 @@ def test_stop_of_one_axis_stops_the_system_along_its_path():
         assert not sts.value & MOVING
 
 
+@pytest.mark.parametrize(("option", "dec"), [(0, 0.5), (1 << 12, 5.0)])
+def test_gt_stop_mask_bit_12_stops_coordinate_system_1(option, dec):
+    """Manual entry 131: mask bit 12 is coordinate system 1; the same option bit picks the
+    abrupt deceleration (GT_SetCrdStopDec), clear the smooth one."""
+    up()
+    assert gt.GT_SetCrdStopDec(1, 0.5, 5.0) == 0
+    assert gt.GT_LnXY(1, 40_000, 30_000, 50.0, 1.0) == 0
+    assert gt.GT_CrdStart(1, 0) == 0
+    gt.GTE_Wait(300)  # cruising at 50 pulse/ms
+    assert gt.GT_Stop(1 << 13, 0) == 0  # coordinate system 2 only: this one keeps going
+    gt.GTE_Wait(1)
+    assert status()[0] == 1
+    assert gt.GT_Stop(1 << 12, option) == 0
+    rows = []
+    for _ in range(1000):
+        gt.GTE_Wait(1)
+        rows.append((prf(1), prf(2)))
+        if not status()[0]:
+            break
+    assert status() == (0, 0)  # stopped before the end of its only segment
+    assert len(rows) == pytest.approx(50.0 / dec, abs=2)
+    for x, y in rows:
+        assert abs(x * 30_000 - y * 40_000) / 50_000 < 1e-6
+    assert math.hypot(*rows[-1]) < 50_000
+
+
 def test_errors():
     up()
     assert gt.GT_CrdStart(1, 0) == 1  # empty FIFO
@@ -237,3 +263,15 @@ def test_helix_and_bufio_on_the_pulse_card():
     assert status() == (0, 2)
     do = c_int32()
     assert gt.GT_GetDo(gt.MC_GPO, byref(do)) == 0 and do.value & 0x0F == 0x05
+
+
+def test_the_axes_are_sent_the_end_point_of_the_path():
+    """The cycle a path ends in still sends its end to the drives (GT_GetAxisPrfPos)."""
+    up()
+    assert gt.GT_LnXY(1, 12_345, -6_789, 20.0, 0.5) == 0
+    run_path()
+    gt.GTE_Wait(2)
+    for axis, want in ((1, 12_345.0), (2, -6_789.0)):
+        p = c_double()
+        assert gt.GT_GetAxisPrfPos(axis, byref(p)) == 0
+        assert p.value == want

@@ -1,0 +1,545 @@
+"""What the ADT850 and MCX314 layers share: one pulse card's registers over the controller's axes.
+
+Both seeds describe MCX314-family chips: four step/dir axes X, Y, Z, W/U, each with a
+range R (multiplier ``M = 8000000/R``), initial speed SV, drive speed V, acceleration A,
+deceleration D and jerk parameter K as register values.  A :class:`PulseCard` keeps those
+registers and turns them into controller units (seed 004 3.1-3.6, seed 003 4.4):
+
+    speed PPS = V·M        acceleration PPS/s = A·125·M        jerk PPS/s² = 62.5e6/K·M
+
+(pulse/ms = PPS/1000, pulse/ms² = PPS/s/1e6, pulse/ms³ = PPS/s²/1e9).  Drives run on the
+controller core: a single-axis drive is the profile's :class:`~gtecat.controller.motion.
+scurve.SCurvePlanner` (mode ``CARD_DRIVE``); an interpolation is a segment of coordinate
+system 1 (X-Y, X-Y-Z, X-Y-Z-W) or 2 (Z-W) whose speed is planned in base pulses
+(:mod:`gtecat.controller.crd.base_pulse`).  The card runs on the pulse-card personality
+(``gts:4``, :mod:`gtecat.controller.card`).
+
+Decisions where the seeds are silent:
+
+* **Opening.**  The card is the controller ``GT_Open(card="gts:4", ...)`` opens; if one
+  is open already (a test opened it with its machine and ``clock="lockstep"``), that one
+  is used.  Opening switches the four amplifiers on (the seeds' cards drive from power-up)
+  and turns off what a pulse card does not do: the following-error check, the alarm input
+  (until enabled) and the controller's own soft limits.
+* **Counters.**  The logic position counter (LP) is the axis planned position, the real
+  position counter (EP) the encoder, both plus an offset that ``set_command_pos`` /
+  ``LPS`` (and the EP twins) write at any time, moving nothing.
+* **Inputs** of axis N come from the machine description of axis N: LMT+/LMT- its limit
+  switches, STOP0 (ADT850) / IN0 (MCX314) the home switch, STOP1 / IN1 the encoder
+  index (active in the cycle an index pulse passes), STOP2 / IN2 probe 1, ALARM the
+  amplifier's fault, INPOS the amplifier standing within 1 pulse of the plan.  The
+  seeds' active-level settings are accepted and kept; a switch is active when the machine
+  says so.  Limits stop a drive as the controller's limit check does (immediately: the
+  abrupt deceleration 32767 pulse/ms²; "decelerate" mode: with D).
+* **A stop signal or a COMP register** (soft limit) stops the drive in its own shape:
+  an accelerating drive decelerates to SV, a constant-speed drive stops at once (seed 004
+  1.3); an interpolation brakes along its path with the master axis's D.
+* **Errors.**  ADT850 calls return the seed's codes and never raise; MCX314 calls are
+  ``void`` in the seed: they return None and raise :class:`CompatError` (a
+  ParameterError) naming the seed's range.  :func:`last_error` gives the reason of the
+  last failure of either.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..controller.axis_status import AxisStatus
+from ..controller.crd import bank, make_arc
+from ..controller.crd.base_pulse import BaseSpeed, base_length
+from ..controller.crd.path import CCW, CW, Line, Segment
+from ..controller.crd.system import CoordSystem, CrdParams, Motion
+from ..controller.motion.scurve import SCurveParams, SCurvePlanner, plan_drive
+from ..controller.motion.stop import STOP_DEC_MAX, StopDecel
+from ..controller.profile import PrfMode
+from ..controller.resources import AxisResources, axis_resources
+from ..errors import CommandError, ParameterError
+
+AXES = (1, 2, 3, 4)
+R_BASE = 8_000_000
+LIMIT_NEG, LIMIT_POS, HOME = 0x1, 0x2, 0x4  # 60FDh bits
+#: the abrupt stop of "immediate" limits and sudden stops, pulse/ms² (GT_SetStopDec's maximum)
+IMMEDIATE = STOP_DEC_MAX
+
+
+class CompatError(ParameterError):
+    """A seed function called outside what its seed documents (MCX314 layer: raised)."""
+
+
+_LAST: list[str] = [""]
+
+
+def last_error() -> str:
+    """The reason of the most recent failed compat call ("" when none failed)."""
+    return _LAST[0]
+
+
+def set_last_error(reason: str) -> None:
+    _LAST[0] = reason
+
+
+def out(ptr: Any, value: Any) -> None:
+    """``*ptr = value`` for ctypes ``byref``/``pointer``/instances and one-element lists."""
+    if ptr is None:
+        raise CompatError("a NULL pointer was passed for an output")
+    obj = getattr(ptr, "_obj", None)  # byref(x)
+    if obj is not None:
+        ptr = obj
+    if isinstance(ptr, ctypes._Pointer):
+        ptr = ptr.contents
+    if isinstance(ptr, ctypes._SimpleCData):
+        ptr.value = value
+        return
+    if isinstance(ptr, list):
+        if not ptr:
+            ptr.append(value)
+        else:
+            ptr[0] = value
+        return
+    raise CompatError(f"cannot write an output through {type(ptr).__name__}")
+
+
+def integer(name: str, value: Any, lo: int, hi: int) -> int:
+    """An integer in ``[lo, hi]`` (the seed's range) or CompatError."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        if isinstance(value, float) and math.isfinite(value) and value.is_integer():
+            value = int(value)
+        else:
+            raise CompatError(f"{name}={value!r}: an integer is expected")
+    if not lo <= value <= hi:
+        raise CompatError(f"{name}={value} out of the seed's range {lo}..{hi}")
+    return int(value)
+
+
+def real(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise CompatError(f"{name}={value!r}: a number is expected")
+    x = float(value)
+    if not math.isfinite(x):
+        raise CompatError(f"{name}={value!r}: a finite number is expected")
+    return x
+
+
+@dataclass(slots=True)
+class AxisRegs:
+    """One axis's registers, as the seeds' chips hold them (defaults: decided, see above)."""
+
+    m: float = 1.0  #: multiplier M = 8000000 / R
+    sv: int = 1
+    v: int = 1
+    a: int = 1
+    d: int = 1
+    k: int = 1
+    s_curve: bool = False
+    asym: bool = False  #: decelerate with D (else with A)
+    manual: bool = False  #: manual deceleration at ``dec_pos``
+    dec_pos: int = 0
+    lp_off: float = 0.0
+    ep_off: float = 0.0
+    comp: list[int] = field(default_factory=lambda: [0, 0])  #: COMP+, COMP-
+    soft: list[bool] = field(default_factory=lambda: [False, False])
+    soft_ep: bool = False  #: COMP registers compare with EP (else LP)
+    limit_decel: bool = False
+    stop_on: list[bool] = field(default_factory=lambda: [False, False, False])
+    stop_logic: list[int] = field(default_factory=lambda: [0, 0, 0])
+    settings: dict[str, Any] = field(default_factory=dict)  #: kept, no effect here
+    stopdata: int = 0
+    stopped_by_user: bool = False
+
+    def vel(self, value: float | None = None) -> float:
+        """pulse/ms of a speed register value."""
+        return (self.v if value is None else value) * self.m / 1000.0
+
+    def params(self, triangle: bool = False) -> SCurveParams:
+        """The drive's curve from the registers (seed 004 3.1-3.6)."""
+        acc = self.a * 125.0 * self.m / 1e6
+        dec = (self.d if self.asym else self.a) * 125.0 * self.m / 1e6
+        jerk = 62.5e6 / self.k * self.m / 1e9 if self.s_curve else math.inf
+        return SCurveParams(self.vel(self.sv), self.vel(), acc, dec, jerk, triangle)
+
+
+class PulseCard:
+    """One opened card: the controller, the registers of its four axes, the outputs."""
+
+    def __init__(self, ctl: Any, name: str) -> None:
+        self.ctl = ctl
+        self.name = name
+        self.regs = {n: AxisRegs() for n in AXES}
+        self.outputs = 0
+        self.general_inputs = 0  #: the IN terminals (nothing in the machine drives them)
+        self.cycle_ms = ctl.clock.cycle_ns / 1e6
+        self._index_seen = dict.fromkeys(AXES, False)
+        for n in AXES:
+            r = self.res(n)
+            r.safety.pos_err = 2**31  # an open-loop pulse card has no following-error check
+            r.safety.alarm_on = False
+            r.clear_flags()
+            self._limit_mode(n)
+        ctl.post_cycle.append(self._post)
+
+    # --- access -------------------------------------------------------------------------
+    def res(self, axis: int) -> AxisResources:
+        return axis_resources(self.ctl, axis)
+
+    def tick(self) -> None:
+        """A host call happened (auto clock: it costs virtual time, so polling loops end)."""
+        self.ctl.clock.on_call()
+
+    def wait_cycle(self) -> None:
+        self.ctl.clock.advance_ns(self.ctl.clock.cycle_ns)
+
+    def close(self) -> None:
+        if self._post in self.ctl.post_cycle:
+            self.ctl.post_cycle.remove(self._post)
+
+    # --- counters -----------------------------------------------------------------------
+    def lp(self, axis: int) -> float:
+        return self.res(axis).ax.prf_pos + self.regs[axis].lp_off
+
+    def ep(self, axis: int) -> float:
+        return self.res(axis).enc_pos + self.regs[axis].ep_off
+
+    def set_lp(self, axis: int, value: int) -> None:
+        self.regs[axis].lp_off = value - self.res(axis).ax.prf_pos
+
+    def set_ep(self, axis: int, value: int) -> None:
+        self.regs[axis].ep_off = value - self.res(axis).enc_pos
+
+    def speed(self, axis: int) -> float:
+        """The axis's current speed in V units (PPS / M)."""
+        r = self.res(axis)
+        return abs(r.prf_vel) * 1000.0 / self.regs[axis].m
+
+    def accel(self, axis: int) -> float:
+        """The current acceleration in A units (PPS/s / (125·M))."""
+        r = self.res(axis)
+        return abs(r.prf_acc) * 1e6 / (125.0 * self.regs[axis].m)
+
+    # --- inputs -------------------------------------------------------------------------
+    def din(self, axis: int) -> int:
+        acc = self.res(axis).ax.io.get(0x60FD)
+        return acc.get() if acc is not None else 0
+
+    def limit(self, axis: int, positive: bool) -> bool:
+        return bool(self.din(axis) & (LIMIT_POS if positive else LIMIT_NEG))
+
+    def stop_input(self, axis: int, k: int) -> bool:
+        """STOP0/1/2 (IN0/1/2): home switch, encoder index this cycle, probe 1."""
+        if k == 0:
+            return bool(self.din(axis) & HOME)
+        if k == 1:
+            return self._index_seen[axis]
+        ch = self.ctl.backend.drive(axis).channel(0)
+        return ch.machine.probe_active(1, ch.machine_position)
+
+    def alarm(self, axis: int) -> bool:
+        return self.res(axis).drive_faulted()
+
+    def inpos(self, axis: int) -> bool:
+        r = self.res(axis)
+        return r.profile.planner.done and abs(r.axis_error) <= 1.0
+
+    # --- state --------------------------------------------------------------------------
+    def crd_of(self, axis: int) -> CoordSystem | None:
+        """The running coordinate system that moves ``axis``."""
+        for c in bank(self.ctl).systems.values():
+            if c.running and c.prm is not None and axis in c.prm.axes():
+                return c
+        return None
+
+    def driving(self, axis: int) -> bool:
+        return not self.res(axis).profile.planner.done
+
+    def planner(self, axis: int) -> SCurvePlanner | None:
+        p = self.res(axis).profile.planner
+        return p if isinstance(p, SCurvePlanner) else None
+
+    def phase(self, axis: int) -> tuple[float, float, bool]:
+        """``(acc, jerk, s_curve)`` of the axis's drive now (interpolations: of the path)."""
+        c = self.crd_of(axis)
+        if c is not None:
+            plan = c.plan
+            if c.stopping:
+                return -1.0, 0.0, False
+            if isinstance(plan, BaseSpeed):
+                _, _, a, j = plan.state(c.t)
+                return a, j, any(p[4] != 0.0 for p in plan.profile.pieces)
+            return 0.0, 0.0, False
+        p = self.planner(axis)
+        if p is None:
+            r = self.res(axis)
+            return r.prf_acc, 0.0, False
+        s = p.prm is not None and p.prm.s_curve
+        g = 1.0 if p.vel >= 0 else -1.0
+        return g * p.acc, g * p.jerk, s
+
+    def status_word(self, axis: int) -> int:
+        """ADT850 get_status / the chip's drive bits: 0 when the drive is over (module doc)."""
+        if not self.driving(axis):
+            return 0
+        regs = self.regs[axis]
+        src = self.ep(axis) if regs.soft_ep else self.lp(axis)
+        w = 0
+        if src >= regs.comp[0]:
+            w |= 0x01
+        if src >= regs.comp[1]:
+            w |= 0x02
+        a, j, s = self.phase(axis)
+        eps = 1e-12
+        w |= 0x04 if a > eps else 0x10 if a < -eps else 0x08
+        if s and (a > eps or a < -eps or j != 0.0):
+            mag_grows = (a > eps and j > 0) or (a < -eps and j < 0) or abs(a) <= eps
+            w |= 0x20 if mag_grows and j != 0.0 else 0x40 if j == 0.0 else 0x80
+        return w
+
+    # --- drives -------------------------------------------------------------------------
+    def _limit_mode(self, axis: int) -> None:
+        regs = self.regs[axis]
+        dec = regs.params().dec if regs.limit_decel else IMMEDIATE
+        prof = self.res(axis).profile
+        prof.stop_dec = StopDecel(prof.stop_dec.smooth, min(max(dec, 1e-9), IMMEDIATE))
+
+    def drive(self, axis: int, distance: int | None, direction: int) -> None:
+        """``pmove`` / ``continue_move`` / TCurve_* / SCurve_*: one axis, registers' curve."""
+        if self.crd_of(axis) is not None:
+            raise CommandError(f"axis {axis} moves in an interpolation; stop it first")
+        r = self.res(axis)
+        regs = self.regs[axis]
+        prof = r.profile
+        if prof.mode != PrfMode.CARD_DRIVE:
+            if not prof.planner.done:
+                prof.stop(abrupt=True)
+                raise CommandError(f"axis {axis} moves in another mode; it is being stopped")
+            prof.enter(PrfMode.CARD_DRIVE, factory=lambda: SCurvePlanner(self.cycle_ms))
+        self._check_soft(axis, direction)
+        r.clear_flags()
+        r.check_motion(f"{self.name} drive", float(direction))
+        self._limit_mode(axis)
+        regs.stopdata = 0
+        regs.stopped_by_user = False
+        planner = prof.planner
+        assert isinstance(planner, SCurvePlanner)
+        prm = regs.params(triangle=distance is not None and not regs.s_curve)
+        planner.start(
+            planner.pos,
+            None if distance is None else float(distance),
+            prm,
+            direction,
+            decel="manual" if regs.manual else "auto",
+            manual_dec=float(regs.dec_pos),
+        )
+
+    def _check_soft(self, axis: int, direction: int) -> None:
+        regs = self.regs[axis]
+        src = self.ep(axis) if regs.soft_ep else self.lp(axis)
+        if direction > 0 and regs.soft[0] and src >= regs.comp[0]:
+            raise CommandError(f"axis {axis} is at or past COMP+ ({regs.comp[0]}): only - moves")
+        if direction < 0 and regs.soft[1] and src < regs.comp[1]:
+            raise CommandError(f"axis {axis} is below COMP- ({regs.comp[1]}): only + moves")
+
+    def decel_stop(self, axis: int) -> None:
+        c = self.crd_of(axis)
+        if c is not None:
+            c.stop(False)
+            return
+        p = self.planner(axis)
+        self.regs[axis].stopped_by_user = True
+        if p is not None:
+            p.decelerate()
+        else:
+            self.res(axis).stop(False)
+
+    def sudden_stop(self, axis: int) -> None:
+        c = self.crd_of(axis)
+        if c is not None:
+            c.stop_dec = StopDecel(c.stop_dec.smooth, IMMEDIATE)
+            c.stop(True)
+            return
+        self.regs[axis].stopped_by_user = True
+        p = self.planner(axis)
+        if p is not None and not p.done:
+            p.hold(p.pos)  # the pulses stop at once
+        else:
+            self.res(axis).stop(True)
+
+    def change_speed(self, axis: int) -> None:
+        p = self.planner(axis)
+        if p is not None and not p.done:
+            p.change_speed(self.regs[axis].vel())
+
+    # --- interpolation ------------------------------------------------------------------
+    def system(self, axes: list[int], master: int) -> CoordSystem:
+        """The coordinate system for ``axes`` (1 unless Z-W), configured when needed."""
+        crd = 2 if axes == [3, 4] else 1
+        c = bank(self.ctl).get(crd)
+        same = c.prm is not None and c.prm.axes() == axes
+        slots = c.slots if same else []
+        if same and all(self.res(n).profile.planner is s for n, s in zip(axes, slots, strict=True)):
+            return c
+        if c.running:
+            raise CommandError(f"an interpolation of axes {c.prm.axes()} is running")
+        for other in bank(self.ctl).systems.values():
+            if other is not c and other.running and set(other.prm.axes()) & set(axes):
+                raise CommandError(f"axes {other.prm.axes()} move in another interpolation")
+        prof = [0] * 8
+        for coord, n in enumerate(axes, 1):
+            prof[n - 1] = coord
+            r = self.res(n)
+            if not r.profile.planner.done:
+                raise CommandError(f"axis {n} is driving: interpolation needs it standing")
+            r.clear_flags()
+        prm = CrdParams(len(axes), tuple(prof), 1e9, 1e9)
+        c.configure(prm, {n: self.res(n).profile for n in axes})
+        regs = self.regs[master]
+        c.stop_dec = StopDecel(min(max(regs.params().dec, 1e-9), IMMEDIATE), IMMEDIATE)
+        return c
+
+    def interpolate(
+        self,
+        axes: list[int],
+        master: int,
+        make: Callable[[tuple[float, ...]], Segment],
+        prm: SCurveParams,
+        decel: str,
+        manual_dec: float = 0.0,
+    ) -> CoordSystem:
+        """Push one node (relative geometry from the FIFO's tail) and start if standing."""
+        c = self.system(axes, master)
+        geom = make(c.tail(0))
+
+        def plan(g: Segment, v0: float, prev: Any) -> BaseSpeed:
+            vb = prev.base_v_end if isinstance(prev, BaseSpeed) and v0 > 0.0 else None
+            return BaseSpeed(
+                g, plan_drive(base_length(g), prm, vb, decel=decel, manual_dec=manual_dec)
+            )
+
+        c.push(Motion(geom, 1.0, 1.0, 0.0, speed_plan=plan), 0)
+        if not c.running:
+            t0 = geom.tangent(False) if geom.length else None
+            for coord, n in enumerate(axes):
+                r = self.res(n)
+                r.check_motion(f"{self.name} interpolation", t0[coord] if t0 else 0.0)
+                self.regs[n].stopdata = 0
+                self.regs[n].stopped_by_user = False
+            c.start(0)
+        return c
+
+    @staticmethod
+    def line(delta: tuple[int, ...]) -> Callable[[tuple[float, ...]], Segment]:
+        def make(start: tuple[float, ...]) -> Segment:
+            return Line(start, tuple(a + b for a, b in zip(start, delta, strict=True)))
+
+        return make
+
+    @staticmethod
+    def arc(end: tuple[int, int], center: tuple[int, int], ccw: bool) -> Callable:
+        """An arc (end and centre relative to the start); an end off the circle ends on the
+        circle at the end's angle (the chips end an arc on their circle, seed 004 5.2),
+        rounded to whole pulses."""
+
+        def make(start: tuple[float, ...]) -> Segment:
+            cx, cy = start[0] + center[0], start[1] + center[1]
+            r = math.hypot(center[0], center[1])
+            if r == 0.0:
+                raise CompatError("the arc's centre lies on its start point (radius 0)")
+            ex, ey = start[0] + end[0], start[1] + end[1]
+            if (end[0], end[1]) != (0, 0):
+                d = math.hypot(ex - cx, ey - cy)
+                if d == 0.0:
+                    raise CompatError("the arc's end lies on its centre")
+                if abs(d - r) > 0.5:
+                    ex = round(cx + (ex - cx) * r / d)
+                    ey = round(cy + (ey - cy) * r / d)
+            return make_arc(start, (ex, ey), (cx, cy), (0, 1), CCW if ccw else CW)
+
+        return make
+
+    # --- the cycle: stop signals, COMP registers, why a drive stopped --------------------
+    def _post(self, t_ns: int, dt_ns: int) -> None:
+        edges = getattr(self.ctl.backend, "edges", {})
+        for n in AXES:
+            self._index_seen[n] = any(e.signal == "index" for e in edges.get(n, ()))
+            if not self.driving(n):
+                continue
+            regs = self.regs[n]
+            r = self.res(n)
+            v = r.prf_vel
+            bits = 0
+            for k in range(3):
+                if regs.stop_on[k] and self.stop_input(n, k):
+                    bits |= 1 << k
+            if v > 0 and self.limit(n, True):
+                bits |= 0x08
+            if v < 0 and self.limit(n, False):
+                bits |= 0x10
+            if r.latched & AxisStatus.ALARM:
+                bits |= 0x20
+            src = self.ep(n) if regs.soft_ep else self.lp(n)
+            if regs.soft[0] and v > 0 and src >= regs.comp[0]:
+                bits |= 0x40
+            if regs.soft[1] and v < 0 and src < regs.comp[1]:
+                bits |= 0x80
+            if not bits:
+                continue
+            regs.stopdata |= bits
+            if bits & (0x07 | 0xC0):
+                self._signal_stop(n)
+
+    def _signal_stop(self, axis: int) -> None:
+        c = self.crd_of(axis)
+        if c is not None:
+            c.stop(False)
+            return
+        p = self.planner(axis)
+        if p is None or p.done:
+            return
+        if p.prm is not None and p.prm.constant:
+            p.hold(p.pos)
+        else:
+            p.decelerate()
+
+
+def open_card(name: str, **options: Any) -> PulseCard:
+    """The controller's card (module docstring, "Opening"); raises what GT_Open reports."""
+    from ..gt import (
+        _core,
+        bus_calls,  # noqa: F401  (registers GT_Open)
+    )
+
+    ctl = _core.SESSION.controllers.get(1)
+    if ctl is None:
+        options.setdefault("card", "gts:4")
+        options.setdefault("log", "")
+        rc = _core.REGISTRY["GT_Open"](**options)
+        if rc != 0:
+            why = _core.last_error()
+            raise CommandError(f"GT_Open returned {rc}: {why.reason if why else ''}")
+        ctl = _core.SESSION.controller(1)
+    if ctl.card is None:
+        raise CommandError("the open controller is an EtherCAT master, not a pulse card")
+    if len(ctl.axes) < 4:
+        raise CommandError(f"{name} needs a 4-axis card; the open card has {len(ctl.axes)}")
+    for n in AXES:
+        if not ctl.axes[n].servo_on:
+            rc = _core.REGISTRY["GT_AxisOn"](n)
+            if rc != 0:
+                why = _core.last_error()
+                raise CommandError(
+                    f"axis {n}: GT_AxisOn returned {rc}: {why.reason if why else ''}"
+                )
+    return PulseCard(ctl, name)
+
+
+__all__ = [
+    "AXES",
+    "AxisRegs",
+    "CompatError",
+    "PulseCard",
+    "last_error",
+    "open_card",
+    "out",
+]

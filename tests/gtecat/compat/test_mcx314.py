@@ -1,0 +1,254 @@
+"""The MCX314 library (gtecat.compat.mcx314) against seed 003's chapter 4.
+
+Sections cited are seed 003's (/work/shared/seeds/003_c64bf74c371d1d19.txt): 4.3 initial
+settings, 4.4 the speed formulas and T/S drives, 4.5 interpolation, 4.7 homing, 4.8 the
+position registers.  Everything goes through the compat API; time passes with GTE_Wait.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from gtecat import gt
+from gtecat.compat import CompatError
+from gtecat.compat import mcx314 as m
+
+from .conftest import open_card
+
+X, Y, Z, U = 1, 2, 4, 8
+
+
+def lp(axis: int) -> int:
+    v = m.ReadLPS(axis)
+    return v - 2**32 if v >= 2**31 else v
+
+
+def busy(axis: int) -> bool:
+    return m.card().status_word({1: 1, 2: 2, 4: 3, 8: 4}[axis]) != 0
+
+
+def crd_busy(no: int = 1) -> bool:
+    from gtecat.controller.crd import bank
+
+    return bank(m.card().ctl).get(no).running
+
+
+def wait(pred, limit: int = 200_000) -> int:
+    for k in range(limit):
+        if not pred():
+            return k
+        gt.GTE_Wait(1)
+    raise AssertionError("never ended")
+
+
+def up(**machine) -> None:
+    open_card(**machine)
+    m.Open()
+    m.SetRange(800_000)  # M = 10 on every axis
+
+
+def test_speed_formulas_of_4_4():
+    """4.4: M = 8000000/R; acceleration A·125·M; jerk 62500000/K·M; SV·M; V·M."""
+    up()
+    card = m.card()
+    m.SetSV(X, 100)
+    m.SetV(X, 2000)
+    m.SetA(X, 80)
+    m.SetAA(X, 625)
+    card.regs[1].s_curve = True
+    prm = card.regs[1].params()
+    assert prm.vel_start * 1000 == pytest.approx(100 * 10)
+    assert prm.vel * 1000 == pytest.approx(2000 * 10)
+    assert prm.acc * 1e6 == pytest.approx(80 * 125 * 10)
+    assert prm.jerk * 1e9 == pytest.approx(62_500_000 / 625 * 10)
+    m.SetMultiple(Y | Z, 500)
+    assert card.regs[2].m == card.regs[3].m == 500 and card.regs[4].m == 10
+    m.SetMaxSpeed(4_000_000)
+    assert card.regs[1].m == 500
+
+
+def test_tcurve_f_and_scurve_f_end_exactly_in_closed_form_time():
+    """4.4 TCurve_F / SCurve_F: fixed drives; the chip computes the ramps, the pulses end."""
+    up()
+    m.TCurve_F(X, 100, 2000, 100, 30_000)
+    k = wait(lambda: busy(X))
+    sv, v, a = 1.0, 20.0, 100 * 125 * 10 / 1e6
+    t = 2 * (v - sv) / a + (30_000 - (sv + v) * (v - sv) / a) / v
+    assert k == pytest.approx(math.ceil(t), abs=1) and lp(X) == 30_000
+    m.SCurve_F(Y, 100, 2000, 100, 0, 200, -30_000)
+    k2 = wait(lambda: busy(Y))
+    jerk = 62_500_000 / 200 * 10 / 1e9
+    t_ramp = (v - sv) / a + a / jerk
+    t2 = 2 * t_ramp + (30_000 - (sv + v) * t_ramp) / v
+    assert k2 == pytest.approx(math.ceil(t2), abs=1) and lp(Y) == -30_000
+
+
+def test_continuous_drives_and_readings():
+    up()
+    m.TCurve_C(X | Y, 100, 1000, 50)
+    gt.GTE_Wait(1000)
+    assert m.ReadCV(X) == 1000 and m.ReadCV(Y) == 1000
+    m.DecStop(X)
+    gt.GTE_Wait(1)
+    assert m.ReadCA(X) == 50
+    m.SuddenStop(Y)
+    wait(lambda: busy(X) or busy(Y))
+    assert m.ReadCV(X) == 0
+
+
+def test_line2d_c_on_the_line_long_axis_speed():
+    """4.5.1: a 2-axis line at constant speed; the end points from SetP."""
+    up()
+    m.SetP(X, 4000)
+    m.SetP(Y, 1000)
+    ld = m.LINEDATA(SV=1000, V=1000)
+    m.Line2D_C(ld, 0x3)
+    pts = []
+    while crd_busy():
+        gt.GTE_Wait(1)
+        pts.append((lp(X), lp(Y)))
+    for x, y in pts:
+        assert abs(x * 1000 - y * 4000) / math.hypot(4000, 1000) <= 0.75
+    assert pts[-1] == (4000, 1000)
+    assert len(pts) == pytest.approx(4000 / 10, abs=1)
+
+
+def test_line3d_s_and_line2d_t():
+    up()
+    for axis, d in ((X, 3000), (Y, -3000), (Z, 6000)):
+        m.SetP(axis, d)
+    m.Line3D_S(m.LINEDATA(SV=100, V=2000, A=100, K=500), 0x7)
+    wait(crd_busy)
+    assert (lp(X), lp(Y), lp(Z)) == (3000, -3000, 6000)
+    m.SetP(Z | U, 2000)
+    m.Line2D_T(m.LINEDATA(SV=100, V=2000, A=100), 0xC)
+    wait(lambda: crd_busy(2))
+    assert (lp(Z), lp(U)) == (8000, 2000)
+    with pytest.raises(CompatError):
+        m.Line2D_C(m.LINEDATA(SV=1, V=1), 0x7)  # not a pair
+
+
+def test_circles_cw_ccw_and_t_needs_manual_dec():
+    """4.5.2: the centre (SetC) and end (SetP) relative to the start; CircleCW_T needs
+    ManualDec (4.4 note on AutoDec)."""
+    up()
+    m.SetC(X, 2000)
+    m.SetC(Y, 0)
+    m.SetP(X | Y, 0)  # end on the start: a full circle
+    m.CircleCCW_C(m.CIRCLEDATA(SV=500, V=500), 0x3)
+    pts = []
+    while crd_busy():
+        gt.GTE_Wait(1)
+        pts.append((lp(X), lp(Y)))
+    assert all(abs(math.hypot(x - 2000, y) - 2000) <= 1.0 for x, y in pts)
+    assert pts[len(pts) // 4][1] < 0  # counter-clockwise from (0,0) around (2000,0): y < 0 first
+    assert pts[-1] == (0, 0)
+    with pytest.raises(CompatError, match="ManualDec"):
+        m.CircleCW_T(m.CIRCLEDATA(SV=100, V=1000, A=100), 0x3)
+    m.ManualDec(X, 4000)
+    m.CircleCW_T(m.CIRCLEDATA(SV=100, V=1000, A=100), 0x3)
+    wait(crd_busy)
+    assert (lp(X), lp(Y)) == (0, 0)
+
+
+def test_bit_pattern_steps():
+    up()
+    m.BitPattern(X | Y, 1000, [[0x00FF], [0x0F0F]], [[0xFF00], [0x0000]])
+    wait(crd_busy)
+    assert (lp(X), lp(Y)) == (0, 8)
+
+
+def test_registers_of_4_8_unsigned_and_any_time():
+    up()
+    m.LPS(X, -5)
+    assert m.ReadLPS(X) == 2**32 - 5
+    m.EPS(X, 0xFFFFFFFF)
+    assert m.ReadEPS(X) == 0xFFFFFFFF
+    m.TCurve_C(X, 1000, 1000, 1)
+    gt.GTE_Wait(10)
+    m.LPS(X, 0)  # while driving: nothing jumps, the counter restarts
+    gt.GTE_Wait(10)
+    assert 0 < lp(X) <= 101
+    m.RESET()
+    gt.GTE_Wait(1)
+    assert not busy(X)
+
+
+def test_soft_limits_slmtp_setcompp():
+    up()
+    m.SetCompP(X, 5000)
+    m.SLMTP(1)
+    m.TCurve_C(X, 100, 1000, 100)
+    wait(lambda: busy(X))
+    assert 5000 <= lp(X) <= 6000
+    assert m.card().regs[1].stopdata & 0x40
+
+
+def test_home_type_1_and_2_find_the_switch():
+    """4.7: type 1 decelerates at ORG; type 2 backs off and approaches slowly."""
+    up(a1=dict(position=20_000, home_switch=((5000, 8000),)))
+    m.LPS(X, 20_000)
+    m.HomeType1(0x2 | 0x100, 100, 1000, 100)  # IN0 (home switch), axis X, negative
+    assert 3000 < lp(X) < 8000
+    m.HomeType2(0x2 | 0x100, 100, 1000, 100)
+    assert lp(X) in range(7990, 8001)  # the switch's upper edge, approached slowly
+    with pytest.raises(CompatError):
+        m.HomeType1(0x100, 100, 1000, 100)  # no input enabled
+
+
+def test_home_type_3_stops_on_the_index():
+    up(a1=dict(position=20_000, home_switch=((5000, 8000),), index_offset=100,
+               counts_per_rev=1000))  # fmt: skip
+    m.LPS(X, 20_000)
+    m.HomeType3(0x2 | 0x100, 100, 1000, 100)
+    ep = m.ReadEPS(X)
+    assert (ep - 100) % 1000 in range(0, 12) or (ep - 100) % 1000 > 988
+
+
+_ANY = st.one_of(st.integers(-(2**40), 2**40), st.floats(allow_nan=True), st.none(),
+                 st.text(max_size=2))  # fmt: skip
+
+
+@settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    name=st.sampled_from(["SetSV", "SetV", "SetA", "SetD", "SetAA", "SetMultiple", "SetP",
+                          "SetC", "LPS", "SetCompP", "ManualDec", "Pulse", "SetAO"]),
+    axis=st.one_of(st.integers(-1, 16), _ANY),
+    data=_ANY,
+)  # fmt: skip
+def test_property_bad_arguments_raise_compat_error_only(name, axis, data):
+    if m.card() is None:
+        up()
+    try:
+        getattr(m, name)(axis, data)
+    except CompatError as e:
+        assert str(e)
+        assert m.last_error()
+    else:
+        assert isinstance(axis, int) and 1 <= axis <= 15
+
+
+def test_scenario_drives_then_interpolation():
+    """Four axes by TCurve_F, then an X-Y line by Line2D_T, read by ReadLPS/ReadEPS."""
+    up()
+    for axis, p in ((X, 12_000), (Y, -6000), (Z, 3000), (U, 9000)):
+        m.TCurve_F(axis, 100, 2000, 100, p)
+    gt.GTE_Wait(50)
+    assert all(busy(a) for a in (X, Y, Z, U))
+    wait(lambda: any(busy(a) for a in (X, Y, Z, U)))
+    assert [lp(a) for a in (X, Y, Z, U)] == [12_000, -6000, 3000, 9000]
+    gt.GTE_Wait(20)
+    assert abs(m.ReadEPS(X) - 12_000) <= 1
+    m.AutoDec()
+    m.SetP(X, -12_000)
+    m.SetP(Y, 6000)
+    m.Line2D_T(m.LINEDATA(SV=100, V=2000, A=100), 0x3)
+    wait(crd_busy)
+    assert (lp(X), lp(Y)) == (0, 0)
+    m.Close()
