@@ -38,6 +38,7 @@ status cycle by cycle).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -50,6 +51,9 @@ from eni.datatypes import CHANNEL_STRIDE
 from eni.model import Direction
 
 from .axis_status import AxisStatus
+from .motion.jog import _IDLE as _JOG_IDLE
+from .motion.jog import _MOVE as _JOG_MOVE
+from .motion.jog import JogPlanner
 from .motion.stop import StopKind
 from .motion.trap import _IDLE, _MOVE, TrapPlanner
 from .motion.trap_table import advance, trap_table
@@ -299,7 +303,11 @@ class AxisBank:
         self.arrived = zi(n, bool)
         self.prf_p, self.prf_v, self.prf_a = z(n), z(n), z(n)
         self.a_last = z(n)
-        self.moving = zi(n, bool)
+        self.moving = zi(n, bool)  # a Trap move runs (its samples come from the table)
+        self.jog = zi(n, bool)  # a Jog cruises (computed every cycle)
+        self.jrp, self.jrv = z(n), z(n)  # the raw ramp's position and speed
+        self.jp, self.jv, self.ja = z(n), z(n), z(n)  # the filter output (the planned values)
+        self.tau, self.jE = z(n), z(n)  # smoothing time constant, e^(-T/tau)
         self.taken = zi(n, np.int64)  # samples taken since the claim
         self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
         self.ended = zi(n, bool)
@@ -322,6 +330,7 @@ class AxisBank:
         self.all_external = bool(self.external.all())
         self.any_sense = bool(np.count_nonzero(self.sense != 1))
         self.any_band = bool(np.count_nonzero(self.band > 0))
+        self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.band_dirty = True
         plc = [p for p in self._plc if alive[p[0]]]
         names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
@@ -380,11 +389,19 @@ class AxisBank:
             return False
         prof = res.profile
         pl = prof.planner
-        if not prof.active or prof.mode != PrfMode.TRAP or pl is not prof.trap:
+        if not prof.active or pl.stopping != StopKind.NONE:
             return False
-        if not isinstance(pl, TrapPlanner) or pl.stopping != StopKind.NONE:
-            return False
-        if pl._mode not in (_IDLE, _MOVE):
+        if prof.mode == PrfMode.TRAP and pl is prof.trap and isinstance(pl, TrapPlanner):
+            if pl._mode not in (_IDLE, _MOVE):
+                return False
+        elif prof.mode == PrfMode.JOG and pl is prof.jog and isinstance(pl, JogPlanner):
+            if pl._mode == _JOG_MOVE:
+                # cruising (the raw ramp at its speed): the ramps themselves stay scalar
+                if pl._raw_v != pl._goal or pl._goal == 0.0 or pl._T != self.T:
+                    return False
+            elif pl._mode != _JOG_IDLE:
+                return False
+        else:
             return False
         enc = res.encoder
         if not (enc._primed and enc.active):
@@ -481,10 +498,18 @@ class AxisBank:
         self.arrived[r] = b.arrived
         pl = res.profile.planner
         self.a_last[r] = ax.prf_pos
-        moving = pl._mode == _MOVE
+        jog = isinstance(pl, JogPlanner) and pl._mode == _JOG_MOVE
+        self.jog[r] = jog
+        if jog:
+            self.jrp[r], self.jrv[r] = pl._raw_p, pl._raw_v
+            self.jp[r], self.jv[r], self.ja[r] = pl._pos, pl._vel, pl._acc
+            tau = pl._tau
+            self.tau[r] = tau
+            self.jE[r] = math.exp(-pl._T / tau) if tau > 0.0 else 0.0
+        moving = isinstance(pl, TrapPlanner) and pl._mode == _MOVE
         self.moving[r] = moving
         self.taken[r] = 0
-        self.k0[r] = pl._k
+        self.k0[r] = pl._k if moving else 0
         self.ended[r] = False
         self.t_cur[r] = 0
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
@@ -558,8 +583,13 @@ class AxisBank:
         b._since = None if since < 0 else since
         b.arrived = bool(self.arrived[r])
         pl = res.profile.planner
+        if self.jog[r]:
+            pl._raw_p, pl._raw_v = float(self.jrp[r]), float(self.jrv[r])
+            pl._pos, pl._vel, pl._acc = float(self.jp[r]), float(self.jv[r]), float(self.ja[r])
+            self.jog[r] = False
+            return
         last = (float(self.prf_p[r]), float(self.prf_v[r]), float(self.prf_a[r]))
-        if pl._mode == _MOVE:
+        if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
             advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
 
     # --- the GT boundary ------------------------------------------------------------------------
@@ -588,12 +618,13 @@ class AxisBank:
 
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
-            sts = np.where(self.moving, _MOVING, np.where(self.arrived, _ARRIVED, 0))
+            run = self.moving | self.jog
+            sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | _SERVO_ON).tolist()
         if name == "axis_enc":
             return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
         if name == "moving":
-            return self.moving.tolist()
+            return (self.moving | self.jog).tolist()
         if name in ("prf_p", "prf_v", "prf_a"):
             self._materialise()
         return getattr(self, name).tolist()
@@ -633,6 +664,9 @@ class AxisBank:
         idx = self.base + cur
         prf_p = self.t_p.take(idx)
         ended = cur == self.t_end
+        if self.n_jog:
+            jog = self._jog_step()
+            prf_p = np.where(self.jog, jog[2], prf_p)
         a = self._link(prf_p, self.prf_ratio, self.prf_off) if self.any_prf_link else prf_p
         # 3. 607Ah (Axis.pulses_to_counts, int32 like the PDO entry) and the drives
         counts = np.rint(a * self.unit2 if self.any_scale else a).astype(np.int64)
@@ -664,7 +698,7 @@ class AxisBank:
         if events is not None:
             hit |= events
         # 6. the in-position band (bit 11)
-        standing = (ended | ~moving) if self.any_band else None
+        standing = ((ended | ~moving) & ~self.jog) if self.any_band else None
         if self.any_band and (self.band_dirty or np.count_nonzero(standing & (self.band > 0))):
             # (moving rows keep since = -1, arrived = False: nothing to do while all move)
             self.band_dirty = False
@@ -685,6 +719,12 @@ class AxisBank:
             self._reindex()
             if not self.n_alive:
                 return
+        if self.n_jog:
+            k = self.jog & self.alive
+            for arr, value in zip(
+                (self.jrp, self.jrv, self.jp, self.jv, self.ja), jog, strict=True
+            ):
+                arr[k] = value[k]
         fin = ended & moving
         any_fin = bool(np.count_nonzero(fin))
         if self.n_alive == self.n:
@@ -728,12 +768,35 @@ class AxisBank:
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
 
+    def _jog_step(self) -> tuple[np.ndarray, ...]:
+        """One cycle of every cruising Jog: :func:`~gtecat.controller.motion.jog.advance` with
+        the raw speed at its goal (a = 0, one piece of length T), then ``JogPlanner.step``'s
+        snap onto the goal; the same operations with the same zero constants, for the same
+        bits (``-0.0`` included)."""
+        h = self.T
+        rp, v, fp, fv, fa = self.jrp, self.jrv, self.jp, self.jv, self.ja
+        p1 = rp + h * (v + 0.5 * 0.0 * h)
+        v1 = v + 0.0 * h
+        tau, e = self.tau, self.jE
+        smooth = tau > 0.0
+        nfp = np.where(smooth, p1 - tau * (v1 - 0.0) + (fp - rp + tau * (v - 0.0)) * e, p1)
+        nfv = np.where(smooth, v1 - 0.0 + (fv - v + 0.0) * e, v1)
+        nfa = np.where(smooth, 0.0 + (fa - 0.0) * e, 0.0)
+        goal = v1
+        snap = (nfv != goal) & (np.abs(nfv - goal) <= 1e-9 * (1.0 + np.abs(goal)))
+        nfv = np.where(snap, goal, nfv)
+        nfa = np.where(snap, 0.0, nfa)
+        return p1, v1, nfp, nfv, nfa
+
     def _materialise(self) -> None:
         """The planned speed and acceleration of the last samples (kept as table indices)."""
         idx = self.t_idx
         self.prf_v = self.t_v.take(idx)
         self.prf_a = self.t_a.take(idx)
         self.prf_p = self.t_p.take(idx)
+        if self.n_jog:
+            j = self.jog
+            self.prf_p[j], self.prf_v[j], self.prf_a[j] = self.jp[j], self.jv[j], self.ja[j]
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

@@ -100,6 +100,16 @@ def _act(action: tuple) -> int:
         gt.GT_SetPos(axis, target)
         gt.GT_SetVel(axis, vel)
         return gt.GT_Update(1 << (axis - 1))
+    if kind == "jog":
+        _, axis, vel, acc, dec, smooth = action
+        gt.GT_PrfJog(axis)
+        prm = gt.TJogPrm()
+        prm.acc, prm.dec, prm.smooth = acc, dec, smooth
+        gt.GT_SetJogPrm(axis, byref(prm))
+        gt.GT_SetVel(axis, vel)
+        return gt.GT_Update(1 << (axis - 1))
+    if kind == "trap":
+        return gt.GT_PrfTrap(action[1])
     if kind == "retarget":
         _, axis, target, vel = action
         gt.GT_SetPos(axis, target)
@@ -161,10 +171,20 @@ move = st.tuples(
     st.sampled_from([0.0, 0.0, 1.0, 3.0]),
     st.sampled_from([0, 0, 5, 25, 50]),
 )
+jog = st.tuples(
+    st.just("jog"),
+    axis,
+    st.floats(-40.0, 40.0),
+    st.floats(0.05, 5.0),
+    st.floats(0.0, 5.0),
+    st.sampled_from([0.0, 0.0, 0.5, 0.9]),
+)
 action = st.one_of(
     move,
     move,
     move,
+    jog,
+    st.tuples(st.just("trap"), axis),
     st.tuples(st.just("retarget"), axis, st.integers(-80_000, 80_000), st.floats(0.5, 80.0)),
     st.tuples(st.just("stop"), st.integers(1, (1 << AXES) - 1), st.integers(0, (1 << AXES) - 1)),
     st.tuples(st.just("soft"), axis, st.integers(0, 60_000), st.integers(-60_000, -1)),
@@ -205,6 +225,19 @@ def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     ref, _, _ = _run(actions, machine, "off")
     got, _, rows = _run(actions, machine, "on")
     assert rows > 12 * 300  # most axis-cycles ran in the bank
+    assert got == ref
+
+
+def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:
+    machine = _machine_file(tmp_path)
+    jogs = [
+        (0, ("jog", a, (-1) ** a * (3.0 + a), 0.2, 0.3, (0.0, 0.5, 0.9)[a % 3])) for a in (1, 3, 4)
+    ]
+    actions = [*jogs, (300, ("jog", 3, -2.0, 0.2, 0.3, 0.5)), (200, ("stop", 0b1101, 0))]
+    actions.append((100, ("clear",)))
+    ref, _, _ = _run(actions, machine, "off")
+    got, _, rows = _run(actions, machine, "on")
+    assert rows > 3 * 300
     assert got == ref
 
 
