@@ -101,7 +101,7 @@ class CspBank:
         self.windows: list[tuple[int, np.ndarray, np.ndarray]] = []
         self._dt = 0.0
         self.e, self.c = f(n), f(n)
-        self.lim, self.nlim = f(n), f(n)
+        self.lim, self.nlim, self.half_lim = f(n), f(n), f(n)
         self.fe_running = self.fe_next = False  # some row's following-error timer runs
         for r, ch in enumerate(self.channels):
             self.load(r)
@@ -164,6 +164,7 @@ class CspBank:
         self.c[r] = (1.0 - kff) * (1.0 - e) / kp
         self.lim[r] = self.amax[r] * dt
         self.nlim[r] = -self.lim[r]
+        self.half_lim[r] = 0.5 * self.lim[r]
 
     def _flags(self) -> None:
         """Which optional parts of the cycle any row needs (skipped when none does)."""
@@ -208,10 +209,11 @@ class CspBank:
         lim = self.lim
         dist = demand - p
         # the closing-speed cap: vstop >= min(|dist|/dt, lim) (m = 0: vstop = |dist|/dt;
-        # m >= 1: vstop >= m*lim), so rows within that of vff cannot be capped
+        # m >= 1: vstop >= m*lim), so rows within half of that of vff cannot be capped
+        # (the half keeps the shortcut clear of every rounding at the boundary)
         gap = v - vff
         adist = np.abs(dist)
-        if np.count_nonzero(np.abs(gap) > np.minimum(adist / dt, lim)):
+        if np.count_nonzero(np.abs(gap) > np.minimum(adist * (0.5 / dt), self.half_lim)):
             vstop = closing_speed(adist, lim, dt)
             hi = vff + vstop
             c1 = (dist > 0.0) & (v > hi)

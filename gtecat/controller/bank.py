@@ -297,7 +297,10 @@ class AxisBank:
         self.external = zi(n, bool)
         self.sense = zi(n, np.int64)
         self.enc_prev = zi(n, np.int64)
-        self.enc_pos, self.enc_vel, self.enc_acc = z(n), z(n), z(n)
+        self.enc_pos, self.enc_vel, self.enc_acc = z(n), z(n), z(n)  # vel/acc: at the claim
+        self.enc_step0, self.enc_step1 = z(n), z(n)  # the last two encoder steps, pulse
+        self.claim_cycle = zi(n, np.int64)
+        self.bank_cycles = 0
         self.band, self.hold_ns = z(n), zi(n, np.int64)
         self.since = zi(n, np.int64)
         self.arrived = zi(n, bool)
@@ -492,6 +495,7 @@ class AxisBank:
         self.sense[r] = enc.sense
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
+        self.claim_cycle[r] = self.bank_cycles
         b = res.band
         self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.since[r] = -1 if b._since is None else b._since
@@ -551,6 +555,7 @@ class AxisBank:
         """Write the rows' committed state back into their objects; they leave the bank."""
         rows = [r for g in groups for r in g.rows]
         self._materialise()
+        self._rates = self._enc_rates()
         for g in groups:
             for obj in self._guarded_objects(g):
                 _OWNER.pop(id(obj), None)
@@ -571,12 +576,13 @@ class AxisBank:
         ax.prf_pos = a
         res._a_last = a
         enc = res.encoder
+        vel, acc = self._rates
         prev = int(self.enc_prev[r])
         enc._prev = ((prev + _HALF) & 0xFFFFFFFF) - _HALF  # the 32-bit value the object holds
         enc.pos, enc.vel, enc.acc = (
             float(self.enc_pos[r]),
-            float(self.enc_vel[r]),
-            float(self.enc_acc[r]),
+            float(vel[r]),
+            float(acc[r]),
         )
         b = res.band
         since = int(self.since[r])
@@ -621,6 +627,9 @@ class AxisBank:
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | _SERVO_ON).tolist()
+        if name in ("enc_vel", "enc_acc"):
+            vel, acc = self._enc_rates()
+            return (vel if name == "enc_vel" else acc).tolist()
         if name == "axis_enc":
             return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
         if name == "moving":
@@ -682,8 +691,8 @@ class AxisBank:
         d = (raw - self.enc_prev).astype(np.int32)
         step = (self.sense * d if self.any_sense else d) * self.unit
         enc_pos = self.enc_pos + step
-        enc_vel = step / self.T
-        enc_acc = (enc_vel - self.enc_vel) / self.T
+        # speed and acceleration are step/T and its difference: kept as the last two steps
+        # and divided out when read (_enc_rates), the same operations Encoder.sample does
         # 5. limit switches (the controller latches them, the drive reacts), soft limits
         # and the following error: each latches a flag, so the row leaves before this cycle
         enc_axis = (
@@ -730,7 +739,8 @@ class AxisBank:
         if self.n_alive == self.n:
             csp.commit(state, din, None)
             self.a_last, self.t_idx = a, idx
-            self.enc_prev, self.enc_pos, self.enc_vel, self.enc_acc = raw, enc_pos, enc_vel, enc_acc
+            self.enc_prev, self.enc_pos = raw, enc_pos
+            self.enc_step0, self.enc_step1 = self.enc_step1, step
             self.since, self.arrived = since, arrived
             self.taken += moving
             if any_fin:
@@ -748,12 +758,13 @@ class AxisBank:
                 ("t_idx", idx),
                 ("enc_prev", raw),
                 ("enc_pos", enc_pos),
-                ("enc_vel", enc_vel),
-                ("enc_acc", enc_acc),
                 ("since", since),
                 ("arrived", arrived),
             ):
                 getattr(self, name)[keep] = value[keep]
+            s0 = self.enc_step1.copy()
+            self.enc_step0[keep] = s0[keep]
+            self.enc_step1[keep] = step[keep]
             mk = moving & keep
             self.taken += mk
             self.ended |= fin & keep
@@ -761,12 +772,24 @@ class AxisBank:
             moving &= ~(fin & keep)
             self.n_moving = int(np.count_nonzero(moving))
         self.rows_run += self.n_alive
+        self.bank_cycles += 1
         # 8. the image: 607Ah out, the drives' TxPDO in, in one scatter
         cols = [target, pa, din]
         for name in self._extra:
             cols.append(csp.output(name, state))
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
+
+    def _enc_rates(self) -> tuple[np.ndarray, np.ndarray]:
+        """Encoder speed and acceleration of every row (Encoder.sample: v = step/T,
+        a = (v - v_before)/T), from the last two steps or the values at the claim."""
+        t = self.T
+        cnt = self.bank_cycles - self.claim_cycle
+        v1 = self.enc_step1 / t
+        v0 = np.where(cnt >= 2, self.enc_step0 / t, self.enc_vel)
+        vel = np.where(cnt >= 1, v1, self.enc_vel)
+        acc = np.where(cnt >= 1, (v1 - v0) / t, self.enc_acc)
+        return vel, acc
 
     def _jog_step(self) -> tuple[np.ndarray, ...]:
         """One cycle of every cruising Jog: :func:`~gtecat.controller.motion.jog.advance` with
