@@ -81,7 +81,8 @@ class CspBank:
         self.dpos, self.dvel, self.fe_time = f(n), f(n), f(n)
         self.limited = np.zeros(n, bool)
         self.sw_limited = np.zeros(n, bool)
-        self.steps = np.zeros(n, np.int64)  # cycles run since load (added to ch.cycle)
+        self.cycles = 0  # cycles stepped; a row has stepped cycles - start[r] since its load
+        self.start = np.zeros(n, np.int64)
         self.din = np.zeros(n, np.int64)  # 60FDh of the last cycle
         self.target = np.zeros(n, np.int64)  # 607Ah of the last cycle
         # constants
@@ -128,7 +129,7 @@ class CspBank:
         m = ch.mech
         self.din[r] = ch.digital_inputs
         self.target[r] = ch.target_position
-        self.steps[r] = 0
+        self.start[r] = self.cycles
         self.pos[r], self.vel[r], self.acc[r], self.torque[r] = m.pos, m.vel, m.acc, m.torque
         self.dpos[r], self.dvel[r] = ch.dpos, ch.dvel
         self.fe_time[r] = ch.fe_time
@@ -230,7 +231,8 @@ class CspBank:
             np.copyto(v, v0 + lim, where=up)
             np.copyto(v, v0 - lim, where=down)
             limited = limited | up | down
-        if np.count_nonzero(limited):
+        limited_any = bool(np.count_nonzero(limited))
+        if limited_any:
             land = limited & (((dist > 0.0) & (v * dt > dist)) | ((dist < 0.0) & (v * dt < dist)))
             np.copyto(v, dist / dt, where=land)
         if np.count_nonzero(np.abs(v) > vmax):
@@ -238,6 +240,7 @@ class CspBank:
             np.copyto(v, vmax, where=over)
             np.copyto(v, self.nvmax, where=under)
             limited = limited | over | under
+            limited_any = True
         a = (v - v0) / dt
         pos = p + v * dt
         # --- following error window (6065h/6066h); a row timing out leaves the bank first
@@ -263,6 +266,7 @@ class CspBank:
             "sw_limited": sw_lim,
             "target": target,
         }
+        self.limited_any = limited_any  # of this tentative state (statusword bit 11)
         return state, events
 
     def commit(
@@ -273,12 +277,13 @@ class CspBank:
         if keep is None:
             for name, value in state.items():
                 setattr(self, name, value)
-            self.steps += 1
+            self.cycles += 1
             self.din = din
         else:
             for name, value in state.items():
                 getattr(self, name)[keep] = value[keep]
-            self.steps[keep] += 1
+            self.cycles += 1
+            self.start[~keep] += 1  # the rows left out did not step
             if self.din is self._din_zero:
                 self.din = self._din_zero.copy()
             self.din[keep] = din[keep]
@@ -301,6 +306,8 @@ class CspBank:
                 din = din | (((lo <= x) & (x < hi)).any(axis=1) * value)
             return din
         if name == "statusword":
+            if state is not None and not self.limited_any and not self.any_sw:
+                return self.sw_const  # no row limited (so no 6041h bit 11)
             lim = g("limited") | g("sw_limited")
             if not np.count_nonzero(lim):
                 return self.sw_const
@@ -347,8 +354,8 @@ class CspBank:
             ch.stopping = False
             ch.limit_stop = False
             ch.oms = SW12
-            ch.cycle += int(self.steps[r])
-            self.steps[r] = 0
+            ch.cycle += self.cycles - int(self.start[r])
+            self.start[r] = self.cycles
             ch.target_position = int(self.target[r])
             for name, values in out.items():
                 x = int(values[r])

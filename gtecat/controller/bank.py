@@ -67,7 +67,7 @@ AUTO_MIN_AXES = 4
 #: cycles between two looks for axes to claim when nothing else happened
 RECHECK_CYCLES = 16
 #: samples of a Trap move computed at once (a table per axis)
-TABLE = 256
+TABLE = 2048
 
 #: TxPDO objects the bank computes (channel-0 numbers -> CspBank output names)
 COMPUTED_TX = {
@@ -333,6 +333,7 @@ class AxisBank:
         self.all_external = bool(self.external.all())
         self.any_sense = bool(np.count_nonzero(self.sense != 1))
         self.any_band = bool(np.count_nonzero(self.band > 0))
+        self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.band_dirty = True
         plc = [p for p in self._plc if alive[p[0]]]
@@ -707,8 +708,11 @@ class AxisBank:
         if events is not None:
             hit |= events
         # 6. the in-position band (bit 11)
-        standing = ((ended | ~moving) & ~self.jog) if self.any_band else None
-        if self.any_band and (self.band_dirty or np.count_nonzero(standing & (self.band > 0))):
+        fin = ended & moving
+        any_fin = bool(np.count_nonzero(fin))
+        # the band only changes where a profile stands (moving rows keep since -1, not arrived)
+        if self.any_band and (self.band_dirty or any_fin or self.n_standing_banded):
+            standing = (ended | ~moving) & ~self.jog
             # (moving rows keep since = -1, arrived = False: nothing to do while all move)
             self.band_dirty = False
             on = self.band > 0
@@ -734,8 +738,6 @@ class AxisBank:
                 (self.jrp, self.jrv, self.jp, self.jv, self.ja), jog, strict=True
             ):
                 arr[k] = value[k]
-        fin = ended & moving
-        any_fin = bool(np.count_nonzero(fin))
         if self.n_alive == self.n:
             csp.commit(state, din, None)
             self.a_last, self.t_idx = a, idx
@@ -748,6 +750,7 @@ class AxisBank:
                 cur += moving & ~ended
                 moving &= ~ended
                 self.n_moving = int(np.count_nonzero(moving))
+                self._count_standing()
             else:
                 cur += moving
         else:
@@ -771,6 +774,7 @@ class AxisBank:
             cur += mk & ~ended
             moving &= ~(fin & keep)
             self.n_moving = int(np.count_nonzero(moving))
+            self._count_standing()
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         # 8. the image: 607Ah out, the drives' TxPDO in, in one scatter
@@ -779,6 +783,11 @@ class AxisBank:
             cols.append(csp.output(name, state))
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
+
+    def _count_standing(self) -> None:
+        """Claimed rows with a band whose profile stands (their bit 11 can change)."""
+        st = ~self.moving & ~self.jog & (self.band > 0) & self.alive
+        self.n_standing_banded = int(np.count_nonzero(st))
 
     def _enc_rates(self) -> tuple[np.ndarray, np.ndarray]:
         """Encoder speed and acceleration of every row (Encoder.sample: v = step/T,
