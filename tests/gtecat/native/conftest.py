@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import fcntl
+import hashlib
 import os
 import shlex
 import shutil
@@ -71,6 +73,38 @@ def compile_client(src: Path, out: Path, compiler: str) -> Path:
     assert r.returncode == 0, f"{cmd}\n{r.stderr}"
     assert "warning" not in r.stderr, r.stderr
     return out
+
+
+@pytest.fixture(scope="session")
+def motion_demo(libgts, tmp_path_factory) -> Path:
+    """examples/native/motion_demo.cpp compiled once per test run (``compile_client``, so as a
+    user compiles it) and shared by the tests that run it, xdist workers included."""
+    return compiled_once(
+        tmp_path_factory, libgts, ROOT / "examples" / "native" / "motion_demo.cpp", "g++"
+    )
+
+
+def compiled_once(tmp_path_factory, libgts, src: Path, compiler: str) -> Path:
+    """``compile_client(src)`` done once for the whole run: the executable goes to a folder
+    every xdist worker sees (the run's base temporary folder), named by the source, the
+    compiler and the library it links, and a lock file makes the other workers wait for the
+    first one's build instead of compiling it again."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent  # shared by the workers of this run
+    key = hashlib.sha256(
+        src.read_bytes() + compiler.encode() + str(libgts.library).encode()
+    ).hexdigest()[:12]
+    folder = base / "compiled"
+    folder.mkdir(exist_ok=True)
+    exe = folder / f"{src.stem}-{key}"
+    with open(folder / f"{exe.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not exe.is_file():
+            tmp = exe.with_name(exe.name + ".tmp")
+            compile_client(src, tmp, compiler)
+            tmp.rename(exe)
+    return exe
 
 
 def run_client(exe: Path, *args: str, env: dict[str, str], cwd: Path, timeout: float = 180):
