@@ -54,11 +54,20 @@ def tool_path() -> str:
     return os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
 
 
+def tool_pythonpath() -> str:
+    """PYTHONPATH with this checkout first: ``python3 -m gtecat`` in a child (``lib --cflags``,
+    the private controller a program starts) is the gtecat under test, never another
+    checkout an editable install points at (a library built from this tree's stubs talking
+    to another tree's controller fails in ways that have nothing to do with the test)."""
+    return os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
+
+
 def native_env(**extra: str) -> dict[str, str]:
     """The environment of a native client: the manual's figure 5-2 bus, auto clock, no
     controller named (the library starts its own)."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
-    env.update(PATH=tool_path(), GTECAT_ENI=str(FIG5_2), GTECAT_CLOCK="auto", GTECAT_LOG="")
+    env.update(PATH=tool_path(), PYTHONPATH=tool_pythonpath())
+    env.update(GTECAT_ENI=str(FIG5_2), GTECAT_CLOCK="auto", GTECAT_LOG="")
     env.update(extra)
     return env
 
@@ -68,7 +77,10 @@ def compile_client(src: Path, out: Path, compiler: str) -> Path:
     flags = "$(python3 -m gtecat lib --cflags --libs)"
     cmd = f"{compiler} {shlex.quote(str(src))} {flags} -o {shlex.quote(str(out))}"
     r = subprocess.run(
-        ["bash", "-c", cmd], capture_output=True, text=True, env={**os.environ, "PATH": tool_path()}
+        ["bash", "-c", cmd],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PATH": tool_path(), "PYTHONPATH": tool_pythonpath()},
     )
     assert r.returncode == 0, f"{cmd}\n{r.stderr}"
     assert "warning" not in r.stderr, r.stderr
