@@ -17,7 +17,8 @@ from .conftest import (
     run_client,
 )
 
-pytestmark = needs_cc
+# the compiled clients serve the module: under pytest-xdist (--dist loadgroup) one worker
+pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
 
 
 @pytest.fixture(scope="module")
