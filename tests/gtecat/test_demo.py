@@ -27,6 +27,8 @@ from gtecat.cli.main import main
 from tests.conftest import EXAMPLES
 
 DATA = resources.files("gtecat") / "data"
+# one demo run serves the module: under pytest-xdist (--dist loadgroup) it stays on one worker
+pytestmark = pytest.mark.xdist_group("demo")
 
 
 def _has(*names: str) -> bool:

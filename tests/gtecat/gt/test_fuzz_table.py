@@ -4,9 +4,10 @@ Every ``GT_*`` function, its ``GTN_*`` twin and every ``GTE_*`` helper is called
 hypothesis test with arguments generated from the table's parameter types
 (``fuzz_table_worker.py`` says what is generated and what each call must satisfy).
 A bad pointer could crash the interpreter, so the fuzzing runs in child processes, one
-per batch, all started at once; the functions that take the bus down (GT_Close,
-GT_TerminateEcatComm, GTE_UnplugSlave, ...) have their own batch, restored after each
-call.  ``CI`` in the environment derandomises the children, as tests/conftest.py does here.
+per batch (all started at once in a plain run, one per test under pytest-xdist); the
+functions that take the bus down (GT_Close, GT_TerminateEcatComm, GTE_UnplugSlave, ...)
+have their own batch, restored after each call.  ``CI`` in the environment derandomises
+the children, as tests/conftest.py does here.
 
 Below them, the cases outside checkers found, as plain regression tests.
 """
@@ -55,43 +56,53 @@ STATE_CHANGING = {
 EXAMPLES = 15  # per GT_/GTE_ function
 TWIN_EXAMPLES = 8  # per GTN_ twin: the same implementation, mostly the core is new
 BATCH_TIMEOUT_S = 150  # a backstop: each call has its own 10 s alarm in the child
+CALL_BATCHES = 4  # batches small enough to spread over the xdist workers (3-5 s each)
 
 
 def _batches() -> dict[str, list[str]]:
     names = sorted(REGISTRY)
     state = [n for n in names if n.partition("_")[2] in STATE_CHANGING]
     rest = [n for n in names if n not in state]
-    return {"calls-a": rest[0::2], "calls-b": rest[1::2], "state-changing": state}
+    calls = {f"calls-{'abcdefgh'[i]}": rest[i::CALL_BATCHES] for i in range(CALL_BATCHES)}
+    return {**calls, "state-changing": state}
 
 
 BATCHES = _batches()
+_RUNS: dict[str, subprocess.Popen[str]] = {}
+
+
+def _start(batch: str) -> subprocess.Popen[str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
+    cmd = [
+        sys.executable,
+        "-m",
+        "tests.gtecat.gt.fuzz_table_worker",
+        "--examples",
+        str(EXAMPLES),
+        "--twin-examples",
+        str(TWIN_EXAMPLES),
+        *BATCHES[batch],
+    ]
+    return subprocess.Popen(
+        cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
 
 
 @pytest.fixture(scope="module")
 def fuzz_runs():
-    """All batches started at once (they run in parallel); killed if still running at the end."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
-    procs = {}
-    for batch, names in BATCHES.items():
-        cmd = [
-            sys.executable,
-            "-m",
-            "tests.gtecat.gt.fuzz_table_worker",
-            "--examples",
-            str(EXAMPLES),
-            "--twin-examples",
-            str(TWIN_EXAMPLES),
-            *names,
-        ]
-        procs[batch] = subprocess.Popen(
-            cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
-        )
-    yield procs
-    for p in procs.values():
+    """The batches' child processes, killed if still running at the end.  In a plain run all
+    batches start at once (they run in parallel); under pytest-xdist each test starts its own
+    batch, so the workers share them out instead of every worker running all of them."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        for batch in BATCHES:
+            _RUNS[batch] = _start(batch)
+    yield _RUNS
+    for p in _RUNS.values():
         if p.poll() is None:
             p.kill()
             p.wait()
+    _RUNS.clear()
 
 
 def test_the_batches_cover_every_function_gt_exposes():
@@ -108,7 +119,7 @@ def test_the_batches_cover_every_function_gt_exposes():
 
 @pytest.mark.parametrize("batch", list(BATCHES))
 def test_fuzz_every_function_with_good_and_bad_arguments(fuzz_runs, batch):
-    proc = fuzz_runs[batch]
+    proc = fuzz_runs.get(batch) or fuzz_runs.setdefault(batch, _start(batch))
     try:
         out, _ = proc.communicate(timeout=BATCH_TIMEOUT_S)
     except subprocess.TimeoutExpired:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import fcntl
+import hashlib
 import os
 import shlex
 import shutil
@@ -52,11 +54,20 @@ def tool_path() -> str:
     return os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
 
 
+def tool_pythonpath() -> str:
+    """PYTHONPATH with this checkout first: ``python3 -m gtecat`` in a child (``lib --cflags``,
+    the private controller a program starts) is the gtecat under test, never another
+    checkout an editable install points at (a library built from this tree's stubs talking
+    to another tree's controller fails in ways that have nothing to do with the test)."""
+    return os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
+
+
 def native_env(**extra: str) -> dict[str, str]:
     """The environment of a native client: the manual's figure 5-2 bus, auto clock, no
     controller named (the library starts its own)."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
-    env.update(PATH=tool_path(), GTECAT_ENI=str(FIG5_2), GTECAT_CLOCK="auto", GTECAT_LOG="")
+    env.update(PATH=tool_path(), PYTHONPATH=tool_pythonpath())
+    env.update(GTECAT_ENI=str(FIG5_2), GTECAT_CLOCK="auto", GTECAT_LOG="")
     env.update(extra)
     return env
 
@@ -66,11 +77,46 @@ def compile_client(src: Path, out: Path, compiler: str) -> Path:
     flags = "$(python3 -m gtecat lib --cflags --libs)"
     cmd = f"{compiler} {shlex.quote(str(src))} {flags} -o {shlex.quote(str(out))}"
     r = subprocess.run(
-        ["bash", "-c", cmd], capture_output=True, text=True, env={**os.environ, "PATH": tool_path()}
+        ["bash", "-c", cmd],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PATH": tool_path(), "PYTHONPATH": tool_pythonpath()},
     )
     assert r.returncode == 0, f"{cmd}\n{r.stderr}"
     assert "warning" not in r.stderr, r.stderr
     return out
+
+
+@pytest.fixture(scope="session")
+def motion_demo(libgts, tmp_path_factory) -> Path:
+    """examples/native/motion_demo.cpp compiled once per test run (``compile_client``, so as a
+    user compiles it) and shared by the tests that run it, xdist workers included."""
+    return compiled_once(
+        tmp_path_factory, libgts, ROOT / "examples" / "native" / "motion_demo.cpp", "g++"
+    )
+
+
+def compiled_once(tmp_path_factory, libgts, src: Path, compiler: str) -> Path:
+    """``compile_client(src)`` done once for the whole run: the executable goes to a folder
+    every xdist worker sees (the run's base temporary folder), named by the source, the
+    compiler and the library it links, and a lock file makes the other workers wait for the
+    first one's build instead of compiling it again."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent  # shared by the workers of this run
+    key = hashlib.sha256(
+        src.read_bytes() + compiler.encode() + str(libgts.library).encode()
+    ).hexdigest()[:12]
+    folder = base / "compiled"
+    folder.mkdir(exist_ok=True)
+    exe = folder / f"{src.stem}-{key}"
+    with open(folder / f"{exe.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not exe.is_file():
+            tmp = exe.with_name(exe.name + ".tmp")
+            compile_client(src, tmp, compiler)
+            tmp.rename(exe)
+    return exe
 
 
 def run_client(exe: Path, *args: str, env: dict[str, str], cwd: Path, timeout: float = 180):

@@ -23,7 +23,7 @@ from gtecat.native import client
 from gtecat.native.client import field
 from gtecat.native.server import wait_for
 
-from .conftest import FIG5_2, ROOT, compile_client, native_env, needs_cxx
+from .conftest import FIG5_2, native_env, needs_cxx
 
 
 def _start_controller(address: str, clock: str, cwd) -> subprocess.Popen:
@@ -206,14 +206,9 @@ def test_every_field_operation_has_its_python_method():
 
 
 # --- the worked example: a compiled program, a test driving the machine and reading traces --
-@pytest.fixture
-def demo(libgts, tmp_path):
-    return compile_client(ROOT / "examples" / "native" / "motion_demo.cpp", tmp_path / "d", "g++")
-
-
 @needs_cxx
 def test_a_compiled_program_and_an_attached_test_share_one_controller_process(
-    demo, tmp_path, monkeypatch
+    motion_demo, tmp_path, monkeypatch
 ):
     monkeypatch.delenv("GTECAT_CONTROLLER", raising=False)
     gt.GT_Close()
@@ -223,7 +218,7 @@ def test_a_compiled_program_and_an_attached_test_share_one_controller_process(
     try:
         assert gt.GT_Open(controller=address) == 0  # the first open opens the controller
         prog = subprocess.Popen(
-            [str(demo), "37", "60000"],
+            [str(motion_demo), "37", "60000"],
             env=native_env(GTECAT_CONTROLLER=address),
             cwd=tmp_path,
             stdout=subprocess.PIPE,

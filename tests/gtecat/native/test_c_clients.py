@@ -4,12 +4,12 @@ nothing started before: ``GT_Open`` starts a private controller that ends with t
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import pytest
 
 from .conftest import (
     C_DIR,
-    ROOT,
     compile_client,
     native_env,
     needs_cc,
@@ -17,7 +17,8 @@ from .conftest import (
     run_client,
 )
 
-pytestmark = needs_cc
+# the compiled clients serve the module: under pytest-xdist (--dist loadgroup) one worker
+pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
 
 
 @pytest.fixture(scope="module")
@@ -82,16 +83,19 @@ def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
 
 
 def test_the_private_controller_ends_with_the_program(gtn_sequence, tmp_path):
-    before = _controllers()
+    assert not _controllers(tmp_path)
     r, v = run_client(gtn_sequence, env=native_env(), cwd=tmp_path)
     assert v.get("done") == "1", r.stdout + r.stderr
     deadline = time.monotonic() + 10
-    while _controllers() - before and time.monotonic() < deadline:
+    while _controllers(tmp_path) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert not (_controllers() - before)
+    assert not _controllers(tmp_path)
 
 
-def _controllers() -> set[int]:
+def _controllers(cwd: Path) -> set[int]:
+    """Private controllers running in ``cwd``: the program's own (it inherits the program's
+    folder), never another test's or another run's on the same machine (xdist workers and
+    other users start private controllers of their own at any time)."""
     import os
 
     out = set()
@@ -100,10 +104,12 @@ def _controllers() -> set[int]:
             continue
         try:
             cmd = open(f"/proc/{pid}/cmdline", "rb").read().split(b"\0")
+            where = os.readlink(f"/proc/{pid}/cwd")
         except OSError:
             continue
         if b"controller" in cmd and b"--private" in cmd and b"gtecat" in cmd:
-            out.add(int(pid))
+            if Path(where) == cwd.resolve():
+                out.add(int(pid))
     return out
 
 
@@ -139,9 +145,8 @@ def test_a_missing_python_is_a_clear_error(clock_probe, tmp_path):
 
 
 @needs_cxx
-def test_seed_002_shaped_cpp_program(libgts, tmp_path):
-    exe = compile_client(ROOT / "examples" / "native" / "motion_demo.cpp", tmp_path / "demo", "g++")
-    r, v = run_client(exe, env=native_env(), cwd=tmp_path)
+def test_seed_002_shaped_cpp_program(motion_demo, tmp_path):
+    r, v = run_client(motion_demo, env=native_env(), cwd=tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
     assert v["axes"] == "2 enabled 1"
     assert v["home"] == "status 3"

@@ -12,29 +12,22 @@ from __future__ import annotations
 import subprocess
 from ctypes import byref, c_long
 
-import pytest
-
 from gtecat import gt
 from gtecat.native.server import Server
 
-from .conftest import FIG5_2, ROOT, compile_client, native_env, needs_cxx
+from .conftest import FIG5_2, native_env, needs_cxx
 
 pytestmark = needs_cxx
 
 
-@pytest.fixture
-def demo(libgts, tmp_path):
-    return compile_client(ROOT / "examples" / "native" / "motion_demo.cpp", tmp_path / "d", "g++")
-
-
-def test_the_program_sees_a_drive_alarm_the_test_injects(demo, tmp_path):
+def test_the_program_sees_a_drive_alarm_the_test_injects(motion_demo, tmp_path):
     gt.GT_Close()
     assert gt.GT_Open(eni=str(FIG5_2), clock="auto", log="") == 0
     address = f"unix:{tmp_path}/controller.sock"
     try:
         with Server(address) as server:
             proc = subprocess.Popen(
-                [str(demo), "37", "60000"],
+                [str(motion_demo), "37", "60000"],
                 env=native_env(GTECAT_CONTROLLER=address),
                 cwd=tmp_path,
                 stdout=subprocess.PIPE,

@@ -21,15 +21,26 @@ from .fuzz_lib_worker import SKIP
 pytestmark = needs_cc
 EXAMPLES = 15  # per function: GT_x and its GTN_x twin (a random core) with the same arguments
 TIMEOUT_S = 600
+BATCHES = 2  # child processes, each with every other function: the xdist workers share them
 
 
-def test_bad_input_through_the_library_gets_the_python_codes(libgts):
+def _eligible() -> list[str]:
+    return sorted(
+        p.name
+        for p in protocol.plans()
+        if p.name not in SKIP and not p.unsupported and p.name in _core.REGISTRY
+    )
+
+
+@pytest.mark.parametrize("batch", range(BATCHES))
+def test_bad_input_through_the_library_gets_the_python_codes(libgts, batch):
+    names = _eligible()[batch::BATCHES]
     env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
     cmd = [sys.executable, "-m", "tests.gtecat.native.fuzz_lib_worker", "--examples"]
     try:
         r = subprocess.run(
-            [*cmd, str(EXAMPLES)],
+            [*cmd, str(EXAMPLES), *names],
             cwd=ROOT,
             env=env,
             capture_output=True,
@@ -44,9 +55,11 @@ def test_bad_input_through_the_library_gets_the_python_codes(libgts):
     failures = [ln for ln in out.splitlines() if ln.startswith("FAIL")]
     assert r.returncode == 0, "\n".join(failures)[-6000:] or out[-3000:]
     done = {ln.split()[1] for ln in out.splitlines() if ln.startswith("ok ")}
-    eligible = {
-        p.name
-        for p in protocol.plans()
-        if p.name not in SKIP and not p.unsupported and p.name in _core.REGISTRY
-    }
-    assert done == eligible, sorted(eligible - done)
+    assert done == set(names), sorted(set(names) - done)
+
+
+def test_the_batches_cover_every_function_the_pair_can_run():
+    names = _eligible()
+    assert len(names) > 100
+    batched = [n for b in range(BATCHES) for n in names[b::BATCHES]]
+    assert sorted(batched) == names

@@ -31,7 +31,8 @@ from tests.conftest import SHARED_FIXTURES
 
 from .conftest import native_env, needs_cxx, tool_path
 
-pytestmark = needs_cxx
+# the compiled seed program serves the module: under pytest-xdist (--dist loadgroup) one worker
+pytestmark = [needs_cxx, pytest.mark.xdist_group("seed002")]
 
 SEEDS = SHARED_FIXTURES.parent / "seeds"
 NBSP = "\u00a0"

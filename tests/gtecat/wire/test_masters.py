@@ -29,7 +29,9 @@ from tests.gtecat.wire.rawmaster import (
     why_not_root,
 )
 
-pytestmark = pytest.mark.wire
+# one `gtecat serve` on one veth pair serves the module: under pytest-xdist (--dist
+# loadgroup) it stays on one worker
+pytestmark = [pytest.mark.wire, pytest.mark.xdist_group("wire_masters")]
 
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"

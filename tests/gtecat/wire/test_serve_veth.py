@@ -30,6 +30,9 @@ FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
 TWINCAT = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
 
 wire = pytest.mark.wire
+# one veth pair and one `gtecat serve` serve the module: under pytest-xdist (--dist
+# loadgroup) it stays on one worker
+pytestmark = pytest.mark.xdist_group("serve_veth")
 
 
 def _skip_reason() -> str | None:
