@@ -21,7 +21,7 @@ from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
-_memmove = ctypes.memmove
+_seen: dict[int, tuple[Any, str]] = {}  # id -> (object, repr of byref(object)), recent ones
 _NO: Any = object()  # an argument the caller did not pass
 _addressof = ctypes.addressof
 
@@ -60,6 +60,7 @@ READERS: dict[str, tuple[Callable[[Any], Any], frozenset]] = {
 def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[..., int]:
     """``slow`` (the table-checked GT function) with the fast path in front of it."""
     get, ctypes_ok = READERS[name]
+    last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
     array_types: dict[type, bool] = {}
 
     def is_array(tp: type) -> bool:
@@ -90,12 +91,22 @@ def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[.
         if res is not None and clock._thread is None:
             if tp is _CArg:
                 obj = p._obj
-                if type(obj) in ctypes_ok and _memmove(p, p, 0) == _addressof(obj):
-                    obj.value = get(res)
-                    session.last = None
-                    if clock.mode is not _LOCKSTEP:
-                        clock.on_call()
-                    return 0
+                if p is not last[0]:
+                    # byref(obj), not byref(obj, offset): its repr names the address it holds
+                    # (cheaper than asking ctypes); any doubt takes the table path
+                    seen = _seen.get(id(obj))
+                    if seen is None or seen[0] is not obj:
+                        if len(_seen) > 512:
+                            _seen.clear()
+                        seen = _seen[id(obj)] = (obj, f"<cparam 'P' ({_addressof(obj):#x})>")
+                    if type(obj) not in ctypes_ok or repr(p) != seen[1]:
+                        return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+                    last[0] = p  # checked: the same pointer object next time needs no check
+                obj.value = get(res)
+                session.last = None
+                if clock.mode is not _LOCKSTEP:
+                    clock.on_call()
+                return 0
             elif is_array(tp):
                 p[0] = get(res)
                 session.last = None

@@ -45,7 +45,20 @@ def moving_bus():
 
 
 TYPES = [ctypes.c_int32, ctypes.c_long, ctypes.c_int16, ctypes.c_double, ctypes.c_float]
-shape = st.sampled_from(["byref", "byref_offset", "array", "array1", "pointer", "obj", "int"])
+shape = st.sampled_from(
+    [
+        "byref",
+        "byref_offset",
+        "scalar_offset",
+        "same_byref",
+        "array",
+        "array1",
+        "pointer",
+        "obj",
+        "int",
+    ]
+)
+_SAME: dict[type, tuple] = {}
 
 
 def _arg(kind: str, t: type):
@@ -55,6 +68,14 @@ def _arg(kind: str, t: type):
     if kind == "byref_offset":
         o = (t * 3)()
         return o, byref(o, ctypes.sizeof(t))
+    if kind == "scalar_offset":  # past the end of a scalar: the table refuses it (7)
+        o = t()
+        return o, byref(o, 4)
+    if kind == "same_byref":  # one pointer object used again and again (a C-style loop)
+        if t not in _SAME:
+            o = t()
+            _SAME[t] = (o, byref(o))
+        return _SAME[t]
     if kind == "array":
         o = (t * 4)()
         return o, o
