@@ -104,6 +104,7 @@ class CspBank:
         self.e, self.c = f(n), f(n)
         self.lim, self.nlim, self.half_lim = f(n), f(n), f(n)
         self.fe_running = self.fe_next = False  # some row's following-error timer runs
+        self._din_safe = 0  # cycles in which no row can reach a limit switch
         for r, ch in enumerate(self.channels):
             self.load(r)
             for bit, win in ((2, ch._hs), (16, ch._p1), (17, ch._p2)):
@@ -129,6 +130,7 @@ class CspBank:
         m = ch.mech
         self.din[r] = ch.digital_inputs
         self.target[r] = ch.target_position
+        self._din_safe = 0
         self.start[r] = self.cycles
         self.pos[r], self.vel[r], self.acc[r], self.torque[r] = m.pos, m.vel, m.acc, m.torque
         self.dpos[r], self.dvel[r] = ch.dpos, ch.dvel
@@ -155,6 +157,7 @@ class CspBank:
     def _prepare(self, dt: float) -> None:
         """``Mechanics._prepare`` per row, with math.exp (numpy's exp may differ by an ulp)."""
         self._dt = dt
+        self._din_safe = 0
         for r in range(len(self.channels)):
             self._prepare_row(r, dt)
 
@@ -191,6 +194,7 @@ class CspBank:
         """
         if dt != self._dt:
             self._prepare(dt)
+        self._din_safe -= 1
         # --- step_csp: clamp to 607Dh, enc_offset, demand velocity
         x = target + self.pos_offset if self.any_pos_offset else target
         if self.any_sw:
@@ -297,9 +301,17 @@ class CspBank:
             return np.rint(x).astype(np.int64)
         if name == "digital_inputs":
             pos = g("pos")
+            if self.no_windows and self._din_safe > 0:
+                return self._din_zero  # no row can have reached a switch yet (see below)
             near = (pos >= self.pl) | (pos <= self.nl)
             if self.no_windows and not np.count_nonzero(near):
-                return self._din_zero  # off every switch (shared: never written into)
+                # off every switch (shared array: never written into); no row moves more
+                # than vmax*dt a cycle, so none can reach one for the next few cycles
+                gap = min(float((self.pl - pos).min()), float((pos - self.nl).min()))
+                step = float(self.vmax.max()) * self._dt
+                cycles = gap / step - 2.0 if step > 0.0 else 1e9
+                self._din_safe = int(min(cycles, 1e9)) if cycles > 0.0 else 0
+                return self._din_zero
             din = 2 * (pos >= self.pl) + (pos <= self.nl)
             for value, lo, hi in self.windows:
                 x = pos[:, None]

@@ -649,7 +649,9 @@ class AxisBank:
     def cycle(self, t_ns: int, dt_ns: int) -> None:
         """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
         self._countdown -= 1
-        if self.dirty or self._countdown <= 0:
+        # with every slave claimed and nothing touched, there is nothing to look for (a hook or
+        # anything else reaching a claimed object goes through a guard, which sets dirty)
+        if self.dirty or (self._countdown <= 0 and self.n_alive != self.n):
             self.refresh()
         if not self.n_alive:
             return

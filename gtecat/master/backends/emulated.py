@@ -48,9 +48,9 @@ class EmulatedBackend(Backend):
         self.watchdog_ns = 100_000_000
         self._silent_ns: dict[int, int] = {}
         self._clients: dict[int, object] = {}
-        #: positions whose slaves the controller's axis bank runs (gtecat.controller.bank):
-        #: they answer (working counter) but are not stepped here
-        self.claimed: set[int] = set()
+        self._claimed: frozenset[int] = frozenset()
+        self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
+        self._claimed_wkc = 0
         self.capture = None
         self._source = ""  # the file the virtual slaves come from
         if pcap:
@@ -79,6 +79,23 @@ class EmulatedBackend(Backend):
             self._plan.append((slave, out, inp))
         # ETG.1000.4 LRW: +2 per slave with outputs, +1 per slave with inputs (fixed per bus)
         self._expected = sum(2 * (o is not None) + (i is not None) for _, o, i in self._plan)
+        self.claimed = set()
+
+    @property
+    def claimed(self) -> frozenset[int]:
+        """Positions whose slaves the controller's axis bank runs (gtecat.controller.bank):
+        they answer in OP (working counter) but are neither stepped nor copied here."""
+        return self._claimed
+
+    @claimed.setter
+    def claimed(self, positions: set[int] | frozenset[int]) -> None:
+        self._claimed = frozenset(positions)
+        self._run_plan = [e for e in self._plan if e[0].position not in self._claimed]
+        self._claimed_wkc = sum(
+            2 * (o is not None) + (i is not None)
+            for sl, o, i in self._plan
+            if sl.position in self._claimed
+        )
 
     def _slave(self, position: int) -> VirtualSlave:
         if position in self.unplugged or not 0 <= position < len(self.slaves):
@@ -134,13 +151,9 @@ class EmulatedBackend(Backend):
     def exchange(self, t_ns: int, dt_ns: int) -> int:
         image = self.image
         assert image is not None
-        wkc = 0
+        wkc = self._claimed_wkc  # the bank's slaves, in OP
         unplugged = self.unplugged
-        claimed = self.claimed
-        for slave, out, inp in self._plan:
-            if claimed and slave.position in claimed:
-                wkc += 2 * (out is not None) + (inp is not None)  # in OP, stepped by the bank
-                continue
+        for slave, out, inp in self._run_plan:
             if unplugged and slave.position in unplugged:
                 # powered but cut off: it keeps running; its watchdog notices the silence
                 silent = self._silent_ns.get(slave.position, 0) + dt_ns
@@ -164,7 +177,8 @@ class EmulatedBackend(Backend):
 
     def emergencies(self) -> list[tuple[int, object]]:
         out = []
-        for slave in self.slaves:
+        claimed = self._claimed  # a claimed slave is not stepped: it raises none
+        for slave in self.slaves if not claimed else (e[0] for e in self._run_plan):
             while slave.emergencies:
                 out.append((slave.position, slave.emergencies.popleft()))
         return out
