@@ -11,8 +11,9 @@ The scalar :class:`~drives.drive.Channel` stays the reference: :meth:`CspBank.lo
 takes a channel's state, :meth:`CspBank.store` gives it back exactly (after which the
 channel's own step continues as if it had run every cycle itself).  The float
 operations are the scalar code's, in the same order, so both give the same bits
-(``tests/drives/test_csp_bank.py`` compares them); transcendental constants
-(``exp(-kp·dt)``) are computed with :mod:`math` per row, never with numpy.
+(``tests/gtecat/controller/test_bank.py`` compares them through the GT API);
+transcendental constants (``exp(-kp·dt)``) are computed with :mod:`math` per row, never
+with numpy.
 
 A row whose next step would leave that state (a limit switch input, a following
 error timing out) is reported by :meth:`CspBank.step` in its ``events`` mask with its
@@ -27,6 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .cia402 import STATE_BITS, State, Sw
+from .drive import _wrap32 as wrap32  # the channel's own 32-bit wrap of its object values
 from .modes import SW12, OpMode
 
 if TYPE_CHECKING:
@@ -371,18 +373,8 @@ class CspBank:
             ch.target_position = int(self.target[r])
             for name, values in out.items():
                 x = int(values[r])
-                setattr(ch, name, _wrap(x) if name in wrapped else x)
+                setattr(ch, name, wrap32(x) if name in wrapped else x)
             ch.mode_display = ch.mode
-
-
-def _wrap(x: int) -> int:
-    return ((x - _INT32_MIN) & 0xFFFFFFFF) + _INT32_MIN
-
-
-def wrap32(x: np.ndarray) -> np.ndarray:
-    """Round-to-integer floats (or ints) wrapped as a signed 32-bit object value."""
-    i = x.astype(np.int64)
-    return ((i - _INT32_MIN) & 0xFFFFFFFF) + _INT32_MIN
 
 
 def closing_speed(dist: np.ndarray, lim: np.ndarray, dt: float) -> np.ndarray:

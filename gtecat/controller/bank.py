@@ -44,10 +44,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from drives.csp_bank import CW_ENABLED, CspBank, claimable
+from drives.csp_bank import CW_ENABLED, CspBank, claimable, wrap32
 from drives.drive import Cia402Drive
 from drives.slave import AlState
-from eni.datatypes import CHANNEL_STRIDE
+from eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from eni.model import Direction
 
 from .axis_status import AxisStatus
@@ -84,8 +84,6 @@ COMPUTED_TX = {
 #: TxPDO objects that cannot change while an axis is in the bank's state
 CONSTANT_TX = {0x603F, 0x6061, 0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, 0x1001, 0x20F2, 0x20F9}
 CONSTANT_TX |= set(range(0x60D1, 0x60D9))
-_DTYPES = {(8, False): "<u1", (8, True): "<i1", (16, False): "<u2", (16, True): "<i2"}
-_DTYPES |= {(32, False): "<u4", (32, True): "<i4"}
 
 #: GT functions whose implementations read a claimed axis through the bank itself
 BANK_READS = frozenset(
@@ -96,7 +94,6 @@ BANK_READS = frozenset(
         "GT_GetPrfAcc",
         "GT_GetEncPos",
         "GT_GetEncVel",
-        "GT_GetEncAcc",
         "GT_GetAxisPrfPos",
         "GT_GetAxisPrfVel",
         "GT_GetAxisPrfAcc",
@@ -108,7 +105,6 @@ BANK_READS = frozenset(
         "GT_GetEcatRawData",
         "GT_SetEcatRawData",
         "GT_GetClock",
-        "GT_GetClockHighPrecision",
         "GTE_Wait",
         "GTE_GetLastError",
         "GT_GetVersion",
@@ -120,7 +116,6 @@ _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.MOVING),
     int(AxisStatus.ARRIVED),
 )
-_HALF, _WRAP = 1 << 31, 1 << 32
 
 
 # --- guards: a claimed axis's objects give themselves back when anything touches them ---------
@@ -138,7 +133,6 @@ def _wake(obj: object) -> None:
     if entry is not None:
         bank, gi = entry
         bank._release_groups([bank.groups[gi]])
-        bank._reindex()
 
 
 def _guard_class(cls: type) -> type:
@@ -197,6 +191,7 @@ class AxisBank:
         self.n_alive = 0
         self._lists: dict[str, list[Any]] = {}
         self.disabled_reason = ""
+        self._stale = False
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
         self.rows_run = 0
 
@@ -220,16 +215,16 @@ class AxisBank:
         for ref in layout.axes:
             by_slave.setdefault(ref.slave, []).append(ref)
         axes, chans, groups = [], [], []
-        tx: dict[str, list[tuple[int, int, int, str]]] = {}
-        a607: list[tuple[int, int]] = []
+        #: the image entries the bank writes: (row, first byte in the buffer, bytes, value)
+        plc: list[tuple[int, int, int, str]] = []
         for pos, refs in by_slave.items():
             slave = backend.slaves[pos] if pos < len(backend.slaves) else None
             if not isinstance(slave, Cia402Drive) or len(slave.channels) != len(refs):
                 continue
             sl = layout.slaves[pos]
             ok, rows = True, []
-            g_tx: list[tuple[int, int, int, str]] = []
-            g_607a: list[tuple[int, int]] = []
+            g_plc: list[tuple[int, int, int, str]] = []
+            n_607a = 0
             rx_idx: list[int] = []
             row_of = {ref.channel: len(axes) + k for k, ref in enumerate(refs)}
             for e in sl.entries:
@@ -237,33 +232,30 @@ class AxisBank:
                     continue
                 k, base = divmod(e.index - 0x6000, CHANNEL_STRIDE)
                 base += 0x6000
-                if not 0x6000 <= e.index < 0x6000 + CHANNEL_STRIDE * 8:
+                if not 0x6000 <= e.index < 0x6000 + CHANNEL_STRIDE * MAX_CHANNELS:
                     k, base = 0, e.index
-                if e.logical_bit & 7 or (e.bits, e.signed) not in _DTYPES:
+                if e.logical_bit & 7 or e.bits not in (8, 16, 32):
                     ok = False
                     break
-                byte = e.logical_bit >> 3
+                byte, size = e.logical_bit >> 3, e.bits // 8
                 if e.direction == Direction.OUT:
-                    if base == 0x607A and e.subindex == 0 and k in row_of:
-                        g_607a.append((row_of[k], byte))
+                    if base == 0x607A and e.subindex == 0 and e.bits == 32 and k in row_of:
+                        g_plc.append((row_of[k], byte, 4, "target"))
+                        n_607a += 1
                     else:
-                        rx_idx.extend(range(byte, byte + e.bits // 8))
+                        rx_idx.extend(range(byte, byte + size))
                 elif base in COMPUTED_TX and e.subindex == 0 and k in row_of:
-                    dt = _DTYPES[(e.bits, e.signed)]
-                    g_tx.append((row_of[k], image.outputs_bytes + byte, e.bits // 8, dt))
-                    g_tx[-1] = (*g_tx[-1][:3], dt + "|" + COMPUTED_TX[base])
+                    g_plc.append((row_of[k], image.outputs_bytes + byte, size, COMPUTED_TX[base]))
                 elif base not in CONSTANT_TX:
                     ok = False
                     break
-            if not ok or len(g_607a) != len(refs):
+            if not ok or n_607a != len(refs):
                 continue
             for ref in refs:
                 rows.append(len(axes))
                 axes.append(ctl.axes[ref.axis])
                 chans.append(slave.channels[ref.channel])
-            for r, off, size, key in g_tx:
-                tx.setdefault(key, []).append((r, off, size, key))
-            a607 += g_607a
+            plc += g_plc
             groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp)))
         if not axes:
             self.disabled_reason = "no drive the bank can run (mapping)"
@@ -279,11 +271,7 @@ class AxisBank:
         n = self.n = len(axes)
         self.csp = CspBank(chans)
         self.alive = np.zeros(n, bool)
-        # image addresses: (row, first byte in the buffer, bytes, value) per PDO entry
-        self._plc = [(r, b, 4, "target") for r, b in a607]
-        self._plc += [
-            (r, off, size, key.split("|")[1]) for lst in tx.values() for r, off, size, key in lst
-        ]
+        self._plc = plc
         z, zi = np.zeros, np.zeros
         # controller-side state and constants
         self.unit2 = z(n)  # 2**PosScale
@@ -292,7 +280,6 @@ class AxisBank:
         self.prf_ratio, self.prf_off = z(n), z(n)
         self.enc_ratio, self.enc_off = z(n), z(n)
         self.soft_pos, self.soft_neg = z(n), z(n)
-        self.hw_mask = zi(n, np.int64)  # 60FDh bits of the limit switches the axis watches
         self.pos_err = z(n)
         self.external = zi(n, bool)
         self.sense = zi(n, np.int64)
@@ -326,6 +313,7 @@ class AxisBank:
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
         alive = self.alive
+        self._stale = False
         self.n_alive = int(alive.sum())
         self.any_prf_link = bool(np.count_nonzero((self.prf_ratio != 1.0) | (self.prf_off != 0.0)))
         self.any_enc_link = bool(np.count_nonzero((self.enc_ratio != 1.0) | (self.enc_off != 0.0)))
@@ -487,9 +475,6 @@ class AxisBank:
         on = sf.active
         self.soft_pos[r] = sf.soft_positive if on else np.inf
         self.soft_neg[r] = sf.soft_negative if on else -np.inf
-        self.hw_mask[r] = (2 if on and sf.positive_on and res._pos_din is not None else 0) | (
-            1 if on and sf.negative_on and res._neg_din is not None else 0
-        )
         self.pos_err[r] = sf.pos_err if on else np.inf
         enc = res.encoder
         self.external[r] = enc.external
@@ -544,13 +529,11 @@ class AxisBank:
     def release_all(self) -> None:
         if self.n_alive:
             self._release_groups([g for g in self.groups if g.claimed])
-            self._reindex()
 
     def release_axis_object(self, ax: Any) -> None:
         r = self._row_of.get(id(ax))
         if r is not None and self.alive[r]:
             self._release_groups([self.groups[self.group_of[r]]])
-            self._reindex()
 
     def _release_groups(self, groups: list[_Group]) -> None:
         """Write the rows' committed state back into their objects; they leave the bank."""
@@ -568,6 +551,10 @@ class AxisBank:
         for r in rows:
             self._store(r)
         self.dirty = True
+        # the image addresses and run lists follow at the next cycle (_reindex), not once per
+        # release: a loop of GT calls over many axes releases one slave per call
+        self._stale = True
+        self.n_alive = int(np.count_nonzero(self.alive))
 
     def _store(self, r: int) -> None:
         ax, res = self.axes[r], self.res[r]
@@ -578,8 +565,7 @@ class AxisBank:
         res._a_last = a
         enc = res.encoder
         vel, acc = self._rates
-        prev = int(self.enc_prev[r])
-        enc._prev = ((prev + _HALF) & 0xFFFFFFFF) - _HALF  # the 32-bit value the object holds
+        enc._prev = wrap32(int(self.enc_prev[r]))  # the 32-bit value the object holds
         enc.pos, enc.vel, enc.acc = (
             float(self.enc_pos[r]),
             float(vel[r]),
@@ -653,6 +639,8 @@ class AxisBank:
         # anything else reaching a claimed object goes through a guard, which sets dirty)
         if self.dirty or (self._countdown <= 0 and self.n_alive != self.n):
             self.refresh()
+        if self._stale:
+            self._reindex()
         if not self.n_alive:
             return
         self._lists.clear()

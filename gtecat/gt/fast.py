@@ -30,7 +30,9 @@ _status = AxisResources.status
 _LOCKSTEP = ClockMode.LOCKSTEP
 
 
-def _attr(name: str) -> Callable[[Any], float]:
+def attr_getter(name: str) -> Callable[[Any], float]:
+    """One axis's reading ``name`` as a double (the table readers of motion_calls use it too)."""
+
     def get(r: Any) -> float:
         return float(getattr(r, name))
 
@@ -44,16 +46,16 @@ _DOUBLE = frozenset({ctypes.c_double})
 #: the vendor's 32 bits, and a Python caller's ``c_long()`` is 64 bits on Linux; both work)
 READERS: dict[str, tuple[Callable[[Any], Any], frozenset]] = {
     "GT_GetSts": (_status, _INTS),
-    "GT_GetPrfPos": (_attr("prf_pos"), _DOUBLE),
-    "GT_GetPrfVel": (_attr("prf_vel"), _DOUBLE),
-    "GT_GetPrfAcc": (_attr("prf_acc"), _DOUBLE),
-    "GT_GetAxisPrfPos": (_attr("axis_prf_pos"), _DOUBLE),
-    "GT_GetAxisPrfVel": (_attr("axis_prf_vel"), _DOUBLE),
-    "GT_GetAxisEncPos": (_attr("axis_enc_pos"), _DOUBLE),
-    "GT_GetAxisEncVel": (_attr("axis_enc_vel"), _DOUBLE),
-    "GT_GetAxisError": (_attr("axis_error"), _DOUBLE),
-    "GT_GetEncPos": (_attr("enc_pos"), _DOUBLE),
-    "GT_GetEncVel": (_attr("enc_vel"), _DOUBLE),
+    "GT_GetPrfPos": (attr_getter("prf_pos"), _DOUBLE),
+    "GT_GetPrfVel": (attr_getter("prf_vel"), _DOUBLE),
+    "GT_GetPrfAcc": (attr_getter("prf_acc"), _DOUBLE),
+    "GT_GetAxisPrfPos": (attr_getter("axis_prf_pos"), _DOUBLE),
+    "GT_GetAxisPrfVel": (attr_getter("axis_prf_vel"), _DOUBLE),
+    "GT_GetAxisEncPos": (attr_getter("axis_enc_pos"), _DOUBLE),
+    "GT_GetAxisEncVel": (attr_getter("axis_enc_vel"), _DOUBLE),
+    "GT_GetAxisError": (attr_getter("axis_error"), _DOUBLE),
+    "GT_GetEncPos": (attr_getter("enc_pos"), _DOUBLE),
+    "GT_GetEncVel": (attr_getter("enc_vel"), _DOUBLE),
 }
 
 
@@ -86,34 +88,32 @@ def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[.
         ):
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
         res = ctl.resources.get(n)
-        tp = type(p)
         clock = ctl.clock
-        if res is not None and clock._thread is None:
-            if tp is _CArg:
-                obj = p._obj
-                if p is not last[0]:
-                    # byref(obj), not byref(obj, offset): its repr names the address it holds
-                    # (cheaper than asking ctypes); any doubt takes the table path
-                    seen = _seen.get(id(obj))
-                    if seen is None or seen[0] is not obj:
-                        if len(_seen) > 512:
-                            _seen.clear()
-                        seen = _seen[id(obj)] = (obj, f"<cparam 'P' ({_addressof(obj):#x})>")
-                    if type(obj) not in ctypes_ok or repr(p) != seen[1]:
-                        return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
-                    last[0] = p  # checked: the same pointer object next time needs no check
-                obj.value = get(res)
-                session.last = None
-                if clock.mode is not _LOCKSTEP:
-                    clock.on_call()
-                return 0
-            elif is_array(tp):
-                p[0] = get(res)
-                session.last = None
-                if clock.mode is not _LOCKSTEP:
-                    clock.on_call()
-                return 0
-        return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+        if res is None or clock._thread is not None:
+            return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+        tp = type(p)
+        if tp is _CArg:
+            obj = p._obj
+            if p is not last[0]:
+                # byref(obj), not byref(obj, offset): its repr names the address it holds
+                # (cheaper than asking ctypes); any doubt takes the table path
+                seen = _seen.get(id(obj))
+                if seen is None or seen[0] is not obj:
+                    if len(_seen) > 512:
+                        _seen.clear()
+                    seen = _seen[id(obj)] = (obj, f"<cparam 'P' ({_addressof(obj):#x})>")
+                if type(obj) not in ctypes_ok or repr(p) != seen[1]:
+                    return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+                last[0] = p  # checked: the same pointer object next time needs no check
+            obj.value = get(res)
+        elif is_array(tp):
+            p[0] = get(res)
+        else:
+            return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+        session.last = None
+        if clock.mode is not _LOCKSTEP:
+            clock.on_call()
+        return 0
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt

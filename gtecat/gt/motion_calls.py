@@ -42,6 +42,7 @@ from ..controller.profile import PrfMode
 from ..controller.resources import AxisResources, axes_in_mask, axis_resources, axis_span
 from ..errors import CommandError, ParameterError
 from ._core import check_range, gt_function, store, store_array, struct_arg
+from .fast import attr_getter
 from .structs import TJogPrm, TTrapPrm
 
 #: GT_Stop mask/option bit of coordinate system 1 (entry 131: bit 12 crd 1, bit 13 crd 2)
@@ -214,7 +215,7 @@ def GT_Stop(ctl: Controller, mask: int, option: int) -> int:
 
 # --- positions ----------------------------------------------------------------------------------
 def _define_reader(name: str, attr: str, doc: str, limit: int | None = None) -> None:
-    getter = _attr_getter(attr)
+    getter = attr_getter(attr)
 
     def read(ctl: Controller, axis: int, pValue: Any, count: int = 1, pClock: Any = None) -> int:
         return _read_many(ctl, axis, pValue, count, pClock, getter, limit)
@@ -222,13 +223,6 @@ def _define_reader(name: str, attr: str, doc: str, limit: int | None = None) -> 
     read.__name__ = read.__qualname__ = name
     read.__doc__ = doc
     globals()[name] = gt_function(read)
-
-
-def _attr_getter(attr: str) -> Callable[[AxisResources], float]:
-    def get(r: AxisResources) -> float:
-        return float(getattr(r, attr))
-
-    return get
 
 
 _define_reader("GT_GetPrfPos", "prf_pos", "Planned position of the profile, pulse (entry 64).")
@@ -261,7 +255,7 @@ def GT_GetEncVel(
 ) -> int:
     """Encoder velocity, pulse/ms (entry 47; at most 8 at once)."""
     return _read_many(
-        ctl, encoder, pValue, count, pClock, lambda r: r.enc_vel, _MAX_ENCODERS_PER_CALL
+        ctl, encoder, pValue, count, pClock, attr_getter("enc_vel"), _MAX_ENCODERS_PER_CALL
     )
 
 

@@ -6,8 +6,8 @@ numpy evaluation instead of ``n`` calls.  The axis bank (:mod:`gtecat.controller
 reads one sample per cycle from such a table.  The arithmetic is the planner's
 ``_sample`` transcribed operation by operation (the same pieces, the same order of
 additions in the smoothing integral, the same end test and final clamp), so every
-sample is bit-identical to what ``step()`` returns; ``tests/gtecat/controller/
-test_bank.py`` holds both to that.
+sample is bit-identical to what ``step()`` returns; ``tests/gtecat/controller/motion/
+test_trap_table.py`` holds both to that.
 """
 
 from __future__ import annotations
@@ -56,20 +56,25 @@ def trap_table(
         total = np.zeros(len(t))
         dist = np.zeros(len(t))
         span_max = int((i - j).max()) if len(t) else 0
-        for d in range(span_max + 1):
-            k = j + d
-            live = k <= i
-            kc = np.minimum(k, m - 1)
-            if d:
-                lo = st[kc]
-                pk = p0s[kc] - p
-                vk = v0s[kc]
-                ak = acs[kc]
-            hi = np.where(k == i, t, st[np.minimum(kc + 1, m - 1)])
-            span = hi - lo
-            add = live & (span > 0.0)
-            total = np.where(add, total + span * (pk + span * (0.5 * vk + ak * span / 6.0)), total)
-            dist = np.where(add, dist + span * (vk + 0.5 * ak * span), dist)
+        # lanes past their own piece i are computed and discarded (np.where): with extreme
+        # parameters (dec = 1e-172) they may overflow, which must not warn
+        with np.errstate(over="ignore", invalid="ignore"):
+            for d in range(span_max + 1):
+                k = j + d
+                live = k <= i
+                kc = np.minimum(k, m - 1)
+                if d:
+                    lo = st[kc]
+                    pk = p0s[kc] - p
+                    vk = v0s[kc]
+                    ak = acs[kc]
+                hi = np.where(k == i, t, st[np.minimum(kc + 1, m - 1)])
+                span = hi - lo
+                add = live & (span > 0.0)
+                total = np.where(
+                    add, total + span * (pk + span * (0.5 * vk + ak * span / 6.0)), total
+                )
+                dist = np.where(add, dist + span * (vk + 0.5 * ak * span), dist)
         p = p + total / ts
         v, a = dist / ts, (v - va) / ts
     final = (t - ts) >= pl._t_final
