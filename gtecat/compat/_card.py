@@ -104,12 +104,12 @@ def out(ptr: Any, value: Any) -> None:
 
 
 def integer(name: str, value: Any, lo: int, hi: int) -> int:
-    """An integer in ``[lo, hi]`` (the seed's range) or CompatError."""
+    """An integer in ``[lo, hi]`` (the seed's range) or CompatError.
+
+    Like the GT layer's argument checks, a float is refused even when it is integral (1.0):
+    the seeds' parameters are C integers, and a float there is a caller's mistake."""
     if isinstance(value, bool) or not isinstance(value, int):
-        if isinstance(value, float) and math.isfinite(value) and value.is_integer():
-            value = int(value)
-        else:
-            raise CompatError(f"{name}={value!r}: an integer is expected")
+        raise CompatError(f"{name}={value!r}: an integer is expected")
     if not lo <= value <= hi:
         raise CompatError(f"{name}={value} out of the seed's range {lo}..{hi}")
     return int(value)
