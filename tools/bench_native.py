@@ -143,8 +143,8 @@ def main(argv: list[str] | None = None) -> int:
         "clock": args.clock,
         "wall_floor": not args.no_wall_floor and args.clock == "auto",
         "spin_us": {
-            "client": env.get("GTECAT_SPIN_US"),
-            "server": env.get("GTECAT_SERVER_SPIN_US"),
+            "client": env.get("GTECAT_SPIN_US", "default"),
+            "server": env.get("GTECAT_SERVER_SPIN_US", "default"),
         },
         "calls": len(samples),
         "round_trip_us": stats,

@@ -14,6 +14,7 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import struct
 from collections.abc import Callable
 from typing import Any
 
@@ -117,3 +118,44 @@ def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[.
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt
+
+
+def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], bytes | None]:
+    """The same fast answer for a request that came over the controller socket
+    (:mod:`gtecat.native.server`): ``body`` is the whole CALL message of ``name`` from a
+    client whose ``long`` has ``long_size`` bytes; the reply frame, or None when the
+    request is not the common shape (``count`` 1, ``pClock`` NULL, an axis that exists,
+    a value that fits) and must take the table path.  One unpack, one pack: the request
+    layout is the protocol's (CALL head, int64 axis, int32 size + the element, int64
+    count, int32 size of pClock), the reply is one block holding the element."""
+    from ..native.protocol import CALL, PTR_NULL
+
+    get, ctypes_ok = READERS[name]
+    code = "d" if ctypes_ok is _DOUBLE else ("i" if long_size == 4 else "q")
+    one = 8 if code != "i" else 4
+    request = struct.Struct(f"<{CALL.format[1:]}qi{one}sqi")
+    reply = struct.Struct(f"<IhHHI{code}")
+    unpack, pack, size, total = request.unpack_from, reply.pack, request.size, reply.size - 4
+    controllers = session.controllers
+
+    def answer(body: Any) -> bytes | None:
+        if len(body) != size:
+            return None
+        axis, psize, _, count, pclock = unpack(body)[4:]
+        ctl = controllers.get(1)
+        if psize != one or count != 1 or pclock != PTR_NULL or ctl is None:
+            return None
+        res = ctl.resources.get(axis)
+        clock = ctl.clock
+        if res is None or clock._thread is not None or session.remote is not None:
+            return None
+        try:
+            out = pack(total, 0, 1, 0, one, get(res))
+        except struct.error:  # a value the client's type cannot hold: the table decides
+            return None
+        session.last = None
+        if clock.mode is not _LOCKSTEP:
+            clock.on_call()
+        return out
+
+    return answer

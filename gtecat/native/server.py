@@ -42,6 +42,7 @@ from typing import Any
 from eni.errors import GtecatError
 
 from ..gt import _core
+from ..gt.fast import READERS, wire_reader
 from . import field as field_ops
 from .floor import WallFloor
 from .protocol import (
@@ -77,8 +78,18 @@ log = logging.getLogger("gtecat.native.server")
 #: a client that sends half a frame, or stops reading replies, this long is dropped
 IO_TIMEOUT_S = 10.0
 #: how long the server keeps serving one client before it looks at the others
-#: (GTECAT_SERVER_SPIN_US; see Server._readable)
-DEFAULT_SPIN_US = 0
+#: (GTECAT_SERVER_SPIN_US; see Server._readable); by default only where this process
+#: may run on two CPUs or more (on one, spinning keeps the client from sending)
+DEFAULT_SPIN_US = 100
+
+
+def default_spin_us() -> float:
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cpus = os.cpu_count() or 1
+    return DEFAULT_SPIN_US if cpus >= 2 else 0.0
+
 
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
 
@@ -173,7 +184,7 @@ class _Decoder:
     """One function's request layout for one client ``long`` size, compiled once into a
     step per parameter."""
 
-    __slots__ = ("fn_gt", "fn_gtn", "plan", "steps")
+    __slots__ = ("fast", "fn_gt", "fn_gtn", "plan", "steps")
 
     def __init__(self, plan: FunctionPlan, long_size: int) -> None:
         self.plan = plan
@@ -194,6 +205,10 @@ class _Decoder:
         self.steps = tuple(steps)
         self.fn_gt = _core.REGISTRY.get(plan.name)
         self.fn_gtn = _core.REGISTRY.get("GTN_" + plan.name[3:]) if plan.proto.gtn else None
+        #: the common request shape answered without decoding (gtecat.gt.fast), GT_ only
+        self.fast = (
+            wire_reader(plan.name, long_size, _core.SESSION) if plan.name in READERS else None
+        )
 
     def decode(self, body: Any, pos: int) -> tuple[list[Any], list[Any]]:
         """(arguments for the GT function, out-buffers in order; None for NULL)."""
@@ -306,7 +321,12 @@ class Server:
         self.open_options = dict(open_options or {})
         self.wall_floor = wall_floor
         if spin_us is None:
-            spin_us = float(os.environ.get("GTECAT_SERVER_SPIN_US", DEFAULT_SPIN_US))
+            env = os.environ.get("GTECAT_SERVER_SPIN_US", "")
+            try:
+                spin_us = float(env) if env else default_spin_us()
+            except ValueError:
+                log.warning("GTECAT_SERVER_SPIN_US=%r is not a number; using the default", env)
+                spin_us = default_spin_us()
         self.spin_s = max(0.0, spin_us) / 1e6
         self.lock = threading.RLock()
         self.calls = 0
@@ -538,6 +558,16 @@ class Server:
             dec = c.decoders.get(fid)
             if dec is None:
                 dec = c.decoders[fid] = self._decoder(c.long_size, fid)
+            if dec.fast is not None and c.opened and not gtn:
+                with self.lock:
+                    if self.wall_floor:
+                        floor = self._current_floor()
+                        if floor is not None:
+                            floor.look()
+                    out = dec.fast(body)
+                if out is not None:
+                    self.calls += 1
+                    return out
             args, backs = dec.decode(body, CALL.size)
             with self.lock:
                 rc, text = self._call(c, dec, gtn, core, args)

@@ -12,6 +12,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -130,9 +131,11 @@ static int send_all(int fd, const unsigned char *p, size_t n, long long deadline
     return 0;
 }
 
-/* How long a call spins for its reply before it sleeps in poll (GTECAT_SPIN_US,
- * default 0: never spin).  The controller usually answers within tens of
- * microseconds; waking a sleeping thread costs about as much again, more in a VM. */
+/* How long a call spins for its reply before it sleeps in poll (GTECAT_SPIN_US; by
+ * default 200 us where this process may run on two CPUs or more, else 0: spinning on
+ * one CPU only keeps the controller from answering).  The controller answers a common
+ * getter within about 20 us; waking a sleeping thread costs as much again in a VM. */
+#define GTE_DEFAULT_SPIN_US 200
 static long spin_ns(void)
 {
     static long cached = -1;
@@ -144,6 +147,10 @@ static long spin_ns(void)
             long x = strtol(v, &end, 10);
             if (*end == '\0' && x >= 0)
                 us = x;
+        } else {
+            cpu_set_t set;
+            if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) >= 2)
+                us = GTE_DEFAULT_SPIN_US;
         }
         cached = us * 1000;
     }
