@@ -54,13 +54,26 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         help="an expired SM watchdog drops the slave to SAFEOP+error 001Bh (as real drives do)",
     )
     p.add_argument(
+        "--wait",
+        choices=("predict", "sleep", "spin"),
+        default="predict",
+        help="how to wait for frames: predict = learn the master's cycle and spin only "
+        "around the cyclic frame's due time (default; a fraction of a CPU), sleep = poll "
+        "(a wake-up per frame, no CPU), spin = spin all the time (a whole CPU)",
+    )
+    p.add_argument(
         "--busy-poll",
         action="store_true",
-        help="spin on the socket instead of sleeping (lowest latency)",
+        help="the same as --wait spin",
     )
     p.add_argument("--rt-priority", type=int, metavar="N", help="run under SCHED_FIFO priority N")
     p.add_argument("--duration", type=float, help="stop after this many seconds")
-    p.add_argument("--stats-json", type=Path, help="write counters and latency here on exit")
+    p.add_argument(
+        "--stats-json",
+        type=Path,
+        help="write counters and latency here on exit (and on SIGUSR1, which also "
+        "starts the latency records afresh: time one phase of a run)",
+    )
     p.add_argument(
         "--foe-file",
         action="append",
@@ -135,7 +148,7 @@ def run(args: argparse.Namespace) -> int:
         args.iface,
         step_mode=args.step,
         cycle_ns=cycle_ns,
-        busy_poll=args.busy_poll,
+        wait="spin" if args.busy_poll else args.wait,
         pcap=pcap,
     )
     if args.rt_priority:
@@ -145,6 +158,19 @@ def run(args: argparse.Namespace) -> int:
         server.stop.set()
 
     old = {s: signal.signal(s, _stop) for s in (signal.SIGINT, signal.SIGTERM)}
+
+    def _write_stats(report: dict[str, object]) -> None:
+        if args.stats_json:
+            tmp = args.stats_json.with_name(args.stats_json.name + ".tmp")
+            tmp.write_text(json.dumps(report, indent=2) + "\n")
+            tmp.replace(args.stats_json)
+
+    def _snapshot(signum: int, _frame: FrameType | None) -> None:
+        server.snapshot_due = True
+
+    server.on_snapshot = _write_stats
+    if hasattr(signal, "SIGUSR1"):  # kill -USR1: stats so far to --stats-json, latency anew
+        old[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, _snapshot)
 
     served = []
 
@@ -160,8 +186,7 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(s, h)
         server.close()
         report = server.report()
-        if args.stats_json:
-            args.stats_json.write_text(json.dumps(report, indent=2) + "\n")
+        _write_stats(report)
         lat = report["latency"]
         if served:  # a server that never started has nothing to report
             print(

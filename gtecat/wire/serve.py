@@ -62,6 +62,8 @@ from drives.esc.frames import ETHERTYPE_ECAT
 from eni.errors import GtecatError
 
 from ..master.pcap import PcapWriter
+from .pacing import Pacing
+from .rx_ring import RxRing, open_ring
 
 log = logging.getLogger(__name__)
 
@@ -115,13 +117,25 @@ class ServeStats:
     stopped_ns: int = 0
     #: kernel receive timestamp (or user-space receive) -> send returned
     latency: LatencyRecorder = field(default_factory=LatencyRecorder)
+    #: kernel receive timestamp -> user-space receive returned (the frame waiting for us)
+    wait: LatencyRecorder = field(default_factory=LatencyRecorder)
     #: user-space receive -> send called (the ESC emulation alone)
     processing: LatencyRecorder = field(default_factory=LatencyRecorder)
     #: the send syscall
     send: LatencyRecorder = field(default_factory=LatencyRecorder)
     #: whether ``latency`` starts at the kernel's receive timestamps
     kernel_timestamps: bool = False
+    #: "rx ring", "recvmsg" (with time stamps) or "recv"
+    receive_path: str = ""
 
+
+#: how the loop waits for the next frame: sleeping in poll (a wake-up per frame),
+#: predicting the master's cyclic frame and spinning only around its due time
+#: (:mod:`gtecat.wire.pacing`; frame step mode), or spinning all the time (a whole CPU)
+WAIT_MODES = ("predict", "sleep", "spin")
+
+#: turns of the busy-poll spin between two looks at the stop flag, watchdogs and timers
+SPIN_TURNS = 256
 
 SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
 SCM_TIMESTAMPNS = SO_TIMESTAMPNS
@@ -191,9 +205,11 @@ class WireServer:
         min_gap_ns: int = 0,
         poll_s: float = 0.02,
         busy_poll: bool = False,
+        wait: str = "predict",
         clock: Callable[[], int] = time.monotonic_ns,
         sock: socket.socket | None = None,
         pcap: PcapWriter | None = None,
+        use_ring: bool = True,
     ) -> None:
         if step_mode not in ("frame", "cycle"):
             raise ValueError(f"step_mode must be 'frame' or 'cycle', not {step_mode!r}")
@@ -206,18 +222,40 @@ class WireServer:
         self.max_dt_ns = max_dt_ns
         self.min_gap_ns = min_gap_ns
         self.poll_s = poll_s
-        self.busy_poll = busy_poll
+        if wait not in WAIT_MODES:
+            raise ValueError(f"wait must be one of {', '.join(WAIT_MODES)}, not {wait!r}")
+        #: how the loop waits for frames (WAIT_MODES); ``busy_poll`` = "spin"
+        self.wait = "spin" if busy_poll else wait
+        self.pacing = Pacing()
         self.clock = clock
         self.stop = threading.Event()
         self.stats = ServeStats()
         #: every frame received and every answer sent, when set (``--pcap``)
         self.pcap = pcap
+        #: receive through a PACKET_RX_RING where the socket takes one
+        self.use_ring = use_ring
         self._sock = sock
         self._t0 = 0
         self._last_step: int | None = None
         #: a process-data frame was answered inside a step: one more step follows it
         self._step_due = False
         self._answered_in_this_step = False
+        #: set (from a signal handler, say) to have :attr:`on_snapshot` called with the
+        #: report between frames, then the latency records started afresh
+        self.snapshot_due = False
+        self.on_snapshot: Callable[[dict[str, object]], None] | None = None
+        self.snapshots = 0
+
+    def _snapshot(self) -> None:
+        """Report what the latency records hold and start them afresh (``gtecat serve``:
+        SIGUSR1), so a benchmark can time one phase of a run, e.g. only the paced cycles."""
+        self.snapshot_due = False
+        self.snapshots += 1
+        if self.on_snapshot is not None:
+            self.on_snapshot(self.report())
+        s = self.stats
+        s.latency, s.wait = LatencyRecorder(), LatencyRecorder()
+        s.processing, s.send = LatencyRecorder(), LatencyRecorder()
 
     # --- slave cycle -----------------------------------------------------------------------
     def _step(self, now: int, between: Callable[[], None] | None = None) -> None:
@@ -244,13 +282,19 @@ class WireServer:
         poller = select.poll()
         poller.register(sock.fileno(), select.POLLIN)
         poll = poller.poll
+        ring = self._ring
+        waiting: Callable[[], object] = ring.ready if ring is not None else (lambda: poll(0))
         self._t0 = stats.started_ns = clock()
         deadline = None if duration_s is None else self._t0 + int(duration_s * 1e9)
         next_cycle = self._t0 + self.cycle_ns
         next_poll = self._t0
         frame_mode = self.step_mode == "frame"
-        latency, processing, send_time = stats.latency, stats.processing, stats.send
         pcap = self.pcap
+        spin = self.wait == "spin"
+        predict = self.wait == "predict" and frame_mode
+        pacing = self.pacing = Pacing()
+        fd = sock.fileno()
+        poll_ns = int(self.poll_s * 1e9)
         self._sync_clocks()
 
         def answer(in_step: bool) -> bool:
@@ -280,9 +324,13 @@ class WireServer:
                 if stats.send_errors <= 5:
                     log.warning("send failed: %s", exc)
             t_out = clock()
-            latency.add(t_out - (t_kernel or t_in))
-            processing.add(t_send - t_in)
-            send_time.add(t_out - t_send)
+            if chain.process_data:
+                pacing.arrived(t_kernel or t_in)
+            stats.latency.add(t_out - (t_kernel or t_in))
+            if t_kernel:
+                stats.wait.add(t_in - t_kernel)
+            stats.processing.add(t_send - t_in)
+            stats.send.add(t_out - t_send)
             if pcap is not None:
                 pcap.write(request, self._wall(t_kernel or t_in))
                 pcap.write(view[:n], self._wall(t_send))
@@ -306,7 +354,7 @@ class WireServer:
         def between() -> None:
             # one frame per step at most: a master sending back to back must neither keep
             # the step from finishing nor take every answer out of the step rhythm
-            if not self._answered_in_this_step and poll(0) and answer(True):
+            if not self._answered_in_this_step and waiting() and answer(True):
                 self._answered_in_this_step = True
 
         gc.collect()
@@ -320,12 +368,36 @@ class WireServer:
                 now = clock()
                 if deadline is not None and now >= deadline:
                     break
-                timeout_ms = 0 if self.busy_poll else int(self.poll_s * 1000)
-                if not frame_mode and timeout_ms:
-                    timeout_ms = max(0, min(timeout_ms, (next_cycle - now + 999_999) // 1_000_000))
-                if poll(timeout_ms):
-                    while answer(False):
-                        pass
+                window = pacing.window() if predict else None
+                if spin or window is not None:
+                    turns = SPIN_TURNS
+                    if window is not None:
+                        opens, closes = window
+                        if now < opens:  # sleep until the window opens; a frame ends it
+                            if select.select([fd], [], [], min(opens - now, poll_ns) / 1e9)[0]:
+                                while answer(False):
+                                    pass
+                            turns = 0
+                        elif now >= closes:  # the frame did not come: poll until it does
+                            pacing.missed()
+                            turns = 0
+                    # a tight spin on the socket (a look at the ring's next slot, or one
+                    # poll syscall, per turn); the loop's housekeeping below runs every
+                    # SPIN_TURNS turns or after a frame
+                    for _ in range(turns):
+                        if waiting():
+                            while answer(False):
+                                pass
+                            break
+                else:
+                    timeout_ms = int(self.poll_s * 1000)
+                    if not frame_mode:
+                        timeout_ms = max(
+                            0, min(timeout_ms, (next_cycle - now + 999_999) // 1_000_000)
+                        )
+                    if poll(timeout_ms):
+                        while answer(False):
+                            pass
                 now = clock()
                 if not frame_mode:
                     while now >= next_cycle:
@@ -334,6 +406,8 @@ class WireServer:
                         if now - next_cycle > 100 * self.cycle_ns:  # fell far behind: resync
                             next_cycle = now + self.cycle_ns
                 if now >= next_poll:
+                    if self.snapshot_due:
+                        self._guarded(self._snapshot)
                     self._guarded(chain.poll, now)
                     gc.collect(0)
                     self._sync_clocks()
@@ -358,9 +432,32 @@ class WireServer:
         """Our clock -> wall-clock ns (pcap timestamps)."""
         return t + self._realtime_offset
 
+    _ring: RxRing | None = None
+
     def _receiver(self, sock: socket.socket, view: memoryview) -> Callable[[], tuple[int, int]]:
-        """``receive() -> (bytes, kernel receive time on our clock or 0)``."""
-        stamps = self.clock is time.monotonic_ns and _ANC_SIZE > 0
+        """``receive() -> (bytes, kernel receive time on our clock or 0)``: from a receive
+        ring where the socket takes one (:mod:`gtecat.wire.rx_ring`), else ``recvmsg``
+        with SO_TIMESTAMPNS, else plain ``recv_into``."""
+        stamps = self.clock is time.monotonic_ns
+        ring = self._ring = open_ring(sock) if self.use_ring else None
+        if ring is not None:
+            self.stats.kernel_timestamps = stamps
+            self.stats.receive_path = "rx ring"
+            take = ring.take
+            if not stamps:
+
+                def ringed_plain() -> tuple[int, int]:
+                    return take(view)[0], 0
+
+                return ringed_plain
+            self._sync_clocks()
+
+            def ringed() -> tuple[int, int]:
+                n, t = take(view)
+                return n, t - self._realtime_offset
+
+            return ringed
+        stamps = stamps and _ANC_SIZE > 0
         if stamps:
             try:
                 sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
@@ -368,12 +465,14 @@ class WireServer:
                 stamps = False
         self.stats.kernel_timestamps = stamps
         if not stamps:
+            self.stats.receive_path = "recv"
             recv_into = sock.recv_into
 
             def plain() -> tuple[int, int]:
                 return recv_into(view), 0
 
             return plain
+        self.stats.receive_path = "recvmsg"
         self._sync_clocks()
         recvmsg_into, unpack = sock.recvmsg_into, _TIMESPEC.unpack
         bufs = [view]
@@ -406,6 +505,9 @@ class WireServer:
         time.sleep(self.poll_s)
 
     def close(self) -> None:
+        if self._ring is not None:
+            self._ring.close()
+            self._ring = None
         if self._sock is not None:
             self._sock.close()
             self._sock = None
@@ -432,7 +534,16 @@ class WireServer:
             "chain": self.chain.stats.as_dict(),
             "latency": s.latency.summary(),
             "latency_from": "kernel receive timestamp" if s.kernel_timestamps else "recv",
+            "receive_path": s.receive_path,
+            "wait": s.wait.summary(),
             "processing": s.processing.summary(),
             "send": s.send.summary(),
             "pid": os.getpid(),
+            "snapshot": self.snapshots,
+            "wait_mode": self.wait,
+            "pacing": {
+                "period_us": round(self.pacing.period_ns / 1000, 1),
+                "jitter_us": round(self.pacing.jitter_ns / 1000, 1),
+                "missed_windows": self.pacing.misses,
+            },
         }

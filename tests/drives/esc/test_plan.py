@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
+from drives.esc import chain as chain_mod
 from drives.esc.registers import Reg
 from drives.slave import AlState
 from tests.drives.esc.mini import MiniMaster, mini_chain
@@ -113,22 +114,34 @@ cyclic = st.tuples(
     st.sampled_from([0, 2, 9]),
     st.sampled_from([22, 13, 8, 12]),
     st.integers(0, 255),
+    st.sampled_from([0, 0, 7]),  # bytes after the EtherCAT frame (Ethernet padding)
 )
+_zero = st.just(0)
+#: the master's cycle: the same two frames again and again (what the shortcut serves)
+#: (byte-aligned slaves only: the bit-mapped third slave keeps a frame off the fast path)
+repeated = st.tuples(
+    st.sampled_from([Command.LRW, Command.LWR]), _zero, st.just(8), st.integers(0, 255), _zero
+) | st.tuples(st.just(Command.LRW), st.just(9), st.just(12), st.integers(0, 255), st.just(7))
 cyclic_ops = st.one_of(
     cyclic,
-    st.tuples(st.just("state"), st.integers(0, 2), st.sampled_from([2, 4, 8]), st.just(0)),
-    st.tuples(st.just("step"), st.just(0), st.just(0), st.just(0)),
-    st.tuples(st.just("fprd"), st.integers(0, 2), st.sampled_from([0x1100, 0x1000]), st.just(0)),
+    repeated,
+    repeated,
+    repeated,
+    st.tuples(st.just("state"), st.integers(0, 2), st.sampled_from([2, 4, 8]), _zero, _zero),
+    st.tuples(st.just("step"), _zero, _zero, _zero, _zero),
+    st.tuples(st.just("fprd"), st.integers(0, 2), st.sampled_from([0x1100, 0x1000]), _zero, _zero),
 )
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=120, deadline=None)
 @given(st.lists(cyclic_ops, min_size=1, max_size=40))
 def test_repeated_cyclic_frames_agree_with_the_general_path(sequence: list) -> None:
+    """Also covers the one-datagram shortcut (Chain._cyclic: a repeat of the last fast
+    frame skips the walk), with and without Ethernet padding after the frame."""
     fast, mf = configured(False)
     slow, ms = configured(True)
     t = 0
-    for op, a, b, c in sequence:
+    for op, a, b, c, pad in sequence:
         if op == "state":
             assert mf.set_state(0x1001 + a, b) == ms.set_state(0x1001 + a, b)
         elif op == "step":
@@ -138,7 +151,9 @@ def test_repeated_cyclic_frames_agree_with_the_general_path(sequence: list) -> N
         elif op == "fprd":
             assert mf.fprd(0x1001 + a, b, 2) == ms.fprd(0x1001 + a, b, 2)
         else:
-            frame = encode_frame([Datagram.logical(op, a, bytes([c]) * b)])
+            frame = bytearray(encode_frame([Datagram.logical(op, a, bytes([c]) * b)]))
+            struct.pack_into("<H", frame, 26 + b, c & 3)  # a working counter already counted
+            frame += b"\xee" * pad
             buf_f, buf_s = bytearray(frame), bytearray(frame)
             assert fast.process(buf_f) == slow.process(buf_s)  # no flush: as the serve loop
             assert buf_f == buf_s
@@ -162,3 +177,40 @@ def test_byte_aligned_cyclic_frames_are_answered_from_the_snapshot() -> None:
     assert bytes(chain.slaves[0].rx) == outputs[:6] and bytes(chain.slaves[1].rx) == outputs[6:]
     data, _wkc = m.lrw(9, bytes(12))
     assert data[:6] == outputs[:6] and data[10:12] == outputs[6:]  # echoed by the step
+
+
+def test_a_repeated_cyclic_frame_takes_the_shortcut_and_answers_alike() -> None:
+    """The shortcut is really taken for the master's repeated frame (not only the walk), gives
+    the general path's bytes, and is forgotten when the mapping changes."""
+    fast, mf = configured(False)
+    slow, ms = configured(True)
+    for m in (mf, ms):
+        for pos in range(3):
+            assert m.set_state(0x1001 + pos, AlState.OP) == (8, 0)
+    frame = encode_frame([Datagram.logical(Command.LRW, 0, bytes(8))])
+    walks = 0
+    real_walk = chain_mod.walk
+
+    def counting_walk(*args):
+        nonlocal walks
+        walks += 1
+        return real_walk(*args)
+
+    chain_mod.walk = counting_walk
+    try:
+        for i in range(5):
+            out = bytearray(frame)
+            out[26:34] = bytes([i]) * 8
+            ref = bytearray(out)
+            assert fast.process(out) and slow.process(ref)
+            assert out == ref
+            fast.service()
+            slow.service()
+            fast.step(i, 1_000_000)
+            slow.step(i, 1_000_000)
+    finally:
+        chain_mod.walk = real_walk
+    assert walks == 2 + 5  # fast: the first (compiles) and second (fast path) only; slow: all
+    assert fast._cyclic is not None
+    assert mf.set_state(0x1001, AlState.SAFEOP) == (4, 0)
+    assert fast._cyclic is None  # a state change forgets the plans and the shortcut
