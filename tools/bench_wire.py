@@ -250,6 +250,7 @@ def main(argv: list[str] | None = None) -> int:
                 "wait_mode",
                 "pacing",
                 "receive_path",
+                "cpu_percent",
             )
             if k in report
         }

@@ -245,6 +245,8 @@ class WireServer:
         self.snapshot_due = False
         self.on_snapshot: Callable[[dict[str, object]], None] | None = None
         self.snapshots = 0
+        #: (process CPU time, clock) when the records last started: the CPU share reported
+        self._cpu_mark = (time.process_time(), clock())
 
     def _snapshot(self) -> None:
         """Report what the latency records hold and start them afresh (``gtecat serve``:
@@ -254,6 +256,7 @@ class WireServer:
         if self.on_snapshot is not None:
             self.on_snapshot(self.report())
         s = self.stats
+        self._cpu_mark = (time.process_time(), self.clock())
         s.latency, s.wait = LatencyRecorder(), LatencyRecorder()
         s.processing, s.send = LatencyRecorder(), LatencyRecorder()
 
@@ -514,6 +517,12 @@ class WireServer:
         if self.pcap is not None:
             self.pcap.close()
 
+    def _cpu_percent(self) -> float:
+        """This process's CPU use since the records started (a whole core = 100)."""
+        cpu0, t0 = self._cpu_mark
+        wall = (self.clock() - t0) / 1e9
+        return round(100 * (time.process_time() - cpu0) / wall, 1) if wall > 0 else 0.0
+
     def report(self) -> dict[str, object]:
         """Counters and latency, for ``--stats-json`` and the benchmark."""
         s = self.stats
@@ -540,6 +549,7 @@ class WireServer:
             "send": s.send.summary(),
             "pid": os.getpid(),
             "snapshot": self.snapshots,
+            "cpu_percent": self._cpu_percent(),
             "wait_mode": self.wait,
             "pacing": {
                 "period_us": round(self.pacing.period_ns / 1000, 1),
