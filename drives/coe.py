@@ -11,6 +11,7 @@ order) and read as "bits 7..0" of the byte the standard draws.
 
 from __future__ import annotations
 
+import functools
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -24,6 +25,7 @@ from construct import (
     ByteSwapped,
     Const,
     ConstructError,
+    Container,
     Flag,
     GreedyBytes,
     Int8ul,
@@ -268,23 +270,60 @@ SEGMENT_OVERHEAD = MAILBOX_HEADER_SIZE + COE_HEADER_SIZE + 1
 
 
 # --- building and parsing helpers -------------------------------------------------
-def build_mailbox(
-    data: bytes, *, counter: int, mbx_type: MailboxType = MailboxType.COE, address: int = 0
-) -> bytes:
-    header = MailboxHeader.build(
+# The fixed headers below are pure functions of a few small numbers (or bytes), built and
+# parsed by their construct definitions once per distinct value: a bus bring-up sends the
+# same few hundred InitCmd SDOs every time, and construct costs ~100 us per build here.
+# Parsed containers are shared: callers only read them.
+@functools.lru_cache(maxsize=4096)
+def _mailbox_header(length: int, address: int, counter: int, mbx_type: int) -> bytes:
+    return MailboxHeader.build(
         {
-            "length": len(data),
+            "length": length,
             "address": address,
             "bits": {
                 "priority": 0,
                 "channel": 0,
                 "reserved": 0,
-                "counter": counter & 7,
-                "type": int(mbx_type),
+                "counter": counter,
+                "type": mbx_type,
             },
         }
     )
-    return header + data
+
+
+@functools.lru_cache(maxsize=64)
+def _coe_header(service: int) -> bytes:
+    return CoeHeader.build({"service": service, "reserved": 0, "number": 0})
+
+
+@functools.lru_cache(maxsize=4096)
+def _parsed_mailbox_header(raw: bytes) -> tuple[int, int, int]:
+    hdr = MailboxHeader.parse(raw)
+    return hdr.length, hdr.bits.counter, hdr.bits.type
+
+
+@functools.lru_cache(maxsize=256)
+def parse_coe_header(raw: bytes) -> Container:
+    """The CoE header (2 bytes) as parsed by CoeHeader; a shared, read-only container."""
+    return CoeHeader.parse(raw)
+
+
+@functools.lru_cache(maxsize=256)
+def parse_initiate_command(raw: bytes) -> Container:
+    """The SDO command byte as parsed by SdoInitiateCommand; shared, read-only."""
+    return SdoInitiateCommand.parse(raw)
+
+
+@functools.lru_cache(maxsize=4096)
+def parse_expedited(raw: bytes) -> Container:
+    """An 8..10-byte expedited SDO frame as parsed by SdoExpedited; shared, read-only."""
+    return SdoExpedited.parse(raw)
+
+
+def build_mailbox(
+    data: bytes, *, counter: int, mbx_type: MailboxType = MailboxType.COE, address: int = 0
+) -> bytes:
+    return _mailbox_header(len(data), address, counter & 7, int(mbx_type)) + data
 
 
 def mailbox_error(detail: MailboxError, *, counter: int = 0) -> bytes:
@@ -295,8 +334,7 @@ def mailbox_error(detail: MailboxError, *, counter: int = 0) -> bytes:
 
 def build_coe(service: CoeService, sdo: bytes, *, counter: int) -> bytes:
     """A whole mailbox message carrying one CoE service."""
-    coe = CoeHeader.build({"service": int(service), "reserved": 0, "number": 0})
-    return build_mailbox(coe + sdo, counter=counter)
+    return build_mailbox(_coe_header(int(service)) + sdo, counter=counter)
 
 
 def initiate_cmd(
@@ -321,6 +359,13 @@ def build_initiate(
 ) -> bytes:
     """An 8-byte initiate frame (ETG.1000.6 5.6.2.1-4): expedited with ``data`` (1-4 bytes)
     and its size indicated, or without data (an upload request, a download answer)."""
+    return _build_initiate(command, index, subindex, bytes(data), complete_access)
+
+
+@functools.lru_cache(maxsize=4096)
+def _build_initiate(
+    command: int, index: int, subindex: int, data: bytes, complete_access: bool
+) -> bytes:
     if data:
         cmd = initiate_cmd(
             command,
@@ -362,11 +407,11 @@ def parse_mailbox(message: bytes) -> ParsedMailbox:
     """Split a whole mailbox message; raises ValueError when it is cut short."""
     if len(message) < MAILBOX_HEADER_SIZE:
         raise ValueError(f"mailbox message of {len(message)} bytes is shorter than its header")
-    hdr = MailboxHeader.parse(message[:MAILBOX_HEADER_SIZE])
-    end = MAILBOX_HEADER_SIZE + hdr.length
+    length, counter, mbx_type = _parsed_mailbox_header(bytes(message[:MAILBOX_HEADER_SIZE]))
+    end = MAILBOX_HEADER_SIZE + length
     if len(message) < end:
-        raise ValueError(f"mailbox header says {hdr.length} bytes, message has {len(message) - 6}")
-    return ParsedMailbox(hdr.bits.counter, hdr.bits.type, bytes(message[MAILBOX_HEADER_SIZE:end]))
+        raise ValueError(f"mailbox header says {length} bytes, message has {len(message) - 6}")
+    return ParsedMailbox(counter, mbx_type, bytes(message[MAILBOX_HEADER_SIZE:end]))
 
 
 def next_counter(counter: int) -> int:
@@ -496,7 +541,7 @@ class SdoClient:
             raise fail(f"answer has mailbox type {mbx.mbx_type}, not CoE")
         if len(mbx.data) < COE_HEADER_SIZE + 1:
             raise fail(f"CoE answer of {len(mbx.data)} bytes carries no SDO frame")
-        coe = CoeHeader.parse(mbx.data[:COE_HEADER_SIZE])
+        coe = parse_coe_header(mbx.data[:COE_HEADER_SIZE])
         body = mbx.data[COE_HEADER_SIZE:]
         is_abort = body[0] == 0x80 and coe.service in (
             CoeService.SDO_REQUEST,  # what ETG.1000.6 / SOES / IgH send

@@ -33,13 +33,10 @@ from drives.coe import (
     INITIATE_OVERHEAD,
     SEGMENT_OVERHEAD,
     Ccs,
-    CoeHeader,
     CoeService,
     MailboxError,
     MailboxType,
     Scs,
-    SdoExpedited,
-    SdoInitiateCommand,
     SdoNormal,
     SdoSegment,
     build_abort,
@@ -50,6 +47,9 @@ from drives.coe import (
     mailbox_error,
     next_counter,
     pad_segment,
+    parse_coe_header,
+    parse_expedited,
+    parse_initiate_command,
     parse_mailbox,
     segment_cmd,
 )
@@ -101,7 +101,7 @@ class SdoServer:
             return self._mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL)
         if len(mbx.data) < COE_HEADER_SIZE + 1:
             return self._mailbox_error(MailboxError.SIZE_TOO_SHORT)
-        coe = CoeHeader.parse(mbx.data[:COE_HEADER_SIZE])
+        coe = parse_coe_header(bytes(mbx.data[:COE_HEADER_SIZE]))
         self._pending.clear()
         if coe.service == CoeService.SDO_INFORMATION:
             return self._information(mbx.data[COE_HEADER_SIZE:])
@@ -173,7 +173,7 @@ class SdoServer:
         self._upload = self._download = None
         if len(body) < 4:
             raise SdoAbort(SdoAbortCode.GENERAL_ERROR, 0, 0, "short upload request")
-        req = SdoExpedited.parse(body.ljust(10, b"\x00"))
+        req = parse_expedited(bytes(body.ljust(10, b"\x00")))
         index, subindex, ca = req.index, req.subindex, req.cmd.complete_access
         data = self.od.upload(index, subindex, complete_access=ca)
         if len(data) <= 4 and data:
@@ -223,7 +223,7 @@ class SdoServer:
         self._upload = self._download = None
         if len(body) < 4:
             raise SdoAbort(SdoAbortCode.GENERAL_ERROR, 0, 0, "short download request")
-        cmd = SdoInitiateCommand.parse(body[:1])
+        cmd = parse_initiate_command(bytes(body[:1]))
         index, subindex = _address(body)
         ca = cmd.complete_access
         if cmd.expedited:

@@ -12,6 +12,7 @@ both ``Gecat.eni``); only the bytes decide.
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from pathlib import Path
@@ -123,4 +124,12 @@ def read_eni(path: str | os.PathLike[str]) -> EniConfig:
         raise EniError(f"cannot read the file: {exc.strerror or exc}", file=str(p)) from None
     if not data.strip():
         raise EniError("the file is empty", file=str(p))
-    return parse_eni(data, str(p))
+    return _parse_cached(data, str(p))
+
+
+@functools.lru_cache(maxsize=32)
+def _parse_cached(data: bytes, source: str) -> EniConfig:
+    """One parse per file content: the model is immutable (frozen dataclasses of tuples), so
+    a program or a test suite that opens the same ENI again gets the same object; a file that
+    changed is a new key, and one that fails raises each time (errors are not cached)."""
+    return parse_eni(data, source)
