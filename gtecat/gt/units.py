@@ -115,11 +115,29 @@ def _matches(pattern: str, name: str) -> bool:
 
 
 @cache
+def _index() -> tuple[dict[str, list[int]], list[tuple[str, int]]]:
+    """Row numbers by exact function name, and the wildcard patterns with theirs."""
+    exact: dict[str, list[int]] = {}
+    wild: list[tuple[str, int]] = []
+    for i, r in enumerate(ROWS):
+        for p in r.functions:
+            if "*" in p:
+                wild.append((p, i))
+            else:
+                exact.setdefault(p, []).append(i)
+    return exact, wild
+
+
+@cache
 def units_of(name: str) -> tuple[Row, ...]:
-    """The rows that name the GT function ``name`` (a ``GTN_`` twin: its ``GT_``'s)."""
+    """The rows that name the GT function ``name`` (a ``GTN_`` twin: its ``GT_``'s), in
+    table order."""
     if name.startswith("GTN_"):
         name = "GT_" + name[4:]
-    return tuple(r for r in ROWS if any(_matches(p, name) for p in r.functions))
+    exact, wild = _index()
+    hits = set(exact.get(name, ()))
+    hits.update(i for p, i in wild if _matches(p, name))
+    return tuple(ROWS[i] for i in sorted(hits))
 
 
 def _plain(text: str) -> str:
