@@ -304,7 +304,8 @@ class Master:
         self._update_offline()
 
     def all_op(self) -> bool:
-        return all(s == AlState.OP for s in self.states)
+        states = self.states
+        return states.count(AlState.OP) == len(states)  # (asked every cycle: no generator)
 
     @property
     def ready(self) -> bool:
