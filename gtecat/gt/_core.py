@@ -39,7 +39,7 @@ from ..errors import (
 )
 from .args import Ref, binder, core_arg
 from .fast import READERS, fast_reader
-from .table import FUNCTIONS, Proto
+from .table import FUNCTIONS, NO_CORE_TWINS, Proto
 from .units import with_units
 
 log = logging.getLogger("gtecat.gt")
@@ -243,15 +243,30 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt
     if proto.gtn:
+        own = NO_CORE_TWINS.get(name)
+        if own is not None:
+            # the vendor's GTN_Open(channel=5, param=1) / GTN_Close(): no core; the core-first
+            # form of earlier gtecat releases (one argument more, or core=) still works
+            def gtn(*args: Any, **kwargs: Any) -> int:
+                if len(args) > len(own) or "core" in kwargs:
+                    if args:
+                        return call(args[0], args[1:], kwargs)
+                    return call(kwargs.pop("core"), (), kwargs)
+                return call(_ONE, args, kwargs)
 
-        def gtn(*args: Any, **kwargs: Any) -> int:
-            if args:
-                return call(args[0], args[1:], kwargs)
-            return call(kwargs.pop("core", None), (), kwargs)
+        else:
+
+            def gtn(*args: Any, **kwargs: Any) -> int:
+                if args:
+                    return call(args[0], args[1:], kwargs)
+                return call(kwargs.pop("core", None), (), kwargs)
 
         gtn.__name__ = "GTN_" + name[3:]
         gtn.__doc__ = with_units(
-            name, f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core)."
+            name,
+            f"``{name}`` of the whole controller (the vendor's GTN header: no core)."
+            if own is not None
+            else f"``{name}`` with ``short core`` first (core 1 is the EtherCAT core).",
         )
         gtn.prototype = proto  # type: ignore[attr-defined]
         REGISTRY[gtn.__name__] = gtn

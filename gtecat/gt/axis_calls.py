@@ -28,7 +28,7 @@ Decisions where the manual is silent:
   latched; entry 5 return 1: "check whether the drive has an alarm").
 * ``GT_GetEcatEncPos`` reports 6064h as the drive counts it (no scaling);
   ``GT_SetPosScale`` affects the controller's own positions.
-* ``GT_GetEcatAxisPdoData(axis, object, pData, subindex=0)`` copies the mapped
+* ``GT_GetEcatAxisPdoData(axis, object, pData)`` copies the mapped
   entry's bytes (little endian, the entry's size rounded up to bytes).  On a
   multi-axis module ``object`` may be numbered as for channel 0 (0x6064) or as
   the axis's own channel (0x6864 on channel 1); another channel's object is
@@ -226,13 +226,13 @@ def GT_GetPosScale(ctl: Controller, axis: int, pScale: Any) -> int:
 
 
 @gt_function
-def GT_GetEcatAxisPdoData(
-    ctl: Controller, axis: int, object: int, pData: Any, subindex: int = 0
-) -> int:
-    """Any mapped object of the axis by index (0x6064, or its channel's own 0x6864)."""
+def GT_GetEcatAxisPdoData(ctl: Controller, axis: int, object: int, pData: Any) -> int:
+    """Any mapped object of the axis by index (0x6064, or its channel's own 0x6864), subindex 0:
+    the vendor header's three parameters (vendor demos call
+    ``GTN_GetEcatAxisPdoData(core, axis, 0x6041, (unsigned char *)&sw)``)."""
     ax = bus_axis(ctl, axis)
     check_range("object", object, 0, 0xFFFF)
-    acc = ax.io.require(int(object), int(subindex))
+    acc = ax.io.require(int(object), 0)
     value = acc.get()
     n = (acc.bits + 7) // 8
     store_bytes(pData, (value & ((1 << (8 * n)) - 1)).to_bytes(n, "little"))

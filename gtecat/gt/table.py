@@ -70,7 +70,7 @@ short GT_SetEcatAxisPT(short axis, short torque);                               
 short GT_SetEcatAxisPV(short axis, long velocity);                               // 102
 short GT_SetPosScale(short axis, unsigned short scale);                          // 117
 short GT_GetPosScale(short axis, unsigned short *pScale);                        // 61
-short GT_GetEcatAxisPdoData(short axis, unsigned short object, unsigned char *pData /*out[?]*/, unsigned char subindex=0);  // header (the object's size)
+short GT_GetEcatAxisPdoData(short axis, unsigned short object, unsigned char *pData /*out[?]*/);  // header (the object's size)
 short GT_SetHomingMode(short axis, short mode);                                  // 112
 short GT_SetEcatHomingPrm(short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);  // 103
 short GT_StartEcatHoming(short axis);                                            // 130
@@ -286,6 +286,15 @@ class Param:
         return float(self.default) if self.is_float else int(self.default, 0)
 
 
+#: ``GT_x`` lines whose ``GTN_x`` twin has no core, as the vendor's GTN header declares
+#: them: ``GTN_Open(short channel=5, short param=1)`` and ``GTN_Close(void)`` open and
+#: close the whole controller (every core); their parameters with the vendor defaults
+NO_CORE_TWINS: dict[str, tuple[tuple[str, str], ...]] = {
+    "GT_Open": (("channel", "5"), ("param", "1")),
+    "GT_Close": (),
+}
+
+
 @dataclass(frozen=True, slots=True)
 class Proto:
     """One GT function as the table declares it."""
@@ -307,6 +316,11 @@ class Proto:
         same ABI, and C++ callers passing a string literal (``GT_LoadConfig("GTS800.cfg")``,
         seed 002) compile without ISO C++'s string-constant warning."""
         name = ("GTN_" + self.name[3:]) if core else self.name
+        if core and self.name in NO_CORE_TWINS:
+            own = [
+                f"short {n}={d}" if defaults else f"short {n}" for n, d in NO_CORE_TWINS[self.name]
+            ]
+            return f"short {name}({', '.join(own) or 'void'})"
         parts = ["short core"] if core else []
         for p in self.params:
             ctype = f"const {p.ctype}" if p.text and p.direction == "in" else p.ctype

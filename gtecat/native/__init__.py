@@ -33,7 +33,7 @@ def cdll():
     """
     import ctypes
 
-    from ..gt.table import FUNCTIONS, SCALARS
+    from ..gt.table import FUNCTIONS, NO_CORE_TWINS, SCALARS
 
     lib = ctypes.CDLL(str(library_path()))
 
@@ -45,7 +45,10 @@ def cdll():
     for proto in FUNCTIONS.values():
         types = [ctype(p) for p in proto.params]
         names = [(proto.name, types)]
-        if proto.gtn:
+        if proto.name in NO_CORE_TWINS:
+            own = [ctypes.c_short] * len(NO_CORE_TWINS[proto.name])
+            names.append(("GTN_" + proto.name[3:], own))
+        elif proto.gtn:
             names.append(("GTN_" + proto.name[3:], [ctypes.c_short, *types]))
         for name, argtypes in names:
             fn = getattr(lib, name)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import socket
 
 from .. import __version__
-from ..gt.table import Proto
+from ..gt.table import NO_CORE_TWINS, Proto
 from .protocol import (
     CHUNK,
     MAX_FRAME,
@@ -119,7 +119,15 @@ def render_stubs(python: str) -> str:
         proto = plan.proto
         lines += _descriptor(plan)
         lines += [proto.c_signature(defaults=False).replace("()", "(void)"), *_body(plan, False)]
-        if proto.gtn:
+        if proto.name in NO_CORE_TWINS:  # the vendor's GTN_Open(channel, param), GTN_Close()
+            own = ", ".join(n for n, _ in NO_CORE_TWINS[proto.name])
+            lines += [
+                proto.c_signature(defaults=False, core=True),
+                "{",
+                f"    return {proto.name}({own});",
+                "}",
+            ]
+        elif proto.gtn:
             lines += [proto.c_signature(defaults=False, core=True), *_body(plan, True)]
         lines.append("")
     return "\n".join(lines)

@@ -197,7 +197,7 @@ def test_a_typed_null_is_a_null_for_an_optional_pointer_and_refused_for_a_requir
         lambda sts: gt.GTN_GetSts(2, 1, byref(sts)),
         lambda sts: gt.GTN_GetSts(1 << 40, 1, byref(sts)),
         lambda sts: gt.GTN_Close(2),
-        lambda sts: gt.GTN_Open(0),
+        lambda sts: gt.GTN_Open(0, 0, 1),  # the core-first form of earlier releases
         lambda sts: gt.GTN_Close("1"),
     ],
 )

@@ -48,7 +48,7 @@ def last_error(lib) -> str:
 
 
 def bring_up(lib) -> None:
-    assert lib.GTN_Open(1, 0, 1) == 0, last_error(lib)
+    assert lib.GTN_Open(5, 1) == 0, last_error(lib)  # the vendor's GTN_Open(channel, param)
     assert lib.GTN_InitEcatComm(1) == 0, last_error(lib)
     status = c_short()
     for _ in range(100):

@@ -14,7 +14,7 @@ import subprocess
 import pytest
 
 from gtecat import gt
-from gtecat.gt.table import FUNCTIONS, PROTOTYPES, parse
+from gtecat.gt.table import FUNCTIONS, NO_CORE_TWINS, PROTOTYPES, parse
 from gtecat.native import cdecl, header
 
 from .conftest import needs_cc, needs_cxx
@@ -63,7 +63,11 @@ def _expected(functions, *, defaults: bool) -> dict[str, list[tuple[str, str, st
             for p in proto.params
         ]
         out[proto.name] = ps
-        if proto.name.startswith("GT_"):
+        if proto.name in NO_CORE_TWINS:  # the vendor's GTN_Open(channel, param), GTN_Close()
+            out["GTN_" + proto.name[3:]] = [
+                ("short", n, d if defaults else None) for n, d in NO_CORE_TWINS[proto.name]
+            ]
+        elif proto.name.startswith("GT_"):
             out["GTN_" + proto.name[3:]] = [("short", "core", None), *ps]
     return out
 

@@ -88,7 +88,7 @@ def test_size_unknown_pointer_gets_what_the_call_wrote(served):
     _, address = served
     c = WireClient(address)
     c.call("GT_Open", 0, 1)
-    rc, blocks, _ = c.call("GT_GetEcatAxisPdoData", 1, 0x6064, "?", 0)
+    rc, blocks, _ = c.call("GT_GetEcatAxisPdoData", 1, 0x6064, "?")
     assert rc == 0
     assert len(blocks[0]) == 4  # 6064h is a DINT
 

@@ -31,7 +31,7 @@ int main(void)
     short rc, status = 0;
     int polls;
 
-    rc = GTN_Open(CORE, 0, 1);
+    rc = GTN_Open(5, 1); /* the vendor GTN header: channel 5, no core */
     say("open", rc);
     if (rc != 0) {
         printf("reason %s\n", why());
@@ -145,10 +145,10 @@ int main(void)
     printf("version %s\n", version);
 
     say("last_error_null", GTE_GetLastError(NULL, 10));
-    say("close", GTN_Close(CORE));
+    say("close", GTN_Close());
     say("after_close", GTN_GetSts(CORE, 1, &sts, 1, NULL));
     printf("after_close_reason %s\n", why());
-    say("reopen", GTN_Open(CORE, 0, 1));
+    say("reopen", GTN_Open(5, 1));
     say("reopen_sts", GTN_GetSts(CORE, 1, &sts, 1, NULL));
     say("done", 1);
     return 0;
