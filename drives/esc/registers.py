@@ -348,7 +348,9 @@ class Esc:
         self.mbx_in_sm: SyncManager | None = None  # slave -> master (SM1)
         self._sm_keys: list[tuple[int, ...]] = [()] * N_SM
         self._mbx_queue: deque[bytes] = deque()
-        self._mbx_last: bytes = b""
+        self._mbx_last: bytes = b""  #: the message the SM1 buffer holds (or held last)
+        #: the message the master read last: what a repeat request puts back
+        self._mbx_read: bytes = b""
         self._mbx_cnt = 0
         self._mbx_in_pending = False
         #: counter of the last mailbox message taken (0: none since the mailbox started)
@@ -657,6 +659,7 @@ class Esc:
     def _enter_state(self, old: AlState, new: AlState) -> None:
         if new == AlState.INIT:
             self._mbx_queue.clear()
+            self._mbx_read = b""
             self._mbx_in_pending = False
             self._mbx_more = False
             self._mbx_write_counter = 0
@@ -737,13 +740,21 @@ class Esc:
         self._irq_update()
 
     def _repeat(self, sm: SyncManager, repeat_bit: int) -> None:
-        """Mailbox repeat request: put the last answer back and acknowledge (ETG.1000.4)."""
-        if self._mbx_last:
-            self._put_mailbox(sm, self._mbx_last)
+        """Mailbox repeat request: put back the message the master read last (its answer was
+        lost), with its own counter, and acknowledge (ETG.1000.4 5.6).  A newer message
+        already waiting unread in the buffer (the next fragment, say) goes back to the front
+        of the queue and follows once the repeated one is read."""
+        last = self._mbx_read or self._mbx_last
+        if last:
+            newer = self._mbx_last
+            if sm.full and newer and newer is not last:
+                self._mbx_queue.appendleft(newer)
+            self._write_mailbox(sm, last)
         a = Reg.SM0 + 8 * sm.num + 7
         self.mem[a] = (self.mem[a] & ~SM_PDI_REPEAT_ACK) | (SM_PDI_REPEAT_ACK if repeat_bit else 0)
 
     def _mailbox_read_done(self, sm: SyncManager) -> None:
+        self._mbx_read = self._mbx_last
         self._set_full(sm, False)
         if self._mbx_queue or self._mbx_more:
             self.on_pending(self)
@@ -900,6 +911,10 @@ class Esc:
             if len(buf) >= 6:
                 buf[5] = (buf[5] & 0x8F) | (self._mbx_cnt << 4)
             answer = bytes(buf)
+        self._write_mailbox(sm, answer)
+
+    def _write_mailbox(self, sm: SyncManager, answer: bytes) -> None:
+        """``answer`` (its link-layer counter stamped) into the SM1 buffer, which is then full."""
         self.mem[sm.start : sm.end] = answer + bytes(sm.length - len(answer))
         self._mbx_last = answer
         self._set_full(sm, True)
