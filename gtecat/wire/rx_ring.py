@@ -20,7 +20,6 @@ from __future__ import annotations
 import mmap
 import socket
 import struct
-from collections.abc import Callable
 
 SOL_PACKET = getattr(socket, "SOL_PACKET", 263)
 PACKET_RX_RING = 5  # linux/if_packet.h
@@ -95,7 +94,5 @@ def open_ring(sock: socket.socket) -> RxRing | None:
         return None
     return RxRing(sock, ring, frames)
 
-
-Receiver = Callable[[], tuple[int, int]]
 
 __all__ = ["RxRing", "open_ring"]

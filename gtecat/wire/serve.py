@@ -63,7 +63,7 @@ from eni.errors import GtecatError
 
 from ..master.pcap import PcapWriter
 from .pacing import Pacing
-from .rx_ring import RxRing, open_ring
+from .rx_ring import SOL_PACKET, RxRing, open_ring
 
 log = logging.getLogger(__name__)
 
@@ -139,7 +139,6 @@ SPIN_TURNS = 256
 
 SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
 SCM_TIMESTAMPNS = SO_TIMESTAMPNS
-SOL_PACKET = getattr(socket, "SOL_PACKET", 263)  # linux/socket.h
 PACKET_QDISC_BYPASS = 20  # linux/if_packet.h
 _TIMESPEC = struct.Struct("@qq")
 _ANC_SIZE = socket.CMSG_SPACE(_TIMESPEC.size) if hasattr(socket, "CMSG_SPACE") else 0
