@@ -43,7 +43,7 @@ from hypothesis import strategies as st
 from gtecat import gt
 from gtecat.gt import _core
 from gtecat.gt.args import _struct_types
-from gtecat.gt.table import SCALARS, Param
+from gtecat.gt.table import NO_CORE_TWINS, SCALARS, Param
 from tests.conftest import EXAMPLES
 from tests.gtecat.gt.conftest import bring_up
 
@@ -472,7 +472,9 @@ def _short(v: Any) -> str:
 def fuzz_function(name: str, examples: int, warnings: set[str]) -> None:
     fn = getattr(gt, name)
     proto = fn.prototype
-    is_gtn = name.startswith("GTN_")
+    # GTN_Open(channel, param) / GTN_Close(): the vendor's GTN header gives them no core
+    no_core = name.startswith("GTN_") and "GT_" + name[4:] in NO_CORE_TWINS
+    is_gtn = name.startswith("GTN_") and not no_core
     base = name.partition("_")[2]
     params = list(proto.params)
     names = [p.name for p in params]
@@ -582,6 +584,13 @@ def fuzz_function(name: str, examples: int, warnings: set[str]) -> None:
             else:
                 args = [core, *args]
                 core_desc = f"core={core!r}"
+        elif no_core and form == "pos" and passed == len(params) and params:
+            # the core-first form of earlier gtecat releases: one argument more than the vendor's
+            if data.draw(st.booleans(), label="earlier core-first form"):
+                core = data.draw(st.sampled_from([1, 1, 2, "1"]))
+                args = [core, *args]
+                must7 = must7 or core != 1
+                core_desc = f"core first={core!r}"
         elif proto.core_first_form and form in ("pos", "omit") and passed == len(params):
             if data.draw(st.booleans(), label="core first (manual 5.2.2.5)"):
                 core = data.draw(st.sampled_from([1, 1, 2, "1"]))
