@@ -209,12 +209,21 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--slave-if")
     p.add_argument("--serve-arg", action="append", default=[], help="extra gtecat serve option")
     p.add_argument("--json", type=Path, help="also write the result here")
+    p.add_argument(
+        "--pin",
+        action="store_true",
+        help="master on the first CPU, gtecat serve --cpu on the last (they never share one)",
+    )
     args = p.parse_args(argv)
+    cpus = sorted(os.sched_getaffinity(0))
+    if args.pin and len(cpus) >= 2:
+        os.sched_setaffinity(0, {cpus[0]})
+        args.serve_arg.append(f"--cpu={cpus[-1]}")
     if os.geteuid() != 0 and not (args.master_if and args.slave_if):
         raise SystemExit("needs root to create the veth pair (or pass --master-if/--slave-if)")
     import pysoem
 
-    result: dict[str, object] = {"eni": str(args.eni), "dc": args.dc}
+    result: dict[str, object] = {"eni": str(args.eni), "dc": args.dc, "serve_args": args.serve_arg}
     with tempfile.TemporaryDirectory() as tmp, veth_pair(args.master_if, args.slave_if) as (m, s):
         stats = Path(tmp) / "stats.json"
         with server(args.eni, s, stats, args.serve_arg) as proc:

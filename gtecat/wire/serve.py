@@ -180,6 +180,16 @@ def realtime_priority(priority: int) -> None:
         raise WireError(f"cannot set SCHED_FIFO priority {priority}: {exc}") from exc
 
 
+def pin_to_cpu(cpu: int) -> None:
+    """Run this process on ``cpu`` alone.  On a small machine the master's busy loop and the
+    server's spin around the frame otherwise meet on one CPU now and then (the scheduler moves
+    the master there while the server sleeps), and each frame then waits for a context switch."""
+    try:
+        os.sched_setaffinity(0, {cpu})
+    except (OSError, AttributeError, ValueError) as exc:
+        raise WireError(f"cannot run on CPU {cpu}: {exc}") from exc
+
+
 def interface_is_up(iface: str) -> bool | None:
     """``True``/``False`` from sysfs; ``None`` when it cannot tell."""
     try:
