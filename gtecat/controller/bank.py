@@ -51,6 +51,9 @@ from eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from eni.model import Direction
 
 from .axis_status import AxisStatus
+from .bank_kernel import Kernel
+from .bank_kernel import library as kernel_library
+from .bank_kernel import wanted as kernel_wanted
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -194,6 +197,11 @@ class AxisBank:
         self._stale = False
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
         self.rows_run = 0
+        #: the compiled plain cycle (gtecat.controller.bank_kernel), None: numpy alone
+        self.kernel: Kernel | None = None
+        self.kernel_reason = "not built yet"
+        #: cycles the compiled kernel ran (statistics)
+        self.kernel_cycles = 0
 
     # --- structure ------------------------------------------------------------------------
     def _build(self) -> None:
@@ -309,6 +317,12 @@ class AxisBank:
         self.t_end = zi(n, np.int64)  # index of the end sample (or -1)
         self.T = ctl.clock.cycle_ns / 1e6
         self._reindex()
+        if kernel_wanted() == "numpy":
+            self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
+        else:
+            lib, self.kernel_reason = kernel_library()
+            if lib is not None:
+                self.kernel = Kernel(self, lib)
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
@@ -347,6 +361,8 @@ class AxisBank:
         banked = {id(self.axes[r]) for r in range(self.n) if alive[r]}
         self.ctl._run_axes = [ax for ax in self.ctl._axis_list if id(ax) not in banked]
         self._lists.clear()
+        if self.kernel is not None:
+            self.kernel.bound = False
 
     # --- when the bank may run ----------------------------------------------------------------
     def _global_reason(self) -> str:
@@ -644,6 +660,18 @@ class AxisBank:
         if not self.n_alive:
             return
         self._lists.clear()
+        k = self.kernel
+        if k is not None:
+            # the plain cycle compiled; a table to refill (rare) or a new cycle time goes
+            # through numpy, and so does a cycle the kernel declines (nothing written then)
+            dt = dt_ns * 1e-9
+            if dt == self.csp._dt and not (self.n_moving and self._refill_in <= 1):
+                self._refill_in -= 1
+                if k.cycle(t_ns, dt) == 0:
+                    self._after_kernel(k)
+                    return
+                self._refill_in += 1
+            k.bound = False  # the numpy cycle replaces some arrays
         buf = self.ctl.master.image.buffer
         # 1. raw writes to a claimed slave's outputs: back to the scalar drive first
         if self._rx_ref and buf.take(self._rx_idx).tobytes() != self._rx_ref:
@@ -773,6 +801,20 @@ class AxisBank:
             cols.append(csp.output(name, state))
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
+
+    def _after_kernel(self, k: Kernel) -> None:
+        """What the numpy cycle does besides its arithmetic, after a compiled cycle."""
+        csp = self.csp
+        csp.cycles += 1
+        csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's
+        if csp.any_fe:
+            csp.fe_running = True  # the numpy cycle then looks at every row's timer
+        if k.io[7]:  # a Trap move ended
+            self.n_moving = int(np.count_nonzero(self.moving))
+            self._count_standing()
+        self.rows_run += self.n_alive
+        self.bank_cycles += 1
+        self.kernel_cycles += 1
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

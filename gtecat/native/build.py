@@ -174,12 +174,55 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             shutil.rmtree(tmp)
 
 
+KERNEL_SOURCE = "bank_kernel.c"
+#: the axis bank's kernel: IEEE arithmetic exactly as written (no contraction into FMA, no
+#: fast-math), so it gives numpy's and the scalar code's bits
+KERNEL_CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+
+
+def ensure_kernel() -> Path:
+    """The compiled axis-bank kernel (:mod:`gtecat.controller.bank_kernel`), built into the
+    same per-version cache as libgts on first use; NativeBuildError when it cannot be."""
+    cc = compiler()
+    text = (resources.files("gtecat.native") / "csrc" / KERNEL_SOURCE).read_text(encoding="utf-8")
+    h = hashlib.sha256(text.encode())
+    h.update(" ".join([*cc, *KERNEL_CFLAGS]).encode())
+    version_dir = cache_root() / __version__
+    lib = version_dir / f"bank_kernel-{h.hexdigest()[:12]}.so"
+    if lib.is_file():
+        return lib
+    try:
+        version_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise NativeBuildError(f"cannot create the build cache {version_dir}: {e}") from None
+    with open(version_dir / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if lib.is_file():
+            return lib
+        tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=version_dir))
+        try:
+            src = tmp / KERNEL_SOURCE
+            src.write_text(text, encoding="utf-8")
+            out = tmp / lib.name
+            cmd = [*cc, *KERNEL_CFLAGS, "-shared", str(src), "-o", str(out), "-lm"]
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            if r.returncode != 0 or r.stderr.strip():
+                raise NativeBuildError(
+                    f"building the bank kernel failed ({shlex.join(cmd)}):\n{r.stderr.strip()}"
+                )
+            out.rename(lib)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    return lib
+
+
 __all__ = [
     "Build",
     "NativeBuildError",
     "cache_root",
     "compiler",
     "ensure_built",
+    "ensure_kernel",
     "python_executable",
     "sources",
 ]

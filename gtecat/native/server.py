@@ -15,7 +15,8 @@ Decisions:
 
 * ``GT_Open`` of a client attaches it: the first one opens the controller (with the
   options the server was started with, else the ``GTECAT_*`` environment of the
-  server), later ones find it open and return 0.  ``GT_Close`` detaches the client;
+  server), later clients find it open and return 0; a client that opens twice gets -6,
+  as a Python program does.  ``GT_Close`` detaches the client;
   the controller stays (it is the device).  Calls of a client that has not opened
   (or has closed) return -1, as in Python before ``GT_Open``.
 * In ``auto`` mode the server keeps the wall floor (:mod:`gtecat.native.floor`)
@@ -675,6 +676,11 @@ class Server:
         return _core.CMD_COMM, f"{name} returned -1: {NOT_OPEN}"
 
     def _open(self, c: _Client, gtn: int, core: int, args: list[Any]) -> tuple[int, str]:
+        if c.opened:  # as in Python: the same program opening twice
+            return _core.CMD_OPEN, (
+                "GT_Open returned -6: the controller is already open "
+                "(GT_Open called twice; call GT_Close first)"
+            )
         if 1 not in _core.SESSION.controllers:
             opener = _core.REGISTRY["GT_Open"]
             # "local": this process is the controller, whatever GTECAT_CONTROLLER says

@@ -1,5 +1,6 @@
 """The axis bank against the scalar reference (issue 17 item 1): the same GT program, cycle by
-cycle, with ``bank="on"`` and ``bank="off"``.
+cycle, with ``bank="on"`` and ``bank="off"``, the bank's plain cycle compiled
+(``GTECAT_BANK_KERNEL=c``, gtecat/native/csrc/bank_kernel.c) and in numpy alone.
 
 Compared exactly (``==`` on floats: the bank does the scalar code's float operations in the
 same order, so no tolerance is needed): every axis's GT_GetSts word, planned position
@@ -13,6 +14,7 @@ back, which is where a difference would show.
 
 from __future__ import annotations
 
+import os
 from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from pathlib import Path
 
@@ -137,8 +139,19 @@ def _act(action: tuple) -> int:
     raise AssertionError(kind)
 
 
-def _run(actions: list[tuple[int, tuple]], machine: str, bank: str) -> tuple[list, list, int]:
-    _bring_up(machine, bank)
+def _run(
+    actions: list[tuple[int, tuple]], machine: str, bank: str, kernel: str = "c"
+) -> tuple[list, list, int]:
+    """The program's trace; ``kernel``: the bank's plain cycle compiled ("c") or numpy."""
+    old = os.environ.get("GTECAT_BANK_KERNEL")
+    os.environ["GTECAT_BANK_KERNEL"] = kernel
+    try:
+        _bring_up(machine, bank)
+    finally:
+        if old is None:
+            del os.environ["GTECAT_BANK_KERNEL"]
+        else:
+            os.environ["GTECAT_BANK_KERNEL"] = old
     ctl = gt.GTE_Controller()
     size = ctl.layout.gt_raw_bytes
     trace, codes = [], []
@@ -149,6 +162,11 @@ def _run(actions: list[tuple[int, tuple]], machine: str, bank: str) -> tuple[lis
                 gt.GTE_Wait(1)
                 trace.append(_sample(size))
         rows = ctl.bank.rows_run if ctl.bank is not None else 0
+        if ctl.bank is not None and kernel == "c":
+            assert ctl.bank.kernel is not None, ctl.bank.kernel_reason  # CI has a compiler
+            KERNEL_CYCLES.append(ctl.bank.kernel_cycles)
+        elif ctl.bank is not None:
+            assert ctl.bank.kernel_cycles == 0
         mech = [
             (ch.mech.pos, ch.mech.vel, ch.statusword)
             for s in ctl.backend.slaves
@@ -159,6 +177,8 @@ def _run(actions: list[tuple[int, tuple]], machine: str, bank: str) -> tuple[lis
         gt.GT_Close()
     return trace, codes, rows
 
+
+KERNEL_CYCLES: list[int] = []  # cycles the compiled kernel ran, per "c" run
 
 axis = st.integers(1, AXES)
 move = st.tuples(
@@ -205,14 +225,16 @@ program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=1
 )
 @given(actions=program)
 def test_bank_matches_the_scalar_path_cycle_by_cycle(tmp_path: Path, actions) -> None:
+    """The scalar reference, the bank with its compiled cycle and the bank with numpy alone."""
     machine = _machine_file(tmp_path)
     actions = [*actions, (150, ("clear",))]
     ref, ref_codes, ref_rows = _run(actions, machine, "off")
-    got, got_codes, _ = _run(actions, machine, "on")
     assert ref_rows == 0
-    assert got_codes == ref_codes
-    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
-        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    for kernel in ("c", "numpy"):
+        got, got_codes, _ = _run(actions, machine, "on", kernel)
+        assert got_codes == ref_codes, kernel
+        for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+            assert a == b, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
 
 
 def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
@@ -223,8 +245,13 @@ def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     ]
     actions = [*moves, (400, ("band", 1, 10, 4))]
     ref, _, _ = _run(actions, machine, "off")
+    KERNEL_CYCLES.clear()
     got, _, rows = _run(actions, machine, "on")
     assert rows > 12 * 300  # most axis-cycles ran in the bank
+    assert KERNEL_CYCLES[0] > 300  # and most of its cycles were the compiled one
+    assert got == ref
+    got, _, rows = _run(actions, machine, "on", "numpy")
+    assert rows > 12 * 300
     assert got == ref
 
 
@@ -236,8 +263,10 @@ def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:
     actions = [*jogs, (300, ("jog", 3, -2.0, 0.2, 0.3, 0.5)), (200, ("stop", 0b1101, 0))]
     actions.append((100, ("clear",)))
     ref, _, _ = _run(actions, machine, "off")
+    KERNEL_CYCLES.clear()
     got, _, rows = _run(actions, machine, "on")
     assert rows > 3 * 300
+    assert KERNEL_CYCLES[0] > 300
     assert got == ref
 
 

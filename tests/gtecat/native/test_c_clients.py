@@ -39,6 +39,8 @@ def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
     assert v["done"] == "1", r.stdout + r.stderr
     # bring-up, polled with usleep as the vendor demo does
     assert (v["open"], v["init"], v["ready"], v["start"]) == ("0", "0", "1", "0")
+    # opening twice: -6 with Python's reason (bus_calls.GT_Open), the first open stays
+    assert v["open_twice"] == "-6" and "already open" in v["open_twice_reason"]
     assert int(v["ready_polls"]) < 100
     # a 200 ms usleep lets at least 200 ms of controller time pass (the wall floor)
     assert int(v["slept_ms"]) >= 200

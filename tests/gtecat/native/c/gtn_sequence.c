@@ -37,6 +37,8 @@ int main(void)
         printf("reason %s\n", why());
         return 1;
     }
+    say("open_twice", GTN_Open(5, 1)); /* -6, as from Python (the first open stays) */
+    printf("open_twice_reason %s\n", why());
     rc = GTN_InitEcatComm(CORE);
     say("init", rc);
     for (polls = 0; polls < 100; polls++) { /* the demo: poll, sleep, give up after 100 */

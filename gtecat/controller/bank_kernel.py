@@ -1,0 +1,202 @@
+"""The axis bank's plain cycle compiled: one C call instead of ~80 numpy operations.
+
+With a dozen axes the numpy cycle of :class:`~gtecat.controller.bank.AxisBank` costs its
+operation count, not its arithmetic (about 80 operations of 0.5-1 µs each, whatever the
+rows).  ``gtecat/native/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
+IEEE operations in the same order, built like libgts (``cc``, on first use, into the
+per-version cache; ``-ffp-contract=off``), so it gives the same bits as numpy and as the
+scalar objects.  It runs only the plain cycle: a raw write to a claimed slave, a row about to
+leave, a table to refill or a new cycle time go through the numpy cycle, which stays the
+reference and the fallback (no compiler: numpy alone, nothing else changes).
+
+``GTECAT_BANK_KERNEL`` = ``auto`` (default: the compiled kernel where it builds), ``c`` (the
+same; a build failure is reported in :attr:`AxisBank.kernel_reason`) or ``numpy``.
+
+The arrays are handed over as one table of addresses, bound by name (the library lists its
+field names; a list that differs from what this module binds is refused).  The numpy cycle
+replaces some arrays by new ones, so every numpy cycle, claim and release unbinds and the next
+kernel cycle binds again.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .bank import AxisBank
+
+_U8, _I64, _F64 = np.uint8, np.int64, np.float64
+_DTYPES = {"u8": _U8, "i64": _I64, "f64": _F64}
+#: placement columns (the kernel's image switch)
+COLUMNS = {
+    "target": 0,
+    "position_actual": 1,
+    "digital_inputs": 2,
+    "statusword": 3,
+    "position_demand": 4,
+    "velocity_actual": 5,
+    "following_error_actual": 6,
+    "torque_actual": 7,
+    "current_actual": 7,
+    "torque_demand": 7,
+}
+#: bank attribute -> kernel field, where the names differ (CspBank fields are c_*)
+_SCRATCH = (
+    "s_target s_raw s_a s_enc s_step s_pos s_vel s_acc s_dpos s_dvel s_fe s_lim s_swl "
+    "s_din s_since s_arr"
+).split()
+
+_LIB: Any = None
+_LIB_REASON = ""
+_FIELDS: list[tuple[str, Any]] = []
+
+
+def library() -> tuple[Any, str]:
+    """(the loaded kernel or None, why not); built and loaded once per process."""
+    global _LIB, _LIB_REASON
+    if _LIB is not None or _LIB_REASON:
+        return _LIB, _LIB_REASON
+    try:
+        from ..native.build import ensure_kernel
+
+        lib = ctypes.CDLL(str(ensure_kernel()))
+        lib.bank_kernel_fields.restype = ctypes.c_char_p
+        lib.bank_kernel_abi.restype = ctypes.c_int
+        lib.bank_kernel_cycle.restype = ctypes.c_int
+        lib.bank_kernel_cycle.argtypes = (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p)
+        fields = [f for f in lib.bank_kernel_fields().decode().split(",") if f]
+        src_types = _field_types()
+        if [f for f, _ in src_types] != fields or lib.bank_kernel_abi() != (
+            len(fields) << 8 | 8 << 4 | 2
+        ):
+            raise RuntimeError("the kernel's field list is not the one this module binds")
+        _FIELDS[:] = src_types
+        _LIB = lib
+    except Exception as e:  # no compiler, a failed build: the numpy cycle alone
+        _LIB_REASON = f"{type(e).__name__}: {e}"
+    return _LIB, _LIB_REASON
+
+
+def _field_types() -> list[tuple[str, Any]]:
+    """(name, dtype) of every field, read from the C source's FIELDS list."""
+    from importlib import resources
+
+    text = (resources.files("gtecat.native") / "csrc" / "bank_kernel.c").read_text()
+    body = text.split("#define FIELDS", 1)[1].split("enum {", 1)[0]
+    out = []
+    for item in body.replace("\\", " ").split("X(")[1:]:
+        name, _, rest = item.partition(",")
+        out.append((name.strip(), _DTYPES[rest.split(")")[0].strip()]))
+    return out
+
+
+def wanted() -> str:
+    mode = os.environ.get("GTECAT_BANK_KERNEL", "auto").strip().lower() or "auto"
+    return mode if mode in ("auto", "c", "numpy") else "auto"
+
+
+class Kernel:
+    """The binding of one bank to the compiled cycle."""
+
+    def __init__(self, bank: AxisBank, lib: Any) -> None:
+        self.bank = bank
+        self.fn = lib.bank_kernel_cycle
+        n = bank.n
+        self.scratch = {name: np.zeros(n, _dtype_of(name)) for name in _SCRATCH}
+        for name in ("s_lim", "s_swl", "s_arr"):
+            self.scratch[name] = np.zeros(n, np.bool_)
+        self.scratch["s_jog"] = np.zeros(5 * n, _F64)
+        self.ptrs = np.zeros(len(_FIELDS), np.uint64)
+        self.io = np.zeros(8, np.int64)
+        self.fp = np.zeros(2, np.float64)
+        self.io[0] = n
+        self.fp[1] = bank.T
+        self.bound = False
+        self._keep: list[np.ndarray] = []
+        self._args = (self.ptrs.ctypes.data, self.io.ctypes.data, self.fp.ctypes.data)
+        self.buffer: np.ndarray | None = None
+
+    def bind(self) -> None:
+        """Take the addresses of the bank's current arrays (fixing dtype/layout in place
+        where the numpy cycle left another one, values unchanged)."""
+        bank, csp = self.bank, self.bank.csp
+        if csp.din is csp._din_zero:
+            csp.din = csp.din.copy()  # the shared zero row is never written into
+        windows = {value: (lo, hi) for value, lo, hi in csp.windows}
+        empty = np.zeros(1, _F64)
+        extra: dict[str, np.ndarray] = {}
+        io = self.io
+        for key, bit, slot in (("w2", 1 << 2, 4), ("w16", 1 << 16, 5), ("w17", 1 << 17, 6)):
+            lo, hi = windows.get(bit, (empty, empty))
+            io[slot] = lo.shape[1] if lo.ndim == 2 else 0
+            extra[key + "_lo"], extra[key + "_hi"] = lo, hi
+        extra.update(self._placements())
+        buf = bank.ctl.master.image.buffer
+        self.buffer = buf
+        extra["buf"] = buf
+        keep = []
+        for i, (name, dtype) in enumerate(_FIELDS):
+            if name in extra:
+                arr = extra[name]
+            elif name in self.scratch:
+                arr = self.scratch[name]
+            else:
+                owner, attr = (csp, name[2:]) if name.startswith("c_") else (bank, name)
+                arr = getattr(owner, attr)
+                if not _fits(arr, dtype) or not arr.flags.writeable:
+                    kind = np.bool_ if dtype is _U8 else dtype  # the bank's flags are bool
+                    arr = np.ascontiguousarray(arr, dtype=kind).copy()
+                    setattr(owner, attr, arr)
+            if not _fits(arr, dtype):
+                raise TypeError(f"bank kernel: {name} is {arr.dtype}, not {np.dtype(dtype)}")
+            keep.append(arr)
+            self.ptrs[i] = arr.ctypes.data
+        self._keep = keep  # the addresses stay valid while these live
+        self.bound = True
+
+    def _placements(self) -> dict[str, np.ndarray]:
+        bank = self.bank
+        plc = [p for p in bank._plc if bank.alive[p[0]]]
+        self.io[2] = len(plc)
+        rx = np.asarray(bank._rx_idx, np.int64)
+        self.io[3] = len(rx)
+        return {
+            "pl_row": np.array([p[0] for p in plc] or [0], np.int64),
+            "pl_off": np.array([p[1] for p in plc] or [0], np.int64),
+            "pl_size": np.array([p[2] for p in plc] or [0], np.int64),
+            "pl_col": np.array([COLUMNS[p[3]] for p in plc] or [0], np.int64),
+            "rx_idx": rx if len(rx) else np.zeros(1, np.int64),
+            "rx_ref": np.frombuffer(bank._rx_ref, np.uint8).copy()
+            if bank._rx_ref
+            else np.zeros(1, np.uint8),
+        }
+
+    def cycle(self, t_ns: int, dt: float) -> int:
+        """0: the cycle ran and is committed; 1/2: nothing was written (the numpy cycle
+        must run it: a raw write, a row leaving)."""
+        if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
+            self.bind()
+        self.io[1] = t_ns
+        self.fp[0] = dt
+        return self.fn(*self._args)
+
+
+def _fits(arr: np.ndarray, dtype: Any) -> bool:
+    """``arr`` is what the kernel reads for ``dtype``: u8 fields take bytes or numpy bools
+    (one byte, 0 or 1), the others exactly their type; C-contiguous either way."""
+    if not arr.flags.c_contiguous:
+        return False
+    if dtype is _U8:
+        return arr.dtype == np.uint8 or arr.dtype == np.bool_
+    return arr.dtype == dtype
+
+
+def _dtype_of(name: str) -> Any:
+    for f, dtype in _FIELDS:
+        if f == name:
+            return dtype
+    raise KeyError(name)

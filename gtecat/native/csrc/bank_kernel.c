@@ -1,0 +1,394 @@
+/* One cycle of the axis bank's claimed rows, compiled (gtecat/controller/bank_kernel.py).
+ *
+ * The numpy cycle of gtecat/controller/bank.py (AxisBank.cycle) and drives/csp_bank.py
+ * (CspBank.step/commit/output) transcribed row by row: the same IEEE operations in the
+ * same order (built with -ffp-contract=off, no fast-math), so every value is the same bit
+ * pattern as numpy's and the scalar reference's.  It only runs the plain cycle: when a
+ * raw write touched a claimed slave's outputs (return 1) or a row would leave the bank
+ * (return 2: a limit switch, a soft limit, the following error, the drive's following
+ * error window) nothing is written and the caller runs the numpy cycle, which releases
+ * the rows.  Return 0: committed; io[OUT_FIN] says a Trap move ended.
+ *
+ * Arrays arrive as one table of addresses in the order of FIELDS below (the Python side
+ * binds them by these names and refuses a library whose list differs).
+ */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#define FIELDS                                                                          \
+    X(alive, u8) X(moving, u8) X(jog, u8) X(ended, u8) X(base, i64) X(t_cur, i64)          \
+    X(t_end, i64) X(t_idx, i64) X(taken, i64) X(t_p, f64)                                  \
+    X(prf_ratio, f64) X(prf_off, f64) X(unit2, f64) X(drive_offset, i64)                   \
+    X(external, u8) X(sense, i64) X(unit, f64) X(enc_prev, i64) X(enc_pos, f64)            \
+    X(enc_step0, f64) X(enc_step1, f64) X(enc_ratio, f64) X(enc_off, f64)                  \
+    X(soft_pos, f64) X(soft_neg, f64) X(pos_err, f64) X(band, f64) X(hold_ns, i64)         \
+    X(since, i64) X(arrived, u8) X(a_last, f64)                                            \
+    X(jrp, f64) X(jrv, f64) X(jp, f64) X(jv, f64) X(ja, f64) X(tau, f64) X(jE, f64)        \
+    X(c_pos, f64) X(c_vel, f64) X(c_acc, f64) X(c_dpos, f64) X(c_dvel, f64)                \
+    X(c_fe_time, f64) X(c_limited, u8) X(c_sw_limited, u8) X(c_start, i64) X(c_din, i64)   \
+    X(c_target, i64) X(c_vmax, f64) X(c_e, f64) X(c_c, f64) X(c_lim, f64) X(c_off, i64)   \
+    X(c_pos_offset, i64) X(c_sw_min, i64) X(c_sw_max, i64) X(c_fe_window, f64)             \
+    X(c_fe_check, u8) X(c_fe_timeout, f64) X(c_nl, f64) X(c_pl, f64) X(c_sw_const, i64)    \
+    X(c_a_rated, f64) X(c_visc, f64)                                                       \
+    X(w2_lo, f64) X(w2_hi, f64) X(w16_lo, f64) X(w16_hi, f64) X(w17_lo, f64) X(w17_hi, f64) \
+    X(pl_row, i64) X(pl_off, i64) X(pl_size, i64) X(pl_col, i64)                           \
+    X(rx_idx, i64) X(rx_ref, u8) X(buf, u8)                                                \
+    X(s_target, i64) X(s_raw, i64) X(s_a, f64) X(s_enc, f64) X(s_step, f64)                \
+    X(s_pos, f64) X(s_vel, f64) X(s_acc, f64) X(s_dpos, f64) X(s_dvel, f64)                \
+    X(s_fe, f64) X(s_lim, u8) X(s_swl, u8) X(s_din, i64) X(s_since, i64) X(s_arr, u8)      \
+    X(s_jog, f64)
+
+enum {
+#define X(name, type) F_##name,
+    FIELDS
+#undef X
+    N_FIELDS
+};
+
+/* io: int64 in/out slots */
+enum { IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN, N_IO };
+/* fp: double inputs */
+enum { FP_DT, FP_T, N_FP };
+
+#define STR_(x) #x
+#define NAME_(name, type) STR_(name) ","
+const char *bank_kernel_fields(void)
+{
+    return
+#define X(name, type) NAME_(name, type)
+        FIELDS
+#undef X
+        ;
+}
+
+int bank_kernel_abi(void) { return (N_FIELDS << 8) | (N_IO << 4) | N_FP; }
+
+#define U8(f) ((uint8_t *)ptr[F_##f])
+#define I64(f) ((int64_t *)ptr[F_##f])
+#define F64(f) ((double *)ptr[F_##f])
+
+/* numpy's float -> int64 cast on x86-64 (cvttsd2si): out of range and NaN give INT64_MIN */
+static int64_t to_i64(double x)
+{
+    if (x >= -9223372036854775808.0 && x < 9223372036854775808.0)
+        return (int64_t)x;
+    return INT64_MIN;
+}
+
+/* Python's float floor division (Objects/floatobject.c _float_div_mod; numpy's npy_divmod) */
+static double floor_div(double vx, double wx)
+{
+    double mod = fmod(vx, wx);
+    double div = (vx - mod) / wx;
+    double fd;
+    if (mod) {
+        if ((wx < 0) != (mod < 0))
+            div -= 1.0;
+    }
+    if (div) {
+        fd = floor(div);
+        if (div - fd > 0.5)
+            fd += 1.0;
+    } else {
+        fd = copysign(0.0, vx / wx);
+    }
+    return fd;
+}
+
+/* drives.mechanics._closing_speed */
+static double closing_speed(double dist, double lim, double dt)
+{
+    double d, half, m, v = 0.0;
+    int k;
+    if (dist <= 0.0 || lim <= 0.0)
+        return 0.0;
+    d = dist / dt;
+    half = 0.5 * lim;
+    m = floor_div(sqrt(half * half + 2.0 * lim * d) - half, lim);
+    m = (double)to_i64(m); /* int(...) */
+    for (k = 0; k < 8; k++) {
+        v = (d + lim * m * (m + 1.0) / 2.0) / (m + 1.0);
+        if (v < m * lim && m > 0.0)
+            m -= 1.0;
+        else if (v >= (m + 1.0) * lim)
+            m += 1.0;
+        else
+            return v;
+    }
+    return d < v ? d : v; /* min(v, d) */
+}
+
+/* AxisBank._link / AffineLink.axis */
+static double link(double x, double ratio, double off)
+{
+    if (ratio == 1.0)
+        return off != 0.0 ? x + off : x;
+    return ratio * x + off;
+}
+
+static int in_window(const double *lo, const double *hi, int64_t width, int64_t r, double x)
+{
+    int64_t j;
+    for (j = 0; j < width; j++)
+        if (lo[r * width + j] <= x && x < hi[r * width + j])
+            return 1;
+    return 0;
+}
+
+/* np.minimum(np.maximum(np.rint(x), -32768), 32767).astype(np.int64): NaN stays NaN */
+static int64_t clip16(double x)
+{
+    double t = rint(x);
+    if (t < -32768.0)
+        t = -32768.0;
+    if (t > 32767.0)
+        t = 32767.0;
+    return to_i64(t);
+}
+
+int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
+{
+    const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
+    const double dt = fp[FP_DT], h = fp[FP_T];
+    const uint8_t *alive = U8(alive);
+    uint8_t *buf = U8(buf);
+    int64_t r, i;
+    int fin_any = 0;
+
+    /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back */
+    for (i = 0; i < io[IN_N_RX]; i++)
+        if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i])
+            return 1;
+
+    /* 2.-7. every claimed row, tentatively (scratch arrays s_*) */
+    for (r = 0; r < n; r++) {
+        int64_t cur, counts, x, target, raw, pa, din, since;
+        int32_t d32;
+        double prf, a, demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, vstop, dv, acc, pos;
+        double fe, step, enc, err, band;
+        int limited = 0, swl = 0, hit = 0, ended, standing, inb, arr;
+        if (!alive[r])
+            continue;
+        cur = I64(t_cur)[r];
+        prf = F64(t_p)[I64(base)[r] + cur];
+        ended = cur == I64(t_end)[r];
+        if (U8(jog)[r]) { /* AxisBank._jog_step */
+            double rp = F64(jrp)[r], jv = F64(jrv)[r], fp_ = F64(jp)[r], fv = F64(jv)[r];
+            double fa = F64(ja)[r], tau = F64(tau)[r], e = F64(jE)[r];
+            double p1 = rp + h * (jv + 0.5 * 0.0 * h);
+            double v1 = jv + 0.0 * h;
+            double nfp, nfv, nfa;
+            if (tau > 0.0) {
+                nfp = p1 - tau * (v1 - 0.0) + (fp_ - rp + tau * (jv - 0.0)) * e;
+                nfv = v1 - 0.0 + (fv - jv + 0.0) * e;
+                nfa = 0.0 + (fa - 0.0) * e;
+            } else {
+                nfp = p1;
+                nfv = v1;
+                nfa = 0.0;
+            }
+            if (nfv != v1 && fabs(nfv - v1) <= 1e-9 * (1.0 + fabs(v1))) {
+                nfv = v1;
+                nfa = 0.0;
+            }
+            F64(s_jog)[5 * r + 0] = p1;
+            F64(s_jog)[5 * r + 1] = v1;
+            F64(s_jog)[5 * r + 2] = nfp;
+            F64(s_jog)[5 * r + 3] = nfv;
+            F64(s_jog)[5 * r + 4] = nfa;
+            prf = nfp;
+        }
+        a = link(prf, F64(prf_ratio)[r], F64(prf_off)[r]);
+        /* 3. 607Ah: Axis.pulses_to_counts, int32 like the PDO entry */
+        counts = to_i64(rint(a * F64(unit2)[r])) + I64(drive_offset)[r];
+        target = (int32_t)(uint32_t)(uint64_t)counts;
+        /* CspBank.step: step_csp */
+        x = target + I64(c_pos_offset)[r];
+        if (x < I64(c_sw_min)[r] || x > I64(c_sw_max)[r])
+            swl = 1;
+        if (x < I64(c_sw_min)[r])
+            x = I64(c_sw_min)[r];
+        if (x > I64(c_sw_max)[r])
+            x = I64(c_sw_max)[r];
+        x += I64(c_off)[r];
+        demand = (double)x;
+        dvel = (demand - F64(c_dpos)[r]) / dt;
+        /* Mechanics.track */
+        p = F64(c_pos)[r];
+        v0 = F64(c_vel)[r];
+        vmax = F64(c_vmax)[r];
+        vff = dvel;
+        if (vff < -vmax)
+            vff = -vmax;
+        if (vff > vmax)
+            vff = vmax;
+        e1 = (demand - vff * dt - p) * F64(c_e)[r] + F64(c_c)[r] * vff;
+        v = (demand - e1 - p) / dt;
+        lim = F64(c_lim)[r];
+        dist = demand - p;
+        vstop = closing_speed(fabs(dist), lim, dt);
+        if (dist > 0.0 && v > vff + vstop) {
+            v = vff + vstop;
+            limited = 1;
+        } else if (dist < 0.0 && v < vff - vstop) {
+            v = vff - vstop;
+            limited = 1;
+        }
+        dv = v - v0;
+        if (dv > lim) {
+            v = v0 + lim;
+            limited = 1;
+        } else if (dv < -lim) {
+            v = v0 - lim;
+            limited = 1;
+        }
+        if (limited) {
+            if (dist > 0.0 && v * dt > dist)
+                v = dist / dt;
+            else if (dist < 0.0 && v * dt < dist)
+                v = dist / dt;
+        }
+        if (v > vmax) {
+            v = vmax;
+            limited = 1;
+        } else if (v < -vmax) {
+            v = -vmax;
+            limited = 1;
+        }
+        acc = (v - v0) / dt;
+        pos = p + v * dt;
+        /* following-error window 6065h/6066h */
+        fe = 0.0;
+        if (U8(c_fe_check)[r]) {
+            if (fabs(demand - pos) > F64(c_fe_window)[r]) {
+                fe = F64(c_fe_time)[r] + dt;
+                if (fe * 1000.0 > F64(c_fe_timeout)[r])
+                    hit = 1;
+            }
+        }
+        /* 6064h and 60FDh (limit switches, home switch, probes) */
+        pa = to_i64(rint(pos - (double)I64(c_off)[r]));
+        din = 2 * (pos >= F64(c_pl)[r]) + (pos <= F64(c_nl)[r]);
+        if (io[IN_W2] && in_window(F64(w2_lo), F64(w2_hi), io[IN_W2], r, pos))
+            din |= 1 << 2;
+        if (io[IN_W16] && in_window(F64(w16_lo), F64(w16_hi), io[IN_W16], r, pos))
+            din |= 1 << 16;
+        if (io[IN_W17] && in_window(F64(w17_lo), F64(w17_hi), io[IN_W17], r, pos))
+            din |= 1 << 17;
+        /* 4. encoder (Encoder.sample) */
+        raw = U8(external)[r] ? pa : target;
+        d32 = (int32_t)(uint32_t)(uint64_t)(raw - I64(enc_prev)[r]);
+        step = (double)(I64(sense)[r] * (int64_t)d32) * F64(unit)[r];
+        enc = F64(enc_pos)[r] + step;
+        /* 5. limits and following error */
+        err = a - link(enc, F64(enc_ratio)[r], F64(enc_off)[r]);
+        if (a > F64(soft_pos)[r] || (din & 3) != 0 || a < F64(soft_neg)[r])
+            hit = 1;
+        if (fabs(err) > F64(pos_err)[r])
+            hit = 1;
+        if (hit)
+            return 2; /* nothing written: the numpy cycle releases it */
+        /* 6. the in-position band (bit 11) */
+        band = F64(band)[r];
+        since = I64(since)[r];
+        arr = U8(arrived)[r];
+        if (band > 0.0) {
+            standing = (ended || !U8(moving)[r]) && !U8(jog)[r];
+            inb = standing && -band <= err && err <= band;
+            since = inb ? (since < 0 ? t_ns : since) : -1;
+            arr = inb && (arr || t_ns - since >= I64(hold_ns)[r]);
+        }
+        I64(s_target)[r] = target;
+        I64(s_raw)[r] = raw;
+        F64(s_a)[r] = a;
+        F64(s_enc)[r] = enc;
+        F64(s_step)[r] = step;
+        F64(s_pos)[r] = pos;
+        F64(s_vel)[r] = v;
+        F64(s_acc)[r] = acc;
+        F64(s_dpos)[r] = demand;
+        F64(s_dvel)[r] = dvel;
+        F64(s_fe)[r] = fe;
+        U8(s_lim)[r] = (uint8_t)limited;
+        U8(s_swl)[r] = (uint8_t)swl;
+        I64(s_din)[r] = din;
+        I64(s_since)[r] = since;
+        U8(s_arr)[r] = (uint8_t)arr;
+    }
+
+    /* commit (CspBank.commit, the bank's state, the table cursors) */
+    for (r = 0; r < n; r++) {
+        int64_t cur;
+        int mv, en;
+        if (!alive[r]) {
+            I64(c_start)[r] += 1; /* a row left out did not step */
+            continue;
+        }
+        if (U8(jog)[r]) {
+            F64(jrp)[r] = F64(s_jog)[5 * r + 0];
+            F64(jrv)[r] = F64(s_jog)[5 * r + 1];
+            F64(jp)[r] = F64(s_jog)[5 * r + 2];
+            F64(jv)[r] = F64(s_jog)[5 * r + 3];
+            F64(ja)[r] = F64(s_jog)[5 * r + 4];
+        }
+        F64(c_pos)[r] = F64(s_pos)[r];
+        F64(c_vel)[r] = F64(s_vel)[r];
+        F64(c_acc)[r] = F64(s_acc)[r];
+        F64(c_dpos)[r] = F64(s_dpos)[r];
+        F64(c_dvel)[r] = F64(s_dvel)[r];
+        F64(c_fe_time)[r] = F64(s_fe)[r];
+        U8(c_limited)[r] = U8(s_lim)[r];
+        U8(c_sw_limited)[r] = U8(s_swl)[r];
+        I64(c_target)[r] = I64(s_target)[r];
+        I64(c_din)[r] = I64(s_din)[r];
+        F64(a_last)[r] = F64(s_a)[r];
+        cur = I64(t_cur)[r];
+        I64(t_idx)[r] = I64(base)[r] + cur;
+        I64(enc_prev)[r] = I64(s_raw)[r];
+        F64(enc_pos)[r] = F64(s_enc)[r];
+        F64(enc_step0)[r] = F64(enc_step1)[r];
+        F64(enc_step1)[r] = F64(s_step)[r];
+        I64(since)[r] = I64(s_since)[r];
+        U8(arrived)[r] = U8(s_arr)[r];
+        mv = U8(moving)[r];
+        en = cur == I64(t_end)[r];
+        I64(taken)[r] += mv;
+        if (mv && en) {
+            U8(ended)[r] = 1;
+            U8(moving)[r] = 0;
+            fin_any = 1;
+        } else if (mv) {
+            I64(t_cur)[r] = cur + 1;
+        }
+    }
+
+    /* 8. the image: 607Ah out, the drives' TxPDO in */
+    for (i = 0; i < io[IN_N_PLC]; i++) {
+        int64_t row = I64(pl_row)[i], val;
+        uint32_t u;
+        switch (I64(pl_col)[i]) {
+        case 0: val = I64(c_target)[row]; break;
+        case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
+        case 2: val = I64(c_din)[row]; break;
+        case 3:
+            val = I64(c_sw_const)[row] +
+                  ((U8(c_limited)[row] | U8(c_sw_limited)[row]) ? 0x800 : 0);
+            break;
+        case 4: val = to_i64(rint(F64(c_dpos)[row] - (double)I64(c_off)[row])); break;
+        case 5: val = to_i64(rint(F64(c_vel)[row])); break;
+        case 6: val = to_i64(rint(F64(c_dpos)[row] - F64(c_pos)[row])); break;
+        default:
+            val = clip16(F64(c_acc)[row] / F64(c_a_rated)[row] * 1000.0 +
+                         F64(c_vel)[row] * F64(c_visc)[row]);
+        }
+        u = (uint32_t)(uint64_t)val;
+        {
+            int64_t k, off = I64(pl_off)[i];
+            for (k = 0; k < I64(pl_size)[i]; k++)
+                buf[off + k] = (uint8_t)(u >> (8 * k));
+        }
+    }
+    io[OUT_FIN] = fin_any;
+    return 0;
+}
