@@ -317,12 +317,18 @@ class AxisBank:
         self.t_end = zi(n, np.int64)  # index of the end sample (or -1)
         self.T = ctl.clock.cycle_ns / 1e6
         self._reindex()
-        if kernel_wanted() == "numpy":
+        mode = kernel_wanted()
+        if mode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
         else:
             lib, self.kernel_reason = kernel_library()
             if lib is not None:
                 self.kernel = Kernel(self, lib)
+            elif mode == "c":
+                ctl.log(
+                    f"GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy "
+                    f"runs the bank ({self.kernel_reason})"
+                )
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""

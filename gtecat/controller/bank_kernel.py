@@ -2,7 +2,7 @@
 
 With a dozen axes the numpy cycle of :class:`~gtecat.controller.bank.AxisBank` costs its
 operation count, not its arithmetic (about 80 operations of 0.5-1 µs each, whatever the
-rows).  ``gtecat/native/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
+rows).  ``gtecat/controller/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
 IEEE operations in the same order, built like libgts (``cc``, on first use, into the
 per-version cache; ``-ffp-contract=off``), so it gives the same bits as numpy and as the
 scalar objects.  It runs only the plain cycle: a raw write to a claimed slave, a row about to
@@ -21,14 +21,21 @@ kernel cycle binds again.
 from __future__ import annotations
 
 import ctypes
+import logging
 import os
+from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..cbuild import shared_library
+
 if TYPE_CHECKING:
     from .bank import AxisBank
 
+log = logging.getLogger(__name__)
+#: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math
+CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64
 _DTYPES = {"u8": _U8, "i64": _I64, "f64": _F64}
 #: placement columns (the kernel's image switch)
@@ -61,9 +68,7 @@ def library() -> tuple[Any, str]:
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
     try:
-        from ..native.build import ensure_kernel
-
-        lib = ctypes.CDLL(str(ensure_kernel()))
+        lib = ctypes.CDLL(str(shared_library("bank_kernel", _source(), CFLAGS, ("-lm",))))
         lib.bank_kernel_fields.restype = ctypes.c_char_p
         lib.bank_kernel_abi.restype = ctypes.c_int
         lib.bank_kernel_cycle.restype = ctypes.c_int
@@ -83,10 +88,7 @@ def library() -> tuple[Any, str]:
 
 def _field_types() -> list[tuple[str, Any]]:
     """(name, dtype) of every field, read from the C source's FIELDS list."""
-    from importlib import resources
-
-    text = (resources.files("gtecat.native") / "csrc" / "bank_kernel.c").read_text()
-    body = text.split("#define FIELDS", 1)[1].split("enum {", 1)[0]
+    body = _source().split("#define FIELDS", 1)[1].split("enum {", 1)[0]
     out = []
     for item in body.replace("\\", " ").split("X(")[1:]:
         name, _, rest = item.partition(",")
@@ -94,9 +96,18 @@ def _field_types() -> list[tuple[str, Any]]:
     return out
 
 
+def _source() -> str:
+    return (resources.files("gtecat.controller") / "csrc" / "bank_kernel.c").read_text("utf-8")
+
+
 def wanted() -> str:
-    mode = os.environ.get("GTECAT_BANK_KERNEL", "auto").strip().lower() or "auto"
-    return mode if mode in ("auto", "c", "numpy") else "auto"
+    """``GTECAT_BANK_KERNEL``; an unknown value is ``auto``, with a warning."""
+    raw = os.environ.get("GTECAT_BANK_KERNEL", "auto")
+    mode = raw.strip().lower() or "auto"
+    if mode not in ("auto", "c", "numpy"):
+        log.warning("GTECAT_BANK_KERNEL=%r: not auto, c or numpy; auto is used", raw)
+        return "auto"
+    return mode
 
 
 class Kernel:

@@ -27,15 +27,12 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
-from ..errors import GtecatError
+from ..cbuild import NativeBuildError, cache_root, compiler
+from ..cbuild import version_dir as made_version_dir
 from . import header, stubs
 
 RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h")
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-pthread")
-
-
-class NativeBuildError(GtecatError):
-    """libgts could not be built (no compiler, a compile error); the Python API is unaffected."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,32 +60,6 @@ class Build:
 
     def libs(self) -> list[str]:
         return [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", "-lgts"]
-
-
-def cache_root() -> Path:
-    env = os.environ.get("GTECAT_CACHE_DIR")
-    if env:
-        return Path(env)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    base = Path(xdg) if xdg else Path.home() / ".cache"
-    return base / "gtecat"
-
-
-def compiler() -> list[str]:
-    """The C compiler command (NativeBuildError when there is none)."""
-    cc = os.environ.get("CC")
-    if cc:
-        cmd = shlex.split(cc)
-        if shutil.which(cmd[0]):
-            return cmd
-        raise NativeBuildError(f"CC={cc!r}: {cmd[0]} not found on PATH")
-    for name in ("cc", "gcc", "clang"):
-        if shutil.which(name):
-            return [name]
-    raise NativeBuildError(
-        "no C compiler (cc, gcc or clang on PATH, or set CC): libgts cannot be built; "
-        "the Python API (from gtecat import gt) works without it"
-    )
 
 
 def python_executable() -> str:
@@ -126,10 +97,7 @@ def ensure_built(*, force: bool = False) -> Build:
     build = Build(version_dir / _digest(files, cc))
     if build.library.is_file() and build.header.is_file() and not force:
         return build
-    try:
-        version_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise NativeBuildError(f"cannot create the build cache {version_dir}: {e}") from None
+    version_dir = made_version_dir()
     with open(version_dir / ".lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if build.library.is_file() and build.header.is_file() and not force:
@@ -174,55 +142,12 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             shutil.rmtree(tmp)
 
 
-KERNEL_SOURCE = "bank_kernel.c"
-#: the axis bank's kernel: IEEE arithmetic exactly as written (no contraction into FMA, no
-#: fast-math), so it gives numpy's and the scalar code's bits
-KERNEL_CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
-
-
-def ensure_kernel() -> Path:
-    """The compiled axis-bank kernel (:mod:`gtecat.controller.bank_kernel`), built into the
-    same per-version cache as libgts on first use; NativeBuildError when it cannot be."""
-    cc = compiler()
-    text = (resources.files("gtecat.native") / "csrc" / KERNEL_SOURCE).read_text(encoding="utf-8")
-    h = hashlib.sha256(text.encode())
-    h.update(" ".join([*cc, *KERNEL_CFLAGS]).encode())
-    version_dir = cache_root() / __version__
-    lib = version_dir / f"bank_kernel-{h.hexdigest()[:12]}.so"
-    if lib.is_file():
-        return lib
-    try:
-        version_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise NativeBuildError(f"cannot create the build cache {version_dir}: {e}") from None
-    with open(version_dir / ".lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if lib.is_file():
-            return lib
-        tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=version_dir))
-        try:
-            src = tmp / KERNEL_SOURCE
-            src.write_text(text, encoding="utf-8")
-            out = tmp / lib.name
-            cmd = [*cc, *KERNEL_CFLAGS, "-shared", str(src), "-o", str(out), "-lm"]
-            r = subprocess.run(cmd, capture_output=True, text=True)
-            if r.returncode != 0 or r.stderr.strip():
-                raise NativeBuildError(
-                    f"building the bank kernel failed ({shlex.join(cmd)}):\n{r.stderr.strip()}"
-                )
-            out.rename(lib)
-        finally:
-            shutil.rmtree(tmp, ignore_errors=True)
-    return lib
-
-
 __all__ = [
     "Build",
     "NativeBuildError",
     "cache_root",
     "compiler",
     "ensure_built",
-    "ensure_kernel",
     "python_executable",
     "sources",
 ]

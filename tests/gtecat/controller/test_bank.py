@@ -1,6 +1,6 @@
 """The axis bank against the scalar reference (issue 17 item 1): the same GT program, cycle by
 cycle, with ``bank="on"`` and ``bank="off"``, the bank's plain cycle compiled
-(``GTECAT_BANK_KERNEL=c``, gtecat/native/csrc/bank_kernel.c) and in numpy alone.
+(``GTECAT_BANK_KERNEL=c``, gtecat/controller/csrc/bank_kernel.c) and in numpy alone.
 
 Compared exactly (``==`` on floats: the bank does the scalar code's float operations in the
 same order, so no tolerance is needed): every axis's GT_GetSts word, planned position
@@ -15,6 +15,7 @@ back, which is where a difference would show.
 from __future__ import annotations
 
 import os
+import shutil
 from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from pathlib import Path
 
@@ -163,8 +164,11 @@ def _run(
                 trace.append(_sample(size))
         rows = ctl.bank.rows_run if ctl.bank is not None else 0
         if ctl.bank is not None and kernel == "c":
-            assert ctl.bank.kernel is not None, ctl.bank.kernel_reason  # CI has a compiler
-            KERNEL_CYCLES.append(ctl.bank.kernel_cycles)
+            if ctl.bank.kernel is None and not HAS_CC:
+                KERNEL_CYCLES.append(-1)  # numpy alone ran: the callers skip their C check
+            else:
+                assert ctl.bank.kernel is not None, ctl.bank.kernel_reason
+                KERNEL_CYCLES.append(ctl.bank.kernel_cycles)
         elif ctl.bank is not None:
             assert ctl.bank.kernel_cycles == 0
         mech = [
@@ -179,6 +183,14 @@ def _run(
 
 
 KERNEL_CYCLES: list[int] = []  # cycles the compiled kernel ran, per "c" run
+HAS_CC = bool(os.environ.get("CC") or any(shutil.which(c) for c in ("cc", "gcc", "clang")))
+
+
+def _kernel_ran(cycles: int) -> None:
+    if cycles < 0:
+        pytest.skip("no C compiler: the bank's compiled cycle was not built (numpy checked)")
+    assert cycles > 300  # most of the bank's cycles were the compiled one
+
 
 axis = st.integers(1, AXES)
 move = st.tuples(
@@ -248,11 +260,11 @@ def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     KERNEL_CYCLES.clear()
     got, _, rows = _run(actions, machine, "on")
     assert rows > 12 * 300  # most axis-cycles ran in the bank
-    assert KERNEL_CYCLES[0] > 300  # and most of its cycles were the compiled one
     assert got == ref
     got, _, rows = _run(actions, machine, "on", "numpy")
     assert rows > 12 * 300
     assert got == ref
+    _kernel_ran(KERNEL_CYCLES[0])
 
 
 def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:
@@ -266,8 +278,8 @@ def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:
     KERNEL_CYCLES.clear()
     got, _, rows = _run(actions, machine, "on")
     assert rows > 3 * 300
-    assert KERNEL_CYCLES[0] > 300
     assert got == ref
+    _kernel_ran(KERNEL_CYCLES[0])
 
 
 def test_gt_calls_release_and_the_bank_claims_again(tmp_path: Path) -> None:

@@ -1,0 +1,100 @@
+"""The bank's compiled cycle (gtecat/controller/bank_kernel.py): how it is chosen, and that a
+machine without a compiler runs the same bank on numpy alone, with the reason readable."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from gtecat.controller import bank_kernel
+
+ROOT = Path(__file__).resolve().parents[3]
+
+PROGRAM = r"""
+import json, sys
+from ctypes import byref, c_short
+from gtecat import gt
+gt.GT_Open(eni=sys.argv[1], clock="lockstep", log="", bank="on")
+gt.GT_InitEcatComm()
+s = c_short()
+for _ in range(300):
+    gt.GT_IsEcatReady(byref(s))
+    if s.value:
+        break
+    gt.GTE_Wait(1)
+assert gt.GT_StartEcatComm() == 0
+for a in range(1, 13):
+    assert gt.GT_AxisOn(a) == 0 and gt.GT_PrfTrap(a) == 0
+assert gt.GT_SetPos(3, 20000) == 0 and gt.GT_SetVel(3, 20.0) == 0 and gt.GT_Update(1 << 2) == 0
+gt.GTE_Wait(100)
+bank = gt.GTE_Controller().bank
+print(json.dumps({"kernel": bank.kernel is not None, "reason": bank.kernel_reason,
+                  "rows": bank.rows_run, "kernel_cycles": bank.kernel_cycles}))
+gt.GT_Close()
+"""
+
+
+def _run(tmp_path: Path, **env: str) -> dict:
+    e = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    e["PYTHONPATH"] = str(ROOT)
+    e["GTECAT_CACHE_DIR"] = str(tmp_path / "cache")  # nothing built before
+    e.update(env)
+    r = subprocess.run(
+        [sys.executable, "-c", PROGRAM, str(ROOT / "examples" / "twelve_axes.eni")],
+        env=e,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_without_a_compiler_the_bank_runs_on_numpy_and_says_why(tmp_path: Path) -> None:
+    got = _run(tmp_path, CC="/no/such/compiler")
+    assert not got["kernel"] and got["kernel_cycles"] == 0
+    assert "/no/such/compiler" in got["reason"]
+    assert got["rows"] > 12 * 50  # the bank itself still ran
+
+
+def test_numpy_on_request(tmp_path: Path) -> None:
+    got = _run(tmp_path, GTECAT_BANK_KERNEL="numpy")
+    assert not got["kernel"] and got["reason"] == "GTECAT_BANK_KERNEL=numpy"
+    assert got["rows"] > 12 * 50
+
+
+@pytest.mark.skipif(
+    not any(os.path.exists(os.path.join(d, c)) for d in os.get_exec_path() for c in ("cc", "gcc")),
+    reason="no C compiler",
+)
+def test_built_on_first_use_into_the_cache_and_used(tmp_path: Path) -> None:
+    got = _run(tmp_path)
+    assert got["kernel"], got["reason"]
+    assert got["kernel_cycles"] > 50
+    built = list((tmp_path / "cache").rglob("bank_kernel-*.so"))
+    assert len(built) == 1
+
+
+def test_the_binding_reads_the_field_list_the_library_was_built_with() -> None:
+    names = [n for n, _ in bank_kernel._field_types()]
+    assert len(names) == len(set(names)) > 80
+    assert names[:2] == ["alive", "moving"] and names[-1] == "s_jog"
+    lib, reason = bank_kernel.library()
+    if lib is None:
+        pytest.skip(f"the kernel did not build here: {reason}")
+    assert lib.bank_kernel_fields().decode().rstrip(",").split(",") == names
+
+
+def test_unknown_mode_means_auto_with_a_warning(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    monkeypatch.setenv("GTECAT_BANK_KERNEL", "fastest")
+    assert bank_kernel.wanted() == "auto"
+    assert "GTECAT_BANK_KERNEL='fastest'" in caplog.text
+    monkeypatch.setenv("GTECAT_BANK_KERNEL", " NumPy ")
+    assert bank_kernel.wanted() == "numpy"
