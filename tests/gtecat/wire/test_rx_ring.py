@@ -125,7 +125,9 @@ def test_every_wait_mode_answers_a_1khz_master(wait: str) -> None:
                 n = 300
                 next_t = time.perf_counter()
                 for _ in range(n):
-                    next_t += 0.001
+                    # 1 ms after the last frame, never sooner: a master held back by a loaded
+                    # machine does not send the frames it owes back to back
+                    next_t = max(next_t + 0.001, time.perf_counter())
                     while time.perf_counter() < next_t:
                         pass
                     m.transact(LRD, 0, 0, bytes(4))  # process data (an FMMU takes part)
@@ -141,7 +143,8 @@ def test_every_wait_mode_answers_a_1khz_master(wait: str) -> None:
         assert chain.slaves[1].steps >= 200  # about one step per process-data frame
         if wait == "predict":
             pacing = report["pacing"]
-            assert 500 <= pacing["period_us"] <= 5000  # a cycle learned (load stretches it)
+            # a cycle learned: 1 ms, stretched by a loaded machine, never shorter
+            assert 900 <= pacing["period_us"] <= 20000
             # a loaded machine breaks the master's own rhythm now and then; the loop then
             # sleeps in poll until it is steady again (every frame was answered regardless)
             assert pacing["missed_windows"] <= 100
