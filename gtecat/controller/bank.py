@@ -29,7 +29,8 @@ Claimed axes are re-examined whenever a GT call or a release happened, else ever
 :data:`RECHECK_CYCLES` cycles.  A multi-axis drive is claimed with all its channels.
 
 Decisions: ``GTECAT_BANK`` / ``GT_Open(bank=...)`` = ``auto`` (default: used when the
-bus has at least :data:`AUTO_MIN_AXES` CiA-402 axes, the measured crossover), ``on``
+bus has at least :meth:`AxisBank.auto_min_axes` CiA-402 axes, the measured crossover: one
+with the compiled cycle of :mod:`.bank_kernel`, :data:`AUTO_MIN_AXES` with numpy alone), ``on``
 (any bus; the differential tests use it) or ``off``.  The results are bit-identical
 to the scalar path (same float operations in the same order; ``tests/gtecat/
 controller/test_bank.py`` compares planned and actual positions, statuswords and GT
@@ -65,7 +66,8 @@ from .profile import PrfMode
 if TYPE_CHECKING:
     from .core import Controller
 
-#: the crossover: below this many axes the scalar path is as fast (tools/bench_scaling.py)
+#: the crossover of the numpy bank: below this many axes the scalar path is as fast
+#: (tools/bench_bank.py); with the compiled cycle the bank wins from one axis
 AUTO_MIN_AXES = 4
 #: cycles between two looks for axes to claim when nothing else happened
 RECHECK_CYCLES = 16
@@ -197,11 +199,28 @@ class AxisBank:
         self._stale = False
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
         self.rows_run = 0
-        #: the compiled plain cycle (gtecat.controller.bank_kernel), None: numpy alone
+        #: the compiled plain cycle (gtecat.controller.bank_kernel), None: numpy alone; the
+        #: library is built (first use on a machine) and loaded here, at GT_InitEcatComm,
+        #: never inside a cycle
         self.kernel: Kernel | None = None
-        self.kernel_reason = "not built yet"
+        self._kernel_lib: Any = None
+        kmode = kernel_wanted()
+        if kmode == "numpy":
+            self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
+        else:
+            self._kernel_lib, self.kernel_reason = kernel_library()
+            if self._kernel_lib is None and kmode == "c":
+                ctl.log(
+                    "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
+                    f"the bank ({self.kernel_reason})"
+                )
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
+
+    def auto_min_axes(self) -> int:
+        """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
+        5 µs a cycle against 23 µs scalar), numpy alone from :data:`AUTO_MIN_AXES`."""
+        return 1 if self._kernel_lib is not None else AUTO_MIN_AXES
 
     # --- structure ------------------------------------------------------------------------
     def _build(self) -> None:
@@ -216,8 +235,9 @@ class AxisBank:
             self.disabled_reason = "a pcap is written"
             return
         layout, image = ctl.layout, master.image
-        if len(layout.axes) < (AUTO_MIN_AXES if self.mode == "auto" else 1):
-            self.disabled_reason = f"fewer than {AUTO_MIN_AXES} axes"
+        least = self.auto_min_axes() if self.mode == "auto" else 1
+        if len(layout.axes) < least:
+            self.disabled_reason = f"fewer than {least} axes"
             return
         by_slave: dict[int, list[Any]] = {}
         for ref in layout.axes:
@@ -317,18 +337,8 @@ class AxisBank:
         self.t_end = zi(n, np.int64)  # index of the end sample (or -1)
         self.T = ctl.clock.cycle_ns / 1e6
         self._reindex()
-        mode = kernel_wanted()
-        if mode == "numpy":
-            self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
-        else:
-            lib, self.kernel_reason = kernel_library()
-            if lib is not None:
-                self.kernel = Kernel(self, lib)
-            elif mode == "c":
-                ctl.log(
-                    f"GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy "
-                    f"runs the bank ({self.kernel_reason})"
-                )
+        if self._kernel_lib is not None:
+            self.kernel = Kernel(self, self._kernel_lib)
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
