@@ -20,6 +20,7 @@ GT_SetPosScale: a 23-bit encoder with scale 6 looks like 17 bits).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -219,6 +220,8 @@ class Axis:
         #: GT_ClrSts with the slave back (GT_AxisOn is refused until then)
         self.link_lost = ""
         self.link_alarm = ""
+        #: why 607Ah could not follow the planned position this cycle (not finite), "" else
+        self.plan_error = ""
         self.csp_follow = True  # write 607A from prf_pos while enabled in CSP
         self.timing = ServoTiming()
         self._cw_acc = io.get(0x6040)
@@ -261,7 +264,16 @@ class Axis:
         return (counts - self.drive_offset) / (1 << self.pos_scale)
 
     def pulses_to_counts(self, pulses: float) -> int:
-        return round(pulses * (1 << self.pos_scale)) + self.drive_offset
+        """Drive counts of an axis position in pulses (exact; 607Ah takes its low 32 bits).
+        A position that is not a number (an unchecked axis jogging into infinity) has no
+        counts: CommandError, which the cycle turns into an axis alarm (Axis.pre)."""
+        x = pulses * (1 << self.pos_scale)
+        if not math.isfinite(x):
+            raise CommandError(
+                f"axis {self.number}: the planned position is {pulses!r} pulses, not a number "
+                "of drive counts"
+            )
+        return round(x) + self.drive_offset
 
     def actual_pulses(self) -> float:
         return self.counts_to_pulses(self.actual_counts())
@@ -282,7 +294,11 @@ class Axis:
         if self._tp_acc is not None:
             if self.servo_on and self.mode_cmd == 8:
                 if self.csp_follow:
-                    self._tp_acc.set(self.pulses_to_counts(self.prf_pos))
+                    try:
+                        self._tp_acc.set(self.pulses_to_counts(self.prf_pos))
+                        self.plan_error = ""
+                    except CommandError as e:  # 607Ah holds; the axis alarms (resources)
+                        self.plan_error = str(e)
             elif not self.servo_on or self.mode_cmd != _PROFILE_POSITION:
                 # elsewhere 607A stays on the actual position, so enabling or coming back
                 # to CSP never jumps; in profile position mode 607A is the application's

@@ -71,6 +71,8 @@ if TYPE_CHECKING:
 AUTO_MIN_AXES = 4
 #: cycles between two looks for axes to claim when nothing else happened
 RECHECK_CYCLES = 16
+#: planned drive counts from which an axis leaves the bank (its int64 arithmetic ends at 2**63)
+HUGE_COUNTS = float(1 << 62)
 #: samples of a Trap move computed at once (a table per axis)
 TABLE = 2048
 
@@ -709,11 +711,17 @@ class AxisBank:
         prf_p = self.t_p.take(idx)
         ended = cur == self.t_end
         if self.n_jog:
-            jog = self._jog_step()
+            with np.errstate(over="ignore", invalid="ignore"):  # a jog into infinity leaves
+                jog = self._jog_step()
             prf_p = np.where(self.jog, jog[2], prf_p)
         a = self._link(prf_p, self.prf_ratio, self.prf_off) if self.any_prf_link else prf_p
         # 3. 607Ah (Axis.pulses_to_counts, int32 like the PDO entry) and the drives
-        counts = np.rint(a * self.unit2 if self.any_scale else a).astype(np.int64)
+        scaled = a * self.unit2 if self.any_scale else a
+        # counts beyond 2**62 (or not a number) leave the bank: the scalar path's exact
+        # integers (and its alarm for a position that is not a number) take them
+        huge = ~(np.abs(scaled) < HUGE_COUNTS)
+        with np.errstate(invalid="ignore"):
+            counts = np.rint(scaled).astype(np.int64)
         if self.any_drive_offset:
             counts += self.drive_offset
         target = counts.astype(np.int32)
@@ -741,6 +749,8 @@ class AxisBank:
         hit |= np.abs(err) > self.pos_err
         if events is not None:
             hit |= events
+        if np.count_nonzero(huge):
+            hit |= huge
         # 6. the in-position band (bit 11)
         fin = ended & moving
         any_fin = bool(np.count_nonzero(fin))

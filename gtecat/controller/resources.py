@@ -345,6 +345,13 @@ class AxisResources:
                     ax.request_disable()
         if ax.servo_on and sw & _SW_STATE_MASK != _SW_ENABLED:
             ax.request_disable()  # the drive dropped out of operation enabled by itself
+        if ax.plan_error and ax.servo_on:
+            # the planned position left the numbers (checks off, a jog into infinity): 607Ah
+            # held its last value; servo off and the alarm bit, as for a drive alarm, so the
+            # plan follows the drive again and GT_ClrSts + GT_AxisOn recover
+            self.ctl.log(f"Axis {ax.number}: {ax.plan_error}; servo off, alarm (GT_GetSts bit 1).")
+            self.latched |= _ALARM
+            ax.request_disable()
         csp = ax.mode_cmd == CSP
         if csp != self._csp:
             self._csp = csp

@@ -201,7 +201,12 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         }
         a = link(prf, F64(prf_ratio)[r], F64(prf_off)[r]);
         /* 3. 607Ah: Axis.pulses_to_counts, int32 like the PDO entry */
-        counts = to_i64(rint(a * F64(unit2)[r])) + I64(drive_offset)[r];
+        {
+            double scaled = a * F64(unit2)[r];
+            if (!(fabs(scaled) < 4611686018427387904.0)) /* 2**62, bank.HUGE_COUNTS */
+                hit = 1;
+            counts = to_i64(rint(scaled)) + I64(drive_offset)[r];
+        }
         target = (int32_t)(uint32_t)(uint64_t)counts;
         /* CspBank.step: step_csp */
         x = target + I64(c_pos_offset)[r];
