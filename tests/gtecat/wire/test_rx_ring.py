@@ -6,6 +6,7 @@ A raw socket on the other end sends the frames; every wait is bounded.
 from __future__ import annotations
 
 import json
+import os
 import select
 import signal
 import socket
@@ -186,3 +187,58 @@ def test_sigusr1_reports_a_phase_and_starts_the_latency_records_afresh(tmp_path)
         final = json.loads(stats.read_text())
         assert final["latency"]["count"] == 25  # only the frames after the snapshot
         assert final["received"] == 65  # the counters go on
+
+
+@pytest.mark.parametrize("wait", ["predict", "sleep"])
+def test_predict_lingers_after_an_answer_for_a_master_in_a_burst(wait: str, tmp_path) -> None:
+    """Bring-up traffic (register and mailbox exchanges, no cycle to learn): a master sends its
+    next frame microseconds after our answer. In predict mode the loop spins a while after each
+    answer (LINGER_NS) instead of sleeping, so those frames need no wake-up; sleep mode keeps
+    its one wake-up per frame. ``gtecat serve`` runs in its own process, as users run it (in a
+    thread of the master's process the spin would hold the GIL the master needs to send)."""
+    from .rawmaster import ServeProcess
+
+    cpus = sorted(os.sched_getaffinity(0))
+    if len(cpus) < 2:
+        pytest.skip("one CPU: a spinning server and the master would share it")
+    root = Path(__file__).resolve().parents[3]
+    stats = tmp_path / "stats.json"
+    mine = os.sched_getaffinity(0)
+    with veth_pair("rl") as (a, b):
+        # server and master on different CPUs, as a machine with room for both runs them
+        server = ServeProcess(
+            root / "examples" / "manual_fig5_2.eni",
+            b,
+            stats,
+            f"--wait={wait}",
+            f"--cpu={cpus[-1]}",
+            cwd=root,
+        )
+        os.sched_setaffinity(0, {cpus[0]})
+        try:
+            with RawMaster(a, timeout=0.5) as m:
+                deadline = time.monotonic() + 5
+                while True:
+                    try:
+                        m.brd(0x0000, 2)
+                        break
+                    except Exception:
+                        assert time.monotonic() < deadline, "the server never answered"
+                for _ in range(100):
+                    # AL status, no process data (no cycle to learn); a master thinks a while
+                    # between frames (SOEM: 50-300 us per mailbox step), longer than the loop
+                    # takes to see its own answer go by
+                    t = time.perf_counter() + 150e-6
+                    while time.perf_counter() < t:
+                        pass
+                    m.brd(0x0130, 2)
+        finally:
+            os.sched_setaffinity(0, mine)
+            assert server.stop() == 0, server.output
+    lingered = json.loads(stats.read_text())["lingered"]
+    if wait == "predict":
+        # frames of the burst found the loop awake (how many depends on the machine: a frame
+        # that comes while the loop still sees its own answer go by is taken there)
+        assert lingered >= 5, lingered
+    else:
+        assert lingered == 0
