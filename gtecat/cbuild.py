@@ -83,7 +83,10 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
             src.write_text(source, encoding="utf-8")
             out = tmp / lib.name
             cmd = [*cc, *cflags, "-shared", str(src), "-o", str(out), *libs]
-            r = subprocess.run(cmd, capture_output=True, text=True)
+            try:
+                r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+            except subprocess.TimeoutExpired:
+                raise NativeBuildError(f"building {stem}: {shlex.join(cmd)} ran 120 s") from None
             if r.returncode != 0 or r.stderr.strip():
                 raise NativeBuildError(f"building {stem} failed ({shlex.join(cmd)}):\n{r.stderr}")
             out.rename(lib)
