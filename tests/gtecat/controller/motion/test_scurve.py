@@ -176,6 +176,9 @@ def test_bad_parameters_are_parameter_errors(bad):
     direction=st.sampled_from([1, -1]),
 )
 def test_property_exact_end_within_limits(length, sv, v, a, d, jerk, direction):
+    # a cruise of more than 5000 cycles adds nothing to check, only steps (v 0.1 over 40,000
+    # pulses was 400,000 of them): long moves stay long at the speeds that reach them quickly
+    length = min(length, int(5000 * v))
     prm = SCurveParams(sv, v, a, d, jerk, triangle=not math.isfinite(jerk))
     pl = SCurvePlanner(1.0)
     pl.start(100.0, length, prm, direction)
