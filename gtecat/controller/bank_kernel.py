@@ -51,7 +51,8 @@ COLUMNS = {
     "current_actual": 7,
     "torque_demand": 7,
 }
-#: bank attribute -> kernel field, where the names differ (CspBank fields are c_*)
+#: the kernel's scratch rows (one cycle's tentative values; c_* fields are CspBank's, the
+#: others the bank's own attributes of the same name)
 _SCRATCH = (
     "s_target s_raw s_a s_enc s_step s_pos s_vel s_acc s_dpos s_dvel s_fe s_lim s_swl "
     "s_din s_since s_arr"
