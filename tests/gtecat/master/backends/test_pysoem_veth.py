@@ -112,6 +112,10 @@ class Runner:
             str(eni),
             "--iface",
             iface,
+            # SCHED_FIFO (root runs these tests): on two CPUs shared with the realtime cycle
+            # thread and another xdist worker, a plain process sat out 5-10 ms scheduler slices
+            "--rt-priority",
+            "10",
         ]
         if machine is not None:
             self.args += ["--machine", str(machine)]
