@@ -835,7 +835,7 @@ class AxisBank:
         csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's
         if csp.any_fe:
             csp.fe_running = True  # the numpy cycle then looks at every row's timer
-        if k.io[7]:  # a Trap move ended
+        if k.move_ended:
             self.n_moving = int(np.count_nonzero(self.moving))
             self._count_standing()
         self.rows_run += self.n_alive

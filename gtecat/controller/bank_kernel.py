@@ -37,6 +37,9 @@ log = logging.getLogger(__name__)
 #: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64
+#: the int64 slots (``io``) and double slots (``fp``) of a cycle call, the C enums' order
+IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN, N_IO = range(9)
+FP_DT, FP_T, N_FP = range(3)
 _DTYPES = {"u8": _U8, "i64": _I64, "f64": _F64}
 #: placement columns (the kernel's image switch)
 COLUMNS = {
@@ -77,7 +80,7 @@ def library() -> tuple[Any, str]:
         fields = [f for f in lib.bank_kernel_fields().decode().split(",") if f]
         src_types = _field_types()
         if [f for f, _ in src_types] != fields or lib.bank_kernel_abi() != (
-            len(fields) << 8 | 8 << 4 | 2
+            len(fields) << 8 | N_IO << 4 | N_FP
         ):
             raise RuntimeError("the kernel's field list is not the one this module binds")
         _FIELDS[:] = src_types
@@ -118,15 +121,13 @@ class Kernel:
         self.bank = bank
         self.fn = lib.bank_kernel_cycle
         n = bank.n
-        self.scratch = {name: np.zeros(n, _dtype_of(name)) for name in _SCRATCH}
-        for name in ("s_lim", "s_swl", "s_arr"):
-            self.scratch[name] = np.zeros(n, np.bool_)
+        self.scratch = {name: np.zeros(n, _array_type(_dtype_of(name))) for name in _SCRATCH}
         self.scratch["s_jog"] = np.zeros(5 * n, _F64)
         self.ptrs = np.zeros(len(_FIELDS), np.uint64)
-        self.io = np.zeros(8, np.int64)
-        self.fp = np.zeros(2, np.float64)
-        self.io[0] = n
-        self.fp[1] = bank.T
+        self.io = np.zeros(N_IO, np.int64)
+        self.fp = np.zeros(N_FP, np.float64)
+        self.io[IN_N] = n
+        self.fp[FP_T] = bank.T
         self.bound = False
         self._keep: list[np.ndarray] = []
         self._args = (self.ptrs.ctypes.data, self.io.ctypes.data, self.fp.ctypes.data)
@@ -142,7 +143,11 @@ class Kernel:
         empty = np.zeros(1, _F64)
         extra: dict[str, np.ndarray] = {}
         io = self.io
-        for key, bit, slot in (("w2", 1 << 2, 4), ("w16", 1 << 16, 5), ("w17", 1 << 17, 6)):
+        for key, bit, slot in (
+            ("w2", 1 << 2, IN_W2),
+            ("w16", 1 << 16, IN_W16),
+            ("w17", 1 << 17, IN_W17),
+        ):
             lo, hi = windows.get(bit, (empty, empty))
             io[slot] = lo.shape[1] if lo.ndim == 2 else 0
             extra[key + "_lo"], extra[key + "_hi"] = lo, hi
@@ -160,8 +165,7 @@ class Kernel:
                 owner, attr = (csp, name[2:]) if name.startswith("c_") else (bank, name)
                 arr = getattr(owner, attr)
                 if not _fits(arr, dtype) or not arr.flags.writeable:
-                    kind = np.bool_ if dtype is _U8 else dtype  # the bank's flags are bool
-                    arr = np.ascontiguousarray(arr, dtype=kind).copy()
+                    arr = np.ascontiguousarray(arr, dtype=_array_type(dtype)).copy()
                     setattr(owner, attr, arr)
             if not _fits(arr, dtype):
                 raise TypeError(f"bank kernel: {name} is {arr.dtype}, not {np.dtype(dtype)}")
@@ -173,9 +177,9 @@ class Kernel:
     def _placements(self) -> dict[str, np.ndarray]:
         bank = self.bank
         plc = [p for p in bank._plc if bank.alive[p[0]]]
-        self.io[2] = len(plc)
+        self.io[IN_N_PLC] = len(plc)
         rx = np.asarray(bank._rx_idx, np.int64)
-        self.io[3] = len(rx)
+        self.io[IN_N_RX] = len(rx)
         return {
             "pl_row": np.array([p[0] for p in plc] or [0], np.int64),
             "pl_off": np.array([p[1] for p in plc] or [0], np.int64),
@@ -192,9 +196,14 @@ class Kernel:
         must run it: a raw write, a row leaving)."""
         if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
             self.bind()
-        self.io[1] = t_ns
-        self.fp[0] = dt
+        self.io[IN_T_NS] = t_ns
+        self.fp[FP_DT] = dt
         return self.fn(*self._args)
+
+    @property
+    def move_ended(self) -> bool:
+        """The last committed cycle ended a Trap move (the bank recounts its moving rows)."""
+        return bool(self.io[OUT_FIN])
 
 
 def _fits(arr: np.ndarray, dtype: Any) -> bool:
@@ -205,6 +214,12 @@ def _fits(arr: np.ndarray, dtype: Any) -> bool:
     if dtype is _U8:
         return arr.dtype == np.uint8 or arr.dtype == np.bool_
     return arr.dtype == dtype
+
+
+def _array_type(dtype: Any) -> Any:
+    """The numpy type of an array the kernel reads as ``dtype``: its u8 fields are the bank's
+    flags, numpy bools."""
+    return np.bool_ if dtype is _U8 else dtype
 
 
 def _dtype_of(name: str) -> Any:

@@ -387,7 +387,12 @@ class WireServer:
                 if deadline is not None and now >= deadline:
                     break
                 window = pacing.window() if predict else None
-                if spin or window is not None:
+                # predict mode with no cycle learned (bring-up, mailbox exchanges): the
+                # master's next frame follows our answer within microseconds, and a wake-up
+                # from poll costs 50-150 us on a VM (SOEM's frame timeout is 2 ms), so the loop
+                # spins a while after each answer before it sleeps
+                linger = predict and window is None and now - self._last_out < LINGER_NS
+                if spin or window is not None or linger:
                     turns = SPIN_TURNS
                     if window is not None:
                         opens, closes = window
@@ -404,16 +409,7 @@ class WireServer:
                     # SPIN_TURNS turns or after a frame
                     for _ in range(turns):
                         if waiting():
-                            while answer(False):
-                                pass
-                            break
-                elif predict and now - self._last_out < LINGER_NS:
-                    # a master in a burst (mailbox exchanges at bring-up, no cycle to learn):
-                    # its next frame follows our answer within microseconds, and a wake-up
-                    # from poll costs 50-150 us on a VM (SOEM's frame timeout is 2 ms)
-                    for _ in range(SPIN_TURNS):
-                        if waiting():
-                            stats.lingered += 1
+                            stats.lingered += linger
                             while answer(False):
                                 pass
                             break
