@@ -550,7 +550,9 @@ def fuzz_function(name: str, examples: int, warnings: set[str]) -> None:
             j = data.draw(st.integers(0, passed), label="first keyword")
             args, kwargs = values[:j], {names[k]: values[k] for k in range(j, passed)}
         elif form == "extra":
-            args += [0, 0] if proto.core_first_form else [0]
+            # one argument more is still a form the function takes where the core may come
+            # first (manual 5.2.2.5; GTN_Open/GTN_Close of earlier gtecat releases): two more
+            args += [0, 0] if proto.core_first_form or no_core else [0]
             must7 = True
         elif form == "unknown_kw":
             kwargs["zz_no_such_parameter"] = 1
