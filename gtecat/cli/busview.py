@@ -15,14 +15,15 @@ import contextlib
 import os
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from drives.machine import MachineError
 
-from ..controller.core import Controller, Options, folder_message
-from ..controller.inspect import view
 from ..errors import BusError, ConfigMismatch, ParameterError
 from . import output
+
+if TYPE_CHECKING:  # the controller (numpy, drives) loads when a verb opens a bus
+    from ..controller.core import Controller
 
 
 def add_bus_options(p: argparse.ArgumentParser, *, position: bool = True) -> None:
@@ -71,12 +72,16 @@ def check_toml_kind(path: str | os.PathLike[str] | None, want: str) -> None:
 def eni_argument(args: argparse.Namespace) -> str | None:
     eni = getattr(args, "eni", None) or getattr(args, "file", None)
     if eni and Path(eni).is_dir():
+        from ..controller.core import folder_message
+
         raise ParameterError(folder_message(Path(eni), "give the file, e.g. --eni"))
     return eni
 
 
 def open_bus(args: argparse.Namespace) -> Controller:
     """Bring the bus up as GT_Open + GT_InitEcatComm would (lockstep; realtime on pysoem)."""
+    from ..controller.core import Controller, Options
+
     backend = args.backend or os.environ.get("GTECAT_BACKEND") or "emulated"
     eni = eni_argument(args)
     check_toml_kind(args.machine, "machine")
@@ -136,6 +141,8 @@ def bus_view(args: argparse.Namespace) -> Iterator[Any]:
         with Field.connect(address) as f:
             yield f
         return
+    from ..controller.inspect import view
+
     ctl = open_bus(args)
     try:
         yield view(ctl)

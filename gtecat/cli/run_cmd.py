@@ -24,12 +24,14 @@ import time
 import traceback
 from collections.abc import Callable
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from eni.errors import GtecatError
 
-from ..controller.core import Controller
 from ..errors import ParameterError
+
+if TYPE_CHECKING:  # loaded by run(), not by every other verb's start
+    from ..controller.core import Controller
 
 ENV = ("GTECAT_ENI", "GTECAT_MACHINE", "GTECAT_CLOCK", "GTECAT_BACKEND", "GTECAT_IFACE")
 
@@ -323,6 +325,7 @@ def run(args: argparse.Namespace) -> int:
         ctl.sample.append(lambda _t: progress(ctl))
 
     from .. import gt as gt_module
+    from ..controller.core import Controller
 
     real_open, real_gtn_open = gt_module.GT_Open, gt_module.GTN_Open
     noted: set[str] = set()

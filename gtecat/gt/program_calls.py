@@ -60,7 +60,7 @@ from typing import Any
 
 from ..controller.core import Controller
 from ..errors import ParameterError
-from ..programs import compiler, image, mram, threads
+from ..programs import image, mram, threads
 from ..programs.model import MAX_FUNCTIONS
 from . import _core
 from ._core import fail, gt_function, store, store_array, store_bytes, struct_arg
@@ -174,6 +174,9 @@ def _report(info: Any, filename: str, line: int, message: str) -> None:
 @gt_function
 def GT_Compile(pFileName: str, pWrongInfo: Any) -> int:
     """Compile a motion program; ``x.bin`` and ``x.ini`` beside ``x.c`` (entry 9, 10.3.2)."""
+    # the compiler (and its parser, lark) loads on the first compile, not with gtecat.gt
+    from ..programs import compiler
+
     info = struct_arg(pWrongInfo, TCompileInfo, "pWrongInfo")
     try:
         program = compiler.compile_file(pFileName)
