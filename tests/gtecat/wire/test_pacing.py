@@ -5,7 +5,23 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gtecat.wire.pacing import BASE_MARGIN_NS, STEADY_AFTER, Pacing
+from gtecat.wire.pacing import (
+    BASE_MARGIN_NS,
+    GUARD_NS,
+    MIN_MARGIN_NS,
+    RELEARN,
+    SAMPLES,
+    STEADY_AFTER,
+    Pacing,
+)
+
+
+def steady(p: Pacing, t: int, n: int, period: int = 1_000_000) -> int:
+    """``n`` arrivals one ``period`` apart from ``t``; the time of the next one."""
+    for _ in range(n):
+        p.arrived(t)
+        t += period
+    return t
 
 
 def test_a_steady_1ms_master_gets_a_window_around_its_next_frame() -> None:
@@ -29,6 +45,59 @@ def test_no_window_before_the_rhythm_is_steady_or_after_a_miss() -> None:
     assert p.window() is not None
     p.missed()
     assert p.window() is None and p.misses == 1
+    # the rhythm is kept: the late frame itself brings the window back for the next one
+    p.arrived((STEADY_AFTER + 2) * 1_000_000 + 90_000)
+    opens, closes = p.window()  # type: ignore[misc]
+    assert opens < (STEADY_AFTER + 3) * 1_000_000 + 90_000 < closes
+
+
+def test_the_margin_learns_the_hosts_late_wake_ups() -> None:
+    """A host whose sleeps end 60 us late, and 2 in 100 of them 300 us late: the window
+    opens early enough for the 99th percentile (300 us) plus the guard."""
+    p = Pacing()
+    t = steady(p, 0, STEADY_AFTER + 2)
+    assert p.margin_ns == BASE_MARGIN_NS  # nothing learned yet
+    for k in range(SAMPLES):
+        p.woke(300_000 if k % 50 == 0 else 60_000)
+        t = steady(p, t, 1)
+    assert p.margin_ns == 300_000 + GUARD_NS
+    opens, closes = p.window()  # type: ignore[misc]
+    assert (opens, closes) == (t - 300_000 - GUARD_NS, t + 300_000 + GUARD_NS)
+
+
+def test_a_quiet_host_and_a_steady_master_spin_little() -> None:
+    p = Pacing()
+    t = steady(p, 0, STEADY_AFTER + 2)
+    for _ in range(RELEARN * 2):
+        p.woke(5_000)
+        t = steady(p, t, 1)
+    assert p.margin_ns == MIN_MARGIN_NS  # 5 us + the guard is less than the floor
+    opens, closes = p.window()  # type: ignore[misc]
+    assert closes - opens == 2 * MIN_MARGIN_NS
+
+
+def test_the_margin_covers_the_masters_own_jitter() -> None:
+    """A master whose frames come 60 us late, 20 us early or on time in turn: its frames
+    wander up to 80 us from the due time, and the learned window holds the next one."""
+    p = Pacing()
+    jitter = (60_000, -20_000, 0)
+    t = 0
+    for k in range(SAMPLES):
+        p.arrived(t + jitter[k % 3])
+        t += 1_000_000
+    assert 80_000 + GUARD_NS <= p.margin_ns < BASE_MARGIN_NS
+    opens, closes = p.window()  # type: ignore[misc]
+    assert opens < t + jitter[SAMPLES % 3] < closes
+
+
+def test_a_margin_wider_than_half_the_period_is_a_window_as_wide_as_the_period() -> None:
+    p = Pacing()
+    t = steady(p, 0, STEADY_AFTER + 2, period=400_000)
+    for _ in range(RELEARN):
+        p.woke(900_000)  # a host far too busy: spin the whole time
+        t = steady(p, t, 1, period=400_000)
+    opens, closes = p.window()  # type: ignore[misc]
+    assert closes - opens == 400_000
 
 
 def test_a_change_of_period_restarts_the_estimate() -> None:
