@@ -44,8 +44,8 @@ the loop.  ``busy_poll`` spins instead of sleeping in ``poll`` (one core at
 
 from __future__ import annotations
 
-import errno
 import ctypes
+import errno
 import gc
 import logging
 import os
