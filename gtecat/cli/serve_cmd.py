@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -55,11 +56,12 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--wait",
-        choices=("predict", "sleep", "spin"),
-        default="predict",
-        help="how to wait for frames: predict = learn the master's cycle and spin only "
-        "around the cyclic frame's due time (default; a fraction of a CPU), sleep = poll "
-        "(a wake-up per frame, no CPU), spin = spin all the time (a whole CPU)",
+        choices=("auto", "predict", "sleep", "spin"),
+        default="auto",
+        help="how to wait for frames: spin = spin all the time (a whole CPU; the lowest "
+        "latency), predict = learn the master's cycle and spin only around the cyclic "
+        "frame's due time (a fraction of a CPU), sleep = poll (a wake-up per frame, no "
+        "CPU); auto (default) = spin on a machine with two CPUs or more, else predict",
     )
     p.add_argument(
         "--busy-poll",
@@ -120,12 +122,40 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
     return chain, config
 
 
+def resolve_wait(wait: str, rt_priority: int | None = None) -> str:
+    """``auto``: spin where the master keeps a CPU of its own, else predict.
+
+    A frame answered from a spinning loop takes half the time of one answered after a
+    sleep, even a predicted one: on a VM the CPU that slept runs slower for a while (p50
+    13 against 28 us on the 2-vCPU machine, docs/hardware.md), and issue 16's bar is the
+    spinning figure.  On one CPU a spinning server would take the master's time slices;
+    under SCHED_FIFO (``--rt-priority``) the kernel stops a task that never sleeps for 50 ms
+    of every second (``sched_rt_runtime_us``), so auto predicts there too.
+    """
+    if wait != "auto":
+        return wait
+    if rt_priority:
+        return "predict"
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cpus = os.cpu_count() or 1
+    return "spin" if cpus >= 2 else "predict"
+
+
 def run(args: argparse.Namespace) -> int:
     from eni.errors import GtecatError
     from gtecat.wire.serve import WireServer, interface_is_up, pin_to_cpu, realtime_priority
 
     if args.verbose:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+    wait = "spin" if args.busy_poll else resolve_wait(args.wait, args.rt_priority)
+    if wait == "spin" and args.rt_priority:
+        print(
+            "warning: a spinning server under SCHED_FIFO is stopped by the kernel for 50 ms "
+            "every second (sched_rt_runtime_us); --wait predict sleeps between frames",
+            file=sys.stderr,
+        )
     if args.cpu is not None:
         pin_to_cpu(args.cpu)
     if not Path("/sys/class/net", args.iface).exists() and Path("/sys/class/net").is_dir():
@@ -157,7 +187,7 @@ def run(args: argparse.Namespace) -> int:
         args.iface,
         step_mode=args.step,
         cycle_ns=cycle_ns,
-        wait="spin" if args.busy_poll else args.wait,
+        wait=wait,
         pcap=pcap,
     )
     if args.rt_priority:
@@ -186,7 +216,10 @@ def run(args: argparse.Namespace) -> int:
     def _ready() -> None:
         served.append(True)
         names = ", ".join(f"{s.position}:{s.name}" for s in chain.slaves)
-        print(f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}); ready", flush=True)
+        print(
+            f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}), --wait {wait}; ready",
+            flush=True,
+        )
 
     try:
         server.serve(ready=_ready, duration_s=args.duration)

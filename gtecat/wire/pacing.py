@@ -40,6 +40,9 @@ QUANTILE = 0.99
 #: samples of each kind kept; the margin is learned anew after every RELEARN new ones
 SAMPLES = 256
 RELEARN = 32
+#: the window stays open at least this long after the due time: a frame the master sends
+#: late (its own scheduling) is still found awake, at the cost of a spin only when it is late
+LATE_SPAN_NS = 300_000
 #: arrivals in a row within a quarter period of the estimate before the window is used
 STEADY_AFTER = 8
 
@@ -102,7 +105,9 @@ class Pacing:
         self.misses += 1
 
     def window(self) -> tuple[int, int] | None:
-        """(open, close) of the spin around the next frame's due time, or None."""
+        """(open, close) of the spin around the next frame's due time, or None.  It opens
+        the learned margin before the due time and closes LATE_SPAN_NS after it (the margin
+        when that is longer), never more than a period in all."""
         period = self.period_ns
         last = self.last_ns
         if (
@@ -113,8 +118,9 @@ class Pacing:
         ):
             return None
         margin = int(min(period / 2, self.margin_ns))
+        late = int(min(period - margin, max(margin, LATE_SPAN_NS)))
         due = last + round(period)
-        return due - margin, due + margin
+        return due - margin, due + late
 
 
 __all__ = ["Pacing"]

@@ -156,7 +156,7 @@ def test_sigusr1_reports_a_phase_and_starts_the_latency_records_afresh(tmp_path)
     with veth_pair("ru") as (a, b):
         proc = subprocess.Popen(
             [sys.executable, "-m", "gtecat", "serve", "--eni", str(FIG52), "--iface", b,
-             "--stats-json", str(stats)],
+             "--stats-json", str(stats), "--wait", "predict"],
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=ROOT,
         )  # fmt: skip
         try:

@@ -106,6 +106,9 @@ class Server:
                 iface,
                 "--stats-json",
                 str(stats),
+                # a fraction of a CPU beside the suite's workers (``extra`` may say otherwise)
+                "--wait",
+                "predict",
                 *extra,
             ],
             stdout=subprocess.PIPE,
