@@ -137,7 +137,9 @@ class DriveSettings:
     #: refuse SDO downloads to RxPDO-mapped objects in SAFEOP/OP with 0x06010006
     block_sdo_to_rxpdo: bool = False
     mailbox_size: int = 128
-    device_name: str = "gtecat virtual CiA-402 servo drive"
+    #: 1008h; empty: the name the configuration gives the slave (a Googol INI's slavename,
+    #: the product an ETG.2100 ENI names), as a real drive names its product there
+    device_name: str = ""
     hardware_version: str = "1.0"
     software_version: str = "gtecat 0.1"
 

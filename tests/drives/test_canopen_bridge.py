@@ -110,7 +110,7 @@ def test_sdo_aborts_segments_and_unknown_objects(rig) -> None:
         node.sdo.upload(0x5FFF, 0)
     assert err.value.code == 0x06020000
     # segmented upload (CAN segments of 7 bytes, served by the bridge)
-    assert node.sdo[0x1008].raw == drive.settings.device_name
+    assert node.sdo[0x1008].raw == drive.od.upload(0x1008, 0).decode()
     # segmented download, collected by the bridge and written through CoE in one go
     node.sdo.download(0x607C, 0, (123456).to_bytes(4, "little", signed=True), force_segment=True)
     assert drive.channel(0).home_offset == 123456
@@ -131,7 +131,7 @@ def test_scripted_sdo_frames_without_a_bus() -> None:
     r = bridge.handle(bytes.fromhex("4041600000000000"))
     assert int.from_bytes(r[4:6], "little") & 0x6F == 0x21  # READY TO SWITCH ON
     # segmented upload of 1008h: initiate answers the size, then 7-byte segments, toggling
-    name = drive.settings.device_name.encode()
+    name = drive.od.upload(0x1008, 0)
     r = bridge.handle(bytes.fromhex("4008100000000000"))
     assert r == bytes.fromhex("41081000") + len(name).to_bytes(4, "little")
     got, toggle = b"", 0

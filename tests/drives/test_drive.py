@@ -175,7 +175,7 @@ def test_fig_5_2_mapping_sizes_and_identity() -> None:
     assert rig.read(0x1018, 2, "I") == 0x00010001
     assert rig.read(0x1018, 4, "I") == 42
     assert rig.read(0x6502, 0, "I") == 0x03AD
-    assert rig.sdo.upload(0x1008, 0).startswith(b"gtecat")
+    assert rig.sdo.upload(0x1008, 0) == rig.drive.name.encode()  # the configured name
 
 
 def test_every_issue_object_exists_per_channel() -> None:

@@ -111,7 +111,7 @@ def test_sdo_upload_json(cli: Cli) -> None:
 
 def test_sdo_string_type_reads_the_device_name(cli: Cli) -> None:
     rc, out, _ = cli("sdo", "upload", "0", "0x1008", "0", "--eni", FIG52)
-    assert rc == 0 and out == "gtecat virtual CiA-402 servo drive\n"  # VISIBLE_STRING
+    assert rc == 0 and out == "GTHD 0\n"  # VISIBLE_STRING: the name the ENI gives the drive
     rc, typed, _ = cli("sdo", "upload", "0", "0x1008", "0", "--type", "string", "--eni", FIG52)
     assert typed == out
     rc, out, err = cli(

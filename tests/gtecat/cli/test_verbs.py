@@ -34,7 +34,7 @@ def test_sdos_lists_the_dictionary_with_values(cli: Cli) -> None:
     assert sw.split()[:5] == ["0", "0x6041:00", "UINT16", "RO", "TxPDO"]
     assert sw.endswith("1616 (0x0650)") and "Statusword" in sw
     assert any("0x1018:01" in line and "Identity: Vendor ID" in line for line in lines)
-    assert any("'gtecat virtual CiA-402 servo drive'" in line for line in lines)
+    assert any("0x1008:00" in line and "'GTHD 0'" in line for line in lines)
 
 
 def test_sdos_json_and_grep(cli: Cli) -> None:

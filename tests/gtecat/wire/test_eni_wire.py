@@ -73,3 +73,14 @@ def test_a_googol_ini_states_no_wire_layout(tmp_path: Path) -> None:
     if eni is None:
         pytest.skip("no Googol INI fixture")
     assert read_wire(eni) is None
+
+
+def test_a_googol_ini_drive_names_its_product_in_1008h() -> None:
+    """Googol's configuration tool writes the device's ESI name as ``slavename``; the drive
+    answers it in 1008h (an outside check read "gtecat virtual CiA-402 servo drive")."""
+    eni = ROOT.parent / "shared" / "fixtures" / "googol" / "Gecat_DM3E_stepper.eni"
+    if not eni.is_file():
+        pytest.skip(f"shared fixture {eni} not found")
+    infos, chain = sii_of(eni)
+    assert chain.escs[0].slave.od.upload(0x1008, 0) == b"DM3E_522_COE_"
+    assert infos[0].name == "DM3E_522_COE_"
