@@ -128,7 +128,9 @@ class FoeServer:
         return self._frame(_REQ.pack(FoeOpcode.DATA, 0, read.packet) + chunk)
 
     def _error(self, code: FoeError, text: str) -> bytes:
-        return self._frame(_REQ.pack(FoeOpcode.ERROR, 0, int(code)) + text.encode("latin-1"))
+        # the text is cut to the mailbox (a long file name echoed in it overflowed SM1)
+        data = text.encode("latin-1", "replace")[: self._room()]
+        return self._frame(_REQ.pack(FoeOpcode.ERROR, 0, int(code)) + data)
 
     def _frame(self, body: bytes) -> bytes:
         self.counter = next_counter(self.counter)

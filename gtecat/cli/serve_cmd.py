@@ -47,7 +47,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         help="step the slaves once per process-data frame (default) or on a timer",
     )
     p.add_argument(
-        "--cycle-us", type=int, help="slave cycle for --step cycle (default: ENI, else 1000)"
+        "--cycle-us",
+        type=_positive(int),
+        help="slave cycle for --step cycle (default: ENI, else 1000)",
     )
     p.add_argument(
         "--sm-watchdog",
@@ -76,7 +78,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         help="run on CPU N only (keep the master's busy loop on another CPU: sharing one "
         "costs a context switch per frame)",
     )
-    p.add_argument("--duration", type=float, help="stop after this many seconds")
+    p.add_argument("--duration", type=_positive(float), help="stop after this many seconds")
     p.add_argument(
         "--stats-json",
         type=Path,
@@ -97,6 +99,34 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         help="write every frame received and answered to FILE (classic pcap, for Wireshark)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="log what the slaves do")
+
+
+def _positive(kind: type[int] | type[float]):
+    """An argparse type: a number greater than 0 (argparse names the option in its error)."""
+
+    def parse(text: str) -> int | float:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not value > 0:  # also refuses nan
+            raise argparse.ArgumentTypeError(f"{text} is not greater than 0")
+        return value
+
+    parse.__name__ = kind.__name__
+    return parse
+
+
+def _writable(path: Path, option: str) -> None:
+    """Fail now, in one line, for a file that cannot be written at the end of the run."""
+    from eni.errors import GtecatError
+
+    probe = path.with_name(path.name + ".tmp")
+    try:
+        probe.touch()
+        probe.unlink()
+    except OSError as exc:
+        raise GtecatError(f"{option} {path}: {exc.strerror or exc}") from None
 
 
 def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool = False):
@@ -181,7 +211,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: interface {args.iface} is down", file=sys.stderr)
     from gtecat.master.pcap import PcapWriter
 
-    pcap = PcapWriter(args.pcap) if args.pcap else None
+    if args.stats_json:
+        _writable(args.stats_json, "--stats-json")
+    try:
+        pcap = PcapWriter(args.pcap) if args.pcap else None
+    except OSError as exc:
+        raise GtecatError(f"--pcap {args.pcap}: {exc.strerror or exc}") from None
     server = WireServer(
         chain,
         args.iface,
@@ -201,8 +236,11 @@ def run(args: argparse.Namespace) -> int:
     def _write_stats(report: dict[str, object]) -> None:
         if args.stats_json:
             tmp = args.stats_json.with_name(args.stats_json.name + ".tmp")
-            tmp.write_text(json.dumps(report, indent=2) + "\n")
-            tmp.replace(args.stats_json)
+            try:
+                tmp.write_text(json.dumps(report, indent=2) + "\n")
+                tmp.replace(args.stats_json)
+            except OSError as exc:  # the folder went away during the run: say so, go on
+                print(f"warning: --stats-json {args.stats_json}: {exc.strerror}", file=sys.stderr)
 
     def _snapshot(signum: int, _frame: FrameType | None) -> None:
         server.snapshot_due = True

@@ -38,6 +38,7 @@ class PcapWriter:
         if not resume:
             self._fh.write(_GLOBAL.pack(MAGIC_NS, 2, 4, 0, 0, SNAPLEN, LINKTYPE_ETHERNET))
         self.frames = 0
+        self._last_ns = 0
 
     def write(self, frame: bytes | bytearray | memoryview, t_ns: int | None = None) -> None:
         """One frame; ``t_ns`` is wall-clock (CLOCK_REALTIME) nanoseconds, default now."""
@@ -46,6 +47,11 @@ class PcapWriter:
             raise ValueError(f"pcap file {self.path} is closed")
         if t_ns is None:
             t_ns = time.time_ns()
+        # records in the order written, with times that never go back: a request that
+        # waited in the socket while the previous answer went out carries its kernel time,
+        # which is before that answer's; it is stamped with the answer's time instead, as
+        # readers (and tools that merge or slice captures) expect non-decreasing times
+        t_ns = self._last_ns = max(t_ns, self._last_ns)
         n = len(frame)
         cap = min(n, SNAPLEN)
         fh.write(_RECORD.pack(t_ns // 1_000_000_000, t_ns % 1_000_000_000, cap, n))

@@ -300,6 +300,16 @@ def test_foe_refuses_unknown_files_and_firmware_writes() -> None:
         assert struct.unpack_from("<BBI", answer, 6) == (5, 0, code)
 
 
+def test_foe_not_found_for_a_name_as_long_as_the_mailbox_still_fits_it() -> None:
+    """The error text echoes the name; a 110-byte name made a 184-byte answer for a 128-byte
+    SM1 (outside check), and the master got mailbox error 7 instead of FoE 8001h."""
+    esc = drive_esc()
+    answer = foe_answer(esc, foe(1, 0, b"n" * (SIZE - 12), 1))
+    assert answer is not None and len(answer) <= SIZE
+    assert struct.unpack_from("<BBI", answer, 6) == (5, 0, 0x8001)
+    assert answer[12:].startswith(b"no file 'nnn")
+
+
 def test_a_repeat_request_after_the_next_fragment_came_puts_back_the_lost_one() -> None:
     """ETG.1000.4 5.6: the repeat request puts back the message the master read last. Here the
     slave has already put the next SDO Information fragment into SM1 when the master asks for

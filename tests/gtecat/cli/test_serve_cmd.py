@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from gtecat.cli import serve_cmd
@@ -35,3 +37,32 @@ def test_the_default_is_auto() -> None:
     serve_cmd.add_parser(parser.add_subparsers())
     args = parser.parse_args(["serve", "--iface", "lo", "--eni", "x.eni"])
     assert args.wait == "auto"
+
+
+FIG52 = str(Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni")
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["--cycle-us", "-10"], "argument --cycle-us: -10 is not greater than 0"),
+        (["--cycle-us", "0"], "argument --cycle-us: 0 is not greater than 0"),
+        (["--duration", "-5"], "argument --duration: -5 is not greater than 0"),
+        (["--duration", "nan"], "argument --duration: nan is not greater than 0"),
+        (["--duration", "x"], "argument --duration: 'x' is not a number"),
+    ],
+)
+def test_numbers_that_make_no_sense_are_refused_by_name(capsys, args, said) -> None:
+    with pytest.raises(SystemExit) as done:
+        serve_cmd.main(["--eni", FIG52, "--iface", "lo", *args])
+    assert done.value.code == 2 and said in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("option", ["--stats-json", "--pcap"])
+def test_a_file_that_cannot_be_written_is_refused_before_serving(capsys, option) -> None:
+    """Not at the first SIGUSR1 with a traceback (outside check): one line, exit 1."""
+    path = "/nonexistent-gtecat/d/out"
+    code = serve_cmd.main(["--eni", FIG52, "--iface", "lo", option, path, "--duration", "0.1"])
+    out = capsys.readouterr()
+    assert code == 1 and "ready" not in out.out
+    assert out.err == f"error: {option} {path}: No such file or directory\n"
