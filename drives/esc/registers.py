@@ -790,7 +790,15 @@ class Esc:
 
     # --- mailbox (the slave's side of SM0/SM1) -------------------------------------------------
     def service(self) -> None:
-        """PDI work after a frame: take a mailbox request, hand out the next answer."""
+        """PDI work after a frame: take a mailbox request, hand out the next answer.
+
+        A slave without a mailbox (an EL2008, an EK1100) is an ESC with no microcontroller:
+        the master may configure SM0/SM1 as mailbox buffers, the ESC keeps them as it keeps
+        any SM, but nobody on the PDI side reads SM0 or writes SM1, so a request stays in
+        SM0 (the next write finds it full: WKC 0) and no answer ever comes."""
+        if not self.slave.has_mailbox:
+            self._mbx_in_pending = False
+            return
         sm = self.mbx_out_sm
         if self._mbx_in_pending and sm is not None and sm.full:
             self._mbx_in_pending = False
@@ -851,9 +859,6 @@ class Esc:
         mtype = msg[5] & 0x0F
         if length + 6 > len(msg):
             self._queue(mailbox_error(MailboxError.INVALID_SIZE))
-            return
-        if not self.slave.has_mailbox:
-            self._queue(mailbox_error(MailboxError.UNSUPPORTED_PROTOCOL))
             return
         if mtype == MailboxType.FOE and getattr(self.slave, "foe", None) is None:
             answer = self.foe.handle(msg[: 6 + length])  # the firmware's FoE (drives.foe)

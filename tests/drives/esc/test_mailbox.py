@@ -108,6 +108,22 @@ def test_a_lost_answer_comes_again_on_the_repeat_request() -> None:
     assert read_mailbox(esc) == first
 
 
+def test_a_bare_esc_keeps_a_mailbox_request_and_never_answers() -> None:
+    """An EL2008 has no microcontroller: SMs the master sets up as a mailbox are plain
+    buffers, nothing reads SM0 or fills SM1 (an outside check got mailbox error 2 from the
+    EK1100, EL2008 and EL1809)."""
+    from tests.drives.esc.test_registers import sm_bytes
+
+    esc, _ = make(mailbox=False)
+    assert esc.write(Reg.SM0, sm_bytes(SM0, SIZE, 0x26) + sm_bytes(SM1, SIZE, 0x22))
+    assert request(esc, AlState.PREOP) == (AlState.PREOP, 0)
+    assert write_mailbox(esc, sdo_upload_request(0x1018, 1, counter=1))
+    for _ in range(3):
+        esc.service()
+        assert read_mailbox(esc) is None  # SM1 stays empty: no WKC
+    assert not write_mailbox(esc, sdo_upload_request(0x1018, 1, counter=2))  # SM0 still full
+
+
 # --- a real drive: SDO Information and emergencies ----------------------------------------------
 def drive_esc() -> Esc:
     rx = (Pdo(0x1600, Direction.OUT, (PdoEntry(0x6040, 0, 16), PdoEntry(0x607A, 0, 32))),)
