@@ -10,11 +10,13 @@ topology builder makes (source and lines aside):
   per sync manager with its ``Pdo`` assignment list, the assigned
   ``TxPdo``/``RxPdo`` with their entries (``Sm`` attribute set), and
   ``Mailbox/CoE/InitCmds`` for slaves with a mailbox;
+* per slave ``InitCmds``: the register commands a master that replays the file
+  word for word (TwinCAT, acontis EC-Master) runs per transition - state
+  requests and checks, identity, station address, SMs, FMMUs
+  (:mod:`eni.register_cmds`) - and the master's ``BeforeSlave`` commands in
+  ``Config/Master/InitCmds``; the readers ignore them (they follow from the rest);
 * ``Cyclic`` (cycle time in microseconds and one LRW command over both images);
 * ``ProcessImage`` with ``ByteSize`` and one ``Variable`` per mapped entry.
-
-Register-level InitCmds (FMMU, SM setup) are not written: the emulated master
-derives them from the process data, as the readers never need them.
 """
 
 from __future__ import annotations
@@ -25,15 +27,18 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from .model import Direction, EniConfig, InitCmd, Pdo, Slave, Variable
-
-LRW = 12  # ETG.1000.4 Table 9: logical read/write
-LOGICAL_BASE = 0x10000000
-# sync manager defaults (ETG.1000.4 6.7, what ESC-based slaves use)
-_SM_DEFAULT = {
-    Direction.OUT: (0x1100, 0x64),  # start address, control byte: 3-buffer, write, watchdog
-    Direction.IN: (0x1400, 0x20),  # 3-buffer, read
-}
-_MBX = ((0x1000, 128), (0x1080, 128))
+from .register_cmds import (
+    LOGICAL_BASE,
+    MAILBOX,
+    SM_DEFAULT,
+    Command,
+    RegisterCmd,
+    has_mailbox,
+    master_cmds,
+    slave_cmds,
+    sm_maps,
+    sm_of,
+)
 
 
 def _hex(v: int, width: int = 4) -> str:
@@ -90,12 +95,6 @@ def _pdo_xml(parent: ET.Element, p: Pdo, sm: int) -> None:
             _sub(ent, "DataType", e.data_type)
 
 
-def _sm_of(p: Pdo) -> int:
-    if p.sm is not None:
-        return p.sm
-    return 2 if p.direction == Direction.OUT else 3
-
-
 def _process_data(parent: ET.Element, s: Slave) -> None:
     pd = _sub(parent, "ProcessData")
     for tag, area in (("Send", s.outputs), ("Recv", s.inputs)):
@@ -103,25 +102,20 @@ def _process_data(parent: ET.Element, s: Slave) -> None:
             a = _sub(pd, tag)
             _sub(a, "BitStart", area.bit_start)
             _sub(a, "BitLength", area.bit_len)
-    by_sm: dict[int, list[Pdo]] = {}
-    for p in (*s.rx_pdos, *s.tx_pdos):
-        by_sm.setdefault(_sm_of(p), []).append(p)
-    for sm in sorted(by_sm):
-        pdos = by_sm[sm]
-        d = pdos[0].direction
-        smel = _sub(pd, f"Sm{sm}")
-        _sub(smel, "Type", "Outputs" if d == Direction.OUT else "Inputs")
-        _sub(smel, "DefaultSize", (sum(p.bit_len for p in pdos) + 7) // 8)
-        start, control = _SM_DEFAULT[d]
+    for m in sm_maps(s):
+        smel = _sub(pd, f"Sm{m.number}")
+        _sub(smel, "Type", "Outputs" if m.direction == Direction.OUT else "Inputs")
+        _sub(smel, "DefaultSize", m.length)
+        start, control = SM_DEFAULT[m.direction]
         _sub(smel, "StartAddress", _hex(start))
         _sub(smel, "ControlByte", _hex(control, 2))
         _sub(smel, "Enable", 1)
-        for p in pdos:
+        for p in m.pdos:
             _sub(smel, "Pdo", _hex(p.index))
     for p in s.tx_pdos:
-        _pdo_xml(pd, p, _sm_of(p))
+        _pdo_xml(pd, p, sm_of(p))
     for p in s.rx_pdos:
-        _pdo_xml(pd, p, _sm_of(p))
+        _pdo_xml(pd, p, sm_of(p))
 
 
 def _init_cmd(parent: ET.Element, c: InitCmd) -> None:
@@ -143,7 +137,7 @@ def _init_cmd(parent: ET.Element, c: InitCmd) -> None:
 
 def _mailbox(parent: ET.Element, s: Slave) -> None:
     mb = _sub(parent, "Mailbox", DataLinkLayer="true")
-    for tag, (start, length) in zip(("Send", "Recv"), _MBX, strict=True):
+    for tag, (start, length) in zip(("Send", "Recv"), MAILBOX, strict=True):
         el = _sub(mb, tag)
         _sub(el, "Start", _hex(start))
         _sub(el, "Length", length)
@@ -153,6 +147,38 @@ def _mailbox(parent: ET.Element, s: Slave) -> None:
         cmds = _sub(coe, "InitCmds")
         for c in s.init_cmds:
             _init_cmd(cmds, c)
+
+
+def _register_cmds(parent: ET.Element, cmds: Iterable[RegisterCmd]) -> None:
+    """``InitCmds`` in the element order of ETG.2100 ``EcatCmdType``."""
+    el = _sub(parent, "InitCmds")
+    for c in cmds:
+        ic = _sub(el, "InitCmd")
+        for t in c.transitions:
+            _sub(ic, "Transition", t)
+        if c.before_slave:
+            _sub(ic, "BeforeSlave", "true")
+        _sub(ic, "Comment", c.comment)
+        if c.cycle:
+            _sub(ic, "Requires", "cycle")
+        _sub(ic, "Cmd", int(c.cmd))
+        _sub(ic, "Adp", c.adp)
+        _sub(ic, "Ado", c.ado)  # decimal, as TwinCAT and EC-Engineer write Cmd/Adp/Ado
+        if isinstance(c.data, int):
+            _sub(ic, "DataLength", c.data)
+        else:
+            _sub(ic, "Data", c.data.hex())
+        if c.cnt is not None:
+            _sub(ic, "Cnt", c.cnt)
+        _sub(ic, "Retries", c.retries)
+        if c.timeout_ms is not None:
+            _sub(ic, "Timeout", c.timeout_ms)
+        if c.validate is not None:
+            v = _sub(ic, "Validate")
+            _sub(v, "Data", c.validate.data.hex())
+            if c.validate.mask is not None:
+                _sub(v, "DataMask", c.validate.mask.hex())
+            _sub(v, "Timeout", c.validate.timeout_ms)
 
 
 def _wkc(slaves: Iterable[Slave]) -> int:
@@ -176,6 +202,8 @@ def to_xml(cfg: EniConfig) -> ET.Element:
     _sub(info, "Destination", "ffffffffffff")
     _sub(info, "Source", "000000000000")
     _sub(info, "EtherType", "a488")
+    if cfg.slaves:
+        _register_cmds(master, master_cmds(len(cfg.slaves)))
     for s in cfg.slaves:
         sel = _sub(config, "Slave")
         si = _sub(sel, "Info")
@@ -188,8 +216,9 @@ def to_xml(cfg: EniConfig) -> ET.Element:
         _sub(si, "SerialNo", s.identity.serial_no)
         if s.rx_pdos or s.tx_pdos or s.outputs or s.inputs:
             _process_data(sel, s)
-        if s.mailbox or s.init_cmds:
+        if has_mailbox(s):
             _mailbox(sel, s)
+        _register_cmds(sel, slave_cmds(s, LOGICAL_BASE))
     if cfg.cycle_time_ns is not None:
         cyc = _sub(config, "Cyclic")
         us = cfg.cycle_time_ns / 1000
@@ -199,7 +228,7 @@ def to_xml(cfg: EniConfig) -> ET.Element:
         _sub(cmd, "State", "SAFEOP")
         _sub(cmd, "State", "OP")
         _sub(cmd, "Comment", "process data")
-        _sub(cmd, "Cmd", LRW)
+        _sub(cmd, "Cmd", int(Command.LRW))
         _sub(cmd, "Addr", LOGICAL_BASE)
         _sub(cmd, "DataLength", max(cfg.outputs_bytes, cfg.inputs_bytes))
         _sub(cmd, "Cnt", _wkc(cfg.slaves))

@@ -19,15 +19,12 @@ PREOP) - then the master's other commands.  A command with ``Cnt`` is repeated
 passes.  Between SAFEOP and OP, and in OP, the cyclic frames run and their
 working counters are checked against ``Cnt``.
 
-An ENI written by gtecat has no register InitCmds; for those the replay
-synthesises the commands TwinCAT generates for such a slave (state requests
-and checks, EEPROM identity checks, station address, SMs and FMMUs from
-``Mailbox``, ``ProcessData/SmN`` and ``Send``/``Recv``).
+Nothing is made up: a slave whose InitCmds do not request a transition's target
+state is a failure (a replaying master would leave it where it is).
 """
 
 from __future__ import annotations
 
-import struct
 import time
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -35,7 +32,7 @@ from pathlib import Path
 
 from tests.gtecat.wire.rawmaster import NoAnswer, RawMaster, SdoAbortSeen
 
-APWR, APRD, FPWR, FPRD, BRD, BWR = 2, 1, 5, 4, 7, 8
+APWR, FPWR, BWR = 2, 5, 8  # ETG.1000.4 Table 9
 _TARGET = {"I": 1, "P": 2, "B": 3, "S": 4, "O": 8}
 
 
@@ -101,7 +98,6 @@ class Eni:
     master: list[RegCmd]
     slaves: list[SlaveCfg]
     cyclic: list[CyclicCmd]
-    synthesised: bool = False
 
 
 def _reg(node: ET.Element) -> RegCmd:
@@ -186,134 +182,7 @@ def parse(path: Path) -> Eni:
                 _int(cnt) if cnt is not None else None,
             )
         )
-    eni = Eni(path, master, slaves, cyclic)
-    if not any(s.reg for s in slaves):
-        _synthesise(eni, root)
-    return eni
-
-
-# --- what TwinCAT generates for a slave, for ENIs that carry no register InitCmds --------------
-def _synthesise(eni: Eni, root: ET.Element) -> None:
-    eni.synthesised = True
-    config = root.find("Config")
-    assert config is not None
-    base = next((c.adp | c.ado << 16 for c in eni.cyclic if c.cmd in (10, 11, 12)), 0x10000000)
-    for cfg, node in zip(eni.slaves, config.findall("Slave"), strict=True):
-        pos, phys = cfg.position, cfg.phys_addr
-        adp = (-pos) & 0xFFFF
-        vendor = _int(node.findtext("Info/VendorId"))
-        product = _int(node.findtext("Info/ProductCode"))
-
-        def state(
-            tr: str, st: int, addr_cmd: tuple[int, int], adp: int = adp, phys: int = phys
-        ) -> list[RegCmd]:
-            wr, rd = addr_cmd
-            a = adp if wr == APWR else phys
-            return [
-                RegCmd((tr,), f"set device state {st}", wr, a, 0x0120, struct.pack("<H", st), 1, 3),
-                RegCmd(
-                    (tr,),
-                    f"check device state {st}",
-                    rd,
-                    a,
-                    0x0130,
-                    bytes(2),
-                    1,
-                    3,
-                    validate=(struct.pack("<H", st), b"\x1f\x00", 3000),
-                ),
-            ]
-
-        cmds = state("IP", 1, (APWR, APRD))
-        cmds += [
-            RegCmd(("IP",), "assign EEPROM to ECAT", APWR, adp, 0x0500, b"\x00", 1),
-            RegCmd(("IP",), "read vendor id", APWR, adp, 0x0502, bytes.fromhex("000108000000"), 1),
-            RegCmd(
-                ("IP",),
-                "check vendor id",
-                APRD,
-                adp,
-                0x0508,
-                bytes(4),
-                1,
-                validate=(struct.pack("<I", vendor), None, 100),
-            ),
-            RegCmd(("IP",), "read product", APWR, adp, 0x0502, bytes.fromhex("00010a000000"), 1),
-            RegCmd(
-                ("IP",),
-                "check product code",
-                APRD,
-                adp,
-                0x0508,
-                bytes(4),
-                1,
-                validate=(struct.pack("<I", product), None, 100),
-            ),
-            RegCmd(("IP",), "set physical address", APWR, adp, 0x0010, struct.pack("<H", phys), 1),
-        ]
-        if cfg.mailbox:
-            s0, l0, s1, l1 = cfg.mailbox
-            sm = struct.pack("<HHBBBB", s0, l0, 0x26, 0, 1, 0) + struct.pack(
-                "<HHBBBB", s1, l1, 0x22, 0, 1, 0
-            )
-            cmds.append(RegCmd(("IP",), "set sm 0/1 (mailbox)", FPWR, phys, 0x0800, sm, 1))
-        cmds += state("IP", 2, (FPWR, FPRD))
-        pd = node.find("ProcessData")
-        fmmu = 0
-        for direction, tag in ((True, "Send"), (False, "Recv")):
-            area = pd.find(tag) if pd is not None else None
-            if area is None:
-                continue
-            bit_start, bits = _int(area.findtext("BitStart")), _int(area.findtext("BitLength"))
-            if not bits:
-                continue
-            kind = "Outputs" if direction else "Inputs"
-            sms = [c for c in (pd or []) if c.tag.startswith("Sm") and c.findtext("Type") == kind]
-            if not sms:
-                continue
-            number = int(sms[0].tag[2:])
-            start = _int(sms[0].findtext("StartAddress"))
-            control = _int(sms[0].findtext("ControlByte"))
-            nbytes = (bits + 7) // 8
-            cmds.append(
-                RegCmd(
-                    ("PS",),
-                    f"set sm {number} ({kind.lower()})",
-                    FPWR,
-                    phys,
-                    0x0800 + 8 * number,
-                    struct.pack("<HHBBBB", start, nbytes, control, 0, 1, 0),
-                    1,
-                )
-            )
-            lbit = bit_start % 8
-            lbytes = (lbit + bits + 7) // 8
-            logical = base + bit_start // 8
-            cmds.append(
-                RegCmd(
-                    ("PS",),
-                    f"set fmmu {fmmu} ({kind.lower()})",
-                    FPWR,
-                    phys,
-                    0x0600 + 16 * fmmu,
-                    struct.pack(
-                        "<IHBBHBBB3x",
-                        logical,
-                        lbytes,
-                        lbit,
-                        (lbit + bits - 1) % 8,
-                        start,
-                        0,
-                        2 if direction else 1,
-                        1,
-                    ),
-                    1,
-                )
-            )
-            fmmu += 1
-        cmds += state("PS", 4, (FPWR, FPRD))
-        cmds += state("SO", 8, (FPWR, FPRD))
-        cfg.reg = cmds
+    return Eni(path, master, slaves, cyclic)
 
 
 # --- the replay ----------------------------------------------------------------------------------
@@ -354,8 +223,11 @@ class Replay:
                     and c.data[:1]
                     and c.data[0] & 0x0F == target
                 ),
-                len(cmds),
+                None,
             )
+            if split is None:
+                self.fail(f"{s.name}: no {tr} InitCmd requests state {target}")
+                continue
             coe = [c for c in s.coe if tr in c.transitions]
             if tr[0] in "PSO":
                 for c in cmds[:split]:

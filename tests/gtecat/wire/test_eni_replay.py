@@ -1,9 +1,11 @@
 """A TwinCAT-style replay of every ENI in examples/ and the shared fixtures brings the slaves
-of ``gtecat serve`` to OP: InitCmds word for word, validations and timeouts as written (item 2:
-TwinCAT's own ENI writes an EL2008's output SM only at SAFEOP -> OP)."""
+of ``gtecat serve`` to OP: each file's own InitCmds word for word, validations and timeouts as
+written, nothing synthesised (item 2: TwinCAT's own ENI writes an EL2008's output SM only at
+SAFEOP -> OP)."""
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
@@ -19,6 +21,23 @@ ENIS = sorted((ROOT / "examples").glob("*.eni")) + sorted(
 
 def is_xml(path: Path) -> bool:
     return b"EtherCATConfig" in path.read_bytes()[:4096]
+
+
+EXAMPLE_ENIS = sorted((ROOT / "examples").glob("*.eni"))
+
+
+@pytest.mark.parametrize("eni", EXAMPLE_ENIS, ids=lambda p: p.name)
+def test_every_example_carries_its_own_register_init_cmds(eni: Path) -> None:
+    """What a replaying master needs from the file alone: per slave the IP, PS and SO
+    requests, and the master's slave count check."""
+    assert is_xml(eni)
+    config = parse(eni)
+    assert any(
+        c.comment == "read slave count" and c.cnt == len(config.slaves) for c in config.master
+    )
+    for s in config.slaves:
+        requested = {(t, c.data[0] & 0x0F) for c in s.reg if c.ado == 0x0120 for t in c.transitions}
+        assert {("IP", 2), ("PS", 4), ("SO", 8)} <= requested, s.name
 
 
 @pytest.mark.wire
@@ -46,7 +65,8 @@ def test_replay_reaches_op(eni: Path, tmp_path: Path) -> None:
         pair.__exit__(None, None, None)
     assert not failures, "\n".join(failures[:20])
     assert states == [(8, 0)] * len(config.slaves), states
-    assert replay.commands > 0 and (replay.sdos > 0 or not any(s.coe for s in config.slaves))
+    assert replay.commands >= 6 * len(config.slaves)  # at least the IP, PS, SO requests and checks
+    assert replay.sdos > 0 or not any(s.coe for s in config.slaves)
 
 
 def test_the_twincat_fixture_is_replayed_as_written() -> None:
@@ -54,7 +74,32 @@ def test_the_twincat_fixture_is_replayed_as_written() -> None:
     if not eni.is_file():
         pytest.skip(f"{eni} not found")
     config = parse(eni)
-    assert not config.synthesised
     el2008 = config.slaves[1]
     so = [c for c in el2008.reg if "SO" in c.transitions and c.ado == 0x0800]
     assert [c.data.hex() for c in so] == ["000f010044000100"]  # the output SM, only at SO
+
+
+class _NoBus:
+    """A master that must not be used: the replay fails before it sends anything."""
+
+    def __init__(self) -> None:
+        self.mbx_counter: dict[int, int] = {}
+
+    def transact(self, *_: object) -> None:
+        raise AssertionError("nothing to send")
+
+
+def test_an_eni_without_register_init_cmds_fails_clearly(tmp_path: Path) -> None:
+    """Nothing is synthesised: without its own commands no slave leaves INIT."""
+    tree = ET.parse(ROOT / "examples" / "manual_fig5_2.eni")
+    for parent in tree.getroot().iter():
+        for child in list(parent):
+            if child.tag == "InitCmds" and parent.tag in ("Master", "Slave"):
+                parent.remove(child)
+    stripped = tmp_path / "stripped.eni"
+    tree.write(stripped)
+    replay = Replay(_NoBus(), parse(stripped))  # type: ignore[arg-type]
+    replay.transition("IP")
+    assert replay.failures == [
+        f"{name}: no IP InitCmd requests state 2" for name in ("GTHD 0", "GTHD 1", "IO 2", "IO 3")
+    ]
