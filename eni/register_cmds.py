@@ -15,8 +15,8 @@ generates for a slave of this kind (compare
   address by auto-increment address, for a slave with a mailbox set SM0/SM1 to
   the ENI's ``Mailbox`` areas, request and check PREOP;
 * ``PS``: the process-data SMs (lengths from the assigned PDOs), one FMMU per SM
-  mapping it onto the slave's ``Send``/``Recv`` bits of the logical image the
-  cyclic frame addresses, request and check SAFEOP;
+  mapping it onto the slave's ``Send``/``Recv`` bits of the image the cyclic frame
+  addresses (outputs and inputs in separate logical ranges), request and check SAFEOP;
 * ``SO``: request and check OP; ``OS`` and ``SP``/``OP`` back likewise.
 
 A slave with a mailbox gets the error acknowledge bit with its INIT and PREOP
@@ -36,8 +36,21 @@ from construct import Const, Int8ul, Int16ul, Int32ul, Padding, Struct
 
 from .model import Direction, Pdo, Slave
 
-#: logical address of the images' first byte, where the cyclic frame's LRW starts
+#: logical address of the output image's first byte (the cyclic frame's LWR)
 LOGICAL_BASE = 0x10000000
+#: the input image starts at the next multiple of this after the outputs (the cyclic LRD)
+INPUTS_ALIGN = 0x800
+
+
+def logical_bases(outputs_bytes: int) -> dict[Direction, int]:
+    """Where each image lies in the logical address space: outputs at LOGICAL_BASE, inputs
+    after them.  The images are zero-based and laid out independently (``Send``/``Recv``
+    BitStart), so one LRW over both would let a slave read the inputs an earlier slave put
+    into the frame as its outputs; apart, an LWR and an LRD carry them (as TwinCAT does)."""
+    gap = -(-outputs_bytes // INPUTS_ALIGN) * INPUTS_ALIGN
+    return {Direction.OUT: LOGICAL_BASE, Direction.IN: LOGICAL_BASE + gap}
+
+
 #: mailbox areas (start, length) master -> slave (SM0) and slave -> master (SM1)
 MAILBOX = ((0x1000, 128), (0x1080, 128))
 #: process-data SM defaults per direction: start address, control byte
@@ -269,8 +282,9 @@ def _identity(adp: int, word: int, value: int, what: str) -> list[RegisterCmd]:
     ]
 
 
-def slave_cmds(s: Slave, logical_base: int = LOGICAL_BASE) -> list[RegisterCmd]:
-    """The register InitCmds of one slave, in document order."""
+def slave_cmds(s: Slave, bases: dict[Direction, int]) -> list[RegisterCmd]:
+    """The register InitCmds of one slave, in document order; ``bases``: where each image
+    starts in the logical address space (:func:`logical_bases`)."""
     ap = (-s.position) & 0xFFFF  # auto-increment (position) address: 0, -1, -2, ...
     fp = s.phys_addr
     mbx = has_mailbox(s)
@@ -307,7 +321,7 @@ def slave_cmds(s: Slave, logical_base: int = LOGICAL_BASE) -> list[RegisterCmd]:
     mapped = sorted((m for m in maps if m.logical_bit is not None), key=lambda m: m.direction)
     for k, m in enumerate(mapped):
         what = f"set fmmu {k} ({_KIND[m.direction]})"
-        data = fmmu_bytes(m, logical_base)
+        data = fmmu_bytes(m, bases[m.direction])
         cmds.append(RegisterCmd(ps, what, Command.FPWR, fp, Reg.FMMU0 + 16 * k, data, cnt=1))
     up, down_mask = AL_STATUS_MASK, AL_STATE_MASK  # up: without error; down: the state only
     cmds += [
@@ -324,7 +338,8 @@ def slave_cmds(s: Slave, logical_base: int = LOGICAL_BASE) -> list[RegisterCmd]:
 
 
 def fmmu_bytes(m: SmMap, logical_base: int = LOGICAL_BASE) -> bytes:
-    """The FMMU mapping SM ``m`` bit for bit onto its logical bits (the SM starts at bit 0)."""
+    """The FMMU mapping SM ``m`` bit for bit onto its logical bits (the SM starts at bit 0);
+    ``logical_base``: the logical address of its direction's image."""
     assert m.logical_bit is not None
     first = m.logical_bit % 8
     return FmmuRegister.build(

@@ -15,7 +15,8 @@ topology builder makes (source and lines aside):
   requests and checks, identity, station address, SMs, FMMUs
   (:mod:`eni.register_cmds`) - and the master's ``BeforeSlave`` commands in
   ``Config/Master/InitCmds``; the readers ignore them (they follow from the rest);
-* ``Cyclic`` (cycle time in microseconds and one LRW command over both images);
+* ``Cyclic`` (cycle time in microseconds; an LWR of the output image and an LRD of the input
+  image, at separate logical addresses: :func:`eni.register_cmds.logical_bases`);
 * ``ProcessImage`` with ``ByteSize`` and one ``Variable`` per mapped entry.
 """
 
@@ -28,12 +29,12 @@ from pathlib import Path
 
 from .model import Direction, EniConfig, InitCmd, Pdo, Slave, Variable
 from .register_cmds import (
-    LOGICAL_BASE,
     MAILBOX,
     SM_DEFAULT,
     Command,
     RegisterCmd,
     has_mailbox,
+    logical_bases,
     master_cmds,
     slave_cmds,
     sm_maps,
@@ -181,9 +182,10 @@ def _register_cmds(parent: ET.Element, cmds: Iterable[RegisterCmd]) -> None:
             _sub(v, "Timeout", c.validate.timeout_ms)
 
 
-def _wkc(slaves: Iterable[Slave]) -> int:
-    """Expected LRW working counter: +2 per slave written, +1 per slave read (ETG.1000.4)."""
-    return sum((2 if s.outputs else 0) + (1 if s.inputs else 0) for s in slaves)
+def _wkc(slaves: Iterable[Slave], direction: Direction) -> int:
+    """Expected working counter of the LWR (outputs) or LRD (inputs): +1 per slave that
+    takes or gives data in that direction (ETG.1000.4 5.4)."""
+    return sum(1 for s in slaves if (s.outputs if direction == Direction.OUT else s.inputs))
 
 
 def to_xml(cfg: EniConfig) -> ET.Element:
@@ -204,6 +206,7 @@ def to_xml(cfg: EniConfig) -> ET.Element:
     _sub(info, "EtherType", "a488")
     if cfg.slaves:
         _register_cmds(master, master_cmds(len(cfg.slaves)))
+    bases = logical_bases(cfg.outputs_bytes)
     for s in cfg.slaves:
         sel = _sub(config, "Slave")
         si = _sub(sel, "Info")
@@ -218,22 +221,28 @@ def to_xml(cfg: EniConfig) -> ET.Element:
             _process_data(sel, s)
         if has_mailbox(s):
             _mailbox(sel, s)
-        _register_cmds(sel, slave_cmds(s, LOGICAL_BASE))
+        _register_cmds(sel, slave_cmds(s, bases))
     if cfg.cycle_time_ns is not None:
         cyc = _sub(config, "Cyclic")
         us = cfg.cycle_time_ns / 1000
         _sub(cyc, "CycleTime", int(us) if us == int(us) else us)
         frame = _sub(cyc, "Frame")
-        cmd = _sub(frame, "Cmd")
-        _sub(cmd, "State", "SAFEOP")
-        _sub(cmd, "State", "OP")
-        _sub(cmd, "Comment", "process data")
-        _sub(cmd, "Cmd", int(Command.LRW))
-        _sub(cmd, "Addr", LOGICAL_BASE)
-        _sub(cmd, "DataLength", max(cfg.outputs_bytes, cfg.inputs_bytes))
-        _sub(cmd, "Cnt", _wkc(cfg.slaves))
-        _sub(cmd, "InputOffs", 0)
-        _sub(cmd, "OutputOffs", 0)
+        for direction, command, size, comment in (
+            (Direction.OUT, Command.LWR, cfg.outputs_bytes, "outputs"),
+            (Direction.IN, Command.LRD, cfg.inputs_bytes, "inputs"),
+        ):
+            if not size:
+                continue
+            cmd = _sub(frame, "Cmd")
+            _sub(cmd, "State", "SAFEOP")
+            _sub(cmd, "State", "OP")
+            _sub(cmd, "Comment", f"process data {comment}")
+            _sub(cmd, "Cmd", int(command))
+            _sub(cmd, "Addr", bases[direction])
+            _sub(cmd, "DataLength", size)
+            _sub(cmd, "Cnt", _wkc(cfg.slaves, direction))
+            _sub(cmd, "InputOffs", 0)
+            _sub(cmd, "OutputOffs", 0)
     pi = _sub(config, "ProcessImage")
     variables = _slave_variables(cfg)
     for tag, d, size in (

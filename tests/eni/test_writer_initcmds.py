@@ -166,7 +166,8 @@ def test_servo_ps_so_commands(text: str) -> None:
         ("set sm 3 (inputs)", 5, 1001, 0x0818, "0014060020000100"),  # 1400h, 6 bytes
         # logical 10000000h, 2 bytes, bits 0..7, physical 1100h, write, active
         ("set fmmu 0 (outputs)", 5, 1001, 0x0600, "00000010020000070011000201000000"),
-        ("set fmmu 1 (inputs)", 5, 1001, 0x0610, "00000010060000070014000101000000"),
+        # the input image starts at logical 10000800h (after the outputs, 800h aligned)
+        ("set fmmu 1 (inputs)", 5, 1001, 0x0610, "00080010060000070014000101000000"),
         ("set device state to SAFEOP", 5, 1001, 0x0120, "0400"),
         ("check device state for SAFEOP", 4, 1001, 0x0130, "000000000000"),
     ]
@@ -202,15 +203,34 @@ def test_terminals_one_direction_each_no_mailbox(text: str) -> None:
     assert ("set physical address", 2, 0xFFFE, 0x0010, "eb03") in _by(_cmds(in12), "IP")
     assert _by(_cmds(in12), "PS")[:2] == [
         ("set sm 3 (inputs)", 5, 1003, 0x0818, "0014020020000100"),
-        # logical byte 6, 2 bytes, bit 0 to bit 3 of the second, read
-        ("set fmmu 0 (inputs)", 5, 1003, 0x0600, "06000010020000030014000101000000"),
+        # input image byte 6 (logical 10000806h), 2 bytes, bit 0 to bit 3 of the second, read
+        ("set fmmu 0 (inputs)", 5, 1003, 0x0600, "06080010020000030014000101000000"),
     ]
 
 
+def _cyclic(root: ET.Element) -> dict[int, tuple[int, int, int]]:
+    """Cyclic commands by command number: (logical address, data length, Cnt)."""
+    return {
+        int(c.findtext("Cmd") or 0): (
+            int(c.findtext("Addr") or 0),
+            int(c.findtext("DataLength") or 0),
+            int(c.findtext("Cnt") or 0),
+        )
+        for c in root.findall("Config/Cyclic/Frame/Cmd")
+    }
+
+
+def test_the_cyclic_frame_writes_outputs_and_reads_inputs_apart(text: str) -> None:
+    """An LWR of the 3-byte output image (2 slaves take outputs) and an LRD of the 8-byte
+    input image (2 slaves give inputs) at 800h further on: the images never share bytes."""
+    assert _cyclic(ET.fromstring(text)) == {11: (0x10000000, 3, 2), 10: (0x10000800, 8, 2)}
+
+
 def test_fmmus_address_the_cyclic_frame(text: str) -> None:
-    """Every FMMU's logical start is the cyclic command's address + BitStart / 8."""
+    """Every FMMU's logical start is its direction's cyclic command's address + BitStart/8."""
     root = ET.fromstring(text)
-    addr = int(root.findtext("Config/Cyclic/Frame/Cmd/Addr") or 0)
+    cyclic = _cyclic(root)
+    addr = {"outputs": cyclic[11][0], "inputs": cyclic[10][0]}
     for s in root.findall("Config/Slave"):
         starts = {
             kind: int(s.findtext(f"ProcessData/{tag}/BitStart") or 0)
@@ -224,8 +244,30 @@ def test_fmmus_address_the_cyclic_frame(text: str) -> None:
         }
         assert fmmus.keys() == starts.keys()
         for kind, data in fmmus.items():
-            assert int.from_bytes(data[:4], "little") == addr + starts[kind] // 8
+            assert int.from_bytes(data[:4], "little") == addr[kind] + starts[kind] // 8
             assert data[6] == starts[kind] % 8
+
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.mark.parametrize("eni", sorted(p.name for p in EXAMPLES.glob("*.eni")))
+def test_no_slave_reads_what_another_slave_wrote_into_the_frame(eni: str) -> None:
+    """Write FMMUs and read FMMUs never share a logical byte across slaves.  One LRW over
+    both zero-based images did: in full_servo.eni the IO terminal took bytes 17-18 of the
+    servo's inputs as its outputs (an outside check of the replay)."""
+    written: dict[int, str] = {}
+    read: dict[int, str] = {}
+    for s in ET.parse(EXAMPLES / eni).getroot().findall("Config/Slave"):
+        name = s.findtext("Info/Name") or ""
+        for c in _cmds(s):
+            if c.comment.startswith("set fmmu"):
+                data = bytes.fromhex(c.data or "")
+                start, length, kind = int.from_bytes(data[:4], "little"), data[4], data[11]
+                for byte in range(start, start + length):
+                    (written if kind == 2 else read)[byte] = name
+    shared = {b: (written[b], read[b]) for b in written.keys() & read.keys()}
+    assert all(w == r for w, r in shared.values()), shared
 
 
 def test_master_before_slave_commands(text: str) -> None:
