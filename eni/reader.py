@@ -87,11 +87,16 @@ def detect_format(data: bytes | str) -> str:
     return "unknown"
 
 
+#: the register InitCmds (the master's and each slave's): the reader builds the bus from the
+#: rest, so their elements (most of a TwinCAT file's) are checked by expat but not kept
+_NOT_READ = frozenset({("Master", "InitCmds"), ("Slave", "InitCmds")})
+
+
 def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
     """Parse configuration text/bytes; ``source`` names it in error messages."""
     fmt = detect_format(text)
     if fmt == "xml":
-        root = parse_xml(text, source)
+        root = parse_xml(text, source, _NOT_READ)
         if root.tag == "EncryptedEtherCATConfig":
             fmt = "encrypted"
         elif root.tag != "EtherCATConfig":

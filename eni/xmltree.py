@@ -140,8 +140,14 @@ class _Refused(Exception):
     pass
 
 
-def parse_xml(data: bytes | str, source: str) -> Node:
-    """Parse a whole document; any error becomes an :class:`EniError` with its line."""
+def parse_xml(
+    data: bytes | str, source: str, skip: frozenset[tuple[str, str]] = frozenset()
+) -> Node:
+    """Parse a whole document; any error becomes an :class:`EniError` with its line.
+
+    ``skip``: (parent, element) local names whose subtrees are checked by expat but not
+    built, for the parts a reader never looks at (an ENI's register InitCmds are most of
+    its elements)."""
     if isinstance(data, bytes):
         data = _decoded(data, source)
     parser = expat.ParserCreate()
@@ -151,8 +157,17 @@ def parse_xml(data: bytes | str, source: str) -> Node:
     texts: list[list[str]] = []
     root: list[Node] = []
 
+    skipped = [0]  # depth inside a skipped subtree
+
     def start(tag: str, attrs: dict[str, str]) -> None:
-        node = Node(_local(tag), {_local(k): v for k, v in attrs.items()}, parser.CurrentLineNumber)
+        if skipped[0]:
+            skipped[0] += 1
+            return
+        name = _local(tag)
+        if skip and stack and (stack[-1].tag, name) in skip:
+            skipped[0] = 1
+            return
+        node = Node(name, {_local(k): v for k, v in attrs.items()}, parser.CurrentLineNumber)
         if stack:
             stack[-1].children.append(node)
         else:
@@ -161,11 +176,14 @@ def parse_xml(data: bytes | str, source: str) -> Node:
         texts.append([])
 
     def end(tag: str) -> None:
+        if skipped[0]:
+            skipped[0] -= 1
+            return
         node = stack.pop()
         node.text = "".join(texts.pop())
 
     def chars(data: str) -> None:
-        if texts:
+        if texts and not skipped[0]:
             texts[-1].append(data)
 
     def refuse_doctype(*_args: object) -> None:
