@@ -16,18 +16,8 @@ from collections import deque
 from dataclasses import dataclass
 from enum import IntEnum
 
+from eni.ethercat import AlState
 from eni.model import Identity
-
-
-class AlState(IntEnum):
-    """EtherCAT application-layer states (ETG.1000.6 5.3.2; register 0x0130 low nibble)."""
-
-    NONE = 0
-    INIT = 1
-    PREOP = 2
-    BOOT = 3
-    SAFEOP = 4
-    OP = 8
 
 
 class AlStatusCode(IntEnum):

@@ -30,10 +30,10 @@ from __future__ import annotations
 
 import struct
 from dataclasses import dataclass
-from enum import IntEnum
 
 from construct import Const, Int8ul, Int16ul, Int32ul, Padding, Struct
 
+from .ethercat import AlState, Command, EepromStatus, Reg
 from .model import Direction, Pdo, Slave
 
 #: logical address of the output image's first byte (the cyclic frame's LWR)
@@ -62,48 +62,10 @@ SM_DEFAULT = {
 _MBX_CONTROL = (0x26, 0x22)
 
 
-class Command(IntEnum):
-    """Datagram commands (ETG.1000.4 Table 9)."""
-
-    APRD = 1
-    APWR = 2
-    FPRD = 4
-    FPWR = 5
-    BRD = 7
-    BWR = 8
-    LRD = 10
-    LWR = 11
-    LRW = 12
-
-
-class AlState(IntEnum):
-    """AL control/status state codes (ETG.1000.4 Table 35)."""
-
-    INIT = 1
-    PREOP = 2
-    BOOT = 3
-    SAFEOP = 4
-    OP = 8
-
-
-class Reg(IntEnum):
-    """ESC registers the commands address (ETG.1000.4 Table 31)."""
-
-    STATION_ADDRESS = 0x0010
-    AL_CONTROL = 0x0120
-    AL_STATUS = 0x0130
-    EEPROM_CONFIG = 0x0500
-    EEPROM_CONTROL = 0x0502
-    EEPROM_DATA = 0x0508
-    FMMU0 = 0x0600
-    SM0 = 0x0800
-
-
 AL_ACK = 0x10  # AL control bit 4: error acknowledge
 AL_STATUS_MASK = 0x1F  # state and error bit: the state must be reached without error
 AL_STATE_MASK = 0x0F  # state only (the way down tolerates a pending error)
 SII_VENDOR_ID, SII_PRODUCT_CODE = 0x0008, 0x000A  # SII word addresses (ETG.1000.6 Table 16)
-EEPROM_READ = 0x0100  # EEPROM control/status command bits 10:8 = 001 (ETG.1000.4 Table 48)
 
 #: one sync manager (ETG.1000.4 Table 59); status and PDI control are the slave's
 SmRegister = Struct(
@@ -265,7 +227,7 @@ def _identity(adp: int, word: int, value: int, what: str) -> list[RegisterCmd]:
             Command.APWR,
             adp,
             Reg.EEPROM_CONTROL,
-            struct.pack("<HI", EEPROM_READ, word),
+            struct.pack("<HI", EepromStatus.CMD_READ, word),
             cnt=1,
         ),
         RegisterCmd(

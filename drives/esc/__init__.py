@@ -12,8 +12,10 @@ Modules: :mod:`.frames` (the wire format), :mod:`.sii` (EEPROM content),
 :mod:`.registers` (one ESC), :mod:`.chain` (a line of ESCs processing a frame).
 """
 
+from eni.ethercat import Command
+
 from .chain import Chain, ChainStats
-from .frames import Command, Datagram, FrameError, decode_frame, encode_frame
+from .frames import Datagram, FrameError, decode_frame, encode_frame
 from .registers import Esc
 from .sii import SiiInfo, build_sii, parse_sii, sii_info_for
 

@@ -36,8 +36,10 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from eni.ethercat import Command
+
 from ..slave import VirtualSlave
-from .frames import Command, walk
+from .frames import walk
 from .registers import Esc, FrameTime, LogicalPlan
 from .sii import SiiInfo, build_sii, sii_info_for
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import struct
 from dataclasses import dataclass, field
-from enum import IntEnum
 
 from construct import (
     Bit,
@@ -59,26 +58,6 @@ MASTER_MAC = b"\x01\x01\x01\x01\x01\x01"
 
 class FrameError(GtecatError):
     """A frame that is not a well-formed EtherCAT frame (dropped, never half-processed)."""
-
-
-class Command(IntEnum):
-    """Datagram commands (ETG.1000.4 5.4: Table 14 is APRD, the other commands follow it)."""
-
-    NOP = 0
-    APRD = 1
-    APWR = 2
-    APRW = 3
-    FPRD = 4
-    FPWR = 5
-    FPRW = 6
-    BRD = 7
-    BWR = 8
-    BRW = 9
-    LRD = 10
-    LWR = 11
-    LRW = 12
-    ARMW = 13
-    FRMW = 14
 
 
 # --- construct declarations -------------------------------------------------------------------

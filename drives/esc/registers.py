@@ -63,9 +63,9 @@ import struct
 import time
 from collections import deque
 from collections.abc import Callable
-from enum import IntEnum
 
 from eni.bits import get_bits, set_bits
+from eni.ethercat import EepromStatus, Reg
 
 from ..coe import CoeService, MailboxError, MailboxType, build_coe, mailbox_error
 from ..foe import FoeServer
@@ -86,78 +86,6 @@ _U64 = struct.Struct("<Q")
 _I64 = struct.Struct("<q")
 _FMMU = struct.Struct("<IHBBHBBB3x")
 _SM = struct.Struct("<HHBBBB")
-
-
-class Reg(IntEnum):
-    """Register addresses (ETG.1000.4 Table 31)."""
-
-    TYPE = 0x0000
-    REVISION = 0x0001
-    BUILD = 0x0002
-    FMMU_COUNT = 0x0004
-    SM_COUNT = 0x0005
-    RAM_SIZE = 0x0006
-    PORT_DESCRIPTOR = 0x0007
-    FEATURES = 0x0008
-    STATION_ADDRESS = 0x0010
-    STATION_ALIAS = 0x0012
-    DL_CONTROL = 0x0100
-    DL_ALIAS = 0x0103
-    DL_STATUS = 0x0110
-    AL_CONTROL = 0x0120
-    AL_STATUS = 0x0130
-    AL_STATUS_CODE = 0x0134
-    PDI_CONTROL = 0x0140
-    ESC_CONFIG = 0x0141
-    EVENT_MASK = 0x0200
-    AL_EVENT_MASK = 0x0204
-    EVENT_REQUEST = 0x0210
-    AL_EVENT_REQUEST = 0x0220
-    RX_ERROR = 0x0300
-    WD_DIVIDER = 0x0400
-    WD_TIME_PDI = 0x0410
-    WD_TIME_PD = 0x0420
-    WD_STATUS_PD = 0x0440
-    WD_COUNTER_PD = 0x0442
-    EEPROM_CONFIG = 0x0500
-    EEPROM_PDI_ACCESS = 0x0501
-    EEPROM_CONTROL = 0x0502
-    EEPROM_ADDRESS = 0x0504
-    EEPROM_DATA = 0x0508
-    FMMU0 = 0x0600
-    SM0 = 0x0800
-    DC_RECEIVE_TIME0 = 0x0900
-    DC_RECEIVE_TIME1 = 0x0904
-    DC_SYSTEM_TIME = 0x0910
-    DC_RECEIVE_TIME_PU = 0x0918
-    DC_SYSTEM_OFFSET = 0x0920
-    DC_SYSTEM_DELAY = 0x0928
-    DC_SYSTEM_DIFF = 0x092C
-    DC_SPEED_COUNT = 0x0930
-    DC_FILTER_DEPTH = 0x0934
-    DC_CYCLIC_CONTROL = 0x0980
-    DC_ACTIVATION = 0x0981
-    DC_START_TIME = 0x0990
-    DC_SYNC0_CYCLE = 0x09A0
-    DC_SYNC1_CYCLE = 0x09A4
-
-
-class EepromStatus:
-    """Bits of 0502h (ETG.1000.4 Table 48)."""
-
-    WRITE_ENABLE = 0x0001
-    READ_8_BYTES = 0x0040
-    TWO_ADDRESS_BYTES = 0x0080
-    CMD_READ = 0x0100
-    CMD_WRITE = 0x0200
-    CMD_RELOAD = 0x0400
-    CMD_MASK = 0x0700
-    CHECKSUM_ERROR = 0x0800
-    LOAD_ERROR = 0x1000
-    ACK_ERROR = 0x2000
-    WRITE_ENABLE_ERROR = 0x4000
-    BUSY = 0x8000
-    ERROR_MASK = 0x7800
 
 
 # --- which register bytes a master may write, and with which bits ----------------------------

@@ -12,13 +12,13 @@ from drives.esc.frames import (
     ETH_HEADER_LEN,
     MAX_ECAT_LEN,
     MIN_ETH_FRAME,
-    Command,
     Datagram,
     FrameError,
     decode_frame,
     encode_frame,
     walk,
 )
+from eni.ethercat import Command
 
 datagrams = st.builds(
     Datagram,
