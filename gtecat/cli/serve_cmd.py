@@ -119,7 +119,7 @@ def _positive(kind: type[int] | type[float]):
 
 def _writable(path: Path, option: str) -> None:
     """Fail now, in one line, for a file that cannot be written at the end of the run."""
-    from eni.errors import GtecatError
+    from gtecat.eni.errors import GtecatError
 
     probe = path.with_name(path.name + ".tmp")
     try:
@@ -133,10 +133,10 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
     # -> tuple[Chain, EniConfig]
     """The ENI's slaves behind ESCs (what ``serve`` puts on the wire), each with the SII
     the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.wire.eni_wire`)."""
-    from drives.esc import Chain
-    from drives.machine import MachineDescription, load_machine
-    from eni.layout import build_layout
-    from eni.reader import read_eni
+    from gtecat.drives.esc import Chain
+    from gtecat.drives.machine import MachineDescription, load_machine
+    from gtecat.eni.layout import build_layout
+    from gtecat.eni.reader import read_eni
     from gtecat.master.factory import build_slaves
     from gtecat.wire.eni_wire import read_wire, sii_for
 
@@ -174,7 +174,7 @@ def resolve_wait(wait: str, rt_priority: int | None = None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from eni.errors import GtecatError
+    from gtecat.eni.errors import GtecatError
     from gtecat.wire.serve import WireServer, interface_is_up, pin_to_cpu, realtime_priority
 
     if args.verbose:
@@ -189,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     if args.cpu is not None:
         pin_to_cpu(args.cpu)
     if not Path("/sys/class/net", args.iface).exists() and Path("/sys/class/net").is_dir():
-        from eni.errors import GtecatError
+        from gtecat.eni.errors import GtecatError
 
         raise GtecatError(
             f"no network interface {args.iface!r}: `gtecat ifaces` lists the ones this machine has"
@@ -280,7 +280,7 @@ def run(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point for ``python -m gtecat.cli.serve_cmd`` (same options as ``gtecat serve``)."""
-    from eni.errors import GtecatError
+    from gtecat.eni.errors import GtecatError
 
     parser = argparse.ArgumentParser(prog="gtecat serve", description=__doc__)
     _arguments(parser)

@@ -1,6 +1,6 @@
 """What an ETG.2100 ENI says about the slaves' wire side, for their SII on ``gtecat serve``.
 
-The configuration model (:mod:`eni.model`) keeps what the process image needs.
+The configuration model (:mod:`gtecat.eni.model`) keeps what the process image needs.
 A slave on the wire must also look like the real device to a master that reads
 its SII rather than the ENI (SOEM, KickCAT, ebpfcat): the sync managers where
 the device has them (an EL2008's output SM is the digital output register
@@ -9,7 +9,7 @@ where the ENI puts it, and the product it is.  This module reads those facts
 from the ENI's ``ProcessData/SmN`` (ETG.2100: ``Type``, ``StartAddress``,
 ``ControlByte``, ``Enable``), ``Mailbox/Send|Recv`` (``Start``, ``Length``) and
 ``Info/ProductRevision``, and :func:`sii_for` applies them to the SII the slave
-would otherwise get (:func:`drives.esc.sii.sii_info_for`).
+would otherwise get (:func:`gtecat.drives.esc.sii.sii_info_for`).
 
 A Googol INI file states none of it: its slaves keep the default layout.
 """
@@ -21,7 +21,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from drives.esc.sii import (
+from gtecat.drives.esc.sii import (
     SM_CONTROL_MBX_IN,
     SM_CONTROL_MBX_OUT,
     SiiInfo,
@@ -29,11 +29,11 @@ from drives.esc.sii import (
     SmType,
     sii_info_for,
 )
-from drives.slave import VirtualSlave
-from eni.model import Direction
-from eni.numbers import parse_int
-from eni.reader import detect_format
-from eni.xmltree import Node, parse_xml
+from gtecat.drives.slave import VirtualSlave
+from gtecat.eni.model import Direction
+from gtecat.eni.numbers import parse_int
+from gtecat.eni.reader import detect_format
+from gtecat.eni.xmltree import Node, parse_xml
 
 _SM_TYPES = {"outputs": SmType.OUTPUTS, "inputs": SmType.INPUTS}
 

@@ -9,12 +9,12 @@ from typing import Any
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from eni.check import check_config
-from eni.layout import build_layout
-from eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, ProcessDataArea, Slave
-from eni.reader import parse_eni
-from eni.topology import build_config
-from eni.writer import write_eni
+from gtecat.eni.check import check_config
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, ProcessDataArea, Slave
+from gtecat.eni.reader import parse_eni
+from gtecat.eni.topology import build_config
+from gtecat.eni.writer import write_eni
 
 OUT, IN = Direction.OUT, Direction.IN
 

@@ -7,10 +7,10 @@ import struct
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
-from drives.esc import chain as chain_mod
-from drives.esc.registers import Reg
-from drives.slave import AlState
+from gtecat.drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
+from gtecat.drives.esc import chain as chain_mod
+from gtecat.drives.esc.registers import Reg
+from gtecat.drives.slave import AlState
 from tests.drives.esc.mini import MiniMaster, mini_chain
 
 FM = struct.Struct("<IHBBHBBB3x")

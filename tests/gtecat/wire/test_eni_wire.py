@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from drives.esc.sii import SmType, parse_sii
 from gtecat.cli.serve_cmd import build_chain
+from gtecat.drives.esc.sii import SmType, parse_sii
 from gtecat.wire.eni_wire import product_name, read_wire
 
 ROOT = Path(__file__).resolve().parents[3]
