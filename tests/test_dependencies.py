@@ -91,3 +91,26 @@ def test_gtecat_subpackages_import_only_downwards(sub):
         if wrong:
             bad.append(f"{path.relative_to(ROOT)} imports gtecat.{', '.join(sorted(wrong))}")
     assert not bad, "\n".join(bad)
+
+
+def test_users_own_modules_beside_the_script_change_nothing(tmp_path):
+    """A user's ``eni.py``, ``drives.py``, ``tools.py`` and ``tests/`` next to their script."""
+    import shutil
+    import subprocess
+    import sys
+
+    for name in ("eni.py", "drives.py", "tools.py"):
+        (tmp_path / name).write_text("raise ImportError('the user module was imported')\n")
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "__init__.py").write_text("raise ImportError('user tests imported')\n")
+    script = (
+        "import sys; sys.path.insert(0, '.')\n"
+        "from gtecat import gt\n"
+        "print(gt.GT_Open(eni='manual_fig5_2.eni', clock='lockstep'), gt.GT_InitEcatComm())\n"
+    )
+    shutil.copy(ROOT / "gtecat" / "examples" / "manual_fig5_2.eni", tmp_path)
+    run = subprocess.run(
+        [sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=60
+    )
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["0", "0"]
