@@ -33,6 +33,7 @@ COMMANDS = (
     "controller_cmd",
     "lib_cmd",
     "compile_cmd",
+    "sweep_cmd",
 )
 
 
