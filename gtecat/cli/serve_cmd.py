@@ -132,22 +132,19 @@ def _writable(path: Path, option: str) -> None:
 def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool = False):
     # -> tuple[Chain, EniConfig]
     """The ENI's slaves behind ESCs (what ``serve`` puts on the wire), each with the SII
-    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.wire.eni_wire`)."""
+    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.drives.esc.sii_eni`)."""
     from gtecat.drives.esc import Chain
+    from gtecat.drives.esc.sii_eni import sii_for
     from gtecat.drives.machine import MachineDescription, load_machine
     from gtecat.eni.layout import build_layout
     from gtecat.eni.reader import read_eni
     from gtecat.master.factory import build_slaves
-    from gtecat.wire.eni_wire import read_wire, sii_for
 
     config = read_eni(eni)
     layout = build_layout(config)
     desc = load_machine(machine) if machine else MachineDescription()
     slaves = build_slaves(layout, desc)
-    wire = read_wire(eni) or [None] * len(slaves)
-    if len(wire) != len(slaves):
-        wire = [None] * len(slaves)
-    sii = [sii_for(slave, w) for slave, w in zip(slaves, wire, strict=True)]
+    sii = [sii_for(slave, s) for slave, s in zip(slaves, config.slaves, strict=True)]
     chain = Chain(slaves, sii=sii, watchdog_trips=watchdog_trips)
     return chain, config
 

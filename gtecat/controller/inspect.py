@@ -314,10 +314,12 @@ class BusView:
             self._escs, self._escs_of = {}, self.master
         if position not in self._escs:
             from gtecat.drives.esc.registers import Esc
-            from gtecat.drives.esc.sii import build_sii, sii_info_for
+            from gtecat.drives.esc.sii import build_sii
+            from gtecat.drives.esc.sii_eni import sii_for
 
+            info = sii_for(slave, self.master.layout.config.slaves[position])
             self._escs[position] = Esc(
-                slave, build_sii(sii_info_for(slave)), position=position, chain_length=self.count
+                slave, build_sii(info), position=position, chain_length=self.count
             )
         esc = self._escs[position]
         esc.sync_al()

@@ -96,6 +96,31 @@ class ProcessDataArea:
 
 
 @dataclass(frozen=True, slots=True)
+class SyncManager:
+    """One ``ProcessData/SmN`` element (ETG.2100): where the device keeps a process-data SM.
+
+    ``direction`` is the element's ``Type`` (``Outputs``/``Inputs``); the wire face puts
+    these into the slave's SII so a master that reads the SII (SOEM) finds the device's own
+    layout (an EL2008's output SM at 0F00h)."""
+
+    number: int
+    direction: Direction
+    start: int
+    control: int = 0
+    enable: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class MailboxLayout:
+    """``Mailbox/Send`` and ``Mailbox/Recv`` (ETG.2100): (start, length) of each direction."""
+
+    out_start: int  #: master -> slave (SM0)
+    out_length: int
+    in_start: int  #: slave -> master (SM1)
+    in_length: int
+
+
+@dataclass(frozen=True, slots=True)
 class Slave:
     """One EtherCAT slave, in bus order (``position`` is 0-based)."""
 
@@ -115,6 +140,10 @@ class Slave:
     nservo_hint: int | None = None
     #: line in the source file where this slave starts (for error messages)
     line: int | None = None
+    #: what an ETG.2100 file says of the device's wire side (empty for a Googol INI file)
+    sync_managers: tuple[SyncManager, ...] = ()
+    mailbox_layout: MailboxLayout | None = None
+    product_revision: str | None = None  #: ``Info/ProductRevision`` (``EL2008-0000-0018``)
 
     @property
     def out_bits(self) -> int:

@@ -43,11 +43,14 @@ from .limits import (
     BIT_OFFSET,
     CCS,
     ENTRY_BITS,
+    ESC_ADDRESS,
     IDENTITY,
     IMAGE_BYTES,
     INDEX,
     PHYS_ADDR,
     SM,
+    SM_CONTROL,
+    SM_LENGTH,
     SUBINDEX,
     TIMEOUT_MS,
     Limit,
@@ -59,17 +62,22 @@ from .model import (
     EniConfig,
     Identity,
     InitCmd,
+    MailboxLayout,
     Pdo,
     PdoEntry,
     ProcessDataArea,
     Slave,
+    SyncManager,
     Variable,
 )
-from .numbers import fmt_index, parse_hex_bytes
+from .numbers import fmt_index, parse_hex_bytes, shown
 from .xmltree import Node
 
 _SM_TAG = re.compile(r"^Sm(\d+)$")
 _TRUE = {"1", "true", "yes"}
+_XS_BOOLEAN = {"true": True, "1": True, "false": False, "0": False}
+_SM_TAG = re.compile(r"Sm(\d+)")
+_SM_TYPES = {"outputs": Direction.OUT, "inputs": Direction.IN}
 _ADDR_IN_NAME = re.compile(r"(?:0x|#x)([0-9a-fA-F]{4}):(?:0x|#x)?([0-9a-fA-F]{1,2})\b")
 _CIA402_BY_NAME = {name.lower(): idx for idx, (name, _t) in CIA402_OBJECTS.items()}
 
@@ -114,6 +122,18 @@ class _Ctx:
             return limit.parse(child.text, tag)
         except ValueError as exc:
             raise self.error(str(exc), child, element or tag) from None
+
+    def bool_of(self, node: Node, tag: str, element: str) -> bool | None:
+        """An xs:boolean child (``true``/``false``/``1``/``0``, blanks around), None if absent."""
+        child = node.find(tag)
+        if child is None or not child.text.strip():
+            return None  # as an empty number: the element says nothing
+        text = child.text.strip()
+        if text not in _XS_BOOLEAN:
+            raise self.error(
+                f"<{tag}> is {shown(text)}, not an xs:boolean (true, false, 1, 0)", child, element
+            )
+        return _XS_BOOLEAN[text]
 
     def int_attr(self, node: Node, name: str, limit: Limit, element: str) -> int | None:
         """The integer in attribute ``name`` (None when absent or empty), checked."""
@@ -326,7 +346,50 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
         init_cmds=init_cmds,
         mailbox=mailbox_node is not None,
         line=snode.line,
+        sync_managers=_sync_managers(ctx, pd) if pd is not None else (),
+        mailbox_layout=_mailbox_layout(ctx, mailbox_node) if mailbox_node is not None else None,
+        product_revision=info.findtext("ProductRevision") or None,
     )
+
+
+def _sync_managers(ctx: _Ctx, pd: Node) -> tuple[SyncManager, ...]:
+    """``ProcessData/SmN`` elements with a ``Type`` of Outputs or Inputs (others: mailbox)."""
+    out = []
+    for child in pd.children:
+        m = _SM_TAG.fullmatch(child.tag)
+        direction = _SM_TYPES.get((child.findtext("Type") or "").strip().lower())
+        if m is None or direction is None:
+            continue
+        elem = f"ProcessData/{child.tag}"
+        try:
+            number = SM.parse(m.group(1), child.tag)
+        except ValueError as exc:
+            raise ctx.error(str(exc), child, elem) from None
+        start = ctx.int_of(child, "StartAddress", ESC_ADDRESS, element=elem)
+        if start is None:
+            continue  # no address: the device's default layout stays
+        out.append(
+            SyncManager(
+                number,
+                direction,
+                start,
+                ctx.int_of(child, "ControlByte", SM_CONTROL, default=0, element=elem) or 0,
+                bool(ctx.bool_of(child, "Enable", elem)),
+            )
+        )
+    return tuple(out)
+
+
+def _mailbox_layout(ctx: _Ctx, mbx: Node) -> MailboxLayout | None:
+    """``Mailbox/Send`` and ``Mailbox/Recv`` start and length, when all four are given."""
+    values = [
+        ctx.int_of(mbx, f"{side}/{tag}", limit, element=f"Mailbox/{side}/{tag}")
+        for side in ("Send", "Recv")
+        for tag, limit in (("Start", ESC_ADDRESS), ("Length", SM_LENGTH))
+    ]
+    if None in values:
+        return None
+    return MailboxLayout(*values)  # type: ignore[arg-type]
 
 
 def _area(ctx: _Ctx, pd: Node, tag: str) -> _Area | None:

@@ -226,7 +226,15 @@ def topologies(draw: st.DrawFn) -> dict[str, Any]:
 
 
 def _norm(cfg: EniConfig) -> EniConfig:
-    return replace(cfg, source="", slaves=tuple(replace(s, line=None) for s in cfg.slaves))
+    """Without what only a file states: lines, and the wire layout the writer derives
+    (sync manager addresses, mailbox) that a topology does not carry."""
+    return replace(
+        cfg,
+        source="",
+        slaves=tuple(
+            replace(s, line=None, sync_managers=(), mailbox_layout=None) for s in cfg.slaves
+        ),
+    )
 
 
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
