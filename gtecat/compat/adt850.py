@@ -108,6 +108,7 @@ def adt850_initial(**options: Any) -> int:
     except Exception as e:
         _set_error(f"adt850_initial: {e}")
         return 0 if "EtherCAT master" in str(e) else -1
+    _CARD[0].stop2_clears_ep = True
     _DEC_ENABLED.update({1: False, 2: False})
     return 1
 
@@ -162,7 +163,17 @@ set_actualcount_mode = _setting(
 )
 set_pulse_mode = _setting("set_pulse_mode", ("value", 0, 1), ("logic", 0, 1), ("dir_logic", 0, 1))
 set_inpos_mode = _setting("set_inpos_mode", ("value", 0, 1), ("logic", 0, 1))
-set_circle_mode = _setting("set_circle_mode", ("value", 0, 1))
+
+
+@_api()
+def set_circle_mode(cardno: int, axis: int, value: int) -> int:
+    """1.17 / 4.3: the variable ring: LP counts 0..COMP+, EP 0..COMP-, wrapping both ways;
+    with it on, COMP+/COMP- are no soft limits."""
+    card, n = _axis(cardno, axis)
+    card.regs[n].ring = _flag("value", value)
+    return 0
+
+
 set_input_filter = _setting("set_input_filter", ("number", 1, 4), ("value", 0, 1))
 set_filter_time = _setting("set_filter_time", ("value", 1, 8))
 set_input_fiilter = set_input_filter  # the seed's chapter 6 spelling
@@ -526,25 +537,32 @@ _SIGNALS = ("LMT+", "LMT-", "STOP0", "STOP1", "STOP2", "INPOS", "ALARM", "IN")
 
 
 def _input(card: PulseCard, number: int) -> int:
+    """The electrical level of input ``number`` (6.1: 0 low, 1 high).
+
+    A signal that is active reads its active level: low unless its mode says high-active
+    (limits: ``set_limit_mode`` logic, 1.1 "低电平有效" by default; STOP0-2: their
+    ``set_stopN_mode`` logic; INPOS/ALARM: ``set_inpos_mode``/``set_alarm_mode`` logic, the
+    nINPOS/nALARM inputs being low-active by default). Code that tests
+    ``read_bit(0, 0) == 0`` for "X LMT+ hit" works as on the card. IN terminals are
+    levels already (nothing in the machine drives them; they read high when open)."""
     n, k = number // 8 + 1, number % 8
-    if k == 0:
-        on = card.limit(n, True)
-    elif k == 1:
-        on = card.limit(n, False)
+    regs = card.regs[n]
+    if k in (0, 1):
+        on, high = card.limit(n, k == 0), regs.settings.get("limit_logic", 0)
     elif k <= 4:
-        on = card.stop_input(n, k - 2)
+        on, high = card.stop_input(n, k - 2), regs.stop_logic[k - 2]
     elif k == 5:
-        on = card.inpos(n)
+        on, high = card.inpos(n), regs.settings.get("set_inpos_mode", (0, 0))[1]
     elif k == 6:
-        on = card.alarm(n)
+        on, high = card.alarm(n), regs.settings.get("alarm_logic", 0)
     else:
-        on = bool(card.general_inputs >> (n - 1) & 1)
-    return 1 if on else 0
+        return 0 if card.general_inputs >> (n - 1) & 1 else 1
+    return int(on) if high else int(not on)
 
 
 @_api()
 def read_di(cardno: int, value: Any) -> int:
-    """6.1: all 32 inputs, D0 X LMT+ ... D31 W IN (1 = active)."""
+    """6.1: all 32 inputs, D0 X LMT+ ... D31 W IN, as electrical levels (0 low, 1 high)."""
     card = _card(cardno)
     out(value, sum(_input(card, b) << b for b in range(32)))
     return 0
@@ -560,7 +578,7 @@ def write_do(cardno: int, value: int) -> int:
 
 @_api(error=-1)
 def read_bit(cardno: int, number: int) -> int:
-    """6.3: one input, 0/1, -1 on a bad card or input number."""
+    """6.3: one input's level, 0 low / 1 high, -1 on a bad card or input number."""
     card = _card(cardno)
     return _input(card, integer("number", number, 0, 31))
 
@@ -1037,11 +1055,24 @@ def set_output(number: int, value: int) -> int:
 def _home(axes: list[int], pfn: FUNCTION) -> int:
     """B.2-B.5: each axis searches its home signal (STOP0 home switch, STOP1 encoder Z) in
     its direction at the home speed; 1 found (the counters become 0 there), -2 a limit
-    came first, -1 a disabled axis, 0 stopped from outside."""
+    came first, -1 a disabled axis, 0 stopped from outside.
+
+    Decision: "-2 未检测到原点信号" also when the machine has neither the signal nor a limit
+    switch ahead of the axis: the search is refused at once (a card would drive until
+    someone stops it; a test would never end)."""
     card = _card(0)
     for n in axes:
         if not _app(n).enabled:
             return -1
+    for n in axes:
+        p = _app(n)
+        if not card.signal_ahead(n, p.home_signal, -1 if p.home_dir else 1):
+            signal = ("home switch (STOP0)", "encoder index (STOP1)")[p.home_signal]
+            _set_error(
+                f"home: axis {n} has no {signal} and no limit switch in its search "
+                "direction: the search would never end"
+            )
+            return -2
     for n in axes:
         p = _app(n)
         regs = card.regs[n]
