@@ -149,6 +149,7 @@ class AxisRegs:
     settings: dict[str, Any] = field(default_factory=dict)  #: kept, no effect here
     stopdata: int = 0
     stopped_by_user: bool = False
+    last_acc: float = 0.0  #: pulse/ms², the last nonzero acceleration of a drive
     ring: bool = False  #: variable ring counters: LP in 0..COMP+, EP in 0..COMP- (4.3)
 
     def vel(self, value: float | None = None) -> float:
@@ -212,25 +213,36 @@ class PulseCard:
         regs = self.regs[axis]
         return _ring(self.res(axis).ax.prf_pos + regs.lp_off, regs.comp[0] if regs.ring else None)
 
+    def counted(self, axis: int) -> float:
+        """The encoder as the real position counter counts it: ``set_actualcount_mode``'s
+        direction (1: reversed) and, for A/B input, its multiplication (4x is the encoder's
+        own count; 2x half of it, 1x a quarter)."""
+        mode = self.regs[axis].settings.get("set_actualcount_mode", (0, 0, 0))
+        value, direction, freq = mode
+        scale = (1.0, 0.5, 0.25)[freq] if value == 0 else 1.0
+        return (-1.0 if direction else 1.0) * scale * self.res(axis).enc_pos
+
     def ep(self, axis: int) -> float:
         regs = self.regs[axis]
-        return _ring(self.res(axis).enc_pos + regs.ep_off, regs.comp[1] if regs.ring else None)
+        return _ring(self.counted(axis) + regs.ep_off, regs.comp[1] if regs.ring else None)
 
     def set_lp(self, axis: int, value: int) -> None:
         self.regs[axis].lp_off = value - self.res(axis).ax.prf_pos
 
     def set_ep(self, axis: int, value: int) -> None:
-        self.regs[axis].ep_off = value - self.res(axis).enc_pos
+        self.regs[axis].ep_off = value - self.counted(axis)
 
     def speed(self, axis: int) -> float:
         """The axis's current speed in V units (PPS / M)."""
         r = self.res(axis)
         return abs(r.prf_vel) * 1000.0 / self.regs[axis].m
 
-    def accel(self, axis: int) -> float:
-        """The current acceleration in A units (PPS/s / (125·M))."""
+    def accel(self, axis: int, held: bool = False) -> float:
+        """The current acceleration in A units (PPS/s / (125·M)); ``held``: the last
+        nonzero one while the acceleration is 0 (a register that holds its value)."""
         r = self.res(axis)
-        return abs(r.prf_acc) * 1e6 / (125.0 * self.regs[axis].m)
+        acc = abs(r.prf_acc) or (self.regs[axis].last_acc if held else 0.0)
+        return acc * 1e6 / (125.0 * self.regs[axis].m)
 
     # --- inputs -------------------------------------------------------------------------
     def din(self, axis: int) -> int:
@@ -516,6 +528,8 @@ class PulseCard:
             regs = self.regs[n]
             r = self.res(n)
             v = r.prf_vel
+            if r.prf_acc:
+                regs.last_acc = abs(r.prf_acc)  # the CA register holds it at constant speed
             bits = 0
             for k in range(3):
                 if regs.stop_on[k] and self.stop_input(n, k):

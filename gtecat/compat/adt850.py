@@ -158,9 +158,24 @@ def _setting(name: str, *ranges: tuple[str, int, int]) -> Callable[..., int]:
     return setter
 
 
-set_actualcount_mode = _setting(
+_set_actualcount_mode = _setting(
     "set_actualcount_mode", ("value", 0, 1), ("dir", 0, 1), ("freq", 0, 2)
 )
+
+
+@functools.wraps(_set_actualcount_mode)
+def set_actualcount_mode(cardno: int, axis: int, value: int, dir: int, freq: int) -> int:
+    """1.6: the real position counter's input: A/B (0) or up/down pulses (1), its
+    direction (1 reversed) and the A/B multiplication (0 4x, 1 2x, 2 1x). The counter
+    keeps its reading; it counts from now on as set."""
+    card = _CARD[0]
+    keep = card.ep(axis) if card is not None and axis in (1, 2, 3, 4) else None
+    rc = _set_actualcount_mode(cardno, axis, value, dir, freq)
+    if rc == 0 and keep is not None:
+        card.set_ep(axis, round(keep))
+    return rc
+
+
 set_pulse_mode = _setting("set_pulse_mode", ("value", 0, 1), ("logic", 0, 1), ("dir_logic", 0, 1))
 set_inpos_mode = _setting("set_inpos_mode", ("value", 0, 1), ("logic", 0, 1))
 

@@ -543,3 +543,14 @@ def test_appendix_b_home1_without_a_signal_or_limit_returns_minus_2():
     assert "no home switch (STOP0) and no limit switch" in adt.last_error()
     assert pos(1) == before  # nothing moved
     assert adt.home4() == -2
+
+
+def test_actualcount_mode_sets_the_real_counters_direction_and_multiplication():
+    """1.6: dir 1 counts the other way; freq 1 (2x) counts half the 4x pulses."""
+    init()
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.set_actualcount_mode(0, 1, 0, 1, 1) == 0
+    assert actual(1) == 0
+    assert adt.pmove(0, 1, 1000) == 0
+    wait_axes(1)
+    assert pos(1) == 1000 and actual(1) == -500
