@@ -1,6 +1,7 @@
 """The MCX314 card library of seed 003 (chapter 4) over our axes.
 
-``from gtecat.compat import mcx314 as m`` and the functions of tables 4-2 to 4-7 with the seed's names and argument order.  The library has no open call (the card is found at
+``from gtecat.compat import mcx314 as m`` and the functions of tables 4-2 to 4-7 with
+the seed's names and argument order.  The library has no open call (the card is found at
 power-up): the first call opens the card (the one ``GT_Open`` opened, else a ``gts:4`` card
 with the ``GTECAT_*`` settings); :func:`Open` (ours) chooses its options.  The seed's
 functions are ``void``: they return None, and a value outside the seed's range (or a call
@@ -29,7 +30,8 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
   ``TCurve_F`` / ``SCurve_F`` ``Pulse`` is relative, its sign the direction.
 * **Soft limits**: ``SLMTP(n)`` / ``SLMTM(n)`` make COMP+ / COMP- soft limits of all
   axes (``SetCompP`` / ``SetCompM(axis, data)``); ``n`` is the "active level" the thesis
-  names, kept (a comparison has none), ``RESET`` turns them off; ``SLMTSig(n)`` compares with LP (0) or EP (1).  Level settings (``HLMTP``,
+  names, kept (a comparison has none), ``RESET`` turns them off; ``SLMTSig(n)`` compares
+  with LP (0) or EP (1).  Level settings (``HLMTP``,
   ``ALMSig``, ...) and encoder modes are kept, with no effect on the emulated signals.
 * **Homing** ``HomeTypeN(WR1Reg, SV, V, A)``: ``WR1Reg`` is the chip's WR1 input-stop
   register - bit 2k+1 enables IN k (IN0 home switch, IN1 encoder Z, IN2 probe 1), bit
