@@ -384,7 +384,7 @@ class Chain:
             if irq:
                 u16_pack(buf, off + 8, u16_unpack(buf, off + 8)[0] | irq)
             wkc = 0
-            if self._deferred and cmd not in _L:
+            if self._deferred and cmd not in _L and not _dc_only(buf, off, dlen):
                 self.flush()  # a register access sees the outputs answered before it
             if cmd in _L:
                 laddr = _U32.unpack_from(buf, off + 2)[0]
@@ -523,6 +523,15 @@ class Chain:
             esc.sync_al()
             if esc.slave.emergencies:
                 esc.collect_emergencies()
+
+
+def _dc_only(buf: bytearray, off: int, dlen: int) -> bool:
+    """A datagram that touches only the distributed-clock registers (0900h-09FFh: port
+    times, system time, offset, delay, SYNC): the outputs a logical datagram left to be
+    applied cannot change what it reads or writes, so it need not wait for them. The DC
+    frame of a master (LRW + ARMW/FRMW of 0910h) stays on the fast path."""
+    ado = _U16.unpack_from(buf, off + 4)[0]
+    return 0x0900 <= ado and ado + dlen <= 0x0A00
 
 
 def _physical(kind: int, esc: Esc, ado: int, buf: bytearray, d0: int, d1: int) -> int:
