@@ -18,13 +18,14 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
   D = 1, K = 1, dec_pos 0.  The modes are the seed's 1.1 list.
 * **Interpolation speed** is the master axis's (X for X-Y, X-Y-Z, X-Y-Z-W; Z for Z-W) in
   base pulses (:mod:`gtecat.controller.crd.base_pulse`): the long axis of a line, the
-  faster axis of each octant of an arc.  Z's settings are not needed (the seed's 5.8
-  requirement on them is a hardware detail).  Interpolation deceleration is disabled at
-  start (9.2.6: "默认情况是插补减速禁止"): a node then accelerates and stops at once at
-  its end; ``inp_dec_enable`` before a node decelerates it (automatically for lines,
-  at ``set_dec_pos`` base pulses from the node's start in manual mode).  Returned 1: an
-  arc with acceleration and automatic deceleration, an S-curve arc, an S-curve node
-  written while one runs (continuous interpolation, 5.4).
+  faster axis of each octant of an arc.  A 3/4-axis line needs Z set as 5.8/5.9 say
+  (refused with 1 otherwise), and one that stopped early needs ``inp_clear`` (9.3).
+  Interpolation deceleration is disabled at start (9.2.6: "默认情况是插补减速禁止"): a
+  node then accelerates and stops at once at its end; ``inp_dec_enable`` before a node
+  decelerates it (automatically for lines, at ``set_dec_pos`` base pulses from the
+  node's start in manual mode).  Returned 1: an arc with acceleration and automatic
+  deceleration, an S-curve arc, an S-curve node written while one runs (continuous
+  interpolation, 5.4).
 * **Continuous interpolation**: ``get_inp_status2`` is 1 while the interpolation runs
   and no next node waits (the chip's one-node buffer); a node written then is run right
   after the current one, at the base speed the current one ends with.
@@ -110,6 +111,7 @@ def adt850_initial(**options: Any) -> int:
         return 0 if "EtherCAT master" in str(e) else -1
     _CARD[0].stop2_clears_ep = True
     _DEC_ENABLED.update({1: False, 2: False})
+    _INP34.clear()
     return 1
 
 
@@ -416,6 +418,7 @@ def pmove(cardno: int, axis: int, pulse: int) -> int:
     """5.1: a fixed drive of ``pulse`` pulses (sign = direction)."""
     card, n = _axis(cardno, axis)
     p = integer("pulse", pulse, -PULSE_MAX, PULSE_MAX)
+    _check_zw(card, n)
     card.drive(n, abs(p), 1 if p >= 0 else -1)
     return 0
 
@@ -424,6 +427,7 @@ def pmove(cardno: int, axis: int, pulse: int) -> int:
 def continue_move(cardno: int, axis: int, dir: int) -> int:
     """5.2: a continuous drive, 0 positive, 1 negative, until a stop."""
     card, n = _axis(cardno, axis)
+    _check_zw(card, n)
     card.drive(n, None, -1 if _flag("dir", dir) else 1)
     return 0
 
@@ -511,7 +515,7 @@ def inp_move3(cardno: int, pulse1: int, pulse2: int, pulse3: int) -> int:
     """5.8: X-Y-Z line."""
     card = _card(cardno)
     d = (_inp("pulse1", pulse1), _inp("pulse2", pulse2), _inp("pulse3", pulse3))
-    _interp(card, 1, [1, 2, 3], PulseCard.line(d), False)
+    _interp34(card, [1, 2, 3], d)
     return 0
 
 
@@ -520,8 +524,47 @@ def inp_move4(cardno: int, pulse1: int, pulse2: int, pulse3: int, pulse4: int) -
     """5.9: X-Y-Z-W line."""
     card = _card(cardno)
     d = tuple(_inp(f"pulse{k + 1}", p) for k, p in enumerate((pulse1, pulse2, pulse3, pulse4)))
-    _interp(card, 1, [1, 2, 3, 4], PulseCard.line(d), False)
+    _interp34(card, [1, 2, 3, 4], d)
     return 0
+
+
+#: where a 3/4-axis interpolation sends Z and W (LP), until it is over or inp_clear
+_INP34: dict[int, float] = {}
+
+
+def _inp34_error(card: PulseCard) -> bool:
+    """9.3: a 3/4-axis interpolation that stopped before its distance leaves an error that
+    makes Z and W move wrongly until ``inp_clear``."""
+    if not _INP34 or bank(card.ctl).get(1).running:
+        return False
+    return any(abs(card.lp(a) - t) > 0.5 for a, t in _INP34.items())
+
+
+def _check_zw(card: PulseCard, axis: int) -> None:
+    if axis in (3, 4) and _inp34_error(card):
+        raise CompatError(
+            "a 3/4-axis interpolation stopped before its end: Z and W do not move right "
+            "until inp_clear (9.3)"
+        )
+
+
+def _interp34(card: PulseCard, axes: list[int], d: tuple[int, ...]) -> None:
+    """5.8/5.9: the speed is X's; the card needs Z's multiplier (range) and drive speed
+    equal to X's, and Z's start speed equal to X's drive speed. Decision: other Z settings
+    are refused with 1 and the rule (the card runs them wrongly)."""
+    _check_zw(card, 3)
+    x, z = card.regs[1], card.regs[3]
+    if (z.m, z.v, z.sv) != (x.m, x.v, x.v):
+        raise CompatError(
+            f"3/4-axis interpolation (5.8/5.9): Z needs X's range and speed and a start "
+            f"speed equal to X's speed: X M={x.m:g} V={x.v}, Z M={z.m:g} V={z.v} SV={z.sv}"
+        )
+    running = bank(card.ctl).get(1).running
+    for a, delta in zip(axes, d, strict=True):
+        if a in (3, 4):
+            base = _INP34.get(a, card.lp(a)) if running else card.lp(a)
+            _INP34[a] = base + delta
+    _interp(card, 1, axes, PulseCard.line(d), False)
 
 
 @_api()
@@ -542,8 +585,9 @@ def inp_dec_disable(cardno: int, no: int) -> int:
 
 @_api()
 def inp_clear(cardno: int) -> int:
-    """5.12: clear a 3/4-axis interpolation error (nothing sticks here: always 0)."""
+    """5.12 / 9.3: clear the error a 3/4-axis interpolation that did not end leaves."""
     _card(cardno)
+    _INP34.clear()
     return 0
 
 

@@ -286,9 +286,15 @@ def test_half_circle_of_chapter_10_1_3_6_on_the_circle():
     assert pts[-1] == (2 * p, 2 * p)
 
 
+def z_like_x(speed: int) -> None:
+    """5.8/5.9: Z's multiplier and speed as X's, Z's start speed = X's speed."""
+    setup_speed(3, speed, speed, 0)
+
+
 def test_three_and_four_axis_lines_end_exactly():
     init()
     setup_speed(1, 20_000, 20_000, 0)
+    z_like_x(20_000)
     assert adt.inp_move3(0, 1000, -2000, 3000) == 0
     while inp_running():
         gt.GTE_Wait(1)
@@ -554,3 +560,32 @@ def test_actualcount_mode_sets_the_real_counters_direction_and_multiplication():
     assert adt.pmove(0, 1, 1000) == 0
     wait_axes(1)
     assert pos(1) == 1000 and actual(1) == -500
+
+
+def test_three_axis_interpolation_needs_z_set_as_x():
+    """5.8 note: Z's multiplier and drive speed as X's, Z's start speed = X's drive speed;
+    other Z settings are refused with the rule."""
+    init()
+    setup_speed(1, 1000, 20_000, 125_000)
+    assert adt.inp_move3(0, 1000, 1000, 1000) == 1
+    assert "Z needs X's range and speed" in adt.last_error()
+    z_like_x(20_000)
+    assert adt.inp_move3(0, 1000, 1000, 1000) == 0
+
+
+def test_an_unfinished_three_axis_interpolation_needs_inp_clear():
+    """9.3 / 5.12: stopped before its distance, a 3/4-axis interpolation leaves Z and W
+    moving wrongly until inp_clear; after it they move again."""
+    init()
+    setup_speed(1, 20_000, 20_000, 0)
+    z_like_x(20_000)
+    assert adt.inp_move3(0, 100_000, 0, 100_000) == 0
+    gt.GTE_Wait(50)
+    assert adt.sudden_stop(0, 1) == 0
+    while inp_running():
+        gt.GTE_Wait(1)
+    assert adt.pmove(0, 3, 100) == 1 and "until inp_clear" in adt.last_error()
+    assert adt.inp_move3(0, 10, 10, 10) == 1
+    assert adt.pmove(0, 1, 100) == 0  # X is not concerned
+    assert adt.inp_clear(0) == 0
+    assert adt.pmove(0, 3, 100) == 0
