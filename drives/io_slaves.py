@@ -166,7 +166,6 @@ class IoSlave(VirtualSlave):
         if self.al_state >= AlState.SAFEOP:
             self.tx[:] = self.field_inputs
 
-
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires
         that move bits between the same two bytes by the same shift are one masked copy.
