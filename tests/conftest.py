@@ -8,11 +8,38 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
-# CI runs the property tests with a fixed derandomised seed (reproducible, never flaky);
-# developers' runs keep exploring new examples.
+# No test depends on the wall clock's speed: hypothesis's deadline is off in every profile (a
+# loaded CI machine must not fail an example for being slow). CI runs the property tests with
+# a fixed derandomised seed (reproducible, never flaky); developers' runs keep exploring.
+settings.register_profile("dev", deadline=None)
 settings.register_profile("ci", derandomize=True, deadline=None)
-if os.environ.get("CI"):
-    settings.load_profile("ci")
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+#: GTECAT_LONG=1 runs the long campaigns (fuzzers over the whole function table, wide sweeps)
+#: in full; the default run keeps a small, bounded, seeded version of each so that the suite
+#: fits its 2-CPU machine.
+LONG = bool(os.environ.get("GTECAT_LONG"))
+
+
+def examples(long: int, default: int) -> int:
+    """A property test's ``max_examples``: ``long`` under GTECAT_LONG=1, else ``default``."""
+    return long if LONG else default
+
+
+def campaign_seed() -> int:
+    """The seed of a sampled campaign: ``GTECAT_SEED`` when set, 0 under ``CI`` (the same
+    sample every run), else a fresh one per run (developers' runs cover the rest over time;
+    a failure names its seed)."""
+    env = os.environ.get("GTECAT_SEED")
+    if env:
+        return int(env)
+    if os.environ.get("CI"):
+        return 0
+    run = os.environ.get("PYTEST_XDIST_TESTRUNUID")  # the same in every worker of one run
+    if run:
+        return int(run[:8], 16)
+    return int.from_bytes(os.urandom(4), "little")
+
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

@@ -215,18 +215,19 @@ class CspBank:
         v = (demand - e1 - p) / dt
         lim = self.lim
         dist = demand - p
-        # the closing-speed cap: vstop >= min(|dist|/dt, lim) (m = 0: vstop = |dist|/dt;
+        rel = dist - vff * dt
+        # the closing-speed cap: vstop >= min(|rel|/dt, lim) (m = 0: vstop = |rel|/dt;
         # m >= 1: vstop >= m*lim), so rows within half of that of vff cannot be capped
         # (the half keeps the shortcut clear of every rounding at the boundary)
         gap = v - vff
-        adist = np.abs(dist)
-        if np.count_nonzero(np.abs(gap) > np.minimum(adist * (0.5 / dt), self.half_lim)):
-            vstop = closing_speed(adist, lim, dt)
+        arel = np.abs(rel)
+        if np.count_nonzero(np.abs(gap) > np.minimum(arel * (0.5 / dt), self.half_lim)):
+            vstop = closing_speed(arel, lim, dt)
             hi = vff + vstop
-            c1 = (dist > 0.0) & (v > hi)
+            c1 = (rel > 0.0) & (v > hi)
             np.copyto(v, hi, where=c1)
             lo = vff - vstop
-            c2 = (dist < 0.0) & (v < lo)
+            c2 = (rel < 0.0) & (v < lo)
             np.copyto(v, lo, where=c2)
             limited = c1 | c2
         else:
@@ -239,7 +240,8 @@ class CspBank:
             limited = limited | up | down
         limited_any = bool(np.count_nonzero(limited))
         if limited_any:
-            land = limited & (((dist > 0.0) & (v * dt > dist)) | ((dist < 0.0) & (v * dt < dist)))
+            fwd = (rel > 0.0) & (dist > 0.0) & (v * dt > dist)
+            land = limited & (fwd | ((rel < 0.0) & (dist < 0.0) & (v * dt < dist)))
             np.copyto(v, dist / dt, where=land)
         if np.count_nonzero(np.abs(v) > vmax):
             over, under = v > vmax, v < self.nvmax

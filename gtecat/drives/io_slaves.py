@@ -90,6 +90,7 @@ class IoSlave(VirtualSlave):
         self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
         self.field_outputs = bytearray(len(self.rx))  # what the terminals drive
         self._wires: list[tuple[int, int]] = []  # (output bit, input bit) in rx/tx numbering
+        self._wire_plan: list[tuple[int, int, int, int]] | None = None  # see _plan_wires
 
     def pdo_sizes(self) -> tuple[int, int]:
         return (sum(p.bit_len for p in self.rx_pdos), sum(p.bit_len for p in self.tx_pdos))
@@ -127,6 +128,7 @@ class IoSlave(VirtualSlave):
         if not 0 <= in_bit < len(self.tx) * 8:
             raise ValueError(f"slave {self.position}: no input bit {in_bit}")
         self._wires.append((out_bit, in_bit))
+        self._wire_plan = None
 
     def wire_objects(
         self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None
@@ -153,10 +155,28 @@ class IoSlave(VirtualSlave):
             self.field_outputs[:] = self.rx
         else:
             self.field_outputs[:] = bytes(len(self.field_outputs))
-        for ob, ib in self._wires:
-            set_bits(self.field_inputs, ib, 1, get_bits(self.field_outputs, ob, 1))
+        if self._wires:
+            plan = self._wire_plan
+            if plan is None:
+                plan = self._wire_plan = self._plan_wires()
+            fo, fi = self.field_outputs, self.field_inputs
+            for ob, ib, shift, mask in plan:
+                v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
+                fi[ib] = (fi[ib] & ~mask) | (v & mask)
         if self.al_state >= AlState.SAFEOP:
             self.tx[:] = self.field_inputs
+
+    def _plan_wires(self) -> list[tuple[int, int, int, int]]:
+        """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires
+        that move bits between the same two bytes by the same shift are one masked copy.
+        Every wire reads the field outputs as they stand, so of several wires onto one
+        input bit the last one wins (as when they ran one by one)."""
+        last = {ib: ob for ob, ib in self._wires}
+        groups: dict[tuple[int, int, int], int] = {}
+        for ib, ob in last.items():
+            key = (ob >> 3, ib >> 3, (ib & 7) - (ob & 7))
+            groups[key] = groups.get(key, 0) | 1 << (ib & 7)
+        return [(ob, ib, shift, mask) for (ob, ib, shift), mask in groups.items()]
 
 
 class CoeIoSlave(IoSlave):

@@ -112,12 +112,17 @@ class Mechanics:
         lim = self.amax * dt
         limited = False
         # closing speed on the (moving) demand that still lets the axis brake onto it
-        # within the acceleration limit (exact for the discrete cycle, _closing_speed)
+        # within the acceleration limit (exact for the discrete cycle, _closing_speed).
+        # The demand itself moves at vff, so the braking is planned in its frame: the gap
+        # to cover at the relative speed v - vff is where the demand stood a cycle ago
+        # (`rel`); measured to `demand` instead, vff + vstop could step past the demand
+        # and the landing below then braked harder than 6083h allows.
         dist = demand - p
-        vstop = _closing_speed(abs(dist), lim, dt)
-        if dist > 0.0 and v > vff + vstop:
+        rel = dist - vff * dt
+        vstop = _closing_speed(abs(rel), lim, dt)
+        if rel > 0.0 and v > vff + vstop:
             v, limited = vff + vstop, True
-        elif dist < 0.0 and v < vff - vstop:
+        elif rel < 0.0 and v < vff - vstop:
             v, limited = vff - vstop, True
         dv = v - v0
         if dv > lim:
@@ -125,11 +130,13 @@ class Mechanics:
         elif dv < -lim:
             v, limited = v0 - lim, True
         if limited:
-            # landing: never run past the demand (with the exact braking curve this only
-            # bites when a cycle is longer than the one before it)
-            if dist > 0.0 and v * dt > dist:
+            # landing: never run past the demand it is closing on (with the exact braking
+            # curve this only bites when a cycle is longer than the one before it); a demand
+            # running away faster than the axis (rel and dist of opposite signs) is not
+            # landed on: the axis may pass its end-of-cycle point and fall behind again
+            if rel > 0.0 and dist > 0.0 and v * dt > dist:
                 v = dist / dt
-            elif dist < 0.0 and v * dt < dist:
+            elif rel < 0.0 and dist < 0.0 and v * dt < dist:
                 v = dist / dt
         if v > vmax:
             v, limited = vmax, True

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from gtecat.drives.mechanics import Mechanics, MechanicsParams
@@ -78,9 +78,15 @@ def test_coasting_stops_with_friction() -> None:
 
 @settings(max_examples=50, deadline=None)
 @given(st.floats(-1e6, 1e6), st.floats(-400000, 400000))
+# the closing speed measured to where the demand will be, not where it was a cycle ago
+# (vff + vstop stepped past a 58-count demand and the landing braked at 9,001,000 > 9e6)
+@example(58.0, 1.0)
+# a demand running away faster than the axis is not landed on (it would brake at 1.5e7)
+@example(-90.0, 59802.62335914802)
+@example(90.0, 168953.41575622372)
 def test_position_velocity_consistency(target: float, vff: float) -> None:
     m = Mechanics(P)
-    for k in range(5):
+    for k in range(40):
         p0 = m.pos
         # a consistent CSP set-point: the demand moves at the feed-forward speed
         m.track(target + vff * 0.001 * k, vff, 0.001)

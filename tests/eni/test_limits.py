@@ -19,6 +19,7 @@ from gtecat.eni.layout import build_layout
 from gtecat.eni.limits import Limit, RangeError, cycle_ns_from_us
 from gtecat.eni.numbers import MAX_DIGITS, TooLong, parse_int
 from gtecat.eni.reader import parse_eni
+from tests.conftest import examples
 
 from .googol_text import GSlave, render
 from .snippets import area, eni, entry, image, line_of, pdo, process_data, servo_slave, slave
@@ -456,7 +457,9 @@ def test_the_property_sees_every_family() -> None:
     assert all(len(_spans_of(name)) > 10 for name in _TEXTS)
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=examples(300, 60), deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
 @given(st.sampled_from(sorted(_TEXTS)), st.data())
 def test_mutated_numbers_give_a_layout_or_an_eni_error(name: str, data: st.DataObject) -> None:
     text = _TEXTS[name]

@@ -15,6 +15,7 @@ from gtecat.eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, Proc
 from gtecat.eni.reader import parse_eni
 from gtecat.eni.topology import build_config
 from gtecat.eni.writer import write_eni
+from tests.conftest import examples
 
 OUT, IN = Direction.OUT, Direction.IN
 
@@ -89,7 +90,7 @@ def configs(draw: st.DrawFn) -> EniConfig:
     return cfg
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=examples(150, 40), deadline=None)
 @given(configs())
 def test_layout_regions_contiguous_disjoint_and_entries_inside(cfg: EniConfig) -> None:
     layout = build_layout(cfg)
@@ -237,7 +238,9 @@ def _norm(cfg: EniConfig) -> EniConfig:
     )
 
 
-@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=examples(120, 30), deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
 @given(topologies())
 def test_write_then_read_gives_the_same_model(topo: dict[str, Any]) -> None:
     cfg = build_config(topo, "topo.toml")

@@ -165,7 +165,7 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
     for (r = 0; r < n; r++) {
         int64_t cur, counts, x, target, raw, pa, din, since;
         int32_t d32;
-        double prf, a, demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, vstop, dv, acc, pos;
+        double prf, a, demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, rel, vstop, dv, acc, pos;
         double fe, step, enc, err, band;
         int limited = 0, swl = 0, hit = 0, ended, standing, inb, arr;
         if (!alive[r])
@@ -232,11 +232,12 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         v = (demand - e1 - p) / dt;
         lim = F64(c_lim)[r];
         dist = demand - p;
-        vstop = closing_speed(fabs(dist), lim, dt);
-        if (dist > 0.0 && v > vff + vstop) {
+        rel = dist - vff * dt;
+        vstop = closing_speed(fabs(rel), lim, dt);
+        if (rel > 0.0 && v > vff + vstop) {
             v = vff + vstop;
             limited = 1;
-        } else if (dist < 0.0 && v < vff - vstop) {
+        } else if (rel < 0.0 && v < vff - vstop) {
             v = vff - vstop;
             limited = 1;
         }
@@ -249,9 +250,9 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
             limited = 1;
         }
         if (limited) {
-            if (dist > 0.0 && v * dt > dist)
+            if (rel > 0.0 && dist > 0.0 && v * dt > dist)
                 v = dist / dt;
-            else if (dist < 0.0 && v * dt < dist)
+            else if (rel < 0.0 && dist < 0.0 && v * dt < dist)
                 v = dist / dt;
         }
         if (v > vmax) {

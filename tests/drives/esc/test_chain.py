@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from gtecat.drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
 from gtecat.drives.esc.registers import Reg
 from gtecat.drives.slave import AlState
+from tests.conftest import examples
 from tests.drives.esc.mini import (
     MiniMaster,
     mini_chain,
@@ -214,7 +215,7 @@ def test_malformed_frames_are_dropped_and_counted() -> None:
 commands = st.sampled_from(list(Command))
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300, 80), deadline=None)
 @given(
     st.lists(
         st.builds(
@@ -244,7 +245,7 @@ def test_any_well_formed_frame_is_answered_and_nothing_raises(dgs: list[Datagram
     assert [d.command for d in back] == [d.command for d in dgs]
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300, 80), deadline=None)
 @given(st.binary(min_size=0, max_size=200))
 def test_garbage_never_raises(raw: bytes) -> None:
     chain = mini_chain(2)

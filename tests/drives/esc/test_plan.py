@@ -11,6 +11,7 @@ from gtecat.drives.esc import Chain, Command, Datagram, decode_frame, encode_fra
 from gtecat.drives.esc import chain as chain_mod
 from gtecat.drives.esc.registers import Reg
 from gtecat.drives.slave import AlState
+from tests.conftest import examples
 from tests.drives.esc.mini import MiniMaster, mini_chain
 
 FM = struct.Struct("<IHBBHBBB3x")
@@ -72,7 +73,7 @@ ops = st.one_of(
 )
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 20), deadline=None)
 @given(st.lists(ops, min_size=1, max_size=25))
 def test_plans_and_the_general_path_agree(sequence: list) -> None:
     fast, mf = configured(False)
@@ -133,7 +134,7 @@ cyclic_ops = st.one_of(
 )
 
 
-@settings(max_examples=120, deadline=None)
+@settings(max_examples=examples(120, 40), deadline=None)
 @given(st.lists(cyclic_ops, min_size=1, max_size=40))
 def test_repeated_cyclic_frames_agree_with_the_general_path(sequence: list) -> None:
     """Also covers the one-datagram shortcut (Chain._cyclic: a repeat of the last fast

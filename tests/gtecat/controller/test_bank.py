@@ -24,6 +24,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
+from tests.conftest import examples
 
 ROOT = Path(__file__).resolve().parents[3]
 ENI = ROOT / "examples" / "twelve_axes.eni"
@@ -230,7 +231,7 @@ program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=1
 
 
 @settings(
-    max_examples=12,
+    max_examples=examples(12, 5),
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
