@@ -54,6 +54,14 @@ CMD_NO_RESPONSE = -7
 ECAT_MISMATCH = -8
 ECAT_NO_ENI = -9
 ECAT_NO_SLAVES = -10
+#: what a function the table declares but gtecat does not emulate returns, whatever its
+#: arguments, from Python, libgts (C) and C# alike: the vendor header's
+#: ``CMD_ERROR_UNKNOWN`` (8, "unsupported command"), the code the vendor's own controller
+#: gives a command its firmware does not know.  Not 1 (a known command that failed, table
+#: 3-1) nor 7 (a bad argument): a caller can tell "not there" from "went wrong".  The
+#: reason (GTE_GetLastError) names the function and its group, and the master log says it
+#: once per function.
+CMD_DECLARED = 8
 
 #: exception type -> return code; first match wins (subclasses before bases)
 ERROR_CODES: tuple[tuple[type[BaseException], int], ...] = (

@@ -81,9 +81,18 @@ def render() -> str:
         "/* ---- constants ---- */",
     ]
     lines += [c.define() for c in cdecl.constants()]
+    lines += ["", "/* ---- enums ---- */"]
+    lines += cdecl.enums()
     lines += ["", "/* ---- structures ---- */"]
+    known = set()
     for cls in cdecl.structures():
         lines += [cdecl.struct_decl(cls), ""]
+        known.add(cls.__name__)
+    opaque = sorted({p.ctype for f in FUNCTIONS.values() for p in f.params if p.is_struct} - known)
+    if opaque:
+        lines.append("/* structures the vendor headers name without a layout gtecat knows */")
+        lines += [f"typedef struct {n} {n};" for n in opaque]
+        lines.append("")
     lines += [
         "#ifdef __cplusplus",
         'extern "C" {',

@@ -682,6 +682,23 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
     return rc;
 }
 
+short gte_declared(int index, int gtn, short core)
+{
+    const gte_declared_info *d = &gte_declared_table[index];
+    gte_function f = {d->name, d->id, 0, GTE_F_DECLARED, NULL};
+    char name[128];
+    snprintf(name, sizeof name, "%s%s", gtn ? "GTN_" : "", gtn ? d->name + 3 : d->name);
+    pthread_mutex_lock(&g_mu);
+    short rc = -1;
+    if (g_fd >= 0 && g_fd_pid == getpid())
+        rc = invoke_locked(&f, gtn, core, NULL); /* the controller logs it and says why */
+    if (rc != GTE_CMD_DECLARED)
+        set_err("%s returned %d: %s is declared but not emulated (group: %s)", name,
+                GTE_CMD_DECLARED, name, d->group);
+    pthread_mutex_unlock(&g_mu);
+    return GTE_CMD_DECLARED;
+}
+
 short GTE_GetLastError(char *buf, short size)
 {
     if (!buf || size < 1)
