@@ -39,7 +39,7 @@ from ..errors import (
 )
 from .args import Ref, binder, core_arg
 from .fast import READERS, fast_reader
-from .table import FUNCTIONS, NO_CORE_TWINS, Proto
+from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
 log = logging.getLogger("gtecat.gt")
@@ -252,6 +252,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     REGISTRY[name] = gt
     if proto.gtn:
         own = NO_CORE_TWINS.get(name)
+        if name in SAME_PARAM_TWINS:  # GTN_Compile(pFileName, pWrongInfo): no core either
+            own = tuple((p.name, p.default or "") for p in proto.params)
         if own is not None:
             # the vendor's GTN_Open(channel=5, param=1) / GTN_Close(): no core; the core-first
             # form of earlier gtecat releases (one argument more, or core=) still works

@@ -18,7 +18,8 @@ Client -> controller, first message of a connection (``HELLO``)::
 
 ``digest`` names the table, the protocol, the structure layouts and the set of emulated
 functions the library was built from (a declared-only function sends no arguments); the
-controller refuses a library built from another table (reply status 1 with the reason).  Reply (``HELLO_REPLY``): ``i16 status, u16 text length, text``.
+controller refuses a library built from another table (reply status 1 with the reason).
+Reply (``HELLO_REPLY``): ``i16 status, u16 text length, text``.
 
 A call (``CALL``)::
 

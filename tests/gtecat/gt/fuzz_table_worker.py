@@ -43,7 +43,7 @@ from hypothesis import strategies as st
 from gtecat import gt
 from gtecat.gt import _core
 from gtecat.gt.args import _struct_types
-from gtecat.gt.table import NO_CORE_TWINS, SCALARS, Param
+from gtecat.gt.table import NO_CORE_TWINS, SAME_PARAM_TWINS, SCALARS, Param
 from tests.conftest import EXAMPLES
 from tests.gtecat.gt.conftest import bring_up
 
@@ -473,7 +473,9 @@ def fuzz_function(name: str, examples: int, warnings: set[str]) -> None:
     fn = getattr(gt, name)
     proto = fn.prototype
     # GTN_Open(channel, param) / GTN_Close(): the vendor's GTN header gives them no core
-    no_core = name.startswith("GTN_") and "GT_" + name[4:] in NO_CORE_TWINS
+    no_core = name.startswith("GTN_") and (
+        "GT_" + name[4:] in NO_CORE_TWINS or "GT_" + name[4:] in SAME_PARAM_TWINS
+    )
     is_gtn = name.startswith("GTN_") and not no_core
     base = name.partition("_")[2]
     params = list(proto.params)
