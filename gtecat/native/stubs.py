@@ -85,11 +85,17 @@ def _descriptor(plan: FunctionPlan) -> list[str]:
 def _body(plan: FunctionPlan, gtn: bool) -> list[str]:
     proto: Proto = plan.proto
     out = ["{"]
+    slots = []  # char **pVersion: the text lands in a buffer of the library, *pVersion points to it
     if plan.args:
         out.append(f"    gte_arg a[{len(plan.args)}];")
         for i, a in enumerate(plan.args):
             p = a.param
-            if p.pointer:
+            if p.pointer and p.stars == 2:
+                slot = f"slot_{p.name}"
+                out.insert(1, f"    static char {slot}[{max(int(a.count), 1)}];")
+                out.append(f"    a[{i}].p = {p.name} ? {slot} : NULL;")
+                slots.append((p.name, slot))
+            elif p.pointer:
                 out.append(f"    a[{i}].p = {p.name};")
             elif a.kind is Kind.DOUBLE:
                 out.append(f"    a[{i}].d = {p.name};")
@@ -99,7 +105,14 @@ def _body(plan: FunctionPlan, gtn: bool) -> list[str]:
     else:
         args = "NULL"
     core = "core" if gtn else "1"
-    out.append(f"    return gte_invoke(&F_{proto.name}, {int(gtn)}, {core}, {args});")
+    if not slots:
+        out.append(f"    return gte_invoke(&F_{proto.name}, {int(gtn)}, {core}, {args});")
+    else:
+        out.append(f"    short rc = gte_invoke(&F_{proto.name}, {int(gtn)}, {core}, {args});")
+        for name, slot in slots:
+            out.append(f"    if (rc == 0 && {name})")
+            out.append(f"        *{name} = {slot};")
+        out.append("    return rc;")
     out.append("}")
     return out
 

@@ -8,7 +8,7 @@ short GT_Open(short channel=0, short param=1);                                  
 short GT_Close();                                                                // 7
 short GT_Reset();                                                                // 96
 short GT_GetClock(unsigned long *pClock, unsigned long *pLoop=NULL);             // 33
-short GT_GetVersion(char *pVersion /*outstr[64]*/);                              // 78
+short GT_GetVersion(char **pVersion /*outstr[64]*/);                             // 78 (the vendor header's char **; Python takes a buffer too)
 short GT_InitEcatComm();                                                         // 79
 short GT_StartEcatComm();                                                        // 129
 short GT_TerminateEcatComm();                                                    // 136

@@ -7,7 +7,7 @@ PROTOTYPES = r"""
 short GT_AxisOn(short axis);                                                     // 5
 short GT_AxisOff(short axis);                                                    // 4
 short GT_SetEcatAxisMode(short axis, short mode);                                // 100
-short GT_GetEcatAxisMode(short axis, short *pMode);                              // 39
+short GT_GetEcatAxisMode(short axis, unsigned short *pMode);                     // 39 (the vendor header's unsigned short *; the manual writes short *)
 short GT_GetEcatEncPos(short axis, long *pEncPos);                               // 41
 short GT_GetEcatEncVel(short axis, long *pEncVel);                               // 42
 short GT_GetEcatAxisPE(short axis, long *pPosErr);                               // 40
@@ -27,7 +27,7 @@ short GT_SetHomingMode(short axis, short mode);                                 
 short GT_SetEcatHomingPrm(short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);  // 103
 short GT_StartEcatHoming(short axis);                                            // 130
 short GT_StopEcatHoming(short axis);                                             // 133
-short GT_GetEcatHomingStatus(short axis, short *pHomingStatus);                  // 43
+short GT_GetEcatHomingStatus(short axis, unsigned short *pHomingStatus);         // 43 (the vendor header's unsigned short *; the manual writes short *)
 short GT_SetTouchProbeFunction(short axis, short ProbePrm);                      // 123
 short GT_SetTouchProbeFunctionEx(short axis, short Probe1Enable, short Probe1TriggerType, short Probe1TriggerLevel, short Probe2Enable, short Probe2TriggerType, short Probe2TriggerLevel);  // 124
 short GT_GetTouchProbeStatus(short axis, unsigned short *probeStatus /*opt*/, long *probe1RiseValue /*opt*/, long *probe1FallValue /*opt*/, long *probe2RiseValue /*opt*/, long *probe2FallValue /*opt*/);  // 73
