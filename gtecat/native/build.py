@@ -32,13 +32,22 @@ from ..cbuild import NativeBuildError, cache_root, compiler
 from ..cbuild import version_dir as made_version_dir
 from . import header, stubs
 
-RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h")
+RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h", "gtecat_vendor.h")
+#: files that go beside gts.h (the rest are the library's sources)
+INCLUDE_FILES = ("gts.h", "gtecat_vendor.h")
+#: the file ``--cflags`` force-includes so a vendor header compiles unchanged
+VENDOR_COMPAT = "gtecat_vendor.h"
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-pthread")
+
+
+#: the library of each ABI: the vendor's (GTN era, one card) and the older multi-card GTS one
+LIBRARIES = {"": "libgts.so", "gts-multicard": "libgts_mc.so"}
 
 
 @dataclass(frozen=True, slots=True)
 class Build:
     root: Path
+    abi: str = ""
 
     @property
     def include_dir(self) -> Path:
@@ -50,17 +59,20 @@ class Build:
 
     @property
     def library(self) -> Path:
-        return self.lib_dir / "libgts.so"
+        return self.lib_dir / LIBRARIES[self.abi]
 
     @property
     def header(self) -> Path:
         return self.include_dir / "gts.h"
 
     def cflags(self) -> list[str]:
-        return [f"-I{self.include_dir}"]
+        """``-I`` for gts.h, and the forced include that lets the vendor's own header
+        compile unchanged (``__stdcall``, NULL, Windows type names: gtecat_vendor.h)."""
+        return [f"-I{self.include_dir}", "-include", str(self.include_dir / VENDOR_COMPAT)]
 
     def libs(self) -> list[str]:
-        return [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", "-lgts"]
+        name = LIBRARIES[self.abi][3:-3]
+        return [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", f"-l{name}"]
 
 
 def python_executable() -> str:
@@ -68,7 +80,7 @@ def python_executable() -> str:
     return os.environ.get("GTECAT_PYTHON") or sys.executable or "python3"
 
 
-def sources(python: str) -> dict[str, str]:
+def sources(python: str, abi: str = "") -> dict[str, str]:
     """Every file of the build, by name."""
     out = {
         "gts.h": header.render(),
@@ -79,6 +91,13 @@ def sources(python: str) -> dict[str, str]:
     pkg = resources.files("gtecat.native") / "csrc"
     for name in RUNTIME_SOURCES:
         out[name] = (pkg / name).read_text(encoding="utf-8")
+    if abi:
+        from . import multicard
+
+        out["gts_sc.h"] = out.pop("gts.h")  # the single-card header, inside the library
+        out["gts.h"] = header.render(abi)
+        out["gts_sc_rename.h"] = multicard.rename_h()
+        out["gts_multicard.c"] = multicard.render_c()
     return out
 
 
@@ -90,13 +109,16 @@ def _digest(files: dict[str, str], cc: list[str]) -> str:
     return h.hexdigest()[:12]
 
 
-def ensure_built(*, force: bool = False) -> Build:
-    """The build for this gtecat, compiled now if it is not in the cache yet."""
+def ensure_built(*, force: bool = False, abi: str = "") -> Build:
+    """The build for this gtecat, compiled now if it is not in the cache yet
+    (``abi="gts-multicard"``: libgts_mc.so, :mod:`gtecat.native.multicard`)."""
+    if abi not in LIBRARIES:
+        raise NativeBuildError(f"--abi {abi}: one of {', '.join(a for a in LIBRARIES if a)}")
     cc = compiler()
     python = python_executable()
-    files = sources(python)
+    files = sources(python, abi)
     version_dir = cache_root() / __version__
-    build = Build(version_dir / _digest(files, cc))
+    build = Build(version_dir / _digest(files, cc), abi)
     if build.library.is_file() and build.header.is_file() and not force:
         return build
     version_dir = made_version_dir()
@@ -115,8 +137,12 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
         for d in (src, inc, lib):
             d.mkdir()
         for name, text in files.items():
-            target = inc / name if name == "gts.h" else src / name
+            target = inc / name if name in INCLUDE_FILES else src / name
             target.write_text(text, encoding="utf-8")
+        inside = [f"-I{inc}", f"-I{src}"]
+        if build.abi:  # the single-card functions renamed gte_sc_x, the header of src first
+            (src / "gts.h").write_text(files["gts_sc.h"], encoding="utf-8")
+            inside = [f"-I{src}", f"-I{inc}", "-include", str(src / "gts_sc_rename.h")]
         # two units compiled side by side: the transport and the emulated functions'
         # stubs optimised, the ~2,000 one-line declared-only functions not (-O0 takes a
         # third of the time and they have nothing to optimise)
@@ -124,10 +150,12 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             (["gts_runtime.c", "gts_stubs.c"], CFLAGS),
             (["gts_declared.c"], (*CFLAGS, "-O0")),
         ]
+        if build.abi:
+            units.append((["gts_multicard.c"], (*CFLAGS, "-O0")))
         procs = []
         for names, flags in units:
             for name in names:
-                cmd = [*cc, *flags, "-c", f"-I{inc}", f"-I{src}", str(src / name)]
+                cmd = [*cc, *flags, "-c", *inside, str(src / name)]
                 cmd += ["-o", str(src / (name[:-2] + ".o"))]
                 procs.append((cmd, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
         for cmd, proc in procs:
@@ -138,10 +166,10 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             *cc,
             *CFLAGS,
             "-shared",
-            "-Wl,-soname,libgts.so",
+            f"-Wl,-soname,{build.library.name}",
             *objs,
             "-o",
-            str(lib / "libgts.so"),
+            str(lib / build.library.name),
         ]
         r = subprocess.run(cmd, capture_output=True, text=True)
         _check(cmd, r.returncode, r.stderr)

@@ -682,6 +682,17 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
     return rc;
 }
 
+short gte_no_card(const char *name, short card, short code)
+{
+    pthread_mutex_lock(&g_mu);
+    if (code == -6)
+        set_err("%s returned -6: no card %d: the emulator is card 0", name, card);
+    else
+        set_err("%s returned %d: card %d is not open: the emulator is card 0", name, code, card);
+    pthread_mutex_unlock(&g_mu);
+    return code;
+}
+
 short gte_declared(int index, int gtn, short core)
 {
     const gte_declared_info *d = &gte_declared_table[index];
