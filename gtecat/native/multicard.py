@@ -79,4 +79,4 @@ def render_c() -> str:
     return "\n".join(lines)
 
 
-__all__ = ["ABI", "prototype", "render_c", "rename_h"]
+__all__ = ["ABI", "prototype", "rename_h", "render_c"]

@@ -63,7 +63,8 @@ def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, tmp_path):
 def test_declared_only_gives_the_same_answer_in_python():
     assert gt.GT_SetHSIOOpt(1) == CMD_DECLARED
     assert gt.GTE_GetLastError() == (
-        "GT_SetHSIOOpt returned 8: GT_SetHSIOOpt is declared but not emulated (group: digital and analog IO)"
+        "GT_SetHSIOOpt returned 8: GT_SetHSIOOpt is declared but not emulated "
+        "(group: digital and analog IO)"
     )
     assert gt.GTN_SetHSIOOpt(1, 1, laserChannel=0) == CMD_DECLARED
     assert "GTN_SetHSIOOpt is declared" in gt.GTE_GetLastError()
