@@ -74,6 +74,7 @@ TOPICS: tuple[tuple[str, str, str], ...] = (
     ("io", "digital and analog IO", r"Di|Do|Gpi|Gpo|Ai|Ao|Io|Hsio|HSIO|Lmt|Limit|Alarm"),
     ("config", "configuration", r"Config|Map|Res|Card|Version|Core"),
     ("basic", "basic functions", r""),
+    ("exports", "exported by the vendor DLL, parameters not public", r"(?!)"),
 )
 
 
@@ -202,9 +203,24 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("headers", nargs="+", type=Path)
     ap.add_argument("--out", type=Path, help="write vendor_*.py group modules into this folder")
+    ap.add_argument(
+        "--dll-exports",
+        type=Path,
+        help="a list of the names a vendor gts.dll exports (one a line, e.g. from "
+        "`objdump -p gts.dll`): those no header declares become `short NAME(...);` lines",
+    )
     args = ap.parse_args(argv)
     functions, tds, consts = extract(args.headers)
     by_topic = lines(functions)
+    if args.dll_exports:
+        have = set(functions)
+        have |= {  # the twins the table gives (a GT_x that takes the core itself has none)
+            "GTN_" + n[3:]
+            for n, ps in functions.items()
+            if n.startswith("GT_") and not (ps and re.search(r"\bcore$", ps[0]))
+        }
+        names = sorted(set(args.dll_exports.read_text().split()) - have)
+        by_topic["exports"] = [f"short {n}(...);" for n in names if re.match(r"^GTN?_\w+$", n)]
     seen: set[str] = set()
     structs = []
     for td in tds:

@@ -20,6 +20,9 @@ chapter-13 entry.  A comment after a parameter states what C cannot say:
 * ``mask``: a ``long`` bit mask (0 .. 2^32-1 accepted as well as negative longs);
 * ``lo..hi``: the legal range of a scalar (beyond the C type's own range).
 
+``short GTN_x(...);`` names a function the vendor DLL exports whose parameters no public
+header gives: it is declared only, exported by the library, and left out of ``gts.h``.
+
 Everything that handles arguments reads this table: the Python wrappers'
 checks (:mod:`gtecat.gt.args`), and the generated ``gts.h`` and C client stubs
 of the native library.  A ``GT_x`` line gives ``GTN_x(short core, ...)`` too;
@@ -132,6 +135,9 @@ class Proto:
     by_name: dict[str, Param] = field(default_factory=dict, compare=False, repr=False)
     group: str = ""  #: the NAME of the group file that declares it
     twin: bool = True  #: a ``GT_x`` line gives ``GTN_x`` (False: a ``GTN_x`` line of its own)
+    #: ``short GTN_x(...);``: the vendor DLL exports the name but no public header gives its
+    #: parameters (declared only; not in gts.h; the library exports it)
+    unknown: bool = False
 
     @property
     def gtn(self) -> bool:
@@ -226,6 +232,11 @@ def parse(text: str, group: str = "") -> dict[str, Proto]:
         name, args, comment = m[1], m[2].strip(), (m[3] or "").strip()
         if args == "void":
             args = ""
+        if args == "...":
+            if name in out:
+                raise ValueError(f"{where} {lineno}: {name} declared twice")
+            out[name] = Proto(name, (), entry=comment, group=group, twin=False, unknown=True)
+            continue
         params = tuple(_param(a, f"{where} {lineno} ({name})") for a in _split(args) if a.strip())
         names = {p.name for p in params}
         for p in params:
@@ -299,7 +310,7 @@ def collect(groups: Iterable) -> dict[str, Proto]:
 
 
 def _replace_twin(p: Proto) -> Proto:
-    return Proto(p.name, p.params, p.entry, p.core_first_form, p.by_name, p.group, twin=False)
+    return Proto(p.name, p.params, p.entry, p.core_first_form, p.by_name, p.group, False, p.unknown)
 
 
 def _merge(out: dict, owner: dict, g, table: dict[str, Proto], *, yield_to_owner: bool) -> None:

@@ -38,6 +38,8 @@ def prototypes(*, defaults: bool, abi: str = "") -> list[str]:
     (``abi="gts-multicard"``: ``GT_x`` with ``short cardNum`` first)."""
     out = []
     for proto in FUNCTIONS.values():
+        if proto.unknown:
+            continue  # exported by the library, parameters unknown: no prototype
         _check_defaults(proto)
         entry = proto.entry
         if entry[:1].isdigit():

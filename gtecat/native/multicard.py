@@ -20,7 +20,8 @@ ABI = "gts-multicard"
 
 
 def _gt(proto: Proto) -> bool:
-    return proto.name.startswith("GT_")
+    """A function that takes the card (not one whose parameters no header gives)."""
+    return proto.name.startswith("GT_") and not proto.unknown
 
 
 def _own_card(proto: Proto) -> bool:

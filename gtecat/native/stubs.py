@@ -192,6 +192,8 @@ def render_declared() -> str:
     lines += ["    {NULL, NULL, 0},", "};", ""]
     for i, plan in enumerate(declared):
         proto = plan.proto
+        if proto.unknown:  # no prototype in gts.h: the parameters are the caller's
+            lines.append(f"short {proto.name}(void);")
         lines += [
             proto.c_signature(defaults=False).replace("()", "(void)"),
             f"{{ return gte_declared({i}, 0, 1); }}",

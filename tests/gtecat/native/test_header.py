@@ -53,6 +53,8 @@ def _read(lines: list[str]) -> dict[str, list[tuple[str, str, str | None]]]:
 def _expected(functions, *, defaults: bool) -> dict[str, list[tuple[str, str, str | None]]]:
     out = {}
     for proto in functions.values():
+        if proto.unknown:  # the vendor DLL's name without public parameters: not in gts.h
+            continue
         ps = [
             (
                 ("const " if p.text and p.direction == "in" else "")  # input text: const char *

@@ -92,3 +92,22 @@ def test_the_multicard_abi(tmp_path):
     assert (v["prftrap"], v["prfmode_rc"], v["prfmode"]) == ("0", "0", "0")  # Trap is mode 0
     assert v["hsio"] == str(CMD_DECLARED)
     assert v["close"] == "0"
+
+
+def test_libgts_exports_every_name_of_the_table(libgts):
+    """`nm -D`: the vendor DLL's names (the table holds every one) are all exported."""
+    import shutil
+
+    from gtecat.gt.table import exported_names
+
+    if shutil.which("nm") is None:
+        pytest.skip("needs nm: apt-get install binutils")
+    out = subprocess.run(
+        ["nm", "-D", "--defined-only", str(libgts.library)], capture_output=True, text=True
+    ).stdout
+    symbols = {line.split()[-1] for line in out.splitlines() if " T " in line}
+    names = set(exported_names())
+    assert not names - symbols
+    assert len(names) > 2700  # the GTN-era vendor DLL exports 2,057 GT_/GTN_ names
+    for name in ("GTN_GetResCount", "GTN_MoveVelocity", "GT_SetHSIOOpt", "GTN_CrdBlendOn"):
+        assert name in symbols
