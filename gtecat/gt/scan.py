@@ -30,6 +30,7 @@ CONSTANT_PREFIXES = (
 _FUNCTION = re.compile(r"\bGTN?_[A-Za-z0-9_]+")
 _CONSTANT = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]+\b")
 _DECLARATION = re.compile(
+    r"^\s*[A-Z][A-Z0-9_]*\s*(?:=[^;]*)?,?\s*$|"  # an enum member of a vendor header
     r"\bGT_API\b|\bextern\s+(?:\"C\"\s+)?short\b|\bDeclare\s+(?:Function|Sub)\b|"
     r"^\s*#\s*define\b|\bconst\s+\w+\s+[A-Z][A-Z0-9_]*\s*=|\bConst\s+[A-Z][A-Z0-9_]*\b|"
     r"\bDllImport\b|^\s*(?:public\s+|private\s+|internal\s+)?static\s+extern\b",
