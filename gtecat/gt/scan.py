@@ -29,8 +29,9 @@ CONSTANT_PREFIXES = (
 
 _FUNCTION = re.compile(r"\bGTN?_[A-Za-z0-9_]+")
 _CONSTANT = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]+\b")
+#: an enum member line of a vendor header (``TIME_ELAPSE_PROFILE = 1000,``)
+_ENUM_MEMBER = re.compile(r"^\s*[A-Z][A-Z0-9]*_[A-Z0-9_]*\s*(?:=\s*[^;()]*)?,?\s*$")
 _DECLARATION = re.compile(
-    r"^\s*[A-Z][A-Z0-9_]*\s*(?:=[^;]*)?,?\s*$|"  # an enum member of a vendor header
     r"\bGT_API\b|\bextern\s+(?:\"C\"\s+)?short\b|\bDeclare\s+(?:Function|Sub)\b|"
     r"^\s*#\s*define\b|\bconst\s+\w+\s+[A-Z][A-Z0-9_]*\s*=|\bConst\s+[A-Z][A-Z0-9_]*\b|"
     r"\bDllImport\b|^\s*(?:public\s+|private\s+|internal\s+)?static\s+extern\b",
@@ -94,7 +95,7 @@ def scan(paths: Iterable[str | Path]) -> list[Use]:
             text = raw.decode("gbk", "replace")  # Chinese Windows sources
         text = _strip(text, f.suffix.lower() in (".vb", ".bas"))
         for lineno, line in enumerate(text.splitlines(), 1):
-            if "_" not in line or _DECLARATION.search(line):
+            if "_" not in line or _DECLARATION.search(line) or _ENUM_MEMBER.match(line):
                 continue
             for m in _FUNCTION.finditer(line):
                 name = m.group(0)
