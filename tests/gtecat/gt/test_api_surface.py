@@ -85,7 +85,7 @@ def test_scan_a_cpp_program(capsys):
     assert fns == {
         "GT_Open", "GT_Reset", "GT_LoadConfig", "GT_ClrSts", "GT_AxisOn", "GT_PrfTrap",
         "GT_GetSts", "GT_SetHSIOOpt", "GTN_GetResCount", "GT_MadeUpFunction",
-    }  # fmt: skip  (not the ones in a comment or a string)
+    }  # fmt: skip
     assert uses["GT_Open"].status == "emulated"
     assert uses["GT_SetHSIOOpt"].status == _status("GT_SetHSIOOpt") == "declared only"
     assert uses["GTN_GetResCount"].status == _status("GTN_GetResCount")

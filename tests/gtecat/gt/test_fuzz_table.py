@@ -3,12 +3,12 @@
 Every ``GT_*`` function, its ``GTN_*`` twin and every ``GTE_*`` helper is called by a
 hypothesis test with arguments generated from the table's parameter types, and a seeded
 sample of the declared-only functions (every one with ``GTECAT_LONG=1``) with anything at
-all: they must answer 8 (``fuzz_table_worker.py`` says what is generated and what each call must satisfy).
-A bad pointer could crash the interpreter, so the fuzzing runs in child processes, one
-per batch (all started at once in a plain run, one per test under pytest-xdist); the
-functions that take the bus down (GT_Close, GT_TerminateEcatComm, GTE_UnplugSlave, ...)
-have their own batch, restored after each call.  ``CI`` in the environment derandomises
-the children, as tests/conftest.py does here.
+all: they must answer 8 (``fuzz_table_worker.py`` says what is generated and what each
+call must satisfy). A bad pointer could crash the interpreter, so the fuzzing runs in
+child processes, one per batch (all started at once in a plain run, one per test under
+pytest-xdist); the functions that take the bus down (GT_Close, GT_TerminateEcatComm,
+GTE_UnplugSlave, ...) have their own batch, restored after each call. ``CI`` in the
+environment derandomises the children, as tests/conftest.py does here.
 
 Below them, the cases outside checkers found, as plain regression tests.
 """
