@@ -111,3 +111,13 @@ def test_libgts_exports_every_name_of_the_table(libgts):
     assert len(names) > 2700  # the GTN-era vendor DLL exports 2,057 GT_/GTN_ names
     for name in ("GTN_GetResCount", "GTN_MoveVelocity", "GT_SetHSIOOpt", "GTN_CrdBlendOn"):
         assert name in symbols
+
+
+@needs_cxx
+def test_the_ecat_demo_calls_compile_against_our_header(gts_h):
+    """CMD_SUCCESS, MC_AXIS, GTN_GetResCount, TMoveVelocityPrm and GTN_MoveVelocity, and the
+    vendor header's unsigned short * of GTN_GetEcatAxisMode / GTN_GetEcatHomingStatus."""
+    cmd = ["g++", "-std=c++11", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fsyntax-only"]
+    cmd += [f"-I{gts_h.parent}", str(C_DIR / "ecat_demo_style.cpp")]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
