@@ -157,3 +157,34 @@ def test_a_declared_call_writes_one_master_log_line(name, tmp_path):
         assert fn(1, 2) == CMD_DECLARED
     lines = [ln for ln in ctl.log.lines if f"{name} is declared but not emulated" in ln]
     assert len(lines) == 1, ctl.log.lines[-5:]
+
+
+def test_the_longer_csharp_home_prm_works_too():
+    """Eleven public C# wrappers declare THomePrm with three ints in pad3 where every C header
+    has two: 4 bytes longer.  The call reads and writes the C layout's bytes, so both work."""
+    import ctypes
+
+    class CSharpHomePrm(ctypes.Structure):  # the C# wrapper's layout
+        _fields_ = [
+            *[(f, ctypes.c_short) for f in ("mode", "moveDir", "indexDir", "edge", "triggerIndex")],
+            ("pad1", ctypes.c_short * 3),
+            *[(f, ctypes.c_double) for f in ("velHigh", "velLow", "acc", "dec")],
+            ("smoothTime", ctypes.c_short),
+            ("pad2", ctypes.c_short * 3),
+            *[(f, ctypes.c_int32) for f in ("homeOffset", "searchHomeDistance")],
+            *[(f, ctypes.c_int32) for f in ("searchIndexDistance", "escapeStep")],
+            ("pad3", ctypes.c_int32 * 3),
+        ]
+
+    assert ctypes.sizeof(CSharpHomePrm) > ctypes.sizeof(gt.THomePrm)  # 84 bytes, padded to 88
+    assert gt.GT_Open(card="gts:2", clock="lockstep", log="") == 0, gt.GTE_GetLastError()
+    prm = CSharpHomePrm()
+    prm.pad3[2] = 12345  # the C# tail the C layout does not have: left alone
+    assert gt.GT_GetHomePrm(1, ctypes.byref(prm)) == 0, gt.GTE_GetLastError()
+    assert prm.pad3[2] == 12345
+    prm.mode, prm.moveDir, prm.velHigh, prm.velLow, prm.acc, prm.dec = 20, 1, 10, 1, 0.5, 0.5
+    assert gt.GT_PrfTrap(1) == 0 and gt.GT_AxisOn(1) == 0
+    assert gt.GT_GoHome(1, ctypes.byref(prm)) == 0, gt.GTE_GetLastError()
+    back = CSharpHomePrm()
+    assert gt.GT_GetHomePrm(1, ctypes.byref(back)) == 0
+    assert (back.mode, back.velHigh) == (20, 10.0)
