@@ -48,6 +48,8 @@ LIBRARIES = {"": "libgts.so", "gts-multicard": "libgts_mc.so"}
 class Build:
     root: Path
     abi: str = ""
+    #: the libgts build a multi-card libgts_mc is a layer over (None for libgts itself)
+    base: Build | None = None
 
     @property
     def include_dir(self) -> Path:
@@ -72,7 +74,8 @@ class Build:
 
     def libs(self) -> list[str]:
         name = LIBRARIES[self.abi][3:-3]
-        return [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", f"-l{name}"]
+        own = [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", f"-l{name}"]
+        return own + (self.base.libs() if self.base is not None else [])
 
 
 def python_executable() -> str:
@@ -91,14 +94,20 @@ def sources(python: str, abi: str = "") -> dict[str, str]:
     pkg = resources.files("gtecat.native") / "csrc"
     for name in RUNTIME_SOURCES:
         out[name] = (pkg / name).read_text(encoding="utf-8")
-    if abi:
-        from . import multicard
-
-        out["gts_sc.h"] = out.pop("gts.h")  # the single-card header, inside the library
-        out["gts.h"] = header.render(abi)
-        out["gts_sc_rename.h"] = multicard.rename_h()
-        out["gts_multicard.c"] = multicard.render_c()
     return out
+
+
+def multicard_sources() -> dict[str, str]:
+    """The files of libgts_mc (a layer over libgts: :mod:`gtecat.native.multicard`)."""
+    from . import multicard
+
+    pkg = resources.files("gtecat.native") / "csrc"
+    return {
+        "gts.h": header.render(multicard.ABI),
+        "gts_sc.h": header.render(),
+        "gts_multicard.c": multicard.render_c(),
+        VENDOR_COMPAT: (pkg / VENDOR_COMPAT).read_text(encoding="utf-8"),
+    }
 
 
 def _digest(files: dict[str, str], cc: list[str]) -> str:
@@ -115,10 +124,15 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Build:
     if abi not in LIBRARIES:
         raise NativeBuildError(f"--abi {abi}: one of {', '.join(a for a in LIBRARIES if a)}")
     cc = compiler()
-    python = python_executable()
-    files = sources(python, abi)
+    base = None
+    if abi:
+        base = ensure_built(force=force)
+        files = multicard_sources()
+        files["base"] = str(base.root)  # the digest names the libgts it is a layer over
+    else:
+        files = sources(python_executable())
     version_dir = cache_root() / __version__
-    build = Build(version_dir / _digest(files, cc), abi)
+    build = Build(version_dir / _digest(files, cc), abi, base)
     if build.library.is_file() and build.header.is_file() and not force:
         return build
     version_dir = made_version_dir()
@@ -137,12 +151,12 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
         for d in (src, inc, lib):
             d.mkdir()
         for name, text in files.items():
+            if name == "base":
+                continue
             target = inc / name if name in INCLUDE_FILES else src / name
             target.write_text(text, encoding="utf-8")
         inside = [f"-I{inc}", f"-I{src}"]
-        if build.abi:  # the single-card functions renamed gte_sc_x, the header of src first
-            (src / "gts.h").write_text(files["gts_sc.h"], encoding="utf-8")
-            inside = [f"-I{src}", f"-I{inc}", "-include", str(src / "gts_sc_rename.h")]
+        link: list[str] = []
         # two units compiled side by side: the transport and the emulated functions'
         # stubs optimised, the ~2,000 one-line declared-only functions not (-O0 takes a
         # third of the time and they have nothing to optimise)
@@ -150,8 +164,9 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             (["gts_runtime.c", "gts_stubs.c"], CFLAGS),
             (["gts_declared.c"], (*CFLAGS, "-O0")),
         ]
-        if build.abi:
-            units.append((["gts_multicard.c"], (*CFLAGS, "-O0")))
+        if build.base is not None:  # libgts_mc: one unit over libgts
+            units = [(["gts_multicard.c"], (*CFLAGS, "-O0"))]
+            link = [*build.base.libs(), "-ldl"]
         procs = []
         for names, flags in units:
             for name in names:
@@ -168,6 +183,7 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             "-shared",
             f"-Wl,-soname,{build.library.name}",
             *objs,
+            *link,
             "-o",
             str(lib / build.library.name),
         ]
@@ -194,6 +210,7 @@ __all__ = [
     "cache_root",
     "compiler",
     "ensure_built",
+    "multicard_sources",
     "python_executable",
     "sources",
 ]

@@ -687,6 +687,8 @@ short gte_no_card(const char *name, short card, short code)
     pthread_mutex_lock(&g_mu);
     if (code == -6)
         set_err("%s returned -6: no card %d: the emulator is card 0", name, card);
+    else if (code == -7)
+        set_err("%s returned -7: libgts_mc found no %s in libgts", name, name);
     else
         set_err("%s returned %d: card %d is not open: the emulator is card 0", name, code, card);
     pthread_mutex_unlock(&g_mu);

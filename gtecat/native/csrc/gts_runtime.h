@@ -53,8 +53,9 @@ typedef struct gte_declared_info {
 GTE_INTERNAL extern const gte_declared_info gte_declared_table[]; /* gts_declared.c */
 GTE_INTERNAL short gte_declared(int index, int gtn, short core);
 
-/* the multi-card ABI given a card other than 0: code (-6 for GT_Open, else -1) with a reason */
-GTE_INTERNAL short gte_no_card(const char *name, short card, short code);
+/* the multi-card ABI (libgts_mc, a layer over this library) given a card other than 0:
+ * code (-6 for GT_Open, else -1) with a reason; exported for libgts_mc, not in gts.h */
+short gte_no_card(const char *name, short card, short code);
 
 /* the interpreter that built the library (generated beside the stubs) */
 GTE_INTERNAL extern const char gte_default_python[];
