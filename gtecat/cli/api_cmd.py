@@ -1,13 +1,15 @@
 """``gtecat api``: the GT API by group - what is emulated and what is declared only.
 
+Examples:
+
     gtecat api                       # every group: emulated / declared-only counts
     gtecat api --group ecat_axis     # one group's functions and prototypes
-    gtecat api --group ext_io --json
+    gtecat api --group vendor_io --json
     gtecat api --json                # the census as JSON
 
 Every function of the vendor's public headers is declared, so an application finds every
 name it calls; an emulated one runs on the emulator, a declared-only one returns 8
-(CMD_ERROR_UNKNOWN) with the reason in GTE_GetLastError.  `gtecat scan` checks an
+(CMD_ERROR_UNKNOWN) with the reason in GTE_GetLastError.  gtecat scan checks an
 application's sources against this census.
 """
 
@@ -24,7 +26,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "api",
         help="the GT API by group: emulated and declared-only functions",
-        description=__doc__,
+        description=__doc__.split("\n\n", 1)[1] if __doc__ else None,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--group", metavar="G", help="list the functions of group G")

@@ -1,8 +1,10 @@
 """``gtecat scan PATH...``: will this application run on gtecat?
 
-    gtecat scan MyMachine/              # a project folder (C, C++, C#, VB.NET)
-    gtecat scan main.cpp motion.cs      # files
-    gtecat scan --json src/ > use.json
+Examples:
+
+    gtecat example motion_demo_cpp -o demo && gtecat scan demo/   # a project folder
+    gtecat scan demo/motion_demo.cpp                  # files (C, C++, C#, VB.NET)
+    gtecat scan --json demo/ > use.json
 
 Lists every GT_/GTN_ function the sources call and every vendor constant they name, and
 says for each whether gtecat emulates it, declares it only (it returns 8,
@@ -21,12 +23,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "scan",
         help="which GT functions an application's sources use, and whether gtecat runs them",
-        description=__doc__,
+        description=__doc__.split("\n\n", 1)[1] if __doc__ else None,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("paths", nargs="+", metavar="PATH", help="source files or folders")
     p.add_argument("--json", action="store_true", help="machine-readable output")
-    p.add_argument("--all", action="store_true", help="list emulated ones too (default: all)")
     p.set_defaults(func=run)
 
 
