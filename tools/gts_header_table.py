@@ -143,9 +143,9 @@ def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
             # the multi-card ABI: the same functions with short cardNum first
             found = [(n, ps[1:] if ps and "cardNum" in ps[0] else ps) for n, ps in found]
             multi.extend(found)
-            continue
-        for name, ps in found:
-            functions.setdefault(name, ps)
+        else:
+            for name, ps in found:
+                functions.setdefault(name, ps)
         for k, v in typedefs.parse_constants(text, consts).items():
             consts.setdefault(k, v)
         body = re.sub(r"^\s*#.*$", "", text, flags=re.M)

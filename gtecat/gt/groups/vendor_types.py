@@ -166,6 +166,27 @@ typedef struct { OptimizeState usePathOptimize; float tolerance; OptimizeMethod 
 typedef struct { ErrorID errorID; long errorRowNum; } TErrorInfo;
 typedef struct { double Pos[8]; } TPreStartPos;
 typedef struct { UINT8 *databuf; UINT32 datalength; } Program_Prm;
+typedef struct { double machinePos[5]; double workPos[6]; } TPos;
+typedef struct { unsigned short doType; unsigned short doMask; unsigned short doValue; unsigned short delayTime; short fifo; } TBufIoDelayData;
+typedef struct { short doType; short doIndex; unsigned short highLevelTime; unsigned short lowLevelTime; long pulseNum; short firstLevel; short fifo; } TBufDoBitPulseData;
+typedef struct { short channel; short daValue; short fifo; } TBufDaData;
+typedef struct { short channel; short fifo; short source; double laserPower; double ratio; double minPower; double maxPower; short tableId; } TBufLaserData;
+typedef struct { short axis; double deltaPos; short fifo; short smoothFlag; short accPercent; short decPercent; } TBufGearData;
+typedef struct { short axis; double pos; double vel; double acc; short modal; short fifo; } TBufMoveData;
+typedef struct { long segNum; short fifo; } TBufSegNumData;
+typedef struct { short crdAxis; short masterIndex; short masterType; short fifo; } TBufFollowMasterData;
+typedef struct { long masterPos; long pad; short fifo; } TBufFollowEventCrossData;
+typedef struct { short triggerIndex; long triggerOffset; long pad; short fifo; } TBufFollowEventTriggerData;
+typedef struct { long masterSegment; long slaveSegment; long masterFrameWidth; short fifo; } TBufFollowStartData;
+typedef struct { long width; short fifo; } TBufFollowNextData;
+typedef struct { double vel; double acc; short smoothPercent; short fifo; } TBufFollowReturnData;
+typedef struct { short index; short enable; short fifo; } TBufSmartCutterData;
+typedef struct { short eventIndex; short count; short fifo; } TBufEventData;
+typedef struct { short century; short year; short month; short date; short day; short hour; short minutes; short seconds; } TRtcTime;
+typedef struct { short mask; short option; } TTaskCrdStop;
+typedef struct { short crd; double synVelOverride; } TTaskCrdOverride;
+typedef struct { TWatchVar var; unsigned short condition; double value; } TWatchCondition;
+typedef struct { unsigned short operation; unsigned short varType; unsigned short result; unsigned short lhs; unsigned short rhs; } TVarCalculate;
 """
 
 CONSTANTS = r"""
@@ -777,4 +798,30 @@ CONSTANTS = r"""
 #define AXIS_LIMIT_MAX_ACC 2
 #define AXIS_LIMIT_MAX_DV 4
 #define KIN_MSG_BUFFER_SIZE 32
+#define LA_MACHINE_AXIS_NUM 5
+#define USER_VAR_LENGTH 16
+#define WATCH_EVENT_MAX 8
+#define WATCH_ADDRESS_TYPE_POS_LOOP_REF_POS 34
+#define CRD_BUF_DATA_NULL 0
+#define WATCH_MODE_STATIC_BACKGROUND 10
+#define WATCH_MODE_LOOP_BACKGROUND 11
+#define WATCH_MODE_DYNAMIC_BACKGROUND 12
+#define WATCH_VAR_CRD_FOLLOW_SLAVE_POS 8600
+#define WATCH_VAR_CRD_FOLLOW_SLAVE_VEL 8601
+#define WATCH_VAR_CRD_FOLLOW_STAGE 8610
+#define WATCH_VAR_AXIS_ENC_POS 20003
+#define WATCH_VAR_ENC_VEL 30001
+#define WATCH_VAR_AUTO_FOCUS_OUT 34006
+#define WATCH_VAR_CONTROL_REF_VEL 41000
+#define WATCH_VAR_BOOL 52024
+#define TASK_CRD_STOP 16389
+#define TASK_CRD_OVERRIDE 16390
+#define VAR_CALCULATE_NONE 0
+#define VAR_CALCULATE_OR 1
+#define VAR_CALCULATE_AND 3
+#define VAR_CALCULATE_NOT 5
+#define VAR_CALCULATE_ADD 11
+#define VAR_CALCULATE_SUB 12
+#define VAR_CALCULATE_MUL 13
+#define VAR_CALCULATE_DIV 14
 """
