@@ -14,9 +14,32 @@ import pytest
 from gtecat import gt
 from gtecat.gt._core import CMD_DECLARED
 
-from .conftest import C_DIR, native_env, needs_cc, needs_cxx, run_client, tool_path, tool_pythonpath
+from .conftest import (
+    C_DIR,
+    FIG5_2,
+    native_env,
+    needs_cc,
+    needs_cxx,
+    run_client,
+    tool_path,
+    tool_pythonpath,
+)
 
 pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
+
+
+@pytest.fixture(scope="module")
+def controller(tmp_path_factory):
+    """One controller in this process for the module's C clients (they attach to it through
+    GTECAT_CONTROLLER instead of each starting a private one)."""
+    from gtecat.native.server import Server
+
+    gt.GT_Close()
+    assert gt.GT_Open(eni=str(FIG5_2), clock="auto", log="") == 0, gt.GTE_GetLastError()
+    address = f"unix:{tmp_path_factory.mktemp('ctl')}/controller.sock"
+    with Server(address):
+        yield address
+    gt.GT_Close()
 
 
 def _compile(src: Path, out: Path, compiler: str, lib_args: str, extra: str = "") -> Path:
@@ -32,7 +55,7 @@ def _compile(src: Path, out: Path, compiler: str, lib_args: str, extra: str = ""
 
 
 @needs_cxx
-def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, tmp_path):
+def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, controller, tmp_path):
     """__stdcall, extern "C" in GT_API, NULL defaults and UINT8 without any include: the
     forced include of --cflags supplies them; the header's own TTrapPrm matches ours."""
     exe = _compile(
@@ -42,7 +65,7 @@ def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, tmp_path):
         "--cflags --libs",
         extra=f"-I{C_DIR / 'vendor_style'}",  # its gts.h before gtecat's
     )
-    r, v = run_client(exe, env=native_env(), cwd=tmp_path)
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
     assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
     assert (v["open"], v["start"], v["version_rc"], v["clock_rc"]) == ("0",) * 4
     assert len(v["version"].split()) == 4  # table 11-3: aaa bbbbbb ccc dddddd
@@ -70,7 +93,7 @@ def test_declared_only_gives_the_same_answer_in_python():
     assert "GTN_SetHSIOOpt is declared" in gt.GTE_GetLastError()
 
 
-def test_the_multicard_abi(tmp_path):
+def test_the_multicard_abi(controller, tmp_path):
     """Manual-era GTS programs pass the card first; card 0 is the emulator."""
     from gtecat.native.build import NativeBuildError, ensure_built
 
@@ -82,7 +105,7 @@ def test_the_multicard_abi(tmp_path):
         C_DIR / "multicard_client.c", tmp_path / "mc", "gcc -Wall -Wextra",
         "--abi gts-multicard --cflags --libs",
     )  # fmt: skip
-    r, v = run_client(exe, env=native_env(), cwd=tmp_path)
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
     assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
     assert v["open_card1"] == "-6"
     assert "no card 1: the emulator is card 0" in v["open_card1_reason"]
