@@ -201,7 +201,7 @@ short Motion::home(Axis axis, short method)
         return ret;
     if (report("GT_StartEcatHoming", ret = GT_StartEcatHoming(short(axis))))
         return ret;
-    short status = 0;
+    unsigned short status = 0; // the vendor header: unsigned short *
     do
     {
         usleep(5 * 1000);

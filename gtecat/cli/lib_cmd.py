@@ -3,10 +3,17 @@
     gcc prog.c $(python3 -m gtecat lib --cflags --libs)
     g++ prog.cpp $(python3 -m gtecat lib --cflags --libs)
 
-``--cflags`` prints the include directory of ``gts.h``; ``--libs`` the ``-L``, the
+``--cflags`` prints the include directory of ``gts.h`` and a forced include
+(``gtecat_vendor.h``) with which the vendor's own header, as it ships for Windows, compiles
+too (``__stdcall``, NULL without <stddef.h>, Windows type names); ``--libs`` the ``-L``, the
 rpath (so the program finds ``libgts.so`` without ``LD_LIBRARY_PATH``) and ``-lgts``;
 ``--path`` the library itself (``ctypes.CDLL``).  The library is built on first use
 into a per-version cache (docs/native.md); with no C compiler this says so and exits 1.
+
+``--abi gts-multicard`` gives the older multi-card GTS ABI instead (``libgts_mc.so``, every
+``GT_x`` with ``short cardNum`` first; the emulator is card 0):
+
+    gcc prog.c $(python3 -m gtecat lib --abi gts-multicard --cflags --libs)
 """
 
 from __future__ import annotations
@@ -29,18 +36,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--include-dir", action="store_true", help="the directory of gts.h")
     p.add_argument("--header", action="store_true", help="print gts.h (generated, no build)")
     p.add_argument("--rebuild", action="store_true", help="compile again even if cached")
+    p.add_argument(
+        "--abi",
+        choices=["gtn", "gts-multicard"],
+        default="gtn",
+        help="gtn: the vendor's (one card, GTN twins; default); gts-multicard: the older "
+        "GTS header with short cardNum first (libgts_mc.so)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    abi = "" if args.abi == "gtn" else args.abi
     if args.header:
         from ..native.header import render
 
-        sys.stdout.write(render())
+        sys.stdout.write(render(abi))
         return 0
     from ..native.build import ensure_built
 
-    build = ensure_built(force=args.rebuild)
+    build = ensure_built(force=args.rebuild, abi=abi)
     words: list[str] = []
     if args.cflags:
         words += build.cflags()

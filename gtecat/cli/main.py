@@ -34,6 +34,8 @@ COMMANDS = (
     "lib_cmd",
     "compile_cmd",
     "sweep_cmd",
+    "api_cmd",
+    "scan_cmd",
 )
 
 

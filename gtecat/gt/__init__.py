@@ -53,3 +53,34 @@ for _name in _MODULES:
             globals()[_k] = _v
 
 globals().update(REGISTRY)
+
+
+def _vendor_surface() -> None:
+    """The groups' structures, enums and constants that no module above defines, and a
+    function for every declared-only name (it returns the declared code with a reason)."""
+    from . import typedefs
+    from .declared import declared_function
+    from .table import FUNCTIONS, GROUPS
+
+    g = globals()
+    existing = {k: v for k, v in g.items() if _is_public(k, v) and isinstance(v, type)}
+    tds = [td for grp in GROUPS for td in typedefs.parse(grp.structs, grp.name)]
+    built = typedefs.build(tds, existing)
+    for name, cls in built.classes.items():
+        g.setdefault(name, cls)
+    known = {k: v for k, v in g.items() if _is_public(k, v) and isinstance(v, int)}
+    for td in built.enums.values():
+        for member, value in td.members:
+            g.setdefault(member, value)
+    for grp in GROUPS:
+        for name, value in typedefs.parse_constants(grp.constants, known).items():
+            if name not in g:
+                g[name] = known[name] = value
+    for name, proto in FUNCTIONS.items():
+        if name not in REGISTRY:
+            for fn in declared_function(proto):
+                g[fn.__name__] = fn
+    typedefs.BUILT = built
+
+
+_vendor_surface()

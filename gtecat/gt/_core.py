@@ -39,7 +39,7 @@ from ..errors import (
 )
 from .args import Ref, binder, core_arg
 from .fast import READERS, fast_reader
-from .table import FUNCTIONS, NO_CORE_TWINS, Proto
+from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
 log = logging.getLogger("gtecat.gt")
@@ -54,6 +54,14 @@ CMD_NO_RESPONSE = -7
 ECAT_MISMATCH = -8
 ECAT_NO_ENI = -9
 ECAT_NO_SLAVES = -10
+#: what a function the table declares but gtecat does not emulate returns, whatever its
+#: arguments, from Python, libgts (C) and C# alike: the vendor header's
+#: ``CMD_ERROR_UNKNOWN`` (8, "unsupported command"), the code the vendor's own controller
+#: gives a command its firmware does not know.  Not 1 (a known command that failed, table
+#: 3-1) nor 7 (a bad argument): a caller can tell "not there" from "went wrong".  The
+#: reason (GTE_GetLastError) names the function and its group, and the master log says it
+#: once per function.
+CMD_DECLARED = 8
 
 #: exception type -> return code; first match wins (subclasses before bases)
 ERROR_CODES: tuple[tuple[type[BaseException], int], ...] = (
@@ -244,6 +252,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     REGISTRY[name] = gt
     if proto.gtn:
         own = NO_CORE_TWINS.get(name)
+        if name in SAME_PARAM_TWINS:  # GTN_Compile(pFileName, pWrongInfo): no core either
+            own = tuple((p.name, p.default or "") for p in proto.params)
         if own is not None:
             # the vendor's GTN_Open(channel=5, param=1) / GTN_Close(): no core; the core-first
             # form of earlier gtecat releases (one argument more, or core=) still works

@@ -1,6 +1,11 @@
 """The one function table: every GT function's C prototype and pointer contract.
 
-Each line below is a prototype as the vendor header writes it (``short`` return,
+The table is a package of group files (:mod:`gtecat.gt.groups`): each module there holds
+``NAME`` (a short id), ``TITLE`` (words) and ``PROTOTYPES``; adding a group is adding a
+file.  A function is *emulated* when the GT layer registers an implementation
+(``@gt_function``), else *declared* only (:func:`declared_only`).
+
+Each line of a group's ``PROTOTYPES`` is a prototype as the vendor header writes it (``short`` return,
 ``long`` stays ``long``, C++ default arguments), followed by the manual's
 chapter-13 entry.  A comment after a parameter states what C cannot say:
 
@@ -15,229 +20,26 @@ chapter-13 entry.  A comment after a parameter states what C cannot say:
 * ``mask``: a ``long`` bit mask (0 .. 2^32-1 accepted as well as negative longs);
 * ``lo..hi``: the legal range of a scalar (beyond the C type's own range).
 
+``short GTN_x(...);`` names a function the vendor DLL exports whose parameters no public
+header gives: it is declared only, exported by the library, and left out of ``gts.h``.
+
 Everything that handles arguments reads this table: the Python wrappers'
 checks (:mod:`gtecat.gt.args`), and the generated ``gts.h`` and C client stubs
 of the native library.  A ``GT_x`` line gives ``GTN_x(short core, ...)`` too;
 ``GTE_`` lines are the emulator's own functions (no ``GTN_`` twin).
 ``long`` is the vendor's 32-bit Windows ``long``: values are checked to 32 bits.
+
+A ``GTN_x`` line of its own declares a function of the vendor's GTN header that has no
+``GT_x`` line, or whose parameters differ from ``short core`` + those of ``GT_x`` (then
+the ``GT_x`` line gives no twin).  ``T **p`` (``char **pVersion``), ``void *`` and
+array parameters (``short axis[8]``: a pointer to 8) are read as the vendor writes them.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-
-PROTOTYPES = r"""
-// chapter 5 / 13: controller, EtherCAT bring-up
-short GT_Open(short channel=0, short param=1);                                   // 84
-short GT_Close();                                                                // 7
-short GT_Reset();                                                                // 96
-short GT_GetClock(unsigned long *pClock, unsigned long *pLoop=NULL);             // 33
-short GT_GetVersion(char *pVersion /*outstr[64]*/);                              // 78
-short GT_InitEcatComm();                                                         // 79
-short GT_StartEcatComm();                                                        // 129
-short GT_TerminateEcatComm();                                                    // 136
-short GT_IsEcatReady(short *pStatus);                                            // 80
-short GT_GetEcatSlaves(short *pSlaveCnt, short *pIoSlaveCnt=NULL);              // 45 (+ header)
-short GT_GetMcEcatAxisNum(short *pNum);                                          // 56
-short GT_GetEcatPdoLength(short *pLength);                                       // header
-short GT_GetEcatSlaveInfo(short slave, TSlaveInfo *pInfo);                       // header
-short GT_GetEcatRawData(unsigned short offset, unsigned short size, unsigned char *pValue /*out[size]*/);  // 44
-short GT_SetEcatRawData(unsigned short offset, unsigned short size, unsigned char *pValue /*in[size]*/);   // 104
-short GT_EcatIOReadInput(unsigned short slave, unsigned short offset, unsigned short nSize, unsigned char *pValue /*out[nSize]*/);  // 11 (core first too)
-short GT_EcatIOWriteOutput(unsigned short slave, unsigned short offset, unsigned short nSize, unsigned char *pValue /*in[nSize]*/);  // 12 (core first too)
-short GT_EcatIOBitWriteOutput(unsigned short slave, unsigned short offset, unsigned short bit /*0..7*/, unsigned char value /*0..1*/);  // header
-short GT_EcatIOSynch();                                                          // header
-short GT_EcatSDODownload(unsigned short slave_position, unsigned short index, unsigned char subindex, unsigned char *pData /*in[data_size]*/, unsigned long data_size, unsigned long *pAbort_code=NULL);  // 13
-short GT_EcatSDOUpload(unsigned short slave_position, unsigned short index, unsigned char subindex, unsigned char *pTarget /*out[target_size]*/, unsigned long target_size, unsigned long *pResult_size=NULL, unsigned long *pAbort_code=NULL);  // 14
-
-// chapter 5.2.2.1-3 / 13: EtherCAT axes, homing, touch probe
-short GT_AxisOn(short axis);                                                     // 5
-short GT_AxisOff(short axis);                                                    // 4
-short GT_SetEcatAxisMode(short axis, short mode);                                // 100
-short GT_GetEcatAxisMode(short axis, short *pMode);                              // 39
-short GT_GetEcatEncPos(short axis, long *pEncPos);                               // 41
-short GT_GetEcatEncVel(short axis, long *pEncVel);                               // 42
-short GT_GetEcatAxisPE(short axis, long *pPosErr);                               // 40
-short GT_GetEcatAxisDI(short axis, unsigned long *pDi);                          // 37
-short GT_GetEcatAxisDO(short axis, unsigned long *pDo);                          // 38
-short GT_GetEcatAxisAtITorque(short axis, short *pTorque);                       // 36
-short GT_GetEcatAxisAtICurrent(short axis, short *pCur);                         // 35
-short GT_GetEcatErrorCode(short axis, unsigned short *pErrorCode);               // header
-short GT_SetEcatAxisDO(short axis, unsigned long DoValue);                       // 99
-short GT_GetEcatAxisAI(short axis, short channel, short *pValue);                // 34
-short GT_SetEcatAxisPT(short axis, short torque);                                // 101
-short GT_SetEcatAxisPV(short axis, long velocity);                               // 102
-short GT_SetPosScale(short axis, unsigned short scale);                          // 117
-short GT_GetPosScale(short axis, unsigned short *pScale);                        // 61
-short GT_GetEcatAxisPdoData(short axis, unsigned short object, unsigned char *pData /*out[?]*/);  // header (the object's size)
-short GT_SetHomingMode(short axis, short mode);                                  // 112
-short GT_SetEcatHomingPrm(short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);  // 103
-short GT_StartEcatHoming(short axis);                                            // 130
-short GT_StopEcatHoming(short axis);                                             // 133
-short GT_GetEcatHomingStatus(short axis, short *pHomingStatus);                  // 43
-short GT_SetTouchProbeFunction(short axis, short ProbePrm);                      // 123
-short GT_SetTouchProbeFunctionEx(short axis, short Probe1Enable, short Probe1TriggerType, short Probe1TriggerLevel, short Probe2Enable, short Probe2TriggerType, short Probe2TriggerLevel);  // 124
-short GT_GetTouchProbeStatus(short axis, unsigned short *probeStatus /*opt*/, long *probe1RiseValue /*opt*/, long *probe1FallValue /*opt*/, long *probe2RiseValue /*opt*/, long *probe2FallValue /*opt*/);  // 73
-
-// chapter 7: profiles, Trap, Jog, positions
-short GT_PrfTrap(short profile);                                                 // 90
-short GT_PrfJog(short profile);                                                  // 88
-short GT_GetPrfMode(short profile, long *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 63
-short GT_SetTrapPrm(short profile, TTrapPrm *pPrm /*in*/);                       // 125
-short GT_GetTrapPrm(short profile, TTrapPrm *pPrm);                              // 74
-short GT_SetPos(short profile, long pos);                                        // 115
-short GT_GetPos(short profile, long *pPos);                                      // 59
-short GT_SetVel(short profile, double vel);                                      // 127
-short GT_GetVel(short profile, double *pVel);                                    // 77
-short GT_SetJogPrm(short profile, TJogPrm *pPrm /*in*/);                         // 113
-short GT_GetJogPrm(short profile, TJogPrm *pPrm);                                // 55
-short GT_Update(long mask /*mask*/);                                             // 137
-short GT_Stop(long mask /*mask*/, long option /*mask*/);                         // 131
-short GT_GetPrfPos(short profile, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 64
-short GT_GetPrfVel(short profile, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 65
-short GT_GetPrfAcc(short profile, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 62
-short GT_GetAxisPrfPos(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 31
-short GT_GetAxisPrfVel(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 32
-short GT_GetAxisPrfAcc(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 30
-short GT_GetAxisEncPos(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 27
-short GT_GetAxisEncVel(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 28
-short GT_GetAxisEncAcc(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 26
-short GT_GetAxisError(short axis, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 29
-short GT_GetEncPos(short encoder, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 46
-short GT_GetEncVel(short encoder, double *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 47
-short GT_SetEncPos(short encoder, long encPos);                                  // 105
-short GT_SetPrfPos(short profile, long prfPos);                                  // 118
-short GT_ZeroPos(short axis, short count=1);                                     // 138
-short GT_SynchAxisPos(long mask /*mask*/);                                       // 135
-
-// chapters 6, 9, 11: status, safety, configuration
-short GT_GetSts(short axis, long *pSts /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 71
-short GT_ClrSts(short axis, short count=1);                                      // 8
-short GT_AlarmOn(short axis);                                                    // 3
-short GT_AlarmOff(short axis);                                                   // 2
-short GT_LmtsOn(short axis, short limitType=-1);                                 // 82
-short GT_LmtsOff(short axis, short limitType=-1);                                // 81
-short GT_SetSoftLimit(short axis, long positive, long negative);                 // 121 (9.2.2)
-short GT_GetSoftLimit(short axis, long *pPositive, long *pNegative);             // 69
-short GT_SetPosErr(short control, long error);                                   // 116
-short GT_GetPosErr(short control, long *pError);                                 // 60
-short GT_SetStopDec(short profile, double decSmoothStop, double decAbruptStop);  // 122
-short GT_GetStopDec(short profile, double *pDecSmoothStop, double *pDecAbruptStop);  // 70
-short GT_SetAxisBand(short axis, long band, long time);                          // 98
-short GT_GetAxisBand(short axis, long *pBand, long *pTime);                      // 25
-short GT_ProfileScale(short axis, short alpha, short beta);                      // 91
-short GT_EncScale(short axis, short alpha, short beta);                          // 17
-short GT_EncSns(unsigned short sense);                                           // 18
-short GT_EncOn(short encoder);                                                   // 16
-short GT_EncOff(short encoder);                                                  // 15
-short GT_LoadConfig(char *pFile /*str*/);                                        // 83
-
-// chapter 7.4-7.6: PT, electronic gear, Follow
-short GT_PrfPt(short profile, short mode=0);                                     // 89
-short GT_PtData(short profile, double pos, long time, short type=0, short fifo=0);  // 93
-short GT_PtSpace(short profile, short *pSpace, short fifo=0);                    // 94
-short GT_PtClear(short profile, short fifo=0);                                   // 92
-short GT_PtStart(long mask /*mask*/, long option=0 /*mask*/);                    // 95
-short GT_SetPtLoop(short profile, long loop);                                    // 119
-short GT_GetPtLoop(short profile, long *pLoop);                                  // 66
-short GT_SetPtMemory(short profile, short memory);                               // 120
-short GT_GetPtMemory(short profile, short *pMemory);                             // 67
-short GT_GetPtRemainder(short profile, long *pRemainder);                        // 68
-short GT_PrfGear(short profile, short dir=0);                                    // 87
-short GT_SetGearMaster(short profile, short masterIndex, short masterType=2, short masterItem=0);  // 110
-short GT_GetGearMaster(short profile, short *pMasterIndex, short *pMasterType /*opt*/, short *pMasterItem /*opt*/);  // 53
-short GT_SetGearRatio(short profile, long masterEven, long slaveEven, long masterSlope=0);  // 111
-short GT_GetGearRatio(short profile, long *pMasterEven, long *pSlaveEven, long *pMasterSlope /*opt*/);  // 54
-short GT_GearStart(long mask /*mask*/);                                          // 24
-short GT_PrfFollow(short profile, short dir=0);                                  // 86
-short GT_SetFollowMaster(short profile, short masterIndex, short masterType=2, short masterItem=0);  // 108
-short GT_GetFollowMaster(short profile, short *pMasterIndex, short *pMasterType /*opt*/, short *pMasterItem /*opt*/);  // 50
-short GT_SetFollowLoop(short profile, long loop);                                // 107
-short GT_GetFollowLoop(short profile, long *pLoop);                              // 49
-short GT_SetFollowEvent(short profile, short event, short masterDir=1, long pos=0);  // 106
-short GT_GetFollowEvent(short profile, short *pEvent, short *pMasterDir /*opt*/, long *pPos /*opt*/);  // 48
-short GT_FollowData(short profile, long masterSegment, double slaveSegment, short type=0, short fifo=0);  // 20
-short GT_FollowSpace(short profile, short *pSpace, short fifo=0);                // 21
-short GT_FollowClear(short profile, short fifo=0);                               // 19
-short GT_FollowStart(long mask /*mask*/, long option=0 /*mask*/);                // 22
-short GT_FollowSwitch(long mask /*mask*/);                                       // 23
-short GT_SetFollowMemory(short profile, short memory);                           // 109
-short GT_GetFollowMemory(short profile, short *pMemory);                         // 51
-
-// chapter 10 / 11.8 / 12: motion programs, MRAM, MAC address
-short GT_Compile(char *pFileName /*str*/, TCompileInfo *pWrongInfo);              // 9
-short GT_Download(char *pFileName /*str*/);                                      // 10
-short GT_GetFunId(char *pFunName /*str*/, short *pFunId);                        // 52
-short GT_GetVarId(char *pFunName /*str opt*/, char *pVarName /*str*/, TVarInfo *pVarInfo);  // 75
-short GT_Bind(short thread /*0..31*/, short funId, short page /*0..31*/);       // 6
-short GT_RunThread(short thread /*0..31*/);                                      // 97
-short GT_StopThread(short thread /*0..31*/);                                     // 134
-short GT_PauseThread(short thread /*0..31*/);                                    // 85
-short GT_GetThreadSts(short thread /*0..31*/, TThreadSts *pThreadSts);           // 72
-short GT_SetVarValue(short page /*-1..31*/, TVarInfo *pVarInfo /*in*/, double *pValue /*in[count]*/, short count=1 /*1..6*/);  // 126
-short GT_GetVarValue(short page /*-1..31*/, TVarInfo *pVarInfo /*in*/, double *pValue /*out[count]*/, short count=1 /*1..6*/);  // 76
-short GT_SetMRAMData(short address /*0..4095*/, short *pData /*in[count]*/, short count /*1..24*/);  // 114
-short GT_GetMRAMData(short address /*0..4095*/, short *pData /*out[count]*/, short count /*1..24*/);  // 57
-short GT_StartAccessMRAM(short address /*0..4095*/, short count /*1..4096*/, short mode /*0..1*/);  // 128
-short GT_StopAccessMRAM();                                                       // 132
-short GT_GetMRAMStatus(short *pSts);                                             // 58
-short GetMacAddress(unsigned long ulAdapterNumber, unsigned char *pMacAddress /*out[ulAddressSize]*/, unsigned long ulAddressSize);  // 1 (chapter 12)
-short GT_GetMacAddress(unsigned long ulAdapterNumber, unsigned char *pMacAddress /*out[ulAddressSize]*/, unsigned long ulAddressSize);  // 1 (chapter 12, the GT_ spelling)
-
-// emulator only (no GTN_ twin)
-short GTE_Wait(double ms /*0..86400000*/);
-short GTE_UnplugSlave(short slave);
-short GTE_ReplugSlave(short slave);
-short GTE_GetMachinePos(short axis, double *pValue);
-short GTE_SetProgramSpeed(double instructionsPerMs /*1..10000000*/);
-short GTE_GetThreadError(short thread /*0..31*/, char *pText /*outstr[256]*/);
-
-// coordinated motion (interpolation, issue 19): coordinate systems, segment FIFOs, look-ahead (header)
-short GT_SetCrdPrm(short crd /*1..2*/, TCrdPrm *pCrdPrm /*in*/);                 // header
-short GT_GetCrdPrm(short crd /*1..2*/, TCrdPrm *pCrdPrm);                        // header
-short GT_CrdSpace(short crd /*1..2*/, long *pSpace, short fifo=0 /*0..1*/);      // header (table 10-2)
-short GT_CrdClear(short crd /*1..2*/, short fifo /*0..1*/);                       // header
-short GT_LnXY(short crd /*1..2*/, long x, long y, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_LnXYZ(short crd /*1..2*/, long x, long y, long z, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_LnXYZA(short crd /*1..2*/, long x, long y, long z, long aPos, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header (the vendor names it a: our C stubs use a)
-short GT_LnXYG0(short crd /*1..2*/, long x, long y, double synVel, double synAcc, short fifo=0 /*0..1*/);  // header
-short GT_ArcXYR(short crd /*1..2*/, long x, long y, double radius, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_ArcXYC(short crd /*1..2*/, long x, long y, double xCenter, double yCenter, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_ArcYZR(short crd /*1..2*/, long y, long z, double radius, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_ArcYZC(short crd /*1..2*/, long y, long z, double yCenter, double zCenter, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_ArcZXR(short crd /*1..2*/, long z, long x, double radius, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_ArcZXC(short crd /*1..2*/, long z, long x, double zCenter, double xCenter, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_HelixXYRZ(short crd /*1..2*/, long x, long y, long z, double radius, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_HelixXYCZ(short crd /*1..2*/, long x, long y, long z, double xCenter, double yCenter, short circleDir /*0..1*/, double synVel, double synAcc, double velEnd=0, short fifo=0 /*0..1*/);  // header
-short GT_BufIO(short crd /*1..2*/, unsigned short doType, unsigned short doMask, unsigned short doValue, short fifo=0 /*0..1*/);  // header
-short GT_BufDelay(short crd /*1..2*/, unsigned short delayTime, short fifo=0 /*0..1*/);  // header
-short GT_BufMove(short crd /*1..2*/, short moveAxis, long pos, double vel, double acc, short modal /*0..1*/, short fifo=0 /*0..1*/);  // header
-short GT_CrdStart(short mask, short option);                                     // header (table 10-2)
-short GT_CrdStatus(short crd /*1..2*/, short *pRun, long *pSegment, short fifo=0 /*0..1*/);  // header (table 10-2)
-short GT_GetCrdPos(short crd /*1..2*/, double *pPos /*out[?]*/);                  // header (dimension values)
-short GT_GetCrdVel(short crd /*1..2*/, double *pSynVel);                         // header (table 10-2)
-short GT_SetOverride(short crd /*1..2*/, double synVelRatio /*0..2*/);           // header (table 10-2)
-short GT_SetCrdStopDec(short crd /*1..2*/, double decSmoothStop, double decAbruptStop);  // header
-short GT_GetCrdStopDec(short crd /*1..2*/, double *pDecSmoothStop, double *pDecAbruptStop);  // header
-short GT_InitLookAhead(short crd /*1..2*/, short fifo /*0..1*/, double T, double accMax, short n /*1..32767*/, TCrdData *pLookAheadBuf /*opt*/);  // header
-
-// GTS pulse card (issue 14): card IO, encoder capture, smart home (vendor GTS header)
-short GT_GetDi(short diType, long *pValue);                                      // header (GTS)
-short GT_GetDiRaw(short diType, long *pValue);                                   // header (GTS)
-short GT_SetDo(short doType, long value);                                        // header (GTS)
-short GT_SetDoBit(short doType, short doIndex, short value /*0..1*/);            // header (GTS)
-short GT_GetDo(short doType, long *pValue);                                      // header (GTS)
-short GT_SetCaptureMode(short encoder, short mode /*0..3*/);                     // header (GTS)
-short GT_GetCaptureMode(short encoder, short *pMode /*out[count]*/, short count=1);  // header (GTS)
-short GT_GetCaptureStatus(short encoder, short *pStatus /*out[count]*/, long *pValue /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // header (GTS)
-short GT_SetCaptureSense(short encoder, short mode /*1..3*/, short sense /*0..1*/);  // header (GTS)
-short GT_ClearCaptureStatus(short encoder);                                      // header (GTS)
-short GT_GoHome(short axis, THomePrm *pHomePrm /*in*/);                          // header (GTS smart home)
-short GT_GetHomePrm(short axis, THomePrm *pHomePrm);                             // header (GTS smart home)
-short GT_GetHomeStatus(short axis, THomeStatus *pHomeStatus);                    // header (GTS smart home)
-short GTE_SetGpi(short gpi /*1..16*/, short value /*0..1*/);
-"""
 
 #: C scalar types: (ctypes name, lo, hi, is_float); ``long`` is the vendor's 32-bit long
 SCALARS: dict[str, tuple[str, int, int, bool]] = {
@@ -249,7 +51,22 @@ SCALARS: dict[str, tuple[str, int, int, bool]] = {
     "long": ("c_long", -(1 << 31), (1 << 31) - 1, False),
     "unsigned long": ("c_ulong", 0, (1 << 32) - 1, False),
     "double": ("c_double", 0, 0, True),
+    "signed char": ("c_byte", -128, 127, False),
+    "unsigned int": ("c_uint", 0, (1 << 32) - 1, False),
+    "float": ("c_float", 0, 0, True),
+    "long long": ("c_longlong", -(1 << 63), (1 << 63) - 1, False),
+    "unsigned long long": ("c_ulonglong", 0, (1 << 64) - 1, False),
+    "__int64": ("c_longlong", -(1 << 63), (1 << 63) - 1, False),
+    "int64_t": ("c_longlong", -(1 << 63), (1 << 63) - 1, False),
+    "int32_t": ("c_int", -(1 << 31), (1 << 31) - 1, False),
+    "uint32_t": ("c_uint", 0, (1 << 32) - 1, False),
+    "int16_t": ("c_short", -(1 << 15), (1 << 15) - 1, False),
+    "uint16_t": ("c_ushort", 0, 0xFFFF, False),
+    "uint8_t": ("c_ubyte", 0, 0xFF, False),
 }
+
+#: scalar types that are a C enum of a group's ``STRUCTS`` (an ``int`` on the wire)
+ENUMS: set[str] = set()
 
 
 @dataclass(frozen=True, slots=True)
@@ -268,6 +85,7 @@ class Param:
     hi: float | None = None
     default: str | None = None  #: the C++ default as written ("1", "NULL", "-1")
     comment: str = ""  #: the annotation as written, for the header
+    stars: int = 1  #: ``2`` for ``char **pVersion`` (pointers only)
 
     @property
     def is_float(self) -> bool:
@@ -275,7 +93,14 @@ class Param:
 
     @property
     def is_struct(self) -> bool:
-        return self.ctype not in SCALARS and self.ctype != "void"
+        return self.ctype not in SCALARS and self.ctype not in ENUMS and self.ctype != "void"
+
+    def c_decl(self) -> str:
+        """``const char *pFile`` / ``short axis`` / ``char **pVersion``."""
+        ctype = f"const {self.ctype}" if self.text and self.direction == "in" else self.ctype
+        if self.pointer:
+            return f"{ctype} {'*' * self.stars}{self.name}"
+        return f"{ctype} {self.name}"
 
     def default_value(self) -> int | float | None:
         """The default as a Python value (``NULL`` -> None); KeyError when there is none."""
@@ -294,6 +119,10 @@ NO_CORE_TWINS: dict[str, tuple[tuple[str, str], ...]] = {
     "GT_Close": (),
 }
 
+#: ``GT_x`` lines whose ``GTN_x`` twin takes the very same parameters (no core), as the
+#: vendor's GTN header declares them: the motion-program compiler runs on the host
+SAME_PARAM_TWINS: frozenset[str] = frozenset({"GT_Compile", "GT_GetFunId", "GT_GetVarId"})
+
 
 @dataclass(frozen=True, slots=True)
 class Proto:
@@ -304,10 +133,19 @@ class Proto:
     entry: str = ""  #: the manual's chapter-13 entry (or "header")
     core_first_form: bool = False  #: the manual also prints it with the core first (5.2.2.5)
     by_name: dict[str, Param] = field(default_factory=dict, compare=False, repr=False)
+    group: str = ""  #: the NAME of the group file that declares it
+    twin: bool = True  #: a ``GT_x`` line gives ``GTN_x`` (False: a ``GTN_x`` line of its own)
+    #: ``short GTN_x(...);``: the vendor DLL exports the name but no public header gives its
+    #: parameters (declared only; not in gts.h; the library exports it)
+    unknown: bool = False
 
     @property
     def gtn(self) -> bool:
-        return self.name.startswith("GT_")
+        return self.twin and self.name.startswith("GT_")
+
+    @property
+    def twin_name(self) -> str:
+        return "GTN_" + self.name[3:]
 
     def c_signature(self, *, defaults: bool, core: bool = False) -> str:
         """The prototype for ``gts.h`` (``core``: the ``GTN_`` twin).
@@ -321,10 +159,9 @@ class Proto:
                 f"short {n}={d}" if defaults else f"short {n}" for n, d in NO_CORE_TWINS[self.name]
             ]
             return f"short {name}({', '.join(own) or 'void'})"
-        parts = ["short core"] if core else []
+        parts = ["short core"] if core and self.name not in SAME_PARAM_TWINS else []
         for p in self.params:
-            ctype = f"const {p.ctype}" if p.text and p.direction == "in" else p.ctype
-            s = f"{ctype} *{p.name}" if p.pointer else f"{ctype} {p.name}"
+            s = p.c_decl()
             if defaults and p.default is not None:
                 s += f"={p.default}"
             parts.append(s)
@@ -333,7 +170,8 @@ class Proto:
 
 _LINE = re.compile(r"^short\s+(\w+)\s*\((.*)\)\s*;\s*(?://\s*(.*))?$")
 _PARAM = re.compile(
-    r"^(?P<const>const\s+)?(?P<type>(?:unsigned\s+)?\w+)\s*(?P<ptr>\*)?\s*(?P<name>\w+)"
+    r"^(?P<const>const\s+)?(?P<type>(?:(?:unsigned|signed)\s+)?(?:long\s+long|\w+))\s*"
+    r"(?P<ptr>\*{0,2})\s*(?P<name>\w+)\s*(?:\[(?P<dim>\d*)\])?"
     r"\s*(?:=\s*(?P<default>[\w.+-]+))?\s*(?:/\*(?P<note>[^*]*)\*/)?$"
 )
 _COUNT = re.compile(r"^(in|out|inout|outstr)(?:\[(\w+|\?)\])?$")
@@ -345,12 +183,19 @@ def _param(text: str, where: str) -> Param:
     if not m:
         raise ValueError(f"{where}: cannot read parameter {text!r}")
     ctype = re.sub(r"\s+", " ", m["type"])
-    pointer = bool(m["ptr"])
+    stars = len(m["ptr"])
+    dim = m["dim"]
+    pointer = stars > 0 or dim is not None
     note = (m["note"] or "").split()
     kw: dict = {"default": m["default"], "comment": m["note"] or ""}
     if pointer:
         kw["direction"] = "in" if m["const"] else "out"
-        kw["optional"] = m["default"] == "NULL"
+        kw["optional"] = m["default"] in ("NULL", "0") and stars > 0
+        kw["stars"] = max(stars, 1)
+        if dim:  # short axis[8]: a pointer to 8
+            kw["count"] = int(dim)
+        if stars > 1 or ctype == "void":
+            kw["count"] = 0  # what a T ** or a void * holds only the call knows
     for word in note:
         if c := _COUNT.match(word):
             kind, count = c.groups()
@@ -368,38 +213,53 @@ def _param(text: str, where: str) -> Param:
             kw["lo"], kw["hi"] = float(r[1]), float(r[2])
         else:
             raise ValueError(f"{where}: unknown annotation {word!r}")
-    if not pointer and ctype not in SCALARS:
-        raise ValueError(f"{where}: scalar type {ctype!r} unknown")
+    if not pointer and ctype not in SCALARS and ctype not in ENUMS and not ctype.startswith("T"):
+        raise ValueError(f"{where}: scalar type {ctype!r} unknown")  # T...: a structure by value
     return Param(m["name"], ctype, pointer, **kw)
 
 
-def parse(text: str) -> dict[str, Proto]:
+def parse(text: str, group: str = "") -> dict[str, Proto]:
     """The prototypes of ``text`` by name (ValueError names the line it cannot read)."""
     out: dict[str, Proto] = {}
+    where = f"group {group}, line" if group else "table line"
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line or line.startswith("//"):
             continue
         m = _LINE.match(line)
         if not m:
-            raise ValueError(f"table line {lineno}: not a prototype: {line!r}")
+            raise ValueError(f"{where} {lineno}: not a prototype: {line!r}")
         name, args, comment = m[1], m[2].strip(), (m[3] or "").strip()
-        params = tuple(
-            _param(a, f"table line {lineno} ({name})") for a in _split(args) if a.strip()
-        )
+        if args == "void":
+            args = ""
+        if args == "...":
+            if name in out:
+                raise ValueError(f"{where} {lineno}: {name} declared twice")
+            out[name] = Proto(name, (), entry=comment, group=group, twin=False, unknown=True)
+            continue
+        params = tuple(_param(a, f"{where} {lineno} ({name})") for a in _split(args) if a.strip())
         names = {p.name for p in params}
         for p in params:
             if isinstance(p.count, str) and p.count not in names:
-                raise ValueError(f"table line {lineno}: {p.name} counts by unknown {p.count!r}")
+                raise ValueError(f"{where} {lineno}: {p.name} counts by unknown {p.count!r}")
+        if len(names) != len(params):
+            raise ValueError(f"{where} {lineno}: {name} names a parameter twice")
         if name in out:
-            raise ValueError(f"table line {lineno}: {name} declared twice")
+            raise ValueError(f"{where} {lineno}: {name} declared twice")
         out[name] = Proto(
             name,
             params,
             entry=comment,
             core_first_form="core first" in comment,
             by_name={p.name: p for p in params},
+            group=group,
+            # the vendor's GT_x that take the core themselves (GT_SetCore(short core)) have
+            # no GTN_x twin
+            twin=not (params and params[0].name == "core"),
         )
+    for name in out:  # GT_x beside a GTN_x line of its own: no twin
+        if name.startswith("GTN_") and "GT_" + name[4:] in out:
+            out["GT_" + name[4:]] = _replace_twin(out["GT_" + name[4:]])
     return out
 
 
@@ -422,6 +282,119 @@ def _split(args: str) -> list[str]:
     return parts
 
 
-FUNCTIONS: dict[str, Proto] = parse(PROTOTYPES)
+def collect(groups: Iterable) -> dict[str, Proto]:
+    """Every group's prototypes in one table (:mod:`gtecat.gt.groups` gives the groups).
 
-__all__ = ["FUNCTIONS", "PROTOTYPES", "SCALARS", "Param", "Proto", "parse"]
+    A name that two groups declare is an error naming both, except that a *vendor*
+    group (``DECLARED_ONLY = True``: the vendor header's declarations, read by
+    ``tools/gts_header_table.py``) yields to a group that owns the function: the owner's
+    line is the one followed.  A ``GTN_x`` line of its own takes the twin of ``GT_x``.
+    """
+    out: dict[str, Proto] = {}
+    owner: dict[str, object] = {}
+    vendor: list[tuple[object, dict[str, Proto]]] = []
+    for g in groups:
+        table = parse(g.prototypes, g.name)
+        if g.declared_only:
+            vendor.append((g, table))
+            continue
+        _merge(out, owner, g, table, yield_to_owner=False)
+    for g, table in vendor:
+        _merge(out, owner, g, table, yield_to_owner=True)
+    for name in list(out):
+        if name.startswith("GTN_") and ("GT_" + name[4:]) in out:
+            gt = out["GT_" + name[4:]]
+            if gt.gtn:
+                out[gt.name] = _replace_twin(gt)
+    return out
+
+
+def _replace_twin(p: Proto) -> Proto:
+    return Proto(p.name, p.params, p.entry, p.core_first_form, p.by_name, p.group, False, p.unknown)
+
+
+def _merge(out: dict, owner: dict, g, table: dict[str, Proto], *, yield_to_owner: bool) -> None:
+    twins = {p.twin_name: p for p in out.values() if p.gtn}
+    for name, proto in table.items():
+        taken = owner.get(name)
+        if taken is None and name.startswith("GTN_") and name in twins:
+            taken = owner.get(twins[name].name)  # the GT_x line of another group gives it
+        if taken is None and proto.gtn and proto.twin_name in out:
+            taken = owner.get(proto.twin_name)
+        if taken is not None:
+            if yield_to_owner and not taken.declared_only:
+                continue
+            raise ValueError(
+                f"{name} is declared in two groups: {taken.name} "
+                f"({taken.module}) and {g.name} ({g.module}); delete one of the lines"
+            )
+        out[name] = proto
+        owner[name] = g
+
+
+def _load() -> tuple[tuple, dict[str, Proto]]:
+    from . import groups as _groups
+    from .typedefs import enum_names
+
+    found = _groups.groups()
+    ENUMS.update(enum_names(found))
+    return found, collect(found)
+
+
+#: every group of the table (:class:`gtecat.gt.groups.Group`), in file-name order
+GROUPS, FUNCTIONS = _load()
+#: the table's text, every group's lines in group order (the protocol digest reads it)
+PROTOTYPES: str = "\n".join(f"// group {g.name}\n{g.prototypes}" for g in GROUPS)
+
+
+def group_of(name: str):
+    """The group that declares ``name`` (``GT_x``, its ``GTN_x`` twin, ``GTE_x``)."""
+    proto = FUNCTIONS.get(name)
+    if proto is None and name.startswith("GTN_"):
+        proto = FUNCTIONS.get("GT_" + name[4:])
+    if proto is None:
+        raise KeyError(name)
+    return next(g for g in GROUPS if g.name == proto.group)
+
+
+def emulated() -> frozenset[str]:
+    """The table's names (``GT_x``/``GTE_x`` lines) that the GT layer implements."""
+    from . import REGISTRY  # importing gtecat.gt registers every @gt_function
+
+    return frozenset(n for n in FUNCTIONS if n in REGISTRY)
+
+
+def declared_only() -> tuple[str, ...]:
+    """The table's names that no implementation registers: calling one returns
+    :data:`gtecat.gt._core.CMD_DECLARED` with a reason."""
+    done = emulated()
+    return tuple(n for n in FUNCTIONS if n not in done)
+
+
+def exported_names() -> list[str]:
+    """Every function name the table gives the native library (``GT_x``, its twin)."""
+    out = []
+    for p in FUNCTIONS.values():
+        out.append(p.name)
+        if p.gtn:
+            out.append(p.twin_name)
+    return out
+
+
+__all__ = [
+    "ENUMS",
+    "FUNCTIONS",
+    "GROUPS",
+    "NO_CORE_TWINS",
+    "PROTOTYPES",
+    "SAME_PARAM_TWINS",
+    "SCALARS",
+    "Param",
+    "Proto",
+    "collect",
+    "declared_only",
+    "emulated",
+    "exported_names",
+    "group_of",
+    "parse",
+]

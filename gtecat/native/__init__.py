@@ -33,21 +33,30 @@ def cdll():
     """
     import ctypes
 
-    from ..gt.table import FUNCTIONS, NO_CORE_TWINS, SCALARS
+    from .. import gt
+    from ..gt.table import ENUMS, FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, SCALARS
 
     lib = ctypes.CDLL(str(library_path()))
 
     def ctype(p):
         if p.pointer:
             return ctypes.c_void_p
-        return getattr(ctypes, SCALARS[p.ctype][0])
+        if p.ctype in ENUMS:
+            return ctypes.c_int
+        if p.ctype in SCALARS:
+            return getattr(ctypes, SCALARS[p.ctype][0])
+        return getattr(gt, p.ctype, None)  # a structure by value (None: argtypes unset)
 
     for proto in FUNCTIONS.values():
         types = [ctype(p) for p in proto.params]
+        if None in types:
+            continue
         names = [(proto.name, types)]
         if proto.name in NO_CORE_TWINS:
             own = [ctypes.c_short] * len(NO_CORE_TWINS[proto.name])
             names.append(("GTN_" + proto.name[3:], own))
+        elif proto.name in SAME_PARAM_TWINS:
+            names.append(("GTN_" + proto.name[3:], types))
         elif proto.gtn:
             names.append(("GTN_" + proto.name[3:], [ctypes.c_short, *types]))
         for name, argtypes in names:

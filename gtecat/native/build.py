@@ -2,7 +2,8 @@
 
 ``pip install`` needs no C compiler: nothing is compiled until a program asks for
 the library (``python3 -m gtecat lib ...``, :func:`gtecat.native.library_path`).
-The build writes the generated sources (``gts.h``, ``gts_wire.h``, ``gts_stubs.c``)
+The build writes the generated sources (``gts.h``, ``gts_wire.h``, ``gts_stubs.c``,
+``gts_declared.c``)
 and the hand-written transport (``csrc/``) into
 ``$GTECAT_CACHE_DIR`` (else ``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``)
 ``/<version>/<digest>/`` and compiles them there with ``$CC`` (else ``cc``, ``gcc``,
@@ -31,13 +32,24 @@ from ..cbuild import NativeBuildError, cache_root, compiler
 from ..cbuild import version_dir as made_version_dir
 from . import header, stubs
 
-RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h")
+RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h", "gtecat_vendor.h")
+#: files that go beside gts.h (the rest are the library's sources)
+INCLUDE_FILES = ("gts.h", "gtecat_vendor.h")
+#: the file ``--cflags`` force-includes so a vendor header compiles unchanged
+VENDOR_COMPAT = "gtecat_vendor.h"
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-pthread")
+
+
+#: the library of each ABI: the vendor's (GTN era, one card) and the older multi-card GTS one
+LIBRARIES = {"": "libgts.so", "gts-multicard": "libgts_mc.so"}
 
 
 @dataclass(frozen=True, slots=True)
 class Build:
     root: Path
+    abi: str = ""
+    #: the libgts build a multi-card libgts_mc is a layer over (None for libgts itself)
+    base: Build | None = None
 
     @property
     def include_dir(self) -> Path:
@@ -49,17 +61,21 @@ class Build:
 
     @property
     def library(self) -> Path:
-        return self.lib_dir / "libgts.so"
+        return self.lib_dir / LIBRARIES[self.abi]
 
     @property
     def header(self) -> Path:
         return self.include_dir / "gts.h"
 
     def cflags(self) -> list[str]:
-        return [f"-I{self.include_dir}"]
+        """``-I`` for gts.h, and the forced include that lets the vendor's own header
+        compile unchanged (``__stdcall``, NULL, Windows type names: gtecat_vendor.h)."""
+        return [f"-I{self.include_dir}", "-include", str(self.include_dir / VENDOR_COMPAT)]
 
     def libs(self) -> list[str]:
-        return [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", "-lgts"]
+        name = LIBRARIES[self.abi][3:-3]
+        own = [f"-L{self.lib_dir}", f"-Wl,-rpath,{self.lib_dir}", f"-l{name}"]
+        return own + (self.base.libs() if self.base is not None else [])
 
 
 def python_executable() -> str:
@@ -67,17 +83,31 @@ def python_executable() -> str:
     return os.environ.get("GTECAT_PYTHON") or sys.executable or "python3"
 
 
-def sources(python: str) -> dict[str, str]:
+def sources(python: str, abi: str = "") -> dict[str, str]:
     """Every file of the build, by name."""
     out = {
         "gts.h": header.render(),
         "gts_wire.h": stubs.render_wire_h(),
         "gts_stubs.c": stubs.render_stubs(python),
+        "gts_declared.c": stubs.render_declared(),
     }
     pkg = resources.files("gtecat.native") / "csrc"
     for name in RUNTIME_SOURCES:
         out[name] = (pkg / name).read_text(encoding="utf-8")
     return out
+
+
+def multicard_sources() -> dict[str, str]:
+    """The files of libgts_mc (a layer over libgts: :mod:`gtecat.native.multicard`)."""
+    from . import multicard
+
+    pkg = resources.files("gtecat.native") / "csrc"
+    return {
+        "gts.h": header.render(multicard.ABI),
+        "gts_sc.h": header.render(),
+        "gts_multicard.c": multicard.render_c(),
+        VENDOR_COMPAT: (pkg / VENDOR_COMPAT).read_text(encoding="utf-8"),
+    }
 
 
 def _digest(files: dict[str, str], cc: list[str]) -> str:
@@ -88,13 +118,21 @@ def _digest(files: dict[str, str], cc: list[str]) -> str:
     return h.hexdigest()[:12]
 
 
-def ensure_built(*, force: bool = False) -> Build:
-    """The build for this gtecat, compiled now if it is not in the cache yet."""
+def ensure_built(*, force: bool = False, abi: str = "") -> Build:
+    """The build for this gtecat, compiled now if it is not in the cache yet
+    (``abi="gts-multicard"``: libgts_mc.so, :mod:`gtecat.native.multicard`)."""
+    if abi not in LIBRARIES:
+        raise NativeBuildError(f"--abi {abi}: one of {', '.join(a for a in LIBRARIES if a)}")
     cc = compiler()
-    python = python_executable()
-    files = sources(python)
+    base = None
+    if abi:
+        base = ensure_built(force=force)
+        files = multicard_sources()
+        files["base"] = str(base.root)  # the digest names the libgts it is a layer over
+    else:
+        files = sources(python_executable())
     version_dir = cache_root() / __version__
-    build = Build(version_dir / _digest(files, cc))
+    build = Build(version_dir / _digest(files, cc), abi, base)
     if build.library.is_file() and build.header.is_file() and not force:
         return build
     version_dir = made_version_dir()
@@ -113,27 +151,44 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
         for d in (src, inc, lib):
             d.mkdir()
         for name, text in files.items():
-            target = inc / name if name == "gts.h" else src / name
+            if name == "base":
+                continue
+            target = inc / name if name in INCLUDE_FILES else src / name
             target.write_text(text, encoding="utf-8")
+        inside = [f"-I{inc}", f"-I{src}"]
+        link: list[str] = []
+        # two units compiled side by side: the transport and the emulated functions'
+        # stubs optimised, the ~2,000 one-line declared-only functions not (-O0 takes a
+        # third of the time and they have nothing to optimise)
+        units = [
+            (["gts_runtime.c", "gts_stubs.c"], CFLAGS),
+            (["gts_declared.c"], (*CFLAGS, "-O0")),
+        ]
+        if build.base is not None:  # libgts_mc: one unit over libgts
+            units = [(["gts_multicard.c"], (*CFLAGS, "-O0"))]
+            link = [*build.base.libs(), "-ldl"]
+        procs = []
+        for names, flags in units:
+            for name in names:
+                cmd = [*cc, *flags, "-c", *inside, str(src / name)]
+                cmd += ["-o", str(src / (name[:-2] + ".o"))]
+                procs.append((cmd, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
+        for cmd, proc in procs:
+            _, err = proc.communicate()
+            _check(cmd, proc.returncode, err)
+        objs = [str(src / (n[:-2] + ".o")) for names, _ in units for n in names]
         cmd = [
             *cc,
             *CFLAGS,
             "-shared",
-            "-Wl,-soname,libgts.so",
-            f"-I{inc}",
-            f"-I{src}",
-            str(src / "gts_runtime.c"),
-            str(src / "gts_stubs.c"),
+            f"-Wl,-soname,{build.library.name}",
+            *objs,
+            *link,
             "-o",
-            str(lib / "libgts.so"),
+            str(lib / build.library.name),
         ]
         r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            raise NativeBuildError(
-                f"building libgts failed ({shlex.join(cmd)}):\n{r.stderr.strip()}"
-            )
-        if r.stderr.strip():
-            raise NativeBuildError(f"building libgts warned (it must not):\n{r.stderr.strip()}")
+        _check(cmd, r.returncode, r.stderr)
         if build.root.exists():
             shutil.rmtree(build.root)
         tmp.rename(build.root)
@@ -142,12 +197,20 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             shutil.rmtree(tmp)
 
 
+def _check(cmd: list[str], returncode: int, stderr: str) -> None:
+    if returncode != 0:
+        raise NativeBuildError(f"building libgts failed ({shlex.join(cmd)}):\n{stderr.strip()}")
+    if stderr.strip():
+        raise NativeBuildError(f"building libgts warned (it must not):\n{stderr.strip()}")
+
+
 __all__ = [
     "Build",
     "NativeBuildError",
     "cache_root",
     "compiler",
     "ensure_built",
+    "multicard_sources",
     "python_executable",
     "sources",
 ]

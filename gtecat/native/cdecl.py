@@ -56,7 +56,7 @@ def _base_and_dims(t: type) -> tuple[type, list[int]]:
 
 def c_type(t: type, where: str = "") -> str:
     """The C spelling of a ctypes element type (no array dimensions)."""
-    if issubclass(t, ctypes.Structure):
+    if issubclass(t, ctypes.Structure | ctypes.Union):
         return t.__name__
     if issubclass(t, ctypes._Pointer):
         return c_type(t._type_, where) + " *"
@@ -85,7 +85,7 @@ def has_pointers(cls: type[ctypes.Structure]) -> bool:
             issubclass(base, ctypes._SimpleCData) and base._type_ in "zZP"
         ):
             return True
-        if issubclass(base, ctypes.Structure) and has_pointers(base):
+        if issubclass(base, ctypes.Structure | ctypes.Union) and has_pointers(base):
             return True
     return False
 
@@ -95,7 +95,7 @@ def _deps(cls: type[ctypes.Structure]) -> Iterator[type[ctypes.Structure]]:
         base, _ = _base_and_dims(t)
         while issubclass(base, ctypes._Pointer):
             base = base._type_
-        if issubclass(base, ctypes.Structure):
+        if issubclass(base, ctypes.Structure | ctypes.Union):
             yield base
 
 
@@ -106,7 +106,9 @@ def structures() -> list[type[ctypes.Structure]]:
     found = {
         v.__name__: v
         for k, v in vars(gt).items()
-        if k.startswith("T") and isinstance(v, type) and issubclass(v, ctypes.Structure)
+        if k.startswith("T")
+        and isinstance(v, type)
+        and issubclass(v, ctypes.Structure | ctypes.Union)
     }
     out: list[type[ctypes.Structure]] = []
     seen: set[str] = set()
@@ -144,7 +146,8 @@ def struct_decl(cls: type[ctypes.Structure]) -> str:
     if doc:
         text = doc[0].replace("``", "").replace("*/", "* /")
         lines.append(f"/* {text} */")
-    lines.append(f"typedef struct {where} {{")
+    kind = "union" if issubclass(cls, ctypes.Union) else "struct"
+    lines.append(f"typedef {kind} {where} {{")
     for spec in cls._fields_:
         if len(spec) != 2:
             raise CDeclError(f"{where}.{spec[0]}: bit fields are not supported")
@@ -182,14 +185,25 @@ class Constant:
 def constants() -> list[Constant]:
     """The constants ``gt`` exports (DESIGN.md "The stable surface"), in definition order."""
     from .. import gt
+    from ..gt import typedefs
 
+    members = {n for td in typedefs.BUILT.enums.values() for n, _ in td.members}
     out = []
     for k, v in vars(gt).items():
-        if k.startswith("_") or k.startswith(("GT_", "GTN_", "GTE_")):
+        if k.startswith("_") or k.startswith(("GT_", "GTN_", "GTE_")) or k in members:
             continue
         if k.isupper() and len(k) > 1 and isinstance(v, int | float | str):
             out.append(Constant(k, v))
     return out
+
+
+def enums() -> list[str]:
+    """``typedef enum`` of every enum the groups declare (their members are not
+    ``#define``d: C++ code passes them where the prototype names the enum)."""
+    from .. import gt  # noqa: F401 - builds typedefs.BUILT
+    from ..gt import typedefs
+
+    return [typedefs.enum_decl(td) for td in typedefs.BUILT.enums.values()]
 
 
 def layout_text() -> str:
@@ -217,6 +231,7 @@ __all__ = [
     "c_type",
     "constants",
     "digest",
+    "enums",
     "field_decl",
     "has_pointers",
     "layout_text",

@@ -33,10 +33,13 @@ def _check_defaults(proto: Proto) -> None:
             )
 
 
-def prototypes(*, defaults: bool) -> list[str]:
-    """Every declaration, ``GT_x`` then ``GTN_x`` per table line, table order."""
+def prototypes(*, defaults: bool, abi: str = "") -> list[str]:
+    """Every declaration, ``GT_x`` then ``GTN_x`` per table line, table order
+    (``abi="gts-multicard"``: ``GT_x`` with ``short cardNum`` first)."""
     out = []
     for proto in FUNCTIONS.values():
+        if proto.unknown:
+            continue  # exported by the library, parameters unknown: no prototype
         _check_defaults(proto)
         entry = proto.entry
         if entry[:1].isdigit():
@@ -45,7 +48,11 @@ def prototypes(*, defaults: bool) -> list[str]:
             entry = "vendor header"
         note = f"  /* {entry} */" if entry else ""
         sig = proto.c_signature(defaults=defaults)
-        if not defaults and not proto.params:
+        if abi and proto.name.startswith("GT_"):
+            from .multicard import prototype
+
+            sig = prototype(proto, defaults=defaults)
+        elif not defaults and not proto.params:
             sig = sig.replace("()", "(void)")  # a C prototype, not an old-style declaration
         out.append(sig + ";" + note)
         if proto.gtn:
@@ -53,8 +60,8 @@ def prototypes(*, defaults: bool) -> list[str]:
     return out
 
 
-def render() -> str:
-    """The text of ``gts.h``."""
+def render(abi: str = "") -> str:
+    """The text of ``gts.h`` (``abi="gts-multicard"``: the older multi-card GTS shape)."""
     lines = [
         f"/* gts.h - the GT API of gtecat {__version__} (table {table_digest()}).",
         " *",
@@ -70,6 +77,14 @@ def render() -> str:
         " * they are spelled `int` here so the layout is the same on every platform.",
         " * Function parameters keep `long`; values must fit in 32 bits.",
         " */",
+        *(
+            [
+                "/* The multi-card GTS ABI (gtecat lib --abi gts-multicard): every GT_x takes",
+                " * short cardNum first; the emulator is card 0. */",
+            ]
+            if abi
+            else []
+        ),
         f"#ifndef {GUARD}",
         f"#define {GUARD}",
         "",
@@ -81,9 +96,18 @@ def render() -> str:
         "/* ---- constants ---- */",
     ]
     lines += [c.define() for c in cdecl.constants()]
+    lines += ["", "/* ---- enums ---- */"]
+    lines += cdecl.enums()
     lines += ["", "/* ---- structures ---- */"]
+    known = set()
     for cls in cdecl.structures():
         lines += [cdecl.struct_decl(cls), ""]
+        known.add(cls.__name__)
+    opaque = sorted({p.ctype for f in FUNCTIONS.values() for p in f.params if p.is_struct} - known)
+    if opaque:
+        lines.append("/* structures the vendor headers name without a layout gtecat knows */")
+        lines += [f"typedef struct {n} {n};" for n in opaque]
+        lines.append("")
     lines += [
         "#ifdef __cplusplus",
         'extern "C" {',
@@ -92,9 +116,9 @@ def render() -> str:
         "#ifdef __cplusplus",
         "/* ---- functions (C++: with the vendor's default arguments) ---- */",
     ]
-    lines += prototypes(defaults=True)
+    lines += prototypes(defaults=True, abi=abi)
     lines += ["#else", "/* ---- functions ---- */"]
-    lines += prototypes(defaults=False)
+    lines += prototypes(defaults=False, abi=abi)
     lines += [
         "#endif",
         "",

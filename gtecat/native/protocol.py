@@ -16,9 +16,10 @@ Client -> controller, first message of a connection (``HELLO``)::
 
     u8 type = 1, 3 pad, u16 protocol version, u16 sizeof(long), char digest[16]
 
-``digest`` names the table, the protocol and the structure layouts the library was
-built from; the controller refuses a library built from another table (reply status 1
-with the reason).  Reply (``HELLO_REPLY``): ``i16 status, u16 text length, text``.
+``digest`` names the table, the protocol, the structure layouts and the set of emulated
+functions the library was built from (a declared-only function sends no arguments); the
+controller refuses a library built from another table (reply status 1 with the reason).
+Reply (``HELLO_REPLY``): ``i16 status, u16 text length, text``.
 
 A call (``CALL``)::
 
@@ -59,7 +60,7 @@ from enum import IntEnum
 from functools import cache
 from typing import Any
 
-from ..gt.table import FUNCTIONS, PROTOTYPES, SCALARS, Param, Proto
+from ..gt.table import FUNCTIONS, PROTOTYPES, SCALARS, Param, Proto, emulated
 from . import cdecl
 
 PROTOCOL_VERSION = 2
@@ -129,6 +130,9 @@ class FunctionPlan:
     args: tuple[ArgPlan, ...]
     #: why the call cannot travel (a structure with pointers), None when it can
     unsupported: str | None = None
+    #: declared but not emulated: no arguments travel, the controller answers
+    #: CMD_DECLARED (:mod:`gtecat.gt.declared`)
+    declared: bool = False
 
 
 def _kind(p: Param) -> Kind:
@@ -141,7 +145,9 @@ def _kind(p: Param) -> Kind:
     return {"in": Kind.IN, "out": Kind.OUT, "inout": Kind.INOUT}[p.direction]
 
 
-def _plan(proto: Proto, fid: int) -> FunctionPlan:
+def _plan(proto: Proto, fid: int, declared: bool = False) -> FunctionPlan:
+    if declared:
+        return FunctionPlan(proto.name, fid, proto, (), None, declared=True)
     index = {p.name: i for i, p in enumerate(proto.params)}
     args = []
     unsupported = None
@@ -198,7 +204,8 @@ FUNCTION_NAMES: tuple[str, ...] = tuple(sorted(FUNCTIONS))
 
 @cache
 def plans() -> tuple[FunctionPlan, ...]:
-    return tuple(_plan(FUNCTIONS[n], i) for i, n in enumerate(FUNCTION_NAMES))
+    done = emulated()
+    return tuple(_plan(FUNCTIONS[n], i, n not in done) for i, n in enumerate(FUNCTION_NAMES))
 
 
 @cache
@@ -209,7 +216,9 @@ def plans_by_name() -> dict[str, FunctionPlan]:
 @cache
 def table_digest() -> str:
     """16 hex digits naming the table, this protocol and the structure layouts."""
-    return cdecl.digest(PROTOTYPES, str(PROTOCOL_VERSION), cdecl.layout_text())
+    return cdecl.digest(
+        PROTOTYPES, str(PROTOCOL_VERSION), cdecl.layout_text(), ",".join(sorted(emulated()))
+    )
 
 
 __all__ = [

@@ -42,7 +42,7 @@ from typing import Any
 
 from gtecat.eni.errors import GtecatError
 
-from ..gt import _core
+from ..gt import _core, declared
 from ..gt.fast import READERS, wire_reader
 from . import field as field_ops
 from .floor import WallFloor
@@ -645,6 +645,10 @@ class Server:
     ) -> tuple[int, str]:
         plan = dec.plan
         self.calls += 1
+        if plan.declared:  # the same code whether or not the client opened (gt.declared)
+            name = plan.proto.twin_name if gtn else plan.name
+            code, why = declared.note(name)
+            return code, f"{name} returned {code}: {why}"
         if not c.opened or plan.name in ("GT_Open", "GT_Close"):
             return self._open_close(c, dec, gtn, core, args)
         if plan.unsupported:

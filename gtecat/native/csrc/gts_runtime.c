@@ -682,6 +682,36 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
     return rc;
 }
 
+short gte_no_card(const char *name, short card, short code)
+{
+    pthread_mutex_lock(&g_mu);
+    if (code == -6)
+        set_err("%s returned -6: no card %d: the emulator is card 0", name, card);
+    else if (code == -7)
+        set_err("%s returned -7: libgts_mc found no %s in libgts", name, name);
+    else
+        set_err("%s returned %d: card %d is not open: the emulator is card 0", name, code, card);
+    pthread_mutex_unlock(&g_mu);
+    return code;
+}
+
+short gte_declared(int index, int gtn, short core)
+{
+    const gte_declared_info *d = &gte_declared_table[index];
+    gte_function f = {d->name, d->id, 0, GTE_F_DECLARED, NULL};
+    char name[128];
+    snprintf(name, sizeof name, "%s%s", gtn ? "GTN_" : "", gtn ? d->name + 3 : d->name);
+    pthread_mutex_lock(&g_mu);
+    short rc = -1;
+    if (g_fd >= 0 && g_fd_pid == getpid())
+        rc = invoke_locked(&f, gtn, core, NULL); /* the controller logs it and says why */
+    if (rc != GTE_CMD_DECLARED)
+        set_err("%s returned %d: %s is declared but not emulated (group: %s)", name,
+                GTE_CMD_DECLARED, name, d->group);
+    pthread_mutex_unlock(&g_mu);
+    return GTE_CMD_DECLARED;
+}
+
 short GTE_GetLastError(char *buf, short size)
 {
     if (!buf || size < 1)

@@ -25,7 +25,7 @@ typedef struct gte_function {
     const gte_param *params;
 } gte_function;
 
-enum { GTE_F_OPEN = 1, GTE_F_CLOSE = 2 };
+enum { GTE_F_OPEN = 1, GTE_F_CLOSE = 2, GTE_F_DECLARED = 4 };
 
 typedef union gte_arg {
     long long i;
@@ -41,6 +41,21 @@ typedef union gte_arg {
 #define GTE_INTERNAL
 #endif
 GTE_INTERNAL short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a);
+
+/* A function the table declares but gtecat does not emulate: returns GTE_CMD_DECLARED (8,
+ * the vendor's CMD_ERROR_UNKNOWN) whatever happens; a connected controller is told (it
+ * writes the master-log line), else the reason is set here. */
+typedef struct gte_declared_info {
+    const char *name;       /* GT_x as the table writes it */
+    const char *group;      /* the group's title */
+    unsigned short id;      /* the protocol's function id */
+} gte_declared_info;
+GTE_INTERNAL extern const gte_declared_info gte_declared_table[]; /* gts_declared.c */
+GTE_INTERNAL short gte_declared(int index, int gtn, short core);
+
+/* the multi-card ABI (libgts_mc, a layer over this library) given a card other than 0:
+ * code (-6 for GT_Open, else -1) with a reason; exported for libgts_mc, not in gts.h */
+short gte_no_card(const char *name, short card, short code);
 
 /* the interpreter that built the library (generated beside the stubs) */
 GTE_INTERNAL extern const char gte_default_python[];

@@ -197,7 +197,7 @@ def test_ifaces_lists_loopback(cli: Cli) -> None:
 
 # --- every verb ------------------------------------------------------------------------------
 VERBS = ["slaves", "pdos", "sdo", "sdos", "states", "reg", "sii", "data", "cstruct", "graph",
-         "ifaces", "example", "map", "run", "serve", "eni"]  # fmt: skip
+         "ifaces", "example", "map", "run", "serve", "eni", "api", "scan"]  # fmt: skip
 
 
 @pytest.mark.parametrize("verb", VERBS)

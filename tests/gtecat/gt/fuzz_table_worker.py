@@ -43,7 +43,7 @@ from hypothesis import strategies as st
 from gtecat import gt
 from gtecat.gt import _core
 from gtecat.gt.args import _struct_types
-from gtecat.gt.table import NO_CORE_TWINS, SCALARS, Param
+from gtecat.gt.table import NO_CORE_TWINS, SAME_PARAM_TWINS, SCALARS, Param
 from tests.conftest import EXAMPLES
 from tests.gtecat.gt.conftest import bring_up
 
@@ -469,11 +469,72 @@ def _short(v: Any) -> str:
     return r if len(r) < 80 else r[:77] + "..."
 
 
+#: anything a caller might pass to a declared-only function (it looks at none of it)
+_ANYTHING = st.one_of(
+    st.integers(-(1 << 70), 1 << 70),
+    st.floats(),
+    st.none(),
+    st.text(max_size=8),
+    st.binary(max_size=8),
+    st.builds(lambda v: ctypes.byref(ctypes.c_short(v)), st.integers(-(1 << 15), (1 << 15) - 1)),
+    st.builds(lambda n: (ctypes.c_double * n)(), st.integers(0, 4)),
+    st.builds(lambda n: create_string_buffer(n), st.integers(0, 16)),
+    st.just(gt.TTrapPrm()),
+)
+
+
+def fuzz_declared(name: str, examples: int) -> None:
+    """A declared-only function (gtecat.gt.declared): whatever it is given - any number of
+    arguments of any kind, keywords - it returns CMD_DECLARED (8) with its reason, writes
+    nothing, never raises, and the bus stays up."""
+    fn = getattr(gt, name)
+    n_params = len(fn.prototype.params)
+
+    def example(data: Any) -> None:
+        args = data.draw(st.lists(_ANYTHING, max_size=n_params + 2), label="args")
+        kwargs = data.draw(
+            st.dictionaries(st.sampled_from(["core", "axis", "zz"]), _ANYTHING, max_size=2),
+            label="kwargs",
+        )
+        snapshot = [bytes(a) if isinstance(a, ctypes.Array) else None for a in args]
+        try:
+            rc = fn(*args, **kwargs)
+        except BaseException as e:
+            raise AssertionError(f"{name}: exception escaped: {e!r}") from e
+        assert rc == _core.CMD_DECLARED, f"{name} returned {rc!r}"
+        reason = gt.GTE_GetLastError()
+        assert reason.startswith(f"{name} returned 8: {name} is declared but not emulated"), reason
+        for a, before in zip(args, snapshot, strict=True):
+            if before is not None:
+                assert bytes(a) == before, f"{name} wrote into an argument"
+
+    @settings(
+        max_examples=examples,
+        deadline=None,
+        database=None,
+        derandomize=bool(os.environ.get("CI")),
+        suppress_health_check=list(HealthCheck),
+        print_blob=False,
+    )
+    @given(st.data())
+    def run(data: Any) -> None:
+        example(data)
+
+    run()
+    problem = healthy()
+    assert not problem, f"after {name}: the bus no longer answers: {problem}"
+
+
 def fuzz_function(name: str, examples: int, warnings: set[str]) -> None:
     fn = getattr(gt, name)
+    if getattr(fn, "declared", False):
+        fuzz_declared(name, min(examples, 8))
+        return
     proto = fn.prototype
     # GTN_Open(channel, param) / GTN_Close(): the vendor's GTN header gives them no core
-    no_core = name.startswith("GTN_") and "GT_" + name[4:] in NO_CORE_TWINS
+    no_core = name.startswith("GTN_") and (
+        "GT_" + name[4:] in NO_CORE_TWINS or "GT_" + name[4:] in SAME_PARAM_TWINS
+    )
     is_gtn = name.startswith("GTN_") and not no_core
     base = name.partition("_")[2]
     params = list(proto.params)

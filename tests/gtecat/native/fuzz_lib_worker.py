@@ -40,7 +40,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from gtecat.gt import _core
-from gtecat.gt.table import SCALARS, Param
+from gtecat.gt.table import SAME_PARAM_TWINS, SCALARS, Param
 from gtecat.native import cdll, protocol
 from gtecat.native.server import Server
 from tests.conftest import EXAMPLES
@@ -189,7 +189,9 @@ def fuzz_function(lib: Any, plan: protocol.FunctionPlan, examples: int, notes: l
             if a.carries_back:
                 outs.append(b)
         calls = [(plan.name, fn_py, fn_c, [])]
-        if twin_py is not None:
+        if twin_py is not None and plan.name in SAME_PARAM_TWINS:  # GTN_Compile: no core
+            calls.append(("GTN_" + plan.name[3:], twin_py, twin_c, []))
+        elif twin_py is not None:
             core = data.draw(st.sampled_from([1, 1, 1, 0, 2, -1, 32767]), label="core")
             calls.append(("GTN_" + plan.name[3:], twin_py, twin_c, [core]))
         for name, py, c, core_args in calls:
@@ -255,10 +257,45 @@ def bring_up() -> None:
     assert gt.GT_StartEcatComm() == 0, gt.GTE_GetLastError()
 
 
+def declared_calls(lib: Any, sample: int) -> int:
+    """Declared-only functions through the library and in Python: 8 and the same reason,
+    with zeros and NULLs for their arguments (a seeded sample; every one with GTECAT_LONG)."""
+    import random
+
+    from gtecat.gt.declared import reason
+
+    plans = [p for p in protocol.plans() if p.declared and not p.proto.unknown]
+    if not os.environ.get("GTECAT_LONG"):
+        plans = random.Random(25).sample(plans, min(sample, len(plans)))
+    failed = 0
+    for plan in plans:
+        fn_c = getattr(lib, plan.name)
+        if fn_c.argtypes is None and plan.proto.params:
+            continue  # a structure passed by value: cdll() leaves it untyped
+        args = [
+            None if t is ctypes.c_void_p else 0.0 if t in (ctypes.c_double, ctypes.c_float) else 0
+            for t in (fn_c.argtypes or [])
+        ]
+        rc_c = fn_c(*args)
+        buf = ctypes.create_string_buffer(512)
+        lib.GTE_GetLastError(buf, 512)
+        rc_py = getattr(gt, plan.name)(*args)
+        want = f"{plan.name} returned 8: {reason(plan.name)}"
+        if (rc_c, rc_py, buf.value.decode(), gt.GTE_GetLastError()) != (8, 8, want, want):
+            failed += 1
+            print(f"FAIL {plan.name}: C {rc_c} {buf.value!r}, Python {rc_py}", flush=True)
+        else:
+            print(f"ok {plan.name} (declared)", flush=True)
+    return failed
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--examples", type=int, default=15)
     ap.add_argument("names", nargs="*", help="functions (default: every one the pair can run)")
+    ap.add_argument(
+        "--declared", type=int, default=0, help="also N declared-only functions (GTECAT_LONG: all)"
+    )
     a = ap.parse_args(argv)
     logging.getLogger("gtecat").setLevel(logging.CRITICAL)
     bring_up()
@@ -286,6 +323,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"FAIL {plan.name}: {str(e)[-3000:]}", flush=True)
         else:
             print(f"ok {plan.name}", flush=True)
+    if a.declared:
+        failed += declared_calls(lib, a.declared)
     for line in notes[:200]:
         print(line)
     lib.GT_Close()

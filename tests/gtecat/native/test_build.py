@@ -19,6 +19,8 @@ def test_lib_flags(libgts, capsys):
     words = capsys.readouterr().out.split()
     assert words == [
         f"-I{libgts.include_dir}",
+        "-include",  # the vendor's own header compiles unchanged (gtecat_vendor.h)
+        str(libgts.include_dir / "gtecat_vendor.h"),
         f"-L{libgts.lib_dir}",
         f"-Wl,-rpath,{libgts.lib_dir}",
         "-lgts",

@@ -142,8 +142,8 @@ int main(void)
     /* several values at once; GT_ spelling (core 1 implied) */
     long two[2] = {0, 0};
     say("sts_two", GT_GetSts(1, two, 2, NULL));
-    char version[64];
-    say("version_rc", GT_GetVersion(version));
+    char *version = NULL; /* the vendor header's char **: the library keeps the text */
+    say("version_rc", GT_GetVersion(&version));
     printf("version %s\n", version);
 
     say("last_error_null", GTE_GetLastError(NULL, 10));

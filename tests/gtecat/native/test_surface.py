@@ -1,0 +1,146 @@
+"""The vendor's whole surface through libgts: a vendor-style header compiles unchanged with
+``gtecat lib --cflags``, declared-only functions answer 8 with a reason from C as from
+Python, and the older multi-card ABI (``--abi gts-multicard``) runs a client of its own."""
+
+from __future__ import annotations
+
+import os
+import shlex
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from gtecat.gt._core import CMD_DECLARED
+
+from .conftest import (
+    C_DIR,
+    FIG5_2,
+    native_env,
+    needs_cc,
+    needs_cxx,
+    run_client,
+    tool_path,
+    tool_pythonpath,
+)
+
+pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
+
+
+@pytest.fixture(scope="module")
+def controller(tmp_path_factory):
+    """One controller in this process for the module's C clients (they attach to it through
+    GTECAT_CONTROLLER instead of each starting a private one)."""
+    from gtecat.native.server import Server
+
+    gt.GT_Close()
+    assert gt.GT_Open(eni=str(FIG5_2), clock="auto", log="") == 0, gt.GTE_GetLastError()
+    address = f"unix:{tmp_path_factory.mktemp('ctl')}/controller.sock"
+    with Server(address):
+        yield address
+    gt.GT_Close()
+
+
+def _compile(src: Path, out: Path, compiler: str, lib_args: str, extra: str = "") -> Path:
+    cmd = (
+        f"{compiler} {extra} {shlex.quote(str(src))} $(python3 -m gtecat lib {lib_args}) "
+        f"-o {shlex.quote(str(out))}"
+    )
+    env = {**os.environ, "PATH": tool_path(), "PYTHONPATH": tool_pythonpath()}
+    r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=env)
+    assert r.returncode == 0, f"{cmd}\n{r.stderr}"
+    assert "warning" not in r.stderr, r.stderr
+    return out
+
+
+@needs_cxx
+def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, controller, tmp_path):
+    """__stdcall, extern "C" in GT_API, NULL defaults and UINT8 without any include: the
+    forced include of --cflags supplies them; the header's own TTrapPrm matches ours."""
+    exe = _compile(
+        C_DIR / "vendor_style_client.cpp",
+        tmp_path / "vendor_style",
+        "g++ -Wall -Wextra",
+        "--cflags --libs",
+        extra=f"-I{C_DIR / 'vendor_style'}",  # its gts.h before gtecat's
+    )
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert (v["open"], v["start"], v["version_rc"], v["clock_rc"]) == ("0",) * 4
+    assert len(v["version"].split()) == 4  # table 11-3: aaa bbbbbb ccc dddddd
+    assert (v["prftrap"], v["gettrap"], v["settrap"]) == ("0", "0", "0")
+    assert (v["trap_smooth"], v["trap_acc_x100"]) == ("5", "25")
+    assert v["hsio"] == str(CMD_DECLARED)
+    assert v["hsio_reason"] == (
+        "GT_SetHSIOOpt returned 8: GT_SetHSIOOpt is declared but not emulated "
+        "(group: digital and analog IO)"
+    )
+    for key in ("rescount", "movevelocity"):  # emulated or declared, never a pretend 0
+        assert v[key] in ("0", str(CMD_DECLARED)), key
+    if v["rescount"] == "0":
+        assert int(v["rescount_value"]) >= 2  # the figure 5-2 bus has two axes
+    assert v["close"] == "0"
+
+
+def test_declared_only_gives_the_same_answer_in_python():
+    assert gt.GT_SetHSIOOpt(1) == CMD_DECLARED
+    assert gt.GTE_GetLastError() == (
+        "GT_SetHSIOOpt returned 8: GT_SetHSIOOpt is declared but not emulated "
+        "(group: digital and analog IO)"
+    )
+    assert gt.GTN_SetHSIOOpt(1, 1, laserChannel=0) == CMD_DECLARED
+    assert "GTN_SetHSIOOpt is declared" in gt.GTE_GetLastError()
+
+
+def test_the_multicard_abi(controller, tmp_path):
+    """Manual-era GTS programs pass the card first; card 0 is the emulator."""
+    from gtecat.native.build import NativeBuildError, ensure_built
+
+    try:
+        ensure_built(abi="gts-multicard")
+    except NativeBuildError as e:
+        pytest.skip(f"libgts_mc cannot be built here: {e}")
+    exe = _compile(
+        C_DIR / "multicard_client.c", tmp_path / "mc", "gcc -Wall -Wextra",
+        "--abi gts-multicard --cflags --libs",
+    )  # fmt: skip
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert v["open_card1"] == "-6"
+    assert "no card 1: the emulator is card 0" in v["open_card1_reason"]
+    assert (v["open"], v["reset"], v["init"], v["ready"], v["start"]) == ("0", "0", "0", "1", "0")
+    assert v["getsts"] == "0"
+    assert v["axison_card2"] == "-1" and "card 2 is not open" in v["axison_card2_reason"]
+    assert (v["prftrap"], v["prfmode_rc"], v["prfmode"]) == ("0", "0", "0")  # Trap is mode 0
+    assert v["hsio"] == str(CMD_DECLARED)
+    assert v["close"] == "0"
+
+
+def test_libgts_exports_every_name_of_the_table(libgts):
+    """`nm -D`: the vendor DLL's names (the table holds every one) are all exported."""
+    import shutil
+
+    from gtecat.gt.table import exported_names
+
+    if shutil.which("nm") is None:
+        pytest.skip("needs nm: apt-get install binutils")
+    out = subprocess.run(
+        ["nm", "-D", "--defined-only", str(libgts.library)], capture_output=True, text=True
+    ).stdout
+    symbols = {line.split()[-1] for line in out.splitlines() if " T " in line}
+    names = set(exported_names())
+    assert not names - symbols
+    assert len(names) > 2700  # the GTN-era vendor DLL exports 2,057 GT_/GTN_ names
+    for name in ("GTN_GetResCount", "GTN_MoveVelocity", "GT_SetHSIOOpt", "GTN_CrdBlendOn"):
+        assert name in symbols
+
+
+@needs_cxx
+def test_the_ecat_demo_calls_compile_against_our_header(gts_h):
+    """CMD_SUCCESS, MC_AXIS, GTN_GetResCount, TMoveVelocityPrm and GTN_MoveVelocity, and the
+    vendor header's unsigned short * of GTN_GetEcatAxisMode / GTN_GetEcatHomingStatus."""
+    cmd = ["g++", "-std=c++11", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fsyntax-only"]
+    cmd += [f"-I{gts_h.parent}", str(C_DIR / "ecat_demo_style.cpp")]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
