@@ -27,6 +27,7 @@ _MODULES = (
     "motion_ext_calls",
     "program_calls",
     "crd_calls",
+    "ext_io_calls",
 )
 
 

@@ -422,6 +422,12 @@ def _split(args: str) -> list[str]:
     return parts
 
 
+# Emulated groups declared in their own modules (gtecat/gt/groups/<group>.py: NAME, TITLE,
+# PROTOTYPES), appended here until the group loader collects them all.
+EMULATED_GROUPS = ("ext_io",)
+for _group in EMULATED_GROUPS:
+    PROTOTYPES += __import__(f"{__package__}.groups.{_group}", fromlist=["PROTOTYPES"]).PROTOTYPES
+
 FUNCTIONS: dict[str, Proto] = parse(PROTOTYPES)
 
 __all__ = ["FUNCTIONS", "PROTOTYPES", "SCALARS", "Param", "Proto", "parse"]
