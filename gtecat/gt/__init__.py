@@ -28,6 +28,7 @@ _MODULES = (
     "program_calls",
     "crd_calls",
     "ext_io_calls",
+    "servo_loop_calls",
 )
 
 
