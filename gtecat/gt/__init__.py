@@ -29,6 +29,7 @@ _MODULES = (
     "crd_calls",
     "ext_io_calls",
     "servo_loop_calls",
+    "buffered_calls",
 )
 
 
