@@ -30,6 +30,7 @@ _MODULES = (
     "ext_io_calls",
     "servo_loop_calls",
     "buffered_calls",
+    "plcopen_calls",
 )
 
 
