@@ -31,6 +31,7 @@ _MODULES = (
     "servo_loop_calls",
     "buffered_calls",
     "plcopen_calls",
+    "ecat_io_calls",
 )
 
 
