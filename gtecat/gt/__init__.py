@@ -32,6 +32,7 @@ _MODULES = (
     "buffered_calls",
     "plcopen_calls",
     "ecat_io_calls",
+    "gantry_calls",
 )
 
 

@@ -424,7 +424,7 @@ def _split(args: str) -> list[str]:
 
 # Emulated groups declared in their own modules (gtecat/gt/groups/<group>.py: NAME, TITLE,
 # PROTOTYPES), appended here until the group loader collects them all.
-EMULATED_GROUPS = ("ext_io", "servo_loop", "buffered", "plcopen", "ecat_io")
+EMULATED_GROUPS = ("ext_io", "servo_loop", "buffered", "plcopen", "ecat_io", "gantry")
 for _group in EMULATED_GROUPS:
     PROTOTYPES += __import__(f"{__package__}.groups.{_group}", fromlist=["PROTOTYPES"]).PROTOTYPES
 
