@@ -13,6 +13,11 @@ entry in ``GT_CrdStatus``'s segment number.  Decisions:
   with a master-log line.
 * ``GT_BufLmtsOn/Off(crd, axis, limitType)``: ``GT_LmtsOn/Off`` of that axis there.
 * ``GT_LnXYZG0`` / ``GT_LnXYZAG0``: rapid lines, like ``GT_LnXYG0``: they stop at their end.
+* ``GT_CrdData(crd, NULL, fifo)``: what applications call after their last segment to push
+  the look-ahead buffer into the FIFO.  The emulator's look-ahead (``GT_InitLookAhead``)
+  plans the corner speeds over the FIFO itself, so every segment is in the FIFO already and
+  the call only checks its arguments.  A segment given as a ``TCrdData`` (three layouts in
+  the vendor's headers) returns 1: push segments with ``GT_LnXY`` ... ``GT_ArcXYC``.
 * ``GT_GetRemainderSegNum``: the entries of the FIFO not finished yet (the one running
   included), in ``GT_CrdStatus``'s unit.
 * ``GT_SetCrdMapBase(crd, base)``: base 0 (``TCrdPrm.profile[k]`` is profile ``k + 1``) is
@@ -136,6 +141,20 @@ def GT_LnXYZAG0(
     """Rapid line to (x, y, z, a): a line that stops at its end."""
     values = {0: x, 1: y, 2: z, 3: aPos}
     return _push_line(_crd(ctl, crd), "GT_LnXYZAG0", fifo, values, synVel, synAcc, 0.0)
+
+
+@gt_function
+def GT_CrdData(ctl: Controller, crd: int, pCrdData: Any = None, fifo: int = 0) -> int:
+    """NULL: flush the look-ahead buffer into the FIFO (nothing is held back here)."""
+    c = _crd(ctl, crd)
+    c.require_prm("GT_CrdData")
+    if pCrdData is not None:
+        raise CommandError(
+            "GT_CrdData: a segment given as TCrdData is not emulated (its layout differs "
+            "between the vendor's headers); push it with GT_LnXY ... GT_ArcXYC"
+        )
+    c.space(int(fifo))  # 7 for a FIFO other than 0 and 1
+    return 0
 
 
 @gt_function

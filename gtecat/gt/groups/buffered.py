@@ -18,6 +18,7 @@ short GT_BufLmtsOn(short crd /*1..2*/, short axis, short limitType, short fifo=0
 short GT_BufLmtsOff(short crd /*1..2*/, short axis, short limitType, short fifo=0 /*0..1*/);  // header (GTS)
 short GT_LnXYZG0(short crd /*1..2*/, long x, long y, long z, double synVel, double synAcc, short fifo=0 /*0..1*/);  // header (GTS)
 short GT_LnXYZAG0(short crd /*1..2*/, long x, long y, long z, long aPos, double synVel, double synAcc, short fifo=0 /*0..1*/);  // header (GTS; the vendor names it a)
+short GT_CrdData(short crd /*1..2*/, TCrdData *pCrdData /*opt*/, short fifo=0 /*0..1*/);  // header (GTS)
 short GT_GetRemainderSegNum(short crd /*1..2*/, long *pSegment, short fifo=0 /*0..1*/);  // header (GTS)
 short GT_SetCrdMapBase(short crd /*1..2*/, short base);                         // header (GTS)
 short GT_GetCrdMapBase(short crd /*1..2*/, short *pBase);                       // header (GTS)

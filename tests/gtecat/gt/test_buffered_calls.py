@@ -98,3 +98,21 @@ def test_limits_off_for_a_move_onto_the_switch_and_on_again():
     sts = c_long()
     assert prf(1) == 1000.0 and status() == (0, 3)
     assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & 1 << 5  # watched again: on it
+
+
+def test_look_ahead_flush_with_crd_data_null():
+    """The vendor examples' sequence: GT_InitLookAhead, the segments, GT_CrdData(crd, NULL,
+    fifo) to push what the look-ahead holds, GT_CrdStart."""
+    card(axes=(1, 2))
+    buf = (gt.TCrdData * 200)()
+    assert gt.GT_InitLookAhead(1, 0, 5.0, 1.0, 200, buf) == 0
+    for k in range(1, 5):
+        assert gt.GT_LnXY(1, 500 * k, 500 * (k % 2), 20.0, 0.5) == 0
+    assert gt.GT_CrdData(1, None, 0) == 0 and remainder() == 4
+    assert gt.GT_CrdStart(1, 0) == 0
+    while status()[0]:
+        gt.GTE_Wait(1)
+    assert (prf(1), prf(2), status()) == (2000.0, 0.0, (0, 4))
+    assert gt.GT_CrdData(1, byref(gt.TCrdData()), 0) == 1
+    assert "not emulated" in gt.GTE_GetLastError()
+    assert gt.GT_CrdData(1, None, 2) == 7
