@@ -283,49 +283,35 @@ def _card(card_num: int, name: str = "cardNum") -> None:
         raise ParameterError(f"{name}={n}: the emulated controller is card 0 (one card)")
 
 
-def _gts(fn: Any) -> Any:
-    """The ``*Gts`` twin of ``fn``: ``cardNum`` checked, then ``fn``."""
+def _gts_form(fn: Any) -> Any:
+    """The multi-card ``<name>Gts`` form of GT function ``fn``: ``cardNum`` first, checked,
+    then ``fn``'s own implementation (one call: one host-call latency, one reason)."""
+    impl = fn.__wrapped__
 
     def twin(ctl: Controller, cardNum: int, *args: Any) -> int:
         _card(cardNum)
-        return fn.__wrapped__(ctl, *args)
+        return impl(ctl, *args)
 
-    return twin
-
-
-def _make_gts(name: str, fn: Any, params: str) -> Any:
-    """A GT function ``name`` (``params`` after ``cardNum``) that checks the card and calls
-    the single-card ``fn`` (its implementation, not its GT wrapper: one call, one code)."""
-    body = _gts(fn)
-    ns: dict[str, Any] = {"body": body, "Controller": Controller, "Any": Any}
-    args = ", ".join(p.split("=")[0] for p in params.split(", ") if p)
-    src = (
-        f"def {name}(ctl, cardNum{', ' + params if params else ''}):\n"
-        f"    return body(ctl, cardNum{', ' + args if args else ''})\n"
-    )
-    exec(src, ns)  # the parameter names must be the table's (the binder reads them)
-    out = ns[name]
-    out.__doc__ = f"``{fn.__name__}`` of card ``cardNum`` (0: the emulated card)."
-    return gt_function(out)
+    twin.__name__ = twin.__qualname__ = fn.__name__ + "Gts"
+    twin.__doc__ = f"``{fn.__name__}`` of card ``cardNum`` (0: the emulated card)."
+    return gt_function(twin)
 
 
-GT_OpenExtMdlGts = _make_gts("GT_OpenExtMdlGts", GT_OpenExtMdl, "pDllName=None")
-GT_CloseExtMdlGts = _make_gts("GT_CloseExtMdlGts", GT_CloseExtMdl, "")
-GT_SwitchtoCardNoExtMdlGts = _make_gts(
-    "GT_SwitchtoCardNoExtMdlGts", GT_SwitchtoCardNoExtMdl, "card"
-)
-GT_ResetExtMdlGts = _make_gts("GT_ResetExtMdlGts", GT_ResetExtMdl, "")
-GT_LoadExtConfigGts = _make_gts("GT_LoadExtConfigGts", GT_LoadExtConfig, "pFileName")
-GT_SetExtIoValueGts = _make_gts("GT_SetExtIoValueGts", GT_SetExtIoValue, "mdl, value")
-GT_GetExtIoValueGts = _make_gts("GT_GetExtIoValueGts", GT_GetExtIoValue, "mdl, pValue")
-GT_SetExtIoBitGts = _make_gts("GT_SetExtIoBitGts", GT_SetExtIoBit, "mdl, index, value")
-GT_GetExtIoBitGts = _make_gts("GT_GetExtIoBitGts", GT_GetExtIoBit, "mdl, index, pValue")
-GT_GetExtAdValueGts = _make_gts("GT_GetExtAdValueGts", GT_GetExtAdValue, "mdl, chn, pValue")
-GT_GetExtAdVoltageGts = _make_gts("GT_GetExtAdVoltageGts", GT_GetExtAdVoltage, "mdl, chn, pValue")
-GT_SetExtDaValueGts = _make_gts("GT_SetExtDaValueGts", GT_SetExtDaValue, "mdl, chn, value")
-GT_SetExtDaVoltageGts = _make_gts("GT_SetExtDaVoltageGts", GT_SetExtDaVoltage, "mdl, chn, value")
-GT_GetStsExtMdlGts = _make_gts("GT_GetStsExtMdlGts", GT_GetStsExtMdl, "mdl, chn, pStatus")
-GT_GetExtDoValueGts = _make_gts("GT_GetExtDoValueGts", GT_GetExtDoValue, "mdl, pValue")
+GT_OpenExtMdlGts = _gts_form(GT_OpenExtMdl)
+GT_CloseExtMdlGts = _gts_form(GT_CloseExtMdl)
+GT_SwitchtoCardNoExtMdlGts = _gts_form(GT_SwitchtoCardNoExtMdl)
+GT_ResetExtMdlGts = _gts_form(GT_ResetExtMdl)
+GT_LoadExtConfigGts = _gts_form(GT_LoadExtConfig)
+GT_SetExtIoValueGts = _gts_form(GT_SetExtIoValue)
+GT_GetExtIoValueGts = _gts_form(GT_GetExtIoValue)
+GT_SetExtIoBitGts = _gts_form(GT_SetExtIoBit)
+GT_GetExtIoBitGts = _gts_form(GT_GetExtIoBit)
+GT_GetExtAdValueGts = _gts_form(GT_GetExtAdValue)
+GT_GetExtAdVoltageGts = _gts_form(GT_GetExtAdVoltage)
+GT_SetExtDaValueGts = _gts_form(GT_SetExtDaValue)
+GT_SetExtDaVoltageGts = _gts_form(GT_SetExtDaVoltage)
+GT_GetStsExtMdlGts = _gts_form(GT_GetStsExtMdl)
+GT_GetExtDoValueGts = _gts_form(GT_GetExtDoValue)
 
 
 # --- the GTN cores' extension modules ----------------------------------------------------------
