@@ -13,6 +13,12 @@ vendor's headers leave open:
 * ``GT_GetDiReverseCount`` / ``GT_SetDiReverseCount``: how often each input of a type
   changed level (``GT_GetDi``'s view, sampled every cycle).  The controller watches a type
   from the first call naming it; ``GT_SetDiReverseCount`` presets the counters.
+* ``GT_LmtSns(sense)`` (bit 2(n-1) the positive, 2(n-1)+1 the negative limit of axis n, 1 =
+  the other level) and ``GT_SetSense(dataType, dataIndex, value)`` (``MC_LIMIT_POSITIVE``,
+  ``MC_LIMIT_NEGATIVE``, ``MC_ALARM``, ``MC_HOME``, ``MC_GPI``, ``MC_ARRIVE``) are the
+  ``reverse`` key of the configuration file's ``[limitPositiveN]`` ... ``[gpiN]`` sections,
+  set at run time: they act exactly as loading a configuration with those ``reverse``
+  values (``GT_GetDi``, the limits, the home capture), and ``GT_GetSense`` reads it back.
 * ``GT_MultiAxisOn/Off(mask)``: bit ``i`` is axis ``i + 1``; a bit for an axis that does
   not exist returns 7 before any axis changes.
 * ``GT_LmtsOnEx/OffEx(axis, limitType, limitMode)``: ``limitMode`` 0 the limit switches
@@ -36,6 +42,7 @@ from __future__ import annotations
 import ctypes
 from typing import Any
 
+from ..controller.config_file import apply_config, parse_vendor, vendor_settings
 from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.digital_io import GPIO_COUNT, digital_io
@@ -49,6 +56,8 @@ from ._core import check_range, gt_function, store, store_array, struct_arg
 from .axis_calls import axis_off, axis_on
 from .constants import (
     MC_ADC,
+    MC_ALARM,
+    MC_ARRIVE,
     MC_AXIS,
     MC_CLEAR,
     MC_CONTROL,
@@ -56,6 +65,9 @@ from .constants import (
     MC_ENCODER,
     MC_GPI,
     MC_GPO,
+    MC_HOME,
+    MC_LIMIT_NEGATIVE,
+    MC_LIMIT_POSITIVE,
     MC_PROFILE,
     MC_STEP,
 )
@@ -358,6 +370,64 @@ def GT_SetDiReverseCount(
     values = pReverseCount.load_values(len(span))
     for i, v in zip(span, values, strict=True):
         e.counts[(int(diType), i)] = int(v) & 0xFFFFFFFF
+    return 0
+
+
+# --- input senses ----------------------------------------------------------------------------
+_SENSE_SECTIONS = {
+    MC_LIMIT_POSITIVE: "limitPositive",
+    MC_LIMIT_NEGATIVE: "limitNegative",
+    MC_ALARM: "alarm",
+    MC_HOME: "home",
+    MC_GPI: "gpi",
+    MC_ARRIVE: "arrive",
+}
+
+
+def _sense_section(ctl: Controller, data_type: int, index: int) -> str:
+    kind = _SENSE_SECTIONS.get(int(data_type))
+    if kind is None:
+        raise ParameterError(
+            f"dataType={data_type}: MC_LIMIT_POSITIVE 0, MC_LIMIT_NEGATIVE 1, MC_ALARM 2, "
+            "MC_HOME 3, MC_GPI 4 or MC_ARRIVE 5"
+        )
+    top = GPIO_COUNT if kind == "gpi" else max(ctl.axes, default=0)
+    check_range("dataIndex", index, 1, top)
+    return kind
+
+
+def _reverse(ctl: Controller, name: str, items: list[tuple[str, int, int]]) -> None:
+    """Set ``reverse`` of ``[kind n]`` as a configuration file would."""
+    text = "".join(f"[{kind}{n}]\nreverse={v}\n" for kind, n, v in items)
+    apply_config(ctl, parse_vendor(text, name))
+
+
+@gt_function
+def GT_LmtSns(ctl: Controller, sense: int) -> int:
+    """The level of every limit switch: bit 2(n-1) positive, 2(n-1)+1 negative of axis n."""
+    s = int(sense) & 0xFFFF
+    items = []
+    for n in range(1, 9):
+        if n in ctl.axes:
+            items.append(("limitPositive", n, s >> (2 * n - 2) & 1))
+            items.append(("limitNegative", n, s >> (2 * n - 1) & 1))
+    _reverse(ctl, "GT_LmtSns", items)
+    return 0
+
+
+@gt_function
+def GT_SetSense(ctl: Controller, dataType: int, dataIndex: int, value: int) -> int:
+    """Input ``dataIndex`` of type ``dataType`` read at the other level (1) or not (0)."""
+    kind = _sense_section(ctl, dataType, dataIndex)
+    _reverse(ctl, "GT_SetSense", [(kind, int(dataIndex), int(value))])
+    return 0
+
+
+@gt_function
+def GT_GetSense(ctl: Controller, dataType: int, dataIndex: int, pValue: Any) -> int:
+    kind = _sense_section(ctl, dataType, dataIndex)
+    section = vendor_settings(ctl).get((kind, int(dataIndex)), {})
+    store(pValue, 1 if section.get("reverse", False) else 0)
     return 0
 
 

@@ -164,3 +164,49 @@ def test_the_gtn_torque_spellings_read_6077h():
     assert gt.GTN_GetResCount(1, gt.MC_AXIS, byref(n)) == 0 and n.value == len(
         gt.GTE_Controller().axes
     )
+
+
+def _observe() -> list[int]:
+    """What an application sees of the inputs: GT_GetDi of the limits and home, and the
+    limit flags of GT_GetSts after GT_ClrSts."""
+    seen = []
+    for t in (gt.MC_LIMIT_POSITIVE, gt.MC_LIMIT_NEGATIVE, gt.MC_HOME):
+        v = c_long()
+        assert gt.GT_GetDi(t, byref(v)) == 0
+        seen.append(v.value)
+    assert gt.GT_ClrSts(1, 2) == 0
+    gt.GTE_Wait(2)
+    for a in (1, 2):
+        s = c_long()
+        assert gt.GT_GetSts(a, byref(s)) == 0
+        seen.append(s.value & 0x60)
+    return seen
+
+
+def test_limit_and_input_senses_act_as_the_configuration_files_reverse(tmp_path):
+    """GT_LmtSns (GTS manual example 4-2: bits 0/1 axis 1's positive/negative limit) and
+    GT_SetSense set the ``reverse`` a configuration file sets: the same observations."""
+    from drives.machine import AxisMachine, MachineDescription
+
+    m = MachineDescription(
+        {1: AxisMachine(positive_limit=-100.0), 2: AxisMachine(home_switch=((-50.0, 50.0),))}
+    )
+    assert gt.GT_Open(card="gts:2", machine=m, clock="lockstep", log="") == 0
+    plain = _observe()
+    assert gt.GT_LmtSns(0b0000_1001) == 0  # axis 1 positive, axis 2 negative
+    assert gt.GT_SetSense(gt.MC_HOME, 2, 1) == 0
+    at_run_time = _observe()
+    sense = c_short()
+    assert gt.GT_GetSense(gt.MC_LIMIT_NEGATIVE, 2, byref(sense)) == 0 and sense.value == 1
+    assert gt.GT_GetSense(gt.MC_LIMIT_NEGATIVE, 1, byref(sense)) == 0 and sense.value == 0
+    assert gt.GT_SetSense(9, 1, 1) == 7 and gt.GT_SetSense(gt.MC_HOME, 3, 1) == 7
+    gt.GT_Close()
+    cfg = tmp_path / "senses.cfg"
+    cfg.write_text(
+        "[limitPositive1]\nreverse=1\n[limitNegative1]\nreverse=0\n"
+        "[limitPositive2]\nreverse=0\n[limitNegative2]\nreverse=1\n[home2]\nreverse=1\n",
+        encoding="utf-8",
+    )
+    assert gt.GT_Open(card="gts:2", machine=m, clock="lockstep", log="") == 0
+    assert gt.GT_LoadConfig(str(cfg)) == 0, gt.GTE_GetLastError()
+    assert _observe() == at_run_time != plain
