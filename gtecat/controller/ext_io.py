@@ -1,7 +1,7 @@
 """Extension IO modules and gLink slaves of a controller: their terminals and their access.
 
 The machine description lists what is plugged in (``[ext.N]``, ``[glink.N]``;
-:mod:`drives.ext_modules`).  Each module here holds what a wire would show: which inputs
+:mod:`gtecat.drives.ext_modules`).  Each module here holds what a wire would show: which inputs
 are active, which outputs are on, the voltage on every analog channel, and whether the
 module answers on its bus.  A scenario drives the field side (:class:`ExtModule`'s
 ``set_input`` / ``set_voltage`` / ``online``, or ``GTE_SetExtDi`` / ``GTE_SetExtAdVoltage``
@@ -28,7 +28,7 @@ import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
-from drives.ext_modules import ExtModuleSpec
+from gtecat.drives.ext_modules import ExtModuleSpec
 
 from ..errors import ParameterError
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from ctypes import byref, c_double, c_int32, c_long, c_short
 
-from drives.machine import AxisMachine, MachineDescription
 from gtecat import gt
+from gtecat.drives.machine import AxisMachine, MachineDescription
 
 
 def card(axes=(1, 2, 3), machine: MachineDescription | None = None) -> None:

@@ -15,8 +15,8 @@ from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ushort
 
 import pytest
 
-from drives.machine import MachineError, machine_from_dict
 from gtecat import gt
+from gtecat.drives.machine import MachineError, machine_from_dict
 
 from .conftest import bring_up
 

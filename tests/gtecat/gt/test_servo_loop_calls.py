@@ -186,7 +186,7 @@ def _observe() -> list[int]:
 def test_limit_and_input_senses_act_as_the_configuration_files_reverse(tmp_path):
     """GT_LmtSns (GTS manual example 4-2: bits 0/1 axis 1's positive/negative limit) and
     GT_SetSense set the ``reverse`` a configuration file sets: the same observations."""
-    from drives.machine import AxisMachine, MachineDescription
+    from gtecat.drives.machine import AxisMachine, MachineDescription
 
     m = MachineDescription(
         {1: AxisMachine(positive_limit=-100.0), 2: AxisMachine(home_switch=((-50.0, 50.0),))}
