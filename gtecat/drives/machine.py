@@ -104,6 +104,9 @@ def _in_windows(windows: Iterable[Window], pos: float) -> bool:
 class MachineDescription:
     axes: Mapping[int, AxisMachine] = field(default_factory=dict)
     source: str = ""
+    #: ``[ext.N]`` extension IO modules, ``[glink.N]`` gLink slaves (drives/ext_modules.py)
+    ext: Mapping[int, Any] = field(default_factory=dict)
+    glink: Mapping[int, Any] = field(default_factory=dict)
 
     def axis(self, n: int) -> AxisMachine:
         """The description of GT axis ``n`` (defaults when the file omits it)."""
@@ -183,7 +186,14 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
             probe2=_windows(table.get("probe2"), f"{where} probe2"),
             following_error_window=num("following_error_window"),
         )
-    return MachineDescription(axes=axes, source=source)
+    from .ext_modules import ext_modules_from_dict, glink_from_dict
+
+    return MachineDescription(
+        axes=axes,
+        source=source,
+        ext=ext_modules_from_dict(data, source),
+        glink=glink_from_dict(data, source),
+    )
 
 
 def load_machine(path: str | Path) -> MachineDescription:

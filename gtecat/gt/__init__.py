@@ -27,6 +27,12 @@ _MODULES = (
     "motion_ext_calls",
     "program_calls",
     "crd_calls",
+    "ext_io_calls",
+    "servo_loop_calls",
+    "buffered_calls",
+    "plcopen_calls",
+    "ecat_io_calls",
+    "gantry_calls",
 )
 
 

@@ -48,10 +48,12 @@ _FLOAT_CODES = "fdg"
 
 
 def _struct_types() -> dict[str, type[ctypes.Structure]]:
+    from ..native.cdecl import structures  # every structure gt exports (the groups' own too)
     from .bus_calls import TSlaveInfo  # defined beside its function
 
     out = {n: getattr(structs, n) for n in structs.__all__}
     out["TSlaveInfo"] = TSlaveInfo
+    out.update({cls.__name__: cls for cls in structures()})
     return out
 
 

@@ -1,0 +1,117 @@
+"""Gantry pairs: ``GT_SetGantryMode(group, master, slave, mode, syncErrorLimit)``.
+
+The vendor header's modes: ``GANTRY_MODE_NONE`` -1, ``GANTRY_MODE_OPEN_LOOP_GANTRY`` 1,
+``GANTRY_MODE_DECOUPLE_POSITION_LOOP`` 2.  Decisions (the header says no more):
+
+* A pair (modes 1 and 2 alike: the emulated drives close their own loops) makes the slave
+  profile an electronic gear of the master profile, 1:1 with no clutch, engaged at once: every
+  motion of the master (Trap, Jog, interpolation, homing) moves the slave by the same
+  amount, and the slave keeps the offset it had.  Both axes must stand still (1 otherwise);
+  master and slave differ and neither is in another group (7).
+* ``GANTRY_MODE_NONE`` releases the slave (a Trap profile again, where it stands); the
+  master must stand still (the call lets the slave take the master's last step: one
+  cycle).  ``syncErrorLimit`` (pulses, > 0) is kept and read back: the emulated drives
+  follow their command exactly, so the two encoders never drift apart.
+* ``GT_GetGantryMode`` of a group never set reads master 0, slave 0, mode -1, limit 1000.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+from typing import Any
+
+from ..controller.core import Controller
+from ..controller.resources import axis_resources
+from ..errors import CommandError, ParameterError
+from ._core import gt_function, store
+from .motion_calls import GT_PrfTrap
+from .motion_ext_calls import GT_GearStart, GT_PrfGear, GT_SetGearMaster, GT_SetGearRatio
+
+GANTRY_MODE_NONE = -1
+GANTRY_MODE_OPEN_LOOP_GANTRY = 1
+GANTRY_MODE_DECOUPLE_POSITION_LOOP = 2
+_GEAR_MASTER_PROFILE = 2
+
+
+@dataclass(slots=True)
+class _Pair:
+    master: int = 0
+    slave: int = 0
+    mode: int = GANTRY_MODE_NONE
+    limit: int = 1000
+
+
+_GROUPS: weakref.WeakKeyDictionary[Any, dict[int, _Pair]] = weakref.WeakKeyDictionary()
+
+
+def _groups(ctl: Controller) -> dict[int, _Pair]:
+    return _GROUPS.setdefault(getattr(ctl, "_base", ctl), {})
+
+
+def _release(ctl: Controller, pair: _Pair) -> None:
+    """The slave out of its gear, where it stands (the master must stand still)."""
+    _still(ctl, pair.master)
+    res = axis_resources(ctl, pair.slave)
+    for _ in range(2):  # the gear follows the master's last step one cycle later
+        if res.profile.planner.vel == 0.0:
+            break
+        ctl.clock.advance_ns(ctl.clock.cycle_ns)
+    if res.profile.planner.vel != 0.0:
+        raise CommandError(f"GT_SetGantryMode: slave axis {pair.slave} is moving; stop it first")
+    res.stop(True)  # the engaged gear (a motion that follows the master) ends here
+    GT_PrfTrap.__wrapped__(ctl, pair.slave)
+
+
+def _still(ctl: Controller, *axes: int) -> None:
+    moving = [a for a in axes if axis_resources(ctl, a).moving]
+    if moving:
+        raise CommandError(f"GT_SetGantryMode: axes {moving} are moving; stop them first")
+
+
+@gt_function
+def GT_SetGantryMode(
+    ctl: Controller, group: int, master: int, slave: int, mode: int, syncErrorLimit: int = 1000
+) -> int:
+    """Pair ``slave`` with ``master`` (modes 1, 2) or release the group (-1)."""
+    g, m = int(group), int(mode)
+    groups = _groups(ctl)
+    old = groups.get(g)
+    if m == GANTRY_MODE_NONE:
+        if old is not None and old.mode != GANTRY_MODE_NONE:
+            _release(ctl, old)
+        groups[g] = _Pair(mode=GANTRY_MODE_NONE, limit=old.limit if old else 1000)
+        return 0
+    if m not in (GANTRY_MODE_OPEN_LOOP_GANTRY, GANTRY_MODE_DECOUPLE_POSITION_LOOP):
+        raise ParameterError(f"mode={m}: -1 none, 1 open-loop gantry, 2 decoupled position loop")
+    a, b = axis_resources(ctl, master).number, axis_resources(ctl, slave).number
+    if a == b:
+        raise ParameterError(f"master={a}, slave={b}: two different axes")
+    if int(syncErrorLimit) <= 0:
+        raise ParameterError(f"syncErrorLimit={syncErrorLimit}: pulses, > 0")
+    for n, p in groups.items():
+        if n != g and p.mode != GANTRY_MODE_NONE and {a, b} & {p.master, p.slave}:
+            raise ParameterError(
+                f"axis in gantry group {n} already (master {p.master}, slave {p.slave})"
+            )
+    if old is not None and old.mode != GANTRY_MODE_NONE:
+        _release(ctl, old)
+    _still(ctl, a, b)
+    GT_PrfGear.__wrapped__(ctl, b, 0)
+    GT_SetGearMaster.__wrapped__(ctl, b, a, _GEAR_MASTER_PROFILE, 0)
+    GT_SetGearRatio.__wrapped__(ctl, b, 1, 1, 0)
+    GT_GearStart.__wrapped__(ctl, 1 << (b - 1))
+    groups[g] = _Pair(a, b, m, int(syncErrorLimit))
+    return 0
+
+
+@gt_function
+def GT_GetGantryMode(
+    ctl: Controller, group: int, pMaster: Any, pSlave: Any, pMode: Any, pSyncErrorLimit: Any
+) -> int:
+    p = _groups(ctl).get(int(group), _Pair())
+    store(pMaster, p.master)
+    store(pSlave, p.slave)
+    store(pMode, p.mode)
+    store(pSyncErrorLimit, p.limit)
+    return 0
