@@ -1,11 +1,17 @@
-"""``gtecat lib --cflags --libs | --path | --header``: what a C/C++ build needs.
+"""``gtecat lib --cflags --libs | --path | --header``: what a C/C++ build needs;
+``--mono-config`` / ``--csharp``: what a C# (or VB.NET) program needs on Mono.
 
     gcc prog.c $(python3 -m gtecat lib --cflags --libs)
     g++ prog.cpp $(python3 -m gtecat lib --cflags --libs)
+    python3 -m gtecat lib --csharp -o gts.cs         (the GT API for new C# code)
+    mcs App.cs gts.cs && python3 -m gtecat lib --mono-config -o App.exe.config && mono App.exe
 
 ``--cflags`` prints the include directory of ``gts.h``; ``--libs`` the ``-L``, the
 rpath (so the program finds ``libgts.so`` without ``LD_LIBRARY_PATH``) and ``-lgts``;
-``--path`` the library itself (``ctypes.CDLL``).  The library is built on first use
+``--path`` the library itself (``ctypes.CDLL``).  ``--mono-config`` writes the Mono
+dllmap that sends ``gts.dll`` (``gen.dll``, ``gxn.dll``) to libgts's Windows-long build
+(docs/csharp.md): put it beside the program as ``App.exe.config``, or give it as
+``MONO_CONFIG``; ``--csharp`` writes ``gts.cs``.  The library is built on first use
 into a per-version cache (docs/native.md); with no C compiler this says so and exits 1.
 """
 
@@ -29,10 +35,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--include-dir", action="store_true", help="the directory of gts.h")
     p.add_argument("--header", action="store_true", help="print gts.h (generated, no build)")
     p.add_argument("--rebuild", action="store_true", help="compile again even if cached")
+    p.add_argument(
+        "--mono-config",
+        action="store_true",
+        help="the Mono dllmap sending gts.dll / gen.dll / gxn.dll to libgts (App.exe.config)",
+    )
+    p.add_argument("--csharp", action="store_true", help="gts.cs: the GT API for C# (generated)")
+    p.add_argument("-o", "--output", metavar="FILE", help="write --mono-config / --csharp here")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.mono_config or args.csharp:
+        return _csharp(args)
     if args.header:
         from ..native.header import render
 
@@ -57,4 +72,25 @@ def run(args: argparse.Namespace) -> int:
         lines.append(str(build.library))
     for line in lines:
         print(line)
+    return 0
+
+
+def _csharp(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..native import csharp
+
+    if args.mono_config and args.csharp:
+        print("error: --mono-config and --csharp write different files; ask for one")
+        return 1
+    if args.csharp:
+        text = csharp.render()
+    else:
+        from ..native.llp64 import ensure_built
+
+        text = csharp.mono_config(ensure_built(force=args.rebuild))
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+    else:
+        sys.stdout.write(text)
     return 0

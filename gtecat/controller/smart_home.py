@@ -106,6 +106,9 @@ from .motion.trap import SMOOTH_TIME_MAX
 from .profile import PrfMode
 from .resources import AxisResources, axis_resources
 
+#: how long GT_GoHome waits (controller time) for a Jog it takes over to stop
+JOG_STOP_TIMEOUT_MS = 60_000
+
 
 class HomeMode(IntEnum):
     LIMIT = 10
@@ -296,6 +299,8 @@ class SmartHome:
             )
         prm.check(len(self.ctl.axes))
         res = self.res
+        if res.profile.mode == PrfMode.JOG:
+            self._leave_jog(res)
         if res.moving:
             raise CommandError(f"axis {self.number} is moving: GT_Stop it first")
         self.params = prm
@@ -357,6 +362,34 @@ class SmartHome:
         self.status = HomeStatus(0, Stage.IDLE, error)
         self.reason = reason
         raise HomeRefused(error, f"GT_GoHome on axis {self.number}: {reason}")
+
+    def _leave_jog(self, res: AxisResources) -> None:
+        """GT_GoHome on an axis in Jog mode starts the homing, as the card does.
+
+        The vendor's smart-home demo jogs with a button (GT_PrfJog, GT_SetJogPrm, GT_SetVel,
+        GT_Update; GT_Stop on release) and its home button calls GT_ClrSts, GT_GetHomePrm and
+        GT_GoHome with no GT_PrfTrap between: on the card the homing runs.  So here a Jog
+        that still moves (still running, or on its GT_Stop ramp) is brought to a stop with the
+        smooth-stop deceleration (decSmoothStop, GT_SetStopDec) - GT_GoHome returns once the
+        axis stands, within :data:`JOG_STOP_TIMEOUT_MS` of controller time - and the profile
+        is put in Trap mode, which the homing moves in; a master-log line says so.  Other
+        modes (PT, Gear, Follow, interpolation) are still refused with
+        ``HOME_ERROR_NOT_TRAP_MODE``."""
+        was_moving = res.moving
+        if was_moving:
+            res.stop(False)
+            if not self.ctl.clock.run_until(lambda: not res.moving, JOG_STOP_TIMEOUT_MS):
+                raise CommandError(
+                    f"axis {self.number}: its Jog motion did not stop within "
+                    f"{JOG_STOP_TIMEOUT_MS} ms (GT_SetStopDec's smooth deceleration); "
+                    "GT_Stop it and home again"
+                )
+        res.prf_trap()
+        self.ctl.log(
+            f"GT_GoHome axis {self.number}: the axis was in Jog mode"
+            f"{' and moving (stopped first)' if was_moving else ''}; homing in Trap mode as "
+            "the card does"
+        )
 
     def _trigger_unit(self, prm: HomeParams, mode: HomeMode) -> CaptureUnit:
         if mode in FORCED_MODES or prm.triggerIndex == -1:

@@ -340,9 +340,44 @@ def test_go_home_return_codes():
     st = gt.THomeStatus()
     assert gt.GT_GetHomeStatus(1, byref(st)) == 0
     assert (st.run, st.error) == (0, gt.HOME_ERROR_HOME_MODE)
-    assert gt.GT_PrfJog(1) == 0
+    assert gt.GT_PrfPt(1) == 0  # Jog is taken over (below); PT, Gear, Follow are refused
     assert gt.GT_GoHome(1, byref(home_prm(mode=gt.HOME_MODE_HOME))) == 1
     assert gt.GT_GetHomeStatus(1, byref(st)) == 0 and st.error == gt.HOME_ERROR_NOT_TRAP_MODE
+
+
+def _jog(vel: float, ms: int) -> None:
+    """The vendor smart-home demo's jog button: PrfJog, GetJogPrm, SetJogPrm, SetVel, Update."""
+    jog = gt.TJogPrm()
+    assert gt.GT_PrfJog(1) == 0
+    assert gt.GT_GetJogPrm(1, byref(jog)) == 0
+    jog.acc, jog.dec, jog.smooth = 0.1, 0.1, 0
+    assert gt.GT_SetJogPrm(1, byref(jog)) == 0
+    assert gt.GT_SetVel(1, vel) == 0
+    assert gt.GT_Update(1) == 0
+    gt.GTE_Wait(ms)
+
+
+@pytest.mark.parametrize("released", [True, False], ids=["after-GT_Stop", "still-jogging"])
+def test_go_home_straight_after_a_jog_homes_as_the_card_does(released):
+    """The vendor smart-home demo: jog (button down), GT_Stop(255, 255) (button up), then
+    its home button: GT_ClrSts, GT_GetHomePrm, GT_GoHome - no GT_PrfTrap - and the card
+    homes.  Straight after the GT_Stop the jog still ramps down; without it the jog runs:
+    either way GT_GoHome stops it smoothly, switches to Trap and homes (smart_home
+    ``_leave_jog``), with a master-log line."""
+    open_card()
+    ctl = gt.GTE_Controller()
+    _jog(5.0, 200)  # 1000 counts up, at 5 pulse/ms
+    if released:
+        assert gt.GT_Stop(255, 255) == 0
+    sts = c_long()
+    assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & MOVING  # still moving
+    assert gt.GT_ClrSts(1) == 0
+    st = go_home(home_prm(mode=gt.HOME_MODE_HOME, moveDir=1))
+    assert (st.stage, st.error) == (gt.HOME_STAGE_END, gt.HOME_ERROR_NONE)
+    assert st.capturePos == LO  # the home switch's edge, as from a standstill
+    mode = c_long()
+    assert gt.GT_GetPrfMode(1, byref(mode)) == 0 and mode.value == 0  # Trap
+    assert any("was in Jog mode and moving" in line for line in ctl.log.lines)
 
 
 def test_home_index_through_the_gtn_twin():
