@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from ..controller import motion, safety
-from ..controller.config_file import apply_config, read_config
+from ..controller.config_file import apply_config, find_config, read_config
 from ..controller.core import Controller
 from ..controller.resources import AxisResources, axis_resources, axis_span, clear_status
 from ..controller.scale import Scale
@@ -268,7 +268,7 @@ def _file_name(pFile: Any) -> str:
 @gt_function
 def GT_LoadConfig(ctl: Controller, pFile: Any) -> int:
     """Load a configuration file (docs/config_file.md); flags update with GT_ClrSts (4.4)."""
-    config = read_config(_file_name(pFile))
+    config = read_config(find_config(_file_name(pFile), ctl.log))
     if not ctl.axes:
         raise BusError("GT_LoadConfig: no EtherCAT axis yet (call GT_InitEcatComm first)")
     moving = [n for n, ax in sorted(ctl.axes.items()) if ax.motion.moving]

@@ -11,6 +11,7 @@ capture is the middle of that cycle's travel: within ``v * T / 2`` and the count
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import importlib.util
 import sys
 from ctypes import byref, c_double, c_long, c_short, c_uint32
@@ -267,14 +268,36 @@ def test_get_di_reads_the_machine_inputs_of_each_axis():
     assert gt.GT_GetDi(99, byref(c_long())) == 7
 
 
-def test_get_di_applies_the_configuration_reverse_get_di_raw_does_not(tmp_path):
-    open_card()
+@pytest.mark.parametrize(
+    ("wiring", "raw", "logical"),
+    [
+        (None, 0, 1),  # wired as the configuration expects: normally closed, read right
+        ("normally_closed", 0, 1),
+        ("normally_open", 1, 0),  # the file disagrees with the machine: read inverted
+    ],
+)
+def test_get_di_applies_the_configuration_reverse_get_di_raw_does_not(
+    tmp_path, wiring, raw, logical
+):
+    """On the home switch, ``[home1] reverse=1``: GT_GetDiRaw is the line, GT_GetDi the line
+    through ``reverse``; the switch's wiring is the machine description's ``switch_wiring``,
+    else what the file expects (config_file.switch_sense)."""
+    machine = card_machine()
+    if wiring is not None:
+        a = dataclasses.replace(machine.axis(1), switch_wiring=wiring)
+        machine = MachineDescription({**machine.axes, 1: a})
+    assert gt.GT_Open(card="gts:2", machine=machine, clock="lockstep", log="") == 0
+    for a in (1, 2):
+        assert gt.GT_AxisOn(a) == 0
     trap_to(1, LO + 100)
+    # no file yet (reverse 0): a normally-closed line is off on the switch, read as is
+    before = (0, 0) if wiring == "normally_closed" else (1, 1)
+    assert (di(gt.MC_HOME, raw=True) & 1, di(gt.MC_HOME) & 1) == before
     cfg = tmp_path / "home.cfg"
     cfg.write_text("[home1]\nactive=1\nreverse=1\nfilterTime=3\n")
     assert gt.GT_LoadConfig(str(cfg)) == 0, gt.GTE_GetLastError()
-    assert di(gt.MC_HOME, raw=True) & 1 == 1
-    assert di(gt.MC_HOME) & 1 == 0  # a normally-closed sensor: active while the line is off
+    assert di(gt.MC_HOME, raw=True) & 1 == raw
+    assert di(gt.MC_HOME) & 1 == logical
 
 
 def test_set_do_drives_enable_clear_and_general_outputs():
