@@ -1,18 +1,22 @@
-"""``gtecat lib --cflags --libs | --path | --header``: what a C/C++ build needs;
-``--mono-config`` / ``--csharp``: what a C# (or VB.NET) program needs on Mono.
+"""gtecat lib: what a C, C++, C# or VB.NET program needs to use libgts.
+
+C and C++ (the header gts.h and libgts.so, built on first use into a per-version cache;
+with no C compiler this says so and exits 1):
 
     gcc prog.c $(python3 -m gtecat lib --cflags --libs)
     g++ prog.cpp $(python3 -m gtecat lib --cflags --libs)
-    python3 -m gtecat lib --csharp -o gts.cs         (the GT API for new C# code)
-    mcs App.cs gts.cs && python3 -m gtecat lib --mono-config -o App.exe.config && mono App.exe
+    python3 -m gtecat lib --path            the library itself (ctypes.CDLL)
 
-``--cflags`` prints the include directory of ``gts.h``; ``--libs`` the ``-L``, the
-rpath (so the program finds ``libgts.so`` without ``LD_LIBRARY_PATH``) and ``-lgts``;
-``--path`` the library itself (``ctypes.CDLL``).  ``--mono-config`` writes the Mono
-dllmap that sends ``gts.dll`` (``gen.dll``, ``gxn.dll``) to libgts's Windows-long build
-(docs/csharp.md): put it beside the program as ``App.exe.config``, or give it as
-``MONO_CONFIG``; ``--csharp`` writes ``gts.cs``.  The library is built on first use
-into a per-version cache (docs/native.md); with no C compiler this says so and exits 1.
+--cflags prints the include directory of gts.h; --libs the -L, the rpath (the program
+finds libgts.so without LD_LIBRARY_PATH) and -lgts.
+
+C# and VB.NET on Mono (docs/csharp.md): --mono-config writes the dllmap that sends the
+vendor's DLL names (gts.dll, gen.dll, gxn.dll) to libgts's Windows-long build (C# int is
+C long there); put it beside the program as App.exe.config, or name it in MONO_CONFIG.
+--csharp writes gts.cs, the GT API for new C# code:
+
+    python3 -m gtecat lib --csharp -o gts.cs
+    mcs App.cs gts.cs && python3 -m gtecat lib --mono-config -o App.exe.config && mono App.exe
 """
 
 from __future__ import annotations

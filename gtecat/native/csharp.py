@@ -10,9 +10,10 @@ code written against the vendor's wrapper reads the same against this one:
   (a text the function writes: ``StringBuilder`` with room for it);
 * a pointer that takes ``count`` elements has two overloads: ``out T`` (one element, as the
   vendor writes it) and ``T[]`` (``count`` of them: ``GT_GetPrfVel(1, vel, 8, out clock)``);
-  a fixed or unknown number of elements is ``T[]``;
+  a fixed or unknown number of elements, and bytes (``byte[]``), are arrays;
 * structures are ``[StructLayout(LayoutKind.Sequential)]`` with the C layout; an array
-  field is unrolled into numbered fields as the vendor does (``profile1`` .. ``profile8``),
+  field is unrolled into numbered fields as the vendor does (``profile1`` .. ``profile8``,
+  ``pad1_1`` .. ``pad1_3``),
   which keeps the structure blittable; a ``char`` array is a ``ByValTStr`` string; a pointer
   field is ``IntPtr``;
 * trailing scalar parameters keep the header's defaults (``GT_Open(short channel = 0, ...)``).
@@ -44,9 +45,13 @@ SCALAR_CS = {
     "unsigned char": "byte",
     "short": "short",
     "unsigned short": "ushort",
+    "signed char": "sbyte",
     "int": "int",
+    "unsigned int": "uint",
     "long": "int",
     "unsigned long": "uint",
+    "long long": "long",
+    "unsigned long long": "ulong",
     "double": "double",
     "float": "float",
 }
@@ -107,7 +112,8 @@ def _field_lines(name: str, t: type, where: str) -> list[str]:
         return [f"public {cs} {name};"]
     if len(dims) > 1:
         raise CSharpError(f"{where}: arrays of arrays are not unrolled")
-    return [f"public {cs} {name}{i};" for i in range(1, dims[0] + 1)]
+    sep = "_" if name[-1:].isdigit() else ""  # pad3 -> pad3_1, profile -> profile1
+    return [f"public {cs} {name}{sep}{i};" for i in range(1, dims[0] + 1)]
 
 
 def struct_decl(cls: type[ctypes.Structure], indent: str = "        ") -> list[str]:
@@ -157,8 +163,13 @@ def constant_decl(c: cdecl.Constant) -> str:
 
 # --- functions --------------------------------------------------------------------------------
 def _counted(p: Param) -> bool:
-    """A pointer whose element count another parameter gives (``out[count]``)."""
-    return p.pointer and isinstance(p.count, str) and not p.text
+    """A pointer whose element count another parameter gives (``out[count]``) and that
+    reads as one value too (``out double pValue``); bytes (``in[size]``) are always arrays."""
+    return p.pointer and isinstance(p.count, str) and not p.text and not _bytes(p)
+
+
+def _bytes(p: Param) -> bool:
+    return p.pointer and not p.text and p.ctype in ("char", "unsigned char")
 
 
 def _param_cs(p: Param, structs: set[str], *, arrays: bool) -> str:
@@ -179,7 +190,7 @@ def _param_cs(p: Param, structs: set[str], *, arrays: bool) -> str:
         return f"IntPtr {n}"
     else:
         raise CSharpError(f"{p.name}: pointer to {p.ctype!r} has no C# spelling")
-    many = p.count == 0 or (isinstance(p.count, int) and p.count > 1)
+    many = p.count == 0 or (isinstance(p.count, int) and p.count > 1) or _bytes(p)
     if many or (arrays and _counted(p)):
         return f"[Out] {cs}[] {n}" if p.direction != "in" else f"{cs}[] {n}"
     if p.direction == "out":
