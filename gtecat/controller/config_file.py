@@ -37,9 +37,12 @@ on an EtherCAT axis (axis/profile/encoder N = GT axis N, 4.3):
   inputs, "配置无效").
 * ``[limitPositiveN]`` / ``[limitNegativeN]`` / ``[homeN]`` / ``[alarmN]``: ``active``
   is the GT_LmtsOn/Off (GT_AlarmOn/Off) state of the axes that take this input (a stop
-  input whose source is not active is none); ``reverse=1`` inverts the input (a
-  normally-closed switch: a limit is triggered while 60FDh's bit is 0; an alarm while the
-  drive is *not* in fault - noted in the log, it is rarely what a bus axis wants);
+  input whose source is not active is none); ``reverse=1`` says the switch is
+  normally closed; the emulated switch is wired the way the file expects unless the machine
+  description's ``switch_wiring`` says otherwise (:func:`switch_sense`), so only a file that
+  disagrees with a stated wiring reads the switch inverted; an alarm's ``reverse=1`` inverts
+  it (active while the drive is *not* in fault - noted in the log, it is rarely what a bus
+  axis wants);
   ``filterTime`` is the card's input debounce (MCT writes 3): on a bus the drive
   debounces its own inputs and the master samples 60FDh / 6041h once a cycle, so the
   value is stored (:func:`vendor_settings`) and filters nothing again.  The drive's own
