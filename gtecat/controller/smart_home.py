@@ -79,7 +79,8 @@ the machine has.  Only an axis with no limit terminal at all (no 60FDh) is refus
 ``HOME_ERROR_HOME_MODE``: that search could never end.
 
 **Errors** end the homing (the axis is stopped with ``dec``; ``run`` drops once it stands;
-``stage`` stays where it failed): 1 not in Trap mode, 2 servo off (at the start or on the
+``stage`` stays where it failed): 1 not in Trap mode (a Jog is taken over instead:
+:meth:`SmartHome._leave_jog`), 2 servo off (at the start or on the
 way), 3 drive alarm, 4 stopped by someone else (GT_Stop, a stop input, the following
 error) or a search refused by a latched flag, 5 another motion command or a limit where
 none belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input
