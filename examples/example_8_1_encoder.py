@@ -15,8 +15,8 @@ import sys
 from ctypes import byref, c_double, c_short
 from pathlib import Path
 
-from drives.machine import AxisMachine, MachineDescription
 from gtecat import gt
+from gtecat.drives.machine import AxisMachine, MachineDescription
 
 HERE = Path(__file__).resolve().parent
 ENI = HERE / "twelve_axes.eni"

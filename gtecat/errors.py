@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from eni.errors import GtecatError
+from gtecat.eni.errors import GtecatError
 
 
 class BusError(GtecatError):

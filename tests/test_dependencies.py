@@ -1,4 +1,7 @@
-"""Dependency direction (DESIGN.md "Layout", STYLE.md "Shape"): eni -> drives -> gtecat.
+"""Dependency direction (DESIGN.md "Layout", STYLE.md "Shape"): eni -> drives -> the rest of gtecat.
+
+Installed, the package occupies the ``gtecat`` name only: ``gtecat.eni`` and ``gtecat.drives``
+are its lowest layers.
 
 Walks every module's imports with ``ast`` (lazy imports inside functions count too).
 """
@@ -11,11 +14,10 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-FORBIDDEN = {
-    "eni": {"drives", "gtecat", "tools"},
-    "drives": {"gtecat", "tools"},
-    "gtecat": {"tools"},
-}
+#: top-level names no module of the package may import
+FORBIDDEN_TOP = {"tools", "tests", "eni", "drives"}
+#: the gtecat subpackages the lowest layers may import (their own and those below)
+LOWEST = {"eni": {"eni"}, "drives": {"eni", "drives"}}
 
 
 def _imports(path: Path) -> set[str]:
@@ -29,13 +31,23 @@ def _imports(path: Path) -> set[str]:
     return out
 
 
-@pytest.mark.parametrize("package", sorted(FORBIDDEN))
-def test_packages_import_only_downwards(package):
+def test_package_imports_no_top_level_neighbours():
+    """A user's own ``eni.py``, ``drives.py`` or ``tools/`` beside their script change nothing."""
     bad = []
-    for path in sorted((ROOT / package).rglob("*.py")):
-        wrong = _imports(path) & FORBIDDEN[package]
+    for path in sorted((ROOT / "gtecat").rglob("*.py")):
+        wrong = _imports(path) & FORBIDDEN_TOP
         if wrong:
             bad.append(f"{path.relative_to(ROOT)} imports {', '.join(sorted(wrong))}")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("layer", sorted(LOWEST))
+def test_lowest_layers_import_only_downwards(layer):
+    bad = []
+    for path in sorted((ROOT / "gtecat" / layer).rglob("*.py")):
+        wrong = _gtecat_imports(path) - LOWEST[layer]
+        if wrong:
+            bad.append(f"{path.relative_to(ROOT)} imports gtecat.{', '.join(sorted(wrong))}")
     assert not bad, "\n".join(bad)
 
 
@@ -79,3 +91,26 @@ def test_gtecat_subpackages_import_only_downwards(sub):
         if wrong:
             bad.append(f"{path.relative_to(ROOT)} imports gtecat.{', '.join(sorted(wrong))}")
     assert not bad, "\n".join(bad)
+
+
+def test_users_own_modules_beside_the_script_change_nothing(tmp_path):
+    """A user's ``eni.py``, ``drives.py``, ``tools.py`` and ``tests/`` next to their script."""
+    import shutil
+    import subprocess
+    import sys
+
+    for name in ("eni.py", "drives.py", "tools.py"):
+        (tmp_path / name).write_text("raise ImportError('the user module was imported')\n")
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "__init__.py").write_text("raise ImportError('user tests imported')\n")
+    script = (
+        "import sys; sys.path.insert(0, '.')\n"
+        "from gtecat import gt\n"
+        "print(gt.GT_Open(eni='manual_fig5_2.eni', clock='lockstep'), gt.GT_InitEcatComm())\n"
+    )
+    shutil.copy(ROOT / "gtecat" / "examples" / "manual_fig5_2.eni", tmp_path)
+    run = subprocess.run(
+        [sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=60
+    )
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["0", "0"]

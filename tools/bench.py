@@ -40,9 +40,9 @@ EXAMPLES = ROOT / "examples"
 
 
 def _bus(eni: Path, *, plain: bool):
-    from drives.io_slaves import IoSlave
-    from eni.layout import build_layout
-    from eni.reader import read_eni
+    from gtecat.drives.io_slaves import IoSlave
+    from gtecat.eni.layout import build_layout
+    from gtecat.eni.reader import read_eni
     from gtecat.master.backends.emulated import EmulatedBackend
     from gtecat.master.bus import Master
 

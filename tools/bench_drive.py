@@ -20,10 +20,10 @@ import sys
 import time
 from typing import Any
 
-from drives.coe import SdoClient
-from drives.drive import Cia402Drive
-from drives.slave import AlState
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.coe import SdoClient
+from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.slave import AlState
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 
 CYCLE_NS = 1_000_000
 RX_PDO = Pdo(0x1600, Direction.OUT, (PdoEntry(0x6040, 0, 16), PdoEntry(0x607A, 0, 32)))

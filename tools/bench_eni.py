@@ -1,9 +1,9 @@
 """Benchmark: read a 64-slave ENI (issue 2 target: < 0.3 s).
 
-``bench_read(n_slaves)`` writes an ETG.2100 ENI with :mod:`eni.writer` into a
+``bench_read(n_slaves)`` writes an ETG.2100 ENI with :mod:`gtecat.eni.writer` into a
 temporary directory (servo drives with the figure 5-2 mapping, every fourth
 slave a 4-axis module, every eighth a DI16/DO16 terminal) and times
-:func:`eni.reader.read_eni` plus :func:`eni.layout.build_layout`, best of
+:func:`gtecat.eni.reader.read_eni` plus :func:`gtecat.eni.layout.build_layout`, best of
 several runs.  ``python tools/bench_eni.py`` prints the result as JSON.
 """
 
@@ -15,10 +15,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from eni.layout import build_layout
-from eni.reader import read_eni
-from eni.topology import build_config
-from eni.writer import write_eni_file
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
+from gtecat.eni.topology import build_config
+from gtecat.eni.writer import write_eni_file
 
 TARGET_S = 0.3
 

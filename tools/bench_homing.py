@@ -4,7 +4,7 @@
 
 ``homing_10s``: one homing run (method 7 from the right of the cam: out to the
 positive limit, back through the cam, index search, return) that takes about 10 s of
-virtual time at 1 kHz, with :class:`drives.homing.Homing` and a kinematic axis (the
+virtual time at 1 kHz, with :class:`gtecat.drives.homing.Homing` and a kinematic axis (the
 actual position is last cycle's demand).  ``all_methods``: every supported method
 once on the same machine.  ``touch_probe_us_per_step``: both probes enabled in
 continuous mode on both edges, axis crossing marks.  Only the components are timed,
@@ -17,9 +17,9 @@ import argparse
 import json
 import time
 
-from drives.homing import SUPPORTED_METHODS, Homing, HomingParams
-from drives.machine import AxisMachine
-from drives.touch_probe import TouchProbe
+from gtecat.drives.homing import SUPPORTED_METHODS, Homing, HomingParams
+from gtecat.drives.machine import AxisMachine
+from gtecat.drives.touch_probe import TouchProbe
 
 MACHINE = AxisMachine(
     counts_per_rev=10000,

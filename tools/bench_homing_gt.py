@@ -33,7 +33,7 @@ START = 60_500.0
 
 
 def _machine():
-    from drives.machine import AxisMachine, MachineDescription
+    from gtecat.drives.machine import AxisMachine, MachineDescription
 
     return MachineDescription(
         {

@@ -135,7 +135,7 @@ def homing_status(a: int) -> int:
 
 def machine(n: int) -> Any:
     """Every axis at 0 with a negative limit switch :data:`FAR` counts away."""
-    from drives.machine import AxisMachine, MachineDescription
+    from gtecat.drives.machine import AxisMachine, MachineDescription
 
     return MachineDescription({a: AxisMachine(negative_limit=-FAR) for a in range(1, n + 1)})
 

@@ -4,7 +4,7 @@ CoE carries CANopen's SDO protocol (ETG.1000.6 5.6.2): an expedited request or
 response, or an initiate/abort frame, is the same 8 bytes on CAN (CiA 301 7.2.4.3)
 as after the mailbox and CoE headers of a mailbox message.  So the bridge wraps each
 8-byte CAN SDO request received on COB-ID 0x600 + node id into a whole mailbox
-message (``drives.coe.build_coe``), hands it to ``slave.mailbox()``, strips the
+message (``gtecat.drives.coe.build_coe``), hands it to ``slave.mailbox()``, strips the
 6-byte mailbox header and 2-byte CoE header from the answer and sends those 8 bytes
 on 0x580 + node id.  That lets a CANopen client nobody here wrote (python-canopen's
 ``BaseNode402``) drive our CiA-402 drive over SDO only.
@@ -35,8 +35,8 @@ import can
 import canopen
 from canopen import objectdictionary as cod
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.coe import (
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.coe import (
     COE_HEADER_SIZE,
     CoeService,
     MailboxType,
@@ -47,8 +47,8 @@ from drives.coe import (
     next_counter,
     parse_mailbox,
 )
-from drives.od import Access, ObjectCode, ObjectDictionary, Variable
-from drives.slave import VirtualSlave
+from gtecat.drives.od import Access, ObjectCode, ObjectDictionary, Variable
+from gtecat.drives.slave import VirtualSlave
 
 SDO_RX = 0x600  # client -> server (CiA 301 predefined connection set)
 SDO_TX = 0x580  # server -> client

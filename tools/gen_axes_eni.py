@@ -6,7 +6,7 @@ Each slave maps, like the drives of ``examples/twelve_axes.eni`` without the
 probe and velocity objects: outputs 6040h (u16), 607Ah (i32), 6060h (i8);
 inputs 6041h (u16), 6064h (i32), 60FDh (u32), 6061h (i8).  ``--no-modes``
 leaves 6060h/6061h out (the controller then reaches them by SDO).  The file is
-built by :mod:`eni.topology` and written by :mod:`eni.writer`, the same path as
+built by :mod:`gtecat.eni.topology` and written by :mod:`gtecat.eni.writer`, the same path as
 ``gtecat eni new``.  The benchmarks import :func:`write_axes_eni`.
 """
 
@@ -21,9 +21,9 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from eni.model import EniConfig  # noqa: E402
-from eni.topology import build_config  # noqa: E402
-from eni.writer import write_eni_file  # noqa: E402
+from gtecat.eni.model import EniConfig  # noqa: E402
+from gtecat.eni.topology import build_config  # noqa: E402
+from gtecat.eni.writer import write_eni_file  # noqa: E402
 
 MAX_AXES = 128
 RX = ("0x6040:0:16", "0x607A:0:32", "0x6060:0:8")

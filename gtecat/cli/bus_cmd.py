@@ -11,7 +11,7 @@ import argparse
 import struct
 from typing import Any
 
-from eni.numbers import parse_int
+from gtecat.eni.numbers import parse_int
 
 from ..errors import ParameterError
 from . import output

@@ -17,7 +17,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from drives.machine import MachineError
+from gtecat.drives.machine import MachineError
 
 from ..errors import BusError, ConfigMismatch, ParameterError
 from . import output

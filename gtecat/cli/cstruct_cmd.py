@@ -16,9 +16,9 @@ import os
 import sys
 from pathlib import Path
 
-from eni.cstruct import render
-from eni.layout import build_layout
-from eni.reader import read_eni
+from gtecat.eni.cstruct import render
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
 
 from ..errors import ParameterError
 from . import output

@@ -15,8 +15,8 @@ from ctypes import byref, c_short, c_ulong, c_ushort
 from importlib import resources
 from pathlib import Path
 
-from eni.topology import parse_topology
-from eni.writer import write_eni_file
+from gtecat.eni.topology import parse_topology
+from gtecat.eni.writer import write_eni_file
 
 from ..errors import BusError
 

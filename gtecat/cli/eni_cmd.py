@@ -1,9 +1,9 @@
 """``gtecat eni new TOPOLOGY.toml -o OUT.eni``: write an ETG.2100 ENI from a short topology.
 
-The topology format is documented in :mod:`eni.topology` (servo drives with a
+The topology format is documented in :mod:`gtecat.eni.topology` (servo drives with a
 chosen PDO mapping, multi-axis modules, DI/DO terminals, couplers with
 DI/DO/AI/AO modules).  The file written reads back to the same model
-(:mod:`eni.writer`); ``gtecat map`` shows its offsets.
+(:mod:`gtecat.eni.writer`); ``gtecat map`` shows its offsets.
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from eni.errors import GtecatError
-from eni.layout import build_layout
-from eni.topology import load_topology
-from eni.writer import write_eni
+from gtecat.eni.errors import GtecatError
+from gtecat.eni.layout import build_layout
+from gtecat.eni.topology import load_topology
+from gtecat.eni.writer import write_eni
 
 
 def add_parser(subparsers: Any) -> None:

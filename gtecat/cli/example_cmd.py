@@ -75,6 +75,11 @@ def find(name: str) -> Example:
     )
 
 
+def read_bytes(path: str) -> bytes:
+    """The content of a shipped example file (``path`` inside the examples folder)."""
+    return _root().joinpath(path).read_bytes()
+
+
 def role(path: str, text: str | None = None) -> str:
     """What a file of an example is, for the listing."""
     p = PurePosixPath(path)
@@ -84,11 +89,16 @@ def role(path: str, text: str | None = None) -> str:
         return "ENI"
     if p.suffix == ".cfg":
         return "controller configuration (GT_LoadConfig)"
+    if p.suffix in (".py", ".toml") and text is None:
+        text = _root().joinpath(path).read_text(encoding="utf-8")
     if p.suffix in (".py", ".cpp", ".c"):
+        if p.suffix == ".py" and text is not None and "def scenario(" in text:
+            return "sweep scenario (gtecat sweep)"
         return "script" if p.suffix == ".py" else "C/C++ program"
     if p.suffix == ".toml":
-        if text is None:
-            text = _root().joinpath(path).read_text(encoding="utf-8")
+        assert text is not None
+        if "[base]" in text:
+            return "sweep grid (gtecat sweep --grid)"
         return "topology (gtecat eni new)" if "[[slave]]" in text else "machine description"
     return "file"
 
@@ -160,8 +170,17 @@ def run(args: argparse.Namespace) -> int:
     for p, rel in zip(written, example.all_files(), strict=True):
         print(f"  {p.name:<{width}}  {role(rel)}")
     cd = "" if str(out) == "." else f"cd {out} && "
+    grid = next(
+        (p for p, r in zip(written, example.all_files(), strict=True) if "grid" in role(r)), None
+    )
+    scenario = next(
+        (p for p, r in zip(written, example.all_files(), strict=True) if "scenario" in role(r)),
+        None,
+    )
     if example.script and example.script.endswith(".py"):
         print(f"next: {cd}python3 {PurePosixPath(example.script).name}")
+    elif grid and scenario:
+        print(f"next: {cd}gtecat sweep {scenario.name} --grid {grid.name}")
     else:
         eni = next((p.name for p in written if p.suffix == ".eni"), None)
         if eni:

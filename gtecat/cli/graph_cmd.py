@@ -13,9 +13,9 @@ import shutil
 import subprocess
 import sys
 
-from eni.graph import render as render_graph
-from eni.layout import build_layout
-from eni.reader import read_eni
+from gtecat.eni.graph import render as render_graph
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
 
 from ..errors import ParameterError
 from . import output

@@ -11,7 +11,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from eni.errors import GtecatError
+from gtecat.eni.errors import GtecatError
 
 #: verb modules under gtecat.cli, in help order
 COMMANDS = (
@@ -33,6 +33,7 @@ COMMANDS = (
     "controller_cmd",
     "lib_cmd",
     "compile_cmd",
+    "sweep_cmd",
 )
 
 

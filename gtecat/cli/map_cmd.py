@@ -13,10 +13,10 @@ import json
 import sys
 from typing import Any
 
-from eni.errors import GtecatError
-from eni.layout import Layout, Placement, SlaveLayout, build_layout
-from eni.model import Direction
-from eni.reader import read_eni
+from gtecat.eni.errors import GtecatError
+from gtecat.eni.layout import Layout, Placement, SlaveLayout, build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.reader import read_eni
 
 _FORMATS = {"xml": "ETG.2100 ENI XML", "googol": "Googol INI Gecat.eni"}
 

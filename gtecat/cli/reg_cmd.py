@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import argparse
 
-from drives.esc.registers import Reg
-from eni.numbers import parse_int
+from gtecat.drives.esc.registers import Reg
+from gtecat.eni.numbers import parse_int
 
 from ..errors import ParameterError
 from . import output

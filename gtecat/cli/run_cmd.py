@@ -26,7 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
-from eni.errors import GtecatError
+from gtecat.eni.errors import GtecatError
 
 from ..errors import ParameterError
 

@@ -70,7 +70,16 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="the same as --wait spin",
     )
-    p.add_argument("--rt-priority", type=int, metavar="N", help="run under SCHED_FIFO priority N")
+    p.add_argument(
+        "--rt-priority",
+        type=_rt_priority,
+        default="auto",
+        metavar="N|auto|off",
+        help="SCHED_FIFO priority N (1-99); auto (default) takes priority "
+        f"{AUTO_RT_PRIORITY} and a CPU of its own where the system permits it (root or "
+        "CAP_SYS_NICE) and says so in the ready line, else runs normally with a warning; "
+        "off never asks",
+    )
     p.add_argument(
         "--cpu",
         type=int,
@@ -119,7 +128,7 @@ def _positive(kind: type[int] | type[float]):
 
 def _writable(path: Path, option: str) -> None:
     """Fail now, in one line, for a file that cannot be written at the end of the run."""
-    from eni.errors import GtecatError
+    from gtecat.eni.errors import GtecatError
 
     probe = path.with_name(path.name + ".tmp")
     try:
@@ -132,24 +141,102 @@ def _writable(path: Path, option: str) -> None:
 def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool = False):
     # -> tuple[Chain, EniConfig]
     """The ENI's slaves behind ESCs (what ``serve`` puts on the wire), each with the SII
-    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.wire.eni_wire`)."""
-    from drives.esc import Chain
-    from drives.machine import MachineDescription, load_machine
-    from eni.layout import build_layout
-    from eni.reader import read_eni
+    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.drives.esc.sii_eni`)."""
+    from gtecat.drives.esc import Chain
+    from gtecat.drives.esc.sii_eni import sii_for
+    from gtecat.drives.machine import MachineDescription, load_machine
+    from gtecat.eni.layout import build_layout
+    from gtecat.eni.reader import read_eni
     from gtecat.master.factory import build_slaves
-    from gtecat.wire.eni_wire import read_wire, sii_for
 
     config = read_eni(eni)
     layout = build_layout(config)
     desc = load_machine(machine) if machine else MachineDescription()
     slaves = build_slaves(layout, desc)
-    wire = read_wire(eni) or [None] * len(slaves)
-    if len(wire) != len(slaves):
-        wire = [None] * len(slaves)
-    sii = [sii_for(slave, w) for slave, w in zip(slaves, wire, strict=True)]
+    sii = [sii_for(slave, s) for slave, s in zip(slaves, config.slaves, strict=True)]
     chain = Chain(slaves, sii=sii, watchdog_trips=watchdog_trips)
     return chain, config
+
+
+#: the SCHED_FIFO priority ``--rt-priority auto`` asks for: above the kernel's threaded
+#: interrupt handlers of ordinary devices (50 is theirs too; a NIC's own stays above)
+AUTO_RT_PRIORITY = 50
+
+
+def _rt_priority(text: str) -> int | str | None:
+    """``--rt-priority``: a number 1-99, ``auto`` or ``off`` (0 is off too)."""
+    t = text.strip().lower()
+    if t in ("auto", "off"):
+        return t
+    try:
+        n = int(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: a priority 1-99, auto or off") from None
+    if n == 0:
+        return "off"
+    if not 1 <= n <= 99:
+        raise argparse.ArgumentTypeError(f"{n}: SCHED_FIFO priorities are 1-99")
+    return n
+
+
+def take_scheduling(rt: int | str, wait_given: str, cpu: int | None) -> tuple[int | None, str]:
+    """The real-time priority ``serve`` runs under and words for the ready line.
+
+    ``auto``: a server that answers frames must not wait behind other work on a busy host
+    (a master drops an answer later than its timeout, SOEM's is 2 ms). It asks for
+    SCHED_FIFO and, on a machine of two CPUs or more with no ``--cpu``, the last CPU; where
+    the system refuses, it runs normally and warns. Decision: an explicit ``--wait spin``
+    keeps normal priority under ``auto`` (a task that never sleeps under SCHED_FIFO is
+    stopped by the kernel for 50 ms of every second and takes the CPU from everything
+    else); the number form takes FIFO anyway, as asked."""
+    from gtecat.wire.serve import WireError, pin_to_cpu, realtime_priority
+
+    if rt == "off" or (rt == "auto" and wait_given == "spin"):
+        return None, "normal priority"
+    prio = AUTO_RT_PRIORITY if rt == "auto" else int(rt)
+    try:
+        realtime_priority(prio)
+    except WireError as exc:
+        if rt != "auto":
+            raise
+        print(
+            f"warning: running at normal priority ({exc}); on a busy host answers may come "
+            "later than a master's timeout: run as root or give python CAP_SYS_NICE",
+            file=sys.stderr,
+        )
+        return None, "normal priority (real-time refused)"
+    where = ""
+    if rt == "auto" and cpu is None:
+        try:
+            cpus = sorted(os.sched_getaffinity(0))
+        except (AttributeError, OSError):
+            cpus = []
+        if len(cpus) >= 2:
+            pin_to_cpu(cpus[-1])
+            where = f" on CPU {cpus[-1]}"
+    return prio, f"SCHED_FIFO {prio}{where}"
+
+
+def _scheduling_now() -> tuple[int, int, set[int]] | None:
+    try:
+        return (
+            os.sched_getscheduler(0),
+            os.sched_getparam(0).sched_priority,
+            os.sched_getaffinity(0),
+        )
+    except (AttributeError, OSError):
+        return None
+
+
+def _restore_scheduling(before: tuple[int, int, set[int]] | None) -> None:
+    if before is None:
+        return
+    policy, prio, cpus = before
+    try:
+        os.sched_setscheduler(0, policy, os.sched_param(prio))
+        os.sched_setaffinity(0, cpus)
+    except (AttributeError, OSError):
+        pass
 
 
 def resolve_wait(wait: str, rt_priority: int | None = None) -> str:
@@ -174,22 +261,26 @@ def resolve_wait(wait: str, rt_priority: int | None = None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from eni.errors import GtecatError
-    from gtecat.wire.serve import WireServer, interface_is_up, pin_to_cpu, realtime_priority
+    from gtecat.eni.errors import GtecatError
+    from gtecat.wire.serve import WireServer, interface_is_up, pin_to_cpu
 
     if args.verbose:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
-    wait = "spin" if args.busy_poll else resolve_wait(args.wait, args.rt_priority)
-    if wait == "spin" and args.rt_priority:
+    wait_given = "spin" if args.busy_poll else args.wait
+    if args.cpu is not None:
+        pin_to_cpu(args.cpu)
+    wants_rt = args.rt_priority != "off" and not (
+        args.rt_priority == "auto" and wait_given == "spin"
+    )
+    wait = resolve_wait(wait_given, AUTO_RT_PRIORITY if wants_rt else None)
+    if wait == "spin" and wants_rt:
         print(
             "warning: a spinning server under SCHED_FIFO is stopped by the kernel for 50 ms "
             "every second (sched_rt_runtime_us); --wait predict sleeps between frames",
             file=sys.stderr,
         )
-    if args.cpu is not None:
-        pin_to_cpu(args.cpu)
     if not Path("/sys/class/net", args.iface).exists() and Path("/sys/class/net").is_dir():
-        from eni.errors import GtecatError
+        from gtecat.eni.errors import GtecatError
 
         raise GtecatError(
             f"no network interface {args.iface!r}: `gtecat ifaces` lists the ones this machine has"
@@ -225,8 +316,12 @@ def run(args: argparse.Namespace) -> int:
         wait=wait,
         pcap=pcap,
     )
-    if args.rt_priority:
-        realtime_priority(args.rt_priority)
+    # the scheduling last, once everything that can fail has been checked; given back at
+    # the end (a program that calls serve in-process keeps its own)
+    before = _scheduling_now()
+    rt, scheduling = take_scheduling(args.rt_priority, wait_given, args.cpu)
+    if rt is None and wants_rt and wait == "predict" and args.wait == "auto":
+        wait = server.wait = resolve_wait("auto", None)
 
     def _stop(signum: int, _frame: FrameType | None) -> None:
         server.stop.set()
@@ -255,13 +350,15 @@ def run(args: argparse.Namespace) -> int:
         served.append(True)
         names = ", ".join(f"{s.position}:{s.name}" for s in chain.slaves)
         print(
-            f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}), --wait {wait}; ready",
+            f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}), --wait {wait}, "
+            f"{scheduling}; ready",
             flush=True,
         )
 
     try:
         server.serve(ready=_ready, duration_s=args.duration)
     finally:
+        _restore_scheduling(before)
         for s, h in old.items():
             signal.signal(s, h)
         server.close()
@@ -280,7 +377,7 @@ def run(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point for ``python -m gtecat.cli.serve_cmd`` (same options as ``gtecat serve``)."""
-    from eni.errors import GtecatError
+    from gtecat.eni.errors import GtecatError
 
     parser = argparse.ArgumentParser(prog="gtecat serve", description=__doc__)
     _arguments(parser)

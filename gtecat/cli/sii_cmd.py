@@ -37,7 +37,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def decoded(raw: bytes) -> dict[str, object]:
-    from drives.esc.sii import parse_sii
+    from gtecat.drives.esc.sii import parse_sii
 
     info = parse_sii(raw)
     i = info.identity

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 
-from drives.slave import AlState
+from gtecat.drives.slave import AlState
 
 from ..errors import ParameterError
 from . import output

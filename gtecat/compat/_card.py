@@ -149,6 +149,8 @@ class AxisRegs:
     settings: dict[str, Any] = field(default_factory=dict)  #: kept, no effect here
     stopdata: int = 0
     stopped_by_user: bool = False
+    last_acc: float = 0.0  #: pulse/ms², the last nonzero acceleration of a drive
+    ring: bool = False  #: variable ring counters: LP in 0..COMP+, EP in 0..COMP- (4.3)
 
     def vel(self, value: float | None = None) -> float:
         """pulse/ms of a speed register value."""
@@ -162,6 +164,14 @@ class AxisRegs:
         return SCurveParams(self.vel(self.sv), self.vel(), acc, dec, jerk, triangle)
 
 
+def _ring(value: float, top: int | None) -> float:
+    """A counter with the variable ring on: it counts 0..``top`` and wraps both ways
+    (seed 004 4.3: COMP+ the logic counter's, COMP- the real counter's largest value)."""
+    if top is None or top < 0:
+        return value
+    return value % (top + 1)
+
+
 class PulseCard:
     """One opened card: the controller, the registers of its four axes, the outputs."""
 
@@ -171,6 +181,8 @@ class PulseCard:
         self.regs = {n: AxisRegs() for n in AXES}
         self.outputs = 0
         self.general_inputs = 0  #: the IN terminals (nothing in the machine drives them)
+        #: a STOP2 stop clears the real position counter at the signal (ADT850 1.5, 9.4)
+        self.stop2_clears_ep = False
         self.cycle_ms = ctl.clock.cycle_ns / 1e6
         self._index_seen = dict.fromkeys(AXES, False)
         for n in AXES:
@@ -198,26 +210,39 @@ class PulseCard:
 
     # --- counters -----------------------------------------------------------------------
     def lp(self, axis: int) -> float:
-        return self.res(axis).ax.prf_pos + self.regs[axis].lp_off
+        regs = self.regs[axis]
+        return _ring(self.res(axis).ax.prf_pos + regs.lp_off, regs.comp[0] if regs.ring else None)
+
+    def counted(self, axis: int) -> float:
+        """The encoder as the real position counter counts it: ``set_actualcount_mode``'s
+        direction (1: reversed) and, for A/B input, its multiplication (4x is the encoder's
+        own count; 2x half of it, 1x a quarter)."""
+        mode = self.regs[axis].settings.get("set_actualcount_mode", (0, 0, 0))
+        value, direction, freq = mode
+        scale = (1.0, 0.5, 0.25)[freq] if value == 0 else 1.0
+        return (-1.0 if direction else 1.0) * scale * self.res(axis).enc_pos
 
     def ep(self, axis: int) -> float:
-        return self.res(axis).enc_pos + self.regs[axis].ep_off
+        regs = self.regs[axis]
+        return _ring(self.counted(axis) + regs.ep_off, regs.comp[1] if regs.ring else None)
 
     def set_lp(self, axis: int, value: int) -> None:
         self.regs[axis].lp_off = value - self.res(axis).ax.prf_pos
 
     def set_ep(self, axis: int, value: int) -> None:
-        self.regs[axis].ep_off = value - self.res(axis).enc_pos
+        self.regs[axis].ep_off = value - self.counted(axis)
 
     def speed(self, axis: int) -> float:
         """The axis's current speed in V units (PPS / M)."""
         r = self.res(axis)
         return abs(r.prf_vel) * 1000.0 / self.regs[axis].m
 
-    def accel(self, axis: int) -> float:
-        """The current acceleration in A units (PPS/s / (125·M))."""
+    def accel(self, axis: int, held: bool = False) -> float:
+        """The current acceleration in A units (PPS/s / (125·M)); ``held``: the last
+        nonzero one while the acceleration is 0 (a register that holds its value)."""
         r = self.res(axis)
-        return abs(r.prf_acc) * 1e6 / (125.0 * self.regs[axis].m)
+        acc = abs(r.prf_acc) or (self.regs[axis].last_acc if held else 0.0)
+        return acc * 1e6 / (125.0 * self.regs[axis].m)
 
     # --- inputs -------------------------------------------------------------------------
     def din(self, axis: int) -> int:
@@ -235,6 +260,20 @@ class PulseCard:
             return self._index_seen[axis]
         ch = self.ctl.backend.drive(axis).channel(0)
         return ch.machine.probe_active(1, ch.machine_position)
+
+    def signal_ahead(self, axis: int, k: int, direction: int) -> bool:
+        """Whether a search in ``direction`` can meet STOP``k`` or a limit switch: the
+        machine description has a home-switch window (STOP0) or an index (STOP1) ahead,
+        or a limit switch in that direction."""
+        ch = self.ctl.backend.drive(axis).channel(0)
+        m, at = ch.machine, ch.machine_position
+        if (m.positive_limit if direction > 0 else m.negative_limit) is not None:
+            return True
+        if k == 1:
+            return m.index_offset is not None
+        if k == 0:
+            return any((hi > at) if direction > 0 else (lo <= at) for lo, hi in m.home_switch)
+        return bool(m.probe1)
 
     def alarm(self, axis: int) -> bool:
         return self.res(axis).drive_faulted()
@@ -290,7 +329,12 @@ class PulseCard:
             w |= 0x02
         a, j, s = self.phase(axis)
         eps = 1e-12
-        w |= 0x04 if a > eps else 0x10 if a < -eps else 0x08
+        if a > eps or (a >= -eps and j > 0):  # a ramp's first instant: a = 0, jerk > 0
+            w |= 0x04
+        elif a < -eps or j < 0:
+            w |= 0x10
+        else:
+            w |= 0x08
         if s and (a > eps or a < -eps or j != 0.0):
             mag_grows = (a > eps and j > 0) or (a < -eps and j < 0) or abs(a) <= eps
             w |= 0x20 if mag_grows and j != 0.0 else 0x40 if j == 0.0 else 0x80
@@ -315,12 +359,15 @@ class PulseCard:
                 prof.stop(abrupt=True)
                 raise CommandError(f"axis {axis} moves in another mode; it is being stopped")
             prof.enter(PrfMode.CARD_DRIVE, factory=lambda: SCurvePlanner(self.cycle_ms))
-        self._check_soft(axis, direction)
+        regs.stopdata = 0
+        regs.stopped_by_user = False
+        blocked = self._blocked(axis, direction)
+        if blocked:
+            regs.stopdata = blocked  # the chip takes the command and ends it at once
+            return
         r.clear_flags()
         r.check_motion(f"{self.name} drive", float(direction))
         self._limit_mode(axis)
-        regs.stopdata = 0
-        regs.stopped_by_user = False
         planner = prof.planner
         assert isinstance(planner, SCurvePlanner)
         prm = regs.params(triangle=distance is not None and not regs.s_curve)
@@ -333,13 +380,26 @@ class PulseCard:
             manual_dec=float(regs.dec_pos),
         )
 
-    def _check_soft(self, axis: int, direction: int) -> None:
+    def _blocked(self, axis: int, direction: int) -> int:
+        """The error bits (get_stopdata D3/D4 limits, D6/D7 COMP registers) of a drive
+        that cannot start: toward an active limit, or past a soft limit in its direction.
+
+        Decision (seed 004 5.x and chapter 8 say a drive "stops" at a limit; 1 is kept for
+        a wrong card or axis): the command is accepted (0) and the drive ends at once with
+        its stop bit, as the chip does; ``get_status`` reads 0, ``get_stopdata`` why."""
         regs = self.regs[axis]
+        if direction > 0 and self.limit(axis, True):
+            return 0x08
+        if direction < 0 and self.limit(axis, False):
+            return 0x10
+        if regs.ring:
+            return 0  # the ring uses COMP+/COMP- as its tops: no soft limits (4.3)
         src = self.ep(axis) if regs.soft_ep else self.lp(axis)
         if direction > 0 and regs.soft[0] and src >= regs.comp[0]:
-            raise CommandError(f"axis {axis} is at or past COMP+ ({regs.comp[0]}): only - moves")
+            return 0x40
         if direction < 0 and regs.soft[1] and src < regs.comp[1]:
-            raise CommandError(f"axis {axis} is below COMP- ({regs.comp[1]}): only + moves")
+            return 0x80
+        return 0
 
     def decel_stop(self, axis: int) -> None:
         c = self.crd_of(axis)
@@ -468,6 +528,8 @@ class PulseCard:
             regs = self.regs[n]
             r = self.res(n)
             v = r.prf_vel
+            if r.prf_acc:
+                regs.last_acc = abs(r.prf_acc)  # the CA register holds it at constant speed
             bits = 0
             for k in range(3):
                 if regs.stop_on[k] and self.stop_input(n, k):
@@ -479,12 +541,14 @@ class PulseCard:
             if r.latched & AxisStatus.ALARM:
                 bits |= 0x20
             src = self.ep(n) if regs.soft_ep else self.lp(n)
-            if regs.soft[0] and v > 0 and src >= regs.comp[0]:
+            if not regs.ring and regs.soft[0] and v > 0 and src >= regs.comp[0]:
                 bits |= 0x40
-            if regs.soft[1] and v < 0 and src < regs.comp[1]:
+            if not regs.ring and regs.soft[1] and v < 0 and src < regs.comp[1]:
                 bits |= 0x80
             if not bits:
                 continue
+            if bits & 0x04 and self.stop2_clears_ep and not regs.stopdata & 0x04:
+                self.set_ep(n, 0)  # the counter clears at the signal; the stop comes after
             regs.stopdata |= bits
             if bits & (0x07 | 0xC0):
                 self._signal_stop(n)

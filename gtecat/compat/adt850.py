@@ -18,13 +18,14 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
   D = 1, K = 1, dec_pos 0.  The modes are the seed's 1.1 list.
 * **Interpolation speed** is the master axis's (X for X-Y, X-Y-Z, X-Y-Z-W; Z for Z-W) in
   base pulses (:mod:`gtecat.controller.crd.base_pulse`): the long axis of a line, the
-  faster axis of each octant of an arc.  Z's settings are not needed (the seed's 5.8
-  requirement on them is a hardware detail).  Interpolation deceleration is disabled at
-  start (9.2.6: "默认情况是插补减速禁止"): a node then accelerates and stops at once at
-  its end; ``inp_dec_enable`` before a node decelerates it (automatically for lines,
-  at ``set_dec_pos`` base pulses from the node's start in manual mode).  Returned 1: an
-  arc with acceleration and automatic deceleration, an S-curve arc, an S-curve node
-  written while one runs (continuous interpolation, 5.4).
+  faster axis of each octant of an arc.  A 3/4-axis line needs Z set as 5.8/5.9 say
+  (refused with 1 otherwise), and one that stopped early needs ``inp_clear`` (9.3).
+  Interpolation deceleration is disabled at start (9.2.6: "默认情况是插补减速禁止"): a
+  node then accelerates and stops at once at its end; ``inp_dec_enable`` before a node
+  decelerates it (automatically for lines, at ``set_dec_pos`` base pulses from the
+  node's start in manual mode).  Returned 1: an arc with acceleration and automatic
+  deceleration, an S-curve arc, an S-curve node written while one runs (continuous
+  interpolation, 5.4).
 * **Continuous interpolation**: ``get_inp_status2`` is 1 while the interpolation runs
   and no next node waits (the chip's one-node buffer); a node written then is run right
   after the current one, at the base speed the current one ends with.
@@ -108,7 +109,9 @@ def adt850_initial(**options: Any) -> int:
     except Exception as e:
         _set_error(f"adt850_initial: {e}")
         return 0 if "EtherCAT master" in str(e) else -1
+    _CARD[0].stop2_clears_ep = True
     _DEC_ENABLED.update({1: False, 2: False})
+    _INP34.clear()
     return 1
 
 
@@ -157,12 +160,37 @@ def _setting(name: str, *ranges: tuple[str, int, int]) -> Callable[..., int]:
     return setter
 
 
-set_actualcount_mode = _setting(
+_set_actualcount_mode = _setting(
     "set_actualcount_mode", ("value", 0, 1), ("dir", 0, 1), ("freq", 0, 2)
 )
+
+
+@functools.wraps(_set_actualcount_mode)
+def set_actualcount_mode(cardno: int, axis: int, value: int, dir: int, freq: int) -> int:
+    """1.6: the real position counter's input: A/B (0) or up/down pulses (1), its
+    direction (1 reversed) and the A/B multiplication (0 4x, 1 2x, 2 1x). The counter
+    keeps its reading; it counts from now on as set."""
+    card = _CARD[0]
+    keep = card.ep(axis) if card is not None and axis in (1, 2, 3, 4) else None
+    rc = _set_actualcount_mode(cardno, axis, value, dir, freq)
+    if rc == 0 and keep is not None:
+        card.set_ep(axis, round(keep))
+    return rc
+
+
 set_pulse_mode = _setting("set_pulse_mode", ("value", 0, 1), ("logic", 0, 1), ("dir_logic", 0, 1))
 set_inpos_mode = _setting("set_inpos_mode", ("value", 0, 1), ("logic", 0, 1))
-set_circle_mode = _setting("set_circle_mode", ("value", 0, 1))
+
+
+@_api()
+def set_circle_mode(cardno: int, axis: int, value: int) -> int:
+    """1.17 / 4.3: the variable ring: LP counts 0..COMP+, EP 0..COMP-, wrapping both ways;
+    with it on, COMP+/COMP- are no soft limits."""
+    card, n = _axis(cardno, axis)
+    card.regs[n].ring = _flag("value", value)
+    return 0
+
+
 set_input_filter = _setting("set_input_filter", ("number", 1, 4), ("value", 0, 1))
 set_filter_time = _setting("set_filter_time", ("value", 1, 8))
 set_input_fiilter = set_input_filter  # the seed's chapter 6 spelling
@@ -390,6 +418,7 @@ def pmove(cardno: int, axis: int, pulse: int) -> int:
     """5.1: a fixed drive of ``pulse`` pulses (sign = direction)."""
     card, n = _axis(cardno, axis)
     p = integer("pulse", pulse, -PULSE_MAX, PULSE_MAX)
+    _check_zw(card, n)
     card.drive(n, abs(p), 1 if p >= 0 else -1)
     return 0
 
@@ -398,6 +427,7 @@ def pmove(cardno: int, axis: int, pulse: int) -> int:
 def continue_move(cardno: int, axis: int, dir: int) -> int:
     """5.2: a continuous drive, 0 positive, 1 negative, until a stop."""
     card, n = _axis(cardno, axis)
+    _check_zw(card, n)
     card.drive(n, None, -1 if _flag("dir", dir) else 1)
     return 0
 
@@ -485,7 +515,7 @@ def inp_move3(cardno: int, pulse1: int, pulse2: int, pulse3: int) -> int:
     """5.8: X-Y-Z line."""
     card = _card(cardno)
     d = (_inp("pulse1", pulse1), _inp("pulse2", pulse2), _inp("pulse3", pulse3))
-    _interp(card, 1, [1, 2, 3], PulseCard.line(d), False)
+    _interp34(card, [1, 2, 3], d)
     return 0
 
 
@@ -494,8 +524,47 @@ def inp_move4(cardno: int, pulse1: int, pulse2: int, pulse3: int, pulse4: int) -
     """5.9: X-Y-Z-W line."""
     card = _card(cardno)
     d = tuple(_inp(f"pulse{k + 1}", p) for k, p in enumerate((pulse1, pulse2, pulse3, pulse4)))
-    _interp(card, 1, [1, 2, 3, 4], PulseCard.line(d), False)
+    _interp34(card, [1, 2, 3, 4], d)
     return 0
+
+
+#: where a 3/4-axis interpolation sends Z and W (LP), until it is over or inp_clear
+_INP34: dict[int, float] = {}
+
+
+def _inp34_error(card: PulseCard) -> bool:
+    """9.3: a 3/4-axis interpolation that stopped before its distance leaves an error that
+    makes Z and W move wrongly until ``inp_clear``."""
+    if not _INP34 or bank(card.ctl).get(1).running:
+        return False
+    return any(abs(card.lp(a) - t) > 0.5 for a, t in _INP34.items())
+
+
+def _check_zw(card: PulseCard, axis: int) -> None:
+    if axis in (3, 4) and _inp34_error(card):
+        raise CompatError(
+            "a 3/4-axis interpolation stopped before its end: Z and W do not move right "
+            "until inp_clear (9.3)"
+        )
+
+
+def _interp34(card: PulseCard, axes: list[int], d: tuple[int, ...]) -> None:
+    """5.8/5.9: the speed is X's; the card needs Z's multiplier (range) and drive speed
+    equal to X's, and Z's start speed equal to X's drive speed. Decision: other Z settings
+    are refused with 1 and the rule (the card runs them wrongly)."""
+    _check_zw(card, 3)
+    x, z = card.regs[1], card.regs[3]
+    if (z.m, z.v, z.sv) != (x.m, x.v, x.v):
+        raise CompatError(
+            f"3/4-axis interpolation (5.8/5.9): Z needs X's range and speed and a start "
+            f"speed equal to X's speed: X M={x.m:g} V={x.v}, Z M={z.m:g} V={z.v} SV={z.sv}"
+        )
+    running = bank(card.ctl).get(1).running
+    for a, delta in zip(axes, d, strict=True):
+        if a in (3, 4):
+            base = _INP34.get(a, card.lp(a)) if running else card.lp(a)
+            _INP34[a] = base + delta
+    _interp(card, 1, axes, PulseCard.line(d), False)
 
 
 @_api()
@@ -516,8 +585,9 @@ def inp_dec_disable(cardno: int, no: int) -> int:
 
 @_api()
 def inp_clear(cardno: int) -> int:
-    """5.12: clear a 3/4-axis interpolation error (nothing sticks here: always 0)."""
+    """5.12 / 9.3: clear the error a 3/4-axis interpolation that did not end leaves."""
     _card(cardno)
+    _INP34.clear()
     return 0
 
 
@@ -526,25 +596,32 @@ _SIGNALS = ("LMT+", "LMT-", "STOP0", "STOP1", "STOP2", "INPOS", "ALARM", "IN")
 
 
 def _input(card: PulseCard, number: int) -> int:
+    """The electrical level of input ``number`` (6.1: 0 low, 1 high).
+
+    A signal that is active reads its active level: low unless its mode says high-active
+    (limits: ``set_limit_mode`` logic, 1.1 "低电平有效" by default; STOP0-2: their
+    ``set_stopN_mode`` logic; INPOS/ALARM: ``set_inpos_mode``/``set_alarm_mode`` logic, the
+    nINPOS/nALARM inputs being low-active by default). Code that tests
+    ``read_bit(0, 0) == 0`` for "X LMT+ hit" works as on the card. IN terminals are
+    levels already (nothing in the machine drives them; they read high when open)."""
     n, k = number // 8 + 1, number % 8
-    if k == 0:
-        on = card.limit(n, True)
-    elif k == 1:
-        on = card.limit(n, False)
+    regs = card.regs[n]
+    if k in (0, 1):
+        on, high = card.limit(n, k == 0), regs.settings.get("limit_logic", 0)
     elif k <= 4:
-        on = card.stop_input(n, k - 2)
+        on, high = card.stop_input(n, k - 2), regs.stop_logic[k - 2]
     elif k == 5:
-        on = card.inpos(n)
+        on, high = card.inpos(n), regs.settings.get("set_inpos_mode", (0, 0))[1]
     elif k == 6:
-        on = card.alarm(n)
+        on, high = card.alarm(n), regs.settings.get("alarm_logic", 0)
     else:
-        on = bool(card.general_inputs >> (n - 1) & 1)
-    return 1 if on else 0
+        return 0 if card.general_inputs >> (n - 1) & 1 else 1
+    return int(on) if high else int(not on)
 
 
 @_api()
 def read_di(cardno: int, value: Any) -> int:
-    """6.1: all 32 inputs, D0 X LMT+ ... D31 W IN (1 = active)."""
+    """6.1: all 32 inputs, D0 X LMT+ ... D31 W IN, as electrical levels (0 low, 1 high)."""
     card = _card(cardno)
     out(value, sum(_input(card, b) << b for b in range(32)))
     return 0
@@ -560,7 +637,7 @@ def write_do(cardno: int, value: int) -> int:
 
 @_api(error=-1)
 def read_bit(cardno: int, number: int) -> int:
-    """6.3: one input, 0/1, -1 on a bad card or input number."""
+    """6.3: one input's level, 0 low / 1 high, -1 on a bad card or input number."""
     card = _card(cardno)
     return _input(card, integer("number", number, 0, 31))
 
@@ -1037,11 +1114,24 @@ def set_output(number: int, value: int) -> int:
 def _home(axes: list[int], pfn: FUNCTION) -> int:
     """B.2-B.5: each axis searches its home signal (STOP0 home switch, STOP1 encoder Z) in
     its direction at the home speed; 1 found (the counters become 0 there), -2 a limit
-    came first, -1 a disabled axis, 0 stopped from outside."""
+    came first, -1 a disabled axis, 0 stopped from outside.
+
+    Decision: "-2 未检测到原点信号" also when the machine has neither the signal nor a limit
+    switch ahead of the axis: the search is refused at once (a card would drive until
+    someone stops it; a test would never end)."""
     card = _card(0)
     for n in axes:
         if not _app(n).enabled:
             return -1
+    for n in axes:
+        p = _app(n)
+        if not card.signal_ahead(n, p.home_signal, -1 if p.home_dir else 1):
+            signal = ("home switch (STOP0)", "encoder index (STOP1)")[p.home_signal]
+            _set_error(
+                f"home: axis {n} has no {signal} and no limit switch in its search "
+                "direction: the search would never end"
+            )
+            return -2
     for n in axes:
         p = _app(n)
         regs = card.regs[n]

@@ -1,8 +1,9 @@
 """The MCX314 card library of seed 003 (chapter 4) over our axes.
 
-``from gtecat.compat import mcx314 as m`` then ``m.Open(clock="lockstep")`` (the seed's
-library has no open call: the card is found at power-up; :func:`Open` is ours) and the
-functions of tables 4-2 to 4-7 with the seed's names and argument order.  The seed's
+``from gtecat.compat import mcx314 as m`` and the functions of tables 4-2 to 4-7 with
+the seed's names and argument order.  The library has no open call (the card is found at
+power-up): the first call opens the card (the one ``GT_Open`` opened, else a ``gts:4`` card
+with the ``GTECAT_*`` settings); :func:`Open` (ours) chooses its options.  The seed's
 functions are ``void``: they return None, and a value outside the seed's range (or a call
 the card cannot do now) raises :class:`~gtecat.compat.CompatError` naming it; the
 ``unsigned`` readers return the register (32-bit two's complement for positions).
@@ -23,11 +24,14 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
 * **Curves**: ``_C`` interpolations run at constant ``V``; ``_T`` with T ramps and the
   deceleration ``AutoDec`` / ``ManualDec`` chose (``ManualDec(axis, DecPulse)``: at
   ``DecPulse`` base pulses); a T arc needs ``ManualDec`` (4.4 note: raises otherwise);
-  ``_S`` lines with S ramps.  ``SCurve_F``'s unnamed fifth argument is the deceleration D.
+  ``_S`` lines with S ramps.  ``SCurve_F``'s unnamed fifth argument has no effect (the
+  text names no deceleration: S drives are symmetric).  ``LINEDATA``/``CIRCLEDATA`` are
+  taken by their fields (or their layout), not their class.
   ``TCurve_F`` / ``SCurve_F`` ``Pulse`` is relative, its sign the direction.
-* **Soft limits**: ``SLMTP(n)`` / ``SLMTM(n)`` with ``n = 1`` make COMP+ / COMP- soft
-  limits of all axes (``SetCompP`` / ``SetCompM(axis, data)``), ``n = 0`` turns them
-  off; ``SLMTSig(n)`` compares with LP (0) or EP (1).  Level settings (``HLMTP``,
+* **Soft limits**: ``SLMTP(n)`` / ``SLMTM(n)`` make COMP+ / COMP- soft limits of all
+  axes (``SetCompP`` / ``SetCompM(axis, data)``); ``n`` is the "active level" the thesis
+  names, kept (a comparison has none), ``RESET`` turns them off; ``SLMTSig(n)`` compares
+  with LP (0) or EP (1).  Level settings (``HLMTP``,
   ``ALMSig``, ...) and encoder modes are kept, with no effect on the emulated signals.
 * **Homing** ``HomeTypeN(WR1Reg, SV, V, A)``: ``WR1Reg`` is the chip's WR1 input-stop
   register - bit 2k+1 enables IN k (IN0 home switch, IN1 encoder Z, IN2 probe 1), bit
@@ -98,9 +102,13 @@ def _api(fn: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def _card() -> PulseCard:
+    """The card; the first call of a program opens it (the thesis' library has no open
+    call: the card is there from power-up), with the card ``GT_Open`` opened if there is
+    one, else a ``gts:4`` card with the ``GTECAT_*`` settings."""
+    if _CARD[0] is None:
+        Open()
     card = _CARD[0]
-    if card is None:
-        raise CompatError("the card is not open: call mcx314.Open() first")
+    assert card is not None
     return card
 
 
@@ -125,8 +133,8 @@ def Open(**options: Any) -> None:
         _set_error(f"Open: {e}")
         raise CompatError(f"Open: {e}") from e
     for n in AXES:
-        _card().regs[n].settings["fp"] = 0
-        _card().regs[n].settings["cp"] = 0
+        _CARD[0].regs[n].settings["fp"] = 0
+        _CARD[0].regs[n].settings["cp"] = 0
 
 
 def Close() -> None:
@@ -278,9 +286,14 @@ def TCurve_C(axis: int, SV: int, V: int, A: int, direction: int = 0) -> None:
 
 
 @_api
-def SCurve_F(axis: int, m_SV: int, m_V: int, m_A: int, m_D: int, m_K: int, m_Pulse: int) -> None:
-    """S-curve fixed drive; ``m_D`` is the seed's unnamed fifth argument (0: = A)."""
-    card, axes = _curve(axis, m_SV, m_V, m_A, m_D, m_K, True)
+def SCurve_F(
+    axis: int, m_SV: int, m_V: int, m_A: int, unnamed: int, m_K: int, m_Pulse: int
+) -> None:
+    """S-curve fixed drive. The prototype's fifth argument has no name and the text names
+    SV, V, A and K only: it is taken (an int, checked) and has no effect; the curve is
+    symmetric (deceleration = A)."""
+    integer("unnamed", unnamed, -(2**31), 2**31 - 1)
+    card, axes = _curve(axis, m_SV, m_V, m_A, 0, m_K, True)
     _fixed(card, axes, m_Pulse)
 
 
@@ -310,12 +323,20 @@ def SuddenStop(axis: int) -> None:
 
 # --- 4.5 interpolation ------------------------------------------------------------------------
 def _data(p: Any, cls: type) -> Any:
+    """A LINEDATA / CIRCLEDATA by its fields, not its class: a program's own structure
+    (ctypes, or any object) with ``SV, V, A, D, K`` works, as in C any struct of that
+    layout would; a ctypes structure without those names is read by layout (five ints)."""
     obj = getattr(p, "_obj", p)
     if isinstance(obj, ctypes._Pointer):
         obj = obj.contents
-    if not isinstance(obj, cls):
-        raise CompatError(f"a {cls.__name__} (or a pointer to one) is expected")
-    return obj
+    names = [f[0] for f in cls._fields_]
+    if all(hasattr(obj, n) for n in names):
+        return obj
+    if isinstance(obj, ctypes.Structure) and ctypes.sizeof(obj) >= ctypes.sizeof(cls):
+        return cls.from_buffer_copy(bytes(memoryview(obj).cast("B"))[: ctypes.sizeof(cls)])
+    raise CompatError(
+        f"a {cls.__name__} (fields {', '.join(names)}), or a pointer to one, is expected"
+    )
 
 
 def _prm(card: PulseCard, master: int, d: Any, shape: str) -> SCurveParams:
@@ -469,18 +490,27 @@ def HLMTSig(n: int, axis: int) -> None:
 
 @_api
 def SLMTP(n: int) -> None:
-    """COMP+ soft limit of all axes on (1) / off (0)."""
+    """Sets up the COMP+ soft limit of all axes; ``n`` is its active level (0 low, 1 high),
+    as the thesis writes it.
+
+    Decision: a soft limit is a comparison, with no electrical level; the call turns the
+    COMP+ limit on whatever ``n`` is (0 and 1 alike), and keeps ``n``. ``RESET`` turns it
+    off."""
     card = _card()
+    level = integer("n", n, 0, 1)
     for a in AXES:
-        card.regs[a].soft[0] = bool(integer("n", n, 0, 1))
+        card.regs[a].soft[0] = True
+        card.regs[a].settings["slmtp_level"] = level
 
 
 @_api
 def SLMTM(n: int) -> None:
-    """COMP- soft limit of all axes on (1) / off (0)."""
+    """The COMP- soft limit of all axes, as :func:`SLMTP` (``n`` the active level)."""
     card = _card()
+    level = integer("n", n, 0, 1)
     for a in AXES:
-        card.regs[a].soft[1] = bool(integer("n", n, 0, 1))
+        card.regs[a].soft[1] = True
+        card.regs[a].settings["slmtm_level"] = level
 
 
 @_api
@@ -632,9 +662,10 @@ def ReadCV(axis: int) -> int:
 
 @_api
 def ReadCA(axis: int) -> int:
-    """The current acceleration in A units."""
+    """The current acceleration in A units; at constant speed it holds the value the ramp
+    ended with (the thesis: the register holds its value), 0 before any drive."""
     card, n = _one(axis)
-    return round(card.accel(n))
+    return round(card.accel(n, held=True))
 
 
 @_api

@@ -25,10 +25,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from drives.cia402 import State as PdsState
-from drives.cia402 import decode_state as _decode_state
-from eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
-from eni.layout import AxisRef, Layout
+from gtecat.drives.cia402 import State as PdsState
+from gtecat.drives.cia402 import decode_state as _decode_state
+from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
+from gtecat.eni.layout import AxisRef, Layout
 
 from ..errors import CommandError
 from ..master.image import EntryAccess, ProcessImage

@@ -5,7 +5,7 @@ drive state machine, mechanics, PDO codec, status and limit checks).  Most axes 
 machine spend most cycles in one state: servo on, drive in CSP, Trap move or holding,
 no flag latched.  :class:`AxisBank` runs exactly that state for every such axis at
 once - the Trap samples (:func:`~gtecat.controller.motion.trap_table.trap_table`), the
-axis layer's 607Ah, the drive (:class:`drives.csp_bank.CspBank`), the encoder, the soft
+axis layer's 607Ah, the drive (:class:`gtecat.drives.csp_bank.CspBank`), the encoder, the soft
 and hardware limits, the following error, the in-position band and the GT_GetSts word -
 and reads/writes the process image as array views.
 
@@ -21,7 +21,7 @@ before anything else may look at or change them:
   drive's own following-error window) releases it *before* that cycle, so the scalar
   code runs that cycle and every later one until the axis is back in the common state;
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
-  the slave through :attr:`drives.drive.Cia402Drive.on_touch`;
+  the slave through :attr:`gtecat.drives.drive.Cia402Drive.on_touch`;
 * per-cycle hooks the bank does not know (a recorder, motion programs, smart homing)
   and axes in Gear/Follow mode (they read other axes every cycle) turn it off.
 
@@ -45,11 +45,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from drives.csp_bank import CW_ENABLED, CspBank, claimable, wrap32
-from drives.drive import Cia402Drive
-from drives.slave import AlState
-from eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
-from eni.model import Direction
+from gtecat.drives.csp_bank import CW_ENABLED, CspBank, claimable, wrap32
+from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.slave import AlState
+from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
+from gtecat.eni.model import Direction
 
 from .axis_status import AxisStatus
 from .bank_kernel import Kernel

@@ -51,8 +51,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from drives.abort import SdoAbort
-from eni.errors import GtecatError
+from gtecat.drives.abort import SdoAbort
+from gtecat.eni.errors import GtecatError
 
 from ..errors import CommandError, ParameterError
 from .axis import Axis

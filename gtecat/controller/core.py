@@ -45,10 +45,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from drives.machine import MachineDescription, load_machine
-from eni.errors import EniError
-from eni.layout import Layout, build_layout
-from eni.reader import read_eni
+from gtecat.drives.machine import MachineDescription, load_machine
+from gtecat.eni.errors import EniError
+from gtecat.eni.layout import Layout, build_layout
+from gtecat.eni.reader import read_eni
 
 from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master

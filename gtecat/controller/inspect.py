@@ -18,8 +18,8 @@ import weakref
 from collections.abc import Sequence
 from typing import Any
 
-from drives.slave import AlState, AlStatusCode
-from eni.model import Direction
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.model import Direction
 
 from ..errors import BusError, ParameterError
 from .core import Controller
@@ -313,11 +313,13 @@ class BusView:
         if self._escs_of is not self.master:  # a new bus (GT_InitEcatComm again)
             self._escs, self._escs_of = {}, self.master
         if position not in self._escs:
-            from drives.esc.registers import Esc
-            from drives.esc.sii import build_sii, sii_info_for
+            from gtecat.drives.esc.registers import Esc
+            from gtecat.drives.esc.sii import build_sii
+            from gtecat.drives.esc.sii_eni import sii_for
 
+            info = sii_for(slave, self.master.layout.config.slaves[position])
             self._escs[position] = Esc(
-                slave, build_sii(sii_info_for(slave)), position=position, chain_length=self.count
+                slave, build_sii(info), position=position, chain_length=self.count
             )
         esc = self._escs[position]
         esc.sync_al()
@@ -415,7 +417,7 @@ class BusView:
 
     # --- the configuration, rendered -----------------------------------------------------------
     def cstruct(self, prefix: str = "", position: int | None = None) -> str:
-        from eni.cstruct import render
+        from gtecat.eni.cstruct import render
 
         if position is not None:
             self.check(position)
@@ -423,7 +425,7 @@ class BusView:
         return render(layout, layout.config.source, prefix=prefix, only=position)
 
     def graph(self) -> str:
-        from eni.graph import render
+        from gtecat.eni.graph import render
 
         layout = self.master.layout
         return render(layout.config, layout)

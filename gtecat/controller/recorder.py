@@ -34,9 +34,9 @@ from pathlib import Path
 
 import numpy as np
 
-from drives.cia402 import STATE_PATTERN, Cw, State, Sw
-from drives.modes import OpMode
-from eni.numbers import parse_int
+from gtecat.drives.cia402 import STATE_PATTERN, Cw, State, Sw
+from gtecat.drives.modes import OpMode
+from gtecat.eni.numbers import parse_int
 
 from ..errors import ParameterError
 from .core import Controller
@@ -223,7 +223,7 @@ def signal_kind(ctl: Controller, spec: str) -> tuple[Getter, Kind]:
         return master.image.access(p).get, _entry_kind(index, p.bits, p.name or "")
     for var in layout.config.variables:
         if var.name == spec:
-            from eni.layout import Placement
+            from gtecat.eni.layout import Placement
 
             p = Placement(
                 slave=-1,

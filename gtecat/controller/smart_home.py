@@ -1,6 +1,6 @@
 """Smart homing (GT_GoHome): the controller's own search for the home of an axis.
 
-Not the drive's homing (6098h methods, :mod:`drives.homing`): here the controller moves
+Not the drive's homing (6098h methods, :mod:`gtecat.drives.homing`): here the controller moves
 the axis in Trap mode, watches its limit inputs and captures home / index edges with its
 own capture (:mod:`gtecat.controller.capture`), on any axis - a GTS card's pulse axis or an
 EtherCAT drive in CSP.  The facts are the vendor header's (``THomePrm``, ``THomeStatus``,

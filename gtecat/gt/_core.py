@@ -21,9 +21,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from drives.abort import SdoAbort
-from drives.machine import MachineError
-from eni.errors import EniError, GtecatError
+from gtecat.drives.abort import SdoAbort
+from gtecat.drives.machine import MachineError
+from gtecat.eni.errors import EniError, GtecatError
 
 from ..controller.bank import BANK_READS
 from ..controller.card import refused

@@ -44,8 +44,8 @@ from __future__ import annotations
 import ctypes
 from typing import Any
 
-from drives.abort import SdoAbort
-from drives.slave import AlState
+from gtecat.drives.abort import SdoAbort
+from gtecat.drives.slave import AlState
 
 from .. import __version__
 from ..controller.core import Controller, Options

@@ -103,7 +103,7 @@ from dataclasses import dataclass
 from enum import IntFlag
 from typing import Any
 
-from drives.abort import SdoAbort
+from gtecat.drives.abort import SdoAbort
 
 from ..controller.axis import Axis, PdsState
 from ..controller.core import Controller

@@ -27,10 +27,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from drives.slave import AlState, AlStatusCode
-from eni.errors import GtecatError
-from eni.layout import Layout
-from eni.model import InitCmd
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.errors import GtecatError
+from gtecat.eni.layout import Layout
+from gtecat.eni.model import InitCmd
 
 from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend

@@ -6,9 +6,9 @@ The controller core is the same; this module is what lies below it on a card.
 
 **How the card is modelled.**  Each axis's step/direction output drives a servo (or
 stepper) amplifier that follows the pulses with the same mechanics model as the
-EtherCAT drives (``drives.mechanics``: acceleration limit, following error), and the
+EtherCAT drives (``gtecat.drives.mechanics``: acceleration limit, following error), and the
 axis's encoder counts the motor.  We build that as an internal bus of N single-axis
-:class:`drives.drive.Cia402Drive` in cyclic synchronous position mode (one slave per
+:class:`gtecat.drives.drive.Cia402Drive` in cyclic synchronous position mode (one slave per
 axis, outputs 6040h/607Ah, inputs 6041h/6064h/60FDh/603Fh), exchanged in-process every
 cycle: the pulse train of a cycle is the step of 607Ah, the enable output is 6040h, the
 encoder is 6064h, the drive's alarm output is its fault bit (6041h bit 3).  The card's
@@ -39,11 +39,11 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from drives.drive import Cia402Drive, DriveSettings
-from drives.machine import MachineDescription
-from drives.signal_edges import merge_windows, window_edges
-from eni.layout import Layout, build_layout
-from eni.topology import build_config
+from gtecat.drives.drive import Cia402Drive, DriveSettings
+from gtecat.drives.machine import MachineDescription
+from gtecat.drives.signal_edges import merge_windows, window_edges
+from gtecat.eni.layout import Layout, build_layout
+from gtecat.eni.topology import build_config
 
 from ..errors import ParameterError
 from .backends.emulated import EmulatedBackend

@@ -1,21 +1,21 @@
 """ENI -> virtual slaves: what the emulated bus (and ``gtecat serve``) puts on the wire.
 
 A slave that maps a CiA-402 controlword/statusword pair per channel becomes a
-:class:`drives.drive.Cia402Drive` with one channel per GT axis (its mechanics
+:class:`gtecat.drives.drive.Cia402Drive` with one channel per GT axis (its mechanics
 from the machine description, by GT axis number); every other slave becomes a
-:class:`drives.io_slaves.IoSlave` driven by its mapping (a
-:class:`drives.io_slaves.CoeIoSlave` when the ENI gives it a mailbox).  The drives' initial
+:class:`gtecat.drives.io_slaves.IoSlave` driven by its mapping (a
+:class:`gtecat.drives.io_slaves.CoeIoSlave` when the ENI gives it a mailbox).  The drives' initial
 PDO mapping is what the ENI lists; the ENI's CoE InitCmds are then applied by
 the master through the mailbox, as on a real bus.
 """
 
 from __future__ import annotations
 
-from drives.io_slaves import CoeIoSlave, IoSlave
-from drives.machine import MachineDescription
-from drives.slave import VirtualSlave
-from eni.layout import Layout
-from eni.model import InitCmd
+from gtecat.drives.io_slaves import CoeIoSlave, IoSlave
+from gtecat.drives.machine import MachineDescription
+from gtecat.drives.slave import VirtualSlave
+from gtecat.eni.layout import Layout
+from gtecat.eni.model import InitCmd
 
 
 def build_slave(
@@ -25,7 +25,7 @@ def build_slave(
     sl = layout.slaves[position]
     cfg = layout.config.slaves[position]
     if sl.channels:
-        from drives.drive import Cia402Drive
+        from gtecat.drives.drive import Cia402Drive
 
         channels = max(sl.channels) + 1
         by_channel = dict(zip(sl.channels, sl.axes, strict=True))
@@ -58,7 +58,7 @@ def adopt_init_cmd_objects(slave: VirtualSlave, cmds: tuple[InitCmd, ...]) -> li
     od = getattr(slave, "od", None)
     if od is None:
         return []
-    from drives.od import Access, DataType, ObjectCode, OdObject, Variable
+    from gtecat.drives.od import Access, DataType, ObjectCode, OdObject, Variable
 
     added = []
     sizes = {1: DataType.UINT8, 2: DataType.UINT16, 4: DataType.UINT32, 8: DataType.UINT64}

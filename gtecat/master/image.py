@@ -6,7 +6,7 @@ flat byte buffer holds the outputs then the inputs, and ``outputs`` /
 image of manual 5.2.2.4 (slaves in bus order, each slave's output bytes then
 its input bytes) is not stored: :class:`ProcessImage` maps every raw byte to
 the logical byte it stands for, so ``GT_GetEcatRawData`` is one numpy gather.
-Slaves whose areas are not byte aligned go through :mod:`eni.bits`.
+Slaves whose areas are not byte aligned go through :mod:`gtecat.eni.bits`.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eni.bits import copy_bits, get_bits, set_bits
-from eni.layout import Layout, Placement
-from eni.model import Direction
+from gtecat.eni.bits import copy_bits, get_bits, set_bits
+from gtecat.eni.layout import Layout, Placement
+from gtecat.eni.model import Direction
 
 from ..errors import ParameterError
 

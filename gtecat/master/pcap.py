@@ -104,7 +104,7 @@ class BusCapture:
     The in-process backend exchanges no frames; for a capture it describes each
     of its operations as the frames SOEM would send for it and the answers a
     chain of ESCs would return (ETG.1000.4 datagrams, built by
-    :func:`drives.esc.frames.encode_frame`):
+    :func:`gtecat.drives.esc.frames.encode_frame`):
 
     * a scan: ``BRD 0000h`` answered with the slave count as WKC;
     * a state request: ``FPWR 0120h`` (AL control) then ``FPRD 0130h`` (AL status,
@@ -125,7 +125,7 @@ class BusCapture:
     _started: set[Path] = set()  # noqa: RUF012 - process-wide on purpose
 
     def __init__(self, path: str | Path, *, mailbox_size: int = 128) -> None:
-        from drives.esc.frames import MASTER_MAC
+        from gtecat.drives.esc.frames import MASTER_MAC
 
         key = Path(path).resolve()
         self.writer = PcapWriter(path, append=key in BusCapture._started)
@@ -160,7 +160,7 @@ class BusCapture:
         wkc: int,
         t_ns: int | None = None,
     ) -> None:
-        from drives.esc.frames import Datagram, encode_frame
+        from gtecat.drives.esc.frames import Datagram, encode_frame
 
         self._index = (self._index + 1) & 0xFF
         n = self._count_adp(command, adp)

@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from eni.errors import GtecatError
+from gtecat.eni.errors import GtecatError
 
 from ..errors import ParameterError
 from ..gt import _core

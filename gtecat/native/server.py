@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from eni.errors import GtecatError
+from gtecat.eni.errors import GtecatError
 
 from ..gt import _core
 from ..gt.fast import READERS, wire_reader

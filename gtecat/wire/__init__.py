@@ -1,1 +1,1 @@
-"""``gtecat serve``: the ENI's virtual slaves on a real or virtual NIC (the ESC is drives.esc)."""
+"""``gtecat serve``: the ENI's virtual slaves on a real or virtual NIC (ESC: gtecat.drives.esc)."""

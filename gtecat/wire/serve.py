@@ -2,7 +2,7 @@
 
 A :class:`WireServer` owns a raw ``AF_PACKET`` socket bound to EtherType 88A4h
 on one interface (one end of a veth pair in tests, a spare NIC in a lab) and a
-:class:`drives.esc.Chain`.  Its loop, single-threaded so the slaves never need
+:class:`gtecat.drives.esc.Chain`.  Its loop, single-threaded so the slaves never need
 locks:
 
 1. receive a frame (``recv_into`` a preallocated buffer, no copies);
@@ -26,7 +26,7 @@ When the slaves step (``step_mode``):
   independent of the master, like a drive in free run.
 
 Latency: the cyclic datagram is answered from input snapshots and its outputs
-reach the slaves after the send (:class:`drives.esc.chain.Chain`); the slaves'
+reach the slaves after the send (:class:`gtecat.drives.esc.chain.Chain`); the slaves'
 step answers a frame that arrives meanwhile between two slaves; the garbage
 collector runs between frames, never inside one; sends bypass the qdisc.  The
 recorded latency is honest: from the kernel's receive timestamp (SO_TIMESTAMPNS,
@@ -58,9 +58,9 @@ from array import array
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from drives.esc import Chain
-from drives.esc.frames import ETHERTYPE_ECAT
-from eni.errors import GtecatError
+from gtecat.drives.esc import Chain
+from gtecat.drives.esc.frames import ETHERTYPE_ECAT
+from gtecat.eni.errors import GtecatError
 
 from ..master.pcap import PcapWriter
 from .pacing import Pacing

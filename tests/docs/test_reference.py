@@ -36,7 +36,7 @@ def test_every_command_is_in_the_commands_page() -> None:
 
 
 def test_every_machine_key_is_described() -> None:
-    from drives.machine import _KEYS
+    from gtecat.drives.machine import _KEYS
 
     text = (REFERENCE / "machine.md").read_text(encoding="utf-8")
     for key in _KEYS:

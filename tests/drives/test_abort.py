@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 import pytest
 
-from drives.abort import ABORT_TEXT, SdoAbort, SdoAbortCode, abort_text
-from drives.coe import (
+from gtecat.drives.abort import ABORT_TEXT, SdoAbort, SdoAbortCode, abort_text
+from gtecat.drives.coe import (
     CoeService,
     SdoClient,
     SdoExpedited,
@@ -16,8 +16,8 @@ from drives.coe import (
     build_coe,
     initiate_cmd,
 )
-from drives.slave import AlState
-from eni.errors import GtecatError
+from gtecat.drives.slave import AlState
+from gtecat.eni.errors import GtecatError
 from tests.drives.test_drive import Rig
 
 # cia402-facts.md section 5, every code

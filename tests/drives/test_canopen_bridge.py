@@ -19,11 +19,11 @@ import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
 
-from drives.cia402 import State
-from drives.drive import Cia402Drive
-from drives.machine import AxisMachine
-from drives.slave import AlState, AlStatusCode
-from eni.model import Identity
+from gtecat.drives.cia402 import State
+from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.machine import AxisMachine
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.model import Identity
 from tools.canopen_bridge import CanSdoBridge, canopen_dictionary
 
 NODE = 5

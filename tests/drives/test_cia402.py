@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.cia402 import (
+from gtecat.drives.cia402 import (
     COMMAND_OF,
     STATE_BITS,
     STATE_PATTERN,
@@ -16,8 +16,8 @@ from drives.cia402 import (
     State,
     decode_state,
 )
-from drives.drive import DriveSettings
-from drives.machine import AxisMachine
+from gtecat.drives.drive import DriveSettings
+from gtecat.drives.machine import AxisMachine
 from tests.drives.test_drive import Rig
 
 S = State

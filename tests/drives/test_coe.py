@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.coe import (
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.coe import (
     CoeHeader,
     CoeService,
     MailboxHeader,
@@ -22,9 +22,9 @@ from drives.coe import (
     next_counter,
     parse_mailbox,
 )
-from drives.od import DataType, ObjectDictionary
-from drives.sdo_server import SdoServer
-from drives.slave import AlState
+from gtecat.drives.od import DataType, ObjectDictionary
+from gtecat.drives.sdo_server import SdoServer
+from gtecat.drives.slave import AlState
 
 
 def blob_od(size: int = 0) -> ObjectDictionary:

@@ -15,8 +15,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.coe import (
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.coe import (
     MIN_SEGMENT_DATA,
     CoeHeader,
     CoeService,

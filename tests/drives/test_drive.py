@@ -14,13 +14,13 @@ from typing import Any
 
 import pytest
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.cia402 import State
-from drives.coe import SdoClient
-from drives.drive import Cia402Drive, DriveSettings
-from drives.machine import AxisMachine
-from drives.slave import AlState, AlStatusCode
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.cia402 import State
+from gtecat.drives.coe import SdoClient
+from gtecat.drives.drive import Cia402Drive, DriveSettings
+from gtecat.drives.machine import AxisMachine
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 
 FMT = {
     0x6040: "H",
@@ -257,7 +257,7 @@ def test_multi_axis_channels_are_independent() -> None:
 
 
 def test_googol_dm3e_fixture_mapping(shared_fixtures: Path) -> None:
-    from eni.model import PdoEntry as E
+    from gtecat.eni.model import PdoEntry as E
 
     # the PDO lists of fixtures/googol/Gecat_DM3E_stepper.eni
     rx = Pdo(0x1600, Direction.OUT, (E(0x6040, 0, 16), E(0x607A, 0, 32), E(0x60B8, 0, 16)))

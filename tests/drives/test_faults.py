@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from drives.cia402 import State
-from drives.drive import DriveSettings
-from drives.faults import ErrorCode, FaultError, FaultMonitor, fault_code
-from drives.machine import AxisMachine
+from gtecat.drives.cia402 import State
+from gtecat.drives.drive import DriveSettings
+from gtecat.drives.faults import ErrorCode, FaultError, FaultMonitor, fault_code
+from gtecat.drives.machine import AxisMachine
 from tests.drives.test_drive import Rig
 
 

@@ -25,7 +25,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.homing import (
+from gtecat.drives.homing import (
     SUPPORTED_METHODS,
     Homing,
     HomingError,
@@ -33,8 +33,8 @@ from drives.homing import (
     HomingPhase,
     UnsupportedHomingMethodError,
 )
-from drives.machine import AxisMachine
-from eni.errors import GtecatError
+from gtecat.drives.machine import AxisMachine
+from gtecat.eni.errors import GtecatError
 
 CAMS = AxisMachine(
     counts_per_rev=1000,

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from drives.io_slaves import IoSlave
-from drives.slave import AlState, AlStatusCode
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.io_slaves import IoSlave
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 
 
 def _coupler() -> IoSlave:
@@ -76,9 +76,9 @@ def test_al_state_machine_refuses_illegal_transitions():
 
 def test_coe_io_slave_sdo_reads_the_process_data_of_mapped_objects():
     """ETG.5001: a module's mapped 0x7000/0x6000 objects are its process data, by SDO too."""
-    from drives.abort import SdoAbort, SdoAbortCode
-    from drives.coe import SdoClient
-    from drives.io_slaves import CoeIoSlave
+    from gtecat.drives.abort import SdoAbort, SdoAbortCode
+    from gtecat.drives.coe import SdoClient
+    from gtecat.drives.io_slaves import CoeIoSlave
 
     ref = _coupler()
     s = CoeIoSlave(0, "coupler", Identity(1, 2), rx_pdos=ref.rx_pdos, tx_pdos=ref.tx_pdos)

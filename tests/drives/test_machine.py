@@ -2,7 +2,7 @@
 
 import pytest
 
-from drives.machine import AxisMachine, MachineError, load_machine, machine_from_dict
+from gtecat.drives.machine import AxisMachine, MachineError, load_machine, machine_from_dict
 
 
 def test_levels_and_defaults():

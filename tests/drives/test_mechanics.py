@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.mechanics import Mechanics, MechanicsParams
+from gtecat.drives.mechanics import Mechanics, MechanicsParams
 
 P = MechanicsParams()
 CPR = P.counts_per_rev

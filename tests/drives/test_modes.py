@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.cia402 import State
-from drives.drive import DriveSettings
-from drives.machine import AxisMachine
-from drives.modes import OpMode, profile_step, supported_bits
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.cia402 import State
+from gtecat.drives.drive import DriveSettings
+from gtecat.drives.machine import AxisMachine
+from gtecat.drives.modes import OpMode, profile_step, supported_bits
 from tests.drives.test_drive import Rig
 
 PP_RX = (0x6040, 0x6060, 0x607A)

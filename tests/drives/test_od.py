@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.od import (
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.od import (
     PREOP_ONLY,
     TYPE_INFO,
     Access,
@@ -19,7 +19,7 @@ from drives.od import (
     PdoDir,
     Variable,
 )
-from drives.slave import AlState
+from gtecat.drives.slave import AlState
 
 
 def make_od() -> tuple[ObjectDictionary, dict[str, int]]:

@@ -9,14 +9,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.coe import SdoClient
-from drives.drive import Cia402Drive
-from drives.od import ObjectDictionary, PdoDir
-from drives.pdo_mapping import PdoMapping, pack_entry, unpack_entry
-from drives.slave import AlState, AlStatusCode
-from eni.bits import get_bits, set_bits
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.coe import SdoClient
+from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.od import ObjectDictionary, PdoDir
+from gtecat.drives.pdo_mapping import PdoMapping, pack_entry, unpack_entry
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.bits import get_bits, set_bits
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 from tests.drives.test_drive import Rig
 
 
@@ -58,7 +58,7 @@ def test_remap_in_preop_then_size_check() -> None:
 
 
 def test_acontis_fixture_init_commands_apply(shared_fixtures: Path) -> None:
-    from eni.reader import read_eni
+    from gtecat.eni.reader import read_eni
 
     cfg = read_eni(shared_fixtures / "eni" / "acontis_training_slaves.xml")
     for slave in cfg.slaves:

@@ -7,9 +7,9 @@ import struct
 from hypothesis import given
 from hypothesis import strategies as st
 
-from drives.coe import CoeService, build_coe
-from drives.od import Access, DataType, ObjectDictionary, PdoDir
-from drives.sdo_server import SdoServer
+from gtecat.drives.coe import CoeService, build_coe
+from gtecat.drives.od import Access, DataType, ObjectDictionary, PdoDir
+from gtecat.drives.sdo_server import SdoServer
 
 
 def big_od(n: int) -> ObjectDictionary:

@@ -11,10 +11,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.machine import AxisMachine
-from drives.signal_edges import level, merge_windows, window_edges
-from drives.touch_probe import TOGGLE_BITS, TouchProbe, TouchProbeError
-from eni.errors import GtecatError
+from gtecat.drives.machine import AxisMachine
+from gtecat.drives.signal_edges import level, merge_windows, window_edges
+from gtecat.drives.touch_probe import TOGGLE_BITS, TouchProbe, TouchProbeError
+from gtecat.eni.errors import GtecatError
 
 ENC0 = 4321.25  # encoder = machine - ENC0 (a homing offset, say)
 M = AxisMachine(

@@ -3,7 +3,7 @@
 from hypothesis import given
 from hypothesis import strategies as st
 
-from eni.bits import copy_bits, get_bits, set_bits
+from gtecat.eni.bits import copy_bits, get_bits, set_bits
 
 
 def _as_int(buf: bytes) -> int:

@@ -10,11 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from eni.layout import build_layout
-from eni.model import Direction
-from eni.reader import read_eni
-from eni.topology import load_topology
-from eni.writer import write_eni
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.reader import read_eni
+from gtecat.eni.topology import load_topology
+from gtecat.eni.writer import write_eni
 
 OUT, IN = Direction.OUT, Direction.IN
 EXAMPLES = ("manual_fig5_2", "manual_fig5_4", "twelve_axes")

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from eni.layout import build_layout
-from eni.model import Direction
-from eni.reader import read_eni
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.reader import read_eni
 
 OUT, IN = Direction.OUT, Direction.IN
 

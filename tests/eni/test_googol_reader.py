@@ -10,10 +10,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eni.errors import EniError
-from eni.layout import build_layout
-from eni.model import Direction
-from eni.reader import parse_eni
+from gtecat.eni.errors import EniError
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.reader import parse_eni
 
 from .googol_text import GSlave, Noise, render
 from .snippets import line_of

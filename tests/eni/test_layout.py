@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import json
 
-from eni.layout import build_layout
-from eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, ProcessDataArea, Slave
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, ProcessDataArea, Slave
 
 OUT, IN = Direction.OUT, Direction.IN
 

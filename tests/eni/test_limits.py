@@ -14,11 +14,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from eni.errors import EniError
-from eni.layout import build_layout
-from eni.limits import Limit, RangeError, cycle_ns_from_us
-from eni.numbers import MAX_DIGITS, TooLong, parse_int
-from eni.reader import parse_eni
+from gtecat.eni.errors import EniError
+from gtecat.eni.layout import build_layout
+from gtecat.eni.limits import Limit, RangeError, cycle_ns_from_us
+from gtecat.eni.numbers import MAX_DIGITS, TooLong, parse_int
+from gtecat.eni.reader import parse_eni
 
 from .googol_text import GSlave, render
 from .snippets import area, eni, entry, image, line_of, pdo, process_data, servo_slave, slave
@@ -100,7 +100,7 @@ def test_googol_cycle_time_zero_is_not_given() -> None:
 
 
 def test_topology_cycle_time_uses_the_same_range() -> None:
-    from eni.topology import parse_topology
+    from gtecat.eni.topology import parse_topology
 
     with pytest.raises(EniError, match=r"31\.25\.\.1000000 us"):
         parse_topology("cycle_time_us = 1e-3\n")

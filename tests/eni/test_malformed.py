@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from eni.errors import EniError
-from eni.reader import parse_eni, read_eni
+from gtecat.eni.errors import EniError
+from gtecat.eni.reader import parse_eni, read_eni
 
 from .snippets import (
     area,

@@ -9,12 +9,12 @@ from typing import Any
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from eni.check import check_config
-from eni.layout import build_layout
-from eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, ProcessDataArea, Slave
-from eni.reader import parse_eni
-from eni.topology import build_config
-from eni.writer import write_eni
+from gtecat.eni.check import check_config
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction, EniConfig, Identity, Pdo, PdoEntry, ProcessDataArea, Slave
+from gtecat.eni.reader import parse_eni
+from gtecat.eni.topology import build_config
+from gtecat.eni.writer import write_eni
 
 OUT, IN = Direction.OUT, Direction.IN
 
@@ -226,7 +226,15 @@ def topologies(draw: st.DrawFn) -> dict[str, Any]:
 
 
 def _norm(cfg: EniConfig) -> EniConfig:
-    return replace(cfg, source="", slaves=tuple(replace(s, line=None) for s in cfg.slaves))
+    """Without what only a file states: lines, and the wire layout the writer derives
+    (sync manager addresses, mailbox) that a topology does not carry."""
+    return replace(
+        cfg,
+        source="",
+        slaves=tuple(
+            replace(s, line=None, sync_managers=(), mailbox_layout=None) for s in cfg.slaves
+        ),
+    )
 
 
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])

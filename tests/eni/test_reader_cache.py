@@ -1,4 +1,4 @@
-"""read_eni parses one file content once (eni.reader._parse_cached)."""
+"""read_eni parses one file content once (gtecat.eni.reader._parse_cached)."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from eni.errors import EniError
-from eni.reader import read_eni
+from gtecat.eni.errors import EniError
+from gtecat.eni.reader import read_eni
 
 ROOT = Path(__file__).resolve().parents[2]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"

@@ -1,4 +1,4 @@
-"""The TOML topology format (eni.topology docstring) and the ENI it makes."""
+"""The TOML topology format (gtecat.eni.topology docstring) and the ENI it makes."""
 
 from __future__ import annotations
 
@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from eni.errors import EniError
-from eni.layout import build_layout
-from eni.model import Direction
-from eni.topology import GTEC_VENDOR_ID, load_topology, parse_topology
+from gtecat.eni.errors import EniError
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.topology import GTEC_VENDOR_ID, load_topology, parse_topology
 
 OUT, IN = Direction.OUT, Direction.IN
 

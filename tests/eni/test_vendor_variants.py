@@ -12,10 +12,10 @@ from pathlib import Path
 
 import pytest
 
-from eni.errors import EniError
-from eni.layout import build_layout
-from eni.model import Direction
-from eni.reader import parse_eni, read_eni
+from gtecat.eni.errors import EniError
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.reader import parse_eni, read_eni
 
 from .googol_text import GSlave, render
 from .snippets import area, eni, entry, image, line_of, pdo, process_data, slave, variable

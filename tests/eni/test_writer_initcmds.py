@@ -12,11 +12,11 @@ from pathlib import Path
 
 import pytest
 
-from eni.model import Direction, Pdo, PdoEntry
-from eni.reader import parse_eni
-from eni.register_cmds import SmMap, fmmu_bytes
-from eni.topology import load_topology
-from eni.writer import write_eni
+from gtecat.eni.model import Direction, Pdo, PdoEntry
+from gtecat.eni.reader import parse_eni
+from gtecat.eni.register_cmds import SmMap, fmmu_bytes
+from gtecat.eni.topology import load_topology
+from gtecat.eni.writer import write_eni
 
 TOPOLOGY = """
 cycle_time_us = 1000

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from eni.errors import EniError
-from eni.layout import build_layout
-from eni.model import Direction
-from eni.reader import detect_format, parse_eni
+from gtecat.eni.errors import EniError
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import Direction
+from gtecat.eni.reader import detect_format, parse_eni
 
 from .snippets import (
     area,

@@ -1,11 +1,11 @@
-"""eni.xmltree.parse_xml: the tree the readers walk, and the subtrees they skip."""
+"""gtecat.eni.xmltree.parse_xml: the tree the readers walk, and the subtrees they skip."""
 
 from __future__ import annotations
 
 import pytest
 
-from eni.errors import EniError
-from eni.xmltree import parse_xml
+from gtecat.eni.errors import EniError
+from gtecat.eni.xmltree import parse_xml
 
 DOC = """<?xml version="1.0"?>
 <Config>

@@ -336,13 +336,13 @@ def run(
         from gtecat import gt as gt_module
 
         gt = gt_module
-    from eni.layout import build_layout
-    from eni.reader import read_eni
+    from gtecat.eni.layout import build_layout
+    from gtecat.eni.reader import read_eni
 
     layout = build_layout(read_eni(eni))
     switches: dict[int, bool] = {}
     if machine:
-        from drives.machine import load_machine
+        from gtecat.drives.machine import load_machine
 
         desc = load_machine(machine)
         switches = {a.axis: bool(desc.axis(a.axis).home_switch) for a in layout.axes}

@@ -131,7 +131,7 @@ def test_map_bad_file_one_line_error(
 
 
 def test_map_debug_reraises(tmp_path: Path) -> None:
-    from eni.errors import EniError
+    from gtecat.eni.errors import EniError
 
     with pytest.raises(EniError):
         map_cmd.run(argparse.Namespace(file=str(tmp_path / "x.eni"), json=False, debug=True))

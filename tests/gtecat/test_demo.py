@@ -17,13 +17,13 @@ from pathlib import Path
 
 import pytest
 
-from eni.layout import build_layout
-from eni.reader import read_eni
-from eni.topology import parse_topology
-from eni.writer import write_eni
 from gtecat import gt
 from gtecat.cli import demo_axes, demo_cmd
 from gtecat.cli.main import main
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
+from gtecat.eni.topology import parse_topology
+from gtecat.eni.writer import write_eni
 from tests.conftest import EXAMPLES
 
 DATA = resources.files("gtecat") / "data"
@@ -58,7 +58,7 @@ def test_demo_topology_lays_out_as_the_figure_5_2_example() -> None:
 
 
 def test_demo_machine_matches_the_scenario_the_demo_tells() -> None:
-    from drives.machine import load_machine
+    from gtecat.drives.machine import load_machine
 
     path = Path(str(DATA.joinpath("demo_machine.toml")))
     m = load_machine(path)

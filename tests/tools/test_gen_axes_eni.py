@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from eni.layout import build_layout
-from eni.reader import read_eni
 from gtecat.cli.main import main
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
 from tools.gen_axes_eni import MAX_AXES, SLAVE_BYTES, write_axes_eni
 
 OUT = [(0x6040, 16), (0x607A, 32), (0x6060, 8)]

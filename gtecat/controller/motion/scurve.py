@@ -438,6 +438,9 @@ class SCurvePlanner:
         self.profile = plan_drive(length, prm, None, decel=decel, manual_dec=self._manual)
         self._mode = _MOVE
         self._vel = direction * self.profile.v_start
+        if self.profile.pieces:  # the drive's state at its start: a status read before the
+            a0, j = self.profile.pieces[0][3:5]  # first cycle sees it accelerating (D2)
+            self._acc, self._jerk = direction * a0, direction * j
 
     def decelerate(self) -> None:
         """``dec_stop``: ramp down to SV (S: the acceleration to 0 first) and stop there;

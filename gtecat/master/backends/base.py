@@ -11,10 +11,10 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
-from drives.slave import AlState, AlStatusCode
-from eni.errors import GtecatError
-from eni.layout import Layout
-from eni.model import Identity
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.errors import GtecatError
+from gtecat.eni.layout import Layout
+from gtecat.eni.model import Identity
 
 from ..image import ProcessImage
 
@@ -77,13 +77,13 @@ class Backend(ABC):
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False
     ) -> bytes:
-        """CoE SDO upload; raises :class:`drives.abort.SdoAbort`."""
+        """CoE SDO upload; raises :class:`gtecat.drives.abort.SdoAbort`."""
 
     @abstractmethod
     def sdo_download(
         self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
     ) -> None:
-        """CoE SDO download; raises :class:`drives.abort.SdoAbort`."""
+        """CoE SDO download; raises :class:`gtecat.drives.abort.SdoAbort`."""
 
     def emergencies(self) -> list[tuple[int, object]]:
         """CoE emergencies received since the last call: ``(position, Emergency)``."""

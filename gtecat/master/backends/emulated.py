@@ -5,7 +5,7 @@ RxPDO buffer, steps the slave, and copies its TxPDO buffer back into the input
 area (ETG.1000.4 logical addressing done by the ESC in real life).  The working
 counter follows ETG.1000.4 for one LRW: +2 per slave whose outputs were written
 (OP), +1 per slave whose inputs were read (SAFEOP and OP).  Mailbox traffic is
-real CoE: whole mailbox messages built by :class:`drives.coe.SdoClient` and
+real CoE: whole mailbox messages built by :class:`gtecat.drives.coe.SdoClient` and
 answered by the slave's own SDO server.  With ``pcap`` (``GTECAT_PCAP``) the
 frames a real master would have exchanged are written to a capture
 (:class:`gtecat.master.pcap.BusCapture`).
@@ -13,10 +13,10 @@ frames a real master would have exchanged are written to a capture
 
 from __future__ import annotations
 
-from drives.machine import MachineDescription
-from drives.slave import AlState, AlStatusCode, VirtualSlave
-from eni.layout import Layout
-from eni.model import Direction
+from gtecat.drives.machine import MachineDescription
+from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
+from gtecat.eni.layout import Layout
+from gtecat.eni.model import Direction
 
 from ...errors import BusError
 from ..image import ProcessImage, Segment
@@ -187,8 +187,8 @@ class EmulatedBackend(Backend):
         return self._expected
 
     # --- mailbox -----------------------------------------------------------------
-    def _client(self, position: int):  # -> drives.coe.SdoClient
-        from drives.coe import SdoClient
+    def _client(self, position: int):  # -> gtecat.drives.coe.SdoClient
+        from gtecat.drives.coe import SdoClient
 
         slave = self._slave(position)
         if not slave.has_mailbox:

@@ -45,10 +45,10 @@ from typing import Any
 
 import numpy as np
 
-from drives.abort import SdoAbort
-from drives.slave import AlState, AlStatusCode
-from eni.layout import Layout
-from eni.model import Direction, Identity, InitCmd
+from gtecat.drives.abort import SdoAbort
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.layout import Layout
+from gtecat.eni.model import Direction, Identity, InitCmd
 
 from ...errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from ..image import ProcessImage, Segment

@@ -1,7 +1,7 @@
 """Small test doubles for the ESC tests: a slave with fixed PDOs and a minimal CoE server,
-and a master that talks to a :class:`~drives.esc.Chain` in-process, datagram by datagram.
+and a master that talks to a :class:`~gtecat.drives.esc.Chain` in-process, datagram by datagram.
 
-The slave's CoE is hand-written on purpose (independent of drives.coe): it
+The slave's CoE is hand-written on purpose (independent of gtecat.drives.coe): it
 answers expedited uploads/downloads, the SM/PDO objects SOEM reads during
 ``config_map`` (1C00h, 1C12h/1C13h, 1600h/1A00h) and aborts unknown objects
 with 06020000h, framed as ETG.1000.6 says (abort = CoE service 2).
@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import struct
 
-from drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
-from drives.slave import VirtualSlave
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
+from gtecat.drives.slave import VirtualSlave
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 
 
 def _pdos(direction: Direction, bits: int) -> tuple[Pdo, ...]:

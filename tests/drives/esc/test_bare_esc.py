@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import struct
 
-from drives.esc.registers import Esc, FrameTime, Reg
-from drives.esc.sii import build_sii, sii_info_for
-from drives.io_slaves import IoSlave
-from drives.slave import AlState
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.esc.registers import Esc, FrameTime, Reg
+from gtecat.drives.esc.sii import build_sii, sii_info_for
+from gtecat.drives.io_slaves import IoSlave
+from gtecat.drives.slave import AlState
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 from tests.drives.esc.test_registers import make, request
 
 

@@ -8,9 +8,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
-from drives.esc.registers import Reg
-from drives.slave import AlState
+from gtecat.drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
+from gtecat.drives.esc.registers import Reg
+from gtecat.drives.slave import AlState
 from tests.drives.esc.mini import (
     MiniMaster,
     mini_chain,

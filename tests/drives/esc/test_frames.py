@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.esc.frames import (
+from gtecat.drives.esc.frames import (
     ETH_HEADER_LEN,
     MAX_ECAT_LEN,
     MIN_ETH_FRAME,
@@ -18,7 +18,7 @@ from drives.esc.frames import (
     encode_frame,
     walk,
 )
-from eni.ethercat import Command
+from gtecat.eni.ethercat import Command
 
 datagrams = st.builds(
     Datagram,

@@ -1,7 +1,7 @@
 """The firmware behind SM0/SM1: repeated messages, multi-message answers, emergencies.
 
 The requests are hand-written bytes (ETG.1000.4 5.5 mailbox header, ETG.1000.6
-5.6.3 SDO Information), not built with drives.coe, so a codec bug cannot hide
+5.6.3 SDO Information), not built with gtecat.drives.coe, so a codec bug cannot hide
 on both sides.
 """
 
@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import struct
 
-from drives.drive import Cia402Drive
-from drives.esc.registers import Esc, FrameTime, Reg
-from drives.esc.sii import build_sii, sii_info_for
-from drives.slave import AlState
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.esc.registers import Esc, FrameTime, Reg
+from gtecat.drives.esc.sii import build_sii, sii_info_for
+from gtecat.drives.slave import AlState
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 from tests.drives.esc.mini import MiniSlave, sdo_upload_request
 from tests.drives.esc.test_registers import configure, make, request
 

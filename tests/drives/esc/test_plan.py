@@ -7,10 +7,10 @@ import struct
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
-from drives.esc import chain as chain_mod
-from drives.esc.registers import Reg
-from drives.slave import AlState
+from gtecat.drives.esc import Chain, Command, Datagram, decode_frame, encode_frame
+from gtecat.drives.esc import chain as chain_mod
+from gtecat.drives.esc.registers import Reg
+from gtecat.drives.slave import AlState
 from tests.drives.esc.mini import MiniMaster, mini_chain
 
 FM = struct.Struct("<IHBBHBBB3x")
@@ -214,3 +214,43 @@ def test_a_repeated_cyclic_frame_takes_the_shortcut_and_answers_alike() -> None:
     assert fast._cyclic is not None
     assert mf.set_state(0x1001, AlState.SAFEOP) == (4, 0)
     assert fast._cyclic is None  # a state change forgets the plans and the shortcut
+
+
+def test_a_dc_datagram_beside_the_cyclic_one_answers_as_if_it_came_alone() -> None:
+    """The DC frame (LRW + FRMW of the system time 0910h): the FRMW does not wait for the
+    LRW's outputs to be applied (DC registers cannot see them), and every byte and WKC of
+    the answer is what the two datagrams give in separate frames."""
+    together, mt = configured(False)
+    apart, ma = configured(False)
+    for m in (mt, ma):
+        for pos in range(3):
+            assert m.set_state(0x1001 + pos, AlState.OP) == (8, 0)
+    flushes = 0
+    real_flush = together.flush
+
+    def counting_flush() -> None:
+        nonlocal flushes
+        flushes += 1
+        real_flush()
+
+    together.flush = counting_flush  # type: ignore[method-assign]
+    for i in range(4):
+        lrw = Datagram.logical(Command.LRW, 0, bytes([i]) * 8)
+        frmw = Datagram(Command.FRMW, 0x1001, Reg.DC_SYSTEM_TIME, bytes(8))
+        both = bytearray(encode_frame([lrw, frmw]))
+        before = flushes
+        t = i * 1_000_000 + 500  # both chains see the frames at the same time
+        assert together.process(both, t_ns=t)
+        assert flushes == before  # the FRMW did not force the outputs in
+        one = bytearray(encode_frame([lrw]))
+        two = bytearray(encode_frame([frmw]))
+        assert apart.process(one, t_ns=t)
+        apart.flush()
+        assert apart.process(two, t_ns=t)
+        got = decode_frame(bytes(both)).datagrams
+        alone = decode_frame(bytes(one)).datagrams + decode_frame(bytes(two)).datagrams
+        assert [(d.data, d.wkc) for d in got] == [(d.data, d.wkc) for d in alone]
+        for chain in (together, apart):
+            chain.flush()
+            chain.service()
+            chain.step(i * 1_000_000, 1_000_000)

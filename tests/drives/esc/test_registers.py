@@ -6,10 +6,10 @@ import struct
 
 import pytest
 
-from drives.esc.registers import Esc, FrameTime, MailboxType, Reg, mailbox_error
-from drives.esc.sii import build_sii, sii_info_for
-from drives.slave import AlState, AlStatusCode
-from eni.model import Identity
+from gtecat.drives.esc.registers import Esc, FrameTime, MailboxType, Reg, mailbox_error
+from gtecat.drives.esc.sii import build_sii, sii_info_for
+from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.eni.model import Identity
 from tests.drives.esc.mini import MiniSlave, sdo_download_request, sdo_upload_request
 
 

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from drives.esc.sii import (
+from gtecat.drives.esc.sii import (
     SII_SOFT_LIMIT,
     Category,
     CoeDetails,
@@ -24,7 +24,7 @@ from drives.esc.sii import (
     sii_crc,
     sii_info_for,
 )
-from eni.model import Direction, Identity, Pdo, PdoEntry
+from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
 from tests.drives.esc.mini import MiniSlave
 
 

@@ -66,3 +66,44 @@ def test_a_file_that_cannot_be_written_is_refused_before_serving(capsys, option)
     out = capsys.readouterr()
     assert code == 1 and "ready" not in out.out
     assert out.err == f"error: {option} {path}: No such file or directory\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "value"), [("auto", "auto"), ("off", "off"), ("0", "off"), ("50", 50), (" 99 ", 99)]
+)
+def test_rt_priority_takes_a_number_auto_or_off(text, value):
+    from gtecat.cli.serve_cmd import _rt_priority
+
+    assert _rt_priority(text) == value
+
+
+@pytest.mark.parametrize("text", ["100", "-1", "high", ""])
+def test_rt_priority_refuses_the_rest(text):
+    import argparse
+
+    from gtecat.cli.serve_cmd import _rt_priority
+
+    with pytest.raises(argparse.ArgumentTypeError):
+        _rt_priority(text)
+
+
+def test_auto_scheduling_takes_fifo_where_permitted_and_is_given_back():
+    """``--rt-priority auto``: SCHED_FIFO (and the last CPU on two or more) where the system
+    permits it, normal priority for an explicit spin; serve gives it back at the end."""
+    import os
+
+    from gtecat.cli.serve_cmd import _restore_scheduling, _scheduling_now, take_scheduling
+
+    before = _scheduling_now()
+    try:
+        assert take_scheduling("auto", "spin", None) == (None, "normal priority")
+        assert _scheduling_now() == before
+        assert take_scheduling("off", "predict", None) == (None, "normal priority")
+        rt, words = take_scheduling("auto", "predict", None)
+        if rt is None:
+            assert words == "normal priority (real-time refused)"
+        else:
+            assert os.sched_getscheduler(0) == os.SCHED_FIFO and words.startswith("SCHED_FIFO 50")
+    finally:
+        _restore_scheduling(before)
+    assert _scheduling_now() == before

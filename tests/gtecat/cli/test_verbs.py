@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from eni.layout import build_layout
-from eni.reader import read_eni
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
 from tests.conftest import EXAMPLES, SHARED_FIXTURES
 
 from .conftest import Cli

@@ -19,7 +19,7 @@ def _closed():
 
 def open_card(**machine_axes) -> None:
     """GT_Open a lockstep gts:4 card whose axis N has ``machine_axes[f"a{N}"]``."""
-    from drives.machine import AxisMachine, MachineDescription
+    from gtecat.drives.machine import AxisMachine, MachineDescription
 
     m = MachineDescription({int(k[1:]): AxisMachine(**v) for k, v in machine_axes.items()})
     assert gt.GT_Open(card="gts:4", machine=m, clock="lockstep", log="") == 0

@@ -286,9 +286,15 @@ def test_half_circle_of_chapter_10_1_3_6_on_the_circle():
     assert pts[-1] == (2 * p, 2 * p)
 
 
+def z_like_x(speed: int) -> None:
+    """5.8/5.9: Z's multiplier and speed as X's, Z's start speed = X's speed."""
+    setup_speed(3, speed, speed, 0)
+
+
 def test_three_and_four_axis_lines_end_exactly():
     init()
     setup_speed(1, 20_000, 20_000, 0)
+    z_like_x(20_000)
     assert adt.inp_move3(0, 1000, -2000, 3000) == 0
     while inp_running():
         gt.GTE_Wait(1)
@@ -338,7 +344,7 @@ def test_stop0_home_switch_stops_and_reports_stopdata_d0():
     data = c_int()
     assert adt.get_stopdata(0, 1, byref(data)) == 0 and data.value & 0x01
     assert 5000 <= pos(1) <= 6500
-    assert adt.read_bit(0, 2) == 1  # X STOP0 = the home switch
+    assert adt.read_bit(0, 2) == 0  # X STOP0 = the home switch, active: low (6.3)
 
 
 def test_limit_switch_stops_and_reports_d3():
@@ -351,7 +357,7 @@ def test_limit_switch_stops_and_reports_d3():
     assert data.value & 0x08
     assert 3000 <= pos(1) <= 3010
     di = c_long()
-    assert adt.read_di(0, byref(di)) == 0 and di.value & 0x1
+    assert adt.read_di(0, byref(di)) == 0 and not di.value & 0x1  # LMT+ active: low (6.1)
     assert adt.pmove(0, 1, -1000) == 0  # away from the limit is allowed
     wait_axes(1)
 
@@ -367,7 +373,12 @@ def test_soft_limit_comp_plus_decelerates():
     adt.get_stopdata(0, 1, byref(data))
     assert data.value & 0x40
     assert 20_000 <= pos(1) < 21_000
-    assert adt.pmove(0, 1, 100) == 1
+    # further + is taken and ends at once with D6 (chapter 8: 1 is for a wrong card or axis)
+    at = pos(1)
+    assert adt.pmove(0, 1, 100) == 0
+    assert status(1) == 0 and pos(1) == at
+    adt.get_stopdata(0, 1, byref(data))
+    assert data.value == 0x40
     assert adt.pmove(0, 1, -100) == 0
 
 
@@ -449,3 +460,132 @@ def test_scenario_four_axes_move_status_and_positions():
         gt.GTE_Wait(1)
     assert (pos(1), pos(2)) == (0, 0)
     assert adt.adt850_end() == 0
+
+
+# --- what a user of the card hits: the documents' own rules ---------------------------------
+def test_a_stop2_stop_clears_the_real_position_counter():
+    """1.5 note and 9.4: with STOP2 valid, the real position counter clears at the STOP2
+    signal; what it reads after the stop is the way run after the signal, not the distance
+    from the start (and the manual tells users not to clear it in software)."""
+    init(a1=dict(probe1=((8000, 9000),)))
+    setup_speed(1, 1000, 10_000, 125_000)
+    assert adt.set_actual_pos(0, 1, 4321) == 0
+    assert adt.set_stop2_mode(0, 1, 1, 0) == 0
+    assert adt.continue_move(0, 1, 0) == 0
+    wait_axes(1)
+    data = c_int()
+    assert adt.get_stopdata(0, 1, byref(data)) == 0 and data.value & 0x04
+    assert pos(1) > 8000  # the logic counter keeps counting
+    assert 0 <= actual(1) <= pos(1) - 8000 + 1  # the real one counted from the signal
+
+
+def test_the_variable_ring_counts_from_0_to_comp_plus():
+    """1.17 / 4.3: with the ring on, 9990 + 20 with COMP+ 9999 reads 10, not 10010; the
+    real counter wraps at COMP-; the COMP registers are no soft limits then."""
+    init()
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.set_comp1(0, 1, 9999) == 0 and adt.set_comp2(0, 1, 9999) == 0
+    assert adt.set_softlimit_mode1(0, 1, 1) == 0
+    assert adt.set_circle_mode(0, 1, 1) == 0
+    assert adt.set_command_pos(0, 1, 9990) == 0 and adt.set_actual_pos(0, 1, 9990) == 0
+    assert adt.pmove(0, 1, 20) == 0
+    wait_axes(1)
+    assert pos(1) == 10 and actual(1) == 10
+    assert adt.set_command_pos(0, 1, 5) == 0
+    assert adt.pmove(0, 1, -10) == 0  # the soft limit COMP+ does not stop the ring
+    wait_axes(1)
+    assert pos(1) == 9995  # 5 - 10 wraps below 0 to the top
+    assert adt.set_circle_mode(0, 1, 0) == 0
+    assert pos(1) == -5  # ring off: the plain 32-bit counter again
+
+
+@pytest.mark.parametrize(("logic", "level"), [(0, 0), (1, 1)])
+def test_inputs_read_their_electrical_level(logic, level):
+    """6.1/6.3: 0 is a low input level. A limit is low-active by default (1.1), so an
+    active LMT+ reads 0; set high-active it reads 1. An inactive one reads the other."""
+    init(a1=dict(positive_limit=0))
+    assert adt.set_limit_mode(0, 1, 0, logic) == 0
+    assert adt.read_bit(0, 0) == level  # X LMT+ active
+    assert adt.read_bit(0, 1) == 1 - level  # X LMT- inactive
+    di = c_long()
+    assert adt.read_di(0, byref(di)) == 0 and di.value & 1 == level
+
+
+def test_status_right_after_pmove_reads_accelerating():
+    """2.1: a T drive that just started is accelerating (D2), before any cycle ran."""
+    init()
+    setup_speed(1, 1000, 10_000, 125_000)
+    assert adt.pmove(0, 1, 50_000) == 0
+    assert status(1) & 0x04
+    assert not status(1) & 0x08
+
+
+def test_a_drive_into_an_active_limit_is_taken_and_ends_at_once():
+    """A drive toward a limit that is on: 0, no motion, get_stopdata D3 (chapter 8 keeps 1
+    for a wrong card or axis)."""
+    init(a1=dict(positive_limit=0))
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.pmove(0, 1, 500) == 0
+    assert status(1) == 0 and pos(1) == 0
+    data = c_int()
+    assert adt.get_stopdata(0, 1, byref(data)) == 0 and data.value == 0x08
+
+
+def test_appendix_b_home1_finds_the_switch_and_zeroes_the_counters():
+    """B.2: home1 searches STOP0 in the tool's direction; 1 and both counters 0 there."""
+    open_card(a1=dict(position=20_000, home_switch=((5_000, 6_000),)))
+    assert adt.adt850_init_board({n: adt.AppParams(home_speed=20.0) for n in range(1, 5)}) == 1
+    assert adt.home1(1) == 1
+    assert pos(1) == 0 and actual(1) == 0
+
+
+def test_appendix_b_home1_without_a_signal_or_limit_returns_minus_2():
+    """B.2 return -2, "未检测到原点信号": no home switch and no limit ahead - refused at once
+    with the reason, instead of a search that never ends."""
+    open_card(a1=dict(position=20_000))
+    assert adt.adt850_init_board({n: adt.AppParams() for n in range(1, 5)}) == 1
+    before = pos(1)
+    assert adt.home1(1) == -2
+    assert "no home switch (STOP0) and no limit switch" in adt.last_error()
+    assert pos(1) == before  # nothing moved
+    assert adt.home4() == -2
+
+
+def test_actualcount_mode_sets_the_real_counters_direction_and_multiplication():
+    """1.6: dir 1 counts the other way; freq 1 (2x) counts half the 4x pulses."""
+    init()
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.set_actualcount_mode(0, 1, 0, 1, 1) == 0
+    assert actual(1) == 0
+    assert adt.pmove(0, 1, 1000) == 0
+    wait_axes(1)
+    assert pos(1) == 1000 and actual(1) == -500
+
+
+def test_three_axis_interpolation_needs_z_set_as_x():
+    """5.8 note: Z's multiplier and drive speed as X's, Z's start speed = X's drive speed;
+    other Z settings are refused with the rule."""
+    init()
+    setup_speed(1, 1000, 20_000, 125_000)
+    assert adt.inp_move3(0, 1000, 1000, 1000) == 1
+    assert "Z needs X's range and speed" in adt.last_error()
+    z_like_x(20_000)
+    assert adt.inp_move3(0, 1000, 1000, 1000) == 0
+
+
+def test_an_unfinished_three_axis_interpolation_needs_inp_clear():
+    """9.3 / 5.12: stopped before its distance, a 3/4-axis interpolation leaves Z and W
+    moving wrongly until inp_clear; after it they move again."""
+    init()
+    setup_speed(1, 20_000, 20_000, 0)
+    z_like_x(20_000)
+    assert adt.inp_move3(0, 100_000, 0, 100_000) == 0
+    gt.GTE_Wait(50)
+    assert adt.sudden_stop(0, 1) == 0
+    while inp_running():
+        gt.GTE_Wait(1)
+    assert adt.pmove(0, 3, 100) == 1 and "until inp_clear" in adt.last_error()
+    assert adt.inp_move3(0, 10, 10, 10) == 1
+    assert adt.pmove(0, 1, 100) == 0  # X is not concerned
+    assert adt.inp_clear(0) == 0
+    assert adt.pmove(0, 3, 100) == 0

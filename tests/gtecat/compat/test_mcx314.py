@@ -252,3 +252,66 @@ def test_scenario_drives_then_interpolation():
     wait(crd_busy)
     assert (lp(X), lp(Y)) == (0, 0)
     m.Close()
+
+
+def test_a_thesis_program_runs_without_an_open_call():
+    """Chapter 4 has no open call: the first library call finds the card. Here the card is
+    the one GT_Open opened (a test's lockstep card), used as it is."""
+    open_card()
+    m.SetRange(800_000)  # the program's first call: no Open() before it
+    m.TCurve_F(X, 100, 1000, 100, 5_000)
+    wait(lambda: busy(X))
+    assert lp(X) == 5_000
+
+
+def test_structures_are_taken_by_their_fields_not_their_class():
+    """4.5: LINEDATA holds the speeds; a program's own structure with the same fields (or
+    the same layout) is what C would pass."""
+    import ctypes
+
+    class MyLine(ctypes.Structure):  # the program's own declaration
+        _fields_ = [(n, ctypes.c_int) for n in ("SV", "V", "A", "D", "K")]
+
+    class Raw(ctypes.Structure):  # same layout, other names
+        _fields_ = [(f"f{i}", ctypes.c_int) for i in range(5)]
+
+    up()
+    m.SetP(X, 3_000)
+    m.SetP(Y, 4_000)
+    m.Line2D_C(ctypes.byref(MyLine(SV=1000, V=1000)), 0x3)
+    wait(lambda: busy(X) or busy(Y))
+    assert (lp(X), lp(Y)) == (3_000, 4_000)
+    m.Line2D_C(Raw(1000, 1000, 0, 0, 0), 0x3)
+    wait(lambda: busy(X) or busy(Y))
+    assert (lp(X), lp(Y)) == (6_000, 8_000)
+    with pytest.raises(m.CompatError, match="fields SV, V, A, D, K"):
+        m.Line2D_C(object(), 0x3)
+
+
+def test_scurve_f_unnamed_argument_changes_nothing():
+    """4.4: SCurve_F(axis, SV, V, A, <unnamed>, K, Pulse): the text names no deceleration;
+    the same drive whatever the fifth argument is."""
+    up()
+    m.SCurve_F(X, 100, 2000, 100, 0, 200, 30_000)
+    k0 = wait(lambda: busy(X))
+    m.SCurve_F(X, 100, 2000, 100, 7, 200, 30_000)
+    assert wait(lambda: busy(X)) == k0 and lp(X) == 60_000
+
+
+@pytest.mark.parametrize("level", [0, 1])
+def test_slmtp_takes_the_active_level_and_sets_up_the_limit(level):
+    """4.6: SLMTP(n)/SLMTM(n): n is the active level (0 Low, 1 Hi); either sets up the
+    soft limit of all axes."""
+    up()
+    m.SetCompP(X, 2_000)
+    m.SLMTP(level)
+    m.TCurve_C(X, 100, 1000, 100)
+    wait(lambda: busy(X))
+    assert 2_000 <= lp(X) < 3_000
+
+
+def test_read_ca_holds_its_value_at_constant_speed():
+    up()
+    m.TCurve_C(X, 100, 1000, 50)
+    gt.GTE_Wait(1000)  # long at constant speed
+    assert m.ReadCV(X) == 1000 and m.ReadCA(X) == 50

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 
-from drives.esc.sii import build_sii, iter_categories, parse_sii, sii_info_for
-from eni.layout import build_layout
-from eni.reader import read_eni
 from gtecat.controller.inspect import read_sii
+from gtecat.drives.esc.sii import build_sii, iter_categories, parse_sii, sii_info_for
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
 from gtecat.master.factory import build_slaves
 from tests.conftest import EXAMPLES
 

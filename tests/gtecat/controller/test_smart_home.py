@@ -24,7 +24,6 @@ from ctypes import byref, c_long
 
 import pytest
 
-from drives.machine import AxisMachine, MachineDescription
 from gtecat import gt
 from gtecat.controller.smart_home import (
     HomeError,
@@ -34,6 +33,7 @@ from gtecat.controller.smart_home import (
     Stage,
     smart_home,
 )
+from gtecat.drives.machine import AxisMachine, MachineDescription
 from gtecat.errors import CommandError, ParameterError
 
 NEG, POS = -30000, 30000

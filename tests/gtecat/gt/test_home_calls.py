@@ -18,10 +18,10 @@ from ctypes import byref, c_double, c_long, c_short, c_uint32
 
 import pytest
 
-from drives.machine import AxisMachine, MachineDescription
 from gtecat import gt
 from gtecat.controller.digital_io import digital_io
 from gtecat.controller.smart_home import smart_home
+from gtecat.drives.machine import AxisMachine, MachineDescription
 from gtecat.native import header
 from tests.conftest import EXAMPLES, SHARED_FIXTURES
 
@@ -533,8 +533,8 @@ def test_ethercat_limit_and_limit_home_index_modes():
 
 
 def test_ethercat_axis_without_60fd_cannot_capture_the_home(tmp_path):
-    from eni.topology import parse_topology
-    from eni.writer import write_eni_file
+    from gtecat.eni.topology import parse_topology
+    from gtecat.eni.writer import write_eni_file
 
     topo = parse_topology(
         '[[slave]]\nkind = "servo"\nrx = ["0x6040:0:16", "0x607A:0:32"]\n'

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import pytest
 
-from drives.machine import AxisMachine, MachineDescription
-from eni.topology import parse_topology
-from eni.writer import write_eni_file
 from gtecat import gt
+from gtecat.drives.machine import AxisMachine, MachineDescription
+from gtecat.eni.topology import parse_topology
+from gtecat.eni.writer import write_eni_file
 from tests.conftest import EXAMPLES
 
 from .conftest import bring_up

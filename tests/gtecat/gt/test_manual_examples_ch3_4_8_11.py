@@ -20,8 +20,8 @@ from ctypes import byref, c_char_p, c_double, c_long, create_string_buffer
 
 import pytest
 
-from drives.machine import AxisMachine, MachineDescription
 from gtecat import gt
+from gtecat.drives.machine import AxisMachine, MachineDescription
 from tests.conftest import EXAMPLES
 from tests.gtecat.gt.conftest import bring_up
 

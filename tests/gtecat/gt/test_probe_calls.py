@@ -17,8 +17,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from drives.machine import AxisMachine, MachineDescription
 from gtecat import gt
+from gtecat.drives.machine import AxisMachine, MachineDescription
 from gtecat.gt.homing_calls import probe_function_ex
 from tests.conftest import EXAMPLES
 

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from drives.drive import Cia402Drive
-from drives.io_slaves import CoeIoSlave, IoSlave
-from eni.layout import build_layout
-from eni.model import InitCmd
-from eni.reader import read_eni
+from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.io_slaves import CoeIoSlave, IoSlave
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import InitCmd
+from gtecat.eni.reader import read_eni
 from gtecat.master.backends.emulated import EmulatedBackend
 from gtecat.master.bus import Master
 from gtecat.master.factory import build_slaves

@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eni.bits import get_bits, set_bits
-from eni.layout import build_layout
-from eni.model import (
+from gtecat.eni.bits import get_bits, set_bits
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import (
     Direction,
     EniConfig,
     Identity,

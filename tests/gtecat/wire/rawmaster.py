@@ -2,8 +2,8 @@
 
 Frames, datagrams, mailbox and CoE messages are packed here with ``struct`` from
 the standard's tables (ETG.1000.4 5.3/5.4 frames and datagrams, 5.5 mailbox,
-ETG.1000.6 5.6 SDO and SDO Information), so a bug in ``drives.esc`` or
-``drives.coe`` cannot hide on both sides.  It can do what real masters do that
+ETG.1000.6 5.6 SDO and SDO Information), so a bug in ``gtecat.drives.esc`` or
+``gtecat.drives.coe`` cannot hide on both sides.  It can do what real masters do that
 matters to the slaves: resend a frame whose answer is late (SOEM's
 ``ecx_srconfirm``), count the mailbox counter 1..7, read every fragment of an
 SDO Information answer, replay ENI InitCmds word for word.

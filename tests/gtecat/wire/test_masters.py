@@ -280,7 +280,7 @@ def test_kickcat_maps_reads_the_dictionary_and_runs_in_op(fig52: tuple[str, Serv
 
 
 def eni_vendor() -> int:
-    from eni.reader import read_eni
+    from gtecat.eni.reader import read_eni
 
     return read_eni(FIG52).slaves[0].identity.vendor_id
 

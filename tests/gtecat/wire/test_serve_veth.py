@@ -188,8 +188,8 @@ def to_op(master) -> None:
 
 
 def expected_layout(eni: Path):
-    from eni.layout import build_layout
-    from eni.reader import read_eni
+    from gtecat.eni.layout import build_layout
+    from gtecat.eni.reader import read_eni
 
     config = read_eni(eni)
     return config, build_layout(config)
@@ -410,7 +410,7 @@ def exchange(sock: socket.socket, frame: bytes, timeout: float = 5.0) -> bytes |
 
 
 def test_runner_answers_steps_and_drops() -> None:
-    from drives.esc import Command, Datagram, decode_frame, encode_frame
+    from gtecat.drives.esc import Command, Datagram, decode_frame, encode_frame
     from gtecat.wire.serve import WireServer
     from tests.drives.esc.mini import mini_chain
 
@@ -467,7 +467,7 @@ def test_runner_refuses_a_bad_step_mode() -> None:
 
 
 def test_runner_survives_a_failing_slave_side() -> None:
-    from drives.esc import Command, Datagram, encode_frame
+    from gtecat.drives.esc import Command, Datagram, encode_frame
     from gtecat.wire.serve import WireServer
     from tests.drives.esc.mini import mini_chain
 

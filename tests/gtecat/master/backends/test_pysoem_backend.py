@@ -16,13 +16,13 @@ from typing import ClassVar
 
 import pytest
 
-from drives.abort import SdoAbort, SdoAbortCode
-from drives.io_slaves import IoSlave
-from drives.slave import AlState, AlStatusCode, VirtualSlave
-from eni.bits import copy_bits
-from eni.layout import build_layout
-from eni.model import InitCmd
-from eni.topology import parse_topology
+from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.io_slaves import IoSlave
+from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
+from gtecat.eni.bits import copy_bits
+from gtecat.eni.layout import build_layout
+from gtecat.eni.model import InitCmd
+from gtecat.eni.topology import parse_topology
 from gtecat.errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from gtecat.master.backends.pysoem_backend import PysoemBackend, soem_bit_starts
 from gtecat.master.bus import Master

@@ -226,8 +226,8 @@ packing = "bits"
 
 def test_bit_terminals_packed_by_soem_keep_the_gt_offsets(veth, machine, tmp_path):
     """SOEM packs slaves under 8 bits into shared IO map bytes; GT offsets must not move."""
-    from eni.topology import parse_topology
-    from eni.writer import write_eni_file
+    from gtecat.eni.topology import parse_topology
+    from gtecat.eni.writer import write_eni_file
 
     eni = tmp_path / "bits.xml"
     write_eni_file(parse_topology(BIT_TERMINALS), eni)

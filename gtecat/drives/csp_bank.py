@@ -1,0 +1,406 @@
+"""Many CiA-402 channels in cyclic synchronous position mode, one numpy row each.
+
+:class:`CspBank` is the array form of what :meth:`gtecat.drives.drive.Channel.step` does in
+its commonest state - *operation enabled*, mode 8 (CSP), no halt, no fault, no
+touch probe, off the limit switches - for every row at once: the CSP demand of
+:func:`gtecat.drives.modes.step_csp`, :meth:`gtecat.drives.mechanics.Mechanics.track`, the
+following-error window (6065h/6066h), and the process values of ``_outputs`` /
+``_refresh_status`` (6041h, 6062h, 6064h, 606Ch, 6074h, 6077h, 6078h, 60F4h, 60FDh).
+
+The scalar :class:`~gtecat.drives.drive.Channel` stays the reference: :meth:`CspBank.load`
+takes a channel's state, :meth:`CspBank.store` gives it back exactly (after which the
+channel's own step continues as if it had run every cycle itself).  The float
+operations are the scalar code's, in the same order, so both give the same bits
+(``tests/gtecat/controller/test_bank.py`` compares them through the GT API);
+transcendental constants (``exp(-kp·dt)``) are computed with :mod:`math` per row, never
+with numpy.
+
+A row whose next step would leave that state (a limit switch input, a following
+error timing out) is reported by :meth:`CspBank.step` in its ``events`` mask with its
+state untouched, so the owner hands it back to the scalar channel for that cycle.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .cia402 import STATE_BITS, State, Sw
+from .drive import _wrap32 as wrap32  # the channel's own 32-bit wrap of its object values
+from .modes import SW12, OpMode
+
+if TYPE_CHECKING:
+    from .drive import Channel
+
+_INT32_MIN, _INT32_MAX = -(1 << 31), (1 << 31) - 1
+_SW_BASE = STATE_BITS[State.OPERATION_ENABLED]
+_SW_REMOTE = int(Sw.REMOTE)
+_SW_INTERNAL_LIMIT = int(Sw.INTERNAL_LIMIT)
+_HALT = 0x100
+#: the controlword of an enabled drive the bank takes (enable operation, nothing else)
+CW_ENABLED = 0x000F
+
+
+def claimable(ch: Channel) -> str:
+    """Why ``ch`` cannot be a bank row now ("" when it can)."""
+    s = ch._settings
+    if ch.psm.state is not State.OPERATION_ENABLED:
+        return "not operation enabled"
+    if ch.mode != OpMode.CYCLIC_SYNC_POSITION or ch.mode_req != ch.mode:
+        return "not in CSP"
+    if ch.mode_due is not None or ch.mode_seen != ch.mode:
+        return "mode change pending"
+    if ch.controlword != CW_ENABLED or ch.prev_cw != CW_ENABLED:
+        return "controlword"
+    if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
+        return "fault"
+    if ch.torque_ctl or ch.stopping or ch.limit_stop:
+        return "stopping"
+    if ch.digital_inputs & 3:
+        return "on a limit switch"
+    if ch.tp_function or ch._tp_applied or ch.probe.function:
+        return "touch probe"
+    if ch.homing is not None and getattr(ch.homing, "active", False):
+        return "homing"
+    if s.limit_reaction not in ("stop", "fault", "none"):
+        return "limit reaction"
+    if ch.fe_flag or ch.fe_time:
+        return "following error"
+    return ""
+
+
+class CspBank:
+    """The rows' state and constants as arrays; ``step`` runs one cycle of all of them."""
+
+    def __init__(self, channels: list[Channel]) -> None:
+        self.channels = list(channels)
+        n = len(self.channels)
+        self.n = n
+        f = np.zeros
+        self.pos, self.vel, self.acc, self.torque = f(n), f(n), f(n), f(n)
+        self.dpos, self.dvel, self.fe_time = f(n), f(n), f(n)
+        self.limited = np.zeros(n, bool)
+        self.sw_limited = np.zeros(n, bool)
+        self.cycles = 0  # cycles stepped; a row has stepped cycles - start[r] since its load
+        self.start = np.zeros(n, np.int64)
+        self.din = np.zeros(n, np.int64)  # 60FDh of the last cycle
+        self.target = np.zeros(n, np.int64)  # 607Ah of the last cycle
+        # constants
+        self.vmax, self.amax, self.a_rated = f(n), f(n), f(n)
+        self.visc, self.e, self.c = f(n), f(n), f(n)
+        self.kp, self.kff = f(n), f(n)
+        self.off = np.zeros(n, np.int64)  # enc_offset
+        self.pos_offset = np.zeros(n, np.int64)
+        self.sw_min = np.zeros(n, np.int64)
+        self.sw_max = np.zeros(n, np.int64)
+        self.fe_window = f(n)
+        self.fe_check = np.zeros(n, bool)
+        self.fe_timeout = f(n)
+        self.nl, self.pl = f(n), f(n)
+        self.sw_const = np.zeros(n, np.int64)  # state bits + remote
+        wins: list[tuple[int, int, tuple[tuple[float, float], ...]]] = []
+        self.windows: list[tuple[int, np.ndarray, np.ndarray]] = []
+        self._dt = 0.0
+        self.e, self.c = f(n), f(n)
+        self.lim, self.nlim, self.half_lim = f(n), f(n), f(n)
+        self.fe_running = self.fe_next = False  # some row's following-error timer runs
+        self._din_safe = 0  # cycles in which no row can reach a limit switch
+        for r, ch in enumerate(self.channels):
+            self.load(r)
+            for bit, win in ((2, ch._hs), (16, ch._p1), (17, ch._p2)):
+                if win:
+                    wins.append((r, bit, win))
+        #: switch windows (home switch 60FDh bit 2, probes bits 16/17) as padded arrays
+        for bit in (2, 16, 17):
+            mine = [(r, w) for r, b, w in wins if b == bit]
+            if not mine:
+                continue
+            width = max(len(w) for _, w in mine)
+            lo = np.full((n, width), np.inf)
+            hi = np.full((n, width), -np.inf)
+            for r, w in mine:
+                for j, (a, b) in enumerate(w):
+                    lo[r, j], hi[r, j] = a, b
+            self.windows.append((1 << bit, lo, hi))
+        self._flags()
+
+    def load(self, r: int) -> None:
+        """Take row ``r``'s state from its channel (which must be :func:`claimable`)."""
+        ch = self.channels[r]
+        m = ch.mech
+        self.din[r] = ch.digital_inputs
+        self.target[r] = ch.target_position
+        self._din_safe = 0
+        self.start[r] = self.cycles
+        self.pos[r], self.vel[r], self.acc[r], self.torque[r] = m.pos, m.vel, m.acc, m.torque
+        self.dpos[r], self.dvel[r] = ch.dpos, ch.dvel
+        self.fe_time[r] = ch.fe_time
+        self.fe_running = self.fe_running or bool(ch.fe_time)
+        self.limited[r] = m.limited
+        self.sw_limited[r] = ch.sw_limited
+        self.vmax[r], self.amax[r], self.a_rated[r] = m.vmax, m.amax, m.a_rated
+        self.visc[r], self.kp[r], self.kff[r] = m.visc, m.kp, m.kff
+        if self._dt:
+            self._prepare_row(r, self._dt)
+        self.off[r] = ch.enc_offset
+        self.pos_offset[r] = ch.pos_offset
+        lo, hi = ch.sw_limit_min, ch.sw_limit_max
+        self.sw_min[r], self.sw_max[r] = (lo, hi) if lo < hi else (_INT32_MIN * 4, _INT32_MAX * 4)
+        w = ch.following_error_window
+        self.fe_check[r] = 0 < w < 0xFFFFFFFF
+        self.fe_window[r] = w
+        self.fe_timeout[r] = ch.following_error_timeout
+        self.nl[r], self.pl[r] = ch._nl, ch._pl
+        self.sw_const[r] = _SW_BASE | SW12 | (_SW_REMOTE if ch._settings.remote else 0)
+        self._flags()
+
+    def _prepare(self, dt: float) -> None:
+        """``Mechanics._prepare`` per row, with math.exp (numpy's exp may differ by an ulp)."""
+        self._dt = dt
+        self._din_safe = 0
+        for r in range(len(self.channels)):
+            self._prepare_row(r, dt)
+
+    def _prepare_row(self, r: int, dt: float) -> None:
+        kp, kff = float(self.kp[r]), float(self.kff[r])
+        e = math.exp(-kp * dt)
+        self.e[r] = e
+        self.c[r] = (1.0 - kff) * (1.0 - e) / kp
+        self.lim[r] = self.amax[r] * dt
+        self.nlim[r] = -self.lim[r]
+        self.half_lim[r] = 0.5 * self.lim[r]
+
+    def _flags(self) -> None:
+        """Which optional parts of the cycle any row needs (skipped when none does)."""
+        self.any_pos_offset = bool(np.count_nonzero(self.pos_offset))
+        self.any_off = bool(np.count_nonzero(self.off))
+        # 607Ah is an int32: limits at (or beyond) the int32 range never clamp it
+        self.any_sw = self.any_pos_offset or bool(
+            np.count_nonzero(self.sw_min > _INT32_MIN) or np.count_nonzero(self.sw_max < _INT32_MAX)
+        )
+        self.no_windows = not self.windows
+        self._din_zero = np.zeros(self.n, np.int64)
+        self.any_fe = bool(np.count_nonzero(self.fe_check))
+        self.nvmax = -self.vmax
+
+    # --- one cycle -------------------------------------------------------------------------
+    def step(self, target: np.ndarray, dt: float) -> tuple[dict[str, np.ndarray], np.ndarray]:
+        """One cycle of every row with 607Ah = ``target`` (int64, already int32-wrapped).
+
+        Returns the tentative state (:meth:`commit` makes it the rows' state) and the mask
+        of rows that must leave the bank *before* this cycle (its following error timing
+        out), or None.  The owner must also let rows whose 60FDh has a limit bit leave
+        (the drive's own reaction runs on the next cycle).
+        """
+        if dt != self._dt:
+            self._prepare(dt)
+        self._din_safe -= 1
+        # --- step_csp: clamp to 607Dh, enc_offset, demand velocity
+        x = target + self.pos_offset if self.any_pos_offset else target
+        if self.any_sw:
+            sw_lim = (x < self.sw_min) | (x > self.sw_max)
+            x = np.minimum(np.maximum(x, self.sw_min), self.sw_max)
+        else:
+            sw_lim = np.zeros(self.n, bool)
+        if self.any_off:
+            x = x + self.off
+        demand = x.astype(np.float64)
+        dvel = (demand - self.dpos) / dt
+        # --- Mechanics.track(demand, dvel, dt), operation for operation
+        p, v0, vmax = self.pos, self.vel, self.vmax
+        vff = np.minimum(np.maximum(dvel, self.nvmax), vmax)
+        e1 = (demand - vff * dt - p) * self.e + self.c * vff
+        v = (demand - e1 - p) / dt
+        lim = self.lim
+        dist = demand - p
+        # the closing-speed cap: vstop >= min(|dist|/dt, lim) (m = 0: vstop = |dist|/dt;
+        # m >= 1: vstop >= m*lim), so rows within half of that of vff cannot be capped
+        # (the half keeps the shortcut clear of every rounding at the boundary)
+        gap = v - vff
+        adist = np.abs(dist)
+        if np.count_nonzero(np.abs(gap) > np.minimum(adist * (0.5 / dt), self.half_lim)):
+            vstop = closing_speed(adist, lim, dt)
+            hi = vff + vstop
+            c1 = (dist > 0.0) & (v > hi)
+            np.copyto(v, hi, where=c1)
+            lo = vff - vstop
+            c2 = (dist < 0.0) & (v < lo)
+            np.copyto(v, lo, where=c2)
+            limited = c1 | c2
+        else:
+            limited = np.zeros(self.n, bool)
+        dv = v - v0
+        if np.count_nonzero(np.abs(dv) > lim):
+            up, down = dv > lim, dv < self.nlim
+            np.copyto(v, v0 + lim, where=up)
+            np.copyto(v, v0 - lim, where=down)
+            limited = limited | up | down
+        limited_any = bool(np.count_nonzero(limited))
+        if limited_any:
+            land = limited & (((dist > 0.0) & (v * dt > dist)) | ((dist < 0.0) & (v * dt < dist)))
+            np.copyto(v, dist / dt, where=land)
+        if np.count_nonzero(np.abs(v) > vmax):
+            over, under = v > vmax, v < self.nvmax
+            np.copyto(v, vmax, where=over)
+            np.copyto(v, self.nvmax, where=under)
+            limited = limited | over | under
+            limited_any = True
+        a = (v - v0) / dt
+        pos = p + v * dt
+        # --- following error window (6065h/6066h); a row timing out leaves the bank first
+        events = None
+        fe_time = self.fe_time
+        if self.any_fe:
+            fe_out = np.abs(demand - pos) > self.fe_window
+            if self.fe_running or np.count_nonzero(fe_out & self.fe_check):
+                fe_out &= self.fe_check
+                fe_time = np.where(fe_out, fe_time + dt, 0.0)
+                events = fe_out & (fe_time * 1000.0 > self.fe_timeout)
+                self.fe_next = bool(np.count_nonzero(fe_time))
+            else:
+                self.fe_next = False
+        state = {
+            "pos": pos,
+            "vel": v,
+            "acc": a,
+            "dpos": demand,
+            "dvel": dvel,
+            "fe_time": fe_time,
+            "limited": limited,
+            "sw_limited": sw_lim,
+            "target": target,
+        }
+        self.limited_any = limited_any  # of this tentative state (statusword bit 11)
+        return state, events
+
+    def commit(
+        self, state: dict[str, np.ndarray], din: np.ndarray, keep: np.ndarray | None
+    ) -> None:
+        """Make ``state`` (whose 60FDh is ``din``) the state of the rows in ``keep`` (None: all)."""
+        self.fe_running = self.fe_next
+        if keep is None:
+            for name, value in state.items():
+                setattr(self, name, value)
+            self.cycles += 1
+            self.din = din
+        else:
+            for name, value in state.items():
+                getattr(self, name)[keep] = value[keep]
+            self.cycles += 1
+            self.start[~keep] += 1  # the rows left out did not step
+            if self.din is self._din_zero:
+                self.din = self._din_zero.copy()
+            self.din[keep] = din[keep]
+
+    def output(self, name: str, state: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """One process value of ``Channel._outputs`` / ``_refresh_status`` for every row (int64,
+        not yet wrapped to 32 bits), of the committed state or of a tentative ``state``."""
+        g = state.__getitem__ if state is not None else self.__getattribute__
+        if name == "position_actual":
+            x = g("pos") - self.off if self.any_off else g("pos")
+            return np.rint(x).astype(np.int64)
+        if name == "digital_inputs":
+            pos = g("pos")
+            if self.no_windows and self._din_safe > 0:
+                return self._din_zero  # no row can have reached a switch yet (see below)
+            near = (pos >= self.pl) | (pos <= self.nl)
+            if self.no_windows and not np.count_nonzero(near):
+                # off every switch (shared array: never written into); no row moves more
+                # than vmax*dt a cycle, so none can reach one for the next few cycles
+                gap = min(float((self.pl - pos).min()), float((pos - self.nl).min()))
+                step = float(self.vmax.max()) * self._dt
+                cycles = gap / step - 2.0 if step > 0.0 else 1e9
+                self._din_safe = int(min(cycles, 1e9)) if cycles > 0.0 else 0
+                return self._din_zero
+            din = 2 * (pos >= self.pl) + (pos <= self.nl)
+            for value, lo, hi in self.windows:
+                x = pos[:, None]
+                din = din | (((lo <= x) & (x < hi)).any(axis=1) * value)
+            return din
+        if name == "statusword":
+            if state is not None and not self.limited_any and not self.any_sw:
+                return self.sw_const  # no row limited (so no 6041h bit 11)
+            lim = g("limited") | g("sw_limited")
+            if not np.count_nonzero(lim):
+                return self.sw_const
+            return self.sw_const + lim * _SW_INTERNAL_LIMIT
+        if name == "position_demand":
+            return np.rint(g("dpos") - self.off).astype(np.int64)
+        if name == "velocity_actual":
+            return np.rint(g("vel")).astype(np.int64)
+        if name == "following_error_actual":
+            return np.rint(g("dpos") - g("pos")).astype(np.int64)
+        if name in ("torque_actual", "current_actual", "torque_demand"):
+            torque = g("acc") / self.a_rated * 1000.0 + g("vel") * self.visc
+            return np.minimum(np.maximum(np.rint(torque), -32768), 32767).astype(np.int64)
+        raise KeyError(name)
+
+    # --- hand back ---------------------------------------------------------------------------
+    def store(self, rows: list[int] | None = None) -> None:
+        """Give rows back to their channels, exactly as if each channel had stepped itself."""
+        names = (
+            "position_actual",
+            "position_demand",
+            "velocity_actual",
+            "torque_actual",
+            "current_actual",
+            "torque_demand",
+            "following_error_actual",
+            "digital_inputs",
+            "statusword",
+        )
+        out = {name: self.output(name) for name in names}
+        wrapped = {"position_actual", "position_demand", "velocity_actual"}
+        wrapped.add("following_error_actual")
+        for r in range(len(self.channels)) if rows is None else rows:
+            ch = self.channels[r]
+            m = ch.mech
+            a, v = float(self.acc[r]), float(self.vel[r])
+            m.pos, m.vel, m.acc = float(self.pos[r]), v, a
+            m.torque = a / m.a_rated * 1000.0 + v * m.visc
+            m.limited = bool(self.limited[r])
+            ch.dpos, ch.dvel = float(self.dpos[r]), float(self.dvel[r])
+            ch.fe_time = float(self.fe_time[r])
+            ch.fe_flag = False
+            ch.sw_limited = bool(self.sw_limited[r])
+            ch.stopping = False
+            ch.limit_stop = False
+            ch.oms = SW12
+            ch.cycle += self.cycles - int(self.start[r])
+            self.start[r] = self.cycles
+            ch.target_position = int(self.target[r])
+            for name, values in out.items():
+                x = int(values[r])
+                setattr(ch, name, wrap32(x) if name in wrapped else x)
+            ch.mode_display = ch.mode
+
+
+def closing_speed(dist: np.ndarray, lim: np.ndarray, dt: float) -> np.ndarray:
+    """:func:`gtecat.drives.mechanics._closing_speed` for every row (same operations and order)."""
+    ok = (dist > 0.0) & (lim > 0.0)
+    out = np.zeros_like(dist)
+    if not ok.any():
+        return out
+    idx = np.nonzero(ok)[0]
+    dd = dist[idx] / dt
+    lm = lim[idx]
+    half = 0.5 * lm
+    m = np.floor_divide(np.sqrt(half * half + 2.0 * lm * dd) - half, lm)
+    res = np.full(len(idx), np.nan)
+    open_ = np.ones(len(idx), bool)
+    v = dd
+    for _ in range(8):
+        v = np.where(open_, (dd + lm * m * (m + 1.0) / 2.0) / (m + 1.0), v)
+        dec = open_ & (v < m * lm) & (m > 0.0)
+        inc = open_ & ~dec & (v >= (m + 1.0) * lm)
+        hit = open_ & ~dec & ~inc
+        res = np.where(hit, v, res)
+        open_ = open_ & ~hit
+        m = m - dec + inc
+        if not open_.any():
+            break
+    res = np.where(open_, np.minimum(v, dd), res)
+    out[idx] = res
+    return out

@@ -1,0 +1,122 @@
+"""Drive faults: the 603Fh error codes and what keeps a fault from being reset.
+
+Error codes are the CiA 402 / CiA 301 emergency codes (IEC 61800-7-201 Annex,
+"error code" table); 0xFFxx are this virtual drive's vendor codes.  A fault has
+a *cause* that may persist: an injected alarm or encoder error stays until the
+scenario clears it, while a following error or a limit-switch fault is over
+once the drive has stopped.  A fault reset (rising edge of 6040h bit 7) is
+honoured only when no cause persists (cia402-facts.md section 7.1).
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+from gtecat.eni.errors import GtecatError
+
+
+class ErrorCode(IntEnum):
+    """Values of 603Fh."""
+
+    NO_ERROR = 0x0000
+    GENERIC = 0x1000
+    CONTINUOUS_OVER_CURRENT = 0x2310
+    SHORT_CIRCUIT = 0x2320
+    DC_LINK_OVER_VOLTAGE = 0x3210
+    DC_LINK_UNDER_VOLTAGE = 0x3220
+    DRIVE_OVER_TEMPERATURE = 0x4310
+    MOTOR_OVER_TEMPERATURE = 0x4410
+    ENCODER = 0x7305  # incremental sensor 1 fault
+    COMMUNICATION = 0x8100
+    FOLLOWING_ERROR = 0x8611
+    REFERENCE_LIMIT = 0x8612
+    ALARM = 0xFF00  # vendor: external alarm / generic servo alarm
+    POSITIVE_LIMIT = 0xFF01  # vendor: positive limit switch (limit reaction "fault")
+    NEGATIVE_LIMIT = 0xFF02  # vendor: negative limit switch
+
+
+#: names a scenario may pass to ``inject_fault`` (besides an ErrorCode or a raw code)
+FAULT_KINDS: dict[str, ErrorCode] = {
+    "alarm": ErrorCode.ALARM,
+    "encoder": ErrorCode.ENCODER,
+    "overcurrent": ErrorCode.CONTINUOUS_OVER_CURRENT,
+    "short_circuit": ErrorCode.SHORT_CIRCUIT,
+    "overvoltage": ErrorCode.DC_LINK_OVER_VOLTAGE,
+    "undervoltage": ErrorCode.DC_LINK_UNDER_VOLTAGE,
+    "overtemperature": ErrorCode.DRIVE_OVER_TEMPERATURE,
+    "motor_overtemperature": ErrorCode.MOTOR_OVER_TEMPERATURE,
+    "following_error": ErrorCode.FOLLOWING_ERROR,
+    "communication": ErrorCode.COMMUNICATION,
+    "generic": ErrorCode.GENERIC,
+}
+
+
+#: faults whose cause is over once the drive has stopped: injecting one fires it once
+TRANSIENT: frozenset[int] = frozenset(
+    {
+        ErrorCode.FOLLOWING_ERROR,
+        ErrorCode.REFERENCE_LIMIT,
+        ErrorCode.POSITIVE_LIMIT,
+        ErrorCode.NEGATIVE_LIMIT,
+        ErrorCode.COMMUNICATION,
+    }
+)
+
+
+class FaultError(GtecatError):
+    """A fault kind a scenario asked for that the drive does not know."""
+
+
+def fault_code(kind: str | int) -> int:
+    """An injectable fault as its 603Fh code: a name of :data:`FAULT_KINDS` or a code."""
+    if isinstance(kind, str):
+        try:
+            return FAULT_KINDS[kind.lower()]
+        except KeyError:
+            raise FaultError(
+                f"unknown fault kind {kind!r}; use one of {', '.join(FAULT_KINDS)} or a code"
+            ) from None
+    code = int(kind)
+    if not 0 < code <= 0xFFFF:
+        raise FaultError(f"fault code 0x{code:X} is not a 16-bit 603Fh code")
+    return code
+
+
+class FaultMonitor:
+    """The latched 603Fh code and the persisting causes of one channel."""
+
+    __slots__ = ("code", "injected", "pending")
+
+    def __init__(self) -> None:
+        self.code = 0  # 603Fh: the fault being shown (kept until a reset succeeds)
+        self.injected = 0  # code of a persisting injected cause (0 = none)
+        self.pending = 0  # a fault detected since the last cycle, not yet acted on
+
+    @property
+    def cause_active(self) -> bool:
+        return self.injected != 0
+
+    def raise_fault(self, code: int) -> None:
+        """Report a fault; the drive enters FAULT REACTION ACTIVE on its next step."""
+        if not self.pending:
+            self.pending = code
+
+    def inject(self, code: int) -> None:
+        """A scenario's fault: its cause persists until cleared, unless it is TRANSIENT."""
+        if code not in TRANSIENT:
+            self.injected = code
+        self.raise_fault(code)
+
+    def clear_injected(self) -> None:
+        self.injected = 0
+
+    def take_pending(self) -> int:
+        code, self.pending = self.pending, 0
+        if code:
+            self.code = code
+        return code
+
+    def reset(self) -> None:
+        """A successful fault reset (transition 15)."""
+        self.code = 0
+        self.pending = 0

@@ -1,0 +1,244 @@
+"""Virtual EtherCAT IO: digital/analog terminals and a modular coupler (ETG.5001 style).
+
+An IO slave's process data is whatever its PDO mapping says (from the ENI).
+The *field side* is what a scenario touches: outputs the master wrote are read
+with :meth:`IoSlave.get_output`, inputs are set with :meth:`IoSlave.set_input`,
+and :meth:`IoSlave.wire` connects an output bit to an input bit (a wire on the
+terminal block), so a raw-data write comes back as an input one cycle later.
+
+A modular coupler maps module ``n``'s inputs at ``0x6000 + 0x10*n`` and its
+outputs at ``0x7000 + 0x10*n`` (ETG.5001.1 modular device profile); the
+Googol coupler of manual figure 5-4 (IBM337 + DI16/DO16/AI4/AO4) is one.
+:meth:`IoSlave.modules` groups the mapped objects that way.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+from gtecat.eni.bits import get_bits, set_bits
+from gtecat.eni.model import Direction, Identity, Pdo
+
+from .pdo_mapping import is_gap
+from .slave import AlState, AlStatusCode, VirtualSlave
+
+_SIGNED_TYPES = {"SINT", "INT", "DINT", "LINT", "INT8", "INT16", "INT32", "INT64"}
+
+
+@dataclass(frozen=True, slots=True)
+class IoPoint:
+    """One mapped object inside the slave's own rx (OUT) or tx (IN) buffer."""
+
+    direction: Direction
+    index: int
+    subindex: int
+    bit: int  # offset inside rx/tx
+    bits: int
+    name: str
+    signed: bool
+
+
+def _place(
+    layout: Iterable[tuple[Direction, Iterable[tuple[int, int, int, str, bool]]]],
+) -> dict[tuple[Direction, int, int], IoPoint]:
+    """Field-side points from mapped entries ``(index, sub, bits, name, signed)`` in mapping
+    order per direction: each at its bit inside rx/tx; gaps (index 0..7) take room only."""
+    points: dict[tuple[Direction, int, int], IoPoint] = {}
+    for direction, entries in layout:
+        bit = 0
+        for index, sub, bits, name, signed in entries:
+            if not is_gap(index):
+                points.setdefault(
+                    (direction, index, sub),
+                    IoPoint(direction, index, sub, bit, bits, name, signed),
+                )
+            bit += bits
+    return points
+
+
+class IoSlave(VirtualSlave):
+    """A generic IO slave driven by its PDO mapping.
+
+    Outputs only reach the field while the slave is in OP (in SAFEOP the
+    outputs stay in their safe state: all zero), as ETG.1000.6 requires.
+    """
+
+    def __init__(
+        self,
+        position: int,
+        name: str,
+        identity: Identity,
+        *,
+        rx_pdos: Sequence[Pdo] = (),
+        tx_pdos: Sequence[Pdo] = (),
+    ) -> None:
+        self.rx_pdos = tuple(rx_pdos)
+        self.tx_pdos = tuple(tx_pdos)
+        super().__init__(position, name, identity)
+        self.points = _place(
+            (
+                d,
+                [
+                    (e.index, e.subindex, e.bit_len, e.name, e.data_type.upper() in _SIGNED_TYPES)
+                    for pdo in pdos
+                    for e in pdo.entries
+                ],
+            )
+            for d, pdos in ((Direction.OUT, self.rx_pdos), (Direction.IN, self.tx_pdos))
+        )
+        self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
+        self.field_outputs = bytearray(len(self.rx))  # what the terminals drive
+        self._wires: list[tuple[int, int]] = []  # (output bit, input bit) in rx/tx numbering
+
+    def pdo_sizes(self) -> tuple[int, int]:
+        return (sum(p.bit_len for p in self.rx_pdos), sum(p.bit_len for p in self.tx_pdos))
+
+    # --- field side -----------------------------------------------------------
+    def point(self, direction: Direction, index: int, subindex: int) -> IoPoint:
+        try:
+            return self.points[(direction, index, subindex)]
+        except KeyError:
+            kind = "output" if direction == Direction.OUT else "input"
+            raise KeyError(
+                f"slave {self.position} ({self.name}) maps no {kind} 0x{index:04X}:{subindex:02X}"
+            ) from None
+
+    def get_output(self, index: int, subindex: int) -> int:
+        """The value the terminal drives for an output object (0 unless in OP)."""
+        p = self.point(Direction.OUT, index, subindex)
+        return get_bits(self.field_outputs, p.bit, p.bits, signed=p.signed)
+
+    def set_input(self, index: int, subindex: int, value: int) -> None:
+        """Set what the terminal reads on an input object (reported from the next cycle)."""
+        p = self.point(Direction.IN, index, subindex)
+        set_bits(self.field_inputs, p.bit, p.bits, int(value))
+
+    def get_output_bit(self, bit: int) -> bool:
+        return bool(get_bits(self.field_outputs, bit, 1))
+
+    def set_input_bit(self, bit: int, on: bool) -> None:
+        set_bits(self.field_inputs, bit, 1, int(bool(on)))
+
+    def wire(self, out_bit: int, in_bit: int) -> None:
+        """Connect output bit ``out_bit`` (rx numbering) to input bit ``in_bit`` (tx numbering)."""
+        if not 0 <= out_bit < len(self.rx) * 8:
+            raise ValueError(f"slave {self.position}: no output bit {out_bit}")
+        if not 0 <= in_bit < len(self.tx) * 8:
+            raise ValueError(f"slave {self.position}: no input bit {in_bit}")
+        self._wires.append((out_bit, in_bit))
+
+    def wire_objects(
+        self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None
+    ) -> None:
+        """Wire a whole output object to an input object (bit for bit)."""
+        po = self.point(Direction.OUT, *out)
+        pi = self.point(Direction.IN, *inp)
+        n = min(po.bits, pi.bits) if bits is None else bits
+        for k in range(n):
+            self.wire(po.bit + k, pi.bit + k)
+
+    def modules(self) -> dict[int, list[IoPoint]]:
+        """Mapped objects grouped by ETG.5001 module number (0x6000/0x7000 + 0x10*n)."""
+        out: dict[int, list[IoPoint]] = {}
+        for p in self.points.values():
+            if 0x6000 <= p.index < 0x8000:
+                n = (p.index & 0x0FFF) >> 4
+                out.setdefault(n, []).append(p)
+        return out
+
+    # --- cycle ------------------------------------------------------------------
+    def step(self, t_ns: int, dt_ns: int) -> None:
+        if self.al_state == AlState.OP:
+            self.field_outputs[:] = self.rx
+        else:
+            self.field_outputs[:] = bytes(len(self.field_outputs))
+        for ob, ib in self._wires:
+            set_bits(self.field_inputs, ib, 1, get_bits(self.field_outputs, ob, 1))
+        if self.al_state >= AlState.SAFEOP:
+            self.tx[:] = self.field_inputs
+
+
+class CoeIoSlave(IoSlave):
+    """An IO slave with a CoE mailbox (an ETG.5001 coupler, an analog terminal...).
+
+    Same object dictionary, PDO mapping/assignment objects (1600h-/1A00h-,
+    1C12h/1C13h) and SDO server as the CiA-402 drive, so the CoE InitCmds an ENI
+    carries for such a slave (acontis clears and re-assigns 1C12h/1C13h) work as
+    on the real device.  The field side keeps the point layout of the mapping the
+    master finally configured (recomputed at PREOP -> SAFEOP).  Mapped objects
+    that the slave does not describe are held as PDO placeholders; their SDO
+    upload reads what the process data holds last (outputs: the master's last
+    RxPDO, inputs: the last TxPDO), as a real terminal's object does
+    (ETG.5001: the mapped 0x6000/0x7000 objects *are* the process data).
+    """
+
+    has_mailbox = True
+
+    def __init__(
+        self,
+        position: int,
+        name: str,
+        identity: Identity,
+        *,
+        rx_pdos: Sequence[Pdo] = (),
+        tx_pdos: Sequence[Pdo] = (),
+        device_type: int = 0x00001389,  # ETG.5001 modular device profile
+        mailbox_size: int = 128,
+    ) -> None:
+        from .od import Access, DataType, ObjectDictionary, add_identity
+        from .pdo_mapping import PdoMapping
+        from .sdo_server import SdoServer
+
+        self.od = ObjectDictionary()
+        self.od.add_var(0x1000, "Device type", DataType.UINT32, Access.RO, default=device_type)
+        self.od.add_var(0x1008, "Device name", DataType.VISIBLE_STRING, Access.CONST, default=name)
+        add_identity(self.od, identity)
+        self.mapping = PdoMapping(self.od, rx_pdos, tx_pdos)
+        self.sdo = SdoServer(self.od, mailbox_size=mailbox_size)
+        super().__init__(position, name, identity, rx_pdos=rx_pdos, tx_pdos=tx_pdos)
+        self._link_process_data()
+
+    def pdo_sizes(self) -> tuple[int, int]:
+        return self.mapping.sizes()
+
+    def _link_process_data(self) -> None:
+        """Placeholders of mapped objects read (and write) their bits of ``rx``/``tx``.
+
+        Read at SDO time, so the cycle pays nothing; the buffers are looked up on
+        every access because a new mapping reallocates them.
+        """
+        for p in self.points.values():
+            var = self.od.find(p.index, p.subindex)
+            if var is None or not var.placeholder:
+                continue
+            if p.direction == Direction.OUT:
+                var.getter = lambda p=p: get_bits(self.rx, p.bit, p.bits)
+                var.setter = lambda v, p=p: set_bits(self.rx, p.bit, p.bits, int(v))
+            else:
+                var.getter = lambda p=p: get_bits(self.tx, p.bit, p.bits)
+
+    def mailbox(self, request: bytes) -> bytes | None:
+        return self.sdo.handle(request, self.al_state)
+
+    def on_state_change(self, old: AlState, new: AlState) -> AlStatusCode:
+        if old == AlState.PREOP and new == AlState.SAFEOP:
+            self._relayout()
+        return AlStatusCode.NO_ERROR
+
+    def _relayout(self) -> None:
+        """Field-side points from the mapping the master configured."""
+
+        def entries(d: Direction) -> list[tuple[int, int, int, str, bool]]:
+            out = []
+            for index, sub, bits in self.mapping.entries(d):
+                old = self.points.get((d, index, sub))
+                out.append((index, sub, bits, old.name if old else "", bool(old and old.signed)))
+            return out
+
+        points = _place((d, entries(d)) for d in (Direction.OUT, Direction.IN))
+        self.points = points
+        rx_bits, tx_bits = self.mapping.sizes()
+        self.field_outputs = bytearray((rx_bits + 7) // 8)
+        self.field_inputs = bytearray((tx_bits + 7) // 8)
+        self._link_process_data()

@@ -1,0 +1,211 @@
+"""The machine description: what the mechanics around each axis look like.
+
+A TOML file (DESIGN.md "Machine description"), one table per GT axis, all
+positions in drive counts of the *machine* (the scale a ruler on the machine
+would read; homing later redefines what the encoder reports, not where the
+switches are)::
+
+    [axis.1]
+    position = 0                 # where the mechanics stand at power-on
+    counts_per_rev = 10000       # encoder counts per motor revolution
+    negative_limit = -200000     # switch active at or below this position
+    positive_limit = 200000      # switch active at or above this position
+    home_switch = [[50000, 60000]]   # [low, high) windows where the switch is active
+    index_offset = 1234          # an index pulse here and every counts_per_rev
+    probe1 = [[30000, 30500]]    # windows where probe input 1 is active
+    probe2 = []
+    following_error_window = 10000
+    switch_wiring = "normally_closed"   # or "normally_open"; absent: as the .cfg expects
+
+Every key is optional: no switches, no index pulse, no probe marks.  ``switch_wiring`` says
+how the axis's limit and home switches are wired, for a configuration file's ``reverse``
+to meet: left out, each switch is wired the way the loaded configuration expects (its
+``reverse=1`` means a normally-closed switch), so an application's own ``.cfg`` runs as on
+the machine it was written for (gtecat.controller.config_file.switch_sense).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gtecat.eni.errors import GtecatError
+
+
+class MachineError(GtecatError):
+    """A machine description that cannot be used."""
+
+
+Window = tuple[float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class AxisMachine:
+    """Mechanics around one axis (see the module docstring for the keys)."""
+
+    position: float = 0.0
+    counts_per_rev: int = 10000
+    negative_limit: float | None = None
+    positive_limit: float | None = None
+    home_switch: tuple[Window, ...] = ()
+    index_offset: float | None = None
+    probe1: tuple[Window, ...] = ()
+    probe2: tuple[Window, ...] = ()
+    following_error_window: int | None = None
+    switch_wiring: str | None = None  #: "normally_open" | "normally_closed" | None (as the cfg)
+
+    # --- levels -----------------------------------------------------------
+    def negative_limit_active(self, pos: float) -> bool:
+        return self.negative_limit is not None and pos <= self.negative_limit
+
+    def positive_limit_active(self, pos: float) -> bool:
+        return self.positive_limit is not None and pos >= self.positive_limit
+
+    def home_active(self, pos: float) -> bool:
+        return _in_windows(self.home_switch, pos)
+
+    def probe_active(self, probe: int, pos: float) -> bool:
+        return _in_windows(self.probe1 if probe == 1 else self.probe2, pos)
+
+    # --- index pulses crossed between two samples ----------------------------
+    # (exact edges of the switch windows: drives/signal_edges.py)
+    def index_positions(self, p0: float, p1: float) -> list[float]:
+        """Index pulse positions in the half-open travel ``(p0, p1]`` (or ``[p1, p0)``),
+        in the order they are met."""
+        if self.index_offset is None or p0 == p1 or self.counts_per_rev <= 0:
+            return []
+        cpr = self.counts_per_rev
+        lo, hi = min(p0, p1), max(p0, p1)
+        k0 = math.floor((lo - self.index_offset) / cpr)
+        out = []
+        k = k0
+        while True:
+            x = self.index_offset + k * cpr
+            if x > hi:
+                break
+            if (p1 > p0 and p0 < x <= p1) or (p1 < p0 and p1 <= x < p0):
+                out.append(float(x))
+            k += 1
+        if p1 < p0:
+            out.reverse()
+        return out
+
+    @property
+    def travel(self) -> tuple[float, float]:
+        """The usable travel: between the limit switches (or +-1e12 counts)."""
+        lo = self.negative_limit if self.negative_limit is not None else -1e12
+        hi = self.positive_limit if self.positive_limit is not None else 1e12
+        return lo, hi
+
+
+def _in_windows(windows: Iterable[Window], pos: float) -> bool:
+    return any(lo <= pos < hi for lo, hi in windows)
+
+
+@dataclass(frozen=True, slots=True)
+class MachineDescription:
+    axes: Mapping[int, AxisMachine] = field(default_factory=dict)
+    source: str = ""
+
+    def axis(self, n: int) -> AxisMachine:
+        """The description of GT axis ``n`` (defaults when the file omits it)."""
+        return self.axes.get(n, AxisMachine())
+
+
+_KEYS = {
+    "position",
+    "counts_per_rev",
+    "negative_limit",
+    "positive_limit",
+    "home_switch",
+    "index_offset",
+    "probe1",
+    "probe2",
+    "following_error_window",
+    "switch_wiring",
+}
+SWITCH_WIRINGS = ("normally_open", "normally_closed")
+
+
+def _windows(raw: Any, where: str) -> tuple[Window, ...]:
+    if raw is None:
+        return ()
+    if not isinstance(raw, list):
+        raise MachineError(f"{where}: expected a list of [low, high) windows, got {raw!r}")
+    if len(raw) == 2 and all(isinstance(v, int | float) for v in raw):
+        raw = [raw]  # a single window written flat
+    out = []
+    for w in raw:
+        if (
+            not isinstance(w, list)
+            or len(w) != 2
+            or not all(isinstance(v, int | float) for v in w)
+            or not w[0] < w[1]
+        ):
+            raise MachineError(f"{where}: window {w!r} is not [low, high) with low < high")
+        out.append((float(w[0]), float(w[1])))
+    return tuple(sorted(out))
+
+
+def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescription:
+    axes_raw = data.get("axis", {})
+    if not isinstance(axes_raw, dict):
+        raise MachineError(f"{source}: [axis.N] tables expected")
+    axes: dict[int, AxisMachine] = {}
+    for key, table in axes_raw.items():
+        where = f"{source}: [axis.{key}]"
+        try:
+            n = int(key)
+        except ValueError:
+            raise MachineError(f"{where}: axis number must be an integer") from None
+        if n < 1:
+            raise MachineError(f"{where}: axes are numbered from 1")
+        unknown = set(table) - _KEYS
+        if unknown:
+            raise MachineError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+
+        def num(name: str, default: Any = None, *, where: str = where, table: Any = table) -> Any:
+            v = table.get(name, default)
+            if v is not None and not isinstance(v, int | float):
+                raise MachineError(f"{where}: {name} must be a number, got {v!r}")
+            return v
+
+        cpr = num("counts_per_rev", 10000)
+        if cpr <= 0:
+            raise MachineError(f"{where}: counts_per_rev must be positive")
+        nl, pl = num("negative_limit"), num("positive_limit")
+        if nl is not None and pl is not None and nl >= pl:
+            raise MachineError(f"{where}: negative_limit {nl} must be below positive_limit {pl}")
+        wiring = table.get("switch_wiring")
+        if wiring is not None and wiring not in SWITCH_WIRINGS:
+            raise MachineError(
+                f"{where}: switch_wiring {wiring!r}: one of {', '.join(SWITCH_WIRINGS)}"
+            )
+        axes[n] = AxisMachine(
+            position=float(num("position", 0)),
+            counts_per_rev=int(cpr),
+            negative_limit=None if nl is None else float(nl),
+            positive_limit=None if pl is None else float(pl),
+            home_switch=_windows(table.get("home_switch"), f"{where} home_switch"),
+            index_offset=None if num("index_offset") is None else float(num("index_offset")),
+            probe1=_windows(table.get("probe1"), f"{where} probe1"),
+            probe2=_windows(table.get("probe2"), f"{where} probe2"),
+            following_error_window=num("following_error_window"),
+            switch_wiring=wiring,
+        )
+    return MachineDescription(axes=axes, source=source)
+
+
+def load_machine(path: str | Path) -> MachineDescription:
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise MachineError(f"{p}: machine description not found") from None
+    except tomllib.TOMLDecodeError as e:
+        raise MachineError(f"{p}: not valid TOML: {e}") from None
+    return machine_from_dict(data, str(p))

@@ -1,0 +1,140 @@
+"""Read a ``Gecat.eni`` of either family, told apart by content (DESIGN.md "Configuration files").
+
+* ETG.2100 ENI XML: root element ``EtherCATConfig`` (:mod:`gtecat.eni.xml_reader`);
+* Googol's INI-style file: ``[CommonInfo]`` / ``[SlaveStart]`` sections
+  (:mod:`gtecat.eni.googol_reader`);
+* ``EncryptedEtherCATConfig`` (TwinCAT's encrypted ENI) is refused: its
+  content cannot be read without the vendor's key.
+
+Both file names and extensions are meaningless here (the real controller calls
+both ``Gecat.eni``); only the bytes decide.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+from pathlib import Path
+
+from .errors import EniError
+from .googol_reader import read_googol
+from .model import EniConfig
+from .xml_reader import read_xml
+from .xmltree import parse_xml
+
+_GOOGOL = re.compile(rb"^\s*\[\s*(CommonInfo|SlaveStart|SlaveIndex|MasterInfo)\s*\]", re.I | re.M)
+_ROOT = re.compile(rb"<\s*(?:[A-Za-z_][\w.-]*:)?([A-Za-z_][\w.-]*)")
+
+
+def _head_bytes(data: bytes | str) -> bytes:
+    if isinstance(data, str):
+        return data[:8192].encode("utf-8", "replace")
+    head = data[:8192]
+    for bom, codec, width in (
+        (b"\x00\x00\xfe\xff", "utf-32-be", 4),
+        (b"\xff\xfe\x00\x00", "utf-32-le", 4),
+        (b"\xff\xfe", "utf-16-le", 2),
+        (b"\xfe\xff", "utf-16-be", 2),
+    ):
+        if head.startswith(bom):
+            # decode whole code units only (the cut may fall inside a character)
+            part = data[len(bom) : len(bom) + 4096 * width]
+            return part.decode(codec, "replace").encode("utf-8", "replace")[:8192]
+    return head
+
+
+def _root_tag(head: bytes) -> bytes | None:
+    """Name of the first element, skipping the declaration, comments and PIs."""
+    i = 0
+    n = len(head)
+    while i < n:
+        j = head.find(b"<", i)
+        if j < 0:
+            return None
+        if head.startswith(b"<?", j):
+            k = head.find(b"?>", j)
+            i = n if k < 0 else k + 2
+            continue
+        if head.startswith(b"<!--", j):
+            k = head.find(b"-->", j)
+            i = n if k < 0 else k + 3
+            continue
+        if head.startswith(b"<!", j):  # DOCTYPE: let the parser refuse it with its line
+            k = head.find(b">", j)
+            i = n if k < 0 else k + 1
+            continue
+        m = _ROOT.match(head, j)
+        return m.group(1) if m else None
+    return None
+
+
+def detect_format(data: bytes | str) -> str:
+    """``"xml"``, ``"googol"``, ``"encrypted"`` or ``"unknown"``."""
+    head = _head_bytes(data)
+    stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if stripped.startswith(b"<"):
+        tag = _root_tag(stripped)
+        if tag == b"EncryptedEtherCATConfig":
+            return "encrypted"
+        if tag == b"EtherCATConfig":
+            return "xml"
+        if tag is None and b"EtherCATConfig" in stripped:
+            return "xml"
+        return "unknown"
+    if _GOOGOL.search(head):
+        return "googol"
+    return "unknown"
+
+
+#: the register InitCmds (the master's and each slave's): the reader builds the bus from the
+#: rest, so their elements (most of a TwinCAT file's) are checked by expat but not kept
+_NOT_READ = frozenset({("Master", "InitCmds"), ("Slave", "InitCmds")})
+
+
+def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
+    """Parse configuration text/bytes; ``source`` names it in error messages."""
+    fmt = detect_format(text)
+    if fmt == "xml":
+        root = parse_xml(text, source, _NOT_READ)
+        if root.tag == "EncryptedEtherCATConfig":
+            fmt = "encrypted"
+        elif root.tag != "EtherCATConfig":
+            raise EniError(
+                f"root element is <{root.tag}>, not <EtherCATConfig>", file=source, line=root.line
+            )
+        else:
+            return read_xml(root, source)
+    if fmt == "encrypted":
+        raise EniError(
+            "this is an EncryptedEtherCATConfig (an encrypted ENI); export it unencrypted "
+            "from the configuration tool",
+            file=source,
+        )
+    if fmt == "googol":
+        return read_googol(text, source)
+    raise EniError(
+        "not an ENI: neither ETG.2100 XML (<EtherCATConfig>) nor a Googol INI Gecat.eni "
+        "([CommonInfo]/[SlaveStart] sections)",
+        file=source,
+    )
+
+
+def read_eni(path: str | os.PathLike[str]) -> EniConfig:
+    """Read and parse a configuration file (either family)."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise EniError(f"cannot read the file: {exc.strerror or exc}", file=str(p)) from None
+    if not data.strip():
+        raise EniError("the file is empty", file=str(p))
+    return _parse_cached(data, str(p))
+
+
+@functools.lru_cache(maxsize=32)
+def _parse_cached(data: bytes, source: str) -> EniConfig:
+    """One parse per file content: the model is immutable (frozen dataclasses of tuples), so
+    a program or a test suite that opens the same ENI again gets the same object; a file that
+    changed is a new key, and one that fails raises each time (errors are not cached)."""
+    return parse_eni(data, source)
