@@ -14,8 +14,8 @@ from ctypes import byref, c_long
 
 import pytest
 
-from drives.machine import AxisMachine, MachineDescription, machine_from_dict
 from gtecat import gt
+from gtecat.drives.machine import AxisMachine, MachineDescription, machine_from_dict
 from tests.conftest import EXAMPLES
 
 from .test_load_config import fixture
