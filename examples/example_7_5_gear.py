@@ -84,11 +84,13 @@ def plc_prg(v: PlcVars) -> None:
         commandhandler("GT_GearStart", v.rtn)
         v.xStart = False
     vel = (c_double * 8)()
-    v.rtn = gt.GT_GetPrfVel(1, vel, 2, None)  # the manual reads 8 axes; this bus has 2
-    v.arrPrfVel[:2] = list(vel[:2])
+    v.rtn = gt.GT_GetPrfVel(1, vel, 8, 0)  # as the manual: 8 profiles, whatever the bus holds
+    commandhandler("GT_GetPrfVel", v.rtn)  # added: the manual leaves it unchecked
+    v.arrPrfVel[:] = list(vel)
     pos = (c_double * 8)()
-    v.rtn = gt.GT_GetPrfPos(1, pos, 2, None)
-    v.arrPrfPos[:2] = list(pos[:2])
+    v.rtn = gt.GT_GetPrfPos(1, pos, 8, 0)
+    commandhandler("GT_GetPrfPos", v.rtn)
+    v.arrPrfPos[:] = list(pos)
 
 
 def bring_up(**options: object) -> None:

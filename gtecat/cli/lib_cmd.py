@@ -1,7 +1,11 @@
-"""``gtecat lib --cflags --libs | --path | --header``: what a C/C++ build needs.
+"""gtecat lib: what a C, C++, C# or VB.NET program needs to use libgts.
+
+C and C++ (the header gts.h and libgts.so, built on first use into a per-version cache;
+with no C compiler this says so and exits 1):
 
     gcc prog.c $(python3 -m gtecat lib --cflags --libs)
     g++ prog.cpp $(python3 -m gtecat lib --cflags --libs)
+    python3 -m gtecat lib --path            the library itself (ctypes.CDLL)
 
 ``--cflags`` prints the include directory of ``gts.h`` and a forced include
 (``gtecat_vendor.h``) with which the vendor's own header, as it ships for Windows, compiles
@@ -14,6 +18,16 @@ into a per-version cache (docs/native.md); with no C compiler this says so and e
 ``GT_x`` with ``short cardNum`` first; the emulator is card 0):
 
     gcc prog.c $(python3 -m gtecat lib --abi gts-multicard --cflags --libs)
+--cflags prints the include directory of gts.h; --libs the -L, the rpath (the program
+finds libgts.so without LD_LIBRARY_PATH) and -lgts.
+
+C# and VB.NET on Mono (docs/csharp.md): --mono-config writes the dllmap that sends the
+vendor's DLL names (gts.dll, gen.dll, gxn.dll) to libgts's Windows-long build (C# int is
+C long there); put it beside the program as App.exe.config, or name it in MONO_CONFIG.
+--csharp writes gts.cs, the GT API for new C# code:
+
+    python3 -m gtecat lib --csharp -o gts.cs
+    mcs App.cs gts.cs && python3 -m gtecat lib --mono-config -o App.exe.config && mono App.exe
 """
 
 from __future__ import annotations
@@ -43,11 +57,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="gtn: the vendor's (one card, GTN twins; default); gts-multicard: the older "
         "GTS header with short cardNum first (libgts_mc.so)",
     )
+    p.add_argument(
+        "--mono-config",
+        action="store_true",
+        help="the Mono dllmap sending gts.dll / gen.dll / gxn.dll to libgts (App.exe.config)",
+    )
+    p.add_argument("--csharp", action="store_true", help="gts.cs: the GT API for C# (generated)")
+    p.add_argument("-o", "--output", metavar="FILE", help="write --mono-config / --csharp here")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     abi = "" if args.abi == "gtn" else args.abi
+    if args.mono_config or args.csharp:
+        return _csharp(args)
     if args.header:
         from ..native.header import render
 
@@ -72,4 +95,25 @@ def run(args: argparse.Namespace) -> int:
         lines.append(str(build.library))
     for line in lines:
         print(line)
+    return 0
+
+
+def _csharp(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..native import csharp
+
+    if args.mono_config and args.csharp:
+        print("error: --mono-config and --csharp write different files; ask for one")
+        return 1
+    if args.csharp:
+        text = csharp.render()
+    else:
+        from ..native.llp64 import ensure_built
+
+        text = csharp.mono_config(ensure_built(force=args.rebuild))
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+    else:
+        sys.stdout.write(text)
     return 0

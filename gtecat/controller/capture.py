@@ -37,7 +37,9 @@ becomes active** (the switch is reached) and **1 where it becomes inactive** (th
 is left); 0 is the reset state, as a vendor configuration file writes it
 (``captureHomeSense=0``).  An index pulse has no width: both senses capture it.  A
 ``[homeN] reverse=1`` of the configuration file swaps active and inactive of the home
-input (a normally-closed sensor).
+input where it disagrees with how the machine's switch is wired
+(:func:`gtecat.controller.config_file.switch_sense`: a switch the machine description
+leaves unwired is wired as the configuration expects).
 
 Values are in encoder units (``GT_GetEncPos``), rounded to the ``long`` the API returns.
 """
@@ -131,10 +133,9 @@ class CaptureUnit:
 
     def refresh_wiring(self) -> None:
         """Take ``[homeN] reverse`` from the configuration file loaded last."""
-        from .config_file import vendor_settings
+        from .config_file import switch_sense
 
-        home = vendor_settings(self.ctl).get(("home", self.number), {})
-        reverse = bool(home.get("reverse", False))
+        reverse = switch_sense(self.ctl, "home", self.number)[1]  # the wiring it meets
         if reverse != self.home_reverse:
             self.home_reverse = reverse
             self._home_prev = self.home_level()

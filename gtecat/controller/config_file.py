@@ -37,9 +37,12 @@ on an EtherCAT axis (axis/profile/encoder N = GT axis N, 4.3):
   inputs, "配置无效").
 * ``[limitPositiveN]`` / ``[limitNegativeN]`` / ``[homeN]`` / ``[alarmN]``: ``active``
   is the GT_LmtsOn/Off (GT_AlarmOn/Off) state of the axes that take this input (a stop
-  input whose source is not active is none); ``reverse=1`` inverts the input (a
-  normally-closed switch: a limit is triggered while 60FDh's bit is 0; an alarm while the
-  drive is *not* in fault - noted in the log, it is rarely what a bus axis wants);
+  input whose source is not active is none); ``reverse=1`` says the switch is
+  normally closed; the emulated switch is wired the way the file expects unless the machine
+  description's ``switch_wiring`` says otherwise (:func:`switch_sense`), so only a file that
+  disagrees with a stated wiring reads the switch inverted; an alarm's ``reverse=1`` inverts
+  it (active while the drive is *not* in fault - noted in the log, it is rarely what a bus
+  axis wants);
   ``filterTime`` is the card's input debounce (MCT writes 3): on a bus the drive
   debounces its own inputs and the master samples 60FDh / 6041h once a cycle, so the
   value is stored (:func:`vendor_settings`) and filters nothing again.  The drive's own
@@ -656,6 +659,44 @@ def decode(data: bytes) -> str:
         return data.decode("latin-1")
 
 
+_WINDOWS_DRIVE = re.compile(r"^[A-Za-z]:")
+
+
+def find_config(name: str, log: Callable[[str], None] | None = None) -> Path:
+    """The file GT_LoadConfig(name) reads.
+
+    Applications are written for the controller's PC or its Windows CE core and pass the
+    path the file had there: ``"\\gugao-board\\gugao1\\test.cfg"``, ``"D:\\cfg\\GTS800.cfg"``,
+    example 5-5's ``"\\hard disk\\CPAC\\GTS800.cfg"``.  Decision: a path that exists is read
+    as given; one that does not (a Windows path, or any other) is looked for by its file
+    name - the part after the last ``\\`` or ``/`` - in the working folder (where the
+    application runs: a private controller started by libgts inherits the program's
+    folder), first as written, then ignoring case as Windows does; what was used goes to
+    the master log.  ConfigFileError (7) names both places when neither has it."""
+    given = Path(name)
+    if given.is_file():
+        return given
+    base = re.split(r"[\\/]", name)[-1]
+    here = Path.cwd()
+    candidates = [here / base] if base and base not in (".", "..") else []
+    if candidates and not candidates[0].is_file():
+        try:
+            candidates = [p for p in here.iterdir() if p.name.lower() == base.lower()]
+        except OSError:
+            candidates = []
+    found = next((p for p in candidates if p.is_file()), None)
+    if found is None:
+        where = f"{name} not found, nor {base!r} in the working folder {here}"
+        raise ConfigFileError(f"configuration file {where}")
+    if log is not None:
+        kind = "a Windows path" if "\\" in name or _WINDOWS_DRIVE.match(name) else "a path"
+        log(
+            f"GT_LoadConfig: {name} ({kind}) does not exist here; reading {found.name} from "
+            f"the working folder {here}"
+        )
+    return found
+
+
 def read_config(path: str | Path) -> VendorConfig | Config:
     """Read and parse a configuration file; ConfigFileError (7) when missing or bad."""
     p = Path(path)
@@ -706,6 +747,50 @@ def vendor_settings(ctl: Controller) -> dict[tuple[str, int], dict[str, Any]]:
     if st is None or st.axes != _axes_id(ctl):
         return {}
     return {k: dict(v) for k, v in st.values.items()}
+
+
+#: the inputs that are switches of the machine (a wiring the machine description may state)
+SWITCH_KINDS = ("limitPositive", "limitNegative", "home")
+
+
+def machine_wiring(ctl: Controller, axis: int) -> bool | None:
+    """Whether axis ``axis``'s switches are normally closed (True) or open (False) as the
+    machine description's ``switch_wiring`` says; None where it does not say.  On real
+    hardware (the pysoem backend) the wiring is the machine's own: False, so a
+    configuration's ``reverse`` applies as written."""
+    options = getattr(ctl, "options", None)
+    if getattr(options, "backend", "emulated") == "pysoem":
+        return False
+    machine = getattr(ctl, "machine", None)
+    wiring = machine.axis(axis).switch_wiring if machine is not None else None
+    return None if wiring is None else wiring == "normally_closed"
+
+
+def switch_sense(
+    ctl: Controller, kind: str, number: int, reverse: bool | None = None
+) -> tuple[bool, bool]:
+    """``(normally_closed, invert)`` of input ``[kind number]``: how the emulated switch is
+    wired (its electrical level is ``active != normally_closed``: GT_GetDiRaw) and whether
+    the controller, applying the configuration's ``reverse``, reads it inverted
+    (``reverse != normally_closed``: a limit stuck triggered, a home seen off the switch).
+
+    Decision: where the machine description does not say how a switch is wired
+    (:func:`machine_wiring` None), the emulated switch is wired the way the loaded
+    configuration expects - ``reverse=1`` on a limit or home is a normally-closed switch
+    on the machine the file was written for (``smarthome_test.cfg`` of the vendor's demo
+    writes it on axis 1's limits and home) - so the application's own ``.cfg`` runs as it
+    does there and never makes every limit read as triggered.  A description that states
+    ``switch_wiring`` wins: a ``reverse`` that disagrees with it inverts the switch, as a
+    wrongly written file would on the machine.  Other inputs (alarm, GPI) are no switches
+    of the machine: ``reverse`` inverts them as written."""
+    if reverse is None:
+        reverse = bool(vendor_settings(ctl).get((kind, number), {}).get("reverse", False))
+    if kind not in SWITCH_KINDS:
+        return False, reverse
+    nc = machine_wiring(ctl, number)
+    if nc is None:
+        nc = reverse
+    return nc, reverse != nc
 
 
 # --- applying a vendor file -----------------------------------------------------------------------
@@ -819,6 +904,7 @@ def apply_vendor(ctl: Controller, cfg: VendorConfig) -> None:
 def _wire_inputs(ctl: Controller, cfg: VendorConfig, st: _State, notes: list[str]) -> None:
     """Alarm, limit and stop inputs of every axis from the merged settings; senses last."""
     sensed: list[tuple[AxisResources, _Role, Any, int, bool]] = []
+    wired: set[tuple[str, int]] = set()
     for n, ax in sorted(ctl.axes.items()):
         res: AxisResources = ax.motion
         merged = st.values.get(("axis", n), {})
@@ -861,8 +947,19 @@ def _wire_inputs(ctl: Controller, cfg: VendorConfig, st: _State, notes: list[str
                 notes.append(
                     f"axis {n} {role.name} = {kind}{index}: axis {index} maps no 0x{obj:04X}"
                 )
-            elif reverse or (kind_t != role.natural if role.natural is not None else obj != 0x60FD):
-                sensed.append((res, role, ctl.axes[index].io.get(obj), bit, reverse))
+            else:
+                invert = switch_sense(ctl, kind, index, reverse)[1]
+                unsaid = kind in SWITCH_KINDS and machine_wiring(ctl, index) is None
+                if reverse and unsaid and (kind, index) not in wired:
+                    wired.add((kind, index))
+                    notes.append(
+                        f"{kind}{index} reverse=1 (a normally-closed switch): the machine "
+                        f"description does not say how axis {index}'s switches are wired "
+                        "(switch_wiring), so the switch is wired as this configuration expects"
+                    )
+                mismatch = kind_t != role.natural if role.natural is not None else obj != 0x60FD
+                if invert or mismatch:
+                    sensed.append((res, role, ctl.axes[index].io.get(obj), bit, invert))
                 if reverse and kind_t == MC_ALARM:
                     notes.append(
                         f"axis {n} {role.name} = alarm{index} reverse=1: active while drive "

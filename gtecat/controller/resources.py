@@ -722,10 +722,33 @@ def axis_resources(ctl: Controller, n: int) -> AxisResources:
     return res
 
 
+#: the EtherCAT controller's axis count: profile, axis and encoder numbers run 1..12 in
+#: chapter 13 ("轴号，取值范围：[1, 12]"), and the status and mask tables have 12 axis columns
+CONTROLLER_AXES = 12
+
+
+def resource_count(ctl: Controller) -> int:
+    """How many axes the controller has, whatever the bus holds: a GTS card's own count
+    (``gts:4``: 4), else 12 (or the bus's axes, where a bus holds more)."""
+    card = getattr(ctl, "card", None)
+    if card is not None:
+        return int(card.spec.axes)
+    return max(CONTROLLER_AXES, max(ctl.axes, default=0))
+
+
 def axis_span(
     ctl: Controller, first: int, count: int, limit: int | None = None
-) -> list[AxisResources]:
-    """Axes ``first .. first+count-1`` (the ``count`` argument form of chapter 13)."""
+) -> list[AxisResources | None]:
+    """Axes ``first .. first+count-1`` (the ``count`` argument form of chapter 13).
+
+    One rule for every function with a ``count`` (GT_GetSts, GT_ClrSts, GT_ZeroPos,
+    GT_GetPrf*, GT_GetAxis*, GT_GetEnc*, GT_GetPrfMode): the controller's profiles, axes
+    and encoders exist up to its axis count (:func:`resource_count`) whatever the bus
+    holds, as on the device; the manual's examples 7-5, 7-7 and 7-8 read 8 profiles
+    (``GT_GetPrfVel(1, ADR(arrPrfVel), 8, 0)``) on machines of fewer axes.  So the span
+    must lie inside ``1 .. resource_count`` (else 7); an axis in it that no drive backs is
+    ``None`` here: it reads as a resource at rest (status 0, positions, velocities and
+    mode 0) and GT_ClrSts / GT_ZeroPos leave it as it is."""
     try:
         first, count = int(first), int(count)
     except (TypeError, ValueError):
@@ -734,7 +757,16 @@ def axis_span(
         raise ParameterError(f"count={count} must be >= 1")
     if limit is not None and count > limit:
         raise ParameterError(f"count={count}: at most {limit} at once")
-    return [axis_resources(ctl, n) for n in range(first, first + count)]
+    if not ctl.axes:
+        axis_resources(ctl, first)  # BusError with the reason
+    n = resource_count(ctl)
+    last = first + count - 1
+    if first < 1 or last > n:
+        raise ParameterError(
+            f"axis={first}, count={count}: axes {first}..{last} run past the controller's "
+            f"axes 1..{n}"
+        )
+    return [axis_resources(ctl, k) if k in ctl.axes else None for k in range(first, last + 1)]
 
 
 def axes_in_mask(ctl: Controller, mask: int, strict: bool) -> list[AxisResources]:

@@ -79,7 +79,8 @@ the machine has.  Only an axis with no limit terminal at all (no 60FDh) is refus
 ``HOME_ERROR_HOME_MODE``: that search could never end.
 
 **Errors** end the homing (the axis is stopped with ``dec``; ``run`` drops once it stands;
-``stage`` stays where it failed): 1 not in Trap mode, 2 servo off (at the start or on the
+``stage`` stays where it failed): 1 not in Trap mode (a Jog is taken over instead:
+:meth:`SmartHome._leave_jog`), 2 servo off (at the start or on the
 way), 3 drive alarm, 4 stopped by someone else (GT_Stop, a stop input, the following
 error) or a search refused by a latched flag, 5 another motion command or a limit where
 none belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input
@@ -105,6 +106,9 @@ from .motion import StopKind, TrapParams
 from .motion.trap import SMOOTH_TIME_MAX
 from .profile import PrfMode
 from .resources import AxisResources, axis_resources
+
+#: how long GT_GoHome waits (controller time) for a Jog it takes over to stop
+JOG_STOP_TIMEOUT_MS = 60_000
 
 
 class HomeMode(IntEnum):
@@ -296,6 +300,8 @@ class SmartHome:
             )
         prm.check(len(self.ctl.axes))
         res = self.res
+        if res.profile.mode == PrfMode.JOG:
+            self._leave_jog(res)
         if res.moving:
             raise CommandError(f"axis {self.number} is moving: GT_Stop it first")
         self.params = prm
@@ -357,6 +363,34 @@ class SmartHome:
         self.status = HomeStatus(0, Stage.IDLE, error)
         self.reason = reason
         raise HomeRefused(error, f"GT_GoHome on axis {self.number}: {reason}")
+
+    def _leave_jog(self, res: AxisResources) -> None:
+        """GT_GoHome on an axis in Jog mode starts the homing, as the card does.
+
+        The vendor's smart-home demo jogs with a button (GT_PrfJog, GT_SetJogPrm, GT_SetVel,
+        GT_Update; GT_Stop on release) and its home button calls GT_ClrSts, GT_GetHomePrm and
+        GT_GoHome with no GT_PrfTrap between: on the card the homing runs.  So here a Jog
+        that still moves (still running, or on its GT_Stop ramp) is brought to a stop with the
+        smooth-stop deceleration (decSmoothStop, GT_SetStopDec) - GT_GoHome returns once the
+        axis stands, within :data:`JOG_STOP_TIMEOUT_MS` of controller time - and the profile
+        is put in Trap mode, which the homing moves in; a master-log line says so.  Other
+        modes (PT, Gear, Follow, interpolation) are still refused with
+        ``HOME_ERROR_NOT_TRAP_MODE``."""
+        was_moving = res.moving
+        if was_moving:
+            res.stop(False)
+            if not self.ctl.clock.run_until(lambda: not res.moving, JOG_STOP_TIMEOUT_MS):
+                raise CommandError(
+                    f"axis {self.number}: its Jog motion did not stop within "
+                    f"{JOG_STOP_TIMEOUT_MS} ms (GT_SetStopDec's smooth deceleration); "
+                    "GT_Stop it and home again"
+                )
+        res.prf_trap()
+        self.ctl.log(
+            f"GT_GoHome axis {self.number}: the axis was in Jog mode"
+            f"{' and moving (stopped first)' if was_moving else ''}; homing in Trap mode as "
+            "the card does"
+        )
 
     def _trigger_unit(self, prm: HomeParams, mode: HomeMode) -> CaptureUnit:
         if mode in FORCED_MODES or prm.triggerIndex == -1:

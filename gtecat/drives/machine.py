@@ -15,8 +15,13 @@ switches are)::
     probe1 = [[30000, 30500]]    # windows where probe input 1 is active
     probe2 = []
     following_error_window = 10000
+    switch_wiring = "normally_closed"   # or "normally_open"; absent: as the .cfg expects
 
-Every key is optional: no switches, no index pulse, no probe marks.
+Every key is optional: no switches, no index pulse, no probe marks.  ``switch_wiring`` says
+how the axis's limit and home switches are wired, for a configuration file's ``reverse``
+to meet: left out, each switch is wired the way the loaded configuration expects (its
+``reverse=1`` means a normally-closed switch), so an application's own ``.cfg`` runs as on
+the machine it was written for (gtecat.controller.config_file.switch_sense).
 """
 
 from __future__ import annotations
@@ -51,6 +56,7 @@ class AxisMachine:
     probe1: tuple[Window, ...] = ()
     probe2: tuple[Window, ...] = ()
     following_error_window: int | None = None
+    switch_wiring: str | None = None  #: "normally_open" | "normally_closed" | None (as the cfg)
 
     # --- levels -----------------------------------------------------------
     def negative_limit_active(self, pos: float) -> bool:
@@ -123,7 +129,9 @@ _KEYS = {
     "probe1",
     "probe2",
     "following_error_window",
+    "switch_wiring",
 }
+SWITCH_WIRINGS = ("normally_open", "normally_closed")
 
 
 def _windows(raw: Any, where: str) -> tuple[Window, ...]:
@@ -175,6 +183,11 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
         nl, pl = num("negative_limit"), num("positive_limit")
         if nl is not None and pl is not None and nl >= pl:
             raise MachineError(f"{where}: negative_limit {nl} must be below positive_limit {pl}")
+        wiring = table.get("switch_wiring")
+        if wiring is not None and wiring not in SWITCH_WIRINGS:
+            raise MachineError(
+                f"{where}: switch_wiring {wiring!r}: one of {', '.join(SWITCH_WIRINGS)}"
+            )
         axes[n] = AxisMachine(
             position=float(num("position", 0)),
             counts_per_rev=int(cpr),
@@ -185,6 +198,7 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
             probe1=_windows(table.get("probe1"), f"{where} probe1"),
             probe2=_windows(table.get("probe2"), f"{where} probe2"),
             following_error_window=num("following_error_window"),
+            switch_wiring=wiring,
         )
     from .ext_modules import ext_modules_from_dict, glink_from_dict
 

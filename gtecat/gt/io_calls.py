@@ -13,7 +13,10 @@ reads or drives:
 * ``GT_GetDi`` gives the levels with the configuration file's ``reverse`` of that
   terminal applied (``[limitPositiveN]``, ``[limitNegativeN]``, ``[homeN]``, ``[alarmN]``,
   ``[gpiN]``), 1 = active; ``GT_GetDiRaw`` the levels as the terminals see them.  The vendor
-  card's terminals are active low; here 1 always means active (triggered).
+  card's terminals are active low; here 1 always means active (triggered).  A limit or home
+  switch is wired as the machine description's ``switch_wiring`` says, else as the loaded
+  configuration expects (``reverse=1``: normally closed, so ``GT_GetDiRaw`` reads 1 off the
+  switch and ``GT_GetDi`` 0; :func:`gtecat.controller.config_file.switch_sense`).
 * ``MC_ENABLE``: the servo-enable outputs: ``GT_SetDo`` switches each axis on or off as
   ``GT_AxisOn`` / ``GT_AxisOff`` do (a bit already in that state changes nothing; the
   first axis that cannot be switched on makes the call return 1 with its reason).
@@ -29,7 +32,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..controller.axis import PdsState
-from ..controller.config_file import vendor_settings
+from ..controller.config_file import switch_sense, vendor_settings
 from ..controller.core import Controller
 from ..controller.digital_io import GPIO_COUNT, digital_io
 from ..controller.resources import _fault_reset
@@ -84,7 +87,12 @@ def read_di(ctl: Controller, di_type: int, raw: bool) -> int:
             value ^= sum(1 << (k - 1) for k in range(1, GPIO_COUNT + 1) if rev(k))
         return value
     index, mask, kind = _AXIS_INPUTS[t]
-    rev = _reversed(ctl, kind) if not raw else (lambda n: False)
+    settings = vendor_settings(ctl)
+
+    def rev(n: int) -> bool:  # raw: the electrical level (wiring); else as the card reads it
+        reverse = bool(settings.get((kind, n), {}).get("reverse", False))
+        return switch_sense(ctl, kind, n, reverse)[0 if raw else 1]
+
     value = 0
     for n, ax in ctl.axes.items():
         if not 1 <= n <= 32:

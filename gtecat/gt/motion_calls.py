@@ -75,7 +75,7 @@ def _read_many(
     limit: int | None = None,
 ) -> int:
     axes = axis_span(ctl, first, count, limit)
-    store_array(pValue, [get(r) for r in axes])
+    store_array(pValue, [get(r) if r is not None else 0 for r in axes])
     store(pClock, ctl.clock_ms() & 0xFFFFFFFF)
     return 0
 
@@ -276,7 +276,7 @@ def GT_SetPrfPos(ctl: Controller, profile: int, prfPos: int) -> int:
 @gt_function
 def GT_ZeroPos(ctl: Controller, axis: int, count: int = 1) -> int:
     """Planned and actual positions of ``count`` axes to 0 (entry 138; 1 while one moves)."""
-    axes = axis_span(ctl, axis, count)
+    axes = [r for r in axis_span(ctl, axis, count) if r is not None]
     for r in axes:
         r.profile.require_idle(f"GT_ZeroPos (axis {r.number})")
     for r in axes:

@@ -34,9 +34,9 @@ from pathlib import Path
 from typing import Any
 
 from ..controller import motion, safety
-from ..controller.config_file import apply_config, read_config
+from ..controller.config_file import apply_config, find_config, read_config
 from ..controller.core import Controller
-from ..controller.resources import AxisResources, axis_resources, clear_status
+from ..controller.resources import AxisResources, axis_resources, axis_span, clear_status
 from ..controller.scale import Scale
 from ..errors import BusError, CommandError, ParameterError
 from ._core import check_range, gt_function, load_bytes, store
@@ -58,15 +58,11 @@ def GT_GetSts(ctl: Controller, axis: int, pSts: Any, count: int = 1, pClock: Any
 @gt_function
 def GT_ClrSts(ctl: Controller, axis: int, count: int = 1) -> int:
     """Clear latched flags whose cause is gone; reset faulted drives first (entry 8)."""
-    first = check_range("axis", axis, 1, 0x7FFF)
-    n = check_range("count", count, 1, 0x7FFF)
+    check_range("axis", axis, 1, 0x7FFF)
+    check_range("count", count, 1, 0x7FFF)
     if not ctl.axes:
         raise BusError("GT_ClrSts: no EtherCAT axis yet (call GT_InitEcatComm)")
-    axes = [ctl.axes[a].motion for a in range(first, first + n) if a in ctl.axes]
-    if not axes:
-        raise ParameterError(
-            f"GT_ClrSts: none of axes {first}..{first + n - 1} exists (1..{max(ctl.axes)})"
-        )
+    axes = [r for r in axis_span(ctl, axis, count) if r is not None]  # the count rule
     reachable = [r for r in axes if not r.ax.link_lost]
     clear_status(ctl, reachable)
     for r in reachable:
@@ -272,7 +268,7 @@ def _file_name(pFile: Any) -> str:
 @gt_function
 def GT_LoadConfig(ctl: Controller, pFile: Any) -> int:
     """Load a configuration file (docs/config_file.md); flags update with GT_ClrSts (4.4)."""
-    config = read_config(_file_name(pFile))
+    config = read_config(find_config(_file_name(pFile), ctl.log))
     if not ctl.axes:
         raise BusError("GT_LoadConfig: no EtherCAT axis yet (call GT_InitEcatComm first)")
     moving = [n for n, ax in sorted(ctl.axes.items()) if ax.motion.moving]

@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import math
 import sys
+from ctypes import c_double
 
 import numpy as np
 import pytest
@@ -234,3 +235,31 @@ def test_example_7_8_strategy_changed_through_the_two_fifos():
     # and the transition started with the ratio curve 1 ended with (0, CONTINUE)
     k = int(np.argmax(master > 60000))
     assert vs[k] < 1.0
+
+
+# --- 7-5, 7-7, 7-8: 8 profiles read on a 2-axis bus -------------------------------------------
+@pytest.mark.parametrize(
+    "name", ["example_7_5_gear", "example_7_7_follow", "example_7_8_follow_switch"]
+)
+def test_examples_7_5_7_7_7_8_read_8_profiles_as_printed(name):
+    """Examples 7-5, 7-7 and 7-8 end every scan with ``GT_GetPrfVel(1, ADR(arrPrfVel), 8, 0)``
+    on the figure 5-2 bus of 2 drives: the controller's 12 profiles exist whatever the bus
+    holds (the count rule of ``resources.axis_span``), so the read returns 0 (the scripts log
+    any non-zero return into ``errors``) and profiles 3..8 read 0."""
+    mod = example(name)
+    mod.LOG.clear()
+    mod.bring_up(clock="lockstep")
+    try:
+        v = mod.PlcVars()
+        mod.plc_prg(v)
+        v.xStart = True
+        mod.plc_prg(v)
+        for _ in range(5):
+            gt.GTE_Wait(1)
+            mod.plc_prg(v)
+        assert list(mod.LOG) == []
+        assert len(v.arrPrfVel) == 8 and v.arrPrfVel[2:] == [0.0] * 6
+        assert gt.GT_ClrSts(1, 8) == 0  # the same rule as the examples' GT_ClrSts(1, 8)
+        assert gt.GT_GetPrfVel(1, (c_double * 13)(), 13, 0) == 7  # past axis 12
+    finally:
+        gt.GT_Close()

@@ -264,11 +264,17 @@ static int split_address(const char *addr, struct sockaddr_un *sa, socklen_t *le
     return 0;
 }
 
+/* the client's long as the stubs were compiled: 8 on Linux, 4 in the LLP64 build that serves
+ * programs written for Windows (C# / VB.NET under Mono, gtecat.native.llp64) */
+#ifndef GTE_CLIENT_LONG_SIZE
+#define GTE_CLIENT_LONG_SIZE sizeof(long)
+#endif
+
 /* hello: announce protocol, sizeof(long) and the table digest; 0 ok */
 static int hello(int fd, const char *fname, long long deadline)
 {
     unsigned char msg[4 + 24];
-    uint16_t version = GTE_PROTOCOL_VERSION, lsize = (uint16_t)sizeof(long);
+    uint16_t version = GTE_PROTOCOL_VERSION, lsize = (uint16_t)GTE_CLIENT_LONG_SIZE;
     put_u32(msg, 24);
     memset(msg + 4, 0, 24);
     msg[4] = GTE_MSG_HELLO;

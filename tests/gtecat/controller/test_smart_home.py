@@ -278,7 +278,7 @@ def test_trigger_index_of_another_axis_watches_that_axis():
 def test_not_trap_mode_off_and_alarm_are_refused_with_their_errors():
     ctl = open_card(START["below"])
     home = smart_home(ctl, 1)
-    assert gt.GT_PrfJog(1) == 0
+    assert gt.GT_PrfPt(1) == 0  # (a Jog is taken over: test_home_calls)
     with pytest.raises(HomeRefused) as e:
         home.start(params())
     assert e.value.error == HomeError.NOT_TRAP_MODE

@@ -11,6 +11,7 @@ capture is the middle of that cycle's travel: within ``v * T / 2`` and the count
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import importlib.util
 import sys
 from ctypes import byref, c_double, c_long, c_short, c_uint32
@@ -267,14 +268,36 @@ def test_get_di_reads_the_machine_inputs_of_each_axis():
     assert gt.GT_GetDi(99, byref(c_long())) == 7
 
 
-def test_get_di_applies_the_configuration_reverse_get_di_raw_does_not(tmp_path):
-    open_card()
+@pytest.mark.parametrize(
+    ("wiring", "raw", "logical"),
+    [
+        (None, 0, 1),  # wired as the configuration expects: normally closed, read right
+        ("normally_closed", 0, 1),
+        ("normally_open", 1, 0),  # the file disagrees with the machine: read inverted
+    ],
+)
+def test_get_di_applies_the_configuration_reverse_get_di_raw_does_not(
+    tmp_path, wiring, raw, logical
+):
+    """On the home switch, ``[home1] reverse=1``: GT_GetDiRaw is the line, GT_GetDi the line
+    through ``reverse``; the switch's wiring is the machine description's ``switch_wiring``,
+    else what the file expects (config_file.switch_sense)."""
+    machine = card_machine()
+    if wiring is not None:
+        a = dataclasses.replace(machine.axis(1), switch_wiring=wiring)
+        machine = MachineDescription({**machine.axes, 1: a})
+    assert gt.GT_Open(card="gts:2", machine=machine, clock="lockstep", log="") == 0
+    for a in (1, 2):
+        assert gt.GT_AxisOn(a) == 0
     trap_to(1, LO + 100)
+    # no file yet (reverse 0): a normally-closed line is off on the switch, read as is
+    before = (0, 0) if wiring == "normally_closed" else (1, 1)
+    assert (di(gt.MC_HOME, raw=True) & 1, di(gt.MC_HOME) & 1) == before
     cfg = tmp_path / "home.cfg"
     cfg.write_text("[home1]\nactive=1\nreverse=1\nfilterTime=3\n")
     assert gt.GT_LoadConfig(str(cfg)) == 0, gt.GTE_GetLastError()
-    assert di(gt.MC_HOME, raw=True) & 1 == 1
-    assert di(gt.MC_HOME) & 1 == 0  # a normally-closed sensor: active while the line is off
+    assert di(gt.MC_HOME, raw=True) & 1 == raw
+    assert di(gt.MC_HOME) & 1 == logical
 
 
 def test_set_do_drives_enable_clear_and_general_outputs():
@@ -340,9 +363,44 @@ def test_go_home_return_codes():
     st = gt.THomeStatus()
     assert gt.GT_GetHomeStatus(1, byref(st)) == 0
     assert (st.run, st.error) == (0, gt.HOME_ERROR_HOME_MODE)
-    assert gt.GT_PrfJog(1) == 0
+    assert gt.GT_PrfPt(1) == 0  # Jog is taken over (below); PT, Gear, Follow are refused
     assert gt.GT_GoHome(1, byref(home_prm(mode=gt.HOME_MODE_HOME))) == 1
     assert gt.GT_GetHomeStatus(1, byref(st)) == 0 and st.error == gt.HOME_ERROR_NOT_TRAP_MODE
+
+
+def _jog(vel: float, ms: int) -> None:
+    """The vendor smart-home demo's jog button: PrfJog, GetJogPrm, SetJogPrm, SetVel, Update."""
+    jog = gt.TJogPrm()
+    assert gt.GT_PrfJog(1) == 0
+    assert gt.GT_GetJogPrm(1, byref(jog)) == 0
+    jog.acc, jog.dec, jog.smooth = 0.1, 0.1, 0
+    assert gt.GT_SetJogPrm(1, byref(jog)) == 0
+    assert gt.GT_SetVel(1, vel) == 0
+    assert gt.GT_Update(1) == 0
+    gt.GTE_Wait(ms)
+
+
+@pytest.mark.parametrize("released", [True, False], ids=["after-GT_Stop", "still-jogging"])
+def test_go_home_straight_after_a_jog_homes_as_the_card_does(released):
+    """The vendor smart-home demo: jog (button down), GT_Stop(255, 255) (button up), then
+    its home button: GT_ClrSts, GT_GetHomePrm, GT_GoHome - no GT_PrfTrap - and the card
+    homes.  Straight after the GT_Stop the jog still ramps down; without it the jog runs:
+    either way GT_GoHome stops it smoothly, switches to Trap and homes (smart_home
+    ``_leave_jog``), with a master-log line."""
+    open_card()
+    ctl = gt.GTE_Controller()
+    _jog(5.0, 200)  # 1000 counts up, at 5 pulse/ms
+    if released:
+        assert gt.GT_Stop(255, 255) == 0
+    sts = c_long()
+    assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & MOVING  # still moving
+    assert gt.GT_ClrSts(1) == 0
+    st = go_home(home_prm(mode=gt.HOME_MODE_HOME, moveDir=1))
+    assert (st.stage, st.error) == (gt.HOME_STAGE_END, gt.HOME_ERROR_NONE)
+    assert st.capturePos == LO  # the home switch's edge, as from a standstill
+    mode = c_long()
+    assert gt.GT_GetPrfMode(1, byref(mode)) == 0 and mode.value == 0  # Trap
+    assert any("was in Jog mode and moving" in line for line in ctl.log.lines)
 
 
 def test_home_index_through_the_gtn_twin():

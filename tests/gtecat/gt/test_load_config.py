@@ -116,8 +116,11 @@ def test_smarthome_file_loads_on_a_two_axis_bus_and_logs_what_it_does_not_apply(
     up()
     assert load(fixture(SMARTHOME)) == 0, gt.GTE_GetLastError()
     lines = log()
-    assert len(lines) == 3, lines
+    assert len(lines) == 4, lines
     assert "138 sections read, applied to axes 1-2" in lines[0]
+    # no switch_wiring in the machine: its normally-closed limits are wired as it expects
+    assert "inputs: limitPositive1 reverse=1 (a normally-closed switch)" in lines[3]
+    assert "limitNegative1 reverse=1" in lines[3]
     assert lines[1].endswith(
         "pulse-card resources without an EtherCAT counterpart, accepted and ignored: "
         "[dac1-12] [step1-4] [gpo1-16] [gpi1-16] [enable1-8] [clear1-8] [arrive1-8] [mpg1-7]"
@@ -198,11 +201,15 @@ def test_alarm_on_its_own_input_and_alarm_active_is_the_alarm_on_state(tmp_path)
     assert sts() & ALARM
 
 
+NO = 'switch_wiring = "normally_open"\n'  # the machine says: reverse=1 then inverts
+
+
 def test_reverse_flips_the_limit_sense(tmp_path):
-    """Axis 1 stands on its positive switch; smarthome's limitPositive1/limitNegative1 have
-    reverse=1 (normally-closed switches): the pressed switch reads released and the other one
-    pressed."""
-    up(tmp_path, "[axis.1]\nposition = 100\npositive_limit = 50\n")
+    """Axis 1 stands on its positive switch, which the machine description wires normally
+    open; smarthome's limitPositive1/limitNegative1 have reverse=1 (normally-closed switches):
+    the pressed switch reads released and the other one pressed.  (Without switch_wiring the
+    switches are wired as the file expects: test_cfg_surroundings.)"""
+    up(tmp_path, "[axis.1]\nposition = 100\npositive_limit = 50\n" + NO)
     gt.GTE_Wait(1)
     assert sts() & (POS_LIM | NEG_LIM) == POS_LIM  # table 4-4: own switches, normal sense
     assert load(fixture(SMARTHOME)) == 0, gt.GTE_GetLastError()
@@ -219,7 +226,7 @@ def test_reverse_flips_the_limit_sense(tmp_path):
 
 
 def test_reverse_is_forgotten_by_gt_reset(tmp_path):
-    up(tmp_path, "[axis.1]\nposition = 100\npositive_limit = 50\n")
+    up(tmp_path, "[axis.1]\nposition = 100\npositive_limit = 50\n" + NO)
     assert load(fixture(SMARTHOME)) == 0
     assert settle() & NEG_LIM
     assert gt.GT_Reset() == 0
@@ -230,7 +237,7 @@ def test_reverse_is_forgotten_by_gt_reset(tmp_path):
 
 def test_limit_from_another_axis_and_from_a_home_switch(tmp_path):
     """4.3.1 "将轴 2 的限位信号配给轴 1"; and a home switch (MC_HOME 3) as positive limit."""
-    up(tmp_path, "[axis.2]\nposition = 100\npositive_limit = 50\nhome_switch = [[0, 200]]\n")
+    up(tmp_path, "[axis.2]\nposition = 100\npositive_limit = 50\nhome_switch = [[0, 200]]\n" + NO)
     assert load(edited(tmp_path, SMARTHOME, {"axis1": {"limitPositiveIndex": "2"}})) == 0
     assert settle() & POS_LIM  # axis 2's switch, with limitPositive2's normal sense
     home = {"axis1": {"limitPositiveType": "3", "limitPositiveIndex": "2"}}
@@ -242,7 +249,7 @@ def test_limit_from_another_axis_and_from_a_home_switch(tmp_path):
 
 def test_smooth_stop_input_from_a_home_switch(tmp_path):
     """9.4: a stop input (extension: the tool says "配置无效") - here home switch 1."""
-    up(tmp_path, "[axis.1]\nhome_switch = [[-100, 100]]\n")
+    up(tmp_path, "[axis.1]\nhome_switch = [[-100, 100]]\n" + NO)
     stop = {"axis1": {"smoothStopType": "3", "smoothStopIndex": "1"}}
     assert load(edited(tmp_path, GTN, stop)) == 0
     gt.GTE_Wait(2)

@@ -359,7 +359,10 @@ def test_clrsts_span_beyond_the_bus_and_errors():
     up()
     assert gt.GT_ClrSts(1, 8) == 0  # the manual's examples clear 8 axes
     assert gt.GT_ClrSts(0, 1) == 7
-    assert gt.GT_ClrSts(5, 2) == 7
+    # the count rule (resources.axis_span): axes without a drive exist up to 12
+    assert gt.GT_ClrSts(5, 2) == 0
+    assert gt.GT_ClrSts(12, 1) == 0
+    assert gt.GT_ClrSts(12, 2) == 7 and "1..12" in gt.GTE_GetLastError()
     assert gt.GT_ClrSts(1, 0) == 7
 
 

@@ -1,0 +1,1 @@
+DEBS="mono-mcs mono-runtime"
