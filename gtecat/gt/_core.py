@@ -157,6 +157,22 @@ class _Refusal(Exception):
         self.code = code
 
 
+def advance(ctl: Any, name: str, rc: int) -> int:
+    """The host-call latency after a GT call (cycles may run, programs step): whatever they
+    raise is turned into a code and a reason like the call's own errors, never let out."""
+    try:
+        ctl.clock.on_call()
+    except Exception as e:
+        code = code_for(e)
+        if code == CMD_NO_RESPONSE:
+            log.error("%s: internal error in the cycle\n%s", name, traceback.format_exc())
+            _record(name, code, f"internal error in the emulator's cycle: {type(e).__name__}: {e}")
+        else:
+            _record(name, code, f"in the cycles after the call: {e}")
+        return rc or code
+    return rc
+
+
 def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     """Make ``fn`` a GT function: never raises, returns a code, costs a host call.
 
@@ -227,7 +243,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         if ctl is None and isinstance(core, int):
             ctl = SESSION.controllers.get(core)
         if ctl is not None:
-            ctl.clock.on_call()
+            rc = advance(ctl, name, rc)
         return rc
 
     @functools.wraps(fn)
@@ -237,7 +253,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     if name in READERS:  # the common shape answered up front (gtecat.gt.fast)
         slow = gt
-        gt = functools.wraps(slow)(fast_reader(name, slow, SESSION))
+        gt = functools.wraps(slow)(fast_reader(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
