@@ -166,7 +166,7 @@ class Ref:
                     raise ParameterError(f"{self.name}: array of {flat.size} too small for {n}")
                 try:
                     flat[:n] = values
-                except (OverflowError, TypeError, ValueError) as e:  # narrower than the C type
+                except (OverflowError, TypeError, ValueError):  # narrower than the C type
                     raise ParameterError(
                         f"{self.name}: {shown(values[:4])} do not fit a {t.dtype} array"
                     ) from None
