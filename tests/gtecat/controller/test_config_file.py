@@ -301,7 +301,7 @@ def test_every_key_parses_to_its_value():
         ("[axis 1]\nspeed = 3\n", 2, "unknown key"),
         ("alarm = on\n", 1, "before any"),
         ("[motor 1]\n", 1, "not a section"),
-        ("[axis 0]\n", 1, ">= 1"),
+        ("[axis 0]\n", 1, "must be 1..32767"),
         ("[axis 1]\n[axis 1]\n", 2, "twice"),
         ("[axis 1]\nalarm = on\nalarm = off\n", 3, "twice"),
         ("[axis 1]\nprofile_scale = 1 2\n", 2, "alpha"),
