@@ -184,3 +184,20 @@ def test_bad_input_gets_the_python_codes(served):
                 got, _, text = c.call("GTN_" + plan.name[3:], *wire, core=core)
                 assert got == want, ("GTN", core, plan.name, py, wire, text)
     assert checked > 1000
+
+
+def test_a_call_that_cannot_travel_checks_its_arguments_first_as_python_does(served):
+    """GT_Compile's TCompileInfo holds pointers (it cannot travel: 1), but a NULL where the
+    prototype needs memory is 7 first, the same code the Python function gives."""
+    _, address = served
+    c = WireClient(address)
+    assert c.call("GT_Open", 0, 1)[0] == 0
+    size = ctypes.sizeof(gt.TCompileInfo)
+    rc, _, text = c.call("GT_Compile", None, size)
+    assert rc == 7 and "pFileName is NULL" in text
+    rc, _, text = c.call("GT_Compile", b"prog.c\0", None)
+    assert rc == 7 and "pWrongInfo is NULL" in text
+    assert gt.GT_Compile("prog.c", None) == 7  # what Python says
+    rc, _, text = c.call("GT_Compile", b"prog.c\0", size)
+    assert rc == 1 and "pointers" in text
+    c.close()
