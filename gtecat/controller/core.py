@@ -364,11 +364,38 @@ class Controller:
     def clock_ms(self) -> int:
         return (self.clock.now_ns - self.reset_ns) // 1_000_000
 
+    #: called between the slices of a long wait (:meth:`wait_ms`), None: nothing.  The
+    #: controller server sets it to let other clients' calls in (it releases its lock for
+    #: a moment); a hook may run GT calls, whose time counts toward the wait.
+    slice_hook: Callable[[], None] | None = None
+    #: controller time one slice of a wait runs before the hook is called
+    WAIT_SLICE_NS = 100_000_000
+
     def wait_ms(self, ms: float) -> None:
-        """GTE_Wait: let ``ms`` of controller time pass, in any clock mode."""
+        """GTE_Wait: let ``ms`` of controller time pass, in any clock mode.
+
+        Virtual time runs in slices of :attr:`WAIT_SLICE_NS` up to the controller time
+        the wait ends at: between slices, a KeyboardInterrupt (Ctrl-C) reaches the
+        caller, and :attr:`slice_hook` serves others (a day's wait no longer holds every
+        native client for the hour it takes to compute).  Without a hook the cycles run
+        are exactly those of one advance of ``ms``.
+        """
         if ms < 0:
             raise ParameterError("wait time must be >= 0")
-        self.clock.advance(ms)
+        clock = self.clock
+        total = round(ms * 1_000_000)
+        if clock.mode is ClockMode.REALTIME or total <= self.WAIT_SLICE_NS:
+            clock.advance_ns(total)
+            return
+        end = clock.now_ns + clock._pending_ns + total
+        while True:
+            left = end - (clock.now_ns + clock._pending_ns)
+            if left <= 0:
+                return
+            clock.advance_ns(min(left, self.WAIT_SLICE_NS))
+            hook = self.slice_hook
+            if hook is not None and left > self.WAIT_SLICE_NS:
+                hook()
 
 
 def folder_message(path: Path, how: str) -> str:
