@@ -40,6 +40,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="gtecat",
         description="EtherCAT master emulator with virtual CiA-402 drives and the GT_* API.",
+        epilog="examples:\n"
+        "  gtecat example manual_fig5_2 -o .    a bus and a first script, into this folder\n"
+        "  gtecat map manual_fig5_2.eni         its GT raw offsets\n"
+        "  gtecat demo                          the figure 5-2 demo, plotted\n"
+        "every command has --help with examples",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     from .. import __version__
