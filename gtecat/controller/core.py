@@ -204,12 +204,13 @@ class Controller:
         path = self.eni_path()
         if path.is_dir():
             raise NoEniError(
-                folder_message(path, "name the file in GT_Open(eni=...) or GTECAT_ENI, e.g.")
+                folder_message(path, "set GTECAT_ENI to the file (Python: GT_Open(eni=...)), e.g.")
             )
         if not path.is_file():
             raise NoEniError(
-                f"no ENI file at {path.resolve()} "
-                "(pass --eni or eni=... to GT_Open, or set GTECAT_ENI)"
+                f"no ENI file at {path.resolve()}: set GTECAT_ENI to your ENI (any program: "
+                "C, C++, C#, Python), or put it in the working folder as Gecat.eni "
+                "(Python may pass GT_Open(eni=...), the command line --eni)"
             )
         try:
             config = read_eni(path)

@@ -193,7 +193,7 @@ short GTE_GetMachinePos(short axis, double *pValue);
 short GTE_SetProgramSpeed(double instructionsPerMs /*1..10000000*/);
 short GTE_GetThreadError(short thread /*0..31*/, char *pText /*outstr[256]*/);
 
-// coordinated motion (interpolation, issue 19): coordinate systems, segment FIFOs, look-ahead (header)
+// coordinated motion (interpolation): coordinate systems, segment FIFOs, look-ahead (header)
 short GT_SetCrdPrm(short crd /*1..2*/, TCrdPrm *pCrdPrm /*in*/);                 // header
 short GT_GetCrdPrm(short crd /*1..2*/, TCrdPrm *pCrdPrm);                        // header
 short GT_CrdSpace(short crd /*1..2*/, long *pSpace, short fifo=0 /*0..1*/);      // header (table 10-2)
@@ -222,7 +222,7 @@ short GT_SetCrdStopDec(short crd /*1..2*/, double decSmoothStop, double decAbrup
 short GT_GetCrdStopDec(short crd /*1..2*/, double *pDecSmoothStop, double *pDecAbruptStop);  // header
 short GT_InitLookAhead(short crd /*1..2*/, short fifo /*0..1*/, double T, double accMax, short n /*1..32767*/, TCrdData *pLookAheadBuf /*opt*/);  // header
 
-// GTS pulse card (issue 14): card IO, encoder capture, smart home (vendor GTS header)
+// GTS pulse card: card IO, encoder capture, smart home (vendor GTS header)
 short GT_GetDi(short diType, long *pValue);                                      // header (GTS)
 short GT_GetDiRaw(short diType, long *pValue);                                   // header (GTS)
 short GT_SetDo(short doType, long value);                                        // header (GTS)
