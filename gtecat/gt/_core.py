@@ -89,6 +89,8 @@ class _Session:
         self.controllers: dict[int, Controller] = {}
         self.errors: deque[LastError] = deque(maxlen=64)  # the recent failures, oldest first
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
+        #: a reason the running call leaves although it succeeds (:func:`note`)
+        self.note: str | None = None
         #: the controller process this session is attached to (``GT_Open(controller=...)``
         #: or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process
         self.remote: Any = None
@@ -144,6 +146,19 @@ def _record(name: str, code: int, reason: str) -> None:
         ms = c.clock_ms()
     SESSION.last = LastError(name, code, reason, ms)
     SESSION.errors.append(SESSION.last)
+
+
+def note(reason: str) -> None:
+    """Leave ``reason`` for GTE_GetLastError although the running call returns 0: something
+    the caller must hear of that is not an error of this call (a homing search that cannot
+    end).  It reads ``NAME returned 0: reason`` and, like any reason, lasts until the next
+    call."""
+    SESSION.note = reason
+
+
+def _note(name: str, reason: str) -> LastError:
+    c = SESSION.controllers.get(1)
+    return LastError(name, 0, reason, c.clock_ms() if c is not None else 0)
 
 
 def fail(code: int, reason: str) -> int:
@@ -227,7 +242,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 rc = fn(*values, **extra)
             rc = 0 if rc is None else int(rc)
             if rc == 0:
-                SESSION.last = None  # GTE_GetLastError speaks of the most recent call only
+                # GTE_GetLastError speaks of the most recent call only: nothing, or a note
+                # of something the call found wrong without failing (note())
+                note_text, SESSION.note = SESSION.note, None
+                SESSION.last = None if note_text is None else _note(name, note_text)
             elif SESSION.last is before:  # no reason recorded by a call made inside
                 _record(name, rc, "no reason given")
         except _Refusal as r:
