@@ -9,6 +9,7 @@ import pytest
 from drives.esc.sii import SmType, parse_sii
 from gtecat.cli.serve_cmd import build_chain
 from gtecat.wire.eni_wire import product_name, read_wire
+from tests.conftest import needs_fixture
 
 ROOT = Path(__file__).resolve().parents[3]
 TWINCAT = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
@@ -22,7 +23,7 @@ def sii_of(eni: Path) -> list:
 
 def test_beckhoff_terminals_get_their_own_sm_layout() -> None:
     if not TWINCAT.is_file():
-        pytest.skip(f"shared fixture {TWINCAT} not found")
+        pytest.skip(needs_fixture(TWINCAT.name))
     infos, chain = sii_of(TWINCAT)
     el2008, el4002, el1809 = infos[1], infos[2], infos[3]
     assert [(s.start, s.length, s.control, s.type) for s in el2008.sync_managers] == [
@@ -71,7 +72,7 @@ def test_a_googol_ini_states_no_wire_layout(tmp_path: Path) -> None:
     files = sorted(ini.glob("*")) if ini.is_dir() else []
     eni = next((f for f in files if f.suffix.lower() in (".eni", ".ini")), None)
     if eni is None:
-        pytest.skip("no Googol INI fixture")
+        pytest.skip(needs_fixture("a Googol INI Gecat.eni"))
     assert read_wire(eni) is None
 
 
@@ -80,7 +81,7 @@ def test_a_googol_ini_drive_names_its_product_in_1008h() -> None:
     answers it in 1008h (an outside check read "gtecat virtual CiA-402 servo drive")."""
     eni = ROOT.parent / "shared" / "fixtures" / "googol" / "Gecat_DM3E_stepper.eni"
     if not eni.is_file():
-        pytest.skip(f"shared fixture {eni} not found")
+        pytest.skip(needs_fixture(eni.name))
     infos, chain = sii_of(eni)
     assert chain.escs[0].slave.od.upload(0x1008, 0) == b"DM3E_522_COE_"
     assert infos[0].name == "DM3E_522_COE_"
