@@ -51,7 +51,7 @@ COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab
           "tab:olive", "tab:cyan", "tab:gray", "tab:red"]  # fmt: skip
 STYLE = {"prf": "--", "enc": "-", "machine": ":", "vel": "--", "encvel": "-", "err": "-"}
 GROUPS = (
-    ("position (pulse)", {"prf", "enc", "machine"}),
+    ("position", {"prf", "enc", "machine"}),
     ("following error (pulse)", {"err"}),
     ("velocity (per ms)", {"vel", "encvel"}),
 )
@@ -124,6 +124,15 @@ def layout(rec: Any) -> tuple[list, list, list]:
     return list(panels.items()), bands, rows
 
 
+def _with_units(rec: Any, group: str, lines: list) -> str:
+    """A panel's label with the units of its lines ("position (pulse, counts)")."""
+    if "(" in group:
+        return group
+    unit_of = dict(zip(rec.names, (k.unit for k in rec.kinds), strict=True))
+    units = list(dict.fromkeys(u for name, *_ in lines if (u := unit_of.get(name))))
+    return f"{group} ({', '.join(units)})" if units else group
+
+
 def plot_recorder(rec: Any, path: Path, title: str) -> Path:
     import matplotlib
 
@@ -161,7 +170,7 @@ def plot_recorder(rec: Any, path: Path, title: str) -> Path:
                 t, col, color=color, ls=style, lw=1.0 if planned else 2.2,
                 alpha=1.0 if planned else 0.45, zorder=3 if planned else 2, label=name,
             )  # fmt: skip
-        ax.set_ylabel(group, fontsize=8)
+        ax.set_ylabel(_with_units(rec, group, lines), fontsize=8)
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, frameon=False)
         ax.grid(alpha=0.3)
     if bands:

@@ -67,7 +67,7 @@ def test_the_trace_plot_shows_the_planned_position_over_the_encoder_with_units(
     rec.plot(tmp_path / "t.png")
     axes = figures[0].axes
     pos = next(a for a in axes if a.get_ylabel().startswith("position"))
-    assert pos.get_ylabel() == "position (pulse)"
+    assert pos.get_ylabel() == "position (pulse, counts)"  # planned in pulses, encoder counts
     lines = {ln.get_label(): ln for ln in pos.get_lines()}
     assert lines["axis1.prf"].get_zorder() > lines["axis1.enc"].get_zorder()
     assert lines["axis1.prf"].get_linewidth() < lines["axis1.enc"].get_linewidth()
