@@ -148,8 +148,8 @@ def _case(plan, rnd: random.Random):
             py.append(b"x.cfg")
             wire.append(b"x.cfg\0")
             continue
-        if a.kind is protocol.Kind.OUT_ANY:
-            py.append((ctypes.c_ubyte * 8)())
+        if a.kind is protocol.Kind.OUT_ANY:  # memory of the prototype's type (7 otherwise)
+            py.append((_elem(a.param.ctype) * max(1, 8 // ctypes.sizeof(_elem(a.param.ctype))))())
             wire.append("?")
             continue
         n = scalars[a.count_arg] if a.count_arg >= 0 else a.count
