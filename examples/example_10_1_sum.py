@@ -1,6 +1,6 @@
 """Manual example 10-1, "single-thread sum": a motion program adds begin..end into ``sum``.
 
-    python examples/example_10_1_sum.py [--keep DIR]
+    python example_10_1_sum.py [--keep DIR]
 
 The motion program is ``example_10_1_sum.c`` beside this script (the manual's
 ``add``, as printed).  The application compiles it as ``sum.c`` in a work

@@ -1,6 +1,6 @@
 """Manual example 10-2, "multi-thread sum": two threads of one function share the work.
 
-    python examples/example_10_2_two_threads.py [--keep DIR]
+    python example_10_2_two_threads.py [--keep DIR]
 
 The motion program is the one of example 10-1 (``example_10_1_sum.c``).  Thread 0
 runs ``add`` on data page 0 with begin = 1, end = 50; thread 1 runs the same

@@ -1,6 +1,6 @@
 """Manual example 11-1, "read the controller's firmware version", against the emulator.
 
-    python examples/example_11_1_version.py
+    python example_11_1_version.py
 
 The manual's program declares ``pVersion: POINTER TO STRING``, passes its
 address (``GT_GetVersion(ADR(pVersion))``) and dereferences it

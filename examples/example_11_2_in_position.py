@@ -1,6 +1,6 @@
 """Manual example 11-2, "in-position detection" (figure 11-2): Y starts when X is in position.
 
-    python examples/example_11_2_in_position.py [--plot inpos.png]
+    python example_11_2_in_position.py [--plot inpos.png]
 
 Both axes get an in-position band of 20 pulses held 5 x 250 µs (GT_SetAxisBand).
 X moves to 10000 (vel 10 pulse/ms, acc 1, dec 0.5 pulse/ms²); the program starts

@@ -1,6 +1,6 @@
 """Manual example 11-3, "write data to the memory": 64 words into the MRAM (11.8.1).
 
-    python examples/example_11_3_mram_write.py [--mram FILE] [--value 12345]
+    python example_11_3_mram_write.py [--mram FILE] [--value 12345]
 
 ``WriteMramBuf: ARRAY [0..3, 0..15] OF INT := 12345``: on the rising edge of
 ``xWriteMRAM`` the program sends the buffer to the controller 16 words at a time

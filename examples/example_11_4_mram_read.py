@@ -1,6 +1,6 @@
 """Manual example 11-4, "read data from the memory": 64 words back from the MRAM (11.8.2).
 
-    python examples/example_11_4_mram_read.py [--mram FILE]
+    python example_11_4_mram_read.py [--mram FILE]
 
 On the rising edge of ``xReadMRAM`` the program starts one read of 64 words
 (``GT_StartAccessMRAM(0, 64, 0)``); every scan it reads ``GT_GetMRAMStatus``, and

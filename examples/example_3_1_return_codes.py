@@ -1,6 +1,6 @@
 """Manual example 3-1, "check that a GTN command executed correctly", against the emulator.
 
-    python examples/example_3_1_return_codes.py
+    python example_3_1_return_codes.py
 
 The manual's PLC program reads axis 1's status word through the EtherCAT core
 (``GT_GetSts(1,1,ADR(sts),1,0)``: core 1, axis 1 - the GTN form its title names)

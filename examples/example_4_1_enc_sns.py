@@ -1,6 +1,6 @@
 """Manual example 4-1, "set the encoder counting direction", against the emulator.
 
-    python examples/example_4_1_enc_sns.py
+    python example_4_1_enc_sns.py
 
 ``GT_EncSns(16#01)`` reverses encoder 1 and leaves the others as they are
 (table 4-3: bit n-1 = encoder n).  To show it, axes 1 and 2 of the figure 5-2

@@ -1,6 +1,6 @@
 """Manual example 4-2, "switch the limit alarm off", against the emulator.
 
-    python examples/example_4_2_lmts_off.py
+    python example_4_2_lmts_off.py
 
 ``GT_LmtsOff(1, -1)``: axis 1's positive and negative limits no longer raise
 the limit alarm.  The machine (``example_4_3_machine.toml``) leaves axis 1

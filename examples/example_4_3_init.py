@@ -1,6 +1,6 @@
 """Manual example 4-3, "initialise the controller's configuration", against the emulator.
 
-    python examples/example_4_3_init.py
+    python example_4_3_init.py
 
 GT_Reset, the alarm and the limit switches of axis 1 switched off, GT_ClrSts so
 that the configuration takes effect ("通过指令配置控制器之后，用户必须调用指令

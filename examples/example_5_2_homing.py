@@ -1,6 +1,6 @@
 """Manual example 5-2, "homing with method 3", as a Python script against the emulator.
 
-    python examples/example_5_2_homing.py
+    python example_5_2_homing.py
 
 The Structured Text program of the manual runs once per PLC scan; here
 :func:`plc_prg` is that program (its VAR block is :class:`PlcVars`) and the main

@@ -1,6 +1,6 @@
 """Manual example 5-3, "probe 1 rising edge, continuous capture (GTHD)", as a Python script.
 
-    python examples/example_5_3_probe.py
+    python example_5_3_probe.py
 
 :func:`plc_prg` is the manual's Structured Text program, run once per PLC scan
 (1 ms of controller time, ``GTE_Wait(1)``).  A captured status bit stays set until

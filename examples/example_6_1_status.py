@@ -1,6 +1,6 @@
 """Manual example 6-1, "axis 1's status, mode, position, velocity and acceleration".
 
-    python examples/example_6_1_status.py
+    python example_6_1_status.py
 
 :func:`plc_prg` is the manual's program: it decodes the status word of
 GT_GetSts bit by bit (table 6-2) and reads the planned position, velocity,

@@ -1,6 +1,6 @@
 """Manual example 7-1, "point-to-point motion" (figure 7-2), against the emulator.
 
-    python examples/example_7_1_trap.py [--plot trap.png]
+    python example_7_1_trap.py [--plot trap.png]
 
 Axis 1 moves 50000 pulses forward at 50 pulse/ms with acceleration 0.25 and
 deceleration 0.125 pulse/ms² and a 25 ms smoothing time: 200 ms up, 600 ms at

@@ -1,6 +1,6 @@
 """Manual example 7-2, "Jog motion" (figure 7-4): the target speed changed on the fly.
 
-    python examples/example_7_2_jog.py [--plot jog.png]
+    python example_7_2_jog.py [--plot jog.png]
 
 Axis 1 jogs at 100 pulse/ms (acc = dec = 0.0625 pulse/ms²: 1600 ms to speed);
 once the planned position passes 100000 pulses the program sets 50 pulse/ms and

@@ -1,6 +1,6 @@
 """Manual example 7-3, "PT static FIFO" (table 7-5, figure 7-8), against the emulator.
 
-    python examples/example_7_3_pt.py [--plot pt.png]
+    python example_7_3_pt.py [--plot pt.png]
 
 Axis 1 in PT mode, static FIFO: three NORMAL segments ending at (1024 pulse,
 1024 ms), (3072, 2048), (4096, 3072) - positions and times are points measured

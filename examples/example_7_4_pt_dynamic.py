@@ -1,6 +1,6 @@
 """Manual example 7-4, "PT dynamic FIFO" (figure 7-9): a sine speed fed while it runs.
 
-    python examples/example_7_4_pt_dynamic.py [--plot pt_sine.png]
+    python example_7_4_pt_dynamic.py [--plot pt_sine.png]
 
 Axis 1 in PT mode, dynamic FIFO.  The speed is 50·sin(2πt/1 s) pulse/ms, cut into
 16 ms NORMAL segments; each period ends with a STOP segment back at position 0,

@@ -1,6 +1,6 @@
 """Manual example 7-5, "electronic gear" (figures 7-11, 7-12), against the emulator.
 
-    python examples/example_7_5_gear.py [--plot gear.png]
+    python example_7_5_gear.py [--plot gear.png]
 
 Axis 1 (master) jogs to 100 pulse/ms with acc 1 pulse/ms²; axis 2 (slave)
 follows its planned position in Gear mode with master speed : slave speed =

@@ -1,6 +1,6 @@
 """Manual example 7-6, "Follow mode in a flying shear" (figures 7-15, 7-16, tables 7-8, 7-9).
 
-    python examples/example_7_6_flying_shear.py [--plot shear.png]
+    python example_7_6_flying_shear.py [--plot shear.png]
 
 The belt (axis 1, master) runs in Jog mode; the knife rotor (axis 2, slave)
 follows its planned position in Follow mode.  One cut every 10000 pulses of

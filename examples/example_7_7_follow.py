@@ -1,6 +1,6 @@
 """Manual example 7-7, "Follow single FIFO" (table 7-10, figures 7-17, 7-18), against the emulator.
 
-    python examples/example_7_7_follow.py [--plot follow.png]
+    python example_7_7_follow.py [--plot follow.png]
 
 Axis 1 (master) jogs at 50 pulse/ms (acc 1); axis 2 (slave) follows its planned
 position in Follow mode.  The slave starts when the master passes 50000 pulses

@@ -1,6 +1,6 @@
 """Manual example 7-8, "Follow double-FIFO switch" (tables 7-11..7-13, figures 7-14, 7-19, 7-20).
 
-    python examples/example_7_8_follow_switch.py [--plot switch.png]
+    python example_7_8_follow_switch.py [--plot switch.png]
 
 Axis 1 (master) jogs at 50 pulse/ms (acc 1); axis 2 (slave) follows it in
 Follow mode, starting at once.  FIFO1 holds the original strategy (table 7-11,

@@ -1,6 +1,6 @@
 """Manual example 8-1, "access the encoders", against the emulator.
 
-    python examples/example_8_1_encoder.py
+    python example_8_1_encoder.py
 
 The manual's program reads eight encoder positions and eight encoder speeds in
 one call each (``GT_GetEncPos(1, ADR(enc), 8, 0)``, ``enc: ARRAY [0..7] OF

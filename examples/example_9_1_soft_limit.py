@@ -1,6 +1,6 @@
 """Manual example 9-1, "soft limits" (figure 9-2): the motion stops at the positive soft limit.
 
-    python examples/example_9_1_soft_limit.py [--plot softlimit.png]
+    python example_9_1_soft_limit.py [--plot softlimit.png]
 
 Axis 1's soft limits are +20000 / -20000.  A Trap move toward 1000000 (50 pulse/ms,
 acc = dec = 0.125 pulse/ms², smoothTime 25 ms) passes +20000: in that cycle the

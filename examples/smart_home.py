@@ -1,8 +1,8 @@
-"""Seed 002's limit homing (``Motion::LimitHome``) in Python, on a virtual GTS-400 card.
+"""A user's C++ limit homing (``Motion::LimitHome``) in Python, on a virtual GTS-400 card.
 
-    python examples/smart_home.py [axis]
+    python smart_home.py [axis]
 
-Seed 002 (``../shared/seeds/002_*.txt``) is a user's C++ class for a 4-axis Googol GTS card:
+The original is a user's C++ class for a 4-axis Googol GTS card:
 ``init`` opens the card, resets it, loads ``GTS800.cfg``, clears and zeroes the axes and
 switches them on; ``moveHomeInner`` clears and zeroes the axis, escapes a limit it stands on,
 reads the smart-home parameters, sets ``HOME_MODE_LIMIT`` (moveDir -1, velHigh 50, velLow
@@ -12,7 +12,7 @@ search raises - until ``run`` drops, then zeroes the position.  Here is the same
 as ctypes code for the vendor DLL would be (``byref``, the structures of ``gt``), against
 ``GT_Open(card="gts:4")`` (or ``GTECAT_CARD=gts:4``): no ``GT_InitEcatComm``, a card.
 
-The card's mechanics are ``smart_home_machine.toml``: axis 3 (the seed's ``Axis_X``) has its
+The card's mechanics are ``smart_home_machine.toml``: axis 3 (the class's ``Axis_X``) has its
 negative limit at -50000 and stands at 0; ``GTS800.cfg`` wires each axis's alarm and limits
 to its own terminals.  The search finds the limit (sampled once per 1 ms cycle, so within
 half a cycle's travel at velLow: +-10 counts), stops at capture + 10000 and the script zeroes
@@ -31,7 +31,7 @@ from gtecat import gt
 HERE = Path(__file__).resolve().parent
 MACHINE = HERE / "smart_home_machine.toml"
 CONFIG = HERE / "GTS800.cfg"
-ESCAPE_DISTANCE = 1000  # the seed's escape_distance
+ESCAPE_DISTANCE = 1000  # the class's escape_distance
 
 
 def check(rc: int, what: str) -> None:
@@ -57,11 +57,11 @@ def init(clock: str) -> None:
 
 
 def limit_home(axis: int) -> gt.THomeStatus:
-    """Motion::moveHomeInner: the seed's limit homing, call for call."""
+    """Motion::moveHomeInner: the class's limit homing, call for call."""
     check(gt.GT_ClrSts(axis), "GT_ClrSts")
     check(gt.GT_ZeroPos(axis), "GT_ZeroPos")
     sts = status(axis)
-    if sts & 0x60 and sts & (1 << 10):  # on a limit and moving: the seed's moveTo stops it
+    if sts & 0x60 and sts & (1 << 10):  # on a limit and moving: the class's moveTo stops it
         check(gt.GT_Stop(1 << (axis - 1), 1 << (axis - 1)), "GT_Stop")
     if sts & 0x60:
         check(gt.GT_ClrSts(axis), "GT_ClrSts")

@@ -9,9 +9,18 @@ Installed with gtecat and loaded by pytest on its own (entry point ``pytest11``)
     ``.axis_on(*axes)``, ``.path`` (the test's own folder). Closed after the test.
 ``gtecat_eni`` / ``gtecat_machine``
     What the bus is built from: a file path, or the name of a shipped example
-    (``gtecat example`` lists them). Default: the ``gtecat`` marker, else the ``gtecat_eni`` /
-    ``gtecat_machine`` ini options, else the ``manual_fig5_2`` example and no machine
-    description. Override either by defining a fixture of that name in your ``conftest.py``.
+    (``gtecat example`` lists them), found in this order - your machine first, a shipped
+    example only when you name it:
+
+    1. the ``gtecat`` marker (``eni=`` / ``machine=``),
+    2. the ``gtecat_eni`` / ``gtecat_machine`` ini options (``pytest.ini``, ``pyproject.toml``),
+    3. ``GTECAT_ENI`` / ``GTECAT_MACHINE`` in the environment (as ``GT_Open`` reads them),
+    4. ``Gecat.eni`` in the rootdir (beside ``pytest.ini``), as the real controller looks for
+       it in its working folder; for the machine description, none;
+    5. else the test errors with a message that says how to choose.
+
+    The pytest header line names the bus and machine of the session and where they came from.
+    Override either by defining a fixture of that name in your ``conftest.py``.
 ``gtecat_env``
     For applications that call ``GT_Open()`` themselves: the ``GTECAT_*`` environment of
     the same ENI, machine and lockstep clock, with the master log and MRAM in the test's folder.
@@ -40,7 +49,12 @@ from typing import Any
 
 import pytest
 
-DEFAULT_EXAMPLE = "manual_fig5_2"
+DEFAULT_FILE = "Gecat.eni"
+NO_ENI = (
+    "gtecat: which bus should the tests run against? Name it in pytest.ini "
+    "([pytest] gtecat_eni = path/to/your.eni, or a shipped example such as manual_fig5_2; "
+    "`gtecat example` lists them), set GTECAT_ENI, or put your Gecat.eni in {rootdir}"
+)
 TRACE_KEY = pytest.StashKey[list]()
 ERRORS_KEY = pytest.StashKey[object]()
 
@@ -118,18 +132,59 @@ def _resolve(value: Any, kind: str, tmp_path: Path, rootdir: Path) -> Any:
     )
 
 
+def _session_choice(config: pytest.Config, kind: str) -> tuple[Any, str]:
+    """(value, where it came from) for the whole session: ini option, environment,
+    ``Gecat.eni`` in the rootdir; (None, "") when nothing names one."""
+    import os
+
+    ini = config.getini(f"gtecat_{kind}")
+    if ini:
+        return ini, f"gtecat_{kind} in {_ini_name(config)}"
+    env = os.environ.get(f"GTECAT_{kind.upper()}", "").strip()
+    if env:
+        return env, f"GTECAT_{kind.upper()}"
+    if kind == "eni":
+        default = config.rootpath / DEFAULT_FILE
+        if default.is_file():
+            return default, f"{DEFAULT_FILE} in the rootdir"
+    return None, ""
+
+
+def _ini_name(config: pytest.Config) -> str:
+    return config.inipath.name if config.inipath is not None else "the ini file"
+
+
+def _choice(request: pytest.FixtureRequest, kind: str) -> Any:
+    marked = _marker(request, kind)
+    if marked:
+        return marked
+    return _session_choice(request.config, kind)[0]
+
+
 @pytest.fixture
 def gtecat_eni(request: pytest.FixtureRequest, tmp_path: Path) -> Path:
-    """The ENI of the bus: marker, ini option ``gtecat_eni``, else the figure 5-2 example."""
-    value = _marker(request, "eni") or request.config.getini("gtecat_eni") or DEFAULT_EXAMPLE
+    """The ENI of the bus: marker, ini option ``gtecat_eni``, ``GTECAT_ENI``, ``Gecat.eni``
+    in the rootdir; an error that says how to choose when none names one."""
+    value = _choice(request, "eni")
+    if value is None:
+        pytest.fail(NO_ENI.format(rootdir=request.config.rootpath), pytrace=False)
     return _resolve(value, "eni", tmp_path, request.config.rootpath)
 
 
 @pytest.fixture
 def gtecat_machine(request: pytest.FixtureRequest, tmp_path: Path) -> Any:
-    """The machine description: marker, ini option ``gtecat_machine``, else none."""
-    value = _marker(request, "machine") or request.config.getini("gtecat_machine") or None
-    return _resolve(value, "machine", tmp_path, request.config.rootpath)
+    """The machine description: marker, ini option ``gtecat_machine``, ``GTECAT_MACHINE``,
+    else none (no switches, no probe marks)."""
+    return _resolve(_choice(request, "machine"), "machine", tmp_path, request.config.rootpath)
+
+
+def pytest_report_header(config: pytest.Config) -> list[str]:
+    """One line: the bus and machine the gtecat fixtures use, and where each came from."""
+    eni, eni_from = _session_choice(config, "eni")
+    machine, machine_from = _session_choice(config, "machine")
+    bus = f"bus {eni} ({eni_from})" if eni is not None else "bus: none chosen (see gtecat_eni)"
+    mach = f"machine {machine} ({machine_from})" if machine is not None else "no machine file"
+    return [f"gtecat: {bus}, {mach}; a gtecat marker overrides them per test"]
 
 
 def _clock(request: pytest.FixtureRequest) -> str:

@@ -47,10 +47,19 @@ EXAMPLES = ROOT / "examples"
 SHARED_FIXTURES = ROOT.parent / "shared" / "fixtures"
 
 
+def needs_fixture(what: object) -> str:
+    """The skip reason of a test that reads the vendors' sample files: they are not shipped
+    with gtecat (a repository checkout keeps them in a fixtures folder beside it)."""
+    return (
+        f"needs the vendors' sample files, not shipped with gtecat ({what} not found; a "
+        "repository checkout has them beside it)"
+    )
+
+
 @pytest.fixture
 def shared_fixtures() -> Path:
     if not SHARED_FIXTURES.is_dir():
-        pytest.skip(f"shared fixtures not found at {SHARED_FIXTURES}")
+        pytest.skip(needs_fixture(SHARED_FIXTURES))
     return SHARED_FIXTURES
 
 

@@ -35,6 +35,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "controller",
         help="run a virtual controller for libgts / ctypes clients (Unix socket)",
         description=__doc__,
+        epilog="examples:\n"
+        "  gtecat controller --eni manual_fig5_2.eni --listen unix:/tmp/ctl.sock\n"
+        "  gtecat controller --eni Gecat.eni --machine machine.toml --clock lockstep",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
             slaves = len(f.positions())
         return _write(args, text, slaves)
     args.file = eni_argument(args) or os.environ.get("GTECAT_ENI") or "Gecat.eni"
-    layout = build_layout(read_eni(args.file))
+    layout = build_layout(output.require_slaves(read_eni(args.file), args.file))
     if args.position is not None and not 0 <= args.position < len(layout.slaves):
         raise ParameterError(
             f"no slave {args.position}: {args.file} has slaves 0..{len(layout.slaves) - 1}"

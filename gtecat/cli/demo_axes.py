@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..controller.recorder import Recorder, signal
+from ..controller.trace_plot import plot_noisy
 
 Say = Callable[[Any, str], None]
 
@@ -584,7 +585,7 @@ def plot_demo(rec: Recorder, path: Path, run: DemoRun) -> Path:
             alpha=0.8,
             label="planned" if a == 1 else None,
         )
-        err.plot(t, prf - enc, color=c, lw=1.2, label=f"axis {a}")
+        plot_noisy(err, t, prf - enc, c, f"axis {a} (band: min-max, line: mean)")
         t0, t1 = run.homing.get(a, (None, None))
         if t0 is not None:
             for ax in (pos, vel, err):

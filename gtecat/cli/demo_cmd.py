@@ -22,7 +22,14 @@ from ..errors import BusError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("demo", help="run the figure 5-2 demo (bus, IO, axes) and plot it")
+    p = sub.add_parser(
+        "demo",
+        help="run the figure 5-2 demo (bus, IO, axes) and plot it",
+        epilog="examples:\n"
+        "  gtecat demo                        demo.png, demo.csv, Gecat.log here\n"
+        "  gtecat demo --out run1 --no-plot   only the CSV and the log, in ./run1",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--out", default=".", help="folder for demo.eni, demo.csv, demo.png, Gecat.log")
     p.add_argument("--no-plot", action="store_true", help="skip demo.png")
     p.set_defaults(func=run)

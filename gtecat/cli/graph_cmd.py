@@ -44,7 +44,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def render(path: str) -> str:
-    config = read_eni(path)
+    config = output.require_slaves(read_eni(path), path)
     return render_graph(config, build_layout(config))
 
 

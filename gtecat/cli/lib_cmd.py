@@ -42,6 +42,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "lib",
         help="compiler and linker flags for libgts / gts.h (C, C++)",
         description=__doc__,
+        epilog="examples:\n"
+        "  gtecat lib --cflags --libs      flags for gcc/g++ (builds libgts on first use)\n"
+        "  gtecat lib --header > gts.h     the generated header alone, no build",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--cflags", action="store_true", help="-I for gts.h")

@@ -6,6 +6,7 @@ Errors print one line (``error: ...``) and exit 1; ``--debug`` shows the traceba
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import sys
@@ -43,6 +44,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="gtecat",
         description="EtherCAT master emulator with virtual CiA-402 drives and the GT_* API.",
+        epilog="examples:\n"
+        "  gtecat example manual_fig5_2 -o .    a bus and a first script, into this folder\n"
+        "  gtecat map manual_fig5_2.eni         its GT raw offsets\n"
+        "  gtecat demo                          the figure 5-2 demo, plotted\n"
+        "every command has --help with examples",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     from .. import __version__
@@ -89,6 +96,33 @@ def _tolerant_streams() -> None:
                 pass
 
 
+_ERRNO_SENTENCES = {
+    errno.EISDIR: "{f} is a folder; give a file name (for example {f}/NAME)",
+    errno.EEXIST: "{f} is in the way: it already exists and is not a folder",
+    errno.ENOENT: "{f} does not exist",
+    errno.ENOTDIR: "{f}: a part of this path is a file, not a folder",
+    errno.EACCES: "no permission to use {f}",
+    errno.EPERM: "no permission to use {f}",
+    errno.ENOSPC: "no space left on the disk for {f}",
+    errno.EROFS: "{f} is on a read-only file system",
+    errno.ENAMETOOLONG: "the name {f} is too long",
+}
+
+
+def os_sentence(e: OSError) -> str:
+    """An OSError as a sentence about the file (``[Errno 21] Is a directory: 'out'`` reads
+    "out is a folder; give a file name ..."); the system's words when no sentence fits."""
+    name = e.filename if e.filename is not None else None
+    if name is not None:
+        f = os.fsdecode(name)
+        sentence = _ERRNO_SENTENCES.get(e.errno or 0)
+        if sentence is not None:
+            return sentence.format(f=f)
+        if e.strerror:
+            return f"{f}: {e.strerror[0].lower()}{e.strerror[1:]}"
+    return e.strerror or str(e)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     _tolerant_streams()
     parser = build_parser()
@@ -109,7 +143,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (GtecatError, OSError) as e:
         if args.debug:
             raise
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {os_sentence(e) if isinstance(e, OSError) else e}", file=sys.stderr)
         return 1
     except Exception as e:  # one clear line, never a traceback by default
         if args.debug:

@@ -18,6 +18,8 @@ from gtecat.eni.layout import Layout, Placement, SlaveLayout, build_layout
 from gtecat.eni.model import Direction
 from gtecat.eni.reader import read_eni
 
+from . import output
+
 _FORMATS = {"xml": "ETG.2100 ENI XML", "googol": "Googol INI Gecat.eni"}
 
 
@@ -123,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
 
     args.file = eni_argument(args) or os.environ.get("GTECAT_ENI") or "Gecat.eni"
     try:
-        layout = build_layout(read_eni(args.file))
+        layout = build_layout(output.require_slaves(read_eni(args.file), args.file))
     except GtecatError as exc:
         if getattr(args, "debug", False):
             raise

@@ -101,6 +101,20 @@ def emit(args: argparse.Namespace, rows: Any, columns: Sequence[Column]) -> int:
     return 0
 
 
+def require_slaves(config: Any, path: Any) -> Any:
+    """Refuse an ENI without slaves (a bus with nothing on it has no offsets, no axes and
+    nothing to show; GT_InitEcatComm answers it with -10)."""
+    if not config.slaves:
+        from gtecat.eni.errors import EniError
+
+        raise EniError(
+            "the configuration describes no slaves, so there is no bus to show; export it "
+            "again from your configuration tool with the slaves scanned in",
+            file=str(path),
+        )
+    return config
+
+
 def describe(doc: str | None) -> str | None:
     """A module docstring as ``--help`` text: without its title line and reST markup."""
     if not doc:

@@ -21,6 +21,8 @@ import sys
 from pathlib import Path
 from types import FrameType
 
+from . import output
+
 log = logging.getLogger("gtecat.wire.serve")
 
 
@@ -28,7 +30,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser(
         "serve",
         help="serve the ENI's virtual slaves on a network interface (raw EtherCAT frames)",
-        description=__doc__,
+        description=output.describe(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     _arguments(p)

@@ -9,6 +9,7 @@ bus the change lasts for this command only, on a running controller (--controlle
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from gtecat.drives.slave import AlState
 
@@ -30,20 +31,36 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("state", nargs="?", type=str.upper, help="state to request")
+    p.add_argument(
+        "words",
+        nargs="*",
+        metavar="[FILE] [STATE]",
+        help="configuration file (same as --eni) and/or the state to request, in any order",
+    )
     add_bus_options(p)
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def _split(args: argparse.Namespace) -> AlState | None:
+    """``states FILE``, ``states STATE``, ``states FILE STATE``: a word that names an AL
+    state is the state, one that ends in .eni/.xml or names a file is the ENI."""
     target = None
-    if args.state:
-        try:
-            target = AlState[args.state]
-        except KeyError:
+    args.file = None
+    for word in args.words:
+        if word.upper() in AlState.__members__ and target is None:
+            target = AlState[word.upper()]
+        elif args.file is None and (word.lower().endswith((".eni", ".xml")) or Path(word).exists()):
+            args.file = word
+        else:
             raise ParameterError(
-                f"no AL state {args.state!r}: give INIT, PREOP, SAFEOP, OP or BOOT"
-            ) from None
+                f"no AL state {word!r}: give INIT, PREOP, SAFEOP, OP or BOOT (and the ENI "
+                "file, if any, once)"
+            )
+    return target
+
+
+def run(args: argparse.Namespace) -> int:
+    target = _split(args)
     with bus_view(args) as bus:
         rows = bus.states(args.position, target.name if target is not None else None)
     if args.json:

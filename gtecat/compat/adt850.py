@@ -455,7 +455,7 @@ def _interp(card: PulseCard, no: int, axes: list[int], make: Callable, arc: bool
     prm: SCurveParams = regs.params()
     c = bank(card.ctl).get(2 if no == 2 else 1)
     if prm.s_curve and arc:
-        raise CompatError("S-curve acceleration cannot drive an arc (seed 004 3.4, 5.4)")
+        raise CompatError("S-curve acceleration cannot drive an arc (ADT850 manual 3.4, 5.4)")
     if prm.s_curve and c.running:
         raise CompatError("S-curve acceleration cannot drive a continuous interpolation (5.4)")
     enabled = _DEC_ENABLED[no]
@@ -466,7 +466,7 @@ def _interp(card: PulseCard, no: int, axes: list[int], make: Callable, arc: bool
     elif arc and not prm.constant:
         raise CompatError(
             "an arc with acceleration decelerates only in manual mode (set_dec2_mode 1 and "
-            "set_dec_pos, seed 004 5.4)"
+            "set_dec_pos, ADT850 manual 5.4)"
         )
     else:
         decel = "auto"

@@ -376,7 +376,9 @@ def _circle(pCD: Any, axis: Any, ccw: bool, shape: str) -> None:
     master = axes[0]
     regs = card.regs[master]
     if shape == "T" and not regs.manual:
-        raise CompatError("a T-curve arc needs ManualDec (seed 003 4.4: AutoDec cannot be used)")
+        raise CompatError(
+            "a T-curve arc needs ManualDec (MCX314 library manual 4.4: AutoDec cannot be used)"
+        )
     end = tuple(card.regs[n].settings.get("fp", 0) for n in axes)
     ctr = tuple(card.regs[n].settings.get("cp", 0) for n in axes)
     card.interpolate(axes, master, PulseCard.arc(end, ctr, ccw), _prm(card, master, d, shape),

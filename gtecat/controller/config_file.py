@@ -85,10 +85,12 @@ only that format has appears (:func:`is_legacy`).  Its reader is :func:`parse_le
 
 from __future__ import annotations
 
+import math
 import re
 import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from decimal import Decimal
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -129,6 +131,7 @@ CARD_INPUTS = {MC_GPI: "gpi", MC_ARRIVE: "arrive", MC_MPG: "mpg"}
 _INPUT_TYPES = (MC_NONE, *BUS_INPUTS, *CARD_INPUTS)
 _SECTION_NUMBER_MAX = 0x7FFF
 _VALUE_CHARS_MAX = 40
+_INTEGER_MAX = Decimal(2**64)
 
 
 # --- values -------------------------------------------------------------------------------------
@@ -136,7 +139,9 @@ _INT_RE = re.compile(r"[+-]?(?:0[xX][0-9a-fA-F]+|\d+)")
 _REAL_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 
-def _number(v: str) -> int | float:
+def _number(v: str) -> int | Decimal:
+    """An integer, or a real as written (a :class:`~decimal.Decimal`, exact: ``1e-999`` is
+    not 0, and no exponent builds a huge integer)."""
     if len(v) > _VALUE_CHARS_MAX:
         raise ValueError(f"{len(v)} characters is not a number")
     if _INT_RE.fullmatch(v):
@@ -144,16 +149,20 @@ def _number(v: str) -> int | float:
         body = v.lstrip("+-")
         return sign * (int(body, 16) if body[:2].lower() == "0x" else int(body, 10))
     if _REAL_RE.fullmatch(v):
-        return float(v)
+        return Decimal(v)
     raise ValueError("not a number (decimal, 0x hex or a float)")
 
 
 def integer(v: str) -> int:
-    """Decimal, ``0x`` hex, or a float with an integral value (``1.000000``)."""
+    """Decimal, ``0x`` hex, or a real whose value *as written* is an integer (``1.000000``,
+    ``1e3``).  One rule for every integer and flag key: ``1e-999`` and ``0.5`` are both
+    refused (neither is an integer), though a float would read the first as 0."""
     x = _number(v)
-    if isinstance(x, float):
-        if not x.is_integer():
+    if isinstance(x, Decimal):
+        if x != x.to_integral_value():
             raise ValueError("not an integer")
+        if abs(x) > _INTEGER_MAX:
+            raise ValueError("out of range (beyond 64 bits)")
         x = int(x)
     return x
 
@@ -176,7 +185,10 @@ def flag(v: str) -> bool:
 
 
 def real(v: str) -> float:
-    return float(_number(v))
+    x = float(_number(v))
+    if not math.isfinite(x):
+        raise ValueError("beyond the range of a double")
+    return x
 
 
 def stop_dec(v: str) -> float:
@@ -330,6 +342,10 @@ _HEADER_RE = re.compile(r"\[\s*([A-Za-z]+)(\d+)\s*\]")
 _COMMENT = re.compile(r"[;#]")
 
 
+def _shown(value: str) -> str:
+    return repr(value) if len(value) <= 48 else f"{value[:24]!r}... ({len(value)} characters)"
+
+
 def _lines(text: str) -> Iterable[tuple[int, str]]:
     """(line number, text without comment), comment-only and blank lines dropped."""
     split = _COMMENT.split
@@ -359,10 +375,12 @@ def parse_vendor(text: str, path: Path | str = "<text>") -> VendorConfig:
                     f"unknown section {line}; a section is a resource and its number, one of "
                     + ", ".join(f"[{k}N]" for k in SCHEMA),
                 )
-            number = int(m.group(2))
+            number = _section_number(m.group(2))
             if not 1 <= number <= _SECTION_NUMBER_MAX:
                 raise _error(
-                    path, lineno, f"section {line}: the number must be 1..{_SECTION_NUMBER_MAX}"
+                    path,
+                    lineno,
+                    f"section {_shown(line)}: the number must be 1..{_SECTION_NUMBER_MAX}",
                 )
             first = cfg.sections.get((kind, number))
             if first is not None:
@@ -397,7 +415,9 @@ def parse_vendor(text: str, path: Path | str = "<text>") -> VendorConfig:
         try:
             parsed = SCHEMA[current.kind][key](value)
         except ValueError as e:
-            raise _error(path, lineno, f"{written}={value!r} in [{current.header}]: {e}") from None
+            raise _error(
+                path, lineno, f"{written}={_shown(value)} in [{current.header}]: {e}"
+            ) from None
         current.settings[key] = Setting(parsed, written, lineno)
     for section in cfg.sections.values():
         _check_section(section, path)
@@ -473,7 +493,14 @@ def _switch(v: str) -> bool:
 
 
 def _int(v: str) -> int:
+    if len(v) > _VALUE_CHARS_MAX:
+        raise ValueError(f"{len(v)} characters is not a number")
     return int(v, 0)
+
+
+def _section_number(digits: str) -> int:
+    """A section's number; one of thousands of digits is out of range, not converted."""
+    return int(digits) if len(digits) <= 9 else _SECTION_NUMBER_MAX + 1
 
 
 def _ints(n: int):
@@ -522,7 +549,7 @@ def _source(v: str) -> bool:
 
 
 def _dec(v: str) -> float:
-    x = float(v)
+    x = float(v) if len(v) <= _VALUE_CHARS_MAX else math.nan
     if not 0 < x <= STOP_DEC_MAX:
         raise ValueError(f"{x:g} not in (0, 32767] pulse/ms²")
     return x
@@ -604,9 +631,9 @@ def parse_legacy(text: str, path: Path | str = "<text>") -> Config:
             m = _LEGACY_SECTION.match(line)
             if not m:
                 raise fail(f"{line!r} is not a section [axis N], [encoder N] or [profile N]")
-            kind, number = m.group(1).lower(), int(m.group(2))
-            if number < 1:
-                raise fail(f"{kind} number {number} must be >= 1")
+            kind, number = m.group(1).lower(), _section_number(m.group(2))
+            if not 1 <= number <= _SECTION_NUMBER_MAX:
+                raise fail(f"{_shown(line)}: the number must be 1..{_SECTION_NUMBER_MAX}")
             if (kind, number) in cfg.sections:
                 raise fail(f"[{kind} {number}] appears twice")
             current = cfg.sections[(kind, number)] = Section(kind, number, lineno)
@@ -628,7 +655,7 @@ def parse_legacy(text: str, path: Path | str = "<text>") -> Config:
         try:
             current.values[key] = parser(value)
         except (ValueError, ParameterError) as e:
-            raise fail(f"{key} = {value!r}: {e}") from None
+            raise fail(f"{key} = {_shown(value)}: {e}") from None
     return cfg
 
 

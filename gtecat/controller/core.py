@@ -204,12 +204,13 @@ class Controller:
         path = self.eni_path()
         if path.is_dir():
             raise NoEniError(
-                folder_message(path, "name the file in GT_Open(eni=...) or GTECAT_ENI, e.g.")
+                folder_message(path, "set GTECAT_ENI to the file (Python: GT_Open(eni=...)), e.g.")
             )
         if not path.is_file():
             raise NoEniError(
-                f"no ENI file at {path.resolve()} "
-                "(pass --eni or eni=... to GT_Open, or set GTECAT_ENI)"
+                f"no ENI file at {path.resolve()}: set GTECAT_ENI to your ENI (any program: "
+                "C, C++, C#, Python), or put it in the working folder as Gecat.eni "
+                "(Python may pass GT_Open(eni=...), the command line --eni)"
             )
         try:
             config = read_eni(path)
@@ -364,11 +365,38 @@ class Controller:
     def clock_ms(self) -> int:
         return (self.clock.now_ns - self.reset_ns) // 1_000_000
 
+    #: called between the slices of a long wait (:meth:`wait_ms`), None: nothing.  The
+    #: controller server sets it to let other clients' calls in (it releases its lock for
+    #: a moment); a hook may run GT calls, whose time counts toward the wait.
+    slice_hook: Callable[[], None] | None = None
+    #: controller time one slice of a wait runs before the hook is called
+    WAIT_SLICE_NS = 100_000_000
+
     def wait_ms(self, ms: float) -> None:
-        """GTE_Wait: let ``ms`` of controller time pass, in any clock mode."""
+        """GTE_Wait: let ``ms`` of controller time pass, in any clock mode.
+
+        Virtual time runs in slices of :attr:`WAIT_SLICE_NS` up to the controller time
+        the wait ends at: between slices, a KeyboardInterrupt (Ctrl-C) reaches the
+        caller, and :attr:`slice_hook` serves others (a day's wait no longer holds every
+        native client for the hour it takes to compute).  Without a hook the cycles run
+        are exactly those of one advance of ``ms``.
+        """
         if ms < 0:
             raise ParameterError("wait time must be >= 0")
-        self.clock.advance(ms)
+        clock = self.clock
+        total = round(ms * 1_000_000)
+        if clock.mode is ClockMode.REALTIME or total <= self.WAIT_SLICE_NS:
+            clock.advance_ns(total)
+            return
+        end = clock.now_ns + clock._pending_ns + total
+        while True:
+            left = end - (clock.now_ns + clock._pending_ns)
+            if left <= 0:
+                return
+            clock.advance_ns(min(left, self.WAIT_SLICE_NS))
+            hook = self.slice_hook
+            if hook is not None and left > self.WAIT_SLICE_NS:
+                hook()
 
 
 def folder_message(path: Path, how: str) -> str:

@@ -23,6 +23,29 @@ import numpy as np
 
 from .recorder import MODE_NAMES, STATE_NAMES, SW_BITS, state_of
 
+
+def envelope(t: Any, y: Any, bins: int = 600) -> tuple[Any, Any, Any, Any]:
+    """(t, low, high, mean) of ``y`` in ``bins`` runs of samples: a signal that toggles by a
+    count every cycle (rounding of the set-point) drawn sample by sample fills its panel
+    like a solid block at this resolution; its band and mean show what it really does."""
+    t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
+    if len(y) <= 2 * bins:
+        return t, y, y, y
+    edges = np.linspace(0, len(y), bins + 1).astype(int)
+    starts = edges[:-1]
+    lo = np.minimum.reduceat(y, starts)
+    hi = np.maximum.reduceat(y, starts)
+    mean = np.add.reduceat(y, starts) / np.diff(edges)
+    return t[starts], lo, hi, mean
+
+
+def plot_noisy(ax: Any, t: Any, y: Any, color: str, label: str | None) -> None:
+    """A fast-changing signal as its min-max band and its mean line (see :func:`envelope`)."""
+    tb, lo, hi, mean = envelope(t, y)
+    ax.fill_between(tb, lo, hi, step="post", color=color, alpha=0.25, lw=0)
+    ax.plot(tb, mean, color=color, lw=1.2, drawstyle="steps-post", label=label)
+
+
 _AXIS = re.compile(r"^axis(\d+)\.(\w+)$")
 COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink",
           "tab:olive", "tab:cyan", "tab:gray", "tab:red"]  # fmt: skip
@@ -101,6 +124,15 @@ def layout(rec: Any) -> tuple[list, list, list]:
     return list(panels.items()), bands, rows
 
 
+def _with_units(rec: Any, group: str, lines: list) -> str:
+    """A panel's label with the units of its lines ("position (pulse, counts)")."""
+    if "(" in group:
+        return group
+    unit_of = dict(zip(rec.names, (k.unit for k in rec.kinds), strict=True))
+    units = list(dict.fromkeys(u for name, *_ in lines if (u := unit_of.get(name))))
+    return f"{group} ({', '.join(units)})" if units else group
+
+
 def plot_recorder(rec: Any, path: Path, title: str) -> Path:
     import matplotlib
 
@@ -128,8 +160,17 @@ def plot_recorder(rec: Any, path: Path, title: str) -> Path:
         ax = axes[k]
         k += 1
         for name, col, color, style in lines:
-            ax.plot(t, col, color=color, ls=style, lw=1.2, label=name)
-        ax.set_ylabel(group, fontsize=8)
+            if name.endswith(".err"):
+                plot_noisy(ax, t, col, color, name)
+                continue
+            # the planned position on top of the encoder (thinner, dashed): both stay visible
+            # where they agree, which is most of the time
+            planned = name.endswith((".prf", ".vel"))
+            ax.plot(
+                t, col, color=color, ls=style, lw=1.0 if planned else 2.2,
+                alpha=1.0 if planned else 0.45, zorder=3 if planned else 2, label=name,
+            )  # fmt: skip
+        ax.set_ylabel(_with_units(rec, group, lines), fontsize=8)
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, frameon=False)
         ax.grid(alpha=0.3)
     if bands:

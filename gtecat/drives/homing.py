@@ -170,6 +170,9 @@ class Homing:
         self._max_travel = (
             self._default_max_travel() if params.max_travel is None else float(params.max_travel)
         )
+        #: what the search needs that the machine description lacks (None: nothing); the
+        #: search still runs (a real drive would too) and fails at its travel limit
+        self.missing = self._missing_signal()
         if spec.kind is MethodKind.INDEX_ONLY:
             self.phase = HomingPhase.INDEX
         else:
@@ -389,6 +392,26 @@ class Homing:
             self._fail(f"search travel exceeded {self._max_travel:.0f} counts")
         elif self._elapsed > self.params.timeout_s:
             self._fail(f"search took longer than {self.params.timeout_s:g} s")
+
+    def _missing_signal(self) -> str | None:
+        spec, m = self._spec, self._m
+        need = []
+        if spec.signal is Signal.HOME_SWITCH and not m.home_switch:
+            need.append("a home switch (home_switch)")
+        if spec.signal is Signal.NEGATIVE_LIMIT and m.negative_limit is None:
+            need.append("a negative limit switch (negative_limit)")
+        if spec.signal is Signal.POSITIVE_LIMIT and m.positive_limit is None:
+            need.append("a positive limit switch (positive_limit)")
+        if spec.uses_index and m.index_offset is None:
+            need.append("an index pulse (index_offset)")
+        if not need:
+            return None
+        return (
+            f"homing method {spec.number} searches for {' and '.join(need)}, but the machine "
+            "description gives this axis none, so the search cannot find it; it ends only "
+            f"after {self._max_travel:.0f} counts of travel (set the key in [axis.N] of the "
+            "machine TOML, or choose a method that needs no switch, e.g. 35/37)"
+        )
 
     def _default_max_travel(self) -> float:
         p = self.params

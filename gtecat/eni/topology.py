@@ -149,6 +149,12 @@ def build_config(data: Mapping[str, Any], source: str = "<topology>") -> EniConf
     tables = data.get("slave", [])
     if not isinstance(tables, list) or not all(isinstance(t, Mapping) for t in tables):
         raise where.error("'slave' must be an array of tables ([[slave]])", "slave")
+    if not tables:
+        raise where.error(
+            "the topology has no slaves: describe each one in a [[slave]] table, in bus order "
+            "(gtecat example manual_fig5_2 writes one to start from)",
+            "slave",
+        )
 
     slaves = []
     for pos, table in enumerate(tables):

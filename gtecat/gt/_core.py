@@ -97,6 +97,8 @@ class _Session:
         self.controllers: dict[int, Controller] = {}
         self.errors: deque[LastError] = deque(maxlen=64)  # the recent failures, oldest first
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
+        #: a reason the running call leaves although it succeeds (:func:`note`)
+        self.note: str | None = None
         #: the controller process this session is attached to (``GT_Open(controller=...)``
         #: or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process
         self.remote: Any = None
@@ -154,6 +156,19 @@ def _record(name: str, code: int, reason: str) -> None:
     SESSION.errors.append(SESSION.last)
 
 
+def note(reason: str) -> None:
+    """Leave ``reason`` for GTE_GetLastError although the running call returns 0: something
+    the caller must hear of that is not an error of this call (a homing search that cannot
+    end).  It reads ``NAME returned 0: reason`` and, like any reason, lasts until the next
+    call."""
+    SESSION.note = reason
+
+
+def _note(name: str, reason: str) -> LastError:
+    c = SESSION.controllers.get(1)
+    return LastError(name, 0, reason, c.clock_ms() if c is not None else 0)
+
+
 def fail(code: int, reason: str) -> int:
     """Return ``code`` from a GT function with a reason (for non-exception refusals)."""
     raise _Refusal(code, reason)
@@ -163,6 +178,22 @@ class _Refusal(Exception):
     def __init__(self, code: int, reason: str) -> None:
         super().__init__(reason)
         self.code = code
+
+
+def advance(ctl: Any, name: str, rc: int) -> int:
+    """The host-call latency after a GT call (cycles may run, programs step): whatever they
+    raise is turned into a code and a reason like the call's own errors, never let out."""
+    try:
+        ctl.clock.on_call()
+    except Exception as e:
+        code = code_for(e)
+        if code == CMD_NO_RESPONSE:
+            log.error("%s: internal error in the cycle\n%s", name, traceback.format_exc())
+            _record(name, code, f"internal error in the emulator's cycle: {type(e).__name__}: {e}")
+        else:
+            _record(name, code, f"in the cycles after the call: {e}")
+        return rc or code
+    return rc
 
 
 def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
@@ -219,7 +250,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 rc = fn(*values, **extra)
             rc = 0 if rc is None else int(rc)
             if rc == 0:
-                SESSION.last = None  # GTE_GetLastError speaks of the most recent call only
+                # GTE_GetLastError speaks of the most recent call only: nothing, or a note
+                # of something the call found wrong without failing (note())
+                note_text, SESSION.note = SESSION.note, None
+                SESSION.last = None if note_text is None else _note(name, note_text)
             elif SESSION.last is before:  # no reason recorded by a call made inside
                 _record(name, rc, "no reason given")
         except _Refusal as r:
@@ -235,7 +269,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         if ctl is None and isinstance(core, int):
             ctl = SESSION.controllers.get(core)
         if ctl is not None:
-            ctl.clock.on_call()
+            rc = advance(ctl, name, rc)
         return rc
 
     @functools.wraps(fn)
@@ -245,7 +279,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     if name in READERS:  # the common shape answered up front (gtecat.gt.fast)
         slow = gt
-        gt = functools.wraps(slow)(fast_reader(name, slow, SESSION))
+        gt = functools.wraps(slow)(fast_reader(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]

@@ -2,7 +2,7 @@
 
 One binder per function (:func:`binder`) turns what the caller passed into
 checked values before the implementation runs, the same way for every
-function (issue "the API boundary"):
+function:
 
 * integer parameters take ints (numpy ints, ctypes integers, bools as C
   would); a float is accepted only where the C parameter is a ``double``;
@@ -13,7 +13,11 @@ function (issue "the API boundary"):
   ``create_string_buffer``, structures), so a write never goes past what that
   object owns; too small is refused with both sizes; a raw integer address is
   refused (its size cannot be known); Python containers (list, bytearray,
-  memoryview, numpy arrays, bytes for inputs) work too;
+  memoryview, numpy arrays, bytes for inputs) work too; memory of the other kind of
+  number (``byref(c_long())`` where the prototype says ``double *``, a ``c_double``
+  array for a ``long *``) is refused: C would not compile it, and the value would be
+  silently rounded; numpy arrays of Python objects and non-contiguous memoryviews are
+  refused (they are not C memory), numeric pointers take numpy arrays of numbers only;
 * optional pointers accept ``None``, ``0`` and NULL ctypes pointers (they
   reach the implementation as ``None``); a required one given NULL is refused;
 * parameter names as the manual writes them work as keywords;
@@ -55,6 +59,21 @@ def _struct_types() -> dict[str, type[ctypes.Structure]]:
     out["TSlaveInfo"] = TSlaveInfo
     out.update({cls.__name__: cls for cls in structures()})
     return out
+
+
+def shown(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` for a message, whatever the value: an integer of thousands of digits
+    (``repr`` refuses past 4,300), an object whose ``repr`` raises, a huge container."""
+    if isinstance(value, int) and value.bit_length() > 200:
+        digits = int(value.bit_length() * 0.30103) + 1
+        return f"{'-' if value < 0 else ''}<an integer of about {digits} digits>"
+    if isinstance(value, list | tuple) and len(value) > 8:
+        value = value[:8]
+    try:
+        r = repr(value)
+    except Exception:
+        r = f"<a {type(value).__name__}>"
+    return r if len(r) <= limit else r[: limit - 3] + "..."
 
 
 class Ref:
@@ -144,14 +163,14 @@ class Ref:
                 t[:n] = values
                 return
             if isinstance(t, np.ndarray):
-                flat = t.reshape(-1)
+                flat = _numeric_array(self.name, t)
                 if flat.size < n:
                     raise ParameterError(f"{self.name}: array of {flat.size} too small for {n}")
                 try:
                     flat[:n] = values
-                except (OverflowError, TypeError, ValueError) as e:  # narrower than the C type
+                except (OverflowError, TypeError, ValueError):  # narrower than the C type
                     raise ParameterError(
-                        f"{self.name}: {values[:4]} do not fit a {t.dtype} array: {e}"
+                        f"{self.name}: {shown(values[:4])} do not fit a {t.dtype} array"
                     ) from None
                 return
             raise ParameterError(f"{self.name}: a byte buffer cannot take numbers")
@@ -172,13 +191,13 @@ class Ref:
         if self.py is not None:
             t = self.py
             if isinstance(t, np.ndarray):
-                t = t.reshape(-1)
+                t = _numeric_array(self.name, t)
             if len(t) < n:
                 raise ParameterError(f"{self.name}: {len(t)} element(s), {n} needed")
             out = [t[i] for i in range(n)]
             for v in out:
                 if not isinstance(v, numbers.Real | np.bool_):  # ["x"], [None], [1j]
-                    raise ParameterError(f"{self.name}: holds {v!r}, not a number")
+                    raise ParameterError(f"{self.name}: holds {shown(v)}, not a number")
             return out
         if self.capacity() < n:
             raise ParameterError(f"{self.name}: {self.capacity()} element(s), {n} needed")
@@ -217,10 +236,15 @@ class Ref:
             return ctypes.string_at(self.addr, n)
         t = self.py
         if isinstance(t, list):
-            try:
-                return bytes(int(v) & 0xFF for v in t[:n])
-            except (TypeError, ValueError):
-                raise ParameterError(f"{self.name}: list holds non-integers") from None
+            head = t[:n]
+            if not all(isinstance(v, numbers.Integral) and -128 <= v <= 255 for v in head):
+                bad = next(
+                    v for v in head if not (isinstance(v, numbers.Integral) and -128 <= v <= 255)
+                )
+                raise ParameterError(
+                    f"{self.name}: the list holds {shown(bad)}; bytes are integers -128..255"
+                )
+            return bytes(int(v) & 0xFF for v in head)
         if isinstance(t, np.ndarray):
             return t.reshape(-1).view(np.uint8)[:n].tobytes()
         return bytes(memoryview(t).cast("B")[:n])
@@ -276,7 +300,7 @@ def fit(ctype: Any, value: Any) -> Any:
             _INT_BOUNDS[ctype] = bounds
         if not bounds[0] <= value <= bounds[1]:
             raise ParameterError(
-                f"the value {value} does not fit the {ctype.__name__} behind the pointer "
+                f"the value {shown(value)} does not fit the {ctype.__name__} behind the pointer "
                 f"({bounds[0]}..{bounds[1]}); pass the prototype's type"
             )
     return value
@@ -377,18 +401,89 @@ def resolve(name: str, value: Any) -> Ref:
             elem=type(value),
             keep=value,
         )
+    if isinstance(value, memoryview):
+        return Ref(name, py=_memoryview_array(name, value))
     if isinstance(value, np.ndarray):
+        if value.dtype.hasobject:
+            raise ParameterError(
+                f"{name}: a numpy array of dtype {value.dtype} holds Python objects, not C "
+                "memory; pass an array of numbers (or uint8 for bytes)"
+            )
         if not value.flags.c_contiguous:
             raise ParameterError(f"{name}: numpy array must be C-contiguous")
-        return Ref(name, py=value)
-    if isinstance(value, list | bytearray | memoryview | bytes):
+        return Ref(name, py=value.view(np.ndarray))  # a matrix or masked array: its memory
+    if isinstance(value, list | bytearray | bytes):
         return Ref(name, py=value)
     if isinstance(value, bool | int):
         raise ParameterError(
-            f"{name}={value!r}: a raw address is not accepted (its size cannot be checked); "
+            f"{name}={shown(value)}: a raw address is not accepted (its size cannot be checked); "
             "pass byref(x), pointer(x) or an array"
         )
     raise ParameterError(f"{name}: a {type(value).__name__} is not a pointer argument")
+
+
+def _memoryview_array(name: str, view: memoryview) -> np.ndarray:
+    """The memory of a memoryview as a numpy array over it (writable as the view is): one
+    way to read and write it whatever its shape and format; a view with gaps (``[::2]``)
+    or of Python objects is not C memory and is refused."""
+    if "O" in view.format:
+        raise ParameterError(f"{name}: a memoryview of Python objects is not C memory")
+    if not view.c_contiguous:
+        raise ParameterError(
+            f"{name}: the memoryview is not contiguous (a slice with a step); pass "
+            "bytes(view) for an input or a contiguous buffer"
+        )
+    try:
+        arr = np.asarray(view)
+    except (TypeError, ValueError, NotImplementedError):
+        raise ParameterError(
+            f"{name}: a memoryview of format {view.format!r} is not a plain buffer"
+        ) from None
+    if arr.dtype.hasobject:
+        raise ParameterError(f"{name}: a memoryview of Python objects is not C memory")
+    return arr
+
+
+_NUMERIC_KINDS = "biuf"  # numpy dtype kinds a numeric pointer takes
+
+
+def _numeric_array(name: str, arr: np.ndarray) -> np.ndarray:
+    if arr.dtype.kind not in _NUMERIC_KINDS:
+        raise ParameterError(
+            f"{name}: a numpy array of dtype {arr.dtype} does not hold numbers; pass an "
+            "integer or float array"
+        )
+    return arr.reshape(-1)
+
+
+def check_kind(p: Param, ref: Ref) -> Ref:
+    """Refuse ctypes memory of the other kind of number than the prototype's pointer (a
+    ``c_long`` where it says ``double *``, a ``c_double`` for a ``long *``): C would not
+    compile the call, and the value would be silently rounded or reinterpreted.  Integer
+    widths may differ (``c_long`` is 64 bits on Linux, the vendor's ``long`` 32); each
+    value is checked to fit when it is stored."""
+    elem = ref.elem
+    if (
+        ref.py is None
+        and isinstance(elem, type)
+        and issubclass(elem, _SIMPLE)
+        and elem._type_ not in _NOT_NUMERIC
+        and not p.is_struct
+        and not p.text
+        and p.ctype not in ("char", "unsigned char", "void")
+    ):
+        want_float = p.ctype in ("double", "float")
+        if (elem._type_ in _FLOAT_CODES) != want_float:
+            raise ParameterError(
+                f"{p.name}: points to {elem.__name__}, the prototype says {p.ctype} *; "
+                f"pass byref({'c_double' if want_float else 'c_long'}()) or an array of it"
+            )
+        if want_float and ctypes.sizeof(elem) != ctypes.sizeof(ctypes.c_double):
+            raise ParameterError(
+                f"{p.name}: points to {elem.__name__}, the prototype says double *; "
+                "pass byref(c_double()) or an array of it"
+            )
+    return ref
 
 
 # --- scalars --------------------------------------------------------------------------------------
@@ -403,17 +498,19 @@ def _integer(p: Param, value: Any) -> int:
     if isinstance(v, numbers.Integral):
         v = int(v)
     elif isinstance(v, float | np.floating):
-        raise ParameterError(f"{p.name}={value!r}: an integer is needed ({p.ctype}), not a float")
+        raise ParameterError(
+            f"{p.name}={shown(value)}: an integer is needed ({p.ctype}), not a float"
+        )
     else:
-        raise ParameterError(f"{p.name}={value!r}: an integer is needed ({p.ctype})")
+        raise ParameterError(f"{p.name}={shown(value)}: an integer is needed ({p.ctype})")
     _, lo, hi, _ = SCALARS[p.ctype]
     if p.mask:
         lo = min(lo, -(1 << 31))
         hi = max(hi, (1 << 32) - 1)
     if not lo <= v <= hi:
-        raise ParameterError(f"{p.name}={v} out of range {lo}..{hi} ({p.ctype})")
+        raise ParameterError(f"{p.name}={shown(v)} out of range {lo}..{hi} ({p.ctype})")
     if p.lo is not None and not p.lo <= v <= p.hi:  # type: ignore[operator]
-        raise ParameterError(f"{p.name}={v} out of range {p.lo:g}..{p.hi:g}")
+        raise ParameterError(f"{p.name}={shown(v)} out of range {p.lo:g}..{p.hi:g}")
     if p.mask and v < 0:
         v &= 0xFFFFFFFF
     return v
@@ -427,11 +524,11 @@ def _real(p: Param, value: Any) -> float:
         try:
             x = float(v)
         except (OverflowError, ValueError, TypeError):
-            raise ParameterError(f"{p.name}={value!r} is not a number") from None
+            raise ParameterError(f"{p.name}={shown(value)} is not a number") from None
     else:
-        raise ParameterError(f"{p.name}={value!r}: a number is needed (double)")
+        raise ParameterError(f"{p.name}={shown(value)}: a number is needed (double)")
     if not math.isfinite(x):
-        raise ParameterError(f"{p.name}={value!r} must be finite")
+        raise ParameterError(f"{p.name}={shown(value)} must be finite")
     if p.lo is not None and not p.lo <= x <= p.hi:  # type: ignore[operator]
         raise ParameterError(f"{p.name}={x:g} out of range {p.lo:g}..{p.hi:g}")
     return x
@@ -458,7 +555,7 @@ def _text(p: Param, value: Any) -> str:
         except UnicodeDecodeError:
             v = v.decode("gbk", "replace")  # Chinese Windows paths
     if not isinstance(v, str):
-        raise ParameterError(f"{p.name}={value!r}: text is needed (char *)")
+        raise ParameterError(f"{p.name}={shown(value)}: text is needed (char *)")
     if "\0" in v:
         v = v.split("\0", 1)[0]
     if len(v) > _TEXT_MAX:
@@ -500,7 +597,7 @@ def _pointer_converter(p: Param) -> Converter:
                 elem = obj._type_ if isinstance(obj, ctypes.Array) else type(obj)
                 if isinstance(elem, type) and issubclass(elem, ctypes.Array):
                     elem = _element_type(obj)
-                return Ref(name, addr, start + size - addr, elem, obj)
+                return check_kind(p, Ref(name, addr, start + size - addr, elem, obj))
         if _null(v):
             if optional:
                 return None
@@ -511,7 +608,7 @@ def _pointer_converter(p: Param) -> Converter:
                 f"{name}: a read-only {type(v).__name__} cannot take what the call writes; "
                 "pass a bytearray, a writable array or a ctypes object"
             )
-        return ref
+        return check_kind(p, ref)
 
     return conv
 
@@ -598,7 +695,7 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
                     extra[k] = v
                     continue
                 raise ParameterError(
-                    f"{proto.name} has no parameter {k!r} (it takes {', '.join(names)})"
+                    f"{proto.name} has no parameter {shown(k)} (it takes {', '.join(names)})"
                 )
             if values[i] is not _MISSING:
                 raise ParameterError(f"{proto.name}: {k} given twice")

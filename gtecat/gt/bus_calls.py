@@ -498,7 +498,8 @@ def GT_EcatSDOUpload(
 # --- emulator-only helpers ----------
 @gt_function
 def GTE_Wait(ctl: Controller, ms: float) -> int:
-    """Let ``ms`` of controller time pass, in any clock mode (DESIGN.md)."""
+    """Let ``ms`` of controller time pass, in any clock mode (virtual time runs, or the
+    realtime clock sleeps), so one script runs unchanged in every mode."""
     ctl.wait_ms(float(ms))
     return 0
 

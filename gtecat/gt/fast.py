@@ -1,4 +1,4 @@
-"""The GT fast path (issue 17 item 3): the common getters in a handful of Python calls.
+"""The GT fast path: the common getters in a handful of Python calls.
 
 A polling loop (``do { GT_GetSts(axis, &sts); } while (sts & 0x400);``) spends most of
 its wall time in the GT layer: the table binder (:mod:`gtecat.gt.args`) checks and
@@ -60,8 +60,14 @@ READERS: dict[str, tuple[Callable[[Any], Any], frozenset]] = {
 }
 
 
-def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[..., int]:
-    """``slow`` (the table-checked GT function) with the fast path in front of it."""
+def fast_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``slow`` (the table-checked GT function) with the fast path in front of it;
+    ``advance(ctl, name, rc)`` runs the call's host latency, catching what the cycle raises."""
     get, ctypes_ok = READERS[name]
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
     array_types: dict[type, bool] = {}
@@ -83,7 +89,7 @@ def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[.
             or extra
             or kw
             or ctl is None
-            or (count is not _NO and count != 1)
+            or (count is not _NO and (type(count) is not int or count != 1))
             or (pClock is not _NO and pClock is not None)
             or session.remote is not None
         ):
@@ -113,7 +119,7 @@ def fast_reader(name: str, slow: Callable[..., int], session: Any) -> Callable[.
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
         session.last = None
         if clock.mode is not _LOCKSTEP:
-            clock.on_call()
+            return advance(ctl, name, 0)
         return 0
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
@@ -129,6 +135,7 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
     layout is the protocol's (CALL head, int64 axis, int32 size + the element, int64
     count, int32 size of pClock), the reply is one block holding the element."""
     from ..native.protocol import CALL, PTR_NULL
+    from ._core import advance
 
     get, ctypes_ok = READERS[name]
     code = "d" if ctypes_ok is _DOUBLE else ("i" if long_size == 4 else "q")
@@ -154,8 +161,8 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
         except struct.error:  # a value the client's type cannot hold: the table decides
             return None
         session.last = None
-        if clock.mode is not _LOCKSTEP:
-            clock.on_call()
+        if clock.mode is not _LOCKSTEP and advance(ctl, name, 0) != 0:
+            return None  # the cycle failed: the table path answers with the reason
         return out
 
     return answer

@@ -108,6 +108,7 @@ from gtecat.drives.abort import SdoAbort
 from ..controller.axis import Axis, PdsState
 from ..controller.core import Controller
 from ..errors import CommandError, ParameterError
+from . import _core
 from ._core import check_range, gt_function, store
 from .axis_calls import ECAT_MODES, bus_axis
 
@@ -169,9 +170,11 @@ class _AxisHoming:
     answered: bool = False
     #: the last run's result, reported between runs (5 before any run)
     result: int = HOMING_FAILED
+    #: why the running search cannot end (the machine lacks its switch), None if it can
+    hint: str | None = None
 
     def begin(self) -> None:
-        self.active, self.answered = True, False
+        self.active, self.answered, self.hint = True, False, None
 
     def end(self, result: int) -> None:
         self.active = False
@@ -399,6 +402,9 @@ def start_homing(ctl: Controller, ax: Axis) -> None:
             f"axis {ax.number}: the drive did not start homing within {_START_TIMEOUT_MS:g} ms "
             f"of CW4 rising (statusword 0x{_statusword(ax):04X})"
         )
+    st.hint = _search_hint(ctl, ax)
+    if st.hint is not None:
+        ctl.log(f"Axis {ax.number}: {st.hint}")
 
 
 def stop_homing(ctl: Controller, ax: Axis) -> None:
@@ -409,12 +415,29 @@ def stop_homing(ctl: Controller, ax: Axis) -> None:
 
 
 def homing_status(ax: Axis) -> int:
-    """GT_GetEcatHomingStatus's value, 0, 3 or 5 (module docstring); the polling hot path."""
+    """GT_GetEcatHomingStatus's value, 0, 3 or 5 (module docstring); the polling hot path.
+    While a search that cannot end runs, GTE_GetLastError says why (a note, the call is 0)."""
     st = _STATE.get(ax)
     if st is None:
         _statusword(ax)  # 6041h must be mapped (return 1 naming it, entry 43)
         return HOMING_FAILED  # no run since the bus came up: not homed
+    if st.active and st.hint is not None:
+        _core.note(f"axis {ax.number}: {st.hint}")
     return HOMING_IN_PROGRESS if st.active else st.result
+
+
+def _search_hint(ctl: Controller, ax: Axis) -> str | None:
+    """What the emulated drive's search lacks in the machine description (None elsewhere)."""
+    from ..master.backends.emulated import EmulatedBackend
+
+    if not isinstance(ctl.backend, EmulatedBackend):
+        return None
+    try:
+        channel = ctl.backend.slaves[ax.io.slave].channel(ax.io.channel)
+    except (AttributeError, IndexError, KeyError):
+        return None
+    homing = getattr(channel, "homing", None)
+    return getattr(homing, "missing", None)
 
 
 def set_probe_function(ctl: Controller, ax: Axis, function: int) -> None:

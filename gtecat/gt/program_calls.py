@@ -62,6 +62,7 @@ from ..controller.core import Controller
 from ..errors import ParameterError
 from ..programs import image, mram, threads
 from ..programs.model import MAX_FUNCTIONS
+from ..programs.verify import ImageInvalid, verify
 from . import _core
 from ._core import fail, gt_function, store, store_array, store_bytes, struct_arg
 from .structs import TCompileInfo, TThreadSts, TVarInfo
@@ -207,6 +208,10 @@ def GT_Download(ctl: Controller, pFileName: str) -> int:
             f"{pFileName} holds {len(program.functions)} functions; a download holds at most "
             f"{MAX_FUNCTIONS} (entry 10)",
         )
+    try:
+        verify(program)
+    except ImageInvalid as e:
+        fail(7, f"{pFileName} cannot run: {e}")
     rt = runtime(ctl)
     assert rt is not None
     rt.download(program)

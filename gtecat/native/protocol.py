@@ -134,6 +134,15 @@ class FunctionPlan:
     #: CMD_DECLARED (:mod:`gtecat.gt.declared`)
     declared: bool = False
 
+    def null_refusal(self, args: list[Any]) -> str | None:
+        """Why the decoded ``args`` are refused before anything else (7, as the Python
+        binder says it: a required pointer given NULL), None when they are not; lets a
+        function that cannot travel still check its arguments first, as in Python."""
+        for a, v in zip(self.args, args, strict=False):
+            if a.param.pointer and not a.param.optional and v is None:
+                return f"{a.param.name} is NULL; this pointer is required"
+        return None
+
 
 def _kind(p: Param) -> Kind:
     if not p.pointer:

@@ -651,7 +651,10 @@ class Server:
             return code, f"{name} returned {code}: {why}"
         if not c.opened or plan.name in ("GT_Open", "GT_Close"):
             return self._open_close(c, dec, gtn, core, args)
-        if plan.unsupported:
+        if plan.unsupported:  # the arguments are checked first, as in Python
+            why = plan.null_refusal(args)
+            if why is not None:
+                return _core.CMD_PARAM, f"{plan.name} returned 7: {why}"
             return _core.CMD_ERROR, plan.unsupported
         fn = dec.fn_gtn if gtn else dec.fn_gt
         if fn is None:

@@ -81,7 +81,12 @@ class _Const:
 
     def text(self) -> str:
         if self.type is VarType.DOUBLE:
-            return f"{float(self.value):g}"
+            try:
+                return f"{float(self.value):g}"
+            except OverflowError:
+                return "a number beyond the double range"
+        if abs(self.value) >= 10**60:  # the parser keeps literals shorter than this
+            return "a number of more than 60 digits"  # pragma: no cover - folded results
         return str(self.value)
 
 
@@ -589,10 +594,13 @@ class _Compiler:
         """A constant, a variable or an array element; anything else is an error."""
         line = _line(node)
         kind = node.data if isinstance(node, Tree) else ""
-        if kind == "int_const":
-            return _CONST_PARSER(str(node.children[0]))
-        if kind == "float_const":
-            return _CONST_PARSER(str(node.children[0]))
+        if kind in ("int_const", "float_const"):
+            try:
+                return _CONST_PARSER(str(node.children[0]))
+            except ValueError as e:
+                raise _Error(
+                    line, f"constant {shown_literal(str(node.children[0]))}: {e}"
+                ) from None
         if kind == "name":
             name = str(node.children[0])
             if name in self.macros:
@@ -893,24 +901,46 @@ def c_value(p: Any, word: int) -> int:
 _INCDEC = "++ and -- are not supported: write `i = i + 1;` (10.4.2)"
 
 
+#: longest literal read: a program's words are 32 bits and its doubles 16.16, so a longer
+#: number is out of range anyway; reading it would cost time (``int()`` of 10**6 digits is
+#: quadratic, a ``Fraction`` of ``1e99999999`` builds a 100-million-digit integer)
+_MAX_DIGITS = 60
+_MAX_EXPONENT = 400
+
+
+def shown_literal(text: str) -> str:
+    return text if len(text) <= 24 else f"{text[:12]}...({len(text)} characters)"
+
+
 class _ConstParser:
-    """Number literals of the language -> :class:`_Const` (ValueError when not one)."""
+    """Number literals of the language -> :class:`_Const` (ValueError, with the reason, when
+    not one or beyond what a program word can hold)."""
 
     def __call__(self, text: str) -> _Const:
         t = text.strip()
         low = t.lower()
+        if len(low) > _MAX_DIGITS + 8:
+            raise ValueError(
+                f"more than {_MAX_DIGITS} digits; a program word holds 32 bits (int) or "
+                "16.16 fixed point (double)"
+            )
         if low.startswith("0x"):
             digits = low[2:].rstrip("ul")
             return _Const(int(digits, 16), VarType.INT, hex=True)
         if any(ch in low for ch in ".e") and not low.startswith("0x"):
             body = low.rstrip("f")
+            _, e, exponent = body.partition("e")
+            if e and exponent.lstrip("+-").isdigit() and abs(int(exponent)) > _MAX_EXPONENT:
+                raise ValueError(
+                    "the exponent is beyond the double range (16.16 fixed point in a program)"
+                )
             try:
                 return _Const(Fraction(body), VarType.DOUBLE)
             except (ValueError, ZeroDivisionError):
-                raise ValueError(text) from None
+                raise ValueError(f"{text} is not a number") from None
         digits = low.rstrip("ul")
         if not digits.isdigit():
-            raise ValueError(text)
+            raise ValueError(f"{text} is not a number")
         return _Const(int(digits, 10), VarType.INT)
 
 

@@ -19,7 +19,8 @@ a new process and a crash: ``GT_Open(mram=PATH)``, else ``GTECAT_MRAM``, else
 Every completed write replaces the file atomically (a temporary file beside it,
 written, flushed and fsync'ed, then renamed over the old one, then the directory
 fsync'ed), so a kill at any moment leaves either the old or the new contents, never a
-torn store.  A missing file reads as zeros.
+torn store; a temporary file a killed process left behind is removed at the next open.
+A missing file reads as zeros.
 
 File format 1 (little-endian): ``8s magic "GTEMRAM\\n"``, ``u16 format``, ``u16 words``
 (4096), ``u32 CRC-32 of the data``, then 4096 ``i16`` words.
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import os
 import struct
+import time
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -55,6 +57,7 @@ class MramStore:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
+        self.removed = remove_stale_temporaries(self.path)
 
     def read(self) -> list[int]:
         try:
@@ -96,6 +99,47 @@ class MramStore:
             except OSError:
                 pass
             raise MramError(f"cannot write the MRAM store {self.path}: {e.strerror or e}") from None
+
+
+def remove_stale_temporaries(path: Path) -> list[Path]:
+    """Remove the temporary files of writes that a killed process left beside ``path``
+    (``.NAME.<pid>.tmp``, see :meth:`MramStore.write`): the store itself was never torn
+    (the rename is atomic), but the leftovers would pile up.  A temporary of a process that
+    still runs is left alone (it may be writing now); on Windows, where no harmless
+    liveness test exists, one younger than a minute is.  Returns what was removed."""
+    prefix = f".{path.name}."
+    removed = []
+    try:
+        candidates = [p for p in path.parent.iterdir() if p.name.startswith(prefix)]
+    except OSError:
+        return removed
+    for p in candidates:
+        pid = p.name[len(prefix) :].removesuffix(".tmp")
+        if not p.name.endswith(".tmp") or not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        if _running(int(pid), p):
+            continue
+        try:
+            p.unlink()
+            removed.append(p)
+        except OSError:
+            pass
+    return removed
+
+
+def _running(pid: int, tmp: Path) -> bool:
+    if os.name == "nt":  # os.kill(pid, 0) would terminate the process there
+        try:
+            return time.time() - tmp.stat().st_mtime < 60
+        except OSError:
+            return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True  # another user's process (or a pid the OS cannot take): not ours to judge
+    return True
 
 
 def _fsync_dir(directory: Path) -> None:

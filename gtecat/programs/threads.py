@@ -44,6 +44,7 @@ returns non-zero (its code: 1, 7 ...), and the program's own faults (:class:`Fau
 from __future__ import annotations
 
 import ctypes
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from enum import IntEnum
@@ -67,6 +68,8 @@ from .model import (
     VarType,
 )
 
+log = logging.getLogger("gtecat.programs")
+
 DEFAULT_SPEED = 100.0  #: instructions per millisecond of controller time (10.2)
 GLOBAL_WORDS = 1024
 
@@ -79,6 +82,7 @@ class Fault(IntEnum):
     VALUE_OUT_OF_RANGE = 103  #: a GT function's double result beyond the 16.16 range
     PAGE_TAKEN = 104  #: GT_SetDataPage to a page another thread holds
     BAD_ARGUMENT = 7  #: a builtin's argument out of range (as a GT function's 7)
+    INTERNAL = 199  #: the emulator failed to run an instruction (a defect of ours; logged)
 
 
 class ProgramError(Exception):
@@ -412,6 +416,9 @@ class ProgramRuntime:
             self._fail(th, e.code, str(e))
         except ZeroDivisionError:
             self._fail(th, Fault.DIVISION_BY_ZERO, "division by zero")
+        except Exception as e:  # the image was verified at download; this is a defect of ours
+            log.error("motion program instruction %d failed", pc, exc_info=True)
+            self._fail(th, Fault.INTERNAL, f"internal error in the emulator: {e!r}")
 
     def _fail(self, th: Thread, code: int, reason: str) -> None:
         th.error = int(code)

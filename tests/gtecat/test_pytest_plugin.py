@@ -98,6 +98,7 @@ def project(tmp_path: Path) -> Path:
     folder = tmp_path / "project"
     folder.mkdir()
     (folder / "test_machine.py").write_text(TESTS)
+    (folder / "pytest.ini").write_text("[pytest]\ngtecat_eni = manual_fig5_2\n")
     return folder
 
 
@@ -121,7 +122,7 @@ def test_fixtures_and_a_failing_test_with_its_trace(project: Path) -> None:
     csv = (project / "traces" / traces[0]).read_text().splitlines()
     assert csv[0].startswith("time_ms,axis1.prf,axis1.enc") and len(csv) > 20
     # nothing in the working directory but what the user put there
-    assert user_files(project) == ["test_machine.py", "traces"]
+    assert user_files(project) == ["pytest.ini", "test_machine.py", "traces"]
 
 
 def test_without_the_option_no_trace_is_written(project: Path) -> None:
@@ -150,4 +151,4 @@ def test_ini_options_choose_the_bus(project: Path) -> None:
 def test_under_xdist_each_worker_and_test_has_its_own_files(project: Path) -> None:
     done = _pytest(project, "-n", "2", "--gtecat-trace")
     assert "5 passed" in done.stdout and "1 failed" in done.stdout, done.stdout + done.stderr
-    assert user_files(project) == ["test_machine.py"]
+    assert user_files(project) == ["pytest.ini", "test_machine.py"]

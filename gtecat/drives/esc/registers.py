@@ -74,6 +74,7 @@ from ..slave import AlState, AlStatusCode, VirtualSlave
 log = logging.getLogger(__name__)
 
 REGISTER_SPACE = 0x1000
+SM_FLOOR = 0x0F00  #: the lowest address an SM buffer may start at (digital I/O, 0F00h)
 MEMORY_SIZE = 0x10000
 N_FMMU = 8
 N_SM = 8
@@ -625,7 +626,12 @@ class Esc:
             key = (start, length, control, activate & SM_ACT_ENABLE)
             prev = old.get(n)
             pdi = Reg.SM0 + 8 * n + 7
-            if activate & SM_ACT_ENABLE and length:
+            # an SM buffer lies at the digital I/O registers (0F00h, TwinCAT's EL2008) or in
+            # the process memory (1000h on): one that would cover the configuration
+            # registers, or run past the memory, is not activated, so a master that wrote
+            # one cannot lock itself (or the next master) out of the FMMU and SM registers
+            usable = SM_FLOOR <= start and start + length <= MEMORY_SIZE
+            if activate & SM_ACT_ENABLE and length and usable:
                 if prev is not None and self._sm_keys[n] == key:
                     sm = prev
                     if sm.mailbox and not sm.ecat_writes:

@@ -1,4 +1,4 @@
-# ruff: noqa: E501  (the prototypes read like the vendor header, one per line)
+
 """Buffered commands of the interpolation FIFO and the G0 lines (vendor GTS / GTN headers):
 outputs, DAC values and limit switches changed where the path reaches them, the FIFO's
 remaining entries, the coordinate map base.

@@ -1,4 +1,4 @@
-# ruff: noqa: E501  (the prototypes read like the vendor header, one per line)
+
 """Extension IO modules: the GTS ``ExtMdl`` functions, their multi-card ``*Gts`` forms, the GTN
 cores' extension modules and gLink-II (vendor GTS / GTN headers, ``gtgl500.h``).
 

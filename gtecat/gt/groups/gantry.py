@@ -1,4 +1,4 @@
-# ruff: noqa: E501  (the prototypes read like the vendor header, one per line)
+
 """Gantry pairs (vendor GTS header): a slave axis driven with its master's command.
 
 Implemented by :mod:`gtecat.gt.gantry_calls` over the electronic gear.

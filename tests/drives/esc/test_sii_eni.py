@@ -13,6 +13,7 @@ from gtecat.drives.esc.sii import SmType, parse_sii
 from gtecat.drives.esc.sii_eni import product_name
 from gtecat.eni.model import Direction
 from gtecat.eni.reader import read_eni
+from tests.conftest import needs_fixture
 
 ROOT = Path(__file__).resolve().parents[3]
 TWINCAT = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
@@ -26,7 +27,7 @@ def sii_of(eni: Path) -> list:
 
 def test_beckhoff_terminals_get_their_own_sm_layout() -> None:
     if not TWINCAT.is_file():
-        pytest.skip(f"shared fixture {TWINCAT} not found")
+        pytest.skip(needs_fixture(TWINCAT.name))
     infos, chain = sii_of(TWINCAT)
     el2008, el4002, el1809 = infos[1], infos[2], infos[3]
     assert [(s.start, s.length, s.control, s.type) for s in el2008.sync_managers] == [
@@ -75,7 +76,7 @@ def test_a_googol_ini_states_no_wire_layout(tmp_path: Path) -> None:
     files = sorted(ini.glob("*")) if ini.is_dir() else []
     eni = next((f for f in files if f.suffix.lower() in (".eni", ".ini")), None)
     if eni is None:
-        pytest.skip("no Googol INI fixture")
+        pytest.skip(needs_fixture("a Googol INI Gecat.eni"))
     config = read_eni(eni)
     assert all(not s.sync_managers and s.mailbox_layout is None for s in config.slaves)
 
@@ -85,7 +86,7 @@ def test_a_googol_ini_drive_names_its_product_in_1008h() -> None:
     answers it in 1008h (an outside check read "gtecat virtual CiA-402 servo drive")."""
     eni = ROOT.parent / "shared" / "fixtures" / "googol" / "Gecat_DM3E_stepper.eni"
     if not eni.is_file():
-        pytest.skip(f"shared fixture {eni} not found")
+        pytest.skip(needs_fixture(eni.name))
     infos, chain = sii_of(eni)
     assert chain.escs[0].slave.od.upload(0x1008, 0) == b"DM3E_522_COE_"
     assert infos[0].name == "DM3E_522_COE_"

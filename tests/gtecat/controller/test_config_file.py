@@ -27,7 +27,7 @@ from gtecat.controller.config_file import (
 )
 from gtecat.controller.safety import StopInput
 from gtecat.controller.scale import Scale
-from tests.conftest import SHARED_FIXTURES
+from tests.conftest import SHARED_FIXTURES, needs_fixture
 
 DATA = Path(__file__).parent / "data"
 GTS400 = DATA / "gts400_4axis.cfg"
@@ -37,7 +37,7 @@ FIXTURES = ("smarthome_test.cfg", "coordinate_gtn_core1.cfg")
 def fixture_text(name: str) -> str:
     path = SHARED_FIXTURES / "googol" / name
     if not path.is_file():
-        pytest.skip(f"shared fixture {path} not found")
+        pytest.skip(needs_fixture(path.name))
     return path.read_text(encoding="ascii")
 
 
@@ -235,7 +235,7 @@ def mutate(lines: list[str], mutations) -> list[str]:
 def test_mutated_fixtures_parse_or_fail_with_file_and_line(name, mutations):
     path = SHARED_FIXTURES / "googol" / name
     if not path.is_file():
-        pytest.skip("shared fixtures not found")
+        pytest.skip(needs_fixture("the Googol configuration files"))
     text = "\n".join(mutate(path.read_text(encoding="ascii").splitlines(), mutations))
     try:
         parse_config(text, "mut.cfg")
@@ -301,7 +301,7 @@ def test_every_key_parses_to_its_value():
         ("[axis 1]\nspeed = 3\n", 2, "unknown key"),
         ("alarm = on\n", 1, "before any"),
         ("[motor 1]\n", 1, "not a section"),
-        ("[axis 0]\n", 1, ">= 1"),
+        ("[axis 0]\n", 1, "must be 1..32767"),
         ("[axis 1]\n[axis 1]\n", 2, "twice"),
         ("[axis 1]\nalarm = on\nalarm = off\n", 3, "twice"),
         ("[axis 1]\nprofile_scale = 1 2\n", 2, "alpha"),

@@ -42,7 +42,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from gtecat.gt import _core
-from gtecat.gt.args import _struct_types
+from gtecat.gt.args import _struct_types, shown
 from gtecat.gt.table import NO_CORE_TWINS, SAME_PARAM_TWINS, SCALARS, Param
 from tests.conftest import EXAMPLES
 from tests.gtecat.gt.conftest import bring_up
@@ -73,6 +73,14 @@ CONFIGS = [Path("servo.cfg"), Path("test.cfg")]  # copied into the scratch direc
 
 CTYPE = {k: getattr(ctypes, v[0]) for k, v in SCALARS.items()}
 ALT_CTYPE = {"long": ctypes.c_int32, "unsigned long": ctypes.c_uint32}
+#: memory of the other kind of number: refused (C would not compile it)
+OTHER_KIND = {"double": ctypes.c_long, "float": ctypes.c_long}
+#: every numpy dtype kind a caller may hand over (numbers, and what is not numbers)
+NP_DTYPES = [
+    np.int8, np.uint8, np.int16, np.uint16, np.int32, np.uint32, np.int64, np.uint64,
+    np.float16, np.float32, np.float64, np.complex128, np.bool_, ">i4", "<f8",
+    "S4", "U2", "V4", "M8[s]", "m8[s]", [("a", "<i4"), ("b", "<f8")],
+]  # fmt: skip
 NPTYPE = {
     "char": np.int8,
     "unsigned char": np.uint8,
@@ -192,6 +200,10 @@ def bad_int(data: Any, p: Param) -> Any:
                     (1,),
                     {},
                     np.array([1]),
+                    np.array(1),
+                    np.array([1], dtype=object),
+                    10**5000,  # beyond what int() and repr() convert to text by default
+                    -(10**5000),
                     np.float64(1.0),
                     ctypes.c_double(1.0),
                     1 + 0j,
@@ -239,6 +251,9 @@ def bad_real(data: Any, p: Param) -> Any:
         1 + 0j,
         object(),
         10**400,
+        10**5000,
+        np.array([1.0]),
+        np.array(1.0, dtype=object),
         np.float64("nan"),
         ctypes.c_double(math.inf),
     ]
@@ -328,7 +343,7 @@ def pointer_arg(data: Any, p: Param, n: int, good: bool) -> Arg:
         b = create_string_buffer(a * s)
         return Arg(b, f"create_string_buffer({a * s})", cap=numeric(ctypes.c_char, a * s))
     if form == "alt_type":
-        alt = ALT_CTYPE.get(p.ctype, ctypes.c_double if kind == "num" else ctypes.c_char)
+        alt = ALT_CTYPE.get(p.ctype, T if kind == "num" else ctypes.c_char)
         if kind == "struct":
             alt = c_ubyte * s  # same size, not the structure type
         g = Guard(alt * a, content, writable)
@@ -395,6 +410,32 @@ def pointer_arg(data: Any, p: Param, n: int, good: bool) -> Arg:
     if form == "narrow_numpy" and kind == "num":
         arr = np.zeros(a, dtype=np.int8)
         return Arg(arr, "np.int8 array (narrow)", cap=a)
+    if form == "other_kind" and kind == "num":
+        other = OTHER_KIND.get(p.ctype, ctypes.c_double)
+        g = Guard(other * a, content, writable)
+        return Arg(byref(g.obj), f"byref(({other.__name__}*{a})())", bad=True, guards=(g,))
+    if form == "object_numpy":
+        arr = np.zeros(max(a * s, 1), dtype=object)
+        return Arg(arr, "numpy array of objects", bad=True)
+    if form == "any_numpy":
+        dt = np.dtype(data.draw(st.sampled_from(NP_DTYPES), label="dtype"))
+        arr = np.zeros(max(a * s // dt.itemsize, 1) + data.draw(st.integers(0, 2)), dtype=dt)
+        if data.draw(st.booleans(), label="2-d"):
+            arr = arr.reshape(1, -1)
+        return Arg(arr, f"np.zeros({arr.shape}, {dt})")  # works or 7, never worse
+    if form == "strided_memoryview":
+        b = bytearray(2 * a * s + 2)
+        return Arg(memoryview(b)[::2], "memoryview(bytearray)[::2]", bad=True)
+    if form == "memoryview":
+        fmt = data.draw(st.sampled_from(["B", "b", "h", "i", "l", "q", "d", "f", "?", "c"]))
+        b = bytearray(a * 8 + 8)
+        mv = memoryview(b).cast(fmt) if fmt != "B" else memoryview(b)
+        if data.draw(st.booleans(), label="2-d"):
+            n = mv.nbytes // mv.itemsize
+            mv = mv[: n - n % 2].cast("B").cast(fmt, shape=[2, n // 2]) if n >= 2 else mv
+        return Arg(mv, f"memoryview format {fmt} shape {mv.shape}")  # works or 7
+    if form == "huge_ints":
+        return Arg([10**5000] * a, "list of 5001-digit integers")  # 7 where it is read
     if form == "list_of_text":
         return Arg(["x"] * a, "list of str", cap=a)
     if form == "junk":
@@ -431,6 +472,12 @@ BAD_FORMS = [
     "readonly_numpy",
     "strided_numpy",
     "narrow_numpy",
+    "other_kind",
+    "object_numpy",
+    "any_numpy",
+    "strided_memoryview",
+    "memoryview",
+    "huge_ints",
     "list_of_text",
     "junk",
 ]
@@ -465,8 +512,7 @@ def text_arg(data: Any, p: Param, good: bool) -> Arg:
 
 # --- one function --------------------------------------------------------------------------------
 def _short(v: Any) -> str:
-    r = repr(v)
-    return r if len(r) < 80 else r[:77] + "..."
+    return shown(v, 80)
 
 
 #: anything a caller might pass to a declared-only function (it looks at none of it)

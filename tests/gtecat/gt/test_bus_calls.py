@@ -245,15 +245,22 @@ def test_master_log_reads_like_the_real_one():
     assert "All slaves are in OP mode" in text
 
 
-def test_integer_pointers_for_double_results_get_rounded_values():
-    """C code passing ``long *`` where the prototype has ``double *`` gets the value
-    converted, not an internal error (ctypes refuses a float in a c_long)."""
+def test_pointers_of_the_other_kind_of_number_are_7_with_a_reason():
+    """``long *`` memory where the prototype has ``double *`` (and a ``c_double`` for a
+    ``long *``) is refused: C would not compile it, and the value would be rounded."""
     bring_up()
     gt.GTE_Controller().axis(1).prf_pos = 12.6
-    as_long, arr = ctypes.c_long(), (ctypes.c_long * 2)()
-    assert gt.GT_GetPrfPos(1, byref(as_long)) == 0, gt.GTE_GetLastError()
-    assert gt.GT_GetPrfPos(1, arr, 1) == 0
-    assert isinstance(as_long.value, int) and list(arr)[1] == 0
+    as_long, arr = ctypes.c_long(-5), (ctypes.c_long * 2)()
+    assert gt.GT_GetPrfPos(1, byref(as_long)) == 7  # the fast path's shape
+    assert "c_long" in gt.GTE_GetLastError() and "double" in gt.GTE_GetLastError()
+    assert gt.GT_GetPrfPos(1, arr, 1) == 7
+    assert gt.GT_GetSts(1, byref(ctypes.c_double())) == 7
+    assert gt.GT_GetPrfPos(1, byref(ctypes.c_float())) == 7
+    assert as_long.value == -5 and list(arr) == [0, 0]
+    pos = ctypes.c_double()
+    assert gt.GT_GetPrfPos(1, byref(pos)) == 0
+    sts = ctypes.c_int32()  # the vendor's 32-bit long: another width of integer is fine
+    assert gt.GT_GetSts(1, byref(sts)) == 0
 
 
 def test_emulator_only_helpers_refuse_other_backends_with_a_reason():

@@ -23,7 +23,7 @@ from gtecat.controller.digital_io import digital_io
 from gtecat.controller.smart_home import smart_home
 from gtecat.drives.machine import AxisMachine, MachineDescription
 from gtecat.native import header
-from tests.conftest import EXAMPLES, SHARED_FIXTURES
+from tests.conftest import EXAMPLES, SHARED_FIXTURES, needs_fixture
 
 from .conftest import bring_up
 
@@ -468,7 +468,7 @@ def test_the_vendor_test_cfg_wires_no_limit_to_axis_3_and_the_search_uses_its_te
     """smarthome_test.cfg (the vendor's MCT) sets axis 3's limits to index -1 (none)."""
     cfg = SHARED_FIXTURES / "googol" / "smarthome_test.cfg"
     if not cfg.is_file():
-        pytest.skip("shared fixtures not found")
+        pytest.skip(needs_fixture("the Googol configuration files"))
     m = MachineDescription({3: AxisMachine(negative_limit=-20000)})
     assert gt.GT_Open(card="gts:4", machine=m, clock="lockstep", log="") == 0
     assert gt.GT_LoadConfig(str(cfg)) == 0 and gt.GT_AxisOn(3) == 0

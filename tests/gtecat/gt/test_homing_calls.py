@@ -606,3 +606,22 @@ def test_a_second_run_reads_0_until_done_again(five_axes: Path) -> None:
     assert vendor_loop(range(1, 2)) == {1: [0, 3]}
     gt.GTE_Wait(50)
     assert machine_pos(1) == pytest.approx(16700, abs=1e-3)  # PL, first index left of it
+
+
+# --- a search the machine description cannot end ------------------------------------------------
+def test_a_search_for_a_switch_the_machine_lacks_says_so_in_the_log_and_when_polled() -> None:
+    """Method 24 (home switch, manual 5.2.2.2's table) on a machine without home_switch: the
+    drive searches (a real one would), and the master log and GTE_GetLastError after each
+    status poll say why it cannot end; a method that needs nothing says nothing."""
+    bring_up(machine=MachineDescription({1: AxisMachine(), 2: AxisMachine()}), log="")
+    start(1, 24)
+    log = "\n".join(gt.GTE_Controller().log.lines)
+    assert "Axis 1: homing method 24 searches for a home switch (home_switch)" in log
+    st = c_short()
+    assert gt.GT_GetEcatHomingStatus(1, byref(st)) == 0 and st.value == 0
+    reason = gt.GTE_GetLastError()
+    assert reason.startswith("GT_GetEcatHomingStatus returned 0: axis 1: homing method 24")
+    assert "machine description gives this axis none" in reason
+    assert gt.GT_GetPrfPos(1, byref(c_double())) == 0 and gt.GTE_GetLastError() == ""
+    start(2, 35)  # the current position: nothing to search for, no hint
+    assert gt.GT_GetEcatHomingStatus(2, byref(st)) == 0 and gt.GTE_GetLastError() == ""

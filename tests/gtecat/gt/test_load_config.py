@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
-from tests.conftest import SHARED_FIXTURES
+from tests.conftest import SHARED_FIXTURES, needs_fixture
 from tests.gtecat.controller.test_config_file import FIXTURES, GTS400, mutate
 
 from .conftest import bring_up
@@ -31,7 +31,7 @@ SMARTHOME, GTN = FIXTURES
 def fixture(name: str) -> Path:
     path = SHARED_FIXTURES / "googol" / name
     if not path.is_file():
-        pytest.skip(f"shared fixture {path} not found")
+        pytest.skip(needs_fixture(path.name))
     return path
 
 

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import SHARED_FIXTURES
+from tests.conftest import SHARED_FIXTURES, needs_fixture
 
 from .conftest import native_env, needs_cxx, tool_path
 
@@ -70,7 +70,7 @@ int main(int argc, char **argv)
 def seed_text() -> str:
     found = sorted(SEEDS.glob("002_*.txt"))
     if not found:
-        pytest.skip(f"seed 002 not found in {SEEDS}")
+        pytest.skip(needs_fixture("the user's C++ homing class (Motion.h/Motion.cpp)"))
     return found[0].read_text(encoding="utf-8")
 
 
@@ -118,7 +118,7 @@ def seed_program(tmp_path_factory, libgts):
 def vendor_cfg(wire_axis_3: bool) -> str:
     cfg = SHARED_FIXTURES / "googol" / "smarthome_test.cfg"
     if not cfg.is_file():
-        pytest.skip(f"vendor configuration not found at {cfg}")
+        pytest.skip(needs_fixture(cfg.name))
     text = cfg.read_text(encoding="utf-8")
     if wire_axis_3:
         a, b = text.index("[axis3]"), text.index("[axis4]")

@@ -148,8 +148,8 @@ def _case(plan, rnd: random.Random):
             py.append(b"x.cfg")
             wire.append(b"x.cfg\0")
             continue
-        if a.kind is protocol.Kind.OUT_ANY:
-            py.append((ctypes.c_ubyte * 8)())
+        if a.kind is protocol.Kind.OUT_ANY:  # memory of the prototype's type (7 otherwise)
+            py.append((_elem(a.param.ctype) * max(1, 8 // ctypes.sizeof(_elem(a.param.ctype))))())
             wire.append("?")
             continue
         n = scalars[a.count_arg] if a.count_arg >= 0 else a.count
@@ -184,3 +184,20 @@ def test_bad_input_gets_the_python_codes(served):
                 got, _, text = c.call("GTN_" + plan.name[3:], *wire, core=core)
                 assert got == want, ("GTN", core, plan.name, py, wire, text)
     assert checked > 1000
+
+
+def test_a_call_that_cannot_travel_checks_its_arguments_first_as_python_does(served):
+    """GT_Compile's TCompileInfo holds pointers (it cannot travel: 1), but a NULL where the
+    prototype needs memory is 7 first, the same code the Python function gives."""
+    _, address = served
+    c = WireClient(address)
+    assert c.call("GT_Open", 0, 1)[0] == 0
+    size = ctypes.sizeof(gt.TCompileInfo)
+    rc, _, text = c.call("GT_Compile", None, size)
+    assert rc == 7 and "pFileName is NULL" in text
+    rc, _, text = c.call("GT_Compile", b"prog.c\0", None)
+    assert rc == 7 and "pWrongInfo is NULL" in text
+    assert gt.GT_Compile("prog.c", None) == 7  # what Python says
+    rc, _, text = c.call("GT_Compile", b"prog.c\0", size)
+    assert rc == 1 and "pointers" in text
+    c.close()

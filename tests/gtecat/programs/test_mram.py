@@ -113,10 +113,25 @@ def test_a_process_killed_mid_write_never_leaves_a_torn_store(tmp_path, where):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     r = subprocess.run([sys.executable, "-c", child], env=env, capture_output=True, timeout=60)
     assert r.returncode == 9, r.stderr.decode()
-    words = mram.MramStore(p).read()  # never raises "damaged"
+    store = mram.MramStore(p)  # the next open removes the dead child's temporary file
+    words = store.read()  # never raises "damaged"
     assert words in ([1] * mram.WORDS, [2] * mram.WORDS)
     if where != "after_replace":
         assert words == [1] * mram.WORDS
+    assert [x.name for x in tmp_path.iterdir()] == ["m.mram"]
+
+
+def test_the_temporary_of_a_running_process_is_left_alone(tmp_path):
+    p = tmp_path / "m.mram"
+    mine = tmp_path / f".m.mram.{os.getpid()}.tmp"
+    parent = tmp_path / f".m.mram.{os.getppid()}.tmp"  # alive: it runs this test's runner
+    other = tmp_path / ".other.mram.1.tmp"
+    for f in (mine, parent, other):
+        f.write_bytes(b"x")
+    assert mram.MramStore(p).removed == []
+    assert sorted(x.name for x in tmp_path.iterdir()) == sorted(
+        [mine.name, parent.name, other.name]
+    )
 
 
 def test_default_path_is_beside_the_log():

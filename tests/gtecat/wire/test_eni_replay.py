@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import needs_fixture
 from tests.gtecat.wire.eni_replay import Replay, parse
 from tests.gtecat.wire.rawmaster import RawMaster, ServeProcess, veth_pair, why_not_root
 
@@ -72,7 +73,7 @@ def test_replay_reaches_op(eni: Path, tmp_path: Path) -> None:
 def test_the_twincat_fixture_is_replayed_as_written() -> None:
     eni = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
     if not eni.is_file():
-        pytest.skip(f"{eni} not found")
+        pytest.skip(needs_fixture(eni.name))
     config = parse(eni)
     el2008 = config.slaves[1]
     so = [c for c in el2008.reg if "SO" in c.transitions and c.ado == 0x0800]

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import needs_fixture
+
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
 TWINCAT = ROOT.parent / "shared" / "fixtures" / "eni" / "twincat_ek1100_el2008_el4002_el1809.xml"
@@ -359,7 +361,7 @@ def test_serve_reports_a_missing_interface_as_an_error(tmp_path: Path) -> None:
 @wire
 def test_bit_outputs_and_a_coupler_without_process_data(spare_veth, tmp_path: Path) -> None:
     if not TWINCAT.is_file():
-        pytest.skip(f"shared fixture {TWINCAT} not found")
+        pytest.skip(needs_fixture(TWINCAT.name))
     config, _ = expected_layout(TWINCAT)
     server = Server(TWINCAT, spare_veth[1], tmp_path / "stats.json")
     try:
