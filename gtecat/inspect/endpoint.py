@@ -1,0 +1,360 @@
+"""The inspection endpoint of a running controller: a Unix socket, JSON lines.
+
+Protocol (one JSON object per line, UTF-8, both ways; documented for other clients):
+
+    request   {"id": 7, "op": "snapshot", "args": []}
+    reply     {"id": 7, "ok": true, "result": ...}
+              {"id": 7, "ok": false, "error": "one line saying why"}
+
+``op`` is one of :data:`gtecat.inspect.ops.OPS` (``info``, ``layout``, ``snapshot``,
+``log``, ``jog``, ``trap``, ``stop``) or of :data:`gtecat.native.field.OPS` (the bus
+verbs' ``slaves``, ``pdos``, ``sdos``, ``states``, ``data``, ``reg_read``, ``sii``,
+``sdo_upload``/``sdo_download``, the field side, ``trace_start``/``trace_read``/
+``trace_stop``).  A connection's traces stop when it closes.  Requests on one connection
+are answered in order; any number of connections are served at once.
+
+**Never slowing the cycle.**  The socket is served by one daemon thread.  A request is not
+run there: it is queued and run by the thread that runs the cycles, at the start of the
+next cycle, before anything of that cycle (so between two cycles, exactly where an
+application's GT call runs; the vectorised axis bank sees it as one).  The cycle pays one
+attribute check when nothing is queued.  When no cycle runs for :data:`IDLE_S` (an
+application waiting for input, a lockstep test between steps, an idle ``gtecat
+controller``), the endpoint thread runs the request itself: with the lock every change of
+the controller takes (the controller server's call lock; the clock's lock in realtime),
+or, in-process in ``auto``/``lockstep``, after a handshake with the cycle so the two never
+overlap.  (A GT call the application makes in that instant, outside any cycle, is not
+held back: in those modes the GT layer takes no lock.  Requests are short.)
+
+**When it publishes.**  :func:`publish` is called by ``GT_Open`` (and so by ``gtecat
+controller``, which opens through it).  ``GTECAT_INSPECT=0`` turns it off; the pytest
+plugin sets that default for the test run (thousands of short controllers; a test that
+wants an endpoint sets ``GTECAT_INSPECT=1``).  Starting costs a thread and a socket.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import json
+import logging
+import os
+import socket
+import sys
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from . import runtime
+
+log = logging.getLogger(__name__)
+
+#: no cycle for this long: the endpoint thread answers itself (module docstring)
+IDLE_S = 0.05
+#: working counters kept (the panel's "last cycles")
+WKC_HISTORY = 32
+_COUNTER = itertools.count(1)
+
+
+@dataclass(eq=False)
+class _Request:
+    fn: Callable[[], Any]
+    done: threading.Event = field(default_factory=threading.Event)
+    claimed: bool = False
+    result: Any = None
+    error: BaseException | None = None
+
+
+class _Conn:
+    """What the operations of one connection run on (gtecat.native.field's Context
+    plus what the panel's operations need)."""
+
+    def __init__(self, endpoint: Endpoint) -> None:
+        from ..native.field import Context
+
+        self.field = Context(endpoint.ctl)
+        self.ctl = endpoint.ctl
+        self.kind = endpoint.kind
+        self.wkc_history = endpoint.wkc_history
+        self.homing: dict[int, int | None] = {}
+
+
+class Endpoint:
+    """One controller's endpoint (module docstring)."""
+
+    def __init__(self, ctl: Any, kind: str = "python", lock: Any = None) -> None:
+        self.ctl = ctl
+        self.kind = kind
+        #: the lock every change of ``ctl`` takes, when there is one (a controller server's)
+        self.lock = lock
+        self.id = ""
+        self.path: Path | None = None
+        self._pending: deque[_Request] = deque()
+        self._claim = threading.Lock()
+        self._gate = threading.Lock()
+        self._direct = False
+        self._in_cycle = False
+        self._wkc = [0] * WKC_HISTORY
+        self._wkc_i = 0
+        self._stop = threading.Event()
+        self._sock: socket.socket | None = None
+        self._threads: list[threading.Thread] = []
+        self._conns: set[socket.socket] = set()
+        clock = ctl.clock
+        self._run_cycle = clock._run_cycle
+        clock._run_cycle = self._cycle
+
+    # --- the cycle side --------------------------------------------------------------------
+    def _cycle(self) -> None:
+        self._in_cycle = True
+        while self._direct:  # the endpoint thread is answering itself: wait for it
+            self._in_cycle = False
+            with self._gate:
+                pass
+            self._in_cycle = True
+        try:
+            if self._pending:
+                self._serve_pending()
+            self._run_cycle()
+            m = self.ctl.master
+            if m is not None:
+                i = self._wkc_i
+                self._wkc[i % WKC_HISTORY] = m.last.wkc
+                self._wkc_i = i + 1
+        finally:
+            self._in_cycle = False
+
+    def _serve_pending(self) -> None:
+        while self._pending:
+            with self._claim:
+                if not self._pending:
+                    return
+                req = self._pending.popleft()
+                if req.claimed:
+                    continue
+                req.claimed = True
+            _run(req)
+
+    def wkc_history(self) -> list[int]:
+        i = self._wkc_i
+        n = min(i, WKC_HISTORY)
+        return [self._wkc[(i - n + k) % WKC_HISTORY] for k in range(n)]
+
+    # --- running one request ------------------------------------------------------------------
+    def execute(self, fn: Callable[[], Any]) -> Any:
+        """Run ``fn`` between two cycles (module docstring) and return its result."""
+        req = _Request(fn)
+        self._pending.append(req)
+        if not req.done.wait(IDLE_S):
+            with self._claim:
+                mine = not req.claimed
+                req.claimed = True
+            if mine:
+                self._direct_run(req)
+            req.done.wait()
+        if req.error is not None:
+            raise req.error
+        return req.result
+
+    def _direct_run(self, req: _Request) -> None:
+        lock = self.lock
+        clock = self.ctl.clock
+        if lock is None and clock.threaded:
+            lock = clock.lock
+        with lock if lock is not None else contextlib.nullcontext(), self._gate:
+            self._direct = True
+            try:
+                while self._in_cycle:
+                    time.sleep(0.0002)
+                _run(req)
+            finally:
+                self._direct = False
+
+    # --- the socket side -------------------------------------------------------------------------
+    def publish(self) -> Endpoint:
+        folder = runtime.checked_folder()
+        pid = os.getpid()
+        n = next(_COUNTER)
+        self.id = str(pid) if n == 1 else f"{pid}-{n}"
+        self.path = folder / f"{self.id}.sock"
+        runtime.remove(self.path)
+        s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        old = os.umask(0o177)
+        try:
+            s.bind(str(self.path))
+        finally:
+            os.umask(old)
+        os.chmod(self.path, 0o600)
+        s.listen(16)
+        self._sock = s
+        o = self.ctl.options
+        meta = {
+            "pid": pid,
+            "kind": self.kind,
+            "program": " ".join(sys.argv) or sys.executable,
+            "eni": str(Path(str(o.eni)).resolve()) if o.eni else "",
+            "clock": str(o.clock),
+            "backend": str(o.backend),
+            "started": time.time(),
+        }
+        tmp = self.path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(meta), encoding="utf-8")
+        os.chmod(tmp, 0o600)
+        tmp.replace(self.path.with_suffix(".json"))
+        t = threading.Thread(target=self._accept, name="gtecat-inspect", daemon=True)
+        t.start()
+        self._threads.append(t)
+        return self
+
+    def close(self) -> None:
+        """Stop serving, remove the files, give the clock its own cycle back."""
+        self._stop.set()
+        if self.ctl.clock._run_cycle == self._cycle:
+            self.ctl.clock._run_cycle = self._run_cycle
+        if self._sock is not None:
+            with contextlib.suppress(OSError):
+                self._sock.shutdown(socket.SHUT_RDWR)
+            self._sock.close()
+            self._sock = None
+        for c in list(self._conns):
+            with contextlib.suppress(OSError):
+                c.shutdown(socket.SHUT_RDWR)
+        if self.path is not None:
+            runtime.remove(self.path)
+        while self._pending:  # nobody runs cycles any more: answer what waits
+            req = self._pending.popleft()
+            req.error = ConnectionError("the controller closed")
+            req.done.set()
+
+    def _accept(self) -> None:
+        sock = self._sock
+        while not self._stop.is_set() and sock is not None:
+            try:
+                conn, _ = sock.accept()
+            except OSError:
+                return
+            self._conns.add(conn)
+            t = threading.Thread(
+                target=self._serve, args=(conn,), name="gtecat-inspect-conn", daemon=True
+            )
+            t.start()
+
+    def _serve(self, conn: socket.socket) -> None:
+        ctx = _Conn(self)
+        try:
+            with conn, conn.makefile("rb") as rf, conn.makefile("wb") as wf:
+                for line in rf:
+                    if self._stop.is_set():
+                        return
+                    reply = self._answer(ctx, line)
+                    wf.write(json.dumps(reply, separators=(",", ":")).encode() + b"\n")
+                    wf.flush()
+        except (OSError, ValueError):
+            pass
+        finally:
+            self._conns.discard(conn)
+            if ctx.field.traces:
+                with contextlib.suppress(Exception):
+                    self.execute(ctx.field.stop_traces)
+
+    def _answer(self, ctx: _Conn, line: bytes) -> dict[str, Any]:
+        rid = None
+        try:
+            msg = json.loads(line)
+            if not isinstance(msg, dict):
+                raise ValueError("a request is a JSON object")
+            rid = msg.get("id")
+            op = str(msg.get("op", ""))
+            args = msg.get("args") or []
+            if not isinstance(args, list):
+                raise ValueError("args is a list")
+            return {"id": rid, "ok": True, "result": self.request(ctx, op, args)}
+        except Exception as e:  # one line back, never a dead endpoint
+            text = str(e) if not isinstance(e, KeyError) else f"no such key {e}"
+            return {"id": rid, "ok": False, "error": text or type(e).__name__}
+
+    def request(self, ctx: _Conn, op: str, args: list[Any]) -> Any:
+        from ..errors import ParameterError
+        from ..native import field
+        from . import ops
+
+        if op == "data" and len(args) > 1 and int(args[1] or 0) > 0:
+            # let the cycles pass here, not inside one: read after them
+            self._wait_cycles(int(args[1]))
+            args = [args[0], 0]
+        fn = ops.OPS.get(op)
+        if fn is not None:
+            return self.execute(lambda: fn(ctx, *args))
+        if op in field.OPS:
+            return self.execute(lambda: field.run(ctx.field, op, args))
+        known = sorted({*ops.OPS, *field.OPS})
+        raise ParameterError(f"no operation {op!r} (there are {', '.join(known)})")
+
+    def _wait_cycles(self, n: int) -> None:
+        clock = self.ctl.clock
+        target = clock.cycles + n
+        deadline = time.monotonic() + max(1.0, n * clock.cycle_ns / 1e9 * 4)
+        while clock.cycles < target and time.monotonic() < deadline:
+            time.sleep(0.001)
+
+
+def _run(req: _Request) -> None:
+    try:
+        req.result = req.fn()
+    except BaseException as e:
+        req.error = e
+    finally:
+        req.done.set()
+
+
+# --- publishing ---------------------------------------------------------------------------------
+_PUBLISHED: dict[int, Endpoint] = {}  # id(controller) -> its endpoint
+#: what this process is (``gtecat controller`` says "controller") and the lock its changes take
+KIND = "python"
+LOCK: Any = None
+
+
+def enabled() -> bool:
+    return os.environ.get("GTECAT_INSPECT", "1").strip().lower() not in ("0", "no", "off", "false")
+
+
+def publish(ctl: Any) -> Endpoint | None:
+    """Publish ``ctl``'s endpoint (unless ``GTECAT_INSPECT=0``); a folder that cannot be
+    used is one warning, never a failed GT_Open."""
+    if not enabled() or id(ctl) in _PUBLISHED:
+        return _PUBLISHED.get(id(ctl))
+    ep = Endpoint(ctl, KIND, LOCK)
+    try:
+        ep.publish()
+    except Exception as e:
+        ep.close()
+        log.warning("gtecat: no inspection endpoint: %s", e)
+        return None
+    _PUBLISHED[id(ctl)] = ep
+    return ep
+
+
+def unpublish(ctl: Any) -> None:
+    ep = _PUBLISHED.pop(id(ctl), None)
+    if ep is not None:
+        ep.close()
+
+
+def published(ctl: Any) -> Endpoint | None:
+    return _PUBLISHED.get(id(ctl))
+
+
+def _close_all() -> None:
+    for ep in list(_PUBLISHED.values()):
+        ep.close()
+    _PUBLISHED.clear()
+
+
+import atexit  # noqa: E402  (the files go with the process, whatever way it ends normally)
+
+atexit.register(_close_all)
+
+__all__ = ["IDLE_S", "Endpoint", "enabled", "publish", "published", "unpublish"]
