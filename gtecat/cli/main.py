@@ -33,6 +33,8 @@ COMMANDS = (
     "controller_cmd",
     "lib_cmd",
     "compile_cmd",
+    "ps_cmd",
+    "panel_cmd",
 )
 
 
