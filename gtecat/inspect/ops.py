@@ -105,7 +105,27 @@ def layout(ctx: Any) -> dict[str, Any]:
     ]
     doc["status_bits"] = {str(int(f).bit_length() - 1): f.name for f in AxisStatus}
     doc["emulated"] = _emulated(ctx.ctl)
+    doc["cycle_ns"] = ctx.ctl.clock.cycle_ns
+    doc.update(_names())
     return doc
+
+
+def _names() -> dict[str, Any]:
+    """Bit and state names the page shows (one table each, the recorder's and CiA 402's)."""
+    from drives.cia402 import STATE_PATTERN
+
+    from ..controller.recorder import CW_BITS, DI_BITS, MODE_NAMES, SW_BITS
+
+    return {
+        "sw_bits": {str(k): v for k, v in SW_BITS.items()},
+        "cw_bits": {str(k): v for k, v in CW_BITS.items()},
+        "di_bits": {str(k): v for k, v in DI_BITS.items()},
+        "mode_names": {str(k): v for k, v in MODE_NAMES.items()},
+        "states_402": [
+            [s.name.replace("_", " ").lower(), mask, value]
+            for s, (mask, value) in STATE_PATTERN.items()
+        ],
+    }
 
 
 def _emulated(ctl: Any) -> bool:
@@ -152,18 +172,15 @@ def snapshot(ctx: Any) -> dict[str, Any]:
 
 
 def _homing(ctx: Any, n: int, res: Any) -> int | None:
-    """GT_GetEcatHomingStatus's value (0, 3, 5) for an axis the bank does not run; a banked
-    axis is in CSP with no homing run (its last value is kept)."""
-    if res.bank is not None:
-        return ctx.homing.get(n)
-    from ..gt.homing_calls import homing_status
+    """GT_GetEcatHomingStatus's value (0 homing, 3 homed, 5 not homed or failed), read
+    from the homing run's own record: the axis object itself is not touched (the bank may
+    be running it)."""
+    from ..gt.homing_calls import HOMING_FAILED, HOMING_IN_PROGRESS, _STATE
 
-    try:
-        v = homing_status(ctl_axis(ctx.ctl, n))
-    except Exception:  # 6041h not mapped: no homing status
-        v = None
-    ctx.homing[n] = v
-    return v
+    st = _STATE.get(ctx.ctl.axes.get(n))
+    if st is None:
+        return HOMING_FAILED  # no run since the bus came up: not homed
+    return HOMING_IN_PROGRESS if st.active else int(st.result)
 
 
 def ctl_axis(ctl: Any, n: int) -> Any:
