@@ -7,7 +7,8 @@ fresh bus and stops it when done; ``--backend pysoem --iface NIC`` talks to a re
 ``--controller ADDR`` (or ``GTECAT_CONTROLLER``) reads and changes a running controller's
 bus; ``--attach ID`` (or, with no file named, the only gtecat running: a Python application
 after ``GT_Open``, a ``gtecat controller``) reads and changes that one's, as IgH's
-``ethercat`` tool reads the running master. What a verb asks of the bus is :class:`gtecat.controller.inspect.BusView` either way.
+``ethercat`` tool reads the running master. What a verb asks of the bus is
+:class:`gtecat.controller.inspect.BusView` either way.
 """
 
 from __future__ import annotations

@@ -85,9 +85,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         import aiohttp  # noqa: F401
     except ImportError:
-        raise ParameterError(
-            "gtecat panel needs aiohttp: pip install 'gtecat[panel]'"
-        ) from None
+        raise ParameterError("gtecat panel needs aiohttp: pip install 'gtecat[panel]'") from None
     from ..inspect import panel, runtime
 
     if args.eni:

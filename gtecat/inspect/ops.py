@@ -175,7 +175,7 @@ def _homing(ctx: Any, n: int, res: Any) -> int | None:
     """GT_GetEcatHomingStatus's value (0 homing, 3 homed, 5 not homed or failed), read
     from the homing run's own record: the axis object itself is not touched (the bank may
     be running it)."""
-    from ..gt.homing_calls import HOMING_FAILED, HOMING_IN_PROGRESS, _STATE
+    from ..gt.homing_calls import _STATE, HOMING_FAILED, HOMING_IN_PROGRESS
 
     st = _STATE.get(ctx.ctl.axes.get(n))
     if st is None:
@@ -234,12 +234,10 @@ def jog(ctx: Any, axis: int, vel: float, acc: float = 0.1, dec: float = 0.1) -> 
 
 
 @_op
-def trap(
-    ctx: Any, axis: int, pos: int, vel: float, acc: float = 0.1, dec: float = 0.1
-) -> None:
+def trap(ctx: Any, axis: int, pos: int, vel: float, acc: float = 0.1, dec: float = 0.1) -> None:
     """GT_PrfTrap, GT_SetTrapPrm, GT_SetPos, GT_SetVel, GT_Update: a point-to-point move."""
-    from ..controller.profile import PrfMode
     from ..controller.motion.trap import TrapParams
+    from ..controller.profile import PrfMode
 
     res = _resources(ctx, axis)
     moving = res.profile.mode == PrfMode.TRAP and not res.profile.planner.done

@@ -118,7 +118,9 @@ def make_app(state: PanelState) -> Any:
             return web.Response(status=404, text="no scope running\n")
         data = await asyncio.to_thread(_call, state, state.command, "trace_read", tid, 0)
         lines = [",".join(["time_ms", *data["names"]])]
-        lines += [",".join(f"{v:.6g}" if i else f"{v:.3f}" for i, v in enumerate(r)) for r in data["rows"]]
+        lines += [
+            ",".join(f"{v:.6g}" if i else f"{v:.3f}" for i, v in enumerate(r)) for r in data["rows"]
+        ]
         return web.Response(text="\n".join(lines) + "\n", content_type="text/csv")
 
     async def ws(request: web.Request) -> web.WebSocketResponse:
@@ -184,7 +186,9 @@ def _browser_request(state: PanelState, text: str) -> dict[str, Any]:
         return {"type": "reply", "id": rid, "ok": False, "error": str(e) or type(e).__name__}
 
 
-def _sdo_write(state: PanelState, slave: int, index: int, sub: int, text: str, type_name: str) -> Any:
+def _sdo_write(
+    state: PanelState, slave: int, index: int, sub: int, text: str, type_name: str
+) -> Any:
     from ..cli.bus_cmd import FROM_DICTIONARY, _encode
 
     kind = FROM_DICTIONARY.get(str(type_name))
@@ -268,9 +272,7 @@ def poll_loop(state: PanelState) -> None:
         state.stop.wait(max(0.0, next_t - time.monotonic()))
 
 
-def serve(
-    socket_path: str, *, control: bool, port: int, title: str, ready: Any = None
-) -> None:
+def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any = None) -> None:
     """Run the panel until interrupted; ``ready(url)`` is called once it listens."""
     from aiohttp import web
 
