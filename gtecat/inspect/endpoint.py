@@ -13,11 +13,13 @@ verbs' ``slaves``, ``pdos``, ``sdos``, ``states``, ``data``, ``reg_read``, ``sii
 ``trace_stop``).  A connection's traces stop when it closes.  Requests on one connection
 are answered in order; any number of connections are served at once.
 
-**Never slowing the cycle.**  The socket is served by one daemon thread.  A request is not
+**Never slowing the cycle.**  Nothing runs in the cycle while nobody is attached.  The
+socket is served by one daemon thread per connection.  A request is not
 run there: it is queued and run by the thread that runs the cycles, at the start of the
 next cycle, before anything of that cycle (so between two cycles, exactly where an
-application's GT call runs; the vectorised axis bank sees it as one).  The cycle pays one
-attribute check when nothing is queued.  When no cycle runs for :data:`IDLE_S` (an
+application's GT call runs; the vectorised axis bank sees it as one).  While a connection
+is open the cycle pays a few attribute checks when nothing is queued.  When no cycle runs
+for :data:`IDLE_S` (an
 application waiting for input, a lockstep test between steps, an idle ``gtecat
 controller``), the endpoint thread runs the request itself: with the lock every change of
 the controller takes (the controller server's call lock; the clock's lock in realtime),
@@ -53,9 +55,7 @@ from . import runtime
 log = logging.getLogger(__name__)
 
 #: no cycle for this long: the endpoint thread answers itself (module docstring)
-IDLE_S = 0.05
-#: working counters kept (the panel's "last cycles")
-WKC_HISTORY = 32
+IDLE_S = 0.02
 _COUNTER = itertools.count(1)
 
 
@@ -78,7 +78,6 @@ class _Conn:
         self.field = Context(endpoint.ctl)
         self.ctl = endpoint.ctl
         self.kind = endpoint.kind
-        self.wkc_history = endpoint.wkc_history
         self.homing: dict[int, int | None] = {}
 
 
@@ -95,37 +94,41 @@ class Endpoint:
         self._pending: deque[_Request] = deque()
         self._claim = threading.Lock()
         self._gate = threading.Lock()
-        self._direct = False
-        self._in_cycle = False
-        self._wkc = [0] * WKC_HISTORY
-        self._wkc_i = 0
+        self._flags = [False, False]  # [a cycle runs, the endpoint thread answers itself]
         self._stop = threading.Event()
         self._sock: socket.socket | None = None
         self._threads: list[threading.Thread] = []
         self._conns: set[socket.socket] = set()
-        clock = ctl.clock
-        self._run_cycle = clock._run_cycle
-        clock._run_cycle = self._cycle
+        self._run_cycle = ctl.clock._run_cycle
+        self._watchers = 0  # open connections: the cycle is wrapped only while one is open
+        self._watch_lock = threading.Lock()
+        self._cycle = self._make_cycle()
 
     # --- the cycle side --------------------------------------------------------------------
-    def _cycle(self) -> None:
-        self._in_cycle = True
-        while self._direct:  # the endpoint thread is answering itself: wait for it
-            self._in_cycle = False
-            with self._gate:
-                pass
-            self._in_cycle = True
-        try:
-            if self._pending:
-                self._serve_pending()
-            self._run_cycle()
-            m = self.ctl.master
-            if m is not None:
-                i = self._wkc_i
-                self._wkc[i % WKC_HISTORY] = m.last.wkc
-                self._wkc_i = i + 1
-        finally:
-            self._in_cycle = False
+    def _make_cycle(self) -> Callable[[], None]:
+        """The clock's cycle with the queue served first (a closure: the fewest operations
+        per cycle; ``flags`` = [a cycle runs, the endpoint thread answers itself])."""
+        run = self._run_cycle
+        pending = self._pending
+        flags = self._flags
+        gate = self._gate
+        serve = self._serve_pending
+
+        def cycle() -> None:
+            flags[0] = True
+            while flags[1]:  # the endpoint thread is answering itself: wait for it
+                flags[0] = False
+                with gate:
+                    pass
+                flags[0] = True
+            try:
+                if pending:
+                    serve()
+                run()
+            finally:
+                flags[0] = False
+
+        return cycle
 
     def _serve_pending(self) -> None:
         while self._pending:
@@ -138,10 +141,15 @@ class Endpoint:
                 req.claimed = True
             _run(req)
 
-    def wkc_history(self) -> list[int]:
-        i = self._wkc_i
-        n = min(i, WKC_HISTORY)
-        return [self._wkc[(i - n + k) % WKC_HISTORY] for k in range(n)]
+    def _watch(self, delta: int) -> None:
+        """Wrap the clock's cycle while a connection is open; nobody watching costs nothing."""
+        with self._watch_lock:
+            self._watchers += delta
+            clock = self.ctl.clock
+            if self._watchers > 0 and not self._stop.is_set():
+                clock._run_cycle = self._cycle
+            elif clock._run_cycle == self._cycle:
+                clock._run_cycle = self._run_cycle
 
     # --- running one request ------------------------------------------------------------------
     def execute(self, fn: Callable[[], Any]) -> Any:
@@ -164,14 +172,15 @@ class Endpoint:
         clock = self.ctl.clock
         if lock is None and clock.threaded:
             lock = clock.lock
+        flags = self._flags
         with lock if lock is not None else contextlib.nullcontext(), self._gate:
-            self._direct = True
+            flags[1] = True
             try:
-                while self._in_cycle:
+                while flags[0]:
                     time.sleep(0.0002)
-                _run(req)
+                _run(req, in_cycle=False)
             finally:
-                self._direct = False
+                flags[1] = False
 
     # --- the socket side -------------------------------------------------------------------------
     def publish(self) -> Endpoint:
@@ -244,14 +253,18 @@ class Endpoint:
 
     def _serve(self, conn: socket.socket) -> None:
         ctx = _Conn(self)
+        self._watch(+1)
         try:
             with conn, conn.makefile("rb") as rf, conn.makefile("wb") as wf:
                 for line in rf:
                     if self._stop.is_set():
                         return
+                    t0 = time.thread_time_ns()
                     reply = self._answer(ctx, line)
                     wf.write(json.dumps(reply, separators=(",", ":")).encode() + b"\n")
                     wf.flush()
+                    COST[0] += 1
+                    COST[1] += time.thread_time_ns() - t0
         except (OSError, ValueError):
             pass
         finally:
@@ -259,6 +272,7 @@ class Endpoint:
             if ctx.field.traces:
                 with contextlib.suppress(Exception):
                     self.execute(ctx.field.stop_traces)
+            self._watch(-1)
 
     def _answer(self, ctx: _Conn, line: bytes) -> dict[str, Any]:
         rid = None
@@ -301,13 +315,23 @@ class Endpoint:
             time.sleep(0.001)
 
 
-def _run(req: _Request) -> None:
+def _run(req: _Request, in_cycle: bool = True) -> None:
+    """Run a request; in the cycle's thread its CPU time is counted here (in the
+    endpoint's thread the whole request is counted around it)."""
+    t0 = time.thread_time_ns() if in_cycle else 0
     try:
         req.result = req.fn()
     except BaseException as e:
         req.error = e
     finally:
+        if in_cycle:
+            COST[1] += time.thread_time_ns() - t0
         req.done.set()
+
+
+#: [requests answered, CPU ns this process spent on them: reading, running, answering];
+#: what watching costs the application (tools/bench_panel.py reports it)
+COST = [0, 0]
 
 
 # --- publishing ---------------------------------------------------------------------------------

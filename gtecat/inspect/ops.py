@@ -9,7 +9,8 @@ every few tens of milliseconds and the few commands it may send:
   in the GT raw image (the ``gtecat map --json`` document, plus each entry's type), the
   axes, the names of the GT status bits; asked once;
 * :func:`snapshot` - the process image bytes, every slave's AL state and status code, the
-  working counter of the last cycles, and per axis what the GT readers return (planned and
+  last cycle's working counter and the count of short ones (every cycle's, kept by the
+  master), and per axis what the GT readers return (planned and
   encoder positions, velocity, following error, ``GT_GetSts``); asked at the page's rate.
   It reads what the master and the axis resources hold (the bank-aware readers, so a
   vectorised axis is not released by being looked at);
@@ -160,7 +161,7 @@ def snapshot(ctx: Any) -> dict[str, Any]:
         "image": m.image.buffer.tobytes().hex(),
         "states": [int(s) for s in m.states],
         "codes": [int(c) for c in m._codes],
-        "wkc": ctx.wkc_history(),
+        "wkc": int(m.last.wkc),
         "expected": int(m.last.expected),
         "wkc_errors": int(m.wkc_errors),
         "lost_frames": int(getattr(stats, "lost_frames", 0) or 0),

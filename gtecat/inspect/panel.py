@@ -37,7 +37,7 @@ from .client import Attached
 from .ops import CONTROL
 
 #: snapshots per second sent to the browsers
-RATE_HZ = 30
+RATE_HZ = 25
 #: what a browser may ask without --control
 READ_OPS = frozenset(
     {"info", "layout", "log", "slaves", "pdos", "sdos", "sdo_upload", "sdo_entry", "data"}

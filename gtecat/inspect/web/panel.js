@@ -7,7 +7,7 @@ const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"
   "#17becf", "#7f7f7f", "#bcbd22", "#393b79", "#ad494a"];
 const S = {
   layout: null, snap: null, control: false, bytes: new Uint8Array(0), snaps: 0, rateT0: 0,
-  entries: [], axisCards: {}, ioBits: [], logStart: 0, odRows: [],
+  entries: [], axisCards: {}, wkcs: [], ioBits: [], logStart: 0, odRows: [],
   scope: {names: [], rows: [], paused: false, window: 2000, running: false},
 };
 window.gtecat = S;
@@ -180,7 +180,8 @@ function onSnap(s) {
   if (S.bytes.length !== n) S.bytes = new Uint8Array(n);
   for (let i = 0; i < n; i++) S.bytes[i] = parseInt(h.substr(2 * i, 2), 16);
   $("time").textContent = s.t_ms.toFixed(0); $("cycles").textContent = s.cycles;
-  $("wkc").textContent = s.wkc.slice(-12).join(" "); $("wkc-expected").textContent = s.expected;
+  S.wkcs.push(s.wkc); if (S.wkcs.length > 12) S.wkcs.shift();
+  $("wkc").textContent = S.wkcs.join(" "); $("wkc-expected").textContent = s.expected;
   $("wkc-errors").textContent = s.wkc_errors; $("lost").textContent = s.lost_frames;
   $("bus-error").textContent = s.error || "";
   const rows = $("slaves").tBodies[0].rows;
