@@ -13,6 +13,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import threading
+import time
 
 from ..errors import BusError, ParameterError
 from . import output
@@ -38,9 +40,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--machine", help="machine description TOML (with --eni)")
     p.add_argument(
         "--clock",
-        default="realtime",
-        choices=("realtime", "auto"),
-        help="clock of the bus --eni brings up (default realtime)",
+        default="paced",
+        choices=("paced", "realtime"),
+        help="with --eni: paced (default: controller time follows the wall clock in 10 ms "
+        "steps, the cycles of each step run at once: light on the CPU) or realtime (a cycle "
+        "thread on the wall clock, every cycle on time)",
     )
     p.add_argument("--control", action="store_true", help="allow changing the machine")
     p.add_argument("--port", type=int, default=0, help="TCP port on 127.0.0.1 (0: any free)")
@@ -56,7 +60,8 @@ def _host(args: argparse.Namespace) -> str:
 
     os.environ["GTECAT_INSPECT"] = "1"  # the panel reads it through its endpoint
     log = os.environ.get("GTECAT_LOG", "")
-    rc = gt.GT_Open(eni=args.eni, machine=args.machine, clock=args.clock, log=log)
+    clock = "realtime" if args.clock == "realtime" else "auto"
+    rc = gt.GT_Open(eni=args.eni, machine=args.machine, clock=clock, log=log)
     if rc:
         raise BusError(f"GT_Open returned {rc}: {gt.GTE_GetLastError()}")
     for call in (gt.GT_Reset, gt.GT_InitEcatComm):
@@ -81,6 +86,31 @@ def _host(args: argparse.Namespace) -> str:
     return str(ep.path)
 
 
+def _pacer() -> threading.Event:
+    """Let controller time follow the wall clock in steps of ``STEP_MS`` (the panel's own
+    bus, ``--clock paced``): one thread, one wake-up per step.  Returns its stop event."""
+    from .. import gt
+
+    stop = threading.Event()
+
+    def pace() -> None:
+        t0 = time.monotonic()
+        ctl = gt.GTE_Controller()
+        ms0 = ctl.clock.now_ns / 1e6
+        while not stop.is_set():
+            behind = (time.monotonic() - t0) * 1000 - (ctl.clock.now_ns / 1e6 - ms0)
+            if behind >= STEP_MS:
+                gt.GTE_Wait(int(behind))
+            stop.wait(STEP_MS / 1000)
+
+    threading.Thread(target=pace, name="gtecat-panel-pace", daemon=True).start()
+    return stop
+
+
+#: controller milliseconds per step of the paced clock
+STEP_MS = 10
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         import aiohttp  # noqa: F401
@@ -88,9 +118,12 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("gtecat panel needs aiohttp: pip install 'gtecat[panel]'") from None
     from ..inspect import panel, runtime
 
+    pace = None
     if args.eni:
         path = _host(args)
         title = f"{os.path.basename(args.eni)} (this process)"
+        if args.clock == "paced":
+            pace = _pacer()
     else:
         info = runtime.find(args.attach)
         if info is None:
@@ -112,4 +145,7 @@ def run(args: argparse.Namespace) -> int:
     except OSError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
+    finally:
+        if pace is not None:
+            pace.set()
     return 0

@@ -56,7 +56,8 @@ class PanelState:
     poll: Attached
     command: Attached
     title: str = ""
-    clients: set[Any] = field(default_factory=set)
+    #: each browser's websocket -> its queue of messages (one writer each keeps the order)
+    clients: dict[Any, asyncio.Queue[str]] = field(default_factory=dict)
     last: str = ""  # the last snapshot message sent (a new browser starts with it)
     scope_id: int | None = None
     scope_names: list[str] = field(default_factory=list)
@@ -134,17 +135,25 @@ def make_app(state: PanelState) -> Any:
             "scope": {"names": state.scope_names} if state.scope_id is not None else None,
         }
         await sock.send_str(json.dumps(hello))
+        queue: asyncio.Queue[str] = asyncio.Queue()
         if state.last:
-            await sock.send_str(state.last)
-        state.clients.add(sock)
+            queue.put_nowait(state.last)
+        state.clients[sock] = queue
+
+        async def writer() -> None:
+            while True:
+                await sock.send_str(await queue.get())
+
+        task = asyncio.create_task(writer())
         try:
             async for msg in sock:
                 if msg.type != WSMsgType.TEXT:
                     continue
                 reply = await asyncio.to_thread(_browser_request, state, msg.data)
-                await sock.send_str(json.dumps(reply))
+                queue.put_nowait(json.dumps(reply))
         finally:
-            state.clients.discard(sock)
+            state.clients.pop(sock, None)
+            task.cancel()
         return sock
 
     app = web.Application(middlewares=[guard])
@@ -238,16 +247,12 @@ _LOOP: asyncio.AbstractEventLoop | None = None
 
 
 def _broadcast(state: PanelState, text: str) -> None:
+    """``text`` to every browser, in order (each browser's queue, from any thread)."""
     loop = _LOOP
     if loop is None:
         return
-    for sock in list(state.clients):
-        asyncio.run_coroutine_threadsafe(_send(sock, text), loop)
-
-
-async def _send(sock: Any, text: str) -> None:
-    with contextlib.suppress(Exception):
-        await sock.send_str(text)
+    for queue in list(state.clients.values()):
+        loop.call_soon_threadsafe(queue.put_nowait, text)
 
 
 def poll_loop(state: PanelState) -> None:

@@ -160,7 +160,7 @@ def test_the_page_shows_the_slaves_of_figure_5_2_in_op(browser: Any) -> None:
 
 def test_a_trap_move_updates_the_position(browser: Any, endpoint_conn: client.Attached) -> None:
     card = browser.find_element("css selector", '[data-axis="2"]')
-    for cls, value in (("trap-pos", "3000"), ("trap-vel", "5"), ("trap-acc", "0.5")):
+    for cls, value in (("trap-pos", "3000"), ("trap-vel", "2"), ("trap-acc", "0.5")):
         box = card.find_element("class name", cls)
         box.clear()
         box.send_keys(value)
@@ -171,7 +171,7 @@ def test_a_trap_move_updates_the_position(browser: Any, endpoint_conn: client.At
     card.find_element("class name", "trap-go").click()
     _wait(lambda: _axis_value(browser, 2, "prf") == "3000", 10, "the target")
     shown = browser.execute_script("clearInterval(tick); return [...seen]")
-    assert len([v for v in shown if v not in ("0", "3000")]) >= 5  # it moved on the page
+    assert len([v for v in shown if v not in ("0", "3000")]) >= 3  # it moved on the page
     _shot(browser, "panel-axes.png", "axes")
     row = dict(
         zip(
