@@ -12,6 +12,7 @@ import itertools
 import json
 import socket
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +51,17 @@ class Attached:
         if not reply.get("ok"):
             raise BusError(str(reply.get("error", "refused")))
         return reply.get("result")
+
+    def subscribe(self, op: str, period_ms: float, *args: Any) -> Iterator[Any]:
+        """Results of ``op`` pushed every ``period_ms`` (the connection is then the
+        subscription's: no other request on it)."""
+        self.call("subscribe", op, period_ms, *args)
+        self._sock.settimeout(None)
+        for line in self._rf:
+            msg = json.loads(line)
+            if msg.get("push") == op:
+                yield msg["result"]
+        raise BusError("the running gtecat closed the connection (it has ended)")
 
     # the face gtecat.native.client.Field expects of a connection
     def field(self, op: str, *args: Any) -> Any:

@@ -6,6 +6,11 @@ Protocol (one JSON object per line, UTF-8, both ways; documented for other clien
     reply     {"id": 7, "ok": true, "result": ...}
               {"id": 7, "ok": false, "error": "one line saying why"}
 
+``{"op": "subscribe", "args": ["snapshot", 40]}`` answers ``{"id": null, "ok": true,
+"result": null}`` and then, every 40 ms until the client closes, pushes
+``{"push": "snapshot", "result": ...}``: the result is made and sent by the cycle's thread
+between two cycles, the connection's thread only keeps time (the cheapest way to watch).
+
 ``op`` is one of :data:`gtecat.inspect.ops.OPS` (``info``, ``layout``, ``snapshot``,
 ``log``, ``jog``, ``trap``, ``stop``) or of :data:`gtecat.native.field.OPS` (the bus
 verbs' ``slaves``, ``pdos``, ``sdos``, ``states``, ``data``, ``reg_read``, ``sii``,
@@ -40,6 +45,7 @@ import itertools
 import json
 import logging
 import os
+import select
 import socket
 import sys
 import threading
@@ -260,11 +266,15 @@ class Endpoint:
                     if self._stop.is_set():
                         return
                     t0 = time.thread_time_ns()
-                    reply = self._answer(ctx, line)
+                    sub = _subscription(line)
+                    reply = self._answer(ctx, line) if sub is None else self._check_sub(sub)
                     wf.write(json.dumps(reply, separators=(",", ":")).encode() + b"\n")
                     wf.flush()
                     COST[0] += 1
                     COST[1] += time.thread_time_ns() - t0
+                    if sub is not None and reply["ok"]:
+                        self._push(ctx, conn, sub)  # until the client goes
+                        return
         except (OSError, ValueError):
             pass
         finally:
@@ -273,6 +283,60 @@ class Endpoint:
                 with contextlib.suppress(Exception):
                     self.execute(ctx.field.stop_traces)
             self._watch(-1)
+
+    # --- subscriptions: the cycle's thread sends, the connection's thread only keeps time ------
+    @staticmethod
+    def _check_sub(sub: tuple[str, float, list[Any]]) -> dict[str, Any]:
+        from . import ops
+
+        op, period, _ = sub
+        if op not in ops.PUSHABLE:
+            return {"id": None, "ok": False, "error": f"{op!r} cannot be subscribed to"}
+        if not 0.005 <= period <= 10:
+            return {"id": None, "ok": False, "error": "period_ms must be 5..10000"}
+        return {"id": None, "ok": True, "result": None}
+
+    def _push(self, ctx: _Conn, conn: socket.socket, sub: tuple[str, float, list[Any]]) -> None:
+        """Every ``period``: one line ``{"push": op, "result": ...}`` (module docstring)."""
+        from . import ops
+
+        op, period, args = sub
+        fn = ops.OPS[op]
+        last: _Request | None = None
+        late: list[bytes] = []  # what the cycle's thread could not send at once
+
+        def push() -> None:
+            data = json.dumps({"push": op, "result": fn(ctx, *args)}, separators=(",", ":"))
+            data = data.encode() + b"\n"
+            if late:
+                late.append(data)
+                return
+            try:
+                n = conn.send(data, socket.MSG_DONTWAIT)
+            except BlockingIOError:
+                n = 0
+            if n < len(data):
+                late.append(data[n:])
+
+        while not self._stop.is_set():
+            t0 = time.thread_time_ns()
+            if late:
+                conn.sendall(b"".join(late))
+                late.clear()
+            if last is not None and not last.done.is_set():
+                with self._claim:
+                    mine = not last.claimed
+                    last.claimed = True
+                if mine:  # no cycle ran for a whole period: the application is idle
+                    self._direct_run(last)
+            if last is None or last.done.is_set():
+                last = _Request(push)
+                self._pending.append(last)
+            COST[1] += time.thread_time_ns() - t0
+            readable, _, _ = select.select([conn], [], [], period)
+            if readable and not conn.recv(4096, socket.MSG_DONTWAIT):
+                return  # the client has gone
+            COST[0] += 1
 
     def _answer(self, ctx: _Conn, line: bytes) -> dict[str, Any]:
         rid = None
@@ -313,6 +377,20 @@ class Endpoint:
         deadline = time.monotonic() + max(1.0, n * clock.cycle_ns / 1e9 * 4)
         while clock.cycles < target and time.monotonic() < deadline:
             time.sleep(0.001)
+
+
+def _subscription(line: bytes) -> tuple[str, float, list[Any]] | None:
+    """``{"op": "subscribe", "args": [OP, PERIOD_MS, *ARGS]}`` -> (OP, seconds, ARGS)."""
+    if b'"subscribe"' not in line:
+        return None
+    try:
+        msg = json.loads(line)
+        if msg.get("op") != "subscribe":
+            return None
+        op, period, *args = msg.get("args") or []
+        return str(op), float(period) / 1000, list(args)
+    except (ValueError, TypeError, AttributeError):
+        return None
 
 
 def _run(req: _Request, in_cycle: bool = True) -> None:

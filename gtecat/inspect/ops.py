@@ -38,6 +38,10 @@ CONTROL = frozenset(
 )
 
 
+#: operations a client may subscribe to (pushed at a period, gtecat.inspect.endpoint)
+PUSHABLE = frozenset({"snapshot"})
+
+
 def _op(fn: Op) -> Op:
     OPS[fn.__name__] = fn
     return fn

@@ -2,12 +2,12 @@
 
 One aiohttp application (HTTP and websockets in one dependency, the ``panel`` extra)
 serves the page (plain HTML/CSS/JS shipped in the package: no CDN, works offline) and one
-websocket per browser.  The server holds two connections to the endpoint: one polls
-:func:`~gtecat.inspect.ops.snapshot` (and the scope's trace) at :data:`RATE_HZ` and sends
-each result to every browser, the other runs what a browser asks (layout, log, object
-dictionary, and with ``--control`` the commands of :data:`gtecat.inspect.ops.CONTROL`).
-Any number of browsers share the one poll, so a second browser costs the watched
-application nothing more.
+websocket per browser.  The server holds three connections to the endpoint: one receives
+:func:`~gtecat.inspect.ops.snapshot` pushed at :data:`RATE_HZ` and sends each to every
+browser, one reads the scope's recorder while it runs, one runs what a browser asks
+(layout, log, object dictionary, and with ``--control`` the commands of
+:data:`gtecat.inspect.ops.CONTROL`).  Any number of browsers share the one subscription,
+so a second browser costs the watched application nothing more.
 
 Security: binds 127.0.0.1; every request (page, assets, websocket) must carry the random
 token of the printed URL (``?token=``) or the cookie the page sets, else 403; the Host
@@ -27,7 +27,6 @@ import contextlib
 import json
 import secrets
 import threading
-import time
 from dataclasses import dataclass, field
 from importlib import resources
 from typing import Any
@@ -53,8 +52,9 @@ class PanelState:
 
     token: str
     control: bool
-    poll: Attached
-    command: Attached
+    poll: Attached  # the snapshots' subscription
+    command: Attached  # what browsers ask
+    scope: Attached  # the scope's recorder (its traces belong to this connection)
     title: str = ""
     #: each browser's websocket -> its queue of messages (one writer each keeps the order)
     clients: dict[Any, asyncio.Queue[str]] = field(default_factory=dict)
@@ -117,7 +117,7 @@ def make_app(state: PanelState) -> Any:
         tid = state.scope_id
         if tid is None:
             return web.Response(status=404, text="no scope running\n")
-        data = await asyncio.to_thread(_call, state, state.command, "trace_read", tid, 0)
+        data = await asyncio.to_thread(_call, state, state.scope, "trace_read", tid, 0)
         lines = [",".join(["time_ms", *data["names"]])]
         lines += [
             ",".join(f"{v:.6g}" if i else f"{v:.3f}" for i, v in enumerate(r)) for r in data["rows"]
@@ -213,8 +213,8 @@ def _scope_start(state: PanelState, names: list[str]) -> dict[str, Any]:
     with state.lock:
         if state.scope_id is not None:
             with contextlib.suppress(BusError):
-                state.poll.call("trace_stop", state.scope_id)
-        state.scope_id = state.poll.call("trace_start", names)
+                state.scope.call("trace_stop", state.scope_id)
+        state.scope_id = state.scope.call("trace_start", names)
         state.scope_names = names
         state.scope_next = 0
         state.scope_rows = 0
@@ -229,13 +229,13 @@ def _scope_stop(state: PanelState) -> dict[str, Any]:
         if tid is not None:
             _scope_read(state, tid)  # the last rows first
             with contextlib.suppress(BusError):
-                state.poll.call("trace_stop", tid)
+                state.scope.call("trace_stop", tid)
     _broadcast(state, json.dumps({"type": "scope_stop", "rows": state.scope_rows}))
     return {"rows": state.scope_rows}
 
 
 def _scope_read(state: PanelState, tid: int) -> None:
-    data = state.poll.call("trace_read", tid, state.scope_next)
+    data = state.scope.call("trace_read", tid, state.scope_next)
     rows = data["rows"]
     if rows:
         state.scope_next += len(rows)
@@ -256,25 +256,31 @@ def _broadcast(state: PanelState, text: str) -> None:
 
 
 def poll_loop(state: PanelState) -> None:
-    """Snapshots (and new scope rows) at RATE_HZ, to every browser."""
+    """Snapshots pushed by the endpoint at RATE_HZ, to every browser."""
+    try:
+        for snap in state.poll.subscribe("snapshot", 1000 / RATE_HZ):
+            if state.stop.is_set():
+                return
+            snap["type"] = "snap"
+            state.last = json.dumps(snap, separators=(",", ":"))
+            state.polls += 1
+            _broadcast(state, state.last)
+    except (BusError, OSError, ValueError) as e:
+        _broadcast(state, json.dumps({"type": "gone", "error": str(e)}))
+        state.stop.set()
+
+
+def scope_loop(state: PanelState) -> None:
+    """The scope's new rows, while it runs, at RATE_HZ (from the recorder in the watched
+    process: every cycle's sample)."""
     period = 1.0 / RATE_HZ
-    next_t = time.monotonic()
-    while not state.stop.is_set():
+    while not state.stop.wait(period):
         try:
             with state.lock:
-                snap = state.poll.call("snapshot")
                 if state.scope_id is not None:
                     _scope_read(state, state.scope_id)
-        except BusError as e:
-            _broadcast(state, json.dumps({"type": "gone", "error": str(e)}))
-            state.stop.set()
+        except BusError:
             return
-        snap["type"] = "snap"
-        state.last = json.dumps(snap, separators=(",", ":"))
-        state.polls += 1
-        _broadcast(state, state.last)
-        next_t = max(next_t + period, time.monotonic())
-        state.stop.wait(max(0.0, next_t - time.monotonic()))
 
 
 def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any = None) -> None:
@@ -287,6 +293,7 @@ def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any 
         control=control,
         poll=Attached(socket_path),
         command=Attached(socket_path),
+        scope=Attached(socket_path),
         title=title,
     )
 
@@ -298,8 +305,8 @@ def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any 
         site = web.TCPSite(runner, "127.0.0.1", port)
         await site.start()
         real_port = site._server.sockets[0].getsockname()[1]  # type: ignore[union-attr]
-        thread = threading.Thread(target=poll_loop, args=(state,), daemon=True)
-        thread.start()
+        for loop in (poll_loop, scope_loop):
+            threading.Thread(target=loop, args=(state,), daemon=True).start()
         url = f"http://127.0.0.1:{real_port}/?token={state.token}"
         if ready is not None:
             ready(url)
@@ -317,8 +324,8 @@ def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any 
     finally:
         _LOOP = None
         state.stop.set()
-        state.poll.close()
-        state.command.close()
+        for conn in (state.poll, state.command, state.scope):
+            conn.close()
 
 
 __all__ = ["RATE_HZ", "PanelState", "make_app", "serve"]
