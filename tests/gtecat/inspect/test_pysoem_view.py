@@ -15,7 +15,7 @@ from ..master.backends.test_pysoem_backend import bring_up, make_bus
 
 
 def _ctl() -> SimpleNamespace:
-    master, backend, devices, lines = make_bus()
+    master, backend, devices, _lines = make_bus()
     backend.check_interval_ms = 1
     bring_up(master)
     clock = Clock(lambda: None, cycle_ns=1_000_000)
@@ -51,8 +51,9 @@ def test_snapshot_and_layout_on_pysoem_read_the_master() -> None:
     assert len(bytes.fromhex(snap["image"])) == lay["outputs_bytes"] + lay["inputs_bytes"]
 
 
-def test_a_state_asked_on_pysoem_holds_against_soem_recovery() -> None:
-    """SOEM's check_and_recover walks every slave back to OP; a held one it leaves."""
+def test_a_state_asked_on_pysoem_holds_until_op_is_asked() -> None:
+    """The master keeps the request (Master.held, which SOEM's check_and_recover also
+    skips) and OP brings the slave back with the master's own walk."""
     ctl = _ctl()
     rows = BusView(ctl).states(2, "PREOP")
     assert rows[0]["state"] == "PREOP" and ctl.master.held == {2: AlState.PREOP}
