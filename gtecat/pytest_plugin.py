@@ -93,6 +93,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    # a test run opens many short controllers: none publishes an inspection endpoint (gtecat
+    # ps, gtecat panel) unless the run asks for it with GTECAT_INSPECT=1
+    import os
+
+    os.environ.setdefault("GTECAT_INSPECT", "0")
     config.addinivalue_line(
         "markers",
         "gtecat(eni=None, machine=None, clock='lockstep'): the bus the gtecat fixtures build",

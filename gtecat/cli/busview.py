@@ -5,7 +5,10 @@ controller's, one slave at a time by ``-p POSITION``.
 ``--iface`` mean what they mean for ``GT_Open``. On the emulated bus every command starts a
 fresh bus and stops it when done; ``--backend pysoem --iface NIC`` talks to a real one;
 ``--controller ADDR`` (or ``GTECAT_CONTROLLER``) reads and changes a running controller's
-bus. What a verb asks of the bus is :class:`gtecat.controller.inspect.BusView` either way.
+bus; ``--attach ID`` (or, with no file named, the only gtecat running: a Python application
+after ``GT_Open``, a ``gtecat controller``) reads and changes that one's, as IgH's
+``ethercat`` tool reads the running master. What a verb asks of the bus is
+:class:`gtecat.controller.inspect.BusView` either way.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -35,6 +39,12 @@ def add_bus_options(p: argparse.ArgumentParser, *, position: bool = True) -> Non
         output.add_position(p)
     output.add_json(p)
     add_controller(p)
+    p.add_argument(
+        "--attach",
+        metavar="ID",
+        help="show the bus of this running gtecat (`gtecat ps` lists them; default: the only "
+        "one running, unless a configuration file is named)",
+    )
 
 
 def add_controller(p: argparse.ArgumentParser) -> None:
@@ -129,6 +139,34 @@ def controller_address(args: argparse.Namespace) -> str | None:
     return env if env and env != "local" else None
 
 
+def attach(args: argparse.Namespace) -> Any:
+    """The running gtecat a verb reads (``--attach ID``, else the only one running when no
+    configuration file is named and ``GTECAT_INSPECT`` is not 0), as a view whose methods
+    are :class:`~gtecat.controller.inspect.BusView`'s; None: the verb opens a bus of its own
+    (and says so in one line when it looked for a running one)."""
+    wanted = getattr(args, "attach", None)
+    if not wanted:
+        if getattr(args, "eni", None) or getattr(args, "file", None):
+            return None
+        if getattr(args, "backend", None) or getattr(args, "iface", None):
+            return None
+        from ..inspect.endpoint import enabled
+
+        if not enabled():
+            return None
+    from ..inspect import client
+
+    found = client.connect(wanted)
+    if found is None:
+        print(
+            "note: no running gtecat to attach to (`gtecat ps`); this command opens a bus "
+            "of its own",
+            file=sys.stderr,
+        )
+        return None
+    return client.attach_view(found[1])
+
+
 @contextlib.contextmanager
 def bus_view(args: argparse.Namespace) -> Iterator[Any]:
     """``with bus_view(args) as bus:`` the bus a verb shows: a bus of its own (a
@@ -139,6 +177,11 @@ def bus_view(args: argparse.Namespace) -> Iterator[Any]:
         from ..native.client import Field
 
         with Field.connect(address) as f:
+            yield f
+        return
+    attached = attach(args)
+    if attached is not None:
+        with attached as f:
             yield f
         return
     from ..controller.inspect import view

@@ -37,6 +37,8 @@ COMMANDS = (
     "sweep_cmd",
     "api_cmd",
     "scan_cmd",
+    "ps_cmd",
+    "panel_cmd",
 )
 
 

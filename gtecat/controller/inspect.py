@@ -288,10 +288,20 @@ class BusView:
         for pos in self.positions(position):
             before, _ = backend.state(pos)
             refused = None
-            if want is not None:
+            running = self.master._op_requested
+            if want == AlState.OP and running:
+                # back to OP on a running bus: the master's own walk, InitCmds included
+                self.master.held.pop(pos, None)
+                self.master.recover()
+                st, code = backend.state(pos)
+                if st != AlState.OP:
+                    refused = al_code_name(int(code)) if code else f"stays in {st.name}"
+            elif want is not None:
                 code = int(backend.request_state(pos, want))
                 if code:
                     refused = al_code_name(code)
+                if running:  # the request holds: recovery leaves the slave there until OP
+                    self.master.held[pos] = want  # is asked (gtecat.master.bus.Master.held)
             state, code = backend.state(pos)
             rows.append(
                 {

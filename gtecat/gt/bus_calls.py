@@ -139,6 +139,9 @@ def GT_Open(
             bank=bank,
         )
     )
+    from ..inspect.endpoint import publish  # gtecat ps / the bus verbs / gtecat panel see it
+
+    publish(SESSION.controllers[1])
     return 0
 
 
@@ -146,6 +149,9 @@ def GT_Open(
 def GT_Close() -> int:
     ctl = SESSION.controllers.pop(1, None)
     if ctl is not None:
+        from ..inspect.endpoint import unpublish
+
+        unpublish(ctl)
         ctl.close()
     return 0
 

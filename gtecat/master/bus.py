@@ -95,6 +95,11 @@ class Master:
         self._bad_ns = 0
         self._op_requested = False  # the OP walk ran: from now on below OP is offline
         self.on_cycle: list[Callable[[Master], None]] = []  # recorders etc.
+        #: states an operator asked of single slaves on the running bus (``gtecat states -p 2
+        #: PREOP``): position -> state; recovery leaves them there until OP is asked again or
+        #: the application brings the bus up anew (GT_InitEcatComm makes a new master)
+        self.held: dict[int, AlState] = {}
+        backend.held = self.held  # a backend that recovers by itself skips them too
 
     # --- bring-up ------------------------------------------------------------------
     def open(self) -> None:
@@ -270,6 +275,8 @@ class Master:
         """
         for cfg in self.layout.config.slaves:
             pos = cfg.position
+            if pos in self.held:
+                continue
             try:
                 state, code = self.backend.state(pos)
             except GtecatError:

@@ -44,6 +44,7 @@ from gtecat.eni.errors import GtecatError
 
 from ..gt import _core, declared
 from ..gt.fast import READERS, wire_reader
+from ..inspect import endpoint as _inspect
 from . import field as field_ops
 from .floor import WallFloor
 from .protocol import (
@@ -330,6 +331,7 @@ class Server:
                 spin_us = default_spin_us()
         self.spin_s = max(0.0, spin_us) / 1e6
         self.lock = threading.RLock()
+        _inspect.KIND, _inspect.LOCK = "controller", self.lock  # its endpoint (gtecat ps)
         self.calls = 0
         self._floor: WallFloor | None = None
         self._floor_clock: Any = None

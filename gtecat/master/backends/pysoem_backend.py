@@ -648,7 +648,10 @@ class PysoemBackend(Backend):
         """
         self.stats.checks += 1
         self.master.read_state()
+        held = getattr(self, "held", {})
         for pos, s in enumerate(self.slaves):
+            if pos in held:  # an operator's state request (Master.held)
+                continue
             raw = int(s.state)
             st = raw & STATE_MASK
             if pos in self._lost or st == 0:

@@ -1,0 +1,2 @@
+# the panel's browser tests (tests/gtecat/inspect/test_panel_browser.py)
+DEBS="chromium chromium-driver"

@@ -1,0 +1,151 @@
+"""Inspection endpoints: published by GT_Open, found by gtecat ps, read by the bus verbs.
+
+The endpoint reads what the master and the controller hold: the tests compare what it
+returns with the GT calls' own readings (manual 13: GT_GetPrfPos, GT_GetEncPos, GT_GetSts)
+on the figure 5-2 bus (manual 5.2.2.4).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import stat
+import threading
+from pathlib import Path
+
+import pytest
+
+from gtecat.cli.main import main
+from gtecat.errors import BusError
+from gtecat.inspect import client, endpoint, runtime
+
+from .conftest import FIG5_2
+
+
+def _attach() -> client.Attached:
+    found = client.connect(None)
+    assert found is not None
+    return found[1]
+
+
+def test_gt_open_publishes_a_private_socket_that_ps_lists(app, runtime_dir: Path, capsys) -> None:
+    assert stat.S_IMODE(runtime_dir.stat().st_mode) == 0o700
+    (ep,) = runtime.endpoints()
+    assert ep.pid == os.getpid() and ep.kind == "python" and ep.clock == "lockstep"
+    assert stat.S_IMODE(ep.socket.stat().st_mode) == 0o600
+    assert main(["ps", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert [e["id"] for e in listed] == [ep.id]
+    app.GT_Close()
+    assert runtime.endpoints() == [] and not ep.socket.exists()
+
+
+def test_snapshot_equals_the_gt_readings(app) -> None:
+    gt = app
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = 0.5, 0.5
+    assert gt.GT_PrfTrap(1) == 0 and gt.GT_SetTrapPrm(1, ctypes.byref(prm)) == 0
+    assert gt.GT_SetPos(1, 3000) == 0 and gt.GT_SetVel(1, 10.0) == 0 and gt.GT_Update(1) == 0
+    gt.GTE_Wait(100)  # mid-move
+    with _attach() as c:
+        snap = c.call("snapshot")  # no cycle runs: the endpoint thread answers itself
+        lay = c.call("layout")
+    row = dict(zip(snap["axis_fields"], snap["axes"][0], strict=True))
+    prf, enc, sts = ctypes.c_double(), ctypes.c_double(), ctypes.c_long()
+    gt.GT_GetPrfPos(1, ctypes.byref(prf))
+    gt.GT_GetEncPos(1, ctypes.byref(enc))
+    gt.GT_GetSts(1, ctypes.byref(sts))
+    assert (row["prf_pos"], row["enc_pos"], row["sts"]) == (prf.value, enc.value, sts.value)
+    assert 0 < prf.value < 3000 and sts.value & 0x400  # moving (table 6-2 bit 10)
+    assert snap["states"] == [8, 8, 8, 8] and snap["wkc"] == snap["expected"]
+    # the GT raw offsets of figure 5-2 beside each entry, and the image decodes to 6064h
+    s0 = lay["slaves"][0]
+    by = {(e["index"], e["dir"]): e for e in s0["entries"]}
+    assert by[(0x6040, "out")]["gt_bit"] == 0 and by[(0x6041, "in")]["gt_bit"] == 6 * 8
+    e = by[(0x6064, "in")]
+    image = bytes.fromhex(snap["image"])
+    start = lay["inputs_offset"] + e["logical_bit"] // 8
+    assert int.from_bytes(image[start : start + 4], "little", signed=True) == enc.value
+
+
+def test_requests_run_between_the_cycles_of_a_running_application(app) -> None:
+    """The application's thread runs the cycles (auto/lockstep); a panel polls meanwhile."""
+    gt = app
+    got: list[int] = []
+    done = threading.Event()
+
+    def poll() -> None:
+        with _attach() as c:
+            while not done.is_set():
+                got.append(c.call("snapshot")["cycles"])
+
+    t = threading.Thread(target=poll)
+    t.start()
+    try:
+        for _ in range(300):
+            gt.GTE_Wait(1)
+    finally:
+        done.set()
+        t.join(5)
+    assert got and got == sorted(got)  # each one a whole cycle's view, in order
+
+
+def test_a_state_asked_on_the_running_bus_holds(app, capsys) -> None:
+    """`gtecat states -p 2 PREOP` beside a running application (ETG.1000.6 AL states): the
+    master's recovery leaves the slave there until OP is asked."""
+    gt = app
+    assert main(["states", "-p", "2", "PREOP"]) == 0
+    gt.GTE_Wait(500)  # 5 recovery periods of the master
+    with _attach() as c:
+        states = c.call("snapshot")["states"]
+        assert states == [8, 8, 2, 8]
+        assert "Lost: slave 2" in "\n".join(c.call("log")["lines"])
+    assert main(["states", "-p", "2", "OP"]) == 0
+    gt.GTE_Wait(20)
+    capsys.readouterr()
+    assert main(["slaves", "--json"]) == 0
+    assert [r["state"] for r in json.loads(capsys.readouterr().out)] == ["OP"] * 4
+
+
+def test_the_verbs_attach_and_say_so_when_none_runs(runtime_dir: Path, capsys, monkeypatch) -> None:
+    monkeypatch.setenv("GTECAT_ENI", str(FIG5_2))
+    assert main(["slaves", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert cap.err.count("\n") == 1 and "no running gtecat" in cap.err
+    assert len(json.loads(cap.out)) == 4
+    with pytest.raises(BusError, match="no running gtecat with id"):
+        runtime.find("12345678")
+
+
+def test_stale_endpoints_are_removed_and_a_shared_folder_refused(runtime_dir: Path) -> None:
+    runtime.checked_folder()
+    dead = runtime_dir / "999999999.json"
+    dead.write_text(json.dumps({"pid": 999_999_999, "started": 0}))
+    (runtime_dir / "999999999.sock").touch()
+    assert runtime.endpoints() == []
+    assert not dead.exists() and not (runtime_dir / "999999999.sock").exists()
+    runtime_dir.chmod(0o755)
+    with pytest.raises(BusError, match="open to other users"):
+        runtime.checked_folder()
+
+
+def test_gtecat_inspect_0_publishes_nothing(runtime_dir: Path, monkeypatch) -> None:
+    from gtecat import gt
+
+    monkeypatch.setenv("GTECAT_INSPECT", "0")
+    assert gt.GT_Open(eni=str(FIG5_2), clock="lockstep", log="") == 0
+    try:
+        assert runtime.endpoints() == []
+        assert endpoint.published(gt.GTE_Controller()) is None
+    finally:
+        gt.GT_Close()
+
+
+def test_a_bad_request_is_one_line_back(app) -> None:
+    with _attach() as c:
+        with pytest.raises(BusError, match="no operation 'nope'"):
+            c.call("nope")
+        with pytest.raises(BusError, match="no axis 9"):
+            c.call("jog", 9, 1.0)
+        assert c.call("info")["axes"] == [1, 2]  # the connection still answers

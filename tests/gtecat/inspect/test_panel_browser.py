@@ -1,0 +1,258 @@
+"""gtecat panel in a real browser (Debian's chromium, headless, driven by Selenium).
+
+One panel brings up the figure 5-2 bus (manual 5.2.2.4) with --control, a second one
+attaches to it read-only; one browser shows both.  What the page shows is compared with
+the endpoint's own readings (the GT readers) and the scope's CSV with a recorder of the
+test's own.  Set GTECAT_PANEL_SHOTS=DIR to save screenshots (the docs' pictures).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import itertools
+import os
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from gtecat.inspect import client, runtime
+
+from .conftest import FIG5_2
+
+pytestmark = pytest.mark.xdist_group("panel_browser")
+CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+ARGS = (
+    "--headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking "
+    "--disable-component-update --disable-sync --window-size=1300,1700"
+).split()
+SIGNALS = [f"axis{a}.{s}" for a in (1, 2) for s in ("prf", "enc", "err", "vel")]
+
+
+def _wait(pred: Any, timeout: float = 10.0, what: str = "") -> Any:
+    deadline = time.monotonic() + timeout
+    while True:
+        v = pred()
+        if v:
+            return v
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what or pred}")
+        time.sleep(0.05)
+
+
+def _start_panel(args: list[str], env: dict[str, str]) -> tuple[subprocess.Popen, str]:
+    p = subprocess.Popen(
+        [sys.executable, "-m", "gtecat", "panel", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    line = p.stdout.readline() if p.stdout else ""
+    if "http://" not in line:
+        p.kill()
+        raise AssertionError(f"panel did not start: {line}{p.stderr.read() if p.stderr else ''}")
+    return p, line[line.index("http://") :].strip()
+
+
+@pytest.fixture(scope="module")
+def panels(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    for need in (CHROMIUM, DRIVER):
+        if not Path(need).exists():
+            pytest.skip("needs Chromium: apt-get install chromium chromium-driver")
+    pytest.importorskip("selenium", reason="needs selenium (the test extra)")
+    pytest.importorskip("aiohttp", reason="needs aiohttp (the panel extra)")
+    run = tmp_path_factory.mktemp("run")
+    run.chmod(0o700)
+    saved = {k: os.environ.get(k) for k in ("XDG_RUNTIME_DIR", "GTECAT_INSPECT")}
+    os.environ.update(XDG_RUNTIME_DIR=str(run), GTECAT_INSPECT="1")
+    env = dict(os.environ, GTECAT_LOG="")
+    procs = []
+    try:
+        p1, url1 = _start_panel(["--eni", str(FIG5_2), "--control", "--port", "0"], env)
+        procs.append(p1)
+        (ep,) = runtime.endpoints()
+        p2, url2 = _start_panel(["--attach", ep.id, "--port", "0"], env)
+        procs.append(p2)
+        yield {"control": url1, "readonly": url2, "socket": ep.socket}
+    finally:
+        for p in procs:
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+@pytest.fixture(scope="module")
+def browser(panels: dict[str, Any]) -> Iterator[Any]:
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+
+    o = Options()
+    o.binary_location = CHROMIUM
+    for a in ARGS:
+        o.add_argument(a)
+    d = webdriver.Chrome(service=Service(DRIVER), options=o)
+    try:
+        d.get(panels["control"])
+        _wait(lambda: d.execute_script("return !!(gtecat.ready && gtecat.snap)"), 20, "page")
+        yield d
+    finally:
+        d.quit()
+
+
+@pytest.fixture(scope="module")
+def endpoint_conn(panels: dict[str, Any]) -> Iterator[client.Attached]:
+    with client.Attached(panels["socket"]) as c:
+        yield c
+
+
+def _shot(d: Any, name: str, element: str | None = None) -> None:
+    where = os.environ.get("GTECAT_PANEL_SHOTS")
+    if not where:
+        return
+    Path(where).mkdir(parents=True, exist_ok=True)
+    if element:
+        d.find_element("id", element).screenshot(str(Path(where) / name))
+    else:
+        d.save_screenshot(str(Path(where) / name))
+
+
+def _axis_value(d: Any, axis: int, field: str) -> str:
+    return d.execute_script(
+        f'return document.querySelector(\'[data-axis="{axis}"] [data-field="{field}"]\')'
+        ".textContent"
+    )
+
+
+def test_the_page_shows_the_slaves_of_figure_5_2_in_op(browser: Any) -> None:
+    rows = browser.execute_script(
+        "return [...document.querySelectorAll('#slaves tbody tr')]"
+        ".map(r => [...r.cells].map(c => c.textContent))"
+    )
+    assert [r[1] for r in rows] == ["GTHD 0", "GTHD 1", "IO 2", "IO 3"]
+    assert [r[2] for r in rows] == ["OP"] * 4
+    assert [r[5] for r in rows] == ["0 + 16", "16 + 16", "32 + 4", "36 + 4"]  # GT raw regions
+    # the GT raw offset beside each entry: slave 1's 6041h at 22 (manual figure 5-2)
+    cells = browser.execute_script(
+        "return [...document.querySelectorAll('#entries tbody tr')]"
+        ".map(r => [...r.cells].map(c => c.textContent))"
+    )
+    s1 = {(r[0], r[2]): r for r in cells}
+    assert s1[("1", "0x6041:00")][7] == "22" and s1[("1", "0x6040:00")][7] == "16"
+    _shot(browser, "panel.png")
+
+
+def test_a_trap_move_updates_the_position(browser: Any, endpoint_conn: client.Attached) -> None:
+    card = browser.find_element("css selector", '[data-axis="2"]')
+    for cls, value in (("trap-pos", "3000"), ("trap-vel", "2"), ("trap-acc", "0.5")):
+        box = card.find_element("class name", cls)
+        box.clear()
+        box.send_keys(value)
+    browser.execute_script(  # what the page shows, sampled in the page every 20 ms
+        "window.seen = new Set(); window.tick = setInterval(() => seen.add(document"
+        '.querySelector(\'[data-axis="2"] [data-field="prf"]\').textContent), 20)'
+    )
+    card.find_element("class name", "trap-go").click()
+    _wait(lambda: _axis_value(browser, 2, "prf") == "3000", 10, "the target")
+    shown = browser.execute_script("clearInterval(tick); return [...seen]")
+    assert len([v for v in shown if v not in ("0", "3000")]) >= 3  # it moved on the page
+    _shot(browser, "panel-axes.png", "axes")
+    row = dict(
+        zip(
+            endpoint_conn.call("snapshot")["axis_fields"],
+            endpoint_conn.call("snapshot")["axes"][1],
+            strict=True,
+        )
+    )
+    assert row["prf_pos"] == 3000.0
+
+
+def test_jog_moves_with_control_and_does_nothing_read_only(
+    browser: Any, panels: dict[str, Any], endpoint_conn: client.Attached
+) -> None:
+    def prf1() -> float:
+        snap = endpoint_conn.call("snapshot")
+        return dict(zip(snap["axis_fields"], snap["axes"][0], strict=True))["prf_pos"]
+
+    # a second browser window, read-only: no jog buttons, and a jog sent anyway is refused
+    first = browser.current_window_handle
+    browser.switch_to.new_window("window")
+    browser.get(panels["readonly"])
+    _wait(lambda: browser.execute_script("return !!(gtecat.ready && gtecat.snap)"), 20, "page 2")
+    assert not browser.find_element("css selector", '[data-axis="1"] .jog-plus').is_displayed()
+    before = prf1()
+    err = browser.execute_async_script(
+        "const done = arguments[0];"
+        "gtecat.ask('jog', 1, 50).then(() => done('accepted'), (e) => done(String(e)));"
+    )
+    assert "read-only" in err
+    snaps = browser.execute_script("return gtecat.snaps")
+    time.sleep(0.3)
+    assert prf1() == before
+    assert browser.execute_script("return gtecat.snaps") != snaps  # this one updates too
+    browser.close()
+    browser.switch_to.window(first)
+    card = browser.find_element("css selector", '[data-axis="1"]')
+    card.find_element("class name", "jog-plus").click()
+    _wait(lambda: prf1() > before + 100, 10, "the jog")
+    card.find_element("class name", "stop").click()
+
+
+def test_the_scope_csv_holds_every_sample_the_recorder_took(
+    browser: Any, endpoint_conn: client.Attached
+) -> None:
+    box = browser.find_element("id", "scope-signals")
+    box.clear()
+    box.send_keys(",".join(SIGNALS))
+    tid = endpoint_conn.call("trace_start", SIGNALS)  # the test's own recorder
+    browser.find_element("id", "scope-start").click()
+    endpoint_conn.call("jog", 2, -20.0)
+    _wait(lambda: browser.execute_script("return gtecat.scope.rows.length") > 300, 15, "samples")
+    browser.find_element("id", "scope-stop").click()
+    _wait(lambda: browser.execute_script("return !gtecat.scope.running"), 5, "the stop")
+    endpoint_conn.call("stop", 2)
+    _shot(browser, "panel-scope.png", "scope")
+    ours = endpoint_conn.call("trace_read", tid, 0)["rows"]
+    endpoint_conn.call("trace_stop", tid)
+    text = browser.execute_script("return gtecat.scopeCsv()")
+    table = list(csv.reader(io.StringIO(text)))
+    assert table[0] == ["time_ms", *SIGNALS]
+    page = [[float(v) for v in r] for r in table[1:]]
+    times = [r[0] for r in page]
+    steps = {round(b - a, 6) for a, b in itertools.pairwise(times)}
+    assert steps == {1.0}  # one row per 1 ms cycle: none dropped, none decimated
+    by_time = {r[0]: r[1:] for r in ours}
+    common = [r for r in page if r[0] in by_time]
+    assert len(common) > 300
+    assert all(r[1:] == by_time[r[0]] for r in common)
+    assert any(r[SIGNALS.index("axis2.vel") + 1] != 0 for r in common)  # it saw the jog
+
+
+def test_a_request_without_the_token_gets_403(panels: dict[str, Any]) -> None:
+    url = panels["readonly"]
+    base = url[: url.index("?")]
+    for path in ("", "static/panel.js", "ws", "scope.csv"):
+        with pytest.raises(urllib.error.HTTPError) as e:
+            urllib.request.urlopen(base + path, timeout=5)
+        assert e.value.code == 403
+    with pytest.raises(urllib.error.HTTPError) as e:
+        urllib.request.urlopen(base + "?token=wrong", timeout=5)
+    assert e.value.code == 403
+    with urllib.request.urlopen(url, timeout=5) as r:
+        assert r.status == 200 and b"gtecat panel" in r.read()
