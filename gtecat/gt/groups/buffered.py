@@ -1,4 +1,3 @@
-
 """Buffered commands of the interpolation FIFO and the G0 lines (vendor GTS / GTN headers):
 outputs, DAC values and limit switches changed where the path reaches them, the FIFO's
 remaining entries, the coordinate map base.

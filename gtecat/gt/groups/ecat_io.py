@@ -1,4 +1,3 @@
-
 """EtherCAT IO seen through the controller's own terminals (vendor GTN header): a general-purpose
 output of the controller wired to a bit of a slave, and one bit of a drive's digital outputs.
 

@@ -1,4 +1,3 @@
-
 """Extension IO modules: the GTS ``ExtMdl`` functions, their multi-card ``*Gts`` forms, the GTN
 cores' extension modules and gLink-II (vendor GTS / GTN headers, ``gtgl500.h``).
 

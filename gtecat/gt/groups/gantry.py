@@ -1,4 +1,3 @@
-
 """Gantry pairs (vendor GTS header): a slave axis driven with its master's command.
 
 Implemented by :mod:`gtecat.gt.gantry_calls` over the electronic gear.

@@ -1,4 +1,3 @@
-
 """The pulse and analog servo loop of GTS cards, and the card-level calls around it (vendor GTS
 and GTN headers): PID sets, control and step modes, DAC and ADC channels, limit modes, DI
 edge counters, timed output pulses, multi-axis enable, resource counts, the card number.

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from gtecat.drives.slave import AlState
 from gtecat.controller.inspect import BusView
+from gtecat.drives.slave import AlState
 from gtecat.inspect import ops
 from gtecat.master.clock import Clock
 from gtecat.master.masterlog import MasterLog
