@@ -231,6 +231,8 @@ class AxisBank:
                 )
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
+        #: homing axis-cycles the compiled kernel ran (statistics)
+        self.homing_rows_run = 0
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -787,6 +789,8 @@ class AxisBank:
             # the plain cycle compiled; a table to refill (rare) or a new cycle time goes
             # through numpy, and so does a cycle the kernel declines (nothing written then)
             dt = dt_ns * 1e-9
+            if self.n_hm and dt != self.csp._dt:
+                self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
             if dt == self.csp._dt and not (self.n_moving and self._refill_in <= 1):
                 self._refill_in -= 1
                 rc = k.cycle(t_ns, dt)
@@ -955,6 +959,7 @@ class AxisBank:
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         self.kernel_cycles += 1
+        self.homing_rows_run += self.n_hm
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

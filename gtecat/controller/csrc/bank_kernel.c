@@ -37,11 +37,10 @@
     X(s_target, i64) X(s_raw, i64) X(s_a, f64) X(s_enc, f64) X(s_step, f64)                \
     X(s_pos, f64) X(s_vel, f64) X(s_acc, f64) X(s_dpos, f64) X(s_dvel, f64)                \
     X(s_fe, f64) X(s_lim, u8) X(s_swl, u8) X(s_din, i64) X(s_since, i64) X(s_arr, u8)      \
-    X(s_jog, f64)                                                                          \
     X(hm, u8) X(h_last, f64) X(h_el, f64) X(h_tr, f64) X(h_v, f64) X(h_p, f64)             \
     X(h_rest, f64) X(h_set, u8) X(h_vt, f64) X(h_acc, f64) X(h_lo, f64) X(h_hi, f64)       \
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
-    X(s_hm, f64) X(s_hit, u8)
+    X(s_hm, f64) X(s_hit, u8) X(s_jog, f64)
 
 enum {
 #define X(name, type) F_##name,
