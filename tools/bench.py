@@ -13,8 +13,8 @@ and with full CiA-402 drives) and on the 12-axis example; the cost of one
 generated buses of single-axis CSP drives (:mod:`tools.bench_scaling`, lockstep
 clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ``ok``: real-time factors of 12 axes moving in Trap, 64 axes (odd axes moving, even
-ones holding), 128 axes moving; 12 axes homing (method 17) and 12 axes in PT
-(reported); ``GT_GetSts`` against building its argument, interleaved; the RSS of a
+ones holding), 128 axes moving; 64 axes homing (method 17); 12 axes homing and 12 axes
+in PT (reported); ``GT_GetSts`` against building its argument, interleaved; the RSS of a
 fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -209,6 +209,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
         ),
         "rtf_128_axes_trap": rtf(128, every(128, "moving"), 5, "all 128 moving in Trap"),
         "rtf_12_axes_homing_17": rtf(12, every(12, "homing"), None, "drive homing method 17"),
+        "rtf_64_axes_homing_17": rtf(64, every(64, "homing"), 10, "drive homing method 17"),
         "rtf_12_axes_pt": rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
         "gt_get_sts_vs_argument": _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
         "rss_128_axes_moving": _figure(
