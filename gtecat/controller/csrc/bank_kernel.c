@@ -210,6 +210,7 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
+    const double half_per_dt = 0.5 / dt;
     const uint8_t *alive = U8(alive);
     uint8_t *buf = U8(buf);
     int64_t r, i;
@@ -308,13 +309,20 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         lim = F64(c_lim)[r];
         dist = demand - p;
         rel = dist - vff * dt;
-        vstop = closing_speed(fabs(rel), lim, dt);
-        if (rel > 0.0 && v > vff + vstop) {
-            v = vff + vstop;
-            limited = 1;
-        } else if (rel < 0.0 && v < vff - vstop) {
-            v = vff - vstop;
-            limited = 1;
+        /* the closing-speed cap (CspBank.step's shortcut, per row): vstop >= min(|rel|/dt,
+         * lim), so a row within half of that of vff cannot be capped */
+        vstop = fabs(rel) * half_per_dt;
+        if (vstop > 0.5 * lim)
+            vstop = 0.5 * lim;
+        if (fabs(v - vff) > vstop) {
+            vstop = closing_speed(fabs(rel), lim, dt);
+            if (rel > 0.0 && v > vff + vstop) {
+                v = vff + vstop;
+                limited = 1;
+            } else if (rel < 0.0 && v < vff - vstop) {
+                v = vff - vstop;
+                limited = 1;
+            }
         }
         dv = v - v0;
         if (dv > lim) {
