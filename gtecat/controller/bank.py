@@ -48,9 +48,9 @@ import numpy as np
 from gtecat.drives.csp_bank import CW_ENABLED, CspBank, claimable, wrap32
 from gtecat.drives.drive import Cia402Drive
 from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
+from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
 from gtecat.drives.homing_bank import homing_claimable
 from gtecat.drives.homing_bank import row_constants as homing_constants
-from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
 from gtecat.drives.modes import SW12
 from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS

@@ -14,15 +14,26 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import functools
 import struct
 from collections.abc import Callable
 from typing import Any
+
+import numpy as np
 
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
-_seen: dict[int, tuple[Any, str]] = {}  # id -> (object, repr of byref(object)), recent ones
+_NDARRAY = np.ndarray
+
+
+@functools.lru_cache(maxsize=1024)
+def _cparam(address: int) -> str:
+    """The repr of ``byref(obj)`` for an object at ``address`` (fresh objects reuse addresses)."""
+    return f"<cparam 'P' ({address:#x})>"
+
+
 _NO: Any = object()  # an argument the caller did not pass
 _addressof = ctypes.addressof
 
@@ -42,6 +53,9 @@ def attr_getter(name: str) -> Callable[[Any], float]:
 
 _INTS = frozenset({ctypes.c_int32, ctypes.c_long, ctypes.c_int64, ctypes.c_longlong})
 _DOUBLE = frozenset({ctypes.c_double})
+#: numpy arrays the fast path writes element 0 of (the table path's flat[:1] = [value])
+_NP_INTS = frozenset({np.dtype(np.int32), np.dtype(np.int64)})
+_NP_DOUBLE = frozenset({np.dtype(np.float64)})
 
 #: function -> (value of one axis's resources, the ctypes types *pValue may have: ``long`` is
 #: the vendor's 32 bits, and a Python caller's ``c_long()`` is 64 bits on Linux; both work)
@@ -69,6 +83,7 @@ def fast_reader(
     """``slow`` (the table-checked GT function) with the fast path in front of it;
     ``advance(ctl, name, rc)`` runs the call's host latency, catching what the cycle raises."""
     get, ctypes_ok = READERS[name]
+    np_ok = _NP_INTS if ctypes_ok is _INTS else _NP_DOUBLE
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
     array_types: dict[type, bool] = {}
 
@@ -90,7 +105,8 @@ def fast_reader(
             or kw
             or ctl is None
             or (count is not _NO and (type(count) is not int or count != 1))
-            or (pClock is not _NO and pClock is not None)
+            # pClock NULL: omitted, None or 0 (the manual's own form, GT_GetSts(1, &s, 1, 0))
+            or (pClock is not _NO and pClock is not None and (type(pClock) is not int or pClock))
             or session.remote is not None
         ):
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
@@ -104,16 +120,15 @@ def fast_reader(
             if p is not last[0]:
                 # byref(obj), not byref(obj, offset): its repr names the address it holds
                 # (cheaper than asking ctypes); any doubt takes the table path
-                seen = _seen.get(id(obj))
-                if seen is None or seen[0] is not obj:
-                    if len(_seen) > 512:
-                        _seen.clear()
-                    seen = _seen[id(obj)] = (obj, f"<cparam 'P' ({_addressof(obj):#x})>")
-                if type(obj) not in ctypes_ok or repr(p) != seen[1]:
+                if type(obj) not in ctypes_ok or repr(p) != _cparam(_addressof(obj)):
                     return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
                 last[0] = p  # checked: the same pointer object next time needs no check
             obj.value = get(res)
+        elif tp in ctypes_ok:  # the ctypes object itself (ctypes passes it by reference)
+            p.value = get(res)
         elif is_array(tp):
+            p[0] = get(res)
+        elif tp is _NDARRAY and p.dtype in np_ok and p.ndim == 1 and p.size and p.flags.writeable:
             p[0] = get(res)
         else:
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
@@ -166,3 +181,154 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
         return out
 
     return answer
+
+
+#: the raw image functions on the fast path (``offset, size, buffer``; the IO pair with the
+#: slave first, offsets inside its region)
+RAW = frozenset(
+    {"GT_GetEcatRawData", "GT_SetEcatRawData", "GT_EcatIOReadInput", "GT_EcatIOWriteOutput"}
+)
+_IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
+_BYTES_NP = np.dtype(np.uint8)
+
+
+def _runs(image: Any, offset: int, size: int, write: bool) -> tuple[tuple[int, int, int], ...]:
+    """``(raw offset, buffer index, length)`` of the contiguous pieces of a raw range, or ()
+    when the fast path must not answer (outside the image, a masked or unaligned image, an
+    input byte written: the table path gives the code and the reason)."""
+    if offset < 0 or size <= 0 or offset + size > image.size or not image.aligned:
+        return ()
+    if not image._full_bytes:
+        return ()
+    if write and not image._raw_is_out[offset : offset + size].all():
+        return ()
+    idx = image._raw_index[offset : offset + size].tolist()
+    runs: list[tuple[int, int, int]] = []
+    start = 0
+    for k in range(1, size + 1):
+        if k == size or idx[k] != idx[k - 1] + 1:
+            runs.append((start, idx[start], k - start))
+            start = k
+    return tuple(runs)
+
+
+def fast_raw(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` with the fast path in front of the table:
+    ``(int offset, int size, buffer)`` on the in-process controller with every slave online,
+    the buffer a ctypes array, a bytearray, a one-byte numpy array or memoryview (and for
+    writes ``bytes`` too) holding at least ``size`` bytes.  The copy goes straight between
+    the caller's memory and the process image; anything else takes the table path."""
+    write = name in ("GT_SetEcatRawData", "GT_EcatIOWriteOutput")
+    io = name in _IO
+    cache: dict[tuple[int, int], tuple[tuple[int, int, int], ...]] = {}
+    seen: list[Any] = [None, None, 0]  # the image the cache is of, its buffer and address
+    sizes: dict[type, int] = {}
+    memmove = ctypes.memmove
+
+    def ctypes_size(tp: type) -> int:
+        n = sizes.get(tp)
+        if n is None:
+            n = sizes[tp] = ctypes.sizeof(tp) if issubclass(tp, ctypes.Array) else -1
+        return n
+
+    def raw_gt(offset: Any = _NO, size: Any = _NO, p: Any = _NO, *extra: Any, **kw: Any) -> int:
+        return run(_NO, offset, size, p, extra, kw)
+
+    def io_gt(
+        slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, *more: Any, **kw: Any
+    ) -> int:
+        return run(slave, offset, size, p, more, kw)
+
+    def run(slave: Any, offset: Any, size: Any, p: Any, extra: tuple, kw: dict) -> int:
+        ctl = session.controllers.get(1)
+        m = ctl.master if ctl is not None else None
+        args = tuple(a for a in (slave, offset, size, p) if a is not _NO)
+        if (
+            (io and type(slave) is not int)
+            or type(offset) is not int
+            or type(size) is not int
+            or extra
+            or kw
+            or m is None
+            or not m.opened
+            or m.offline
+            or session.remote is not None
+            or ctl.clock._thread is not None
+        ):
+            return slow(*args, *extra, **kw)
+        image = m.image
+        raw = offset
+        if io:  # an offset inside one slave's region (the table path's _region)
+            slaves = image.layout.slaves
+            if not 0 <= slave < len(slaves):
+                return slow(*args)
+            sl = slaves[slave]
+            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
+                return slow(*args)
+            raw = sl.gt_offset + offset
+        buf = image.buffer
+        if image is not seen[0]:
+            cache.clear()
+            seen[0] = image
+        if buf is not seen[1]:
+            seen[1], seen[2] = buf, buf.ctypes.data  # asking numpy costs microseconds
+        runs = cache.get((raw, size))
+        if runs is None:
+            runs = cache[raw, size] = _runs(image, raw, size, write)
+        if not runs:
+            return slow(*args)
+        tp = type(p)
+        n = ctypes_size(tp)
+        if n >= size:  # a ctypes array: memory to memory
+            base = seen[2]
+            if write:
+                src = ctypes.addressof(p)
+                for at, idx, length in runs:
+                    memmove(base + idx, src + at, length)
+            else:
+                dst = ctypes.addressof(p)
+                for at, idx, length in runs:
+                    memmove(dst + at, base + idx, length)
+        elif n == -1 and (
+            (tp is bytearray and len(p) >= size)
+            or (write and tp is bytes and len(p) >= size)
+            or (
+                tp is memoryview
+                and p.format == "B"
+                and p.ndim == 1
+                and p.c_contiguous
+                and p.nbytes >= size
+                and (write or not p.readonly)
+            )
+            or (
+                tp is _NDARRAY
+                and p.dtype == _BYTES_NP
+                and p.ndim == 1
+                and p.flags.c_contiguous
+                and p.size >= size
+                and (write or p.flags.writeable)
+            )
+        ):
+            if write:
+                src = np.frombuffer(p, np.uint8, size) if tp is not _NDARRAY else p
+                for at, idx, length in runs:
+                    buf[idx : idx + length] = src[at : at + length]
+            else:
+                dst = memoryview(p) if tp is bytearray else p
+                for at, idx, length in runs:
+                    dst[at : at + length] = buf[idx : idx + length]
+        else:
+            return slow(*args)
+        session.last = None
+        if ctl.clock.mode is not _LOCKSTEP:
+            return advance(ctl, name, 0)
+        return 0
+
+    gt = io_gt if io else raw_gt
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt

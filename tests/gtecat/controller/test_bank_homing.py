@@ -127,8 +127,7 @@ def test_homing_in_the_bank_matches_the_scalar_drives(runs: tuple) -> None:
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"cycle {k}: the bank and the scalar drives differ"
     # found (3); axis 5 still searching (0: method 7 without an index pulse never ends);
-    # failed (5): axis 6 switched off, axis 7 stopped, axis 12 halted by the raw write and never finding
-    # its limit anyway
+    # failed (5): axis 6 switched off, axis 7 stopped, axis 12 halted by the raw write
     assert ref[-2][3] == (3, 3, 3, 3, 0, 5, 5, 3, 3, 3, 3, 5)
 
 
