@@ -332,3 +332,35 @@ def fast_raw(
     gt = io_gt if io else raw_gt
     gt.slow = slow  # type: ignore[attr-defined]
     return gt
+
+
+#: why a function that takes pointers is answered by the table path only (its binder checks
+#: and converts every argument generically: a few microseconds).  By group; every function of
+#: the table with a pointer parameter is on the fast path (READERS, RAW), declared only, or
+#: covered here (tests/gtecat/gt/test_fast_shapes.py walks the table).
+SLOW_REASONS: dict[str, str] = {
+    "buffered": "buffered commands: each call queues planning work that outweighs its arguments",
+    "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
+    "arguments); the clock and version readers are answered after the table's checks",
+    "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
+    "ecat_axis": "per-axis PDO readers and homing/probe status: table path (a few microseconds)",
+    "ecat_io": "one output bit read: table path",
+    "emulator": "emulator helpers for tests, not called in control loops",
+    "ext_io": "extension-module IO: each call walks the module configuration (table path)",
+    "gantry": "a mode query: table path",
+    "gts_card": "the pulse-card (GTS) layer: table path",
+    "motion": "profile set-up and parameter readers (called once per move); the position and "
+    "speed readers that polling loops use are on the fast path",
+    "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
+    "programs": "motion programs, variables and MRAM: compile and download work outweighs "
+    "the arguments",
+    "pt_gear_follow": "PT/gear/follow queue and set-up readers: table path",
+    "servo_loop": "servo-loop parameters and analog values: table path",
+    "status": "status set-up readers (soft limits, bands, stop decelerations) and the "
+    "configuration file: GT_GetSts, the polled one, is on the fast path",
+}
+
+
+def fast_functions() -> frozenset[str]:
+    """The functions whose common shapes the fast path answers."""
+    return frozenset(READERS) | RAW
