@@ -822,14 +822,33 @@ def _setup(axis: int, speed: float, startv: float, addtime: float) -> None:
     regs.s_curve = regs.manual = regs.asym = False
 
 
+#: how long an appendix B call waits for INPOS after its pulses (ms of controller time)
+INPOS_WAIT_MS = 10_000.0
+
+
 def _run(axes: list[int], pfn: FUNCTION, limit_stop: bool = True) -> int:
-    """Run cycles until ``axes`` stand: 1 done, 0 stopped from outside, -3/-2 limits."""
+    """Run cycles until ``axes`` stand: 1 done, 0 stopped from outside, -3/-2 limits.
+
+    Decision: with INPOS valid and never active (9.5: the drive never ends), the call
+    stops waiting :data:`INPOS_WAIT_MS` after the pulses and returns 0, with the reason
+    in :func:`last_error` (the library would wait for ever; a test must end)."""
     card = _card(0)
     _EXTERNAL[0] = False
+    waited = 0.0
     while any(card.driving(n) for n in axes):
         if pfn is not None:
             pfn()
         card.wait_cycle()
+        if not any(card.pulsing(n) for n in axes):
+            waited += card.cycle_ms
+            if waited > INPOS_WAIT_MS:
+                _set_error(
+                    f"the pulses are out but INPOS never came within {INPOS_WAIT_MS:g} ms "
+                    "(set_inpos_mode valid, 9.5); the call gives up with 0"
+                )
+                for n in axes:
+                    card.regs[n].await_inpos = False
+                return 0
     if _EXTERNAL[0]:
         return 0
     data = 0
