@@ -210,6 +210,7 @@ class PulseCard:
         self.stop2_clears_ep = False
         self.cycle_ms = ctl.clock.cycle_ns / 1e6
         self._index_seen = dict.fromkeys(AXES, False)
+        self._was_pulsing = dict.fromkeys(AXES, False)
         #: cards whose controllers run one cycle after each of this card's (multi-card)
         self.followers: list[PulseCard] = []
         #: the layer's own state of this card (adt850: interpolation settings)
@@ -630,7 +631,10 @@ class PulseCard:
         for n in AXES:
             self._index_seen[n] = any(e.signal == "index" for e in edges.get(n, ()))
         for n in AXES:
-            if not self.pulsing(n):
+            was, self._was_pulsing[n] = self._was_pulsing[n], self.pulsing(n)
+            if not self._was_pulsing[n]:
+                if was and self.regs[n].alarm_on and self.alarm(n):
+                    self.regs[n].stopdata |= 0x20  # the amplifier's fault ended the pulses
                 continue
             regs = self.regs[n]
             r = self.res(n)

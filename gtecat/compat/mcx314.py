@@ -83,6 +83,8 @@ from ._card import set_last_error as _set_error
 _CARD: list[PulseCard | None] = [None]
 PULSE_MAX = 268_435_455
 HOME_TIMEOUT_MS = 600_000.0
+#: how long a homing step waits for INPOS once its pulses are out (EnableInPos)
+INPOS_WAIT_MS = 10_000.0
 _MASKS2 = {0x3: (1, 2), 0x5: (1, 3), 0x9: (1, 4), 0x6: (2, 3), 0xA: (2, 4), 0xC: (3, 4)}
 _MASKS3 = {0x7: (1, 2, 3), 0xB: (1, 2, 4), 0xD: (1, 3, 4), 0xE: (2, 3, 4)}
 
@@ -613,13 +615,22 @@ def _search(card: PulseCard, axes: list[int], direction: int, prm: tuple[int, in
         if cond(n):
             continue
         card.drive(n, None, direction)
-    t = 0.0
+    t = waited = 0.0
     while any(card.driving(n) for n in axes):
         card.wait_cycle()
         t += card.cycle_ms
         for n in axes:
-            if card.driving(n) and cond(n) and not card.regs[n].stopped_by_user:
+            if card.pulsing(n) and cond(n) and not card.regs[n].stopped_by_user:
                 (card.sudden_stop if immediate else card.decel_stop)(n)
+        if not any(card.pulsing(n) for n in axes):
+            waited += card.cycle_ms
+            if waited > INPOS_WAIT_MS:
+                for n in axes:
+                    card.regs[n].await_inpos = False
+                raise CompatError(
+                    f"homing: the axes stand but INPOS never came within {INPOS_WAIT_MS:g} ms "
+                    "(EnableInPos on, InPosSig's level never seen)"
+                )
         if t > HOME_TIMEOUT_MS:
             for n in axes:
                 card.sudden_stop(n)
