@@ -171,7 +171,8 @@ class AxisRegs:
     inpos_on: bool = False  #: a drive ends only when INPOS is active
     alarm_on: bool = False  #: ALARM stops a drive at once
     await_inpos: bool = False  #: the pulses of a drive are out; INPOS is awaited
-    settings: dict[str, Any] = field(default_factory=dict)  #: kept, no effect here
+    #: registers by name: the real counter's mode, end points, settings kept without effect
+    settings: dict[str, Any] = field(default_factory=dict)
     stopdata: int = 0
     stopped_by_user: bool = False
     last_acc: float = 0.0  #: pulse/ms², the last nonzero acceleration of a drive
@@ -485,8 +486,9 @@ class PulseCard:
         )
 
     def _blocked(self, axis: int, direction: int) -> int:
-        """The error bits (get_stopdata D3/D4 limits, D6/D7 COMP registers) of a drive
-        that cannot start: toward an active limit, or past a soft limit in its direction.
+        """The error bits (get_stopdata D3/D4 limits, D5 alarm, D6/D7 COMP registers) of a
+        drive that cannot start: toward an active limit, with the alarm input on and
+        active, or past a soft limit in its direction.
 
         Decision (seed 004 5.x and chapter 8 say a drive "stops" at a limit; 1 is kept for
         a wrong card or axis): the command is accepted (0) and the drive ends at once with

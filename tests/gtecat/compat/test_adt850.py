@@ -766,3 +766,15 @@ def test_up_down_counter_input_holds_with_an_ab_encoder():
     assert adt.pmove(0, 1, 300) == 0
     wait_axes(1)
     assert pos(1) == 300 and actual(1) == 77
+
+
+def test_a_limit_of_any_axis_stops_an_interpolation():
+    """Chapter 5 (插补时的越限错误): any axis's limit stops the interpolation, here Y's
+    LMT+ at 200 on an X-Y line; get_stopdata of Y says D3."""
+    init(a2=dict(positive_limit=200))
+    setup_speed(1, 10_000, 10_000, 0)
+    assert adt.inp_move2(0, 1, 1000, 500) == 0
+    while inp_running():
+        gt.GTE_Wait(1)
+    assert stopdata(2) == 0x08
+    assert 200 <= pos(2) <= 206 and 400 <= pos(1) <= 412
