@@ -148,6 +148,17 @@ def _close_all() -> None:
     _CARD[:] = [None] * MAX_CARDS
 
 
+def _card_count(cards: Any) -> int:
+    if cards is not None:
+        return integer("cards", cards, 1, MAX_CARDS)
+    env = os.environ.get("GTECAT_ADT850_CARDS", "").strip()
+    if not env:
+        return 1
+    if not env.isdigit() or not 1 <= int(env) <= MAX_CARDS:
+        raise CompatError(f"GTECAT_ADT850_CARDS={env!r}: the number of cards, 1..{MAX_CARDS}")
+    return int(env)
+
+
 # --- 1. basic parameters ------------------------------------------------------------------
 def adt850_initial(
     cards: int | None = None, machines: Mapping[int, Any] | None = None, **options: Any
@@ -165,8 +176,7 @@ def adt850_initial(
     state the manual lists."""
     _close_all()
     try:
-        n = cards if cards is not None else int(os.environ.get("GTECAT_ADT850_CARDS") or 1)
-        n = integer("cards", n, 1, MAX_CARDS)
+        n = _card_count(cards)
         machines = dict(machines or {})
         for k in machines:
             integer("machines key", k, 0, n - 1)

@@ -631,6 +631,8 @@ def test_card_count_from_the_environment(monkeypatch):
     open_card()
     assert adt.adt850_initial() == 2
     assert adt.adt850_initial(cards=17) == -1 and "out of" in adt.last_error()
+    monkeypatch.setenv("GTECAT_ADT850_CARDS", "two")
+    assert adt.adt850_initial() == -1 and "the number of cards, 1..16" in adt.last_error()
 
 
 def test_inpos_valid_the_drive_ends_when_the_amplifier_is_in_position():
