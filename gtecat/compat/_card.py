@@ -637,6 +637,8 @@ class PulseCard:
             if not self._was_pulsing[n]:
                 if was and self.regs[n].alarm_on and self.alarm(n):
                     self.regs[n].stopdata |= 0x20  # the amplifier's fault ended the pulses
+                if self.regs[n].await_inpos:
+                    self.driving(n)  # the drive ends in the cycle INPOS is seen
                 continue
             regs = self.regs[n]
             r = self.res(n)
