@@ -1,9 +1,9 @@
 """What the ADT850 and MCX314 layers share: one pulse card's registers over the controller's axes.
 
-Both seeds describe MCX314-family chips: four step/dir axes X, Y, Z, W/U, each with a
+Both manuals describe MCX314-family chips: four step/dir axes X, Y, Z, W/U, each with a
 range R (multiplier ``M = 8000000/R``), initial speed SV, drive speed V, acceleration A,
 deceleration D and jerk parameter K as register values.  A :class:`PulseCard` keeps those
-registers and turns them into controller units (seed 004 3.1-3.6, seed 003 4.4):
+registers and turns them into controller units (ADT850 manual 3.1-3.6, MCX314 manual 4.4):
 
     speed PPS = V·M        acceleration PPS/s = A·125·M        jerk PPS/s² = 62.5e6/K·M
 
@@ -14,11 +14,11 @@ system 1 (X-Y, X-Y-Z, X-Y-Z-W) or 2 (Z-W) whose speed is planned in base pulses
 (:mod:`gtecat.controller.crd.base_pulse`).  The card runs on the pulse-card personality
 (``gts:4``, :mod:`gtecat.controller.card`).
 
-Decisions where the seeds are silent:
+Decisions where the manuals are silent:
 
 * **Opening.**  The card is the controller ``GT_Open(card="gts:4", ...)`` opens; if one
   is open already (a test opened it with its machine and ``clock="lockstep"``), that one
-  is used.  Opening switches the four amplifiers on (the seeds' cards drive from power-up)
+  is used.  Opening switches the four amplifiers on (the manuals' cards drive from power-up)
   and turns off what a pulse card does not do: the following-error check, the alarm input
   (until enabled) and the controller's own soft limits.
 * **Counters.**  The logic position counter (LP) is the axis planned position, the real
@@ -28,8 +28,8 @@ Decisions where the seeds are silent:
   switches, STOP0 (ADT850) / IN0 (MCX314) the home switch, STOP1 / IN1 the encoder
   index (on in the cycle an index pulse passes), STOP2 / IN2 probe 1, ALARM the
   amplifier's fault, INPOS the amplifier standing within 1 pulse of the plan.
-* **Electrical levels and logic settings** (seed 004 chapter 3 wiring, 1.1, 1.3-1.13,
-  6.1; seed 003 4.6).  Every input has an electrical level (0 low, 1 high), and the
+* **Electrical levels and logic settings** (ADT850 manual chapter 3 wiring, 1.1, 1.3-1.13,
+  6.1; MCX314 manual 4.6).  Every input has an electrical level (0 low, 1 high), and the
   card sees a signal *active* when the level equals the signal's logic setting (0
   low-active, the power-up setting of all of them).  The level comes from the wiring:
   the amplifier's INPOS and ALARM outputs, the encoder's Z and the probe are pulled low
@@ -44,16 +44,16 @@ Decisions where the seeds are silent:
   that ends at once.  The card, not the controller, stops at limits and alarms: at once
   (a sudden stop; an interpolation brakes at once along its path) or, with the
   limit's "decelerate" mode, as a decelerating stop.
-* **INPOS** (seed 004 1.12, 5 "伺服马达对应的信号", 9.5; seed 003 ``EnableInPos``): when
+* **INPOS** (ADT850 manual 1.12, 5 "伺服马达对应的信号", 9.5; MCX314 manual ``EnableInPos``): when
   valid, a drive whose pulses are out stays "driving" until the card sees INPOS active;
   an interpolation stays running until every axis of it does.  Not wired (or a stepper)
   and set valid, a drive never ends - as 9.5 warns.
 * **A stop signal or a COMP register** (soft limit) stops the drive in its own shape:
-  an accelerating drive decelerates to SV, a constant-speed drive stops at once (seed 004
+  an accelerating drive decelerates to SV, a constant-speed drive stops at once (ADT850 manual
   1.3); an interpolation brakes along its path with the master axis's D.
-* **Errors.**  ADT850 calls return the seed's codes and never raise; MCX314 calls are
-  ``void`` in the seed: they return None and raise :class:`CompatError` (a
-  ParameterError) naming the seed's range.  :func:`last_error` gives the reason of the
+* **Errors.**  ADT850 calls return the manual's codes and never raise; MCX314 calls are
+  ``void`` in the manual: they return None and raise :class:`CompatError` (a
+  ParameterError) naming the manual's range.  :func:`last_error` gives the reason of the
   last failure of either.
 """
 
@@ -88,7 +88,7 @@ IMMEDIATE = STOP_DEC_MAX
 
 
 class CompatError(ParameterError):
-    """A seed function called outside what its seed documents (MCX314 layer: raised)."""
+    """A card function called outside what its manual documents (MCX314 layer: raised)."""
 
 
 _LAST: list[str] = [""]
@@ -125,14 +125,14 @@ def out(ptr: Any, value: Any) -> None:
 
 
 def integer(name: str, value: Any, lo: int, hi: int) -> int:
-    """An integer in ``[lo, hi]`` (the seed's range) or CompatError.
+    """An integer in ``[lo, hi]`` (the manual's range) or CompatError.
 
     Like the GT layer's argument checks, a float is refused even when it is integral (1.0):
-    the seeds' parameters are C integers, and a float there is a caller's mistake."""
+    the manuals' parameters are C integers, and a float there is a caller's mistake."""
     if isinstance(value, bool) or not isinstance(value, int):
         raise CompatError(f"{name}={value!r}: an integer is expected")
     if not lo <= value <= hi:
-        raise CompatError(f"{name}={value} out of the seed's range {lo}..{hi}")
+        raise CompatError(f"{name}={value} out of the manual's range {lo}..{hi}")
     return int(value)
 
 
@@ -147,7 +147,7 @@ def real(name: str, value: Any) -> float:
 
 @dataclass(slots=True)
 class AxisRegs:
-    """One axis's registers, as the seeds' chips hold them (defaults: decided, see above)."""
+    """One axis's registers, as the manuals' chips hold them (defaults: decided, see above)."""
 
     m: float = 1.0  #: multiplier M = 8000000 / R
     sv: int = 1
@@ -183,7 +183,7 @@ class AxisRegs:
         return (self.v if value is None else value) * self.m / 1000.0
 
     def params(self, triangle: bool = False) -> SCurveParams:
-        """The drive's curve from the registers (seed 004 3.1-3.6)."""
+        """The drive's curve from the registers (ADT850 manual 3.1-3.6)."""
         acc = self.a * 125.0 * self.m / 1e6
         dec = (self.d if self.asym else self.a) * 125.0 * self.m / 1e6
         jerk = 62.5e6 / self.k * self.m / 1e9 if self.s_curve else math.inf
@@ -192,7 +192,7 @@ class AxisRegs:
 
 def _ring(value: float, top: int | None) -> float:
     """A counter with the variable ring on: it counts 0..``top`` and wraps both ways
-    (seed 004 4.3: COMP+ the logic counter's, COMP- the real counter's largest value)."""
+    (ADT850 manual 4.3: COMP+ the logic counter's, COMP- the real counter's largest value)."""
     if top is None or top < 0:
         return value
     return value % (top + 1)
@@ -250,7 +250,7 @@ class PulseCard:
         return _ring(self.res(axis).ax.prf_pos + regs.lp_off, regs.comp[0] if regs.ring else None)
 
     def counted(self, axis: int) -> float:
-        """The encoder as the real position counter counts it (seed 004 1.6, seed 003
+        """The encoder as the real position counter counts it (ADT850 manual 1.6, MCX314 manual
         ``EncoderMode``/``EncoderCWCCW``): the direction (1: reversed) and, for A/B input,
         the multiplication (4x is the encoder's own count; 2x half of it, 1x a quarter).
 
@@ -490,7 +490,7 @@ class PulseCard:
         drive that cannot start: toward an active limit, with the alarm input on and
         active, or past a soft limit in its direction.
 
-        Decision (seed 004 5.x and chapter 8 say a drive "stops" at a limit; 1 is kept for
+        Decision (ADT850 manual 5.x and chapter 8 say a drive "stops" at a limit; 1 is kept for
         a wrong card or axis): the command is accepted (0) and the drive ends at once with
         its stop bit, as the chip does; ``get_status`` reads 0, ``get_stopdata`` why."""
         regs = self.regs[axis]
@@ -607,7 +607,7 @@ class PulseCard:
     @staticmethod
     def arc(end: tuple[int, int], center: tuple[int, int], ccw: bool) -> Callable:
         """An arc (end and centre relative to the start); an end off the circle ends on the
-        circle at the end's angle (the chips end an arc on their circle, seed 004 5.2),
+        circle at the end's angle (the chips end an arc on their circle, ADT850 manual 5.2),
         rounded to whole pulses."""
 
         def make(start: tuple[float, ...]) -> Segment:

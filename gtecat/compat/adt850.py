@@ -1,16 +1,16 @@
-"""The ADT850 four-axis card's C API (seed 004, chapters 6, 7 and appendix B) over our axes.
+"""The ADT850 four-axis card's C API (ADT850 manual, chapters 6, 7 and appendix B) over our axes.
 
 ``from gtecat.compat import adt850 as adt`` then ``adt.adt850_initial()`` opens the card
 (the controller's ``gts:4`` pulse card, :mod:`gtecat.compat._card`) and every function of
-chapter 7 works with the seed's names, argument order, ranges and return codes: 0 right,
+chapter 7 works with the manual's names, argument order, ranges and return codes: 0 right,
 1 error (a card number adt850_initial did not find, an axis outside 1-4, a value outside
-the seed's range, a command the card refuses now); ``read_bit`` 0/1 and -1 on error;
+the manual's range, a command the card refuses now); ``read_bit`` 0/1 and -1 on error;
 ``adt850_initial`` the number of cards (1..16), 0 when the open controller is no pulse
 card, -1 when a card cannot be opened.  Nothing raises: :func:`last_error` gives the reason of
 the last failure.  Pointer outputs (``int *value``, ``long *pos``) take ctypes ``byref``
 / ``pointer`` / instances or a one-element list.
 
-Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
+Decisions where the manual is silent (besides the shared ones of :mod:`._card`):
 
 * **Cards**: up to 16 (chapter 1), numbered from 0; how many the emulated PC holds is
   ``adt850_initial(cards=N)`` or ``GTECAT_ADT850_CARDS`` (default 1).  Card 0 is the
@@ -18,7 +18,7 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
   already open is used), the others separate ``gts:4`` controllers that keep card 0's
   time (:func:`adt850_initial`).  Appendix B works on card 0.
 * **Registers after initialisation** ("值不确定", 3.x): R = 8000000 (M = 1), SV = V = A =
-  D = 1, K = 1, dec_pos 0.  The modes are the seed's 1.1 list.
+  D = 1, K = 1, dec_pos 0.  The modes are the manual's 1.1 list.
 * **Interpolation speed** is the master axis's (X for X-Y, X-Y-Z, X-Y-Z-W; Z for Z-W) in
   base pulses (:mod:`gtecat.controller.crd.base_pulse`): the long axis of a line, the
   faster axis of each octant of an arc.  A 3/4-axis line needs Z set as 5.8/5.9 say
@@ -111,7 +111,7 @@ def _api(error: int = 1) -> Callable:
             card = _CARD[0]  # card 0's controller keeps the time of every card
             try:
                 rc = fn(*args, **kwargs)
-            except Exception as e:  # the seed's C API never raises
+            except Exception as e:  # the manual's C API never raises
                 _set_error(f"{fn.__name__}: {e}")
                 rc = error
             if card is not None:
@@ -311,7 +311,7 @@ def set_filter_time(cardno: int, axis: int, value: int) -> int:
     return 0
 
 
-set_input_fiilter = set_input_filter  # the seed's chapter 6 spelling
+set_input_fiilter = set_input_filter  # the manual's chapter 6 spelling
 set_filer_time = set_filter_time
 
 

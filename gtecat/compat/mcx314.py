@@ -1,23 +1,23 @@
-"""The MCX314 card library of seed 003 (chapter 4) over our axes.
+"""The MCX314 card library (its manual's chapter 4) over our axes.
 
 ``from gtecat.compat import mcx314 as m`` and the functions of tables 4-2 to 4-7 with
-the seed's names and argument order.  The library has no open call (the card is found at
+the manual's names and argument order.  The library has no open call (the card is found at
 power-up): the first call opens the card (the one ``GT_Open`` opened, else a ``gts:4`` card
-with the ``GTECAT_*`` settings); :func:`Open` (ours) chooses its options.  The seed's
-functions are ``void``: they return None, and a value outside the seed's range (or a call
+with the ``GTECAT_*`` settings); :func:`Open` (ours) chooses its options.  The manual's
+functions are ``void``: they return None, and a value outside the manual's range (or a call
 the card cannot do now) raises :class:`~gtecat.compat.CompatError` naming it; the
 ``unsigned`` readers return the register (32-bit two's complement for positions).
 
-Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
+Decisions where the manual is silent (besides the shared ones of :mod:`._card`):
 
-* **``axis`` is a bit mask** (X 0x1, Y 0x2, Z 0x4, U 0x8), as the seed writes it for the
+* **``axis`` is a bit mask** (X 0x1, Y 0x2, Z 0x4, U 0x8), as the manual writes it for the
   interpolation pairs (xy 0x3 ...) and for its I/O functions ("可多軸設置"): a register
   call writes every selected axis (the MCX314 way); range 1..15.
 * **LINEDATA / CIRCLEDATA** (4.5: "初速度、速度、加速度等") hold ``SV, V, A, D, K`` as
   ctypes ints; ``D = 0`` decelerates with ``A``.  The end point of an interpolation is
   each axis's ``SetP`` register, an arc's centre the ``SetC`` registers (both relative to
   the start, 4.5.2); ``SetFP`` / ``SetCP`` (table 4-4's names) are the same calls.
-* **Speeds** (4.4): the formulas of the seed with M from ``SetRange`` (M = 8000000/R, all
+* **Speeds** (4.4): the formulas of the manual with M from ``SetRange`` (M = 8000000/R, all
   axes), ``SetMultiple`` (M directly, per axis) or ``SetMaxSpeed`` (the smallest M with
   ``8000·M >= max speed``, all axes).  An interpolation uses the lowest selected axis's M
   and counts speed in base pulses (:mod:`gtecat.controller.crd.base_pulse`).
@@ -47,7 +47,7 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
   and level bits, the interrupt enables); every axis is homed, negatively, unless ours
   ``axis=`` / ``direction=`` say otherwise (:func:`HomeType1`).  The origin signal is the
   lowest enabled IN; the EZ of types 3/4 is IN1.  The slow speed is SV.  The call
-  returns when the axes stand (it runs the controller), like the seed's blocking flow
+  returns when the axes stand (it runs the controller), like the manual's blocking flow
   (figures 3-28 to 3-31).
 * **Bit-pattern interpolation** is named in table 4-1 but no function is documented;
   :func:`BitPattern` (ours) takes per-step ``(+, -)`` bit words per axis and runs them as
@@ -337,7 +337,7 @@ def SCurve_C(axis: int, m_SV: int, m_V: int, m_A: int, m_K: int, direction: int 
 
 @_api
 def DecStop(axis: int) -> None:
-    """Decelerating stop (the chip's command; seed 003 lists it among the basic commands)."""
+    """Decelerating stop (the chip's command; the manual lists it among the basic commands)."""
     card, axes = _each(axis)
     for n in axes:
         card.decel_stop(n)
