@@ -76,8 +76,10 @@ def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, controller, t
         "GT_SetHSIOOpt returned 8: GT_SetHSIOOpt is declared but not emulated "
         "(group: digital and analog IO)"
     )
-    for key in ("rescount", "movevelocity"):  # emulated or declared, never a pretend 0
-        assert v[key] in ("0", str(CMD_DECLARED)), key
+    assert v["rescount"] in ("0", str(CMD_DECLARED))  # emulated or declared, never a pretend 0
+    # MoveVelocity on an axis that is not servo-enabled: refused with its reason
+    assert v["movevelocity"] == "1", v["movevelocity_reason"]
+    assert "not servo-enabled" in v["movevelocity_reason"]
     if v["rescount"] == "0":
         assert int(v["rescount_value"]) >= 2  # the figure 5-2 bus has two axes
     assert v["close"] == "0"
