@@ -225,6 +225,11 @@ def _stop_mode(k: int) -> Callable[..., int]:
         "high): the card sees the signal active at that level (module docstring of "
         'gtecat.compat._card, "Electrical levels"); valid and active, it stops a drive '
         "(decelerating, a constant-speed drive at once: 1.3 note)."
+        + (
+            " A STOP2 stop also clears the real position counter at the signal (1.5 note, 9.4)."
+            if k == 2
+            else ""
+        )
     )
     return set_stop_mode
 
