@@ -732,9 +732,10 @@ def open_card(name: str, **options: Any) -> PulseCard:
 
 
 def open_follower(base: PulseCard, name: str, machine: Any = None) -> PulseCard:
-    """Another card in the same PC (multi-card): a controller of its own (a ``gts:4``
-    card with ``machine``; None: no switches, whatever ``GTECAT_MACHINE`` says), whose cycles run with ``base``'s, one after each of its cycles,
-    so the cards share one time.  ``base.close()`` closes it."""
+    """Another card in the same PC (multi-card): a controller of its own, a ``gts:4`` card
+    with ``machine`` (None: no switches, whatever ``GTECAT_MACHINE`` says), whose cycles
+    run with ``base``'s, one after each of its cycles, so the cards share one time.
+    ``base.close()`` closes it."""
     from ..controller.core import Controller, Options
     from ..drives.machine import MachineDescription
     from ..gt.axis_calls import axis_on
