@@ -192,24 +192,17 @@ _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
 _BYTES_NP = np.dtype(np.uint8)
 
 
-def _runs(image: Any, offset: int, size: int, write: bool) -> tuple[tuple[int, int, int], ...]:
-    """``(raw offset, buffer index, length)`` of the contiguous pieces of a raw range, or ()
-    when the fast path must not answer (outside the image, a masked or unaligned image, an
-    input byte written: the table path gives the code and the reason)."""
+def _index(image: Any, offset: int, size: int, write: bool) -> np.ndarray | None:
+    """The process-image indices of a raw range, or None when the fast path must not answer
+    (outside the image, a masked or unaligned image, an input byte written: the table path
+    gives the code and the reason)."""
     if offset < 0 or size <= 0 or offset + size > image.size or not image.aligned:
-        return ()
+        return None
     if not image._full_bytes:
-        return ()
+        return None
     if write and not image._raw_is_out[offset : offset + size].all():
-        return ()
-    idx = image._raw_index[offset : offset + size].tolist()
-    runs: list[tuple[int, int, int]] = []
-    start = 0
-    for k in range(1, size + 1):
-        if k == size or idx[k] != idx[k - 1] + 1:
-            runs.append((start, idx[start], k - start))
-            start = k
-    return tuple(runs)
+        return None
+    return image._raw_index[offset : offset + size].copy()
 
 
 def fast_raw(
@@ -218,49 +211,75 @@ def fast_raw(
     session: Any,
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
-    """``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` with the fast path in front of the table:
-    ``(int offset, int size, buffer)`` on the in-process controller with every slave online,
-    the buffer a ctypes array, a bytearray, a one-byte numpy array or memoryview (and for
-    writes ``bytes`` too) holding at least ``size`` bytes.  The copy goes straight between
-    the caller's memory and the process image; anything else takes the table path."""
+    """``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` (and the IO pair, slave first) with the
+    fast path in front of the table: ``(int offset, int size, buffer)`` on the in-process
+    controller with every slave online, the buffer a ctypes array, a bytearray, a one-byte
+    numpy array or memoryview (and for writes ``bytes`` too) holding at least ``size`` bytes.
+    One numpy copy between the caller's memory and the process image; anything else takes
+    the table path."""
     write = name in ("GT_SetEcatRawData", "GT_EcatIOWriteOutput")
     io = name in _IO
-    cache: dict[tuple[int, int], tuple[tuple[int, int, int], ...]] = {}
-    seen: list[Any] = [None, None, 0]  # the image the cache is of, its buffer and address
-    sizes: dict[type, int] = {}
-    memmove = ctypes.memmove
+    cache: dict[tuple[int, int], np.ndarray | None] = {}
+    seen: list[Any] = [None]  # the image the cache is of
+    #: byte views of the caller's ctypes and numpy buffers, the last few (kept alive)
+    views: dict[tuple[int, int], tuple[Any, np.ndarray]] = {}
+    take, frombuffer, u8 = np.take, np.frombuffer, np.uint8
 
-    def ctypes_size(tp: type) -> int:
-        n = sizes.get(tp)
-        if n is None:
-            n = sizes[tp] = ctypes.sizeof(tp) if issubclass(tp, ctypes.Array) else -1
-        return n
+    def view(p: Any, tp: type, size: int) -> np.ndarray | None:
+        """``size`` bytes of the caller's buffer as a numpy array (None: not a fast shape)."""
+        key = (id(p), size)
+        v = views.get(key)
+        if v is not None and v[0] is p:
+            return v[1]
+        if issubclass(tp, ctypes.Array):
+            if ctypes.sizeof(p) < size:
+                return None
+            arr = frombuffer(p, u8, size)
+        elif tp is _NDARRAY:
+            if p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous or p.size < size:
+                return None
+            if not write and not p.flags.writeable:
+                return None
+            arr = p[:size]
+        elif tp is bytearray or tp is memoryview or (write and tp is bytes):
+            # never kept: a cached view would stop the caller resizing a bytearray
+            if tp is memoryview and (p.format != "B" or p.ndim != 1 or not p.c_contiguous):
+                return None
+            if len(p) < size or (not write and tp is memoryview and p.readonly):
+                return None
+            return frombuffer(p, u8, size)
+        else:
+            return None
+        if len(views) >= 16:
+            views.clear()
+        views[key] = (p, arr)
+        return arr
 
     def raw_gt(offset: Any = _NO, size: Any = _NO, p: Any = _NO, *extra: Any, **kw: Any) -> int:
-        return run(_NO, offset, size, p, extra, kw)
+        if extra or kw or p is _NO:
+            return slow(*(a for a in (offset, size, p) if a is not _NO), *extra, **kw)
+        return run(-1, offset, size, p, (offset, size, p))
 
     def io_gt(
         slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, *more: Any, **kw: Any
     ) -> int:
-        return run(slave, offset, size, p, more, kw)
+        if more or kw or p is _NO or type(slave) is not int:
+            return slow(*(a for a in (slave, offset, size, p) if a is not _NO), *more, **kw)
+        return run(slave, offset, size, p, (slave, offset, size, p))
 
-    def run(slave: Any, offset: Any, size: Any, p: Any, extra: tuple, kw: dict) -> int:
+    def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)
         m = ctl.master if ctl is not None else None
-        args = tuple(a for a in (slave, offset, size, p) if a is not _NO)
         if (
-            (io and type(slave) is not int)
-            or type(offset) is not int
+            type(offset) is not int
             or type(size) is not int
-            or extra
-            or kw
             or m is None
             or not m.opened
             or m.offline
             or session.remote is not None
             or ctl.clock._thread is not None
         ):
-            return slow(*args, *extra, **kw)
+            return slow(*args)
         image = m.image
         raw = offset
         if io:  # an offset inside one slave's region (the table path's _region)
@@ -271,59 +290,23 @@ def fast_raw(
             if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
                 return slow(*args)
             raw = sl.gt_offset + offset
-        buf = image.buffer
         if image is not seen[0]:
             cache.clear()
             seen[0] = image
-        if buf is not seen[1]:
-            seen[1], seen[2] = buf, buf.ctypes.data  # asking numpy costs microseconds
-        runs = cache.get((raw, size))
-        if runs is None:
-            runs = cache[raw, size] = _runs(image, raw, size, write)
-        if not runs:
-            return slow(*args)
-        tp = type(p)
-        n = ctypes_size(tp)
-        if n >= size:  # a ctypes array: memory to memory
-            base = seen[2]
-            if write:
-                src = ctypes.addressof(p)
-                for at, idx, length in runs:
-                    memmove(base + idx, src + at, length)
-            else:
-                dst = ctypes.addressof(p)
-                for at, idx, length in runs:
-                    memmove(dst + at, base + idx, length)
-        elif n == -1 and (
-            (tp is bytearray and len(p) >= size)
-            or (write and tp is bytes and len(p) >= size)
-            or (
-                tp is memoryview
-                and p.format == "B"
-                and p.ndim == 1
-                and p.c_contiguous
-                and p.nbytes >= size
-                and (write or not p.readonly)
-            )
-            or (
-                tp is _NDARRAY
-                and p.dtype == _BYTES_NP
-                and p.ndim == 1
-                and p.flags.c_contiguous
-                and p.size >= size
-                and (write or p.flags.writeable)
-            )
-        ):
-            if write:
-                src = np.frombuffer(p, np.uint8, size) if tp is not _NDARRAY else p
-                for at, idx, length in runs:
-                    buf[idx : idx + length] = src[at : at + length]
-            else:
-                dst = memoryview(p) if tp is bytearray else p
-                for at, idx, length in runs:
-                    dst[at : at + length] = buf[idx : idx + length]
+        key = (raw, size)
+        if key in cache:
+            idx = cache[key]
         else:
+            idx = cache[key] = _index(image, raw, size, write)
+        if idx is None:
             return slow(*args)
+        arr = view(p, type(p), size)
+        if arr is None:
+            return slow(*args)
+        if write:
+            image.buffer[idx] = arr
+        else:
+            take(image.buffer, idx, out=arr)
         session.last = None
         if ctl.clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)
