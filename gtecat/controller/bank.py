@@ -45,7 +45,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gtecat.drives.csp_bank import CW_ENABLED, CspBank, claimable, wrap32
+from gtecat.drives.csp_bank import (
+    CW_ENABLED,
+    FROZEN_ATTRS,
+    CspBank,
+    claimable,
+    frozen_claimable,
+    wrap32,
+)
 from gtecat.drives.drive import Cia402Drive
 from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
 from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
@@ -130,7 +137,7 @@ _HOMING_MODE = 6
 _HM_ARRAYS = (
     "h_last h_el h_tr h_v h_p h_rest h_vt h_acc h_lo h_hi h_maxtr h_tmo h_fd h_from h_ilim"
 ).split()
-_HM_U8 = ("hm", "h_set", "h_idx")
+_HM_U8 = ("hm", "h_set", "h_idx", "frz")
 _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.SERVO_ON),
     int(AxisStatus.MOVING),
@@ -233,6 +240,8 @@ class AxisBank:
         self.kernel_cycles = 0
         #: homing axis-cycles the compiled kernel ran (statistics)
         self.homing_rows_run = 0
+        #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
+        self.frozen_rows_run = 0
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -357,7 +366,8 @@ class AxisBank:
             setattr(self, name, z(n))
         for name in _HM_U8:
             setattr(self, name, zi(n, bool))
-        self.n_hm = 0
+        self.n_hm = self.n_frz = 0
+        self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -376,6 +386,7 @@ class AxisBank:
         self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.n_hm = int(np.count_nonzero(self.hm & alive))
+        self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.band_dirty = True
         plc = [p for p in self._plc if alive[p[0]]]
         names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
@@ -443,6 +454,8 @@ class AxisBank:
         res = self.res[r]
         if res is None:
             return False
+        if not ax.servo_on:
+            return self._eligible_frozen(r)
         if ax.mode_cmd == _HOMING_MODE:
             return self._eligible_homing(r)
         if not (ax.servo_on and ax.mode_cmd == 8 and ax.csp_follow) or ax.link_lost:
@@ -482,6 +495,47 @@ class AxisBank:
         if res._pos_din is not ax.io.get(0x60FD) and res._pos_din is not None:
             return False
         return not claimable(self.csp.channels[r])
+
+    def _eligible_frozen(self, r: int) -> bool:
+        """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
+        every value of its cycle stays as it is, so the compiled cycle skips the row (the
+        image keeps the values the scalar objects wrote)."""
+        if self.kernel is None:
+            return False
+        ax, res = self.axes[r], self.res[r]
+        if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error:
+            return False
+        st = self._homing_hook(ax, res)
+        if st is False or (st is not None and st.active):
+            return False
+        if res.latched or ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
+            return False
+        if None in (res._act, ax._tp_acc, ax._pos_acc):
+            return False
+        pl = res.profile.planner
+        if not pl.done or pl.stopping != StopKind.NONE:
+            return False
+        if not self._inputs_plain(ax, res):
+            return False
+        enc = res.encoder
+        if enc.vel != 0.0 or enc.acc != 0.0:
+            return False
+        a = (res._act.get() - ax.drive_offset) / (1 << ax.pos_scale)
+        if a != ax.prf_pos or pl.pos != res.prf_link.source(a):
+            return False  # the plan does not follow 6064h yet
+        if ax._tp_acc.get() != ax._pos_acc.get():
+            return False  # 607Ah does not hold 6064h yet
+        ch = self.csp.channels[r]
+        s = res.safety
+        if s.active and (a > s.soft_positive or a < s.soft_negative or ch.digital_inputs & 3):
+            return False  # a flag would latch
+        b = res.band
+        if b.band > 0:
+            err = a - res.enc_link.axis(enc.pos)
+            inside = -b.band <= err <= b.band
+            if (inside and not b.arrived) or (not inside and (b._since is not None or b.arrived)):
+                return False  # bit 11 still changes with time
+        return not frozen_claimable(ch)
 
     def _eligible_homing(self, r: int) -> bool:
         """An axis whose drive runs a homing search (gtecat.drives.homing_bank): the axis
@@ -625,6 +679,16 @@ class AxisBank:
         else:
             self.t_len[r], self.t_end[r] = 1, 0
         ch = self.csp.channels[r]
+        self.frz[r] = frozen = not ax.servo_on
+        if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
+            self._frozen[r] = (
+                tuple(getattr(ch, name) for name in FROZEN_ATTRS),
+                ch.mech.torque,
+                ch.mech.acc,
+            )
+            self.enc_step0[r] = self.enc_step1[r] = 0.0  # the encoder stands: speed 0
+            self.hm[r] = False
+            return
         self.hm[r] = homing = ax.mode_cmd == _HOMING_MODE
         if homing:  # the drive's search (gtecat.drives.homing_bank)
             h = ch.homing
@@ -703,6 +767,14 @@ class AxisBank:
         b._since = None if since < 0 else since
         b.arrived = bool(self.arrived[r])
         pl = res.profile.planner
+        if self.frz[r]:
+            self.frz[r] = False
+            ch = self.csp.channels[r]
+            values, torque, acc = self._frozen.pop(r)
+            for name, value in zip(FROZEN_ATTRS, values, strict=True):
+                setattr(ch, name, value)
+            ch.mech.torque, ch.mech.acc = torque, acc
+            return
         if self.hm[r]:
             self.hm[r] = False
             ch = self.csp.channels[r]
@@ -753,7 +825,7 @@ class AxisBank:
         if name == "sts":
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | _SERVO_ON).tolist()
+            return (sts | np.where(self.frz, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             vel, acc = self._enc_rates()
             return (vel if name == "enc_vel" else acc).tolist()
@@ -789,7 +861,7 @@ class AxisBank:
             # the plain cycle compiled; a table to refill (rare) or a new cycle time goes
             # through numpy, and so does a cycle the kernel declines (nothing written then)
             dt = dt_ns * 1e-9
-            if self.n_hm and dt != self.csp._dt:
+            if (self.n_hm or self.n_frz) and dt != self.csp._dt:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
             if dt == self.csp._dt and not (self.n_moving and self._refill_in <= 1):
                 self._refill_in -= 1
@@ -804,8 +876,8 @@ class AxisBank:
                     return
                 self._refill_in += 1
             k.bound = False  # the numpy cycle replaces some arrays
-        if self.n_hm:  # the numpy cycle runs CSP rows only: homing rows go back first
-            self._release_rows(np.nonzero(self.hm & self.alive)[0])
+        if self.n_hm or self.n_frz:  # the numpy cycle runs CSP rows only: the others go back
+            self._release_rows(np.nonzero((self.hm | self.frz) & self.alive)[0])
             if not self.n_alive:
                 return
         buf = self.ctl.master.image.buffer
@@ -960,6 +1032,7 @@ class AxisBank:
         self.bank_cycles += 1
         self.kernel_cycles += 1
         self.homing_rows_run += self.n_hm
+        self.frozen_rows_run += self.n_frz
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

@@ -178,7 +178,8 @@ class Kernel:
 
     def _placements(self) -> dict[str, np.ndarray]:
         bank = self.bank
-        plc = [p for p in bank._plc if bank.alive[p[0]]]
+        # a frozen row's image keeps what its scalar objects wrote
+        plc = [p for p in bank._plc if bank.alive[p[0]] and not bank.frz[p[0]]]
         self.io[IN_N_PLC] = len(plc)
         rx = np.asarray(bank._rx_idx, np.int64)
         self.io[IN_N_RX] = len(rx)

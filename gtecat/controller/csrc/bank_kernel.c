@@ -40,7 +40,7 @@
     X(hm, u8) X(h_last, f64) X(h_el, f64) X(h_tr, f64) X(h_v, f64) X(h_p, f64)             \
     X(h_rest, f64) X(h_set, u8) X(h_vt, f64) X(h_acc, f64) X(h_lo, f64) X(h_hi, f64)       \
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
-    X(s_hm, f64) X(s_hit, u8) X(s_jog, f64)
+    X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)
 
 enum {
 #define X(name, type) F_##name,
@@ -229,7 +229,7 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         double prf, a, demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, rel, vstop, dv, acc, pos;
         double fe, step, enc, err, band;
         int limited = 0, swl = 0, hit = 0, ended, standing, inb, arr;
-        if (!alive[r])
+        if (!alive[r] || U8(frz)[r]) /* a frozen row: nothing of its cycle changes */
             continue;
         if (hm[r]) {
             U8(s_hit)[r] = 0;
@@ -428,6 +428,8 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
             I64(c_start)[r] += 1; /* a row left out did not step */
             continue;
         }
+        if (U8(frz)[r])
+            continue;
         if (U8(jog)[r]) {
             F64(jrp)[r] = F64(s_jog)[5 * r + 0];
             F64(jrv)[r] = F64(s_jog)[5 * r + 1];

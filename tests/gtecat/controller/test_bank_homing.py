@@ -137,3 +137,43 @@ def test_the_bank_ran_the_searches(runs: tuple) -> None:
         pytest.skip("no C compiler: homing rows run only in the compiled cycle")
     _, (_, rows) = runs
     assert rows > 800  # axis-cycles of searches between their events
+
+
+def _resting_run(bank: str) -> tuple[list, int]:
+    """Twelve axes that start switched off and are enabled and disabled one group at a time
+    (a resting, servo-off axis is a frozen row of the bank: its cycle changes nothing)."""
+    gt.GT_Close()
+    _ok(gt.GT_Open(eni=str(ENI), clock="lockstep", log="", bank=bank), "open")
+    trace: list = []
+    try:
+        _ok(gt.GT_InitEcatComm(), "init")
+        gt.GTE_Wait(60)
+        _ok(gt.GT_StartEcatComm(), "start")
+        ctl = gt.GTE_Controller()
+        size = ctl.layout.gt_raw_bytes
+        plan = {10: ("on", 3), 30: ("on", 5), 31: ("on", 6), 32: ("on", 7), 33: ("on", 8)}
+        plan |= {60: ("off", 3), 90: ("off", 6), 120: ("clear", 0), 130: ("on", 6)}
+        for k in range(160):
+            what, axis = plan.get(k, ("", 0))
+            if what == "on":
+                _ok(gt.GT_AxisOn(axis), f"on {axis}")
+            elif what == "off":
+                _ok(gt.GT_AxisOff(axis), f"off {axis}")
+            elif what == "clear":
+                _ok(gt.GT_ClrSts(1, AXES), "clear")
+            gt.GTE_Wait(1)
+            trace.append(_sample(size))
+        frozen = ctl.bank.frozen_rows_run if ctl.bank is not None else 0
+    finally:
+        gt.GT_Close()
+    return trace, frozen
+
+
+def test_resting_axes_in_the_bank_match_the_scalar_drives() -> None:
+    ref, ref_rows = _resting_run("off")
+    got, rows = _resting_run("on")
+    assert ref_rows == 0
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar drives differ"
+    if HAS_CC:
+        assert rows > 12 * 100  # most axis-cycles of the switched-off axes were skipped
