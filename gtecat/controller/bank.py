@@ -388,17 +388,7 @@ class AxisBank:
         self.n_hm = int(np.count_nonzero(self.hm & alive))
         self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.band_dirty = True
-        plc = [p for p in self._plc if alive[p[0]]]
-        names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
-        self._extra = names
-        col = {"target": 0, "position_actual": 1, "digital_inputs": 2}
-        col |= {name: 3 + k for k, name in enumerate(names)}
-        n = self.n
-        self._img_src = np.array([col[name] * n + r for r, _, _, name in plc], np.intp)
-        self._img_dst = np.array([off + j for _, off, size, _ in plc for j in range(size)], np.intp)
-        self._img_bytes = np.array(
-            [4 * i + j for i, (_, _, size, _) in enumerate(plc) for j in range(size)], np.intp
-        )
+        self._img_stale = True  # the numpy cycle's image indices follow when it runs
         self.n_moving = int(np.count_nonzero(self.moving & alive))
         self._refill_in = 0  # look for tables to fill at the next cycle
         self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
@@ -413,6 +403,22 @@ class AxisBank:
         self._lists.clear()
         if self.kernel is not None:
             self.kernel.bound = False
+
+    def _image_indices(self) -> None:
+        """The numpy cycle's scatter of the claimed rows' values into the image."""
+        alive = self.alive
+        self._img_stale = False
+        plc = [p for p in self._plc if alive[p[0]]]
+        names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
+        self._extra = names
+        col = {"target": 0, "position_actual": 1, "digital_inputs": 2}
+        col |= {name: 3 + k for k, name in enumerate(names)}
+        n = self.n
+        self._img_src = np.array([col[name] * n + r for r, _, _, name in plc], np.intp)
+        self._img_dst = np.array([off + j for _, off, size, _ in plc for j in range(size)], np.intp)
+        self._img_bytes = np.array(
+            [4 * i + j for i, (_, _, size, _) in enumerate(plc) for j in range(size)], np.intp
+        )
 
     # --- when the bank may run ----------------------------------------------------------------
     def _global_reason(self) -> str:
@@ -1012,6 +1018,8 @@ class AxisBank:
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         # 8. the image: 607Ah out, the drives' TxPDO in, in one scatter
+        if self._img_stale:
+            self._image_indices()
         cols = [target, pa, din]
         for name in self._extra:
             cols.append(csp.output(name, state))
