@@ -313,6 +313,9 @@ class Esc:
         self._irq = 0
         #: SM configuration or PDI (de)activation changed: compiled datagram plans are stale
         self.on_sm_change: Callable[[Esc], None] = _noop
+        #: the system time's constants changed (offset, delay, a drift correction that moved
+        #: the clock): the chain's compiled DC datagrams are stale
+        self.on_dc_change: Callable[[Esc], None] = _noop
         self.on_pending: Callable[[Esc], None] = _noop
         self.errors = 0
         self._reset_registers()
@@ -509,6 +512,8 @@ class Esc:
             self._system_time_written(addr, data)
         if addr < 0x0928 and end > 0x0920:
             self._dc_correction = 0  # a new offset: the control loop starts over
+        if addr < 0x092C and end > 0x0920:
+            self.on_dc_change(self)
 
     # --- AL state machine ----------------------------------------------------------------------
     def _al_control(self) -> None:
@@ -1046,9 +1051,18 @@ class Esc:
         diff = (received + delay - self.system_time()) & mask
         if diff >> (nbits - 1):
             diff -= 1 << nbits
-        self._dc_correction += diff  # the control loop locks at once
         mag = min(abs(diff), 0x7FFFFFFF)
         _U32.pack_into(self.mem, Reg.DC_SYSTEM_DIFF, mag | (0x80000000 if diff > 0 else 0))
+        if diff:
+            self._dc_correction += diff  # the control loop locks at once
+            self.on_dc_change(self)
+
+    def system_time_constant(self) -> int:
+        """``system_time() - frame time``: what this ESC adds to the frame's arrival time
+        (its place in the line, its local clock's base, offset 0920h and the correction),
+        constant until :attr:`on_dc_change` says otherwise."""
+        offset = _I64.unpack_from(self.mem, Reg.DC_SYSTEM_OFFSET)[0]
+        return self.position * HOP_NS + self._dc_base + offset + self._dc_correction
 
     # --- watchdog ------------------------------------------------------------------------------
     def watchdog_ns(self) -> int:
