@@ -77,7 +77,7 @@ def bring_up(chain: Chain, dc: bool = True) -> tuple[int, int]:
         ins.append((tx_bits + 7) // 8)
     out_total = sum(outs)
     laddr_out, laddr_in, wkc = 0, out_total, 0
-    for pos, esc in enumerate(chain.escs):
+    for pos in range(n):
         station = REF + pos
         sms, fmmus = b"", b""
         if outs[pos]:
