@@ -318,6 +318,10 @@ def run(args: argparse.Namespace) -> int:
     rt, scheduling = take_scheduling(args.rt_priority, wait_given, args.cpu)
     if rt is None and wants_rt and wait == "predict" and args.wait == "auto":
         wait = server.wait = resolve_wait("auto", None)
+    if rt is not None:
+        from gtecat.wire.serve import LINGER_RT_NS
+
+        server.linger_ns = LINGER_RT_NS  # a real-time spin holds the CPU against the master
 
     def _stop(signum: int, _frame: FrameType | None) -> None:
         server.stop.set()
