@@ -80,10 +80,17 @@ class LatencyRecorder:
         self.samples = array("q", bytes(8 * size))
         self.size = size
         self.count = 0
+        #: samples over 1 ms and over 2 ms (SOEM's frame timeout), of all, not only the kept
+        self.over_1ms = 0
+        self.over_2ms = 0
 
     def add(self, ns: int) -> None:
         self.samples[self.count % self.size] = ns
         self.count += 1
+        if ns > 1_000_000:
+            self.over_1ms += 1
+            if ns > 2_000_000:
+                self.over_2ms += 1
 
     def summary(self) -> dict[str, float]:
         n = min(self.count, self.size)
@@ -101,6 +108,8 @@ class LatencyRecorder:
             "p90_us": pct(0.90),
             "p99_us": pct(0.99),
             "max_us": data[-1] / 1000.0,
+            "over_1ms": self.over_1ms,
+            "over_2ms": self.over_2ms,
         }
 
 
