@@ -582,9 +582,11 @@ class Chain:
             elif cmd in (Command.FRMW, Command.FPRD):
                 stations = self._stations if self._stations is not None else self._station_map()
                 found = stations.get(adp, [])
-                # one reader that no other slave precedes (FPRD: one slave, anywhere)
+                # one reader that no other slave precedes (FPRD: one slave, anywhere); an
+                # address two slaves answer to stays with the register path
                 stable = len(found) == 1 and (cmd == Command.FPRD or found[0] is escs[0])
-                plan = _DcPlan(cmd, found[:1], stable, dlen)
+                if len(found) <= 1 or cmd == Command.FRMW:
+                    plan = _DcPlan(cmd, found[:1], stable, dlen)
         self._dc_plans[(cmd, adp, ado, dlen)] = plan
         return plan
 

@@ -157,6 +157,8 @@ frames = st.sampled_from(
         ("lrw+frmw", 4),
         ("lrw+brd", 8),
         ("fprd", 8),
+        ("fprd1", 8),  # after "twin": two slaves answer to this address
+        ("twin", 0),  # the third slave takes the second's station address
         ("frmw2", 8),  # FRMW of the second slave: the first writes the master's bytes
         ("offset", 0),  # the master sets a new offset (the compiled plans must notice)
         ("write", 0),  # the master writes a system time itself (first slave only)
@@ -185,6 +187,10 @@ def test_compiled_dc_datagrams_answer_like_the_registers(sequence: list) -> None
             dgs = [Datagram(Command.FPWR, STATIONS[0], 0x0910, struct.pack("<Q", t * 3))]
         elif kind == "fprd":
             dgs = [Datagram(Command.FPRD, STATIONS[2], 0x0910, bytes(size))]
+        elif kind == "fprd1":
+            dgs = [Datagram(Command.FPRD, STATIONS[1], 0x0910, bytes(size))]
+        elif kind == "twin":
+            dgs = [Datagram(Command.APWR, (-2) & 0xFFFF, 0x0010, struct.pack("<H", STATIONS[1]))]
         else:
             cmd, adp = {
                 "lrw+armw": (Command.ARMW, 0),
