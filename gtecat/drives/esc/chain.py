@@ -169,10 +169,24 @@ class _DcPlan:
     shape stays on the register path.
     """
 
-    __slots__ = ("cmd", "consts", "gen", "mask", "nbytes", "readers", "stable", "wkc")
+    __slots__ = (
+        "adp_inc",
+        "brd",
+        "cmd",
+        "consts",
+        "gen",
+        "mask",
+        "nbytes",
+        "readers",
+        "stable",
+        "wkc",
+    )
 
-    def __init__(self, cmd: int, readers: list[Esc], stable: bool, nbytes: int) -> None:
+    def __init__(self, cmd: int, readers: list[Esc], stable: bool, nbytes: int, count: int) -> None:
         self.cmd = cmd
+        self.brd = cmd == Command.BRD
+        #: what the line adds to the address field (auto-increment and broadcast commands)
+        self.adp_inc = count if cmd in (Command.ARMW, Command.BRD, Command.APRD) else 0
         self.readers = readers
         #: no slave writes ahead of the reader: the plan may lock
         self.stable = stable
@@ -255,8 +269,11 @@ class Chain:
         #: counts changes of any ESC's system-time constants (locked DC plans compare it)
         self._dc_gen = 0
         #: the last frame of several datagrams that were all compiled (fast logical ones, DC
-        #: plans): (frame length, the header bytes that must match, the datagrams' plans)
-        self._multi: tuple[int, tuple[tuple[int, int, bytes], ...], tuple[tuple, ...]] | None = None
+        #: plans): (frame length, each datagram's (offset, command, address and length bytes),
+        #: their plans, EtherType and frame header)
+        self._multi: (
+            tuple[int, tuple[tuple[int, int, bytes], ...], tuple[tuple, ...], bytes] | None
+        ) = None
         self._multi_seen: list[tuple] | None = None
 
     @property
@@ -362,9 +379,9 @@ class Chain:
                 buf, cyclic[3], cyclic[4], self.clock() if t_ns is None else t_ns
             )
         multi = self._multi
-        if multi is not None and n == multi[0] and not self._deferred:
-            for a, b, want in multi[1]:
-                if buf[a:b] != want:
+        if multi is not None and n == multi[0] and buf[12:16] == multi[3] and not self._deferred:
+            for off, cmd, want in multi[1]:
+                if buf[off] != cmd or buf[off + 2 : off + 8] != want:
                     break
             else:  # the same frame of compiled datagrams again: no walk, no dispatch
                 return self._multi_answer(buf, multi[2], self.clock() if t_ns is None else t_ns)
@@ -378,14 +395,12 @@ class Chain:
         self.ft.t_ns = self.clock() if t_ns is None else t_ns
         self.process_data = False
         self._cyclic_seen = None
-        checks = None
+        checks = frame_header = None
         if len(offsets) > 1 and not self._deferred:
             # what a frame must repeat to be this one: EtherType and frame header, and each
             # datagram's command, address and length (as the master sent them)
-            checks = [(12, 16, bytes(buf[12:16]))]
-            for off in offsets:
-                checks.append((off, off + 1, bytes(buf[off : off + 1])))
-                checks.append((off + 2, off + 8, bytes(buf[off + 2 : off + 8])))
+            checks = [(off, buf[off], bytes(buf[off + 2 : off + 8])) for off in offsets]
+            frame_header = bytes(buf[12:16])
             self._multi_seen = []
         else:
             self._multi_seen = None
@@ -400,7 +415,8 @@ class Chain:
             self._cyclic = (n, *seen)
         ops = self._multi_seen
         if ops is not None and checks is not None and len(ops) == len(offsets):
-            self._multi = (n, tuple(checks), tuple(ops))  # every datagram was compiled
+            # every datagram was compiled
+            self._multi = (n, tuple(checks), tuple(ops), frame_header)
         buf[6] |= 0x02  # the source address comes back locally administered
         self.stats.frames += 1
         self.stats.datagrams += len(offsets)
@@ -450,8 +466,22 @@ class Chain:
                 wkc = fast.wkc
                 if wkc:
                     u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
-            else:
-                self._dc_datagram(dc, buf, off, d0, d1, t_ns)
+            elif dc.gen != self._dc_gen:
+                self._dc_datagram(dc, buf, off, d0, d1, t_ns)  # not locked (any more)
+            else:  # _dc_datagram's locked path, inline
+                consts = dc.consts
+                if dc.brd:
+                    value = int.from_bytes(buf[d0:d1], "little")
+                    for c in consts:
+                        value |= t_ns + c
+                    buf[d0:d1] = (value & dc.mask).to_bytes(dc.nbytes, "little")
+                elif consts:
+                    buf[d0:d1] = ((t_ns + consts[0]) & dc.mask).to_bytes(dc.nbytes, "little")
+                if dc.adp_inc:
+                    u16_pack(buf, off + 2, (u16_unpack(buf, off + 2)[0] + dc.adp_inc) & 0xFFFF)
+                wkc = dc.wkc
+                if wkc:
+                    u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
         self.process_data = pd
         buf[6] |= 0x02
         stats = self.stats
@@ -571,14 +601,14 @@ class Chain:
         """The plan of a system-time datagram (:class:`_DcPlan`), or None for another one."""
         plan: _DcPlan | None = None
         escs = self.escs
+        count = len(escs)
         if ado == 0x0910 and dlen in (4, 8):
-            count = len(escs)
             if cmd == Command.BRD:
-                plan = _DcPlan(cmd, list(escs), True, dlen)
+                plan = _DcPlan(cmd, list(escs), True, dlen, count)
             elif cmd in (Command.ARMW, Command.APRD):
                 pos = (-adp) & 0xFFFF
                 readers = [escs[pos]] if pos < count else []
-                plan = _DcPlan(cmd, readers, cmd == Command.APRD or pos == 0, dlen)
+                plan = _DcPlan(cmd, readers, cmd == Command.APRD or pos == 0, dlen, count)
             elif cmd in (Command.FRMW, Command.FPRD):
                 stations = self._stations if self._stations is not None else self._station_map()
                 found = stations.get(adp, [])
@@ -586,7 +616,7 @@ class Chain:
                 # address two slaves answer to stays with the register path
                 stable = len(found) == 1 and (cmd == Command.FPRD or found[0] is escs[0])
                 if len(found) <= 1 or cmd == Command.FRMW:
-                    plan = _DcPlan(cmd, found[:1], stable, dlen)
+                    plan = _DcPlan(cmd, found[:1], stable, dlen, len(escs))
         self._dc_plans[(cmd, adp, ado, dlen)] = plan
         return plan
 
@@ -595,7 +625,6 @@ class Chain:
     ) -> None:
         """Run a :class:`_DcPlan`: from its constants when locked, else the register path."""
         cmd = plan.cmd
-        count = len(self.escs)
         if plan.gen == self._dc_gen:
             mask = plan.mask
             if cmd == Command.BRD:
@@ -624,9 +653,9 @@ class Chain:
                 plan.gen = gen
                 plan.consts = tuple(e.system_time_constant() for e in plan.readers)
                 plan.wkc = wkc
-        if cmd == Command.ARMW or cmd == Command.BRD or cmd == Command.APRD:
+        if plan.adp_inc:
             adp = _U16.unpack_from(buf, off + 2)[0]
-            _U16.pack_into(buf, off + 2, (adp + count) & 0xFFFF)
+            _U16.pack_into(buf, off + 2, (adp + plan.adp_inc) & 0xFFFF)
         if wkc:
             _U16.pack_into(buf, d1, (_U16.unpack_from(buf, d1)[0] + wkc) & 0xFFFF)
 
