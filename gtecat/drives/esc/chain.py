@@ -617,6 +617,9 @@ class Chain:
                 stable = len(found) == 1 and (cmd == Command.FPRD or found[0] is escs[0])
                 if len(found) <= 1 or cmd == Command.FRMW:
                     plan = _DcPlan(cmd, found[:1], stable, dlen, len(escs))
+        if len(self._dc_plans) > 256:  # a master that sends ever new shapes: keep it bounded
+            self._dc_plans.clear()
+            self._multi = None
         self._dc_plans[(cmd, adp, ado, dlen)] = plan
         return plan
 
