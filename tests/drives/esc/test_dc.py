@@ -144,6 +144,39 @@ def test_brd_of_the_system_time_ors_every_clock() -> None:
         assert struct.unpack("<Q", got.data)[0] == want
 
 
+def test_sync0_activated_as_ec_dcsync0_does_reads_its_next_pulse() -> None:
+    """SOEM's ``ec_dcsync0(slave, TRUE, 1 ms, 0)``: deactivate, read the system time, start
+    100 ms ahead on a cycle boundary, cycle 1 ms, activate; 0990h then reads the system time
+    of the next SYNC0 pulse, 098Eh bit 0 once one came. ``ec_dcsync01`` adds SYNC1."""
+    chain = dc_chain()
+    configure_dc(chain)
+    station, cycle = STATIONS[1], 1_000_000
+    t = T_LATCH + 40_000_000
+
+    def fpwr(ado: int, data: bytes) -> None:
+        assert send(chain, [Datagram(Command.FPWR, station, ado, data)], t)[0].wkc == 1
+
+    fpwr(0x0981, b"\0")
+    fpwr(0x0980, b"\0")
+    now = u64(chain, station, 0x0910, t)
+    start = ((now + 100_000_000) // cycle) * cycle + cycle
+    fpwr(0x0990, struct.pack("<Q", start))
+    fpwr(0x09A0, struct.pack("<I", cycle))
+    fpwr(0x09A4, struct.pack("<I", 300_000))  # SYNC1 300 us after each SYNC0
+    fpwr(0x0981, b"\x07")  # cyclic operation, SYNC0, SYNC1
+    assert u64(chain, station, 0x0990, t) == start  # not yet: the first pulse is the start
+    assert send(chain, [Datagram(Command.FPRD, station, 0x098E, bytes(2))], t)[0].data == bytes(2)
+    later = t + (start - now) + 3 * cycle + cycle // 2  # 3.5 cycles after the start
+    assert u64(chain, station, 0x0990, later) == start + 4 * cycle
+    assert u64(chain, station, 0x0998, later) == start + 4 * cycle + 300_000
+    assert send(chain, [Datagram(Command.FPRD, station, 0x098E, bytes(2))], later)[0].data == (
+        b"\x01\x01"
+    )
+    t = later
+    fpwr(0x0981, b"\0")  # deactivated: the start time reads back as written
+    assert u64(chain, station, 0x0990, later) == start
+
+
 # --- the compiled DC datagrams answer exactly what the register path answers ---------------------
 def _general_only(chain: Chain) -> Chain:
     chain._dc_plan = lambda *key: None  # type: ignore[method-assign]
