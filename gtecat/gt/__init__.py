@@ -33,6 +33,7 @@ _MODULES = (
     "plcopen_calls",
     "ecat_io_calls",
     "gantry_calls",
+    "compare_calls",
 )
 
 
