@@ -34,6 +34,7 @@ _MODULES = (
     "ecat_io_calls",
     "gantry_calls",
     "compare_calls",
+    "crd_ex_calls",
 )
 
 
