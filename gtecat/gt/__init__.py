@@ -35,6 +35,7 @@ _MODULES = (
     "gantry_calls",
     "compare_calls",
     "crd_ex_calls",
+    "pvt_calls",
 )
 
 
