@@ -36,6 +36,7 @@ _MODULES = (
     "compare_calls",
     "crd_ex_calls",
     "pvt_calls",
+    "lead_screw_calls",
 )
 
 
