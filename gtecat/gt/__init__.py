@@ -37,6 +37,7 @@ _MODULES = (
     "crd_ex_calls",
     "pvt_calls",
     "lead_screw_calls",
+    "net_init_calls",
 )
 
 

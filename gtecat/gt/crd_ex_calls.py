@@ -78,14 +78,14 @@ def GT_LnXYZG0Ex(ctl, crd, x, y, z, synVel, synAcc, segNum, override2, fifo=0) -
 
 
 @gt_function
-def GT_LnXYZAEx(ctl, crd, x, y, z, a, synVel, synAcc, segNum, override2, fifo=0) -> int:
-    v = {0: x, 1: y, 2: z, 3: a}
+def GT_LnXYZAEx(ctl, crd, x, y, z, aPos, synVel, synAcc, segNum, override2, fifo=0) -> int:
+    v = {0: x, 1: y, 2: z, 3: aPos}
     return _line(ctl, crd, "GT_LnXYZAEx", v, synVel, synAcc, segNum, override2, fifo)
 
 
 @gt_function
-def GT_LnXYZAG0Ex(ctl, crd, x, y, z, a, synVel, synAcc, segNum, override2, fifo=0) -> int:
-    v = {0: x, 1: y, 2: z, 3: a}
+def GT_LnXYZAG0Ex(ctl, crd, x, y, z, aPos, synVel, synAcc, segNum, override2, fifo=0) -> int:
+    v = {0: x, 1: y, 2: z, 3: aPos}
     return _line(ctl, crd, "GT_LnXYZAG0Ex", v, synVel, synAcc, segNum, override2, fifo)
 
 

@@ -19,7 +19,7 @@ short GT_2DCompareClear(short chn /*0..1*/);  // header (GTS)
 short GT_2DCompareClearData(short chn /*0..1*/);  // header (GTS)
 short GT_2DCompareStatus(short chn /*0..1*/, short *pStatus, long *pCount, short *pFifo, short *pFifoCount, short *pBufCount=NULL);  // header (GTS)
 short GT_2DCompareSetPrm(short chn /*0..1*/, T2DComparePrm *pPrm /*in*/);  // header (GTS)
-short GT_2DCompareData(short chn /*0..1*/, short count, T2DCompareData *pBuf /*in[?]*/, short fifo /*0..1*/);  // header (GTS)
+short GT_2DCompareData(short chn /*0..1*/, short count, T2DCompareData *pBuf /*in[count]*/, short fifo /*0..1*/);  // header (GTS)
 short GT_2DCompareStart(short chn /*0..1*/);  // header (GTS)
 
 // position compare of the GTN header: the GT_ and GTN_ forms both take the core first
