@@ -47,6 +47,8 @@ from tests.gtecat.gt.conftest import bring_up
 # --- the fuzzer, in child processes --------------------------------------------------------------
 STATE_CHANGING = {
     "Open",
+    "OpenCard",
+    "NetInit",
     "Close",
     "Reset",
     "InitEcatComm",
