@@ -68,6 +68,7 @@ def test_2d_compare_fires_along_the_diagonal_and_waits_for_a_point_off_the_path(
     assert (st, cnt) == (0, 5)  # (7000, 9000) is off the path: the channel waits for it
     assert gt.GT_2DComparePulse(0, 1, 0, 50) == 0 and status2d(0)[1] == 6
     assert gt.GT_2DCompareStop(0) == 0 and status2d(0)[0] == 1
+    assert gt.GT_2DCompareClearData(0) == 0 and status2d(0)[1] == 6  # the count stays
     assert gt.GT_2DCompareClear(0) == 0 and status2d(0)[1] == 0
     assert gt.GT_2DCompareStart(0) == 1  # no points
     assert gt.GT_2DCompareData(0, 0, pts, 0) == 7
@@ -130,7 +131,18 @@ def test_gtn_position_compare_fifo_and_linear():
     assert gt.GTN_SetPosCompareLinear(1, 3, byref(one)) == 0
     assert gt.GT_GetPosCompareLinear(1, 3, byref(got := gt.TPosCompareLinear())) == 0
     assert got.interval == 50
-    assert gt.GT_PosCompareStart(1, 4) == 1  # no mode
+    assert gt.GTN_GetPosCompareLinear(1, 3, byref(got)) == 0 and got.count == 2
+    assert gt.GTN_PosCompareStop(1, 2) == 0 and gt.GTN_PosCompareClear(1, 2) == 0
+    # FIFO, two dimensions: a point of the plane reached on the way back
+    mode.mode, mode.dimension = 0, 2
+    assert gt.GT_SetPosCompareMode(1, 4, byref(mode)) == 0
+    assert gt.GTN_PosCompareData2D(1, 4, byref(gt.TPosCompareData2D(posX=1000, posY=0))) == 0
+    assert gt.GTN_SetPosCompareLinear2D(1, 4, byref(lin)) == 1  # a FIFO unit
+    assert gt.GTN_PosCompareStart(1, 4) == 0
+    trap(1, 0)
+    run(0b1)
+    assert gt.GT_PosCompareStatus(1, 4, byref(st)) == 0 and (st.run, st.pulseCount) == (0, 1)
+    assert gt.GT_PosCompareStart(1, 5) == 1  # no mode
     assert gt.GT_SetPosCompareMode(1, 9, byref(mode)) == 7
 
 
