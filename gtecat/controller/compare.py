@@ -57,6 +57,9 @@ class CompareChannel:
     count: int = 0  #: outputs fired
     level: int = 0
     last: Point | None = None
+    #: called with the new level after a level output toggles (the output routed to a
+    #: terminal: GT_SetComparePort)
+    on_level: Callable[[int], None] | None = None
     received: int = 0  #: points pushed since the last clear
     sent: int = 0  #: points that fired since the last clear
     _prev: tuple[float, ...] | None = None
@@ -108,6 +111,8 @@ class CompareChannel:
         self.count += 1
         if not self.pulse:
             self.level ^= 1
+            if self.on_level is not None:
+                self.on_level(self.level)
         if point is not None:
             self.last = point
             self.sent += 1

@@ -31,6 +31,12 @@ what the arguments mean.  Decisions where they say no more:
   (never below 0).
 * ``GT_2DComparePulse(chn, level, outputType, time)``: one output now: it counts; a level
   output (``outputType`` 1) takes ``level`` (0 the start level, 1 its opposite).
+* ``GT_SetComparePort(channel, hsio0, hsio1)``: ``COMPARE_PORT_HSIO`` (0, the default) sends
+  the two channels to the card's HSIO pins, which are not terminals of the emulated card;
+  ``COMPARE_PORT_GPO`` (1) to general outputs ``hsio0 + 1`` and ``hsio1 + 1`` (``hsio``
+  0..15 counts from 0).  There a level output is seen with ``GT_GetDo(MC_GPO)``: every
+  toggle inverts that output (the vendor says to set it high, its idle state, first); a
+  pulse is shorter than a cycle and leaves it as it is.
 
 **Position compare (GTN header)**, ``index`` 1..8; the ``GT_`` form takes the core first
 too, as the vendor's header declares it.
@@ -83,7 +89,7 @@ from ..controller.resources import axis_resources, position_source, resource_cou
 from ..controller.trigger import Edge, Trigger, triggers
 from ..errors import CommandError, ParameterError
 from ._core import SESSION, check_range, gt_function, store, struct_arg
-from .constants import MC_GPI, MC_HOME
+from .constants import MC_GPI, MC_GPO, MC_HOME
 
 MC_ENCODER, MC_AXIS, MC_PROFILE = 23, 30, 31
 _FPGA_POINTS = 512
@@ -176,6 +182,7 @@ def GT_2DCompareStart(ctl: Controller, chn: int) -> int:
         raise CommandError(
             f"GT_2DCompareStart: channel {chn} has no parameters (GT_2DCompareSetPrm)"
         )
+    _route(ctl, chn, u)
     u.start()
     return 0
 
@@ -232,12 +239,50 @@ def GT_2DComparePulse(ctl: Controller, chn: int, level: int, outputType: int, ti
     """One output now (it counts); a level output takes ``level``."""
     u, s = _unit2d(ctl, chn)
     if int(outputType) == 1:
-        u.fire()
-        u.level = s.start_level ^ int(level)
+        want = s.start_level ^ int(level)
+        u.count += 1
+        if want != u.level:
+            _route(ctl, chn, u)
+            u.level = want
+            if u.on_level is not None:
+                u.on_level(want)
     else:
         if int(time) < 1:
             raise ParameterError(f"time={time}: the pulse length in us, >= 1")
         u.count += 1
+    return 0
+
+
+class _Port:
+    __slots__ = ("gpo",)
+
+    def __init__(self) -> None:
+        self.gpo: tuple[int, int] | None = None
+
+
+def _route(ctl: Controller, chn: int, u: CompareChannel) -> None:
+    """Send channel ``chn``'s level toggles to its general output (GT_SetComparePort)."""
+    port = compare_units(ctl).settings.setdefault("port", _Port())
+    if port.gpo is None:
+        u.on_level = None
+        return
+    bit = 1 << port.gpo[int(chn)]
+
+    def toggle(level: int) -> None:
+        from .io_calls import read_do, write_do
+
+        write_do(ctl, MC_GPO, read_do(ctl, MC_GPO) ^ bit)
+
+    u.on_level = toggle
+
+
+@gt_function
+def GT_SetComparePort(ctl: Controller, channel: int, hsio0: int, hsio1: int) -> int:
+    """0 the HSIO pins, 1 general outputs hsio0 + 1 and hsio1 + 1."""
+    port = compare_units(ctl).settings.setdefault("port", _Port())
+    port.gpo = (int(hsio0), int(hsio1)) if int(channel) == 1 else None
+    for chn in (0, 1):
+        _route(ctl, chn, _unit2d(ctl, chn)[0])
     return 0
 
 

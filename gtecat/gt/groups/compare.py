@@ -21,6 +21,7 @@ short GT_2DCompareStatus(short chn /*0..1*/, short *pStatus, long *pCount, short
 short GT_2DCompareSetPrm(short chn /*0..1*/, T2DComparePrm *pPrm /*in*/);  // header (GTS)
 short GT_2DCompareData(short chn /*0..1*/, short count, T2DCompareData *pBuf /*in[count]*/, short fifo /*0..1*/);  // header (GTS)
 short GT_2DCompareStart(short chn /*0..1*/);  // header (GTS)
+short GT_SetComparePort(short channel /*0..1*/, short hsio0 /*0..15*/, short hsio1 /*0..15*/);  // header (GTS)
 
 // position compare of the GTN header: the GT_ and GTN_ forms both take the core first
 short GT_SetPosCompareMode(short core, short index /*1..8*/, TPosCompareMode *pMode /*in*/);  // header (GTN)

@@ -39,6 +39,12 @@ def run(mask: int) -> None:
     raise AssertionError("the axes never stopped")
 
 
+def gpo() -> int:
+    v = c_long()
+    assert gt.GT_GetDo(gt.MC_GPO, byref(v)) == 0
+    return v.value
+
+
 def status2d(chn: int) -> tuple[int, int, int, int, int]:
     st, cnt, fifo, room, buf = c_short(), c_long(), c_short(), c_short(), c_short()
     assert (
@@ -81,6 +87,21 @@ def test_2d_compare_fires_along_the_diagonal_and_waits_for_a_point_off_the_path(
     run(0b1)
     assert status2d(1)[:2] == (1, 3)
     assert gt.GT_2DCompareStart(3) == 7
+    # a level output on general output 3 (COMPARE_PORT_GPO, hsio 2): it toggles at each point
+    assert gt.GT_SetComparePort(gt.COMPARE_PORT_GPO, 2, 5) == 0
+    assert gt.GT_SetDoBit(gt.MC_GPO, 3, 1) == 0  # high first, as the vendor says
+    prm.outputType = 1
+    assert gt.GT_2DCompareMode(0, 0) == 0 and gt.GT_2DCompareSetPrm(0, byref(prm)) == 0
+    xs = (gt.T2DCompareData * 2)(gt.T2DCompareData(3000, 0), gt.T2DCompareData(5000, 0))
+    assert gt.GT_2DCompareData(0, 2, xs, 0) == 0 and gt.GT_2DCompareStart(0) == 0
+    trap(1, 4000)
+    run(0b1)
+    assert gpo() & 0b100 == 0  # toggled once
+    trap(1, 6000)
+    run(0b1)
+    assert gpo() & 0b100 and status2d(0)[:2] == (1, 2)
+    assert gt.GT_2DComparePulse(0, 1, 1, 0) == 0 and not gpo() & 0b100
+    assert gt.GT_SetComparePort(gt.COMPARE_PORT_HSIO, 0, 1) == 0
 
 
 def test_gtn_position_compare_fifo_and_linear():
