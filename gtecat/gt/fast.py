@@ -323,6 +323,11 @@ def fast_raw(
 #: covered here (tests/gtecat/gt/test_fast_shapes.py walks the table).
 SLOW_REASONS: dict[str, str] = {
     "buffered": "buffered commands: each call queues planning work that outweighs its arguments",
+    "compare": "position compare and trigger set-up, data and status: table path",
+    "crd_ex": "extended coordinated-motion queue calls: the planning work outweighs the arguments",
+    "lead_screw": "lead-screw compensation tables: set up once",
+    "net_init": "network cards' set-up and their encoder readers: table path",
+    "pvt": "PVT tables and status: the table work outweighs the arguments",
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
     "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
