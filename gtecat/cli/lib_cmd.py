@@ -70,8 +70,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def _abi(args: argparse.Namespace) -> str:
+    return "" if args.abi == "gtn" else args.abi
+
+
 def run(args: argparse.Namespace) -> int:
-    abi = "" if args.abi == "gtn" else args.abi
+    abi = _abi(args)
     if args.mono_config or args.csharp:
         return _csharp(args)
     if args.header:
@@ -114,7 +118,7 @@ def _csharp(args: argparse.Namespace) -> int:
     else:
         from ..native.llp64 import ensure_built
 
-        text = csharp.mono_config(ensure_built(force=args.rebuild))
+        text = csharp.mono_config(ensure_built(force=args.rebuild, abi=_abi(args)))
     if args.output:
         Path(args.output).write_text(text, encoding="utf-8")
     else:
