@@ -489,16 +489,7 @@ class AxisBank:
                 return False
         else:
             return False
-        enc = res.encoder
-        if not (enc._primed and enc.active):
-            return False
-        s = res.safety
-        n = ax.number
-        if s.alarm_input not in (n, None) or s.smooth_stop_input or s.abrupt_stop_input:
-            return False
-        if s.positive_input not in (n, None) or s.negative_input not in (n, None):
-            return False
-        if res._pos_din is not ax.io.get(0x60FD) and res._pos_din is not None:
+        if not self._inputs_plain(ax, res):
             return False
         return not claimable(self.csp.channels[r])
 
@@ -579,7 +570,11 @@ class AxisBank:
             return False
         if s.positive_input not in (n, None) or s.negative_input not in (n, None):
             return False
-        return res._pos_din is ax.io.get(0x60FD) or res._pos_din is None
+        din = ax.io.get(0x60FD)
+        if any(e is not None and e is not din for e in (res._pos_din, res._neg_din)):
+            return False  # a configuration's reverse (SensedInput) or another source
+        # the alarm read through a reverse: the kernel reads 6041h as it is
+        return res._alarm_sw is res._sw
 
     def refresh(self) -> None:
         """Claim every slave whose axes are all eligible; drop all when the bank cannot run."""
