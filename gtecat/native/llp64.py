@@ -95,8 +95,10 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Path:
 
 
 def _ensure_multicard(*, force: bool, abi: str) -> Path:
-    base = ensure_built(force=force)  # libgts-llp64.so, the library the layer calls
-    build = _build.ensure_built(force=force, abi=abi)  # its folder names the same table
+    # libgts_mc's folder (it names the same table); forced, this compiles libgts again too,
+    # which empties libgts's folder, so libgts-llp64.so is asked for after it, unforced
+    build = _build.ensure_built(force=force, abi=abi)
+    base = ensure_built()  # libgts-llp64.so, the library the layer calls
     target = build.lib_dir / MULTICARD_LIBRARY
     if target.is_file() and not force:
         return target
