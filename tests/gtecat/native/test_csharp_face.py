@@ -77,9 +77,14 @@ def test_the_multicard_llp64_layer_spells_long_as_int():
 
 def test_lib_csharp_refuses_the_multicard_abi(capsys):
     """gts.cs is the one-card API: --abi gts-multicard --csharp says so instead of writing it."""
-    from gtecat.cli.main import main
+    import argparse
 
-    assert main(["lib", "--abi", "gts-multicard", "--csharp"]) == 1
+    from gtecat.cli import lib_cmd
+
+    parser = argparse.ArgumentParser()
+    lib_cmd.add_parser(parser.add_subparsers())  # the lib verb alone: no other verb imported
+    args = parser.parse_args(["lib", "--abi", "gts-multicard", "--csharp"])
+    assert args.func(args) == 1
     out = capsys.readouterr().out
     assert out.startswith("error: --csharp writes gts.cs for the one-card API only")
     assert "--abi gts-multicard --mono-config" in out
