@@ -394,6 +394,8 @@ class AxisBank:
             return "per-cycle hooks"
         if ctl.backend.unplugged:
             return "a slave is unplugged"
+        if ctl.backend.answer_hook is not None:
+            return "faults on the frames (gtecat.faults)"
         for res in ctl.resources.values():  # never the Axis objects: they may be guarded
             if res.profile.mode in (PrfMode.GEAR, PrfMode.FOLLOW):
                 return "an axis follows another (Gear/Follow)"
