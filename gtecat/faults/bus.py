@@ -27,6 +27,10 @@ from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
 from ..errors import ParameterError
 
 
+def _no_objects(_od: Any) -> None:
+    pass
+
+
 class FaultBus:
     """What an injector needs of a bus (subclasses: :class:`EmulatedBus`, :class:`WireBus`)."""
 
@@ -58,7 +62,7 @@ class FaultBus:
     def set_frame_faults(self, on: bool) -> None:
         """Route the cyclic answers through the injector (on) or not."""
 
-    # --- what the faults reach -------------------------------------------------------------
+    # --- what the faults reach ----------------------------------------
     def slave(self, position: int) -> VirtualSlave:
         slaves = self.slaves
         if not 0 <= position < len(slaves):
@@ -102,7 +106,7 @@ class FaultBus:
         h = self.channel(axis).homing
         return "" if h is None else h.phase.name.lower()
 
-    # --- slaves ----------------------------------------------------------------------------
+    # --- slaves ----------------------------------------
     def power_cycle(self, position: int) -> None:
         """Power gone and back: INIT, the AL error gone, the drive's settings at power-on
         values (its mechanics stay where they are; an incremental encoder forgets its home)."""
@@ -118,7 +122,12 @@ class FaultBus:
         if isinstance(s, Cia402Drive):
             for ch in s.channels:
                 pos, ff = ch.mech.pos, ch.field
-                Channel.__init__(ch, s, ch.k, replace(ch.machine, position=pos))
+                # the power-on values of every setting; the objects stay registered
+                ch._add_objects = _no_objects  # type: ignore[method-assign]
+                try:
+                    Channel.__init__(ch, s, ch.k, replace(ch.machine, position=pos))
+                finally:
+                    del ch._add_objects
                 ch.field = ff
 
     def fall(self, position: int, state: AlState, code: int) -> None:

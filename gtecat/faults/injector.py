@@ -90,7 +90,7 @@ class Injector:
         bus._hook = self.answer if bus.name == "emulated" else self.frame  # type: ignore[attr-defined]
         self._wrap_mailboxes()
 
-    # --- adding and clearing ------------------------------------------------------------------
+    # --- adding and clearing ----------------------------------------
     def add(
         self,
         fault: k.Fault,
@@ -159,7 +159,7 @@ class Injector:
                 f"slaves 0..{len(self.bus.slaves) - 1})"
             )
 
-    # --- the cycle --------------------------------------------------------------------------------
+    # --- the cycle ----------------------------------------
     def tick(self, _t_ns: int = 0, _dt_ns: int = 0) -> None:
         if not self.entries:
             return
@@ -220,7 +220,7 @@ class Injector:
             self.bank_safe = safe
             self.bus.before_change()
 
-    # --- start and end ----------------------------------------------------------------------------
+    # --- start and end ----------------------------------------
     def _start(self, e: Entry) -> None:
         e.state = "active"
         e.started_ms = self.bus.now_ms()
@@ -345,7 +345,7 @@ class Injector:
             except AttributeError:
                 pass
 
-    # --- the mailbox --------------------------------------------------------------------------------
+    # --- the mailbox ----------------------------------------
     def _wrap_mailboxes(self) -> None:
         for s in self.bus.slaves:
             if not s.has_mailbox or s.position in self._mailboxes:
@@ -407,7 +407,7 @@ class Injector:
                     return _protocol_fault(request, f.variant)
         return inner(request)
 
-    # --- cyclic answers -------------------------------------------------------------------------------
+    # --- cyclic answers ----------------------------------------
     def answer(self, wkc: int) -> tuple[int, int]:
         """The emulated bus's cyclic LRW answer: (ANSWERED | LOST | PREVIOUS, working counter)."""
         action = ANSWERED
@@ -510,7 +510,7 @@ class Injector:
         return f.area[0] < a0 + dlen and a0 < f.area[1]
 
 
-# --- mailbox messages -------------------------------------------------------------------------------
+# --- mailbox messages ----------------------------------------
 _STEP_OF_CCS = {1: "download_init", 0: "download_segment", 2: "upload_init", 3: "upload_segment"}
 
 

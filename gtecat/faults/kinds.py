@@ -92,7 +92,7 @@ def _times(count: int) -> str:
     return "once" if count == 1 else f"{count} times"
 
 
-# --- the frame -------------------------------------------------------------------------------
+# --- the frame ----------------------------------------
 @_register
 @dataclass(kw_only=True)
 class DropResponses(Fault):
@@ -192,7 +192,7 @@ class FrameDelay(Fault):
         return f"answers delayed by {self.us} us, {_times(self.count)}"
 
 
-# --- the slave -------------------------------------------------------------------------------
+# --- the slave ----------------------------------------
 @_register
 @dataclass(kw_only=True)
 class PowerCycle(Fault):
@@ -237,7 +237,7 @@ class AlError(Fault):
         return f"slave {self.slave} latches AL status 0x{self.code:04X} in {self.state.upper()}"
 
 
-# --- the mailbox -----------------------------------------------------------------------------
+# --- the mailbox ----------------------------------------
 @_register
 @dataclass(kw_only=True)
 class MailboxAbort(Fault):
@@ -302,7 +302,7 @@ class MailboxLost(Fault):
         )
 
 
-# --- the drive -------------------------------------------------------------------------------
+# --- the drive ----------------------------------------
 @_register
 @dataclass(kw_only=True)
 class DriveFault(Fault):
@@ -356,7 +356,7 @@ class Brake(Fault):
         return f"holding brake of axis {self.axis} stuck closed"
 
 
-# --- the machine and the field ---------------------------------------------------------------
+# --- the machine and the field ----------------------------------------
 @_register
 @dataclass(kw_only=True)
 class SwitchStuck(Fault):
