@@ -39,6 +39,7 @@ COMMANDS = (
     "scan_cmd",
     "ps_cmd",
     "panel_cmd",
+    "fault_cmd",
 )
 
 
