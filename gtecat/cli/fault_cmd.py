@@ -126,9 +126,7 @@ def run(args: argparse.Namespace) -> int:
         elif not got:
             print("no fault armed or active")
         else:
-            output.print_table(
-                got, [("id", "id"), ("state", "state"), ("describe", "fault")]
-            )
+            output.print_table(got, [("id", "id"), ("state", "state"), ("describe", "fault")])
         return 0
     with _connect(args) as conn:
         n = conn.call("fault_clear", args.id)

@@ -40,6 +40,8 @@ COMMANDS = (
     "ps_cmd",
     "panel_cmd",
     "fault_cmd",
+    "record_cmd",
+    "replay_cmd",
 )
 
 

@@ -52,6 +52,23 @@ class FaultSpec:
             text += f", for {self.duration_ms:g} ms"
         return text
 
+    def as_dict(self) -> dict[str, Any]:
+        d = {**self.fault.as_dict(), **self.trigger.as_dict()}
+        if self.duration_ms is not None:
+            d["duration_ms"] = self.duration_ms
+        if self.after is not None:
+            d["after"] = self.after
+        if self.name:
+            d["name"] = self.name
+        return d
+
+
+def _tell(what: str, values: dict[str, Any]) -> None:
+    from .injector import OBSERVERS
+
+    for fn in list(OBSERVERS):
+        fn(what, values)
+
 
 def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
     """A ``[[fault]]`` table (or ``key=value`` pairs) as a :class:`FaultSpec`."""
@@ -175,7 +192,9 @@ def inject(
         spec = spec_from_dict({"kind": kind, **values})
     inj = injector_for(ctl)
     assert inj is not None
-    return arm(inj, [spec])[0].id
+    fid = arm(inj, [spec])[0].id
+    _tell("inject", spec.as_dict())
+    return fid
 
 
 def script(steps: list[dict[str, Any]], *, core: int = 1, ctl: Any = None) -> list[int]:
@@ -190,6 +209,7 @@ def script(steps: list[dict[str, Any]], *, core: int = 1, ctl: Any = None) -> li
         if ids and spec.after is None:
             spec.after = ids[-1]
         ids.append(arm(inj, [spec])[0].id)
+        _tell("inject", spec.as_dict())
     return ids
 
 
@@ -201,7 +221,9 @@ def clear(ident: int | None = None, *, core: int = 1, ctl: Any = None) -> int:
         if ident is not None:
             raise ParameterError(f"no fault {ident}: none was injected")
         return 0
-    return inj.clear(ident)
+    n = inj.clear(ident)
+    _tell("clear", {"id": ident})
+    return n
 
 
 def listing(*, core: int = 1, ctl: Any = None) -> list[dict[str, Any]]:
@@ -247,3 +269,21 @@ __all__ = [
     "spec_from_dict",
     "specs_from_tables",
 ]
+
+
+def _record_from_environment() -> None:
+    """``GTECAT_RECORD=FILE`` (set by ``gtecat record`` for a program it starts): record this
+    process's GT calls into FILE, written when the process ends."""
+    import atexit
+    import os
+
+    path = os.environ.get("GTECAT_RECORD")
+    if not path:
+        return
+    from .record import Recorder
+
+    rec = Recorder(path, {"program": os.environ.get("GTECAT_RECORD_PROGRAM", "")}).start()
+    atexit.register(rec.write)
+
+
+_record_from_environment()

@@ -37,6 +37,11 @@ _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
 
 
+#: called with ("inject", values) / ("clear", {"id": N}) for every fault a program or an
+#: operator adds or ends (recordings keep them in the stream)
+OBSERVERS: list[Any] = []
+
+
 @dataclass(eq=False)
 class Entry:
     id: int

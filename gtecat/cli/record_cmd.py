@@ -1,0 +1,102 @@
+"""``gtecat record -o FILE -- COMMAND ...``: run a program and record its whole GT session.
+
+Every GT call (name, arguments, values written back, return code, controller time), every
+fault injected from the program or ``gtecat fault``, and the bus state every 100 ms of
+controller time go into FILE (JSON lines; gzip when FILE ends in ``.gz``).  A Python script
+(``python3 my_machine.py`` or ``my_machine.py``) runs in this process; any other command
+runs as a child with ``GTECAT_RECORD=FILE`` in its environment (a Python program that
+imports gtecat records itself).  ``gtecat replay FILE`` re-runs the session.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import runpy
+import subprocess
+import sys
+from pathlib import Path
+
+from ..errors import ParameterError
+from . import output
+
+EPILOG = """\
+examples:
+  gtecat record -o session.gtrec -- python3 first_script.py
+  gtecat record -o session.gtrec.gz -- first_script.py
+  gtecat replay session.gtrec"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "record",
+        help="run a program and record its GT calls, faults and bus state for gtecat replay",
+        description=output.describe(__doc__),
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("-o", "--output", required=True, type=Path, help="the recording to write")
+    p.add_argument("command", nargs=argparse.REMAINDER, help="-- COMMAND [ARGS...]")
+    p.set_defaults(func=run)
+
+
+def _script(command: list[str]) -> tuple[Path, list[str]] | None:
+    """The Python script a command runs (to run it here), else None."""
+    if command and command[0].endswith(".py"):
+        return Path(command[0]), command[1:]
+    if (
+        len(command) >= 2
+        and Path(command[0]).name.startswith("python")
+        and command[1].endswith(".py")
+    ):
+        return Path(command[1]), command[2:]
+    return None
+
+
+def run(args: argparse.Namespace) -> int:
+    command = list(args.command)
+    if command and command[0] == "--":
+        command = command[1:]
+    if not command:
+        raise ParameterError("no command to record: gtecat record -o FILE -- python3 SCRIPT.py")
+    out: Path = args.output
+    if out.is_dir():
+        raise ParameterError(f"-o {out} is a folder; name the recording file")
+    if not out.parent.exists():
+        raise ParameterError(f"-o {out}: folder {out.parent} does not exist")
+    script = _script(command)
+    if script is None:
+        env = dict(os.environ, GTECAT_RECORD=str(out.resolve()))
+        env["GTECAT_RECORD_PROGRAM"] = " ".join(command)
+        try:
+            rc = subprocess.call(command, env=env)
+        except OSError as e:
+            raise ParameterError(f"cannot run {command[0]}: {e.strerror or e}") from None
+        if not out.exists():
+            print(
+                "record: nothing recorded (the program made no GT call through gtecat)",
+                file=sys.stderr,
+            )
+        return rc
+    path, script_args = script
+    if not path.is_file():
+        raise ParameterError(f"{path}: no such script")
+    from .. import gt
+    from ..faults.record import Recorder
+
+    rec = Recorder(out, {"program": " ".join(command)}).start()
+    saved_argv, saved_path = sys.argv, list(sys.path)
+    sys.argv = [str(path), *script_args]
+    sys.path.insert(0, str(path.resolve().parent))
+    rc = 0
+    try:
+        runpy.run_path(str(path), run_name="__main__")
+    except SystemExit as e:
+        rc = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+    finally:
+        gt.GT_Close()
+        rec.stop()
+        sys.argv, sys.path[:] = saved_argv, saved_path
+    rec.write()
+    print(f"record: {rec.calls} GT calls -> {out}", file=sys.stderr)
+    return rc
