@@ -336,7 +336,12 @@ def test_mailbox_abort_lost_answer_and_protocol_fault() -> None:
 def test_abort_at_a_download_step_on_the_nth_sdo() -> None:
     up()
     faults.inject(
-        "mailbox_abort", slave=0, index=0x6081, code=0x06090031, step="download_init", on_sdo=[0, 0x6081, 2]
+        "mailbox_abort",
+        slave=0,
+        index=0x6081,
+        code=0x06090031,
+        step="download_init",
+        on_sdo=[0, 0x6081, 2],
     )
     data, abort = (c_ubyte * 4)(1, 0, 0, 0), c_uint32()
     assert gt.GT_EcatSDODownload(0, 0x6081, 0, data, 4, byref(abort)) == 0  # the 1st passes

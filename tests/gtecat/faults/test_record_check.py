@@ -1,0 +1,158 @@
+"""Recordings and replays, application checks, the command line, the pytest plugin's options."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from gtecat.cli.main import main
+from tests.conftest import EXAMPLES
+
+SCRIPT = textwrap.dedent(
+    f"""
+    from ctypes import byref, c_long, c_short, c_ubyte, c_uint32
+    from gtecat import faults, gt
+
+    gt.GT_Open(eni={str(EXAMPLES / "full_servo.eni")!r}, clock="auto", log="")
+    gt.GT_InitEcatComm()
+    st, clock = c_short(), c_long()
+    while gt.GT_IsEcatReady(byref(st)) == 0 and st.value != 1:
+        gt.GTE_Wait(1)
+    gt.GT_StartEcatComm()
+    raw = (c_ubyte * 2)(0x0F, 0)
+    gt.GT_SetEcatRawData(0, 2, raw)
+    gt.GTE_Wait(5)
+    gt.GT_AxisOn(1)
+    prm = gt.TTrapPrm()
+    prm.acc = prm.dec = 0.5
+    gt.GT_PrfTrap(1)
+    gt.GT_SetTrapPrm(1, byref(prm))
+    gt.GT_SetPos(1, 20000)
+    gt.GT_SetVel(1, 10)
+    gt.GT_Update(1)
+    faults.inject("drive_fault", axis=1, code=0x2310, after_ms=200)
+    sts = c_long()
+    for _ in range(60):
+        gt.GTE_Wait(10)
+        gt.GT_GetSts(1, byref(sts))
+    gt.GT_Update(1)
+    data, size, ab = (c_ubyte * 4)(), c_uint32(), c_uint32()
+    gt.GT_EcatSDOUpload(0, 0x603F, 0, data, 4, byref(size), byref(ab))
+    gt.GT_Close()
+    """
+)
+
+
+@pytest.fixture(autouse=True)
+def _closed():
+    gt.GT_Close()
+    yield
+    gt.GT_Close()
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("rec")
+    (folder / "app.py").write_text(SCRIPT)
+    out = folder / "session.gtrec"
+    assert main(["record", "-o", str(out), "--", "python3", str(folder / "app.py")]) == 0
+    return out
+
+
+def test_record_then_replay_matches(recorded: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    lines = recorded.read_text().splitlines()
+    head = json.loads(lines[0])
+    assert head["gtecat_recording"] == 1 and head["calls"] > 80
+    entries = [json.loads(x) for x in lines[1:]]
+    assert any(e.get("f") == "inject" and e["v"]["kind"] == "drive_fault" for e in entries)
+    assert any("cp" in e for e in entries)
+    sts = [e for e in entries if e.get("c") == "GT_GetSts"]
+    assert any(int(e["o"]["1"]["ref"]["v"]) & 2 for e in sts if "o" in e)  # the alarm was seen
+    assert main(["replay", str(recorded)]) == 0
+    assert "calls match" in capsys.readouterr().out
+
+
+def test_replay_reports_the_first_divergence(
+    recorded: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = recorded.read_text().splitlines()
+    for i, line in enumerate(lines):
+        e = json.loads(line)
+        if e.get("c") == "GT_GetSts" and "o" in e:
+            e["o"]["1"]["ref"]["v"] ^= 0x10
+            lines[i] = json.dumps(e)
+            break
+    bad = tmp_path / "bad.gtrec"
+    bad.write_text("\n".join(lines) + "\n")
+    assert main(["replay", str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "GT_GetSts: argument 2 recorded" in err and "replay gives" in err
+    (tmp_path / "junk").write_text("hello\n")
+    assert main(["replay", str(tmp_path / "junk")]) == 1
+    assert "not a gtecat recording" in capsys.readouterr().err
+
+
+def test_checks_name_the_script_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    app = tmp_path / "app.py"
+    app.write_text(SCRIPT)
+    assert main(["run", "--check", "--no-progress", str(app)]) == 0
+    err = capsys.readouterr().err
+    found = [x for x in err.splitlines() if x.startswith("check: ")]
+    assert any(f"{app}:12:" in x and "skips a state" in x for x in found), err
+    assert any(
+        f"{app}:27:" in x and "GT_Update starts axis 1 while its alarm bit is set" in x
+        for x in found
+    ), err
+
+
+def test_fault_kinds_and_refusals(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["fault", "kinds", "--json"]) == 0
+    kinds = {r["kind"] for r in json.loads(capsys.readouterr().out)}
+    assert {"drive_fault", "link_down", "drop_responses", "mailbox_abort", "switch_stuck"} <= kinds
+    assert main(["fault", "inject", "melt_down"]) == 1
+    assert "unknown fault kind" in capsys.readouterr().err
+    assert main(["fault", "inject", "drive_fault", "axis"]) == 1
+    assert "KEY=VALUE" in capsys.readouterr().err
+
+
+PLUGIN_TESTS = textwrap.dedent(
+    """
+    from ctypes import byref, c_long
+
+    def test_a_drive_fault(gtecat_bus, gtecat_faults):
+        gtecat_bus.axis_on(1)
+        gtecat_faults.inject("drive_fault", axis=1, code=0x2310, after_cycles=5)
+        gtecat_bus.wait(20)
+        sts = c_long()
+        gtecat_bus.gt.GT_GetSts(1, byref(sts))
+        assert sts.value & 2
+        assert gtecat_faults.listing()[0]["state"] == "active"
+
+    def test_fails_and_keeps_its_recording(gtecat_bus):
+        gtecat_bus.gt.GT_SetEcatRawData(0, 2, (__import__("ctypes").c_ubyte * 2)(0x0F, 0))
+        gtecat_bus.wait(3)
+        assert False, "on purpose"
+    """
+)
+
+
+def test_plugin_fixture_record_and_check(tmp_path: Path) -> None:
+    (tmp_path / "test_m.py").write_text(PLUGIN_TESTS)
+    (tmp_path / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-n", "0",
+         "--gtecat-record", "--gtecat-check", "-s"],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    out = done.stdout + done.stderr
+    assert "1 passed" in out and "1 failed" in out, out
+    assert "gtecat replay " in out and "gtecat-recording.jsonl" in out
+    assert "check: " in out and "test_m.py:14: axis 1: controlword 0x000F" in out, out
