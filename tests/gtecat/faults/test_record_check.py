@@ -13,7 +13,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli.main import main
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, LONG
 
 SCRIPT = textwrap.dedent(
     f"""
@@ -143,6 +143,7 @@ PLUGIN_TESTS = textwrap.dedent(
 )
 
 
+@pytest.mark.skipif(not LONG, reason="a pytest run in a child process (GTECAT_LONG=1)")
 def test_plugin_fixture_record_and_check(tmp_path: Path) -> None:
     (tmp_path / "test_m.py").write_text(PLUGIN_TESTS)
     (tmp_path / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import faults, gt
+from gtecat.errors import ParameterError
 from gtecat.faults import FaultSpecError
 from tests.conftest import EXAMPLES
 
@@ -419,7 +420,7 @@ def test_words_and_refusals() -> None:
     with pytest.raises(FaultSpecError, match="one trigger"):
         faults.describe({"kind": "sto", "axis": 1, "at_ms": 1, "after_cycles": 2})
     up()
-    assert pytest.raises(Exception, faults.inject, "drive_fault", axis=7).match("no axis 7")
-    assert pytest.raises(Exception, faults.inject, "link_down", after_slave=1).match(
-        "nothing follows"
-    )
+    with pytest.raises(ParameterError, match="no axis 7"):
+        faults.inject("drive_fault", axis=7)
+    with pytest.raises(ParameterError, match="nothing follows"):
+        faults.inject("link_down", after_slave=1)
