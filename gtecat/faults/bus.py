@@ -221,9 +221,12 @@ class WireBus(FaultBus):
         self.server = server
         self._t_ns = 0
         self._log = log
-        self._cycle_ok = True
         if server is not None:
             self.cycle_ns = int(server.cycle_ns)
+
+    def at(self, t_ns: int) -> None:
+        """The slaves' time now (ns since the server started)."""
+        self._t_ns = t_ns
 
     @property
     def slaves(self) -> list[VirtualSlave]:

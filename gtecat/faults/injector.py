@@ -31,7 +31,7 @@ from ..errors import ParameterError
 from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
 from . import kinds as k
 from .bus import FaultBus
-from .triggers import Now, Trigger
+from .triggers import AfterTime, AtTime, Now, Trigger
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
@@ -165,16 +165,26 @@ class Injector:
             )
 
     # --- the cycle ----------------------------------------
-    def tick(self, _t_ns: int = 0, _dt_ns: int = 0) -> None:
+    def tick(self, _t_ns: int = 0, _dt_ns: int = 0, *, cycle: bool = True) -> None:
+        """Once per cycle; ``cycle=False``: time alone passed (``gtecat serve`` between
+        frames), so only time triggers and durations are looked at."""
         if not self.entries:
             return
         now = self.bus.now_ms()
         for e in self.entries:
-            if e.state == "armed" and self._gate_open(e) and e.trigger.due(self.bus):
-                self._start(e)
+            if e.state == "armed" and self._gate_open(e):
+                if not cycle and not isinstance(e.trigger, AtTime | AfterTime):
+                    continue
+                if e.trigger.due(self.bus):
+                    self._start(e)
             elif e.state == "active" and e.duration_ms is not None:
                 if now - (e.started_ms or 0.0) >= e.duration_ms:
                     self._end(e, "over")
+        if not cycle:
+            if any(e.state == "ended" for e in self.entries):
+                self.entries = [e for e in self.entries if e.state != "ended"]
+                self._refresh()
+            return
         self._chatter_cycle += 1
         for e in self.entries:
             if e.state != "active":

@@ -278,6 +278,8 @@ class WireServer:
         self.frame_hook: Callable[[bytearray, int, int], int] | None = None
         #: called after every step of the slaves with the slaves' time (ns since the start)
         self.step_hooks: list[Callable[[int], None]] = []
+        #: called between frames (every few ms) with that time: timers of the hooks above
+        self.poll_hooks: list[Callable[[int], None]] = []
 
     def _snapshot(self) -> None:
         """Report what the latency records hold and start them afresh (``gtecat serve``:
@@ -463,6 +465,8 @@ class WireServer:
                     if self.snapshot_due:
                         self._guarded(self._snapshot)
                     self._guarded(chain.poll, now)
+                    for hook in self.poll_hooks:
+                        self._guarded(hook, now - self._t0)
                     gc.collect(0)
                     self._sync_clocks()
                     next_poll = clock() + 5_000_000

@@ -1,0 +1,83 @@
+"""The same fault objects on the wire: ``gtecat serve --fault FILE`` against a real master.
+
+pysoem (SOEM, through gtecat's pysoem backend and the GT API in the realtime clock) on one
+end of a veth pair, ``gtecat serve`` with ``[[fault]]`` tables on the other: a mailbox abort
+and a lost mailbox answer reach the SDO calls, a link down after slave 1 takes slaves 2 and
+3 out of the process data (GT_IsEcatReady 0, their IO calls refused) until its time is
+over, dropped answers make a short dip.  Needs root and pysoem (skipped with the reason);
+several seconds of two processes, so it runs with GTECAT_LONG=1.
+"""
+
+from __future__ import annotations
+
+from ctypes import byref, c_short, c_ubyte, c_uint32
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import EXAMPLES, LONG
+from tests.gtecat import scenario_common
+
+pytestmark = [pytest.mark.wire]
+
+if not LONG:
+    pytest.skip("two processes for several seconds (GTECAT_LONG=1)", allow_module_level=True)
+
+from tests.gtecat.master.backends import test_pysoem_veth as pv  # noqa: E402  (skips itself)
+
+veth = pv.veth
+frame_timeout_for_a_python_slave = pv.frame_timeout_for_a_python_slave
+
+FAULTS = """
+[[fault]]
+kind = "mailbox_abort"
+slave = 0
+index = 0x6060
+code = 0x06090030
+[[fault]]
+kind = "mailbox_lost"
+slave = 0
+index = 0x6061
+[[fault]]
+kind = "link_down"
+after_slave = 1
+after_cycles = 1500
+duration_ms = 1500
+"""
+
+
+def _ready(gt) -> int:
+    st = c_short()
+    gt.GT_IsEcatReady(byref(st))
+    return st.value
+
+
+def test_faults_on_the_wire(veth, tmp_path: Path) -> None:
+    from gtecat import gt
+
+    faults = tmp_path / "faults.toml"
+    faults.write_text(FAULTS)
+    r = pv.Runner(EXAMPLES / "manual_fig5_2.eni", veth[1])
+    r.args += ["--fault", str(faults)]
+    r.start()
+    try:
+        assert gt.GT_Open(
+            eni=str(EXAMPLES / "manual_fig5_2.eni"), backend="pysoem", iface=veth[0], clock="realtime"
+        ) == 0
+        assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=5000, step_ms=5)
+        data, size, abort = (c_ubyte * 4)(), c_uint32(), c_uint32()
+        rc = gt.GT_EcatSDOUpload(0, 0x6060, 0, data, 4, byref(size), byref(abort))
+        assert rc != 0 and abort.value == 0x06090030, gt.GTE_GetLastError()
+        assert gt.GT_EcatSDOUpload(0, 0x6060, 0, data, 4, byref(size), byref(abort)) == 0
+        rc = gt.GT_EcatSDOUpload(0, 0x6061, 0, data, 4, byref(size), byref(abort))
+        assert rc != 0, "a lost answer is an error"
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=5000, step_ms=5)
+        buf = (c_ubyte * 2)()
+        assert scenario_common.wait_until(
+            gt, lambda: gt.GT_EcatIOReadInput(2, 0, 2, buf) == 1, ms=2000, step_ms=5
+        )
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=8000, step_ms=10)
+    finally:
+        gt.GT_Close()
+        r.stop()
