@@ -30,7 +30,7 @@ examples:
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "record",
-        help="run a program and record its GT calls, faults and bus state for gtecat replay",
+        help="run a program and record its GT calls, faults and bus state (to replay)",
         description=output.describe(__doc__),
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,

@@ -20,7 +20,7 @@ from . import output
 EPILOG = """\
 examples:
   gtecat replay session.gtrec
-  gtecat replay session.gtrec --machine machine.toml   the same session on another machine"""
+  gtecat replay session.gtrec --eni manual_fig5_2.eni   the same session on another ENI"""
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

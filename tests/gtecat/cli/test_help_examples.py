@@ -34,6 +34,9 @@ NEEDS = {
     "gtecat controller": "runs until stopped",
     "gtecat lib --cflags": "a C compiler (builds libgts once)",
     "gtecat demo": "the whole demo (tests/gtecat/test_demo.py runs it)",
+    "gtecat fault inject": "a running gtecat to break (tests/gtecat/faults)",
+    "gtecat fault list": "a running gtecat (tests/gtecat/faults)",
+    "gtecat fault clear": "a running gtecat (tests/gtecat/faults)",
 }
 
 
