@@ -636,6 +636,15 @@ class AxisBank:
                 if ax is not None:
                     self.release_axis_object(ax)
                     return
+        if params and params[0].name == "mask" and values and type(values[0]) is int:
+            # GT_Update(mask), GT_Stop(mask, option): only the axes of the mask go back
+            mask = values[0]
+            axes = ctl.axes
+            named = [axes.get(n) for n in range(1, mask.bit_length() + 1) if mask >> (n - 1) & 1]
+            if named and all(ax is not None for ax in named):
+                for ax in named:
+                    self.release_axis_object(ax)
+                return
         self.release_all()
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------

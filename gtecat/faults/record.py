@@ -320,7 +320,8 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
     try:
-        entries = [json.loads(line) for line in lines if line.strip()]
+        body = lines.read().strip()
+        entries = json.loads("[" + body.replace("\n", ",") + "]") if body else []
     except json.JSONDecodeError as e:
         raise ParameterError(f"{p}: damaged recording: {e}") from None
     return head, entries
