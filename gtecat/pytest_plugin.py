@@ -355,7 +355,9 @@ def gtecat_bus(
         _bring_up(gt, bench)
         if request.config.getoption("gtecat_trace"):
             per_axis = ("prf", "enc", "err", "sw")
-            bench.record(*(f"axis{a}.{s}" for a in range(1, bench.axes() + 1) for s in per_axis))
+            bench.record(
+                *(f"axis{a}.{s}" for a in range(1, bench.axes() + 1) for s in per_axis), "faults"
+            )
         yield bench
     finally:
         for rec in bench.recorders:

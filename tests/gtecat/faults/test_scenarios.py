@@ -424,3 +424,22 @@ def test_words_and_refusals() -> None:
         faults.inject("drive_fault", axis=7)
     with pytest.raises(ParameterError, match="nothing follows"):
         faults.inject("link_down", after_slave=1)
+
+
+def test_faults_show_in_the_trace_and_the_master_log(tmp_path: Path) -> None:
+    from gtecat.controller.recorder import Recorder
+
+    log = tmp_path / "Gecat.log"
+    assert gt.GT_Open(eni=str(EXAMPLES / "full_servo.eni"), clock="lockstep", log=str(log)) == 0
+    assert gt.GT_InitEcatComm() == 0
+    assert wait(lambda: ready() == 1, 200)
+    rec = Recorder(gt.GTE_Controller(), ["faults"]).start()
+    faults.inject("drop_responses", count=0, after_ms=5, duration_ms=10)
+    gt.GTE_Wait(30)
+    rec.stop()
+    seen = rec.column("faults").tolist()
+    assert seen[0] == 0 and max(seen) == 1 and seen[-1] == 0
+    gt.GT_Close()
+    text = log.read_text()
+    assert "Fault 1 armed: every answer lost" in text and "Fault 1 started" in text
+    assert "Fault 1 ended (over)" in text
