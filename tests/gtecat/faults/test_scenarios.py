@@ -443,3 +443,22 @@ def test_faults_show_in_the_trace_and_the_master_log(tmp_path: Path) -> None:
     text = log.read_text()
     assert "Fault 1 armed: every answer lost" in text and "Fault 1 started" in text
     assert "Fault 1 ended (over)" in text
+
+
+def test_homing_interrupted_by_a_link_loss() -> None:
+    """The cable goes at the homing's approach stage: while it is out the homing state is
+    unknown (1 naming the slave), the axis is in alarm; back, the homing reads failed (5)."""
+    from ctypes import c_ushort as u16
+
+    m = EXAMPLES / "homing_probe_machine.toml"
+    up("homing_probe.eni", machine=m)
+    assert gt.GT_SetHomingMode(1, 6) == 0
+    assert gt.GT_SetEcatHomingPrm(1, 3, 20000, 2000, 100000, 0, 0) == 0
+    gt.GTE_Wait(10)
+    faults.inject("link_down", after_slave=-1, at_homing=[1, "approach"], duration_ms=200)
+    assert gt.GT_StartEcatHoming(1) == 0
+    hs = u16()
+    assert wait(lambda: gt.GT_GetEcatHomingStatus(1, byref(hs)) == 1, 2000)
+    assert "homing state is unknown" in gt.GTE_GetLastError()
+    assert sts() & ALARM
+    assert wait(lambda: gt.GT_GetEcatHomingStatus(1, byref(hs)) == 0 and hs.value == 5, 1000)

@@ -61,9 +61,15 @@ def test_faults_on_the_wire(veth, tmp_path: Path) -> None:
     r.args += ["--fault", str(faults)]
     r.start()
     try:
-        assert gt.GT_Open(
-            eni=str(EXAMPLES / "manual_fig5_2.eni"), backend="pysoem", iface=veth[0], clock="realtime"
-        ) == 0
+        assert (
+            gt.GT_Open(
+                eni=str(EXAMPLES / "manual_fig5_2.eni"),
+                backend="pysoem",
+                iface=veth[0],
+                clock="realtime",
+            )
+            == 0
+        )
         assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=5000, step_ms=5)
         data, size, abort = (c_ubyte * 4)(), c_uint32(), c_uint32()
