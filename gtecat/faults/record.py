@@ -25,7 +25,9 @@ import ctypes
 import gzip
 import io
 import json
+import os
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,6 +36,17 @@ from ..errors import ParameterError
 from .tap import Listener, tap, untap
 
 CHECKPOINT_MS = 100
+#: the settings a recording keeps and a replay restores (what GT_Open reads)
+_ENV = (
+    "GTECAT_ENI",
+    "GTECAT_MACHINE",
+    "GTECAT_CLOCK",
+    "GTECAT_BACKEND",
+    "GTECAT_IFACE",
+    "GTECAT_BUS",
+    "GTECAT_BANK",
+    "GTECAT_CARD",
+)
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _SIMPLE = {
     name: getattr(ctypes, name)
@@ -195,6 +208,11 @@ class Recorder(Listener):
         self._last_cp = -(1 << 62)
         self.calls = 0
         self._dumps = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+        #: where the session ran: its folder and the GTECAT_* settings GT_Open reads
+        self.where = {
+            "cwd": os.getcwd(),
+            "env": {k: v for k, v in os.environ.items() if k in _ENV},
+        }
 
     def start(self) -> Recorder:
         from . import injector
@@ -252,7 +270,7 @@ class Recorder(Listener):
         self.lines.append(self._dumps(entry))
 
     def write(self) -> Path:
-        head = {"gtecat_recording": 1, "calls": self.calls, **self.meta}
+        head = {"gtecat_recording": 1, "calls": self.calls, **self.meta, **self.where}
         text = json.dumps(head) + "\n" + "\n".join(self.lines) + ("\n" if self.lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
@@ -334,9 +352,48 @@ def replay(
     machine: str | None = None,
 ) -> tuple[int, Divergence | None]:
     """Re-run a recording; (calls replayed, the first divergence or None)."""
+    head, entries = read(path)
+    with _where(head):
+        return _replay(entries, eni, machine)
+
+
+@contextmanager
+def _where(head: dict[str, Any]) -> Any:
+    """The recorded folder and GTECAT_* settings for the replay (a backend of real hardware
+    is replaced by the emulated one)."""
+    saved_env = {k: os.environ.get(k) for k in _ENV}
+    saved_cwd = os.getcwd()
+    env = head.get("env") or {}
+    for k in _ENV:
+        os.environ.pop(k, None)
+    for k, v in env.items():
+        if k in _ENV and isinstance(v, str):
+            os.environ[k] = v
+    if os.environ.get("GTECAT_BACKEND") == "pysoem":
+        os.environ["GTECAT_BACKEND"] = "emulated"
+    if os.environ.get("GTECAT_CLOCK") == "realtime":
+        os.environ["GTECAT_CLOCK"] = "auto"
+    cwd = head.get("cwd")
+    if isinstance(cwd, str) and os.path.isdir(cwd):
+        os.chdir(cwd)
+    try:
+        yield
+    finally:
+        os.chdir(saved_cwd)
+        for k, v in saved_env.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def _replay(
+    entries: list[dict[str, Any]], eni: str | None, machine: str | None
+) -> tuple[int, Divergence | None]:
     from .. import faults, gt
 
-    _head, entries = read(path)
+    eni = str(Path(eni).resolve()) if eni else None
+    machine = str(Path(machine).resolve()) if machine else None
     gt.GT_Close()
     n = 0
     fns: dict[str, Any] = {}
@@ -360,6 +417,9 @@ def replay(
                         kw["machine"] = str(machine)
                     if kw.get("clock") == "realtime":
                         kw["clock"] = "auto"
+                    if kw.get("backend") == "pysoem":
+                        kw["backend"] = "emulated"
+                    kw["log"] = ""  # the session's master log is not written again
                 rc = fn(*args, **kw)
                 if rc != e["r"]:
                     return n, Divergence(n, name, "return code", e["r"], rc)

@@ -94,6 +94,8 @@ def test_replay_reports_the_first_divergence(
     assert main(["replay", str(bad)]) == 1
     err = capsys.readouterr().err
     assert "GT_GetSts: argument 2 recorded" in err and "replay gives" in err
+    assert main(["replay", str(recorded), "--eni", str(EXAMPLES / "manual_fig5_2.eni")]) == 1
+    assert "diverged at call" in capsys.readouterr().err  # another bus: another session
     (tmp_path / "junk").write_text("hello\n")
     assert main(["replay", str(tmp_path / "junk")]) == 1
     assert "not a gtecat recording" in capsys.readouterr().err
