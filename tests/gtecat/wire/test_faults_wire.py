@@ -2,9 +2,10 @@
 
 pysoem (SOEM, through gtecat's pysoem backend and the GT API in the realtime clock) on one
 end of a veth pair, ``gtecat serve`` with ``[[fault]]`` tables on the other: a mailbox abort
-and a lost mailbox answer reach the SDO calls, a link down after slave 1 takes slaves 2 and
-3 out of the process data (GT_IsEcatReady 0, their IO calls refused) until its time is
-over, dropped answers make a short dip.  Needs root and pysoem (skipped with the reason);
+a lost mailbox answer and a protocol fault reach the SDO calls, a link down after slave 1
+takes slaves 2 and 3 out of the process data (GT_IsEcatReady 0, their IO calls refused) until
+its time is over, a working counter off by one makes GT_IsEcatReady 0 while it lasts, and a
+latched AL error keeps slave 3 out until it is cleared: one script of steps.  Needs root and pysoem (skipped with the reason);
 several seconds of two processes, so it runs with GTECAT_LONG=1.
 """
 
@@ -39,10 +40,31 @@ kind = "mailbox_lost"
 slave = 0
 index = 0x6061
 [[fault]]
+kind = "mailbox_protocol"
+slave = 1
+index = 0x6061
+variant = "wrong_service"
+[[fault]]
 kind = "link_down"
 after_slave = 1
 after_cycles = 1500
 duration_ms = 1500
+name = "cut"
+[[fault]]
+kind = "wkc_offset"
+offset = -1
+command = "LRW"
+after = "cut"
+after_ms = 4000
+duration_ms = 600
+name = "wkc"
+[[fault]]
+kind = "al_error"
+slave = 3
+code = 0x1B
+after = "wkc"
+after_ms = 3000
+duration_ms = 1000
 """
 
 
@@ -78,12 +100,25 @@ def test_faults_on_the_wire(veth, tmp_path: Path) -> None:
         assert gt.GT_EcatSDOUpload(0, 0x6060, 0, data, 4, byref(size), byref(abort)) == 0
         rc = gt.GT_EcatSDOUpload(0, 0x6061, 0, data, 4, byref(size), byref(abort))
         assert rc != 0, "a lost answer is an error"
+        rc = gt.GT_EcatSDOUpload(1, 0x6061, 0, data, 4, byref(size), byref(abort))
+        assert rc != 0, "a protocol fault is an error"
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=5000, step_ms=5)
         buf = (c_ubyte * 2)()
         assert scenario_common.wait_until(
             gt, lambda: gt.GT_EcatIOReadInput(2, 0, 2, buf) == 1, ms=2000, step_ms=5
         )
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=8000, step_ms=10)
+        assert gt.GT_EcatIOReadInput(2, 0, 2, buf) == 0
+        # the working counter off by one: not ready while it lasts, then ready again
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=8000, step_ms=5)
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=8000, step_ms=10)
+        # slave 3 latches AL status 001Bh: out of OP, the recovery refused until it is over
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=8000, step_ms=5)
+        assert scenario_common.wait_until(
+            gt, lambda: gt.GT_EcatIOReadInput(3, 0, 2, buf) == 1, ms=3000, step_ms=5
+        )
+        assert "slave 3" in gt.GTE_GetLastError()
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=10000, step_ms=10)
     finally:
         gt.GT_Close()
         r.stop()
