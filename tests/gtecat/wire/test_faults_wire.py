@@ -5,8 +5,10 @@ end of a veth pair, ``gtecat serve`` with ``[[fault]]`` tables on the other: a m
 a lost mailbox answer and a protocol fault reach the SDO calls, a link down after slave 1
 takes slaves 2 and 3 out of the process data (GT_IsEcatReady 0, their IO calls refused) until
 its time is over, a working counter off by one makes GT_IsEcatReady 0 while it lasts, and a
-latched AL error keeps slave 3 out until it is cleared: one script of steps.  Needs root and pysoem (skipped with the reason);
-several seconds of two processes, so it runs with GTECAT_LONG=1.
+latched AL error keeps slave 3 out until it is cleared, a power-cycled slave 2 (its ESC
+without address or configuration) is found and brought back: one script of steps.  Needs
+root and pysoem (skipped with the reason); several seconds of two processes, so it runs with
+GTECAT_LONG=1.
 """
 
 from __future__ import annotations
@@ -65,6 +67,12 @@ code = 0x1B
 after = "wkc"
 after_ms = 3000
 duration_ms = 1000
+name = "al"
+[[fault]]
+kind = "power_cycle"
+slave = 2
+after = "al"
+after_ms = 4000
 """
 
 
@@ -119,6 +127,10 @@ def test_faults_on_the_wire(veth, tmp_path: Path) -> None:
         )
         assert "slave 3" in gt.GTE_GetLastError()
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=10000, step_ms=10)
+        # slave 2 power-cycled: its ESC forgot its address and configuration; the master
+        # finds it in INIT and brings it back
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=8000, step_ms=5)
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=15000, step_ms=10)
     finally:
         gt.GT_Close()
         r.stop()
