@@ -334,6 +334,23 @@ def test_mailbox_abort_lost_answer_and_protocol_fault() -> None:
     assert "not SDO_RESPONSE" in gt.GTE_GetLastError()
 
 
+def test_an_abort_hits_its_step_only() -> None:
+    up()
+    faults.inject("mailbox_abort", slave=0, index=0x1008, code=0x06060000, step="download_init")
+    data, size, abort = (c_ubyte * 64)(), c_uint32(), c_uint32()
+    assert gt.GT_EcatSDOUpload(0, 0x1008, 0, data, 64, byref(size), byref(abort)) == 0
+    assert bytes(data)[: size.value] == b"Servo 0"  # an upload is no download: it passes
+    faults.clear()
+    faults.inject("mailbox_abort", slave=0, index=0x1008, code=0x06060000, step="upload_init")
+    rc = gt.GT_EcatSDOUpload(0, 0x1008, 0, data, 64, byref(size), byref(abort))
+    assert rc != 0 and abort.value == 0x06060000
+    gt.GTE_Slave(0).sdo.mailbox_size = 16  # a small mailbox: the name takes segments
+    faults.inject("mailbox_abort", slave=0, index=0x1008, code=0x05040000, step="upload_segment")
+    rc = gt.GT_EcatSDOUpload(0, 0x1008, 0, data, 64, byref(size), byref(abort))
+    assert rc != 0 and abort.value == 0x05040000
+    assert gt.GT_EcatSDOUpload(0, 0x1008, 0, data, 64, byref(size), byref(abort)) == 0
+
+
 def test_abort_at_a_download_step_on_the_nth_sdo() -> None:
     up()
     faults.inject(
@@ -439,10 +456,13 @@ def test_faults_show_in_the_trace_and_the_master_log(tmp_path: Path) -> None:
     rec.stop()
     seen = rec.column("faults").tolist()
     assert seen[0] == 0 and max(seen) == 1 and seen[-1] == 0
+    faults.inject("drive_fault", axis=1, code="overtemperature")
+    gt.GTE_Wait(5)
     gt.GT_Close()
     text = log.read_text()
     assert "Fault 1 armed: every answer lost" in text and "Fault 1 started" in text
     assert "Fault 1 ended (over)" in text
+    assert "CoE EMERGENCY 0x4310" in text  # the drive's emergency, as the master logs it
 
 
 def test_homing_interrupted_by_a_link_loss() -> None:
