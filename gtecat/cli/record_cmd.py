@@ -5,7 +5,8 @@ fault injected from the program or ``gtecat fault``, and the bus state every 100
 controller time go into FILE (JSON lines; gzip when FILE ends in ``.gz``).  A Python script
 (``python3 my_machine.py`` or ``my_machine.py``) runs in this process; any other command
 runs as a child with ``GTECAT_RECORD=FILE`` in its environment (a Python program that
-imports gtecat records itself).  ``gtecat replay FILE`` re-runs the session.
+imports gtecat records itself; the calls of a C, C++ or C# program through libgts are not
+recorded).  ``gtecat replay FILE`` re-runs the session.
 """
 
 from __future__ import annotations
@@ -72,11 +73,23 @@ def run(args: argparse.Namespace) -> int:
             rc = subprocess.call(command, env=env)
         except OSError as e:
             raise ParameterError(f"cannot run {command[0]}: {e.strerror or e}") from None
-        if not out.exists():
+        from ..faults.record import read
+
+        calls = 0
+        if out.exists():
+            try:
+                calls = int(read(out)[0].get("calls", 0))
+            except ParameterError:
+                calls = 0
+        if not calls:
             print(
-                "record: nothing recorded (the program made no GT call through gtecat)",
+                "record: nothing recorded: the GT calls of Python programs are recorded (run "
+                "in-process or attached to a controller); a C, C++ or C# program's calls "
+                "through libgts are not",
                 file=sys.stderr,
             )
+        else:
+            print(f"record: {calls} GT calls -> {out}", file=sys.stderr)
         return rc
     path, script_args = script
     if not path.is_file():
