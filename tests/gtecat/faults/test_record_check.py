@@ -159,3 +159,48 @@ def test_plugin_fixture_record_and_check(tmp_path: Path) -> None:
     assert "1 passed" in out and "1 failed" in out, out
     assert "gtecat replay " in out and "gtecat-recording.jsonl" in out
     assert "check: " in out and "test_m.py:14: axis 1: controlword 0x000F" in out, out
+
+
+def test_checks_of_what_the_drive_sees(tmp_path: Path) -> None:
+    """A CSP step past the following-error window, a mode change in motion, an enable in
+    FAULT without a fault reset: each found once, at the line of the call that did it."""
+    import io
+    from ctypes import byref, c_short, c_ubyte
+
+    from gtecat import faults
+    from gtecat.faults.checks import Checker
+
+    m = tmp_path / "m.toml"
+    m.write_text("[axis.1]\nfollowing_error_window = 100\n")
+    out = io.StringIO()
+    checker = Checker(out).start()
+    try:
+        gt.GT_Open(eni=str(EXAMPLES / "full_servo.eni"), machine=str(m), clock="lockstep", log="")
+        gt.GT_InitEcatComm()
+        st = c_short()
+        while gt.GT_IsEcatReady(byref(st)) == 0 and st.value != 1:
+            gt.GTE_Wait(1)
+        gt.GT_StartEcatComm()
+        gt.GT_AxisOn(1)
+        gt.GTE_Wait(10)
+        prm = gt.TTrapPrm()
+        prm.acc = prm.dec = 50
+        gt.GT_PrfTrap(1)
+        gt.GT_SetTrapPrm(1, byref(prm))
+        gt.GT_SetPos(1, 100000)
+        gt.GT_SetVel(1, 300)
+        gt.GT_Update(1)  # a step of 300 counts a cycle: the window is 100
+        gt.GTE_Wait(20)
+        gt.GT_SetEcatAxisMode(1, 9)  # in motion
+        gt.GTE_Wait(20)
+        faults.inject("drive_fault", axis=1, code=0x2310)
+        gt.GTE_Wait(20)
+        gt.GT_SetEcatRawData(0, 2, (c_ubyte * 2)(0x0F, 0))  # enable, no fault reset
+        gt.GTE_Wait(3)
+    finally:
+        checker.stop()
+    rules = [f.rule for f in checker.findings]
+    assert rules == ["csp-step", "mode-while-moving", "enable-in-fault"], out.getvalue()
+    here = Path(__file__).name
+    assert all(Path(f.file).name == here for f in checker.findings)
+    assert out.getvalue().count("check: ") == 3
