@@ -156,7 +156,16 @@ def injector_for(ctl: Any, create: bool = True) -> Injector | None:
 
 
 def _bus_up(ctl: Any) -> None:
-    """Arm the machine description's ``[[fault]]`` tables on every bus that comes up."""
+    """Arm the machine description's ``[[fault]]`` tables on every bus that comes up (the
+    faults of a bus brought up before go with it)."""
+    ctl.pre_cycle[:] = [
+        f
+        for f in ctl.pre_cycle
+        if not (
+            isinstance(getattr(f, "__self__", None), Injector)
+            and getattr(f.__self__.bus, "backend", None) is not ctl.backend
+        )
+    ]
     tables = getattr(ctl.machine, "faults", ())
     if tables and ctl.options.backend == "emulated":
         specs = specs_from_tables(list(tables), ctl.machine.source or "machine description")

@@ -482,3 +482,15 @@ def test_homing_interrupted_by_a_link_loss() -> None:
     assert "homing state is unknown" in gt.GTE_GetLastError()
     assert sts() & ALARM
     assert wait(lambda: gt.GT_GetEcatHomingStatus(1, byref(hs)) == 0 and hs.value == 5, 1000)
+
+
+def test_a_new_bus_starts_without_the_faults_of_the_old_one() -> None:
+    up()
+    faults.inject("drive_fault", axis=1, code=0x2310, at_ms=10**6)
+    assert len(faults.listing()) == 1
+    assert gt.GT_InitEcatComm() == 0  # a new bus: the armed fault went with the old one
+    assert faults.listing() == []
+    ctl = gt.GTE_Controller()
+    assert not [
+        f for f in ctl.pre_cycle if type(getattr(f, "__self__", None)).__name__ == "Injector"
+    ]
