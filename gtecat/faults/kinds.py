@@ -445,7 +445,34 @@ class IoStuck(Fault):
 
 
 # --- building one from plain values (TOML, the command line, recordings) -------------------
-_ALIASES = {"drop": "drop_responses", "disconnect": "link_down", "quick_stop_input": "quick_stop"}
+_ALIASES = {
+    "drop": "drop_responses",
+    "drop_answers": "drop_responses",
+    "disconnect": "link_down",
+    "link_loss": "link_down",
+    "quick_stop_input": "quick_stop",
+    "switch_chattering": "switch_chatter",
+    "chatter": "switch_chatter",
+    "mailbox_lost_answer": "mailbox_lost",
+    "lost_answer": "mailbox_lost",
+    "sdo_abort": "mailbox_abort",
+    "latch_al_error": "al_error",
+    "safeop": "retreat_safeop",
+    "safe_torque_off": "sto",
+    "brake_stuck": "brake",
+    "encoder_counts_lost": "encoder_lost",
+    "io_input_stuck": "io_stuck",
+}
+#: other names of the switches
+_SWITCHES = {
+    "neg": "negative",
+    "negative_limit": "negative",
+    "limit-": "negative",
+    "pos": "positive",
+    "positive_limit": "positive",
+    "limit+": "positive",
+    "home_switch": "home",
+}
 
 
 def _int(name: str, v: Any) -> int:
@@ -575,6 +602,9 @@ def fault_from_dict(values: dict[str, Any], where: str = "") -> Fault:
     ]
     if missing:
         raise FaultSpecError(f"{prefix}{kind} needs {', '.join(missing)}")
+    if isinstance(kwargs.get("switch"), str):
+        sw = kwargs["switch"].strip().lower()
+        kwargs["switch"] = _SWITCHES.get(sw, sw)
     fault = cls(**kwargs)
     try:
         _check(fault)
