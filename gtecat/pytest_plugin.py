@@ -418,7 +418,16 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) ->
     if recording is not None:
         recording.stop()
         path = recording.write()
-        report.sections.append(("gtecat recording", f"gtecat replay {path}"))
+        lines = [f"gtecat replay {path}"]
+        extra = item.config.getoption("gtecat_trace_dir")
+        if extra:  # beside the traces copied there
+            import shutil
+
+            out = Path(extra)
+            out.mkdir(parents=True, exist_ok=True)
+            copy = shutil.copy(path, out / (_safe(item.nodeid) + ".gtrec.jsonl"))
+            lines.append(f"gtecat replay {copy}")
+        report.sections.append(("gtecat recording", "\n".join(lines)))
     recorders = item.stash.get(TRACE_KEY, None)
     if recorders is None:
         return

@@ -152,12 +152,17 @@ def test_plugin_fixture_record_and_check(tmp_path: Path) -> None:
     env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
     done = subprocess.run(
         [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-n", "0",
-         "--gtecat-record", "--gtecat-check", "-s"],
+         "--gtecat-record", "--gtecat-check", "--gtecat-trace-dir", "traces", "-s"],
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     out = done.stdout + done.stderr
     assert "1 passed" in out and "1 failed" in out, out
     assert "gtecat replay " in out and "gtecat-recording.jsonl" in out
+    kept = tmp_path / "traces" / "test_m.py_test_fails_and_keeps_its_recording.gtrec.jsonl"
+    assert kept.is_file()
+    from gtecat.cli.main import main as gtecat_main
+
+    assert gtecat_main(["replay", str(kept)]) == 0  # the failing test's session, again
     assert "check: " in out and "test_m.py:14: axis 1: controlword 0x000F" in out, out
 
 
