@@ -42,7 +42,12 @@ class FaultBus:
         raise NotImplementedError
 
     def now_ms(self) -> float:
+        """Controller time, ms: what GT_GetClock reads (``at_ms``)."""
         raise NotImplementedError
+
+    def t_ms(self) -> float:
+        """Time that never goes back (a GT_Reset does not move it): durations, ``after_ms``."""
+        return self.now_ms()
 
     def healthy(self) -> bool:
         return True
@@ -174,6 +179,9 @@ class EmulatedBus(FaultBus):
 
     def now_ms(self) -> float:
         return (self.ctl.clock.now_ns - self.ctl.reset_ns) / 1e6
+
+    def t_ms(self) -> float:
+        return self.ctl.clock.now_ns / 1e6
 
     def healthy(self) -> bool:
         m = self.ctl.master

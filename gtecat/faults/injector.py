@@ -116,7 +116,7 @@ class Injector:
         self._next += 1
         trig = e.trigger
         if hasattr(trig, "since"):
-            trig.since = self.bus.now_ms()  # type: ignore[attr-defined]
+            trig.since = self.bus.t_ms()  # type: ignore[attr-defined]
         self.entries.append(e)
         self.bus.log(f"Fault {e.id} armed: {e.describe()}.")
         self._refresh()
@@ -170,7 +170,7 @@ class Injector:
         frames), so only time triggers and durations are looked at."""
         if not self.entries:
             return
-        now = self.bus.now_ms()
+        now = self.bus.t_ms()
         for e in self.entries:
             if e.state == "armed" and self._gate_open(e):
                 if not cycle and not isinstance(e.trigger, AtTime | AfterTime):
@@ -210,7 +210,7 @@ class Injector:
             return True
         if e.after in self._started:
             if "armed_ms" not in e.data:
-                e.data["armed_ms"] = self.bus.now_ms()
+                e.data["armed_ms"] = self.bus.t_ms()
                 if hasattr(e.trigger, "since"):
                     e.trigger.since = e.data["armed_ms"]  # type: ignore[attr-defined]
             return True
@@ -238,7 +238,7 @@ class Injector:
     # --- start and end ----------------------------------------
     def _start(self, e: Entry) -> None:
         e.state = "active"
-        e.started_ms = self.bus.now_ms()
+        e.started_ms = self.bus.t_ms()
         self._started.add(e.id)
         f = e.fault
         e.left = int(getattr(f, "count", 0) or 0)
@@ -293,7 +293,7 @@ class Injector:
         e.state = "ended"
         f = e.fault
         bus = self.bus
-        now = bus.now_ms()
+        now = bus.t_ms()
         self.events.append((now, "end", e.id, why))
         if not f.once:
             bus.log(f"Fault {e.id} ended ({why}): {f.describe()}.")

@@ -61,7 +61,7 @@ class AfterTime(Trigger):
     since: float = 0.0
 
     def due(self, bus: Any) -> bool:
-        return bus.now_ms() - self.since >= self.ms
+        return bus.t_ms() - self.since >= self.ms
 
     def describe(self) -> str:
         return f"{self.ms:g} ms later"
