@@ -17,9 +17,9 @@ The rules and where they come from:
   6.2: a mode change is made at standstill; drives refuse or jerk);
 * ``sdo-on-pdo`` - an SDO write, in OP, to an object that is mapped in an RxPDO: the next
   cycle overwrites it, many drives abort with 06010006h (ETG.1000.6 5.6.2; CiA 301);
-* ``ready-poll`` - ``GT_IsEcatReady`` polled again and again without a time limit (no clock
-  read in the loop: a bus that never comes up hangs the program; the manual's example 5-5
-  loops so, entry 80 gives no limit);
+* ``ready-poll`` - ``GT_IsEcatReady`` polled from one line again and again (200 times) with no
+  ``GT_GetClock`` in between: a loop without a time limit hangs the program when the bus
+  never comes up (the manual's example 5-5 loops so; entry 80 gives no limit);
 * ``move-with-alarm`` - a move started (``GT_Update`` and the other start calls) on an axis
   whose status has the alarm bit set (manual 7.1, table 6-2 bit 1: clear it with GT_ClrSts
   once the cause is gone).
@@ -44,8 +44,8 @@ SOURCES = {
     "ready-poll": "manual entry 80, example 5-5",
     "move-with-alarm": "manual table 6-2 bit 1",
 }
-#: consecutive GT_IsEcatReady calls with no clock read that make a "poll without a limit"
-READY_POLLS = 2000
+#: GT_IsEcatReady calls in a row from one line with no clock read: a "poll without a limit"
+READY_POLLS = 200
 _START_CALLS = frozenset({"GT_Update", "GT_MoveAbsolute", "GT_MoveRelative", "GT_MoveVelocity"})
 
 
@@ -99,6 +99,7 @@ class Checker(Listener):
         self._ctl: Any = None
         self._prev: dict[int, tuple[int, int, int, int]] = {}
         self._polls = 0
+        self._poll_site: tuple[str, int] = ("", 0)
 
     def start(self) -> Checker:
         tap(self)
@@ -135,15 +136,16 @@ class Checker(Listener):
         if name.startswith("GTN_") and args:
             name, args = "GT_" + name[4:], args[1:]
         if name == "GT_IsEcatReady":
-            self._polls += 1
+            self._polls = self._polls + 1 if site == self._poll_site else 1
+            self._poll_site = site
             if self._polls == READY_POLLS:
                 self.report_here(
                     "ready-poll",
                     f"GT_IsEcatReady polled {READY_POLLS} times in a row without reading the "
-                    "clock: give the loop a time limit (GT_GetClock) so a bus that never comes "
-                    "up ends it",
+                    "clock: give the loop a time limit (GT_GetClock) so that a bus that never "
+                    "comes up (a cable, a slave missing) ends it instead of hanging",
                 )
-        elif name in ("GT_GetClock", "GTE_Wait") or name.startswith("GT_GetClock"):
+        elif name == "GT_GetClock":  # a loop that reads the clock can have a time limit
             self._polls = 0
         if ctl is None:
             return None

@@ -114,6 +114,22 @@ def test_checks_name_the_script_line(tmp_path: Path, capsys: pytest.CaptureFixtu
     ), err
 
 
+def test_an_endless_ready_poll(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    app = tmp_path / "poll.py"
+    app.write_text(
+        "from ctypes import byref, c_short\n"
+        "from gtecat import gt\n"
+        f"gt.GT_Open(eni={str(EXAMPLES / 'full_servo.eni')!r}, log='')\n"
+        "gt.GT_InitEcatComm()\n"
+        "s = c_short()\n"
+        "while gt.GT_IsEcatReady(byref(s)) == 0 and s.value != 1:\n"
+        "    pass\n"
+    )
+    assert main(["run", "--check", "--no-progress", str(app)]) == 0
+    err = capsys.readouterr().err
+    assert f"check: {app}:6: GT_IsEcatReady polled 200 times" in err, err
+
+
 def test_fault_kinds_and_refusals(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["fault", "kinds", "--json"]) == 0
     kinds = {r["kind"] for r in json.loads(capsys.readouterr().out)}
