@@ -220,7 +220,8 @@ class Injector:
         """Frame faults routed while one is armed or active; bank-safe without position or
         homing triggers."""
         frame = any(
-            e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown) for e in self.entries
+            e.state == "active" and e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown)
+            for e in self.entries
         )
         if frame != self._frame_on:
             self._frame_on = frame
@@ -284,6 +285,8 @@ class Injector:
             s = bus.slave(f.slave)
             if isinstance(s, IoSlave):
                 s.set_input_bit(f.bit, bool(f.value))
+        if f.depth == "frame":
+            self._refresh()  # the cyclic answers pass the injector from now on
         if f.once:
             self._end(e, "done")
 
