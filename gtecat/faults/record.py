@@ -165,6 +165,22 @@ def decode(v: Any) -> Any:
     return None  # a value that cannot be rebuilt (an object of the caller's)
 
 
+def _pooled(pool: dict[tuple[str, int, str], tuple[Any, Any]], name: str, i: int, v: Any) -> Any:
+    """``decode(v)``, but a pointer to a simple value is one object per function and argument,
+    reused with the recorded value (an application polls with the same variable: so does the
+    replay, and the GT layer's fast path recognises it)."""
+    ref = v.get("ref")
+    if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
+        key = (name, i, ref["c"])
+        hit = pool.get(key)
+        if hit is None:
+            obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
+            hit = pool[key] = (obj, ctypes.byref(obj))
+        hit[0].value = ref["v"]
+        return hit[1]
+    return decode(v)
+
+
 def _set_field(obj: Any, name: str, fv: Any) -> None:
     cur = getattr(obj, name)
     if isinstance(cur, ctypes.Array):
@@ -397,6 +413,7 @@ def _replay(
     gt.GT_Close()
     n = 0
     fns: dict[str, Any] = {}
+    pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
     try:
         for e in entries:
             if "c" in e:
@@ -408,7 +425,10 @@ def _replay(
                     if fn is None:
                         return n, Divergence(n, name, "function", "present", "missing")
                 a = e["a"]
-                args = [decode(x) if isinstance(x, dict) else x for x in a]
+                args = [
+                    x if not isinstance(x, dict) else _pooled(pool, name, i, x)
+                    for i, x in enumerate(a)
+                ]
                 kw = {k: decode(v) for k, v in e.get("k", {}).items()}
                 if name in ("GT_Open", "GTN_Open"):
                     if eni:
