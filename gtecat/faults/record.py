@@ -61,15 +61,20 @@ _SIMPLE = {
 def _scalar(v: Any) -> Any:
     if isinstance(v, bytes):
         return {"b": v.hex()}
-    if isinstance(v, float) and v != v:
-        return {"nan": 1}
+    if isinstance(v, float) and (v != v or v in (_INF, -_INF)):
+        return {"nan": 1} if v != v else {"inf": 1 if v > 0 else -1}
     return v
+
+
+_INF = float("inf")
 
 
 def encode(x: Any) -> Any:
     """An argument as plain JSON (module docstring)."""
-    if x is None or isinstance(x, bool | int | float | str):
+    if x is None or isinstance(x, bool | int | str):
         return x
+    if isinstance(x, float):
+        return _scalar(x)
     if isinstance(x, _CArg):
         return {"ref": encode(x._obj)}
     if isinstance(x, ctypes._SimpleCData):  # type: ignore[attr-defined]
@@ -118,6 +123,8 @@ def _unscalar(v: Any) -> Any:
             return bytes.fromhex(v["b"])
         if "nan" in v:
             return float("nan")
+        if "inf" in v:
+            return _INF if v["inf"] > 0 else -_INF
     return v
 
 
@@ -125,6 +132,8 @@ def decode(v: Any) -> Any:
     """A fresh object of the recorded type holding the recorded value."""
     if not isinstance(v, dict):
         return v
+    if "nan" in v or "inf" in v:
+        return _unscalar(v)
     if "ref" in v:
         return ctypes.byref(decode(v["ref"]))
     if "c" in v:
