@@ -225,3 +225,28 @@ def test_checks_of_what_the_drive_sees(tmp_path: Path) -> None:
     here = Path(__file__).name
     assert all(Path(f.file).name == here for f in checker.findings)
     assert out.getvalue().count("check: ") == 3
+
+
+def test_recorded_values_come_back_as_they_were() -> None:
+    import ctypes
+    import json
+
+    from gtecat import gt
+    from gtecat.faults.record import decode, encode
+
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = float("inf"), 0.5
+    values = [
+        ctypes.byref(ctypes.c_double(float("nan"))),
+        ctypes.byref(prm),
+        (ctypes.c_long * 3)(1, 2, 3),
+        ctypes.create_string_buffer(b"abc", 8),
+        [ctypes.c_short(4)],
+        bytearray(b"xy"),
+        float("-inf"),
+        3,
+        None,
+    ]
+    for x in values:
+        text = json.dumps(encode(x), allow_nan=False)
+        assert json.dumps(encode(decode(json.loads(text))), allow_nan=False) == text

@@ -63,28 +63,3 @@ def test_only_cyclic_frames_are_hit() -> None:
     inj.add(kinds.DropResponses(count=1))
     buf = _frame()
     assert inj.frame(buf, len(buf), 0) == len(buf)  # a register read at bring-up passes
-
-
-def test_recorded_values_come_back_as_they_were() -> None:
-    import ctypes
-    import json
-
-    from gtecat import gt
-    from gtecat.faults.record import decode, encode
-
-    prm = gt.TTrapPrm()
-    prm.acc, prm.dec = float("inf"), 0.5
-    values = [
-        ctypes.byref(ctypes.c_double(float("nan"))),
-        ctypes.byref(prm),
-        (ctypes.c_long * 3)(1, 2, 3),
-        ctypes.create_string_buffer(b"abc", 8),
-        [ctypes.c_short(4)],
-        bytearray(b"xy"),
-        float("-inf"),
-        3,
-        None,
-    ]
-    for x in values:
-        text = json.dumps(encode(x), allow_nan=False)
-        assert json.dumps(encode(decode(json.loads(text))), allow_nan=False) == text
