@@ -4,9 +4,9 @@ Every GT call (name, arguments, values written back, return code, controller tim
 fault injected from the program or ``gtecat fault``, and the bus state every 100 ms of
 controller time go into FILE (JSON lines; gzip when FILE ends in ``.gz``).  A Python script
 (``python3 my_machine.py`` or ``my_machine.py``) runs in this process; any other command
-runs as a child with ``GTECAT_RECORD=FILE`` in its environment (a Python program that
-imports gtecat records itself; the calls of a C, C++ or C# program through libgts are not
-recorded).  ``gtecat replay FILE`` re-runs the session.
+runs as a child with ``GTECAT_RECORD=FILE`` in its environment: a Python program that
+imports gtecat records itself, and the controller that libgts starts for a C, C++ or C#
+program records that program's calls.  ``gtecat replay FILE`` re-runs the session.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ EPILOG = """\
 examples:
   gtecat record -o session.gtrec -- python3 first_script.py
   gtecat record -o session.gtrec.gz -- first_script.py
+  gtecat record -o c.gtrec -- ./my_machine            a C program linked with libgts
   gtecat replay session.gtrec"""
 
 
@@ -88,9 +89,9 @@ def run(args: argparse.Namespace) -> int:
                 calls = 0
         if not calls:
             print(
-                "record: nothing recorded: the GT calls of Python programs are recorded (run "
-                "in-process or attached to a controller); a C, C++ or C# program's calls "
-                "through libgts are not",
+                "record: nothing recorded: the program made no GT call through gtecat (a "
+                "program attached to a controller that was already running is recorded by "
+                "starting that controller under gtecat record)",
                 file=sys.stderr,
             )
         else:

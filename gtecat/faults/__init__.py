@@ -291,7 +291,8 @@ def _record_from_environment() -> None:
         return
     from .record import Recorder
 
-    rec = Recorder(path, {"program": os.environ.get("GTECAT_RECORD_PROGRAM", "")}).start()
+    program = os.environ.get("GTECAT_RECORD_PROGRAM", "")
+    rec = Recorder(path, {"program": program}, any_thread=True).start()
     atexit.register(rec.write)
 
 

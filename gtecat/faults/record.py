@@ -4,7 +4,9 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
 * a header ``{"gtecat_recording": 1, ...}``;
 * one line per GT call: ``{"c": NAME, "a": [arguments], "k": {keywords}, "o": {index:
-  value written back}, "r": return code, "t": controller time in ns}``;
+  value written back}, "r": return code, "t": controller time in ns}``, and ``"b"``: the
+  controller time when the call began, where time passed since the call before (a
+  controller process lets its clock follow the wall clock between its clients' calls);
 * ``{"f": "inject", "v": {a [[fault]] table}}`` / ``{"f": "clear", "id": N}`` for faults
   injected from Python or the command line, at their place in the stream;
 * ``{"cp": ns, "wkc": [got, expected], "states": [...], "ready": 0|1}`` checkpoints of the bus
@@ -225,12 +227,17 @@ def _mutable(x: Any) -> bool:
 class Recorder(Listener):
     """Writes the stream of the calls this thread makes (and the faults injected)."""
 
-    def __init__(self, path: str | Path, meta: dict[str, Any] | None = None) -> None:
+    def __init__(
+        self, path: str | Path, meta: dict[str, Any] | None = None, *, any_thread: bool = False
+    ) -> None:
         self.path = Path(path)
         self.lines: list[str] = []
         self.meta = dict(meta or {})
-        self.thread = threading.get_ident()
+        #: the thread whose calls are the session's (None: every thread's, as in a controller
+        #: process serving its clients' calls)
+        self.thread = None if any_thread else threading.get_ident()
         self._last_cp = -(1 << 62)
+        self._t_end = -1  # controller time (with the latency not yet run) after the last call
         self.calls = 0
         self._dumps = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
         #: where the session ran: its folder and the GTECAT_* settings GT_Open reads
@@ -254,14 +261,20 @@ class Recorder(Listener):
             injector.OBSERVERS.remove(self.fault_event)
 
     def before(self, name: str, args: tuple, kwargs: dict) -> Any:
-        if threading.get_ident() != self.thread:
+        if self.thread is not None and threading.get_ident() != self.thread:
             return None
-        return [encode(a) for a in args], {k: encode(v) for k, v in kwargs.items()}
+        ctl = _controller()
+        gap = None
+        if ctl is not None:  # time that passed between calls (a controller's wall-clock floor)
+            total = ctl.clock.now_ns + ctl.clock._pending_ns
+            if total != self._t_end and self._t_end >= 0:
+                gap = total
+        return [encode(a) for a in args], {k: encode(v) for k, v in kwargs.items()}, gap
 
     def after(self, name: str, args: tuple, kwargs: dict, rc: Any, token: Any) -> None:
         if token is None:
             return
-        a, kw = token
+        a, kw, gap = token
         outs = {str(i): encode(x) for i, x in enumerate(args) if _mutable(x)}
         outs.update({k: encode(v) for k, v in kwargs.items() if _mutable(v)})
         outs = {k: v for k, v in outs.items() if v != (a[int(k)] if k.isdigit() else kw.get(k))}
@@ -277,6 +290,9 @@ class Recorder(Listener):
             entry["k"] = kw
         if outs:
             entry["o"] = outs
+        if gap is not None:
+            entry["b"] = gap
+        self._t_end = t + ctl.clock._pending_ns if ctl is not None else -1
         self.lines.append(self._dumps(entry))
         self.calls += 1
         if ctl is not None and t - self._last_cp >= CHECKPOINT_MS * 1_000_000:
@@ -286,7 +302,7 @@ class Recorder(Listener):
                 self.lines.append(self._dumps(cp))
 
     def fault_event(self, what: str, values: dict[str, Any]) -> None:
-        same = threading.get_ident() == self.thread
+        same = threading.get_ident() == self.thread or self.thread is None
         entry = {"f": what, "v": values, "sync": same}
         ctl = _controller()
         if ctl is not None:
@@ -433,6 +449,13 @@ def _replay(
                     fn = fns[name] = getattr(gt, name, None)
                     if fn is None:
                         return n, Divergence(n, name, "function", "present", "missing")
+                before = e.get("b")
+                if before is not None:  # time passed between the calls: let it pass here too
+                    ctl = _controller()
+                    if ctl is not None:
+                        gap = before - ctl.clock.now_ns - ctl.clock._pending_ns
+                        if gap > 0:
+                            ctl.clock.advance_ns(gap)
                 a = e["a"]
                 args = [
                     x if not isinstance(x, dict) else _pooled(pool, name, i, x)

@@ -77,7 +77,10 @@ def _wrap(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def tap(listener: Listener) -> None:
+    """Listen to the GT calls: ``gtecat.gt``'s functions and the registry a controller process
+    dispatches its clients' calls through (``gtecat controller``, libgts programs)."""
     from .. import gt
+    from ..gt import _core
 
     if not _saved:
         for name, fn in list(vars(gt).items()):
@@ -85,19 +88,27 @@ def tap(listener: Listener) -> None:
                 if isinstance(fn, type):
                     continue
                 _saved[name] = fn
-                setattr(gt, name, _wrap(name, fn))
+                wrapped = _wrap(name, fn)
+                setattr(gt, name, wrapped)
+                if _core.REGISTRY.get(name) is fn:
+                    _core.REGISTRY[name] = wrapped
+        _core.TAPPED = True  # a controller's fast answers would pass by: it takes the calls
     _listeners.append(listener)
 
 
 def untap(listener: Listener) -> None:
     from .. import gt
+    from ..gt import _core
 
     if listener in _listeners:
         _listeners.remove(listener)
     if not _listeners and _saved:
         for name, fn in _saved.items():
+            if getattr(_core.REGISTRY.get(name), "__wrapped__", None) is fn:
+                _core.REGISTRY[name] = fn
             setattr(gt, name, fn)
         _saved.clear()
+        _core.TAPPED = False
 
 
 __all__ = ["Listener", "call_site", "tap", "untap"]

@@ -41,6 +41,7 @@ NEEDS = {
     "gtecat fault inject": "a running gtecat to break (tests/gtecat/faults)",
     "gtecat fault list": "a running gtecat (tests/gtecat/faults)",
     "gtecat fault clear": "a running gtecat (tests/gtecat/faults)",
+    "-- ./my_machine": "a C program built against libgts (tests/gtecat/faults, GTECAT_LONG)",
 }
 
 

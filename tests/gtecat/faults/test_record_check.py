@@ -250,3 +250,48 @@ def test_recorded_values_come_back_as_they_were() -> None:
     for x in values:
         text = json.dumps(encode(x), allow_nan=False)
         assert json.dumps(encode(decode(json.loads(text))), allow_nan=False) == text
+
+
+C_PROGRAM = r"""
+#include <stdio.h>
+#include "gts.h"
+int main(void) {
+    short st = 0; long sts = 0; int i;
+    GT_Open(0, 1);
+    GT_InitEcatComm();
+    for (i = 0; i < 5000 && !(GT_IsEcatReady(&st) == 0 && st == 1); i++) GTE_Wait(1);
+    GT_StartEcatComm();
+    GT_AxisOn(1);
+    GTE_Wait(20);
+    GT_GetSts(1, &sts, 1, NULL);
+    printf("sts %ld\n", sts);
+    GT_Close();
+    return 0;
+}
+"""
+
+
+@pytest.mark.skipif(not LONG, reason="builds and runs a C program (GTECAT_LONG=1)")
+def test_a_c_program_is_recorded_and_replayed(tmp_path: Path) -> None:
+    import shutil
+
+    if shutil.which("gcc") is None:
+        pytest.skip("no C compiler (gcc) on PATH")
+    src = tmp_path / "prog.c"
+    src.write_text(C_PROGRAM)
+    flags = subprocess.run(
+        [sys.executable, "-m", "gtecat", "lib", "--cflags", "--libs"],
+        capture_output=True, text=True, check=True,
+    ).stdout.split()  # fmt: skip
+    subprocess.run(["gcc", str(src), "-o", str(tmp_path / "prog"), *flags], check=True)
+    shutil.copy(EXAMPLES / "full_servo.eni", tmp_path / "Gecat.eni")
+    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}:{os.environ['PATH']}")
+    env.pop("GTECAT_CONTROLLER", None)
+    out = tmp_path / "c.gtrec"
+    done = subprocess.run(
+        [sys.executable, "-m", "gtecat", "record", "-o", str(out), "--", "./prog"],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert "sts 512" in done.stdout, done.stdout + done.stderr
+    assert "record: 7 GT calls" in done.stderr, done.stderr
+    assert main(["replay", str(out)]) == 0
