@@ -64,8 +64,8 @@ class FaultBus:
     def before_change(self) -> None:
         """Called before a fault touches slaves (the emulated bus gives back banked axes)."""
 
-    def set_frame_faults(self, on: bool) -> None:
-        """Route the cyclic answers through the injector (on) or not."""
+    def set_frame_faults(self, injector: Any) -> None:
+        """Route the cyclic answers through ``injector`` (None: no longer)."""
 
     # --- what the faults reach ----------------------------------------
     def slave(self, position: int) -> VirtualSlave:
@@ -209,14 +209,12 @@ class EmulatedBus(FaultBus):
             self.backend.replug(pos)
         self._cut = []
 
-    def set_frame_faults(self, on: bool) -> None:
-        self.backend.answer_hook = self._hook if on else None
-        if on:
+    def set_frame_faults(self, injector: Any) -> None:
+        self.backend.answer_hook = None if injector is None else injector.answer
+        if injector is not None:
             self.before_change()
         elif self.ctl.bank is not None:
             self.ctl.bank.dirty = True
-
-    _hook: Any = None
 
 
 class WireBus(FaultBus):
@@ -264,11 +262,9 @@ class WireBus(FaultBus):
         esc.on_fmmu_change(esc)
         esc.on_sm_change(esc)
 
-    def set_frame_faults(self, on: bool) -> None:
+    def set_frame_faults(self, injector: Any) -> None:
         if self.server is not None:
-            self.server.frame_hook = self._hook if on else None
-
-    _hook: Any = None
+            self.server.frame_hook = None if injector is None else injector.frame
 
 
 __all__ = ["EmulatedBus", "FaultBus", "WireBus"]

@@ -92,7 +92,6 @@ class Injector:
         self._last_answer: bytes | None = None
         self._lbase: int | None = None
         self._started: set[int] = set()
-        bus._hook = self.answer if bus.name == "emulated" else self.frame  # type: ignore[attr-defined]
         self._wrap_mailboxes()
 
     # --- adding and clearing ----------------------------------------
@@ -225,7 +224,7 @@ class Injector:
         )
         if frame != self._frame_on:
             self._frame_on = frame
-            self.bus.set_frame_faults(frame)
+            self.bus.set_frame_faults(self if frame else None)
         from .triggers import AtHomingStage, WhenPosition
 
         safe = not any(
