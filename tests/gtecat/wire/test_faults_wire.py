@@ -6,7 +6,8 @@ a lost mailbox answer and a protocol fault reach the SDO calls, a link down afte
 takes slaves 2 and 3 out of the process data (GT_IsEcatReady 0, their IO calls refused) until
 its time is over, a working counter off by one makes GT_IsEcatReady 0 while it lasts, and a
 latched AL error keeps slave 3 out until it is cleared, a power-cycled slave 2 (its ESC
-without address or configuration) is found and brought back: one script of steps.  Needs
+without address or configuration) is found and brought back, 30 lost answers make a dip:
+one script of steps.  Needs
 root and pysoem (skipped with the reason); several seconds of two processes, so it runs with
 GTECAT_LONG=1.
 """
@@ -73,6 +74,12 @@ kind = "power_cycle"
 slave = 2
 after = "al"
 after_ms = 4000
+name = "power"
+[[fault]]
+kind = "drop_responses"
+count = 30
+after = "power"
+after_ms = 5000
 """
 
 
@@ -131,6 +138,9 @@ def test_faults_on_the_wire(veth, tmp_path: Path) -> None:
         # finds it in INIT and brings it back
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=8000, step_ms=5)
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=15000, step_ms=10)
+        # 30 cyclic answers lost: a dip, then the bus goes on by itself
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=10000, step_ms=2)
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=10000, step_ms=10)
     finally:
         gt.GT_Close()
         r.stop()
