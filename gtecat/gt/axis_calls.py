@@ -150,10 +150,12 @@ def GT_GetEcatAxisMode(ctl: Controller, axis: int, pMode: Any) -> int:
 def _reader(index: int, subindex: int = 0):
     def read(ctl: Controller, axis: int, ptr: Any) -> int:
         ax = bus_axis(ctl, axis)
-        if ax.link_lost:  # the bytes there are the last received, not the drive's
+        # read past the axis bank's guard: looking must not give a banked axis back
+        lost = object.__getattribute__(ax, "link_lost")
+        if lost:  # the bytes there are the last received, not the drive's
             raise CommandError(
-                f"axis {ax.number}: {ax.link_lost}: 0x{index:04X} cannot be read (check the "
-                "slave, its cable and the EtherCAT communication)"
+                f"axis {axis}: {lost}: 0x{index:04X} cannot be read (check the slave, its "
+                "cable and the EtherCAT communication)"
             )
         store(ptr, ax.io.read(index, subindex))
         return 0
