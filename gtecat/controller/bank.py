@@ -432,6 +432,8 @@ class AxisBank:
             return "per-cycle hooks"
         if ctl.backend.unplugged:
             return "a slave is unplugged"
+        if ctl.backend.answer_hook is not None:
+            return "faults on the frames (gtecat.faults)"
         for res in ctl.resources.values():  # never the Axis objects: they may be guarded
             if res.profile.mode in (PrfMode.GEAR, PrfMode.FOLLOW):
                 return "an axis follows another (Gear/Follow)"
@@ -813,6 +815,15 @@ class AxisBank:
                 if ax is not None:
                     self.release_axis_object(ax)
                     return
+        if params and params[0].name == "mask" and values and type(values[0]) is int:
+            # GT_Update(mask), GT_Stop(mask, option): only the axes of the mask go back
+            mask = values[0]
+            axes = ctl.axes
+            named = [axes.get(n) for n in range(1, mask.bit_length() + 1) if mask >> (n - 1) & 1]
+            if named and all(ax is not None for ax in named):
+                for ax in named:
+                    self.release_axis_object(ax)
+                return
         self.release_all()
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
