@@ -611,6 +611,16 @@ class AxisBank:
             now = self.ctl.master.image.buffer[start : start + sl.out_bytes].tobytes()
             if now != bytes(g.drive.rx[: sl.out_bytes]):
                 return False
+        # and sent what its objects hold now: the bank leaves the constant TxPDO entries
+        # (analog inputs, 603Fh...) as the last scalar step wrote them, so one changed since
+        # (a test's set_analog_input) waits for the next scalar step to be sent first
+        drive = g.drive
+        codec = drive.codec
+        if len(drive.tx) >= codec.tx_bytes:
+            fresh = bytearray(len(drive.tx))
+            codec.encode(fresh)
+            if fresh != drive.tx:
+                return False
         for r in g.rows:
             self.csp.load(r)
             self._load(r)
