@@ -63,6 +63,12 @@ def test_the_gsn_sample_runs_its_path_in_millimetres():
     assert gt.GTN_SetAxisLimitModeLa(1, 1, limit_mode) == 0, gt.GTE_GetLastError()
     assert gt.GTN_SetAxisVelValidModeLa(1, 1, 0xF) == 0
     assert gt.GTN_SetVelModeLa(1, 1, gt.S_CURVE) == 0
+    assert gt.GTN_SetVelSmoothModeLa(1, 1, 1) == 0
+    assert gt.GTN_SetVelDefineModeLa(1, 1, gt.NORMAL_DEF_VEL) == 0
+    assert gt.GTN_SetAccDefineModeLa(1, 1, gt.LONG_AXIS_ACC) == 0
+    assert gt.GTN_SetWorkLimitModeLa(1, 1, gt.WORK_LIMIT_INVALID) == 0
+    assert gt.GTN_SetAxisVelValidCompModeLa(1, 1, 0, (c_int * 8)()) == 0
+    assert gt.GTN_SetFollowAxisProcessModeLa(1, 1, 0) == 0
     assert any("GT_SetVelModeLa" in line and "trapezoidal" in line for line in ctl.log.lines)
     assert gt.GTN_InitLookAheadEx(1, 1, byref(para()), 0, 0) == 0, gt.GTE_GetLastError()
     assert gt.GTN_LnXYEx(1, 1, 20, 10, 50, 1000, 0, 0) == 0, gt.GTE_GetLastError()
