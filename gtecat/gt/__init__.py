@@ -38,6 +38,8 @@ _MODULES = (
     "pvt_calls",
     "lead_screw_calls",
     "net_init_calls",
+    "legacy_home_calls",
+    "look_ahead_ex_calls",
 )
 
 

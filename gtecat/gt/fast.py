@@ -326,6 +326,8 @@ SLOW_REASONS: dict[str, str] = {
     "compare": "position compare and trigger set-up, data and status: table path",
     "crd_ex": "extended coordinated-motion queue calls: the planning work outweighs the arguments",
     "lead_screw": "lead-screw compensation tables: set up once",
+    "legacy_home": "the older homing calls: set up once, then a polled status (table path)",
+    "look_ahead_ex": "look-ahead set-up and planner modes: set up once",
     "net_init": "network cards' set-up and their encoder readers: table path",
     "pvt": "PVT tables and status: the table work outweighs the arguments",
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
