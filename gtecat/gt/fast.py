@@ -255,17 +255,19 @@ def fast_raw(
         views[key] = (p, arr)
         return arr
 
-    def raw_gt(offset: Any = _NO, size: Any = _NO, p: Any = _NO, *extra: Any, **kw: Any) -> int:
-        if extra or kw or p is _NO:
-            return slow(*(a for a in (offset, size, p) if a is not _NO), *extra, **kw)
-        return run(-1, offset, size, p, (offset, size, p))
+    # positional arguments only (no parameter names here: a keyword that repeats a
+    # positional one goes to the table path, which answers it with 7, not a TypeError)
+    def raw_gt(*args: Any, **kw: Any) -> int:
+        if kw or len(args) != 3:
+            return slow(*args, **kw)
+        offset, size, p = args
+        return run(-1, offset, size, p, args)
 
-    def io_gt(
-        slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, *more: Any, **kw: Any
-    ) -> int:
-        if more or kw or p is _NO or type(slave) is not int:
-            return slow(*(a for a in (slave, offset, size, p) if a is not _NO), *more, **kw)
-        return run(slave, offset, size, p, (slave, offset, size, p))
+    def io_gt(*args: Any, **kw: Any) -> int:
+        if kw or len(args) != 4 or type(args[0]) is not int:
+            return slow(*args, **kw)
+        slave, offset, size, p = args
+        return run(slave, offset, size, p, args)
 
     def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)

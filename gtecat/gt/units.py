@@ -112,6 +112,32 @@ ROWS: tuple[Row, ...] = (
        "byte in the GT raw image (`gtecat map`)"),
     _r("GT_EcatIOReadInput GT_EcatIOWriteOutput GT_EcatIOBitWriteOutput", "`offset`",
        "byte inside the slave's region"),
+    _r("GT_Home GT_HomeStop GT_Index", "`pos`, `offset`", P),
+    _r("GT_Home GT_HomeStop", "`vel`", V),
+    _r("GT_Home GT_HomeStop", "`acc`", A),
+    _r("GT_BufGear GT_BufGearEx", "`pos`, `deltaPos`", P),
+    _r("GT_CrdDataEx GT_LnXY*Ex GT_ArcXY*Ex", "positions, `radius`, centre",
+       "pulse; mm after `GT_InitLookAheadEx` on the FIFO", "TCrdData"),
+    _r("GT_CrdDataEx GT_LnXY*Ex GT_ArcXY*Ex", "`vel`, `velEnd`",
+       "pulse/ms; mm/s after `GT_InitLookAheadEx` on the FIFO", "TCrdData"),
+    _r("GT_CrdDataEx GT_LnXY*Ex GT_ArcXY*Ex", "`acc`",
+       "pulse/ms²; mm/s² after `GT_InitLookAheadEx` on the FIFO", "TCrdData"),
+    _r("GT_InitLookAheadEx", "`vMax`", "mm/s per axis", "TLookAheadParameter"),
+    _r("GT_InitLookAheadEx", "`aMax`", "mm/s² per axis", "TLookAheadParameter"),
+    _r("GT_InitLookAheadEx", "`scale`", "pulse/mm per axis", "TLookAheadParameter"),
+    _r("GT_InitLookAheadEx", "`time`", "ms", "TLookAheadParameter"),
+    _r("GT_SetVelModeLa GT_SetVelDefineModeLa GT_SetAccDefineModeLa GT_SetAxisVelValidModeLa",
+       "`velMode`, `velDefMode`, `accDefMode`, `velValidAxis`", "a mode or an axis mask: no unit"),
+    _r("GT*_SetPosCompareLinear* GT*_GetPosCompareLinear*",
+       "`startPos*`, `interval*`", P, "TPosCompareLinear(2D)"),
+    _r("GT*_PosCompareData GT*_PosCompareData2D", "`pos`, `posX`, `posY`", P,
+       "TPosCompareData(2D)"),
+    _r("GT*_PosCompareInfo", "`posX`, `posY`", P, "TPosCompareInfo"),
+    _r("GT_PvtTable GT_PvtTableEx GT_PvtTableComplete", "`pTime`", "ms"),
+    _r("GT_PvtTable GT_PvtTableEx GT_PvtTableComplete", "`pPos`", P),
+    _r("GT_PvtTable GT_PvtTableEx GT_PvtTableComplete", "`pVel*`, `velBegin`, `velEnd`", V),
+    _r("GT_SetLeadScrewComp", "`startPos`, `lenPos`, `pPositive`, `pNegative`", P),
+    _r("GTN_RN_GetAbsEncPosEx", "`pEncPos`", "counts of the absolute encoder"),
     _r("GT_GetClock", "clock", "ms since `GT_Reset`"),
     _r("GTE_Wait", "`ms`", "ms of controller time"),
     _r("GTE_SetProgramSpeed", "`instructionsPerMs`", "motion-program instructions per ms"),
@@ -140,11 +166,11 @@ def _index() -> tuple[dict[str, list[int]], list[tuple[str, int]]]:
 
 @cache
 def units_of(name: str) -> tuple[Row, ...]:
-    """The rows that name the GT function ``name`` (a ``GTN_`` twin: its ``GT_``'s), in
-    table order."""
-    if name.startswith("GTN_"):
-        name = "GT_" + name[4:]
+    """The rows that name the GT function ``name`` (a ``GTN_`` twin: its ``GT_``'s; a
+    ``GTN_`` function of its own, with no ``GT_`` form: its own), in table order."""
     exact, wild = _index()
+    if name.startswith("GTN_") and name not in exact:
+        name = "GT_" + name[4:]
     hits = set(exact.get(name, ()))
     hits.update(i for p, i in wild if _matches(p, name))
     return tuple(ROWS[i] for i in sorted(hits))
