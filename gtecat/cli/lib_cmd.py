@@ -28,6 +28,13 @@ C long there); put it beside the program as App.exe.config, or name it in MONO_C
 
     python3 -m gtecat lib --csharp -o gts.cs
     mcs App.cs gts.cs && python3 -m gtecat lib --mono-config -o App.exe.config && mono App.exe
+
+Windows (docs/windows.md): --windows x64|x86 -o DIR writes gts.dll (the GT API with the vendor
+DLL's undecorated __stdcall export names, reaching a gtecat controller over TCP), its import
+library gts.lib, gts.def and gts.h into DIR, cross-compiled with mingw-w64 on first use
+(x86_64-w64-mingw32-gcc / i686-w64-mingw32-gcc):
+
+    python3 -m gtecat lib --windows x86 -o win32
 """
 
 from __future__ import annotations
@@ -44,7 +51,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=__doc__,
         epilog="examples:\n"
         "  gtecat lib --cflags --libs      flags for gcc/g++ (builds libgts on first use)\n"
-        "  gtecat lib --header > gts.h     the generated header alone, no build",
+        "  gtecat lib --header > gts.h     the generated header alone, no build\n"
+        "  gtecat lib --windows x64 -o win64   gts.dll, gts.lib, gts.h for 64-bit Windows",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--cflags", action="store_true", help="-I for gts.h")
@@ -66,12 +74,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="the Mono dllmap sending gts.dll / gen.dll / gxn.dll to libgts (App.exe.config)",
     )
     p.add_argument("--csharp", action="store_true", help="gts.cs: the GT API for C# (generated)")
-    p.add_argument("-o", "--output", metavar="FILE", help="write --mono-config / --csharp here")
+    p.add_argument(
+        "--windows",
+        choices=["x64", "x86"],
+        help="gts.dll for Windows (with gts.lib, gts.def, gts.h) into the folder -o names "
+        "(mingw-w64 cross compiler)",
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="PATH",
+        help="write --mono-config / --csharp here; the folder of --windows",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     abi = "" if args.abi == "gtn" else args.abi
+    if args.windows:
+        return _windows(args)
     if args.mono_config or args.csharp:
         return _csharp(args)
     if args.header:
@@ -119,4 +140,17 @@ def _csharp(args: argparse.Namespace) -> int:
         Path(args.output).write_text(text, encoding="utf-8")
     else:
         sys.stdout.write(text)
+    return 0
+
+
+def _windows(args: argparse.Namespace) -> int:
+    from ..native import windows
+
+    if not args.output:
+        print(
+            "error: --windows writes several files: name their folder with -o DIR", file=sys.stderr
+        )
+        return 1
+    for path in windows.write(args.windows, args.output, force=args.rebuild):
+        print(path)
     return 0

@@ -118,6 +118,7 @@ def ensure_built(target: str, *, force: bool = False) -> WindowsBuild:
     for name in sorted(files):
         h.update(name.encode() + b"\0" + files[name].encode() + b"\0")
     h.update(" ".join([*cc, *CFLAGS, *LDFLAGS, *LIBS]).encode())
+    h.update(Path(__file__).read_bytes())  # this recipe: a changed build builds again
     build = WindowsBuild(cache_root() / __version__ / f"win-{target}-{h.hexdigest()[:12]}", target)
     if all(f.is_file() for f in build.files()) and not force:
         return build
@@ -181,17 +182,22 @@ def _compile(build: WindowsBuild, files: dict[str, str], cc: list[str]) -> None:
             )
         lines = ["LIBRARY gts.dll", "EXPORTS", *(decorated.get(n, n) for n in names), ""]
         (tmp / "gts.def").write_text("\n".join(lines), encoding="ascii")
-        cmd = [
-            *cc,
-            *LDFLAGS,
-            *objs,
-            str(tmp / "gts.def"),
-            f"-Wl,--out-implib,{tmp / 'gts.lib'}",
-            *LIBS,
-            "-o",
-            str(tmp / "gts.dll"),
-        ]
+        cmd = [*cc, *LDFLAGS, *objs, str(tmp / "gts.def"), *LIBS, "-o", str(tmp / "gts.dll")]
         _run(cmd, what)
+        # the import library from the same .def: its symbols keep the decoration a compiler
+        # emits for a __stdcall call (_GT_Open@8), each importing the undecorated name (-k)
+        dlltool = cc[0][: -len("gcc")] + "dlltool"
+        cmd = [
+            dlltool,
+            "-k",
+            "-d",
+            str(tmp / "gts.def"),
+            "-D",
+            "gts.dll",
+            "-l",
+            str(tmp / "gts.lib"),
+        ]
+        _run(cmd, what + " import library")
         out = tmp / "out"
         out.mkdir()
         for name in OUTPUTS:
