@@ -33,6 +33,7 @@ NEEDS = {
     "gtecat serve ": "a network interface (runs until stopped)",
     "gtecat controller": "runs until stopped",
     "gtecat lib --cflags": "a C compiler (builds libgts once)",
+    "gtecat lib --windows": "the mingw-w64 cross compiler (builds gts.dll once)",
     "gtecat demo": "the whole demo (tests/gtecat/test_demo.py runs it)",
 }
 
