@@ -1,6 +1,6 @@
 """Manual example 5-1, "read the bus communication state", as a Python script.
 
-    python examples/example_5_1_ecat_status.py
+    python example_5_1_ecat_status.py
 
 :func:`plc_prg` is the manual's program: every scan it asks ``GT_IsEcatReady`` and returns
 early while the bus is not in OP (``iEcatSts <> 1``); only then does the rest of the program

@@ -1,6 +1,6 @@
 """Manual example 5-4, "using EtherCAT IO", as a Python script.
 
-    python examples/example_5_4_ecat_io.py
+    python example_5_4_ecat_io.py
 
 The bus is the manual's figure 5-4: one coupler (slave 0) with a DI16, a DO16, an AI4 and an
 AO4 module; figure 5-5 gives the byte offsets inside the slave: outputs DO16 at 2, AO4 at

@@ -1,6 +1,6 @@
 """Manual example 5-5, "EtherCAT initialisation in C or C++", in Python.
 
-    python examples/example_5_5_init.py
+    python example_5_5_init.py
 
 The manual's listing is ``example_5_5_init.cpp`` (build and run it with libgts: its first
 lines say how); this script makes the same calls through ``from gtecat import gt``:

@@ -1,4 +1,4 @@
-"""gtecat lib: what a C, C++, C# or VB.NET program needs to use libgts.
+"""What a C, C++, C# or VB.NET program needs to use libgts.
 
 C and C++ (the header gts.h and libgts.so, built on first use into a per-version cache;
 with no C compiler this says so and exits 1):

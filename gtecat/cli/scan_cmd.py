@@ -22,7 +22,7 @@ import json
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "scan",
-        help="which GT functions an application's sources use, and whether gtecat runs them",
+        help="which GT functions an application's sources use, and whether they are emulated",
         description=__doc__.split("\n\n", 1)[1] if __doc__ else None,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -115,7 +115,7 @@ ROWS: tuple[Row, ...] = (
     _r("GT_GetClock", "clock", "ms since `GT_Reset`"),
     _r("GTE_Wait", "`ms`", "ms of controller time"),
     _r("GTE_SetProgramSpeed", "`instructionsPerMs`", "motion-program instructions per ms"),
-    _r("GTE_GetMachinePos", "position", "counts of the machine (see [machine.md](machine.md))"),
+    _r("GTE_GetMachinePos", "position", "counts of the machine (its description sets them)"),
 )
 # fmt: on
 

@@ -27,11 +27,12 @@ vendor's other library names ``gen.dll``, ``gxn.dll``) at ``libgts-llp64.so``
 from __future__ import annotations
 
 import ctypes
+import math
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from .. import __version__
-from ..gt.table import FUNCTIONS, NO_CORE_TWINS, Param, Proto
+from ..gt.table import ENUMS, FUNCTIONS, NO_CORE_TWINS, Param, Proto
 from . import cdecl
 from .protocol import table_digest
 
@@ -97,9 +98,9 @@ def _field_lines(name: str, t: type, where: str) -> list[str]:
         cs = "IntPtr"
     elif issubclass(t, ctypes.Structure):
         cs = t.__name__
+    elif issubclass(t, ctypes._SimpleCData) and t._type_ == "c" and len(dims) != 1:
+        cs = "byte"  # one char (a separator), or a table of them: bytes, not a text
     elif issubclass(t, ctypes._SimpleCData) and t._type_ == "c":
-        if len(dims) != 1:
-            raise CSharpError(f"{where}: a char field must be one array (a text)")
         return [
             f"[MarshalAs(UnmanagedType.ByValTStr, SizeConst = {dims[0]})]",
             f"public string {name};",
@@ -111,7 +112,12 @@ def _field_lines(name: str, t: type, where: str) -> list[str]:
     if not dims:
         return [f"public {cs} {name};"]
     if len(dims) > 1:
-        raise CSharpError(f"{where}: arrays of arrays are not unrolled")
+        # an array of arrays (corrX[65][65]) is one flat array in C order: the vendor's
+        # wrappers unroll short arrays into numbered fields, which thousands of fields are not
+        return [
+            f"[MarshalAs(UnmanagedType.ByValArray, SizeConst = {math.prod(dims)})]",
+            f"public {cs}[] {name};  // [{']['.join(map(str, dims))}], row after row",
+        ]
     sep = "_" if name[-1:].isdigit() else ""  # pad3 -> pad3_1, profile -> profile1
     return [f"public {cs} {name}{sep}{i};" for i in range(1, dims[0] + 1)]
 
@@ -175,6 +181,10 @@ def _bytes(p: Param) -> bool:
 def _param_cs(p: Param, structs: set[str], *, arrays: bool) -> str:
     n = _name(p.name)
     if not p.pointer:
+        if p.ctype in ENUMS:  # a C enum is an int
+            return f"int {n}"
+        if p.ctype in structs:  # a structure passed by value
+            return f"{p.ctype} {n}"
         if p.ctype not in SCALAR_CS:
             raise CSharpError(f"{p.name}: scalar type {p.ctype!r} has no C# spelling")
         return f"{SCALAR_CS[p.ctype]} {n}"
@@ -186,6 +196,8 @@ def _param_cs(p: Param, structs: set[str], *, arrays: bool) -> str:
             return f"IntPtr {n}"
     elif p.ctype in SCALAR_CS:
         cs = SCALAR_CS[p.ctype]
+    elif p.ctype in ENUMS:
+        cs = "int"
     elif p.ctype == "void":
         return f"IntPtr {n}"
     else:

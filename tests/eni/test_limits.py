@@ -100,12 +100,15 @@ def test_googol_cycle_time_zero_is_not_given() -> None:
     assert parse_eni(_googol_cycle("31250"), "ok.eni").cycle_time_ns == 31_250
 
 
+ONE_SLAVE = '[[slave]]\nkind = "servo"\n'
+
+
 def test_topology_cycle_time_uses_the_same_range() -> None:
     from gtecat.eni.topology import parse_topology
 
     with pytest.raises(EniError, match=r"31\.25\.\.1000000 us"):
-        parse_topology("cycle_time_us = 1e-3\n")
-    assert parse_topology("cycle_time_us = 62.5\n").cycle_time_ns == 62_500
+        parse_topology(f"cycle_time_us = 1e-3\n{ONE_SLAVE}")
+    assert parse_topology(f"cycle_time_us = 62.5\n{ONE_SLAVE}").cycle_time_ns == 62_500
 
 
 # --- the XML declaration's encoding ------------------------------------------------------------

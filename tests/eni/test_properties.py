@@ -189,7 +189,7 @@ def _generic_pdos(draw: st.DrawFn, base: int) -> list[dict[str, Any]]:
 @st.composite
 def topologies(draw: st.DrawFn) -> dict[str, Any]:
     slaves: list[dict[str, Any]] = []
-    for _ in range(draw(st.integers(0, 6))):
+    for _ in range(draw(st.integers(1, 6))):  # a topology without slaves is refused
         kind = draw(st.sampled_from(["servo", "io", "coupler", "generic"]))
         t: dict[str, Any] = {"kind": kind}
         if draw(st.booleans()):

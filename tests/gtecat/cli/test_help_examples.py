@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import io
+import re
 import shlex
 import shutil
 from contextlib import nullcontext, redirect_stdout
@@ -32,6 +33,9 @@ NEEDS = {
     "--png": "Graphviz's dot",
     "gtecat serve ": "a network interface (runs until stopped)",
     "gtecat controller": "runs until stopped",
+    "gtecat sweep": "a sweep of many cases (tests/gtecat/sweep runs them)",
+    "--attach ": "a running gtecat with that id (gtecat ps)",
+    "gtecat panel": "serves a page until stopped (tests/gtecat/inspect runs it)",
     "gtecat lib --cflags": "a C compiler (builds libgts once)",
     "gtecat lib --windows": "the mingw-w64 cross compiler (builds gts.dll once)",
     "gtecat demo": "the whole demo (tests/gtecat/test_demo.py runs it)",
@@ -112,7 +116,7 @@ def test_every_example_runs(folder: Path, monkeypatch: pytest.MonkeyPatch, capsy
     ran = []
     for example in EXAMPLES:
         need = next((why for key, why in NEEDS.items() if key in example), None)
-        stages = [shlex.split(s) for s in example.split(" | ")]
+        stages = [shlex.split(s) for s in re.split(r" \| | && ", example)]  # a pipe or a sequence
         if need is not None:
             for words in stages:
                 args = [w for w in words[1:] if w != ">"]

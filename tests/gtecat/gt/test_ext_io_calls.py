@@ -191,3 +191,39 @@ def test_active_low_overrides_the_family_wiring(card):
     assert gt.GT_Open(card="gts:1", machine=m, clock="lockstep", log="") == 0
     assert gt.GT_OpenExtMdl() == 0 and gt.GT_LoadExtConfig("ExtModule.cfg") == 0
     assert gt.GT_SetExtIoBit(0, 0, 1) == 0 and gt.GTE_ExtModule(0).output(0)
+
+
+def test_the_multi_card_forms_act_on_the_same_modules(card):
+    """The ``...Gts`` forms of the multi-card wrappers (``cardNum`` first, card 0 here) read and
+    write the modules the single-card forms do: levels, raw analog values and volts."""
+    assert gt.GT_OpenExtMdlGts(0, "gts.dll") == 0
+    assert gt.GT_LoadExtConfigGts(0, "ExtModule.cfg") == 0
+    assert gt.GT_SwitchtoCardNoExtMdlGts(0, 0) == 0
+    assert gt.GT_SwitchtoCardNoExtMdlGts(0, 2) == 7
+    assert gt.GT_SetExtIoValueGts(0, 1, 0xFFF0) == 0  # module 1: outputs 0..3 on (active low)
+    assert u16(gt.GT_GetExtDoValueGts, 0, 1) == 0xFFF0 == u16(gt.GT_GetExtDoValue, 1)
+    assert gt.GTE_ExtModule(1).output(0) and not gt.GTE_ExtModule(1).output(4)
+    gt.GTE_ExtModule(0).set_input(5, True)  # on = low level
+    assert u16(gt.GT_GetExtIoBitGts, 0, 0, 5) == 0 and u16(gt.GT_GetExtIoBitGts, 0, 0, 4) == 1
+    assert gt.GT_SetExtDaVoltageGts(0, 2, 0, -5.0) == 0
+    assert gt.GTE_ExtModule(2).ao_voltage(0) == -5.0
+    assert gt.GT_SetExtDaValueGts(0, 2, 1, 65535) == 0
+    assert gt.GTE_ExtModule(2).ao_voltage(1) == 10.0
+    assert gt.GTE_SetExtAdVoltage(2, 0, 5.0) == 0
+    assert u16(gt.GT_GetExtAdValueGts, 0, 2, 0) == round(5.0 / 10 * 65535)  # range [0, 10] V
+    assert gt.GT_SetExtIoValueGts(1, 1, 0) == 7 and "card 0" in gt.GTE_GetLastError()
+
+
+def test_the_gtn_core_reads_an_output_back_and_writes_raw_analog_values():
+    bring_up(clock="lockstep", machine=machine_from_dict(MACHINE))
+    assert gt.GTN_ExtModuleInit(1, 1) == 0
+    assert gt.GTN_SetExtDoBit(1, 18, 1) == 0  # module 1's output 1
+    bit = c_short()
+    assert gt.GTN_GetExtDoBit(1, 18, byref(bit)) == 0 and bit.value == 1
+    assert gt.GTN_GetExtDoBit(1, 17, byref(bit)) == 0 and bit.value == 0
+    assert gt.GTN_GetExtDoBit(1, 25, byref(bit)) == 7  # 24 outputs on the chain
+    # +-32767 is +-10 V (the default range); AO 2 of the chain is module 2's channel 1
+    assert gt.GTN_SetExtAoValue(1, 2, (c_short * 1)(-16384), 1) == 0
+    assert abs(gt.GTE_ExtModule(2).ao_voltage(1) - (-16384 / 32767 * 10)) < 1e-9
+    assert gt.GT_SetExtAoValue(1, byref(c_short(32767)), 1) == 0  # the GT_ form is core 1
+    assert gt.GTE_ExtModule(2).ao_voltage(0) == 10.0

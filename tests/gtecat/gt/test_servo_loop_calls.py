@@ -185,13 +185,23 @@ def _observe() -> list[int]:
 
 def test_limit_and_input_senses_act_as_the_configuration_files_reverse(tmp_path):
     """GT_LmtSns (GTS manual example 4-2: bits 0/1 axis 1's positive/negative limit) and
-    GT_SetSense set the ``reverse`` a configuration file sets: the same observations."""
+    GT_SetSense set the ``reverse`` a configuration file sets: the same observations on a
+    machine whose switches are stated normally open.  Where the machine description does
+    not state the wiring, the switches are wired as the application expects (a ``reverse=1``
+    of its file, or a sense it sets, is a normally-closed switch): neither changes what is
+    seen, as on the machine the application was written for."""
     from gtecat.drives.machine import AxisMachine, MachineDescription
 
-    m = MachineDescription(
-        {1: AxisMachine(positive_limit=-100.0), 2: AxisMachine(home_switch=((-50.0, 50.0),))}
-    )
-    assert gt.GT_Open(card="gts:2", machine=m, clock="lockstep", log="") == 0
+    def machine(wiring: str | None) -> MachineDescription:
+        return MachineDescription(
+            {
+                1: AxisMachine(positive_limit=-100.0, switch_wiring=wiring),
+                2: AxisMachine(home_switch=((-50.0, 50.0),), switch_wiring=wiring),
+            }
+        )
+
+    stated, unstated = machine("normally_open"), machine(None)
+    assert gt.GT_Open(card="gts:2", machine=stated, clock="lockstep", log="") == 0
     plain = _observe()
     assert gt.GT_LmtSns(0b0000_1001) == 0  # axis 1 positive, axis 2 negative
     assert gt.GT_SetSense(gt.MC_HOME, 2, 1) == 0
@@ -207,6 +217,15 @@ def test_limit_and_input_senses_act_as_the_configuration_files_reverse(tmp_path)
         "[limitPositive2]\nreverse=0\n[limitNegative2]\nreverse=1\n[home2]\nreverse=1\n",
         encoding="utf-8",
     )
-    assert gt.GT_Open(card="gts:2", machine=m, clock="lockstep", log="") == 0
+    assert gt.GT_Open(card="gts:2", machine=stated, clock="lockstep", log="") == 0
     assert gt.GT_LoadConfig(str(cfg)) == 0, gt.GTE_GetLastError()
     assert _observe() == at_run_time != plain
+    gt.GT_Close()
+    assert gt.GT_Open(card="gts:2", machine=unstated, clock="lockstep", log="") == 0
+    assert _observe() == plain
+    assert gt.GT_LoadConfig(str(cfg)) == 0, gt.GTE_GetLastError()
+    assert _observe() == plain  # wired as the file expects
+    assert gt.GT_LmtSns(0b0000_1000) == 0  # a sense set at run time: the same rule
+    assert _observe() == plain
+    sense = c_short()
+    assert gt.GT_GetSense(gt.MC_LIMIT_POSITIVE, 1, byref(sense)) == 0 and sense.value == 0

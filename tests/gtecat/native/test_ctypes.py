@@ -13,7 +13,7 @@ import signal
 import subprocess
 import sys
 import time
-from ctypes import byref, c_double, c_long, c_short, c_ulong, create_string_buffer
+from ctypes import byref, c_char_p, c_double, c_long, c_short, c_ulong, create_string_buffer
 
 import pytest
 
@@ -112,8 +112,8 @@ def test_the_vendor_sequence_through_ctypes(lib, env):
         assert lib.GT_GetSts(40, byref(sts), 1, None) == 7
         lib.GT_GetSts.restype = c_short
         assert lib.GT_GetSts(1, byref(sts), 1, None) == 0
-        version = create_string_buffer(64)
-        assert lib.GT_GetVersion(version) == 0
+        version = c_char_p()  # the vendor header's char **: the library sets the pointer
+        assert lib.GT_GetVersion(byref(version)) == 0
         assert version.value == b"010 261201 010 261201"  # table 11-3
     finally:
         assert lib.GT_Close() == 0
@@ -179,9 +179,9 @@ def test_a_dead_controller_makes_calls_return_minus_1(lib, controller):
 
 
 def test_a_stopped_controller_times_out(lib, controller, env):
-    env.setenv("GTECAT_TIMEOUT_MS", "300")
     sts = c_long()
     assert lib.GT_Open(0, 1) == 0, last_error(lib)
+    env.setenv("GTECAT_TIMEOUT_MS", "300")  # read at each call: the open has its default
     controller.send_signal(signal.SIGSTOP)
     try:
         t = time.monotonic()

@@ -44,6 +44,7 @@ int main()
     say("rescount_value", count);
     TMoveVelocityPrm mv = {10, 1, 1, 0, 0, 1};
     say("movevelocity", GTN_MoveVelocity(1, 1, &mv));
+    why("movevelocity_reason");
     say("close", GT_Close());
     say("done", 1);
     return 0;
