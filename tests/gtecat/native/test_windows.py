@@ -54,10 +54,12 @@ def _needs_wine() -> None:
 
 @pytest.fixture(scope="module")
 def tcp_controller():
-    """One controller in this process on a free TCP port of 127.0.0.1, with a token."""
+    """One controller in this process on a free TCP port of 127.0.0.1, with a token; the
+    first client's GT_Open opens it (until then no bus cycles run, e.g. while the tests
+    compile)."""
     gt.GT_Close()
-    assert gt.GT_Open(eni=str(FIG5_2), clock="auto", log="") == 0, gt.GTE_GetLastError()
-    with server_mod.Server("tcp:127.0.0.1:0", token=TOKEN) as server:
+    options = {"eni": str(FIG5_2), "clock": "auto", "log": ""}
+    with server_mod.Server("tcp:127.0.0.1:0", token=TOKEN, open_options=options) as server:
         yield server.address
     gt.GT_Close()
 
@@ -132,7 +134,9 @@ def _windows_programs(dll: windows.WindowsBuild, folder: Path, target: str) -> d
         "load": _cross(target, "gcc", C_DIR / "win_loadlibrary.c", folder / "load.exe"),
     }
     if shutil.which(f"{windows.TRIPLES[target]}-g++"):
-        # a vendor-style header, as an MFC program sees it: windows.h first (stdafx.h)
+        # a vendor-style header, unchanged: it needs NULL and the Windows type names that an
+        # MFC program's windows.h gives it (basetsd.h is the part with UINT8; gtecat_vendor.h,
+        # which `gtecat lib --cflags` force-includes on Linux, gives <stddef.h> on Windows)
         out["vendor"] = _cross(
             target,
             "g++",
@@ -140,7 +144,9 @@ def _windows_programs(dll: windows.WindowsBuild, folder: Path, target: str) -> d
             folder / "vendor.exe",
             f"-I{C_DIR / 'vendor_style'}",
             "-include",
-            "windows.h",
+            str(dll.root / "gtecat_vendor.h"),
+            "-include",
+            "basetsd.h",
             "-static",  # its C++ runtime inside the .exe, as a Visual C++ program links it
             lib,
         )
@@ -152,13 +158,13 @@ def test_windows_programs_under_wine_match_the_linux_library(
 ):
     _needs_wine()
     programs = _windows_programs(dll_x86, tmp_path / "win", "x86")
-    env = _wine_env(GTECAT_CONTROLLER=tcp_controller.replace("tcp:", "tcp://"), GTECAT_TOKEN=TOKEN)
-    r, win = _wine(programs["gtn"], env)
-    assert r.returncode == 0 and win.get("done") == "1", r.stdout + r.stderr
-    # the same program built for Linux against libgts, over the same TCP transport
+    # the same program built for Linux against libgts, to run over the same TCP transport
     linux_exe = tmp_path / "gtn_linux"
     cmd = ["gcc", str(C_DIR / "gtn_sequence.c"), *libgts.cflags(), *libgts.libs(), "-o"]
     subprocess.run([*cmd, str(linux_exe)], check=True, capture_output=True)
+    env = _wine_env(GTECAT_CONTROLLER=tcp_controller.replace("tcp:", "tcp://"), GTECAT_TOKEN=TOKEN)
+    r, win = _wine(programs["gtn"], env)
+    assert r.returncode == 0 and win.get("done") == "1", r.stdout + r.stderr
     r2, lin = run_client(
         linux_exe,
         env=native_env(GTECAT_CONTROLLER=tcp_controller, GTECAT_TOKEN=TOKEN),

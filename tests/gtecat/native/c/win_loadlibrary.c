@@ -2,7 +2,8 @@
  * LoadLibrary, then GetProcAddress by the undecorated names the vendor's DLL exports.
  * Prints `key value` lines the test reads. */
 #include <stdio.h>
-#include <windows.h>
+#include <windef.h>
+#include <libloaderapi.h> /* LoadLibraryA, GetProcAddress */
 
 typedef short(__stdcall *open_fn)(short, short);
 typedef short(__stdcall *void_fn)(void);
