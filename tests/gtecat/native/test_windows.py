@@ -30,7 +30,7 @@ from gtecat.native import server as server_mod
 from gtecat.native import transport, windows
 
 from ...conftest import LONG
-from .conftest import C_DIR, FIG5_2, native_env, parse_lines, run_client
+from .conftest import C_DIR, FIG5_2, ROOT, native_env, parse_lines, run_client
 from .wire_client import WireClient
 
 pytestmark = pytest.mark.xdist_group("windows")
@@ -258,7 +258,7 @@ def test_bad_connections_are_dropped_and_never_disturb_a_client(
     worst = 0.0
     for _ in range(5):
         t0 = time.perf_counter()
-        rc, blocks, _ = good.call("GT_GetSts", 1, 8, 1, None)
+        rc, blocks, _ = good.call("GT_GetClock", 8, None)
         worst = max(worst, time.perf_counter() - t0)
         assert rc == 0 and len(blocks) == 1
     assert worst < 0.5
@@ -272,7 +272,7 @@ def test_bad_connections_are_dropped_and_never_disturb_a_client(
         "no hello with a token",
     ):
         assert needle in text, needle
-    assert good.call("GT_GetSts", 1, 8, 1, None)[0] == 0
+    assert good.call("GT_GetClock", 8, None)[0] == 0
     for s in (wrong.sock, none.sock, silent, half, junk, early, hog.sock, good.sock):
         s.close()
 
@@ -288,6 +288,28 @@ def test_the_controller_command_refuses_bad_addresses_and_token_files(tmp_path, 
     assert "holds no token" in capsys.readouterr().err
     assert main(["controller", "--listen", "unix:/tmp/x.sock", "--token-file", str(empty)]) == 1
     assert "for tcp: addresses" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("tcp:127.0.0.1:7701", "tcp:127.0.0.1:7701"),
+        ("tcp://10.0.0.5:7701/", "tcp:10.0.0.5:7701"),
+        ("tcp:7701", "tcp:127.0.0.1:7701"),
+        ("tcp:[::1]:7701", "tcp:[::1]:7701"),
+        ("unix:/tmp/x.sock", "unix:/tmp/x.sock"),
+        ("/tmp/x.sock", "unix:/tmp/x.sock"),
+        ("unix:@name", "unix:@name"),
+    ],
+)
+def test_controller_addresses(text, expected):
+    assert str(transport.parse(text)) == expected
+
+
+@pytest.mark.parametrize("text", ["tcp:host", "tcp:host:99999", "tcp:[::1]7701", "http://x", ""])
+def test_bad_controller_addresses_say_what_is_expected(text):
+    with pytest.raises(transport.AddressError):
+        transport.parse(text)
 
 
 def test_a_token_file_is_readable_by_its_owner_only(tmp_path):
@@ -309,6 +331,17 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
     for name in ("gtn", "load"):
         r, v = _wine(programs[name], env)
         assert r.returncode == 0 and v.get("done") == "1", r.stdout + r.stderr
+    # a C++ application in the usual shape (a Motion class): bring-up, homing, a Trap move
+    if shutil.which("x86_64-w64-mingw32-g++"):
+        demo = programs["load"].parent / "motion_demo.exe"
+        src = ROOT / "examples" / "native" / "motion_demo.cpp"
+        _cross("x64", "g++", src, demo, f"-I{dll.root}", "-static", str(dll.root / "gts.lib"))
+        r = subprocess.run(
+            ["wine", str(demo)], capture_output=True, text=True, env=env, timeout=300
+        )
+        seen = r.stdout.splitlines()
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "home status 3" in seen and "moved prf 30000 enc 30000" in seen, seen
     # gtecat.ini beside the program instead of the environment
     (programs["load"].parent / "gtecat.ini").write_text(
         f"[gtecat]\ncontroller = {tcp_controller}\ntoken = {TOKEN}\n"
@@ -319,33 +352,58 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
 
 @pytest.mark.skipif(not LONG, reason="GTECAT_LONG=1: the flood of bad connections and messages")
 def test_the_endpoint_survives_a_flood(tcp_controller):
+    """100 unauthenticated connections held open, then 100,000 bad messages, each on a
+    connection of its own and each read by the controller (the test waits until it closes
+    the connection): garbage, truncated, oversized, a replayed hello without the token, a
+    call before the hello, and, after a right hello, truncated and oversized calls.  An
+    attached client is answered throughout."""
     addr = transport.parse(tcp_controller)
     good = WireClient(tcp_controller, token=TOKEN)
     assert good.call("GT_Open", 0, 1)[0] == 0
     idle = [transport.connect(addr, 5) for _ in range(100)]  # 100 unauthenticated at once
     rng = random.Random(27)
     hello = p.HELLO.pack(p.MSG_HELLO, p.PROTOCOL_VERSION, 8, p.table_digest().encode())
+    token = TOKEN.encode()
+    authed = hello + struct.pack("<H", len(token)) + token
+    sts = p.plans_by_name()["GT_GetSts"].fid
+    call = p.CALL.pack(p.MSG_CALL, 0, sts, 1) + p.I64.pack(1) + p.PTR.pack(8) + bytes(8)
     shapes = [
         lambda: bytes(rng.getrandbits(8) for _ in range(rng.randrange(1, 40))),  # garbage
         lambda: p.FRAME.pack(len(hello)) + hello,  # a replayed hello without the token
-        lambda: p.FRAME.pack(len(hello) + 4) + hello[:10],  # truncated
+        lambda: p.FRAME.pack(len(hello) + 4) + hello[:10],  # truncated, then silence
         lambda: p.FRAME.pack(1 << 30) + b"x" * 16,  # oversized
         lambda: p.FRAME.pack(6) + p.CALL.pack(p.MSG_CALL, 0, 1, 1),  # a call, no hello
     ]
-    sent, conns = 0, 0
-    while sent < 100_000:
-        s = transport.connect(addr, 5)
-        conns += 1
-        try:
-            for _ in range(50):
-                s.sendall(rng.choice(shapes)())
-                sent += 1
-        except OSError:
-            pass  # dropped: as it should be
-        s.close()
-        if conns % 200 == 0:
-            assert good.call("GT_GetSts", 1, 8, 1, None)[0] == 0
-    assert good.call("GT_GetSts", 1, 8, 1, None)[0] == 0
+    after_hello = [
+        lambda: p.FRAME.pack(len(call) - 5) + call[:-5],  # a call cut short
+        lambda: p.FRAME.pack(len(call) + 9) + call + p.I64.pack(1) + b"x",  # bytes left over
+        lambda: p.FRAME.pack(p.MAX_FRAME + 1),  # larger than the protocol allows
+        lambda: p.FRAME.pack(6) + p.CALL.pack(p.MSG_CALL, 0, 65000, 1),  # unknown function
+    ]
+    linger = struct.pack("ii", 1, 0)  # close with a reset: no TIME_WAIT for 100,000 ports
+    server_mod_timeout = server_mod.IO_TIMEOUT_S
+    server_mod.IO_TIMEOUT_S = 0.05  # "truncated, then silence" is dropped quickly
+    try:
+        for i in range(100_000):
+            s = socket.create_connection((addr.host, addr.port), timeout=5)
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, linger)
+            try:
+                if i % 3 == 2:
+                    s.sendall(p.FRAME.pack(len(authed)) + authed)
+                    assert p.HELLO_REPLY.unpack_from(s.recv(64), 4)[0] == 0
+                    s.sendall(rng.choice(after_hello)())
+                else:
+                    s.sendall(rng.choice(shapes)())
+                assert _closed_soon(s, 10)
+            except OSError:
+                pass  # reset by the controller: as it should be
+            finally:
+                s.close()
+            if i % 1000 == 0:
+                assert good.call("GT_GetClock", 8, None)[0] == 0
+    finally:
+        server_mod.IO_TIMEOUT_S = server_mod_timeout
+    assert good.call("GT_GetClock", 8, None)[0] == 0
     for s in idle:
         s.close()
     good.sock.close()
