@@ -19,6 +19,7 @@ import shutil
 import socket
 import struct
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -381,8 +382,9 @@ def test_the_endpoint_survives_a_flood(tcp_controller):
         lambda: p.FRAME.pack(6) + p.CALL.pack(p.MSG_CALL, 0, 65000, 1),  # unknown function
     ]
     linger = struct.pack("ii", 1, 0)  # close with a reset: no TIME_WAIT for 100,000 ports
-    server_mod_timeout = server_mod.IO_TIMEOUT_S
-    server_mod.IO_TIMEOUT_S = 0.05  # "truncated, then silence" is dropped quickly
+    timeouts = server_mod.IO_TIMEOUT_S, server_mod.AUTH_TIMEOUT_S
+    # "truncated, then silence" is dropped at once, not after seconds
+    server_mod.IO_TIMEOUT_S = server_mod.AUTH_TIMEOUT_S = 0.02
     try:
         for i in range(100_000):
             s = socket.create_connection((addr.host, addr.port), timeout=5)
@@ -402,7 +404,7 @@ def test_the_endpoint_survives_a_flood(tcp_controller):
             if i % 1000 == 0:
                 assert good.call("GT_GetClock", 8, None)[0] == 0
     finally:
-        server_mod.IO_TIMEOUT_S = server_mod_timeout
+        server_mod.IO_TIMEOUT_S, server_mod.AUTH_TIMEOUT_S = timeouts
     assert good.call("GT_GetClock", 8, None)[0] == 0
     for s in idle:
         s.close()
@@ -417,3 +419,48 @@ def test_a_client_built_with_the_wrong_token_length_is_refused_cleanly(tcp_contr
     s.sendall(p.FRAME.pack(len(body)) + body)
     assert _closed_soon(s)
     s.close()
+
+
+@pytest.mark.skipif(not LONG, reason="GTECAT_LONG=1: a controller in a Python shaped like Windows'")
+def test_the_controller_runs_without_what_windows_lacks(tmp_path):
+    """The controller in a Python without fcntl, Unix sockets, epoll/poll or os.getuid (as on
+    Windows) serves a Python program attached over TCP: bring-up and a servo-on axis."""
+    from ctypes import byref, c_long, c_short
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp:127.0.0.1:{port}"
+    env = native_env(GTECAT_TOKEN=TOKEN)
+    shim = Path(__file__).parent / "winlike_controller.py"
+    proc = subprocess.Popen(
+        [sys.executable, str(shim), "--listen", address, "--eni", str(FIG5_2)],
+        env=env,
+        cwd=tmp_path,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        server_mod.wait_for(address, 60)
+        gt.GT_Close()
+        os.environ["GTECAT_TOKEN"] = TOKEN
+        try:
+            assert gt.GT_Open(controller=address) == 0, gt.GTE_GetLastError()
+            assert gt.GT_InitEcatComm() == 0
+            ready = c_short()
+            for _ in range(1000):
+                gt.GT_IsEcatReady(byref(ready))
+                if ready.value == 1:
+                    break
+            assert ready.value == 1
+            assert (gt.GT_StartEcatComm(), gt.GT_AxisOn(1)) == (0, 0)
+            sts = c_long()
+            assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & (1 << 9)
+            assert gt.GT_Close() == 0
+        finally:
+            del os.environ["GTECAT_TOKEN"]
+            gt.GT_Close()
+    finally:
+        proc.terminate()
+        _, err = proc.communicate(timeout=30)
+    assert "listening on " + address in err, err
