@@ -163,6 +163,9 @@ class ProbeStatus(IntFlag):
 class _AxisHoming:
     """What the controller remembers about one axis's homing (lives as long as the axis)."""
 
+    #: the axis bank knows this hook: an inactive one does nothing, and while a claimed
+    #: drive searches its answer stays "in progress" (gtecat.controller.bank)
+    bank_homing_hook = True
     params_set: bool = False
     #: a run started by GT_StartEcatHoming has not ended yet (status 0)
     active: bool = False
