@@ -432,6 +432,8 @@ class AxisBank:
             return "per-cycle hooks"
         if ctl.backend.unplugged:
             return "a slave is unplugged"
+        if ctl.backend.answer_hook is not None:
+            return "faults on the frames (gtecat.faults)"
         for res in ctl.resources.values():  # never the Axis objects: they may be guarded
             if res.profile.mode in (PrfMode.GEAR, PrfMode.FOLLOW):
                 return "an axis follows another (Gear/Follow)"
@@ -489,16 +491,7 @@ class AxisBank:
                 return False
         else:
             return False
-        enc = res.encoder
-        if not (enc._primed and enc.active):
-            return False
-        s = res.safety
-        n = ax.number
-        if s.alarm_input not in (n, None) or s.smooth_stop_input or s.abrupt_stop_input:
-            return False
-        if s.positive_input not in (n, None) or s.negative_input not in (n, None):
-            return False
-        if res._pos_din is not ax.io.get(0x60FD) and res._pos_din is not None:
+        if not self._inputs_plain(ax, res):
             return False
         return not claimable(self.csp.channels[r])
 
@@ -579,7 +572,11 @@ class AxisBank:
             return False
         if s.positive_input not in (n, None) or s.negative_input not in (n, None):
             return False
-        return res._pos_din is ax.io.get(0x60FD) or res._pos_din is None
+        din = ax.io.get(0x60FD)
+        if any(e is not None and e is not din for e in (res._pos_din, res._neg_din)):
+            return False  # a configuration's reverse (SensedInput) or another source
+        # the alarm read through a reverse: the kernel reads 6041h as it is
+        return res._alarm_sw is res._sw
 
     def refresh(self) -> None:
         """Claim every slave whose axes are all eligible; drop all when the bank cannot run."""
@@ -818,6 +815,15 @@ class AxisBank:
                 if ax is not None:
                     self.release_axis_object(ax)
                     return
+        if params and params[0].name == "mask" and values and type(values[0]) is int:
+            # GT_Update(mask), GT_Stop(mask, option): only the axes of the mask go back
+            mask = values[0]
+            axes = ctl.axes
+            named = [axes.get(n) for n in range(1, mask.bit_length() + 1) if mask >> (n - 1) & 1]
+            if named and all(ax is not None for ax in named):
+                for ax in named:
+                    self.release_axis_object(ax)
+                return
         self.release_all()
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------

@@ -56,6 +56,8 @@ def claimable(ch: Channel) -> str:
         return "controlword"
     if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
         return "fault"
+    if ch.field is not None:
+        return "field fault"
     if ch.torque_ctl or ch.stopping or ch.limit_stop:
         return "stopping"
     if ch.digital_inputs & 3:

@@ -95,3 +95,5 @@ def _vendor_surface() -> None:
 
 
 _vendor_surface()
+
+from .. import faults as _faults  # noqa: E402,F401  (arms the machine TOML's [[fault]] tables)

@@ -136,6 +136,9 @@ class _Session:
 
 SESSION = _Session()
 REGISTRY: dict[str, Callable[..., int]] = {}
+#: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
+#: a controller process then runs every call through REGISTRY, none on a fast path
+TAPPED = False
 
 
 def code_for(exc: BaseException) -> int:

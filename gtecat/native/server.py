@@ -233,7 +233,9 @@ class _Decoder:
         self.fn_gtn = _core.REGISTRY.get("GTN_" + plan.name[3:]) if plan.proto.gtn else None
         #: the common request shape answered without decoding (gtecat.gt.fast), GT_ only
         self.fast = (
-            wire_reader(plan.name, long_size, _core.SESSION) if plan.name in READERS else None
+            wire_reader(plan.name, long_size, _core.SESSION)
+            if plan.name in READERS and not _core.TAPPED
+            else None
         )
 
     def decode(self, body: Any, pos: int) -> tuple[list[Any], list[Any]]:

@@ -39,6 +39,10 @@ NEEDS = {
     "gtecat lib --cflags": "a C compiler (builds libgts once)",
     "gtecat lib --windows": "the mingw-w64 cross compiler (builds gts.dll once)",
     "gtecat demo": "the whole demo (tests/gtecat/test_demo.py runs it)",
+    "gtecat fault inject": "a running gtecat to break (tests/gtecat/faults)",
+    "gtecat fault list": "a running gtecat (tests/gtecat/faults)",
+    "gtecat fault clear": "a running gtecat (tests/gtecat/faults)",
+    "-- ./my_machine": "a C program built against libgts (tests/gtecat/faults, GTECAT_LONG)",
 }
 
 
