@@ -586,8 +586,11 @@ static int split_tcp(const char *addr, char *host, size_t hcap, char *port, size
     }
     if (!*h || !*p || strlen(p) > 5 || strspn(p, "0123456789") != strlen(p) || atoi(p) > 65535)
         return -1;
-    snprintf(host, hcap, "%s", h);
-    snprintf(port, pcap, "%s", p);
+    size_t hl = strlen(h), pl = strlen(p);
+    if (hl + 1 > hcap || pl + 1 > pcap)
+        return -1;
+    memcpy(host, h, hl + 1);
+    memcpy(port, p, pl + 1);
     return 0;
 }
 
