@@ -10,7 +10,6 @@ the digest of its source and flags (a lock file serialises concurrent builders).
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import os
 import shlex
@@ -21,6 +20,11 @@ from pathlib import Path
 
 from . import __version__
 from .errors import GtecatError
+
+try:
+    import fcntl
+except ImportError:  # Windows: a controller runs there without these builds' lock
+    fcntl = None  # type: ignore[assignment]
 
 
 class NativeBuildError(GtecatError):
@@ -74,7 +78,8 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
         return lib
     vdir = version_dir()
     with open(vdir / ".lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)
         if lib.is_file():
             return lib
         tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=vdir))

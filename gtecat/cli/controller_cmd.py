@@ -1,13 +1,21 @@
-"""``gtecat controller [--listen unix:/path]``: one virtual controller for native clients.
+"""``gtecat controller [--listen unix:/path | tcp:HOST:PORT]``: one virtual controller for
+native clients.
 
 Runs the controller (bus, clock, axes, field side) of the ``GTECAT_*`` environment (or
-the options) and serves it over a Unix socket to any number of clients: programs
-linked with ``libgts.so`` (``GTECAT_CONTROLLER=unix:/path``), Python code loading it
-through ctypes, other tools.  The first client's ``GT_Open`` opens the controller;
-calls are served one at a time.  In ``auto`` clock mode the controller keeps its time
-at or ahead of wall time (the wall floor, docs/native.md), so programs that sleep
-between polls see their sleeps pass; ``--no-wall-floor`` (GTECAT_WALL_FLOOR=0) keeps
-pure, deterministic ``auto``.
+the options) and serves it over a Unix socket, or over TCP, to any number of clients:
+programs linked with ``libgts.so`` (``GTECAT_CONTROLLER=unix:/path``), a Windows program
+with gtecat's ``gts.dll`` beside it (``tcp:HOST:PORT``), Python code loading the library
+through ctypes, other tools.
+
+Over TCP every connection presents a token: the one in ``--token-file`` when given, else
+``GTECAT_TOKEN``, else a random one written to a file only you can read (its path is
+printed).  It listens on 127.0.0.1 unless you name another address; the clients are
+served independently, and a connection without the right token is closed.
+
+The first client's ``GT_Open`` opens the controller; calls are served one at a time.
+In ``auto`` clock mode the controller keeps its time at or ahead of wall time (the wall
+floor, docs/native.md), so programs that sleep between polls see their sleeps pass;
+``--no-wall-floor`` (GTECAT_WALL_FLOOR=0) keeps pure, deterministic ``auto``.
 
 ``libgts.so`` starts a private one of these by itself on ``GT_Open`` when
 ``GTECAT_CONTROLLER`` is not set; it ends with the program.
@@ -19,15 +27,18 @@ import argparse
 import contextlib
 import os
 import signal
+import socket
 import sys
-import tempfile
 from pathlib import Path
 from types import FrameType
 
 
 def default_address() -> str:
-    base = os.environ.get("XDG_RUNTIME_DIR") or tempfile.gettempdir()
-    return f"unix:{Path(base) / f'gtecat-{os.getuid()}' / 'controller.sock'}"
+    from ..native.transport import DEFAULT_TCP_PORT, runtime_dir
+
+    if not hasattr(socket, "AF_UNIX"):  # Windows: no Unix sockets for the DLL to reach
+        return f"tcp:127.0.0.1:{DEFAULT_TCP_PORT}"
+    return f"unix:{runtime_dir() / 'controller.sock'}"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -37,13 +48,22 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=__doc__,
         epilog="examples:\n"
         "  gtecat controller --eni manual_fig5_2.eni --listen unix:/tmp/ctl.sock\n"
-        "  gtecat controller --eni Gecat.eni --machine machine.toml --clock lockstep",
+        "  gtecat controller --eni Gecat.eni --machine machine.toml --clock lockstep\n"
+        "  gtecat controller --eni Gecat.eni --listen tcp:127.0.0.1:7701\n"
+        "  gtecat controller --eni Gecat.eni --listen tcp:0.0.0.0:7701 --token-file ctl.token",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
         "--listen",
         metavar="ADDR",
-        help=f"unix:/path (or unix:@name, Linux abstract); default {default_address()}",
+        help="unix:/path (or unix:@name, Linux abstract), or tcp:HOST:PORT (127.0.0.1 unless "
+        f"HOST says otherwise; port 0: any free port); default {default_address()}",
+    )
+    p.add_argument(
+        "--token-file",
+        metavar="FILE",
+        help="tcp: the token clients must present, read from FILE (else GTECAT_TOKEN, else "
+        "a random one written to a file only you can read)",
     )
     p.add_argument("--eni", help="configuration file (else GTECAT_ENI, else ./Gecat.eni)")
     p.add_argument("--machine", help="machine description TOML (else GTECAT_MACHINE)")
@@ -62,6 +82,22 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--lifeline-fd", type=int, help=argparse.SUPPRESS)
     p.add_argument("--private", action="store_true", help=argparse.SUPPRESS)
     p.set_defaults(func=run)
+
+
+def _token(args: argparse.Namespace) -> tuple[str, str]:
+    """The token of a TCP controller and a line saying where clients find it."""
+    from ..native import transport
+
+    if args.token_file:
+        return transport.read_token_file(args.token_file), f"token: in {args.token_file}"
+    env = os.environ.get("GTECAT_TOKEN", "").strip()
+    if env:
+        transport.check_token(env, "GTECAT_TOKEN")
+        return env, "token: GTECAT_TOKEN"
+    token = transport.make_token()
+    path = transport.default_token_file()
+    transport.write_token_file(path, token)
+    return token, f"token: written to {path} (readable by you only)"
 
 
 def _wall_floor(args: argparse.Namespace) -> bool:
@@ -88,9 +124,23 @@ def run(args: argparse.Namespace) -> int:
 
     if args.private:
         _close_inherited({fd for fd in (args.ready_fd, args.lifeline_fd) if fd is not None})
+    from ..native import transport
+
     address = args.listen or default_address()
-    if not args.listen:
-        Path(address[5:]).parent.mkdir(mode=0o700, exist_ok=True)
+    token, token_note = None, ""
+    try:
+        addr = transport.parse(address)
+        if args.token_file and not addr.tcp:
+            raise ValueError(
+                "--token-file is for tcp: addresses (a Unix socket is guarded by its folder)"
+            )
+        if addr.tcp:
+            token, token_note = _token(args)
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    if not args.listen and not addr.tcp:
+        Path(addr.path).parent.mkdir(mode=0o700, exist_ok=True)
     options = {
         k: v
         for k, v in (
@@ -109,6 +159,7 @@ def run(args: argparse.Namespace) -> int:
         wall_floor=_wall_floor(args),
         lifeline_fd=args.lifeline_fd,
         remove_dir=args.private,
+        token=token,
     )
 
     def stop(signum: int, frame: FrameType | None) -> None:
@@ -122,6 +173,8 @@ def run(args: argparse.Namespace) -> int:
             os.write(args.ready_fd, b"ready\n")
             os.close(args.ready_fd)
     else:
-        print(f"gtecat controller listening on {address}", file=sys.stderr, flush=True)
+        print(f"gtecat controller listening on {server.address}", file=sys.stderr, flush=True)
+        if token_note:
+            print(token_note, file=sys.stderr, flush=True)
     server.serve_forever()
     return 0

@@ -34,6 +34,13 @@ short param)) needs the multi-card map: --abi gts-multicard --mono-config sends 
 libgts_mc-llp64.so, the multi-card layer built for C# int:
 
     python3 -m gtecat lib --abi gts-multicard --mono-config -o App.exe.config
+
+Windows (docs/windows.md): --windows x64|x86 -o DIR writes gts.dll (the GT API with the vendor
+DLL's undecorated __stdcall export names, reaching a gtecat controller over TCP), its import
+library gts.lib, gts.def and gts.h into DIR, cross-compiled with mingw-w64 on first use
+(x86_64-w64-mingw32-gcc / i686-w64-mingw32-gcc):
+
+    python3 -m gtecat lib --windows x86 -o win32
 """
 
 from __future__ import annotations
@@ -50,7 +57,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=__doc__,
         epilog="examples:\n"
         "  gtecat lib --cflags --libs      flags for gcc/g++ (builds libgts on first use)\n"
-        "  gtecat lib --header > gts.h     the generated header alone, no build",
+        "  gtecat lib --header > gts.h     the generated header alone, no build\n"
+        "  gtecat lib --windows x64 -o win64   gts.dll, gts.lib, gts.h for 64-bit Windows",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--cflags", action="store_true", help="-I for gts.h")
@@ -73,7 +81,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "with --abi gts-multicard to the multi-card layer)",
     )
     p.add_argument("--csharp", action="store_true", help="gts.cs: the GT API for C# (generated)")
-    p.add_argument("-o", "--output", metavar="FILE", help="write --mono-config / --csharp here")
+    p.add_argument(
+        "--windows",
+        choices=["x64", "x86"],
+        help="gts.dll for Windows (with gts.lib, gts.def, gts.h) into the folder -o names "
+        "(mingw-w64 cross compiler)",
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="PATH",
+        help="write --mono-config / --csharp here; the folder of --windows",
+    )
     p.set_defaults(func=run)
 
 
@@ -83,6 +102,8 @@ def _abi(args: argparse.Namespace) -> str:
 
 def run(args: argparse.Namespace) -> int:
     abi = _abi(args)
+    if args.windows:
+        return _windows(args)
     if args.mono_config or args.csharp:
         return _csharp(args)
     if args.header:
@@ -137,4 +158,17 @@ def _csharp(args: argparse.Namespace) -> int:
         Path(args.output).write_text(text, encoding="utf-8")
     else:
         sys.stdout.write(text)
+    return 0
+
+
+def _windows(args: argparse.Namespace) -> int:
+    from ..native import windows
+
+    if not args.output:
+        print(
+            "error: --windows writes several files: name their folder with -o DIR", file=sys.stderr
+        )
+        return 1
+    for path in windows.write(args.windows, args.output, force=args.rebuild):
+        print(path)
     return 0

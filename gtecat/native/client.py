@@ -45,6 +45,7 @@ from gtecat.eni.errors import GtecatError
 from ..errors import ParameterError
 from ..gt import _core
 from ..gt.args import Ref, fit
+from . import transport
 from .protocol import (
     BLOCK,
     CALL,
@@ -64,12 +65,10 @@ from .protocol import (
     PTR_NULL,
     PTR_UNKNOWN,
     REPLY,
-    SOCKET_TYPE,
     FunctionPlan,
     Kind,
     element_type,
     plans_by_name,
-    socket_path,
     table_digest,
 )
 
@@ -100,17 +99,17 @@ class Connection:
         self.lost = ""  #: why the connection broke ("" while it works)
         self._lock = threading.Lock()
         self._codecs: dict[int, _Codec] = {}
-        sock = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
-        sock.settimeout(timeout_s if timeout_s is not None else _timeout_s())
         try:
-            sock.connect(socket_path(address))
+            addr = transport.parse(address)
+            token = transport.client_token().encode() if addr.tcp else b""
+            sock = transport.connect(addr, timeout_s if timeout_s is not None else _timeout_s())
         except (OSError, ValueError) as e:
-            sock.close()
             raise ControllerError(f"cannot reach the controller at {address}: {e}") from None
         self._sock = sock
-        body = self._exchange(
-            HELLO.pack(MSG_HELLO, PROTOCOL_VERSION, _LONG, table_digest().encode("ascii"))
-        )
+        hello = HELLO.pack(MSG_HELLO, PROTOCOL_VERSION, _LONG, table_digest().encode("ascii"))
+        if token:  # a TCP controller's token (gtecat.native.transport)
+            hello += struct.pack("<H", len(token)) + token
+        body = self._exchange(hello)
         status, n = HELLO_REPLY.unpack_from(body, 0)
         if status != 0:
             text = body[HELLO_REPLY.size : HELLO_REPLY.size + n].decode("utf-8", "replace")

@@ -1,4 +1,4 @@
-"""The controller process: one virtual controller served over a Unix socket.
+"""The controller process: one virtual controller served over a Unix socket or TCP.
 
 A :class:`Server` owns gt's in-process session (``SESSION``: bus, clock, axes) and
 answers the calls of any number of clients (``libgts.so``, its ctypes users, other
@@ -21,6 +21,12 @@ Decisions:
   (or has closed) return -1, as in Python before ``GT_Open``.
 * In ``auto`` mode the server keeps the wall floor (:mod:`gtecat.native.floor`)
   unless asked not to, so native clients that sleep between polls see time pass.
+* Every client is served independently: its bytes are buffered until a frame is whole and
+  its replies until it reads them, so a client that sends half a frame, or stops reading,
+  delays nobody; it is dropped after :data:`IO_TIMEOUT_S`.
+* Over TCP (:mod:`gtecat.native.transport`) a connection must present the token in its
+  hello within :data:`AUTH_TIMEOUT_S`; before that, frames larger than a hello, any other
+  message or a wrong token close it with a log line.
 """
 
 from __future__ import annotations
@@ -46,6 +52,7 @@ from ..gt import _core, declared
 from ..gt.fast import READERS, wire_reader
 from ..inspect import endpoint as _inspect
 from . import field as field_ops
+from . import transport
 from .floor import WallFloor
 from .protocol import (
     BLOCK,
@@ -66,12 +73,10 @@ from .protocol import (
     PTR_NULL,
     PTR_TOO_BIG,
     PTR_UNKNOWN,
-    SOCKET_TYPE,
     FunctionPlan,
     Kind,
     element_type,
     plans,
-    socket_path,
     table_digest,
 )
 
@@ -79,6 +84,12 @@ log = logging.getLogger("gtecat.native.server")
 
 #: a client that sends half a frame, or stops reading replies, this long is dropped
 IO_TIMEOUT_S = 10.0
+#: a TCP connection that has not presented its token this long is dropped
+AUTH_TIMEOUT_S = 5.0
+#: the largest frame before the hello (a hello with the longest token fits)
+MAX_HELLO_FRAME = 64 + transport.MAX_TOKEN
+#: connections that have not greeted yet, at most (more are closed at once)
+MAX_PENDING = 256
 #: how long the server keeps serving one client before it looks at the others
 #: (GTECAT_SERVER_SPIN_US; see Server._readable); by default only where this process
 #: may run on two CPUs or more (on one, spinning keeps the client from sending)
@@ -112,6 +123,8 @@ class ProtocolError(Exception):
 
 
 _i64 = I64.unpack_from
+#: let another thread run (Windows has no os.sched_yield; sleep(0) yields there)
+_yield = getattr(os, "sched_yield", None) or (lambda: time.sleep(0))
 _f64 = F64.unpack_from
 _ptr = PTR.unpack_from
 _byref = ctypes.byref
@@ -249,7 +262,36 @@ class _Client:
     long_size: int = 0  # 0 until the hello
     opened: bool = False
     decoders: dict[int, _Decoder] = field(default_factory=dict)
+    #: reply bytes the client has not read yet (while any wait, its requests wait too)
+    out: bytearray = field(default_factory=bytearray)
     field: field_ops.Context | None = None  # its traces
+    #: may call (a Unix socket client at once; a TCP client once its token was right)
+    authed: bool = True
+    #: monotonic time by which it must have greeted / completed its frame / read its
+    #: replies, 0: none pending
+    deadline: float = 0.0
+    why_late: str = ""
+
+
+class _DropLog:
+    """One log line per dropped connection, at most ``burst`` per ``window_s`` (a flood of
+    bad connections must not become a flood of log lines); then a count."""
+
+    def __init__(self, burst: int = 20, window_s: float = 10.0) -> None:
+        self.burst, self.window_s = burst, window_s
+        self.start, self.count, self.hidden = 0.0, 0, 0
+
+    def __call__(self, level: int, text: str, *args: Any) -> None:
+        now = time.monotonic()
+        if now - self.start > self.window_s:
+            if self.hidden:
+                log.warning("%d more connections dropped in %.0f s", self.hidden, self.window_s)
+            self.start, self.count, self.hidden = now, 0, 0
+        self.count += 1
+        if self.count <= self.burst:
+            log.log(level, text, *args)
+        else:
+            self.hidden += 1
 
 
 _REPLY_HEAD = struct.Struct("<IhHH")  # FRAME + REPLY
@@ -290,28 +332,57 @@ def _jsonable(v: Any) -> Any:
     return str(v)
 
 
+#: poller events: the descriptor can be read (or hung up), can be written
+READ, WRITE = 1, 4
+
+
 class _Poller:
-    """epoll where there is one (Linux), poll elsewhere: fd -> readable."""
+    """epoll where there is one (Linux), poll elsewhere, select on Windows: fd -> events
+    (:data:`READ` / :data:`WRITE`); a descriptor waits for one of the two."""
 
     def __init__(self) -> None:
         self._ep = select.epoll() if hasattr(select, "epoll") else None
-        self._p = None if self._ep is not None else select.poll()
+        self._p = select.poll() if self._ep is None and hasattr(select, "poll") else None
+        self._sel: dict[int, bool] = {}  # select: fd -> waits for WRITE
 
-    def register(self, fd: int) -> None:
+    def register(self, fd: int, writable: bool = False) -> None:
         if self._ep is not None:
-            self._ep.register(fd, select.EPOLLIN)
+            self._ep.register(fd, select.EPOLLOUT if writable else select.EPOLLIN)
+        elif self._p is not None:
+            self._p.register(fd, select.POLLOUT if writable else select.POLLIN)
         else:
-            self._p.register(fd, select.POLLIN)  # type: ignore[union-attr]
+            self._sel[fd] = writable
+
+    def modify(self, fd: int, writable: bool) -> None:
+        if self._ep is not None:
+            self._ep.modify(fd, select.EPOLLOUT if writable else select.EPOLLIN)
+        elif self._p is not None:
+            self._p.modify(fd, select.POLLOUT if writable else select.POLLIN)
+        else:
+            self._sel[fd] = writable
 
     def unregister(self, fd: int) -> None:
         with contextlib.suppress(OSError, KeyError, ValueError):
-            (self._ep or self._p).unregister(fd)  # type: ignore[union-attr]
+            if self._ep is not None:
+                self._ep.unregister(fd)
+            elif self._p is not None:
+                self._p.unregister(fd)
+            else:
+                del self._sel[fd]
 
     def poll(self, timeout_s: float | None) -> list[tuple[int, int]]:
         if self._ep is not None:
-            return self._ep.poll(-1 if timeout_s is None else timeout_s)
-        ms = None if timeout_s is None else int(timeout_s * 1000)
-        return self._p.poll(ms)  # type: ignore[union-attr]
+            out = select.EPOLLOUT
+            got = self._ep.poll(-1 if timeout_s is None else timeout_s)
+        elif self._p is not None:
+            out = select.POLLOUT
+            got = self._p.poll(None if timeout_s is None else int(timeout_s * 1000))
+        else:
+            rd = [fd for fd, w in self._sel.items() if not w]
+            wr = [fd for fd, w in self._sel.items() if w]
+            r, w, x = select.select(rd, wr, wr, timeout_s)
+            return [(fd, READ) for fd in r] + [(fd, WRITE) for fd in {*w, *x}]
+        return [(fd, (WRITE if ev & out else 0) | (READ if ev & ~out else 0)) for fd, ev in got]
 
     def close(self) -> None:
         if self._ep is not None:
@@ -330,9 +401,15 @@ class Server:
         lifeline_fd: int | None = None,
         remove_dir: bool = False,
         spin_us: float | None = None,
+        token: str | None = None,
     ) -> None:
-        self.address = address
-        self.path = socket_path(address)
+        addr = transport.parse(address)
+        if addr.tcp and not token:
+            raise ValueError("a controller on TCP needs a token (transport.make_token())")
+        if token is not None:
+            transport.check_token(token, "the token")
+        self.token = token.encode() if addr.tcp and token else None
+        self.path = addr.path
         self.open_options = dict(open_options or {})
         self.wall_floor = wall_floor
         if spin_us is None:
@@ -353,31 +430,17 @@ class Server:
         self._lifeline = lifeline_fd
         self._remove_dir = remove_dir
         self._stop = threading.Event()
-        self._wake_r, self._wake_w = os.pipe()
+        self._wake_r, self._wake_w = socket.socketpair()  # select on Windows takes sockets only
+        self._wake_r.setblocking(False)
+        self._drop_log = _DropLog()
         self._thread: threading.Thread | None = None
         self._clients: dict[int, _Client] = {}  # by file descriptor
         self._decoders: dict[tuple[int, int], _Decoder] = {}  # (long size, fid)
         self._poller = _Poller()
-        self._listener = self._listen()
-
-    # --- socket ------------------------------------------------------------------------
-    def _listen(self) -> socket.socket:
-        s = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
-        if not self.path.startswith("\0") and os.path.exists(self.path):
-            probe = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
-            try:
-                probe.connect(self.path)
-            except OSError:
-                os.unlink(self.path)  # a stale socket of a controller that died
-            else:
-                s.close()
-                raise OSError(f"a controller already listens at {self.address}")
-            finally:
-                probe.close()
-        s.bind(self.path)
-        s.listen(64)
-        s.setblocking(False)
-        return s
+        self._listener = transport.listen(addr)
+        self.addr = transport.bound(addr, self._listener)
+        #: the address clients reach (with the chosen port for tcp:HOST:0)
+        self.address = str(self.addr) if addr.tcp else address
 
     def fileno(self) -> int:
         return self._listener.fileno()
@@ -386,8 +449,9 @@ class Server:
     def serve_forever(self) -> None:
         poller = self._poller
         listen_fd = self._listener.fileno()
+        wake_fd = self._wake_r.fileno()
         poller.register(listen_fd)
-        poller.register(self._wake_r)
+        poller.register(wake_fd)
         if self._lifeline is not None:
             poller.register(self._lifeline)
         clients = self._clients
@@ -395,25 +459,45 @@ class Server:
             while not self._stop.is_set():
                 floor = self._current_floor()
                 timeout = floor.idle_timeout() if floor is not None else None
+                late = self._next_deadline()
+                if late is not None:
+                    left = max(0.0, late - time.monotonic())
+                    timeout = left if timeout is None else min(timeout, left)
                 events = poller.poll(timeout)
+                if late is not None:
+                    self._drop_late()
                 if not events and floor is not None:
                     with self.lock:
                         floor.look()
                     continue
-                for fd, _ in events:
+                for fd, ev in events:
                     c = clients.get(fd)
                     if c is not None:
-                        self._readable(c)
+                        if ev & WRITE:
+                            self._writable(c)
+                        elif ev & READ:
+                            self._readable(c)
                     elif fd == listen_fd:
                         self._accept()
-                    elif fd == self._wake_r:
-                        os.read(self._wake_r, 64)
+                    elif fd == wake_fd:
+                        with contextlib.suppress(OSError):
+                            self._wake_r.recv(64)
                     elif fd == self._lifeline:
                         if not os.read(self._lifeline, 64):
                             log.info("the program that started this controller has ended")
                             self._stop.set()
         finally:
             self._cleanup()
+
+    def _next_deadline(self) -> float | None:
+        late = [c.deadline for c in self._clients.values() if c.deadline]
+        return min(late) if late else None
+
+    def _drop_late(self) -> None:
+        now = time.monotonic()
+        for c in [c for c in self._clients.values() if c.deadline and c.deadline <= now]:
+            self._drop_log(logging.WARNING, "client %s: %s; connection closed", c.peer, c.why_late)
+            self._drop(c)
 
     def start(self) -> Server:
         """Serve from a background thread (tests, a Python program hosting the controller)."""
@@ -426,7 +510,7 @@ class Server:
     def stop(self) -> None:
         self._stop.set()
         with contextlib.suppress(OSError):
-            os.write(self._wake_w, b"x")
+            self._wake_w.send(b"x")
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5)
 
@@ -442,27 +526,48 @@ class Server:
         with contextlib.suppress(Exception):
             self._poller.close()
         self._listener.close()
-        if not self.path.startswith("\0"):
+        if self.path and not self.path.startswith("\0"):
             with contextlib.suppress(OSError):
                 os.unlink(self.path)
             if self._remove_dir:
                 with contextlib.suppress(OSError):
                     Path(self.path).parent.rmdir()
-        for fd in (self._wake_r, self._wake_w):
-            with contextlib.suppress(OSError):
-                os.close(fd)
+        for s in (self._wake_r, self._wake_w):
+            s.close()
 
     def _accept(self) -> None:
-        try:
-            sock, _ = self._listener.accept()
-        except BlockingIOError:
-            return
-        sock.setblocking(False)
-        client = _Client(sock, peer=f"fd {sock.fileno()}")
-        self._clients[sock.fileno()] = client
-        self._poller.register(sock.fileno())
+        for _ in range(64):  # a burst of connections, without starving the clients
+            try:
+                sock, _ = self._listener.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as e:  # out of descriptors: the others go on
+                self._drop_log(logging.WARNING, "cannot accept a connection: %s", e)
+                return
+            sock.setblocking(False)
+            peer = transport.peer_name(sock, f"fd {sock.fileno()}")
+            client = _Client(sock, peer=peer)
+            if self.token is not None:
+                transport.tune(sock)
+                pending = sum(1 for c in self._clients.values() if not c.authed)
+                if pending >= MAX_PENDING:
+                    self._drop_log(
+                        logging.WARNING,
+                        "client %s: %d connections have not greeted yet; connection closed",
+                        peer,
+                        pending,
+                    )
+                    sock.close()
+                    continue
+                client.authed = False
+                client.deadline = time.monotonic() + AUTH_TIMEOUT_S
+                client.why_late = f"no hello with a token within {AUTH_TIMEOUT_S:g} s"
+            self._clients[sock.fileno()] = client
+            self._poller.register(sock.fileno())
 
     def _drop(self, c: _Client) -> None:
+        if c.sock.fileno() < 0:
+            return  # dropped already
         if self._clients.pop(c.sock.fileno(), None) is not None:
             self._poller.unregister(c.sock.fileno())
         if c.field is not None:
@@ -519,7 +624,7 @@ class Server:
                 if now >= deadline:
                     self._spin_done(False)
                     return
-                os.sched_yield()  # the client first, where it shares this CPU
+                _yield()  # the client first, where it shares this CPU
                 continue
             except OSError:
                 data = b""
@@ -530,82 +635,100 @@ class Server:
                 self._spin_done(True)
             deadline = 0.0
             budget = -1.0
-            if not self._frames(c, data):
-                return
+            if not self._frames(c, data) or c.out or c.buf:
+                return  # dropped, or waiting for the client to read or to send the rest
 
     def _frames(self, c: _Client, data: bytes) -> bool:
-        """Answer every whole frame in the client's buffer; False once it is dropped."""
+        """Answer every whole frame in the client's buffer; False once it is dropped.  A
+        frame not yet whole waits in the buffer (the client has IO_TIMEOUT_S to send the
+        rest); while the client has not read a reply, its next requests wait unread."""
         buf = c.buf
         try:
-            if not buf and len(data) >= 4 and FRAME.unpack_from(data, 0)[0] == len(data) - 4:
+            if (
+                not buf
+                and c.authed
+                and len(data) >= 4
+                and FRAME.unpack_from(data, 0)[0] == len(data) - 4
+            ):
                 # the usual case: exactly one whole request in one record
-                self._send(c.sock, self._message(c, memoryview(data)[4:]))
+                self._send(c, self._message(c, memoryview(data)[4:]))
                 return True
             buf += data
-            while len(buf) >= 4:
+            limit = MAX_FRAME if c.authed else MAX_HELLO_FRAME
+            while len(buf) >= 4 and not c.out:
                 (n,) = FRAME.unpack_from(buf, 0)
-                if n > MAX_FRAME:
-                    raise ProtocolError(f"frame of {n} bytes")
+                if n > limit:
+                    where = "" if c.authed else " before the hello"
+                    raise ProtocolError(f"frame of {n} bytes{where}")
                 if len(buf) < 4 + n:
-                    self._wait_rest(c, 4 + n)
+                    if not c.deadline:
+                        c.deadline = time.monotonic() + IO_TIMEOUT_S
+                        c.why_late = f"a frame cut short (no more bytes within {IO_TIMEOUT_S:g} s)"
+                    return True
                 body = memoryview(bytes(buf[4 : 4 + n]))
                 del buf[: 4 + n]
-                self._send(c.sock, self._message(c, body))
+                self._send(c, self._message(c, body))
+            if not c.out and c.authed and len(buf) < 4:
+                c.deadline = 0.0
         except ProtocolError as e:
-            log.warning("client %s: %s; connection closed", c.peer, e)
+            self._drop_log(logging.WARNING, "client %s: %s; connection closed", c.peer, e)
             self._drop(c)
             return False
         except OSError as e:
-            log.info("client %s: %s; connection closed", c.peer, e)
+            self._drop_log(logging.INFO, "client %s: %s; connection closed", c.peer, e)
             self._drop(c)
             return False
-        return True
+        return c.sock.fileno() >= 0
 
-    @staticmethod
-    def _wait_rest(c: _Client, need: int) -> None:
-        """The rest of a frame is on its way: read it (OSError after 10 s without it)."""
-        buf = c.buf
-        deadline = time.monotonic() + IO_TIMEOUT_S
-        while len(buf) < need:
-            left = deadline - time.monotonic()
-            if left <= 0 or not select.select([c.sock], [], [], left)[0]:
-                raise OSError("a frame cut short (no more bytes within 10 s)")
-            more = c.sock.recv(max(need - len(buf), CHUNK))
-            if not more:
-                raise OSError("the connection closed inside a frame")
-            buf += more
-
-    @staticmethod
-    def _send(sock: socket.socket, data: bytes) -> None:
-        """Send a reply in records of at most CHUNK bytes; a client that stops reading for
-        10 s is dropped (OSError)."""
-        n = 0
-        if len(data) <= CHUNK:  # the usual case: one record, sent at once
+    def _send(self, c: _Client, data: bytes) -> None:
+        """Send a reply in records of at most CHUNK bytes; what the client does not take now
+        waits in its outbox (sent when it can take more; dropped after IO_TIMEOUT_S)."""
+        if not c.out and len(data) <= CHUNK:  # the usual case: one record, sent at once
             try:
-                n = sock.send(data)
+                n = c.sock.send(data)
             except BlockingIOError:
                 n = 0
             if n == len(data):
                 return
-        view = memoryview(data)[n:]
-        deadline = 0.0
-        while view:
+            data = data[n:]
+        c.out += data
+        self._flush(c)
+
+    def _flush(self, c: _Client) -> None:
+        out = c.out
+        while out:
             try:
-                view = view[sock.send(view[:CHUNK]) :]
-                continue
+                n = c.sock.send(out[:CHUNK])
             except BlockingIOError:
-                pass
-            if not deadline:
-                deadline = time.monotonic() + IO_TIMEOUT_S
-            left = deadline - time.monotonic()
-            if left <= 0 or not select.select([], [sock], [], left)[1]:
-                raise OSError("the client does not read its replies")
+                break
+            del out[:n]
+        if out:
+            if not c.deadline or not c.why_late.startswith("does not read"):
+                c.deadline = time.monotonic() + IO_TIMEOUT_S
+                c.why_late = f"does not read its replies (none taken for {IO_TIMEOUT_S:g} s)"
+            self._poller.modify(c.sock.fileno(), True)
+
+    def _writable(self, c: _Client) -> None:
+        try:
+            self._flush(c)
+        except OSError as e:
+            self._drop_log(logging.INFO, "client %s: %s; connection closed", c.peer, e)
+            self._drop(c)
+            return
+        if c.out:
+            return
+        c.deadline = 0.0
+        self._poller.modify(c.sock.fileno(), False)
+        if c.buf:  # requests that arrived while it was not reading
+            self._frames(c, b"")
 
     # --- messages ------------------------------------------------------------------------
     def _message(self, c: _Client, body: memoryview) -> bytes:
         if not body:
             raise ProtocolError("empty frame")
         kind = body[0]
+        if not c.authed and kind != MSG_HELLO:
+            raise ProtocolError(f"message type {kind} before the hello with the token")
         if kind == MSG_CALL and c.long_size:
             _, gtn, fid, core = CALL.unpack_from(body, 0)
             dec = c.decoders.get(fid)
@@ -647,6 +770,8 @@ class Server:
         if len(body) < HELLO.size:
             raise ProtocolError("a hello cut short")
         _, version, long_size, digest = HELLO.unpack_from(body, 0)
+        if not c.authed:
+            self._check_token(c, body)
         status, text = 0, ""
         if version != PROTOCOL_VERSION or digest.decode("ascii", "replace") != table_digest():
             status = 1
@@ -663,6 +788,29 @@ class Server:
         t = text.encode()
         out = HELLO_REPLY.pack(status, len(t)) + t
         return FRAME.pack(len(out)) + out
+
+    def _check_token(self, c: _Client, body: memoryview) -> None:
+        """The hello's token (``u16 length, bytes`` after the hello) against ours: right, the
+        client may call; wrong or missing, it is told so and dropped."""
+        assert self.token is not None
+        given = b""
+        tail = bytes(body[HELLO.size :])
+        if len(tail) >= 2:
+            (n,) = struct.unpack_from("<H", tail, 0)
+            given = tail[2 : 2 + n]
+        if transport.tokens_equal(given, self.token):
+            c.authed = True
+            c.deadline = 0.0
+            return
+        why = "a wrong token" if given else "no token"
+        text = (
+            f"this controller needs its token ({why} was given): set GTECAT_TOKEN or "
+            "GTECAT_TOKEN_FILE, or token / token_file in gtecat.ini"
+        ).encode()
+        out = HELLO_REPLY.pack(1, len(text)) + text
+        with contextlib.suppress(OSError):
+            c.sock.send(FRAME.pack(len(out)) + out)
+        raise ProtocolError(f"hello with {why}")
 
     def _field(self, c: _Client, body: memoryview) -> bytes:
         """A field-side or bus operation (:mod:`gtecat.native.field`)."""
@@ -777,19 +925,16 @@ def _invoke(fn: Any, args: Any) -> tuple[int, str]:
 
 def wait_for(address: str, timeout_s: float = 10.0) -> None:
     """Return once something accepts connections at ``address`` (TimeoutError otherwise)."""
-    path = socket_path(address)
+    addr = transport.parse(address)
     deadline = time.monotonic() + timeout_s
     while True:
-        s = socket.socket(socket.AF_UNIX, SOCKET_TYPE)
         try:
-            s.connect(path)
+            transport.connect(addr, 1.0).close()
             return
         except OSError:
             if time.monotonic() > deadline:
                 raise TimeoutError(f"no controller at {address} after {timeout_s:g} s") from None
             time.sleep(0.01)
-        finally:
-            s.close()
 
 
-__all__ = ["NOT_OPEN", "ProtocolError", "Server", "socket_path", "wait_for"]
+__all__ = ["NOT_OPEN", "ProtocolError", "Server", "wait_for"]

@@ -1,31 +1,54 @@
-/* gts_runtime.c - the transport of libgts: connect (or start) a controller, one request
- * and one reply per GT call (gtecat/native/protocol.py describes the bytes).
+/* gts_runtime.c - the transport of libgts and of gts.dll: connect (or start) a controller,
+ * one request and one reply per GT call (gtecat/native/protocol.py describes the bytes).
  *
  * Hand-written and function-independent; the per-function stubs are generated from the
  * function table into gts_stubs.c.  Calls of all threads are serialised by one mutex.
  * Nothing here ever waits without a bound: a controller that does not answer within
  * GTECAT_TIMEOUT_MS (default 30000) is given up, the call returns -1 and
  * GTE_GetLastError says why.
+ *
+ * Where the controller is: GTECAT_CONTROLLER (unix:/path, or tcp:HOST:PORT /
+ * tcp://HOST:PORT), else a private controller this library starts (Linux).  A TCP
+ * controller wants a token: GTECAT_TOKEN, else the file GTECAT_TOKEN_FILE names, else the
+ * controller's default token file (same user, same machine).  Every GTECAT_x setting may
+ * also be written `x = value` in a gtecat.ini beside the program's executable (or the
+ * file GTECAT_INI names); the environment wins.  On Windows (gts.dll, built with
+ * mingw-w64) the transport is TCP over winsock and there is no private controller.
  */
 #define _GNU_SOURCE
+#if defined(_WIN32)
+#ifndef _WIN32_WINNT
+#define _WIN32_WINNT 0x0600 /* WSAPoll */
+#endif
+#define WIN32_LEAN_AND_MEAN
+#include <winsock2.h>
+#include <ws2tcpip.h>
+#include <windows.h>
+#endif
 #include <errno.h>
-#include <fcntl.h>
-#include <poll.h>
-#include <pthread.h>
-#include <sched.h>
-#include <signal.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
+#include <time.h>
+#if !defined(_WIN32)
+#include <fcntl.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
-#include <sys/types.h>
 #include <sys/un.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
+#endif
 
 #include "gts.h"
 #include "gts_runtime.h"
@@ -33,17 +56,58 @@
 #define CMD_COMM (-1)
 #define CMD_PARAM 7
 
+/* ---- the platform ---------------------------------------------------------------------- */
+#if defined(_WIN32)
+typedef SOCKET gte_sock;
+typedef DWORD gte_pid;
+#define GTE_NO_SOCK INVALID_SOCKET
+#define GTE_SEND_FLAGS 0
+#define GTE_RECV_FLAGS 0
+#define GTE_STDCALL __stdcall
+#define sock_close closesocket
+#define gte_getpid() GetCurrentProcessId()
+static SRWLOCK g_mu = SRWLOCK_INIT;
+#define LOCK() AcquireSRWLockExclusive(&g_mu)
+#define UNLOCK() ReleaseSRWLockExclusive(&g_mu)
+static int net_errno(void) { return WSAGetLastError(); }
+#define NET_WOULDBLOCK(e) ((e) == WSAEWOULDBLOCK)
+#define NET_INTR(e) ((e) == WSAEINTR)
+#define NET_INPROGRESS(e) ((e) == WSAEWOULDBLOCK || (e) == WSAEINPROGRESS)
+#define gte_yield() SwitchToThread()
+#else
+typedef int gte_sock;
+typedef pid_t gte_pid;
+#define GTE_NO_SOCK (-1)
+#define GTE_SEND_FLAGS (MSG_NOSIGNAL | MSG_DONTWAIT)
+#define GTE_RECV_FLAGS MSG_DONTWAIT
+#define GTE_STDCALL
+#define sock_close close
+#define gte_getpid() getpid()
 static pthread_mutex_t g_mu = PTHREAD_MUTEX_INITIALIZER;
-static int g_fd = -1;              /* connection to the controller */
-static pid_t g_fd_pid;             /* process that made it (a forked child reconnects) */
-static char g_addr[300];           /* unix:/path of the connection */
+#define LOCK() pthread_mutex_lock(&g_mu)
+#define UNLOCK() pthread_mutex_unlock(&g_mu)
+static int net_errno(void) { return errno; }
+#define NET_WOULDBLOCK(e) ((e) == EAGAIN || (e) == EWOULDBLOCK)
+#define NET_INTR(e) ((e) == EINTR)
+#define NET_INPROGRESS(e) ((e) == EINPROGRESS)
+#define gte_yield() sched_yield()
+#endif
+
+static gte_sock g_fd = GTE_NO_SOCK; /* connection to the controller */
+static gte_pid g_fd_pid;           /* process that made it (a forked child reconnects) */
+static char g_addr[300];           /* unix:/path or tcp:host:port of the connection */
+#if !defined(_WIN32)
 static char g_private_addr[300];   /* unix:/path of the controller this library started */
 static pid_t g_child;              /* that controller's pid */
 static int g_lifeline = -1;        /* its lifeline: EOF when this process ends */
+#endif
 static char g_lost[1300];          /* why the connection was lost ("" if it was not) */
 static char g_err[2048];           /* the last error, for GTE_GetLastError */
 static unsigned char *g_buf;       /* request/reply buffer */
 static size_t g_cap;
+/* a reason of our own for the last I/O failure (NULL: the system's error says it) */
+static const char *g_io_why;
+static const char TIMED_OUT[] = "timed out";
 
 /* ---- small helpers ------------------------------------------------------------------- */
 static void set_err(const char *fmt, ...)
@@ -54,16 +118,143 @@ static void set_err(const char *fmt, ...)
     va_end(ap);
 }
 
-static long long now_ms(void)
+/* the text of the last I/O failure */
+static const char *io_error(void)
 {
+    if (g_io_why)
+        return g_io_why;
+#if defined(_WIN32)
+    static char text[256];
+    int e = WSAGetLastError();
+    DWORD n = FormatMessageA(FORMAT_MESSAGE_FROM_SYSTEM | FORMAT_MESSAGE_IGNORE_INSERTS, NULL,
+                             (DWORD)e, 0, text, sizeof text, NULL);
+    while (n > 0 && (text[n - 1] == '\n' || text[n - 1] == '\r' || text[n - 1] == '.'))
+        text[--n] = '\0';
+    if (n == 0)
+        snprintf(text, sizeof text, "winsock error %d", e);
+    return text;
+#else
+    return strerror(errno);
+#endif
+}
+
+static long long now_ns(void)
+{
+#if defined(_WIN32)
+    static LARGE_INTEGER freq;
+    LARGE_INTEGER t;
+    if (!freq.QuadPart)
+        QueryPerformanceFrequency(&freq);
+    QueryPerformanceCounter(&t);
+    return (long long)((double)t.QuadPart * 1e9 / (double)freq.QuadPart);
+#else
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+    return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
+#endif
+}
+
+static long long now_ms(void) { return now_ns() / 1000000; }
+
+/* ---- settings: the environment, else gtecat.ini ---------------------------------------- */
+#define INI_MAX 32
+static struct { char key[40]; char value[600]; } g_ini[INI_MAX];
+static int g_ini_n = -1;           /* -1: not read yet */
+static char g_ini_path[600];       /* the file looked for ("" if none could be named) */
+
+static char *trim(char *t)
+{
+    while (*t == ' ' || *t == '\t')
+        t++;
+    size_t n = strlen(t);
+    while (n && (t[n - 1] == ' ' || t[n - 1] == '\t' || t[n - 1] == '\r' || t[n - 1] == '\n'))
+        t[--n] = '\0';
+    if (n >= 2 && (t[0] == '"' || t[0] == '\'') && t[n - 1] == t[0]) {
+        t[n - 1] = '\0';
+        t++;
+    }
+    return t;
+}
+
+static void ini_locate(void)
+{
+    const char *named = getenv("GTECAT_INI");
+    if (named && *named) {
+        snprintf(g_ini_path, sizeof g_ini_path, "%s", named);
+        return;
+    }
+    char exe[520];
+    size_t n = 0;
+#if defined(_WIN32)
+    DWORD r = GetModuleFileNameA(NULL, exe, sizeof exe);
+    if (r > 0 && r < sizeof exe)
+        n = r;
+#else
+    ssize_t r = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (r > 0)
+        n = (size_t)r;
+#endif
+    exe[n] = '\0';
+    while (n && exe[n - 1] != '/' && exe[n - 1] != '\\')
+        exe[--n] = '\0';
+    if (n)
+        snprintf(g_ini_path, sizeof g_ini_path, "%sgtecat.ini", exe);
+}
+
+/* key = value lines; [sections], ; and # comments ignored */
+static void ini_read(void)
+{
+    g_ini_n = 0;
+    ini_locate();
+    if (!g_ini_path[0])
+        return;
+    FILE *f = fopen(g_ini_path, "r");
+    if (!f)
+        return;
+    char line[700];
+    while (g_ini_n < INI_MAX && fgets(line, sizeof line, f)) {
+        char *t = trim(line);
+        if (!*t || *t == ';' || *t == '#' || *t == '[')
+            continue;
+        char *eq = strchr(t, '=');
+        if (!eq)
+            continue;
+        *eq = '\0';
+        char *k = trim(t), *v = trim(eq + 1);
+        if (strlen(k) >= sizeof g_ini[0].key)
+            continue;
+        for (char *c = k; *c; c++)
+            if (*c >= 'A' && *c <= 'Z')
+                *c = (char)(*c - 'A' + 'a');
+        snprintf(g_ini[g_ini_n].key, sizeof g_ini[0].key, "%s", k);
+        snprintf(g_ini[g_ini_n].value, sizeof g_ini[0].value, "%s", v);
+        g_ini_n++;
+    }
+    fclose(f);
+}
+
+/* GTECAT_x from the environment, else `x = ...` (any case) from gtecat.ini; NULL if neither */
+static const char *setting(const char *name)
+{
+    const char *v = getenv(name);
+    if (v && *v)
+        return v;
+    if (g_ini_n < 0)
+        ini_read();
+    const char *key = strncmp(name, "GTECAT_", 7) == 0 ? name + 7 : name;
+    for (int i = 0; i < g_ini_n; i++) {
+        const char *a = g_ini[i].key, *b = key;
+        while (*a && *b && (*a == *b || *a == *b - 'A' + 'a'))
+            a++, b++;
+        if (!*a && !*b && g_ini[i].value[0])
+            return g_ini[i].value;
+    }
+    return NULL;
 }
 
 static long env_ms(const char *name, long dflt)
 {
-    const char *v = getenv(name);
+    const char *v = setting(name);
     if (v && *v) {
         char *end;
         long x = strtol(v, &end, 10);
@@ -89,39 +280,46 @@ static int reserve(size_t n)
 }
 
 /* wait until fd is ready for ev, at most until deadline; 0 ok, -1 timeout/error */
-static int wait_fd(int fd, short ev, long long deadline)
+static int wait_fd(gte_sock fd, short ev, long long deadline)
 {
     for (;;) {
         long long left = deadline - now_ms();
         if (left < 0)
             left = 0;
+#if defined(_WIN32)
+        WSAPOLLFD p = {fd, ev, 0};
+        int r = WSAPoll(&p, 1, left > 0x7fffffff ? 0x7fffffff : (int)left);
+#else
         struct pollfd p = {fd, ev, 0};
         int r = poll(&p, 1, left > 0x7fffffff ? 0x7fffffff : (int)left);
+#endif
         if (r > 0)
             return 0;
         if (r == 0) {
-            errno = ETIMEDOUT;
+            g_io_why = TIMED_OUT;
             return -1;
         }
-        if (errno != EINTR)
+        if (!NET_INTR(net_errno()))
             return -1;
     }
 }
 
 /* send one message: records of at most GTE_CHUNK bytes (SOCK_SEQPACKET keeps each whole) */
-static int send_all(int fd, const unsigned char *p, size_t n, long long deadline)
+static int send_all(gte_sock fd, const unsigned char *p, size_t n, long long deadline)
 {
+    g_io_why = NULL;
     while (n) {
         size_t part = n > GTE_CHUNK ? GTE_CHUNK : n;
-        ssize_t w = send(fd, p, part, MSG_NOSIGNAL | MSG_DONTWAIT);
+        long w = (long)send(fd, (const char *)p, (int)part, GTE_SEND_FLAGS);
         if (w > 0) {
             p += w;
             n -= (size_t)w;
             continue;
         }
-        if (w < 0 && errno == EINTR)
+        int e = net_errno();
+        if (w < 0 && NET_INTR(e))
             continue;
-        if (w < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+        if (w < 0 && NET_WOULDBLOCK(e)) {
             if (wait_fd(fd, POLLOUT, deadline) < 0)
                 return -1;
             continue;
@@ -145,11 +343,21 @@ static long spin_ns(void)
 {
     static long cached = -1;
     if (cached < 0) {
-        const char *v = getenv("GTECAT_SPIN_US");
+        const char *v = setting("GTECAT_SPIN_US");
         long us = 0;
+#if defined(_WIN32)
+        DWORD_PTR mine, all;
+        if (GetProcessAffinityMask(GetCurrentProcess(), &mine, &all)) {
+            int n = 0;
+            for (; mine; mine &= mine - 1)
+                n++;
+            g_cpus = n;
+        }
+#else
         cpu_set_t set;
         if (sched_getaffinity(0, sizeof set, &set) == 0)
             g_cpus = CPU_COUNT(&set);
+#endif
         if (v && *v) {
             char *end;
             long x = strtol(v, &end, 10);
@@ -163,15 +371,15 @@ static long spin_ns(void)
     return cached;
 }
 
-static long long now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
-}
-
 /* More threads runnable than this process has CPUs (the 4th field of /proc/loadavg, read at
  * most every 10 ms): then spinning only takes the CPU the other side waits for. */
+#if defined(_WIN32)
+static int cpus_busy(long long t)
+{
+    (void)t;
+    return 0; /* no /proc/loadavg: the adaptive halving alone */
+}
+#else
 static int cpus_busy(long long t)
 {
     static long long next_check = 0;
@@ -198,6 +406,7 @@ static int cpus_busy(long long t)
     }
     return busy;
 }
+#endif
 
 /* The spin budget of this call in ns (0: sleep in poll at once); spin_done() reports how
  * it went. */
@@ -233,25 +442,28 @@ static void spin_done(int answered_while_spinning, long budget)
 /* Receive one message (frame header included) into g_buf, always offering a read at least
  * GTE_CHUNK bytes of room, so one recv takes a whole record (SOCK_SEQPACKET; usually the
  * whole reply).  0 ok with *total = 4 + body; -1 error (errno); -2 the peer closed. */
-static int recv_msg(int fd, size_t *total, long long deadline)
+static int recv_msg(gte_sock fd, size_t *total, long long deadline)
 {
     size_t got = 0, need = 4;
     long long spin_until = 0;
     long budget = -1; /* this call's spin, asked for when the reply is not there at once */
     int slept = 0;
+    g_io_why = NULL;
     while (got < need) {
         if (reserve(got + GTE_CHUNK) < 0) {
-            errno = ENOMEM;
+            g_io_why = "out of memory";
             return -1;
         }
-        ssize_t r = recv(fd, g_buf + got, g_cap - got, MSG_DONTWAIT);
+        size_t room = g_cap - got;
+        long r = (long)recv(fd, (char *)g_buf + got, (int)(room > 0x40000000 ? 0x40000000 : room),
+                            GTE_RECV_FLAGS);
         if (r > 0) {
             got += (size_t)r;
             if (need == 4 && got >= 4) {
                 uint32_t body;
                 memcpy(&body, g_buf, 4);
                 if (body > GTE_MAX_FRAME) {
-                    errno = EPROTO;
+                    g_io_why = "a reply larger than the protocol allows";
                     return -1;
                 }
                 need = 4 + (size_t)body;
@@ -260,9 +472,10 @@ static int recv_msg(int fd, size_t *total, long long deadline)
         }
         if (r == 0)
             return -2;
-        if (errno == EINTR)
+        int e = net_errno();
+        if (NET_INTR(e))
             continue;
-        if (errno == EAGAIN || errno == EWOULDBLOCK) {
+        if (NET_WOULDBLOCK(e)) {
             if (budget < 0)
                 budget = spin_allowed();
             if (budget > 0 && !slept) {
@@ -270,7 +483,7 @@ static int recv_msg(int fd, size_t *total, long long deadline)
                 if (!spin_until)
                     spin_until = t + budget;
                 if (t < spin_until) {
-                    sched_yield(); /* the controller first, where it shares this CPU */
+                    gte_yield(); /* the controller first, where it shares this CPU */
                     continue;
                 }
             }
@@ -293,6 +506,9 @@ static uint16_t get_u16(const unsigned char *p) { uint16_t v; memcpy(&v, p, 2); 
 static int16_t get_i16(const unsigned char *p) { int16_t v; memcpy(&v, p, 2); return v; }
 
 /* ---- the connection ------------------------------------------------------------------ */
+#if defined(_WIN32)
+static const char *child_fate(void) { return ""; }
+#else
 static const char *child_fate(void)
 {
     static char text[160];
@@ -314,15 +530,17 @@ static const char *child_fate(void)
     }
     return "";
 }
+#endif
 
 static void drop(const char *why)
 {
-    if (g_fd >= 0)
-        close(g_fd);
-    g_fd = -1;
+    if (g_fd != GTE_NO_SOCK)
+        sock_close(g_fd);
+    g_fd = GTE_NO_SOCK;
     snprintf(g_lost, sizeof g_lost, "%s%s", why, child_fate());
 }
 
+#if !defined(_WIN32)
 static int split_address(const char *addr, struct sockaddr_un *sa, socklen_t *len)
 {
     const char *path = strncmp(addr, "unix:", 5) == 0 ? addr + 5 : addr;
@@ -337,6 +555,89 @@ static int split_address(const char *addr, struct sockaddr_un *sa, socklen_t *le
     *len = (socklen_t)(offsetof(struct sockaddr_un, sun_path) + n + (path[0] == '@' ? 0 : 1));
     return 0;
 }
+#endif
+
+/* tcp:HOST:PORT, tcp://HOST:PORT, tcp:PORT (127.0.0.1), tcp:[v6]:PORT -> host, port; 0 ok */
+static int split_tcp(const char *addr, char *host, size_t hcap, char *port, size_t pcap)
+{
+    const char *rest = addr + 4;
+    if (strncmp(rest, "//", 2) == 0)
+        rest += 2;
+    char buf[300];
+    snprintf(buf, sizeof buf, "%s", rest);
+    size_t n = strlen(buf);
+    while (n && buf[n - 1] == '/')
+        buf[--n] = '\0';
+    const char *h = "127.0.0.1", *p = buf;
+    if (buf[0] == '[') {
+        char *close = strstr(buf, "]:");
+        if (!close)
+            return -1;
+        *close = '\0';
+        h = buf + 1;
+        p = close + 2;
+    } else {
+        char *colon = strrchr(buf, ':');
+        if (colon) {
+            *colon = '\0';
+            h = buf;
+            p = colon + 1;
+        }
+    }
+    if (!*h || !*p || strlen(p) > 5 || strspn(p, "0123456789") != strlen(p) || atoi(p) > 65535)
+        return -1;
+    size_t hl = strlen(h), pl = strlen(p);
+    if (hl + 1 > hcap || pl + 1 > pcap)
+        return -1;
+    memcpy(host, h, hl + 1);
+    memcpy(port, p, pl + 1);
+    return 0;
+}
+
+/* the token a TCP controller wants (see the top of this file); 0 ok ("" if none), -1 error */
+static int client_token(char *out, size_t cap, const char *fname)
+{
+    out[0] = '\0';
+    const char *t = setting("GTECAT_TOKEN");
+    if (t) {
+        snprintf(out, cap, "%s", t);
+        char *s = trim(out);
+        memmove(out, s, strlen(s) + 1);
+        return 0;
+    }
+    const char *file = setting("GTECAT_TOKEN_FILE");
+#if !defined(_WIN32)
+    char dflt[400];
+#endif
+    if (!file) {
+#if defined(_WIN32)
+        return 0;
+#else
+        const char *base = getenv("XDG_RUNTIME_DIR");
+        if (!base || !*base) {
+            base = getenv("TMPDIR");
+            if (!base || !*base)
+                base = "/tmp";
+        }
+        snprintf(dflt, sizeof dflt, "%s/gtecat-%u/controller.token", base, (unsigned)getuid());
+        if (access(dflt, R_OK) != 0)
+            return 0;
+        file = dflt;
+#endif
+    }
+    FILE *f = fopen(file, "r");
+    char line[600] = "";
+    if (!f || !fgets(line, sizeof line, f)) {
+        set_err("%s returned -1: cannot read the token file %s%s%s", fname, file, f ? "" : ": ",
+                f ? " (it is empty)" : strerror(errno));
+        if (f)
+            fclose(f);
+        return -1;
+    }
+    fclose(f);
+    snprintf(out, cap, "%s", trim(line));
+    return 0;
+}
 
 /* the client's long as the stubs were compiled: 8 on Linux, 4 in the LLP64 build that serves
  * programs written for Windows (C# / VB.NET under Mono, gtecat.native.llp64) */
@@ -344,27 +645,41 @@ static int split_address(const char *addr, struct sockaddr_un *sa, socklen_t *le
 #define GTE_CLIENT_LONG_SIZE sizeof(long)
 #endif
 
-/* hello: announce protocol, sizeof(long) and the table digest; 0 ok */
-static int hello(int fd, const char *fname, long long deadline)
+/* hello: announce protocol, sizeof(long) and the table digest (and the token, for TCP);
+ * 0 ok */
+static int hello(gte_sock fd, const char *token, const char *fname, long long deadline)
 {
-    unsigned char msg[4 + 24];
+    unsigned char msg[4 + 24 + 2 + 256];
     uint16_t version = GTE_PROTOCOL_VERSION, lsize = (uint16_t)GTE_CLIENT_LONG_SIZE;
-    put_u32(msg, 24);
-    memset(msg + 4, 0, 24);
+    size_t toklen = strlen(token), body = 24;
+    if (toklen > 256) {
+        set_err("%s returned -1: the token is longer than 256 bytes", fname);
+        return -1;
+    }
+    memset(msg, 0, sizeof msg);
     msg[4] = GTE_MSG_HELLO;
     memcpy(msg + 8, &version, 2);
     memcpy(msg + 10, &lsize, 2);
     memcpy(msg + 12, GTE_TABLE_DIGEST, 16);
-    if (send_all(fd, msg, sizeof msg, deadline) < 0) {
+    if (toklen) {
+        uint16_t t16 = (uint16_t)toklen;
+        memcpy(msg + 28, &t16, 2);
+        memcpy(msg + 30, token, toklen);
+        body += 2 + toklen;
+    }
+    put_u32(msg, (uint32_t)body);
+    if (send_all(fd, msg, 4 + body, deadline) < 0) {
         set_err("%s returned -1: cannot greet the controller at %s: %s", fname, g_addr,
-                strerror(errno));
+                io_error());
         return -1;
     }
     size_t total = 0;
     int r = recv_msg(fd, &total, deadline);
     if (r < 0 || total < 8) {
         set_err("%s returned -1: the controller at %s did not answer the greeting (%s)", fname,
-                g_addr, r == -2 ? "connection closed" : r < 0 ? strerror(errno) : "too short");
+                g_addr, r == -2 ? (toklen ? "connection closed" :
+                                   "connection closed; a TCP controller needs GTECAT_TOKEN")
+                        : r < 0 ? io_error() : "too short");
         return -1;
     }
     int16_t status = get_i16(g_buf + 4);
@@ -383,36 +698,135 @@ static int hello(int fd, const char *fname, long long deadline)
     return 0;
 }
 
+static int set_nonblocking(gte_sock fd)
+{
+#if defined(_WIN32)
+    u_long one = 1;
+    return ioctlsocket(fd, FIONBIO, &one) == 0 ? 0 : -1;
+#else
+    int fl = fcntl(fd, F_GETFL);
+    return fl < 0 || fcntl(fd, F_SETFL, fl | O_NONBLOCK) < 0 ? -1 : 0;
+#endif
+}
+
+/* a connected TCP socket (non-blocking, no Nagle delay), GTE_NO_SOCK with the reason set */
+static gte_sock connect_tcp(const char *addr, const char *fname, long long deadline)
+{
+    char host[300], port[8];
+    if (split_tcp(addr, host, sizeof host, port, sizeof port) < 0) {
+        set_err("%s returned -1: controller address '%s' is not tcp:HOST:PORT", fname, addr);
+        return GTE_NO_SOCK;
+    }
+    struct addrinfo hints, *res = NULL;
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    int gai = getaddrinfo(host, port, &hints, &res);
+    if (gai != 0 || !res) {
+#if defined(_WIN32)
+        set_err("%s returned -1: cannot find the controller's host %s (winsock error %d)",
+                fname, host, gai);
+#else
+        set_err("%s returned -1: cannot find the controller's host %s: %s", fname, host,
+                gai_strerror(gai));
+#endif
+        return GTE_NO_SOCK;
+    }
+    gte_sock fd = GTE_NO_SOCK;
+    char why[300] = "no address";
+    for (struct addrinfo *ai = res; ai; ai = ai->ai_next) {
+#if defined(_WIN32)
+        fd = socket(ai->ai_family, SOCK_STREAM, IPPROTO_TCP);
+#else
+        fd = socket(ai->ai_family, SOCK_STREAM | SOCK_CLOEXEC, IPPROTO_TCP);
+#endif
+        if (fd == GTE_NO_SOCK || set_nonblocking(fd) < 0) {
+            snprintf(why, sizeof why, "socket: %s", io_error());
+            if (fd != GTE_NO_SOCK)
+                sock_close(fd);
+            fd = GTE_NO_SOCK;
+            continue;
+        }
+        g_io_why = NULL;
+        int r = connect(fd, ai->ai_addr, (int)ai->ai_addrlen);
+        if (r != 0 && NET_INPROGRESS(net_errno())) {
+            if (wait_fd(fd, POLLOUT, deadline) == 0) {
+                int err = 0;
+                socklen_t len = sizeof err;
+                getsockopt(fd, SOL_SOCKET, SO_ERROR, (char *)&err, &len);
+                r = err ? -1 : 0;
+#if defined(_WIN32)
+                WSASetLastError(err);
+#else
+                errno = err;
+#endif
+            } else {
+                r = -1;
+            }
+        }
+        if (r == 0) {
+            int one = 1;
+            setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, (const char *)&one, sizeof one);
+            break;
+        }
+        snprintf(why, sizeof why, "%s", io_error());
+        sock_close(fd);
+        fd = GTE_NO_SOCK;
+    }
+    freeaddrinfo(res);
+    if (fd == GTE_NO_SOCK)
+        set_err("%s returned -1: cannot reach the controller at %s: %s", fname, addr, why);
+    return fd;
+}
+
 static int connect_to(const char *addr, const char *fname, long long deadline)
 {
-    struct sockaddr_un sa;
-    socklen_t len;
     snprintf(g_addr, sizeof g_addr, "%s", addr);
-    if (split_address(addr, &sa, &len) < 0) {
-        set_err("%s returned -1: controller address '%s' is not unix:/path", fname, addr);
+    gte_sock fd;
+    char token[600] = "";
+    if (strncmp(addr, "tcp:", 4) == 0) {
+        if (client_token(token, sizeof token, fname) < 0)
+            return -1;
+        fd = connect_tcp(addr, fname, deadline);
+        if (fd == GTE_NO_SOCK)
+            return -1;
+    } else {
+#if defined(_WIN32)
+        set_err("%s returned -1: controller address '%s' is not tcp:HOST:PORT (Windows reaches "
+                "a controller over TCP)", fname, addr);
         return -1;
+#else
+        struct sockaddr_un sa;
+        socklen_t len;
+        if (split_address(addr, &sa, &len) < 0) {
+            set_err("%s returned -1: controller address '%s' is not unix:/path or "
+                    "tcp:HOST:PORT", fname, addr);
+            return -1;
+        }
+        fd = socket(AF_UNIX, GTE_SOCKET_TYPE | SOCK_CLOEXEC, 0);
+        if (fd < 0) {
+            set_err("%s returned -1: socket: %s", fname, strerror(errno));
+            return -1;
+        }
+        if (connect(fd, (struct sockaddr *)&sa, len) < 0) {
+            set_err("%s returned -1: cannot reach the controller at %s: %s", fname, addr,
+                    strerror(errno));
+            close(fd);
+            return -1;
+        }
+#endif
     }
-    int fd = socket(AF_UNIX, GTE_SOCKET_TYPE | SOCK_CLOEXEC, 0);
-    if (fd < 0) {
-        set_err("%s returned -1: socket: %s", fname, strerror(errno));
-        return -1;
-    }
-    if (connect(fd, (struct sockaddr *)&sa, len) < 0) {
-        set_err("%s returned -1: cannot reach the controller at %s: %s", fname, addr,
-                strerror(errno));
-        close(fd);
-        return -1;
-    }
-    if (hello(fd, fname, deadline) < 0) {
-        close(fd);
+    if (hello(fd, token, fname, deadline) < 0) {
+        sock_close(fd);
         return -1;
     }
     g_fd = fd;
-    g_fd_pid = getpid();
+    g_fd_pid = gte_getpid();
     g_lost[0] = '\0';
     return 0;
 }
 
+#if !defined(_WIN32)
 /* Start `python -m gtecat controller` on a socket of our own; it ends with this process
  * (its lifeline pipe reaches EOF when we exit).  0 once it listens. */
 static int start_private(const char *fname)
@@ -534,25 +948,45 @@ static int start_private(const char *fname)
         return -1;
     return 0;
 }
+#endif
 
 static int ensure_open(const char *fname)
 {
-    if (g_fd >= 0 && g_fd_pid == getpid())
+    if (g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid())
         return 0;
-    if (g_fd >= 0) { /* a forked child: leave the parent's connection to the parent */
-        close(g_fd);
-        g_fd = -1;
+    if (g_fd != GTE_NO_SOCK) { /* a forked child: leave the parent's connection to the parent */
+        sock_close(g_fd);
+        g_fd = GTE_NO_SOCK;
     }
+#if defined(_WIN32)
+    static int wsa_ready;
+    if (!wsa_ready) {
+        WSADATA wsa;
+        int e = WSAStartup(MAKEWORD(2, 2), &wsa);
+        if (e != 0) {
+            set_err("%s returned -1: winsock did not start (error %d)", fname, e);
+            return -1;
+        }
+        wsa_ready = 1;
+    }
+#endif
     long long deadline = now_ms() + env_ms("GTECAT_TIMEOUT_MS", 30000);
-    const char *named = getenv("GTECAT_CONTROLLER");
-    if (named && *named)
+    const char *named = setting("GTECAT_CONTROLLER");
+    if (named)
         return connect_to(named, fname, deadline);
+#if defined(_WIN32)
+    set_err("%s returned -1: no controller named: write controller = tcp://HOST:PORT (and "
+            "token = ...) in %s, or set GTECAT_CONTROLLER and GTECAT_TOKEN", fname,
+            g_ini_path[0] ? g_ini_path : "gtecat.ini beside the program");
+    return -1;
+#else
     if (g_private_addr[0] && g_child > 0) {
         if (kill(g_child, 0) == 0 && connect_to(g_private_addr, fname, deadline) == 0)
             return 0;
         child_fate();
     }
     return start_private(fname);
+#endif
 }
 
 /* ---- one call ------------------------------------------------------------------------- */
@@ -580,12 +1014,12 @@ static short invoke_locked(const gte_function *f, int gtn, short core, const gte
     if (f->flags & GTE_F_OPEN) {
         if (ensure_open(f->name) < 0)
             return CMD_COMM;
-    } else if (g_fd < 0 || g_fd_pid != getpid()) {
-        if ((f->flags & GTE_F_CLOSE) && g_fd < 0)
+    } else if (g_fd == GTE_NO_SOCK || g_fd_pid != gte_getpid()) {
+        if ((f->flags & GTE_F_CLOSE) && g_fd == GTE_NO_SOCK)
             return 0; /* closing what is not open: nothing to do (as in Python) */
-        if (g_fd >= 0 && g_fd_pid != getpid()) {
-            close(g_fd); /* forked child: reconnect to the same controller */
-            g_fd = -1;
+        if (g_fd != GTE_NO_SOCK && g_fd_pid != gte_getpid()) {
+            sock_close(g_fd); /* forked child: reconnect to the same controller */
+            g_fd = GTE_NO_SOCK;
             if (g_addr[0] && connect_to(g_addr, f->name,
                                         now_ms() + env_ms("GTECAT_TIMEOUT_MS", 30000)) == 0)
                 goto connected;
@@ -678,8 +1112,7 @@ connected:;
     long long deadline = now_ms() + timeout;
     if (send_all(g_fd, g_buf, size, deadline) < 0) {
         char why[1024];
-        snprintf(why, sizeof why, "sending %s to %s failed: %s", f->name, g_addr,
-                 strerror(errno));
+        snprintf(why, sizeof why, "sending %s to %s failed: %s", f->name, g_addr, io_error());
         drop(why);
         set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
         return CMD_COMM;
@@ -692,12 +1125,11 @@ connected:;
         if (r == -2)
             snprintf(why, sizeof why, "the controller at %s closed the connection during %s",
                      g_addr, f->name);
-        else if (errno == ETIMEDOUT)
+        else if (g_io_why == TIMED_OUT)
             snprintf(why, sizeof why, "no reply to %s within %ld ms (GTECAT_TIMEOUT_MS)",
                      f->name, timeout);
         else
-            snprintf(why, sizeof why, "reading the reply to %s failed: %s", f->name,
-                     strerror(errno));
+            snprintf(why, sizeof why, "reading the reply to %s failed: %s", f->name, io_error());
         drop(why);
         set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
         return CMD_COMM;
@@ -749,29 +1181,29 @@ connected:;
 
 short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
 {
-    pthread_mutex_lock(&g_mu);
+    LOCK();
     short rc = invoke_locked(f, gtn, core, a);
-    if ((f->flags & GTE_F_CLOSE) && g_fd >= 0 && g_fd_pid == getpid()) {
+    if ((f->flags & GTE_F_CLOSE) && g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid()) {
         /* GT_Close ends this connection; a private controller lives on until the
          * program ends, so the next GT_Open finds it again */
-        close(g_fd);
-        g_fd = -1;
+        sock_close(g_fd);
+        g_fd = GTE_NO_SOCK;
         g_lost[0] = '\0';
     }
-    pthread_mutex_unlock(&g_mu);
+    UNLOCK();
     return rc;
 }
 
 short gte_no_card(const char *name, short card, short code)
 {
-    pthread_mutex_lock(&g_mu);
+    LOCK();
     if (code == -6)
         set_err("%s returned -6: no card %d: the emulator is card 0", name, card);
     else if (code == -7)
         set_err("%s returned -7: libgts_mc found no %s in libgts", name, name);
     else
         set_err("%s returned %d: card %d is not open: the emulator is card 0", name, code, card);
-    pthread_mutex_unlock(&g_mu);
+    UNLOCK();
     return code;
 }
 
@@ -781,23 +1213,23 @@ short gte_declared(int index, int gtn, short core)
     gte_function f = {d->name, d->id, 0, GTE_F_DECLARED, NULL};
     char name[128];
     snprintf(name, sizeof name, "%s%s", gtn ? "GTN_" : "", gtn ? d->name + 3 : d->name);
-    pthread_mutex_lock(&g_mu);
+    LOCK();
     short rc = -1;
-    if (g_fd >= 0 && g_fd_pid == getpid())
+    if (g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid())
         rc = invoke_locked(&f, gtn, core, NULL); /* the controller logs it and says why */
     if (rc != GTE_CMD_DECLARED)
         set_err("%s returned %d: %s is declared but not emulated (group: %s)", name,
                 GTE_CMD_DECLARED, name, d->group);
-    pthread_mutex_unlock(&g_mu);
+    UNLOCK();
     return GTE_CMD_DECLARED;
 }
 
-short GTE_GetLastError(char *buf, short size)
+short GTE_STDCALL GTE_GetLastError(char *buf, short size)
 {
     if (!buf || size < 1)
         return CMD_PARAM;
-    pthread_mutex_lock(&g_mu);
+    LOCK();
     snprintf(buf, (size_t)size, "%s", g_err);
-    pthread_mutex_unlock(&g_mu);
+    UNLOCK();
     return 0;
 }

@@ -35,7 +35,7 @@ typedef union gte_arg {
 
 /* Marshal one call, send it to the controller, copy the out-pointers back, return the code.
  * gtn: 1 for GTN_x (the core is checked), 0 for GT_x / GTE_x. */
-#if defined(__GNUC__)
+#if defined(__GNUC__) && !defined(_WIN32)
 #define GTE_INTERNAL __attribute__((visibility("hidden")))
 #else
 #define GTE_INTERNAL

@@ -37,6 +37,7 @@ NEEDS = {
     "--attach ": "a running gtecat with that id (gtecat ps)",
     "gtecat panel": "serves a page until stopped (tests/gtecat/inspect runs it)",
     "gtecat lib --cflags": "a C compiler (builds libgts once)",
+    "gtecat lib --windows": "the mingw-w64 cross compiler (builds gts.dll once)",
     "gtecat demo": "the whole demo (tests/gtecat/test_demo.py runs it)",
     "gtecat fault inject": "a running gtecat to break (tests/gtecat/faults)",
     "gtecat fault list": "a running gtecat (tests/gtecat/faults)",

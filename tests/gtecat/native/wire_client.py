@@ -7,16 +7,22 @@ import socket
 from typing import Any
 
 from gtecat.native import protocol as p
+from gtecat.native import transport
 from gtecat.native.protocol import socket_path
 
 _LONG = ctypes.sizeof(ctypes.c_long)
 
 
 class WireClient:
-    def __init__(self, address: str, *, digest: str | None = None) -> None:
-        self.sock = socket.socket(socket.AF_UNIX, p.SOCKET_TYPE)
-        self.sock.settimeout(10)
-        self.sock.connect(socket_path(address))
+    def __init__(self, address: str, *, digest: str | None = None, token: str = "") -> None:
+        addr = transport.parse(address)
+        if addr.tcp:  # a TCP controller: the token travels after the hello
+            self.sock = transport.connect(addr, 10)
+        else:
+            self.sock = socket.socket(socket.AF_UNIX, p.SOCKET_TYPE)
+            self.sock.settimeout(10)
+            self.sock.connect(socket_path(address))
+        self.token = token.encode()
         d = (digest or p.table_digest()).encode()
         status, text = self._hello(d)
         self.hello_status, self.hello_text = status, text
@@ -38,7 +44,10 @@ class WireClient:
         return out[4:need]
 
     def _hello(self, digest: bytes) -> tuple[int, str]:
-        body = self._send(p.HELLO.pack(p.MSG_HELLO, p.PROTOCOL_VERSION, _LONG, digest))
+        hello = p.HELLO.pack(p.MSG_HELLO, p.PROTOCOL_VERSION, _LONG, digest)
+        if self.token:
+            hello += len(self.token).to_bytes(2, "little") + self.token
+        body = self._send(hello)
         status, n = p.HELLO_REPLY.unpack_from(body, 0)
         return status, body[p.HELLO_REPLY.size : p.HELLO_REPLY.size + n].decode()
 
