@@ -66,3 +66,43 @@ def shared_fixtures() -> Path:
 @pytest.fixture
 def examples_dir() -> Path:
     return EXAMPLES
+
+
+# GTECAT_CPU_REPORT=FILE: every process of the run (each xdist worker, the controller) appends
+# one line per test to FILE.<worker>: the CPU seconds (user+sys, its own and its waited-for
+# children's) that the test's setup, call and teardown cost, and one line for the process's
+# fixed cost (interpreter, imports, collection) before its first test. The suite's budget
+# (docs/performance.md) is kept with it.
+_CPU_REPORT = os.environ.get("GTECAT_CPU_REPORT")
+
+
+def _cpu_now() -> float:
+    import resource
+
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+if _CPU_REPORT:
+    _cpu_first = [True]
+
+    def _cpu_write(line: str) -> None:
+        worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
+        with open(f"{_CPU_REPORT}.{worker}", "a") as f:
+            f.write(line + "\n")
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_protocol(item, nextitem):  # type: ignore[no-untyped-def]
+        start = _cpu_now()
+        if _cpu_first[0]:
+            _cpu_first[0] = False
+            _cpu_write(f"{start:.3f}\t<process start, imports, collection>")
+        yield
+        _cpu_write(f"{_cpu_now() - start:.3f}\t{item.nodeid}")
+
+    def pytest_collection_finish(session):  # type: ignore[no-untyped-def]
+        _cpu_write(f"{_cpu_now():.3f}\t<collected>")
+
+    def pytest_sessionfinish(session, exitstatus):  # type: ignore[no-untyped-def]
+        _cpu_write(f"{_cpu_now():.3f}\t<process total>")
