@@ -125,19 +125,17 @@ def test_fixtures_and_a_failing_test_with_its_trace(project: Path) -> None:
     assert user_files(project) == ["pytest.ini", "test_machine.py", "traces"]
 
 
-def test_without_the_option_no_trace_is_written(project: Path) -> None:
-    done = _pytest(project, "-k", "fails")
-    assert "1 failed" in done.stdout and "gtecat trace" not in done.stdout
-    assert "GT_AxisOn returned 7" in done.stdout  # the reasons are always reported
-
-
-def test_ini_options_choose_the_bus(project: Path) -> None:
+def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Path) -> None:
     (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
     (project / "test_ini.py").write_text(
         "def test_one_axis(gtecat_bus):\n    assert gtecat_bus.axes() == 1\n"
     )
-    done = _pytest(project, "test_ini.py")
-    assert "1 passed" in done.stdout, done.stdout + done.stderr
+    # one child for two checks: the ini option's bus, and a failure without --gtecat-trace
+    done = _pytest(project, "test_ini.py", "test_machine.py", "-k", "one_axis or fails")
+    out = done.stdout
+    assert "1 passed" in out and "1 failed" in out, out + done.stderr
+    assert "gtecat trace" not in out
+    assert "GT_AxisOn returned 7" in out  # the reasons are always reported
     (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = no_such_bus\n")
     done = _pytest(project, "test_ini.py")
     assert done.returncode != 0 and "neither a file nor a shipped example" in (
