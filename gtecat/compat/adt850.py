@@ -1,21 +1,24 @@
-"""The ADT850 four-axis card's C API (seed 004, chapters 6, 7 and appendix B) over our axes.
+"""The ADT850 four-axis card's C API (ADT850 manual, chapters 6, 7 and appendix B) over our axes.
 
 ``from gtecat.compat import adt850 as adt`` then ``adt.adt850_initial()`` opens the card
 (the controller's ``gts:4`` pulse card, :mod:`gtecat.compat._card`) and every function of
-chapter 7 works with the seed's names, argument order, ranges and return codes: 0 right,
-1 error (a card number other than 0, an axis outside 1-4, a value outside the seed's
-range, a command the card refuses now); ``read_bit`` 0/1 and -1 on error;
-``adt850_initial`` the number of cards (1), 0 when the open controller is no pulse card,
--1 when the card cannot be opened.  Nothing raises: :func:`last_error` gives the reason of
+chapter 7 works with the manual's names, argument order, ranges and return codes: 0 right,
+1 error (a card number adt850_initial did not find, an axis outside 1-4, a value outside
+the manual's range, a command the card refuses now); ``read_bit`` 0/1 and -1 on error;
+``adt850_initial`` the number of cards (1..16), 0 when the open controller is no pulse
+card, -1 when a card cannot be opened.  Nothing raises: :func:`last_error` gives the reason of
 the last failure.  Pointer outputs (``int *value``, ``long *pos``) take ctypes ``byref``
 / ``pointer`` / instances or a one-element list.
 
-Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
+Decisions where the manual is silent (besides the shared ones of :mod:`._card`):
 
-* **One card**, number 0 (``adt850_initial`` returns 1).  Its options (``clock``,
-  ``machine``, ...) are GT_Open's; with a controller already open that one is used.
+* **Cards**: up to 16 (chapter 1), numbered from 0; how many the emulated PC holds is
+  ``adt850_initial(cards=N)`` or ``GTECAT_ADT850_CARDS`` (default 1).  Card 0 is the
+  controller GT_Open opens (its options: ``clock``, ``machine``, ...; a controller
+  already open is used), the others separate ``gts:4`` controllers that keep card 0's
+  time (:func:`adt850_initial`).  Appendix B works on card 0.
 * **Registers after initialisation** ("值不确定", 3.x): R = 8000000 (M = 1), SV = V = A =
-  D = 1, K = 1, dec_pos 0.  The modes are the seed's 1.1 list.
+  D = 1, K = 1, dec_pos 0.  The modes are the manual's 1.1 list.
 * **Interpolation speed** is the master axis's (X for X-Y, X-Y-Z, X-Y-Z-W; Z for Z-W) in
   base pulses (:mod:`gtecat.controller.crd.base_pulse`): the long axis of a line, the
   faster axis of each octant of an arc.  A 3/4-axis line needs Z set as 5.8/5.9 say
@@ -29,10 +32,18 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
 * **Continuous interpolation**: ``get_inp_status2`` is 1 while the interpolation runs
   and no next node waits (the chip's one-node buffer); a node written then is run right
   after the current one, at the base speed the current one ends with.
-* **get_status** while driving always has one of D2/D3/D4 set (D3 also for a
+* **get_status** while pulses go out always has one of D2/D3/D4 set (D3 also for a
   constant-speed drive), so "0 = drive over" holds; D0/D1 compare with COMP+/COMP-.
-* **read_di / read_bit** give 1 for an active input (the machine's switch on), whatever
-  its logic level setting.  Outputs are the card's 32-bit register (``write_do``).
+  A drive whose pulses are out but that is not over - INPOS valid and not yet active
+  (1.12, 9.5), or Z and W held in the drive state by a 3/4-axis interpolation that
+  stopped early (5.12, 9.3) - reads D8 (0x100) alone: the manual leaves D8-D15 unused,
+  and the value must not be 0 while the card still drives.
+* **read_di / read_bit** give electrical levels (6.1; the wiring model and the logic
+  settings are gtecat.compat._card's "Electrical levels").  Outputs are the card's 32-bit
+  register (``write_do``).
+* **Settings with nothing to act on** in an emulation - ``set_pulse_mode`` (the emulated
+  amplifier takes any mode) and the input filters - return 0 and say so in
+  :func:`last_error`.
 * **Appendix B** (the application library): distances in units of ``AppParams.pulses``
   pulses, speeds in units/s, ``addtime`` in s; the blocking calls run the controller
   cycle by cycle, calling ``pfn`` (if given) every cycle; a ``one_stop``/``all_stop``
@@ -44,21 +55,51 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
-from dataclasses import dataclass
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 from ..controller.crd import bank
 from ..controller.motion.scurve import SCurveParams
-from ._card import AXES, CompatError, PulseCard, integer, open_card, out, real
+from ._card import (
+    AXES,
+    GPIN,
+    SIGNALS,
+    WAITING,
+    CompatError,
+    PulseCard,
+    integer,
+    open_card,
+    open_follower,
+    out,
+    real,
+)
 from ._card import last_error as last_error
 from ._card import set_last_error as _set_error
 
-_CARD: list[PulseCard | None] = [None]
-_DEC_ENABLED = {1: False, 2: False}
+MAX_CARDS = 16
+#: the cards adt850_initial found, by card number (None: no such card)
+_CARD: list[PulseCard | None] = [None] * MAX_CARDS
 PULSE_MAX = 268_435_455
 INP_MIN, INP_MAX = -8_388_608, 8_388_607
 POS_MIN, POS_MAX = -2_147_483_648, 2_147_483_647
+
+
+@dataclass(slots=True)
+class _Layer:
+    """What one ADT850 card keeps besides the chip registers of :class:`PulseCard`."""
+
+    #: interpolation deceleration enabled (5.10/5.11), by ``no`` (1 X-Y/3-4 axes, 2 Z-W)
+    dec_enabled: dict[int, bool] = field(default_factory=lambda: {1: False, 2: False})
+    #: where a 3/4-axis interpolation sends Z and W (LP), until it is over or inp_clear
+    inp34: dict[int, float] = field(default_factory=dict)
+
+
+def _layer(card: PulseCard) -> _Layer:
+    if not isinstance(card.layer, _Layer):
+        card.layer = _Layer()
+    return card.layer
 
 
 def _api(error: int = 1) -> Callable:
@@ -67,10 +108,10 @@ def _api(error: int = 1) -> Callable:
     def wrap(fn: Callable[..., int | None]) -> Callable[..., int]:
         @functools.wraps(fn)
         def call(*args: Any, **kwargs: Any) -> int:
-            card = _CARD[0]
+            card = _CARD[0]  # card 0's controller keeps the time of every card
             try:
                 rc = fn(*args, **kwargs)
-            except Exception as e:  # the seed's C API never raises
+            except Exception as e:  # the manual's C API never raises
                 _set_error(f"{fn.__name__}: {e}")
                 rc = error
             if card is not None:
@@ -83,10 +124,13 @@ def _api(error: int = 1) -> Callable:
 
 
 def _card(cardno: Any) -> PulseCard:
-    card = _CARD[0]
-    if card is None:
+    if _CARD[0] is None:
         raise CompatError("no card: call adt850_initial first")
-    integer("cardno", cardno, 0, 0)
+    k = integer("cardno", cardno, 0, MAX_CARDS - 1)
+    card = _CARD[k]
+    if card is None:
+        count = sum(c is not None for c in _CARD)
+        raise CompatError(f"cardno={k}: adt850_initial found {count} card(s), 0..{count - 1}")
     return card
 
 
@@ -98,31 +142,72 @@ def _flag(name: str, value: Any) -> bool:
     return bool(integer(name, value, 0, 1))
 
 
-# --- 1. basic parameters ------------------------------------------------------------------
-def adt850_initial(**options: Any) -> int:
-    """1.1: open the card; the number of cards (1), 0 no pulse card, -1 cannot open."""
+def _close_all() -> None:
     if _CARD[0] is not None:
-        _CARD[0].close()
-        _CARD[0] = None
+        _CARD[0].close()  # closes the other cards' controllers too
+    _CARD[:] = [None] * MAX_CARDS
+
+
+def _card_count(cards: Any) -> int:
+    if cards is not None:
+        return integer("cards", cards, 1, MAX_CARDS)
+    env = os.environ.get("GTECAT_ADT850_CARDS", "").strip()
+    if not env:
+        return 1
+    if not env.isdigit() or not 1 <= int(env) <= MAX_CARDS:
+        raise CompatError(f"GTECAT_ADT850_CARDS={env!r}: the number of cards, 1..{MAX_CARDS}")
+    return int(env)
+
+
+# --- 1. basic parameters ------------------------------------------------------------------
+def adt850_initial(
+    cards: int | None = None, machines: Mapping[int, Any] | None = None, **options: Any
+) -> int:
+    """1.1: open the cards; the number of cards (1..16), 0 when the open controller is no
+    pulse card, -1 when a card cannot be opened (the reason in :func:`last_error`).
+
+    The manual's PC holds up to 16 cards (chapter 1), numbered 0, 1, 2, ... in the
+    order ``adt850_initial`` counts them.  Decision: ``cards`` (ours; else the
+    ``GTECAT_ADT850_CARDS`` environment variable, else 1) says how many the emulated PC
+    has.  Card 0 is the controller ``GT_Open`` opens (or the pulse card open already; the
+    ``options`` are GT_Open's); every other card is a controller of its own, a ``gts:4``
+    card with ``machines[k]`` (a machine description or its TOML file; none: no
+    switches), whose time is card 0's.  After 1.1 every card stands in the power-up
+    state the manual lists."""
+    _close_all()
     try:
-        _CARD[0] = open_card("ADT850", **options)
+        n = _card_count(cards)
+        machines = dict(machines or {})
+        for k in machines:
+            integer("machines key", k, 0, n - 1)
+        if 0 in machines:
+            options.setdefault("machine", machines[0])
+        base = open_card("ADT850", **options)
     except Exception as e:
         _set_error(f"adt850_initial: {e}")
         return 0 if "EtherCAT master" in str(e) else -1
-    _CARD[0].stop2_clears_ep = True
-    _DEC_ENABLED.update({1: False, 2: False})
-    _INP34.clear()
-    return 1
+    _CARD[0] = base
+    try:
+        for k in range(1, n):
+            _CARD[k] = open_follower(base, f"ADT850 card {k}", machines.get(k))
+    except Exception as e:
+        _set_error(f"adt850_initial: card {k}: {e}")
+        _close_all()
+        return -1
+    for card in _CARD[:n]:
+        assert card is not None
+        card.stop2_clears_ep = True
+        card.layer = _Layer()
+    return n
 
 
 @_api()
 def adt850_end() -> int:
-    """1.2: release the card (the controller stays open: GT_Close closes it)."""
-    card = _CARD[0]
-    if card is None:
+    """1.2: release the cards (card 0's controller stays open - GT_Close closes it -, the
+    other cards' controllers close)."""
+    if _CARD[0] is None:
         raise CompatError("no card open")
-    card.close()
-    _CARD[0] = None
+    _close_all()
     return 0
 
 
@@ -131,11 +216,21 @@ def _stop_mode(k: int) -> Callable[..., int]:
     def set_stop_mode(cardno: int, axis: int, value: int, logic: int) -> int:
         card, n = _axis(cardno, axis)
         card.regs[n].stop_on[k] = _flag("value", value)
-        card.regs[n].stop_logic[k] = integer("logic", logic, 0, 1)
+        card.regs[n].logic[2 + k] = integer("logic", logic, 0, 1)
         return 0
 
     set_stop_mode.__name__ = set_stop_mode.__qualname__ = f"set_stop{k}_mode"
-    set_stop_mode.__doc__ = f"1.{3 + k}: STOP{k} valid (1) / invalid (0), stop level."
+    set_stop_mode.__doc__ = (
+        f"1.{3 + k}: STOP{k} valid (1) / invalid (0) and the level that stops (0 low, 1 "
+        "high): the card sees the signal active at that level (module docstring of "
+        'gtecat.compat._card, "Electrical levels"); valid and active, it stops a drive '
+        "(decelerating, a constant-speed drive at once: 1.3 note)."
+        + (
+            " A STOP2 stop also clears the real position counter at the signal (1.5 note, 9.4)."
+            if k == 2
+            else ""
+        )
+    )
     return set_stop_mode
 
 
@@ -144,42 +239,52 @@ set_stop1_mode = _stop_mode(1)
 set_stop2_mode = _stop_mode(2)
 
 
-def _setting(name: str, *ranges: tuple[str, int, int]) -> Callable[..., int]:
-    @_api()
-    def setter(cardno: int, axis: int, *values: int) -> int:
-        card, n = _axis(cardno, axis)
-        if len(values) != len(ranges):
-            raise CompatError(f"{name} takes {len(ranges)} values after cardno, axis")
-        card.regs[n].settings[name] = tuple(
-            integer(arg, v, lo, hi) for (arg, lo, hi), v in zip(ranges, values, strict=True)
-        )
-        return 0
-
-    setter.__name__ = setter.__qualname__ = name
-    setter.__doc__ = f"{name}: kept (the emulated amplifier and encoder need no such setting)."
-    return setter
+def _no_effect(name: str, why: str) -> None:
+    """A setting the emulation takes and that changes nothing observable: 0, and the
+    reason in :func:`last_error` (a program that checks it learns so)."""
+    _set_error(f"{name}: kept; {why}")
 
 
-_set_actualcount_mode = _setting(
-    "set_actualcount_mode", ("value", 0, 1), ("dir", 0, 1), ("freq", 0, 2)
-)
-
-
-@functools.wraps(_set_actualcount_mode)
+@_api()
 def set_actualcount_mode(cardno: int, axis: int, value: int, dir: int, freq: int) -> int:
     """1.6: the real position counter's input: A/B (0) or up/down pulses (1), its
-    direction (1 reversed) and the A/B multiplication (0 4x, 1 2x, 2 1x). The counter
-    keeps its reading; it counts from now on as set."""
-    card = _CARD[0]
-    keep = card.ep(axis) if card is not None and axis in (1, 2, 3, 4) else None
-    rc = _set_actualcount_mode(cardno, axis, value, dir, freq)
-    if rc == 0 and keep is not None:
-        card.set_ep(axis, round(keep))
-    return rc
+    direction (1 reversed) and the A/B multiplication (0 4x, 1 2x, 2 1x).  The counter
+    keeps its reading and counts from now on as set; up/down input fed with the emulated
+    amplifier's A/B signals holds its reading (gtecat.compat._card ``counted``)."""
+    card, n = _axis(cardno, axis)
+    card.count_mode(
+        n, integer("value", value, 0, 1), integer("dir", dir, 0, 1), integer("freq", freq, 0, 2)
+    )
+    return 0
 
 
-set_pulse_mode = _setting("set_pulse_mode", ("value", 0, 1), ("logic", 0, 1), ("dir_logic", 0, 1))
-set_inpos_mode = _setting("set_inpos_mode", ("value", 0, 1), ("logic", 0, 1))
+@_api()
+def set_pulse_mode(cardno: int, axis: int, value: int, logic: int, dir_logic: int) -> int:
+    """1.7: pulse + pulse (0) or pulse + direction (1), pulse and direction logic.
+
+    Decision: the emulated amplifier is set up for whatever the card puts out (as the
+    manual's chapter 11 asks of a real one), so the motor follows the logic counter in
+    every mode: the call returns 0 and :func:`last_error` says it changes nothing here."""
+    card, n = _axis(cardno, axis)
+    card.regs[n].settings["pulse_mode"] = (
+        integer("value", value, 0, 1),
+        integer("logic", logic, 0, 1),
+        integer("dir_logic", dir_logic, 0, 1),
+    )
+    _no_effect("set_pulse_mode", "the emulated amplifier takes any pulse output mode")
+    return 0
+
+
+@_api()
+def set_inpos_mode(cardno: int, axis: int, value: int, logic: int) -> int:
+    """1.12: nINPOS valid (1) and its active level: valid, a drive (and an
+    interpolation, 5 "伺服马达的到位信号") ends only when the card sees INPOS active -
+    the amplifier within 1 pulse of the plan, its output low.  9.5: valid without an
+    INPOS the card can see active, the drive never ends."""
+    card, n = _axis(cardno, axis)
+    card.regs[n].inpos_on = _flag("value", value)
+    card.regs[n].logic[5] = integer("logic", logic, 0, 1)
+    return 0
 
 
 @_api()
@@ -191,18 +296,37 @@ def set_circle_mode(cardno: int, axis: int, value: int) -> int:
     return 0
 
 
-set_input_filter = _setting("set_input_filter", ("number", 1, 4), ("value", 0, 1))
-set_filter_time = _setting("set_filter_time", ("value", 1, 8))
-set_input_fiilter = set_input_filter  # the seed's chapter 6 spelling
+@_api()
+def set_input_filter(cardno: int, axis: int, number: int, value: int) -> int:
+    """1.18: the integral filter of an input group (1 LMT+/LMT-/STOP0/STOP1, 2 STOP2,
+    3 INPOS/ALARM, 4 IN) on or off.  The emulated inputs do not bounce: the filter
+    changes nothing (said in :func:`last_error`)."""
+    card, n = _axis(cardno, axis)
+    card.regs[n].settings[f"filter{integer('number', number, 1, 4)}"] = _flag("value", value)
+    _no_effect("set_input_filter", "the emulated inputs have no noise for a filter to remove")
+    return 0
+
+
+@_api()
+def set_filter_time(cardno: int, axis: int, value: int) -> int:
+    """1.19: the filters' time constant, 1..8: kept, no effect (see set_input_filter)."""
+    card, n = _axis(cardno, axis)
+    card.regs[n].settings["filter_time"] = integer("value", value, 1, 8)
+    _no_effect("set_filter_time", "the emulated inputs have no noise for a filter to remove")
+    return 0
+
+
+set_input_fiilter = set_input_filter  # the manual's chapter 6 spelling
 set_filer_time = set_filter_time
 
 
 @_api()
 def set_limit_mode(cardno: int, axis: int, value: int, logic: int) -> int:
-    """1.8: a limit stops at once (0) or decelerating (1)."""
+    """1.8: a limit stops at once (0) or decelerating (1); ``logic`` its active level
+    (0 low, the power-up setting; 1 high), for LMT+ and LMT- both."""
     card, n = _axis(cardno, axis)
     card.regs[n].limit_decel = _flag("value", value)
-    card.regs[n].settings["limit_logic"] = integer("logic", logic, 0, 1)
+    card.regs[n].logic[0] = card.regs[n].logic[1] = integer("logic", logic, 0, 1)
     card._limit_mode(n)
     return 0
 
@@ -233,10 +357,11 @@ def set_softlimit_mode3(cardno: int, axis: int, value: int) -> int:
 
 @_api()
 def set_alarm_mode(cardno: int, axis: int, value: int, logic: int) -> int:
-    """1.13: the amplifier alarm input valid (1): it stops a drive at once."""
+    """1.13: nALARM valid (1) and its active level: valid, ALARM active stops a drive at
+    once (get_stopdata D5) and a drive started then ends at once with D5."""
     card, n = _axis(cardno, axis)
-    card.res(n).safety.alarm_on = _flag("value", value)
-    card.regs[n].settings["alarm_logic"] = integer("logic", logic, 0, 1)
+    card.regs[n].alarm_on = _flag("value", value)
+    card.regs[n].logic[6] = integer("logic", logic, 0, 1)
     return 0
 
 
@@ -267,9 +392,14 @@ def set_dec2_mode(cardno: int, axis: int, value: int) -> int:
 # --- 2. drive status ----------------------------------------------------------------------
 @_api()
 def get_status(cardno: int, axis: int, value: Any) -> int:
-    """2.1: 0 when the drive is over, else D0-D7 (module docstring)."""
+    """2.1: 0 when the drive is over, else D0-D7; D8 alone while the card waits for
+    INPOS (1.12) or holds Z/W in the drive state after a broken 3/4-axis interpolation
+    (5.12: "Z、W轴会一直停在驱动状态", until inp_clear) - module docstring."""
     card, n = _axis(cardno, axis)
-    out(value, card.status_word(n))
+    word = card.status_word(n)
+    if word == 0 and n in (3, 4) and _inp34_error(card):
+        word = WAITING
+    out(value, word)
     return 0
 
 
@@ -287,10 +417,15 @@ def _no(no: Any) -> int:
 
 @_api()
 def get_inp_status(cardno: int, no: int, value: Any) -> int:
-    """2.3: 1 while the interpolation ``no`` (1 X-Y and 3/4 axes, 2 Z-W) runs."""
+    """2.3: 1 while the interpolation ``no`` (1 X-Y and 3/4 axes, 2 Z-W) runs - with
+    INPOS valid, until every axis of it sees INPOS active (chapter 5, "伺服马达的到位信号":
+    the interpolation ends when the INPOS signals are active)."""
     card = _card(cardno)
     c = bank(card.ctl).get(_no(no))
-    out(value, 1 if c.running else 0)
+    waiting = c.prm is not None and any(
+        card.driving(a) and not card.pulsing(a) for a in c.prm.axes()
+    )
+    out(value, 1 if c.running or waiting else 0)
     return 0
 
 
@@ -458,7 +593,7 @@ def _interp(card: PulseCard, no: int, axes: list[int], make: Callable, arc: bool
         raise CompatError("S-curve acceleration cannot drive an arc (ADT850 manual 3.4, 5.4)")
     if prm.s_curve and c.running:
         raise CompatError("S-curve acceleration cannot drive a continuous interpolation (5.4)")
-    enabled = _DEC_ENABLED[no]
+    enabled = _layer(card).dec_enabled[no]
     if not enabled:
         decel = "none"
     elif regs.manual:
@@ -528,16 +663,13 @@ def inp_move4(cardno: int, pulse1: int, pulse2: int, pulse3: int, pulse4: int) -
     return 0
 
 
-#: where a 3/4-axis interpolation sends Z and W (LP), until it is over or inp_clear
-_INP34: dict[int, float] = {}
-
-
 def _inp34_error(card: PulseCard) -> bool:
     """9.3: a 3/4-axis interpolation that stopped before its distance leaves an error that
     makes Z and W move wrongly until ``inp_clear``."""
-    if not _INP34 or bank(card.ctl).get(1).running:
+    inp34 = _layer(card).inp34
+    if not inp34 or bank(card.ctl).get(1).running:
         return False
-    return any(abs(card.lp(a) - t) > 0.5 for a, t in _INP34.items())
+    return any(abs(card.lp(a) - t) > 0.5 for a, t in inp34.items())
 
 
 def _check_zw(card: PulseCard, axis: int) -> None:
@@ -562,61 +694,45 @@ def _interp34(card: PulseCard, axes: list[int], d: tuple[int, ...]) -> None:
     running = bank(card.ctl).get(1).running
     for a, delta in zip(axes, d, strict=True):
         if a in (3, 4):
-            base = _INP34.get(a, card.lp(a)) if running else card.lp(a)
-            _INP34[a] = base + delta
+            inp34 = _layer(card).inp34
+            base = inp34.get(a, card.lp(a)) if running else card.lp(a)
+            inp34[a] = base + delta
     _interp(card, 1, axes, PulseCard.line(d), False)
 
 
 @_api()
 def inp_dec_enable(cardno: int, no: int) -> int:
     """5.10: the next nodes decelerate at their end."""
-    _card(cardno)
-    _DEC_ENABLED[_no(no)] = True
+    _layer(_card(cardno)).dec_enabled[_no(no)] = True
     return 0
 
 
 @_api()
 def inp_dec_disable(cardno: int, no: int) -> int:
     """5.11: the next nodes run on at speed (continuous interpolation; the default)."""
-    _card(cardno)
-    _DEC_ENABLED[_no(no)] = False
+    _layer(_card(cardno)).dec_enabled[_no(no)] = False
     return 0
 
 
 @_api()
 def inp_clear(cardno: int) -> int:
     """5.12 / 9.3: clear the error a 3/4-axis interpolation that did not end leaves."""
-    _card(cardno)
-    _INP34.clear()
+    _layer(_card(cardno)).inp34.clear()
     return 0
 
 
 # --- 6. digital inputs and outputs --------------------------------------------------------
-_SIGNALS = ("LMT+", "LMT-", "STOP0", "STOP1", "STOP2", "INPOS", "ALARM", "IN")
-
-
 def _input(card: PulseCard, number: int) -> int:
-    """The electrical level of input ``number`` (6.1: 0 low, 1 high).
+    """The electrical level of input ``number`` (6.1: 0 low, 1 high), D0 X LMT+ ... D31
+    W IN (:data:`~gtecat.compat._card.SIGNALS` per axis).
 
-    A signal that is active reads its active level: low unless its mode says high-active
-    (limits: ``set_limit_mode`` logic, 1.1 "低电平有效" by default; STOP0-2: their
-    ``set_stopN_mode`` logic; INPOS/ALARM: ``set_inpos_mode``/``set_alarm_mode`` logic, the
-    nINPOS/nALARM inputs being low-active by default). Code that tests
-    ``read_bit(0, 0) == 0`` for "X LMT+ hit" works as on the card. IN terminals are
-    levels already (nothing in the machine drives them; they read high when open)."""
+    The level is the wiring's (gtecat.compat._card, "Electrical levels"), not the
+    logic setting's: with the power-up settings an active limit, STOP, INPOS or ALARM
+    reads 0, so code that tests ``read_bit(0, 0) == 0`` for "X LMT+ hit" works as on the
+    card.  The general input IN reads high (1): nothing in the machine drives it."""
     n, k = number // 8 + 1, number % 8
-    regs = card.regs[n]
-    if k in (0, 1):
-        on, high = card.limit(n, k == 0), regs.settings.get("limit_logic", 0)
-    elif k <= 4:
-        on, high = card.stop_input(n, k - 2), regs.stop_logic[k - 2]
-    elif k == 5:
-        on, high = card.inpos(n), regs.settings.get("set_inpos_mode", (0, 0))[1]
-    elif k == 6:
-        on, high = card.alarm(n), regs.settings.get("alarm_logic", 0)
-    else:
-        return 0 if card.general_inputs >> (n - 1) & 1 else 1
-    return int(on) if high else int(not on)
+    assert SIGNALS[GPIN] == "IN"
+    return card.level(n, k)
 
 
 @_api()
@@ -721,14 +837,33 @@ def _setup(axis: int, speed: float, startv: float, addtime: float) -> None:
     regs.s_curve = regs.manual = regs.asym = False
 
 
+#: how long an appendix B call waits for INPOS after its pulses (ms of controller time)
+INPOS_WAIT_MS = 10_000.0
+
+
 def _run(axes: list[int], pfn: FUNCTION, limit_stop: bool = True) -> int:
-    """Run cycles until ``axes`` stand: 1 done, 0 stopped from outside, -3/-2 limits."""
+    """Run cycles until ``axes`` stand: 1 done, 0 stopped from outside, -3/-2 limits.
+
+    Decision: with INPOS valid and never active (9.5: the drive never ends), the call
+    stops waiting :data:`INPOS_WAIT_MS` after the pulses and returns 0, with the reason
+    in :func:`last_error` (the library would wait for ever; a test must end)."""
     card = _card(0)
     _EXTERNAL[0] = False
+    waited = 0.0
     while any(card.driving(n) for n in axes):
         if pfn is not None:
             pfn()
         card.wait_cycle()
+        if not any(card.pulsing(n) for n in axes):
+            waited += card.cycle_ms
+            if waited > INPOS_WAIT_MS:
+                _set_error(
+                    f"the pulses are out but INPOS never came within {INPOS_WAIT_MS:g} ms "
+                    "(set_inpos_mode valid, 9.5); the call gives up with 0"
+                )
+                for n in axes:
+                    card.regs[n].await_inpos = False
+                return 0
     if _EXTERNAL[0]:
         return 0
     data = 0
@@ -977,7 +1112,7 @@ def _work_inp(
     p = _app(master)
     speed = p.work_speed if integer("speedmode", speedmode, 0, 1) == 0 else p.rapid_speed
     _setup(master, speed, p.start_speed, p.acc_time)
-    _DEC_ENABLED[no] = True
+    _layer(card).dec_enabled[no] = True
     if arc is not None:
         card.regs[master].sv = card.regs[master].v  # an arc at constant speed (no S, no auto)
         _interp(card, no, axes, PulseCard.arc(*arc), True)

@@ -1,23 +1,23 @@
-"""The MCX314 card library of seed 003 (chapter 4) over our axes.
+"""The MCX314 card library (its manual's chapter 4) over our axes.
 
 ``from gtecat.compat import mcx314 as m`` and the functions of tables 4-2 to 4-7 with
-the seed's names and argument order.  The library has no open call (the card is found at
+the manual's names and argument order.  The library has no open call (the card is found at
 power-up): the first call opens the card (the one ``GT_Open`` opened, else a ``gts:4`` card
-with the ``GTECAT_*`` settings); :func:`Open` (ours) chooses its options.  The seed's
-functions are ``void``: they return None, and a value outside the seed's range (or a call
+with the ``GTECAT_*`` settings); :func:`Open` (ours) chooses its options.  The manual's
+functions are ``void``: they return None, and a value outside the manual's range (or a call
 the card cannot do now) raises :class:`~gtecat.compat.CompatError` naming it; the
 ``unsigned`` readers return the register (32-bit two's complement for positions).
 
-Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
+Decisions where the manual is silent (besides the shared ones of :mod:`._card`):
 
-* **``axis`` is a bit mask** (X 0x1, Y 0x2, Z 0x4, U 0x8), as the seed writes it for the
+* **``axis`` is a bit mask** (X 0x1, Y 0x2, Z 0x4, U 0x8), as the manual writes it for the
   interpolation pairs (xy 0x3 ...) and for its I/O functions ("可多軸設置"): a register
   call writes every selected axis (the MCX314 way); range 1..15.
 * **LINEDATA / CIRCLEDATA** (4.5: "初速度、速度、加速度等") hold ``SV, V, A, D, K`` as
   ctypes ints; ``D = 0`` decelerates with ``A``.  The end point of an interpolation is
   each axis's ``SetP`` register, an arc's centre the ``SetC`` registers (both relative to
   the start, 4.5.2); ``SetFP`` / ``SetCP`` (table 4-4's names) are the same calls.
-* **Speeds** (4.4): the formulas of the seed with M from ``SetRange`` (M = 8000000/R, all
+* **Speeds** (4.4): the formulas of the manual with M from ``SetRange`` (M = 8000000/R, all
   axes), ``SetMultiple`` (M directly, per axis) or ``SetMaxSpeed`` (the smallest M with
   ``8000·M >= max speed``, all axes).  An interpolation uses the lowest selected axis's M
   and counts speed in base pulses (:mod:`gtecat.controller.crd.base_pulse`).
@@ -31,15 +31,24 @@ Decisions where the seed is silent (besides the shared ones of :mod:`._card`):
 * **Soft limits**: ``SLMTP(n)`` / ``SLMTM(n)`` make COMP+ / COMP- soft limits of all
   axes (``SetCompP`` / ``SetCompM(axis, data)``); ``n`` is the "active level" the thesis
   names, kept (a comparison has none), ``RESET`` turns them off; ``SLMTSig(n)`` compares
-  with LP (0) or EP (1).  Level settings (``HLMTP``,
-  ``ALMSig``, ...) and encoder modes are kept, with no effect on the emulated signals.
-* **Homing** ``HomeTypeN(WR1Reg, SV, V, A)``: ``WR1Reg`` is the chip's WR1 input-stop
-  register - bit 2k+1 enables IN k (IN0 home switch, IN1 encoder Z, IN2 probe 1), bit
-  2k its level (kept) - plus our bits 8-11 (the axes to home, 0 = X) and bit 12 (search
-  in the positive direction; clear: negative).  The origin signal is the lowest enabled
-  IN; the EZ of types 3/4 is IN1.  The slow speed is SV.  The call returns when the axes
-  stand (it runs the controller), like the seed's blocking flow (figures 3-28 to 3-31);
-  it raises when no origin signal is found within ``HOME_TIMEOUT_MS``.
+  with LP (0) or EP (1).
+* **Signal levels** (``HLMTP``, ``HLMTM``, ``ALMSig``, ``InPosSig``, ``HomeTypeN``'s
+  level bits) set the level the card reads as active, as gtecat.compat._card's
+  "Electrical levels" describes (the ADT850's logic settings); ``EnableALM`` /
+  ``EnableInPos`` make the alarm stop drives / drives wait for INPOS.  ``EncoderMode`` /
+  ``EncoderCWCCW`` set the real counter's input and direction.  ``SetPulseMode`` and
+  ``SetAO`` change nothing here and say so in :func:`last_error`.
+* **Axis numbers**: every ``axis`` is the chip's bit mask (X 1, Y 2, Z 4, U 8), as the
+  thesis writes the interpolation pairs (xy 0x3 ...); the readers (``ReadLPS``,
+  ``ReadEPS``, ``ReadCV``, ``ReadCA``) read one axis ("為各軸分別讀取"): 1, 2, 4 or 8.
+  Decision: a plain axis number is not guessed (3 could be Z or X+Y, 4 Z or U): a value
+  that is no single axis's bit raises CompatError naming the four.
+* **Homing** ``HomeTypeN(WR1Reg, SV, V, A)``: ``WR1Reg`` is the chip's WR1 (IN k enable
+  and level bits, the interrupt enables); every axis is homed, negatively, unless ours
+  ``axis=`` / ``direction=`` say otherwise (:func:`HomeType1`).  The origin signal is the
+  lowest enabled IN; the EZ of types 3/4 is IN1.  The slow speed is SV.  The call
+  returns when the axes stand (it runs the controller), like the manual's blocking flow
+  (figures 3-28 to 3-31).
 * **Bit-pattern interpolation** is named in table 4-1 but no function is documented;
   :func:`BitPattern` (ours) takes per-step ``(+, -)`` bit words per axis and runs them as
   one-base-pulse lines at constant ``V``.
@@ -55,13 +64,27 @@ from typing import Any
 
 from ..controller.crd import bank
 from ..controller.motion.scurve import SCurveParams
-from ._card import AXES, CompatError, PulseCard, integer, open_card
+from ._card import (
+    ALARM,
+    AXES,
+    GPIN,
+    INPOS,
+    LMTM,
+    LMTP,
+    STOP0,
+    CompatError,
+    PulseCard,
+    integer,
+    open_card,
+)
 from ._card import last_error as last_error
 from ._card import set_last_error as _set_error
 
 _CARD: list[PulseCard | None] = [None]
 PULSE_MAX = 268_435_455
 HOME_TIMEOUT_MS = 600_000.0
+#: how long a homing step waits for INPOS once its pulses are out (EnableInPos)
+INPOS_WAIT_MS = 10_000.0
 _MASKS2 = {0x3: (1, 2), 0x5: (1, 3), 0x9: (1, 4), 0x6: (2, 3), 0xA: (2, 4), 0xC: (3, 4)}
 _MASKS3 = {0x7: (1, 2, 3), 0xB: (1, 2, 4), 0xD: (1, 3, 4), 0xE: (2, 3, 4)}
 
@@ -147,10 +170,13 @@ def Close() -> None:
 # --- 4.3 initial settings ---------------------------------------------------------------------
 @_api
 def SetPulseMode(axis: int, mode: int) -> None:
-    """Single (0) or double (1) pulse output: kept."""
+    """Single (0) or double (1) pulse output (4.3).  Decision: the emulated amplifier
+    takes either (it is set up for the card's output), so nothing changes; the call says
+    so in :func:`last_error`."""
     card, axes = _each(axis)
     for n in axes:
         card.regs[n].settings["pulse_mode"] = integer("mode", mode, 0, 1)
+    _set_error("SetPulseMode: kept; the emulated amplifier takes either pulse output mode")
 
 
 @_api
@@ -212,10 +238,14 @@ for _f, _n in ((SetSV, "SetSV"), (SetV, "SetV"), (SetA, "SetA"), (SetD, "SetD"),
 
 @_api
 def SetAO(axis: int, data: int) -> None:
-    """Deceleration offset, 0..65535: kept (the stop ends at SV exactly here)."""
+    """The deceleration offset, 0..65535 (4.4: pulses a fixed drive runs at SV after its
+    deceleration, so a stepper does not stop from speed).  Decision: the emulated
+    deceleration ends exactly at SV on the last pulse (no rounding to make up for), so
+    the offset changes nothing; kept, and said in :func:`last_error`."""
     card, axes = _each(axis)
     for n in axes:
         card.regs[n].settings["ao"] = integer("data", data, 0, 65_535)
+    _set_error("SetAO: kept; the emulated deceleration reaches SV on the last pulse")
 
 
 @_api
@@ -307,7 +337,7 @@ def SCurve_C(axis: int, m_SV: int, m_V: int, m_A: int, m_K: int, direction: int 
 
 @_api
 def DecStop(axis: int) -> None:
-    """Decelerating stop (the chip's command; seed 003 lists it among the basic commands)."""
+    """Decelerating stop (the chip's command; the manual lists it among the basic commands)."""
     card, axes = _each(axis)
     for n in axes:
         card.decel_stop(n)
@@ -463,21 +493,53 @@ def BitPattern(axis: int, V: int, plus: Sequence[Sequence[int]], minus: Sequence
 
 
 # --- 4.6 I/O signals --------------------------------------------------------------------------
-def _kept(name: str) -> Callable:
-    @_api
+def _axis_setting(name: str, doc: str, apply: Callable[[PulseCard, int, int], None]) -> Callable:
     def fn(n: int, axis: int) -> None:
         card, axes = _each(axis)
+        v = integer("n", n, 0, 1)
         for a in axes:
-            card.regs[a].settings[name] = integer("n", n, 0, 1)
+            apply(card, a, v)
 
     fn.__name__ = fn.__qualname__ = name
-    fn.__doc__ = f"{name}(n, axis): a level / mode setting, kept."
-    return fn
+    fn.__doc__ = doc
+    return _api(fn)
 
 
-HLMTP, HLMTM = _kept("HLMTP"), _kept("HLMTM")
-EncoderMode, EncoderCWCCW = _kept("EncoderMode"), _kept("EncoderCWCCW")
-ALMSig, InPosSig = _kept("ALMSig"), _kept("InPosSig")
+def _set_logic(k: int) -> Callable[[PulseCard, int, int], None]:
+    def apply(card: PulseCard, a: int, v: int) -> None:
+        card.regs[a].logic[k] = v
+
+    return apply
+
+
+HLMTP = _axis_setting(
+    "HLMTP",
+    "4.6: the hardware + limit's active level, 0 Low, 1 Hi (the level the card reads as "
+    'active: gtecat.compat._card, "Electrical levels").',
+    _set_logic(LMTP),
+)
+HLMTM = _axis_setting(
+    "HLMTM", "4.6: the hardware - limit's active level (as HLMTP).", _set_logic(LMTM)
+)
+ALMSig = _axis_setting(
+    "ALMSig", "4.6: the alarm input's active level, 0 Low, 1 Hi.", _set_logic(ALARM)
+)
+InPosSig = _axis_setting(
+    "InPosSig", "4.6: the in-position input's active level, 0 Low, 1 Hi.", _set_logic(INPOS)
+)
+EncoderMode = _axis_setting(
+    "EncoderMode",
+    "4.6: the real counter's input: 2-phase A/B (0) or single pulses up/down (1). The "
+    "emulated amplifier gives A/B: set to 1, the counter holds its reading "
+    "(gtecat.compat._card ``counted``).",
+    lambda card, a, v: card.count_mode(a, v, None, None),
+)
+EncoderCWCCW = _axis_setting(
+    "EncoderCWCCW",
+    "4.6 (named, not described): the real counter's direction, 0 as the encoder turns, "
+    "1 reversed (decision: the chip's counting-direction setting).",
+    lambda card, a, v: card.count_mode(a, None, v, None),
+)
 
 
 @_api
@@ -525,18 +587,21 @@ def SLMTSig(n: int) -> None:
 
 @_api
 def EnableALM(n: int) -> None:
-    """The amplifier alarm input of all axes on (1): it stops a drive at once."""
+    """The amplifier alarm input of all axes on (1): active, it stops a drive at once
+    and a drive started then ends at once."""
     card = _card()
     for a in AXES:
-        card.res(a).safety.alarm_on = bool(integer("n", n, 0, 1))
+        card.regs[a].alarm_on = bool(integer("n", n, 0, 1))
 
 
 @_api
 def EnableInPos(n: int) -> None:
-    """In-position input on/off: kept."""
+    """The in-position input of all axes on (1): a drive whose pulses are out is over
+    only when the card sees INPOS active (the amplifier within 1 pulse of the plan,
+    InPosSig's level); a homing step waits for it before the next."""
     card = _card()
     for a in AXES:
-        card.regs[a].settings["inpos"] = integer("n", n, 0, 1)
+        card.regs[a].inpos_on = bool(integer("n", n, 0, 1))
 
 
 # --- 4.7 homing -------------------------------------------------------------------------------
@@ -550,13 +615,22 @@ def _search(card: PulseCard, axes: list[int], direction: int, prm: tuple[int, in
         if cond(n):
             continue
         card.drive(n, None, direction)
-    t = 0.0
+    t = waited = 0.0
     while any(card.driving(n) for n in axes):
         card.wait_cycle()
         t += card.cycle_ms
         for n in axes:
-            if card.driving(n) and cond(n) and not card.regs[n].stopped_by_user:
+            if card.pulsing(n) and cond(n) and not card.regs[n].stopped_by_user:
                 (card.sudden_stop if immediate else card.decel_stop)(n)
+        if not any(card.pulsing(n) for n in axes):
+            waited += card.cycle_ms
+            if waited > INPOS_WAIT_MS:
+                for n in axes:
+                    card.regs[n].await_inpos = False
+                raise CompatError(
+                    f"homing: the axes stand but INPOS never came within {INPOS_WAIT_MS:g} ms "
+                    "(EnableInPos on, InPosSig's level never seen)"
+                )
         if t > HOME_TIMEOUT_MS:
             for n in axes:
                 card.sudden_stop(n)
@@ -566,20 +640,46 @@ def _search(card: PulseCard, axes: list[int], direction: int, prm: tuple[int, in
             raise CompatError(f"homing: axis {n} ran into a limit before its origin signal")
 
 
-def _home(kind: int, WR1Reg: Any, SV: Any, V: Any, A: Any) -> None:
+def _in(k: int) -> int:
+    """The input index (gtecat.compat._card SIGNALS) of the chip's IN k: IN0-IN2 are the
+    ADT850's STOP0-STOP2 (home switch, encoder Z, probe 1); IN3 is an input nothing in the
+    machine drives (it reads high)."""
+    return STOP0 + k if k < 3 else GPIN
+
+
+def _home(
+    kind: int, WR1Reg: Any, SV: Any, V: Any, A: Any, axis: Any = None, direction: Any = -1
+) -> None:
     card = _card()
-    w = integer("WR1Reg", WR1Reg, 0, 0x1FFF)
+    w = integer("WR1Reg", WR1Reg, 0, 0xFFFF)
     prm = (integer("SV", SV, 1, 8000), integer("V", V, 1, 8000), integer("A", A, 1, 8000))
+    if integer("direction", direction, -1, 1) == 0:
+        raise CompatError("direction=0: -1 (negative, the default) or 1 (positive)")
+    g = int(direction)
     slow = (prm[0], prm[0], prm[2])
-    axes = [n for n in AXES if w >> (7 + n) & 1] or [1]
     ins = [k for k in range(4) if w >> (2 * k + 1) & 1]
     if not ins:
-        raise CompatError("WR1Reg enables no input (bit 1 IN0, bit 3 IN1, bit 5 IN2)")
+        raise CompatError("WR1Reg enables no input (bit 1 IN0, bit 3 IN1, bit 5 IN2, bit 7 IN3)")
     org = ins[0]
-    g = 1 if w >> 12 & 1 else -1
-    on = lambda n: org < 3 and card.stop_input(n, org)  # noqa: E731
+    chosen = _axes(axis) if axis is not None else list(AXES)
+    for n in chosen:  # the chip's WR1 of every axis: IN k enabled with its level bit
+        for k in ins:
+            card.regs[n].logic[_in(k)] = w >> (2 * k) & 1
+    can = [n for n in chosen if _can_find(card, n, org, g)]
+    lost = [n for n in chosen if n not in can]
+    if lost and (axis is not None or not can):
+        raise CompatError(
+            f"homing: axis {', '.join(map(str, lost))} has no IN{org} signal "
+            f"{'ahead' if g < 0 else 'ahead in the positive direction'} in the machine "
+            "description: the search would never end"
+        )
+    if lost:
+        _set_error(f"HomeType{kind}: axis {', '.join(map(str, lost))} left standing: no IN{org} "
+                   "signal ahead in the machine description")  # fmt: skip
+    axes = can
+    on = lambda n: card.active(n, _in(org))  # noqa: E731
     off = lambda n: not on(n)  # noqa: E731
-    ez = lambda n: card.stop_input(n, 1)  # noqa: E731
+    ez = lambda n: card.active(n, _in(1))  # noqa: E731
     _search(card, axes, g, prm, on, immediate=False)
     if kind == 2:
         _search(card, axes, -g, slow, off, immediate=True)
@@ -592,13 +692,40 @@ def _home(kind: int, WR1Reg: Any, SV: Any, V: Any, A: Any) -> None:
         _search(card, axes, g, slow, on, immediate=True)
 
 
+def _can_find(card: PulseCard, n: int, org: int, g: int) -> bool:
+    """Whether axis ``n``'s search in direction ``g`` can meet IN ``org`` (it is active
+    now, or the machine has it ahead; a limit ahead does not count: the search would end
+    on the limit, an error)."""
+    if card.active(n, _in(org)):
+        return True
+    return org < 3 and card.signal_ahead(n, org, g, limits=False)
+
+
 def _home_fn(kind: int, doc: str) -> Callable:
-    def fn(WR1Reg: int, SV: int, V: int, A: int) -> None:
-        _home(kind, WR1Reg, SV, V, A)
+    def fn(WR1Reg: int, SV: int, V: int, A: int, *, axis: int | None = None,
+           direction: int = -1) -> None:  # fmt: skip
+        _home(kind, WR1Reg, SV, V, A, axis, direction)
 
     fn.__name__ = fn.__qualname__ = f"HomeType{kind}"
-    fn.__doc__ = doc
+    fn.__doc__ = doc + _HOME_DOC
     return _api(fn)
+
+
+_HOME_DOC = """
+
+    4.7: ``WR1Reg`` is the chip's WR1 register, written to every axis homed: bit 2k+1
+    enables IN k as a stop input and bit 2k is its active level (0 Low, 1 Hi; IN0 the
+    home switch, IN1 the encoder Z, IN2 probe 1, IN3 an input nothing drives); the
+    lowest enabled IN is the origin signal, types 3 and 4 stop on IN1 at SV.  Bits 8-15
+    are the chip's interrupt enables: taken, no interrupts are emulated.
+
+    Decisions (the thesis names no axis and no direction): every axis is homed, in the
+    negative direction.  An axis whose machine description has no origin signal ahead
+    is left standing (named in ``last_error()``; the chip would search until stopped);
+    none able to find it: CompatError.  Ours, after the thesis' arguments: ``axis`` (a
+    bit mask; then every axis of it must find its signal) and ``direction`` (1
+    positive).  The call returns when the axes stand (with EnableInPos: in position); a
+    limit met first raises CompatError."""
 
 
 HomeType1 = _home_fn(1, "Search the origin signal, decelerate and stop (figure 3-28).")
@@ -635,9 +762,12 @@ def EPS(axis: int, data: int) -> None:
 
 def _one(axis: Any) -> tuple[PulseCard, int]:
     card = _card()
-    m = integer("axis", axis, 1, 8)
+    m = integer("axis", axis, 0, 15)
     if m not in (1, 2, 4, 8):
-        raise CompatError(f"axis={m}: one axis (1, 2, 4 or 8) is read at a time")
+        raise CompatError(
+            f"axis={m}: one axis is read at a time, by its bit: X 1, Y 2, Z 4, U 8 "
+            "(not an axis number)"
+        )
     return card, {1: 1, 2: 2, 4: 3, 8: 4}[m]
 
 

@@ -211,6 +211,9 @@ class Axis:
         self.io = io
         self.pos_scale = 0  # GT_SetPosScale exponent
         self.prf_pos = 0.0  # planned position, pulses
+        #: added to the planned position on its way to the drive (lead-screw compensation,
+        #: :mod:`gtecat.controller.lead_screw`), pulses
+        self.compensation = 0.0
         self.drive_offset = 0  # drive counts at planned position 0
         self.cw = 0  # controlword the controller sends
         self._cw_sent = -1
@@ -295,7 +298,7 @@ class Axis:
             if self.servo_on and self.mode_cmd == 8:
                 if self.csp_follow:
                     try:
-                        self._tp_acc.set(self.pulses_to_counts(self.prf_pos))
+                        self._tp_acc.set(self.pulses_to_counts(self.prf_pos + self.compensation))
                         self.plan_error = ""
                     except CommandError as e:  # 607Ah holds; the axis alarms (resources)
                         self.plan_error = str(e)

@@ -33,6 +33,11 @@ _MODULES = (
     "plcopen_calls",
     "ecat_io_calls",
     "gantry_calls",
+    "compare_calls",
+    "crd_ex_calls",
+    "pvt_calls",
+    "lead_screw_calls",
+    "net_init_calls",
 )
 
 

@@ -44,8 +44,9 @@ def to_llp64(c_text: str) -> str:
 
 
 def llp64_sources(files: dict[str, str]) -> dict[str, str]:
-    """The files of the LLP64 build from libgts's: the prototypes of ``gts.h`` and the
-    stubs (signatures and the element sizes of their pointers) take ``int`` for ``long``;
+    """The files of the LLP64 build from libgts's: the prototypes of ``gts.h``, the stubs
+    (signatures and the element sizes of their pointers) and the declared-only functions
+    take ``int`` for ``long``;
     the runtime is unchanged (it keeps its own ``long`` for its own numbers)."""
     out = dict(files)
     out["gts.h"] = "\n".join(
@@ -53,6 +54,7 @@ def llp64_sources(files: dict[str, str]) -> dict[str, str]:
         for line in files["gts.h"].splitlines()
     )
     out["gts_stubs.c"] = to_llp64(files["gts_stubs.c"])
+    out["gts_declared.c"] = to_llp64(files["gts_declared.c"])
     return out
 
 
@@ -94,6 +96,7 @@ def _compile(build: _build.Build, target: Path) -> None:
             f"-I{tmp}",
             str(tmp / "gts_runtime.c"),
             str(tmp / "gts_stubs.c"),
+            str(tmp / "gts_declared.c"),  # the declared-only functions
             "-o",
             str(out),
         ]

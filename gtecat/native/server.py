@@ -651,7 +651,7 @@ class Server:
             name = plan.proto.twin_name if gtn else plan.name
             code, why = declared.note(name)
             return code, f"{name} returned {code}: {why}"
-        if not c.opened or plan.name in ("GT_Open", "GT_Close"):
+        if not c.opened or plan.name in ("GT_Open", "GT_Close", "GTN_OpenCard"):
             return self._open_close(c, dec, gtn, core, args)
         if plan.unsupported:  # the arguments are checked first, as in Python
             why = plan.null_refusal(args)
@@ -675,6 +675,8 @@ class Server:
         self, c: _Client, dec: _Decoder, gtn: int, core: int, args: list[Any]
     ) -> tuple[int, str]:
         name = dec.plan.name
+        if name == "GTN_OpenCard":  # the GSN-E form of GT_Open; its arguments are reserved
+            return self._open(c, 0, 1, [])
         if name in ("GT_Open", "GT_Close"):
             if gtn and core != 1:  # the Python twin refuses it (7) before doing anything
                 return _invoke(dec.fn_gtn, (core, *args))

@@ -64,7 +64,11 @@ def _elem(plan_arg) -> str:
 
 def _descriptor(plan: FunctionPlan) -> list[str]:
     name = plan.name
-    flags = {"GT_Open": "GTE_F_OPEN", "GT_Close": "GTE_F_CLOSE"}.get(name, "0")
+    flags = {
+        "GT_Open": "GTE_F_OPEN",
+        "GTN_OpenCard": "GTE_F_OPEN",  # the GSN-E form of GT_Open
+        "GT_Close": "GTE_F_CLOSE",
+    }.get(name, "0")
     out = []
     if plan.args:
         out.append(f"static const gte_param P_{name}[] = {{")

@@ -123,7 +123,19 @@ class BufMove:
     run: Callable[[], Callable[[], bool]] = field(repr=False, default=lambda: lambda: True)
 
 
-Entry = Motion | Delay | BufIO | BufMove
+@dataclass(slots=True)
+class BufGear:
+    """An axis outside the system that moves with the next motion segment: ``start()``
+    (called when the path reaches this entry) returns ``follow(fraction)``, which the
+    system calls every cycle of that segment with the share of its length done (1.0 at
+    its end) and with None when the path stops before the segment's end."""
+
+    axis: int
+    delta: float
+    start: Callable[[], Callable[[float | None], None]] = field(repr=False)
+
+
+Entry = Motion | Delay | BufIO | BufMove | BufGear
 
 
 @dataclass(slots=True)
@@ -214,6 +226,16 @@ class CoordSystem:
         self.speed = 0.0
         self.stop_acc = 0.0
         self.waiting: Callable[[], bool] | None = None
+        self._gear_end(None)
+        #: BufGear riders waiting for the next motion segment, and those riding this one
+        self.gears_next: list[Callable[[float | None], None]] = []
+        self.gears: list[Callable[[float | None], None]] = []
+        self.gear_entry: Motion | None = None
+
+    def _gear_end(self, fraction: float | None) -> None:
+        for follow in getattr(self, "gears", ()):
+            follow(fraction)
+        self.gears = []
 
     # --- configuration ----------------------------------------------------------------
     def configure(self, prm: CrdParams, profiles: dict[int, Any]) -> None:
@@ -403,6 +425,8 @@ class CoordSystem:
                     self.segments_done[self.fifo] += 1
                     continue
                 self.s = 0.0
+                self._gear_end(None)
+                self.gears, self.gears_next, self.gear_entry = self.gears_next, [], e
                 if e.speed_plan is not None:
                     self.plan = e.speed_plan(e.geom, self.speed, self.plan)
                     return
@@ -424,6 +448,10 @@ class CoordSystem:
                 self.io_log.append((e.do_type, e.mask, e.value))
                 if e.apply is not None:
                     e.apply(e.mask, e.value)
+                self.segments_done[self.fifo] += 1
+                continue
+            if isinstance(e, BufGear):
+                self.gears_next.append(e.start())
                 self.segments_done[self.fifo] += 1
                 continue
             if isinstance(e, BufMove):
@@ -450,7 +478,7 @@ class CoordSystem:
         window: list[Motion] = []
         for nxt in q:
             if not isinstance(nxt, Motion):
-                if isinstance(nxt, BufIO):
+                if isinstance(nxt, BufIO | BufGear):
                     continue
                 break  # a delay or a modal move: the path stops before it
             if nxt.geom.length <= 0.0:
@@ -520,6 +548,12 @@ class CoordSystem:
             self._sample_point_of(e, self.s)
 
     def _sample_point_of(self, e: Motion, s: float) -> None:
+        if self.gears and e is self.gear_entry:
+            frac = min(max(s / e.geom.length, 0.0), 1.0)
+            for follow in self.gears:
+                follow(frac)
+            if frac >= 1.0:
+                self.gears = []
         p = e.geom.point(s)
         for slot, o, x in zip(self.slots, self.origin, p, strict=True):
             slot._pos = o + x

@@ -12,7 +12,7 @@ from gtecat.compat import adt850, mcx314
 def _closed():
     gt.GT_Close()
     yield
-    adt850._CARD[0] = None
+    adt850._close_all()
     mcx314._CARD[0] = None
     gt.GT_Close()
 

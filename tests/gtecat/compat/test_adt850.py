@@ -585,7 +585,198 @@ def test_an_unfinished_three_axis_interpolation_needs_inp_clear():
     while inp_running():
         gt.GTE_Wait(1)
     assert adt.pmove(0, 3, 100) == 1 and "until inp_clear" in adt.last_error()
+    assert status(3) == status(4) == 0x100  # 5.12: Z and W stay in the drive state
     assert adt.inp_move3(0, 10, 10, 10) == 1
     assert adt.pmove(0, 1, 100) == 0  # X is not concerned
     assert adt.inp_clear(0) == 0
+    assert status(3) == status(4) == 0
     assert adt.pmove(0, 3, 100) == 0
+
+
+# --- what a user of the card still hit: cards, INPOS, levels, settings -----------------------
+def stopdata(axis: int, cardno: int = 0) -> int:
+    v = c_int()
+    assert adt.get_stopdata(cardno, axis, byref(v)) == 0
+    return v.value
+
+
+def test_up_to_16_cards_each_its_own_and_one_time():
+    """1.1 and chapter 1: adt850_initial returns the number of cards (a PC holds up to 16),
+    numbered 0, 1, 2 ...; each is a card of its own: its axes, registers and switches. A
+    card number it did not find is an error (8.4: 1)."""
+    from gtecat.drives.machine import AxisMachine, MachineDescription
+
+    open_card()
+    limit_on_x = MachineDescription({1: AxisMachine(positive_limit=0)})
+    assert adt.adt850_initial(cards=3, machines={2: limit_on_x}) == 3
+    for cardno in (0, 1, 2):
+        assert adt.set_range(cardno, 1, 800_000) == 0
+        assert adt.set_startv(cardno, 1, 100) == 0 and adt.set_speed(cardno, 1, 100) == 0
+    assert adt.pmove(1, 1, 500) == 0
+    assert adt.pmove(2, 1, 500) == 0  # card 2's X stands on its limit: taken, ended (D3)
+    gt.GTE_Wait(20)  # time passes for every card at once
+    p = [c_long() for _ in range(3)]
+    for cardno in (0, 1, 2):
+        assert adt.get_command_pos(cardno, 1, byref(p[cardno])) == 0
+    assert [x.value for x in p] == [0, 20, 0]  # 1 pulse/ms on card 1 only
+    assert stopdata(1, 2) == 0x08 and stopdata(1, 1) == 0
+    assert adt.read_bit(2, 0) == 0 and adt.read_bit(1, 0) == 1  # only card 2's LMT+ is low
+    assert adt.get_command_pos(3, 1, byref(p[0])) == 1
+    assert "found 3 card(s), 0..2" in adt.last_error()
+    assert adt.adt850_end() == 0
+
+
+def test_card_count_from_the_environment(monkeypatch):
+    monkeypatch.setenv("GTECAT_ADT850_CARDS", "2")
+    open_card()
+    assert adt.adt850_initial() == 2
+    assert adt.adt850_initial(cards=17) == -1 and "out of" in adt.last_error()
+    monkeypatch.setenv("GTECAT_ADT850_CARDS", "two")
+    assert adt.adt850_initial() == -1 and "the number of cards, 1..16" in adt.last_error()
+
+
+def test_inpos_valid_the_drive_ends_when_the_amplifier_is_in_position():
+    """1.12 and chapter 5 (伺服马达对应的信号): with INPOS valid, a drive whose pulses are out
+    ends only when INPOS is active; get_status reads D8 (0x100) while it waits. Without
+    it the drive ends with the last pulse, the amplifier still a few pulses behind."""
+    init()
+    assert adt.set_range(0, 1, 200_000) == 0  # M = 40: 200 pulse/ms, a lagging amplifier
+    assert adt.set_startv(0, 1, 5000) == 0 and adt.set_speed(0, 1, 5000) == 0
+    lags, waits = [], []
+    for valid in (0, 1):
+        gt.GTE_Wait(10)  # the motor catches up with the last drive
+        assert adt.set_inpos_mode(0, 1, valid, 0) == 0
+        assert adt.set_command_pos(0, 1, 0) == 0 and adt.set_actual_pos(0, 1, 0) == 0
+        assert adt.pmove(0, 1, 30_000) == 0
+        seen = []
+        while (s := status(1)) != 0:
+            seen.append(s)
+            gt.GTE_Wait(1)
+        assert pos(1) == 30_000
+        lags.append(30_000 - actual(1))
+        waits.append(seen.count(0x100))
+    assert lags[0] >= 2 and waits[0] == 0  # ended with the pulses, the motor behind
+    assert lags[1] == 0 and waits[1] >= 1  # ended in position
+
+
+def test_inpos_valid_but_never_active_the_drive_never_ends():
+    """9.5: INPOS valid while the card cannot see it active (here: set high-active, the
+    amplifier's in-position output being low): the drive status never ends; an
+    interpolation (2.3) does not end either."""
+    init()
+    setup_speed(1, 10_000, 10_000, 0)
+    assert adt.set_inpos_mode(0, 1, 1, 1) == 0
+    assert adt.read_bit(0, 5) == 0  # X INPOS: low, the amplifier in position
+    assert adt.pmove(0, 1, 100) == 0
+    gt.GTE_Wait(200)
+    assert pos(1) == 100 and status(1) == 0x100
+    assert adt.set_inpos_mode(0, 1, 0, 0) == 0
+    assert status(1) == 0
+    assert adt.set_inpos_mode(0, 2, 1, 1) == 0
+    assert adt.inp_move2(0, 1, 100, 50) == 0
+    gt.GTE_Wait(100)
+    assert (pos(1), pos(2)) == (200, 50) and inp_running() == 1  # Y never in position
+
+
+def test_limit_level_against_the_wiring():
+    """1.8 logic, 6.1: a normally-open limit switch reads low while hit. Set high-active,
+    the card sees the limit active everywhere but on the switch: a + drive is taken and
+    ends at once (D3), as on the card; the power-up low-active setting drives."""
+    init(a1=dict(positive_limit=5000, switch_wiring="normally_open"))
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.read_bit(0, 0) == 1  # not hit: high
+    assert adt.set_limit_mode(0, 1, 0, 1) == 0
+    assert adt.pmove(0, 1, 100) == 0
+    assert status(1) == 0 and stopdata(1) == 0x08 and pos(1) == 0
+    assert adt.set_limit_mode(0, 1, 0, 0) == 0
+    assert adt.pmove(0, 1, 100) == 0
+    wait_axes(1)
+    assert pos(1) == 100 and stopdata(1) == 0
+
+
+def test_normally_closed_limit_needs_high_active_logic():
+    """A normally-closed switch opens (reads high) when hit; set high-active (1.8) the
+    limit stops the drive there, at once (immediate mode, D3)."""
+    init(a1=dict(positive_limit=300, switch_wiring="normally_closed"))
+    setup_speed(1, 5000, 5000, 0)
+    assert adt.read_bit(0, 0) == 0  # closed: low
+    assert adt.set_limit_mode(0, 1, 0, 1) == 0
+    assert adt.continue_move(0, 1, 0) == 0
+    wait_axes(1)
+    assert stopdata(1) == 0x08 and 300 <= pos(1) <= 305
+    assert adt.read_bit(0, 0) == 1  # hit: open, high
+
+
+def test_alarm_valid_with_a_level_the_amplifier_never_gives_stops_every_drive():
+    """1.13: ALARM valid and high-active, while the healthy amplifier's alarm output is
+    high (its alarm pulls it low): the card sees an alarm; a drive ends at once with D5.
+    Valid and low-active, the drive runs; the amplifier in fault stops it at once (D5)."""
+    init()
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.read_bit(0, 6) == 1
+    assert adt.set_alarm_mode(0, 1, 1, 1) == 0
+    assert adt.pmove(0, 1, 100) == 0
+    assert status(1) == 0 and stopdata(1) == 0x20
+    assert adt.set_alarm_mode(0, 1, 1, 0) == 0
+    assert adt.continue_move(0, 1, 0) == 0
+    gt.GTE_Wait(10)
+    gt.GTE_Slave(0).channel(0).inject_fault("alarm")
+    gt.GTE_Wait(3)
+    assert status(1) == 0 and stopdata(1) == 0x20
+    assert adt.read_bit(0, 6) == 0  # the alarm output pulls the input low
+
+
+def test_stop1_level_against_the_encoder_z():
+    """1.4: STOP1 valid, low level (the encoder's Z pulls the input low as it passes):
+    the drive stops at the index (D1). Set to stop at the high level, the card sees STOP1
+    active off the index: the drive ends at once."""
+    init(a1=dict(index_offset=700, counts_per_rev=10_000))
+    setup_speed(1, 2000, 2000, 0)
+    assert adt.set_stop1_mode(0, 1, 1, 0) == 0
+    assert adt.continue_move(0, 1, 0) == 0
+    wait_axes(1)
+    assert stopdata(1) == 0x02 and 700 <= actual(1) <= 720
+    assert adt.set_stop1_mode(0, 1, 1, 1) == 0
+    at = pos(1)
+    assert adt.continue_move(0, 1, 0) == 0
+    wait_axes(1, limit=5)
+    assert stopdata(1) == 0x02 and pos(1) - at <= 2 * 20
+
+
+def test_settings_with_nothing_to_act_on_say_so():
+    """1.7, 1.18, 1.19: taken (0) and said in last_error: the emulated amplifier takes any
+    pulse mode, the emulated inputs have no noise to filter."""
+    init()
+    assert adt.set_pulse_mode(0, 1, 0, 1, 1) == 0 and "kept" in adt.last_error()
+    assert adt.set_input_filter(0, 1, 1, 1) == 0 and "filter" in adt.last_error()
+    assert adt.set_filter_time(0, 1, 8) == 0
+    assert adt.set_filter_time(0, 1, 9) == 1
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.pmove(0, 1, -50) == 0
+    wait_axes(1)
+    gt.GTE_Wait(5)
+    assert pos(1) == -50 and actual(1) == -50  # the motor follows in every mode
+
+
+def test_up_down_counter_input_holds_with_an_ab_encoder():
+    """1.6 value 1: up/down pulse input, fed the emulated amplifier's A/B signals, counts
+    up and down in turn: the real counter holds its reading."""
+    init()
+    setup_speed(1, 1000, 1000, 0)
+    assert adt.set_actual_pos(0, 1, 77) == 0
+    assert adt.set_actualcount_mode(0, 1, 1, 0, 0) == 0
+    assert adt.pmove(0, 1, 300) == 0
+    wait_axes(1)
+    assert pos(1) == 300 and actual(1) == 77
+
+
+def test_a_limit_of_any_axis_stops_an_interpolation():
+    """Chapter 5 (插补时的越限错误): any axis's limit stops the interpolation, here Y's
+    LMT+ at 200 on an X-Y line; get_stopdata of Y says D3."""
+    init(a2=dict(positive_limit=200))
+    setup_speed(1, 10_000, 10_000, 0)
+    assert adt.inp_move2(0, 1, 1000, 500) == 0
+    while inp_running():
+        gt.GTE_Wait(1)
+    assert stopdata(2) == 0x08
+    assert 200 <= pos(2) <= 206 and 400 <= pos(1) <= 412

@@ -192,19 +192,19 @@ def test_home_type_1_and_2_find_the_switch():
     """4.7: type 1 decelerates at ORG; type 2 backs off and approaches slowly."""
     up(a1=dict(position=20_000, home_switch=((5000, 8000),)))
     m.LPS(X, 20_000)
-    m.HomeType1(0x2 | 0x100, 100, 1000, 100)  # IN0 (home switch), axis X, negative
+    m.HomeType1(0x2, 100, 1000, 100)  # IN0 (home switch), low-active: the chip's WR1
     assert 3000 < lp(X) < 8000
-    m.HomeType2(0x2 | 0x100, 100, 1000, 100)
+    m.HomeType2(0x2, 100, 1000, 100)
     assert lp(X) in range(7990, 8001)  # the switch's upper edge, approached slowly
     with pytest.raises(CompatError):
-        m.HomeType1(0x100, 100, 1000, 100)  # no input enabled
+        m.HomeType1(0x100, 100, 1000, 100)  # no input enabled (bit 8: an interrupt enable)
 
 
 def test_home_type_3_stops_on_the_index():
     up(a1=dict(position=20_000, home_switch=((5000, 8000),), index_offset=100,
                counts_per_rev=1000))  # fmt: skip
     m.LPS(X, 20_000)
-    m.HomeType3(0x2 | 0x100, 100, 1000, 100)
+    m.HomeType3(0x2, 100, 1000, 100)
     ep = m.ReadEPS(X)
     assert (ep - 100) % 1000 in range(0, 12) or (ep - 100) % 1000 > 988
 
@@ -315,3 +315,114 @@ def test_read_ca_holds_its_value_at_constant_speed():
     m.TCurve_C(X, 100, 1000, 50)
     gt.GTE_Wait(1000)  # long at constant speed
     assert m.ReadCV(X) == 1000 and m.ReadCA(X) == 50
+
+
+# --- levels, INPOS, encoder settings, homing without invented bits, axis numbers -------------
+def ep(axis: int) -> int:
+    v = m.ReadEPS(axis)
+    return v - 2**32 if v >= 2**31 else v
+
+
+def test_home_type_takes_the_chips_wr1_and_homes_every_axis_that_can():
+    """4.7: HomeTypeN(WR1Reg, SV, V, A) names no axis: every axis whose machine has the
+    origin signal ahead is homed, negatively; the others stand (named in last_error).
+    WR1's upper byte (the chip's interrupt enables) changes nothing. Ours: axis=, then an
+    axis without its signal is an error before anything moves."""
+    up(a1=dict(position=2_000, home_switch=((500, 800),)), a3=dict(position=-100,
+       home_switch=((-900, -700),)))  # fmt: skip
+    m.LPS(X | Z, 0)
+    m.HomeType1(0xFF02, 100, 100, 100)
+    assert 1_200 <= -lp(X) <= 1_500 and 0 < -lp(Z) <= 900
+    assert lp(Y) == 0 and lp(U) == 0
+    assert "axis 2, 4 left standing" in m.last_error()
+    with pytest.raises(CompatError, match="axis 2 has no IN0"):
+        m.HomeType1(0x2, 100, 100, 100, axis=Y)
+    m.HomeType1(0x2, 100, 100, 100, axis=X, direction=1)  # back up onto the switch
+    assert m.card().active(1, 2)
+
+
+def test_enable_in_pos_makes_homing_wait_for_the_amplifier():
+    """4.6 EnableInPos / InPosSig: with the in-position input on, a homing step ends when
+    the amplifier stands in position (EP = LP); with a level the amplifier never gives,
+    the step never ends (here: an error after INPOS_WAIT_MS)."""
+    lags = []
+    for on in (0, 1):
+        up(a1=dict(position=20_000, home_switch=((5000, 8000),)))
+        m.SetRange(200_000)  # M = 40: 200 pulse/ms, the amplifier lags
+        m.LPS(X, 20_000)
+        m.EPS(X, 20_000)
+        m.EnableInPos(on)
+        m.HomeType1(0x2, 5000, 5000, 100, axis=X)  # constant speed: stops at once
+        lags.append(ep(X) - lp(X))
+        m.Close()
+        gt.GT_Close()
+    assert lags[0] >= 2 and lags[1] == 0
+
+
+def test_in_pos_sig_against_the_amplifier_never_ends(monkeypatch):
+    monkeypatch.setattr(m, "INPOS_WAIT_MS", 30.0)
+    up(a1=dict(position=1_000, home_switch=((0, 500),)))
+    m.EnableInPos(1)
+    m.InPosSig(1, X)  # the amplifier's in-position output is low
+    with pytest.raises(CompatError, match="INPOS never came"):
+        m.HomeType1(0x2, 1000, 1000, 100, axis=X)
+
+
+def test_hlmtp_level_against_a_normally_open_switch():
+    """4.6 HLMTP(n, axis): n the active level. A normally-open + limit reads low when hit;
+    set Hi-active, the card sees it active off the switch: a + drive does not move."""
+    up(a1=dict(positive_limit=5000, switch_wiring="normally_open"))
+    m.HLMTP(1, X)
+    m.TCurve_C(X, 100, 100, 1)
+    gt.GTE_Wait(20)
+    assert lp(X) == 0 and m.ReadCV(X) == 0
+    m.HLMTP(0, X)
+    m.TCurve_F(X, 1000, 1000, 1, 200)
+    gt.GTE_Wait(30)
+    assert lp(X) == 200
+
+
+def test_alm_sig_and_enable_alm():
+    """4.6: EnableALM(1) and ALMSig(1, X) (Hi active) while the healthy amplifier's alarm
+    output is high: the card sees an alarm and X does not drive; Low active, it does."""
+    up()
+    m.EnableALM(1)
+    m.ALMSig(1, X)
+    m.TCurve_F(X, 100, 100, 1, 100)
+    gt.GTE_Wait(20)
+    assert lp(X) == 0 and m.card().regs[1].stopdata == 0x20
+    m.ALMSig(0, X)
+    m.TCurve_F(X, 1000, 1000, 1, 100)
+    gt.GTE_Wait(20)
+    assert lp(X) == 100
+
+
+def test_encoder_mode_and_direction():
+    """4.6 EncoderCWCCW(1, axis): the real counter counts the other way; EncoderMode(1,
+    axis): single up/down pulse input, fed A/B signals: it holds its reading."""
+    up()
+    m.EncoderCWCCW(1, X)
+    m.EncoderMode(1, Y)
+    m.TCurve_F(X | Y, 1000, 1000, 1, 500)
+    gt.GTE_Wait(60)
+    assert (lp(X), ep(X)) == (500, -500)
+    assert (lp(Y), ep(Y)) == (500, 0)
+
+
+def test_readers_take_one_axis_bit_not_a_number():
+    """4.8: the readers read one axis (為各軸分別讀取); the axis is its bit, as everywhere in
+    the library: 3 (Z as a number, or X and Y) is refused, naming the bits."""
+    up()
+    assert m.ReadLPS(4) == 0
+    with pytest.raises(CompatError, match="X 1, Y 2, Z 4, U 8"):
+        m.ReadLPS(3)
+    with pytest.raises(CompatError):
+        m.ReadCV(0)
+
+
+def test_settings_with_nothing_to_act_on_say_so():
+    up()
+    m.SetPulseMode(X, 1)
+    assert "kept" in m.last_error()
+    m.SetAO(X, 100)
+    assert "SetAO" in m.last_error()

@@ -54,10 +54,13 @@ OWN_CODES = {
     "Download": {2007, 2008},  # entry 10
     "GetFunId": {2007, 2008},  # entry 52
     "GetVarId": {2007, 2008},  # entry 75
+    "NetInit": {11702, 11902},  # the vendor's network codes (gtecat.gt.net_init_calls)
 }
 #: functions that may legitimately take the bus down (restored after each call)
 STATEFUL = {
     "Open",
+    "OpenCard",
+    "NetInit",
     "Close",
     "Reset",
     "InitEcatComm",
@@ -581,7 +584,10 @@ def fuzz_function(name: str, examples: int, warnings: set[str]) -> None:
     no_core = name.startswith("GTN_") and (
         "GT_" + name[4:] in NO_CORE_TWINS or "GT_" + name[4:] in SAME_PARAM_TWINS
     )
-    is_gtn = name.startswith("GTN_") and not no_core
+    # a GTN_x line of its own that names its core (GTN_PosCompareSpace(core, ...)): the
+    # table's parameters already hold it
+    own_core = bool(proto.params) and proto.params[0].name == "core"
+    is_gtn = name.startswith("GTN_") and not no_core and not own_core
     base = name.partition("_")[2]
     params = list(proto.params)
     names = [p.name for p in params]

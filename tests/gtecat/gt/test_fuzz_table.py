@@ -47,6 +47,8 @@ from tests.gtecat.gt.conftest import bring_up
 # --- the fuzzer, in child processes --------------------------------------------------------------
 STATE_CHANGING = {
     "Open",
+    "OpenCard",
+    "NetInit",
     "Close",
     "Reset",
     "InitEcatComm",
@@ -130,7 +132,7 @@ def test_the_batches_cover_every_function_gt_exposes():
     # implemented yet are the table tests' business, not the fuzzer's)
     for name in REGISTRY:
         base = "GT_" + name[4:] if name.startswith("GTN_") else name
-        assert base in FUNCTIONS, name
+        assert base in FUNCTIONS or name in FUNCTIONS, name  # or a GTN_x line of its own
         if name.startswith("GT_"):
             assert "GTN_" + name[3:] in REGISTRY, name
     covered = [n for b, names in BATCHES.items() if b != "declared" for n in names]

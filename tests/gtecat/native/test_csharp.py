@@ -27,7 +27,7 @@ import pytest
 
 from gtecat import gt
 
-from .conftest import ROOT, native_env, parse_lines
+from .conftest import ROOT, built, native_env, parse_lines
 
 CS_DIR = Path(__file__).resolve().parent / "cs"
 EXAMPLES = ROOT / "examples"
@@ -52,14 +52,9 @@ def _gtecat(*args: str, cwd: Path) -> None:
 @pytest.fixture(scope="module")
 def programs(tmp_path_factory) -> Path:
     """Both programs compiled into one folder with ``gts.cs`` and the dllmap beside them."""
-    from gtecat.native.build import NativeBuildError
+    from gtecat.native import llp64
 
-    try:
-        from gtecat.native import llp64
-
-        llp64.ensure_built()
-    except NativeBuildError as e:
-        pytest.skip(f"libgts cannot be built here: {e}")
+    built("libgts-llp64", llp64.ensure_built)
     d = tmp_path_factory.mktemp("cs")
     _gtecat("lib", "--csharp", "-o", "gts.cs", cwd=d)
     _gtecat("lib", "--mono-config", "-o", "CardStation.exe.config", cwd=d)
