@@ -147,6 +147,7 @@ def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Pat
     importlib.util.find_spec("xdist") is None, reason="pytest-xdist is not installed"
 )
 def test_under_xdist_each_worker_and_test_has_its_own_files(project: Path) -> None:
+    """(The tutorial's page 6 shows its tests run with ``-n 2``: this is that promise's test.)"""
     done = _pytest(project, "-n", "2", "--gtecat-trace")
     assert "5 passed" in done.stdout and "1 failed" in done.stdout, done.stdout + done.stderr
     assert user_files(project) == ["pytest.ini", "test_machine.py"]
