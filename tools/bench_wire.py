@@ -108,6 +108,7 @@ def server(eni: Path, iface: str, stats: Path, extra: list[str]) -> Iterator[sub
         if "ready" not in line:
             raise SystemExit(f"gtecat serve did not start: {line!r}")
         proc.stats_path = stats  # type: ignore[attr-defined]
+        proc.ready_line = line.strip()  # type: ignore[attr-defined]
         yield proc
     finally:
         if proc.poll() is None:
@@ -165,10 +166,23 @@ def bring_to_op(master, dc: bool) -> None:
             raise SystemExit("the chain did not reach OP")
 
 
+def cpu_times() -> tuple[int, int]:
+    """(busy, total) jiffies of the whole machine from /proc/stat; (0, 0) where unreadable."""
+    try:
+        with open("/proc/stat") as fh:
+            fields = [int(x) for x in fh.readline().split()[1:]]
+    except (OSError, ValueError):
+        return 0, 0
+    idle = fields[3] + (fields[4] if len(fields) > 4 else 0)  # idle + iowait
+    return sum(fields) - idle, sum(fields)
+
+
 def run_cycles(master, n: int, period_ns: int = 0) -> dict[str, object]:
     expected = master.expected_wkc
     rtt: list[int] = []
-    bad = late = 0
+    bad = late = late_2ms = 0
+    busy0, total0 = cpu_times()
+    load0 = os.getloadavg()
     clock = time.perf_counter_ns
     start = next_t = clock()
     for _ in range(n):
@@ -184,7 +198,9 @@ def run_cycles(master, n: int, period_ns: int = 0) -> dict[str, object]:
         bad += wkc != expected
         if period_ns and t1 - t0 > period_ns:
             late += 1
+            late_2ms += t1 - t0 > 2_000_000
     elapsed = (clock() - start) / 1e9
+    busy1, total1 = cpu_times()
     out: dict[str, object] = {
         "cycles": n,
         "elapsed_s": round(elapsed, 3),
@@ -192,9 +208,15 @@ def run_cycles(master, n: int, period_ns: int = 0) -> dict[str, object]:
         "wkc_errors": bad,
         "rtt_us": percentiles(rtt),
     }
+    if total1 > total0:  # the whole machine's CPUs busy (all processes), in percent
+        out["host_cpu_busy_percent"] = round(100 * (busy1 - busy0) / (total1 - total0), 1)
+    out["loadavg_1min"] = [round(load0[0], 2), round(os.getloadavg()[0], 2)]
     if period_ns:
         out["period_us"] = period_ns / 1000
+        #: round trips longer than the period, and longer than SOEM's 2 ms frame timeout
         out["late"] = late
+        out["late_over_2ms"] = late_2ms
+        out["late_per_100k"] = round(late * 100_000 / n, 1)
     return out
 
 
@@ -205,6 +227,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--paced-cycles", type=int, default=2000, help="cycles at --period-us")
     p.add_argument("--period-us", type=int, default=1000)
     p.add_argument("--dc", action="store_true", help="configure DC (adds the FRMW datagram)")
+    p.add_argument(
+        "--master-rt",
+        type=int,
+        metavar="N",
+        help="run the master (pysoem) under SCHED_FIFO N, as a real master runs",
+    )
     p.add_argument("--master-if")
     p.add_argument("--slave-if")
     p.add_argument("--serve-arg", action="append", default=[], help="extra gtecat serve option")
@@ -219,14 +247,22 @@ def main(argv: list[str] | None = None) -> int:
     if args.pin and len(cpus) >= 2:
         os.sched_setaffinity(0, {cpus[0]})
         args.serve_arg.append(f"--cpu={cpus[-1]}")
+    if args.master_rt:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(args.master_rt))
     if os.geteuid() != 0 and not (args.master_if and args.slave_if):
         raise SystemExit("needs root to create the veth pair (or pass --master-if/--slave-if)")
     import pysoem
 
-    result: dict[str, object] = {"eni": str(args.eni), "dc": args.dc, "serve_args": args.serve_arg}
+    result: dict[str, object] = {
+        "eni": str(args.eni),
+        "dc": args.dc,
+        "serve_args": args.serve_arg,
+        "master_rt": args.master_rt,
+    }
     with tempfile.TemporaryDirectory() as tmp, veth_pair(args.master_if, args.slave_if) as (m, s):
         stats = Path(tmp) / "stats.json"
         with server(args.eni, s, stats, args.serve_arg) as proc:
+            result["serve_ready"] = proc.ready_line  # type: ignore[attr-defined]
             master = pysoem.Master()
             master.open(m)
             try:

@@ -78,9 +78,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         default="auto",
         metavar="N|auto|off",
         help="SCHED_FIFO priority N (1-99); auto (default) takes priority "
-        f"{AUTO_RT_PRIORITY} and a CPU of its own where the system permits it (root or "
-        "CAP_SYS_NICE) and says so in the ready line, else runs normally with a warning; "
-        "off never asks",
+        f"{AUTO_RT_PRIORITY} where the system permits it (root or CAP_SYS_NICE) and says so "
+        "in the ready line, else runs normally with a warning; off never asks",
     )
     p.add_argument(
         "--cpu",
@@ -186,12 +185,16 @@ def take_scheduling(rt: int | str, wait_given: str, cpu: int | None) -> tuple[in
 
     ``auto``: a server that answers frames must not wait behind other work on a busy host
     (a master drops an answer later than its timeout, SOEM's is 2 ms). It asks for
-    SCHED_FIFO and, on a machine of two CPUs or more with no ``--cpu``, the last CPU; where
-    the system refuses, it runs normally and warns. Decision: an explicit ``--wait spin``
-    keeps normal priority under ``auto`` (a task that never sleeps under SCHED_FIFO is
-    stopped by the kernel for 50 ms of every second and takes the CPU from everything
-    else); the number form takes FIFO anyway, as asked."""
-    from gtecat.wire.serve import WireError, pin_to_cpu, realtime_priority
+    SCHED_FIFO; where the system refuses, it runs normally and warns. It does not pin itself
+    to a CPU (``--cpu`` does): a real-time task takes whichever CPU it wakes on from normal
+    work, and the kernel moves it to another when one real-time task already runs there, which
+    it cannot do for a pinned one - two servers pinned to one CPU at the same priority never
+    preempt each other, and one answering back-to-back mailbox frames held the other's frames
+    for many milliseconds (its master then configured a slave wrongly). Decision: an explicit
+    ``--wait spin`` keeps normal priority under ``auto`` (a task that never sleeps under
+    SCHED_FIFO is stopped by the kernel for 50 ms of every second and takes the CPU from
+    everything else); the number form takes FIFO anyway, as asked."""
+    from gtecat.wire.serve import WireError, realtime_priority
 
     if rt == "off" or (rt == "auto" and wait_given == "spin"):
         return None, "normal priority"
@@ -207,16 +210,7 @@ def take_scheduling(rt: int | str, wait_given: str, cpu: int | None) -> tuple[in
             file=sys.stderr,
         )
         return None, "normal priority (real-time refused)"
-    where = ""
-    if rt == "auto" and cpu is None:
-        try:
-            cpus = sorted(os.sched_getaffinity(0))
-        except (AttributeError, OSError):
-            cpus = []
-        if len(cpus) >= 2:
-            pin_to_cpu(cpus[-1])
-            where = f" on CPU {cpus[-1]}"
-    return prio, f"SCHED_FIFO {prio}{where}"
+    return prio, f"SCHED_FIFO {prio}"
 
 
 def _scheduling_now() -> tuple[int, int, set[int]] | None:
@@ -324,6 +318,10 @@ def run(args: argparse.Namespace) -> int:
     rt, scheduling = take_scheduling(args.rt_priority, wait_given, args.cpu)
     if rt is None and wants_rt and wait == "predict" and args.wait == "auto":
         wait = server.wait = resolve_wait("auto", None)
+    if rt is not None:
+        from gtecat.wire.serve import LINGER_RT_NS
+
+        server.linger_ns = LINGER_RT_NS  # a real-time spin holds the CPU against the master
 
     def _stop(signum: int, _frame: FrameType | None) -> None:
         server.stop.set()

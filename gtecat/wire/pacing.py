@@ -45,6 +45,13 @@ RELEARN = 32
 LATE_SPAN_NS = 300_000
 #: arrivals in a row within a quarter period of the estimate before the window is used
 STEADY_AFTER = 8
+#: intervals in a row off the learned period, agreeing with each other, before it is learned
+#: anew (the master changed its cycle): one or two off the
+#: rhythm (a frame the master sent late, the ones it then owed sent back to back, an extra
+#: frame) do not throw a learned period away - on a busy host that happened every few
+#: hundred cycles, and the loop then spent the next STEADY_AFTER frames without a window
+#: (a 1 ms master was once reported at 344 us)
+RELEARN_AFTER = 3
 
 
 @dataclass(slots=True)
@@ -63,6 +70,9 @@ class Pacing:
     deviations: deque[int] = field(default_factory=lambda: deque(maxlen=SAMPLES))
     #: a window passed without the frame: no window until the next one arrives
     waiting: bool = False
+    #: intervals in a row off the learned period that agree with each other, and the last
+    off: int = 0
+    candidate_ns: float = 0.0
     _new: int = 0
 
     def woke(self, late_ns: int) -> None:
@@ -89,8 +99,19 @@ class Pacing:
                 self.jitter_ns += (abs(dt - period) - self.jitter_ns) / 16
                 self.period_ns += (dt - period) / 16
                 self.steady += 1
+                self.off = 0
             elif dt > 0:
-                self.period_ns, self.jitter_ns, self.steady = float(dt), 0.0, 0
+                # off the learned period: a new one only when RELEARN_AFTER intervals in a
+                # row agree on it (a change of the master's cycle); stray ones (a late frame,
+                # the owed ones after it) leave the period, and the window waits two frames
+                cand = self.candidate_ns
+                self.off = self.off + 1 if cand and abs(dt - cand) < cand / 4 else 1
+                self.candidate_ns = float(dt)
+                if not period or self.off >= RELEARN_AFTER:
+                    self.period_ns, self.jitter_ns, self.steady = float(dt), 0.0, 0
+                    self.off = 0
+                else:
+                    self.steady = min(self.steady, STEADY_AFTER - 2)
             if self._new >= RELEARN:  # after the answer: the sort is not in a frame's time
                 self._new = 0
                 self._learn()

@@ -80,10 +80,17 @@ class LatencyRecorder:
         self.samples = array("q", bytes(8 * size))
         self.size = size
         self.count = 0
+        #: samples over 1 ms and over 2 ms (SOEM's frame timeout), of all, not only the kept
+        self.over_1ms = 0
+        self.over_2ms = 0
 
     def add(self, ns: int) -> None:
         self.samples[self.count % self.size] = ns
         self.count += 1
+        if ns > 1_000_000:
+            self.over_1ms += 1
+            if ns > 2_000_000:
+                self.over_2ms += 1
 
     def summary(self) -> dict[str, float]:
         n = min(self.count, self.size)
@@ -101,6 +108,8 @@ class LatencyRecorder:
             "p90_us": pct(0.90),
             "p99_us": pct(0.99),
             "max_us": data[-1] / 1000.0,
+            "over_1ms": self.over_1ms,
+            "over_2ms": self.over_2ms,
         }
 
 
@@ -141,6 +150,9 @@ WAIT_MODES = ("predict", "sleep", "spin")
 SPIN_TURNS = 256
 #: predict mode, no cycle learned: how long the loop spins after an answer before it sleeps
 LINGER_NS = 500_000
+#: the same under SCHED_FIFO: a real-time task wakes within tens of microseconds, and one that
+#: spins holds its CPU against every normal task (the master) and every other server there
+LINGER_RT_NS = 50_000
 
 SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
 SCM_TIMESTAMPNS = SO_TIMESTAMPNS
@@ -252,6 +264,8 @@ class WireServer:
         #: how the loop waits for frames (WAIT_MODES); ``busy_poll`` = "spin"
         self.wait = "spin" if busy_poll else wait
         self.pacing = Pacing()
+        #: predict mode, no cycle learned: the spin after an answer (LINGER_RT_NS under FIFO)
+        self.linger_ns = LINGER_NS
         self.clock = clock
         self.stop = threading.Event()
         self.stats = ServeStats()
@@ -324,6 +338,7 @@ class WireServer:
         pacing = self.pacing = Pacing()
         fd = sock.fileno()
         poll_ns = int(self.poll_s * 1e9)
+        linger_ns = self.linger_ns
         self._sync_clocks()
         fine_timers()
 
@@ -404,7 +419,7 @@ class WireServer:
                 # master's next frame follows our answer within microseconds, and a wake-up
                 # from poll costs 50-150 us on a VM (SOEM's frame timeout is 2 ms), so the loop
                 # spins a while after each answer before it sleeps
-                linger = predict and window is None and now - self._last_out < LINGER_NS
+                linger = predict and window is None and now - self._last_out < linger_ns
                 if spin or window is not None or linger:
                     turns = SPIN_TURNS
                     if window is not None:

@@ -152,6 +152,51 @@ class _Fast:
                 handler(sm)
 
 
+class _DcPlan:
+    """A datagram of the system time (0910h, 4 or 8 bytes) answered without the register path.
+
+    The master's drift compensation sends it every cycle beside the LRW: ARMW/FRMW (the
+    reference clock reads, every other slave writes what passes by), BRD (every slave's time
+    ORed), APRD/FPRD (one slave's time).  Every emulated clock runs on the host's clock, so a
+    slave's system time is the frame's arrival time plus a constant of its own
+    (:meth:`Esc.system_time_constant`), and the difference a write makes (0910h written =
+    reference time + delay - own time) does not depend on when the frame comes: once one
+    pass through the registers moved no clock, every further one would not either.  So the
+    plan runs the register path until a pass changes nothing, then answers from the
+    constants: the reader's time (or the OR of all) into the datagram, the working counter
+    of the pass - until an offset, a delay or a correction changes (:attr:`Esc.on_dc_change`).
+    Writers ahead of the reader take the master's own bytes, which change every cycle: that
+    shape stays on the register path.
+    """
+
+    __slots__ = (
+        "adp_inc",
+        "brd",
+        "cmd",
+        "consts",
+        "gen",
+        "mask",
+        "nbytes",
+        "readers",
+        "stable",
+        "wkc",
+    )
+
+    def __init__(self, cmd: int, readers: list[Esc], stable: bool, nbytes: int, count: int) -> None:
+        self.cmd = cmd
+        self.brd = cmd == Command.BRD
+        #: what the line adds to the address field (auto-increment and broadcast commands)
+        self.adp_inc = count if cmd in (Command.ARMW, Command.BRD, Command.APRD) else 0
+        self.readers = readers
+        #: no slave writes ahead of the reader: the plan may lock
+        self.stable = stable
+        self.nbytes = nbytes
+        self.mask = (1 << (8 * nbytes)) - 1
+        self.gen = -1  #: the chain's DC generation the constants belong to (-1: not locked)
+        self.consts: tuple[int, ...] = ()
+        self.wkc = 0
+
+
 class Chain:
     """Virtual slaves behind ESCs, in bus order."""
 
@@ -194,6 +239,7 @@ class Chain:
             esc.on_irq_change = self._irq_changed
             esc.on_inputs = self._inputs_loaded
             esc.on_pending = self._add_pending
+            esc.on_dc_change = self._dc_changed
             self.escs.append(esc)
             self.sii_info.append(info)
         self.stats = ChainStats()
@@ -218,6 +264,17 @@ class Chain:
         #: plan, where its working counter is)
         self._cyclic: tuple[int, bytes, bytes, _Fast, int] | None = None
         self._cyclic_seen: tuple[bytes, bytes, _Fast, int] | None = None
+        #: datagrams of the system time: (cmd, adp, ado, length) -> plan (None: not one)
+        self._dc_plans: dict[tuple[int, int, int, int], _DcPlan | None] = {}
+        #: counts changes of any ESC's system-time constants (locked DC plans compare it)
+        self._dc_gen = 0
+        #: the last frame of several datagrams that were all compiled (fast logical ones, DC
+        #: plans): (frame length, each datagram's (offset, command, address and length bytes),
+        #: their plans, EtherType and frame header)
+        self._multi: (
+            tuple[int, tuple[tuple[int, int, bytes], ...], tuple[tuple, ...], bytes] | None
+        ) = None
+        self._multi_seen: list[tuple] | None = None
 
     @property
     def slaves(self) -> list[VirtualSlave]:
@@ -229,6 +286,11 @@ class Chain:
     # --- bookkeeping the ESCs report ---------------------------------------------------------
     def _stations_changed(self, _esc: Esc) -> None:
         self._stations = None
+        self._dc_plans.clear()
+        self._multi = None
+
+    def _dc_changed(self, _esc: Esc) -> None:
+        self._dc_gen += 1
 
     def _fmmus_changed(self, _esc: Esc) -> None:
         self._lmap = None
@@ -250,6 +312,7 @@ class Chain:
         self._plans.clear()
         self._fast.clear()
         self._cyclic = None
+        self._multi = None
 
     def _inputs_loaded(self, _esc: Esc) -> None:
         self._inputs_changed = True
@@ -315,6 +378,13 @@ class Chain:
             return self._cyclic_answer(
                 buf, cyclic[3], cyclic[4], self.clock() if t_ns is None else t_ns
             )
+        multi = self._multi
+        if multi is not None and n == multi[0] and buf[12:16] == multi[3] and not self._deferred:
+            for off, cmd, want in multi[1]:
+                if buf[off] != cmd or buf[off + 2 : off + 8] != want:
+                    break
+            else:  # the same frame of compiled datagrams again: no walk, no dispatch
+                return self._multi_answer(buf, multi[2], self.clock() if t_ns is None else t_ns)
         offsets = walk(buf, n)
         if offsets is None:
             if n >= 14 and buf[12:14] != b"\x88\xa4":
@@ -325,6 +395,15 @@ class Chain:
         self.ft.t_ns = self.clock() if t_ns is None else t_ns
         self.process_data = False
         self._cyclic_seen = None
+        checks = frame_header = None
+        if len(offsets) > 1 and not self._deferred:
+            # what a frame must repeat to be this one: EtherType and frame header, and each
+            # datagram's command, address and length (as the master sent them)
+            checks = [(off, buf[off], bytes(buf[off + 2 : off + 8])) for off in offsets]
+            frame_header = bytes(buf[12:16])
+            self._multi_seen = []
+        else:
+            self._multi_seen = None
         try:
             self._datagrams(buf, offsets)
         except Exception:  # never let one frame take the chain down
@@ -334,6 +413,10 @@ class Chain:
         seen = self._cyclic_seen
         if seen is not None:  # one fast datagram: the next frame like it skips the walk
             self._cyclic = (n, *seen)
+        ops = self._multi_seen
+        if ops is not None and checks is not None and len(ops) == len(offsets):
+            # every datagram was compiled
+            self._multi = (n, tuple(checks), tuple(ops), frame_header)
         buf[6] |= 0x02  # the source address comes back locally administered
         self.stats.frames += 1
         self.stats.datagrams += len(offsets)
@@ -363,6 +446,51 @@ class Chain:
         stats.process_data_frames += 1
         return True
 
+    def _multi_answer(self, buf: bytearray, ops: tuple[tuple, ...], t_ns: int) -> bool:
+        """:meth:`_datagrams` for a frame :attr:`_multi` describes: each datagram by its plan."""
+        self.ft.t_ns = t_ns
+        irq = self._irq
+        u16_unpack, u16_pack = _U16.unpack_from, _U16.pack_into
+        deferred = self._deferred
+        pd = False
+        for fast, dc, off, d0, d1 in ops:
+            if irq:
+                u16_pack(buf, off + 8, u16_unpack(buf, off + 8)[0] | irq)
+            if fast is not None:
+                if self._inputs_changed:
+                    self.refresh_snapshots()
+                deferred.append((fast, buf[d0 + fast.w0 : d0 + fast.w1], t_ns))
+                for f0, f1, snap in fast.runs:
+                    buf[d0 + f0 : d0 + f1] = snap
+                pd = True
+                wkc = fast.wkc
+                if wkc:
+                    u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
+            elif dc.gen != self._dc_gen:
+                self._dc_datagram(dc, buf, off, d0, d1, t_ns)  # not locked (any more)
+            else:  # _dc_datagram's locked path, inline
+                consts = dc.consts
+                if dc.brd:
+                    value = int.from_bytes(buf[d0:d1], "little")
+                    for c in consts:
+                        value |= t_ns + c
+                    buf[d0:d1] = (value & dc.mask).to_bytes(dc.nbytes, "little")
+                elif consts:
+                    buf[d0:d1] = ((t_ns + consts[0]) & dc.mask).to_bytes(dc.nbytes, "little")
+                if dc.adp_inc:
+                    u16_pack(buf, off + 2, (u16_unpack(buf, off + 2)[0] + dc.adp_inc) & 0xFFFF)
+                wkc = dc.wkc
+                if wkc:
+                    u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
+        self.process_data = pd
+        buf[6] |= 0x02
+        stats = self.stats
+        stats.frames += 1
+        stats.datagrams += len(ops)
+        if pd:
+            stats.process_data_frames += 1
+        return True
+
     def exchange(self, frame: bytes) -> bytes | None:
         """Process a copy of ``frame``; the answer, or ``None`` when it was dropped."""
         buf = bytearray(frame)
@@ -384,7 +512,18 @@ class Chain:
             if irq:
                 u16_pack(buf, off + 8, u16_unpack(buf, off + 8)[0] | irq)
             wkc = 0
-            if self._deferred and cmd not in _L and not _dc_only(buf, off, dlen):
+            if cmd not in _L and _dc_only(buf, off, dlen):
+                # the system time (0910h): a compiled plan where the datagram is one
+                dkey = (cmd, u16_unpack(buf, off + 2)[0], u16_unpack(buf, off + 4)[0], dlen)
+                dc = self._dc_plans.get(dkey, False)
+                if dc is False:
+                    dc = self._dc_plan(*dkey)
+                if dc is not None:
+                    self._dc_datagram(dc, buf, off, d0, d1, ft_ns)
+                    if self._multi_seen is not None:
+                        self._multi_seen.append((None, dc, off, d0, d1))
+                    continue
+            elif self._deferred and cmd not in _L:
                 self.flush()  # a register access sees the outputs answered before it
             if cmd in _L:
                 laddr = _U32.unpack_from(buf, off + 2)[0]
@@ -393,6 +532,8 @@ class Chain:
                 if fast:
                     if len(offsets) == 1 and not self._deferred:
                         self._cyclic_seen = (bytes(buf[12:17]), bytes(buf[18:24]), fast, d1)
+                    if self._multi_seen is not None:
+                        self._multi_seen.append((fast, None, off, d0, d1))
                     if self._inputs_changed:
                         self.refresh_snapshots()
                     self._deferred.append((fast, buf[d0 + fast.w0 : d0 + fast.w1], ft_ns))
@@ -455,6 +596,71 @@ class Chain:
                 continue  # NOP or unknown: data and WKC pass untouched
             if wkc:
                 u16_pack(buf, d1, (u16_unpack(buf, d1)[0] + wkc) & 0xFFFF)
+
+    def _dc_plan(self, cmd: int, adp: int, ado: int, dlen: int) -> _DcPlan | None:
+        """The plan of a system-time datagram (:class:`_DcPlan`), or None for another one."""
+        plan: _DcPlan | None = None
+        escs = self.escs
+        count = len(escs)
+        if ado == 0x0910 and dlen in (4, 8):
+            if cmd == Command.BRD:
+                plan = _DcPlan(cmd, list(escs), True, dlen, count)
+            elif cmd in (Command.ARMW, Command.APRD):
+                pos = (-adp) & 0xFFFF
+                readers = [escs[pos]] if pos < count else []
+                plan = _DcPlan(cmd, readers, cmd == Command.APRD or pos == 0, dlen, count)
+            elif cmd in (Command.FRMW, Command.FPRD):
+                stations = self._stations if self._stations is not None else self._station_map()
+                found = stations.get(adp, [])
+                # one reader that no other slave precedes (FPRD: one slave, anywhere); an
+                # address two slaves answer to stays with the register path
+                stable = len(found) == 1 and (cmd == Command.FPRD or found[0] is escs[0])
+                if len(found) <= 1 or cmd == Command.FRMW:
+                    plan = _DcPlan(cmd, found[:1], stable, dlen, len(escs))
+        if len(self._dc_plans) > 256:  # a master that sends ever new shapes: keep it bounded
+            self._dc_plans.clear()
+            self._multi = None
+        self._dc_plans[(cmd, adp, ado, dlen)] = plan
+        return plan
+
+    def _dc_datagram(
+        self, plan: _DcPlan, buf: bytearray, off: int, d0: int, d1: int, t_ns: int
+    ) -> None:
+        """Run a :class:`_DcPlan`: from its constants when locked, else the register path."""
+        cmd = plan.cmd
+        if plan.gen == self._dc_gen:
+            mask = plan.mask
+            if cmd == Command.BRD:
+                value = int.from_bytes(buf[d0:d1], "little")  # ORed into what the frame carries
+                for c in plan.consts:
+                    value |= (t_ns + c) & mask
+            elif plan.consts:
+                value = (t_ns + plan.consts[0]) & mask
+            else:
+                value = -1
+            if value >= 0:
+                buf[d0:d1] = value.to_bytes(plan.nbytes, "little")
+            wkc = plan.wkc
+        else:
+            gen = self._dc_gen
+            escs = self.escs
+            ado = _U16.unpack_from(buf, off + 4)[0]
+            if cmd == Command.BRD:
+                wkc = _broadcast(1, escs, ado, buf, d0, d1)
+            elif cmd == Command.ARMW or cmd == Command.FRMW:
+                reader = plan.readers[0] if plan.readers else None
+                wkc = _read_multiple_write(reader, escs, ado, buf, d0, d1)
+            else:
+                wkc = _physical(1, plan.readers[0], ado, buf, d0, d1) if plan.readers else 0
+            if plan.stable and gen == self._dc_gen:  # the pass moved no clock: lock
+                plan.gen = gen
+                plan.consts = tuple(e.system_time_constant() for e in plan.readers)
+                plan.wkc = wkc
+        if plan.adp_inc:
+            adp = _U16.unpack_from(buf, off + 2)[0]
+            _U16.pack_into(buf, off + 2, (adp + plan.adp_inc) & 0xFFFF)
+        if wkc:
+            _U16.pack_into(buf, d1, (_U16.unpack_from(buf, d1)[0] + wkc) & 0xFFFF)
 
     def _compile(self, cmd: int, laddr: int, dlen: int) -> list[LogicalPlan | Esc]:
         """The ESCs a logical datagram hits, each as a copy plan where it can be one."""

@@ -47,8 +47,9 @@ What the registers do, and where it is specified:
   ``esc.foe.files``, "not found" otherwise, writes refused: no firmware update).
 * 0900h-0935h DC: receive times latched by a write to 0900h, 64-bit system time at
   0910h (a write there is the drift compensation: the local copy locks onto
-  it), offset 0920h, delay 0928h, difference 092Ch; 0980h-09A7h sync registers are
-  plain storage.
+  it), offset 0920h, delay 0928h, difference 092Ch; SYNC0/SYNC1: once activated (0981h)
+  with a cycle (09A0h), 0990h/0998h read the next pulse's system time and 098Eh/098Fh say
+  a pulse came (no PDI side acts on the pulses).
 
 Sync managers are deactivated by the slave's side (PDI control bit 0) in the
 states where the slave does not serve them: mailboxes in INIT, inputs below
@@ -297,6 +298,8 @@ class Esc:
         self._eeprom_busy_until = 0
         self._dc_base = (position + 1) * 123_456_789
         self._dc_correction = 0
+        #: the start time the master wrote (0990h reads back the next SYNC0 pulse once active)
+        self._sync_start = 0
         self._wd_last = 0
         self._wd_expired = False
         self._id_request = False
@@ -313,6 +316,9 @@ class Esc:
         self._irq = 0
         #: SM configuration or PDI (de)activation changed: compiled datagram plans are stale
         self.on_sm_change: Callable[[Esc], None] = _noop
+        #: the system time's constants changed (offset, delay, a drift correction that moved
+        #: the clock): the chain's compiled DC datagrams are stale
+        self.on_dc_change: Callable[[Esc], None] = _noop
         self.on_pending: Callable[[Esc], None] = _noop
         self.errors = 0
         self._reset_registers()
@@ -428,6 +434,8 @@ class Esc:
     def _reg_read(self, addr: int, end: int) -> bytes:
         if addr < 0x0918 and end > 0x0910:
             _U64.pack_into(self.mem, Reg.DC_SYSTEM_TIME, self.system_time())
+        if addr < 0x09A0 and end > 0x098E:
+            self._sync_pulses()
         if addr < 0x0504 and end > 0x0502:
             self._eeprom_poll()
         data = bytes(self.mem[addr:end])
@@ -509,6 +517,10 @@ class Esc:
             self._system_time_written(addr, data)
         if addr < 0x0928 and end > 0x0920:
             self._dc_correction = 0  # a new offset: the control loop starts over
+        if addr < 0x092C and end > 0x0920:
+            self.on_dc_change(self)
+        if addr < 0x0998 and end > 0x0990:
+            self._sync_start = _U64.unpack_from(m, Reg.DC_START_TIME)[0]
 
     # --- AL state machine ----------------------------------------------------------------------
     def _al_control(self) -> None:
@@ -1046,9 +1058,49 @@ class Esc:
         diff = (received + delay - self.system_time()) & mask
         if diff >> (nbits - 1):
             diff -= 1 << nbits
-        self._dc_correction += diff  # the control loop locks at once
         mag = min(abs(diff), 0x7FFFFFFF)
         _U32.pack_into(self.mem, Reg.DC_SYSTEM_DIFF, mag | (0x80000000 if diff > 0 else 0))
+        if diff:
+            self._dc_correction += diff  # the control loop locks at once
+            self.on_dc_change(self)
+
+    def system_time_constant(self) -> int:
+        """``system_time() - frame time``: what this ESC adds to the frame's arrival time
+        (its place in the line, its local clock's base, offset 0920h and the correction),
+        constant until :attr:`on_dc_change` says otherwise."""
+        offset = _I64.unpack_from(self.mem, Reg.DC_SYSTEM_OFFSET)[0]
+        return self.position * HOP_NS + self._dc_base + offset + self._dc_correction
+
+    def _sync_pulses(self) -> None:
+        """SYNC0/SYNC1 as the master reads them (ET1100 datasheet, 0980h-09A7h): once cyclic
+        operation and SYNC0 are activated (0981h bits 0 and 1) with a cycle (09A0h), 0990h
+        reads the system time of the next SYNC0 pulse (start time + k cycles), 098Eh bit 0
+        says a pulse came; with SYNC1 (bit 2) 0998h reads the next SYNC1 pulse, 09A4h after
+        its SYNC0 pulse (0: with it).  Inactive, 0990h reads back the start time written."""
+        m = self.mem
+        act = m[Reg.DC_ACTIVATION]
+        cycle0 = _U32.unpack_from(m, Reg.DC_SYNC0_CYCLE)[0]
+        start = self._sync_start
+        if act & 0x03 != 0x03 or not cycle0:
+            _U64.pack_into(m, Reg.DC_START_TIME, start)
+            m[0x098E] = 0
+            return
+        now = self.system_time()
+        if now <= start:
+            next0, pulsed = start, False
+        else:
+            next0, pulsed = start + -(-(now - start) // cycle0) * cycle0, True
+        _U64.pack_into(m, Reg.DC_START_TIME, next0 & 0xFFFFFFFFFFFFFFFF)
+        m[0x098E] = 0x01 if pulsed else 0
+        if act & 0x04:
+            cycle1 = _U32.unpack_from(m, Reg.DC_SYNC1_CYCLE)[0] % cycle0
+            next1 = (
+                next0 - cycle0 + cycle1
+                if pulsed and next0 - cycle0 + cycle1 > now
+                else (next0 + cycle1)
+            )
+            _U64.pack_into(m, 0x0998, next1 & 0xFFFFFFFFFFFFFFFF)
+            m[0x098F] = 0x01 if pulsed else 0
 
     # --- watchdog ------------------------------------------------------------------------------
     def watchdog_ns(self) -> int:

@@ -88,8 +88,9 @@ def test_rt_priority_refuses_the_rest(text):
 
 
 def test_auto_scheduling_takes_fifo_where_permitted_and_is_given_back():
-    """``--rt-priority auto``: SCHED_FIFO (and the last CPU on two or more) where the system
-    permits it, normal priority for an explicit spin; serve gives it back at the end."""
+    """``--rt-priority auto``: SCHED_FIFO where the system permits it, on no CPU in particular
+    (a pinned real-time server cannot be moved away from another one), normal priority for an
+    explicit spin; serve gives it back at the end."""
     import os
 
     from gtecat.cli.serve_cmd import _restore_scheduling, _scheduling_now, take_scheduling
@@ -103,7 +104,8 @@ def test_auto_scheduling_takes_fifo_where_permitted_and_is_given_back():
         if rt is None:
             assert words == "normal priority (real-time refused)"
         else:
-            assert os.sched_getscheduler(0) == os.SCHED_FIFO and words.startswith("SCHED_FIFO 50")
+            assert os.sched_getscheduler(0) == os.SCHED_FIFO and words == "SCHED_FIFO 50"
+            assert os.sched_getaffinity(0) == before[2]  # type: ignore[index]
     finally:
         _restore_scheduling(before)
     assert _scheduling_now() == before

@@ -148,3 +148,28 @@ def test_the_window_holds_the_next_frame_of_a_jittery_master(period, jitter) -> 
     assert closes - opens <= p.period_ns  # never wider than the period it estimates
     for j in (-20_000, 0, 20_000):
         assert opens <= t + j <= closes
+
+
+def test_a_late_frame_and_the_burst_after_it_keep_the_learned_period() -> None:
+    """A master held back once sends late, then the frames it owes back to back: two or
+    three arrivals off the rhythm. The learned period stays (a busy host once had the loop
+    report 344 us for a 1 ms master), the window comes back after two frames in rhythm."""
+    p = Pacing()
+    t = 0
+    for _ in range(20):
+        p.arrived(t)
+        t += 1_000_000
+    t += 700_000  # late by 0.7 ms
+    p.arrived(t)
+    p.arrived(t + 50_000)  # the owed frame, back to back
+    t += 1_000_000
+    assert p.window() is None  # off the rhythm: no window yet
+    for _ in range(2):
+        p.arrived(t)
+        t += 1_000_000
+    assert abs(p.period_ns - 1_000_000) < 10_000
+    assert p.window() is not None
+    for _ in range(4):  # a real change of period (three intervals agreeing) is still learned
+        p.arrived(t)
+        t += 3_000_000
+    assert abs(p.period_ns - 3_000_000) < 1_000

@@ -292,6 +292,8 @@ def test_distributed_clocks_configure_and_tick(veth, fig52) -> None:
         master.config_init()
         master.config_map()
         assert master.config_dc()
+        for slave in master.slaves:  # SOEM's ec_dcsync0: SYNC0 every millisecond
+            slave.dc_sync(1, 1_000_000)
         to_op(master)
         cycle(master, 10)
         before = master.dc_time
