@@ -44,6 +44,29 @@ def campaign_seed() -> int:
     return int.from_bytes(os.urandom(4), "little")
 
 
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config, items):  # type: ignore[no-untyped-def]
+    """``--dist loadgroup`` (pyproject's addopts) keeps the tests of one ``xdist_group`` on one
+    worker, so a module's expensive fixture (a demo run, compiled programs, a panel and its
+    browser) is built once.  pytest-xdist marks them by appending ``@group`` to the nodeid
+    through an attribute that pytest 9.2 no longer reads (its nodeid is structured now):
+    without this the groups were split over the workers and each built the fixture."""
+    if not config.getvalue("loadgroup"):
+        return
+    try:
+        from _pytest.nodeid import NodeId
+    except ImportError:  # an older pytest: xdist's own marking works
+        return
+    for item in items:
+        names = {
+            str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+            for m in item.iter_markers("xdist_group")
+        }
+        suffix = "@" + "_".join(sorted(names))
+        if names and not item.nodeid.endswith(suffix) and hasattr(item, "_id"):
+            item._id = NodeId.parse(item.nodeid + suffix)
+
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 # ../shared/fixtures beside the checkout (CI clones main with shared/ beside it)
