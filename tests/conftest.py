@@ -51,7 +51,7 @@ def pytest_collection_modifyitems(config, items):  # type: ignore[no-untyped-def
     browser) is built once.  pytest-xdist marks them by appending ``@group`` to the nodeid
     through an attribute that pytest 9.2 no longer reads (its nodeid is structured now):
     without this the groups were split over the workers and each built the fixture."""
-    if not config.getvalue("loadgroup"):
+    if not getattr(config.option, "loadgroup", False):  # set in xdist workers
         return
     try:
         from _pytest.nodeid import NodeId

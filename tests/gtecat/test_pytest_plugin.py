@@ -107,24 +107,6 @@ def test_the_plugin_is_an_entry_point() -> None:
     assert any(e.value == "gtecat.pytest_plugin" for e in eps)
 
 
-def test_fixtures_and_a_failing_test_with_its_trace(project: Path) -> None:
-    done = _pytest(project, "--gtecat-trace", "--gtecat-trace-dir", "traces")
-    out = done.stdout
-    assert "5 passed" in out and "1 failed" in out, out + done.stderr
-    assert "test_fails_with_a_trace" in out and "on purpose" in out
-    assert "gtecat: recent GT errors" in out and "GT_AxisOn returned 7: axis 7" in out
-    assert "gtecat trace" in out and "gtecat-trace.png" in out and "master log:" in out
-    traces = sorted(p.name for p in (project / "traces").iterdir())
-    assert traces == [
-        "test_machine.py_test_fails_with_a_trace.csv",
-        "test_machine.py_test_fails_with_a_trace.png",
-    ]
-    csv = (project / "traces" / traces[0]).read_text().splitlines()
-    assert csv[0].startswith("time_ms,axis1.prf,axis1.enc") and len(csv) > 20
-    # nothing in the working directory but what the user put there
-    assert user_files(project) == ["pytest.ini", "test_machine.py", "traces"]
-
-
 def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Path) -> None:
     (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
     (project / "test_ini.py").write_text(
@@ -146,8 +128,23 @@ def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Pat
 @pytest.mark.skipif(
     importlib.util.find_spec("xdist") is None, reason="pytest-xdist is not installed"
 )
-def test_under_xdist_each_worker_and_test_has_its_own_files(project: Path) -> None:
-    """(The tutorial's page 6 shows its tests run with ``-n 2``: this is that promise's test.)"""
-    done = _pytest(project, "-n", "2", "--gtecat-trace")
-    assert "5 passed" in done.stdout and "1 failed" in done.stdout, done.stdout + done.stderr
-    assert user_files(project) == ["pytest.ini", "test_machine.py"]
+def test_fixtures_and_a_failing_test_with_its_trace_under_xdist(project: Path) -> None:
+    """One child pytest on two workers (the tutorial's page 6 shows its tests run with
+    ``-n 2``: this is that promise's test): the fixtures, a failure's report and trace, and
+    each worker and test with its own files - nothing in the working directory but the
+    traces the option collects."""
+    done = _pytest(project, "-n", "2", "--gtecat-trace", "--gtecat-trace-dir", "traces")
+    out = done.stdout
+    assert "5 passed" in out and "1 failed" in out, out + done.stderr
+    assert "test_fails_with_a_trace" in out and "on purpose" in out
+    assert "gtecat: recent GT errors" in out and "GT_AxisOn returned 7: axis 7" in out
+    assert "gtecat trace" in out and "gtecat-trace.png" in out and "master log:" in out
+    traces = sorted(p.name for p in (project / "traces").iterdir())
+    assert traces == [
+        "test_machine.py_test_fails_with_a_trace.csv",
+        "test_machine.py_test_fails_with_a_trace.png",
+    ]
+    csv = (project / "traces" / traces[0]).read_text().splitlines()
+    assert csv[0].startswith("time_ms,axis1.prf,axis1.enc") and len(csv) > 20
+    # nothing in the working directory but what the user put there
+    assert user_files(project) == ["pytest.ini", "test_machine.py", "traces"]
