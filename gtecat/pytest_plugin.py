@@ -43,6 +43,7 @@ Marker: ``@pytest.mark.gtecat(eni="homing_probe", machine="machine.toml", clock=
 from __future__ import annotations
 
 import re
+import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -57,6 +58,8 @@ NO_ENI = (
 )
 TRACE_KEY = pytest.StashKey[list]()
 ERRORS_KEY = pytest.StashKey[object]()
+RECORD_KEY = pytest.StashKey[Any]()
+LISTENERS_KEY = pytest.StashKey[list]()
 
 
 def _errors_seen() -> object:
@@ -87,6 +90,18 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "--gtecat-trace-dir",
         metavar="DIR",
         help="also copy the traces of failing tests into DIR (one file pair per test)",
+    )
+    group.addoption(
+        "--gtecat-check",
+        action="store_true",
+        help="report where a test's GT calls do what a real drive or controller punishes "
+        "(check: FILE:LINE lines; gtecat run --check)",
+    )
+    group.addoption(
+        "--gtecat-record",
+        action="store_true",
+        help="record the GT calls of every test that uses gtecat_bus; a failing test keeps "
+        "its recording (gtecat replay FILE) beside its trace",
     )
     parser.addini("gtecat_eni", "ENI file or shipped example name for the gtecat fixtures")
     parser.addini("gtecat_machine", "machine description TOML for the gtecat fixtures")
@@ -312,6 +327,18 @@ def gtecat_bus(
         monkeypatch.delenv(k, raising=False)
     gt.GT_Close()
     machine = str(gtecat_machine) if isinstance(gtecat_machine, Path) else gtecat_machine
+    listeners: list[Any] = []
+    if request.config.getoption("gtecat_record"):
+        from .faults.record import Recorder
+
+        rec = Recorder(tmp_path / "gtecat-recording.jsonl", {"test": request.node.nodeid})
+        listeners.append(rec.start())
+        request.node.stash[RECORD_KEY] = rec
+    if request.config.getoption("gtecat_check"):
+        from .faults.checks import Checker
+
+        listeners.append(Checker(sys.stderr).start())
+    request.node.stash[LISTENERS_KEY] = listeners
     rc = gt.GT_Open(
         eni=str(gtecat_eni),
         machine=machine,
@@ -328,12 +355,38 @@ def gtecat_bus(
         _bring_up(gt, bench)
         if request.config.getoption("gtecat_trace"):
             per_axis = ("prf", "enc", "err", "sw")
-            bench.record(*(f"axis{a}.{s}" for a in range(1, bench.axes() + 1) for s in per_axis))
+            bench.record(
+                *(f"axis{a}.{s}" for a in range(1, bench.axes() + 1) for s in per_axis), "faults"
+            )
         yield bench
     finally:
         for rec in bench.recorders:
             rec.stop()
         gt.GT_Close()
+        for listener in listeners:
+            listener.stop()
+
+
+@pytest.fixture
+def gtecat_faults(gtecat_bus: Bench) -> Iterator[Any]:
+    """The fault vocabulary on the test's bus: ``gtecat_faults.inject("drive_fault", axis=1,
+    code=0x2310, at_ms=500)``, ``.clear()``, ``.listing()``, ``.script([...])``; every fault
+    is cleared at the end of the test."""
+    import types
+
+    from . import faults
+
+    ctl = gtecat_bus.ctl
+    face = types.SimpleNamespace(
+        inject=lambda kind, **values: faults.inject(kind, ctl=ctl, **values),
+        clear=lambda ident=None: faults.clear(ident, ctl=ctl),
+        listing=lambda: faults.listing(ctl=ctl),
+        script=lambda steps: faults.script(steps, ctl=ctl),
+        describe=faults.describe,
+    )
+    yield face
+    if ctl.master is not None and ctl.master.opened:
+        faults.clear(ctl=ctl)
 
 
 @pytest.fixture
@@ -361,6 +414,20 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) ->
     report = outcome.get_result()
     if report.when != "call" or not report.failed:
         return
+    recording = item.stash.get(RECORD_KEY, None)
+    if recording is not None:
+        recording.stop()
+        path = recording.write()
+        lines = [f"gtecat replay {path}"]
+        extra = item.config.getoption("gtecat_trace_dir")
+        if extra:  # beside the traces copied there
+            import shutil
+
+            out = Path(extra)
+            out.mkdir(parents=True, exist_ok=True)
+            copy = shutil.copy(path, out / (_safe(item.nodeid) + ".gtrec.jsonl"))
+            lines.append(f"gtecat replay {copy}")
+        report.sections.append(("gtecat recording", "\n".join(lines)))
     recorders = item.stash.get(TRACE_KEY, None)
     if recorders is None:
         return

@@ -13,8 +13,9 @@ and with full CiA-402 drives) and on the 12-axis example; the cost of one
 generated buses of single-axis CSP drives (:mod:`tools.bench_scaling`, lockstep
 clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ``ok``: real-time factors of 12 axes moving in Trap, 64 axes (odd axes moving, even
-ones holding), 128 axes moving; 12 axes homing (method 17) and 12 axes in PT
-(reported); ``GT_GetSts`` against building its argument, interleaved; the RSS of a
+ones holding), 128 axes moving; 64 axes homing (method 17); 12 axes homing and 12 axes
+in PT (reported); ``GT_GetSts`` against building its argument, interleaved, and every call
+shape of the fast path likewise (the worst ratio is held to 4); the RSS of a
 fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -155,6 +156,83 @@ def bench_get_sts(seconds: float = 1.0, block: int = 200) -> dict[str, object]:
     }
 
 
+def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, object]:
+    """Each call shape of the fast path against building its arguments, in alternating
+    blocks on figure 5-2's bus (lockstep): µs per call, µs per argument build, their ratio
+    (medians); ``worst`` is the largest ratio."""
+    import numpy as np
+
+    from gtecat import gt
+
+    gt.GT_Close()
+    gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="")
+    gt.GT_InitEcatComm()
+    gt.GTE_Wait(60)
+    gt.GT_StartEcatComm()
+    gt.GT_AxisOn(1)
+    held = c_long()
+    p = byref(held)
+    buf8, ba8, np8 = (c_ubyte * 8)(), bytearray(8), np.zeros(8, np.uint8)
+    mv8 = memoryview(bytearray(8))
+    out2 = bytes([0x0F, 0x00])
+    sts, raw_get, raw_set = gt.GT_GetSts, gt.GT_GetEcatRawData, gt.GT_SetEcatRawData
+    io_read = gt.GT_EcatIOReadInput
+    np1 = np.zeros(1, np.int32)
+    shapes = {
+        # shape: (the call, building its arguments)
+        "GT_GetSts(1, byref(s))": (lambda: sts(1, p), lambda: byref(c_long())),
+        "GT_GetSts(1, byref(c_long()))": (
+            lambda: sts(1, byref(c_long())),
+            lambda: byref(c_long()),
+        ),
+        "GT_GetSts(1, byref(s), 1, 0)": (lambda: sts(1, p, 1, 0), lambda: byref(c_long())),
+        "GT_GetSts(1, s)": (lambda: sts(1, held), lambda: c_long()),
+        "GT_GetSts(1, numpy int32[1])": (lambda: sts(1, np1), lambda: np.zeros(1, np.int32)),
+        "GTN_GetSts(1, 1, byref(s))": (lambda: gt.GTN_GetSts(1, 1, p), lambda: byref(c_long())),
+        "GT_GetEcatRawData(0, 8, c_ubyte[8])": (
+            lambda: raw_get(0, 8, buf8),
+            lambda: (c_ubyte * 8)(),
+        ),
+        "GT_GetEcatRawData(0, 8, bytearray)": (lambda: raw_get(0, 8, ba8), lambda: bytearray(8)),
+        "GT_GetEcatRawData(0, 8, numpy uint8)": (
+            lambda: raw_get(0, 8, np8),
+            lambda: np.zeros(8, np.uint8),
+        ),
+        "GT_GetEcatRawData(0, 8, memoryview)": (
+            lambda: raw_get(0, 8, mv8),
+            lambda: memoryview(bytearray(8)),
+        ),
+        "GT_SetEcatRawData(0, 2, bytes)": (lambda: raw_set(0, 2, out2), lambda: bytes([15, 0])),
+        "GT_EcatIOReadInput(2, 0, 4, c_ubyte[8])": (
+            lambda: io_read(2, 0, 4, buf8),
+            lambda: (c_ubyte * 8)(),
+        ),
+    }
+    clock, rng = time.perf_counter, range(block)
+    out: dict[str, object] = {}
+    worst = 0.0
+    per = seconds / len(shapes)
+    for name, (call, build) in shapes.items():
+        calls, args = [], []
+        t_end = clock() + per
+        while clock() < t_end:
+            t0 = clock()
+            for _ in rng:
+                build()
+            t1 = clock()
+            for _ in rng:
+                call()
+            t2 = clock()
+            args.append((t1 - t0) / block)
+            calls.append((t2 - t1) / block)
+        c_us, a_us = statistics.median(calls) * 1e6, statistics.median(args) * 1e6
+        ratio = round(c_us / a_us, 2)
+        worst = max(worst, ratio)
+        out[name] = {"call_us": round(c_us, 3), "argument_us": round(a_us, 3), "ratio": ratio}
+    gt.GT_Close()
+    return {"shapes": out, "worst": worst}
+
+
 def _rss() -> dict[str, float]:
     """VmRSS and VmHWM of this process in MB (``ru_maxrss`` where /proc is absent)."""
     out: dict[str, float] = {}
@@ -209,8 +287,12 @@ def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
         ),
         "rtf_128_axes_trap": rtf(128, every(128, "moving"), 5, "all 128 moving in Trap"),
         "rtf_12_axes_homing_17": rtf(12, every(12, "homing"), None, "drive homing method 17"),
+        "rtf_64_axes_homing_17": rtf(64, every(64, "homing"), 10, "drive homing method 17"),
         "rtf_12_axes_pt": rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
         "gt_get_sts_vs_argument": _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
+        "call_shapes_vs_arguments": _figure(
+            bench_call_shapes(2 * seconds), "worst", 4, at_most=True
+        ),
         "rss_128_axes_moving": _figure(
             bench_rss(128, min(seconds, 1.0)), "VmHWM_mb", 150, at_most=True
         ),

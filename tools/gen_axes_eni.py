@@ -25,7 +25,7 @@ from gtecat.eni.model import EniConfig  # noqa: E402
 from gtecat.eni.topology import build_config  # noqa: E402
 from gtecat.eni.writer import write_eni_file  # noqa: E402
 
-MAX_AXES = 128
+MAX_AXES = 64535  # station addresses 1001 + position fit 16 bits (ETG.2100 PhysAddr)
 RX = ("0x6040:0:16", "0x607A:0:32", "0x6060:0:8")
 TX = ("0x6041:0:16", "0x6064:0:32", "0x60FD:0:32", "0x6061:0:8")
 #: GT raw bytes of one slave: outputs 2 + 4 (+ 1), inputs 2 + 4 + 4 (+ 1)
@@ -61,7 +61,7 @@ def write_axes_eni(n: int, path: str | Path, *, modes: bool = True) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("axes", type=int, help=f"number of drives, 1..{MAX_AXES}")
+    ap.add_argument("axes", type=int, help=f"number of drives, 1..{MAX_AXES} (station addresses)")
     ap.add_argument("-o", "--output", required=True, help="ENI file to write")
     ap.add_argument("--no-modes", action="store_true", help="leave 6060h/6061h unmapped")
     args = ap.parse_args(argv)

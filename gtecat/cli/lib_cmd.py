@@ -28,6 +28,12 @@ C long there); put it beside the program as App.exe.config, or name it in MONO_C
 
     python3 -m gtecat lib --csharp -o gts.cs
     mcs App.cs gts.cs && python3 -m gtecat lib --mono-config -o App.exe.config && mono App.exe
+
+A C# program whose own wrapper passes the card first (GT_Open(short cardNum, short channel,
+short param)) needs the multi-card map: --abi gts-multicard --mono-config sends gts.dll to
+libgts_mc-llp64.so, the multi-card layer built for C# int:
+
+    python3 -m gtecat lib --abi gts-multicard --mono-config -o App.exe.config
 """
 
 from __future__ import annotations
@@ -63,15 +69,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--mono-config",
         action="store_true",
-        help="the Mono dllmap sending gts.dll / gen.dll / gxn.dll to libgts (App.exe.config)",
+        help="the Mono dllmap sending gts.dll / gen.dll / gxn.dll to libgts (App.exe.config; "
+        "with --abi gts-multicard to the multi-card layer)",
     )
     p.add_argument("--csharp", action="store_true", help="gts.cs: the GT API for C# (generated)")
     p.add_argument("-o", "--output", metavar="FILE", help="write --mono-config / --csharp here")
     p.set_defaults(func=run)
 
 
+def _abi(args: argparse.Namespace) -> str:
+    return "" if args.abi == "gtn" else args.abi
+
+
 def run(args: argparse.Namespace) -> int:
-    abi = "" if args.abi == "gtn" else args.abi
+    abi = _abi(args)
     if args.mono_config or args.csharp:
         return _csharp(args)
     if args.header:
@@ -109,12 +120,19 @@ def _csharp(args: argparse.Namespace) -> int:
     if args.mono_config and args.csharp:
         print("error: --mono-config and --csharp write different files; ask for one")
         return 1
+    if args.csharp and _abi(args):
+        print(
+            f"error: --csharp writes gts.cs for the one-card API only, not --abi {args.abi}; "
+            f"a program with a multi-card wrapper keeps its own and needs only "
+            f"--abi {args.abi} --mono-config"
+        )
+        return 1
     if args.csharp:
         text = csharp.render()
     else:
         from ..native.llp64 import ensure_built
 
-        text = csharp.mono_config(ensure_built(force=args.rebuild))
+        text = csharp.mono_config(ensure_built(force=args.rebuild, abi=_abi(args)))
     if args.output:
         Path(args.output).write_text(text, encoding="utf-8")
     else:

@@ -39,6 +39,9 @@ COMMANDS = (
     "scan_cmd",
     "ps_cmd",
     "panel_cmd",
+    "fault_cmd",
+    "record_cmd",
+    "replay_cmd",
 )
 
 

@@ -49,6 +49,14 @@ def _add_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--trace-out", default=None, help="output stem (default: the script's name)")
     p.add_argument("--no-progress", action="store_true", help="no status line on stderr")
+    p.add_argument(
+        "--check",
+        action="store_true",
+        help="warn (check: FILE:LINE: ...) where a real drive or controller would punish the "
+        "script: skipped CiA-402 states, enable in fault, CSP steps past the following-error "
+        "window, mode changes in motion, SDO writes to mapped objects in OP, endless "
+        "GT_IsEcatReady polls, moves on an axis in alarm",
+    )
 
 
 EPILOG = """\
@@ -57,6 +65,7 @@ backend=..., iface=...) arguments; a note on stderr names each one replaced.
 
 examples:
   gtecat run first_script.py --eni manual_fig5_2.eni
+  gtecat run --check first_script.py --eni manual_fig5_2.eni    warnings with file and line
   gtecat run home.py --machine machine.toml --trace axis1.enc,axis1.sw,0:0x60FD:0
   gtecat run my_machine.py --clock realtime --backend pysoem --iface eth0
 
@@ -332,6 +341,11 @@ def run(args: argparse.Namespace) -> int:
     gt_module.GT_Open = overriding_open(real_open, forced, noted, core_first=False)
     gt_module.GTN_Open = overriding_open(real_gtn_open, forced, noted, core_first=True)
     Controller.bus_up_hooks.append(attach)
+    checker = None
+    if getattr(args, "check", False):
+        from ..faults.checks import Checker
+
+        checker = Checker(sys.stderr).start()
     saved_streams = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = progress.guard(sys.stdout), progress.guard(sys.stderr)
     sys.argv = [str(script), *script_args]
@@ -355,6 +369,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: {script} raised {type(e).__name__}: {e}", file=sys.stderr)
         rc = 1
     finally:
+        if checker is not None:
+            checker.stop()
         Controller.bus_up_hooks.remove(attach)
         gt_module.GT_Open, gt_module.GTN_Open = real_open, real_gtn_open
         progress.done()

@@ -8,6 +8,7 @@ other end of the wire sees a chain of real-looking slaves.  Needs root or CAP_NE
 examples:
   gtecat serve --eni manual_fig5_2.eni --iface veth1
   gtecat serve --eni Gecat.eni --machine machine.toml --iface enp3s0 --duration 60
+  gtecat serve --eni Gecat.eni --iface veth1 --fault link_loss.toml
 """
 
 from __future__ import annotations
@@ -107,6 +108,16 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         type=Path,
         metavar="FILE",
         help="write every frame received and answered to FILE (classic pcap, for Wireshark)",
+    )
+    p.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        type=Path,
+        metavar="FILE",
+        help="arm the [[fault]] tables of FILE (TOML; repeatable): the same faults as on the "
+        "emulated bus, in the slaves' time since the server started (a machine "
+        "description's own [[fault]] tables are armed too)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="log what the slaves do")
 
@@ -312,6 +323,7 @@ def run(args: argparse.Namespace) -> int:
         wait=wait,
         pcap=pcap,
     )
+    _arm_faults(args, chain, server)
     # the scheduling last, once everything that can fail has been checked; given back at
     # the end (a program that calls serve in-process keeps its own)
     before = _scheduling_now()
@@ -354,6 +366,9 @@ def run(args: argparse.Namespace) -> int:
             f"{scheduling}; ready",
             flush=True,
         )
+        server.said_ready = True
+        for message in getattr(server, "early_messages", ()):
+            print(f"gtecat serve: {message}", file=sys.stderr, flush=True)
 
     try:
         server.serve(ready=_ready, duration_s=args.duration)
@@ -373,6 +388,47 @@ def run(args: argparse.Namespace) -> int:
                 flush=True,
             )
     return 0
+
+
+def _arm_faults(args: argparse.Namespace, chain, server) -> None:
+    """The machine description's and the --fault files' [[fault]] tables on the chain."""
+    from gtecat.drives.machine import load_machine
+    from gtecat.faults import Injector, WireBus, arm, load, specs_from_tables
+
+    specs = []
+    if args.machine:
+        tables = load_machine(args.machine).faults
+        if tables:
+            specs += specs_from_tables(list(tables), str(args.machine))
+    for path in args.fault:
+        specs += load(path)
+    if not specs:
+        return
+
+    early: list[str] = []  # said before the ready line: said right after it
+
+    def say(message: str) -> None:
+        if early is not None and not getattr(server, "said_ready", False):
+            early.append(message)
+            return
+        print(f"gtecat serve: {message}", file=sys.stderr, flush=True)
+
+    server.early_messages = early
+
+    bus = WireBus(chain, server, log=say)
+    injector = Injector(bus)
+    arm(injector, specs)
+
+    def step(t_ns: int) -> None:
+        bus.at(t_ns)
+        injector.tick()
+
+    def poll(t_ns: int) -> None:
+        bus.at(t_ns)
+        injector.tick(cycle=False)
+
+    server.step_hooks.append(step)
+    server.poll_hooks.append(poll)
 
 
 def main(argv: list[str] | None = None) -> int:

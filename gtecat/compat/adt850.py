@@ -1277,6 +1277,7 @@ def _home(axes: list[int], pfn: FUNCTION) -> int:
     if rc == 0:
         return 0
     found = 1
+    missed = []
     for n in axes:
         regs = card.regs[n]
         regs.stop_on = [False, False, False]
@@ -1285,6 +1286,13 @@ def _home(axes: list[int], pfn: FUNCTION) -> int:
             card.set_ep(n, 0)
         else:
             found = -2
+            missed.append(n)
+    if missed:
+        _set_error(
+            f"home: axis {', '.join(map(str, missed))} stopped before its home signal "
+            f"(stop data {', '.join(f'{card.regs[n].stopdata:#04x}' for n in missed)}: "
+            "a limit or an error, B.2)"
+        )
     return found
 
 

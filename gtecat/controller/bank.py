@@ -45,8 +45,20 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gtecat.drives.csp_bank import CW_ENABLED, CspBank, claimable, wrap32
+from gtecat.drives.csp_bank import (
+    CW_ENABLED,
+    FROZEN_ATTRS,
+    CspBank,
+    claimable,
+    frozen_claimable,
+    wrap32,
+)
 from gtecat.drives.drive import Cia402Drive
+from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
+from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
+from gtecat.drives.homing_bank import homing_claimable
+from gtecat.drives.homing_bank import row_constants as homing_constants
+from gtecat.drives.modes import SW12
 from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
@@ -116,8 +128,16 @@ BANK_READS = frozenset(
         "GTE_GetLastError",
         "GT_GetVersion",
         "GT_IsEcatReady",
+        "GT_GetEcatHomingStatus",
     }
 )
+#: the axis's mode while its drive homes (6060h = 6)
+_HOMING_MODE = 6
+#: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
+_HM_ARRAYS = (
+    "h_last h_el h_tr h_v h_p h_rest h_vt h_acc h_lo h_hi h_maxtr h_tmo h_fd h_from h_ilim"
+).split()
+_HM_U8 = ("hm", "h_set", "h_idx", "frz")
 _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.SERVO_ON),
     int(AxisStatus.MOVING),
@@ -218,6 +238,10 @@ class AxisBank:
                 )
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
+        #: homing axis-cycles the compiled kernel ran (statistics)
+        self.homing_rows_run = 0
+        #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
+        self.frozen_rows_run = 0
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -338,6 +362,12 @@ class AxisBank:
         self.t_cur = zi(n, np.int64)  # next sample to take
         self.t_end = zi(n, np.int64)  # index of the end sample (or -1)
         self.T = ctl.clock.cycle_ns / 1e6
+        for name in _HM_ARRAYS:
+            setattr(self, name, z(n))
+        for name in _HM_U8:
+            setattr(self, name, zi(n, bool))
+        self.n_hm = self.n_frz = 0
+        self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -355,18 +385,10 @@ class AxisBank:
         self.any_band = bool(np.count_nonzero(self.band > 0))
         self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
+        self.n_hm = int(np.count_nonzero(self.hm & alive))
+        self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.band_dirty = True
-        plc = [p for p in self._plc if alive[p[0]]]
-        names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
-        self._extra = names
-        col = {"target": 0, "position_actual": 1, "digital_inputs": 2}
-        col |= {name: 3 + k for k, name in enumerate(names)}
-        n = self.n
-        self._img_src = np.array([col[name] * n + r for r, _, _, name in plc], np.intp)
-        self._img_dst = np.array([off + j for _, off, size, _ in plc for j in range(size)], np.intp)
-        self._img_bytes = np.array(
-            [4 * i + j for i, (_, _, size, _) in enumerate(plc) for j in range(size)], np.intp
-        )
+        self._img_stale = True  # the numpy cycle's image indices follow when it runs
         self.n_moving = int(np.count_nonzero(self.moving & alive))
         self._refill_in = 0  # look for tables to fill at the next cycle
         self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
@@ -382,6 +404,22 @@ class AxisBank:
         if self.kernel is not None:
             self.kernel.bound = False
 
+    def _image_indices(self) -> None:
+        """The numpy cycle's scatter of the claimed rows' values into the image."""
+        alive = self.alive
+        self._img_stale = False
+        plc = [p for p in self._plc if alive[p[0]]]
+        names = sorted({p[3] for p in plc} - {"target", "position_actual", "digital_inputs"})
+        self._extra = names
+        col = {"target": 0, "position_actual": 1, "digital_inputs": 2}
+        col |= {name: 3 + k for k, name in enumerate(names)}
+        n = self.n
+        self._img_src = np.array([col[name] * n + r for r, _, _, name in plc], np.intp)
+        self._img_dst = np.array([off + j for _, off, size, _ in plc for j in range(size)], np.intp)
+        self._img_bytes = np.array(
+            [4 * i + j for i, (_, _, size, _) in enumerate(plc) for j in range(size)], np.intp
+        )
+
     # --- when the bank may run ----------------------------------------------------------------
     def _global_reason(self) -> str:
         ctl = self.ctl
@@ -394,10 +432,29 @@ class AxisBank:
             return "per-cycle hooks"
         if ctl.backend.unplugged:
             return "a slave is unplugged"
+        if ctl.backend.answer_hook is not None:
+            return "faults on the frames (gtecat.faults)"
         for res in ctl.resources.values():  # never the Axis objects: they may be guarded
             if res.profile.mode in (PrfMode.GEAR, PrfMode.FOLLOW):
                 return "an axis follows another (Gear/Follow)"
         return ""
+
+    @staticmethod
+    def _homing_hook(ax: Any, res: Any) -> Any:
+        """The axis's hooks are the resources' own plus at most the GT layer's homing
+        follower (gtecat.gt.homing_calls): that follower, None without one, False when
+        some other hook runs."""
+        if len(ax.pre_hooks) != 1:
+            return False
+        hooks = ax.post_hooks
+        if not hooks or hooks[0] != res._post:
+            return False
+        if len(hooks) == 1:
+            return None
+        if len(hooks) != 2:
+            return False
+        st = getattr(hooks[1], "__self__", None)
+        return st if getattr(st, "bank_homing_hook", False) else False
 
     def _eligible(self, r: int) -> bool:
         """The scalar state the bank reproduces (module docstring)."""
@@ -405,11 +462,16 @@ class AxisBank:
         res = self.res[r]
         if res is None:
             return False
+        if not ax.servo_on:
+            return self._eligible_frozen(r)
+        if ax.mode_cmd == _HOMING_MODE:
+            return self._eligible_homing(r)
         if not (ax.servo_on and ax.mode_cmd == 8 and ax.csp_follow) or ax.link_lost:
             return False
         if ax.cw != CW_ENABLED or ax._cw_sent != CW_ENABLED:
             return False
-        if len(ax.pre_hooks) != 1 or len(ax.post_hooks) != 1 or not res._csp:
+        st = self._homing_hook(ax, res)
+        if st is False or (st is not None and st.active) or not res._csp:
             return False
         if res.latched or ax.prf_pos != res._a_last:
             return False
@@ -429,6 +491,78 @@ class AxisBank:
                 return False
         else:
             return False
+        if not self._inputs_plain(ax, res):
+            return False
+        return not claimable(self.csp.channels[r])
+
+    def _eligible_frozen(self, r: int) -> bool:
+        """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
+        every value of its cycle stays as it is, so the compiled cycle skips the row (the
+        image keeps the values the scalar objects wrote)."""
+        if self.kernel is None:
+            return False
+        ax, res = self.axes[r], self.res[r]
+        if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error:
+            return False
+        st = self._homing_hook(ax, res)
+        if st is False or (st is not None and st.active):
+            return False
+        if res.latched or ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
+            return False
+        if None in (res._act, ax._tp_acc, ax._pos_acc):
+            return False
+        pl = res.profile.planner
+        if not pl.done or pl.stopping != StopKind.NONE:
+            return False
+        if not self._inputs_plain(ax, res):
+            return False
+        enc = res.encoder
+        if enc.vel != 0.0 or enc.acc != 0.0:
+            return False
+        a = (res._act.get() - ax.drive_offset) / (1 << ax.pos_scale)
+        if a != ax.prf_pos or pl.pos != res.prf_link.source(a):
+            return False  # the plan does not follow 6064h yet
+        if ax._tp_acc.get() != ax._pos_acc.get():
+            return False  # 607Ah does not hold 6064h yet
+        ch = self.csp.channels[r]
+        s = res.safety
+        if s.active and (a > s.soft_positive or a < s.soft_negative or ch.digital_inputs & 3):
+            return False  # a flag would latch
+        b = res.band
+        if b.band > 0:
+            err = a - res.enc_link.axis(enc.pos)
+            inside = -b.band <= err <= b.band
+            if (inside and not b.arrived) or (not inside and (b._since is not None or b.arrived)):
+                return False  # bit 11 still changes with time
+        return not frozen_claimable(ch)
+
+    def _eligible_homing(self, r: int) -> bool:
+        """An axis whose drive runs a homing search (gtecat.drives.homing_bank): the axis
+        layer only follows it (607Ah = 6064h, the plan = the actual position, the
+        encoder), so the compiled cycle runs the row whole."""
+        if self.kernel is None:
+            return False  # the numpy cycle has no homing rows
+        ax, res = self.axes[r], self.res[r]
+        if not ax.servo_on or ax.link_lost or res._csp:
+            return False
+        if ax.cw != 0x1F or ax._cw_sent != 0x1F:
+            return False
+        st = self._homing_hook(ax, res)
+        if not st or not st.active or not st.answered:
+            return False
+        if res.latched or ax.prf_pos != res._a_last:
+            return False
+        if None in (res._act, res._cmd, ax._tp_acc, ax._pos_acc):
+            return False
+        pl = res.profile.planner
+        if not pl.done or pl.stopping != StopKind.NONE:
+            return False
+        if not self._inputs_plain(ax, res):
+            return False
+        return not homing_claimable(self.csp.channels[r])
+
+    @staticmethod
+    def _inputs_plain(ax: Any, res: Any) -> bool:
         enc = res.encoder
         if not (enc._primed and enc.active):
             return False
@@ -438,9 +572,11 @@ class AxisBank:
             return False
         if s.positive_input not in (n, None) or s.negative_input not in (n, None):
             return False
-        if res._pos_din is not ax.io.get(0x60FD) and res._pos_din is not None:
-            return False
-        return not claimable(self.csp.channels[r])
+        din = ax.io.get(0x60FD)
+        if any(e is not None and e is not din for e in (res._pos_din, res._neg_din)):
+            return False  # a configuration's reverse (SensedInput) or another source
+        # the alarm read through a reverse: the kernel reads 6041h as it is
+        return res._alarm_sw is res._sw
 
     def refresh(self) -> None:
         """Claim every slave whose axes are all eligible; drop all when the bank cannot run."""
@@ -474,6 +610,16 @@ class AxisBank:
             start = (sl.out_logical_bit or 0) >> 3
             now = self.ctl.master.image.buffer[start : start + sl.out_bytes].tobytes()
             if now != bytes(g.drive.rx[: sl.out_bytes]):
+                return False
+        # and sent what its objects hold now: the bank leaves the constant TxPDO entries
+        # (analog inputs, 603Fh...) as the last scalar step wrote them, so one changed since
+        # (a test's set_analog_input) waits for the next scalar step to be sent first
+        drive = g.drive
+        codec = drive.codec
+        if len(drive.tx) >= codec.tx_bytes:
+            fresh = bytearray(len(drive.tx))
+            codec.encode(fresh)
+            if fresh != drive.tx:
                 return False
         for r in g.rows:
             self.csp.load(r)
@@ -545,6 +691,30 @@ class AxisBank:
             self.t_len[r], self.t_end[r] = 0, -1
         else:
             self.t_len[r], self.t_end[r] = 1, 0
+        ch = self.csp.channels[r]
+        self.frz[r] = frozen = not ax.servo_on
+        if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
+            self._frozen[r] = (
+                tuple(getattr(ch, name) for name in FROZEN_ATTRS),
+                ch.mech.torque,
+                ch.mech.acc,
+            )
+            self.enc_step0[r] = self.enc_step1[r] = 0.0  # the encoder stands: speed 0
+            self.hm[r] = False
+            return
+        self.hm[r] = homing = ax.mode_cmd == _HOMING_MODE
+        if homing:  # the drive's search (gtecat.drives.homing_bank)
+            h = ch.homing
+            for name, attr in HM_ROW_FIELDS:
+                getattr(self, name)[r] = getattr(h, attr)
+            self.h_set[r] = h._settled
+            for name, value in homing_constants(h).items():
+                getattr(self, name)[r] = value
+            bounds = homing_event_bounds(h, ch.mech.pos)
+            assert bounds is not None  # homing_claimable checked it
+            self.h_lo[r], self.h_hi[r] = bounds
+            # 6041h: the state bits and remote, no mode bits while searching (step_hm's oms 0)
+            self.csp.sw_const[r] -= SW12
 
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
@@ -610,6 +780,27 @@ class AxisBank:
         b._since = None if since < 0 else since
         b.arrived = bool(self.arrived[r])
         pl = res.profile.planner
+        if self.frz[r]:
+            self.frz[r] = False
+            ch = self.csp.channels[r]
+            values, torque, acc = self._frozen.pop(r)
+            for name, value in zip(FROZEN_ATTRS, values, strict=True):
+                setattr(ch, name, value)
+            ch.mech.torque, ch.mech.acc = torque, acc
+            return
+        if self.hm[r]:
+            self.hm[r] = False
+            ch = self.csp.channels[r]
+            ch.oms = 0  # step_hm: hm_bits (0 while searching), no following-error flag
+            h = ch.homing
+            for name, attr in HM_ROW_FIELDS:
+                setattr(h, attr, float(getattr(self, name)[r]))
+            h._settled = bool(self.h_set[r])
+            # AxisResources._post: the plan holds the axis's actual position
+            p = res.prf_link.source(a)
+            if p != pl.pos or not pl.done:
+                pl.hold(p)
+            return
         if self.jog[r]:
             pl._raw_p, pl._raw_v = float(self.jrp[r]), float(self.jrv[r])
             pl._pos, pl._vel, pl._acc = float(self.jp[r]), float(self.jv[r]), float(self.ja[r])
@@ -634,6 +825,15 @@ class AxisBank:
                 if ax is not None:
                     self.release_axis_object(ax)
                     return
+        if params and params[0].name == "mask" and values and type(values[0]) is int:
+            # GT_Update(mask), GT_Stop(mask, option): only the axes of the mask go back
+            mask = values[0]
+            axes = ctl.axes
+            named = [axes.get(n) for n in range(1, mask.bit_length() + 1) if mask >> (n - 1) & 1]
+            if named and all(ax is not None for ax in named):
+                for ax in named:
+                    self.release_axis_object(ax)
+                return
         self.release_all()
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
@@ -647,7 +847,7 @@ class AxisBank:
         if name == "sts":
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | _SERVO_ON).tolist()
+            return (sts | np.where(self.frz, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             vel, acc = self._enc_rates()
             return (vel if name == "enc_vel" else acc).tolist()
@@ -683,13 +883,25 @@ class AxisBank:
             # the plain cycle compiled; a table to refill (rare) or a new cycle time goes
             # through numpy, and so does a cycle the kernel declines (nothing written then)
             dt = dt_ns * 1e-9
+            if (self.n_hm or self.n_frz) and dt != self.csp._dt:
+                self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
             if dt == self.csp._dt and not (self.n_moving and self._refill_in <= 1):
                 self._refill_in -= 1
-                if k.cycle(t_ns, dt) == 0:
+                rc = k.cycle(t_ns, dt)
+                while rc == 3:  # homing rows meeting an event: back to their drives first
+                    self._release_rows(np.nonzero(k.scratch["s_hit"] & self.hm)[0])
+                    if not self.n_alive:
+                        return
+                    rc = k.cycle(t_ns, dt)
+                if rc == 0:
                     self._after_kernel(k)
                     return
                 self._refill_in += 1
             k.bound = False  # the numpy cycle replaces some arrays
+        if self.n_hm or self.n_frz:  # the numpy cycle runs CSP rows only: the others go back
+            self._release_rows(np.nonzero((self.hm | self.frz) & self.alive)[0])
+            if not self.n_alive:
+                return
         buf = self.ctl.master.image.buffer
         # 1. raw writes to a claimed slave's outputs: back to the scalar drive first
         if self._rx_ref and buf.take(self._rx_idx).tobytes() != self._rx_ref:
@@ -822,6 +1034,8 @@ class AxisBank:
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         # 8. the image: 607Ah out, the drives' TxPDO in, in one scatter
+        if self._img_stale:
+            self._image_indices()
         cols = [target, pa, din]
         for name in self._extra:
             cols.append(csp.output(name, state))
@@ -841,6 +1055,8 @@ class AxisBank:
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         self.kernel_cycles += 1
+        self.homing_rows_run += self.n_hm
+        self.frozen_rows_run += self.n_frz
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""
@@ -887,6 +1103,16 @@ class AxisBank:
         if self.n_jog:
             j = self.jog
             self.prf_p[j], self.prf_v[j], self.prf_a[j] = self.jp[j], self.jv[j], self.ja[j]
+        if self.n_hm:  # a homing axis's plan holds its actual position
+            for r in np.nonzero(self.hm & self.alive)[0].tolist():
+                self.prf_p[r] = self.res[r].prf_link.source(float(self.a_last[r]))
+                self.prf_v[r] = self.prf_a[r] = 0.0
+
+    def _release_rows(self, rows: np.ndarray) -> None:
+        """Release the groups of ``rows`` (before this cycle) and re-index."""
+        gs = {self.group_of[r] for r in rows.tolist()}
+        self._release_groups([self.groups[g] for g in sorted(gs)])
+        self._reindex()
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

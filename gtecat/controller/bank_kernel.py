@@ -123,6 +123,8 @@ class Kernel:
         n = bank.n
         self.scratch = {name: np.zeros(n, _array_type(_dtype_of(name))) for name in _SCRATCH}
         self.scratch["s_jog"] = np.zeros(5 * n, _F64)
+        self.scratch["s_hm"] = np.zeros(7 * n, _F64)  # a homing row's tentative search state
+        self.scratch["s_hit"] = np.zeros(n, np.bool_)  # homing rows that must leave first
         self.ptrs = np.zeros(len(_FIELDS), np.uint64)
         self.io = np.zeros(N_IO, np.int64)
         self.fp = np.zeros(N_FP, np.float64)
@@ -156,14 +158,27 @@ class Kernel:
         self.buffer = buf
         extra["buf"] = buf
         keep = []
+        # the arrays of the last bind that are still the same objects keep their checked
+        # address (a bind follows every claim and release: it is on the GT calls' path)
+        known = {id(a): (a, p) for a, p in zip(self._keep, self.ptrs.tolist(), strict=False)}
         for i, (name, dtype) in enumerate(_FIELDS):
             if name in extra:
                 arr = extra[name]
             elif name in self.scratch:
                 arr = self.scratch[name]
+                hit = known.get(id(arr))
+                if hit is not None and hit[0] is arr:
+                    keep.append(arr)
+                    self.ptrs[i] = hit[1]
+                    continue
             else:
                 owner, attr = (csp, name[2:]) if name.startswith("c_") else (bank, name)
                 arr = getattr(owner, attr)
+                hit = known.get(id(arr))
+                if hit is not None and hit[0] is arr:
+                    keep.append(arr)
+                    self.ptrs[i] = hit[1]
+                    continue
                 if not _fits(arr, dtype) or not arr.flags.writeable:
                     arr = np.ascontiguousarray(arr, dtype=_array_type(dtype)).copy()
                     setattr(owner, attr, arr)
@@ -176,7 +191,8 @@ class Kernel:
 
     def _placements(self) -> dict[str, np.ndarray]:
         bank = self.bank
-        plc = [p for p in bank._plc if bank.alive[p[0]]]
+        # a frozen row's image keeps what its scalar objects wrote
+        plc = [p for p in bank._plc if bank.alive[p[0]] and not bank.frz[p[0]]]
         self.io[IN_N_PLC] = len(plc)
         rx = np.asarray(bank._rx_idx, np.int64)
         self.io[IN_N_RX] = len(rx)

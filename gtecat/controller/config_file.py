@@ -40,9 +40,9 @@ on an EtherCAT axis (axis/profile/encoder N = GT axis N, 4.3):
   input whose source is not active is none); ``reverse=1`` says the switch is
   normally closed; the emulated switch is wired the way the file expects unless the machine
   description's ``switch_wiring`` says otherwise (:func:`switch_sense`), so only a file that
-  disagrees with a stated wiring reads the switch inverted; an alarm's ``reverse=1`` inverts
-  it (active while the drive is *not* in fault - noted in the log, it is rarely what a bus
-  axis wants);
+  disagrees with a stated wiring reads the switch inverted; an alarm's ``reverse=1`` follows
+  the same rule (against a stated ``switch_wiring`` it inverts the alarm: active while the
+  drive is *not* in fault, noted in the log);
   ``filterTime`` is the card's input debounce (MCT writes 3): on a bus the drive
   debounces its own inputs and the master samples 60FDh / 6041h once a cycle, so the
   value is stored (:func:`vendor_settings`) and filters nothing again.  The drive's own
@@ -777,7 +777,10 @@ def vendor_settings(ctl: Controller) -> dict[tuple[str, int], dict[str, Any]]:
 
 
 #: the inputs that are switches of the machine (a wiring the machine description may state)
-SWITCH_KINDS = ("limitPositive", "limitNegative", "home")
+#: the inputs whose wiring follows the configuration unless the machine description states
+#: it: the limit and home switches, and the drive's alarm output (a ``reverse=1`` alarm is
+#: one that opens in fault, as the machine the file was written for has it)
+SWITCH_KINDS = ("limitPositive", "limitNegative", "home", "alarm")
 
 
 def machine_wiring(ctl: Controller, axis: int) -> bool | None:
@@ -806,10 +809,12 @@ def switch_sense(
     configuration expects - ``reverse=1`` on a limit or home is a normally-closed switch
     on the machine the file was written for (``smarthome_test.cfg`` of the vendor's demo
     writes it on axis 1's limits and home) - so the application's own ``.cfg`` runs as it
-    does there and never makes every limit read as triggered.  A description that states
-    ``switch_wiring`` wins: a ``reverse`` that disagrees with it inverts the switch, as a
-    wrongly written file would on the machine.  Other inputs (alarm, GPI) are no switches
-    of the machine: ``reverse`` inverts them as written."""
+    does there and never makes every limit read as triggered.  The drive's alarm is wired
+    the same way (an application's own file with ``[alarm2] reverse=1`` must not leave its
+    axis 2 in alarm for good).  A description that states ``switch_wiring`` wins: a
+    ``reverse`` that disagrees with it inverts the input, as a wrongly written file would
+    on the machine.  Other inputs (GPI) are no switches of the machine: ``reverse``
+    inverts them as written."""
     if reverse is None:
         reverse = bool(vendor_settings(ctl).get((kind, number), {}).get("reverse", False))
     if kind not in SWITCH_KINDS:
@@ -979,15 +984,20 @@ def _wire_inputs(ctl: Controller, cfg: VendorConfig, st: _State, notes: list[str
                 unsaid = kind in SWITCH_KINDS and machine_wiring(ctl, index) is None
                 if reverse and unsaid and (kind, index) not in wired:
                     wired.add((kind, index))
+                    what = (
+                        "an alarm that opens in fault"
+                        if kind == "alarm"
+                        else ("a normally-closed switch")
+                    )
                     notes.append(
-                        f"{kind}{index} reverse=1 (a normally-closed switch): the machine "
-                        f"description does not say how axis {index}'s switches are wired "
-                        "(switch_wiring), so the switch is wired as this configuration expects"
+                        f"{kind}{index} reverse=1 ({what}): the machine description does not "
+                        f"say how axis {index}'s inputs are wired (switch_wiring), so it is "
+                        "wired as this configuration expects"
                     )
                 mismatch = kind_t != role.natural if role.natural is not None else obj != 0x60FD
                 if invert or mismatch:
                     sensed.append((res, role, ctl.axes[index].io.get(obj), bit, invert))
-                if reverse and kind_t == MC_ALARM:
+                if invert and kind_t == MC_ALARM:
                     notes.append(
                         f"axis {n} {role.name} = alarm{index} reverse=1: active while drive "
                         f"{index} is not in fault"

@@ -212,6 +212,13 @@ def signal_kind(ctl: Controller, spec: str) -> tuple[Getter, Kind]:
     m = _AXIS.match(spec)
     if m:
         return _axis_getter(ctl, int(m.group(1)), m.group(2))
+    if spec == "faults":  # how many injected faults are active (gtecat.faults)
+
+        def active() -> float:
+            inj = getattr(ctl.backend, "injector", None)
+            return float(sum(e.state == "active" for e in inj.entries)) if inj else 0.0
+
+        return active, Kind("value", "faults")
     master = ctl.require_master()
     layout = master.layout
     m = _ENTRY.match(spec)
@@ -243,7 +250,7 @@ def signal_kind(ctl: Controller, spec: str) -> tuple[Getter, Kind]:
             return master.image.access(p).get, kind
     raise ParameterError(
         f"unknown signal {spec!r}: use SLAVE:INDEX:SUB (e.g. 0:0x6041:0), an ENI variable "
-        f"name, or axisN.{'|'.join(AXIS_SIGNALS)}"
+        f"name, faults, or axisN.{'|'.join(AXIS_SIGNALS)}"
     )
 
 

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .cia402 import STATE_BITS, State, Sw
+from .cia402 import COMMAND_OF, STATE_BITS, TRANSITIONS, State, Sw
 from .drive import _wrap32 as wrap32  # the channel's own 32-bit wrap of its object values
 from .modes import SW12, OpMode
 
@@ -56,6 +56,8 @@ def claimable(ch: Channel) -> str:
         return "controlword"
     if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
         return "fault"
+    if ch.field is not None:
+        return "field fault"
     if ch.torque_ctl or ch.stopping or ch.limit_stop:
         return "stopping"
     if ch.digital_inputs & 3:
@@ -68,6 +70,60 @@ def claimable(ch: Channel) -> str:
         return "limit reaction"
     if ch.fe_flag or ch.fe_time:
         return "following error"
+    return ""
+
+
+#: a channel's values that stay as they are while it rests unpowered (frozen rows)
+FROZEN_ATTRS = (
+    "position_actual",
+    "position_demand",
+    "velocity_actual",
+    "torque_actual",
+    "current_actual",
+    "torque_demand",
+    "following_error_actual",
+    "digital_inputs",
+    "statusword",
+    "mode_display",
+    "oms",
+    "target_position",
+    "fe_flag",
+    "stopping",
+    "limit_stop",
+    "sw_limited",
+)
+_UNPOWERED_IDLE = frozenset(
+    {State.SWITCH_ON_DISABLED, State.READY_TO_SWITCH_ON, State.SWITCHED_ON, State.FAULT}
+)
+
+
+def frozen_claimable(ch: Channel) -> str:
+    """Why ``ch`` is not resting unpowered with nothing to change from cycle to cycle ("" when
+    it is): its step would coast a standing motor, take no transition and write the same
+    process values, so a bank row may skip it whole (``frz`` rows of the axis bank)."""
+    psm = ch.psm
+    if psm.state not in _UNPOWERED_IDLE:
+        return "powered or starting"
+    cw = ch.controlword
+    if cw != ch.prev_cw or psm.last_cw != cw:
+        return "controlword"
+    if psm.state is not State.FAULT and TRANSITIONS.get((psm.state, COMMAND_OF[cw & 0xFF])):
+        return "a transition is due"
+    if ch.faults.pending or ch.faults.injected:
+        return "fault"
+    if ch.mode_req != ch.mode_seen or ch.mode_due is not None:
+        return "mode change pending"
+    m = ch.mech
+    if m.vel != 0.0 or math.copysign(1.0, m.vel) < 0 or m.acc != 0.0 or m.torque != 0.0:
+        return "moving"
+    if m.limited or (m.pos == 0.0 and math.copysign(1.0, m.pos) < 0):
+        return "moving"
+    if ch.dpos != m.pos or ch.dvel != 0.0:
+        return "moving"
+    if ch.tp_function or ch._tp_applied or ch.probe.function:
+        return "touch probe"
+    if ch.target_position != ch.position_actual:
+        return "607Ah not yet on 6064h"
     return ""
 
 

@@ -54,7 +54,7 @@ from typing import Any
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
 from gtecat.drives.cia402 import STATE_BITS, PowerStateMachine, State, Sw
-from gtecat.drives.faults import ErrorCode, FaultMonitor, fault_code
+from gtecat.drives.faults import ErrorCode, FaultMonitor, FieldOverride, fault_code
 from gtecat.drives.homing import SUPPORTED_METHODS, Homing, HomingParams
 from gtecat.drives.machine import AxisMachine
 from gtecat.drives.mechanics import Mechanics, MechanicsParams
@@ -96,6 +96,7 @@ DEFAULT_HOMING_METHODS = (0, *sorted(SUPPORTED_METHODS))
 
 _INT32_MIN, _INT32_MAX = -(1 << 31), (1 << 31) - 1
 _HALT = 0x100
+_QUICK_STOP = 0x4  # controlword bit 2, active low
 _SW_WARNING = int(Sw.WARNING)
 _SW_REMOTE = int(Sw.REMOTE)
 _SW_INTERNAL_LIMIT = int(Sw.INTERNAL_LIMIT)
@@ -258,6 +259,8 @@ class Channel:
         self.dtorque = 0.0
         self.torque_ctl = False
         self.stopping = False  # a stop ramp (halt, quick stop, fault reaction) is running
+        #: the field's hands on this channel (gtecat.faults): None while nothing is forced
+        self.field: FieldOverride | None = None
         self.oms = 0
         self.fe_time = 0.0
         self.fe_flag = False
@@ -678,8 +681,11 @@ class Channel:
             psm.power_on()
         if faults.pending:
             self._take_fault()
+        ff = self.field
         if cw_valid:
             cw = self.controlword
+            if ff is not None and ff.quick_stop:
+                cw &= ~_QUICK_STOP  # the drive's quick-stop input acts like CW bit 2
             number = psm.command(cw, self.quick_stop_option, faults.cause_active)
             if number:
                 self._transition(number)
@@ -730,13 +736,19 @@ class Channel:
                     psm.fault_reaction_done()
         else:
             powered = False
+        if ff is not None and ff.sto:
+            powered = False  # safe torque off: the power stage has no enable
         # --- limit switches
         self.limit_stop = False
         din = self.digital_inputs
         if powered and din & 3 and mode != OpMode.HOMING:
             self._limit_switches(din, p0, dt)
         # --- mechanics
-        if powered:
+        if ff is not None and ff.brake:
+            mech.vel = mech.acc = 0.0  # the holding brake stays closed: the motor stalls
+            if not powered:
+                self.dpos, self.dvel = mech.pos, 0.0
+        elif powered:
             if self.torque_ctl and not self.limit_stop:
                 mech.drive_torque(self.dtorque, dt)
                 self.dpos = mech.pos
@@ -765,7 +777,7 @@ class Channel:
         if self.tp_function != self._tp_applied:
             self._tp_applied = self.tp_function
             probe.write_function(self.tp_function)
-        if probe.function:
+        if probe.function and not (ff is not None and ff.probe_off):
             off = self.enc_offset
             probe.step(p0, mech.pos, p0 - off, mech.pos - off, t_ns, dt_ns)
         if faults.pending:
@@ -827,6 +839,9 @@ class Channel:
             din |= 1 << 16
         if self._p2 and _level(self._p2, pos):
             din |= 1 << 17
+        ff = self.field
+        if ff is not None:
+            din = (din | ff.din_set) & ~ff.din_clear
         return din
 
     def _outputs(self) -> None:
@@ -834,7 +849,11 @@ class Channel:
         pos = mech.pos
         off = self.enc_offset
         if self.faults.injected != ErrorCode.ENCODER:
-            self.position_actual = _wrap32(round(pos - off))
+            ff = self.field
+            if ff is None:
+                self.position_actual = _wrap32(round(pos - off))
+            else:
+                self.position_actual = _wrap32(round(pos - off) + ff.enc_shift + ff.noise())
         self.position_demand = _wrap32(round(self.dpos - off))
         self.velocity_actual = _wrap32(round(mech.vel))
         t = _clamp16(mech.torque)

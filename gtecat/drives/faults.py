@@ -33,6 +33,7 @@ class ErrorCode(IntEnum):
     ALARM = 0xFF00  # vendor: external alarm / generic servo alarm
     POSITIVE_LIMIT = 0xFF01  # vendor: positive limit switch (limit reaction "fault")
     NEGATIVE_LIMIT = 0xFF02  # vendor: negative limit switch
+    SAFE_TORQUE_OFF = 0xFF10  # vendor: the STO input removed the power stage's enable
 
 
 #: names a scenario may pass to ``inject_fault`` (besides an ErrorCode or a raw code)
@@ -48,6 +49,7 @@ FAULT_KINDS: dict[str, ErrorCode] = {
     "following_error": ErrorCode.FOLLOWING_ERROR,
     "communication": ErrorCode.COMMUNICATION,
     "generic": ErrorCode.GENERIC,
+    "sto": ErrorCode.SAFE_TORQUE_OFF,
 }
 
 
@@ -120,3 +122,59 @@ class FaultMonitor:
         """A successful fault reset (transition 15)."""
         self.code = 0
         self.pending = 0
+
+
+class FieldOverride:
+    """What the field does to one channel against the machine description: the scenario's
+    hands on the wiring and the mechanics (set by :mod:`gtecat.faults`, read every cycle).
+
+    ``din_set`` / ``din_clear``: 60FDh bits forced on / off (a switch stuck, a chattering
+    one toggled every few cycles, a probe input that never switches); ``enc_shift``:
+    counts the encoder lost (added to 6064h); ``enc_noise``: +/- that many counts of noise
+    on 6064h (from ``rng``, seeded: runs repeat); ``quick_stop``: the drive's quick-stop
+    input is active (as controlword bit 2 clear); ``brake``: the holding brake stays
+    closed (the motor cannot turn); ``sto``: safe torque off (no torque at all);
+    ``probe_off``: the touch-probe inputs never switch.
+    """
+
+    __slots__ = (
+        "brake",
+        "din_clear",
+        "din_set",
+        "enc_noise",
+        "enc_shift",
+        "probe_off",
+        "quick_stop",
+        "rng",
+        "sto",
+    )
+
+    def __init__(self) -> None:
+        import random
+
+        self.din_set = 0
+        self.din_clear = 0
+        self.enc_shift = 0
+        self.enc_noise = 0
+        self.quick_stop = False
+        self.brake = False
+        self.sto = False
+        self.probe_off = False
+        self.rng = random.Random(0x6064)
+
+    @property
+    def idle(self) -> bool:
+        return not (
+            self.din_set
+            or self.din_clear
+            or self.enc_shift
+            or self.enc_noise
+            or self.quick_stop
+            or self.brake
+            or self.sto
+            or self.probe_off
+        )
+
+    def noise(self) -> int:
+        n = self.enc_noise
+        return self.rng.randint(-n, n) if n else 0

@@ -113,6 +113,8 @@ class MachineDescription:
     #: ``[ext.N]`` extension IO modules, ``[glink.N]`` gLink slaves (drives/ext_modules.py)
     ext: Mapping[int, Any] = field(default_factory=dict)
     glink: Mapping[int, Any] = field(default_factory=dict)
+    #: ``[[fault]]`` tables as written (the fault vocabulary, :mod:`gtecat.faults`, reads them)
+    faults: tuple[Mapping[str, Any], ...] = ()
 
     def axis(self, n: int) -> AxisMachine:
         """The description of GT axis ``n`` (defaults when the file omits it)."""
@@ -202,11 +204,17 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
         )
     from .ext_modules import ext_modules_from_dict, glink_from_dict
 
+    faults = data.get("fault", [])
+    if isinstance(faults, dict):
+        faults = [faults]
+    if not isinstance(faults, list) or not all(isinstance(f, dict) for f in faults):
+        raise MachineError(f"{source}: [[fault]] tables expected (one per fault)")
     return MachineDescription(
         axes=axes,
         source=source,
         ext=ext_modules_from_dict(data, source),
         glink=glink_from_dict(data, source),
+        faults=tuple(faults),
     )
 
 

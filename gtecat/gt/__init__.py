@@ -38,6 +38,8 @@ _MODULES = (
     "pvt_calls",
     "lead_screw_calls",
     "net_init_calls",
+    "legacy_home_calls",
+    "look_ahead_ex_calls",
 )
 
 
@@ -95,3 +97,5 @@ def _vendor_surface() -> None:
 
 
 _vendor_surface()
+
+from .. import faults as _faults  # noqa: E402,F401  (arms the machine TOML's [[fault]] tables)

@@ -38,7 +38,7 @@ from ..errors import (
     ParameterError,
 )
 from .args import Ref, binder, core_arg
-from .fast import READERS, fast_reader
+from .fast import RAW, READERS, fast_raw, fast_reader
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -136,6 +136,9 @@ class _Session:
 
 SESSION = _Session()
 REGISTRY: dict[str, Callable[..., int]] = {}
+#: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
+#: a controller process then runs every call through REGISTRY, none on a fast path
+TAPPED = False
 
 
 def code_for(exc: BaseException) -> int:
@@ -277,9 +280,11 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         return call(_ONE, args, kwargs)
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
-    if name in READERS:  # the common shape answered up front (gtecat.gt.fast)
+    fast = None
+    if name in READERS or name in RAW:  # the common shapes answered up front (gtecat.gt.fast)
         slow = gt
-        gt = functools.wraps(slow)(fast_reader(name, slow, SESSION, advance))
+        make = fast_reader if name in READERS else fast_raw
+        fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
@@ -302,6 +307,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
             def gtn(*args: Any, **kwargs: Any) -> int:
                 if args:
+                    if fast is not None and args[0] == 1 and type(args[0]) is int and not kwargs:
+                        return fast(*args[1:])  # core 1: the GT_ function's fast path
                     return call(args[0], args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 

@@ -41,7 +41,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from . import structs
-from .table import SCALARS, Param, Proto
+from .table import ENUMS, SCALARS, Param, Proto
 
 _CArgObject = type(ctypes.byref(ctypes.c_int()))
 _SIMPLE = ctypes._SimpleCData
@@ -503,7 +503,7 @@ def _integer(p: Param, value: Any) -> int:
         )
     else:
         raise ParameterError(f"{p.name}={shown(value)}: an integer is needed ({p.ctype})")
-    _, lo, hi, _ = SCALARS[p.ctype]
+    _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]  # a C enum is an int
     if p.mask:
         lo = min(lo, -(1 << 31))
         hi = max(hi, (1 << 32) - 1)
@@ -569,7 +569,7 @@ Converter = Callable[[Any], Any]
 
 def _int_converter(p: Param) -> Converter:
     """The integer check of ``p`` with its bounds precomputed; plain ints take the fast path."""
-    _, lo, hi, _ = SCALARS[p.ctype]
+    _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]  # a C enum is an int
     if p.mask:
         lo, hi = min(lo, -(1 << 31)), max(hi, (1 << 32) - 1)
     if p.lo is not None:

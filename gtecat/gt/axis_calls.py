@@ -149,7 +149,15 @@ def GT_GetEcatAxisMode(ctl: Controller, axis: int, pMode: Any) -> int:
 
 def _reader(index: int, subindex: int = 0):
     def read(ctl: Controller, axis: int, ptr: Any) -> int:
-        store(ptr, bus_axis(ctl, axis).io.read(index, subindex))
+        ax = bus_axis(ctl, axis)
+        # read past the axis bank's guard: looking must not give a banked axis back
+        lost = object.__getattribute__(ax, "link_lost")
+        if lost:  # the bytes there are the last received, not the drive's
+            raise CommandError(
+                f"axis {axis}: {lost}: 0x{index:04X} cannot be read (check the slave, its "
+                "cable and the EtherCAT communication)"
+            )
+        store(ptr, ax.io.read(index, subindex))
         return 0
 
     return read

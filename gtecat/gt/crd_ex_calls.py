@@ -5,7 +5,10 @@ The vendor's GTN header gives every line and arc an ``Ex`` form for its look-ahe
 override flag instead of an end speed.  Decisions (the header says no more):
 
 * Coordinates are pulses as doubles and are kept as given (no rounding): a path of
-  fractional points is followed as written.
+  fractional points is followed as written.  After ``GT_InitLookAheadEx`` on the FIFO
+  they are the user's units instead (mm: coordinates times ``scale[k]``, ``synVel`` in
+  units/s, ``synAcc`` in units/s², as the vendor's samples use them;
+  :mod:`gtecat.gt.look_ahead_ex_calls`).
 * There is no ``velEnd``: a segment ends at the speed the look-ahead allows
   (``GT_InitLookAhead`` on the FIFO), else at 0 - the non-``Ex`` forms' default.
   The ``G0Ex`` forms end at 0 like ``GT_LnXYG0``.
@@ -32,6 +35,7 @@ from typing import Any
 
 from ..controller.core import Controller
 from ..controller.crd.gear_rider import GearRider
+from ..controller.crd.path import PLANES
 from ..controller.crd.system import BufGear
 from ..controller.profile import PrfMode
 from ..controller.resources import axis_resources
@@ -47,10 +51,30 @@ def _ex(segNum: Any, override2: Any) -> None:
         raise ParameterError(f"override2={override2}: 0 or 1")
 
 
+def _units(c, fifo: Any, synVel: Any, synAcc: Any):
+    """The FIFO's pulses per user unit (None: pulses) and the speed and acceleration in
+    pulse/ms and pulse/ms² (``GT_InitLookAheadEx``: :mod:`gtecat.gt.look_ahead_ex_calls`)."""
+    la = c.look[int(fifo)] if int(fifo) in (0, 1) else None
+    unit = la.unit if la is not None else None
+    v, a = _real("synVel", synVel), _real("synAcc", synAcc)
+    if unit is None:
+        return None, v, a
+    v, a = v * unit[0] / 1e3, a * unit[0] / 1e6
+    if la.vel_max is not None and v > la.vel_max:
+        v = la.vel_max
+    return unit, v, a
+
+
+def _scale(unit, k: int) -> float:
+    return unit[k] if unit is not None and k < len(unit) else 1.0
+
+
 def _line(ctl, crd, what, values, synVel, synAcc, segNum, override2, fifo, g0=False) -> int:
     _ex(segNum, override2)
-    vals = {k: _real(f"coordinate {k + 1}", v) for k, v in values.items()}
-    return _push_line(_crd(ctl, crd), what, fifo, vals, synVel, synAcc, 0.0)
+    c = _crd(ctl, crd)
+    unit, synVel, synAcc = _units(c, fifo, synVel, synAcc)
+    vals = {k: _real(f"coordinate {k + 1}", v) * _scale(unit, k) for k, v in values.items()}
+    return _push_line(c, what, fifo, vals, synVel, synAcc, 0.0)
 
 
 @gt_function
@@ -91,8 +115,20 @@ def GT_LnXYZAG0Ex(ctl, crd, x, y, z, aPos, synVel, synAcc, segNum, override2, fi
 
 def _arc(ctl, crd, what, plane, a, b, d, synVel, synAcc, segNum, override2, fifo, **kw) -> int:
     _ex(segNum, override2)
-    a, b = _real("end", a), _real("end", b)
-    return _push_arc(_crd(ctl, crd), what, fifo, plane, a, b, synVel, synAcc, 0.0, d, **kw)
+    c = _crd(ctl, crd)
+    unit, synVel, synAcc = _units(c, fifo, synVel, synAcc)
+    i, j = PLANES[plane]
+    a, b = _real("end", a) * _scale(unit, i), _real("end", b) * _scale(unit, j)
+    if unit is not None:
+        if kw.get("radius") is not None:
+            kw["radius"] = _real("radius", kw["radius"]) * _scale(unit, i)
+        if kw.get("center") is not None:
+            ca, cb = kw["center"]
+            kw["center"] = (
+                _real("center", ca) * _scale(unit, i),
+                _real("center", cb) * _scale(unit, j),
+            )
+    return _push_arc(c, what, fifo, plane, a, b, synVel, synAcc, 0.0, d, **kw)
 
 
 @gt_function

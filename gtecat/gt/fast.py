@@ -14,15 +14,26 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import functools
 import struct
 from collections.abc import Callable
 from typing import Any
+
+import numpy as np
 
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
-_seen: dict[int, tuple[Any, str]] = {}  # id -> (object, repr of byref(object)), recent ones
+_NDARRAY = np.ndarray
+
+
+@functools.lru_cache(maxsize=1024)
+def _cparam(address: int) -> str:
+    """The repr of ``byref(obj)`` for an object at ``address`` (fresh objects reuse addresses)."""
+    return f"<cparam 'P' ({address:#x})>"
+
+
 _NO: Any = object()  # an argument the caller did not pass
 _addressof = ctypes.addressof
 
@@ -42,6 +53,9 @@ def attr_getter(name: str) -> Callable[[Any], float]:
 
 _INTS = frozenset({ctypes.c_int32, ctypes.c_long, ctypes.c_int64, ctypes.c_longlong})
 _DOUBLE = frozenset({ctypes.c_double})
+#: numpy arrays the fast path writes element 0 of (the table path's flat[:1] = [value])
+_NP_INTS = frozenset({np.dtype(np.int32), np.dtype(np.int64)})
+_NP_DOUBLE = frozenset({np.dtype(np.float64)})
 
 #: function -> (value of one axis's resources, the ctypes types *pValue may have: ``long`` is
 #: the vendor's 32 bits, and a Python caller's ``c_long()`` is 64 bits on Linux; both work)
@@ -69,6 +83,7 @@ def fast_reader(
     """``slow`` (the table-checked GT function) with the fast path in front of it;
     ``advance(ctl, name, rc)`` runs the call's host latency, catching what the cycle raises."""
     get, ctypes_ok = READERS[name]
+    np_ok = _NP_INTS if ctypes_ok is _INTS else _NP_DOUBLE
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
     array_types: dict[type, bool] = {}
 
@@ -90,7 +105,8 @@ def fast_reader(
             or kw
             or ctl is None
             or (count is not _NO and (type(count) is not int or count != 1))
-            or (pClock is not _NO and pClock is not None)
+            # pClock NULL: omitted, None or 0 (the manual's own form, GT_GetSts(1, &s, 1, 0))
+            or (pClock is not _NO and pClock is not None and (type(pClock) is not int or pClock))
             or session.remote is not None
         ):
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
@@ -104,16 +120,15 @@ def fast_reader(
             if p is not last[0]:
                 # byref(obj), not byref(obj, offset): its repr names the address it holds
                 # (cheaper than asking ctypes); any doubt takes the table path
-                seen = _seen.get(id(obj))
-                if seen is None or seen[0] is not obj:
-                    if len(_seen) > 512:
-                        _seen.clear()
-                    seen = _seen[id(obj)] = (obj, f"<cparam 'P' ({_addressof(obj):#x})>")
-                if type(obj) not in ctypes_ok or repr(p) != seen[1]:
+                if type(obj) not in ctypes_ok or repr(p) != _cparam(_addressof(obj)):
                     return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
                 last[0] = p  # checked: the same pointer object next time needs no check
             obj.value = get(res)
+        elif tp in ctypes_ok:  # the ctypes object itself (ctypes passes it by reference)
+            p.value = get(res)
         elif is_array(tp):
+            p[0] = get(res)
+        elif tp is _NDARRAY and p.dtype in np_ok and p.ndim == 1 and p.size and p.flags.writeable:
             p[0] = get(res)
         else:
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
@@ -166,3 +181,176 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
         return out
 
     return answer
+
+
+#: the raw image functions on the fast path (``offset, size, buffer``; the IO pair with the
+#: slave first, offsets inside its region)
+RAW = frozenset(
+    {"GT_GetEcatRawData", "GT_SetEcatRawData", "GT_EcatIOReadInput", "GT_EcatIOWriteOutput"}
+)
+_IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
+_BYTES_NP = np.dtype(np.uint8)
+
+
+def _index(image: Any, offset: int, size: int, write: bool) -> np.ndarray | None:
+    """The process-image indices of a raw range, or None when the fast path must not answer
+    (outside the image, a masked or unaligned image, an input byte written: the table path
+    gives the code and the reason)."""
+    if offset < 0 or size <= 0 or offset + size > image.size or not image.aligned:
+        return None
+    if not image._full_bytes:
+        return None
+    if write and not image._raw_is_out[offset : offset + size].all():
+        return None
+    return image._raw_index[offset : offset + size].copy()
+
+
+def fast_raw(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` (and the IO pair, slave first) with the
+    fast path in front of the table: ``(int offset, int size, buffer)`` on the in-process
+    controller with every slave online, the buffer a ctypes array, a bytearray, a one-byte
+    numpy array or memoryview (and for writes ``bytes`` too) holding at least ``size`` bytes.
+    One numpy copy between the caller's memory and the process image; anything else takes
+    the table path."""
+    write = name in ("GT_SetEcatRawData", "GT_EcatIOWriteOutput")
+    io = name in _IO
+    cache: dict[tuple[int, int], np.ndarray | None] = {}
+    seen: list[Any] = [None]  # the image the cache is of
+    #: byte views of the caller's ctypes and numpy buffers, the last few (kept alive)
+    views: dict[tuple[int, int], tuple[Any, np.ndarray]] = {}
+    copyto, frombuffer, u8 = np.copyto, np.frombuffer, np.uint8
+
+    def view(p: Any, tp: type, size: int) -> np.ndarray | None:
+        """``size`` bytes of the caller's buffer as a numpy array (None: not a fast shape)."""
+        key = (id(p), size)
+        v = views.get(key)
+        if v is not None and v[0] is p:
+            return v[1]
+        if issubclass(tp, ctypes.Array):
+            if ctypes.sizeof(p) < size:
+                return None
+            arr = frombuffer(p, u8, size)
+        elif tp is _NDARRAY:
+            if p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous or p.size < size:
+                return None
+            if not write and not p.flags.writeable:
+                return None
+            arr = p[:size]
+        elif tp is bytearray or tp is memoryview or (write and tp is bytes):
+            # never kept: a cached view would stop the caller resizing a bytearray
+            if tp is memoryview and (p.format != "B" or p.ndim != 1 or not p.c_contiguous):
+                return None
+            if len(p) < size or (not write and tp is memoryview and p.readonly):
+                return None
+            return frombuffer(p, u8, size)
+        else:
+            return None
+        if len(views) >= 16:
+            views.clear()
+        views[key] = (p, arr)
+        return arr
+
+    def raw_gt(offset: Any = _NO, size: Any = _NO, p: Any = _NO, *extra: Any, **kw: Any) -> int:
+        if extra or kw or p is _NO:
+            return slow(*(a for a in (offset, size, p) if a is not _NO), *extra, **kw)
+        return run(-1, offset, size, p, (offset, size, p))
+
+    def io_gt(
+        slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, *more: Any, **kw: Any
+    ) -> int:
+        if more or kw or p is _NO or type(slave) is not int:
+            return slow(*(a for a in (slave, offset, size, p) if a is not _NO), *more, **kw)
+        return run(slave, offset, size, p, (slave, offset, size, p))
+
+    def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
+        ctl = session.controllers.get(1)
+        m = ctl.master if ctl is not None else None
+        if (
+            type(offset) is not int
+            or type(size) is not int
+            or m is None
+            or not m.opened
+            or m.offline
+            or session.remote is not None
+            or ctl.clock._thread is not None
+        ):
+            return slow(*args)
+        image = m.image
+        raw = offset
+        if io:  # an offset inside one slave's region (the table path's _region)
+            slaves = image.layout.slaves
+            if not 0 <= slave < len(slaves):
+                return slow(*args)
+            sl = slaves[slave]
+            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
+                return slow(*args)
+            raw = sl.gt_offset + offset
+        if image is not seen[0]:
+            cache.clear()
+            seen[0] = image
+        key = (raw, size)
+        if key in cache:
+            idx = cache[key]
+        else:
+            idx = cache[key] = _index(image, raw, size, write)
+        if idx is None:
+            return slow(*args)
+        arr = view(p, type(p), size)
+        if arr is None:
+            return slow(*args)
+        if write:
+            image.buffer[idx] = arr
+        else:
+            copyto(arr, image.buffer.take(idx))  # (np.take with out= costs microseconds)
+        session.last = None
+        if ctl.clock.mode is not _LOCKSTEP:
+            return advance(ctl, name, 0)
+        return 0
+
+    gt = io_gt if io else raw_gt
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
+#: why a function that takes pointers is answered by the table path only (its binder checks
+#: and converts every argument generically: a few microseconds).  By group; every function of
+#: the table with a pointer parameter is on the fast path (READERS, RAW), declared only, or
+#: covered here (tests/gtecat/gt/test_fast_shapes.py walks the table).
+SLOW_REASONS: dict[str, str] = {
+    "buffered": "buffered commands: each call queues planning work that outweighs its arguments",
+    "compare": "position compare and trigger set-up, data and status: table path",
+    "crd_ex": "extended coordinated-motion queue calls: the planning work outweighs the arguments",
+    "lead_screw": "lead-screw compensation tables: set up once",
+    "legacy_home": "the older homing calls: set up once, then a polled status (table path)",
+    "look_ahead_ex": "look-ahead set-up and planner modes: set up once",
+    "net_init": "network cards' set-up and their encoder readers: table path",
+    "pvt": "PVT tables and status: the table work outweighs the arguments",
+    "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
+    "arguments); the clock and version readers are answered after the table's checks",
+    "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
+    "ecat_axis": "per-axis PDO readers and homing/probe status: table path (a few microseconds)",
+    "ecat_io": "one output bit read: table path",
+    "emulator": "emulator helpers for tests, not called in control loops",
+    "ext_io": "extension-module IO: each call walks the module configuration (table path)",
+    "gantry": "a mode query: table path",
+    "gts_card": "the pulse-card (GTS) layer: table path",
+    "motion": "profile set-up and parameter readers (called once per move); the position and "
+    "speed readers that polling loops use are on the fast path",
+    "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
+    "programs": "motion programs, variables and MRAM: compile and download work outweighs "
+    "the arguments",
+    "pt_gear_follow": "PT/gear/follow queue and set-up readers: table path",
+    "servo_loop": "servo-loop parameters and analog values: table path",
+    "status": "status set-up readers (soft limits, bands, stop decelerations) and the "
+    "configuration file: GT_GetSts, the polled one, is on the fast path",
+}
+
+
+def fast_functions() -> frozenset[str]:
+    """The functions whose common shapes the fast path answers."""
+    return frozenset(READERS) | RAW

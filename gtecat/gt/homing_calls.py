@@ -163,6 +163,9 @@ class ProbeStatus(IntFlag):
 class _AxisHoming:
     """What the controller remembers about one axis's homing (lives as long as the axis)."""
 
+    #: the axis bank knows this hook: an inactive one does nothing, and while a claimed
+    #: drive searches its answer stays "in progress" (gtecat.controller.bank)
+    bank_homing_hook = True
     params_set: bool = False
     #: a run started by GT_StartEcatHoming has not ended yet (status 0)
     active: bool = False
@@ -417,6 +420,13 @@ def stop_homing(ctl: Controller, ax: Axis) -> None:
 def homing_status(ax: Axis) -> int:
     """GT_GetEcatHomingStatus's value, 0, 3 or 5 (module docstring); the polling hot path.
     While a search that cannot end runs, GTE_GetLastError says why (a note, the call is 0)."""
+    # read past the axis bank's guard (the polling hot path must not give a banked axis back)
+    lost = object.__getattribute__(ax, "link_lost")
+    if lost:  # the drive cannot be reached: its homing is not known (entry 43: 1)
+        raise CommandError(
+            f"axis {object.__getattribute__(ax, 'number')}: {lost}: the homing state is "
+            "unknown (a homing in progress was interrupted; home again once the slave is back)"
+        )
     st = _STATE.get(ax)
     if st is None:
         _statusword(ax)  # 6041h must be mapped (return 1 naming it, entry 43)

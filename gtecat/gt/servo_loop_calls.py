@@ -47,7 +47,7 @@ from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.digital_io import GPIO_COUNT, digital_io
 from ..controller.ext_io import ext_io
-from ..controller.resources import axis_resources
+from ..controller.resources import axis_resources, resource_count
 from ..controller.safety import SOFT_NEGATIVE_OFF, SOFT_POSITIVE_OFF
 from ..controller.servo_loop import ADC_CHANNELS, PID_SETS, PidSet, servo_loop
 from ..errors import CommandError, ParameterError
@@ -521,9 +521,13 @@ def _resources(ctl: Controller, res_type: int) -> tuple[int, int]:
     t = int(res_type)
     io = ext_io(ctl)
     if t in _PER_AXIS:
+        # the count is the controller's own (resource_count: a GTS card's axes, else 12),
+        # before GT_InitEcatComm too: applications size their loops by it at start-up (the
+        # vendor's EtherCAT demo counts its cores from it before the bus is up), and the
+        # count forms of chapter 13 accept every one of these axes
         card = getattr(ctl, "card", None)
         top = card.spec.axes if card is not None else AXES_PER_CORE
-        return top, len(ctl.axes)
+        return top, resource_count(ctl)
     fixed = {MC_ADC: ADC_CHANNELS, MC_GPI: GPIO_COUNT, MC_GPO: GPIO_COUNT}
     if t in fixed:
         return fixed[t], fixed[t]

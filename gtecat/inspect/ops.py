@@ -34,7 +34,18 @@ Op = Callable[..., Any]
 OPS: dict[str, Op] = {}
 #: operations that change the machine (the panel sends them only with --control)
 CONTROL = frozenset(
-    {"jog", "trap", "stop", "sdo_download", "reg_write", "states", "set_input_bit", "set_input"}
+    {
+        "jog",
+        "trap",
+        "stop",
+        "sdo_download",
+        "reg_write",
+        "states",
+        "set_input_bit",
+        "set_input",
+        "fault_inject",
+        "fault_clear",
+    }
 )
 
 
@@ -263,3 +274,33 @@ def stop(ctx: Any, axis: int, abrupt: bool = False) -> None:
 
 
 __all__ = ["CONTROL", "OPS"]
+
+
+# --- faults (gtecat.faults: ``gtecat fault``, the panel) -----------------------------------------
+@_op
+def fault_inject(ctx: Any, values: dict[str, Any]) -> dict[str, Any]:
+    """Arm a fault from ``{"kind": ..., key: value}`` (a ``[[fault]]`` table); its listing."""
+    from .. import faults
+
+    if not isinstance(values, dict):
+        raise ParameterError("a fault is {kind: ..., key: value}")
+    spec = faults.spec_from_dict(values)
+    fid = faults.inject(spec, ctl=ctx.ctl)
+    for f in faults.listing(ctl=ctx.ctl):
+        if f["id"] == fid:
+            return f
+    return {"id": fid, "state": "ended", "describe": spec.describe()}  # a power cycle: done
+
+
+@_op
+def fault_list(ctx: Any) -> list[dict[str, Any]]:
+    from .. import faults
+
+    return faults.listing(ctl=ctx.ctl)
+
+
+@_op
+def fault_clear(ctx: Any, ident: int | None = None) -> int:
+    from .. import faults
+
+    return faults.clear(None if ident is None else int(ident), ctl=ctx.ctl)

@@ -39,7 +39,18 @@ from .ops import CONTROL
 RATE_HZ = 25
 #: what a browser may ask without --control
 READ_OPS = frozenset(
-    {"info", "layout", "log", "slaves", "pdos", "sdos", "sdo_upload", "sdo_entry", "data"}
+    {
+        "info",
+        "layout",
+        "log",
+        "slaves",
+        "pdos",
+        "sdos",
+        "sdo_upload",
+        "sdo_entry",
+        "data",
+        "fault_list",
+    }
 )
 CONTROL_OPS = CONTROL | {"sdo_write", "set_input"}
 #: scope rows kept for the page at most (about 10 minutes at 1 ms)

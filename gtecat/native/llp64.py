@@ -12,6 +12,14 @@ their 32-bit fields are ``int`` in both builds (:mod:`gtecat.native.cdecl`).
 It is compiled on first use beside ``libgts.so`` in the same cache folder
 (:func:`ensure_built`), so a changed table rebuilds both.  The Mono dllmap of
 :mod:`gtecat.native.csharp` points ``gts.dll`` here.
+
+The older multi-card ABI (:mod:`gtecat.native.multicard`, ``short cardNum`` first) has its
+LLP64 build too, ``libgts_mc-llp64.so`` (``ensure_built(abi="gts-multicard")``): the same
+generated layer with ``long`` -> ``int``, linked to ``libgts-llp64.so`` instead of
+``libgts.so`` and compiled beside ``libgts_mc.so``.  Its ``dlsym(RTLD_NEXT)`` finds each
+``GT_x`` in ``libgts-llp64.so`` (the library it needs), so a C# wrapper in the multi-card
+style (``GT_GetSts(short cardNum, short axis, out int pSts, ...)``) meets 4-byte ``long``
+all the way down.
 """
 
 from __future__ import annotations
@@ -24,12 +32,15 @@ import shlex
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 from ..cbuild import NativeBuildError, compiler
 from . import build as _build
 
 LIBRARY = "libgts-llp64.so"
+#: the LLP64 build of the multi-card layer, over :data:`LIBRARY`
+MULTICARD_LIBRARY = "libgts_mc-llp64.so"
 
 # ``long`` that is not half of ``long long``; ``unsigned long`` first so it becomes
 # ``unsigned int`` in one piece
@@ -43,16 +54,20 @@ def to_llp64(c_text: str) -> str:
     return _LONG.sub("int", _UNSIGNED_LONG.sub("unsigned int", c_text))
 
 
+def llp64_header(text: str) -> str:
+    """``gts.h`` with ``int`` for ``long`` in its prototypes (structures keep their types)."""
+    return "\n".join(
+        to_llp64(line) if line.startswith("short ") else line for line in text.splitlines()
+    )
+
+
 def llp64_sources(files: dict[str, str]) -> dict[str, str]:
     """The files of the LLP64 build from libgts's: the prototypes of ``gts.h``, the stubs
     (signatures and the element sizes of their pointers) and the declared-only functions
     take ``int`` for ``long``;
     the runtime is unchanged (it keeps its own ``long`` for its own numbers)."""
     out = dict(files)
-    out["gts.h"] = "\n".join(
-        to_llp64(line) if line.startswith("short ") else line
-        for line in files["gts.h"].splitlines()
-    )
+    out["gts.h"] = llp64_header(files["gts.h"])
     out["gts_stubs.c"] = to_llp64(files["gts_stubs.c"])
     out["gts_declared.c"] = to_llp64(files["gts_declared.c"])
     return out
@@ -62,8 +77,11 @@ def library(build: _build.Build) -> Path:
     return build.lib_dir / LIBRARY
 
 
-def ensure_built(*, force: bool = False) -> Path:
-    """``libgts-llp64.so`` for this gtecat, compiled beside ``libgts.so`` if needed."""
+def ensure_built(*, force: bool = False, abi: str = "") -> Path:
+    """``libgts-llp64.so`` for this gtecat, compiled beside ``libgts.so`` if needed
+    (``abi="gts-multicard"``: ``libgts_mc-llp64.so``, beside ``libgts_mc.so``)."""
+    if abi:
+        return _ensure_multicard(force=force, abi=abi)
     build = _build.ensure_built(force=force)
     target = library(build)
     if target.is_file() and not force:
@@ -76,11 +94,79 @@ def ensure_built(*, force: bool = False) -> Path:
     return target
 
 
+def _ensure_multicard(*, force: bool, abi: str) -> Path:
+    # libgts_mc's folder (it names the same table); forced, this compiles libgts again too,
+    # which empties libgts's folder, so libgts-llp64.so is asked for after it, unforced
+    build = _build.ensure_built(force=force, abi=abi)
+    base = ensure_built()  # libgts-llp64.so, the library the layer calls
+    target = build.lib_dir / MULTICARD_LIBRARY
+    if target.is_file() and not force:
+        return target
+    with open(build.root.parent / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if target.is_file() and not force:
+            return target
+        _compile_multicard(build, base, target)
+    return target
+
+
+def multicard_sources() -> dict[str, str]:
+    """The files of ``libgts_mc-llp64.so``: libgts_mc's with ``long`` -> ``int`` in its
+    layer and in the single-card header it includes."""
+    files = _build.multicard_sources()
+    out = dict(files)
+    out["gts_sc.h"] = llp64_header(files["gts_sc.h"])
+    out["gts_multicard.c"] = to_llp64(files["gts_multicard.c"])
+    return out
+
+
+def _compile_multicard(build: _build.Build, base: Path, target: Path) -> None:
+    files = multicard_sources()
+    with _scratch(build) as tmp:
+        for name, text in files.items():
+            (tmp / name).write_text(text, encoding="utf-8")
+        out = tmp / MULTICARD_LIBRARY
+        cmd = [
+            *compiler(),
+            *_build.CFLAGS,
+            "-O0",  # one-line forwarders, as libgts_mc's
+            "-shared",
+            f"-Wl,-soname,{MULTICARD_LIBRARY}",
+            f"-I{tmp}",
+            str(tmp / "gts_multicard.c"),
+            f"-L{base.parent}",
+            f"-Wl,-rpath,{base.parent}",
+            f"-l:{base.name}",
+            "-ldl",
+            "-o",
+            str(out),
+        ]
+        _run(cmd, MULTICARD_LIBRARY)
+        os.replace(out, target)
+
+
+@contextlib.contextmanager
+def _scratch(build: _build.Build) -> Iterator[Path]:
+    tmp = Path(tempfile.mkdtemp(prefix=".llp64-", dir=build.root))
+    try:
+        yield tmp
+    finally:
+        with contextlib.suppress(OSError):
+            shutil.rmtree(tmp)
+
+
+def _run(cmd: list[str], what: str) -> None:
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise NativeBuildError(f"building {what} failed ({shlex.join(cmd)}):\n{r.stderr.strip()}")
+    if r.stderr.strip():
+        raise NativeBuildError(f"building {what} warned (it must not):\n{r.stderr.strip()}")
+
+
 def _compile(build: _build.Build, target: Path) -> None:
     cc = compiler()
     files = llp64_sources(_build.sources(_build.python_executable()))
-    tmp = Path(tempfile.mkdtemp(prefix=".llp64-", dir=build.root))
-    try:
+    with _scratch(build) as tmp:
         for name, text in files.items():
             (tmp / name).write_text(text, encoding="utf-8")
         out = tmp / LIBRARY
@@ -100,17 +186,16 @@ def _compile(build: _build.Build, target: Path) -> None:
             "-o",
             str(out),
         ]
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            raise NativeBuildError(
-                f"building {LIBRARY} failed ({shlex.join(cmd)}):\n{r.stderr.strip()}"
-            )
-        if r.stderr.strip():
-            raise NativeBuildError(f"building {LIBRARY} warned (it must not):\n{r.stderr.strip()}")
+        _run(cmd, LIBRARY)
         os.replace(out, target)
-    finally:
-        with contextlib.suppress(OSError):
-            shutil.rmtree(tmp)
 
 
-__all__ = ["LIBRARY", "ensure_built", "library", "llp64_sources", "to_llp64"]
+__all__ = [
+    "LIBRARY",
+    "MULTICARD_LIBRARY",
+    "ensure_built",
+    "library",
+    "llp64_sources",
+    "multicard_sources",
+    "to_llp64",
+]

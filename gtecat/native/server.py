@@ -85,6 +85,17 @@ IO_TIMEOUT_S = 10.0
 DEFAULT_SPIN_US = 100
 
 
+def _cpus_busy() -> bool:
+    """More threads runnable than this process may use CPUs (/proc/loadavg's 4th field)."""
+    try:
+        with open("/proc/loadavg", encoding="ascii") as f:
+            running = int(f.read().split()[3].split("/")[0])
+        cpus = len(os.sched_getaffinity(0))
+    except (OSError, ValueError, IndexError, AttributeError):
+        return False
+    return running > cpus
+
+
 def default_spin_us() -> float:
     try:
         cpus = len(os.sched_getaffinity(0))
@@ -209,7 +220,9 @@ class _Decoder:
         self.fn_gtn = _core.REGISTRY.get("GTN_" + plan.name[3:]) if plan.proto.gtn else None
         #: the common request shape answered without decoding (gtecat.gt.fast), GT_ only
         self.fast = (
-            wire_reader(plan.name, long_size, _core.SESSION) if plan.name in READERS else None
+            wire_reader(plan.name, long_size, _core.SESSION)
+            if plan.name in READERS and not _core.TAPPED
+            else None
         )
 
     def decode(self, body: Any, pos: int) -> tuple[list[Any], list[Any]]:
@@ -330,6 +343,8 @@ class Server:
                 log.warning("GTECAT_SERVER_SPIN_US=%r is not a number; using the default", env)
                 spin_us = default_spin_us()
         self.spin_s = max(0.0, spin_us) / 1e6
+        self._budget = self.spin_s  # the adaptive spin (_spin_budget)
+        self._busy, self._busy_next, self._since_probe = False, 0.0, 0
         self.lock = threading.RLock()
         _inspect.KIND, _inspect.LOCK = "controller", self.lock  # its endpoint (gtecat ps)
         self.calls = 0
@@ -455,6 +470,33 @@ class Server:
                 c.field.stop_traces()
         c.sock.close()
 
+    def _spin_budget(self) -> float:
+        """Seconds to spin for this client's next request: none while more threads are
+        runnable than this process has CPUs (spinning would take the CPU the client waits
+        for), half the last one after a spin that found nothing (a short probe every 256
+        rounds once it is none), up to ``spin_s``."""
+        if not self.spin_s:
+            return 0.0
+        now = time.monotonic()
+        if now >= self._busy_next:
+            self._busy_next = now + 0.01
+            self._busy = _cpus_busy()
+        if self._busy:
+            return 0.0
+        if not self._budget:
+            self._since_probe += 1
+            if self._since_probe < 256:
+                return 0.0
+            self._since_probe = 0
+            return self.spin_s / 8
+        return self._budget
+
+    def _spin_done(self, found: bool) -> None:
+        if found:
+            self._budget = min(self.spin_s, max(self._budget * 2, self.spin_s / 8))
+        else:
+            self._budget = self._budget / 2 if self._budget / 2 >= 1e-6 else 0.0
+
     def _readable(self, c: _Client) -> None:
         """Serve what ``c`` sent; then, for ``spin_s``, serve its next request at once
         (a client polling in a loop sends it within microseconds; answering it without
@@ -462,24 +504,32 @@ class Server:
         wake-up)."""
         recv = c.sock.recv
         deadline = 0.0
+        budget = -1.0
         while True:
             try:
                 data = recv(CHUNK)
             except BlockingIOError:
-                if not self.spin_s:
+                if budget < 0.0:
+                    budget = self._spin_budget()
+                if not budget:
                     return
                 now = time.perf_counter()
                 if not deadline:
-                    deadline = now + self.spin_s
+                    deadline = now + budget
                 if now >= deadline:
+                    self._spin_done(False)
                     return
+                os.sched_yield()  # the client first, where it shares this CPU
                 continue
             except OSError:
                 data = b""
             if not data:
                 self._drop(c)
                 return
+            if deadline:
+                self._spin_done(True)
             deadline = 0.0
+            budget = -1.0
             if not self._frames(c, data):
                 return
 

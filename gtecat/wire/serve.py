@@ -287,6 +287,13 @@ class WireServer:
         self.snapshots = 0
         #: (process CPU time, clock) when the records last started: the CPU share reported
         self._cpu_mark = (time.process_time(), clock())
+        #: what an answer meets on its way back (gtecat.faults): called with the answered
+        #: frame, its length and the receive time; returns the length to send (0: lost)
+        self.frame_hook: Callable[[bytearray, int, int], int] | None = None
+        #: called after every step of the slaves with the slaves' time (ns since the start)
+        self.step_hooks: list[Callable[[int], None]] = []
+        #: called between frames (every few ms) with that time: timers of the hooks above
+        self.poll_hooks: list[Callable[[int], None]] = []
 
     def _snapshot(self) -> None:
         """Report what the latency records hold and start them afresh (``gtecat serve``:
@@ -308,6 +315,8 @@ class WireServer:
         self._last_step = now
         self.chain.step(now - self._t0, dt, between)
         self.stats.steps += 1
+        for hook in self.step_hooks:
+            hook(now - self._t0)
 
     # --- the loop --------------------------------------------------------------------------
     def serve(
@@ -360,6 +369,14 @@ class WireServer:
                 if pcap is not None:
                     pcap.write(request, self._wall(t_kernel or t_in))
                 return True
+            hook = self.frame_hook
+            if hook is not None:
+                n = hook(buf, n, t_in - self._t0)
+                if n <= 0:  # lost on its way back: the master's frame times out
+                    if pcap is not None:
+                        pcap.write(request, self._wall(t_kernel or t_in))
+                    self._guarded(chain.service)
+                    return True
             t_send = clock()
             try:
                 send(view[:n])
@@ -463,6 +480,8 @@ class WireServer:
                     if self.snapshot_due:
                         self._guarded(self._snapshot)
                     self._guarded(chain.poll, now)
+                    for hook in self.poll_hooks:
+                        self._guarded(hook, now - self._t0)
                     gc.collect(0)
                     self._sync_clocks()
                     next_poll = clock() + 5_000_000

@@ -143,6 +143,11 @@ class LookAhead:
     T: float
     acc_max: float
     n: int
+    #: pulses per user unit of each coordinate when the look-ahead was set up in user
+    #: units (GT_InitLookAheadEx): the ``Ex`` lines and arcs of the FIFO are in those units
+    unit: tuple[float, ...] | None = None
+    #: the fastest speed along the path in pulse/ms (the axes' vMax), None = no limit
+    vel_max: float | None = None
 
 
 class AxisSlot:
@@ -208,6 +213,8 @@ class CoordSystem:
         self.fifos: tuple[deque[Entry], deque[Entry]] = (deque(), deque())
         self.tails: list[tuple[float, ...] | None] = [None, None]
         self.look: list[LookAhead | None] = [None, None]
+        #: GT_SetupLookAheadCrd's machine mode and the planner modes (``...ModeLa``) by name
+        self.la_modes: dict[str, Any] = {}
         self.stop_dec = StopDecel()
         self.override = 1.0
         self.outputs: dict[int, int] = {}

@@ -37,7 +37,10 @@
     X(s_target, i64) X(s_raw, i64) X(s_a, f64) X(s_enc, f64) X(s_step, f64)                \
     X(s_pos, f64) X(s_vel, f64) X(s_acc, f64) X(s_dpos, f64) X(s_dvel, f64)                \
     X(s_fe, f64) X(s_lim, u8) X(s_swl, u8) X(s_din, i64) X(s_since, i64) X(s_arr, u8)      \
-    X(s_jog, f64)
+    X(hm, u8) X(h_last, f64) X(h_el, f64) X(h_tr, f64) X(h_v, f64) X(h_p, f64)             \
+    X(h_rest, f64) X(h_set, u8) X(h_vt, f64) X(h_acc, f64) X(h_lo, f64) X(h_hi, f64)       \
+    X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
+    X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)
 
 enum {
 #define X(name, type) F_##name,
@@ -147,14 +150,72 @@ static int64_t clip16(double x)
     return to_i64(t);
 }
 
+/* drives.homing.Homing.step of a row in a search phase (SEARCH, APPROACH, INDEX), not halted,
+ * and the demand step_hm hands to the mechanics.  The row was claimed between two events:
+ * h_lo < every position it has been at < h_hi, where h_lo/h_hi are the nearest positions at
+ * which _scan would find something (a switch edge, a limit, an index pulse).  Returns 1 when
+ * this cycle would leave that state (an event crossed, a search bound reached): nothing is
+ * written and the row goes back to the scalar drive for this cycle. */
+static int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
+{
+    double pos = F64(c_pos)[r], p0 = F64(h_last)[r];
+    double el = F64(h_el)[r], tr = F64(h_tr)[r], v = F64(h_v)[r], vt = F64(h_vt)[r];
+    double a_dt, p, rest = F64(h_rest)[r], x;
+    double *sh = F64(s_hm) + 7 * r;
+    int settled;
+    el += dt;
+    if (pos != p0) {
+        double lo = pos < p0 ? pos : p0, hi = pos < p0 ? p0 : pos;
+        tr += fabs(pos - p0);
+        if (!(F64(h_lo)[r] < lo && hi < F64(h_hi)[r]))
+            return 1; /* _scan would meet an event */
+    }
+    /* _check_bounds */
+    if (U8(h_idx)[r] && (pos - F64(h_from)[r]) * F64(h_fd)[r] > F64(h_ilim)[r])
+        return 1;
+    if (tr > F64(h_maxtr)[r] || el > F64(h_tmo)[r])
+        return 1;
+    /* _move */
+    a_dt = F64(h_acc)[r] * dt;
+    if (v < vt) {
+        x = v + a_dt;
+        v = vt < x ? vt : x; /* min(v + a_dt, v_target) */
+    } else if (v > vt) {
+        x = v - a_dt;
+        v = vt > x ? vt : x; /* max(v - a_dt, v_target) */
+    }
+    p = F64(h_p)[r] + v * dt;
+    /* settling (a search phase is never RETURN) */
+    if (v == 0.0) {
+        rest += dt;
+        settled = fabs(pos - p) <= 1.0 || rest >= 0.05; /* POSITION_WINDOW, SETTLE_TIME_S */
+    } else {
+        rest = 0.0;
+        settled = 0;
+    }
+    sh[0] = pos;
+    sh[1] = el;
+    sh[2] = tr;
+    sh[3] = v;
+    sh[4] = p;
+    sh[5] = rest;
+    sh[6] = settled ? 1.0 : 0.0;
+    /* step_hm: the demand and its speed */
+    *dvel = (p - F64(c_dpos)[r]) / dt;
+    *demand = p;
+    return 0;
+}
+
 int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
+    const double half_per_dt = 0.5 / dt;
     const uint8_t *alive = U8(alive);
     uint8_t *buf = U8(buf);
     int64_t r, i;
-    int fin_any = 0;
+    int fin_any = 0, csp_hit = 0, hm_hit = 0;
+    const uint8_t *hm = U8(hm);
 
     /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back */
     for (i = 0; i < io[IN_N_RX]; i++)
@@ -168,8 +229,22 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         double prf, a, demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, rel, vstop, dv, acc, pos;
         double fe, step, enc, err, band;
         int limited = 0, swl = 0, hit = 0, ended, standing, inb, arr;
-        if (!alive[r])
+        if (!alive[r] || U8(frz)[r]) /* a frozen row: nothing of its cycle changes */
             continue;
+        if (hm[r]) {
+            U8(s_hit)[r] = 0;
+            if (homing_row(ptr, r, dt, &demand, &dvel)) {
+                U8(s_hit)[r] = 1;
+                hm_hit = 1;
+                continue;
+            }
+            /* Axis.pre: 607Ah follows 6064h (the value in the image since the last cycle) */
+            target = (int32_t)(uint32_t)(uint64_t)to_i64(rint(F64(c_pos)[r] - (double)I64(c_off)[r]));
+            swl = U8(c_sw_limited)[r]; /* step_csp does not run: 6041h bit 11 keeps its cause */
+            a = 0.0;  /* from 6064h below */
+            ended = 1;
+            goto mechanics;
+        }
         cur = I64(t_cur)[r];
         prf = F64(t_p)[I64(base)[r] + cur];
         ended = cur == I64(t_end)[r];
@@ -219,6 +294,7 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         x += I64(c_off)[r];
         demand = (double)x;
         dvel = (demand - F64(c_dpos)[r]) / dt;
+    mechanics:
         /* Mechanics.track */
         p = F64(c_pos)[r];
         v0 = F64(c_vel)[r];
@@ -233,13 +309,20 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         lim = F64(c_lim)[r];
         dist = demand - p;
         rel = dist - vff * dt;
-        vstop = closing_speed(fabs(rel), lim, dt);
-        if (rel > 0.0 && v > vff + vstop) {
-            v = vff + vstop;
-            limited = 1;
-        } else if (rel < 0.0 && v < vff - vstop) {
-            v = vff - vstop;
-            limited = 1;
+        /* the closing-speed cap (CspBank.step's shortcut, per row): vstop >= min(|rel|/dt,
+         * lim), so a row within half of that of vff cannot be capped */
+        vstop = fabs(rel) * half_per_dt;
+        if (vstop > 0.5 * lim)
+            vstop = 0.5 * lim;
+        if (fabs(v - vff) > vstop) {
+            vstop = closing_speed(fabs(rel), lim, dt);
+            if (rel > 0.0 && v > vff + vstop) {
+                v = vff + vstop;
+                limited = 1;
+            } else if (rel < 0.0 && v < vff - vstop) {
+                v = vff - vstop;
+                limited = 1;
+            }
         }
         dv = v - v0;
         if (dv > lim) {
@@ -282,6 +365,9 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
             din |= 1 << 16;
         if (io[IN_W17] && in_window(F64(w17_lo), F64(w17_hi), io[IN_W17], r, pos))
             din |= 1 << 17;
+        if (hm[r]) /* AxisResources._post of an axis not in CSP: the plan follows 6064h */
+            a = (double)((int64_t)(int32_t)(uint32_t)(uint64_t)pa - I64(drive_offset)[r]) /
+                F64(unit2)[r];
         /* 4. encoder (Encoder.sample) */
         raw = U8(external)[r] ? pa : target;
         d32 = (int32_t)(uint32_t)(uint64_t)(raw - I64(enc_prev)[r]);
@@ -291,10 +377,17 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         err = a - link(enc, F64(enc_ratio)[r], F64(enc_off)[r]);
         if (a > F64(soft_pos)[r] || (din & 3) != 0 || a < F64(soft_neg)[r])
             hit = 1;
-        if (fabs(err) > F64(pos_err)[r])
+        if (fabs(err) > F64(pos_err)[r] && !hm[r]) /* the following error: in CSP only */
             hit = 1;
-        if (hit)
-            return 2; /* nothing written: the numpy cycle releases it */
+        if (hit && hm[r]) {
+            U8(s_hit)[r] = 1;
+            hm_hit = 1;
+            continue;
+        }
+        if (hit) {
+            csp_hit = 1;
+            break;
+        }
         /* 6. the in-position band (bit 11) */
         band = F64(band)[r];
         since = I64(since)[r];
@@ -322,6 +415,10 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         I64(s_since)[r] = since;
         U8(s_arr)[r] = (uint8_t)arr;
     }
+    if (csp_hit)
+        return 2; /* nothing written: the numpy cycle releases it */
+    if (hm_hit)
+        return 3; /* nothing written: the caller releases the homing rows in s_hit */
 
     /* commit (CspBank.commit, the bank's state, the table cursors) */
     for (r = 0; r < n; r++) {
@@ -331,6 +428,8 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
             I64(c_start)[r] += 1; /* a row left out did not step */
             continue;
         }
+        if (U8(frz)[r])
+            continue;
         if (U8(jog)[r]) {
             F64(jrp)[r] = F64(s_jog)[5 * r + 0];
             F64(jrv)[r] = F64(s_jog)[5 * r + 1];
@@ -357,6 +456,17 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         F64(enc_step1)[r] = F64(s_step)[r];
         I64(since)[r] = I64(s_since)[r];
         U8(arrived)[r] = U8(s_arr)[r];
+        if (hm[r]) {
+            const double *sh = F64(s_hm) + 7 * r;
+            F64(h_last)[r] = sh[0];
+            F64(h_el)[r] = sh[1];
+            F64(h_tr)[r] = sh[2];
+            F64(h_v)[r] = sh[3];
+            F64(h_p)[r] = sh[4];
+            F64(h_rest)[r] = sh[5];
+            U8(h_set)[r] = sh[6] != 0.0;
+            continue;
+        }
         mv = U8(moving)[r];
         en = cur == I64(t_end)[r];
         I64(taken)[r] += mv;

@@ -275,10 +275,41 @@ class Chain:
             tuple[int, tuple[tuple[int, int, bytes], ...], tuple[tuple, ...], bytes] | None
         ) = None
         self._multi_seen: list[tuple] | None = None
+        #: ESCs behind an open link (:meth:`cut_after`): powered, stepped, out of the frames
+        self.cut: list[Esc] = []
 
     @property
     def slaves(self) -> list[VirtualSlave]:
-        return [e.slave for e in self.escs]
+        return [e.slave for e in (*self.escs, *self.cut)]
+
+    def cut_after(self, position: int) -> None:
+        """The link behind ``position`` opens: the frame turns back there (the ESC closes
+        its port), so the slaves after it vanish from every datagram; they keep running
+        and their watchdogs see the silence.  ``-1`` cuts in front of the first slave."""
+        self.mend()
+        keep = max(0, position + 1)
+        if keep >= len(self.escs):
+            return
+        if self._deferred:
+            self.flush()
+        self.escs, self.cut = self.escs[:keep], self.escs[keep:]
+        self._line_changed()
+
+    def mend(self) -> None:
+        """Close the link again (the slaves behind it answer from the next frame on)."""
+        if self.cut:
+            if self._deferred:
+                self.flush()
+            self.escs, self.cut = [*self.escs, *self.cut], []
+            self._line_changed()
+
+    def _line_changed(self) -> None:
+        self._stations = None
+        self._lmap = None
+        self._dc_plans.clear()  # the datagrams of the system time reach other ESCs now
+        self._dc_gen += 1
+        self._forget_plans()
+        self._irq_changed(self.escs[0] if self.escs else None)  # type: ignore[arg-type]
 
     def __len__(self) -> int:
         return len(self.escs)
@@ -702,7 +733,7 @@ class Chain:
         """
         if self._deferred:
             self.flush()
-        for esc in self.escs:
+        for esc in self.escs if not self.cut else (*self.escs, *self.cut):
             slave = esc.slave
             try:
                 slave.step(t_ns, dt_ns)
@@ -724,7 +755,7 @@ class Chain:
         now = self.clock() if now_ns is None else now_ns
         if self._deferred:
             self.flush()
-        for esc in self.escs:
+        for esc in self.escs if not self.cut else (*self.escs, *self.cut):
             esc.check_watchdog(now)
             esc.sync_al()
             if esc.slave.emergencies:

@@ -370,6 +370,36 @@ $("od-write").onclick = async () => {
     $("od-msg").textContent = "written";
   } catch (e) { $("od-msg").textContent = String(e); }
 };
+// faults: "KIND key=value ..." as the command line takes it (gtecat fault inject)
+function faultSpec(text) {
+  const words = text.trim().split(/\s+/).filter(Boolean);
+  const spec = {kind: words.shift() || ""};
+  for (const w of words) {
+    const i = w.indexOf("=");
+    if (i <= 0) throw new Error(`${w}: expected key=value`);
+    const v = w.slice(i + 1);
+    spec[w.slice(0, i)] = v.includes(",") ? v.split(",") : v;
+  }
+  return spec;
+}
+async function listFaults() {
+  try {
+    const rows = await ask("fault_list");
+    const body = $("fault-table").querySelector("tbody");
+    body.replaceChildren(...rows.map((f) => { const tr = el("tr");
+      tr.append(el("td", {}, String(f.id)), el("td", {}, f.state), el("td", {}, f.describe)); return tr; }));
+    if (!rows.length) $("fault-msg").textContent = "no fault armed or active";
+  } catch (e) { $("fault-msg").textContent = String(e); }
+}
+$("fault-list").onclick = listFaults;
+$("fault-inject").onclick = async () => {
+  try { const f = await ask("fault_inject", faultSpec($("fault-spec").value));
+    $("fault-msg").textContent = `fault ${f.id}: ${f.describe} (${f.state})`; listFaults();
+  } catch (e) { $("fault-msg").textContent = String(e); }
+};
+$("fault-clear").onclick = async () => {
+  try { await ask("fault_clear"); listFaults(); } catch (e) { $("fault-msg").textContent = String(e); }
+};
 setInterval(() => { const now = performance.now(); if (S.rateT0) $("rate").textContent = (S.snaps * 1000 / (now - S.rateT0)).toFixed(1);
   S.rateT0 = now; S.snaps = 0; }, 1000);
 connect();

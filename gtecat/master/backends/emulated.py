@@ -13,6 +13,10 @@ frames a real master would have exchanged are written to a capture
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+import numpy as np
+
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
 from gtecat.eni.layout import Layout
@@ -21,6 +25,9 @@ from gtecat.eni.model import Direction
 from ...errors import BusError
 from ..image import ProcessImage, Segment
 from .base import Backend, FoundSlave
+
+#: what :attr:`EmulatedBackend.answer_hook` says became of a cycle's frame
+ANSWERED, LOST, PREVIOUS = 0, 1, 2
 
 
 class EmulatedBackend(Backend):
@@ -53,6 +60,10 @@ class EmulatedBackend(Backend):
         self._claimed_wkc = 0
         self.capture = None
         self._source = ""  # the file the virtual slaves come from
+        #: what the frame of a cycle meets on its way back (gtecat.faults): called with the
+        #: working counter, returns (ANSWERED | LOST | PREVIOUS, working counter); None: nothing
+        self.answer_hook: Callable[[int], tuple[int, int]] | None = None
+        self._prev_answer: tuple[bytes, int] | None = None
         if pcap:
             from ..pcap import BusCapture
 
@@ -149,6 +160,25 @@ class EmulatedBackend(Backend):
         return s.al_state, s.al_status_code
 
     def exchange(self, t_ns: int, dt_ns: int) -> int:
+        hook = self.answer_hook
+        if hook is None:
+            return self._exchange(t_ns, dt_ns)
+        image = self.image
+        assert image is not None
+        before = image.inputs.tobytes()
+        wkc = self._exchange(t_ns, dt_ns)
+        action, wkc = hook(wkc)
+        if action == LOST:  # the answer never came back: the inputs stay the last received
+            image.inputs[:] = np.frombuffer(before, np.uint8)
+            return 0
+        if action == PREVIOUS and self._prev_answer is not None:
+            got, wkc = self._prev_answer
+            image.inputs[:] = np.frombuffer(got, np.uint8)
+            return wkc
+        self._prev_answer = (image.inputs.tobytes(), wkc)
+        return wkc
+
+    def _exchange(self, t_ns: int, dt_ns: int) -> int:
         image = self.image
         assert image is not None
         wkc = self._claimed_wkc  # the bank's slaves, in OP
@@ -195,14 +225,14 @@ class EmulatedBackend(Backend):
             raise BusError(f"slave {position} ({slave.name}) has no CoE mailbox")
         client = self._clients.get(position)
         if client is None:
-            transfer = slave.mailbox
             capture = self.capture
-            if capture is not None:
 
-                def transfer(request: bytes, mailbox=slave.mailbox) -> bytes | None:
-                    answer = mailbox(request)
+            # the slave's mailbox looked up per message: a fault may stand in front of it
+            def transfer(request: bytes, slave: VirtualSlave = slave) -> bytes | None:
+                answer = slave.mailbox(request)
+                if capture is not None:
                     capture.mailbox(position, request, answer)
-                    return answer
+                return answer
 
             client = SdoClient(transfer)
             self._clients[position] = client

@@ -134,23 +134,29 @@ static int send_all(int fd, const unsigned char *p, size_t n, long long deadline
 /* How long a call spins for its reply before it sleeps in poll (GTECAT_SPIN_US; by
  * default 200 us where this process may run on two CPUs or more, else 0: spinning on
  * one CPU only keeps the controller from answering).  The controller answers a common
- * getter within about 20 us; waking a sleeping thread costs as much again in a VM. */
+ * getter within about 20 us; waking a sleeping thread costs as much again in a VM.
+ * The spin adapts (spin_allowed): it never runs while more threads are runnable than this
+ * process has CPUs (the controller would be waiting for the CPU the spin holds), and a spin
+ * that ends without the reply halves the next one (down to none; a short probe every 256
+ * calls finds out whether spinning pays again). */
 #define GTE_DEFAULT_SPIN_US 200
+static int g_cpus = 1;
 static long spin_ns(void)
 {
     static long cached = -1;
     if (cached < 0) {
         const char *v = getenv("GTECAT_SPIN_US");
         long us = 0;
+        cpu_set_t set;
+        if (sched_getaffinity(0, sizeof set, &set) == 0)
+            g_cpus = CPU_COUNT(&set);
         if (v && *v) {
             char *end;
             long x = strtol(v, &end, 10);
             if (*end == '\0' && x >= 0)
                 us = x;
-        } else {
-            cpu_set_t set;
-            if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) >= 2)
-                us = GTE_DEFAULT_SPIN_US;
+        } else if (g_cpus >= 2) {
+            us = GTE_DEFAULT_SPIN_US;
         }
         cached = us * 1000;
     }
@@ -164,6 +170,66 @@ static long long now_ns(void)
     return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
 }
 
+/* More threads runnable than this process has CPUs (the 4th field of /proc/loadavg, read at
+ * most every 10 ms): then spinning only takes the CPU the other side waits for. */
+static int cpus_busy(long long t)
+{
+    static long long next_check = 0;
+    static int busy = 0;
+    if (t >= next_check) {
+        char b[128];
+        int fd = open("/proc/loadavg", O_RDONLY | O_CLOEXEC);
+        next_check = t + 10000000LL;
+        busy = 0;
+        if (fd >= 0) {
+            ssize_t n = read(fd, b, sizeof b - 1);
+            close(fd);
+            if (n > 0) {
+                char *slash, *q;
+                b[n] = '\0';
+                slash = strchr(b, '/');
+                if (slash) {
+                    for (q = slash; q > b && q[-1] != ' '; q--)
+                        ;
+                    busy = strtol(q, NULL, 10) > g_cpus;
+                }
+            }
+        }
+    }
+    return busy;
+}
+
+/* The spin budget of this call in ns (0: sleep in poll at once); spin_done() reports how
+ * it went. */
+static long g_budget = -1;
+static unsigned g_since_probe;
+static long spin_allowed(void)
+{
+    long full = spin_ns();
+    if (full <= 0)
+        return 0;
+    if (g_budget < 0)
+        g_budget = full;
+    if (cpus_busy(now_ns()))
+        return 0;
+    if (g_budget == 0 && ++g_since_probe >= 256) {
+        g_since_probe = 0;
+        return full / 8; /* a probe */
+    }
+    return g_budget;
+}
+
+static void spin_done(int answered_while_spinning, long budget)
+{
+    long full = spin_ns();
+    if (budget <= 0)
+        return;
+    if (answered_while_spinning)
+        g_budget = g_budget * 2 > full ? full : (g_budget ? g_budget * 2 : budget);
+    else
+        g_budget = g_budget / 2 < 1000 ? 0 : g_budget / 2;
+}
+
 /* Receive one message (frame header included) into g_buf, always offering a read at least
  * GTE_CHUNK bytes of room, so one recv takes a whole record (SOCK_SEQPACKET; usually the
  * whole reply).  0 ok with *total = 4 + body; -1 error (errno); -2 the peer closed. */
@@ -171,6 +237,8 @@ static int recv_msg(int fd, size_t *total, long long deadline)
 {
     size_t got = 0, need = 4;
     long long spin_until = 0;
+    long budget = -1; /* this call's spin, asked for when the reply is not there at once */
+    int slept = 0;
     while (got < need) {
         if (reserve(got + GTE_CHUNK) < 0) {
             errno = ENOMEM;
@@ -195,20 +263,26 @@ static int recv_msg(int fd, size_t *total, long long deadline)
         if (errno == EINTR)
             continue;
         if (errno == EAGAIN || errno == EWOULDBLOCK) {
-            long spin = spin_ns();
-            if (spin > 0) {
+            if (budget < 0)
+                budget = spin_allowed();
+            if (budget > 0 && !slept) {
                 long long t = now_ns();
                 if (!spin_until)
-                    spin_until = t + spin;
-                if (t < spin_until)
+                    spin_until = t + budget;
+                if (t < spin_until) {
+                    sched_yield(); /* the controller first, where it shares this CPU */
                     continue;
+                }
             }
+            slept = 1;
             if (wait_fd(fd, POLLIN, deadline) < 0)
                 return -1;
             continue;
         }
         return -1;
     }
+    if (budget > 0)
+        spin_done(!slept, budget);
     *total = need;
     return 0;
 }

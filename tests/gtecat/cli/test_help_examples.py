@@ -38,6 +38,10 @@ NEEDS = {
     "gtecat panel": "serves a page until stopped (tests/gtecat/inspect runs it)",
     "gtecat lib --cflags": "a C compiler (builds libgts once)",
     "gtecat demo": "the whole demo (tests/gtecat/test_demo.py runs it)",
+    "gtecat fault inject": "a running gtecat to break (tests/gtecat/faults)",
+    "gtecat fault list": "a running gtecat (tests/gtecat/faults)",
+    "gtecat fault clear": "a running gtecat (tests/gtecat/faults)",
+    "-- ./my_machine": "a C program built against libgts (tests/gtecat/faults, GTECAT_LONG)",
 }
 
 

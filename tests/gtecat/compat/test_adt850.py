@@ -554,6 +554,15 @@ def test_appendix_b_home1_without_a_signal_or_limit_returns_minus_2():
     assert adt.home4() == -2
 
 
+def test_appendix_b_home1_stopped_by_a_limit_returns_minus_2_with_the_reason():
+    """B.2 -2 after a search that met a limit switch instead of the home signal: the stop
+    data says why and last_error() names it."""
+    open_card(a1=dict(position=0, negative_limit=-1_000))
+    assert adt.adt850_init_board({n: adt.AppParams() for n in range(1, 5)}) == 1
+    assert adt.home1(1) == -2
+    assert "axis 1 stopped before its home signal" in adt.last_error()
+
+
 def test_actualcount_mode_sets_the_real_counters_direction_and_multiplication():
     """1.6: dir 1 counts the other way; freq 1 (2x) counts half the 4x pulses."""
     init()

@@ -43,7 +43,7 @@ from hypothesis import strategies as st
 from gtecat import gt
 from gtecat.gt import _core
 from gtecat.gt.args import _struct_types, shown
-from gtecat.gt.table import NO_CORE_TWINS, SAME_PARAM_TWINS, SCALARS, Param
+from gtecat.gt.table import ENUMS, NO_CORE_TWINS, SAME_PARAM_TWINS, SCALARS, Param
 from tests.conftest import EXAMPLES
 from tests.gtecat.gt.conftest import bring_up
 
@@ -162,7 +162,7 @@ class Arg:
 
 # --- scalars -------------------------------------------------------------------------------------
 def int_range(p: Param) -> tuple[int, int]:
-    _, lo, hi, _ = SCALARS[p.ctype]
+    _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]  # a C enum is an int
     if p.mask:
         lo, hi = min(lo, -(1 << 31)), max(hi, (1 << 32) - 1)
     if p.lo is not None:

@@ -273,7 +273,21 @@ def test_inputs_on_card_terminals_or_missing_axes_are_noted(tmp_path):
     notes = log()[-1]
     assert "axis 1 positive limit = limitPositive7: no axis 7 on this bus" in notes
     assert "axis 1 smooth stop = gpi3, a card terminal: none" in notes
-    assert "axis 2 alarm = alarm2 reverse=1: active while drive 2 is not in fault" in notes
+    # the machine description does not say how the alarm is wired: as the file expects
+    assert "alarm2 reverse=1 (an alarm that opens in fault)" in notes
+    gt.GTE_Wait(2)
+    assert not sts(2) & ALARM  # the application's own file leaves its healthy axis usable
+
+
+def test_an_alarm_reverse_against_a_stated_wiring_inverts_it(tmp_path):
+    up(tmp_path, '[axis.2]\nswitch_wiring = "normally_open"\n')
+    edits = {
+        "axis1": {"smoothStopIndex": "3", "limitPositiveIndex": "7"},
+        "axis2": {"alarmIndex": "2"},
+        "alarm2": {"reverse": "1"},
+    }
+    assert load(edited(tmp_path, GTN, edits)) == 0, gt.GTE_GetLastError()
+    assert "axis 2 alarm = alarm2 reverse=1: active while drive 2 is not in fault" in log()[-1]
     gt.GTE_Wait(2)
     assert sts(2) & ALARM  # reversed: the healthy drive is "in alarm"
 

@@ -17,7 +17,7 @@ import pytest
 from gtecat import gt
 from gtecat.native import header
 
-from .conftest import bring_up
+from .conftest import EXAMPLES, bring_up
 
 
 @pytest.fixture
@@ -161,9 +161,25 @@ def test_the_gtn_torque_spellings_read_6077h():
     assert a.value == b.value == c.value
     n = c_short()
     assert gt.GTN_GetResMax(1, gt.MC_AXIS, byref(n)) == 0 and n.value == 32
-    assert gt.GTN_GetResCount(1, gt.MC_AXIS, byref(n)) == 0 and n.value == len(
-        gt.GTE_Controller().axes
-    )
+    assert gt.GTN_GetResCount(1, gt.MC_AXIS, byref(n)) == 0 and n.value == 12  # the controller's
+
+
+def test_the_axis_count_is_the_controllers_before_the_bus_is_up():
+    """The vendor's EtherCAT demo counts axes (and from them cores) before GTN_InitEcatComm:
+    the controller's 12 axes, whatever the bus holds, as the count forms accept them."""
+    from gtecat.drives.machine import MachineDescription
+
+    assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="") == 0
+    n = c_short()
+    assert gt.GTN_GetResCount(1, gt.MC_AXIS, byref(n)) == 0 and n.value == 12
+    gt.GT_Close()
+    bring_up(clock="lockstep")  # the figure 5-2 bus: 2 axes
+    assert gt.GTN_GetResCount(1, gt.MC_AXIS, byref(n)) == 0 and n.value == 12
+    sts = (c_long * 12)()
+    assert gt.GT_GetSts(1, sts, 12) == 0 and gt.GT_GetSts(1, sts, 13) == 7
+    gt.GT_Close()
+    assert gt.GT_Open(card="gts:4", machine=MachineDescription({}), clock="lockstep", log="") == 0
+    assert gt.GT_GetResCount(gt.MC_AXIS, byref(n)) == 0 and n.value == 4  # a GTS-400 card
 
 
 def _observe() -> list[int]:

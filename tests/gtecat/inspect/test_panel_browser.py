@@ -256,3 +256,17 @@ def test_a_request_without_the_token_gets_403(panels: dict[str, Any]) -> None:
     assert e.value.code == 403
     with urllib.request.urlopen(url, timeout=5) as r:
         assert r.status == 200 and b"gtecat panel" in r.read()
+
+
+def test_faults_from_the_panel(browser: Any, endpoint_conn: client.Attached) -> None:
+    """The fourth way in: a fault typed as on the command line, injected, listed, cleared."""
+    spec = browser.find_element("id", "fault-spec")
+    spec.clear()
+    spec.send_keys("drive_fault axis=1 code=0x2310 after_ms=100000")
+    browser.find_element("id", "fault-inject").click()
+    _wait(lambda: "fault" in browser.find_element("id", "fault-msg").text, 10, "the injection")
+    listed = endpoint_conn.call("fault_list")
+    assert [f["kind"] for f in listed] == ["drive_fault"] and listed[0]["state"] == "armed"
+    _wait(lambda: "0x2310" in browser.find_element("id", "fault-table").text, 10, "the list")
+    browser.find_element("id", "fault-clear").click()
+    _wait(lambda: endpoint_conn.call("fault_list") == [], 10, "the clear")

@@ -9,7 +9,10 @@ Two console programs, compiled once per module with ``mcs`` as a user would and 
   configuration loaded by a Windows path, Trap, Jog, the smart home straight after the Jog
   (the vendor's smart-home demo), card IO;
 * ``cs/EcatStation.cs`` is new code on the generated ``gts.cs``: the GTN bring-up on the
-  manual's figure 5-2 bus, Trap, the 8-profile read of examples 7-5/7-7/7-8, raw data, IO, SDO.
+  manual's figure 5-2 bus, Trap, the 8-profile read of examples 7-5/7-7/7-8, raw data, IO, SDO;
+* ``cs/MultiCardStation.cs`` carries a wrapper of the older multi-card style (``short cardNum``
+  first in every ``GT_`` function) and runs on the map of ``--abi gts-multicard``
+  (``libgts_mc-llp64.so``).
 
 Every return code each prints equals the one Python gives for the same call sequence.
 VB.NET (``Declare Function ... Lib "gts.dll"``) binds through the same dllmap; Debian ships
@@ -270,6 +273,92 @@ def test_ecat_station_codes_equal_pythons(ecat, tmp_path, monkeypatch):
     c["close"] = gt.GTN_Close()
     assert set(c) == set(ECAT_CODES)
     assert {k: int(ecat[k]) for k in ECAT_CODES} == c
+
+
+# --- a wrapper of the older multi-card style (cardNum first) ------------------------------------
+@pytest.fixture(scope="module")
+def multicard(tmp_path_factory) -> tuple[dict[str, str], Path]:
+    """MultiCardStation.cs compiled and run on the ``--abi gts-multicard`` map."""
+    from gtecat.native import llp64
+
+    built("libgts_mc-llp64", lambda: llp64.ensure_built(abi="gts-multicard"))
+    d = tmp_path_factory.mktemp("multicard")
+    shutil.copy(CS_DIR / "MultiCardStation.cs", d)
+    shutil.copy(EXAMPLES / "GTS800.cfg", d)
+    config = "MultiCardStation.exe.config"
+    _gtecat("lib", "--abi", "gts-multicard", "--mono-config", "-o", config, cwd=d)
+    r = subprocess.run(
+        ["mcs", "-nologo", "MultiCardStation.cs"], cwd=d, capture_output=True, text=True
+    )
+    assert r.returncode == 0 and "warning" not in r.stdout, r.stdout + r.stderr
+    return _mono(d / "MultiCardStation.exe", d, GTECAT_CARD="gts:4"), d
+
+
+def test_a_multicard_wrapper_runs_on_the_multicard_map(multicard):
+    v, d = multicard
+    from gtecat.native import llp64
+
+    target = llp64.ensure_built(abi="gts-multicard")
+    assert target.name == "libgts_mc-llp64.so"
+    text = (d / "MultiCardStation.exe.config").read_text(encoding="utf-8")
+    assert f'<dllmap dll="i:gts.dll" target="{target}" os="!windows"/>' in text
+    # the emulator is card 0
+    assert v["open_card1"] == "-6" and "no card 1" in v["open_card1_reason"]
+    assert v["axison_card2"] == "-1" and "card 2 is not open" in v["axison_card2_reason"]
+    # C long as int (GT_SetPos / GT_GetPos, GT_GetSts, GT_Update's mask), ref / out TTrapPrm
+    assert (v["trap_acc"], v["target"], v["prfpos"]) == ("2", "12345", "12345")
+    assert (v["sts_servo"], v["gpo"]) == ("1111", "2")
+
+
+MULTICARD_CODES = (
+    "open reset loadconfig clrsts axison1 axison2 axison3 axison4 prftrap gettrapprm settrapprm "
+    "gettrapprm_back setpos getpos setvel update getprfpos getsts4 setdobit getdo close"
+).split()
+
+
+def test_multicard_station_codes_and_values_equal_pythons(multicard, monkeypatch):
+    v, d = multicard
+    monkeypatch.chdir(d)
+    c: dict[str, int] = {}
+    c["open"] = gt.GT_Open(card="gts:4", clock="lockstep", log="")
+    c["reset"] = gt.GT_Reset()
+    c["loadconfig"] = gt.GT_LoadConfig("GTS800.cfg")
+    c["clrsts"] = gt.GT_ClrSts(1, 4)
+    for a in range(1, 5):
+        c[f"axison{a}"] = gt.GT_AxisOn(a)
+    trap, back = gt.TTrapPrm(), gt.TTrapPrm()
+    c["prftrap"] = gt.GT_PrfTrap(1)
+    c["gettrapprm"] = gt.GT_GetTrapPrm(1, byref(trap))
+    trap.acc, trap.dec, trap.smoothTime = 2, 2, 0
+    c["settrapprm"] = gt.GT_SetTrapPrm(1, byref(trap))
+    c["gettrapprm_back"] = gt.GT_GetTrapPrm(1, byref(back))
+    target = c_long()
+    c["setpos"] = gt.GT_SetPos(1, 12345)
+    c["getpos"] = gt.GT_GetPos(1, byref(target))
+    c["setvel"], c["update"] = gt.GT_SetVel(1, 100), gt.GT_Update(1)
+    sts, clk, prf = c_long(), c_uint32(), c_double()
+    for _ in range(2000):
+        gt.GTE_Wait(5)
+        if gt.GT_GetSts(1, byref(sts)) == 0 and not sts.value & 0x400:
+            break
+    c["getprfpos"] = gt.GT_GetPrfPos(1, byref(prf), 1, byref(clk))
+    four = (c_long * 4)()
+    c["getsts4"] = gt.GT_GetSts(1, four, 4, byref(clk))
+    gpo = c_long()
+    c["setdobit"] = gt.GT_SetDoBit(gt.MC_GPO, 2, 1)
+    c["getdo"] = gt.GT_GetDo(gt.MC_GPO, byref(gpo))
+    c["close"] = gt.GT_Close()
+    assert set(c) == set(MULTICARD_CODES)
+    assert {k: int(v[k]) for k in MULTICARD_CODES} == c
+    servo = "".join("1" if s & 0x200 else "0" for s in four)
+    values = (back.acc, target.value, prf.value, servo, gpo.value)
+    assert values == (
+        float(v["trap_acc"]),
+        int(v["target"]),
+        float(v["prfpos"]),
+        v["sts_servo"],
+        int(v["gpo"]),
+    )
 
 
 # --- the map the programs ran with ------------------------------------------------------------

@@ -62,3 +62,29 @@ def test_the_mono_config_maps_the_vendor_names_and_keeps_monos_own(tmp_path):
     for dll in csharp.DLL_NAMES:
         assert f'<dllmap dll="i:{dll}" target="/lib/libgts-llp64.so" os="!windows"/>' in text
     assert ET.fromstring(text).tag == "configuration"  # well-formed (a valid comment too)
+
+
+def test_the_multicard_llp64_layer_spells_long_as_int():
+    """libgts_mc-llp64.so's layer and the header it includes take int for long (a C#
+    multi-card wrapper's ``out int pSts``), long long stays."""
+    files = llp64.multicard_sources()
+    layer = files["gts_multicard.c"]
+    assert re.search(r"short gte_mc_GetSts\(short cardNum, short axis, int \*pSts,", layer)
+    assert "short gte_mc_SetPos(short cardNum, short profile, int pos)" in layer
+    assert "long" not in layer.replace("long long", "")
+    assert "short GT_GetSts(short axis, int *pSts" in files["gts_sc.h"]
+
+
+def test_lib_csharp_refuses_the_multicard_abi(capsys):
+    """gts.cs is the one-card API: --abi gts-multicard --csharp says so instead of writing it."""
+    import argparse
+
+    from gtecat.cli import lib_cmd
+
+    parser = argparse.ArgumentParser()
+    lib_cmd.add_parser(parser.add_subparsers())  # the lib verb alone: no other verb imported
+    args = parser.parse_args(["lib", "--abi", "gts-multicard", "--csharp"])
+    assert args.func(args) == 1
+    out = capsys.readouterr().out
+    assert out.startswith("error: --csharp writes gts.cs for the one-card API only")
+    assert "--abi gts-multicard --mono-config" in out

@@ -45,9 +45,12 @@ class WireClient:
     def call(self, name: str, *args: Any, core: int | None = None) -> tuple[int, list, str]:
         """(return code, out blocks as bytes, error text); pointer args are bytes / None /
         an int (an out pointer of that many bytes) / "?" (size unknown)."""
-        base = "GT_" + name[4:] if name.startswith("GTN_") else name
+        # a GTN_ line of its own (the header declares it with its core) is a plan of its own;
+        # else GTN_x is GT_x's twin with the core in front
+        own = name in self.by_name
+        base = name if own else "GT_" + name[4:]
         plan = self.by_name[base]
-        gtn = name.startswith("GTN_")
+        gtn = name.startswith("GTN_") and not own
         parts = [p.CALL.pack(p.MSG_CALL, int(gtn), plan.fid, core if core is not None else 1)]
         for a, v in zip(plan.args, args, strict=True):
             if a.kind is p.Kind.INT:

@@ -1,0 +1,121 @@
+"""``gtecat record -o FILE -- COMMAND ...``: run a program and record its whole GT session.
+
+Every GT call (name, arguments, values written back, return code, controller time), every
+fault injected from the program or ``gtecat fault``, and the bus state every 100 ms of
+controller time go into FILE (JSON lines; gzip when FILE ends in ``.gz``).  A Python script
+(``python3 my_machine.py`` or ``my_machine.py``) runs in this process; any other command
+runs as a child with ``GTECAT_RECORD=FILE`` in its environment: a Python program that
+imports gtecat records itself, and the controller that libgts starts for a C, C++ or C#
+program records that program's calls.  ``gtecat replay FILE`` re-runs the session.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import runpy
+import subprocess
+import sys
+from pathlib import Path
+
+from ..errors import ParameterError
+from . import output
+
+EPILOG = """\
+examples:
+  gtecat record -o session.gtrec -- python3 first_script.py
+  gtecat record -o session.gtrec.gz -- first_script.py
+  gtecat record -o c.gtrec -- ./my_machine            a C program linked with libgts
+  gtecat replay session.gtrec"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "record",
+        help="run a program and record its GT calls, faults and bus state (to replay)",
+        description=output.describe(__doc__),
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("-o", "--output", required=True, type=Path, help="the recording to write")
+    p.add_argument(
+        "program",
+        nargs=argparse.REMAINDER,
+        metavar="-- COMMAND",
+        help="the program and its arguments",
+    )
+    p.set_defaults(func=run)
+
+
+def _script(command: list[str]) -> tuple[Path, list[str]] | None:
+    """The Python script a command runs (to run it here), else None."""
+    if command and command[0].endswith(".py"):
+        return Path(command[0]), command[1:]
+    if (
+        len(command) >= 2
+        and Path(command[0]).name.startswith("python")
+        and command[1].endswith(".py")
+    ):
+        return Path(command[1]), command[2:]
+    return None
+
+
+def run(args: argparse.Namespace) -> int:
+    command = list(args.program)
+    if command and command[0] == "--":
+        command = command[1:]
+    if not command:
+        raise ParameterError("no command to record: gtecat record -o FILE -- python3 SCRIPT.py")
+    out: Path = args.output
+    if out.is_dir():
+        raise ParameterError(f"-o {out} is a folder; name the recording file")
+    if not out.parent.exists():
+        raise ParameterError(f"-o {out}: folder {out.parent} does not exist")
+    script = _script(command)
+    if script is None:
+        env = dict(os.environ, GTECAT_RECORD=str(out.resolve()))
+        env["GTECAT_RECORD_PROGRAM"] = " ".join(command)
+        try:
+            rc = subprocess.call(command, env=env)
+        except OSError as e:
+            raise ParameterError(f"cannot run {command[0]}: {e.strerror or e}") from None
+        from ..faults.record import read
+
+        calls = 0
+        if out.exists():
+            try:
+                calls = int(read(out)[0].get("calls", 0))
+            except ParameterError:
+                calls = 0
+        if not calls:
+            print(
+                "record: nothing recorded: the program made no GT call through gtecat (a "
+                "program attached to a controller that was already running is recorded by "
+                "starting that controller under gtecat record)",
+                file=sys.stderr,
+            )
+        else:
+            print(f"record: {calls} GT calls -> {out}", file=sys.stderr)
+        return rc
+    path, script_args = script
+    if not path.is_file():
+        raise ParameterError(f"{path}: no such script")
+    from .. import gt
+    from ..faults.record import Recorder
+
+    rec = Recorder(out, {"program": " ".join(command)}).start()
+    saved_argv, saved_path = sys.argv, list(sys.path)
+    sys.argv = [str(path), *script_args]
+    sys.path.insert(0, str(path.resolve().parent))
+    rc = 0
+    try:
+        runpy.run_path(str(path), run_name="__main__")
+    except SystemExit as e:
+        rc = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+    finally:
+        gt.GT_Close()
+        rec.stop()
+        sys.argv, sys.path[:] = saved_argv, saved_path
+    rec.write()
+    print(f"record: {rec.calls} GT calls -> {out}", file=sys.stderr)
+    return rc

@@ -1,0 +1,118 @@
+"""Drive homing (6060h = 6) as bank rows: when a channel's search can run without its Python.
+
+Between two events a homing search (:class:`gtecat.drives.homing.Homing`, phases SEARCH,
+APPROACH and INDEX) is a plain ramp to a constant speed: ``_scan`` finds nothing, the
+phase and direction stay, and only the search bounds (travel, time, one revolution in
+INDEX) can end it.  The axis bank's compiled cycle runs exactly that per row
+(``homing_row`` in ``gtecat/controller/csrc/bank_kernel.c``, the same operations in the
+same order as :meth:`Homing.step` and :func:`gtecat.drives.modes.step_hm`); a row leaves
+the bank, before the cycle, whenever its travel since the last step touches one of the
+positions where ``_scan`` could find something, or a bound would be reached.  The scalar
+channel then runs that cycle (edges, reversals, the home point, RETURN, errors) and the
+bank may take the row again once the search is plain again.
+
+This module says when a channel may be such a row (:func:`homing_claimable`), where the
+nearest events lie (:func:`event_bounds`), and moves the search state between the
+:class:`Homing` object and a row (:data:`ROW_FIELDS`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from .cia402 import State
+from .homing import HomingPhase
+from .homing_methods import Signal
+from .modes import OpMode
+
+if TYPE_CHECKING:
+    from .drive import Channel
+    from .homing import Homing
+
+#: the controlword of a drive homing (enable operation + CW4 "homing operation start")
+CW_HOMING = 0x001F
+_SEARCHING = (HomingPhase.SEARCH, HomingPhase.APPROACH, HomingPhase.INDEX)
+#: (row array, Homing attribute): the search state that changes every cycle
+ROW_FIELDS = (
+    ("h_last", "_last"),
+    ("h_el", "_elapsed"),
+    ("h_tr", "_travel"),
+    ("h_v", "_v"),
+    ("h_p", "_p"),
+    ("h_rest", "_rest_time"),
+)
+
+
+def homing_claimable(ch: Channel) -> str:
+    """Why ``ch`` cannot run its homing search as a bank row now ("" when it can)."""
+    if ch.psm.state is not State.OPERATION_ENABLED:
+        return "not operation enabled"
+    if ch.mode != OpMode.HOMING or ch.mode_req != ch.mode:
+        return "not in homing mode"
+    if ch.mode_due is not None or ch.mode_seen != ch.mode:
+        return "mode change pending"
+    if ch.controlword != CW_HOMING or ch.prev_cw != CW_HOMING:
+        return "controlword"
+    if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
+        return "fault"
+    if ch.field is not None:
+        return "field fault"
+    if ch.torque_ctl or ch.stopping or ch.limit_stop:
+        return "stopping"
+    if ch.digital_inputs & 3:
+        return "on a limit switch"
+    if ch.tp_function or ch._tp_applied or ch.probe.function:
+        return "touch probe"
+    if ch.fe_flag or ch.fe_time:
+        return "following error"
+    h = ch.homing
+    if h is None or ch.hm_halt or ch.hm_bits or ch.hm_applied or ch.oms:
+        return "no search running"
+    if h.phase not in _SEARCHING or h._stopping or h.error or h.attained:
+        return "not searching"
+    if event_bounds(h, ch.mech.pos) is None:
+        return "at an event"
+    return ""
+
+
+def event_bounds(h: Homing, pos: float) -> tuple[float, float] | None:
+    """The nearest positions below and above the travel ``[h._last, pos]`` at which
+    ``Homing._scan`` could meet an event (±inf: none), or None when one lies on it.
+
+    Every event ``_scan`` reports lies inside the closed travel of its step, so a row whose
+    travel stays strictly between the two bounds meets none."""
+    spec, m = h._spec, h._m
+    a, b = min(h._last, pos), max(h._last, pos)
+    xs: list[float] = []
+    if spec.signal is Signal.HOME_SWITCH:
+        for lo, hi in h._hs:
+            xs += (lo, hi)
+    for lim in (m.negative_limit, m.positive_limit):
+        if lim is not None:
+            xs.append(float(lim))
+    if spec.uses_index and m.index_offset is not None and m.counts_per_rev > 0:
+        cpr = float(m.counts_per_rev)
+        xs += m.index_positions(a - 2.0 * cpr, b + 2.0 * cpr)
+    if any(a <= x <= b for x in xs) or not (math.isfinite(a) and math.isfinite(b)):
+        return None
+    lo = max((x for x in xs if x < a), default=-math.inf)
+    hi = min((x for x in xs if x > b), default=math.inf)
+    return lo, hi
+
+
+def row_constants(h: Homing) -> dict[str, float]:
+    """The row's constants while it searches (they change only at an event)."""
+    phase = h.phase
+    speed = h.params.speed_switch if phase is HomingPhase.SEARCH else h.params.speed_zero
+    fd = h._spec.final_dir
+    return {
+        "h_vt": h._dir * float(speed),  # Homing._move's v_target, the same operation
+        "h_acc": h._acc,
+        "h_maxtr": h._max_travel,
+        "h_tmo": float(h.params.timeout_s),
+        "h_idx": float(phase is HomingPhase.INDEX),
+        "h_fd": float(fd),
+        "h_from": h._index_from,
+        "h_ilim": float(h._m.counts_per_rev + 0.5),
+    }

@@ -1,0 +1,299 @@
+"""Break the machine on purpose: one fault vocabulary for the emulated bus and ``gtecat serve``.
+
+Four ways in build the same objects (:mod:`.kinds`, :mod:`.triggers`):
+
+* Python - :func:`inject` on the open controller (``GT_Open`` + ``GT_InitEcatComm`` first),
+  :func:`clear`, :func:`listing`; the ``gtecat_faults`` pytest fixture is the same;
+* the machine TOML - ``[[fault]]`` tables, armed each time the bus comes up
+  (:func:`specs_from_tables`);
+* the command line on a running gtecat - ``gtecat fault inject|list|clear``;
+* the panel, over the same inspection endpoint.
+
+A fault is armed with a trigger (at once, ``at_ms``, ``after_ms``, ``after_cycles``,
+``when_position = [axis, position]``, ``at_homing = [axis, stage]``, ``on_sdo = [slave,
+index, n]``), may last ``duration_ms``, and may wait for another (``after = id``: a script's
+step).  Starts and ends go to the master log.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParameterError
+from .bus import EmulatedBus, FaultBus, WireBus
+from .injector import Entry, Injector
+from .kinds import KINDS, Fault, FaultSpecError, fault_from_dict, kind_rows
+from .triggers import TRIGGER_KEYS, Trigger, trigger_from_dict
+
+_EXTRA_KEYS = ("duration_ms", "after", "name")
+
+
+class FaultSpec:
+    """One fault as the four ways in give it: the fault, its trigger, how long, after what."""
+
+    __slots__ = ("after", "duration_ms", "fault", "name", "trigger")
+
+    def __init__(
+        self,
+        fault: Fault,
+        trigger: Trigger,
+        duration_ms: float | None = None,
+        after: int | str | None = None,
+        name: str = "",
+    ) -> None:
+        self.fault, self.trigger, self.duration_ms = fault, trigger, duration_ms
+        self.after, self.name = after, name
+
+    def describe(self) -> str:
+        text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        if self.duration_ms is not None:
+            text += f", for {self.duration_ms:g} ms"
+        return text
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {**self.fault.as_dict(), **self.trigger.as_dict()}
+        if self.duration_ms is not None:
+            d["duration_ms"] = self.duration_ms
+        if self.after is not None:
+            d["after"] = self.after
+        if self.name:
+            d["name"] = self.name
+        return d
+
+
+def _tell(what: str, values: dict[str, Any]) -> None:
+    from .injector import OBSERVERS
+
+    for fn in list(OBSERVERS):
+        fn(what, values)
+
+
+def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
+    """A ``[[fault]]`` table (or ``key=value`` pairs) as a :class:`FaultSpec`."""
+    prefix = f"{where}: " if where else ""
+    vals = dict(values)
+    extra = {k: vals.pop(k) for k in _EXTRA_KEYS if k in vals}
+    trig = {k: vals.pop(k) for k in TRIGGER_KEYS if k in vals}
+    try:
+        trigger = trigger_from_dict(trig)
+    except FaultSpecError as e:
+        raise FaultSpecError(f"{prefix}{e}") from None
+    fault = fault_from_dict(vals, where)
+    duration = extra.get("duration_ms")
+    if duration is not None:
+        try:
+            duration = float(duration)
+        except (TypeError, ValueError):
+            raise FaultSpecError(f"{prefix}duration_ms must be a number") from None
+        if duration < 0:
+            raise FaultSpecError(f"{prefix}duration_ms must be >= 0")
+    after = extra.get("after")
+    if isinstance(after, str) and after.strip().lstrip("-").isdigit():
+        after = int(after)
+    return FaultSpec(fault, trigger, duration, after, str(extra.get("name", "")))
+
+
+def specs_from_tables(tables: Any, source: str = "") -> list[FaultSpec]:
+    if isinstance(tables, dict):
+        tables = [tables]
+    if not isinstance(tables, list):
+        raise FaultSpecError(f"{source}: [[fault]] tables expected")
+    return [
+        spec_from_dict(t, f"{source} [[fault]] #{i}" if source else f"[[fault]] #{i}")
+        for i, t in enumerate(tables, 1)
+    ]
+
+
+def load(path: str | Path) -> list[FaultSpec]:
+    """The ``[[fault]]`` tables of a TOML file (a machine description or a faults file)."""
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise FaultSpecError(f"{p}: no such file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise FaultSpecError(f"{p}: cannot be read: {e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise FaultSpecError(f"{p}: not valid TOML: {e}") from None
+    if "fault" not in data:
+        raise FaultSpecError(f"{p}: no [[fault]] table")
+    return specs_from_tables(data["fault"], str(p))
+
+
+def arm(injector: Injector, specs: list[FaultSpec]) -> list[Entry]:
+    """Add the specs to an injector, a script's ``after`` names resolved to ids."""
+    names: dict[str, int] = {e.name: e.id for e in injector.entries if e.name}
+    out = []
+    for s in specs:
+        after = s.after
+        if isinstance(after, str):
+            if after not in names:
+                raise FaultSpecError(f"after={after!r}: no fault named so before it")
+            after = names[after]
+        e = injector.add(s.fault, s.trigger, s.duration_ms, after=after, name=s.name)
+        if s.name:
+            names[s.name] = e.id
+        out.append(e)
+    return out
+
+
+# --- the controller's injector ----------------------------------------------------------------
+def injector_for(ctl: Any, create: bool = True) -> Injector | None:
+    """The injector of ``ctl``'s bus (made on first use; one per GT_InitEcatComm)."""
+    backend = ctl.backend
+    if backend is None or ctl.master is None or not ctl.master.opened:
+        if not create:
+            return None
+        raise ParameterError("the bus is not up: GT_InitEcatComm first, then inject faults")
+    inj = getattr(backend, "injector", None)
+    if inj is None and create:
+        inj = Injector(EmulatedBus(ctl))
+        backend.injector = inj
+        ctl.pre_cycle.append(inj.tick)
+    return inj
+
+
+def _bus_up(ctl: Any) -> None:
+    """Arm the machine description's ``[[fault]]`` tables on every bus that comes up (the
+    faults of a bus brought up before go with it)."""
+    ctl.pre_cycle[:] = [
+        f
+        for f in ctl.pre_cycle
+        if not (
+            isinstance(getattr(f, "__self__", None), Injector)
+            and getattr(f.__self__.bus, "backend", None) is not ctl.backend
+        )
+    ]
+    tables = getattr(ctl.machine, "faults", ())
+    if tables and ctl.options.backend == "emulated":
+        specs = specs_from_tables(list(tables), ctl.machine.source or "machine description")
+        arm(injector_for(ctl), specs)  # type: ignore[arg-type]
+
+
+def _controller(core: int = 1) -> Any:
+    from ..gt._core import SESSION
+
+    return SESSION.controller(core)
+
+
+def inject(
+    kind: str | Fault | FaultSpec,
+    *,
+    core: int = 1,
+    ctl: Any = None,
+    **values: Any,
+) -> int:
+    """Inject a fault on the open controller's emulated bus; its id.
+
+    ``inject("drive_fault", axis=1, code=0x2310)``, ``inject("link_down", after_slave=1,
+    at_ms=500, duration_ms=200)``, ``inject(DriveFault(axis=2), after_cycles=100)``.
+    Trigger keys (``at_ms``, ``after_ms``, ``after_cycles``, ``when_position``,
+    ``at_homing``, ``on_sdo``), ``duration_ms`` and ``after`` (an id) mix with the kind's
+    own values.  Raises :class:`FaultSpecError` / ParameterError for what cannot be."""
+    ctl = ctl or _controller(core)
+    if isinstance(kind, FaultSpec):
+        spec = kind
+    elif isinstance(kind, Fault):
+        spec = spec_from_dict({**kind.as_dict(), **values})
+    else:
+        spec = spec_from_dict({"kind": kind, **values})
+    inj = injector_for(ctl)
+    assert inj is not None
+    fid = arm(inj, [spec])[0].id
+    _tell("inject", spec.as_dict())
+    return fid
+
+
+def script(steps: list[dict[str, Any]], *, core: int = 1, ctl: Any = None) -> list[int]:
+    """Steps run in order: each is armed once the one before it has started (its trigger
+    then counts from there: ``after_ms``, ``after_cycles``); the ids."""
+    ctl = ctl or _controller(core)
+    inj = injector_for(ctl)
+    assert inj is not None
+    ids: list[int] = []
+    for i, step in enumerate(steps, 1):
+        spec = spec_from_dict(step, f"step {i}")
+        if ids and spec.after is None:
+            spec.after = ids[-1]
+        ids.append(arm(inj, [spec])[0].id)
+        _tell("inject", spec.as_dict())
+    return ids
+
+
+def clear(ident: int | None = None, *, core: int = 1, ctl: Any = None) -> int:
+    """End one fault (its id) or every fault; how many."""
+    ctl = ctl or _controller(core)
+    inj = injector_for(ctl, create=False)
+    if inj is None:
+        if ident is not None:
+            raise ParameterError(f"no fault {ident}: none was injected")
+        return 0
+    n = inj.clear(ident)
+    _tell("clear", {"id": ident})
+    return n
+
+
+def listing(*, core: int = 1, ctl: Any = None) -> list[dict[str, Any]]:
+    """The armed and active faults: id, kind, values, trigger, state and ``describe``."""
+    ctl = ctl or _controller(core)
+    inj = injector_for(ctl, create=False)
+    return [] if inj is None else inj.listing()
+
+
+def describe(values: dict[str, Any]) -> str:
+    """A ``[[fault]]`` table in words."""
+    return spec_from_dict(values).describe()
+
+
+def _install() -> None:
+    from ..controller.core import Controller
+
+    if _bus_up not in Controller.bus_up_hooks:
+        Controller.bus_up_hooks.append(_bus_up)
+
+
+_install()
+
+__all__ = [
+    "KINDS",
+    "EmulatedBus",
+    "Entry",
+    "Fault",
+    "FaultBus",
+    "FaultSpec",
+    "FaultSpecError",
+    "Injector",
+    "WireBus",
+    "arm",
+    "clear",
+    "describe",
+    "inject",
+    "injector_for",
+    "kind_rows",
+    "listing",
+    "load",
+    "script",
+    "spec_from_dict",
+    "specs_from_tables",
+]
+
+
+def _record_from_environment() -> None:
+    """``GTECAT_RECORD=FILE`` (set by ``gtecat record`` for a program it starts): record this
+    process's GT calls into FILE, written when the process ends."""
+    import atexit
+    import os
+
+    path = os.environ.get("GTECAT_RECORD")
+    if not path:
+        return
+    from .record import Recorder
+
+    program = os.environ.get("GTECAT_RECORD_PROGRAM", "")
+    rec = Recorder(path, {"program": program}, any_thread=True).start()
+    atexit.register(rec.write)
+
+
+_record_from_environment()

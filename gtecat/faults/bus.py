@@ -1,0 +1,270 @@
+"""The buses a fault acts on: the emulated bus in-process, and the chain ``gtecat serve`` serves.
+
+A fault kind (:mod:`.kinds`) says what goes wrong; a :class:`FaultBus` says how that is
+done on its bus, so the same fault object means the same thing on both:
+
+* frames: the emulated bus has one cyclic logical frame per cycle; what happens to its
+  answer (lost, the previous one again, a working counter off) is decided by
+  :meth:`gtecat.faults.injector.Injector.answer` through the backend's ``answer_hook``.
+  On the wire the answered frame itself is changed (:meth:`Injector.frame`: cut short,
+  another index, the previous answer, late, working counters changed) through the
+  server's ``frame_hook``.  Frame faults act on cyclic (process-data) frames only, on both
+  buses, so bring-up and mailbox traffic are not what they hit;
+* the link: the emulated backend's unplugged set; the chain's :meth:`~gtecat.drives.esc.
+  chain.Chain.cut_after`;
+* slaves, mailboxes, drives and the field: the very same virtual slave objects on both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+from gtecat.drives.drive import Channel, Cia402Drive
+from gtecat.drives.faults import FieldOverride
+from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
+
+from ..errors import ParameterError
+
+
+def _no_objects(_od: Any) -> None:
+    pass
+
+
+class FaultBus:
+    """What an injector needs of a bus (subclasses: :class:`EmulatedBus`, :class:`WireBus`)."""
+
+    name = "bus"
+    cycle_ns = 1_000_000
+
+    @property
+    def slaves(self) -> list[VirtualSlave]:
+        raise NotImplementedError
+
+    def now_ms(self) -> float:
+        """Controller time, ms: what GT_GetClock reads (``at_ms``)."""
+        raise NotImplementedError
+
+    def t_ms(self) -> float:
+        """Time that never goes back (a GT_Reset does not move it): durations, ``after_ms``."""
+        return self.now_ms()
+
+    def healthy(self) -> bool:
+        return True
+
+    def log(self, message: str) -> None:
+        pass
+
+    def cut_after(self, position: int) -> None:
+        raise NotImplementedError
+
+    def mend(self) -> None:
+        raise NotImplementedError
+
+    def before_change(self) -> None:
+        """Called before a fault touches slaves (the emulated bus gives back banked axes)."""
+
+    def set_frame_faults(self, injector: Any) -> None:
+        """Route the cyclic answers through ``injector`` (None: no longer)."""
+
+    # --- what the faults reach ----------------------------------------
+    def slave(self, position: int) -> VirtualSlave:
+        slaves = self.slaves
+        if not 0 <= position < len(slaves):
+            raise ParameterError(f"no slave {position}: the bus has slaves 0..{len(slaves) - 1}")
+        return slaves[position]
+
+    def channels(self) -> list[Channel]:
+        """The CiA-402 channels in bus order: GT axis k is ``channels()[k - 1]``."""
+        out: list[Channel] = []
+        for s in sorted(self.slaves, key=lambda s: s.position):
+            if isinstance(s, Cia402Drive):
+                out.extend(s.channels)
+        return out
+
+    def channel(self, axis: int) -> Channel:
+        chans = self.channels()
+        if not 1 <= axis <= len(chans):
+            raise ParameterError(
+                f"no axis {axis}: the bus has axes 1..{len(chans)}"
+                if chans
+                else f"no axis {axis}: the bus has no CiA-402 drive"
+            )
+        return chans[axis - 1]
+
+    def override(self, axis: int) -> FieldOverride:
+        ch = self.channel(axis)
+        if ch.field is None:
+            self.before_change()
+            ch.field = FieldOverride()
+        return ch.field
+
+    def forget_override(self, axis: int) -> None:
+        ch = self.channel(axis)
+        if ch.field is not None and ch.field.idle:
+            ch.field = None
+
+    def position(self, axis: int) -> float:
+        return self.channel(axis).machine_position
+
+    def homing_stage(self, axis: int) -> str:
+        h = self.channel(axis).homing
+        return "" if h is None else h.phase.name.lower()
+
+    # --- slaves ----------------------------------------
+    def power_cycle(self, position: int) -> None:
+        """Power gone and back: INIT, the AL error gone, the drive's settings at power-on
+        values (its mechanics stay where they are; an incremental encoder forgets its home)."""
+        s = self.slave(position)
+        self.before_change()
+        old = s.al_state
+        if old != AlState.INIT:
+            s.on_state_change(old, AlState.INIT)
+        s.al_state = AlState.INIT
+        s.al_error = False
+        s.al_status_code = AlStatusCode.NO_ERROR
+        s.outputs_valid = False
+        if isinstance(s, Cia402Drive):
+            for ch in s.channels:
+                pos, ff = ch.mech.pos, ch.field
+                # the power-on values of every setting; the objects stay registered
+                ch._add_objects = _no_objects  # type: ignore[method-assign]
+                try:
+                    Channel.__init__(ch, s, ch.k, replace(ch.machine, position=pos))
+                finally:
+                    del ch._add_objects
+                ch.field = ff
+
+    def fall(self, position: int, state: AlState, code: int) -> None:
+        """The slave leaves its state for ``state`` by itself, with AL status ``code``."""
+        s = self.slave(position)
+        self.before_change()
+        old = s.al_state
+        if old > state:
+            s.on_state_change(old, state)
+            s.al_state = state
+            if state < AlState.OP:
+                s.outputs_valid = False
+        if code:
+            s.al_error = True
+            s.al_status_code = (
+                AlStatusCode(code) if code in AlStatusCode._value2member_map_ else code
+            )  # type: ignore[assignment]
+
+
+class EmulatedBus(FaultBus):
+    """The in-process emulated bus of one controller."""
+
+    name = "emulated"
+
+    def __init__(self, ctl: Any) -> None:
+        from ..master.backends.emulated import EmulatedBackend
+
+        if not isinstance(ctl.backend, EmulatedBackend):
+            raise ParameterError(
+                "faults act on the emulated bus (and on gtecat serve); this controller's bus "
+                f"is {type(ctl.backend).__name__}"
+            )
+        self.ctl = ctl
+        self.backend = ctl.backend
+        self._cut: list[int] = []
+
+    @property
+    def cycle_ns(self) -> int:  # type: ignore[override]
+        return int(self.ctl.clock.cycle_ns)
+
+    @property
+    def slaves(self) -> list[VirtualSlave]:
+        return self.backend.slaves
+
+    def now_ms(self) -> float:
+        return (self.ctl.clock.now_ns - self.ctl.reset_ns) / 1e6
+
+    def t_ms(self) -> float:
+        return self.ctl.clock.now_ns / 1e6
+
+    def healthy(self) -> bool:
+        m = self.ctl.master
+        return m is not None and m.last.ok and m.last.expected > 0
+
+    def log(self, message: str) -> None:
+        self.ctl.log(message)
+
+    def before_change(self) -> None:
+        bank = self.ctl.bank
+        if bank is not None:
+            bank.release_all()
+            bank.dirty = True
+
+    def cut_after(self, position: int) -> None:
+        self.mend()
+        self.before_change()
+        for pos in range(position + 1, len(self.slaves)):
+            if pos not in self.backend.unplugged:
+                self.backend.unplug(pos)
+                self._cut.append(pos)
+
+    def mend(self) -> None:
+        for pos in self._cut:
+            self.backend.replug(pos)
+        self._cut = []
+
+    def set_frame_faults(self, injector: Any) -> None:
+        self.backend.answer_hook = None if injector is None else injector.answer
+        if injector is not None:
+            self.before_change()
+        elif self.ctl.bank is not None:
+            self.ctl.bank.dirty = True
+
+
+class WireBus(FaultBus):
+    """The chain of software ESCs a :class:`gtecat.wire.serve.WireServer` serves."""
+
+    name = "wire"
+
+    def __init__(self, chain: Any, server: Any = None, log: Any = None) -> None:
+        self.chain = chain
+        self.server = server
+        self._t_ns = 0
+        self._log = log
+        if server is not None:
+            self.cycle_ns = int(server.cycle_ns)
+
+    def at(self, t_ns: int) -> None:
+        """The slaves' time now (ns since the server started)."""
+        self._t_ns = t_ns
+
+    @property
+    def slaves(self) -> list[VirtualSlave]:
+        return self.chain.slaves
+
+    def now_ms(self) -> float:
+        return self._t_ns / 1e6
+
+    def log(self, message: str) -> None:
+        if self._log is not None:
+            self._log(message)
+
+    def cut_after(self, position: int) -> None:
+        self.chain.cut_after(position)
+
+    def mend(self) -> None:
+        self.chain.mend()
+
+    def power_cycle(self, position: int) -> None:
+        super().power_cycle(position)
+        esc = next(e for e in (*self.chain.escs, *self.chain.cut) if e.position == position)
+        esc.mem[:] = bytes(len(esc.mem))  # station address, SMs and FMMUs: gone
+        esc._reset_registers()
+        esc._decode_sms()
+        esc._decode_fmmus()
+        esc.on_station_change(esc)
+        esc.on_fmmu_change(esc)
+        esc.on_sm_change(esc)
+
+    def set_frame_faults(self, injector: Any) -> None:
+        if self.server is not None:
+            self.server.frame_hook = None if injector is None else injector.frame
+
+
+__all__ = ["EmulatedBus", "FaultBus", "WireBus"]

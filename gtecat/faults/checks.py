@@ -1,0 +1,269 @@
+"""Checks of the application's own behaviour: what a real drive or controller would punish.
+
+:class:`Checker` watches the GT call stream (:mod:`.tap`) and, once the bus is up, every
+cycle of the drives; each finding is printed once per call site and rule as
+``check: FILE:LINE: text [source]`` (on stderr) and kept in :attr:`Checker.findings`.
+The rules and where they come from:
+
+* ``cw-skip`` - a controlword that asks for a state the CiA-402 state machine cannot reach
+  from the present one in one transition (CiA 402-2 / IEC 61800-7-201 Figure 4, the
+  transition table: e.g. enable operation from SWITCH ON DISABLED);
+* ``enable-in-fault`` - an enable command while the drive is in FAULT without a fault reset
+  (rising edge of controlword bit 7) first (CiA 402 transition 15);
+* ``csp-step`` - a CSP target position step (607Ah from one cycle to the next) larger than
+  the following-error window (6065h): the drive faults with 8611h (CiA 402 6.3.4;
+  ETG.6010 cyclic synchronous position);
+* ``mode-while-moving`` - a new mode of operation (6060h) while the axis moves (ETG.6010
+  6.2: a mode change is made at standstill; drives refuse or jerk);
+* ``sdo-on-pdo`` - an SDO write, in OP, to an object that is mapped in an RxPDO: the next
+  cycle overwrites it, many drives abort with 06010006h (ETG.1000.6 5.6.2; CiA 301);
+* ``ready-poll`` - ``GT_IsEcatReady`` polled from one line again and again (200 times) with no
+  ``GT_GetClock`` in between: a loop without a time limit hangs the program when the bus
+  never comes up (the manual's example 5-5 loops so; entry 80 gives no limit);
+* ``move-with-alarm`` - a move started (``GT_Update`` and the other start calls) on an axis
+  whose status has the alarm bit set (manual 7.1, table 6-2 bit 1: clear it with GT_ClrSts
+  once the cause is gone).
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from typing import Any, TextIO
+
+from gtecat.drives.cia402 import State
+
+from .tap import Listener, call_site, tap, untap
+
+SOURCES = {
+    "cw-skip": "CiA 402 state machine",
+    "enable-in-fault": "CiA 402 transition 15",
+    "csp-step": "CiA 402 6065h / ETG.6010 CSP",
+    "mode-while-moving": "ETG.6010 modes of operation",
+    "sdo-on-pdo": "ETG.1000.6 / CiA 301",
+    "ready-poll": "manual entry 80, example 5-5",
+    "move-with-alarm": "manual table 6-2 bit 1",
+}
+#: GT_IsEcatReady calls in a row from one line with no clock read: a "poll without a limit"
+READY_POLLS = 200
+_START_CALLS = frozenset({"GT_Update", "GT_MoveAbsolute", "GT_MoveRelative", "GT_MoveVelocity"})
+
+
+def _command(cw: int) -> str:
+    """The command of a controlword (CiA 402 Table 2)."""
+    if cw & 0x80:
+        return "fault_reset"
+    if not cw & 0x02:
+        return "disable_voltage"
+    if not cw & 0x04:
+        return "quick_stop"
+    if cw & 0x0F == 0x06:
+        return "shutdown"
+    if cw & 0x0F == 0x07:
+        return "switch_on"
+    if cw & 0x0F == 0x0F:
+        return "enable"
+    return ""
+
+
+#: state -> the commands that are one transition from it (or hold it)
+_ALLOWED = {
+    State.SWITCH_ON_DISABLED: {"shutdown", "disable_voltage", "quick_stop", "fault_reset"},
+    State.READY_TO_SWITCH_ON: {"shutdown", "switch_on", "disable_voltage", "quick_stop", "enable"},
+    State.SWITCHED_ON: {"switch_on", "enable", "shutdown", "disable_voltage", "quick_stop"},
+    State.OPERATION_ENABLED: {"enable", "switch_on", "shutdown", "disable_voltage", "quick_stop"},
+}
+
+
+@dataclass
+class Finding:
+    rule: str
+    file: str
+    line: int
+    text: str
+
+    def __str__(self) -> str:
+        return f"check: {self.file}:{self.line}: {self.text} [{SOURCES[self.rule]}]"
+
+
+class Checker(Listener):
+    """The application checks (module docstring)."""
+
+    bank_safe = False  # it reads the drives every cycle
+
+    def __init__(self, out: TextIO | None = None) -> None:
+        self.out = out if out is not None else sys.stderr
+        self.findings: list[Finding] = []
+        self._seen: set[tuple[str, str, int]] = set()
+        self._site: tuple[str, int] = ("?", 0)
+        self._ctl: Any = None
+        self._prev: dict[int, tuple[int, int, int, int]] = {}
+        self._polls = 0
+        self._poll_site: tuple[str, int] = ("", 0)
+
+    def start(self) -> Checker:
+        tap(self)
+        return self
+
+    def stop(self) -> None:
+        untap(self)
+        ctl = self._ctl
+        if ctl is not None and self._cycle in ctl.pre_cycle:
+            ctl.pre_cycle.remove(self._cycle)
+
+    def report(self, rule: str, text: str, site: tuple[str, int] | None = None) -> None:
+        file, line = site or self._site
+        key = (rule, file, line)
+        if key in self._seen:
+            return
+        self._seen.add(key)
+        f = Finding(rule, file, line, text)
+        self.findings.append(f)
+        print(str(f), file=self.out, flush=True)
+
+    def report_here(self, rule: str, text: str) -> None:
+        self.report(rule, text, getattr(self, "_now", None))
+
+    # --- the call stream -----------------------------------------------------------------------
+    def before(self, name: str, args: tuple, kwargs: dict) -> Any:
+        site = call_site()
+        self._now = site
+        if not name.startswith(("GT_Get", "GTN_Get", "GT_IsEcatReady", "GTN_IsEcatReady")) and (
+            name not in ("GTE_Wait", "GT_GetClock")
+        ):
+            self._site = site  # what a cycle's finding is about: the last call that acts
+        ctl = self._attach()
+        if name.startswith("GTN_") and args:
+            name, args = "GT_" + name[4:], args[1:]
+        if name == "GT_IsEcatReady":
+            self._polls = self._polls + 1 if site == self._poll_site else 1
+            self._poll_site = site
+            if self._polls == READY_POLLS:
+                self.report_here(
+                    "ready-poll",
+                    f"GT_IsEcatReady polled {READY_POLLS} times in a row without reading the "
+                    "clock: give the loop a time limit (GT_GetClock) so that a bus that never "
+                    "comes up (a cable, a slave missing) ends it instead of hanging",
+                )
+        elif name == "GT_GetClock":  # a loop that reads the clock can have a time limit
+            self._polls = 0
+        if ctl is None:
+            return None
+        if name in _START_CALLS and args:
+            self._check_start(ctl, name, args)
+        elif name == "GT_EcatSDODownload" and len(args) >= 2:
+            self._check_sdo(ctl, int(args[0]), int(args[1]))
+        return None
+
+    def _attach(self) -> Any:
+        from ..gt._core import SESSION
+
+        ctl = SESSION.controllers.get(1)
+        if ctl is not self._ctl:
+            self._ctl = ctl
+            self._prev.clear()
+        if ctl is not None and ctl.master is not None and self._cycle not in ctl.pre_cycle:
+            ctl.pre_cycle.append(self._cycle)
+        return ctl
+
+    def _check_start(self, ctl: Any, name: str, args: tuple) -> None:
+        try:
+            mask = int(args[0])
+        except (TypeError, ValueError):
+            return
+        axes = [a for a in range(1, 33) if mask >> (a - 1) & 1] if name == "GT_Update" else [mask]
+        for a in axes:
+            ax = ctl.axes.get(a)
+            res = ctl.resources.get(a) if hasattr(ctl, "resources") else None
+            if ax is None or res is None:
+                continue
+            try:
+                sts = int(res.status())
+            except Exception:
+                continue
+            if sts & 0x2:
+                self.report_here(
+                    "move-with-alarm",
+                    f"{name} starts axis {a} while its alarm bit is set (GT_GetSts bit 1): "
+                    "find the cause, GT_ClrSts, servo on again first",
+                )
+
+    def _check_sdo(self, ctl: Any, slave: int, index: int) -> None:
+        m = ctl.master
+        if m is None or not 0 <= slave < len(m.layout.slaves):
+            return
+        from gtecat.drives.slave import AlState
+
+        if m.states[slave] != AlState.OP:
+            return
+        for e in m.layout.slaves[slave].entries:
+            if (
+                getattr(e, "direction", None) is not None
+                and e.direction.name == "OUT"
+                and e.index == index
+            ):
+                self.report_here(
+                    "sdo-on-pdo",
+                    f"SDO write to 0x{index:04X} of slave {slave} in OP: the object is mapped "
+                    "in its RxPDO, the next cycle overwrites it (write the process data, or "
+                    "write it before OP)",
+                )
+                return
+
+    # --- every cycle ------------------------------------------------------------------------------
+    def _cycle(self, _t: int, _dt: int) -> None:
+        ctl = self._ctl
+        backend = getattr(ctl, "backend", None)
+        slaves = getattr(backend, "slaves", None)
+        if not slaves:
+            return
+        axis = 0
+        for s in slaves:
+            for ch in getattr(s, "channels", ()):
+                axis += 1
+                self._channel(axis, ch)
+
+    def _channel(self, axis: int, ch: Any) -> None:
+        cw, state = int(ch.controlword), ch.psm.state
+        target, mode = int(ch.target_position), int(ch.mode_req)
+        prev = self._prev.get(axis)
+        self._prev[axis] = (cw, target, mode, int(ch.prev_cw))
+        if prev is None:
+            return
+        pcw, ptarget, pmode, _ = prev
+        if cw != pcw:
+            cmd = _command(cw)
+            if state in (State.FAULT, State.FAULT_REACTION_ACTIVE):
+                if cmd in ("enable", "switch_on", "shutdown") and not pcw & 0x80:
+                    self.report(
+                        "enable-in-fault",
+                        f"axis {axis}: controlword 0x{cw:04X} while the drive is in FAULT "
+                        "without a fault reset (bit 7 rising) first",
+                    )
+            elif state in _ALLOWED and cmd and cmd not in _ALLOWED[state]:
+                self.report(
+                    "cw-skip",
+                    f"axis {axis}: controlword 0x{cw:04X} ({cmd.replace('_', ' ')}) in "
+                    f"{state.name.replace('_', ' ')} skips a state of the CiA-402 machine",
+                )
+        window = int(ch.following_error_window)
+        if (
+            ch.mode == 8
+            and state is State.OPERATION_ENABLED
+            and 0 < window < 0xFFFFFFFF
+            and abs(target - ptarget) > window
+        ):
+            self.report(
+                "csp-step",
+                f"axis {axis}: CSP target jumps {target - ptarget} counts in one cycle, more "
+                f"than the following-error window {window}: the drive faults (8611h)",
+            )
+        if mode != pmode and abs(ch.mech.vel) > max(ch.standstill, 1.0):
+            self.report(
+                "mode-while-moving",
+                f"axis {axis}: mode of operation {pmode} -> {mode} while the axis moves "
+                f"({ch.mech.vel:.0f} counts/s)",
+            )
+
+
+__all__ = ["SOURCES", "Checker", "Finding"]

@@ -1,0 +1,576 @@
+"""The injector: the faults of one bus, armed, active and spent, run once per cycle.
+
+:class:`Injector` holds entries (a fault, its trigger, how long it lasts); :meth:`tick`
+runs once per cycle before the exchange (the controller's ``pre_cycle``; after each step
+on ``gtecat serve``): triggers that are due start their fault, faults whose time is up
+end, chattering switches toggle, stuck IO inputs are held.  Mailbox requests pass
+:meth:`mailbox` (a stand-in in front of every slave's mailbox), cyclic answers
+:meth:`answer` (emulated) or :meth:`frame` (wire).  Every start and end is written to the
+master log (``fault 3 started: ...``) and kept in :attr:`events` (recordings read them).
+"""
+
+from __future__ import annotations
+
+import struct
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from gtecat.drives.coe import (
+    CoeService,
+    MailboxError,
+    build_coe,
+    mailbox_error,
+    parse_mailbox,
+)
+from gtecat.drives.faults import ErrorCode
+from gtecat.drives.io_slaves import IoSlave
+from gtecat.drives.slave import AlState
+
+from ..errors import ParameterError
+from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
+from . import kinds as k
+from .bus import FaultBus
+from .triggers import AfterTime, AtTime, Now, Trigger
+
+_LOGICAL = frozenset({"LRW", "LRD", "LWR"})
+_STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
+
+
+#: called with ("inject", values) / ("clear", {"id": N}) for every fault a program or an
+#: operator adds or ends (recordings keep them in the stream)
+OBSERVERS: list[Any] = []
+
+
+@dataclass(eq=False)
+class Entry:
+    id: int
+    fault: k.Fault
+    trigger: Trigger
+    duration_ms: float | None = None
+    state: str = "armed"  # armed | active | ended
+    started_ms: float | None = None
+    left: int = 0  # answers / requests still to hit (count kinds), 0 = no limit
+    data: dict[str, Any] = field(default_factory=dict)
+    #: a step of a script: armed only once the fault with this id has started
+    after: int | None = None
+    name: str = ""
+
+    def describe(self) -> str:
+        text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        if self.duration_ms is not None:
+            text += f", for {self.duration_ms:g} ms"
+        if self.after is not None:
+            text += f", once fault {self.after} has started"
+        return text
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {"id": self.id, **self.fault.as_dict(), **self.trigger.as_dict()}
+        if self.duration_ms is not None:
+            d["duration_ms"] = self.duration_ms
+        d["state"] = self.state
+        d["describe"] = self.describe()
+        return d
+
+
+class Injector:
+    """The faults of one bus (module docstring)."""
+
+    #: the controller's pre_cycle protocol: time triggers do not touch banked axes
+    bank_safe = True
+
+    def __init__(self, bus: FaultBus) -> None:
+        self.bus = bus
+        self.entries: list[Entry] = []
+        self._next = 1
+        #: (time ms, "start" | "end", entry id, description): what happened, in order
+        self.events: list[tuple[float, str, int, str]] = []
+        self._frame_on = False
+        self._mailboxes: dict[int, Any] = {}
+        self._al_guards: dict[int, Any] = {}
+        self._chatter_cycle = 0
+        self._last_answer: bytes | None = None
+        self._lbase: int | None = None
+        self._started: set[int] = set()
+        self._wrap_mailboxes()
+
+    # --- adding and clearing ----------------------------------------
+    def add(
+        self,
+        fault: k.Fault,
+        trigger: Trigger | None = None,
+        duration_ms: float | None = None,
+        *,
+        after: int | None = None,
+        name: str = "",
+    ) -> Entry:
+        self._check_target(fault)
+        if (
+            after is not None
+            and after not in self._started
+            and not any(e.id == after for e in self.entries)
+        ):
+            raise ParameterError(f"after={after}: no such fault")
+        e = Entry(self._next, fault, trigger or Now(), duration_ms, after=after, name=name)
+        self._next += 1
+        trig = e.trigger
+        if hasattr(trig, "since"):
+            trig.since = self.bus.t_ms()  # type: ignore[attr-defined]
+        self.entries.append(e)
+        self.bus.log(f"Fault {e.id} armed: {e.describe()}.")
+        self._refresh()
+        if isinstance(trig, Now) and self._gate_open(e):
+            self._start(e)
+        return e
+
+    def clear(self, ident: int | None = None) -> int:
+        """End one fault (by id) or all; the number ended."""
+        n = 0
+        for e in list(self.entries):
+            if ident is not None and e.id != ident:
+                continue
+            if e.state == "active":
+                self._end(e, "cleared")
+            elif e.state == "armed":
+                e.state = "ended"
+                self.bus.log(f"Fault {e.id} disarmed: {e.describe()}.")
+            n += 1
+        if ident is not None and n == 0:
+            raise ParameterError(f"no fault {ident} (gtecat fault list shows them)")
+        self.entries = [e for e in self.entries if e.state != "ended"]
+        self._refresh()
+        return n
+
+    def listing(self) -> list[dict[str, Any]]:
+        return [e.as_dict() for e in self.entries]
+
+    def _check_target(self, f: k.Fault) -> None:
+        """Refuse a fault naming a slave or axis the bus does not have, when it is given."""
+        if getattr(f, "axis", None) is not None:
+            self.bus.channel(int(f.axis))  # type: ignore[attr-defined]
+        if getattr(f, "slave", None) is not None:
+            s = self.bus.slave(int(f.slave))  # type: ignore[attr-defined]
+            if f.depth == "mailbox" and not s.has_mailbox:
+                raise ParameterError(f"slave {s.position} ({s.name}) has no mailbox")
+            if isinstance(f, k.IoStuck):
+                if not isinstance(s, IoSlave):
+                    raise ParameterError(f"slave {s.position} ({s.name}) is no IO slave")
+                if not 0 <= f.bit < len(s.field_inputs) * 8:
+                    raise ParameterError(f"slave {s.position}: no input bit {f.bit}")
+        if isinstance(f, k.LinkDown) and f.after_slave >= len(self.bus.slaves) - 1:
+            raise ParameterError(
+                f"link_down after slave {f.after_slave}: nothing follows it (the bus has "
+                f"slaves 0..{len(self.bus.slaves) - 1})"
+            )
+
+    # --- the cycle ----------------------------------------
+    def tick(self, _t_ns: int = 0, _dt_ns: int = 0, *, cycle: bool = True) -> None:
+        """Once per cycle; ``cycle=False``: time alone passed (``gtecat serve`` between
+        frames), so only time triggers and durations are looked at."""
+        if not self.entries:
+            return
+        now = self.bus.t_ms()
+        for e in self.entries:
+            if e.state == "armed" and self._gate_open(e):
+                if not cycle and not isinstance(e.trigger, AtTime | AfterTime):
+                    continue
+                if e.trigger.due(self.bus):
+                    self._start(e)
+            elif e.state == "active" and e.duration_ms is not None:
+                if now - (e.started_ms or 0.0) >= e.duration_ms:
+                    self._end(e, "over")
+        if not cycle:
+            if any(e.state == "ended" for e in self.entries):
+                self.entries = [e for e in self.entries if e.state != "ended"]
+                self._refresh()
+            return
+        self._chatter_cycle += 1
+        for e in self.entries:
+            if e.state != "active":
+                continue
+            f = e.fault
+            if isinstance(f, k.SwitchChatter):
+                ff = self.bus.channel(f.axis).field
+                if ff is not None:
+                    bit = 1 << k.SWITCH_BITS[f.switch]
+                    on = (self._chatter_cycle // f.period_cycles) % 2 == 0
+                    ff.din_set = (ff.din_set | bit) if on else (ff.din_set & ~bit)
+                    ff.din_clear = (ff.din_clear & ~bit) if on else (ff.din_clear | bit)
+            elif isinstance(f, k.IoStuck):
+                s = self.bus.slave(f.slave)
+                if isinstance(s, IoSlave):
+                    s.set_input_bit(f.bit, bool(f.value))
+        if any(e.state == "ended" for e in self.entries):
+            self.entries = [e for e in self.entries if e.state != "ended"]
+            self._refresh()
+
+    def _gate_open(self, e: Entry) -> bool:
+        if e.after is None:
+            return True
+        if e.after in self._started:
+            if "armed_ms" not in e.data:
+                e.data["armed_ms"] = self.bus.t_ms()
+                if hasattr(e.trigger, "since"):
+                    e.trigger.since = e.data["armed_ms"]  # type: ignore[attr-defined]
+            return True
+        return False
+
+    def _refresh(self) -> None:
+        """Frame faults routed while one is armed or active; bank-safe without position or
+        homing triggers."""
+        frame = any(
+            e.state == "active" and e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown)
+            for e in self.entries
+        )
+        if frame != self._frame_on:
+            self._frame_on = frame
+            self.bus.set_frame_faults(self if frame else None)
+        from .triggers import AtHomingStage, WhenPosition
+
+        safe = not any(
+            e.state == "armed" and isinstance(e.trigger, WhenPosition | AtHomingStage)
+            for e in self.entries
+        )
+        if safe != self.bank_safe:
+            self.bank_safe = safe
+            self.bus.before_change()
+
+    # --- start and end ----------------------------------------
+    def _start(self, e: Entry) -> None:
+        e.state = "active"
+        e.started_ms = self.bus.t_ms()
+        self._started.add(e.id)
+        f = e.fault
+        e.left = int(getattr(f, "count", 0) or 0)
+        self.events.append((e.started_ms, "start", e.id, e.describe()))
+        self.bus.log(f"Fault {e.id} started: {f.describe()}.")
+        bus = self.bus
+        if isinstance(f, k.LinkDown):
+            bus.cut_after(f.after_slave)
+        elif isinstance(f, k.PowerCycle):
+            bus.power_cycle(f.slave)
+        elif isinstance(f, k.RetreatSafeop):
+            bus.fall(f.slave, AlState.SAFEOP, f.code)
+        elif isinstance(f, k.AlError):
+            self._latch(f)
+        elif isinstance(f, k.DriveFault):
+            bus.before_change()
+            bus.channel(f.axis).inject_fault(f.code)
+        elif isinstance(f, k.Sto):
+            bus.override(f.axis).sto = True
+            bus.channel(f.axis).inject_fault(ErrorCode.SAFE_TORQUE_OFF)
+        elif isinstance(f, k.QuickStopInput):
+            bus.override(f.axis).quick_stop = True
+        elif isinstance(f, k.Brake):
+            bus.override(f.axis).brake = True
+        elif isinstance(f, k.SwitchStuck):
+            ff = bus.override(f.axis)
+            bit = 1 << k.SWITCH_BITS[f.switch]
+            if f.value:
+                ff.din_set |= bit
+            else:
+                ff.din_clear |= bit
+        elif isinstance(f, k.SwitchChatter):
+            bus.override(f.axis)
+        elif isinstance(f, k.EncoderLost):
+            bus.override(f.axis).enc_shift -= f.counts
+        elif isinstance(f, k.EncoderNoise):
+            bus.override(f.axis).enc_noise = f.counts
+        elif isinstance(f, k.ProbeMissing):
+            ff = bus.override(f.axis)
+            ff.probe_off = True
+            ff.din_clear |= 3 << 16
+        elif isinstance(f, k.IoStuck):
+            s = bus.slave(f.slave)
+            if isinstance(s, IoSlave):
+                s.set_input_bit(f.bit, bool(f.value))
+        if f.depth == "frame":
+            self._refresh()  # the cyclic answers pass the injector from now on
+        if f.once:
+            self._end(e, "done")
+
+    def _end(self, e: Entry, why: str) -> None:
+        if e.state == "ended":
+            return
+        e.state = "ended"
+        f = e.fault
+        bus = self.bus
+        now = bus.t_ms()
+        self.events.append((now, "end", e.id, why))
+        if not f.once:
+            bus.log(f"Fault {e.id} ended ({why}): {f.describe()}.")
+        if isinstance(f, k.LinkDown):
+            bus.mend()
+        elif isinstance(f, k.AlError):
+            self._unlatch(f)
+        elif isinstance(f, k.DriveFault):
+            bus.before_change()
+            bus.channel(f.axis).clear_injected_fault()
+        elif isinstance(f, k.Sto):
+            bus.override(f.axis).sto = False
+            bus.channel(f.axis).clear_injected_fault()
+        elif isinstance(f, k.QuickStopInput):
+            bus.override(f.axis).quick_stop = False
+        elif isinstance(f, k.Brake):
+            bus.override(f.axis).brake = False
+        elif isinstance(f, k.SwitchStuck | k.SwitchChatter):
+            ff = bus.override(f.axis)
+            bit = 1 << k.SWITCH_BITS[f.switch]
+            ff.din_set &= ~bit
+            ff.din_clear &= ~bit
+        elif isinstance(f, k.EncoderLost):
+            bus.override(f.axis).enc_shift += f.counts
+        elif isinstance(f, k.EncoderNoise):
+            bus.override(f.axis).enc_noise = 0
+        elif isinstance(f, k.ProbeMissing):
+            ff = bus.override(f.axis)
+            ff.probe_off = False
+            ff.din_clear &= ~(3 << 16)
+        axis = getattr(f, "axis", None)
+        if axis is not None and f.depth in ("drive", "field"):
+            bus.forget_override(axis)
+
+    def _spend(self, e: Entry) -> None:
+        """One hit of a counted fault; the last one ends it."""
+        if e.left:
+            e.left -= 1
+            if e.left == 0:
+                self._end(e, "spent")
+
+    # --- AL errors ------------------------------------------------------------------------------
+    def _latch(self, f: k.AlError) -> None:
+        s = self.bus.slave(f.slave)
+        state = _STATES[f.state.upper()]
+        self.bus.fall(f.slave, state, f.code)
+        if f.slave in self._al_guards:
+            return
+        inner = s.on_state_change  # the class's (or a guard already there)
+
+        def refuse(old: AlState, new: AlState, _code: int = f.code, _top: AlState = state) -> Any:
+            if new > _top and new != AlState.BOOT:
+                return _code  # the error is latched: the slave will not go higher
+            return inner(old, new)
+
+        s.on_state_change = refuse  # type: ignore[method-assign]
+        self._al_guards[f.slave] = refuse
+
+    def _unlatch(self, f: k.AlError) -> None:
+        s = self.bus.slave(f.slave)
+        if self._al_guards.pop(f.slave, None) is not None:
+            try:
+                del s.on_state_change  # back to the class's method
+            except AttributeError:
+                pass
+
+    # --- the mailbox ----------------------------------------
+    def _wrap_mailboxes(self) -> None:
+        for s in self.bus.slaves:
+            if not s.has_mailbox or s.position in self._mailboxes:
+                continue
+            inner = s.mailbox
+            self._mailboxes[s.position] = inner
+
+            def stand_in(request: bytes, _pos: int = s.position, _inner: Any = inner) -> Any:
+                return self.mailbox(_pos, request, _inner)
+
+            s.mailbox = stand_in  # type: ignore[method-assign]
+
+    def detach(self) -> None:
+        """Take every stand-in away (the bus goes on without faults)."""
+        for e in list(self.entries):
+            if e.state == "active":
+                self._end(e, "cleared")
+        self.entries = []
+        self._refresh()
+        for s in self.bus.slaves:
+            if s.position in self._mailboxes:
+                try:
+                    del s.mailbox
+                except AttributeError:
+                    pass
+        self._mailboxes.clear()
+
+    def mailbox(self, position: int, request: bytes, inner: Any) -> bytes | None:
+        info = _sdo_request(request)
+        if info is not None and info[1] is not None:
+            for e in self.entries:
+                if e.state == "armed" and e.trigger.sdo(position, info[1]):
+                    self._start(e)
+        if info is not None:
+            step, index, subindex = info
+            if index is not None:
+                self._mbx_index = (position, index)
+            elif getattr(self, "_mbx_index", (None, None))[0] == position:
+                index = self._mbx_index[1]  # a segment: the object of the transfer
+            for e in self.entries:
+                f = e.fault
+                if e.state != "active" or f.depth != "mailbox" or f.slave != position:  # type: ignore[attr-defined]
+                    continue
+                if f.index is not None and f.index != index:  # type: ignore[attr-defined]
+                    continue
+                if isinstance(f, k.MailboxAbort):
+                    if f.step != "request" and f.step != step:
+                        continue
+                    if f.subindex is not None and subindex is not None and f.subindex != subindex:
+                        continue
+                    self._spend(e)
+                    return _abort(request, index or 0, subindex or 0, f.code)
+                if isinstance(f, k.MailboxLost):
+                    inner(request)  # the slave did it; only the answer is lost
+                    self._spend(e)
+                    return None
+                if isinstance(f, k.MailboxProtocol):
+                    self._spend(e)
+                    return _protocol_fault(request, f.variant)
+        return inner(request)
+
+    # --- cyclic answers ----------------------------------------
+    def answer(self, wkc: int) -> tuple[int, int]:
+        """The emulated bus's cyclic LRW answer: (ANSWERED | LOST | PREVIOUS, working counter)."""
+        action = ANSWERED
+        size = 0
+        for e in self.entries:
+            if e.state != "active" or e.fault.depth != "frame":
+                continue
+            f = e.fault
+            if isinstance(f, k.WkcOffset):
+                if f.command is not None and f.command.upper() not in ("LRW",):
+                    continue
+                if f.area is not None:
+                    if not size:
+                        img = self.bus.ctl.master.image  # type: ignore[attr-defined]
+                        size = img.outputs_bytes + img.inputs_bytes
+                    if not (f.area[0] < size and 0 < f.area[1]):
+                        continue
+                wkc = max(0, wkc + f.offset)
+                self._spend(e)
+            elif action == ANSWERED:
+                if isinstance(f, k.DropResponses | k.FrameTruncate | k.FrameWrongIndex):
+                    action = LOST
+                elif isinstance(f, k.FrameDelay):
+                    if f.us * 1000 >= self.bus.cycle_ns:
+                        action = LOST  # later than the master waits: lost for this cycle
+                elif isinstance(f, k.FrameReplay):
+                    action = PREVIOUS
+                else:
+                    continue
+                self._spend(e)
+        return action, wkc
+
+    def frame(self, buf: bytearray, n: int, _t_ns: int) -> int:
+        """An answered frame on the wire, changed in place; the length to send (0: lost)."""
+        from gtecat.drives.esc.frames import walk
+
+        chain = self.bus.chain  # type: ignore[attr-defined]
+        if not chain.process_data:
+            return n
+        offsets = walk(buf, n) or []
+        for e in self.entries:
+            if e.state != "active" or e.fault.depth != "frame":
+                continue
+            f = e.fault
+            if isinstance(f, k.WkcOffset):
+                hit = False
+                for off in offsets:
+                    if not self._datagram_hit(buf, off, f):
+                        continue
+                    dlen = struct.unpack_from("<H", buf, off + 6)[0] & 0x07FF
+                    at = off + 10 + dlen
+                    w = struct.unpack_from("<H", buf, at)[0]
+                    struct.pack_into("<H", buf, at, max(0, w + f.offset) & 0xFFFF)
+                    hit = True
+                if hit:
+                    self._spend(e)
+                continue
+            if isinstance(f, k.DropResponses):
+                self._spend(e)
+                return 0
+            if isinstance(f, k.FrameTruncate):
+                self._spend(e)
+                return max(1, n - f.bytes)
+            if isinstance(f, k.FrameWrongIndex):
+                for off in offsets:
+                    buf[off + 1] ^= 0x80
+                self._spend(e)
+                break
+            if isinstance(f, k.FrameReplay):
+                self._spend(e)
+                prev = self._last_answer
+                if prev is not None:
+                    buf[: len(prev)] = prev
+                    return len(prev)
+                break
+            if isinstance(f, k.FrameDelay):
+                self._spend(e)
+                end = time.monotonic_ns() + f.us * 1000
+                while time.monotonic_ns() < end:
+                    time.sleep(0)
+                break
+        self._last_answer = bytes(buf[:n])
+        return n
+
+    def _datagram_hit(self, buf: bytearray, off: int, f: k.WkcOffset) -> bool:
+        from gtecat.eni.ethercat import Command
+
+        cmd = buf[off]
+        if f.command is not None and Command.__members__.get(f.command.upper()) != cmd:
+            return False
+        if f.area is None:
+            return True
+        if f.command is None and Command(cmd).name not in _LOGICAL:
+            return False
+        laddr = struct.unpack_from("<I", buf, off + 2)[0]
+        dlen = struct.unpack_from("<H", buf, off + 6)[0] & 0x07FF
+        if self._lbase is None or laddr < self._lbase:
+            self._lbase = laddr
+        a0 = laddr - self._lbase
+        return f.area[0] < a0 + dlen and a0 < f.area[1]
+
+
+# --- mailbox messages ----------------------------------------
+_STEP_OF_CCS = {1: "download_init", 0: "download_segment", 2: "upload_init", 3: "upload_segment"}
+
+
+def _sdo_request(request: bytes) -> tuple[str, int | None, int | None] | None:
+    """(step, index or None for a segment, subindex) of a CoE SDO request, else None."""
+    try:
+        mbx = parse_mailbox(bytes(request))
+    except ValueError:
+        return None
+    data = mbx.data
+    if mbx.mbx_type != 3 or len(data) < 3:  # CoE (ETG.1000.6 Table 29)
+        return None
+    service = struct.unpack_from("<H", data)[0] >> 12
+    if service != CoeService.SDO_REQUEST:
+        return None
+    ccs = data[2] >> 5
+    step = _STEP_OF_CCS.get(ccs)
+    if step is None:
+        return None
+    if step.endswith("init") and len(data) >= 6:
+        return step, struct.unpack_from("<H", data, 3)[0], data[5]
+    return step, None, None
+
+
+def _counter(request: bytes) -> int:
+    try:
+        return parse_mailbox(bytes(request)).counter
+    except ValueError:
+        return 1
+
+
+def _abort(request: bytes, index: int, subindex: int, code: int) -> bytes:
+    body = struct.pack("<BHBI", 0x80, index, subindex, code & 0xFFFFFFFF)
+    return build_coe(CoeService.SDO_REQUEST, body, counter=_counter(request))
+
+
+def _protocol_fault(request: bytes, variant: str) -> bytes:
+    counter = _counter(request)
+    if variant == "mailbox_error":
+        return mailbox_error(MailboxError.SERVICE_NOT_SUPPORTED, counter=counter)
+    if variant == "wrong_service":
+        return build_coe(CoeService.EMERGENCY, bytes(8), counter=counter)
+    return build_coe(CoeService.SDO_RESPONSE, b"", counter=counter)  # "short": no SDO frame
+
+
+__all__ = ["ANSWERED", "LOST", "PREVIOUS", "Entry", "Injector"]

@@ -1,0 +1,516 @@
+"""Recordings: the GT call stream of a session, its faults and the bus at checkpoints; replay.
+
+A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
+
+* a header ``{"gtecat_recording": 1, ...}``;
+* one line per GT call: ``{"c": NAME, "a": [arguments], "k": {keywords}, "o": {index:
+  value written back}, "r": return code, "t": controller time in ns}``, and ``"b"``: the
+  controller time when the call began, where time passed since the call before (a
+  controller process lets its clock follow the wall clock between its clients' calls);
+* ``{"f": "inject", "v": {a [[fault]] table}}`` / ``{"f": "clear", "id": N}`` for faults
+  injected from Python or the command line, at their place in the stream;
+* ``{"cp": ns, "wkc": [got, expected], "states": [...], "ready": 0|1}`` checkpoints of the bus
+  every :data:`CHECKPOINT_MS` of controller time.
+
+Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
+structure field by field, an array as its values, a buffer as hex); replay builds fresh
+objects of the same types, makes the same calls in the same order and compares every return
+code, every value written back and every checkpoint: the first difference is the
+divergence (call number, function, argument, recorded and new value).  Replays are
+deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session replays in
+``auto`` (the values its wall clock decided may then differ, and are reported so).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import gzip
+import io
+import json
+import os
+import threading
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParameterError
+from .tap import Listener, tap, untap
+
+CHECKPOINT_MS = 100
+#: the settings a recording keeps and a replay restores (what GT_Open reads)
+_ENV = (
+    "GTECAT_ENI",
+    "GTECAT_MACHINE",
+    "GTECAT_CLOCK",
+    "GTECAT_BACKEND",
+    "GTECAT_IFACE",
+    "GTECAT_BUS",
+    "GTECAT_BANK",
+    "GTECAT_CARD",
+)
+_CArg = type(ctypes.byref(ctypes.c_int()))
+_SIMPLE = {
+    name: getattr(ctypes, name)
+    for name in dir(ctypes)
+    if name.startswith("c_")
+    and isinstance(getattr(ctypes, name), type)
+    and issubclass(getattr(ctypes, name), ctypes._SimpleCData)  # type: ignore[attr-defined]
+}
+
+
+# --- values ------------------------------------------------------------------------------
+def _scalar(v: Any) -> Any:
+    if isinstance(v, bytes):
+        return {"b": v.hex()}
+    if isinstance(v, float) and (v != v or v in (_INF, -_INF)):
+        return {"nan": 1} if v != v else {"inf": 1 if v > 0 else -1}
+    return v
+
+
+_INF = float("inf")
+
+
+def encode(x: Any) -> Any:
+    """An argument as plain JSON (module docstring)."""
+    if x is None or isinstance(x, bool | int | str):
+        return x
+    if isinstance(x, float):
+        return _scalar(x)
+    if isinstance(x, _CArg):
+        return {"ref": encode(x._obj)}
+    if isinstance(x, ctypes._SimpleCData):  # type: ignore[attr-defined]
+        return {
+            "c": type(x).__name__ if type(x).__name__ in _SIMPLE else _base(x),
+            "v": _scalar(x.value),
+        }
+    if isinstance(x, ctypes.Array):
+        et = x._type_
+        if et in (ctypes.c_char, ctypes.c_ubyte, ctypes.c_uint8, ctypes.c_byte):
+            return {"arr": et.__name__, "n": len(x), "hex": bytes(x).hex()}
+        return {
+            "arr": et.__name__ if et.__name__ in _SIMPLE else "",
+            "n": len(x),
+            "v": [encode(e) for e in x],
+        }
+    if isinstance(x, ctypes.Structure):
+        return {"st": type(x).__name__, "v": {f[0]: encode(getattr(x, f[0])) for f in x._fields_}}
+    if isinstance(x, ctypes._Pointer):  # type: ignore[attr-defined]
+        return {"ptr": encode(x.contents)} if x else None
+    if isinstance(x, bytes):
+        return {"b": x.hex()}
+    if isinstance(x, bytearray):
+        return {"ba": x.hex()}
+    if isinstance(x, memoryview):
+        return {"ba": bytes(x).hex()}
+    if isinstance(x, list):
+        return {"list": [encode(e) for e in x]}
+    if isinstance(x, tuple):
+        return {"tuple": [encode(e) for e in x]}
+    if hasattr(x, "dtype") and hasattr(x, "tolist"):
+        return {"np": str(x.dtype), "v": x.tolist()}
+    return {"repr": repr(x)}
+
+
+def _base(x: Any) -> str:
+    for cls in type(x).__mro__:
+        if cls.__name__ in _SIMPLE:
+            return cls.__name__
+    return "c_long"
+
+
+def _unscalar(v: Any) -> Any:
+    if isinstance(v, dict):
+        if "b" in v:
+            return bytes.fromhex(v["b"])
+        if "nan" in v:
+            return float("nan")
+        if "inf" in v:
+            return _INF if v["inf"] > 0 else -_INF
+    return v
+
+
+def decode(v: Any) -> Any:
+    """A fresh object of the recorded type holding the recorded value."""
+    if not isinstance(v, dict):
+        return v
+    if "nan" in v or "inf" in v:
+        return _unscalar(v)
+    if "ref" in v:
+        return ctypes.byref(decode(v["ref"]))
+    if "c" in v:
+        return _SIMPLE.get(v["c"], ctypes.c_long)(_unscalar(v["v"]))
+    if "arr" in v:
+        et = _SIMPLE.get(v["arr"], ctypes.c_ubyte)
+        arr = (et * v["n"])()
+        if "hex" in v:
+            ctypes.memmove(arr, bytes.fromhex(v["hex"]), min(v["n"], len(v["hex"]) // 2))
+        else:
+            for i, e in enumerate(v["v"]):
+                arr[i] = _unscalar(e["v"]) if isinstance(e, dict) and "v" in e else _unscalar(e)
+        return arr
+    if "st" in v:
+        from .. import gt
+
+        cls = getattr(gt, v["st"], None)
+        if cls is None:
+            raise ParameterError(f"structure {v['st']} is not part of gtecat.gt")
+        obj = cls()
+        for name, fv in v["v"].items():
+            _set_field(obj, name, fv)
+        return obj
+    if "ptr" in v:
+        return ctypes.pointer(decode(v["ptr"]))
+    if "ba" in v:
+        return bytearray.fromhex(v["ba"])
+    if "list" in v:
+        return [decode(e) for e in v["list"]]
+    if "tuple" in v:
+        return tuple(decode(e) for e in v["tuple"])
+    if "np" in v:
+        import numpy as np
+
+        return np.array(v["v"], dtype=v["np"])
+    if "b" in v:
+        return bytes.fromhex(v["b"])
+    return None  # a value that cannot be rebuilt (an object of the caller's)
+
+
+def _pooled(pool: dict[tuple[str, int, str], tuple[Any, Any]], name: str, i: int, v: Any) -> Any:
+    """``decode(v)``, but a pointer to a simple value is one object per function and argument,
+    reused with the recorded value (an application polls with the same variable: so does the
+    replay, and the GT layer's fast path recognises it)."""
+    ref = v.get("ref")
+    if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
+        key = (name, i, ref["c"])
+        hit = pool.get(key)
+        if hit is None:
+            obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
+            hit = pool[key] = (obj, ctypes.byref(obj))
+        hit[0].value = ref["v"]
+        return hit[1]
+    return decode(v)
+
+
+def _set_field(obj: Any, name: str, fv: Any) -> None:
+    cur = getattr(obj, name)
+    if isinstance(cur, ctypes.Array):
+        src = decode(fv) if isinstance(fv, dict) else fv
+        for i in range(min(len(cur), len(src))):
+            cur[i] = src[i]
+    elif isinstance(cur, ctypes.Structure) and isinstance(fv, dict) and "st" in fv:
+        for n2, v2 in fv["v"].items():
+            _set_field(cur, n2, v2)
+    else:
+        setattr(
+            obj, name, _unscalar(fv) if not isinstance(fv, dict) else _unscalar(fv.get("v", fv))
+        )
+
+
+def _mutable(x: Any) -> bool:
+    return isinstance(
+        x,
+        _CArg
+        | ctypes._SimpleCData
+        | ctypes.Array
+        | ctypes.Structure
+        | bytearray
+        | memoryview
+        | list
+        | ctypes._Pointer,
+    ) or (  # type: ignore[attr-defined]
+        hasattr(x, "dtype") and hasattr(x, "tolist")
+    )
+
+
+# --- recording ----------------------------------------------------------------------------
+class Recorder(Listener):
+    """Writes the stream of the calls this thread makes (and the faults injected)."""
+
+    def __init__(
+        self, path: str | Path, meta: dict[str, Any] | None = None, *, any_thread: bool = False
+    ) -> None:
+        self.path = Path(path)
+        self.lines: list[str] = []
+        self.meta = dict(meta or {})
+        #: the thread whose calls are the session's (None: every thread's, as in a controller
+        #: process serving its clients' calls)
+        self.thread = None if any_thread else threading.get_ident()
+        self._last_cp = -(1 << 62)
+        self._t_end = -1  # controller time (with the latency not yet run) after the last call
+        self.calls = 0
+        self._dumps = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+        #: where the session ran: its folder and the GTECAT_* settings GT_Open reads
+        self.where = {
+            "cwd": os.getcwd(),
+            "env": {k: v for k, v in os.environ.items() if k in _ENV},
+        }
+
+    def start(self) -> Recorder:
+        from . import injector
+
+        tap(self)
+        injector.OBSERVERS.append(self.fault_event)
+        return self
+
+    def stop(self) -> None:
+        from . import injector
+
+        untap(self)
+        if self.fault_event in injector.OBSERVERS:
+            injector.OBSERVERS.remove(self.fault_event)
+
+    def before(self, name: str, args: tuple, kwargs: dict) -> Any:
+        if self.thread is not None and threading.get_ident() != self.thread:
+            return None
+        ctl = _controller()
+        gap = None
+        if ctl is not None:  # time that passed between calls (a controller's wall-clock floor)
+            total = ctl.clock.now_ns + ctl.clock._pending_ns
+            if total != self._t_end and self._t_end >= 0:
+                gap = total
+        return [encode(a) for a in args], {k: encode(v) for k, v in kwargs.items()}, gap
+
+    def after(self, name: str, args: tuple, kwargs: dict, rc: Any, token: Any) -> None:
+        if token is None:
+            return
+        a, kw, gap = token
+        outs = {str(i): encode(x) for i, x in enumerate(args) if _mutable(x)}
+        outs.update({k: encode(v) for k, v in kwargs.items() if _mutable(v)})
+        outs = {k: v for k, v in outs.items() if v != (a[int(k)] if k.isdigit() else kw.get(k))}
+        ctl = _controller()
+        t = ctl.clock.now_ns if ctl is not None else 0
+        entry: dict[str, Any] = {
+            "c": name,
+            "a": a,
+            "r": rc if isinstance(rc, int) else encode(rc),
+            "t": t,
+        }
+        if kw:
+            entry["k"] = kw
+        if outs:
+            entry["o"] = outs
+        if gap is not None:
+            entry["b"] = gap
+        self._t_end = t + ctl.clock._pending_ns if ctl is not None else -1
+        self.lines.append(self._dumps(entry))
+        self.calls += 1
+        if ctl is not None and t - self._last_cp >= CHECKPOINT_MS * 1_000_000:
+            self._last_cp = t
+            cp = checkpoint(ctl)
+            if cp is not None:
+                self.lines.append(self._dumps(cp))
+
+    def fault_event(self, what: str, values: dict[str, Any]) -> None:
+        same = threading.get_ident() == self.thread or self.thread is None
+        entry = {"f": what, "v": values, "sync": same}
+        ctl = _controller()
+        if ctl is not None:
+            entry["t"] = ctl.clock.now_ns
+            entry["ms"] = (ctl.clock.now_ns - ctl.reset_ns) / 1e6
+        self.lines.append(self._dumps(entry))
+
+    def write(self) -> Path:
+        head = {"gtecat_recording": 1, "calls": self.calls, **self.meta, **self.where}
+        text = json.dumps(head) + "\n" + "\n".join(self.lines) + ("\n" if self.lines else "")
+        data = text.encode()
+        if self.path.suffix == ".gz":
+            data = gzip.compress(data, 6)
+        self.path.write_bytes(data)
+        return self.path
+
+
+def _controller() -> Any:
+    from ..gt._core import SESSION
+
+    return SESSION.controllers.get(1)
+
+
+def checkpoint(ctl: Any) -> dict[str, Any] | None:
+    m = ctl.master
+    if m is None or not m.opened:
+        return None
+    return {
+        "cp": ctl.clock.now_ns,
+        "wkc": [m.last.wkc, m.last.expected],
+        "states": [int(s) for s in m.states],
+        "ready": int(m.ready),
+    }
+
+
+# --- replay ------------------------------------------------------------------------------------
+@dataclass
+class Divergence:
+    index: int  # the call's number in the stream (1-based)
+    call: str
+    what: str  # "return code", "argument 2", "bus state at 1200 ms"
+    recorded: Any
+    now: Any
+
+    def __str__(self) -> str:
+        return (
+            f"call {self.index} {self.call}: {self.what} recorded {_show(self.recorded)}, "
+            f"replay gives {_show(self.now)}"
+        )
+
+
+def _show(v: Any) -> str:
+    if isinstance(v, dict) and "v" in v and len(v) <= 3:
+        return _show(v["v"])
+    if isinstance(v, dict) and "ref" in v:
+        return _show(v["ref"])
+    text = json.dumps(v) if not isinstance(v, str) else v
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise ParameterError(f"{p}: no such recording") from None
+    if raw[:2] == b"\x1f\x8b":
+        raw = gzip.decompress(raw)
+    lines = io.StringIO(raw.decode("utf-8", "replace"))
+    try:
+        head = json.loads(lines.readline() or "{}")
+    except json.JSONDecodeError:
+        head = {}
+    if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
+        raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
+    try:
+        body = lines.read().strip()
+        entries = json.loads("[" + body.replace("\n", ",") + "]") if body else []
+    except json.JSONDecodeError as e:
+        raise ParameterError(f"{p}: damaged recording: {e}") from None
+    return head, entries
+
+
+def replay(
+    path: str | Path,
+    *,
+    eni: str | None = None,
+    machine: str | None = None,
+) -> tuple[int, Divergence | None]:
+    """Re-run a recording; (calls replayed, the first divergence or None)."""
+    head, entries = read(path)
+    with _where(head):
+        return _replay(entries, eni, machine)
+
+
+@contextmanager
+def _where(head: dict[str, Any]) -> Any:
+    """The recorded folder and GTECAT_* settings for the replay (a backend of real hardware
+    is replaced by the emulated one)."""
+    saved_env = {k: os.environ.get(k) for k in _ENV}
+    saved_cwd = os.getcwd()
+    env = head.get("env") or {}
+    for k in _ENV:
+        os.environ.pop(k, None)
+    for k, v in env.items():
+        if k in _ENV and isinstance(v, str):
+            os.environ[k] = v
+    if os.environ.get("GTECAT_BACKEND") == "pysoem":
+        os.environ["GTECAT_BACKEND"] = "emulated"
+    if os.environ.get("GTECAT_CLOCK") == "realtime":
+        os.environ["GTECAT_CLOCK"] = "auto"
+    cwd = head.get("cwd")
+    if isinstance(cwd, str) and os.path.isdir(cwd):
+        os.chdir(cwd)
+    try:
+        yield
+    finally:
+        os.chdir(saved_cwd)
+        for k, v in saved_env.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def _replay(
+    entries: list[dict[str, Any]], eni: str | None, machine: str | None
+) -> tuple[int, Divergence | None]:
+    from .. import faults, gt
+
+    eni = str(Path(eni).resolve()) if eni else None
+    machine = str(Path(machine).resolve()) if machine else None
+    gt.GT_Close()
+    n = 0
+    fns: dict[str, Any] = {}
+    pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
+    try:
+        for e in entries:
+            if "c" in e:
+                n += 1
+                name = e["c"]
+                fn = fns.get(name)
+                if fn is None:
+                    fn = fns[name] = getattr(gt, name, None)
+                    if fn is None:
+                        return n, Divergence(n, name, "function", "present", "missing")
+                before = e.get("b")
+                if before is not None:  # time passed between the calls: let it pass here too
+                    ctl = _controller()
+                    if ctl is not None:
+                        gap = before - ctl.clock.now_ns - ctl.clock._pending_ns
+                        if gap > 0:
+                            ctl.clock.advance_ns(gap)
+                a = e["a"]
+                args = [
+                    x if not isinstance(x, dict) else _pooled(pool, name, i, x)
+                    for i, x in enumerate(a)
+                ]
+                kw = {k: decode(v) for k, v in e.get("k", {}).items()}
+                if name in ("GT_Open", "GTN_Open"):
+                    if eni:
+                        kw["eni"] = str(eni)
+                    if machine:
+                        kw["machine"] = str(machine)
+                    if kw.get("clock") == "realtime":
+                        kw["clock"] = "auto"
+                    if kw.get("backend") == "pysoem":
+                        kw["backend"] = "emulated"
+                    kw["log"] = ""  # the session's master log is not written again
+                rc = fn(*args, **kw)
+                if rc != e["r"]:
+                    return n, Divergence(n, name, "return code", e["r"], rc)
+                outs = e.get("o")
+                if outs:
+                    for key, want in outs.items():
+                        got = encode(args[int(key)] if key.isdigit() else kw[key])
+                        if got != want:
+                            what = f"argument {int(key) + 1}" if key.isdigit() else key
+                            return n, Divergence(n, name, what, want, got)
+            elif "cp" in e:
+                ctl = _controller()
+                got = checkpoint(ctl) if ctl is not None else None
+                if got != e:
+                    ms = e["cp"] / 1e6
+                    return n, Divergence(n, "(bus)", f"bus state at {ms:g} ms", e, got)
+            elif "f" in e:
+                ctl = _controller()
+                if ctl is None:
+                    continue
+                if e["f"] == "inject":
+                    values = dict(e["v"])
+                    if not e.get("sync") and "ms" in e:
+                        values["at_ms"] = e["ms"]
+                    faults.inject(faults.spec_from_dict(values), ctl=ctl)
+                elif e["f"] == "clear":
+                    faults.clear(e["v"].get("id"), ctl=ctl)
+    finally:
+        gt.GT_Close()
+    return n, None
+
+
+__all__ = [
+    "CHECKPOINT_MS",
+    "Divergence",
+    "Recorder",
+    "checkpoint",
+    "decode",
+    "encode",
+    "read",
+    "replay",
+]

@@ -1,0 +1,234 @@
+"""When a fault happens: in virtual time, after healthy cycles, on a milestone of the machine.
+
+A trigger is asked once per cycle (:meth:`Trigger.due`) with the bus it watches
+(:class:`gtecat.faults.bus.FaultBus`), except :class:`OnSdo`, which counts the mailbox
+requests as they pass (:meth:`Trigger.sdo`), so the fault it arms meets the very request
+that fired it.  Every trigger has ``describe()`` in words and the plain-dict keys the
+``[[fault]]`` tables use (``at_ms``, ``after_cycles``, ``when_position``, ``at_homing``,
+``on_sdo``); no key: at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from .kinds import HOMING_STAGES, FaultSpecError
+
+
+@dataclass(kw_only=True)
+class Trigger:
+    def due(self, bus: Any) -> bool:
+        return True
+
+    def sdo(self, slave: int, index: int) -> bool:
+        return False
+
+    def describe(self) -> str:
+        return "at once"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {}
+
+
+@dataclass(kw_only=True)
+class Now(Trigger):
+    pass
+
+
+@dataclass(kw_only=True)
+class AtTime(Trigger):
+    """At controller time ``ms`` (what GT_GetClock reads; on ``gtecat serve``: since it began)."""
+
+    ms: float
+
+    def due(self, bus: Any) -> bool:
+        return bus.now_ms() >= self.ms
+
+    def describe(self) -> str:
+        return f"at {self.ms:g} ms"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"at_ms": self.ms}
+
+
+@dataclass(kw_only=True)
+class AfterTime(Trigger):
+    """``ms`` of controller time after the fault was armed (a script's step: after the
+    step before it started)."""
+
+    ms: float
+    since: float = 0.0
+
+    def due(self, bus: Any) -> bool:
+        return bus.t_ms() - self.since >= self.ms
+
+    def describe(self) -> str:
+        return f"{self.ms:g} ms later"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"after_ms": self.ms}
+
+
+@dataclass(kw_only=True)
+class AfterCycles(Trigger):
+    """After ``cycles`` healthy cycles (working counter as expected) from when it was armed."""
+
+    cycles: int
+    seen: int = 0
+
+    def due(self, bus: Any) -> bool:
+        if bus.healthy():
+            self.seen += 1
+        return self.seen >= self.cycles
+
+    def describe(self) -> str:
+        return f"after {self.cycles} healthy cycles"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"after_cycles": self.cycles}
+
+
+@dataclass(kw_only=True)
+class WhenPosition(Trigger):
+    """When the mechanics of ``axis`` reach or pass ``position`` (drive counts, either way)."""
+
+    axis: int
+    position: float
+    _side: int | None = None
+
+    def due(self, bus: Any) -> bool:
+        pos = bus.position(self.axis)
+        side = (pos > self.position) - (pos < self.position)
+        if side == 0:
+            return True
+        if self._side is None:
+            self._side = side
+            return False
+        return side != self._side
+
+    def describe(self) -> str:
+        return f"when axis {self.axis} passes {self.position:g}"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"when_position": [self.axis, self.position]}
+
+
+@dataclass(kw_only=True)
+class AtHomingStage(Trigger):
+    """When the homing of ``axis`` reaches ``stage`` (search, approach, index, return, ...)."""
+
+    axis: int
+    stage: str
+
+    def due(self, bus: Any) -> bool:
+        return bus.homing_stage(self.axis) == self.stage
+
+    def describe(self) -> str:
+        return f"when the homing of axis {self.axis} reaches its {self.stage} stage"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"at_homing": [self.axis, self.stage]}
+
+
+@dataclass(kw_only=True)
+class OnSdo(Trigger):
+    """On the ``n``-th SDO request to object ``index`` of ``slave`` (counted from arming)."""
+
+    slave: int
+    index: int
+    n: int = 1
+    seen: int = 0
+
+    def due(self, bus: Any) -> bool:
+        return False
+
+    def sdo(self, slave: int, index: int) -> bool:
+        if slave == self.slave and index == self.index:
+            self.seen += 1
+        return self.seen >= self.n
+
+    def describe(self) -> str:
+        nth = {1: "1st", 2: "2nd", 3: "3rd"}.get(self.n, f"{self.n}th")
+        return f"on the {nth} SDO to 0x{self.index:04X} of slave {self.slave}"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"on_sdo": [self.slave, self.index, self.n]}
+
+
+TRIGGER_KEYS = ("at_ms", "after_ms", "after_cycles", "when_position", "at_homing", "on_sdo")
+
+
+def _num(name: str, v: Any) -> float:
+    if isinstance(v, bool):
+        raise FaultSpecError(f"{name} must be a number, got {v!r}")
+    if isinstance(v, int | float):
+        return float(v)
+    try:
+        return float(int(str(v), 0)) if str(v).strip().lower().startswith("0x") else float(v)
+    except (TypeError, ValueError):
+        raise FaultSpecError(f"{name} must be a number, got {v!r}") from None
+
+
+def _list(name: str, v: Any, n: tuple[int, ...]) -> list[Any]:
+    if isinstance(v, str):
+        v = [p.strip() for p in v.split(",")]
+    if not isinstance(v, list | tuple) or len(v) not in n:
+        want = " or ".join(str(k) for k in n)
+        raise FaultSpecError(f"{name} must be a list of {want} values, got {v!r}")
+    return list(v)
+
+
+def trigger_from_dict(values: dict[str, Any]) -> Trigger:
+    """The trigger the keys of :data:`TRIGGER_KEYS` in ``values`` give (at most one)."""
+    given = [k for k in TRIGGER_KEYS if k in values]
+    if len(given) > 1:
+        raise FaultSpecError(f"one trigger per fault, got {', '.join(given)}")
+    if not given:
+        return Now()
+    key = given[0]
+    v = values[key]
+    if key == "at_ms":
+        ms = _num(key, v)
+        if ms < 0:
+            raise FaultSpecError("at_ms must be >= 0")
+        return AtTime(ms=ms)
+    if key == "after_ms":
+        ms = _num(key, v)
+        if ms < 0:
+            raise FaultSpecError("after_ms must be >= 0")
+        return AfterTime(ms=ms)
+    if key == "after_cycles":
+        n = int(_num(key, v))
+        if n < 0:
+            raise FaultSpecError("after_cycles must be >= 0")
+        return AfterCycles(cycles=n)
+    if key == "when_position":
+        axis, pos = _list(key, v, (2,))
+        return WhenPosition(axis=int(_num("axis", axis)), position=_num("position", pos))
+    if key == "at_homing":
+        axis, stage = _list(key, v, (2,))
+        stage = str(stage).strip().lower()
+        if stage not in HOMING_STAGES:
+            raise FaultSpecError(f"at_homing: stage {stage!r}: one of {', '.join(HOMING_STAGES)}")
+        return AtHomingStage(axis=int(_num("axis", axis)), stage=stage)
+    parts = _list(key, v, (2, 3))
+    slave, index = int(_num("slave", parts[0])), int(_num("index", parts[1]))
+    n = int(_num("n", parts[2])) if len(parts) == 3 else 1
+    if n < 1:
+        raise FaultSpecError("on_sdo: n must be >= 1")
+    return OnSdo(slave=slave, index=index, n=n)
+
+
+__all__ = [
+    "TRIGGER_KEYS",
+    "AfterCycles",
+    "AfterTime",
+    "AtHomingStage",
+    "AtTime",
+    "Now",
+    "OnSdo",
+    "Trigger",
+    "WhenPosition",
+    "trigger_from_dict",
+]

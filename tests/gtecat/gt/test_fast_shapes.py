@@ -1,0 +1,177 @@
+"""Every call shape of the fast path answers as the table path does, and takes the fast path.
+
+The shapes a client uses for the polled readers (``GT_GetSts(1, byref(s), 1, 0)`` with 0 or
+None as NULL, a reused or a fresh ``byref``, the ctypes object itself, a ctypes or numpy
+array, ``GTN_`` with core 1) and for the raw image (``GT_Get/SetEcatRawData``,
+``GT_EcatIOReadInput/WriteOutput`` with ctypes arrays, bytearrays, numpy byte arrays,
+memoryviews, bytes) are called through the public function and through its table path
+(``.slow``): return code, the memory written and GTE_GetLastError agree.  A profiler (not a
+clock) shows the table path's ``call`` never ran for them.  Every function of the table
+that takes a pointer is on the fast path, declared only, or has a recorded reason.  The
+default run samples the shapes; GTECAT_LONG=1 runs them all.
+"""
+
+from __future__ import annotations
+
+import cProfile
+import ctypes
+import pstats
+import random
+from ctypes import byref
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gtecat import gt
+from gtecat.gt import fast
+from gtecat.gt.table import FUNCTIONS, declared_only
+from tests.conftest import LONG
+
+ENI = Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni"
+
+
+def _open() -> object:
+    """Figure 5-2's bus in OP with axis 1 on (the directory's fixture closes it after)."""
+    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="") == 0
+    assert gt.GT_InitEcatComm() == 0
+    gt.GTE_Wait(60)
+    assert gt.GT_StartEcatComm() == 0
+    assert gt.GT_AxisOn(1) == 0
+    gt.GTE_Wait(5)
+    return gt.GTE_Controller()
+
+
+_HELD = ctypes.c_long()
+_HELD_REF = byref(_HELD)
+READER_SHAPES = {
+    "byref": lambda t: (o := t(), (byref(o),), o),
+    "same_byref": lambda t: ((_HELD_REF,), _HELD),
+    "count_null0": lambda t: (o := t(), (byref(o), 1, 0), o),
+    "count_none": lambda t: (o := t(), (byref(o), 1, None), o),
+    "obj": lambda t: (o := t(), (o,), o),
+    "array": lambda t: (o := (t * 2)(), (o,), o),
+    "numpy": lambda t: (
+        o := np.zeros(2, np.float64 if t is ctypes.c_double else np.int32),
+        (o,),
+        o,
+    ),
+}
+RAW_SHAPES = {
+    "ctypes": lambda n: (o := (ctypes.c_ubyte * n)(), o),
+    "bytearray": lambda n: (o := bytearray(n), o),
+    "numpy": lambda n: (o := np.zeros(n, np.uint8), o),
+    "memoryview": lambda n: (o := bytearray(n), memoryview(o)),
+}
+
+
+def _value(o):
+    if isinstance(o, ctypes.Array):
+        return list(o)
+    if isinstance(o, np.ndarray | bytearray):
+        return bytes(o) if isinstance(o, bytearray) else o.tolist()
+    return o.value
+
+
+def _cases() -> list[tuple[str, str]]:
+    cases = [(n, s) for n in sorted(fast.READERS) for s in READER_SHAPES]
+    cases += [(n, s) for n in sorted(fast.RAW) for s in RAW_SHAPES]
+    cases += [(n, "gtn") for n in sorted(fast.READERS)]
+    if LONG:
+        return cases
+    rnd = random.Random(30)
+    return sorted(rnd.sample(cases, 24))
+
+
+def _call(name: str, shape: str, which: str) -> tuple:
+    """One call of ``name`` in ``shape`` through the public function (``fast``) or its table
+    path (``slow``): (return code, what it wrote, last error, calls of the table path)."""
+    fn = getattr(gt, name)
+    call = fn if which == "fast" else fn.slow
+    if name in fast.READERS:
+        t = ctypes.c_double if ctypes.c_double in fast.READERS[name][1] else ctypes.c_long
+        if shape == "gtn":
+            o = t()
+            if which == "fast":
+                call, args = getattr(gt, "GTN_" + name[3:]), (1, 1, byref(o))
+            else:
+                args = (1, byref(o))
+        else:
+            made = READER_SHAPES[shape](t)
+            if len(made) == 2:
+                extra, o = made
+            else:
+                _, extra, o = made
+            args = (1, *extra)
+    else:
+        o, buf = RAW_SHAPES[shape](4)
+        if "Set" in name or "Write" in name:
+            o[0], o[1] = 0x0F, 0x01
+        io = name in ("GT_EcatIOReadInput", "GT_EcatIOWriteOutput")
+        args = (2, 0, 2 if "Write" in name else 4, buf) if io else (0, 4, buf)
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = call(*args)
+    pr.disable()
+    table = sum(
+        v[1]
+        for (file, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        if func == "call" and file.endswith("_core.py")
+    )
+    return rc, _value(o), gt.GTE_GetLastError() if rc else "", table
+
+
+def test_every_shape_answers_as_the_table_and_takes_the_fast_path() -> None:
+    ctl = _open()
+    bad = []
+    for name, shape in _cases():
+        if shape == "same_byref" and ctypes.c_double in fast.READERS.get(name, ((), ()))[1]:
+            continue  # the held pointer object is a c_long
+        rc, value, error, table = _call(name, shape, "fast")
+        image = bytes(ctl.master.image.buffer)
+        slow = _call(name, shape, "slow")
+        if (rc, value, error) != slow[:3] or image != bytes(ctl.master.image.buffer):
+            bad.append(f"{name} {shape}: {(rc, value, error)} != {slow[:3]}")
+        elif rc != 0 or table:
+            bad.append(f"{name} {shape}: rc {rc}, the table path ran {table} time(s)")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [(-1, 4), (0, 0), (0, 10_000), (38, 4)],
+    ids=["negative", "empty", "past the end", "into inputs"],
+)
+def test_raw_edges_answer_as_the_table(args: tuple[int, int]) -> None:
+    _open()
+    for name in ("GT_GetEcatRawData", "GT_SetEcatRawData"):
+        fn = getattr(gt, name)
+        got = []
+        for call in (fn, fn.slow):
+            buf = bytearray(8)
+            rc = call(*args, buf)
+            got.append((rc, bytes(buf), gt.GTE_GetLastError() if rc else ""))
+        assert got[0] == got[1], name
+
+
+def test_too_small_buffers_take_the_table_path() -> None:
+    _open()
+    for buf in (bytearray(2), (ctypes.c_ubyte * 2)(), np.zeros(2, np.uint8)):
+        got = [
+            (call(0, 4, buf), gt.GTE_GetLastError())
+            for call in (gt.GT_GetEcatRawData, gt.GT_GetEcatRawData.slow)
+        ]
+        assert got[0] == got[1] and got[0][0] != 0
+
+
+def test_every_pointer_function_is_fast_declared_or_has_a_reason() -> None:
+    declared = set(declared_only())
+    quick = fast.fast_functions()
+    missing = []
+    for name, proto in FUNCTIONS.items():
+        if not any(p.pointer for p in proto.params) or name in quick or name in declared:
+            continue
+        if not fast.SLOW_REASONS.get(proto.group, "").strip():
+            missing.append(f"{name} ({proto.group})")
+    assert not missing, "on the table path without a recorded reason: " + ", ".join(missing)
+    assert quick <= set(FUNCTIONS)
