@@ -281,3 +281,17 @@ def test_a_structure_for_a_numeric_pointer_is_7(bus):
     assert gt.GT_GetEcatSlaves(byref(c_short()), byref(gt.TJogPrm())) == 7
     assert gt.GT_GetPrfPos(1, byref(c_double())) == 0
     assert _answers()
+
+
+def test_a_keyword_given_twice_to_a_fast_path_function_is_7_not_a_typeerror(bus):
+    """The fast path's wrappers (raw image, IO pair, status readers) once bound their own
+    parameter names: ``offset=`` beside a positional offset raised a TypeError."""
+    buf = (c_ubyte * 16)()
+    sts = c_long()
+    assert gt.GT_SetEcatRawData(0, 4, buf, offset=0) == 7
+    assert "offset" in gt.GTE_GetLastError()
+    assert gt.GT_GetEcatRawData(0, 4, buf, size=4) == 7
+    assert gt.GT_EcatIOReadInput(2, 0, 1, buf, slave=2) == 7
+    assert gt.GT_GetSts(1, byref(sts), 1, count=1) == 7
+    assert gt.GT_GetSts(1, byref(sts), count=1) == 0  # once, as a keyword: fine
+    assert _answers()
