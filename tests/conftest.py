@@ -11,14 +11,17 @@ from hypothesis import settings
 # No test depends on the wall clock's speed: hypothesis's deadline is off in every profile (a
 # loaded CI machine must not fail an example for being slow). CI runs the property tests with
 # a fixed derandomised seed (reproducible, never flaky); developers' runs keep exploring.
-settings.register_profile("dev", deadline=None)
-settings.register_profile("ci", derandomize=True, deadline=None)
-settings.load_profile("ci" if os.environ.get("CI") else "dev")
-
 #: GTECAT_LONG=1 runs the long campaigns (fuzzers over the whole function table, wide sweeps)
 #: in full; the default run keeps a small, bounded, seeded version of each so that the suite
 #: fits its 2-CPU machine.
 LONG = bool(os.environ.get("GTECAT_LONG"))
+
+# A property test that names no example count runs hypothesis's 100 under GTECAT_LONG=1 and
+# 25 in the default run (the suite's CPU budget, docs/performance.md).
+_EXAMPLES = 100 if LONG else 25
+settings.register_profile("dev", deadline=None, max_examples=_EXAMPLES)
+settings.register_profile("ci", derandomize=True, deadline=None, max_examples=_EXAMPLES)
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
 
 def examples(long: int, default: int) -> int:
@@ -39,6 +42,29 @@ def campaign_seed() -> int:
     if run:
         return int(run[:8], 16)
     return int.from_bytes(os.urandom(4), "little")
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config, items):  # type: ignore[no-untyped-def]
+    """``--dist loadgroup`` (pyproject's addopts) keeps the tests of one ``xdist_group`` on one
+    worker, so a module's expensive fixture (a demo run, compiled programs, a panel and its
+    browser) is built once.  pytest-xdist marks them by appending ``@group`` to the nodeid
+    through an attribute that pytest 9.2 no longer reads (its nodeid is structured now):
+    without this the groups were split over the workers and each built the fixture."""
+    if not getattr(config.option, "loadgroup", False):  # set in xdist workers
+        return
+    try:
+        from _pytest.nodeid import NodeId
+    except ImportError:  # an older pytest: xdist's own marking works
+        return
+    for item in items:
+        names = {
+            str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+            for m in item.iter_markers("xdist_group")
+        }
+        suffix = "@" + "_".join(sorted(names))
+        if names and not item.nodeid.endswith(suffix) and hasattr(item, "_id"):
+            item._id = NodeId.parse(item.nodeid + suffix)
 
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -66,3 +92,43 @@ def shared_fixtures() -> Path:
 @pytest.fixture
 def examples_dir() -> Path:
     return EXAMPLES
+
+
+# GTECAT_CPU_REPORT=FILE: every process of the run (each xdist worker, the controller) appends
+# one line per test to FILE.<worker>: the CPU seconds (user+sys, its own and its waited-for
+# children's) that the test's setup, call and teardown cost, and one line for the process's
+# fixed cost (interpreter, imports, collection) before its first test. The suite's budget
+# (docs/performance.md) is kept with it.
+_CPU_REPORT = os.environ.get("GTECAT_CPU_REPORT")
+
+
+def _cpu_now() -> float:
+    import resource
+
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+if _CPU_REPORT:
+    _cpu_first = [True]
+
+    def _cpu_write(line: str) -> None:
+        worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
+        with open(f"{_CPU_REPORT}.{worker}", "a") as f:
+            f.write(line + "\n")
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_protocol(item, nextitem):  # type: ignore[no-untyped-def]
+        start = _cpu_now()
+        if _cpu_first[0]:
+            _cpu_first[0] = False
+            _cpu_write(f"{start:.3f}\t<process start, imports, collection>")
+        yield
+        _cpu_write(f"{_cpu_now() - start:.3f}\t{item.nodeid}")
+
+    def pytest_collection_finish(session):  # type: ignore[no-untyped-def]
+        _cpu_write(f"{_cpu_now():.3f}\t<collected>")
+
+    def pytest_sessionfinish(session, exitstatus):  # type: ignore[no-untyped-def]
+        _cpu_write(f"{_cpu_now():.3f}\t<process total>")

@@ -9,6 +9,7 @@ Walks every module's imports with ``ast`` (lazy imports inside functions count t
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -20,8 +21,13 @@ FORBIDDEN_TOP = {"tools", "tests", "eni", "drives"}
 LOWEST = {"eni": {"eni"}, "drives": {"eni", "drives"}}
 
 
+@functools.cache  # the tests below walk the same modules: parse each once per process
+def _tree(path: Path) -> ast.Module:
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
 def _imports(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     out: set[str] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -53,7 +59,7 @@ def test_lowest_layers_import_only_downwards(layer):
 
 def _gtecat_imports(path: Path) -> set[str]:
     """Absolute ``gtecat.X`` subpackages a module imports (relative imports resolved)."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     pkg = list(path.relative_to(ROOT).with_suffix("").parts)
     pkg = pkg[:-1]  # the module's package ( __init__ counts as its own package's module)
     out: set[str] = set()

@@ -96,8 +96,10 @@ def fast_reader(
         return ok
 
     def gt(
-        n: Any = _NO, p: Any = _NO, count: Any = _NO, pClock: Any = _NO, *extra: Any, **kw: Any
+        n: Any = _NO, p: Any = _NO, count: Any = _NO, pClock: Any = _NO, /, *extra: Any, **kw: Any
     ) -> int:
+        # positional-only: a keyword of the same name (count=1) goes to **kw, so the table
+        # path answers it (7 for one given twice), never a TypeError
         ctl = session.controllers.get(1)
         if (
             type(n) is not int
@@ -255,19 +257,19 @@ def fast_raw(
         views[key] = (p, arr)
         return arr
 
-    # positional arguments only (no parameter names here: a keyword that repeats a
-    # positional one goes to the table path, which answers it with 7, not a TypeError)
-    def raw_gt(*args: Any, **kw: Any) -> int:
-        if kw or len(args) != 3:
-            return slow(*args, **kw)
-        offset, size, p = args
-        return run(-1, offset, size, p, args)
+    def raw_gt(
+        offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any
+    ) -> int:  # positional-only, as the readers
+        if extra or kw or p is _NO:
+            return slow(*(a for a in (offset, size, p) if a is not _NO), *extra, **kw)
+        return run(-1, offset, size, p, (offset, size, p))
 
-    def io_gt(*args: Any, **kw: Any) -> int:
-        if kw or len(args) != 4 or type(args[0]) is not int:
-            return slow(*args, **kw)
-        slave, offset, size, p = args
-        return run(slave, offset, size, p, args)
+    def io_gt(
+        slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *more: Any, **kw: Any
+    ) -> int:
+        if more or kw or p is _NO or type(slave) is not int:
+            return slow(*(a for a in (slave, offset, size, p) if a is not _NO), *more, **kw)
+        return run(slave, offset, size, p, (slave, offset, size, p))
 
     def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)

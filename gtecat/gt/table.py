@@ -176,13 +176,14 @@ _PARAM = re.compile(
 )
 _COUNT = re.compile(r"^(in|out|inout|outstr)(?:\[(\w+|\?)\])?$")
 _RANGE = re.compile(r"^(-?[\d.]+)\.\.(-?[\d.]+)$")
+_SPACES = re.compile(r"\s+")
 
 
 def _param(text: str, where: str) -> Param:
-    m = _PARAM.match(re.sub(r"\s+", " ", text.strip()))
+    m = _PARAM.match(_SPACES.sub(" ", text.strip()))
     if not m:
         raise ValueError(f"{where}: cannot read parameter {text!r}")
-    ctype = re.sub(r"\s+", " ", m["type"])
+    ctype = _SPACES.sub(" ", m["type"])
     stars = len(m["ptr"])
     dim = m["dim"]
     pointer = stars > 0 or dim is not None
@@ -263,23 +264,21 @@ def parse(text: str, group: str = "") -> dict[str, Proto]:
     return out
 
 
+_COMMENT = re.compile(r"/\*.*?\*/", re.S)
+
+
 def _split(args: str) -> list[str]:
     """Split a parameter list at commas outside comments."""
-    parts, depth, cur = [], 0, []
-    i = 0
-    while i < len(args):
-        if args.startswith("/*", i):
-            depth += 1
-        elif args.startswith("*/", i):
-            depth -= 1
-        if args[i] == "," and depth == 0:
-            parts.append("".join(cur))
-            cur = []
-        else:
-            cur.append(args[i])
-        i += 1
-    parts.append("".join(cur))
-    return parts
+    if "/*" not in args:
+        return args.split(",")
+    comments = _COMMENT.findall(args)
+    parts = _COMMENT.sub("\0", args).split(",")
+    if not comments:
+        return parts
+    out, it = [], iter(comments)
+    for part in parts:
+        out.append(re.sub("\0", lambda _: next(it), part))
+    return out
 
 
 def collect(groups: Iterable) -> dict[str, Proto]:

@@ -55,15 +55,37 @@ def test_there_are_tutorial_pages() -> None:
     assert all(any(b.lang in ("python", "console") for b in blocks(p)) for p in PAGES)
 
 
+@pytest.fixture(scope="module")
+def followed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """Every page followed by one runner process (an interpreter start and gtecat's import
+    once, not per page), each page in an empty folder of its own: (folder, output)."""
+    folder = tmp_path_factory.mktemp("pages")
+    assert not folder.resolve().is_relative_to(ROOT)
+    done = subprocess.run(
+        [sys.executable, "-P", str(RUNNER), *map(str, [*PAGES, ROOT / "README.md"])],
+        cwd=folder,
+        env=user_env(),
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    return folder, done.stdout + done.stderr
+
+
+@pytest.mark.xdist_group("tutorial_pages")  # one worker follows them all, once
 @pytest.mark.parametrize(
     "page", [*PAGES, ROOT / "README.md"], ids=[*(p.stem for p in PAGES), "README"]
 )
 def test_page_runs_in_an_empty_folder_with_the_installed_package(
-    page: Path, tmp_path: Path
+    page: Path, followed: tuple[Path, str]
 ) -> None:
-    assert not tmp_path.resolve().is_relative_to(ROOT)
-    done = follow(page, tmp_path)
-    assert done.returncode == 0, done.stderr + done.stdout
+    folder, out = followed
+    assert (folder / page.stem).is_dir()
+    failed = [ln for ln in out.splitlines() if ln.startswith(f"FAILED {page.name}:")]
+    assert not failed, out[out.index(failed[0]) :]
+    assert any(ln.startswith(f"{page.name}: ") and "blocks ran" in ln for ln in out.splitlines()), (
+        out
+    )
 
 
 def test_every_page_starts_from_a_shipped_example() -> None:

@@ -95,6 +95,8 @@ def test_messages_speak_to_a_user() -> None:
     bad = []
     for pkg in PACKAGES:
         for path in sorted((ROOT / pkg).rglob("*.py")):
+            if not INTERNAL.search(path.read_text(encoding="utf-8")):
+                continue  # nothing in the file at all: no string of it can hold a hit
             for line, text in _message_strings(path):
                 for h in _hits(text):
                     bad.append(f"{path.relative_to(ROOT)}:{line}: {h.split(': ', 1)[1]}")

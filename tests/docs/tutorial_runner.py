@@ -1,11 +1,13 @@
 """Run every code block of one tutorial page, in the current folder, as a reader would.
 
-    python3 -P tutorial_runner.py PAGE.md
+    python3 -P tutorial_runner.py PAGE.md [PAGE.md...]
 
 Standalone on purpose: it imports nothing of the repository but the installed ``gtecat``,
 so the tests run it from an empty temporary folder outside the checkout (``-P``: not even
 this file's folder goes on ``sys.path``) and a page only passes if it works for someone
-who has nothing but ``pip install gtecat``. The blocks:
+who has nothing but ``pip install gtecat``. Given several pages, it runs each in an empty
+folder of its own below the current one (named after the page), one after the other in the
+same interpreter. The blocks:
 
 * ```` ```python ```` blocks share one namespace per page (a page is one script, cut
   into pieces by the text);
@@ -148,20 +150,46 @@ def run_page(page: Path, cwd: Path | None = None) -> int:
     return ran
 
 
-def main(argv: list[str]) -> int:
-    if len(argv) != 1:
-        print(__doc__.split("\n\n")[1], file=sys.stderr)
-        return 2
-    page = Path(argv[0]).resolve()
-    sys.path.insert(0, os.getcwd())  # the page's own modules (test_homing.py, ...)
+def follow_page(page: Path) -> int:
+    """Run ``page`` in the current folder with the folder on ``sys.path`` (the page's own
+    modules: test_homing.py, ...), and forget those modules afterwards; 0 if it passed."""
+    here = os.getcwd()
+    sys.path.insert(0, here)
     try:
         ran = run_page(page)
     except Exception as e:
         notes = "".join(f"\n{n}" for n in getattr(e, "__notes__", []))
-        print(f"FAILED {page.name}: {type(e).__name__}: {e}{notes}", file=sys.stderr)
+        print(f"FAILED {page.name}: {type(e).__name__}: {e}{notes}", file=sys.stderr, flush=True)
         return 1
-    print(f"{page.name}: {ran} blocks ran")
+    finally:
+        sys.path.remove(here)
+        for name, mod in list(sys.modules.items()):
+            if (getattr(mod, "__file__", None) or "").startswith(here + os.sep):
+                del sys.modules[name]
+    print(f"{page.name}: {ran} blocks ran", flush=True)
     return 0 if ran else 1
+
+
+def main(argv: list[str]) -> int:
+    """One page in the current folder; several pages each in an empty folder of its own
+    below the current one, named after the page (one interpreter for all of them)."""
+    if not argv:
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    pages = [Path(a).resolve() for a in argv]
+    if len(pages) == 1:
+        return follow_page(pages[0])
+    failed = 0
+    top = os.getcwd()
+    for page in pages:
+        folder = Path(top) / page.stem
+        folder.mkdir()
+        os.chdir(folder)
+        try:
+            failed += follow_page(page)
+        finally:
+            os.chdir(top)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

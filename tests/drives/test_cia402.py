@@ -18,6 +18,7 @@ from gtecat.drives.cia402 import (
 )
 from gtecat.drives.drive import DriveSettings
 from gtecat.drives.machine import AxisMachine
+from tests.conftest import examples
 from tests.drives.test_drive import Rig
 
 S = State
@@ -214,7 +215,7 @@ def test_transition_table_lists_all_sixteen() -> None:
     assert set(TRANSITION_TABLE) == set(range(17))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 15), deadline=None)
 @given(st.lists(st.integers(0, 0xFFFF), min_size=1, max_size=40))
 def test_any_controlword_sequence_stays_legal(cws: list[int]) -> None:
     rig = Rig(machines=[AxisMachine()])

@@ -7,6 +7,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from gtecat.drives.mechanics import Mechanics, MechanicsParams
+from tests.conftest import examples
 
 P = MechanicsParams()
 CPR = P.counts_per_rev
@@ -76,7 +77,7 @@ def test_coasting_stops_with_friction() -> None:
     assert m.vel == 0.0 and m.torque == 0.0
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50, 12), deadline=None)
 @given(st.floats(-1e6, 1e6), st.floats(-400000, 400000))
 # the closing speed measured to where the demand will be, not where it was a cycle ago
 # (vff + vstop stepped past a 58-count demand and the landing braked at 9,001,000 > 9e6)

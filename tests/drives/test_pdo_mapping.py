@@ -17,6 +17,7 @@ from gtecat.drives.pdo_mapping import PdoMapping, pack_entry, unpack_entry
 from gtecat.drives.slave import AlState, AlStatusCode
 from gtecat.eni.bits import get_bits, set_bits
 from gtecat.eni.model import Direction, Identity, Pdo, PdoEntry
+from tests.conftest import examples
 from tests.drives.test_drive import Rig
 
 
@@ -113,7 +114,7 @@ def test_bit_entries_and_gaps_of_the_generator_slave() -> None:
     assert bytes(d.tx) == b"\x04\x03\x02\x01\x01"
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80, 20), deadline=None)
 @given(
     st.lists(
         st.tuples(st.booleans(), st.sampled_from([1, 2, 3, 5, 7, 8, 12, 16, 24, 32])),

@@ -15,6 +15,7 @@ from gtecat.drives.machine import AxisMachine
 from gtecat.drives.signal_edges import level, merge_windows, window_edges
 from gtecat.drives.touch_probe import TOGGLE_BITS, TouchProbe, TouchProbeError
 from gtecat.eni.errors import GtecatError
+from tests.conftest import examples
 
 ENC0 = 4321.25  # encoder = machine - ENC0 (a homing offset, say)
 M = AxisMachine(
@@ -238,7 +239,7 @@ def test_manual_example_5_3_continuous_refresh_logic() -> None:
     assert tp.status & 0x7 == 0 and tp.values[0] == 7000
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200, 50), deadline=None)
 @given(
     lo=st.floats(-1e6, 1e6),
     width=st.floats(0.01, 5000.0),
@@ -273,7 +274,7 @@ windows_st = st.lists(
 )
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300, 75), deadline=None)
 @given(windows=windows_st, p0=st.floats(-100, 100), p1=st.floats(-100, 100))
 def test_window_edges_replay_the_sampled_levels(windows, p0, p1) -> None:
     merged = merge_windows(windows)

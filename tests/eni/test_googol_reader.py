@@ -14,6 +14,7 @@ from gtecat.eni.errors import EniError
 from gtecat.eni.layout import build_layout
 from gtecat.eni.model import Direction
 from gtecat.eni.reader import parse_eni
+from tests.conftest import examples
 
 from .googol_text import GSlave, Noise, render
 from .snippets import line_of
@@ -133,7 +134,7 @@ def _slaves(draw: st.DrawFn) -> list[GSlave]:
     return out
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 15), deadline=None)
 @given(
     _slaves(),
     st.builds(

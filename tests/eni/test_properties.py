@@ -239,7 +239,7 @@ def _norm(cfg: EniConfig) -> EniConfig:
 
 
 @settings(
-    max_examples=examples(120, 30), deadline=None, suppress_health_check=[HealthCheck.too_slow]
+    max_examples=examples(120, 12), deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 @given(topologies())
 def test_write_then_read_gives_the_same_model(topo: dict[str, Any]) -> None:

@@ -107,8 +107,33 @@ def test_the_plugin_is_an_entry_point() -> None:
     assert any(e.value == "gtecat.pytest_plugin" for e in eps)
 
 
-def test_fixtures_and_a_failing_test_with_its_trace(project: Path) -> None:
-    done = _pytest(project, "--gtecat-trace", "--gtecat-trace-dir", "traces")
+def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Path) -> None:
+    (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
+    (project / "test_ini.py").write_text(
+        "def test_one_axis(gtecat_bus):\n    assert gtecat_bus.axes() == 1\n"
+    )
+    # one child for two checks: the ini option's bus, and a failure without --gtecat-trace
+    done = _pytest(project, "test_ini.py", "test_machine.py", "-k", "one_axis or fails")
+    out = done.stdout
+    assert "1 passed" in out and "1 failed" in out, out + done.stderr
+    assert "gtecat trace" not in out
+    assert "GT_AxisOn returned 7" in out  # the reasons are always reported
+    (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = no_such_bus\n")
+    done = _pytest(project, "test_ini.py")
+    assert done.returncode != 0 and "neither a file nor a shipped example" in (
+        done.stdout + done.stderr
+    )
+
+
+@pytest.mark.skipif(
+    importlib.util.find_spec("xdist") is None, reason="pytest-xdist is not installed"
+)
+def test_fixtures_and_a_failing_test_with_its_trace_under_xdist(project: Path) -> None:
+    """One child pytest on two workers (the tutorial's page 6 shows its tests run with
+    ``-n 2``: this is that promise's test): the fixtures, a failure's report and trace, and
+    each worker and test with its own files - nothing in the working directory but the
+    traces the option collects."""
+    done = _pytest(project, "-n", "2", "--gtecat-trace", "--gtecat-trace-dir", "traces")
     out = done.stdout
     assert "5 passed" in out and "1 failed" in out, out + done.stderr
     assert "test_fails_with_a_trace" in out and "on purpose" in out
@@ -123,32 +148,3 @@ def test_fixtures_and_a_failing_test_with_its_trace(project: Path) -> None:
     assert csv[0].startswith("time_ms,axis1.prf,axis1.enc") and len(csv) > 20
     # nothing in the working directory but what the user put there
     assert user_files(project) == ["pytest.ini", "test_machine.py", "traces"]
-
-
-def test_without_the_option_no_trace_is_written(project: Path) -> None:
-    done = _pytest(project, "-k", "fails")
-    assert "1 failed" in done.stdout and "gtecat trace" not in done.stdout
-    assert "GT_AxisOn returned 7" in done.stdout  # the reasons are always reported
-
-
-def test_ini_options_choose_the_bus(project: Path) -> None:
-    (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
-    (project / "test_ini.py").write_text(
-        "def test_one_axis(gtecat_bus):\n    assert gtecat_bus.axes() == 1\n"
-    )
-    done = _pytest(project, "test_ini.py")
-    assert "1 passed" in done.stdout, done.stdout + done.stderr
-    (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = no_such_bus\n")
-    done = _pytest(project, "test_ini.py")
-    assert done.returncode != 0 and "neither a file nor a shipped example" in (
-        done.stdout + done.stderr
-    )
-
-
-@pytest.mark.skipif(
-    importlib.util.find_spec("xdist") is None, reason="pytest-xdist is not installed"
-)
-def test_under_xdist_each_worker_and_test_has_its_own_files(project: Path) -> None:
-    done = _pytest(project, "-n", "2", "--gtecat-trace")
-    assert "5 passed" in done.stdout and "1 failed" in done.stdout, done.stdout + done.stderr
-    assert user_files(project) == ["pytest.ini", "test_machine.py"]

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from gtecat.compat import adt850 as adt
+from tests.conftest import examples
 
 from .conftest import open_card
 
@@ -416,7 +417,9 @@ _VALUES = st.one_of(
 
 
 @settings(
-    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(150, 37),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 @given(
     name=st.sampled_from(

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from gtecat import gt
 from gtecat.compat import CompatError
 from gtecat.compat import mcx314 as m
+from tests.conftest import examples
 
 from .conftest import open_card
 
@@ -214,7 +215,9 @@ _ANY = st.one_of(st.integers(-(2**40), 2**40), st.floats(allow_nan=True), st.non
 
 
 @settings(
-    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(150, 37),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 @given(
     name=st.sampled_from(["SetSV", "SetV", "SetA", "SetD", "SetAA", "SetMultiple", "SetP",

@@ -231,7 +231,7 @@ program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=1
 
 
 @settings(
-    max_examples=examples(12, 5),
+    max_examples=examples(12, 3),
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],

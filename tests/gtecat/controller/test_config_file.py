@@ -27,7 +27,7 @@ from gtecat.controller.config_file import (
 )
 from gtecat.controller.safety import StopInput
 from gtecat.controller.scale import Scale
-from tests.conftest import SHARED_FIXTURES, needs_fixture
+from tests.conftest import SHARED_FIXTURES, examples, needs_fixture
 
 DATA = Path(__file__).parent / "data"
 GTS400 = DATA / "gts400_4axis.cfg"
@@ -230,7 +230,7 @@ def mutate(lines: list[str], mutations) -> list[str]:
     return out
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200, 50), deadline=None)
 @given(st.sampled_from(FIXTURES), st.lists(_mutation, min_size=1, max_size=3))
 def test_mutated_fixtures_parse_or_fail_with_file_and_line(name, mutations):
     path = SHARED_FIXTURES / "googol" / name

@@ -4,10 +4,12 @@ GT_StartEcatComm gate on motion (manual entries 79, 80, 129; example 5-5).
 
 from __future__ import annotations
 
+import contextlib
+import io
 import re
+import runpy
 import shutil
-import subprocess
-import sys
+import signal
 from ctypes import byref, c_long, c_short, c_ubyte
 from pathlib import Path
 
@@ -109,18 +111,32 @@ def test_while_coming_up_is_ready_returns_0_with_status_0():
     assert gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1
 
 
-def test_readme_first_script_ends_when_run_outside_the_repository(tmp_path):
-    """The checkers' finding: in a folder without the ENI (-9) the README's loop hung."""
+def test_readme_first_script_ends_when_run_outside_the_repository(tmp_path, monkeypatch):
+    """The checkers' finding: in a folder without the ENI (-9) the README's loop hung.  The
+    script runs in this process (a child would only add an interpreter start), in an empty
+    folder, under a 60 s alarm."""
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     block = re.search(r"## A first script.*?```python\n(.*?)```", text, re.S)
     assert block is not None and "GT_IsEcatReady" in block.group(1)
     script = tmp_path / "first.py"
     script.write_text(block.group(1))
-    res = subprocess.run(
-        [sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=60
-    )
-    assert res.returncode == 0, res.stderr
-    assert "returned 1" in res.stdout  # a GT call's reason: not established
+    monkeypatch.chdir(tmp_path)
+
+    def hung(*_: object) -> None:
+        raise TimeoutError("the README's first script still ran after 60 s")
+
+    out = io.StringIO()
+    old = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(60)
+    gt.GT_Close()
+    try:
+        with contextlib.redirect_stdout(out):
+            runpy.run_path(str(script), run_name="__main__")
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+        gt.GT_Close()
+    assert "returned 1" in out.getvalue()  # a GT call's reason: not established
 
 
 # --- entry 129: motion only after GT_StartEcatComm ----------------------------------------------

@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from gtecat.gt.fast import READERS
+from tests.conftest import examples
 
 ENI = Path(__file__).resolve().parents[3] / "examples" / "twelve_axes.eni"
 
@@ -100,7 +101,7 @@ def _value(o):
 
 
 @settings(
-    max_examples=150,
+    max_examples=examples(150, 37),
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.function_scoped_fixture],

@@ -14,6 +14,7 @@ The home point is read where a scale on the machine would read it (``GTE_GetMach
 from __future__ import annotations
 
 import importlib.util
+import random
 import sys
 from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32, c_ushort
 from pathlib import Path
@@ -24,7 +25,7 @@ from gtecat import gt
 from gtecat.drives.machine import AxisMachine, MachineDescription
 from gtecat.eni.topology import parse_topology
 from gtecat.eni.writer import write_eni_file
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, LONG, campaign_seed
 
 from .conftest import bring_up
 
@@ -116,7 +117,19 @@ FAMILIES: dict[str, tuple[dict, tuple[float, ...], dict[int, tuple[float, ...]]]
         {35: (1234.0, -777.0), 37: (1234.0, -777.0)},
     ),
 }
-CASES = [(family, method) for family, (_, _, table) in FAMILIES.items() for method in sorted(table)]
+ALL_CASES = [(f, method) for f, (_, _, table) in FAMILIES.items() for method in sorted(table)]
+
+
+def _sampled(cases: list[tuple[str, int]]) -> list[tuple[str, int]]:
+    """Every method under GTECAT_LONG=1; else one method of each family, a seeded sample
+    (each method's home point is also checked at the drive, tests/drives/test_homing.py)."""
+    if LONG:
+        return cases
+    rng = random.Random(campaign_seed())
+    return [rng.choice([c for c in cases if c[0] == f]) for f in FAMILIES]
+
+
+CASES = _sampled(ALL_CASES)
 
 
 @pytest.fixture(scope="module")

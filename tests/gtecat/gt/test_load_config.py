@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
-from tests.conftest import SHARED_FIXTURES, needs_fixture
+from tests.conftest import SHARED_FIXTURES, examples, needs_fixture
 from tests.gtecat.controller.test_config_file import FIXTURES, GTS400, mutate
 
 from .conftest import bring_up
@@ -371,7 +371,7 @@ def test_legacy_file_still_loads_with_a_deprecation_line(tmp_path):
 
 
 # --- random damage: 0 or 7, never an exception (-7) -----------------------------------------------
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100, 25), deadline=None)
 @given(
     st.sampled_from(FIXTURES),
     st.lists(

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from gtecat.controller.recorder import Recorder
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, examples
 from tests.gtecat.controller.motion.reference import Trapezoid
 
 from .conftest import bring_up
@@ -495,7 +495,7 @@ def test_homing_then_csp_positions_are_the_drives():
 
 
 # --- property: any move through GT ends exactly, never overshoots, respects the limits ----------
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=examples(12, 4), deadline=None)
 @given(
     st.lists(
         st.tuples(

@@ -25,6 +25,7 @@ from gtecat.eni.model import (
 )
 from gtecat.errors import ParameterError
 from gtecat.master.image import ProcessImage
+from tests.conftest import examples
 
 
 @st.composite
@@ -88,7 +89,7 @@ def _model_raw(image: ProcessImage) -> bytes:
     return bytes(raw)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 15), deadline=None)
 @given(configs(), st.data())
 def test_raw_reads_match_the_model(cfg, data):
     image = ProcessImage(build_layout(cfg))
@@ -103,7 +104,7 @@ def test_raw_reads_match_the_model(cfg, data):
     assert image.read_raw(off, size) == model[off : off + size]
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 15), deadline=None)
 @given(configs(), st.data())
 def test_raw_writes_land_in_outputs_only(cfg, data):
     image = ProcessImage(build_layout(cfg))

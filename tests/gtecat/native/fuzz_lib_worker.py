@@ -40,7 +40,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from gtecat.gt import _core
-from gtecat.gt.table import SAME_PARAM_TWINS, SCALARS, Param
+from gtecat.gt.table import ENUMS, SAME_PARAM_TWINS, SCALARS, Param
 from gtecat.native import cdll, protocol
 from gtecat.native.server import Server
 from tests.conftest import EXAMPLES
@@ -57,19 +57,24 @@ MAX_BUFFER = 4 << 20
 LONG_BITS = ctypes.sizeof(ctypes.c_long) * 8
 
 
+def _scalar(p: Param) -> str:
+    """``p``'s scalar type: a C enum is an int."""
+    return "int" if p.ctype in ENUMS else p.ctype
+
+
 def c_range(p: Param) -> tuple[int, int]:
     """What a C caller can pass for ``p`` (``long`` is this platform's long)."""
     if p.ctype == "long":
         return -(1 << (LONG_BITS - 1)), (1 << (LONG_BITS - 1)) - 1
     if p.ctype == "unsigned long":
         return 0, (1 << LONG_BITS) - 1
-    _, lo, hi, _ = SCALARS[p.ctype]
+    _, lo, hi, _ = SCALARS[_scalar(p)]
     return int(lo), int(hi)
 
 
 def legal_range(p: Param) -> tuple[int, int]:
     """What the table accepts (the vendor's 32-bit long, the /*lo..hi*/ range, masks)."""
-    _, lo, hi, _ = SCALARS[p.ctype]
+    _, lo, hi, _ = SCALARS[_scalar(p)]
     if p.mask:
         lo, hi = min(lo, -(1 << 31)), max(hi, (1 << 32) - 1)
     if p.lo is not None:
@@ -79,7 +84,7 @@ def legal_range(p: Param) -> tuple[int, int]:
 
 def narrow(p: Param, v: int) -> int:
     """``v`` as C holds it in ``p``'s type (ctypes wraps, as a C conversion does)."""
-    t = getattr(ctypes, SCALARS[p.ctype][0]) if p.ctype in SCALARS else ctypes.c_long
+    t = getattr(ctypes, SCALARS[_scalar(p)][0]) if _scalar(p) in SCALARS else ctypes.c_long
     if p.ctype == "long":
         t = ctypes.c_long
     elif p.ctype == "unsigned long":

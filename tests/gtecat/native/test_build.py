@@ -39,15 +39,30 @@ def test_the_cache_is_per_version_and_per_sources(libgts):
     assert build.ensure_built().root == libgts.root  # built once
 
 
-@needs_cc
-def test_a_fresh_cache_builds_on_first_use(tmp_path, monkeypatch):
+def test_a_fresh_cache_builds_on_first_use_and_only_then(tmp_path, monkeypatch):
+    """A compiler that logs its calls and writes its ``-o`` file: the build runs on first use
+    into the fresh cache, and not again (the real compiler's build is the ``libgts`` fixture's,
+    once per run)."""
+    log = tmp_path / "cc.log"
+    cc = tmp_path / "logging-cc"
+    cc.write_text(
+        "#!/bin/sh\n"
+        f'echo "$@" >> "{log}"\n'
+        'while [ $# -gt 0 ]; do if [ "$1" = -o ]; then : > "$2"; fi; shift; done\n'
+    )
+    cc.chmod(0o755)
+    monkeypatch.setenv("CC", str(cc))
     monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
     b = build.ensure_built()
-    assert b.library.is_file()
+    assert b.library.is_file() and b.header.is_file()
     assert str(b.root).startswith(str(tmp_path / "cache"))
+    calls = log.read_text().splitlines()
+    assert any("-shared" in c for c in calls) and any("gts_runtime.c" in c for c in calls)
     from gtecat import native
 
     assert native.library_path() == b.library
+    assert build.ensure_built().root == b.root
+    assert log.read_text().splitlines() == calls  # cached: not compiled again
 
 
 def test_no_compiler_is_a_clear_error(tmp_path, monkeypatch, capsys):

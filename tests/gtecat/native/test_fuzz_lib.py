@@ -19,7 +19,10 @@ from .conftest import ROOT, needs_cc
 from .fuzz_lib_worker import SKIP
 
 pytestmark = needs_cc
-EXAMPLES = 15  # per function: GT_x and its GTN_x twin (a random core) with the same arguments
+# per function: GT_x and its GTN_x twin (a random core) with the same arguments; the default
+# run calls every function with a few, GTECAT_LONG=N runs 15 x N (the suite's CPU budget)
+_LONG = int(os.environ.get("GTECAT_LONG", "0") or 0)
+EXAMPLES = 15 * _LONG if _LONG else 3
 TIMEOUT_S = 600
 BATCHES = 2  # child processes, each with every other function: the xdist workers share them
 

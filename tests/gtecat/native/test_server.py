@@ -15,6 +15,7 @@ from gtecat.gt import _core
 from gtecat.gt.table import SCALARS
 from gtecat.native import cdecl, protocol
 from gtecat.native.server import Server
+from tests.conftest import examples
 
 from .conftest import FIG5_2
 from .wire_client import WireClient
@@ -172,7 +173,7 @@ def test_bad_input_gets_the_python_codes(served):
         fn = _core.REGISTRY.get(plan.name)
         if fn is None:  # declared in the table, not implemented yet
             continue
-        for _ in range(12):
+        for _ in range(examples(12, 4)):  # cases per function: all 12 under GTECAT_LONG
             py, wire = _case(plan, rnd)
             want = fn(*py)
             got, _, text = c.call(plan.name, *wire)

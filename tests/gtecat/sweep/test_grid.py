@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 
 from gtecat.errors import ParameterError
 from gtecat.sweep.grid import Case, case_id_of, load_grid, set_path
+from tests.conftest import examples
 
 MACHINE = """
 [axis.1]
@@ -90,7 +91,7 @@ def test_find_names_a_case_by_id(tmp_path):
 values = st.one_of(st.integers(), st.floats(allow_nan=False), st.text(max_size=8), st.booleans())
 
 
-@settings(max_examples=60)
+@settings(max_examples=examples(60, 15))
 @given(st.dictionaries(st.text(min_size=1, max_size=10), values, max_size=5))
 def test_case_ids_depend_on_the_parameters_only(params):
     """Key order never changes an id; the seed follows the id."""

@@ -3,6 +3,7 @@ one case by id, the pytest face, the report."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import shutil
@@ -18,10 +19,19 @@ from gtecat.cli.main import main
 from gtecat.sweep import run_one
 from gtecat.sweep.results import read_rows
 
-pytest.importorskip("dask.distributed", reason="needs Dask: pip install 'gtecat[sweep]'")
-pytest.importorskip("pyarrow", reason="needs pyarrow: pip install 'gtecat[sweep]'")
-
-pytestmark = pytest.mark.xdist_group("sweep")
+# skipped without importing them: collecting this file in every xdist worker must not cost
+# Dask's import (most workers never run these tests)
+pytestmark = [
+    pytest.mark.xdist_group("sweep"),
+    pytest.mark.skipif(
+        importlib.util.find_spec("distributed") is None,
+        reason="needs Dask: pip install 'gtecat[sweep]'",
+    ),
+    pytest.mark.skipif(
+        importlib.util.find_spec("pyarrow") is None,
+        reason="needs pyarrow: pip install 'gtecat[sweep]'",
+    ),
+]
 
 #: a Trap move of `distance` on axis 1; fails where the machine's positive limit is in the way
 SCENARIO = """

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from gtecat.controller.motion import JogParams, JogPlanner, StopKind
 from gtecat.controller.motion.jog import ramp
 from gtecat.errors import CommandError, ParameterError
+from tests.conftest import examples
 
 
 def steps(jp: JogPlanner, n: int) -> np.ndarray:
@@ -169,7 +170,7 @@ def test_unset_dec_is_acc():
     assert JogParams(0.25).dec == 0.25
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80, 20), deadline=None)
 @given(
     v0=st.floats(-50, 50),
     goal=st.floats(-50, 50),

@@ -22,6 +22,7 @@ from gtecat.controller.motion.scurve import (
     ramp_time,
 )
 from gtecat.errors import ParameterError
+from tests.conftest import examples
 
 
 def run(pl: SCurvePlanner, limit: int = 1_000_000) -> list[tuple[float, float, float]]:
@@ -165,7 +166,7 @@ def test_bad_parameters_are_parameter_errors(bad):
         SCurveParams(**kw)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 15), deadline=None)
 @given(
     length=st.integers(0, 40_000),
     sv=st.floats(0.05, 5.0),

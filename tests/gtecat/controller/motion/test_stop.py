@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from gtecat.controller.motion import StopDecel, StopRamp, stop_distance
 from gtecat.errors import ParameterError
+from tests.conftest import examples
 
 
 def test_defaults_are_table_4_4():
@@ -66,7 +67,7 @@ def test_bad_deceleration(dec):
         StopRamp().start(0.0, 1.0, dec)
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80, 20), deadline=None)
 @given(
     # speeds a controller can hold: zero, or at least 1e-9 pulse/ms (denormals underflow
     # in the formula itself)

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from gtecat.controller.motion import StopKind, TrapParams, TrapPlanner
 from gtecat.errors import CommandError, ParameterError
+from tests.conftest import examples
 
 from .reference import Trapezoid
 
@@ -370,7 +371,7 @@ def test_non_integer_target_and_bad_cycle_are_refused():
 cycles = st.sampled_from([0.25, 0.5, 1.0, 2.0])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60, 15), deadline=None)
 @given(
     dist=st.integers(-30000, 30000),
     vel=st.floats(0.5, 100.0),
@@ -408,7 +409,7 @@ def test_random_moves_end_exactly_on_target_within_limits(dist, vel, acc, dec, v
     np.testing.assert_allclose(out[:, 0], -77.0 + p, atol=1e-6)
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50, 12), deadline=None)
 @given(
     first=st.integers(-20000, 20000),
     second=st.integers(-20000, 20000),

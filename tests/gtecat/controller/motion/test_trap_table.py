@@ -10,9 +10,10 @@ from hypothesis import strategies as st
 
 from gtecat.controller.motion.trap import TrapParams, TrapPlanner
 from gtecat.controller.motion.trap_table import advance, trap_table
+from tests.conftest import examples
 
 
-@settings(max_examples=150, deadline=None, derandomize=True)
+@settings(max_examples=examples(150, 37), deadline=None, derandomize=True)
 @given(
     start=st.floats(-1e5, 1e5),
     target=st.integers(-200_000, 200_000),
