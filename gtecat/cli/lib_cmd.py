@@ -35,6 +35,12 @@ libgts_mc-llp64.so, the multi-card layer built for C# int:
 
     python3 -m gtecat lib --abi gts-multicard --mono-config -o App.exe.config
 
+A program compiled on Linux against the vendor's own gts.h (its structures hold C long,
+4 bytes on Windows, 8 on 64-bit Linux) builds as a 32-bit program with --m32, so every
+structure has the layout it has on Windows (needs Debian's gcc-multilib / g++-multilib):
+
+    g++ prog.cpp -I vendor_include $(python3 -m gtecat lib --m32 --cflags --libs)
+
 Windows (docs/windows.md): --windows x64|x86 -o DIR writes gts.dll (the GT API with the vendor
 DLL's undecorated __stdcall export names, reaching a gtecat controller over TCP), its import
 library gts.lib, gts.def and gts.h into DIR, cross-compiled with mingw-w64 on first use
@@ -80,6 +86,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="the Mono dllmap sending gts.dll / gen.dll / gxn.dll to libgts (App.exe.config; "
         "with --abi gts-multicard to the multi-card layer)",
     )
+    p.add_argument(
+        "--m32",
+        action="store_true",
+        help="with --cflags/--libs/--path: a 32-bit program (-m32 -malign-double) whose C long "
+        "has 4 bytes, as on Windows: for code compiled against the vendor's own gts.h",
+    )
     p.add_argument("--csharp", action="store_true", help="gts.cs: the GT API for C# (generated)")
     p.add_argument(
         "--windows",
@@ -113,7 +125,26 @@ def run(args: argparse.Namespace) -> int:
         return 0
     from ..native.build import ensure_built
 
-    build = ensure_built(force=args.rebuild, abi=abi)
+    if args.m32:
+        if abi:
+            print(
+                f"error: --m32 builds the one-card API only, not --abi {args.abi}", file=sys.stderr
+            )
+            return 1
+        from ..cbuild import NativeBuildError
+        from ..native.llp64 import ensure_built_m32
+
+        try:
+            build = ensure_built_m32(force=args.rebuild)
+        except NativeBuildError as e:
+            print(
+                "error: the 32-bit libgts does not build here (it needs a 32-bit C library: "
+                f"Debian's gcc-multilib, g++-multilib for C++):\n{e}",
+                file=sys.stderr,
+            )
+            return 1
+    else:
+        build = ensure_built(force=args.rebuild, abi=abi)
     words: list[str] = []
     if args.cflags:
         words += build.cflags()

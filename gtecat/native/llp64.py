@@ -20,6 +20,14 @@ generated layer with ``long`` -> ``int``, linked to ``libgts-llp64.so`` instead 
 ``GT_x`` in ``libgts-llp64.so`` (the library it needs), so a C# wrapper in the multi-card
 style (``GT_GetSts(short cardNum, short axis, out int pSts, ...)``) meets 4-byte ``long``
 all the way down.
+
+``gtecat lib --m32`` builds the same LLP64 sources as a 32-bit x86 library
+(``-m32 -malign-double``: ``long`` and pointers of 4 bytes, doubles aligned to 8 as the
+vendor's Windows compilers align them) into a folder of its own (``m32/lib/libgts.so``,
+``m32/include/gts.h``): a program compiled on Linux against the vendor's **own** header,
+whose structures hold ``long`` fields (``THomePrm``), then has the structure layouts of the
+Windows program it was written as (:func:`ensure_built_m32`).  It needs a 32-bit C library
+(Debian's ``gcc-multilib``).
 """
 
 from __future__ import annotations
@@ -33,6 +41,7 @@ import shutil
 import subprocess
 import tempfile
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 from ..cbuild import NativeBuildError, compiler
@@ -163,22 +172,76 @@ def _run(cmd: list[str], what: str) -> None:
         raise NativeBuildError(f"building {what} warned (it must not):\n{r.stderr.strip()}")
 
 
-def _compile(build: _build.Build, target: Path) -> None:
+#: the flags of a 32-bit program with the vendor's Windows layouts (:func:`ensure_built_m32`)
+M32_FLAGS = ("-m32", "-malign-double")
+
+
+@dataclass(frozen=True)
+class M32Build:
+    """The 32-bit library's folder: ``include`` (gts.h, gtecat_vendor.h) and ``lib``."""
+
+    root: Path
+
+    @property
+    def include_dir(self) -> Path:
+        return self.root / "include"
+
+    @property
+    def library(self) -> Path:
+        return self.root / "lib" / "libgts.so"
+
+    def cflags(self) -> list[str]:
+        inc = self.include_dir
+        return [*M32_FLAGS, f"-I{inc}", "-include", str(inc / _build.VENDOR_COMPAT)]
+
+    def libs(self) -> list[str]:
+        lib = self.library.parent
+        return ["-m32", f"-L{lib}", f"-Wl,-rpath,{lib}", "-lgts"]
+
+
+def ensure_built_m32(*, force: bool = False) -> M32Build:
+    """The 32-bit libgts (module docstring), compiled on first use beside libgts."""
+    build = _build.ensure_built(force=force)
+    m32 = M32Build(build.root / "m32")
+    if m32.library.is_file() and not force:
+        return m32
+    with open(build.root.parent / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if m32.library.is_file() and not force:
+            return m32
+        files = llp64_sources(_build.sources(_build.python_executable()))
+        m32.include_dir.mkdir(parents=True, exist_ok=True)
+        m32.library.parent.mkdir(parents=True, exist_ok=True)
+        for name in ("gts.h", _build.VENDOR_COMPAT):
+            (m32.include_dir / name).write_text(files[name], encoding="utf-8")
+        _compile(build, m32.library, files, M32_FLAGS, "libgts.so")
+    return m32
+
+
+def _compile(
+    build: _build.Build,
+    target: Path,
+    files: dict[str, str] | None = None,
+    extra: tuple[str, ...] = (),
+    soname: str = LIBRARY,
+) -> None:
     cc = compiler()
-    files = llp64_sources(_build.sources(_build.python_executable()))
+    if files is None:
+        files = llp64_sources(_build.sources(_build.python_executable()))
     with _scratch(build) as tmp:
         for name, text in files.items():
             (tmp / name).write_text(text, encoding="utf-8")
-        out = tmp / LIBRARY
+        out = tmp / soname
         # -O1, not libgts's -O2: the stubs only pack arguments for a socket round trip, and
         # it halves the compile (a test run builds this once)
         flags = [f for f in _build.CFLAGS if not f.startswith("-O")] + ["-O1"]
         cmd = [
             *cc,
+            *extra,
             *flags,
             "-DGTE_CLIENT_LONG_SIZE=4",
             "-shared",
-            f"-Wl,-soname,{LIBRARY}",
+            f"-Wl,-soname,{soname}",
             f"-I{tmp}",
             str(tmp / "gts_runtime.c"),
             str(tmp / "gts_stubs.c"),
@@ -186,14 +249,17 @@ def _compile(build: _build.Build, target: Path) -> None:
             "-o",
             str(out),
         ]
-        _run(cmd, LIBRARY)
+        _run(cmd, soname if not extra else f"the 32-bit {soname} ({' '.join(extra)})")
         os.replace(out, target)
 
 
 __all__ = [
     "LIBRARY",
+    "M32_FLAGS",
     "MULTICARD_LIBRARY",
+    "M32Build",
     "ensure_built",
+    "ensure_built_m32",
     "library",
     "llp64_sources",
     "multicard_sources",
