@@ -85,7 +85,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def _token(args: argparse.Namespace) -> tuple[str, str]:
-    """The token of a TCP controller and a line saying where clients find it."""
+    """The token of a TCP controller and a line saying where clients find it ("" when it
+    is a new one: written to the port's default token file once the port is bound)."""
     from ..native import transport
 
     if args.token_file:
@@ -94,10 +95,7 @@ def _token(args: argparse.Namespace) -> tuple[str, str]:
     if env:
         transport.check_token(env, "GTECAT_TOKEN")
         return env, "token: GTECAT_TOKEN"
-    token = transport.make_token()
-    path = transport.default_token_file()
-    transport.write_token_file(path, token)
-    return token, f"token: written to {path} (readable by you only)"
+    return transport.make_token(), ""
 
 
 def _wall_floor(args: argparse.Namespace) -> bool:
@@ -128,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
 
     address = args.listen or default_address()
     token, token_note = None, ""
+    own_file = False
     try:
         addr = transport.parse(address)
         if args.token_file and not addr.tcp:
@@ -136,6 +135,7 @@ def run(args: argparse.Namespace) -> int:
             )
         if addr.tcp:
             token, token_note = _token(args)
+            own_file = not token_note
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
@@ -162,6 +162,13 @@ def run(args: argparse.Namespace) -> int:
         token=token,
     )
 
+    token_path = None
+    if own_file and token is not None:
+        # the port's own file (port 0: the one bound), gone when the controller ends
+        token_path = transport.default_token_file(transport.parse(server.address).port)
+        transport.write_token_file(token_path, token)
+        token_note = f"token: written to {token_path} (readable by you only)"
+
     def stop(signum: int, frame: FrameType | None) -> None:
         server.stop()
 
@@ -176,5 +183,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"gtecat controller listening on {server.address}", file=sys.stderr, flush=True)
         if token_note:
             print(token_note, file=sys.stderr, flush=True)
-    server.serve_forever()
+    try:
+        server.serve_forever()
+    finally:
+        if token_path is not None:
+            with contextlib.suppress(OSError):
+                token_path.unlink()
     return 0

@@ -101,7 +101,7 @@ class Connection:
         self._codecs: dict[int, _Codec] = {}
         try:
             addr = transport.parse(address)
-            token = transport.client_token().encode() if addr.tcp else b""
+            token = transport.client_token(addr.port).encode() if addr.tcp else b""
             sock = transport.connect(addr, timeout_s if timeout_s is not None else _timeout_s())
         except (OSError, ValueError) as e:
             raise ControllerError(f"cannot reach the controller at {address}: {e}") from None

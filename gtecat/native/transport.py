@@ -98,8 +98,10 @@ def runtime_dir() -> Path:
     return Path(base) / f"gtecat-{who}"
 
 
-def default_token_file() -> Path:
-    return runtime_dir() / "controller.token"
+def default_token_file(port: int) -> Path:
+    """The token file of the controller listening on ``port`` (one file per port: two
+    controllers of one user never take each other's)."""
+    return runtime_dir() / f"controller-{int(port)}.token"
 
 
 def make_token() -> str:
@@ -139,9 +141,10 @@ def write_token_file(path: str | os.PathLike[str], token: str) -> None:
         os.close(fd)
 
 
-def client_token() -> str:
-    """The token a client presents: ``GTECAT_TOKEN``, else the file ``GTECAT_TOKEN_FILE``
-    names, else the default token file when it exists, else ""."""
+def client_token(port: int) -> str:
+    """The token a client of the controller on ``port`` presents: ``GTECAT_TOKEN``, else
+    the file ``GTECAT_TOKEN_FILE`` names, else that port's default token file when it
+    exists, else ""."""
     token = os.environ.get("GTECAT_TOKEN", "").strip()
     if token:
         return token
@@ -149,8 +152,8 @@ def client_token() -> str:
     if named:
         return read_token_file(named)
     with contextlib.suppress(ValueError):
-        if default_token_file().is_file():
-            return read_token_file(default_token_file())
+        if default_token_file(port).is_file():
+            return read_token_file(default_token_file(port))
     return ""
 
 

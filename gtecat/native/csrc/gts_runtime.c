@@ -595,7 +595,7 @@ static int split_tcp(const char *addr, char *host, size_t hcap, char *port, size
 }
 
 /* the token a TCP controller wants (see the top of this file); 0 ok ("" if none), -1 error */
-static int client_token(char *out, size_t cap, const char *fname)
+static int client_token(char *out, size_t cap, const char *fname, const char *port)
 {
     out[0] = '\0';
     const char *t = setting("GTECAT_TOKEN");
@@ -611,6 +611,7 @@ static int client_token(char *out, size_t cap, const char *fname)
 #endif
     if (!file) {
 #if defined(_WIN32)
+        (void)port; /* no default token file on Windows: gtecat.ini or the environment */
         return 0;
 #else
         const char *base = getenv("XDG_RUNTIME_DIR");
@@ -619,7 +620,8 @@ static int client_token(char *out, size_t cap, const char *fname)
             if (!base || !*base)
                 base = "/tmp";
         }
-        snprintf(dflt, sizeof dflt, "%s/gtecat-%u/controller.token", base, (unsigned)getuid());
+        snprintf(dflt, sizeof dflt, "%s/gtecat-%u/controller-%s.token", base, (unsigned)getuid(),
+                 port);
         if (access(dflt, R_OK) != 0)
             return 0;
         file = dflt;
@@ -785,7 +787,10 @@ static int connect_to(const char *addr, const char *fname, long long deadline)
     gte_sock fd;
     char token[600] = "";
     if (strncmp(addr, "tcp:", 4) == 0) {
-        if (client_token(token, sizeof token, fname) < 0)
+        char host[300], port[8];
+        if (split_tcp(addr, host, sizeof host, port, sizeof port) < 0)
+            port[0] = '\0'; /* connect_tcp says what is wrong with the address */
+        if (client_token(token, sizeof token, fname, port) < 0)
             return -1;
         fd = connect_tcp(addr, fname, deadline);
         if (fd == GTE_NO_SOCK)
