@@ -140,7 +140,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 1
     if not args.listen and not addr.tcp:
-        Path(addr.path).parent.mkdir(mode=0o700, exist_ok=True)
+        try:
+            transport.private_dir(Path(addr.path).parent)
+        except (OSError, ValueError) as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 1
     options = {
         k: v
         for k, v in (
@@ -166,7 +170,13 @@ def run(args: argparse.Namespace) -> int:
     if own_file and token is not None:
         # the port's own file (port 0: the one bound), gone when the controller ends
         token_path = transport.default_token_file(transport.parse(server.address).port)
-        transport.write_token_file(token_path, token)
+        try:
+            transport.private_dir(token_path.parent)
+            transport.write_token_file(token_path, token)
+        except (OSError, ValueError) as e:
+            print(f"error: {e}", file=sys.stderr)
+            server.stop()
+            return 1
         token_note = f"token: written to {token_path} (readable by you only)"
 
     def stop(signum: int, frame: FrameType | None) -> None:

@@ -423,6 +423,9 @@ class Server:
         self._budget = self.spin_s  # the adaptive spin (_spin_budget)
         self._busy, self._busy_next, self._since_probe = False, 0.0, 0
         self.lock = threading.RLock()
+        #: clients whose call is running (a GTE_Wait serving others between its slices
+        #: runs their calls inside it: :meth:`_serve_others`)
+        self._running: list[_Client] = []
         # its endpoint (gtecat ps) says "controller" while it serves; given back when it stops
         self._inspect_before = (_inspect.KIND, _inspect.LOCK)
         _inspect.KIND, _inspect.LOCK = "controller", self.lock
@@ -490,6 +493,39 @@ class Server:
                             self._stop.set()
         finally:
             self._cleanup()
+
+    def _serve_others(self) -> None:
+        """Between the slices of a long GTE_Wait (Controller.slice_hook): answer what the
+        other clients sent meanwhile and take new connections, without waiting and without
+        the spin, so a day's wait by one client delays no other by more than a slice.
+        Their calls run inside the wait (their time counts toward it); a client whose call
+        is running is left for later, and a wait inside such a call serves nobody."""
+        if len(self._running) != 1 or self._stop.is_set():
+            return
+        busy = self._running[0]
+        for fd, ev in self._poller.poll(0):
+            c = self._clients.get(fd)
+            if c is busy:
+                continue
+            if c is not None:
+                if ev & WRITE:
+                    self._writable(c)
+                elif ev & READ:
+                    try:
+                        data = c.sock.recv(CHUNK)
+                    except BlockingIOError:
+                        continue
+                    except OSError:
+                        data = b""
+                    if not data:
+                        self._drop(c)
+                    else:
+                        self._frames(c, data)
+            elif fd == self._listener.fileno():
+                self._accept()
+            elif fd == self._wake_r.fileno():
+                with contextlib.suppress(OSError):
+                    self._wake_r.recv(64)
 
     def _next_deadline(self) -> float | None:
         late = [c.deadline for c in self._clients.values() if c.deadline]
@@ -750,7 +786,13 @@ class Server:
                     return out
             args, backs = dec.decode(body, CALL.size)
             with self.lock:
-                rc, text = self._call(c, dec, gtn, core, args)
+                for ctl in _core.SESSION.controllers.values():
+                    ctl.slice_hook = self._serve_others
+                self._running.append(c)
+                try:
+                    rc, text = self._call(c, dec, gtn, core, args)
+                finally:
+                    self._running.pop()
             return _reply(rc, backs, text)
         if kind == MSG_HELLO:
             return self._hello(c, body)

@@ -23,6 +23,7 @@ import hmac
 import os
 import secrets
 import socket
+import stat
 import sys
 import tempfile
 from dataclasses import dataclass
@@ -96,6 +97,28 @@ def runtime_dir() -> Path:
     base = os.environ.get("XDG_RUNTIME_DIR") or tempfile.gettempdir()
     who = os.getuid() if hasattr(os, "getuid") else os.environ.get("USERNAME", "user")
     return Path(base) / f"gtecat-{who}"
+
+
+def private_dir(path: Path) -> Path:
+    """``path`` made (0700) when missing, and checked: a folder of this user's that no one
+    else may enter, else ValueError with the reason (another user who made it first could
+    take the socket's address over)."""
+    with contextlib.suppress(FileExistsError):
+        path.mkdir(mode=0o700, parents=True)
+    st = path.lstat()
+    if not stat.S_ISDIR(st.st_mode):
+        raise ValueError(f"{path} is not a folder; remove it (gtecat keeps its sockets there)")
+    if hasattr(os, "getuid") and st.st_uid != os.getuid():
+        raise ValueError(
+            f"{path} belongs to uid {st.st_uid}, not to you: gtecat will not put its socket "
+            "there (remove it, or set XDG_RUNTIME_DIR)"
+        )
+    if st.st_mode & 0o077:
+        raise ValueError(
+            f"{path} is open to other users (mode {stat.S_IMODE(st.st_mode):04o}): "
+            "chmod 700 it, or remove it"
+        )
+    return path
 
 
 def default_token_file(port: int) -> Path:
@@ -193,6 +216,8 @@ def listen(addr: Address, backlog: int = 128) -> socket.socket:
         finally:
             probe.close()
     s.bind(path)
+    if not path.startswith("\0"):
+        os.chmod(path, 0o600)  # its folder guards it too; the socket is the owner's alone
     s.listen(backlog)
     s.setblocking(False)
     return s

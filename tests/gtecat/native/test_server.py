@@ -202,3 +202,61 @@ def test_a_call_that_cannot_travel_checks_its_arguments_first_as_python_does(ser
     rc, _, text = c.call("GT_Compile", b"prog.c\0", size)
     assert rc == 1 and "pointers" in text
     c.close()
+
+
+def test_a_long_wait_of_one_client_lets_the_others_in_between_its_slices(served):
+    """GTE_Wait runs its time in slices; between them the server answers the other clients
+    (a client's day-long wait must not hold everyone for the hours it takes to compute)."""
+    import threading
+
+    _, address = served
+    waiter, other = WireClient(address), WireClient(address)
+    assert waiter.call("GT_Open", 0, 1)[0] == 0 and other.call("GT_Open", 0, 1)[0] == 0
+    done = threading.Event()
+    result: list[int] = []
+
+    def wait_long() -> None:
+        result.append(waiter.call("GTE_Wait", 30_000.0)[0])  # 300 slices of 100 ms
+        done.set()
+
+    t = threading.Thread(target=wait_long)
+    t.start()
+    answered_during = 0
+    try:
+        for _ in range(2000):
+            if done.is_set():
+                break
+            assert other.call("GT_GetSts", 1, 8, 1, None)[0] == 0
+            answered_during += not done.is_set()
+    finally:
+        t.join(60)
+    assert result == [0]
+    assert answered_during > 0  # the other client was answered while the wait ran
+
+
+def test_the_socket_is_its_owners_and_its_folder_is_checked(served, tmp_path):
+    """The socket is 0600; a socket folder another user could enter or own is refused with
+    the reason (whoever made it first could take the controller's address over)."""
+    import os
+    import stat
+
+    from gtecat.native import transport
+
+    _, address = served
+    assert stat.S_IMODE(os.stat(address[len("unix:") :]).st_mode) == 0o600
+    mine = transport.private_dir(tmp_path / "run" / "gtecat-me")
+    assert stat.S_IMODE(mine.stat().st_mode) == 0o700
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    with pytest.raises(ValueError, match="open to other users"):
+        transport.private_dir(shared)
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(ValueError, match="not a folder"):
+        transport.private_dir(tmp_path / "file")
+    if os.getuid() == 0:  # root can make a folder another user owns
+        theirs = tmp_path / "theirs"
+        theirs.mkdir(mode=0o700)
+        os.chown(theirs, 65534, 65534)
+        with pytest.raises(ValueError, match="belongs to uid 65534"):
+            transport.private_dir(theirs)
