@@ -64,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
     if not scenario.is_file():
         raise ParameterError(f"{scenario}: scenario file not found")
     grid = load_grid(args.grid)
+    grid.check()
+    _check_scenario(scenario)
     cases = grid.cases()
     if args.list:
         for case in cases:
@@ -79,6 +81,19 @@ def run(args: argparse.Namespace) -> int:
     return _sweep(args, scenario, grid, cases)
 
 
+def _check_scenario(scenario: Path) -> None:
+    """The scenario compiles and defines ``scenario(gt, case)``: refused here, with the
+    reason, rather than failing every case alike on the workers."""
+    from ..sweep.case import load_scenario
+
+    try:
+        load_scenario(str(scenario), scenario.read_text(encoding="utf-8"))
+    except SyntaxError as e:
+        raise ParameterError(f"{scenario}:{e.lineno}: {e.msg}") from None
+    except Exception as e:  # what its top level raises is the user's
+        raise ParameterError(f"{scenario}: {type(e).__name__}: {e}") from None
+
+
 def _sweep(args: argparse.Namespace, scenario: Path, grid, cases) -> int:
     from ..sweep import results
     from ..sweep.case import Job
@@ -88,6 +103,16 @@ def _sweep(args: argparse.Namespace, scenario: Path, grid, cases) -> int:
         raise ParameterError("--workers must be 1 or more")
     out = results.check_path(args.output or f"{Path(args.grid).stem}.parquet")
     done = results.read_rows(out)
+    before = results.read_meta(out).get("scenario_sha")
+    if done and before and before != results.scenario_sha(scenario):
+        failed = [r for r in done if not r.get("ok")]
+        if failed:
+            print(
+                f"{scenario} changed since {out} was written: its {len(failed)} failed "
+                "case(s) run again",
+                file=sys.stderr,
+            )
+            done = [r for r in done if r.get("ok")]
     done_ids = {str(r["id"]) for r in done}
     todo = [c for c in cases if c.id not in done_ids]
     keep = out.with_name(out.stem + ".failures")

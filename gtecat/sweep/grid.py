@@ -44,6 +44,8 @@ import numpy as np
 from ..errors import ParameterError
 
 MACHINE_PREFIX = "machine."
+#: the most cases one sweep holds (each is a row in memory and in RESULTS)
+MAX_CASES = 1_000_000
 DISTRIBUTIONS = ("uniform", "normal")
 
 
@@ -100,8 +102,42 @@ class Grid:
     seed: int = 0
     card: str | None = None  #: ``[base] card = "gts:4"``: a pulse card instead of EtherCAT
 
+    def size(self) -> int:
+        """How many cases the grid describes (before identical ones are dropped)."""
+        return math.prod(len(v) for v in self.grid.values()) * (self.n if self.random else 1)
+
+    def check(self) -> None:
+        """Refuse, before any case runs, what would fail every case alike: more cases than
+        one sweep holds, and ``machine.*`` keys or values the machine description refuses
+        (each [grid] value, and each [random] key at its first draw)."""
+        from ..drives.machine import machine_from_dict
+
+        if self.size() > MAX_CASES:
+            raise ParameterError(
+                f"{self.path}: the grid describes {self.size():,} cases; a sweep holds at most "
+                f"{MAX_CASES:,} (split it into several grids, or sample with [random])"
+            )
+        first = {k: v[0] for k, v in self.grid.items()}
+        rng = np.random.default_rng(self.seed)
+        first.update({k: v[0] for k, v in self._draw(rng).items()})
+        # each key alone on the base first, then each value beside the others' first ones
+        trials = [(key, first[key], {}) for key in [*self.random, *self.grid]]
+        trials += [(k, v, first) for k, values in self.grid.items() for v in values]
+        seen: set[tuple[str, str, bool]] = set()
+        for key, value, rest in trials:
+            if not key.startswith(MACHINE_PREFIX) or (key, repr(value), bool(rest)) in seen:
+                continue
+            seen.add((key, repr(value), bool(rest)))
+            try:
+                machine_from_dict(self.machine_for(Case({**rest, key: value})), "machine")
+            except Exception as e:  # every refusal of the description
+                where = "[grid]" if key in self.grid else "[random]"
+                raise ParameterError(f"{self.path}: {where} {key} = {value!r}: {e}") from None
+
     def cases(self) -> list[Case]:
         """Every case in a fixed order; ids repeat only for identical parameters (dropped)."""
+        if self.size() > MAX_CASES:
+            self.check()
         names = list(self.grid)
         points = list(itertools.product(*(self.grid[k] for k in names))) if names else [()]
         rng = np.random.default_rng(self.seed)
@@ -211,8 +247,8 @@ def load_grid(path: str | Path) -> Grid:
         grid[key] = values
     rnd = dict(_table(data, "random", p))
     n, seed = rnd.pop("n", 1), rnd.pop("seed", 0)
-    if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 10_000_000:
-        raise ParameterError(f"{p}: [random] n must be a whole number from 1 to 10000000")
+    if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CASES:
+        raise ParameterError(f"{p}: [random] n must be a whole number from 1 to {MAX_CASES}")
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise ParameterError(f"{p}: [random] seed must be a whole number >= 0")
     random: dict[str, tuple[str, float, float]] = {}

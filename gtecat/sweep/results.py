@@ -13,6 +13,7 @@ case's values are; the journal is what makes "incremental" and "resumable" true 
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import os
@@ -161,8 +162,16 @@ def meta_of(path: Path) -> Path:
 
 def write_meta(path: Path, scenario: Path, grid: Path) -> None:
     """Which scenario and grid made RESULTS: the report's re-run commands need them."""
-    meta = {"scenario": str(scenario), "grid": str(grid)}
+    meta = {"scenario": str(scenario), "grid": str(grid), "scenario_sha": scenario_sha(scenario)}
     meta_of(path).write_text(json.dumps(meta, indent=1) + "\n", encoding="utf-8")
+
+
+def scenario_sha(scenario: Path) -> str:
+    """What the scenario file holds, in short: a changed scenario re-runs the failed cases."""
+    try:
+        return hashlib.sha256(scenario.read_bytes()).hexdigest()[:16]
+    except OSError:
+        return ""
 
 
 def read_meta(path: Path) -> dict[str, str]:

@@ -105,3 +105,41 @@ def test_set_path_refuses_to_walk_through_a_value():
     data = {"axis": {"1": {"position": 5}}}
     with pytest.raises(ParameterError, match="is a value"):
         set_path(data, "axis.1.position.x", 1, "machine.axis.1.position.x")
+
+
+def test_what_would_fail_every_case_is_refused_before_any_runs(tmp_path):
+    """A grid of more cases than a sweep holds is refused before it is built (it would
+    fill the memory); a ``machine.*`` key or index the description refuses is named once."""
+    base = '[base]\neni = "manual_fig5_2"\nmachine = "m.toml"\n'
+    huge = _grid(
+        tmp_path, base + "[grid]\n" + "".join(f"p{i} = {list(range(10))}\n" for i in range(9))
+    )
+    with pytest.raises(ParameterError, match="1,000,000,000 cases; a sweep holds at most"):
+        huge.check()
+    with pytest.raises(ParameterError, match="a sweep holds at most"):
+        huge.cases()
+    bad_key = _grid(tmp_path, base + '[grid]\n"machine.axis.1.nosuchkey" = [1]\n')
+    with pytest.raises(ParameterError, match=r"\[grid\] machine.axis.1.nosuchkey = 1: .*nosuchkey"):
+        bad_key.check()
+    bad_index = _grid(
+        tmp_path,
+        base + '[random]\nn = 3\n"machine.axis.1.home_switch.5.0" = { uniform = [0, 1] }\n',
+    )
+    with pytest.raises(
+        ParameterError, match=r"\[random\] machine.axis.1.home_switch.5.0 = .*list of 1"
+    ):
+        bad_index.check()
+    _grid(tmp_path, base + '[grid]\n"machine.axis.1.position" = [0, 10]\n').check()  # fine
+
+
+def test_a_scenario_that_does_not_compile_is_refused_at_once(tmp_path, capsys, monkeypatch):
+    from gtecat.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "grid.toml").write_text('[base]\neni = "manual_fig5_2"\n[grid]\nx = [1, 2]\n')
+    (tmp_path / "syn.py").write_text("def scenario(gt, case) return 1\n")
+    (tmp_path / "none.py").write_text("x = 1\n")
+    assert main(["sweep", "syn.py", "--grid", "grid.toml", "--list"]) == 1
+    assert "syn.py:1:" in capsys.readouterr().err
+    assert main(["sweep", "none.py", "--grid", "grid.toml", "--list"]) == 1
+    assert "defines no function scenario(gt, case)" in capsys.readouterr().err
