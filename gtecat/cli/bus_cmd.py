@@ -61,10 +61,10 @@ examples:
   gtecat sdo upload 0 0x6502 0 --type uint32 --backend pysoem --iface eth0
   gtecat sdo upload 0 Statusword --controller unix:/tmp/ctl.sock
 
-On the emulated bus every command starts a fresh bus: a download lasts for that
-command only (use a script and `gtecat run` for sequences), unless --controller (or
-GTECAT_CONTROLLER) names a running controller (`gtecat controller`): then it reads
-and writes that one's bus."""
+With a gtecat running (gtecat ps), the command reads and writes that one's bus: the
+only one running, --attach ID, or --controller ADDRESS (GTECAT_CONTROLLER; gtecat ps
+shows which bus each has).  With none running it starts a fresh bus of its own, and a
+download lasts for that command only (use a script and `gtecat run` for sequences)."""
 
 
 def _file(p: argparse.ArgumentParser) -> None:

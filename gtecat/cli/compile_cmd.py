@@ -21,6 +21,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "compile",
         help="compile motion programs (.c -> .bin + .ini, manual chapter 10)",
         description=__doc__,
+        epilog="examples:\n  gtecat compile sum.c\n  gtecat compile --check sum.c\n"
+        "  gtecat compile --list sum.c",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("sources", nargs="+", metavar="FILE.c", help="motion program source")

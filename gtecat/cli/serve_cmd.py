@@ -251,7 +251,7 @@ def resolve_wait(wait: str, rt_priority: int | None = None) -> str:
 
     A frame answered from a spinning loop takes half the time of one answered after a
     sleep, even a predicted one: on a VM the CPU that slept runs slower for a while (p50
-    13 against 28 us on the 2-vCPU machine, docs/hardware.md), and issue 16's bar is the
+    13 against 28 us on the 2-vCPU machine, docs/hardware.md), and the wire's latency target is the
     spinning figure.  On one CPU a spinning server would take the master's time slices;
     under SCHED_FIFO (``--rt-priority``) the kernel stops a task that never sleeps for 50 ms
     of every second (``sched_rt_runtime_us``), so auto predicts there too.

@@ -33,6 +33,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "sweep",
         help="run a scenario over a grid of machine variants (Dask), or report the results",
         description=output.describe(__doc__),
+        epilog="examples:\n"
+        "  gtecat example sweep_homing -o sw             (then in sw/:)\n"
+        "  gtecat sweep sweep_homing.py --grid sweep_homing.toml --list\n"
+        "  gtecat sweep sweep_homing.py --grid sweep_homing.toml -o results.parquet\n"
+        "  gtecat sweep report results.parquet -o report/",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("scenario", metavar="SCENARIO.py|report", help="the scenario file, or 'report'")

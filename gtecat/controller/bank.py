@@ -1,4 +1,4 @@
-"""The vectorised axis bank: the common servo cycle of many axes as numpy rows (issue 17).
+"""The vectorised axis bank: the common servo cycle of many axes as numpy rows.
 
 Per axis and cycle the scalar objects cost 15-25 µs of Python (planner, axis layer,
 drive state machine, mechanics, PDO codec, status and limit checks).  Most axes of a

@@ -1,4 +1,4 @@
-"""Cores 2, 3, 4 ...: the axes beyond 32 of the one EtherCAT bus (issue 17, item 4).
+"""Cores 2, 3, 4 ...: the axes beyond 32 of the one EtherCAT bus.
 
 ``GT_Update(long mask)``, ``GT_Stop(long mask, long option)`` and every ``short axis``
 argument reach 32 axes per core, as on the real controller.  A bus with more CiA-402

@@ -1,4 +1,4 @@
-"""The legal range of every number a configuration file holds (issue 12: checked at the reader).
+"""The legal range of every number a configuration file holds, checked at the reader.
 
 Both readers (ETG.2100 XML and Googol's INI ``Gecat.eni``) take each number they
 use through :meth:`Limit.parse` or :meth:`Limit.check` with its limit from the

@@ -456,12 +456,26 @@ def _numeric_array(name: str, arr: np.ndarray) -> np.ndarray:
     return arr.reshape(-1)
 
 
+#: the vendor's integer types: their width (Windows, where ``long`` is 4 bytes) and the
+#: ctypes type to pass for them (wider integers are taken: ``c_long`` is 8 bytes on Linux)
+_C_WIDTH = {
+    "char": 1, "unsigned char": 1, "short": 2, "unsigned short": 2, "int": 4,
+    "unsigned int": 4, "long": 4, "unsigned long": 4, "long long": 8, "unsigned long long": 8,
+}  # fmt: skip
+_CTYPES_OF = {
+    "short": "c_short", "unsigned short": "c_ushort", "int": "c_int", "unsigned int": "c_uint",
+    "long": "c_long", "unsigned long": "c_ulong", "long long": "c_longlong",
+    "unsigned long long": "c_ulonglong",
+}  # fmt: skip
+
+
 def check_kind(p: Param, ref: Ref) -> Ref:
     """Refuse ctypes memory of the other kind of number than the prototype's pointer (a
     ``c_long`` where it says ``double *``, a ``c_double`` for a ``long *``): C would not
     compile the call, and the value would be silently rounded or reinterpreted.  Integer
-    widths may differ (``c_long`` is 64 bits on Linux, the vendor's ``long`` 32); each
-    value is checked to fit when it is stored."""
+    memory may be wider than the C type (``c_long`` is 64 bits on Linux, the vendor's
+    ``long`` 32; each value is checked to fit when it is stored), never narrower
+    (``c_short`` for a ``long *``): 7 with the type to pass."""
     elem = ref.elem
     if (
         ref.py is None
@@ -473,10 +487,20 @@ def check_kind(p: Param, ref: Ref) -> Ref:
         and p.ctype not in ("char", "unsigned char", "void")
     ):
         want_float = p.ctype in ("double", "float")
+        right = "c_double" if want_float else _CTYPES_OF.get(p.ctype, "c_long")
         if (elem._type_ in _FLOAT_CODES) != want_float:
             raise ParameterError(
                 f"{p.name}: points to {elem.__name__}, the prototype says {p.ctype} *; "
-                f"pass byref({'c_double' if want_float else 'c_long'}()) or an array of it"
+                f"pass byref({right}()) or an array of it"
+            )
+        width = _C_WIDTH.get(p.ctype)
+        if not want_float and width is not None and ctypes.sizeof(elem) < width:
+            # narrower than the C type: a C compiler would refuse it, and whether a value
+            # fits would depend on the value (a status that grows past it one day)
+            raise ParameterError(
+                f"{p.name}: points to {elem.__name__} ({ctypes.sizeof(elem)} bytes), the "
+                f"prototype says {p.ctype} * ({width} bytes); pass byref({right}()) or an "
+                "array of it"
             )
         if want_float and ctypes.sizeof(elem) != ctypes.sizeof(ctypes.c_double):
             raise ParameterError(

@@ -76,10 +76,10 @@ class TCompileInfo(ctypes.Structure):
     )
 
 
-from .crd_structs import TCrdData, TCrdPrm  # noqa: E402 - coordinated motion (issue 19)
+from .crd_structs import TCrdData, TCrdPrm  # noqa: E402 - coordinated motion
 
 __all__ = ["TCompileInfo", "TCrdData", "TCrdPrm", "TJogPrm", "TThreadSts", "TTrapPrm", "TVarInfo"]
 
-from .home_structs import THomePrm, THomeStatus  # noqa: E402 - smart home (issue 14)
+from .home_structs import THomePrm, THomeStatus  # noqa: E402 - smart home
 
 __all__ += ["THomePrm", "THomeStatus"]

@@ -199,7 +199,7 @@ def test_gt_stop_brakes_the_slave_and_a_new_start_engages_again():
     assert gt.GT_Stop(0b10, 0) == 0
     out = trace(15)
     assert not moving(2) and out[-1, 1] == pytest.approx(before[-1, 1] + 10 * 10 / 2)
-    mode = c_short()
+    mode = c_long()
     assert gt.GT_GetPrfMode(2, byref(mode)) == 0 and mode.value == 3
     assert gt.GT_GearStart(0b10) == 0, gt.GTE_GetLastError()
     out2 = trace(5)

@@ -83,7 +83,7 @@ def rc_reason(rc: int, expected: int, *words: str) -> None:
 def test_example_7_3_static_fifo_sample_by_sample():
     up()
     assert gt.GT_PrfPt(1, gt.PT_MODE_STATIC) == 0
-    mode = c_short()
+    mode = c_long()
     assert gt.GT_GetPrfMode(1, byref(mode)) == 0 and mode.value == 2
     push(1, EX_7_3)
     assert space() == 29 and remainder() == 3

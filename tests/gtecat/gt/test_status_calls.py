@@ -503,3 +503,17 @@ def test_scale_arguments():
     assert gt.GT_ProfileScale(1, 1.5, 1) == 7
     sh = c_short()
     assert gt.GT_GetPosScale(1, byref(sh)) == 0
+
+
+def test_integer_memory_narrower_than_the_prototype_is_refused_with_the_type_to_pass():
+    """A C compiler refuses a ``short *`` for a ``long *``; here such memory gets 7 and the
+    ctypes type to pass, whatever the value (it used to depend on whether it fitted)."""
+    from ctypes import c_int, c_int8, c_ushort
+
+    bring_up(clock="lockstep")
+    assert gt.GT_GetSts(1, byref(c_short())) == 7
+    assert "pass byref(c_long())" in gt.GTE_GetLastError()
+    assert gt.GT_GetSts(1, byref(c_int())) == 0 and gt.GT_GetSts(1, byref(c_long())) == 0
+    assert gt.GT_GetEcatHomingStatus(1, byref(c_int8())) == 7
+    assert "pass byref(c_ushort())" in gt.GTE_GetLastError()
+    assert gt.GT_GetEcatHomingStatus(1, byref(c_ushort())) == 0
