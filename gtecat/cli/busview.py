@@ -164,6 +164,13 @@ def attach(args: argparse.Namespace) -> Any:
             file=sys.stderr,
         )
         return None
+    if not wanted:  # found by itself: say which one, so nobody mistakes it for their file
+        info = found[0]
+        print(
+            f"note: attached to the running gtecat {info.id} ({info.kind}, "
+            f"{info.eni or 'no ENI'}; `gtecat ps`); --eni FILE opens a bus of its own",
+            file=sys.stderr,
+        )
     return client.attach_view(found[1])
 
 
