@@ -42,6 +42,7 @@ Decisions where the manual is silent:
 from __future__ import annotations
 
 import ctypes
+import time
 from typing import Any
 
 from gtecat.drives.abort import SdoAbort
@@ -50,6 +51,8 @@ from gtecat.drives.slave import AlState
 from .. import __version__
 from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
+from ..inspect.endpoint import _PUBLISHED as _ENDPOINTS
+from ..master.clock import ClockMode
 from . import _core
 from ._core import (
     SESSION,
@@ -505,8 +508,15 @@ def GT_EcatSDOUpload(
 @gt_function
 def GTE_Wait(ctl: Controller, ms: float) -> int:
     """Let ``ms`` of controller time pass, in any clock mode (virtual time runs, or the
-    realtime clock sleeps), so one script runs unchanged in every mode."""
+    realtime clock sleeps), so one script runs unchanged in every mode.
+
+    While the controller's inspection endpoint is published, a wait in virtual time ends
+    with a yield (``time.sleep(0)``, no waiting): a script that runs quick lockstep waits
+    back to back would otherwise keep the interpreter from the endpoint's threads, and an
+    attached panel or verb would get no answer until the script ends."""
     ctl.wait_ms(float(ms))
+    if _ENDPOINTS and ctl.clock.mode is not ClockMode.REALTIME:
+        time.sleep(0)
     return 0
 
 
