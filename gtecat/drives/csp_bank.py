@@ -43,16 +43,17 @@ _HALT = 0x100
 CW_ENABLED = 0x000F
 
 
-def claimable(ch: Channel) -> str:
-    """Why ``ch`` cannot be a bank row now ("" when it can)."""
-    s = ch._settings
+def running_reason(ch: Channel, mode: OpMode, cw: int, not_in_mode: str) -> str:
+    """Why ``ch`` is not simply running in ``mode`` under controlword ``cw`` ("" when it
+    is): what every kind of bank row (CSP here, homing searches in
+    :mod:`gtecat.drives.homing_bank`) requires before its own conditions."""
     if ch.psm.state is not State.OPERATION_ENABLED:
         return "not operation enabled"
-    if ch.mode != OpMode.CYCLIC_SYNC_POSITION or ch.mode_req != ch.mode:
-        return "not in CSP"
+    if ch.mode != mode or ch.mode_req != ch.mode:
+        return not_in_mode
     if ch.mode_due is not None or ch.mode_seen != ch.mode:
         return "mode change pending"
-    if ch.controlword != CW_ENABLED or ch.prev_cw != CW_ENABLED:
+    if ch.controlword != cw or ch.prev_cw != cw:
         return "controlword"
     if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
         return "fault"
@@ -64,6 +65,15 @@ def claimable(ch: Channel) -> str:
         return "on a limit switch"
     if ch.tp_function or ch._tp_applied or ch.probe.function:
         return "touch probe"
+    return ""
+
+
+def claimable(ch: Channel) -> str:
+    """Why ``ch`` cannot be a bank row now ("" when it can)."""
+    s = ch._settings
+    why = running_reason(ch, OpMode.CYCLIC_SYNC_POSITION, CW_ENABLED, "not in CSP")
+    if why:
+        return why
     if ch.homing is not None and getattr(ch.homing, "active", False):
         return "homing"
     if s.limit_reaction not in ("stop", "fault", "none"):

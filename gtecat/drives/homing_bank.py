@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from .cia402 import State
+from .csp_bank import running_reason
 from .homing import HomingPhase
 from .homing_methods import Signal
 from .modes import OpMode
@@ -46,24 +46,9 @@ ROW_FIELDS = (
 
 def homing_claimable(ch: Channel) -> str:
     """Why ``ch`` cannot run its homing search as a bank row now ("" when it can)."""
-    if ch.psm.state is not State.OPERATION_ENABLED:
-        return "not operation enabled"
-    if ch.mode != OpMode.HOMING or ch.mode_req != ch.mode:
-        return "not in homing mode"
-    if ch.mode_due is not None or ch.mode_seen != ch.mode:
-        return "mode change pending"
-    if ch.controlword != CW_HOMING or ch.prev_cw != CW_HOMING:
-        return "controlword"
-    if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
-        return "fault"
-    if ch.field is not None:
-        return "field fault"
-    if ch.torque_ctl or ch.stopping or ch.limit_stop:
-        return "stopping"
-    if ch.digital_inputs & 3:
-        return "on a limit switch"
-    if ch.tp_function or ch._tp_applied or ch.probe.function:
-        return "touch probe"
+    why = running_reason(ch, OpMode.HOMING, CW_HOMING, "not in homing mode")
+    if why:
+        return why
     if ch.fe_flag or ch.fe_time:
         return "following error"
     h = ch.homing
