@@ -11,7 +11,7 @@ resource and ``key=value`` lines, values decimal, ``0x`` hex or floats::
                                 limitPositiveType=0 ...
                                 prfMap=0x1  prfMapAlpha1=1 ...
 
-Real files are in ``../shared/fixtures/googol/*.cfg``; ``docs/config_file.md`` is the
+Real files are in the vendor's sample ``.cfg`` files; ``docs/config_file.md`` is the
 user's reference.  :data:`SCHEMA` declares every section and key; what each does
 on an EtherCAT axis (axis/profile/encoder N = GT axis N, 4.3):
 

@@ -40,8 +40,9 @@ class PrfMode(IntEnum):
     FOLLOW = 4
     INTERPOLATION = 5
     PVT = 6
-    #: not a manual mode: the pulse-card drive of the compat layers (seeds 003/004,
-    #: :mod:`gtecat.controller.motion.scurve`), what GT_GetPrfMode reports for such an axis
+    #: not a manual mode: the pulse-card drive of the compat layers (the MCX314 thesis and
+    #: the ADT850 manual, :mod:`gtecat.controller.motion.scurve`), what GT_GetPrfMode
+    #: reports for such an axis
     CARD_DRIVE = 16
 
 

@@ -4,9 +4,9 @@ Not the drive's homing (6098h methods, :mod:`gtecat.drives.homing`): here the co
 the axis in Trap mode, watches its limit inputs and captures home / index edges with its
 own capture (:mod:`gtecat.controller.capture`), on any axis - a GTS card's pulse axis or an
 EtherCAT drive in CSP.  The facts are the vendor header's (``THomePrm``, ``THomeStatus``,
-``HOME_MODE_*``, ``HOME_STAGE_*``, ``HOME_ERROR_*``: ``../shared/reference/gts-header-facts.md``
-"Smart home"); what each mode does is seed 002's description of the GTS manual.  Units are
-the Trap mode's: pulse, pulse/ms, pulse/ms².
+``HOME_MODE_*``, ``HOME_STAGE_*``, ``HOME_ERROR_*``: the "Smart home" part of the vendor's GTS
+header); what each mode does follows the GTS manual as a user's C++ homing program reads
+it.  Units are the Trap mode's: pulse, pulse/ms, pulse/ms².
 
 Every move is a Trap move of the axis's profile with ``acc``, ``dec`` and ``smoothTime`` of
 THomePrm; searches run at ``velHigh`` ("Home 搜索速度"), the final approach at ``velLow``
@@ -27,8 +27,8 @@ Modes (stages in brackets):
   home [25], then slowly in ``indexDir`` to the first index pulse beyond the home [30].
 * **20 home**: the home search in ``d`` [20].
 * **22 home + index**: home [20], back to it [25], first index beyond it in ``indexDir`` [30].
-* **30 index**: fast in ``d`` to the first index pulse [30] (seed 002: "fast with capture
-  armed until the index pulse"); a limit on the way turns the search round once.
+* **30 index**: fast in ``d`` to the first index pulse [30] (a user's C++ homing program:
+  "fast with capture armed until the index pulse"); a limit on the way turns the search round once.
 * **40 forced home**: the trigger - GPI ``triggerIndex`` (1..16), or the axis's home input
   when -1 - is sampled by the controller instead of latched: fast in ``d`` until it is
   active [40] (a limit first turns the search round once, as in mode 20), stop, slowly
@@ -40,9 +40,9 @@ Modes (stages in brackets):
 
 Then **go home** [80]: to ``targetPos = capturePos + homeOffset`` at ``velLow``; the axis
 stands there in Trap mode [100, run 0].  Positions are not zeroed (``GT_ZeroPos`` after,
-as seed 002 does).  ``capturePos`` is the encoder value of the capture (of the trigger's
-encoder); the target is a profile position: profile and encoder are taken to count the
-same pulses (GT_ZeroPos makes them agree; GT_ProfileScale/GT_EncScale 1:1).
+as a user's C++ homing program does).  ``capturePos`` is the encoder value of the capture
+(of the trigger's encoder); the target is a profile position: profile and encoder are taken
+to count the same pulses (GT_ZeroPos makes them agree; GT_ProfileScale/GT_EncScale 1:1).
 
 **The home search** [20] (modes 11, 13, 20, 22) moves fast in its direction with the home
 capture armed for ``edge`` (0: where the switch is reached, 1: where it is left; the
@@ -66,15 +66,15 @@ stops the axis abruptly (with GT_LmtsOff the search sees the input anyway and st
 ``dec``).  A search that starts on the limit it looks for has reached it at once (the limit
 modes go on with the escape, the home and index searches turn).  Before every move toward
 one side the search clears that side's limit flag if its cause is gone (the axis left the
-switch), whoever raised it, and at the end the flags it raised itself, as seed 002's
-``GT_ClrSts`` in its polling loop would; other latched flags (alarm, following error, stop
-inputs) refuse the search with ``HOME_ERROR_STOP`` / ``_ALARM``, as they refuse GT_Update
+switch), whoever raised it, and at the end the flags it raised itself, as the
+``GT_ClrSts`` in a user's C++ homing program's polling loop would; other latched flags
+(alarm, following error, stop inputs) refuse the search with ``HOME_ERROR_STOP`` / ``_ALARM``, as they refuse GT_Update
 (the vendor's demo calls GT_ClrSts first: "无清除状态会导致回零失败").  A limit mode on an
 axis whose limit input in ``moveDir`` is *none* (a configuration file's index -1 takes it
 away from the limit check: no stop, no bit 5/6) reads the axis's own limit terminal
 (60FDh of the axis; on a card its terminal N) and stops there with ``dec``, with a line in
-the master log: the vendor's own test.cfg (``../shared/fixtures/googol/smarthome_test.cfg``)
-wires none to axes 2-4, and seed 002's limit homing on them must still find the switch
+the master log: the vendor's own ``smarthome_test.cfg`` (its smart-home demo) wires none to
+axes 2-4, and a user's C++ limit homing on them must still find the switch
 the machine has.  Only an axis with no limit terminal at all (no 60FDh) is refused with
 ``HOME_ERROR_HOME_MODE``: that search could never end.
 

@@ -1,6 +1,6 @@
 """GT smart-home and capture calls: GT_GoHome, GT_GetHomePrm, GT_GetHomeStatus, GT_*Capture*.
 
-The GTS vendor header's functions (``../shared/reference/gts-header-facts.md`` "Smart home");
+The GTS vendor header's functions (the "Smart home" part of the vendor's GTS header);
 the semantics live in :mod:`gtecat.controller.smart_home` (modes, stages, errors) and
 :mod:`gtecat.controller.capture` (where edges come from, how exact they are).  They work on
 every axis: a GTS card's (``GTECAT_CARD=gts:N``) and an EtherCAT drive in CSP.

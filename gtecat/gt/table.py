@@ -152,7 +152,7 @@ class Proto:
 
         An input text (``str``) is ``const char *`` where the vendor writes ``char *``: the
         same ABI, and C++ callers passing a string literal (``GT_LoadConfig("GTS800.cfg")``,
-        seed 002) compile without ISO C++'s string-constant warning."""
+        a user's C++ homing program) compile without ISO C++'s string-constant warning."""
         name = ("GTN_" + self.name[3:]) if core else self.name
         if core and self.name in NO_CORE_TWINS:
             own = [

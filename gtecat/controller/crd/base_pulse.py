@@ -1,14 +1,16 @@
-"""Interpolation speed counted in base pulses, as the MCX314-family chips count it (seeds 003/004).
+"""Interpolation speed counted in base pulses, as the MCX314-family chips count it.
+
+Sources: the MCX314 thesis and the ADT850 manual.
 
 On those chips the set speed of an interpolation is the rate of *base pulses*, not the
-vector speed (seed 004, 9.2.6 "插补速度": "并不是代表X轴是以这个速度运动,而是长轴的速度"):
+vector speed (the ADT850 manual, 9.2.6 "插补速度": "并不是代表X轴是以这个速度运动,而是长轴的速度"):
 
 * a **line**'s base pulses are the long axis's pulses, ``N = max|Δ_i|``; the path moves
   ``L/N`` per base pulse, so the vector speed is ``V·L/N`` (between ``V`` and ``V·√dim``);
 * an **arc**'s base pulses are those of the axis that pulses on every base pulse in each
-  octant (seed 004, 5.2: the axis with the smaller coordinate about the centre, i.e. the
+  octant (the ADT850 manual, 5.2: the axis with the smaller coordinate about the centre, i.e. the
   one moving faster), ``dn/dθ = r·max(|sin θ|, |cos θ|)``; over a full circle
-  ``N = 8·r/√2`` - the figure seed 004's arc example computes for its manual
+  ``N = 8·r/√2`` - the figure the ADT850 manual's arc example computes for its manual
   deceleration point.  The vector speed varies between ``V`` and ``V·√2`` along the arc.
 
 :class:`BaseSpeed` puts a :class:`~gtecat.controller.motion.scurve.DriveProfile` (planned in

@@ -1,13 +1,15 @@
-"""The pulse-card drive planner: T (trapezoid) and jerk-limited S-curve drives of seeds 003/004.
+"""The pulse-card drive planner: T (trapezoid) and jerk-limited S-curve drives.
 
-The MCX314-family chips behind the ADT850 (seed 004, chapter 5 "速度曲线") and the
-MCX314 library of seed 003 (4.4) drive an axis from an initial speed ``SV`` to a
+Sources: the MCX314 thesis and the ADT850 manual.
+
+The MCX314-family chips behind the ADT850 (the ADT850 manual, chapter 5 "速度曲线") and the
+MCX314 library of the MCX314 thesis (4.4) drive an axis from an initial speed ``SV`` to a
 drive speed ``V``:
 
 * **T** (直线加/减速): the speed ramps linearly with ``A`` up, ``D`` down (``D = A``
-  when symmetric, seed 004 3.3).
+  when symmetric, the ADT850 manual 3.3).
 * **S** (S 曲线): the acceleration grows linearly with the jerk ``K`` from 0 to ``A``,
-  stays, and falls back to 0 as the speed nears ``V`` (seed 004 3.4: *partial* S, the
+  stays, and falls back to 0 as the speed nears ``V`` (the ADT850 manual 3.4: *partial* S, the
   a/b/c sections); when ``V`` comes before ``A`` is reached the b section vanishes
   (*full* S).  Deceleration mirrors it with ``D`` and the same jerk.
 
@@ -24,18 +26,18 @@ A/K``, jerk ``A/K``) else ``2·sqrt(Δv/K)`` (full S), ``Δv/A`` for T; its spee
 point-symmetric, so it covers ``(va + vb)/2 · duration``.
 
 * **Start**: the speed jumps from 0 to ``SV`` (the chips output their first pulses at the
-  initial speed); ``V <= SV`` is a constant-speed drive at ``V`` (seed 004 3.1/3.6).
+  initial speed); ``V <= SV`` is a constant-speed drive at ``V`` (the ADT850 manual 3.1/3.6).
 * **Fixed drive, automatic deceleration** (定量驱动, 自动减速): up to a peak ``vp``,
   cruise, down to ``SV`` exactly at the target, then 0.  ``vp = V`` when the distance
   allows it, else the largest ``vp`` whose up and down ramps fit (found by bisection,
-  to float precision; the cruise takes the rest).  *Triangle prevention* (seed 004 3.2,
+  to float precision; the cruise takes the rest).  *Triangle prevention* (the ADT850 manual 3.2,
   T only when asked): acceleration stops once the up and down ramps would use half the
   pulses, so such a short move cruises over the middle half.
 * **Manual deceleration** (手动减速, ``set_dec_pos`` / ``ManualDec``): up to ``V``, the
   deceleration to ``SV`` starts when ``manual_dec`` pulses are out (not before the up
   ramp ends, for an S ramp), then ``SV`` until the last pulse; a target reached
   earlier ends the drive at once (the chip runs out of pulses).
-* **No deceleration** (interpolation with deceleration disabled, seed 004 5.4): up to
+* **No deceleration** (interpolation with deceleration disabled, the ADT850 manual 5.4): up to
   ``V`` and on to the end, where the drive stops at once.
 * **Continuous drive** (连续驱动): up to ``V``, then on until stopped.
 
@@ -45,9 +47,9 @@ target with zero speed (``done``).  Samples never pass the target.
 
 Commands while driving: :meth:`SCurvePlanner.decelerate` (``dec_stop``) brings the
 acceleration to zero with the jerk, then ramps down to ``SV`` and stops (a constant-speed
-drive stops at once, seed 004 5.3); :meth:`SCurvePlanner.change_speed` (``set_speed``
-while driving, seed 004 3.6) re-plans the same way toward the new ``V``; an S fixed drive
-keeps its speed (seed 004: "S曲线加/减速的定量脉冲驱动在驱动中不能变更驱动速度").
+drive stops at once, the ADT850 manual 5.3); :meth:`SCurvePlanner.change_speed` (``set_speed``
+while driving, the ADT850 manual 3.6) re-plans the same way toward the new ``V``; an S fixed drive
+keeps its speed (the ADT850 manual: "S曲线加/减速的定量脉冲驱动在驱动中不能变更驱动速度").
 :meth:`stop` (GT_Stop, limits) hands over to the constant-deceleration
 :class:`~.stop.StopRamp` as every planner does.
 """
@@ -72,7 +74,7 @@ Piece = tuple[float, float, float, float, float]
 class SCurveParams:
     """One drive's speed curve: ``vel_start`` SV, ``vel`` V (pulse/ms), ``acc`` A, ``dec`` D
     (pulse/ms², 0 = ``acc``: symmetric), ``jerk`` K (pulse/ms³, ``inf`` = T shape),
-    ``triangle`` triangle prevention (T fixed drives, seed 004 3.2)."""
+    ``triangle`` triangle prevention (T fixed drives, the ADT850 manual 3.2)."""
 
     vel_start: float
     vel: float
@@ -444,7 +446,7 @@ class SCurvePlanner:
 
     def decelerate(self) -> None:
         """``dec_stop``: ramp down to SV (S: the acceleration to 0 first) and stop there;
-        a constant-speed drive stops at once (seed 004 5.3)."""
+        a constant-speed drive stops at once (the ADT850 manual 5.3)."""
         if self._mode != _MOVE or self.prm is None or self.decelerating:
             return
         prm = self.prm
