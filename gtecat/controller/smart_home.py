@@ -70,7 +70,8 @@ switch), whoever raised it, and at the end the flags it raised itself, as the
 ``GT_ClrSts`` in a user's C++ homing program's polling loop would; other latched flags
 (alarm, following error, stop inputs) refuse the search with ``HOME_ERROR_STOP`` /
 ``_ALARM``, as they refuse GT_Update (the vendor's demo calls GT_ClrSts first:
-"无清除状态会导致回零失败").  A limit mode on an axis whose limit input in ``moveDir`` is *none* (a configuration file's index -1 takes it
+"无清除状态会导致回零失败").  A limit mode on an axis whose
+limit input in ``moveDir`` is *none* (a configuration file's index -1 takes it
 away from the limit check: no stop, no bit 5/6) reads the axis's own limit terminal
 (60FDh of the axis; on a card its terminal N) and stops there with ``dec``, with a line in
 the master log: the vendor's own ``smarthome_test.cfg`` (its smart-home demo) wires none to
