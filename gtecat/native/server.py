@@ -453,13 +453,10 @@ class Server:
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
         poller = self._poller
-        listen_fd = self._listener.fileno()
-        wake_fd = self._wake_r.fileno()
-        poller.register(listen_fd)
-        poller.register(wake_fd)
+        poller.register(self._listener.fileno())
+        poller.register(self._wake_r.fileno())
         if self._lifeline is not None:
             poller.register(self._lifeline)
-        clients = self._clients
         try:
             while not self._stop.is_set():
                 floor = self._current_floor()
@@ -476,23 +473,28 @@ class Server:
                         floor.look()
                     continue
                 for fd, ev in events:
-                    c = clients.get(fd)
-                    if c is not None:
-                        if ev & WRITE:
-                            self._writable(c)
-                        elif ev & READ:
-                            self._readable(c)
-                    elif fd == listen_fd:
-                        self._accept()
-                    elif fd == wake_fd:
-                        with contextlib.suppress(OSError):
-                            self._wake_r.recv(64)
-                    elif fd == self._lifeline:
-                        if not os.read(self._lifeline, 64):
-                            log.info("the program that started this controller has ended")
-                            self._stop.set()
+                    self._event(fd, ev, self._readable)
         finally:
             self._cleanup()
+
+    def _event(self, fd: int, ev: int, read: Callable[[_Client], None]) -> None:
+        """One poller event: a client's (``read`` serves what it sent), a connection, the
+        wake-up, or the lifeline."""
+        c = self._clients.get(fd)
+        if c is not None:
+            if ev & WRITE:
+                self._writable(c)
+            elif ev & READ:
+                read(c)
+        elif fd == self._listener.fileno():
+            self._accept()
+        elif fd == self._wake_r.fileno():
+            with contextlib.suppress(OSError):
+                self._wake_r.recv(64)
+        elif fd == self._lifeline:
+            if not os.read(self._lifeline, 64):
+                log.info("the program that started this controller has ended")
+                self._stop.set()
 
     def _serve_others(self) -> None:
         """Between the slices of a long GTE_Wait (Controller.slice_hook): answer what the
@@ -504,28 +506,21 @@ class Server:
             return
         busy = self._running[0]
         for fd, ev in self._poller.poll(0):
-            c = self._clients.get(fd)
-            if c is busy:
-                continue
-            if c is not None:
-                if ev & WRITE:
-                    self._writable(c)
-                elif ev & READ:
-                    try:
-                        data = c.sock.recv(CHUNK)
-                    except BlockingIOError:
-                        continue
-                    except OSError:
-                        data = b""
-                    if not data:
-                        self._drop(c)
-                    else:
-                        self._frames(c, data)
-            elif fd == self._listener.fileno():
-                self._accept()
-            elif fd == self._wake_r.fileno():
-                with contextlib.suppress(OSError):
-                    self._wake_r.recv(64)
+            if self._clients.get(fd) is not busy:
+                self._event(fd, ev, self._read_once)
+
+    def _read_once(self, c: _Client) -> None:
+        """Serve what ``c`` sent, without :meth:`_readable`'s spin for its next request."""
+        try:
+            data = c.sock.recv(CHUNK)
+        except BlockingIOError:
+            return
+        except OSError:
+            data = b""
+        if not data:
+            self._drop(c)
+        else:
+            self._frames(c, data)
 
     def _next_deadline(self) -> float | None:
         late = [c.deadline for c in self._clients.values() if c.deadline]
