@@ -139,13 +139,19 @@ def run(args: argparse.Namespace) -> int:
         print(f"gtecat panel ({mode}): {url}", flush=True)
 
     try:
-        panel.serve(path, control=args.control, port=args.port, title=title, ready=ready)
+        gone = panel.serve(path, control=args.control, port=args.port, title=title, ready=ready)
     except KeyboardInterrupt:
-        pass
+        gone = ""
     except OSError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
     finally:
         if pace is not None:
             pace.set()
+    if gone:
+        print(
+            f"the watched gtecat ({title}) stopped answering: {gone}; the panel ends",
+            file=sys.stderr,
+        )
+        return 1
     return 0

@@ -77,6 +77,8 @@ class PanelState:
     polls: int = 0
     lock: threading.Lock = field(default_factory=threading.Lock)
     stop: threading.Event = field(default_factory=threading.Event)
+    #: why the watched gtecat stopped answering ("" while it answers)
+    gone: str = ""
 
 
 def _asset(name: str) -> bytes:
@@ -277,7 +279,8 @@ def poll_loop(state: PanelState) -> None:
             state.polls += 1
             _broadcast(state, state.last)
     except (BusError, OSError, ValueError) as e:
-        _broadcast(state, json.dumps({"type": "gone", "error": str(e)}))
+        state.gone = str(e) or type(e).__name__
+        _broadcast(state, json.dumps({"type": "gone", "error": state.gone}))
         state.stop.set()
 
 
@@ -294,8 +297,10 @@ def scope_loop(state: PanelState) -> None:
             return
 
 
-def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any = None) -> None:
-    """Run the panel until interrupted; ``ready(url)`` is called once it listens."""
+def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any = None) -> str:
+    """Run the panel until interrupted or until the watched gtecat ends; ``ready(url)`` is
+    called once it listens.  Returns why the watched gtecat stopped answering ("" when
+    the panel was interrupted)."""
     from aiohttp import web
 
     global _LOOP
@@ -337,6 +342,7 @@ def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any 
         state.stop.set()
         for conn in (state.poll, state.command, state.scope):
             conn.close()
+    return state.gone
 
 
 __all__ = ["RATE_HZ", "PanelState", "make_app", "serve"]

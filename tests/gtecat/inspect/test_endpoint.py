@@ -153,3 +153,26 @@ def test_a_bad_request_is_one_line_back(app) -> None:
         with pytest.raises(BusError, match="no axis 9"):
             c.call("jog", 9, 1.0)
         assert c.call("info")["axes"] == [1, 2]  # the connection still answers
+
+
+def test_the_panel_ends_and_says_why_when_the_watched_gtecat_ends(app) -> None:
+    """An application that closes takes its endpoint along: the panel watching it ends
+    with the reason (the command prints it and exits 1) instead of going quiet."""
+    pytest.importorskip("aiohttp", reason="gtecat panel needs aiohttp (the test extra)")
+    from gtecat.inspect import panel
+
+    (ep,) = runtime.endpoints()
+    listening = threading.Event()
+    gone: list[str] = []
+    t = threading.Thread(
+        target=lambda: gone.append(
+            panel.serve(
+                str(ep.socket), control=False, port=0, title="t", ready=lambda u: listening.set()
+            )
+        )
+    )
+    t.start()
+    assert listening.wait(20)
+    app.GT_Close()
+    t.join(20)
+    assert not t.is_alive() and gone and gone[0]
