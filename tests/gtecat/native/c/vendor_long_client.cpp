@@ -13,7 +13,7 @@ int main(int argc, char **argv) {
     THomePrm prm;
     GT_GetHomePrm(1, &prm);
     prm.mode = 20; prm.moveDir = 1; prm.indexDir = 1; prm.edge = 0;
-    prm.velHigh = 5; prm.velLow = 1; prm.acc = 0.1; prm.dec = 0.1;
+    prm.velHigh = 50; prm.velLow = 5; prm.acc = 1; prm.dec = 1;  // a search of about 1 s
     prm.searchHomeDistance = 200000; prm.searchIndexDistance = 30000; prm.escapeStep = 1000;
     prm.homeOffset = offset;
     printf("gohome %d\n", GT_GoHome(1, &prm));
