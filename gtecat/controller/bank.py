@@ -64,7 +64,7 @@ from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
 from .axis_status import AxisStatus
-from .bank_kernel import Kernel
+from .bank_kernel import MAXSEG, NTPRM, Kernel, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
 from .motion.jog import _IDLE as _JOG_IDLE
@@ -85,8 +85,11 @@ AUTO_MIN_AXES = 4
 RECHECK_CYCLES = 16
 #: planned drive counts from which an axis leaves the bank (its int64 arithmetic ends at 2**63)
 HUGE_COUNTS = float(1 << 62)
-#: samples of a Trap move computed at once (a table per axis)
+#: samples of a Trap move computed at once (a table per axis) by numpy alone
 TABLE = 2048
+#: the same with the compiled cycle, which fills a used-up table itself within the cycle:
+#: a short table costs no time and little memory (24 bytes per sample and axis)
+KERNEL_TABLE = 64
 
 #: TxPDO objects the bank computes (channel-0 numbers -> CspBank output names)
 COMPUTED_TX = {
@@ -226,6 +229,9 @@ class AxisBank:
         #: never inside a cycle
         self.kernel: Kernel | None = None
         self._kernel_lib: Any = None
+        self.table = TABLE
+        self._c_fill = False  # the kernel refills every moving row's table itself
+        self._fill_out: np.ndarray | None = None
         kmode = kernel_wanted()
         if kmode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
@@ -238,6 +244,8 @@ class AxisBank:
                 )
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
+        #: of those, the cycles it ran many at a time (:meth:`run_many`; statistics)
+        self.many_cycles = 0
         #: homing axis-cycles the compiled kernel ran (statistics)
         self.homing_rows_run = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
@@ -355,8 +363,13 @@ class AxisBank:
         self.taken = zi(n, np.int64)  # samples taken since the claim
         self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
         self.ended = zi(n, bool)
-        self.t_p, self.t_v, self.t_a = z((n, TABLE + 1)), z((n, TABLE + 1)), z((n, TABLE + 1))
-        self.base = np.arange(n, dtype=np.int64) * (TABLE + 1)
+        tl = self.table = KERNEL_TABLE if self._kernel_lib is not None else TABLE
+        self.t_p, self.t_v, self.t_a = z((n, tl + 1)), z((n, tl + 1)), z((n, tl + 1))
+        self.base = np.arange(n, dtype=np.int64) * (tl + 1)
+        # a moving row's raw pieces and move constants, for the kernel's own refills
+        self.nseg = zi(n, np.int64)  # 0: none (the table is refilled here)
+        self.seg = z(n * MAXSEG * 4)
+        self.tprm = z(n * NTPRM)
         self.t_idx = self.base.copy()  # table index of each row's last sample
         self.t_len = zi(n, np.int64)  # valid samples in the table
         self.t_cur = zi(n, np.int64)  # next sample to take
@@ -391,6 +404,9 @@ class AxisBank:
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
         self.n_moving = int(np.count_nonzero(self.moving & alive))
         self._refill_in = 0  # look for tables to fill at the next cycle
+        self._c_fill = self.kernel is not None and not np.count_nonzero(
+            self.moving & alive & (self.nseg <= 0)
+        )
         self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
         rx = [g.rx_bytes for g in self.groups if g.claimed]
         self._rx_idx = np.concatenate(rx) if rx else np.zeros(0, np.intp)
@@ -684,7 +700,20 @@ class AxisBank:
         self.t_cur[r] = 0
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
         # table) or in slot 0, the hold slot of a row at rest
-        slot = TABLE if moving else 0
+        slot = self.table if moving else 0
+        self.nseg[r] = 0
+        if moving and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
+            m = len(pl._segs)
+            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = np.array(pl._segs, np.float64).ravel()
+            self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
+                pl._t_done,
+                pl._ts,
+                pl._t_final,
+                float(pl._target),
+                pl._dir,
+                pl._T,
+            )
+            self.nseg[r] = m
         self.t_p[r, slot], self.t_v[r, slot], self.t_a[r, slot] = pl._pos, pl._vel, pl._acc
         self.t_idx[r] = self.base[r] + slot
         if moving:
@@ -718,16 +747,28 @@ class AxisBank:
 
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
+        tl = self.table
         _Bypass.on = True
         try:
-            p, v, a, end = trap_table(pl, TABLE, int(self.k0[r] + self.taken[r]))
+            k0 = int(self.k0[r] + self.taken[r])
+            if self._kernel_lib is not None:  # the same samples, compiled
+                segs = np.array(pl._segs, np.float64).reshape(-1, 4)
+                prm = np.array([pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir])
+                out = self._fill_out
+                if out is None:
+                    out = self._fill_out = np.zeros((3, tl + 1))
+                end = trap_fill(self._kernel_lib, segs, pl._T, prm, k0, tl, out)
+                m = end + 1 if end < tl else tl
+                p, v, a = out[0, :m], out[1, :m], out[2, :m]
+            else:
+                p, v, a, end = trap_table(pl, tl, k0)
         finally:
             _Bypass.on = False
         m = len(p)
         self.t_p[r, :m], self.t_v[r, :m], self.t_a[r, :m] = p, v, a
         self.t_len[r] = m
         self.t_cur[r] = 0
-        self.t_end[r] = end if end < TABLE else -1
+        self.t_end[r] = end if end < tl else -1
 
     # --- release ---------------------------------------------------------------------------------
     def release_all(self) -> None:
@@ -885,18 +926,22 @@ class AxisBank:
             dt = dt_ns * 1e-9
             if (self.n_hm or self.n_frz) and dt != self.csp._dt:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
-            if dt == self.csp._dt and not (self.n_moving and self._refill_in <= 1):
+            c_fill = self._c_fill  # the kernel refills the tables itself
+            if dt == self.csp._dt and (c_fill or not (self.n_moving and self._refill_in <= 1)):
                 self._refill_in -= 1
                 rc = k.cycle(t_ns, dt)
                 while rc == 3:  # homing rows meeting an event: back to their drives first
                     self._release_rows(np.nonzero(k.scratch["s_hit"] & self.hm)[0])
                     if not self.n_alive:
                         return
+                    c_fill = self._c_fill
                     rc = k.cycle(t_ns, dt)
                 if rc == 0:
                     self._after_kernel(k)
                     return
-                self._refill_in += 1
+                # declined: the numpy cycle looks at every table (the kernel may have
+                # refilled some, or left one for it: code 4)
+                self._refill_in = 1 if c_fill else self._refill_in + 1
             k.bound = False  # the numpy cycle replaces some arrays
         if self.n_hm or self.n_frz:  # the numpy cycle runs CSP rows only: the others go back
             self._release_rows(np.nonzero((self.hm | self.frz) & self.alive)[0])
@@ -918,7 +963,7 @@ class AxisBank:
                 for r in np.nonzero(need)[0].tolist():
                     self._refill(r)
             left = (self.t_len - cur)[moving]
-            self._refill_in = int(left.min()) if len(left) else TABLE
+            self._refill_in = int(left.min()) if len(left) else self.table
         idx = self.base + cur
         prf_p = self.t_p.take(idx)
         ended = cur == self.t_end
@@ -1042,21 +1087,52 @@ class AxisBank:
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
 
-    def _after_kernel(self, k: Kernel) -> None:
-        """What the numpy cycle does besides its arithmetic, after a compiled cycle."""
+    def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
+        """What the numpy cycle does besides its arithmetic, after compiled cycles."""
         csp = self.csp
-        csp.cycles += 1
+        csp.cycles += cycles
         csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's
         if csp.any_fe:
             csp.fe_running = True  # the numpy cycle then looks at every row's timer
         if k.move_ended:
             self.n_moving = int(np.count_nonzero(self.moving))
             self._count_standing()
-        self.rows_run += self.n_alive
-        self.bank_cycles += 1
-        self.kernel_cycles += 1
-        self.homing_rows_run += self.n_hm
-        self.frozen_rows_run += self.n_frz
+        self.rows_run += self.n_alive * cycles
+        self.bank_cycles += cycles
+        self.kernel_cycles += cycles
+        self.homing_rows_run += self.n_hm * cycles
+        self.frozen_rows_run += self.n_frz * cycles
+
+    def run_many(self, t_ns: int, dt_ns: int, most: int) -> int:
+        """Up to ``most`` whole cycles from ``t_ns`` in one call of the compiled kernel,
+        when the bank runs every axis it has and nothing is pending (no GT call, claim or
+        release since the last cycle); the cycles run, 0 for none (the caller then runs
+        one cycle the ordinary way).  The kernel stops after a cycle that ended a Trap move
+        and before one it declines, so every cycle it runs is one :meth:`cycle` would have
+        run in the kernel too."""
+        k = self.kernel
+        if (
+            k is None
+            or most < 2
+            or self.dirty
+            or self._stale
+            or not self.n_alive
+            or self.n_alive != self.n
+            or dt_ns * 1e-9 != self.csp._dt
+        ):
+            return 0
+        if self.n_moving and not self._c_fill:
+            most = min(most, self._refill_in - 1)  # the numpy cycle refills the tables
+            if most < 2:
+                return 0
+        self._lists.clear()
+        _, done = k.run(t_ns, dt_ns * 1e-9, dt_ns, most)
+        if done:
+            self._countdown -= done
+            self._refill_in -= done
+            self._after_kernel(k, done)
+            self.many_cycles += done
+        return done
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

@@ -166,6 +166,25 @@ class IoSlave(VirtualSlave):
         if self.al_state >= AlState.SAFEOP:
             self.tx[:] = self.field_inputs
 
+    def settled(self) -> bool:
+        """Another :meth:`step` with the same RxPDO would change nothing: in OP, the field
+        outputs are the RxPDO, every wire already holds, the TxPDO is the field inputs and
+        no emergency waits (a subclass with its own step is never settled)."""
+        if type(self).step is not IoSlave.step or self.al_state != AlState.OP:
+            return False
+        if self.emergencies or self.field_outputs != self.rx:
+            return False
+        if self._wires:
+            plan = self._wire_plan
+            if plan is None:
+                plan = self._wire_plan = self._plan_wires()
+            fo, fi = self.field_outputs, self.field_inputs
+            for ob, ib, shift, mask in plan:
+                v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
+                if (fi[ib] & ~mask) | (v & mask) != fi[ib]:
+                    return False
+        return self.tx == self.field_inputs
+
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires
         that move bits between the same two bytes by the same shift are one masked copy.

@@ -266,6 +266,26 @@ class Master:
             hook(self)
         return self.last
 
+    def steady(self) -> bool:
+        """Cycles would change nothing here but the count: every slave in OP and run by
+        someone else (the axis bank), the working counter whole and as last time, no
+        hook, no countdown, no pending state change (:meth:`Controller._run_many`)."""
+        steady_wkc = getattr(self.backend, "steady_wkc", None)
+        last = self.last
+        return (
+            self.opened
+            and steady_wkc is not None
+            and not self.on_cycle
+            and self._op_countdown < 0
+            and self.target == AlState.OP
+            and not self._wkc_bad
+            and not self.offline
+            and last.ok
+            and last.wkc == steady_wkc()
+            and last.expected == self.backend.expected_wkc()
+            and self.all_op()
+        )
+
     def recover(self) -> None:
         """Bring back slaves that answer again but fell below OP (acknowledge, re-walk).
 

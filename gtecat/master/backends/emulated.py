@@ -205,6 +205,43 @@ class EmulatedBackend(Backend):
             self.capture.cycle(t_ns, bytes(image.view), image.outputs_bytes, wkc)
         return wkc
 
+    def steady_wkc(self) -> int | None:
+        """The working counter of a cycle that would change nothing here: every slave
+        claimed by the axis bank or settled (an IO slave whose next step, with the outputs
+        the image holds, gives the inputs the image holds), nothing watching the frames;
+        None when a cycle has work here."""
+        if self.answer_hook is not None or self.capture is not None or self.unplugged:
+            return None
+        wkc = self._claimed_wkc
+        image = self.image
+        if not self._run_plan:
+            return wkc
+        if image is None:
+            return None
+        view = image.view
+        for slave, out, inp in self._run_plan:
+            settled = getattr(slave, "settled", None)
+            if settled is None or not settled():
+                return None
+            if out is not None:
+                if not out.aligned:
+                    return None
+                start = out.logical_bit >> 3
+                n = min(len(slave.rx), out.raw_bytes)
+                if view[start : start + n] != slave.rx[:n]:
+                    return None
+                wkc += 2
+            if inp is not None:
+                tx = slave.tx
+                if not inp.aligned or inp.bit_len & 7:
+                    return None
+                start = image.outputs_bytes + (inp.logical_bit >> 3)
+                n = min(len(tx), inp.bit_len >> 3)
+                if view[start : start + n] != tx[:n]:
+                    return None
+                wkc += 1
+        return wkc
+
     def emergencies(self) -> list[tuple[int, object]]:
         out = []
         claimed = self._claimed  # a claimed slave is not stepped: it raises none
