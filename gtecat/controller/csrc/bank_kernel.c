@@ -610,8 +610,19 @@ static int cycle_once(void **ptr, int64_t *io, const double *fp)
         }
         u = (uint32_t)(uint64_t)val;
         {
-            int64_t k, off = I64(pl_off)[i];
-            for (k = 0; k < I64(pl_size)[i]; k++)
+            int64_t k, off = I64(pl_off)[i], size = I64(pl_size)[i];
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            if (size == 4) { /* the PDO's little-endian bytes are the value's own */
+                memcpy(buf + off, &u, 4);
+                continue;
+            }
+            if (size == 2) {
+                uint16_t u16 = (uint16_t)u;
+                memcpy(buf + off, &u16, 2);
+                continue;
+            }
+#endif
+            for (k = 0; k < size; k++)
                 buf[off + k] = (uint8_t)(u >> (8 * k));
         }
     }
