@@ -301,7 +301,7 @@ def test_cycles_run_many_at_once_are_the_cycles_one_by_one(tmp_path: Path) -> No
     ref, ref_codes, _ = _run(actions, machine, "off", chunked=True)
     KERNEL_CYCLES.clear()
     MANY_CYCLES.clear()
-    got, codes, rows = _run(actions, machine, "on", chunked=True)
+    got, codes, _ = _run(actions, machine, "on", chunked=True)
     assert codes == ref_codes
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"sample {k}: the bank and the scalar path differ"
