@@ -73,9 +73,11 @@ from gtecat.drives.modes import (
 )
 from gtecat.drives.od import (
     Access,
+    AttrVariable,
     DataType,
     ObjectCode,
     ObjectDictionary,
+    OdObject,
     PdoDir,
     Variable,
     add_identity,
@@ -295,16 +297,9 @@ class Channel:
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
     ) -> Variable:
-        return od.add_var(
-            index + self.base,
-            name,
-            dt,
-            access,
-            pdo=pdo,
-            getter=partial(getattr, self, attr),
-            setter=partial(setattr, self, attr),
-            **kw,
-        )
+        at = index + self.base
+        obj = od.add_object(OdObject(at, name, ObjectCode.VAR))
+        return obj.add(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
 
     def _sub(
         self,
@@ -317,17 +312,7 @@ class Channel:
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
     ) -> Variable:
-        return Variable(
-            index + self.base,
-            sub,
-            name,
-            dt,
-            access,
-            pdo=pdo,
-            getter=partial(getattr, self, attr),
-            setter=partial(setattr, self, attr),
-            **kw,
-        )
+        return AttrVariable(self, attr, index + self.base, sub, name, dt, access, pdo=pdo, **kw)
 
     def _add_objects(self, od: ObjectDictionary) -> None:
         s = self._settings

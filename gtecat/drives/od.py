@@ -20,6 +20,7 @@ import struct
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
+from functools import partial
 from typing import Any
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
@@ -191,7 +192,7 @@ class Variable:
         self.index = index
         self.subindex = subindex
         self.name = name
-        self.data_type = DataType(data_type)
+        self.data_type = data_type if type(data_type) is DataType else DataType(data_type)
         self.info = TYPE_INFO[self.data_type]
         self.access = access
         self.pdo = pdo
@@ -328,16 +329,104 @@ class Variable:
         return bits
 
 
+def _only_none(self: Variable, value: object) -> None:
+    if value is not None:
+        raise TypeError(f"{type(self).__name__} {self!r}: its value has a fixed home")
+
+
+class AttrVariable(Variable):
+    """An entry whose value is the attribute ``attr`` of ``owner`` (a drive's own state).
+
+    The same as ``Variable(..., getter=partial(getattr, owner, attr), setter=partial(setattr,
+    owner, attr))``, but the two callables are made only when asked for: a drive holds a
+    hundred such entries, and hundreds of drives a bus."""
+
+    __slots__ = ("_attr", "_owner")
+
+    def __init__(
+        self,
+        owner: object,
+        attr: str,
+        index: int,
+        subindex: int,
+        name: str,
+        data_type: DataType,
+        access: Access = Access.RW,
+        **kw: Any,
+    ) -> None:
+        self._owner, self._attr = owner, attr
+        super().__init__(index, subindex, name, data_type, access, **kw)
+
+    getter = property(lambda self: partial(getattr, self._owner, self._attr), _only_none)
+    setter = property(lambda self: partial(setattr, self._owner, self._attr), _only_none)
+
+    def get(self) -> Any:
+        return getattr(self._owner, self._attr)
+
+    def set(self, value: Any) -> None:
+        setattr(self._owner, self._attr, value)
+
+
+class SlotVariable(Variable):
+    """An entry whose value is ``values[k]`` of a list its owner keeps (a PDO mapping's or
+    assignment's entry); a write goes through ``put(k, value)``, one callable shared by the
+    object's entries (no closures per entry)."""
+
+    __slots__ = ("_k", "_put", "_values")
+
+    def __init__(
+        self,
+        values: list[Any],
+        k: int,
+        put: Callable[[int, Any], None],
+        index: int,
+        name: str,
+        data_type: DataType,
+        access: Access = Access.RW,
+        **kw: Any,
+    ) -> None:
+        self._values, self._k, self._put = values, k, put
+        super().__init__(index, k + 1, name, data_type, access, **kw)
+
+    getter = property(lambda self: partial(self._values.__getitem__, self._k), _only_none)
+    setter = property(lambda self: partial(self._put, self._k), _only_none)
+
+    def get(self) -> Any:
+        return self._values[self._k]
+
+    def set(self, value: Any) -> None:
+        self._put(self._k, value)
+
+
 class OdObject:
     """One index: a VAR (only subindex 0) or an ARRAY/RECORD (subindex 0 = count)."""
 
-    __slots__ = ("code", "index", "name", "subs")
+    __slots__ = ("_make", "_subs", "code", "index", "name")
 
-    def __init__(self, index: int, name: str, code: ObjectCode = ObjectCode.VAR) -> None:
+    def __init__(
+        self,
+        index: int,
+        name: str,
+        code: ObjectCode = ObjectCode.VAR,
+        make: Callable[[], Iterable[Variable]] | None = None,
+    ) -> None:
         self.index = index
         self.name = name
         self.code = code
-        self.subs: dict[int, Variable] = {}
+        #: ``make``: the entries are made when first looked at (a drive's spare PDO mappings
+        #: are 50 entries nobody reads on most buses)
+        self._subs: dict[int, Variable] | None = None if make is not None else {}
+        self._make = make
+
+    @property
+    def subs(self) -> dict[int, Variable]:
+        """Subindex -> entry."""
+        subs = self._subs
+        if subs is None:
+            make, self._make = self._make, None
+            assert make is not None
+            subs = self._subs = {v.subindex: v for v in make()}
+        return subs
 
     def __repr__(self) -> str:
         return (
@@ -421,6 +510,18 @@ class ObjectDictionary:
         for e in entries:
             obj.add(e)
         return obj
+
+    def add_lazy_record(
+        self,
+        index: int,
+        name: str,
+        make: Callable[[], Iterable[Variable]],
+        *,
+        code: ObjectCode = ObjectCode.RECORD,
+    ) -> OdObject:
+        """A record/array whose entries (subindex 0 included) ``make`` returns when the
+        object is first looked at."""
+        return self.add_object(OdObject(index, name, code, make))
 
     def placeholder(self, index: int, subindex: int, bits: int, direction: PdoDir) -> Variable:
         """An entry a PDO mapping names but this device does not implement.
