@@ -19,7 +19,6 @@ from xml.parsers import expat
 from .errors import EniError
 from .numbers import shown
 
-
 #: what an element without attributes or children holds (shared: a tree is read, never
 #: changed, and an ENI has a few hundred thousand such elements)
 _NO_ATTRS: dict[str, str] = {}
@@ -40,6 +39,11 @@ class Node:
 
     def find(self, tag: str) -> Node | None:
         """First child named ``tag`` (``a/b`` walks down), or None."""
+        if "/" not in tag:
+            for c in self.children:
+                if c.tag == tag:
+                    return c
+            return None
         node: Node | None = self
         for part in tag.split("/"):
             assert node is not None
