@@ -198,7 +198,7 @@ class Variable:
         self.pdo = pdo
         self.low = low
         self.high = high
-        self.allowed = None if allowed is None else frozenset(allowed)
+        self.allowed = None if allowed is None else _shared(frozenset(allowed))
         self.write_states = write_states
         self.getter = getter
         self.setter = setter
@@ -327,6 +327,17 @@ class Variable:
         if self.pdo & PdoDir.TX:
             bits |= ObjectAccess.TXPDO_MAPPABLE
         return bits
+
+
+def _shared(values: frozenset[int]) -> frozenset[int]:
+    """One frozenset per content for every dictionary (the same allowed values of the same
+    objects, drive after drive)."""
+    if len(_SHARED) >= 1024:
+        _SHARED.clear()
+    return _SHARED.setdefault(values, values)
+
+
+_SHARED: dict[frozenset[int], frozenset[int]] = {}
 
 
 def _only_none(self: Variable, value: object) -> None:
