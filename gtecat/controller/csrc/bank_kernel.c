@@ -16,6 +16,12 @@
 #include <stdint.h>
 #include <string.h>
 
+#if defined(__GNUC__)
+#define INLINE static inline __attribute__((always_inline))
+#else
+#define INLINE static inline
+#endif
+
 #define FIELDS                                                                          \
     X(alive, u8) X(moving, u8) X(jog, u8) X(ended, u8) X(base, i64) X(t_cur, i64)          \
     X(t_end, i64) X(t_idx, i64) X(taken, i64) X(t_p, f64)                                  \
@@ -167,7 +173,7 @@ static int64_t clip16(double x)
  * which _scan would find something (a switch edge, a limit, an index pulse).  Returns 1 when
  * this cycle would leave that state (an event crossed, a search bound reached): nothing is
  * written and the row goes back to the scalar drive for this cycle. */
-static int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
+INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
 {
     double pos = F64(c_pos)[r], p0 = F64(h_last)[r];
     double el = F64(h_el)[r], tr = F64(h_tr)[r], v = F64(h_v)[r], vt = F64(h_vt)[r];
@@ -290,7 +296,7 @@ int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *pr
 /* AxisBank._refill of row r in the kernel: the last sample taken moves to the row's spare
  * slot (TABLE), so a declined cycle still finds it; 0, or 1 when the row's pieces are not
  * here (the caller refills it) */
-static int refill_row(void **ptr, int64_t *io, int64_t r)
+INLINE int refill_row(void **ptr, int64_t *io, int64_t r)
 {
     const int64_t table = io[IN_TABLE], base = I64(base)[r], last = I64(t_idx)[r];
     int64_t m = I64(nseg)[r], end, got;
@@ -311,7 +317,9 @@ static int refill_row(void **ptr, int64_t *io, int64_t r)
     return 0;
 }
 
-static int cycle_once(void **ptr, int64_t *io, const double *fp)
+/* inlined where the field table is a local copy: the compiler then knows no store through a
+ * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
+INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
