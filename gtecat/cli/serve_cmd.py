@@ -5,10 +5,15 @@ same machine description), puts them behind software ESCs and answers EtherCAT f
 IFACE until Ctrl-C or SIGTERM.  Any master (SOEM/pysoem, TwinCAT, IgH, acontis) on the
 other end of the wire sees a chain of real-looking slaves.  Needs root or CAP_NET_RAW.
 
+While it runs, the ps verb lists it (its id is in the ready line); the fault verbs
+(inject, list, clear, with --attach ID) then break its chain at runtime, and the states
+verb shows its slaves' AL states.
+
 examples:
   gtecat serve --eni manual_fig5_2.eni --iface veth1
   gtecat serve --eni Gecat.eni --machine machine.toml --iface enp3s0 --duration 60
   gtecat serve --eni Gecat.eni --iface veth1 --fault link_loss.toml
+  gtecat fault inject link_down after_slave=1 --attach 5120   (another terminal)
 """
 
 from __future__ import annotations
