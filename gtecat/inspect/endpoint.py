@@ -98,6 +98,10 @@ class Endpoint:
 
     #: the longest request line a client may send (bytes); a longer one ends the connection
     max_line = 1 << 20
+    #: connections open at once at most (0: no limit); one more is told so and closed
+    max_conns = 0
+    #: a connection's requests start this many seconds apart at least (0: as they come)
+    min_gap_s = 0.0
 
     def __init__(self, ctl: Any, kind: str = "python", lock: Any = None) -> None:
         self.ctl = ctl
@@ -280,6 +284,12 @@ class Endpoint:
                 conn, _ = sock.accept()
             except OSError:
                 return
+            if self.max_conns and len(self._conns) >= self.max_conns:
+                with contextlib.suppress(OSError), conn:
+                    error = f"{self.max_conns} connections are open already: try again later"
+                    conn.sendall(json.dumps({"id": None, "ok": False, "error": error}).encode())
+                    conn.sendall(b"\n")
+                continue
             self._conns.add(conn)
             t = threading.Thread(
                 target=self._serve, args=(conn,), name="gtecat-inspect-conn", daemon=True
@@ -311,13 +321,19 @@ class Endpoint:
     def _serve(self, conn: socket.socket) -> None:
         ctx = self._context()
         self._watch(+1)
-        limit = self.max_line
+        limit, gap = self.max_line, self.min_gap_s
+        last = 0.0
         try:
             with conn, conn.makefile("rb") as rf, conn.makefile("wb") as wf:
                 while True:
                     line = rf.readline(limit + 1)
                     if not line or self._stop.is_set():
                         return
+                    if gap:  # a client asking without pause is slowed down, not served faster
+                        wait = last + gap - time.monotonic()
+                        if wait > 0:
+                            time.sleep(wait)
+                        last = time.monotonic()
                     t0 = time.thread_time_ns()
                     if len(line) > limit:  # no JSON parsed, the connection ends
                         error = f"a request line is {limit // 1024} KiB at most"

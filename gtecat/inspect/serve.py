@@ -19,8 +19,10 @@ controller's:
   the wire: those operations are refused with a sentence that says so.
 * **A client cannot slow the frames.**  Each connection has one request at a time (it
   waits for its answer), and the loop runs at most :data:`PER_PASS` requests per pass;
-  the requests there are are short (no dictionary walks); a request line is
-  :attr:`ServeEndpoint.max_line` bytes at most; and the interpreter is asked to switch
+  the requests there are are short (no dictionary walks); a request line is 64 KiB at
+  most, a connection's requests start 1 ms apart at least (a client that floods the
+  endpoint, even with lines answered at once as errors, costs the process a few per cent
+  of a CPU), at most 8 connections are open; and the interpreter is asked to switch
   threads every :data:`SWITCH_S` (5 ms by default), so a connection's thread reading a
   request holds the serve's thread back that long at most.
 """
@@ -120,6 +122,10 @@ class ServeEndpoint(Endpoint):
     """A ``gtecat serve``'s endpoint (module docstring)."""
 
     max_line = 64 * 1024
+    max_conns = 8
+    #: 1000 requests a second per connection at most: a client that floods the endpoint
+    #: costs the serve's CPU a few per cent, not a share that delays frames
+    min_gap_s = 0.001
 
     def __init__(self, host: ServeHost) -> None:
         self.host = host
