@@ -10,6 +10,7 @@ Every wait is bounded.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import socket
 import threading
@@ -21,6 +22,7 @@ import pytest
 
 from gtecat.cli.main import main
 from gtecat.inspect.client import Attached
+from tests.conftest import LONG
 from tests.gtecat.wire.test_serve_veth import FIG52, Server, cycle, soem, to_op, veth_pair
 
 pytestmark = [pytest.mark.wire, pytest.mark.xdist_group("serve_attach")]
@@ -65,14 +67,30 @@ class Rig:
             return c.call("log")["lines"]
 
 
-@pytest.fixture(scope="module")
-def rig(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Rig]:
-    tmp = tmp_path_factory.mktemp("serve_attach")
+@contextlib.contextmanager
+def serve_rig(tmp: Path) -> Iterator[tuple[str, str, Path]]:
+    """A veth pair (master end, slave end) and a private runtime folder whose endpoints are
+    published (the test run's default is GTECAT_INSPECT=0); SOEM gives a frame 20 ms, not
+    2 ms, before it sends it again: a Python serve on a loaded test machine answers late now
+    and then, and a mailbox exchange repeated that way reads a stale answer (see
+    tests/gtecat/master/backends/test_pysoem_veth.py)."""
     xdg = tmp / "xdg"
     xdg.mkdir(mode=0o700)
     with pytest.MonkeyPatch.context() as mp, veth_pair() as (master_if, slave_if):
+        import pysoem
+
         mp.setenv("XDG_RUNTIME_DIR", str(xdg))
-        mp.setenv("GTECAT_INSPECT", "1")  # the test run's default is 0
+        mp.setenv("GTECAT_INSPECT", "1")
+        settings = getattr(pysoem, "settings", None)  # an older pysoem has none
+        if settings is not None:
+            mp.setattr(settings.timeouts, "ret", 20_000)
+        yield master_if, slave_if, xdg / "gtecat"
+
+
+@pytest.fixture(scope="module")
+def rig(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Rig]:
+    tmp = tmp_path_factory.mktemp("serve_attach")
+    with serve_rig(tmp) as (master_if, slave_if, run):
         # sleeping between frames: the lightest on the CPU (the answers need not be fast here)
         server = Server(
             FIG52, slave_if, tmp / "stats.json", "--rt-priority", "off", "--wait", "sleep"
@@ -84,7 +102,7 @@ def rig(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Rig]:
                 assert master.expected_wkc == EXPECTED_WKC
                 to_op(master)
                 assert cycle(master, 5) == EXPECTED_WKC
-                yield Rig(server, master, xdg / "gtecat")
+                yield Rig(server, master, run)
         finally:
             rig_stop(server)
 
@@ -222,3 +240,59 @@ def test_the_serve_said_every_fault_on_stderr_and_stops_cleanly(rig: Rig) -> Non
     ):
         assert line in out, out
     assert not list(rig.run.glob("*.sock")) and not list(rig.run.glob("*.json"))
+
+
+@pytest.mark.skipif(not LONG, reason="an application on the pysoem backend for several seconds")
+def test_an_application_sees_faults_injected_at_runtime(tmp_path: Path, capsys) -> None:
+    """What the application sees through the GT API (gtecat's own master on pysoem, the
+    realtime clock) while faults are added and cleared on the serve by the command line: a
+    link down makes GT_IsEcatReady 0 and refuses slave 2's IO until cleared, a mailbox abort
+    reaches GT_EcatSDOUpload's abort code, lost answers make a dip the bus recovers from."""
+    from ctypes import byref, c_short, c_ubyte, c_uint32
+
+    from gtecat import gt
+    from tests.gtecat import scenario_common
+
+    def ready() -> int:
+        st = c_short()
+        gt.GT_IsEcatReady(byref(st))
+        return st.value
+
+    def until(pred, ms: int) -> bool:
+        return scenario_common.wait_until(gt, pred, ms=ms, step_ms=5)
+
+    with serve_rig(tmp_path) as (master_if, slave_if, _run):
+        server = Server(FIG52, slave_if, tmp_path / "stats.json", "--rt-priority", "off")
+        sid = str(server.proc.pid)
+
+        def fault(*words: str) -> str:
+            assert main(["fault", *words, "--attach", sid]) == 0
+            return capsys.readouterr().out
+
+        try:
+            assert (
+                gt.GT_Open(eni=str(FIG52), backend="pysoem", iface=master_if, clock="realtime") == 0
+            )
+            assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+            assert until(lambda: ready() == 1, 5000)
+            fault("inject", "link_down", "after_slave=1")
+            buf = (c_ubyte * 2)()
+            assert until(lambda: ready() == 0, 3000)
+            assert until(lambda: gt.GT_EcatIOReadInput(2, 0, 2, buf) == 1, 2000)
+            assert fault("clear").strip() == "1 fault cleared"
+            assert until(lambda: ready() == 1, 8000)
+            assert gt.GT_EcatIOReadInput(2, 0, 2, buf) == 0
+            fault("inject", "mailbox_abort", "slave=0", "index=0x6060", "code=0x06090030")
+            data, size, abort = (c_ubyte * 4)(), c_uint32(), c_uint32()
+            rc = gt.GT_EcatSDOUpload(0, 0x6060, 0, data, 4, byref(size), byref(abort))
+            assert rc != 0 and abort.value == 0x06090030, gt.GTE_GetLastError()
+            assert gt.GT_EcatSDOUpload(0, 0x6060, 0, data, 4, byref(size), byref(abort)) == 0
+            fault("inject", "drop_responses", "count=30")
+            assert until(lambda: ready() == 0, 3000)
+            assert until(lambda: ready() == 1, 8000)
+            assert fault("list").strip() == "no fault armed or active"
+        finally:
+            gt.GT_Close()
+            rig_stop(server)
+        for line in ("Fault 1 started: link down after slave 1", "Fault 3 ended (spent)"):
+            assert line in server.output, server.output
