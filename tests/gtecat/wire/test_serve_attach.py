@@ -11,6 +11,7 @@ Every wait is bounded.
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import json
 import socket
 import threading
@@ -123,6 +124,9 @@ def test_ps_lists_the_serve_and_its_slaves_answer(rig: Rig, capsys) -> None:
     assert rc == 1 and "needs a controller" in err and "Traceback" not in err
     rc, _, err = rig.cli(capsys, "states", "INIT")
     assert rc == 1 and "does not change its slaves' states" in err
+    rc, _, err = rig.cli(capsys, "panel")
+    want = "is a gtecat serve" if importlib.util.find_spec("aiohttp") else "needs aiohttp"
+    assert rc == 1 and want in err, err
 
 
 def test_drop_responses_armed_at_runtime_loses_that_many_answers(rig: Rig, capsys) -> None:
