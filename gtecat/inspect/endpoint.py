@@ -33,7 +33,9 @@ overlap.  (A GT call the application makes in that instant, outside any cycle, i
 held back: in those modes the GT layer takes no lock.  Requests are short.)
 
 **When it publishes.**  :func:`publish` is called by ``GT_Open`` (and so by ``gtecat
-controller``, which opens through it).  ``GTECAT_INSPECT=0`` turns it off; the pytest
+controller``, which opens through it); ``gtecat serve`` publishes the same endpoint over its
+chain of slaves once it answers frames (:mod:`gtecat.inspect.serve`: its requests run
+between two frames).  ``GTECAT_INSPECT=0`` turns it off; the pytest
 plugin sets that default for the test run (thousands of short controllers; a test that
 wants an endpoint sets ``GTECAT_INSPECT=1``).  Starting costs a thread and a socket.
 """
@@ -274,7 +276,7 @@ class Endpoint:
             runtime.remove(self.path)
         while self._pending:  # nobody runs cycles any more: answer what waits
             req = self._pending.popleft()
-            req.error = ConnectionError(f"the {self.kind} closed")
+            req.error = ConnectionError("the running gtecat closed")
             req.done.set()
 
     def _accept(self) -> None:

@@ -11,15 +11,17 @@ controller's:
   request the loop has not taken within :data:`TAKE_S` (the server is stopping) ends with
   an error.
 * **What there is to ask.**  ``info``, ``slaves``, ``pdos``, ``states`` (read; the master on
-  the wire sets the states), ``snapshot`` (AL states and status codes, frame counters), ``log``
-  (the serve's log: every fault armed, started, ended) and the faults (``fault_inject``,
+  the wire sets the states), ``reg_read`` and ``sii`` (the ESC's memory as it holds it:
+  reading it acknowledges nothing the master waits for), ``snapshot`` (AL states and
+  status codes, frame counters), ``log`` (the serve's log: every fault armed, started,
+  ended) and the faults (``fault_inject``,
   ``fault_list``, ``fault_clear``: :mod:`gtecat.faults` on the serve's
   :class:`~gtecat.faults.WireBus`, the same injector as ``--fault FILE``).  The process
   image, axes, SDO transfers, motion and traces belong to the master on the other end of
   the wire: those operations are refused with a sentence that says so.
 * **A client cannot slow the frames.**  Each connection has one request at a time (it
   waits for its answer), and the loop runs at most :data:`PER_PASS` requests per pass;
-  the requests there are are short (no dictionary walks); a request line is 64 KiB at
+  the operations are short (no dictionary walks, no bus traffic); a request line is 64 KiB at
   most, a connection's requests start 1 ms apart at least (a client that floods the
   endpoint, even with lines answered at once as errors, costs the process a few per cent
   of a CPU), at most 8 connections are open; and the interpreter is asked to switch
@@ -266,6 +268,12 @@ def info(ctx: Any) -> dict[str, Any]:
 
 
 @_op
+def positions(ctx: Any, position: int | None = None) -> list[int]:
+    """``[position]`` (checked) or every slave's."""
+    return _check(ctx.host, position)
+
+
+@_op
 def slaves(ctx: Any, position: int | None = None) -> list[dict[str, Any]]:
     """The rows of ``gtecat slaves``: the slave's own AL state; axes and GT raw region as
     a controller with this ENI numbers them; ``link`` down behind a link_down fault."""
@@ -330,6 +338,30 @@ def states(ctx: Any, position: int | None = None, target: str | None = None) -> 
             }
         )
     return rows
+
+
+def _esc(host: ServeHost, position: int) -> Any:
+    pos = _check(host, position)[0]
+    return next(e for e in (*host.chain.escs, *host.chain.cut) if e.position == pos)
+
+
+@_op
+def reg_read(ctx: Any, position: int, address: int, size: int) -> str:
+    """ESC memory as the slave's ESC holds it (hex).  Not a read on the wire: no event
+    is acknowledged, no mailbox emptied, so the master on the wire misses nothing."""
+    from gtecat.drives.esc.registers import MEMORY_SIZE
+
+    esc = _esc(ctx.host, position)
+    address, size = int(address), int(size)
+    if size < 1 or address < 0 or address + size > MEMORY_SIZE:
+        raise ParameterError(f"0x{address:04X}+{size} is outside the ESC's 64 KiB")
+    return bytes(esc.mem[address : address + size]).hex()
+
+
+@_op
+def sii(ctx: Any, position: int) -> str:
+    """The slave's SII EEPROM (hex): what the serve built from the ENI."""
+    return bytes(_esc(ctx.host, position).sii).hex()
 
 
 @_op

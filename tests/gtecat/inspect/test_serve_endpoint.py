@@ -88,6 +88,7 @@ def test_ps_lists_the_serve_and_the_fault_verbs_break_its_chain(served: Served, 
     assert [r["link"] for r in rows] == ["up", "up", "down", "down"]
     assert [r["axes"] for r in rows] == [[1], [2], [], []]
     assert main(["fault", "clear", "--attach", served.id]) == 0
+    assert capsys.readouterr().out.strip() == "1 fault cleared"
     assert served.slaves_answering() == 4
     with Attached(served.endpoint.path) as c:
         lines = c.call("log")["lines"]
@@ -98,10 +99,19 @@ def test_ps_lists_the_serve_and_the_fault_verbs_break_its_chain(served: Served, 
         "Fault 1 ended (cleared): link down after slave 1 (slaves 2.. vanish).",
     ]
     assert snap["states"] == [1, 1, 1, 1] and snap["received"] == 3  # INIT: no master
+    # the ESCs' own registers: AL status 0x0130 = INIT, read without side effects
+    assert main(["reg", "read", "0x130", "--json", "--attach", served.id]) == 0
+    assert [r["value"] for r in json.loads(capsys.readouterr().out)] == [1, 1, 1, 1]
+    assert main(["sii", "read", "-p", "2", "--json", "--attach", served.id]) == 0
+    assert '"name": "IO 2"' in capsys.readouterr().out
 
 
 def test_what_needs_a_controller_is_refused_in_one_line(served: Served, capsys) -> None:
-    for argv in (["data"], ["sdo", "upload", "0", "0x6041", "0"], ["reg", "read", "0x130"]):
+    for argv in (
+        ["data"],
+        ["sdo", "upload", "0", "0x6041", "0"],
+        ["reg", "write", "-p", "0", "0x120", "2"],  # the master's to write
+    ):
         assert main([*argv, "--attach", served.id]) == 1
         err = capsys.readouterr().err
         assert "needs a controller" in err and "Traceback" not in err, err
