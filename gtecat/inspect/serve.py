@@ -22,7 +22,7 @@ controller's:
 * **A client cannot slow the frames.**  Each connection has one request at a time (it
   waits for its answer), and the loop runs at most :data:`PER_PASS` requests per pass;
   the operations are short (no dictionary walks, no bus traffic); a request line is 64 KiB at
-  most, a connection's requests start 1 ms apart at least (a client that floods the
+  most, a connection's requests start 5 ms apart at least (a client that floods the
   endpoint, even with lines answered at once as errors, costs the process a few per cent
   of a CPU), at most 8 connections are open; and the interpreter is asked to switch
   threads every :data:`SWITCH_S` (5 ms by default), so a connection's thread reading a
@@ -125,9 +125,9 @@ class ServeEndpoint(Endpoint):
 
     max_line = 64 * 1024
     max_conns = 8
-    #: 1000 requests a second per connection at most: a client that floods the endpoint
+    #: 200 requests a second per connection at most: a client that floods the endpoint
     #: costs the serve's CPU a few per cent, not a share that delays frames
-    min_gap_s = 0.001
+    min_gap_s = 0.005
 
     def __init__(self, host: ServeHost) -> None:
         self.host = host
