@@ -12,7 +12,8 @@ controller's:
   an error.
 * **What there is to ask.**  ``info``, ``slaves``, ``pdos``, ``states`` (read; the master on
   the wire sets the states), ``reg_read`` and ``sii`` (the ESC's memory as it holds it:
-  reading it acknowledges nothing the master waits for), ``snapshot`` (AL states and
+  reading it acknowledges nothing the master waits for), ``sdo_upload`` (from the slave's
+  own dictionary, not through its mailbox), ``snapshot`` (AL states and
   status codes, frame counters), ``log`` (the serve's log: every fault armed, started,
   ended) and the faults (``fault_inject``,
   ``fault_list``, ``fault_clear``: :mod:`gtecat.faults` on the serve's
@@ -220,8 +221,8 @@ def _needs_controller(op: str) -> Callable[..., Any]:
     def refuse(_ctx: Any, *_args: Any) -> Any:
         raise BusError(
             f"{op!r} needs a controller: a gtecat serve only plays the slaves, the process "
-            "image, axes, SDO transfers and traces are its master's (on the other end of "
-            f"the wire); a serve answers {', '.join(sorted(OPS))}"
+            "image, axes, SDO downloads, register writes and traces are its master's (on "
+            f"the other end of the wire); a serve answers {', '.join(sorted(OPS))}"
         )
 
     return refuse
@@ -362,6 +363,54 @@ def reg_read(ctx: Any, position: int, address: int, size: int) -> str:
 def sii(ctx: Any, position: int) -> str:
     """The slave's SII EEPROM (hex): what the serve built from the ENI."""
     return bytes(_esc(ctx.host, position).sii).hex()
+
+
+class _Dictionaries:
+    """The slaves' object dictionaries, as :class:`gtecat.controller.inspect.BusView`'s
+    dictionary look-ups (``sdo_find``) expect them."""
+
+    def __init__(self, host: ServeHost) -> None:
+        self.host = host
+
+    def check(self, position: int) -> int:
+        return _check(self.host, position)[0]
+
+    def od(self, position: int) -> Any:
+        slave = self.host.chain.slaves[self.check(position)]
+        od = getattr(slave, "od", None)
+        if od is None:
+            raise BusError(f"slave {slave.position} ({slave.name}) has no CoE object dictionary")
+        return od
+
+
+@_op
+def sdo_upload(ctx: Any, slave: int, index: int, subindex: int) -> dict[str, Any]:
+    """An object's value from the slave's own dictionary (hex), with its name and type.
+    Not an SDO on the wire: the master's mailbox exchange is not touched (and a mailbox
+    fault does not apply to it)."""
+    od = _Dictionaries(ctx.host).od(slave)
+    raw = od.upload(int(index), int(subindex))
+    return {"bytes": bytes(raw).hex(), **sdo_entry(ctx, slave, index, subindex)}
+
+
+@_op
+def sdo_entry(ctx: Any, slave: int, index: int, subindex: int) -> dict[str, str]:
+    """The dictionary's name and type of an object ({} when the slave has none)."""
+    try:
+        od = _Dictionaries(ctx.host).od(slave)
+    except BusError:
+        return {}
+    var = od.find(int(index), int(subindex))
+    return {"name": var.name, "type": var.data_type.name} if var is not None else {}
+
+
+@_op
+def sdo_find(ctx: Any, slave: int, name: str, subindex: int | None = None) -> dict[str, Any]:
+    """The object called ``name`` in the slave's dictionary: {index, subindex, name, type}."""
+    from ..controller.inspect import BusView
+
+    sub = None if subindex is None else int(subindex)
+    return BusView.sdo_find(_Dictionaries(ctx.host), int(slave), str(name), sub)  # type: ignore[arg-type]
 
 
 @_op

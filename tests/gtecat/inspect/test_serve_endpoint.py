@@ -14,6 +14,7 @@ import json
 import socket
 import sys
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -29,6 +30,17 @@ class Served:
     def __init__(self, server, endpoint, ours: socket.socket) -> None:
         self.server, self.endpoint, self.ours = server, endpoint, ours
         self.id = endpoint.id
+
+    def error_code(self, slave: int, capsys: pytest.CaptureFixture[str]) -> int:
+        """The drive's 603Fh once it is not 0 (it is set at the drive's next step), else 0."""
+        deadline = time.monotonic() + 2
+        while True:
+            argv = ["sdo", "upload", str(slave), "0x603F", "0", "--json", "--attach", self.id]
+            assert main(argv) == 0
+            value = json.loads(capsys.readouterr().out)["value"]
+            if value or time.monotonic() > deadline:
+                return value
+            time.sleep(0.02)
 
     def slaves_answering(self) -> int:
         """The working counter of a broadcast read: how many slaves the frame passed."""
@@ -49,7 +61,11 @@ def served(runtime_dir: Path) -> Iterator[Served]:
 
     chain, config = build_chain(FIG5_2)
     ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_DGRAM)
-    server = WireServer(chain, "socketpair", sock=theirs, poll_s=0.005, wait="sleep")
+    # the slaves step on their own every 10 ms (no master sends process data here)
+    server = WireServer(
+        chain, "socketpair", sock=theirs, poll_s=0.005, wait="sleep", step_mode="cycle",
+        cycle_ns=10_000_000,
+    )  # fmt: skip
     host = ServeHost(server, config, eni=FIG5_2, iface="socketpair")
     published = []
     ready = threading.Event()
@@ -104,12 +120,28 @@ def test_ps_lists_the_serve_and_the_fault_verbs_break_its_chain(served: Served, 
     assert [r["value"] for r in json.loads(capsys.readouterr().out)] == [1, 1, 1, 1]
     assert main(["sii", "read", "-p", "2", "--json", "--attach", served.id]) == 0
     assert '"name": "IO 2"' in capsys.readouterr().out
+    # an object read from the drive's own dictionary (by name, as the verb allows)
+    assert main(["sdo", "upload", "0", "Error code", "--json", "--attach", served.id]) == 0
+    got = json.loads(capsys.readouterr().out)
+    assert (got["index"], got["value"]) == (0x603F, 0), got
+    # a drive fault injected at runtime: the drive's 603Fh says so; clearing the cause
+    # leaves the drive in FAULT until its master resets it (CiA 402): the code stays
+    assert (
+        main(["fault", "inject", "drive_fault", "axis=2", "code=0x2310", "--attach", served.id])
+        == 0
+    )
+    assert "(active)" in capsys.readouterr().out
+    assert served.error_code(1, capsys) == 0x2310
+    assert main(["fault", "clear", "--attach", served.id]) == 0
+    capsys.readouterr()
+    time.sleep(0.05)
+    assert served.error_code(1, capsys) == 0x2310
 
 
 def test_what_needs_a_controller_is_refused_in_one_line(served: Served, capsys) -> None:
     for argv in (
         ["data"],
-        ["sdo", "upload", "0", "0x6041", "0"],
+        ["sdo", "download", "0", "0x6060", "0", "6"],
         ["reg", "write", "-p", "0", "0x120", "2"],  # the master's to write
     ):
         assert main([*argv, "--attach", served.id]) == 1
