@@ -77,7 +77,6 @@ from gtecat.drives.od import (
     DataType,
     ObjectCode,
     ObjectDictionary,
-    OdObject,
     PdoDir,
     Variable,
     add_identity,
@@ -298,8 +297,7 @@ class Channel:
         **kw: Any,
     ) -> Variable:
         at = index + self.base
-        obj = od.add_object(OdObject(at, name, ObjectCode.VAR))
-        return obj.add(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
+        return od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
 
     def _sub(
         self,

@@ -419,13 +419,15 @@ class OdObject:
         index: int,
         name: str,
         code: ObjectCode = ObjectCode.VAR,
-        make: Callable[[], Iterable[Variable]] | None = None,
+        make: Callable[[], Iterable[Variable]] | Variable | None = None,
     ) -> None:
         self.index = index
         self.name = name
         self.code = code
         #: ``make``: the entries are made when first looked at (a drive's spare PDO mappings
-        #: are 50 entries nobody reads on most buses)
+        #: are 50 entries nobody reads on most buses); a Variable: the one entry, put in a
+        #: dict when first looked at (most of a drive's objects never are: its own code
+        #: holds the entry)
         self._subs: dict[int, Variable] | None = None if make is not None else {}
         self._make = make
 
@@ -435,8 +437,11 @@ class OdObject:
         subs = self._subs
         if subs is None:
             make, self._make = self._make, None
-            assert make is not None
-            subs = self._subs = {v.subindex: v for v in make()}
+            if isinstance(make, Variable):
+                subs = self._subs = {make.subindex: make}
+            else:
+                assert make is not None
+                subs = self._subs = {v.subindex: v for v in make()}
         return subs
 
     def __repr__(self) -> str:
@@ -499,8 +504,12 @@ class ObjectDictionary:
     def add_var(
         self, index: int, name: str, data_type: DataType, access: Access = Access.RW, **kw: Any
     ) -> Variable:
-        obj = self.add_object(OdObject(index, name, ObjectCode.VAR))
-        return obj.add(Variable(index, 0, name, data_type, access, **kw))
+        return self.add_entry(Variable(index, 0, name, data_type, access, **kw))
+
+    def add_entry(self, var: Variable) -> Variable:
+        """A VAR object holding ``var`` (subindex 0), named as it is."""
+        self.add_object(OdObject(var.index, var.name, ObjectCode.VAR, var))
+        return var
 
     def add_record(
         self,
