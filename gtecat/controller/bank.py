@@ -89,7 +89,7 @@ HUGE_COUNTS = float(1 << 62)
 TABLE = 2048
 #: the same with the compiled cycle, which fills a used-up table itself within the cycle:
 #: a short table costs no time and little memory (24 bytes per sample and axis)
-KERNEL_TABLE = 64
+KERNEL_TABLE = 32
 
 #: TxPDO objects the bank computes (channel-0 numbers -> CspBank output names)
 COMPUTED_TX = {

@@ -419,15 +419,15 @@ class OdObject:
         index: int,
         name: str,
         code: ObjectCode = ObjectCode.VAR,
-        make: Callable[[], Iterable[Variable]] | Variable | None = None,
+        make: Callable[[], Iterable[Variable]] | Variable | tuple[Variable, ...] | None = None,
     ) -> None:
         self.index = index
         self.name = name
         self.code = code
         #: ``make``: the entries are made when first looked at (a drive's spare PDO mappings
-        #: are 50 entries nobody reads on most buses); a Variable: the one entry, put in a
-        #: dict when first looked at (most of a drive's objects never are: its own code
-        #: holds the entry)
+        #: are 50 entries nobody reads on most buses); a Variable or a tuple of them: the
+        #: entries, put in a dict when first looked at (most of a drive's objects never are:
+        #: its own code holds the entries)
         self._subs: dict[int, Variable] | None = None if make is not None else {}
         self._make = make
 
@@ -439,6 +439,8 @@ class OdObject:
             make, self._make = self._make, None
             if isinstance(make, Variable):
                 subs = self._subs = {make.subindex: make}
+            elif isinstance(make, tuple):
+                subs = self._subs = {v.subindex: v for v in make}
             else:
                 assert make is not None
                 subs = self._subs = {v.subindex: v for v in make()}
@@ -521,15 +523,12 @@ class ObjectDictionary:
         sub0: Variable | None = None,
     ) -> OdObject:
         """A record/array; subindex 0 is a read-only count of the entries unless given."""
-        obj = self.add_object(OdObject(index, name, code))
         entries = list(entries)
         if sub0 is None:
             n = max((e.subindex for e in entries), default=0)
             sub0 = Variable(index, 0, "Number of entries", DataType.UINT8, Access.RO, default=n)
-        obj.add(sub0)
-        for e in entries:
-            obj.add(e)
-        return obj
+        # the entries in a tuple until the object is first looked at (then in a dict)
+        return self.add_object(OdObject(index, name, code, (sub0, *entries)))
 
     def add_lazy_record(
         self,

@@ -68,6 +68,19 @@ def _names(head: str, n: int) -> tuple[str, ...]:
     return tuple(f"{head} {k + 1}" for k in range(n))
 
 
+class _MapEntries:
+    """Makes a mapping object's entries when it is first looked at (a ``partial`` of
+    :meth:`PdoMapping._map_entries`, in half the memory: eight per drive)."""
+
+    __slots__ = ("access", "cap", "index", "owner", "slots")
+
+    def __init__(self, owner: PdoMapping, index: int, slots: _Slots, cap: int, access: Access):
+        self.owner, self.index, self.slots, self.cap, self.access = owner, index, slots, cap, access
+
+    def __call__(self) -> list[Variable]:
+        return self.owner._map_entries(self.index, self.slots, self.cap, self.access)
+
+
 @dataclass(slots=True)
 class _Slots:
     """Values behind one mapping or assignment object."""
@@ -183,7 +196,7 @@ class PdoMapping:
         direction = PdoDir.RX if index in RX_MAP_RANGE else PdoDir.TX
         access = Access.RO if fixed else Access.RW
         name = ("RxPDO" if direction is PdoDir.RX else "TxPDO") + f" mapping 0x{index:04X}"
-        self.od.add_lazy_record(index, name, partial(self._map_entries, index, slots, cap, access))
+        self.od.add_lazy_record(index, name, _MapEntries(self, index, slots, cap, access))
         return slots
 
     def _map_entries(self, index: int, slots: _Slots, cap: int, access: Access) -> list[Variable]:

@@ -166,6 +166,7 @@ def parse_xml(
     stack: list[Node] = []
     root: list[Node] = []
     local: dict[str, str] = {}  # qualified name -> local name
+    seen: dict[str, str] = {}  # short texts, one object each
 
     skipped = [0]  # depth inside a skipped subtree
 
@@ -200,7 +201,10 @@ def parse_xml(
     def chars(data: str) -> None:
         if stack and not skipped[0]:
             node = stack[-1]
-            node.text = node.text + data if node.text else data
+            if node.text:
+                node.text = node.text + data
+            else:  # one string for each text a file repeats (names, types: slave after slave)
+                node.text = seen.setdefault(data, data) if len(data) <= 64 else data
 
     def refuse_doctype(*_args: object) -> None:
         raise _Refused(
