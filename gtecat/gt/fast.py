@@ -160,13 +160,12 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
     request = struct.Struct(f"<{CALL.format[1:]}qi{one}sqi")
     reply = struct.Struct(f"<IhHHI{code}")
     unpack, pack, size, total = request.unpack_from, reply.pack, request.size, reply.size - 4
-    controllers = session.controllers
 
     def answer(body: Any) -> bytes | None:
         if len(body) != size:
             return None
         axis, psize, _, count, pclock = unpack(body)[4:]
-        ctl = controllers.get(1)
+        ctl = session.controllers.get(1)  # the card the server selected for this call
         if psize != one or count != 1 or pclock != PTR_NULL or ctl is None:
             return None
         res = ctl.resources.get(axis)

@@ -49,6 +49,8 @@ from . import transport
 from .protocol import (
     BLOCK,
     CALL,
+    CALL_GTN,
+    CARD_SHIFT,
     CHUNK,
     F64,
     FIELD_REPLY,
@@ -97,6 +99,8 @@ class Connection:
     def __init__(self, address: str, *, timeout_s: float | None = None) -> None:
         self.address = address
         self.lost = ""  #: why the connection broke ("" while it works)
+        #: the cards this connection has opened (gtecat.controller.cards)
+        self.cards: set[int] = set()
         self._lock = threading.Lock()
         self._codecs: dict[int, _Codec] = {}
         try:
@@ -165,14 +169,16 @@ class Connection:
             self._close_socket()
 
     # --- GT calls ------------------------------------------------------------------------------
-    def call(self, name: str, gtn: bool, core: int, values: list[Any]) -> tuple[int, str]:
-        """Run a bound GT call in the controller: (return code, reason); the out-pointers
-        among ``values`` are written."""
+    def call(
+        self, name: str, gtn: bool, core: int, values: list[Any], card: int = 0
+    ) -> tuple[int, str]:
+        """Run a bound GT call in the controller on card ``card``: (return code, reason);
+        the out-pointers among ``values`` are written."""
         plan = plans_by_name()[name]
         codec = self._codecs.get(plan.fid)
         if codec is None:
             codec = self._codecs[plan.fid] = _Codec(plan, _LONG)
-        request, outs = codec.encode(gtn, core, values)
+        request, outs = codec.encode(gtn, core, values, card)
         body = self._exchange(request)
         rc, nblocks, nerr = REPLY.unpack_from(body, 0)
         pos = REPLY.size
@@ -258,8 +264,11 @@ class _Codec:
             _Arg(a, long_size) if a.kind not in (Kind.INT, Kind.DOUBLE) else None for a in plan.args
         ]
 
-    def encode(self, gtn: bool, core: int, values: list[Any]) -> tuple[bytes, list[Any]]:
-        parts = [CALL.pack(MSG_CALL, int(gtn), self.plan.fid, core)]
+    def encode(
+        self, gtn: bool, core: int, values: list[Any], card: int = 0
+    ) -> tuple[bytes, list[Any]]:
+        flags = (CALL_GTN if gtn else 0) | (card << CARD_SHIFT)
+        parts = [CALL.pack(MSG_CALL, flags, self.plan.fid, core)]
         outs: list[Any] = []
         for a, spec, v in zip(self.plan.args, self.args, values, strict=True):
             if spec is None:
@@ -333,27 +342,32 @@ def remote_call(
     """A bound GT call of an attached session (``gtecat.gt._core`` calls this); 0, or a
     refusal that carries the controller's code and reason."""
     conn: Connection | None = session.remote
+    card = session.card
     if name == "GT_Open":
         return _open(session, conn, gtn, core, values, extra, address)
     assert conn is not None
     if name == "GT_Close":  # detach; a controller already gone leaves nothing to close
         try:
-            rc, text = conn.call(name, gtn, core, values)
+            rc, text = conn.call(name, gtn, core, values, card)
         except ControllerLost:
             rc, text = 0, ""
         if rc == 0:
-            conn.close()
-            session.remote = None
+            conn.cards.discard(card)
+            if not conn.cards:  # the last card this session had open
+                conn.close()
+                session.remote = None
             return 0
         _refuse(name, rc, text)
     if conn.lost:
         _core.fail(_core.CMD_COMM, f"controller not responding: {conn.lost}")
     try:
-        rc, text = conn.call(name, gtn, core, values)
+        rc, text = conn.call(name, gtn, core, values, card)
     except ControllerLost as e:
         _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
     if rc != 0:
         _refuse(name, rc, text)
+    if name == "GT_SetCardNo":  # the session's own setting; the controller checked it
+        session.select(int(values[0]))
     return 0
 
 
@@ -372,11 +386,27 @@ def _open(
     extra: dict[str, Any],
     address: str,
 ) -> int:
-    if session.controllers:
+    if session.all_controllers():
         _core.fail(
             _core.CMD_OPEN,
             "the controller is already open in this process (GT_Close first, then attach)",
         )
+    card = session.card
+    if conn is not None and not conn.lost and (not address or address == conn.address):
+        if card in conn.cards:
+            _core.fail(
+                _core.CMD_OPEN,
+                f"card {card} is already open on the controller at {conn.address} "
+                "(GT_Close first)",
+            )
+        try:  # another card of the same controller, on the same connection
+            rc, text = conn.call("GT_Open", gtn, core, values, card)
+        except ControllerLost as e:
+            _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
+        if rc != 0:
+            _refuse("GT_Open", rc, text)
+        conn.cards.add(card)
+        return 0
     if conn is not None and not conn.lost:
         _core.fail(
             _core.CMD_OPEN,
@@ -398,12 +428,13 @@ def _open(
     except ControllerError as e:
         _core.fail(_core.CMD_COMM, str(e))
     try:
-        rc, text = new.call("GT_Open", gtn, core, values)
+        rc, text = new.call("GT_Open", gtn, core, values, card)
     except ControllerLost as e:
         _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
     if rc != 0:
         new.close()
         _refuse("GT_Open", rc, text)
+    new.cards.add(card)
     session.remote = new
     return 0
 
