@@ -780,12 +780,16 @@ class Server:
                 dec = c.decoders[fid] = self._decoder(c.long_size, fid)
             if dec.fast is not None and card in c.cards and not gtn:
                 with self.lock:
-                    _core.SESSION.select(card)
                     if self.wall_floor:
                         floor = self._current_floor()
                         if floor is not None:
                             floor.look()
-                    out = dec.fast(body)
+                    session = _core.SESSION
+                    if card == session.card:
+                        out = dec.fast(body)
+                    else:
+                        with session.selected(card):
+                            out = dec.fast(body)
                 if out is not None:
                     self.calls += 1
                     return out
@@ -795,8 +799,9 @@ class Server:
                     ctl.slice_hook = self._serve_others
                 self._running.append(c)
                 try:
-                    _core.SESSION.select(card)  # the client's card (gtecat.controller.cards)
-                    rc, text = self._call(c, dec, gtn, core, args)
+                    # the client's card (gtecat.controller.cards); this process's own stays
+                    with _core.SESSION.selected(card):
+                        rc, text = self._call(c, dec, gtn, core, args)
                 finally:
                     self._running.pop()
             return _reply(rc, backs, text)
@@ -902,7 +907,7 @@ class Server:
             code, why = declared.note(name)
             return code, f"{name} returned {code}: {why}"
         if plan.name in ("GT_SetCardNo", "GT_GetCardNo"):  # the client's own setting
-            return _invoke(dec.fn_gt, args)
+            return _invoke(dec.fn_gtn, (core, *args)) if gtn else _invoke(dec.fn_gt, args)
         card = _core.SESSION.card
         if card not in c.cards or plan.name in ("GT_Open", "GT_Close", "GTN_OpenCard"):
             return self._open_close(c, dec, gtn, core, args)

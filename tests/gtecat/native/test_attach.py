@@ -100,7 +100,7 @@ def test_attached_calls_return_the_controllers_codes_and_write_the_callers_memor
     assert gt.GT_GetSts(99, byref(sts)) == 7 and sts.value == -12345
     assert gt.GTE_GetLastError().startswith("GT_GetSts returned 7: axis=99")
     assert gt.GT_GetSts(1, None) == 7 and "NULL" in gt.GTE_GetLastError()
-    assert gt.GTN_GetSts(2, 1, byref(sts)) == 7 and "core 2" in gt.GTE_GetLastError()
+    assert gt.GTN_GetSts(3, 1, byref(sts)) == 7 and "core 3" in gt.GTE_GetLastError()
     assert gt.GT_SetVel(1, float("nan")) == 7
     assert gt.GT_GetSts(1, byref(sts)) == 0 and gt.GTE_GetLastError() == ""
     pos = c_double()
