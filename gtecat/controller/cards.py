@@ -148,7 +148,7 @@ def options_for(
     if "hardware" in desc:
         hw = desc["hardware"]
         if not isinstance(hw, str) or not hw:
-            raise MachineError(f"{where}: hardware must be \"ethercat\" or \"gts:N\"")
+            raise MachineError(f'{where}: hardware must be "ethercat" or "gts:N"')
         o.card = None if hw.strip().lower() == "ethercat" else hw
     if "eni" in desc:
         o.eni = path("eni")

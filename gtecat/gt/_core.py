@@ -177,9 +177,7 @@ class _Session:
 
     def not_open(self) -> str:
         if self.card:
-            return (
-                f"card {self.card} is not open: call GT_Open after GT_SetCardNo({self.card})"
-            )
+            return f"card {self.card} is not open: call GT_Open after GT_SetCardNo({self.card})"
         return "the controller is not open: call GT_Open first"
 
     def _core_view(self, core: int) -> Any:
@@ -223,6 +221,8 @@ def close_all() -> None:
         SESSION.select(card)
         REGISTRY["GT_Close"]()
     SESSION.select(0)
+
+
 REGISTRY: dict[str, Callable[..., int]] = {}
 #: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
 #: a controller process then runs every call through REGISTRY, none on a fast path

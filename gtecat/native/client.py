@@ -396,8 +396,7 @@ def _open(
         if card in conn.cards:
             _core.fail(
                 _core.CMD_OPEN,
-                f"card {card} is already open on the controller at {conn.address} "
-                "(GT_Close first)",
+                f"card {card} is already open on the controller at {conn.address} (GT_Close first)",
             )
         try:  # another card of the same controller, on the same connection
             rc, text = conn.call("GT_Open", gtn, core, values, card)
