@@ -43,7 +43,7 @@ from __future__ import annotations
 import ctypes
 from typing import Any
 
-from ..controller.cards import MAX_CARDS
+from ..controller.cards import MAX_CARDS as _MAX_CARDS
 from ..controller.config_file import apply_config, parse_vendor, vendor_settings
 from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE
@@ -565,7 +565,7 @@ def GT_GetResCount(ctl: Controller, type: int, pCount: Any) -> int:
 def GT_SetCardNo(index: int) -> int:
     """The card later calls address, 0..15 (the current card of the process; GT_Open
     opens it: :mod:`gtecat.controller.cards`)."""
-    SESSION.select(check_range("index", index, 0, MAX_CARDS - 1))
+    SESSION.select(check_range("index", index, 0, _MAX_CARDS - 1))
     return 0
 
 
