@@ -57,6 +57,7 @@ STATE_CHANGING = {
     "LoadConfig",
     "UnplugSlave",
     "ReplugSlave",
+    "SetCardNo",  # every later call addresses another card
 }
 # The default run calls every function with a few examples (the suite's CPU budget);
 # GTECAT_LONG=N runs the campaign: 15 x N examples per function, 8 x N per twin (fresh seeds
@@ -220,7 +221,7 @@ def test_a_typed_null_is_a_null_for_an_optional_pointer_and_refused_for_a_requir
         lambda sts: gt.GTN_GetSts(1.0, 1, byref(sts)),
         lambda sts: gt.GTN_GetSts(None, 1, byref(sts)),
         lambda sts: gt.GTN_GetSts(math.nan, 1, byref(sts)),
-        lambda sts: gt.GTN_GetSts(2, 1, byref(sts)),
+        lambda sts: gt.GTN_GetSts(3, 1, byref(sts)),  # core 2 is the card's second core
         lambda sts: gt.GTN_GetSts(1 << 40, 1, byref(sts)),
         lambda sts: gt.GTN_Close(2),
         lambda sts: gt.GTN_Open(0, 0, 1),  # the core-first form of earlier releases
