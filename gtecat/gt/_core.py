@@ -152,11 +152,17 @@ class _Session:
         return [c for cores in self.cards.values() for c in cores.values()]
 
     def controller(self, core: int = 1) -> Controller:
-        c = self.controllers.get(core)
-        if c is None and core > 1 and 1 in self.controllers:
-            c = self._core_view(core)
-            if c is None and core <= CARD_CORES:
-                c = self._open_core(core)
+        cores = self.controllers
+        c = cores.get(core) if core == 1 else None
+        if core > 1 and 1 in cores:
+            c = self._core_view(core)  # the bus's axes of that core, where it has them
+            if c is not None:
+                own = cores.pop(core, None)
+                if own is not None:  # a second core opened before the bus came up
+                    self.time.leave(own.clock)
+                    own.close()
+            elif core <= CARD_CORES:
+                c = cores.get(core) or self._open_core(core)
         if c is None:
             if self.remote is not None:
                 raise NotOpen(

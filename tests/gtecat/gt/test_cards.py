@@ -159,3 +159,22 @@ def test_a_described_core_2_and_the_multi_card_twin(tmp_path):
     assert gt.GTN_AxisOn(2, 8) == 0
     _card(0)
     assert gt.GTN_AxisOn(2, 8) == 7  # card 0's core 2 has 4 axes
+
+
+def test_on_a_bus_of_more_than_32_axes_core_2_is_the_bus_axes_33_and_up(tmp_path):
+    """The card's own core 2, opened by an early GTN_Reset(2), gives way to the bus's axes
+    33.. once the bus is up (gtecat.controller.core_view)."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(33, tmp_path / "axes33.eni")
+    assert gt.GT_Open(eni=str(eni), log="", clock="lockstep") == 0
+    assert gt.GTN_Reset(2) == 0  # before the bus: the card's second core
+    n = c_short()
+    assert gt.GTN_GetResCount(2, gt.MC_AXIS, byref(n)) == 0 and n.value == 12
+    assert gt.GT_InitEcatComm() == 0
+    ready = c_short()
+    while gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value != 1:
+        gt.GTE_Wait(1)
+    assert gt.GT_StartEcatComm() == 0
+    assert gt.GTN_AxisOn(2, 1) == 0  # bus axis 33
+    assert gt.GTN_AxisOn(2, 2) == 7 and "bus axes 33..33" in gt.GTE_GetLastError()
