@@ -114,6 +114,14 @@ def test_open_twice_options_and_the_python_objects_are_refused_clearly(controlle
     assert gt.GT_Open(controller=address, log="") == 0
     assert gt.GT_Open(controller=address) == -6
     assert gt.GT_Open() == -6  # attached: a second open, as in-process
+    # a second card of the same controller, on the same connection (gtecat.controller.cards)
+    assert gt.GT_SetCardNo(1) == 0 and gt.GT_Open(controller=address) == 0
+    assert gt.GT_AxisOn(1) == 7  # card 1's own bus is not up
+    assert "bus not initialised" in gt.GTE_GetLastError()
+    index = c_short()
+    assert gt.GT_GetCardNo(byref(index)) == 0 and index.value == 1
+    assert gt.GT_Close() == 0 and _core.SESSION.remote is not None  # card 0 still open
+    assert gt.GT_SetCardNo(0) == 0
     with pytest.raises(_core.NotOpen, match=r"field\(\)"):
         gt.GTE_Slave(0)
     with pytest.raises(_core.NotOpen, match="attached"):
