@@ -193,9 +193,13 @@ class Connection:
         return rc, text
 
     # --- the field side -------------------------------------------------------------------------
-    def field(self, op: str, *args: Any) -> Any:
-        """Run one operation of :mod:`gtecat.native.field`; ControllerError with its reason."""
-        body = bytes([MSG_FIELD]) + json.dumps({"op": op, "args": list(args)}).encode()
+    def field(self, op: str, *args: Any, card: int = 0) -> Any:
+        """Run one operation of :mod:`gtecat.native.field` on card ``card``; ControllerError
+        with its reason."""
+        req: dict[str, Any] = {"op": op, "args": list(args)}
+        if card:
+            req["card"] = int(card)
+        body = bytes([MSG_FIELD]) + json.dumps(req).encode()
         reply = self._exchange(body)
         (status,) = FIELD_REPLY.unpack_from(reply, 0)
         value = json.loads(reply[FIELD_REPLY.size :].decode("utf-8"))
@@ -469,14 +473,16 @@ class Field:
     """The operations of :mod:`gtecat.native.field`, run by the controller (its call lock
     held, so each is atomic with respect to a cycle and to the other clients' calls)."""
 
-    def __init__(self, connection: Connection, *, owned: bool = False) -> None:
+    def __init__(self, connection: Connection, *, owned: bool = False, card: int = 0) -> None:
         self.connection = connection
         self._owned = owned
+        #: the card whose machine the operations act on (gtecat.controller.cards)
+        self.card = card
 
     @classmethod
-    def connect(cls, address: str) -> Field:
+    def connect(cls, address: str, card: int = 0) -> Field:
         """A connection of its own (an inspection verb; no GT_Open needed)."""
-        return cls(Connection(address), owned=True)
+        return cls(Connection(address), owned=True, card=card)
 
     def close(self) -> None:
         if self._owned:
@@ -489,7 +495,7 @@ class Field:
         self.close()
 
     def call(self, op: str, *args: Any) -> Any:
-        return self.connection.field(op, *args)
+        return self.connection.field(op, *args, card=self.card)
 
     # the bus: gtecat.controller.inspect.BusView's methods, same names and results
     def positions(self, position: int | None = None) -> list[int]:
@@ -575,18 +581,21 @@ class Field:
         return self.call("cycle_stats")
 
 
-def field(address: str | None = None) -> Field:
+def field(address: str | None = None, card: int | None = None) -> Field:
     """The field side of the controller this session is attached to (``GT_Open(controller=
-    ...)``), or of the one at ``address`` on a connection of its own."""
+    ...)``), or of the one at ``address`` on a connection of its own; of card ``card``
+    (default: the session's current card, ``GT_SetCardNo``)."""
+    if card is None:
+        card = _core.SESSION.card
     if address is not None:
-        return Field.connect(address)
+        return Field.connect(address, card)
     conn = _core.SESSION.remote
     if conn is None:
         raise ControllerError(
             "this session is not attached to a controller: GT_Open(controller='unix:/path') "
             "first, or field('unix:/path')"
         )
-    return Field(conn)
+    return Field(conn, card=card)
 
 
 __all__ = [

@@ -272,7 +272,8 @@ class _Client:
     decoders: dict[int, _Decoder] = field(default_factory=dict)
     #: reply bytes the client has not read yet (while any wait, its requests wait too)
     out: bytearray = field(default_factory=bytearray)
-    field: field_ops.Context | None = None  # its traces
+    #: per card: its traces
+    fields: dict[int, field_ops.Context] = field(default_factory=dict)
     #: may call (a Unix socket client at once; a TCP client once its token was right)
     authed: bool = True
     #: monotonic time by which it must have greeted / completed its frame / read its
@@ -613,9 +614,10 @@ class Server:
             return  # dropped already
         if self._clients.pop(c.sock.fileno(), None) is not None:
             self._poller.unregister(c.sock.fileno())
-        if c.field is not None:
+        if c.fields:
             with self.lock:
-                c.field.stop_traces()
+                for ctx in c.fields.values():
+                    ctx.stop_traces()
         c.sock.close()
 
     def _spin_budget(self) -> float:
@@ -874,20 +876,29 @@ class Server:
         try:
             req = json.loads(bytes(body[1:]).decode("utf-8"))
             op, args = str(req["op"]), list(req.get("args", []))
+            card = int(req.get("card", 0))
         except (ValueError, KeyError, TypeError) as e:
             raise ProtocolError(f"a field request that is not JSON {{op, args}}: {e}") from None
         status, result = 0, None
         with self.lock:
-            ctl = _core.SESSION.first()  # card 0 (the field side of other cards: not yet)
+            ctl = _core.SESSION.cards.get(card, {}).get(1)  # the card's machine
             if ctl is None:
-                status, result = 1, "the controller is not open yet (no client has called GT_Open)"
+                status, result = (
+                    1,
+                    (
+                        f"card {card} is not open (no client has opened it)"
+                        if card
+                        else "the controller is not open yet (no client has called GT_Open)"
+                    ),
+                )
             else:
-                if c.field is None or c.field.ctl is not ctl:
-                    if c.field is not None:
-                        c.field.stop_traces()
-                    c.field = field_ops.Context(ctl)
+                ctx = c.fields.get(card)
+                if ctx is None or ctx.ctl is not ctl:
+                    if ctx is not None:
+                        ctx.stop_traces()
+                    ctx = c.fields[card] = field_ops.Context(ctl)
                 try:
-                    result = field_ops.run(c.field, op, args)
+                    result = field_ops.run(ctx, op, args)
                 except GtecatError as e:
                     status, result = 1, str(e)
                 except Exception as e:  # a field operation never takes the controller down

@@ -47,11 +47,11 @@ def _start_controller(address: str, clock: str, cwd) -> subprocess.Popen:
 def controller(tmp_path, monkeypatch):
     """A ``gtecat controller`` process (lockstep, figure 5-2 bus); yields its address."""
     monkeypatch.delenv("GTECAT_CONTROLLER", raising=False)
-    gt.GT_Close()
+    _core.close_all()
     address = f"unix:{tmp_path}/ctl.sock"
     proc = _start_controller(address, "lockstep", tmp_path)
     yield address, proc
-    gt.GT_Close()
+    _core.close_all()
     proc.kill()
     proc.wait()
 
@@ -120,6 +120,14 @@ def test_open_twice_options_and_the_python_objects_are_refused_clearly(controlle
     assert "bus not initialised" in gt.GTE_GetLastError()
     index = c_short()
     assert gt.GT_GetCardNo(byref(index)) == 0 and index.value == 1
+    _bring_up()  # card 1's bus; its field side is its own
+    field().inject_fault(0, "alarm")  # the session's current card: 1
+    assert gt.GTE_Wait(5) == 0
+    sts = c_long()
+    assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & (1 << 1)  # alarm on card 1
+    assert field().drive(0)["error_code"] != 0
+    with pytest.raises(client.ControllerError, match="card 2 is not open"):
+        field(card=2).drive(0)
     assert gt.GT_Close() == 0 and _core.SESSION.remote is not None  # card 0 still open
     assert gt.GT_SetCardNo(0) == 0
     with pytest.raises(_core.NotOpen, match=r"field\(\)"):
