@@ -73,6 +73,7 @@ def _descriptor(plan: FunctionPlan) -> list[str]:
         "GTN_OpenCard": "GTE_F_OPEN",  # the GSN-E form of GT_Open
         "GT_Close": "GTE_F_CLOSE",
         "GT_SetCardNo": "GTE_F_CARDNO",  # the process's current card (gts_runtime.c)
+        "GT_GetCardNo": "GTE_F_GETCARDNO",
     }.get(name, "0")
     out = []
     if plan.args:

@@ -1195,18 +1195,47 @@ connected:;
     return rc;
 }
 
+/* GT_SetCardNo / GT_GetCardNo: the process's own setting, answered here (before GT_Open
+ * too, as applications call it) with the codes and reasons of the Python functions */
+static short card_number(const gte_function *f, int gtn, short core, const gte_arg *a)
+{
+    if (gtn && core != 1) {
+        set_err("%s returned 7: core=%d: the EtherCAT core is 1", f->name, core);
+        return CMD_PARAM;
+    }
+    if (f->flags & GTE_F_CARDNO) {
+        long long index = a[0].i;
+        if (index < 0 || index > 15) {
+            set_err("%s returned 7: index=%lld out of range 0..15", f->name, index);
+            return CMD_PARAM;
+        }
+        g_card = (short)index;
+    } else {
+        if (!a[0].p) {
+            set_err("%s returned 7: pIndex is NULL; this pointer is required", f->name);
+            return CMD_PARAM;
+        }
+        *(short *)a[0].p = g_card;
+    }
+    g_err[0] = '\0';
+    return 0;
+}
+
 short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
 {
     short card = t_card; /* the multi-card ABI's card for this one call, else the current */
     t_card = -1;
     LOCK();
+    if (f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO)) {
+        short rc = card_number(f, gtn, core, a);
+        UNLOCK();
+        return rc;
+    }
     if (card < 0)
         card = g_card;
     short rc = invoke_locked(f, gtn, core, card, a);
     if (rc == 0 && (f->flags & GTE_F_OPEN))
         g_cards_open |= 1u << (card & 15);
-    if (rc == 0 && (f->flags & GTE_F_CARDNO))
-        g_card = (short)a[0].i;
     if (f->flags & GTE_F_CLOSE)
         g_cards_open &= ~(1u << (card & 15));
     if ((f->flags & GTE_F_CLOSE) && !g_cards_open && g_fd != GTE_NO_SOCK &&

@@ -25,7 +25,13 @@ typedef struct gte_function {
     const gte_param *params;
 } gte_function;
 
-enum { GTE_F_OPEN = 1, GTE_F_CLOSE = 2, GTE_F_DECLARED = 4, GTE_F_CARDNO = 8 };
+enum {
+    GTE_F_OPEN = 1,
+    GTE_F_CLOSE = 2,
+    GTE_F_DECLARED = 4,
+    GTE_F_CARDNO = 8,    /* GT_SetCardNo: the process's current card (gts_runtime.c) */
+    GTE_F_GETCARDNO = 16 /* GT_GetCardNo */
+};
 
 typedef union gte_arg {
     long long i;

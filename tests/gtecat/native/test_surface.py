@@ -122,6 +122,23 @@ def test_the_multicard_abi(controller, tmp_path):
     assert (v["getsts1"], v["running1"], v["stop1"], v["close1"]) == ("0", "1", "0", "0")
 
 
+def test_two_cards_through_the_one_card_abi(libgts, controller, tmp_path):
+    """GT_SetCardNo (before GT_Open too) chooses the card of every later call; card 1 jogs
+    while card 0 is polled; closing card 1 leaves card 0.  (Compiled with the library's own
+    flags, the ones `gtecat lib --cflags --libs` prints: the other tests here run the command.)"""
+    exe = tmp_path / "cards"
+    cmd = ["gcc", "-Wall", "-Wextra", str(C_DIR / "cards_client.c"), *libgts.cflags()]
+    r = subprocess.run([*cmd, *libgts.libs(), "-o", str(exe)], capture_output=True, text=True)
+    assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert (v["set16"], v["set1"], v["get_rc"], v["card"]) == ("7", "0", "0", "1")
+    assert (v["up1"], v["set0"], v["up0"], v["jog1"]) == ("0",) * 4
+    assert (v["vel0"], v["vel1"]) == ("0", "-10")
+    assert (v["close1"], v["sts1_closed"], v["sts0"], v["servo0"]) == ("0", "-1", "0", "1")
+    assert v["close0"] == "0"
+
+
 def test_libgts_exports_every_name_of_the_table(libgts):
     """`nm -D`: the vendor DLL's names (the table holds every one) are all exported."""
     import shutil
