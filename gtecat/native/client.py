@@ -495,7 +495,9 @@ class Field:
         self.close()
 
     def call(self, op: str, *args: Any) -> Any:
-        return self.connection.field(op, *args, card=self.card)
+        if self.card:  # (an inspection endpoint's connection knows one machine only)
+            return self.connection.field(op, *args, card=self.card)
+        return self.connection.field(op, *args)
 
     # the bus: gtecat.controller.inspect.BusView's methods, same names and results
     def positions(self, position: int | None = None) -> list[int]:
