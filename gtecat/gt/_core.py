@@ -104,6 +104,8 @@ class _Session:
         self.card = 0
         #: the current card's cores (``cards[card]``)
         self.controllers: dict[int, Controller] = self.cards[0]
+        #: the core the GT_* functions address (GT_SetCore; the GTN_* ones name theirs)
+        self.core = 1
         #: the options the first card was opened with (resolved): the other cards' base
         self.base_options: Any = None
         #: every card and core of the process shares one time
@@ -124,14 +126,18 @@ class _Session:
             self.controllers = self.cards.setdefault(card, {})
 
     @contextlib.contextmanager
-    def selected(self, card: int) -> Iterator[None]:
-        """Address ``card`` for a while (a call of the multi-card ABI, a motion program)."""
-        before = self.card
+    def selected(self, card: int, core: int | None = None) -> Iterator[None]:
+        """Address ``card`` (and the GT_* functions core ``core``) for a while: a call of
+        the multi-card ABI, of a client of the controller process, a motion program."""
+        before, before_core = self.card, self.core
         self.select(card)
+        if core is not None:
+            self.core = core
         try:
             yield
         finally:
             self.select(before)
+            self.core = before_core
 
     def where(self, ctl: Any) -> tuple[int, int] | None:
         """(card, core) of an open controller, None when it is not open here."""
@@ -221,12 +227,13 @@ SESSION = _Session()
 
 
 def close_all() -> None:
-    """Close every card of this process and make card 0 the current one (a test's
-    clean start; GT_Close closes the current card only)."""
+    """Close every card of this process and make card 0 (core 1) the current one (a
+    test's clean start; GT_Close closes the current card only)."""
     for card in sorted(SESSION.cards):
         SESSION.select(card)
         REGISTRY["GT_Close"]()
     SESSION.select(0)
+    SESSION.core = 1
 
 
 REGISTRY: dict[str, Callable[..., int]] = {}
@@ -325,7 +332,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if not needs_ctl and core != 1:  # GTN_Open/GTN_Close: no other core exists
                     raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
-                core = 1
+                core = SESSION.core  # GT_SetCore: 1 unless the program chose another
             values, extra = bind(args, kwargs)
             if address or SESSION.remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
@@ -401,7 +408,13 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
             def gtn(*args: Any, **kwargs: Any) -> int:
                 if args:
-                    if fast is not None and args[0] == 1 and type(args[0]) is int and not kwargs:
+                    if (
+                        fast is not None
+                        and args[0] == 1
+                        and type(args[0]) is int
+                        and not kwargs
+                        and SESSION.core == 1
+                    ):
                         return fast(*args[1:])  # core 1: the GT_ function's fast path
                     return call(args[0], args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)

@@ -110,6 +110,7 @@ def fast_reader(
             # pClock NULL: omitted, None or 0 (the manual's own form, GT_GetSts(1, &s, 1, 0))
             or (pClock is not _NO and pClock is not None and (type(pClock) is not int or pClock))
             or session.remote is not None
+            or session.core != 1  # GT_SetCore: another core
         ):
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
         res = ctl.resources.get(n)
@@ -281,6 +282,7 @@ def fast_raw(
             or m.offline
             or session.remote is not None
             or ctl.clock._thread is not None
+            or session.core != 1  # GT_SetCore: another core
         ):
             return slow(*args)
         image = m.image

@@ -33,7 +33,9 @@ vendor's headers leave open:
   ``MC_EXT_AI`` / ``MC_EXT_AO`` (the machine's extension modules; up to 16 modules).
 * ``GT_SetCardNo(index)``: the card later calls address, 0..15 (7 otherwise), one per
   process; it works before ``GT_Open``, which then opens that card
-  (:mod:`gtecat.controller.cards` says what each card is).
+  (:mod:`gtecat.controller.cards` says what each card is).  ``GT_SetCore(core)`` (GTN
+  header): the core the ``GT_*`` functions address, 1 or 2, one per process; the
+  ``GTN_*`` functions name their own.
 * ``GT_GetAtlTorque`` / ``GT_GetEcatAxisAtlTorque``: the vendor GTN header's spellings of
   ``GT_GetEcatAxisAtITorque`` (6077h).
 """
@@ -43,6 +45,7 @@ from __future__ import annotations
 import ctypes
 from typing import Any
 
+from ..controller.cards import CARD_CORES as _CARD_CORES
 from ..controller.cards import MAX_CARDS as _MAX_CARDS
 from ..controller.config_file import apply_config, parse_vendor, vendor_settings
 from ..controller.core import Controller
@@ -573,6 +576,21 @@ def GT_SetCardNo(index: int) -> int:
 def GT_GetCardNo(pIndex: Any) -> int:
     """The current card (GT_SetCardNo; 0 at start)."""
     store(pIndex, SESSION.card)
+    return 0
+
+
+@gt_function
+def GT_SetCore(core: int) -> int:
+    """The core the ``GT_*`` functions address, 1 or 2 (the ``GTN_*`` ones name theirs):
+    one per process, as the current card (:mod:`gtecat.controller.cards`)."""
+    SESSION.core = check_range("core", core, 1, _CARD_CORES)
+    return 0
+
+
+@gt_function
+def GT_GetCore(pCore: Any) -> int:
+    """The core the ``GT_*`` functions address (GT_SetCore; 1 at start)."""
+    store(pCore, SESSION.core)
     return 0
 
 

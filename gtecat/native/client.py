@@ -370,8 +370,10 @@ def remote_call(
         _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
     if rc != 0:
         _refuse(name, rc, text)
-    if name == "GT_SetCardNo":  # the session's own setting; the controller checked it
+    if name == "GT_SetCardNo":  # the session's own settings; the controller checked them
         session.select(int(values[0]))
+    elif name == "GT_SetCore":
+        session.core = int(values[0])
     return 0
 
 

@@ -123,6 +123,8 @@ def default_spin_us() -> float:
 
 
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
+#: what a client sets for itself: its current card and the core of its GT_x calls
+_OWN_SETTINGS = frozenset({"GT_SetCardNo", "GT_GetCardNo", "GT_SetCore", "GT_GetCore"})
 
 
 class ProtocolError(Exception):
@@ -780,7 +782,7 @@ class Server:
             dec = c.decoders.get(fid)
             if dec is None:
                 dec = c.decoders[fid] = self._decoder(c.long_size, fid)
-            if dec.fast is not None and card in c.cards and not gtn:
+            if dec.fast is not None and card in c.cards and not gtn and core == 1:
                 with self.lock:
                     if self.wall_floor:
                         floor = self._current_floor()
@@ -801,8 +803,9 @@ class Server:
                     ctl.slice_hook = self._serve_others
                 self._running.append(c)
                 try:
-                    # the client's card (gtecat.controller.cards); this process's own stays
-                    with _core.SESSION.selected(card):
+                    # the client's card and, for GT_x, its core (gtecat.controller.cards);
+                    # this process's own stay
+                    with _core.SESSION.selected(card, None if gtn else core):
                         rc, text = self._call(c, dec, gtn, core, args)
                 finally:
                     self._running.pop()
@@ -917,7 +920,7 @@ class Server:
             name = plan.proto.twin_name if gtn else plan.name
             code, why = declared.note(name)
             return code, f"{name} returned {code}: {why}"
-        if plan.name in ("GT_SetCardNo", "GT_GetCardNo"):  # the client's own setting
+        if plan.name in _OWN_SETTINGS:  # the client's own setting
             return _invoke(dec.fn_gtn, (core, *args)) if gtn else _invoke(dec.fn_gt, args)
         card = _core.SESSION.card
         if card not in c.cards or plan.name in ("GT_Open", "GT_Close", "GTN_OpenCard"):

@@ -74,6 +74,8 @@ def _descriptor(plan: FunctionPlan) -> list[str]:
         "GT_Close": "GTE_F_CLOSE",
         "GT_SetCardNo": "GTE_F_CARDNO",  # the process's current card (gts_runtime.c)
         "GT_GetCardNo": "GTE_F_GETCARDNO",
+        "GT_SetCore": "GTE_F_SETCORE",
+        "GT_GetCore": "GTE_F_GETCORE",
     }.get(name, "0")
     out = []
     if plan.args:

@@ -106,6 +106,7 @@ static char g_lost[1300];          /* why the connection was lost ("" if it was 
  * has open (bit n: card n; the connection ends when the last one closes), and a card one
  * call of this thread addresses instead (the multi-card ABI, gte_use_card) */
 static short g_card;
+static short g_core = 1; /* the core of the GT_x calls (GT_SetCore); GTN_x name theirs */
 static unsigned g_cards_open;
 #if defined(_MSC_VER)
 static __declspec(thread) short t_card = -1;
@@ -1195,27 +1196,35 @@ connected:;
     return rc;
 }
 
-/* GT_SetCardNo / GT_GetCardNo: the process's own setting, answered here (before GT_Open
- * too, as applications call it) with the codes and reasons of the Python functions */
-static short card_number(const gte_function *f, int gtn, short core, const gte_arg *a)
+/* GT_SetCardNo / GT_GetCardNo, GT_SetCore / GT_GetCore: the process's own settings,
+ * answered here (before GT_Open too, as applications call them) with the codes and reasons
+ * of the Python functions */
+static short own_setting(const gte_function *f, int gtn, short core, const gte_arg *a)
 {
+    int set = f->flags & (GTE_F_CARDNO | GTE_F_SETCORE);
+    int card = f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO);
     if (gtn && core != 1) {
         set_err("%s returned 7: core=%d: the EtherCAT core is 1", f->name, core);
         return CMD_PARAM;
     }
-    if (f->flags & GTE_F_CARDNO) {
-        long long index = a[0].i;
-        if (index < 0 || index > 15) {
-            set_err("%s returned 7: index=%lld out of range 0..15", f->name, index);
+    if (set) {
+        long long v = a[0].i, top = card ? 15 : 2;
+        if (v < (card ? 0 : 1) || v > top) {
+            set_err("%s returned 7: %s=%lld out of range %d..%lld", f->name,
+                    card ? "index" : "core", v, card ? 0 : 1, top);
             return CMD_PARAM;
         }
-        g_card = (short)index;
+        if (card)
+            g_card = (short)v;
+        else
+            g_core = (short)v;
     } else {
         if (!a[0].p) {
-            set_err("%s returned 7: pIndex is NULL; this pointer is required", f->name);
+            set_err("%s returned 7: %s is NULL; this pointer is required", f->name,
+                    card ? "pIndex" : "pCore");
             return CMD_PARAM;
         }
-        *(short *)a[0].p = g_card;
+        *(short *)a[0].p = card ? g_card : g_core;
     }
     g_err[0] = '\0';
     return 0;
@@ -1226,13 +1235,15 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
     short card = t_card; /* the multi-card ABI's card for this one call, else the current */
     t_card = -1;
     LOCK();
-    if (f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO)) {
-        short rc = card_number(f, gtn, core, a);
+    if (f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO | GTE_F_SETCORE | GTE_F_GETCORE)) {
+        short rc = own_setting(f, gtn, core, a);
         UNLOCK();
         return rc;
     }
     if (card < 0)
         card = g_card;
+    if (!gtn)
+        core = g_core; /* a GT_x call: the core GT_SetCore chose */
     short rc = invoke_locked(f, gtn, core, card, a);
     if (rc == 0 && (f->flags & GTE_F_OPEN))
         g_cards_open |= 1u << (card & 15);

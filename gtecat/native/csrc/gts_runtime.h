@@ -29,8 +29,10 @@ enum {
     GTE_F_OPEN = 1,
     GTE_F_CLOSE = 2,
     GTE_F_DECLARED = 4,
-    GTE_F_CARDNO = 8,    /* GT_SetCardNo: the process's current card (gts_runtime.c) */
-    GTE_F_GETCARDNO = 16 /* GT_GetCardNo */
+    GTE_F_CARDNO = 8,     /* GT_SetCardNo: the process's current card (gts_runtime.c) */
+    GTE_F_GETCARDNO = 16, /* GT_GetCardNo */
+    GTE_F_SETCORE = 32,   /* GT_SetCore: the core of the GT_x calls */
+    GTE_F_GETCORE = 64    /* GT_GetCore */
 };
 
 typedef union gte_arg {

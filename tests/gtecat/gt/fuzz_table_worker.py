@@ -70,6 +70,7 @@ STATEFUL = {
     "UnplugSlave",
     "ReplugSlave",
     "SetCardNo",  # every later call addresses another card
+    "SetCore",  # every later GT_ call addresses another core
 }
 CALL_TIMEOUT_S = 10.0
 PAD = 16

@@ -140,6 +140,16 @@ def test_core_2_is_the_cards_second_core(tmp_path):
     assert gt.GTN_GetPrfPos(1, 1, byref(pos)) == 1  # core 1's bus is not up: its own state
     assert gt.GTN_Reset(3) == 7 and "core 3 does not exist" in gt.GTE_GetLastError()
     assert gt.GTN_EcatIOReadInput(2, 0, 0, 2, byref(c_short())) == 1  # no EtherCAT there
+    # GT_SetCore: the GT_* functions address core 2 (the fast paths step aside)
+    core = c_short()
+    assert gt.GT_GetCore(byref(core)) == 0 and core.value == 1
+    assert gt.GT_SetCore(2) == 0 and gt.GT_GetCore(byref(core)) == 0 and core.value == 2
+    assert gt.GT_GetEncPos(3, byref(pos)) == 0 and pos.value == 2000
+    assert gt.GT_GetSts(3, byref(sts)) == 0 and sts.value & SERVO
+    assert gt.GTN_GetEncPos(1, 3, byref(pos)) == 1  # GTN_* name their core
+    assert gt.GT_SetCore(3) == 7 and "core=3 out of range 1..2" in gt.GTE_GetLastError()
+    assert gt.GT_SetCore(1) == 0
+    assert gt.GT_GetEncPos(3, byref(pos)) == 1  # core 1 again: its bus is not up
     assert gt.GTN_Close() == 0
     assert gt.GTN_GetSts(2, 3, byref(sts)) == -1  # closed with its card
 

@@ -58,6 +58,7 @@ STATE_CHANGING = {
     "UnplugSlave",
     "ReplugSlave",
     "SetCardNo",  # every later call addresses another card
+    "SetCore",  # every later GT_ call addresses another core
 }
 # The default run calls every function with a few examples (the suite's CPU budget);
 # GTECAT_LONG=N runs the campaign: 15 x N examples per function, 8 x N per twin (fresh seeds

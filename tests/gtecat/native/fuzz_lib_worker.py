@@ -49,7 +49,7 @@ from tests.conftest import EXAMPLES
 SKIP = {
     "GT_Open", "GT_Close", "GT_Reset", "GT_InitEcatComm", "GT_TerminateEcatComm",
     "GT_StartEcatComm", "GT_LoadConfig", "GTE_Wait", "GTE_UnplugSlave", "GTE_ReplugSlave",
-    "GT_EcatIOSynch", "GT_SetCardNo",
+    "GT_EcatIOSynch", "GT_SetCardNo", "GT_SetCore",
 }  # fmt: skip
 CODES = {0, 1, 7, -1, -6, -8, -9, -10}
 TEXTS = [b"", b"x.cfg", str(EXAMPLES / "servo.cfg").encode(), b"/nonexistent/a.cfg", b"a" * 300]

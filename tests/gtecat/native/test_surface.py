@@ -136,6 +136,8 @@ def test_two_cards_through_the_one_card_abi(libgts, controller, tmp_path):
     assert (v["up1"], v["set0"], v["up0"], v["jog1"]) == ("0",) * 4
     assert (v["vel0"], v["vel1"]) == ("0", "-10")
     assert (v["close1"], v["sts1_closed"], v["sts0"], v["servo0"]) == ("0", "-1", "0", "1")
+    assert (v["setcore2"], v["getcore_rc"], v["core"], v["rescount_rc"]) == ("0", "0", "2", "0")
+    assert (v["core2_axes"], v["setcore3"], v["setcore1"]) == ("12", "7", "0")
     assert v["close0"] == "0"
 
 

@@ -49,6 +49,14 @@ int main(void)
     GT_SetCardNo(0);
     say("sts0", GT_GetSts(1, &sts, 1, NULL));
     say("servo0", (int)((sts >> 9) & 1));
+    short core = 0, axes = 0;
+    say("setcore2", GT_SetCore(2)); /* GT_x address core 2, the card's second core */
+    say("getcore_rc", GT_GetCore(&core));
+    say("core", core);
+    say("rescount_rc", GT_GetResCount(MC_AXIS, &axes));
+    say("core2_axes", axes);
+    say("setcore3", GT_SetCore(3));
+    say("setcore1", GT_SetCore(1));
     say("close0", GT_Close());
     say("done", 1);
     return 0;
