@@ -43,7 +43,8 @@ reserved) and the headers say no more:
   EtherCAT card; ``[core.2]`` of
   the description (``[card.N.core.2]`` for card N) says otherwise, with the keys of a
   ``[card.N]`` table.  A card has cores 1 and 2 (the vendor's GTN cards have two); core
-  3 and up exist only as bus views.
+  3 and up exist only as bus views.  ``GT_SetCore(core)`` (GTN header) chooses the core
+  the ``GT_*`` functions address, 1 or 2, one per process like the current card.
 """
 
 from __future__ import annotations
