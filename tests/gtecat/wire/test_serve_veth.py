@@ -26,6 +26,7 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import needs_fixture
+from tests.gtecat.wire.rawmaster import _wait_carrier
 
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
@@ -72,6 +73,7 @@ def veth_pair() -> Iterator[tuple[str, str]]:
             subprocess.run(["ip", "link", "set", name, "up"], check=True, timeout=10)
             with contextlib.suppress(OSError):
                 Path(f"/proc/sys/net/ipv6/conf/{name}/disable_ipv6").write_text("1")
+        _wait_carrier(master_if, slave_if)
         yield master_if, slave_if
     finally:
         subprocess.run(["ip", "link", "del", master_if], capture_output=True, timeout=10)
