@@ -200,10 +200,133 @@ def start_pt(axes: Sequence[int], points: int = 400) -> None:
         _ok(gt.GTN_PtStart(core, mask, 0), f"GTN_PtStart({core}, {mask:#x})", core)
 
 
+def by_core(axes: Sequence[int]) -> dict[int, list[int]]:
+    """The bus axes of ``axes`` grouped by their core, in axis order."""
+    out: dict[int, list[int]] = {}
+    for a in sorted(axes):
+        out.setdefault(core_axis(a)[0], []).append(a)
+    return out
+
+
+def _master_trap(a: int) -> None:
+    """Bus axis ``a`` a Trap move in the positive direction, far longer than any measurement."""
+    prm = _gt().TTrapPrm()
+    prm.acc, prm.dec, prm.velStart, prm.smoothTime = 0.5, 0.5, 0, 25
+    gtn("PrfTrap", a)
+    gtn("SetTrapPrm", a, byref(prm))
+    gtn("SetPos", a, 50_000_000)
+    gtn("SetVel", a, 20)
+    update([a])
+
+
+def _start_slaves(axes: Sequence[int], setup: Callable[[int, int], None], start: str) -> None:
+    """Per core: the first axis of ``axes`` is the master (a Trap move), the others are set
+    up as its slaves by ``setup(bus_axis, master_profile)`` and started together with
+    ``GTN_<start>(core, mask)``."""
+    gt = _gt()
+    for core, group in sorted(by_core(axes).items()):
+        master, slaves = group[0], group[1:]
+        _master_trap(master)
+        local = core_axis(master)[1]
+        mask = 0
+        for a in slaves:
+            setup(a, local)
+            mask |= 1 << (core_axis(a)[1] - 1)
+        if mask:
+            fn = getattr(gt, "GTN_" + start)
+            args = (core, mask) if start == "GearStart" else (core, mask, 0)
+            _ok(fn(*args), f"GTN_{start}({core}, {mask:#x})", core)
+
+
+def start_gear(axes: Sequence[int]) -> None:
+    """Per core, the first axis moves in Trap and every other axis follows its planned
+    position in Gear (slave : master = 1 : 2, a 4000-pulse clutch zone)."""
+    gt = _gt()
+
+    def setup(a: int, master: int) -> None:
+        gtn("PrfGear", a, 0)
+        gtn("SetGearMaster", a, master, gt.GEAR_MASTER_PROFILE, 0)
+        gtn("SetGearRatio", a, 2, 1, 4000)
+
+    _start_slaves(axes, setup, "GearStart")
+
+
+#: the cam of the Follow figure: (master, slave, type) points of one pass, 16 segments
+#: of 2000 master pulses up 8000 pulses and back (the FIFO's default 16 points)
+FOLLOW_CAM = tuple((2000 * (k + 1), 1000.0 * min(k + 1, 15 - k), 0) for k in range(16))
+
+
+def start_follow(axes: Sequence[int]) -> None:
+    """Per core, the first axis moves in Trap and every other axis follows its planned
+    position in Follow over :data:`FOLLOW_CAM`, looped endlessly (FIFO 0)."""
+    gt = _gt()
+
+    def setup(a: int, master: int) -> None:
+        gtn("PrfFollow", a, 0)
+        gtn("SetFollowMaster", a, master, gt.FOLLOW_MASTER_PROFILE, 0)
+        gtn("FollowClear", a, 0)
+        for m, s, kind in FOLLOW_CAM:
+            gtn("FollowData", a, m, s, kind, 0)
+        gtn("SetFollowLoop", a, 0)
+
+    _start_slaves(axes, setup, "FollowStart")
+
+
+#: coordinate systems per core (GT_SetCrdPrm's crd 1..2)
+CRD_SYSTEMS = 2
+#: laps of the crd figure's path (4 segments each: line, half circle, line, half circle)
+CRD_LAPS = 250
+
+
+def crd_plan(n: int) -> dict[int, str]:
+    """The crd figure's plan for ``n`` axes: on each core, local axes 1-2 are coordinate
+    system 1 and 3-4 system 2 (the controller's two per core); the other axes hold."""
+    plan = dict.fromkeys(range(1, n + 1), "idle")
+    for a in plan:
+        if core_axis(a)[1] <= 2 * CRD_SYSTEMS:
+            plan[a] = "crd"
+    return plan
+
+
+def start_crd(axes: Sequence[int]) -> None:
+    """Pairs of ``axes`` on one core as XY coordinate systems 1, 2 (at most two per core),
+    each running :data:`CRD_LAPS` laps of a 10000 x 10000 stadium (lines and half circles,
+    tangent joints passed at speed: synVel 20, synAcc 0.5, velEnd 20)."""
+    gt = _gt()
+    for core, group in sorted(by_core(axes).items()):
+        mask = 0
+        for crd in range(1, CRD_SYSTEMS + 1):
+            pair = group[2 * crd - 2 : 2 * crd]
+            if len(pair) < 2:
+                break
+            prm = gt.TCrdPrm()
+            prm.dimension = 2
+            for c, a in enumerate(pair, 1):
+                prm.profile[core_axis(a)[1] - 1] = c
+            prm.synVelMax, prm.synAccMax = 100.0, 2.0
+            _ok(gt.GTN_SetCrdPrm(core, crd, byref(prm)), f"GTN_SetCrdPrm({core}, {crd})", core)
+            _ok(gt.GTN_CrdClear(core, crd, 0), f"GTN_CrdClear({core}, {crd})", core)
+            v, acc = 20.0, 0.5
+            for _ in range(CRD_LAPS):
+                for rc, what in (
+                    (gt.GTN_LnXY(core, crd, 10_000, 0, v, acc, v, 0), "LnXY"),
+                    (gt.GTN_ArcXYC(core, crd, 10_000, 10_000, 0, 5_000, 1, v, acc, v, 0), "Arc"),
+                    (gt.GTN_LnXY(core, crd, 0, 10_000, v, acc, v, 0), "LnXY"),
+                    (gt.GTN_ArcXYC(core, crd, 0, 0, 0, -5_000, 1, v, acc, v, 0), "Arc"),
+                ):
+                    _ok(rc, f"GTN_{what}({core}, {crd})", core)
+            mask |= 1 << (crd - 1)
+        if mask:
+            _ok(gt.GTN_CrdStart(core, mask, 0), f"GTN_CrdStart({core}, {mask:#x})", core)
+
+
 STARTERS: dict[str, Callable[[Sequence[int]], None]] = {
     "moving": start_trap,
     "homing": start_homing,
     "pt": start_pt,
+    "gear": start_gear,
+    "follow": start_follow,
+    "crd": start_crd,
 }
 
 

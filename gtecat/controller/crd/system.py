@@ -602,8 +602,10 @@ class CrdBank:
 
 
 def bank(ctl: Any) -> CrdBank:
-    """The controller's coordinate systems (made on first use)."""
-    b = getattr(ctl, "crd_bank", None)
+    """The coordinate systems of a core (made on first use): each core has its own
+    (``GTN_SetCrdPrm(2, 1, ...)`` sets up system 1 of core 2 over that core's profiles),
+    so a core's view (:mod:`gtecat.controller.core_view`) never reaches core 1's."""
+    b = vars(ctl).get("crd_bank")
     if b is None:
         b = CrdBank(ctl)
         ctl.crd_bank = b
