@@ -14,7 +14,11 @@ puts it in the state, then lets controller time pass with ``GTE_Wait`` and count
 * ``homing``: drive homing method 17 (negative limit switch) through
   ``GT_SetHomingMode`` / ``GT_SetEcatHomingPrm`` / ``GT_StartEcatHoming``; the machine
   description puts each axis's negative limit a billion counts away, so the search
-  outlasts the measurement.
+  outlasts the measurement;
+* ``pt``, ``gear``, ``follow``, ``crd`` (not in the default set): PT over a static FIFO
+  looped endlessly; per core a Trap master and the other axes in Gear / Follow on it;
+  per core two XY coordinate systems on a path of lines and arcs, the other axes holding
+  (:func:`start_pt`, :func:`start_gear`, :func:`start_follow`, :func:`start_crd`).
 
 Everything goes through the public GT API, axis by axis through :func:`core_axis`
 and the ``GTN_*`` functions: the real ``GT_Update(long mask)`` reaches 32 axes per
@@ -47,6 +51,8 @@ from tools.gen_axes_eni import write_axes_eni  # noqa: E402
 
 AXES = (1, 2, 4, 8, 12, 16, 32, 64, 96, 128)
 STATES = ("idle", "moving", "homing")
+#: the other motion modes (``--states pt,gear,follow,crd``): see their ``start_*``
+MODES = ("pt", "gear", "follow", "crd")
 AXES_PER_CORE = 32
 #: axes per core that :func:`core_axis` uses; ``--addressing flat`` puts every axis on
 #: core 1 (the emulator's own extension before issue 17: no GT_Update beyond axis 32)
@@ -429,9 +435,10 @@ def run_bus(
 
 def bench_point(n: int, state: str, *, seconds: float = 1.5, repeat: int = 3) -> dict[str, Any]:
     """One (axes, state) point: every axis in ``state``."""
-    if state not in STATES:
-        raise ValueError(f"state must be one of {', '.join(STATES)}, not {state!r}")
-    r = run_bus(n, dict.fromkeys(range(1, n + 1), state), seconds=seconds, repeat=repeat)
+    if state not in STATES + MODES:
+        raise ValueError(f"state must be one of {', '.join(STATES + MODES)}, not {state!r}")
+    plan = crd_plan(n) if state == "crd" else dict.fromkeys(range(1, n + 1), state)
+    r = run_bus(n, plan, seconds=seconds, repeat=repeat)
     addressing = "cores" if _per_core == AXES_PER_CORE else "flat"
     return {"axes": n, "state": state, **r, "addressing": addressing}
 
@@ -482,7 +489,7 @@ def write_table(results: Sequence[Mapping[str, Any]], path: str | Path) -> None:
     When ``path`` holds the :data:`BEGIN` / :data:`END` markers (``docs/performance.md``),
     only the text between them is replaced; otherwise the file is the table alone.
     """
-    states = [s for s in STATES if any(r["state"] == s for r in results)]
+    states = [s for s in STATES + MODES if any(r["state"] == s for r in results)]
     by = {(r["axes"], r["state"]): r for r in results}
     head = "| axes | " + " | ".join(f"{s} µs/cycle | {s} RTF" for s in states) + " |"
     rule = "|---:|" + "---:|---:|" * len(states)
@@ -516,7 +523,7 @@ def write_plot(results: Sequence[Mapping[str, Any]], path: str | Path, title: st
     import matplotlib.pyplot as plt
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for s in STATES:
+    for s in STATES + MODES:
         pts = sorted((r["axes"], r) for r in results if r["state"] == s and "error" not in r)
         if not pts:
             continue
@@ -553,7 +560,9 @@ def _ints(text: str) -> list[int]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--axes", type=_ints, default=list(AXES), help="e.g. 1,12,64")
-    ap.add_argument("--states", default=",".join(STATES), help="idle,moving,homing")
+    ap.add_argument(
+        "--states", default=",".join(STATES), help="idle,moving,homing (also pt,gear,follow,crd)"
+    )
     ap.add_argument("--seconds", type=float, default=1.5, help="wall seconds per point")
     ap.add_argument("--repeat", type=int, default=3, help="windows per point (best counts)")
     ap.add_argument(
