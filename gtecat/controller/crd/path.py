@@ -53,7 +53,7 @@ class Line:
         if s >= ln or ln == 0.0:
             return self.end
         u = max(s, 0.0) / ln
-        return tuple(a + d * u for a, d in zip(self.start, self._delta))
+        return tuple(a + d * u for a, d in zip(self.start, self._delta, strict=True))
 
     def tangent(self, at_end: bool) -> Vec:
         ln = self.length
