@@ -13,7 +13,8 @@ and with full CiA-402 drives) and on the 12-axis example; the cost of one
 generated buses of single-axis CSP drives (:mod:`tools.bench_scaling`, lockstep
 clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ``ok``: real-time factors of 12 axes moving in Trap, 64 axes (odd axes moving, even
-ones holding), 128 axes moving; 64 axes homing (method 17); 12 axes homing (reported); PT,
+ones holding), 128 axes moving, 12 axes in Trap on the scalar path (bank off: what the modes
+outside the bank compare with); 64 axes homing (method 17); 12 axes homing (reported); PT,
 Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (target 10:
 every motion mode); ``GT_GetSts`` against building its argument, interleaved, and every call
 shape of the fast path likewise (the worst ratio is held to 4); the RSS of a
@@ -278,8 +279,10 @@ def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
     """The issue-17 figures, measured one after the other in this run."""
     from tools.bench_scaling import crd_plan, run_bus
 
-    def rtf(n: int, plan: dict[int, str], target: float | None, what: str) -> dict[str, object]:
-        r = {"axes": n, "what": what, **run_bus(n, plan, seconds=seconds, repeat=repeat)}
+    def rtf(
+        n: int, plan: dict[int, str], target: float | None, what: str, bank: str | None = None
+    ) -> dict[str, object]:
+        r = {"axes": n, "what": what, **run_bus(n, plan, seconds=seconds, repeat=repeat, bank=bank)}
         return r if target is None else _figure(r, "rtf", target)
 
     def every(n: int, state: str) -> dict[int, str]:
@@ -294,6 +297,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
         "rtf_128_axes_trap": rtf(128, every(128, "moving"), 5, "all 128 moving in Trap"),
         "rtf_12_axes_homing_17": rtf(12, every(12, "homing"), None, "drive homing method 17"),
         "rtf_64_axes_homing_17": rtf(64, every(64, "homing"), 10, "drive homing method 17"),
+        "rtf_12_axes_trap_scalar": rtf(
+            12, every(12, "moving"), None, "all 12 moving in Trap, scalar path (bank off)", "off"
+        ),
         "rtf_12_axes_pt": rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
         "rtf_64_axes_pt": rtf(64, every(64, "pt"), 10, "PT, static FIFO, endless loop"),
         "rtf_12_axes_gear": rtf(12, every(12, "gear"), None, GEAR),

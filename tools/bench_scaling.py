@@ -146,11 +146,14 @@ def machine(n: int) -> Any:
     return MachineDescription({a: AxisMachine(negative_limit=-FAR) for a in range(1, n + 1)})
 
 
-def bring_up(eni: Path, n: int) -> None:
-    """Open the controller on ``eni`` (lockstep clock) and take the bus to OP."""
+def bring_up(eni: Path, n: int, bank: str | None = None) -> None:
+    """Open the controller on ``eni`` (lockstep clock) and take the bus to OP; ``bank``:
+    GT_Open's ``bank`` (None: its default, ``off``: the scalar path alone)."""
     gt = _gt()
     gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(eni), machine=machine(n), clock="lockstep", log=""), "GT_Open")
+    opts = {} if bank is None else {"bank": bank}
+    rc = gt.GT_Open(eni=str(eni), machine=machine(n), clock="lockstep", log="", **opts)
+    _ok(rc, "GT_Open")
     _ok(gt.GT_InitEcatComm(), "GT_InitEcatComm")
     ready = c_short()
     for _ in range(10_000):
@@ -391,8 +394,10 @@ def run_bus(
     repeat: int = 3,
     eni_dir: str | Path | None = None,
     after: Callable[[], dict[str, Any]] | None = None,
+    bank: str | None = None,
 ) -> dict[str, Any]:
-    """Bring up ``n`` axes, put axis ``a`` in ``plan[a]`` (missing: ``idle``), measure.
+    """Bring up ``n`` axes, put axis ``a`` in ``plan[a]`` (missing: ``idle``), measure
+    (``bank``: as :func:`bring_up`).
 
     Returns cycles_per_s, rtf, us_per_cycle, us_per_axis, bringup_s, and whatever
     ``after()`` adds (called with the controller still open); ``error`` instead of
@@ -404,7 +409,7 @@ def run_bus(
         eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
         t0 = time.perf_counter()
         try:
-            bring_up(eni, n)
+            bring_up(eni, n, bank)
             for a in full:
                 gtn("AxisOn", a)
             for state, start in STARTERS.items():
