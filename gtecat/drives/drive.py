@@ -106,6 +106,15 @@ _LIMIT_REACTIONS = ("stop", "fault", "none")
 _COMM_REACTIONS = ("disable", "fault", "none")
 
 
+def _shared_int(value: int) -> int:
+    """One int object per object index for every drive's dictionary (an index above 256 is
+    a new object each time it is computed)."""
+    return _INTS.setdefault(value, value)
+
+
+_INTS: dict[int, int] = {}
+
+
 @dataclass(frozen=True, slots=True)
 class DriveSettings:
     """What differs between real drives (see the module docstring for each policy)."""
@@ -296,7 +305,7 @@ class Channel:
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
     ) -> Variable:
-        at = index + self.base
+        at = _shared_int(index + self.base)
         return od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
 
     def _sub(
@@ -310,7 +319,8 @@ class Channel:
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
     ) -> Variable:
-        return AttrVariable(self, attr, index + self.base, sub, name, dt, access, pdo=pdo, **kw)
+        at = _shared_int(index + self.base)
+        return AttrVariable(self, attr, at, sub, name, dt, access, pdo=pdo, **kw)
 
     def _add_objects(self, od: ObjectDictionary) -> None:
         s = self._settings

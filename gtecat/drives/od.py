@@ -151,19 +151,15 @@ class Variable:
     """One entry (index, subindex) of the dictionary."""
 
     __slots__ = (
+        "_x",
         "access",
-        "allowed",
         "data_type",
         "getter",
-        "high",
         "index",
         "info",
-        "low",
-        "max_size",
         "name",
         "pdo",
         "pdo_bits",
-        "placeholder",
         "setter",
         "subindex",
         "value",
@@ -196,17 +192,23 @@ class Variable:
         self.info = TYPE_INFO[self.data_type]
         self.access = access
         self.pdo = pdo
-        self.low = low
-        self.high = high
-        self.allowed = None if allowed is None else _shared(frozenset(allowed))
+        #: what few entries have (a range, allowed values, a string's size, a placeholder
+        #: mark): None or a dict of them, so that the hundreds of entries of a drive without
+        #: them stay small (:attr:`low` and the others read it)
+        self._x: dict[str, Any] | None = None
+        if low is not None:
+            self.low = low
+        if high is not None:
+            self.high = high
+        if allowed is not None:
+            self.allowed = _shared(frozenset(allowed))
         self.write_states = write_states
         self.getter = getter
         self.setter = setter
-        self.max_size = max_size if self.info.is_string else self.info.size
+        if self.info.is_string and max_size:
+            self.max_size = max_size
         #: bit length when mapped: the type's, unless a placeholder was sized by a mapping
         self.pdo_bits = pdo_bits if pdo_bits is not None else self.info.pdo_bits
-        #: created only because a PDO mapping names it (see ObjectDictionary.placeholder)
-        self.placeholder = False
         if default is None:
             default = b"" if self.info.is_string else (0.0 if self.info.fmt == "f" else 0)
         self.value = default
@@ -215,6 +217,39 @@ class Variable:
         return (
             f"<Variable 0x{self.index:04X}:{self.subindex:02X} {self.name} {self.data_type.name}>"
         )
+
+    def _get_x(self, key: str, default: Any = None) -> Any:
+        x = self._x
+        return default if x is None else x.get(key, default)
+
+    def _set_x(self, key: str, value: Any) -> None:
+        x = self._x
+        if x is None:
+            x = self._x = {}
+        x[key] = value
+
+    low = property(lambda self: self._get_x("low"), lambda self, v: self._set_x("low", v))
+    high = property(lambda self: self._get_x("high"), lambda self, v: self._set_x("high", v))
+    allowed = property(
+        lambda self: self._get_x("allowed"), lambda self, v: self._set_x("allowed", v)
+    )
+    #: created only because a PDO mapping names it (see ObjectDictionary.placeholder)
+    placeholder = property(
+        lambda self: self._get_x("placeholder", False),
+        lambda self, v: self._set_x("placeholder", v),
+    )
+
+    @property
+    def max_size(self) -> int:
+        """Bytes a value may have: a string's given size, else the type's."""
+        x = self._x
+        if x is not None and "max_size" in x:
+            return x["max_size"]
+        return 0 if self.info.is_string else self.info.size
+
+    @max_size.setter
+    def max_size(self, value: int) -> None:
+        self._set_x("max_size", value)
 
     # --- values -------------------------------------------------------------
     def get(self) -> Any:

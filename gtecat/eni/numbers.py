@@ -78,6 +78,21 @@ def _parse(text: str) -> int:
 
 def parse_hex_bytes(text: str) -> bytes:
     """ETG.2100 ``Data`` (hex digits, little-endian payload as written) -> bytes."""
+    hit = _HEX.get(text)
+    if hit is not None:
+        return hit
+    data = _parse_hex(text)
+    if len(text) <= 64:  # one object for the same short data, slave after slave
+        if len(_HEX) >= 4096:
+            _HEX.clear()
+        _HEX[text] = data
+    return data
+
+
+_HEX: dict[str, bytes] = {}
+
+
+def _parse_hex(text: str) -> bytes:
     s = "".join(text.split())
     if s.lower().startswith(("#x", "0x")):
         s = s[2:]
