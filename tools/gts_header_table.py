@@ -209,7 +209,8 @@ def _cs_type(t: str) -> str:
 
 def cs_params(text: str) -> list[str]:
     """A C# parameter list in table syntax."""
-    text = re.sub(r"\[[^\]]*\]", " ", " ".join(text.split()))  # [MarshalAs(...)], [In, Out]
+    # [MarshalAs(...)], [In, Out] go; an array's [] stays
+    text = re.sub(r"\[[^\]]*[A-Za-z][^\]]*\]", " ", " ".join(text.split()))
     if not text.strip():
         return []
     out = []
@@ -449,13 +450,21 @@ def only_missing(
             print(f"struct {td.name} left out: a field of an unknown type", file=sys.stderr)
         kept_tds = [td for td in kept_tds if td not in bad]
     kept_consts = {k: v for k, v in consts.items() if k not in have_consts}
-    gives = {"GTN_" + n[3:] for n, ps in new.items() if n.startswith("GT_") and not (
-        ps and re.match(r"^short\s+core\b", ps[0]))}
+    gives = {
+        "GTN_" + n[3:]
+        for n, ps in new.items()
+        if n.startswith("GT_") and not (ps and re.match(r"^short\s+core\b", ps[0]))
+    }
     return new, kept_tds, kept_consts, unknown & (set(new) | gives)
 
 
-def write_missing(folder: Path, by_topic: dict[str, list[str]], structs: list[str], consts: dict,
-                  resolved: set[str]) -> None:
+def write_missing(
+    folder: Path,
+    by_topic: dict[str, list[str]],
+    structs: list[str],
+    consts: dict,
+    resolved: set[str],
+) -> None:
     for old in folder.glob("vendor_gtn_*.py"):
         old.unlink()
     for key, title, _ in TOPICS:
