@@ -418,6 +418,10 @@ def table_has(folder: Path) -> tuple[set[str], set[str], set[str], set[str]]:
     return names, unknown, structs, consts
 
 
+#: macros of C and windows.h that a vendor header defines when its compiler lacks them
+C_MACROS = frozenset({"NULL", "TRUE", "FALSE", "true", "false", "EOF", "INFINITE"})
+
+
 def only_missing(
     folder: Path, functions: dict[str, list[str]], tds: list, consts: dict
 ) -> tuple[dict[str, list[str]], list, dict, set[str]]:
@@ -449,7 +453,11 @@ def only_missing(
         for td in bad:
             print(f"struct {td.name} left out: a field of an unknown type", file=sys.stderr)
         kept_tds = [td for td in kept_tds if td not in bad]
-    kept_consts = {k: v for k, v in consts.items() if k not in have_consts}
+    kept_consts = {  # not the C library's own macros a header may define for itself
+        k: v
+        for k, v in consts.items()
+        if k not in have_consts and k not in C_MACROS and not k.startswith("_")
+    }
     gives = {
         "GTN_" + n[3:]
         for n, ps in new.items()

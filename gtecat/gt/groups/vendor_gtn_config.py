@@ -9,7 +9,16 @@ TITLE = "configuration (newer GTN headers)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GT_GetCardInfo(short *pCardNum, short *pCardType);
+short GT_GetConfig(short mdl, TExtMdlCfgInfo *pExtMdlCfgInfo);
+short GT_GetDriverVersion(unsigned short *mainVer, unsigned short *slaveVer);
+short GT_GetJoystickMapAxis(short joystickIndex, short *pAxis);
+short GT_JoystickReset(short joystickIndex);
 short GTN_LoadReadHsConfig(short core, char *pFile /*str*/);
+short GT_ResetPciCommandFlag();
+short GT_SaveConfigToFile(char *pFile);
+short GT_SetConfig(short mdl, TExtMdlCfgInfo *pExtMdlCfgInfo);
+short GT_SetJoystickMapAxis(short joystickIndex, short *axis);
 short GTN_SetMotionTimeRestrict(short core, short restrictIndex, TMotionTimeRestrict *pRestrict /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_SetResetMode(short core, short type, TResetModePrmUnion *pResetPrm);
 """

@@ -9,6 +9,8 @@ TITLE = "coordinated motion (newer GTN headers)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GT_CrdDisableVariableCircle(short crd, short fifo);
+short GT_CrdEnableVariableCircle(short crd, short fifo);
 short GT_CrdStatusEx(short crd, TCrdStatusEx *pCrdStatus, short fifo);
 short GT_GetCrdJerkTime(short crd, double *pJerkTime, double *pCoef);
 short GT_GetCrdSmoothTime(short crd, short *pSmoothType, double *pPrm /*inout*/);

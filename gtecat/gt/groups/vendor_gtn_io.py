@@ -13,9 +13,11 @@ short GTN_ClearAlarm(short core, short axis, short count, unsigned short delayTi
 short GTN_GetAxisRotaryDirectionSelectMode(short core, short axis, short *pMode);
 short GT_GetBufWaitDiStatus(short crd, short *pDiType, short *pDiIndex, short *pLevel, short *pContinueTime, long *pOverTime, short *pFlagMode, long *pSegNum, short *pEnable, long *pCount, short fifo);
 short GTN_GetBufWaitDiStatusEx(short core, short crd, short fifo, TBufWaitDiStatusEx *pStatus);
+short GT_GetDisplayDip(short *pMode);
 short GTN_GetLimit(short core, short axis, short type, void *pPrm);
 short GTN_GetLimitInfo(short core, short axis, TLimitInfo *pInfo);
 short GTN_SetAxisRotaryDirectionSelectMode(short core, short axis, short mode);
+short GT_SetDisplayDip(short mode);
 short GTN_SetLimit(short core, short axis, short type, void *pPrm);
 short GTN_WriteDigitalOutputBit(short core, TDigitalOutputBit *pDoBit /*inout*/, TListInfo *pListInfo /*inout*/);
 """

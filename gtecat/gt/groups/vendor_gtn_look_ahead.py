@@ -10,9 +10,11 @@ DECLARED_ONLY = True
 
 PROTOTYPES = r"""
 short GTN_BufMoveAbsoluteEx(short core, short crd, short moveAxis, TBufMoveAbsPrm *pPrm /*inout*/);
+short GT_BufMoveJog(short crd, short moveAxis, double vel, double acc, short modal, short fifo=0);
 short GTN_BufMoveJogEx(short core, short crd, short moveAxis, double vel, double acc, short modal, short fifo);
 short GTN_BufPrfCompEnable(short core, short crd, short fifo, short profile, short enable, short enableType);
 short GT_BufPrfCompEnableEx(short crd, short fifo, short profile, short enable, short enableType);
+short GT_BufStop(short crd, long mask, long option, short fifo=0);
 short GTN_BufStopEx(short core, short crd, long mask, long option, short fifo);
 short GT_BufWaitDi(short crd, short diType, short diIndex, short level, short continueTime, long overTime, short flagMode, long segNum, short fifo);
 short GT_BufWaitLongVar(short crd, short index, long value, long overTime, short flagMode, long segNum, short fifo);

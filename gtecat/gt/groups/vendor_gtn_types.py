@@ -116,6 +116,18 @@ typedef struct { EMachineType machineType; short reserve1[2]; double primaryAxis
 typedef struct { short frqTableId; short dutyTableId; double pad1[8]; short pad2[8]; } TLaserFollowDuoTablePrm;
 typedef struct { short type; short dimension; short index[3]; short subIndex[3]; double targetMax; double targetMin; double factor; long fixRegionP; long fixRegionN; long fixRegionInterval; long tmp[16]; } TAxisPressCompensateFixFactor;
 typedef struct { short type; short dimension; short index[3]; short subIndex[3]; double target; double factor; TAxisPressPid pid; long fixPosLimitP; long fixPosLimitN; double thredshold; double deadZone; double Knp; double K1; double K2; double K3; double Krise; double Kpeak; double Tset; double Td; double tmp[8]; } TAxisPressCompensateFixPid;
+typedef struct { double totalTime; double remainderTime; double pad[2]; } TTrapTime;
+typedef struct { short mode; short encoderX; short encoderY; short source; short outputType; short startLevel; long pulseTime; short maxerr; long pulseCount; long pulseCycle; long interval; unsigned short pad1[2]; long pad2[2]; } T2DComparePrmEx;
+typedef struct { long px; long py; long intervalX; long intervalY; long count; } T2DCompareDataGroup;
+typedef struct { long startPosX; long startPosY; long intervalX; long intervalY; unsigned long count; } T2DCompareLinear;
+typedef struct { short mdlType; short mdlAddressBegin; short adChannels; double adMaxVoltage; double adMinVoltage; short daChannels; double daMaxVoltage; double daMinVoltage; unsigned short outSave; } TExtMdlCfgInfo;
+typedef struct { short mode; double homeSearchVel; double acc; long homeSearchDis; long indexSearchDis; long homeReturnOffset; long indexReturnOffest; } TAutoHomePrm;
+typedef struct { short run; short stage; short result; long capturePos; long targetPos; } TAutoHomeStatus;
+typedef struct { unsigned short config; unsigned short fifoEmpty; unsigned short head; unsigned short tail; unsigned long commandReceive; unsigned long commandSend; long posX; long posY; short sourceReverseX; short sourceReverseY; short reserve[12]; } TPosCompareInfoEx;
+typedef struct { long scale[3]; double motionAcc[3]; double motionDec[3]; double motionSmooth[3]; } TJoystickMoitonPrm;
+typedef struct { double xMotionVel[3]; double yMotionVel[3]; double zMotionVel[3]; } TJoystickMoitonVel;
+typedef struct { long thresholdValue[3]; long joystickMaxValue[3]; long joystickMedianValue[3]; long joystickMinValue[3]; } TJoystickCriticalValue;
+typedef struct { long baudRate; short byteSize; short parity; short stopBits; short reserve; } TSericalPortPrm;
 """
 
 CONSTANTS = r"""
@@ -285,4 +297,22 @@ CONSTANTS = r"""
 #define PRESS_COMPENSATE_MODE_TABLE 1
 #define PRESS_COMPENSATE_MODE_REGION_LEARN 2
 #define CRD_OPERATION_TYPE_LASER_FOLLOW 6
+#define LASER_DIS_TABLE_COUNT 10
+#define CRD_OPERATION_TYPE_SET_LASER_DIS_ENABLE 30
+#define CRD_OPERATION_TYPE_SELECT_LASER_DIS_TABLE 31
+#define CRD_OPERATION_TYPE_BUF_STOP 36
+#define CRD_OPERATION_TYPE_BUF_MOVE_JOG 37
+#define CRD_OPERATION_TYPE_BUF_POS_COMPARE_START 90
+#define CRD_OPERATION_TYPE_BUF_POS_COMPARE_STOP 91
+#define CRD_OPERATION_TYPE_BUF_POS_COMPARE_PSO_PRM 97
+#define CRD_OPERATION_TYPE_BUF_SET_COMPARE_PORT 98
+#define CRD_OPERATION_TYPE_BUF_2D_COMPARE_DATA 100
+#define CRD_OPERATION_TYPE_BUF_2D_COMPARE_PULSE 101
+#define CRD_OPERATION_TYPE_LASER_FOLLOW_TABLE 200
+#define INTERPOLATION_MOTION_TYPE_CIRCLE_VARIABLE 60
+#define AUTO_HOME_MODE_HOME 1
+#define AUTO_HOME_MODE_HOME_INDEX 2
+#define AUTO_HOME_MODE_HOME_STOP 3
+#define MC_JOYSTICK_AXIS_COUNT_MAX 3
+#define MC_JOYSTICK_VEL_COUNT_MAX 3
 """
