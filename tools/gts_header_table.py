@@ -299,16 +299,41 @@ def read_cs(path: Path, text: str) -> tuple[list[tuple[str, list[str]]], dict, l
     return found, consts, enums + structs
 
 
+#: a function's other parameter lists, as later headers or wrappers declare it (the first
+#: named wins; its table line says what the others declare)
+OTHERS: dict[str, list[str]] = {}
+
+
+def _plain(ps: list[str]) -> str:
+    """The parameter types, as a reader compares them (``short, long *, short``)."""
+    return ", ".join(re.sub(r"\s*\*\s*", " *", t).strip() for t in _types(ps))
+
+
 def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
     functions: dict[str, list[str]] = {}
     tds: list = []
     consts: dict[str, int | float] = {}
     multi: list[tuple[str, list[str]]] = []
+
+    def take(found: list[tuple[str, list[str]]]) -> None:
+        firsts = [ps[0] for n, ps in found if n.startswith("GT_") and ps]
+        if firsts and sum("cardNum" in p for p in firsts) > len(firsts) / 2:
+            # the multi-card ABI: the same functions with short cardNum first
+            multi.extend((n, ps[1:] if ps and "cardNum" in ps[0] else ps) for n, ps in found)
+        else:
+            for name, ps in found:
+                add(name, ps)
+
+    def add(name: str, ps: list[str]) -> None:
+        if name not in functions:
+            functions[name] = ps
+        elif _plain(functions[name]) != _plain(ps) and _plain(ps) not in OTHERS.get(name, []):
+            OTHERS.setdefault(name, []).append(_plain(ps))
+
     for path in paths:
         if path.suffix.lower() == ".cs":
             found_cs, cs_consts, cs_structs = read_cs(path, read(path))
-            for name, ps in found_cs:
-                functions.setdefault(name, ps)
+            take(found_cs)
             for k, v in cs_consts.items():
                 consts.setdefault(k, v)
             for block in cs_structs:
@@ -319,15 +344,7 @@ def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
             continue
         text = typedefs.strip_comments(read(path))
         CALLBACKS.update(_CALLBACK.findall(text))
-        found = [(m[1], params(m[2], f"{path}:{m[1]}")) for m in _API.finditer(text)]
-        firsts = [ps[0] for n, ps in found if n.startswith("GT_") and ps]
-        if firsts and sum("cardNum" in p for p in firsts) > len(firsts) / 2:
-            # the multi-card ABI: the same functions with short cardNum first
-            found = [(n, ps[1:] if ps and "cardNum" in ps[0] else ps) for n, ps in found]
-            multi.extend(found)
-        else:
-            for name, ps in found:
-                functions.setdefault(name, ps)
+        take([(m[1], params(m[2], f"{path}:{m[1]}")) for m in _API.finditer(text)])
         for k, v in typedefs.parse_constants(text, consts).items():
             consts.setdefault(k, v)
         body = re.sub(r"^\s*#.*$", "", text, flags=re.M)
@@ -343,7 +360,7 @@ def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
             except typedefs.TypedefError as e:
                 print(f"{path}: skipped: {e}", file=sys.stderr)
     for name, ps in multi:  # after every single-card header: those win
-        functions.setdefault(name, ps)
+        add(name, ps)
     return functions, tds, consts
 
 
@@ -355,7 +372,13 @@ def lines(functions: dict[str, list[str]]) -> dict[str, list[str]]:
             gt = functions.get("GT_" + name[4:])
             if gt is not None and _types(ps) == ["short", *_types(gt)]:
                 continue  # the GT_x line gives it
-        by_topic[topic(name)].append(f"short {name}({', '.join(ps)});")
+        line = f"short {name}({', '.join(ps)});"
+        others = [o for o in OTHERS.get(name, []) if o != _plain(ps)]
+        if others:
+            line += "  // header; other public copies declare " + " or ".join(
+                f"({o})" for o in others
+            )
+        by_topic[topic(name)].append(line)
     return by_topic
 
 

@@ -102,3 +102,15 @@ def test_only_missing_writes_what_the_table_lacks(tmp_path: Path) -> None:
     # run again: the same files (its own vendor_gtn_* do not count as the table)
     assert tool.main(["--only-missing", "--out", str(groups), str(cs)]) == 0
     assert {p.name for p in groups.glob("vendor_gtn_*.py")} == written
+
+
+def test_headers_that_disagree_first_named_wins_and_the_line_says_so(tmp_path: Path) -> None:
+    newer = tmp_path / "newer.h"
+    newer.write_text("GT_API GTN_SetFifoMode(short core, short index, short mode);\n")
+    older = tmp_path / "older.h"
+    older.write_text("GT_API GTN_SetFifoMode(short core, short index, short mode, short on);\n")
+    tool.OTHERS.clear()
+    functions, _, _ = tool.extract([newer, older])
+    (line,) = tool.lines(functions)["basic"]
+    assert line.startswith("short GTN_SetFifoMode(short core, short index, short mode);")
+    assert "other public copies declare (short, short, short, short)" in line

@@ -18,10 +18,8 @@ short GTN_ClearCommandListStatus(short core, short list);
 short GTN_CommandListDataEnd(short core, short list);
 short GTN_Ellipse(short core, short crd, TEllipseParameter *pEllipse /*inout*/, double synVel, double synAcc, double velEnd, long long segNum, short fifo=0);
 short GTN_EllipseEx(short core, short crd, TEllipseParameter *pEllipse /*inout*/, double synVel, double synAcc, double velEnd, long long segNum, short fifo=0);
-short GTN_EllipsePro(short core, short crd, short mode, void *pData, double synVel, double synAcc, double velEnd, long long segNum, short fifo=0);
-short GT_EllipsePro(short cardNum, short crd, short mode, void *pData, double synVel, double synAcc, double velEnd, long long segNum, short fifo);
-short GTN_EllipseProEx(short core, short crd, short mode, void *pData, double synVel, double synAcc, double velEnd, long long segNum, short fifo=0);
-short GT_EllipseProEx(short cardNum, short crd, short mode, void *pData, double synVel, double synAcc, double velEnd, long long segNum, short fifo);
+short GT_EllipsePro(short crd, short mode, void *pData, double synVel, double synAcc, double velEnd, long long segNum, short fifo);
+short GT_EllipseProEx(short crd, short mode, void *pData, double synVel, double synAcc, double velEnd, long long segNum, short fifo);
 short GTN_GetAtlPress(short core, short pressProfile, double *pValue);
 short GTN_GetAxisArriveMode(short core, short axis, TAxisArrivePrm *pPrm);
 short GT_GetAxisMotionSmooth(short axis, double *pTime, double *pK);
@@ -62,7 +60,7 @@ short GTN_GetStsEx(short core, short axis, long *pSts, short count=1, unsigned l
 short GTN_GetTaskStatus(short core, short index, TaskStatus *pStatus);
 short GTN_GetTemperature(short core, double *pTemperature);
 short GT_GetTrapTime(short profile, TTrapTime *pTime);
-short GTN_GetWaitForCondition(short core, short list, TWatchCondition *pWatchCondition, short *pConditionCount, short *pOperation, TWaitTimeout *pTimeout, short *pConditionResult, short *pConditionDone);
+short GTN_GetWaitForCondition(short core, short list, TWatchCondition *pWatchCondition, short *pConditionCount, short *pOperation, TWaitTimeout *pTimeout, short *pConditionResult, short *pConditionDone);  // header; other public copies declare (short, short, TWatchCondition *, short *, short, TWaitTimeout *, short *)
 short GTN_InitIlc(short core);
 short GTN_InitialMachineBuildingPara(short core, short crd, TMachCfgInfo *pMachCfgInfo /*inout*/, double *machineCoordCenter /*inout*/, double *workCoordCenter /*inout*/, double toolLength);
 short GT_JoystickCheckEnable(short joystickIndex, short checkEnable);

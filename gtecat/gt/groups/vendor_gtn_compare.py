@@ -47,7 +47,7 @@ short GTN_GetTriggerLatchValue(short core, short i, long count, long *pValue, lo
 short GTN_GetTriggerPrm(short core, short i, TTriggerPrm *pTriggerPrm);
 short GTN_GetTriggerProfileStatus(short core, short profile, TTriggerProfileStatus *pSts);
 short GT_LaserFollowOff(short crd, short fifo, short channel);
-short GTN_PosCompareDataMass(short core, short index, TPosCompareData *pData /*inout*/, long long *pSendCount, long long count);
+short GTN_PosCompareDataMass(short core, short index, TPosCompareData *pData /*inout*/, long long *pSendCount, long long count);  // header; other public copies declare (short, short, void *, long long *, long long)
 short GT_PosCompareInfoEx(short index, TPosCompareInfoEx *pInfo);
 short GT_PosComparePulse(short index, short outputMode, short level, unsigned short outputPulseWidth);
 short GTN_PosComparePulseEx(short core, short index, TPosComparePulse *pPosComparePulse /*inout*/);
@@ -58,7 +58,7 @@ short GT_SelectLaserDisTable(short channel, short index);
 short GTN_SetLaserFollowMode(short core, TLaserFollowPrm *pPrm /*inout*/, short channel);
 short GT_SetLaserFollowTable(short tableId, long n, double *pVel, double *pPower, short channel);
 short GTN_SetLaserOnOffSmooth(short core, short crd, short fifo, short channel, short mask);
-short GTN_SetPosCompareFifoMode(short core, short index, short mode);
+short GTN_SetPosCompareFifoMode(short core, short index, short mode);  // header; other public copies declare (short, short, short, short)
 short GTN_SetPosComparePulseCount(short core, short index, long count);
 short GTN_SetPressTrigger(short core, short pressAxis, short pressThread, short triggerCondition);
 short GTN_SetScanLaserDelayPro(short core, short scanCrd, double laserOnDelay, double laserOffDelay, TListInfo *pListInfo /*inout*/);

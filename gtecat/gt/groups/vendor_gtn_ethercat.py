@@ -12,5 +12,5 @@ PROTOTYPES = r"""
 short GTN_GetEcatDcErrorEx(short core, TEcatErrInfo *pEcatErrorInfo);
 short GTN_SetEcatAxisDOBit(short core, short axis, short bitOffset, unsigned char DoBitValue);
 short GTN_SetEcatAxisLmtHomeIndex(short core, short axis, short index_LimitN, short index_LimitP, short index_Home);
-short GTN_SetEcatHomingPrmEx(short core, short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);
+short GTN_SetEcatHomingPrmEx(short core, short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);  // header; other public copies declare (short, short, void *, void *, void *, void *, void *, void *)
 """

@@ -13,7 +13,7 @@ short GTN_ClearScanExecuteTimePro(short core, short scanCrd);
 short GTN_EncryptionFunConfig(short core, short slotIndex, unsigned char *pOldKey /*inout*/, unsigned char *pNewKey /*inout*/, unsigned char *pUserData /*inout*/, short *pSts, short *pConfigured);
 short GT_GetBufWaitLongVarStatus(short crd, short *pIndex, long *pValue, short *pFlagMode, long *pSegNum, short *pEnable, short *pStatus, short fifo);
 short GTN_GetEventStatus(short core, short index, TEventStatus *pStatus);
-short GT_GetFlagVar(short cardNum, short index, short *pMode, short *pValue);
+short GT_GetFlagVar(short index, short *pMode, short *pValue);
 short GTN_GetScanExecuteTimePro(short core, short scanCrd, double *pExecuteTime);
 short GTN_GetScanStatusPro(short core, short scanCrd, TScanStatusPro *pPrm);
 short GTN_LoadVarCalculate(short core, TVarCalculate *pVarCalculate /*inout*/, short count, TListInfo *pListInfo /*inout*/);
@@ -33,7 +33,7 @@ short GTN_ScanLinearPro(short core, short scanCrd, short motionMode, TScanLinear
 short GTN_ScanLoadInfiniteViewFile(short core, short scanCrd, char *pFileName /*str*/);
 short GTN_ScanSendInfiniteViewData(short core, short scanCrd, double time, double *pTime, double *pMotionTime);
 short GTN_ScanWobbleMotionCircularEnablePro(short core, short scanCrd, short enable, TScanWobbleMotionCircular *pWobbleMotionCircular /*inout*/, TListInfo *pListInfo /*inout*/);
-short GT_SetFlagVar(short cardNum, short index, short mode, short value);
+short GT_SetFlagVar(short index, short mode, short value);
 short GTN_SetScanDelayPrmPro(short core, short scanCrd, TScanDelayParameterPro *pPrm /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_SetScanMotionDelayPro(short core, short scanCrd, double delayTime, TListInfo *pListInfo /*inout*/);
 short GTN_SetVarCondition(short core, TVarCondition *pVarCondition /*inout*/, short count, TListInfo *pListInfo /*inout*/);
