@@ -33,6 +33,18 @@ def test_point_is_well_formed(state: str) -> None:
     json.dumps(r)
 
 
+@pytest.mark.parametrize("state", bench_scaling.MODES)
+def test_mode_point_is_well_formed(state: str) -> None:
+    """PT, Gear, Follow, crd on 4 axes: every axis of the plan still moving at the end."""
+    r = bench_point(4, state, seconds=0.02, repeat=1)
+    assert FIGURES <= r.keys(), r.get("error")
+
+
+def test_crd_plan_takes_four_axes_per_core() -> None:
+    plan = bench_scaling.crd_plan(40)
+    assert [a for a, s in plan.items() if s == "crd"] == [1, 2, 3, 4, 33, 34, 35, 36]
+
+
 def test_pt_and_mixed_plan() -> None:
     r = bench_scaling.run_bus(3, {1: "pt", 2: "moving"}, seconds=0.02, repeat=1)
     assert FIGURES <= r.keys(), r.get("error")
@@ -44,8 +56,9 @@ def test_axis_beyond_32_names_its_core(tmp_path: Path) -> None:
 
     bench_scaling.bring_up(write_axes_eni(1, tmp_path / "one.eni"), 1)
     try:
-        with pytest.raises(BenchError, match=r"GTN_AxisOn\(2, 1\) for bus axis 33"):
-            gtn("AxisOn", 33)
+        # (core 2 of a bus this small is the card's second core, a pulse core of its own)
+        with pytest.raises(BenchError, match=r"GTN_AxisOn\(3, 1\) for bus axis 65"):
+            gtn("AxisOn", 65)
     finally:
         gt.GT_Close()
 
