@@ -213,6 +213,7 @@ class AxisBank:
         self.groups: list[_Group] = []
         self.dirty = True
         self._countdown = 0
+        self._missed = False  # the last refresh found an eligible group it could not claim
         self.n = 0
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
@@ -591,7 +592,7 @@ class AxisBank:
             if self.n_alive:
                 self.release_all()
             return
-        changed = False
+        changed = missed = False
         for g in self.groups:
             if g.claimed:
                 continue
@@ -599,9 +600,16 @@ class AxisBank:
                 continue
             if not all(self._eligible(r) for r in g.rows):
                 continue
-            changed |= self._claim(g)
+            claimed = self._claim(g)
+            changed |= claimed
+            missed |= not claimed
         if changed:
             self._reindex()
+        if missed and not self._missed:
+            # an eligible drive had not yet taken (or sent) what the image holds: its next
+            # scalar step does, so look again after it rather than RECHECK_CYCLES later
+            self._countdown = 1
+        self._missed = missed
 
     def _claim(self, g: _Group) -> bool:
         # the slave decoded exactly what is in the image (no raw write since its last step)
@@ -1042,21 +1050,45 @@ class AxisBank:
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
 
-    def _after_kernel(self, k: Kernel) -> None:
+    def run_cycles(self, t_ns: int, dt_ns: int, n: int) -> int:
+        """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
+        controller whose cycle has nothing else to do (:meth:`Controller.run_cycles`): the
+        cycles run, each exactly the one :meth:`cycle` would run; 0 when the next cycle
+        needs :meth:`cycle` (something to claim or release, a table to refill, a row
+        leaving, no compiled kernel).  It stops before the first cycle the kernel declines."""
+        k = self.kernel
+        if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
+            return 0
+        dt = dt_ns * 1e-9
+        if dt != self.csp._dt:
+            return 0
+        if self.n_moving:  # a table runs out: the numpy cycle refills it
+            n = min(n, self._refill_in - 1)
+            if n <= 0:
+                return 0
+        done = k.run(t_ns, dt_ns, dt, n)
+        if done:
+            self._countdown -= done
+            self._refill_in -= done
+            self._lists.clear()
+            self._after_kernel(k, done)
+        return done
+
+    def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
         """What the numpy cycle does besides its arithmetic, after a compiled cycle."""
         csp = self.csp
-        csp.cycles += 1
+        csp.cycles += cycles
         csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's
         if csp.any_fe:
             csp.fe_running = True  # the numpy cycle then looks at every row's timer
         if k.move_ended:
             self.n_moving = int(np.count_nonzero(self.moving))
             self._count_standing()
-        self.rows_run += self.n_alive
-        self.bank_cycles += 1
-        self.kernel_cycles += 1
-        self.homing_rows_run += self.n_hm
-        self.frozen_rows_run += self.n_frz
+        self.rows_run += self.n_alive * cycles
+        self.bank_cycles += cycles
+        self.kernel_cycles += cycles
+        self.homing_rows_run += self.n_hm * cycles
+        self.frozen_rows_run += self.n_frz * cycles
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

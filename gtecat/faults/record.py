@@ -402,7 +402,7 @@ def replay(
 def _where(head: dict[str, Any]) -> Any:
     """The recorded folder and GTECAT_* settings for the replay (a backend of real hardware
     is replaced by the emulated one)."""
-    saved_env = {k: os.environ.get(k) for k in _ENV}
+    saved_env = {k: os.environ.get(k) for k in (*_ENV, "GTECAT_INSPECT")}
     saved_cwd = os.getcwd()
     env = head.get("env") or {}
     for k in _ENV:
@@ -414,6 +414,8 @@ def _where(head: dict[str, Any]) -> Any:
         os.environ["GTECAT_BACKEND"] = "emulated"
     if os.environ.get("GTECAT_CLOCK") == "realtime":
         os.environ["GTECAT_CLOCK"] = "auto"
+    # nothing to watch: a replay runs many times faster than real time
+    os.environ["GTECAT_INSPECT"] = "0"
     cwd = head.get("cwd")
     if isinstance(cwd, str) and os.path.isdir(cwd):
         os.chdir(cwd)
