@@ -737,6 +737,18 @@ class AxisBank:
         self.t_cur[r] = 0
         self.t_end[r] = end if end < TABLE else -1
 
+    def _fill_tables(self) -> None:
+        """New Trap samples for the moving rows whose table ran out; :attr:`_refill_in`: the
+        cycles until the next one runs out."""
+        moving, cur = self.moving, self.t_cur
+        need = moving & (cur >= self.t_len)
+        if np.count_nonzero(need):
+            self._materialise()
+            for r in np.nonzero(need)[0].tolist():
+                self._refill(r)
+        left = (self.t_len - cur)[moving]
+        self._refill_in = int(left.min()) if len(left) else TABLE
+
     # --- release ---------------------------------------------------------------------------------
     def release_all(self) -> None:
         if self.n_alive:
@@ -888,13 +900,16 @@ class AxisBank:
         self._lists.clear()
         k = self.kernel
         if k is not None:
-            # the plain cycle compiled; a table to refill (rare) or a new cycle time goes
-            # through numpy, and so does a cycle the kernel declines (nothing written then)
+            # the plain cycle compiled; a new cycle time goes through numpy, and so does a
+            # cycle the kernel declines (nothing written then)
             dt = dt_ns * 1e-9
             if (self.n_hm or self.n_frz) and dt != self.csp._dt:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
-            if dt == self.csp._dt and not (self.n_moving and self._refill_in <= 1):
-                self._refill_in -= 1
+            if dt == self.csp._dt:
+                if self.n_moving and self._refill_in <= 1:
+                    self._fill_tables()  # as the numpy cycle would first (its step 2)
+                else:
+                    self._refill_in -= 1
                 rc = k.cycle(t_ns, dt)
                 while rc == 3:  # homing rows meeting an event: back to their drives first
                     self._release_rows(np.nonzero(k.scratch["s_hit"] & self.hm)[0])
@@ -920,13 +935,7 @@ class AxisBank:
         moving, cur = self.moving, self.t_cur
         self._refill_in -= 1
         if self.n_moving and self._refill_in <= 0:
-            need = moving & (cur >= self.t_len)
-            if np.count_nonzero(need):
-                self._materialise()
-                for r in np.nonzero(need)[0].tolist():
-                    self._refill(r)
-            left = (self.t_len - cur)[moving]
-            self._refill_in = int(left.min()) if len(left) else TABLE
+            self._fill_tables()
         idx = self.base + cur
         prf_p = self.t_p.take(idx)
         ended = cur == self.t_end
@@ -1054,16 +1063,20 @@ class AxisBank:
         """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
         controller whose cycle has nothing else to do (:meth:`Controller.run_cycles`): the
         cycles run, each exactly the one :meth:`cycle` would run; 0 when the next cycle
-        needs :meth:`cycle` (something to claim or release, a table to refill, a row
-        leaving, no compiled kernel).  It stops before the first cycle the kernel declines."""
+        needs :meth:`cycle` (something to claim or release, a row leaving, no compiled
+        kernel).  It stops before the first cycle the kernel declines and where the shortest
+        Trap table ends (the next call fills it)."""
         k = self.kernel
         if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
             return 0
         dt = dt_ns * 1e-9
         if dt != self.csp._dt:
             return 0
-        if self.n_moving:  # a table runs out: the numpy cycle refills it
-            n = min(n, self._refill_in - 1)
+        if self.n_moving:
+            if self._refill_in <= 1:  # a table runs out: fill it first, as cycle() would
+                self._fill_tables()
+                self._refill_in += 1  # (counted like cycle()'s: one more than the samples left)
+            n = min(n, self._refill_in - 1)  # no further than the shortest table goes
             if n <= 0:
                 return 0
         done = k.run(t_ns, dt_ns, dt, n)

@@ -3,8 +3,8 @@
 A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
 * a header ``{"gtecat_recording": 1, ...}``;
-* one line per GT call: ``{"c": NAME, "a": [arguments], "k": {keywords}, "o": {index:
-  value written back}, "r": return code, "t": controller time in ns}``, and ``"b"``: the
+* one line per GT call: ``{"t": controller time in ns, "c": NAME, "a": [arguments], "r":
+  return code, "k": {keywords}, "o": {index: value written back}}``, and ``"b"``: the
   controller time when the call began, where time passed since the call before (a
   controller process lets its clock follow the wall clock between its clients' calls);
 * ``{"f": "inject", "v": {a [[fault]] table}}`` / ``{"f": "clear", "id": N}`` for faults
@@ -15,7 +15,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
 structure field by field, an array as its values, a buffer as hex); replay builds fresh
 objects of the same types, makes the same calls in the same order and compares every return
-code, every value written back and every checkpoint: the first difference is the
+code, every value the call leaves in its pointer arguments (written back or left as it was)
+and every checkpoint: the first difference is the
 divergence (call number, function, argument, recorded and new value).  Replays are
 deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session replays in
 ``auto`` (the values its wall clock decided may then differ, and are reported so).
@@ -25,7 +26,6 @@ from __future__ import annotations
 
 import ctypes
 import gzip
-import io
 import json
 import os
 import threading
@@ -176,22 +176,6 @@ def decode(v: Any) -> Any:
     return None  # a value that cannot be rebuilt (an object of the caller's)
 
 
-def _pooled(pool: dict[tuple[str, int, str], tuple[Any, Any]], name: str, i: int, v: Any) -> Any:
-    """``decode(v)``, but a pointer to a simple value is one object per function and argument,
-    reused with the recorded value (an application polls with the same variable: so does the
-    replay, and the GT layer's fast path recognises it)."""
-    ref = v.get("ref")
-    if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
-        key = (name, i, ref["c"])
-        hit = pool.get(key)
-        if hit is None:
-            obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
-            hit = pool[key] = (obj, ctypes.byref(obj))
-        hit[0].value = ref["v"]
-        return hit[1]
-    return decode(v)
-
-
 def _set_field(obj: Any, name: str, fv: Any) -> None:
     cur = getattr(obj, name)
     if isinstance(cur, ctypes.Array):
@@ -281,10 +265,10 @@ class Recorder(Listener):
         ctl = _controller()
         t = ctl.clock.now_ns if ctl is not None else 0
         entry: dict[str, Any] = {
+            "t": t,  # first: a reader finds calls that differ only in time (read)
             "c": name,
             "a": a,
             "r": rc if isinstance(rc, int) else encode(rc),
-            "t": t,
         }
         if kw:
             entry["k"] = kw
@@ -364,6 +348,9 @@ def _show(v: Any) -> str:
 
 
 def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """(header, entries) of a recording.  Calls that differ only in their time are one
+    shared entry (an application polls the same way thousands of times): read them, never
+    change them."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -371,18 +358,28 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         raise ParameterError(f"{p}: no such recording") from None
     if raw[:2] == b"\x1f\x8b":
         raw = gzip.decompress(raw)
-    lines = io.StringIO(raw.decode("utf-8", "replace"))
+    lines = raw.decode("utf-8", "replace").split("\n")
     try:
-        head = json.loads(lines.readline() or "{}")
+        head = json.loads(lines[0] or "{}")
     except json.JSONDecodeError:
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
-    try:
-        body = lines.read().strip()
-        entries = json.loads("[" + body.replace("\n", ",") + "]") if body else []
-    except json.JSONDecodeError as e:
-        raise ParameterError(f"{p}: damaged recording: {e}") from None
+    entries: list[dict[str, Any]] = []
+    same: dict[str, dict[str, Any]] = {}  # a call's line without its time -> its entry
+    loads, add = json.loads, entries.append
+    for no, line in enumerate(lines[1:], 2):
+        try:
+            if line.startswith('{"t":'):  # as Recorder writes a call: the time first
+                rest = line[line.find(",", 5) :]
+                e = same.get(rest)
+                if e is None:
+                    e = same[rest] = loads(line)
+                add(e)
+            elif line.strip():
+                add(loads(line))
+        except json.JSONDecodeError as err:
+            raise ParameterError(f"{p}: damaged recording: line {no}: {err}") from None
     return head, entries
 
 
@@ -430,6 +427,88 @@ def _where(head: dict[str, Any]) -> Any:
                 os.environ[k] = v
 
 
+@dataclass(slots=True)
+class _Call:
+    """One recorded call made ready to run again (once per distinct entry)."""
+
+    fn: Any
+    name: str
+    args: list[Any]  # the arguments; a pooled pointer is its byref, a fresh one None
+    sets: list[tuple[Any, Any]]  # (pooled object, the value it held at the call)
+    fresh: list[tuple[int, Any]]  # (index, encoding): an object built anew for every call
+    kw: dict[str, Any] | None  # encoded keywords (None: none)
+    rc: Any
+    #: what the call leaves in its pointer arguments: (index or keyword, the recorded value,
+    #: the pooled object and its plain recorded value for a quick look, or None, None)
+    checks: list[tuple[int | str, Any, Any, Any]]
+    before: int | None  # "b": the controller time the call began at
+    opens: bool  # GT_Open: the replay's own settings
+
+
+def _prepare(
+    e: dict[str, Any], fn: Any, pool: dict[tuple[str, int, str], tuple[Any, Any]]
+) -> _Call:
+    name = e["c"]
+    a = e["a"]
+    outs = e.get("o") or {}
+    args: list[Any] = []
+    sets: list[tuple[Any, Any]] = []
+    fresh: list[tuple[int, Any]] = []
+    checks: list[tuple[int | str, Any, Any, Any]] = []
+    for i, x in enumerate(a):
+        if not isinstance(x, dict):
+            args.append(x)
+            continue
+        want = outs.get(str(i), x)  # not in "o": the call left the value as it was
+        ref = x.get("ref")
+        if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
+            # a pointer to a simple value: one object per function and argument, set to the
+            # recorded value before each call (an application polls with the same variable:
+            # so does the replay, and the GT layer's fast path recognises it)
+            key = (name, i, ref["c"])
+            hit = pool.get(key)
+            if hit is None:
+                obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
+                hit = pool[key] = (obj, ctypes.byref(obj))
+            obj = hit[0]
+            sets.append((obj, ref["v"]))
+            args.append(hit[1])
+            w = want.get("ref") if isinstance(want, dict) and len(want) == 1 else None
+            quick = (
+                isinstance(w, dict)
+                and len(w) == 2
+                and w.get("c") == type(obj).__name__
+                and "v" in w
+                and not isinstance(w["v"], dict)
+            )
+            checks.append((i, want, obj if quick else None, w["v"] if quick else None))
+            continue
+        fresh.append((i, x))
+        args.append(None)
+        if str(i) in outs or _round_trips(x):
+            checks.append((i, want, None, None))
+    kw = e.get("k")
+    for k, want in outs.items():
+        if not k.isdigit():
+            checks.append((k, want, None, None))
+    for k, x in (kw or {}).items():
+        if k not in outs and isinstance(x, dict) and _round_trips(x):
+            checks.append((k, x, None, None))
+    return _Call(
+        fn, name, args, sets, fresh, kw, e["r"], checks, e.get("b"), name in ("GT_Open", "GTN_Open")
+    )
+
+
+def _round_trips(x: Any) -> bool:
+    """A recorded argument that the call may write into and that comes back as recorded:
+    the value it still holds after the call is then compared too."""
+    try:
+        v = decode(x)
+    except ParameterError:
+        return False
+    return _mutable(v) and encode(v) == x
+
+
 def _replay(
     entries: list[dict[str, Any]], eni: str | None, machine: str | None
 ) -> tuple[int, Divergence | None]:
@@ -439,32 +518,42 @@ def _replay(
     machine = str(Path(machine).resolve()) if machine else None
     gt.GT_Close()
     n = 0
-    fns: dict[str, Any] = {}
     pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
+    ready: dict[int, _Call] = {}  # id(entry) -> the call (entries that differ only in time
+    # are one object: see read)
     try:
         for e in entries:
-            if "c" in e:
-                n += 1
-                name = e["c"]
-                fn = fns.get(name)
+            p = ready.get(id(e))
+            if p is None:
+                if "c" not in e:
+                    div = _other(e, n, faults)
+                    if div is not None:
+                        return n, div
+                    continue
+                fn = getattr(gt, e["c"], None)
                 if fn is None:
-                    fn = fns[name] = getattr(gt, name, None)
-                    if fn is None:
-                        return n, Divergence(n, name, "function", "present", "missing")
-                before = e.get("b")
-                if before is not None:  # time passed between the calls: let it pass here too
-                    ctl = _controller()
-                    if ctl is not None:
-                        gap = before - ctl.clock.now_ns - ctl.clock._pending_ns
-                        if gap > 0:
-                            ctl.clock.advance_ns(gap)
-                a = e["a"]
-                args = [
-                    x if not isinstance(x, dict) else _pooled(pool, name, i, x)
-                    for i, x in enumerate(a)
-                ]
-                kw = {k: decode(v) for k, v in e.get("k", {}).items()}
-                if name in ("GT_Open", "GTN_Open"):
+                    return n + 1, Divergence(n + 1, e["c"], "function", "present", "missing")
+                p = ready[id(e)] = _prepare(e, fn, pool)
+            n += 1
+            if p.before is not None:  # time passed between the calls: let it pass here too
+                ctl = _controller()
+                if ctl is not None:
+                    gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
+                    if gap > 0:
+                        ctl.clock.advance_ns(gap)
+            for obj, v in p.sets:
+                obj.value = v
+            args = p.args
+            if p.fresh:
+                args = list(args)
+                for i, x in p.fresh:
+                    args[i] = decode(x)
+            if p.kw is None and not p.opens:
+                kw: dict[str, Any] = {}
+                rc = p.fn(*args)
+            else:
+                kw = {k: decode(v) for k, v in (p.kw or {}).items()}
+                if p.opens:
                     if eni:
                         kw["eni"] = str(eni)
                     if machine:
@@ -474,36 +563,40 @@ def _replay(
                     if kw.get("backend") == "pysoem":
                         kw["backend"] = "emulated"
                     kw["log"] = ""  # the session's master log is not written again
-                rc = fn(*args, **kw)
-                if rc != e["r"]:
-                    return n, Divergence(n, name, "return code", e["r"], rc)
-                outs = e.get("o")
-                if outs:
-                    for key, want in outs.items():
-                        got = encode(args[int(key)] if key.isdigit() else kw[key])
-                        if got != want:
-                            what = f"argument {int(key) + 1}" if key.isdigit() else key
-                            return n, Divergence(n, name, what, want, got)
-            elif "cp" in e:
-                ctl = _controller()
-                got = checkpoint(ctl) if ctl is not None else None
-                if got != e:
-                    ms = e["cp"] / 1e6
-                    return n, Divergence(n, "(bus)", f"bus state at {ms:g} ms", e, got)
-            elif "f" in e:
-                ctl = _controller()
-                if ctl is None:
+                rc = p.fn(*args, **kw)
+            if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
+                return n, Divergence(n, p.name, "return code", p.rc, rc)
+            for where, want, obj, v in p.checks:
+                if obj is not None and obj.value == v:
                     continue
-                if e["f"] == "inject":
-                    values = dict(e["v"])
-                    if not e.get("sync") and "ms" in e:
-                        values["at_ms"] = e["ms"]
-                    faults.inject(faults.spec_from_dict(values), ctl=ctl)
-                elif e["f"] == "clear":
-                    faults.clear(e["v"].get("id"), ctl=ctl)
+                got = encode(args[where] if type(where) is int else kw.get(where))
+                if got != want:
+                    what = f"argument {where + 1}" if type(where) is int else where
+                    return n, Divergence(n, p.name, what, want, got)
     finally:
         gt.GT_Close()
     return n, None
+
+
+def _other(e: dict[str, Any], n: int, faults: Any) -> Divergence | None:
+    """A checkpoint (compared) or a fault (injected or cleared again)."""
+    if "cp" in e:
+        ctl = _controller()
+        got = checkpoint(ctl) if ctl is not None else None
+        if got != e:
+            return Divergence(n, "(bus)", f"bus state at {e['cp'] / 1e6:g} ms", e, got)
+    elif "f" in e:
+        ctl = _controller()
+        if ctl is None:
+            return None
+        if e["f"] == "inject":
+            values = dict(e["v"])
+            if not e.get("sync") and "ms" in e:
+                values["at_ms"] = e["ms"]
+            faults.inject(faults.spec_from_dict(values), ctl=ctl)
+        elif e["f"] == "clear":
+            faults.clear(e["v"].get("id"), ctl=ctl)
+    return None
 
 
 __all__ = [
