@@ -33,7 +33,7 @@ sys.path.insert(0, str(ROOT))
 ENI = ROOT / "examples" / "twelve_axes.eni"
 AXES = 12
 HOMING = (1, 2)  # home first (method 3: home switch, index pulse)
-JOG = (11, 12)  # jog, turning round every JOG_TURN_MS
+JOG = (3, 4)  # jog, turning round every JOG_TURN_MS
 JOG_TURN_MS = 3000
 #: axes 1 and 2 stand inside the home switch's window, like bench_homing_gt's axis
 MACHINE = """\

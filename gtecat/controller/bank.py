@@ -104,7 +104,9 @@ COMPUTED_TX = {
 CONSTANT_TX = {0x603F, 0x6061, 0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, 0x1001, 0x20F2, 0x20F9}
 CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 
-#: GT functions whose implementations read a claimed axis through the bank itself
+#: GT functions whose implementations read a claimed axis through the bank itself, or touch
+#: no axis object at all (the process image, the clock: a raw write to a claimed slave's
+#: outputs is seen by the bank's next cycle, which gives the slave back first)
 BANK_READS = frozenset(
     {
         "GT_GetSts",
@@ -123,6 +125,9 @@ BANK_READS = frozenset(
         "GT_GetPrfMode",
         "GT_GetEcatRawData",
         "GT_SetEcatRawData",
+        "GT_EcatIOReadInput",
+        "GT_EcatIOWriteOutput",
+        "GT_EcatIOBitWriteOutput",
         "GT_GetClock",
         "GTE_Wait",
         "GTE_GetLastError",

@@ -57,6 +57,10 @@ _SIMPLE = {
     and isinstance(getattr(ctypes, name), type)
     and issubclass(getattr(ctypes, name), ctypes._SimpleCData)  # type: ignore[attr-defined]
 }
+#: the simple types whose own name is their recorded name (an alias such as c_int32 records
+#: its class's name)
+_SIMPLE_NAME = {cls: cls.__name__ for cls in _SIMPLE.values() if cls.__name__ in _SIMPLE}
+_PLAIN = (int, str, bool, type(None))
 
 
 # --- values ------------------------------------------------------------------------------
@@ -73,6 +77,11 @@ _INF = float("inf")
 
 def encode(x: Any) -> Any:
     """An argument as plain JSON (module docstring)."""
+    if type(x) is _CArg:  # byref(c_long()), the usual pointer: the quick way to the same
+        name = _SIMPLE_NAME.get(type(x._obj))
+        if name is not None:
+            v = x._obj.value
+            return {"ref": {"c": name, "v": v if type(v) is int else _scalar(v)}}
     if x is None or isinstance(x, bool | int | str):
         return x
     if isinstance(x, float):
@@ -253,15 +262,32 @@ class Recorder(Listener):
             total = ctl.clock.now_ns + ctl.clock._pending_ns
             if total != self._t_end and self._t_end >= 0:
                 gap = total
-        return [encode(a) for a in args], {k: encode(v) for k, v in kwargs.items()}, gap
+        a: list[Any] = []
+        held: list[tuple[str, Any, Any]] = []  # (index or keyword, object, its value before)
+        for i, x in enumerate(args):
+            if type(x) in _PLAIN:
+                a.append(x)
+                continue
+            enc = encode(x)
+            a.append(enc)
+            if _mutable(x):
+                held.append((str(i), x, enc))
+        kw = {}
+        for k, x in kwargs.items():
+            kw[k] = enc = encode(x)
+            if _mutable(x):
+                held.append((k, x, enc))
+        return a, kw, gap, held
 
     def after(self, name: str, args: tuple, kwargs: dict, rc: Any, token: Any) -> None:
         if token is None:
             return
-        a, kw, gap = token
-        outs = {str(i): encode(x) for i, x in enumerate(args) if _mutable(x)}
-        outs.update({k: encode(v) for k, v in kwargs.items() if _mutable(v)})
-        outs = {k: v for k, v in outs.items() if v != (a[int(k)] if k.isdigit() else kw.get(k))}
+        a, kw, gap, held = token
+        outs = {}
+        for k, x, enc in held:  # what the call wrote back into its pointer arguments
+            now = encode(x)
+            if now != enc:
+                outs[k] = now
         ctl = _controller()
         t = ctl.clock.now_ns if ctl is not None else 0
         entry: dict[str, Any] = {
@@ -305,9 +331,15 @@ class Recorder(Listener):
 
 
 def _controller() -> Any:
-    from ..gt._core import SESSION
+    session = _SESSION[0]
+    if session is None:
+        from ..gt._core import SESSION
 
-    return SESSION.controllers.get(1)
+        session = _SESSION[0] = SESSION
+    return session.controllers.get(1)
+
+
+_SESSION: list[Any] = [None]
 
 
 def checkpoint(ctl: Any) -> dict[str, Any] | None:
