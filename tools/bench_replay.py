@@ -13,15 +13,18 @@ recording's and the replay's wall and CPU time, and how many times faster than r
 the replay runs: virtual/wall (``times_real_time``) and virtual/CPU
 (``times_real_time_cpu``, the same figure on a machine nobody else loads; the bar: at least
 50).  ``--repeat N`` replays N times and reports the best of each.  The plain session
-(no recording) is run too, to show what recording costs.
+(no recording) is run too, to show what recording costs.  ``--against CHECKOUT`` replays the
+same recording with another checkout's gtecat as well (each replay in a fresh process, the two
+in turn): before and after in one run.
 
-    python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--json]
+    python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import subprocess
 import sys
 import tempfile
 import time
@@ -135,7 +138,33 @@ def _best(runs: list[tuple[float, float]]) -> tuple[float, float]:
     return min(r[0] for r in runs), min(r[1] for r in runs)
 
 
-def measure(seconds: float, poll_ms: int, repeat: int) -> dict[str, object]:
+_CHILD = """
+import json, sys, time
+sys.path.insert(0, sys.argv[1])
+from gtecat.faults.record import replay
+t0, c0 = time.perf_counter(), time.process_time()
+n, div = replay(sys.argv[2])
+wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+print(json.dumps([wall, cpu, n, str(div) if div else None]))
+"""
+
+
+def replay_in(root: Path, path: Path) -> tuple[float, float, int, str | None]:
+    """(wall, CPU, calls, divergence) of a replay of ``path`` by the gtecat of checkout ``root``,
+    in a fresh process."""
+    out = subprocess.run(
+        [sys.executable, "-c", _CHILD, str(root), str(path)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    wall, cpu, n, div = json.loads(out.stdout.strip().splitlines()[-1])
+    return wall, cpu, n, div
+
+
+def measure(
+    seconds: float, poll_ms: int, repeat: int, against: Path | None = None
+) -> dict[str, object]:
     from gtecat import gt
     from gtecat.faults.record import Recorder, replay
 
@@ -165,6 +194,22 @@ def measure(seconds: float, poll_ms: int, repeat: int) -> dict[str, object]:
             if div is not None:
                 break
         size = path.stat().st_size
+        before: dict[str, object] = {}
+        if against is not None:  # the same recording, old and new, in fresh processes, in turn
+            old_runs, new_runs = [], []
+            for _ in range(repeat):
+                old_runs.append(replay_in(against, path))
+                new_runs.append(replay_in(ROOT, path))
+            for key, rr in (("before", old_runs), ("after", new_runs)):
+                w, c = _best([(r[0], r[1]) for r in rr])
+                before[key] = {
+                    "checkout": str(against if key == "before" else ROOT),
+                    "replay_wall_s": round(w, 3),
+                    "replay_cpu_s": round(c, 3),
+                    "times_real_time": round(seconds / w, 1),
+                    "times_real_time_cpu": round(seconds / c, 1),
+                    "diverged": rr[-1][3],
+                }
     wall, cpu = _best(runs)
     pw, pc = _best(plain)
     return {
@@ -182,6 +227,7 @@ def measure(seconds: float, poll_ms: int, repeat: int) -> dict[str, object]:
         "times_real_time_cpu": round(seconds / cpu, 1),
         "file_bytes": size,
         "diverged": str(div) if div else None,
+        **before,
     }
 
 
@@ -190,9 +236,14 @@ def main() -> int:
     ap.add_argument("--seconds", type=float, default=60.0)
     ap.add_argument("--poll-ms", type=int, default=10, help="the application's loop period")
     ap.add_argument("--repeat", type=int, default=3, help="runs; the best is reported")
+    ap.add_argument(
+        "--against",
+        type=Path,
+        help="another checkout: replay the same recording with its gtecat too (before/after)",
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    out = measure(args.seconds, args.poll_ms, max(1, args.repeat))
+    out = measure(args.seconds, args.poll_ms, max(1, args.repeat), args.against)
     print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
     return 0 if out["diverged"] is None else 1
 

@@ -397,22 +397,33 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
-    entries: list[dict[str, Any]] = []
-    same: dict[str, dict[str, Any]] = {}  # a call's line without its time -> its entry
-    loads, add = json.loads, entries.append
-    for no, line in enumerate(lines[1:], 2):
-        try:
-            if line.startswith('{"t":'):  # as Recorder writes a call: the time first
-                rest = line[line.find(",", 5) :]
-                e = same.get(rest)
-                if e is None:
-                    e = same[rest] = loads(line)
-                add(e)
-            elif line.strip():
-                add(loads(line))
-        except json.JSONDecodeError as err:
-            raise ParameterError(f"{p}: damaged recording: line {no}: {err}") from None
-    return head, entries
+    texts: list[str] = []  # the distinct lines, parsed at once below
+    order: list[int] = []  # each entry's line in texts
+    same: dict[str, int] = {}  # a call's line without its time -> its place in texts
+    for line in lines[1:]:
+        if line.startswith('{"t":'):  # as Recorder writes a call: the time first
+            rest = line[line.find(",", 5) :]
+            k = same.get(rest)
+            if k is None:
+                k = same[rest] = len(texts)
+                texts.append(line)
+            order.append(k)
+        elif line.strip():
+            order.append(len(texts))
+            texts.append(line)
+    try:
+        parsed = json.loads("[" + ",".join(texts) + "]")
+        if len(parsed) != len(texts) or not all(type(x) is dict for x in parsed):
+            raise json.JSONDecodeError("a line that is not one entry", "", 0)
+    except json.JSONDecodeError:
+        for no, line in enumerate(lines[1:], 2):  # which line
+            try:
+                if line.strip() and not isinstance(json.loads(line), dict):
+                    raise json.JSONDecodeError("not an entry (a JSON object)", line, 0)
+            except json.JSONDecodeError as err:
+                raise ParameterError(f"{p}: damaged recording: line {no}: {err}") from None
+        raise ParameterError(f"{p}: damaged recording") from None
+    return head, [parsed[k] for k in order]
 
 
 def replay(
@@ -562,10 +573,16 @@ def _replay(
                     if div is not None:
                         return n, div
                     continue
-                fn = getattr(gt, e["c"], None)
+                fn = getattr(gt, e["c"], None) if type(e["c"]) is str else None
                 if fn is None:
                     return n + 1, Divergence(n + 1, e["c"], "function", "present", "missing")
-                p = ready[id(e)] = _prepare(e, fn, pool)
+                try:
+                    p = ready[id(e)] = _prepare(e, fn, pool)
+                except (KeyError, TypeError, ValueError, AttributeError) as err:
+                    raise ParameterError(
+                        f"damaged recording: call {n + 1} ({e['c']}) cannot be made again: "
+                        f"{type(err).__name__}: {err}"
+                    ) from None
             n += 1
             if p.before is not None:  # time passed between the calls: let it pass here too
                 ctl = _controller()
