@@ -141,6 +141,7 @@ def _best(runs: list[tuple[float, float]]) -> tuple[float, float]:
 _CHILD = """
 import json, sys, time
 sys.path.insert(0, sys.argv[1])
+from gtecat import gt  # imported before the clock starts, as in this process
 from gtecat.faults.record import replay
 t0, c0 = time.perf_counter(), time.process_time()
 n, div = replay(sys.argv[2])
@@ -151,7 +152,7 @@ print(json.dumps([wall, cpu, n, str(div) if div else None]))
 
 def replay_in(root: Path, path: Path) -> tuple[float, float, int, str | None]:
     """(wall, CPU, calls, divergence) of a replay of ``path`` by the gtecat of checkout ``root``,
-    in a fresh process."""
+    in a fresh process (its start and imports not counted)."""
     out = subprocess.run(
         [sys.executable, "-c", _CHILD, str(root), str(path)],
         capture_output=True,
