@@ -2,7 +2,7 @@
 
 The session is an application's loop on the 12-axis example bus: bring-up, servo on, axes 1
 and 2 home (CiA-402 method 3 on a home switch with an index pulse) and join the others,
-which run Trap moves (a new one as soon as an axis is at rest), axes 11 and 12 jog and
+which run Trap moves (a new one as soon as an axis is at rest), axes 3 and 4 jog and
 turn round every 3 s; every ``--poll-ms`` of controller time (default 10) the loop reads
 the clock and GT_GetSts of each axis (and the homing status while an axis homes), every
 100 ms the planned and encoder positions of each axis and the DIO slave's inputs, every
@@ -18,12 +18,14 @@ same recording with another checkout's gtecat as well (each replay in a fresh pr
 in turn): before and after in one run.
 
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
+                                 [--simple] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -58,8 +60,11 @@ index_offset = 3000
 """
 
 
-def session(gt, seconds: float, poll_ms: int = 10, machine: str | None = None) -> int:
-    """The application (module docstring); returns the GT calls it made (about)."""
+def session(
+    gt, seconds: float, poll_ms: int = 10, machine: str | None = None, simple: bool = False
+) -> int:
+    """The application (module docstring); returns the loop's passes.  ``simple``: Trap moves
+    on every axis and the status polling only (the first version of this benchmark)."""
     kw = {"machine": machine} if machine else {}
     assert gt.GT_Open(eni=str(ENI), clock="auto", log="", **kw) == 0
     assert gt.GT_InitEcatComm() == 0
@@ -70,7 +75,8 @@ def session(gt, seconds: float, poll_ms: int = 10, machine: str | None = None) -
     gt.GT_Reset()
     for a in range(1, AXES + 1):
         gt.GT_AxisOn(a)
-    homing = set(HOMING if machine else ())
+    homing = set(HOMING if machine and not simple else ())
+    jogging = () if simple else JOG
     for a in homing:
         gt.GT_SetHomingMode(a, 6)
         gt.GT_SetEcatHomingPrm(a, 3, 5000, 3000, 100000, 0, 0)
@@ -79,7 +85,7 @@ def session(gt, seconds: float, poll_ms: int = 10, machine: str | None = None) -
     prm.acc = prm.dec = 0.5
     jog = gt.TJogPrm()
     jog.acc = jog.dec = 0.25
-    for a in JOG:
+    for a in jogging:
         gt.GT_PrfJog(a)
         gt.GT_SetJogPrm(a, byref(jog))
         gt.GT_SetVel(a, 8.0)
@@ -89,7 +95,7 @@ def session(gt, seconds: float, poll_ms: int = 10, machine: str | None = None) -
     di = (c_ubyte * 2)()
     do = (c_ubyte * 2)()
     target = [0] * (AXES + 1)
-    jog_dir = {a: 1 for a in JOG}
+    jog_dir = {a: 1 for a in jogging}
     t_end = seconds * 1000
     step = 0
     per_100ms = max(1, 100 // poll_ms)
@@ -106,7 +112,7 @@ def session(gt, seconds: float, poll_ms: int = 10, machine: str | None = None) -
                 gt.GT_SetHomingMode(a, 8)
         for a in range(1, AXES + 1):
             gt.GT_GetSts(a, byref(sts))
-            if a in homing or a in JOG:
+            if a in homing or a in jogging:
                 continue
             if not sts.value & 0x400:  # at rest: the next move
                 target[a] = 20_000 if target[a] <= 0 else -20_000
@@ -116,16 +122,18 @@ def session(gt, seconds: float, poll_ms: int = 10, machine: str | None = None) -
                 gt.GT_SetVel(a, 10 + a)
                 gt.GT_Update(1 << (a - 1))
         if step % per_turn == per_turn - 1:
-            for a in JOG:
+            for a in jogging:
                 jog_dir[a] = -jog_dir[a]
                 gt.GT_SetVel(a, 8.0 * jog_dir[a])
                 gt.GT_Update(1 << (a - 1))
         if step % per_100ms == 0:
             for a in range(1, AXES + 1):
                 gt.GT_GetPrfPos(a, byref(pos))
-                gt.GT_GetEncPos(a, byref(enc))
-            gt.GT_EcatIOReadInput(6, 0, 2, di)
-        if step % per_s == 0:
+                if not simple:
+                    gt.GT_GetEncPos(a, byref(enc))
+            if not simple:
+                gt.GT_EcatIOReadInput(6, 0, 2, di)
+        if step % per_s == 0 and not simple:
             do[0] = (step // per_s) & 0xFF
             gt.GT_EcatIOWriteOutput(6, 0, 2, do)
         step += 1
@@ -164,7 +172,7 @@ def replay_in(root: Path, path: Path) -> tuple[float, float, int, str | None]:
 
 
 def measure(
-    seconds: float, poll_ms: int, repeat: int, against: Path | None = None
+    seconds: float, poll_ms: int, repeat: int, against: Path | None = None, simple: bool = False
 ) -> dict[str, object]:
     from gtecat import gt
     from gtecat.faults.record import Recorder, replay
@@ -176,12 +184,12 @@ def measure(
         plain = []
         for _ in range(repeat):
             t0, c0 = time.perf_counter(), time.process_time()
-            session(gt, seconds, poll_ms, str(machine))
+            session(gt, seconds, poll_ms, str(machine), simple)
             plain.append((time.perf_counter() - t0, time.process_time() - c0))
         rec = Recorder(path).start()
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            session(gt, seconds, poll_ms, str(machine))
+            session(gt, seconds, poll_ms, str(machine), simple)
         finally:
             rec.stop()
         recorded = (time.perf_counter() - t0, time.process_time() - c0)
@@ -214,8 +222,10 @@ def measure(
     wall, cpu = _best(runs)
     pw, pc = _best(plain)
     return {
+        "session": "simple" if simple else "full",
         "virtual_s": seconds,
         "poll_ms": poll_ms,
+        "load_average": round(os.getloadavg()[0], 2),
         "calls": n,
         "session_wall_s": round(pw, 3),
         "session_cpu_s": round(pc, 3),
@@ -242,9 +252,14 @@ def main() -> int:
         type=Path,
         help="another checkout: replay the same recording with its gtecat too (before/after)",
     )
+    ap.add_argument(
+        "--simple",
+        action="store_true",
+        help="Trap moves and status polling only (no homing, jog, IO)",
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    out = measure(args.seconds, args.poll_ms, max(1, args.repeat), args.against)
+    out = measure(args.seconds, args.poll_ms, max(1, args.repeat), args.against, args.simple)
     print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
     return 0 if out["diverged"] is None else 1
 
