@@ -1,7 +1,8 @@
 """``gtecat fault``: break a running machine on purpose (inject, list, clear), or list the kinds.
 
 ``inject KIND key=value ...`` arms a fault on a running gtecat (``--attach ID``, else the
-only one ``gtecat ps`` lists): the same kinds and keys as a machine description's
+only one ``gtecat ps`` lists: an application, a controller, or a ``gtecat serve``, whose
+master on the wire then sees it): the same kinds and keys as a machine description's
 ``[[fault]]`` tables, a trigger among them (``at_ms=``, ``after_ms=``, ``after_cycles=``,
 ``when_position=AXIS,POS``, ``at_homing=AXIS,STAGE``, ``on_sdo=SLAVE,INDEX,N``; none: at
 once), ``duration_ms=`` for how long it lasts.  ``list`` shows what is armed or active,
@@ -22,6 +23,7 @@ examples:
   gtecat fault inject drive_fault axis=1 code=0x2310   on the only running gtecat
   gtecat fault inject link_down after_slave=1 at_ms=5000 duration_ms=200 --attach 4242
   gtecat fault inject mailbox_abort slave=0 index=0x6060 code=0x06090030
+  gtecat fault inject drop_responses count=3 --attach 5120   on a gtecat serve: 3 answers lost
   gtecat fault list
   gtecat fault clear 3"""
 
@@ -90,7 +92,7 @@ def _connect(args: argparse.Namespace) -> Any:
     if found is None:
         raise BusError(
             "no running gtecat to act on (gtecat ps lists them; an application publishes one "
-            "when it calls GT_Open)"
+            "when it calls GT_Open, a gtecat serve once it answers frames)"
         )
     return found[1]
 

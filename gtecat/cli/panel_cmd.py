@@ -131,6 +131,13 @@ def run(args: argparse.Namespace) -> int:
                 "no running gtecat to show (gtecat ps); start your application, or give "
                 "--eni FILE for a bus of the panel's own"
             )
+        if info.kind == "serve":
+            raise BusError(
+                f"{info.id} is a gtecat serve: the panel shows a controller's bus, and a "
+                "serve's controller is its master on the other end of the wire; see the "
+                f"serve's slaves with gtecat states --attach {info.id} and its faults with "
+                f"gtecat fault list --attach {info.id}"
+            )
         path = str(info.socket)
         title = f"{info.kind} {info.id}: {os.path.basename(info.eni)}"
 

@@ -1,9 +1,10 @@
 """``gtecat ps``: the running gtecats whose bus the verbs and the panel can attach to.
 
-Every Python application that called ``GT_Open`` and every ``gtecat controller``
-publishes an inspection endpoint (unless ``GTECAT_INSPECT=0``) in a per-user runtime
-folder (``$XDG_RUNTIME_DIR/gtecat``, else ``/tmp/gtecat-UID``).  Entries of processes
-that have ended are removed as they are found.
+Every Python application that called ``GT_Open``, every running controller and every
+serve (the kind column says which: python, controller, serve) publishes an inspection
+endpoint (unless ``GTECAT_INSPECT=0``) in a per-user runtime folder
+(``$XDG_RUNTIME_DIR/gtecat``, else ``/tmp/gtecat-UID``).  Entries of processes that have
+ended are removed as they are found.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ examples:
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "ps",
-        help="list the running gtecats (applications, controllers) the verbs can attach to",
+        help="list the running gtecats (applications, controllers, serves) the verbs can attach to",
         description=output.describe(__doc__),
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,

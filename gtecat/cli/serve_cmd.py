@@ -5,10 +5,15 @@ same machine description), puts them behind software ESCs and answers EtherCAT f
 IFACE until Ctrl-C or SIGTERM.  Any master (SOEM/pysoem, TwinCAT, IgH, acontis) on the
 other end of the wire sees a chain of real-looking slaves.  Needs root or CAP_NET_RAW.
 
+While it runs, the ps verb lists it (its id is in the ready line); the fault verbs
+(inject, list, clear, with --attach ID) then break its chain at runtime, and the states
+verb shows its slaves' AL states.
+
 examples:
   gtecat serve --eni manual_fig5_2.eni --iface veth1
   gtecat serve --eni Gecat.eni --machine machine.toml --iface enp3s0 --duration 60
   gtecat serve --eni Gecat.eni --iface veth1 --fault link_loss.toml
+  gtecat fault inject link_down after_slave=1 --attach 5120   (another terminal)
 """
 
 from __future__ import annotations
@@ -323,7 +328,10 @@ def run(args: argparse.Namespace) -> int:
         wait=wait,
         pcap=pcap,
     )
-    _arm_faults(args, chain, server)
+    from gtecat.inspect.serve import ServeHost
+
+    host = ServeHost(server, config, eni=args.eni, iface=args.iface, say=_sayer(server))
+    _arm_faults(args, host)
     # the scheduling last, once everything that can fail has been checked; given back at
     # the end (a program that calls serve in-process keeps its own)
     before = _scheduling_now()
@@ -357,13 +365,19 @@ def run(args: argparse.Namespace) -> int:
         old[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, _snapshot)
 
     served = []
+    endpoint = None
 
     def _ready() -> None:
+        nonlocal endpoint
+        from gtecat.inspect.serve import publish
+
         served.append(True)
+        endpoint = publish(host)  # `gtecat ps` lists it; `gtecat fault --attach` acts on it
         names = ", ".join(f"{s.position}:{s.name}" for s in chain.slaves)
+        seen = f", id {endpoint.id} (gtecat ps)" if endpoint is not None else ""
         print(
             f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}), --wait {wait}, "
-            f"{scheduling}; ready",
+            f"{scheduling}{seen}; ready",
             flush=True,
         )
         server.said_ready = True
@@ -373,6 +387,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         server.serve(ready=_ready, duration_s=args.duration)
     finally:
+        if endpoint is not None:
+            endpoint.close()
         _restore_scheduling(before)
         for s, h in old.items():
             signal.signal(s, h)
@@ -390,10 +406,25 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _arm_faults(args: argparse.Namespace, chain, server) -> None:
-    """The machine description's and the --fault files' [[fault]] tables on the chain."""
+def _sayer(server):
+    """``gtecat serve: MESSAGE`` on stderr; said before the ready line: said right after it."""
+    early: list[str] = []
+    server.early_messages = early
+
+    def say(message: str) -> None:
+        if not getattr(server, "said_ready", False):
+            early.append(message)
+            return
+        print(f"gtecat serve: {message}", file=sys.stderr, flush=True)
+
+    return say
+
+
+def _arm_faults(args: argparse.Namespace, host) -> None:
+    """The machine description's and the --fault files' [[fault]] tables on the chain (the
+    injector ``gtecat fault --attach`` reaches at runtime)."""
     from gtecat.drives.machine import load_machine
-    from gtecat.faults import Injector, WireBus, arm, load, specs_from_tables
+    from gtecat.faults import arm, load, specs_from_tables
 
     specs = []
     if args.machine:
@@ -402,33 +433,8 @@ def _arm_faults(args: argparse.Namespace, chain, server) -> None:
             specs += specs_from_tables(list(tables), str(args.machine))
     for path in args.fault:
         specs += load(path)
-    if not specs:
-        return
-
-    early: list[str] = []  # said before the ready line: said right after it
-
-    def say(message: str) -> None:
-        if early is not None and not getattr(server, "said_ready", False):
-            early.append(message)
-            return
-        print(f"gtecat serve: {message}", file=sys.stderr, flush=True)
-
-    server.early_messages = early
-
-    bus = WireBus(chain, server, log=say)
-    injector = Injector(bus)
-    arm(injector, specs)
-
-    def step(t_ns: int) -> None:
-        bus.at(t_ns)
-        injector.tick()
-
-    def poll(t_ns: int) -> None:
-        bus.at(t_ns)
-        injector.tick(cycle=False)
-
-    server.step_hooks.append(step)
-    server.poll_hooks.append(poll)
+    if specs:
+        arm(host.fault_injector(), specs)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -141,7 +141,11 @@ def arm(injector: Injector, specs: list[FaultSpec]) -> list[Entry]:
 
 # --- the controller's injector ----------------------------------------------------------------
 def injector_for(ctl: Any, create: bool = True) -> Injector | None:
-    """The injector of ``ctl``'s bus (made on first use; one per GT_InitEcatComm)."""
+    """The injector of ``ctl``'s bus (made on first use; one per GT_InitEcatComm); a
+    ``gtecat serve`` (:class:`gtecat.inspect.serve.ServeHost`) keeps its own."""
+    own = getattr(ctl, "fault_injector", None)
+    if own is not None:
+        return own(create)
     backend = ctl.backend
     if backend is None or ctl.master is None or not ctl.master.opened:
         if not create:

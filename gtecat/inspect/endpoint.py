@@ -33,7 +33,9 @@ overlap.  (A GT call the application makes in that instant, outside any cycle, i
 held back: in those modes the GT layer takes no lock.  Requests are short.)
 
 **When it publishes.**  :func:`publish` is called by ``GT_Open`` (and so by ``gtecat
-controller``, which opens through it).  ``GTECAT_INSPECT=0`` turns it off; the pytest
+controller``, which opens through it); ``gtecat serve`` publishes the same endpoint over its
+chain of slaves once it answers frames (:mod:`gtecat.inspect.serve`: its requests run
+between two frames).  ``GTECAT_INSPECT=0`` turns it off; the pytest
 plugin sets that default for the test run (thousands of short controllers; a test that
 wants an endpoint sets ``GTECAT_INSPECT=1``).  Starting costs a thread and a socket.
 """
@@ -88,7 +90,20 @@ class _Conn:
 
 
 class Endpoint:
-    """One controller's endpoint (module docstring)."""
+    """One controller's endpoint (module docstring).
+
+    What is particular to a controller is in a few methods a subclass replaces (the
+    ``gtecat serve`` endpoint, :mod:`gtecat.inspect.serve`): :meth:`_setup` and
+    :meth:`_install` (how requests reach the thread that runs the cycles), :meth:`_idle`
+    (a request no cycle took), :meth:`_meta` (what ``gtecat ps`` shows), :meth:`_context`
+    and :meth:`_lookup` (what the operations run on, and which there are)."""
+
+    #: the longest request line a client may send (bytes); a longer one ends the connection
+    max_line = 1 << 20
+    #: connections open at once at most (0: no limit); one more is told so and closed
+    max_conns = 0
+    #: a connection's requests start this many seconds apart at least (0: as they come)
+    min_gap_s = 0.0
 
     def __init__(self, ctl: Any, kind: str = "python", lock: Any = None) -> None:
         self.ctl = ctl
@@ -105,12 +120,15 @@ class Endpoint:
         self._sock: socket.socket | None = None
         self._threads: list[threading.Thread] = []
         self._conns: set[socket.socket] = set()
-        self._run_cycle = ctl.clock._run_cycle
         self._watchers = 0  # open connections: the cycle is wrapped only while one is open
         self._watch_lock = threading.Lock()
-        self._cycle = self._make_cycle()
+        self._setup()
 
     # --- the cycle side --------------------------------------------------------------------
+    def _setup(self) -> None:
+        self._run_cycle = self.ctl.clock._run_cycle
+        self._cycle = self._make_cycle()
+
     def _make_cycle(self) -> Callable[[], None]:
         """The clock's cycle with the queue served first (a closure: the fewest operations
         per cycle; ``flags`` = [a cycle runs, the endpoint thread answers itself])."""
@@ -151,11 +169,15 @@ class Endpoint:
         """Wrap the clock's cycle while a connection is open; nobody watching costs nothing."""
         with self._watch_lock:
             self._watchers += delta
-            clock = self.ctl.clock
-            if self._watchers > 0 and not self._stop.is_set():
-                clock._run_cycle = self._cycle
-            elif clock._run_cycle == self._cycle:
-                clock._run_cycle = self._run_cycle
+            self._install(self._watchers > 0 and not self._stop.is_set())
+
+    def _install(self, on: bool) -> None:
+        """The clock runs :meth:`_cycle` (the queue served first) or its own cycle."""
+        clock = self.ctl.clock
+        if on:
+            clock._run_cycle = self._cycle
+        elif clock._run_cycle == self._cycle:
+            clock._run_cycle = self._run_cycle
 
     # --- running one request ------------------------------------------------------------------
     def execute(self, fn: Callable[[], Any]) -> Any:
@@ -163,15 +185,23 @@ class Endpoint:
         req = _Request(fn)
         self._pending.append(req)
         if not req.done.wait(IDLE_S):
-            with self._claim:
-                mine = not req.claimed
-                req.claimed = True
-            if mine:
-                self._direct_run(req)
+            self._idle(req)
             req.done.wait()
         if req.error is not None:
             raise req.error
         return req.result
+
+    def _claimed(self, req: _Request) -> bool:
+        """Take ``req`` from the queue's side: True when no cycle has taken it yet."""
+        with self._claim:
+            mine = not req.claimed
+            req.claimed = True
+        return mine
+
+    def _idle(self, req: _Request) -> None:
+        """No cycle took ``req`` for :data:`IDLE_S`: the endpoint thread runs it."""
+        if self._claimed(req):
+            self._direct_run(req)
 
     def _direct_run(self, req: _Request) -> None:
         lock = self.lock
@@ -189,6 +219,15 @@ class Endpoint:
                 flags[1] = False
 
     # --- the socket side -------------------------------------------------------------------------
+    def _meta(self) -> dict[str, Any]:
+        """Who published the endpoint, beyond pid, program and start (``gtecat ps``)."""
+        o = self.ctl.options
+        return {
+            "eni": str(Path(str(o.eni)).resolve()) if o.eni else "",
+            "clock": str(o.clock),
+            "backend": str(o.backend),
+        }
+
     def publish(self) -> Endpoint:
         folder = runtime.checked_folder()
         pid = os.getpid()
@@ -205,14 +244,11 @@ class Endpoint:
         os.chmod(self.path, 0o600)
         s.listen(16)
         self._sock = s
-        o = self.ctl.options
         meta = {
             "pid": pid,
             "kind": self.kind,
             "program": " ".join(sys.argv) or sys.executable,
-            "eni": str(Path(str(o.eni)).resolve()) if o.eni else "",
-            "clock": str(o.clock),
-            "backend": str(o.backend),
+            **self._meta(),
             "started": time.time(),
         }
         tmp = self.path.with_suffix(".tmp")
@@ -227,8 +263,7 @@ class Endpoint:
     def close(self) -> None:
         """Stop serving, remove the files, give the clock its own cycle back."""
         self._stop.set()
-        if self.ctl.clock._run_cycle == self._cycle:
-            self.ctl.clock._run_cycle = self._run_cycle
+        self._install(False)
         if self._sock is not None:
             with contextlib.suppress(OSError):
                 self._sock.shutdown(socket.SHUT_RDWR)
@@ -241,7 +276,7 @@ class Endpoint:
             runtime.remove(self.path)
         while self._pending:  # nobody runs cycles any more: answer what waits
             req = self._pending.popleft()
-            req.error = ConnectionError("the controller closed")
+            req.error = ConnectionError("the running gtecat closed")
             req.done.set()
 
     def _accept(self) -> None:
@@ -251,21 +286,63 @@ class Endpoint:
                 conn, _ = sock.accept()
             except OSError:
                 return
+            if self.max_conns and len(self._conns) >= self.max_conns:
+                with contextlib.suppress(OSError), conn:
+                    error = f"{self.max_conns} connections are open already: try again later"
+                    conn.sendall(json.dumps({"id": None, "ok": False, "error": error}).encode())
+                    conn.sendall(b"\n")
+                continue
             self._conns.add(conn)
             t = threading.Thread(
                 target=self._serve, args=(conn,), name="gtecat-inspect-conn", daemon=True
             )
             t.start()
 
+    def _context(self) -> Any:
+        """What the operations of one connection run on."""
+        return _Conn(self)
+
+    def _lookup(self, op: str) -> Callable[..., Any] | None:
+        """The operation ``op`` as ``fn(ctx, *args)``; None: there is none of that name."""
+        from ..native import field
+        from . import ops
+
+        fn = ops.OPS.get(op)
+        if fn is not None:
+            return fn
+        if op in field.OPS:
+            return lambda ctx, *args: field.run(ctx.field, op, list(args))
+        return None
+
+    def _known(self) -> list[str]:
+        from ..native import field
+        from . import ops
+
+        return sorted({*ops.OPS, *field.OPS})
+
     def _serve(self, conn: socket.socket) -> None:
-        ctx = _Conn(self)
+        ctx = self._context()
         self._watch(+1)
+        limit, gap = self.max_line, self.min_gap_s
+        last = 0.0
         try:
             with conn, conn.makefile("rb") as rf, conn.makefile("wb") as wf:
-                for line in rf:
-                    if self._stop.is_set():
+                while True:
+                    line = rf.readline(limit + 1)
+                    if not line or self._stop.is_set():
                         return
+                    if gap:  # a client asking without pause is slowed down, not served faster
+                        wait = last + gap - time.monotonic()
+                        if wait > 0:
+                            time.sleep(wait)
+                        last = time.monotonic()
                     t0 = time.thread_time_ns()
+                    if len(line) > limit:  # no JSON parsed, the connection ends
+                        error = f"a request line is {limit // 1024} KiB at most"
+                        reply = {"id": None, "ok": False, "error": error}
+                        wf.write(json.dumps(reply).encode() + b"\n")
+                        wf.flush()
+                        return
                     sub = _subscription(line)
                     reply = self._answer(ctx, line) if sub is None else self._check_sub(sub)
                     wf.write(json.dumps(reply, separators=(",", ":")).encode() + b"\n")
@@ -279,18 +356,18 @@ class Endpoint:
             pass
         finally:
             self._conns.discard(conn)
-            if ctx.field.traces:
+            traces = getattr(getattr(ctx, "field", None), "traces", None)
+            if traces:
                 with contextlib.suppress(Exception):
                     self.execute(ctx.field.stop_traces)
             self._watch(-1)
 
     # --- subscriptions: the cycle's thread sends, the connection's thread only keeps time ------
-    @staticmethod
-    def _check_sub(sub: tuple[str, float, list[Any]]) -> dict[str, Any]:
+    def _check_sub(self, sub: tuple[str, float, list[Any]]) -> dict[str, Any]:
         from . import ops
 
         op, period, _ = sub
-        if op not in ops.PUSHABLE:
+        if op not in ops.PUSHABLE or self._lookup(op) is None:
             return {"id": None, "ok": False, "error": f"{op!r} cannot be subscribed to"}
         if not 0.005 <= period <= 10:
             return {"id": None, "ok": False, "error": "period_ms must be 5..10000"}
@@ -298,10 +375,9 @@ class Endpoint:
 
     def _push(self, ctx: _Conn, conn: socket.socket, sub: tuple[str, float, list[Any]]) -> None:
         """Every ``period``: one line ``{"push": op, "result": ...}`` (module docstring)."""
-        from . import ops
-
         op, period, args = sub
-        fn = ops.OPS[op]
+        fn = self._lookup(op)
+        assert fn is not None  # _check_sub looked
         last: _Request | None = None
         late: list[bytes] = []  # what the cycle's thread could not send at once
 
@@ -324,11 +400,7 @@ class Endpoint:
                 conn.sendall(b"".join(late))
                 late.clear()
             if last is not None and not last.done.is_set():
-                with self._claim:
-                    mine = not last.claimed
-                    last.claimed = True
-                if mine:  # no cycle ran for a whole period: the application is idle
-                    self._direct_run(last)
+                self._idle_push(last)
             if last is None or last.done.is_set():
                 last = _Request(push)
                 self._pending.append(last)
@@ -337,6 +409,11 @@ class Endpoint:
             if readable and not conn.recv(4096, socket.MSG_DONTWAIT):
                 return  # the client has gone
             COST[0] += 1
+
+    def _idle_push(self, req: _Request) -> None:
+        """A pushed result no cycle made for a whole period: the application is idle."""
+        if self._claimed(req):
+            self._direct_run(req)
 
     def _answer(self, ctx: _Conn, line: bytes) -> dict[str, Any]:
         rid = None
@@ -356,20 +433,16 @@ class Endpoint:
 
     def request(self, ctx: _Conn, op: str, args: list[Any]) -> Any:
         from ..errors import ParameterError
-        from ..native import field
-        from . import ops
 
+        fn = self._lookup(op)
+        if fn is None:
+            known = self._known()
+            raise ParameterError(f"no operation {op!r} (there are {', '.join(known)})")
         if op == "data" and len(args) > 1 and int(args[1] or 0) > 0:
             # let the cycles pass here, not inside one: read after them
             self._wait_cycles(int(args[1]))
             args = [args[0], 0]
-        fn = ops.OPS.get(op)
-        if fn is not None:
-            return self.execute(lambda: fn(ctx, *args))
-        if op in field.OPS:
-            return self.execute(lambda: field.run(ctx.field, op, args))
-        known = sorted({*ops.OPS, *field.OPS})
-        raise ParameterError(f"no operation {op!r} (there are {', '.join(known)})")
+        return self.execute(lambda: fn(ctx, *args))
 
     def _wait_cycles(self, n: int) -> None:
         clock = self.ctl.clock

@@ -30,7 +30,6 @@ from pathlib import Path
 from .. import __version__
 from ..cbuild import NativeBuildError, cache_root, compiler
 from ..cbuild import version_dir as made_version_dir
-from . import header, stubs
 
 RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h", "gtecat_vendor.h")
 #: files that go beside gts.h (the rest are the library's sources)
@@ -85,6 +84,8 @@ def python_executable() -> str:
 
 def sources(python: str, abi: str = "") -> dict[str, str]:
     """Every file of the build, by name."""
+    from . import header, stubs
+
     out = {
         "gts.h": header.render(),
         "gts_wire.h": stubs.render_wire_h(),
@@ -99,7 +100,7 @@ def sources(python: str, abi: str = "") -> dict[str, str]:
 
 def multicard_sources() -> dict[str, str]:
     """The files of libgts_mc (a layer over libgts: :mod:`gtecat.native.multicard`)."""
-    from . import multicard
+    from . import header, multicard
 
     pkg = resources.files("gtecat.native") / "csrc"
     return {
@@ -127,21 +128,50 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Build:
     base = None
     if abi:
         base = ensure_built(force=force)
+    version_dir = cache_root() / __version__
+    python = python_executable()
+    known = version_dir / "inputs" / _inputs(python, abi, cc)
+    if not force:
+        with contextlib.suppress(OSError):
+            build = Build(version_dir / known.read_text(encoding="utf-8").strip(), abi, base)
+            if build.library.is_file() and build.header.is_file():
+                return build
+    if abi:
         files = multicard_sources()
         files["base"] = str(base.root)  # the digest names the libgts it is a layer over
     else:
-        files = sources(python_executable())
-    version_dir = cache_root() / __version__
+        files = sources(python)
     build = Build(version_dir / _digest(files, cc), abi, base)
-    if build.library.is_file() and build.header.is_file() and not force:
-        return build
-    version_dir = made_version_dir()
-    with open(version_dir / ".lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if build.library.is_file() and build.header.is_file() and not force:
-            return build
-        _compile(build, files, cc)
+    if not (build.library.is_file() and build.header.is_file()) or force:
+        version_dir = made_version_dir()
+        with open(version_dir / ".lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if not (build.library.is_file() and build.header.is_file()) or force:
+                _compile(build, files, cc)
+    _remember(known, build.root.name)
     return build
+
+
+def _inputs(python: str, abi: str, cc: list[str]) -> str:
+    """A name for what the generated sources are made of: every file of this gtecat, the
+    interpreter, the ABI and the compiler.  A build found by it is used without rendering
+    the sources again, which needs the whole GT layer imported (most of a second); a
+    changed file of the package (an editable install) gives another name."""
+    h = hashlib.sha256(f"{python}\0{abi}\0{' '.join([*cc, *CFLAGS])}".encode())
+    root = Path(__file__).resolve().parent.parent
+    for path in sorted(root.rglob("*")):
+        if "__pycache__" not in path.parts and path.is_file():
+            h.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return h.hexdigest()[:24]
+
+
+def _remember(known: Path, digest: str) -> None:
+    """Write the inputs' name -> build folder, atomically (builders may run side by side)."""
+    with contextlib.suppress(OSError):
+        known.parent.mkdir(parents=True, exist_ok=True)
+        tmp = known.with_name(f".{known.name}.{os.getpid()}")
+        tmp.write_text(digest, encoding="utf-8")
+        os.replace(tmp, known)
 
 
 def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:

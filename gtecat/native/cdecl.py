@@ -17,6 +17,7 @@ passes the C ``long`` of the client; the controller checks values to 32 bits).
 from __future__ import annotations
 
 import ctypes
+import functools
 import hashlib
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -101,6 +102,12 @@ def _deps(cls: type[ctypes.Structure]) -> Iterator[type[ctypes.Structure]]:
 
 def structures() -> list[type[ctypes.Structure]]:
     """Every structure ``from gtecat import gt`` exports, nested ones first."""
+    return list(_structures())
+
+
+@functools.cache
+def _structures() -> tuple[type[ctypes.Structure], ...]:
+    """gt's structures are made once, at its import: walked once."""
     from .. import gt
 
     found = {
@@ -123,15 +130,17 @@ def structures() -> list[type[ctypes.Structure]]:
 
     for cls in found.values():  # definition order: the manual's, TSlaveInfo with bus calls
         visit(cls)
-    return out
+    return tuple(out)
 
 
 def structure(name: str) -> type[ctypes.Structure]:
     """The ctypes structure the table names (``TTrapPrm``); KeyError if gt has none."""
-    for cls in structures():
-        if cls.__name__ == name:
-            return cls
-    raise KeyError(name)
+    return _by_name()[name]
+
+
+@functools.cache
+def _by_name() -> dict[str, type[ctypes.Structure]]:
+    return {cls.__name__: cls for cls in _structures()}
 
 
 def struct_decl(cls: type[ctypes.Structure]) -> str:

@@ -52,9 +52,7 @@ or the reason as a JSON string.
 from __future__ import annotations
 
 import ctypes
-import socket
 import struct
-import sys
 from dataclasses import dataclass
 from enum import IntEnum
 from functools import cache
@@ -62,11 +60,10 @@ from typing import Any
 
 from ..gt.table import FUNCTIONS, PROTOTYPES, SCALARS, Param, Proto, emulated
 from . import cdecl
+from .transport import SOCKET_TYPE, socket_path
 
 PROTOCOL_VERSION = 2
 
-#: one record per message where the system has them (Linux), a byte stream elsewhere
-SOCKET_TYPE = socket.SOCK_SEQPACKET if sys.platform.startswith("linux") else socket.SOCK_STREAM
 #: the largest record one send makes (well inside the default socket buffer)
 CHUNK = 1 << 16
 
@@ -195,16 +192,6 @@ def element_type(ctype: str, long_size: int) -> Any:
     if ctype in SCALARS:
         return getattr(ctypes, SCALARS[ctype][0])
     return cdecl.structure(ctype)
-
-
-def socket_path(address: str) -> str:
-    """``unix:/path``, ``/path`` or ``unix:@name`` (Linux abstract) -> the AF_UNIX address."""
-    addr = address[5:] if address.startswith("unix:") else address
-    if not addr:
-        raise ValueError(f"controller address {address!r} names no socket")
-    if addr.startswith("@"):
-        return "\0" + addr[1:]
-    return addr
 
 
 #: function ids: the table's names in sorted order

@@ -29,7 +29,19 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from .protocol import SOCKET_TYPE, socket_path
+#: one record per message where the system has them (Linux), a byte stream elsewhere
+SOCKET_TYPE = socket.SOCK_SEQPACKET if sys.platform.startswith("linux") else socket.SOCK_STREAM
+
+
+def socket_path(address: str) -> str:
+    """``unix:/path``, ``/path`` or ``unix:@name`` (Linux abstract) -> the AF_UNIX address."""
+    addr = address[5:] if address.startswith("unix:") else address
+    if not addr:
+        raise ValueError(f"controller address {address!r} names no socket")
+    if addr.startswith("@"):
+        return "\0" + addr[1:]
+    return addr
+
 
 #: the port the documentation and ``gtecat.ini`` examples use
 DEFAULT_TCP_PORT = 7701

@@ -135,7 +135,8 @@ class Pacing:
             last is None
             or self.waiting
             or self.steady < STEADY_AFTER
-            or not MIN_PERIOD_NS <= period <= MAX_PERIOD_NS
+            # the learned estimate of a master at either bound sits a few ns beside it
+            or not MIN_PERIOD_NS * 0.99 <= period <= MAX_PERIOD_NS * 1.01
         ):
             return None
         margin = int(min(period / 2, self.margin_ns))

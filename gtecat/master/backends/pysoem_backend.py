@@ -37,6 +37,7 @@ import logging
 import os
 import sys
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from gtecat.drives.abort import SdoAbort
-from gtecat.drives.slave import AlState, AlStatusCode
+from gtecat.drives.slave import AlState, AlStatusCode, Emergency
 from gtecat.eni.layout import Layout
 from gtecat.eni.model import Direction, Identity, InitCmd
 
@@ -231,6 +232,8 @@ class PysoemBackend(Backend):
         self.layout: Layout | None = None
         self.image: ProcessImage | None = None
         self.slaves: list[Any] = []  # pysoem CdefSlave, bus order
+        #: CoE emergencies pysoem handed over since the last cycle: (position, Emergency)
+        self._emcy: deque[tuple[int, Emergency]] = deque()
         self.mapped = False
         self._pending_safeop: set[int] = set()
         self._op: set[int] = set()
@@ -304,10 +307,28 @@ class PysoemBackend(Backend):
             )
         self.slaves = list(m.slaves)
         self._coe = [self._has_coe(s) for s in self.slaves]
+        self._emcy.clear()
+        for i, s in enumerate(self.slaves):
+            self._listen_for_emergencies(i, s)
         found = []
         for i, s in enumerate(self.slaves):
             found.append(FoundSlave(i, Identity(int(s.man), int(s.id), int(s.rev)), str(s.name)))
         return found
+
+    def _listen_for_emergencies(self, position: int, s: Any) -> None:
+        """A CoE emergency that arrives while SOEM waits for a mailbox answer goes to the
+        master log (as the emulated bus's do), not into the SDO call: without a callback
+        pysoem raises it from ``sdo_read``/``sdo_write`` and the SDO's own answer is lost."""
+        add = getattr(s, "add_emergency_callback", None)
+        if add is None:  # an older pysoem: sdo_upload/sdo_download catch it instead
+            return
+        add(lambda e, pos=position: self._emcy.append((pos, _emergency(e))))
+
+    def emergencies(self) -> list[tuple[int, object]]:
+        out = []
+        while self._emcy:
+            out.append(self._emcy.popleft())
+        return out
 
     @staticmethod
     def _has_coe(s: Any) -> bool:
@@ -720,6 +741,21 @@ class PysoemBackend(Backend):
             return BusError(f"{where}: {_describe_soem_error(e)}")
         return BusError(f"{where}: {e!r}")
 
+    def _past_emergencies(
+        self, position: int, call: Callable[..., Any], *args: Any, **kw: Any
+    ) -> Any:
+        """``call``, again after an emergency pysoem raised in its place (a pysoem without
+        emergency callbacks): the emergency goes to the master log, the SDO is asked again."""
+        emergency = getattr(self.soem, "Emergency", None)
+        for _ in range(3):
+            try:
+                return call(*args, **kw)
+            except Exception as e:
+                if emergency is None or not isinstance(e, emergency):
+                    raise
+                self._emcy.append((position, _emergency(e)))
+        return call(*args, **kw)
+
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False
     ) -> bytes:
@@ -728,7 +764,11 @@ class PysoemBackend(Backend):
         errors = (soem.SdoError, soem.WkcError, soem.MailboxError, soem.PacketError)
         try:
             try:
-                return bytes(s.sdo_read(index, subindex, ca=complete_access))
+                return bytes(
+                    self._past_emergencies(
+                        position, s.sdo_read, index, subindex, ca=complete_access
+                    )
+                )
             except soem.PacketError as e:
                 if getattr(e, "error_code", None) != 3:  # 3: data container too small
                     raise
@@ -743,7 +783,9 @@ class PysoemBackend(Backend):
         soem = self.soem
         errors = (soem.SdoError, soem.WkcError, soem.MailboxError, soem.PacketError)
         try:
-            s.sdo_write(index, subindex, bytes(data), ca=complete_access)
+            self._past_emergencies(
+                position, s.sdo_write, index, subindex, bytes(data), ca=complete_access
+            )
         except errors as e:
             raise self._sdo_error(e, position, "download", index, subindex) from None
 
@@ -780,3 +822,11 @@ def _describe_soem_error(e: Any) -> str:
     except Exception:
         desc = ""
     return f"slave {getattr(e, 'slave_pos', '?')}: error {code} {desc}".strip()
+
+
+def _emergency(e: Any) -> Emergency:
+    """pysoem's emergency (error code, register, byte 1, words 2 and 3) as the emulated
+    slaves give theirs (ETG.1000.6 5.6.4: 2 + 1 + 5 bytes)."""
+    data = bytes([int(e.b1) & 0xFF]) + (int(e.w1) & 0xFFFF).to_bytes(2, "little")
+    data += (int(e.w2) & 0xFFFF).to_bytes(2, "little")
+    return Emergency(int(e.error_code) & 0xFFFF, int(e.error_reg) & 0xFF, data)

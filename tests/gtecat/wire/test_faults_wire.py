@@ -6,8 +6,9 @@ a lost mailbox answer and a protocol fault reach the SDO calls, a link down afte
 takes slaves 2 and 3 out of the process data (GT_IsEcatReady 0, their IO calls refused) until
 its time is over, a working counter off by one makes GT_IsEcatReady 0 while it lasts, and a
 latched AL error keeps slave 3 out until it is cleared, a power-cycled slave 2 (its ESC
-without address or configuration) is found and brought back, 30 lost answers make a dip:
-one script of steps.  Needs
+without address or configuration) is found and brought back, 30 lost answers make a dip,
+and so do answers cut short, with a wrong index, replayed or late; a slave that retreats to
+SAFEOP is brought back: one script of steps.  Needs
 root and pysoem (skipped with the reason); several seconds of two processes, so it runs with
 GTECAT_LONG=1.
 """
@@ -80,6 +81,39 @@ kind = "drop_responses"
 count = 30
 after = "power"
 after_ms = 5000
+name = "drops"
+[[fault]]
+kind = "frame_truncate"
+bytes = 8
+count = 30
+after = "drops"
+after_ms = 3000
+name = "cut_short"
+[[fault]]
+kind = "frame_wrong_index"
+count = 30
+after = "cut_short"
+after_ms = 3000
+name = "wrong_index"
+[[fault]]
+kind = "frame_replay"
+count = 30
+after = "wrong_index"
+after_ms = 3000
+name = "replayed"
+[[fault]]
+kind = "frame_delay"
+us = 40000
+count = 5
+after = "replayed"
+after_ms = 3000
+name = "late"
+[[fault]]
+kind = "retreat_safeop"
+slave = 2
+code = 0x1B
+after = "late"
+after_ms = 1500
 """
 
 
@@ -141,6 +175,38 @@ def test_faults_on_the_wire(veth, tmp_path: Path) -> None:
         # 30 cyclic answers lost: a dip, then the bus goes on by itself
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 0, ms=10000, step_ms=2)
         assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=10000, step_ms=10)
+        # frame faults: 30 answers cut short, 30 with another datagram index, 30 replays of
+        # the previous answer, 5 answers 40 ms late (past SOEM's wait): SOEM takes none of
+        # them for the cycle's answer; each is a run of bad working counters in the master
+        # log, and the bus goes on by itself
+        ctl = gt.GTE_Controller()
+        frame_faults_from = len(ctl.log.lines)
+        for what in ("cut short", "wrong index", "replayed", "late"):
+            seen = len(ctl.log.lines)
+
+            def back(seen: int = seen) -> bool:
+                return any("Working counter back to 12/12" in x for x in ctl.log.lines[seen:])
+
+            assert scenario_common.wait_until(gt, back, ms=8000, step_ms=5), what
+            assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=8000, step_ms=10)
+        # slave 2 leaves OP for SAFEOP by itself (AL status 001Bh): the master sees it leave
+        # (the working counter, its AL status) and brings it back into the process data (it
+        # comes 1.5 s after the late answers: perhaps before their check above has ended)
+        seen = frame_faults_from
+
+        def since() -> str:
+            return "\n".join(ctl.log.lines[seen:])
+
+        assert scenario_common.wait_until(
+            gt, lambda: "Back in process data: slaves 2" in since(), ms=10000, step_ms=5
+        ), since()
+        assert "slave 2 (IO 2) SAFEOP+ERROR, AL status 0x001B" in since()
+        assert scenario_common.wait_until(gt, lambda: _ready(gt) == 1, ms=10000, step_ms=10)
+        assert gt.GT_EcatIOReadInput(2, 0, 2, buf) == 0
+        assert "internal error" not in ctl.log.text()
     finally:
         gt.GT_Close()
+        proc = r.proc
         r.stop()
+        if proc is not None and proc.stdout is not None:
+            print(proc.stdout.read())  # the serve's own lines (its faults), shown on a failure

@@ -651,3 +651,50 @@ def test_backend_states_reads_every_slave_at_once():
     devices[3].present = False
     got = backend.states(4)
     assert [g[0] if g else None for g in got] == [AlState.OP, AlState.OP, AlState.OP, None]
+
+
+class FakeEmergency(Exception):
+    """pysoem.Emergency: error code, register, byte 1, words 2 and 3."""
+
+    def __init__(self, slave_pos: int, error_code: int, error_reg: int, b1: int, w1: int, w2: int):
+        super().__init__(slave_pos, error_code)
+        self.slave_pos, self.error_code, self.error_reg = slave_pos, error_code, error_reg
+        self.b1, self.w1, self.w2 = b1, w1, w2
+
+
+@pytest.mark.parametrize("callbacks", [True, False], ids=["callback", "raised"])
+def test_an_emergency_during_an_sdo_goes_to_the_master_log_and_the_sdo_answers(
+    monkeypatch, callbacks: bool
+):
+    """A CoE emergency (ETG.1000.6 5.6.4) that SOEM receives while it waits for an SDO answer:
+    pysoem raises it from sdo_read unless a callback takes it; either way the SDO's answer is
+    returned and the emergency is the master log's line, as on the emulated bus."""
+    master, backend, devices, lines = make_bus()
+    devices[0].od[(0x1018, 1)] = (0x47544543).to_bytes(4, "little")
+    pending = [FakeEmergency(1, 0x2310, 0x02, 0x11, 0x3322, 0x5544)]
+    handlers: dict[int, object] = {}
+    read = FakeSlave.sdo_read
+
+    def sdo_read(self, index, subindex, size=0, ca=False):
+        if pending:
+            e = pending.pop()
+            if self._pos in handlers:
+                handlers[self._pos](e)
+            else:
+                raise e
+        return read(self, index, subindex, size, ca)
+
+    monkeypatch.setattr(FakeSlave, "sdo_read", sdo_read)
+    if callbacks:
+        monkeypatch.setattr(
+            FakeSlave,
+            "add_emergency_callback",
+            lambda self, fn: handlers.__setitem__(self._pos, fn),
+            raising=False,
+        )
+    bring_up(master)
+    backend.soem.Emergency = FakeEmergency
+    assert master.sdo_upload(0, 0x1018, 1) == (0x47544543).to_bytes(4, "little")
+    master.cycle(10_000_000, 1_000_000)
+    assert "WARNING 0: CoE EMERGENCY 0x2310 0x02 11 22 33 44 55" in lines
+    assert master.emergency_count == 1
