@@ -15,7 +15,9 @@ the replay runs: virtual/wall (``times_real_time``) and virtual/CPU
 50).  ``--repeat N`` replays N times and reports the best of each.  The plain session
 (no recording) is run too, to show what recording costs.  ``--against CHECKOUT`` replays the
 same recording with another checkout's gtecat as well (each replay in a fresh process, the two
-in turn): before and after in one run.
+in turn): before and after in one run.  The CPU time a process gets done per second depends on
+what else the machine runs: ``reference_12_axes_trap_one_cycle_at_a_time`` measures, in the same
+run, a figure docs/performance.md took on a lightly loaded machine (219 times real time).
 
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
                                  [--simple] [--json]
@@ -142,6 +144,31 @@ def session(
     return step
 
 
+#: the reference figure on a lightly loaded machine (docs/performance.md, load 1.2-1.5)
+REFERENCE_QUIET = 219.0
+
+
+def reference() -> dict[str, object]:
+    """How loaded this machine is now: 12 axes moving in Trap, one cycle at a time (the
+    compiled cycle alone, as docs/performance.md measured it: 219 times real time per CPU
+    second on a lightly loaded machine)."""
+    from gtecat.controller.core import Controller
+    from tools.bench_scaling import run_bus
+
+    run = Controller.run_cycles
+    Controller.run_cycles = lambda self, n: 0  # type: ignore[method-assign]
+    try:
+        r = run_bus(12, dict.fromkeys(range(1, 13), "moving"), seconds=1.0, repeat=3)
+    finally:
+        Controller.run_cycles = run  # type: ignore[method-assign]
+    rtf = r.get("rtf_cpu")
+    return {
+        "rtf_cpu": rtf,
+        "quiet_machine": REFERENCE_QUIET,
+        "slower_than_quiet": round(REFERENCE_QUIET / rtf, 2) if rtf else None,
+    }
+
+
 def _best(runs: list[tuple[float, float]]) -> tuple[float, float]:
     return min(r[0] for r in runs), min(r[1] for r in runs)
 
@@ -239,6 +266,7 @@ def measure(
         "file_bytes": size,
         "diverged": str(div) if div else None,
         **before,
+        "reference_12_axes_trap_one_cycle_at_a_time": reference(),
     }
 
 
