@@ -344,9 +344,12 @@ class Controller:
         master = self.master
         if master is None or not master.steady():
             return 0
-        done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, n)
+        done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, min(n, self.BATCH_CYCLES))
         master.cycles += done
         return done
+
+    #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
+    BATCH_CYCLES = 1000
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
