@@ -239,7 +239,7 @@ def gtecat_env(
     yield env
     from . import gt
 
-    gt.GT_Close()  # an application that forgot: the next test starts clean
+    gt._core.close_all()  # an application that forgot (every card): the next test starts clean
 
 
 class Bench:
@@ -325,7 +325,7 @@ def gtecat_bus(
 
     for k in ("GTECAT_BACKEND", "GTECAT_IFACE", "GTECAT_BUS", "GTECAT_CONTROLLER"):
         monkeypatch.delenv(k, raising=False)
-    gt.GT_Close()
+    gt._core.close_all()
     machine = str(gtecat_machine) if isinstance(gtecat_machine, Path) else gtecat_machine
     listeners: list[Any] = []
     if request.config.getoption("gtecat_record"):
@@ -362,7 +362,7 @@ def gtecat_bus(
     finally:
         for rec in bench.recorders:
             rec.stop()
-        gt.GT_Close()
+        gt._core.close_all()  # every card the test opened
         for listener in listeners:
             listener.stop()
 

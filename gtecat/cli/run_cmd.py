@@ -382,9 +382,9 @@ def run(args: argparse.Namespace) -> int:
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
-        from ..gt import GT_Close
+        from ..gt._core import close_all
 
-        GT_Close()  # a script that forgot it: stop a realtime thread, flush the log
+        close_all()  # a script that forgot it (every card): stop realtime threads, flush logs
     if specs and not any(rec.n for rec in recorders):
         print(
             "trace: nothing recorded (the script never brought the bus up with GT_InitEcatComm)",

@@ -86,9 +86,12 @@ class Options:
     pcap: str | None = None
     #: the vectorised axis bank: auto | on | off (GTECAT_BANK; gtecat.controller.bank)
     bank: str | None = None
+    #: False: the ``GTECAT_*`` environment is not read (the options of another card or
+    #: core, derived from the first card's: :mod:`gtecat.controller.cards`)
+    use_env: bool = True
 
     def resolved(self) -> Options:
-        env = os.environ
+        env = os.environ if self.use_env else {}
         return Options(
             eni=self.eni or env.get("GTECAT_ENI") or "Gecat.eni",
             machine=self.machine if self.machine is not None else env.get("GTECAT_MACHINE"),
@@ -109,6 +112,7 @@ class Options:
             mram=self.mram or env.get("GTECAT_MRAM"),
             pcap=self.pcap or env.get("GTECAT_PCAP") or None,
             bank=(self.bank or env.get("GTECAT_BANK") or "auto").lower(),
+            use_env=self.use_env,
         )
 
 

@@ -115,6 +115,10 @@ class MachineDescription:
     glink: Mapping[int, Any] = field(default_factory=dict)
     #: ``[[fault]]`` tables as written (the fault vocabulary, :mod:`gtecat.faults`, reads them)
     faults: tuple[Mapping[str, Any], ...] = ()
+    #: ``[card.N]`` and ``[core.N]`` tables as written: the other cards and cores of the
+    #: controller (:mod:`gtecat.controller.cards` reads them)
+    cards: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
+    cores: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
 
     def axis(self, n: int) -> AxisMachine:
         """The description of GT axis ``n`` (defaults when the file omits it)."""
@@ -215,7 +219,23 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
         ext=ext_modules_from_dict(data, source),
         glink=glink_from_dict(data, source),
         faults=tuple(faults),
+        cards=_numbered(data, "card", source),
+        cores=_numbered(data, "core", source),
     )
+
+
+def _numbered(data: Mapping[str, Any], name: str, source: str) -> dict[int, Mapping[str, Any]]:
+    """``[name.N]`` tables by number (their content is checked where it is used)."""
+    raw = data.get(name, {})
+    if not isinstance(raw, dict) or not all(isinstance(t, dict) for t in raw.values()):
+        raise MachineError(f"{source}: [{name}.N] tables expected")
+    out = {}
+    for key, table in raw.items():
+        try:
+            out[int(key)] = table
+        except ValueError:
+            raise MachineError(f"{source}: [{name}.{key}]: a number is expected") from None
+    return out
 
 
 def load_machine(path: str | Path) -> MachineDescription:

@@ -10,6 +10,7 @@ writable ``bytearray``/``memoryview``/numpy array, or a one-element list.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import functools
 import inspect
@@ -17,7 +18,7 @@ import logging
 import os
 import traceback
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +28,7 @@ from gtecat.eni.errors import EniError, GtecatError
 
 from ..controller.bank import BANK_READS
 from ..controller.card import refused
+from ..controller.cards import CARD_CORES
 from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE, CoreView
 from ..errors import (
@@ -37,6 +39,7 @@ from ..errors import (
     NoSlavesError,
     ParameterError,
 )
+from ..master.clock import ClockGroup
 from .args import Ref, binder, core_arg
 from .fast import RAW, READERS, fast_raw, fast_reader
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
@@ -91,10 +94,23 @@ class LastError:
 
 
 class _Session:
-    """The open cores (core 1 is the EtherCAT core) and the error ring."""
+    """The open cards and cores (core 1 is the EtherCAT core), the current card, the
+    error ring (:mod:`gtecat.controller.cards`)."""
 
     def __init__(self) -> None:
-        self.controllers: dict[int, Controller] = {}
+        #: card -> core -> its controller
+        self.cards: dict[int, dict[int, Controller]] = {0: {}}
+        #: the card GT_* calls address (GT_SetCardNo): one per process, as the vendor's
+        self.card = 0
+        #: the current card's cores (``cards[card]``)
+        self.controllers: dict[int, Controller] = self.cards[0]
+        #: the core the GT_* functions address (GT_SetCore; the GTN_* ones name theirs)
+        self.core = 1
+        #: the options the first card was opened with (resolved): the other cards' base
+        self.base_options: Any = None
+        #: every card and core of the process shares one time
+        self.time = ClockGroup()
+        self.views: dict[tuple[int, int], CoreView] = {}
         self.errors: deque[LastError] = deque(maxlen=64)  # the recent failures, oldest first
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
         #: a reason the running call leaves although it succeeds (:func:`note`)
@@ -103,10 +119,56 @@ class _Session:
         #: or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process
         self.remote: Any = None
 
+    def select(self, card: int) -> None:
+        """Make ``card`` the current card (GT_SetCardNo; checked by the caller)."""
+        if card != self.card:
+            self.card = card
+            self.controllers = self.cards.setdefault(card, {})
+
+    @contextlib.contextmanager
+    def selected(self, card: int, core: int | None = None) -> Iterator[None]:
+        """Address ``card`` (and the GT_* functions core ``core``) for a while: a call of
+        the multi-card ABI, of a client of the controller process, a motion program."""
+        before, before_core = self.card, self.core
+        self.select(card)
+        if core is not None:
+            self.core = core
+        try:
+            yield
+        finally:
+            self.select(before)
+            self.core = before_core
+
+    def where(self, ctl: Any) -> tuple[int, int] | None:
+        """(card, core) of an open controller, None when it is not open here."""
+        for card, cores in self.cards.items():
+            for core, c in cores.items():
+                if c is ctl:
+                    return card, core
+        return None
+
+    def first(self) -> Controller | None:
+        """Card 0's core 1, else the first open card's (what the process shows)."""
+        c = self.cards.get(0, {}).get(1)
+        if c is None:
+            c = next((cores[1] for cores in self.cards.values() if 1 in cores), None)
+        return c
+
+    def all_controllers(self) -> list[Controller]:
+        return [c for cores in self.cards.values() for c in cores.values()]
+
     def controller(self, core: int = 1) -> Controller:
-        c = self.controllers.get(core)
-        if c is None and core > 1 and 1 in self.controllers:
-            c = self._core_view(core)
+        cores = self.controllers
+        c = cores.get(core) if core == 1 else None
+        if core > 1 and 1 in cores:
+            c = self._core_view(core)  # the bus's axes of that core, where it has them
+            if c is not None:
+                own = cores.pop(core, None)
+                if own is not None:  # a second core opened before the bus came up
+                    self.time.leave(own.clock)
+                    own.close()
+            elif core <= CARD_CORES:
+                c = cores.get(core) or self._open_core(core)
         if c is None:
             if self.remote is not None:
                 raise NotOpen(
@@ -116,25 +178,64 @@ class _Session:
                 )
             if core != 1 and 1 in self.controllers:
                 n = len(self.controllers[1].axes)
-                cores = max(1, (n + AXES_PER_CORE - 1) // AXES_PER_CORE)
+                cores = max(CARD_CORES, (n + AXES_PER_CORE - 1) // AXES_PER_CORE)
                 raise ParameterError(
-                    f"core {core} does not exist: the bus has {n} axes, cores 1..{cores} "
-                    f"({AXES_PER_CORE} axes per core; core 1 is the EtherCAT core)"
+                    f"core {core} does not exist: cores 1..{cores} (core 1 is the EtherCAT "
+                    f"core; core 2 the card's second core, or bus axes 33..64 on a bus of "
+                    f"more than {AXES_PER_CORE} axes)"
                 )
-            raise NotOpen("the controller is not open: call GT_Open first")
+            raise NotOpen(self.not_open())
         return c
+
+    def not_open(self) -> str:
+        if self.card:
+            return f"card {self.card} is not open: call GT_Open after GT_SetCardNo({self.card})"
+        return "the controller is not open: call GT_Open first"
 
     def _core_view(self, core: int) -> Any:
         """Core ``core`` > 1: bus axes 32·(core-1)+1 .. 32·core (gtecat.controller.core_view)."""
         base = self.controllers[1]
-        views = self.__dict__.setdefault("views", {})
-        view = views.get(core)
+        key = (self.card, core)
+        view = self.views.get(key)
         if view is None or view._base is not base:
-            view = views[core] = CoreView(base, core)
+            view = self.views[key] = CoreView(base, core)
         return view if view.exists else None
+
+    def _open_core(self, core: int) -> Controller:
+        """The card's second core, opened at its first call (gtecat.controller.cards)."""
+        from ..controller.cards import options_for
+
+        card = self.controllers[1].options.card  # the card's own pulse personality
+        base = self.base_options or self.controllers[1].options
+        ctl = Controller(options_for(base, self.card, core, hardware=card))
+        self.controllers[core] = ctl
+        self.time.join(ctl.clock)
+        return ctl
+
+    def close_card(self) -> list[Controller]:
+        """Close the current card, every core of it; the controllers closed."""
+        closed = list(self.controllers.values())
+        self.controllers.clear()
+        for key in [k for k in self.views if k[0] == self.card]:
+            del self.views[key]
+        for c in closed:
+            self.time.leave(c.clock)
+        return closed
 
 
 SESSION = _Session()
+
+
+def close_all() -> None:
+    """Close every card of this process and make card 0 (core 1) the current one (a
+    test's clean start; GT_Close closes the current card only)."""
+    for card in sorted(SESSION.cards):
+        SESSION.select(card)
+        REGISTRY["GT_Close"]()
+    SESSION.select(0)
+    SESSION.core = 1
+
+
 REGISTRY: dict[str, Callable[..., int]] = {}
 #: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
 #: a controller process then runs every call through REGISTRY, none on a fast path
@@ -231,7 +332,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if not needs_ctl and core != 1:  # GTN_Open/GTN_Close: no other core exists
                     raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
-                core = 1
+                core = SESSION.core  # GT_SetCore: 1 unless the program chose another
             values, extra = bind(args, kwargs)
             if address or SESSION.remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
@@ -307,7 +408,13 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
             def gtn(*args: Any, **kwargs: Any) -> int:
                 if args:
-                    if fast is not None and args[0] == 1 and type(args[0]) is int and not kwargs:
+                    if (
+                        fast is not None
+                        and args[0] == 1
+                        and type(args[0]) is int
+                        and not kwargs
+                        and SESSION.core == 1
+                    ):
                         return fast(*args[1:])  # core 1: the GT_ function's fast path
                     return call(args[0], args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)

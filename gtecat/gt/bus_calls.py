@@ -49,6 +49,7 @@ from gtecat.drives.abort import SdoAbort
 from gtecat.drives.slave import AlState
 
 from .. import __version__
+from ..controller.cards import options_for
 from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
 from ..inspect.endpoint import _PUBLISHED as _ENDPOINTS
@@ -110,7 +111,10 @@ def GT_Open(
     pcap: str | None = None,
     bank: str | None = None,
 ) -> int:
-    """Open the (emulated) controller.  Keyword options override ``GTECAT_*``.
+    """Open the (emulated) controller: the current card (``GT_SetCardNo``; card 0 unless
+    one was chosen).  ``channel`` and ``param`` do not choose it (the manual: how the
+    host reaches the controller, and reserved); another card is described as
+    :mod:`gtecat.controller.cards` says.  Keyword options override ``GTECAT_*``.
 
     ``bank="auto" | "on" | "off"`` (GTECAT_BANK): the vectorised axis bank
     (:mod:`gtecat.controller.bank`; results are the same either way, only faster).
@@ -119,41 +123,50 @@ def GT_Open(
 
     ``card="gts:4"`` (GTECAT_CARD) opens a GTS pulse card with 4 axes instead of an
     EtherCAT master (:mod:`gtecat.controller.card`)."""
+    card_kind, card = card, SESSION.card
     if 1 in SESSION.controllers:
         fail(
             _core.CMD_OPEN,
-            "the controller is already open (GT_Open called twice; call GT_Close first)",
+            (f"card {card} is" if card else "the controller is")
+            + " already open (GT_Open called twice; call GT_Close first)",
         )
-    SESSION.controllers[1] = Controller(
-        Options(
-            eni=eni,
-            machine=machine,
-            clock=clock,
-            backend=backend,
-            iface=iface,
-            cycle_ms=cycle_ms,
-            call_latency_us=call_latency_us,
-            log=log,
-            bus=bus,
-            op_delay_cycles=op_delay_cycles,
-            mram=mram,
-            card=card,
-            pcap=pcap,
-            bank=bank,
-        )
+    explicit = Options(
+        eni=eni,
+        machine=machine,
+        clock=clock,
+        backend=backend,
+        iface=iface,
+        cycle_ms=cycle_ms,
+        call_latency_us=call_latency_us,
+        log=log,
+        bus=bus,
+        op_delay_cycles=op_delay_cycles,
+        mram=mram,
+        card=card_kind,
+        pcap=pcap,
+        bank=bank,
     )
+    if card == 0 or SESSION.base_options is None:
+        opts = SESSION.base_options = explicit.resolved()
+        if card:
+            opts = options_for(opts, card, 1)
+    else:  # another card: the first card's options, its description, this call's keywords
+        opts = options_for(SESSION.base_options, card, 1, explicit)
+    ctl = Controller(opts)
+    SESSION.controllers[1] = ctl
+    SESSION.time.join(ctl.clock)
     from ..inspect.endpoint import publish  # gtecat ps / the bus verbs / gtecat panel see it
 
-    publish(SESSION.controllers[1])
+    publish(ctl)
     return 0
 
 
 @gt_function
 def GT_Close() -> int:
-    ctl = SESSION.controllers.pop(1, None)
-    if ctl is not None:
-        from ..inspect.endpoint import unpublish
+    """Close the current card (every core of it); the other cards keep running."""
+    from ..inspect.endpoint import unpublish
 
+    for ctl in SESSION.close_card():
         unpublish(ctl)
         ctl.close()
     return 0

@@ -20,8 +20,11 @@ vendor's manual of the ``ExtMdl`` library describes it, and what it leaves open:
   description says which modules exist.  A module the machine description lacks, or one
   that is offline, makes a terminal call return 1 (``GT_GetStsExtMdl`` returns 0 and
   status 1 for it); a terminal or channel the module lacks returns 7.
-* **``*Gts`` forms** (the multi-card wrappers): ``cardNum`` first; the emulated controller
-  is card 0, any other number returns 7.
+* **``*Gts`` forms** (the multi-card wrappers): ``cardNum`` first, the card whose modules
+  the call addresses (each card has its own, :mod:`gtecat.controller.cards`): 7 outside
+  0..15, -1 for a card that is not open.  ``GT_SwitchtoCardNoExtMdl(card)`` accepts the
+  current card; another card's modules are reached with ``GT_SetCardNo`` (or a ``*Gts``
+  form): switching them here returns 1 and says so.
 * **GTN cores** (``GTN_ExtModuleInit`` ...): the same chain numbered from 1 across the
   modules in order (module 0's inputs first), values are levels with 1 = on unless the
   module says ``active_low``; ``GTN_Get/SetExtDo`` and ``GTN_GetExtDi`` work on 32
@@ -39,10 +42,20 @@ import re
 from pathlib import Path
 from typing import Any
 
+from ..controller.cards import MAX_CARDS as _MAX_CARDS
 from ..controller.core import Controller
 from ..controller.ext_io import GLINK, GTN_EXT, GTS_EXTMDL, ExtIo, ExtModule, ext_io
 from ..errors import CommandError, ParameterError
-from ._core import check_range, gt_function, load_bytes, store, store_array, store_bytes
+from ._core import (
+    SESSION,
+    NotOpen,
+    check_range,
+    gt_function,
+    load_bytes,
+    store,
+    store_array,
+    store_bytes,
+)
 
 _U16 = 0xFFFF
 
@@ -136,9 +149,15 @@ def GT_CloseExtMdl(ctl: Controller) -> int:
 
 @gt_function
 def GT_SwitchtoCardNoExtMdl(ctl: Controller, card: int) -> int:
-    """The card whose modules the calls address: the emulated controller is card 0."""
+    """The card whose modules the calls address: the current card (module docstring)."""
     _opened(ctl, "GT_SwitchtoCardNoExtMdl")
-    _card(card, "card")
+    n = check_range("card", card, 0, _MAX_CARDS - 1)
+    if n != SESSION.card:
+        raise CommandError(
+            f"GT_SwitchtoCardNoExtMdl: card {n}'s modules are addressed through that card "
+            f"(GT_SetCardNo({n}), or the *Gts forms with cardNum {n}); switching the modules "
+            f"of card {SESSION.card} over to it is not emulated"
+        )
     return 0
 
 
@@ -277,23 +296,32 @@ def GT_SetExtMdlMode(ctl: Controller, mode: int) -> int:
 
 
 # --- the multi-card wrappers' *Gts forms -------------------------------------------------------
-def _card(card_num: int, name: str = "cardNum") -> None:
-    n = check_range(name, card_num, -(1 << 15), (1 << 15) - 1)
-    if n != 0:
-        raise ParameterError(f"{name}={n}: the emulated controller is card 0 (one card)")
+def _card(ctl: Controller, card_num: int, name: str = "cardNum") -> Controller:
+    """The controller of card ``card_num``: 7 outside 0..15, -1 when it is not open."""
+    n = check_range(name, card_num, 0, _MAX_CARDS - 1)
+    if n == SESSION.card:
+        return ctl
+    other = SESSION.cards.get(n, {}).get(1)
+    if other is None:
+        raise NotOpen(f"{name}={n}: card {n} is not open (GT_SetCardNo({n}), then GT_Open)")
+    return other
 
 
 def _gts_form(fn: Any) -> Any:
-    """The multi-card ``<name>Gts`` form of GT function ``fn``: ``cardNum`` first, checked,
-    then ``fn``'s own implementation (one call: one host-call latency, one reason)."""
+    """The multi-card ``<name>Gts`` form of GT function ``fn``: ``cardNum`` first, the card
+    whose modules it addresses, then ``fn``'s own implementation (one call: one host-call
+    latency, one reason)."""
     impl = fn.__wrapped__
 
     def twin(ctl: Controller, cardNum: int, *args: Any) -> int:
-        _card(cardNum)
-        return impl(ctl, *args)
+        target = _card(ctl, cardNum)
+        if target is not ctl and target.clock.threaded:
+            with target.clock.lock:  # atomic with respect to that card's cycle
+                return impl(target, *args)
+        return impl(target, *args)
 
     twin.__name__ = twin.__qualname__ = fn.__name__ + "Gts"
-    twin.__doc__ = f"``{fn.__name__}`` of card ``cardNum`` (0: the emulated card)."
+    twin.__doc__ = f"``{fn.__name__}`` of card ``cardNum``."
     return gt_function(twin)
 
 
@@ -509,9 +537,8 @@ def _bytes_of(m: ExtModule, kind: str, offset: int, n: int) -> range:
 
 @gt_function
 def GT_GLinkInit(ctl: Controller, cardNum: int) -> int:
-    """Start the gLink-II master of card ``cardNum`` (0); 1 when no slave is connected."""
-    _card(cardNum)
-    io = ext_io(ctl)
+    """Start the gLink-II master of card ``cardNum``; 1 when no slave is connected."""
+    io = ext_io(_card(ctl, cardNum))
     if not io.glink:
         raise CommandError(
             f"GT_GLinkInit: no gLink slave on this machine ({io.source} has no [glink.N])"

@@ -110,6 +110,7 @@ def fast_reader(
             # pClock NULL: omitted, None or 0 (the manual's own form, GT_GetSts(1, &s, 1, 0))
             or (pClock is not _NO and pClock is not None and (type(pClock) is not int or pClock))
             or session.remote is not None
+            or session.core != 1  # GT_SetCore: another core
         ):
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
         res = ctl.resources.get(n)
@@ -160,13 +161,12 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
     request = struct.Struct(f"<{CALL.format[1:]}qi{one}sqi")
     reply = struct.Struct(f"<IhHHI{code}")
     unpack, pack, size, total = request.unpack_from, reply.pack, request.size, reply.size - 4
-    controllers = session.controllers
 
     def answer(body: Any) -> bytes | None:
         if len(body) != size:
             return None
         axis, psize, _, count, pclock = unpack(body)[4:]
-        ctl = controllers.get(1)
+        ctl = session.controllers.get(1)  # the card the server selected for this call
         if psize != one or count != 1 or pclock != PTR_NULL or ctl is None:
             return None
         res = ctl.resources.get(axis)
@@ -282,6 +282,7 @@ def fast_raw(
             or m.offline
             or session.remote is not None
             or ctl.clock._thread is not None
+            or session.core != 1  # GT_SetCore: another core
         ):
             return slow(*args)
         image = m.image

@@ -100,11 +100,16 @@ def _caller(ctl: Controller):
 
     def call(name: str, args: tuple) -> tuple[int, str]:
         c = ref()
-        if c is None or _core.SESSION.controllers.get(1) is not c:
+        at = None if c is None else _core.SESSION.where(c)
+        if at is None:
             return _core.CMD_COMM, "the controller running the program is closed"
+        card, core = at  # the program's own card and core, whatever the host addresses
+        fn = _core.REGISTRY[name]
+        twin = _core.REGISTRY.get("GTN_" + name[3:]) if core != 1 else None
         host_last = _core.SESSION.last  # the host's GTE_GetLastError is not the program's
         try:
-            rc = _core.REGISTRY[name](*args)
+            with _core.SESSION.selected(card):
+                rc = twin(core, *args) if twin is not None else fn(*args)
             e = _core.last_error()
             reason = e.reason if rc != 0 and e is not None and e.function == name else ""
         finally:

@@ -31,8 +31,11 @@ vendor's headers leave open:
   ``MC_DAC`` (the card's or core's axes; the EtherCAT core holds up to 32), ``MC_ADC`` (8),
   ``MC_GPI`` / ``MC_GPO`` (16), ``MC_EXT_MODULE`` / ``MC_EXT_DI`` / ``MC_EXT_DO`` /
   ``MC_EXT_AI`` / ``MC_EXT_AO`` (the machine's extension modules; up to 16 modules).
-* ``GT_SetCardNo(index)``: the emulator is card 0; 1..15 return 1 (no such card), works
-  before ``GT_Open`` as on the vendor's library.
+* ``GT_SetCardNo(index)``: the card later calls address, 0..15 (7 otherwise), one per
+  process; it works before ``GT_Open``, which then opens that card
+  (:mod:`gtecat.controller.cards` says what each card is).  ``GT_SetCore(core)`` (GTN
+  header): the core the ``GT_*`` functions address, 1 or 2, one per process; the
+  ``GTN_*`` functions name their own.
 * ``GT_GetAtlTorque`` / ``GT_GetEcatAxisAtlTorque``: the vendor GTN header's spellings of
   ``GT_GetEcatAxisAtITorque`` (6077h).
 """
@@ -42,6 +45,8 @@ from __future__ import annotations
 import ctypes
 from typing import Any
 
+from ..controller.cards import CARD_CORES as _CARD_CORES
+from ..controller.cards import MAX_CARDS as _MAX_CARDS
 from ..controller.config_file import apply_config, parse_vendor, vendor_settings
 from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE
@@ -52,7 +57,7 @@ from ..controller.safety import SOFT_NEGATIVE_OFF, SOFT_POSITIVE_OFF
 from ..controller.servo_loop import ADC_CHANNELS, PID_SETS, PidSet, servo_loop
 from ..errors import CommandError, ParameterError
 from . import axis_calls
-from ._core import check_range, gt_function, store, store_array, struct_arg
+from ._core import SESSION, check_range, gt_function, store, store_array, struct_arg
 from .axis_calls import axis_off, axis_on
 from .constants import (
     MC_ADC,
@@ -559,22 +564,33 @@ def GT_GetResCount(ctl: Controller, type: int, pCount: Any) -> int:
     return 0
 
 
-_CARD = {"index": 0}
-
-
 @gt_function
 def GT_SetCardNo(index: int) -> int:
-    """The card later calls address: the emulator is card 0 (the vendor numbers 0..15)."""
-    i = check_range("index", index, 0, 15)
-    if i != 0:
-        raise CommandError(f"GT_SetCardNo: there is no card {i}; the emulated controller is card 0")
-    _CARD["index"] = i
+    """The card later calls address, 0..15 (the current card of the process; GT_Open
+    opens it: :mod:`gtecat.controller.cards`)."""
+    SESSION.select(check_range("index", index, 0, _MAX_CARDS - 1))
     return 0
 
 
 @gt_function
 def GT_GetCardNo(pIndex: Any) -> int:
-    store(pIndex, _CARD["index"])
+    """The current card (GT_SetCardNo; 0 at start)."""
+    store(pIndex, SESSION.card)
+    return 0
+
+
+@gt_function
+def GT_SetCore(core: int) -> int:
+    """The core the ``GT_*`` functions address, 1 or 2 (the ``GTN_*`` ones name theirs):
+    one per process, as the current card (:mod:`gtecat.controller.cards`)."""
+    SESSION.core = check_range("core", core, 1, _CARD_CORES)
+    return 0
+
+
+@gt_function
+def GT_GetCore(pCore: Any) -> int:
+    """The core the ``GT_*`` functions address (GT_SetCore; 1 at start)."""
+    store(pCore, SESSION.core)
     return 0
 
 

@@ -66,11 +66,11 @@ def _master(ctx: Any) -> Any:
 
 
 def _session_of(ctl: Any) -> Any:
-    """gt's session when ``ctl`` is its core 1 (the GT error ring is that session's)."""
+    """gt's session when ``ctl`` is one of its cards (the GT error ring is that session's)."""
     from ..gt import _core
 
     s = _core.SESSION
-    return s if s.controllers.get(1) is ctl else None
+    return s if s.where(ctl) is not None else None
 
 
 @_op

@@ -48,8 +48,9 @@ from gtecat.eni.topology import build_config
 from ..errors import ParameterError
 from .backends.emulated import EmulatedBackend
 
-#: card kinds GTECAT_CARD names, and how many axes each may have
-CARD_KINDS = {"gts": (1, 8)}
+#: card kinds GTECAT_CARD names, and how many axes each may have: a GTS card, a GTN
+#: card's core (up to 32 axes, the width of GT_Update's mask)
+CARD_KINDS = {"gts": (1, 8), "gtn": (1, 32)}
 
 _SPEC = re.compile(r"^\s*([a-zA-Z]+)\s*:\s*(\d+)\s*$")
 _RX = ["0x6040:0:16", "0x607A:0:32"]
@@ -75,7 +76,9 @@ def parse_card(spec: str) -> CardSpec:
         raise ParameterError(f"card={spec!r}: expected KIND:AXES, e.g. gts:4 (GTECAT_CARD)")
     kind, n = m[1].lower(), int(m[2])
     if kind not in CARD_KINDS:
-        raise ParameterError(f"card={spec!r}: unknown card kind {kind!r}; known: gts")
+        raise ParameterError(
+            f"card={spec!r}: unknown card kind {kind!r}; known: {', '.join(CARD_KINDS)}"
+        )
     lo, hi = CARD_KINDS[kind]
     if not lo <= n <= hi:
         raise ParameterError(f"card={spec!r}: a {kind} card has {lo}..{hi} axes, not {n}")

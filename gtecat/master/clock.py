@@ -8,6 +8,13 @@
 
 Time is integer nanoseconds.  The clock does not know what a cycle does: the
 owner passes ``run_cycle`` (one bus + controller cycle).
+
+Several controllers in one process (the cards of one PC, the cores of one card) share
+one time: their clocks join a :class:`ClockGroup`, and whatever time one of them lets
+pass (a call's latency, a wait, a polling loop's cycles) passes for all of them, so a
+card keeps moving while the application polls another.  Each clock still counts its own
+cycles and its own time since its power-on.  Realtime clocks need no group: the wall
+clock is shared already.
 """
 
 from __future__ import annotations
@@ -67,6 +74,8 @@ class Clock:
         self.stats = CycleStats()
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
+        #: the clocks this one shares time with (None: it runs alone)
+        self.group: ClockGroup | None = None
 
     # --- virtual time ------------------------------------------------------
     def cycle(self) -> None:
@@ -95,6 +104,8 @@ class Clock:
             self._pending_ns -= self.cycle_ns
             self.cycle()
             n += 1
+        if self.group is not None:
+            self.group.share(self, int(ns))
         return n
 
     def advance(self, ms: float) -> int:
@@ -127,6 +138,8 @@ class Clock:
                 return False
             self.cycle()
             spent += self.cycle_ns
+            if self.group is not None:
+                self.group.share(self, self.cycle_ns)
         return True
 
     def _sleep(self, seconds: float) -> None:
@@ -185,3 +198,43 @@ class Clock:
                 # missed a whole period: count it and re-phase instead of bursting
                 self.stats.overruns += 1
                 next_t = time.perf_counter_ns() + period
+
+
+class ClockGroup:
+    """Clocks that share one time (module docstring): the time one member lets pass, the
+    others let pass too, in the order they joined, right after it."""
+
+    def __init__(self) -> None:
+        self.clocks: list[Clock] = []
+        self._sharing = False
+
+    def join(self, clock: Clock) -> None:
+        if clock.mode is ClockMode.REALTIME or clock in self.clocks:
+            return
+        self.clocks.append(clock)
+        self._link()
+
+    def leave(self, clock: Clock) -> None:
+        if clock in self.clocks:
+            self.clocks.remove(clock)
+            clock.group = None
+            self._link()
+
+    def _link(self) -> None:
+        """A clock alone needs no sharing (nothing to do on its hot path)."""
+        alone = len(self.clocks) < 2
+        for c in self.clocks:
+            c.group = None if alone else self
+
+    def share(self, source: Clock, ns: int) -> None:
+        """``source`` let ``ns`` pass: the other members let it pass too (once: what they
+        run meanwhile does not share again)."""
+        if self._sharing or ns <= 0:
+            return
+        self._sharing = True
+        try:
+            for c in self.clocks:
+                if c is not source:
+                    c.advance_ns(ns)
+        finally:
+            self._sharing = False

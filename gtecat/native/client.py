@@ -49,6 +49,8 @@ from . import transport
 from .protocol import (
     BLOCK,
     CALL,
+    CALL_GTN,
+    CARD_SHIFT,
     CHUNK,
     F64,
     FIELD_REPLY,
@@ -97,6 +99,8 @@ class Connection:
     def __init__(self, address: str, *, timeout_s: float | None = None) -> None:
         self.address = address
         self.lost = ""  #: why the connection broke ("" while it works)
+        #: the cards this connection has opened (gtecat.controller.cards)
+        self.cards: set[int] = set()
         self._lock = threading.Lock()
         self._codecs: dict[int, _Codec] = {}
         try:
@@ -165,14 +169,16 @@ class Connection:
             self._close_socket()
 
     # --- GT calls ------------------------------------------------------------------------------
-    def call(self, name: str, gtn: bool, core: int, values: list[Any]) -> tuple[int, str]:
-        """Run a bound GT call in the controller: (return code, reason); the out-pointers
-        among ``values`` are written."""
+    def call(
+        self, name: str, gtn: bool, core: int, values: list[Any], card: int = 0
+    ) -> tuple[int, str]:
+        """Run a bound GT call in the controller on card ``card``: (return code, reason);
+        the out-pointers among ``values`` are written."""
         plan = plans_by_name()[name]
         codec = self._codecs.get(plan.fid)
         if codec is None:
             codec = self._codecs[plan.fid] = _Codec(plan, _LONG)
-        request, outs = codec.encode(gtn, core, values)
+        request, outs = codec.encode(gtn, core, values, card)
         body = self._exchange(request)
         rc, nblocks, nerr = REPLY.unpack_from(body, 0)
         pos = REPLY.size
@@ -187,9 +193,13 @@ class Connection:
         return rc, text
 
     # --- the field side -------------------------------------------------------------------------
-    def field(self, op: str, *args: Any) -> Any:
-        """Run one operation of :mod:`gtecat.native.field`; ControllerError with its reason."""
-        body = bytes([MSG_FIELD]) + json.dumps({"op": op, "args": list(args)}).encode()
+    def field(self, op: str, *args: Any, card: int = 0) -> Any:
+        """Run one operation of :mod:`gtecat.native.field` on card ``card``; ControllerError
+        with its reason."""
+        req: dict[str, Any] = {"op": op, "args": list(args)}
+        if card:
+            req["card"] = int(card)
+        body = bytes([MSG_FIELD]) + json.dumps(req).encode()
         reply = self._exchange(body)
         (status,) = FIELD_REPLY.unpack_from(reply, 0)
         value = json.loads(reply[FIELD_REPLY.size :].decode("utf-8"))
@@ -258,8 +268,11 @@ class _Codec:
             _Arg(a, long_size) if a.kind not in (Kind.INT, Kind.DOUBLE) else None for a in plan.args
         ]
 
-    def encode(self, gtn: bool, core: int, values: list[Any]) -> tuple[bytes, list[Any]]:
-        parts = [CALL.pack(MSG_CALL, int(gtn), self.plan.fid, core)]
+    def encode(
+        self, gtn: bool, core: int, values: list[Any], card: int = 0
+    ) -> tuple[bytes, list[Any]]:
+        flags = (CALL_GTN if gtn else 0) | (card << CARD_SHIFT)
+        parts = [CALL.pack(MSG_CALL, flags, self.plan.fid, core)]
         outs: list[Any] = []
         for a, spec, v in zip(self.plan.args, self.args, values, strict=True):
             if spec is None:
@@ -333,27 +346,34 @@ def remote_call(
     """A bound GT call of an attached session (``gtecat.gt._core`` calls this); 0, or a
     refusal that carries the controller's code and reason."""
     conn: Connection | None = session.remote
+    card = session.card
     if name == "GT_Open":
         return _open(session, conn, gtn, core, values, extra, address)
     assert conn is not None
     if name == "GT_Close":  # detach; a controller already gone leaves nothing to close
         try:
-            rc, text = conn.call(name, gtn, core, values)
+            rc, text = conn.call(name, gtn, core, values, card)
         except ControllerLost:
             rc, text = 0, ""
         if rc == 0:
-            conn.close()
-            session.remote = None
+            conn.cards.discard(card)
+            if not conn.cards:  # the last card this session had open
+                conn.close()
+                session.remote = None
             return 0
         _refuse(name, rc, text)
     if conn.lost:
         _core.fail(_core.CMD_COMM, f"controller not responding: {conn.lost}")
     try:
-        rc, text = conn.call(name, gtn, core, values)
+        rc, text = conn.call(name, gtn, core, values, card)
     except ControllerLost as e:
         _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
     if rc != 0:
         _refuse(name, rc, text)
+    if name == "GT_SetCardNo":  # the session's own settings; the controller checked them
+        session.select(int(values[0]))
+    elif name == "GT_SetCore":
+        session.core = int(values[0])
     return 0
 
 
@@ -372,11 +392,26 @@ def _open(
     extra: dict[str, Any],
     address: str,
 ) -> int:
-    if session.controllers:
+    if session.all_controllers():
         _core.fail(
             _core.CMD_OPEN,
             "the controller is already open in this process (GT_Close first, then attach)",
         )
+    card = session.card
+    if conn is not None and not conn.lost and (not address or address == conn.address):
+        if card in conn.cards:
+            _core.fail(
+                _core.CMD_OPEN,
+                f"card {card} is already open on the controller at {conn.address} (GT_Close first)",
+            )
+        try:  # another card of the same controller, on the same connection
+            rc, text = conn.call("GT_Open", gtn, core, values, card)
+        except ControllerLost as e:
+            _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
+        if rc != 0:
+            _refuse("GT_Open", rc, text)
+        conn.cards.add(card)
+        return 0
     if conn is not None and not conn.lost:
         _core.fail(
             _core.CMD_OPEN,
@@ -398,12 +433,13 @@ def _open(
     except ControllerError as e:
         _core.fail(_core.CMD_COMM, str(e))
     try:
-        rc, text = new.call("GT_Open", gtn, core, values)
+        rc, text = new.call("GT_Open", gtn, core, values, card)
     except ControllerLost as e:
         _core.fail(_core.CMD_COMM, f"controller not responding: {e}")
     if rc != 0:
         new.close()
         _refuse("GT_Open", rc, text)
+    new.cards.add(card)
     session.remote = new
     return 0
 
@@ -439,14 +475,16 @@ class Field:
     """The operations of :mod:`gtecat.native.field`, run by the controller (its call lock
     held, so each is atomic with respect to a cycle and to the other clients' calls)."""
 
-    def __init__(self, connection: Connection, *, owned: bool = False) -> None:
+    def __init__(self, connection: Connection, *, owned: bool = False, card: int = 0) -> None:
         self.connection = connection
         self._owned = owned
+        #: the card whose machine the operations act on (gtecat.controller.cards)
+        self.card = card
 
     @classmethod
-    def connect(cls, address: str) -> Field:
+    def connect(cls, address: str, card: int = 0) -> Field:
         """A connection of its own (an inspection verb; no GT_Open needed)."""
-        return cls(Connection(address), owned=True)
+        return cls(Connection(address), owned=True, card=card)
 
     def close(self) -> None:
         if self._owned:
@@ -459,6 +497,8 @@ class Field:
         self.close()
 
     def call(self, op: str, *args: Any) -> Any:
+        if self.card:  # (an inspection endpoint's connection knows one machine only)
+            return self.connection.field(op, *args, card=self.card)
         return self.connection.field(op, *args)
 
     # the bus: gtecat.controller.inspect.BusView's methods, same names and results
@@ -545,18 +585,21 @@ class Field:
         return self.call("cycle_stats")
 
 
-def field(address: str | None = None) -> Field:
+def field(address: str | None = None, card: int | None = None) -> Field:
     """The field side of the controller this session is attached to (``GT_Open(controller=
-    ...)``), or of the one at ``address`` on a connection of its own."""
+    ...)``), or of the one at ``address`` on a connection of its own; of card ``card``
+    (default: the session's current card, ``GT_SetCardNo``)."""
+    if card is None:
+        card = _core.SESSION.card
     if address is not None:
-        return Field.connect(address)
+        return Field.connect(address, card)
     conn = _core.SESSION.remote
     if conn is None:
         raise ControllerError(
             "this session is not attached to a controller: GT_Open(controller='unix:/path') "
             "first, or field('unix:/path')"
         )
-    return Field(conn)
+    return Field(conn, card=card)
 
 
 __all__ = [

@@ -8,10 +8,12 @@ over ``libgts.so`` (it needs it, and ``--libs`` names both): each ``GT_x(cardNum
 checks the card and calls libgts's own ``GT_x``, found once with ``dlsym(RTLD_NEXT)``, so
 the ~2,000 stubs of libgts are not compiled twice.
 
-The emulator is one card, number 0 (the vendor numbers cards from 0).  ``GT_Open`` of
-another card returns -6 (``CMD_ERROR_OPEN``: no such card); any other function given
-another card returns -1 (that card is not open), each with the reason in
-``GTE_GetLastError``.  ``GTN_x`` and ``GTE_x`` keep their own shapes.
+Each card 0..15 is a controller of its own (:mod:`gtecat.controller.cards`): the card
+travels with the call (``gte_use_card`` of libgts: for this one call of this thread, so
+threads driving different cards never race), and ``GT_Open(cardNum, ...)`` opens that
+card.  A card outside 0..15 is refused: ``GT_Open`` with -6 (``CMD_ERROR_OPEN``), any
+other function with -1, each with the reason in ``GTE_GetLastError``.  ``GTN_x`` and
+``GTE_x`` keep their own shapes and address the current card (``GT_SetCardNo``).
 """
 
 from __future__ import annotations
@@ -50,8 +52,10 @@ def render_c() -> str:
         "#include <dlfcn.h>",
         '#include "gts_sc.h" /* the single-card header: its structures and enums */',
         "",
-        "/* in libgts (gts_runtime.c): the reason of a card other than 0 */",
+        "/* in libgts (gts_runtime.c): the reason of a card outside 0..15; the card of the",
+        " * next call of this thread */",
         "short gte_no_card(const char *name, short card, short code);",
+        "void gte_use_card(short card);",
         "",
     ]
     for name, proto in FUNCTIONS.items():
@@ -65,8 +69,12 @@ def render_c() -> str:
         check = (
             []
             if _own_card(proto)
-            else [f'    if (cardNum != 0) return gte_no_card("{name}", cardNum, {code});']
+            else [
+                "    if (cardNum < 0 || cardNum > 15)",
+                f'        return gte_no_card("{name}", cardNum, {code});',
+            ]
         )
+        use = [] if _own_card(proto) else ["    gte_use_card(cardNum);"]
         lines += [
             f"typedef short (*t_{bare})({own});",
             f'{sig} __asm__("{name}");',
@@ -76,6 +84,7 @@ def render_c() -> str:
             *check,
             "    if (!f)",
             f'        *(void **)(&f) = dlsym(RTLD_NEXT, "{name}");',
+            *use,
             f'    return f ? f({args}) : gte_no_card("{name}", cardNum, -7);',
             "}",
         ]

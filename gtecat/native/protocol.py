@@ -23,8 +23,9 @@ Reply (``HELLO_REPLY``): ``i16 status, u16 text length, text``.
 
 A call (``CALL``)::
 
-    u8 type = 2, u8 gtn (1: GTN_x, the core is checked; 0: GT_x / GTE_x),
-    u16 function id (index in :data:`FUNCTION_NAMES`), i16 core,
+    u8 type = 2, u8 flags (bit 0: 1 = GTN_x, the core is checked, 0 = GT_x / GTE_x;
+    bits 4..7: the card the call addresses, 0..15), u16 function id (index in
+    :data:`FUNCTION_NAMES`), i16 core,
     then every parameter in prototype order:
       integer scalar: i64            double: f64
       pointer: i32 size, then ``size`` bytes: the memory behind the pointer
@@ -62,7 +63,7 @@ from ..gt.table import FUNCTIONS, PROTOTYPES, SCALARS, Param, Proto, emulated
 from . import cdecl
 from .transport import SOCKET_TYPE, socket_path
 
-PROTOCOL_VERSION = 2
+PROTOCOL_VERSION = 3
 
 #: the largest record one send makes (well inside the default socket buffer)
 CHUNK = 1 << 16
@@ -81,6 +82,10 @@ FIELD_REPLY = struct.Struct("<h")
 
 MSG_HELLO = 1
 MSG_CALL = 2
+
+#: the flags byte of a call: bit 0 GTN, bits 4..7 the card
+CALL_GTN = 0x01
+CARD_SHIFT = 4
 MSG_FIELD = 3
 
 PTR_NULL = -1
@@ -220,6 +225,8 @@ def table_digest() -> str:
 __all__ = [
     "BLOCK",
     "CALL",
+    "CALL_GTN",
+    "CARD_SHIFT",
     "CHUNK",
     "F64",
     "FIELD_REPLY",

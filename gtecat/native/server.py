@@ -19,6 +19,11 @@ Decisions:
   as a Python program does.  ``GT_Close`` detaches the client;
   the controller stays (it is the device).  Calls of a client that has not opened
   (or has closed) return -1, as in Python before ``GT_Open``.
+* **Cards** (:mod:`gtecat.controller.cards`): every call carries the card it addresses
+  (the client's current card, ``GT_SetCardNo``, or the multi-card ABI's ``cardNum``).  A
+  client opens each card it uses; the first client to open a card opens its controller,
+  which stays when the client closes it.  ``GT_SetCardNo`` / ``GT_GetCardNo`` are the
+  client's own setting (two programs on one controller do not share it).
 * In ``auto`` mode the server keeps the wall floor (:mod:`gtecat.native.floor`)
   unless asked not to, so native clients that sleep between polls see time pass.
 * Every client is served independently: its bytes are buffered until a frame is whole and
@@ -57,6 +62,8 @@ from .floor import WallFloor
 from .protocol import (
     BLOCK,
     CALL,
+    CALL_GTN,
+    CARD_SHIFT,
     CHUNK,
     F64,
     FIELD_REPLY,
@@ -116,6 +123,8 @@ def default_spin_us() -> float:
 
 
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
+#: what a client sets for itself: its current card and the core of its GT_x calls
+_OWN_SETTINGS = frozenset({"GT_SetCardNo", "GT_GetCardNo", "GT_SetCore", "GT_GetCore"})
 
 
 class ProtocolError(Exception):
@@ -260,11 +269,13 @@ class _Client:
     peer: str
     buf: bytearray = field(default_factory=bytearray)
     long_size: int = 0  # 0 until the hello
-    opened: bool = False
+    #: the cards this client has opened (GT_Open after GT_SetCardNo, or cardNum)
+    cards: set[int] = field(default_factory=set)
     decoders: dict[int, _Decoder] = field(default_factory=dict)
     #: reply bytes the client has not read yet (while any wait, its requests wait too)
     out: bytearray = field(default_factory=bytearray)
-    field: field_ops.Context | None = None  # its traces
+    #: per card: its traces
+    fields: dict[int, field_ops.Context] = field(default_factory=dict)
     #: may call (a Unix socket client at once; a TCP client once its token was right)
     authed: bool = True
     #: monotonic time by which it must have greeted / completed its frame / read its
@@ -605,9 +616,10 @@ class Server:
             return  # dropped already
         if self._clients.pop(c.sock.fileno(), None) is not None:
             self._poller.unregister(c.sock.fileno())
-        if c.field is not None:
+        if c.fields:
             with self.lock:
-                c.field.stop_traces()
+                for ctx in c.fields.values():
+                    ctx.stop_traces()
         c.sock.close()
 
     def _spin_budget(self) -> float:
@@ -765,27 +777,36 @@ class Server:
         if not c.authed and kind != MSG_HELLO:
             raise ProtocolError(f"message type {kind} before the hello with the token")
         if kind == MSG_CALL and c.long_size:
-            _, gtn, fid, core = CALL.unpack_from(body, 0)
+            _, flags, fid, core = CALL.unpack_from(body, 0)
+            gtn, card = flags & CALL_GTN, flags >> CARD_SHIFT
             dec = c.decoders.get(fid)
             if dec is None:
                 dec = c.decoders[fid] = self._decoder(c.long_size, fid)
-            if dec.fast is not None and c.opened and not gtn:
+            if dec.fast is not None and card in c.cards and not gtn and core == 1:
                 with self.lock:
                     if self.wall_floor:
                         floor = self._current_floor()
                         if floor is not None:
                             floor.look()
-                    out = dec.fast(body)
+                    session = _core.SESSION
+                    if card == session.card:
+                        out = dec.fast(body)
+                    else:
+                        with session.selected(card):
+                            out = dec.fast(body)
                 if out is not None:
                     self.calls += 1
                     return out
             args, backs = dec.decode(body, CALL.size)
             with self.lock:
-                for ctl in _core.SESSION.controllers.values():
+                for ctl in _core.SESSION.all_controllers():
                     ctl.slice_hook = self._serve_others
                 self._running.append(c)
                 try:
-                    rc, text = self._call(c, dec, gtn, core, args)
+                    # the client's card and, for GT_x, its core (gtecat.controller.cards);
+                    # this process's own stay
+                    with _core.SESSION.selected(card, None if gtn else core):
+                        rc, text = self._call(c, dec, gtn, core, args)
                 finally:
                     self._running.pop()
             return _reply(rc, backs, text)
@@ -858,20 +879,29 @@ class Server:
         try:
             req = json.loads(bytes(body[1:]).decode("utf-8"))
             op, args = str(req["op"]), list(req.get("args", []))
+            card = int(req.get("card", 0))
         except (ValueError, KeyError, TypeError) as e:
             raise ProtocolError(f"a field request that is not JSON {{op, args}}: {e}") from None
         status, result = 0, None
         with self.lock:
-            ctl = _core.SESSION.controllers.get(1)
+            ctl = _core.SESSION.cards.get(card, {}).get(1)  # the card's machine
             if ctl is None:
-                status, result = 1, "the controller is not open yet (no client has called GT_Open)"
+                status, result = (
+                    1,
+                    (
+                        f"card {card} is not open (no client has opened it)"
+                        if card
+                        else "the controller is not open yet (no client has called GT_Open)"
+                    ),
+                )
             else:
-                if c.field is None or c.field.ctl is not ctl:
-                    if c.field is not None:
-                        c.field.stop_traces()
-                    c.field = field_ops.Context(ctl)
+                ctx = c.fields.get(card)
+                if ctx is None or ctx.ctl is not ctl:
+                    if ctx is not None:
+                        ctx.stop_traces()
+                    ctx = c.fields[card] = field_ops.Context(ctl)
                 try:
-                    result = field_ops.run(c.field, op, args)
+                    result = field_ops.run(ctx, op, args)
                 except GtecatError as e:
                     status, result = 1, str(e)
                 except Exception as e:  # a field operation never takes the controller down
@@ -890,7 +920,10 @@ class Server:
             name = plan.proto.twin_name if gtn else plan.name
             code, why = declared.note(name)
             return code, f"{name} returned {code}: {why}"
-        if not c.opened or plan.name in ("GT_Open", "GT_Close", "GTN_OpenCard"):
+        if plan.name in _OWN_SETTINGS:  # the client's own setting
+            return _invoke(dec.fn_gtn, (core, *args)) if gtn else _invoke(dec.fn_gt, args)
+        card = _core.SESSION.card
+        if card not in c.cards or plan.name in ("GT_Open", "GT_Close", "GTN_OpenCard"):
             return self._open_close(c, dec, gtn, core, args)
         if plan.unsupported:  # the arguments are checked first, as in Python
             why = plan.null_refusal(args)
@@ -921,31 +954,41 @@ class Server:
                 return _invoke(dec.fn_gtn, (core, *args))
             if name == "GT_Open":
                 return self._open(c, gtn, core, args)
-            c.opened = False
+            c.cards.discard(_core.SESSION.card)
             return 0, ""
+        card = _core.SESSION.card
+        if card:
+            return _core.CMD_COMM, (
+                f"{name} returned -1: this client has not opened card {card}: call GT_Open "
+                f"after GT_SetCardNo({card})"
+            )
         return _core.CMD_COMM, f"{name} returned -1: {NOT_OPEN}"
 
     def _open(self, c: _Client, gtn: int, core: int, args: list[Any]) -> tuple[int, str]:
-        if c.opened:  # as in Python: the same program opening twice
+        card = _core.SESSION.card
+        if card in c.cards:  # as in Python: the same program opening twice
             return _core.CMD_OPEN, (
-                "GT_Open returned -6: the controller is already open "
-                "(GT_Open called twice; call GT_Close first)"
+                f"GT_Open returned -6: {f'card {card}' if card else 'the controller'} is "
+                "already open (GT_Open called twice; call GT_Close first)"
             )
         if 1 not in _core.SESSION.controllers:
             opener = _core.REGISTRY["GT_Open"]
             # "local": this process is the controller, whatever GTECAT_CONTROLLER says
-            rc = opener(*args, controller="local", **self.open_options)
+            # another card: the first card's options and its description
+            # (gtecat.controller.cards), not the options the server gives the first
+            first = card == 0 or _core.SESSION.base_options is None
+            rc = opener(*args, controller="local", **(self.open_options if first else {}))
             if rc != 0:
                 e = _core.SESSION.last
                 return rc, (f"GT_Open returned {rc}: {e.reason}" if e else "")
-        c.opened = True
+        c.cards.add(card)
         return 0, ""
 
     # --- time ----------------------------------------------------------------------------
     def _current_floor(self) -> WallFloor | None:
         if not self.wall_floor:
             return None
-        ctl = _core.SESSION.controllers.get(1)
+        ctl = _core.SESSION.first()  # every card shares its time
         if ctl is None:
             return None
         if ctl.clock is not self._floor_clock:

@@ -14,6 +14,8 @@ from .. import __version__
 from ..gt._core import CMD_DECLARED
 from ..gt.table import GROUPS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .protocol import (
+    CALL_GTN,
+    CARD_SHIFT,
     CHUNK,
     MAX_FRAME,
     MAX_POINTER_BYTES,
@@ -43,6 +45,8 @@ def render_wire_h() -> str:
         f'#define GTE_TABLE_DIGEST "{table_digest()}"',
         f"#define GTE_MSG_HELLO {MSG_HELLO}",
         f"#define GTE_MSG_CALL {MSG_CALL}",
+        f"#define GTE_CALL_GTN {CALL_GTN}",
+        f"#define GTE_CARD_SHIFT {CARD_SHIFT}",
         f"#define GTE_PTR_NULL ({PTR_NULL})",
         f"#define GTE_PTR_UNKNOWN ({PTR_UNKNOWN})",
         f"#define GTE_PTR_TOO_BIG ({PTR_TOO_BIG})",
@@ -68,6 +72,10 @@ def _descriptor(plan: FunctionPlan) -> list[str]:
         "GT_Open": "GTE_F_OPEN",
         "GTN_OpenCard": "GTE_F_OPEN",  # the GSN-E form of GT_Open
         "GT_Close": "GTE_F_CLOSE",
+        "GT_SetCardNo": "GTE_F_CARDNO",  # the process's current card (gts_runtime.c)
+        "GT_GetCardNo": "GTE_F_GETCARDNO",
+        "GT_SetCore": "GTE_F_SETCORE",
+        "GT_GetCore": "GTE_F_GETCORE",
     }.get(name, "0")
     out = []
     if plan.args:

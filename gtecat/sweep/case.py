@@ -108,7 +108,7 @@ def run_case(job: Job, case: Case) -> dict[str, Any]:
     try:
         scenario = load_scenario(job.scenario_name, job.scenario_source)
         machine = _machine(job, case)
-        gt.GT_Close()
+        gt._core.close_all()
         options: dict[str, Any] = {
             "machine": machine_from_dict(machine, f"case {case.id}") if machine else None,
             "clock": "lockstep",
@@ -144,7 +144,7 @@ def run_case(job: Job, case: Case) -> dict[str, Any]:
             row["kept"] = _keep(job.keep_dir, case, row["error"], recorder)
         if recorder is not None:
             recorder.stop()
-        gt.GT_Close()
+        gt._core.close_all()  # every card the scenario opened
         shutil.rmtree(folder, ignore_errors=True)
     return row
 

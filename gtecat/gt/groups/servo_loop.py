@@ -1,6 +1,7 @@
 """The pulse and analog servo loop of GTS cards, and the card-level calls around it (vendor GTS
 and GTN headers): PID sets, control and step modes, DAC and ADC channels, limit modes, DI
-edge counters, timed output pulses, multi-axis enable, resource counts, the card number.
+edge counters, timed output pulses, multi-axis enable, resource counts, the card number and
+the core the GT_ functions address.
 
 Implemented by :mod:`gtecat.gt.servo_loop_calls` (state in :mod:`gtecat.controller.servo_loop`).
 """
@@ -38,6 +39,8 @@ short GT_GetResMax(short type, short *pCount);                                  
 short GT_GetResCount(short type, short *pCount);                                 // header (GTN)
 short GT_SetCardNo(short index);                                                 // header (GTS)
 short GT_GetCardNo(short *pIndex);                                               // header (GTS)
+short GT_SetCore(short core /*1..2*/);                                           // header (GTN)
+short GT_GetCore(short *pCore);                                                  // header (GTN)
 short GT_GetAtlTorque(short axis, short *pTorque);                               // header (GTN)
 short GT_GetEcatAxisAtlTorque(short axis, short *pTorque);                       // header (GTN, the manual's AtI spelled Atl)
 

@@ -102,6 +102,17 @@ static pid_t g_child;              /* that controller's pid */
 static int g_lifeline = -1;        /* its lifeline: EOF when this process ends */
 #endif
 static char g_lost[1300];          /* why the connection was lost ("" if it was not) */
+/* the current card of the process (GT_SetCardNo; gtecat/controller/cards.py), the cards it
+ * has open (bit n: card n; the connection ends when the last one closes), and a card one
+ * call of this thread addresses instead (the multi-card ABI, gte_use_card) */
+static short g_card;
+static short g_core = 1; /* the core of the GT_x calls (GT_SetCore); GTN_x name theirs */
+static unsigned g_cards_open;
+#if defined(_MSC_VER)
+static __declspec(thread) short t_card = -1;
+#else
+static __thread short t_card = -1;
+#endif
 static char g_err[2048];           /* the last error, for GTE_GetLastError */
 static unsigned char *g_buf;       /* request/reply buffer */
 static size_t g_cap;
@@ -1014,7 +1025,8 @@ static long long ptr_bytes(const gte_function *f, int i, const gte_arg *a)
     return n * (long long)f->params[i].elem;
 }
 
-static short invoke_locked(const gte_function *f, int gtn, short core, const gte_arg *a)
+static short invoke_locked(const gte_function *f, int gtn, short core, short card,
+                           const gte_arg *a)
 {
     if (f->flags & GTE_F_OPEN) {
         if (ensure_open(f->name) < 0)
@@ -1059,7 +1071,7 @@ connected:;
     put_u32(w, (uint32_t)(size - 4));
     w += 4;
     *w++ = GTE_MSG_CALL;
-    *w++ = (unsigned char)(gtn ? 1 : 0);
+    *w++ = (unsigned char)((gtn ? GTE_CALL_GTN : 0) | ((card & 15) << GTE_CARD_SHIFT));
     memcpy(w, &f->id, 2);
     w += 2;
     memcpy(w, &core, 2);
@@ -1184,13 +1196,63 @@ connected:;
     return rc;
 }
 
+/* GT_SetCardNo / GT_GetCardNo, GT_SetCore / GT_GetCore: the process's own settings,
+ * answered here (before GT_Open too, as applications call them) with the codes and reasons
+ * of the Python functions */
+static short own_setting(const gte_function *f, int gtn, short core, const gte_arg *a)
+{
+    int set = f->flags & (GTE_F_CARDNO | GTE_F_SETCORE);
+    int card = f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO);
+    if (gtn && core != 1) {
+        set_err("%s returned 7: core=%d: the EtherCAT core is 1", f->name, core);
+        return CMD_PARAM;
+    }
+    if (set) {
+        long long v = a[0].i, top = card ? 15 : 2;
+        if (v < (card ? 0 : 1) || v > top) {
+            set_err("%s returned 7: %s=%lld out of range %d..%lld", f->name,
+                    card ? "index" : "core", v, card ? 0 : 1, top);
+            return CMD_PARAM;
+        }
+        if (card)
+            g_card = (short)v;
+        else
+            g_core = (short)v;
+    } else {
+        if (!a[0].p) {
+            set_err("%s returned 7: %s is NULL; this pointer is required", f->name,
+                    card ? "pIndex" : "pCore");
+            return CMD_PARAM;
+        }
+        *(short *)a[0].p = card ? g_card : g_core;
+    }
+    g_err[0] = '\0';
+    return 0;
+}
+
 short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
 {
+    short card = t_card; /* the multi-card ABI's card for this one call, else the current */
+    t_card = -1;
     LOCK();
-    short rc = invoke_locked(f, gtn, core, a);
-    if ((f->flags & GTE_F_CLOSE) && g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid()) {
-        /* GT_Close ends this connection; a private controller lives on until the
-         * program ends, so the next GT_Open finds it again */
+    if (f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO | GTE_F_SETCORE | GTE_F_GETCORE)) {
+        short rc = own_setting(f, gtn, core, a);
+        UNLOCK();
+        return rc;
+    }
+    if (card < 0)
+        card = g_card;
+    if (!gtn)
+        core = g_core; /* a GT_x call: the core GT_SetCore chose */
+    short rc = invoke_locked(f, gtn, core, card, a);
+    if (rc == 0 && (f->flags & GTE_F_OPEN))
+        g_cards_open |= 1u << (card & 15);
+    if (f->flags & GTE_F_CLOSE)
+        g_cards_open &= ~(1u << (card & 15));
+    if ((f->flags & GTE_F_CLOSE) && !g_cards_open && g_fd != GTE_NO_SOCK &&
+        g_fd_pid == gte_getpid()) {
+        /* the last card's GT_Close ends this connection; a private controller lives on
+         * until the program ends, so the next GT_Open finds it again */
         sock_close(g_fd);
         g_fd = GTE_NO_SOCK;
         g_lost[0] = '\0';
@@ -1199,15 +1261,20 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
     return rc;
 }
 
+void gte_use_card(short card)
+{
+    t_card = card;
+}
+
 short gte_no_card(const char *name, short card, short code)
 {
     LOCK();
     if (code == -6)
-        set_err("%s returned -6: no card %d: the emulator is card 0", name, card);
+        set_err("%s returned -6: no card %d: cards are numbered 0..15", name, card);
     else if (code == -7)
         set_err("%s returned -7: libgts_mc found no %s in libgts", name, name);
     else
-        set_err("%s returned %d: card %d is not open: the emulator is card 0", name, code, card);
+        set_err("%s returned %d: no card %d: cards are numbered 0..15", name, code, card);
     UNLOCK();
     return code;
 }
@@ -1221,7 +1288,7 @@ short gte_declared(int index, int gtn, short core)
     LOCK();
     short rc = -1;
     if (g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid())
-        rc = invoke_locked(&f, gtn, core, NULL); /* the controller logs it and says why */
+        rc = invoke_locked(&f, gtn, core, g_card, NULL); /* the controller logs it, says why */
     if (rc != GTE_CMD_DECLARED)
         set_err("%s returned %d: %s is declared but not emulated (group: %s)", name,
                 GTE_CMD_DECLARED, name, d->group);

@@ -25,7 +25,15 @@ typedef struct gte_function {
     const gte_param *params;
 } gte_function;
 
-enum { GTE_F_OPEN = 1, GTE_F_CLOSE = 2, GTE_F_DECLARED = 4 };
+enum {
+    GTE_F_OPEN = 1,
+    GTE_F_CLOSE = 2,
+    GTE_F_DECLARED = 4,
+    GTE_F_CARDNO = 8,     /* GT_SetCardNo: the process's current card (gts_runtime.c) */
+    GTE_F_GETCARDNO = 16, /* GT_GetCardNo */
+    GTE_F_SETCORE = 32,   /* GT_SetCore: the core of the GT_x calls */
+    GTE_F_GETCORE = 64    /* GT_GetCore */
+};
 
 typedef union gte_arg {
     long long i;
@@ -53,9 +61,12 @@ typedef struct gte_declared_info {
 GTE_INTERNAL extern const gte_declared_info gte_declared_table[]; /* gts_declared.c */
 GTE_INTERNAL short gte_declared(int index, int gtn, short core);
 
-/* the multi-card ABI (libgts_mc, a layer over this library) given a card other than 0:
+/* the multi-card ABI (libgts_mc, a layer over this library) given a card outside 0..15:
  * code (-6 for GT_Open, else -1) with a reason; exported for libgts_mc, not in gts.h */
 short gte_no_card(const char *name, short card, short code);
+/* the multi-card ABI: the next call of this thread addresses card ``card`` (0..15) instead
+ * of the current card; exported for libgts_mc, not in gts.h */
+void gte_use_card(short card);
 
 /* the interpreter that built the library (generated beside the stubs) */
 GTE_INTERNAL extern const char gte_default_python[];

@@ -7,14 +7,15 @@ from ctypes import byref, c_short
 import pytest
 
 from gtecat import gt
+from gtecat.gt import _core
 from tests.conftest import EXAMPLES
 
 
 @pytest.fixture(autouse=True)
 def _closed_controller():
-    gt.GT_Close()
+    _core.close_all()
     yield
-    gt.GT_Close()
+    _core.close_all()
 
 
 def bring_up(eni: str = "manual_fig5_2.eni", **options) -> None:

@@ -69,6 +69,8 @@ STATEFUL = {
     "LoadConfig",
     "UnplugSlave",
     "ReplugSlave",
+    "SetCardNo",  # every later call addresses another card
+    "SetCore",  # every later GT_ call addresses another core
 }
 CALL_TIMEOUT_S = 10.0
 PAD = 16
@@ -123,7 +125,9 @@ def healthy() -> str:
 
 
 def restart() -> None:
-    gt.GT_Close()
+    from gtecat.gt import _core
+
+    _core.close_all()  # every card, and card 0 current again
     bring_up(clock="lockstep")
 
 

@@ -151,7 +151,9 @@ def test_example_5_4_ethercat_io_on_the_coupler():
     assert [coupler.get_output(0x7030, k) for k in range(1, 5)] == [1, 2, 3, 4]
     # the GTN twin with the EtherCAT core first, as 5.2.2.5 writes it
     assert gt.GTN_EcatIOReadInput(1, 0, 14, 2, byref(w_input)) == 0
-    assert gt.GTN_EcatIOReadInput(2, 0, 14, 2, byref(w_input)) == 7
+    assert gt.GTN_EcatIOReadInput(3, 0, 14, 2, byref(w_input)) == 7  # no core 3
+    # core 2 is the card's pulse core (gtecat.controller.cards): no EtherCAT there
+    assert gt.GTN_EcatIOReadInput(2, 0, 14, 2, byref(w_input)) == 1
     # the manual's 5.2.2.5 text spells it with the core first: GT_EcatIOReadInput(1, 0, 14, 2, ...)
     assert gt.GT_EcatIOReadInput(1, 0, 14, 2, byref(w_input)) == 0 and w_input.value == 0xBEEF
     assert gt.GT_EcatIOWriteOutput(1, 0, 2, 2, byref(w_out)) == 0

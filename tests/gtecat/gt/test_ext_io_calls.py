@@ -81,7 +81,8 @@ def test_the_access_and_the_modules_refuse_clearly(card):
     assert gt.GT_SetExtIoBit(16, 0, 0) == 7  # the vendor's range 0..15
     assert gt.GT_SetExtIoBit(1, 8, 0) == 7 and "8 output(s)" in gt.GTE_GetLastError()
     assert gt.GT_SetExtIoBit(0, 1, 2) == 7  # a level is 0 or 1
-    assert gt.GT_SetExtIoBitGts(1, 0, 1, 0) == 7 and "card 0" in gt.GTE_GetLastError()
+    assert gt.GT_SetExtIoBitGts(1, 0, 1, 0) == -1 and "card 1 is not open" in gt.GTE_GetLastError()
+    assert gt.GT_SetExtIoBitGts(16, 0, 1, 0) == 7  # cards 0..15
     assert u16(gt.GT_GetStsExtMdl, 5, 0) == 1  # absent: status 1, the call itself succeeds
     gt.GTE_ExtModule(1).online = False  # the module's cable pulled
     assert u16(gt.GT_GetStsExtMdl, 1, 0) == 1
@@ -89,7 +90,8 @@ def test_the_access_and_the_modules_refuse_clearly(card):
     assert gt.GT_ResetExtMdl() == 1 and "[1]" in gt.GTE_GetLastError()
     gt.GTE_ExtModule(1).online = True
     assert gt.GT_SetExtMdlMode(1) == 0 and u16(gt.GT_GetExtMdlMode) == 1
-    assert gt.GT_SwitchtoCardNoExtMdl(0) == 0 and gt.GT_SwitchtoCardNoExtMdl(2) == 7
+    assert gt.GT_SwitchtoCardNoExtMdl(0) == 0 and gt.GT_SwitchtoCardNoExtMdl(16) == 7
+    assert gt.GT_SwitchtoCardNoExtMdl(2) == 1 and "GT_SetCardNo(2)" in gt.GTE_GetLastError()
 
 
 def test_reset_switches_the_module_outputs_off_and_gt_reset_does_not(card):
@@ -199,7 +201,7 @@ def test_the_multi_card_forms_act_on_the_same_modules(card):
     assert gt.GT_OpenExtMdlGts(0, "gts.dll") == 0
     assert gt.GT_LoadExtConfigGts(0, "ExtModule.cfg") == 0
     assert gt.GT_SwitchtoCardNoExtMdlGts(0, 0) == 0
-    assert gt.GT_SwitchtoCardNoExtMdlGts(0, 2) == 7
+    assert gt.GT_SwitchtoCardNoExtMdlGts(0, 2) == 1
     assert gt.GT_SetExtIoValueGts(0, 1, 0xFFF0) == 0  # module 1: outputs 0..3 on (active low)
     assert u16(gt.GT_GetExtDoValueGts, 0, 1) == 0xFFF0 == u16(gt.GT_GetExtDoValue, 1)
     assert gt.GTE_ExtModule(1).output(0) and not gt.GTE_ExtModule(1).output(4)
@@ -211,7 +213,7 @@ def test_the_multi_card_forms_act_on_the_same_modules(card):
     assert gt.GTE_ExtModule(2).ao_voltage(1) == 10.0
     assert gt.GTE_SetExtAdVoltage(2, 0, 5.0) == 0
     assert u16(gt.GT_GetExtAdValueGts, 0, 2, 0) == round(5.0 / 10 * 65535)  # range [0, 10] V
-    assert gt.GT_SetExtIoValueGts(1, 1, 0) == 7 and "card 0" in gt.GTE_GetLastError()
+    assert gt.GT_SetExtIoValueGts(1, 1, 0) == -1 and "card 1 is not open" in gt.GTE_GetLastError()
 
 
 def test_the_gtn_core_reads_an_output_back_and_writes_raw_analog_values():
@@ -227,3 +229,20 @@ def test_the_gtn_core_reads_an_output_back_and_writes_raw_analog_values():
     assert abs(gt.GTE_ExtModule(2).ao_voltage(1) - (-16384 / 32767 * 10)) < 1e-9
     assert gt.GT_SetExtAoValue(1, byref(c_short(32767)), 1) == 0  # the GT_ form is core 1
     assert gt.GTE_ExtModule(2).ao_voltage(0) == 10.0
+
+
+def test_the_gts_forms_address_each_cards_own_modules(card):
+    """A station of two cards, each with its own modules (card 1: an identical controller):
+    the ``*Gts`` forms name the card; the current card stays 0."""
+    assert gt.GT_SetCardNo(1) == 0 and gt.GT_Open() == 0
+    assert gt.GT_SetCardNo(0) == 0
+    for n in (0, 1):
+        assert gt.GT_OpenExtMdlGts(n, "gts.dll") == 0
+        assert gt.GT_LoadExtConfigGts(n, "ExtModule.cfg") == 0, gt.GTE_GetLastError()
+    assert gt.GT_SetExtIoBitGts(1, 0, 3, 0) == 0  # card 1, module 0, output 3 on (active low)
+    assert gt.GTE_ExtModule(0).output(3) is False  # card 0's module is untouched
+    assert u16(gt.GT_GetExtDoValueGts, 0, 0) == 0xFFFF
+    assert u16(gt.GT_GetExtDoValueGts, 1, 0) == 0xFFF7
+    assert gt.GT_SetCardNo(1) == 0
+    assert gt.GTE_ExtModule(0).output(3) is True and u16(gt.GT_GetExtDoValue, 0) == 0xFFF7
+    assert gt.GT_SwitchtoCardNoExtMdl(1) == 0  # the current card

@@ -57,6 +57,8 @@ STATE_CHANGING = {
     "LoadConfig",
     "UnplugSlave",
     "ReplugSlave",
+    "SetCardNo",  # every later call addresses another card
+    "SetCore",  # every later GT_ call addresses another core
 }
 # The default run calls every function with a few examples (the suite's CPU budget);
 # GTECAT_LONG=N runs the campaign: 15 x N examples per function, 8 x N per twin (fresh seeds
@@ -134,7 +136,7 @@ def test_the_batches_cover_every_function_gt_exposes():
     for name in REGISTRY:
         base = "GT_" + name[4:] if name.startswith("GTN_") else name
         assert base in FUNCTIONS or name in FUNCTIONS, name  # or a GTN_x line of its own
-        if name.startswith("GT_"):
+        if name.startswith("GT_") and FUNCTIONS[name].gtn:  # GT_SetCore(core) has none
             assert "GTN_" + name[3:] in REGISTRY, name
     covered = [n for names in BATCHES.values() for n in names if n in REGISTRY]
     assert sorted(covered) == sorted(REGISTRY)
@@ -220,7 +222,7 @@ def test_a_typed_null_is_a_null_for_an_optional_pointer_and_refused_for_a_requir
         lambda sts: gt.GTN_GetSts(1.0, 1, byref(sts)),
         lambda sts: gt.GTN_GetSts(None, 1, byref(sts)),
         lambda sts: gt.GTN_GetSts(math.nan, 1, byref(sts)),
-        lambda sts: gt.GTN_GetSts(2, 1, byref(sts)),
+        lambda sts: gt.GTN_GetSts(3, 1, byref(sts)),  # core 2 is the card's second core
         lambda sts: gt.GTN_GetSts(1 << 40, 1, byref(sts)),
         lambda sts: gt.GTN_Close(2),
         lambda sts: gt.GTN_Open(0, 0, 1),  # the core-first form of earlier releases
@@ -252,7 +254,7 @@ def test_gte_wait_out_of_range_is_7_at_once(bus, ms):
     before = clock.value
     t0 = time.monotonic()
     assert gt.GTE_Wait(ms) == 7
-    assert time.monotonic() - t0 < 1.0
+    assert time.monotonic() - t0 < 30  # refused at once: a wait of a day would never end
     assert gt.GT_GetClock(byref(clock)) == 0 and clock.value == before
 
 

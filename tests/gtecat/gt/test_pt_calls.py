@@ -175,7 +175,7 @@ def test_gtn_twin_takes_the_core_first():
     assert gt.GTN_PtSpace(1, 1, byref(s), 0) == 0 and s.value == 31
     assert gt.GTN_PtStart(1, 1, 0) == 0
     assert samples()[-1, 0] == 10
-    assert gt.GTN_PtSpace(2, 1, byref(s), 0) == 7  # core 2 does not exist
+    assert gt.GTN_PtSpace(3, 1, byref(s), 0) == 7  # core 3 does not exist
 
 
 def test_float_times_are_7_the_prototype_takes_a_long():

@@ -32,3 +32,26 @@ def test_run_until_is_bounded():
     assert c.cycles == 3
     assert not c.run_until(lambda: False, timeout_ms=5)
     assert c.cycles == 8
+
+
+def test_a_group_of_clocks_shares_one_time():
+    """The cards of one PC: the time one lets pass passes for the others (cycles of their
+    own length), once; a clock that leaves runs alone again."""
+    from gtecat.master.clock import ClockGroup
+
+    runs: list[str] = []
+    a = Clock(lambda: runs.append("a"), cycle_ns=1_000_000, mode="lockstep")
+    b = Clock(lambda: runs.append("b"), cycle_ns=2_000_000, mode="lockstep")
+    group = ClockGroup()
+    group.join(a)
+    assert a.group is None  # alone: nothing to share
+    group.join(b)
+    a.advance(4)
+    assert (a.cycles, b.cycles, b.now_ns) == (4, 2, 4_000_000)
+    assert b.run_until(lambda: b.cycles == 3, 10)
+    assert (a.now_ns, b.now_ns) == (6_000_000, 6_000_000)
+    group.leave(b)
+    a.advance(2)
+    assert (a.cycles, b.cycles, a.group, b.group) == (8, 3, None, None)
+    group.join(Clock(lambda: None, mode="realtime"))  # the wall clock is shared already
+    assert group.clocks == [a]

@@ -47,11 +47,11 @@ def _start_controller(address: str, clock: str, cwd) -> subprocess.Popen:
 def controller(tmp_path, monkeypatch):
     """A ``gtecat controller`` process (lockstep, figure 5-2 bus); yields its address."""
     monkeypatch.delenv("GTECAT_CONTROLLER", raising=False)
-    gt.GT_Close()
+    _core.close_all()
     address = f"unix:{tmp_path}/ctl.sock"
     proc = _start_controller(address, "lockstep", tmp_path)
     yield address, proc
-    gt.GT_Close()
+    _core.close_all()
     proc.kill()
     proc.wait()
 
@@ -100,7 +100,7 @@ def test_attached_calls_return_the_controllers_codes_and_write_the_callers_memor
     assert gt.GT_GetSts(99, byref(sts)) == 7 and sts.value == -12345
     assert gt.GTE_GetLastError().startswith("GT_GetSts returned 7: axis=99")
     assert gt.GT_GetSts(1, None) == 7 and "NULL" in gt.GTE_GetLastError()
-    assert gt.GTN_GetSts(2, 1, byref(sts)) == 7 and "core 2" in gt.GTE_GetLastError()
+    assert gt.GTN_GetSts(3, 1, byref(sts)) == 7 and "core 3" in gt.GTE_GetLastError()
     assert gt.GT_SetVel(1, float("nan")) == 7
     assert gt.GT_GetSts(1, byref(sts)) == 0 and gt.GTE_GetLastError() == ""
     pos = c_double()
@@ -114,6 +114,22 @@ def test_open_twice_options_and_the_python_objects_are_refused_clearly(controlle
     assert gt.GT_Open(controller=address, log="") == 0
     assert gt.GT_Open(controller=address) == -6
     assert gt.GT_Open() == -6  # attached: a second open, as in-process
+    # a second card of the same controller, on the same connection (gtecat.controller.cards)
+    assert gt.GT_SetCardNo(1) == 0 and gt.GT_Open(controller=address) == 0
+    assert gt.GT_AxisOn(1) == 7  # card 1's own bus is not up
+    assert "bus not initialised" in gt.GTE_GetLastError()
+    index = c_short()
+    assert gt.GT_GetCardNo(byref(index)) == 0 and index.value == 1
+    _bring_up()  # card 1's bus; its field side is its own
+    field().inject_fault(0, "alarm")  # the session's current card: 1
+    assert gt.GTE_Wait(5) == 0
+    sts = c_long()
+    assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & (1 << 1)  # alarm on card 1
+    assert field().drive(0)["error_code"] != 0
+    with pytest.raises(client.ControllerError, match="card 2 is not open"):
+        field(card=2).drive(0)
+    assert gt.GT_Close() == 0 and _core.SESSION.remote is not None  # card 0 still open
+    assert gt.GT_SetCardNo(0) == 0
     with pytest.raises(_core.NotOpen, match=r"field\(\)"):
         gt.GTE_Slave(0)
     with pytest.raises(_core.NotOpen, match="attached"):

@@ -302,9 +302,14 @@ def test_a_multicard_wrapper_runs_on_the_multicard_map(multicard):
     assert target.name == "libgts_mc-llp64.so"
     text = (d / "MultiCardStation.exe.config").read_text(encoding="utf-8")
     assert f'<dllmap dll="i:gts.dll" target="{target}" os="!windows"/>' in text
-    # the emulator is card 0
-    assert v["open_card1"] == "-6" and "no card 1" in v["open_card1_reason"]
-    assert v["axison_card2"] == "-1" and "card 2 is not open" in v["axison_card2_reason"]
+    # cards 0..15; card 2 is not open; card 1 is a controller of its own: its axis 1 stands
+    # where card 0's moved, and it keeps working after card 0 is closed
+    assert v["open_card16"] == "-6" and "no card 16" in v["open_card16_reason"]
+    assert v["axison_card2"] == "-1" and "card 2" in v["axison_card2_reason"]
+    assert (v["open_card1"], v["axison_card1"], v["getprfpos_card1"]) == ("0", "0", "0")
+    assert float(v["prfpos_card1"]) == 0.0
+    assert (v["getsts_card1"], v["servo_card1"], v["close_card1"]) == ("0", "1", "0")
+    assert v["getsts_closed"] == "-1"
     # C long as int (GT_SetPos / GT_GetPos, GT_GetSts, GT_Update's mask), ref / out TTrapPrm
     assert (v["trap_acc"], v["target"], v["prfpos"]) == ("2", "12345", "12345")
     assert (v["sts_servo"], v["gpo"]) == ("1111", "2")

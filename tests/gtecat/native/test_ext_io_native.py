@@ -75,6 +75,6 @@ def test_ext_io_from_c_matches_python(libgts, tmp_path):
         "7",
         "1",
         "2500",
-        "7",
+        "-1",  # card 1 is not open
     )
     assert c_out["gtndi"] == str(1 << 5)

@@ -42,8 +42,8 @@ def moving():
 
 
 def _clients(long_size: int) -> tuple[srv_mod._Client, srv_mod._Client]:
-    fast = srv_mod._Client(sock=None, peer="fast", long_size=long_size, opened=True)  # type: ignore[arg-type]
-    slow = srv_mod._Client(sock=None, peer="slow", long_size=long_size, opened=True)  # type: ignore[arg-type]
+    fast = srv_mod._Client(sock=None, peer="fast", long_size=long_size, cards={0})  # type: ignore[arg-type]
+    slow = srv_mod._Client(sock=None, peer="slow", long_size=long_size, cards={0})  # type: ignore[arg-type]
     return fast, slow
 
 

@@ -97,7 +97,8 @@ def test_declared_only_gives_the_same_answer_in_python():
 
 
 def test_the_multicard_abi(controller, tmp_path):
-    """Manual-era GTS programs pass the card first; card 0 is the emulator."""
+    """Manual-era GTS programs pass the card first: two cards, each a controller of its own
+    (card 1 jogs while card 0 stands; card 0 closes, card 1 keeps running)."""
     from gtecat.native.build import ensure_built
 
     built("libgts_mc", lambda: ensure_built(abi="gts-multicard"))
@@ -107,14 +108,37 @@ def test_the_multicard_abi(controller, tmp_path):
     )  # fmt: skip
     r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
     assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
-    assert v["open_card1"] == "-6"
-    assert "no card 1: the emulator is card 0" in v["open_card1_reason"]
-    assert (v["open"], v["reset"], v["init"], v["ready"], v["start"]) == ("0", "0", "0", "1", "0")
-    assert v["getsts"] == "0"
-    assert v["axison_card2"] == "-1" and "card 2 is not open" in v["axison_card2_reason"]
-    assert (v["prftrap"], v["prfmode_rc"], v["prfmode"]) == ("0", "0", "0")  # Trap is mode 0
+    assert v["open_card16"] == "-6"
+    assert "no card 16: cards are numbered 0..15" in v["open_card16_reason"]
+    assert v["axison_card2"] == "-1"
+    assert "has not opened card 2" in v["axison_card2_reason"]
+    assert (v["up0"], v["up1"], v["open1_again"]) == ("0", "0", "-6")
+    assert (v["axison0"], v["axison1"], v["prfjog1"], v["setjog1"]) == ("0",) * 4
+    assert (v["setvel1"], v["update1"], v["prfvel0_rc"], v["prfvel1_rc"]) == ("0",) * 4
+    assert (v["vel0"], v["vel1"], v["moved1"]) == ("0", "20", "1")
+    assert (v["mode0"], v["mode1"]) == ("0", "1")  # Trap on card 0, Jog on card 1
     assert v["hsio"] == str(CMD_DECLARED)
-    assert v["close"] == "0"
+    assert v["close0"] == "0" and v["getsts0_closed"] == "-1"
+    assert (v["getsts1"], v["running1"], v["stop1"], v["close1"]) == ("0", "1", "0", "0")
+
+
+def test_two_cards_through_the_one_card_abi(libgts, controller, tmp_path):
+    """GT_SetCardNo (before GT_Open too) chooses the card of every later call; card 1 jogs
+    while card 0 is polled; closing card 1 leaves card 0.  (Compiled with the library's own
+    flags, the ones `gtecat lib --cflags --libs` prints: the other tests here run the command.)"""
+    exe = tmp_path / "cards"
+    cmd = ["gcc", "-Wall", "-Wextra", str(C_DIR / "cards_client.c"), *libgts.cflags()]
+    r = subprocess.run([*cmd, *libgts.libs(), "-o", str(exe)], capture_output=True, text=True)
+    assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert (v["set16"], v["set1"], v["get_rc"], v["card"]) == ("7", "0", "0", "1")
+    assert (v["up1"], v["set0"], v["up0"], v["jog1"]) == ("0",) * 4
+    assert (v["vel0"], v["vel1"]) == ("0", "-10")
+    assert (v["close1"], v["sts1_closed"], v["sts0"], v["servo0"]) == ("0", "-1", "0", "1")
+    assert (v["setcore2"], v["getcore_rc"], v["core"], v["rescount_rc"]) == ("0", "0", "2", "0")
+    assert (v["core2_axes"], v["setcore3"], v["setcore1"]) == ("12", "7", "0")
+    assert v["close0"] == "0"
 
 
 def test_libgts_exports_every_name_of_the_table(libgts):

@@ -6,6 +6,9 @@
 //     mcs MultiCardStation.cs
 //     gtecat lib --abi gts-multicard --mono-config -o MultiCardStation.exe.config
 //     GTECAT_CARD=gts:4 mono MultiCardStation.exe
+//
+// A second card (card 1, an identical controller of its own) is opened after card 0's move:
+// its axis stands where card 0's moved, and it keeps working after card 0 is closed.
 using System;
 using System.Runtime.InteropServices;
 using System.Text;
@@ -88,8 +91,8 @@ namespace Station
 
         static int Main(string[] args)
         {
-            Say("open_card1", mc.GT_Open(1, 0, 1));
-            Say("open_card1_reason", Why());
+            Say("open_card16", mc.GT_Open(16, 0, 1));
+            Say("open_card16_reason", Why());
             short rtn = mc.GT_Open(CARD, 0, 1);
             Say("open", rtn);
             if (rtn != 0)
@@ -139,7 +142,17 @@ namespace Station
             int gpo;
             Say("getdo", mc.GT_GetDo(CARD, mc.MC_GPO, out gpo));
             Say("gpo", gpo);
+            Say("open_card1", mc.GT_Open(1, 0, 1));
+            Say("axison_card1", mc.GT_AxisOn(1, 1));
+            double prf1;
+            Say("getprfpos_card1", mc.GT_GetPrfPos(1, 1, out prf1, 1, out clk));
+            Say("prfpos_card1", prf1);
             Say("close", mc.GT_Close(CARD));
+            int sts1;
+            Say("getsts_card1", mc.GT_GetSts(1, 1, out sts1, 1, out clk));
+            Say("servo_card1", (sts1 & 0x200) != 0 ? 1 : 0);
+            Say("getsts_closed", mc.GT_GetSts(CARD, 1, out sts1, 1, out clk));
+            Say("close_card1", mc.GT_Close(1));
             Say("done", 1);
             return 0;
         }
