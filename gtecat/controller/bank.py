@@ -150,6 +150,11 @@ _SERVO_ON, _MOVING, _ARRIVED = (
 )
 
 
+def _trap_key(pl: TrapPlanner) -> tuple:
+    """What a Trap table is computed from (trap_table), but the sample count."""
+    return (pl._T, pl._t_done, tuple(pl._segs), pl._ts, pl._t_final, pl._target, pl._dir)
+
+
 # --- guards: a claimed axis's objects give themselves back when anything touches them ---------
 class _Bypass:
     on = False
@@ -374,6 +379,9 @@ class AxisBank:
             setattr(self, name, zi(n, bool))
         self.n_hm = self.n_frz = 0
         self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
+        #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
+        #: back in the same move, instead of computed again
+        self._kept: dict[int, tuple] = {}
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -695,6 +703,7 @@ class AxisBank:
         self.k0[r] = pl._k if moving else 0
         self.ended[r] = False
         self.t_cur[r] = 0
+        kept = self._kept.pop(r, None)
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
         # table) or in slot 0, the hold slot of a row at rest
         slot = TABLE if moving else 0
@@ -702,6 +711,11 @@ class AxisBank:
         self.t_idx[r] = self.base[r] + slot
         if moving:
             self.t_len[r], self.t_end[r] = 0, -1
+            if kept is not None and kept[0] is pl and kept[1] == _trap_key(pl):
+                # the same move as when the row left: its table is still in place
+                j = pl._k - kept[2]
+                if 0 <= j < kept[3]:
+                    self.t_cur[r], self.t_len[r], self.t_end[r] = j, kept[3], kept[4]
         else:
             self.t_len[r], self.t_end[r] = 1, 0
         ch = self.csp.channels[r]
@@ -728,6 +742,17 @@ class AxisBank:
             self.h_lo[r], self.h_hi[r] = bounds
             # 6041h: the state bits and remote, no mode bits while searching (step_hm's oms 0)
             self.csp.sw_const[r] -= SW12
+
+    def _keep_table(self, r: int, pl: TrapPlanner) -> None:
+        """A moving row leaves: remember its table (its samples stay in ``t_p``/``t_v``/``t_a``
+        until the row is loaded again), so that a row given back by a call about another
+        axis of its drive takes it up again.  Each sample of a table depends on the move and
+        its own index only (trap_table), so the samples are the ones a new table would hold."""
+        n = int(self.t_len[r])
+        if n <= 0 or self.ended[r] or pl._mode != _MOVE:
+            return
+        first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
+        self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
 
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
@@ -834,6 +859,7 @@ class AxisBank:
         last = (float(self.prf_p[r]), float(self.prf_v[r]), float(self.prf_a[r]))
         if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
             advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
+            self._keep_table(r, pl)
 
     # --- the GT boundary ------------------------------------------------------------------------
     def before_call(self, ctl: Any, proto: Any, values: tuple) -> None:

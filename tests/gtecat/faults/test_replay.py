@@ -1,5 +1,6 @@
 """Replays of a 12-axis session: exact, at the first divergence exit 1, and the controller's
-many-cycles-at-once path gives the same bits as one cycle at a time.
+many-cycles-at-once path (and the bank's Trap tables taken up again) gives the same bits as
+one cycle at a time.
 
 The session is tools/bench_replay.py's (homing, jogs, Trap moves, status polling, IO); a few
 virtual seconds here, the whole minute under GTECAT_LONG=1.
@@ -15,6 +16,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli.main import main
+from gtecat.controller.bank import AxisBank
 from gtecat.controller.core import Controller
 from gtecat.faults.record import Recorder, replay
 from tests.conftest import EXAMPLES, LONG
@@ -32,13 +34,15 @@ def _closed():
 
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The session recorded with every cycle run one by one (the reference)."""
+    """The session recorded with every cycle run one by one and every Trap table computed
+    afresh when an axis comes back to the bank (the reference)."""
     folder = tmp_path_factory.mktemp("replay")
     machine = folder / "machine.toml"
     machine.write_text(bench_replay.MACHINE)
     out = folder / "session.gtrec"
     mp = pytest.MonkeyPatch()
     mp.setattr(Controller, "run_cycles", lambda self, n: 0)
+    mp.setattr(AxisBank, "_keep_table", lambda self, r, pl: None)
     rec = Recorder(out).start()
     try:
         bench_replay.session(gt, SECONDS, 10, str(machine))
