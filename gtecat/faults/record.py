@@ -590,13 +590,19 @@ def _replay(
                     gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
                     if gap > 0:
                         ctl.clock.advance_ns(gap)
-            for obj, v in p.sets:
-                obj.value = v
             args = p.args
-            if p.fresh:
-                args = list(args)
-                for i, x in p.fresh:
-                    args[i] = decode(x)
+            try:
+                for obj, v in p.sets:
+                    obj.value = v
+                if p.fresh:
+                    args = list(args)
+                    for i, x in p.fresh:
+                        args[i] = decode(x)
+            except (TypeError, ValueError, KeyError, AttributeError) as err:
+                raise ParameterError(
+                    f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+                    f"again: {type(err).__name__}: {err}"
+                ) from None
             if p.kw is None and not p.opens:
                 kw: dict[str, Any] = {}
                 rc = p.fn(*args)

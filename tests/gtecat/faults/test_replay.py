@@ -137,3 +137,23 @@ def test_an_input_set_between_cycles_reaches_the_image() -> None:
     buf = (c_ubyte * 2)()
     assert gt.GT_EcatIOReadInput(6, 2, 2, buf) == 0
     assert buf[0] & 0x08
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        '{"t":1,"c":"GT_Open","a":[],"r":0}\n{"t":2,"c":"GT_Clo\n',  # cut short
+        '{"t":1,"c":"GT_Open","a":[],"r":0}, {"t":2}\n',  # two entries on a line
+        "5\n",  # not an entry
+        '{"t":1,"c":"GT_Open","r":0}\n',  # no arguments
+        '{"t":1,"c":"GT_GetSts","a":[1,{"ref":{"c":"c_long","v":"x"}}],"r":0}\n',
+    ],
+)
+def test_a_damaged_recording_is_a_clear_error(
+    body: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "damaged.gtrec"
+    bad.write_text('{"gtecat_recording": 1}\n' + body)
+    assert main(["replay", str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "damaged recording" in err and "Traceback" not in err
