@@ -132,3 +132,18 @@ if _CPU_REPORT:
 
     def pytest_sessionfinish(session, exitstatus):  # type: ignore[no-untyped-def]
         _cpu_write(f"{_cpu_now():.3f}\t<process total>")
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _no_controller_left_open():
+    """After each module: every card and core it left open in this process is closed.
+
+    ``GT_Close`` closes the current card only (as on the vendor's library), so a module
+    whose clients opened a second card through a controller of this process would hand
+    it to the next module, whose ``GT_Open(controller=...)`` is then refused."""
+    yield
+    import sys
+
+    core = sys.modules.get("gtecat.gt._core")
+    if core is not None and core.SESSION.all_controllers():
+        core.close_all()

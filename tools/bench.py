@@ -13,8 +13,10 @@ and with full CiA-402 drives) and on the 12-axis example; the cost of one
 generated buses of single-axis CSP drives (:mod:`tools.bench_scaling`, lockstep
 clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ``ok``: real-time factors of 12 axes moving in Trap, 64 axes (odd axes moving, even
-ones holding), 128 axes moving; 64 axes homing (method 17); 12 axes homing and 12 axes
-in PT (reported); ``GT_GetSts`` against building its argument, interleaved, and every call
+ones holding), 128 axes moving, 12 axes in Trap on the scalar path (bank off: what the modes
+outside the bank compare with); 64 axes homing (method 17); 12 axes homing (reported); PT,
+Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (target 10:
+every motion mode); ``GT_GetSts`` against building its argument, interleaved, and every call
 shape of the fast path likewise (the worst ratio is held to 4); the RSS of a
 fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
@@ -268,12 +270,19 @@ def bench_rss(n: int = 128, seconds: float = 0.5) -> dict[str, object]:
     return {"axes": n, "state": "moving", **r}
 
 
+GEAR = "per core: the first axis in Trap, the others in Gear on it (1:2)"
+FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-point cam, endless)"
+CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
+
+
 def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
     """The issue-17 figures, measured one after the other in this run."""
-    from tools.bench_scaling import run_bus
+    from tools.bench_scaling import crd_plan, run_bus
 
-    def rtf(n: int, plan: dict[int, str], target: float | None, what: str) -> dict[str, object]:
-        r = {"axes": n, "what": what, **run_bus(n, plan, seconds=seconds, repeat=repeat)}
+    def rtf(
+        n: int, plan: dict[int, str], target: float | None, what: str, bank: str | None = None
+    ) -> dict[str, object]:
+        r = {"axes": n, "what": what, **run_bus(n, plan, seconds=seconds, repeat=repeat, bank=bank)}
         return r if target is None else _figure(r, "rtf", target)
 
     def every(n: int, state: str) -> dict[int, str]:
@@ -288,7 +297,17 @@ def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
         "rtf_128_axes_trap": rtf(128, every(128, "moving"), 5, "all 128 moving in Trap"),
         "rtf_12_axes_homing_17": rtf(12, every(12, "homing"), None, "drive homing method 17"),
         "rtf_64_axes_homing_17": rtf(64, every(64, "homing"), 10, "drive homing method 17"),
+        "rtf_12_axes_trap_scalar": rtf(
+            12, every(12, "moving"), None, "all 12 moving in Trap, scalar path (bank off)", "off"
+        ),
         "rtf_12_axes_pt": rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
+        "rtf_64_axes_pt": rtf(64, every(64, "pt"), 10, "PT, static FIFO, endless loop"),
+        "rtf_12_axes_gear": rtf(12, every(12, "gear"), None, GEAR),
+        "rtf_64_axes_gear": rtf(64, every(64, "gear"), 10, GEAR),
+        "rtf_12_axes_follow": rtf(12, every(12, "follow"), None, FOLLOW),
+        "rtf_64_axes_follow": rtf(64, every(64, "follow"), 10, FOLLOW),
+        "rtf_12_axes_crd": rtf(12, crd_plan(12), None, CRD),
+        "rtf_64_axes_crd": rtf(64, crd_plan(64), 10, CRD),
         "gt_get_sts_vs_argument": _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
         "call_shapes_vs_arguments": _figure(
             bench_call_shapes(2 * seconds), "worst", 4, at_most=True

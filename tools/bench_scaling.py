@@ -14,7 +14,11 @@ puts it in the state, then lets controller time pass with ``GTE_Wait`` and count
 * ``homing``: drive homing method 17 (negative limit switch) through
   ``GT_SetHomingMode`` / ``GT_SetEcatHomingPrm`` / ``GT_StartEcatHoming``; the machine
   description puts each axis's negative limit a billion counts away, so the search
-  outlasts the measurement.
+  outlasts the measurement;
+* ``pt``, ``gear``, ``follow``, ``crd`` (not in the default set): PT over a static FIFO
+  looped endlessly; per core a Trap master and the other axes in Gear / Follow on it;
+  per core two XY coordinate systems on a path of lines and arcs, the other axes holding
+  (:func:`start_pt`, :func:`start_gear`, :func:`start_follow`, :func:`start_crd`).
 
 Everything goes through the public GT API, axis by axis through :func:`core_axis`
 and the ``GTN_*`` functions: the real ``GT_Update(long mask)`` reaches 32 axes per
@@ -47,6 +51,8 @@ from tools.gen_axes_eni import write_axes_eni  # noqa: E402
 
 AXES = (1, 2, 4, 8, 12, 16, 32, 64, 96, 128)
 STATES = ("idle", "moving", "homing")
+#: the other motion modes (``--states pt,gear,follow,crd``): see their ``start_*``
+MODES = ("pt", "gear", "follow", "crd")
 AXES_PER_CORE = 32
 #: axes per core that :func:`core_axis` uses; ``--addressing flat`` puts every axis on
 #: core 1 (the emulator's own extension before issue 17: no GT_Update beyond axis 32)
@@ -140,11 +146,14 @@ def machine(n: int) -> Any:
     return MachineDescription({a: AxisMachine(negative_limit=-FAR) for a in range(1, n + 1)})
 
 
-def bring_up(eni: Path, n: int) -> None:
-    """Open the controller on ``eni`` (lockstep clock) and take the bus to OP."""
+def bring_up(eni: Path, n: int, bank: str | None = None) -> None:
+    """Open the controller on ``eni`` (lockstep clock) and take the bus to OP; ``bank``:
+    GT_Open's ``bank`` (None: its default, ``off``: the scalar path alone)."""
     gt = _gt()
     gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(eni), machine=machine(n), clock="lockstep", log=""), "GT_Open")
+    opts = {} if bank is None else {"bank": bank}
+    rc = gt.GT_Open(eni=str(eni), machine=machine(n), clock="lockstep", log="", **opts)
+    _ok(rc, "GT_Open")
     _ok(gt.GT_InitEcatComm(), "GT_InitEcatComm")
     ready = c_short()
     for _ in range(10_000):
@@ -200,10 +209,133 @@ def start_pt(axes: Sequence[int], points: int = 400) -> None:
         _ok(gt.GTN_PtStart(core, mask, 0), f"GTN_PtStart({core}, {mask:#x})", core)
 
 
+def by_core(axes: Sequence[int]) -> dict[int, list[int]]:
+    """The bus axes of ``axes`` grouped by their core, in axis order."""
+    out: dict[int, list[int]] = {}
+    for a in sorted(axes):
+        out.setdefault(core_axis(a)[0], []).append(a)
+    return out
+
+
+def _master_trap(a: int) -> None:
+    """Bus axis ``a`` a Trap move in the positive direction, far longer than any measurement."""
+    prm = _gt().TTrapPrm()
+    prm.acc, prm.dec, prm.velStart, prm.smoothTime = 0.5, 0.5, 0, 25
+    gtn("PrfTrap", a)
+    gtn("SetTrapPrm", a, byref(prm))
+    gtn("SetPos", a, 50_000_000)
+    gtn("SetVel", a, 20)
+    update([a])
+
+
+def _start_slaves(axes: Sequence[int], setup: Callable[[int, int], None], start: str) -> None:
+    """Per core: the first axis of ``axes`` is the master (a Trap move), the others are set
+    up as its slaves by ``setup(bus_axis, master_profile)`` and started together with
+    ``GTN_<start>(core, mask)``."""
+    gt = _gt()
+    for core, group in sorted(by_core(axes).items()):
+        master, slaves = group[0], group[1:]
+        _master_trap(master)
+        local = core_axis(master)[1]
+        mask = 0
+        for a in slaves:
+            setup(a, local)
+            mask |= 1 << (core_axis(a)[1] - 1)
+        if mask:
+            fn = getattr(gt, "GTN_" + start)
+            args = (core, mask) if start == "GearStart" else (core, mask, 0)
+            _ok(fn(*args), f"GTN_{start}({core}, {mask:#x})", core)
+
+
+def start_gear(axes: Sequence[int]) -> None:
+    """Per core, the first axis moves in Trap and every other axis follows its planned
+    position in Gear (slave : master = 1 : 2, a 4000-pulse clutch zone)."""
+    gt = _gt()
+
+    def setup(a: int, master: int) -> None:
+        gtn("PrfGear", a, 0)
+        gtn("SetGearMaster", a, master, gt.GEAR_MASTER_PROFILE, 0)
+        gtn("SetGearRatio", a, 2, 1, 4000)
+
+    _start_slaves(axes, setup, "GearStart")
+
+
+#: the cam of the Follow figure: (master, slave, type) points of one pass, 16 segments
+#: of 2000 master pulses up 8000 pulses and back (the FIFO's default 16 points)
+FOLLOW_CAM = tuple((2000 * (k + 1), 1000.0 * min(k + 1, 15 - k), 0) for k in range(16))
+
+
+def start_follow(axes: Sequence[int]) -> None:
+    """Per core, the first axis moves in Trap and every other axis follows its planned
+    position in Follow over :data:`FOLLOW_CAM`, looped endlessly (FIFO 0)."""
+    gt = _gt()
+
+    def setup(a: int, master: int) -> None:
+        gtn("PrfFollow", a, 0)
+        gtn("SetFollowMaster", a, master, gt.FOLLOW_MASTER_PROFILE, 0)
+        gtn("FollowClear", a, 0)
+        for m, s, kind in FOLLOW_CAM:
+            gtn("FollowData", a, m, s, kind, 0)
+        gtn("SetFollowLoop", a, 0)
+
+    _start_slaves(axes, setup, "FollowStart")
+
+
+#: coordinate systems per core (GT_SetCrdPrm's crd 1..2)
+CRD_SYSTEMS = 2
+#: laps of the crd figure's path (4 segments each: line, half circle, line, half circle)
+CRD_LAPS = 250
+
+
+def crd_plan(n: int) -> dict[int, str]:
+    """The crd figure's plan for ``n`` axes: on each core, local axes 1-2 are coordinate
+    system 1 and 3-4 system 2 (the controller's two per core); the other axes hold."""
+    plan = dict.fromkeys(range(1, n + 1), "idle")
+    for a in plan:
+        if core_axis(a)[1] <= 2 * CRD_SYSTEMS:
+            plan[a] = "crd"
+    return plan
+
+
+def start_crd(axes: Sequence[int]) -> None:
+    """Pairs of ``axes`` on one core as XY coordinate systems 1, 2 (at most two per core),
+    each running :data:`CRD_LAPS` laps of a 10000 x 10000 stadium (lines and half circles,
+    tangent joints passed at speed: synVel 20, synAcc 0.5, velEnd 20)."""
+    gt = _gt()
+    for core, group in sorted(by_core(axes).items()):
+        mask = 0
+        for crd in range(1, CRD_SYSTEMS + 1):
+            pair = group[2 * crd - 2 : 2 * crd]
+            if len(pair) < 2:
+                break
+            prm = gt.TCrdPrm()
+            prm.dimension = 2
+            for c, a in enumerate(pair, 1):
+                prm.profile[core_axis(a)[1] - 1] = c
+            prm.synVelMax, prm.synAccMax = 100.0, 2.0
+            _ok(gt.GTN_SetCrdPrm(core, crd, byref(prm)), f"GTN_SetCrdPrm({core}, {crd})", core)
+            _ok(gt.GTN_CrdClear(core, crd, 0), f"GTN_CrdClear({core}, {crd})", core)
+            v, acc = 20.0, 0.5
+            for _ in range(CRD_LAPS):
+                for rc, what in (
+                    (gt.GTN_LnXY(core, crd, 10_000, 0, v, acc, v, 0), "LnXY"),
+                    (gt.GTN_ArcXYC(core, crd, 10_000, 10_000, 0, 5_000, 1, v, acc, v, 0), "Arc"),
+                    (gt.GTN_LnXY(core, crd, 0, 10_000, v, acc, v, 0), "LnXY"),
+                    (gt.GTN_ArcXYC(core, crd, 0, 0, 0, -5_000, 1, v, acc, v, 0), "Arc"),
+                ):
+                    _ok(rc, f"GTN_{what}({core}, {crd})", core)
+            mask |= 1 << (crd - 1)
+        if mask:
+            _ok(gt.GTN_CrdStart(core, mask, 0), f"GTN_CrdStart({core}, {mask:#x})", core)
+
+
 STARTERS: dict[str, Callable[[Sequence[int]], None]] = {
     "moving": start_trap,
     "homing": start_homing,
     "pt": start_pt,
+    "gear": start_gear,
+    "follow": start_follow,
+    "crd": start_crd,
 }
 
 
@@ -262,8 +394,10 @@ def run_bus(
     repeat: int = 3,
     eni_dir: str | Path | None = None,
     after: Callable[[], dict[str, Any]] | None = None,
+    bank: str | None = None,
 ) -> dict[str, Any]:
-    """Bring up ``n`` axes, put axis ``a`` in ``plan[a]`` (missing: ``idle``), measure.
+    """Bring up ``n`` axes, put axis ``a`` in ``plan[a]`` (missing: ``idle``), measure
+    (``bank``: as :func:`bring_up`).
 
     Returns cycles_per_s, rtf, us_per_cycle, us_per_axis, bringup_s, and whatever
     ``after()`` adds (called with the controller still open); ``error`` instead of
@@ -275,7 +409,7 @@ def run_bus(
         eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
         t0 = time.perf_counter()
         try:
-            bring_up(eni, n)
+            bring_up(eni, n, bank)
             for a in full:
                 gtn("AxisOn", a)
             for state, start in STARTERS.items():
@@ -306,9 +440,10 @@ def run_bus(
 
 def bench_point(n: int, state: str, *, seconds: float = 1.5, repeat: int = 3) -> dict[str, Any]:
     """One (axes, state) point: every axis in ``state``."""
-    if state not in STATES:
-        raise ValueError(f"state must be one of {', '.join(STATES)}, not {state!r}")
-    r = run_bus(n, dict.fromkeys(range(1, n + 1), state), seconds=seconds, repeat=repeat)
+    if state not in STATES + MODES:
+        raise ValueError(f"state must be one of {', '.join(STATES + MODES)}, not {state!r}")
+    plan = crd_plan(n) if state == "crd" else dict.fromkeys(range(1, n + 1), state)
+    r = run_bus(n, plan, seconds=seconds, repeat=repeat)
     addressing = "cores" if _per_core == AXES_PER_CORE else "flat"
     return {"axes": n, "state": state, **r, "addressing": addressing}
 
@@ -359,7 +494,7 @@ def write_table(results: Sequence[Mapping[str, Any]], path: str | Path) -> None:
     When ``path`` holds the :data:`BEGIN` / :data:`END` markers (``docs/performance.md``),
     only the text between them is replaced; otherwise the file is the table alone.
     """
-    states = [s for s in STATES if any(r["state"] == s for r in results)]
+    states = [s for s in STATES + MODES if any(r["state"] == s for r in results)]
     by = {(r["axes"], r["state"]): r for r in results}
     head = "| axes | " + " | ".join(f"{s} µs/cycle | {s} RTF" for s in states) + " |"
     rule = "|---:|" + "---:|---:|" * len(states)
@@ -393,7 +528,7 @@ def write_plot(results: Sequence[Mapping[str, Any]], path: str | Path, title: st
     import matplotlib.pyplot as plt
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for s in STATES:
+    for s in STATES + MODES:
         pts = sorted((r["axes"], r) for r in results if r["state"] == s and "error" not in r)
         if not pts:
             continue
@@ -430,7 +565,9 @@ def _ints(text: str) -> list[int]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--axes", type=_ints, default=list(AXES), help="e.g. 1,12,64")
-    ap.add_argument("--states", default=",".join(STATES), help="idle,moving,homing")
+    ap.add_argument(
+        "--states", default=",".join(STATES), help="idle,moving,homing (also pt,gear,follow,crd)"
+    )
     ap.add_argument("--seconds", type=float, default=1.5, help="wall seconds per point")
     ap.add_argument("--repeat", type=int, default=3, help="windows per point (best counts)")
     ap.add_argument(

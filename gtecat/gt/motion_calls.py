@@ -204,7 +204,7 @@ def GT_Stop(ctl: Controller, mask: int, option: int) -> int:
     opt = long_arg("option", option)
     for r in axes_in_mask(ctl, m & 0xFFF, strict=False):
         r.stop(bool(opt >> (r.number - 1) & 1))
-    crds = getattr(ctl, "crd_bank", None)
+    crds = vars(ctl).get("crd_bank")  # this core's own systems (gtecat.controller.crd.bank)
     if crds is not None:
         for n, c in crds.systems.items():
             bit = CRD_STOP_BIT + n - 1

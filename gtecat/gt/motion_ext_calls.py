@@ -119,9 +119,18 @@ def _require_free(res: AxisResources, what: str) -> None:
     p.require_idle(what)
 
 
+def _mask32(name: str, value: Any) -> int:
+    """A 32-bit ``long`` mask: bit 31 (axis 32) may come as a negative ``long`` or, as the
+    argument layer hands a mask over, as the unsigned word; the word is returned."""
+    v = checks.integer(name, value)
+    if not _LONG_MIN <= v <= 0xFFFFFFFF:
+        raise ParameterError(f"{name}={v} is not a 32-bit mask")
+    return v & 0xFFFFFFFF
+
+
 def _mask_axes(ctl: Controller, mask: Any, what: str) -> list[AxisResources]:
     """Axes of ``mask`` (bit 0 = axis 1); a bit of a missing axis is 7, no axis at all is 1."""
-    m = _long("mask", mask)
+    m = _mask32("mask", mask)
     axes = axes_in_mask(ctl, m, strict=True)
     if not axes:
         raise CommandError(f"{what}: mask {m:#x} selects no axis (chapter 13: check mask)")
@@ -209,7 +218,7 @@ def GT_PtClear(ctl: Controller, profile: int, fifo: int = 0) -> int:
 def GT_PtStart(ctl: Controller, mask: int, option: int = 0) -> int:
     """Start PT on the axes of ``mask``; ``option`` bit n-1 picks FIFO2 for axis n (entry 95)."""
     axes = _mask_axes(ctl, mask, "GT_PtStart")
-    opt = _long("option", option)
+    opt = _mask32("option", option)
     plan: list[tuple[PtPlanner, int]] = []
     for r in axes:
         what = f"GT_PtStart (axis {r.number})"
@@ -501,7 +510,7 @@ def GT_FollowClear(ctl: Controller, profile: int, fifo: int = 0) -> int:
 def GT_FollowStart(ctl: Controller, mask: int, option: int = 0) -> int:
     """Start Follow on the axes of ``mask``; ``option`` bit n-1: FIFO2 for axis n (entry 22)."""
     axes = _mask_axes(ctl, mask, "GT_FollowStart")
-    opt = _long("option", option)
+    opt = _mask32("option", option)
     plan: list[tuple[FollowPlanner, int]] = []
     for r in axes:
         what = f"GT_FollowStart (axis {r.number})"

@@ -33,6 +33,18 @@ def test_point_is_well_formed(state: str) -> None:
     json.dumps(r)
 
 
+@pytest.mark.parametrize("state", bench_scaling.MODES)
+def test_mode_point_is_well_formed(state: str) -> None:
+    """PT, Gear, Follow, crd on 4 axes: every axis of the plan still moving at the end."""
+    r = bench_point(4, state, seconds=0.02, repeat=1)
+    assert FIGURES <= r.keys(), r.get("error")
+
+
+def test_crd_plan_takes_four_axes_per_core() -> None:
+    plan = bench_scaling.crd_plan(40)
+    assert [a for a, s in plan.items() if s == "crd"] == [1, 2, 3, 4, 33, 34, 35, 36]
+
+
 def test_pt_and_mixed_plan() -> None:
     r = bench_scaling.run_bus(3, {1: "pt", 2: "moving"}, seconds=0.02, repeat=1)
     assert FIGURES <= r.keys(), r.get("error")

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...errors import ParameterError
 
@@ -39,21 +39,25 @@ def _norm(v: Sequence[float]) -> float:
 class Line:
     start: Vec
     end: Vec
+    #: derived once (a segment is sampled every cycle): its length and end - start
+    length: float = field(init=False, repr=False, compare=False)
+    _delta: Vec = field(init=False, repr=False, compare=False)
 
-    @property
-    def length(self) -> float:
-        return _norm([b - a for a, b in zip(self.start, self.end, strict=True)])
+    def __post_init__(self) -> None:
+        delta = tuple(b - a for a, b in zip(self.start, self.end, strict=True))
+        object.__setattr__(self, "_delta", delta)
+        object.__setattr__(self, "length", _norm(delta))
 
     def point(self, s: float) -> Vec:
         ln = self.length
         if s >= ln or ln == 0.0:
             return self.end
         u = max(s, 0.0) / ln
-        return tuple(a + (b - a) * u for a, b in zip(self.start, self.end, strict=True))
+        return tuple(a + d * u for a, d in zip(self.start, self._delta, strict=True))
 
     def tangent(self, at_end: bool) -> Vec:
         ln = self.length
-        return tuple((b - a) / ln for a, b in zip(self.start, self.end, strict=True))
+        return tuple(d / ln for d in self._delta)
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,30 +68,27 @@ class Arc:
     plane: tuple[int, int]
     sweep: float  #: signed angle (radian), positive counter-clockwise
     axis3: int | None = None  #: the helix's linear coordinate
+    #: derived once (a segment is sampled every cycle): start and end radius, start angle,
+    #: the helix's rise and the length along the path
+    r0: float = field(init=False, repr=False, compare=False)
+    r1: float = field(init=False, repr=False, compare=False)
+    theta0: float = field(init=False, repr=False, compare=False)
+    rise: float = field(init=False, repr=False, compare=False)
+    length: float = field(init=False, repr=False, compare=False)
 
-    @property
-    def r0(self) -> float:
+    def __post_init__(self) -> None:
         i, j = self.plane
-        return math.hypot(self.start[i] - self.center[0], self.start[j] - self.center[1])
-
-    @property
-    def r1(self) -> float:
-        i, j = self.plane
-        return math.hypot(self.end[i] - self.center[0], self.end[j] - self.center[1])
-
-    @property
-    def theta0(self) -> float:
-        i, j = self.plane
-        return math.atan2(self.start[j] - self.center[1], self.start[i] - self.center[0])
-
-    @property
-    def rise(self) -> float:
-        return 0.0 if self.axis3 is None else self.end[self.axis3] - self.start[self.axis3]
-
-    @property
-    def length(self) -> float:
-        planar = abs(self.sweep) * 0.5 * (self.r0 + self.r1)
-        return math.hypot(planar, self.rise)
+        start, end, (cx, cy) = self.start, self.end, self.center
+        r0 = math.hypot(start[i] - cx, start[j] - cy)
+        r1 = math.hypot(end[i] - cx, end[j] - cy)
+        rise = 0.0 if self.axis3 is None else end[self.axis3] - start[self.axis3]
+        planar = abs(self.sweep) * 0.5 * (r0 + r1)
+        put = object.__setattr__
+        put(self, "r0", r0)
+        put(self, "r1", r1)
+        put(self, "theta0", math.atan2(start[j] - cy, start[i] - cx))
+        put(self, "rise", rise)
+        put(self, "length", math.hypot(planar, rise))
 
     def point(self, s: float) -> Vec:
         ln = self.length
@@ -95,11 +96,13 @@ class Arc:
             return self.end
         u = max(s, 0.0) / ln
         i, j = self.plane
-        r = self.r0 + (self.r1 - self.r0) * u
+        r0 = self.r0
+        r = r0 + (self.r1 - r0) * u
         th = self.theta0 + self.sweep * u
         out = list(self.start)
-        out[i] = self.center[0] + r * math.cos(th)
-        out[j] = self.center[1] + r * math.sin(th)
+        cx, cy = self.center
+        out[i] = cx + r * math.cos(th)
+        out[j] = cy + r * math.sin(th)
         if self.axis3 is not None:
             k = self.axis3
             out[k] = self.start[k] + self.rise * u

@@ -371,15 +371,24 @@ class CoordSystem:
         if not self.running:
             return
         cyc = self._cycle_ms()
-        before = [s._pos for s in self.slots]
-        if self.stopping != StopKind.NONE:
+        slots = self.slots
+        before = [s._pos for s in slots]
+        if self.stopping:  # StopKind.NONE is 0
             self._step_stop(cyc * max(self.override, 1e-3))
         else:
             self._advance(cyc * self.override)
-        self._sample_point()
-        for slot, old in zip(self.slots, before, strict=True):
+        e = self.entry
+        if type(e) is Motion:  # _sample_point(), without its checks: the common case
+            self._sample_point_of(e, self.s)
+        else:
+            self._sample_point()
+        stopping = self.stopping
+        for slot, old in zip(slots, before, strict=True):  # AxisSlot.sample, inline
             v = (slot._pos - old) / cyc
-            slot.sample(slot._pos, v, (v - slot._vel) / cyc)
+            slot._acc = (v - slot._vel) / cyc
+            slot._vel = v
+            slot._fresh = True
+            slot.stopping = stopping
         if not self.running:
             for slot in self.slots:
                 slot._vel = slot._acc = 0.0
@@ -387,6 +396,14 @@ class CoordSystem:
 
     def _advance(self, dt: float) -> None:
         self.t += dt
+        e = self.entry
+        if type(e) is Motion and self.waiting is None:  # the common case: inside a segment
+            plan = self.plan
+            t = self.t
+            if t < plan.duration:
+                self.s = plan.s(t)
+                self.speed = plan.v(t)
+                return
         while self.running:
             e = self.entry
             if self.waiting is not None:
@@ -561,8 +578,7 @@ class CoordSystem:
                 follow(frac)
             if frac >= 1.0:
                 self.gears = []
-        p = e.geom.point(s)
-        for slot, o, x in zip(self.slots, self.origin, p, strict=True):
+        for slot, o, x in zip(self.slots, self.origin, e.geom.point(s), strict=True):
             slot._pos = o + x
 
     def vector_speed(self) -> float:
@@ -602,8 +618,10 @@ class CrdBank:
 
 
 def bank(ctl: Any) -> CrdBank:
-    """The controller's coordinate systems (made on first use)."""
-    b = getattr(ctl, "crd_bank", None)
+    """The coordinate systems of a core (made on first use): each core has its own
+    (``GTN_SetCrdPrm(2, 1, ...)`` sets up system 1 of core 2 over that core's profiles),
+    so a core's view (:mod:`gtecat.controller.core_view`) never reaches core 1's."""
+    b = vars(ctl).get("crd_bank")
     if b is None:
         b = CrdBank(ctl)
         ctl.crd_bank = b

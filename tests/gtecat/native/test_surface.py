@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
+from gtecat.gt import _core
 from gtecat.gt._core import CMD_DECLARED
 
 from .conftest import (
@@ -40,7 +41,7 @@ def controller(tmp_path_factory):
     address = f"unix:{tmp_path_factory.mktemp('ctl')}/controller.sock"
     with Server(address):
         yield address
-    gt.GT_Close()
+    _core.close_all()  # the clients opened cards 1 and 2 here too
 
 
 def _compile(src: Path, out: Path, compiler: str, lib_args: str, extra: str = "") -> Path:

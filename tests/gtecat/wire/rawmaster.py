@@ -62,9 +62,23 @@ def veth_pair(prefix: str = "gr") -> Iterator[tuple[str, str]]:
             with contextlib.suppress(OSError):
                 Path(f"/proc/sys/net/ipv6/conf/{name}/disable_ipv6").write_text("1")
             subprocess.run(["ip", "link", "set", name, "up"], check=True, timeout=10)
+        _wait_carrier(a, b)
         yield a, b
     finally:
         subprocess.run(["ip", "link", "del", a], capture_output=True, timeout=10)
+
+
+def _wait_carrier(*names: str, timeout_s: float = 5.0) -> None:
+    """Both ends up (operstate): a frame sent before the peer's carrier is up is dropped by
+    the kernel, which a loaded machine makes likely for the first frames of a test."""
+    deadline = time.monotonic() + timeout_s
+    for name in names:
+        state = Path(f"/sys/class/net/{name}/operstate")
+        while time.monotonic() < deadline:
+            with contextlib.suppress(OSError):
+                if state.read_text().strip() == "up":
+                    break
+            time.sleep(0.01)
 
 
 @dataclass

@@ -26,6 +26,7 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import needs_fixture
+from tests.gtecat.wire.rawmaster import _wait_carrier
 
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
@@ -72,6 +73,7 @@ def veth_pair() -> Iterator[tuple[str, str]]:
             subprocess.run(["ip", "link", "set", name, "up"], check=True, timeout=10)
             with contextlib.suppress(OSError):
                 Path(f"/proc/sys/net/ipv6/conf/{name}/disable_ipv6").write_text("1")
+        _wait_carrier(master_if, slave_if)
         yield master_if, slave_if
     finally:
         subprocess.run(["ip", "link", "del", master_if], capture_output=True, timeout=10)
@@ -263,9 +265,15 @@ def test_a_drive_is_enabled_and_moved_through_pdos(veth, fig52) -> None:
         to_op(master)
         cycle(master, 5)
         start = struct.unpack_from("<i", drive.input, 2)[0]
-        for cw in (0x0006, 0x0007, 0x000F):
+        # each controlword until the drive shows its state (a frame lost on a loaded machine
+        # costs a cycle, not the test): ready to switch on, switched on, operation enabled
+        for cw, shows in ((0x0006, 0x0021), (0x0007, 0x0023), (0x000F, 0x0027)):
             drive.output = struct.pack("<Hi", cw, start)
-            cycle(master, 10)
+            deadline = time.monotonic() + 5
+            while time.monotonic() < deadline:
+                cycle(master)
+                if struct.unpack_from("<H", drive.input)[0] & 0x006F == shows:
+                    break
         status = struct.unpack_from("<H", drive.input)[0]
         assert status & 0x006F == 0x0027, f"statusword 0x{status:04X} is not OPERATION ENABLED"
         # a CSP ramp; the master cycles as fast as it can, the drive follows in real time
