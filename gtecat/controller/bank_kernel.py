@@ -5,9 +5,10 @@ operation count, not its arithmetic (about 80 operations of 0.5-1 µs each, what
 rows).  ``gtecat/controller/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
 IEEE operations in the same order, built like libgts (``cc``, on first use, into the
 per-version cache; ``-ffp-contract=off``), so it gives the same bits as numpy and as the
-scalar objects.  It runs only the plain cycle: a raw write to a claimed slave, a row about to
-leave, a table to refill or a new cycle time go through the numpy cycle, which stays the
-reference and the fallback (no compiler: numpy alone, nothing else changes).
+scalar objects.  It runs only the plain cycle (the bank fills a Trap table that runs out
+before it): a raw write to a claimed slave, a row about to leave or a new cycle time go
+through the numpy cycle, which stays the reference and the fallback (no compiler: numpy
+alone, nothing else changes).
 
 ``GTECAT_BANK_KERNEL`` = ``auto`` (default: the compiled kernel where it builds), ``c`` (the
 same; a build failure is reported in :attr:`AxisBank.kernel_reason`) or ``numpy``.
@@ -77,6 +78,12 @@ def library() -> tuple[Any, str]:
         lib.bank_kernel_abi.restype = ctypes.c_int
         lib.bank_kernel_cycle.restype = ctypes.c_int
         lib.bank_kernel_cycle.argtypes = (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p)
+        lib.bank_kernel_run.restype = ctypes.c_int64
+        lib.bank_kernel_run.argtypes = (
+            *lib.bank_kernel_cycle.argtypes,
+            ctypes.c_int64,
+            ctypes.c_int64,
+        )
         fields = [f for f in lib.bank_kernel_fields().decode().split(",") if f]
         src_types = _field_types()
         if [f for f, _ in src_types] != fields or lib.bank_kernel_abi() != (
@@ -120,6 +127,7 @@ class Kernel:
     def __init__(self, bank: AxisBank, lib: Any) -> None:
         self.bank = bank
         self.fn = lib.bank_kernel_cycle
+        self.run_fn = lib.bank_kernel_run
         n = bank.n
         self.scratch = {name: np.zeros(n, _array_type(_dtype_of(name))) for name in _SCRATCH}
         self.scratch["s_jog"] = np.zeros(5 * n, _F64)
@@ -216,9 +224,20 @@ class Kernel:
         self.fp[FP_DT] = dt
         return self.fn(*self._args)
 
+    def run(self, t_ns: int, dt_ns: int, dt: float, n: int) -> int:
+        """Up to ``n`` cycles back to back from ``t_ns`` (one call): the cycles committed;
+        it stops before the first one :meth:`cycle` would not commit (that one is the numpy
+        cycle's).  :attr:`move_ended` tells whether any of them ended a Trap move."""
+        if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
+            self.bind()
+        self.io[IN_T_NS] = t_ns
+        self.fp[FP_DT] = dt
+        return self.run_fn(*self._args, n, dt_ns)
+
     @property
     def move_ended(self) -> bool:
-        """The last committed cycle ended a Trap move (the bank recounts its moving rows)."""
+        """The last committed cycle ended a Trap move (the bank recounts its moving rows);
+        after :meth:`run`: any of its cycles did."""
         return bool(self.io[OUT_FIN])
 
 

@@ -166,6 +166,28 @@ class IoSlave(VirtualSlave):
         if self.al_state >= AlState.SAFEOP:
             self.tx[:] = self.field_inputs
 
+    def settled(self) -> bool:
+        """A :meth:`step` now would change nothing (its outputs reached the field, the wires
+        and the field inputs reached ``tx``), given the same ``rx``."""
+        if self.emergencies:
+            return False
+        fo = self.field_outputs
+        if self.al_state == AlState.OP:
+            if fo != self.rx:
+                return False
+        elif any(fo):
+            return False
+        fi = self.field_inputs
+        if self._wires:
+            plan = self._wire_plan
+            if plan is None:
+                plan = self._wire_plan = self._plan_wires()
+            for ob, ib, shift, mask in plan:
+                v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
+                if (fi[ib] ^ v) & mask:
+                    return False
+        return self.al_state < AlState.SAFEOP or self.tx == fi
+
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires
         that move bits between the same two bytes by the same shift are one masked copy.

@@ -266,6 +266,22 @@ class Master:
             hook(self)
         return self.last
 
+    def steady(self) -> bool:
+        """A cycle now would change nothing but the time and :attr:`cycles`: every slave in OP
+        as asked, the working counter whole, nothing to log, no hook, and a backend whose
+        exchange would change nothing (:meth:`Backend.steady`)."""
+        return (
+            self.opened
+            and not self.on_cycle
+            and self._op_countdown < 0
+            and not self._wkc_bad
+            and not self.offline
+            and self.target == AlState.OP
+            and self.last.ok
+            and self.all_op()
+            and self.backend.steady()
+        )
+
     def recover(self) -> None:
         """Bring back slaves that answer again but fell below OP (acknowledge, re-walk).
 

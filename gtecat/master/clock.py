@@ -64,6 +64,9 @@ class Clock:
         self.cycle_ns = int(cycle_ns)
         self.call_latency_ns = int(call_latency_ns)
         self._run_cycle = run_cycle
+        #: the owner's way to run up to N cycles at once (returns the cycles it ran, 0: run
+        #: the next one through ``run_cycle``); virtual time only, None: one by one
+        self.run_many: Callable[[int], int] | None = None
         self.now_ns = 0  # controller time since power-on
         self.cycles = 0
         self._pending_ns = 0  # auto mode: latency accumulated since the last cycle
@@ -88,7 +91,16 @@ class Clock:
             return 0
         self._pending_ns += int(ns)
         n = 0
+        many = self.run_many
         while self._pending_ns >= self.cycle_ns:
+            if many is not None:
+                k = many(self._pending_ns // self.cycle_ns)
+                if k:
+                    self._pending_ns -= k * self.cycle_ns
+                    self.cycles += k
+                    self.now_ns += k * self.cycle_ns
+                    n += k
+                    continue
             self._pending_ns -= self.cycle_ns
             self.cycle()
             n += 1

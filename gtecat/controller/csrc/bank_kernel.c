@@ -9,6 +9,11 @@
  * error window) nothing is written and the caller runs the numpy cycle, which releases
  * the rows.  Return 0: committed; io[OUT_FIN] says a Trap move ended.
  *
+ * bank_kernel_run runs up to n such cycles back to back (t advancing by dt_ns each), for a
+ * controller whose cycle has nothing else to do (AxisBank.run_cycles): it stops before the
+ * first cycle that is not committed and returns the cycles committed; io[OUT_FIN] then says
+ * whether any of them ended a Trap move.
+ *
  * Arrays arrive as one table of addresses in the order of FIELDS below (the Python side
  * binds them by these names and refuses a library whose list differs).
  */
@@ -507,4 +512,19 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
     }
     io[OUT_FIN] = fin_any;
     return 0;
+}
+
+int64_t bank_kernel_run(void **ptr, int64_t *io, const double *fp, int64_t n, int64_t dt_ns)
+{
+    int64_t k, t0 = io[IN_T_NS];
+    int fin = 0;
+    for (k = 0; k < n; k++) {
+        io[IN_T_NS] = t0 + k * dt_ns;
+        if (bank_kernel_cycle(ptr, io, fp) != 0)
+            break;
+        fin |= (int)io[OUT_FIN];
+    }
+    io[IN_T_NS] = t0;
+    io[OUT_FIN] = fin;
+    return k;
 }

@@ -17,6 +17,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
 from gtecat.eni.layout import Layout
@@ -205,6 +206,36 @@ class EmulatedBackend(Backend):
             self.capture.cycle(t_ns, bytes(image.view), image.outputs_bytes, wkc)
         return wkc
 
+    def steady(self) -> bool:
+        """An exchange now would change nothing: no hook, capture or cable pulled, and every
+        slave it steps (the ones the axis bank does not run) is a plain IO slave at its fixed
+        point - the image's outputs are its ``rx``, its step changes nothing, its ``tx`` is in
+        the image's inputs (byte-aligned areas; anything else: not steady)."""
+        if self.answer_hook is not None or self.capture is not None or self.unplugged:
+            return False
+        image = self.image
+        if image is None:
+            return False
+        view, base = image.view, image.outputs_bytes
+        for slave, out, inp in self._run_plan:
+            if type(slave).step is not _IO_STEP or not slave.settled():
+                return False
+            if out is not None:
+                if not out.aligned:
+                    return False
+                start = out.logical_bit >> 3
+                n = min(len(slave.rx), out.raw_bytes)
+                if view[start : start + n] != slave.rx[:n]:
+                    return False
+            if inp is not None and slave.al_state >= AlState.SAFEOP:
+                if not inp.aligned or inp.bit_len & 7:
+                    return False
+                start = base + (inp.logical_bit >> 3)
+                n = min(len(slave.tx), inp.bit_len >> 3)
+                if view[start : start + n] != slave.tx[:n]:
+                    return False
+        return True
+
     def emergencies(self) -> list[tuple[int, object]]:
         out = []
         claimed = self._claimed  # a claimed slave is not stepped: it raises none
@@ -260,3 +291,6 @@ class EmulatedBackend(Backend):
         self._client(position).download(
             index, subindex, bytes(data), complete_access=complete_access
         )
+
+
+_IO_STEP = IoSlave.step
