@@ -1,52 +1,121 @@
 """Replay speed: a recorded 12-axis, 60-virtual-second session replayed against real time.
 
-The session is an application's loop: bring-up, servo on, then every 10 ms of controller
-time GT_GetSts on each of the 12 axes, a new Trap move on every axis that is at rest, and
-one GT_GetPrfPos per axis every 100 ms.  It is recorded (gtecat.faults.record) and
-replayed; the report gives the calls, the replay's wall and CPU time, and virtual/wall = how
-many times faster than real time the replay runs (the bar: at least 50; virtual/CPU is the
-same figure on a machine nobody else loads).
+The session is an application's loop on the 12-axis example bus: bring-up, servo on, axes 1
+and 2 home (CiA-402 method 3 on a home switch with an index pulse) and join the others,
+which run Trap moves (a new one as soon as an axis is at rest), axes 3 and 4 jog and
+turn round every 3 s; every ``--poll-ms`` of controller time (default 10) the loop reads
+the clock and GT_GetSts of each axis (and the homing status while an axis homes), every
+100 ms the planned and encoder positions of each axis and the DIO slave's inputs, every
+second it writes the DIO slave's outputs.
 
-    python tools/bench_replay.py [--seconds 60] [--json]
+It is recorded (gtecat.faults.record), then replayed: the report gives the calls, the
+recording's and the replay's wall and CPU time, and how many times faster than real time
+the replay runs: virtual/wall (``times_real_time``) and virtual/CPU
+(``times_real_time_cpu``, the same figure on a machine nobody else loads; the bar: at least
+50).  ``--repeat N`` replays N times and reports the best of each.  The plain session
+(no recording) is run too, to show what recording costs.  ``--against CHECKOUT`` replays the
+same recording with another checkout's gtecat as well (each replay in a fresh process, the two
+in turn): before and after in one run.  The CPU time a process gets done per second depends on
+what else the machine runs: ``reference_12_axes_trap_one_cycle_at_a_time`` measures, in the same
+run, a figure docs/performance.md took on a lightly loaded machine (219 times real time).
+
+    python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
+                                 [--simple] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import subprocess
+import sys
 import tempfile
 import time
-from ctypes import byref, c_double, c_long, c_short
+from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 ENI = ROOT / "examples" / "twelve_axes.eni"
+AXES = 12
+HOMING = (1, 2)  # home first (method 3: home switch, index pulse)
+JOG = (3, 4)  # jog, turning round every JOG_TURN_MS
+JOG_TURN_MS = 3000
+#: axes 1 and 2 stand inside the home switch's window, like bench_homing_gt's axis
+MACHINE = """\
+[axis.1]
+position = 60500
+counts_per_rev = 10000
+negative_limit = -400000
+positive_limit = 400000
+home_switch = [[100000, 400000]]
+index_offset = 3000
+
+[axis.2]
+position = 70500
+counts_per_rev = 10000
+negative_limit = -400000
+positive_limit = 400000
+home_switch = [[100000, 400000]]
+index_offset = 3000
+"""
 
 
-def session(gt, seconds: float) -> None:
-    assert gt.GT_Open(eni=str(ENI), clock="auto", log="") == 0
+def session(
+    gt, seconds: float, poll_ms: int = 10, machine: str | None = None, simple: bool = False
+) -> int:
+    """The application (module docstring); returns the loop's passes.  ``simple``: Trap moves
+    on every axis and the status polling only (the first version of this benchmark)."""
+    kw = {"machine": machine} if machine else {}
+    assert gt.GT_Open(eni=str(ENI), clock="auto", log="", **kw) == 0
     assert gt.GT_InitEcatComm() == 0
     st = c_short()
     while gt.GT_IsEcatReady(byref(st)) == 0 and st.value != 1:
         gt.GTE_Wait(1)
     gt.GT_StartEcatComm()
     gt.GT_Reset()
-    n = 12
-    for a in range(1, n + 1):
+    for a in range(1, AXES + 1):
         gt.GT_AxisOn(a)
+    homing = set(HOMING if machine and not simple else ())
+    jogging = () if simple else JOG
+    for a in homing:
+        gt.GT_SetHomingMode(a, 6)
+        gt.GT_SetEcatHomingPrm(a, 3, 5000, 3000, 100000, 0, 0)
+        gt.GT_StartEcatHoming(a)
     prm = gt.TTrapPrm()
     prm.acc = prm.dec = 0.5
-    sts, pos = c_long(), c_double()
-    target = [0] * (n + 1)
-    t_end = seconds * 1000
+    jog = gt.TJogPrm()
+    jog.acc = jog.dec = 0.25
+    for a in jogging:
+        gt.GT_PrfJog(a)
+        gt.GT_SetJogPrm(a, byref(jog))
+        gt.GT_SetVel(a, 8.0)
+        gt.GT_Update(1 << (a - 1))
+    sts, pos, enc, hs = c_long(), c_double(), c_double(), c_short()
     clock = c_long()
+    di = (c_ubyte * 2)()
+    do = (c_ubyte * 2)()
+    target = [0] * (AXES + 1)
+    jog_dir = {a: 1 for a in jogging}
+    t_end = seconds * 1000
     step = 0
+    per_100ms = max(1, 100 // poll_ms)
+    per_s = max(1, 1000 // poll_ms)
+    per_turn = max(1, JOG_TURN_MS // poll_ms)
     while True:
         gt.GT_GetClock(byref(clock))
         if clock.value >= t_end:
             break
-        for a in range(1, n + 1):
+        for a in sorted(homing):
+            gt.GT_GetEcatHomingStatus(a, byref(hs))
+            if hs.value & 1:  # done: back to CSP and into the Trap moves
+                homing.discard(a)
+                gt.GT_SetHomingMode(a, 8)
+        for a in range(1, AXES + 1):
             gt.GT_GetSts(a, byref(sts))
+            if a in homing or a in jogging:
+                continue
             if not sts.value & 0x400:  # at rest: the next move
                 target[a] = 20_000 if target[a] <= 0 else -20_000
                 gt.GT_PrfTrap(a)
@@ -54,49 +123,173 @@ def session(gt, seconds: float) -> None:
                 gt.GT_SetPos(a, target[a])
                 gt.GT_SetVel(a, 10 + a)
                 gt.GT_Update(1 << (a - 1))
-        if step % 10 == 0:
-            for a in range(1, n + 1):
+        if step % per_turn == per_turn - 1:
+            for a in jogging:
+                jog_dir[a] = -jog_dir[a]
+                gt.GT_SetVel(a, 8.0 * jog_dir[a])
+                gt.GT_Update(1 << (a - 1))
+        if step % per_100ms == 0:
+            for a in range(1, AXES + 1):
                 gt.GT_GetPrfPos(a, byref(pos))
+                if not simple:
+                    gt.GT_GetEncPos(a, byref(enc))
+            if not simple:
+                gt.GT_EcatIOReadInput(6, 0, 2, di)
+        if step % per_s == 0 and not simple:
+            do[0] = (step // per_s) & 0xFF
+            gt.GT_EcatIOWriteOutput(6, 0, 2, do)
         step += 1
-        gt.GTE_Wait(10)
+        gt.GTE_Wait(poll_ms)
     gt.GT_Close()
+    return step
+
+
+#: the reference figure on a lightly loaded machine (docs/performance.md, load 1.2-1.5)
+REFERENCE_QUIET = 219.0
+
+
+def reference() -> dict[str, object]:
+    """How loaded this machine is now: 12 axes moving in Trap, one cycle at a time (the
+    compiled cycle alone, as docs/performance.md measured it: 219 times real time per CPU
+    second on a lightly loaded machine)."""
+    from gtecat.controller.core import Controller
+    from tools.bench_scaling import run_bus
+
+    run = Controller.run_cycles
+    Controller.run_cycles = lambda self, n: 0  # type: ignore[method-assign]
+    try:
+        r = run_bus(12, dict.fromkeys(range(1, 13), "moving"), seconds=1.0, repeat=3)
+    finally:
+        Controller.run_cycles = run  # type: ignore[method-assign]
+    rtf = r.get("rtf_cpu")
+    return {
+        "rtf_cpu": rtf,
+        "quiet_machine": REFERENCE_QUIET,
+        "slower_than_quiet": round(REFERENCE_QUIET / rtf, 2) if rtf else None,
+    }
+
+
+def _best(runs: list[tuple[float, float]]) -> tuple[float, float]:
+    return min(r[0] for r in runs), min(r[1] for r in runs)
+
+
+_CHILD = """
+import json, sys, time
+sys.path.insert(0, sys.argv[1])
+from gtecat import gt  # imported before the clock starts, as in this process
+from gtecat.faults.record import replay
+t0, c0 = time.perf_counter(), time.process_time()
+n, div = replay(sys.argv[2])
+wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+print(json.dumps([wall, cpu, n, str(div) if div else None]))
+"""
+
+
+def replay_in(root: Path, path: Path) -> tuple[float, float, int, str | None]:
+    """(wall, CPU, calls, divergence) of a replay of ``path`` by the gtecat of checkout ``root``,
+    in a fresh process (its start and imports not counted)."""
+    out = subprocess.run(
+        [sys.executable, "-c", _CHILD, str(root), str(path)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    wall, cpu, n, div = json.loads(out.stdout.strip().splitlines()[-1])
+    return wall, cpu, n, div
+
+
+def measure(
+    seconds: float, poll_ms: int, repeat: int, against: Path | None = None, simple: bool = False
+) -> dict[str, object]:
+    from gtecat import gt
+    from gtecat.faults.record import Recorder, replay
+
+    with tempfile.TemporaryDirectory() as tmp:
+        machine = Path(tmp) / "machine.toml"
+        machine.write_text(MACHINE)
+        path = Path(tmp) / "session.gtrec"
+        plain = []
+        for _ in range(repeat):
+            t0, c0 = time.perf_counter(), time.process_time()
+            session(gt, seconds, poll_ms, str(machine), simple)
+            plain.append((time.perf_counter() - t0, time.process_time() - c0))
+        rec = Recorder(path).start()
+        t0, c0 = time.perf_counter(), time.process_time()
+        try:
+            session(gt, seconds, poll_ms, str(machine), simple)
+        finally:
+            rec.stop()
+        recorded = (time.perf_counter() - t0, time.process_time() - c0)
+        rec.write()
+        runs = []
+        n, div = 0, None
+        for _ in range(repeat):
+            t0, c0 = time.perf_counter(), time.process_time()
+            n, div = replay(path)
+            runs.append((time.perf_counter() - t0, time.process_time() - c0))
+            if div is not None:
+                break
+        size = path.stat().st_size
+        before: dict[str, object] = {}
+        if against is not None:  # the same recording, old and new, in fresh processes, in turn
+            old_runs, new_runs = [], []
+            for _ in range(repeat):
+                old_runs.append(replay_in(against, path))
+                new_runs.append(replay_in(ROOT, path))
+            for key, rr in (("before", old_runs), ("after", new_runs)):
+                w, c = _best([(r[0], r[1]) for r in rr])
+                before[key] = {
+                    "checkout": str(against if key == "before" else ROOT),
+                    "replay_wall_s": round(w, 3),
+                    "replay_cpu_s": round(c, 3),
+                    "times_real_time": round(seconds / w, 1),
+                    "times_real_time_cpu": round(seconds / c, 1),
+                    "diverged": rr[-1][3],
+                }
+    wall, cpu = _best(runs)
+    pw, pc = _best(plain)
+    return {
+        "session": "simple" if simple else "full",
+        "virtual_s": seconds,
+        "poll_ms": poll_ms,
+        "load_average": round(os.getloadavg()[0], 2),
+        "calls": n,
+        "session_wall_s": round(pw, 3),
+        "session_cpu_s": round(pc, 3),
+        "record_wall_s": round(recorded[0], 3),
+        "record_cpu_s": round(recorded[1], 3),
+        "record_cost": round(recorded[1] / pc, 2),
+        "replay_wall_s": round(wall, 3),
+        "replay_cpu_s": round(cpu, 3),
+        "times_real_time": round(seconds / wall, 1),
+        "times_real_time_cpu": round(seconds / cpu, 1),
+        "file_bytes": size,
+        "diverged": str(div) if div else None,
+        **before,
+        "reference_12_axes_trap_one_cycle_at_a_time": reference(),
+    }
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=60.0)
+    ap.add_argument("--poll-ms", type=int, default=10, help="the application's loop period")
+    ap.add_argument("--repeat", type=int, default=3, help="runs; the best is reported")
+    ap.add_argument(
+        "--against",
+        type=Path,
+        help="another checkout: replay the same recording with its gtecat too (before/after)",
+    )
+    ap.add_argument(
+        "--simple",
+        action="store_true",
+        help="Trap moves and status polling only (no homing, jog, IO)",
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    from gtecat import gt
-    from gtecat.faults.record import Recorder, replay
-
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "session.gtrec"
-        rec = Recorder(path).start()
-        t0 = time.perf_counter()
-        try:
-            session(gt, args.seconds)
-        finally:
-            rec.stop()
-        t_rec = time.perf_counter() - t0
-        rec.write()
-        t0, c0 = time.perf_counter(), time.process_time()
-        n, div = replay(path)
-        t_rep, c_rep = time.perf_counter() - t0, time.process_time() - c0
-        size = path.stat().st_size
-    out = {
-        "virtual_s": args.seconds,
-        "calls": n,
-        "record_wall_s": round(t_rec, 3),
-        "replay_wall_s": round(t_rep, 3),
-        "replay_cpu_s": round(c_rep, 3),
-        "times_real_time": round(args.seconds / t_rep, 1),
-        "times_real_time_cpu": round(args.seconds / c_rep, 1),
-        "file_bytes": size,
-        "diverged": str(div) if div else None,
-    }
+    out = measure(args.seconds, args.poll_ms, max(1, args.repeat), args.against, args.simple)
     print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
-    return 0 if div is None else 1
+    return 0 if out["diverged"] is None else 1
 
 
 if __name__ == "__main__":

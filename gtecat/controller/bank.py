@@ -107,7 +107,9 @@ COMPUTED_TX = {
 CONSTANT_TX = {0x603F, 0x6061, 0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, 0x1001, 0x20F2, 0x20F9}
 CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 
-#: GT functions whose implementations read a claimed axis through the bank itself
+#: GT functions whose implementations read a claimed axis through the bank itself, or touch
+#: no axis object at all (the process image, the clock: a raw write to a claimed slave's
+#: outputs is seen by the bank's next cycle, which gives the slave back first)
 BANK_READS = frozenset(
     {
         "GT_GetSts",
@@ -126,6 +128,9 @@ BANK_READS = frozenset(
         "GT_GetPrfMode",
         "GT_GetEcatRawData",
         "GT_SetEcatRawData",
+        "GT_EcatIOReadInput",
+        "GT_EcatIOWriteOutput",
+        "GT_EcatIOBitWriteOutput",
         "GT_GetClock",
         "GTE_Wait",
         "GTE_GetLastError",
@@ -146,6 +151,11 @@ _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.MOVING),
     int(AxisStatus.ARRIVED),
 )
+
+
+def _trap_key(pl: TrapPlanner) -> tuple:
+    """What a Trap table is computed from (trap_table), but the sample count."""
+    return (pl._T, pl._t_done, tuple(pl._segs), pl._ts, pl._t_final, pl._target, pl._dir)
 
 
 # --- guards: a claimed axis's objects give themselves back when anything touches them ---------
@@ -216,6 +226,7 @@ class AxisBank:
         self.groups: list[_Group] = []
         self.dirty = True
         self._countdown = 0
+        self._missed = False  # the last refresh found an eligible group it could not claim
         self.n = 0
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
@@ -381,6 +392,9 @@ class AxisBank:
             setattr(self, name, zi(n, bool))
         self.n_hm = self.n_frz = 0
         self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
+        #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
+        #: back in the same move, instead of computed again
+        self._kept: dict[int, tuple] = {}
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -607,7 +621,7 @@ class AxisBank:
             if self.n_alive:
                 self.release_all()
             return
-        changed = False
+        changed = missed = False
         for g in self.groups:
             if g.claimed:
                 continue
@@ -615,9 +629,16 @@ class AxisBank:
                 continue
             if not all(self._eligible(r) for r in g.rows):
                 continue
-            changed |= self._claim(g)
+            claimed = self._claim(g)
+            changed |= claimed
+            missed |= not claimed
         if changed:
             self._reindex()
+        if missed and not self._missed:
+            # an eligible drive had not yet taken (or sent) what the image holds: its next
+            # scalar step does, so look again after it rather than RECHECK_CYCLES later
+            self._countdown = 1
+        self._missed = missed
 
     def _claim(self, g: _Group) -> bool:
         # the slave decoded exactly what is in the image (no raw write since its last step)
@@ -698,6 +719,7 @@ class AxisBank:
         self.k0[r] = pl._k if moving else 0
         self.ended[r] = False
         self.t_cur[r] = 0
+        kept = self._kept.pop(r, None)
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
         # table) or in slot 0, the hold slot of a row at rest
         slot = self.table if moving else 0
@@ -718,6 +740,11 @@ class AxisBank:
         self.t_idx[r] = self.base[r] + slot
         if moving:
             self.t_len[r], self.t_end[r] = 0, -1
+            if kept is not None and kept[0] is pl and kept[1] == _trap_key(pl):
+                # the same move as when the row left: its table is still in place
+                j = pl._k - kept[2]
+                if 0 <= j < kept[3]:
+                    self.t_cur[r], self.t_len[r], self.t_end[r] = j, kept[3], kept[4]
         else:
             self.t_len[r], self.t_end[r] = 1, 0
         ch = self.csp.channels[r]
@@ -745,6 +772,17 @@ class AxisBank:
             # 6041h: the state bits and remote, no mode bits while searching (step_hm's oms 0)
             self.csp.sw_const[r] -= SW12
 
+    def _keep_table(self, r: int, pl: TrapPlanner) -> None:
+        """A moving row leaves: remember its table (its samples stay in ``t_p``/``t_v``/``t_a``
+        until the row is loaded again), so that a row given back by a call about another
+        axis of its drive takes it up again.  Each sample of a table depends on the move and
+        its own index only (trap_table), so the samples are the ones a new table would hold."""
+        n = int(self.t_len[r])
+        if n <= 0 or self.ended[r] or pl._mode != _MOVE:
+            return
+        first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
+        self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
+
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
         tl = self.table
@@ -769,6 +807,18 @@ class AxisBank:
         self.t_len[r] = m
         self.t_cur[r] = 0
         self.t_end[r] = end if end < tl else -1
+
+    def _fill_tables(self) -> None:
+        """New Trap samples for the moving rows whose table ran out; :attr:`_refill_in`: the
+        cycles until the next one runs out."""
+        moving, cur = self.moving, self.t_cur
+        need = moving & (cur >= self.t_len)
+        if np.count_nonzero(need):
+            self._materialise()
+            for r in np.nonzero(need)[0].tolist():
+                self._refill(r)
+        left = (self.t_len - cur)[moving]
+        self._refill_in = int(left.min()) if len(left) else self.table
 
     # --- release ---------------------------------------------------------------------------------
     def release_all(self) -> None:
@@ -850,6 +900,7 @@ class AxisBank:
         last = (float(self.prf_p[r]), float(self.prf_v[r]), float(self.prf_a[r]))
         if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
             advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
+            self._keep_table(r, pl)
 
     # --- the GT boundary ------------------------------------------------------------------------
     def before_call(self, ctl: Any, proto: Any, values: tuple) -> None:
@@ -921,14 +972,17 @@ class AxisBank:
         self._lists.clear()
         k = self.kernel
         if k is not None:
-            # the plain cycle compiled; a table to refill (rare) or a new cycle time goes
-            # through numpy, and so does a cycle the kernel declines (nothing written then)
+            # the plain cycle compiled; a new cycle time goes through numpy, and so does a
+            # cycle the kernel declines (nothing written then)
             dt = dt_ns * 1e-9
             if (self.n_hm or self.n_frz) and dt != self.csp._dt:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
             c_fill = self._c_fill  # the kernel refills the tables itself
-            if dt == self.csp._dt and (c_fill or not (self.n_moving and self._refill_in <= 1)):
-                self._refill_in -= 1
+            if dt == self.csp._dt:
+                if not c_fill and self.n_moving and self._refill_in <= 1:
+                    self._fill_tables()  # as the numpy cycle would first (its step 2)
+                else:
+                    self._refill_in -= 1
                 rc = k.cycle(t_ns, dt)
                 while rc == 3:  # homing rows meeting an event: back to their drives first
                     self._release_rows(np.nonzero(k.scratch["s_hit"] & self.hm)[0])
@@ -957,13 +1011,7 @@ class AxisBank:
         moving, cur = self.moving, self.t_cur
         self._refill_in -= 1
         if self.n_moving and self._refill_in <= 0:
-            need = moving & (cur >= self.t_len)
-            if np.count_nonzero(need):
-                self._materialise()
-                for r in np.nonzero(need)[0].tolist():
-                    self._refill(r)
-            left = (self.t_len - cur)[moving]
-            self._refill_in = int(left.min()) if len(left) else self.table
+            self._fill_tables()
         idx = self.base + cur
         prf_p = self.t_p.take(idx)
         ended = cur == self.t_end
@@ -1087,6 +1135,36 @@ class AxisBank:
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
 
+    def run_cycles(self, t_ns: int, dt_ns: int, n: int) -> int:
+        """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
+        controller whose cycle has nothing else to do (:meth:`Controller.run_cycles`): the
+        cycles run, each exactly the one :meth:`cycle` would run; 0 when the next cycle
+        needs :meth:`cycle` (something to claim or release, a row leaving, no compiled
+        kernel).  It stops before the first cycle the kernel declines and after one that
+        ended a Trap move; the kernel fills a Trap table that runs out itself (else the run
+        stops where the shortest table ends: the next call fills it)."""
+        k = self.kernel
+        if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
+            return 0
+        dt = dt_ns * 1e-9
+        if dt != self.csp._dt:
+            return 0
+        if self.n_moving and not self._c_fill:
+            if self._refill_in <= 1:  # a table runs out: fill it first, as cycle() would
+                self._fill_tables()
+                self._refill_in += 1  # (counted like cycle()'s: one more than the samples left)
+            n = min(n, self._refill_in - 1)  # no further than the shortest table goes
+            if n <= 0:
+                return 0
+        _, done = k.run(t_ns, dt, dt_ns, n)
+        if done:
+            self._countdown -= done
+            self._refill_in -= done
+            self._lists.clear()
+            self._after_kernel(k, done)
+            self.many_cycles += done
+        return done
+
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
         """What the numpy cycle does besides its arithmetic, after compiled cycles."""
         csp = self.csp
@@ -1102,37 +1180,6 @@ class AxisBank:
         self.kernel_cycles += cycles
         self.homing_rows_run += self.n_hm * cycles
         self.frozen_rows_run += self.n_frz * cycles
-
-    def run_many(self, t_ns: int, dt_ns: int, most: int) -> int:
-        """Up to ``most`` whole cycles from ``t_ns`` in one call of the compiled kernel,
-        when the bank runs every axis it has and nothing is pending (no GT call, claim or
-        release since the last cycle); the cycles run, 0 for none (the caller then runs
-        one cycle the ordinary way).  The kernel stops after a cycle that ended a Trap move
-        and before one it declines, so every cycle it runs is one :meth:`cycle` would have
-        run in the kernel too."""
-        k = self.kernel
-        if (
-            k is None
-            or most < 2
-            or self.dirty
-            or self._stale
-            or not self.n_alive
-            or self.n_alive != self.n
-            or dt_ns * 1e-9 != self.csp._dt
-        ):
-            return 0
-        if self.n_moving and not self._c_fill:
-            most = min(most, self._refill_in - 1)  # the numpy cycle refills the tables
-            if most < 2:
-                return 0
-        self._lists.clear()
-        _, done = k.run(t_ns, dt_ns * 1e-9, dt_ns, most)
-        if done:
-            self._countdown -= done
-            self._refill_in -= done
-            self._after_kernel(k, done)
-            self.many_cycles += done
-        return done
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

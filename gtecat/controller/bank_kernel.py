@@ -5,9 +5,10 @@ operation count, not its arithmetic (about 80 operations of 0.5-1 µs each, what
 rows).  ``gtecat/controller/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
 IEEE operations in the same order, built like libgts (``cc``, on first use, into the
 per-version cache; ``-ffp-contract=off``), so it gives the same bits as numpy and as the
-scalar objects.  It runs only the plain cycle: a raw write to a claimed slave, a row about to
-leave, a table to refill or a new cycle time go through the numpy cycle, which stays the
-reference and the fallback (no compiler: numpy alone, nothing else changes).
+scalar objects.  It runs only the plain cycle (the bank fills a Trap table that runs out
+before it): a raw write to a claimed slave, a row about to leave or a new cycle time go
+through the numpy cycle, which stays the reference and the fallback (no compiler: numpy
+alone, nothing else changes).
 
 ``GTECAT_BANK_KERNEL`` = ``auto`` (default: the compiled kernel where it builds), ``c`` (the
 same; a build failure is reported in :attr:`AxisBank.kernel_reason`) or ``numpy``.
@@ -141,6 +142,7 @@ class Kernel:
     def __init__(self, bank: AxisBank, lib: Any) -> None:
         self.bank = bank
         self.fn = lib.bank_kernel_cycle
+        self.run_fn = lib.bank_kernel_run
         n = bank.n
         self.scratch = {name: np.zeros(n, _array_type(_dtype_of(name))) for name in _SCRATCH}
         self.scratch["s_jog"] = np.zeros(5 * n, _F64)
@@ -260,7 +262,8 @@ class Kernel:
 
     @property
     def move_ended(self) -> bool:
-        """The last committed cycle ended a Trap move (the bank recounts its moving rows)."""
+        """The last committed cycle ended a Trap move (the bank recounts its moving rows);
+        after :meth:`run`: any of its cycles did."""
         return bool(self.io[OUT_FIN])
 
 

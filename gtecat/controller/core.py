@@ -144,7 +144,7 @@ class Controller:
             mode=mode,
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
-        self.clock.run_many = self._run_many
+        self.clock.run_many = self.run_cycles
         self._cycle_fixed = self.options.cycle_ms is not None
         self.log = MasterLog(self.options.log, clock_ms=lambda: self.clock.now_ms)
         self.machine = self._load_machine(self.options.machine)
@@ -335,30 +335,35 @@ class Controller:
         for f in self.sample:
             f(t + dt)  # stamped when the cycle's values become visible (= GT_GetClock after it)
 
-    def _run_many(self, most: int) -> int:
-        """Up to ``most`` whole cycles at once, when the compiled axis bank runs every axis
-        and slave and nothing else has work in a cycle (no hook, no axis or slave outside
-        the bank, the bus in OP with its working counter whole, nobody wrapping the cycle);
-        the cycles run, 0 for none (the clock then runs one the ordinary way).  The
-        cycles are the ones :meth:`_cycle` would have run, with the same results."""
-        bank, m = self.bank, self.master
+    def run_cycles(self, n: int) -> int:
+        """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has
+        anything to do in them: every axis claimed by the bank, no hook, the bus steady
+        (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
+        one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
+        cycles run, 0 when the next one must go through :meth:`_cycle`."""
+        if self._run_axes:
+            return 0
+        bank = self.bank
         if (
             bank is None
-            or m is None
-            or self._run_axes
+            or bank.kernel is None
             or self.before_cycle
             or self.pre_cycle
             or self.post_cycle
             or self.sample
             or self._links_down
             or self.clock._run_cycle != self._cycle
-            or not m.steady()
         ):
             return 0
-        done = bank.run_many(self.clock.now_ns, self.clock.cycle_ns, most)
-        if done:
-            m.cycles += done
+        master = self.master
+        if master is None or not master.steady():
+            return 0
+        done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, min(n, self.BATCH_CYCLES))
+        master.cycles += done
         return done
+
+    #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
+    BATCH_CYCLES = 1000
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle

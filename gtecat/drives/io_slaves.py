@@ -167,23 +167,26 @@ class IoSlave(VirtualSlave):
             self.tx[:] = self.field_inputs
 
     def settled(self) -> bool:
-        """Another :meth:`step` with the same RxPDO would change nothing: in OP, the field
-        outputs are the RxPDO, every wire already holds, the TxPDO is the field inputs and
-        no emergency waits (a subclass with its own step is never settled)."""
-        if type(self).step is not IoSlave.step or self.al_state != AlState.OP:
+        """A :meth:`step` now would change nothing (its outputs reached the field, the wires
+        and the field inputs reached ``tx``), given the same ``rx``."""
+        if self.emergencies:
             return False
-        if self.emergencies or self.field_outputs != self.rx:
+        fo = self.field_outputs
+        if self.al_state == AlState.OP:
+            if fo != self.rx:
+                return False
+        elif any(fo):
             return False
+        fi = self.field_inputs
         if self._wires:
             plan = self._wire_plan
             if plan is None:
                 plan = self._wire_plan = self._plan_wires()
-            fo, fi = self.field_outputs, self.field_inputs
             for ob, ib, shift, mask in plan:
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
-                if (fi[ib] & ~mask) | (v & mask) != fi[ib]:
+                if (fi[ib] ^ v) & mask:
                     return False
-        return self.tx == self.field_inputs
+        return self.al_state < AlState.SAFEOP or self.tx == fi
 
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires

@@ -3,8 +3,8 @@
 A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
 * a header ``{"gtecat_recording": 1, ...}``;
-* one line per GT call: ``{"c": NAME, "a": [arguments], "k": {keywords}, "o": {index:
-  value written back}, "r": return code, "t": controller time in ns}``, and ``"b"``: the
+* one line per GT call: ``{"t": controller time in ns, "c": NAME, "a": [arguments], "r":
+  return code, "k": {keywords}, "o": {index: value written back}}``, and ``"b"``: the
   controller time when the call began, where time passed since the call before (a
   controller process lets its clock follow the wall clock between its clients' calls);
 * ``{"f": "inject", "v": {a [[fault]] table}}`` / ``{"f": "clear", "id": N}`` for faults
@@ -15,7 +15,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
 structure field by field, an array as its values, a buffer as hex); replay builds fresh
 objects of the same types, makes the same calls in the same order and compares every return
-code, every value written back and every checkpoint: the first difference is the
+code, every value the call leaves in its pointer arguments (written back or left as it was)
+and every checkpoint: the first difference is the
 divergence (call number, function, argument, recorded and new value).  Replays are
 deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session replays in
 ``auto`` (the values its wall clock decided may then differ, and are reported so).
@@ -25,7 +26,6 @@ from __future__ import annotations
 
 import ctypes
 import gzip
-import io
 import json
 import os
 import threading
@@ -57,6 +57,10 @@ _SIMPLE = {
     and isinstance(getattr(ctypes, name), type)
     and issubclass(getattr(ctypes, name), ctypes._SimpleCData)  # type: ignore[attr-defined]
 }
+#: the simple types whose own name is their recorded name (an alias such as c_int32 records
+#: its class's name)
+_SIMPLE_NAME = {cls: cls.__name__ for cls in _SIMPLE.values() if cls.__name__ in _SIMPLE}
+_PLAIN = (int, str, bool, type(None))
 
 
 # --- values ------------------------------------------------------------------------------
@@ -73,6 +77,11 @@ _INF = float("inf")
 
 def encode(x: Any) -> Any:
     """An argument as plain JSON (module docstring)."""
+    if type(x) is _CArg:  # byref(c_long()), the usual pointer: the quick way to the same
+        name = _SIMPLE_NAME.get(type(x._obj))
+        if name is not None:
+            v = x._obj.value
+            return {"ref": {"c": name, "v": v if type(v) is int else _scalar(v)}}
     if x is None or isinstance(x, bool | int | str):
         return x
     if isinstance(x, float):
@@ -176,22 +185,6 @@ def decode(v: Any) -> Any:
     return None  # a value that cannot be rebuilt (an object of the caller's)
 
 
-def _pooled(pool: dict[tuple[str, int, str], tuple[Any, Any]], name: str, i: int, v: Any) -> Any:
-    """``decode(v)``, but a pointer to a simple value is one object per function and argument,
-    reused with the recorded value (an application polls with the same variable: so does the
-    replay, and the GT layer's fast path recognises it)."""
-    ref = v.get("ref")
-    if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
-        key = (name, i, ref["c"])
-        hit = pool.get(key)
-        if hit is None:
-            obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
-            hit = pool[key] = (obj, ctypes.byref(obj))
-        hit[0].value = ref["v"]
-        return hit[1]
-    return decode(v)
-
-
 def _set_field(obj: Any, name: str, fv: Any) -> None:
     cur = getattr(obj, name)
     if isinstance(cur, ctypes.Array):
@@ -269,22 +262,39 @@ class Recorder(Listener):
             total = ctl.clock.now_ns + ctl.clock._pending_ns
             if total != self._t_end and self._t_end >= 0:
                 gap = total
-        return [encode(a) for a in args], {k: encode(v) for k, v in kwargs.items()}, gap
+        a: list[Any] = []
+        held: list[tuple[str, Any, Any]] = []  # (index or keyword, object, its value before)
+        for i, x in enumerate(args):
+            if type(x) in _PLAIN:
+                a.append(x)
+                continue
+            enc = encode(x)
+            a.append(enc)
+            if _mutable(x):
+                held.append((str(i), x, enc))
+        kw = {}
+        for k, x in kwargs.items():
+            kw[k] = enc = encode(x)
+            if _mutable(x):
+                held.append((k, x, enc))
+        return a, kw, gap, held
 
     def after(self, name: str, args: tuple, kwargs: dict, rc: Any, token: Any) -> None:
         if token is None:
             return
-        a, kw, gap = token
-        outs = {str(i): encode(x) for i, x in enumerate(args) if _mutable(x)}
-        outs.update({k: encode(v) for k, v in kwargs.items() if _mutable(v)})
-        outs = {k: v for k, v in outs.items() if v != (a[int(k)] if k.isdigit() else kw.get(k))}
+        a, kw, gap, held = token
+        outs = {}
+        for k, x, enc in held:  # what the call wrote back into its pointer arguments
+            now = encode(x)
+            if now != enc:
+                outs[k] = now
         ctl = _controller()
         t = ctl.clock.now_ns if ctl is not None else 0
         entry: dict[str, Any] = {
+            "t": t,  # first: a reader finds calls that differ only in time (read)
             "c": name,
             "a": a,
             "r": rc if isinstance(rc, int) else encode(rc),
-            "t": t,
         }
         if kw:
             entry["k"] = kw
@@ -321,9 +331,15 @@ class Recorder(Listener):
 
 
 def _controller() -> Any:
-    from ..gt._core import SESSION
+    session = _SESSION[0]
+    if session is None:
+        from ..gt._core import SESSION
 
-    return SESSION.controllers.get(1)
+        session = _SESSION[0] = SESSION
+    return session.controllers.get(1)
+
+
+_SESSION: list[Any] = [None]
 
 
 def checkpoint(ctl: Any) -> dict[str, Any] | None:
@@ -364,6 +380,9 @@ def _show(v: Any) -> str:
 
 
 def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """(header, entries) of a recording.  Calls that differ only in their time are one
+    shared entry (an application polls the same way thousands of times): read them, never
+    change them."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -371,19 +390,40 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         raise ParameterError(f"{p}: no such recording") from None
     if raw[:2] == b"\x1f\x8b":
         raw = gzip.decompress(raw)
-    lines = io.StringIO(raw.decode("utf-8", "replace"))
+    lines = raw.decode("utf-8", "replace").split("\n")
     try:
-        head = json.loads(lines.readline() or "{}")
+        head = json.loads(lines[0] or "{}")
     except json.JSONDecodeError:
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
+    texts: list[str] = []  # the distinct lines, parsed at once below
+    order: list[int] = []  # each entry's line in texts
+    same: dict[str, int] = {}  # a call's line without its time -> its place in texts
+    for line in lines[1:]:
+        if line.startswith('{"t":'):  # as Recorder writes a call: the time first
+            rest = line[line.find(",", 5) :]
+            k = same.get(rest)
+            if k is None:
+                k = same[rest] = len(texts)
+                texts.append(line)
+            order.append(k)
+        elif line.strip():
+            order.append(len(texts))
+            texts.append(line)
     try:
-        body = lines.read().strip()
-        entries = json.loads("[" + body.replace("\n", ",") + "]") if body else []
-    except json.JSONDecodeError as e:
-        raise ParameterError(f"{p}: damaged recording: {e}") from None
-    return head, entries
+        parsed = json.loads("[" + ",".join(texts) + "]")
+        if len(parsed) != len(texts) or not all(type(x) is dict for x in parsed):
+            raise json.JSONDecodeError("a line that is not one entry", "", 0)
+    except json.JSONDecodeError:
+        for no, line in enumerate(lines[1:], 2):  # which line
+            try:
+                if line.strip() and not isinstance(json.loads(line), dict):
+                    raise json.JSONDecodeError("not an entry (a JSON object)", line, 0)
+            except json.JSONDecodeError as err:
+                raise ParameterError(f"{p}: damaged recording: line {no}: {err}") from None
+        raise ParameterError(f"{p}: damaged recording") from None
+    return head, [parsed[k] for k in order]
 
 
 def replay(
@@ -402,7 +442,7 @@ def replay(
 def _where(head: dict[str, Any]) -> Any:
     """The recorded folder and GTECAT_* settings for the replay (a backend of real hardware
     is replaced by the emulated one)."""
-    saved_env = {k: os.environ.get(k) for k in _ENV}
+    saved_env = {k: os.environ.get(k) for k in (*_ENV, "GTECAT_INSPECT")}
     saved_cwd = os.getcwd()
     env = head.get("env") or {}
     for k in _ENV:
@@ -414,6 +454,8 @@ def _where(head: dict[str, Any]) -> Any:
         os.environ["GTECAT_BACKEND"] = "emulated"
     if os.environ.get("GTECAT_CLOCK") == "realtime":
         os.environ["GTECAT_CLOCK"] = "auto"
+    # nothing to watch: a replay runs many times faster than real time
+    os.environ["GTECAT_INSPECT"] = "0"
     cwd = head.get("cwd")
     if isinstance(cwd, str) and os.path.isdir(cwd):
         os.chdir(cwd)
@@ -428,6 +470,88 @@ def _where(head: dict[str, Any]) -> Any:
                 os.environ[k] = v
 
 
+@dataclass(slots=True)
+class _Call:
+    """One recorded call made ready to run again (once per distinct entry)."""
+
+    fn: Any
+    name: str
+    args: list[Any]  # the arguments; a pooled pointer is its byref, a fresh one None
+    sets: list[tuple[Any, Any]]  # (pooled object, the value it held at the call)
+    fresh: list[tuple[int, Any]]  # (index, encoding): an object built anew for every call
+    kw: dict[str, Any] | None  # encoded keywords (None: none)
+    rc: Any
+    #: what the call leaves in its pointer arguments: (index or keyword, the recorded value,
+    #: the pooled object and its plain recorded value for a quick look, or None, None)
+    checks: list[tuple[int | str, Any, Any, Any]]
+    before: int | None  # "b": the controller time the call began at
+    opens: bool  # GT_Open: the replay's own settings
+
+
+def _prepare(
+    e: dict[str, Any], fn: Any, pool: dict[tuple[str, int, str], tuple[Any, Any]]
+) -> _Call:
+    name = e["c"]
+    a = e["a"]
+    outs = e.get("o") or {}
+    args: list[Any] = []
+    sets: list[tuple[Any, Any]] = []
+    fresh: list[tuple[int, Any]] = []
+    checks: list[tuple[int | str, Any, Any, Any]] = []
+    for i, x in enumerate(a):
+        if not isinstance(x, dict):
+            args.append(x)
+            continue
+        want = outs.get(str(i), x)  # not in "o": the call left the value as it was
+        ref = x.get("ref")
+        if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
+            # a pointer to a simple value: one object per function and argument, set to the
+            # recorded value before each call (an application polls with the same variable:
+            # so does the replay, and the GT layer's fast path recognises it)
+            key = (name, i, ref["c"])
+            hit = pool.get(key)
+            if hit is None:
+                obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
+                hit = pool[key] = (obj, ctypes.byref(obj))
+            obj = hit[0]
+            sets.append((obj, ref["v"]))
+            args.append(hit[1])
+            w = want.get("ref") if isinstance(want, dict) and len(want) == 1 else None
+            quick = (
+                isinstance(w, dict)
+                and len(w) == 2
+                and w.get("c") == type(obj).__name__
+                and "v" in w
+                and not isinstance(w["v"], dict)
+            )
+            checks.append((i, want, obj if quick else None, w["v"] if quick else None))
+            continue
+        fresh.append((i, x))
+        args.append(None)
+        if str(i) in outs or _round_trips(x):
+            checks.append((i, want, None, None))
+    kw = e.get("k")
+    for k, want in outs.items():
+        if not k.isdigit():
+            checks.append((k, want, None, None))
+    for k, x in (kw or {}).items():
+        if k not in outs and isinstance(x, dict) and _round_trips(x):
+            checks.append((k, x, None, None))
+    return _Call(
+        fn, name, args, sets, fresh, kw, e["r"], checks, e.get("b"), name in ("GT_Open", "GTN_Open")
+    )
+
+
+def _round_trips(x: Any) -> bool:
+    """A recorded argument that the call may write into and that comes back as recorded:
+    the value it still holds after the call is then compared too."""
+    try:
+        v = decode(x)
+    except ParameterError:
+        return False
+    return _mutable(v) and encode(v) == x
+
+
 def _replay(
     entries: list[dict[str, Any]], eni: str | None, machine: str | None
 ) -> tuple[int, Divergence | None]:
@@ -437,32 +561,54 @@ def _replay(
     machine = str(Path(machine).resolve()) if machine else None
     gt.GT_Close()
     n = 0
-    fns: dict[str, Any] = {}
     pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
+    ready: dict[int, _Call] = {}  # id(entry) -> the call (entries that differ only in time
+    # are one object: see read)
     try:
         for e in entries:
-            if "c" in e:
-                n += 1
-                name = e["c"]
-                fn = fns.get(name)
+            p = ready.get(id(e))
+            if p is None:
+                if "c" not in e:
+                    div = _other(e, n, faults)
+                    if div is not None:
+                        return n, div
+                    continue
+                fn = getattr(gt, e["c"], None) if type(e["c"]) is str else None
                 if fn is None:
-                    fn = fns[name] = getattr(gt, name, None)
-                    if fn is None:
-                        return n, Divergence(n, name, "function", "present", "missing")
-                before = e.get("b")
-                if before is not None:  # time passed between the calls: let it pass here too
-                    ctl = _controller()
-                    if ctl is not None:
-                        gap = before - ctl.clock.now_ns - ctl.clock._pending_ns
-                        if gap > 0:
-                            ctl.clock.advance_ns(gap)
-                a = e["a"]
-                args = [
-                    x if not isinstance(x, dict) else _pooled(pool, name, i, x)
-                    for i, x in enumerate(a)
-                ]
-                kw = {k: decode(v) for k, v in e.get("k", {}).items()}
-                if name in ("GT_Open", "GTN_Open"):
+                    return n + 1, Divergence(n + 1, e["c"], "function", "present", "missing")
+                try:
+                    p = ready[id(e)] = _prepare(e, fn, pool)
+                except (KeyError, TypeError, ValueError, AttributeError) as err:
+                    raise ParameterError(
+                        f"damaged recording: call {n + 1} ({e['c']}) cannot be made again: "
+                        f"{type(err).__name__}: {err}"
+                    ) from None
+            n += 1
+            if p.before is not None:  # time passed between the calls: let it pass here too
+                ctl = _controller()
+                if ctl is not None:
+                    gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
+                    if gap > 0:
+                        ctl.clock.advance_ns(gap)
+            args = p.args
+            try:
+                for obj, v in p.sets:
+                    obj.value = v
+                if p.fresh:
+                    args = list(args)
+                    for i, x in p.fresh:
+                        args[i] = decode(x)
+            except (TypeError, ValueError, KeyError, AttributeError) as err:
+                raise ParameterError(
+                    f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+                    f"again: {type(err).__name__}: {err}"
+                ) from None
+            if p.kw is None and not p.opens:
+                kw: dict[str, Any] = {}
+                rc = p.fn(*args)
+            else:
+                kw = {k: decode(v) for k, v in (p.kw or {}).items()}
+                if p.opens:
                     if eni:
                         kw["eni"] = str(eni)
                     if machine:
@@ -472,36 +618,40 @@ def _replay(
                     if kw.get("backend") == "pysoem":
                         kw["backend"] = "emulated"
                     kw["log"] = ""  # the session's master log is not written again
-                rc = fn(*args, **kw)
-                if rc != e["r"]:
-                    return n, Divergence(n, name, "return code", e["r"], rc)
-                outs = e.get("o")
-                if outs:
-                    for key, want in outs.items():
-                        got = encode(args[int(key)] if key.isdigit() else kw[key])
-                        if got != want:
-                            what = f"argument {int(key) + 1}" if key.isdigit() else key
-                            return n, Divergence(n, name, what, want, got)
-            elif "cp" in e:
-                ctl = _controller()
-                got = checkpoint(ctl) if ctl is not None else None
-                if got != e:
-                    ms = e["cp"] / 1e6
-                    return n, Divergence(n, "(bus)", f"bus state at {ms:g} ms", e, got)
-            elif "f" in e:
-                ctl = _controller()
-                if ctl is None:
+                rc = p.fn(*args, **kw)
+            if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
+                return n, Divergence(n, p.name, "return code", p.rc, rc)
+            for where, want, obj, v in p.checks:
+                if obj is not None and obj.value == v:
                     continue
-                if e["f"] == "inject":
-                    values = dict(e["v"])
-                    if not e.get("sync") and "ms" in e:
-                        values["at_ms"] = e["ms"]
-                    faults.inject(faults.spec_from_dict(values), ctl=ctl)
-                elif e["f"] == "clear":
-                    faults.clear(e["v"].get("id"), ctl=ctl)
+                got = encode(args[where] if type(where) is int else kw.get(where))
+                if got != want:
+                    what = f"argument {where + 1}" if type(where) is int else where
+                    return n, Divergence(n, p.name, what, want, got)
     finally:
         gt.GT_Close()
     return n, None
+
+
+def _other(e: dict[str, Any], n: int, faults: Any) -> Divergence | None:
+    """A checkpoint (compared) or a fault (injected or cleared again)."""
+    if "cp" in e:
+        ctl = _controller()
+        got = checkpoint(ctl) if ctl is not None else None
+        if got != e:
+            return Divergence(n, "(bus)", f"bus state at {e['cp'] / 1e6:g} ms", e, got)
+    elif "f" in e:
+        ctl = _controller()
+        if ctl is None:
+            return None
+        if e["f"] == "inject":
+            values = dict(e["v"])
+            if not e.get("sync") and "ms" in e:
+                values["at_ms"] = e["ms"]
+            faults.inject(faults.spec_from_dict(values), ctl=ctl)
+        elif e["f"] == "clear":
+            faults.clear(e["v"].get("id"), ctl=ctl)
+    return None
 
 
 __all__ = [

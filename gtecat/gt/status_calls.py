@@ -46,6 +46,7 @@ from .motion_calls import _read_many, long_arg, real_arg
 #: GT_LoadConfig file names longer than this fail (manual 4.4 "注意")
 _CONFIG_NAME_MAX = 125
 _ENCODER_BITS = 12  # GT_EncSns: bit0..bit11 = encoders 1..12
+_PRF_MOVING = 1 << 10  # table 6-2 bit 10: the one bit of a profile's own (GT_GetPrfSts)
 
 
 # --- status ------------------------------------------------------------------------------------
@@ -53,6 +54,25 @@ _ENCODER_BITS = 12  # GT_EncSns: bit0..bit11 = encoders 1..12
 def GT_GetSts(ctl: Controller, axis: int, pSts: Any, count: int = 1, pClock: Any = None) -> int:
     """32-bit axis status word of table 6-2 for ``count`` axes (entry 71)."""
     return _read_many(ctl, axis, pSts, count, pClock, AxisResources.status)
+
+
+@gt_function
+def GT_GetPrfSts(
+    ctl: Controller, profile: int, pSts: Any, count: int = 1, pClock: Any = None
+) -> int:
+    """The status word of ``count`` profiles (GTN-era vendor header; the manual has no entry).
+
+    Decision: a profile is the planner of table 6-2, so its word holds the bits the planner
+    itself sets and nothing that comes from the axis's inputs or encoder: bit 10 (规划运动,
+    "set while the planner moves") and no other.  Alarm (1), following error (4), limits
+    (5, 6), IO stops (7, 8), servo on (9) and in position (11, which compares the encoder
+    with the plan) are the axis's, read with GT_GetSts.  Profile n drives axis n (the default
+    ``prfMap``), so profile n's bit 10 is axis n's bit 10 at the same instant.  ``count`` follows
+    the one rule of GT_GetSts (:func:`~gtecat.controller.resources.axis_span`): a profile the
+    controller has but no drive backs reads 0, as the field's ``GTN_GetPrfSts(1, 1, sts, 5)``
+    expects on a machine of fewer axes; a span past the controller's profiles is 7.
+    """
+    return _read_many(ctl, profile, pSts, count, pClock, lambda r: r.status() & _PRF_MOVING)
 
 
 @gt_function

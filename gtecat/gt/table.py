@@ -291,15 +291,16 @@ def collect(groups: Iterable) -> dict[str, Proto]:
     """
     out: dict[str, Proto] = {}
     owner: dict[str, object] = {}
+    twins: dict[str, Proto] = {}  #: GTN_x -> the GT_x line that gives it, as lines arrive
     vendor: list[tuple[object, dict[str, Proto]]] = []
     for g in groups:
         table = parse(g.prototypes, g.name)
         if g.declared_only:
             vendor.append((g, table))
             continue
-        _merge(out, owner, g, table, yield_to_owner=False)
+        _merge(out, owner, twins, g, table, yield_to_owner=False)
     for g, table in vendor:
-        _merge(out, owner, g, table, yield_to_owner=True)
+        _merge(out, owner, twins, g, table, yield_to_owner=True)
     for name in list(out):
         if name.startswith("GTN_") and ("GT_" + name[4:]) in out:
             gt = out["GT_" + name[4:]]
@@ -312,8 +313,10 @@ def _replace_twin(p: Proto) -> Proto:
     return Proto(p.name, p.params, p.entry, p.core_first_form, p.by_name, p.group, False, p.unknown)
 
 
-def _merge(out: dict, owner: dict, g, table: dict[str, Proto], *, yield_to_owner: bool) -> None:
-    twins = {p.twin_name: p for p in out.values() if p.gtn}
+def _merge(
+    out: dict, owner: dict, twins: dict, g, table: dict[str, Proto], *, yield_to_owner: bool
+) -> None:
+    # (a group's own GT_x and GTN_x lines give no twin: parse() said so, twins has none)
     for name, proto in table.items():
         taken = owner.get(name)
         if taken is None and name.startswith("GTN_") and name in twins:
@@ -329,6 +332,8 @@ def _merge(out: dict, owner: dict, g, table: dict[str, Proto], *, yield_to_owner
             )
         out[name] = proto
         owner[name] = g
+        if proto.gtn:
+            twins[proto.twin_name] = proto
 
 
 def _load() -> tuple[tuple, dict[str, Proto]]:

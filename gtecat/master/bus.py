@@ -267,23 +267,19 @@ class Master:
         return self.last
 
     def steady(self) -> bool:
-        """Cycles would change nothing here but the count: every slave in OP and run by
-        someone else (the axis bank), the working counter whole and as last time, no
-        hook, no countdown, no pending state change (:meth:`Controller._run_many`)."""
-        steady_wkc = getattr(self.backend, "steady_wkc", None)
-        last = self.last
+        """A cycle now would change nothing but the time and :attr:`cycles`: every slave in OP
+        as asked, the working counter whole, nothing to log, no hook, and a backend whose
+        exchange would change nothing (:meth:`Backend.steady`)."""
         return (
             self.opened
-            and steady_wkc is not None
             and not self.on_cycle
             and self._op_countdown < 0
-            and self.target == AlState.OP
             and not self._wkc_bad
             and not self.offline
-            and last.ok
-            and last.wkc == steady_wkc()
-            and last.expected == self.backend.expected_wkc()
+            and self.target == AlState.OP
+            and self.last.ok
             and self.all_op()
+            and self.backend.steady()
         )
 
     def recover(self) -> None:

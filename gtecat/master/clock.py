@@ -64,8 +64,8 @@ class Clock:
         self.cycle_ns = int(cycle_ns)
         self.call_latency_ns = int(call_latency_ns)
         self._run_cycle = run_cycle
-        #: runs up to n whole cycles at once when nothing but the compiled axis bank has
-        #: work in them; returns how many it ran (0: run one the ordinary way)
+        #: the owner's way to run up to N cycles at once (returns the cycles it ran, 0: run
+        #: the next one through ``run_cycle``); virtual time only, None: one by one
         self.run_many: Callable[[int], int] | None = None
         self.now_ns = 0  # controller time since power-on
         self.cycles = 0
@@ -91,18 +91,17 @@ class Clock:
             return 0
         self._pending_ns += int(ns)
         n = 0
-        cyc = self.cycle_ns
-        while self._pending_ns >= cyc:
-            many = self.run_many
-            if many is not None and self._pending_ns >= 2 * cyc:
-                k = many(self._pending_ns // cyc)
+        many = self.run_many
+        while self._pending_ns >= self.cycle_ns:
+            if many is not None:
+                k = many(self._pending_ns // self.cycle_ns)
                 if k:
-                    self._pending_ns -= k * cyc
+                    self._pending_ns -= k * self.cycle_ns
                     self.cycles += k
-                    self.now_ns += k * cyc
+                    self.now_ns += k * self.cycle_ns
                     n += k
                     continue
-            self._pending_ns -= cyc
+            self._pending_ns -= self.cycle_ns
             self.cycle()
             n += 1
         if self.group is not None:

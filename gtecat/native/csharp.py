@@ -96,7 +96,7 @@ def _field_lines(name: str, t: type, where: str) -> list[str]:
         t = t._type_
     if issubclass(t, ctypes._Pointer):
         cs = "IntPtr"
-    elif issubclass(t, ctypes.Structure):
+    elif issubclass(t, ctypes.Structure | ctypes.Union):
         cs = t.__name__
     elif issubclass(t, ctypes._SimpleCData) and t._type_ == "c" and len(dims) != 1:
         cs = "byte"  # one char (a separator), or a table of them: bytes, not a text
@@ -126,7 +126,9 @@ def struct_decl(cls: type[ctypes.Structure], indent: str = "        ") -> list[s
     """``[StructLayout] public struct T { ... }`` with array fields unrolled."""
     where = cls.__name__
     pack = getattr(cls, "_pack_", None)
-    layout = "LayoutKind.Sequential" + (f", Pack = {int(pack)}" if pack else "")
+    union = issubclass(cls, ctypes.Union)
+    layout = "LayoutKind.Explicit" if union else "LayoutKind.Sequential"
+    layout += f", Pack = {int(pack)}" if pack else ""
     doc = (cls.__doc__ or "").strip().splitlines()
     out = []
     if doc:
@@ -136,7 +138,15 @@ def struct_decl(cls: type[ctypes.Structure], indent: str = "        ") -> list[s
         if len(spec) != 2:
             raise CSharpError(f"{where}.{spec[0]}: bit fields are not supported")
         fname, t = spec
-        out += [f"{indent}    {line}" for line in _field_lines(fname, t, f"{where}.{fname}")]
+        lines = _field_lines(fname, t, f"{where}.{fname}")
+        if union:  # every member at offset 0; an unrolled array's elements one after another
+            step = ctypes.sizeof(t._type_) if issubclass(t, ctypes.Array) else 0
+            members = [i for i, line in enumerate(lines) if not line.startswith("[")]
+            if len(members) > 1:
+                lines = [f"[FieldOffset({k * step})] {lines[i]}" for k, i in enumerate(members)]
+            else:
+                lines = ["[FieldOffset(0)]", *lines]
+        out += [f"{indent}    {line}" for line in lines]
     out.append(f"{indent}}}")
     return out
 

@@ -9,6 +9,11 @@
  * error window) nothing is written and the caller runs the numpy cycle, which releases
  * the rows.  Return 0: committed; io[OUT_FIN] says a Trap move ended.
  *
+ * bank_kernel_run runs up to n such cycles back to back (t advancing by dt_ns each), for a
+ * controller whose cycle has nothing else to do (AxisBank.run_cycles): it stops before the
+ * first cycle that is not committed and returns the cycles committed; io[OUT_FIN] then says
+ * whether any of them ended a Trap move.
+ *
  * Arrays arrive as one table of addresses in the order of FIELDS below (the Python side
  * binds them by these names and refuses a library whose list differs).
  */

@@ -6,6 +6,7 @@ TITLE = "status, safety and axis configuration"
 PROTOTYPES = r"""
 short GT_GetSts(short axis, long *pSts /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // 71
 short GT_ClrSts(short axis, short count=1);                                      // 8
+short GT_GetPrfSts(short profile, long *pSts /*out[count]*/, short count=1, unsigned long *pClock=NULL);  // header (GTN era)
 short GT_AlarmOn(short axis);                                                    // 3
 short GT_AlarmOff(short axis);                                                   // 2
 short GT_LmtsOn(short axis, short limitType=-1);                                 // 82

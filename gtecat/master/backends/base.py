@@ -69,6 +69,12 @@ class Backend(ABC):
     def exchange(self, t_ns: int, dt_ns: int) -> int:
         """One process-data cycle: outputs out, inputs in; returns the working counter."""
 
+    def steady(self) -> bool:
+        """An exchange now would change nothing but the time (the controller may then run
+        many cycles at once, :meth:`gtecat.master.bus.Master.steady`); False unless the
+        backend can tell."""
+        return False
+
     @abstractmethod
     def expected_wkc(self) -> int:
         """The working counter of a healthy cycle with every slave in OP."""

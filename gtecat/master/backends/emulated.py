@@ -17,6 +17,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
 from gtecat.eni.layout import Layout
@@ -205,42 +206,35 @@ class EmulatedBackend(Backend):
             self.capture.cycle(t_ns, bytes(image.view), image.outputs_bytes, wkc)
         return wkc
 
-    def steady_wkc(self) -> int | None:
-        """The working counter of a cycle that would change nothing here: every slave
-        claimed by the axis bank or settled (an IO slave whose next step, with the outputs
-        the image holds, gives the inputs the image holds), nothing watching the frames;
-        None when a cycle has work here."""
+    def steady(self) -> bool:
+        """An exchange now would change nothing: no hook, capture or cable pulled, and every
+        slave it steps (the ones the axis bank does not run) is a plain IO slave at its fixed
+        point - the image's outputs are its ``rx``, its step changes nothing, its ``tx`` is in
+        the image's inputs (byte-aligned areas; anything else: not steady)."""
         if self.answer_hook is not None or self.capture is not None or self.unplugged:
-            return None
-        wkc = self._claimed_wkc
+            return False
         image = self.image
-        if not self._run_plan:
-            return wkc
         if image is None:
-            return None
-        view = image.view
+            return False
+        view, base = image.view, image.outputs_bytes
         for slave, out, inp in self._run_plan:
-            settled = getattr(slave, "settled", None)
-            if settled is None or not settled():
-                return None
+            if type(slave).step is not _IO_STEP or not slave.settled():
+                return False
             if out is not None:
                 if not out.aligned:
-                    return None
+                    return False
                 start = out.logical_bit >> 3
                 n = min(len(slave.rx), out.raw_bytes)
                 if view[start : start + n] != slave.rx[:n]:
-                    return None
-                wkc += 2
-            if inp is not None:
-                tx = slave.tx
+                    return False
+            if inp is not None and slave.al_state >= AlState.SAFEOP:
                 if not inp.aligned or inp.bit_len & 7:
-                    return None
-                start = image.outputs_bytes + (inp.logical_bit >> 3)
-                n = min(len(tx), inp.bit_len >> 3)
-                if view[start : start + n] != tx[:n]:
-                    return None
-                wkc += 1
-        return wkc
+                    return False
+                start = base + (inp.logical_bit >> 3)
+                n = min(len(slave.tx), inp.bit_len >> 3)
+                if view[start : start + n] != slave.tx[:n]:
+                    return False
+        return True
 
     def emergencies(self) -> list[tuple[int, object]]:
         out = []
@@ -297,3 +291,6 @@ class EmulatedBackend(Backend):
         self._client(position).download(
             index, subindex, bytes(data), complete_access=complete_access
         )
+
+
+_IO_STEP = IoSlave.step

@@ -6,7 +6,7 @@ entries 2, 3, 8, 15-18, 25, 60, 69-71, 81-83, 91, 98, 116, 121, 122.
 
 from __future__ import annotations
 
-from ctypes import byref, c_double, c_long, c_short, c_ubyte, create_string_buffer
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong, create_string_buffer
 from pathlib import Path
 
 import numpy as np
@@ -97,6 +97,28 @@ def test_servo_and_moving_bits():
     many = (c_long * 2)()
     assert gt.GT_GetSts(1, many, 2) == 0 and list(many) == [SERVO, 0]
     assert gt.GT_GetSts(1, many, 3) == 7  # there is no axis 3
+
+
+def test_profile_status_word_is_bit_10_while_the_trap_move_runs():
+    """GT_GetPrfSts (GTN-era header): the planner's own bit 10, nothing of the axis's."""
+    up()
+    on()
+    word = (c_long * 5)()
+    clock = c_ulong()
+    # the field's call: 5 profiles from profile 1, whatever the bus holds (2 drives here)
+    assert gt.GTN_GetPrfSts(1, 1, word, 5) == 0, gt.GTE_GetLastError()
+    assert list(word) == [0] * 5  # servo on (bit 9) is the axis's, not the profile's
+    assert trap(1, 2000, 10) == 0
+    gt.GTE_Wait(1)
+    assert gt.GT_GetPrfSts(1, word, 5, byref(clock)) == 0
+    assert list(word) == [MOVING, 0, 0, 0, 0] and clock.value > 0
+    assert sts() == SERVO | MOVING  # the axis's word has both
+    wait_still()
+    one = c_long(-1)
+    assert gt.GT_GetPrfSts(1, byref(one)) == 0 and one.value == 0
+    assert gt.GTN_GetPrfSts(1, 1, word, 5) == 0 and list(word) == [0] * 5
+    assert gt.GT_GetPrfSts(12, word, 2) == 7  # past the controller's profiles
+    assert gt.GT_GetPrfSts(0, byref(one)) == 7
 
 
 # --- soft limits (example 9-1) -------------------------------------------------------------------

@@ -87,6 +87,26 @@ def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, controller, t
     assert v["close"] == "0"
 
 
+@needs_cxx
+def test_a_gvn_era_header_with_its_own_linux_branch_compiles_and_runs(libgts, controller, tmp_path):
+    """The newest header shape (GT_API without __stdcall under __linux__, __int64 from
+    int64_t, GP_CORE): GTN_GetPrfSts reads 5 profiles, a declared-only call answers 8."""
+    exe = _compile(
+        C_DIR / "vendor_gvn_client.cpp",
+        tmp_path / "vendor_gvn",
+        "g++ -Wall -Wextra",
+        "--cflags --libs",
+        extra=f"-I{C_DIR / 'vendor_gvn'}",
+    )
+    r, v = run_client(exe, env=native_env(GTECAT_CONTROLLER=controller), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert (v["prfsts"], v["prfsts_any"], v["gt_prfsts"], v["gt_prfsts_value"]) == ("0",) * 4
+    assert (v["prfmode"], v["mode1"]) == ("0", "1")
+    assert v["multilines"] == str(CMD_DECLARED)
+    assert "GTN_RN_SetEncMultiLinesEx is declared but not emulated" in v["multilines_reason"]
+    assert v["limitinfo"] == str(CMD_DECLARED)
+
+
 def test_declared_only_gives_the_same_answer_in_python():
     assert gt.GT_SetHSIOOpt(1) == CMD_DECLARED
     assert gt.GTE_GetLastError() == (

@@ -1,0 +1,159 @@
+"""Replays of a 12-axis session: exact, at the first divergence exit 1, and the controller's
+many-cycles-at-once path (and the bank's Trap tables taken up again) gives the same bits as
+one cycle at a time.
+
+The session is tools/bench_replay.py's (homing, jogs, Trap moves, status polling, IO); a few
+virtual seconds here, the whole minute under GTECAT_LONG=1.
+"""
+
+from __future__ import annotations
+
+import json
+from ctypes import byref, c_short, c_ubyte
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from gtecat.cli.main import main
+from gtecat.controller.bank import AxisBank
+from gtecat.controller.core import Controller
+from gtecat.faults.record import Recorder, replay
+from tests.conftest import EXAMPLES, LONG
+from tools import bench_replay
+
+SECONDS = 60.0 if LONG else 3.0
+
+
+@pytest.fixture(autouse=True)
+def _closed():
+    gt.GT_Close()
+    yield
+    gt.GT_Close()
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The session recorded with every cycle run one by one and every Trap table computed
+    afresh when an axis comes back to the bank (the reference)."""
+    folder = tmp_path_factory.mktemp("replay")
+    machine = folder / "machine.toml"
+    machine.write_text(bench_replay.MACHINE)
+    out = folder / "session.gtrec"
+    mp = pytest.MonkeyPatch()
+    mp.setattr(Controller, "run_cycles", lambda self, n: 0)
+    mp.setattr(AxisBank, "_keep_table", lambda self, r, pl: None)
+    rec = Recorder(out).start()
+    try:
+        bench_replay.session(gt, SECONDS, 10, str(machine))
+    finally:
+        rec.stop()
+        mp.undo()
+        gt.GT_Close()
+    rec.write()
+    return out
+
+
+def _calls(path: Path) -> list[dict]:
+    return [json.loads(x) for x in path.read_text().splitlines()[1:] if '"c":' in x]
+
+
+def test_the_session_replays_exactly_many_cycles_at_once(
+    recorded: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = _calls(recorded)
+    names = {e["c"] for e in calls}
+    assert {"GT_StartEcatHoming", "GT_PrfJog", "GT_PrfTrap", "GT_EcatIOWriteOutput"} <= names
+    assert sum(e["c"] == "GT_GetSts" for e in calls) >= 12 * 100 * SECONDS * 0.9
+    batches = []
+    run = Controller.run_cycles
+
+    def counting(self: Controller, n: int) -> int:
+        done = run(self, n)
+        batches.append(done)
+        return done
+
+    monkeypatch.setattr(Controller, "run_cycles", counting)
+    n, div = replay(recorded)
+    assert div is None, str(div)
+    assert n == len(calls)
+    # most cycles ran in batches (the compiled kernel), not one by one
+    assert sum(batches) > 0.8 * SECONDS * 1000
+
+
+def test_a_tampered_recording_reports_its_first_divergence(
+    recorded: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = recorded.read_text().splitlines()
+    number, first, second = 0, None, None
+    for i, line in enumerate(lines[1:], 1):
+        if '"c":' not in line:
+            continue
+        number += 1
+        e = json.loads(line)
+        # a status the call left as it was (no "o"): compared all the same
+        if first is None and number > 400 and e["c"] == "GT_GetSts" and "o" not in e:
+            e["a"][1]["ref"]["v"] ^= 0x400
+            first = (number, e["a"][1]["ref"]["v"])
+            lines[i] = json.dumps(e)
+        elif first is not None and e["c"] == "GT_GetPrfPos":  # a later one: not reported
+            e["r"] = 7
+            lines[i] = json.dumps(e)
+            second = number
+            break
+    assert first is not None and second is not None
+    bad = tmp_path / "tampered.gtrec"
+    bad.write_text("\n".join(lines) + "\n")
+    assert main(["replay", str(bad)]) == 1
+    err = capsys.readouterr().err
+    n, value = first
+    assert f"diverged at call {n} GT_GetSts: argument 2 recorded {value}, replay gives" in err
+    assert f"call {second} " not in err
+    assert main(["replay", str(recorded)]) == 0
+    assert "calls match" in capsys.readouterr().out
+
+
+def test_an_input_set_between_cycles_reaches_the_image() -> None:
+    """The bus runs many cycles at once only while every IO slave is at its fixed point: an
+    input the field changes (not through a GT call) is in the next cycle's image."""
+    assert gt.GT_Open(eni=str(EXAMPLES / "twelve_axes.eni"), clock="lockstep", log="") == 0
+    ctl = gt.GTE_Controller()
+    gt.GT_InitEcatComm()
+    st = c_short()
+    for _ in range(200):
+        ctl.clock.advance(1)
+        if gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1:
+            break
+    gt.GT_StartEcatComm()
+    for a in range(1, 13):
+        gt.GT_AxisOn(a)
+    ctl.clock.advance(50)
+    done = ctl.run_cycles(5)
+    assert done == 5, "every axis in the bank and the bus steady: the batch runs"
+    dio = ctl.backend.slaves[6]
+    dio.set_input_bit(3, True)
+    assert not ctl.master.steady()
+    ctl.clock.advance(2)
+    buf = (c_ubyte * 2)()
+    assert gt.GT_EcatIOReadInput(6, 2, 2, buf) == 0
+    assert buf[0] & 0x08
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        '{"t":1,"c":"GT_Open","a":[],"r":0}\n{"t":2,"c":"GT_Clo\n',  # cut short
+        '{"t":1,"c":"GT_Open","a":[],"r":0}, {"t":2}\n',  # two entries on a line
+        "5\n",  # not an entry
+        '{"t":1,"c":"GT_Open","r":0}\n',  # no arguments
+        '{"t":1,"c":"GT_GetSts","a":[1,{"ref":{"c":"c_long","v":"x"}}],"r":0}\n',
+    ],
+)
+def test_a_damaged_recording_is_a_clear_error(
+    body: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "damaged.gtrec"
+    bad.write_text('{"gtecat_recording": 1}\n' + body)
+    assert main(["replay", str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "damaged recording" in err and "Traceback" not in err
