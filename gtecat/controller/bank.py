@@ -786,6 +786,13 @@ class AxisBank:
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
         tl = self.table
+        # the last sample taken moves to the row's spare slot first (as the kernel's
+        # refill_row does): the new samples overwrite the table it sat in, and a release in
+        # this same cycle (a row hitting a soft limit) reads it from there
+        last, spare = int(self.t_idx[r]), int(self.base[r]) + tl
+        for t in (self.t_p, self.t_v, self.t_a):
+            t.flat[spare] = t.flat[last]
+        self.t_idx[r] = spare
         _Bypass.on = True
         try:
             k0 = int(self.k0[r] + self.taken[r])

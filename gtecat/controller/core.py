@@ -44,7 +44,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from gtecat.drives.machine import MachineDescription, load_machine
 from gtecat.eni.errors import EniError
@@ -235,6 +235,7 @@ class Controller:
         if not self._cycle_fixed and config.cycle_time_ns:
             self.clock.cycle_ns = int(config.cycle_time_ns)
         backend = self._make_backend()
+        kept = _machine_positions(self.backend)
         if self.master is not None:
             self.terminate_ecat()
         master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
@@ -254,6 +255,7 @@ class Controller:
         if _relatch_link_alarms not in self.on_reset:
             self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
         master.open()
+        _put_back(backend, kept)
         if self.options.bank != "off" and self.options.backend == "emulated":
             self.bank = AxisBank(self, self.options.bank)
         for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
@@ -463,3 +465,29 @@ def _relatch_link_alarms(ctl: Controller) -> None:
                 ax.motion.latched |= AxisStatus.ALARM
         else:
             ax.link_alarm = ""
+
+
+def _machine_positions(backend: Any) -> dict[tuple[int, Any, int], float]:
+    """Where the emulated machine's mechanics stand: (slave position, identity, channel) ->
+    machine position.  Read before GT_InitEcatComm builds the bus again."""
+    out: dict[tuple[int, Any, int], float] = {}
+    for slave in getattr(backend, "slaves", None) or ():
+        for k, ch in enumerate(getattr(slave, "channels", None) or ()):
+            out[(slave.position, getattr(slave, "identity", None), k)] = ch.machine_position
+    return out
+
+
+def _put_back(backend: Any, kept: dict[tuple[int, Any, int], float]) -> None:
+    """GT_InitEcatComm again (an application restarting, a second client's bring-up) finds
+    the load where the last bus left it: re-initialising the bus does not move a real
+    machine.  Only the power-on of a new controller (GT_Open) starts from the machine
+    description's ``position``.  The drives themselves start as after power-on (their
+    state machine, their object dictionary), as the slaves of a bus walked from INIT do.
+    A slave whose identity changed (another bus) starts from its description."""
+    if not kept:
+        return
+    for slave in getattr(backend, "slaves", None) or ():
+        for k, ch in enumerate(getattr(slave, "channels", None) or ()):
+            pos = kept.get((slave.position, getattr(slave, "identity", None), k))
+            if pos is not None:
+                ch.machine_position = pos

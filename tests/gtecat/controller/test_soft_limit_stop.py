@@ -274,3 +274,18 @@ def test_gt_sts_shows_the_limit_in_the_cycle_the_plan_passes_it(gt_lockstep, sig
     assert trace[first_past][0] == 20001.25 == trace[-1][0]  # 20000 + 50²/2000, at rest
     assert gt.GT_ClrSts(1) == 0
     assert gt.GT_GetSts(1, byref(sts)) == 0 and sts.value & flag  # still past: stays
+
+
+@pytest.mark.parametrize("limit", [544, 576, 2048])
+def test_both_axes_cross_where_the_bank_refills_their_trap_tables(ctl, limit):
+    """The crossing cycle of both axes is one where the axis bank refills their Trap tables
+    (every 32 samples compiled, 2048 in numpy): the first row's release must still find
+    the second's last sample (it moves to the table's spare slot before the refill)."""
+    up, down = fresh(ctl, 1, 20.0), fresh(ctl, 2, 20.0)
+    up.safety.set_soft_limits(limit, SOFT_NEGATIVE_OFF)
+    down.safety.set_soft_limits(SOFT_POSITIVE_OFF, -limit)
+    start_trap(up, FAR, 1.0, 1.0)
+    start_trap(down, -FAR, 1.0, 1.0)
+    log = run_to_rest(ctl, [up, down])
+    check(log[1], +1.0, limit, 1.0, 1.0, 20.0, 1.0)
+    check(log[2], -1.0, limit, 1.0, 1.0, 20.0, 1.0)

@@ -276,3 +276,30 @@ def test_emulator_only_helpers_refuse_other_backends_with_a_reason():
         assert gt.GTE_UnplugSlave(1) == 1 and "emulated" in gt.GTE_GetLastError()
     finally:
         ctl.backend = real
+
+
+def test_init_again_finds_the_load_where_the_last_bus_left_it():
+    """Example 5-5's sequence run twice in one controller (an application restarting on a
+    running controller, or a second client's bring-up): the second GT_InitEcatComm does not
+    move the machine back to its power-on position; the encoder reads where the axis went."""
+    from ctypes import c_double
+
+    bring_up()
+    assert gt.GT_ClrSts(1, 1) == 0 and gt.GT_AxisOn(1) == 0
+    assert gt.GT_PrfTrap(1) == 0
+    prm = gt.TTrapPrm(acc=1, dec=1, velStart=0, smoothTime=0)
+    assert gt.GT_SetTrapPrm(1, byref(prm)) == 0
+    assert gt.GT_SetPos(1, 30000) == 0 and gt.GT_SetVel(1, 50) == 0
+    assert gt.GT_Update(1) == 0
+    assert gt.GTE_Wait(1500) == 0
+    enc = c_double()
+    assert gt.GT_GetEncPos(1, byref(enc)) == 0 and abs(enc.value - 30000) < 2, enc.value
+    assert gt.GT_TerminateEcatComm() == 0
+    assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+    ready = c_short()
+    for _ in range(1000):
+        if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+            break
+        assert gt.GTE_Wait(1) == 0
+    assert ready.value == 1
+    assert gt.GT_GetEncPos(1, byref(enc)) == 0 and abs(enc.value - 30000) < 2, enc.value
