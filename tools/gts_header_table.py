@@ -33,7 +33,12 @@ this mode's own ``vendor_gtn_*`` files) lacks, and writes it as ``vendor_gtn_<to
 groups and ``vendor_gtn_types.py`` (structures and constants the table lacks): run it after
 the vendor groups, naming the newer headers and wrappers; a function the table has (itself,
 or as the ``GTN_x`` twin of a ``GT_x``) is not repeated, whatever parameters the newer header
-gives it (the table's line is the one the field was checked against).
+gives it (the table's line is the one the field was checked against; a header that declares
+it otherwise is named on stderr).  ``--add`` keeps the ``vendor_gtn_*`` lines an earlier run
+wrote (they count as the table) and adds what they lack, so a newer header can be read on its
+own; a ``(...)`` line it gives a prototype for gives way.
+
+    python tools/gts_header_table.py --only-missing --add --out gtecat/gt/groups newer.h
 """
 
 from __future__ import annotations
@@ -417,16 +422,23 @@ def _module(path: Path):
 _HAND_STRUCT = re.compile(r"^class (\w+)\((?:ctypes\.)?(?:Structure|Union)\)", re.M)
 
 
-def table_has(folder: Path) -> tuple[set[str], set[str], set[str], set[str]]:
-    """What the table's group files in ``folder`` declare, but ``vendor_gtn_*``: function
-    names (with the ``GTN_x`` twins), names declared ``(...)`` only, structure/enum names and
-    constants."""
+#: the parameter types of what the table declares (``table_has`` fills it): a header that
+#: declares one of them otherwise is reported, and the table's line is kept
+TABLE_PARAMS: dict[str, str] = {}
+
+
+def table_has(
+    folder: Path, own: bool = False
+) -> tuple[set[str], set[str], set[str], set[str]]:
+    """What the table's group files in ``folder`` declare, but ``vendor_gtn_*`` (unless
+    ``own``): function names (with the ``GTN_x`` twins), names declared ``(...)`` only,
+    structure/enum names and constants."""
     names: set[str] = set()
     unknown: set[str] = set()
     structs: set[str] = set()
     consts: set[str] = set()
     for path in sorted(folder.glob("*.py")):
-        if path.name.startswith(("_", "vendor_gtn_")):
+        if path.name.startswith("_") or (path.name.startswith("vendor_gtn_") and not own):
             continue
         mod = _module(path)
         for m in re.finditer(r"^short\s+(\w+)\s*\((.*)\)\s*;", mod.PROTOTYPES, re.M):
@@ -435,6 +447,9 @@ def table_has(folder: Path) -> tuple[set[str], set[str], set[str], set[str]]:
                 unknown.add(name)
                 continue
             names.add(name)
+            if args not in ("", "void"):
+                ps = [p.strip() for p in re.sub(r"/\*.*?\*/", "", args).split(",")]
+                TABLE_PARAMS.setdefault(name, _plain(ps))
             if name.startswith("GT_") and not re.match(r"^short\s+core\b", args):
                 names.add("GTN_" + name[3:])
         text = typedefs.strip_comments(getattr(mod, "STRUCTS", ""))
@@ -450,12 +465,19 @@ C_MACROS = frozenset({"NULL", "TRUE", "FALSE", "true", "false", "EOF", "INFINITE
 
 
 def only_missing(
-    folder: Path, functions: dict[str, list[str]], tds: list, consts: dict
+    folder: Path, functions: dict[str, list[str]], tds: list, consts: dict, own: bool = False
 ) -> tuple[dict[str, list[str]], list, dict, set[str]]:
-    """Keep what the table lacks; also the ``(...)`` names that now have a prototype."""
-    names, unknown, structs, have_consts = table_has(folder)
+    """Keep what the table lacks (with ``own``, the ``vendor_gtn_*`` files count as the
+    table); also the ``(...)`` names that now have a prototype."""
+    names, unknown, structs, have_consts = table_has(folder, own)
     new: dict[str, list[str]] = {}
     for name, ps in functions.items():
+        if name in TABLE_PARAMS and _plain(ps) != TABLE_PARAMS[name]:
+            print(
+                f"{name}: the table's ({TABLE_PARAMS[name]}) kept; this header declares"
+                f" ({_plain(ps)})",
+                file=sys.stderr,
+            )
         if name in names or not re.match(r"^GTN?_\w+$", name):
             continue
         if name.startswith("GT_") and "GTN_" + name[3:] in names:
@@ -493,13 +515,55 @@ def only_missing(
     return new, kept_tds, kept_consts, unknown & (set(new) | gives)
 
 
+def _name(line: str) -> str:
+    return re.match(r"short\s+(\w+)", line)[1]  # type: ignore[index]
+
+
+def _earlier(folder: Path, resolved: set[str]) -> tuple[dict[str, list[str]], list[str], dict]:
+    """The lines the ``vendor_gtn_*`` files of an earlier run hold (for ``--add``), but the
+    ``(...)`` lines of names that now have a prototype."""
+    by_topic: dict[str, list[str]] = {}
+    structs: list[str] = []
+    consts: dict[str, str] = {}
+    for key, _, _ in TOPICS:
+        path = folder / f"vendor_gtn_{key}.py"
+        if path.exists():
+            body = _module(path).PROTOTYPES
+            by_topic[key] = [
+                ln
+                for ln in body.strip().splitlines()
+                if ln.strip() and not (ln.endswith("(...);") and _name(ln) in resolved)
+            ]
+    path = folder / "vendor_gtn_types.py"
+    if path.exists():
+        mod = _module(path)
+        structs = [ln for ln in mod.STRUCTS.strip().splitlines() if ln.strip()]
+        for m in re.finditer(r"^#define\s+(\w+)\s+(.*)$", mod.CONSTANTS, re.M):
+            consts[m[1]] = m[2]
+    return by_topic, structs, consts
+
+
+def _sort_key(line: str) -> tuple[str, str]:
+    name = _name(line)
+    return (re.sub(r"^GTN?_", "", name), name)
+
+
 def write_missing(
     folder: Path,
     by_topic: dict[str, list[str]],
     structs: list[str],
     consts: dict,
     resolved: set[str],
+    add: bool = False,
 ) -> None:
+    if add:  # an earlier run's lines stay; this run's join them
+        old_topic, old_structs, old_consts = _earlier(folder, resolved)
+        by_topic = {
+            k: sorted(old_topic.get(k, []) + by_topic.get(k, []), key=_sort_key)
+            for k in set(old_topic) | set(by_topic)
+        }
+        structs = old_structs + structs
+        consts = {**old_consts, **consts}
     for old in folder.glob("vendor_gtn_*.py"):
         old.unlink()
     for key, title, _ in TOPICS:
@@ -548,13 +612,23 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="keep what the group files of --out lack; write vendor_gtn_*.py",
     )
+    ap.add_argument(
+        "--add",
+        action="store_true",
+        help="with --only-missing: keep the vendor_gtn_*.py lines an earlier run wrote and "
+        "add what they lack too (a (...) line gives way to a prototype)",
+    )
     args = ap.parse_args(argv)
     functions, tds, consts = extract(args.headers)
     resolved: set[str] = set()
     if args.only_missing:
         if not args.out:
             ap.error("--only-missing needs --out (the folder of the group files)")
-        functions, tds, consts, resolved = only_missing(args.out, functions, tds, consts)
+        functions, tds, consts, resolved = only_missing(
+            args.out, functions, tds, consts, own=args.add
+        )
+    elif args.add:
+        ap.error("--add needs --only-missing")
     by_topic = lines(functions)
     if args.dll_exports:
         have = set(functions)
@@ -564,7 +638,7 @@ def main(argv: list[str] | None = None) -> int:
             if n.startswith("GT_") and not (ps and re.search(r"\bcore$", ps[0]))
         }
         if args.only_missing:  # and what the table declares, with or without parameters
-            table_names, table_unknown, _, _ = table_has(args.out)
+            table_names, table_unknown, _, _ = table_has(args.out, args.add)
             have |= table_names | (table_unknown - resolved)
         names = sorted(set(args.dll_exports.read_text().split()) - have)
         by_topic["exports"] = [f"short {n}(...);" for n in names if re.match(r"^GTN?_\w+$", n)]
@@ -580,7 +654,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  {prefix}{key:<14} {len(by_topic.get(key, [])):5d}  {title}")
     if args.only_missing:
         print(f"  {len(resolved)} names declared (...) before now have a prototype")
-        write_missing(args.out, by_topic, structs, consts, resolved)
+        write_missing(args.out, by_topic, structs, consts, resolved, args.add)
     elif args.out:
         for key, title, _ in TOPICS:
             if by_topic.get(key):

@@ -12,13 +12,18 @@ PROTOTYPES = r"""
 short GT_GetCardInfo(short *pCardNum, short *pCardType);
 short GT_GetConfig(short mdl, TExtMdlCfgInfo *pExtMdlCfgInfo);
 short GT_GetDriverVersion(unsigned short *mainVer, unsigned short *slaveVer);
+short GTN_GetGPIOConfigEx(short core, short station, short index, TGPIOConfig *pGPIOConfig, short count);
 short GT_GetJoystickMapAxis(short joystickIndex, short *pAxis);
+short GTN_GetMotionSmoothFpgaResCount(short core, short *pCount);
+short GTN_GetMotionTimeRestrict(short core, short restrictIndex, TMotionTimeRestrict *pRestrict);
 short GT_JoystickReset(short joystickIndex);
 short GTN_LoadReadHsConfig(short core, char *pFile /*str*/);
 short GT_ResetPciCommandFlag();
 short GT_SaveConfigToFile(char *pFile);
 short GT_SetConfig(short mdl, TExtMdlCfgInfo *pExtMdlCfgInfo);
+short GTN_SetGPIOConfigEx(short core, short station, short index, TGPIOConfig *pGPIOConfig, short count);
 short GT_SetJoystickMapAxis(short joystickIndex, short *axis);
+short GTN_SetMotionSmoothFpgaResCount(short core, short count);
 short GTN_SetMotionTimeRestrict(short core, short restrictIndex, TMotionTimeRestrict *pRestrict /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_SetResetMode(short core, short type, TResetModePrmUnion *pResetPrm);
 """

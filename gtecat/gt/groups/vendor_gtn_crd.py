@@ -9,14 +9,51 @@ TITLE = "coordinated motion (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_CrdBlendOff(short core, short crd);
+short GTN_CrdBlendOn(short core, short crd);
 short GT_CrdDisableVariableCircle(short crd, short fifo);
 short GT_CrdEnableVariableCircle(short crd, short fifo);
 short GT_CrdStatusEx(short crd, TCrdStatusEx *pCrdStatus, short fifo);
+short GTN_GetCrdAccTime(short core, short crd, short *pTime, short *pK);
+short GTN_GetCrdBlend(short core, short crd, TCrdBlend *pCrdBlend);
+short GTN_GetCrdContourErrorControl(short core, short crd, short *pEnable, double *pPercent);
+short GTN_GetCrdJerkEx(short core, short crd, double *pJerkMax, double *pAcc);
+short GTN_GetCrdJerkMode(short core, short crd, double *pJerkMax, short *pMode);
 short GT_GetCrdJerkTime(short crd, double *pJerkTime, double *pCoef);
+short GTN_GetCrdPrintLogEnable(short core, short crd, short *pEnable);
+short GTN_GetCrdSegSyncInfo(short core, short crd, short fifo, TCrdSegSyncInfo *pSegInfo);
+short GTN_GetCrdSegmentLength(short core, short crd, TCrdSegmentLength *pSegmentLength, short fifo);
 short GT_GetCrdSmoothTime(short crd, short *pSmoothType, double *pPrm /*inout*/);
+short GTN_GetGroupPathMode(short core, short group, TGroupPathPrm *pPrm);
+short GTN_GetPathShaping(short core, short axis, short *pEnable, double *pT1, double *pT2);
 short GTN_GetScanCrdPosPro(short core, short scanCrd, double *pPos);
+short GTN_HelixXYCMultiZ(short core, short crd, long *pPos, double xCenter, double yCenter, short circleDir, double synVel, double synAcc, double velEnd, long segNum, short override2, short fifo);
+short GTN_HelixXYRMultiZ(short core, short crd, long *pPos, double radius, short circleDir, double synVel, double synAcc, double velEnd, long segNum, short override2, short fifo);
+short GTN_HelixYZCMultiX(short core, short crd, long *pPos, double yCenter, double zCenter, short circleDir, double synVel, double synAcc, double velEnd, long segNum, short override2, short fifo);
+short GTN_HelixYZRMultiX(short core, short crd, long *pPos, double radius, short circleDir, double synVel, double synAcc, double velEnd, long segNum, short override2, short fifo);
+short GTN_HelixZXCMultiY(short core, short crd, long *pPos, double zCenter, double xCenter, short circleDir, double synVel, double synAcc, double velEnd, long segNum, short override2, short fifo);
+short GTN_HelixZXRMultiY(short core, short crd, long *pPos, double radius, short circleDir, double synVel, double synAcc, double velEnd, long segNum, short override2, short fifo);
+short GTN_LnXYZAC(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, double velEnd, short fifo);
+short GTN_LnXYZACG0(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, short fifo);
+short GTN_LnXYZACG0Override2(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, short fifo);
+short GTN_LnXYZACG0Override2WN(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, long segNum, short fifo);
+short GTN_LnXYZACG0WN(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, long segNum, short fifo);
+short GTN_LnXYZACOverride2(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, double velEnd, short fifo);
+short GTN_LnXYZACOverride2WN(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, double velEnd, long segNum, short fifo);
+short GTN_LnXYZACWN(short core, short crd, long *pPos, short posMask, double synVel, double synAcc, double velEnd, long segNum, short fifo);
+short GTN_SetCrdAccTime(short core, short crd, short time, short k);
+short GTN_SetCrdBlend(short core, short crd, TCrdBlend *pCrdBlend);
 short GTN_SetCrdBufCommandDelay(short core, short crd, short fifo, short enable);
+short GTN_SetCrdContourErrorControl(short core, short crd, short enable, double percent);
+short GTN_SetCrdJerkEx(short core, short crd, double jerkMax, double acc);
+short GTN_SetCrdJerkMode(short core, short crd, double jerkMax, short mode);
 short GT_SetCrdJerkTime(short crd, double jerkTime, double coef);
+short GTN_SetCrdPrintLogEnable(short core, short crd, short enable);
 short GT_SetCrdSmoothTime(short crd, short smoothType, double *pPrm /*inout*/);
 short GTN_SetCrdUserDataEndVelLa(short core, short crd, short crdUserDataType, double endVel);
+short GTN_SetGroupPathMode(short core, short group, TGroupPathPrm *pPrm, TListInfo *pListInfo=NULL);
+short GTN_SetGroupPathRefAxis(short core, short group, TGroupPathRefAxis *pPathRefAxis, TListInfo *pListInfo=NULL);
+short GTN_SetPathOptimizePrmLa(short core, short crd, short enable, short mode, void *pPrm);
+short GTN_SetPathShaping(short core, short axis, short enable, double t1, double t2);
+short GTN_SetPathShapingPara(short core, short axis, double coef, short level);
 """

@@ -10,14 +10,34 @@ DECLARED_ONLY = True
 
 PROTOTYPES = r"""
 short GTN_ClearAlarm(short core, short axis, short count, unsigned short delayTime);
+short GTN_DisableFriction(short core, short axis);
+short GTN_GetAoLinkPrm(short core, short aoType, short aoIndex, short *pLink, TAoLinkPrm *pAolinkPrm);
+short GTN_GetAuMtrLmt(short core, short dac, short *pLimit);
 short GTN_GetAxisRotaryDirectionSelectMode(short core, short axis, short *pMode);
+short GTN_GetBufIoHoldValue(short core, short crd, short doType, unsigned short *pDoMask, unsigned short *pDoValue);
 short GT_GetBufWaitDiStatus(short crd, short *pDiType, short *pDiIndex, short *pLevel, short *pContinueTime, long *pOverTime, short *pFlagMode, long *pSegNum, short *pEnable, long *pCount, short fifo);
 short GTN_GetBufWaitDiStatusEx(short core, short crd, short fifo, TBufWaitDiStatusEx *pStatus);
+short GTN_GetCbtDiscardPieceData(short core, short cbtIndex, short count, TCbtPieceData *pCbtPieceData, short *pActualCount);
 short GT_GetDisplayDip(short *pMode);
+short GTN_GetEHMIDi(short core, unsigned char *data, unsigned short offset, unsigned short count);
+short GTN_GetEHMIDo(short core, unsigned char *data, unsigned short offset, unsigned short count);
+short GTN_GetGtmDiBit(short core, short station, short slot, short diIndex, short *pValue, short count=1);
+short GTN_GetGtmDoBit(short core, short station, short slot, short doIndex, short *pValue, short count=1);
 short GTN_GetLimit(short core, short axis, short type, void *pPrm);
 short GTN_GetLimitInfo(short core, short axis, TLimitInfo *pInfo);
+short GTN_ReadDigitalInput(short core, short diType, short diIndex, short *pDi, short diCount=1);
+short GTN_ReadDigitalOutput(short core, short doType, short doIndex, short *pValue, short doCount=1);
+short GTN_SetAoLinkPrm(short core, short aoType, short aoIndex, short link, TAoLinkPrm *pAolinkPrm, TListInfo *pListInfo=NULL);
+short GTN_SetAuMtrLmt(short core, short dac, short limit);
 short GTN_SetAxisRotaryDirectionSelectMode(short core, short axis, short mode);
+short GTN_SetBufIoHoldValue(short core, short crd, short doType, unsigned short doMask, unsigned short doValue);
 short GT_SetDisplayDip(short mode);
+short GTN_SetDoBitReverseEx(short core, short doType, short doIndex, short value, TDoBit *pDoBit);
+short GTN_SetDoMultiBit(short core, short doType, long *pValue, long *pMask, short count=1);
+short GTN_SetEHMIDo(short core, unsigned char *data, unsigned short offset, unsigned short count);
+short GTN_SetGtmDoBit(short core, short station, short slot, short doIndex, short *pValue, short count=1);
 short GTN_SetLimit(short core, short axis, short type, void *pPrm);
+short GTN_WaitDigitalInput(short core, TDigitalInput *pDi, TListInfo *pListInfo);
+short GTN_WriteDigitalOutput(short core, TDigitalOutput *pDo, TListInfo *pListInfo=NULL);
 short GTN_WriteDigitalOutputBit(short core, TDigitalOutputBit *pDoBit /*inout*/, TListInfo *pListInfo /*inout*/);
 """

@@ -9,13 +9,21 @@ TITLE = "programs, variables, watch and scan (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_ClearScanExecuteTime(short core, short scan=1);
 short GTN_ClearScanExecuteTimePro(short core, short scanCrd);
 short GTN_EncryptionFunConfig(short core, short slotIndex, unsigned char *pOldKey /*inout*/, unsigned char *pNewKey /*inout*/, unsigned char *pUserData /*inout*/, short *pSts, short *pConfigured);
 short GT_GetBufWaitLongVarStatus(short crd, short *pIndex, long *pValue, short *pFlagMode, long *pSegNum, short *pEnable, short *pStatus, short fifo);
 short GTN_GetEventStatus(short core, short index, TEventStatus *pStatus);
 short GT_GetFlagVar(short index, short *pMode, short *pValue);
+short GTN_GetMcVarEx(short core, const TWatchVar *pVar, double *pValue, short count);
+short GTN_GetScanExecuteTime(short core, short scan, double *pExecuteTime);
 short GTN_GetScanExecuteTimePro(short core, short scanCrd, double *pExecuteTime);
+short GTN_GetScanPosSuperposeParameter(short core, short scan, TScanPosSuperposeParameter *pParam);
 short GTN_GetScanStatusPro(short core, short scanCrd, TScanStatusPro *pPrm);
+short GTN_GetScanWorkMode(short core, short scan, short *pMode);
+short GTN_GetTaskSaveMcVarResult(short core, short taskIndex, TWatchVar *pVar, double *pValue, short count, short *pReadCount);
+short GTN_GetTaskSaveMcVarResultEx(short core, short index, TWatchVar *pVar, double *pValue, short count, short *pReadCount);
+short GTN_GetVarCondition(short core, short varIndex, TWatchCondition *pWatchCondition, short *pConditionCount, short *pOperation);
 short GTN_LoadVarCalculate(short core, TVarCalculate *pVarCalculate /*inout*/, short count, TListInfo *pListInfo /*inout*/);
 short GTN_ScanCircularPro(short core, short scanCrd, short motionMode, TScanCircularMotionPro *pPrm /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_ScanDisableInfiniteView(short core, short scanCrd, TScanDisableInfiniteView *pScanInfiniteView /*inout*/, TListInfo *pListInfo /*inout*/);
@@ -32,9 +40,17 @@ short GTN_ScanIvStop(short core, short scanCrd, short stopMode);
 short GTN_ScanLinearPro(short core, short scanCrd, short motionMode, TScanLinearMotionPro *pPrm /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_ScanLoadInfiniteViewFile(short core, short scanCrd, char *pFileName /*str*/);
 short GTN_ScanSendInfiniteViewData(short core, short scanCrd, double time, double *pTime, double *pMotionTime);
+short GTN_ScanSetDa(short core, short chn, short value, short scan=1);
+short GTN_ScanSynchOff(short core);
+short GTN_ScanSynchOn(short core);
 short GTN_ScanWobbleMotionCircularEnablePro(short core, short scanCrd, short enable, TScanWobbleMotionCircular *pWobbleMotionCircular /*inout*/, TListInfo *pListInfo /*inout*/);
+short GTN_SetEventWaitTime(short core, double waitTime);
 short GT_SetFlagVar(short index, short mode, short value);
+short GTN_SetMcVar(short core, const TWatchVar *pVar, double value, TListInfo *pListInfo);
+short GTN_SetMcVarEx(short core, const TWatchVar *pVar, double *pValue, short count, TListInfo *pListInfo);
 short GTN_SetScanDelayPrmPro(short core, short scanCrd, TScanDelayParameterPro *pPrm /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_SetScanMotionDelayPro(short core, short scanCrd, double delayTime, TListInfo *pListInfo /*inout*/);
+short GTN_SetScanSynchModePrm(short core, short masterScan, short count, short *synchScan, short synchSignalSource);
 short GTN_SetVarCondition(short core, TVarCondition *pVarCondition /*inout*/, short count, TListInfo *pListInfo /*inout*/);
+short GTN_SetVariableCalculate(short core, TVariableCalculatePrm *pPrm, short count, TListInfo *pListInfo=NULL);
 """

@@ -9,6 +9,7 @@ TITLE = "ring net, GSN and terminals (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_BufSetTerminalPermitEx(short core, short crd, short station, short dataType, short index, short permit, short fifo=0);
 short GTN_RN_ClearStationSafeModeStatus(short cardIndex, short stationPhyId);
 short GTN_RN_GeneralCommand(short core, short stationId, long cmdId, long prmSizeCount, void *pPrm, long resultSizeCount, void *pResult);
 short GTN_RN_GetTorqueLimit(short core, short axis, TTorqueLimit *pTorqueLimit);

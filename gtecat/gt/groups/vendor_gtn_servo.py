@@ -9,17 +9,23 @@ TITLE = "servo loop, pulse output and analog (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_GetAbsEncPosEx(short core, short encoder, short mode, __int64 *pValue);
 short GTN_GetAdcBias(short core, short adc, short *pBias);
 short GTN_GetAuAdcBias(short core, short auAdc, short *pBias);
 short GTN_GetAxisFilterArrivalBand(short core, short axis, double *pBand, long *pTime);
 short GT_GetAxisPressCompensateFixPidStatus(short axis, short *pFixPidSts, TAxisPressCompensateFixPid *pPressComp);
+short GTN_GetDacScale(short core, short dac, long *pScale);
+short GTN_GetEncPrm(short core, short encoder, long *pLineNum, short *pType);
 short GTN_GetEncoderMapRelation(short core, short masterEncType, short masterEncIndex, short *pMapEncType, short *pMapEncIndex);
 short GT_GetEncoderOutSelect(short *pMode);
+short GTN_GetEncoderSource(short core, short encoder, TEncoderSource *pEncoderSource);
 short GTN_GetFPGAEncoder(short core, long *pDataChn1, long *pDataChn2, long *pDataChn3, long *pDataChn4, long *pCount, long *pOverFlowFlag);
 short GTN_GetHsoPulsePrm(short core, short station, short hsoIndex, THsoPulsePrm *pPem, short hsoCount);
 short GTN_GetPressPid(short core, short pressControl, TPressPid *pPid);
+short GTN_GetScanPosSuperposeEncPos(short core, short scan, double *pXPos, double *pYPos);
 short GT_GetSecondOrderFilterPara(short control, short type, short index, TSecondOrderFilterPara *pFilterPrm);
 short GTN_GetServoPosLoopPid(short core, short axis, TServoPosLoopPid *pServoPosLoopPid);
+short GTN_GetSignalTimeFilter(short core, short type, short index, double *pFilterWidth);
 short GT_GetStepOutLevel(short axis, short type, short *pReverse);
 short GTN_InitFPGAEncoder(short core);
 short GTN_ReadAuAbsEncPos(short core, short encoder, double *pPos /*inout*/);
@@ -27,14 +33,18 @@ short GTN_SetAdcBias(short core, short adc, short bias);
 short GTN_SetAuAbsEncMultiTurnRange(short core, short encoder, double range);
 short GTN_SetAuAdcBias(short core, short auAdc, short bias);
 short GTN_SetAxisFilterArrivalBand(short core, short axis, double band, long time);
+short GTN_SetDacScale(short core, short dac, long scale);
+short GTN_SetEncPrm(short core, short encoder, long lineNum, short type);
 short GTN_SetEncoderMapRelation(short core, short masterEncType, short masterEncIndex, short mapEncType, short mapEncIndex);
 short GT_SetEncoderOutSelect(short mode);
+short GTN_SetEncoderSource(short core, short encoder, TEncoderSource *pEncoderSource);
 short GTN_SetFPGAEncoder(short core, short enable, long intervalTime, short reverseMask);
 short GTN_SetHsoPulsePrm(short core, short station, short hsoIndex, THsoPulsePrm *pPem /*inout*/, short hsoCount);
 short GTN_SetPressPid(short core, short pressControl, TPressPid *pPid /*inout*/);
 short GTN_SetPulseCloseWorkMode(short core, short axis, TPulseCloseWorkModePrm *pPulseModePrm);
 short GT_SetSecondOrderFilterPara(short control, short type, short index, TSecondOrderFilterPara *pFilterPrm /*inout*/);
 short GTN_SetServoPosLoopPid(short core, short axis, TServoPosLoopPid *pServoPosLoopPid /*inout*/);
+short GTN_SetSignalTimeFilter(short core, short type, short index, double filterWidth);
 short GT_SetStepOutLevel(short axis, short type, short reverse);
 short GT_StartAxisPressCompensateFixPid(short axis, TAxisPressCompensateFixPid *pPressComp /*inout*/);
 short GT_StepResponse(short control, short gain, double time);

@@ -128,6 +128,184 @@ typedef struct { long scale[3]; double motionAcc[3]; double motionDec[3]; double
 typedef struct { double xMotionVel[3]; double yMotionVel[3]; double zMotionVel[3]; } TJoystickMoitonVel;
 typedef struct { long thresholdValue[3]; long joystickMaxValue[3]; long joystickMedianValue[3]; long joystickMinValue[3]; } TJoystickCriticalValue;
 typedef struct { long baudRate; short byteSize; short parity; short stopBits; short reserve; } TSericalPortPrm;
+typedef struct { long position1; long position2; } TToolPosition;
+typedef struct { unsigned short masterIndex; short masterValueSource; short pad1; short pad2; long ratioNumerator; unsigned long ratioDenominator; double acceleration; double deceleration; double jerk; double pad3; } TGearInParameter;
+typedef struct { short state; unsigned short masterIndex; unsigned short masterValueSource; short pad1[3]; long ratioNumerator; unsigned long ratioDenominator; long slaveEven; unsigned long masterEven; double acceleration; double deceleration; double jerk; double pad2; } TGearInInfo;
+typedef struct { short fifoNum; short switchStatus; short segNum; short pad1; double masterPosDelta; double slavePosDelta; double virtualMasterError; double pad2; double pad3; } TFollowInfo;
+typedef struct { double accTime; double k; double reserve[18]; } TVelProfileModeSmooth;
+typedef struct { double value; double beginPercent; double endPercent; double reserve[17]; } TVelProfileModeJerk;
+typedef struct { short mode; short reserve1[7]; double reserve2[18]; } TVelProfileModeFollow;
+typedef union { TVelProfileModeSmooth smooth; TVelProfileModeJerk jerk; TVelProfileModeFollow follow; double data[20]; } TVelProfileModeParameter;
+typedef struct { short mode; short reserve[3]; TVelProfileModeParameter parameter; } TVelProfileMode;
+typedef struct { double distance; double vel; double velEnd; double acc; double dec; short direction; short overrideSelect; short reserve; short velProfileMode; TVelProfileModeParameter velProfile; } TMoveContinuousRelativePrm;
+typedef struct { short profile; short reserve[3]; short group; short cmdCoord; short oriMode; short configIndex; TMoveContinuousAbsolutePrm prm; } TTaskMoveContinuousAbsolute;
+typedef struct { short overrideSelect; short reserve1[3]; double vel; double acc; double dec; short reserve[44]; } TJogParameter;
+typedef union { TJogParameter jog; short reserve[60]; } TMoveJogPrmUnion;
+typedef struct { short mode; short reserve[3]; TMoveJogPrmUnion data; } TMoveJogPrm;
+typedef union { TMotionTimeRestrictDirect direct; TMotionTimeRestrictAttentionProfile attentionProfile; double data[32]; } TMotionTimeRestrictUnion;
+typedef struct { short profileCount; short profile[8]; short pad1[7]; double profilePos[8]; short mode; short pad2[3]; TMotionTimeRestrictUnion parameter; } TMotionTimeRestrict;
+typedef struct { short type; short index; short subIndex; short reserve[5]; } TProfileItem;
+typedef struct { double masterEven; double slaveEven; double slope; short slopeType; short dir; short startMode; short startPrmType; double startPrm[6]; double deltaSlaveEven; double deltaSlope; short deltaSlopeType; short deltaLoop; short reserve2[10]; } TGearParameter;
+typedef struct { double masterEven; double slaveEven; double masterFilterTime; double sampleTime; double stopWaitTime; double acceleration; double deceleration; double maxVel; short reserve[28]; } TMpgParameter;
+typedef struct { double masterEven; double slaveEven; short reserve[52]; } TFollowParameter;
+typedef struct { double pos; double masterLength; short reserve[52]; } TGearPosParameter;
+typedef union { TGearParameter gear; TMpgParameter mpg; TFollowParameter follow; TGearPosParameter gearPos; short reserve[60]; } TMoveSynchronizationUnion;
+typedef struct { short mode; short enable; short softDirCheck; short reserve; TMoveSynchronizationUnion prm; } TMoveSynchronizationPrm;
+typedef struct { short info1[8]; long info2[8]; double info3[8]; } TMoveSynchronizationInfo;
+typedef struct { short type; short pad1[3]; double masterPos; double slavePos; double slaveVelRatio; double slaveVelRatioMax; double slaveAccRatio; double slaveDecRatio; double percentAcc; double percentDec; double pad2[4]; } TCamTableTrapPoint;
+typedef struct { unsigned long camTableId; unsigned long pad1; unsigned short periodic; unsigned short masterAbsolute; unsigned short slaveAbsolute; unsigned short pad2; double masterPosBegin; double slavePosBegin; double slaveVelRatioBegin; TCamTableTrapPoint *pPoint; unsigned long pointCount; unsigned long pad3; } TCamTableTrap;
+typedef struct { unsigned short periodic; unsigned short masterAbsolute; unsigned short slaveAbsolute; unsigned short pad2; double masterPosBegin; double slavePosBegin; double slaveVelRatioBegin; short slavePosCalcMode; unsigned long camTableSpace; } TCamTableTrapPrm;
+typedef struct { unsigned short masterIndex; unsigned short masterValueSource; unsigned short slaveIndex; unsigned short slaveType; unsigned long camTableId; unsigned short pad1; unsigned short bufferMode; unsigned short bufferCommandType; unsigned short startMode; unsigned short masterModulo; unsigned short slaveModulo; double masterModuloBegin; double masterModuloLength; double slaveModuloBegin; double slaveModuloLength; double masterOffset; double slaveOffset; double masterScaling; double slaveScaling; double masterStartDistance; double masterSyncPosition; double velRatioMax; double accRatioMax; double decRatioMax; double pad2[8]; } TCamInParameter;
+typedef struct { unsigned short slaveIndex; unsigned short slaveType; unsigned short mode; unsigned short rampType; unsigned short pad1[3]; unsigned short segCount; double pos; double vel; double acc; double dec; double jerk; double velEnd; double pad2[8]; } TCamOutParameter;
+typedef struct { unsigned short execute; unsigned short inSync; unsigned short done; unsigned short command; unsigned long pad1; unsigned long loopCount; double masterPos; double masterVel; double masterAcc; double masterJerk; double slavePos; double slaveVel; double slaveAcc; double slaveJerk; double masterPosModulo; double slavePosModulo; double pad2[4]; } TCamStatus;
+typedef struct { short time; short aheadOfTime; short shape; short reverseSmooth; double velDelta; } TCrdBlend;
+typedef struct { long segNumUserSet; long segNumInCmd; double synPrfVel; double prfPosCrd[8]; } TCrdSegSyncInfo;
+typedef struct { double receive; double travel; double left; } TCrdSegmentLength;
+typedef struct { double ratio; double laserPowerFollowVelMax; double laserPowerFollowFreqMax; double laserFollowPulseMax; double pad1[4]; } TLaserFollowSpline2Prm;
+typedef struct { short tableId; short channel; short enable; short loopCount; long intervalTime; short pad[2]; } TLaserPowerWave;
+typedef struct { short tableId; short enable; short loopIndex; short pad; double power; } TLaserPowerWaveStatus;
+typedef struct { short optimizeMode; short blendingType; short pad[2]; double tolerance; double blendingPrm; double blendingMinAngle; double blendingMaxAngle; } TPathOptimizePrm;
+typedef struct { short enable; long compValue; long compTime; short dir; } TBacklashComp;
+typedef struct { short run; short pad1[3]; long pad2[2]; double pad3[2]; } TLeadScrewCompStatus;
+typedef struct { int16_t axis; int16_t link; int16_t pad; int16_t n; double startPos; double lenPos; } TAxisLeadScrewCrossCompPrm;
+typedef struct { double compPos; double compNeg; } TLeadScrewCrossCompData;
+typedef struct { int16_t axis; int16_t pad[2]; int16_t compDataCount; TLeadScrewCrossCompData leadScrewCrossCompData[64]; } TAxisLeadScrewCrossCompData;
+typedef struct { int16_t axis; int16_t enable; int16_t pad[2]; } TEnableAxisLeadScrewCrossComp;
+typedef struct { short pad1[2]; long reverseTime; long pad2[3]; double pad3[2]; } TDoBit;
+typedef struct { double distance; double delayTime; double reserve[8]; } TAtParameter;
+typedef struct { double distance; double reserve[9]; } TPsoParameter;
+typedef struct { double time; double reserve[9]; } TTsoParameter;
+typedef struct { TAtParameter atPrm; TPsoParameter psoPrm; TTsoParameter tsoPrm; TDoReverseParameter doReverse; double data[10]; } TWriteDigitalOutputMode;
+typedef struct { short mode; short doType; short doIndex; short doCount; short *pValue; short reverse1[2]; long reserve2[2]; TWriteDigitalOutputMode prm; } TDigitalOutput;
+typedef struct { short type; short motionType; long delayTime; double distance; } TDigitalOutputProByMoveDistance;
+typedef struct { short type; short motionType; short reserve1[2]; double delayTime; } TDigitalOutputProByMoveTime;
+typedef struct { double time; } TDigitalOutputProDelay;
+typedef union { double data[30]; TDigitalOutputProDelay delay; TDigitalOutputProByMoveTime moveTime; TDigitalOutputProByMoveDistance moveDistance; } TWriteDigitalOutputProPrmUnion;
+typedef struct { short mode; short doType; short doIndex; short doCount; short *pValue; short reserve1[2]; long reserve2[2]; TWriteDigitalOutputProPrmUnion prm; } TDigitalOutputPro;
+typedef struct { short aoType; short aoIndex; short count; short reserve1; double *pValue; long reserve2[3]; } TAnalogOutput;
+typedef struct { short diType; short diIndex; short diCount; short *pValue; short reverse1[3]; long reserve2[2]; } TDigitalInput;
+typedef struct { short inputType; short inputIndex; short mode; short modePrm; short reserve1[4]; double resuerve2[4]; } TStopIoPrm;
+typedef struct { short linkType; short linkIndex; short reserve1[6]; double linkRatio; double reserve2[4]; } TAoLinkPrm;
+typedef struct { short type; short index; } TEncoderSource;
+typedef struct { short probeType; short probeIndex; short latchType; short latchIndex; short sense; short pad[3]; double filterWidth; } TSignalDetect;
+typedef struct { short status; short pad[3]; double latchWidth; } TSignalDetectStatus;
+typedef struct { unsigned short mode; unsigned short run; uint32_t space; uint32_t pulseCount; unsigned short hso; unsigned short gpo; uint32_t segmentNumber; uint32_t reserve1[3]; double reserve2[2]; } TPosCompareStatusEx;
+typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long syncPos; long time; short pulseWidth; short pad; } TPosComparePsoPrmPro;
+typedef struct { short referenceX; short referenceY; short pad1[2]; double pad2[2]; } TPosCompareReferencePrm;
+typedef struct { short outputMode; short level; long count; double highLevelTime; double lowLevelTime; double reserve2[4]; } TPosCompareMultiPulse;
+typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long time; short multiNumber; short pad1; long syncPosArray[256]; } TPosCompareMultiPsoPrm;
+typedef struct { short sourceMode; short additionX; short additionY; short additionZ; } TPosCompareAdditionPrm;
+typedef struct { short mode; short dimension; short sourceMode; short source[8]; short outputMode; short outputCounter; unsigned short outputPulseWidth; unsigned short errorBand; short reserve1[2]; double reserve2[16]; } TPosCompareModeEx;
+typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long time; short pad1; short multiNumber; long scale[6]; double syncPosArray[256]; } TPosComparePsoPrmEx;
+typedef struct { unsigned short velCompCoeff[3]; short reserve1[2]; unsigned short accCompCoeff[3]; short reserve2[2]; } TPosCompareCompensateCoeff;
+typedef struct { short index; short enable; long reserve[3]; } TPosCompareEnablePro;
+typedef struct { short index; short pulseWidth; short reserve[2]; unsigned long count; long syncPos; long time; } TPosComparePrmPro;
+typedef struct { short mask; short option; } TTaskCrdStepMode;
+typedef struct { short list; short reserve1[23]; } TTaskStartCommandList;
+typedef struct { short option; short reserve; } TTaskTriggerCallbackFunction;
+typedef struct { short count; TWatchVar var[5]; } TTaskSaveMcVar;
+typedef struct { short profile; short refType; short refIndex; short refSubIndex; short reserve1[4]; double refPosition; double refLinearVelocity; double minAngleVelocity; double maxAngleVelocity; double reserve2[4]; } TTaskAdjustMoveJogAngleVelocity;
+typedef struct { short fifo; short count; TWatchVar var[8]; } TTaskSaveMcVarEx;
+typedef struct { short enable; short loop; short reserve[2]; } TConditionTaskEnable;
+typedef struct { short halt; short reserve1[15]; } TCommandListStopParameter;
+typedef struct { short stopList; short stopMode; short triggerSource; short reserve[5]; TCommandListStopParameter prm; } TTaskStopCommandList;
+typedef struct { TWatchVar leftOperands; TWatchVar rightOperands; TWatchVar result; unsigned short operation; short reserve[6]; } TVariableCalculatePrm;
+typedef struct { short type; short subType; short dir[8]; short reserve1[6]; double prm[20]; double offset[8]; long reserve2[10]; double reserve3[11]; } TRobotKinematicParameter;
+typedef struct { short type; short reserve1[3]; double primaryAxisPoint[3]; double slaveAxisPoint[3]; double toolLocationPoint[3]; short dirMode; short reserve2[2]; short dir[5]; double axisVector[15]; long reserve3[10]; double reserve4[16]; } TFiveAxisKinematicParameter;
+typedef struct { short axisCount; short reserve1[3]; long reserve2[10]; double reserve3[42]; } TMultiAxisKinematicParameter;
+typedef struct { short subType; short axisCount; short mode; short majorAxis[3]; short reserve1[6]; short parallelAxis[8]; long reserve2[10]; double reserve3[38]; } TParallelParameter;
+typedef struct { short axisCount; short reserve1[3]; long reserve2[10]; double reserve3[42]; } TOrthogonalExtendParameter;
+typedef union { TOrthogonalExtendParameter orthogonalExtend; TRobotKinematicParameter robot; TFiveAxisKinematicParameter fiveAxis; TMultiAxisKinematicParameter multiAxis; TParallelParameter parallel; double data[48]; } TKinematicParameter;
+typedef struct { short type; short reserve[3]; TKinematicParameter kinPrm; } TKinematicTransform;
+typedef struct { double velMax; double accMax; double decMax; double jerkMax; double reserve[10]; } TGroupMotionConstraint;
+typedef struct { double oriVelMax; double oriAccMax; double oriDecMax; double oriJerkMax; double reserve[10]; } TGroupOrientationConstraint;
+typedef struct { double transX; double transY; double transZ; double rotAngle1; double rotAngle2; double rotAngle3; } TCartesianParameter;
+typedef struct { double vel; double oriVel; double reserve[18]; } TCartesianTransformVelConstraint;
+typedef union { TCartesianTransformVelConstraint velConstraint; double value[20]; } TCartesianTransformConstraintUnion;
+typedef struct { short mode; short reserve[3]; TCartesianTransformConstraintUnion data; } TCartesianTransformConstraint;
+typedef struct { double prm[8]; double reserve[12]; } TCoordinateTransformAcsPos;
+typedef struct { double transX; double transY; double transZ; double rotAngle1; double rotAngle2; double alpha; double reserve[14]; } TCoordinateTransformToolDir;
+typedef struct { double prm[8]; double reserve[12]; } TCoordinateTransformOffset;
+typedef struct { double point1[3]; double point2[3]; double point3[3]; double offset[3]; double gama; double reserve[7]; } TCoordinateTransformPoints;
+typedef struct { double offset[3]; double vector1[3]; double vector2[3]; double reserve[11]; } TCoordinateTransformTwoVectors;
+typedef struct { double offset[3]; double alpha; double beta; double gama; double reserve[14]; } TCoordinateTransformProjectAngle;
+typedef union { TCoordinateTransformAcsPos acsPos; TCartesianParameter euler; TCoordinateTransformToolDir toolDir; TCoordinateTransformOffset offset; TCoordinateTransformPoints points; TCoordinateTransformTwoVectors twoVectors; TCoordinateTransformProjectAngle projectAngle; double value[20]; } TCoordinateTransformUnion;
+typedef struct { short mode; short reserve[3]; TCoordinateTransformUnion data; } TCoordinateTransform;
+typedef struct { short masterType; short masterIndex; short masterMoveType; short trackMode; double originPrfPos; TCartesianParameter masterOrigin; TCartesianParameter pcsToMasterTcs; TCartesianParameter dynamicPcsToSlaveMcs; } TDynamicCoordinateTransformData;
+typedef union { TDynamicCoordinateTransformData trans; double reserve[60]; } TDynamicCoordinateTransformUnion;
+typedef struct { short mode; short pad[3]; TDynamicCoordinateTransformUnion prm; } TDynamicCoordinateTransform;
+typedef struct { short masterType; short masterIndex; short reserve1[7]; short commandPosCoord; short commandOrientationMode; short commandConfigIndex; double pos[8]; long reserve2[8]; double reserve3[8]; } TDynamicCoordinateTransformMasterPos;
+typedef struct { short source; short reserve1[7]; short enableFriction[8]; short enableCompensate[8]; long reserve2[8]; double reserve3[8]; } TGroupDynamicsCompensate;
+typedef struct { short master; short slave; short reserve[2]; double alpha; double beta; } TGroupCoupleParameter;
+typedef struct { short positiveLimitEnable; short negativeLimitEnable; short positiveLimitMode; short negativeLimitMode; double positiveLimit; double negativeLimit; } TGroupSoftLimit;
+typedef struct { short run; short state; short stopInfo; short reserve1[13]; long reserve2[4]; } TGroupStatus;
+typedef struct { double time; double k; } TGroupMotionSmooth;
+typedef union { TGroupMotionSmooth smooth; double value[20]; } TGroupMotionSmoothUnion;
+typedef struct { short mode; short reserve[3]; TGroupMotionSmoothUnion data; } TGroupMotionSmoothPrm;
+typedef struct { short feedback; short reserve1[3]; double percent; double reserve2[4]; } TGroupContourErrorControlPrm;
+typedef struct { long userTag; long segNum; double segmentTravel; double segmentLength; double totalTravel; short reserve1[8]; double reserve2[8]; } TGroupMoveSegmentInfo;
+typedef struct { short enable; short reserve[3]; short refAxis[8]; } TGroupPathRefAxis;
+typedef struct { TKinematicTransform kinTrans; short enablePcsTrans; short enableTcsTrans; short reserve1[2]; TCartesianParameter pcsTrans; TCartesianParameter tcsTrans; double acsKinOffset[8]; short inputCoordSystem; short inputOriMode; short configIndex; short outputOriMode; double preAcsPos[8]; short reserve2[4]; double reserve3[8]; } TCoordinateTransformParameter;
+typedef struct { TKinematicTransform kinTrans; short enablePcsTrans; short enableTcsTrans; short enableUserPcsTrans; short reserve1[5]; TCoordinateTransform pcsTrans; TCoordinateTransform tcsTrans; TCoordinateTransform userPcsTrans; double acsKinOffset[8]; short inputCoordSystem; short inputOriMode; short configIndex; short outputOriMode; double preAcsPos[8]; short reserve2[4]; double reserve3[8]; } TCoordinateTransformParameterEx;
+typedef struct { TKinematicTransform kinTrans; short enablePcsTrans; short enableTcsTrans; short enableUserPcsTrans; short userPcsTransCount; short inclinedPlaneMode; short inclinedPlaneConfigIndex; short reserve1[2]; TCoordinateTransform pcsTrans; TCoordinateTransform tcsTrans; TCoordinateTransform userPcsTrans[4]; double acsKinOffset[8]; double preRotateAxisPos[2]; short inputCoordSystem; short inputOriMode; short configIndex; short outputOriMode; double preAcsPos[8]; short reserve2[4]; double reserve3[8]; } TGroupPosTransformPrm;
+typedef struct { double pcsPos[8]; double mcsPos[8]; double acsPos[8]; } TCoordinatePos;
+typedef struct { short coordSystem; short oriMode; short configIndex; short targetOriMode; short reserve1[8]; double inputPos[8]; double preAcsPos[8]; double reserve2[24]; } TGroupPosTransformInput;
+typedef struct { short configIndex; short singularity; short reserve1[10]; double pcsPos[8]; double mcsPos[8]; double acsPos[8]; double reserve2[16]; } TGroupPosTransformOutput;
+typedef struct { double deceleration; double jerk; short reserve1[4]; double reserve2[5]; } TGroupStopParameter;
+typedef struct { short plane; short reserve1[5]; short rotateIdent; short setOriginFlag; double origin[3]; double rotateOrigin; double reserve2[14]; } TGroupPathPolar;
+typedef struct { short plane; short reserve1[4]; short linearIdent; short rotateIdent; short setOriginFlag; double r; double origin[3]; double rotateOrigin; double reserve2[13]; } TGroupPathCynlinder;
+typedef union { TGroupPathPolar polar; TGroupPathCynlinder cynlinder; double value[20]; } TGroupPathUnion;
+typedef struct { short mode; short reserve[3]; TGroupPathUnion data; } TGroupPathPrm;
+typedef struct { long lookAheadNum; short reserve1[6]; long reserve2[4]; double time; double radiusRatio; double reserve3[7]; } TGroupLookAheadParameter;
+typedef struct { long segNum; long userTag; double data[32]; } TLookAheadErrorInfo;
+typedef struct { short blendType; short prmType; short reserve1[2]; double prm; double reserve2[8]; double minAngle; double maxAngle; } TPathBlendingParameter;
+typedef struct { short blendType; short prmType; short reserve[5]; short percentMode; double percent; double prm[17]; } TVelBlendingParameter;
+typedef union { TPathBlendingParameter pathBlendingPrm; TVelBlendingParameter velBlendingPrm; double data[20]; } TBlendingParameter;
+typedef struct { short mode; short reserve[3]; TBlendingParameter prm; } TGroupBlendingParameter;
+typedef struct { short type; short optMode; } TGroupDvMaxLimit;
+typedef struct { short enable; short mode; long n1; long n2; } TGroupCmdVelLimit;
+typedef struct { double value[2]; double reserve[14]; } TRotateAxisPos;
+typedef struct { double value[3]; double reserve[13]; } TToolVector;
+typedef union { TRotateAxisPos rotateAxisPos; TToolVector toolVector; double value[16]; } TInclinePlaneRotateAxisInfoUnion;
+typedef struct { short mode; short pad[3]; TInclinePlaneRotateAxisInfoUnion data; } TInclinedPlaneRotateAxisInfo;
+typedef struct { short configIndex; short reserve1[3]; double reserve2[9]; } TSelectConfig;
+typedef union { TSelectConfig select; double value[10]; } TGroupInclinedPlanePrmUnion;
+typedef struct { short mode; short reserve[3]; TGroupInclinedPlanePrmUnion data; } TGroupInclinedPlanePrm;
+typedef struct { double velocity; double acceleration; double reserve1[3]; double deceleration; short overrideSelect; short endVelocityMode; short orientationDir; short reserve2[3]; long reserve3[3]; } TGroupMoveParameter;
+typedef struct { short endPointMode; short arcPlane; short arcPathChoice; short pad; double centralAngle; double centerPoint[8]; } TCircularPlaneCenterDirData;
+typedef struct { short endPointMode; short arcPlane; short arcPathChoice; short pad; double centralAngle; double arcRadius; } TCircularPlaneRadiusDirData;
+typedef struct { short endPointMode; short pad[3]; double centralAngle; double auxPoint[8]; } TCircularSpaceBorderData;
+typedef struct { short endPointMode; short auxPointCommandCoord; short auxPointOrientationMode; short auxPointConfigIndex; short auxStartPointCommandCoord; short auxStartPointOrientationMode; short auxStartPointConfigIndex; short pad; double centralAngle; double auxPoint[8]; double auxStartPoint[8]; } TCircularSpaceBorderFourData;
+typedef struct { short endPointMode; short arcPlane; short arcPathChoice; short periodCount; double centralAngle; double centerPoint[8]; double periodDeltaRadius; } TCircularPlaneCenterDirSpiralData;
+typedef union { TCircularPlaneCenterDirData centerDir; TCircularPlaneRadiusDirData radiusDir; TCircularSpaceBorderData spaceBorder; TCircularSpaceBorderFourData spaceBorderFour; TCircularPlaneCenterDirSpiralData spiral; double data[32]; } TCircularModeUnion;
+typedef struct { short arcMode; short pad[3]; TCircularModeUnion data; } TCircularParameter;
+typedef struct { double h1; double h2; double h3; double k1; double k2; short curveMode; short oriChangeMode; short reserve1[6]; double reserve2[8]; } TGate;
+typedef union { TGate gate; double data[32]; } TGateUnion;
+typedef struct { short mode; short reserve[3]; TGateUnion data; } TGatePrm;
+typedef struct { short type; short weaveMode; short frequencyMode; short pad1; double amplitude; double frequency; double weavePrm[10]; short startPosition; short dweelFullStop; short pad2[2]; double dweelLeft; double dwellMid; double dwellRight; short oriControlMode; short pad3[3]; double rotateAngleX; double rotateAngleY; double rotateAngleZ; } TGroupWeaveParameter;
+typedef struct { short mode; short dataCount; short reserve1[6]; double period; double reserve2[5]; } TGroupSuperpositionTablePrm;
+typedef struct { double value[8]; } TGroupSuperpositionTableData;
+typedef struct { short workIndex; short reserve1[7]; double reserve2[14]; } TGroupSuperpositionTableStatus;
+typedef struct { double value[8]; double reserve[24]; } TGroupSuperpositionValueDirect;
+typedef struct { short mode; short pad[3]; double time; double velocity; double reserve[29]; } TGroupSuperpositionWeaveEx;
+typedef struct { short mode; short startIndex; short count; short reserve1[5]; double time; double velocity; double reserve2[28]; } TGroupSuperpositionTable;
+typedef union { TGroupSuperpositionValueDirect direct; TGroupSuperpositionWeaveEx weaveEx; TGroupSuperpositionTable table; double data[32]; } TGroupSuperpositionUnion;
+typedef struct { short enable; short mode; short pad[2]; double smoothTime; TGroupSuperpositionUnion data; } TGroupSuperposition;
+typedef struct { short masterMode; short masterType; short masterIndex; short cbtTag; double detectPos; double parkPos; double stopPos; double delay; double sampleTime; double velMax; double acc; double cbOrigin[6]; short group; short masterMotionType; short masterMotionDir; short reserve1[5]; double reserve2[10]; } TCbtPrm;
+typedef struct { short group; short pieceConfigIndex; short waitMode; short waitProfileCoord; short waitCmdPosCoord; short waitConfigIndex; short reserve1[2]; double locatePoint[6]; double waitPoint[6]; double groupVel; double groupAcc; double groupDec; short reserve2[8]; double reserve3[10]; } TCbtGroupPrm;
+typedef struct { short cbtTag; short pieceTag; short reserve1[2]; double masterPos; double pose[6]; double reserve2[5]; double processTime; } TCbtPieceData;
+typedef struct { short cbtIndex1; short cbtIndex2; short reserve1[2]; double reserve2[10]; } TCoupleCbtPrm;
+typedef struct { short executeMode; short reserve1[3]; double reserve2[10]; } TStartCbtPrm;
+typedef struct { short execute; short state; short stopInfo; short reserve1[3]; short pieceTag; short pieceEmpty; unsigned long pieceReceive; unsigned long pieceRemainder; unsigned long pieceProcess; unsigned long validPieceProcess; unsigned long reserve2[6]; double catchUpStartPos; double actualPiecePos; double virtualPiecePos; } TCbtInfo;
+typedef struct { double axis[9]; double length[3]; } TObjectCuboid;
+typedef struct { double axis[3]; double radius; double height; } TObjectCylinder;
+typedef union { TObjectCuboid cuboid; TObjectCylinder cylinder; double data[32]; } TObjectShape;
+typedef struct { short shapeType; short reserve1[3]; TObjectShape shape; short source; short index[3]; short locate; short side[3]; double offset[3]; short reserve2[4]; } TCollisionCheckObjectPrm;
+typedef struct { short objectIndex[2]; short reserve1[2]; short rotateMode; short dir[3]; double originOffset[3]; double distance; double reserve2[8]; } TCollisionCheckPrm;
+typedef struct { short enable; short checkResult; short reserve1[6]; double reserve2[4]; } TCollisionCheckStatus;
+typedef struct { short windowSize; short lostSize; long torqueLimitMax; long torqueLimitMin; short continuousProtectCount; short oscillationPositiveProtectCount; short oscillationNegativeProtectCount; short reserve[15]; } TGantryTorqueProtectPrm;
+typedef struct { long torqueProtectSts; long torqueProtectEnable; short reserve[20]; } TGantryInf;
+typedef struct { short direction; short reserve[3]; } TGPIOConfig;
 """
 
 CONSTANTS = r"""
@@ -315,4 +493,288 @@ CONSTANTS = r"""
 #define AUTO_HOME_MODE_HOME_STOP 3
 #define MC_JOYSTICK_AXIS_COUNT_MAX 3
 #define MC_JOYSTICK_VEL_COUNT_MAX 3
+#define GEAR_MASTER_MPG 9
+#define LISTINFO_RESERVE2_USERTAG 0
+#define VEL_PROFILE_MODE_TRAP 1
+#define VEL_PROFILE_MODE_SMOOTH 40
+#define VEL_PROFILE_MODE_SMOOTH_EX 41
+#define VEL_PROFILE_MODE_JERK 46
+#define VEL_PROFILE_MODE_FOLLOW 50
+#define MOVE_JOG_MODE_GENERAL 0
+#define MOTION_RESTRICT_PROFILE_MAX 8
+#define MOTION_TIME_RESTRICT_MODE_DIRECT 1
+#define MOTION_TIME_RESTRICT_MODE_ATTENTION_PROFILE 2
+#define MOVE_SYNCHRONIZATION_MODE_GEAR 0
+#define MOVE_SYNCHRONIZATION_MODE_MPG 1
+#define MOVE_SYNCHRONIZATION_MODE_FOLLOW 2
+#define MOVE_SYNCHRONIZATION_MODE_GEAR_POS 3
+#define MOVE_SYNCH_MPG_RESERVE_MASTER_VEL_LIMIT 0
+#define MC_START_MODE_ABSOLUTE 0
+#define MC_START_MODE_RELATIVE 1
+#define MC_START_MODE_CLUTCH_TRAP_POS 63
+#define MC_START_MODE_CLUTCH_TRAP_NEG 64
+#define MC_START_MODE_CLUTCH_TRAP_CURRENT 65
+#define CAM_POINT_TYPE_CLUTCH -1
+#define CAM_POINT_TYPE_TRAP 20
+#define CAM_POINT_TYPE_TRAP_EVEN 21
+#define CAM_OUT_MODE_STOP 0
+#define CAM_OUT_MODE_CONTINUOUS 1
+#define CAM_OUT_MODE_TO_POS 3
+#define RAMP_TYPE_TRAP 0
+#define RAMP_TYPE_JERK 2
+#define COMP_TYPE_COORD_SYNC 0
+#define HOME_STAGE_SERCH_HOME_STOP 22
+#define HOME_STAGE_SEARCH_HOME_AGAIN 24
+#define HOME_ERROR_ESCAPE 12
+#define HOME_MODE_LIMITPOS_INDEX 14
+#define HOME_MODE_HOME_LEVEL 24
+#define HOME_MODE_DRIVER_HOME 42
+#define CRD_AXIS_X 1
+#define CRD_AXIS_Y 2
+#define CRD_AXIS_Z 3
+#define CRD_AXIS_A 4
+#define CRD_AXIS_C 5
+#define CRD_AXIS_U 6
+#define CRD_AXIS_V 7
+#define CRD_AXIS_W 8
+#define BUF_CMD_TYPE_ALL -1
+#define BUF_CMD_TYPE_BUF_MOVE 0
+#define BUF_CMD_TYPE_BUF_GEAR 1
+#define BUF_CMD_TYPE_BUF_IO 2
+#define BUF_CMD_STOP_MODE_DEFAULT 0
+#define BUF_CMD_STOP_MODE_CONTINUE 1
+#define BUF_CMD_STOP_MODE_HOLD 2
+#define DIMENSION_MAX 8
+#define DIGITAL_OUTPUT_MODE_NORMAL 0
+#define DIGITAL_OUTPUT_MODE_REVERSE_TIME 10
+#define POS_COMPARE_MODE_EQUIDISTANT_BUFFER_PERMIT 3
+#define POS_COMPARE_MODE_PSO7 7
+#define POS_COMPARE_MODE_LINEAR_ABS 8
+#define POS_COMPARE_MODE_FIFO_ABS 14
+#define POS_COMPARE_MODE_FIFO_ABS_STATIC 15
+#define POS_COMPARE_THRESHOLD_DEFAULT 0
+#define POS_COMPARE_THRESHOLD_ZERO 1
+#define POS_COMPARE_THRESHOLD_FPGA 2
+#define POS_COMPARE_MODE_PSO_SYNC_EXTERNAL_SIGNAL 1
+#define POS_COMPARE_MODE_PSO_SYNC_INTERNAL_SIGNAL 2
+#define TASK_TRIGGER_CALLBACK_FUNCTION 4508
+#define TASK_MOVE_CONTINUOUS_ABSOLUTE 9568
+#define TASK_START_COMMAND_LIST 18469
+#define TASK_STOP_COMMAND_LIST 18475
+#define TASK_MOVE_ESCAPE 20480
+#define TASK_UPDATE_SERVO_GAIN 24576
+#define TASK_SET_TRIGGER_PRM 24577
+#define TASK_SAVE_MC_VAR_MAX 5
+#define TASK_SAVE_MC_VAR_EX_MAX 8
+#define TASK_SAVE_MC_VAR 50
+#define TASK_ADJUST_MOVE_JOG_ANGLE_VELOCITY 51
+#define TASK_SAVE_MC_VAR_EX 52
+#define TASK_ADJUST_JOG_VEL_RESERVE1_GROUP 0
+#define TASK_ADJUST_JOG_VEL_RESERVE1_TARGET_TYPE 1
+#define TASK_ADJUST_JOG_VEL_RESERVE2_ORIGIN_VEL 0
+#define TASK_ADJUST_JOG_VEL_RESERVE2_DAC_RATIO 1
+#define COORD_SYSTEM_PCS 0
+#define COORD_SYSTEM_MCS 1
+#define COORD_SYSTEM_ACS 2
+#define COORD_SYSTEM_TCS 3
+#define COORD_SYSTEM_VCS 4
+#define COORD_SYSTEM_FCS 5
+#define COORD_SYSTEM_MVCS 10
+#define COORD_SYSTEM_TCS_USER_DEFINE 20
+#define COORD_SYSTEM_PCS_USER_DEFINE 30
+#define COORD_SYSTEM_POLAR 40
+#define COORD_SYSTEM_CYNLINDER 41
+#define ORI_MODE_NONE 0
+#define ORI_MODE_EULER 1
+#define ORI_MODE_QUAD 2
+#define ORI_MODE_VECTOR 3
+#define ORI_MODE_ROTATE_AXIS_POS 4
+#define ORI_MODE_SPACE_ROTATE 5
+#define VEL_MODE_DEFAULT 0
+#define VEL_MODE_PERCENT 1
+#define ORI_PROFILE_MODE_MINOR 0
+#define ORI_PROFILE_MODE_MAJOR 1
+#define ORI_PROFILE_MODE_COMMAND_DIR 2
+#define GROUP_PROGRAM_COORD_SYSTEM_TABLE 0
+#define GROUP_PROGRAM_COORD_SYSTEM_PIECE 1
+#define GROUP_PCS_ROTATE_AXIS_POS_MODE_ORI 0
+#define GROUP_PCS_ROTATE_AXIS_POS_MODE_DIRECT 1
+#define PCS_USER_DEFINE_COORD_TRANS_COUNT_MAX 4
+#define COORD_TRANS_TYPE_EULER 1
+#define COORD_TRANS_TYPE_QUAD 2
+#define COORD_TRANS_TYPE_VECTOR 3
+#define COORD_TRANS_TYPE_ROTATE_AXIS_POS 4
+#define COORD_TRANS_TYPE_ACS_POS 5
+#define COORD_TRANS_TYPE_EULER_FIX 11
+#define COORD_TRANS_TYPE_TOOL_DIR 20
+#define COORD_TRANS_TYPE_OFFSET 30
+#define COORD_TRANS_TYPE_POINTS 40
+#define COORD_TRANS_TYPE_TWO_VECTORS 50
+#define COORD_TRANS_TYPE_PROJECT_ANGLE 60
+#define GROUP_INCLINED_PLANE_MODE_ORI_UNCHANGED 0
+#define GROUP_INCLINED_PLANE_MODE_ORI_CHANGED 1
+#define EULER_MODE_ZYX 0
+#define EULER_MODE_ZXZ 3
+#define EULER_MODE_XYZ 4
+#define KIN_TYPE_ORTHOGONAL 0
+#define KIN_TYPE_PARALLEL 2
+#define KIN_TYPE_ORTHOGONAL_EXTEND 6
+#define KIN_TYPE_ROBOT 10
+#define KIN_TYPE_FIVE_AXIS 20
+#define KIN_TYPE_MULTI_AXIS 30
+#define KIN_TYPE_CYLINDER 40
+#define ROBOT_TYPE_SCARA 0
+#define ROBOT_TYPE_SIX_REVOLUTE 1
+#define ROBOT_TYPE_FOUR_REVOLUTE 2
+#define ROBOT_TYPE_PALLETIZE 3
+#define ROBOT_TYPE_POSITIONER 4
+#define ROBOT_TYPE_FIVE_REVOLUTE 5
+#define ROBOT_TYPE_XYZRR 6
+#define ROBOT_TYPE_SEVEN_REVOLUTE 7
+#define ROBOT_TYPE_UR 10
+#define ROBOT_TYPE_CYLINDER 20
+#define ROBOT_TYPE_SCARA_EXTEND 30
+#define CYLINDER_TYPE_NORMAL 0
+#define ROBOT_TYPE_DELTA 100
+#define DELTA_TYPE_BASIC 0
+#define DELTA_TYPE_COMMON 1
+#define DELTA_TYPE_COMMON_PRO 2
+#define SCARA_TYPE_RRPR 0
+#define SCARA_TYPE_PRRR 1
+#define SCARA_TYPE_RPRR 2
+#define SCARA_TYPE_RRRP 3
+#define PALLETIZE_TYPE_RPPR 0
+#define POSITIONER_TYPE_SINGLE 0
+#define POSITIONER_TYPE_DUAL 10
+#define XYZRR_TYPE_LIKE_SCARA 0
+#define XYZRR_TYPE_DT_C_ON_A 100
+#define PARALLEL_INDEPENDENT 0
+#define PARALLEL_SUPERPOSITION 1
+#define RW_A_ON_C 20
+#define RW_B_ON_C 21
+#define COORDINATE_TRANSFORM_RESERVE_SUB_MODE 0
+#define GROUP_STATE_DISABLED 0
+#define GROUP_STATE_ERROR_STOP 1
+#define GROUP_STATE_STANDBY 6
+#define GROUP_STATE_HOMING 10
+#define GROUP_STATE_MOVING 20
+#define GROUP_STATE_STOPPING 30
+#define GROUP_STATUS_RESERVE1_ERROR_STOP_STATE 0
+#define GROUP_CONTOUR_ERROR_CONTROL_RESERVE2_MAX_COMPENSATE_VALUE 0
+#define GROUP_PATH_REF_AXIS_X 0
+#define GROUP_PATH_REF_AXIS_Y 1
+#define GROUP_PATH_REF_AXIS_Z 2
+#define OVERRIDE_TYPE_VEL 0
+#define OVERRIDE_TYPE_ACC 1
+#define GROUP_TRANSFORM_PRM_RESERVE2_ACS_POS_TYPE 0
+#define GROUP_TRANSFORM_PRM_RESERVE2_PROGRAM_MODE 2
+#define GROUP_TRANSFORM_INPUT_RESERVE1_ACS_POS_TYPE 7
+#define GROUP_INDENT_MAX 8
+#define GROUP_PATH_MODE_GENERAL 0
+#define GROUP_PATH_MODE_POLAR 1
+#define GROUP_PATH_MODE_CYNLINDER 2
+#define GROUP_PATH_PLANE_XY 0
+#define GROUP_PATH_PLANE_YZ 1
+#define GROUP_PATH_PLANE_ZX 2
+#define LA_FUNC_MODE_DV_MAX_LIMIT 1
+#define LA_FUNC_MODE_SOFTLIMIT_CHECK 2
+#define LA_FUNC_MODE_DV_MAX_THRESHOLD 3
+#define LA_FUNC_MODE_GEOMETRY_LIMIT 4
+#define LA_FUNC_MODE_CMD_VEL_LIMIT 50
+#define LA_FUNC_MODE_LA_PRM_TYPE 99
+#define BLEND_MODE_NONE 0
+#define BLEND_MODE_ARC 1
+#define BLEND_MODE_BIARC 2
+#define BLEND_MODE_SPLINE 3
+#define BLEND_PARA_TYPE_ERROR 0
+#define BLEND_PARA_TYPE_RADIUS 1
+#define BLEND_PARA_TYPE_DISTANCE 2
+#define VEL_BLEND_MODE_NONE 0
+#define VEL_BLEND_MODE_BUFFERER 1
+#define VEL_BLEND_MODE_LOW 2
+#define VEL_BLEND_MODE_PREVIOUS 3
+#define VEL_BLEND_MODE_NEXT 4
+#define VEL_BLEND_MODE_HIGH 5
+#define GEOMETRY_LIMIT_MODE_WORK 0
+#define GEOMETRY_LIMIT_MODE_AXIS 1
+#define GEOMETRY_LIMIT_MODE_NONE 2
+#define GROUP_MOVE_PRM_RESERVE2_POS_MASK 0
+#define GROUP_MOVE_PRM_RESERVE2_START_POINT_MODE 2
+#define CIRCULAR_PARAMETER_MAX_ERROR 0
+#define CIRCULAR_PARAMETER_ORIENTAION_PASS_MODE 1
+#define CIRCULAR_PARAMETER_AUXILIARY_START_MASTER_POS 2
+#define CIRCULAR_PARAMETER_AUXILIARY_MASTER_POS 3
+#define CIRCULAR_MODE_PLANE_CENTER_DIR 0
+#define CIRCULAR_MODE_PLANE_RADIUS_DIR 1
+#define CIRCULAR_MODE_SPACE_BORDER 2
+#define CIRCULAR_MODE_SPACE_CENTER 3
+#define CIRCULAR_MODE_SPACE_RADIUS 4
+#define CIRCULAR_MODE_PLANE_RELATIVE_CENTER_DIR 5
+#define CIRCULAR_MODE_SPACE_BORDER_FOUR 6
+#define CIRCULAR_MODE_PLANE_CENTER_DIR_SPIRAL 10
+#define CIRCULAR_MODE_PLANE_RELATIVE_CENTER_DIR_SPIRAL 11
+#define CIRCULAR_PLANE_XY 0
+#define CIRCULAR_PLANE_YZ 1
+#define CIRCULAR_PLANE_ZX 2
+#define CIRCULAR_PLANE_XYZ 3
+#define CIRCULAR_PLANE_XY_HELIX 10
+#define CIRCULAR_PLANE_YZ_HELIX 11
+#define CIRCULAR_PLANE_ZX_HELIX 12
+#define CIRCULAR_END_POINT_MODE_END_POINT 0
+#define CIRCULAR_END_POINT_MODE_CENTRAL_ANGLE 1
+#define CIRCULAR_PATH_CHOICE_CW 0
+#define CIRCULAR_PATH_CHOICE_CCW 1
+#define GATE_MODE_NORMAL 0
+#define WEAVE_TYPE_SINE 0
+#define WEAVE_TYPE_SINE_DIR_X 100
+#define GROUP_SUPERPOSITION_TABLE_MAX 4
+#define GROUP_SUPERPOSITION_TABLE_DATA_MAX 128
+#define GROUP_SUPERPOSITION_MODE_DIRECT 0
+#define GROUP_SUPERPOSITION_MODE_WEAVE 1
+#define GROUP_SUPERPOSITION_MODE_WEAVE_EX 2
+#define GROUP_SUPERPOSITION_MODE_TABLE 3
+#define GROUP_SUPERPOSITION_MODE_DIRECT_RELATIVE 10
+#define GROUP_SUPERPOSITON_WEAVE_EX_RESERVE_STOP_VEL 0
+#define GROUP_SUPERPOSITON_TABLE_RESERVE2_STOP_VEL 0
+#define CBT_MODE_CONTINUOUS 0
+#define CBT_MODE_INTERMITTEN 1
+#define CBT_EXECUTE_MODE_AUTO 0
+#define CBT_EXECUTE_MODE_COMMAND 1
+#define CBT_MASTER_MOTION_TYPE_LINEAR 0
+#define CBT_MASTER_MOTION_TYPE_ROTATE 1
+#define CBT_STATE_IDLE 0
+#define CBT_STATE_BACK_TO_WAIT_POINT 10
+#define CBT_STATE_WAITTING_PIECE 20
+#define CBT_STATE_LOCATING 110
+#define CBT_STATE_WAITING_SYNCHRONIZATION 120
+#define CBT_STATE_SYNCHRONIZATION 130
+#define CBT_STATE_DELAY 140
+#define CBT_STATE_EXECUTING_TASK 150
+#define CBT_STATE_EXITING_SYNCHRONIZATION 160
+#define CBT_STATE_STOPPING 300
+#define CBT_STATE_DONE 400
+#define CBT_STOP_INFO_NONE 0
+#define CBT_STOP_INFO_CU_OUT_OF_RANGE 1
+#define CBT_STOP_INFO_GET_CU_INFO 2
+#define CBT_STOP_INFO_ENABLE_GROUP_DYNAMICA_TRANSFORM 3
+#define CBT_STOP_INFO_DISABLE_GROUP_DYNAMICA_TRANSFORM 4
+#define CBT_STOP_INFO_START_GROUP_LOCATE_MOTION 5
+#define CBT_STOP_INFO_START_GROUP_WAIT_MOTION 6
+#define CBT_STOP_INFO_START_CU 7
+#define CBT_STOP_INFO_USER_STOP 10
+#define CBT_STOP_INFO_USER_STOP_COMMAND_LIST 11
+#define CBT_STOP_INFO_USER_STOP_IN_LIST 12
+#define CBT_STOP_INFO_GROUP_ERROR 50
+#define CBT_STOP_INFO_PROFILE_ERROR 51
+#define COLLISION_CHECK_MAX 8
+#define COLLISION_CHECK_OBJECT_MAX 16
+#define OBJECT_TYPE_NONE -1
+#define OBJECT_TYPE_CUBOID 1
+#define OBJECT_TYPE_CYLINDER 2
+#define OBJECT_LOCATE_FIX 0
+#define OBJECT_LOCATE_TOOL 1
+#define OBJECT_LOCATE_WORK_PIECE 2
+#define AXIS_SIDE_TOOL 0
+#define AXIS_SIDE_WORK_PIECE 1
+#define GANTRY_MODE_RINGNET_DRIVER 10
 """
