@@ -120,11 +120,19 @@ CALLBACKS: set[str] = set()
 _CALLBACK = re.compile(r"typedef\s+[\w\s*]+\(\s*(?:__stdcall\s*)?\*\s*(\w+)\s*\)")
 
 
+_INLINE_CALLBACK = re.compile(
+    r"(^|,)\s*[\w\s*]*?\(\s*(?:__stdcall\s*)?\*\s*(\w+)\s*\)\s*\([^()]*\)"
+)
+
+
 def params(text: str, where: str) -> list[str]:
     """The parameters in table syntax (``type *name=default``)."""
     text = " ".join(text.split())
     for cb in (*CALLBACKS, "HANDLE", "LPVOID"):  # a pointer whatever it points to
         text = re.sub(rf"\b{cb}\b\s*", "void *", text)
+    # a function-pointer parameter spelled in place (``void (*pfn)(void *, short *)``)
+    text = _INLINE_CALLBACK.sub(r"\1 void *\2", text)
+    text = re.sub(r"\bbool\b", "unsigned char", text)  # C++'s bool: one byte under MSVC
     if text in ("", "void"):
         return []
     out = []
@@ -314,6 +322,35 @@ def _plain(ps: list[str]) -> str:
     return ", ".join(re.sub(r"\s*\*\s*", " *", t).strip() for t in _types(ps))
 
 
+#: the width in bits of the integer types a bit-field is declared with
+_BITS = {
+    "char": 8, "unsigned char": 8, "int8_t": 8, "uint8_t": 8,
+    "short": 16, "unsigned short": 16, "int16_t": 16, "uint16_t": 16,
+    "int": 32, "unsigned int": 32, "long": 32, "unsigned long": 32,
+    "int32_t": 32, "uint32_t": 32,
+}  # fmt: skip
+_BITFIELD = re.compile(r"((?:unsigned\s+)?\w+)\s+\w+\s*:\s*(\d+)\s*;")
+
+
+def fold_bitfields(block: str) -> str:
+    """Bit-fields of one integer type (``unsigned short a : 1; ...``) become the whole
+    storage units they fill (``unsigned short bits1;``): the layout MSVC gives them; the
+    table names no single bit."""
+    fields = list(_BITFIELD.finditer(block))
+    if not fields:
+        return block
+    kinds = {" ".join(m[1].split()) for m in fields}
+    if len(kinds) != 1 or next(iter(kinds)) not in _BITS:
+        return block  # mixed types: left to the reader, which says it cannot read them
+    kind = kinds.pop()
+    units = -(-sum(int(m[2]) for m in fields) // _BITS[kind])
+    unit_fields = " ".join(f"{kind} bits{i + 1};" for i in range(units))
+    start, end = fields[0].start(), fields[-1].end()
+    if _BITFIELD.sub("", block[start:end]).strip():
+        return block  # other fields between the bit-fields
+    return block[:start] + unit_fields + block[end:]
+
+
 def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
     functions: dict[str, list[str]] = {}
     tds: list = []
@@ -360,6 +397,7 @@ def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
             body,
         )
         for block in re.findall(r"typedef\s+(?:struct|union|enum)\s*\w*\s*\{[^{}]*\}[^;]*;", body):
+            block = fold_bitfields(block)
             try:
                 tds.extend(typedefs.parse(block, known=consts))
             except typedefs.TypedefError as e:
@@ -464,6 +502,15 @@ def table_has(
 C_MACROS = frozenset({"NULL", "TRUE", "FALSE", "true", "false", "EOF", "INFINITE"})
 
 
+def _table_reads(ctype: str, tds: list) -> bool:
+    """Whether the table reads a parameter of this type passed by value: a scalar, an
+    enum, or a structure named ``T...``."""
+    ctype = re.sub(r"^const\s+", "", ctype).strip()
+    if ctype in typedefs.FIELD_TYPES or ctype.startswith("T"):
+        return True
+    return any(td.name == ctype and td.kind == "enum" for td in tds)
+
+
 def only_missing(
     folder: Path, functions: dict[str, list[str]], tds: list, consts: dict, own: bool = False
 ) -> tuple[dict[str, list[str]], list, dict, set[str]]:
@@ -479,6 +526,9 @@ def only_missing(
                 file=sys.stderr,
             )
         if name in names or not re.match(r"^GTN?_\w+$", name):
+            continue
+        if odd := [t for t in _types(ps) if "*" not in t and not _table_reads(t, tds)]:
+            print(f"{name} left out: a {odd[0]} by value the table cannot name", file=sys.stderr)
             continue
         if name.startswith("GT_") and "GTN_" + name[3:] in names:
             # the table declares the GTN_x on its own: a GT_x line would give a second one

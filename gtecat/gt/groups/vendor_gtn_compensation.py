@@ -33,6 +33,8 @@ short GTN_SetCompensate2DMode(short core, short axis, short mode);
 short GT_SetCompensate2DTableRotationAngle(short tableIndex, short enable, double rotationAngle);
 short GTN_SetCompensateLimit(short core, short compensateIndex, short compensateType, double minLimit, double maxLimit);
 short GTN_SetCoordSyncCompPrm(short core, short index, TCoordSyncCompPrm *pPrm /*inout*/);
+short GTN_SetGantryModePro(short core, short group, short master, short slave, short mode, long syncErrorLimit);
+short GTN_SetGantryPrmPro(short core, short group, TGantryPrmPro *pGantryPrmPro);
 short GTN_SetGantryProtectPrm(short core, short group, short torqueProtectType, TGantryTorqueProtectPrm *pPrm);
 short GT_SetGantrySynchErrorCompensate2D(short group, TCompensate2D *pComp2d /*inout*/);
 short GT_SetGantrySynchErrorCompensate2DTable(short tableIndex, TCompensate2DTable *pTable /*inout*/, long *pData /*inout*/, short extend);

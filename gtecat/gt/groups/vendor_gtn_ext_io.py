@@ -13,4 +13,8 @@ short GTN_BufExtDoBit(short core, short crd, unsigned short doIndex, unsigned sh
 short GTN_BufExtDoBitEx(short core, short crd, unsigned short doIndex, unsigned short doValue, short fifo);
 short GTN_FollowExtDoEx(short core, short profile, short doIndex, int32_t value, int32_t mask, short fifo);
 short GT_GetChnStsExtMdl(unsigned short *pStatus);
+short GTN_GetExtModuleAccessMode(short core, short *pMode);
+short GTN_GetExtModuleInitMode(short core, short *pInitMode);
+short GTN_SetExtModuleAccessMode(short core, short mode);
+short GTN_SetExtModuleInitMode(short core, short initMode);
 """

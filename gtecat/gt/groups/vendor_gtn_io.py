@@ -18,6 +18,7 @@ short GTN_GetBufIoHoldValue(short core, short crd, short doType, unsigned short 
 short GT_GetBufWaitDiStatus(short crd, short *pDiType, short *pDiIndex, short *pLevel, short *pContinueTime, long *pOverTime, short *pFlagMode, long *pSegNum, short *pEnable, long *pCount, short fifo);
 short GTN_GetBufWaitDiStatusEx(short core, short crd, short fifo, TBufWaitDiStatusEx *pStatus);
 short GTN_GetCbtDiscardPieceData(short core, short cbtIndex, short count, TCbtPieceData *pCbtPieceData, short *pActualCount);
+short GTN_GetCommandListDirection(short core, short index, short *pDirection);
 short GT_GetDisplayDip(short *pMode);
 short GTN_GetEHMIDi(short core, unsigned char *data, unsigned short offset, unsigned short count);
 short GTN_GetEHMIDo(short core, unsigned char *data, unsigned short offset, unsigned short count);
@@ -25,19 +26,29 @@ short GTN_GetGtmDiBit(short core, short station, short slot, short diIndex, shor
 short GTN_GetGtmDoBit(short core, short station, short slot, short doIndex, short *pValue, short count=1);
 short GTN_GetLimit(short core, short axis, short type, void *pPrm);
 short GTN_GetLimitInfo(short core, short axis, TLimitInfo *pInfo);
+short GTN_GetStopIoPro(short core, short axis, short stopType, TStopIoPrm *pPrm, short *pCount);
+short GTN_GetTorqueLimit(short core, short axis, TTorqueLimit *pTorqueLimit);
 short GTN_ReadDigitalInput(short core, short diType, short diIndex, short *pDi, short diCount=1);
 short GTN_ReadDigitalOutput(short core, short doType, short doIndex, short *pValue, short doCount=1);
 short GTN_SetAoLinkPrm(short core, short aoType, short aoIndex, short link, TAoLinkPrm *pAolinkPrm, TListInfo *pListInfo=NULL);
 short GTN_SetAuMtrLmt(short core, short dac, short limit);
 short GTN_SetAxisRotaryDirectionSelectMode(short core, short axis, short mode);
 short GTN_SetBufIoHoldValue(short core, short crd, short doType, unsigned short doMask, unsigned short doValue);
+short GTN_SetCommandListDirection(short core, short index, short direction, TListInfo *pListInfo);
+short GTN_SetCurveVelLimitModeLa(short core, short crd, short mode);
 short GT_SetDisplayDip(short mode);
 short GTN_SetDoBitReverseEx(short core, short doType, short doIndex, short value, TDoBit *pDoBit);
 short GTN_SetDoMultiBit(short core, short doType, long *pValue, long *pMask, short count=1);
 short GTN_SetEHMIDo(short core, unsigned char *data, unsigned short offset, unsigned short count);
 short GTN_SetGtmDoBit(short core, short station, short slot, short doIndex, short *pValue, short count=1);
 short GTN_SetLimit(short core, short axis, short type, void *pPrm);
+short GTN_SetPowerOffDo(short core, short mode, short doIndex, short doValue);
+short GTN_SetStopIoPrm(short core, short axis, short stopType, short inputType, short inputIndex, short mode, short modePrm);
+short GTN_SetStopIoPro(short core, short axis, short stopType, TStopIoPrm *pPrm, short count, TListInfo *pListInfo);
+short GTN_SetTorqueLimit(short core, short axis, TTorqueLimit *pTorqueLimit);
+short GTN_SetVelLimitAngleThresholdLa(short core, short crd, double angleThreshold);
 short GTN_WaitDigitalInput(short core, TDigitalInput *pDi, TListInfo *pListInfo);
 short GTN_WriteDigitalOutput(short core, TDigitalOutput *pDo, TListInfo *pListInfo=NULL);
 short GTN_WriteDigitalOutputBit(short core, TDigitalOutputBit *pDoBit /*inout*/, TListInfo *pListInfo /*inout*/);
+short GTN_WriteDigitalOutputPro(short core, TDigitalOutputPro *pDo, TListInfo *pListInfo);
 """

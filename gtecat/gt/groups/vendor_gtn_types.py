@@ -306,6 +306,116 @@ typedef struct { short enable; short checkResult; short reserve1[6]; double rese
 typedef struct { short windowSize; short lostSize; long torqueLimitMax; long torqueLimitMin; short continuousProtectCount; short oscillationPositiveProtectCount; short oscillationNegativeProtectCount; short reserve[15]; } TGantryTorqueProtectPrm;
 typedef struct { long torqueProtectSts; long torqueProtectEnable; short reserve[20]; } TGantryInf;
 typedef struct { short direction; short reserve[3]; } TGPIOConfig;
+typedef struct { double stopPos; short mode; short pad[3]; } TStopPos;
+typedef struct { short start; short execute; short occupyStatus; short executeCount; long pad2[2]; double pad3[2]; } TTaskStatus;
+typedef struct { short mode; short elementSize; short reserve1[6]; long forwardSpace; long reverseSpace; long reserve2[6]; } TCommandListConfig;
+typedef struct { short command; short index[2]; short reserve[5]; } TCommandListLink;
+typedef struct { short startMode; short reserve1[15]; } TCommandListStartParameter;
+typedef struct { unsigned long loop; short reserve1[10]; long reserve2[2]; } TCommandListStaticParameter;
+typedef struct { double velOverride; double reserve[40]; } TCommandListEstimatePrm;
+typedef struct { short mode; short reserve1[3]; double time; double reserve2[8]; } TCommandListEstimateInfo;
+typedef struct { short enable; short master; short filterTime; short mode; short fixedMpgVelCount; short pad1[3]; long masterEven; long slaveEven; long pad2[2]; double fixedMpgVel[8]; double ratioUpdateTime; double pad3[3]; } TCommandListMpgPrm;
+typedef struct { double velMax; double accMax; double decMax; double jerkMax; double dvMax; short reverseLimitMode; short reserve1[3]; double reserve2[8]; } TAxisMotionConstraint;
+typedef struct { short count; short reserve[3]; double alpha[4]; double beta[4]; } TScaleParameter;
+typedef struct { double currentToTorqueCoef; double ratedCurrent; double reserve[4]; } TAxisMotorParameter;
+typedef struct { double deceleration; double jerk; short reserve1[4]; double reserve2[5]; } TAxisStopParameter;
+typedef struct { long code; short index; short subIndex; short pad1[2]; } TReadHsCommand;
+typedef struct { short enable; short master; short filterTime; short mode; short fixedMpgVelCount; short pad1[3]; long masterEven; long slaveEven; long pad2[2]; double fixedMpgVel[8]; double ratioUpdateTime; double pad3[3]; } TCrdMpgPrm;
+typedef struct { unsigned long commandCode; short commandRtn; short errorCode; unsigned long clockTime; long segmentNum; long userTag; short dataLength; unsigned short data16[225]; } TCommandInfoData;
+typedef struct { double minDuty; double maxDuty; double minFrequency; double maxFrequency; double minPulseWidth; double maxPulseWidth; } TLaserPwmPrmPro;
+typedef struct { double endPos[3]; double centerPos[3]; short circleDir; short pad[3]; TScanMotionPrmUnionPro motionPrm; } TScanArcMotionPro;
+typedef struct { short enable; int16_t batchCmdReceive; int16_t batchCmdSend; int16_t fifoSpace; } TBatchDataSendingSts;
+typedef struct { TBatchDataSendingSts batchDataSts; int16_t batchSendCount; int16_t wordDataSendCount; int16_t stationFifoSpace; int32_t cmdCount; int16_t reserve[7]; } TScanBatchDataSendingSts;
+typedef struct { double pos; double vel; double acc; double dec; short percent; short pad1[3]; double velStart; double velEnd; short accStartPercent; short decEndPercent; short dir; short pad2; short reserve[10]; } TMoveAbsoluteProPrm;
+typedef struct { short active; short alarmType; short alarmIndex; short limitPositiveType; short limitPositiveIndex; short limitNegativeType; short limitNegativeIndex; short smoothStopType; short smoothStopIndex; short abruptStopType; short abruptStopIndex; short prfMap[2]; short encMap[2]; short prfMapAlpha[2]; short prfMapBeta[2]; short encMapAlpha[2]; short encMapBeta[2]; } TAxisConfigPro;
+typedef struct { unsigned long terminalTxBuf[256]; unsigned long terminalRxBuf[256]; } TTerminalData;
+typedef struct { short enable; short latchType; short latchIndex; short probeType; short probeIndex; short windowOnly; long firstPosition; long lastPosition; long continueTime; double currentValue; double pad2[3]; } TTorqueTriggerPrm;
+typedef struct { double value; double reverse[4]; } TServoSpdLoopPidMode0;
+typedef union { TServoSpdLoopPidMode0 servoSpdLoopPidMode0; } TServoSpdLoopPidUnion;
+typedef struct { short mode; short reverse[3]; TServoSpdLoopPidUnion servoSpdLoopPidPrm; } TServoSpdLoopPid;
+typedef struct { char uuid[32]; char mcInf[32]; } TEncryptConfigPrm;
+typedef struct { char keyValue[32]; char data[32]; } TEncryptData;
+typedef struct { short type; short userKeySlotOffset; short userDataSlotOffset; short cardType; short reverse1[8]; } TEncryptChipInf;
+typedef struct { char sn[9]; char random[32]; TEncryptChipInf chipInf; } TEncryptAuxInf;
+typedef struct { char data[32]; char hMac[32]; } TEncryptDataPro;
+typedef struct { char oldKey[32]; char newKey[32]; } TEncryptKey;
+typedef struct { short type; short index[2]; } TAddition;
+typedef struct { double pos; double vel; } TAdditionStatus;
+typedef struct { short profileType[3]; short profileIndex[3]; short profileId[3]; short encoderType[3]; short encoderIndex[3]; short encoderId[3]; } TContourConfig;
+typedef struct { double kp[3]; double ki[3]; short errorWindow[3]; short limit[3]; } TContourControl;
+typedef struct { short cornerStepIn; short cornerStepOut; short reserved1[2]; double cornerTheta; short reserved2[4]; double window; double para; } TContourMode;
+typedef struct { short index; } TPVTPosCompareStart;
+typedef struct { short index; } TPVTPosCompareStop;
+typedef struct { short index; short id; short reverse1[2]; double reverse2[4]; } TResPhyInfo;
+typedef struct { short core; short dataType; short index; short reserve[5]; } TLogicInfo;
+typedef struct { short cardIndex; short stationPhyId; short modulePhyId; short dataType; short index; short reserve[3]; } TPhysicInfo;
+typedef struct { short relateEnable; short netSrc; short netSrcIndex; short reserve1[9]; double reserve2[3]; } TSlaveRelateInfo;
+typedef struct { double distance; double vM; double acc; double pa1; double pa2; double dec; double pd1; double pd2; double velM; double accM; double decM; double time; } TPvtTableMoveAbsolutePrm;
+typedef struct { double targetPos; double safetyPos; double slaveMiddlePos[3]; } TBufLeapFrogInfo;
+typedef struct { double synDistance; double movedsynDistance; double reserve1[10]; } TCrdMoveInfo;
+typedef struct { short followMode; short hsoOutputMode; short timeScale; short pad; double maxValue; double minValue; double k; double b; } TPosCompareFollowCrd;
+typedef struct { short index; short enable; short reserve1[2]; long reserve2[2]; } TPosCompareOnOffList;
+typedef struct { short index; short reserve[3]; unsigned long count; long syncPos; long time; } TPosComparePsoPrmList;
+typedef struct { unsigned short resType; unsigned short resIndex; unsigned short resSubIndex; unsigned short resCount; double resValue[256]; } TMcVarResInfo;
+typedef struct { TWatchVar var; unsigned short condition; double value; double continueTime; } TWatchConditionVar;
+typedef struct { short conditionDone; short modal; short reserve1[2]; long segNum; long userTag; long reserve2[8]; } TWaitForConditionInfo;
+typedef struct { short mode; short clear; short reserve[2]; } TStartTimerPrm;
+typedef struct { short run; short reserve[3]; double value; } TTimerInfo;
+typedef struct { unsigned long objectIndex; unsigned short subIndex; unsigned short reserve; short byteSize; short memType; } TServoParamReader;
+typedef struct { double gain1; double gain2; double smoothTime; double spdLimitUpper; double spdLimitLower; double reserved[4]; } TServoNonlinearGlobalGain;
+typedef struct { long segmentNumber; long posX; long posY; short gpo; short hso; short reserve[4]; } TPosCompareCommandPos;
+typedef struct { long segmentNumber; long time; short pad[2]; short gpo; short hso; } TPosCompareCommandTime;
+typedef union { TPosCompareCommandPos pos; TPosCompareCommandTime time; short data16[12]; } TPosComparePredictiondataUnion;
+typedef struct { short type; short pad[3]; TPosComparePredictiondataUnion data; } TPosComparePredictionData;
+typedef struct { double pos[40]; } TEllipseAuxPoint;
+typedef struct { double centerPoint[8]; double theta; double a; double b; } TEllipseStandard;
+typedef union { TEllipseAuxPoint auxPoint; TEllipseStandard standard; double reserve[60]; } TEllipseParameterUnion;
+typedef struct { double endPoint[8]; short plane; short dir; short overrideSelect; short mode; TEllipseParameterUnion data; } TEllipseParameter;
+typedef struct { short commandCount; short errorCommandNumber; short errorCode; short reserve[5]; } TBatchCommandResult;
+typedef struct { short active; short ctlMode; short linkHeightCtlGroup; short feedbackType; short feedbackIndex; short interval; long errorLimit; short reserve[8]; } THeightControlPrm;
+typedef struct { short type; short index; long crossPos; short dir; short pad1[3]; } THeightCrossPrm;
+typedef struct { short keepEnable; short pad1[3]; THeightCrossPrm enableData; THeightCrossPrm disableData; } THeightFollowPrm;
+typedef struct { short ctlMode; short errorSts; double cmpValue; } THeightInf;
+typedef struct { short heightCtlGroup; short motorEncoder; short pad[2]; double homeVel; double homeDir; long frqMutationStopValue; long offset; double distance; double calibrationVel; double calibrationStepCount; double calibrationCountPerStep[50]; double reserve[4]; } TDifferentStepCalibration;
+typedef union { TDifferentStepCalibration differentStep; } THeightCalibration;
+typedef struct { short mode; THeightCalibration prm; } THeightCalibrationPrm;
+typedef struct { long positiveMutationValue; short positiveMutationStopLinkLimitType; long negativeMutationValue; short negativeMutationStopLinkLimitType; } TFrqMutationStopPrm;
+typedef struct { short type; short moveAxis; short latchNum; short reserve1; short latchType[4]; short latchIndex[4]; long heightDiff; long reserve2; double findTime; } THeightFindEdgePrm;
+typedef struct { short findEdgeSts; short error; double latchValue[4]; } THeightFindEdgeResult;
+typedef struct { double vel; double acc; double dec; double smoothTime; double safetyVel; short slaveType; short slaveIndex; long followCmd; short followEnable; short enable; short reserve1[2]; double reserve2[4]; } TSetAxisLeapFrogPrm;
+typedef struct { double pos[2]; double compensateValue; } TCompensatePathPoint;
+typedef struct { short tableIndex; short axisType[2]; short axisIndex[2]; short reserve1[3]; double offset[2]; double compensateVelMax; double approachRadius; double workBand; double workHeight; double reserve2[2]; } TCompensatePathParameter;
+typedef struct { short enable; short state; short errorStatus; short pointIndex; double compensateStartPos[2]; double compensateValue; double reserve1[2]; } TCompensatePathStatus;
+typedef struct { short stationId; short axis; unsigned long long multiLines; double pos; } StAbsEncPos;
+typedef struct { short mode; short smoothTimer; long moveTime; long pad; double synVel; double synAcc; double synJeck; } TPvtLinePrm;
+typedef struct { unsigned short type; unsigned short closewise; unsigned long cutEnable; double targetPosX; double targetPosY; double circleCenterX; double circleCenterY; } StBatteryTargetSegment;
+typedef struct { unsigned short segmentNum; unsigned short cycleNum; StBatteryTargetSegment batteryTargetSegment[100]; double segmentIncreaseX[100]; double segmentIncreaseY[100]; } StScanShape;
+typedef struct { long encAxisSrc; long prfEncSel; double encPulsePreDistance; double scanPulsePreDistance; } StScanBatteryParam;
+typedef struct { unsigned short bits1; } StScanAttributeCfg;
+typedef struct { unsigned short skip_count; unsigned short netOpenSts; unsigned short *slave_position; char *eniFilePath; unsigned short reserve2[20]; } TEcatInitPrm;
+typedef struct { short resType; short resIndex; short mapIndex; short mapCount; } TResTypeMapInfo;
+typedef struct { short resMapType; short resMapCount; TResTypeMapInfo resmapInfo[64]; } TTerminalResMapInfo;
+typedef struct { short netType; unsigned short terminalType; unsigned short terminalSubType; short phyId; short slotCount; unsigned short slotType[16]; unsigned short slotSubType[16]; short stationResMapCount; TTerminalResMapInfo terminalResMapInfo[64]; } TTerminalInfo;
+typedef struct { short stationPhyId; short index; short type; } TRemoteChannelPrm;
+typedef struct { short enableFlag; short occupy; short type; short index; short lastReceiveError; short lastSendError; unsigned short errorCount; unsigned short continueErrorCount; } TRemoteChannelInfo;
+typedef struct { short laserOn; short laserEnable; short laserRed; short laserPowerLatch; double duty; double frequency; double pulseWidth; double voltage; double parallel; } TLaserPowerPro;
+typedef struct { short laserOn; short laserEnable; short laserRed; short laserPowerLatch; double duty; double frequency; double pulseWidth; double voltage; double parallel; double minDuty; double maxDuty; double minFrequency; double maxFrequency; double minPulseWidth; double maxPulseWidth; double minVoltage; double maxVoltage; double minParallel; double maxParallel; double laserOnDelay; double laserOffDelay; } TLaserPro;
+typedef struct { short powerType; short group; short source; short coordSystem; double ratio; double minPower; double maxPower; } TLaserFollowPrmPro;
+typedef struct { short powerType; short group; short source; short coordSystem; short tableId; short pad[3]; double minPower; double maxPower; } TLaserFollowTablePrmPro;
+typedef struct { short group; short source; short coordSystem; short dutyTableId; short frequencyTableId; short pad[3]; double minDuty; double maxDuty; double minFrequency; double maxFrequency; } TLaserFollowDuoTablePrmPro;
+typedef struct { short enable; short mode; short errorCode; short returnValue; double power; double powerAnother; TLaserFollowPrmPro ratioPrm; TLaserFollowTablePrmPro tablePrm; TLaserFollowDuoTablePrmPro duoTablePrm; } TLaserFollowPro;
+typedef struct { double kp; double ki; double kd; double kvff; double kaff; long integralLimit; long derivativeLimit; short limit; short reserve[3]; } TPidAlign;
+typedef struct { short mode; short master; short slave; short reserve[3]; long syncErrorLimit; TPidAlign gantryMasterPid; TPidAlign gantrySlavePid; TPidAlign masterPid; TPidAlign slavePid; } TGantryPrmPro;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short mode; unsigned short reserve; unsigned short reserve2; long modify_delta; long ratio_a; long ratio_b; } TStGearParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long long target_pos; unsigned long max_vel; unsigned short reserve2[2]; } TStTrapParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long target_vel; unsigned long max_acc; unsigned long reserve1; unsigned short reserve2[2]; } TStJogParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long long target_pos; unsigned long max_vel; long main_axis_shift; long second_axis_shift; unsigned short reserve2[2]; } TStGantrayTrapParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long target_vel; unsigned short reserve3[2]; long long reserve2; } TStDriverVelParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long target_acc; unsigned short reserve3[2]; long long reserve2; } TStDriverCurParam;
+typedef struct { short profileMode; unsigned short reserve2[3]; TStTrapParam trapPrm; TStJogParam jogPrm; TStGearParam gearPrm; TStGantrayTrapParam gantrayTrapPrm; TStDriverVelParam driverVelPrm; TStDriverCurParam driverCurPrm; } TSetMultiMcFunctionPrm;
+typedef struct { unsigned short prmErrorInf; short readCommandVarTableIndex; short readCount; short pad[2]; short realReadCount; double *pVarValue; } TMultiMcFunctionReadPrm;
+typedef struct { short enable; short reserve1[3]; double reserve2[4]; } TAxisSimulationParameter;
+typedef struct { short varId; short stationId; short varType; short varIndex; } StSamplingVar;
 """
 
 CONSTANTS = r"""
@@ -777,4 +887,212 @@ CONSTANTS = r"""
 #define AXIS_SIDE_TOOL 0
 #define AXIS_SIDE_WORK_PIECE 1
 #define GANTRY_MODE_RINGNET_DRIVER 10
+#define STANDARD_HOME_ERROR_NO_MOTOR_STOP_CHECK -2
+#define POS_COMPARE_RESULT_FIFO_MODE_STATIC 0
+#define POS_COMPARE_RESULT_FIFO_MODE_LOOP 1
+#define LIST_STATUS_RESERVE2_REVERSE_LAST_USER_TAG 4
+#define COMMAND_LIST_MODE_STATIC 0
+#define COMMAND_LIST_MODE_DYNAMIC 1
+#define COMMAND_LIST_MPG_MODE_BIDIRECTION 0
+#define COMMAND_LIST_MPG_MODE_POS 1
+#define COMMAND_LIST_MPG_MODE_NEG -1
+#define COMMAND_LIST_MPG_MODE_WINDOW 2
+#define COMMAND_LIST_MPG_MODE_SIM 100
+#define COMMAND_LIST_MPG_FIXED_VEL_COUNT_MAX 8
+#define AXIS_MOTION_CONSTRAINT_RESERVE1_DV_MAX_LIMIT 0
+#define WATCH_CONDITION_NONE 0
+#define WATCH_VAR_NONE 0
+#define WATCH_VAR_UUID 1000
+#define WATCH_VAR_POWER_ON_COUNT 1060
+#define WATCH_VAR_DSP_PROGRAM_COUNT 1070
+#define WATCH_VAR_DSP_TEMPERATURE 1072
+#define WATCH_VAR_FPGA_PROGRAM_COUNT 1080
+#define WATCH_VAR_LINKPORT_TX_STATUS 1662
+#define WATCH_VAR_LINKPORT_TX_ERROR_COUNT 1663
+#define WATCH_VAR_LINKPORT_TX_SKIP_MAX 1664
+#define WATCH_VAR_SPORT_STATUS 1682
+#define WATCH_VAR_SPORT_ERROR_COUNT 1683
+#define WATCH_VAR_PRF_POS_RAW 6003
+#define WATCH_VAR_PRF_VEL_RAW 6004
+#define WATCH_VAR_PRF_VEL_F32 6011
+#define WATCH_VAR_PRF_ACC_F32 6012
+#define WATCH_VAR_PRF_JERK_F32 6013
+#define WATCH_VAR_PRF_VEL_64 6021
+#define WATCH_VAR_LIMIT_POSITIVE_STATUS 6201
+#define WATCH_VAR_LIMIT_NEGATIVE_STATUS 6202
+#define WATCH_VAR_PT_SPACE 6660
+#define WATCH_VAR_PT_RECEIVE 6662
+#define WATCH_VAR_PT_EXECUTE 6663
+#define WATCH_VAR_TRAP_TOTAL_TIME 6670
+#define WATCH_VAR_TRAP_REMAIN_TIME 6671
+#define WATCH_VAR_MOVE_ABSOLUTE_DONE 7008
+#define WATCH_VAR_MOVE_VELOCITY_IN_VELOCITY 7058
+#define WATCH_VAR_CRD_PRF_VEL_RAW 8003
+#define WATCH_VAR_CRD_PRF_TEMP_DATA 8010
+#define WATCH_VAR_CONTOUR_PEDAL_POS 8800
+#define WATCH_VAR_CONTOUR_PRF_POS 8801
+#define WATCH_VAR_CONTOUR_PRF_POS_SHAPING 8802
+#define WATCH_VAR_CONTOUR_ENC_POS 8803
+#define WATCH_VAR_CONTOUR_DAC 8804
+#define WATCH_VAR_CONTOUR_FIFO_POINT_COUNT 8808
+#define WATCH_VAR_CONTOUR_FIFO_POINT_MAX 8809
+#define WATCH_VAR_LIST_EXECUTE 9240
+#define WATCH_VAR_LIST_SEG_NUM 9250
+#define WATCH_VAR_CATCH_UP_STATE 12000
+#define WATCH_VAR_CATCH_UP_COMMAND 12001
+#define WATCH_VAR_CATCH_UP_MASTER_POS 12002
+#define WATCH_VAR_CATCH_UP_MASTER_VEL 12003
+#define WATCH_VAR_CATCH_UP_SLAVE_POS 12004
+#define WATCH_VAR_CATCH_UP_SLAVE_VEL 12005
+#define WATCH_VAR_CATCH_UP_PIECE_POS 12006
+#define WATCH_VAR_CATCH_UP_PIECE_ID 12007
+#define WATCH_VAR_CATCH_UP_PIECE_COUNT 12008
+#define WATCH_VAR_CATCH_UP_PIECE_FIFO_COMMAND_RECEIVE 12009
+#define WATCH_VAR_CATCH_UP_PIECE_FIFO_COMMAND_SEND 12010
+#define WATCH_VAR_CATCH_UP_SYNCH_DISTANCE 12011
+#define WATCH_VAR_CATCH_UP_SYNCN_TIME 12012
+#define WATCH_VAR_CATCH_UP_PIECE_START_POS 12013
+#define WATCH_VAR_CATCH_UP_PIECE_SYNCH_POS 12014
+#define WATCH_VAR_CATCH_UP_SLAVE_START_POS 12015
+#define WATCH_VAR_CATCH_UP_SLAVE_SYNCH_POS 12016
+#define WATCH_VAR_POS_COMPARE_PULSE_COUNT 17426
+#define WATCH_VAR_POS_COMPARE_PSO_ON_OFF 17427
+#define WATCH_VAR_POS_COMPARE_PSO_REG 17430
+#define WATCH_VAR_POS_COMPARE_PSO_REG_EXT 17431
+#define WATCH_VAR_POS_COMPARE_ENC_PSO_ON_OFF 17432
+#define WATCH_VAR_SCAN_PRF_POS_Z 18030
+#define WATCH_VAR_LASER_WORK_RATIO 18602
+#define WATCH_VAR_AXIS_PRF_POS_FILTER 20010
+#define WATCH_VAR_AXIS_TEMP_PRF_POS_FILTER 20012
+#define WATCH_VAR_AXIS_PRF_POS_FILTER_BEFORE_COMP 20013
+#define WATCH_VAR_AXIS_PRF_VEL_64 20021
+#define WATCH_VAR_AXIS_RUN 20200
+#define WATCH_VAR_AXIS_ENC_POS_FILTER 20310
+#define WATCH_VAR_AXIS_ENC_VEL_FILTER 20311
+#define WATCH_VAR_AXIS_ENC_VEL_64_FILTER 20321
+#define WATCH_VAR_AXIS_PREDICTION_POS_IN 20350
+#define WATCH_VAR_AXIS_PREDICTION_POS_IN_2 20351
+#define WATCH_VAR_AXIS_PREDICTION_POS_OUT 20352
+#define WATCH_VAR_AXIS_PREDICTION_VEL_IN 20355
+#define WATCH_VAR_AXIS_PREDICTION_VEL_IN_2 20356
+#define WATCH_VAR_AXIS_PREDICTION_VEL_OUT 20357
+#define WATCH_VAR_AXIS_PREDICTION_OUT 20360
+#define WATCH_VAR_AXIS_PREDICTION_FILTER_POS 20361
+#define WATCH_VAR_AXIS_PREDICTION_FILTER_VEL 20362
+#define WATCH_VAR_POSCOMPARE_PREDICTION_ENABLE 20370
+#define WATCH_VAR_POSCOMPARE_PREDICTION_WORK 20371
+#define WATCH_VAR_POSCOMPARE_PREDICTION_OUTPUT_COUNT_TOTAL 20372
+#define WATCH_VAR_DRIVER_ACT_VEL 20400
+#define WATCH_VAR_STIMULATE_DATA 20401
+#define WATCH_VAR_DRIVER_CURRENT_KVFF 20402
+#define WATCH_VAR_CONTROL_ERROR 20500
+#define WATCH_VAR_BACKLASH_VALUE 21000
+#define WATCH_VAR_LEADSCREW_VALUE 21001
+#define WATCH_VAR_FRICTION_VALUE 21003
+#define WATCH_VAR_PULSE_POS 30010
+#define WATCH_VAR_ENC_VEL_64 30021
+#define WATCH_VAR_AU_ENC_VEL_64 30022
+#define WATCH_VAR_ENC_VEL_64_1MS 30023
+#define WATCH_VAR_AU_ENC_VEL_64_1MS 30024
+#define WATCH_VAR_MPG_INFO 30200
+#define WATCH_VAR_AU_ENCODER_EX_POS 30201
+#define WATCH_VAR_AU_ENCODER_EX_VEL 30202
+#define WATCH_VAR_MPG_ENCODER_POS 30203
+#define WATCH_VAR_MPG_ENCODER_VEL 30204
+#define WATCH_VAR_ARRIVE_DI 31055
+#define WATCH_VAR_SERVO_READY_DI 31056
+#define WATCH_VAR_SERVO_READY_TO_SWITCH_ON_DI 31057
+#define WATCH_VAR_BANK_GPI 31060
+#define WATCH_VAR_AU_AI 33100
+#define WATCH_VAR_POS_LOOP_REF_POS 40001
+#define WATCH_VAR_POS_LOOP_FILTER_VALUE 40002
+#define WATCH_VAR_FIR_POS_IN 48000
+#define WATCH_VAR_FIR_POS_OUT 48001
+#define WATCH_VAR_WATCH_ENABLE 52000
+#define WATCH_VAR_WATCH_EVENT_VALUE_WORK 52002
+#define WATCH_VAR_EVENT_HIT 60000
+#define WATCH_VAR_TASK_START 61000
+#define WATCH_VAR_TASK_WORK 61001
+#define WATCH_VAR_ATL_TORQUE 61201
+#define WATCH_VAR_CONSTANT 61405
+#define VAR_FORMAT_INT 1
+#define VAR_FORMAT_FLOAT 2
+#define VAR_FORMAT_DOUBLE 3
+#define VAR_CALCULATE_MAX 32
+#define MAX_CRDMPG_FIXEDMPGVEL 8
+#define TRIGGER_PROFILE_STATUS_NONE 0
+#define TRIGGER_PROFILE_STATUS_ERROR_END_POS 1
+#define TRIGGER_PROFILE_STATUS_VEL 2
+#define COMMANDINFO_DATA_MAX 225
+#define SCAN_LASER_MODE_NONE 10
+#define SCAN_MOTION_CIRCLE_DIR_CW 0
+#define SCAN_MOTION_CIRCLE_DIR_CCW 1
+#define SCAN_MARK_DELAY_MODE_CONST 0
+#define SCAN_MARK_DELAY_MODE_CHANGE 1
+#define LASER_ENABLE_DO 76
+#define LASER_RED_LED_DO 77
+#define LASER_POWER_LATCH_DO 78
+#define SERBVO_POS_LOOP 0
+#define SERBVO_SPD_LOOP 1
+#define PORT_A_GENERAL_GLINK_II 1
+#define PORT_B_GENERAL_GLINK_II 2
+#define PORT_C_HIGH_SPEED_GLINK_II 3
+#define PORT_D_ETHER_CAT 4
+#define SLAVE_MIDDLE_POS_DIMENSION_MAX 3
+#define PREDICTION_MODE_AXIS_VELOCITY_TO_FOLLOWERROR 0
+#define PREDICTION_MODE_AXIS_VELOCITY_TO_VELOCITY 1
+#define PREDICTION_MODE_AXIS_POSITION_TO_POSITION 2
+#define START_TIMER_MAX 32
+#define BATCH_COMMAND_END_MODE_DEFAULT 0
+#define BATCH_COMMAND_END_MODE_GET_MC_VAR_EX 1
+#define MC_HEIGHT_FREQUENCY 450
+#define HEIGHT_DIR_CROSS_POSITIVE 1
+#define HEIGHT_DIR_CROSS_NEGATIVE 2
+#define HEIGHT_DIR_CROSS_EQUAL 3
+#define HEIGHT_FOLLOW_ENABLE_MODE_MANUAL 0
+#define HEIGHT_FOLLOW_ENABLE_MODE_AUTO 1
+#define HEIGHT_FILTER_TYPE_FREQUENCY 1
+#define HEIGHT_FILTER_TYPE_CMP_VALUE 2
+#define CALIBRATION_MODE_DIFFERENT_STEP 1
+#define DIFFERENT_STEP_CALIBRATION_STAGE_NONE -1
+#define DIFFERENT_STEP_CALIBRATION_STAGE_HOME_SEARCH 1
+#define DIFFERENT_STEP_CALIBRATION_STAGE_GO_OFFSET 2
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_INIT 3
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION 4
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_DONE 5
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_STOP 6
+#define DIFFERENT_STEP_CALIBRATION_STAGE_HOME_START_ERROR 100
+#define DIFFERENT_STEP_CALIBRATION_STAGE_HOME_SEARCH_ERROR 101
+#define DIFFERENT_STEP_CALIBRATION_STAGE_GO_OFFSET_ERROR 102
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_ERROR 103
+#define DIFFERENT_STEP_CALIBRATION_STAGE_NOT_AXIS_ON 104
+#define DIFFERENT_STEP_CALIBRATION_STAGE_SET_TABLE_ERROR 105
+#define DIFFERENT_STEP_CALIBRATION_STEP_MAX 4000
+#define CALIBRATION_STEP_MAX 50
+#define HEIGHT_FINDEDGE_LATCH_MAX 4
+#define MAX_SEGMENT_NUM 100
+#define ERROR_CODE_NO_SLAVE -10
+#define ERROR_CODE_NO_ENI -9
+#define ERROR_CODE_CONFIG_FAIL -8
+#define ERROR_CODE_ENI_ERROR -1
+#define RING_NET_PDU_FAST_LINK_TYPE_NONE 0
+#define RING_NET_PDU_FAST_LINK_TYPE_REMOTE_AU_ENCODER 1
+#define RING_NET_PDU_FAST_LINK_TYPE_POS_COMPARE_LINEAR 2
+#define LASER_ON_MODE_DEFAULT 0
+#define LASER_OFF_MODE_POWER_OFF 0
+#define LASER_OFF_MODE_POWER_HOLD 1
+#define LASER_FOLLOW_MODE_NONE 0
+#define LASER_FOLLOW_MODE_RATIO 1
+#define LASER_FOLLOW_MODE_TABLE 2
+#define LASER_FOLLOW_MODE_DUO_TABLE 3
+#define LASER_FOLLOW_POWER_TYPE_DUTY 0
+#define LASER_FOLLOW_POWER_TYPE_FREQUENCY 1
+#define LASER_FOLLOW_POWER_TYPE_PULSE_WIDTH 2
+#define LASER_FOLLOW_POWER_TYPE_VOLTAGE 3
+#define LASER_FOLLOW_POWER_TYPE_PARALLEL 4
+#define LASER_FOLLOW_SYNCH_VEL_SOURCE_PROFILE 0
+#define LASER_FOLLOW_SYNCH_VEL_SOURCE_ENCODER 1
+#define SCAN_START_IN_LIST_MODE_INDIVIDUAL 0
+#define SCAN_START_IN_LIST_MODE_CHECK 1
+#define AXISSIMULATION_RESERVE1_SUBMODE 0
 """
