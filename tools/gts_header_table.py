@@ -120,6 +120,21 @@ CALLBACKS: set[str] = set()
 _CALLBACK = re.compile(r"typedef\s+[\w\s*]+\(\s*(?:__stdcall\s*)?\*\s*(\w+)\s*\)")
 
 
+#: the <stdint.h> and Windows spellings a newer header uses, as the table spells them (the
+#: header gts.h declares them with no <stdint.h>)
+_PLAIN_C = {
+    "__int64": "long long", "int64_t": "long long", "uint64_t": "unsigned long long",
+    "int32_t": "int", "uint32_t": "unsigned int", "int16_t": "short",
+    "uint16_t": "unsigned short", "int8_t": "signed char", "uint8_t": "unsigned char",
+}  # fmt: skip
+
+
+def plain_c(text: str) -> str:
+    return re.sub(
+        r"\b(" + "|".join(_PLAIN_C) + r")\b", lambda m: _PLAIN_C[m[1]], text
+    )
+
+
 _INLINE_CALLBACK = re.compile(
     r"(^|,)\s*[\w\s*]*?\(\s*(?:__stdcall\s*)?\*\s*(\w+)\s*\)\s*\([^()]*\)"
 )
@@ -133,6 +148,7 @@ def params(text: str, where: str) -> list[str]:
     # a function-pointer parameter spelled in place (``void (*pfn)(void *, short *)``)
     text = _INLINE_CALLBACK.sub(r"\1 void *\2", text)
     text = re.sub(r"\bbool\b", "unsigned char", text)  # C++'s bool: one byte under MSVC
+    text = plain_c(text)
     if text in ("", "void"):
         return []
     out = []
@@ -397,7 +413,7 @@ def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
             body,
         )
         for block in re.findall(r"typedef\s+(?:struct|union|enum)\s*\w*\s*\{[^{}]*\}[^;]*;", body):
-            block = fold_bitfields(block)
+            block = plain_c(fold_bitfields(block))
             try:
                 tds.extend(typedefs.parse(block, known=consts))
             except typedefs.TypedefError as e:

@@ -38,6 +38,6 @@ short GTN_SetGantryPrmPro(short core, short group, TGantryPrmPro *pGantryPrmPro)
 short GTN_SetGantryProtectPrm(short core, short group, short torqueProtectType, TGantryTorqueProtectPrm *pPrm);
 short GT_SetGantrySynchErrorCompensate2D(short group, TCompensate2D *pComp2d /*inout*/);
 short GT_SetGantrySynchErrorCompensate2DTable(short tableIndex, TCompensate2DTable *pTable /*inout*/, long *pData /*inout*/, short extend);
-short GTN_SetMultiAxisLeadScrewCrossCompData(short core, TAxisLeadScrewCrossCompData *pAxisLeadScrewCrossCompData, int16_t count);
+short GTN_SetMultiAxisLeadScrewCrossCompData(short core, TAxisLeadScrewCrossCompData *pAxisLeadScrewCrossCompData, short count);
 short GT_StartAxisPressCompensateFixFactor(short axis, TAxisPressCompensateFixFactor *pPressComp /*inout*/);
 """

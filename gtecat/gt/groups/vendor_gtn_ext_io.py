@@ -11,7 +11,7 @@ DECLARED_ONLY = True
 PROTOTYPES = r"""
 short GTN_BufExtDoBit(short core, short crd, unsigned short doIndex, unsigned short doValue, short fifo);
 short GTN_BufExtDoBitEx(short core, short crd, unsigned short doIndex, unsigned short doValue, short fifo);
-short GTN_FollowExtDoEx(short core, short profile, short doIndex, int32_t value, int32_t mask, short fifo);
+short GTN_FollowExtDoEx(short core, short profile, short doIndex, int value, int mask, short fifo);
 short GT_GetChnStsExtMdl(unsigned short *pStatus);
 short GTN_GetExtModuleAccessMode(short core, short *pMode);
 short GTN_GetExtModuleInitMode(short core, short *pInitMode);

@@ -11,7 +11,7 @@ DECLARED_ONLY = True
 PROTOTYPES = r"""
 short GTN_ClearScanExecuteTime(short core, short scan=1);
 short GTN_ClearScanExecuteTimePro(short core, short scanCrd);
-short GTN_EnableScanBatchDataSend(int16_t core, int16_t enable);
+short GTN_EnableScanBatchDataSend(short core, short enable);
 short GTN_EncryptionFunConfig(short core, short slotIndex, unsigned char *pOldKey /*inout*/, unsigned char *pNewKey /*inout*/, unsigned char *pUserData /*inout*/, short *pSts, short *pConfigured);
 short GT_GetBufWaitLongVarStatus(short crd, short *pIndex, long *pValue, short *pFlagMode, long *pSegNum, short *pEnable, short *pStatus, short fifo);
 short GTN_GetEventStatus(short core, short index, TEventStatus *pStatus);
@@ -20,7 +20,7 @@ short GTN_GetFunIdPro(short core, char *pFunName, short *pFunId);
 short GTN_GetMcVarArray(short core, short resInfoCount, TMcVarResInfo *pResInfo);
 short GTN_GetMcVarEx(short core, const TWatchVar *pVar, double *pValue, short count);
 short GTN_GetScanAlarmAutoStopMode(short core, short *pMode, unsigned long *pErrorcodeCheckMask, unsigned long *pErrorcodeCheckRef, short crd);
-short GTN_GetScanBatchDataSendingSts(int16_t core, int16_t scanIndex, TScanBatchDataSendingSts *pScanBatchDataSendingSts);
+short GTN_GetScanBatchDataSendingSts(short core, short scanIndex, TScanBatchDataSendingSts *pScanBatchDataSendingSts);
 short GTN_GetScanErrorCode(short core, unsigned long *pErrorCode, short crd);
 short GTN_GetScanExecuteTime(short core, short scan, double *pExecuteTime);
 short GTN_GetScanExecuteTimePro(short core, short scanCrd, double *pExecuteTime);

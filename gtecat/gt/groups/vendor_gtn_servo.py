@@ -13,7 +13,7 @@ short GTN_AxisHeightControlEnable(short core, short axis, short enable, long pos
 short GTN_DisableMpgRoundOff(short core, short mpgIndex, short count=1);
 short GTN_EnableMpgRoundOff(short core, short mpgIndex, short count=1);
 short GTN_GetAbsEncMultiAndSinglePos(short core, short encoder, unsigned long *pMultiPos, unsigned long *pSinglePos);
-short GTN_GetAbsEncPosEx(short core, short encoder, short mode, __int64 *pValue);
+short GTN_GetAbsEncPosEx(short core, short encoder, short mode, long long *pValue);
 short GTN_GetAdcBias(short core, short adc, short *pBias);
 short GTN_GetAuAdcBias(short core, short auAdc, short *pBias);
 short GTN_GetAuEncVelFilter(short core, short type, short encoder, short *pFilterNum);

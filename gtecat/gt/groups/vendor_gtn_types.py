@@ -167,10 +167,10 @@ typedef struct { short tableId; short enable; short loopIndex; short pad; double
 typedef struct { short optimizeMode; short blendingType; short pad[2]; double tolerance; double blendingPrm; double blendingMinAngle; double blendingMaxAngle; } TPathOptimizePrm;
 typedef struct { short enable; long compValue; long compTime; short dir; } TBacklashComp;
 typedef struct { short run; short pad1[3]; long pad2[2]; double pad3[2]; } TLeadScrewCompStatus;
-typedef struct { int16_t axis; int16_t link; int16_t pad; int16_t n; double startPos; double lenPos; } TAxisLeadScrewCrossCompPrm;
+typedef struct { short axis; short link; short pad; short n; double startPos; double lenPos; } TAxisLeadScrewCrossCompPrm;
 typedef struct { double compPos; double compNeg; } TLeadScrewCrossCompData;
-typedef struct { int16_t axis; int16_t pad[2]; int16_t compDataCount; TLeadScrewCrossCompData leadScrewCrossCompData[64]; } TAxisLeadScrewCrossCompData;
-typedef struct { int16_t axis; int16_t enable; int16_t pad[2]; } TEnableAxisLeadScrewCrossComp;
+typedef struct { short axis; short pad[2]; short compDataCount; TLeadScrewCrossCompData leadScrewCrossCompData[64]; } TAxisLeadScrewCrossCompData;
+typedef struct { short axis; short enable; short pad[2]; } TEnableAxisLeadScrewCrossComp;
 typedef struct { short pad1[2]; long reverseTime; long pad2[3]; double pad3[2]; } TDoBit;
 typedef struct { double distance; double delayTime; double reserve[8]; } TAtParameter;
 typedef struct { double distance; double reserve[9]; } TPsoParameter;
@@ -189,7 +189,7 @@ typedef struct { short linkType; short linkIndex; short reserve1[6]; double link
 typedef struct { short type; short index; } TEncoderSource;
 typedef struct { short probeType; short probeIndex; short latchType; short latchIndex; short sense; short pad[3]; double filterWidth; } TSignalDetect;
 typedef struct { short status; short pad[3]; double latchWidth; } TSignalDetectStatus;
-typedef struct { unsigned short mode; unsigned short run; uint32_t space; uint32_t pulseCount; unsigned short hso; unsigned short gpo; uint32_t segmentNumber; uint32_t reserve1[3]; double reserve2[2]; } TPosCompareStatusEx;
+typedef struct { unsigned short mode; unsigned short run; unsigned int space; unsigned int pulseCount; unsigned short hso; unsigned short gpo; unsigned int segmentNumber; unsigned int reserve1[3]; double reserve2[2]; } TPosCompareStatusEx;
 typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long syncPos; long time; short pulseWidth; short pad; } TPosComparePsoPrmPro;
 typedef struct { short referenceX; short referenceY; short pad1[2]; double pad2[2]; } TPosCompareReferencePrm;
 typedef struct { short outputMode; short level; long count; double highLevelTime; double lowLevelTime; double reserve2[4]; } TPosCompareMultiPulse;
@@ -324,8 +324,8 @@ typedef struct { short enable; short master; short filterTime; short mode; short
 typedef struct { unsigned long commandCode; short commandRtn; short errorCode; unsigned long clockTime; long segmentNum; long userTag; short dataLength; unsigned short data16[225]; } TCommandInfoData;
 typedef struct { double minDuty; double maxDuty; double minFrequency; double maxFrequency; double minPulseWidth; double maxPulseWidth; } TLaserPwmPrmPro;
 typedef struct { double endPos[3]; double centerPos[3]; short circleDir; short pad[3]; TScanMotionPrmUnionPro motionPrm; } TScanArcMotionPro;
-typedef struct { short enable; int16_t batchCmdReceive; int16_t batchCmdSend; int16_t fifoSpace; } TBatchDataSendingSts;
-typedef struct { TBatchDataSendingSts batchDataSts; int16_t batchSendCount; int16_t wordDataSendCount; int16_t stationFifoSpace; int32_t cmdCount; int16_t reserve[7]; } TScanBatchDataSendingSts;
+typedef struct { short enable; short batchCmdReceive; short batchCmdSend; short fifoSpace; } TBatchDataSendingSts;
+typedef struct { TBatchDataSendingSts batchDataSts; short batchSendCount; short wordDataSendCount; short stationFifoSpace; int cmdCount; short reserve[7]; } TScanBatchDataSendingSts;
 typedef struct { double pos; double vel; double acc; double dec; short percent; short pad1[3]; double velStart; double velEnd; short accStartPercent; short decEndPercent; short dir; short pad2; short reserve[10]; } TMoveAbsoluteProPrm;
 typedef struct { short active; short alarmType; short alarmIndex; short limitPositiveType; short limitPositiveIndex; short limitNegativeType; short limitNegativeIndex; short smoothStopType; short smoothStopIndex; short abruptStopType; short abruptStopIndex; short prfMap[2]; short encMap[2]; short prfMapAlpha[2]; short prfMapBeta[2]; short encMapAlpha[2]; short encMapBeta[2]; } TAxisConfigPro;
 typedef struct { unsigned long terminalTxBuf[256]; unsigned long terminalRxBuf[256]; } TTerminalData;
