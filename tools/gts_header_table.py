@@ -130,9 +130,7 @@ _PLAIN_C = {
 
 
 def plain_c(text: str) -> str:
-    return re.sub(
-        r"\b(" + "|".join(_PLAIN_C) + r")\b", lambda m: _PLAIN_C[m[1]], text
-    )
+    return re.sub(r"\b(" + "|".join(_PLAIN_C) + r")\b", lambda m: _PLAIN_C[m[1]], text)
 
 
 _INLINE_CALLBACK = re.compile(
@@ -481,9 +479,7 @@ _HAND_STRUCT = re.compile(r"^class (\w+)\((?:ctypes\.)?(?:Structure|Union)\)", r
 TABLE_PARAMS: dict[str, str] = {}
 
 
-def table_has(
-    folder: Path, own: bool = False
-) -> tuple[set[str], set[str], set[str], set[str]]:
+def table_has(folder: Path, own: bool = False) -> tuple[set[str], set[str], set[str], set[str]]:
     """What the table's group files in ``folder`` declare, but ``vendor_gtn_*`` (unless
     ``own``): function names (with the ``GTN_x`` twins), names declared ``(...)`` only,
     structure/enum names and constants."""

@@ -119,7 +119,8 @@ def test_headers_that_disagree_first_named_wins_and_the_line_says_so(tmp_path: P
 NEWER = """
 typedef short (*TUserCallback)(void *, long, void *);
 typedef struct { short varId; short stationId; } StVar;
-typedef struct Flags { unsigned short a : 1; unsigned short b : 1; unsigned short rest : 14; } TFlags;
+typedef struct Flags { unsigned short a : 1; unsigned short b : 1;
+                       unsigned short rest : 14; } TFlags;
 GT_API GTN_Upload(short card, char *path, void (*pfnProgress)(void *, short *), short &progress);
 GT_API GTN_Close2(short card, bool en, int16_t mode, __int64 *pPos, TUserCallback cb);
 GT_API GTN_AddVar(short card, StVar var);
