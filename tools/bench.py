@@ -32,7 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from ctypes import byref, c_long, c_ubyte
 from dataclasses import replace
 from pathlib import Path
@@ -251,23 +251,107 @@ def _rss() -> dict[str, float]:
     return out
 
 
-def rss_child(n: int, seconds: float) -> int:
-    """In this (fresh) process: ``n`` axes open and moving in Trap; print the RSS."""
+def rss_child(n: int, seconds: float, eni: str = "") -> int:
+    """In this (fresh) process: ``n`` axes open and moving in Trap (on ``eni``, the bus
+    the parent wrote); print the RSS.  ``n`` 0: the modules imported, nothing open."""
     from tools.bench_scaling import run_bus
 
-    r = run_bus(n, dict.fromkeys(range(1, n + 1), "moving"), seconds=seconds, repeat=1, after=_rss)
+    if not n:
+        from gtecat import gt  # noqa: F401  (what every process holds before its bus)
+
+        print(json.dumps(_rss()))
+        return 0
+    plan = dict.fromkeys(range(1, n + 1), "moving")
+    r = run_bus(n, plan, seconds=seconds, repeat=1, after=_rss, eni_file=eni or None)
     print(json.dumps(r))
     return 0
 
 
-def bench_rss(n: int = 128, seconds: float = 0.5) -> dict[str, object]:
-    """The RSS of a fresh Python process with an ``n``-axis controller open and moving."""
-    cmd = [sys.executable, __file__, "--rss-child", str(n), "--seconds", str(seconds)]
+def _child(args: list[str]) -> dict[str, object]:
+    """Run this script with ``args`` in a fresh process: its last JSON line, with the
+    process's wall and CPU seconds from spawn to exit."""
+    import resource
+
+    cmd = [sys.executable, __file__, *args]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
-        return {"error": (p.stderr.strip().splitlines() or ["rss child failed"])[-1]}
+        return {"error": (p.stderr.strip().splitlines() or ["child failed"])[-1]}
     r = json.loads(p.stdout.strip().splitlines()[-1])
-    return {"axes": n, "state": "moving", **r}
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return {**r, "process_wall_s": round(wall, 3), "process_cpu_s": round(cpu, 3)}
+
+
+def bench_rss(n: int = 128, seconds: float = 0.5) -> dict[str, object]:
+    """The RSS of a fresh Python process with an ``n``-axis controller open and moving
+    (the ENI written beforehand, by this process), and the memory per axis: its peak RSS
+    less that of a process that only imported gtecat, per axis."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    with tempfile.TemporaryDirectory() as tmp:
+        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        r = _child(["--rss-child", str(n), "--seconds", str(seconds), "--eni", str(eni)])
+    base = _child(["--rss-child", "0"])
+    if "error" in r or "error" in base:
+        return {"error": str(r.get("error") or base.get("error"))}
+    per_axis = (float(r["VmHWM_mb"]) - float(base["VmHWM_mb"])) / n  # type: ignore[arg-type]
+    return {
+        "axes": n,
+        "state": "moving",
+        **r,
+        "import_only_VmHWM_mb": base["VmHWM_mb"],
+        "mb_per_axis": round(per_axis, 4),
+    }
+
+
+def bringup_child(eni: str) -> int:
+    """In this (fresh) process: import gtecat, open ``eni`` (lockstep), GT_InitEcatComm,
+    GT_IsEcatReady until ready, GT_StartEcatComm: every slave in OP.  Prints the phases'
+    wall and CPU seconds."""
+    from ctypes import c_short
+
+    t0 = time.perf_counter()
+    from gtecat import gt
+
+    t1, c1 = time.perf_counter(), time.process_time()
+    ok = gt.GT_Open(eni=eni, clock="lockstep", log="") == 0 and gt.GT_InitEcatComm() == 0
+    ready = c_short()
+    for _ in range(10_000):
+        if not ok or (gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1):
+            break
+        gt.GTE_Wait(1)
+    ok = ok and ready.value == 1 and gt.GT_StartEcatComm() == 0
+    if not ok:
+        print(json.dumps({"error": gt.GTE_GetLastError() or "the bus did not reach OP"}))
+        return 1
+    t2, c2 = time.perf_counter(), time.process_time()
+    print(
+        json.dumps(
+            {
+                "import_s": round(t1 - t0, 3),
+                "import_cpu_s": round(c1, 3),
+                "to_op_s": round(t2 - t1, 3),
+                "to_op_cpu_s": round(c2 - c1, 3),
+                **_rss(),
+            }
+        )
+    )
+    gt.GT_Close()
+    return 0
+
+
+def bench_bringup(n: int) -> dict[str, object]:
+    """A fresh process taking an ``n``-axis bus (written beforehand) to OP: the process's
+    wall and CPU seconds from spawn to exit (Python start and imports included)."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    with tempfile.TemporaryDirectory() as tmp:
+        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        r = _child(["--bringup-child", str(eni)])
+    return {"axes": n, **r}
 
 
 GEAR = "per core: the first axis in Trap, the others in Gear on it (1:2)"
@@ -275,8 +359,8 @@ FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-poi
 CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
 
 
-def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
-    """The issue-17 figures, measured one after the other in this run."""
+def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> dict[str, object]:
+    """The many-axes figures, measured one after the other in this run (``only``: those)."""
     from tools.bench_scaling import crd_plan, run_bus
 
     def rtf(
@@ -289,32 +373,46 @@ def issue17(seconds: float = 1.5, repeat: int = 3) -> dict[str, object]:
         return dict.fromkeys(range(1, n + 1), state)
 
     half = {a: "moving" if a % 2 else "idle" for a in range(1, 65)}
-    out: dict[str, object] = {
-        "rtf_12_axes_trap": rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
-        "rtf_64_axes_32_trap_32_holding": rtf(
+    figures: dict[str, Callable[[], dict[str, object]]] = {
+        "rtf_12_axes_trap": lambda: rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
+        "rtf_64_axes_32_trap_32_holding": lambda: rtf(
             64, half, 10, "odd axes moving in Trap, even axes enabled and holding"
         ),
-        "rtf_128_axes_trap": rtf(128, every(128, "moving"), 5, "all 128 moving in Trap"),
-        "rtf_12_axes_homing_17": rtf(12, every(12, "homing"), None, "drive homing method 17"),
-        "rtf_64_axes_homing_17": rtf(64, every(64, "homing"), 10, "drive homing method 17"),
-        "rtf_12_axes_trap_scalar": rtf(
+        "rtf_128_axes_trap": lambda: rtf(128, every(128, "moving"), 100, "all 128 moving in Trap"),
+        "rtf_12_axes_homing_17": lambda: rtf(
+            12, every(12, "homing"), None, "drive homing method 17"
+        ),
+        "rtf_64_axes_homing_17": lambda: rtf(64, every(64, "homing"), 10, "drive homing method 17"),
+        "rtf_12_axes_trap_scalar": lambda: rtf(
             12, every(12, "moving"), None, "all 12 moving in Trap, scalar path (bank off)", "off"
         ),
-        "rtf_12_axes_pt": rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
-        "rtf_64_axes_pt": rtf(64, every(64, "pt"), 10, "PT, static FIFO, endless loop"),
-        "rtf_12_axes_gear": rtf(12, every(12, "gear"), None, GEAR),
-        "rtf_64_axes_gear": rtf(64, every(64, "gear"), 10, GEAR),
-        "rtf_12_axes_follow": rtf(12, every(12, "follow"), None, FOLLOW),
-        "rtf_64_axes_follow": rtf(64, every(64, "follow"), 10, FOLLOW),
-        "rtf_12_axes_crd": rtf(12, crd_plan(12), None, CRD),
-        "rtf_64_axes_crd": rtf(64, crd_plan(64), 10, CRD),
-        "gt_get_sts_vs_argument": _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
-        "call_shapes_vs_arguments": _figure(
+        "rtf_12_axes_pt": lambda: rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
+        "rtf_64_axes_pt": lambda: rtf(64, every(64, "pt"), 10, "PT, static FIFO, endless loop"),
+        "rtf_12_axes_gear": lambda: rtf(12, every(12, "gear"), None, GEAR),
+        "rtf_64_axes_gear": lambda: rtf(64, every(64, "gear"), 10, GEAR),
+        "rtf_12_axes_follow": lambda: rtf(12, every(12, "follow"), None, FOLLOW),
+        "rtf_64_axes_follow": lambda: rtf(64, every(64, "follow"), 10, FOLLOW),
+        "rtf_12_axes_crd": lambda: rtf(12, crd_plan(12), None, CRD),
+        "rtf_64_axes_crd": lambda: rtf(64, crd_plan(64), 10, CRD),
+        "gt_get_sts_vs_argument": lambda: _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
+        "call_shapes_vs_arguments": lambda: _figure(
             bench_call_shapes(2 * seconds), "worst", 4, at_most=True
         ),
-        "rss_128_axes_moving": _figure(
-            bench_rss(128, min(seconds, 1.0)), "VmHWM_mb", 150, at_most=True
+        "rss_128_axes_moving": lambda: _figure(
+            bench_rss(128, min(seconds, 1.0)), "mb_per_axis", 0.1, at_most=True
         ),
+        "bringup_512_axes_to_op": lambda: _figure(
+            bench_bringup(512), "process_wall_s", 3.0, at_most=True
+        ),
+        "bringup_1024_axes_to_op": lambda: _figure(
+            bench_bringup(1024), "process_wall_s", 6.0, at_most=True
+        ),
+    }
+    unknown = sorted(set(only) - set(figures))
+    if unknown:
+        raise SystemExit(f"unknown figure(s): {', '.join(unknown)}; known: {', '.join(figures)}")
+    out: dict[str, object] = {
+        name: make() for name, make in figures.items() if not only or name in only
     }
     out["ok"] = all(isinstance(v, dict) and v.get("ok", True) for v in out.values())
     return out
@@ -329,13 +427,23 @@ def main() -> int:
     ap.add_argument("--seconds", type=float, help="wall seconds per issue-17 figure (1.5)")
     ap.add_argument("--repeat", type=int, default=3, help="windows per real-time factor")
     ap.add_argument("--rss-child", type=int, metavar="AXES", help=argparse.SUPPRESS)
+    ap.add_argument("--eni", default="", help=argparse.SUPPRESS)
+    ap.add_argument("--bringup-child", metavar="ENI", help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--only",
+        default="",
+        help="comma-separated figure names of --targets to measure (e.g. rtf_128_axes_trap)",
+    )
     args = ap.parse_args()
-    if args.rss_child:
-        return rss_child(args.rss_child, args.seconds or 0.5)
+    if args.rss_child is not None:
+        return rss_child(args.rss_child, args.seconds or 0.5, args.eni)
+    if args.bringup_child:
+        return bringup_child(args.bringup_child)
     secs = 0.5 if args.quick else 2.0
     secs17 = args.seconds or (0.6 if args.quick else 1.5)
-    if args.targets:
-        print(json.dumps({"targets": issue17(secs17, args.repeat)}, indent=2))
+    only = [x for x in args.only.split(",") if x]
+    if args.targets or only:
+        print(json.dumps({"targets": issue17(secs17, args.repeat, only)}, indent=2))
         return 0
     out: dict[str, object] = {}
     try:

@@ -395,18 +395,20 @@ def run_bus(
     eni_dir: str | Path | None = None,
     after: Callable[[], dict[str, Any]] | None = None,
     bank: str | None = None,
+    eni_file: str | Path | None = None,
 ) -> dict[str, Any]:
     """Bring up ``n`` axes, put axis ``a`` in ``plan[a]`` (missing: ``idle``), measure
     (``bank``: as :func:`bring_up`).
 
     Returns cycles_per_s, rtf, us_per_cycle, us_per_axis, bringup_s, and whatever
     ``after()`` adds (called with the controller still open); ``error`` instead of
-    the figures when an axis cannot be addressed or set up.
+    the figures when an axis cannot be addressed or set up.  ``eni_file``: the bus
+    already written (by :func:`write_axes_eni` for ``n`` axes), else it is written here.
     """
     full = {a: plan.get(a, "idle") for a in range(1, n + 1)}
     gt = _gt()
     with tempfile.TemporaryDirectory(dir=eni_dir) as tmp:
-        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        eni = Path(eni_file) if eni_file else write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
         t0 = time.perf_counter()
         try:
             bring_up(eni, n, bank)

@@ -64,7 +64,7 @@ from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
 from .axis_status import AxisStatus
-from .bank_kernel import Kernel
+from .bank_kernel import MAXSEG, NTPRM, Kernel, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
 from .motion.jog import _IDLE as _JOG_IDLE
@@ -85,8 +85,11 @@ AUTO_MIN_AXES = 4
 RECHECK_CYCLES = 16
 #: planned drive counts from which an axis leaves the bank (its int64 arithmetic ends at 2**63)
 HUGE_COUNTS = float(1 << 62)
-#: samples of a Trap move computed at once (a table per axis)
+#: samples of a Trap move computed at once (a table per axis) by numpy alone
 TABLE = 2048
+#: the same with the compiled cycle, which fills a used-up table itself within the cycle:
+#: a short table costs no time and little memory (24 bytes per sample and axis)
+KERNEL_TABLE = 32
 
 #: TxPDO objects the bank computes (channel-0 numbers -> CspBank output names)
 COMPUTED_TX = {
@@ -237,6 +240,9 @@ class AxisBank:
         #: never inside a cycle
         self.kernel: Kernel | None = None
         self._kernel_lib: Any = None
+        self.table = TABLE
+        self._c_fill = False  # the kernel refills every moving row's table itself
+        self._fill_out: np.ndarray | None = None
         kmode = kernel_wanted()
         if kmode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
@@ -249,6 +255,8 @@ class AxisBank:
                 )
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
+        #: of those, the cycles it ran many at a time (:meth:`run_many`; statistics)
+        self.many_cycles = 0
         #: homing axis-cycles the compiled kernel ran (statistics)
         self.homing_rows_run = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
@@ -366,8 +374,13 @@ class AxisBank:
         self.taken = zi(n, np.int64)  # samples taken since the claim
         self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
         self.ended = zi(n, bool)
-        self.t_p, self.t_v, self.t_a = z((n, TABLE + 1)), z((n, TABLE + 1)), z((n, TABLE + 1))
-        self.base = np.arange(n, dtype=np.int64) * (TABLE + 1)
+        tl = self.table = KERNEL_TABLE if self._kernel_lib is not None else TABLE
+        self.t_p, self.t_v, self.t_a = z((n, tl + 1)), z((n, tl + 1)), z((n, tl + 1))
+        self.base = np.arange(n, dtype=np.int64) * (tl + 1)
+        # a moving row's raw pieces and move constants, for the kernel's own refills
+        self.nseg = zi(n, np.int64)  # 0: none (the table is refilled here)
+        self.seg = z(n * MAXSEG * 4)
+        self.tprm = z(n * NTPRM)
         self.t_idx = self.base.copy()  # table index of each row's last sample
         self.t_len = zi(n, np.int64)  # valid samples in the table
         self.t_cur = zi(n, np.int64)  # next sample to take
@@ -405,6 +418,9 @@ class AxisBank:
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
         self.n_moving = int(np.count_nonzero(self.moving & alive))
         self._refill_in = 0  # look for tables to fill at the next cycle
+        self._c_fill = self.kernel is not None and not np.count_nonzero(
+            self.moving & alive & (self.nseg <= 0)
+        )
         self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
         rx = [g.rx_bytes for g in self.groups if g.claimed]
         self._rx_idx = np.concatenate(rx) if rx else np.zeros(0, np.intp)
@@ -706,7 +722,20 @@ class AxisBank:
         kept = self._kept.pop(r, None)
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
         # table) or in slot 0, the hold slot of a row at rest
-        slot = TABLE if moving else 0
+        slot = self.table if moving else 0
+        self.nseg[r] = 0
+        if moving and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
+            m = len(pl._segs)
+            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = np.array(pl._segs, np.float64).ravel()
+            self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
+                pl._t_done,
+                pl._ts,
+                pl._t_final,
+                float(pl._target),
+                pl._dir,
+                pl._T,
+            )
+            self.nseg[r] = m
         self.t_p[r, slot], self.t_v[r, slot], self.t_a[r, slot] = pl._pos, pl._vel, pl._acc
         self.t_idx[r] = self.base[r] + slot
         if moving:
@@ -756,16 +785,28 @@ class AxisBank:
 
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
+        tl = self.table
         _Bypass.on = True
         try:
-            p, v, a, end = trap_table(pl, TABLE, int(self.k0[r] + self.taken[r]))
+            k0 = int(self.k0[r] + self.taken[r])
+            if self._kernel_lib is not None:  # the same samples, compiled
+                segs = np.array(pl._segs, np.float64).reshape(-1, 4)
+                prm = np.array([pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir])
+                out = self._fill_out
+                if out is None:
+                    out = self._fill_out = np.zeros((3, tl + 1))
+                end = trap_fill(self._kernel_lib, segs, pl._T, prm, k0, tl, out)
+                m = end + 1 if end < tl else tl
+                p, v, a = out[0, :m], out[1, :m], out[2, :m]
+            else:
+                p, v, a, end = trap_table(pl, tl, k0)
         finally:
             _Bypass.on = False
         m = len(p)
         self.t_p[r, :m], self.t_v[r, :m], self.t_a[r, :m] = p, v, a
         self.t_len[r] = m
         self.t_cur[r] = 0
-        self.t_end[r] = end if end < TABLE else -1
+        self.t_end[r] = end if end < tl else -1
 
     def _fill_tables(self) -> None:
         """New Trap samples for the moving rows whose table ran out; :attr:`_refill_in`: the
@@ -777,7 +818,7 @@ class AxisBank:
             for r in np.nonzero(need)[0].tolist():
                 self._refill(r)
         left = (self.t_len - cur)[moving]
-        self._refill_in = int(left.min()) if len(left) else TABLE
+        self._refill_in = int(left.min()) if len(left) else self.table
 
     # --- release ---------------------------------------------------------------------------------
     def release_all(self) -> None:
@@ -936,8 +977,9 @@ class AxisBank:
             dt = dt_ns * 1e-9
             if (self.n_hm or self.n_frz) and dt != self.csp._dt:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
+            c_fill = self._c_fill  # the kernel refills the tables itself
             if dt == self.csp._dt:
-                if self.n_moving and self._refill_in <= 1:
+                if not c_fill and self.n_moving and self._refill_in <= 1:
                     self._fill_tables()  # as the numpy cycle would first (its step 2)
                 else:
                     self._refill_in -= 1
@@ -946,11 +988,14 @@ class AxisBank:
                     self._release_rows(np.nonzero(k.scratch["s_hit"] & self.hm)[0])
                     if not self.n_alive:
                         return
+                    c_fill = self._c_fill
                     rc = k.cycle(t_ns, dt)
                 if rc == 0:
                     self._after_kernel(k)
                     return
-                self._refill_in += 1
+                # declined: the numpy cycle looks at every table (the kernel may have
+                # refilled some, or left one for it: code 4)
+                self._refill_in = 1 if c_fill else self._refill_in + 1
             k.bound = False  # the numpy cycle replaces some arrays
         if self.n_hm or self.n_frz:  # the numpy cycle runs CSP rows only: the others go back
             self._release_rows(np.nonzero((self.hm | self.frz) & self.alive)[0])
@@ -1095,31 +1140,33 @@ class AxisBank:
         controller whose cycle has nothing else to do (:meth:`Controller.run_cycles`): the
         cycles run, each exactly the one :meth:`cycle` would run; 0 when the next cycle
         needs :meth:`cycle` (something to claim or release, a row leaving, no compiled
-        kernel).  It stops before the first cycle the kernel declines and where the shortest
-        Trap table ends (the next call fills it)."""
+        kernel).  It stops before the first cycle the kernel declines and after one that
+        ended a Trap move; the kernel fills a Trap table that runs out itself (else the run
+        stops where the shortest table ends: the next call fills it)."""
         k = self.kernel
         if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
             return 0
         dt = dt_ns * 1e-9
         if dt != self.csp._dt:
             return 0
-        if self.n_moving:
+        if self.n_moving and not self._c_fill:
             if self._refill_in <= 1:  # a table runs out: fill it first, as cycle() would
                 self._fill_tables()
                 self._refill_in += 1  # (counted like cycle()'s: one more than the samples left)
             n = min(n, self._refill_in - 1)  # no further than the shortest table goes
             if n <= 0:
                 return 0
-        done = k.run(t_ns, dt_ns, dt, n)
+        _, done = k.run(t_ns, dt, dt_ns, n)
         if done:
             self._countdown -= done
             self._refill_in -= done
             self._lists.clear()
             self._after_kernel(k, done)
+            self.many_cycles += done
         return done
 
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
-        """What the numpy cycle does besides its arithmetic, after a compiled cycle."""
+        """What the numpy cycle does besides its arithmetic, after compiled cycles."""
         csp = self.csp
         csp.cycles += cycles
         csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's

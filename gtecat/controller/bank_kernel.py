@@ -39,7 +39,11 @@ log = logging.getLogger(__name__)
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64
 #: the int64 slots (``io``) and double slots (``fp``) of a cycle call, the C enums' order
-IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN, N_IO = range(9)
+(IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN) = range(8)
+IN_TABLE, IN_MAXC, IN_DT_NS, OUT_DONE, OUT_FILLED, N_IO = range(8, 14)
+#: the Trap pieces a row may hold for the kernel to fill its table itself, and the per-row
+#: move constants (t_done, ts, t_final, target, dir, cycle ms): the C side's MAXSEG, NTPRM
+MAXSEG, NTPRM = 16, 6
 FP_DT, FP_T, N_FP = range(3)
 _DTYPES = {"u8": _U8, "i64": _I64, "f64": _F64}
 #: placement columns (the kernel's image switch)
@@ -78,16 +82,27 @@ def library() -> tuple[Any, str]:
         lib.bank_kernel_abi.restype = ctypes.c_int
         lib.bank_kernel_cycle.restype = ctypes.c_int
         lib.bank_kernel_cycle.argtypes = (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p)
-        lib.bank_kernel_run.restype = ctypes.c_int64
-        lib.bank_kernel_run.argtypes = (
-            *lib.bank_kernel_cycle.argtypes,
+        lib.bank_kernel_run.restype = ctypes.c_int
+        lib.bank_kernel_run.argtypes = (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p)
+        lib.bank_kernel_sizes.restype = ctypes.c_int
+        lib.bank_trap_fill.restype = ctypes.c_int64
+        lib.bank_trap_fill.argtypes = (
+            ctypes.c_void_p,
+            ctypes.c_int64,
+            ctypes.c_double,
+            ctypes.c_void_p,
             ctypes.c_int64,
             ctypes.c_int64,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
         )
         fields = [f for f in lib.bank_kernel_fields().decode().split(",") if f]
         src_types = _field_types()
-        if [f for f, _ in src_types] != fields or lib.bank_kernel_abi() != (
-            len(fields) << 8 | N_IO << 4 | N_FP
+        if (
+            [f for f, _ in src_types] != fields
+            or lib.bank_kernel_abi() != (len(fields) << 8 | N_IO << 4 | N_FP)
+            or lib.bank_kernel_sizes() != (MAXSEG << 8 | NTPRM)
         ):
             raise RuntimeError("the kernel's field list is not the one this module binds")
         _FIELDS[:] = src_types
@@ -137,7 +152,9 @@ class Kernel:
         self.io = np.zeros(N_IO, np.int64)
         self.fp = np.zeros(N_FP, np.float64)
         self.io[IN_N] = n
+        self.io[IN_TABLE] = bank.table
         self.fp[FP_T] = bank.T
+        self.run_fn = lib.bank_kernel_run
         self.bound = False
         self._keep: list[np.ndarray] = []
         self._args = (self.ptrs.ctypes.data, self.io.ctypes.data, self.fp.ctypes.data)
@@ -224,21 +241,50 @@ class Kernel:
         self.fp[FP_DT] = dt
         return self.fn(*self._args)
 
-    def run(self, t_ns: int, dt_ns: int, dt: float, n: int) -> int:
-        """Up to ``n`` cycles back to back from ``t_ns`` (one call): the cycles committed;
-        it stops before the first one :meth:`cycle` would not commit (that one is the numpy
-        cycle's).  :attr:`move_ended` tells whether any of them ended a Trap move."""
+    def run(self, t_ns: int, dt: float, dt_ns: int, most: int) -> tuple[int, int]:
+        """Up to ``most`` whole cycles from ``t_ns``: (the code of the cycle that stopped the
+        run, 0 when none did; the cycles committed).  The run stops after a cycle that ended
+        a Trap move and before one the kernel declines (nothing of it written)."""
         if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
             self.bind()
-        self.io[IN_T_NS] = t_ns
+        io = self.io
+        io[IN_T_NS] = t_ns
+        io[IN_DT_NS] = dt_ns
+        io[IN_MAXC] = most
         self.fp[FP_DT] = dt
-        return self.run_fn(*self._args, n, dt_ns)
+        rc = self.run_fn(*self._args)
+        return rc, int(io[OUT_DONE])
+
+    @property
+    def filled(self) -> bool:
+        """The last call refilled some Trap table itself."""
+        return bool(self.io[OUT_FILLED])
 
     @property
     def move_ended(self) -> bool:
         """The last committed cycle ended a Trap move (the bank recounts its moving rows);
         after :meth:`run`: any of its cycles did."""
         return bool(self.io[OUT_FIN])
+
+
+def trap_fill(
+    lib: Any, segs: np.ndarray, cyc: float, prm: np.ndarray, k0: int, n: int, out: np.ndarray
+) -> int:
+    """The compiled :func:`~gtecat.controller.motion.trap_table.trap_table`: samples
+    ``k0+1 .. k0+n`` of the move of raw pieces ``segs`` ((m, 4) float64) and constants
+    ``prm`` (t_done, ts, t_final, target, dir) into ``out`` ((3, >= n) float64: position,
+    speed, acceleration); returns the end sample's index, or ``n`` when the move goes on."""
+    return lib.bank_trap_fill(
+        segs.ctypes.data,
+        len(segs),
+        cyc,
+        prm.ctypes.data,
+        k0,
+        n,
+        out[0].ctypes.data,
+        out[1].ctypes.data,
+        out[2].ctypes.data,
+    )
 
 
 def _fits(arr: np.ndarray, dtype: Any) -> bool:

@@ -73,6 +73,7 @@ from gtecat.drives.modes import (
 )
 from gtecat.drives.od import (
     Access,
+    AttrVariable,
     DataType,
     ObjectCode,
     ObjectDictionary,
@@ -103,6 +104,15 @@ _SW_INTERNAL_LIMIT = int(Sw.INTERNAL_LIMIT)
 _RX, _TX, _RXTX = PdoDir.RX, PdoDir.TX, PdoDir.RX | PdoDir.TX
 _LIMIT_REACTIONS = ("stop", "fault", "none")
 _COMM_REACTIONS = ("disable", "fault", "none")
+
+
+def _shared_int(value: int) -> int:
+    """One int object per object index for every drive's dictionary (an index above 256 is
+    a new object each time it is computed)."""
+    return _INTS.setdefault(value, value)
+
+
+_INTS: dict[int, int] = {}
 
 
 @dataclass(frozen=True, slots=True)
@@ -295,16 +305,8 @@ class Channel:
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
     ) -> Variable:
-        return od.add_var(
-            index + self.base,
-            name,
-            dt,
-            access,
-            pdo=pdo,
-            getter=partial(getattr, self, attr),
-            setter=partial(setattr, self, attr),
-            **kw,
-        )
+        at = _shared_int(index + self.base)
+        return od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
 
     def _sub(
         self,
@@ -317,17 +319,8 @@ class Channel:
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
     ) -> Variable:
-        return Variable(
-            index + self.base,
-            sub,
-            name,
-            dt,
-            access,
-            pdo=pdo,
-            getter=partial(getattr, self, attr),
-            setter=partial(setattr, self, attr),
-            **kw,
-        )
+        at = _shared_int(index + self.base)
+        return AttrVariable(self, attr, at, sub, name, dt, access, pdo=pdo, **kw)
 
     def _add_objects(self, od: ObjectDictionary) -> None:
         s = self._settings

@@ -20,6 +20,7 @@ import struct
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
+from functools import partial
 from typing import Any
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
@@ -150,19 +151,15 @@ class Variable:
     """One entry (index, subindex) of the dictionary."""
 
     __slots__ = (
+        "_x",
         "access",
-        "allowed",
         "data_type",
         "getter",
-        "high",
         "index",
         "info",
-        "low",
-        "max_size",
         "name",
         "pdo",
         "pdo_bits",
-        "placeholder",
         "setter",
         "subindex",
         "value",
@@ -191,21 +188,27 @@ class Variable:
         self.index = index
         self.subindex = subindex
         self.name = name
-        self.data_type = DataType(data_type)
+        self.data_type = data_type if type(data_type) is DataType else DataType(data_type)
         self.info = TYPE_INFO[self.data_type]
         self.access = access
         self.pdo = pdo
-        self.low = low
-        self.high = high
-        self.allowed = None if allowed is None else frozenset(allowed)
+        #: what few entries have (a range, allowed values, a string's size, a placeholder
+        #: mark): None or a dict of them, so that the hundreds of entries of a drive without
+        #: them stay small (:attr:`low` and the others read it)
+        self._x: dict[str, Any] | None = None
+        if low is not None:
+            self.low = low
+        if high is not None:
+            self.high = high
+        if allowed is not None:
+            self.allowed = _shared(frozenset(allowed))
         self.write_states = write_states
         self.getter = getter
         self.setter = setter
-        self.max_size = max_size if self.info.is_string else self.info.size
+        if self.info.is_string and max_size:
+            self.max_size = max_size
         #: bit length when mapped: the type's, unless a placeholder was sized by a mapping
         self.pdo_bits = pdo_bits if pdo_bits is not None else self.info.pdo_bits
-        #: created only because a PDO mapping names it (see ObjectDictionary.placeholder)
-        self.placeholder = False
         if default is None:
             default = b"" if self.info.is_string else (0.0 if self.info.fmt == "f" else 0)
         self.value = default
@@ -214,6 +217,39 @@ class Variable:
         return (
             f"<Variable 0x{self.index:04X}:{self.subindex:02X} {self.name} {self.data_type.name}>"
         )
+
+    def _get_x(self, key: str, default: Any = None) -> Any:
+        x = self._x
+        return default if x is None else x.get(key, default)
+
+    def _set_x(self, key: str, value: Any) -> None:
+        x = self._x
+        if x is None:
+            x = self._x = {}
+        x[key] = value
+
+    low = property(lambda self: self._get_x("low"), lambda self, v: self._set_x("low", v))
+    high = property(lambda self: self._get_x("high"), lambda self, v: self._set_x("high", v))
+    allowed = property(
+        lambda self: self._get_x("allowed"), lambda self, v: self._set_x("allowed", v)
+    )
+    #: created only because a PDO mapping names it (see ObjectDictionary.placeholder)
+    placeholder = property(
+        lambda self: self._get_x("placeholder", False),
+        lambda self, v: self._set_x("placeholder", v),
+    )
+
+    @property
+    def max_size(self) -> int:
+        """Bytes a value may have: a string's given size, else the type's."""
+        x = self._x
+        if x is not None and "max_size" in x:
+            return x["max_size"]
+        return 0 if self.info.is_string else self.info.size
+
+    @max_size.setter
+    def max_size(self, value: int) -> None:
+        self._set_x("max_size", value)
 
     # --- values -------------------------------------------------------------
     def get(self) -> Any:
@@ -328,16 +364,122 @@ class Variable:
         return bits
 
 
+def _shared(values: frozenset[int]) -> frozenset[int]:
+    """One frozenset per content for every dictionary (the same allowed values of the same
+    objects, drive after drive)."""
+    if len(_SHARED) >= 1024:
+        _SHARED.clear()
+    return _SHARED.setdefault(values, values)
+
+
+_SHARED: dict[frozenset[int], frozenset[int]] = {}
+
+
+def _only_none(self: Variable, value: object) -> None:
+    if value is not None:
+        raise TypeError(f"{type(self).__name__} {self!r}: its value has a fixed home")
+
+
+class AttrVariable(Variable):
+    """An entry whose value is the attribute ``attr`` of ``owner`` (a drive's own state).
+
+    The same as ``Variable(..., getter=partial(getattr, owner, attr), setter=partial(setattr,
+    owner, attr))``, but the two callables are made only when asked for: a drive holds a
+    hundred such entries, and hundreds of drives a bus."""
+
+    __slots__ = ("_attr", "_owner")
+
+    def __init__(
+        self,
+        owner: object,
+        attr: str,
+        index: int,
+        subindex: int,
+        name: str,
+        data_type: DataType,
+        access: Access = Access.RW,
+        **kw: Any,
+    ) -> None:
+        self._owner, self._attr = owner, attr
+        super().__init__(index, subindex, name, data_type, access, **kw)
+
+    getter = property(lambda self: partial(getattr, self._owner, self._attr), _only_none)
+    setter = property(lambda self: partial(setattr, self._owner, self._attr), _only_none)
+
+    def get(self) -> Any:
+        return getattr(self._owner, self._attr)
+
+    def set(self, value: Any) -> None:
+        setattr(self._owner, self._attr, value)
+
+
+class SlotVariable(Variable):
+    """An entry whose value is ``values[k]`` of a list its owner keeps (a PDO mapping's or
+    assignment's entry); a write goes through ``put(k, value)``, one callable shared by the
+    object's entries (no closures per entry)."""
+
+    __slots__ = ("_k", "_put", "_values")
+
+    def __init__(
+        self,
+        values: list[Any],
+        k: int,
+        put: Callable[[int, Any], None],
+        index: int,
+        name: str,
+        data_type: DataType,
+        access: Access = Access.RW,
+        **kw: Any,
+    ) -> None:
+        self._values, self._k, self._put = values, k, put
+        super().__init__(index, k + 1, name, data_type, access, **kw)
+
+    getter = property(lambda self: partial(self._values.__getitem__, self._k), _only_none)
+    setter = property(lambda self: partial(self._put, self._k), _only_none)
+
+    def get(self) -> Any:
+        return self._values[self._k]
+
+    def set(self, value: Any) -> None:
+        self._put(self._k, value)
+
+
 class OdObject:
     """One index: a VAR (only subindex 0) or an ARRAY/RECORD (subindex 0 = count)."""
 
-    __slots__ = ("code", "index", "name", "subs")
+    __slots__ = ("_make", "_subs", "code", "index", "name")
 
-    def __init__(self, index: int, name: str, code: ObjectCode = ObjectCode.VAR) -> None:
+    def __init__(
+        self,
+        index: int,
+        name: str,
+        code: ObjectCode = ObjectCode.VAR,
+        make: Callable[[], Iterable[Variable]] | Variable | tuple[Variable, ...] | None = None,
+    ) -> None:
         self.index = index
         self.name = name
         self.code = code
-        self.subs: dict[int, Variable] = {}
+        #: ``make``: the entries are made when first looked at (a drive's spare PDO mappings
+        #: are 50 entries nobody reads on most buses); a Variable or a tuple of them: the
+        #: entries, put in a dict when first looked at (most of a drive's objects never are:
+        #: its own code holds the entries)
+        self._subs: dict[int, Variable] | None = None if make is not None else {}
+        self._make = make
+
+    @property
+    def subs(self) -> dict[int, Variable]:
+        """Subindex -> entry."""
+        subs = self._subs
+        if subs is None:
+            make, self._make = self._make, None
+            if isinstance(make, Variable):
+                subs = self._subs = {make.subindex: make}
+            elif isinstance(make, tuple):
+                subs = self._subs = {v.subindex: v for v in make}
+            else:
+                assert make is not None
+                subs = self._subs = {v.subindex: v for v in make()}
+        return subs
 
     def __repr__(self) -> str:
         return (
@@ -399,8 +541,12 @@ class ObjectDictionary:
     def add_var(
         self, index: int, name: str, data_type: DataType, access: Access = Access.RW, **kw: Any
     ) -> Variable:
-        obj = self.add_object(OdObject(index, name, ObjectCode.VAR))
-        return obj.add(Variable(index, 0, name, data_type, access, **kw))
+        return self.add_entry(Variable(index, 0, name, data_type, access, **kw))
+
+    def add_entry(self, var: Variable) -> Variable:
+        """A VAR object holding ``var`` (subindex 0), named as it is."""
+        self.add_object(OdObject(var.index, var.name, ObjectCode.VAR, var))
+        return var
 
     def add_record(
         self,
@@ -412,15 +558,24 @@ class ObjectDictionary:
         sub0: Variable | None = None,
     ) -> OdObject:
         """A record/array; subindex 0 is a read-only count of the entries unless given."""
-        obj = self.add_object(OdObject(index, name, code))
         entries = list(entries)
         if sub0 is None:
             n = max((e.subindex for e in entries), default=0)
             sub0 = Variable(index, 0, "Number of entries", DataType.UINT8, Access.RO, default=n)
-        obj.add(sub0)
-        for e in entries:
-            obj.add(e)
-        return obj
+        # the entries in a tuple until the object is first looked at (then in a dict)
+        return self.add_object(OdObject(index, name, code, (sub0, *entries)))
+
+    def add_lazy_record(
+        self,
+        index: int,
+        name: str,
+        make: Callable[[], Iterable[Variable]],
+        *,
+        code: ObjectCode = ObjectCode.RECORD,
+    ) -> OdObject:
+        """A record/array whose entries (subindex 0 included) ``make`` returns when the
+        object is first looked at."""
+        return self.add_object(OdObject(index, name, code, make))
 
     def placeholder(self, index: int, subindex: int, bits: int, direction: PdoDir) -> Variable:
         """An entry a PDO mapping names but this device does not implement.

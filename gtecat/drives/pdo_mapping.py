@@ -16,10 +16,12 @@ master configured.
 
 from __future__ import annotations
 
+import functools
 import logging
 import struct
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
@@ -30,6 +32,7 @@ from gtecat.drives.od import (
     ObjectCode,
     ObjectDictionary,
     PdoDir,
+    SlotVariable,
     Variable,
 )
 from gtecat.eni.bits import get_bits, set_bits
@@ -57,6 +60,25 @@ def unpack_entry(value: int) -> tuple[int, int, int]:
 def is_gap(index: int) -> bool:
     """Padding entries: index 0 (ETG) or a CiA 301 dummy data-type index 0x0001-0x0007."""
     return index <= 0x0007
+
+
+@functools.cache
+def _names(head: str, n: int) -> tuple[str, ...]:
+    """``head 1`` .. ``head n``: one set of entry names for every drive's objects."""
+    return tuple(f"{head} {k + 1}" for k in range(n))
+
+
+class _MapEntries:
+    """Makes a mapping object's entries when it is first looked at (a ``partial`` of
+    :meth:`PdoMapping._map_entries`, in half the memory: eight per drive)."""
+
+    __slots__ = ("access", "cap", "index", "owner", "slots")
+
+    def __init__(self, owner: PdoMapping, index: int, slots: _Slots, cap: int, access: Access):
+        self.owner, self.index, self.slots, self.cap, self.access = owner, index, slots, cap, access
+
+    def __call__(self) -> list[Variable]:
+        return self.owner._map_entries(self.index, self.slots, self.cap, self.access)
 
 
 @dataclass(slots=True)
@@ -174,6 +196,11 @@ class PdoMapping:
         direction = PdoDir.RX if index in RX_MAP_RANGE else PdoDir.TX
         access = Access.RO if fixed else Access.RW
         name = ("RxPDO" if direction is PdoDir.RX else "TxPDO") + f" mapping 0x{index:04X}"
+        self.od.add_lazy_record(index, name, _MapEntries(self, index, slots, cap, access))
+        return slots
+
+    def _map_entries(self, index: int, slots: _Slots, cap: int, access: Access) -> list[Variable]:
+        """The entries of mapping object ``index`` (made when the object is first read)."""
         sub0 = Variable(
             index,
             0,
@@ -185,21 +212,21 @@ class PdoMapping:
             getter=lambda s=slots: s.count,
             setter=lambda v, i=index: self._set_map_count(i, v),
         )
-        entries = [
-            Variable(
+        put = partial(self._set_map_entry, index)  # (k, value), shared by the entries
+        names = _names("Mapped object", cap)
+        return [sub0] + [
+            SlotVariable(
+                slots.values,
+                k,
+                put,
                 index,
-                k + 1,
-                f"Mapped object {k + 1}",
+                names[k],
                 DataType.UINT32,
                 access,
                 write_states=PREOP_ONLY,
-                getter=lambda s=slots, k=k: s.values[k],
-                setter=lambda v, i=index, k=k: self._set_map_entry(i, k, v),
             )
             for k in range(cap)
         ]
-        self.od.add_record(index, name, entries, code=ObjectCode.RECORD, sub0=sub0)
-        return slots
 
     def _add_assign_object(self, index: int, name: str) -> None:
         slots = self._assign[index]
@@ -215,16 +242,18 @@ class PdoMapping:
             getter=lambda: slots.count,
             setter=lambda v: self._set_assign_count(index, v),
         )
+        put = partial(self._set_assign_entry, index)
+        names = _names("Assigned PDO", cap)
         entries = [
-            Variable(
+            SlotVariable(
+                slots.values,
+                k,
+                put,
                 index,
-                k + 1,
-                f"Assigned PDO {k + 1}",
+                names[k],
                 DataType.UINT16,
                 Access.RW,
                 write_states=PREOP_ONLY,
-                getter=lambda k=k: slots.values[k],
-                setter=lambda v, k=k: self._set_assign_entry(index, k, v),
             )
             for k in range(cap)
         ]

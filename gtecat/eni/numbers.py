@@ -30,10 +30,28 @@ def parse_int(text: str | int) -> int:
     :class:`TooLong` (a ValueError) when the text has more than :data:`MAX_DIGITS`
     significant digits: no field takes such a number (:mod:`gtecat.eni.limits`).
     """
+    if type(text) is str:
+        hit = _PARSED.get(text)
+        if hit is not None:
+            return hit
     if isinstance(text, bool):
         raise ValueError(f"not an integer: {shown(str(text))}")
     if isinstance(text, int):
         return text
+    value = _parse(text)
+    if type(text) is str and len(text) <= 24:
+        if len(_PARSED) >= 4096:
+            _PARSED.clear()
+        _PARSED[text] = value
+    return value
+
+
+#: texts already parsed (an ENI spells the same few hundred numbers thousands of times);
+#: only successes are kept, and only short texts
+_PARSED: dict[str, int] = {}
+
+
+def _parse(text: str) -> int:
     s = text.strip().replace("_", "")
     neg = s.startswith("-")
     if s.startswith(("-", "+")):
@@ -60,6 +78,21 @@ def parse_int(text: str | int) -> int:
 
 def parse_hex_bytes(text: str) -> bytes:
     """ETG.2100 ``Data`` (hex digits, little-endian payload as written) -> bytes."""
+    hit = _HEX.get(text)
+    if hit is not None:
+        return hit
+    data = _parse_hex(text)
+    if len(text) <= 64:  # one object for the same short data, slave after slave
+        if len(_HEX) >= 4096:
+            _HEX.clear()
+        _HEX[text] = data
+    return data
+
+
+_HEX: dict[str, bytes] = {}
+
+
+def _parse_hex(text: str) -> bytes:
     s = "".join(text.split())
     if s.lower().startswith(("#x", "0x")):
         s = s[2:]

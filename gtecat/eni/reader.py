@@ -12,7 +12,7 @@ both ``Gecat.eni``); only the bytes decide.
 
 from __future__ import annotations
 
-import functools
+import hashlib
 import os
 import re
 from pathlib import Path
@@ -129,12 +129,19 @@ def read_eni(path: str | os.PathLike[str]) -> EniConfig:
         raise EniError(f"cannot read the file: {exc.strerror or exc}", file=str(p)) from None
     if not data.strip():
         raise EniError("the file is empty", file=str(p))
-    return _parse_cached(data, str(p))
+    key = (hashlib.sha256(data).digest(), str(p))
+    config = _PARSED.get(key)
+    if config is None:
+        config = parse_eni(data, str(p))
+        if len(_PARSED) >= _PARSED_MAX:
+            _PARSED.pop(next(iter(_PARSED)))
+        _PARSED[key] = config
+    return config
 
 
-@functools.lru_cache(maxsize=32)
-def _parse_cached(data: bytes, source: str) -> EniConfig:
-    """One parse per file content: the model is immutable (frozen dataclasses of tuples), so
-    a program or a test suite that opens the same ENI again gets the same object; a file that
-    changed is a new key, and one that fails raises each time (errors are not cached)."""
-    return parse_eni(data, source)
+#: one parse per file content: the model is immutable (frozen dataclasses of tuples), so a
+#: program or a test suite that opens the same ENI again gets the same object; a file that
+#: changed is a new key, and one that fails raises each time (errors are not cached).  The
+#: key is the content's digest, not the content (a 1,000-axis ENI is 20 MB).
+_PARSED: dict[tuple[bytes, str], EniConfig] = {}
+_PARSED_MAX = 32

@@ -19,21 +19,31 @@ from xml.parsers import expat
 from .errors import EniError
 from .numbers import shown
 
+#: what an element without attributes or children holds (shared: a tree is read, never
+#: changed, and an ENI has a few hundred thousand such elements)
+_NO_ATTRS: dict[str, str] = {}
+_NO_CHILDREN: tuple[Node, ...] = ()
+
 
 class Node:
-    """One element: local tag name, attributes, children, text and source line."""
+    """One element: local tag name, attributes, children, text and source line (read only)."""
 
     __slots__ = ("attrib", "children", "line", "tag", "text")
 
     def __init__(self, tag: str, attrib: dict[str, str], line: int) -> None:
         self.tag = tag
         self.attrib = attrib
-        self.children: list[Node] = []
+        self.children: list[Node] | tuple[Node, ...] = _NO_CHILDREN
         self.text = ""
         self.line = line
 
     def find(self, tag: str) -> Node | None:
         """First child named ``tag`` (``a/b`` walks down), or None."""
+        if "/" not in tag:
+            for c in self.children:
+                if c.tag == tag:
+                    return c
+            return None
         node: Node | None = self
         for part in tag.split("/"):
             assert node is not None
@@ -154,8 +164,9 @@ def parse_xml(
     parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
     parser.buffer_text = True
     stack: list[Node] = []
-    texts: list[list[str]] = []
     root: list[Node] = []
+    local: dict[str, str] = {}  # qualified name -> local name
+    seen: dict[str, str] = {}  # short texts, one object each
 
     skipped = [0]  # depth inside a skipped subtree
 
@@ -163,28 +174,37 @@ def parse_xml(
         if skipped[0]:
             skipped[0] += 1
             return
-        name = _local(tag)
+        name = local.get(tag)
+        if name is None:
+            name = local[tag] = _local(tag)
         if skip and stack and (stack[-1].tag, name) in skip:
             skipped[0] = 1
             return
-        node = Node(name, {_local(k): v for k, v in attrs.items()}, parser.CurrentLineNumber)
+        attrib = {_local(k): v for k, v in attrs.items()} if attrs else _NO_ATTRS
+        node = Node(name, attrib, parser.CurrentLineNumber)
         if stack:
-            stack[-1].children.append(node)
+            parent = stack[-1]
+            if parent.children:
+                parent.children.append(node)  # type: ignore[union-attr]
+            else:
+                parent.children = [node]
         else:
             root.append(node)
         stack.append(node)
-        texts.append([])
 
     def end(tag: str) -> None:
         if skipped[0]:
             skipped[0] -= 1
             return
-        node = stack.pop()
-        node.text = "".join(texts.pop())
+        stack.pop()
 
     def chars(data: str) -> None:
-        if texts and not skipped[0]:
-            texts[-1].append(data)
+        if stack and not skipped[0]:
+            node = stack[-1]
+            if node.text:
+                node.text = node.text + data
+            else:  # one string for each text a file repeats (names, types: slave after slave)
+                node.text = seen.setdefault(data, data) if len(data) <= 64 else data
 
     def refuse_doctype(*_args: object) -> None:
         raise _Refused(
@@ -210,6 +230,11 @@ def parse_xml(
         raise EniError(f"malformed XML: {msg}", file=source, line=exc.lineno) from None
     except (ValueError, LookupError) as exc:  # an encoding pyexpat cannot use
         raise EniError(f"cannot decode the XML: {shown(str(exc))}", file=source, line=1) from None
+    finally:
+        # the handlers and the parser refer to each other: without this the cycle (and the
+        # whole tree through ``root``) would wait for the cyclic collector
+        parser.StartElementHandler = parser.EndElementHandler = None  # type: ignore[assignment]
+        parser.CharacterDataHandler = None  # type: ignore[assignment]
     if not root:
         raise EniError("empty XML document", file=source)
     return root[0]

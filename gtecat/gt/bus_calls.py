@@ -53,6 +53,7 @@ from ..controller.cards import options_for
 from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
 from ..inspect.endpoint import _PUBLISHED as _ENDPOINTS
+from ..inspect.endpoint import attached as _attached
 from ..master.clock import ClockMode
 from . import _core
 from ._core import (
@@ -523,12 +524,14 @@ def GTE_Wait(ctl: Controller, ms: float) -> int:
     """Let ``ms`` of controller time pass, in any clock mode (virtual time runs, or the
     realtime clock sleeps), so one script runs unchanged in every mode.
 
-    While the controller's inspection endpoint is published, a wait in virtual time ends
-    with a yield (``time.sleep(0)``, no waiting): a script that runs quick lockstep waits
-    back to back would otherwise keep the interpreter from the endpoint's threads, and an
-    attached panel or verb would get no answer until the script ends."""
+    While a panel or verb is attached to the controller's inspection endpoint, a wait in
+    virtual time ends with a yield (``time.sleep(0)``, no waiting): a script that runs
+    quick lockstep waits back to back would otherwise keep the interpreter from the
+    endpoint's threads, and the panel would get no answer until the script ends.  With
+    nobody attached there is no yield: on a busy machine one hands the CPU to another
+    process for a scheduler slice."""
     ctl.wait_ms(float(ms))
-    if _ENDPOINTS and ctl.clock.mode is not ClockMode.REALTIME:
+    if _ENDPOINTS and ctl.clock.mode is not ClockMode.REALTIME and _attached():
         time.sleep(0)
     return 0
 

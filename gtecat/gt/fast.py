@@ -16,6 +16,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import struct
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -36,6 +37,35 @@ def _cparam(address: int) -> str:
 
 _NO: Any = object()  # an argument the caller did not pass
 _addressof = ctypes.addressof
+
+
+def _carg_address_offset() -> int | None:
+    """Where a ``byref()`` object keeps the address it passes, in bytes from its start.
+
+    ctypes offers no reader for it (``byref(obj, offset)`` looks like ``byref(obj)``), and
+    its repr costs a microsecond; the field's place in CPython's ``PyCArgObject`` is found
+    here by probing objects whose addresses are known, and used only when every probe,
+    with and without an offset, agrees.  None: not found, the repr is compared instead."""
+    try:
+        size = sys.getsizeof(ctypes.byref(ctypes.c_int()))
+        objs = [ctypes.c_long(), ctypes.c_int(), ctypes.c_double(), (ctypes.c_long * 3)()]
+        for k in range(16, size - 7, 8):
+            ok = True
+            for obj in objs:
+                for off in (0, 4, 8):
+                    p = ctypes.byref(obj, off)
+                    if ctypes.c_void_p.from_address(id(p) + k).value != _addressof(obj) + off:
+                        ok = False
+            if ok:
+                return k
+    except Exception:  # another implementation: the repr it is
+        return None
+    return None
+
+
+#: see :func:`_carg_address_offset`
+_CARG_AT = _carg_address_offset() if sys.implementation.name == "cpython" else None
+_from_address = ctypes.c_void_p.from_address
 
 
 _status = AxisResources.status
@@ -121,9 +151,13 @@ def fast_reader(
         if tp is _CArg:
             obj = p._obj
             if p is not last[0]:
-                # byref(obj), not byref(obj, offset): its repr names the address it holds
-                # (cheaper than asking ctypes); any doubt takes the table path
-                if type(obj) not in ctypes_ok or repr(p) != _cparam(_addressof(obj)):
+                # byref(obj), not byref(obj, offset): the address it holds is the object's
+                # (read where ctypes keeps it, else from its repr); any doubt: the table path
+                if type(obj) not in ctypes_ok or (
+                    _from_address(id(p) + _CARG_AT).value != _addressof(obj)
+                    if _CARG_AT is not None
+                    else repr(p) != _cparam(_addressof(obj))
+                ):
                     return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
                 last[0] = p  # checked: the same pointer object next time needs no check
             obj.value = get(res)
@@ -207,6 +241,27 @@ def _index(image: Any, offset: int, size: int, write: bool) -> np.ndarray | None
     return image._raw_index[offset : offset + size].copy()
 
 
+#: a raw range of at most this many runs of the image buffer is copied run by run
+MAX_RUNS = 4
+
+
+def _plan(
+    image: Any, offset: int, size: int, write: bool
+) -> tuple[tuple[tuple[int, int, int], ...], np.ndarray] | None:
+    """How a raw range is copied: its runs of the image buffer ``(first byte in the range,
+    first byte in the buffer, bytes)`` (empty: too many, numpy copies it) and its buffer
+    indices; None when the fast path must not answer (:func:`_index`)."""
+    idx = _index(image, offset, size, write)
+    if idx is None:
+        return None
+    cuts = np.flatnonzero(np.diff(idx) != 1) + 1
+    starts = [0, *cuts.tolist()]
+    ends = [*cuts.tolist(), size]
+    if len(starts) > MAX_RUNS:
+        return (), idx
+    return tuple((a, int(idx[a]), b - a) for a, b in zip(starts, ends, strict=True)), idx
+
+
 def fast_raw(
     name: str,
     slow: Callable[..., int],
@@ -217,15 +272,18 @@ def fast_raw(
     fast path in front of the table: ``(int offset, int size, buffer)`` on the in-process
     controller with every slave online, the buffer a ctypes array, a bytearray, a one-byte
     numpy array or memoryview (and for writes ``bytes`` too) holding at least ``size`` bytes.
-    One numpy copy between the caller's memory and the process image; anything else takes
-    the table path."""
+    Into or from a bytearray, memoryview or bytes, a range of a few runs of the process image
+    (a slave's outputs, its inputs) is copied run by run as slices; otherwise one numpy copy
+    through a cached view; anything else takes the table path."""
     write = name in ("GT_SetEcatRawData", "GT_EcatIOWriteOutput")
     io = name in _IO
-    cache: dict[tuple[int, int], np.ndarray | None] = {}
-    seen: list[Any] = [None]  # the image the cache is of
-    #: byte views of the caller's ctypes and numpy buffers, the last few (kept alive)
+    cache: dict[tuple[int, int], tuple[int, np.ndarray] | None] = {}
+    #: the image the cache is of and its bytes as a memoryview
+    seen: list[Any] = [None, None]
+    #: byte views of the caller's numpy buffers, the last few (kept alive)
     views: dict[tuple[int, int], tuple[Any, np.ndarray]] = {}
     copyto, frombuffer, u8 = np.copyto, np.frombuffer, np.uint8
+    sizeof, Array = ctypes.sizeof, ctypes.Array
 
     def view(p: Any, tp: type, size: int) -> np.ndarray | None:
         """``size`` bytes of the caller's buffer as a numpy array (None: not a fast shape)."""
@@ -233,8 +291,8 @@ def fast_raw(
         v = views.get(key)
         if v is not None and v[0] is p:
             return v[1]
-        if issubclass(tp, ctypes.Array):
-            if ctypes.sizeof(p) < size:
+        if issubclass(tp, Array):
+            if sizeof(p) < size:
                 return None
             arr = frombuffer(p, u8, size)
         elif tp is _NDARRAY:
@@ -256,6 +314,26 @@ def fast_raw(
             views.clear()
         views[key] = (p, arr)
         return arr
+
+    def copy_runs(p: Any, tp: type, runs: tuple, size: int) -> bool:
+        """The runs of the image to or from the caller's buffer (False: not this way)."""
+        img = seen[1]
+        if tp is bytearray or tp is memoryview or (tp is bytes and write):
+            if len(p) < size:
+                return False
+            if tp is memoryview:
+                if p.format != "B" or p.ndim != 1 or not p.c_contiguous:
+                    return False
+                if p.readonly and not write:
+                    return False
+            if write:
+                for a, first, n in runs:
+                    img[first : first + n] = p[a : a + n]
+            else:
+                for a, first, n in runs:
+                    p[a : a + n] = img[first : first + n]
+            return True
+        return False  # ctypes and numpy buffers: one numpy copy through a cached view
 
     def raw_gt(
         offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any
@@ -297,21 +375,23 @@ def fast_raw(
             raw = sl.gt_offset + offset
         if image is not seen[0]:
             cache.clear()
-            seen[0] = image
+            seen[0], seen[1] = image, memoryview(image.buffer)
         key = (raw, size)
-        if key in cache:
-            idx = cache[key]
-        else:
-            idx = cache[key] = _index(image, raw, size, write)
-        if idx is None:
+        plan = cache.get(key, _NO)
+        if plan is _NO:
+            plan = cache[key] = _plan(image, raw, size, write)
+        if plan is None:
             return slow(*args)
-        arr = view(p, type(p), size)
-        if arr is None:
-            return slow(*args)
-        if write:
-            image.buffer[idx] = arr
-        else:
-            copyto(arr, image.buffer.take(idx))  # (np.take with out= costs microseconds)
+        runs, idx = plan
+        tp = type(p)
+        if not runs or not copy_runs(p, tp, runs, size):
+            arr = view(p, tp, size)
+            if arr is None:
+                return slow(*args)
+            if write:
+                image.buffer[idx] = arr
+            else:
+                copyto(arr, image.buffer.take(idx))  # (np.take with out= costs microseconds)
         session.last = None
         if ctl.clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)

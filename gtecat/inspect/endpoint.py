@@ -522,6 +522,17 @@ def published(ctl: Any) -> Endpoint | None:
     return _PUBLISHED.get(id(ctl))
 
 
+def attached() -> bool:
+    """Some endpoint of this process has a connection open or a request waiting: its
+    threads then need the interpreter between the application's calls.  (A client that
+    just connected gets it within the interpreter's switch interval and is counted here
+    from its first line on.)"""
+    for ep in _PUBLISHED.values():
+        if ep._watchers or ep._pending:
+            return True
+    return False
+
+
 def _close_all() -> None:
     for ep in list(_PUBLISHED.values()):
         ep.close()

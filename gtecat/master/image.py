@@ -11,6 +11,7 @@ Slaves whose areas are not byte aligned go through :mod:`gtecat.eni.bits`.
 
 from __future__ import annotations
 
+import functools
 import struct
 from dataclasses import dataclass
 
@@ -23,6 +24,12 @@ from gtecat.eni.model import Direction
 from ..errors import ParameterError
 
 _INT_FMT = {8: "b", 16: "h", 32: "i", 64: "q"}
+
+
+@functools.cache
+def _struct(fmt: str) -> struct.Struct:
+    """One (immutable) codec per format for every accessor of every slave."""
+    return struct.Struct(fmt)
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,7 +62,7 @@ class EntryAccess:
         self._buf = image.view
         fmt = _INT_FMT.get(self.bits) if not (bit & 7) else None
         if fmt is not None:
-            self._fmt = struct.Struct("<" + (fmt if self.signed else fmt.upper()))
+            self._fmt = _struct("<" + (fmt if self.signed else fmt.upper()))
             self._off = bit >> 3
         else:
             self._fmt = None

@@ -96,3 +96,22 @@ def test_coe_io_slave_sdo_reads_the_process_data_of_mapped_objects():
     with pytest.raises(SdoAbort) as err:
         sdo.download(0x6000, 1, b"\x00\x00")  # inputs are read-only
     assert err.value.code == SdoAbortCode.WRITE_OF_READ_ONLY
+
+
+def test_settled_means_another_step_changes_nothing():
+    """The controller runs cycles many at a time only while every IO slave is settled."""
+    s = _coupler()
+    s.wire_objects((0x7010, 1), (0x6000, 1))
+    s.rx[0:2] = b"\x0f\x00"
+    assert not s.settled()  # the outputs have not reached the field yet
+    s.step(0, 1_000_000)
+    assert s.settled()
+    before = (bytes(s.field_outputs), bytes(s.field_inputs), bytes(s.tx))
+    s.step(0, 1_000_000)
+    assert (bytes(s.field_outputs), bytes(s.field_inputs), bytes(s.tx)) == before
+    s.set_input(0x6020, 1, 7)  # the field changed: the next step sends it
+    assert not s.settled()
+    s.step(0, 1_000_000)
+    assert s.settled()
+    s.request_state(AlState.SAFEOP)
+    assert not s.settled()  # only in OP

@@ -1,4 +1,4 @@
-"""read_eni parses one file content once (gtecat.eni.reader._parse_cached)."""
+"""read_eni parses one file content once (gtecat.eni.reader._PARSED, keyed by its digest)."""
 
 from __future__ import annotations
 

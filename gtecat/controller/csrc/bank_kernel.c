@@ -21,6 +21,12 @@
 #include <stdint.h>
 #include <string.h>
 
+#if defined(__GNUC__)
+#define INLINE static inline __attribute__((always_inline))
+#else
+#define INLINE static inline
+#endif
+
 #define FIELDS                                                                          \
     X(alive, u8) X(moving, u8) X(jog, u8) X(ended, u8) X(base, i64) X(t_cur, i64)          \
     X(t_end, i64) X(t_idx, i64) X(taken, i64) X(t_p, f64)                                  \
@@ -45,7 +51,8 @@
     X(hm, u8) X(h_last, f64) X(h_el, f64) X(h_tr, f64) X(h_v, f64) X(h_p, f64)             \
     X(h_rest, f64) X(h_set, u8) X(h_vt, f64) X(h_acc, f64) X(h_lo, f64) X(h_hi, f64)       \
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
-    X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)
+    X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
+    X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)
 
 enum {
 #define X(name, type) F_##name,
@@ -55,7 +62,14 @@ enum {
 };
 
 /* io: int64 in/out slots */
-enum { IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN, N_IO };
+enum {
+    IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN,
+    IN_TABLE, IN_MAXC, IN_DT_NS, OUT_DONE, OUT_FILLED, N_IO
+};
+/* the segments a row's Trap move may hold for the kernel to fill its table itself */
+#define MAXSEG 16
+/* tprm per row: t_done, ts, t_final, target, dir, the planner's cycle (ms) */
+#define NTPRM 6
 /* fp: double inputs */
 enum { FP_DT, FP_T, N_FP };
 
@@ -71,6 +85,9 @@ const char *bank_kernel_fields(void)
 }
 
 int bank_kernel_abi(void) { return (N_FIELDS << 8) | (N_IO << 4) | N_FP; }
+
+/* the sizes the Python side allocates: MAXSEG << 8 | NTPRM */
+int bank_kernel_sizes(void) { return (MAXSEG << 8) | NTPRM; }
 
 #define U8(f) ((uint8_t *)ptr[F_##f])
 #define I64(f) ((int64_t *)ptr[F_##f])
@@ -161,7 +178,7 @@ static int64_t clip16(double x)
  * which _scan would find something (a switch edge, a limit, an index pulse).  Returns 1 when
  * this cycle would leave that state (an event crossed, a search bound reached): nothing is
  * written and the row goes back to the scalar drive for this cycle. */
-static int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
+INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
 {
     double pos = F64(c_pos)[r], p0 = F64(h_last)[r];
     double el = F64(h_el)[r], tr = F64(h_tr)[r], v = F64(h_v)[r], vt = F64(h_vt)[r];
@@ -211,7 +228,103 @@ static int homing_row(void **ptr, int64_t r, double dt, double *demand, double *
     return 0;
 }
 
-int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
+
+/* motion/trap_table.py's trap_table for one planner, sample by sample in the planner's own
+ * order of operations (TrapPlanner._sample): samples k0+1 .. k0+n of the move whose raw
+ * pieces are sg[4*q .. 4*q+3] = (t0, p0, v0, a), q < m.  Writes min(end + 1, n) samples;
+ * returns end, the index of the end sample (target, 0, 0), or n when the move goes on. */
+int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm, int64_t k0,
+                       int64_t n, double *po, double *vo, double *ao)
+{
+    const double t_done = prm[0], ts = prm[1], t_final = prm[2], tgt = prm[3], dir = prm[4];
+    const double thr = t_done - 1e-9 * (1.0 + t_done * 1e-3); /* _EPS_T */
+    int64_t s, i = 0, j = 0;
+    for (s = 0; s < n; s++) {
+        double t = (double)(k0 + 1 + s) * cyc;
+        double tau, p, v, a;
+        if (t >= thr) {
+            po[s] = tgt;
+            vo[s] = 0.0;
+            ao[s] = 0.0;
+            return s;
+        }
+        while (i + 1 < m && sg[4 * (i + 1)] <= t)
+            i++;
+        tau = t - sg[4 * i];
+        p = sg[4 * i + 1] + tau * (sg[4 * i + 2] + 0.5 * sg[4 * i + 3] * tau);
+        v = sg[4 * i + 2] + sg[4 * i + 3] * tau;
+        a = sg[4 * i + 3];
+        if (ts > 0.0) {
+            double ta = t - ts, pk, vk, ak, va, lo, hi, span, total = 0.0, dist = 0.0;
+            int64_t k;
+            while (j + 1 < m && sg[4 * (j + 1)] <= ta)
+                j++;
+            tau = ta - sg[4 * j];
+            ak = sg[4 * j + 3];
+            vk = sg[4 * j + 2] + ak * tau;
+            pk = sg[4 * j + 1] + tau * (sg[4 * j + 2] + 0.5 * ak * tau) - p;
+            va = vk;
+            lo = ta;
+            for (k = j;; k++) {
+                if (k > j) {
+                    lo = sg[4 * k];
+                    pk = sg[4 * k + 1] - p;
+                    vk = sg[4 * k + 2];
+                    ak = sg[4 * k + 3];
+                }
+                hi = k == i ? t : sg[4 * (k + 1)];
+                span = hi - lo;
+                if (span > 0.0) {
+                    total = total + span * (pk + span * (0.5 * vk + ak * span / 6.0));
+                    dist = dist + span * (vk + 0.5 * ak * span);
+                }
+                if (k >= i)
+                    break;
+            }
+            p = p + total / ts;
+            a = (v - va) / ts;
+            v = dist / ts;
+        }
+        if (t - ts >= t_final) { /* the final approach: min(p, target) / max(p, target) */
+            if (dir > 0.0)
+                p = tgt < p ? tgt : p;
+            else
+                p = tgt > p ? tgt : p;
+        }
+        po[s] = p;
+        vo[s] = v;
+        ao[s] = a;
+    }
+    return n;
+}
+
+/* AxisBank._refill of row r in the kernel: the last sample taken moves to the row's spare
+ * slot (TABLE), so a declined cycle still finds it; 0, or 1 when the row's pieces are not
+ * here (the caller refills it) */
+INLINE int refill_row(void **ptr, int64_t *io, int64_t r)
+{
+    const int64_t table = io[IN_TABLE], base = I64(base)[r], last = I64(t_idx)[r];
+    int64_t m = I64(nseg)[r], end, got;
+    if (m <= 0)
+        return 1;
+    F64(t_p)[base + table] = F64(t_p)[last];
+    F64(t_v)[base + table] = F64(t_v)[last];
+    F64(t_a)[base + table] = F64(t_a)[last];
+    I64(t_idx)[r] = base + table;
+    end = bank_trap_fill(F64(seg) + 4 * MAXSEG * r, m, F64(tprm)[NTPRM * r + 5], F64(tprm) + NTPRM * r,
+                         I64(k0)[r] + I64(taken)[r], table, F64(t_p) + base, F64(t_v) + base,
+                         F64(t_a) + base);
+    got = end < table ? end + 1 : table;
+    I64(t_len)[r] = got;
+    I64(t_cur)[r] = 0;
+    I64(t_end)[r] = end < table ? end : -1;
+    io[OUT_FILLED] = 1;
+    return 0;
+}
+
+/* inlined where the field table is a local copy: the compiler then knows no store through a
+ * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
+INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
@@ -251,6 +364,11 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
             goto mechanics;
         }
         cur = I64(t_cur)[r];
+        if (U8(moving)[r] && cur >= I64(t_len)[r]) { /* the table is used up: the next one */
+            if (refill_row(ptr, io, r))
+                return 4; /* nothing written: the caller refills it */
+            cur = 0;
+        }
         prf = F64(t_p)[I64(base)[r] + cur];
         ended = cur == I64(t_end)[r];
         if (U8(jog)[r]) { /* AxisBank._jog_step */
@@ -505,8 +623,19 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
         }
         u = (uint32_t)(uint64_t)val;
         {
-            int64_t k, off = I64(pl_off)[i];
-            for (k = 0; k < I64(pl_size)[i]; k++)
+            int64_t k, off = I64(pl_off)[i], size = I64(pl_size)[i];
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            if (size == 4) { /* the PDO's little-endian bytes are the value's own */
+                memcpy(buf + off, &u, 4);
+                continue;
+            }
+            if (size == 2) {
+                uint16_t u16 = (uint16_t)u;
+                memcpy(buf + off, &u16, 2);
+                continue;
+            }
+#endif
+            for (k = 0; k < size; k++)
                 buf[off + k] = (uint8_t)(u >> (8 * k));
         }
     }
@@ -514,17 +643,36 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
     return 0;
 }
 
-int64_t bank_kernel_run(void **ptr, int64_t *io, const double *fp, int64_t n, int64_t dt_ns)
+/* One cycle (io[IN_T_NS], fp[FP_DT]): 0 committed, else what was declined (nothing written). */
+int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 {
-    int64_t k, t0 = io[IN_T_NS];
-    int fin = 0;
-    for (k = 0; k < n; k++) {
-        io[IN_T_NS] = t0 + k * dt_ns;
-        if (bank_kernel_cycle(ptr, io, fp) != 0)
+    void *lp[N_FIELDS]; /* a local copy: stores through the rows cannot alias it */
+    memcpy(lp, ptr, sizeof lp);
+    io[OUT_FILLED] = 0;
+    return cycle_once(lp, io, fp);
+}
+
+/* Up to io[IN_MAXC] cycles from io[IN_T_NS], io[IN_DT_NS] apart; io[OUT_DONE] = cycles
+ * committed.  Stops after a cycle that ended a Trap move (io[OUT_FIN]) and before one the
+ * kernel declines (its code is returned, nothing of that cycle written). */
+int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
+{
+    void *lp[N_FIELDS];
+    int64_t c, maxc = io[IN_MAXC], t0 = io[IN_T_NS];
+    int rc = 0;
+    memcpy(lp, ptr, sizeof lp);
+    io[OUT_FILLED] = 0;
+    for (c = 0; c < maxc; c++) {
+        io[IN_T_NS] = t0 + c * io[IN_DT_NS];
+        rc = cycle_once(lp, io, fp);
+        if (rc)
             break;
-        fin |= (int)io[OUT_FIN];
+        if (io[OUT_FIN]) {
+            c++;
+            break;
+        }
     }
+    io[OUT_DONE] = c;
     io[IN_T_NS] = t0;
-    io[OUT_FIN] = fin;
-    return k;
+    return rc;
 }

@@ -142,9 +142,15 @@ def _act(action: tuple) -> int:
 
 
 def _run(
-    actions: list[tuple[int, tuple]], machine: str, bank: str, kernel: str = "c"
+    actions: list[tuple[int, tuple]],
+    machine: str,
+    bank: str,
+    kernel: str = "c",
+    chunked: bool = False,
 ) -> tuple[list, list, int]:
-    """The program's trace; ``kernel``: the bank's plain cycle compiled ("c") or numpy."""
+    """The program's trace; ``kernel``: the bank's plain cycle compiled ("c") or numpy;
+    ``chunked``: each wait in one GTE_Wait, sampled at its end only (the clock may run
+    its cycles many at a time)."""
     old = os.environ.get("GTECAT_BANK_KERNEL")
     os.environ["GTECAT_BANK_KERNEL"] = kernel
     try:
@@ -160,10 +166,15 @@ def _run(
     try:
         for wait, action in actions:
             codes.append(_act(action))
+            if chunked:
+                gt.GTE_Wait(wait)
+                trace.append(_sample(size))
+                continue
             for _ in range(wait):
                 gt.GTE_Wait(1)
                 trace.append(_sample(size))
         rows = ctl.bank.rows_run if ctl.bank is not None else 0
+        MANY_CYCLES.append(ctl.bank.many_cycles if ctl.bank is not None else 0)
         if ctl.bank is not None and kernel == "c":
             if ctl.bank.kernel is None and not HAS_CC:
                 KERNEL_CYCLES.append(-1)  # numpy alone ran: the callers skip their C check
@@ -184,6 +195,7 @@ def _run(
 
 
 KERNEL_CYCLES: list[int] = []  # cycles the compiled kernel ran, per "c" run
+MANY_CYCLES: list[int] = []  # cycles the kernel ran many at a time, per run
 HAS_CC = bool(os.environ.get("CC") or any(shutil.which(c) for c in ("cc", "gcc", "clang")))
 
 
@@ -266,6 +278,35 @@ def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     assert rows > 12 * 300
     assert got == ref
     _kernel_ran(KERNEL_CYCLES[0])
+
+
+def test_cycles_run_many_at_once_are_the_cycles_one_by_one(tmp_path: Path) -> None:
+    """Long waits with nothing else to do run many cycles per call of the kernel, which fills
+    its short Trap tables itself; moves that end, a stop, a new target, a band, a limit
+    switch and a raw write interrupt them.  The results are the scalar path's."""
+    machine = _machine_file(tmp_path)
+    moves = [
+        (0, ("move", a, (-1) ** a * 30_000, 15.0 + a, 0.5, 0.4, 0.0, (0, 5, 25)[a % 3]))
+        for a in range(1, 13)
+    ]
+    actions = [
+        *moves,
+        (333, ("band", 4, 10, 4)),
+        (101, ("retarget", 6, 2_000, 30.0)),
+        (250, ("stop", 0b1001, 0b1000)),
+        (97, ("move", 2, 70_000, 60.0, 2.0, 2.0, 0.0, 5)),  # runs into its +60000 limit
+        (1200, ("raw", 3, 7)),
+        (150, ("clear",)),
+    ]
+    ref, ref_codes, _ = _run(actions, machine, "off", chunked=True)
+    KERNEL_CYCLES.clear()
+    MANY_CYCLES.clear()
+    got, codes, _ = _run(actions, machine, "on", chunked=True)
+    assert codes == ref_codes
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"sample {k}: the bank and the scalar path differ"
+    _kernel_ran(KERNEL_CYCLES[0])
+    assert MANY_CYCLES[0] > 300  # the waits before the limit ran many cycles at a time
 
 
 def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:

@@ -1,0 +1,102 @@
+"""gtecat's own modules compiled once per source text, also where Python writes no bytecode.
+
+With ``PYTHONDONTWRITEBYTECODE`` set (container images often set it) and gtecat installed
+from a source tree (``pip install -e``), Python compiles every gtecat module from its source
+in every process: about half a second of each process's start, more than the rest of its
+import.  When bytecode writing is off, a finder put in front of the import system for
+``gtecat.*`` only keeps the compiled modules in gtecat's per-version cache (the folder of
+its built C parts, :mod:`gtecat.cbuild`): one file per module, named by the digest of the
+module's path and source text, written once and read by every later process.  A changed
+source is a new name; an unreadable or foreign file is compiled again.  Python's own caches
+work as always when bytecode writing is on (this module then does nothing), and
+``GTECAT_PYC_CACHE=0`` turns it off.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import marshal
+import os
+import sys
+from pathlib import Path
+from types import CodeType
+from typing import Any
+
+_DIR: list[Path] = []
+
+
+def _cache_dir(version: str) -> Path:
+    """The folder :func:`gtecat.cbuild.cache_root` names (kept here: that module's imports
+    would cost the time this one saves)."""
+    env = os.environ.get("GTECAT_CACHE_DIR")
+    if env:
+        root = Path(env)
+    else:
+        xdg = os.environ.get("XDG_CACHE_HOME")
+        root = (Path(xdg) if xdg else Path.home() / ".cache") / "gtecat"
+    tag = sys.implementation.cache_tag or "python"
+    return root / version / "pyc" / tag
+
+
+class _Loader(importlib.machinery.SourceFileLoader):
+    """A source module's code from the cache, compiled and stored there on a miss."""
+
+    def get_code(self, fullname: str) -> CodeType:
+        path = self.get_filename(fullname)
+        source = self.get_data(path)
+        h = hashlib.sha256(importlib.util.MAGIC_NUMBER)
+        h.update(os.fsencode(path))
+        h.update(b"\0")
+        h.update(source)
+        cached = _DIR[0] / f"{fullname}-{h.hexdigest()[:32]}.pyc"
+        try:
+            code = marshal.loads(cached.read_bytes())
+            if isinstance(code, CodeType) and code.co_filename == path:
+                return code
+        except (OSError, EOFError, ValueError, TypeError):
+            pass
+        code = self.source_to_code(source, path)
+        try:
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            tmp = cached.with_name(f"{cached.name}.{os.getpid()}.tmp")
+            tmp.write_bytes(marshal.dumps(code))
+            os.replace(tmp, cached)
+        except OSError:
+            pass  # a read-only home: compiled again next time, as without this module
+        return code
+
+
+class _Finder:
+    """Finds ``gtecat.*`` modules as the path finder does, with :class:`_Loader`."""
+
+    @classmethod
+    def find_spec(cls, name: str, path: Any = None, target: Any = None) -> Any:
+        if not name.startswith("gtecat."):
+            return None
+        spec = importlib.machinery.PathFinder.find_spec(name, path, target)
+        loader = spec.loader if spec is not None else None
+        if type(loader) is importlib.machinery.SourceFileLoader:
+            spec.loader = _Loader(loader.name, loader.path)
+        return spec
+
+    @classmethod
+    def invalidate_caches(cls) -> None:
+        pass
+
+
+def install(version: str) -> None:
+    """Put the finder in front when Python writes no bytecode (once per process)."""
+    if not sys.dont_write_bytecode or os.environ.get("GTECAT_PYC_CACHE", "1") == "0":
+        return
+    if any(f is _Finder for f in sys.meta_path):
+        return
+    _DIR[:] = [_cache_dir(version)]
+    # just before the path finder: finders put in front of it (pytest's assertion rewriting
+    # of plugins, coverage tools) keep their turn
+    at = next(
+        (k for k, f in enumerate(sys.meta_path) if f is importlib.machinery.PathFinder),
+        len(sys.meta_path),
+    )
+    sys.meta_path.insert(at, _Finder)
