@@ -357,7 +357,11 @@ def fold_bitfields(block: str) -> str:
     if len(kinds) != 1 or next(iter(kinds)) not in _BITS:
         return block  # mixed types: left to the reader, which says it cannot read them
     kind = kinds.pop()
-    units = -(-sum(int(m[2]) for m in fields) // _BITS[kind])
+    units, used = 1, 0
+    for m in fields:  # a bit-field that does not fit what is left starts the next unit
+        if used + int(m[2]) > _BITS[kind]:
+            units, used = units + 1, 0
+        used += int(m[2])
     unit_fields = " ".join(f"{kind} bits{i + 1};" for i in range(units))
     start, end = fields[0].start(), fields[-1].end()
     if _BITFIELD.sub("", block[start:end]).strip():

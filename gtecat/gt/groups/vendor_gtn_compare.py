@@ -56,6 +56,7 @@ short GTN_BufSetLaserPowerWaveEnableEx(short core, short crd, TLaserPowerWave *p
 short GTN_BufSetPosComparePsoSynchPosEx(short core, short crd, short posCompareIndex, double synchPos, short fifo);
 short GTN_ClearLaserFollowTablePro(short core, short laserChannel, short tableId);
 short GTN_ClearLaserOnOffCount(short core, short channel);
+short GTN_ClearSoftTrigger(short core, short triggerIndex, short triggerCount);
 short GTN_ClearTriggerStatusArray(short core, short trigger, short count);
 short GTN_CrdPosCompareFollowPulseWidthEnable(short core, short crd, short posCompareIndex, short enable);
 short GTN_DisableAuTrigger(short core, short index);
@@ -74,6 +75,7 @@ short GTN_GetLaserPowerWaveStatus(short core, short laserChannel, TLaserPowerWav
 short GTN_GetLaserPro(short core, short laserChannel, TLaserPro *pLaserPro);
 short GTN_GetLaserStatus(short core, short channel, TLaserStatus *pStatus);
 short GTN_GetPosCompareAddition(short core, short posCompareIndex, TPosCompareAdditionPrm *pPrm);
+short GTN_GetPosCompareBufEnableInfo(short core, short posCompareIndex, TPosCompareBufEnableInfo *pEnableInfo);
 short GTN_GetPosCompareCompensateCoeff(short core, short posCompareIndex, TPosCompareCompensateCoeff *pCoeff);
 short GTN_GetPosCompareFifoMode(short core, short index, short *pMode);
 short GTN_GetPosCompareLatchValue(short core, short index, long count, long *pDataX, long *pDataY, long *pCount, TLatchValueInfo *pInfo);
@@ -91,6 +93,8 @@ short GTN_GetScanLaserLinkPro(short core, short scanCrd, short *pLaserChannel);
 short GTN_GetScanLaserParallelPrmPro(short core, short scanCrd, double *pMinParallel, double *pMaxParallel);
 short GTN_GetScanLaserPwmPrmPro(short core, short scanCrd, TLaserPwmPrmPro *pPrm);
 short GTN_GetScanLaserVoltagePrmPro(short core, short scanCrd, double *pMinVoltage, double *pMaxVoltage);
+short GTN_GetSoftTriggerInfo(short core, short triggerIndex, TSoftTriggerInfo *pInfo, short triggerCount);
+short GTN_GetSoftTriggerLatchValue(short core, short triggerIndex, short start, short readCount, TSoftTriggerLatchValue *pLatchValue, short *pRealCount);
 short GTN_GetTorqueTriggerPrm(short core, short index, TTorqueTriggerPrm *pPrm);
 short GTN_GetTriggerLatchValue(short core, short i, long count, long *pValue, long *pCount, TLatchValueInfo *pInfo /*inout*/);
 short GTN_GetTriggerLatchValuePro(short core, short index, long count, TTriggerLatchPrm *pLatchPrm, long *pCount, TLatchValueInfo *pInfo);
@@ -100,6 +104,8 @@ short GTN_GetTriggerToolPosition(short core, short triggerIndex, TToolPosition *
 short GTN_LaserFollowMode(short core, short laserChannel, short *pLaserFollowSource, double *pLaserFollowStartPower, short laserCount);
 short GT_LaserFollowOff(short crd, short fifo, short channel);
 short GTN_LaserFollowRatio(short core, short laserChannel, double *pLaserFollowRatio, double *pLaserFollowMinPower, double *pLaserFollowMaxPower, short laserCount);
+short GTN_PosCompareBufCmdEnable(short core, short posCompareIndex, short enable);
+short GTN_PosCompareBufSourceEnable(short core, short posCompareIndex, TPosCompareBufSourceEnable *pSourceEnable);
 short GTN_PosCompareDataFifoSizeExtend(short core, short posCompareIndex, short enable, short fifoOperation);
 short GTN_PosCompareDataMass(short core, short index, TPosCompareData *pData /*inout*/, long long *pSendCount, long long count);  // header; other public copies declare (short, short, void *, long long *, long long)
 short GT_PosCompareInfoEx(short index, TPosCompareInfoEx *pInfo);
@@ -177,6 +183,7 @@ short GTN_SetScanLaserPwmPrmPro(short core, short scanCrd, TLaserPwmPrmPro *pPrm
 short GTN_SetScanLaserPwmPulseWidthPro(short core, short scanCrd, double pulseWidth, TListInfo *pListInfo);
 short GTN_SetScanLaserVoltagePrmPro(short core, short scanCrd, double minVoltage, double maxVoltage, TListInfo *pListInfo);
 short GTN_SetScanLaserVoltagePro(short core, short scanCrd, double voltage, TListInfo *pListInfo);
+short GTN_SetSoftTriggerPrm(short core, short triggerIndex, TSoftTriggerPrm *pPrm, short triggerCount, TListInfo *pListInfo=NULL);
 short GTN_SetTorqueTriggerPrm(short core, short index, TTorqueTriggerPrm *pPrm);
 short GTN_SetTriggerArray(short core, short trigger, TTrigger *pTrigger, short count);
 short GTN_SetTriggerMoveEscape(short core, short trigger, TTaskMoveEscape *pPrm /*inout*/);

@@ -10,15 +10,24 @@ DECLARED_ONLY = True
 
 PROTOTYPES = r"""
 short GTN_AxisPressCompensateEnable(short core, short axis, short enable, double deadZone, double factor, TListInfo *pListInfo /*inout*/);
+short GTN_ClearFirCompensate(short core);
 short GTN_EnableAxisLeadScrewCrossComp(short core, TEnableAxisLeadScrewCrossComp *pEnableAxisLeadScrewCrossComp);
 short GTN_GantryProtectEnable(short core, short group, short enable, short protectType, short subProtectType);
 short GT_GetAxisPressCompensateFixFactorStatus(short axis, short *pFixFactorSts, TAxisPressCompensateFixFactor *pPressComp);
 short GTN_GetBacklashComp(short core, short axis, TBacklashComp *pBacklash);
 short GTN_GetCompensate2DMode(short core, short axis, short *pMode);
+short GTN_GetCompensate2DTableOffset(short core, short tableIndex, double *pXOffset, double *pYOffset);
 short GT_GetCompensate2DTableRotationAngle(short tableIndex, short *pEnable, double *pRotationAngle);
+short GTN_GetCompensate3D(short core, short axis, TCompensate3D *pCompensate3D);
+short GTN_GetCompensate3DTable(short core, short tableIndex, TCompensate3DTable *pTable, TCompensate3DPoint *pPointArray, TCompensate3DPointRange *pPointRange, short *pExtend);
+short GTN_GetCompensate3DValue(short core, short axis, double *pValue);
 short GTN_GetCompensateLimit(short core, short compensateIndex, short compensateType, double *pMinLimit, double *pMaxLimit);
 short GTN_GetCoordSyncCompPrm(short core, short index, TCoordSyncCompPrm *pPrm);
 short GTN_GetCoordSyncCompValue(short core, short index, double x, double y, double *pCompX, double *pCompY);
+short GTN_GetDynamicCompensateParameter(short core, short dcIndex, TDynamicCompensateParameter *pPrm);
+short GTN_GetDynamicCompensateStatus(short core, short dcIndex, TDynamicCompensateStatus *pStatus);
+short GTN_GetFirCompensateParameter(short core, unsigned short index, TFirCompensateParameter *pPrm);
+short GTN_GetFirCompensateValue(short core, unsigned short index, TFirCompensateValue *pValue);
 short GTN_GetGantryInf(short core, short group, TGantryInf *pPrm);
 short GTN_GetGantryProtectPrm(short core, short group, short torqueProtectType, TGantryTorqueProtectPrm *pPrm);
 short GT_GetGantrySynchErrorCompensate2D(short group, TCompensate2D *pComp2d);
@@ -26,18 +35,26 @@ short GT_GetGantrySynchErrorCompensate2DTable(short tableIndex, TCompensate2DTab
 short GT_GetGantrySynchErrorCompensate2DValue(short group, double *pValue);
 short GTN_GetLeadScrewCompStatus(short core, short axis, TLeadScrewCompStatus *pSts);
 short GTN_GetPrfPosBeforeLeadScrewComp(short core, short axis, short dir, double endPos, double *pOriginPos);
+short GTN_GetSpringCompensatePara(short core, short control, short *pEnable, long *pRefPos, double *pK, double *pB, double *pLimit);
 short GTN_SetAxisLeadScrewCrossCompPrm(short core, TAxisLeadScrewCrossCompPrm *pAxisLeadScrewCrossCompPrm);
 short GTN_SetAxisPressCompensateTarget(short core, short axis, double target, double thredshold, TListInfo *pListInfo /*inout*/);
 short GTN_SetBacklashComp(short core, short axis, TBacklashComp *pBacklash);
 short GTN_SetCompensate2DMode(short core, short axis, short mode);
+short GTN_SetCompensate2DTableOffset(short core, short tableIndex, double xOffset, double yOffset);
 short GT_SetCompensate2DTableRotationAngle(short tableIndex, short enable, double rotationAngle);
+short GTN_SetCompensate3D(short core, short axis, TCompensate3D *pCompensate3D);
+short GTN_SetCompensate3DTable(short core, short tableIndex, TCompensate3DTable *pTable, TCompensate3DPoint *pPointArray, long pointCount, short extend);
 short GTN_SetCompensateLimit(short core, short compensateIndex, short compensateType, double minLimit, double maxLimit);
 short GTN_SetCoordSyncCompPrm(short core, short index, TCoordSyncCompPrm *pPrm /*inout*/);
+short GTN_SetDynamicCompensateParameter(short core, short dcIndex, TDynamicCompensateParameter *pPrm);
+short GTN_SetDynamicCompensatePoint(short core, short dcIndex, TDynamicCompensatePoint *pPoint);
+short GTN_SetFirCompensateParameter(short core, unsigned short index, TFirCompensateParameter *pPrm);
 short GTN_SetGantryModePro(short core, short group, short master, short slave, short mode, long syncErrorLimit);
 short GTN_SetGantryPrmPro(short core, short group, TGantryPrmPro *pGantryPrmPro);
 short GTN_SetGantryProtectPrm(short core, short group, short torqueProtectType, TGantryTorqueProtectPrm *pPrm);
 short GT_SetGantrySynchErrorCompensate2D(short group, TCompensate2D *pComp2d /*inout*/);
 short GT_SetGantrySynchErrorCompensate2DTable(short tableIndex, TCompensate2DTable *pTable /*inout*/, long *pData /*inout*/, short extend);
 short GTN_SetMultiAxisLeadScrewCrossCompData(short core, TAxisLeadScrewCrossCompData *pAxisLeadScrewCrossCompData, short count);
+short GTN_SetSpringCompensatePara(short core, short control, short enable, long refPos, double k, double b, double limit);
 short GT_StartAxisPressCompensateFixFactor(short axis, TAxisPressCompensateFixFactor *pPressComp /*inout*/);
 """

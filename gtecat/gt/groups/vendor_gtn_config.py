@@ -31,6 +31,7 @@ short GT_JoystickReset(short joystickIndex);
 short GTN_LoadReadHsConfig(short core, char *pFile /*str*/);
 short GTN_ProgramCardNumToFlash(short core, short coreNum);
 short GTN_ReadCardNumFromFlash(short core, short *pCardNum);
+short GTN_ResetDualAxis(short core, short index);
 short GT_ResetPciCommandFlag();
 short GTN_ResetServoDSP(short core, short axis);
 short GT_SaveConfigToFile(char *pFile);

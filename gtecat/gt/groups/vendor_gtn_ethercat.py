@@ -19,6 +19,7 @@ short GTN_GetEcatAxisDIEx(short core, short axis, unsigned long *pDi, short coun
 short GTN_GetEcatAxisLmtHomeIndex(short core, short axis, short *index_LimitN, short *index_LimitP, short *index_Home);
 short GTN_GetEcatAxisMaxTargetVel(short core, short axis, unsigned long *targetMaxVel);
 short GTN_GetEcatDcErrorEx(short core, TEcatErrInfo *pEcatErrorInfo);
+short GTN_GetEcatSlavePdo(short core, unsigned short station, unsigned short index, unsigned char subIndex, unsigned char *pData, unsigned int data_size);
 short GTN_GetMcRelateEcatSlaveInfo(short core, short mcType, short index, short *pEcatIndex, short *pEcatType, short *pPdoOffset, short *pBitoffset, short *pdPoByteLength);
 short GTN_InitEcatCommEx(short core, char *eniFilePath);
 short GTN_InitEcatComm_MultiTask(short core, TEcatInitPrm *pPrm);
@@ -35,4 +36,5 @@ short GTN_SetEcatAxisLmtHomeIndex(short core, short axis, short index_LimitN, sh
 short GTN_SetEcatAxisMaxTargetVel(short core, short axis, unsigned long targetMaxVel);
 short GTN_SetEcatHomingPrmEx(short core, short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);  // header; other public copies declare (short, short, void *, void *, void *, void *, void *, void *)
 short GTN_SetEcatHomingPrmPro(short core, short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction, unsigned short mask);
+short GTN_SetEcatSlavePdo(short core, unsigned short station, unsigned short index, unsigned char subIndex, unsigned char *pData, unsigned int data_size);
 """

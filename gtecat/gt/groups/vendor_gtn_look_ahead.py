@@ -13,6 +13,8 @@ short GTN_BufAuDA(short core, short crd, short chn, short daValue, short fifo=0)
 short GTN_BufAuDAEx(short core, short crd, short chn, short daValue, short fifo=0);
 short GTN_BufCrdBlendOff(short core, short crd, short fifo);
 short GTN_BufCrdBlendOn(short core, short crd, short fifo);
+short GTN_BufEnableWaveform(short core, short crd, short index, TWaveformOutput *pOutput, short enable, short modal, short fifo);
+short GTN_BufEnableWaveformEx(short core, short crd, short index, TWaveformOutput *pOutput, short enable, short modal, short fifo);
 short GTN_BufExtAo(short core, short crd, short aoIndex, double aoValue, short fifo);
 short GTN_BufExtAoEx(short core, short crd, short aoIndex, double aoValue, short fifo);
 short GTN_BufExtDA(short core, short crd, short chn, short daValue, short fifo);
@@ -29,6 +31,7 @@ short GTN_BufMoveSpEx(short core, short crd, short moveAxis, double pos, double 
 short GTN_BufMoveSpSetPrmEx(short core, short crd, short moveAxis, double acc, double dec, double velMax, short fifo);
 short GTN_BufPrfCompEnable(short core, short crd, short fifo, short profile, short enable, short enableType);
 short GT_BufPrfCompEnableEx(short crd, short fifo, short profile, short enable, short enableType);
+short GTN_BufSetCompensate2DTableOffsetEx(short core, short crd, short tableIndex, double xOffset, double yOffset, short fifo);
 short GTN_BufSetCrdBlend(short core, short crd, TCrdBlend *pCrdBlend, short fifo);
 short GTN_BufSetDoubleVarEx(short core, short crd, short index, double value, short fifo);
 short GTN_BufSetLongVarEx(short core, short crd, short index, long value, short fifo);

@@ -9,8 +9,10 @@ TITLE = "programs, variables, watch and scan (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_BindMP(short core, short task, char *pFileMpName);
 short GTN_ClearScanExecuteTime(short core, short scan=1);
 short GTN_ClearScanExecuteTimePro(short core, short scanCrd);
+short GTN_DownloadAxisRefMP(short core, short axis, short index, double *axis_ref, short count);
 short GTN_EnableScanBatchDataSend(short core, short enable);
 short GTN_EncryptionFunConfig(short core, short slotIndex, unsigned char *pOldKey /*inout*/, unsigned char *pNewKey /*inout*/, unsigned char *pUserData /*inout*/, short *pSts, short *pConfigured);
 short GT_GetBufWaitLongVarStatus(short crd, short *pIndex, long *pValue, short *pFlagMode, long *pSegNum, short *pEnable, short *pStatus, short fifo);
@@ -19,6 +21,8 @@ short GT_GetFlagVar(short index, short *pMode, short *pValue);
 short GTN_GetFunIdPro(short core, char *pFunName, short *pFunId);
 short GTN_GetMcVarArray(short core, short resInfoCount, TMcVarResInfo *pResInfo);
 short GTN_GetMcVarEx(short core, const TWatchVar *pVar, double *pValue, short count);
+short GTN_GetPublicFloat64VarValueMP(short core, int index, double *pValue, int count);
+short GTN_GetPublicInt32VarValueMP(short core, int index, int *pValue, int count);
 short GTN_GetScanAlarmAutoStopMode(short core, short *pMode, unsigned long *pErrorcodeCheckMask, unsigned long *pErrorcodeCheckRef, short crd);
 short GTN_GetScanBatchDataSendingSts(short core, short scanIndex, TScanBatchDataSendingSts *pScanBatchDataSendingSts);
 short GTN_GetScanErrorCode(short core, unsigned long *pErrorCode, short crd);
@@ -32,6 +36,7 @@ short GTN_GetTaskSaveMcVarResultEx(short core, short index, TWatchVar *pVar, dou
 short GTN_GetVarCondition(short core, short varIndex, TWatchCondition *pWatchCondition, short *pConditionCount, short *pOperation);
 short GTN_GetVarIdPro(short core, char *pFunName, char *pVarName, TVarInfo *pVarInfo);
 short GTN_GetVarValueEx(short core, short page, TVarInfo *pVarInfo, double *pValue, short count=1);
+short GTN_InsertCallbackEvent(short core, short motionMode, short index, short eventNumber, TListInfo *pListInfo);
 short GTN_LoadReadCommandVarTable(short core, short tableIndex, char *pFile);
 short GTN_LoadScanCorrectionTable(short core, short scan, char *pFile, short type);
 short GTN_LoadVarCalculate(short core, TVarCalculate *pVarCalculate /*inout*/, short count, TListInfo *pListInfo /*inout*/);
@@ -61,6 +66,8 @@ short GTN_SetEventWaitTime(short core, double waitTime);
 short GT_SetFlagVar(short index, short mode, short value);
 short GTN_SetMcVar(short core, const TWatchVar *pVar, double value, TListInfo *pListInfo);
 short GTN_SetMcVarEx(short core, const TWatchVar *pVar, double *pValue, short count, TListInfo *pListInfo);
+short GTN_SetPublicFloat64VarValueMP(short core, int index, double *pValue, int count);
+short GTN_SetPublicInt32VarValueMP(short core, int index, int *pValue, int count);
 short GTN_SetScanAlarmAutoStopMode(short core, short mode, unsigned long errorcodeCheckMask, unsigned long errorcodeCheckRef, short crd);
 short GTN_SetScanDelayPrmPro(short core, short scanCrd, TScanDelayParameterPro *pPrm /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_SetScanMotionDelayPro(short core, short scanCrd, double delayTime, TListInfo *pListInfo /*inout*/);

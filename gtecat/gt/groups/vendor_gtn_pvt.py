@@ -30,6 +30,7 @@ short GTN_GetPvtTableLoop(short core, short profile, short tableId, long *pLoopC
 short GTN_GoToAxisFollowHeight(short core, short axis, long followCmd, THeightFollowPrm *pFollowPrm, double trapVel, TTrapPrm *pTrapPrm);
 short GTN_PrfComp(short core, short profile, TPrfComp *pComp /*inout*/);
 short GTN_PrfCompEnable(short core, short profile, short enable, short enableType);
+short GTN_PrfTrack(short core, short profile);
 short GTN_PrfTrapEx(short core, short profile);
 short GTN_PtDataArray(short core, short profile, double *pos, long time, short *type, short fifo, short count);
 short GTN_PtDataPro(short core, short profile, double pos, double time, short type=0, short fifo=0);

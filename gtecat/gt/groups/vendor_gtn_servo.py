@@ -24,6 +24,7 @@ short GT_GetAxisPressCompensateFixPidStatus(short axis, short *pFixPidSts, TAxis
 short GTN_GetCommandListMpgMode(short core, short list, TCommandListMpgPrm *pCommandListMpgPrm);
 short GTN_GetContourControl(short core, short index, TContourControl *pContourControl);
 short GTN_GetControlAddition(short core, short index, TAddition *pAddition);
+short GTN_GetControlLoopMode(short core, short control, short index, short *loopMode);
 short GTN_GetDacScale(short core, short dac, long *pScale);
 short GTN_GetEncPrm(short core, short encoder, long *pLineNum, short *pType);
 short GTN_GetEncoderMapRelation(short core, short masterEncType, short masterEncIndex, short *pMapEncType, short *pMapEncIndex);
@@ -32,6 +33,9 @@ short GTN_GetEncoderSource(short core, short encoder, TEncoderSource *pEncoderSo
 short GTN_GetFPGAEncoder(short core, long *pDataChn1, long *pDataChn2, long *pDataChn3, long *pDataChn4, long *pCount, long *pOverFlowFlag);
 short GTN_GetHsoPulsePrm(short core, short station, short hsoIndex, THsoPulsePrm *pPem, short hsoCount);
 short GTN_GetLightPowerCtrlPara(short core, unsigned short *pCtrlMode, unsigned short *pDutyCycle, unsigned short *pPulseWidth);
+short GTN_GetLowpassFilterFirstOrder(short core, short control, short index, short filterLocation, short filterIndex, short *pEnableFlag, double *pFreq);
+short GTN_GetLowpassFilterSecondOrder(short core, short control, short index, short filterLocation, short filterIndex, short *pEnableFlag, double *pFreq, double *pDamping);
+short GTN_GetNotchFilter(short core, short control, short index, short filterLocation, short filterIndex, short *pEnableFlag, double *pCenterFreq, double *pBandWidth, double *pNotchDepth);
 short GTN_GetPressPid(short core, short pressControl, TPressPid *pPid);
 short GTN_GetScanPosSuperposeEncPos(short core, short scan, double *pXPos, double *pYPos);
 short GT_GetSecondOrderFilterPara(short control, short type, short index, TSecondOrderFilterPara *pFilterPrm);
@@ -41,10 +45,15 @@ short GTN_GetServoPosLoopPid(short core, short axis, TServoPosLoopPid *pServoPos
 short GTN_GetServoSpdLoopPid(short core, short axis, TServoSpdLoopPid *pServoSpdLoopPid);
 short GTN_GetSignalTimeFilter(short core, short type, short index, double *pFilterWidth);
 short GT_GetStepOutLevel(short axis, short type, short *pReverse);
+short GTN_GetVelLoopPid(short core, short control, short index, TPid *pPid);
 short GTN_InitFPGAEncoder(short core);
 short GTN_ReadAbsEncPos(short core, short encoder, double *pPos);
 short GTN_ReadAuAbsEncPos(short core, short encoder, double *pPos /*inout*/);
 short GTN_RelateEcSlvToMcMpgEnc(short core, short mpg, short ecatAxisIndex);
+short GTN_SamplingSetAuEncDir(short core, short auEncoderType, short auEncoder, short dir);
+short GTN_SamplingSetAuEncPos(short core, short auEncoderType, short auEncoder, double pos);
+short GTN_SamplingSetEncDir(short core, short encoder, short dir);
+short GTN_SamplingSetEncPos(short core, short encoder, double pos);
 short GTN_SetAbsEncMultiTurnRange(short cardIndex, short encoder, double range);
 short GTN_SetAdcBias(short core, short adc, short bias);
 short GTN_SetAuAbsEncMultiTurnRange(short core, short encoder, double range);
@@ -65,6 +74,9 @@ short GTN_SetEncoderSource(short core, short encoder, TEncoderSource *pEncoderSo
 short GTN_SetFPGAEncoder(short core, short enable, long intervalTime, short reverseMask);
 short GTN_SetHsoPulsePrm(short core, short station, short hsoIndex, THsoPulsePrm *pPem /*inout*/, short hsoCount);
 short GTN_SetLightPowerCtrlPara(short core, unsigned short ctrlMode, unsigned short *pDutyCycle, unsigned short *pPulseWidth);
+short GTN_SetLowpassFilterFirstOrder(short core, short control, short index, short filterLocation, short filterIndex, short enableFlag, double freq);
+short GTN_SetLowpassFilterSecondOrder(short core, short control, short index, short filterLocation, short filterIndex, short enableFlag, double freq, double damping);
+short GTN_SetNotchFilter(short core, short control, short index, short filterLocation, short filterIndex, short enableFlag, double centerFreq, double bandWidth, double notchDepth);
 short GTN_SetPressPid(short core, short pressControl, TPressPid *pPid /*inout*/);
 short GTN_SetPulseCloseWorkMode(short core, short axis, TPulseCloseWorkModePrm *pPulseModePrm);
 short GT_SetSecondOrderFilterPara(short control, short type, short index, TSecondOrderFilterPara *pFilterPrm /*inout*/);
@@ -74,7 +86,9 @@ short GTN_SetServoPosLoopPid(short core, short axis, TServoPosLoopPid *pServoPos
 short GTN_SetServoSpdLoopPid(short core, short axis, TServoSpdLoopPid *pServoSpdLoopPid);
 short GTN_SetSignalTimeFilter(short core, short type, short index, double filterWidth);
 short GT_SetStepOutLevel(short axis, short type, short reverse);
+short GTN_SetVelLoopPid(short core, short control, short index, TPid *pPid);
 short GT_StartAxisPressCompensateFixPid(short axis, TAxisPressCompensateFixPid *pPressComp /*inout*/);
 short GT_StepResponse(short control, short gain, double time);
+short GTN_SwitchControlLoopMode(short core, short control, short index, short loopMode, double loopOutput, short switchMode);
 short GTN_ZerophaseFilter(short core, long dataLen, double inputdata[], double smoothArray[]);
 """

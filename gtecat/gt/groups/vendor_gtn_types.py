@@ -416,6 +416,55 @@ typedef struct { short profileMode; unsigned short reserve2[3]; TStTrapParam tra
 typedef struct { unsigned short prmErrorInf; short readCommandVarTableIndex; short readCount; short pad[2]; short realReadCount; double *pVarValue; } TMultiMcFunctionReadPrm;
 typedef struct { short enable; short reserve1[3]; double reserve2[4]; } TAxisSimulationParameter;
 typedef struct { short varId; short stationId; short varType; short varIndex; } StSamplingVar;
+typedef struct { short masterMode; short masterType; short masterIndex; short slaveMode; short slaveType; short slaveIndex; short slaveAdditionType; short slaveAdditionIndex; short slaveLink; short outOfRangeAction; short trapSmoothTime; short followSmoothPercent; double synchOffset; double detectPos; double parkPos; double stopPos; double slaveVelMax; double slaveAcc; double sampleTime; double reserve2[5]; } TCatchUpPrm;
+typedef struct { short mode; short fifoEmptyAction; short reserve1[2]; long reserve2[4]; double reserve3[4]; } TStartCatchUpPrm;
+typedef struct { short mode; short reserve1[3]; long reserve2[4]; double reserve3[4]; } TStopCatchUpPrm;
+typedef struct { short mode; short crdIndex; short reserve1[2]; long reserve2[4]; double reserve3[4]; } TStartCatchUpProcessPrm;
+typedef struct { short mode; short reserve1[3]; long reserve2[4]; double reserve3[4]; } TStopCatchUpSynchPrm;
+typedef struct { unsigned long id; long reserve1[3]; double pos; double reserve2[3]; } TCatchUpPieceFifo;
+typedef struct { short state; short stopInfo; short errorCode; short reserve1[5]; unsigned long id; unsigned long pieceCount; long reserve2[6]; double synchDistance; double synchTime; double reserve3[6]; } TCatchUpStatus;
+typedef struct { short state; short stopInfo; short errorCode; short reserve1[5]; long reserve2[8]; double pieceStartPos; double slaveStartPos; double pieceSynchPos; double slaveSynchPos; double pieceDistanceMin; double reserve3[8]; } TCatchUpInfo;
+typedef struct { unsigned long segmentNumber; short xAxisEnable; short yAxisEnable; short zAxisEnable; short reserve[5]; } TPosCompareBufSourceEnable;
+typedef struct { short bufCmdEnable; short xAxisEnable; short yAxisEnable; short zAxisEnable; short reserve[4]; } TPosCompareBufEnableInfo;
+typedef struct { double posBegin; double posEnd; double acc; double dec; double percentAcc; double percentDec; double vel; } TMpParameter;
+typedef struct { double posBegin; double posEnd; double acc; double dec; double percentAcc; double percentDec; double vel1; double vel2; double posMiddle; } TMp2Parameter;
+typedef struct { double time; double vel; double pos; double accDir; double am; double jerk; unsigned short segmentType; } TMpPoint;
+typedef struct { short dir; unsigned short pad[2]; unsigned short knotCount; TMpPoint knot[16]; } TMpResult;
+typedef struct { short stationId; unsigned short stationType; unsigned short subType; short reserve1; short reserve2; short reserve3; short reserve4; short reserve5; } TOnlineStationType;
+typedef struct { short enable; short mode; long dir; long threshold; long openLoopDac; double overTime; long posOffset; short reserve[2]; } TSwitchLoopParameter;
+typedef struct { long loopFlag; long tableMax; double startPos; double length; double refPos; double positiveOffset; double positiveScale; double negativeOffset; double negativeScale; } TTorqueForceCompensatePara;
+typedef struct { short masterIndex; short slaveIndex[2]; short pad1; double stopDec; double stopJerk; double borderPositive[2]; double borderNegative[2]; } TDualAxisParameter;
+typedef struct { short enable; short errorId; short pad1[2]; short state[2]; short border[2]; double pad2[6]; } TDualAxisStatus;
+typedef struct { double pos; double vel; double acc; double dec; double jerkAcc; double jerkDec; double velEvenTime; double accEvenTime; double decEvenTime; unsigned short bufferMode; unsigned short pad1; unsigned short pad2; unsigned short pad3; double reserve1; double reserve2; double reserve3; double reserve4; } TMoveAbsoluteSineParameter;
+typedef struct { double pos; double vel; double acc; double dec; double jerkAcc; double jerkDec; double velEvenTime; double accEvenTime; double decEvenTime; unsigned short bufferMode; unsigned short pad1; unsigned short pad2; unsigned short pad3; double reserve1; double reserve2; double reserve3; double reserve4; } TMoveAbsoluteJerkParameter;
+typedef struct { unsigned short motionDone; unsigned short pad1[3]; double timeElapse; double timeLeft; double aimPos; double prfPos; double prfVel; double prfAcc; double reserve1[4]; } TMoveAbsoluteJerkStatus;
+typedef struct { short enable; short tableIndex; short axisType[3]; short axisIndex[3]; short reserve1[4]; } TCompensate3D;
+typedef struct { long count[3]; long pad1[5]; double posBegin[3]; double step[3]; double reserve1[4]; } TCompensate3DTable;
+typedef struct { long pointIndex[3]; long pad1; double pointValue; } TCompensate3DPoint;
+typedef struct { long rangeIndex[3]; long rangeCount[3]; } TCompensate3DPointRange;
+typedef struct { unsigned short sourceType; unsigned short sourceIndex; unsigned int filterTime; unsigned short filterMode; unsigned short reserve1[3]; double reserve2[4]; } TFirCompensateParameter;
+typedef struct { double posRaw; double posFir; double posFirCompensate; double velRaw; double velFir; double velFirCompensate; } TFirCompensateValue;
+typedef struct { unsigned short enable; unsigned short mode; unsigned short sourceType; unsigned short sourceIndex; unsigned short estimate; unsigned short pad1[3]; double sampleTime; double smoothCoef; double reserve1[4]; } TTrackParameter;
+typedef struct { short enable; short reserve1[3]; double stopPos; double reserve2[8]; } TExactStopPrm;
+typedef struct { unsigned short cfgSize; unsigned short pduWrEn; unsigned short pduWrSize; unsigned short pduRdEn; unsigned short pduRdSize; unsigned short cmdEn; unsigned short fifoWrEn; unsigned short fifoRdEn; } StRnMailSlaveDeviceCfg;
+typedef struct { unsigned short cfgSize; unsigned short pduWrEn; unsigned short pduRdEn; unsigned short cmdEn; unsigned short fifoWrEn; unsigned short fifoRdEn; } StRnMailSlaveDeviceUpDateParam;
+typedef struct { double time; double value; } TWaveformParameter;
+typedef struct { short type; short index; short laserOn; short pad; } TWaveformOutput;
+typedef struct { short enable; short outputType; short outputIndex; short laserOn; short loopCount; short pad[3]; double outputValue; } TWaveformStatus;
+typedef struct { short startMode; short pad[3]; double voltage; double highLevelTime; double lowLevelTime; } TRectangleWavePrm;
+typedef struct { short startMode; short pad[3]; double voltage; double frequency; double dutyRatio; } TRectangleWaveDutyMode;
+typedef struct { short stepCount; short pad[3]; double voltageStart; double voltageEnd; double aheadTime; } TStageWavePrm;
+typedef struct { short enable; short laserOn; short loopCount; short rectOutputType; short rectOutputIndex; short rectOutputValid; short outputType; short outputIndex; short outputValid; short pad[3]; double rectVoltage; double outputVoltage; } TWaveformPairStatus;
+typedef struct { unsigned short enable; unsigned short dimension; unsigned short moveAxis1; unsigned short moveAxis2; unsigned short source; unsigned short compensateAxis; unsigned short mode; unsigned short pad1; double reserve1; double reserve2; double reserve3; double reserve4; } TDynamicCompensateParameter;
+typedef struct { unsigned short pointType; unsigned short pad1; unsigned short pad2; unsigned short pad3; double compensateValue; double compensateDistance; double reserve1; double reserve2; double reserve3; double reserve4; } TDynamicCompensatePoint;
+typedef struct { unsigned short enable; unsigned short execute; unsigned short pad1; unsigned short pad2; unsigned long pointReceive; unsigned long pointUse; TDynamicCompensatePoint point; double pos1; double pos2; double travelDistance; double compensateValue; double reserve1; double reserve2; double reserve3; double reserve4; } TDynamicCompensateStatus;
+typedef struct { unsigned char m_master_flag; unsigned char m_port_link_up_a; unsigned char m_port_link_up_b; unsigned char m_id_auto_set; unsigned char m_sync_status; unsigned char m_dc_status; unsigned char m_device_num; unsigned char m_device_id; unsigned short m_sync_cycle; unsigned short rsvd0; unsigned char m_station_id_list[256]; unsigned char m_station_ready[256]; unsigned long m_crc_ok_cnt_a; unsigned long m_crc_err_cn_a; unsigned long m_crc_ok_cn_b; unsigned long m_crc_err_cn_b; } StRingInfVer1;
+typedef struct { unsigned short bits1; unsigned short bits2; } TKsSampleStatus;
+typedef struct { long emb_state; long emb_curr_line; } EmbState;
+typedef struct { unsigned short level_; unsigned long index_; char data_[128]; } EmbLog;
+typedef struct { short enable; short reserve1[6]; short loop; TWatchCondition condition; short reserve2[3]; short latchVarCount; TWatchVar latchVar[8]; double reserve3[8]; } TSoftTriggerPrm;
+typedef struct { unsigned long clock; short reserve[2]; double latchValue[8]; } TSoftTriggerLatchValue;
+typedef struct { short enable; short triggerFlag; short reminderCount; short reserve1[7]; long totalCount; double reserve2[8]; } TSoftTriggerInfo;
 """
 
 CONSTANTS = r"""
@@ -1095,4 +1144,56 @@ CONSTANTS = r"""
 #define SCAN_START_IN_LIST_MODE_INDIVIDUAL 0
 #define SCAN_START_IN_LIST_MODE_CHECK 1
 #define AXISSIMULATION_RESERVE1_SUBMODE 0
+#define DI_STOP_VALUE_LOW_LEVEL 0
+#define DI_STOP_VALUE_HIG_LEVEL 1
+#define DI_STOP_VALUE_FALLING_EDGE 2
+#define DI_STOP_VALUE_RISING_EDGE 3
+#define DI_STOP_AXSI_STOP_TYPE_NONE -1
+#define DI_STOP_AXIS_STOP_TYPE_ABRUPT 0
+#define DI_STOP_AXIS_STOP_TYPE_SMOOTH 1
+#define DI_STOP_AXIS_STOP_TYPE_ABRUPT_THEN_AXIS_OFF 10
+#define DI_STOP_AXIS_STOP_TYPE_SMOOTH_THEN_AXIS_OFF 11
+#define MP_POINT_MAX 16
+#define MP_ERROR_NONE 0
+#define MP_ERROR_VEL 700
+#define MP_ERROR_ACC 701
+#define MP_ERROR_DEC 702
+#define MP_ERROR_POS_END 703
+#define MP_ERROR_POS_OUT_OF_RANGE 704
+#define MP_ERROR_PERCENT 705
+#define MP_ERROR_ROOT 706
+#define MP_ERROR_SQRT 707
+#define MP_ERROR_SEGMENT_TYPE 708
+#define MP_ERROR_TIME_NOT_FIND 709
+#define MP_SEGMENT_ASCEND_1 1
+#define MP_SEGMENT_ASCEND_TRAP 2
+#define MP_SEGMENT_ASCEND_3 3
+#define MP_SEGMENT_EVEN 4
+#define MP_SEGMENT_DESCEND_5 5
+#define MP_SEGMENT_DESCEND_TRAP 6
+#define MP_SEGMENT_DESCEND_7 7
+#define MP_SEGMENT_END 8
+#define FILTER_LOCATION_FEEDBACK_POS 0
+#define FILTER_LOCATION_VEL_LOOP_ERROR 1
+#define FILTER_LOCATION_VEL_LOOP_OUTPUT 2
+#define FILTER_LOCATION_FEEDBACK_VEL 3
+#define FILTER_LOCATION_FORCE_CONTROL_OUTPUT 4
+#define WAVEFORM_WORK_MODE_DEFAULT 0
+#define WAVEFORM_WORK_MODE_LINK_POS_COMPARE 1
+#define RECTANGLE_WAVE_START_MODE_LOW_LEVEL 0
+#define RECTANGLE_WAVE_START_MODE_HIGH_LEVEL 1
+#define USER_MAX_STATION_NUM_V1 256
+#define RN_LWR 0
+#define RN_AWR 1
+#define RN_LMWR 2
+#define RN_TCWR 3
+#define RN_LRD 4
+#define RN_ARD 5
+#define RN_LMRD 6
+#define RN_TCRD 7
+#define MOTION_PROGRAM_CLEAR_ALL_TASK 1
+#define MOTION_PROGRAM_CLEAR_TASK 2
+#define MOTION_PROGRAM_CLEAR_FILE 3
+#define MOTION_PROGRAM_MODE_DEBUG 0
+#define MOTION_PROGRAM_MODE_RELEASE 1
 """
