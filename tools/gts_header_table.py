@@ -13,7 +13,12 @@ newest first.  A ``GTN_x`` equal to ``short core`` + ``GT_x`` becomes one ``GT_x
 (the table gives the twin); otherwise both lines are written.  A header whose functions
 take ``short cardNum`` first (the older multi-card GTS ABI) gives its functions without
 that parameter, after every other header (``gtecat lib --abi gts-multicard`` puts it
-back).  Comments of the headers are not carried over.
+back).  Comments of the headers are not carried over.  A newer header's ``int16_t``,
+``uint32_t``, ``__int64`` ... are written as the table spells them (``short``, ``unsigned
+int``, ``long long``), C++ ``bool`` as ``unsigned char``, a function pointer spelled in place
+as ``void *``, bit-fields of one type as the whole units they fill (``unsigned short
+bits1;``); a function taking by value a structure the table cannot name (not ``T...``) is
+left out with a line on stderr.
 
 A C# wrapper (``*.cs``: ``[DllImport("gts.dll")] public static extern short GT_x(...)``,
 ``public const short NAME = value;``, ``public struct TName { ... }``) is read as a header
