@@ -13,7 +13,12 @@ newest first.  A ``GTN_x`` equal to ``short core`` + ``GT_x`` becomes one ``GT_x
 (the table gives the twin); otherwise both lines are written.  A header whose functions
 take ``short cardNum`` first (the older multi-card GTS ABI) gives its functions without
 that parameter, after every other header (``gtecat lib --abi gts-multicard`` puts it
-back).  Comments of the headers are not carried over.
+back).  Comments of the headers are not carried over.  A newer header's ``int16_t``,
+``uint32_t``, ``__int64`` ... are written as the table spells them (``short``, ``unsigned
+int``, ``long long``), C++ ``bool`` as ``unsigned char``, a function pointer spelled in place
+as ``void *``, bit-fields of one type as the whole units they fill (``unsigned short
+bits1;``); a function taking by value a structure the table cannot name (not ``T...``) is
+left out with a line on stderr.
 
 A C# wrapper (``*.cs``: ``[DllImport("gts.dll")] public static extern short GT_x(...)``,
 ``public const short NAME = value;``, ``public struct TName { ... }``) is read as a header
@@ -33,7 +38,12 @@ this mode's own ``vendor_gtn_*`` files) lacks, and writes it as ``vendor_gtn_<to
 groups and ``vendor_gtn_types.py`` (structures and constants the table lacks): run it after
 the vendor groups, naming the newer headers and wrappers; a function the table has (itself,
 or as the ``GTN_x`` twin of a ``GT_x``) is not repeated, whatever parameters the newer header
-gives it (the table's line is the one the field was checked against).
+gives it (the table's line is the one the field was checked against; a header that declares
+it otherwise is named on stderr).  ``--add`` keeps the ``vendor_gtn_*`` lines an earlier run
+wrote (they count as the table) and adds what they lack, so a newer header can be read on its
+own; a ``(...)`` line it gives a prototype for gives way.
+
+    python tools/gts_header_table.py --only-missing --add --out gtecat/gt/groups newer.h
 """
 
 from __future__ import annotations
@@ -115,11 +125,33 @@ CALLBACKS: set[str] = set()
 _CALLBACK = re.compile(r"typedef\s+[\w\s*]+\(\s*(?:__stdcall\s*)?\*\s*(\w+)\s*\)")
 
 
+#: the <stdint.h> and Windows spellings a newer header uses, as the table spells them (the
+#: header gts.h declares them with no <stdint.h>)
+_PLAIN_C = {
+    "__int64": "long long", "int64_t": "long long", "uint64_t": "unsigned long long",
+    "int32_t": "int", "uint32_t": "unsigned int", "int16_t": "short",
+    "uint16_t": "unsigned short", "int8_t": "signed char", "uint8_t": "unsigned char",
+}  # fmt: skip
+
+
+def plain_c(text: str) -> str:
+    return re.sub(r"\b(" + "|".join(_PLAIN_C) + r")\b", lambda m: _PLAIN_C[m[1]], text)
+
+
+_INLINE_CALLBACK = re.compile(
+    r"(^|,)\s*[\w\s*]*?\(\s*(?:__stdcall\s*)?\*\s*(\w+)\s*\)\s*\([^()]*\)"
+)
+
+
 def params(text: str, where: str) -> list[str]:
     """The parameters in table syntax (``type *name=default``)."""
     text = " ".join(text.split())
     for cb in (*CALLBACKS, "HANDLE", "LPVOID"):  # a pointer whatever it points to
         text = re.sub(rf"\b{cb}\b\s*", "void *", text)
+    # a function-pointer parameter spelled in place (``void (*pfn)(void *, short *)``)
+    text = _INLINE_CALLBACK.sub(r"\1 void *\2", text)
+    text = re.sub(r"\bbool\b", "unsigned char", text)  # C++'s bool: one byte under MSVC
+    text = plain_c(text)
     if text in ("", "void"):
         return []
     out = []
@@ -309,6 +341,39 @@ def _plain(ps: list[str]) -> str:
     return ", ".join(re.sub(r"\s*\*\s*", " *", t).strip() for t in _types(ps))
 
 
+#: the width in bits of the integer types a bit-field is declared with
+_BITS = {
+    "char": 8, "unsigned char": 8, "int8_t": 8, "uint8_t": 8,
+    "short": 16, "unsigned short": 16, "int16_t": 16, "uint16_t": 16,
+    "int": 32, "unsigned int": 32, "long": 32, "unsigned long": 32,
+    "int32_t": 32, "uint32_t": 32,
+}  # fmt: skip
+_BITFIELD = re.compile(r"((?:unsigned\s+)?\w+)\s+\w+\s*:\s*(\d+)\s*;")
+
+
+def fold_bitfields(block: str) -> str:
+    """Bit-fields of one integer type (``unsigned short a : 1; ...``) become the whole
+    storage units they fill (``unsigned short bits1;``): the layout MSVC gives them; the
+    table names no single bit."""
+    fields = list(_BITFIELD.finditer(block))
+    if not fields:
+        return block
+    kinds = {" ".join(m[1].split()) for m in fields}
+    if len(kinds) != 1 or next(iter(kinds)) not in _BITS:
+        return block  # mixed types: left to the reader, which says it cannot read them
+    kind = kinds.pop()
+    units, used = 1, 0
+    for m in fields:  # a bit-field that does not fit what is left starts the next unit
+        if used + int(m[2]) > _BITS[kind]:
+            units, used = units + 1, 0
+        used += int(m[2])
+    unit_fields = " ".join(f"{kind} bits{i + 1};" for i in range(units))
+    start, end = fields[0].start(), fields[-1].end()
+    if _BITFIELD.sub("", block[start:end]).strip():
+        return block  # other fields between the bit-fields
+    return block[:start] + unit_fields + block[end:]
+
+
 def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
     functions: dict[str, list[str]] = {}
     tds: list = []
@@ -355,6 +420,7 @@ def extract(paths: list[Path]) -> tuple[dict[str, list[str]], list, dict]:
             body,
         )
         for block in re.findall(r"typedef\s+(?:struct|union|enum)\s*\w*\s*\{[^{}]*\}[^;]*;", body):
+            block = plain_c(fold_bitfields(block))
             try:
                 tds.extend(typedefs.parse(block, known=consts))
             except typedefs.TypedefError as e:
@@ -417,16 +483,21 @@ def _module(path: Path):
 _HAND_STRUCT = re.compile(r"^class (\w+)\((?:ctypes\.)?(?:Structure|Union)\)", re.M)
 
 
-def table_has(folder: Path) -> tuple[set[str], set[str], set[str], set[str]]:
-    """What the table's group files in ``folder`` declare, but ``vendor_gtn_*``: function
-    names (with the ``GTN_x`` twins), names declared ``(...)`` only, structure/enum names and
-    constants."""
+#: the parameter types of what the table declares (``table_has`` fills it): a header that
+#: declares one of them otherwise is reported, and the table's line is kept
+TABLE_PARAMS: dict[str, str] = {}
+
+
+def table_has(folder: Path, own: bool = False) -> tuple[set[str], set[str], set[str], set[str]]:
+    """What the table's group files in ``folder`` declare, but ``vendor_gtn_*`` (unless
+    ``own``): function names (with the ``GTN_x`` twins), names declared ``(...)`` only,
+    structure/enum names and constants."""
     names: set[str] = set()
     unknown: set[str] = set()
     structs: set[str] = set()
     consts: set[str] = set()
     for path in sorted(folder.glob("*.py")):
-        if path.name.startswith(("_", "vendor_gtn_")):
+        if path.name.startswith("_") or (path.name.startswith("vendor_gtn_") and not own):
             continue
         mod = _module(path)
         for m in re.finditer(r"^short\s+(\w+)\s*\((.*)\)\s*;", mod.PROTOTYPES, re.M):
@@ -435,6 +506,9 @@ def table_has(folder: Path) -> tuple[set[str], set[str], set[str], set[str]]:
                 unknown.add(name)
                 continue
             names.add(name)
+            if args not in ("", "void"):
+                ps = [p.strip() for p in re.sub(r"/\*.*?\*/", "", args).split(",")]
+                TABLE_PARAMS.setdefault(name, _plain(ps))
             if name.startswith("GT_") and not re.match(r"^short\s+core\b", args):
                 names.add("GTN_" + name[3:])
         text = typedefs.strip_comments(getattr(mod, "STRUCTS", ""))
@@ -449,14 +523,33 @@ def table_has(folder: Path) -> tuple[set[str], set[str], set[str], set[str]]:
 C_MACROS = frozenset({"NULL", "TRUE", "FALSE", "true", "false", "EOF", "INFINITE"})
 
 
+def _table_reads(ctype: str, tds: list) -> bool:
+    """Whether the table reads a parameter of this type passed by value: a scalar, an
+    enum, or a structure named ``T...``."""
+    ctype = re.sub(r"^const\s+", "", ctype).strip()
+    if ctype in typedefs.FIELD_TYPES or ctype.startswith("T"):
+        return True
+    return any(td.name == ctype and td.kind == "enum" for td in tds)
+
+
 def only_missing(
-    folder: Path, functions: dict[str, list[str]], tds: list, consts: dict
+    folder: Path, functions: dict[str, list[str]], tds: list, consts: dict, own: bool = False
 ) -> tuple[dict[str, list[str]], list, dict, set[str]]:
-    """Keep what the table lacks; also the ``(...)`` names that now have a prototype."""
-    names, unknown, structs, have_consts = table_has(folder)
+    """Keep what the table lacks (with ``own``, the ``vendor_gtn_*`` files count as the
+    table); also the ``(...)`` names that now have a prototype."""
+    names, unknown, structs, have_consts = table_has(folder, own)
     new: dict[str, list[str]] = {}
     for name, ps in functions.items():
+        if name in TABLE_PARAMS and _plain(ps) != TABLE_PARAMS[name]:
+            print(
+                f"{name}: the table's ({TABLE_PARAMS[name]}) kept; this header declares"
+                f" ({_plain(ps)})",
+                file=sys.stderr,
+            )
         if name in names or not re.match(r"^GTN?_\w+$", name):
+            continue
+        if odd := [t for t in _types(ps) if "*" not in t and not _table_reads(t, tds)]:
+            print(f"{name} left out: a {odd[0]} by value the table cannot name", file=sys.stderr)
             continue
         if name.startswith("GT_") and "GTN_" + name[3:] in names:
             # the table declares the GTN_x on its own: a GT_x line would give a second one
@@ -493,13 +586,55 @@ def only_missing(
     return new, kept_tds, kept_consts, unknown & (set(new) | gives)
 
 
+def _name(line: str) -> str:
+    return re.match(r"short\s+(\w+)", line)[1]  # type: ignore[index]
+
+
+def _earlier(folder: Path, resolved: set[str]) -> tuple[dict[str, list[str]], list[str], dict]:
+    """The lines the ``vendor_gtn_*`` files of an earlier run hold (for ``--add``), but the
+    ``(...)`` lines of names that now have a prototype."""
+    by_topic: dict[str, list[str]] = {}
+    structs: list[str] = []
+    consts: dict[str, str] = {}
+    for key, _, _ in TOPICS:
+        path = folder / f"vendor_gtn_{key}.py"
+        if path.exists():
+            body = _module(path).PROTOTYPES
+            by_topic[key] = [
+                ln
+                for ln in body.strip().splitlines()
+                if ln.strip() and not (ln.endswith("(...);") and _name(ln) in resolved)
+            ]
+    path = folder / "vendor_gtn_types.py"
+    if path.exists():
+        mod = _module(path)
+        structs = [ln for ln in mod.STRUCTS.strip().splitlines() if ln.strip()]
+        for m in re.finditer(r"^#define\s+(\w+)\s+(.*)$", mod.CONSTANTS, re.M):
+            consts[m[1]] = m[2]
+    return by_topic, structs, consts
+
+
+def _sort_key(line: str) -> tuple[str, str]:
+    name = _name(line)
+    return (re.sub(r"^GTN?_", "", name), name)
+
+
 def write_missing(
     folder: Path,
     by_topic: dict[str, list[str]],
     structs: list[str],
     consts: dict,
     resolved: set[str],
+    add: bool = False,
 ) -> None:
+    if add:  # an earlier run's lines stay; this run's join them
+        old_topic, old_structs, old_consts = _earlier(folder, resolved)
+        by_topic = {
+            k: sorted(old_topic.get(k, []) + by_topic.get(k, []), key=_sort_key)
+            for k in set(old_topic) | set(by_topic)
+        }
+        structs = old_structs + structs
+        consts = {**old_consts, **consts}
     for old in folder.glob("vendor_gtn_*.py"):
         old.unlink()
     for key, title, _ in TOPICS:
@@ -548,13 +683,23 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="keep what the group files of --out lack; write vendor_gtn_*.py",
     )
+    ap.add_argument(
+        "--add",
+        action="store_true",
+        help="with --only-missing: keep the vendor_gtn_*.py lines an earlier run wrote and "
+        "add what they lack too (a (...) line gives way to a prototype)",
+    )
     args = ap.parse_args(argv)
     functions, tds, consts = extract(args.headers)
     resolved: set[str] = set()
     if args.only_missing:
         if not args.out:
             ap.error("--only-missing needs --out (the folder of the group files)")
-        functions, tds, consts, resolved = only_missing(args.out, functions, tds, consts)
+        functions, tds, consts, resolved = only_missing(
+            args.out, functions, tds, consts, own=args.add
+        )
+    elif args.add:
+        ap.error("--add needs --only-missing")
     by_topic = lines(functions)
     if args.dll_exports:
         have = set(functions)
@@ -564,7 +709,7 @@ def main(argv: list[str] | None = None) -> int:
             if n.startswith("GT_") and not (ps and re.search(r"\bcore$", ps[0]))
         }
         if args.only_missing:  # and what the table declares, with or without parameters
-            table_names, table_unknown, _, _ = table_has(args.out)
+            table_names, table_unknown, _, _ = table_has(args.out, args.add)
             have |= table_names | (table_unknown - resolved)
         names = sorted(set(args.dll_exports.read_text().split()) - have)
         by_topic["exports"] = [f"short {n}(...);" for n in names if re.match(r"^GTN?_\w+$", n)]
@@ -580,7 +725,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  {prefix}{key:<14} {len(by_topic.get(key, [])):5d}  {title}")
     if args.only_missing:
         print(f"  {len(resolved)} names declared (...) before now have a prototype")
-        write_missing(args.out, by_topic, structs, consts, resolved)
+        write_missing(args.out, by_topic, structs, consts, resolved, args.add)
     elif args.out:
         for key, title, _ in TOPICS:
             if by_topic.get(key):

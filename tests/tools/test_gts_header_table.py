@@ -114,3 +114,63 @@ def test_headers_that_disagree_first_named_wins_and_the_line_says_so(tmp_path: P
     (line,) = tool.lines(functions)["basic"]
     assert line.startswith("short GTN_SetFifoMode(short core, short index, short mode);")
     assert "other public copies declare (short, short, short, short)" in line
+
+
+NEWER = """
+typedef short (*TUserCallback)(void *, long, void *);
+typedef struct { short varId; short stationId; } StVar;
+typedef struct Flags { unsigned short a : 1; unsigned short b : 1;
+                       unsigned short rest : 14; } TFlags;
+GT_API GTN_Upload(short card, char *path, void (*pfnProgress)(void *, short *), short &progress);
+GT_API GTN_Close2(short card, bool en, int16_t mode, __int64 *pPos, TUserCallback cb);
+GT_API GTN_AddVar(short card, StVar var);
+GT_API GTN_GetFlags(short card, TFlags *pFlags);
+GT_API GTN_Other(short core, short index);
+"""
+
+
+def test_the_constructs_of_a_newer_header_read_as_table_lines(tmp_path: Path) -> None:
+    h = tmp_path / "newer.h"
+    h.write_text(NEWER)
+    functions, tds, _ = tool.extract([h])
+    assert functions["GTN_Upload"] == [
+        "short card",
+        "char *path",
+        "void *pfnProgress",  # a function pointer spelled in place
+        "short *progress",  # a C++ reference travels as a pointer
+    ]
+    assert functions["GTN_Close2"] == [
+        "short card",
+        "unsigned char en",  # C++ bool: one byte
+        "short mode",  # <stdint.h> names as the table spells them
+        "long long *pPos",
+        "void *cb",
+    ]
+    flags = next(td for td in tds if td.name == "TFlags")
+    assert [(f.ctype, f.name) for f in flags.fields] == [("unsigned short", "bits1")]
+
+
+def test_add_keeps_an_earlier_runs_lines_and_adds_the_newer_headers(tmp_path: Path) -> None:
+    groups = tmp_path / "groups"
+    groups.mkdir()
+    (groups / "vendor_basic.py").write_text(GROUP)
+    (groups / "vendor_exports.py").write_text(EXPORTS)
+    cs = tmp_path / "w.cs"
+    cs.write_text(WRAPPER)
+    assert tool.main(["--only-missing", "--out", str(groups), str(cs)]) == 0
+    before = "".join(p.read_text() for p in groups.glob("vendor_gtn_*.py"))
+    assert "short GTN_Other(...);" not in before  # still in vendor_exports
+    h = tmp_path / "newer.h"
+    h.write_text(NEWER)
+    assert tool.main(["--only-missing", "--add", "--out", str(groups), str(h)]) == 0
+    after = "".join(p.read_text() for p in groups.glob("vendor_gtn_*.py"))
+    line = "short GTN_RN_SetMulti(short core, short encoder, unsigned long long multiLines);"
+    assert line in after  # the earlier run's line stays
+    assert "short GTN_Upload(short card, char *path, void *pfnProgress" in after
+    assert "GTN_AddVar" not in after  # a structure by value the table cannot name
+    assert "typedef struct { unsigned short bits1; } TFlags;" in after
+    assert "GTN_Other(...)" not in (groups / "vendor_exports.py").read_text()
+    assert "short GTN_Other(short core, short index);" in after
+    # the same run again changes nothing
+    assert tool.main(["--only-missing", "--add", "--out", str(groups), str(h)]) == 0
+    assert "".join(p.read_text() for p in groups.glob("vendor_gtn_*.py")) == after

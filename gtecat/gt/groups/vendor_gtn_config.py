@@ -9,16 +9,41 @@ TITLE = "configuration (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_GetAxisConfigPro(short core, short axis, TAxisConfigPro *pAxisConfigPro);
 short GT_GetCardInfo(short *pCardNum, short *pCardType);
+short GTN_GetCardType(unsigned long *pCardTypeArray, short cardTypeArraySize, short *pCardTypeCount);
+short GT_GetCardType(unsigned long *pCardTypeArray, short cardTypeArraySize, short *pCardTypeCount);
+short GTN_GetCommandListConfig(short core, short index, TCommandListConfig *pConfig);
 short GT_GetConfig(short mdl, TExtMdlCfgInfo *pExtMdlCfgInfo);
+short GTN_GetContourConfig(short core, short index, TContourConfig *pContourConfig);
+short GTN_GetCoreInfo(short cardIndex, short *pCoreIndex, short *pCoreCount, short *pCoreValidFlag, short cardCount);
+short GTN_GetCorePeriod(short core, double *pPeriod, short *pFlag, short *pInfo);
 short GT_GetDriverVersion(unsigned short *mainVer, unsigned short *slaveVer);
+short GTN_GetGPIOConfigEx(short core, short station, short index, TGPIOConfig *pGPIOConfig, short count);
+short GTN_GetHeightFindEdgeResult(short core, short heightFbIndex, THeightFindEdgeResult *pFindEdgeResult);
 short GT_GetJoystickMapAxis(short joystickIndex, short *pAxis);
+short GTN_GetMotionSmoothFpgaResCount(short core, short *pCount);
+short GTN_GetMotionTimeRestrict(short core, short restrictIndex, TMotionTimeRestrict *pRestrict);
+short GTN_GetRemoteChannelResult(short core, double *pValue, short channelIndex, short channelCount);
+short GTN_GetResPhyInfo(short core, short type, short index, TResPhyInfo *pStationPhyInfo);
+short GTN_InitializeCommandListConfig(short core, TCommandListConfig *pConfig, short count=2);
 short GT_JoystickReset(short joystickIndex);
 short GTN_LoadReadHsConfig(short core, char *pFile /*str*/);
+short GTN_ProgramCardNumToFlash(short core, short coreNum);
+short GTN_ReadCardNumFromFlash(short core, short *pCardNum);
+short GTN_ResetDualAxis(short core, short index);
 short GT_ResetPciCommandFlag();
+short GTN_ResetServoDSP(short core, short axis);
 short GT_SaveConfigToFile(char *pFile);
+short GTN_SetAxisConfigPro(short core, short axis, TAxisConfigPro *pAxisConfigPro);
+short GTN_SetCommandListConfig(short core, short index, TCommandListConfig *pConfig);
 short GT_SetConfig(short mdl, TExtMdlCfgInfo *pExtMdlCfgInfo);
+short GTN_SetContourConfig(short core, short index, TContourConfig *pContourConfig);
+short GTN_SetCorePeriod(short core, double period);
+short GTN_SetEncryptConfig(short core, TEncryptConfigPrm *pConfigPrm, short *pSts);
+short GTN_SetGPIOConfigEx(short core, short station, short index, TGPIOConfig *pGPIOConfig, short count);
 short GT_SetJoystickMapAxis(short joystickIndex, short *axis);
+short GTN_SetMotionSmoothFpgaResCount(short core, short count);
 short GTN_SetMotionTimeRestrict(short core, short restrictIndex, TMotionTimeRestrict *pRestrict /*inout*/, TListInfo *pListInfo /*inout*/);
 short GTN_SetResetMode(short core, short type, TResetModePrmUnion *pResetPrm);
 """

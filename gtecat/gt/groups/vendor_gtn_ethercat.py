@@ -9,8 +9,32 @@ TITLE = "EtherCAT (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_EcatIOBitReadInput(short core, unsigned short slaveno, unsigned short offset, unsigned short Index, unsigned char *pValue);
+short GTN_EcatIOBitReadOutput(short core, unsigned short slaveno, unsigned short offset, unsigned short Index, unsigned char *pValue);
+short GTN_EcatIOReadOutput(short core, unsigned short slaveno, unsigned short offset, unsigned short nSize, unsigned char *pValue);
+short GTN_EcatSDODownloadEx(short core, unsigned short axisNumber, unsigned short index, unsigned char subindex, unsigned char *data, unsigned int data_size, unsigned int *abort_code);
+short GTN_EcatSDOUploadEx(short core, unsigned short axisNumber, unsigned short index, unsigned char subindex, unsigned char *target, unsigned int target_size, unsigned int *result_size, unsigned int *abort_code);
+short GTN_GetEcatAxisCtrlwordEx(short core, short axis, unsigned short *ctrlex);
+short GTN_GetEcatAxisDIEx(short core, short axis, unsigned long *pDi, short count);
+short GTN_GetEcatAxisLmtHomeIndex(short core, short axis, short *index_LimitN, short *index_LimitP, short *index_Home);
+short GTN_GetEcatAxisMaxTargetVel(short core, short axis, unsigned long *targetMaxVel);
 short GTN_GetEcatDcErrorEx(short core, TEcatErrInfo *pEcatErrorInfo);
+short GTN_GetEcatSlavePdo(short core, unsigned short station, unsigned short index, unsigned char subIndex, unsigned char *pData, unsigned int data_size);
+short GTN_GetMcRelateEcatSlaveInfo(short core, short mcType, short index, short *pEcatIndex, short *pEcatType, short *pPdoOffset, short *pBitoffset, short *pdPoByteLength);
+short GTN_InitEcatCommEx(short core, char *eniFilePath);
+short GTN_InitEcatComm_MultiTask(short core, TEcatInitPrm *pPrm);
+short GTN_InitEcatComm_PhysicalID(short core);
+short GTN_LoadRelateEcatSlaveConfig(short core, char *pFile);
+short GTN_RelateEcatSlaveToMcAuDac(short core, short auDac, short ecatIndex, short ecatType, short pdoOffset, short pdoByteLength);
+short GTN_RelateEcatSlaveToMcAuEncoder(short core, short auenc, short ecatAxisIndex);
+short GTN_RelateEcatSlaveToMcDac(short core, short dac, short ecatIndex, short ecatType, short pdoOffset, short pdoByteLength);
+short GTN_RelateEcatSlaveToMcMpgDiEx(short core, short mpg, short ecatIndex, short ecatType, short bitoffset, short pdoOffset);
+short GTN_RelateEcatSlaveToMcMpgEncoder(short core, short mpg, short ecatAxisIndex);
+short GTN_SetEcatAxisCtrlwordEx(short core, short axis, unsigned short ctrlex);
 short GTN_SetEcatAxisDOBit(short core, short axis, short bitOffset, unsigned char DoBitValue);
 short GTN_SetEcatAxisLmtHomeIndex(short core, short axis, short index_LimitN, short index_LimitP, short index_Home);
+short GTN_SetEcatAxisMaxTargetVel(short core, short axis, unsigned long targetMaxVel);
 short GTN_SetEcatHomingPrmEx(short core, short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction);  // header; other public copies declare (short, short, void *, void *, void *, void *, void *, void *)
+short GTN_SetEcatHomingPrmPro(short core, short axis, short method, double speed1, double speed2, double acc, long offset, unsigned short probeFunction, unsigned short mask);
+short GTN_SetEcatSlavePdo(short core, unsigned short station, unsigned short index, unsigned char subIndex, unsigned char *pData, unsigned int data_size);
 """

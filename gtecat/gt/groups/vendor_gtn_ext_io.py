@@ -9,5 +9,12 @@ TITLE = "extension IO modules (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_BufExtDoBit(short core, short crd, unsigned short doIndex, unsigned short doValue, short fifo);
+short GTN_BufExtDoBitEx(short core, short crd, unsigned short doIndex, unsigned short doValue, short fifo);
+short GTN_FollowExtDoEx(short core, short profile, short doIndex, int value, int mask, short fifo);
 short GT_GetChnStsExtMdl(unsigned short *pStatus);
+short GTN_GetExtModuleAccessMode(short core, short *pMode);
+short GTN_GetExtModuleInitMode(short core, short *pInitMode);
+short GTN_SetExtModuleAccessMode(short core, short mode);
+short GTN_SetExtModuleInitMode(short core, short initMode);
 """

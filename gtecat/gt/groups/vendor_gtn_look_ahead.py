@@ -9,13 +9,55 @@ TITLE = "look-ahead and buffered interpolation commands (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_BufAuDA(short core, short crd, short chn, short daValue, short fifo=0);
+short GTN_BufAuDAEx(short core, short crd, short chn, short daValue, short fifo=0);
+short GTN_BufCrdBlendOff(short core, short crd, short fifo);
+short GTN_BufCrdBlendOn(short core, short crd, short fifo);
+short GTN_BufEnableWaveform(short core, short crd, short index, TWaveformOutput *pOutput, short enable, short modal, short fifo);
+short GTN_BufEnableWaveformEx(short core, short crd, short index, TWaveformOutput *pOutput, short enable, short modal, short fifo);
+short GTN_BufExtAo(short core, short crd, short aoIndex, double aoValue, short fifo);
+short GTN_BufExtAoEx(short core, short crd, short aoIndex, double aoValue, short fifo);
+short GTN_BufExtDA(short core, short crd, short chn, short daValue, short fifo);
+short GTN_BufExtIO(short core, short crd, unsigned short doIndex, unsigned short doMask, unsigned short doValue, short fifo);
+short GTN_BufGearListAdd(short core, short crd, float k, float percent, short fifo);
+short GTN_BufGearListBegin(short core, short crd, short gearAxis, double pos, short fifo);
+short GTN_BufGearListEnd(short core, short crd, short fifo);
+short GTN_BufLeapFrog(short core, short crd, short axis, TBufLeapFrogInfo *pLeapFrogInfo, short modal, short fifo);
+short GTN_BufLeapFrogEx(short core, short crd, short axis, TBufLeapFrogInfo *pLeapFrogInfo, short modal, short fifo=0);
 short GTN_BufMoveAbsoluteEx(short core, short crd, short moveAxis, TBufMoveAbsPrm *pPrm /*inout*/);
 short GT_BufMoveJog(short crd, short moveAxis, double vel, double acc, short modal, short fifo=0);
 short GTN_BufMoveJogEx(short core, short crd, short moveAxis, double vel, double acc, short modal, short fifo);
+short GTN_BufMoveSpEx(short core, short crd, short moveAxis, double pos, double vel, short smoothTime, short modal, short enableRatio, short fifo);
+short GTN_BufMoveSpSetPrmEx(short core, short crd, short moveAxis, double acc, double dec, double velMax, short fifo);
 short GTN_BufPrfCompEnable(short core, short crd, short fifo, short profile, short enable, short enableType);
 short GT_BufPrfCompEnableEx(short crd, short fifo, short profile, short enable, short enableType);
+short GTN_BufSetCompensate2DTableOffsetEx(short core, short crd, short tableIndex, double xOffset, double yOffset, short fifo);
+short GTN_BufSetCrdBlend(short core, short crd, TCrdBlend *pCrdBlend, short fifo);
+short GTN_BufSetDoubleVarEx(short core, short crd, short index, double value, short fifo);
+short GTN_BufSetLongVarEx(short core, short crd, short index, long value, short fifo);
+short GTN_BufSetOverride(short core, short crd, double synVelRatio, short mode, short fifo);
+short GTN_BufSetOverrideEx(short core, short crd, double synVelRatio, short mode, short fifo);
+short GTN_BufSetPrfTorque(short core, short crd, short axis, short prfTorque, short fifo);
+short GTN_BufSetPrfTorqueEx(short core, short crd, short axis, short prfTorque, short fifo);
+short GTN_BufSetPulseWidthEx(short core, short crd, unsigned short width, short fifo=0, short channel=0);
+short GTN_BufSetSoftLimit(short core, short crd, short axis, long positive, long negative, short fifo);
+short GTN_BufSetSoftLimitEx(short core, short crd, short axis, double positive, double negative, short fifo);
+short GTN_BufSetWaitLongVarEx(short core, short crd, short index, long value, short fifo);
 short GT_BufStop(short crd, long mask, long option, short fifo=0);
 short GTN_BufStopEx(short core, short crd, long mask, long option, short fifo);
+short GTN_BufStopPos(short core, short crd, short profile, TStopPos *pStopPos, short modal, short fifo);
+short GTN_BufStopPosEx(short core, short crd, short profile, TStopPos *pStopPos, short modal, short fifo);
 short GT_BufWaitDi(short crd, short diType, short diIndex, short level, short continueTime, long overTime, short flagMode, long segNum, short fifo);
 short GT_BufWaitLongVar(short crd, short index, long value, long overTime, short flagMode, long segNum, short fifo);
+short GTN_BufWaitWatchVar(short core, short crd, TWatchCondition *pWatchCondition, TWaitTimeout *pWaitTimeout, long segNum, short fifo);
+short GTN_BufWaitWatchVarEx(short core, short crd, TWatchCondition *pWaitCondition, TWaitTimeout *pWaitTimeout, long segNum, short fifo);
+short GTN_GetGroupLookAheadSegCount(short core, short group, long *pSegCount);
+short GTN_GetLookAheadErrorInfo(short core, short group, TLookAheadErrorInfo *pLaErrorInfo);
+short GTN_GetLookAheadParaEx(short core, short crd, short fifo, TLookAheadParameter *pLookAheadPrm, short *pMotionMode);
+short GTN_GroupLookAheadDisable(short core, short group, TListInfo *pListInfo=NULL);
+short GTN_GroupLookAheadEnable(short core, short group, TListInfo *pListInfo=NULL);
+short GTN_SetGroupLookAheadFunc(short core, short group, short mode, void *pLookAheadFunc, TListInfo *pListInfo=NULL);
+short GTN_SetGroupLookAheadParameter(short core, short group, TGroupLookAheadParameter *pLookAheadPrm, TListInfo *pListInfo=NULL);
+short GTN_SetLookAheadMinSegmentLength(short core, short crd, short fifo, double minSegmentLength);
+short GTN_SetVelLookAheadModeLa(short core, short crd, int VelMode);
 """

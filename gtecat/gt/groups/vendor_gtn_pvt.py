@@ -9,7 +9,51 @@ TITLE = "PT, PVT, gear, follow and cam (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short GTN_CamIn(short core, TCamInParameter *pPrm, TListInfo *pListInfo=NULL);
+short GTN_CamOut(short core, TCamOutParameter *pPrm, TListInfo *pListInfo=NULL);
+short GTN_CamTableClear(short core, TListInfo *pListInfo=NULL);
+short GTN_CamTableLoadTrap(short core, const TCamTableTrap *pCamTableTrap, TListInfo *pListInfo=NULL);
+short GTN_CamTableTrapPoint(short core, unsigned long camTableId, const TCamTableTrapPoint *pPoint, TListInfo *pListInfo=NULL);
+short GTN_CamTableTrapPointEnd(short core, unsigned long camTableId, TListInfo *pListInfo=NULL);
+short GTN_FollowStartExPro(short core, short *pAxis, short *pOption, short count);
+short GTN_FollowStartPro(short core, short *pAxis, short *pOption, short count);
+short GTN_FollowSwitchExPro(short core, short *pAxis, short count);
+short GTN_FollowSwitchPro(short core, short *pAxis, short count);
+short GTN_GearInStart(short core, unsigned long *pStartMask, unsigned short maskCount);
+short GTN_GearStartPro(short core, short *pAxis, short count);
+short GTN_GetAxisFollowErrorMode(short core, short axis, short *pFollowErrorMode);
+short GTN_GetAxisGearRatio(short core, short profile, double *pGearRatio, short count);
+short GTN_GetCamStatus(short core, unsigned short slaveIndex, unsigned short slaveType, TCamStatus *pStatus);
+short GTN_GetFollowInfo(short core, short profile, TFollowInfo *pFollowInfo);
+short GTN_GetGearInInfo(short core, unsigned short slaveIndex, TGearInInfo *pGearInInfo);
+short GTN_GetPvtTableLoop(short core, short profile, short tableId, long *pLoopCount, long *pLoop, short *pNextTableId);
+short GTN_GoToAxisFollowHeight(short core, short axis, long followCmd, THeightFollowPrm *pFollowPrm, double trapVel, TTrapPrm *pTrapPrm);
 short GTN_PrfComp(short core, short profile, TPrfComp *pComp /*inout*/);
 short GTN_PrfCompEnable(short core, short profile, short enable, short enableType);
+short GTN_PrfTrack(short core, short profile);
+short GTN_PrfTrapEx(short core, short profile);
+short GTN_PtDataArray(short core, short profile, double *pos, long time, short *type, short fifo, short count);
+short GTN_PtDataPro(short core, short profile, double pos, double time, short type=0, short fifo=0);
+short GTN_PtSmoothBegin(short core, short profile, long deltaTime, long degree, short fifo);
+short GTN_PtSmoothEnd(short core, short profile, short fifo);
+short GTN_PtSpaceArray(short core, short profile, short *pSpace, short fifo, short count);
+short GTN_PtSpaceDmaType(short core, short profile, short mode);
+short GTN_PtStartPro(short core, short *pAxis, short *pOption, short count);
+short GTN_PvtLine(short core, short axisCount, short *moveAxis, long *pos, TPvtLinePrm *pPrm);
+short GTN_PvtStartPro(short core, short *pAxis, short count);
+short GTN_PvtTableMove2Calculate(short core, long distance, double vm, double am, double *pVm, double *pJm);
+short GTN_PvtTableMoveAbsolute(short core, short profile, double *pDistance, double *pVm, double *pAcc, double *pPa1, double *pPa2, double *pDec, double *pPd1, double *pPd2, double *pVelM, double *pAccM, double *pDecM, double *pTime, short count);
+short GTN_PvtTableMoveAbsoluteJerk(short core, short profile, short tableId, double *pPos, double *pVelMax, double *pAccMax, double *pJerkMax, double *pTime, short count);
+short GTN_PvtTableMoveAbsoluteTwoSegment(short core, short profile, TPvtTableMoveAbsolutePrm *pTargetPos1, double *pDelay, TPvtTableMoveAbsolutePrm *pTargetPos2, short count);
+short GTN_PvtTableMoveCalculate(short core, long distance, double vm, double am, double *pVm, double *pJm);
 short GTN_PvtTableUserData(short core, short tableId, short userDataType, double time, void *pData);
+short GTN_SetAxisFollowErrorMode(short core, short axis, short followErrorMode);
+short GTN_SetAxisGearRatio(short core, short profile, double *pGearRatio, short count, TListInfo *pListInfo);
+short GTN_SetAxisHeightFollowMode(short core, short axis, short mode, THeightFollowPrm *pPrm);
+short GTN_SetCamErrorStopPrm(short core, TCamOutParameter *pPrm, TListInfo *pListInfo=NULL);
+short GTN_SetCamTableTrapPrm(short core, unsigned long camTableId, const TCamTableTrapPrm *pPrm, TListInfo *pListInfo=NULL);
+short GTN_SetFollowAxisParaLaPro(short core, short crd, int *pAxisLimitMode, double *pVmax, double *pAmax, double *pDVmax, short count);
+short GTN_SetGearInParameter(short core, short slaveIndex, TGearInParameter *pGearInPrm);
+short GTN_SetPvtTableLoop(short core, short profile, short tableId, long loop, short nextTableId);
+short GTN_SetPvtTableMoveAccList(short core, short tableId, short count, long *pDistance, double *pAccMax);
 """

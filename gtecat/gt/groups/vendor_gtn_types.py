@@ -128,6 +128,343 @@ typedef struct { long scale[3]; double motionAcc[3]; double motionDec[3]; double
 typedef struct { double xMotionVel[3]; double yMotionVel[3]; double zMotionVel[3]; } TJoystickMoitonVel;
 typedef struct { long thresholdValue[3]; long joystickMaxValue[3]; long joystickMedianValue[3]; long joystickMinValue[3]; } TJoystickCriticalValue;
 typedef struct { long baudRate; short byteSize; short parity; short stopBits; short reserve; } TSericalPortPrm;
+typedef struct { long position1; long position2; } TToolPosition;
+typedef struct { unsigned short masterIndex; short masterValueSource; short pad1; short pad2; long ratioNumerator; unsigned long ratioDenominator; double acceleration; double deceleration; double jerk; double pad3; } TGearInParameter;
+typedef struct { short state; unsigned short masterIndex; unsigned short masterValueSource; short pad1[3]; long ratioNumerator; unsigned long ratioDenominator; long slaveEven; unsigned long masterEven; double acceleration; double deceleration; double jerk; double pad2; } TGearInInfo;
+typedef struct { short fifoNum; short switchStatus; short segNum; short pad1; double masterPosDelta; double slavePosDelta; double virtualMasterError; double pad2; double pad3; } TFollowInfo;
+typedef struct { double accTime; double k; double reserve[18]; } TVelProfileModeSmooth;
+typedef struct { double value; double beginPercent; double endPercent; double reserve[17]; } TVelProfileModeJerk;
+typedef struct { short mode; short reserve1[7]; double reserve2[18]; } TVelProfileModeFollow;
+typedef union { TVelProfileModeSmooth smooth; TVelProfileModeJerk jerk; TVelProfileModeFollow follow; double data[20]; } TVelProfileModeParameter;
+typedef struct { short mode; short reserve[3]; TVelProfileModeParameter parameter; } TVelProfileMode;
+typedef struct { double distance; double vel; double velEnd; double acc; double dec; short direction; short overrideSelect; short reserve; short velProfileMode; TVelProfileModeParameter velProfile; } TMoveContinuousRelativePrm;
+typedef struct { short profile; short reserve[3]; short group; short cmdCoord; short oriMode; short configIndex; TMoveContinuousAbsolutePrm prm; } TTaskMoveContinuousAbsolute;
+typedef struct { short overrideSelect; short reserve1[3]; double vel; double acc; double dec; short reserve[44]; } TJogParameter;
+typedef union { TJogParameter jog; short reserve[60]; } TMoveJogPrmUnion;
+typedef struct { short mode; short reserve[3]; TMoveJogPrmUnion data; } TMoveJogPrm;
+typedef union { TMotionTimeRestrictDirect direct; TMotionTimeRestrictAttentionProfile attentionProfile; double data[32]; } TMotionTimeRestrictUnion;
+typedef struct { short profileCount; short profile[8]; short pad1[7]; double profilePos[8]; short mode; short pad2[3]; TMotionTimeRestrictUnion parameter; } TMotionTimeRestrict;
+typedef struct { short type; short index; short subIndex; short reserve[5]; } TProfileItem;
+typedef struct { double masterEven; double slaveEven; double slope; short slopeType; short dir; short startMode; short startPrmType; double startPrm[6]; double deltaSlaveEven; double deltaSlope; short deltaSlopeType; short deltaLoop; short reserve2[10]; } TGearParameter;
+typedef struct { double masterEven; double slaveEven; double masterFilterTime; double sampleTime; double stopWaitTime; double acceleration; double deceleration; double maxVel; short reserve[28]; } TMpgParameter;
+typedef struct { double masterEven; double slaveEven; short reserve[52]; } TFollowParameter;
+typedef struct { double pos; double masterLength; short reserve[52]; } TGearPosParameter;
+typedef union { TGearParameter gear; TMpgParameter mpg; TFollowParameter follow; TGearPosParameter gearPos; short reserve[60]; } TMoveSynchronizationUnion;
+typedef struct { short mode; short enable; short softDirCheck; short reserve; TMoveSynchronizationUnion prm; } TMoveSynchronizationPrm;
+typedef struct { short info1[8]; long info2[8]; double info3[8]; } TMoveSynchronizationInfo;
+typedef struct { short type; short pad1[3]; double masterPos; double slavePos; double slaveVelRatio; double slaveVelRatioMax; double slaveAccRatio; double slaveDecRatio; double percentAcc; double percentDec; double pad2[4]; } TCamTableTrapPoint;
+typedef struct { unsigned long camTableId; unsigned long pad1; unsigned short periodic; unsigned short masterAbsolute; unsigned short slaveAbsolute; unsigned short pad2; double masterPosBegin; double slavePosBegin; double slaveVelRatioBegin; TCamTableTrapPoint *pPoint; unsigned long pointCount; unsigned long pad3; } TCamTableTrap;
+typedef struct { unsigned short periodic; unsigned short masterAbsolute; unsigned short slaveAbsolute; unsigned short pad2; double masterPosBegin; double slavePosBegin; double slaveVelRatioBegin; short slavePosCalcMode; unsigned long camTableSpace; } TCamTableTrapPrm;
+typedef struct { unsigned short masterIndex; unsigned short masterValueSource; unsigned short slaveIndex; unsigned short slaveType; unsigned long camTableId; unsigned short pad1; unsigned short bufferMode; unsigned short bufferCommandType; unsigned short startMode; unsigned short masterModulo; unsigned short slaveModulo; double masterModuloBegin; double masterModuloLength; double slaveModuloBegin; double slaveModuloLength; double masterOffset; double slaveOffset; double masterScaling; double slaveScaling; double masterStartDistance; double masterSyncPosition; double velRatioMax; double accRatioMax; double decRatioMax; double pad2[8]; } TCamInParameter;
+typedef struct { unsigned short slaveIndex; unsigned short slaveType; unsigned short mode; unsigned short rampType; unsigned short pad1[3]; unsigned short segCount; double pos; double vel; double acc; double dec; double jerk; double velEnd; double pad2[8]; } TCamOutParameter;
+typedef struct { unsigned short execute; unsigned short inSync; unsigned short done; unsigned short command; unsigned long pad1; unsigned long loopCount; double masterPos; double masterVel; double masterAcc; double masterJerk; double slavePos; double slaveVel; double slaveAcc; double slaveJerk; double masterPosModulo; double slavePosModulo; double pad2[4]; } TCamStatus;
+typedef struct { short time; short aheadOfTime; short shape; short reverseSmooth; double velDelta; } TCrdBlend;
+typedef struct { long segNumUserSet; long segNumInCmd; double synPrfVel; double prfPosCrd[8]; } TCrdSegSyncInfo;
+typedef struct { double receive; double travel; double left; } TCrdSegmentLength;
+typedef struct { double ratio; double laserPowerFollowVelMax; double laserPowerFollowFreqMax; double laserFollowPulseMax; double pad1[4]; } TLaserFollowSpline2Prm;
+typedef struct { short tableId; short channel; short enable; short loopCount; long intervalTime; short pad[2]; } TLaserPowerWave;
+typedef struct { short tableId; short enable; short loopIndex; short pad; double power; } TLaserPowerWaveStatus;
+typedef struct { short optimizeMode; short blendingType; short pad[2]; double tolerance; double blendingPrm; double blendingMinAngle; double blendingMaxAngle; } TPathOptimizePrm;
+typedef struct { short enable; long compValue; long compTime; short dir; } TBacklashComp;
+typedef struct { short run; short pad1[3]; long pad2[2]; double pad3[2]; } TLeadScrewCompStatus;
+typedef struct { short axis; short link; short pad; short n; double startPos; double lenPos; } TAxisLeadScrewCrossCompPrm;
+typedef struct { double compPos; double compNeg; } TLeadScrewCrossCompData;
+typedef struct { short axis; short pad[2]; short compDataCount; TLeadScrewCrossCompData leadScrewCrossCompData[64]; } TAxisLeadScrewCrossCompData;
+typedef struct { short axis; short enable; short pad[2]; } TEnableAxisLeadScrewCrossComp;
+typedef struct { short pad1[2]; long reverseTime; long pad2[3]; double pad3[2]; } TDoBit;
+typedef struct { double distance; double delayTime; double reserve[8]; } TAtParameter;
+typedef struct { double distance; double reserve[9]; } TPsoParameter;
+typedef struct { double time; double reserve[9]; } TTsoParameter;
+typedef struct { TAtParameter atPrm; TPsoParameter psoPrm; TTsoParameter tsoPrm; TDoReverseParameter doReverse; double data[10]; } TWriteDigitalOutputMode;
+typedef struct { short mode; short doType; short doIndex; short doCount; short *pValue; short reverse1[2]; long reserve2[2]; TWriteDigitalOutputMode prm; } TDigitalOutput;
+typedef struct { short type; short motionType; long delayTime; double distance; } TDigitalOutputProByMoveDistance;
+typedef struct { short type; short motionType; short reserve1[2]; double delayTime; } TDigitalOutputProByMoveTime;
+typedef struct { double time; } TDigitalOutputProDelay;
+typedef union { double data[30]; TDigitalOutputProDelay delay; TDigitalOutputProByMoveTime moveTime; TDigitalOutputProByMoveDistance moveDistance; } TWriteDigitalOutputProPrmUnion;
+typedef struct { short mode; short doType; short doIndex; short doCount; short *pValue; short reserve1[2]; long reserve2[2]; TWriteDigitalOutputProPrmUnion prm; } TDigitalOutputPro;
+typedef struct { short aoType; short aoIndex; short count; short reserve1; double *pValue; long reserve2[3]; } TAnalogOutput;
+typedef struct { short diType; short diIndex; short diCount; short *pValue; short reverse1[3]; long reserve2[2]; } TDigitalInput;
+typedef struct { short inputType; short inputIndex; short mode; short modePrm; short reserve1[4]; double resuerve2[4]; } TStopIoPrm;
+typedef struct { short linkType; short linkIndex; short reserve1[6]; double linkRatio; double reserve2[4]; } TAoLinkPrm;
+typedef struct { short type; short index; } TEncoderSource;
+typedef struct { short probeType; short probeIndex; short latchType; short latchIndex; short sense; short pad[3]; double filterWidth; } TSignalDetect;
+typedef struct { short status; short pad[3]; double latchWidth; } TSignalDetectStatus;
+typedef struct { unsigned short mode; unsigned short run; unsigned int space; unsigned int pulseCount; unsigned short hso; unsigned short gpo; unsigned int segmentNumber; unsigned int reserve1[3]; double reserve2[2]; } TPosCompareStatusEx;
+typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long syncPos; long time; short pulseWidth; short pad; } TPosComparePsoPrmPro;
+typedef struct { short referenceX; short referenceY; short pad1[2]; double pad2[2]; } TPosCompareReferencePrm;
+typedef struct { short outputMode; short level; long count; double highLevelTime; double lowLevelTime; double reserve2[4]; } TPosCompareMultiPulse;
+typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long time; short multiNumber; short pad1; long syncPosArray[256]; } TPosCompareMultiPsoPrm;
+typedef struct { short sourceMode; short additionX; short additionY; short additionZ; } TPosCompareAdditionPrm;
+typedef struct { short mode; short dimension; short sourceMode; short source[8]; short outputMode; short outputCounter; unsigned short outputPulseWidth; unsigned short errorBand; short reserve1[2]; double reserve2[16]; } TPosCompareModeEx;
+typedef struct { unsigned long count; unsigned short hso; unsigned short gpo; long startPosX; long startPosY; long time; short pad1; short multiNumber; long scale[6]; double syncPosArray[256]; } TPosComparePsoPrmEx;
+typedef struct { unsigned short velCompCoeff[3]; short reserve1[2]; unsigned short accCompCoeff[3]; short reserve2[2]; } TPosCompareCompensateCoeff;
+typedef struct { short index; short enable; long reserve[3]; } TPosCompareEnablePro;
+typedef struct { short index; short pulseWidth; short reserve[2]; unsigned long count; long syncPos; long time; } TPosComparePrmPro;
+typedef struct { short mask; short option; } TTaskCrdStepMode;
+typedef struct { short list; short reserve1[23]; } TTaskStartCommandList;
+typedef struct { short option; short reserve; } TTaskTriggerCallbackFunction;
+typedef struct { short count; TWatchVar var[5]; } TTaskSaveMcVar;
+typedef struct { short profile; short refType; short refIndex; short refSubIndex; short reserve1[4]; double refPosition; double refLinearVelocity; double minAngleVelocity; double maxAngleVelocity; double reserve2[4]; } TTaskAdjustMoveJogAngleVelocity;
+typedef struct { short fifo; short count; TWatchVar var[8]; } TTaskSaveMcVarEx;
+typedef struct { short enable; short loop; short reserve[2]; } TConditionTaskEnable;
+typedef struct { short halt; short reserve1[15]; } TCommandListStopParameter;
+typedef struct { short stopList; short stopMode; short triggerSource; short reserve[5]; TCommandListStopParameter prm; } TTaskStopCommandList;
+typedef struct { TWatchVar leftOperands; TWatchVar rightOperands; TWatchVar result; unsigned short operation; short reserve[6]; } TVariableCalculatePrm;
+typedef struct { short type; short subType; short dir[8]; short reserve1[6]; double prm[20]; double offset[8]; long reserve2[10]; double reserve3[11]; } TRobotKinematicParameter;
+typedef struct { short type; short reserve1[3]; double primaryAxisPoint[3]; double slaveAxisPoint[3]; double toolLocationPoint[3]; short dirMode; short reserve2[2]; short dir[5]; double axisVector[15]; long reserve3[10]; double reserve4[16]; } TFiveAxisKinematicParameter;
+typedef struct { short axisCount; short reserve1[3]; long reserve2[10]; double reserve3[42]; } TMultiAxisKinematicParameter;
+typedef struct { short subType; short axisCount; short mode; short majorAxis[3]; short reserve1[6]; short parallelAxis[8]; long reserve2[10]; double reserve3[38]; } TParallelParameter;
+typedef struct { short axisCount; short reserve1[3]; long reserve2[10]; double reserve3[42]; } TOrthogonalExtendParameter;
+typedef union { TOrthogonalExtendParameter orthogonalExtend; TRobotKinematicParameter robot; TFiveAxisKinematicParameter fiveAxis; TMultiAxisKinematicParameter multiAxis; TParallelParameter parallel; double data[48]; } TKinematicParameter;
+typedef struct { short type; short reserve[3]; TKinematicParameter kinPrm; } TKinematicTransform;
+typedef struct { double velMax; double accMax; double decMax; double jerkMax; double reserve[10]; } TGroupMotionConstraint;
+typedef struct { double oriVelMax; double oriAccMax; double oriDecMax; double oriJerkMax; double reserve[10]; } TGroupOrientationConstraint;
+typedef struct { double transX; double transY; double transZ; double rotAngle1; double rotAngle2; double rotAngle3; } TCartesianParameter;
+typedef struct { double vel; double oriVel; double reserve[18]; } TCartesianTransformVelConstraint;
+typedef union { TCartesianTransformVelConstraint velConstraint; double value[20]; } TCartesianTransformConstraintUnion;
+typedef struct { short mode; short reserve[3]; TCartesianTransformConstraintUnion data; } TCartesianTransformConstraint;
+typedef struct { double prm[8]; double reserve[12]; } TCoordinateTransformAcsPos;
+typedef struct { double transX; double transY; double transZ; double rotAngle1; double rotAngle2; double alpha; double reserve[14]; } TCoordinateTransformToolDir;
+typedef struct { double prm[8]; double reserve[12]; } TCoordinateTransformOffset;
+typedef struct { double point1[3]; double point2[3]; double point3[3]; double offset[3]; double gama; double reserve[7]; } TCoordinateTransformPoints;
+typedef struct { double offset[3]; double vector1[3]; double vector2[3]; double reserve[11]; } TCoordinateTransformTwoVectors;
+typedef struct { double offset[3]; double alpha; double beta; double gama; double reserve[14]; } TCoordinateTransformProjectAngle;
+typedef union { TCoordinateTransformAcsPos acsPos; TCartesianParameter euler; TCoordinateTransformToolDir toolDir; TCoordinateTransformOffset offset; TCoordinateTransformPoints points; TCoordinateTransformTwoVectors twoVectors; TCoordinateTransformProjectAngle projectAngle; double value[20]; } TCoordinateTransformUnion;
+typedef struct { short mode; short reserve[3]; TCoordinateTransformUnion data; } TCoordinateTransform;
+typedef struct { short masterType; short masterIndex; short masterMoveType; short trackMode; double originPrfPos; TCartesianParameter masterOrigin; TCartesianParameter pcsToMasterTcs; TCartesianParameter dynamicPcsToSlaveMcs; } TDynamicCoordinateTransformData;
+typedef union { TDynamicCoordinateTransformData trans; double reserve[60]; } TDynamicCoordinateTransformUnion;
+typedef struct { short mode; short pad[3]; TDynamicCoordinateTransformUnion prm; } TDynamicCoordinateTransform;
+typedef struct { short masterType; short masterIndex; short reserve1[7]; short commandPosCoord; short commandOrientationMode; short commandConfigIndex; double pos[8]; long reserve2[8]; double reserve3[8]; } TDynamicCoordinateTransformMasterPos;
+typedef struct { short source; short reserve1[7]; short enableFriction[8]; short enableCompensate[8]; long reserve2[8]; double reserve3[8]; } TGroupDynamicsCompensate;
+typedef struct { short master; short slave; short reserve[2]; double alpha; double beta; } TGroupCoupleParameter;
+typedef struct { short positiveLimitEnable; short negativeLimitEnable; short positiveLimitMode; short negativeLimitMode; double positiveLimit; double negativeLimit; } TGroupSoftLimit;
+typedef struct { short run; short state; short stopInfo; short reserve1[13]; long reserve2[4]; } TGroupStatus;
+typedef struct { double time; double k; } TGroupMotionSmooth;
+typedef union { TGroupMotionSmooth smooth; double value[20]; } TGroupMotionSmoothUnion;
+typedef struct { short mode; short reserve[3]; TGroupMotionSmoothUnion data; } TGroupMotionSmoothPrm;
+typedef struct { short feedback; short reserve1[3]; double percent; double reserve2[4]; } TGroupContourErrorControlPrm;
+typedef struct { long userTag; long segNum; double segmentTravel; double segmentLength; double totalTravel; short reserve1[8]; double reserve2[8]; } TGroupMoveSegmentInfo;
+typedef struct { short enable; short reserve[3]; short refAxis[8]; } TGroupPathRefAxis;
+typedef struct { TKinematicTransform kinTrans; short enablePcsTrans; short enableTcsTrans; short reserve1[2]; TCartesianParameter pcsTrans; TCartesianParameter tcsTrans; double acsKinOffset[8]; short inputCoordSystem; short inputOriMode; short configIndex; short outputOriMode; double preAcsPos[8]; short reserve2[4]; double reserve3[8]; } TCoordinateTransformParameter;
+typedef struct { TKinematicTransform kinTrans; short enablePcsTrans; short enableTcsTrans; short enableUserPcsTrans; short reserve1[5]; TCoordinateTransform pcsTrans; TCoordinateTransform tcsTrans; TCoordinateTransform userPcsTrans; double acsKinOffset[8]; short inputCoordSystem; short inputOriMode; short configIndex; short outputOriMode; double preAcsPos[8]; short reserve2[4]; double reserve3[8]; } TCoordinateTransformParameterEx;
+typedef struct { TKinematicTransform kinTrans; short enablePcsTrans; short enableTcsTrans; short enableUserPcsTrans; short userPcsTransCount; short inclinedPlaneMode; short inclinedPlaneConfigIndex; short reserve1[2]; TCoordinateTransform pcsTrans; TCoordinateTransform tcsTrans; TCoordinateTransform userPcsTrans[4]; double acsKinOffset[8]; double preRotateAxisPos[2]; short inputCoordSystem; short inputOriMode; short configIndex; short outputOriMode; double preAcsPos[8]; short reserve2[4]; double reserve3[8]; } TGroupPosTransformPrm;
+typedef struct { double pcsPos[8]; double mcsPos[8]; double acsPos[8]; } TCoordinatePos;
+typedef struct { short coordSystem; short oriMode; short configIndex; short targetOriMode; short reserve1[8]; double inputPos[8]; double preAcsPos[8]; double reserve2[24]; } TGroupPosTransformInput;
+typedef struct { short configIndex; short singularity; short reserve1[10]; double pcsPos[8]; double mcsPos[8]; double acsPos[8]; double reserve2[16]; } TGroupPosTransformOutput;
+typedef struct { double deceleration; double jerk; short reserve1[4]; double reserve2[5]; } TGroupStopParameter;
+typedef struct { short plane; short reserve1[5]; short rotateIdent; short setOriginFlag; double origin[3]; double rotateOrigin; double reserve2[14]; } TGroupPathPolar;
+typedef struct { short plane; short reserve1[4]; short linearIdent; short rotateIdent; short setOriginFlag; double r; double origin[3]; double rotateOrigin; double reserve2[13]; } TGroupPathCynlinder;
+typedef union { TGroupPathPolar polar; TGroupPathCynlinder cynlinder; double value[20]; } TGroupPathUnion;
+typedef struct { short mode; short reserve[3]; TGroupPathUnion data; } TGroupPathPrm;
+typedef struct { long lookAheadNum; short reserve1[6]; long reserve2[4]; double time; double radiusRatio; double reserve3[7]; } TGroupLookAheadParameter;
+typedef struct { long segNum; long userTag; double data[32]; } TLookAheadErrorInfo;
+typedef struct { short blendType; short prmType; short reserve1[2]; double prm; double reserve2[8]; double minAngle; double maxAngle; } TPathBlendingParameter;
+typedef struct { short blendType; short prmType; short reserve[5]; short percentMode; double percent; double prm[17]; } TVelBlendingParameter;
+typedef union { TPathBlendingParameter pathBlendingPrm; TVelBlendingParameter velBlendingPrm; double data[20]; } TBlendingParameter;
+typedef struct { short mode; short reserve[3]; TBlendingParameter prm; } TGroupBlendingParameter;
+typedef struct { short type; short optMode; } TGroupDvMaxLimit;
+typedef struct { short enable; short mode; long n1; long n2; } TGroupCmdVelLimit;
+typedef struct { double value[2]; double reserve[14]; } TRotateAxisPos;
+typedef struct { double value[3]; double reserve[13]; } TToolVector;
+typedef union { TRotateAxisPos rotateAxisPos; TToolVector toolVector; double value[16]; } TInclinePlaneRotateAxisInfoUnion;
+typedef struct { short mode; short pad[3]; TInclinePlaneRotateAxisInfoUnion data; } TInclinedPlaneRotateAxisInfo;
+typedef struct { short configIndex; short reserve1[3]; double reserve2[9]; } TSelectConfig;
+typedef union { TSelectConfig select; double value[10]; } TGroupInclinedPlanePrmUnion;
+typedef struct { short mode; short reserve[3]; TGroupInclinedPlanePrmUnion data; } TGroupInclinedPlanePrm;
+typedef struct { double velocity; double acceleration; double reserve1[3]; double deceleration; short overrideSelect; short endVelocityMode; short orientationDir; short reserve2[3]; long reserve3[3]; } TGroupMoveParameter;
+typedef struct { short endPointMode; short arcPlane; short arcPathChoice; short pad; double centralAngle; double centerPoint[8]; } TCircularPlaneCenterDirData;
+typedef struct { short endPointMode; short arcPlane; short arcPathChoice; short pad; double centralAngle; double arcRadius; } TCircularPlaneRadiusDirData;
+typedef struct { short endPointMode; short pad[3]; double centralAngle; double auxPoint[8]; } TCircularSpaceBorderData;
+typedef struct { short endPointMode; short auxPointCommandCoord; short auxPointOrientationMode; short auxPointConfigIndex; short auxStartPointCommandCoord; short auxStartPointOrientationMode; short auxStartPointConfigIndex; short pad; double centralAngle; double auxPoint[8]; double auxStartPoint[8]; } TCircularSpaceBorderFourData;
+typedef struct { short endPointMode; short arcPlane; short arcPathChoice; short periodCount; double centralAngle; double centerPoint[8]; double periodDeltaRadius; } TCircularPlaneCenterDirSpiralData;
+typedef union { TCircularPlaneCenterDirData centerDir; TCircularPlaneRadiusDirData radiusDir; TCircularSpaceBorderData spaceBorder; TCircularSpaceBorderFourData spaceBorderFour; TCircularPlaneCenterDirSpiralData spiral; double data[32]; } TCircularModeUnion;
+typedef struct { short arcMode; short pad[3]; TCircularModeUnion data; } TCircularParameter;
+typedef struct { double h1; double h2; double h3; double k1; double k2; short curveMode; short oriChangeMode; short reserve1[6]; double reserve2[8]; } TGate;
+typedef union { TGate gate; double data[32]; } TGateUnion;
+typedef struct { short mode; short reserve[3]; TGateUnion data; } TGatePrm;
+typedef struct { short type; short weaveMode; short frequencyMode; short pad1; double amplitude; double frequency; double weavePrm[10]; short startPosition; short dweelFullStop; short pad2[2]; double dweelLeft; double dwellMid; double dwellRight; short oriControlMode; short pad3[3]; double rotateAngleX; double rotateAngleY; double rotateAngleZ; } TGroupWeaveParameter;
+typedef struct { short mode; short dataCount; short reserve1[6]; double period; double reserve2[5]; } TGroupSuperpositionTablePrm;
+typedef struct { double value[8]; } TGroupSuperpositionTableData;
+typedef struct { short workIndex; short reserve1[7]; double reserve2[14]; } TGroupSuperpositionTableStatus;
+typedef struct { double value[8]; double reserve[24]; } TGroupSuperpositionValueDirect;
+typedef struct { short mode; short pad[3]; double time; double velocity; double reserve[29]; } TGroupSuperpositionWeaveEx;
+typedef struct { short mode; short startIndex; short count; short reserve1[5]; double time; double velocity; double reserve2[28]; } TGroupSuperpositionTable;
+typedef union { TGroupSuperpositionValueDirect direct; TGroupSuperpositionWeaveEx weaveEx; TGroupSuperpositionTable table; double data[32]; } TGroupSuperpositionUnion;
+typedef struct { short enable; short mode; short pad[2]; double smoothTime; TGroupSuperpositionUnion data; } TGroupSuperposition;
+typedef struct { short masterMode; short masterType; short masterIndex; short cbtTag; double detectPos; double parkPos; double stopPos; double delay; double sampleTime; double velMax; double acc; double cbOrigin[6]; short group; short masterMotionType; short masterMotionDir; short reserve1[5]; double reserve2[10]; } TCbtPrm;
+typedef struct { short group; short pieceConfigIndex; short waitMode; short waitProfileCoord; short waitCmdPosCoord; short waitConfigIndex; short reserve1[2]; double locatePoint[6]; double waitPoint[6]; double groupVel; double groupAcc; double groupDec; short reserve2[8]; double reserve3[10]; } TCbtGroupPrm;
+typedef struct { short cbtTag; short pieceTag; short reserve1[2]; double masterPos; double pose[6]; double reserve2[5]; double processTime; } TCbtPieceData;
+typedef struct { short cbtIndex1; short cbtIndex2; short reserve1[2]; double reserve2[10]; } TCoupleCbtPrm;
+typedef struct { short executeMode; short reserve1[3]; double reserve2[10]; } TStartCbtPrm;
+typedef struct { short execute; short state; short stopInfo; short reserve1[3]; short pieceTag; short pieceEmpty; unsigned long pieceReceive; unsigned long pieceRemainder; unsigned long pieceProcess; unsigned long validPieceProcess; unsigned long reserve2[6]; double catchUpStartPos; double actualPiecePos; double virtualPiecePos; } TCbtInfo;
+typedef struct { double axis[9]; double length[3]; } TObjectCuboid;
+typedef struct { double axis[3]; double radius; double height; } TObjectCylinder;
+typedef union { TObjectCuboid cuboid; TObjectCylinder cylinder; double data[32]; } TObjectShape;
+typedef struct { short shapeType; short reserve1[3]; TObjectShape shape; short source; short index[3]; short locate; short side[3]; double offset[3]; short reserve2[4]; } TCollisionCheckObjectPrm;
+typedef struct { short objectIndex[2]; short reserve1[2]; short rotateMode; short dir[3]; double originOffset[3]; double distance; double reserve2[8]; } TCollisionCheckPrm;
+typedef struct { short enable; short checkResult; short reserve1[6]; double reserve2[4]; } TCollisionCheckStatus;
+typedef struct { short windowSize; short lostSize; long torqueLimitMax; long torqueLimitMin; short continuousProtectCount; short oscillationPositiveProtectCount; short oscillationNegativeProtectCount; short reserve[15]; } TGantryTorqueProtectPrm;
+typedef struct { long torqueProtectSts; long torqueProtectEnable; short reserve[20]; } TGantryInf;
+typedef struct { short direction; short reserve[3]; } TGPIOConfig;
+typedef struct { double stopPos; short mode; short pad[3]; } TStopPos;
+typedef struct { short start; short execute; short occupyStatus; short executeCount; long pad2[2]; double pad3[2]; } TTaskStatus;
+typedef struct { short mode; short elementSize; short reserve1[6]; long forwardSpace; long reverseSpace; long reserve2[6]; } TCommandListConfig;
+typedef struct { short command; short index[2]; short reserve[5]; } TCommandListLink;
+typedef struct { short startMode; short reserve1[15]; } TCommandListStartParameter;
+typedef struct { unsigned long loop; short reserve1[10]; long reserve2[2]; } TCommandListStaticParameter;
+typedef struct { double velOverride; double reserve[40]; } TCommandListEstimatePrm;
+typedef struct { short mode; short reserve1[3]; double time; double reserve2[8]; } TCommandListEstimateInfo;
+typedef struct { short enable; short master; short filterTime; short mode; short fixedMpgVelCount; short pad1[3]; long masterEven; long slaveEven; long pad2[2]; double fixedMpgVel[8]; double ratioUpdateTime; double pad3[3]; } TCommandListMpgPrm;
+typedef struct { double velMax; double accMax; double decMax; double jerkMax; double dvMax; short reverseLimitMode; short reserve1[3]; double reserve2[8]; } TAxisMotionConstraint;
+typedef struct { short count; short reserve[3]; double alpha[4]; double beta[4]; } TScaleParameter;
+typedef struct { double currentToTorqueCoef; double ratedCurrent; double reserve[4]; } TAxisMotorParameter;
+typedef struct { double deceleration; double jerk; short reserve1[4]; double reserve2[5]; } TAxisStopParameter;
+typedef struct { long code; short index; short subIndex; short pad1[2]; } TReadHsCommand;
+typedef struct { short enable; short master; short filterTime; short mode; short fixedMpgVelCount; short pad1[3]; long masterEven; long slaveEven; long pad2[2]; double fixedMpgVel[8]; double ratioUpdateTime; double pad3[3]; } TCrdMpgPrm;
+typedef struct { unsigned long commandCode; short commandRtn; short errorCode; unsigned long clockTime; long segmentNum; long userTag; short dataLength; unsigned short data16[225]; } TCommandInfoData;
+typedef struct { double minDuty; double maxDuty; double minFrequency; double maxFrequency; double minPulseWidth; double maxPulseWidth; } TLaserPwmPrmPro;
+typedef struct { double endPos[3]; double centerPos[3]; short circleDir; short pad[3]; TScanMotionPrmUnionPro motionPrm; } TScanArcMotionPro;
+typedef struct { short enable; short batchCmdReceive; short batchCmdSend; short fifoSpace; } TBatchDataSendingSts;
+typedef struct { TBatchDataSendingSts batchDataSts; short batchSendCount; short wordDataSendCount; short stationFifoSpace; int cmdCount; short reserve[7]; } TScanBatchDataSendingSts;
+typedef struct { double pos; double vel; double acc; double dec; short percent; short pad1[3]; double velStart; double velEnd; short accStartPercent; short decEndPercent; short dir; short pad2; short reserve[10]; } TMoveAbsoluteProPrm;
+typedef struct { short active; short alarmType; short alarmIndex; short limitPositiveType; short limitPositiveIndex; short limitNegativeType; short limitNegativeIndex; short smoothStopType; short smoothStopIndex; short abruptStopType; short abruptStopIndex; short prfMap[2]; short encMap[2]; short prfMapAlpha[2]; short prfMapBeta[2]; short encMapAlpha[2]; short encMapBeta[2]; } TAxisConfigPro;
+typedef struct { unsigned long terminalTxBuf[256]; unsigned long terminalRxBuf[256]; } TTerminalData;
+typedef struct { short enable; short latchType; short latchIndex; short probeType; short probeIndex; short windowOnly; long firstPosition; long lastPosition; long continueTime; double currentValue; double pad2[3]; } TTorqueTriggerPrm;
+typedef struct { double value; double reverse[4]; } TServoSpdLoopPidMode0;
+typedef union { TServoSpdLoopPidMode0 servoSpdLoopPidMode0; } TServoSpdLoopPidUnion;
+typedef struct { short mode; short reverse[3]; TServoSpdLoopPidUnion servoSpdLoopPidPrm; } TServoSpdLoopPid;
+typedef struct { char uuid[32]; char mcInf[32]; } TEncryptConfigPrm;
+typedef struct { char keyValue[32]; char data[32]; } TEncryptData;
+typedef struct { short type; short userKeySlotOffset; short userDataSlotOffset; short cardType; short reverse1[8]; } TEncryptChipInf;
+typedef struct { char sn[9]; char random[32]; TEncryptChipInf chipInf; } TEncryptAuxInf;
+typedef struct { char data[32]; char hMac[32]; } TEncryptDataPro;
+typedef struct { char oldKey[32]; char newKey[32]; } TEncryptKey;
+typedef struct { short type; short index[2]; } TAddition;
+typedef struct { double pos; double vel; } TAdditionStatus;
+typedef struct { short profileType[3]; short profileIndex[3]; short profileId[3]; short encoderType[3]; short encoderIndex[3]; short encoderId[3]; } TContourConfig;
+typedef struct { double kp[3]; double ki[3]; short errorWindow[3]; short limit[3]; } TContourControl;
+typedef struct { short cornerStepIn; short cornerStepOut; short reserved1[2]; double cornerTheta; short reserved2[4]; double window; double para; } TContourMode;
+typedef struct { short index; } TPVTPosCompareStart;
+typedef struct { short index; } TPVTPosCompareStop;
+typedef struct { short index; short id; short reverse1[2]; double reverse2[4]; } TResPhyInfo;
+typedef struct { short core; short dataType; short index; short reserve[5]; } TLogicInfo;
+typedef struct { short cardIndex; short stationPhyId; short modulePhyId; short dataType; short index; short reserve[3]; } TPhysicInfo;
+typedef struct { short relateEnable; short netSrc; short netSrcIndex; short reserve1[9]; double reserve2[3]; } TSlaveRelateInfo;
+typedef struct { double distance; double vM; double acc; double pa1; double pa2; double dec; double pd1; double pd2; double velM; double accM; double decM; double time; } TPvtTableMoveAbsolutePrm;
+typedef struct { double targetPos; double safetyPos; double slaveMiddlePos[3]; } TBufLeapFrogInfo;
+typedef struct { double synDistance; double movedsynDistance; double reserve1[10]; } TCrdMoveInfo;
+typedef struct { short followMode; short hsoOutputMode; short timeScale; short pad; double maxValue; double minValue; double k; double b; } TPosCompareFollowCrd;
+typedef struct { short index; short enable; short reserve1[2]; long reserve2[2]; } TPosCompareOnOffList;
+typedef struct { short index; short reserve[3]; unsigned long count; long syncPos; long time; } TPosComparePsoPrmList;
+typedef struct { unsigned short resType; unsigned short resIndex; unsigned short resSubIndex; unsigned short resCount; double resValue[256]; } TMcVarResInfo;
+typedef struct { TWatchVar var; unsigned short condition; double value; double continueTime; } TWatchConditionVar;
+typedef struct { short conditionDone; short modal; short reserve1[2]; long segNum; long userTag; long reserve2[8]; } TWaitForConditionInfo;
+typedef struct { short mode; short clear; short reserve[2]; } TStartTimerPrm;
+typedef struct { short run; short reserve[3]; double value; } TTimerInfo;
+typedef struct { unsigned long objectIndex; unsigned short subIndex; unsigned short reserve; short byteSize; short memType; } TServoParamReader;
+typedef struct { double gain1; double gain2; double smoothTime; double spdLimitUpper; double spdLimitLower; double reserved[4]; } TServoNonlinearGlobalGain;
+typedef struct { long segmentNumber; long posX; long posY; short gpo; short hso; short reserve[4]; } TPosCompareCommandPos;
+typedef struct { long segmentNumber; long time; short pad[2]; short gpo; short hso; } TPosCompareCommandTime;
+typedef union { TPosCompareCommandPos pos; TPosCompareCommandTime time; short data16[12]; } TPosComparePredictiondataUnion;
+typedef struct { short type; short pad[3]; TPosComparePredictiondataUnion data; } TPosComparePredictionData;
+typedef struct { double pos[40]; } TEllipseAuxPoint;
+typedef struct { double centerPoint[8]; double theta; double a; double b; } TEllipseStandard;
+typedef union { TEllipseAuxPoint auxPoint; TEllipseStandard standard; double reserve[60]; } TEllipseParameterUnion;
+typedef struct { double endPoint[8]; short plane; short dir; short overrideSelect; short mode; TEllipseParameterUnion data; } TEllipseParameter;
+typedef struct { short commandCount; short errorCommandNumber; short errorCode; short reserve[5]; } TBatchCommandResult;
+typedef struct { short active; short ctlMode; short linkHeightCtlGroup; short feedbackType; short feedbackIndex; short interval; long errorLimit; short reserve[8]; } THeightControlPrm;
+typedef struct { short type; short index; long crossPos; short dir; short pad1[3]; } THeightCrossPrm;
+typedef struct { short keepEnable; short pad1[3]; THeightCrossPrm enableData; THeightCrossPrm disableData; } THeightFollowPrm;
+typedef struct { short ctlMode; short errorSts; double cmpValue; } THeightInf;
+typedef struct { short heightCtlGroup; short motorEncoder; short pad[2]; double homeVel; double homeDir; long frqMutationStopValue; long offset; double distance; double calibrationVel; double calibrationStepCount; double calibrationCountPerStep[50]; double reserve[4]; } TDifferentStepCalibration;
+typedef union { TDifferentStepCalibration differentStep; } THeightCalibration;
+typedef struct { short mode; THeightCalibration prm; } THeightCalibrationPrm;
+typedef struct { long positiveMutationValue; short positiveMutationStopLinkLimitType; long negativeMutationValue; short negativeMutationStopLinkLimitType; } TFrqMutationStopPrm;
+typedef struct { short type; short moveAxis; short latchNum; short reserve1; short latchType[4]; short latchIndex[4]; long heightDiff; long reserve2; double findTime; } THeightFindEdgePrm;
+typedef struct { short findEdgeSts; short error; double latchValue[4]; } THeightFindEdgeResult;
+typedef struct { double vel; double acc; double dec; double smoothTime; double safetyVel; short slaveType; short slaveIndex; long followCmd; short followEnable; short enable; short reserve1[2]; double reserve2[4]; } TSetAxisLeapFrogPrm;
+typedef struct { double pos[2]; double compensateValue; } TCompensatePathPoint;
+typedef struct { short tableIndex; short axisType[2]; short axisIndex[2]; short reserve1[3]; double offset[2]; double compensateVelMax; double approachRadius; double workBand; double workHeight; double reserve2[2]; } TCompensatePathParameter;
+typedef struct { short enable; short state; short errorStatus; short pointIndex; double compensateStartPos[2]; double compensateValue; double reserve1[2]; } TCompensatePathStatus;
+typedef struct { short stationId; short axis; unsigned long long multiLines; double pos; } StAbsEncPos;
+typedef struct { short mode; short smoothTimer; long moveTime; long pad; double synVel; double synAcc; double synJeck; } TPvtLinePrm;
+typedef struct { unsigned short type; unsigned short closewise; unsigned long cutEnable; double targetPosX; double targetPosY; double circleCenterX; double circleCenterY; } StBatteryTargetSegment;
+typedef struct { unsigned short segmentNum; unsigned short cycleNum; StBatteryTargetSegment batteryTargetSegment[100]; double segmentIncreaseX[100]; double segmentIncreaseY[100]; } StScanShape;
+typedef struct { long encAxisSrc; long prfEncSel; double encPulsePreDistance; double scanPulsePreDistance; } StScanBatteryParam;
+typedef struct { unsigned short bits1; } StScanAttributeCfg;
+typedef struct { unsigned short skip_count; unsigned short netOpenSts; unsigned short *slave_position; char *eniFilePath; unsigned short reserve2[20]; } TEcatInitPrm;
+typedef struct { short resType; short resIndex; short mapIndex; short mapCount; } TResTypeMapInfo;
+typedef struct { short resMapType; short resMapCount; TResTypeMapInfo resmapInfo[64]; } TTerminalResMapInfo;
+typedef struct { short netType; unsigned short terminalType; unsigned short terminalSubType; short phyId; short slotCount; unsigned short slotType[16]; unsigned short slotSubType[16]; short stationResMapCount; TTerminalResMapInfo terminalResMapInfo[64]; } TTerminalInfo;
+typedef struct { short stationPhyId; short index; short type; } TRemoteChannelPrm;
+typedef struct { short enableFlag; short occupy; short type; short index; short lastReceiveError; short lastSendError; unsigned short errorCount; unsigned short continueErrorCount; } TRemoteChannelInfo;
+typedef struct { short laserOn; short laserEnable; short laserRed; short laserPowerLatch; double duty; double frequency; double pulseWidth; double voltage; double parallel; } TLaserPowerPro;
+typedef struct { short laserOn; short laserEnable; short laserRed; short laserPowerLatch; double duty; double frequency; double pulseWidth; double voltage; double parallel; double minDuty; double maxDuty; double minFrequency; double maxFrequency; double minPulseWidth; double maxPulseWidth; double minVoltage; double maxVoltage; double minParallel; double maxParallel; double laserOnDelay; double laserOffDelay; } TLaserPro;
+typedef struct { short powerType; short group; short source; short coordSystem; double ratio; double minPower; double maxPower; } TLaserFollowPrmPro;
+typedef struct { short powerType; short group; short source; short coordSystem; short tableId; short pad[3]; double minPower; double maxPower; } TLaserFollowTablePrmPro;
+typedef struct { short group; short source; short coordSystem; short dutyTableId; short frequencyTableId; short pad[3]; double minDuty; double maxDuty; double minFrequency; double maxFrequency; } TLaserFollowDuoTablePrmPro;
+typedef struct { short enable; short mode; short errorCode; short returnValue; double power; double powerAnother; TLaserFollowPrmPro ratioPrm; TLaserFollowTablePrmPro tablePrm; TLaserFollowDuoTablePrmPro duoTablePrm; } TLaserFollowPro;
+typedef struct { double kp; double ki; double kd; double kvff; double kaff; long integralLimit; long derivativeLimit; short limit; short reserve[3]; } TPidAlign;
+typedef struct { short mode; short master; short slave; short reserve[3]; long syncErrorLimit; TPidAlign gantryMasterPid; TPidAlign gantrySlavePid; TPidAlign masterPid; TPidAlign slavePid; } TGantryPrmPro;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short mode; unsigned short reserve; unsigned short reserve2; long modify_delta; long ratio_a; long ratio_b; } TStGearParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long long target_pos; unsigned long max_vel; unsigned short reserve2[2]; } TStTrapParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long target_vel; unsigned long max_acc; unsigned long reserve1; unsigned short reserve2[2]; } TStJogParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long long target_pos; unsigned long max_vel; long main_axis_shift; long second_axis_shift; unsigned short reserve2[2]; } TStGantrayTrapParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long target_vel; unsigned short reserve3[2]; long long reserve2; } TStDriverVelParam;
+typedef struct { unsigned short axis_id; unsigned short axis_mode; unsigned short axis_ctrl; unsigned short reserve; long target_acc; unsigned short reserve3[2]; long long reserve2; } TStDriverCurParam;
+typedef struct { short profileMode; unsigned short reserve2[3]; TStTrapParam trapPrm; TStJogParam jogPrm; TStGearParam gearPrm; TStGantrayTrapParam gantrayTrapPrm; TStDriverVelParam driverVelPrm; TStDriverCurParam driverCurPrm; } TSetMultiMcFunctionPrm;
+typedef struct { unsigned short prmErrorInf; short readCommandVarTableIndex; short readCount; short pad[2]; short realReadCount; double *pVarValue; } TMultiMcFunctionReadPrm;
+typedef struct { short enable; short reserve1[3]; double reserve2[4]; } TAxisSimulationParameter;
+typedef struct { short varId; short stationId; short varType; short varIndex; } StSamplingVar;
+typedef struct { short masterMode; short masterType; short masterIndex; short slaveMode; short slaveType; short slaveIndex; short slaveAdditionType; short slaveAdditionIndex; short slaveLink; short outOfRangeAction; short trapSmoothTime; short followSmoothPercent; double synchOffset; double detectPos; double parkPos; double stopPos; double slaveVelMax; double slaveAcc; double sampleTime; double reserve2[5]; } TCatchUpPrm;
+typedef struct { short mode; short fifoEmptyAction; short reserve1[2]; long reserve2[4]; double reserve3[4]; } TStartCatchUpPrm;
+typedef struct { short mode; short reserve1[3]; long reserve2[4]; double reserve3[4]; } TStopCatchUpPrm;
+typedef struct { short mode; short crdIndex; short reserve1[2]; long reserve2[4]; double reserve3[4]; } TStartCatchUpProcessPrm;
+typedef struct { short mode; short reserve1[3]; long reserve2[4]; double reserve3[4]; } TStopCatchUpSynchPrm;
+typedef struct { unsigned long id; long reserve1[3]; double pos; double reserve2[3]; } TCatchUpPieceFifo;
+typedef struct { short state; short stopInfo; short errorCode; short reserve1[5]; unsigned long id; unsigned long pieceCount; long reserve2[6]; double synchDistance; double synchTime; double reserve3[6]; } TCatchUpStatus;
+typedef struct { short state; short stopInfo; short errorCode; short reserve1[5]; long reserve2[8]; double pieceStartPos; double slaveStartPos; double pieceSynchPos; double slaveSynchPos; double pieceDistanceMin; double reserve3[8]; } TCatchUpInfo;
+typedef struct { unsigned long segmentNumber; short xAxisEnable; short yAxisEnable; short zAxisEnable; short reserve[5]; } TPosCompareBufSourceEnable;
+typedef struct { short bufCmdEnable; short xAxisEnable; short yAxisEnable; short zAxisEnable; short reserve[4]; } TPosCompareBufEnableInfo;
+typedef struct { double posBegin; double posEnd; double acc; double dec; double percentAcc; double percentDec; double vel; } TMpParameter;
+typedef struct { double posBegin; double posEnd; double acc; double dec; double percentAcc; double percentDec; double vel1; double vel2; double posMiddle; } TMp2Parameter;
+typedef struct { double time; double vel; double pos; double accDir; double am; double jerk; unsigned short segmentType; } TMpPoint;
+typedef struct { short dir; unsigned short pad[2]; unsigned short knotCount; TMpPoint knot[16]; } TMpResult;
+typedef struct { short stationId; unsigned short stationType; unsigned short subType; short reserve1; short reserve2; short reserve3; short reserve4; short reserve5; } TOnlineStationType;
+typedef struct { short enable; short mode; long dir; long threshold; long openLoopDac; double overTime; long posOffset; short reserve[2]; } TSwitchLoopParameter;
+typedef struct { long loopFlag; long tableMax; double startPos; double length; double refPos; double positiveOffset; double positiveScale; double negativeOffset; double negativeScale; } TTorqueForceCompensatePara;
+typedef struct { short masterIndex; short slaveIndex[2]; short pad1; double stopDec; double stopJerk; double borderPositive[2]; double borderNegative[2]; } TDualAxisParameter;
+typedef struct { short enable; short errorId; short pad1[2]; short state[2]; short border[2]; double pad2[6]; } TDualAxisStatus;
+typedef struct { double pos; double vel; double acc; double dec; double jerkAcc; double jerkDec; double velEvenTime; double accEvenTime; double decEvenTime; unsigned short bufferMode; unsigned short pad1; unsigned short pad2; unsigned short pad3; double reserve1; double reserve2; double reserve3; double reserve4; } TMoveAbsoluteSineParameter;
+typedef struct { double pos; double vel; double acc; double dec; double jerkAcc; double jerkDec; double velEvenTime; double accEvenTime; double decEvenTime; unsigned short bufferMode; unsigned short pad1; unsigned short pad2; unsigned short pad3; double reserve1; double reserve2; double reserve3; double reserve4; } TMoveAbsoluteJerkParameter;
+typedef struct { unsigned short motionDone; unsigned short pad1[3]; double timeElapse; double timeLeft; double aimPos; double prfPos; double prfVel; double prfAcc; double reserve1[4]; } TMoveAbsoluteJerkStatus;
+typedef struct { short enable; short tableIndex; short axisType[3]; short axisIndex[3]; short reserve1[4]; } TCompensate3D;
+typedef struct { long count[3]; long pad1[5]; double posBegin[3]; double step[3]; double reserve1[4]; } TCompensate3DTable;
+typedef struct { long pointIndex[3]; long pad1; double pointValue; } TCompensate3DPoint;
+typedef struct { long rangeIndex[3]; long rangeCount[3]; } TCompensate3DPointRange;
+typedef struct { unsigned short sourceType; unsigned short sourceIndex; unsigned int filterTime; unsigned short filterMode; unsigned short reserve1[3]; double reserve2[4]; } TFirCompensateParameter;
+typedef struct { double posRaw; double posFir; double posFirCompensate; double velRaw; double velFir; double velFirCompensate; } TFirCompensateValue;
+typedef struct { unsigned short enable; unsigned short mode; unsigned short sourceType; unsigned short sourceIndex; unsigned short estimate; unsigned short pad1[3]; double sampleTime; double smoothCoef; double reserve1[4]; } TTrackParameter;
+typedef struct { short enable; short reserve1[3]; double stopPos; double reserve2[8]; } TExactStopPrm;
+typedef struct { unsigned short cfgSize; unsigned short pduWrEn; unsigned short pduWrSize; unsigned short pduRdEn; unsigned short pduRdSize; unsigned short cmdEn; unsigned short fifoWrEn; unsigned short fifoRdEn; } StRnMailSlaveDeviceCfg;
+typedef struct { unsigned short cfgSize; unsigned short pduWrEn; unsigned short pduRdEn; unsigned short cmdEn; unsigned short fifoWrEn; unsigned short fifoRdEn; } StRnMailSlaveDeviceUpDateParam;
+typedef struct { double time; double value; } TWaveformParameter;
+typedef struct { short type; short index; short laserOn; short pad; } TWaveformOutput;
+typedef struct { short enable; short outputType; short outputIndex; short laserOn; short loopCount; short pad[3]; double outputValue; } TWaveformStatus;
+typedef struct { short startMode; short pad[3]; double voltage; double highLevelTime; double lowLevelTime; } TRectangleWavePrm;
+typedef struct { short startMode; short pad[3]; double voltage; double frequency; double dutyRatio; } TRectangleWaveDutyMode;
+typedef struct { short stepCount; short pad[3]; double voltageStart; double voltageEnd; double aheadTime; } TStageWavePrm;
+typedef struct { short enable; short laserOn; short loopCount; short rectOutputType; short rectOutputIndex; short rectOutputValid; short outputType; short outputIndex; short outputValid; short pad[3]; double rectVoltage; double outputVoltage; } TWaveformPairStatus;
+typedef struct { unsigned short enable; unsigned short dimension; unsigned short moveAxis1; unsigned short moveAxis2; unsigned short source; unsigned short compensateAxis; unsigned short mode; unsigned short pad1; double reserve1; double reserve2; double reserve3; double reserve4; } TDynamicCompensateParameter;
+typedef struct { unsigned short pointType; unsigned short pad1; unsigned short pad2; unsigned short pad3; double compensateValue; double compensateDistance; double reserve1; double reserve2; double reserve3; double reserve4; } TDynamicCompensatePoint;
+typedef struct { unsigned short enable; unsigned short execute; unsigned short pad1; unsigned short pad2; unsigned long pointReceive; unsigned long pointUse; TDynamicCompensatePoint point; double pos1; double pos2; double travelDistance; double compensateValue; double reserve1; double reserve2; double reserve3; double reserve4; } TDynamicCompensateStatus;
+typedef struct { unsigned char m_master_flag; unsigned char m_port_link_up_a; unsigned char m_port_link_up_b; unsigned char m_id_auto_set; unsigned char m_sync_status; unsigned char m_dc_status; unsigned char m_device_num; unsigned char m_device_id; unsigned short m_sync_cycle; unsigned short rsvd0; unsigned char m_station_id_list[256]; unsigned char m_station_ready[256]; unsigned long m_crc_ok_cnt_a; unsigned long m_crc_err_cn_a; unsigned long m_crc_ok_cn_b; unsigned long m_crc_err_cn_b; } StRingInfVer1;
+typedef struct { unsigned short bits1; unsigned short bits2; } TKsSampleStatus;
+typedef struct { long emb_state; long emb_curr_line; } EmbState;
+typedef struct { unsigned short level_; unsigned long index_; char data_[128]; } EmbLog;
+typedef struct { short enable; short reserve1[6]; short loop; TWatchCondition condition; short reserve2[3]; short latchVarCount; TWatchVar latchVar[8]; double reserve3[8]; } TSoftTriggerPrm;
+typedef struct { unsigned long clock; short reserve[2]; double latchValue[8]; } TSoftTriggerLatchValue;
+typedef struct { short enable; short triggerFlag; short reminderCount; short reserve1[7]; long totalCount; double reserve2[8]; } TSoftTriggerInfo;
 """
 
 CONSTANTS = r"""
@@ -315,4 +652,548 @@ CONSTANTS = r"""
 #define AUTO_HOME_MODE_HOME_STOP 3
 #define MC_JOYSTICK_AXIS_COUNT_MAX 3
 #define MC_JOYSTICK_VEL_COUNT_MAX 3
+#define GEAR_MASTER_MPG 9
+#define LISTINFO_RESERVE2_USERTAG 0
+#define VEL_PROFILE_MODE_TRAP 1
+#define VEL_PROFILE_MODE_SMOOTH 40
+#define VEL_PROFILE_MODE_SMOOTH_EX 41
+#define VEL_PROFILE_MODE_JERK 46
+#define VEL_PROFILE_MODE_FOLLOW 50
+#define MOVE_JOG_MODE_GENERAL 0
+#define MOTION_RESTRICT_PROFILE_MAX 8
+#define MOTION_TIME_RESTRICT_MODE_DIRECT 1
+#define MOTION_TIME_RESTRICT_MODE_ATTENTION_PROFILE 2
+#define MOVE_SYNCHRONIZATION_MODE_GEAR 0
+#define MOVE_SYNCHRONIZATION_MODE_MPG 1
+#define MOVE_SYNCHRONIZATION_MODE_FOLLOW 2
+#define MOVE_SYNCHRONIZATION_MODE_GEAR_POS 3
+#define MOVE_SYNCH_MPG_RESERVE_MASTER_VEL_LIMIT 0
+#define MC_START_MODE_ABSOLUTE 0
+#define MC_START_MODE_RELATIVE 1
+#define MC_START_MODE_CLUTCH_TRAP_POS 63
+#define MC_START_MODE_CLUTCH_TRAP_NEG 64
+#define MC_START_MODE_CLUTCH_TRAP_CURRENT 65
+#define CAM_POINT_TYPE_CLUTCH -1
+#define CAM_POINT_TYPE_TRAP 20
+#define CAM_POINT_TYPE_TRAP_EVEN 21
+#define CAM_OUT_MODE_STOP 0
+#define CAM_OUT_MODE_CONTINUOUS 1
+#define CAM_OUT_MODE_TO_POS 3
+#define RAMP_TYPE_TRAP 0
+#define RAMP_TYPE_JERK 2
+#define COMP_TYPE_COORD_SYNC 0
+#define HOME_STAGE_SERCH_HOME_STOP 22
+#define HOME_STAGE_SEARCH_HOME_AGAIN 24
+#define HOME_ERROR_ESCAPE 12
+#define HOME_MODE_LIMITPOS_INDEX 14
+#define HOME_MODE_HOME_LEVEL 24
+#define HOME_MODE_DRIVER_HOME 42
+#define CRD_AXIS_X 1
+#define CRD_AXIS_Y 2
+#define CRD_AXIS_Z 3
+#define CRD_AXIS_A 4
+#define CRD_AXIS_C 5
+#define CRD_AXIS_U 6
+#define CRD_AXIS_V 7
+#define CRD_AXIS_W 8
+#define BUF_CMD_TYPE_ALL -1
+#define BUF_CMD_TYPE_BUF_MOVE 0
+#define BUF_CMD_TYPE_BUF_GEAR 1
+#define BUF_CMD_TYPE_BUF_IO 2
+#define BUF_CMD_STOP_MODE_DEFAULT 0
+#define BUF_CMD_STOP_MODE_CONTINUE 1
+#define BUF_CMD_STOP_MODE_HOLD 2
+#define DIMENSION_MAX 8
+#define DIGITAL_OUTPUT_MODE_NORMAL 0
+#define DIGITAL_OUTPUT_MODE_REVERSE_TIME 10
+#define POS_COMPARE_MODE_EQUIDISTANT_BUFFER_PERMIT 3
+#define POS_COMPARE_MODE_PSO7 7
+#define POS_COMPARE_MODE_LINEAR_ABS 8
+#define POS_COMPARE_MODE_FIFO_ABS 14
+#define POS_COMPARE_MODE_FIFO_ABS_STATIC 15
+#define POS_COMPARE_THRESHOLD_DEFAULT 0
+#define POS_COMPARE_THRESHOLD_ZERO 1
+#define POS_COMPARE_THRESHOLD_FPGA 2
+#define POS_COMPARE_MODE_PSO_SYNC_EXTERNAL_SIGNAL 1
+#define POS_COMPARE_MODE_PSO_SYNC_INTERNAL_SIGNAL 2
+#define TASK_TRIGGER_CALLBACK_FUNCTION 4508
+#define TASK_MOVE_CONTINUOUS_ABSOLUTE 9568
+#define TASK_START_COMMAND_LIST 18469
+#define TASK_STOP_COMMAND_LIST 18475
+#define TASK_MOVE_ESCAPE 20480
+#define TASK_UPDATE_SERVO_GAIN 24576
+#define TASK_SET_TRIGGER_PRM 24577
+#define TASK_SAVE_MC_VAR_MAX 5
+#define TASK_SAVE_MC_VAR_EX_MAX 8
+#define TASK_SAVE_MC_VAR 50
+#define TASK_ADJUST_MOVE_JOG_ANGLE_VELOCITY 51
+#define TASK_SAVE_MC_VAR_EX 52
+#define TASK_ADJUST_JOG_VEL_RESERVE1_GROUP 0
+#define TASK_ADJUST_JOG_VEL_RESERVE1_TARGET_TYPE 1
+#define TASK_ADJUST_JOG_VEL_RESERVE2_ORIGIN_VEL 0
+#define TASK_ADJUST_JOG_VEL_RESERVE2_DAC_RATIO 1
+#define COORD_SYSTEM_PCS 0
+#define COORD_SYSTEM_MCS 1
+#define COORD_SYSTEM_ACS 2
+#define COORD_SYSTEM_TCS 3
+#define COORD_SYSTEM_VCS 4
+#define COORD_SYSTEM_FCS 5
+#define COORD_SYSTEM_MVCS 10
+#define COORD_SYSTEM_TCS_USER_DEFINE 20
+#define COORD_SYSTEM_PCS_USER_DEFINE 30
+#define COORD_SYSTEM_POLAR 40
+#define COORD_SYSTEM_CYNLINDER 41
+#define ORI_MODE_NONE 0
+#define ORI_MODE_EULER 1
+#define ORI_MODE_QUAD 2
+#define ORI_MODE_VECTOR 3
+#define ORI_MODE_ROTATE_AXIS_POS 4
+#define ORI_MODE_SPACE_ROTATE 5
+#define VEL_MODE_DEFAULT 0
+#define VEL_MODE_PERCENT 1
+#define ORI_PROFILE_MODE_MINOR 0
+#define ORI_PROFILE_MODE_MAJOR 1
+#define ORI_PROFILE_MODE_COMMAND_DIR 2
+#define GROUP_PROGRAM_COORD_SYSTEM_TABLE 0
+#define GROUP_PROGRAM_COORD_SYSTEM_PIECE 1
+#define GROUP_PCS_ROTATE_AXIS_POS_MODE_ORI 0
+#define GROUP_PCS_ROTATE_AXIS_POS_MODE_DIRECT 1
+#define PCS_USER_DEFINE_COORD_TRANS_COUNT_MAX 4
+#define COORD_TRANS_TYPE_EULER 1
+#define COORD_TRANS_TYPE_QUAD 2
+#define COORD_TRANS_TYPE_VECTOR 3
+#define COORD_TRANS_TYPE_ROTATE_AXIS_POS 4
+#define COORD_TRANS_TYPE_ACS_POS 5
+#define COORD_TRANS_TYPE_EULER_FIX 11
+#define COORD_TRANS_TYPE_TOOL_DIR 20
+#define COORD_TRANS_TYPE_OFFSET 30
+#define COORD_TRANS_TYPE_POINTS 40
+#define COORD_TRANS_TYPE_TWO_VECTORS 50
+#define COORD_TRANS_TYPE_PROJECT_ANGLE 60
+#define GROUP_INCLINED_PLANE_MODE_ORI_UNCHANGED 0
+#define GROUP_INCLINED_PLANE_MODE_ORI_CHANGED 1
+#define EULER_MODE_ZYX 0
+#define EULER_MODE_ZXZ 3
+#define EULER_MODE_XYZ 4
+#define KIN_TYPE_ORTHOGONAL 0
+#define KIN_TYPE_PARALLEL 2
+#define KIN_TYPE_ORTHOGONAL_EXTEND 6
+#define KIN_TYPE_ROBOT 10
+#define KIN_TYPE_FIVE_AXIS 20
+#define KIN_TYPE_MULTI_AXIS 30
+#define KIN_TYPE_CYLINDER 40
+#define ROBOT_TYPE_SCARA 0
+#define ROBOT_TYPE_SIX_REVOLUTE 1
+#define ROBOT_TYPE_FOUR_REVOLUTE 2
+#define ROBOT_TYPE_PALLETIZE 3
+#define ROBOT_TYPE_POSITIONER 4
+#define ROBOT_TYPE_FIVE_REVOLUTE 5
+#define ROBOT_TYPE_XYZRR 6
+#define ROBOT_TYPE_SEVEN_REVOLUTE 7
+#define ROBOT_TYPE_UR 10
+#define ROBOT_TYPE_CYLINDER 20
+#define ROBOT_TYPE_SCARA_EXTEND 30
+#define CYLINDER_TYPE_NORMAL 0
+#define ROBOT_TYPE_DELTA 100
+#define DELTA_TYPE_BASIC 0
+#define DELTA_TYPE_COMMON 1
+#define DELTA_TYPE_COMMON_PRO 2
+#define SCARA_TYPE_RRPR 0
+#define SCARA_TYPE_PRRR 1
+#define SCARA_TYPE_RPRR 2
+#define SCARA_TYPE_RRRP 3
+#define PALLETIZE_TYPE_RPPR 0
+#define POSITIONER_TYPE_SINGLE 0
+#define POSITIONER_TYPE_DUAL 10
+#define XYZRR_TYPE_LIKE_SCARA 0
+#define XYZRR_TYPE_DT_C_ON_A 100
+#define PARALLEL_INDEPENDENT 0
+#define PARALLEL_SUPERPOSITION 1
+#define RW_A_ON_C 20
+#define RW_B_ON_C 21
+#define COORDINATE_TRANSFORM_RESERVE_SUB_MODE 0
+#define GROUP_STATE_DISABLED 0
+#define GROUP_STATE_ERROR_STOP 1
+#define GROUP_STATE_STANDBY 6
+#define GROUP_STATE_HOMING 10
+#define GROUP_STATE_MOVING 20
+#define GROUP_STATE_STOPPING 30
+#define GROUP_STATUS_RESERVE1_ERROR_STOP_STATE 0
+#define GROUP_CONTOUR_ERROR_CONTROL_RESERVE2_MAX_COMPENSATE_VALUE 0
+#define GROUP_PATH_REF_AXIS_X 0
+#define GROUP_PATH_REF_AXIS_Y 1
+#define GROUP_PATH_REF_AXIS_Z 2
+#define OVERRIDE_TYPE_VEL 0
+#define OVERRIDE_TYPE_ACC 1
+#define GROUP_TRANSFORM_PRM_RESERVE2_ACS_POS_TYPE 0
+#define GROUP_TRANSFORM_PRM_RESERVE2_PROGRAM_MODE 2
+#define GROUP_TRANSFORM_INPUT_RESERVE1_ACS_POS_TYPE 7
+#define GROUP_INDENT_MAX 8
+#define GROUP_PATH_MODE_GENERAL 0
+#define GROUP_PATH_MODE_POLAR 1
+#define GROUP_PATH_MODE_CYNLINDER 2
+#define GROUP_PATH_PLANE_XY 0
+#define GROUP_PATH_PLANE_YZ 1
+#define GROUP_PATH_PLANE_ZX 2
+#define LA_FUNC_MODE_DV_MAX_LIMIT 1
+#define LA_FUNC_MODE_SOFTLIMIT_CHECK 2
+#define LA_FUNC_MODE_DV_MAX_THRESHOLD 3
+#define LA_FUNC_MODE_GEOMETRY_LIMIT 4
+#define LA_FUNC_MODE_CMD_VEL_LIMIT 50
+#define LA_FUNC_MODE_LA_PRM_TYPE 99
+#define BLEND_MODE_NONE 0
+#define BLEND_MODE_ARC 1
+#define BLEND_MODE_BIARC 2
+#define BLEND_MODE_SPLINE 3
+#define BLEND_PARA_TYPE_ERROR 0
+#define BLEND_PARA_TYPE_RADIUS 1
+#define BLEND_PARA_TYPE_DISTANCE 2
+#define VEL_BLEND_MODE_NONE 0
+#define VEL_BLEND_MODE_BUFFERER 1
+#define VEL_BLEND_MODE_LOW 2
+#define VEL_BLEND_MODE_PREVIOUS 3
+#define VEL_BLEND_MODE_NEXT 4
+#define VEL_BLEND_MODE_HIGH 5
+#define GEOMETRY_LIMIT_MODE_WORK 0
+#define GEOMETRY_LIMIT_MODE_AXIS 1
+#define GEOMETRY_LIMIT_MODE_NONE 2
+#define GROUP_MOVE_PRM_RESERVE2_POS_MASK 0
+#define GROUP_MOVE_PRM_RESERVE2_START_POINT_MODE 2
+#define CIRCULAR_PARAMETER_MAX_ERROR 0
+#define CIRCULAR_PARAMETER_ORIENTAION_PASS_MODE 1
+#define CIRCULAR_PARAMETER_AUXILIARY_START_MASTER_POS 2
+#define CIRCULAR_PARAMETER_AUXILIARY_MASTER_POS 3
+#define CIRCULAR_MODE_PLANE_CENTER_DIR 0
+#define CIRCULAR_MODE_PLANE_RADIUS_DIR 1
+#define CIRCULAR_MODE_SPACE_BORDER 2
+#define CIRCULAR_MODE_SPACE_CENTER 3
+#define CIRCULAR_MODE_SPACE_RADIUS 4
+#define CIRCULAR_MODE_PLANE_RELATIVE_CENTER_DIR 5
+#define CIRCULAR_MODE_SPACE_BORDER_FOUR 6
+#define CIRCULAR_MODE_PLANE_CENTER_DIR_SPIRAL 10
+#define CIRCULAR_MODE_PLANE_RELATIVE_CENTER_DIR_SPIRAL 11
+#define CIRCULAR_PLANE_XY 0
+#define CIRCULAR_PLANE_YZ 1
+#define CIRCULAR_PLANE_ZX 2
+#define CIRCULAR_PLANE_XYZ 3
+#define CIRCULAR_PLANE_XY_HELIX 10
+#define CIRCULAR_PLANE_YZ_HELIX 11
+#define CIRCULAR_PLANE_ZX_HELIX 12
+#define CIRCULAR_END_POINT_MODE_END_POINT 0
+#define CIRCULAR_END_POINT_MODE_CENTRAL_ANGLE 1
+#define CIRCULAR_PATH_CHOICE_CW 0
+#define CIRCULAR_PATH_CHOICE_CCW 1
+#define GATE_MODE_NORMAL 0
+#define WEAVE_TYPE_SINE 0
+#define WEAVE_TYPE_SINE_DIR_X 100
+#define GROUP_SUPERPOSITION_TABLE_MAX 4
+#define GROUP_SUPERPOSITION_TABLE_DATA_MAX 128
+#define GROUP_SUPERPOSITION_MODE_DIRECT 0
+#define GROUP_SUPERPOSITION_MODE_WEAVE 1
+#define GROUP_SUPERPOSITION_MODE_WEAVE_EX 2
+#define GROUP_SUPERPOSITION_MODE_TABLE 3
+#define GROUP_SUPERPOSITION_MODE_DIRECT_RELATIVE 10
+#define GROUP_SUPERPOSITON_WEAVE_EX_RESERVE_STOP_VEL 0
+#define GROUP_SUPERPOSITON_TABLE_RESERVE2_STOP_VEL 0
+#define CBT_MODE_CONTINUOUS 0
+#define CBT_MODE_INTERMITTEN 1
+#define CBT_EXECUTE_MODE_AUTO 0
+#define CBT_EXECUTE_MODE_COMMAND 1
+#define CBT_MASTER_MOTION_TYPE_LINEAR 0
+#define CBT_MASTER_MOTION_TYPE_ROTATE 1
+#define CBT_STATE_IDLE 0
+#define CBT_STATE_BACK_TO_WAIT_POINT 10
+#define CBT_STATE_WAITTING_PIECE 20
+#define CBT_STATE_LOCATING 110
+#define CBT_STATE_WAITING_SYNCHRONIZATION 120
+#define CBT_STATE_SYNCHRONIZATION 130
+#define CBT_STATE_DELAY 140
+#define CBT_STATE_EXECUTING_TASK 150
+#define CBT_STATE_EXITING_SYNCHRONIZATION 160
+#define CBT_STATE_STOPPING 300
+#define CBT_STATE_DONE 400
+#define CBT_STOP_INFO_NONE 0
+#define CBT_STOP_INFO_CU_OUT_OF_RANGE 1
+#define CBT_STOP_INFO_GET_CU_INFO 2
+#define CBT_STOP_INFO_ENABLE_GROUP_DYNAMICA_TRANSFORM 3
+#define CBT_STOP_INFO_DISABLE_GROUP_DYNAMICA_TRANSFORM 4
+#define CBT_STOP_INFO_START_GROUP_LOCATE_MOTION 5
+#define CBT_STOP_INFO_START_GROUP_WAIT_MOTION 6
+#define CBT_STOP_INFO_START_CU 7
+#define CBT_STOP_INFO_USER_STOP 10
+#define CBT_STOP_INFO_USER_STOP_COMMAND_LIST 11
+#define CBT_STOP_INFO_USER_STOP_IN_LIST 12
+#define CBT_STOP_INFO_GROUP_ERROR 50
+#define CBT_STOP_INFO_PROFILE_ERROR 51
+#define COLLISION_CHECK_MAX 8
+#define COLLISION_CHECK_OBJECT_MAX 16
+#define OBJECT_TYPE_NONE -1
+#define OBJECT_TYPE_CUBOID 1
+#define OBJECT_TYPE_CYLINDER 2
+#define OBJECT_LOCATE_FIX 0
+#define OBJECT_LOCATE_TOOL 1
+#define OBJECT_LOCATE_WORK_PIECE 2
+#define AXIS_SIDE_TOOL 0
+#define AXIS_SIDE_WORK_PIECE 1
+#define GANTRY_MODE_RINGNET_DRIVER 10
+#define STANDARD_HOME_ERROR_NO_MOTOR_STOP_CHECK -2
+#define POS_COMPARE_RESULT_FIFO_MODE_STATIC 0
+#define POS_COMPARE_RESULT_FIFO_MODE_LOOP 1
+#define LIST_STATUS_RESERVE2_REVERSE_LAST_USER_TAG 4
+#define COMMAND_LIST_MODE_STATIC 0
+#define COMMAND_LIST_MODE_DYNAMIC 1
+#define COMMAND_LIST_MPG_MODE_BIDIRECTION 0
+#define COMMAND_LIST_MPG_MODE_POS 1
+#define COMMAND_LIST_MPG_MODE_NEG -1
+#define COMMAND_LIST_MPG_MODE_WINDOW 2
+#define COMMAND_LIST_MPG_MODE_SIM 100
+#define COMMAND_LIST_MPG_FIXED_VEL_COUNT_MAX 8
+#define AXIS_MOTION_CONSTRAINT_RESERVE1_DV_MAX_LIMIT 0
+#define WATCH_CONDITION_NONE 0
+#define WATCH_VAR_NONE 0
+#define WATCH_VAR_UUID 1000
+#define WATCH_VAR_POWER_ON_COUNT 1060
+#define WATCH_VAR_DSP_PROGRAM_COUNT 1070
+#define WATCH_VAR_DSP_TEMPERATURE 1072
+#define WATCH_VAR_FPGA_PROGRAM_COUNT 1080
+#define WATCH_VAR_LINKPORT_TX_STATUS 1662
+#define WATCH_VAR_LINKPORT_TX_ERROR_COUNT 1663
+#define WATCH_VAR_LINKPORT_TX_SKIP_MAX 1664
+#define WATCH_VAR_SPORT_STATUS 1682
+#define WATCH_VAR_SPORT_ERROR_COUNT 1683
+#define WATCH_VAR_PRF_POS_RAW 6003
+#define WATCH_VAR_PRF_VEL_RAW 6004
+#define WATCH_VAR_PRF_VEL_F32 6011
+#define WATCH_VAR_PRF_ACC_F32 6012
+#define WATCH_VAR_PRF_JERK_F32 6013
+#define WATCH_VAR_PRF_VEL_64 6021
+#define WATCH_VAR_LIMIT_POSITIVE_STATUS 6201
+#define WATCH_VAR_LIMIT_NEGATIVE_STATUS 6202
+#define WATCH_VAR_PT_SPACE 6660
+#define WATCH_VAR_PT_RECEIVE 6662
+#define WATCH_VAR_PT_EXECUTE 6663
+#define WATCH_VAR_TRAP_TOTAL_TIME 6670
+#define WATCH_VAR_TRAP_REMAIN_TIME 6671
+#define WATCH_VAR_MOVE_ABSOLUTE_DONE 7008
+#define WATCH_VAR_MOVE_VELOCITY_IN_VELOCITY 7058
+#define WATCH_VAR_CRD_PRF_VEL_RAW 8003
+#define WATCH_VAR_CRD_PRF_TEMP_DATA 8010
+#define WATCH_VAR_CONTOUR_PEDAL_POS 8800
+#define WATCH_VAR_CONTOUR_PRF_POS 8801
+#define WATCH_VAR_CONTOUR_PRF_POS_SHAPING 8802
+#define WATCH_VAR_CONTOUR_ENC_POS 8803
+#define WATCH_VAR_CONTOUR_DAC 8804
+#define WATCH_VAR_CONTOUR_FIFO_POINT_COUNT 8808
+#define WATCH_VAR_CONTOUR_FIFO_POINT_MAX 8809
+#define WATCH_VAR_LIST_EXECUTE 9240
+#define WATCH_VAR_LIST_SEG_NUM 9250
+#define WATCH_VAR_CATCH_UP_STATE 12000
+#define WATCH_VAR_CATCH_UP_COMMAND 12001
+#define WATCH_VAR_CATCH_UP_MASTER_POS 12002
+#define WATCH_VAR_CATCH_UP_MASTER_VEL 12003
+#define WATCH_VAR_CATCH_UP_SLAVE_POS 12004
+#define WATCH_VAR_CATCH_UP_SLAVE_VEL 12005
+#define WATCH_VAR_CATCH_UP_PIECE_POS 12006
+#define WATCH_VAR_CATCH_UP_PIECE_ID 12007
+#define WATCH_VAR_CATCH_UP_PIECE_COUNT 12008
+#define WATCH_VAR_CATCH_UP_PIECE_FIFO_COMMAND_RECEIVE 12009
+#define WATCH_VAR_CATCH_UP_PIECE_FIFO_COMMAND_SEND 12010
+#define WATCH_VAR_CATCH_UP_SYNCH_DISTANCE 12011
+#define WATCH_VAR_CATCH_UP_SYNCN_TIME 12012
+#define WATCH_VAR_CATCH_UP_PIECE_START_POS 12013
+#define WATCH_VAR_CATCH_UP_PIECE_SYNCH_POS 12014
+#define WATCH_VAR_CATCH_UP_SLAVE_START_POS 12015
+#define WATCH_VAR_CATCH_UP_SLAVE_SYNCH_POS 12016
+#define WATCH_VAR_POS_COMPARE_PULSE_COUNT 17426
+#define WATCH_VAR_POS_COMPARE_PSO_ON_OFF 17427
+#define WATCH_VAR_POS_COMPARE_PSO_REG 17430
+#define WATCH_VAR_POS_COMPARE_PSO_REG_EXT 17431
+#define WATCH_VAR_POS_COMPARE_ENC_PSO_ON_OFF 17432
+#define WATCH_VAR_SCAN_PRF_POS_Z 18030
+#define WATCH_VAR_LASER_WORK_RATIO 18602
+#define WATCH_VAR_AXIS_PRF_POS_FILTER 20010
+#define WATCH_VAR_AXIS_TEMP_PRF_POS_FILTER 20012
+#define WATCH_VAR_AXIS_PRF_POS_FILTER_BEFORE_COMP 20013
+#define WATCH_VAR_AXIS_PRF_VEL_64 20021
+#define WATCH_VAR_AXIS_RUN 20200
+#define WATCH_VAR_AXIS_ENC_POS_FILTER 20310
+#define WATCH_VAR_AXIS_ENC_VEL_FILTER 20311
+#define WATCH_VAR_AXIS_ENC_VEL_64_FILTER 20321
+#define WATCH_VAR_AXIS_PREDICTION_POS_IN 20350
+#define WATCH_VAR_AXIS_PREDICTION_POS_IN_2 20351
+#define WATCH_VAR_AXIS_PREDICTION_POS_OUT 20352
+#define WATCH_VAR_AXIS_PREDICTION_VEL_IN 20355
+#define WATCH_VAR_AXIS_PREDICTION_VEL_IN_2 20356
+#define WATCH_VAR_AXIS_PREDICTION_VEL_OUT 20357
+#define WATCH_VAR_AXIS_PREDICTION_OUT 20360
+#define WATCH_VAR_AXIS_PREDICTION_FILTER_POS 20361
+#define WATCH_VAR_AXIS_PREDICTION_FILTER_VEL 20362
+#define WATCH_VAR_POSCOMPARE_PREDICTION_ENABLE 20370
+#define WATCH_VAR_POSCOMPARE_PREDICTION_WORK 20371
+#define WATCH_VAR_POSCOMPARE_PREDICTION_OUTPUT_COUNT_TOTAL 20372
+#define WATCH_VAR_DRIVER_ACT_VEL 20400
+#define WATCH_VAR_STIMULATE_DATA 20401
+#define WATCH_VAR_DRIVER_CURRENT_KVFF 20402
+#define WATCH_VAR_CONTROL_ERROR 20500
+#define WATCH_VAR_BACKLASH_VALUE 21000
+#define WATCH_VAR_LEADSCREW_VALUE 21001
+#define WATCH_VAR_FRICTION_VALUE 21003
+#define WATCH_VAR_PULSE_POS 30010
+#define WATCH_VAR_ENC_VEL_64 30021
+#define WATCH_VAR_AU_ENC_VEL_64 30022
+#define WATCH_VAR_ENC_VEL_64_1MS 30023
+#define WATCH_VAR_AU_ENC_VEL_64_1MS 30024
+#define WATCH_VAR_MPG_INFO 30200
+#define WATCH_VAR_AU_ENCODER_EX_POS 30201
+#define WATCH_VAR_AU_ENCODER_EX_VEL 30202
+#define WATCH_VAR_MPG_ENCODER_POS 30203
+#define WATCH_VAR_MPG_ENCODER_VEL 30204
+#define WATCH_VAR_ARRIVE_DI 31055
+#define WATCH_VAR_SERVO_READY_DI 31056
+#define WATCH_VAR_SERVO_READY_TO_SWITCH_ON_DI 31057
+#define WATCH_VAR_BANK_GPI 31060
+#define WATCH_VAR_AU_AI 33100
+#define WATCH_VAR_POS_LOOP_REF_POS 40001
+#define WATCH_VAR_POS_LOOP_FILTER_VALUE 40002
+#define WATCH_VAR_FIR_POS_IN 48000
+#define WATCH_VAR_FIR_POS_OUT 48001
+#define WATCH_VAR_WATCH_ENABLE 52000
+#define WATCH_VAR_WATCH_EVENT_VALUE_WORK 52002
+#define WATCH_VAR_EVENT_HIT 60000
+#define WATCH_VAR_TASK_START 61000
+#define WATCH_VAR_TASK_WORK 61001
+#define WATCH_VAR_ATL_TORQUE 61201
+#define WATCH_VAR_CONSTANT 61405
+#define VAR_FORMAT_INT 1
+#define VAR_FORMAT_FLOAT 2
+#define VAR_FORMAT_DOUBLE 3
+#define VAR_CALCULATE_MAX 32
+#define MAX_CRDMPG_FIXEDMPGVEL 8
+#define TRIGGER_PROFILE_STATUS_NONE 0
+#define TRIGGER_PROFILE_STATUS_ERROR_END_POS 1
+#define TRIGGER_PROFILE_STATUS_VEL 2
+#define COMMANDINFO_DATA_MAX 225
+#define SCAN_LASER_MODE_NONE 10
+#define SCAN_MOTION_CIRCLE_DIR_CW 0
+#define SCAN_MOTION_CIRCLE_DIR_CCW 1
+#define SCAN_MARK_DELAY_MODE_CONST 0
+#define SCAN_MARK_DELAY_MODE_CHANGE 1
+#define LASER_ENABLE_DO 76
+#define LASER_RED_LED_DO 77
+#define LASER_POWER_LATCH_DO 78
+#define SERBVO_POS_LOOP 0
+#define SERBVO_SPD_LOOP 1
+#define PORT_A_GENERAL_GLINK_II 1
+#define PORT_B_GENERAL_GLINK_II 2
+#define PORT_C_HIGH_SPEED_GLINK_II 3
+#define PORT_D_ETHER_CAT 4
+#define SLAVE_MIDDLE_POS_DIMENSION_MAX 3
+#define PREDICTION_MODE_AXIS_VELOCITY_TO_FOLLOWERROR 0
+#define PREDICTION_MODE_AXIS_VELOCITY_TO_VELOCITY 1
+#define PREDICTION_MODE_AXIS_POSITION_TO_POSITION 2
+#define START_TIMER_MAX 32
+#define BATCH_COMMAND_END_MODE_DEFAULT 0
+#define BATCH_COMMAND_END_MODE_GET_MC_VAR_EX 1
+#define MC_HEIGHT_FREQUENCY 450
+#define HEIGHT_DIR_CROSS_POSITIVE 1
+#define HEIGHT_DIR_CROSS_NEGATIVE 2
+#define HEIGHT_DIR_CROSS_EQUAL 3
+#define HEIGHT_FOLLOW_ENABLE_MODE_MANUAL 0
+#define HEIGHT_FOLLOW_ENABLE_MODE_AUTO 1
+#define HEIGHT_FILTER_TYPE_FREQUENCY 1
+#define HEIGHT_FILTER_TYPE_CMP_VALUE 2
+#define CALIBRATION_MODE_DIFFERENT_STEP 1
+#define DIFFERENT_STEP_CALIBRATION_STAGE_NONE -1
+#define DIFFERENT_STEP_CALIBRATION_STAGE_HOME_SEARCH 1
+#define DIFFERENT_STEP_CALIBRATION_STAGE_GO_OFFSET 2
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_INIT 3
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION 4
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_DONE 5
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_STOP 6
+#define DIFFERENT_STEP_CALIBRATION_STAGE_HOME_START_ERROR 100
+#define DIFFERENT_STEP_CALIBRATION_STAGE_HOME_SEARCH_ERROR 101
+#define DIFFERENT_STEP_CALIBRATION_STAGE_GO_OFFSET_ERROR 102
+#define DIFFERENT_STEP_CALIBRATION_STAGE_CALIBRATION_ERROR 103
+#define DIFFERENT_STEP_CALIBRATION_STAGE_NOT_AXIS_ON 104
+#define DIFFERENT_STEP_CALIBRATION_STAGE_SET_TABLE_ERROR 105
+#define DIFFERENT_STEP_CALIBRATION_STEP_MAX 4000
+#define CALIBRATION_STEP_MAX 50
+#define HEIGHT_FINDEDGE_LATCH_MAX 4
+#define MAX_SEGMENT_NUM 100
+#define ERROR_CODE_NO_SLAVE -10
+#define ERROR_CODE_NO_ENI -9
+#define ERROR_CODE_CONFIG_FAIL -8
+#define ERROR_CODE_ENI_ERROR -1
+#define RING_NET_PDU_FAST_LINK_TYPE_NONE 0
+#define RING_NET_PDU_FAST_LINK_TYPE_REMOTE_AU_ENCODER 1
+#define RING_NET_PDU_FAST_LINK_TYPE_POS_COMPARE_LINEAR 2
+#define LASER_ON_MODE_DEFAULT 0
+#define LASER_OFF_MODE_POWER_OFF 0
+#define LASER_OFF_MODE_POWER_HOLD 1
+#define LASER_FOLLOW_MODE_NONE 0
+#define LASER_FOLLOW_MODE_RATIO 1
+#define LASER_FOLLOW_MODE_TABLE 2
+#define LASER_FOLLOW_MODE_DUO_TABLE 3
+#define LASER_FOLLOW_POWER_TYPE_DUTY 0
+#define LASER_FOLLOW_POWER_TYPE_FREQUENCY 1
+#define LASER_FOLLOW_POWER_TYPE_PULSE_WIDTH 2
+#define LASER_FOLLOW_POWER_TYPE_VOLTAGE 3
+#define LASER_FOLLOW_POWER_TYPE_PARALLEL 4
+#define LASER_FOLLOW_SYNCH_VEL_SOURCE_PROFILE 0
+#define LASER_FOLLOW_SYNCH_VEL_SOURCE_ENCODER 1
+#define SCAN_START_IN_LIST_MODE_INDIVIDUAL 0
+#define SCAN_START_IN_LIST_MODE_CHECK 1
+#define AXISSIMULATION_RESERVE1_SUBMODE 0
+#define DI_STOP_VALUE_LOW_LEVEL 0
+#define DI_STOP_VALUE_HIG_LEVEL 1
+#define DI_STOP_VALUE_FALLING_EDGE 2
+#define DI_STOP_VALUE_RISING_EDGE 3
+#define DI_STOP_AXSI_STOP_TYPE_NONE -1
+#define DI_STOP_AXIS_STOP_TYPE_ABRUPT 0
+#define DI_STOP_AXIS_STOP_TYPE_SMOOTH 1
+#define DI_STOP_AXIS_STOP_TYPE_ABRUPT_THEN_AXIS_OFF 10
+#define DI_STOP_AXIS_STOP_TYPE_SMOOTH_THEN_AXIS_OFF 11
+#define MP_POINT_MAX 16
+#define MP_ERROR_NONE 0
+#define MP_ERROR_VEL 700
+#define MP_ERROR_ACC 701
+#define MP_ERROR_DEC 702
+#define MP_ERROR_POS_END 703
+#define MP_ERROR_POS_OUT_OF_RANGE 704
+#define MP_ERROR_PERCENT 705
+#define MP_ERROR_ROOT 706
+#define MP_ERROR_SQRT 707
+#define MP_ERROR_SEGMENT_TYPE 708
+#define MP_ERROR_TIME_NOT_FIND 709
+#define MP_SEGMENT_ASCEND_1 1
+#define MP_SEGMENT_ASCEND_TRAP 2
+#define MP_SEGMENT_ASCEND_3 3
+#define MP_SEGMENT_EVEN 4
+#define MP_SEGMENT_DESCEND_5 5
+#define MP_SEGMENT_DESCEND_TRAP 6
+#define MP_SEGMENT_DESCEND_7 7
+#define MP_SEGMENT_END 8
+#define FILTER_LOCATION_FEEDBACK_POS 0
+#define FILTER_LOCATION_VEL_LOOP_ERROR 1
+#define FILTER_LOCATION_VEL_LOOP_OUTPUT 2
+#define FILTER_LOCATION_FEEDBACK_VEL 3
+#define FILTER_LOCATION_FORCE_CONTROL_OUTPUT 4
+#define WAVEFORM_WORK_MODE_DEFAULT 0
+#define WAVEFORM_WORK_MODE_LINK_POS_COMPARE 1
+#define RECTANGLE_WAVE_START_MODE_LOW_LEVEL 0
+#define RECTANGLE_WAVE_START_MODE_HIGH_LEVEL 1
+#define USER_MAX_STATION_NUM_V1 256
+#define RN_LWR 0
+#define RN_AWR 1
+#define RN_LMWR 2
+#define RN_TCWR 3
+#define RN_LRD 4
+#define RN_ARD 5
+#define RN_LMRD 6
+#define RN_TCRD 7
+#define MOTION_PROGRAM_CLEAR_ALL_TASK 1
+#define MOTION_PROGRAM_CLEAR_TASK 2
+#define MOTION_PROGRAM_CLEAR_FILE 3
+#define MOTION_PROGRAM_MODE_DEBUG 0
+#define MOTION_PROGRAM_MODE_RELEASE 1
 """
