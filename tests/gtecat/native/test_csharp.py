@@ -36,9 +36,18 @@ CS_DIR = Path(__file__).resolve().parent / "cs"
 EXAMPLES = ROOT / "examples"
 MACHINE = EXAMPLES / "smart_home_machine.toml"
 
+#: the assemblies the vendor's own C# wrappers name in their `using` lines (System.Data,
+#: System.Drawing, System.Windows.Forms), which CardStation's copy keeps as they ship
+WRAPPER_ASSEMBLIES = ("System.Data", "System.Drawing", "System.Windows.Forms")
+MONO_DEBS = (
+    "mono-mcs mono-runtime libmono-system-data4.0-cil libmono-system-drawing4.0-cil "
+    "libmono-system-windows-forms4.0-cil"
+)
 needs_mono = pytest.mark.skipif(
-    shutil.which("mcs") is None or shutil.which("mono") is None,
-    reason="needs Mono: apt-get install mono-mcs mono-runtime",
+    shutil.which("mcs") is None
+    or shutil.which("mono") is None
+    or not all(Path(f"/usr/lib/mono/4.5/{a}.dll").is_file() for a in WRAPPER_ASSEMBLIES),
+    reason=f"needs Mono and the assemblies vendor wrappers name: apt-get install {MONO_DEBS}",
 )
 pytestmark = [needs_mono, pytest.mark.xdist_group("csharp")]
 
@@ -66,7 +75,7 @@ def programs(tmp_path_factory) -> Path:
     for name in ("CardStation", "EcatStation"):
         shutil.copy(CS_DIR / f"{name}.cs", d)
     for cmd in (
-        ["mcs", "-nologo", "CardStation.cs"],
+        ["mcs", "-nologo", *(f"-r:{a}" for a in WRAPPER_ASSEMBLIES), "CardStation.cs"],
         ["mcs", "-nologo", "EcatStation.cs", "gts.cs"],
     ):
         r = subprocess.run(cmd, cwd=d, capture_output=True, text=True)

@@ -5,12 +5,16 @@
 // on the machine's PC, jogs, homes straight after the jog (as the vendor's smart-home demo),
 // moves point to point and reads IO.  It prints `key value` lines a test reads.
 //
-//     mcs CardStation.cs && gtecat lib --mono-config -o CardStation.exe.config
+//     mcs -r:System.Data -r:System.Drawing -r:System.Windows.Forms CardStation.cs
+//     gtecat lib --mono-config -o CardStation.exe.config
 //     GTECAT_CARD=gts:4 GTECAT_MACHINE=machine.toml mono CardStation.exe
 using System;
+using System.Data;             // as the vendor's wrappers ship (nothing here uses them)
+using System.Drawing;
 using System.Runtime.InteropServices;
 using System.Text;
 using System.Threading;
+using System.Windows.Forms;
 
 namespace gts
 {
