@@ -76,7 +76,8 @@ class Card:
         """The reason a refused function returns 1."""
         return (
             f"{name} needs an EtherCAT bus; this controller is a {self.description} "
-            "(GTECAT_CARD): its axes work without GT_InitEcatComm, use the card's own "
+            "(chosen by GTECAT_CARD, the machine file or GT_Open(card=...); a GTN core 2 is one by "
+            "default): its axes work without GT_InitEcatComm, use the card's own "
             "functions (GT_GetDi, GT_GetEncPos, GT_GoHome, ...)"
         )
 

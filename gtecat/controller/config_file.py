@@ -700,6 +700,14 @@ def find_config(name: str, log: Callable[[str], None] | None = None) -> Path:
     application runs: a private controller started by libgts inherits the program's
     folder), first as written, then ignoring case as Windows does; what was used goes to
     the master log.  ConfigFileError (7) names both places when neither has it."""
+    if not name.isprintable() or "\ufffd" in name:
+        # not a file name: bytes of memory (a C# wrapper declaring `ref string pFile`
+        # passes a char ** where the function reads a char *)
+        raise ConfigFileError(
+            f"the configuration file name is not text ({name[:16]!r}...): the program passed "
+            "something other than a C string (char *); a C# wrapper must declare the name "
+            "`string pFile`, not `ref string pFile`"
+        )
     given = Path(name)
     if given.is_file():
         return given

@@ -60,3 +60,14 @@ def test_compile_refuses_constants_beyond_a_word_with_the_line(tmp_path, constan
     assert gt.GT_Compile(str(src), byref(info)) == 1
     assert info.pLineNo[0] == 4 and words in info.pMessage.decode()
     assert len(gt.GTE_GetLastError()) < 400
+
+
+@pytest.mark.parametrize("name", ["P_\ufffd\ufffd KV", "\x01\x02\x9c"])
+def test_load_config_given_memory_instead_of_a_name_says_so(name):
+    """A C# wrapper that declares ``ref string pFile`` passes a char ** where GT_LoadConfig
+    reads a char *: the bytes it finds are not a file name, and the reason says what to fix
+    instead of quoting them as a missing file."""
+    bring_up(clock="lockstep")
+    assert gt.GT_LoadConfig(name) == 7
+    reason = gt.GTE_GetLastError()
+    assert "not text" in reason and "ref string" in reason
