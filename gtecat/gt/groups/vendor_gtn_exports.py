@@ -9,6 +9,7 @@ TITLE = "exported by the vendor DLL, parameters not public (newer GTN era)"
 DECLARED_ONLY = True
 
 PROTOTYPES = r"""
+short ConvertLogical(...);
 short GTN_BufDoBitReverse(...);
 short GTN_BufDoBitReverseEx(...);
 short GTN_BufLaserOutFrqEx(...);
@@ -220,6 +221,7 @@ short GT_RN_Read300CfgFileStationNumbers(...);
 short GTN_RN_ReadLocalStationInfo(...);
 short GTN_RN_ReadMailMultiReg(...);
 short GTN_RN_ReadServoSafeRunSts(...);
+short GTN_RN_MultiSamplingAddVar(...);
 short GTN_RN_SamplingAddVar(...);
 short GTN_RN_SetExtModuleInfo(...);
 short GTN_RN_SetFollowCtrlSrc(...);
