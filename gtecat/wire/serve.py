@@ -476,7 +476,7 @@ class WireServer:
                         next_cycle += self.cycle_ns
                         if now - next_cycle > 100 * self.cycle_ns:  # fell far behind: resync
                             next_cycle = now + self.cycle_ns
-                if now >= next_poll:
+                if now >= next_poll and self._housekeeping_may_run(pacing, predict, now, next_poll):
                     if self.snapshot_due:
                         self._guarded(self._snapshot)
                     self._guarded(chain.poll, now)
@@ -493,6 +493,21 @@ class WireServer:
             stats.stopped_ns = clock()
             poller.unregister(sock.fileno())
             view.release()
+
+    #: a housekeeping pass (chain poll, inspection requests, a young-generation collection)
+    #: takes up to this long; it does not start this close before the next frame's window
+    HOUSEKEEPING_NS = 300_000
+    #: ... unless it is this late (a master whose frames leave no gap: it runs anyway)
+    HOUSEKEEPING_OVERDUE_NS = 50_000_000
+
+    def _housekeeping_may_run(self, pacing: Pacing, predict: bool, now: int, due: int) -> bool:
+        """Housekeeping runs between frames, not in the spin around the next one: a frame
+        that arrived during a pass waited for the pass (the loaded-host tail of the answer
+        time).  With a learned cycle it waits for the gap after an answer."""
+        if not predict or now - due > self.HOUSEKEEPING_OVERDUE_NS:
+            return True
+        window = pacing.window()
+        return window is None or not (window[0] - self.HOUSEKEEPING_NS <= now < window[1])
 
     # --- receive, with the kernel's timestamp when there is one ------------------------
     _realtime_offset = 0

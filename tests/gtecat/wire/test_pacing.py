@@ -174,3 +174,30 @@ def test_a_late_frame_and_the_burst_after_it_keep_the_learned_period() -> None:
         p.arrived(t)
         t += 3_000_000
     assert abs(p.period_ns - 3_000_000) < 1_000
+
+
+def test_housekeeping_waits_for_the_gap_after_an_answer() -> None:
+    """The serve loop's housekeeping (chain poll, inspection requests, a collection) does not
+    start in the spin around the next frame's window, only in the gap after an answer - or
+    when it is long overdue (a master whose frames leave no gap)."""
+    from types import SimpleNamespace
+
+    from gtecat.wire.serve import WireServer
+
+    server = SimpleNamespace(
+        HOUSEKEEPING_NS=WireServer.HOUSEKEEPING_NS,
+        HOUSEKEEPING_OVERDUE_NS=WireServer.HOUSEKEEPING_OVERDUE_NS,
+    )
+    may_run = WireServer._housekeeping_may_run
+    p = Pacing()
+    period = 1_000_000
+    for k in range(20):
+        p.arrived(k * period)
+    last = 19 * period
+    opens, _closes = p.window()
+    assert may_run(server, p, True, last + 100_000, last)  # just after the answer
+    assert not may_run(server, p, True, opens - 100_000, last)  # about to spin
+    assert not may_run(server, p, True, opens + 10_000, last)  # spinning
+    assert may_run(server, p, True, opens + 10_000, opens - 60_000_000)  # long overdue
+    assert may_run(server, p, False, opens + 10_000, last)  # not predicting: as before
+    assert may_run(server, Pacing(), True, 5, 0)  # nothing learned yet
