@@ -11,7 +11,6 @@ import contextlib
 import json
 import math
 import os
-import secrets
 import select
 import shutil
 import signal
@@ -26,7 +25,7 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import needs_fixture
-from tests.gtecat.wire.rawmaster import _wait_carrier
+from tests.gtecat.wire import rawmaster
 
 ROOT = Path(__file__).resolve().parents[3]
 FIG52 = ROOT / "examples" / "manual_fig5_2.eni"
@@ -54,29 +53,17 @@ def _skip_reason() -> str | None:
 
 @contextlib.contextmanager
 def veth_pair() -> Iterator[tuple[str, str]]:
-    """A fresh veth pair (master end, slave end), deleted on the way out."""
+    """A fresh veth pair (master end, slave end), deleted on the way out (the raw master's,
+    skipped with the reason where this machine cannot make one)."""
     reason = _skip_reason()
     if reason:
         pytest.skip(reason)
-    tag = secrets.token_hex(3)
-    master_if, slave_if = f"gtm{tag}", f"gts{tag}"
-    made = subprocess.run(
-        ["ip", "link", "add", master_if, "type", "veth", "peer", "name", slave_if],
-        capture_output=True,
-        text=True,
-        timeout=10,
-    )
-    if made.returncode != 0:
-        pytest.skip(f"cannot create a veth pair: {made.stderr.strip()}")
-    try:
-        for name in (master_if, slave_if):
-            subprocess.run(["ip", "link", "set", name, "up"], check=True, timeout=10)
-            with contextlib.suppress(OSError):
-                Path(f"/proc/sys/net/ipv6/conf/{name}/disable_ipv6").write_text("1")
-        _wait_carrier(master_if, slave_if)
-        yield master_if, slave_if
-    finally:
-        subprocess.run(["ip", "link", "del", master_if], capture_output=True, timeout=10)
+    with contextlib.ExitStack() as stack:
+        try:
+            pair = stack.enter_context(rawmaster.veth_pair("gt"))
+        except OSError as e:
+            pytest.skip(str(e))
+        yield pair
 
 
 @pytest.fixture(scope="module")
