@@ -24,20 +24,14 @@ from pathlib import Path
 from types import CodeType
 from typing import Any
 
+from ._cache import cache_root
+
 _DIR: list[Path] = []
 
 
 def _cache_dir(version: str) -> Path:
-    """The folder :func:`gtecat.cbuild.cache_root` names (kept here: that module's imports
-    would cost the time this one saves)."""
-    env = os.environ.get("GTECAT_CACHE_DIR")
-    if env:
-        root = Path(env)
-    else:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        root = (Path(xdg) if xdg else Path.home() / ".cache") / "gtecat"
     tag = sys.implementation.cache_tag or "python"
-    return root / version / "pyc" / tag
+    return cache_root() / version / "pyc" / tag
 
 
 class _Loader(importlib.machinery.SourceFileLoader):

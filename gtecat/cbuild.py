@@ -19,6 +19,7 @@ import tempfile
 from pathlib import Path
 
 from . import __version__
+from ._cache import cache_root
 from .errors import GtecatError
 
 try:
@@ -29,15 +30,6 @@ except ImportError:  # Windows: a controller runs there without these builds' lo
 
 class NativeBuildError(GtecatError):
     """A C part could not be built (no compiler, a compile error); the Python API is unaffected."""
-
-
-def cache_root() -> Path:
-    env = os.environ.get("GTECAT_CACHE_DIR")
-    if env:
-        return Path(env)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    base = Path(xdg) if xdg else Path.home() / ".cache"
-    return base / "gtecat"
 
 
 def compiler() -> list[str]:
