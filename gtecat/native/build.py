@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import functools
 import hashlib
 import os
 import shlex
@@ -158,11 +159,20 @@ def _inputs(python: str, abi: str, cc: list[str]) -> str:
     the sources again, which needs the whole GT layer imported (most of a second); a
     changed file of the package (an editable install) gives another name."""
     h = hashlib.sha256(f"{python}\0{abi}\0{' '.join([*cc, *CFLAGS])}".encode())
+    h.update(_package_digest())
+    return h.hexdigest()[:24]
+
+
+@functools.cache
+def _package_digest() -> bytes:
+    """Every file of this gtecat, read once per process (a multi-card or 32-bit build asks
+    for the libgts build below it too)."""
+    h = hashlib.sha256()
     root = Path(__file__).resolve().parent.parent
     for path in sorted(root.rglob("*")):
         if "__pycache__" not in path.parts and path.is_file():
             h.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
-    return h.hexdigest()[:24]
+    return h.digest()
 
 
 def _remember(known: Path, digest: str) -> None:
