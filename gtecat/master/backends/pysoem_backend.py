@@ -772,7 +772,11 @@ class PysoemBackend(Backend):
             except soem.PacketError as e:
                 if getattr(e, "error_code", None) != 3:  # 3: data container too small
                     raise
-                return bytes(s.sdo_read(index, subindex, _SDO_BIG, ca=complete_access))
+                return bytes(
+                    self._past_emergencies(
+                        position, s.sdo_read, index, subindex, _SDO_BIG, ca=complete_access
+                    )
+                )
         except errors as e:
             raise self._sdo_error(e, position, "upload", index, subindex) from None
 
