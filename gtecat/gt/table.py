@@ -219,6 +219,18 @@ def _param(text: str, where: str) -> Param:
     return Param(m["name"], ctype, pointer, **kw)
 
 
+#: each parameter text read once (a table of 3,000 prototypes writes ``short axis`` and its
+#: like over and over: 11,000 parameters, 2,000 texts); Param is frozen, so they share it
+_PARAMS: dict[str, Param] = {}
+
+
+def _param_of(text: str, where: str, lineno: int, name: str) -> Param:
+    p = _PARAMS.get(text)
+    if p is None:
+        p = _PARAMS[text] = _param(text, f"{where} {lineno} ({name})")
+    return p
+
+
 def parse(text: str, group: str = "") -> dict[str, Proto]:
     """The prototypes of ``text`` by name (ValueError names the line it cannot read)."""
     out: dict[str, Proto] = {}
@@ -238,7 +250,7 @@ def parse(text: str, group: str = "") -> dict[str, Proto]:
                 raise ValueError(f"{where} {lineno}: {name} declared twice")
             out[name] = Proto(name, (), entry=comment, group=group, twin=False, unknown=True)
             continue
-        params = tuple(_param(a, f"{where} {lineno} ({name})") for a in _split(args) if a.strip())
+        params = tuple(_param_of(a, where, lineno, name) for a in _split(args) if a.strip())
         names = {p.name for p in params}
         for p in params:
             if isinstance(p.count, str) and p.count not in names:
