@@ -107,10 +107,16 @@ def strip_comments(text: str) -> str:
     return _COMMENT.sub(" ", text)
 
 
+#: a plain decimal (no leading zero: C reads 010 as octal) or hexadecimal integer
+_PLAIN = re.compile(r"-?(?:0[xX][0-9a-fA-F]+|[1-9][0-9]*|0)")
+
+
 def number(text: str, known: dict[str, int] | None = None) -> int | float | None:
     """A C constant expression of the simple kinds headers use (``(-6)``, ``0x100``,
     ``1<<3``, ``(MC_AXIS+1)``, ``1.5``), None when it is something else."""
     t = text.strip()
+    if _PLAIN.fullmatch(t):  # most are: enum values, array sizes
+        return int(t, 0)
     t = re.sub(r"(?<=[0-9a-fA-FxX])[uUlL]+\b", "", t)
     if not t or not re.fullmatch(r"[\w\s()+\-*/<>|&~.^]+", t):
         return None
@@ -143,6 +149,19 @@ def parse_constants(text: str, known: dict[str, int] | None = None) -> dict[str,
 def parse(text: str, group: str = "", known: dict[str, Any] | None = None) -> list[Typedef]:
     """The typedefs of ``text`` in order (TypedefError names what it cannot read);
     ``known``: constants an array size may name."""
+    if known is None:  # the table's enum names and gtecat.gt's structures read the same text
+        hit = _PARSED.get((text, group))
+        if hit is None:
+            hit = _PARSED[text, group] = tuple(_parse(text, group, None))
+        return list(hit)
+    return _parse(text, group, known)
+
+
+#: (text, group) -> its typedefs (frozen), for the texts read without ``known``
+_PARSED: dict[tuple[str, str], tuple[Typedef, ...]] = {}
+
+
+def _parse(text: str, group: str, known: dict[str, Any] | None) -> list[Typedef]:
     out: list[Typedef] = []
     for m in _TYPEDEF.finditer(strip_comments(text)):
         kind, body = m[1], m["body"]
