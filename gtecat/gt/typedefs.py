@@ -146,19 +146,19 @@ def parse_constants(text: str, known: dict[str, int] | None = None) -> dict[str,
     return out
 
 
+#: (text, group) -> its typedefs, read without ``known``: the table reads every group's
+#: STRUCTS for its enum names and ``gtecat.gt`` again for its classes, once per process
+_PARSED: dict[tuple[str, str], tuple[Typedef, ...]] = {}
+
+
 def parse(text: str, group: str = "", known: dict[str, Any] | None = None) -> list[Typedef]:
     """The typedefs of ``text`` in order (TypedefError names what it cannot read);
     ``known``: constants an array size may name."""
-    if known is None:  # the table's enum names and gtecat.gt's structures read the same text
-        hit = _PARSED.get((text, group))
-        if hit is None:
-            hit = _PARSED[text, group] = tuple(_parse(text, group, None))
-        return list(hit)
+    if known is None:
+        if (text, group) not in _PARSED:
+            _PARSED[text, group] = tuple(_parse(text, group, None))
+        return list(_PARSED[text, group])
     return _parse(text, group, known)
-
-
-#: (text, group) -> its typedefs (frozen), for the texts read without ``known``
-_PARSED: dict[tuple[str, str], tuple[Typedef, ...]] = {}
 
 
 def _parse(text: str, group: str, known: dict[str, Any] | None) -> list[Typedef]:
