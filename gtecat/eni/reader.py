@@ -202,5 +202,16 @@ def _store(file: Path, config: EniConfig) -> None:
         with tmp.open("wb") as f:
             pickle.dump(config, f, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(tmp, file)
+        _prune(file.parent)
     except (OSError, pickle.PicklingError, RecursionError):
         pass
+
+
+#: models kept per reader version: the least recently stored go first
+_CACHE_FILES = 32
+
+
+def _prune(folder: Path) -> None:
+    files = sorted(folder.glob("*.pickle"), key=lambda f: f.stat().st_mtime)
+    for f in files[:-_CACHE_FILES]:
+        f.unlink(missing_ok=True)

@@ -64,3 +64,15 @@ def test_a_damaged_cache_file_is_parsed_again(tmp_path) -> None:
     stored.write_bytes(b"\x80\x05not a pickle")
     reader._PARSED.clear()
     assert read_eni(a, cache) == first
+
+
+def test_the_cache_folder_keeps_the_latest_models_only(tmp_path, monkeypatch) -> None:
+    from gtecat.eni import reader
+
+    monkeypatch.setattr(reader, "_CACHE_FILES", 2)
+    cache, text = tmp_path / "cache", FIG52.read_bytes()
+    for k in range(3):  # three contents (the same bus, blank lines added)
+        f = tmp_path / f"bus{k}.eni"
+        f.write_bytes(text + b"\n" * (k + 1))
+        read_eni(f, cache)
+    assert len(list(cache.rglob("*.pickle"))) == 2
