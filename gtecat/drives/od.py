@@ -238,10 +238,17 @@ class Variable:
         return default if x is None else x.get(key, default)
 
     def _set_x(self, key: str, value: Any) -> None:
-        x = self._x
-        if x is None:
-            x = self._x = {}
+        # a new dict each time, never changed after: entries with the same extras (the
+        # same object of drive after drive) share one
+        x = dict(self._x) if self._x else {}
         x[key] = value
+        try:
+            shared = tuple(sorted((k, type(v).__name__, v) for k, v in x.items()))
+            if len(_XS) >= 4096:
+                _XS.clear()
+            self._x = _XS.setdefault(shared, x)
+        except TypeError:  # an unhashable value: its own dict
+            self._x = x
 
     low = property(lambda self: self._get_x("low"), lambda self, v: self._set_x("low", v))
     high = property(lambda self: self._get_x("high"), lambda self, v: self._set_x("high", v))
@@ -388,6 +395,8 @@ def _shared(values: frozenset[int]) -> frozenset[int]:
 
 
 _SHARED: dict[frozenset[int], frozenset[int]] = {}
+#: the rare attributes of entries (range, allowed values, sizes), one dict per content
+_XS: dict[tuple[tuple[str, str, Any], ...], dict[str, Any]] = {}
 
 
 def _only_none(self: Variable, value: object) -> None:
