@@ -204,6 +204,9 @@ class CoordSystem:
     def __init__(self, number: int, cycle_ms: Callable[[], float]) -> None:
         self.number = number
         self._cycle_ms = cycle_ms
+        #: the axis bank (gtecat.controller.bank) steps this system ahead with its axes'
+        #: samples while it runs them: the controller's hook then leaves it alone
+        self.banked = False
         self.reset()
 
     def reset(self) -> None:
@@ -597,7 +600,7 @@ class CrdBank:
 
     def _pre(self, t_ns: int, dt_ns: int) -> None:
         for c in self.systems.values():
-            if c.running:
+            if c.running and not c.banked:
                 c.step()
 
     _pre.bank_safe = True  # type: ignore[attr-defined]  # touches interpolating axes only

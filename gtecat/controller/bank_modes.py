@@ -1,0 +1,320 @@
+"""The axis bank's other motion modes: PT, Gear, Follow and coordinated motion (crd).
+
+A Trap move's samples have a closed form, so the bank computes them in tables
+(:func:`~gtecat.controller.motion.trap_table.trap_table`, or the compiled kernel).  The
+planners of the other modes are stepped cycle by cycle, and some read other axes: a Gear or
+Follow slave reads its master's planned position every cycle, a coordinate system moves
+its axes together.  The bank runs them so:
+
+* **Clusters.**  The axes whose planners depend on each other form one cluster: a moving
+  Gear/Follow slave with its master (reading the master's *profile*, ``GT_Set*Master`` type 2),
+  the axes of one running coordinate system, chains of those; a PT axis is a cluster of its
+  own.  A cluster is claimed whole or not at all, and given back whole.  A slave that reads
+  its master some other way (the encoder, the axis's planned position), or a master or a
+  system the bank cannot run, keeps the whole cluster on the scalar path, and nothing else.
+* **Tables stepped ahead.**  When a cluster's tables run out, its real planner objects are
+  stepped :data:`SAMPLED_TABLE` cycles ahead, all in the controller's order (coordinate
+  systems first, as their ``pre_cycle`` hook runs before the axes; then the axes in number
+  order, so a slave reads the sample its master has in that cycle, exactly as in the scalar
+  cycle), and the samples go into the rows' tables; the compiled kernel takes them one a
+  cycle as it takes a Trap table's.
+* **Given back exactly.**  Before the steps, the state of every planner (and coordinate
+  system) of the cluster is kept.  A release puts it back and steps the planners again as
+  many cycles as the bank ran since (never more than one table), so they stand where the
+  scalar path would have them.  That needs the steps to be repeatable and to touch nothing
+  outside the planner: a static PT FIFO (a dynamic one empties its FIFOs), a Follow without
+  a pending FIFO switch, a coordinate system whose FIFO holds only lines, arcs and delays
+  (no GT_BufIO, GT_BufMove, GT_BufGear, no segment with its own speed plan); anything else
+  stays scalar.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import TYPE_CHECKING, Any
+
+from .crd.system import AxisSlot, CoordSystem, Delay, Motion
+from .motion.follow import FollowPlanner
+from .motion.gear import GearPlanner
+from .motion.master import SlavePlanner
+from .motion.pt import PtMode, PtPlanner
+from .motion.stop import StopKind
+from .motion.trap import _IDLE as _TRAP_IDLE
+from .motion.trap import _MOVE as _TRAP_MOVE
+from .motion.trap import TrapPlanner
+
+if TYPE_CHECKING:
+    from .bank import AxisBank
+
+#: samples a cluster's planners are stepped ahead at once (the rewind at a release is at
+#: most this many steps)
+SAMPLED_TABLE = 32
+#: master type of GT_SetGearMaster / GT_SetFollowMaster the bank follows: the profile
+_MASTER_PROFILE = 2
+
+_get = object.__getattribute__
+_set = object.__setattr__
+
+
+# --- which planners a cluster may hold -----------------------------------------------------
+def sampled_kind(pl: Any) -> bool:
+    """``pl`` is a planner of a mode the bank steps ahead (PT, Gear, Follow, crd), in a state
+    it can step ahead and rewind (module docstring); False for Trap and Jog (their own paths)
+    and anything else."""
+    if pl.stopping != StopKind.NONE:
+        return False
+    t = type(pl).__mro__
+    if PtPlanner in t:
+        return _get(pl, "_state") == 0 or _get(pl, "_mode") == PtMode.STATIC
+    if GearPlanner in t:
+        return True
+    if FollowPlanner in t:
+        return not _get(pl, "_switch")
+    if AxisSlot in t:
+        return not _get(pl, "_fresh") and (not pl.crd.running or system_plain(pl.crd))
+    return False
+
+
+def trap_steppable(pl: Any) -> bool:
+    """A Trap planner a cluster may step (a master of a Gear/Follow slave): at rest or moving."""
+    return TrapPlanner in type(pl).__mro__ and _get(pl, "_mode") in (_TRAP_IDLE, _TRAP_MOVE)
+
+
+def system_plain(c: CoordSystem) -> bool:
+    """A running coordinate system whose steps are repeatable and touch nothing else."""
+    if c.stopping != StopKind.NONE or c.waiting is not None or c.gears or c.gears_next:
+        return False
+    e = c.entry
+    if e is not None and not (type(e) is Delay or (type(e) is Motion and e.speed_plan is None)):
+        return False
+    for e in c.fifos[c.fifo]:
+        t = type(e)
+        if t is Delay:
+            continue
+        if t is not Motion or e.speed_plan is not None:
+            return False
+    return True
+
+
+def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
+    """(pairs of rows that must stay together, rows stepped ahead in the bank, rows that must
+    stay scalar because of a dependency the bank cannot follow); read with the guards off."""
+    pairs: list[tuple[int, int]] = []
+    sampled: set[int] = set()
+    bad: set[int] = set()
+    row_of_ax = bank._row_of
+    row_of_pl: dict[int, int] | None = None
+    for r, res in enumerate(bank.res):
+        if res is None:
+            continue
+        pl = res.profile.planner
+        t = type(pl).__mro__
+        if SlavePlanner in t:
+            if _get(pl, "_state") == 0:
+                continue  # a slave at rest reads nobody
+            sampled.add(r)
+            src = _get(pl, "_source")
+            master = getattr(src, "master", None)
+            mr = row_of_ax.get(id(master[0].ax)) if master is not None else None
+            if mr is None:
+                bad.add(r)
+                continue
+            if master[1] != _MASTER_PROFILE:
+                bad.update((r, mr))
+                continue
+            pairs.append((r, mr))
+            sampled.add(mr)
+        elif AxisSlot in t:
+            c = pl.crd
+            if not c.running:
+                continue
+            if row_of_pl is None:
+                row_of_pl = {
+                    id(x.profile.planner): k for k, x in enumerate(bank.res) if x is not None
+                }
+            sampled.add(r)
+            for s in c.slots:
+                k = row_of_pl.get(id(s))
+                if k is None:
+                    bad.add(r)
+                else:
+                    pairs.append((r, k))
+        elif PtPlanner in t and _get(pl, "_state") != 0:
+            sampled.add(r)
+    return pairs, sampled, bad
+
+
+# --- keeping and putting back a planner's state ----------------------------------------------
+_NAMES: dict[type, tuple[tuple[str, ...], bool]] = {}
+_UNSET = object()
+_CONTAINERS = (list, deque, dict)
+
+
+def _names(cls: type) -> tuple[tuple[str, ...], bool]:
+    got = _NAMES.get(cls)
+    if got is None:
+        slots: list[str] = []
+        has_dict = False
+        for k in cls.__mro__:
+            if k is object:
+                continue
+            s = k.__dict__.get("__slots__")
+            if s is None:
+                has_dict = True
+                continue
+            for name in (s,) if isinstance(s, str) else s:
+                if name == "__dict__":
+                    has_dict = True
+                elif name != "__weakref__" and name not in slots:
+                    slots.append(name)
+        got = _NAMES[cls] = (tuple(slots), has_dict)
+    return got
+
+
+def _keep(v: Any) -> Any:
+    t = type(v)
+    if t is list or t is deque:
+        return (v, list(v))
+    if t is dict:
+        return (v, dict(v))
+    if t is tuple and any(type(x) in _CONTAINERS for x in v):
+        return (v, tuple(_keep(x) for x in v))
+    return (v, None)
+
+
+def _put(kept: Any) -> Any:
+    v, c = kept
+    if c is not None:
+        t = type(v)
+        if t is list:
+            v[:] = c
+        elif t is deque:
+            v.clear()
+            v.extend(c)
+        elif t is dict:
+            v.clear()
+            v.update(c)
+        else:  # a tuple of containers
+            for x in c:
+                _put(x)
+    return v
+
+
+def snapshot(obj: Any) -> tuple:
+    """Everything ``obj`` holds (its slots and its ``__dict__``; lists, deques and dicts by
+    content): :func:`restore` puts it back."""
+    slots, has_dict = _names(type(obj))
+    vals = []
+    for name in slots:
+        try:
+            vals.append(_keep(_get(obj, name)))
+        except AttributeError:
+            vals.append((_UNSET, None))
+    d = None
+    if has_dict:
+        d = {k: _keep(v) for k, v in _get(obj, "__dict__").items()}
+    return (vals, d)
+
+
+def restore(obj: Any, snap: tuple) -> None:
+    slots, _ = _names(type(obj))
+    vals, d = snap
+    for name, kept in zip(slots, vals, strict=True):
+        v = _put(kept)
+        if v is not _UNSET:
+            _set(obj, name, v)
+    if d is not None:
+        od = _get(obj, "__dict__")
+        od.clear()
+        for k, kept in d.items():
+            od[k] = _put(kept)
+
+
+class Cluster:
+    """Rows whose planners the bank steps ahead together (module docstring)."""
+
+    __slots__ = ("groups", "planners", "rows", "snaps", "systems")
+
+    def __init__(self, bank: AxisBank, rows: list[int], groups: list[int]) -> None:
+        order = bank.order
+        self.rows = sorted(rows, key=lambda r: order[r])
+        self.groups = groups
+        self.planners = [bank.res[r].profile.planner for r in self.rows]
+        systems: list[CoordSystem] = []
+        for pl in self.planners:
+            if AxisSlot in type(pl).__mro__ and pl.crd.running and pl.crd not in systems:
+                systems.append(pl.crd)
+        self.systems = systems
+        self.snaps: list[tuple[Any, tuple]] | None = None
+
+    def step(self) -> None:
+        """One scalar cycle of the cluster's planners: the systems (the controller's
+        ``pre_cycle``), then each axis that moves (``AxisResources._pre``)."""
+        for c in self.systems:
+            if c.running:
+                c.step()
+        for pl in self.planners:
+            if not pl.done:
+                pl.step()
+
+    def fill(self, bank: AxisBank) -> None:
+        """The next :data:`SAMPLED_TABLE` samples of every moving row, its planners stepped
+        (their state before kept for :meth:`rewind`)."""
+        self.snaps = [(o, snapshot(o)) for o in (*self.planners, *self.systems)]
+        rows = self.rows
+        moving = bank.moving
+        tp, tv, ta = bank.t_p, bank.t_v, bank.t_a
+        for r in rows:
+            bank.fill_taken[r] = bank.taken[r]
+        live = [bool(moving[r]) for r in rows]
+        cols: list[tuple[list[float], list[float], list[float]]] = [([], [], []) for _ in rows]
+        ends = [-1] * len(rows)
+        pls = self.planners
+        systems = self.systems
+        for j in range(SAMPLED_TABLE):
+            for c in systems:
+                if c.running:
+                    c.step()
+            for i, pl in enumerate(pls):
+                if pl.done:
+                    continue
+                p, v, a = pl.step()
+                if live[i]:
+                    col = cols[i]
+                    col[0].append(p)
+                    col[1].append(v)
+                    col[2].append(a)
+                    if pl.done:
+                        live[i] = False
+                        ends[i] = j
+        tl = bank.table
+        for i, r in enumerate(rows):
+            col = cols[i]
+            m = len(col[0])
+            if not m:
+                continue
+            # the last sample taken moves to the row's spare slot first (as for a Trap
+            # table): a release in this cycle reads it there
+            last, spare = int(bank.t_idx[r]), int(bank.base[r]) + tl
+            for t in (tp, tv, ta):
+                t.flat[spare] = t.flat[last]
+            bank.t_idx[r] = spare
+            tp[r, :m], tv[r, :m], ta[r, :m] = col
+            bank.t_len[r] = m
+            bank.t_cur[r] = 0
+            bank.t_end[r] = ends[i]
+
+    def rewind(self, bank: AxisBank) -> None:
+        """Put the planners where the scalar path has them: their state at the last fill,
+        then as many steps as the bank ran since."""
+        if self.snaps is None:
+            return  # never stepped ahead
+        n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
+        for obj, snap in self.snaps:
+            restore(obj, snap)
+        self.snaps = None
+        for _ in range(n):
+            self.step()
+
+
+__all__ = ["SAMPLED_TABLE", "Cluster", "links", "restore", "sampled_kind", "snapshot"]
