@@ -266,6 +266,8 @@ class AxisBank:
         self.homing_rows_run = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
+        #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
+        self.sampled_samples = 0
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -655,7 +657,11 @@ class AxisBank:
             for g in gs:
                 self._claim(g)
             if srows:
-                cl = Cluster(self, srows, [self._gi[id(g)] for g in gs])
+                _Bypass.on = True
+                try:
+                    cl = Cluster(self, srows, [self._gi[id(g)] for g in gs])
+                finally:
+                    _Bypass.on = False
                 for gi in cl.groups:
                     self._cluster_of[gi] = cl
                 for c in cl.systems:

@@ -87,13 +87,27 @@ def system_plain(c: CoordSystem) -> bool:
     e = c.entry
     if e is not None and not (type(e) is Delay or (type(e) is Motion and e.speed_plan is None)):
         return False
-    for e in c.fifos[c.fifo]:
+    q = c.fifos[c.fifo]
+    if not q:
+        return True
+    # a FIFO seen plain stays plain while it only loses entries (the last one and the
+    # length tell a push)
+    key = (c.fifo, id(q[-1]))
+    seen = _PLAIN.get(id(c))
+    if seen is not None and seen[0] == key and len(q) <= seen[1]:
+        return True
+    for e in q:
         t = type(e)
         if t is Delay:
             continue
         if t is not Motion or e.speed_plan is not None:
             return False
+    _PLAIN[id(c)] = (key, len(q))
     return True
+
+
+#: id(system) -> (fifo and id of its last entry, length) of the last FIFO seen plain
+_PLAIN: dict[int, tuple[tuple[int, int], int]] = {}
 
 
 def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
@@ -293,6 +307,7 @@ class Cluster:
             m = len(col[0])
             if not m:
                 continue
+            bank.sampled_samples += m
             # the last sample taken moves to the row's spare slot first (as for a Trap
             # table): a release in this cycle reads it there
             last, spare = int(bank.t_idx[r]), int(bank.base[r]) + tl
