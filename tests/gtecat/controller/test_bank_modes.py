@@ -66,6 +66,28 @@ def _pt_setup() -> object:
     return gt.GT_PtStart(_bit(*range(1, AXES + 1)), 0)
 
 
+def _edge_setup() -> object:
+    """Constant speed from the start (EVEN segments: sample k at 10·k pulses): the first table
+    holds samples 1-32, the refill 33-64.  Soft limits crossed at samples 31-36 on axes 1-4
+    and 6 (each PT axis is a cluster of its own), on a geared pair's slave (7 follows 5 1:1) at
+    sample 33, so one of each is crossed in a refill cycle whatever cycle the claim took."""
+    for a in (1, 2, 3, 4, 5, 6):
+        _ok(gt.GT_PrfPt(a, gt.PT_MODE_STATIC), "PrfPt")
+        gt.GT_PtClear(a, 0)
+        for k in range(1, 9):
+            _ok(gt.GT_PtData(a, 200.0 * k, 20 * k, gt.PT_SEGMENT_EVEN, 0), "PtData")
+    for a, k in ((1, 31), (2, 32), (3, 33), (4, 34), (6, 35)):
+        gt.GT_SetSoftLimit(a, 10 * k - 5, -(1 << 30))
+    _gear(7, 5, gt.GEAR_MASTER_PROFILE, (1, 1, 0))
+    gt.GT_SetSoftLimit(7, 10 * 33 - 5, -(1 << 30))
+    _gear(8, 5, gt.GEAR_MASTER_PROFILE, (1, 1, 0))
+    gt.GT_SetSoftLimit(8, 10 * 34 - 5, -(1 << 30))
+    return (gt.GT_PtStart(_bit(1, 2, 3, 4, 5, 6), 0), gt.GT_GearStart(_bit(7, 8)))
+
+
+EDGE: Script = [(0, _edge_setup), (40, lambda: gt.GT_ClrSts(1, AXES))]
+
+
 def _loops() -> tuple:
     out = []
     for a in range(1, AXES + 1):
@@ -230,8 +252,18 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
     return _machine_file(Path(tmp_path_factory.mktemp("modes")))
 
 
-@pytest.mark.parametrize(("script", "least"), [(PT, 800), (GEAR, 1500), (CRD, 600)])
-@pytest.mark.parametrize("chunked", [False, True])
+@pytest.mark.parametrize(
+    ("script", "least", "chunked"),
+    [
+        (PT, 800, False),
+        (PT, 800, True),
+        (GEAR, 1500, False),
+        (GEAR, 1500, True),
+        (CRD, 800, False),
+        (EDGE, 300, False),
+    ],
+    ids=["pt", "pt-chunked", "gear-follow", "gear-follow-chunked", "crd", "refill-cycle"],
+)
 def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked) -> None:
     ref, none = _run(script, machine, "off", chunked)
     assert none == 0
