@@ -54,6 +54,13 @@ _MASTER_PROFILE = 2
 
 _get = object.__getattribute__
 _set = object.__setattr__
+#: the attribute that is 0 when a planner of this type stands (``done``), where it has one
+_REST: dict[type, str] = {
+    PtPlanner: "_state",
+    GearPlanner: "_state",
+    FollowPlanner: "_state",
+    TrapPlanner: "_mode",
+}
 
 
 # --- which planners a cluster may hold -----------------------------------------------------
@@ -277,34 +284,50 @@ class Cluster:
         self.snaps = [(o, snapshot(o)) for o in (*self.planners, *self.systems)]
         rows = self.rows
         moving = bank.moving
-        tp, tv, ta = bank.t_p, bank.t_v, bank.t_a
         for r in rows:
             bank.fill_taken[r] = bank.taken[r]
-        live = [bool(moving[r]) for r in rows]
-        cols: list[tuple[list[float], list[float], list[float]]] = [([], [], []) for _ in rows]
-        ends = [-1] * len(rows)
         pls = self.planners
         systems = self.systems
-        for j in range(SAMPLED_TABLE):
-            for c in systems:
-                if c.running:
-                    c.step()
-            for i, pl in enumerate(pls):
-                if pl.done:
-                    continue
-                p, v, a = pl.step()
-                if live[i]:
-                    col = cols[i]
-                    col[0].append(p)
-                    col[1].append(v)
-                    col[2].append(a)
-                    if pl.done:
-                        live[i] = False
+        # (index, step, the attribute that is 0 at rest or None: ``done``, its samples);
+        # a row not moving has a planner at rest, which a cycle does not step
+        live = [
+            (i, pl.step, _REST.get(type(pl)), [])
+            for i, pl in enumerate(pls)
+            if moving[rows[i]] and not pl.done
+        ]
+        ends = [-1] * len(rows)
+        cols: list[list[tuple[float, float, float]]] = [[] for _ in rows]
+        for i, _, _, col in live:
+            cols[i] = col
+        table = SAMPLED_TABLE
+        if len(live) == 1 and not systems:  # one planner (a PT axis): its steps alone
+            i, step, rest, col = live[0]
+            pl = pls[i]
+            for j in range(table):
+                col.append(step())
+                if (_get(pl, rest) == 0) if rest else pl.done:
+                    ends[i] = j
+                    break
+        else:
+            for j in range(table):
+                for c in systems:
+                    if c.running:
+                        c.step()
+                ended = False
+                for i, step, rest, col in live:
+                    # the others of the cluster at rest: stepping them changes nothing
+                    col.append(step())
+                    pl = pls[i]
+                    if (_get(pl, rest) == 0) if rest else pl.done:
                         ends[i] = j
+                        ended = True
+                if ended:
+                    live = [x for x in live if ends[x[0]] < 0]
+        tp, tv, ta = bank.t_p, bank.t_v, bank.t_a
         tl = bank.table
         for i, r in enumerate(rows):
             col = cols[i]
-            m = len(col[0])
+            m = len(col)
             if not m:
                 continue
             bank.sampled_samples += m
@@ -314,7 +337,7 @@ class Cluster:
             for t in (tp, tv, ta):
                 t.flat[spare] = t.flat[last]
             bank.t_idx[r] = spare
-            tp[r, :m], tv[r, :m], ta[r, :m] = col
+            tp[r, :m], tv[r, :m], ta[r, :m] = zip(*col, strict=True)
             bank.t_len[r] = m
             bank.t_cur[r] = 0
             bank.t_end[r] = ends[i]
