@@ -42,6 +42,7 @@ from .motion.stop import StopKind
 from .motion.trap import _IDLE as _TRAP_IDLE
 from .motion.trap import _MOVE as _TRAP_MOVE
 from .motion.trap import TrapPlanner
+from .motion.trap_table import advance, trap_table
 
 if TYPE_CHECKING:
     from .bank import AxisBank
@@ -254,7 +255,7 @@ def restore(obj: Any, snap: tuple) -> None:
 class Cluster:
     """Rows whose planners the bank steps ahead together (module docstring)."""
 
-    __slots__ = ("groups", "planners", "rows", "snaps", "systems")
+    __slots__ = ("before", "groups", "masters", "planners", "rows", "snaps", "systems", "topo")
 
     def __init__(self, bank: AxisBank, rows: list[int], groups: list[int]) -> None:
         order = bank.order
@@ -267,6 +268,44 @@ class Cluster:
                 systems.append(pl.crd)
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
+        self.before: list[bool] = []
+        # the planners one after the other (masters first) where no coordinate system is
+        # in the cluster: :meth:`fill` by columns; else cycle by cycle, all together
+        self.masters: list[int | None] = [None] * len(self.rows)
+        self.topo: list[int] | None = None
+        if systems:
+            return
+        at = {r: i for i, r in enumerate(self.rows)}
+        for i, pl in enumerate(self.planners):
+            t = type(pl).__mro__
+            if not (PtPlanner in t or TrapPlanner in t or SlavePlanner in t):
+                return
+            if SlavePlanner in t and _get(pl, "_state") != 0:
+                master = getattr(_get(pl, "_source"), "master", None)
+                mi = at.get(bank._row_of.get(id(master[0].ax), -1)) if master else None
+                if mi is None:
+                    return
+                self.masters[i] = mi
+        topo: list[int] = []
+        placed = [False] * len(self.rows)
+        while len(topo) < len(self.rows):
+            ready = [
+                i
+                for i in range(len(self.rows))
+                if not placed[i] and (self.masters[i] is None or placed[self.masters[i]])
+            ]
+            if not ready:
+                return  # slaves of each other: cycle by cycle
+            for i in ready:
+                placed[i] = True
+            topo += ready
+        self.topo = topo
+        # a master read before its slave steps (numbered below it) gives the slave the sample
+        # of the same cycle, else the one before (the controller steps axes in number order)
+        self.before = [
+            m is not None and order[self.rows[m]] < order[r]
+            for m, r in zip(self.masters, self.rows, strict=True)
+        ]
 
     def step(self) -> None:
         """One scalar cycle of the cluster's planners: the systems (the controller's
@@ -286,6 +325,9 @@ class Cluster:
         moving = bank.moving
         for r in rows:
             bank.fill_taken[r] = bank.taken[r]
+        if self.topo is not None:
+            self._fill_columns(bank)
+            return
         pls = self.planners
         systems = self.systems
         # (index, step, the attribute that is 0 at rest or None: ``done``, its samples);
@@ -323,24 +365,64 @@ class Cluster:
                         ended = True
                 if ended:
                     live = [x for x in live if ends[x[0]] < 0]
-        tp, tv, ta = bank.t_p, bank.t_v, bank.t_a
-        tl = bank.table
         for i, r in enumerate(rows):
-            col = cols[i]
-            m = len(col)
-            if not m:
+            if cols[i]:
+                ps, vs, as_ = (list(x) for x in zip(*cols[i], strict=True))
+                self._put(bank, r, ps, vs, as_, ends[i])
+
+    def _fill_columns(self, bank: AxisBank) -> None:
+        """:meth:`fill` one planner after the other, masters first: each planner's ``run``
+        (its steps at once), a slave given the positions its master holds in those cycles."""
+        n = SAMPLED_TABLE
+        rows, pls = self.rows, self.planners
+        moving = bank.moving
+        seen: list[list[float] | None] = [None] * len(rows)  # positions after each cycle
+        starts = [0.0] * len(rows)  # positions before the first
+        for i in self.topo:  # type: ignore[union-attr]
+            pl = pls[i]
+            r = rows[i]
+            starts[i] = start = pl.pos
+            if not moving[r] or pl.done:
+                seen[i] = [start] * n
                 continue
-            bank.sampled_samples += m
-            # the last sample taken moves to the row's spare slot first (as for a Trap
-            # table): a release in this cycle reads it there
-            last, spare = int(bank.t_idx[r]), int(bank.base[r]) + tl
-            for t in (tp, tv, ta):
-                t.flat[spare] = t.flat[last]
-            bank.t_idx[r] = spare
-            tp[r, :m], tv[r, :m], ta[r, :m] = zip(*col, strict=True)
-            bank.t_len[r] = m
-            bank.t_cur[r] = 0
-            bank.t_end[r] = ends[i]
+            mi = self.masters[i]
+            if TrapPlanner in type(pl).__mro__:
+                p, v, a, end = trap_table(pl, n)
+                m = end + 1 if end < n else n
+                ps, vs, as_ = p[:m].tolist(), v[:m].tolist(), a[:m].tolist()
+                advance(pl, m, (ps[-1], vs[-1], as_[-1]), end < n)
+                end = end if end < n else -1
+            elif mi is None:
+                ps, vs, as_, end = pl.run(n)
+            else:
+                ms = seen[mi]
+                assert ms is not None
+                if not self.before[i]:  # the master steps after this slave in a cycle
+                    ms = [starts[mi], *ms[:-1]]
+                ps, vs, as_, end = pl.run(ms)
+            last = ps[-1]
+            seen[i] = ps + [last] * (n - len(ps))
+            self._put(bank, r, ps, vs, as_, end)
+
+    @staticmethod
+    def _put(
+        bank: AxisBank, r: int, ps: list[float], vs: list[float], as_: list[float], end: int
+    ) -> None:
+        """A row's new table (the last sample taken kept in its spare slot first, as for a
+        Trap table: a release in this cycle reads it there)."""
+        m = len(ps)
+        if not m:
+            return
+        bank.sampled_samples += m
+        tp, tv, ta = bank.t_p, bank.t_v, bank.t_a
+        last, spare = int(bank.t_idx[r]), int(bank.base[r]) + bank.table
+        for t in (tp, tv, ta):
+            t.flat[spare] = t.flat[last]
+        bank.t_idx[r] = spare
+        tp[r, :m], tv[r, :m], ta[r, :m] = ps, vs, as_
+        bank.t_len[r] = m
+        bank.t_cur[r] = 0
+        bank.t_end[r] = end
 
     def rewind(self, bank: AxisBank) -> None:
         """Put the planners where the scalar path has them: their state at the last fill,

@@ -398,6 +398,46 @@ class FollowPlanner(SlavePlanner):
                 self._vel = self._acc = 0.0
         return self._pos, self._vel, self._acc
 
+    def run(self, masters: list[float]) -> tuple[list[float], list[float], list[float], int]:
+        """:meth:`step` once per master position of ``masters`` (the axis bank's tables), the
+        same operations: the samples up to the end and its index (-1: the motion goes on).
+        Inside the current cam segment the sample is :meth:`_follow`'s closed form; anything
+        else (a segment, pass or FIFO boundary, a master moving back) is :meth:`_follow`."""
+        if self._state != _MOVE:
+            return self.run_steps(masters)
+        ps: list[float] = []
+        vs_: list[float] = []
+        as_: list[float] = []
+        cyc, dir_ = self._T, self._dir
+        for j, m in enumerate(masters):
+            m = float(m)
+            x = self._x + passed(m - self._m_prev, dir_)
+            self._x = x
+            self._m_prev = m
+            sd = self._sd
+            i = self._i
+            seg = self._segs[i]
+            if (x - seg.x1) * sd >= 0.0 or (i > 0 and (x - seg.x0) * sd < 0.0):
+                self._follow()
+                if self._state == _IDLE:
+                    ps.append(self._pos)
+                    vs_.append(self._vel)
+                    as_.append(self._acc)
+                    return ps, vs_, as_, j
+            else:
+                u = x - seg.x0
+                if u * sd < 0.0:
+                    u = 0.0  # behind the start of the pass: wait there
+                s = self._origin + seg.s0 + u * (seg.rs + seg.k * u)
+                v = (s - self._pos) / cyc
+                self._acc = (v - self._vel) / cyc
+                self._vel = v
+                self._pos = s
+            ps.append(self._pos)
+            vs_.append(self._vel)
+            as_.append(self._acc)
+        return ps, vs_, as_, -1
+
     # ------------------------------------------------------------ internals
     def _follow(self) -> None:
         """Slave position for the current master travel ``_x``."""
