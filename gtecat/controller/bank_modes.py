@@ -31,6 +31,7 @@ its axes together.  The bank runs them so:
 from __future__ import annotations
 
 from collections import deque
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 from .crd.system import AxisSlot, CoordSystem, Delay, Motion
@@ -167,12 +168,13 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
 
 
 # --- keeping and putting back a planner's state ----------------------------------------------
-_NAMES: dict[type, tuple[tuple[str, ...], bool]] = {}
+_NAMES: dict[type, tuple[tuple[str, ...], bool, Any]] = {}
 _UNSET = object()
 _CONTAINERS = (list, deque, dict)
 
 
-def _names(cls: type) -> tuple[tuple[str, ...], bool]:
+def _names(cls: type) -> tuple[tuple[str, ...], bool, Any]:
+    """(the slots of ``cls``, whether it has a ``__dict__``, a getter of all slots at once)."""
     got = _NAMES.get(cls)
     if got is None:
         slots: list[str] = []
@@ -189,7 +191,8 @@ def _names(cls: type) -> tuple[tuple[str, ...], bool]:
                     has_dict = True
                 elif name != "__weakref__" and name not in slots:
                     slots.append(name)
-        got = _NAMES[cls] = (tuple(slots), has_dict)
+        getter = attrgetter(*slots) if len(slots) > 1 else None
+        got = _NAMES[cls] = (tuple(slots), has_dict, getter)
     return got
 
 
@@ -224,32 +227,45 @@ def _put(kept: Any) -> Any:
 
 def snapshot(obj: Any) -> tuple:
     """Everything ``obj`` holds (its slots and its ``__dict__``; lists, deques and dicts by
-    content): :func:`restore` puts it back."""
-    slots, has_dict = _names(type(obj))
-    vals = []
-    for name in slots:
+    content): :func:`restore` puts it back.  ``obj`` must not be guarded by the bank."""
+    slots, has_dict, getter = _names(type(obj))
+    vals: Any = None
+    if getter is not None:
         try:
-            vals.append(_keep(_get(obj, name)))
+            vals = getter(obj)  # every slot in one call
         except AttributeError:
-            vals.append((_UNSET, None))
+            vals = None
+    if vals is None:
+        vals = []
+        for name in slots:
+            try:
+                vals.append(_get(obj, name))
+            except AttributeError:
+                vals.append(_UNSET)
+    kept = [(i, _keep(v)) for i, v in enumerate(vals) if type(v) in _KEEP]
     d = None
     if has_dict:
         d = {k: _keep(v) for k, v in _get(obj, "__dict__").items()}
-    return (vals, d)
+    return (tuple(vals), kept, d)
+
+
+#: values kept by content (a tuple: when it holds containers)
+_KEEP = (list, deque, dict, tuple)
 
 
 def restore(obj: Any, snap: tuple) -> None:
-    slots, _ = _names(type(obj))
-    vals, d = snap
-    for name, kept in zip(slots, vals, strict=True):
-        v = _put(kept)
+    slots, _, _ = _names(type(obj))
+    vals, kept, d = snap
+    for name, v in zip(slots, vals, strict=True):
         if v is not _UNSET:
             _set(obj, name, v)
+    for _, k in kept:
+        _put(k)
     if d is not None:
         od = _get(obj, "__dict__")
         od.clear()
-        for k, kept in d.items():
-            od[k] = _put(kept)
+        for k, kv in d.items():
+            od[k] = _put(kv)
 
 
 class Cluster:
