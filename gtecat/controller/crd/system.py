@@ -605,6 +605,11 @@ class CrdBank:
 
     _pre.bank_safe = True  # type: ignore[attr-defined]  # touches interpolating axes only
 
+    def bank_quiet(self) -> bool:
+        """No cycle of this hook does anything: every running system is stepped by the axis
+        bank (the controller may then run its cycles many at a time)."""
+        return all(c.banked or not c.running for c in self.systems.values())
+
     def _reset(self, ctl: Any) -> None:
         for c in self.systems.values():
             c.reset()

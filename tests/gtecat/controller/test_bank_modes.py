@@ -150,7 +150,7 @@ GEAR: Script = [
 ]
 
 
-# --- coordinated motion ----------------------------------------------------------------------------
+# --- coordinated motion ---------------------------------------------------------------------
 def _crd_system(crd: int, axes: tuple[int, int], io: bool, laps: int) -> None:
     prm = gt.TCrdPrm()
     prm.dimension = 2
@@ -260,9 +260,10 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
         (GEAR, 1500, False),
         (GEAR, 1500, True),
         (CRD, 800, False),
+        (CRD, 800, True),
         (EDGE, 300, False),
     ],
-    ids=["pt", "pt-chunked", "gear-follow", "gear-follow-chunked", "crd", "refill-cycle"],
+    ids=["pt", "pt-chunked", "gear-follow", "gear-follow-chunked", "crd", "crd-chunked", "edge"],
 )
 def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked) -> None:
     ref, none = _run(script, machine, "off", chunked)
