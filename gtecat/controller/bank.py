@@ -248,6 +248,7 @@ class AxisBank:
         self.table = TABLE
         self._c_fill = False  # the kernel refills every moving row's table itself
         self._fill_out: np.ndarray | None = None
+        self.pt_out: np.ndarray | None = None  # the compiled PT fill's samples (bank_modes)
         kmode = kernel_wanted()
         if kmode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"

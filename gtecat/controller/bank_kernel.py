@@ -97,6 +97,19 @@ def library() -> tuple[Any, str]:
             ctypes.c_void_p,
             ctypes.c_void_p,
         )
+        lib.bank_pt_run.restype = ctypes.c_int64
+        lib.bank_pt_run.argtypes = (
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_int64,
+            ctypes.c_int64,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+        )
+        lib.bank_pt_state_size.restype = ctypes.c_int
+        if lib.bank_pt_state_size() != len(PT_STATE):
+            raise RuntimeError("the kernel's PT state is not the one this module packs")
         fields = [f for f in lib.bank_kernel_fields().decode().split(",") if f]
         src_types = _field_types()
         if (
@@ -285,6 +298,36 @@ def trap_fill(
         out[1].ctypes.data,
         out[2].ctypes.data,
     )
+
+
+#: the PtPlanner slots bank_pt_run reads and writes, in the C side's PT_ST_* order
+PT_STATE = (
+    "_k _T _i _loop _loops_done _toff _poff _t0 _p0 _t1 _p1 _vs _ve _a _origin _pos _vel _acc "
+    "_state"
+).split()
+_PT_INTS = frozenset({"_k", "_i", "_loop", "_loops_done", "_state"})
+
+
+def pt_run(lib: Any, pl: Any, pts: np.ndarray, n: int, out: np.ndarray) -> int:
+    """The compiled :meth:`~gtecat.controller.motion.pt.PtPlanner.run` of a static FIFO in
+    motion: ``n`` samples into ``out`` ((3, >= n): position, speed, acceleration) from the
+    running FIFO's points ``pts`` ((m, 3) float64: position, time, type); the planner's state
+    moves on as ``n`` steps move it.  Returns the end sample's index or -1."""
+    get = object.__getattribute__
+    st = np.array([float(get(pl, name)) for name in PT_STATE])
+    end = lib.bank_pt_run(
+        st.ctypes.data,
+        pts.ctypes.data,
+        len(pts),
+        n,
+        out[0].ctypes.data,
+        out[1].ctypes.data,
+        out[2].ctypes.data,
+    )
+    put = object.__setattr__
+    for name, value in zip(PT_STATE, st.tolist(), strict=True):
+        put(pl, name, int(value) if name in _PT_INTS else value)
+    return int(end)
 
 
 def _fits(arr: np.ndarray, dtype: Any) -> bool:

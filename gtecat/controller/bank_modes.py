@@ -34,6 +34,9 @@ from collections import deque
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from .bank_kernel import pt_run
 from .crd.system import AxisSlot, CoordSystem, Delay, Motion
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
@@ -271,7 +274,17 @@ def restore(obj: Any, snap: tuple) -> None:
 class Cluster:
     """Rows whose planners the bank steps ahead together (module docstring)."""
 
-    __slots__ = ("before", "groups", "masters", "planners", "rows", "snaps", "systems", "topo")
+    __slots__ = (
+        "before",
+        "groups",
+        "masters",
+        "planners",
+        "pts",
+        "rows",
+        "snaps",
+        "systems",
+        "topo",
+    )
 
     def __init__(self, bank: AxisBank, rows: list[int], groups: list[int]) -> None:
         order = bank.order
@@ -285,6 +298,7 @@ class Cluster:
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
         self.before: list[bool] = []
+        self.pts: dict[int, np.ndarray] = {}  # a static PT FIFO's points (the compiled fill)
         # the planners one after the other (masters first) where no coordinate system is
         # in the cluster: :meth:`fill` by columns; else cycle by cycle, all together
         self.masters: list[int | None] = [None] * len(self.rows)
@@ -392,6 +406,7 @@ class Cluster:
         n = SAMPLED_TABLE
         rows, pls = self.rows, self.planners
         moving = bank.moving
+        lib = bank._kernel_lib
         seen: list[list[float] | None] = [None] * len(rows)  # positions after each cycle
         starts = [0.0] * len(rows)  # positions before the first
         for i in self.topo:  # type: ignore[union-attr]
@@ -409,6 +424,12 @@ class Cluster:
                 advance(pl, m, (ps[-1], vs[-1], as_[-1]), end < n)
                 end = end if end < n else -1
             elif mi is None:
+                if lib is not None and PtPlanner in type(pl).__mro__:
+                    if _get(pl, "_mode") == PtMode.STATIC and _get(pl, "_state") == 1:
+                        self._pt_compiled(bank, lib, i, pl)
+                        if i in self.masters:  # (a master of a slave: its positions)
+                            seen[i] = self._pad(bank.t_p[r, : bank.t_len[r]].tolist(), n)
+                        continue
                 ps, vs, as_, end = pl.run(n)
             else:
                 ms = seen[mi]
@@ -416,9 +437,30 @@ class Cluster:
                 if not self.before[i]:  # the master steps after this slave in a cycle
                     ms = [starts[mi], *ms[:-1]]
                 ps, vs, as_, end = pl.run(ms)
-            last = ps[-1]
-            seen[i] = ps + [last] * (n - len(ps))
+            seen[i] = self._pad(ps, n)
             self._put(bank, r, ps, vs, as_, end)
+
+    @staticmethod
+    def _pad(ps: list[float], n: int) -> list[float]:
+        """A planner's positions in ``n`` cycles (it holds the last after its end)."""
+        return ps + [ps[-1]] * (n - len(ps))
+
+    def _pt_compiled(self, bank: AxisBank, lib: Any, i: int, pl: PtPlanner) -> None:
+        """A static PT row's table by the compiled kernel (bank_kernel.pt_run)."""
+        pts = self.pts.get(i)
+        if pts is None:  # the FIFO cannot change while the cluster is claimed
+            q = _get(pl, "_fifos")[_get(pl, "_r")]
+            pts = self.pts[i] = np.array(
+                [(p.pos, p.time, float(int(p.type))) for p in q], np.float64
+            ).reshape(-1, 3)
+        r = self.rows[i]
+        n = SAMPLED_TABLE
+        out = bank.pt_out
+        if out is None:
+            out = bank.pt_out = np.zeros((3, n))
+        end = pt_run(lib, pl, pts, n, out)
+        m = end + 1 if end >= 0 else n
+        self._put(bank, r, out[0, :m], out[1, :m], out[2, :m], end)
 
     @staticmethod
     def _put(

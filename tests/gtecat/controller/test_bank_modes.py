@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from ctypes import byref, c_long, c_short
+from ctypes import byref, c_double, c_long, c_short
 from pathlib import Path
 
 import pytest
@@ -204,6 +204,13 @@ CRD: Script = [
 ]
 
 
+def _look(size: int) -> tuple:
+    """test_bank's sample and every axis's planned acceleration."""
+    acc = (c_double * AXES)()
+    gt.GT_GetPrfAcc(1, acc, AXES)
+    return (_sample(size), tuple(acc))
+
+
 def _run(script: Script, machine: str, bank: str, chunked: bool = False) -> tuple[list, int]:
     """The script's trace (every cycle, or the end of each wait when ``chunked``) and the
     samples the bank stepped ahead."""
@@ -224,14 +231,14 @@ def _run(script: Script, machine: str, bank: str, chunked: bool = False) -> tupl
             if chunked:
                 if wait:
                     gt.GTE_Wait(wait)
-                trace.append(_sample(size))
+                trace.append(_look(size))
             else:
                 for _ in range(wait):
                     gt.GTE_Wait(1)
-                    trace.append(_sample(size))
+                    trace.append(_look(size))
             trace.append(("call", action()))
         gt.GTE_Wait(20)
-        trace.append(_sample(size))
+        trace.append(_look(size))
         trace.append(_loops())
         trace.append(_crd_status())
         trace.append(
