@@ -64,7 +64,7 @@ from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
 from .axis_status import AxisStatus
-from .bank_kernel import MAXSEG, NTPRM, Kernel, trap_fill
+from .bank_kernel import MAXSEG, NTPRM, Kernel, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
 from .bank_modes import Cluster, links, sampled_kind, trap_steppable
@@ -248,7 +248,6 @@ class AxisBank:
         self.table = TABLE
         self._c_fill = False  # the kernel refills every moving row's table itself
         self._fill_out: np.ndarray | None = None
-        self.pt_out: np.ndarray | None = None  # the compiled PT fill's samples (bank_modes)
         kmode = kernel_wanted()
         if kmode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
@@ -259,6 +258,8 @@ class AxisBank:
                     "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
                     f"the bank ({self.kernel_reason})"
                 )
+        #: the compiled fill of a static PT table (bank_modes), None without the kernel
+        self.pt_run = PtRun(self._kernel_lib) if self._kernel_lib is not None else None
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
         #: of those, the cycles it ran many at a time (:meth:`run_many`; statistics)

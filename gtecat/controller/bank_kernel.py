@@ -25,6 +25,7 @@ import ctypes
 import logging
 import os
 from importlib import resources
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -308,26 +309,43 @@ PT_STATE = (
 _PT_INTS = frozenset({"_k", "_i", "_loop", "_loops_done", "_state"})
 
 
-def pt_run(lib: Any, pl: Any, pts: np.ndarray, n: int, out: np.ndarray) -> int:
+class PtRun:
     """The compiled :meth:`~gtecat.controller.motion.pt.PtPlanner.run` of a static FIFO in
-    motion: ``n`` samples into ``out`` ((3, >= n): position, speed, acceleration) from the
-    running FIFO's points ``pts`` ((m, 3) float64: position, time, type); the planner's state
-    moves on as ``n`` steps move it.  Returns the end sample's index or -1."""
-    get = object.__getattribute__
-    st = np.array([float(get(pl, name)) for name in PT_STATE])
-    end = lib.bank_pt_run(
-        st.ctypes.data,
-        pts.ctypes.data,
-        len(pts),
-        n,
-        out[0].ctypes.data,
-        out[1].ctypes.data,
-        out[2].ctypes.data,
-    )
-    put = object.__setattr__
-    for name, value in zip(PT_STATE, st.tolist(), strict=True):
-        put(pl, name, int(value) if name in _PT_INTS else value)
-    return int(end)
+    motion (``bank_pt_run``), writing straight into a row of the bank's tables."""
+
+    def __init__(self, lib: Any) -> None:
+        self.fn = lib.bank_pt_run
+        self.st = np.zeros(len(PT_STATE))
+        self.st_ptr = self.st.ctypes.data
+        #: the planner's state in PT_STATE order (also what a rewind puts back)
+        self.state = attrgetter(*PT_STATE)
+        self._tables: tuple = ()
+        self._ptrs = (0, 0, 0)
+
+    def __call__(
+        self, pl: Any, pts: tuple[int, int], n: int, tables: tuple[np.ndarray, ...], offset: int
+    ) -> int:
+        """``n`` samples from the planner's state into ``tables`` (position, speed and
+        acceleration arrays, float64) from flat index ``offset`` on, over the running FIFO's
+        points ``pts`` (the address of m rows of float64 position, time, type; m); the
+        planner's state moves on
+        as ``n`` steps move it.  Returns the end sample's index or -1."""
+        known = self._tables
+        if not known or any(t is not k for t, k in zip(tables, known, strict=True)):
+            self._tables = tables
+            self._ptrs = tuple(t.ctypes.data for t in tables)
+        st = self.st
+        st[:] = self.state(pl)
+        p, v, a = self._ptrs
+        off = 8 * offset
+        end = self.fn(self.st_ptr, pts[0], pts[1], n, p + off, v + off, a + off)
+        put = object.__setattr__
+        for name, value, whole in zip(PT_STATE, st.tolist(), _PT_WHOLE, strict=True):
+            put(pl, name, int(value) if whole else value)
+        return int(end)
+
+
+_PT_WHOLE = tuple(name in _PT_INTS for name in PT_STATE)
 
 
 def _fits(arr: np.ndarray, dtype: Any) -> bool:

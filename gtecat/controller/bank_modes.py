@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .bank_kernel import pt_run
+from .bank_kernel import PT_STATE
 from .crd.system import AxisSlot, CoordSystem, Delay, Motion
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
@@ -271,6 +271,23 @@ def restore(obj: Any, snap: tuple) -> None:
             od[k] = _put(kv)
 
 
+#: a PT planner's steps through a static FIFO change only these slots (bank_kernel.PT_STATE)
+_PT_MOVING = object()
+_PT_STATE_OF = attrgetter(*PT_STATE)
+
+
+def keep(obj: Any) -> tuple:
+    """:func:`snapshot`, or for a PT planner moving through a static FIFO only the slots
+    its steps change."""
+    if (
+        PtPlanner in type(obj).__mro__
+        and _get(obj, "_state") == 1
+        and _get(obj, "_mode") == PtMode.STATIC
+    ):
+        return (_PT_MOVING, _PT_STATE_OF(obj))
+    return snapshot(obj)
+
+
 class Cluster:
     """Rows whose planners the bank steps ahead together (module docstring)."""
 
@@ -298,7 +315,8 @@ class Cluster:
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
         self.before: list[bool] = []
-        self.pts: dict[int, np.ndarray] = {}  # a static PT FIFO's points (the compiled fill)
+        #: a static PT FIFO's points for the compiled fill: (address, rows, the array)
+        self.pts: dict[int, tuple[int, int, np.ndarray]] = {}
         # the planners one after the other (masters first) where no coordinate system is
         # in the cluster: :meth:`fill` by columns; else cycle by cycle, all together
         self.masters: list[int | None] = [None] * len(self.rows)
@@ -350,7 +368,7 @@ class Cluster:
     def fill(self, bank: AxisBank) -> None:
         """The next :data:`SAMPLED_TABLE` samples of every moving row, its planners stepped
         (their state before kept for :meth:`rewind`)."""
-        self.snaps = [(o, snapshot(o)) for o in (*self.planners, *self.systems)]
+        self.snaps = [(o, keep(o)) for o in (*self.planners, *self.systems)]
         rows = self.rows
         moving = bank.moving
         for r in rows:
@@ -406,7 +424,7 @@ class Cluster:
         n = SAMPLED_TABLE
         rows, pls = self.rows, self.planners
         moving = bank.moving
-        lib = bank._kernel_lib
+        compiled = bank.pt_run is not None
         seen: list[list[float] | None] = [None] * len(rows)  # positions after each cycle
         starts = [0.0] * len(rows)  # positions before the first
         for i in self.topo:  # type: ignore[union-attr]
@@ -424,9 +442,9 @@ class Cluster:
                 advance(pl, m, (ps[-1], vs[-1], as_[-1]), end < n)
                 end = end if end < n else -1
             elif mi is None:
-                if lib is not None and PtPlanner in type(pl).__mro__:
+                if compiled and PtPlanner in type(pl).__mro__:
                     if _get(pl, "_mode") == PtMode.STATIC and _get(pl, "_state") == 1:
-                        self._pt_compiled(bank, lib, i, pl)
+                        self._pt_compiled(bank, i, pl)
                         if i in self.masters:  # (a master of a slave: its positions)
                             seen[i] = self._pad(bank.t_p[r, : bank.t_len[r]].tolist(), n)
                         continue
@@ -445,22 +463,26 @@ class Cluster:
         """A planner's positions in ``n`` cycles (it holds the last after its end)."""
         return ps + [ps[-1]] * (n - len(ps))
 
-    def _pt_compiled(self, bank: AxisBank, lib: Any, i: int, pl: PtPlanner) -> None:
-        """A static PT row's table by the compiled kernel (bank_kernel.pt_run)."""
+    def _pt_compiled(self, bank: AxisBank, i: int, pl: PtPlanner) -> None:
+        """A static PT row's table by the compiled kernel (bank_kernel.PtRun)."""
         pts = self.pts.get(i)
         if pts is None:  # the FIFO cannot change while the cluster is claimed
             q = _get(pl, "_fifos")[_get(pl, "_r")]
-            pts = self.pts[i] = np.array(
-                [(p.pos, p.time, float(int(p.type))) for p in q], np.float64
-            ).reshape(-1, 3)
+            arr = np.array([(p.pos, p.time, float(int(p.type))) for p in q], np.float64)
+            pts = self.pts[i] = (arr.ctypes.data, len(arr), arr)
         r = self.rows[i]
-        n = SAMPLED_TABLE
-        out = bank.pt_out
-        if out is None:
-            out = bank.pt_out = np.zeros((3, n))
-        end = pt_run(lib, pl, pts, n, out)
-        m = end + 1 if end >= 0 else n
-        self._put(bank, r, out[0, :m], out[1, :m], out[2, :m], end)
+        tables = (bank.t_p, bank.t_v, bank.t_a)
+        last, base = int(bank.t_idx[r]), int(bank.base[r])
+        spare = base + bank.table
+        for t in tables:  # the last sample taken to the spare slot (as _put)
+            t.flat[spare] = t.flat[last]
+        bank.t_idx[r] = spare
+        end = bank.pt_run(pl, pts[:2], SAMPLED_TABLE, tables, base)
+        m = end + 1 if end >= 0 else SAMPLED_TABLE
+        bank.sampled_samples += m
+        bank.t_len[r] = m
+        bank.t_cur[r] = 0
+        bank.t_end[r] = end
 
     @staticmethod
     def _put(
@@ -489,7 +511,11 @@ class Cluster:
             return  # never stepped ahead
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
-            restore(obj, snap)
+            if snap[0] is _PT_MOVING:
+                for name, value in zip(PT_STATE, snap[1], strict=True):
+                    _set(obj, name, value)
+            else:
+                restore(obj, snap)
         self.snaps = None
         for _ in range(n):
             self.step()
