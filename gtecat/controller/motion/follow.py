@@ -409,33 +409,42 @@ class FollowPlanner(SlavePlanner):
         vs_: list[float] = []
         as_: list[float] = []
         cyc, dir_ = self._T, self._dir
+        x, m_prev = self._x, self._m_prev
+        pos, vel, acc = self._pos, self._vel, self._acc
+        sd, i = self._sd, self._i
+        seg = self._segs[i]
+        x0, x1, base, rs, k = seg.x0, seg.x1, self._origin + seg.s0, seg.rs, seg.k
         for j, m in enumerate(masters):
             m = float(m)
-            x = self._x + passed(m - self._m_prev, dir_)
-            self._x = x
-            self._m_prev = m
-            sd = self._sd
-            i = self._i
-            seg = self._segs[i]
-            if (x - seg.x1) * sd >= 0.0 or (i > 0 and (x - seg.x0) * sd < 0.0):
+            x += passed(m - m_prev, dir_)
+            m_prev = m
+            if (x - x1) * sd >= 0.0 or (i > 0 and (x - x0) * sd < 0.0):
+                self._x, self._m_prev = x, m_prev
+                self._pos, self._vel, self._acc = pos, vel, acc
                 self._follow()
+                pos, vel, acc = self._pos, self._vel, self._acc
                 if self._state == _IDLE:
-                    ps.append(self._pos)
-                    vs_.append(self._vel)
-                    as_.append(self._acc)
+                    ps.append(pos)
+                    vs_.append(vel)
+                    as_.append(acc)
                     return ps, vs_, as_, j
+                sd, i = self._sd, self._i
+                seg = self._segs[i]
+                x0, x1, base, rs, k = seg.x0, seg.x1, self._origin + seg.s0, seg.rs, seg.k
             else:
-                u = x - seg.x0
+                u = x - x0
                 if u * sd < 0.0:
                     u = 0.0  # behind the start of the pass: wait there
-                s = self._origin + seg.s0 + u * (seg.rs + seg.k * u)
-                v = (s - self._pos) / cyc
-                self._acc = (v - self._vel) / cyc
-                self._vel = v
-                self._pos = s
-            ps.append(self._pos)
-            vs_.append(self._vel)
-            as_.append(self._acc)
+                s = base + u * (rs + k * u)
+                v = (s - pos) / cyc
+                acc = (v - vel) / cyc
+                vel = v
+                pos = s
+            ps.append(pos)
+            vs_.append(vel)
+            as_.append(acc)
+        self._x, self._m_prev = x, m_prev
+        self._pos, self._vel, self._acc = pos, vel, acc
         return ps, vs_, as_, -1
 
     # ------------------------------------------------------------ internals
