@@ -23,7 +23,13 @@ before anything else may look at or change them:
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
   the slave through :attr:`gtecat.drives.drive.Cia402Drive.on_touch`;
 * per-cycle hooks the bank does not know (a recorder, motion programs, smart homing)
-  and axes in Gear/Follow mode (they read other axes every cycle) turn it off.
+  turn it off.
+
+PT, Gear, Follow and coordinated motion run in it too (:mod:`.bank_modes`): the axes whose
+planners depend on each other (a Gear/Follow slave and its master, the axes of a coordinate
+system) are claimed and given back together as a cluster, their planners stepped a table
+ahead and put back exactly at a release; a slave the bank cannot follow (it reads an encoder)
+keeps only its own cluster (and the drives it shares) on the scalar path.
 
 Claimed axes are re-examined whenever a GT call or a release happened, else every
 :data:`RECHECK_CYCLES` cycles.  A multi-axis drive is claimed with all its channels.
