@@ -276,15 +276,20 @@ _PT_MOVING = object()
 _PT_STATE_OF = attrgetter(*PT_STATE)
 
 
+#: ... and a geared planner's (GearPlanner.step and _through_clutch)
+_GEAR_MOVING = object()
+_GEAR_STATE = ("_m_prev", "_pos", "_vel", "_acc", "_cl", "_x", "_state")
+_GEAR_STATE_OF = attrgetter(*_GEAR_STATE)
+
+
 def keep(obj: Any) -> tuple:
-    """:func:`snapshot`, or for a PT planner moving through a static FIFO only the slots
-    its steps change."""
-    if (
-        PtPlanner in type(obj).__mro__
-        and _get(obj, "_state") == 1
-        and _get(obj, "_mode") == PtMode.STATIC
-    ):
+    """:func:`snapshot`, or for a PT planner moving through a static FIFO or a geared planner
+    only the slots its steps change."""
+    t = type(obj).__mro__
+    if PtPlanner in t and _get(obj, "_state") == 1 and _get(obj, "_mode") == PtMode.STATIC:
         return (_PT_MOVING, _PT_STATE_OF(obj))
+    if GearPlanner in t and _get(obj, "_state") == 1:
+        return (_GEAR_MOVING, _GEAR_STATE_OF(obj))
     return snapshot(obj)
 
 
@@ -294,6 +299,7 @@ class Cluster:
     __slots__ = (
         "before",
         "groups",
+        "leads",
         "masters",
         "planners",
         "pts",
@@ -321,6 +327,7 @@ class Cluster:
         # in the cluster: :meth:`fill` by columns; else cycle by cycle, all together
         self.masters: list[int | None] = [None] * len(self.rows)
         self.topo: list[int] | None = None
+        self.leads: set[int] = set()  # the planners some slave of the cluster reads
         if systems:
             return
         at = {r: i for i, r in enumerate(self.rows)}
@@ -348,6 +355,7 @@ class Cluster:
                 placed[i] = True
             topo += ready
         self.topo = topo
+        self.leads = {m for m in self.masters if m is not None}
         # a master read before its slave steps (numbered below it) gives the slave the sample
         # of the same cycle, else the one before (the controller steps axes in number order)
         self.before = [
@@ -426,6 +434,7 @@ class Cluster:
         moving = bank.moving
         compiled = bank.pt_run is not None
         seen: list[list[float] | None] = [None] * len(rows)  # positions after each cycle
+        full: list[tuple[int, list[float], list[float], list[float]]] = []
         starts = [0.0] * len(rows)  # positions before the first
         for i in self.topo:  # type: ignore[union-attr]
             pl = pls[i]
@@ -445,7 +454,7 @@ class Cluster:
                 if compiled and PtPlanner in type(pl).__mro__:
                     if _get(pl, "_mode") == PtMode.STATIC and _get(pl, "_state") == 1:
                         self._pt_compiled(bank, i, pl)
-                        if i in self.masters:  # (a master of a slave: its positions)
+                        if i in self.leads:  # (a master of a slave: its positions)
                             seen[i] = self._pad(bank.t_p[r, : bank.t_len[r]].tolist(), n)
                         continue
                 ps, vs, as_, end = pl.run(n)
@@ -455,8 +464,24 @@ class Cluster:
                 if not self.before[i]:  # the master steps after this slave in a cycle
                     ms = [starts[mi], *ms[:-1]]
                 ps, vs, as_, end = pl.run(ms)
-            seen[i] = self._pad(ps, n)
-            self._put(bank, r, ps, vs, as_, end)
+            if i in self.leads:
+                seen[i] = self._pad(ps, n)
+            if end < 0 and len(ps) == n:
+                full.append((r, ps, vs, as_))
+            else:
+                self._put(bank, r, ps, vs, as_, end)
+        if full:  # the rows that go on, in one assignment per table
+            rs = np.array([f[0] for f in full], np.intp)
+            last = bank.t_idx[rs]
+            spare = bank.base[rs] + bank.table
+            for k, t in enumerate((bank.t_p, bank.t_v, bank.t_a)):
+                t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
+                t[rs, :n] = [f[k + 1] for f in full]
+            bank.t_idx[rs] = spare
+            bank.t_len[rs] = n
+            bank.t_cur[rs] = 0
+            bank.t_end[rs] = -1
+            bank.sampled_samples += n * len(full)
 
     @staticmethod
     def _pad(ps: list[float], n: int) -> list[float]:
@@ -511,8 +536,9 @@ class Cluster:
             return  # never stepped ahead
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
-            if snap[0] is _PT_MOVING:
-                for name, value in zip(PT_STATE, snap[1], strict=True):
+            if snap[0] is _PT_MOVING or snap[0] is _GEAR_MOVING:
+                names = PT_STATE if snap[0] is _PT_MOVING else _GEAR_STATE
+                for name, value in zip(names, snap[1], strict=True):
                     _set(obj, name, value)
             else:
                 restore(obj, snap)
