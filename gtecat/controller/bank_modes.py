@@ -435,6 +435,7 @@ class Cluster:
         compiled = bank.pt_run is not None
         seen: list[list[float] | None] = [None] * len(rows)  # positions after each cycle
         full: list[tuple[int, list[float], list[float], list[float]]] = []
+        geared: dict[tuple, tuple[list[float], list[int]]] = {}
         starts = [0.0] * len(rows)  # positions before the first
         for i in self.topo:  # type: ignore[union-attr]
             pl = pls[i]
@@ -463,6 +464,15 @@ class Cluster:
                 assert ms is not None
                 if not self.before[i]:  # the master steps after this slave in a cycle
                     ms = [starts[mi], *ms[:-1]]
+                if (
+                    i not in self.leads
+                    and GearPlanner in type(pl).__mro__
+                    and _get(pl, "_state") == 1
+                    and _get(pl, "_cl") == 0.0
+                ):  # geared at a fixed ratio: with the others of its master at once
+                    key = (mi, self.before[i], _get(pl, "_dir"), _get(pl, "_m_prev"))
+                    geared.setdefault(key, (ms, []))[1].append(i)
+                    continue
                 ps, vs, as_, end = pl.run(ms)
             if i in self.leads:
                 seen[i] = self._pad(ps, n)
@@ -470,6 +480,8 @@ class Cluster:
                 full.append((r, ps, vs, as_))
             else:
                 self._put(bank, r, ps, vs, as_, end)
+        for ms, slaves in geared.values():
+            self._gear_rows(bank, ms, slaves)
         if full:  # the rows that go on, in one assignment per table
             rs = np.array([f[0] for f in full], np.intp)
             last = bank.t_idx[rs]
@@ -482,6 +494,47 @@ class Cluster:
             bank.t_cur[rs] = 0
             bank.t_end[rs] = -1
             bank.sampled_samples += n * len(full)
+
+    def _gear_rows(self, bank: AxisBank, ms: list[float], slaves: list[int]) -> None:
+        """Geared slaves of one master at a fixed ratio (no clutch zone), one table each:
+        GearPlanner.step's operations for all of them at once (``pos += ratio·d`` summed in
+        order, speed ``ds/T``, acceleration the change of speed over ``T``)."""
+        pls = [self.planners[i] for i in slaves]
+        first = pls[0]
+        cyc, dir_, m_prev = _get(first, "_T"), _get(first, "_dir"), _get(first, "_m_prev")
+        m = np.array(ms, np.float64)
+        d = np.diff(m, prepend=m_prev)
+        if dir_ > 0:
+            d = np.where(d > 0.0, d, 0.0)
+        elif dir_ < 0:
+            d = np.where(d < 0.0, d, 0.0)
+        r1 = np.array([_get(pl, "_r1") for pl in pls])
+        ds = r1[:, None] * d[None, :]
+        pos0 = np.array([[_get(pl, "_pos")] for pl in pls])
+        pos = np.add.accumulate(np.concatenate((pos0, ds), axis=1), axis=1)[:, 1:]
+        v = ds / cyc
+        vel0 = np.array([[_get(pl, "_vel")] for pl in pls])
+        acc = (v - np.concatenate((vel0, v[:, :-1]), axis=1)) / cyc
+        n = len(ms)
+        rs = np.array([self.rows[i] for i in slaves], np.intp)
+        last = bank.t_idx[rs]
+        spare = bank.base[rs] + bank.table
+        for t, values in zip((bank.t_p, bank.t_v, bank.t_a), (pos, v, acc), strict=True):
+            t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
+            t[rs, :n] = values
+        bank.t_idx[rs] = spare
+        bank.t_len[rs] = n
+        bank.t_cur[rs] = 0
+        bank.t_end[rs] = -1
+        bank.sampled_samples += n * len(slaves)
+        m_last = float(m[-1])
+        for pl, p, vv, a in zip(
+            pls, pos[:, -1].tolist(), v[:, -1].tolist(), acc[:, -1].tolist(), strict=True
+        ):
+            _set(pl, "_m_prev", m_last)
+            _set(pl, "_pos", p)
+            _set(pl, "_vel", vv)
+            _set(pl, "_acc", a)
 
     @staticmethod
     def _pad(ps: list[float], n: int) -> list[float]:
