@@ -70,10 +70,10 @@ from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
 from .axis_status import AxisStatus
-from .bank_kernel import MAXSEG, NTPRM, Kernel, PtRun, trap_fill
+from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
-from .bank_modes import Cluster, links, sampled_kind, trap_steppable
+from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -264,8 +264,9 @@ class AxisBank:
                     "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
                     f"the bank ({self.kernel_reason})"
                 )
-        #: the compiled fill of a static PT table (bank_modes), None without the kernel
+        #: the compiled fills of static PT tables (bank_modes), None without the kernel
         self.pt_run = PtRun(self._kernel_lib) if self._kernel_lib is not None else None
+        self.pt_fill: PtFill | None = None  # (made with the rows)
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
         #: of those, the cycles it ran many at a time (:meth:`run_many`; statistics)
@@ -416,6 +417,7 @@ class AxisBank:
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
+            self.pt_fill = PtFill(self._kernel_lib, n)
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
@@ -926,11 +928,16 @@ class AxisBank:
         if np.count_nonzero(need):
             self._materialise()
             filled: list[Cluster] = []
+            pt_rows: list[int] = []
             for r in np.nonzero(need)[0].tolist():
                 if not self.sampled[r]:
                     self._refill(r)
                     continue
                 cl = self._cluster_of[self.group_of[r]]
+                if cl.compiled_pt:  # a PT axis alone: all of them in one compiled call
+                    pt_rows.append(r)
+                    cl.snaps = []
+                    continue
                 if cl in filled:
                     continue
                 filled.append(cl)
@@ -944,6 +951,9 @@ class AxisBank:
                 finally:
                     for pl, cls in guarded:
                         _set(pl, "__class__", cls)
+            if pt_rows:
+                assert self.pt_fill is not None
+                self.sampled_samples += self.pt_fill.fill(self, pt_rows, SAMPLED_TABLE)
         left = (self.t_len - cur)[moving]
         self._refill_in = int(left.min()) if len(left) else self.table
 

@@ -298,6 +298,7 @@ class Cluster:
 
     __slots__ = (
         "before",
+        "compiled_pt",
         "groups",
         "leads",
         "masters",
@@ -320,6 +321,18 @@ class Cluster:
                 systems.append(pl.crd)
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
+        # a PT axis alone through a static FIFO: its tables filled by the compiled kernel for
+        # all such rows at once (bank_kernel.PtFill holds its state meanwhile)
+        pl = self.planners[0]
+        self.compiled_pt = (
+            bank.pt_fill is not None
+            and len(self.rows) == 1
+            and PtPlanner in type(pl).__mro__
+            and _get(pl, "_state") == 1
+            and _get(pl, "_mode") == PtMode.STATIC
+        )
+        if self.compiled_pt:
+            bank.pt_fill.load(self.rows[0], pl)  # type: ignore[union-attr]
         self.before: list[bool] = []
         #: a static PT FIFO's points for the compiled fill: (address, rows, the array)
         self.pts: dict[int, tuple[int, int, np.ndarray]] = {}
@@ -585,6 +598,16 @@ class Cluster:
     def rewind(self, bank: AxisBank) -> None:
         """Put the planners where the scalar path has them: their state at the last fill,
         then as many steps as the bank ran since."""
+        if self.compiled_pt:
+            assert bank.pt_fill is not None
+            if self.snaps is None:  # never filled: the planner never left its state
+                bank.pt_fill.drop(self.rows[0])
+                return
+            bank.pt_fill.put_back(self.rows[0], self.planners[0])
+            self.snaps = None
+            for _ in range(int(bank.taken[self.rows[0]] - bank.fill_taken[self.rows[0]])):
+                self.step()
+            return
         if self.snaps is None:
             return  # never stepped ahead
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)

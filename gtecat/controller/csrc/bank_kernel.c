@@ -766,3 +766,51 @@ int64_t bank_pt_run(double *st, const double *pts, int64_t m, int64_t n, double 
     }
     return -1;
 }
+
+/* The tables of many static PT rows at once (AxisBank._fill_tables): a[] holds the row count,
+ * the samples per table, the table width and the addresses of the arrays (PT_FILL_* below).
+ * For each row r: its state st[r] (PT_NST doubles) is kept in before[r], the last sample taken
+ * moves to the row's spare slot (as AxisBank._refill does), bank_pt_run fills the table from
+ * the row's points and moves st[r] on, and the table's cursor, length and end follow; the
+ * samples written are returned. */
+enum {
+    PT_FILL_NR, PT_FILL_N, PT_FILL_TABLE, PT_FILL_ROWS, PT_FILL_ST, PT_FILL_BEFORE,
+    PT_FILL_PTS, PT_FILL_M, PT_FILL_TP, PT_FILL_TV, PT_FILL_TA, PT_FILL_BASE, PT_FILL_IDX,
+    PT_FILL_LEN, PT_FILL_CUR, PT_FILL_END, PT_FILL_TAKEN, PT_FILL_FILLTAKEN, PT_FILL_NARGS
+};
+
+int bank_pt_fill_args(void) { return PT_FILL_NARGS; }
+
+int64_t bank_pt_fill(const int64_t *a)
+{
+#define PA(T, k) ((T *)(intptr_t)a[k])
+    const int64_t nr = a[PT_FILL_NR], n = a[PT_FILL_N], table = a[PT_FILL_TABLE];
+    const int64_t *rows = PA(const int64_t, PT_FILL_ROWS);
+    double *st = PA(double, PT_FILL_ST), *before = PA(double, PT_FILL_BEFORE);
+    const int64_t *pts = PA(const int64_t, PT_FILL_PTS), *m = PA(const int64_t, PT_FILL_M);
+    double *tp = PA(double, PT_FILL_TP), *tv = PA(double, PT_FILL_TV), *ta = PA(double, PT_FILL_TA);
+    const int64_t *base = PA(const int64_t, PT_FILL_BASE);
+    int64_t *idx = PA(int64_t, PT_FILL_IDX), *len = PA(int64_t, PT_FILL_LEN);
+    int64_t *cur = PA(int64_t, PT_FILL_CUR), *end = PA(int64_t, PT_FILL_END);
+    const int64_t *taken = PA(const int64_t, PT_FILL_TAKEN);
+    int64_t *fill_taken = PA(int64_t, PT_FILL_FILLTAKEN);
+    int64_t i, total = 0;
+#undef PA
+    for (i = 0; i < nr; i++) {
+        const int64_t r = rows[i], b = base[r], spare = b + table, last = idx[r];
+        int64_t e;
+        memcpy(before + PT_NST * r, st + PT_NST * r, PT_NST * sizeof(double));
+        tp[spare] = tp[last];
+        tv[spare] = tv[last];
+        ta[spare] = ta[last];
+        idx[r] = spare;
+        e = bank_pt_run(st + PT_NST * r, (const double *)(intptr_t)pts[r], m[r], n, tp + b, tv + b,
+                        ta + b);
+        len[r] = e >= 0 ? e + 1 : n;
+        cur[r] = 0;
+        end[r] = e;
+        fill_taken[r] = taken[r];
+        total += len[r];
+    }
+    return total;
+}
