@@ -51,6 +51,8 @@ from .motion.trap_table import advance, trap_table
 if TYPE_CHECKING:
     from .bank import AxisBank
 
+#: the state in which a slave's table may be filled with the others of its master (moving)
+_FAST = {GearPlanner: 1, FollowPlanner: 2}
 #: samples a cluster's planners are stepped ahead at once (the rewind at a release is at
 #: most this many steps)
 SAMPLED_TABLE = 32
@@ -282,6 +284,13 @@ _GEAR_STATE = ("_m_prev", "_pos", "_vel", "_acc", "_cl", "_x", "_state")
 _GEAR_STATE_OF = attrgetter(*_GEAR_STATE)
 
 
+#: ... and a following planner's (FollowPlanner.step, _follow, _advance, _begin_pass; its
+#: cam segment list only grows, or is replaced, within a pass: kept with its length)
+_FOLLOW_MOVING = object()
+_FOLLOW_STATE = ("_x _m_prev _pos _vel _acc _i _segs _loops_done _x0 _s0 _carry _sd _state").split()
+_FOLLOW_STATE_OF = attrgetter(*_FOLLOW_STATE)
+
+
 def keep(obj: Any) -> tuple:
     """:func:`snapshot`, or for a PT planner moving through a static FIFO or a geared planner
     only the slots its steps change."""
@@ -290,6 +299,8 @@ def keep(obj: Any) -> tuple:
         return (_PT_MOVING, _PT_STATE_OF(obj))
     if GearPlanner in t and _get(obj, "_state") == 1:
         return (_GEAR_MOVING, _GEAR_STATE_OF(obj))
+    if FollowPlanner in t and _get(obj, "_state") == 2 and not _get(obj, "_switch"):
+        return (_FOLLOW_MOVING, _FOLLOW_STATE_OF(obj), len(_get(obj, "_segs")))
     return snapshot(obj)
 
 
@@ -477,15 +488,17 @@ class Cluster:
                 assert ms is not None
                 if not self.before[i]:  # the master steps after this slave in a cycle
                     ms = [starts[mi], *ms[:-1]]
-                if (
-                    i not in self.leads
-                    and GearPlanner in type(pl).__mro__
-                    and _get(pl, "_state") == 1
-                    and _get(pl, "_cl") == 0.0
-                ):  # geared at a fixed ratio: with the others of its master at once
-                    key = (mi, self.before[i], _get(pl, "_dir"), _get(pl, "_m_prev"))
-                    geared.setdefault(key, (ms, []))[1].append(i)
-                    continue
+                if i not in self.leads and _get(pl, "_state") == _FAST.get(type(pl)):
+                    # geared at a fixed ratio, or following inside a cam segment: with the
+                    # others of its master at once
+                    if GearPlanner in type(pl).__mro__ and _get(pl, "_cl") == 0.0:
+                        key = (0, mi, self.before[i], _get(pl, "_dir"), _get(pl, "_m_prev"))
+                        geared.setdefault(key, (ms, []))[1].append(i)
+                        continue
+                    if FollowPlanner in type(pl).__mro__:
+                        key = (1, mi, self.before[i], _get(pl, "_dir"), _get(pl, "_m_prev"))
+                        geared.setdefault(key, (ms, []))[1].append(i)
+                        continue
                 ps, vs, as_, end = pl.run(ms)
             if i in self.leads:
                 seen[i] = self._pad(ps, n)
@@ -493,8 +506,17 @@ class Cluster:
                 full.append((r, ps, vs, as_))
             else:
                 self._put(bank, r, ps, vs, as_, end)
-        for ms, slaves in geared.values():
-            self._gear_rows(bank, ms, slaves)
+        for key, (ms, slaves) in geared.items():
+            if key[0] == 0:
+                self._gear_rows(bank, ms, slaves)
+                continue
+            for i in self._follow_rows(bank, ms, slaves):  # the ones not inside a segment
+                ps, vs, as_, end = self.planners[i].run(ms)
+                r = self.rows[i]
+                if end < 0 and len(ps) == n:
+                    full.append((r, ps, vs, as_))
+                else:
+                    self._put(bank, r, ps, vs, as_, end)
         if full:  # the rows that go on, in one assignment per table
             rs = np.array([f[0] for f in full], np.intp)
             last = bank.t_idx[rs]
@@ -548,6 +570,77 @@ class Cluster:
             _set(pl, "_pos", p)
             _set(pl, "_vel", vv)
             _set(pl, "_acc", a)
+
+    def _follow_rows(self, bank: AxisBank, ms: list[float], slaves: list[int]) -> list[int]:
+        """Following slaves of one master whose master travel stays inside their current cam
+        segment for the whole table: FollowPlanner.step's operations for all of them at once
+        (travel summed in order, ``s = origin + s0 + u·(rs + k·u)``, speed and acceleration
+        as differences over ``T``).  Returns the others (each run on its own)."""
+        pls = [self.planners[i] for i in slaves]
+        first = pls[0]
+        cyc, dir_, m_prev = _get(first, "_T"), _get(first, "_dir"), _get(first, "_m_prev")
+        m = np.array(ms, np.float64)
+        d = np.diff(m, prepend=m_prev)
+        if dir_ > 0:
+            d = np.where(d > 0.0, d, 0.0)
+        elif dir_ < 0:
+            d = np.where(d < 0.0, d, 0.0)
+        segs = [_get(pl, "_segs")[_get(pl, "_i")] for pl in pls]
+        x0 = np.array([[_get(pl, "_x")] for pl in pls])
+        x = np.add.accumulate(np.concatenate((x0, np.broadcast_to(d, (len(pls), len(d)))), 1), 1)
+        x = x[:, 1:]
+        sd = np.array([[_get(pl, "_sd")] for pl in pls])
+        sx0 = np.array([[g.x0] for g in segs])
+        sx1 = np.array([[g.x1] for g in segs])
+        first_seg = np.array([[_get(pl, "_i") == 0] for pl in pls])
+        # _follow's two loops do nothing in a cycle where x is before x1 and, past the
+        # first segment of the pass, not behind x0
+        inside = ((x - sx1) * sd < 0.0) & (first_seg | ((x - sx0) * sd >= 0.0))
+        ok = inside.all(axis=1)
+        rest = [i for i, good in zip(slaves, ok.tolist(), strict=True) if not good]
+        if not ok.any():
+            return rest
+        sel = np.nonzero(ok)[0]
+        pls = [pls[k] for k in sel.tolist()]
+        segs = [segs[k] for k in sel.tolist()]
+        x, sd, sx0 = x[sel], sd[sel], sx0[sel]
+        u = x - sx0
+        u = np.where(u * sd < 0.0, 0.0, u)  # behind the start of the pass: wait there
+        base = np.array([[_get(pl, "_origin") + g.s0] for pl, g in zip(pls, segs, strict=True)])
+        rs = np.array([[g.rs] for g in segs])
+        k = np.array([[g.k] for g in segs])
+        pos = base + u * (rs + k * u)
+        pos0 = np.array([[_get(pl, "_pos")] for pl in pls])
+        vel0 = np.array([[_get(pl, "_vel")] for pl in pls])
+        v = (pos - np.concatenate((pos0, pos[:, :-1]), 1)) / cyc
+        acc = (v - np.concatenate((vel0, v[:, :-1]), 1)) / cyc
+        n = len(ms)
+        rs_rows = np.array([self.rows[slaves[k]] for k in sel.tolist()], np.intp)
+        last = bank.t_idx[rs_rows]
+        spare = bank.base[rs_rows] + bank.table
+        for t, values in zip((bank.t_p, bank.t_v, bank.t_a), (pos, v, acc), strict=True):
+            t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
+            t[rs_rows, :n] = values
+        bank.t_idx[rs_rows] = spare
+        bank.t_len[rs_rows] = n
+        bank.t_cur[rs_rows] = 0
+        bank.t_end[rs_rows] = -1
+        bank.sampled_samples += n * len(pls)
+        m_last = float(m[-1])
+        for pl, xe, p, vv, a in zip(
+            pls,
+            x[:, -1].tolist(),
+            pos[:, -1].tolist(),
+            v[:, -1].tolist(),
+            acc[:, -1].tolist(),
+            strict=True,
+        ):
+            _set(pl, "_x", xe)
+            _set(pl, "_m_prev", m_last)
+            _set(pl, "_pos", p)
+            _set(pl, "_vel", vv)
+            _set(pl, "_acc", a)
+        return rest
 
     @staticmethod
     def _pad(ps: list[float], n: int) -> list[float]:
@@ -612,10 +705,14 @@ class Cluster:
             return  # never stepped ahead
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
-            if snap[0] is _PT_MOVING or snap[0] is _GEAR_MOVING:
-                names = PT_STATE if snap[0] is _PT_MOVING else _GEAR_STATE
+            if snap[0] is _PT_MOVING or snap[0] is _GEAR_MOVING or snap[0] is _FOLLOW_MOVING:
+                names = {_PT_MOVING: PT_STATE, _GEAR_MOVING: _GEAR_STATE}.get(
+                    snap[0], _FOLLOW_STATE
+                )
                 for name, value in zip(names, snap[1], strict=True):
                     _set(obj, name, value)
+                if snap[0] is _FOLLOW_MOVING:
+                    del _get(obj, "_segs")[snap[2] :]  # the segments added since
             else:
                 restore(obj, snap)
         self.snaps = None
