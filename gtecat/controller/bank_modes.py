@@ -510,9 +510,7 @@ class Cluster:
             if key[0] == 0:
                 self._gear_rows(bank, ms, slaves)
                 continue
-            for i in self._follow_rows(bank, ms, slaves):  # the ones not inside a segment
-                ps, vs, as_, end = self.planners[i].run(ms)
-                r = self.rows[i]
+            for r, ps, vs, as_, end in self._follow_rows(bank, ms, slaves):
                 if end < 0 and len(ps) == n:
                     full.append((r, ps, vs, as_))
                 else:
@@ -571,11 +569,14 @@ class Cluster:
             _set(pl, "_vel", vv)
             _set(pl, "_acc", a)
 
-    def _follow_rows(self, bank: AxisBank, ms: list[float], slaves: list[int]) -> list[int]:
-        """Following slaves of one master whose master travel stays inside their current cam
-        segment for the whole table: FollowPlanner.step's operations for all of them at once
-        (travel summed in order, ``s = origin + s0 + u·(rs + k·u)``, speed and acceleration
-        as differences over ``T``).  Returns the others (each run on its own)."""
+    def _follow_rows(
+        self, bank: AxisBank, ms: list[float], slaves: list[int]
+    ) -> list[tuple[int, list[float], list[float], list[float], int]]:
+        """Following slaves of one master, their cycles inside the current cam segment all at
+        once: FollowPlanner.step's operations (travel summed in order, ``s = origin + s0 +
+        u·(rs + k·u)``, speed and acceleration as differences over ``T``).  A slave whose
+        travel leaves the segment within the table is stepped on from there by its ``run``;
+        returns those rows' samples (row, positions, speeds, accelerations, end)."""
         pls = [self.planners[i] for i in slaves]
         first = pls[0]
         cyc, dir_, m_prev = _get(first, "_T"), _get(first, "_dir"), _get(first, "_m_prev")
@@ -596,14 +597,8 @@ class Cluster:
         # _follow's two loops do nothing in a cycle where x is before x1 and, past the
         # first segment of the pass, not behind x0
         inside = ((x - sx1) * sd < 0.0) & (first_seg | ((x - sx0) * sd >= 0.0))
-        ok = inside.all(axis=1)
-        rest = [i for i, good in zip(slaves, ok.tolist(), strict=True) if not good]
-        if not ok.any():
-            return rest
-        sel = np.nonzero(ok)[0]
-        pls = [pls[k] for k in sel.tolist()]
-        segs = [segs[k] for k in sel.tolist()]
-        x, sd, sx0 = x[sel], sd[sel], sx0[sel]
+        n = len(ms)
+        stay = np.where(inside.all(axis=1), n, np.argmin(inside, axis=1)).tolist()
         u = x - sx0
         u = np.where(u * sd < 0.0, 0.0, u)  # behind the start of the pass: wait there
         base = np.array([[_get(pl, "_origin") + g.s0] for pl, g in zip(pls, segs, strict=True)])
@@ -614,27 +609,47 @@ class Cluster:
         vel0 = np.array([[_get(pl, "_vel")] for pl in pls])
         v = (pos - np.concatenate((pos0, pos[:, :-1]), 1)) / cyc
         acc = (v - np.concatenate((vel0, v[:, :-1]), 1)) / cyc
-        n = len(ms)
-        rs_rows = np.array([self.rows[slaves[k]] for k in sel.tolist()], np.intp)
+        whole = [j for j, c in enumerate(stay) if c == n]
+        rest: list[tuple[int, list[float], list[float], list[float], int]] = []
+        for j, c in enumerate(stay):
+            if c == n:
+                continue
+            pl = pls[j]
+            if c:  # the cycles inside the segment, then the planner's own steps
+                _set(pl, "_x", float(x[j, c - 1]))
+                _set(pl, "_m_prev", ms[c - 1])
+                _set(pl, "_pos", float(pos[j, c - 1]))
+                _set(pl, "_vel", float(v[j, c - 1]))
+                _set(pl, "_acc", float(acc[j, c - 1]))
+            ps, vs, as_, end = pl.run(ms[c:])
+            if end >= 0:
+                end += c
+            head = (pos[j, :c].tolist(), v[j, :c].tolist(), acc[j, :c].tolist())
+            rest.append((self.rows[slaves[j]], head[0] + ps, head[1] + vs, head[2] + as_, end))
+        if not whole:
+            return rest
+        sel = np.array(whole, np.intp)
+        rs_rows = np.array([self.rows[slaves[j]] for j in whole], np.intp)
         last = bank.t_idx[rs_rows]
         spare = bank.base[rs_rows] + bank.table
         for t, values in zip((bank.t_p, bank.t_v, bank.t_a), (pos, v, acc), strict=True):
             t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
-            t[rs_rows, :n] = values
+            t[rs_rows, :n] = values[sel]
         bank.t_idx[rs_rows] = spare
         bank.t_len[rs_rows] = n
         bank.t_cur[rs_rows] = 0
         bank.t_end[rs_rows] = -1
-        bank.sampled_samples += n * len(pls)
+        bank.sampled_samples += n * len(whole)
         m_last = float(m[-1])
-        for pl, xe, p, vv, a in zip(
-            pls,
-            x[:, -1].tolist(),
-            pos[:, -1].tolist(),
-            v[:, -1].tolist(),
-            acc[:, -1].tolist(),
+        for j, xe, p, vv, a in zip(
+            whole,
+            x[sel, -1].tolist(),
+            pos[sel, -1].tolist(),
+            v[sel, -1].tolist(),
+            acc[sel, -1].tolist(),
             strict=True,
         ):
+            pl = pls[j]
             _set(pl, "_x", xe)
             _set(pl, "_m_prev", m_last)
             _set(pl, "_pos", p)
