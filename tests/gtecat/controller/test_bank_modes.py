@@ -211,11 +211,13 @@ def _look(size: int) -> tuple:
     return (_sample(size), tuple(acc))
 
 
-def _run(script: Script, machine: str, bank: str, chunked: bool = False) -> tuple[list, int]:
+def _run(
+    script: Script, machine: str, bank: str, chunked: bool = False, kernel: str = "c"
+) -> tuple[list, int]:
     """The script's trace (every cycle, or the end of each wait when ``chunked``) and the
-    samples the bank stepped ahead."""
+    samples the bank stepped ahead; ``kernel``: the bank's cycle compiled or numpy alone."""
     old = os.environ.get("GTECAT_BANK_KERNEL")
-    os.environ["GTECAT_BANK_KERNEL"] = "c"
+    os.environ["GTECAT_BANK_KERNEL"] = kernel
     try:
         _bring_up(machine, bank)
     finally:
@@ -279,3 +281,13 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"step {k}: the bank and the scalar path differ"
     assert samples >= least, "the bank hardly ran this mode"
+
+
+@pytest.mark.parametrize("script", [PT, GEAR], ids=["pt", "gear-follow"])
+def test_modes_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
+    """The same without the compiled cycle (no C compiler): numpy runs the bank's cycle and
+    Python every table."""
+    ref, _ = _run(script, machine, "off", True)
+    got, samples = _run(script, machine, "on", True, kernel="numpy")
+    assert got == ref
+    assert samples >= 500
