@@ -308,6 +308,7 @@ class Cluster:
     """Rows whose planners the bank steps ahead together (module docstring)."""
 
     __slots__ = (
+        "alone",
         "before",
         "compiled_pt",
         "groups",
@@ -332,6 +333,10 @@ class Cluster:
                 systems.append(pl.crd)
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
+        #: the cluster is one coordinate system with its axes and nothing else
+        self.alone = len(systems) == 1 and {id(pl) for pl in self.planners} == {
+            id(slot) for slot in systems[0].slots
+        }
         # a PT axis alone through a static FIFO: its tables filled by the compiled kernel for
         # all such rows at once (bank_kernel.PtFill holds its state meanwhile)
         pl = self.planners[0]
@@ -408,6 +413,17 @@ class Cluster:
         if self.topo is not None:
             self._fill_columns(bank)
             return
+        if self.alone:  # one coordinate system and its axes: its own run
+            c = self.systems[0]
+            if c.running:
+                cols, end = c.run(SAMPLED_TABLE)
+                at = {id(slot): k for k, slot in enumerate(c.slots)}
+                for i, r in enumerate(rows):
+                    col = cols[at[id(self.planners[i])]]
+                    if moving[r] and col:
+                        ps, vs, as_ = (list(x) for x in zip(*col, strict=True))
+                        self._put(bank, r, ps, vs, as_, end)
+                return
         pls = self.planners
         systems = self.systems
         # (index, step, the attribute that is 0 at rest or None: ``done``, its samples);
