@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .bank_kernel import PT_STATE
+from .bank_kernel import MAXSEG, PT_STATE, trap_fill
 from .crd.system import AxisSlot, CoordSystem, Delay, Motion
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
@@ -304,6 +304,20 @@ def keep(obj: Any) -> tuple:
     return snapshot(obj)
 
 
+def _trap_samples(bank: AxisBank, pl: TrapPlanner, n: int) -> tuple[Any, Any, Any, int]:
+    """:func:`~gtecat.controller.motion.trap_table.trap_table` of a Trap master, compiled
+    where the kernel is (bank_kernel.trap_fill: the same samples)."""
+    lib = bank._kernel_lib
+    if lib is None or len(pl._segs) > MAXSEG:
+        return trap_table(pl, n)
+    segs = np.array(pl._segs, np.float64).reshape(-1, 4)
+    prm = np.array([pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir])
+    out = np.zeros((3, n + 1))
+    end = trap_fill(lib, segs, pl._T, prm, pl._k, n, out)
+    m = end + 1 if end < n else n
+    return out[0, :m], out[1, :m], out[2, :m], end
+
+
 class Cluster:
     """Rows whose planners the bank steps ahead together (module docstring)."""
 
@@ -486,7 +500,7 @@ class Cluster:
                 continue
             mi = self.masters[i]
             if TrapPlanner in type(pl).__mro__:
-                p, v, a, end = trap_table(pl, n)
+                p, v, a, end = _trap_samples(bank, pl, n)
                 m = end + 1 if end < n else n
                 ps, vs, as_ = p[:m].tolist(), v[:m].tolist(), a[:m].tolist()
                 advance(pl, m, (ps[-1], vs[-1], as_[-1]), end < n)
