@@ -616,14 +616,31 @@ class Cluster:
             d = np.where(d > 0.0, d, 0.0)
         elif dir_ < 0:
             d = np.where(d < 0.0, d, 0.0)
-        segs = [_get(pl, "_segs")[_get(pl, "_i")] for pl in pls]
-        x0 = np.array([[_get(pl, "_x")] for pl in pls])
+        # each planner's travel, direction, segment (x0, x1, origin + s0, rs, k), position and
+        # speed: one row per planner, read in one pass
+        cols = []
+        for pl in pls:
+            i = _get(pl, "_i")
+            g = _get(pl, "_segs")[i]
+            cols.append(
+                (
+                    _get(pl, "_x"),
+                    _get(pl, "_sd"),
+                    g.x0,
+                    g.x1,
+                    _get(pl, "_origin") + g.s0,
+                    g.rs,
+                    g.k,
+                    _get(pl, "_pos"),
+                    _get(pl, "_vel"),
+                    i == 0,
+                )
+            )
+        st = np.array(cols, np.float64)
+        x0, sd, sx0, sx1, base, rs, k, pos0, vel0, first_seg = (st[:, c : c + 1] for c in range(10))
+        first_seg = first_seg != 0.0
         x = np.add.accumulate(np.concatenate((x0, np.broadcast_to(d, (len(pls), len(d)))), 1), 1)
         x = x[:, 1:]
-        sd = np.array([[_get(pl, "_sd")] for pl in pls])
-        sx0 = np.array([[g.x0] for g in segs])
-        sx1 = np.array([[g.x1] for g in segs])
-        first_seg = np.array([[_get(pl, "_i") == 0] for pl in pls])
         # _follow's two loops do nothing in a cycle where x is before x1 and, past the
         # first segment of the pass, not behind x0
         inside = ((x - sx1) * sd < 0.0) & (first_seg | ((x - sx0) * sd >= 0.0))
@@ -631,12 +648,7 @@ class Cluster:
         stay = np.where(inside.all(axis=1), n, np.argmin(inside, axis=1)).tolist()
         u = x - sx0
         u = np.where(u * sd < 0.0, 0.0, u)  # behind the start of the pass: wait there
-        base = np.array([[_get(pl, "_origin") + g.s0] for pl, g in zip(pls, segs, strict=True)])
-        rs = np.array([[g.rs] for g in segs])
-        k = np.array([[g.k] for g in segs])
         pos = base + u * (rs + k * u)
-        pos0 = np.array([[_get(pl, "_pos")] for pl in pls])
-        vel0 = np.array([[_get(pl, "_vel")] for pl in pls])
         v = (pos - np.concatenate((pos0, pos[:, :-1]), 1)) / cyc
         acc = (v - np.concatenate((vel0, v[:, :-1]), 1)) / cyc
         whole = [j for j, c in enumerate(stay) if c == n]
