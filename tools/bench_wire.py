@@ -35,7 +35,6 @@ import os
 import secrets
 import select
 import signal
-import stat
 import subprocess
 import sys
 import tempfile
@@ -82,13 +81,19 @@ def veth_pair(master_if: str | None, slave_if: str | None) -> Iterator[tuple[str
         subprocess.run(["ip", "link", "del", m], capture_output=True, timeout=10)
 
 
+def _plain_process() -> None:
+    """A busy loop's scheduling: normal priority, any CPU (whatever the bench runs under)."""
+    os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+    os.sched_setaffinity(0, range(os.cpu_count() or 1))
+
+
 @contextlib.contextmanager
 def busy_loops(n: int) -> Iterator[None]:
     """``n`` processes spinning at normal priority (the load of a busy host), stopped after."""
     loops = [
         subprocess.Popen(
             ["sh", "-c", "while :; do :; done"],
-            preexec_fn=lambda: os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0)),
+            preexec_fn=_plain_process,
         )
         for _ in range(n)
     ]
@@ -161,6 +166,10 @@ def latency_of(report: dict) -> dict[str, object]:
         "server_wait_us": report.get("wait", {}),
         "server_processing_us": report.get("processing", {}),
         "server_send_us": report.get("send", {}),
+        #: where the server's loop was when it took the frames, and the frames over 1 ms
+        "server_found": report.get("found", {}),
+        "server_late": report.get("late", []),
+        "server_host_steal_percent": report.get("host_steal_percent"),
     }
 
 
@@ -207,23 +216,25 @@ def cpu_times() -> tuple[int, int]:
     return sum(fields) - idle, sum(fields)
 
 
-def open_fds() -> set[int]:
-    """This process's open file descriptors."""
-    return {int(name) for name in os.listdir("/proc/self/fd")}
-
-
-def nonblocking(fds: set[int]) -> int:
-    """Make the sockets among ``fds`` (pysoem's raw socket) non-blocking; how many there were.
-    SOEM's receive then returns at once while no frame is there and its wait loop polls: the
-    master spins for its answer instead of sleeping in the kernel (its SO_RCVTIMEO is 1 us,
-    which a blocking read rounds up to a wake-up by the answer)."""
-    done = 0
-    for fd in fds:
+def open_sockets() -> set[tuple[int, str]]:
+    """This process's open sockets: (descriptor, ``socket:[inode]``)."""
+    found = set()
+    for name in os.listdir("/proc/self/fd"):
         with contextlib.suppress(OSError):
-            if stat.S_ISSOCK(os.fstat(fd).st_mode):
-                os.set_blocking(fd, False)
-                done += 1
-    return done
+            link = os.readlink(f"/proc/self/fd/{name}")
+            if link.startswith("socket:"):
+                found.add((int(name), link))
+    return found
+
+
+def nonblocking(sockets: set[tuple[int, str]]) -> int:
+    """Make ``sockets`` (pysoem's raw socket) non-blocking; how many there were. SOEM's
+    receive then returns at once while no frame is there and its wait loop polls: the master
+    spins for its answer instead of sleeping in the kernel (its SO_RCVTIMEO is 1 us, which a
+    blocking read turns into a sleep until the answer wakes it)."""
+    for fd, _link in sockets:
+        os.set_blocking(fd, False)
+    return len(sockets)
 
 
 def fine_timers() -> None:
@@ -378,10 +389,10 @@ def main(argv: list[str] | None = None) -> int:
         with server(args.eni, s, stats, args.serve_arg) as proc:
             result["serve_ready"] = proc.ready_line  # type: ignore[attr-defined]
             master = pysoem.Master()
-            fds = open_fds()
+            before = open_sockets()
             master.open(m)
             if args.master_wait == "spin":
-                result["master_sockets_nonblocking"] = nonblocking(open_fds() - fds)
+                result["master_sockets_nonblocking"] = nonblocking(open_sockets() - before)
             result["master_wait"] = args.master_wait
             try:
                 bring_to_op(master, args.dc)
@@ -419,11 +430,22 @@ def main(argv: list[str] | None = None) -> int:
             )
             if k in report
         }
-        result["target"] = {"p50_us": 30, "p99_us": 150}
-        lat = report["latency"]
-        result["meets_target"] = bool(
-            args.paced_cycles and lat.get("p50_us", 1e9) <= 30 and lat.get("p99_us", 1e9) <= 150
-        )
+        # the bar, in both views: the server's (kernel receive time to send returned) and
+        # the master's (pysoem's round trip), and no answer later than 1 ms in either
+        result["target"] = {"p50_us": 30, "p99_us": 150, "over_1ms": 0}
+        if args.paced_cycles:
+            lat, rtt = report["latency"], result["paced"]["rtt_us"]
+            server_ok = (
+                lat.get("p50_us", 1e9) <= 30
+                and lat.get("p99_us", 1e9) <= 150
+                and lat.get("over_1ms", 1) == 0
+            )
+            master_ok = (
+                rtt.get("p50", 1e9) <= 30
+                and rtt.get("p99", 1e9) <= 150
+                and result["paced"]["rtt_over_1ms"] == 0
+            )
+            result["meets_target"] = {"server": server_ok, "master": master_ok}
     text = json.dumps(result, indent=2)
     print(text)
     if args.json:
