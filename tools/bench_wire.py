@@ -346,11 +346,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument(
         "--master-wait",
-        choices=("spin", "block"),
-        default="spin",
-        help="how pysoem waits for each answer: spin = its socket non-blocking, so SOEM polls "
-        "it (the round trip is the wire and the server, not the master's own wake-up; "
-        "default), block = SOEM's own blocking receive",
+        choices=("block", "spin"),
+        default="block",
+        help="how pysoem waits for each answer: block = SOEM's own blocking receive "
+        "(default), spin = its socket non-blocking, so SOEM polls it (the master's wake-up "
+        "leaves its round trip; measured: no clear gain on the 2-vCPU VM)",
     )
     p.add_argument("--master-if")
     p.add_argument("--slave-if")
