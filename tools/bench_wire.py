@@ -43,7 +43,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -247,7 +247,15 @@ def fine_timers() -> None:
         ctypes.CDLL(None).prctl(29, 1, 0, 0, 0)
 
 
-def run_cycles(master, n: int, period_ns: int = 0, spin_ns: int = 200_000) -> dict[str, object]:
+def run_cycles(
+    master,
+    n: int,
+    period_ns: int = 0,
+    spin_ns: int = 200_000,
+    *,
+    clock: Callable[[], int] = time.perf_counter_ns,
+    sleep: Callable[[float], object] = time.sleep,
+) -> dict[str, object]:
     """``n`` process-data cycles, back to back or every ``period_ns``.
 
     Paced, the master sleeps until ``spin_ns`` before each cycle's start and spins the rest,
@@ -264,8 +272,6 @@ def run_cycles(master, n: int, period_ns: int = 0, spin_ns: int = 200_000) -> di
     busy0, total0 = cpu_times()
     steal0 = steal_jiffies()
     load0 = os.getloadavg()
-    clock = time.perf_counter_ns
-    sleep = time.sleep
     start = next_t = clock() + period_ns
     for _ in range(n):
         if period_ns:
