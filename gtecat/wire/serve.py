@@ -439,9 +439,12 @@ class WireServer:
         linger_ns = self.linger_ns
         self._sync_clocks()
         fine_timers()
-        #: where the loop waits now (FOUND index) and since when: the frame it takes is
-        #: counted there, and a late one reported with it
-        where = [_POLLED, 0]
+        #: where the loop waits now (FOUND index), since when, and this thread's CPU time
+        #: then where it keeps running (spinning; 0 asleep): the frame it takes is counted
+        #: there, and a late one reported with it; the same two times at the slaves' step
+        where = [_POLLED, 0, 0]
+        step_mark = [0, 0]
+        thread_time = time.thread_time_ns
         # maintainers' diagnostics: every frame's times and where it was found, as int64
         # records (kernel time, taken, send called, send returned, FOUND index, since)
         flog_path = os.environ.get("GTECAT_SERVE_FRAMELOG")
@@ -489,8 +492,12 @@ class WireServer:
             found = _IN_STEP if in_step else where[0]
             stats.found[found] += 1
             if t_out - t_arrived > 1_000_000 and len(stats.late) < LATE_KEPT:
-                since = 0 if in_step else where[1]
-                stats.late.append(self._late_record(t_arrived, t_in, t_out, found, since))
+                since, cpu = step_mark if in_step else where[1:]
+                record = self._late_record(t_arrived, t_in, t_out, found, since)
+                if cpu:  # it kept running: how much of that time it really ran
+                    wall, ran = clock() - since, thread_time() - cpu
+                    record["not_running_us"] = round(max(0, wall - ran) / 1000, 1)
+                stats.late.append(record)
             stats.latency.add(t_out - t_arrived)
             if flog is not None:
                 flog.extend((t_kernel, t_in, t_send, t_out, found, where[1]))
@@ -509,6 +516,7 @@ class WireServer:
             if frame_mode and chain.process_data:
                 last = self._last_step
                 if last is None or t_in - last >= self.min_gap_ns:
+                    step_mark[0], step_mark[1] = clock(), thread_time()
                     self._guarded(self._step, t_in, between)
                     for _ in range(8):  # process data answered during a step: its own step
                         if not self._step_due:
@@ -546,7 +554,7 @@ class WireServer:
                     if window is not None:
                         opens, closes = window
                         if now < opens:  # sleep until the window opens; a frame ends it
-                            where[0], where[1] = _WOKEN, now
+                            where[0], where[1], where[2] = _WOKEN, now, 0
                             if select.select([fd], [], [], min(opens - now, poll_ns) / 1e9)[0]:
                                 while answer(False):
                                     pass
@@ -560,7 +568,7 @@ class WireServer:
                     # poll syscall, per turn); the loop's housekeeping below runs every
                     # SPIN_TURNS turns or after a frame
                     if where[0] != _SPINNING:
-                        where[0], where[1] = _SPINNING, clock()
+                        where[0], where[1], where[2] = _SPINNING, clock(), thread_time()
                     for _ in range(turns):
                         if waiting():
                             stats.lingered += linger
@@ -573,7 +581,7 @@ class WireServer:
                         timeout_ms = max(
                             0, min(timeout_ms, (next_cycle - now + 999_999) // 1_000_000)
                         )
-                    where[0], where[1] = _POLLED, now
+                    where[0], where[1], where[2] = _POLLED, now, 0
                     if poll(timeout_ms):
                         while answer(False):
                             pass
@@ -614,8 +622,12 @@ class WireServer:
             "latency_us": round((t_out - t_arrived) / 1000, 1),
             "wait_us": round((t_in - t_arrived) / 1000, 1),
             "found": FOUND[found],
-            #: how long before the frame the loop began that wait (negative: after it)
+            #: how long before the frame the loop began that wait or step (negative: after it)
             "waiting_since_us": round((t_arrived - since) / 1000, 1) if since else None,
+            #: (spinning or in a step: it kept running) how much of the time since then this
+            #: thread did not run: the hypervisor took its CPU (a guest kernel leaves steal out
+            #: of a task's CPU time) or something above it ran; None where it slept
+            "not_running_us": None,
         }
 
     #: a housekeeping pass (chain poll, inspection requests, a young-generation collection)

@@ -38,6 +38,8 @@ def test_every_frame_is_counted_where_it_was_found_and_a_late_one_is_described()
         assert record["wait_us"] == 0.0  # no kernel time stamp on a socket pair
         assert record["found"] in FOUND
         assert record["at_s"] > 0
+        # how much of a wait it spent running (None: it slept, nothing to tell)
+        assert record["not_running_us"] is None or record["not_running_us"] >= 0
     assert report["host_steal_percent"] is None or report["host_steal_percent"] >= 0
     server._snapshot()  # the records start afresh (SIGUSR1)
     again = server.report()
