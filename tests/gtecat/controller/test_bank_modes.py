@@ -284,6 +284,7 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
 
 
 @pytest.mark.parametrize("script", [PT, GEAR], ids=["pt", "gear-follow"])
+@pytest.mark.sample(1)
 def test_modes_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
     """The same without the compiled cycle (no C compiler): numpy runs the bank's cycle and
     Python every table."""
