@@ -194,3 +194,41 @@ def _no_controller_left_open():
     core = sys.modules.get("gtecat.gt._core")
     if core is not None and core.SESSION.all_controllers():
         core.close_all()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The controller of a pytest-xdist run rewrites the test modules' asserts once, before
+    its workers start (:func:`_rewrite_ahead`)."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None and getattr(
+        config.option, "numprocesses", None
+    ):
+        _rewrite_ahead(config)
+
+
+def _rewrite_ahead(config: pytest.Config) -> None:
+    """Write the rewritten byte code of every test module and conftest that has none cached.
+
+    pytest rewrites a test module's asserts when it first imports it and caches the result
+    beside it; in a fresh checkout (CI) every worker found no cache and did the same ~10 s of
+    rewriting at once, as each collects every module.  Done here once, the workers read it.
+    Uses pytest's own rewriter (the same code and cache files as an import); with another
+    pytest whose internals differ, or no writable cache, the workers rewrite as before."""
+    import sys
+
+    if sys.dont_write_bytecode:
+        return
+    try:
+        from _pytest.assertion import rewrite
+        from _pytest.assertion.rewrite import assertstate_key
+
+        state = config.stash[assertstate_key]
+        for fn in sorted(ROOT.joinpath("tests").rglob("*.py")):
+            if not (fn.name.startswith("test_") or fn.name == "conftest.py"):
+                continue
+            pyc = rewrite.get_cache_dir(fn) / (fn.name[:-3] + rewrite.PYC_TAIL)
+            if rewrite._read_pyc(fn, pyc) is not None or not rewrite.try_makedirs(pyc.parent):
+                continue
+            source_hash, co = rewrite._rewrite_test(fn, config)
+            rewrite._write_pyc(state, co, source_hash, pyc)
+    except (ImportError, AttributeError, KeyError, TypeError, OSError, SyntaxError):
+        return
