@@ -96,6 +96,8 @@ class _Ctx:
     #: equal model values, one object each (the same init commands, identity, sync manager
     #: and mailbox layout slave after slave: a bus of a thousand drives holds one copy)
     seen: dict[object, object] = field(default_factory=dict)
+    #: an InitCmd element's content (attributes, children's tags, texts, attributes) -> its model
+    init_cmds: dict[tuple[object, ...], InitCmd] = field(default_factory=dict)
 
     def shared(self, value: _T) -> _T:
         """``value``, or the equal one this file gave before (the model is immutable)."""
@@ -344,9 +346,7 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
     init_cmds: tuple[InitCmd, ...] = ()
     if mailbox_node is not None:
         init_cmds = ctx.shared(
-            tuple(
-                ctx.shared(_init_cmd(ctx, n)) for n in mailbox_node.findall("CoE/InitCmds/InitCmd")
-            )
+            tuple(_init_cmd_once(ctx, n) for n in mailbox_node.findall("CoE/InitCmds/InitCmd"))
         )
     return Slave(
         position=pos,
@@ -773,6 +773,23 @@ def _place_unplaced(slaves: list[Slave]) -> list[Slave]:
                 ends[d] = start + bits
         out.append(replace(s, **changes) if changes else s)
     return out
+
+
+def _init_cmd_once(ctx: _Ctx, node: Node) -> InitCmd:
+    """:func:`_init_cmd`, read once per content: the init commands of a bus of like drives are
+    the same elements slave after slave (an InitCmd is leaves only; one with more depth, or
+    one that is wrong, is read as it stands)."""
+    children = node.children
+    if any(c.children for c in children):
+        return ctx.shared(_init_cmd(ctx, node))
+    key = (
+        tuple(node.attrib.items()),
+        tuple((c.tag, c.text, tuple(c.attrib.items())) for c in children),
+    )
+    cmd = ctx.init_cmds.get(key)
+    if cmd is None:
+        cmd = ctx.init_cmds[key] = ctx.shared(_init_cmd(ctx, node))
+    return cmd
 
 
 def _init_cmd(ctx: _Ctx, node: Node) -> InitCmd:
