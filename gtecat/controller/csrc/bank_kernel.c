@@ -94,13 +94,19 @@ int bank_kernel_sizes(void) { return (MAXSEG << 8) | NTPRM; }
 #define I64(f) ((int64_t *)ptr[F_##f])
 #define F64(f) ((double *)ptr[F_##f])
 
-/* numpy's float -> int64 cast on x86-64 (cvttsd2si): out of range and NaN give INT64_MIN */
+/* numpy's float -> int64 cast on x86-64 (cvttsd2si): out of range and NaN give INT64_MIN;
+ * on x86-64 that instruction itself, elsewhere the same result spelled out */
+#if defined(__x86_64__) && defined(__SSE2__)
+#include <emmintrin.h>
+INLINE int64_t to_i64(double x) { return _mm_cvttsd_si64(_mm_set_sd(x)); }
+#else
 static int64_t to_i64(double x)
 {
     if (x >= -9223372036854775808.0 && x < 9223372036854775808.0)
         return (int64_t)x;
     return INT64_MIN;
 }
+#endif
 
 /* Python's float floor division (Objects/floatobject.c _float_div_mod; numpy's npy_divmod) */
 static double floor_div(double vx, double wx)
