@@ -26,18 +26,24 @@ import logging
 import os
 from importlib import resources
 from operator import attrgetter
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..cbuild import shared_library
+from ..cbuild import NativeBuildError, shared_library
 
 if TYPE_CHECKING:
     from .bank import AxisBank
 
 log = logging.getLogger(__name__)
-#: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+#: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math (-O3 changes no
+#: value: it reorders no floating-point operation without -ffast-math's licences); portable
+#: code for any processor of the architecture (no -march: the cache may be shared between
+#: machines, and an instruction set chosen per processor measured no faster)
+CFLAGS = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+#: the plain build, when the compiler refuses CFLAGS
+PLAIN_CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64
 #: the int64 slots (``io``) and double slots (``fp``) of a cycle call, the C enums' order
 (IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN) = range(8)
@@ -78,7 +84,7 @@ def library() -> tuple[Any, str]:
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
     try:
-        lib = ctypes.CDLL(str(shared_library("bank_kernel", _source(), CFLAGS, ("-lm",))))
+        lib = ctypes.CDLL(str(build(CFLAGS)))
         lib.bank_kernel_fields.restype = ctypes.c_char_p
         lib.bank_kernel_abi.restype = ctypes.c_int
         lib.bank_kernel_cycle.restype = ctypes.c_int
@@ -129,6 +135,18 @@ def library() -> tuple[Any, str]:
     except Exception as e:  # no compiler, a failed build: the numpy cycle alone
         _LIB_REASON = f"{type(e).__name__}: {e}"
     return _LIB, _LIB_REASON
+
+
+def build(cflags: tuple[str, ...]) -> Path:
+    """The kernel built with ``cflags``, else (the compiler refused them) with the plain flags
+    (NativeBuildError when that fails too)."""
+    try:
+        return shared_library("bank_kernel", _source(), cflags, ("-lm",))
+    except NativeBuildError as e:
+        if cflags == PLAIN_CFLAGS:
+            raise
+        log.info("bank kernel: the build with %s failed, built plain: %s", " ".join(cflags), e)
+        return shared_library("bank_kernel", _source(), PLAIN_CFLAGS, ("-lm",))
 
 
 def _field_types() -> list[tuple[str, Any]]:
