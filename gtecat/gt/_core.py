@@ -39,9 +39,9 @@ from ..errors import (
     NoSlavesError,
     ParameterError,
 )
-from ..master.clock import ClockGroup
+from ..master.clock import ClockGroup, ClockMode
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder
-from .fast import RAW, READERS, fast_raw, fast_reader
+from .fast import CLOCK, RAW, READERS, fast_clock, fast_raw, fast_reader
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -236,6 +236,7 @@ def close_all() -> None:
     SESSION.core = 1
 
 
+_AUTO = ClockMode.AUTO
 REGISTRY: dict[str, Callable[..., int]] = {}
 #: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
 #: a controller process then runs every call through REGISTRY, none on a fast path
@@ -287,8 +288,16 @@ class _Refusal(Exception):
 def advance(ctl: Any, name: str, rc: int) -> int:
     """The host-call latency after a GT call (cycles may run, programs step): whatever they
     raise is turned into a code and a reason like the call's own errors, never let out."""
+    clock = ctl.clock
+    if clock.mode is _AUTO and clock.group is None:
+        # Clock.on_call in the common case, inline: the latency runs no cycle and no other
+        # clock shares this one's time
+        pending = clock._pending_ns + clock.call_latency_ns
+        if pending < clock.cycle_ns:
+            clock._pending_ns = pending
+            return rc
     try:
-        ctl.clock.on_call()
+        clock.on_call()
     except Exception as e:
         code = code_for(e)
         if code == CMD_NO_RESPONSE:
@@ -419,9 +428,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    if name in READERS or name in RAW:  # the common shapes answered up front (gtecat.gt.fast)
+    if name in READERS or name in RAW or name == CLOCK:  # common shapes up front (gt.fast)
         slow = gt
-        make = fast_reader if name in READERS else fast_raw
+        make = fast_reader if name in READERS else fast_raw if name in RAW else fast_clock
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]

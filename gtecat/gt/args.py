@@ -847,6 +847,13 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         "_INF": _INF,
         "P": params,
     }
+    env["_from_address"] = _from_address
+
+    def where(a: str) -> str:  # the address a byref() passes
+        if CARG_AT is None:
+            return f"_byref_address({a})"
+        return f"_from_address(id({a}) + {CARG_AT}).value"
+
     sig, body, out = [], [], []
     for i, p in enumerate(params):
         a, v = f"a{i}", f"v{i}"
@@ -888,7 +895,7 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
                 f"t = type({a})",
                 "if t is _CArg:",
                 f"    o = {a}._obj",
-                f"    if type(o) in OK{i} and _byref_address({a}) == _addressof(o):",
+                f"    if type(o) in OK{i} and {where(a)} == _addressof(o):",
                 f"        {v} = Ref({p.name!r}, _addressof(o), _sizeof(o), type(o), o)",
                 f"    else: {v} = C{i}({a})",
                 f"elif t in OK{i}: {v} = Ref({p.name!r}, _addressof({a}), _sizeof({a}), t, {a})",

@@ -14,9 +14,7 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
-import functools
 import struct
-import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -24,48 +22,17 @@ import numpy as np
 
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
+from .args import CARG_AT, byref_address
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
 
 
-@functools.lru_cache(maxsize=1024)
-def _cparam(address: int) -> str:
-    """The repr of ``byref(obj)`` for an object at ``address`` (fresh objects reuse addresses)."""
-    return f"<cparam 'P' ({address:#x})>"
-
-
 _NO: Any = object()  # an argument the caller did not pass
 _addressof = ctypes.addressof
-
-
-def _carg_address_offset() -> int | None:
-    """Where a ``byref()`` object keeps the address it passes, in bytes from its start.
-
-    ctypes offers no reader for it (``byref(obj, offset)`` looks like ``byref(obj)``), and
-    its repr costs a microsecond; the field's place in CPython's ``PyCArgObject`` is found
-    here by probing objects whose addresses are known, and used only when every probe,
-    with and without an offset, agrees.  None: not found, the repr is compared instead."""
-    try:
-        size = sys.getsizeof(ctypes.byref(ctypes.c_int()))
-        objs = [ctypes.c_long(), ctypes.c_int(), ctypes.c_double(), (ctypes.c_long * 3)()]
-        for k in range(16, size - 7, 8):
-            ok = True
-            for obj in objs:
-                for off in (0, 4, 8):
-                    p = ctypes.byref(obj, off)
-                    if ctypes.c_void_p.from_address(id(p) + k).value != _addressof(obj) + off:
-                        ok = False
-            if ok:
-                return k
-    except Exception:  # another implementation: the repr it is
-        return None
-    return None
-
-
-#: see :func:`_carg_address_offset`
-_CARG_AT = _carg_address_offset() if sys.implementation.name == "cpython" else None
 _from_address = ctypes.c_void_p.from_address
+#: where a byref() keeps its address (args.CARG_AT); -1: not known (byref_address reads it)
+_AT = CARG_AT if CARG_AT is not None else -1
 
 
 _status = AxisResources.status
@@ -130,6 +97,37 @@ def fast_reader(
     ) -> int:
         # positional-only: a keyword of the same name (count=1) goes to **kw, so the table
         # path answers it (7 for one given twice), never a TypeError
+        if type(n) is int and count is _NO and not kw and not extra:
+            # GT_GetSts(axis, p): the shape nearly every caller uses, in the fewest steps
+            ctl = session.controllers.get(1)
+            if ctl is not None and session.remote is None and session.core == 1:
+                res = ctl.resources.get(n)
+                clock = ctl.clock
+                if res is not None and clock._thread is None:
+                    tp = type(p)
+                    if tp is _CArg:
+                        if p is not last[0]:
+                            obj = p._obj
+                            # byref(obj), not byref(obj, offset); any doubt: the table path
+                            if type(obj) not in ctypes_ok or (
+                                _from_address(id(p) + _AT).value if _AT >= 0 else byref_address(p)
+                            ) != _addressof(obj):
+                                return slow(n, p)
+                            last[0] = p  # checked: the same pointer object next time is fine
+                        p._obj.value = get(res)
+                    elif tp in ctypes_ok:  # the ctypes object itself (passed by reference)
+                        p.value = get(res)
+                    else:
+                        return general(n, p, count, pClock, extra, kw)
+                    session.last = None
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+        return general(n, p, count, pClock, extra, kw)
+
+    def general(n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict) -> int:
+        """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
+        array, a numpy array, and anything the table path must answer."""
         ctl = session.controllers.get(1)
         if (
             type(n) is not int
@@ -152,12 +150,9 @@ def fast_reader(
             obj = p._obj
             if p is not last[0]:
                 # byref(obj), not byref(obj, offset): the address it holds is the object's
-                # (read where ctypes keeps it, else from its repr); any doubt: the table path
                 if type(obj) not in ctypes_ok or (
-                    _from_address(id(p) + _CARG_AT).value != _addressof(obj)
-                    if _CARG_AT is not None
-                    else repr(p) != _cparam(_addressof(obj))
-                ):
+                    _from_address(id(p) + _AT).value if _AT >= 0 else byref_address(p)
+                ) != _addressof(obj):
                     return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
                 last[0] = p  # checked: the same pointer object next time needs no check
             obj.value = get(res)
@@ -173,6 +168,62 @@ def fast_reader(
         if clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)
         return 0
+
+    gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
+    return gt
+
+
+#: the clock reader on the fast path (``pClock``, ``pLoop`` NULL or omitted)
+CLOCK = "GT_GetClock"
+#: the largest value each integer type of ``_INTS`` holds
+_INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
+
+
+def fast_clock(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetClock(pClock[, pLoop])`` with the fast path in front of the table: ``pClock``
+    ``byref(x)`` or ``x`` of an integer type of at least 32 bits, ``pLoop`` omitted, None or
+    0, on the in-process controller; anything else (a value the type cannot hold included)
+    takes the table path."""
+    last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
+
+    def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if (
+            (pLoop is _NO or pLoop is None or (type(pLoop) is int and pLoop == 0))
+            and not kw
+            and not extra
+        ):
+            ctl = session.controllers.get(1)
+            if ctl is not None and session.remote is None and session.core == 1:
+                clock = ctl.clock
+                if clock._thread is None:
+                    tp = type(pClock)
+                    if tp is _CArg:
+                        obj = pClock._obj
+                        if pClock is not last[0]:
+                            if type(obj) not in _INTS or (
+                                _from_address(id(pClock) + _AT).value
+                                if _AT >= 0
+                                else byref_address(pClock)
+                            ) != _addressof(obj):
+                                obj = None
+                            else:
+                                last[0] = pClock
+                    else:
+                        obj = pClock if tp in _INTS else None
+                    if obj is not None:
+                        ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
+                        if ms <= _INT_MAX[type(obj)]:
+                            obj.value = ms
+                            session.last = None
+                            if clock.mode is _LOCKSTEP:
+                                return 0
+                            return advance(ctl, name, 0)
+        return slow(*(a for a in (pClock, pLoop) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt
@@ -438,4 +489,4 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW
+    return frozenset(READERS) | RAW | {CLOCK}
