@@ -465,6 +465,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     return call(args[0], args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 
+        if fast is not None and hasattr(fast, "gtn"):  # the reader's own GTN_ fast path
+            fast.gtn_slow = gtn  # type: ignore[attr-defined]  # every other shape
+            gtn = functools.wraps(gtn)(fast.gtn)  # type: ignore[attr-defined]
         gtn.__name__ = "GTN_" + name[3:]
         gtn.__doc__ = with_units(
             name,

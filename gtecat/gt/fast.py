@@ -93,38 +93,24 @@ def fast_reader(
             )
         return ok
 
-    def gt(
-        n: Any = _NO, p: Any = _NO, count: Any = _NO, pClock: Any = _NO, /, *extra: Any, **kw: Any
-    ) -> int:
-        # positional-only: a keyword of the same name (count=1) goes to **kw, so the table
-        # path answers it (7 for one given twice), never a TypeError
-        if type(n) is int and count is _NO and not kw and not extra:
-            # GT_GetSts(axis, p): the shape nearly every caller uses, in the fewest steps
-            ctl = session.controllers.get(1)
-            if ctl is not None and session.remote is None and session.core == 1:
-                res = ctl.resources.get(n)
-                clock = ctl.clock
-                if res is not None and clock._thread is None:
-                    tp = type(p)
-                    if tp is _CArg:
-                        if p is not last[0]:
-                            obj = p._obj
-                            # byref(obj), not byref(obj, offset); any doubt: the table path
-                            if type(obj) not in ctypes_ok or (
-                                _from_address(id(p) + _AT).value if _AT >= 0 else byref_address(p)
-                            ) != _addressof(obj):
-                                return slow(n, p)
-                            last[0] = p  # checked: the same pointer object next time is fine
-                        p._obj.value = get(res)
-                    elif tp in ctypes_ok:  # the ctypes object itself (passed by reference)
-                        p.value = get(res)
-                    else:
-                        return general(n, p, count, pClock, extra, kw)
-                    session.last = None
-                    if clock.mode is _LOCKSTEP:
-                        return 0
-                    return advance(ctl, name, 0)
-        return general(n, p, count, pClock, extra, kw)
+    env = {
+        "_NO": _NO,
+        "_CArg": _CArg,
+        "_LOCKSTEP": _LOCKSTEP,
+        "_addressof": _addressof,
+        "_from_address": _from_address,
+        "byref_address": byref_address,
+        "session": session,
+        "get": get,
+        "ok": ctypes_ok,
+        "last": last,
+        "advance": advance,
+        "name": name,
+        "slow": slow,
+        "key": BANK_LISTS.get(name),
+        "to": float if ctypes_ok is _DOUBLE else None,
+    }
+    gt = _compiled(_READER, "gt", env, core="", session_core=" and session.core == 1")
 
     def general(n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict) -> int:
         """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
@@ -170,8 +156,97 @@ def fast_reader(
             return advance(ctl, name, 0)
         return 0
 
+    env["general"] = general
+
+    def gtn_general(
+        core: Any, n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict
+    ) -> int:
+        args = [a for a in (core, n, p, count, pClock) if a is not _NO]
+        return gt.gtn_slow(*args, *extra, **kw)  # type: ignore[attr-defined]
+
+    env["gtn_general"] = gtn_general
+    #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
+    #: its core); every other shape: the table's GTN_ function (set by gt_function)
+    gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session_core="")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt
+
+
+#: the bank's list of each reader's value (AxisBank.value), read without the two calls
+BANK_LISTS = {
+    "GT_GetSts": "sts",
+    "GT_GetPrfPos": "prf_p",
+    "GT_GetPrfVel": "prf_v",
+    "GT_GetPrfAcc": "prf_a",
+    "GT_GetAxisPrfPos": "a_last",
+    "GT_GetEncPos": "enc_pos",
+    "GT_GetEncVel": "enc_vel",
+}
+
+#: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
+#: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
+_READER = """
+def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
+    if type(n) is int and count is _NO and not kw and not extra{core_check}:
+        ctl = session.controllers.get(1)
+        if ctl is not None and session.remote is None{session_core}:
+            res = ctl.resources.get(n)
+            clock = ctl.clock
+            if res is not None and clock._thread is None:
+{{value}}
+                tp = type(p)
+                if tp is _CArg:
+                    if p is not last[0]:
+                        obj = p._obj
+                        # byref(obj), not byref(obj, offset); any doubt: the table path
+                        if type(obj) not in ok or {address} != _addressof(obj):
+                            return {fallback}
+                        last[0] = p  # checked: the same pointer object next time is fine
+                    p._obj.value = v
+                elif tp in ok:  # the ctypes object itself (passed by reference)
+                    p.value = v
+                else:
+                    return {fallback}
+                session.last = None
+                if clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+    return {fallback}
+"""
+
+
+def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session_core: str) -> Any:
+    """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
+    address = "_from_address(id(p) + _AT).value" if _AT >= 0 else "byref_address(p)"
+    gtn = bool(core)
+    code = template.format(
+        fname=fname,
+        core=core,
+        core_check=" and type(core) is int and core == 1" if gtn else "",
+        session_core=session_core,
+        address=address,
+        fallback=(
+            "gtn_general(core, n, p, count, pClock, extra, kw)"
+            if gtn
+            else "general(n, p, count, pClock, extra, kw)"
+        ),
+    )
+    env["_AT"] = _AT
+    if env["key"] is None:
+        value = "                v = get(res)"
+    else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
+        row = "lst[res.bank_row]" if env["to"] is None else "to(lst[res.bank_row])"
+        value = "\n".join(
+            "                " + line
+            for line in (
+                "b = res.bank",
+                "lst = b._lists.get(key) if b is not None else None",
+                f"v = get(res) if lst is None else {row}",
+            )
+        )
+    code = code.replace("{value}", value)
+    exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
+    return env[fname]
 
 
 #: the clock reader on the fast path (``pClock``, ``pLoop`` NULL or omitted)
