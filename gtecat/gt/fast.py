@@ -187,26 +187,39 @@ BANK_LISTS = {
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
 _READER = """
 def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
-    if type(n) is int and count is _NO and not kw and not extra{core_check}:
+    if (
+        type(n) is int
+        and not kw
+        and not extra{core_check}
+        and (
+            count is _NO
+            or (
+                type(count) is int
+                and count == 1
+                # pClock NULL: omitted, None or 0 (the manual's own GT_GetSts(1, &s, 1, 0))
+                and (pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0))
+            )
+        )
+    ):
         ctl = session.controllers.get(1)
         if ctl is not None and session.remote is None{session_core}:
             res = ctl.resources.get(n)
             clock = ctl.clock
             if res is not None and clock._thread is None:
-{{value}}
                 tp = type(p)
                 if tp is _CArg:
+                    obj = p._obj
                     if p is not last[0]:
-                        obj = p._obj
                         # byref(obj), not byref(obj, offset); any doubt: the table path
                         if type(obj) not in ok or {address} != _addressof(obj):
                             return {fallback}
                         last[0] = p  # checked: the same pointer object next time is fine
-                    p._obj.value = v
                 elif tp in ok:  # the ctypes object itself (passed by reference)
-                    p.value = v
+                    obj = p
                 else:
                     return {fallback}
+{{value}}
+                obj.value = v
                 session.last = None
                 if clock.mode is _LOCKSTEP:
                     return 0
@@ -353,6 +366,7 @@ RAW = frozenset(
 )
 _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
 _CAST: Any = object()
+_NUMPY: Any = object()
 _BYTES_NP = np.dtype(np.uint8)
 
 
@@ -487,6 +501,8 @@ def fast_raw(
             cast = None
         elif issubclass(tp, Array) and sizeof(tp) >= size:
             cast = _CAST  # a ctypes array: its bytes, through a memoryview kept per object
+        elif tp is _NDARRAY:
+            cast = _NUMPY  # one byte per element, checked per call; a memoryview kept
         else:
             return None
         if write:
@@ -539,6 +555,25 @@ def fast_raw(
                 ):
                     return False
                 move(p)
+                return True
+
+        elif cast is _NUMPY:
+
+            def copy(p: Any) -> bool:
+                if (
+                    p.dtype != _BYTES_NP
+                    or p.ndim != 1
+                    or not p.flags.c_contiguous
+                    or p.size < size
+                    or (not write and not p.flags.writeable)
+                ):
+                    return False
+                v = casts.get(id(p))
+                if v is None or v.obj is not p:
+                    if len(casts) >= 16:
+                        casts.clear()
+                    v = casts[id(p)] = memoryview(p)
+                move(v)
                 return True
 
         else:
