@@ -108,6 +108,9 @@ def fast_reader(
         "name": name,
         "slow": slow,
         "key": BANK_LISTS.get(name),
+        "_NDARRAY": _NDARRAY,
+        "np_ok": np_ok,
+        "is_array": is_array,
         "to": float if ctypes_ok is _DOUBLE else None,
     }
     gt = _compiled(_READER, "gt", env, core="", session_core=" and session.core == 1")
@@ -216,10 +219,21 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
                         last[0] = p  # checked: the same pointer object next time is fine
                 elif tp in ok:  # the ctypes object itself (passed by reference)
                     obj = p
+                elif (
+                    tp is _NDARRAY
+                    and p.dtype in np_ok
+                    and p.ndim == 1
+                    and p.size
+                    and p.flags.writeable
+                ) or is_array(tp):  # a numpy or ctypes array: its first element
+                    obj = None
                 else:
                     return {fallback}
 {{value}}
-                obj.value = v
+                if obj is None:
+                    p[0] = v
+                else:
+                    obj.value = v
                 session.last = None
                 if clock.mode is _LOCKSTEP:
                     return 0
@@ -482,7 +496,11 @@ def fast_raw(
     copiers: dict[tuple[int, int, int, type], Callable[[Any], bool]] = {}
 
     def copier(slave: int, offset: int, size: int, tp: type, image: Any) -> Any:
-        """The copier of a shape (module docstring of :func:`fast_raw`), None: none."""
+        """``copy(p)`` for one shape (a range of the image, a buffer type): it moves the
+        bytes and returns True, or False when this buffer cannot take them this way (the
+        general path decides); None: no copier for the shape.  Compiled from
+        :data:`_COPY` (one function: the checks of the buffer, then one slice per run or
+        one gather of the whole range)."""
         raw = offset
         if io:
             slaves = image.layout.slaves
@@ -496,148 +514,84 @@ def fast_raw(
         if plan is None or not plan[0]:
             return None
         runs, idx = plan
-        img = memoryview(image.buffer)
         if tp is bytearray or tp is memoryview or (write and tp is bytes):
-            cast = None
+            get = "q = p"
+            check = ["if len(p) < size: return False"]
+            if tp is memoryview:
+                check.append(
+                    'if p.format != "B" or p.ndim != 1 or not p.c_contiguous: return False'
+                )
+                if not write:
+                    check.append("if p.readonly: return False")
         elif issubclass(tp, Array) and sizeof(tp) >= size:
-            cast = _CAST  # a ctypes array: its bytes, through a memoryview kept per object
+            # a ctypes array: its bytes, through a memoryview kept per object
+            get = "q = kept(p, True)\n    if q is None: return False"
+            check = []
         elif tp is _NDARRAY:
-            cast = _NUMPY  # one byte per element, checked per call; a memoryview kept
+            check = [
+                "if (p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous "
+                "or p.size < size): return False"
+            ]
+            if not write:
+                check.append("if not p.flags.writeable: return False")
+            get = "q = kept(p, False)"
         else:
             return None
         if write:
-            if len(runs) == 1:
-                ((a, first, n),) = runs
-
-                def put(p: Any) -> None:
-                    img[first : first + n] = p[a : a + n]
-            else:
-
-                def put(p: Any) -> None:
-                    for a, first, n in runs:
-                        img[first : first + n] = p[a : a + n]
-
-            move = put
+            move = [f"img[{first}:{first + n}] = q[{a}:{a + n}]" for a, first, n in runs]
         elif len(runs) == 1:
             ((a, first, n),) = runs
-            end = first + n
-
-            def get(p: Any) -> None:
-                p[a : a + n] = img[first:end]
-
-            move = get
+            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]"]
+        elif tp is bytearray:
+            move = ["q[0:size] = gather(img)"]  # the bytes of the range, in one C call
         else:
-            gather = itemgetter(*idx.tolist())  # the bytes of the range, in one C call
+            move = ["q[0:size] = bytes(gather(img))"]
+        body = "\n    ".join([*check, get, *move, "return True"])
+        env = {
+            "img": memoryview(image.buffer),
+            "size": size,
+            "gather": itemgetter(*idx.tolist()) if len(idx) > 1 else None,
+            "kept": kept,
+            "_BYTES_NP": _BYTES_NP,
+        }
+        exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
+        return env["copy"]
 
-            if tp is bytearray:
+    casts: dict[int, memoryview] = {}  # byte views of buffers, the last few (kept alive)
 
-                def get_ints(p: Any) -> None:
-                    p[0:size] = gather(img)
+    def kept(p: Any, cast: bool) -> memoryview | None:
+        """A memoryview of the bytes of ``p`` (a ctypes array: cast to bytes), kept for the
+        next call with the same object; None: none can be made."""
+        v = casts.get(id(p))
+        if v is None or v.obj is not p:
+            if len(casts) >= 16:
+                casts.clear()
+            try:
+                v = memoryview(p).cast("B") if cast else memoryview(p)
+            except (TypeError, ValueError):  # a format memoryview cannot take
+                return None
+            casts[id(p)] = v
+        return v
 
-                move = get_ints
-            else:
-
-                def get_bytes(p: Any) -> None:
-                    p[0:size] = bytes(gather(img))
-
-                move = get_bytes
-        if cast is None:
-            check_memoryview = tp is memoryview
-
-            def copy(p: Any) -> bool:
-                if len(p) < size:
-                    return False
-                if check_memoryview and (
-                    p.format != "B"
-                    or p.ndim != 1
-                    or not p.c_contiguous
-                    or (p.readonly and not write)
-                ):
-                    return False
-                move(p)
-                return True
-
-        elif cast is _NUMPY:
-
-            def copy(p: Any) -> bool:
-                if (
-                    p.dtype != _BYTES_NP
-                    or p.ndim != 1
-                    or not p.flags.c_contiguous
-                    or p.size < size
-                    or (not write and not p.flags.writeable)
-                ):
-                    return False
-                v = casts.get(id(p))
-                if v is None or v.obj is not p:
-                    if len(casts) >= 16:
-                        casts.clear()
-                    v = casts[id(p)] = memoryview(p)
-                move(v)
-                return True
-
-        else:
-
-            def copy(p: Any) -> bool:
-                v = casts.get(id(p))
-                if v is None or v.obj is not p:
-                    if len(casts) >= 16:
-                        casts.clear()
-                    try:
-                        v = memoryview(p).cast("B")
-                    except (TypeError, ValueError):  # a format memoryview cannot take
-                        return False
-                    casts[id(p)] = v
-                move(v)
-                return True
-
-        return copy
-
-    casts: dict[int, memoryview] = {}  # ctypes arrays' bytes, the last few (kept alive)
-
-    def front(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
-        """The common shapes in the fewest steps; the rest through :func:`run`."""
-        ctl = session.controllers.get(1)
-        if (
-            ctl is not None
-            and type(offset) is int
-            and type(size) is int
-            and session.remote is None
-            and session.core == 1
-        ):
-            m = ctl.master
-            clock = ctl.clock
-            if m is not None and m.opened and not m.offline and clock._thread is None:
-                image = m.image
-                if image is not seen[0]:
-                    cache.clear()
-                    copiers.clear()
-                    casts.clear()
-                    seen[0], seen[1] = image, memoryview(image.buffer)
-                key = (slave, offset, size, type(p))
-                copy = copiers.get(key, _NO)
-                if copy is _NO:
-                    copy = copiers[key] = copier(slave, offset, size, type(p), image)
-                if copy is not None and copy(p):
-                    session.last = None
-                    if clock.mode is _LOCKSTEP:
-                        return 0
-                    return advance(ctl, name, 0)
-        return run(slave, offset, size, p, args)
-
-    def raw_gt(
-        offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any
-    ) -> int:  # positional-only, as the readers
-        if extra or kw or p is _NO:
-            return slow(*(a for a in (offset, size, p) if a is not _NO), *extra, **kw)
-        return front(-1, offset, size, p, (offset, size, p))
-
-    def io_gt(
-        slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *more: Any, **kw: Any
-    ) -> int:
-        if more or kw or p is _NO or type(slave) is not int:
-            return slow(*(a for a in (slave, offset, size, p) if a is not _NO), *more, **kw)
-        return front(slave, offset, size, p, (slave, offset, size, p))
+    env = {
+        "_NO": _NO,
+        "_LOCKSTEP": _LOCKSTEP,
+        "session": session,
+        "seen": seen,
+        "copiers": copiers,
+        "copier": copier,
+        "reset": lambda image: (
+            cache.clear(),
+            copiers.clear(),
+            casts.clear(),
+            seen.__setitem__(slice(None), [image, memoryview(image.buffer)]),
+        ),
+        "advance": advance,
+        "name": name,
+        "slow": slow,
+    }
+    gt = _compiled_raw(env, io)
+    env["run"] = lambda *a: run(*a)
 
     def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)
@@ -687,9 +641,59 @@ def fast_raw(
             return advance(ctl, name, 0)
         return 0
 
-    gt = io_gt if io else raw_gt
     gt.slow = slow  # type: ignore[attr-defined]
     return gt
+
+
+#: the raw image functions' common shapes in the fewest steps (the IO pair with the slave
+#: first): the session's checks, then the shape's copier; anything else: ``run``
+_RAW = """
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+    if extra or kw or p is _NO{slave_check}:
+        return slow(*(a for a in ({slave_arg}offset, size, p) if a is not _NO), *extra, **kw)
+    ctl = session.controllers.get(1)
+    if (
+        ctl is not None
+        and type(offset) is int
+        and type(size) is int
+        and session.remote is None
+        and session.core == 1
+    ):
+        m = ctl.master
+        clock = ctl.clock
+        if m is not None and m.opened and not m.offline and clock._thread is None:
+            image = m.image
+            if image is not seen[0]:
+                reset(image)
+            key = ({slave_key}, offset, size, type(p))
+            copy = copiers.get(key, _NO)
+            if copy is _NO:
+                copy = copiers[key] = copier({slave_key}, offset, size, type(p), image)
+            if copy is None:
+                done = False
+            else:
+                try:
+                    done = copy(p)
+                except Exception:  # (a released memoryview): the general path answers
+                    done = False
+            if done:
+                session.last = None
+                if clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+    return run({slave_key}, offset, size, p, ({slave_arg}offset, size, p))
+"""
+
+
+def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
+    code = _RAW.format(
+        slave="slave=_NO, " if io else "",
+        slave_check=" or type(slave) is not int" if io else "",
+        slave_arg="slave, " if io else "",
+        slave_key="slave" if io else "-1",
+    )
+    exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
+    return env["gt"]
 
 
 #: why a function that takes pointers is answered by the table path only (its binder checks
