@@ -25,6 +25,7 @@ deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session re
 from __future__ import annotations
 
 import ctypes
+import gc
 import gzip
 import json
 import os
@@ -476,11 +477,31 @@ def replay(
     eni: str | None = None,
     machine: str | None = None,
 ) -> tuple[int, Divergence | None]:
-    """Re-run a recording; (calls replayed, the first divergence or None)."""
+    """Re-run a recording; (calls replayed, the first divergence or None).
+
+    The recording's entries are read with the cyclic collector paused (a hundred thousand
+    objects made at once, none in a cycle: the collector would walk them again and again
+    while they are made, as Controller.init_ecat says of the bus model), and they are kept
+    out of its later walks while the calls run (``gc.freeze``)."""
     p, head, lines = _open(path)
-    steps = _steps(p, lines)
-    with _where(head):
-        return _replay(steps, eni, machine)
+    paused = gc.isenabled()
+    if paused:
+        gc.disable()
+    try:
+        steps = _steps(p, lines)
+    finally:
+        if paused:
+            gc.enable()
+    del lines
+    freeze = gc.get_freeze_count() == 0  # (a process that froze its own objects: left so)
+    if freeze:
+        gc.freeze()
+    try:
+        with _where(head):
+            return _replay(steps, eni, machine)
+    finally:
+        if freeze:
+            gc.unfreeze()
 
 
 @dataclass(slots=True)
@@ -505,6 +526,8 @@ class _Call:
     checks: list[tuple[int | str, Any]]
     before: int | None  # "b": the controller time the call began at
     opens: bool  # GT_Open: the replay's own settings
+    #: the call in one compiled function (:func:`_compiled`), None: the loop runs it
+    run: Any = None
 
 
 def _prepare(
@@ -580,7 +603,36 @@ def _prepare(
         e.get("b"),
         name in ("GT_Open", "GTN_Open"),
     )
+    if call.before is None and not fresh and kw is None and not call.opens and not checks:
+        call.run = _compiled(call)
     return call, tuple(vals)
+
+
+_DAMAGED = (TypeError, ValueError, KeyError, AttributeError)
+
+
+def _compiled(p: _Call) -> Any:
+    """``run(vals)``: the call of ``p`` made as the replay loop makes it (the pooled pointers
+    set, the function called, its return code and the values it left compared), compiled
+    into one function: None when everything matched, ``(rc,)`` when something may differ
+    (the loop compares in full and reports), an exception when a value cannot be set."""
+    env: dict[str, Any] = {"fn": p.fn, "RC": p.rc, "_DAMAGED": _DAMAGED}
+    lines = ["def run(vals):"]
+    if p.sets:
+        lines.append("    try:")
+        for j, (obj, k) in enumerate(p.sets):
+            env[f"S{j}"] = obj
+            lines.append(f"        S{j}.value = vals[{k}]")
+        lines += ["    except _DAMAGED as err:", "        return err"]
+    for j, a in enumerate(p.args):
+        env[f"A{j}"] = a
+    lines.append(f"    rc = fn({', '.join(f'A{j}' for j in range(len(p.args)))})")
+    same = ["rc != RC", *(f"Q{j}.value != vals[{k}]" for j, (_, k, _, _) in enumerate(p.quick))]
+    for j, (obj, _, _, _) in enumerate(p.quick):
+        env[f"Q{j}"] = obj
+    lines += [f"    if {' or '.join(same)}:", "        return (rc,)", "    return None"]
+    exec(compile("\n".join(lines), f"<replay {p.name}>", "exec"), env)
+    return env["run"]
 
 
 def _pooled(
@@ -765,41 +817,19 @@ def _replay(
                 if what == "missing":
                     return n, Divergence(n, text, "function", "present", "missing")
                 raise ParameterError(f"damaged recording: call {n} {text}")
-            if p.before is not None:  # time passed between the calls: let it pass here too
-                ctl = _controller()
-                if ctl is not None:
-                    gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
-                    if gap > 0:
-                        ctl.clock.advance_ns(gap)
-            args = p.args
-            try:
-                for obj, k in p.sets:
-                    obj.value = vals[k]
-                if p.fresh:
-                    args = list(args)
-                    for i, x in p.fresh:
-                        args[i] = decode(x)
-            except (TypeError, ValueError, KeyError, AttributeError) as err:
-                raise ParameterError(
-                    f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                    f"again: {type(err).__name__}: {err}"
-                ) from None
-            if p.kw is None and not p.opens:
-                kw: dict[str, Any] = {}
-                rc = p.fn(*args)
+            run = p.run
+            if run is not None:  # the common call, compiled: compared in full only if it may differ
+                r = run(vals)
+                if r is None:
+                    continue
+                if type(r) is not tuple:
+                    raise ParameterError(
+                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+                        f"again: {type(r).__name__}: {r}"
+                    )
+                args, kw, rc = p.args, {}, r[0]
             else:
-                kw = {k: decode(v) for k, v in (p.kw or {}).items()}
-                if p.opens:
-                    if eni:
-                        kw["eni"] = str(eni)
-                    if machine:
-                        kw["machine"] = str(machine)
-                    if kw.get("clock") == "realtime":
-                        kw["clock"] = "auto"
-                    if kw.get("backend") == "pysoem":
-                        kw["backend"] = "emulated"
-                    kw["log"] = ""  # the session's master log is not written again
-                rc = p.fn(*args, **kw)
+                args, kw, rc = _call(p, vals, n, eni, machine)
             if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
                 return n, Divergence(n, p.name, "return code", p.rc, rc)
             for obj, k, i, c in p.quick:
@@ -816,6 +846,45 @@ def _replay(
     finally:
         gt.GT_Close()
     return n, None
+
+
+def _call(
+    p: _Call, vals: Any, n: int, eni: str | None, machine: str | None
+) -> tuple[Any, dict[str, Any], Any]:
+    """Call ``n`` made as recorded (the general way): (its arguments, keywords, code)."""
+    if p.before is not None:  # time passed between the calls: let it pass here too
+        ctl = _controller()
+        if ctl is not None:
+            gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
+            if gap > 0:
+                ctl.clock.advance_ns(gap)
+    args = p.args
+    try:
+        for obj, k in p.sets:
+            obj.value = vals[k]
+        if p.fresh:
+            args = list(args)
+            for i, x in p.fresh:
+                args[i] = decode(x)
+    except _DAMAGED as err:
+        raise ParameterError(
+            f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+            f"again: {type(err).__name__}: {err}"
+        ) from None
+    if p.kw is None and not p.opens:
+        return args, {}, p.fn(*args)
+    kw = {k: decode(v) for k, v in (p.kw or {}).items()}
+    if p.opens:
+        if eni:
+            kw["eni"] = str(eni)
+        if machine:
+            kw["machine"] = str(machine)
+        if kw.get("clock") == "realtime":
+            kw["clock"] = "auto"
+        if kw.get("backend") == "pysoem":
+            kw["backend"] = "emulated"
+        kw["log"] = ""  # the session's master log is not written again
+    return args, kw, p.fn(*args, **kw)
 
 
 def _other(e: dict[str, Any], n: int, faults: Any) -> Divergence | None:
