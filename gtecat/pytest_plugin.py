@@ -50,6 +50,24 @@ from typing import Any
 
 import pytest
 
+
+def _not_rewritten() -> None:
+    """Leave gtecat's own modules to Python's import, not pytest's assertion rewriter.
+
+    pytest rewrites the asserts of every module of a plugin's distribution, and that is all of
+    gtecat (~350 modules) since this plugin ships with it: parsed and compiled again in every
+    pytest process that has no rewritten copy cached yet (a fresh install, or
+    ``PYTHONDONTWRITEBYTECODE`` set), about 14 s of CPU each.  Its modules hold no test
+    asserts; this module (imported first) keeps the rewriting.  Without the hook's set (another
+    pytest) nothing changes."""
+    for finder in sys.meta_path:
+        marked = getattr(finder, "_must_rewrite", None)
+        if type(finder).__name__ == "AssertionRewritingHook" and isinstance(marked, set):
+            marked.discard(__name__.partition(".")[0])
+
+
+_not_rewritten()
+
 DEFAULT_FILE = "Gecat.eni"
 NO_ENI = (
     "gtecat: which bus should the tests run against? Name it in pytest.ini "

@@ -44,13 +44,60 @@ def campaign_seed() -> int:
     return int.from_bytes(os.urandom(4), "little")
 
 
+#: why the default run skips a ``@pytest.mark.long`` test
+LONG_REASON = (
+    "a longer check: GTECAT_LONG=1 runs it (the default run keeps the suite within its CPU "
+    "budget of 120 s on two CPUs)"
+)
+
+
+def _long_and_sampled(items: list[pytest.Item]) -> None:
+    """The default run's share of the longer checks (docs/performance.md, the test suite).
+
+    ``@pytest.mark.long``: skipped unless ``GTECAT_LONG=1``.  ``@pytest.mark.sample(k)`` on
+    a parametrized test: the default run keeps ``k`` of its cases, chosen by
+    :func:`campaign_seed` (the same ones on every CI run, others on each developer's run),
+    and skips the rest saying so; ``GTECAT_LONG=1`` runs every case.  Skips are marks added at
+    collection, so every xdist worker collects the same items."""
+    if LONG:
+        return
+    import random
+
+    families: dict[tuple[str, str], list[pytest.Item]] = {}
+    for item in items:
+        if item.get_closest_marker("long") is not None:
+            item.add_marker(pytest.mark.skip(reason=LONG_REASON))
+        elif item.get_closest_marker("sample") is not None:
+            key = (item.nodeid.split("::")[0], getattr(item, "originalname", item.name))
+            families.setdefault(key, []).append(item)
+    seed = campaign_seed()
+    rng = random.Random(seed)
+    for (_, name), family in sorted(families.items()):
+        keep = int(family[0].get_closest_marker("sample").args[0])
+        if keep >= len(family):
+            continue
+        family.sort(key=lambda i: i.name)
+        kept = set(rng.sample(range(len(family)), keep))
+        for n, item in enumerate(family):
+            if n not in kept:
+                item.add_marker(
+                    pytest.mark.skip(
+                        reason=f"sampled out: the default run takes {keep} of the {len(family)} "
+                        f"cases of {name} (seed {seed}); GTECAT_LONG=1 runs all"
+                    )
+                )
+
+
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config, items):  # type: ignore[no-untyped-def]
-    """``--dist loadgroup`` (pyproject's addopts) keeps the tests of one ``xdist_group`` on one
+    """The default run's longer checks (:func:`_long_and_sampled`), then the xdist groups.
+
+    ``--dist loadgroup`` (pyproject's addopts) keeps the tests of one ``xdist_group`` on one
     worker, so a module's expensive fixture (a demo run, compiled programs, a panel and its
     browser) is built once.  pytest-xdist marks them by appending ``@group`` to the nodeid
     through an attribute that pytest 9.2 no longer reads (its nodeid is structured now):
     without this the groups were split over the workers and each built the fixture."""
+    _long_and_sampled(items)
     if not getattr(config.option, "loadgroup", False):  # set in xdist workers
         return
     try:
@@ -147,3 +194,41 @@ def _no_controller_left_open():
     core = sys.modules.get("gtecat.gt._core")
     if core is not None and core.SESSION.all_controllers():
         core.close_all()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The controller of a pytest-xdist run rewrites the test modules' asserts once, before
+    its workers start (:func:`_rewrite_ahead`)."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None and getattr(
+        config.option, "numprocesses", None
+    ):
+        _rewrite_ahead(config)
+
+
+def _rewrite_ahead(config: pytest.Config) -> None:
+    """Write the rewritten byte code of every test module and conftest that has none cached.
+
+    pytest rewrites a test module's asserts when it first imports it and caches the result
+    beside it; in a fresh checkout (CI) every worker found no cache and did the same ~10 s of
+    rewriting at once, as each collects every module.  Done here once, the workers read it.
+    Uses pytest's own rewriter (the same code and cache files as an import); with another
+    pytest whose internals differ, or no writable cache, the workers rewrite as before."""
+    import sys
+
+    if sys.dont_write_bytecode:
+        return
+    try:
+        from _pytest.assertion import rewrite
+        from _pytest.assertion.rewrite import assertstate_key
+
+        state = config.stash[assertstate_key]
+        for fn in sorted(ROOT.joinpath("tests").rglob("*.py")):
+            if not (fn.name.startswith("test_") or fn.name == "conftest.py"):
+                continue
+            pyc = rewrite.get_cache_dir(fn) / (fn.name[:-3] + rewrite.PYC_TAIL)
+            if rewrite._read_pyc(fn, pyc) is not None or not rewrite.try_makedirs(pyc.parent):
+                continue
+            source_hash, co = rewrite._rewrite_test(fn, config)
+            rewrite._write_pyc(state, co, source_hash, pyc)
+    except (ImportError, AttributeError, KeyError, TypeError, OSError, SyntaxError):
+        return

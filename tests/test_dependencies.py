@@ -37,6 +37,7 @@ def _imports(path: Path) -> set[str]:
     return out
 
 
+@pytest.mark.long
 def test_package_imports_no_top_level_neighbours():
     """A user's own ``eni.py``, ``drives.py`` or ``tools/`` beside their script change nothing."""
     bad = []
@@ -99,6 +100,7 @@ def test_gtecat_subpackages_import_only_downwards(sub):
     assert not bad, "\n".join(bad)
 
 
+@pytest.mark.long
 def test_users_own_modules_beside_the_script_change_nothing(tmp_path):
     """A user's ``eni.py``, ``drives.py``, ``tools.py`` and ``tests/`` next to their script."""
     import shutil

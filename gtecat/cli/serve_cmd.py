@@ -229,6 +229,28 @@ def take_scheduling(rt: int | str, wait_given: str, cpu: int | None) -> tuple[in
     return prio, f"SCHED_FIFO {prio}"
 
 
+def preemption_words(realtime: bool) -> tuple[str, str | None]:
+    """The kernel's preemption model for the ready line (``, kernel preemption none``), with a
+    warning where it does not bound a real-time wake-up: under ``none`` and ``voluntary`` a
+    normal task inside a system call keeps its CPU until the call ends, and a frame for the
+    server waits for it, whatever the server's priority. Decision: serve does not switch the
+    model itself (a boot option, ``preempt=full``, or the debugfs switch of a PREEMPT_DYNAMIC
+    kernel, which changes the whole host); it says what it found."""
+    from gtecat.wire.serve import UNPREEMPTIBLE, kernel_preemption
+
+    model = kernel_preemption()
+    if model is None:
+        return "", None
+    warning = None
+    if realtime and model in UNPREEMPTIBLE:
+        warning = (
+            f"the kernel's preemption model is {model!r}: another program's system call "
+            "can hold the server's CPU for milliseconds before it runs; boot with "
+            "preempt=full (or a PREEMPT_RT kernel) for a bounded answer time"
+        )
+    return f", kernel preemption {model}", warning
+
+
 def _scheduling_now() -> tuple[int, int, set[int]] | None:
     try:
         return (
@@ -336,6 +358,10 @@ def run(args: argparse.Namespace) -> int:
     # the end (a program that calls serve in-process keeps its own)
     before = _scheduling_now()
     rt, scheduling = take_scheduling(args.rt_priority, wait_given, args.cpu)
+    words, warning = preemption_words(rt is not None)
+    scheduling += words
+    if warning:  # said right after the ready line (the first line is the ready line)
+        server.early_messages.append(f"warning: {warning}")
     if rt is None and wants_rt and wait == "predict" and args.wait == "auto":
         wait = server.wait = resolve_wait("auto", None)
     if rt is not None:
@@ -397,10 +423,13 @@ def run(args: argparse.Namespace) -> int:
         _write_stats(report)
         lat = report["latency"]
         if served:  # a server that never started has nothing to report
+            steal = report.get("host_steal_percent")
             print(
                 f"gtecat serve: stopped after {report['elapsed_s']} s, "
                 f"{report['sent']} frames answered, {report['chain']['dropped']} dropped, "
-                f"latency p50 {lat.get('p50_us', 0):.1f} us",
+                f"latency p50 {lat.get('p50_us', 0):.1f} us, p99 {lat.get('p99_us', 0):.1f} us, "
+                f"{lat.get('over_1ms', 0)} over 1 ms"
+                + (f" (the hypervisor took {steal} % of the CPUs)" if steal else ""),
                 flush=True,
             )
     return 0

@@ -23,7 +23,13 @@ before anything else may look at or change them:
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
   the slave through :attr:`gtecat.drives.drive.Cia402Drive.on_touch`;
 * per-cycle hooks the bank does not know (a recorder, motion programs, smart homing)
-  and axes in Gear/Follow mode (they read other axes every cycle) turn it off.
+  turn it off.
+
+PT, Gear, Follow and coordinated motion run in it too (:mod:`.bank_modes`): the axes whose
+planners depend on each other (a Gear/Follow slave and its master, the axes of a coordinate
+system) are claimed and given back together as a cluster, their planners stepped a table
+ahead and put back exactly at a release; a slave the bank cannot follow (it reads an encoder)
+keeps only its own cluster (and the drives it shares) on the scalar path.
 
 Claimed axes are re-examined whenever a GT call or a release happened, else every
 :data:`RECHECK_CYCLES` cycles.  A multi-axis drive is claimed with all its channels.
@@ -64,9 +70,10 @@ from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
 from .axis_status import AxisStatus
-from .bank_kernel import MAXSEG, NTPRM, Kernel, trap_fill
+from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
+from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -151,6 +158,10 @@ _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.MOVING),
     int(AxisStatus.ARRIVED),
 )
+
+
+#: the modes whose planners a cluster steps ahead (gtecat.controller.bank_modes)
+_SAMPLED_MODES = (PrfMode.PT, PrfMode.GEAR, PrfMode.FOLLOW, PrfMode.INTERPOLATION)
 
 
 def _trap_key(pl: TrapPlanner) -> tuple:
@@ -253,6 +264,9 @@ class AxisBank:
                     "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
                     f"the bank ({self.kernel_reason})"
                 )
+        #: the compiled fills of static PT tables (bank_modes), None without the kernel
+        self.pt_run = PtRun(self._kernel_lib) if self._kernel_lib is not None else None
+        self.pt_fill: PtFill | None = None  # (made with the rows)
         #: cycles the compiled kernel ran (statistics)
         self.kernel_cycles = 0
         #: of those, the cycles it ran many at a time (:meth:`run_many`; statistics)
@@ -261,6 +275,8 @@ class AxisBank:
         self.homing_rows_run = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
+        #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
+        self.sampled_samples = 0
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -373,6 +389,9 @@ class AxisBank:
         self.tau, self.jE = z(n), z(n)  # smoothing time constant, e^(-T/tau)
         self.taken = zi(n, np.int64)  # samples taken since the claim
         self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
+        #: rows whose planners a cluster steps ahead (gtecat.controller.bank_modes)
+        self.sampled = zi(n, bool)
+        self.fill_taken = zi(n, np.int64)  # ``taken`` at the cluster's last fill
         self.ended = zi(n, bool)
         tl = self.table = KERNEL_TABLE if self._kernel_lib is not None else TABLE
         self.t_p, self.t_v, self.t_a = z((n, tl + 1)), z((n, tl + 1)), z((n, tl + 1))
@@ -398,6 +417,7 @@ class AxisBank:
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
+            self.pt_fill = PtFill(self._kernel_lib, n)
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
@@ -464,9 +484,6 @@ class AxisBank:
             return "a slave is unplugged"
         if ctl.backend.answer_hook is not None:
             return "faults on the frames (gtecat.faults)"
-        for res in ctl.resources.values():  # never the Axis objects: they may be guarded
-            if res.profile.mode in (PrfMode.GEAR, PrfMode.FOLLOW):
-                return "an axis follows another (Gear/Follow)"
         return ""
 
     @staticmethod
@@ -519,6 +536,13 @@ class AxisBank:
                     return False
             elif pl._mode != _JOG_IDLE:
                 return False
+        elif prof.mode in _SAMPLED_MODES and pl is prof.planners.get(prof.mode):
+            _Bypass.on = True  # (a claimed cluster's planners are read in refresh too)
+            try:
+                if not sampled_kind(pl):
+                    return False
+            finally:
+                _Bypass.on = False
         else:
             return False
         if not self._inputs_plain(ax, res):
@@ -622,16 +646,37 @@ class AxisBank:
                 self.release_all()
             return
         changed = missed = False
-        for g in self.groups:
-            if g.claimed:
+        for gs, srows, bad in self._components():
+            if all(g.claimed for g in gs):
                 continue
-            if g.drive.al_state != AlState.OP:
+            held = [g for g in gs if g.claimed]
+            if held:  # part of a cluster is out: the rest comes back too, then all together
+                self._release_groups(held)
+                changed = True
+            if bad or any(g.drive.al_state != AlState.OP for g in gs):
                 continue
-            if not all(self._eligible(r) for r in g.rows):
+            if not all(self._eligible(r) for g in gs for r in g.rows):
                 continue
-            claimed = self._claim(g)
-            changed |= claimed
-            missed |= not claimed
+            if srows and not all(self._steppable(r) for r in srows):
+                continue
+            if not all(self._can_claim(g) for g in gs):
+                missed = True
+                continue
+            for r in srows:
+                self.sampled[r] = True
+            for g in gs:
+                self._claim(g)
+            if srows:
+                _Bypass.on = True
+                try:
+                    cl = Cluster(self, srows, [self._gi[id(g)] for g in gs])
+                finally:
+                    _Bypass.on = False
+                for gi in cl.groups:
+                    self._cluster_of[gi] = cl
+                for c in cl.systems:
+                    c.banked = True
+            changed = True
         if changed:
             self._reindex()
         if missed and not self._missed:
@@ -640,17 +685,66 @@ class AxisBank:
             self._countdown = 1
         self._missed = missed
 
-    def _claim(self, g: _Group) -> bool:
-        # the slave decoded exactly what is in the image (no raw write since its last step)
+    def _components(self) -> list[tuple[list[_Group], list[int], bool]]:
+        """The groups to claim together, each with its rows a cluster steps ahead and whether
+        a dependency keeps it scalar (gtecat.controller.bank_modes); a group alone otherwise."""
+        if not hasattr(self, "_gi"):
+            self._gi = {id(g): gi for gi, g in enumerate(self.groups)}
+            self._cluster_of: dict[int, Cluster] = {}
+            pos = {id(ax): k for k, ax in enumerate(self.ctl._axis_list)}
+            self.order = [pos.get(id(ax), k) for k, ax in enumerate(self.axes)]
+        _Bypass.on = True
+        try:
+            pairs, sampled, bad = links(self)
+        finally:
+            _Bypass.on = False
+        if not pairs and not sampled and not bad:
+            return [([g], [], False) for g in self.groups]
+        group_of = self.group_of
+        parent = list(range(len(self.groups)))
+
+        def find(i: int) -> int:
+            while parent[i] != i:
+                parent[i] = parent[parent[i]]
+                i = parent[i]
+            return i
+
+        for a, b in pairs:
+            ra, rb = find(group_of[a]), find(group_of[b])
+            if ra != rb:
+                parent[ra] = rb
+        comps: dict[int, list[int]] = {}
+        for gi in range(len(self.groups)):
+            comps.setdefault(find(gi), []).append(gi)
+        bad_g = {group_of[r] for r in bad}
+        out = []
+        for gis in comps.values():
+            gs = [self.groups[gi] for gi in gis]
+            srows = sorted(r for g in gs for r in g.rows if r in sampled)
+            out.append((gs, srows, any(gi in bad_g for gi in gis)))
+        return out
+
+    def _steppable(self, r: int) -> bool:
+        """A row a cluster steps: driven in CSP, its planner PT/Gear/Follow/crd or a Trap
+        (a master)."""
+        ax = self.axes[r]
+        if not ax.servo_on or ax.mode_cmd != 8:
+            return False
+        pl = self.res[r].profile.planner
+        return sampled_kind(pl) or trap_steppable(pl)
+
+    def _can_claim(self, g: _Group) -> bool:
+        """:meth:`_claim` would take the group now: the slave decoded exactly what is in the
+        image (no raw write since its last step) and sent what its objects hold now (the bank
+        leaves the constant TxPDO entries - analog inputs, 603Fh... - as the last scalar step
+        wrote them, so one changed since, e.g. a test's set_analog_input, waits for the next
+        scalar step to be sent first)."""
         sl = self.ctl.layout.slaves[g.position]
         if sl.out_bytes:
             start = (sl.out_logical_bit or 0) >> 3
             now = self.ctl.master.image.buffer[start : start + sl.out_bytes].tobytes()
             if now != bytes(g.drive.rx[: sl.out_bytes]):
                 return False
-        # and sent what its objects hold now: the bank leaves the constant TxPDO entries
-        # (analog inputs, 603Fh...) as the last scalar step wrote them, so one changed since
-        # (a test's set_analog_input) waits for the next scalar step to be sent first
         drive = g.drive
         codec = drive.codec
         if len(drive.tx) >= codec.tx_bytes:
@@ -658,6 +752,11 @@ class AxisBank:
             codec.encode(fresh)
             if fresh != drive.tx:
                 return False
+        return True
+
+    def _claim(self, g: _Group) -> bool:
+        if not self._can_claim(g):
+            return False
         for r in g.rows:
             self.csp.load(r)
             self._load(r)
@@ -713,18 +812,24 @@ class AxisBank:
             tau = pl._tau
             self.tau[r] = tau
             self.jE[r] = math.exp(-pl._T / tau) if tau > 0.0 else 0.0
-        moving = isinstance(pl, TrapPlanner) and pl._mode == _MOVE
+        sampled = bool(self.sampled[r])  # stepped ahead by its cluster (bank_modes)
+        if sampled:
+            moving = not pl.done
+        else:
+            moving = isinstance(pl, TrapPlanner) and pl._mode == _MOVE
         self.moving[r] = moving
         self.taken[r] = 0
-        self.k0[r] = pl._k if moving else 0
+        self.k0[r] = pl._k if moving and not sampled else 0
         self.ended[r] = False
         self.t_cur[r] = 0
         kept = self._kept.pop(r, None)
+        if sampled:
+            kept = None
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
         # table) or in slot 0, the hold slot of a row at rest
         slot = self.table if moving else 0
         self.nseg[r] = 0
-        if moving and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
+        if moving and not sampled and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
             m = len(pl._segs)
             self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = np.array(pl._segs, np.float64).ravel()
             self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
@@ -822,8 +927,33 @@ class AxisBank:
         need = moving & (cur >= self.t_len)
         if np.count_nonzero(need):
             self._materialise()
+            filled: list[Cluster] = []
+            pt_rows: list[int] = []
             for r in np.nonzero(need)[0].tolist():
-                self._refill(r)
+                if not self.sampled[r]:
+                    self._refill(r)
+                    continue
+                cl = self._cluster_of[self.group_of[r]]
+                if cl.compiled_pt:  # a PT axis alone: all of them in one compiled call
+                    pt_rows.append(r)
+                    cl.snaps = []
+                    continue
+                if cl in filled:
+                    continue
+                filled.append(cl)
+                # the planners step without their guards (a guarded attribute costs ~1 µs)
+                guarded = [(pl, type(pl)) for pl in cl.planners]
+                guarded = [(pl, c) for pl, c in guarded if _GUARDS.get(c.__mro__[1]) is c]
+                for pl, cls in guarded:
+                    _set(pl, "__class__", cls.__mro__[1])
+                try:
+                    cl.fill(self)  # every moving row of the cluster, the same cycles
+                finally:
+                    for pl, cls in guarded:
+                        _set(pl, "__class__", cls)
+            if pt_rows:
+                assert self.pt_fill is not None
+                self.sampled_samples += self.pt_fill.fill(self, pt_rows, SAMPLED_TABLE)
         left = (self.t_len - cur)[moving]
         self._refill_in = int(left.min()) if len(left) else self.table
 
@@ -839,6 +969,15 @@ class AxisBank:
 
     def _release_groups(self, groups: list[_Group]) -> None:
         """Write the rows' committed state back into their objects; they leave the bank."""
+        clusters: list[Cluster] = []
+        if getattr(self, "_cluster_of", None):
+            out = list(groups)
+            for g in groups:
+                cl = self._cluster_of.get(self._gi[id(g)])
+                if cl is not None and cl not in clusters:
+                    clusters.append(cl)
+                    out += [self.groups[gi] for gi in cl.groups if self.groups[gi] not in out]
+            groups = [g for g in out if g.claimed]
         rows = [r for g in groups for r in g.rows]
         self._materialise()
         self._rates = self._enc_rates()
@@ -852,6 +991,14 @@ class AxisBank:
         self.csp.store(rows)
         for r in rows:
             self._store(r)
+        for cl in clusters:
+            # the planners stand where the scalar path has them (bank_modes.Cluster.rewind)
+            cl.rewind(self)
+            for c in cl.systems:
+                c.banked = False
+            for gi in cl.groups:
+                self._cluster_of.pop(gi, None)
+            self.sampled[cl.rows] = False
         self.dirty = True
         # the image addresses and run lists follow at the next cycle (_reindex), not once per
         # release: a loop of GT calls over many axes releases one slave per call
@@ -899,6 +1046,8 @@ class AxisBank:
             if p != pl.pos or not pl.done:
                 pl.hold(p)
             return
+        if self.sampled[r]:
+            return  # its cluster puts the planner back (_release_groups)
         if self.jog[r]:
             pl._raw_p, pl._raw_v = float(self.jrp[r]), float(self.jrv[r])
             pl._pos, pl._vel, pl._acc = float(self.jp[r]), float(self.jv[r]), float(self.ja[r])

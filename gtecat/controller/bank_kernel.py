@@ -25,6 +25,7 @@ import ctypes
 import logging
 import os
 from importlib import resources
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -97,6 +98,24 @@ def library() -> tuple[Any, str]:
             ctypes.c_void_p,
             ctypes.c_void_p,
         )
+        lib.bank_pt_run.restype = ctypes.c_int64
+        lib.bank_pt_run.argtypes = (
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_int64,
+            ctypes.c_int64,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+        )
+        lib.bank_pt_state_size.restype = ctypes.c_int
+        lib.bank_pt_fill.restype = ctypes.c_int64
+        lib.bank_pt_fill.argtypes = (ctypes.c_void_p,)
+        lib.bank_pt_fill_args.restype = ctypes.c_int
+        if lib.bank_pt_fill_args() != len(PT_FILL_ARGS):
+            raise RuntimeError("the kernel's PT fill arguments are not the ones this module packs")
+        if lib.bank_pt_state_size() != len(PT_STATE):
+            raise RuntimeError("the kernel's PT state is not the one this module packs")
         fields = [f for f in lib.bank_kernel_fields().decode().split(",") if f]
         src_types = _field_types()
         if (
@@ -321,6 +340,124 @@ def trap_fill(
         out[1].ctypes.data,
         out[2].ctypes.data,
     )
+
+
+#: the PtPlanner slots bank_pt_run reads and writes, in the C side's PT_ST_* order
+PT_STATE = (
+    "_k _T _i _loop _loops_done _toff _poff _t0 _p0 _t1 _p1 _vs _ve _a _origin _pos _vel _acc "
+    "_state"
+).split()
+_PT_INTS = frozenset({"_k", "_i", "_loop", "_loops_done", "_state"})
+
+
+class PtRun:
+    """The compiled :meth:`~gtecat.controller.motion.pt.PtPlanner.run` of a static FIFO in
+    motion (``bank_pt_run``), writing straight into a row of the bank's tables."""
+
+    def __init__(self, lib: Any) -> None:
+        self.fn = lib.bank_pt_run
+        self.st = np.zeros(len(PT_STATE))
+        self.st_ptr = self.st.ctypes.data
+        #: the planner's state in PT_STATE order (also what a rewind puts back)
+        self.state = attrgetter(*PT_STATE)
+        self._tables: tuple = ()
+        self._ptrs = (0, 0, 0)
+
+    def __call__(
+        self, pl: Any, pts: tuple[int, int], n: int, tables: tuple[np.ndarray, ...], offset: int
+    ) -> int:
+        """``n`` samples from the planner's state into ``tables`` (position, speed and
+        acceleration arrays, float64) from flat index ``offset`` on, over the running FIFO's
+        points ``pts`` (the address of m rows of float64 position, time, type; m); the
+        planner's state moves on
+        as ``n`` steps move it.  Returns the end sample's index or -1."""
+        known = self._tables
+        if not known or any(t is not k for t, k in zip(tables, known, strict=True)):
+            self._tables = tables
+            self._ptrs = tuple(t.ctypes.data for t in tables)
+        st = self.st
+        st[:] = self.state(pl)
+        p, v, a = self._ptrs
+        off = 8 * offset
+        end = self.fn(self.st_ptr, pts[0], pts[1], n, p + off, v + off, a + off)
+        put = object.__setattr__
+        for name, value, whole in zip(PT_STATE, st.tolist(), _PT_WHOLE, strict=True):
+            put(pl, name, int(value) if whole else value)
+        return int(end)
+
+
+_PT_WHOLE = tuple(name in _PT_INTS for name in PT_STATE)
+#: bank_pt_fill's argument slots (the C side's PT_FILL_* order): counts, then addresses
+PT_FILL_ARGS = (
+    "nr n table rows st before pts m t_p t_v t_a base t_idx t_len t_cur t_end taken fill_taken"
+).split()
+
+
+class PtFill:
+    """The tables of a bank's PT rows (static FIFOs in motion, one per cluster) refilled by
+    one call of the compiled ``bank_pt_fill``.  While such a row is claimed its planner's
+    state lives here (``st``, and ``before``: the state when the row's current table began);
+    :meth:`put_back` hands the planner the latter, which a release then steps on."""
+
+    def __init__(self, lib: Any, n: int) -> None:
+        self.fn = lib.bank_pt_fill
+        self.st = np.zeros((n, len(PT_STATE)))
+        self.before = np.zeros((n, len(PT_STATE)))
+        self.pts = np.zeros(n, np.int64)
+        self.m = np.zeros(n, np.int64)
+        self.rows = np.zeros(n, np.int64)
+        self.args = np.zeros(len(PT_FILL_ARGS), np.int64)
+        self._args_ptr = self.args.ctypes.data
+        self._points: dict[int, np.ndarray] = {}  # row -> its FIFO's points (kept alive)
+        self._state = attrgetter(*PT_STATE)
+        a = self.args
+        a[3], a[4], a[5] = self.rows.ctypes.data, self.st.ctypes.data, self.before.ctypes.data
+        a[6], a[7] = self.pts.ctypes.data, self.m.ctypes.data
+
+    def load(self, r: int, pl: Any) -> None:
+        """Row ``r`` runs PT planner ``pl`` (static FIFO, in motion) from now on."""
+        get = object.__getattribute__
+        self.st[r] = [float(v) for v in self._state(pl)]
+        q = get(pl, "_fifos")[get(pl, "_r")]
+        pts = np.array([(p.pos, p.time, float(int(p.type))) for p in q], np.float64)
+        self._points[r] = pts
+        self.pts[r], self.m[r] = pts.ctypes.data, len(pts)
+
+    def fill(self, bank: Any, rows: list[int], n: int) -> int:
+        """New tables of ``n`` samples for ``rows``; the samples written."""
+        k = len(rows)
+        self.rows[:k] = rows
+        a = self.args
+        a[0], a[1], a[2] = k, n, bank.table
+        for slot, arr in enumerate(
+            (
+                bank.t_p,
+                bank.t_v,
+                bank.t_a,
+                bank.base,
+                bank.t_idx,
+                bank.t_len,
+                bank.t_cur,
+                bank.t_end,
+                bank.taken,
+                bank.fill_taken,
+            ),
+            8,
+        ):
+            if arr.dtype != (np.float64 if slot < 11 else np.int64) or not arr.flags.c_contiguous:
+                raise TypeError(f"PT fill: {PT_FILL_ARGS[slot]} is {arr.dtype}")
+            a[slot] = arr.ctypes.data
+        return int(self.fn(self._args_ptr))
+
+    def put_back(self, r: int, pl: Any) -> None:
+        """The planner of row ``r`` as it stood when the row's current table began."""
+        put = object.__setattr__
+        for name, value, whole in zip(PT_STATE, self.before[r].tolist(), _PT_WHOLE, strict=True):
+            put(pl, name, int(value) if whole else value)
+        self._points.pop(r, None)
+
+    def drop(self, r: int) -> None:
+        self._points.pop(r, None)
 
 
 def _fits(arr: np.ndarray, dtype: Any) -> bool:

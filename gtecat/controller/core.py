@@ -350,7 +350,7 @@ class Controller:
             bank is None
             or bank.kernel is None
             or self.before_cycle
-            or self.pre_cycle
+            or not all(_quiet(f) for f in self.pre_cycle)
             or self.post_cycle
             or self.sample
             or self._links_down
@@ -444,6 +444,13 @@ class Controller:
             hook = self.slice_hook
             if hook is not None and left > self.WAIT_SLICE_NS:
                 hook()
+
+
+def _quiet(hook: Callable[[int, int], None]) -> bool:
+    """A ``pre_cycle`` hook with nothing to do in the next cycles: its object says so
+    (``bank_quiet()``: the coordinate systems while the axis bank steps every running one)."""
+    quiet = getattr(getattr(hook, "__self__", None), "bank_quiet", None)
+    return quiet is not None and quiet()
 
 
 def folder_message(path: Path, how: str) -> str:

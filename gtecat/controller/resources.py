@@ -796,14 +796,19 @@ def position_source(ctl: Controller, kind: int, index: int, item: int = 0) -> Ca
     numbered below its slave is read in the same cycle."""
     res = axis_resources(ctl, index)
     if kind == 1:
-        return lambda: res.encoder.pos
-    if kind == 2:
-        return lambda: res.profile.planner.pos
-    if kind == 3:
+        f = lambda: res.encoder.pos  # noqa: E731
+    elif kind == 2:
+        f = lambda: res.profile.planner.pos  # noqa: E731
+    elif kind == 3:
         if item == 0:
-            return lambda: res.ax.prf_pos
-        return lambda: res.enc_link.axis(res.encoder.pos)
-    raise ParameterError(f"master type {kind}: 1 encoder, 2 profile or 3 axis")
+            f = lambda: res.ax.prf_pos  # noqa: E731
+        else:
+            f = lambda: res.enc_link.axis(res.encoder.pos)  # noqa: E731
+    else:
+        raise ParameterError(f"master type {kind}: 1 encoder, 2 profile or 3 axis")
+    # what the axis bank reads to keep a slave and its master together (gtecat.controller.bank)
+    f.master = (res, kind)  # type: ignore[attr-defined]
+    return f
 
 
 def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:

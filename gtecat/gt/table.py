@@ -219,6 +219,16 @@ def _param(text: str, where: str) -> Param:
     return Param(m["name"], ctype, pointer, **kw)
 
 
+#: a parameter's text -> its Param: the ~10,000 parameters of the table are ~2,200 texts
+#: (``short axis`` alone hundreds of times), and Param is immutable, so each is read once
+_PARAMS: dict[str, Param] = {}
+
+
+def _param_once(text: str, where: str) -> Param:
+    p = _PARAMS[text] = _param(text, where)
+    return p
+
+
 def parse(text: str, group: str = "") -> dict[str, Proto]:
     """The prototypes of ``text`` by name (ValueError names the line it cannot read)."""
     out: dict[str, Proto] = {}
@@ -238,7 +248,11 @@ def parse(text: str, group: str = "") -> dict[str, Proto]:
                 raise ValueError(f"{where} {lineno}: {name} declared twice")
             out[name] = Proto(name, (), entry=comment, group=group, twin=False, unknown=True)
             continue
-        params = tuple(_param(a, f"{where} {lineno} ({name})") for a in _split(args) if a.strip())
+        params = tuple(
+            _PARAMS.get(a) or _param_once(a, f"{where} {lineno} ({name})")
+            for a in _split(args)
+            if a.strip()
+        )
         names = {p.name for p in params}
         for p in params:
             if isinstance(p.count, str) and p.count not in names:
@@ -349,6 +363,7 @@ def _load() -> tuple[tuple, dict[str, Proto]]:
 GROUPS, FUNCTIONS = _load()
 #: the table's text, every group's lines in group order (the protocol digest reads it)
 PROTOTYPES: str = "\n".join(f"// group {g.name}\n{g.prototypes}" for g in GROUPS)
+_GROUP_BY_NAME = {g.name: g for g in GROUPS}
 
 
 def group_of(name: str):
@@ -358,7 +373,7 @@ def group_of(name: str):
         proto = FUNCTIONS.get("GT_" + name[4:])
     if proto is None:
         raise KeyError(name)
-    return next(g for g in GROUPS if g.name == proto.group)
+    return _GROUP_BY_NAME[proto.group]
 
 
 def emulated() -> frozenset[str]:

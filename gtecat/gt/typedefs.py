@@ -140,9 +140,22 @@ def parse_constants(text: str, known: dict[str, int] | None = None) -> dict[str,
     return out
 
 
+#: (text, group) -> its typedefs, read without ``known``: the table reads every group's
+#: STRUCTS for its enum names and ``gtecat.gt`` again for its classes, once per process
+_PARSED: dict[tuple[str, str], tuple[Typedef, ...]] = {}
+
+
 def parse(text: str, group: str = "", known: dict[str, Any] | None = None) -> list[Typedef]:
     """The typedefs of ``text`` in order (TypedefError names what it cannot read);
     ``known``: constants an array size may name."""
+    if known is None:
+        if (text, group) not in _PARSED:
+            _PARSED[text, group] = tuple(_parse(text, group, None))
+        return list(_PARSED[text, group])
+    return _parse(text, group, known)
+
+
+def _parse(text: str, group: str, known: dict[str, Any] | None) -> list[Typedef]:
     out: list[Typedef] = []
     for m in _TYPEDEF.finditer(strip_comments(text)):
         kind, body = m[1], m["body"]

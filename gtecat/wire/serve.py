@@ -139,6 +139,20 @@ class ServeStats:
     kernel_timestamps: bool = False
     #: "rx ring", "recvmsg" (with time stamps) or "recv"
     receive_path: str = ""
+    #: where the loop was when it took each frame, counted by FOUND index
+    found: list[int] = field(default_factory=lambda: [0] * len(FOUND))
+    #: the first LATE_KEPT frames answered later than 1 ms: when, how late, where found
+    late: list[dict[str, object]] = field(default_factory=list)
+
+
+#: where the loop was when it took a frame: spinning on the ring (around the predicted frame,
+#: lingering after an answer, or --wait spin), asleep before the predicted window (the frame
+#: came first and woke it), asleep in poll (no window: --wait sleep, a missed window, no cycle
+#: learned), or inside the slaves' step (answered between two slaves)
+FOUND = ("spinning", "woken", "polled", "in_step")
+_SPINNING, _WOKEN, _POLLED, _IN_STEP = range(len(FOUND))
+#: frames over 1 ms kept in the report with their details
+LATE_KEPT = 32
 
 
 #: how the loop waits for the next frame: sleeping in poll (a wake-up per frame),
@@ -218,6 +232,77 @@ def pin_to_cpu(cpu: int) -> None:
         raise WireError(f"cannot run on CPU {cpu}: {exc}") from exc
 
 
+def host_steal() -> tuple[int, int]:
+    """(all CPU time, steal) of the machine so far, in clock ticks, from ``/proc/stat``: on a
+    virtual machine, steal is time the hypervisor ran something else on our CPUs - a frame
+    that arrives for a CPU that is not running waits for it, whatever our priority.
+    (0, 0) where unreadable."""
+    try:
+        with open("/proc/stat") as fh:
+            fields = fh.readline().split()[1:]
+        ticks = [int(x) for x in fields[:8]]
+    except (OSError, ValueError):
+        return 0, 0
+    return sum(ticks), ticks[7] if len(ticks) > 7 else 0
+
+
+#: the kernel's preemption models, as ``/sys/kernel/debug/sched/preempt`` and ``preempt=`` name them
+PREEMPTION_MODELS = ("none", "voluntary", "full", "lazy", "rt")
+#: models under which a normal task inside a system call keeps its CPU until the call ends or
+#: reaches a preemption point: a real-time wake-up on that CPU waits for it (measured on the
+#: development VM: a frame taken 4.2 ms late behind another program's system call)
+UNPREEMPTIBLE = ("none", "voluntary")
+
+
+def kernel_preemption(
+    debugfs: str = "/sys/kernel/debug/sched/preempt",
+    cmdline: str = "/proc/cmdline",
+    configs: tuple[str, ...] = ("/proc/config.gz", f"/boot/config-{os.uname().release}"),
+) -> str | None:
+    """The running kernel's preemption model (one of PREEMPTION_MODELS), or ``None`` where it
+    cannot be told: the debugfs switch of a PREEMPT_DYNAMIC kernel (the chosen model in
+    parentheses), else ``preempt=`` on the command line, else the kernel configuration."""
+    try:
+        with open(debugfs) as fh:
+            text = fh.read()
+        start, end = text.find("("), text.find(")")
+        if 0 <= start < end and text[start + 1 : end] in PREEMPTION_MODELS:
+            return text[start + 1 : end]
+    except OSError:
+        pass
+    try:
+        with open(cmdline) as fh:
+            for word in fh.read().split():
+                if word.startswith("preempt=") and word[8:] in PREEMPTION_MODELS:
+                    return word[8:]
+    except OSError:
+        pass
+    for path in configs:
+        try:
+            if path.endswith(".gz"):
+                import gzip
+
+                with gzip.open(path, "rt") as fh:
+                    config = fh.read()
+            else:
+                with open(path) as fh:
+                    config = fh.read()
+        except (OSError, EOFError):
+            continue
+        options = {line.strip() for line in config.splitlines()}
+        for option, model in (
+            ("CONFIG_PREEMPT_RT=y", "rt"),
+            ("CONFIG_PREEMPT=y", "full"),
+            ("CONFIG_PREEMPT_LAZY=y", "lazy"),
+            ("CONFIG_PREEMPT_VOLUNTARY=y", "voluntary"),
+            ("CONFIG_PREEMPT_NONE=y", "none"),
+        ):
+            if option in options:
+                return model
+        return None
+    return None
+
+
 def interface_is_up(iface: str) -> bool | None:
     """``True``/``False`` from sysfs; ``None`` when it cannot tell."""
     try:
@@ -287,6 +372,8 @@ class WireServer:
         self.snapshots = 0
         #: (process CPU time, clock) when the records last started: the CPU share reported
         self._cpu_mark = (time.process_time(), clock())
+        #: the host's CPU time and steal when the records last started
+        self._steal_mark = host_steal()
         #: what an answer meets on its way back (gtecat.faults): called with the answered
         #: frame, its length and the receive time; returns the length to send (0: lost)
         self.frame_hook: Callable[[bytearray, int, int], int] | None = None
@@ -306,6 +393,8 @@ class WireServer:
         self._cpu_mark = (time.process_time(), self.clock())
         s.latency, s.wait = LatencyRecorder(), LatencyRecorder()
         s.processing, s.send = LatencyRecorder(), LatencyRecorder()
+        s.found, s.late = [0] * len(FOUND), []
+        self._steal_mark = host_steal()
 
     # --- slave cycle -----------------------------------------------------------------------
     def _step(self, now: int, between: Callable[[], None] | None = None) -> None:
@@ -350,6 +439,16 @@ class WireServer:
         linger_ns = self.linger_ns
         self._sync_clocks()
         fine_timers()
+        #: where the loop waits now (FOUND index), since when, and this thread's CPU time
+        #: then where it keeps running (spinning; 0 asleep): the frame it takes is counted
+        #: there, and a late one reported with it; the same two times at the slaves' step
+        where = [_POLLED, 0, 0]
+        step_mark = [0, 0]
+        thread_time = time.thread_time_ns
+        # maintainers' diagnostics: every frame's times and where it was found, as int64
+        # records (kernel time, taken, send called, send returned, FOUND index, since)
+        flog_path = os.environ.get("GTECAT_SERVE_FRAMELOG")
+        flog = array("q") if flog_path else None
 
         def answer(in_step: bool) -> bool:
             """Receive, process and answer one frame; False when none was waiting."""
@@ -389,7 +488,19 @@ class WireServer:
             self._last_out = t_out
             if chain.process_data:
                 pacing.arrived(t_kernel or t_in)
-            stats.latency.add(t_out - (t_kernel or t_in))
+            t_arrived = t_kernel or t_in
+            found = _IN_STEP if in_step else where[0]
+            stats.found[found] += 1
+            if t_out - t_arrived > 1_000_000 and len(stats.late) < LATE_KEPT:
+                since, cpu = step_mark if in_step else where[1:]
+                record = self._late_record(t_arrived, t_in, t_out, found, since)
+                if cpu:  # it kept running: how much of that time it really ran
+                    wall, ran = clock() - since, thread_time() - cpu
+                    record["not_running_us"] = round(max(0, wall - ran) / 1000, 1)
+                stats.late.append(record)
+            stats.latency.add(t_out - t_arrived)
+            if flog is not None:
+                flog.extend((t_kernel, t_in, t_send, t_out, found, where[1]))
             if t_kernel:
                 stats.wait.add(t_in - t_kernel)
             stats.processing.add(t_send - t_in)
@@ -405,6 +516,7 @@ class WireServer:
             if frame_mode and chain.process_data:
                 last = self._last_step
                 if last is None or t_in - last >= self.min_gap_ns:
+                    step_mark[0], step_mark[1] = clock(), thread_time()
                     self._guarded(self._step, t_in, between)
                     for _ in range(8):  # process data answered during a step: its own step
                         if not self._step_due:
@@ -442,6 +554,7 @@ class WireServer:
                     if window is not None:
                         opens, closes = window
                         if now < opens:  # sleep until the window opens; a frame ends it
+                            where[0], where[1], where[2] = _WOKEN, now, 0
                             if select.select([fd], [], [], min(opens - now, poll_ns) / 1e9)[0]:
                                 while answer(False):
                                     pass
@@ -454,6 +567,8 @@ class WireServer:
                     # a tight spin on the socket (a look at the ring's next slot, or one
                     # poll syscall, per turn); the loop's housekeeping below runs every
                     # SPIN_TURNS turns or after a frame
+                    if where[0] != _SPINNING:
+                        where[0], where[1], where[2] = _SPINNING, clock(), thread_time()
                     for _ in range(turns):
                         if waiting():
                             stats.lingered += linger
@@ -466,6 +581,7 @@ class WireServer:
                         timeout_ms = max(
                             0, min(timeout_ms, (next_cycle - now + 999_999) // 1_000_000)
                         )
+                    where[0], where[1], where[2] = _POLLED, now, 0
                     if poll(timeout_ms):
                         while answer(False):
                             pass
@@ -486,6 +602,9 @@ class WireServer:
                     self._sync_clocks()
                     next_poll = clock() + 5_000_000
         finally:
+            if flog is not None and flog_path:
+                with open(flog_path, "wb") as fh:
+                    flog.tofile(fh)
             if gc_was_enabled:
                 gc.enable()
             if pcap is not None:
@@ -493,6 +612,23 @@ class WireServer:
             stats.stopped_ns = clock()
             poller.unregister(sock.fileno())
             view.release()
+
+    def _late_record(
+        self, t_arrived: int, t_in: int, t_out: int, found: int, since: int
+    ) -> dict[str, object]:
+        """What the report says of a frame answered later than 1 ms."""
+        return {
+            "at_s": round((t_arrived - self._t0) / 1e9, 6),
+            "latency_us": round((t_out - t_arrived) / 1000, 1),
+            "wait_us": round((t_in - t_arrived) / 1000, 1),
+            "found": FOUND[found],
+            #: how long before the frame the loop began that wait or step (negative: after it)
+            "waiting_since_us": round((t_arrived - since) / 1000, 1) if since else None,
+            #: (spinning or in a step: it kept running) how much of the time since then this
+            #: thread did not run: the hypervisor took its CPU (a guest kernel leaves steal out
+            #: of a task's CPU time) or something above it ran; None where it slept
+            "not_running_us": None,
+        }
 
     #: a housekeeping pass (chain poll, inspection requests, a young-generation collection)
     #: takes up to this long; it does not start this close before the next frame's window
@@ -608,6 +744,15 @@ class WireServer:
         wall = (self.clock() - t0) / 1e9
         return round(100 * (time.process_time() - cpu0) / wall, 1) if wall > 0 else 0.0
 
+    def _steal_percent(self) -> float | None:
+        """The share of the machine's CPU time stolen by the hypervisor since the records
+        started (``None`` where /proc/stat says nothing)."""
+        total0, steal0 = self._steal_mark
+        total1, steal1 = host_steal()
+        if total1 <= total0:
+            return None
+        return round(100 * (steal1 - steal0) / (total1 - total0), 2)
+
     def report(self) -> dict[str, object]:
         """Counters and latency, for ``--stats-json`` and the benchmark."""
         s = self.stats
@@ -637,6 +782,9 @@ class WireServer:
             "snapshot": self.snapshots,
             "cpu_percent": self._cpu_percent(),
             "wait_mode": self.wait,
+            "found": dict(zip(FOUND, s.found, strict=True)),
+            "late": list(s.late),
+            "host_steal_percent": self._steal_percent(),
             "pacing": {
                 "period_us": round(self.pacing.period_ns / 1000, 1),
                 "jitter_us": round(self.pacing.jitter_ns / 1000, 1),

@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
+from tests.conftest import LONG
 
 from .tutorial_runner import blocks, matches, run_page
 
@@ -55,14 +56,25 @@ def test_there_are_tutorial_pages() -> None:
     assert all(any(b.lang in ("python", "console") for b in blocks(p)) for p in PAGES)
 
 
+#: what the default run follows: the first page and the README (no pytest run inside, a few
+#: seconds); the pages that run pytest and ``gtecat run`` follow under GTECAT_LONG=1
+QUICK = {"01-raw-offsets", "README"}
+
+
+def _followed_here(page: Path) -> bool:
+    return LONG or (page.stem if page.parent == TUTORIAL else "README") in QUICK
+
+
 @pytest.fixture(scope="module")
 def followed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """Every page followed by one runner process (an interpreter start and gtecat's import
-    once, not per page), each page in an empty folder of its own: (folder, output)."""
+    """Every page of this run followed by one runner process (an interpreter start and
+    gtecat's import once, not per page), each page in an empty folder of its own:
+    (folder, output)."""
     folder = tmp_path_factory.mktemp("pages")
     assert not folder.resolve().is_relative_to(ROOT)
+    pages = [p for p in [*PAGES, ROOT / "README.md"] if _followed_here(p)]
     done = subprocess.run(
-        [sys.executable, "-P", str(RUNNER), *map(str, [*PAGES, ROOT / "README.md"])],
+        [sys.executable, "-P", str(RUNNER), *map(str, pages)],
         cwd=folder,
         env=user_env(),
         capture_output=True,
@@ -74,7 +86,12 @@ def followed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
 
 @pytest.mark.xdist_group("tutorial_pages")  # one worker follows them all, once
 @pytest.mark.parametrize(
-    "page", [*PAGES, ROOT / "README.md"], ids=[*(p.stem for p in PAGES), "README"]
+    "page",
+    [
+        pytest.param(p, marks=() if _followed_here(p) else pytest.mark.long)
+        for p in [*PAGES, ROOT / "README.md"]
+    ],
+    ids=[*(p.stem for p in PAGES), "README"],
 )
 def test_page_runs_in_an_empty_folder_with_the_installed_package(
     page: Path, followed: tuple[Path, str]
@@ -156,6 +173,7 @@ def test_runner_writes_files_and_runs_shell_lines(workdir: Path) -> None:
         run_page(page)
 
 
+@pytest.mark.long
 def test_runner_as_a_process_reports_one_failure_line(tmp_path: Path) -> None:
     page = tmp_path / "page.md"
     page.write_text("```python\nassert 1 == 2, 'the reason'\n```\n")

@@ -195,6 +195,7 @@ def run(
 @pytest.mark.parametrize(
     "start_i", range(len(CAM_STARTS)), ids=["left", "in1", "mid", "in2", "right"]
 )
+@pytest.mark.sample(10)
 def test_cam_methods(method: int, start_i: int) -> None:
     homes, final_dir = CAM_EXPECTED[method]
     r = run(params(method), CAMS, CAM_STARTS[start_i])
@@ -287,6 +288,7 @@ def _first_index_left(e: float, offset: float, cpr: int) -> float:
     acc=st.floats(50000.0, 500000.0),
     dt=st.sampled_from([0.0005, 0.001, 0.004]),
 )
+@pytest.mark.long
 def test_random_cam_matches_method_table(
     method, lo, width, cpr, offset_frac, start_zone, speed, zero_ratio, acc, dt
 ) -> None:
@@ -549,6 +551,7 @@ def test_home_offset_sign_convention() -> None:
     dt=st.sampled_from([0.0005, 0.001, 0.004]),
     lag=st.integers(1, 3),
 )
+@pytest.mark.long
 def test_random_switch_layout_matches_method_table(
     method, edge, cpr, offset_frac, start_frac, speed, zero_ratio, acc, dt, lag
 ) -> None:

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import pytest
+
 from tools.bench_eni import bench_read
 
 
+@pytest.mark.long
 def test_bench_read_64_slaves() -> None:
     r = bench_read(64, repeat=1)
     assert r["name"] == "eni_read" and r["n_slaves"] == 64

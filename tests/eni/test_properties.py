@@ -6,6 +6,7 @@ from dataclasses import replace
 from itertools import pairwise
 from typing import Any
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -242,6 +243,7 @@ def _norm(cfg: EniConfig) -> EniConfig:
     max_examples=examples(120, 12), deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 @given(topologies())
+@pytest.mark.long
 def test_write_then_read_gives_the_same_model(topo: dict[str, Any]) -> None:
     cfg = build_config(topo, "topo.toml")
     text = write_eni(cfg)

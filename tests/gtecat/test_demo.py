@@ -206,6 +206,7 @@ def test_demo_axes_skips_steps_whose_gt_functions_are_missing(
     assert "servo on: both drives in operation enabled" in text
 
 
+@pytest.mark.long
 def test_demo_reports_a_step_that_went_wrong(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

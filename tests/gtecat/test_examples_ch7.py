@@ -60,6 +60,7 @@ def test_example_7_3_trapezoid_sample_by_sample():
     assert r["pos"][-1] == 4096 and vel[-1] == 0.0 and not r["sts"][-1] & MOVING
 
 
+@pytest.mark.long
 def test_example_7_3_in_the_auto_clock_keeps_its_shape():
     r = example("example_7_3_pt").run(clock="auto")
     assert r["errors"] == [] and r["pos"][-1] == 4096
@@ -87,6 +88,7 @@ def manual_sine_stream():
             loop += 1
 
 
+@pytest.mark.long
 def test_example_7_4_sine_through_the_dynamic_fifos_sample_by_sample():
     r = example("example_7_4_pt_dynamic").run(clock="lockstep")
     assert r["errors"] == []
@@ -107,6 +109,7 @@ def test_example_7_4_sine_through_the_dynamic_fifos_sample_by_sample():
 
 
 # --- 7-5 electronic gear ---------------------------------------------------------------------
+@pytest.mark.long
 def test_example_7_5_clutch_of_100000_master_pulses_sample_by_sample():
     r = example("example_7_5_gear").run(clock="lockstep")
     assert r["errors"] == []
@@ -145,6 +148,7 @@ REGION_2 = [
 ]
 
 
+@pytest.mark.long
 def test_example_7_6_flying_shear_8000_knife_pulses_per_10000_belt_pulses():
     r = example("example_7_6_flying_shear").run(clock="lockstep")
     assert r["errors"] == []
@@ -183,6 +187,7 @@ def test_example_7_6_flying_shear_8000_knife_pulses_per_10000_belt_pulses():
 TABLE_7_10 = [(20000, 10000, FN), (40000, 30000, FN), (60000, 40000, FN)]
 
 
+@pytest.mark.long
 def test_example_7_7_start_after_the_50000_pass_endless_trapezoid_cam():
     r = example("example_7_7_follow").run(clock="lockstep")
     assert r["errors"] == []
@@ -212,6 +217,7 @@ TABLE_7_12 = [(20000, 10000, FC), (40000, 30000, FN), (60000, 46000, FN)]
 TABLE_7_13 = [(20000, 16000, FC), (40000, 36000, FN), (60000, 52000, FN)]
 
 
+@pytest.mark.long
 def test_example_7_8_strategy_changed_through_the_two_fifos():
     r = example("example_7_8_follow_switch").run(clock="lockstep")
     assert r["errors"] == []

@@ -107,6 +107,7 @@ def test_the_plugin_is_an_entry_point() -> None:
     assert any(e.value == "gtecat.pytest_plugin" for e in eps)
 
 
+@pytest.mark.long
 def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Path) -> None:
     (project / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
     (project / "test_ini.py").write_text(
@@ -128,6 +129,7 @@ def test_ini_options_choose_the_bus_and_no_trace_without_the_option(project: Pat
 @pytest.mark.skipif(
     importlib.util.find_spec("xdist") is None, reason="pytest-xdist is not installed"
 )
+@pytest.mark.long
 def test_fixtures_and_a_failing_test_with_its_trace_under_xdist(project: Path) -> None:
     """One child pytest on two workers (the tutorial's page 6 shows its tests run with
     ``-n 2``: this is that promise's test): the fixtures, a failure's report and trace, and

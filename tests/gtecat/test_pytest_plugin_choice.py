@@ -42,6 +42,7 @@ def test_nothing_named_is_an_error_that_says_how_to_choose(mine: pytest.Pytester
     assert "gtecat: bus: none chosen" in text
 
 
+@pytest.mark.long
 def test_gecat_eni_in_the_rootdir_then_the_environment_then_the_ini(
     mine: pytest.Pytester, monkeypatch: pytest.MonkeyPatch
 ) -> None:

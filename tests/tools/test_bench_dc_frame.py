@@ -14,6 +14,7 @@ FIG52 = Path(__file__).resolve().parents[2] / "examples" / "manual_fig5_2.eni"
 
 
 @pytest.mark.parametrize("shape", SHAPES)
+@pytest.mark.sample(1)
 def test_each_shape_runs_and_reports(shape: str) -> None:
     got = run_shape(FIG52, shape, 30)
     assert got["slaves"] == 4 and got["frames"] == 30

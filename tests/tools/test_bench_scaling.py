@@ -63,6 +63,7 @@ def test_axis_beyond_32_names_its_core(tmp_path: Path) -> None:
         gt.GT_Close()
 
 
+@pytest.mark.long
 def test_table_and_plot(tmp_path: Path) -> None:
     results = [
         {"axes": 1, "state": "idle", "rtf": 20.0, "us_per_cycle": 50.0},

@@ -204,6 +204,9 @@ class CoordSystem:
     def __init__(self, number: int, cycle_ms: Callable[[], float]) -> None:
         self.number = number
         self._cycle_ms = cycle_ms
+        #: the axis bank (gtecat.controller.bank) steps this system ahead with its axes'
+        #: samples while it runs them: the controller's hook then leaves it alone
+        self.banked = False
         self.reset()
 
     def reset(self) -> None:
@@ -393,6 +396,41 @@ class CoordSystem:
             for slot in self.slots:
                 slot._vel = slot._acc = 0.0
                 slot.stopping = StopKind.NONE
+
+    def run(self, n: int) -> tuple[list[list[tuple[float, float, float]]], int]:
+        """``n`` cycles of :meth:`step`, each followed by every axis taking its slot's sample
+        (``AxisSlot.step``), for the axis bank's tables: each slot's samples and the index of
+        the cycle the path ended in (-1: it goes on).  A cycle inside a motion segment is
+        step's own common case written out (the same operations in the same order); any
+        other is :meth:`step`."""
+        slots = self.slots
+        origin = self.origin
+        out: list[list[tuple[float, float, float]]] = [[] for _ in slots]
+        for j in range(n):
+            e = self.entry
+            if not self.stopping and type(e) is Motion and self.waiting is None and not self.gears:
+                cyc = self._cycle_ms()
+                t = self.t + cyc * self.override
+                plan = self.plan
+                if t < plan.duration:
+                    self.t = t
+                    s = plan.s(t)
+                    self.s = s
+                    self.speed = plan.v(t)
+                    for col, slot, o, x in zip(out, slots, origin, e.geom.point(s), strict=True):
+                        p = o + x
+                        v = (p - slot._pos) / cyc
+                        a = (v - slot._vel) / cyc
+                        slot._pos, slot._vel, slot._acc = p, v, a
+                        slot._fresh = False  # the axis took it
+                        col.append((p, v, a))
+                    continue
+            self.step()
+            for col, slot in zip(out, slots, strict=True):
+                col.append(slot.step())
+            if not self.running:
+                return out, j
+        return out, -1
 
     def _advance(self, dt: float) -> None:
         self.t += dt
@@ -597,10 +635,15 @@ class CrdBank:
 
     def _pre(self, t_ns: int, dt_ns: int) -> None:
         for c in self.systems.values():
-            if c.running:
+            if c.running and not c.banked:
                 c.step()
 
     _pre.bank_safe = True  # type: ignore[attr-defined]  # touches interpolating axes only
+
+    def bank_quiet(self) -> bool:
+        """No cycle of this hook does anything: every running system is stepped by the axis
+        bank (the controller may then run its cycles many at a time)."""
+        return all(c.banked or not c.running for c in self.systems.values())
 
     def _reset(self, ctl: Any) -> None:
         for c in self.systems.values():

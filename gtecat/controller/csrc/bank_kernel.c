@@ -676,3 +676,141 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
     io[IN_T_NS] = t0;
     return rc;
 }
+
+/* PtPlanner.run of a static FIFO (gtecat/controller/motion/pt.py, step/_next/_enter/_finish
+ * transcribed with the same operations in the same order): n samples of the motion from the
+ * state st (PT_ST_* below; updated to the state after them) over the running FIFO's points
+ * pts (m rows of position, time, segment type) into po/vo/ao; returns the index of the end
+ * sample (the motion ran out of passes) or -1. */
+enum {
+    PT_K, PT_T, PT_I, PT_LOOP, PT_LOOPS, PT_TOFF, PT_POFF, PT_T0, PT_P0, PT_T1, PT_P1, PT_VS,
+    PT_VE, PT_A, PT_ORIGIN, PT_POS, PT_VEL, PT_ACC, PT_STATE, PT_NST
+};
+
+int bank_pt_state_size(void) { return PT_NST; }
+
+static void pt_enter(double *st, const double *pt, int first)
+{
+    const double t0 = st[PT_T1], p0 = st[PT_P1], v_prev = st[PT_VE];
+    const double t1 = pt[1] + st[PT_TOFF], p1 = pt[0] + st[PT_POFF];
+    const double dt = t1 - t0, dp = p1 - p0;
+    double vs, ve;
+    if (pt[2] == 1.0) { /* PT_SEGMENT_EVEN */
+        vs = ve = dp / dt;
+    } else if (pt[2] == 2.0) { /* PT_SEGMENT_STOP */
+        vs = 2.0 * dp / dt;
+        ve = 0.0;
+    } else {
+        vs = first ? 0.0 : v_prev;
+        ve = 2.0 * dp / dt - vs;
+    }
+    st[PT_T0] = t0;
+    st[PT_P0] = p0;
+    st[PT_T1] = t1;
+    st[PT_P1] = p1;
+    st[PT_VS] = vs;
+    st[PT_VE] = ve;
+    st[PT_A] = (ve - vs) / dt;
+}
+
+static int pt_next(double *st, const double *pts, int64_t m)
+{
+    const int64_t i = (int64_t)st[PT_I];
+    if (i + 1 < m) {
+        st[PT_I] = (double)(i + 1);
+        pt_enter(st, pts + 3 * (i + 1), 0);
+        return 1;
+    }
+    st[PT_LOOPS] += 1.0;
+    if (st[PT_LOOP] != 0.0 && st[PT_LOOPS] >= st[PT_LOOP])
+        return 0;
+    st[PT_TOFF] = st[PT_T1];
+    st[PT_POFF] = st[PT_P1];
+    st[PT_I] = 0.0;
+    pt_enter(st, pts, 1);
+    return 1;
+}
+
+int64_t bank_pt_run(double *st, const double *pts, int64_t m, int64_t n, double *po, double *vo,
+                    double *ao)
+{
+    int64_t j, k = (int64_t)st[PT_K];
+    const double cyc = st[PT_T];
+    for (j = 0; j < n; j++) {
+        double t, tau, a;
+        k += 1;
+        t = (double)k * cyc;
+        while (t >= st[PT_T1] - 1e-9 * (1.0 + fabs(st[PT_T1]) * 1e-3)) { /* _EPS_T */
+            if (!pt_next(st, pts, m)) { /* _finish(origin + p1) */
+                st[PT_K] = (double)k;
+                st[PT_POS] = st[PT_ORIGIN] + st[PT_P1];
+                st[PT_VEL] = st[PT_ACC] = 0.0;
+                st[PT_STATE] = 0.0;
+                po[j] = st[PT_POS];
+                vo[j] = 0.0;
+                ao[j] = 0.0;
+                return j;
+            }
+        }
+        tau = t - st[PT_T0];
+        a = st[PT_A];
+        po[j] = st[PT_ORIGIN] + st[PT_P0] + tau * (st[PT_VS] + 0.5 * a * tau);
+        vo[j] = st[PT_VS] + a * tau;
+        ao[j] = a;
+    }
+    st[PT_K] = (double)k;
+    if (n > 0) {
+        st[PT_POS] = po[n - 1];
+        st[PT_VEL] = vo[n - 1];
+        st[PT_ACC] = ao[n - 1];
+    }
+    return -1;
+}
+
+/* The tables of many static PT rows at once (AxisBank._fill_tables): a[] holds the row count,
+ * the samples per table, the table width and the addresses of the arrays (PT_FILL_* below).
+ * For each row r: its state st[r] (PT_NST doubles) is kept in before[r], the last sample taken
+ * moves to the row's spare slot (as AxisBank._refill does), bank_pt_run fills the table from
+ * the row's points and moves st[r] on, and the table's cursor, length and end follow; the
+ * samples written are returned. */
+enum {
+    PT_FILL_NR, PT_FILL_N, PT_FILL_TABLE, PT_FILL_ROWS, PT_FILL_ST, PT_FILL_BEFORE,
+    PT_FILL_PTS, PT_FILL_M, PT_FILL_TP, PT_FILL_TV, PT_FILL_TA, PT_FILL_BASE, PT_FILL_IDX,
+    PT_FILL_LEN, PT_FILL_CUR, PT_FILL_END, PT_FILL_TAKEN, PT_FILL_FILLTAKEN, PT_FILL_NARGS
+};
+
+int bank_pt_fill_args(void) { return PT_FILL_NARGS; }
+
+int64_t bank_pt_fill(const int64_t *a)
+{
+#define PA(T, k) ((T *)(intptr_t)a[k])
+    const int64_t nr = a[PT_FILL_NR], n = a[PT_FILL_N], table = a[PT_FILL_TABLE];
+    const int64_t *rows = PA(const int64_t, PT_FILL_ROWS);
+    double *st = PA(double, PT_FILL_ST), *before = PA(double, PT_FILL_BEFORE);
+    const int64_t *pts = PA(const int64_t, PT_FILL_PTS), *m = PA(const int64_t, PT_FILL_M);
+    double *tp = PA(double, PT_FILL_TP), *tv = PA(double, PT_FILL_TV), *ta = PA(double, PT_FILL_TA);
+    const int64_t *base = PA(const int64_t, PT_FILL_BASE);
+    int64_t *idx = PA(int64_t, PT_FILL_IDX), *len = PA(int64_t, PT_FILL_LEN);
+    int64_t *cur = PA(int64_t, PT_FILL_CUR), *end = PA(int64_t, PT_FILL_END);
+    const int64_t *taken = PA(const int64_t, PT_FILL_TAKEN);
+    int64_t *fill_taken = PA(int64_t, PT_FILL_FILLTAKEN);
+    int64_t i, total = 0;
+#undef PA
+    for (i = 0; i < nr; i++) {
+        const int64_t r = rows[i], b = base[r], spare = b + table, last = idx[r];
+        int64_t e;
+        memcpy(before + PT_NST * r, st + PT_NST * r, PT_NST * sizeof(double));
+        tp[spare] = tp[last];
+        tv[spare] = tv[last];
+        ta[spare] = ta[last];
+        idx[r] = spare;
+        e = bank_pt_run(st + PT_NST * r, (const double *)(intptr_t)pts[r], m[r], n, tp + b, tv + b,
+                        ta + b);
+        len[r] = e >= 0 ? e + 1 : n;
+        cur[r] = 0;
+        end[r] = e;
+        fill_taken[r] = taken[r];
+        total += len[r];
+    }
+    return total;
+}

@@ -398,6 +398,55 @@ class FollowPlanner(SlavePlanner):
                 self._vel = self._acc = 0.0
         return self._pos, self._vel, self._acc
 
+    def run(self, masters: list[float]) -> tuple[list[float], list[float], list[float], int]:
+        """:meth:`step` once per master position of ``masters`` (the axis bank's tables), the
+        same operations: the samples up to the end and its index (-1: the motion goes on).
+        Inside the current cam segment the sample is :meth:`_follow`'s closed form; anything
+        else (a segment, pass or FIFO boundary, a master moving back) is :meth:`_follow`."""
+        if self._state != _MOVE:
+            return self.run_steps(masters)
+        ps: list[float] = []
+        vs_: list[float] = []
+        as_: list[float] = []
+        cyc, dir_ = self._T, self._dir
+        x, m_prev = self._x, self._m_prev
+        pos, vel, acc = self._pos, self._vel, self._acc
+        sd, i = self._sd, self._i
+        seg = self._segs[i]
+        x0, x1, base, rs, k = seg.x0, seg.x1, self._origin + seg.s0, seg.rs, seg.k
+        for j, m in enumerate(masters):
+            m = float(m)
+            x += passed(m - m_prev, dir_)
+            m_prev = m
+            if (x - x1) * sd >= 0.0 or (i > 0 and (x - x0) * sd < 0.0):
+                self._x, self._m_prev = x, m_prev
+                self._pos, self._vel, self._acc = pos, vel, acc
+                self._follow()
+                pos, vel, acc = self._pos, self._vel, self._acc
+                if self._state == _IDLE:
+                    ps.append(pos)
+                    vs_.append(vel)
+                    as_.append(acc)
+                    return ps, vs_, as_, j
+                sd, i = self._sd, self._i
+                seg = self._segs[i]
+                x0, x1, base, rs, k = seg.x0, seg.x1, self._origin + seg.s0, seg.rs, seg.k
+            else:
+                u = x - x0
+                if u * sd < 0.0:
+                    u = 0.0  # behind the start of the pass: wait there
+                s = base + u * (rs + k * u)
+                v = (s - pos) / cyc
+                acc = (v - vel) / cyc
+                vel = v
+                pos = s
+            ps.append(pos)
+            vs_.append(vel)
+            as_.append(acc)
+        self._x, self._m_prev = x, m_prev
+        self._pos, self._vel, self._acc = pos, vel, acc
+        return ps, vs_, as_, -1
+
     # ------------------------------------------------------------ internals
     def _follow(self) -> None:
         """Slave position for the current master travel ``_x``."""

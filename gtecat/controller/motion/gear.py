@@ -199,6 +199,35 @@ class GearPlanner(SlavePlanner):
                 self._vel = self._acc = 0.0
         return self._pos, self._vel, self._acc
 
+    def run(self, masters: list[float]) -> tuple[list[float], list[float], list[float], int]:
+        """:meth:`step` once per master position of ``masters`` (the axis bank's tables), the
+        same operations: the samples, and -1 (a gear never ends by itself)."""
+        if self._state != _MOVE:
+            return self.run_steps(masters)
+        ps: list[float] = []
+        vs_: list[float] = []
+        as_: list[float] = []
+        cyc, r1, dir_ = self._T, self._r1, self._dir
+        m_prev, pos, vel = self._m_prev, self._pos, self._vel
+        acc = self._acc
+        for m in masters:
+            m = float(m)
+            d = passed(m - m_prev, dir_)
+            m_prev = m
+            if self._cl > 0.0 and d != 0.0:
+                ds = self._through_clutch(d)
+            else:
+                ds = r1 * d
+            pos += ds
+            v = ds / cyc
+            acc = (v - vel) / cyc
+            vel = v
+            ps.append(pos)
+            vs_.append(vel)
+            as_.append(acc)
+        self._m_prev, self._pos, self._vel, self._acc = m_prev, pos, vel, acc
+        return ps, vs_, as_, -1
+
     # ------------------------------------------------------------ internals
     def _begin_clutch(self, r_from: float, r_to: float, length: float) -> None:
         self._r0, self._r1 = r_from, r_to

@@ -147,3 +147,24 @@ class SlavePlanner:
     def _require_idle(self, what: str) -> None:
         if self._state != 0:
             raise CommandError(f"{what}: the profile is moving; call GT_Stop first")
+
+    def run_steps(self, masters: list[float]) -> tuple[list[float], list[float], list[float], int]:
+        """One ``step()`` per master position of ``masters`` (what the source reads in each
+        of those cycles; the axis bank's tables): the samples up to the end and the end
+        sample's index (-1: the motion goes on)."""
+        ps: list[float] = []
+        vs_: list[float] = []
+        as_: list[float] = []
+        src = self._source
+        self._source = iter(masters).__next__
+        try:
+            for j in range(len(masters)):
+                p, v, a = self.step()  # type: ignore[attr-defined]
+                ps.append(p)
+                vs_.append(v)
+                as_.append(a)
+                if self._state == 0:
+                    return ps, vs_, as_, j
+        finally:
+            self._source = src
+        return ps, vs_, as_, -1

@@ -378,6 +378,58 @@ class PtPlanner:
                 self._finish(self._pos)
         return self._pos, self._vel, self._acc
 
+    def run(self, n: int) -> tuple[list[float], list[float], list[float], int]:
+        """``n`` calls of :meth:`step` at once (the axis bank's tables): the positions, speeds
+        and accelerations up to the end sample, and its index (-1: the motion goes on).
+        Inside a segment the samples are the closed form of :meth:`step`, the same
+        operations in the same order; a segment boundary is :meth:`step` itself."""
+        ps: list[float] = []
+        vs_: list[float] = []
+        as_: list[float] = []
+        if self._state != _MOVE:
+            for j in range(n):
+                p, v, a = self.step()
+                ps.append(p)
+                vs_.append(v)
+                as_.append(a)
+                if self._state == _IDLE:
+                    return ps, vs_, as_, j
+            return ps, vs_, as_, -1
+        cyc = self._T
+        k = self._k
+        j = 0
+        while j < n:
+            t1 = self._t1
+            lim = t1 - _EPS_T * (1.0 + abs(t1) * 1e-3)
+            t0, a, vs = self._t0, self._a, self._vs
+            base = self._origin + self._p0
+            half = 0.5 * a
+            while j < n:
+                t = (k + 1) * cyc
+                if t >= lim:
+                    break
+                k += 1
+                tau = t - t0
+                ps.append(base + tau * (vs + half * tau))
+                vs_.append(vs + a * tau)
+                as_.append(a)
+                j += 1
+            else:
+                break
+            self._k = k  # a segment boundary: step() itself
+            p, v, acc = self.step()
+            k = self._k
+            ps.append(p)
+            vs_.append(v)
+            as_.append(acc)
+            j += 1
+            if self._state != _MOVE:
+                return ps, vs_, as_, j - 1
+        self._k = k
+        if ps:
+            self._pos, self._vel, self._acc = ps[-1], vs_[-1], as_[-1]
+        return ps, vs_, as_, -1
+
     # ------------------------------------------------------------ internals
     def _require_idle(self, what: str) -> None:
         if self._state != _IDLE:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import struct
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -202,6 +203,7 @@ frames = st.sampled_from(
 
 @settings(max_examples=examples(25, 10), deadline=None)
 @given(st.lists(st.tuples(frames, st.integers(0, 3_000)), min_size=1, max_size=30))
+@pytest.mark.long
 def test_compiled_dc_datagrams_answer_like_the_registers(sequence: list) -> None:
     fast = dc_chain()
     slow = _general_only(dc_chain())

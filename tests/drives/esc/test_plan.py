@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import struct
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -136,6 +137,7 @@ cyclic_ops = st.one_of(
 
 @settings(max_examples=examples(120, 40), deadline=None)
 @given(st.lists(cyclic_ops, min_size=1, max_size=40))
+@pytest.mark.long
 def test_repeated_cyclic_frames_agree_with_the_general_path(sequence: list) -> None:
     """Also covers the one-datagram shortcut (Chain._cyclic: a repeat of the last fast
     frame skips the walk), with and without Ethernet padding after the frame."""

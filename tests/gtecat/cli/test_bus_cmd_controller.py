@@ -103,6 +103,7 @@ READS = [
 
 @pytest.mark.parametrize("argv", READS, ids=[" ".join(a) for a in READS])
 @pytest.mark.parametrize("fmt", ["table", "json"])
+@pytest.mark.sample(6)
 def test_a_verb_on_a_running_controller_prints_what_it_prints_for_a_bus_of_its_own(
     cli: Cli, shared: str, argv: tuple[str, ...], fmt: str
 ) -> None:
@@ -129,6 +130,7 @@ def test_gtecat_controller_in_the_environment_is_read_unless_a_file_is_named(
     assert cli("states")[2].startswith("error: cannot reach the controller at unix:/nonexistent")
 
 
+@pytest.mark.long
 def test_changes_through_a_controller_stay_on_its_bus(cli: Cli, address: str) -> None:
     assert cli("sdo", "download", "0", "0x6060", "0", "6", "--controller", address)[0] == 0
     rc, out, _ = cli("sdo", "upload", "0", "Modes of operation", "--controller", address, "--json")
@@ -163,11 +165,13 @@ def test_changes_through_a_controller_stay_on_its_bus(cli: Cli, address: str) ->
         (("cstruct", "-p", "4"), "no slave 4"),
     ],
 )
+@pytest.mark.sample(3)
 def test_controller_refusals_are_one_line(cli: Cli, shared: str, argv, text) -> None:
     rc, out, err = cli(*argv, "--controller", shared)
     assert rc == 1 and out == "" and err.count("\n") == 1 and text in err, err
 
 
+@pytest.mark.long
 def test_no_controller_at_the_address_is_one_line(cli: Cli, tmp_path) -> None:
     for verb in (("slaves",), ("sdos",), ("graph",), ("cstruct",)):
         rc, _, err = cli(*verb, "--controller", f"unix:{tmp_path}/none.sock")

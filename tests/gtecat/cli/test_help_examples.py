@@ -115,6 +115,7 @@ def _run(argv: list[str], stdin: str | None, monkeypatch: pytest.MonkeyPatch) ->
     return rc, buf.getvalue()
 
 
+@pytest.mark.long
 def test_every_example_runs(folder: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
     assert len(EXAMPLES) > 20
     ran = []

@@ -51,6 +51,7 @@ def _script(tmp_path: Path, wait_ms: int = 20, exit_code: int = 0) -> Path:
     return path
 
 
+@pytest.mark.long
 def test_trace_writes_csv_and_png_with_one_row_per_cycle(
     cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -286,6 +287,7 @@ def test_gt_open_is_restored_after_the_run(cli: Cli, tmp_path: Path) -> None:
     assert gt.GT_Open is before
 
 
+@pytest.mark.long
 def test_axis_mode_and_state_come_from_the_drive_when_not_mapped(
     cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

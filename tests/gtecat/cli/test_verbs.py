@@ -140,6 +140,7 @@ def test_cstruct_macros_are_the_map_offsets(cli: Cli) -> None:
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="no C compiler")
 @pytest.mark.parametrize("eni", ENIS, ids=[p.name for p in ENIS])
+@pytest.mark.sample(2)
 def test_cstruct_compiles_as_c_and_cpp_and_agrees_with_the_layout(
     cli: Cli, tmp_path: Path, eni: Path
 ) -> None:

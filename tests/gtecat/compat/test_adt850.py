@@ -112,6 +112,7 @@ def test_speed_example_of_9_2_100_khz_and_10_khz():
 
 
 # --- 5.1 fixed drives ----------------------------------------------------------------------
+@pytest.mark.long
 def test_pmove_t_curve_closed_form_time_and_exact_end():
     """5.1 with 2.2's symmetric T curve: SV 100, V 2000, A 100 (x125x10 PPS/s)."""
     init()
@@ -127,6 +128,7 @@ def test_pmove_t_curve_closed_form_time_and_exact_end():
     assert abs(actual(1) - 50_000) <= 1  # the encoder follows the amplifier
 
 
+@pytest.mark.long
 def test_s_curve_status_bits_follow_the_sections():
     """2.1: D5/D6/D7 while the acceleration grows / holds / falls; D2 D3 D4 accel/const/dec."""
     init()
@@ -144,6 +146,7 @@ def test_s_curve_status_bits_follow_the_sections():
     assert pos(1) == 60_000
 
 
+@pytest.mark.long
 def test_manual_deceleration_point_of_the_vb_example():
     """Chapter 10 Set_DecPos: DecPulse = (StartV + Speed)·addtime/2, addtime = (Speed -
     StartV)/Add; set_dec_pos(value - DecPulse): the drive reaches SV as the pulses end."""
@@ -200,6 +203,7 @@ def test_line_xy_long_axis_speed_points_within_half_lsb():
     assert len(xs) == pytest.approx(3000 / 10, abs=1)  # 3000 base pulses at 10 per ms
 
 
+@pytest.mark.long
 def test_xy_dec_disabled_by_default_then_enabled_auto_deceleration():
     """9.2.6: "默认情况是插补减速禁止": a lone node accelerates and stops at once; with
     inp_dec_enable it decelerates to SV at its end."""
@@ -225,6 +229,7 @@ def test_xy_dec_disabled_by_default_then_enabled_auto_deceleration():
     assert (pos(1), pos(2)) == (0, 0)
 
 
+@pytest.mark.long
 def test_continuous_interpolation_of_chapter_10_1_3_5():
     """Four X-Y nodes (the VB CmdContinueInp): decel disabled, manual deceleration on the
     last node, each next node written when get_inp_status2 allows; the speed never falls
@@ -363,6 +368,7 @@ def test_limit_switch_stops_and_reports_d3():
     wait_axes(1)
 
 
+@pytest.mark.long
 def test_soft_limit_comp_plus_decelerates():
     """1.9 / 3.9: COMP+ as a soft limit: a decelerating stop, D6; then only - moves."""
     init()

@@ -72,6 +72,7 @@ def test_speed_formulas_of_4_4():
     assert card.regs[1].m == 500
 
 
+@pytest.mark.long
 def test_tcurve_f_and_scurve_f_end_exactly_in_closed_form_time():
     """4.4 TCurve_F / SCurve_F: fixed drives; the chip computes the ramps, the pulses end."""
     up()
@@ -133,6 +134,7 @@ def test_line3d_s_and_line2d_t():
         m.Line2D_C(m.LINEDATA(SV=1, V=1), 0x7)  # not a pair
 
 
+@pytest.mark.long
 def test_circles_cw_ccw_and_t_needs_manual_dec():
     """4.5.2: the centre (SetC) and end (SetP) relative to the start; CircleCW_T needs
     ManualDec (4.4 note on AutoDec)."""
@@ -291,6 +293,7 @@ def test_structures_are_taken_by_their_fields_not_their_class():
         m.Line2D_C(object(), 0x3)
 
 
+@pytest.mark.long
 def test_scurve_f_unnamed_argument_changes_nothing():
     """4.4: SCurve_F(axis, SV, V, A, <unnamed>, K, Pulse): the text names no deceleration;
     the same drive whatever the fifth argument is."""

@@ -262,6 +262,7 @@ def test_bank_matches_the_scalar_path_cycle_by_cycle(tmp_path: Path, actions) ->
             assert a == b, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
 
 
+@pytest.mark.long
 def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     """Without this the differential test could pass with the bank never engaged."""
     machine = _machine_file(tmp_path)
@@ -280,6 +281,7 @@ def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     _kernel_ran(KERNEL_CYCLES[0])
 
 
+@pytest.mark.long
 def test_cycles_run_many_at_once_are_the_cycles_one_by_one(tmp_path: Path) -> None:
     """Long waits with nothing else to do run many cycles per call of the kernel, which fills
     its short Trap tables itself; moves that end, a stop, a new target, a band, a limit
@@ -309,6 +311,7 @@ def test_cycles_run_many_at_once_are_the_cycles_one_by_one(tmp_path: Path) -> No
     assert MANY_CYCLES[0] > 300  # the waits before the limit ran many cycles at a time
 
 
+@pytest.mark.long
 def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:
     machine = _machine_file(tmp_path)
     jogs = [

@@ -169,6 +169,7 @@ def _resting_run(bank: str) -> tuple[list, int]:
     return trace, frozen
 
 
+@pytest.mark.long
 def test_resting_axes_in_the_bank_match_the_scalar_drives() -> None:
     ref, ref_rows = _resting_run("off")
     got, rows = _resting_run("on")

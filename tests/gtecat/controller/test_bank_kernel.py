@@ -55,6 +55,7 @@ def _run(tmp_path: Path, **env: str) -> dict:
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.long
 def test_without_a_compiler_the_bank_runs_on_numpy_and_says_why(tmp_path: Path) -> None:
     got = _run(tmp_path, CC="/no/such/compiler")
     assert not got["kernel"] and got["kernel_cycles"] == 0
@@ -62,6 +63,7 @@ def test_without_a_compiler_the_bank_runs_on_numpy_and_says_why(tmp_path: Path) 
     assert got["rows"] > 12 * 50  # the bank itself still ran
 
 
+@pytest.mark.long
 def test_numpy_on_request(tmp_path: Path) -> None:
     got = _run(tmp_path, GTECAT_BANK_KERNEL="numpy")
     assert not got["kernel"] and got["reason"] == "GTECAT_BANK_KERNEL=numpy"

@@ -20,6 +20,7 @@ def _closed():
     gt.GT_Close()
 
 
+@pytest.mark.long
 def test_records_every_cycle_what_the_bus_carried(tmp_path):
     bring_up()
     ctl = gt.GTE_Controller()

@@ -187,6 +187,7 @@ CASES = [
     ("mode", "d", "edge", "idx", "where"),
     [(m, d, e, i, w) for m, d, e, i, starts in CASES for w in starts],
 )
+@pytest.mark.sample(8)
 def test_every_mode_lands_on_the_closed_form(mode, d, edge, idx, where):
     start = START[where]
     ctl = open_card(start)

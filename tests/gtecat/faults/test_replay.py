@@ -58,6 +58,7 @@ def _calls(path: Path) -> list[dict]:
     return [json.loads(x) for x in path.read_text().splitlines()[1:] if '"c":' in x]
 
 
+@pytest.mark.long
 def test_the_session_replays_exactly_many_cycles_at_once(
     recorded: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -81,6 +82,7 @@ def test_the_session_replays_exactly_many_cycles_at_once(
     assert sum(batches) > 0.8 * SECONDS * 1000
 
 
+@pytest.mark.long
 def test_a_tampered_recording_reports_its_first_divergence(
     recorded: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

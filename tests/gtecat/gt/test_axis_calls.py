@@ -168,6 +168,7 @@ def test_sdo_existing_missing_read_only_against_cia301_abort_codes():
     assert size.value == 4 and int.from_bytes(bytes(data[:4]), "little") == 12345
 
 
+@pytest.mark.long
 def test_forced_following_error_faults_and_a_reset_clears_it():
     """cia402-facts pitfall 4: a set-point step beyond 6065h trips the following error."""
     bring_up(FULL)

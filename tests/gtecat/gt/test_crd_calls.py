@@ -86,6 +86,7 @@ def test_line_on_the_line_within_synvel_exact_end_closed_form_time():
 
 
 @pytest.mark.parametrize("direction", [0, 1])
+@pytest.mark.long
 def test_arc_by_centre_on_the_circle_and_turning_the_right_way(direction):
     up()
     # half circle from (0, 0) to (20000, 0) around (10000, 0) (centre relative to the start)

@@ -240,6 +240,7 @@ def test_defaults_and_settings_that_survive_a_trip_through_another_mode():
         lambda: gt.GT_GearStart(0b10),
     ],
 )
+@pytest.mark.long
 def test_every_gear_call_returns_1_outside_gear_mode(call):
     up()
     rc_reason(call(), 1, "Trap mode", "GT_PrfGear")

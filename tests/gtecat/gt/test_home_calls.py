@@ -205,6 +205,7 @@ def capture(encoder: int = 1) -> tuple[int, int]:
         (gt.CAPTURE_PROBE, 1, 20000, PROBE[1]),
     ],
 )
+@pytest.mark.sample(2)
 def test_card_capture_latches_the_encoder_at_the_edge(mode, sense, target, want):
     open_card()
     assert gt.GT_SetCaptureSense(1, mode, sense) == 0
@@ -424,6 +425,7 @@ def test_forced_home_on_a_gpi_the_field_side_drives():
     assert st.error == 0 and abs(st.capturePos - 15000) <= 4 / 2 + 1  # sampled at velLow
 
 
+@pytest.mark.long
 def test_seed_002_polling_loop_sees_and_clears_the_limit_flag():
     """Seed 002's moveHomeInner loop: GT_GetHomeStatus + GT_ClrSts until run drops."""
     open_card(start=5000, clock="auto")
@@ -502,6 +504,7 @@ def ecat_machine() -> MachineDescription:
 
 
 @pytest.mark.parametrize("eni", ["homing_probe.eni", "manual_fig5_2.eni"])
+@pytest.mark.long
 def test_ethercat_home_index_mode_captures_the_index_exactly(eni):
     """homing_probe.eni maps the touch probe (PDO); figure 5-2's bus does not (SDO)."""
     bring_up(eni, machine=ecat_machine(), clock="lockstep")
@@ -521,6 +524,7 @@ def test_ethercat_home_edge_is_sampled_within_half_a_cycle():
     assert st.error == 0 and abs(st.capturePos - ECAT_LO) <= 40 / 2 + 1  # velHigh 40, 1 ms
 
 
+@pytest.mark.long
 def test_ethercat_limit_and_limit_home_index_modes():
     bring_up("homing_probe.eni", machine=ecat_machine(), clock="lockstep")
     assert gt.GT_AxisOn(1) == 0

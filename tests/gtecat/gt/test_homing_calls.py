@@ -222,6 +222,7 @@ def vendor_loop(axes: range, limit_ms: int = 20_000) -> dict[int, list[int]]:
 # --- one test per method, all starts of its family at once (one axis per start) --------------
 # and the vendor's polling loop on each of them (manual entry 43): 0 ... 0 3, never 1/2/4
 @pytest.mark.parametrize(("family", "method"), CASES, ids=[f"{f}-{m}" for f, m in CASES])
+@pytest.mark.sample(2)
 def test_home_point_matches_the_method_table(five_axes: Path, family: str, method: int) -> None:
     layout, starts, table = FAMILIES[family]
     offset = 250
@@ -547,6 +548,7 @@ def test_vendor_loop_on_the_figure_5_2_bus_by_sdo() -> None:
     [c[1:] for c in ERROR_CASES],
     ids=[c[0] for c in ERROR_CASES],
 )
+@pytest.mark.long
 def test_vendor_loop_sees_0_then_5_on_a_homing_error(
     five_axes: Path, layout: dict, starts: tuple, method: int
 ) -> None:

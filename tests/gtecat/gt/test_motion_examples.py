@@ -69,6 +69,7 @@ def test_example_7_1_in_the_auto_clock_keeps_its_shape():
     assert 1320 <= r["t"][-1] - r["t"][0] <= 1335
 
 
+@pytest.mark.long
 def test_example_7_2_speed_up_to_100_then_down_to_50():
     r = example("example_7_2_jog").run(clock="lockstep")
     assert r["errors"] == []

@@ -72,6 +72,7 @@ def sweep(axis: int, speed: int, until: float, on_scan=None) -> None:
 
 # --- example 5-3 ------------------------------------------------------------------------------
 @pytest.mark.parametrize("speed", [7301, 14200, 33333, 260000])
+@pytest.mark.sample(1)
 def test_example_5_3_captures_every_rising_edge_within_one_count(speed: int) -> None:
     r = _example_5_3().run(speed=speed)
     assert r["rtn"] == 0
@@ -81,12 +82,14 @@ def test_example_5_3_captures_every_rising_edge_within_one_count(speed: int) -> 
     assert r["status_after_stop"] & 0x0707 == 0
 
 
+@pytest.mark.long
 def test_example_5_3_in_lockstep() -> None:
     r = _example_5_3().run(clock="lockstep")
     assert within_one_count(r["captures"], RISING)
 
 
 # --- the 60B8h / 60B9h rules through the GT calls --------------------------------------------
+@pytest.mark.long
 def test_both_edges_continuous_toggle_bits_6_and_7() -> None:
     bring_up("homing_probe.eni", machine=str(EXAMPLES / "homing_probe_machine.toml"))
     assert gt.GT_AxisOn(2) == 0

@@ -167,6 +167,7 @@ def test_example_scripts_succeed(name, tmp_path, capsys):
         assert (tmp_path / "sum.bin").is_file() and (tmp_path / "sum.ini").is_file()
 
 
+@pytest.mark.long
 def test_examples_11_3_and_11_4_in_two_fresh_processes(tmp_path):
     store = tmp_path / "store.mram"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
@@ -342,6 +343,7 @@ wait:
 """
 
 
+@pytest.mark.long
 def test_threads_bound_to_one_function_move_two_axes_at_the_same_time(tmp_path):
     bring_up(clock="lockstep")
     load(tmp_path, MOVE)

@@ -122,6 +122,7 @@ def test_random_sequences_match_the_integrated_reference_and_start_where_the_axi
         here = out[-1]
 
 
+@pytest.mark.long
 def test_loops_repeat_the_fifo_and_get_pt_loop_counts_passes():
     up()
     assert gt.GT_PrfPt(1) == 0

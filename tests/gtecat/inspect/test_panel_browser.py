@@ -258,6 +258,7 @@ def test_a_request_without_the_token_gets_403(panels: dict[str, Any]) -> None:
         assert r.status == 200 and b"gtecat panel" in r.read()
 
 
+@pytest.mark.long
 def test_faults_from_the_panel(browser: Any, endpoint_conn: client.Attached) -> None:
     """The fourth way in: a fault typed as on the command line, injected, listed, cleared."""
     spec = browser.find_element("id", "fault-spec")

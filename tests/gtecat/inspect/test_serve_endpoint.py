@@ -91,6 +91,7 @@ def served(runtime_dir: Path) -> Iterator[Served]:
     assert not thread.is_alive()
 
 
+@pytest.mark.long
 def test_ps_lists_the_serve_and_the_fault_verbs_break_its_chain(served: Served, capsys) -> None:
     assert main(["ps", "--json"]) == 0
     (entry,) = json.loads(capsys.readouterr().out)

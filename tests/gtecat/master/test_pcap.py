@@ -58,6 +58,7 @@ def tshark_check(path: Path) -> str:
 
 
 @pytest.mark.wire
+@pytest.mark.long
 def test_serve_captures_a_pysoem_session_tshark_decodes(tmp_path: Path) -> None:
     from tests.gtecat.wire.rawmaster import ServeProcess, veth_pair, why_not_root
 

@@ -107,6 +107,7 @@ def test_attached_calls_return_the_controllers_codes_and_write_the_callers_memor
     assert gt.GT_GetPrfPos(1, byref(pos)) == 0
 
 
+@pytest.mark.long
 def test_open_twice_options_and_the_python_objects_are_refused_clearly(controller):
     address, _ = controller
     assert gt.GT_Open(controller=address, eni=str(FIG5_2)) == 7
@@ -141,6 +142,7 @@ def test_open_twice_options_and_the_python_objects_are_refused_clearly(controlle
         field()
 
 
+@pytest.mark.long
 def test_gtecat_controller_in_the_environment_attaches_and_local_does_not(controller, monkeypatch):
     address, _ = controller
     monkeypatch.setenv("GTECAT_CONTROLLER", address)
@@ -151,6 +153,7 @@ def test_gtecat_controller_in_the_environment_attaches_and_local_does_not(contro
     assert gt.GT_Close() == 0
 
 
+@pytest.mark.long
 def test_a_controller_that_dies_makes_every_call_minus_1_with_the_reason(controller):
     address, proc = controller
     assert gt.GT_Open(controller=address) == 0
@@ -165,6 +168,7 @@ def test_a_controller_that_dies_makes_every_call_minus_1_with_the_reason(control
     assert "cannot reach" in gt.GTE_GetLastError()
 
 
+@pytest.mark.long
 def test_field_operations_reach_the_machine_and_refuse_with_reasons(controller):
     address, _ = controller
     with field(address) as f:  # no GT_Open yet: nothing to show
@@ -223,6 +227,7 @@ def test_every_field_operation_has_its_python_method():
 
 # --- the worked example: a compiled program, a test driving the machine and reading traces --
 @needs_cxx
+@pytest.mark.long
 def test_a_compiled_program_and_an_attached_test_share_one_controller_process(
     motion_demo, tmp_path, monkeypatch
 ):

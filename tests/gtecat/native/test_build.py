@@ -83,6 +83,7 @@ def test_the_header_prints_without_a_build(capsys):
     assert "short GT_GetSts(short axis, long *pSts" in capsys.readouterr().out
 
 
+@pytest.mark.long
 def test_importing_gtecat_needs_no_compiler(tmp_path):
     """pip install works without cc: nothing is compiled until the library is asked for."""
     code = "import gtecat.native, gtecat.native.server, gtecat.gt; print('ok')"

@@ -115,6 +115,7 @@ def _controllers(cwd: Path) -> set[int]:
     return out
 
 
+@pytest.mark.long
 def test_auto_with_the_wall_floor(clock_probe, tmp_path):
     r, v = run_client(clock_probe, env=native_env(), cwd=tmp_path)
     assert v.get("open") == "0", r.stdout + r.stderr
@@ -147,6 +148,7 @@ def test_a_missing_python_is_a_clear_error(clock_probe, tmp_path):
 
 
 @needs_cxx
+@pytest.mark.long
 def test_seed_002_shaped_cpp_program(motion_demo, tmp_path):
     r, v = run_client(motion_demo, env=native_env(), cwd=tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr

@@ -303,6 +303,7 @@ def multicard(tmp_path_factory) -> tuple[dict[str, str], Path]:
     return _mono(d / "MultiCardStation.exe", d, GTECAT_CARD="gts:4"), d
 
 
+@pytest.mark.long
 def test_a_multicard_wrapper_runs_on_the_multicard_map(multicard):
     v, d = multicard
     from gtecat.native import llp64
@@ -330,6 +331,7 @@ MULTICARD_CODES = (
 ).split()
 
 
+@pytest.mark.long
 def test_multicard_station_codes_and_values_equal_pythons(multicard, monkeypatch):
     v, d = multicard
     monkeypatch.chdir(d)

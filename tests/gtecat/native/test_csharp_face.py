@@ -6,10 +6,13 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 
+import pytest
+
 from gtecat.gt.table import FUNCTIONS
 from gtecat.native import build, csharp, llp64
 
 
+@pytest.mark.long
 def test_gts_cs_declares_the_whole_table_in_the_vendor_style():
     """Every table function and its GTN twin; C long is int, unsigned long uint; counted
     outputs have an out and an array overload; bytes are arrays; structures unrolled as the

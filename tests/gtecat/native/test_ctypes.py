@@ -160,6 +160,7 @@ def test_cdll_declares_the_table_so_0_is_null(libgts, env):
         typed.GT_Close()
 
 
+@pytest.mark.long
 def test_a_dead_controller_makes_calls_return_minus_1(lib, controller):
     sts = c_long()
     assert lib.GT_Open(0, 1) == 0, last_error(lib)
@@ -178,6 +179,7 @@ def test_a_dead_controller_makes_calls_return_minus_1(lib, controller):
     assert "cannot reach the controller" in last_error(lib)
 
 
+@pytest.mark.long
 def test_a_stopped_controller_times_out(lib, controller, env):
     sts = c_long()
     assert lib.GT_Open(0, 1) == 0, last_error(lib)
@@ -193,6 +195,7 @@ def test_a_stopped_controller_times_out(lib, controller, env):
         lib.GT_Close()
 
 
+@pytest.mark.long
 def test_several_clients_share_one_controller(lib, controller, libgts, tmp_path):
     """The test process and a second process attach to the same controller at once."""
     assert lib.GT_Open(0, 1) == 0

@@ -12,6 +12,8 @@ from __future__ import annotations
 import subprocess
 from ctypes import byref, c_long
 
+import pytest
+
 from gtecat import gt
 from gtecat.native.server import Server
 
@@ -20,6 +22,7 @@ from .conftest import FIG5_2, native_env, needs_cxx
 pytestmark = needs_cxx
 
 
+@pytest.mark.long
 def test_the_program_sees_a_drive_alarm_the_test_injects(motion_demo, tmp_path):
     gt.GT_Close()
     assert gt.GT_Open(eni=str(FIG5_2), clock="auto", log="") == 0

@@ -52,6 +52,7 @@ say("done", 1)
 
 
 @needs_cc
+@pytest.mark.long
 def test_ext_io_from_c_matches_python(libgts, tmp_path):
     (tmp_path / "machine.toml").write_text(MACHINE, encoding="utf-8")
     (tmp_path / "ExtModule.cfg").write_text("[mdl0]\n", encoding="utf-8")

@@ -36,6 +36,7 @@ def _eligible() -> list[str]:
 
 
 @pytest.mark.parametrize("batch", range(BATCHES))
+@pytest.mark.long
 def test_bad_input_through_the_library_gets_the_python_codes(libgts, batch):
     names = _eligible()[batch::BATCHES]
     env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}

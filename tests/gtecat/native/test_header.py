@@ -100,6 +100,7 @@ def test_header_declares_the_table_exactly():
     assert disagreements(header.render(), FUNCTIONS) == []
 
 
+@pytest.mark.long
 def test_a_drifted_table_is_noticed():
     text = header.render()
     groups = []
@@ -204,6 +205,7 @@ def test_compiles_warning_free_as_cxx11_with_defaults(tmp_path, gts_h):
 
 
 @needs_cc
+@pytest.mark.long
 def test_structure_layout_equals_ctypes(tmp_path, gts_h):
     structs = cdecl.structures()
     assert {"TTrapPrm", "TJogPrm", "TThreadSts", "TVarInfo", "TCompileInfo", "TSlaveInfo"} <= {

@@ -39,6 +39,7 @@ MACHINE = (
 
 @needs_cxx
 @needs_m32
+@pytest.mark.long
 def test_a_vendor_header_with_long_fields_runs_as_a_32_bit_program(tmp_path: Path) -> None:
     exe = tmp_path / "home32"
     cmd = (

@@ -150,6 +150,7 @@ def run_seed(exe: Path, folder: Path, cfg: str, axis: int = 3) -> dict[str, list
 
 
 @pytest.mark.parametrize("wired", [True, False], ids=["axis 3 wired", "vendor file as is"])
+@pytest.mark.long
 def test_seed_002_limit_homing_runs_unchanged_on_gts4(seed_program, tmp_path, wired):
     out = run_seed(seed_program, tmp_path / "run", vendor_cfg(wired))
     assert out["init"] == [0] and out["home"] == [0] and out["close"] == [0]

@@ -162,6 +162,7 @@ def _case(plan, rnd: random.Random):
     return py, wire
 
 
+@pytest.mark.long
 def test_bad_input_gets_the_python_codes(served):
     _, address = served
     c = WireClient(address)

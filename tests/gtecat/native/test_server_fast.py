@@ -51,6 +51,7 @@ def _pointer(size: int | None) -> bytes:
     return PTR.pack(PTR_NULL) if size is None else PTR.pack(size) + b"\xa5" * size
 
 
+@pytest.mark.long
 def test_fast_and_table_answer_alike(moving):
     """Every combination (11 readers x 2 long sizes x axes x pointer sizes x counts x pClock x
     a trailing byte): about 19,000 requests, each answered twice."""

@@ -57,6 +57,7 @@ def _compile(src: Path, out: Path, compiler: str, lib_args: str, extra: str = ""
 
 
 @needs_cxx
+@pytest.mark.long
 def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, controller, tmp_path):
     """__stdcall, extern "C" in GT_API, NULL defaults and UINT8 without any include: the
     forced include of --cflags supplies them; the header's own TTrapPrm matches ours."""
@@ -88,6 +89,7 @@ def test_a_vendor_style_header_compiles_unchanged_and_runs(libgts, controller, t
 
 
 @needs_cxx
+@pytest.mark.long
 def test_a_gvn_era_header_with_its_own_linux_branch_compiles_and_runs(libgts, controller, tmp_path):
     """The newest header shape (GT_API without __stdcall under __linux__, __int64 from
     int64_t, GP_CORE): GTN_GetPrfSts reads 5 profiles, a declared-only call answers 8."""
@@ -117,6 +119,7 @@ def test_declared_only_gives_the_same_answer_in_python():
     assert "GTN_SetHSIOOpt is declared" in gt.GTE_GetLastError()
 
 
+@pytest.mark.long
 def test_the_multicard_abi(controller, tmp_path):
     """Manual-era GTS programs pass the card first: two cards, each a controller of its own
     (card 1 jogs while card 0 stands; card 0 closes, card 1 keeps running)."""

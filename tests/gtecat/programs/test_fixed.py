@@ -194,6 +194,7 @@ def _run(h, sets: dict[str, int], result: str) -> tuple[int, int]:
 @pytest.mark.parametrize("op", sorted(_INT_OPS))
 @settings(deadline=None)
 @given(a=WORDS, b=WORDS)
+@pytest.mark.sample(4)
 def test_int_operations_in_a_program_match_the_model(programs, op, a, b):
     err, r = _run(programs(f"ir = ia {op} ib;"), {"ia": a, "ib": b}, "ir")
     if op in "/%" and b == 0:

@@ -84,6 +84,7 @@ def _sweep(folder: Path, *extra: str) -> int:
         os.chdir(cwd)
 
 
+@pytest.mark.long
 def test_local_sweep_resume_rerun_and_report(sweep_dir: Path, capsys) -> None:
     rc = _sweep(sweep_dir, "-o", "results.csv", "--workers", "1")
     err = capsys.readouterr().err
@@ -162,6 +163,7 @@ def _wait_for(path: Path, text: str, proc: subprocess.Popen, timeout_s: float = 
     )
 
 
+@pytest.mark.long
 def test_a_scheduler_with_two_workers_survives_a_killed_worker(sweep_dir: Path) -> None:
     """Every case exactly once in the results, though a worker died mid-sweep."""
     from dask.distributed import Client

@@ -199,6 +199,7 @@ def test_the_sii_lists_the_drive_mapping_and_the_eni_sm_layout(raw: RawMaster) -
 
 
 # --- CoE emergencies on the wire ----------------------------------------------------------------
+@pytest.mark.long
 def test_pysoem_sees_the_emergency_of_a_faulting_drive(tmp_path: Path) -> None:
     pysoem = pytest.importorskip("pysoem")
     with served(FIG52, tmp_path) as (master_if, _server):
@@ -241,6 +242,7 @@ def test_pysoem_sees_the_emergency_of_a_faulting_drive(tmp_path: Path) -> None:
 
 
 # --- KickCAT and ebpfcat (PyPI) -------------------------------------------------------------------
+@pytest.mark.long
 def test_kickcat_maps_reads_the_dictionary_and_runs_in_op(fig52: tuple[str, ServeProcess]) -> None:
     kickcat = pytest.importorskip(
         "kickcat", reason="kickcat is not installed (pip install kickcat)"
@@ -342,6 +344,7 @@ def test_ebpfcat_initialises_lists_the_dictionary_and_cycles(
     assert len(drive_inputs) == 10
 
 
+@pytest.mark.long
 def test_pysoem_foe_reads_a_file_and_gets_not_found_for_another(
     fig52: tuple[str, ServeProcess],
 ) -> None:

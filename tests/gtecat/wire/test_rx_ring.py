@@ -106,6 +106,7 @@ def _configured_chain():
 
 
 @pytest.mark.parametrize("wait", ["predict", "sleep", "spin"])
+@pytest.mark.sample(1)
 def test_every_wait_mode_answers_a_1khz_master(wait: str) -> None:
     from gtecat.wire.serve import WireServer
 
@@ -151,6 +152,7 @@ def test_every_wait_mode_answers_a_1khz_master(wait: str) -> None:
             assert pacing["missed_windows"] <= 100
 
 
+@pytest.mark.long
 def test_sigusr1_reports_a_phase_and_starts_the_latency_records_afresh(tmp_path) -> None:
     stats = tmp_path / "stats.json"
     with veth_pair("ru") as (a, b):
@@ -190,6 +192,7 @@ def test_sigusr1_reports_a_phase_and_starts_the_latency_records_afresh(tmp_path)
 
 
 @pytest.mark.parametrize("wait", ["predict", "sleep"])
+@pytest.mark.long
 def test_predict_lingers_after_an_answer_for_a_master_in_a_burst(wait: str, tmp_path) -> None:
     """Bring-up traffic (register and mailbox exchanges, no cycle to learn): a master sends its
     next frame microseconds after our answer. In predict mode the loop spins a while after each

@@ -232,6 +232,7 @@ def test_a_hostile_client_does_not_delay_the_frames(rig: Rig, capsys) -> None:
     assert rig.cycles(3) == [EXPECTED_WKC] * 3
 
 
+@pytest.mark.long
 def test_the_serve_said_every_fault_on_stderr_and_stops_cleanly(rig: Rig) -> None:
     """As for ``--fault FILE``: each fault armed, started and ended has its line; the
     endpoint's files go with the serve."""

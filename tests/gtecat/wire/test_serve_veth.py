@@ -326,6 +326,7 @@ def test_malformed_frames_are_dropped_and_the_chain_keeps_running(spare_veth, tm
 
 
 @wire
+@pytest.mark.long
 def test_clean_shutdown_on_sigint_and_sigterm(spare_veth, tmp_path: Path) -> None:
     for sig in (signal.SIGINT, signal.SIGTERM):
         stats = tmp_path / f"stats{int(sig)}.json"
@@ -356,6 +357,7 @@ def test_serve_reports_a_missing_interface_as_an_error(tmp_path: Path) -> None:
 
 
 @wire
+@pytest.mark.long
 def test_bit_outputs_and_a_coupler_without_process_data(spare_veth, tmp_path: Path) -> None:
     if not TWINCAT.is_file():
         pytest.skip(needs_fixture(TWINCAT.name))
@@ -465,6 +467,7 @@ def test_runner_refuses_a_bad_step_mode() -> None:
         WireServer(mini_chain(1), "x", step_mode="sometimes")
 
 
+@pytest.mark.long
 def test_runner_survives_a_failing_slave_side() -> None:
     from gtecat.drives.esc import Command, Datagram, encode_frame
     from gtecat.wire.serve import WireServer

@@ -106,6 +106,7 @@ def test_fractional_start_ends_on_integer_target():
     assert out[-1, 0] == 100.0 and np.all(np.diff(out[:, 0]) >= 0)
 
 
+@pytest.mark.long
 def test_far_from_zero_speed_stays_within_limit():
     """Near the GT_SetPos range end (±1073741823) the smoothed speed has no cancellation."""
     start = -1073741823 + 26650.25
@@ -117,6 +118,7 @@ def test_far_from_zero_speed_stays_within_limit():
 
 
 # --------------------------------------------------------------- smoothing
+@pytest.mark.long
 def test_smoothing_is_the_moving_average_of_the_trapezoid():
     """Example 7-1 with smoothTime 25 (7.2.2: the time over which the acceleration changes):
     the moving average of the trapezoid over 25 ms, integrated numerically; 1325 ms."""

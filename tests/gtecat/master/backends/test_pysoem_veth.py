@@ -224,6 +224,7 @@ packing = "bits"
 """
 
 
+@pytest.mark.long
 def test_bit_terminals_packed_by_soem_keep_the_gt_offsets(veth, machine, tmp_path):
     """SOEM packs slaves under 8 bits into shared IO map bytes; GT offsets must not move."""
     from gtecat.eni.topology import parse_topology
@@ -255,6 +256,7 @@ def _wait_ready(gt, value: int, ms: int) -> bool:
     return scenario_common.wait_until(gt, lambda: _ready(gt) == value, ms=ms, step_ms=5)
 
 
+@pytest.mark.long
 def test_slave_runner_stopped_and_restarted(veth, runner, machine):
     from gtecat import gt
 
@@ -288,6 +290,7 @@ def test_slave_runner_stopped_and_restarted(veth, runner, machine):
         gt.GT_Close()
 
 
+@pytest.mark.long
 def test_terminate_then_init_again(veth, runner):
     from gtecat import gt
 
@@ -330,6 +333,7 @@ def test_no_slave_on_the_wire_is_minus_10(veth):
         gt.GT_Close()
 
 
+@pytest.mark.long
 def test_other_slaves_than_the_eni_is_minus_8(veth, machine):
     from gtecat import gt
 
@@ -376,6 +380,7 @@ def _move(gt, axis: int, target: int, vel: float = 50.0) -> None:
     assert gt.GT_Update(1 << (axis - 1)) == 0, gt.GTE_GetLastError()
 
 
+@pytest.mark.long
 def test_bus_lost_mid_move_stops_the_axes_and_they_recover(veth, runner):
     """Issue 12 item 4 on the wire: the slave runner dies during a Trap move."""
     from gtecat import gt
@@ -440,6 +445,7 @@ def _verb(capsys, *argv: str) -> tuple[int, str, str]:
     return rc, out, err
 
 
+@pytest.mark.long
 def test_reg_and_sii_through_pysoem_read_what_the_emulated_bus_shows(veth, runner, capsys):
     eni = str(EXAMPLES / "manual_fig5_2.eni")
     wire = ("--eni", eni, "--backend", "pysoem", "--iface", veth[0])
