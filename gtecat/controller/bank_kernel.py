@@ -258,21 +258,21 @@ class Kernel:
             lo, hi = windows.get(bit, (empty, empty))
             io[slot] = lo.shape[1] if lo.ndim == 2 else 0
             extra[name + "_lo"], extra[name + "_hi"] = lo, hi
-        extra.update(self._placements())
+        extra.update(self._placements(key[1]))
         self._extra_key, self._extra_last = key, extra
         return dict(extra)
 
     def _placement_key(self) -> tuple[Any, ...]:
         """What :meth:`_placements` builds its arrays from."""
         bank = self.bank
-        alive, frz = bank.alive, bank.frz
+        alive, frz = bank.alive.tolist(), bank.frz.tolist()
+        # a frozen row's image keeps what its scalar objects wrote
         plc = tuple(p for p in bank._plc if alive[p[0]] and not frz[p[0]])
         return plc, tuple(bank._rx_idx), bytes(bank._rx_ref) if bank._rx_ref else b""
 
-    def _placements(self) -> dict[str, np.ndarray]:
+    def _placements(self, plc: tuple[Any, ...]) -> dict[str, np.ndarray]:
+        """``plc``: the placements of the rows the kernel writes (:meth:`_placement_key`)."""
         bank = self.bank
-        # a frozen row's image keeps what its scalar objects wrote
-        plc = [p for p in bank._plc if bank.alive[p[0]] and not bank.frz[p[0]]]
         self.io[IN_N_PLC] = len(plc)
         rx = np.asarray(bank._rx_idx, np.int64)
         self.io[IN_N_RX] = len(rx)
