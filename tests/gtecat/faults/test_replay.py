@@ -159,3 +159,33 @@ def test_a_damaged_recording_is_a_clear_error(
     assert main(["replay", str(bad)]) == 1
     err = capsys.readouterr().err
     assert "damaged recording" in err and "Traceback" not in err
+
+
+def test_every_line_of_a_shared_form_is_compared(recorded: Path, tmp_path: Path) -> None:
+    """Polling calls that differ only in the numbers their pointers held share one prepared
+    call: a value the call left (``"o"``) changed in one line of such a form is reported at
+    that call, and the lines before it still replay."""
+    lines = recorded.read_text().splitlines()
+    number, seen, at = 0, 0, None
+    for i, line in enumerate(lines[1:], 1):
+        if '"c":' not in line:
+            continue
+        number += 1
+        e = json.loads(line)
+        if e["c"] == "GT_GetClock" and "o" in e:
+            seen += 1
+            if seen == 50:
+                e["o"]["0"]["ref"]["v"] += 1
+                lines[i] = json.dumps(e, separators=(",", ":"))
+                at = (number, e["o"]["0"]["ref"]["v"])
+                break
+    assert at is not None
+    bad = tmp_path / "one_clock.gtrec"
+    bad.write_text("\n".join(lines) + "\n")
+    n, div = replay(bad)
+    assert div is not None and (div.index, div.call, div.what) == (
+        at[0],
+        "GT_GetClock",
+        "argument 1",
+    )
+    assert div.recorded["ref"]["v"] == at[1] and div.now["ref"]["v"] == at[1] - 1
