@@ -880,6 +880,8 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         elif p.is_float and p.lo is None:
             body += [
                 f"if type({a}) is float and -_INF < {a} < _INF: {v} = {a}",
+                # an int the double holds exactly (GT_SetVel(axis, 10)): as _real converts it
+                f"elif type({a}) is int and -{1 << 53} <= {a} <= {1 << 53}: {v} = float({a})",
                 f"else: {v} = C{i}({a})",
             ]
         elif (
