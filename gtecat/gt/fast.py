@@ -539,13 +539,17 @@ def fast_raw(
             return None
         if write:
             move = [f"img[{first}:{first + n}] = q[{a}:{a + n}]" for a, first, n in runs]
-        elif len(runs) == 1:
+        elif len(runs) == 1:  # one slice
             ((a, first, n),) = runs
             move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]"]
-        elif tp is bytearray:
-            move = ["q[0:size] = gather(img)"]  # the bytes of the range, in one C call
-        else:
+        elif tp is bytearray and size <= 6 * len(runs):
+            # the bytes of the range in one C call (a bytearray takes the ints as they are):
+            # fewer steps than a slice per run while the runs are short
+            move = ["q[0:size] = gather(img)"]
+        elif size <= 2 * len(runs):
             move = ["q[0:size] = bytes(gather(img))"]
+        else:  # a slice per run
+            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]" for a, first, n in runs]
         body = "\n    ".join([*check, get, *move, "return True"])
         env = {
             "img": memoryview(image.buffer),

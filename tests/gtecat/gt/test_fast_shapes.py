@@ -179,3 +179,27 @@ def test_every_pointer_function_is_fast_declared_or_has_a_reason() -> None:
             missing.append(f"{name} ({proto.group})")
     assert not missing, "on the table path without a recorded reason: " + ", ".join(missing)
     assert quick <= set(FUNCTIONS)
+
+
+def test_every_raw_range_reads_as_the_table() -> None:
+    """Each copier (one slice, a slice per run, one gather) against the table path: every
+    offset and size of figure 5-2's image (and past it), into each kind of buffer."""
+    _open()
+    makers = (
+        bytearray,
+        lambda n: (ctypes.c_ubyte * n)(),
+        lambda n: np.zeros(n, np.uint8),
+        lambda n: memoryview(bytearray(n)),
+    )
+    bad = []
+    for offset in range(0, 42, 3):
+        for size in range(1, 12):
+            for make in makers:
+                got = []
+                for call in (gt.GT_GetEcatRawData, gt.GT_GetEcatRawData.slow):
+                    buf = make(size)
+                    rc = call(offset, size, buf)
+                    got.append((rc, bytes(buf), gt.GTE_GetLastError() if rc else ""))
+                if got[0] != got[1]:
+                    bad.append(f"{offset} {size} {type(buf).__name__}: {got}")
+    assert not bad, "\n".join(bad[:10])
