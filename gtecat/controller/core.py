@@ -228,7 +228,7 @@ class Controller:
                 "(Python may pass GT_Open(eni=...), the command line --eni)"
             )
         try:
-            config = read_eni(path)
+            config = read_eni(path, _eni_cache(path))
         except EniError:
             raise
         layout = build_layout(config)
@@ -498,3 +498,23 @@ def _put_back(backend: Any, kept: dict[tuple[int, Any, int], float]) -> None:
             pos = kept.get((slave.position, getattr(slave, "identity", None), k))
             if pos is not None:
                 ch.machine_position = pos
+
+
+#: ENI files from this size on keep their parsed model in the user's cache (a 64-axis file
+#: is about 1 MB and parses in tens of milliseconds; a thousand axes, 20 MB, in a second)
+ENI_CACHE_MIN_BYTES = 1 << 20
+
+
+def _eni_cache(path: Path) -> Path | None:
+    """Where a large ENI's model is kept between processes (``GTECAT_ENI_CACHE=0``: nowhere)."""
+    if os.environ.get("GTECAT_ENI_CACHE", "1").strip() == "0":
+        return None
+    try:
+        if path.stat().st_size < ENI_CACHE_MIN_BYTES:
+            return None
+    except OSError:
+        return None  # read_eni says why
+    from .. import __version__
+    from .._cache import cache_root
+
+    return cache_root() / __version__ / "eni"

@@ -156,10 +156,8 @@ class Variable:
         "data_type",
         "getter",
         "index",
-        "info",
         "name",
         "pdo",
-        "pdo_bits",
         "setter",
         "subindex",
         "value",
@@ -189,7 +187,7 @@ class Variable:
         self.subindex = subindex
         self.name = name
         self.data_type = data_type if type(data_type) is DataType else DataType(data_type)
-        self.info = TYPE_INFO[self.data_type]
+        info = TYPE_INFO[self.data_type]
         self.access = access
         self.pdo = pdo
         #: what few entries have (a range, allowed values, a string's size, a placeholder
@@ -205,13 +203,30 @@ class Variable:
         self.write_states = write_states
         self.getter = getter
         self.setter = setter
-        if self.info.is_string and max_size:
+        if info.is_string and max_size:
             self.max_size = max_size
-        #: bit length when mapped: the type's, unless a placeholder was sized by a mapping
-        self.pdo_bits = pdo_bits if pdo_bits is not None else self.info.pdo_bits
+        if pdo_bits is not None and pdo_bits != info.pdo_bits:
+            self.pdo_bits = pdo_bits
         if default is None:
-            default = b"" if self.info.is_string else (0.0 if self.info.fmt == "f" else 0)
+            default = b"" if info.is_string else (0.0 if info.fmt == "f" else 0)
         self.value = default
+
+    @property
+    def info(self) -> TypeInfo:
+        """The data type's sizes and format."""
+        return TYPE_INFO[self.data_type]
+
+    @property
+    def pdo_bits(self) -> int:
+        """Bit length when mapped: the type's, unless a placeholder was sized by a mapping."""
+        x = self._x
+        if x is not None and "pdo_bits" in x:
+            return x["pdo_bits"]  # type: ignore[no-any-return]
+        return TYPE_INFO[self.data_type].pdo_bits
+
+    @pdo_bits.setter
+    def pdo_bits(self, value: int) -> None:
+        self._set_x("pdo_bits", value)
 
     def __repr__(self) -> str:
         return (
@@ -223,10 +238,17 @@ class Variable:
         return default if x is None else x.get(key, default)
 
     def _set_x(self, key: str, value: Any) -> None:
-        x = self._x
-        if x is None:
-            x = self._x = {}
+        # a new dict each time, never changed after: entries with the same extras (the
+        # same object of drive after drive) share one
+        x = dict(self._x) if self._x else {}
         x[key] = value
+        try:
+            shared = tuple(sorted((k, type(v).__name__, v) for k, v in x.items()))
+            if len(_XS) >= 4096:
+                _XS.clear()
+            self._x = _XS.setdefault(shared, x)
+        except TypeError:  # an unhashable value: its own dict
+            self._x = x
 
     low = property(lambda self: self._get_x("low"), lambda self, v: self._set_x("low", v))
     high = property(lambda self: self._get_x("high"), lambda self, v: self._set_x("high", v))
@@ -373,6 +395,8 @@ def _shared(values: frozenset[int]) -> frozenset[int]:
 
 
 _SHARED: dict[frozenset[int], frozenset[int]] = {}
+#: the rare attributes of entries (range, allowed values, sizes), one dict per content
+_XS: dict[tuple[tuple[str, str, Any], ...], dict[str, Any]] = {}
 
 
 def _only_none(self: Variable, value: object) -> None:

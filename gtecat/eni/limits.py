@@ -78,7 +78,9 @@ class Limit:
             value = parse_int(text)
         except TooLong:  # more digits than any range holds
             raise self.error(field, str(text)) from None
-        return self.check(value, field, text if isinstance(text, str) else None)
+        if self.lo <= value <= self.hi:  # parse_int gives an int: check()'s test, inline
+            return value
+        raise self.error(field, text if isinstance(text, str) else value)
 
 
 # --- object dictionary and identity --------------------------------------------------------

@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import hashlib
 import os
+import pickle
 import re
+from dataclasses import replace
 from pathlib import Path
 
 from .errors import EniError
@@ -120,8 +122,14 @@ def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
     )
 
 
-def read_eni(path: str | os.PathLike[str]) -> EniConfig:
-    """Read and parse a configuration file (either family)."""
+def read_eni(
+    path: str | os.PathLike[str], cache_dir: str | os.PathLike[str] | None = None
+) -> EniConfig:
+    """Read and parse a configuration file (either family).
+
+    ``cache_dir``: a folder where the model of each file content is kept between processes
+    (see :func:`_load_cached`): a program, test or CI job that opens the same ENI in every
+    run parses it once."""
     p = Path(path)
     try:
         data = p.read_bytes()
@@ -129,10 +137,16 @@ def read_eni(path: str | os.PathLike[str]) -> EniConfig:
         raise EniError(f"cannot read the file: {exc.strerror or exc}", file=str(p)) from None
     if not data.strip():
         raise EniError("the file is empty", file=str(p))
-    key = (hashlib.sha256(data).digest(), str(p))
+    digest = hashlib.sha256(data).digest()
+    key = (digest, str(p))
     config = _PARSED.get(key)
     if config is None:
-        config = parse_eni(data, str(p))
+        stored = _cache_file(cache_dir, digest) if cache_dir is not None else None
+        config = _load_cached(stored, str(p)) if stored is not None else None
+        if config is None:
+            config = parse_eni(data, str(p))
+            if stored is not None:
+                _store(stored, config)
         if len(_PARSED) >= _PARSED_MAX:
             _PARSED.pop(next(iter(_PARSED)))
         _PARSED[key] = config
@@ -145,3 +159,59 @@ def read_eni(path: str | os.PathLike[str]) -> EniConfig:
 #: key is the content's digest, not the content (a 1,000-axis ENI is 20 MB).
 _PARSED: dict[tuple[bytes, str], EniConfig] = {}
 _PARSED_MAX = 32
+
+_READER_DIGEST: list[str] = []
+
+
+def _reader_digest() -> str:
+    """The digest of this package's source: a model stored by other reader code is not read."""
+    if not _READER_DIGEST:
+        h = hashlib.sha256()
+        for f in sorted(Path(__file__).parent.glob("*.py")):
+            h.update(f.name.encode())
+            h.update(f.read_bytes())
+        _READER_DIGEST.append(h.hexdigest()[:16])
+    return _READER_DIGEST[0]
+
+
+def _cache_file(cache_dir: str | os.PathLike[str], digest: bytes) -> Path:
+    return Path(cache_dir) / _reader_digest() / f"{digest.hex()[:40]}.pickle"
+
+
+def _load_cached(file: Path, source: str) -> EniConfig | None:
+    """The model stored for this content (its ``source`` made this file's), or None.
+
+    The folder is the user's own cache (mode 0700 where it is made, like the compiled
+    bytecode beside it); a file that is unreadable, cut short or of another kind is ignored
+    and parsed again."""
+    try:
+        with file.open("rb") as f:
+            config = pickle.load(f)
+    except Exception:  # absent, partial, foreign: parse the file instead
+        return None
+    if not isinstance(config, EniConfig):
+        return None
+    return config if config.source == source else replace(config, source=source)
+
+
+def _store(file: Path, config: EniConfig) -> None:
+    """Keep ``config`` for the next process (atomically; a failure only costs the speed)."""
+    try:
+        file.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        tmp = file.with_name(f"{file.name}.{os.getpid()}.tmp")
+        with tmp.open("wb") as f:
+            pickle.dump(config, f, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, file)
+        _prune(file.parent)
+    except (OSError, pickle.PicklingError, RecursionError):
+        pass
+
+
+#: models kept per reader version: the least recently stored go first
+_CACHE_FILES = 32
+
+
+def _prune(folder: Path) -> None:
+    files = sorted(folder.glob("*.pickle"), key=lambda f: f.stat().st_mtime)
+    for f in files[:-_CACHE_FILES]:
+        f.unlink(missing_ok=True)

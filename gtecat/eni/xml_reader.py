@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
+from typing import TypeVar
 
 from .check import check_config
 from .datatypes import CIA402_OBJECTS, type_bits
@@ -74,6 +75,7 @@ from .numbers import fmt_index, parse_hex_bytes, shown
 from .xmltree import Node
 
 _SM_TAG = re.compile(r"^Sm(\d+)$")
+_T = TypeVar("_T")
 _TRUE = {"1", "true", "yes"}
 _XS_BOOLEAN = {"true": True, "1": True, "false": False, "0": False}
 _SM_TAG = re.compile(r"Sm(\d+)")
@@ -91,6 +93,15 @@ class _Ctx:
     slave_name: str | None = None
     #: slave name -> bus positions, to spot names that ProcessImage variables cannot tell apart
     positions_by_name: dict[str, list[int]] = field(default_factory=dict)
+    #: equal model values, one object each (the same init commands, identity, sync manager
+    #: and mailbox layout slave after slave: a bus of a thousand drives holds one copy)
+    seen: dict[object, object] = field(default_factory=dict)
+    #: an InitCmd element's content (attributes, children's tags, texts, attributes) -> its model
+    init_cmds: dict[tuple[object, ...], InitCmd] = field(default_factory=dict)
+
+    def shared(self, value: _T) -> _T:
+        """``value``, or the equal one this file gave before (the model is immutable)."""
+        return self.seen.setdefault(value, value)  # type: ignore[return-value]
 
     def error(self, message: str, node: Node | None, element: str | None = None) -> EniError:
         return EniError(
@@ -305,11 +316,13 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
     vendor = ctx.int_of(info, "VendorId", IDENTITY, required=True, element="Info/VendorId")
     product = ctx.int_of(info, "ProductCode", IDENTITY, required=True, element="Info/ProductCode")
     assert vendor is not None and product is not None
-    identity = Identity(
-        vendor_id=vendor,
-        product_code=product,
-        revision_no=ctx.int_of(info, "RevisionNo", IDENTITY, default=0) or 0,
-        serial_no=ctx.int_of(info, "SerialNo", IDENTITY, default=0) or 0,
+    identity = ctx.shared(
+        Identity(
+            vendor_id=vendor,
+            product_code=product,
+            revision_no=ctx.int_of(info, "RevisionNo", IDENTITY, default=0) or 0,
+            serial_no=ctx.int_of(info, "SerialNo", IDENTITY, default=0) or 0,
+        )
     )
     phys = ctx.int_of(info, "PhysAddr", PHYS_ADDR, default=0) or 0
     # the 16-bit register value: "-1" and "65535" are the same auto-increment address
@@ -332,7 +345,9 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
     mailbox_node = snode.find("Mailbox")
     init_cmds: tuple[InitCmd, ...] = ()
     if mailbox_node is not None:
-        init_cmds = tuple(_init_cmd(ctx, n) for n in mailbox_node.findall("CoE/InitCmds/InitCmd"))
+        init_cmds = ctx.shared(
+            tuple(_init_cmd_once(ctx, n) for n in mailbox_node.findall("CoE/InitCmds/InitCmd"))
+        )
     return Slave(
         position=pos,
         name=name,
@@ -377,7 +392,7 @@ def _sync_managers(ctx: _Ctx, pd: Node) -> tuple[SyncManager, ...]:
                 bool(ctx.bool_of(child, "Enable", elem)),
             )
         )
-    return tuple(out)
+    return ctx.shared(tuple(out))
 
 
 def _mailbox_layout(ctx: _Ctx, mbx: Node) -> MailboxLayout | None:
@@ -389,7 +404,7 @@ def _mailbox_layout(ctx: _Ctx, mbx: Node) -> MailboxLayout | None:
     ]
     if None in values:
         return None
-    return MailboxLayout(*values)  # type: ignore[arg-type]
+    return ctx.shared(MailboxLayout(*values))  # type: ignore[arg-type]
 
 
 def _area(ctx: _Ctx, pd: Node, tag: str) -> _Area | None:
@@ -758,6 +773,23 @@ def _place_unplaced(slaves: list[Slave]) -> list[Slave]:
                 ends[d] = start + bits
         out.append(replace(s, **changes) if changes else s)
     return out
+
+
+def _init_cmd_once(ctx: _Ctx, node: Node) -> InitCmd:
+    """:func:`_init_cmd`, read once per content: the init commands of a bus of like drives are
+    the same elements slave after slave (an InitCmd is leaves only; one with more depth, or
+    one that is wrong, is read as it stands)."""
+    children = node.children
+    if any(c.children for c in children):
+        return ctx.shared(_init_cmd(ctx, node))
+    key = (
+        tuple(node.attrib.items()),
+        tuple((c.tag, c.text, tuple(c.attrib.items())) for c in children),
+    )
+    cmd = ctx.init_cmds.get(key)
+    if cmd is None:
+        cmd = ctx.init_cmds[key] = ctx.shared(_init_cmd(ctx, node))
+    return cmd
 
 
 def _init_cmd(ctx: _Ctx, node: Node) -> InitCmd:

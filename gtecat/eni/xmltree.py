@@ -150,6 +150,10 @@ class _Refused(Exception):
     pass
 
 
+#: bytes handed to expat at a time: it then holds one such piece, not a copy of the document
+_CHUNK = 1 << 18
+
+
 def parse_xml(
     data: bytes | str, source: str, skip: frozenset[tuple[str, str]] = frozenset()
 ) -> Node:
@@ -157,7 +161,11 @@ def parse_xml(
 
     ``skip``: (parent, element) local names whose subtrees are checked by expat but not
     built, for the parts a reader never looks at (an ENI's register InitCmds are most of
-    its elements)."""
+    its elements): inside one, only a depth counter runs, and no text is delivered.
+
+    An element's ``text`` is its character data; an element with children keeps the
+    first piece only when the others are blank (the indentation between its children
+    would otherwise make one long string per parent)."""
     if isinstance(data, bytes):
         data = _decoded(data, source)
     parser = expat.ParserCreate()
@@ -167,44 +175,54 @@ def parse_xml(
     root: list[Node] = []
     local: dict[str, str] = {}  # qualified name -> local name
     seen: dict[str, str] = {}  # short texts, one object each
-
-    skipped = [0]  # depth inside a skipped subtree
+    depth = 0  # inside a skipped subtree
 
     def start(tag: str, attrs: dict[str, str]) -> None:
-        if skipped[0]:
-            skipped[0] += 1
-            return
+        nonlocal depth
         name = local.get(tag)
         if name is None:
             name = local[tag] = _local(tag)
-        if skip and stack and (stack[-1].tag, name) in skip:
-            skipped[0] = 1
+        parent = stack[-1] if stack else None
+        if skip and parent is not None and (parent.tag, name) in skip:
+            depth = 1
+            parser.StartElementHandler, parser.EndElementHandler = skipping
+            parser.CharacterDataHandler = None  # type: ignore[assignment]
             return
         attrib = {_local(k): v for k, v in attrs.items()} if attrs else _NO_ATTRS
         node = Node(name, attrib, parser.CurrentLineNumber)
-        if stack:
-            parent = stack[-1]
-            if parent.children:
-                parent.children.append(node)  # type: ignore[union-attr]
-            else:
-                parent.children = [node]
-        else:
+        if parent is None:
             root.append(node)
+        elif parent.children:
+            parent.children.append(node)  # type: ignore[union-attr]
+        else:
+            parent.children = [node]
         stack.append(node)
 
     def end(tag: str) -> None:
-        if skipped[0]:
-            skipped[0] -= 1
-            return
-        stack.pop()
+        node = stack.pop()
+        if node.children:  # read only from here on: a tuple is smaller than a list
+            node.children = tuple(node.children)
+
+    def skip_start(tag: str, attrs: dict[str, str]) -> None:
+        nonlocal depth
+        depth += 1
+
+    def skip_end(tag: str) -> None:
+        nonlocal depth
+        depth -= 1
+        if not depth:
+            parser.StartElementHandler, parser.EndElementHandler, parser.CharacterDataHandler = (
+                building
+            )
 
     def chars(data: str) -> None:
-        if stack and not skipped[0]:
+        if stack:
             node = stack[-1]
-            if node.text:
-                node.text = node.text + data
-            else:  # one string for each text a file repeats (names, types: slave after slave)
+            text = node.text
+            if not text:  # one string for each text a file repeats (names, types, indents)
                 node.text = seen.setdefault(data, data) if len(data) <= 64 else data
+            elif not (data.isspace() and text.isspace()):
+                node.text = text + data
 
     def refuse_doctype(*_args: object) -> None:
         raise _Refused(
@@ -214,6 +232,8 @@ def parse_xml(
     def refuse_entity(*_args: object) -> None:
         raise _Refused("entity declarations and references are not accepted in an ENI")
 
+    building = [start, end, chars]
+    skipping = [skip_start, skip_end]
     parser.StartElementHandler = start
     parser.EndElementHandler = end
     parser.CharacterDataHandler = chars
@@ -222,7 +242,13 @@ def parse_xml(
     parser.ExternalEntityRefHandler = refuse_entity  # type: ignore[assignment]
     parser.UnparsedEntityDeclHandler = refuse_entity
     try:
-        parser.Parse(data, True)
+        if isinstance(data, bytes) and len(data) > _CHUNK:
+            view = memoryview(data)
+            for at in range(0, len(data), _CHUNK):
+                parser.Parse(view[at : at + _CHUNK], False)
+            parser.Parse(b"", True)
+        else:
+            parser.Parse(data, True)
     except _Refused as exc:
         raise EniError(str(exc), file=source, line=parser.CurrentLineNumber) from None
     except expat.ExpatError as exc:
@@ -235,6 +261,10 @@ def parse_xml(
         # whole tree through ``root``) would wait for the cyclic collector
         parser.StartElementHandler = parser.EndElementHandler = None  # type: ignore[assignment]
         parser.CharacterDataHandler = None  # type: ignore[assignment]
+        # and the handlers refer to each other through these lists (start and skip_end
+        # swap them): emptying them frees the parser and its buffers now
+        building.clear()
+        skipping.clear()
     if not root:
         raise EniError("empty XML document", file=source)
     return root[0]

@@ -323,7 +323,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     proto = FUNCTIONS.get(name)
     if proto is None:
         raise RuntimeError(f"{name} is not in the function table (gtecat/gt/table.py)")
-    params = list(inspect.signature(fn).parameters)
+    fn_sig = inspect.signature(fn)
+    params = list(fn_sig.parameters)
     needs_ctl = bool(params) and params[0] == "ctl"
     bind = binder(proto, fn)
     card_refused = refused(name)
@@ -433,7 +434,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         make = fast_reader if name in READERS else fast_raw if name in RAW else fast_clock
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
-    gt.__signature__ = _signature(proto, fn)  # type: ignore[attr-defined]
+    gt.__signature__ = _signature(proto, fn_sig)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt
     if proto.gtn:
@@ -496,7 +497,7 @@ def _attach_address(kwargs: dict) -> str:
     return "" if address == "local" else address
 
 
-def _signature(proto: Proto, fn: Callable[..., Any]) -> inspect.Signature:
+def _signature(proto: Proto, fn_sig: inspect.Signature) -> inspect.Signature:
     """The Python signature shown by help(): the table's parameters and defaults, then the
     implementation's keyword-only options (GT_Open's ``eni=...``)."""
     out = []
@@ -507,7 +508,7 @@ def _signature(proto: Proto, fn: Callable[..., Any]) -> inspect.Signature:
             d = inspect.Parameter.empty
         out.append(inspect.Parameter(p.name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=d))
     kw = inspect.Parameter.KEYWORD_ONLY
-    out += [q for q in inspect.signature(fn).parameters.values() if q.kind is kw]
+    out += [q for q in fn_sig.parameters.values() if q.kind is kw]
     return inspect.Signature(out)
 
 

@@ -107,10 +107,16 @@ def strip_comments(text: str) -> str:
     return _COMMENT.sub(" ", text)
 
 
+#: a plain decimal (no leading zero: C reads 010 as octal) or hexadecimal integer
+_PLAIN = re.compile(r"-?(?:0[xX][0-9a-fA-F]+|[1-9][0-9]*|0)")
+
+
 def number(text: str, known: dict[str, int] | None = None) -> int | float | None:
     """A C constant expression of the simple kinds headers use (``(-6)``, ``0x100``,
     ``1<<3``, ``(MC_AXIS+1)``, ``1.5``), None when it is something else."""
     t = text.strip()
+    if _PLAIN.fullmatch(t):  # most are: enum values, array sizes
+        return int(t, 0)
     t = re.sub(r"(?<=[0-9a-fA-FxX])[uUlL]+\b", "", t)
     if not t or not re.fullmatch(r"[\w\s()+\-*/<>|&~.^]+", t):
         return None

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import fnmatch
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 
@@ -151,14 +152,14 @@ def _matches(pattern: str, name: str) -> bool:
 
 
 @cache
-def _index() -> tuple[dict[str, list[int]], list[tuple[str, int]]]:
-    """Row numbers by exact function name, and the wildcard patterns with theirs."""
+def _index() -> tuple[dict[str, list[int]], list[tuple[Callable[[str], object], int]]]:
+    """Row numbers by exact function name, and the wildcard patterns (compiled) with theirs."""
     exact: dict[str, list[int]] = {}
-    wild: list[tuple[str, int]] = []
+    wild: list[tuple[Callable[[str], object], int]] = []
     for i, r in enumerate(ROWS):
         for p in r.functions:
             if "*" in p:
-                wild.append((p, i))
+                wild.append((re.compile(fnmatch.translate(p)).match, i))
             else:
                 exact.setdefault(p, []).append(i)
     return exact, wild
@@ -172,7 +173,7 @@ def units_of(name: str) -> tuple[Row, ...]:
     if name.startswith("GTN_") and name not in exact:
         name = "GT_" + name[4:]
     hits = set(exact.get(name, ()))
-    hits.update(i for p, i in wild if _matches(p, name))
+    hits.update(i for match, i in wild if match(name))
     return tuple(ROWS[i] for i in sorted(hits))
 
 

@@ -37,3 +37,42 @@ def test_the_same_bytes_under_another_name_keep_their_own_source(tmp_path) -> No
     for f in (a, b):
         f.write_bytes(FIG52.read_bytes())
     assert read_eni(a).source != read_eni(b).source
+
+
+def test_a_cache_folder_keeps_the_model_for_the_next_process(tmp_path, monkeypatch) -> None:
+    from gtecat.eni import reader
+
+    cache, a, b = tmp_path / "cache", tmp_path / "a.eni", tmp_path / "b.eni"
+    a.write_bytes(FIG52.read_bytes())
+    first = read_eni(a, cache)
+    assert len(list(cache.rglob("*.pickle"))) == 1
+    monkeypatch.setattr(reader, "_PARSED", {})  # a new process
+    monkeypatch.setattr(reader, "parse_eni", lambda *_: pytest.fail("parsed again"))
+    assert read_eni(a, cache) == first
+    b.write_bytes(FIG52.read_bytes())  # the same content elsewhere: its own source
+    assert read_eni(b, cache).source == str(b)
+    assert read_eni(b, cache).slaves == first.slaves
+
+
+def test_a_damaged_cache_file_is_parsed_again(tmp_path) -> None:
+    from gtecat.eni import reader
+
+    cache, a = tmp_path / "cache", tmp_path / "a.eni"
+    a.write_bytes(FIG52.read_bytes())
+    first = read_eni(a, cache)
+    (stored,) = cache.rglob("*.pickle")
+    stored.write_bytes(b"\x80\x05not a pickle")
+    reader._PARSED.clear()
+    assert read_eni(a, cache) == first
+
+
+def test_the_cache_folder_keeps_the_latest_models_only(tmp_path, monkeypatch) -> None:
+    from gtecat.eni import reader
+
+    monkeypatch.setattr(reader, "_CACHE_FILES", 2)
+    cache, text = tmp_path / "cache", FIG52.read_bytes()
+    for k in range(3):  # three contents (the same bus, blank lines added)
+        f = tmp_path / f"bus{k}.eni"
+        f.write_bytes(text + b"\n" * (k + 1))
+        read_eni(f, cache)
+    assert len(list(cache.rglob("*.pickle"))) == 2

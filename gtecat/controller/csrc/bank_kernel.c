@@ -19,6 +19,7 @@
  */
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #if defined(__GNUC__)
@@ -324,7 +325,7 @@ INLINE int refill_row(void **ptr, int64_t *io, int64_t r)
 
 /* inlined where the field table is a local copy: the compiler then knows no store through a
  * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
-INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
+INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
@@ -340,13 +341,16 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
         if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i])
             return 1;
 
-    /* 2.-7. every claimed row, tentatively (scratch arrays s_*) */
+    /* 2.-7. every claimed row, tentatively (scratch arrays s_*), in three passes over the
+     * rows (the profile and the demand; the mechanics; the feedback and the checks): each
+     * pass's rows are independent and short, so the processor overlaps several rows' chains
+     * of divisions instead of waiting on one long chain per row.  Per row the operations
+     * and their order are those of one pass. */
     for (r = 0; r < n; r++) {
-        int64_t cur, counts, x, target, raw, pa, din, since;
-        int32_t d32;
-        double prf, a, demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, rel, vstop, dv, acc, pos;
-        double fe, step, enc, err, band;
-        int limited = 0, swl = 0, hit = 0, ended, standing, inb, arr;
+        int64_t cur, counts, x, target;
+        double prf, a, demand, dvel;
+        int swl = 0, hit = 0, ended;
+        go[r] = 0;
         if (!alive[r] || U8(frz)[r]) /* a frozen row: nothing of its cycle changes */
             continue;
         if (hm[r]) {
@@ -361,64 +365,80 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
             swl = U8(c_sw_limited)[r]; /* step_csp does not run: 6041h bit 11 keeps its cause */
             a = 0.0;  /* from 6064h below */
             ended = 1;
-            goto mechanics;
-        }
-        cur = I64(t_cur)[r];
-        if (U8(moving)[r] && cur >= I64(t_len)[r]) { /* the table is used up: the next one */
-            if (refill_row(ptr, io, r))
-                return 4; /* nothing written: the caller refills it */
-            cur = 0;
-        }
-        prf = F64(t_p)[I64(base)[r] + cur];
-        ended = cur == I64(t_end)[r];
-        if (U8(jog)[r]) { /* AxisBank._jog_step */
-            double rp = F64(jrp)[r], jv = F64(jrv)[r], fp_ = F64(jp)[r], fv = F64(jv)[r];
-            double fa = F64(ja)[r], tau = F64(tau)[r], e = F64(jE)[r];
-            double p1 = rp + h * (jv + 0.5 * 0.0 * h);
-            double v1 = jv + 0.0 * h;
-            double nfp, nfv, nfa;
-            if (tau > 0.0) {
-                nfp = p1 - tau * (v1 - 0.0) + (fp_ - rp + tau * (jv - 0.0)) * e;
-                nfv = v1 - 0.0 + (fv - jv + 0.0) * e;
-                nfa = 0.0 + (fa - 0.0) * e;
-            } else {
-                nfp = p1;
-                nfv = v1;
-                nfa = 0.0;
+        } else {
+            cur = I64(t_cur)[r];
+            if (U8(moving)[r] && cur >= I64(t_len)[r]) { /* the table is used up: the next one */
+                if (refill_row(ptr, io, r))
+                    return 4; /* nothing written: the caller refills it */
+                cur = 0;
             }
-            if (nfv != v1 && fabs(nfv - v1) <= 1e-9 * (1.0 + fabs(v1))) {
-                nfv = v1;
-                nfa = 0.0;
+            prf = F64(t_p)[I64(base)[r] + cur];
+            ended = cur == I64(t_end)[r];
+            if (U8(jog)[r]) { /* AxisBank._jog_step */
+                double rp = F64(jrp)[r], jv = F64(jrv)[r], fp_ = F64(jp)[r], fv = F64(jv)[r];
+                double fa = F64(ja)[r], tau = F64(tau)[r], e = F64(jE)[r];
+                double p1 = rp + h * (jv + 0.5 * 0.0 * h);
+                double v1 = jv + 0.0 * h;
+                double nfp, nfv, nfa;
+                if (tau > 0.0) {
+                    nfp = p1 - tau * (v1 - 0.0) + (fp_ - rp + tau * (jv - 0.0)) * e;
+                    nfv = v1 - 0.0 + (fv - jv + 0.0) * e;
+                    nfa = 0.0 + (fa - 0.0) * e;
+                } else {
+                    nfp = p1;
+                    nfv = v1;
+                    nfa = 0.0;
+                }
+                if (nfv != v1 && fabs(nfv - v1) <= 1e-9 * (1.0 + fabs(v1))) {
+                    nfv = v1;
+                    nfa = 0.0;
+                }
+                F64(s_jog)[5 * r + 0] = p1;
+                F64(s_jog)[5 * r + 1] = v1;
+                F64(s_jog)[5 * r + 2] = nfp;
+                F64(s_jog)[5 * r + 3] = nfv;
+                F64(s_jog)[5 * r + 4] = nfa;
+                prf = nfp;
             }
-            F64(s_jog)[5 * r + 0] = p1;
-            F64(s_jog)[5 * r + 1] = v1;
-            F64(s_jog)[5 * r + 2] = nfp;
-            F64(s_jog)[5 * r + 3] = nfv;
-            F64(s_jog)[5 * r + 4] = nfa;
-            prf = nfp;
+            a = link(prf, F64(prf_ratio)[r], F64(prf_off)[r]);
+            /* 3. 607Ah: Axis.pulses_to_counts, int32 like the PDO entry */
+            {
+                double scaled = a * F64(unit2)[r];
+                if (!(fabs(scaled) < 4611686018427387904.0)) /* 2**62, bank.HUGE_COUNTS */
+                    hit = 1;
+                counts = to_i64(rint(scaled)) + I64(drive_offset)[r];
+            }
+            if (hit)
+                return 2; /* nothing written: the numpy cycle releases it */
+            target = (int32_t)(uint32_t)(uint64_t)counts;
+            /* CspBank.step: step_csp */
+            x = target + I64(c_pos_offset)[r];
+            if (x < I64(c_sw_min)[r] || x > I64(c_sw_max)[r])
+                swl = 1;
+            if (x < I64(c_sw_min)[r])
+                x = I64(c_sw_min)[r];
+            if (x > I64(c_sw_max)[r])
+                x = I64(c_sw_max)[r];
+            x += I64(c_off)[r];
+            demand = (double)x;
+            dvel = (demand - F64(c_dpos)[r]) / dt;
         }
-        a = link(prf, F64(prf_ratio)[r], F64(prf_off)[r]);
-        /* 3. 607Ah: Axis.pulses_to_counts, int32 like the PDO entry */
-        {
-            double scaled = a * F64(unit2)[r];
-            if (!(fabs(scaled) < 4611686018427387904.0)) /* 2**62, bank.HUGE_COUNTS */
-                hit = 1;
-            counts = to_i64(rint(scaled)) + I64(drive_offset)[r];
-        }
-        target = (int32_t)(uint32_t)(uint64_t)counts;
-        /* CspBank.step: step_csp */
-        x = target + I64(c_pos_offset)[r];
-        if (x < I64(c_sw_min)[r] || x > I64(c_sw_max)[r])
-            swl = 1;
-        if (x < I64(c_sw_min)[r])
-            x = I64(c_sw_min)[r];
-        if (x > I64(c_sw_max)[r])
-            x = I64(c_sw_max)[r];
-        x += I64(c_off)[r];
-        demand = (double)x;
-        dvel = (demand - F64(c_dpos)[r]) / dt;
-    mechanics:
-        /* Mechanics.track */
+        go[r] = (uint8_t)(1 + ended);
+        I64(s_target)[r] = target;
+        F64(s_a)[r] = a;
+        F64(s_dpos)[r] = demand;
+        F64(s_dvel)[r] = dvel;
+        U8(s_swl)[r] = (uint8_t)swl;
+    }
+
+    /* Mechanics.track */
+    for (r = 0; r < n; r++) {
+        double demand, dvel, p, v0, vmax, vff, e1, v, lim, dist, rel, vstop, dv;
+        int limited = 0;
+        if (!go[r])
+            continue;
+        demand = F64(s_dpos)[r];
+        dvel = F64(s_dvel)[r];
         p = F64(c_pos)[r];
         v0 = F64(c_vel)[r];
         vmax = F64(c_vmax)[r];
@@ -468,8 +488,25 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
             v = -vmax;
             limited = 1;
         }
-        acc = (v - v0) / dt;
-        pos = p + v * dt;
+        F64(s_acc)[r] = (v - v0) / dt;
+        F64(s_pos)[r] = p + v * dt;
+        F64(s_vel)[r] = v;
+        U8(s_lim)[r] = (uint8_t)limited;
+    }
+
+    /* the feedback (6064h, 60FDh, the encoder), the checks and the in-position band */
+    for (r = 0; r < n; r++) {
+        int64_t target, raw, pa, din, since;
+        int32_t d32;
+        double a, demand, pos, fe, step, enc, err, band;
+        int hit = 0, ended, standing, inb, arr;
+        if (!go[r])
+            continue;
+        ended = go[r] == 2;
+        target = I64(s_target)[r];
+        a = F64(s_a)[r];
+        demand = F64(s_dpos)[r];
+        pos = F64(s_pos)[r];
         /* following-error window 6065h/6066h */
         fe = 0.0;
         if (U8(c_fe_check)[r]) {
@@ -521,19 +558,11 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
             since = inb ? (since < 0 ? t_ns : since) : -1;
             arr = inb && (arr || t_ns - since >= I64(hold_ns)[r]);
         }
-        I64(s_target)[r] = target;
         I64(s_raw)[r] = raw;
         F64(s_a)[r] = a;
         F64(s_enc)[r] = enc;
         F64(s_step)[r] = step;
-        F64(s_pos)[r] = pos;
-        F64(s_vel)[r] = v;
-        F64(s_acc)[r] = acc;
-        F64(s_dpos)[r] = demand;
-        F64(s_dvel)[r] = dvel;
         F64(s_fe)[r] = fe;
-        U8(s_lim)[r] = (uint8_t)limited;
-        U8(s_swl)[r] = (uint8_t)swl;
         I64(s_din)[r] = din;
         I64(s_since)[r] = since;
         U8(s_arr)[r] = (uint8_t)arr;
@@ -643,13 +672,24 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp)
     return 0;
 }
 
+/* the row flags of one cycle's passes (0: the row does not step, 1: it steps, 2: it steps
+ * and its Trap move ends here): on the stack for the usual banks, else on the heap */
+#define GO_STACK 4096
+
 /* One cycle (io[IN_T_NS], fp[FP_DT]): 0 committed, else what was declined (nothing written). */
 int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 {
     void *lp[N_FIELDS]; /* a local copy: stores through the rows cannot alias it */
+    uint8_t stack[GO_STACK], *go = stack;
+    int rc;
     memcpy(lp, ptr, sizeof lp);
     io[OUT_FILLED] = 0;
-    return cycle_once(lp, io, fp);
+    if (io[IN_N] > GO_STACK && !(go = malloc((size_t)io[IN_N])))
+        return 5; /* no memory: the numpy cycle runs it */
+    rc = cycle_once(lp, io, fp, go);
+    if (go != stack)
+        free(go);
+    return rc;
 }
 
 /* Up to io[IN_MAXC] cycles from io[IN_T_NS], io[IN_DT_NS] apart; io[OUT_DONE] = cycles
@@ -658,13 +698,17 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
 {
     void *lp[N_FIELDS];
+    uint8_t stack[GO_STACK], *go = stack;
     int64_t c, maxc = io[IN_MAXC], t0 = io[IN_T_NS];
     int rc = 0;
     memcpy(lp, ptr, sizeof lp);
     io[OUT_FILLED] = 0;
+    io[OUT_DONE] = 0;
+    if (io[IN_N] > GO_STACK && !(go = malloc((size_t)io[IN_N])))
+        return 5; /* no memory: the numpy cycle runs it */
     for (c = 0; c < maxc; c++) {
         io[IN_T_NS] = t0 + c * io[IN_DT_NS];
-        rc = cycle_once(lp, io, fp);
+        rc = cycle_once(lp, io, fp, go);
         if (rc)
             break;
         if (io[OUT_FIN]) {
@@ -672,6 +716,8 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
             break;
         }
     }
+    if (go != stack)
+        free(go);
     io[OUT_DONE] = c;
     io[IN_T_NS] = t0;
     return rc;
