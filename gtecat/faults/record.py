@@ -768,34 +768,36 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
         except (KeyError, TypeError, ValueError, AttributeError) as err:
             return _Stop, ("damaged", f"({name}) cannot be made again: {type(err).__name__}: {err}")
 
-    def step(key: str) -> tuple[Any, Any]:
-        if key[:5] == ',"c":':  # a call as Recorder writes it, after its time
-            parts = key.split(_V)
-            vals: list[Any] = []
-            for k in range(1, len(parts)):
-                part = parts[k]
-                m = number(part)
-                if m is None:
-                    break
-                lit = m.group()
-                try:
-                    vals.append(float(lit) if m.lastindex else int(lit))
-                except ValueError:  # an integer too long to read: as JSON reads it, below
-                    break
-                parts[k] = part[m.end() :]
-            else:
-                if vals:
-                    form_key = _V.join(parts)
-                    form = forms.get(form_key, _NO)
-                    if form is _NO:  # the first line of this form
-                        form = forms[form_key] = None
-                        e = parse(key)
-                        if _form(e) == len(vals):
-                            call = prepare(e)[0]
-                            if call is not _Stop and not call.checks and not call.fresh:
-                                form = forms[form_key] = call
-                    if form is not None:
-                        return form, tuple(vals)
+    def numbers(key: str) -> tuple[str, list[Any]] | None:
+        """(the form's key, the numbers) of a call's line, one number at a time."""
+        parts = key.split(_V)
+        vals: list[Any] = []
+        for k in range(1, len(parts)):
+            part = parts[k]
+            m = number(part)
+            if m is None:
+                return None
+            lit = m.group()
+            try:
+                vals.append(float(lit) if m.lastindex else int(lit))
+            except ValueError:  # an integer too long to read: as JSON reads it, below
+                return None
+            parts[k] = part[m.end() :]
+        return _V.join(parts), vals
+
+    def step(key: str, split: tuple[str, list[Any]] | None) -> tuple[Any, Any]:
+        if split is not None and split[1]:
+            form_key, vals = split
+            form = forms.get(form_key, _NO)
+            if form is _NO:  # the first line of this form
+                form = forms[form_key] = None
+                e = parse(key)
+                if _form(e) == len(vals):
+                    call = prepare(e)[0]
+                    if call is not _Stop and not call.checks and not call.fresh:
+                        form = forms[form_key] = call
+            if form is not None:
+                return form, tuple(vals)
         e = parse(key)
         return (None, e) if "c" not in e else prepare(e)
 
@@ -803,10 +805,49 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
     keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
     made = dict.fromkeys(keys)
     made.pop("", None)  # the empty line after the last
+    calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
+    for key, split in zip(calls, _numbers(calls) or map(numbers, calls), strict=True):
+        made[key] = step(key, split)
     for key in made:
-        if key.strip():
-            made[key] = step(key)
+        if made[key] is None and key.strip():
+            made[key] = step(key, None)
     return [s for s in map(made.get, keys) if s is not None]
+
+
+_NUMBER_START = frozenset("-0123456789")
+
+
+def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
+    """(the form's key, the numbers) of each call's line, the numbers of all of them read
+    in one JSON parse (the numbers of pointers to simple values end at their ``}``); None
+    when any of them is not a plain JSON number (each line is then read on its own)."""
+    out: list[Any] = []
+    lits: list[str] = []
+    for key in calls:
+        parts = key.split(_V)
+        if len(parts) == 1:
+            out.append((key, []))
+            continue
+        first = len(lits)
+        for k in range(1, len(parts)):
+            part = parts[k]
+            j = part.find("}")
+            if j < 0 or part[:1] not in _NUMBER_START:  # a structure, an array, text
+                break
+            lits.append(part[:j])
+            parts[k] = part[j:]
+        else:
+            out.append((_V.join(parts), first, len(lits)))
+            continue
+        del lits[first:]
+        out.append(None)
+    try:
+        values = json.loads("[" + ",".join(lits) + "]")
+    except ValueError:
+        return None
+    if len(values) != len(lits) or not all(type(v) is int or type(v) is float for v in values):
+        return None
+    return [x if x is None or len(x) == 2 else (x[0], values[x[1] : x[2]]) for x in out]
 
 
 _NO: Any = object()

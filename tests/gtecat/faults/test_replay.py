@@ -186,3 +186,19 @@ def test_every_line_of_a_shared_form_is_compared(recorded: Path, tmp_path: Path)
     assert n == at[0] and div is not None
     assert (div.index, div.call, div.what) == (at[0], "GT_GetClock", "argument 1")
     assert div.recorded["ref"]["v"] == at[1] and div.now["ref"]["v"] == at[1] - 1
+
+
+def test_the_numbers_of_a_form_are_read_as_json_reads_them() -> None:
+    """The numbers of all call lines are read in one JSON parse; a structure's fields are
+    left to the line's own parse, and a number JSON would refuse sends every line to its
+    own parse (where the damaged one is reported)."""
+    from gtecat.faults.record import _numbers
+
+    ref = ',"c":"GT_GetPrfPos","a":[1,{{"ref":{{"c":"c_double","v":{}}}}}],"r":0}}'
+    st = ',"c":"GT_SetTrapPrm","a":[1,{"ref":{"st":"TTrapPrm","v":{"acc":0.5}}}],"r":0}'
+    got = _numbers([ref.format("-1.5e-3"), ref.format("12"), st, ',"c":"GT_Reset","a":[],"r":0}'])
+    assert got is not None
+    assert got[0][1] == [-1.5e-3] and type(got[1][1][0]) is int and got[1][1] == [12]
+    assert got[0][0] == got[1][0]  # one form
+    assert got[2] is None and got[3] == (',"c":"GT_Reset","a":[],"r":0}', [])
+    assert _numbers([ref.format("12"), ref.format("012")]) is None
