@@ -49,6 +49,7 @@ def test_package_imports_no_top_level_neighbours():
 
 
 @pytest.mark.parametrize("layer", sorted(LOWEST))
+@pytest.mark.sample(1)
 def test_lowest_layers_import_only_downwards(layer):
     bad = []
     for path in sorted((ROOT / "gtecat" / layer).rglob("*.py")):
@@ -91,6 +92,7 @@ INNER_FORBIDDEN = {
 
 
 @pytest.mark.parametrize("sub", sorted(INNER_FORBIDDEN))
+@pytest.mark.sample(1)
 def test_gtecat_subpackages_import_only_downwards(sub):
     bad = []
     for path in sorted((ROOT / "gtecat" / sub).rglob("*.py")):

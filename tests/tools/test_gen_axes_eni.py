@@ -17,7 +17,7 @@ IN = [(0x6041, 16), (0x6064, 32), (0x60FD, 32), (0x6061, 8)]
 
 
 @pytest.mark.parametrize("n", [1, 33, 129])  # 129: past the 128 the generator once stopped at
-@pytest.mark.sample(1)
+@pytest.mark.long
 def test_reader_sees_n_axes(tmp_path: Path, n: int) -> None:
     layout = build_layout(read_eni(write_axes_eni(n, tmp_path / "bus.eni")))
     assert len(layout.axes) == n and len(layout.slaves) == n

@@ -448,6 +448,7 @@ def test_property_bad_arguments_return_1_never_raise(name, cardno, axis, value):
 
 
 # --- a scenario through the compat API only -------------------------------------------------
+@pytest.mark.long
 def test_scenario_four_axes_move_status_and_positions():
     """The VB CmdPmove with all four axes, then an X-Y interpolation, read back as the
     monitor timer (1.4) does: positions, speeds, get_status until all are 0."""

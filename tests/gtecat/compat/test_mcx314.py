@@ -191,6 +191,7 @@ def test_soft_limits_slmtp_setcompp():
     assert m.card().regs[1].stopdata & 0x40
 
 
+@pytest.mark.long
 def test_home_type_1_and_2_find_the_switch():
     """4.7: type 1 decelerates at ORG; type 2 backs off and approaches slowly."""
     up(a1=dict(position=20_000, home_switch=((5000, 8000),)))
@@ -203,6 +204,7 @@ def test_home_type_1_and_2_find_the_switch():
         m.HomeType1(0x100, 100, 1000, 100)  # no input enabled (bit 8: an interrupt enable)
 
 
+@pytest.mark.long
 def test_home_type_3_stops_on_the_index():
     up(a1=dict(position=20_000, home_switch=((5000, 8000),), index_offset=100,
                counts_per_rev=1000))  # fmt: skip
@@ -239,6 +241,7 @@ def test_property_bad_arguments_raise_compat_error_only(name, axis, data):
         assert isinstance(axis, int) and 1 <= axis <= 15
 
 
+@pytest.mark.long
 def test_scenario_drives_then_interpolation():
     """Four axes by TCurve_F, then an X-Y line by Line2D_T, read by ReadLPS/ReadEPS."""
     up()

@@ -108,6 +108,7 @@ def crd_status(core: int, crd: int) -> tuple[int, int]:
     return run.value, seg.value
 
 
+@pytest.mark.long
 def test_each_core_has_its_own_coordinate_systems(bus: None) -> None:
     for core in (1, 2):
         prm = gt.TCrdPrm()

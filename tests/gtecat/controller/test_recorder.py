@@ -54,6 +54,7 @@ def test_unknown_signal_is_a_clear_error():
         Recorder(gt.GTE_Controller(), ["nonsense"])
 
 
+@pytest.mark.long
 def test_the_trace_plot_shows_the_planned_position_over_the_encoder_with_units(
     tmp_path, monkeypatch
 ):

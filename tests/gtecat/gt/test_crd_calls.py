@@ -64,6 +64,7 @@ def speeds(rows) -> list[float]:
     return [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(rows)]
 
 
+@pytest.mark.long
 def test_line_on_the_line_within_synvel_exact_end_closed_form_time():
     up()
     x1, y1, v, a = 30_000, -12_000, 40.0, 0.5
@@ -131,6 +132,7 @@ def test_line_then_arc_counts_segments_and_keeps_speed_through_velend():
     assert len(rows) == math.ceil(total / v + v / a)
 
 
+@pytest.mark.long
 def test_look_ahead_slows_a_right_angle_to_the_corner_limit():
     up(vmax=100.0, amax=1.0)
     t_corner, acc_max = 2.0, 1.0

@@ -103,6 +103,7 @@ def rc_reason(rc: int, expected: int, *words: str) -> None:
 
 
 # --- shapes -----------------------------------------------------------------------------------
+@pytest.mark.long
 def test_finite_loops_end_on_the_last_point_with_get_follow_loop_counting():
     up()
     jog(1, 100, acc=2)

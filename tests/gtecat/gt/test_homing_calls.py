@@ -355,6 +355,7 @@ def test_switching_to_csp_after_the_home_point_was_found_finishes_on_it(five_axe
     assert machine_pos(1) == pytest.approx(700, abs=1e-3) and enc_pos(1) == -9
 
 
+@pytest.mark.long
 def test_example_5_2_scans_on_quietly_once_homed() -> None:
     """The manual's program asks for mode 8 on every scan while the status reads 3."""
     ex = _example_5_2()
@@ -425,6 +426,7 @@ def test_homing_can_be_started_again_after_completion(five_axes: Path) -> None:
     assert enc_pos(1) == 20
 
 
+@pytest.mark.long
 def test_homing_error_when_the_switch_is_never_found(five_axes: Path) -> None:
     """Method 3 without a home switch runs into PL, where it may not reverse: SW13."""
     bring_up(str(five_axes), machine=machine((0,)))

@@ -102,6 +102,7 @@ def test_example_9_1_stops_just_past_the_soft_limit_with_bit_5():
     assert not np.any(sts[stopped:] & MOVING)
 
 
+@pytest.mark.long
 def test_example_11_2_y_starts_after_x_is_in_position():
     r = example("example_11_2_in_position").run(clock="lockstep")
     assert r["errors"] == []

@@ -112,6 +112,7 @@ def test_both_edges_continuous_toggle_bits_6_and_7() -> None:
     assert sts & 0b111 == 0b111  # enabled, both edges stored; they stay until disabled
 
 
+@pytest.mark.long
 def test_first_event_keeps_the_first_capture_until_rearmed() -> None:
     bring_up("homing_probe.eni", machine=str(EXAMPLES / "homing_probe_machine.toml"))
     assert gt.GT_AxisOn(2) == 0

@@ -124,6 +124,7 @@ def test_auto_with_the_wall_floor(clock_probe, tmp_path):
     assert int(v["poll2000_ms"]) >= 100  # 2000 calls x 50 us of virtual latency
 
 
+@pytest.mark.long
 def test_deterministic_auto_without_the_floor(clock_probe, tmp_path):
     r, v = run_client(clock_probe, env=native_env(GTECAT_WALL_FLOOR="0"), cwd=tmp_path)
     assert v.get("open") == "0", r.stdout + r.stderr
@@ -159,6 +160,7 @@ def test_seed_002_shaped_cpp_program(motion_demo, tmp_path):
 
 
 @needs_cxx
+@pytest.mark.long
 def test_the_vendor_gtn_open_close_and_pdo_data_shapes_compile_and_run(libgts, tmp_path):
     """GTN_Open(5) / GTN_Open() / GTN_Close() and a three-parameter GTN_GetEcatAxisPdoData,
     as the vendor's GTN header declares them (an outside check found our core-first forms

@@ -287,6 +287,7 @@ def eni_vendor() -> int:
     return read_eni(FIG52).slaves[0].identity.vendor_id
 
 
+@pytest.mark.long
 def test_ebpfcat_initialises_lists_the_dictionary_and_cycles(
     fig52: tuple[str, ServeProcess],
 ) -> None:

@@ -263,12 +263,16 @@ def test_a_drive_is_enabled_and_moved_through_pdos(veth, fig52) -> None:
                     break
         status = struct.unpack_from("<H", drive.input)[0]
         assert status & 0x006F == 0x0027, f"statusword 0x{status:04X} is not OPERATION ENABLED"
-        # a CSP ramp; the master cycles as fast as it can, the drive follows in real time
+        # a CSP ramp of 20 counts a cycle, sent as a master does: at most one step per
+        # millisecond, the drive's cycle (a master that sent them as fast as it could made the
+        # drive see jumps of hundreds of counts per cycle when the host was busy, and its
+        # servo overshot by as many)
         target = start
         for _ in range(200):
             target += 20
             drive.output = struct.pack("<Hi", 0x000F, target)
             cycle(master)
+            time.sleep(0.001)
         positions = []
         deadline = time.monotonic() + 5
         while time.monotonic() < deadline:
