@@ -218,6 +218,16 @@ def _guard_class(cls: type) -> type:
     return g
 
 
+def _bank_safe(hook: Any) -> bool:
+    """A ``pre_cycle`` hook that leaves the axes the bank runs alone: the function says so
+    (``bank_safe`` on it), else the object of a bound method (``bank_safe`` on it, which
+    may change: the fault injector while a trigger watches an axis every cycle)."""
+    safe = getattr(hook, "bank_safe", None)
+    if safe is None:
+        safe = getattr(getattr(hook, "__self__", None), "bank_safe", False)
+    return bool(safe)
+
+
 @dataclass
 class _Group:
     """One slave (all its channels are claimed together)."""
@@ -480,7 +490,7 @@ class AxisBank:
             return "bus not in OP"
         if ctl.before_cycle or ctl.post_cycle or ctl.sample:
             return "per-cycle hooks (recorder, programs, smart homing)"
-        if any(not getattr(f, "bank_safe", False) for f in ctl.pre_cycle):
+        if not all(_bank_safe(f) for f in ctl.pre_cycle):
             return "per-cycle hooks"
         if ctl.backend.unplugged:
             return "a slave is unplugged"

@@ -350,18 +350,27 @@ class Controller:
             bank is None
             or bank.kernel is None
             or self.before_cycle
-            or not all(_quiet(f) for f in self.pre_cycle)
             or self.post_cycle
             or self.sample
             or self._links_down
             or self.clock._run_cycle != self._cycle
         ):
             return 0
+        n = min(n, self.BATCH_CYCLES)
+        for f in self.pre_cycle:
+            n = _quiet_cycles(f, n)
+            if n <= 0:
+                return 0
         master = self.master
         if master is None or not master.steady():
             return 0
-        done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, min(n, self.BATCH_CYCLES))
+        done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, n)
         master.cycles += done
+        if done:
+            for f in self.pre_cycle:
+                passed = getattr(getattr(f, "__self__", None), "cycles_passed", None)
+                if passed is not None:
+                    passed(done)
         return done
 
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
@@ -446,11 +455,18 @@ class Controller:
                 hook()
 
 
-def _quiet(hook: Callable[[int, int], None]) -> bool:
-    """A ``pre_cycle`` hook with nothing to do in the next cycles: its object says so
-    (``bank_quiet()``: the coordinate systems while the axis bank steps every running one)."""
-    quiet = getattr(getattr(hook, "__self__", None), "bank_quiet", None)
-    return quiet is not None and quiet()
+def _quiet_cycles(hook: Callable[[int, int], None], n: int) -> int:
+    """How many of the next ``n`` cycles a ``pre_cycle`` hook has nothing to do in (0: it
+    must run in the next one); its object says so: ``quiet_cycles(n)`` (the fault
+    injector: until its first trigger is due), or ``bank_quiet()`` for all or none (the
+    coordinate systems while the axis bank steps every running one).  After cycles run
+    at once, the object's ``cycles_passed(k)``, if it has one, counts them."""
+    obj = getattr(hook, "__self__", None)
+    horizon = getattr(obj, "quiet_cycles", None)
+    if horizon is not None:
+        return min(n, horizon(n))
+    quiet = getattr(obj, "bank_quiet", None)
+    return n if quiet is not None and quiet() else 0
 
 
 def folder_message(path: Path, how: str) -> str:

@@ -41,13 +41,13 @@ class FaultBus:
     def slaves(self) -> list[VirtualSlave]:
         raise NotImplementedError
 
-    def now_ms(self) -> float:
-        """Controller time, ms: what GT_GetClock reads (``at_ms``)."""
+    def now_ms(self, ahead: int = 0) -> float:
+        """Controller time, ms: what GT_GetClock reads (``at_ms``); ``ahead`` cycles on."""
         raise NotImplementedError
 
-    def t_ms(self) -> float:
+    def t_ms(self, ahead: int = 0) -> float:
         """Time that never goes back (a GT_Reset does not move it): durations, ``after_ms``."""
-        return self.now_ms()
+        return self.now_ms(ahead)
 
     def healthy(self) -> bool:
         return True
@@ -177,11 +177,13 @@ class EmulatedBus(FaultBus):
     def slaves(self) -> list[VirtualSlave]:
         return self.backend.slaves
 
-    def now_ms(self) -> float:
-        return (self.ctl.clock.now_ns - self.ctl.reset_ns) / 1e6
+    def now_ms(self, ahead: int = 0) -> float:
+        clock = self.ctl.clock
+        return (clock.now_ns + ahead * clock.cycle_ns - self.ctl.reset_ns) / 1e6
 
-    def t_ms(self) -> float:
-        return self.ctl.clock.now_ns / 1e6
+    def t_ms(self, ahead: int = 0) -> float:
+        clock = self.ctl.clock
+        return (clock.now_ns + ahead * clock.cycle_ns) / 1e6
 
     def healthy(self) -> bool:
         m = self.ctl.master
@@ -238,8 +240,8 @@ class WireBus(FaultBus):
     def slaves(self) -> list[VirtualSlave]:
         return self.chain.slaves
 
-    def now_ms(self) -> float:
-        return self._t_ns / 1e6
+    def now_ms(self, ahead: int = 0) -> float:
+        return (self._t_ns + ahead * self.cycle_ns) / 1e6
 
     def log(self, message: str) -> None:
         if self._log is not None:

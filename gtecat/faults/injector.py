@@ -31,7 +31,7 @@ from ..errors import ParameterError
 from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
 from . import kinds as k
 from .bus import FaultBus
-from .triggers import AfterTime, AtTime, Now, Trigger
+from .triggers import AfterTime, AtTime, Now, Trigger, first_cycle
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
@@ -203,6 +203,43 @@ class Injector:
         if any(e.state == "ended" for e in self.entries):
             self.entries = [e for e in self.entries if e.state != "ended"]
             self._refresh()
+
+    def quiet_cycles(self, n: int) -> int:
+        """How many of the next ``n`` cycles :meth:`tick` surely does nothing in but count
+        (the controller runs them at once, :meth:`Controller.run_cycles`): all of them
+        without faults; up to the first trigger due or duration over; none while a
+        chattering switch or a stuck IO input needs every cycle, or a trigger watches one."""
+        for e in self.entries:
+            if n <= 0:
+                return 0
+            if e.state == "armed":
+                if e.after is not None:
+                    if e.after not in self._started:
+                        continue  # its gate opens only in a tick that starts another
+                    if "armed_ms" not in e.data:
+                        return 0  # the gate's first tick notes the time
+                n = min(n, e.trigger.quiet_cycles(self.bus, n))
+            elif e.state == "active":
+                f = e.fault
+                if isinstance(f, k.SwitchChatter | k.IoStuck):
+                    return 0
+                if e.duration_ms is not None:
+                    t0, d = e.started_ms or 0.0, e.duration_ms
+                    left = d - (self.bus.t_ms() - t0)
+                    n = min(n, first_cycle(lambda j: self.bus.t_ms(j) - t0 >= d, self.bus, left, n))
+            else:
+                return 0  # an ended entry the next tick drops
+        return max(0, n)
+
+    def cycles_passed(self, n: int) -> None:
+        """``n`` quiet cycles (:meth:`quiet_cycles`) ran at once: count them as :meth:`tick`
+        would have."""
+        if not self.entries:
+            return
+        self._chatter_cycle += n
+        for e in self.entries:
+            if e.state == "armed" and (e.after is None or e.after in self._started):
+                e.trigger.cycles_passed(self.bus, n)
 
     def _gate_open(self, e: Entry) -> bool:
         if e.after is None:

@@ -24,6 +24,14 @@ class Trigger:
     def sdo(self, slave: int, index: int) -> bool:
         return False
 
+    def quiet_cycles(self, bus: Any, n: int) -> int:
+        """How many of the next ``n`` cycles :meth:`due` is surely False in, so the
+        controller may run them at once (0: it must be asked in the next cycle)."""
+        return 0
+
+    def cycles_passed(self, bus: Any, k: int) -> None:
+        """``k`` quiet cycles ran at once: count them as :meth:`due` would have."""
+
     def describe(self) -> str:
         return "at once"
 
@@ -45,6 +53,9 @@ class AtTime(Trigger):
     def due(self, bus: Any) -> bool:
         return bus.now_ms() >= self.ms
 
+    def quiet_cycles(self, bus: Any, n: int) -> int:
+        return first_cycle(lambda k: bus.now_ms(k) >= self.ms, bus, self.ms - bus.now_ms(), n)
+
     def describe(self) -> str:
         return f"at {self.ms:g} ms"
 
@@ -62,6 +73,14 @@ class AfterTime(Trigger):
 
     def due(self, bus: Any) -> bool:
         return bus.t_ms() - self.since >= self.ms
+
+    def quiet_cycles(self, bus: Any, n: int) -> int:
+        return first_cycle(
+            lambda k: bus.t_ms(k) - self.since >= self.ms,
+            bus,
+            self.ms - (bus.t_ms() - self.since),
+            n,
+        )
 
     def describe(self) -> str:
         return f"{self.ms:g} ms later"
@@ -81,6 +100,15 @@ class AfterCycles(Trigger):
         if bus.healthy():
             self.seen += 1
         return self.seen >= self.cycles
+
+    def quiet_cycles(self, bus: Any, n: int) -> int:
+        if not bus.healthy():
+            return n  # the cycles run at once are steady ones: none counts
+        return max(0, min(n, self.cycles - self.seen - 1))
+
+    def cycles_passed(self, bus: Any, k: int) -> None:
+        if bus.healthy():
+            self.seen += k
 
     def describe(self) -> str:
         return f"after {self.cycles} healthy cycles"
@@ -143,6 +171,9 @@ class OnSdo(Trigger):
     def due(self, bus: Any) -> bool:
         return False
 
+    def quiet_cycles(self, bus: Any, n: int) -> int:
+        return n  # it counts mailbox requests, never cycles
+
     def sdo(self, slave: int, index: int) -> bool:
         if slave == self.slave and index == self.index:
             self.seen += 1
@@ -154,6 +185,19 @@ class OnSdo(Trigger):
 
     def as_dict(self) -> dict[str, Any]:
         return {"on_sdo": [self.slave, self.index, self.n]}
+
+
+def first_cycle(due: Any, bus: Any, left_ms: float, n: int) -> int:
+    """The first of the next ``n`` cycles (0: the coming one) in which ``due(k)`` holds,
+    ``n`` when none: guessed from the time left, then settled with ``due`` itself, so the
+    very comparison the per-cycle check makes decides (``due`` grows with ``k``)."""
+    step = bus.cycle_ns / 1e6
+    k = 0 if left_ms <= 0 else min(n, max(0, int(left_ms / step)))
+    while k > 0 and due(k - 1):
+        k -= 1
+    while k < n and not due(k):
+        k += 1
+    return k
 
 
 TRIGGER_KEYS = ("at_ms", "after_ms", "after_cycles", "when_position", "at_homing", "on_sdo")
