@@ -250,6 +250,8 @@ class AxisBank:
         self.dirty = True
         self._countdown = 0
         self._missed = False  # the last refresh found an eligible group it could not claim
+        #: GT axes kept off the bank (a fault trigger reads their drive every cycle)
+        self.held: frozenset[int] = frozenset()
         self.n = 0
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
@@ -519,7 +521,7 @@ class AxisBank:
         """The scalar state the bank reproduces (module docstring)."""
         ax = self.axes[r]
         res = self.res[r]
-        if res is None:
+        if res is None or ax.number in self.held:
             return False
         if not ax.servo_on:
             return self._eligible_frozen(r)
@@ -973,6 +975,20 @@ class AxisBank:
     def release_all(self) -> None:
         if self.n_alive:
             self._release_groups([g for g in self.groups if g.claimed])
+
+    def hold(self, axes: frozenset[int]) -> None:
+        """Keep the GT ``axes`` off the bank from now on, the others as they are (a fault
+        trigger watches their mechanics every cycle: :mod:`gtecat.faults`); an empty set
+        lets them back at the next refresh."""
+        axes = frozenset(axes)
+        if axes == self.held:
+            return
+        self.held = axes
+        for n in axes:
+            ax = self.ctl.axes.get(n)
+            if ax is not None:
+                self.release_axis_object(ax)
+        self.dirty = True
 
     def release_axis_object(self, ax: Any) -> None:
         r = self._row_of.get(id(ax))

@@ -67,6 +67,10 @@ class FaultBus:
     def set_frame_faults(self, injector: Any) -> None:
         """Route the cyclic answers through ``injector`` (None: no longer)."""
 
+    def watch_axes(self, axes: frozenset[int]) -> None:
+        """A trigger reads the drives of ``axes`` every cycle (the emulated bus keeps them
+        off the axis bank, the other axes stay on it)."""
+
     # --- what the faults reach ----------------------------------------
     def slave(self, position: int) -> VirtualSlave:
         slaves = self.slaves
@@ -197,6 +201,11 @@ class EmulatedBus(FaultBus):
         if bank is not None:
             bank.release_all()
             bank.dirty = True
+
+    def watch_axes(self, axes: frozenset[int]) -> None:
+        bank = self.ctl.bank
+        if bank is not None:
+            bank.hold(axes)
 
     def cut_after(self, position: int) -> None:
         self.mend()

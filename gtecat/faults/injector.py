@@ -76,7 +76,8 @@ class Entry:
 class Injector:
     """The faults of one bus (module docstring)."""
 
-    #: the controller's pre_cycle protocol: time triggers do not touch banked axes
+    #: the controller's pre_cycle protocol: the axis bank may run while faults are armed
+    #: (the axes a trigger watches every cycle are kept off it: :meth:`_refresh`)
     bank_safe = True
 
     def __init__(self, bus: FaultBus) -> None:
@@ -92,6 +93,7 @@ class Injector:
         self._last_answer: bytes | None = None
         self._lbase: int | None = None
         self._started: set[int] = set()
+        self._watched: frozenset[int] = frozenset()
         self._wrap_mailboxes()
 
     # --- adding and clearing ----------------------------------------
@@ -264,13 +266,14 @@ class Injector:
             self.bus.set_frame_faults(self if frame else None)
         from .triggers import AtHomingStage, WhenPosition
 
-        safe = not any(
-            e.state == "armed" and isinstance(e.trigger, WhenPosition | AtHomingStage)
+        watched = frozenset(
+            e.trigger.axis  # type: ignore[attr-defined]
             for e in self.entries
+            if e.state == "armed" and isinstance(e.trigger, WhenPosition | AtHomingStage)
         )
-        if safe != self.bank_safe:
-            self.bank_safe = safe
-            self.bus.before_change()
+        if watched != self._watched:
+            self._watched = watched
+            self.bus.watch_axes(watched)  # the others stay on the bank
 
     # --- start and end ----------------------------------------
     def _start(self, e: Entry) -> None:
@@ -321,8 +324,9 @@ class Injector:
             s = bus.slave(f.slave)
             if isinstance(s, IoSlave):
                 s.set_input_bit(f.bit, bool(f.value))
-        if f.depth == "frame":
-            self._refresh()  # the cyclic answers pass the injector from now on
+        # the cyclic answers pass the injector from now on (a frame fault); a trigger that
+        # watched an axis no longer does
+        self._refresh()
         if f.once:
             self._end(e, "done")
 
