@@ -984,7 +984,7 @@ class AxisBank:
         if axes == self.held:
             return
         self.held = axes
-        for n in axes:
+        for n in axes if self.built else ():
             ax = self.ctl.axes.get(n)
             if ax is not None:
                 self.release_axis_object(ax)

@@ -204,7 +204,7 @@ class Injector:
                     s.set_input_bit(f.bit, bool(f.value))
         if any(e.state == "ended" for e in self.entries):
             self.entries = [e for e in self.entries if e.state != "ended"]
-            self._refresh()
+        self._refresh()  # what the next cycle's triggers may change
 
     def quiet_cycles(self, n: int) -> int:
         """How many of the next ``n`` cycles :meth:`tick` surely does nothing in but count
@@ -220,7 +220,9 @@ class Injector:
                         continue  # its gate opens only in a tick that starts another
                     if "armed_ms" not in e.data:
                         return 0  # the gate's first tick notes the time
-                n = min(n, e.trigger.quiet_cycles(self.bus, n))
+                # the cycle before the trigger's runs on its own: its tick keeps the
+                # fault's axes off the bank (_refresh)
+                n = min(n, e.trigger.quiet_cycles(self.bus, n + 1) - 1)
             elif e.state == "active":
                 f = e.fault
                 if isinstance(f, k.SwitchChatter | k.IoStuck):
@@ -266,11 +268,30 @@ class Injector:
             self.bus.set_frame_faults(self if frame else None)
         from .triggers import AtHomingStage, WhenPosition
 
-        watched = frozenset(
-            e.trigger.axis  # type: ignore[attr-defined]
-            for e in self.entries
-            if e.state == "armed" and isinstance(e.trigger, WhenPosition | AtHomingStage)
-        )
+        # The axis bank runs its axes' whole cycle before this tick: an axis a fault is
+        # about to change (its trigger may fire in the next cycle, or is watched every
+        # cycle) is kept off the bank from now on, so the fault meets it in the very cycle
+        # the trigger fires, as on the scalar path; a fault on the bus or a slave: all axes.
+        held: set[int] = set()
+        safe = True
+        for e in self.entries:
+            if e.state != "armed":
+                continue
+            trig = e.trigger
+            if isinstance(trig, WhenPosition | AtHomingStage):
+                held.add(trig.axis)
+            elif e.after is None and not trig.soon(self.bus):
+                continue
+            axis = getattr(e.fault, "axis", None)
+            if axis is not None:
+                held.add(int(axis))
+            elif e.fault.depth != "mailbox":
+                safe = False
+        if safe != self.bank_safe:
+            self.bank_safe = safe
+            if not safe:
+                self.bus.before_change()
+        watched = frozenset(held)
         if watched != self._watched:
             self._watched = watched
             self.bus.watch_axes(watched)  # the others stay on the bank

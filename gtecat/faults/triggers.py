@@ -32,6 +32,10 @@ class Trigger:
     def cycles_passed(self, bus: Any, k: int) -> None:
         """``k`` quiet cycles ran at once: count them as :meth:`due` would have."""
 
+    def soon(self, bus: Any) -> bool:
+        """Whether :meth:`due` may hold in the next cycle (True when it cannot tell)."""
+        return True
+
     def describe(self) -> str:
         return "at once"
 
@@ -55,6 +59,9 @@ class AtTime(Trigger):
 
     def quiet_cycles(self, bus: Any, n: int) -> int:
         return first_cycle(lambda k: bus.now_ms(k) >= self.ms, bus, self.ms - bus.now_ms(), n)
+
+    def soon(self, bus: Any) -> bool:
+        return bus.now_ms(1) >= self.ms
 
     def describe(self) -> str:
         return f"at {self.ms:g} ms"
@@ -81,6 +88,9 @@ class AfterTime(Trigger):
             self.ms - (bus.t_ms() - self.since),
             n,
         )
+
+    def soon(self, bus: Any) -> bool:
+        return bus.t_ms(1) - self.since >= self.ms
 
     def describe(self) -> str:
         return f"{self.ms:g} ms later"
@@ -109,6 +119,9 @@ class AfterCycles(Trigger):
     def cycles_passed(self, bus: Any, k: int) -> None:
         if bus.healthy():
             self.seen += k
+
+    def soon(self, bus: Any) -> bool:
+        return self.seen + 1 >= self.cycles
 
     def describe(self) -> str:
         return f"after {self.cycles} healthy cycles"
@@ -173,6 +186,9 @@ class OnSdo(Trigger):
 
     def quiet_cycles(self, bus: Any, n: int) -> int:
         return n  # it counts mailbox requests, never cycles
+
+    def soon(self, bus: Any) -> bool:
+        return False  # it fires in a mailbox request, between cycles
 
     def sdo(self, slave: int, index: int) -> bool:
         if slave == self.slave and index == self.index:
