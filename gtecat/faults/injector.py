@@ -230,7 +230,8 @@ class Injector:
                 if e.duration_ms is not None:
                     t0, d = e.started_ms or 0.0, e.duration_ms
                     left = d - (self.bus.t_ms() - t0)
-                    n = min(n, first_cycle(lambda j: self.bus.t_ms(j) - t0 >= d, self.bus, left, n))
+                    over = lambda j, t0=t0, d=d: self.bus.t_ms(j) - t0 >= d  # noqa: E731
+                    n = min(n, first_cycle(over, self.bus, left, n))
             else:
                 return 0  # an ended entry the next tick drops
         return max(0, n)

@@ -21,7 +21,10 @@ ALARM = 1 << 1
 
 
 def _up(bank: str = "auto") -> object:
-    assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="", bank=bank) == 0
+    assert (
+        gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="", bank=bank)
+        == 0
+    )
     assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
     st = c_short()
     for _ in range(300):
