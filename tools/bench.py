@@ -359,6 +359,59 @@ FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-poi
 CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
 
 
+def bench_crd_poll(seconds: float = 1.0, pairs: int = 3, n: int = 12) -> dict[str, object]:
+    """Coordinated motion polled every cycle, as field applications do: ``n`` axes, two XY
+    systems (axes 1-2 and 3-4, the crd figure's path), and after each 1 ms cycle
+    ``GT_CrdStatus`` of both systems and ``GT_GetPrfPos`` of their four axes.  Controller
+    milliseconds per CPU second with the axis bank (``auto``) and on the scalar path
+    (``off``), measured in pairs back to back (the best window of each); ``ratio``:
+    bank / scalar."""
+    from ctypes import c_double, c_int32, c_short
+
+    from tools.bench_scaling import bring_up, check, crd_plan, gtn, start_crd
+    from tools.gen_axes_eni import write_axes_eni
+
+    gt = importlib.import_module("gtecat.gt")
+    plan = crd_plan(n)
+    crd_axes = [a for a, s in plan.items() if s == "crd"]
+    best = {"auto": 0.0, "off": 0.0}
+    run, seg, pos = c_short(), c_int32(), c_double()
+    prun, pseg, ppos = byref(run), byref(seg), byref(pos)
+    with tempfile.TemporaryDirectory() as tmp:
+        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        for _ in range(pairs):
+            for bank in ("auto", "off"):
+                bring_up(eni, n, bank)
+                try:
+                    for a in plan:
+                        gtn("AxisOn", a)
+                    start_crd(crd_axes)
+                    gt.GTE_Wait(50)
+                    check(plan)
+                    ms = 0
+                    c0, t0 = time.process_time(), time.perf_counter()
+                    while time.perf_counter() - t0 < seconds / pairs:
+                        for _ in range(100):
+                            gt.GTE_Wait(1)
+                            for crd in (1, 2):
+                                gt.GT_CrdStatus(crd, prun, pseg, 0)
+                            for a in crd_axes:
+                                gt.GT_GetPrfPos(a, ppos)
+                        ms += 100
+                    cpu = max(time.process_time() - c0, 1e-9)
+                    check(plan)
+                finally:
+                    gt.GT_Close()
+                best[bank] = max(best[bank], ms / 1000 / cpu)
+    return {
+        "axes": n,
+        "what": "2 XY systems, GT_CrdStatus x2 + GT_GetPrfPos x4 after every cycle",
+        "rtf_cpu_bank": round(best["auto"], 2),
+        "rtf_cpu_scalar": round(best["off"], 2),
+        "ratio": round(best["auto"] / best["off"], 2) if best["off"] else None,
+    }
+
+
 def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> dict[str, object]:
     """The many-axes figures, measured one after the other in this run (``only``: those)."""
     from tools.bench_scaling import crd_plan, run_bus
@@ -394,6 +447,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_64_axes_follow": lambda: rtf(64, every(64, "follow"), 10, FOLLOW),
         "rtf_12_axes_crd": lambda: rtf(12, crd_plan(12), None, CRD),
         "rtf_64_axes_crd": lambda: rtf(64, crd_plan(64), 10, CRD),
+        "crd_polled_12_axes_bank_vs_scalar": lambda: _figure(
+            bench_crd_poll(2 * seconds), "ratio", 1.0
+        ),
         "gt_get_sts_vs_argument": lambda: _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
         "call_shapes_vs_arguments": lambda: _figure(
             bench_call_shapes(2 * seconds), "worst", 4, at_most=True

@@ -144,8 +144,24 @@ BANK_READS = frozenset(
         "GT_GetVersion",
         "GT_IsEcatReady",
         "GT_GetEcatHomingStatus",
+        # a coordinate system's state, read from the cycle the bank records of it
+        # (CoordSystem.now, bank_modes.SystemTrace), or its parameters (never stepped)
+        "GT_CrdStatus",
+        "GT_CrdSpace",
+        "GT_GetCrdPos",
+        "GT_GetCrdVel",
+        "GT_GetCrdPrm",
+        "GT_GetCrdStopDec",
+        "GT_GetRemainderSegNum",
+        "GT_GetCrdMapBase",
+        "GT_CrdData",
     }
 )
+#: GT functions naming coordinate systems by a mask (GT_CrdStart: bit 0 = system 1; GT_Stop:
+#: bits 12, 13 = systems 1, 2, bits 0-11 = axes 1-12): (the first system's bit, axes' bits)
+_CRD_MASKS = {"GT_CrdStart": (0, 0), "GT_Stop": (12, 0xFFF)}
+#: GT functions naming a system that read or change other systems too: every axis goes back
+_CRD_ALL = frozenset({"GT_SetCrdPrm"})
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -996,6 +1012,7 @@ class AxisBank:
             cl.rewind(self)
             for c in cl.systems:
                 c.banked = False
+                c.trace = None
             for gi in cl.groups:
                 self._cluster_of.pop(gi, None)
             self.sampled[cl.rows] = False
@@ -1066,6 +1083,21 @@ class AxisBank:
         if not self.n_alive:
             return
         params = proto.params
+        if params and values and type(values[0]) is int:
+            name = proto.name
+            if params[0].name == "crd" and name not in _CRD_ALL:
+                # a call on one coordinate system: its own cluster goes back (its axes and
+                # any other object it reaches release themselves through their guards)
+                self._release_systems(ctl, [values[0]])
+                return
+            masked = _CRD_MASKS.get(name)
+            if masked is not None:
+                first, axis_bits = masked
+                m = values[0]
+                self._release_systems(ctl, [n for n in (1, 2) if m >> (first + n - 1) & 1])
+                if not m & axis_bits:
+                    return
+                values = (m & axis_bits, *values[1:])  # the axes of the mask, below
         if params and params[0].name in ("axis", "profile", "encoder") and values:
             if not any(p.name == "count" for p in params):
                 n = values[0]
@@ -1083,6 +1115,20 @@ class AxisBank:
                     self.release_axis_object(ax)
                 return
         self.release_all()
+
+    def _release_systems(self, ctl: Any, numbers: list[int]) -> None:
+        """Give back the clusters that run coordinate systems ``numbers`` of ``ctl``."""
+        crds = vars(ctl).get("crd_bank")
+        if crds is None:
+            return
+        for n in numbers:
+            c = crds.systems.get(n)
+            if c is None or not c.banked:
+                continue
+            for cl in {id(cl): cl for cl in self._cluster_of.values()}.values():
+                if c in cl.systems:
+                    self._release_groups([self.groups[cl.groups[0]]])
+                    break
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
     def value(self, name: str, r: int) -> Any:
