@@ -104,24 +104,29 @@ def system_plain(c: CoordSystem) -> bool:
     q = c.fifos[c.fifo]
     if not q:
         return True
-    # a FIFO seen plain stays plain while it only loses entries (the last one and the
-    # length tell a push)
-    key = (c.fifo, id(q[-1]))
+    # a FIFO seen plain stays plain while it only loses entries at its head and gains plain
+    # ones at its tail: only those after the last entry seen are looked at (a segment pushed
+    # every cycle while the path runs costs one look, not one over the whole FIFO)
+    last = q[-1]
     seen = _PLAIN.get(id(c))
-    if seen is not None and seen[0] == key and len(q) <= seen[1]:
+    old = seen[1] if seen is not None and seen[0] == c.fifo else None
+    if last is old and len(q) <= seen[2]:  # type: ignore[index]
         return True
-    for e in q:
+    for e in reversed(q):
+        if e is old:
+            break
         t = type(e)
         if t is Delay:
             continue
         if t is not Motion or e.speed_plan is not None:
             return False
-    _PLAIN[id(c)] = (key, len(q))
+    _PLAIN[id(c)] = (c.fifo, last, len(q))
     return True
 
 
-#: id(system) -> (fifo and id of its last entry, length) of the last FIFO seen plain
-_PLAIN: dict[int, tuple[tuple[int, int], int]] = {}
+#: id(system) -> (fifo, its last entry, length) of the last FIFO seen plain (the entry itself
+#: kept: its id cannot be taken by a new one)
+_PLAIN: dict[int, tuple[int, Any, int]] = {}
 
 
 def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
