@@ -74,6 +74,7 @@ from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
 from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
+from .crd.system import Delay, Motion
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -162,6 +163,15 @@ BANK_READS = frozenset(
 _CRD_MASKS = {"GT_CrdStart": (0, 0), "GT_Stop": (12, 0xFFF)}
 #: GT functions naming a system that read or change other systems too: every axis goes back
 _CRD_ALL = frozenset({"GT_SetCrdPrm"})
+
+
+def _crd_push(name: str) -> bool:
+    """A GT function that pushes one line, arc, helix or delay onto a FIFO, nothing else."""
+    return name == "GT_BufDelay" or (
+        name.startswith(("GT_Ln", "GT_Arc", "GT_Helix")) and not name.endswith("Ex")
+    )
+
+
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -1013,6 +1023,7 @@ class AxisBank:
             for c in cl.systems:
                 c.banked = False
                 c.trace = None
+                c.push_hook = None
             for gi in cl.groups:
                 self._cluster_of.pop(gi, None)
             self.sampled[cl.rows] = False
@@ -1086,9 +1097,12 @@ class AxisBank:
         if params and values and type(values[0]) is int:
             name = proto.name
             if params[0].name == "crd" and name not in _CRD_ALL:
-                # a call on one coordinate system: its own cluster goes back (its axes and
-                # any other object it reaches release themselves through their guards)
-                self._release_systems(ctl, [values[0]])
+                # a segment pushed onto the tail of a path the bank holds ahead: kept there
+                # where no cycle of the bank's window reaches the tail (_push_ahead); else a
+                # call on one coordinate system gives back its own cluster (its axes and any
+                # other object it reaches release themselves through their guards)
+                if not (_crd_push(name) and self._push_ahead(ctl, proto, values)):
+                    self._release_systems(ctl, [values[0]])
                 return
             masked = _CRD_MASKS.get(name)
             if masked is not None:
@@ -1115,6 +1129,45 @@ class AxisBank:
                     self.release_axis_object(ax)
                 return
         self.release_all()
+
+    def _push_ahead(self, ctl: Any, proto: Any, values: tuple) -> bool:
+        """A GT_LnXY, GT_ArcXY..., GT_HelixXY... or GT_BufDelay onto the running FIFO of a system
+        the bank holds a window of cycles ahead may go onto the FIFO as it stands there: the
+        segment at its tail is not reached in that window, and no segment starting in it looks
+        that far (its exit speed looks at the next segment only, without a look-ahead).  Then
+        the entry joins the FIFO kept for the rewind too (:meth:`_pushed_ahead`); True."""
+        crds = vars(ctl).get("crd_bank")
+        c = crds.systems.get(values[0]) if crds is not None else None
+        if c is None or not c.banked:
+            return False
+        names = [p.name for p in proto.params]
+        fifo = values[names.index("fifo")] if "fifo" in names else 0
+        if type(fifo) is not int or fifo != c.fifo or not c.running or c.stopping:
+            return False
+        if c.look[fifo] is not None or c.now().space(fifo) <= 1:
+            return False
+        for e in c.fifos[fifo]:  # a delay, or a segment of some length, before the tail
+            if type(e) is Delay or (type(e) is Motion and e.geom.length > 0.0):
+                break
+        else:
+            return False
+        cl = next((x for x in self._cluster_of.values() if c in x.systems), None)
+        if cl is None:
+            return False
+        c.push_hook = lambda c, entry, fifo: self._pushed_ahead(cl, c, entry, fifo)
+        return True
+
+    def _pushed_ahead(self, cl: Cluster, c: Any, entry: Any, fifo: int) -> None:
+        if cl.snaps is not None:  # (None: the system stands where the scalar path has it)
+            for obj, snap in cl.snaps:
+                if obj is c:
+                    kept = snap[2]  # bank_modes.snapshot: the __dict__, containers by content
+                    kept["fifos"][1][fifo][1].append(entry)
+                    kept["tails"][1][fifo] = c.tails[fifo]
+            if c.trace is not None:
+                c.trace.pushed[fifo] += 1
+        if not (type(entry) is Delay or (type(entry) is Motion and entry.speed_plan is None)):
+            self._release_groups([self.groups[cl.groups[0]]])
 
     def _release_systems(self, ctl: Any, numbers: list[int]) -> None:
         """Give back the clusters that run coordinate systems ``numbers`` of ``ctl``."""

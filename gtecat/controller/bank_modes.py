@@ -334,7 +334,7 @@ class SystemTrace:
     the positions are the slots' samples, ``cols``); every cycle is marked where ``cols`` is
     None."""
 
-    __slots__ = ("bank", "cols", "marks", "rows", "speeds", "start")
+    __slots__ = ("bank", "cols", "marks", "pushed", "rows", "speeds", "start")
 
     def __init__(self, bank: AxisBank, rows: list[int], c: CoordSystem) -> None:
         self.bank = bank
@@ -343,6 +343,8 @@ class SystemTrace:
         self.speeds: list[float] = []
         self.marks: list[tuple[int, tuple]] = []
         self.cols: list[list[tuple[float, float, float]]] | None = None
+        #: entries pushed onto each FIFO since (AxisBank._pushed_ahead): not in the states
+        self.pushed = [0, 0]
 
     def now(self, c: CoordSystem) -> Any:
         """``c`` as the scalar path has it now: the cluster's rows took ``m`` samples since the
@@ -353,19 +355,25 @@ class SystemTrace:
         if m >= len(self.speeds):  # the objects stand where the scalar path has them
             return CrdNow(c, c.state())
         if m == 0:
-            return CrdNow(c, self.start)
+            return CrdNow(c, self._pushed(self.start))
         marks = self.marks
         j = m - 1
         k = len(marks) - 1
         while k >= 0 and marks[k][0] > j:
             k -= 1
         if k >= 0 and marks[k][0] == j:
-            return CrdNow(c, marks[k][1])
+            return CrdNow(c, self._pushed(marks[k][1]))
         base = marks[k][1] if k >= 0 else self.start
         cols = self.cols
         assert cols is not None
         pos = tuple(col[j][0] - o for col, o in zip(cols, c.origin, strict=True))
-        return CrdNow(c, (*base[:6], self.speeds[j], pos, base[8]))
+        return CrdNow(c, self._pushed((*base[:6], self.speeds[j], pos, base[8])))
+
+    def _pushed(self, st: tuple) -> tuple:
+        p0, p1 = self.pushed
+        if not (p0 or p1):
+            return st
+        return (*st[:4], st[4] + p0, st[5] + p1, *st[6:])
 
 
 class Cluster:

@@ -212,6 +212,9 @@ class CoordSystem:
         #: while banked, what the system was in each cycle the bank stepped it ahead
         #: (:class:`gtecat.controller.bank_modes.SystemTrace`): :meth:`now` reads it
         self.trace: Any = None
+        #: set by the axis bank for one push onto the system it holds ahead (AxisBank.before_call):
+        #: called with (system, entry, fifo) after the entry is in the FIFO
+        self.push_hook: Callable[[CoordSystem, Entry, int], None] | None = None
         self.reset()
 
     def reset(self) -> None:
@@ -341,6 +344,10 @@ class CoordSystem:
         elif not q and not self._runs(fifo):
             self.tails[fifo] = self.position()
         q.append(entry)
+        hook = self.push_hook
+        if hook is not None:
+            self.push_hook = None
+            hook(self, entry, fifo)
 
     def clear(self, fifo: int) -> None:
         if self._runs(fifo):

@@ -328,7 +328,19 @@ def _polled_setup() -> object:
 #: (cycle, a call that changes a running path) of the polled program
 POLLED_CALLS: list[tuple[int, Callable[[], object]]] = [
     (0, _polled_setup),
-    (170, lambda: gt.GT_LnXY(1, 100, 100, 9.0, 0.4, 0.0, 0)),  # appended while system 1 runs
+    # segments streamed onto system 1's running FIFO (kept in the bank: pushed ahead), a
+    # delay, a segment into its other FIFO (given back), a line of no length
+    *[
+        (100 + 5 * k, lambda k=k: gt.GT_LnXY(1, 40 * (k % 2), 40 * k, 9.0, 0.4, 9.0, 0))
+        for k in range(6)
+    ],
+    (131, lambda: gt.GT_BufDelay(1, 3, 0)),
+    (140, lambda: gt.GT_LnXY(1, 0, 0, 9.0, 0.4, 0.0, 1)),
+    (145, lambda: gt.GT_LnXY(1, 40, 200, 9.0, 0.4, 0.0, 0)),
+    (150, lambda: gt.GT_LnXY(1, 40, 200, 9.0, 0.4, 0.0, 0)),
+    (170, lambda: gt.GT_LnXY(1, 100, 100, 9.0, 0.4, 0.0, 0)),
+    # near the end of system 1's path: pushes the bank's window may reach (given back then)
+    *[(440 + 12 * k, lambda k=k: gt.GT_LnXY(1, 60 * k, 0, 9.0, 0.4, 9.0, 0)) for k in range(6)],
     (230, lambda: gt.GT_SetOverride(2, 1.5)),
     (330, lambda: gt.GT_Stop(1 << 13, 0)),  # system 2 stops along its path
 ]
@@ -343,7 +355,7 @@ def _run_polled(machine: str, bank: str) -> tuple[list, list[tuple[bool, bool]],
     trace: list = []
     banked: list[tuple[bool, bool]] = []
     try:
-        for k in range(480):
+        for k in range(540):
             action = calls.get(k)
             if action is not None:
                 trace.append(("call", action()))
@@ -372,3 +384,6 @@ def test_crd_reads_polled_every_cycle_match_the_scalar_path_without_a_release(ma
     assert sum(b[0] for b in banked[:300]) >= 280
     assert sum(b[1] for b in banked[160:330]) >= 165
     assert banked[170][1] and banked[171][1], "a call on system 1 gave back system 2"
+    for k in (100, 105, 110, 115, 120, 125, 131, 145, 150, 170):
+        assert banked[k - 1][0] and banked[k][0], f"the push at cycle {k} gave back system 1"
+    assert not banked[140][0], "a push into the FIFO that does not run stays in the bank"
