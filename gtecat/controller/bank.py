@@ -174,6 +174,8 @@ def _crd_push(name: str) -> bool:
     )
 
 
+#: rows up to which GT_GetSts's words are made row by row (fewer calls than numpy's)
+_SMALL_BANK = 32
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -1194,6 +1196,17 @@ class AxisBank:
 
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
+            if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
+                return [
+                    (_MOVING if m or j else _ARRIVED if a else 0) | (0 if f else _SERVO_ON)
+                    for m, j, a, f in zip(
+                        self.moving.tolist(),
+                        self.jog.tolist(),
+                        self.arrived.tolist(),
+                        self.frz.tolist(),
+                        strict=True,
+                    )
+                ]
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | np.where(self.frz, 0, _SERVO_ON)).tolist()

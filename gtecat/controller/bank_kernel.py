@@ -26,18 +26,24 @@ import logging
 import os
 from importlib import resources
 from operator import attrgetter
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..cbuild import shared_library
+from ..cbuild import NativeBuildError, shared_library
 
 if TYPE_CHECKING:
     from .bank import AxisBank
 
 log = logging.getLogger(__name__)
-#: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+#: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math (-O3 changes no
+#: value: it reorders no floating-point operation without -ffast-math's licences); portable
+#: code for any processor of the architecture (no -march: the cache may be shared between
+#: machines, and an instruction set chosen per processor measured no faster)
+CFLAGS = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+#: the plain build, when the compiler refuses CFLAGS
+PLAIN_CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64
 #: the int64 slots (``io``) and double slots (``fp``) of a cycle call, the C enums' order
 (IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN) = range(8)
@@ -78,7 +84,7 @@ def library() -> tuple[Any, str]:
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
     try:
-        lib = ctypes.CDLL(str(shared_library("bank_kernel", _source(), CFLAGS, ("-lm",))))
+        lib = ctypes.CDLL(str(build(CFLAGS)))
         lib.bank_kernel_fields.restype = ctypes.c_char_p
         lib.bank_kernel_abi.restype = ctypes.c_int
         lib.bank_kernel_cycle.restype = ctypes.c_int
@@ -131,6 +137,18 @@ def library() -> tuple[Any, str]:
     return _LIB, _LIB_REASON
 
 
+def build(cflags: tuple[str, ...]) -> Path:
+    """The kernel built with ``cflags``, else (the compiler refused them) with the plain flags
+    (NativeBuildError when that fails too)."""
+    try:
+        return shared_library("bank_kernel", _source(), cflags, ("-lm",))
+    except NativeBuildError as e:
+        if cflags == PLAIN_CFLAGS:
+            raise
+        log.info("bank kernel: the build with %s failed, built plain: %s", " ".join(cflags), e)
+        return shared_library("bank_kernel", _source(), PLAIN_CFLAGS, ("-lm",))
+
+
 def _field_types() -> list[tuple[str, Any]]:
     """(name, dtype) of every field, read from the C source's FIELDS list."""
     body = _source().split("#define FIELDS", 1)[1].split("enum {", 1)[0]
@@ -175,68 +193,104 @@ class Kernel:
         self.fp[FP_T] = bank.T
         self.run_fn = lib.bank_kernel_run
         self.bound = False
-        self._keep: list[np.ndarray] = []
+        self._keep: list[Any] = []
+        self._fields_plan: list[tuple[int, str, str | None, str | None, Any]] | None = None
+        self._extra_key: Any = None
+        self._extra_last: dict[str, np.ndarray] | None = None
         self._args = (self.ptrs.ctypes.data, self.io.ctypes.data, self.fp.ctypes.data)
         self.buffer: np.ndarray | None = None
 
     def bind(self) -> None:
         """Take the addresses of the bank's current arrays (fixing dtype/layout in place
-        where the numpy cycle left another one, values unchanged)."""
+        where the numpy cycle left another one, values unchanged).
+
+        A bind follows every claim and release (it is on the GT calls' path): a field whose
+        array is the very object of the last bind keeps its checked address, and the arrays
+        built here (windows, placements) are built again only when what they hold changed."""
         bank, csp = self.bank, self.bank.csp
         if csp.din is csp._din_zero:
             csp.din = csp.din.copy()  # the shared zero row is never written into
+        extra = self._extra()
+        buf = bank.ctl.master.image.buffer
+        self.buffer = buf
+        extra["buf"] = buf
+        keep = self._keep
+        if len(keep) != len(_FIELDS):
+            keep = [None] * len(_FIELDS)
+        ptrs = self.ptrs
+        for i, name, owner, attr, dtype in self._plan():
+            if owner is None:
+                arr = extra[name] if attr is None else self.scratch[name]
+            else:
+                arr = getattr(bank if owner == "bank" else csp, attr)
+            if arr is keep[i]:
+                continue  # the same object as the last bind: its address was checked then
+            if owner is not None and (not _fits(arr, dtype) or not arr.flags.writeable):
+                arr = np.ascontiguousarray(arr, dtype=_array_type(dtype)).copy()
+                setattr(bank if owner == "bank" else csp, attr, arr)
+            if not _fits(arr, dtype):
+                raise TypeError(f"bank kernel: {name} is {arr.dtype}, not {np.dtype(dtype)}")
+            keep[i] = arr
+            ptrs[i] = arr.ctypes.data
+        self._keep = keep  # the addresses stay valid while these live
+        self.bound = True
+
+    def _plan(self) -> list[tuple[int, str, str | None, str | None, Any]]:
+        """(index, name, owner "bank"/"csp" or None for this binding's own arrays, the
+        attribute or None for an array built by :meth:`_extra`, dtype) of every field."""
+        plan = self._fields_plan
+        if plan is None:
+            extra = set(self._extra())
+            plan = []
+            for i, (name, dtype) in enumerate(_FIELDS):
+                if name in extra or name == "buf":
+                    plan.append((i, name, None, None, dtype))
+                elif name in self.scratch:
+                    plan.append((i, name, None, name, dtype))
+                elif name.startswith("c_"):
+                    plan.append((i, name, "csp", name[2:], dtype))
+                else:
+                    plan.append((i, name, "bank", name, dtype))
+            self._fields_plan = plan
+        return plan
+
+    def _extra(self) -> dict[str, np.ndarray]:
+        """The arrays this binding builds (windows, placements), the last ones again while
+        what they are built from is unchanged."""
+        csp = self.bank.csp
         windows = {value: (lo, hi) for value, lo, hi in csp.windows}
+        key = (
+            tuple((id(lo), id(hi), lo.shape) for lo, hi in windows.values()),
+            *self._placement_key(),
+        )
+        if key == self._extra_key and self._extra_last is not None:
+            return dict(self._extra_last)
         empty = np.zeros(1, _F64)
         extra: dict[str, np.ndarray] = {}
         io = self.io
-        for key, bit, slot in (
+        for name, bit, slot in (
             ("w2", 1 << 2, IN_W2),
             ("w16", 1 << 16, IN_W16),
             ("w17", 1 << 17, IN_W17),
         ):
             lo, hi = windows.get(bit, (empty, empty))
             io[slot] = lo.shape[1] if lo.ndim == 2 else 0
-            extra[key + "_lo"], extra[key + "_hi"] = lo, hi
-        extra.update(self._placements())
-        buf = bank.ctl.master.image.buffer
-        self.buffer = buf
-        extra["buf"] = buf
-        keep = []
-        # the arrays of the last bind that are still the same objects keep their checked
-        # address (a bind follows every claim and release: it is on the GT calls' path)
-        known = {id(a): (a, p) for a, p in zip(self._keep, self.ptrs.tolist(), strict=False)}
-        for i, (name, dtype) in enumerate(_FIELDS):
-            if name in extra:
-                arr = extra[name]
-            elif name in self.scratch:
-                arr = self.scratch[name]
-                hit = known.get(id(arr))
-                if hit is not None and hit[0] is arr:
-                    keep.append(arr)
-                    self.ptrs[i] = hit[1]
-                    continue
-            else:
-                owner, attr = (csp, name[2:]) if name.startswith("c_") else (bank, name)
-                arr = getattr(owner, attr)
-                hit = known.get(id(arr))
-                if hit is not None and hit[0] is arr:
-                    keep.append(arr)
-                    self.ptrs[i] = hit[1]
-                    continue
-                if not _fits(arr, dtype) or not arr.flags.writeable:
-                    arr = np.ascontiguousarray(arr, dtype=_array_type(dtype)).copy()
-                    setattr(owner, attr, arr)
-            if not _fits(arr, dtype):
-                raise TypeError(f"bank kernel: {name} is {arr.dtype}, not {np.dtype(dtype)}")
-            keep.append(arr)
-            self.ptrs[i] = arr.ctypes.data
-        self._keep = keep  # the addresses stay valid while these live
-        self.bound = True
+            extra[name + "_lo"], extra[name + "_hi"] = lo, hi
+        extra.update(self._placements(key[1]))
+        self._extra_key, self._extra_last = key, extra
+        return dict(extra)
 
-    def _placements(self) -> dict[str, np.ndarray]:
+    def _placement_key(self) -> tuple[Any, ...]:
+        """What :meth:`_placements` builds its arrays from."""
         bank = self.bank
+        alive, frz = bank.alive.tolist(), bank.frz.tolist()
         # a frozen row's image keeps what its scalar objects wrote
-        plc = [p for p in bank._plc if bank.alive[p[0]] and not bank.frz[p[0]]]
+        plc = tuple(p for p in bank._plc if alive[p[0]] and not frz[p[0]])
+        return plc, tuple(bank._rx_idx), bytes(bank._rx_ref) if bank._rx_ref else b""
+
+    def _placements(self, plc: tuple[Any, ...]) -> dict[str, np.ndarray]:
+        """``plc``: the placements of the rows the kernel writes (:meth:`_placement_key`)."""
+        bank = self.bank
         self.io[IN_N_PLC] = len(plc)
         rx = np.asarray(bank._rx_idx, np.int64)
         self.io[IN_N_RX] = len(rx)

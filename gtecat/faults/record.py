@@ -25,9 +25,11 @@ deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session re
 from __future__ import annotations
 
 import ctypes
+import gc
 import gzip
 import json
 import os
+import re
 import threading
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -379,10 +381,8 @@ def _show(v: Any) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
-def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """(header, entries) of a recording.  Calls that differ only in their time are one
-    shared entry (an application polls the same way thousands of times): read them, never
-    change them."""
+def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
+    """(path, header, the lines after it) of a recording."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -397,10 +397,29 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
+    return p, head, lines[1:]
+
+
+def _damaged(p: Path, lines: list[str]) -> ParameterError:
+    """The error for a recording with a line that is not one entry: which line."""
+    for no, line in enumerate(lines, 2):
+        try:
+            if line.strip() and not isinstance(json.loads(line), dict):
+                raise json.JSONDecodeError("not an entry (a JSON object)", line, 0)
+        except json.JSONDecodeError as err:
+            return ParameterError(f"{p}: damaged recording: line {no}: {err}")
+    return ParameterError(f"{p}: damaged recording")
+
+
+def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """(header, entries) of a recording.  Calls that differ only in their time are one
+    shared entry (an application polls the same way thousands of times): read them, never
+    change them."""
+    p, head, lines = _open(path)
     texts: list[str] = []  # the distinct lines, parsed at once below
     order: list[int] = []  # each entry's line in texts
     same: dict[str, int] = {}  # a call's line without its time -> its place in texts
-    for line in lines[1:]:
+    for line in lines:
         if line.startswith('{"t":'):  # as Recorder writes a call: the time first
             rest = line[line.find(",", 5) :]
             k = same.get(rest)
@@ -416,26 +435,8 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         if len(parsed) != len(texts) or not all(type(x) is dict for x in parsed):
             raise json.JSONDecodeError("a line that is not one entry", "", 0)
     except json.JSONDecodeError:
-        for no, line in enumerate(lines[1:], 2):  # which line
-            try:
-                if line.strip() and not isinstance(json.loads(line), dict):
-                    raise json.JSONDecodeError("not an entry (a JSON object)", line, 0)
-            except json.JSONDecodeError as err:
-                raise ParameterError(f"{p}: damaged recording: line {no}: {err}") from None
-        raise ParameterError(f"{p}: damaged recording") from None
+        raise _damaged(p, lines) from None
     return head, [parsed[k] for k in order]
-
-
-def replay(
-    path: str | Path,
-    *,
-    eni: str | None = None,
-    machine: str | None = None,
-) -> tuple[int, Divergence | None]:
-    """Re-run a recording; (calls replayed, the first divergence or None)."""
-    head, entries = read(path)
-    with _where(head):
-        return _replay(entries, eni, machine)
 
 
 @contextmanager
@@ -470,76 +471,201 @@ def _where(head: dict[str, Any]) -> Any:
                 os.environ[k] = v
 
 
+def replay(
+    path: str | Path,
+    *,
+    eni: str | None = None,
+    machine: str | None = None,
+) -> tuple[int, Divergence | None]:
+    """Re-run a recording; (calls replayed, the first divergence or None).
+
+    The recording's entries are read with the cyclic collector paused (a hundred thousand
+    objects made at once, none in a cycle: the collector would walk them again and again
+    while they are made, as Controller.init_ecat says of the bus model), and they are kept
+    out of its later walks while the calls run (``gc.freeze``)."""
+    p, head, lines = _open(path)
+    paused = gc.isenabled()
+    if paused:
+        gc.disable()
+    try:
+        steps = _steps(p, lines)
+    finally:
+        if paused:
+            gc.enable()
+    del lines
+    freeze = gc.get_freeze_count() == 0  # (a process that froze its own objects: left so)
+    if freeze:
+        gc.freeze()
+    try:
+        with _where(head):
+            return _replay(steps, eni, machine)
+    finally:
+        if freeze:
+            gc.unfreeze()
+
+
 @dataclass(slots=True)
 class _Call:
-    """One recorded call made ready to run again (once per distinct entry)."""
+    """One recorded call made ready to run again: once per distinct entry, or once per
+    *form* of entry (:func:`_steps`), the values that differ from one call of the form to the
+    next (what its pointers held before the call and after it) given beside it as ``vals``."""
 
     fn: Any
     name: str
     args: list[Any]  # the arguments; a pooled pointer is its byref, a fresh one None
-    sets: list[tuple[Any, Any]]  # (pooled object, the value it held at the call)
+    sets: list[tuple[Any, int]]  # (pooled object, the value it held at the call: vals[k])
     fresh: list[tuple[int, Any]]  # (index, encoding): an object built anew for every call
     kw: dict[str, Any] | None  # encoded keywords (None: none)
     rc: Any
-    #: what the call leaves in its pointer arguments: (index or keyword, the recorded value,
-    #: the pooled object and its plain recorded value for a quick look, or None, None)
-    checks: list[tuple[int | str, Any, Any, Any]]
+    #: what the call leaves in its pooled pointers: (the object, vals[k] it must hold, its
+    #: argument's index, the recorded type's name); compared by value, the full encoding
+    #: only when they differ
+    quick: list[tuple[Any, int, int, str]]
+    #: what the call leaves in its other pointer arguments: (index or keyword, the recorded
+    #: value), compared encoded
+    checks: list[tuple[int | str, Any]]
     before: int | None  # "b": the controller time the call began at
     opens: bool  # GT_Open: the replay's own settings
+    #: the call in one compiled function (:func:`_compiled`), None: the loop runs it
+    run: Any = None
 
 
 def _prepare(
     e: dict[str, Any], fn: Any, pool: dict[tuple[str, int, str], tuple[Any, Any]]
-) -> _Call:
+) -> tuple[_Call, tuple[Any, ...]]:
+    """``e`` made ready: (the call, its values).  The values are those of its pointers to
+    simple values, in the order of the line: what each held before the call, then what
+    the call left in them (``"o"``)."""
     name = e["c"]
     a = e["a"]
     outs = e.get("o") or {}
     args: list[Any] = []
-    sets: list[tuple[Any, Any]] = []
+    vals: list[Any] = []
+    sets: list[tuple[Any, int]] = []
     fresh: list[tuple[int, Any]] = []
-    checks: list[tuple[int | str, Any, Any, Any]] = []
+    pooled: list[tuple[int, Any, int, Any]] = []  # (index, object, its slot, its encoding)
+    checks: list[tuple[int | str, Any]] = []
     for i, x in enumerate(a):
         if not isinstance(x, dict):
             args.append(x)
             continue
-        want = outs.get(str(i), x)  # not in "o": the call left the value as it was
         ref = x.get("ref")
         if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
             # a pointer to a simple value: one object per function and argument, set to the
             # recorded value before each call (an application polls with the same variable:
             # so does the replay, and the GT layer's fast path recognises it)
-            key = (name, i, ref["c"])
-            hit = pool.get(key)
-            if hit is None:
-                obj = _SIMPLE.get(ref["c"], ctypes.c_long)()
-                hit = pool[key] = (obj, ctypes.byref(obj))
-            obj = hit[0]
-            sets.append((obj, ref["v"]))
-            args.append(hit[1])
-            w = want.get("ref") if isinstance(want, dict) and len(want) == 1 else None
-            quick = (
-                isinstance(w, dict)
-                and len(w) == 2
-                and w.get("c") == type(obj).__name__
-                and "v" in w
-                and not isinstance(w["v"], dict)
-            )
-            checks.append((i, want, obj if quick else None, w["v"] if quick else None))
+            obj, p = _pooled(pool, name, i, ref["c"])
+            pooled.append((i, obj, len(vals), x))
+            sets.append((obj, len(vals)))
+            vals.append(ref["v"])
+            args.append(p)
             continue
         fresh.append((i, x))
         args.append(None)
         if str(i) in outs or _round_trips(x):
-            checks.append((i, want, None, None))
+            checks.append((i, outs.get(str(i), x)))  # not in "o": left as it was
+    slots = {}
+    for k, w in outs.items():
+        slots[k] = len(vals)
+        r = w.get("ref") if isinstance(w, dict) and len(w) == 1 else None
+        vals.append(r.get("v") if isinstance(r, dict) else None)
+    quick: list[tuple[Any, int, int, str]] = []
+    for i, obj, slot, x in pooled:
+        want = outs.get(str(i), x)  # not in "o": the call left the value as it was
+        w = want.get("ref") if isinstance(want, dict) and len(want) == 1 else None
+        if (
+            isinstance(w, dict)
+            and len(w) == 2
+            and w.get("c") == type(obj).__name__
+            and "v" in w
+            and not isinstance(w["v"], dict)
+        ):
+            quick.append((obj, slots.get(str(i), slot), i, w["c"]))
+        else:
+            checks.append((i, want))
     kw = e.get("k")
     for k, want in outs.items():
         if not k.isdigit():
-            checks.append((k, want, None, None))
+            checks.append((k, want))
     for k, x in (kw or {}).items():
         if k not in outs and isinstance(x, dict) and _round_trips(x):
-            checks.append((k, x, None, None))
-    return _Call(
-        fn, name, args, sets, fresh, kw, e["r"], checks, e.get("b"), name in ("GT_Open", "GTN_Open")
+            checks.append((k, x))
+    call = _Call(
+        fn,
+        name,
+        args,
+        sets,
+        fresh,
+        kw,
+        e["r"],
+        quick,
+        checks,
+        e.get("b"),
+        name in ("GT_Open", "GTN_Open"),
     )
+    if call.before is None and not fresh and kw is None and not call.opens and not checks:
+        call.run = _compiled(call)
+    return call, tuple(vals)
+
+
+_DAMAGED = (TypeError, ValueError, KeyError, AttributeError)
+
+
+def _compiled(p: _Call) -> Any:
+    """``run(vals)``: the call of ``p`` made as the replay loop makes it (the pooled pointers
+    set, the function called, its return code and the values it left compared), compiled
+    into one function: None when everything matched, ``(rc,)`` when something may differ
+    (the loop compares in full and reports), an exception when a value cannot be set."""
+    fn, rc0, args = p.fn, p.rc, tuple(p.args)
+    if not p.sets and not p.quick:  # GTE_Wait(10), GT_Update(mask): no pointer at all
+
+        def run_plain(vals: Any) -> Any:
+            rc = fn(*args)
+            return None if rc == rc0 else (rc,)
+
+        return run_plain
+    if len(p.sets) == 1 and len(p.quick) == 1:  # GT_GetSts(axis, &s): a polled reader
+        ((obj, k),) = p.sets
+        ((out, k_out, _, _),) = p.quick
+
+        def run_one(vals: Any) -> Any:
+            try:
+                obj.value = vals[k]
+            except _DAMAGED as err:
+                return err
+            rc = fn(*args)
+            return None if rc == rc0 and out.value == vals[k_out] else (rc,)
+
+        return run_one
+    env: dict[str, Any] = {"fn": p.fn, "RC": p.rc, "_DAMAGED": _DAMAGED}
+    lines = ["def run(vals):"]
+    if p.sets:
+        lines.append("    try:")
+        for j, (obj, k) in enumerate(p.sets):
+            env[f"S{j}"] = obj
+            lines.append(f"        S{j}.value = vals[{k}]")
+        lines += ["    except _DAMAGED as err:", "        return err"]
+    for j, a in enumerate(p.args):
+        env[f"A{j}"] = a
+    lines.append(f"    rc = fn({', '.join(f'A{j}' for j in range(len(p.args)))})")
+    same = ["rc != RC", *(f"Q{j}.value != vals[{k}]" for j, (_, k, _, _) in enumerate(p.quick))]
+    for j, (obj, _, _, _) in enumerate(p.quick):
+        env[f"Q{j}"] = obj
+    lines += [f"    if {' or '.join(same)}:", "        return (rc,)", "    return None"]
+    exec(compile("\n".join(lines), f"<replay {p.name}>", "exec"), env)
+    return env["run"]
+
+
+def _pooled(
+    pool: dict[tuple[str, int, str], tuple[Any, Any]], name: str, i: int, c: str
+) -> tuple[Any, Any]:
+    """The object (and its byref) a pointer argument of ``c`` uses in replay."""
+    key = (name, i, c)
+    hit = pool.get(key)
+    if hit is None:
+        obj = _SIMPLE.get(c, ctypes.c_long)()
+        hit = pool[key] = (obj, ctypes.byref(obj))
+    return hit
 
 
 def _round_trips(x: Any) -> bool:
@@ -552,8 +678,187 @@ def _round_trips(x: Any) -> bool:
     return _mutable(v) and encode(v) == x
 
 
+#: the value of a pointer to a simple value in a recorded call: its JSON number
+_NUMBER = re.compile(r"-?(?:0|[1-9]\d*)(\.\d+)?([eE][+-]?\d+)?")
+_V = '"v":'
+
+
+def _form(e: dict[str, Any]) -> int:
+    """How many values a call of this form has (``"v":`` numbers, in the order of the line),
+    or -1 when the entry is not of a simple form: plain arguments and pointers to simple
+    values (``{"ref": {"c": "c_long", "v": 5}}``), the values those hold after the call in
+    ``"o"``, no keywords.  Such an entry's values all come from :func:`_prepare`'s pooled
+    pointers, in the same order, so one prepared call serves every line of the form."""
+    if "k" in e or type(e.get("a")) is not list or type(e.get("r")) is not int:
+        return -1
+    keys = list(e)
+    if "o" in e and keys.index("o") < keys.index("a"):  # the values' order is the line's
+        return -1
+    a = e["a"]
+    n = 0
+    for x in a:
+        if type(x) is dict:
+            ref = x.get("ref")
+            if (
+                len(x) != 1
+                or type(ref) is not dict
+                or len(ref) != 2
+                or type(ref.get("c")) is not str
+                or _SIMPLE_NAME.get(_SIMPLE.get(ref["c"])) != ref["c"]  # type: ignore[arg-type]
+                or type(ref.get("v")) not in (int, float)
+            ):
+                return -1
+            n += 1
+    outs = e.get("o", {})
+    if type(outs) is not dict:
+        return -1
+    for k, w in outs.items():
+        if not k.isdigit() or int(k) >= len(a) or type(a[int(k)]) is not dict:
+            return -1
+        ref = w.get("ref") if type(w) is dict and len(w) == 1 else None
+        if (
+            type(ref) is not dict
+            or len(ref) != 2
+            or ref.get("c") != a[int(k)]["ref"]["c"]
+            or type(ref.get("v")) not in (int, float)
+        ):
+            return -1
+        n += 1
+    return n
+
+
+def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
+    """The recording's entries made ready to run: ``(call, its values)`` for a call,
+    ``(None, entry)`` for a checkpoint or a fault, ``(_Stop, why)`` where a call cannot be
+    made again (reported when the replay gets there).
+
+    Calls that differ only in their time share one step: each distinct line (without the
+    time) is made ready once, and the work done for every line is a few operations on the
+    whole list.  Calls that differ only in the numbers their pointers held (a polling loop's
+    clock and positions) share one prepared call: the line with those numbers taken out is
+    the form's key, the numbers are read from the line (:data:`_NUMBER`, as JSON reads
+    them) and the first line of each form is parsed and checked whole (:func:`_form`); a
+    line of any other form is parsed whole."""
+    from .. import gt
+
+    pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
+    forms: dict[str, Any] = {}  # a line without its time and values -> its call (or None)
+    number = _NUMBER.match
+
+    def parse(key: str) -> Any:
+        try:
+            e = json.loads("{" + key[1:] if key[:1] == "," else key)
+        except ValueError as err:  # JSONDecodeError, an integer too long to read
+            raise ParameterError(
+                f"{p}: damaged recording: line {keys.index(key) + 2}: {err}"
+            ) from None
+        if type(e) is not dict:
+            raise ParameterError(
+                f"{p}: damaged recording: line {keys.index(key) + 2}: not an entry (a JSON object)"
+            )
+        return e
+
+    def prepare(e: dict[str, Any]) -> tuple[Any, Any]:
+        name = e.get("c")
+        fn = getattr(gt, name, None) if type(name) is str else None
+        if fn is None:
+            return _Stop, ("missing", name)
+        try:
+            return _prepare(e, fn, pool)
+        except (KeyError, TypeError, ValueError, AttributeError) as err:
+            return _Stop, ("damaged", f"({name}) cannot be made again: {type(err).__name__}: {err}")
+
+    def numbers(key: str) -> tuple[str, list[Any]] | None:
+        """(the form's key, the numbers) of a call's line, one number at a time."""
+        parts = key.split(_V)
+        vals: list[Any] = []
+        for k in range(1, len(parts)):
+            part = parts[k]
+            m = number(part)
+            if m is None:
+                return None
+            lit = m.group()
+            try:
+                vals.append(float(lit) if m.lastindex else int(lit))
+            except ValueError:  # an integer too long to read: as JSON reads it, below
+                return None
+            parts[k] = part[m.end() :]
+        return _V.join(parts), vals
+
+    def step(key: str, split: tuple[str, list[Any]] | None) -> tuple[Any, Any]:
+        if split is not None and split[1]:
+            form_key, vals = split
+            form = forms.get(form_key, _NO)
+            if form is _NO:  # the first line of this form
+                form = forms[form_key] = None
+                e = parse(key)
+                if _form(e) == len(vals):
+                    call = prepare(e)[0]
+                    if call is not _Stop and not call.checks and not call.fresh:
+                        form = forms[form_key] = call
+            if form is not None:
+                return form, tuple(vals)
+        e = parse(key)
+        return (None, e) if "c" not in e else prepare(e)
+
+    # a call's line without its time (from the comma after it), any other line whole
+    keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
+    made = dict.fromkeys(keys)
+    made.pop("", None)  # the empty line after the last
+    calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
+    for key, split in zip(calls, _numbers(calls) or map(numbers, calls), strict=True):
+        made[key] = step(key, split)
+    for key in made:
+        if made[key] is None and key.strip():
+            made[key] = step(key, None)
+    return [s for s in map(made.get, keys) if s is not None]
+
+
+_NUMBER_START = frozenset("-0123456789")
+
+
+def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
+    """(the form's key, the numbers) of each call's line, the numbers of all of them read
+    in one JSON parse (the numbers of pointers to simple values end at their ``}``); None
+    when any of them is not a plain JSON number (each line is then read on its own)."""
+    out: list[Any] = []
+    lits: list[str] = []
+    for key in calls:
+        parts = key.split(_V)
+        if len(parts) == 1:
+            out.append((key, []))
+            continue
+        first = len(lits)
+        for k in range(1, len(parts)):
+            part = parts[k]
+            j = part.find("}")
+            if j < 0 or part[:1] not in _NUMBER_START:  # a structure, an array, text
+                break
+            lits.append(part[:j])
+            parts[k] = part[j:]
+        else:
+            out.append((_V.join(parts), first, len(lits)))
+            continue
+        del lits[first:]
+        out.append(None)
+    try:
+        values = json.loads("[" + ",".join(lits) + "]")
+    except ValueError:
+        return None
+    if len(values) != len(lits) or not all(type(v) is int or type(v) is float for v in values):
+        return None
+    return [x if x is None or len(x) == 2 else (x[0], values[x[1] : x[2]]) for x in out]
+
+
+_NO: Any = object()
+
+
+class _Stop:
+    """A step that ends the replay: a divergence (a function gtecat lacks) or an error."""
+
+
 def _replay(
-    entries: list[dict[str, Any]], eni: str | None, machine: str | None
+    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None
 ) -> tuple[int, Divergence | None]:
     from .. import faults, gt
 
@@ -561,69 +866,41 @@ def _replay(
     machine = str(Path(machine).resolve()) if machine else None
     gt.GT_Close()
     n = 0
-    pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
-    ready: dict[int, _Call] = {}  # id(entry) -> the call (entries that differ only in time
-    # are one object: see read)
     try:
-        for e in entries:
-            p = ready.get(id(e))
+        for p, vals in steps:
             if p is None:
-                if "c" not in e:
-                    div = _other(e, n, faults)
-                    if div is not None:
-                        return n, div
-                    continue
-                fn = getattr(gt, e["c"], None) if type(e["c"]) is str else None
-                if fn is None:
-                    return n + 1, Divergence(n + 1, e["c"], "function", "present", "missing")
-                try:
-                    p = ready[id(e)] = _prepare(e, fn, pool)
-                except (KeyError, TypeError, ValueError, AttributeError) as err:
-                    raise ParameterError(
-                        f"damaged recording: call {n + 1} ({e['c']}) cannot be made again: "
-                        f"{type(err).__name__}: {err}"
-                    ) from None
+                div = _other(vals, n, faults)
+                if div is not None:
+                    return n, div
+                continue
             n += 1
-            if p.before is not None:  # time passed between the calls: let it pass here too
-                ctl = _controller()
-                if ctl is not None:
-                    gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
-                    if gap > 0:
-                        ctl.clock.advance_ns(gap)
-            args = p.args
-            try:
-                for obj, v in p.sets:
-                    obj.value = v
-                if p.fresh:
-                    args = list(args)
-                    for i, x in p.fresh:
-                        args[i] = decode(x)
-            except (TypeError, ValueError, KeyError, AttributeError) as err:
-                raise ParameterError(
-                    f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                    f"again: {type(err).__name__}: {err}"
-                ) from None
-            if p.kw is None and not p.opens:
-                kw: dict[str, Any] = {}
-                rc = p.fn(*args)
+            if p is _Stop:
+                what, text = vals
+                if what == "missing":
+                    return n, Divergence(n, text, "function", "present", "missing")
+                raise ParameterError(f"damaged recording: call {n} {text}")
+            run = p.run
+            if run is not None:  # the common call, compiled: compared in full only if it may differ
+                r = run(vals)
+                if r is None:
+                    continue
+                if type(r) is not tuple:
+                    raise ParameterError(
+                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+                        f"again: {type(r).__name__}: {r}"
+                    )
+                args, kw, rc = p.args, {}, r[0]
             else:
-                kw = {k: decode(v) for k, v in (p.kw or {}).items()}
-                if p.opens:
-                    if eni:
-                        kw["eni"] = str(eni)
-                    if machine:
-                        kw["machine"] = str(machine)
-                    if kw.get("clock") == "realtime":
-                        kw["clock"] = "auto"
-                    if kw.get("backend") == "pysoem":
-                        kw["backend"] = "emulated"
-                    kw["log"] = ""  # the session's master log is not written again
-                rc = p.fn(*args, **kw)
+                args, kw, rc = _call(p, vals, n, eni, machine)
             if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
                 return n, Divergence(n, p.name, "return code", p.rc, rc)
-            for where, want, obj, v in p.checks:
-                if obj is not None and obj.value == v:
-                    continue
+            for obj, k, i, c in p.quick:
+                if obj.value != vals[k]:
+                    want = {"ref": {"c": c, "v": vals[k]}}
+                    got = encode(args[i])
+                    if got != want:
+                        return n, Divergence(n, p.name, f"argument {i + 1}", want, got)
+            for where, want in p.checks:
                 got = encode(args[where] if type(where) is int else kw.get(where))
                 if got != want:
                     what = f"argument {where + 1}" if type(where) is int else where
@@ -631,6 +908,45 @@ def _replay(
     finally:
         gt.GT_Close()
     return n, None
+
+
+def _call(
+    p: _Call, vals: Any, n: int, eni: str | None, machine: str | None
+) -> tuple[Any, dict[str, Any], Any]:
+    """Call ``n`` made as recorded (the general way): (its arguments, keywords, code)."""
+    if p.before is not None:  # time passed between the calls: let it pass here too
+        ctl = _controller()
+        if ctl is not None:
+            gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
+            if gap > 0:
+                ctl.clock.advance_ns(gap)
+    args = p.args
+    try:
+        for obj, k in p.sets:
+            obj.value = vals[k]
+        if p.fresh:
+            args = list(args)
+            for i, x in p.fresh:
+                args[i] = decode(x)
+    except _DAMAGED as err:
+        raise ParameterError(
+            f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+            f"again: {type(err).__name__}: {err}"
+        ) from None
+    if p.kw is None and not p.opens:
+        return args, {}, p.fn(*args)
+    kw = {k: decode(v) for k, v in (p.kw or {}).items()}
+    if p.opens:
+        if eni:
+            kw["eni"] = str(eni)
+        if machine:
+            kw["machine"] = str(machine)
+        if kw.get("clock") == "realtime":
+            kw["clock"] = "auto"
+        if kw.get("backend") == "pysoem":
+            kw["backend"] = "emulated"
+        kw["log"] = ""  # the session's master log is not written again
+    return args, kw, p.fn(*args, **kw)
 
 
 def _other(e: dict[str, Any], n: int, faults: Any) -> Divergence | None:

@@ -39,9 +39,9 @@ from ..errors import (
     NoSlavesError,
     ParameterError,
 )
-from ..master.clock import ClockGroup
-from .args import Ref, binder, core_arg
-from .fast import RAW, READERS, fast_raw, fast_reader
+from ..master.clock import ClockGroup, ClockMode
+from .args import _NUMERIC, Ref, binder, core_arg, fast_binder
+from .fast import CLOCK, RAW, READERS, fast_clock, fast_raw, fast_reader
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -236,6 +236,7 @@ def close_all() -> None:
     SESSION.core = 1
 
 
+_AUTO = ClockMode.AUTO
 REGISTRY: dict[str, Callable[..., int]] = {}
 #: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
 #: a controller process then runs every call through REGISTRY, none on a fast path
@@ -287,8 +288,16 @@ class _Refusal(Exception):
 def advance(ctl: Any, name: str, rc: int) -> int:
     """The host-call latency after a GT call (cycles may run, programs step): whatever they
     raise is turned into a code and a reason like the call's own errors, never let out."""
+    clock = ctl.clock
+    if clock.mode is _AUTO and clock.group is None:
+        # Clock.on_call in the common case, inline: the latency runs no cycle and no other
+        # clock shares this one's time
+        pending = clock._pending_ns + clock.call_latency_ns
+        if pending < clock.cycle_ns:
+            clock._pending_ns = pending
+            return rc
     try:
-        ctl.clock.on_call()
+        clock.on_call()
     except Exception as e:
         code = code_for(e)
         if code == CMD_NO_RESPONSE:
@@ -323,9 +332,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
-        ctl = None
         before = SESSION.last
-        gtn = core is not _ONE
+        gtn = core is not _GT
         try:
             address = _attach_address(kwargs) if opens else ""
             if gtn:
@@ -335,18 +343,31 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             else:
                 core = SESSION.core  # GT_SetCore: 1 unless the program chose another
             values, extra = bind(args, kwargs)
+        except Exception as e:
+            return failed(e, None, core, before)
+        return run(core, values, extra, address, before, gtn)
+
+    def run(
+        core: int, values: Any, extra: dict, address: str, before: Any, gtn: bool = False
+    ) -> int:
+        """The call with its arguments bound (``core``: the core it addresses; ``gtn``: the
+        ``GTN_`` twin was called)."""
+        ctl = None
+        try:
             if address or SESSION.remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
 
                 rc = remote_call(SESSION, name, gtn, core, values, extra, address)
             elif needs_ctl:
-                ctl = SESSION.controller(core)
+                ctl = SESSION.controllers.get(1) if core == 1 else None
+                if ctl is None:
+                    ctl = SESSION.controller(core)
                 if card_refused and ctl.card is not None:  # an EtherCAT function on a card
                     raise CommandError(ctl.card.refusal(name))
                 bank = ctl.bank
                 if bank is not None and not bank_read:
                     bank.before_call(ctl, proto, values)  # the axes it names go back first
-                if ctl.clock.threaded:
+                if ctl.clock._thread is not None:
                     with ctl.clock.lock:  # atomic with respect to the cycle thread
                         rc = fn(ctl, *values, **extra)
                 else:
@@ -357,14 +378,27 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             if rc == 0:
                 # GTE_GetLastError speaks of the most recent call only: nothing, or a note
                 # of something the call found wrong without failing (note())
-                note_text, SESSION.note = SESSION.note, None
-                SESSION.last = None if note_text is None else _note(name, note_text)
+                if SESSION.note is None:
+                    SESSION.last = None
+                else:
+                    note_text, SESSION.note = SESSION.note, None
+                    SESSION.last = _note(name, note_text)
             elif SESSION.last is before:  # no reason recorded by a call made inside
                 _record(name, rc, "no reason given")
-        except _Refusal as r:
-            rc = r.code
-            _record(name, rc, str(r))
-        except Exception as e:  # the GT layer never raises
+        except Exception as e:
+            return failed(e, ctl, core, before)
+        if ctl is None:
+            ctl = SESSION.controllers.get(core)
+        if ctl is not None:
+            rc = advance(ctl, name, rc)
+        return rc
+
+    def failed(e: Exception, ctl: Any, core: Any, before: Any) -> int:
+        """The code and reason of an exception the call raised (the GT layer never raises)."""
+        if isinstance(e, _Refusal):
+            rc = e.code
+            _record(name, rc, str(e))
+        else:
             rc = code_for(e)
             if rc == CMD_NO_RESPONSE:
                 log.error("%s: internal error\n%s", name, traceback.format_exc())
@@ -377,15 +411,27 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             rc = advance(ctl, name, rc)
         return rc
 
+    compiled: list[Any] = []  # the compiled binder, made at the first call (args.fast_binder)
+
+    def quick(args: tuple) -> Any:
+        """``args`` bound by the compiled binder (None: not a plain shape)."""
+        if not compiled:
+            compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
+        return compiled[0](*args)
+
     @functools.wraps(fn)
     def gt(*args: Any, **kwargs: Any) -> int:
-        return call(_ONE, args, kwargs)
+        if not kwargs and not opens:
+            values = quick(args)
+            if values is not None:
+                return run(SESSION.core, values, _NO_KW, "", SESSION.last)
+        return call(_GT, args, kwargs)
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    if name in READERS or name in RAW:  # the common shapes answered up front (gtecat.gt.fast)
+    if name in READERS or name in RAW or name == CLOCK:  # common shapes up front (gt.fast)
         slow = gt
-        make = fast_reader if name in READERS else fast_raw
+        make = fast_reader if name in READERS else fast_raw if name in RAW else fast_clock
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn_sig)  # type: ignore[attr-defined]
@@ -403,7 +449,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     if args:
                         return call(args[0], args[1:], kwargs)
                     return call(kwargs.pop("core"), (), kwargs)
-                return call(_ONE, args, kwargs)
+                return call(_GT, args, kwargs)
 
         else:
 
@@ -420,6 +466,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     return call(args[0], args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 
+        if fast is not None and hasattr(fast, "gtn"):  # the reader's own GTN_ fast path
+            fast.gtn_slow = gtn  # type: ignore[attr-defined]  # every other shape
+            gtn = functools.wraps(gtn)(fast.gtn)  # type: ignore[attr-defined]
         gtn.__name__ = "GTN_" + name[3:]
         gtn.__doc__ = with_units(
             name,
@@ -432,7 +481,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     return gt
 
 
-_ONE = object()  # GT_x: core 1 without a check
+_GT: Any = object()  # GT_x: the session's core (GT_SetCore), no core argument
+_NO_KW: dict = {}  # (never written: the implementations take no keywords from a plain call)
 
 
 def _attach_address(kwargs: dict) -> str:
@@ -477,7 +527,36 @@ def last_error() -> LastError | None:
 def store(ptr: Ref | None, value: Any) -> None:
     """``*ptr = value`` (None = an optional NULL pointer: nothing is written)."""
     if ptr is not None:
+        keep = ptr._keep
+        t = type(keep)
+        if t is ptr.elem and ptr.nbytes == _sizeof(t):  # byref(x) or x: Ref's common case
+            bounds = _PLAIN.get(t, _NOT_PLAIN)
+            if bounds is None:  # a double: as Ref.store_values writes it
+                keep.value = value
+                return
+            if type(value) is int and bounds is not _NOT_PLAIN and bounds[0] <= value <= bounds[1]:
+                keep.value = value
+                return
         ptr.store_values([value])
+
+
+def _plain_numbers() -> dict[type, tuple[int, int] | None]:
+    """The ctypes number types :meth:`Ref.store_values` writes as ``x.value = v``: None for
+    the floating ones (any value), else the integer range (the others: its checks)."""
+    out: dict[type, tuple[int, int] | None] = {}
+    for t in _NUMERIC:
+        if t._type_ in "fdg":
+            out[t] = None
+        else:
+            bits = 8 * ctypes.sizeof(t)
+            signed = t._type_.islower()
+            out[t] = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+    return out
+
+
+_PLAIN = _plain_numbers()
+_NOT_PLAIN: Any = object()
+_sizeof = ctypes.sizeof
 
 
 def store_array(ptr: Ref | None, values: list[Any]) -> None:

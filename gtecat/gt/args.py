@@ -34,6 +34,7 @@ import ctypes
 import inspect
 import math
 import numbers
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -753,7 +754,182 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
                     _check_room(params[i], ref, k)
         return out, extra
 
+    bind.convs = convs  # type: ignore[attr-defined]  # (fast_binder compiles with them)
     return bind
+
+
+# --- the compiled binder ----------------------------------------------------------------------
+def _carg_address_offset() -> int | None:
+    """Where a ``byref()`` object keeps the address it passes, in bytes from its start.
+
+    ctypes offers no reader for it (``byref(obj, offset)`` looks like ``byref(obj)``), and
+    its repr costs a microsecond; the field's place in CPython's ``PyCArgObject`` is found
+    here by probing objects whose addresses are known, and used only when every probe,
+    with and without an offset, agrees.  None: not found (the slower ways are used)."""
+    try:
+        size = sys.getsizeof(ctypes.byref(ctypes.c_int()))
+        objs = [ctypes.c_long(), ctypes.c_int(), ctypes.c_double(), (ctypes.c_long * 3)()]
+        for k in range(16, size - 7, 8):
+            ok = True
+            for obj in objs:
+                for off in (0, 4, 8):
+                    p = ctypes.byref(obj, off)
+                    if ctypes.c_void_p.from_address(id(p) + k).value != ctypes.addressof(obj) + off:
+                        ok = False
+            if ok:
+                return k
+    except Exception:  # another implementation
+        return None
+    return None
+
+
+#: see :func:`_carg_address_offset`
+CARG_AT = _carg_address_offset() if sys.implementation.name == "cpython" else None
+_from_address = ctypes.c_void_p.from_address
+
+
+def byref_address(p: Any) -> int:
+    """The address ``byref(obj[, offset])`` passes (where ctypes keeps it, or memmove's)."""
+    if CARG_AT is not None:
+        return _from_address(id(p) + CARG_AT).value or 0
+    return _address(p)
+
+
+def _numeric_types() -> list[type]:
+    out = []
+    for name in dir(ctypes):
+        t = getattr(ctypes, name)
+        if (
+            name.startswith("c_")
+            and isinstance(t, type)
+            and issubclass(t, _SIMPLE)
+            and t._type_ not in _NOT_NUMERIC
+            and t not in out
+        ):
+            out.append(t)
+    return out
+
+
+_NUMERIC = _numeric_types()
+
+
+def _scalar_types(p: Param) -> frozenset[type]:
+    """The ctypes types whose ``byref(x)`` (or ``x`` itself) the table path takes for ``p``
+    as one plain value (:func:`check_kind` passes; :meth:`Ref.store_values` writes ``x.value``)."""
+    ok = set()
+    for t in _NUMERIC:
+        try:
+            check_kind(p, Ref(p.name, 0, ctypes.sizeof(t), t))
+        except ParameterError:
+            continue
+        ok.add(t)
+    return frozenset(ok)
+
+
+def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
+    """The table's checks of ``proto``'s arguments compiled into one function (declare once,
+    generate the rest): ``bind(*args)`` -> the converted values, exactly what
+    :func:`binder`'s ``bind`` gives for them, or None when any argument is not of a plain
+    shape (a plain int or float in range, ``byref(x)`` or ``x`` of a ctypes number the
+    pointer takes, None or 0 for an optional pointer, an omitted argument with a default,
+    no more arguments than parameters) or the generic conversion (``convs``, one per
+    parameter) refused it: the caller then binds through :func:`binder`, which gives the
+    value or the refusal with its reason.  Never raises."""
+    params = proto.params
+    env: dict[str, Any] = {
+        "_CArg": _CArgObject,
+        "_addressof": ctypes.addressof,
+        "_sizeof": ctypes.sizeof,
+        "_byref_address": byref_address,
+        "_check_room": _check_room,
+        "Ref": Ref,
+        "_MISSING": _MISSING,
+        "_INF": _INF,
+        "P": params,
+    }
+    env["_from_address"] = _from_address
+
+    def where(a: str) -> str:  # the address a byref() passes
+        if CARG_AT is None:
+            return f"_byref_address({a})"
+        return f"_from_address(id({a}) + {CARG_AT}).value"
+
+    sig, body, out = [], [], []
+    for i, p in enumerate(params):
+        a, v = f"a{i}", f"v{i}"
+        try:
+            d = p.default_value()
+        except KeyError:  # an optional pointer left out is NULL (Python callers omit them)
+            d = None if p.optional else _MISSING
+        env[f"D{i}"] = d
+        env[f"C{i}"] = convs[i]
+        sig.append(f"{a}=D{i}")
+        if d is _MISSING:
+            body.append(f"if {a} is _MISSING: return None")
+        scalar = p.ctype in SCALARS or p.ctype in ENUMS
+        if not p.pointer and not p.is_float and scalar:
+            _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]
+            if p.mask:
+                lo, hi = min(lo, -(1 << 31)), max(hi, (1 << 32) - 1)
+            if p.lo is not None:
+                lo, hi = max(lo, int(p.lo)), min(hi, int(p.hi))  # type: ignore[arg-type]
+            body.append(f"if type({a}) is int and {lo} <= {a} <= {hi}: {v} = {a}")
+            body.append(f"else: {v} = C{i}({a})")
+            if p.mask:
+                body.append(f"if {v} < 0: {v} &= 0xFFFFFFFF")
+        elif p.is_float and p.lo is None:
+            body += [
+                f"if type({a}) is float and -_INF < {a} < _INF: {v} = {a}",
+                # an int the double holds exactly (GT_SetVel(axis, 10)): as _real converts it
+                f"elif type({a}) is int and -{1 << 53} <= {a} <= {1 << 53}: {v} = float({a})",
+                f"else: {v} = C{i}({a})",
+            ]
+        elif (
+            p.pointer
+            and not p.text
+            and not p.is_struct
+            and p.ctype not in ("char", "unsigned char", "void")
+            and p.stars == 1
+        ):
+            # a pointer to numbers: byref(x) or x itself of a plain number inline
+            env[f"OK{i}"] = _scalar_types(p)
+            body += [
+                f"t = type({a})",
+                "if t is _CArg:",
+                f"    o = {a}._obj",
+                f"    if type(o) in OK{i} and {where(a)} == _addressof(o):",
+                f"        {v} = Ref({p.name!r}, _addressof(o), _sizeof(o), type(o), o)",
+                f"    else: {v} = C{i}({a})",
+                f"elif t in OK{i}: {v} = Ref({p.name!r}, _addressof({a}), _sizeof({a}), t, {a})",
+            ]
+            if p.optional:  # NULL as None or 0 (False and NULL ctypes pointers: generic)
+                body.append(f"elif {a} is None or (t is int and {a} == 0): {v} = None")
+            body.append(f"else: {v} = C{i}({a})")
+        else:
+            body.append(f"{v} = C{i}({a})")
+        out.append(v)
+    # the room of counted pointers, as binder's bind checks it
+    index = {p.name: i for i, p in enumerate(params)}
+    for i, p in enumerate(params):
+        if p.pointer and not p.text and not p.is_struct and p.count != 0:
+            k = f"v{index[p.count]}" if isinstance(p.count, str) else repr(p.count)
+            v = f"v{i}"
+            body += [
+                f"if {v} is not None and not ({k} == 1 and {v}.elem is type({v}._keep) "
+                f"and {v}.nbytes == _sizeof({v}.elem)) and type({k}) is int and {k} > 0:",
+                f"    _check_room(P[{i}], {v}, {k})",
+            ]
+    lines = [f"def bind({', '.join([*sig, '*more'])}):", "    if more: return None", "    try:"]
+    lines += [f"        {x}" for x in body] or ["        pass"]
+    lines += [
+        "    except Exception: return None",  # the table path gives the refusal
+        f"    return ({', '.join(out)}{',' if len(out) == 1 else ''})",
+    ]
+    code = "\n".join(lines)
+    exec(compile(code, f"<gt binder {proto.name}>", "exec"), env)
+    fn = env["bind"]
+    fn.source = code  # type: ignore[attr-defined]
+    return fn
 
 
 def _check_room(p: Param, ref: Ref, n: int) -> None:
@@ -787,4 +963,4 @@ def core_arg(value: Any) -> int:
     return _integer(_CORE, value)
 
 
-__all__ = ["Ref", "binder", "core_arg", "fit", "resolve"]
+__all__ = ["Ref", "binder", "byref_address", "core_arg", "fast_binder", "fit", "resolve"]

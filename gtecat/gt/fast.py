@@ -14,58 +14,26 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
-import functools
 import struct
-import sys
 from collections.abc import Callable
+from operator import itemgetter
 from typing import Any
 
 import numpy as np
 
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
+from .args import CARG_AT, byref_address
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
 
 
-@functools.lru_cache(maxsize=1024)
-def _cparam(address: int) -> str:
-    """The repr of ``byref(obj)`` for an object at ``address`` (fresh objects reuse addresses)."""
-    return f"<cparam 'P' ({address:#x})>"
-
-
 _NO: Any = object()  # an argument the caller did not pass
 _addressof = ctypes.addressof
-
-
-def _carg_address_offset() -> int | None:
-    """Where a ``byref()`` object keeps the address it passes, in bytes from its start.
-
-    ctypes offers no reader for it (``byref(obj, offset)`` looks like ``byref(obj)``), and
-    its repr costs a microsecond; the field's place in CPython's ``PyCArgObject`` is found
-    here by probing objects whose addresses are known, and used only when every probe,
-    with and without an offset, agrees.  None: not found, the repr is compared instead."""
-    try:
-        size = sys.getsizeof(ctypes.byref(ctypes.c_int()))
-        objs = [ctypes.c_long(), ctypes.c_int(), ctypes.c_double(), (ctypes.c_long * 3)()]
-        for k in range(16, size - 7, 8):
-            ok = True
-            for obj in objs:
-                for off in (0, 4, 8):
-                    p = ctypes.byref(obj, off)
-                    if ctypes.c_void_p.from_address(id(p) + k).value != _addressof(obj) + off:
-                        ok = False
-            if ok:
-                return k
-    except Exception:  # another implementation: the repr it is
-        return None
-    return None
-
-
-#: see :func:`_carg_address_offset`
-_CARG_AT = _carg_address_offset() if sys.implementation.name == "cpython" else None
 _from_address = ctypes.c_void_p.from_address
+#: where a byref() keeps its address (args.CARG_AT); -1: not known (byref_address reads it)
+_AT = CARG_AT if CARG_AT is not None else -1
 
 
 _status = AxisResources.status
@@ -125,11 +93,31 @@ def fast_reader(
             )
         return ok
 
-    def gt(
-        n: Any = _NO, p: Any = _NO, count: Any = _NO, pClock: Any = _NO, /, *extra: Any, **kw: Any
-    ) -> int:
-        # positional-only: a keyword of the same name (count=1) goes to **kw, so the table
-        # path answers it (7 for one given twice), never a TypeError
+    env = {
+        "_NO": _NO,
+        "_CArg": _CArg,
+        "_LOCKSTEP": _LOCKSTEP,
+        "_addressof": _addressof,
+        "_from_address": _from_address,
+        "byref_address": byref_address,
+        "session": session,
+        "get": get,
+        "ok": ctypes_ok,
+        "last": last,
+        "advance": advance,
+        "name": name,
+        "slow": slow,
+        "key": BANK_LISTS.get(name),
+        "_NDARRAY": _NDARRAY,
+        "np_ok": np_ok,
+        "is_array": is_array,
+        "to": float if ctypes_ok is _DOUBLE else None,
+    }
+    gt = _compiled(_READER, "gt", env, core="", session_core=" and session.core == 1")
+
+    def general(n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict) -> int:
+        """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
+        array, a numpy array, and anything the table path must answer."""
         ctl = session.controllers.get(1)
         if (
             type(n) is not int
@@ -152,12 +140,9 @@ def fast_reader(
             obj = p._obj
             if p is not last[0]:
                 # byref(obj), not byref(obj, offset): the address it holds is the object's
-                # (read where ctypes keeps it, else from its repr); any doubt: the table path
                 if type(obj) not in ctypes_ok or (
-                    _from_address(id(p) + _CARG_AT).value != _addressof(obj)
-                    if _CARG_AT is not None
-                    else repr(p) != _cparam(_addressof(obj))
-                ):
+                    _from_address(id(p) + _AT).value if _AT >= 0 else byref_address(p)
+                ) != _addressof(obj):
                     return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
                 last[0] = p  # checked: the same pointer object next time needs no check
             obj.value = get(res)
@@ -173,6 +158,175 @@ def fast_reader(
         if clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)
         return 0
+
+    env["general"] = general
+
+    def gtn_general(
+        core: Any, n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict
+    ) -> int:
+        args = [a for a in (core, n, p, count, pClock) if a is not _NO]
+        return gt.gtn_slow(*args, *extra, **kw)  # type: ignore[attr-defined]
+
+    env["gtn_general"] = gtn_general
+    #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
+    #: its core); every other shape: the table's GTN_ function (set by gt_function)
+    gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session_core="")  # type: ignore[attr-defined]
+    gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
+    return gt
+
+
+#: the bank's list of each reader's value (AxisBank.value), read without the two calls
+BANK_LISTS = {
+    "GT_GetSts": "sts",
+    "GT_GetPrfPos": "prf_p",
+    "GT_GetPrfVel": "prf_v",
+    "GT_GetPrfAcc": "prf_a",
+    "GT_GetAxisPrfPos": "a_last",
+    "GT_GetEncPos": "enc_pos",
+    "GT_GetEncVel": "enc_vel",
+}
+
+#: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
+#: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
+_READER = """
+def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
+    if (
+        type(n) is int
+        and not kw
+        and not extra{core_check}
+        and (
+            count is _NO
+            or (
+                type(count) is int
+                and count == 1
+                # pClock NULL: omitted, None or 0 (the manual's own GT_GetSts(1, &s, 1, 0))
+                and (pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0))
+            )
+        )
+    ):
+        ctl = session.controllers.get(1)
+        if ctl is not None and session.remote is None{session_core}:
+            res = ctl.resources.get(n)
+            clock = ctl.clock
+            if res is not None and clock._thread is None:
+                tp = type(p)
+                if tp is _CArg:
+                    obj = p._obj
+                    if p is not last[0]:
+                        # byref(obj), not byref(obj, offset); any doubt: the table path
+                        if type(obj) not in ok or {address} != _addressof(obj):
+                            return {fallback}
+                        last[0] = p  # checked: the same pointer object next time is fine
+                elif tp in ok:  # the ctypes object itself (passed by reference)
+                    obj = p
+                elif (
+                    tp is _NDARRAY
+                    and p.dtype in np_ok
+                    and p.ndim == 1
+                    and p.size
+                    and p.flags.writeable
+                ) or is_array(tp):  # a numpy or ctypes array: its first element
+                    obj = None
+                else:
+                    return {fallback}
+{{value}}
+                if obj is None:
+                    p[0] = v
+                else:
+                    obj.value = v
+                session.last = None
+                if clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+    return {fallback}
+"""
+
+
+def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session_core: str) -> Any:
+    """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
+    address = "_from_address(id(p) + _AT).value" if _AT >= 0 else "byref_address(p)"
+    gtn = bool(core)
+    code = template.format(
+        fname=fname,
+        core=core,
+        core_check=" and type(core) is int and core == 1" if gtn else "",
+        session_core=session_core,
+        address=address,
+        fallback=(
+            "gtn_general(core, n, p, count, pClock, extra, kw)"
+            if gtn
+            else "general(n, p, count, pClock, extra, kw)"
+        ),
+    )
+    env["_AT"] = _AT
+    if env["key"] is None:
+        value = "                v = get(res)"
+    else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
+        row = "lst[res.bank_row]" if env["to"] is None else "to(lst[res.bank_row])"
+        value = "\n".join(
+            "                " + line
+            for line in (
+                "b = res.bank",
+                "lst = b._lists.get(key) if b is not None else None",
+                f"v = get(res) if lst is None else {row}",
+            )
+        )
+    code = code.replace("{value}", value)
+    exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
+    return env[fname]
+
+
+#: the clock reader on the fast path (``pClock``, ``pLoop`` NULL or omitted)
+CLOCK = "GT_GetClock"
+#: the largest value each integer type of ``_INTS`` holds
+_INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
+
+
+def fast_clock(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetClock(pClock[, pLoop])`` with the fast path in front of the table: ``pClock``
+    ``byref(x)`` or ``x`` of an integer type of at least 32 bits, ``pLoop`` omitted, None or
+    0, on the in-process controller; anything else (a value the type cannot hold included)
+    takes the table path."""
+    last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
+
+    def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if (
+            (pLoop is _NO or pLoop is None or (type(pLoop) is int and pLoop == 0))
+            and not kw
+            and not extra
+        ):
+            ctl = session.controllers.get(1)
+            if ctl is not None and session.remote is None and session.core == 1:
+                clock = ctl.clock
+                if clock._thread is None:
+                    tp = type(pClock)
+                    if tp is _CArg:
+                        obj = pClock._obj
+                        if pClock is not last[0]:
+                            if type(obj) not in _INTS or (
+                                _from_address(id(pClock) + _AT).value
+                                if _AT >= 0
+                                else byref_address(pClock)
+                            ) != _addressof(obj):
+                                obj = None
+                            else:
+                                last[0] = pClock
+                    else:
+                        obj = pClock if tp in _INTS else None
+                    if obj is not None:
+                        ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
+                        if ms <= _INT_MAX[type(obj)]:
+                            obj.value = ms
+                            session.last = None
+                            if clock.mode is _LOCKSTEP:
+                                return 0
+                            return advance(ctl, name, 0)
+        return slow(*(a for a in (pClock, pLoop) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt
@@ -225,6 +379,8 @@ RAW = frozenset(
     {"GT_GetEcatRawData", "GT_SetEcatRawData", "GT_EcatIOReadInput", "GT_EcatIOWriteOutput"}
 )
 _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
+_CAST: Any = object()
+_NUMPY: Any = object()
 _BYTES_NP = np.dtype(np.uint8)
 
 
@@ -335,19 +491,111 @@ def fast_raw(
             return True
         return False  # ctypes and numpy buffers: one numpy copy through a cached view
 
-    def raw_gt(
-        offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any
-    ) -> int:  # positional-only, as the readers
-        if extra or kw or p is _NO:
-            return slow(*(a for a in (offset, size, p) if a is not _NO), *extra, **kw)
-        return run(-1, offset, size, p, (offset, size, p))
+    #: (slave or -1, offset, size, the buffer's type) -> a copier: ``copy(p)`` moves the
+    #: bytes (False: this buffer cannot take them this way, the general path decides)
+    copiers: dict[tuple[int, int, int, type], Callable[[Any], bool]] = {}
 
-    def io_gt(
-        slave: Any = _NO, offset: Any = _NO, size: Any = _NO, p: Any = _NO, /, *more: Any, **kw: Any
-    ) -> int:
-        if more or kw or p is _NO or type(slave) is not int:
-            return slow(*(a for a in (slave, offset, size, p) if a is not _NO), *more, **kw)
-        return run(slave, offset, size, p, (slave, offset, size, p))
+    def copier(slave: int, offset: int, size: int, tp: type, image: Any) -> Any:
+        """``copy(p)`` for one shape (a range of the image, a buffer type): it moves the
+        bytes and returns True, or False when this buffer cannot take them this way (the
+        general path decides); None: no copier for the shape.  Compiled from
+        :data:`_COPY` (one function: the checks of the buffer, then one slice per run or
+        one gather of the whole range)."""
+        raw = offset
+        if io:
+            slaves = image.layout.slaves
+            if not 0 <= slave < len(slaves):
+                return None
+            sl = slaves[slave]
+            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
+                return None
+            raw = sl.gt_offset + offset
+        plan = _plan(image, raw, size, write)
+        if plan is None or not plan[0]:
+            return None
+        runs, idx = plan
+        if tp is bytearray or tp is memoryview or (write and tp is bytes):
+            get = "q = p"
+            check = ["if len(p) < size: return False"]
+            if tp is memoryview:
+                check.append(
+                    'if p.format != "B" or p.ndim != 1 or not p.c_contiguous: return False'
+                )
+                if not write:
+                    check.append("if p.readonly: return False")
+        elif issubclass(tp, Array) and sizeof(tp) >= size:
+            # a ctypes array: its bytes, through a memoryview kept per object
+            get = "q = kept(p, True)\n    if q is None: return False"
+            check = []
+        elif tp is _NDARRAY:
+            check = [
+                "if (p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous "
+                "or p.size < size): return False"
+            ]
+            if not write:
+                check.append("if not p.flags.writeable: return False")
+            get = "q = kept(p, False)"
+        else:
+            return None
+        if write:
+            move = [f"img[{first}:{first + n}] = q[{a}:{a + n}]" for a, first, n in runs]
+        elif len(runs) == 1:  # one slice
+            ((a, first, n),) = runs
+            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]"]
+        elif tp is bytearray and size <= 6 * len(runs):
+            # the bytes of the range in one C call (a bytearray takes the ints as they are):
+            # fewer steps than a slice per run while the runs are short
+            move = ["q[0:size] = gather(img)"]
+        elif size <= 2 * len(runs):
+            move = ["q[0:size] = bytes(gather(img))"]
+        else:  # a slice per run
+            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]" for a, first, n in runs]
+        body = "\n    ".join([*check, get, *move, "return True"])
+        env = {
+            "img": memoryview(image.buffer),
+            "size": size,
+            "gather": itemgetter(*idx.tolist()) if len(idx) > 1 else None,
+            "kept": kept,
+            "_BYTES_NP": _BYTES_NP,
+        }
+        exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
+        return env["copy"]
+
+    casts: dict[int, memoryview] = {}  # byte views of buffers, the last few (kept alive)
+
+    def kept(p: Any, cast: bool) -> memoryview | None:
+        """A memoryview of the bytes of ``p`` (a ctypes array: cast to bytes), kept for the
+        next call with the same object; None: none can be made."""
+        v = casts.get(id(p))
+        if v is None or v.obj is not p:
+            if len(casts) >= 16:
+                casts.clear()
+            try:
+                v = memoryview(p).cast("B") if cast else memoryview(p)
+            except (TypeError, ValueError):  # a format memoryview cannot take
+                return None
+            casts[id(p)] = v
+        return v
+
+    env = {
+        "_NO": _NO,
+        "_LOCKSTEP": _LOCKSTEP,
+        "session": session,
+        "seen": seen,
+        "copiers": copiers,
+        "copier": copier,
+        "reset": lambda image: (
+            cache.clear(),
+            copiers.clear(),
+            casts.clear(),
+            seen.__setitem__(slice(None), [image, memoryview(image.buffer)]),
+        ),
+        "advance": advance,
+        "name": name,
+        "slow": slow,
+    }
+    gt = _compiled_raw(env, io)
+    env["run"] = lambda *a: run(*a)
 
     def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)
@@ -397,9 +645,59 @@ def fast_raw(
             return advance(ctl, name, 0)
         return 0
 
-    gt = io_gt if io else raw_gt
     gt.slow = slow  # type: ignore[attr-defined]
     return gt
+
+
+#: the raw image functions' common shapes in the fewest steps (the IO pair with the slave
+#: first): the session's checks, then the shape's copier; anything else: ``run``
+_RAW = """
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+    if extra or kw or p is _NO{slave_check}:
+        return slow(*(a for a in ({slave_arg}offset, size, p) if a is not _NO), *extra, **kw)
+    ctl = session.controllers.get(1)
+    if (
+        ctl is not None
+        and type(offset) is int
+        and type(size) is int
+        and session.remote is None
+        and session.core == 1
+    ):
+        m = ctl.master
+        clock = ctl.clock
+        if m is not None and m.opened and not m.offline and clock._thread is None:
+            image = m.image
+            if image is not seen[0]:
+                reset(image)
+            key = ({slave_key}, offset, size, type(p))
+            copy = copiers.get(key, _NO)
+            if copy is _NO:
+                copy = copiers[key] = copier({slave_key}, offset, size, type(p), image)
+            if copy is None:
+                done = False
+            else:
+                try:
+                    done = copy(p)
+                except Exception:  # (a released memoryview): the general path answers
+                    done = False
+            if done:
+                session.last = None
+                if clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+    return run({slave_key}, offset, size, p, ({slave_arg}offset, size, p))
+"""
+
+
+def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
+    code = _RAW.format(
+        slave="slave=_NO, " if io else "",
+        slave_check=" or type(slave) is not int" if io else "",
+        slave_arg="slave, " if io else "",
+        slave_key="slave" if io else "-1",
+    )
+    exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
+    return env["gt"]
 
 
 #: why a function that takes pointers is answered by the table path only (its binder checks
@@ -438,4 +736,4 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW
+    return frozenset(READERS) | RAW | {CLOCK}

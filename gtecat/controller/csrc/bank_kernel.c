@@ -94,13 +94,19 @@ int bank_kernel_sizes(void) { return (MAXSEG << 8) | NTPRM; }
 #define I64(f) ((int64_t *)ptr[F_##f])
 #define F64(f) ((double *)ptr[F_##f])
 
-/* numpy's float -> int64 cast on x86-64 (cvttsd2si): out of range and NaN give INT64_MIN */
+/* numpy's float -> int64 cast on x86-64 (cvttsd2si): out of range and NaN give INT64_MIN;
+ * on x86-64 that instruction itself, elsewhere the same result spelled out */
+#if defined(__x86_64__) && defined(__SSE2__)
+#include <emmintrin.h>
+INLINE int64_t to_i64(double x) { return _mm_cvttsd_si64(_mm_set_sd(x)); }
+#else
 static int64_t to_i64(double x)
 {
     if (x >= -9223372036854775808.0 && x < 9223372036854775808.0)
         return (int64_t)x;
     return INT64_MIN;
 }
+#endif
 
 /* Python's float floor division (Objects/floatobject.c _float_div_mod; numpy's npy_divmod) */
 static double floor_div(double vx, double wx)
@@ -323,6 +329,67 @@ INLINE int refill_row(void **ptr, int64_t *io, int64_t r)
     return 0;
 }
 
+#define COPY(dst, src, type) memcpy(ptr[F_##dst], ptr[F_##src], (size_t)n * sizeof(type))
+
+/* the commit of a cycle in which every row stepped in CSP (none left out, frozen or homing):
+ * the same values as the row-by-row commit, copied array by array */
+INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog)
+{
+    int64_t r;
+    if (n_jog)
+        for (r = 0; r < n; r++)
+            if (U8(jog)[r]) {
+                F64(jrp)[r] = F64(s_jog)[5 * r + 0];
+                F64(jrv)[r] = F64(s_jog)[5 * r + 1];
+                F64(jp)[r] = F64(s_jog)[5 * r + 2];
+                F64(jv)[r] = F64(s_jog)[5 * r + 3];
+                F64(ja)[r] = F64(s_jog)[5 * r + 4];
+            }
+    COPY(c_pos, s_pos, double);
+    COPY(c_vel, s_vel, double);
+    COPY(c_acc, s_acc, double);
+    COPY(c_dpos, s_dpos, double);
+    COPY(c_dvel, s_dvel, double);
+    COPY(c_fe_time, s_fe, double);
+    COPY(c_limited, s_lim, uint8_t);
+    COPY(c_sw_limited, s_swl, uint8_t);
+    COPY(c_target, s_target, int64_t);
+    COPY(c_din, s_din, int64_t);
+    COPY(a_last, s_a, double);
+    COPY(enc_prev, s_raw, int64_t);
+    COPY(enc_pos, s_enc, double);
+    COPY(enc_step0, enc_step1, double);
+    COPY(enc_step1, s_step, double);
+    COPY(since, s_since, int64_t);
+    COPY(arrived, s_arr, uint8_t);
+}
+
+/* the table cursors of every row after commit_all; 1 when a Trap move ended */
+INLINE int commit_cursors(void **ptr, int64_t n)
+{
+    int64_t r;
+    int fin_any = 0;
+    int64_t *t_idx = I64(t_idx), *t_cur = I64(t_cur), *taken = I64(taken);
+    const int64_t *base = I64(base), *t_end = I64(t_end);
+    uint8_t *moving = U8(moving), *ended = U8(ended);
+    for (r = 0; r < n; r++) {
+        const int64_t cur = t_cur[r];
+        const int mv = moving[r];
+        t_idx[r] = base[r] + cur;
+        taken[r] += mv;
+        if (mv) {
+            if (cur == t_end[r]) {
+                ended[r] = 1;
+                moving[r] = 0;
+                fin_any = 1;
+            } else {
+                t_cur[r] = cur + 1;
+            }
+        }
+    }
+    return fin_any;
+}
+
 /* inlined where the field table is a local copy: the compiler then knows no store through a
  * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
 INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
@@ -332,7 +399,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
     const double half_per_dt = 0.5 / dt;
     const uint8_t *alive = U8(alive);
     uint8_t *buf = U8(buf);
-    int64_t r, i;
+    int64_t r, i, n_csp = 0, n_jog = 0;
     int fin_any = 0, csp_hit = 0, hm_hit = 0;
     const uint8_t *hm = U8(hm);
 
@@ -424,6 +491,8 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
             dvel = (demand - F64(c_dpos)[r]) / dt;
         }
         go[r] = (uint8_t)(1 + ended);
+        n_csp += !hm[r];
+        n_jog += U8(jog)[r];
         I64(s_target)[r] = target;
         F64(s_a)[r] = a;
         F64(s_dpos)[r] = demand;
@@ -573,6 +642,11 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
         return 3; /* nothing written: the caller releases the homing rows in s_hit */
 
     /* commit (CspBank.commit, the bank's state, the table cursors) */
+    if (n_csp == n) {
+        commit_all(ptr, n, n_jog);
+        fin_any = commit_cursors(ptr, n);
+        goto image;
+    }
     for (r = 0; r < n; r++) {
         int64_t cur;
         int mv, en;
@@ -632,6 +706,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
     }
 
     /* 8. the image: 607Ah out, the drives' TxPDO in */
+image:
     for (i = 0; i < io[IN_N_PLC]; i++) {
         int64_t row = I64(pl_row)[i], val;
         uint32_t u;

@@ -100,3 +100,38 @@ def test_unknown_mode_means_auto_with_a_warning(
     assert "GTECAT_BANK_KERNEL='fastest'" in caplog.text
     monkeypatch.setenv("GTECAT_BANK_KERNEL", " NumPy ")
     assert bank_kernel.wanted() == "numpy"
+
+
+def test_refused_flags_get_the_plain_build(monkeypatch: pytest.MonkeyPatch) -> None:
+    asked: list[tuple[str, ...]] = []
+    plain_builds = [True]
+
+    def fake(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:
+        asked.append(cflags)
+        if cflags != bank_kernel.PLAIN_CFLAGS or not plain_builds[0]:
+            raise bank_kernel.NativeBuildError("cc: error: unrecognized command-line option")
+        return Path(f"/cache/{stem}-plain.so")
+
+    monkeypatch.setattr(bank_kernel, "shared_library", fake)
+    assert bank_kernel.build(bank_kernel.CFLAGS) == Path("/cache/bank_kernel-plain.so")
+    assert asked == [bank_kernel.CFLAGS, bank_kernel.PLAIN_CFLAGS]
+    asked.clear()
+    plain_builds[0] = False  # the plain build failing too is the reason given
+    with pytest.raises(bank_kernel.NativeBuildError, match="unrecognized"):
+        bank_kernel.build(bank_kernel.CFLAGS)
+    assert asked == [bank_kernel.CFLAGS, bank_kernel.PLAIN_CFLAGS]
+
+
+@pytest.mark.long
+@pytest.mark.skipif(
+    not any(os.path.exists(os.path.join(d, c)) for d in os.get_exec_path() for c in ("cc", "gcc")),
+    reason="no C compiler",
+)
+def test_a_real_refused_flag_falls_back_to_a_working_plain_build() -> None:
+    import ctypes
+
+    lib = ctypes.CDLL(str(bank_kernel.build((*bank_kernel.CFLAGS, "-fno-such-option-here"))))
+    lib.bank_kernel_fields.restype = ctypes.c_char_p
+    assert lib.bank_kernel_fields().decode().rstrip(",").split(",") == [
+        n for n, _ in bank_kernel._field_types()
+    ]

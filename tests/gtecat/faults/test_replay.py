@@ -159,3 +159,46 @@ def test_a_damaged_recording_is_a_clear_error(
     assert main(["replay", str(bad)]) == 1
     err = capsys.readouterr().err
     assert "damaged recording" in err and "Traceback" not in err
+
+
+def test_every_line_of_a_shared_form_is_compared(recorded: Path, tmp_path: Path) -> None:
+    """Polling calls that differ only in the numbers their pointers held share one prepared
+    call: a value the call left (``"o"``) changed in one line of such a form is reported at
+    that call, and the lines before it still replay."""
+    lines = recorded.read_text().splitlines()
+    number, seen, at = 0, 0, None
+    for i, line in enumerate(lines[1:], 1):
+        if '"c":' not in line:
+            continue
+        number += 1
+        e = json.loads(line)
+        if e["c"] == "GT_GetClock" and "o" in e:
+            seen += 1
+            if seen == 50:
+                e["o"]["0"]["ref"]["v"] += 1
+                lines[i] = json.dumps(e, separators=(",", ":"))
+                at = (number, e["o"]["0"]["ref"]["v"])
+                break
+    assert at is not None
+    bad = tmp_path / "one_clock.gtrec"
+    bad.write_text("\n".join(lines) + "\n")
+    n, div = replay(bad)
+    assert n == at[0] and div is not None
+    assert (div.index, div.call, div.what) == (at[0], "GT_GetClock", "argument 1")
+    assert div.recorded["ref"]["v"] == at[1] and div.now["ref"]["v"] == at[1] - 1
+
+
+def test_the_numbers_of_a_form_are_read_as_json_reads_them() -> None:
+    """The numbers of all call lines are read in one JSON parse; a structure's fields are
+    left to the line's own parse, and a number JSON would refuse sends every line to its
+    own parse (where the damaged one is reported)."""
+    from gtecat.faults.record import _numbers
+
+    ref = ',"c":"GT_GetPrfPos","a":[1,{{"ref":{{"c":"c_double","v":{}}}}}],"r":0}}'
+    st = ',"c":"GT_SetTrapPrm","a":[1,{"ref":{"st":"TTrapPrm","v":{"acc":0.5}}}],"r":0}'
+    got = _numbers([ref.format("-1.5e-3"), ref.format("12"), st, ',"c":"GT_Reset","a":[],"r":0}'])
+    assert got is not None
+    assert got[0][1] == [-1.5e-3] and type(got[1][1][0]) is int and got[1][1] == [12]
+    assert got[0][0] == got[1][0]  # one form
+    assert got[2] is None and got[3] == (',"c":"GT_Reset","a":[],"r":0}', [])
+    assert _numbers([ref.format("12"), ref.format("012")]) is None

@@ -152,3 +152,26 @@ def test_keywords_and_gtn_take_the_table_path(moving_bus) -> None:
     assert gt.GT_GetPrfPos(profile=2, pValue=byref(a)) == 0
     assert gt.GTN_GetPrfPos(1, 2, byref(b)) == 0
     assert a.value == b.value != 0.0
+
+
+def test_the_clock_reader_answers_as_the_table(moving_bus) -> None:
+    """GT_GetClock's fast path (pClock of an integer type, pLoop NULL) against its table path,
+    a clock past what a 32-bit signed pClock holds included."""
+    ctl = gt.GTE_Controller()
+    bad = []
+    for reset_ns in (ctl.reset_ns, ctl.clock.now_ns - (1 << 31) * 1_000_000):
+        ctl.reset_ns = reset_ns
+        for kind in ("byref", "byref_offset", "same_byref", "array", "obj", "int"):
+            for t in (ctypes.c_long, ctypes.c_int32, ctypes.c_int16, ctypes.c_double):
+                for loop in ("omitted", "none", "zero", "byref"):
+                    results = []
+                    for fn in (gt.GT_GetClock, gt.GT_GetClock.slow):
+                        o, p = _arg(kind, t)
+                        loops = ctypes.c_uint32()
+                        extra = {"omitted": (), "none": (None,), "zero": (0,)}
+                        rc = fn(p, *extra.get(loop, (byref(loops),)))
+                        err = gt.GTE_GetLastError() if rc else ""
+                        results.append((rc, _value(o), err, loops.value))
+                    if results[0] != results[1]:
+                        bad.append(f"{kind} {t.__name__} {loop}: {results}")
+    assert not bad, "\n".join(bad)
