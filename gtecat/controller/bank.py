@@ -1140,6 +1140,8 @@ class AxisBank:
         segment at its tail is not reached in that window, and no segment starting in it looks
         that far (its exit speed looks at the next segment only, without a look-ahead).  Then
         the entry joins the FIFO kept for the rewind too (:meth:`_pushed_ahead`); True."""
+        if ctl.clock.threaded:  # the cycles may go on before the call takes the lock
+            return False
         crds = vars(ctl).get("crd_bank")
         c = crds.systems.get(values[0]) if crds is not None else None
         if c is None or not c.banked:
