@@ -320,9 +320,12 @@ def _crd_reads() -> tuple:
 def _polled_setup() -> object:
     _crd_system(1, (1, 2), False, 2)  # a delay in its second lap
     _crd_system(2, (3, 4), True, 3)  # a GT_BufIO in its first lap: scalar until it passes
-    for a in range(5, AXES + 1):
+    # axis 5 geared to system 2's X: that system's cluster is stepped cycle by cycle with the
+    # slave (system 1 alone: CoordSystem.run)
+    _gear(5, 3, gt.GEAR_MASTER_PROFILE, (1, 2, 0))
+    for a in range(6, AXES + 1):
         _trap(a, 10_000 * (a - 4), 2.0 + a, 0.3)
-    return gt.GT_CrdStart(0b11, 0)
+    return (gt.GT_GearStart(_bit(5)), gt.GT_CrdStart(0b11, 0))
 
 
 #: (cycle, a call that changes a running path) of the polled program
