@@ -1172,6 +1172,7 @@ class AxisBank:
                     kept["tails"][1][fifo] = c.tails[fifo]
             if c.trace is not None:
                 c.trace.pushed[fifo] += 1
+                c.trace.memo = None
         if not (type(entry) is Delay or (type(entry) is Motion and entry.speed_plan is None)):
             self._release_groups([self.groups[cl.groups[0]]])
 

@@ -334,11 +334,13 @@ class SystemTrace:
     the positions are the slots' samples, ``cols``); every cycle is marked where ``cols`` is
     None."""
 
-    __slots__ = ("bank", "cols", "marks", "pushed", "rows", "speeds", "start")
+    __slots__ = ("bank", "cols", "marks", "memo", "pushed", "rows", "speeds", "start")
 
     def __init__(self, bank: AxisBank, rows: list[int], c: CoordSystem) -> None:
         self.bank = bank
-        self.rows = np.array(rows, np.intp)
+        self.rows = rows
+        #: (the bank's cycle count, the answer): the reads of one cycle share it
+        self.memo: tuple[int, Any] | None = None
         self.start = c.state()
         self.speeds: list[float] = []
         self.marks: list[tuple[int, tuple]] = []
@@ -350,8 +352,18 @@ class SystemTrace:
         """``c`` as the scalar path has it now: the cluster's rows took ``m`` samples since the
         fill (as :meth:`Cluster.rewind` counts them); past the cycles stepped, ``c``'s own."""
         bank = self.bank
-        rows = self.rows
-        m = int((bank.taken[rows] - bank.fill_taken[rows]).max())
+        memo = self.memo
+        cycles = bank.bank_cycles
+        if memo is not None and memo[0] == cycles:
+            return memo[1]
+        now = self._at(c)
+        self.memo = (cycles, now)
+        return now
+
+    def _at(self, c: CoordSystem) -> Any:
+        bank = self.bank
+        taken, filled = bank.taken, bank.fill_taken
+        m = max(int(taken[r]) - int(filled[r]) for r in self.rows)
         if m >= len(self.speeds):  # the objects stand where the scalar path has them
             return CrdNow(c, c.state())
         if m == 0:
