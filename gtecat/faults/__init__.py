@@ -25,7 +25,7 @@ from ..errors import CommandError, ParameterError
 from .bus import EmulatedBus, FaultBus, WireBus
 from .injector import Entry, Injector
 from .kinds import KINDS, Fault, FaultSpecError, fault_from_dict, kind_rows
-from .triggers import TRIGGER_KEYS, Trigger, _ms, trigger_from_dict
+from .triggers import TRIGGER_KEYS, Trigger, _ms, describe_after, trigger_from_dict
 
 _EXTRA_KEYS = ("duration_ms", "after", "name")
 
@@ -50,11 +50,14 @@ class FaultSpec:
         self.where = where
 
     def describe(self) -> str:
-        text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        if self.after is None:
+            text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        else:
+            text = (
+                f"{self.fault.describe()}, {describe_after(self.trigger, _after_words(self.after))}"
+            )
         if self.duration_ms is not None:
             text += f", for {self.duration_ms:g} ms"
-        if self.after is not None:
-            text += f", once {_after_words(self.after)} has started"
         return text
 
     def as_dict(self) -> dict[str, Any]:

@@ -705,9 +705,11 @@ def kind_rows() -> list[dict[str, str]]:
 
 
 __all__ = [
+    "HEX_FIELDS",
     "HOMING_STAGES",
     "KINDS",
     "MAILBOX_STEPS",
+    "RANGES",
     "SWITCH_BITS",
     "AlError",
     "Brake",
@@ -734,8 +736,6 @@ __all__ = [
     "SwitchChatter",
     "SwitchStuck",
     "WkcOffset",
-    "HEX_FIELDS",
-    "RANGES",
     "fault_from_dict",
     "field_range",
     "kind_rows",
