@@ -159,14 +159,10 @@ class OnSdo(Trigger):
 
 def describe_after(trigger: Trigger, after: str) -> str:
     """The trigger in words for a script's step that waits for ``after`` (e.g. "fault 1"):
-    its time and cycles count from when that one started, so say so."""
-    if isinstance(trigger, AfterTime):
-        return f"{trigger.ms:g} ms after {after} has started"
-    if isinstance(trigger, AfterCycles):
-        return f"{trigger.cycles} healthy cycles after {after} has started"
+    its time and cycles count from when that one started, so it says so first."""
     if isinstance(trigger, Now):
-        return f"as soon as {after} has started"
-    return f"{trigger.describe()}, once {after} has started"
+        return f"once {after} has started"
+    return f"once {after} has started, {trigger.describe()}"
 
 
 TRIGGER_KEYS = ("at_ms", "after_ms", "after_cycles", "when_position", "at_homing", "on_sdo")
