@@ -214,10 +214,10 @@ MODE_SCRIPT = textwrap.dedent(
     gt.GT_AxisOn(2); gt.GTE_Wait(20)
     prm = gt.TTrapPrm(); prm.acc = prm.dec = 0.5
     gt.GT_PrfTrap(2); gt.GT_SetTrapPrm(2, byref(prm))
-    gt.GT_SetPos(2, 500000); gt.GT_SetVel(2, 20); gt.GT_Update(2); gt.GTE_Wait(100)
+    gt.GT_SetPos(2, 500000); gt.GT_SetVel(2, 20); gt.GT_Update(2); gt.GTE_Wait(30)
     mode, ab = (c_ubyte * 1)(6), c_uint32()
     gt.GT_EcatSDODownload(1, 0x6060, 0, mode, 1, byref(ab))
-    gt.GT_AxisOff(2); gt.GTE_Wait(50)
+    gt.GT_AxisOff(2); gt.GTE_Wait(10)
     """
 )
 
@@ -233,6 +233,14 @@ def test_a_mode_change_names_the_sdo_call_and_the_check_exits_3(
     assert found and all(x.startswith(f"check: {app}:10: ") for x in found), err
     assert "check: 1 finding" in err
     # the script's own failure code wins over the findings'
-    app.write_text(MODE_SCRIPT + "raise SystemExit(5)\n")
+    app.write_text(
+        "from ctypes import byref, c_short\n"
+        "from gtecat import gt\n"
+        f"gt.GT_Open(eni={str(EXAMPLES / 'full_servo.eni')!r}, log='')\n"
+        "s = c_short()\n"
+        "for _ in range(200):\n"
+        "    gt.GT_IsEcatReady(byref(s))\n"
+        "raise SystemExit(5)\n"
+    )
     assert main(["run", "--check", "--no-progress", str(app)]) == 5
-    capsys.readouterr()
+    assert "GT_IsEcatReady polled 200 times" in capsys.readouterr().err
