@@ -137,11 +137,14 @@ class LinkDown(Fault):
     kind: ClassVar[str] = "link_down"
     depth: ClassVar[str] = "frame"
     summary: ClassVar[str] = (
-        "the cable behind slave AFTER_SLAVE is pulled: the slaves after it vanish"
+        "the cable behind slave AFTER_SLAVE is pulled: the slaves after it vanish "
+        "(-1: the cable at the master, the whole bus)"
     )
     after_slave: int
 
     def describe(self) -> str:
+        if self.after_slave < 0:
+            return "link down at the master (every slave vanishes)"
         return f"link down after slave {self.after_slave} (slaves {self.after_slave + 1}.. vanish)"
 
 

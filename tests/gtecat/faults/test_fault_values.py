@@ -199,7 +199,7 @@ def test_python_inject_refuses_and_after_slave_minus_1_takes_the_whole_bus() -> 
     fid = faults.inject("link_down", after_slave=-1)
     ids = faults.script([{"kind": "drop_responses", "after_ms": 300}])
     words = {f["id"]: f["describe"] for f in faults.listing()}
-    assert "slaves 0.. vanish" in words[fid]
+    assert "link down at the master (every slave vanishes)" in words[fid]
     assert words[ids[0]] == "the next 1 answer lost, 300 ms later" or "fault" not in words[ids[0]]
     step = faults.describe({"kind": "drop_responses", "after_ms": 300, "after": fid})
     assert step == f"the next 1 answer lost, once fault {fid} has started, 300 ms later"
