@@ -76,9 +76,10 @@ def error_register(code: int) -> int:
     CiA 301 (7.5.2.2, object 1001h): bit 0 generic error is set for every error; the
     class of the code (its high digits, CiA 301 table of emergency error codes) sets
     one more: bit 1 current (2xxxh), bit 2 voltage (3xxxh), bit 3 temperature (4xxxh),
-    bit 4 communication (81xxh), bit 5 device profile specific (the CiA 402 codes of
-    the drive's control, 86xxh: following error, reference limit), bit 7 manufacturer
-    specific (FFxxh).  0 for no error.
+    bit 4 communication (81xxh: 8100h, 8130h life guard), bit 7 manufacturer specific
+    (FFxxh).  The other classes (1000h generic, 5xxxh device hardware, 7xxxh additional
+    modules such as the encoder, 86xxh the CiA 402 positioning codes: following error,
+    reference limit) set bit 0 alone.  0 for no error.
     """
     code &= 0xFFFF
     if not code:
@@ -92,8 +93,6 @@ def error_register(code: int) -> int:
         reg |= 0x08
     elif 0x8100 <= code < 0x8200:
         reg |= 0x10
-    elif 0x8600 <= code < 0x8700:
-        reg |= 0x20
     elif code >= 0xFF00:
         reg |= 0x80
     return reg
