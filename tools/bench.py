@@ -16,9 +16,11 @@ clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ones holding), 128 axes moving, 12 axes in Trap on the scalar path (bank off: what the modes
 outside the bank compare with); 64 axes homing (method 17); 12 axes homing (reported); PT,
 Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (target 10:
-every motion mode); ``GT_GetSts`` against building its argument, interleaved, and every call
-shape of the fast path likewise (the worst ratio is held to 4); the RSS of a
-fresh process with a 128-axis controller open and moving.  A figure that cannot be
+every motion mode); two coordinate systems polled every cycle (GT_CrdStatus, GT_GetPrfPos),
+and the same with a segment streamed onto each every 10 cycles, bank against scalar path in
+pairs (target: the bank no slower); ``GT_GetSts`` against building its argument,
+interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4);
+the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
 
@@ -359,6 +361,68 @@ FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-poi
 CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
 
 
+def bench_crd_poll(
+    seconds: float = 1.0, pairs: int = 3, n: int = 12, push_every: int = 0
+) -> dict[str, object]:
+    """Coordinated motion polled every cycle, as field applications do: ``n`` axes, two XY
+    systems (axes 1-2 and 3-4, the crd figure's path), and after each 1 ms cycle
+    ``GT_CrdStatus`` of both systems and ``GT_GetPrfPos`` of their four axes (``push_every``:
+    and every that many cycles ``GT_CrdSpace`` and a ``GT_LnXY`` onto each running path, a
+    segment streamed).  Controller milliseconds per CPU second with the axis bank (``auto``)
+    and on the scalar path (``off``), measured in pairs back to back (the best window of
+    each); ``ratio``: bank / scalar."""
+    from ctypes import c_double, c_int32, c_short
+
+    from tools.bench_scaling import bring_up, check, crd_plan, gtn, start_crd
+    from tools.gen_axes_eni import write_axes_eni
+
+    gt = importlib.import_module("gtecat.gt")
+    plan = crd_plan(n)
+    crd_axes = [a for a, s in plan.items() if s == "crd"]
+    best = {"auto": 0.0, "off": 0.0}
+    run, seg, pos, space = c_short(), c_int32(), c_double(), c_int32()
+    prun, pseg, ppos, pspace = byref(run), byref(seg), byref(pos), byref(space)
+    with tempfile.TemporaryDirectory() as tmp:
+        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        for _ in range(pairs):
+            for bank in ("auto", "off"):
+                bring_up(eni, n, bank)
+                try:
+                    for a in plan:
+                        gtn("AxisOn", a)
+                    start_crd(crd_axes)
+                    gt.GTE_Wait(50)
+                    check(plan)
+                    ms = 0
+                    c0, t0 = time.process_time(), time.perf_counter()
+                    while time.perf_counter() - t0 < seconds / pairs:
+                        for k in range(100):
+                            gt.GTE_Wait(1)
+                            for crd in (1, 2):
+                                gt.GT_CrdStatus(crd, prun, pseg, 0)
+                            for a in crd_axes:
+                                gt.GT_GetPrfPos(a, ppos)
+                            if push_every and k % push_every == 0:
+                                for crd in (1, 2):
+                                    gt.GT_CrdSpace(crd, pspace, 0)
+                                    x = 10_000 * (k // push_every % 2)
+                                    gt.GT_LnXY(crd, x, 0, 20.0, 0.5, 20.0, 0)
+                        ms += 100
+                    cpu = max(time.process_time() - c0, 1e-9)
+                    check(plan)
+                finally:
+                    gt.GT_Close()
+                best[bank] = max(best[bank], ms / 1000 / cpu)
+    return {
+        "axes": n,
+        "what": "2 XY systems, GT_CrdStatus x2 + GT_GetPrfPos x4 after every cycle"
+        + (f", a segment pushed onto each every {push_every} cycles" if push_every else ""),
+        "rtf_cpu_bank": round(best["auto"], 2),
+        "rtf_cpu_scalar": round(best["off"], 2),
+        "ratio": round(best["auto"] / best["off"], 2) if best["off"] else None,
+    }
+
+
 def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> dict[str, object]:
     """The many-axes figures, measured one after the other in this run (``only``: those)."""
     from tools.bench_scaling import crd_plan, run_bus
@@ -394,6 +458,12 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_64_axes_follow": lambda: rtf(64, every(64, "follow"), 10, FOLLOW),
         "rtf_12_axes_crd": lambda: rtf(12, crd_plan(12), None, CRD),
         "rtf_64_axes_crd": lambda: rtf(64, crd_plan(64), 10, CRD),
+        "crd_polled_12_axes_bank_vs_scalar": lambda: _figure(
+            bench_crd_poll(2 * seconds), "ratio", 1.0
+        ),
+        "crd_streamed_12_axes_bank_vs_scalar": lambda: _figure(
+            bench_crd_poll(2 * seconds, push_every=10), "ratio", 1.0
+        ),
         "gt_get_sts_vs_argument": lambda: _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
         "call_shapes_vs_arguments": lambda: _figure(
             bench_call_shapes(2 * seconds), "worst", 4, at_most=True

@@ -11,7 +11,9 @@ own ``GT_Open(eni=..., ...)`` (a note on stderr says so, once per option); the s
 arguments win over the ``GTECAT_*`` environment, which wins over the defaults.
 
 The script's own exit code is the command's; an exception in the script prints its
-traceback (the script's frames only) and exits 1.
+traceback (the script's frames only) and exits 1.  With ``--check``, a script that ends
+well (0) but drew findings exits :data:`CHECK_FINDINGS` (3), so CI can gate on it; a
+script that fails keeps its own code (its failure says more than the findings).
 """
 
 from __future__ import annotations
@@ -55,8 +57,13 @@ def _add_options(p: argparse.ArgumentParser) -> None:
         help="warn (check: FILE:LINE: ...) where a real drive or controller would punish the "
         "script: skipped CiA-402 states, enable in fault, CSP steps past the following-error "
         "window, mode changes in motion, SDO writes to mapped objects in OP, endless "
-        "GT_IsEcatReady polls, moves on an axis in alarm",
+        "GT_IsEcatReady polls, moves on an axis in alarm; exit 3 when it finds any (the "
+        "script's own non-zero code wins)",
     )
+
+
+#: the exit code of ``gtecat run --check`` when the script ended well but drew findings
+CHECK_FINDINGS = 3
 
 
 EPILOG = """\
@@ -66,6 +73,9 @@ backend=..., iface=...) arguments; a note on stderr names each one replaced.
 examples:
   gtecat run first_script.py --eni manual_fig5_2.eni
   gtecat run --check first_script.py --eni manual_fig5_2.eni    warnings with file and line
+
+exit codes: the script's own (0 when it ends well, 1 on an exception); with --check, 3 when
+the script ended with 0 but a check found something.
   gtecat run home.py --machine machine.toml --trace axis1.enc,axis1.sw,0:0x60FD:0
   gtecat run my_machine.py --clock realtime --backend pysoem --iface eth0
 
@@ -402,4 +412,9 @@ def run(args: argparse.Namespace) -> int:
                 f"--trace-out {stem}: cannot write the trace: {e.strerror or e}"
             ) from None
         print(f"trace: {rec.n} cycles -> {csv_path}, {png_path}")
+    if checker is not None and checker.findings:
+        n = len(checker.findings)
+        print(f"check: {n} finding{'s' if n != 1 else ''}", file=sys.stderr)
+        if rc == 0:
+            return CHECK_FINDINGS
     return rc

@@ -15,7 +15,9 @@ state written back into its objects exactly as if they had run every cycle thems
 before anything else may look at or change them:
 
 * any GT function except the bank-aware readers (:data:`BANK_READS`) releases the
-  axis it names (or every axis when it names several, a mask or none) before it runs;
+  axis it names (or every axis when it names several, a mask or none) before it runs; one
+  naming a coordinate system releases that system's cluster alone (:meth:`AxisBank.before_call`;
+  a segment pushed onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit, the following
   error, a new sample past a soft limit, a raw write to its slave's outputs, the
   drive's own following-error window) releases it *before* that cycle, so the scalar
@@ -74,6 +76,7 @@ from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import wanted as kernel_wanted
 from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
+from .crd.system import Delay, Motion
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -144,8 +147,33 @@ BANK_READS = frozenset(
         "GT_GetVersion",
         "GT_IsEcatReady",
         "GT_GetEcatHomingStatus",
+        # a coordinate system's state, read from the cycle the bank records of it
+        # (CoordSystem.now, bank_modes.SystemTrace), or its parameters (never stepped)
+        "GT_CrdStatus",
+        "GT_CrdSpace",
+        "GT_GetCrdPos",
+        "GT_GetCrdVel",
+        "GT_GetCrdPrm",
+        "GT_GetCrdStopDec",
+        "GT_GetRemainderSegNum",
+        "GT_GetCrdMapBase",
+        "GT_CrdData",
     }
 )
+#: GT functions naming coordinate systems by a mask (GT_CrdStart: bit 0 = system 1; GT_Stop:
+#: bits 12, 13 = systems 1, 2, bits 0-11 = axes 1-12): (the first system's bit, axes' bits)
+_CRD_MASKS = {"GT_CrdStart": (0, 0), "GT_Stop": (12, 0xFFF)}
+#: GT functions naming a system that read or change other systems too: every axis goes back
+_CRD_ALL = frozenset({"GT_SetCrdPrm"})
+
+
+def _crd_push(name: str) -> bool:
+    """A GT function that pushes one line, arc, helix or delay onto a FIFO, nothing else."""
+    return name == "GT_BufDelay" or (
+        name.startswith(("GT_Ln", "GT_Arc", "GT_Helix")) and not name.endswith("Ex")
+    )
+
+
 #: rows up to which GT_GetSts's words are made row by row (fewer calls than numpy's)
 _SMALL_BANK = 32
 #: the axis's mode while its drive homes (6060h = 6)
@@ -1024,6 +1052,8 @@ class AxisBank:
             cl.rewind(self)
             for c in cl.systems:
                 c.banked = False
+                c.trace = None
+                c.push_hook = None
             for gi in cl.groups:
                 self._cluster_of.pop(gi, None)
             self.sampled[cl.rows] = False
@@ -1094,6 +1124,24 @@ class AxisBank:
         if not self.n_alive:
             return
         params = proto.params
+        if params and values and type(values[0]) is int:
+            name = proto.name
+            if params[0].name == "crd" and name not in _CRD_ALL:
+                # a segment pushed onto the tail of a path the bank holds ahead: kept there
+                # where no cycle of the bank's window reaches the tail (_push_ahead); else a
+                # call on one coordinate system gives back its own cluster (its axes and any
+                # other object it reaches release themselves through their guards)
+                if not (_crd_push(name) and self._push_ahead(ctl, proto, values)):
+                    self._release_systems(ctl, [values[0]])
+                return
+            masked = _CRD_MASKS.get(name)
+            if masked is not None:
+                first, axis_bits = masked
+                m = values[0]
+                self._release_systems(ctl, [n for n in (1, 2) if m >> (first + n - 1) & 1])
+                if not m & axis_bits:
+                    return
+                values = (m & axis_bits, *values[1:])  # the axes of the mask, below
         if params and params[0].name in ("axis", "profile", "encoder") and values:
             if not any(p.name == "count" for p in params):
                 n = values[0]
@@ -1111,6 +1159,62 @@ class AxisBank:
                     self.release_axis_object(ax)
                 return
         self.release_all()
+
+    def _push_ahead(self, ctl: Any, proto: Any, values: tuple) -> bool:
+        """A GT_LnXY, GT_ArcXY..., GT_HelixXY... or GT_BufDelay onto the running FIFO of a system
+        the bank holds a window of cycles ahead may go onto the FIFO as it stands there: the
+        segment at its tail is not reached in that window, and no segment starting in it looks
+        that far (its exit speed looks at the next segment only, without a look-ahead).  Then
+        the entry joins the FIFO kept for the rewind too (:meth:`_pushed_ahead`); True."""
+        if ctl.clock.threaded:  # the cycles may go on before the call takes the lock
+            return False
+        crds = vars(ctl).get("crd_bank")
+        c = crds.systems.get(values[0]) if crds is not None else None
+        if c is None or not c.banked:
+            return False
+        names = [p.name for p in proto.params]
+        fifo = values[names.index("fifo")] if "fifo" in names else 0
+        if type(fifo) is not int or fifo != c.fifo or not c.running or c.stopping:
+            return False
+        if c.look[fifo] is not None or c.now().space(fifo) <= 1:
+            return False
+        for e in c.fifos[fifo]:  # a delay, or a segment of some length, before the tail
+            if type(e) is Delay or (type(e) is Motion and e.geom.length > 0.0):
+                break
+        else:
+            return False
+        cl = next((x for x in self._cluster_of.values() if c in x.systems), None)
+        if cl is None:
+            return False
+        c.push_hook = lambda c, entry, fifo: self._pushed_ahead(cl, c, entry, fifo)
+        return True
+
+    def _pushed_ahead(self, cl: Cluster, c: Any, entry: Any, fifo: int) -> None:
+        if cl.snaps is not None:  # (None: the system stands where the scalar path has it)
+            for obj, snap in cl.snaps:
+                if obj is c:
+                    kept = snap[2]  # bank_modes.snapshot: the __dict__, containers by content
+                    kept["fifos"][1][fifo][1].append(entry)
+                    kept["tails"][1][fifo] = c.tails[fifo]
+            if c.trace is not None:
+                c.trace.pushed[fifo] += 1
+                c.trace.memo = None
+        if not (type(entry) is Delay or (type(entry) is Motion and entry.speed_plan is None)):
+            self._release_groups([self.groups[cl.groups[0]]])
+
+    def _release_systems(self, ctl: Any, numbers: list[int]) -> None:
+        """Give back the clusters that run coordinate systems ``numbers`` of ``ctl``."""
+        crds = vars(ctl).get("crd_bank")
+        if crds is None:
+            return
+        for n in numbers:
+            c = crds.systems.get(n)
+            if c is None or not c.banked:
+                continue
+            for cl in {id(cl): cl for cl in self._cluster_of.values()}.values():
+                if c in cl.systems:
+                    self._release_groups([self.groups[cl.groups[0]]])
+                    break
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
     def value(self, name: str, r: int) -> Any:

@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .bank_kernel import MAXSEG, PT_STATE, trap_fill
-from .crd.system import AxisSlot, CoordSystem, Delay, Motion
+from .crd.system import AxisSlot, CoordSystem, CrdNow, Delay, Motion
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
 from .motion.master import SlavePlanner
@@ -104,24 +104,29 @@ def system_plain(c: CoordSystem) -> bool:
     q = c.fifos[c.fifo]
     if not q:
         return True
-    # a FIFO seen plain stays plain while it only loses entries (the last one and the
-    # length tell a push)
-    key = (c.fifo, id(q[-1]))
+    # a FIFO seen plain stays plain while it only loses entries at its head and gains plain
+    # ones at its tail: only those after the last entry seen are looked at (a segment pushed
+    # every cycle while the path runs costs one look, not one over the whole FIFO)
+    last = q[-1]
     seen = _PLAIN.get(id(c))
-    if seen is not None and seen[0] == key and len(q) <= seen[1]:
+    old = seen[1] if seen is not None and seen[0] == c.fifo else None
+    if last is old and len(q) <= seen[2]:  # type: ignore[index]
         return True
-    for e in q:
+    for e in reversed(q):
+        if e is old:
+            break
         t = type(e)
         if t is Delay:
             continue
         if t is not Motion or e.speed_plan is not None:
             return False
-    _PLAIN[id(c)] = (key, len(q))
+    _PLAIN[id(c)] = (c.fifo, last, len(q))
     return True
 
 
-#: id(system) -> (fifo and id of its last entry, length) of the last FIFO seen plain
-_PLAIN: dict[int, tuple[tuple[int, int], int]] = {}
+#: id(system) -> (fifo, its last entry, length) of the last FIFO seen plain (the entry itself
+#: kept: its id cannot be taken by a new one)
+_PLAIN: dict[int, tuple[int, Any, int]] = {}
 
 
 def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
@@ -318,6 +323,71 @@ def _trap_samples(bank: AxisBank, pl: TrapPlanner, n: int) -> tuple[Any, Any, An
     return out[0, :m], out[1, :m], out[2, :m], end
 
 
+class SystemTrace:
+    """A coordinate system's state in each cycle of a cluster's last fill: the read calls
+    (GT_CrdStatus, GT_CrdSpace, GT_GetCrdPos, GT_GetCrdVel) answer from it while the bank
+    holds the system a table ahead of the controller's time, without giving it back.
+
+    ``start``: :meth:`CoordSystem.state` before the fill; ``speeds[j]``: the path speed after
+    cycle ``j``; ``marks``: (cycle, state after it) of the cycles :meth:`CoordSystem.run` did
+    not take as its common case (only the speed and the positions change in one of those:
+    the positions are the slots' samples, ``cols``); every cycle is marked where ``cols`` is
+    None."""
+
+    __slots__ = ("bank", "cols", "marks", "memo", "pushed", "rows", "speeds", "start")
+
+    def __init__(self, bank: AxisBank, rows: list[int], c: CoordSystem) -> None:
+        self.bank = bank
+        self.rows = rows
+        #: (the bank's cycle count, the answer): the reads of one cycle share it
+        self.memo: tuple[int, Any] | None = None
+        self.start = c.state()
+        self.speeds: list[float] = []
+        self.marks: list[tuple[int, tuple]] = []
+        self.cols: list[list[tuple[float, float, float]]] | None = None
+        #: entries pushed onto each FIFO since (AxisBank._pushed_ahead): not in the states
+        self.pushed = [0, 0]
+
+    def now(self, c: CoordSystem) -> Any:
+        """``c`` as the scalar path has it now: the cluster's rows took ``m`` samples since the
+        fill (as :meth:`Cluster.rewind` counts them); past the cycles stepped, ``c``'s own."""
+        bank = self.bank
+        memo = self.memo
+        cycles = bank.bank_cycles
+        if memo is not None and memo[0] == cycles:
+            return memo[1]
+        now = self._at(c)
+        self.memo = (cycles, now)
+        return now
+
+    def _at(self, c: CoordSystem) -> Any:
+        bank = self.bank
+        taken, filled = bank.taken, bank.fill_taken
+        m = max(int(taken[r]) - int(filled[r]) for r in self.rows)
+        if m >= len(self.speeds):  # the objects stand where the scalar path has them
+            return CrdNow(c, c.state())
+        if m == 0:
+            return CrdNow(c, self._pushed(self.start))
+        marks = self.marks
+        j = m - 1
+        k = len(marks) - 1
+        while k >= 0 and marks[k][0] > j:
+            k -= 1
+        if k >= 0 and marks[k][0] == j:
+            return CrdNow(c, self._pushed(marks[k][1]))
+        base = marks[k][1] if k >= 0 else self.start
+        cols = self.cols
+        assert cols is not None
+        pos = tuple(col[j][0] - o for col, o in zip(cols, c.origin, strict=True))
+        return CrdNow(c, self._pushed((*base[:6], self.speeds[j], pos, base[8])))
+
+    def _pushed(self, st: tuple) -> tuple:
+        p0, p1 = self.pushed
+        if not (p0 or p1):
+            return st
+        return (*st[:4], st[4] + p0, st[5] + p1, *st[6:])
+
+
 class Cluster:
     """Rows whose planners the bank steps ahead together (module docstring)."""
 
@@ -427,10 +497,15 @@ class Cluster:
         if self.topo is not None:
             self._fill_columns(bank)
             return
+        for c in self.systems:
+            c.trace = None
         if self.alone:  # one coordinate system and its axes: its own run
             c = self.systems[0]
             if c.running:
-                cols, end = c.run(SAMPLED_TABLE)
+                trace = SystemTrace(bank, rows, c)
+                cols, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks)
+                trace.cols = cols
+                c.trace = trace
                 at = {id(slot): k for k, slot in enumerate(c.slots)}
                 for i, r in enumerate(rows):
                     col = cols[at[id(self.planners[i])]]
@@ -461,10 +536,14 @@ class Cluster:
                     ends[i] = j
                     break
         else:
+            traces = [SystemTrace(bank, rows, c) for c in systems]
             for j in range(table):
                 for c in systems:
                     if c.running:
                         c.step()
+                for c, trace in zip(systems, traces, strict=True):
+                    trace.speeds.append(c.speed)
+                    trace.marks.append((j, c.state()))
                 ended = False
                 for i, step, rest, col in live:
                     # the others of the cluster at rest: stepping them changes nothing
@@ -475,6 +554,8 @@ class Cluster:
                         ended = True
                 if ended:
                     live = [x for x in live if ends[x[0]] < 0]
+            for c, trace in zip(systems, traces, strict=True):
+                c.trace = trace
         for i, r in enumerate(rows):
             if cols[i]:
                 ps, vs, as_ = (list(x) for x in zip(*cols[i], strict=True))
@@ -777,4 +858,12 @@ class Cluster:
             self.step()
 
 
-__all__ = ["SAMPLED_TABLE", "Cluster", "links", "restore", "sampled_kind", "snapshot"]
+__all__ = [
+    "SAMPLED_TABLE",
+    "Cluster",
+    "SystemTrace",
+    "links",
+    "restore",
+    "sampled_kind",
+    "snapshot",
+]

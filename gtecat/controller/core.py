@@ -33,8 +33,9 @@ Decisions where the manual is silent:
   GT_AxisOn returns 1 naming the slave.  Once the slave is back in OP:
   GT_ClrSts (resets the drive fault the loss caused, clears bit 1), then
   GT_AxisOn; before GT_ClrSts, GT_AxisOn returns 1 saying so.  Axes of other
-  slaves keep running.  The master confirms a loss after 10 ms of short working
-  counter, so one lost frame does not stop a machine.
+  slaves keep running.  The master reads the slaves' states in the first cycle of
+  short working counter, so the axes stop in that cycle; one lost frame (every
+  slave still in OP when asked) does not stop a machine.
 """
 
 from __future__ import annotations

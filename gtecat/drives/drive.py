@@ -18,7 +18,14 @@ Behaviour the standard leaves open, as implemented (each configurable in
   PDO-mapped controlword is ignored.  When the master leaves OP, a channel
   whose 6040h is PDO-mapped and whose power stage is on goes to SWITCH ON
   DISABLED (``comm_loss_reaction="disable"``, as kubabuda/ecat_servo does),
-  or to FAULT with 603Fh = 0x8100 (``"fault"``).  A controlword that is not
+  or to FAULT with 603Fh = 0x8100 (``"fault"``).  When the drive itself finds
+  its process data stopped (its sync-manager watchdog ran out: a cable pulled,
+  a master that died), it faults with 603Fh = ``watchdog_fault_code`` (8130h,
+  CiA 301 "life guard or heartbeat error", the code CiA 301 gives a drive that
+  lost its cyclic communication; vendors' EtherCAT drives raise an alarm of
+  their own for it rather than switching off silently), whatever its power
+  stage did, so the application reads why its axis stopped once the link is
+  back; 0 takes ``comm_loss_reaction`` for that case too.  A controlword that is not
   PDO-mapped (SDO-only masters) is obeyed in every AL state.  Inputs are
   encoded every cycle.
 - **Limit switches** (``limit_reaction``): ``"stop"`` (default): while 60FDh
@@ -54,7 +61,13 @@ from typing import Any
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
 from gtecat.drives.cia402 import STATE_BITS, PowerStateMachine, State, Sw
-from gtecat.drives.faults import ErrorCode, FaultMonitor, FieldOverride, fault_code
+from gtecat.drives.faults import (
+    ErrorCode,
+    FaultMonitor,
+    FieldOverride,
+    error_register,
+    fault_code,
+)
 from gtecat.drives.homing import SUPPORTED_METHODS, Homing, HomingParams
 from gtecat.drives.machine import AxisMachine
 from gtecat.drives.mechanics import Mechanics, MechanicsParams
@@ -132,6 +145,9 @@ class DriveSettings:
     mode_change_states: frozenset[State] | None = None
     limit_reaction: str = "stop"
     comm_loss_reaction: str = "disable"
+    #: 603Fh when the sync-manager watchdog runs out (process data stopped); 0: as
+    #: ``comm_loss_reaction``
+    watchdog_fault_code: int = 0x8130
     following_error_fault: bool = True
     #: 6065h when the machine description gives no following_error_window, counts
     following_error_window: int = 10000
@@ -718,11 +734,16 @@ class Channel:
         if self.psm.power_on():
             self._refresh_status()
 
-    def comm_lost(self) -> None:
-        """The master left OP while this channel's controlword was PDO-mapped."""
+    def comm_lost(self, watchdog: bool = False) -> None:
+        """The slave left OP while this channel's controlword was PDO-mapped: the master
+        asked for it, or (``watchdog``) the process data stopped coming."""
         reaction = self._settings.comm_loss_reaction
         state = self.psm.state
-        if reaction == "fault":
+        wd_code = self._settings.watchdog_fault_code if watchdog else 0
+        if wd_code:
+            if state not in (State.FAULT, State.FAULT_REACTION_ACTIVE):
+                self.faults.raise_fault(wd_code)
+        elif reaction == "fault":
             if state not in (State.FAULT, State.FAULT_REACTION_ACTIVE):
                 self.faults.raise_fault(ErrorCode.COMMUNICATION)
         elif reaction == "disable":
@@ -756,7 +777,7 @@ class Channel:
             self.error_code_value = code
             self._transition(13)
             # CiA 301 7.2.7 / ETG.1000.6 5.6.4: an emergency telegram with 603Fh and 1001h
-            self.drive.emit_emergency(code, 0x01, bytes([self.k, 0, 0, 0, 0]))
+            self.drive.emit_emergency(code, error_register(code), bytes([self.k, 0, 0, 0, 0]))
 
     def step(self, t_ns: int, dt_ns: int, dt: float, cw_valid: bool) -> None:
         self.cycle += 1
@@ -1056,7 +1077,10 @@ class Cia402Drive(VirtualSlave):
         add_identity(od, identity)
 
     def _error_register(self) -> int:
-        return 1 if any(ch.error_code_value for ch in self.channels) else 0
+        reg = 0
+        for ch in self.channels:
+            reg |= error_register(ch.error_code_value)
+        return reg
 
     def _guard_rxpdo(self, var: Variable, al_state: AlState) -> None:
         if (
@@ -1096,8 +1120,17 @@ class Cia402Drive(VirtualSlave):
         if old == AlState.OP and new != AlState.OP:
             for ch in self.channels:
                 if ch.cw_mapped:
-                    ch.comm_lost()
+                    ch.comm_lost(self._watchdog_ran_out)
         return AlStatusCode.NO_ERROR
+
+    _watchdog_ran_out = False
+
+    def watchdog_expired(self) -> None:
+        self._watchdog_ran_out = True
+        try:
+            super().watchdog_expired()
+        finally:
+            self._watchdog_ran_out = False
 
     def step(self, t_ns: int, dt_ns: int) -> None:
         codec = self.codec

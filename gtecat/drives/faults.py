@@ -28,6 +28,9 @@ class ErrorCode(IntEnum):
     MOTOR_OVER_TEMPERATURE = 0x4410
     ENCODER = 0x7305  # incremental sensor 1 fault
     COMMUNICATION = 0x8100
+    #: CiA 301 "life guard error or heartbeat error": the drive's process data stopped
+    #: (its sync-manager watchdog ran out)
+    LIFE_GUARD = 0x8130
     FOLLOWING_ERROR = 0x8611
     REFERENCE_LIMIT = 0x8612
     ALARM = 0xFF00  # vendor: external alarm / generic servo alarm
@@ -48,6 +51,7 @@ FAULT_KINDS: dict[str, ErrorCode] = {
     "motor_overtemperature": ErrorCode.MOTOR_OVER_TEMPERATURE,
     "following_error": ErrorCode.FOLLOWING_ERROR,
     "communication": ErrorCode.COMMUNICATION,
+    "life_guard": ErrorCode.LIFE_GUARD,
     "generic": ErrorCode.GENERIC,
     "sto": ErrorCode.SAFE_TORQUE_OFF,
 }
@@ -61,8 +65,37 @@ TRANSIENT: frozenset[int] = frozenset(
         ErrorCode.POSITIVE_LIMIT,
         ErrorCode.NEGATIVE_LIMIT,
         ErrorCode.COMMUNICATION,
+        ErrorCode.LIFE_GUARD,
     }
 )
+
+
+def error_register(code: int) -> int:
+    """1001h (and the error register byte of the emergency) for a 603Fh ``code``.
+
+    CiA 301 (7.5.2.2, object 1001h): bit 0 generic error is set for every error; the
+    class of the code (its high digits, CiA 301 table of emergency error codes) sets
+    one more: bit 1 current (2xxxh), bit 2 voltage (3xxxh), bit 3 temperature (4xxxh),
+    bit 4 communication (81xxh: 8100h, 8130h life guard), bit 7 manufacturer specific
+    (FFxxh).  The other classes (1000h generic, 5xxxh device hardware, 7xxxh additional
+    modules such as the encoder, 86xxh the CiA 402 positioning codes: following error,
+    reference limit) set bit 0 alone.  0 for no error.
+    """
+    code &= 0xFFFF
+    if not code:
+        return 0
+    reg = 0x01
+    if 0x2000 <= code < 0x3000:
+        reg |= 0x02
+    elif 0x3000 <= code < 0x4000:
+        reg |= 0x04
+    elif 0x4000 <= code < 0x5000:
+        reg |= 0x08
+    elif 0x8100 <= code < 0x8200:
+        reg |= 0x10
+    elif code >= 0xFF00:
+        reg |= 0x80
+    return reg
 
 
 class FaultError(GtecatError):

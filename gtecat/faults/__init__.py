@@ -21,11 +21,11 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from ..errors import ParameterError
+from ..errors import CommandError, ParameterError
 from .bus import EmulatedBus, FaultBus, WireBus
 from .injector import Entry, Injector
 from .kinds import KINDS, Fault, FaultSpecError, fault_from_dict, kind_rows
-from .triggers import TRIGGER_KEYS, Trigger, trigger_from_dict
+from .triggers import TRIGGER_KEYS, Trigger, _ms, describe_after, trigger_from_dict
 
 _EXTRA_KEYS = ("duration_ms", "after", "name")
 
@@ -33,7 +33,7 @@ _EXTRA_KEYS = ("duration_ms", "after", "name")
 class FaultSpec:
     """One fault as the four ways in give it: the fault, its trigger, how long, after what."""
 
-    __slots__ = ("after", "duration_ms", "fault", "name", "trigger")
+    __slots__ = ("after", "duration_ms", "fault", "name", "trigger", "where")
 
     def __init__(
         self,
@@ -42,12 +42,20 @@ class FaultSpec:
         duration_ms: float | None = None,
         after: int | str | None = None,
         name: str = "",
+        where: str = "",
     ) -> None:
         self.fault, self.trigger, self.duration_ms = fault, trigger, duration_ms
         self.after, self.name = after, name
+        #: where it was written (a file and its table, a script's step): errors name it
+        self.where = where
 
     def describe(self) -> str:
-        text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        if self.after is None:
+            text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        else:
+            text = (
+                f"{self.fault.describe()}, {describe_after(self.trigger, _after_words(self.after))}"
+            )
         if self.duration_ms is not None:
             text += f", for {self.duration_ms:g} ms"
         return text
@@ -61,6 +69,10 @@ class FaultSpec:
         if self.name:
             d["name"] = self.name
         return d
+
+
+def _after_words(after: int | str) -> str:
+    return f"fault {after}" if isinstance(after, int) else f"the fault named {after!r}"
 
 
 def _tell(what: str, values: dict[str, Any]) -> None:
@@ -84,15 +96,28 @@ def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
     duration = extra.get("duration_ms")
     if duration is not None:
         try:
-            duration = float(duration)
-        except (TypeError, ValueError):
-            raise FaultSpecError(f"{prefix}duration_ms must be a number") from None
-        if duration < 0:
-            raise FaultSpecError(f"{prefix}duration_ms must be >= 0")
+            duration = _ms("duration_ms", duration)
+        except FaultSpecError as e:
+            raise FaultSpecError(f"{prefix}{e}") from None
     after = extra.get("after")
     if isinstance(after, str) and after.strip().lstrip("-").isdigit():
         after = int(after)
-    return FaultSpec(fault, trigger, duration, after, str(extra.get("name", "")))
+    if isinstance(after, float) and after.is_integer():
+        after = int(after)
+    if after is not None and (
+        isinstance(after, bool)
+        or not isinstance(after, int | str)
+        or (isinstance(after, int) and after < 1)
+        or (isinstance(after, str) and not after.strip())
+    ):
+        raise FaultSpecError(
+            f"{prefix}after must be a fault's id (1 or more) or the name of a fault before it, "
+            f"got {after!r}"
+        )
+    name = extra.get("name", "")
+    if not isinstance(name, str):
+        raise FaultSpecError(f"{prefix}name must be text, got {name!r}")
+    return FaultSpec(fault, trigger, duration, after, name, where)
 
 
 def specs_from_tables(tables: Any, source: str = "") -> list[FaultSpec]:
@@ -130,9 +155,15 @@ def arm(injector: Injector, specs: list[FaultSpec]) -> list[Entry]:
         after = s.after
         if isinstance(after, str):
             if after not in names:
-                raise FaultSpecError(f"after={after!r}: no fault named so before it")
+                prefix = f"{s.where}: " if s.where else ""
+                raise FaultSpecError(f"{prefix}after={after!r}: no fault named so before it")
             after = names[after]
-        e = injector.add(s.fault, s.trigger, s.duration_ms, after=after, name=s.name)
+        try:
+            e = injector.add(s.fault, s.trigger, s.duration_ms, after=after, name=s.name)
+        except ParameterError as err:  # a slave, an axis, a fault the bus does not have
+            if not s.where:
+                raise
+            raise ParameterError(f"{s.where}: {err}") from None
         if s.name:
             names[s.name] = e.id
         out.append(e)
@@ -161,7 +192,15 @@ def injector_for(ctl: Any, create: bool = True) -> Injector | None:
 
 def _bus_up(ctl: Any) -> None:
     """Arm the machine description's ``[[fault]]`` tables on every bus that comes up (the
-    faults of a bus brought up before go with it)."""
+    faults of a bus brought up before go with it).
+
+    Every error in them - a value out of range, an unknown kind, a slave or an axis the bus
+    does not have (``link_down after_slave=5`` on a bus of three slaves), an ``after`` that
+    names nothing - is one :class:`~gtecat.errors.CommandError`, so ``GT_InitEcatComm``
+    returns 1 for each alike.  Decided from the manual's return codes (table 3-1): 7 is
+    "a parameter of this call is wrong", and the call's own parameters are right; 1 is "the
+    command could not be carried out", which is what a bus that cannot be brought up as its
+    description says is.  GTE_GetLastError gives the one line naming the file and table."""
     ctl.pre_cycle[:] = [
         f
         for f in ctl.pre_cycle
@@ -172,8 +211,12 @@ def _bus_up(ctl: Any) -> None:
     ]
     tables = getattr(ctl.machine, "faults", ())
     if tables and ctl.options.backend == "emulated":
-        specs = specs_from_tables(list(tables), ctl.machine.source or "machine description")
-        arm(injector_for(ctl), specs)  # type: ignore[arg-type]
+        source = ctl.machine.source or "machine description"
+        try:
+            specs = specs_from_tables(list(tables), source)
+            arm(injector_for(ctl), specs)  # type: ignore[arg-type]
+        except (FaultSpecError, ParameterError) as e:
+            raise CommandError(str(e)) from None
 
 
 def _controller(core: int = 1) -> Any:

@@ -49,6 +49,16 @@ READY_POLLS = 200
 _START_CALLS = frozenset({"GT_Update", "GT_MoveAbsolute", "GT_MoveRelative", "GT_MoveVelocity"})
 
 
+#: cycles a drive may take to make an SDO-written 6060h its mode (the finding then still
+#: names the SDO call, not the one running when the drive took it up)
+_MODE_TAKE_UP_CYCLES = 4
+
+
+def _is_mode_index(index: int) -> bool:
+    """6060h of a drive's first channel, or of another (each 800h further: CiA 402 ch. 2)."""
+    return index >= 0x6060 and (index - 0x6060) % 0x800 == 0 and index <= 0x6060 + 0x800 * 7
+
+
 def _command(cw: int) -> str:
     """The command of a controlword (CiA 402 Table 2)."""
     if cw & 0x80:
@@ -100,6 +110,12 @@ class Checker(Listener):
         self._prev: dict[int, tuple[int, int, int, int]] = {}
         self._polls = 0
         self._poll_site: tuple[str, int] = ("", 0)
+        self._cycles = 0
+        #: (slave, 6060h of a channel) -> (call site, cycle it ended in): the call that wrote
+        #: a mode by SDO; the drive takes it up a cycle or two later, maybe inside the next
+        #: call, and the finding must name the call that made the change
+        self._mode_writes: dict[tuple[int, int], tuple[tuple[str, int], int]] = {}
+        self._pending_write: tuple[tuple[int, int], tuple[str, int]] | None = None
 
     def start(self) -> Checker:
         tap(self)
@@ -153,7 +169,14 @@ class Checker(Listener):
             self._check_start(ctl, name, args)
         elif name == "GT_EcatSDODownload" and len(args) >= 2:
             self._check_sdo(ctl, int(args[0]), int(args[1]))
+            if _is_mode_index(int(args[1])):
+                self._pending_write = ((int(args[0]), int(args[1])), site)
         return None
+
+    def after(self, name: str, args: tuple, kwargs: dict, rc: Any, token: Any) -> None:
+        pending, self._pending_write = self._pending_write, None
+        if pending is not None and rc == 0:
+            self._mode_writes[pending[0]] = (pending[1], self._cycles)
 
     def _attach(self) -> Any:
         from ..gt._core import SESSION
@@ -217,13 +240,21 @@ class Checker(Listener):
         slaves = getattr(backend, "slaves", None)
         if not slaves:
             return
+        self._cycles += 1
         axis = 0
-        for s in slaves:
-            for ch in getattr(s, "channels", ()):
+        for pos, s in enumerate(slaves):
+            for k, ch in enumerate(getattr(s, "channels", ())):
                 axis += 1
-                self._channel(axis, ch)
+                self._channel(axis, ch, (pos, 0x6060 + 0x800 * k))
 
-    def _channel(self, axis: int, ch: Any) -> None:
+    def _mode_site(self, key: tuple[int, int]) -> tuple[str, int] | None:
+        """The call that wrote this mode object by SDO, when it did so a few cycles ago."""
+        got = self._mode_writes.pop(key, None)
+        if got is None or self._cycles - got[1] > _MODE_TAKE_UP_CYCLES:
+            return None
+        return got[0]
+
+    def _channel(self, axis: int, ch: Any, mode_key: tuple[int, int] = (-1, 0)) -> None:
         cw, state = int(ch.controlword), ch.psm.state
         target, mode = int(ch.target_position), int(ch.mode_req)
         prev = self._prev.get(axis)
@@ -263,7 +294,10 @@ class Checker(Listener):
                 "mode-while-moving",
                 f"axis {axis}: mode of operation {pmode} -> {mode} while the axis moves "
                 f"({ch.mech.vel:.0f} counts/s)",
+                self._mode_site(mode_key),
             )
+        elif mode != pmode:
+            self._mode_writes.pop(mode_key, None)
 
 
 __all__ = ["SOURCES", "Checker", "Finding"]

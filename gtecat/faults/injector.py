@@ -31,7 +31,7 @@ from ..errors import ParameterError
 from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
 from . import kinds as k
 from .bus import FaultBus
-from .triggers import AfterTime, AtTime, Now, Trigger, first_cycle
+from .triggers import AfterTime, AtTime, Now, Trigger, describe_after, first_cycle
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
@@ -57,11 +57,12 @@ class Entry:
     name: str = ""
 
     def describe(self) -> str:
-        text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        if self.after is None:
+            text = f"{self.fault.describe()}, {self.trigger.describe()}"
+        else:
+            text = f"{self.fault.describe()}, {describe_after(self.trigger, f'fault {self.after}')}"
         if self.duration_ms is not None:
             text += f", for {self.duration_ms:g} ms"
-        if self.after is not None:
-            text += f", once fault {self.after} has started"
         return text
 
     def as_dict(self) -> dict[str, Any]:

@@ -60,6 +60,9 @@ class Fault:
     once: ClassVar[bool] = False
     summary: ClassVar[str] = ""
 
+    def __post_init__(self) -> None:
+        _check(self)  # every way in (a dict, the command line, the class itself) is checked
+
     def describe(self) -> str:
         return self.kind
 
@@ -134,11 +137,14 @@ class LinkDown(Fault):
     kind: ClassVar[str] = "link_down"
     depth: ClassVar[str] = "frame"
     summary: ClassVar[str] = (
-        "the cable behind slave AFTER_SLAVE is pulled: the slaves after it vanish"
+        "the cable behind slave AFTER_SLAVE is pulled: the slaves after it vanish "
+        "(-1: the cable at the master, the whole bus)"
     )
     after_slave: int
 
     def describe(self) -> str:
+        if self.after_slave < 0:
+            return "link down at the master (every slave vanishes)"
         return f"link down after slave {self.after_slave} (slaves {self.after_slave + 1}.. vanish)"
 
 
@@ -509,8 +515,12 @@ def _drive_code(v: Any) -> int:
     if isinstance(v, str) and v.strip().lower() in FAULT_KINDS:
         return int(FAULT_KINDS[v.strip().lower()])
     code = _int("code", v)
-    if not 0 < code <= 0xFFFF:
-        raise FaultSpecError(f"code 0x{code:X} is not a 16-bit 603Fh error code")
+    lo, hi = _KIND_RANGES[("drive_fault", "code")]
+    if not lo <= code <= hi:
+        raise FaultSpecError(
+            f"code {_shown('code', code)} is out of range 0x{lo:X}..0x{hi:X} "
+            "(a 16-bit 603Fh error code, or a name: " + ", ".join(FAULT_KINDS) + ")"
+        )
     return code
 
 
@@ -532,16 +542,80 @@ def _convert(cls: type[Fault], name: str, raw: Any) -> Any:
     return raw
 
 
+#: the range of every integer value, by field name: (lowest, highest, how it reads)
+_I32 = 0x7FFFFFFF
+RANGES: dict[str, tuple[int, int]] = {
+    "slave": (0, 0xFFFF),
+    "axis": (1, 0xFFFF),
+    "after_slave": (-1, 0xFFFF),  # -1: before the first slave, the whole bus goes
+    "count": (0, _I32),  # 0: until cleared
+    "bytes": (1, 1500),  # at most a whole Ethernet payload
+    "us": (0, 60_000_000),
+    "period_cycles": (1, _I32),
+    "bit": (0, 0xFFFF),
+    "value": (0, 1),
+    "offset": (-0xFFFF, 0xFFFF),  # the working counter is 16 bits
+    "index": (0, 0xFFFF),
+    "subindex": (0, 0xFF),
+    "counts": (-_I32, _I32),
+}
+#: per-kind ranges where a field name means something else
+_KIND_RANGES: dict[tuple[str, str], tuple[int, int]] = {
+    ("mailbox_abort", "code"): (0, 0xFFFFFFFF),  # SDO abort code, 32 bits (ETG.1000.6)
+    ("retreat_safeop", "code"): (0, 0xFFFF),  # AL status code, 16 bits
+    ("al_error", "code"): (0, 0xFFFF),
+    ("drive_fault", "code"): (1, 0xFFFF),  # 603Fh error code, 16 bits, 0: no error
+    ("encoder_noise", "counts"): (0, _I32),
+}
+#: fields shown (and best read) in hex
+HEX_FIELDS = frozenset({"code", "index"})
+
+
+def field_range(kind: str, name: str) -> tuple[int, int] | None:
+    """The accepted range of integer value ``name`` of ``kind`` (None: not an integer)."""
+    return _KIND_RANGES.get((kind, name), RANGES.get(name))
+
+
+def _shown(name: str, v: int, kind: str = "") -> str:
+    if name in HEX_FIELDS:
+        width = 8 if kind == "mailbox_abort" and name == "code" else 4
+        return f"-0x{-v:X}" if v < 0 else f"0x{v:0{width}X}"
+    return str(v)
+
+
+def _in_range(kind: str, name: str, v: Any) -> None:
+    rng = field_range(kind, name)
+    if rng is None or v is None:
+        return
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise FaultSpecError(f"{kind}: {name} must be an integer, got {v!r}")
+    lo, hi = rng
+    if not lo <= v <= hi:
+        raise FaultSpecError(
+            f"{kind}: {name} {_shown(name, v, kind)} is out of range "
+            f"{_shown(name, lo, kind)}..{_shown(name, hi, kind)}"
+        )
+
+
 def _check(fault: Fault) -> None:
-    for name in ("slave", "axis", "after_slave", "count", "bytes", "us", "period_cycles", "bit"):
-        v = getattr(fault, name, None)
-        if v is None:
+    for f in dataclasses.fields(fault):
+        v = getattr(fault, f.name)
+        if f.name == "area" and v is not None:
+            if not (isinstance(v, tuple) and len(v) == 2):
+                raise FaultSpecError(f"{fault.kind}: area must be two integers [start, end]")
+            for x in v:
+                if isinstance(x, bool) or not isinstance(x, int) or not 0 <= x <= 0xFFFFFFFF:
+                    raise FaultSpecError(
+                        f"{fault.kind}: area {list(v)}: each end in range 0..4294967295"
+                    )
+            if not v[0] < v[1]:
+                raise FaultSpecError(f"{fault.kind}: area {list(v)}: start must be below end")
             continue
-        low = 1 if name in ("axis", "period_cycles") else (-1 if name == "after_slave" else 0)
-        if name in ("bytes",) and v < 1:
-            raise FaultSpecError("bytes must be at least 1")
-        if v < low:
-            raise FaultSpecError(f"{fault.kind}: {name} must be >= {low}, got {v}")
+        if f.name in ("switch", "step", "variant", "state", "command") and v is not None:
+            if not isinstance(v, str):
+                raise FaultSpecError(f"{fault.kind}: {f.name} must be text, got {v!r}")
+            continue
+        _in_range(fault.kind, f.name, v)
     if isinstance(fault, SwitchStuck | SwitchChatter) and fault.switch not in SWITCH_BITS:
         raise FaultSpecError(
             f"{fault.kind}: switch {fault.switch!r}: one of {', '.join(SWITCH_BITS)}"
@@ -573,6 +647,10 @@ def _check(fault: Fault) -> None:
 def fault_from_dict(values: dict[str, Any], where: str = "") -> Fault:
     """A fault from ``{"kind": ..., key: value}`` (extra keys raise); values may be text."""
     prefix = f"{where}: " if where else ""
+    if values.get("kind") is None or not str(values.get("kind")).strip():
+        raise FaultSpecError(
+            f"{prefix}the fault kind is missing (kind=); the kinds are " + ", ".join(KINDS)
+        )
     kind = str(values.get("kind", "")).strip().lower()
     kind = _ALIASES.get(kind, kind)
     cls = KINDS.get(kind)
@@ -605,12 +683,10 @@ def fault_from_dict(values: dict[str, Any], where: str = "") -> Fault:
     if isinstance(kwargs.get("switch"), str):
         sw = kwargs["switch"].strip().lower()
         kwargs["switch"] = _SWITCHES.get(sw, sw)
-    fault = cls(**kwargs)
     try:
-        _check(fault)
+        return cls(**kwargs)
     except FaultSpecError as e:
         raise FaultSpecError(f"{prefix}{e}") from None
-    return fault
 
 
 def kind_rows() -> list[dict[str, str]]:
@@ -622,7 +698,9 @@ def kind_rows() -> list[dict[str, str]]:
             if f.default is dataclasses.MISSING:
                 params.append(f.name)
             else:
-                params.append(f"{f.name}={f.default if f.default is not None else '-'}")
+                d = f.default
+                shown = "-" if d is None else _shown(f.name, d, name) if isinstance(d, int) else d
+                params.append(f"{f.name}={shown}")
         rows.append(
             {"kind": name, "depth": cls.depth, "values": " ".join(params), "what": cls.summary}
         )
@@ -630,9 +708,11 @@ def kind_rows() -> list[dict[str, str]]:
 
 
 __all__ = [
+    "HEX_FIELDS",
     "HOMING_STAGES",
     "KINDS",
     "MAILBOX_STEPS",
+    "RANGES",
     "SWITCH_BITS",
     "AlError",
     "Brake",
@@ -660,5 +740,6 @@ __all__ = [
     "SwitchStuck",
     "WkcOffset",
     "fault_from_dict",
+    "field_range",
     "kind_rows",
 ]

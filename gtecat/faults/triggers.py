@@ -10,6 +10,7 @@ that fired it.  Every trigger has ``describe()`` in words and the plain-dict key
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -216,6 +217,14 @@ def first_cycle(due: Any, bus: Any, left_ms: float, n: int) -> int:
     return k
 
 
+def describe_after(trigger: Trigger, after: str) -> str:
+    """The trigger in words for a script's step that waits for ``after`` (e.g. "fault 1"):
+    its time and cycles count from when that one started, so it says so first."""
+    if isinstance(trigger, Now):
+        return f"once {after} has started"
+    return f"once {after} has started, {trigger.describe()}"
+
+
 TRIGGER_KEYS = ("at_ms", "after_ms", "after_cycles", "when_position", "at_homing", "on_sdo")
 
 
@@ -223,24 +232,61 @@ def _num(name: str, v: Any) -> float:
     if isinstance(v, bool):
         raise FaultSpecError(f"{name} must be a number, got {v!r}")
     if isinstance(v, int | float):
-        return float(v)
-    try:
-        return float(int(str(v), 0)) if str(v).strip().lower().startswith("0x") else float(v)
-    except (TypeError, ValueError):
-        raise FaultSpecError(f"{name} must be a number, got {v!r}") from None
+        out = float(v)
+    else:
+        try:
+            text = str(v).strip().replace("_", "")
+            out = float(int(text, 0)) if text.lower().lstrip("-").startswith("0x") else float(text)
+        except (TypeError, ValueError, OverflowError):
+            raise FaultSpecError(f"{name} must be a number, got {v!r}") from None
+    if not math.isfinite(out):
+        raise FaultSpecError(f"{name} must be a finite number, got {v!r}")
+    return out
 
 
-def _list(name: str, v: Any, n: tuple[int, ...]) -> list[Any]:
+def _whole(name: str, v: Any, lo: int, hi: int) -> int:
+    """An integer value in ``lo..hi`` (hex text allowed) or a one-line error naming it."""
+    x = _num(name, v)
+    if not x.is_integer():
+        raise FaultSpecError(f"{name} must be a whole number, got {v!r}")
+    n = int(x)
+    if not lo <= n <= hi:
+        shown = (lambda k: f"0x{k:X}") if name.endswith("index") else str
+        raise FaultSpecError(
+            f"{name} {shown(n) if n >= 0 else n} is out of range {shown(lo)}..{shown(hi)}"
+        )
+    return n
+
+
+def _list(name: str, v: Any, n: tuple[int, ...], what: str) -> list[Any]:
     if isinstance(v, str):
         v = [p.strip() for p in v.split(",")]
     if not isinstance(v, list | tuple) or len(v) not in n:
         want = " or ".join(str(k) for k in n)
-        raise FaultSpecError(f"{name} must be a list of {want} values, got {v!r}")
+        raise FaultSpecError(f"{name} needs {want} values [{what}], got {v!r}")
     return list(v)
 
 
+#: the highest controller time (ms) a trigger may name: about 24 days, the GT clock's range
+MAX_MS = float(0x7FFFFFFF)
+_MAX_AXIS = 0xFFFF
+_MAX_SLAVE = 0xFFFF
+_MAX_COUNT = 0x7FFFFFFF
+
+
+def _ms(name: str, v: Any) -> float:
+    ms = _num(name, v)
+    if not 0 <= ms <= MAX_MS:
+        raise FaultSpecError(f"{name} {ms:g} is out of range 0..{MAX_MS:.0f}")
+    return ms
+
+
 def trigger_from_dict(values: dict[str, Any]) -> Trigger:
-    """The trigger the keys of :data:`TRIGGER_KEYS` in ``values`` give (at most one)."""
+    """The trigger the keys of :data:`TRIGGER_KEYS` in ``values`` give (at most one).
+
+    Every value is range-checked (times 0..MAX_MS ms, axes 1..65535, slaves 0..65535,
+    indexes 0..0xFFFF, counts as below) and a wrong one raises :class:`FaultSpecError`
+    with one line naming the key and its range."""
     given = [k for k in TRIGGER_KEYS if k in values]
     if len(given) > 1:
         raise FaultSpecError(f"one trigger per fault, got {', '.join(given)}")
@@ -249,35 +295,29 @@ def trigger_from_dict(values: dict[str, Any]) -> Trigger:
     key = given[0]
     v = values[key]
     if key == "at_ms":
-        ms = _num(key, v)
-        if ms < 0:
-            raise FaultSpecError("at_ms must be >= 0")
-        return AtTime(ms=ms)
+        return AtTime(ms=_ms(key, v))
     if key == "after_ms":
-        ms = _num(key, v)
-        if ms < 0:
-            raise FaultSpecError("after_ms must be >= 0")
-        return AfterTime(ms=ms)
+        return AfterTime(ms=_ms(key, v))
     if key == "after_cycles":
-        n = int(_num(key, v))
-        if n < 0:
-            raise FaultSpecError("after_cycles must be >= 0")
-        return AfterCycles(cycles=n)
+        return AfterCycles(cycles=_whole(key, v, 0, _MAX_COUNT))
     if key == "when_position":
-        axis, pos = _list(key, v, (2,))
-        return WhenPosition(axis=int(_num("axis", axis)), position=_num("position", pos))
+        axis, pos = _list(key, v, (2,), "AXIS, POSITION")
+        return WhenPosition(
+            axis=_whole("when_position: axis", axis, 1, _MAX_AXIS),
+            position=_num("when_position: position", pos),
+        )
     if key == "at_homing":
-        axis, stage = _list(key, v, (2,))
+        axis, stage = _list(key, v, (2,), "AXIS, STAGE")
         stage = str(stage).strip().lower()
         if stage not in HOMING_STAGES:
             raise FaultSpecError(f"at_homing: stage {stage!r}: one of {', '.join(HOMING_STAGES)}")
-        return AtHomingStage(axis=int(_num("axis", axis)), stage=stage)
-    parts = _list(key, v, (2, 3))
-    slave, index = int(_num("slave", parts[0])), int(_num("index", parts[1]))
-    n = int(_num("n", parts[2])) if len(parts) == 3 else 1
-    if n < 1:
-        raise FaultSpecError("on_sdo: n must be >= 1")
-    return OnSdo(slave=slave, index=index, n=n)
+        return AtHomingStage(axis=_whole("at_homing: axis", axis, 1, _MAX_AXIS), stage=stage)
+    slave, index, n = _list(key, v, (3,), "SLAVE, INDEX, N")
+    return OnSdo(
+        slave=_whole("on_sdo: slave", slave, 0, _MAX_SLAVE),
+        index=_whole("on_sdo: index", index, 0, 0xFFFF),
+        n=_whole("on_sdo: n", n, 1, _MAX_COUNT),
+    )
 
 
 __all__ = [
@@ -290,5 +330,6 @@ __all__ = [
     "OnSdo",
     "Trigger",
     "WhenPosition",
+    "describe_after",
     "trigger_from_dict",
 ]

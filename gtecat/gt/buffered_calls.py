@@ -162,9 +162,7 @@ def GT_GetRemainderSegNum(ctl: Controller, crd: int, pSegment: Any, fifo: int = 
     """Entries of ``fifo`` not finished yet (the running one included)."""
     c = _crd(ctl, crd)
     c.require_prm("GT_GetRemainderSegNum")
-    f = int(fifo)
-    running = 1 if c.running and c.fifo == f and c.entry is not None else 0
-    store(pSegment, len(c.fifos[f]) + running)
+    store(pSegment, c.now().remainder(int(fifo)))
     return 0
 
 

@@ -118,7 +118,7 @@ def GT_GetCrdPrm(ctl: Controller, crd: int, pCrdPrm: Any) -> int:
 def GT_CrdSpace(ctl: Controller, crd: int, pSpace: Any, fifo: int = 0) -> int:
     c = _crd(ctl, crd)
     c.require_prm("GT_CrdSpace")
-    store(pSpace, c.space(fifo))
+    store(pSpace, c.now().space(fifo))
     return 0
 
 
@@ -456,8 +456,9 @@ def GT_CrdStatus(ctl: Controller, crd: int, pRun: Any, pSegment: Any, fifo: int 
     c = _crd(ctl, crd)
     c.require_prm("GT_CrdStatus")
     f = int(fifo)
-    store(pRun, 1 if c.running and c.fifo == f else 0)
-    store(pSegment, c.segments_done[f])
+    now = c.now()  # (the axis bank's record of this cycle while it holds the system)
+    store(pRun, 1 if now.running and now.fifo == f else 0)
+    store(pSegment, now.segments_done[f])
     return 0
 
 
@@ -466,7 +467,7 @@ def GT_GetCrdPos(ctl: Controller, crd: int, pPos: Any) -> int:
     """The coordinates now, X first (``dimension`` doubles)."""
     c = _crd(ctl, crd)
     c.require_prm("GT_GetCrdPos")
-    store_array(pPos, list(c.position()))
+    store_array(pPos, list(c.now().position()))
     return 0
 
 
@@ -475,7 +476,7 @@ def GT_GetCrdVel(ctl: Controller, crd: int, pSynVel: Any) -> int:
     """The vector (path) speed now, pulse/ms."""
     c = _crd(ctl, crd)
     c.require_prm("GT_GetCrdVel")
-    store(pSynVel, c.vector_speed())
+    store(pSynVel, c.now().vector_speed())
     return 0
 
 

@@ -12,14 +12,23 @@ The OP request is made ``op_delay_cycles`` cycles after SAFEOP is reached
 (the real master waits for the DC clocks and the first valid inputs), so
 ``GT_IsEcatReady`` polling loops see 0 before 1, as on the real controller.
 
-Comm loss: once the bus has been asked for OP, a working counter short for
-:attr:`Master.loss_confirm_ns` (10 ms) in a row makes the master read every
-slave's AL state; a slave that does not answer, or is below OP, is *offline*
-(:attr:`Master.offline`: position -> reason) until a later state read finds
-it in OP again.  One lost frame, or a short stall of the wire, is not a loss:
-only a slave that is still silent (or out of OP) when asked counts.  The
-controller stops the axes of offline slaves and the GT layer refuses process
-data that touches them (:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
+Comm loss: once the bus has been asked for OP, the first cycle whose working
+counter is short makes the master read every slave's AL state at once (the
+master knows in that very cycle: ETG.1000.4 counts every slave that processes
+the LRW, so a slave behind a pulled cable lowers it in the next frame).  A slave
+that does not answer, or is below OP, is *offline* (:attr:`Master.offline`:
+position -> reason) from that cycle until a later state read finds it in OP
+again.  The manual names no filter of lost frames for the controller (its
+entries of ``GT_IsEcatReady``, ``GT_GetEcatSlaves`` and the chapter 5 and 13
+reads of PDO objects give no delay), so there is none here: what
+``GT_IsEcatReady``/``GT_GetEcatSlaves`` show and what the reads of the slave's
+objects return agree from the first cycle.  One lost frame, or a short stall of
+the wire, is still no loss: the state read is answered, every slave in OP, and
+nothing goes offline.  While the working counter stays short the states are read
+again after :attr:`Master.loss_confirm_ns` (10 ms) and every
+:attr:`Master.recover_every` cycles from then on.  The controller stops the axes
+of offline slaves and the GT layer refuses process data that touches them
+(:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
 """
 
 from __future__ import annotations
@@ -90,7 +99,8 @@ class Master:
         #: slaves out of the process-data exchange although the bus should be in OP:
         #: position -> reason ("slave 1 (Drive) does not answer"); empty while all is well
         self.offline: dict[int, str] = {}
-        #: a short working counter this long in a row is a loss worth a state read
+        #: a short working counter this long in a row is worth a second state read (the
+        #: first is made in the first short cycle)
         self.loss_confirm_ns = 10_000_000
         self._bad_ns = 0
         self._op_requested = False  # the OP walk ran: from now on below OP is offline
@@ -248,8 +258,9 @@ class Master:
             periodic = confirmed and self.cycles % self.recover_every == 0
             if periodic and not self.backend.recovers_itself:
                 self.recover()
-            elif periodic or bad < self.loss_confirm_ns <= self._bad_ns:
-                self.refresh_states()  # who is gone (comm loss, module docstring)
+            elif periodic or bad == 0 or bad < self.loss_confirm_ns <= self._bad_ns:
+                # who is gone, from the first short cycle on (comm loss, module docstring)
+                self.refresh_states()
         if self.last.ok:
             self._bad_ns = 0
         if self._wkc_bad and self.last.ok and self.all_op():

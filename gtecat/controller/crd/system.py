@@ -63,6 +63,8 @@ from ..profile import PrfMode
 from .path import Arc, Segment
 from .velocity import Trapezoid
 
+_get = object.__getattribute__
+
 CRD_COUNT = 2
 FIFO_SIZE = 4096
 DIM_MAX = 4
@@ -207,6 +209,12 @@ class CoordSystem:
         #: the axis bank (gtecat.controller.bank) steps this system ahead with its axes'
         #: samples while it runs them: the controller's hook then leaves it alone
         self.banked = False
+        #: while banked, what the system was in each cycle the bank stepped it ahead
+        #: (:class:`gtecat.controller.bank_modes.SystemTrace`): :meth:`now` reads it
+        self.trace: Any = None
+        #: set by the axis bank for one push onto the system it holds ahead (AxisBank.before_call):
+        #: called with (system, entry, fifo) after the entry is in the FIFO
+        self.push_hook: Callable[[CoordSystem, Entry, int], None] | None = None
         self.reset()
 
     def reset(self) -> None:
@@ -280,6 +288,36 @@ class CoordSystem:
         """The coordinates now (profile positions minus the origin)."""
         return tuple(s.pos - o for s, o in zip(self.slots, self.origin, strict=True))
 
+    def now(self) -> Any:
+        """What the read calls look at (``running``, ``fifo``, ``segments_done``,
+        :meth:`position`, :meth:`vector_speed`, :meth:`space`): the system itself, or, while
+        the axis bank has stepped it ahead of the controller's time, its state in this cycle."""
+        t = self.trace
+        if t is not None:
+            return t.now(self)
+        # claimed but not yet stepped ahead: its own state, read past the slots' guards
+        return CrdNow(self, self.state()) if self.banked else self
+
+    def state(self) -> tuple:
+        """What :meth:`now` reports, as one tuple (the axis bank's record of a cycle)."""
+        f0, f1 = self.fifos
+        return (
+            self.running,
+            self.fifo,
+            self.segments_done[0],
+            self.segments_done[1],
+            len(f0),
+            len(f1),
+            self.speed,
+            tuple(_get(s, "_pos") - o for s, o in zip(self.slots, self.origin, strict=True)),
+            self.entry is not None,
+        )
+
+    def remainder(self, fifo: int) -> int:
+        """Entries of ``fifo`` not finished yet (the running one included)."""
+        running = 1 if self.running and self.fifo == fifo and self.entry is not None else 0
+        return len(self.fifos[fifo]) + running
+
     # --- the FIFOs ----------------------------------------------------------------------
     def _fifo(self, fifo: int) -> deque[Entry]:
         if fifo not in (0, 1):
@@ -306,6 +344,10 @@ class CoordSystem:
         elif not q and not self._runs(fifo):
             self.tails[fifo] = self.position()
         q.append(entry)
+        hook = self.push_hook
+        if hook is not None:
+            self.push_hook = None
+            hook(self, entry, fifo)
 
     def clear(self, fifo: int) -> None:
         if self._runs(fifo):
@@ -397,13 +439,20 @@ class CoordSystem:
                 slot._vel = slot._acc = 0.0
                 slot.stopping = StopKind.NONE
 
-    def run(self, n: int) -> tuple[list[list[tuple[float, float, float]]], int]:
+    def run(
+        self,
+        n: int,
+        speeds: list[float] | None = None,
+        marks: list[tuple[int, tuple]] | None = None,
+    ) -> tuple[list[list[tuple[float, float, float]]], int]:
         """``n`` cycles of :meth:`step`, each followed by every axis taking its slot's sample
         (``AxisSlot.step``), for the axis bank's tables: each slot's samples and the index of
         the cycle the path ended in (-1: it goes on).  A cycle inside a motion segment is
         step's own common case written out (the same operations in the same order); any
-        other is :meth:`step`."""
+        other is :meth:`step`.  ``speeds``/``marks``: the path speed after each cycle, and
+        (cycle, :meth:`state`) after each cycle that was not the common case."""
         slots = self.slots
+        rec = speeds is not None and marks is not None
         origin = self.origin
         out: list[list[tuple[float, float, float]]] = [[] for _ in slots]
         for j in range(n):
@@ -416,7 +465,9 @@ class CoordSystem:
                     self.t = t
                     s = plan.s(t)
                     self.s = s
-                    self.speed = plan.v(t)
+                    self.speed = sp = plan.v(t)
+                    if rec:
+                        speeds.append(sp)  # type: ignore[union-attr]
                     for col, slot, o, x in zip(out, slots, origin, e.geom.point(s), strict=True):
                         p = o + x
                         v = (p - slot._pos) / cyc
@@ -428,6 +479,9 @@ class CoordSystem:
             self.step()
             for col, slot in zip(out, slots, strict=True):
                 col.append(slot.step())
+            if rec:
+                speeds.append(self.speed)  # type: ignore[union-attr]
+                marks.append((j, self.state()))  # type: ignore[union-attr]
             if not self.running:
                 return out, j
         return out, -1
@@ -621,6 +675,33 @@ class CoordSystem:
 
     def vector_speed(self) -> float:
         return self.speed * self.override if self.running else 0.0
+
+
+class CrdNow:
+    """A coordinate system as its read calls see it in one cycle (:meth:`CoordSystem.now`
+    while the axis bank holds it): a :meth:`CoordSystem.state` tuple."""
+
+    __slots__ = ("_c", "_st", "fifo", "running", "segments_done")
+
+    def __init__(self, c: CoordSystem, st: tuple) -> None:
+        self._c, self._st = c, st
+        self.running, self.fifo = st[0], st[1]
+        self.segments_done = [st[2], st[3]]
+
+    def position(self) -> tuple[float, ...]:
+        return self._st[7]
+
+    def vector_speed(self) -> float:
+        return self._st[6] * self._c.override if self.running else 0.0
+
+    def space(self, fifo: int) -> int:
+        self._c._fifo(fifo)  # its check of the number
+        return FIFO_SIZE - self._st[4 + int(fifo)]
+
+    def remainder(self, fifo: int) -> int:
+        st = self._st
+        running = 1 if self.running and self.fifo == fifo and st[8] else 0
+        return st[4:6][fifo] + running
 
 
 class CrdBank:

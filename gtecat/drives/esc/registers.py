@@ -1127,10 +1127,6 @@ class Esc:
         self.mem[Reg.WD_STATUS_PD] &= 0xFE
         self.mem[Reg.WD_COUNTER_PD] = min(self.mem[Reg.WD_COUNTER_PD] + 1, 0xFF)
         if self.watchdog_trips:
-            slave = self.slave
-            slave.outputs_valid = False
-            slave.request_state(AlState.SAFEOP)
-            slave.al_error = True
-            slave.al_status_code = AlStatusCode.SYNC_MANAGER_WATCHDOG
+            self.slave.watchdog_expired()  # SAFEOP + error 001Bh; a drive faults
             self.sync_al()
         return True

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import struct
 
+import pytest
+
 from gtecat.drives.drive import Cia402Drive
 from gtecat.drives.esc.registers import Esc, FrameTime, Reg
 from gtecat.drives.esc.sii import build_sii, sii_info_for
@@ -258,6 +260,31 @@ def test_a_fault_sends_a_coe_emergency() -> None:
     assert msg is not None
     assert msg[5] & 0x0F == 3 and struct.unpack_from("<H", msg, 6)[0] >> 12 == 1
     assert struct.unpack_from("<HB", msg, 8) == (code, 0x01)
+
+
+@pytest.mark.parametrize(
+    ("kind", "code", "register"),
+    [
+        ("overcurrent", 0x2310, 0x03),  # CiA 301 1001h: generic + current
+        ("overvoltage", 0x3210, 0x05),  # generic + voltage
+        ("undervoltage", 0x3220, 0x05),
+        ("overtemperature", 0x4310, 0x09),  # generic + temperature
+    ],
+)
+def test_the_emergency_frame_carries_the_error_register_of_the_code(
+    kind: str, code: int, register: int
+) -> None:
+    esc = drive_esc()
+    drive = esc.slave
+    assert isinstance(drive, Cia402Drive)
+    assert drive.channel(0).inject_fault(kind) == code
+    drive.step(0, 1_000_000)
+    esc.collect_emergencies()
+    esc.service()
+    msg = read_mailbox(esc)
+    assert msg is not None
+    assert struct.unpack_from("<HB", msg, 8) == (code, register)
+    assert drive.od.upload(0x1001, 0) == bytes([register])
 
 
 def test_emergencies_are_dropped_without_a_mailbox_state() -> None:

@@ -292,3 +292,101 @@ def test_modes_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
     got, samples = _run(script, machine, "on", True, kernel="numpy")
     assert got == ref
     assert samples >= 500
+
+
+# --- coordinated motion polled every cycle ----------------------------------------------------
+def _crd_reads() -> tuple:
+    """Every read call of both systems (and of their axes), as a field application polls them
+    after each cycle: the bank answers them from its record of the cycle (CoordSystem.now)."""
+    out: list = []
+    run, seg, space = c_short(), c_long(), c_long()
+    vel = c_double()
+    for crd in (1, 2):
+        for fifo in (0, 1):
+            out.append((gt.GT_CrdStatus(crd, byref(run), byref(seg), fifo), run.value, seg.value))
+            out.append((gt.GT_CrdSpace(crd, byref(space), fifo), space.value))
+            out.append((gt.GT_GetRemainderSegNum(crd, byref(seg), fifo), seg.value))
+        pos = (c_double * 2)()
+        out.append((gt.GT_GetCrdPos(crd, pos), tuple(pos)))
+        out.append((gt.GT_GetCrdVel(crd, byref(vel)), vel.value))
+    out.append(gt.GT_CrdStatus(1, byref(run), byref(seg), 2))  # a FIFO that does not exist
+    sts, prf, pv = (c_long * 4)(), (c_double * 4)(), (c_double * 4)()
+    out.append((gt.GT_GetSts(1, sts, 4), tuple(sts)))
+    out.append((gt.GT_GetPrfPos(1, prf, 4), tuple(prf)))
+    out.append((gt.GT_GetPrfVel(1, pv, 4), tuple(pv)))
+    return tuple(out)
+
+
+def _polled_setup() -> object:
+    _crd_system(1, (1, 2), False, 2)  # a delay in its second lap
+    _crd_system(2, (3, 4), True, 3)  # a GT_BufIO in its first lap: scalar until it passes
+    # axis 5 geared to system 2's X: that system's cluster is stepped cycle by cycle with the
+    # slave (system 1 alone: CoordSystem.run)
+    _gear(5, 3, gt.GEAR_MASTER_PROFILE, (1, 2, 0))
+    for a in range(6, AXES + 1):
+        _trap(a, 10_000 * (a - 4), 2.0 + a, 0.3)
+    return (gt.GT_GearStart(_bit(5)), gt.GT_CrdStart(0b11, 0))
+
+
+#: (cycle, a call that changes a running path) of the polled program
+POLLED_CALLS: list[tuple[int, Callable[[], object]]] = [
+    (0, _polled_setup),
+    # segments streamed onto system 1's running FIFO (kept in the bank: pushed ahead), a
+    # delay, a segment into its other FIFO (given back), a line of no length
+    *[
+        (100 + 5 * k, lambda k=k: gt.GT_LnXY(1, 40 * (k % 2), 40 * k, 9.0, 0.4, 9.0, 0))
+        for k in range(6)
+    ],
+    (131, lambda: gt.GT_BufDelay(1, 3, 0)),
+    (140, lambda: gt.GT_LnXY(1, 0, 0, 9.0, 0.4, 0.0, 1)),
+    (145, lambda: gt.GT_LnXY(1, 40, 200, 9.0, 0.4, 0.0, 0)),
+    (150, lambda: gt.GT_LnXY(1, 40, 200, 9.0, 0.4, 0.0, 0)),
+    (170, lambda: gt.GT_LnXY(1, 100, 100, 9.0, 0.4, 0.0, 0)),
+    # near the end of system 1's path: pushes the bank's window may reach (given back then)
+    *[(440 + 12 * k, lambda k=k: gt.GT_LnXY(1, 60 * k, 0, 9.0, 0.4, 9.0, 0)) for k in range(6)],
+    (230, lambda: gt.GT_SetOverride(2, 1.5)),
+    (330, lambda: gt.GT_Stop(1 << 13, 0)),  # system 2 stops along its path
+]
+
+
+def _run_polled(machine: str, bank: str) -> tuple[list, list[tuple[bool, bool]], int]:
+    """The polled program's reads after every cycle; on the bank, whether each system was in
+    it at each poll, and (system 2 before, after) each call on system 1."""
+    _bring_up(machine, bank)
+    ctl = gt.GTE_Controller()
+    calls = dict(POLLED_CALLS)
+    trace: list = []
+    banked: list[tuple[bool, bool]] = []
+    try:
+        for k in range(540):
+            action = calls.get(k)
+            if action is not None:
+                trace.append(("call", action()))
+            gt.GTE_Wait(1)
+            trace.append(_crd_reads())
+            systems = ctl.crd_bank.systems
+            banked.append((systems[1].banked, systems[2].banked))
+        got = ctl.bank.sampled_samples if ctl.bank is not None else 0
+    finally:
+        gt.GT_Close()
+    return trace, banked, got
+
+
+def test_crd_reads_polled_every_cycle_match_the_scalar_path_without_a_release(machine) -> None:
+    """GT_CrdStatus, GT_CrdSpace, GT_GetRemainderSegNum, GT_GetCrdPos, GT_GetCrdVel and the
+    axes' GT_GetSts/GT_GetPrfPos/GT_GetPrfVel after every cycle: the bank's answers equal the
+    scalar path's, and the polling keeps the systems in the bank (a call that changes one
+    system's path gives back that system alone)."""
+    ref, _, _ = _run_polled(machine, "off")
+    got, banked, samples = _run_polled(machine, "on")
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"step {k}: the bank and the scalar path differ"
+    assert samples >= 500, "the bank hardly ran the paths"
+    # system 1 is in the bank from its first cycles to its end but for the cycle after each
+    # call on it; system 2 from the end of its first lap (the GT_BufIO) to its stop
+    assert sum(b[0] for b in banked[:300]) >= 280
+    assert sum(b[1] for b in banked[160:330]) >= 165
+    assert banked[170][1] and banked[171][1], "a call on system 1 gave back system 2"
+    for k in (100, 105, 110, 115, 120, 125, 131, 145, 150, 170):
+        assert banked[k - 1][0] and banked[k][0], f"the push at cycle {k} gave back system 1"
+    assert not banked[140][0], "a push into the FIFO that does not run stays in the bank"

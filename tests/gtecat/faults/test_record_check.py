@@ -104,7 +104,7 @@ def test_replay_reports_the_first_divergence(
 def test_checks_name_the_script_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     app = tmp_path / "app.py"
     app.write_text(SCRIPT)
-    assert main(["run", "--check", "--no-progress", str(app)]) == 0
+    assert main(["run", "--check", "--no-progress", str(app)]) == 3
     err = capsys.readouterr().err
     found = [x for x in err.splitlines() if x.startswith("check: ")]
     assert any(f"{app}:12:" in x and "skips a state" in x for x in found), err
@@ -125,7 +125,7 @@ def test_an_endless_ready_poll(tmp_path: Path, capsys: pytest.CaptureFixture[str
         "while gt.GT_IsEcatReady(byref(s)) == 0 and s.value != 1:\n"
         "    pass\n"
     )
-    assert main(["run", "--check", "--no-progress", str(app)]) == 0
+    assert main(["run", "--check", "--no-progress", str(app)]) == 3
     err = capsys.readouterr().err
     assert f"check: {app}:6: GT_IsEcatReady polled 200 times" in err, err
 

@@ -618,14 +618,15 @@ def test_ready_returns_after_recovery_even_if_states_were_read_during_the_outage
     assert ready[-1]
 
 
-def test_a_lost_slave_is_offline_after_10_ms_of_short_working_counter_and_back_after():
-    """Master.offline (comm loss, gtecat.master.bus): one read_state tells who is gone."""
+def test_a_lost_slave_is_offline_from_the_first_short_cycle_and_back_after():
+    """Master.offline (comm loss, gtecat.master.bus): one read_state, in the first cycle of
+    short working counter, tells who is gone."""
     master, _backend, devices, lines = make_bus()
     bring_up(master)
     devices[2].present = False
-    _run(master, 9)
-    assert master.offline == {}  # 9 ms: not yet a loss
-    _run(master, 2, t0=110_000_000)
+    _run(master, 1)
+    assert master.offline == {2: "slave 2 (Bits C) does not answer"}
+    _run(master, 10, t0=110_000_000)
     assert master.offline == {2: "slave 2 (Bits C) does not answer"}
     assert any("Lost: slave 2 (Bits C) does not answer" in x for x in lines)
     devices[2].present = True
