@@ -930,16 +930,21 @@ class AxisBank:
         first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
         self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
 
+    def keep_last_sample(self, rows: Any) -> None:
+        """Before a row's table is written anew: the last sample taken moves to the row's
+        spare slot and the row reads it there (as the kernel's refill_row does), because the
+        new samples overwrite the table it sat in and a release in this same cycle (a row
+        hitting a soft limit) reads it.  ``rows``: one row or an array of rows."""
+        last = self.t_idx[rows]
+        spare = self.base[rows] + self.table
+        for t in (self.t_p, self.t_v, self.t_a):
+            t.flat[spare] = t.flat[last]
+        self.t_idx[rows] = spare
+
     def _refill(self, r: int) -> None:
         pl = self.res[r].profile.planner
         tl = self.table
-        # the last sample taken moves to the row's spare slot first (as the kernel's
-        # refill_row does): the new samples overwrite the table it sat in, and a release in
-        # this same cycle (a row hitting a soft limit) reads it from there
-        last, spare = int(self.t_idx[r]), int(self.base[r]) + tl
-        for t in (self.t_p, self.t_v, self.t_a):
-            t.flat[spare] = t.flat[last]
-        self.t_idx[r] = spare
+        self.keep_last_sample(r)
         _Bypass.on = True
         try:
             k0 = int(self.k0[r] + self.taken[r])

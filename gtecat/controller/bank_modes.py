@@ -628,16 +628,7 @@ class Cluster:
                     self._put(bank, r, ps, vs, as_, end)
         if full:  # the rows that go on, in one assignment per table
             rs = np.array([f[0] for f in full], np.intp)
-            last = bank.t_idx[rs]
-            spare = bank.base[rs] + bank.table
-            for k, t in enumerate((bank.t_p, bank.t_v, bank.t_a)):
-                t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
-                t[rs, :n] = [f[k + 1] for f in full]
-            bank.t_idx[rs] = spare
-            bank.t_len[rs] = n
-            bank.t_cur[rs] = 0
-            bank.t_end[rs] = -1
-            bank.sampled_samples += n * len(full)
+            self._put_rows(bank, rs, tuple([f[k + 1] for f in full] for k in range(3)), n)
 
     def _gear_rows(self, bank: AxisBank, ms: list[float], slaves: list[int]) -> None:
         """Geared slaves of one master at a fixed ratio (no clutch zone), one table each:
@@ -659,18 +650,8 @@ class Cluster:
         v = ds / cyc
         vel0 = np.array([[_get(pl, "_vel")] for pl in pls])
         acc = (v - np.concatenate((vel0, v[:, :-1]), axis=1)) / cyc
-        n = len(ms)
         rs = np.array([self.rows[i] for i in slaves], np.intp)
-        last = bank.t_idx[rs]
-        spare = bank.base[rs] + bank.table
-        for t, values in zip((bank.t_p, bank.t_v, bank.t_a), (pos, v, acc), strict=True):
-            t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
-            t[rs, :n] = values
-        bank.t_idx[rs] = spare
-        bank.t_len[rs] = n
-        bank.t_cur[rs] = 0
-        bank.t_end[rs] = -1
-        bank.sampled_samples += n * len(slaves)
+        self._put_rows(bank, rs, (pos, v, acc), len(ms))
         m_last = float(m[-1])
         for pl, p, vv, a in zip(
             pls, pos[:, -1].tolist(), v[:, -1].tolist(), acc[:, -1].tolist(), strict=True
@@ -753,16 +734,7 @@ class Cluster:
             return rest
         sel = np.array(whole, np.intp)
         rs_rows = np.array([self.rows[slaves[j]] for j in whole], np.intp)
-        last = bank.t_idx[rs_rows]
-        spare = bank.base[rs_rows] + bank.table
-        for t, values in zip((bank.t_p, bank.t_v, bank.t_a), (pos, v, acc), strict=True):
-            t.flat[spare] = t.flat[last]  # the last sample taken kept (as _put)
-            t[rs_rows, :n] = values[sel]
-        bank.t_idx[rs_rows] = spare
-        bank.t_len[rs_rows] = n
-        bank.t_cur[rs_rows] = 0
-        bank.t_end[rs_rows] = -1
-        bank.sampled_samples += n * len(whole)
+        self._put_rows(bank, rs_rows, (pos[sel], v[sel], acc[sel]), n)
         m_last = float(m[-1])
         for j, xe, p, vv, a in zip(
             whole,
@@ -793,13 +765,9 @@ class Cluster:
             arr = np.array([(p.pos, p.time, float(int(p.type))) for p in q], np.float64)
             pts = self.pts[i] = (arr.ctypes.data, len(arr), arr)
         r = self.rows[i]
+        bank.keep_last_sample(r)
         tables = (bank.t_p, bank.t_v, bank.t_a)
-        last, base = int(bank.t_idx[r]), int(bank.base[r])
-        spare = base + bank.table
-        for t in tables:  # the last sample taken to the spare slot (as _put)
-            t.flat[spare] = t.flat[last]
-        bank.t_idx[r] = spare
-        end = bank.pt_run(pl, pts[:2], SAMPLED_TABLE, tables, base)
+        end = bank.pt_run(pl, pts[:2], SAMPLED_TABLE, tables, int(bank.base[r]))
         m = end + 1 if end >= 0 else SAMPLED_TABLE
         bank.sampled_samples += m
         bank.t_len[r] = m
@@ -810,21 +778,28 @@ class Cluster:
     def _put(
         bank: AxisBank, r: int, ps: list[float], vs: list[float], as_: list[float], end: int
     ) -> None:
-        """A row's new table (the last sample taken kept in its spare slot first, as for a
-        Trap table: a release in this cycle reads it there)."""
+        """A row's new table (AxisBank.keep_last_sample first, as for a Trap table)."""
         m = len(ps)
         if not m:
             return
         bank.sampled_samples += m
-        tp, tv, ta = bank.t_p, bank.t_v, bank.t_a
-        last, spare = int(bank.t_idx[r]), int(bank.base[r]) + bank.table
-        for t in (tp, tv, ta):
-            t.flat[spare] = t.flat[last]
-        bank.t_idx[r] = spare
-        tp[r, :m], tv[r, :m], ta[r, :m] = ps, vs, as_
+        bank.keep_last_sample(r)
+        bank.t_p[r, :m], bank.t_v[r, :m], bank.t_a[r, :m] = ps, vs, as_
         bank.t_len[r] = m
         bank.t_cur[r] = 0
         bank.t_end[r] = end
+
+    @staticmethod
+    def _put_rows(bank: AxisBank, rs: np.ndarray, tables: tuple[Any, Any, Any], n: int) -> None:
+        """Rows whose new tables are full and go on (positions, speeds, accelerations: one
+        row of ``n`` samples each), in one assignment per table."""
+        bank.keep_last_sample(rs)
+        for t, values in zip((bank.t_p, bank.t_v, bank.t_a), tables, strict=True):
+            t[rs, :n] = values
+        bank.t_len[rs] = n
+        bank.t_cur[rs] = 0
+        bank.t_end[rs] = -1
+        bank.sampled_samples += n * len(rs)
 
     def rewind(self, bank: AxisBank) -> None:
         """Put the planners where the scalar path has them: their state at the last fill,
