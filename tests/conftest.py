@@ -54,7 +54,8 @@ LONG_REASON = (
 def _long_and_sampled(items: list[pytest.Item]) -> None:
     """The default run's share of the longer checks (docs/performance.md, the test suite).
 
-    ``@pytest.mark.long``: skipped unless ``GTECAT_LONG=1``.  ``@pytest.mark.sample(k)`` on
+    ``@pytest.mark.long`` or ``@pytest.mark.long("what it runs")``: skipped unless
+    ``GTECAT_LONG=1``, the skip saying what it would have run.  ``@pytest.mark.sample(k)`` on
     a parametrized test: the default run keeps ``k`` of its cases, chosen by
     :func:`campaign_seed` (the same ones on every CI run, others on each developer's run),
     and skips the rest saying so; ``GTECAT_LONG=1`` runs every case.  Skips are marks added at
@@ -65,8 +66,9 @@ def _long_and_sampled(items: list[pytest.Item]) -> None:
 
     families: dict[tuple[str, str], list[pytest.Item]] = {}
     for item in items:
-        if item.get_closest_marker("long") is not None:
-            item.add_marker(pytest.mark.skip(reason=LONG_REASON))
+        if (mark := item.get_closest_marker("long")) is not None:
+            what = f" ({mark.args[0]})" if mark.args else ""
+            item.add_marker(pytest.mark.skip(reason=LONG_REASON + what))
         elif item.get_closest_marker("sample") is not None:
             key = (item.nodeid.split("::")[0], getattr(item, "originalname", item.name))
             families.setdefault(key, []).append(item)

@@ -13,7 +13,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli.main import main
-from tests.conftest import EXAMPLES, LONG
+from tests.conftest import EXAMPLES
 
 SCRIPT = textwrap.dedent(
     f"""
@@ -161,7 +161,7 @@ PLUGIN_TESTS = textwrap.dedent(
 )
 
 
-@pytest.mark.skipif(not LONG, reason="a pytest run in a child process (GTECAT_LONG=1)")
+@pytest.mark.long("a pytest run in a child process")
 def test_plugin_fixture_record_and_check(tmp_path: Path) -> None:
     (tmp_path / "test_m.py").write_text(PLUGIN_TESTS)
     (tmp_path / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
@@ -271,7 +271,7 @@ int main(void) {
 """
 
 
-@pytest.mark.skipif(not LONG, reason="builds and runs a C program (GTECAT_LONG=1)")
+@pytest.mark.long("builds and runs a C program")
 def test_a_c_program_is_recorded_and_replayed(tmp_path: Path) -> None:
     import shutil
 

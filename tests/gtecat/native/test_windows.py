@@ -30,7 +30,6 @@ from gtecat.native import protocol as p
 from gtecat.native import server as server_mod
 from gtecat.native import transport, windows
 
-from ...conftest import LONG
 from .conftest import C_DIR, FIG5_2, ROOT, native_env, parse_lines, run_client
 from .wire_client import WireClient
 
@@ -321,7 +320,7 @@ def test_a_token_file_is_readable_by_its_owner_only(tmp_path):
     assert transport.tokens_equal(b"abc", b"abc") and not transport.tokens_equal(b"abc", b"abd")
 
 
-@pytest.mark.skipif(not LONG, reason="GTECAT_LONG=1: the x64 DLL under 64-bit Wine")
+@pytest.mark.long("the x64 DLL under 64-bit Wine")
 def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
     _needs_wine()
     dll = _dll("x64")
@@ -351,7 +350,7 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
     assert v.get("open") == "0", r.stdout + r.stderr
 
 
-@pytest.mark.skipif(not LONG, reason="GTECAT_LONG=1: the flood of bad connections and messages")
+@pytest.mark.long("the flood of bad connections and messages")
 def test_the_endpoint_survives_a_flood(tcp_controller):
     """100 unauthenticated connections held open, then 100,000 bad messages, each on a
     connection of its own and each read by the controller (the test waits until it closes
@@ -427,7 +426,7 @@ def test_a_client_built_with_the_wrong_token_length_is_refused_cleanly(tcp_contr
     s.close()
 
 
-@pytest.mark.skipif(not LONG, reason="GTECAT_LONG=1: a controller in a Python shaped like Windows'")
+@pytest.mark.long("a controller in a Python shaped like Windows'")
 def test_the_controller_runs_without_what_windows_lacks(tmp_path):
     """The controller in a Python without fcntl, Unix sockets, epoll/poll or os.getuid (as on
     Windows) serves a Python program attached over TCP: bring-up and a servo-on axis."""

@@ -23,7 +23,6 @@ import pytest
 
 from gtecat.cli.main import main
 from gtecat.inspect.client import Attached
-from tests.conftest import LONG
 from tests.gtecat.wire.test_serve_veth import FIG52, Server, cycle, soem, to_op, veth_pair
 
 pytestmark = [pytest.mark.wire, pytest.mark.xdist_group("serve_attach")]
@@ -247,7 +246,7 @@ def test_the_serve_said_every_fault_on_stderr_and_stops_cleanly(rig: Rig) -> Non
     assert not list(rig.run.glob("*.sock")) and not list(rig.run.glob("*.json"))
 
 
-@pytest.mark.skipif(not LONG, reason="an application on the pysoem backend for several seconds")
+@pytest.mark.long("an application on the pysoem backend for several seconds")
 def test_an_application_sees_faults_injected_at_runtime(tmp_path: Path, capsys) -> None:
     """What the application sees through the GT API (gtecat's own master on pysoem, the
     realtime clock) while faults are added and cleared on the serve by the command line: a
