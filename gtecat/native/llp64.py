@@ -239,12 +239,19 @@ def _compile(
         units = (
             ("gts_runtime.c", _build.CFLAGS),
             ("gts_stubs.c", (*_build.CFLAGS, *_build.STUB_CFLAGS)),
-            ("gts_declared.c", (*_build.CFLAGS, *_build.STUB_CFLAGS)),
+            *_build.declared_units(cc, extra),
         )
         what = soname if not extra else f"the 32-bit {soname} ({' '.join(extra)})"
         procs = []
         for name, flags in units:
-            cmd = [*base, *flags, "-c", str(tmp / name), "-o", str(tmp / (name[:-2] + ".o"))]
+            cmd = [
+                *base,
+                *flags,
+                "-c",
+                str(tmp / name),
+                "-o",
+                str(tmp / _build.object_name(name)),
+            ]
             procs.append((cmd, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
         for cmd, proc in procs:
             _, err = proc.communicate()
@@ -253,7 +260,7 @@ def _compile(
                 raise NativeBuildError(
                     f"building {what} {word} ({shlex.join(cmd)}):\n{err.strip()}"
                 )
-        objs = [str(tmp / (name[:-2] + ".o")) for name, _ in units]
+        objs = [str(tmp / _build.object_name(name)) for name, _ in units]
         cmd = [
             *cc,
             *extra,
