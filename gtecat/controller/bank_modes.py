@@ -36,7 +36,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .bank_kernel import MAXSEG, PT_STATE, trap_fill
+from .bank_kernel import MAXSEG, PT_STATE
+from .bank_slaves import compiled_kind, slave_fill
 from .crd.system import AxisSlot, CoordSystem, CrdNow, Delay, Motion
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
@@ -311,14 +312,21 @@ def keep(obj: Any) -> tuple:
 
 def _trap_samples(bank: AxisBank, pl: TrapPlanner, n: int) -> tuple[Any, Any, Any, int]:
     """:func:`~gtecat.controller.motion.trap_table.trap_table` of a Trap master, compiled
-    where the kernel is (bank_kernel.trap_fill: the same samples)."""
+    where the kernel is (bank_kernel.trap_fill: the same samples; the arrays returned are
+    the bank's scratch, valid until the next call)."""
     lib = bank._kernel_lib
-    if lib is None or len(pl._segs) > MAXSEG:
+    k = len(pl._segs)
+    if lib is None or k > MAXSEG:
         return trap_table(pl, n)
-    segs = np.array(pl._segs, np.float64).reshape(-1, 4)
-    prm = np.array([pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir])
-    out = np.zeros((3, n + 1))
-    end = trap_fill(lib, segs, pl._T, prm, pl._k, n, out)
+    sc = bank.__dict__.get("_trap_scratch")
+    if sc is None or sc[0] is not lib or sc[1].shape[1] < n + 1:
+        segs, prm, out = np.zeros((MAXSEG, 4)), np.zeros(5), np.zeros((3, n + 1))
+        ptrs = (segs.ctypes.data, prm.ctypes.data, *(out[j].ctypes.data for j in range(3)))
+        sc = bank._trap_scratch = (lib, out, segs, prm, ptrs)
+    _, out, segs, prm, (p_segs, p_prm, p0, p1, p2) = sc
+    segs[:k] = pl._segs
+    prm[:] = (pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir)
+    end = lib.bank_trap_fill(p_segs, k, pl._T, p_prm, pl._k, n, p0, p1, p2)
     m = end + 1 if end < n else n
     return out[0, :m], out[1, :m], out[2, :m], end
 
@@ -394,14 +402,22 @@ class Cluster:
     __slots__ = (
         "alone",
         "before",
+        "compiled",
+        "compiled_by_master",
         "compiled_pt",
+        "compiled_rows",
+        "ext",
         "groups",
+        "kept",
         "leads",
+        "list_leads",
         "masters",
         "planners",
         "pts",
         "rows",
+        "rows_arr",
         "snaps",
+        "stepped",
         "systems",
         "topo",
     )
@@ -417,6 +433,19 @@ class Cluster:
                 systems.append(pl.crd)
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
+        self.rows_arr = np.array(self.rows, np.intp)
+        #: the objects a fill keeps for the rewind; the planners it steps in Python (the
+        #: others: the compiled slaves, bank_slaves)
+        self.kept: list[Any] = [*self.planners, *systems]
+        self.stepped: list[Any] = list(self.planners)
+        #: the indices of the slaves the compiled fill runs (bank_slaves.SlaveFill), their
+        #: rows, and per master (index, rows reading its sample of the same cycle, rows
+        #: reading the one before)
+        self.compiled: list[int] = []
+        self.compiled_rows = np.zeros(0, np.int64)
+        #: per master of compiled slaves: its position before a fill and after each cycle
+        #: of it (what the slaves read, at addresses SlaveFill.mp holds)
+        self.ext: dict[int, np.ndarray] = {}
         #: the cluster is one coordinate system with its axes and nothing else
         self.alone = len(systems) == 1 and {id(pl) for pl in self.planners} == {
             id(slot) for slot in systems[0].slots
@@ -441,6 +470,7 @@ class Cluster:
         self.masters: list[int | None] = [None] * len(self.rows)
         self.topo: list[int] | None = None
         self.leads: set[int] = set()  # the planners some slave of the cluster reads
+        self.list_leads: set[int] = set()  # ... some slave stepped in Python reads
         if systems:
             return
         at = {r: i for i, r in enumerate(self.rows)}
@@ -469,12 +499,49 @@ class Cluster:
             topo += ready
         self.topo = topo
         self.leads = {m for m in self.masters if m is not None}
+        self.list_leads = set(self.leads)
         # a master read before its slave steps (numbered below it) gives the slave the sample
         # of the same cycle, else the one before (the controller steps axes in number order)
         self.before = [
             m is not None and order[self.rows[m]] < order[r]
             for m, r in zip(self.masters, self.rows, strict=True)
         ]
+        self._compile(bank)
+
+    def _compile(self, bank: AxisBank) -> None:
+        """Hand the slaves in motion that read a master reading nobody, and that no slave
+        reads, to the compiled fill (bank_slaves), where it runs; they are stepped there."""
+        masters = self.masters
+        cand = [
+            i
+            for i, mi in enumerate(masters)
+            if mi is not None
+            and masters[mi] is None
+            and i not in self.leads
+            and compiled_kind(self.planners[i])
+        ]
+        if not cand:
+            return
+        sf = slave_fill(bank)
+        if sf is None:
+            return
+        rows = self.rows
+        for i in cand:
+            sf.load(rows[i], self.planners[i])
+        self.compiled = cand
+        self.compiled_rows = np.array([rows[i] for i in cand], np.int64)
+        for i in cand:
+            mi = masters[i]
+            ext = self.ext.get(mi)  # type: ignore[arg-type]
+            if ext is None:
+                ext = self.ext[mi] = np.zeros(SAMPLED_TABLE + 1)  # type: ignore[index]
+            # the master's sample of the same cycle (it steps first), else the one before
+            sf.mp[rows[i]] = ext.ctypes.data + (8 if self.before[i] else 0)
+        out = set(cand)
+        self.list_leads = {mi for i, mi in enumerate(masters) if mi is not None and i not in out}
+        self.kept = [pl for i, pl in enumerate(self.planners) if i not in out]
+        self.stepped = list(self.kept)
+        self.topo = [i for i in self.topo if i not in out]  # type: ignore[union-attr]
 
     def step(self) -> None:
         """One scalar cycle of the cluster's planners: the systems (the controller's
@@ -489,11 +556,11 @@ class Cluster:
     def fill(self, bank: AxisBank) -> None:
         """The next :data:`SAMPLED_TABLE` samples of every moving row, its planners stepped
         (their state before kept for :meth:`rewind`)."""
-        self.snaps = [(o, keep(o)) for o in (*self.planners, *self.systems)]
+        self.snaps = [(o, keep(o)) for o in self.kept]
         rows = self.rows
         moving = bank.moving
-        for r in rows:
-            bank.fill_taken[r] = bank.taken[r]
+        ra = self.rows_arr
+        bank.fill_taken[ra] = bank.taken[ra]
         if self.topo is not None:
             self._fill_columns(bank)
             return
@@ -578,20 +645,24 @@ class Cluster:
             starts[i] = start = pl.pos
             if not moving[r] or pl.done:
                 seen[i] = [start] * n
+                if i in self.ext:
+                    self.ext[i][:] = start
                 continue
             mi = self.masters[i]
             if TrapPlanner in type(pl).__mro__:
                 p, v, a, end = _trap_samples(bank, pl, n)
-                m = end + 1 if end < n else n
-                ps, vs, as_ = p[:m].tolist(), v[:m].tolist(), a[:m].tolist()
-                advance(pl, m, (ps[-1], vs[-1], as_[-1]), end < n)
-                end = end if end < n else -1
+                m = len(p)
+                advance(pl, m, (float(p[-1]), float(v[-1]), float(a[-1])), end < n)
+                self._put(bank, r, p, v, a, end if end < n else -1)
+                if i in self.leads:
+                    self._lead(i, start, p, seen)
+                continue
             elif mi is None:
                 if compiled and PtPlanner in type(pl).__mro__:
                     if _get(pl, "_mode") == PtMode.STATIC and _get(pl, "_state") == 1:
                         self._pt_compiled(bank, i, pl)
                         if i in self.leads:  # (a master of a slave: its positions)
-                            seen[i] = self._pad(bank.t_p[r, : bank.t_len[r]].tolist(), n)
+                            self._lead(i, start, bank.t_p[r, : bank.t_len[r]], seen)
                         continue
                 ps, vs, as_, end = pl.run(n)
             else:
@@ -612,7 +683,7 @@ class Cluster:
                         continue
                 ps, vs, as_, end = pl.run(ms)
             if i in self.leads:
-                seen[i] = self._pad(ps, n)
+                self._lead(i, start, ps, seen)
             if end < 0 and len(ps) == n:
                 full.append((r, ps, vs, as_))
             else:
@@ -629,6 +700,23 @@ class Cluster:
         if full:  # the rows that go on, in one assignment per table
             rs = np.array([f[0] for f in full], np.intp)
             self._put_rows(bank, rs, tuple([f[k + 1] for f in full] for k in range(3)), n)
+        if self.compiled:  # the compiled slaves, all at once (bank_slaves)
+            bank.sampled_samples += bank._slave_fill.fill(bank, self.compiled_rows, n)
+
+    def _lead(self, i: int, start: float, ps: Any, seen: list[list[float] | None]) -> None:
+        """Master ``i``'s positions in a fill (``ps``: its samples, a list or an array; it
+        holds the last after its end) for the slaves that read them: :attr:`ext` for the
+        compiled ones, ``seen`` for the others."""
+        n = SAMPLED_TABLE
+        ext = self.ext.get(i)
+        if ext is not None:
+            m = len(ps)
+            ext[0] = start
+            ext[1 : m + 1] = ps
+            if m < n:
+                ext[m + 1 :] = ps[-1]
+        if i in self.list_leads:
+            seen[i] = self._pad(ps if type(ps) is list else ps.tolist(), n)
 
     def _gear_rows(self, bank: AxisBank, ms: list[float], slaves: list[int]) -> None:
         """Geared slaves of one master at a fixed ratio (no clutch zone), one table each:
@@ -814,8 +902,10 @@ class Cluster:
             for _ in range(int(bank.taken[self.rows[0]] - bank.fill_taken[self.rows[0]])):
                 self.step()
             return
-        if self.snaps is None:
-            return  # never stepped ahead
+        if self.snaps is None:  # never stepped ahead
+            for i in self.compiled:
+                bank._slave_fill.drop(self.rows[i])
+            return
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
             if snap[0] is _PT_MOVING or snap[0] is _GEAR_MOVING or snap[0] is _FOLLOW_MOVING:
@@ -828,6 +918,8 @@ class Cluster:
                     del _get(obj, "_segs")[snap[2] :]  # the segments added since
             else:
                 restore(obj, snap)
+        for i in self.compiled:
+            bank._slave_fill.put_back(self.rows[i], self.planners[i])
         self.snaps = None
         for _ in range(n):
             self.step()
