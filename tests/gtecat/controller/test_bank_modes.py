@@ -150,6 +150,57 @@ GEAR: Script = [
 ]
 
 
+# --- the compiled slaves (bank_slaves) -------------------------------------------------------
+def _cam(a: int, master: int, points: list[tuple[int, float, int]], loop: int, d: int = 0) -> None:
+    _ok(gt.GT_PrfFollow(a, d), "PrfFollow")
+    _ok(gt.GT_SetFollowMaster(a, master, gt.FOLLOW_MASTER_PROFILE, 0), "SetFollowMaster")
+    gt.GT_FollowClear(a, 0)
+    for m, sv, kind in points:
+        _ok(gt.GT_FollowData(a, m, sv, kind, 0), "FollowData")
+    _ok(gt.GT_SetFollowLoop(a, loop), "SetFollowLoop")
+
+
+def _slaves_setup() -> object:
+    """Slaves of two Trap masters with ratios, clutches and cams whose values are not powers
+    of two (an operation done in another order gives other bits): Gear with a clutch both
+    ways and one way, cams of every segment type, forwards and backwards, a one-point cam, a
+    cam that ends after its passes, a slave waiting for a pass event (Python until its cluster
+    is taken again), masters numbered below and above their slaves."""
+    _trap(1, 9_000, 23.7, 0.37, 7)
+    _trap(9, -7_000, 19.3, 0.29)
+    _gear(2, 1, gt.GEAR_MASTER_PROFILE, (7, 3, 997))
+    _gear(3, 1, gt.GEAR_MASTER_PROFILE, (3, -5, 0), -1)
+    kinds = (0, 1, 3, 2, 0, 0, 1)
+    cam = [(173 * (k + 1) + 11 * k * k, 97.3 * (k + 1) - 41.9 * (k % 3), kinds[k]) for k in range(7)]
+    _cam(4, 1, cam, 2)  # ends after two passes
+    _cam(5, 9, [(-211 * (k + 1), 61.7 * (k + 1) ** 1.5, k % 3) for k in range(5)], 0)
+    _gear(6, 9, gt.GEAR_MASTER_PROFILE, (11, 13, 2001))
+    _cam(7, 1, cam, 0)
+    _ok(gt.GT_SetFollowEvent(7, gt.FOLLOW_EVENT_PASS, 1, 1_500), "SetFollowEvent")
+    _cam(8, 9, [(-377, 211.9, 0)], 0, -1)  # one point: a pass every 377 pulses
+    _cam(10, 9, [(-300 * (k + 1), 77.7 * k, 3) for k in range(4)], 2)
+    return (gt.GT_GearStart(_bit(2, 3, 6)), gt.GT_FollowStart(_bit(4, 5, 7, 8, 10), 0))
+
+
+def _follow_loops() -> tuple:
+    out = []
+    for a in (4, 5, 7, 8, 10):
+        v = c_long()
+        out.append((gt.GT_GetFollowLoop(a, byref(v)), v.value))
+    return out
+
+
+SLAVES: Script = [
+    (0, _slaves_setup),
+    (57, lambda: gt.GT_SetGearRatio(2, 9, -4, 1_501)),  # a clutch from ratio 3/7 to -4/9
+    (41, _follow_loops),  # every cam slave back to its planner mid-table, then taken again
+    (66, lambda: _trap(1, 1_000, 17.1, 0.41)),  # master 1 turns back: the cams run backwards
+    (150, lambda: gt.GT_Stop(_bit(5), 0)),
+    (40, lambda: gt.GT_FollowStart(_bit(5), 0)),  # again, from where it stopped
+    (60, _follow_loops),
+]
+
+
 # --- coordinated motion ---------------------------------------------------------------------
 def _crd_system(crd: int, axes: tuple[int, int], io: bool, laps: int) -> None:
     prm = gt.TCrdPrm()
@@ -251,9 +302,15 @@ def _run(
             )
         )
         got = ctl.bank.sampled_samples if ctl.bank is not None else 0
+        sf = ctl.bank.__dict__.get("_slave_fill") if ctl.bank is not None else None
+        COMPILED_SLAVES[0] = sf.samples if sf else 0
     finally:
         gt.GT_Close()
     return trace, got
+
+
+#: the samples of the last _run's compiled slaves (bank_slaves.SlaveFill)
+COMPILED_SLAVES = [0]
 
 
 @pytest.fixture(scope="module")
@@ -271,8 +328,20 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
         (CRD, 800, False),
         (CRD, 800, True),
         (EDGE, 300, False),
+        (SLAVES, 2500, False),
+        (SLAVES, 2500, True),
     ],
-    ids=["pt", "pt-chunked", "gear-follow", "gear-follow-chunked", "crd", "crd-chunked", "edge"],
+    ids=[
+        "pt",
+        "pt-chunked",
+        "gear-follow",
+        "gear-follow-chunked",
+        "crd",
+        "crd-chunked",
+        "edge",
+        "slaves",
+        "slaves-chunked",
+    ],
 )
 def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked) -> None:
     ref, none = _run(script, machine, "off", chunked)
@@ -281,6 +350,8 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"step {k}: the bank and the scalar path differ"
     assert samples >= least, "the bank hardly ran this mode"
+    if script is SLAVES:
+        assert COMPILED_SLAVES[0] >= 1500, "the compiled slaves hardly ran"
 
 
 @pytest.mark.parametrize("script", [PT, GEAR], ids=["pt", "gear-follow"])
