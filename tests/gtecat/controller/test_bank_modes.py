@@ -171,7 +171,9 @@ def _slaves_setup() -> object:
     _gear(2, 1, gt.GEAR_MASTER_PROFILE, (7, 3, 997))
     _gear(3, 1, gt.GEAR_MASTER_PROFILE, (3, -5, 0), -1)
     kinds = (0, 1, 3, 2, 0, 0, 1)
-    cam = [(173 * (k + 1) + 11 * k * k, 97.3 * (k + 1) - 41.9 * (k % 3), kinds[k]) for k in range(7)]
+    cam = [
+        (173 * (k + 1) + 11 * k * k, 97.3 * (k + 1) - 41.9 * (k % 3), kinds[k]) for k in range(7)
+    ]
     _cam(4, 1, cam, 2)  # ends after two passes
     _cam(5, 9, [(-211 * (k + 1), 61.7 * (k + 1) ** 1.5, k % 3) for k in range(5)], 0)
     _gear(6, 9, gt.GEAR_MASTER_PROFILE, (11, 13, 2001))
