@@ -41,7 +41,7 @@ log = logging.getLogger(__name__)
 #: value: it reorders no floating-point operation without -ffast-math's licences); portable
 #: code for any processor of the architecture (no -march: the cache may be shared between
 #: machines, and an instruction set chosen per processor measured no faster)
-CFLAGS = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+CFLAGS = ("-std=c99", "-O3", "-g", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 #: the plain build, when the compiler refuses CFLAGS
 PLAIN_CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64

@@ -390,6 +390,49 @@ INLINE int commit_cursors(void **ptr, int64_t n)
     return fin_any;
 }
 
+/* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement) */
+INLINE void write_image(void **ptr, const int64_t *io)
+{
+    uint8_t *buf = U8(buf);
+    int64_t i;
+    for (i = 0; i < io[IN_N_PLC]; i++) {
+        int64_t row = I64(pl_row)[i], val;
+        uint32_t u;
+        switch (I64(pl_col)[i]) {
+        case 0: val = I64(c_target)[row]; break;
+        case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
+        case 2: val = I64(c_din)[row]; break;
+        case 3:
+            val = I64(c_sw_const)[row] +
+                  ((U8(c_limited)[row] | U8(c_sw_limited)[row]) ? 0x800 : 0);
+            break;
+        case 4: val = to_i64(rint(F64(c_dpos)[row] - (double)I64(c_off)[row])); break;
+        case 5: val = to_i64(rint(F64(c_vel)[row])); break;
+        case 6: val = to_i64(rint(F64(c_dpos)[row] - F64(c_pos)[row])); break;
+        default:
+            val = clip16(F64(c_acc)[row] / F64(c_a_rated)[row] * 1000.0 +
+                         F64(c_vel)[row] * F64(c_visc)[row]);
+        }
+        u = (uint32_t)(uint64_t)val;
+        {
+            int64_t k, off = I64(pl_off)[i], size = I64(pl_size)[i];
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            if (size == 4) { /* the PDO's little-endian bytes are the value's own */
+                memcpy(buf + off, &u, 4);
+                continue;
+            }
+            if (size == 2) {
+                uint16_t u16 = (uint16_t)u;
+                memcpy(buf + off, &u16, 2);
+                continue;
+            }
+#endif
+            for (k = 0; k < size; k++)
+                buf[off + k] = (uint8_t)(u >> (8 * k));
+        }
+    }
+}
+
 /* inlined where the field table is a local copy: the compiler then knows no store through a
  * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
 INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
@@ -707,44 +750,378 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
 
     /* 8. the image: 607Ah out, the drives' TxPDO in */
 image:
-    for (i = 0; i < io[IN_N_PLC]; i++) {
-        int64_t row = I64(pl_row)[i], val;
-        uint32_t u;
-        switch (I64(pl_col)[i]) {
-        case 0: val = I64(c_target)[row]; break;
-        case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
-        case 2: val = I64(c_din)[row]; break;
-        case 3:
-            val = I64(c_sw_const)[row] +
-                  ((U8(c_limited)[row] | U8(c_sw_limited)[row]) ? 0x800 : 0);
-            break;
-        case 4: val = to_i64(rint(F64(c_dpos)[row] - (double)I64(c_off)[row])); break;
-        case 5: val = to_i64(rint(F64(c_vel)[row])); break;
-        case 6: val = to_i64(rint(F64(c_dpos)[row] - F64(c_pos)[row])); break;
-        default:
-            val = clip16(F64(c_acc)[row] / F64(c_a_rated)[row] * 1000.0 +
-                         F64(c_vel)[row] * F64(c_visc)[row]);
-        }
-        u = (uint32_t)(uint64_t)val;
-        {
-            int64_t k, off = I64(pl_off)[i], size = I64(pl_size)[i];
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-            if (size == 4) { /* the PDO's little-endian bytes are the value's own */
-                memcpy(buf + off, &u, 4);
-                continue;
-            }
-            if (size == 2) {
-                uint16_t u16 = (uint16_t)u;
-                memcpy(buf + off, &u16, 2);
-                continue;
-            }
-#endif
-            for (k = 0; k < size; k++)
-                buf[off + k] = (uint8_t)(u >> (8 * k));
-        }
-    }
+    write_image(ptr, io);
     io[OUT_FIN] = fin_any;
     return 0;
+}
+
+/* Many cycles row by row (bank_kernel_run when every stepping row is in CSP).  The rows of
+ * such a bank do not read each other: a row's cycles are its own chain, the same operations
+ * in the same order as in cycle_once's three passes and its commit, whichever row runs
+ * first.  So each row runs all the cycles of the call at once with its state in locals, and
+ * the call commits the cycles every row could run: a row stops before a cycle it declines
+ * (cycle_once would decline that cycle for the whole bank) and after the cycle that ends its
+ * Trap move (the run stops there).  A row that ran further than the shortest one is put back
+ * (its table as it was) and runs again to that length. */
+typedef struct {
+    double pos, vel, acc, dpos, dvel, fe_time, a, enc_pos, step0, step1;
+    double jrp, jrv, jp, jv, ja;
+    int64_t target, din, enc_prev, since, cur, t_idx, taken, t_len, t_end;
+    int64_t len; /* the cycles run */
+    int code;    /* 0, or why the next cycle is declined */
+    uint8_t lim, swl, arrived, moving, ended, fin, refilled;
+} RowRun;
+
+INLINE void row_load(void **ptr, int64_t r, RowRun *s)
+{
+    s->pos = F64(c_pos)[r];
+    s->vel = F64(c_vel)[r];
+    s->acc = F64(c_acc)[r];
+    s->dpos = F64(c_dpos)[r];
+    s->dvel = F64(c_dvel)[r];
+    s->fe_time = F64(c_fe_time)[r];
+    s->a = F64(a_last)[r];
+    s->enc_pos = F64(enc_pos)[r];
+    s->step0 = F64(enc_step0)[r];
+    s->step1 = F64(enc_step1)[r];
+    s->jrp = F64(jrp)[r];
+    s->jrv = F64(jrv)[r];
+    s->jp = F64(jp)[r];
+    s->jv = F64(jv)[r];
+    s->ja = F64(ja)[r];
+    s->target = I64(c_target)[r];
+    s->din = I64(c_din)[r];
+    s->enc_prev = I64(enc_prev)[r];
+    s->since = I64(since)[r];
+    s->cur = I64(t_cur)[r];
+    s->t_idx = I64(t_idx)[r];
+    s->taken = I64(taken)[r];
+    s->t_len = I64(t_len)[r];
+    s->t_end = I64(t_end)[r];
+    s->lim = U8(c_limited)[r];
+    s->swl = U8(c_sw_limited)[r];
+    s->arrived = U8(arrived)[r];
+    s->moving = U8(moving)[r];
+    s->ended = U8(ended)[r];
+    s->len = 0;
+    s->code = 0;
+    s->fin = 0;
+    s->refilled = 0;
+}
+
+INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
+{
+    F64(c_pos)[r] = s->pos;
+    F64(c_vel)[r] = s->vel;
+    F64(c_acc)[r] = s->acc;
+    F64(c_dpos)[r] = s->dpos;
+    F64(c_dvel)[r] = s->dvel;
+    F64(c_fe_time)[r] = s->fe_time;
+    F64(a_last)[r] = s->a;
+    F64(enc_pos)[r] = s->enc_pos;
+    F64(enc_step0)[r] = s->step0;
+    F64(enc_step1)[r] = s->step1;
+    F64(jrp)[r] = s->jrp;
+    F64(jrv)[r] = s->jrv;
+    F64(jp)[r] = s->jp;
+    F64(jv)[r] = s->jv;
+    F64(ja)[r] = s->ja;
+    I64(c_target)[r] = s->target;
+    I64(c_din)[r] = s->din;
+    I64(enc_prev)[r] = s->enc_prev;
+    I64(since)[r] = s->since;
+    I64(t_cur)[r] = s->cur;
+    I64(t_idx)[r] = s->t_idx;
+    I64(taken)[r] = s->taken;
+    I64(t_len)[r] = s->t_len;
+    I64(t_end)[r] = s->t_end;
+    U8(c_limited)[r] = s->lim;
+    U8(c_sw_limited)[r] = s->swl;
+    U8(arrived)[r] = s->arrived;
+    U8(moving)[r] = s->moving;
+    U8(ended)[r] = s->ended;
+}
+
+/* Row r's cycles from the state in s, at most `limit` of them (see RowRun).  Before its first
+ * refill the row's table (TABLE + 1 samples of position, speed, acceleration) is kept in bk. */
+static void row_cycles(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
+                       int64_t limit, double *bk)
+{
+    const double dt = fp[FP_DT], h = fp[FP_T];
+    const double half_per_dt = 0.5 / dt;
+    const int64_t t0 = io[IN_T_NS], dt_ns = io[IN_DT_NS], table = io[IN_TABLE];
+    const int64_t base = I64(base)[r];
+    double *const tp = F64(t_p), *const tv = F64(t_v), *const ta = F64(t_a);
+    const int jog = U8(jog)[r];
+    const double tau = F64(tau)[r], e = F64(jE)[r];
+    const double prf_ratio = F64(prf_ratio)[r], prf_off = F64(prf_off)[r], unit2 = F64(unit2)[r];
+    const int64_t drive_offset = I64(drive_offset)[r], pos_offset = I64(c_pos_offset)[r];
+    const int64_t sw_min = I64(c_sw_min)[r], sw_max = I64(c_sw_max)[r], off = I64(c_off)[r];
+    const double vmax = F64(c_vmax)[r], ce = F64(c_e)[r], cc = F64(c_c)[r], lim = F64(c_lim)[r];
+    const int fe_check = U8(c_fe_check)[r];
+    const double fe_window = F64(c_fe_window)[r], fe_timeout = F64(c_fe_timeout)[r];
+    const double pl = F64(c_pl)[r], nl = F64(c_nl)[r];
+    const int external = U8(external)[r];
+    const int64_t sense = I64(sense)[r];
+    const double unit = F64(unit)[r], enc_ratio = F64(enc_ratio)[r], enc_off = F64(enc_off)[r];
+    const double soft_pos = F64(soft_pos)[r], soft_neg = F64(soft_neg)[r];
+    const double pos_err = F64(pos_err)[r], band = F64(band)[r];
+    const int64_t hold_ns = I64(hold_ns)[r];
+    const int64_t w2 = io[IN_W2], w16 = io[IN_W16], w17 = io[IN_W17];
+    RowRun q = *s;
+    int64_t c;
+    for (c = 0; c < limit; c++) {
+        const int64_t t_ns = t0 + c * dt_ns;
+        int64_t cur = q.cur, counts, x, target, pa, din, raw, since;
+        int32_t d32;
+        double prf, a, demand, dvel, p1 = 0.0, v1 = 0.0, nfp = 0.0, nfv = 0.0, nfa = 0.0;
+        double p, v0, vff, e1, v, dist, rel, vstop, dv, pos, fe, step, enc, err;
+        int swl = 0, ended, limited = 0, arr;
+        /* pass 1: the profile and the demand */
+        if (q.moving && cur >= q.t_len) { /* the table is used up: the next one (refill_row) */
+            const int64_t m = I64(nseg)[r];
+            int64_t end;
+            if (m <= 0) {
+                q.code = 4;
+                break;
+            }
+            if (!q.refilled) {
+                memcpy(bk, tp + base, (size_t)(table + 1) * sizeof(double));
+                memcpy(bk + table + 1, tv + base, (size_t)(table + 1) * sizeof(double));
+                memcpy(bk + 2 * (table + 1), ta + base, (size_t)(table + 1) * sizeof(double));
+                q.refilled = 1;
+            }
+            tp[base + table] = tp[q.t_idx];
+            tv[base + table] = tv[q.t_idx];
+            ta[base + table] = ta[q.t_idx];
+            q.t_idx = base + table;
+            end = bank_trap_fill(F64(seg) + 4 * MAXSEG * r, m, F64(tprm)[NTPRM * r + 5],
+                                 F64(tprm) + NTPRM * r, I64(k0)[r] + q.taken, table, tp + base,
+                                 tv + base, ta + base);
+            q.t_len = end < table ? end + 1 : table;
+            q.t_end = end < table ? end : -1;
+            q.cur = cur = 0;
+        }
+        prf = tp[base + cur];
+        ended = cur == q.t_end;
+        if (jog) { /* AxisBank._jog_step */
+            const double rp = q.jrp, jv = q.jrv, fp_ = q.jp, fv = q.jv, fa = q.ja;
+            p1 = rp + h * (jv + 0.5 * 0.0 * h);
+            v1 = jv + 0.0 * h;
+            if (tau > 0.0) {
+                nfp = p1 - tau * (v1 - 0.0) + (fp_ - rp + tau * (jv - 0.0)) * e;
+                nfv = v1 - 0.0 + (fv - jv + 0.0) * e;
+                nfa = 0.0 + (fa - 0.0) * e;
+            } else {
+                nfp = p1;
+                nfv = v1;
+                nfa = 0.0;
+            }
+            if (nfv != v1 && fabs(nfv - v1) <= 1e-9 * (1.0 + fabs(v1))) {
+                nfv = v1;
+                nfa = 0.0;
+            }
+            prf = nfp;
+        }
+        a = link(prf, prf_ratio, prf_off);
+        {
+            double scaled = a * unit2;
+            if (!(fabs(scaled) < 4611686018427387904.0)) { /* 2**62, bank.HUGE_COUNTS */
+                q.code = 2;
+                break;
+            }
+            counts = to_i64(rint(scaled)) + drive_offset;
+        }
+        target = (int32_t)(uint32_t)(uint64_t)counts;
+        x = target + pos_offset;
+        if (x < sw_min || x > sw_max)
+            swl = 1;
+        if (x < sw_min)
+            x = sw_min;
+        if (x > sw_max)
+            x = sw_max;
+        x += off;
+        demand = (double)x;
+        dvel = (demand - q.dpos) / dt;
+        /* pass 2: Mechanics.track */
+        p = q.pos;
+        v0 = q.vel;
+        vff = dvel;
+        if (vff < -vmax)
+            vff = -vmax;
+        if (vff > vmax)
+            vff = vmax;
+        e1 = (demand - vff * dt - p) * ce + cc * vff;
+        v = (demand - e1 - p) / dt;
+        dist = demand - p;
+        rel = dist - vff * dt;
+        vstop = fabs(rel) * half_per_dt;
+        if (vstop > 0.5 * lim)
+            vstop = 0.5 * lim;
+        if (fabs(v - vff) > vstop) {
+            vstop = closing_speed(fabs(rel), lim, dt);
+            if (rel > 0.0 && v > vff + vstop) {
+                v = vff + vstop;
+                limited = 1;
+            } else if (rel < 0.0 && v < vff - vstop) {
+                v = vff - vstop;
+                limited = 1;
+            }
+        }
+        dv = v - v0;
+        if (dv > lim) {
+            v = v0 + lim;
+            limited = 1;
+        } else if (dv < -lim) {
+            v = v0 - lim;
+            limited = 1;
+        }
+        if (limited) {
+            if (rel > 0.0 && dist > 0.0 && v * dt > dist)
+                v = dist / dt;
+            else if (rel < 0.0 && dist < 0.0 && v * dt < dist)
+                v = dist / dt;
+        }
+        if (v > vmax) {
+            v = vmax;
+            limited = 1;
+        } else if (v < -vmax) {
+            v = -vmax;
+            limited = 1;
+        }
+        pos = p + v * dt;
+        /* pass 3: the feedback, the checks and the in-position band */
+        fe = 0.0;
+        if (fe_check && fabs(demand - pos) > fe_window) {
+            fe = q.fe_time + dt;
+            if (fe * 1000.0 > fe_timeout) {
+                q.code = 2;
+                break;
+            }
+        }
+        pa = to_i64(rint(pos - (double)off));
+        din = 2 * (pos >= pl) + (pos <= nl);
+        if (w2 && in_window(F64(w2_lo), F64(w2_hi), w2, r, pos))
+            din |= 1 << 2;
+        if (w16 && in_window(F64(w16_lo), F64(w16_hi), w16, r, pos))
+            din |= 1 << 16;
+        if (w17 && in_window(F64(w17_lo), F64(w17_hi), w17, r, pos))
+            din |= 1 << 17;
+        raw = external ? pa : target;
+        d32 = (int32_t)(uint32_t)(uint64_t)(raw - q.enc_prev);
+        step = (double)(sense * (int64_t)d32) * unit;
+        enc = q.enc_pos + step;
+        err = a - link(enc, enc_ratio, enc_off);
+        if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err) {
+            q.code = 2;
+            break;
+        }
+        since = q.since;
+        arr = q.arrived;
+        if (band > 0.0) {
+            const int standing = (ended || !q.moving) && !jog;
+            const int inb = standing && -band <= err && err <= band;
+            since = inb ? (since < 0 ? t_ns : since) : -1;
+            arr = inb && (arr || t_ns - since >= hold_ns);
+        }
+        /* the commit */
+        if (jog) {
+            q.jrp = p1;
+            q.jrv = v1;
+            q.jp = nfp;
+            q.jv = nfv;
+            q.ja = nfa;
+        }
+        q.pos = pos;
+        q.vel = v;
+        q.acc = (v - v0) / dt;
+        q.dpos = demand;
+        q.dvel = dvel;
+        q.fe_time = fe;
+        q.lim = (uint8_t)limited;
+        q.swl = (uint8_t)swl;
+        q.target = target;
+        q.din = din;
+        q.a = a;
+        q.t_idx = base + cur;
+        q.enc_prev = raw;
+        q.enc_pos = enc;
+        q.step0 = q.step1;
+        q.step1 = step;
+        q.since = since;
+        q.arrived = (uint8_t)arr;
+        q.taken += q.moving;
+        if (q.moving) {
+            if (ended) {
+                q.ended = 1;
+                q.moving = 0;
+                q.fin = 1;
+                c++;
+                break;
+            }
+            q.cur = cur + 1;
+        }
+    }
+    q.len = c;
+    *s = q;
+}
+
+/* Row r back where it stood before row_cycles (its table refilled: the table kept in bk). */
+INLINE void row_undo(void **ptr, const int64_t *io, int64_t r, RowRun *s, const double *bk)
+{
+    const int64_t table = io[IN_TABLE], base = I64(base)[r];
+    if (s->refilled) {
+        memcpy(F64(t_p) + base, bk, (size_t)(table + 1) * sizeof(double));
+        memcpy(F64(t_v) + base, bk + table + 1, (size_t)(table + 1) * sizeof(double));
+        memcpy(F64(t_a) + base, bk + 2 * (table + 1), (size_t)(table + 1) * sizeof(double));
+    }
+    row_load(ptr, r, s);
+}
+
+/* bank_kernel_run row by row (see RowRun); the cycles committed */
+static int64_t run_rows(void **ptr, int64_t *io, const double *fp, RowRun *rs, double *bk,
+                        int *rc)
+{
+    const int64_t n = io[IN_N], maxc = io[IN_MAXC], width = 3 * (io[IN_TABLE] + 1);
+    const uint8_t *alive = U8(alive), *frz = U8(frz);
+    int64_t r, lim = maxc, code_row = -1;
+    int fin_any = 0, filled = 0;
+    for (r = 0; r < n; r++) {
+        if (!alive[r] || frz[r])
+            continue;
+        row_load(ptr, r, rs + r);
+        row_cycles(ptr, io, fp, r, rs + r, lim, bk + width * r);
+        if (rs[r].len < lim) /* it stops there (declines the next cycle, or its move ended) */
+            lim = rs[r].len;
+    }
+    for (r = 0; r < n; r++) {
+        RowRun *s = rs + r;
+        if (!alive[r] || frz[r])
+            continue;
+        if (s->len > lim) { /* it ran past the cycles the bank commits: again, that far */
+            row_undo(ptr, io, r, s, bk + width * r);
+            row_cycles(ptr, io, fp, r, s, lim, bk + width * r);
+        }
+        if (s->code && s->len == lim && code_row < 0)
+            code_row = r;
+        fin_any |= s->fin && s->len == lim;
+        filled |= s->refilled;
+    }
+    for (r = 0; r < n; r++) {
+        if (!alive[r]) {
+            I64(c_start)[r] += lim; /* a row left out did not step */
+            continue;
+        }
+        if (!frz[r])
+            row_store(ptr, r, rs + r);
+    }
+    if (lim)
+        write_image(ptr, io);
+    io[OUT_FIN] = fin_any;
+    if (filled)
+        io[OUT_FILLED] = 1;
+    *rc = code_row >= 0 ? rs[code_row].code : 0;
+    return lim;
 }
 
 /* the row flags of one cycle's passes (0: the row does not step, 1: it steps, 2: it steps
@@ -769,16 +1146,44 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 
 /* Up to io[IN_MAXC] cycles from io[IN_T_NS], io[IN_DT_NS] apart; io[OUT_DONE] = cycles
  * committed.  Stops after a cycle that ended a Trap move (io[OUT_FIN]) and before one the
- * kernel declines (its code is returned, nothing of that cycle written). */
+ * kernel declines (its code is returned, nothing of that cycle written).  Without a homing
+ * row the cycles run row by row (run_rows), the image written once after the last. */
 int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
 {
     void *lp[N_FIELDS];
     uint8_t stack[GO_STACK], *go = stack;
-    int64_t c, maxc = io[IN_MAXC], t0 = io[IN_T_NS];
-    int rc = 0;
+    int64_t c, r, maxc = io[IN_MAXC], t0 = io[IN_T_NS], n = io[IN_N];
+    int rc = 0, rows = 1;
     memcpy(lp, ptr, sizeof lp);
     io[OUT_FILLED] = 0;
     io[OUT_DONE] = 0;
+    io[OUT_FIN] = 0;
+    {
+        const uint8_t *alive = U8(alive), *frz = U8(frz), *hm = U8(hm);
+        for (r = 0; r < n; r++)
+            if (alive[r] && !frz[r] && hm[r])
+                rows = 0;
+    }
+    if (rows && maxc > 0) {
+        void **ptr = lp; /* the local table for U8/I64/F64 */
+        const uint8_t *buf = U8(buf);
+        RowRun *rs;
+        double *bk;
+        for (r = 0; r < io[IN_N_RX]; r++) /* a raw write to a claimed slave's outputs */
+            if (buf[I64(rx_idx)[r]] != U8(rx_ref)[r])
+                return 1;
+        rs = malloc((size_t)(n > 0 ? n : 1) * sizeof(RowRun));
+        bk = malloc((size_t)(n > 0 ? n : 1) * (size_t)(3 * (io[IN_TABLE] + 1)) * sizeof(double));
+        if (!rs || !bk) {
+            free(rs);
+            free(bk);
+            return 5; /* no memory: the numpy cycle runs it */
+        }
+        io[OUT_DONE] = run_rows(lp, io, fp, rs, bk, &rc);
+        free(rs);
+        free(bk);
+        return rc;
+    }
     if (io[IN_N] > GO_STACK && !(go = malloc((size_t)io[IN_N])))
         return 5; /* no memory: the numpy cycle runs it */
     for (c = 0; c < maxc; c++) {
