@@ -282,14 +282,19 @@ int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *pr
                 hi = k == i ? t : sg[4 * (k + 1)];
                 span = hi - lo;
                 if (span > 0.0) {
-                    total = total + span * (pk + span * (0.5 * vk + ak * span / 6.0));
+                    /* ak * span / 6.0, the division left out where it gives its zero back
+                     * (a piece at constant speed): the divider is this loop's bottleneck */
+                    const double as = ak * span, as6 = as == 0.0 ? as : as / 6.0;
+                    total = total + span * (pk + span * (0.5 * vk + as6));
                     dist = dist + span * (vk + 0.5 * ak * span);
                 }
                 if (k >= i)
                     break;
             }
             p = p + total / ts;
-            a = (v - va) / ts;
+            a = v - va; /* (v - va) / ts: a zero stays the same zero (ts > 0) */
+            if (a != 0.0)
+                a = a / ts;
             v = dist / ts;
         }
         if (t - ts >= t_final) { /* the final approach: min(p, target) / max(p, target) */
