@@ -236,6 +236,72 @@ INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *
 }
 
 
+/* bank_trap_fill's final approach of a sample (t - ts = ta): min(p, target) / max(p, target) */
+INLINE double final_approach(double p, double ta, double t_final, double tgt, double dir)
+{
+    if (ta >= t_final) {
+        if (dir > 0.0)
+            p = tgt < p ? tgt : p;
+        else
+            p = tgt > p ? tgt : p;
+    }
+    return p;
+}
+
+#if defined(__GNUC__)
+typedef double v2d __attribute__((vector_size(16)));
+
+/* Samples kk and kk + 1 of bank_trap_fill's smoothed move (ts > 0) at once, two lanes of the
+ * same operations in the same order (each lane its own IEEE result: the same bits), where
+ * both lie in one raw piece, their smoothing windows start in that piece too and neither is
+ * the end sample; 0 (nothing written) otherwise.  *pi, *pj: the
+ * pieces of the last sample (moved on as the scalar loop would). */
+INLINE int trap_pair(const double *sg, int64_t m, double cyc, const double *prm, double thr,
+                     int64_t kk, int64_t *pi, int64_t *pj, double *po, double *vo, double *ao)
+{
+    const double ts = prm[1], t_final = prm[2];
+    const double t0 = (double)kk * cyc, t1 = (double)(kk + 1) * cyc;
+    const double ta0 = t0 - ts, ta1 = t1 - ts;
+    int64_t i = *pi, j = *pj;
+    if (!(t0 < thr && t1 < thr))
+        return 0;
+    while (i + 1 < m && sg[4 * (i + 1)] <= t0)
+        i++;
+    while (j + 1 < m && sg[4 * (j + 1)] <= ta0)
+        j++;
+    *pi = i;
+    *pj = j;
+    if (i != j || (i + 1 < m && sg[4 * (i + 1)] <= t1) || !(t1 - ta1 > 0.0 && t0 - ta0 > 0.0))
+        return 0;
+    {
+        const v2d half = {0.5, 0.5}, six = {6.0, 6.0}, zero = {0.0, 0.0}, tsv = {ts, ts};
+        const v2d s0 = {sg[4 * i], sg[4 * i]}, s1 = {sg[4 * i + 1], sg[4 * i + 1]};
+        const v2d s2 = {sg[4 * i + 2], sg[4 * i + 2]}, s3 = {sg[4 * i + 3], sg[4 * i + 3]};
+        const v2d t = {t0, t1}, ta = {ta0, ta1};
+        v2d tau = t - s0;
+        v2d p = s1 + tau * (s2 + half * s3 * tau);
+        v2d v = s2 + s3 * tau;
+        v2d tk = ta - s0; /* the window's start, in the same piece */
+        v2d vk = s2 + s3 * tk;
+        v2d pk = s1 + tk * (s2 + half * s3 * tk) - p;
+        v2d span = t - ta;
+        v2d as6 = s3 * span / six;
+        v2d total = zero + span * (pk + span * (half * vk + as6));
+        v2d dist = zero + span * (vk + half * s3 * span);
+        v2d a = (v - vk) / tsv;
+        p = p + total / tsv;
+        v = dist / tsv;
+        po[0] = final_approach(p[0], ta0, t_final, prm[3], prm[4]);
+        po[1] = final_approach(p[1], ta1, t_final, prm[3], prm[4]);
+        vo[0] = v[0];
+        vo[1] = v[1];
+        ao[0] = a[0];
+        ao[1] = a[1];
+    }
+    return 1;
+}
+#endif
+
 /* motion/trap_table.py's trap_table for one planner, sample by sample in the planner's own
  * order of operations (TrapPlanner._sample): samples k0+1 .. k0+n of the move whose raw
  * pieces are sg[4*q .. 4*q+3] = (t0, p0, v0, a), q < m.  Writes min(end + 1, n) samples;
@@ -249,6 +315,13 @@ int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *pr
     for (s = 0; s < n; s++) {
         double t = (double)(k0 + 1 + s) * cyc;
         double tau, p, v, a;
+#if defined(__GNUC__)
+        if (ts > 0.0 && s + 1 < n && trap_pair(sg, m, cyc, prm, thr, k0 + 1 + s, &i, &j, po + s,
+                                               vo + s, ao + s)) {
+            s++;
+            continue;
+        }
+#endif
         if (t >= thr) {
             po[s] = tgt;
             vo[s] = 0.0;
@@ -297,13 +370,7 @@ int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *pr
                 a = a / ts;
             v = dist / ts;
         }
-        if (t - ts >= t_final) { /* the final approach: min(p, target) / max(p, target) */
-            if (dir > 0.0)
-                p = tgt < p ? tgt : p;
-            else
-                p = tgt > p ? tgt : p;
-        }
-        po[s] = p;
+        po[s] = final_approach(p, t - ts, t_final, tgt, dir);
         vo[s] = v;
         ao[s] = a;
     }
