@@ -285,10 +285,14 @@ INLINE int trap_pair(const double *sg, int64_t m, double cyc, const double *prm,
         v2d vk = s2 + s3 * tk;
         v2d pk = s1 + tk * (s2 + half * s3 * tk) - p;
         v2d span = t - ta;
-        v2d as6 = s3 * span / six;
+        /* the divisions that give a zero back are left out (a piece at constant speed):
+         * ak * span / 6.0 and (v - va) / ts of a zero are that zero (ts > 0) */
+        v2d as6 = s3[0] == 0.0 ? s3 * span : s3 * span / six;
         v2d total = zero + span * (pk + span * (half * vk + as6));
         v2d dist = zero + span * (vk + half * s3 * span);
-        v2d a = (v - vk) / tsv;
+        v2d a = v - vk;
+        if (a[0] != 0.0 || a[1] != 0.0)
+            a = a / tsv;
         p = p + total / tsv;
         v = dist / tsv;
         po[0] = final_approach(p[0], ta0, t_final, prm[3], prm[4]);
