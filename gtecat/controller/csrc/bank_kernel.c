@@ -28,6 +28,18 @@
 #define INLINE static inline
 #endif
 
+/* The hot loops built twice, the processor picking at load time (glibc's ifunc): with SSE4.1
+ * rint is one instruction (roundsd, rounding as rint does: the same bits), else the baseline
+ * sequence.  Nothing else differs (no FMA: -ffp-contract=off either way). */
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__GLIBC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define CLONES __attribute__((target_clones("sse4.1", "default")))
+#endif
+#endif
+#ifndef CLONES
+#define CLONES
+#endif
+
 #define FIELDS                                                                          \
     X(alive, u8) X(moving, u8) X(jog, u8) X(ended, u8) X(base, i64) X(t_cur, i64)          \
     X(t_end, i64) X(t_idx, i64) X(taken, i64) X(t_p, f64)                                  \
@@ -310,7 +322,7 @@ INLINE int trap_pair(const double *sg, int64_t m, double cyc, const double *prm,
  * order of operations (TrapPlanner._sample): samples k0+1 .. k0+n of the move whose raw
  * pieces are sg[4*q .. 4*q+3] = (t0, p0, v0, a), q < m.  Writes min(end + 1, n) samples;
  * returns end, the index of the end sample (target, 0, 0), or n when the move goes on. */
-int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm, int64_t k0,
+CLONES int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm, int64_t k0,
                        int64_t n, double *po, double *vo, double *ao)
 {
     const double t_done = prm[0], ts = prm[1], t_final = prm[2], tgt = prm[3], dir = prm[4];
@@ -920,7 +932,7 @@ INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
 
 /* Row r's cycles from the state in s, at most `limit` of them (see RowRun).  Before its first
  * refill the row's table (TABLE + 1 samples of position, speed, acceleration) is kept in bk. */
-static void row_cycles(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
+CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
                        int64_t limit, double *bk)
 {
     const double dt = fp[FP_DT], h = fp[FP_T];
