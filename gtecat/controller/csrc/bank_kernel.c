@@ -860,43 +860,6 @@ typedef struct {
     uint8_t lim, swl, arrived, moving, ended, fin, refilled;
 } RowRun;
 
-INLINE void row_load(void **ptr, int64_t r, RowRun *s)
-{
-    s->pos = F64(c_pos)[r];
-    s->vel = F64(c_vel)[r];
-    s->acc = F64(c_acc)[r];
-    s->dpos = F64(c_dpos)[r];
-    s->dvel = F64(c_dvel)[r];
-    s->fe_time = F64(c_fe_time)[r];
-    s->a = F64(a_last)[r];
-    s->enc_pos = F64(enc_pos)[r];
-    s->step0 = F64(enc_step0)[r];
-    s->step1 = F64(enc_step1)[r];
-    s->jrp = F64(jrp)[r];
-    s->jrv = F64(jrv)[r];
-    s->jp = F64(jp)[r];
-    s->jv = F64(jv)[r];
-    s->ja = F64(ja)[r];
-    s->target = I64(c_target)[r];
-    s->din = I64(c_din)[r];
-    s->enc_prev = I64(enc_prev)[r];
-    s->since = I64(since)[r];
-    s->cur = I64(t_cur)[r];
-    s->t_idx = I64(t_idx)[r];
-    s->taken = I64(taken)[r];
-    s->t_len = I64(t_len)[r];
-    s->t_end = I64(t_end)[r];
-    s->lim = U8(c_limited)[r];
-    s->swl = U8(c_sw_limited)[r];
-    s->arrived = U8(arrived)[r];
-    s->moving = U8(moving)[r];
-    s->ended = U8(ended)[r];
-    s->len = 0;
-    s->code = 0;
-    s->fin = 0;
-    s->refilled = 0;
-}
-
 INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
 {
     F64(c_pos)[r] = s->pos;
@@ -956,44 +919,48 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
     const double pos_err = F64(pos_err)[r], band = F64(band)[r];
     const int64_t hold_ns = I64(hold_ns)[r];
     const int64_t w2 = io[IN_W2], w16 = io[IN_W16], w17 = io[IN_W17];
-    RowRun q = *s;
+    /* the row's state in locals (from the committed arrays: a row run again starts there) */
+    double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r], q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r], q_a = F64(a_last)[r], q_enc_pos = F64(enc_pos)[r], q_step0 = F64(enc_step0)[r], q_step1 = F64(enc_step1)[r], q_jrp = F64(jrp)[r], q_jrv = F64(jrv)[r], q_jp = F64(jp)[r], q_jv = F64(jv)[r], q_ja = F64(ja)[r];
+    int64_t q_target = I64(c_target)[r], q_din = I64(c_din)[r], q_enc_prev = I64(enc_prev)[r], q_since = I64(since)[r], q_cur = I64(t_cur)[r], q_t_idx = I64(t_idx)[r], q_taken = I64(taken)[r], q_t_len = I64(t_len)[r], q_t_end = I64(t_end)[r];
+    uint8_t q_lim = U8(c_limited)[r], q_swl = U8(c_sw_limited)[r], q_arrived = U8(arrived)[r], q_moving = U8(moving)[r], q_ended = U8(ended)[r], q_fin = 0, q_refilled = 0;
+    int q_code = 0;
     int64_t c;
     for (c = 0; c < limit; c++) {
         const int64_t t_ns = t0 + c * dt_ns;
-        int64_t cur = q.cur, counts, x, target, pa, din, raw, since;
+        int64_t cur = q_cur, counts, x, target, pa, din, raw, since;
         int32_t d32;
         double prf, a, demand, dvel, p1 = 0.0, v1 = 0.0, nfp = 0.0, nfv = 0.0, nfa = 0.0;
         double p, v0, vff, e1, v, dist, rel, vstop, dv, pos, fe, step, enc, err;
         int swl = 0, ended, limited = 0, arr;
         /* pass 1: the profile and the demand */
-        if (q.moving && cur >= q.t_len) { /* the table is used up: the next one (refill_row) */
+        if (q_moving && cur >= q_t_len) { /* the table is used up: the next one (refill_row) */
             const int64_t m = I64(nseg)[r];
             int64_t end;
             if (m <= 0) {
-                q.code = 4;
+                q_code = 4;
                 break;
             }
-            if (!q.refilled) {
+            if (!q_refilled) {
                 memcpy(bk, tp + base, (size_t)(table + 1) * sizeof(double));
                 memcpy(bk + table + 1, tv + base, (size_t)(table + 1) * sizeof(double));
                 memcpy(bk + 2 * (table + 1), ta + base, (size_t)(table + 1) * sizeof(double));
-                q.refilled = 1;
+                q_refilled = 1;
             }
-            tp[base + table] = tp[q.t_idx];
-            tv[base + table] = tv[q.t_idx];
-            ta[base + table] = ta[q.t_idx];
-            q.t_idx = base + table;
+            tp[base + table] = tp[q_t_idx];
+            tv[base + table] = tv[q_t_idx];
+            ta[base + table] = ta[q_t_idx];
+            q_t_idx = base + table;
             end = bank_trap_fill(F64(seg) + 4 * MAXSEG * r, m, F64(tprm)[NTPRM * r + 5],
-                                 F64(tprm) + NTPRM * r, I64(k0)[r] + q.taken, table, tp + base,
+                                 F64(tprm) + NTPRM * r, I64(k0)[r] + q_taken, table, tp + base,
                                  tv + base, ta + base);
-            q.t_len = end < table ? end + 1 : table;
-            q.t_end = end < table ? end : -1;
-            q.cur = cur = 0;
+            q_t_len = end < table ? end + 1 : table;
+            q_t_end = end < table ? end : -1;
+            q_cur = cur = 0;
         }
         prf = tp[base + cur];
-        ended = cur == q.t_end;
+        ended = cur == q_t_end;
         if (jog) { /* AxisBank._jog_step */
-            const double rp = q.jrp, jv = q.jrv, fp_ = q.jp, fv = q.jv, fa = q.ja;
+            const double rp = q_jrp, jv = q_jrv, fp_ = q_jp, fv = q_jv, fa = q_ja;
             p1 = rp + h * (jv + 0.5 * 0.0 * h);
             v1 = jv + 0.0 * h;
             if (tau > 0.0) {
@@ -1015,7 +982,7 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
         {
             double scaled = a * unit2;
             if (!(fabs(scaled) < 4611686018427387904.0)) { /* 2**62, bank.HUGE_COUNTS */
-                q.code = 2;
+                q_code = 2;
                 break;
             }
             counts = to_i64(rint(scaled)) + drive_offset;
@@ -1030,10 +997,10 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
             x = sw_max;
         x += off;
         demand = (double)x;
-        dvel = (demand - q.dpos) / dt;
+        dvel = (demand - q_dpos) / dt;
         /* pass 2: Mechanics.track */
-        p = q.pos;
-        v0 = q.vel;
+        p = q_pos;
+        v0 = q_vel;
         vff = dvel;
         if (vff < -vmax)
             vff = -vmax;
@@ -1081,9 +1048,9 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
         /* pass 3: the feedback, the checks and the in-position band */
         fe = 0.0;
         if (fe_check && fabs(demand - pos) > fe_window) {
-            fe = q.fe_time + dt;
+            fe = q_fe_time + dt;
             if (fe * 1000.0 > fe_timeout) {
-                q.code = 2;
+                q_code = 2;
                 break;
             }
         }
@@ -1096,62 +1063,93 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
         if (w17 && in_window(F64(w17_lo), F64(w17_hi), w17, r, pos))
             din |= 1 << 17;
         raw = external ? pa : target;
-        d32 = (int32_t)(uint32_t)(uint64_t)(raw - q.enc_prev);
+        d32 = (int32_t)(uint32_t)(uint64_t)(raw - q_enc_prev);
         step = (double)(sense * (int64_t)d32) * unit;
-        enc = q.enc_pos + step;
+        enc = q_enc_pos + step;
         err = a - link(enc, enc_ratio, enc_off);
         if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err) {
-            q.code = 2;
+            q_code = 2;
             break;
         }
-        since = q.since;
-        arr = q.arrived;
+        since = q_since;
+        arr = q_arrived;
         if (band > 0.0) {
-            const int standing = (ended || !q.moving) && !jog;
+            const int standing = (ended || !q_moving) && !jog;
             const int inb = standing && -band <= err && err <= band;
             since = inb ? (since < 0 ? t_ns : since) : -1;
             arr = inb && (arr || t_ns - since >= hold_ns);
         }
         /* the commit */
         if (jog) {
-            q.jrp = p1;
-            q.jrv = v1;
-            q.jp = nfp;
-            q.jv = nfv;
-            q.ja = nfa;
+            q_jrp = p1;
+            q_jrv = v1;
+            q_jp = nfp;
+            q_jv = nfv;
+            q_ja = nfa;
         }
-        q.pos = pos;
-        q.vel = v;
-        q.acc = (v - v0) / dt;
-        q.dpos = demand;
-        q.dvel = dvel;
-        q.fe_time = fe;
-        q.lim = (uint8_t)limited;
-        q.swl = (uint8_t)swl;
-        q.target = target;
-        q.din = din;
-        q.a = a;
-        q.t_idx = base + cur;
-        q.enc_prev = raw;
-        q.enc_pos = enc;
-        q.step0 = q.step1;
-        q.step1 = step;
-        q.since = since;
-        q.arrived = (uint8_t)arr;
-        q.taken += q.moving;
-        if (q.moving) {
+        q_pos = pos;
+        q_vel = v;
+        q_acc = (v - v0) / dt;
+        q_dpos = demand;
+        q_dvel = dvel;
+        q_fe_time = fe;
+        q_lim = (uint8_t)limited;
+        q_swl = (uint8_t)swl;
+        q_target = target;
+        q_din = din;
+        q_a = a;
+        q_t_idx = base + cur;
+        q_enc_prev = raw;
+        q_enc_pos = enc;
+        q_step0 = q_step1;
+        q_step1 = step;
+        q_since = since;
+        q_arrived = (uint8_t)arr;
+        q_taken += q_moving;
+        if (q_moving) {
             if (ended) {
-                q.ended = 1;
-                q.moving = 0;
-                q.fin = 1;
+                q_ended = 1;
+                q_moving = 0;
+                q_fin = 1;
                 c++;
                 break;
             }
-            q.cur = cur + 1;
+            q_cur = cur + 1;
         }
     }
-    q.len = c;
-    *s = q;
+    s->len = c;
+    s->code = q_code;
+    s->pos = q_pos;
+    s->vel = q_vel;
+    s->acc = q_acc;
+    s->dpos = q_dpos;
+    s->dvel = q_dvel;
+    s->fe_time = q_fe_time;
+    s->a = q_a;
+    s->enc_pos = q_enc_pos;
+    s->step0 = q_step0;
+    s->step1 = q_step1;
+    s->jrp = q_jrp;
+    s->jrv = q_jrv;
+    s->jp = q_jp;
+    s->jv = q_jv;
+    s->ja = q_ja;
+    s->target = q_target;
+    s->din = q_din;
+    s->enc_prev = q_enc_prev;
+    s->since = q_since;
+    s->cur = q_cur;
+    s->t_idx = q_t_idx;
+    s->taken = q_taken;
+    s->t_len = q_t_len;
+    s->t_end = q_t_end;
+    s->lim = q_lim;
+    s->swl = q_swl;
+    s->arrived = q_arrived;
+    s->moving = q_moving;
+    s->ended = q_ended;
+    s->fin = q_fin;
+    s->refilled = q_refilled;
 }
 
 /* Row r back where it stood before row_cycles (its table refilled: the table kept in bk). */
@@ -1163,7 +1161,6 @@ INLINE void row_undo(void **ptr, const int64_t *io, int64_t r, RowRun *s, const 
         memcpy(F64(t_v) + base, bk + table + 1, (size_t)(table + 1) * sizeof(double));
         memcpy(F64(t_a) + base, bk + 2 * (table + 1), (size_t)(table + 1) * sizeof(double));
     }
-    row_load(ptr, r, s);
 }
 
 /* bank_kernel_run row by row (see RowRun); the cycles committed */
@@ -1177,7 +1174,6 @@ static int64_t run_rows(void **ptr, int64_t *io, const double *fp, RowRun *rs, d
     for (r = 0; r < n; r++) {
         if (!alive[r] || frz[r])
             continue;
-        row_load(ptr, r, rs + r);
         row_cycles(ptr, io, fp, r, rs + r, lim, bk + width * r);
         if (rs[r].len < lim) /* it stops there (declines the next cycle, or its move ended) */
             lim = rs[r].len;
@@ -1232,10 +1228,15 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
     return rc;
 }
 
+/* the fewest cycles a call runs row by row: each row's run costs its loads and stores once,
+ * which a call of a few cycles does not win back (measured: 128 rows, even at 5-6) */
+#define ROWS_FROM 6
+
 /* Up to io[IN_MAXC] cycles from io[IN_T_NS], io[IN_DT_NS] apart; io[OUT_DONE] = cycles
  * committed.  Stops after a cycle that ended a Trap move (io[OUT_FIN]) and before one the
  * kernel declines (its code is returned, nothing of that cycle written).  Without a homing
- * row the cycles run row by row (run_rows), the image written once after the last. */
+ * row, ROWS_FROM cycles and more run row by row (run_rows), the image written once after the
+ * last. */
 int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
 {
     void *lp[N_FIELDS];
@@ -1252,7 +1253,7 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
             if (alive[r] && !frz[r] && hm[r])
                 rows = 0;
     }
-    if (rows && maxc > 0) {
+    if (rows && maxc >= ROWS_FROM) {
         void **ptr = lp; /* the local table for U8/I64/F64 */
         const uint8_t *buf = U8(buf);
         RowRun *rs;
