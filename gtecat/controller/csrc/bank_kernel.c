@@ -895,15 +895,15 @@ INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
 
 /* Row r's cycles from the state in s, at most `limit` of them (see RowRun).  Before its first
  * refill the row's table (TABLE + 1 samples of position, speed, acceleration) is kept in bk. */
-CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
-                       int64_t limit, double *bk)
+INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
+                         int64_t limit, double *bk, const int plain)
 {
     const double dt = fp[FP_DT], h = fp[FP_T];
     const double half_per_dt = 0.5 / dt;
     const int64_t t0 = io[IN_T_NS], dt_ns = io[IN_DT_NS], table = io[IN_TABLE];
     const int64_t base = I64(base)[r];
     double *const tp = F64(t_p), *const tv = F64(t_v), *const ta = F64(t_a);
-    const int jog = U8(jog)[r];
+    const int jog = plain ? 0 : U8(jog)[r];
     const double tau = F64(tau)[r], e = F64(jE)[r];
     const double prf_ratio = F64(prf_ratio)[r], prf_off = F64(prf_off)[r], unit2 = F64(unit2)[r];
     const int64_t drive_offset = I64(drive_offset)[r], pos_offset = I64(c_pos_offset)[r];
@@ -916,9 +916,10 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
     const int64_t sense = I64(sense)[r];
     const double unit = F64(unit)[r], enc_ratio = F64(enc_ratio)[r], enc_off = F64(enc_off)[r];
     const double soft_pos = F64(soft_pos)[r], soft_neg = F64(soft_neg)[r];
-    const double pos_err = F64(pos_err)[r], band = F64(band)[r];
+    const double pos_err = F64(pos_err)[r], band = plain ? 0.0 : F64(band)[r];
     const int64_t hold_ns = I64(hold_ns)[r];
-    const int64_t w2 = io[IN_W2], w16 = io[IN_W16], w17 = io[IN_W17];
+    const int64_t w2 = plain ? 0 : io[IN_W2], w16 = plain ? 0 : io[IN_W16];
+    const int64_t w17 = plain ? 0 : io[IN_W17];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
     double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r], q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r], q_a = F64(a_last)[r], q_enc_pos = F64(enc_pos)[r], q_step0 = F64(enc_step0)[r], q_step1 = F64(enc_step1)[r], q_jrp = F64(jrp)[r], q_jrv = F64(jrv)[r], q_jp = F64(jp)[r], q_jv = F64(jv)[r], q_ja = F64(ja)[r];
     int64_t q_target = I64(c_target)[r], q_din = I64(c_din)[r], q_enc_prev = I64(enc_prev)[r], q_since = I64(since)[r], q_cur = I64(t_cur)[r], q_t_idx = I64(t_idx)[r], q_taken = I64(taken)[r], q_t_len = I64(t_len)[r], q_t_end = I64(t_end)[r];
@@ -978,7 +979,7 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
             }
             prf = nfp;
         }
-        a = link(prf, prf_ratio, prf_off);
+        a = plain ? prf : link(prf, prf_ratio, prf_off);
         {
             double scaled = a * unit2;
             if (!(fabs(scaled) < 4611686018427387904.0)) { /* 2**62, bank.HUGE_COUNTS */
@@ -1046,10 +1047,13 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
         }
         pos = p + v * dt;
         /* pass 3: the feedback, the checks and the in-position band */
-        fe = 0.0;
-        if (fe_check && fabs(demand - pos) > fe_window) {
-            fe = q_fe_time + dt;
-            if (fe * 1000.0 > fe_timeout) {
+        {
+            /* without a branch on the window: a following error near it comes and goes
+             * from cycle to cycle, which no branch predictor follows */
+            const int out = fe_check & (fabs(demand - pos) > fe_window);
+            const double fe_in = q_fe_time + dt;
+            fe = out ? fe_in : 0.0;
+            if (out && fe * 1000.0 > fe_timeout) {
                 q_code = 2;
                 break;
             }
@@ -1066,7 +1070,7 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
         d32 = (int32_t)(uint32_t)(uint64_t)(raw - q_enc_prev);
         step = (double)(sense * (int64_t)d32) * unit;
         enc = q_enc_pos + step;
-        err = a - link(enc, enc_ratio, enc_off);
+        err = a - (plain ? enc : link(enc, enc_ratio, enc_off));
         if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err) {
             q_code = 2;
             break;
@@ -1152,6 +1156,29 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
     s->refilled = q_refilled;
 }
 
+/* a row with none of the rarer parts (see row_plain): the same cycles with less to look at */
+CLONES static void row_cycles_plain(void **ptr, const int64_t *io, const double *fp, int64_t r,
+                                    RowRun *s, int64_t limit, double *bk)
+{
+    row_cycles_t(ptr, io, fp, r, s, limit, bk, 1);
+}
+
+CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
+                              int64_t limit, double *bk)
+{
+    row_cycles_t(ptr, io, fp, r, s, limit, bk, 0);
+}
+
+/* row r has none of the rarer parts row_cycles_plain leaves out: no Jog, no switch windows
+ * (home switch, probes), its plan and encoder in pulses as they are (links of ratio 1 and
+ * offset 0) and no in-position band */
+INLINE int row_plain(void **ptr, const int64_t *io, int64_t r)
+{
+    return !U8(jog)[r] && !io[IN_W2] && !io[IN_W16] && !io[IN_W17] &&
+           F64(prf_ratio)[r] == 1.0 && F64(prf_off)[r] == 0.0 && F64(enc_ratio)[r] == 1.0 &&
+           F64(enc_off)[r] == 0.0 && !(F64(band)[r] > 0.0);
+}
+
 /* Row r back where it stood before row_cycles (its table refilled: the table kept in bk). */
 INLINE void row_undo(void **ptr, const int64_t *io, int64_t r, RowRun *s, const double *bk)
 {
@@ -1174,7 +1201,10 @@ static int64_t run_rows(void **ptr, int64_t *io, const double *fp, RowRun *rs, d
     for (r = 0; r < n; r++) {
         if (!alive[r] || frz[r])
             continue;
-        row_cycles(ptr, io, fp, r, rs + r, lim, bk + width * r);
+        if (row_plain(ptr, io, r))
+            row_cycles_plain(ptr, io, fp, r, rs + r, lim, bk + width * r);
+        else
+            row_cycles(ptr, io, fp, r, rs + r, lim, bk + width * r);
         if (rs[r].len < lim) /* it stops there (declines the next cycle, or its move ended) */
             lim = rs[r].len;
     }
@@ -1184,7 +1214,10 @@ static int64_t run_rows(void **ptr, int64_t *io, const double *fp, RowRun *rs, d
             continue;
         if (s->len > lim) { /* it ran past the cycles the bank commits: again, that far */
             row_undo(ptr, io, r, s, bk + width * r);
-            row_cycles(ptr, io, fp, r, s, lim, bk + width * r);
+            if (row_plain(ptr, io, r))
+                row_cycles_plain(ptr, io, fp, r, s, lim, bk + width * r);
+            else
+                row_cycles(ptr, io, fp, r, s, lim, bk + width * r);
         }
         if (s->code && s->len == lim && code_row < 0)
             code_row = r;
