@@ -6,14 +6,14 @@ commits as many as every row could run.  The programs make rows stop at differen
 one call - moves that end, a soft limit and a limit switch met in the middle of a wait - after
 tables refilled at different cycles (the moves start a few cycles apart), so rows that ran
 further are put back and run again; bands and following-error windows check the band and
-the checks of every cycle.  Sampled at the end of each wait, compared with ``==``.
+the checks of every cycle, and a Jog runs among them.  Sampled at the end of each wait,
+compared with ``==``.
 """
 
 from __future__ import annotations
 
 import os
 from ctypes import byref, c_double, c_long, c_short, c_ubyte
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -79,6 +79,16 @@ def _act(action: tuple) -> int:
         gt.GT_SetPos(axis, target)
         gt.GT_SetVel(axis, vel)
         return gt.GT_Update(1 << (axis - 1))
+    if kind == "jog":
+        _, _, vel, acc, smooth = action
+        gt.GT_PrfJog(axis)
+        prm = gt.TJogPrm()
+        prm.acc, prm.dec, prm.smooth = acc, acc, smooth
+        gt.GT_SetJogPrm(axis, byref(prm))
+        gt.GT_SetVel(axis, vel)
+        return gt.GT_Update(1 << (axis - 1))
+    if kind == "trap":
+        return gt.GT_PrfTrap(axis)
     if kind == "soft":
         return gt.GT_SetSoftLimit(axis, action[2], -1_000_000)
     if kind == "band":
@@ -134,13 +144,13 @@ def test_rows_stopping_at_different_cycles_of_one_call(bus: tuple[str, str]) -> 
         (4, ("move", 4, 7_777, 15.0, 0.4, 50)),
         (1, ("band", 5, 8, 3)),
         (6, ("move", 5, -5_000, 10.0, 0.3, 25)),
-        (9, ("move", 6, 12_345, 28.0, 0.7, 5)),
+        (9, ("jog", 6, -12.0, 0.3, 0.5)),
         (700, ("band", 1, 5, 4)),
+        (3, ("move", 1, -4_000, 40.0, 2.0, 0)),
+        (300, ("jog", 6, 7.5, 0.2, 0.9)),
         (2, ("move", 3, 20_000, 25.0, 0.6, 25)),  # runs into its soft limit at 1000
         (900, ("clear", 0)),
-        (3, ("move", 1, -4_000, 40.0, 2.0, 0)),
-        (600, ("move", 6, 0, 30.0, 1.0, 25)),
-        (500, ("clear", 0)),
+        (300, ("clear", 0)),
     ]
     assert _check(bus, program) > 800  # most of the waits ran many cycles per kernel call
 
@@ -155,6 +165,14 @@ step = st.one_of(
         st.floats(0.1, 3.0),
         st.sampled_from([0, 5, 25, 50]),
     ),
+    st.tuples(
+        st.just("jog"),
+        axis,
+        st.floats(-30.0, 30.0),
+        st.floats(0.05, 2.0),
+        st.sampled_from([0.0, 0.5, 0.9]),
+    ),
+    st.tuples(st.just("trap"), axis),
     st.tuples(st.just("soft"), axis, st.integers(0, 30_000)),
     st.tuples(st.just("band"), axis, st.integers(0, 30), st.integers(0, 10)),
     st.tuples(st.just("clear"), st.just(0)),
