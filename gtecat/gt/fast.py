@@ -16,7 +16,6 @@ from __future__ import annotations
 import ctypes
 import struct
 from collections.abc import Callable
-from operator import itemgetter
 from typing import Any
 
 import numpy as np
@@ -399,10 +398,12 @@ def _index(image: Any, offset: int, size: int, write: bool) -> np.ndarray | None
 
 #: a raw range of at most this many runs of the image buffer is copied run by run
 MAX_RUNS = 4
+#: ... and by a shape's compiled copier (one struct call for all its runs)
+COPY_RUNS = 64
 
 
 def _plan(
-    image: Any, offset: int, size: int, write: bool
+    image: Any, offset: int, size: int, write: bool, max_runs: int = MAX_RUNS
 ) -> tuple[tuple[tuple[int, int, int], ...], np.ndarray] | None:
     """How a raw range is copied: its runs of the image buffer ``(first byte in the range,
     first byte in the buffer, bytes)`` (empty: too many, numpy copies it) and its buffer
@@ -413,7 +414,7 @@ def _plan(
     cuts = np.flatnonzero(np.diff(idx) != 1) + 1
     starts = [0, *cuts.tolist()]
     ends = [*cuts.tolist(), size]
-    if len(starts) > MAX_RUNS:
+    if len(starts) > max_runs:
         return (), idx
     return tuple((a, int(idx[a]), b - a) for a, b in zip(starts, ends, strict=True)), idx
 
@@ -498,9 +499,11 @@ def fast_raw(
     def copier(slave: int, offset: int, size: int, tp: type, image: Any) -> Any:
         """``copy(p)`` for one shape (a range of the image, a buffer type): it moves the
         bytes and returns True, or False when this buffer cannot take them this way (the
-        general path decides); None: no copier for the shape.  Compiled from
-        :data:`_COPY` (one function: the checks of the buffer, then one slice per run or
-        one gather of the whole range)."""
+        general path decides); None: no copier for the shape.  Compiled from the range's
+        runs of the image buffer: each run is a ``c_char`` array over its bytes of the
+        image, and one ``struct`` call moves them all into or out of the caller's buffer
+        (``pack_into`` / ``unpack_from`` check that the buffer is big enough, writable for
+        a read, and C-contiguous; whatever they refuse goes to the general path)."""
         raw = offset
         if io:
             slaves = image.layout.slaves
@@ -510,86 +513,57 @@ def fast_raw(
             if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
                 return None
             raw = sl.gt_offset + offset
-        plan = _plan(image, raw, size, write)
+        plan = _plan(image, raw, size, write, COPY_RUNS)
         if plan is None or not plan[0]:
             return None
-        runs, idx = plan
-        if tp is bytearray or tp is memoryview or (write and tp is bytes):
-            get = "q = p"
-            check = ["if len(p) < size: return False"]
-            if tp is memoryview:
-                check.append(
-                    'if p.format != "B" or p.ndim != 1 or not p.c_contiguous: return False'
-                )
-                if not write:
-                    check.append("if p.readonly: return False")
+        runs = plan[0]
+        if tp is bytearray or (write and tp is bytes):
+            check = []
+        elif tp is memoryview:
+            check = ['if p.format != "B" or p.ndim != 1: return False']
         elif issubclass(tp, Array) and sizeof(tp) >= size:
-            # a ctypes array: its bytes, through a memoryview kept per object
-            get = "q = kept(p, True)\n    if q is None: return False"
             check = []
         elif tp is _NDARRAY:
-            check = [
-                "if (p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous "
-                "or p.size < size): return False"
-            ]
-            if not write:
-                check.append("if not p.flags.writeable: return False")
-            get = "q = kept(p, False)"
+            check = ["if p.dtype != _BYTES_NP or p.ndim != 1: return False"]
         else:
             return None
+        fmt = struct.Struct("".join(f"{n}s" for _, _, n in runs))
+        env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP}
+        cells = []
+        for k, (_, first, n) in enumerate(runs):
+            env[f"c{k}"] = (ctypes.c_char * n).from_buffer(image.buffer, first)
+            cells.append(f"c{k}.raw")
         if write:
-            move = [f"img[{first}:{first + n}] = q[{a}:{a + n}]" for a, first, n in runs]
-        elif len(runs) == 1:  # one slice
-            ((a, first, n),) = runs
-            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]"]
-        elif tp is bytearray and size <= 6 * len(runs):
-            # the bytes of the range in one C call (a bytearray takes the ints as they are):
-            # fewer steps than a slice per run while the runs are short
-            move = ["q[0:size] = gather(img)"]
-        elif size <= 2 * len(runs):
-            move = ["q[0:size] = bytes(gather(img))"]
-        else:  # a slice per run
-            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]" for a, first, n in runs]
-        body = "\n    ".join([*check, get, *move, "return True"])
-        env = {
-            "img": memoryview(image.buffer),
-            "size": size,
-            "gather": itemgetter(*idx.tolist()) if len(idx) > 1 else None,
-            "kept": kept,
-            "_BYTES_NP": _BYTES_NP,
-        }
+            env["unpack"] = fmt.unpack_from
+            move = [f"{', '.join(cells)}, = unpack(p)"]
+        else:
+            env["pack"] = fmt.pack_into
+            move = [f"pack(p, 0, {', '.join(cells)})"]
+        body = "\n    ".join([*check, *move, "return True"])
         exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
         return env["copy"]
 
-    casts: dict[int, memoryview] = {}  # byte views of buffers, the last few (kept alive)
+    def reset(image: Any) -> None:
+        """Another process image (the bus was brought up again): every copier goes."""
+        cache.clear()
+        copiers.clear()
+        seen[:] = [image, memoryview(image.buffer)]
+        remember(-1, -1, None, -1, None)
 
-    def kept(p: Any, cast: bool) -> memoryview | None:
-        """A memoryview of the bytes of ``p`` (a ctypes array: cast to bytes), kept for the
-        next call with the same object; None: none can be made."""
-        v = casts.get(id(p))
-        if v is None or v.obj is not p:
-            if len(casts) >= 16:
-                casts.clear()
-            try:
-                v = memoryview(p).cast("B") if cast else memoryview(p)
-            except (TypeError, ValueError):  # a format memoryview cannot take
-                return None
-            casts[id(p)] = v
-        return v
+    def remember(offset: int, size: int, tp: Any, slave: int, copy: Any) -> None:
+        """The shape the next call is checked against first, and its copier."""
+        env["LAST"] = (offset, size, tp, slave, copy)
 
     env = {
+        "LAST": (-1, -1, None, -1, None),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
         "session": session,
         "seen": seen,
         "copiers": copiers,
         "copier": copier,
-        "reset": lambda image: (
-            cache.clear(),
-            copiers.clear(),
-            casts.clear(),
-            seen.__setitem__(slice(None), [image, memoryview(image.buffer)]),
-        ),
+        "reset": reset,
+        "remember": remember,
         "advance": advance,
         "name": name,
         "slow": slow,
@@ -669,10 +643,18 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
             image = m.image
             if image is not seen[0]:
                 reset(image)
-            key = ({slave_key}, offset, size, type(p))
-            copy = copiers.get(key, _NO)
-            if copy is _NO:
-                copy = copiers[key] = copier({slave_key}, offset, size, type(p), image)
+            tp = type(p)
+            # the shape of the previous call (a polling loop repeats its shape), else the
+            # copiers by shape
+            last = LAST  # (one read: another thread may replace it meanwhile)
+            if offset == last[0] and size == last[1] and tp is last[2]{slave_memo}:
+                copy = last[4]
+            else:
+                key = ({slave_key}, offset, size, tp)
+                copy = copiers.get(key, _NO)
+                if copy is _NO:
+                    copy = copiers[key] = copier({slave_key}, offset, size, tp, image)
+                remember(offset, size, tp, {slave_key}, copy)
             if copy is None:
                 done = False
             else:
@@ -695,6 +677,7 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
         slave_check=" or type(slave) is not int" if io else "",
         slave_arg="slave, " if io else "",
         slave_key="slave" if io else "-1",
+        slave_memo=" and slave == last[3]" if io else "",
     )
     exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
     return env["gt"]
