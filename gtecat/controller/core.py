@@ -392,7 +392,7 @@ class Controller:
                     )
                 ax.lose_link(reason)
                 if ax.motion is not None:
-                    ax.motion.latched |= AxisStatus.ALARM
+                    ax.motion.latched |= int(AxisStatus.ALARM)  # (the word stays a plain int)
             elif ax.link_lost:
                 ax.link_lost = ""  # reachable again; bit 1 stays until GT_ClrSts
                 self.log(f"Axis {ax.number}: slave {ax.io.slave} back; GT_ClrSts, GT_AxisOn.")
@@ -486,7 +486,7 @@ def _relatch_link_alarms(ctl: Controller) -> None:
     for ax in ctl.axes.values():
         if ax.link_lost:
             if ax.motion is not None:
-                ax.motion.latched |= AxisStatus.ALARM
+                ax.motion.latched |= int(AxisStatus.ALARM)  # (the word stays a plain int)
         else:
             ax.link_alarm = ""
 

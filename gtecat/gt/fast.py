@@ -20,9 +20,10 @@ from typing import Any
 
 import numpy as np
 
+from ..controller.axis_status import AxisStatus
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
-from .args import CARG_AT, byref_address
+from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
@@ -45,6 +46,7 @@ def attr_getter(name: str) -> Callable[[Any], float]:
     def get(r: Any) -> float:
         return float(getattr(r, name))
 
+    get.attr = name  # type: ignore[attr-defined]  # (the fast reader reads it inline)
     return get
 
 
@@ -111,6 +113,7 @@ def fast_reader(
         "np_ok": np_ok,
         "is_array": is_array,
         "to": float if ctypes_ok is _DOUBLE else None,
+        "T0": ctypes.c_double if ctypes_ok is _DOUBLE else ctypes.c_long,  # the usual type
     }
     gt = _compiled(_READER, "gt", env, core="", session_core=" and session.core == 1")
 
@@ -174,6 +177,28 @@ def fast_reader(
     return gt
 
 
+#: a reader's value of an axis the bank does not run, inline (without the getter's call):
+#: GT_GetSts's word as :meth:`AxisResources.status` makes it (tests/gtecat/gt/test_fast.py
+#: holds the two to the same word in every state they combine)
+SCALAR_INLINE: dict[str, tuple[str, ...]] = {
+    "GT_GetSts": (
+        "v = res.latched",
+        "if type(v) is not int:",
+        "    v = int(v)",
+        "if res.ax.servo_on:",
+        "    v |= SERVO_ON",
+        "if not res.profile.planner.done:",
+        "    v |= MOVING",
+        "elif res.band.arrived:",
+        "    v |= ARRIVED",
+    ),
+}
+_STATUS_BITS = {
+    "SERVO_ON": int(AxisStatus.SERVO_ON),
+    "MOVING": int(AxisStatus.MOVING),
+    "ARRIVED": int(AxisStatus.ARRIVED),
+}
+
 #: the bank's list of each reader's value (AxisBank.value), read without the two calls
 BANK_LISTS = {
     "GT_GetSts": "sts",
@@ -216,7 +241,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
                         if type(obj) not in ok or {address} != _addressof(obj):
                             return {fallback}
                         last[0] = p  # checked: the same pointer object next time is fine
-                elif tp in ok:  # the ctypes object itself (passed by reference)
+                elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
                     obj = p
                 elif (
                     tp is _NDARRAY
@@ -243,7 +268,8 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
 
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session_core: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
-    address = "_from_address(id(p) + _AT).value" if _AT >= 0 else "byref_address(p)"
+    address = carg_address_source("p")
+    env.update(CARG_ENV)
     gtn = bool(core)
     code = template.format(
         fname=fname,
@@ -258,18 +284,27 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         ),
     )
     env["_AT"] = _AT
+    attr = getattr(env["get"], "attr", None)
+    if env["name"] in SCALAR_INLINE:
+        scalar = list(SCALAR_INLINE[env["name"]])
+        env.update(_STATUS_BITS)
+    elif attr is None:
+        scalar = ["v = get(res)"]
+    else:  # the attribute itself (attr_getter's value, without the two calls)
+        scalar = [f"v = res.{attr}", "if type(v) is not float:", "    v = float(v)"]
     if env["key"] is None:
-        value = "                v = get(res)"
+        lines = scalar
     else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
         row = "lst[res.bank_row]" if env["to"] is None else "to(lst[res.bank_row])"
-        value = "\n".join(
-            "                " + line
-            for line in (
-                "b = res.bank",
-                "lst = b._lists.get(key) if b is not None else None",
-                f"v = get(res) if lst is None else {row}",
-            )
-        )
+        lines = [
+            "b = res.bank",
+            "if b is None:",
+            *("    " + x for x in scalar),
+            "else:",
+            "    lst = b._lists.get(key)",
+            f"    v = get(res) if lst is None else {row}",
+        ]
+    value = "\n".join("                " + line for line in lines)
     code = code.replace("{value}", value)
     exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
     return env[fname]
