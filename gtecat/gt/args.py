@@ -865,6 +865,90 @@ def _scalar_types(p: Param) -> frozenset[type]:
     return frozenset(ok)
 
 
+def _pointer_kind(p: Param) -> str:
+    """What a one-star pointer parameter points to: ``numbers``, ``struct`` or ``bytes``."""
+    if p.is_struct:
+        return "struct"
+    return "bytes" if p.ctype in ("char", "unsigned char", "void") else "numbers"
+
+
+def _learn(kind: str, ok: frozenset, cache: dict, t: Any) -> Any:
+    """Whether the compiled binder takes a ctypes object of type ``t`` inline for a pointer
+    of ``kind`` (``ok``: the number types it takes): the element type its :class:`Ref` has,
+    as :func:`resolve` and :func:`check_kind` would make it, else False.  Kept in ``cache``."""
+    e: Any = False
+    if isinstance(t, type):
+        if kind == "struct":
+            e = t if issubclass(t, ctypes.Structure | ctypes.Union) else False
+        elif issubclass(t, ctypes.Array):
+            inner = t._type_
+            if kind == "bytes":
+                while issubclass(inner, ctypes.Array):
+                    inner = inner._type_
+                e = inner
+            elif inner in ok:  # a one-dimensional array of a number the pointer takes
+                e = inner
+    if len(cache) < 256:
+        cache[t] = e
+    return e
+
+
+def _pointer_source(i: int, p: Param, a: str, v: str, env: dict[str, Any]) -> list[str]:
+    """The compiled binder's lines for one pointer parameter ``p`` (argument ``a``, value
+    ``v``): the shapes clients pass, inline, each giving the :class:`Ref` that the table's
+    converter ``C{i}`` gives for it - ``byref(x)`` (no offset) and ``x`` itself of a number
+    the pointer takes, of a ctypes array of such numbers, of a structure; a ``bytearray``,
+    ``bytes`` (read only), a ctypes array or a numpy array for a byte buffer; a numpy array
+    of numbers; ``None`` or ``0`` for an optional NULL.  Any other shape: ``C{i}``."""
+    kind = _pointer_kind(p)
+    writes = p.direction != "in"
+    ok = _scalar_types(p) if kind == "numbers" else frozenset()
+    cache: dict[Any, Any] = {}
+    env[f"OK{i}"] = ok
+    env[f"AK{i}"] = cache
+    env[f"L{i}"] = lambda t: _learn(kind, ok, cache, t)
+    env["_NDARRAY"] = np.ndarray
+    name = repr(p.name)
+    at = carg_address_source(a)
+    numpy = f"t is _NDARRAY and not {a}.dtype.hasobject and {a}.flags.c_contiguous" + (
+        f" and {a}.flags.writeable" if writes else ""
+    )
+    if kind == "numbers":
+        numpy += f" and {a}.dtype.kind in 'biuf'"
+    lines = [f"t = type({a})", "if t is _CArg:", f"    o = {a}._obj", "    to = type(o)"]
+    if kind == "numbers":
+        lines += [
+            f"    if to in OK{i}: e = to",
+            "    else:",
+            f"        e = AK{i}.get(to)",
+            f"        if e is None: e = L{i}(to)",
+        ]
+    else:
+        lines += [f"    e = AK{i}.get(to)", f"    if e is None: e = L{i}(to)"]
+    lines += [
+        f"    if e and {at} == _addressof(o): {v} = Ref({name}, _addressof(o), _sizeof(o), e, o)",
+        f"    else: {v} = C{i}({a})",
+    ]
+    if kind == "numbers":
+        lines.append(f"elif t in OK{i}: {v} = Ref({name}, _addressof({a}), _sizeof({a}), t, {a})")
+    if kind == "bytes":
+        lines.append(f"elif t is bytearray: {v} = Ref({name}, py={a})")
+        if not writes:
+            lines.append(f"elif t is bytes: {v} = Ref({name}, py={a})")
+    if p.optional:  # NULL as None or 0 (False and NULL ctypes pointers: the converter)
+        lines.append(f"elif {a} is None or (t is int and {a} == 0): {v} = None")
+    if kind != "struct":
+        lines.append(f"elif {numpy}: {v} = Ref({name}, py={a})")
+    lines += [
+        "else:",
+        f"    e = AK{i}.get(t)",
+        f"    if e is None: e = L{i}(t)",
+        f"    if e: {v} = Ref({name}, _addressof({a}), _sizeof({a}), e, {a})",
+        f"    else: {v} = C{i}({a})",
+    ]
+    return lines
+
+
 def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
     """The table's checks of ``proto``'s arguments compiled into one function (declare once,
     generate the rest): ``bind(*args)`` -> the converted values, exactly what
@@ -887,7 +971,6 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         "P": params,
     }
     env.update(CARG_ENV)
-    where = carg_address_source  # the address a byref() passes
 
     sig, body, out = [], [], []
     for i, p in enumerate(params):
@@ -919,27 +1002,8 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
                 f"elif type({a}) is int and -{1 << 53} <= {a} <= {1 << 53}: {v} = float({a})",
                 f"else: {v} = C{i}({a})",
             ]
-        elif (
-            p.pointer
-            and not p.text
-            and not p.is_struct
-            and p.ctype not in ("char", "unsigned char", "void")
-            and p.stars == 1
-        ):
-            # a pointer to numbers: byref(x) or x itself of a plain number inline
-            env[f"OK{i}"] = _scalar_types(p)
-            body += [
-                f"t = type({a})",
-                "if t is _CArg:",
-                f"    o = {a}._obj",
-                f"    if type(o) in OK{i} and {where(a)} == _addressof(o):",
-                f"        {v} = Ref({p.name!r}, _addressof(o), _sizeof(o), type(o), o)",
-                f"    else: {v} = C{i}({a})",
-                f"elif t in OK{i}: {v} = Ref({p.name!r}, _addressof({a}), _sizeof({a}), t, {a})",
-            ]
-            if p.optional:  # NULL as None or 0 (False and NULL ctypes pointers: generic)
-                body.append(f"elif {a} is None or (t is int and {a} == 0): {v} = None")
-            body.append(f"else: {v} = C{i}({a})")
+        elif p.pointer and not p.text and p.stars == 1:
+            body += _pointer_source(i, p, a, v, env)
         else:
             body.append(f"{v} = C{i}({a})")
         out.append(v)
