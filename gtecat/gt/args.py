@@ -865,6 +865,15 @@ def _scalar_types(p: Param) -> frozenset[type]:
     return frozenset(ok)
 
 
+#: pointer shapes the compiled binder leaves to the table's converter, and why (a test walks
+#: every pointer parameter of the table with every shape clients pass and fails on any other
+#: shape that does not bind inline: tests/gtecat/gt/test_compiled_binder.py)
+NOT_INLINE: dict[str, str] = {
+    "pointer to pointer": "a char ** that the call points at text of its own (GT_GetVersion, "
+    "called once): the converter resolves it",
+}
+
+
 def _pointer_kind(p: Param) -> str:
     """What a one-star pointer parameter points to: ``numbers``, ``struct`` or ``bytes``."""
     if p.is_struct:
@@ -1002,7 +1011,13 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
                 f"elif type({a}) is int and -{1 << 53} <= {a} <= {1 << 53}: {v} = float({a})",
                 f"else: {v} = C{i}({a})",
             ]
-        elif p.pointer and not p.text and p.stars == 1:
+        elif p.pointer and p.text and p.direction == "in":
+            # text: a str as _text takes it (a file or variable name), inline
+            body += [
+                f"if type({a}) is str and len({a}) <= {_TEXT_MAX} and '\\0' not in {a}: {v} = {a}",
+                f"else: {v} = C{i}({a})",
+            ]
+        elif p.pointer and p.stars == 1:  # (text the call writes: a buffer of bytes)
             body += _pointer_source(i, p, a, v, env)
         else:
             body.append(f"{v} = C{i}({a})")
@@ -1064,6 +1079,7 @@ def core_arg(value: Any) -> int:
 
 __all__ = [
     "CARG_ENV",
+    "NOT_INLINE",
     "Ref",
     "binder",
     "byref_address",
