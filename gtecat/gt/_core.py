@@ -237,6 +237,7 @@ def close_all() -> None:
 
 
 _AUTO = ClockMode.AUTO
+_LOCKSTEP = ClockMode.LOCKSTEP
 REGISTRY: dict[str, Callable[..., int]] = {}
 #: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
 #: a controller process then runs every call through REGISTRY, none on a fast path
@@ -289,7 +290,10 @@ def advance(ctl: Any, name: str, rc: int) -> int:
     """The host-call latency after a GT call (cycles may run, programs step): whatever they
     raise is turned into a code and a reason like the call's own errors, never let out."""
     clock = ctl.clock
-    if clock.mode is _AUTO and clock.group is None:
+    mode = clock.mode
+    if mode is _LOCKSTEP:  # (Clock.on_call does nothing in lockstep)
+        return rc
+    if mode is _AUTO and clock.group is None:
         # Clock.on_call in the common case, inline: the latency runs no cycle and no other
         # clock shares this one's time
         pending = clock._pending_ns + clock.call_latency_ns
@@ -370,11 +374,16 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if ctl.clock._thread is not None:
                     with ctl.clock.lock:  # atomic with respect to the cycle thread
                         rc = fn(ctl, *values, **extra)
-                else:
+                elif extra:
                     rc = fn(ctl, *values, **extra)
+                else:
+                    rc = fn(ctl, *values)
             else:
                 rc = fn(*values, **extra)
-            rc = 0 if rc is None else int(rc)
+            if rc is None:
+                rc = 0
+            elif type(rc) is not int:
+                rc = int(rc)
             if rc == 0:
                 # GTE_GetLastError speaks of the most recent call only: nothing, or a note
                 # of something the call found wrong without failing (note())
@@ -413,18 +422,16 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     compiled: list[Any] = []  # the compiled binder, made at the first call (args.fast_binder)
 
-    def quick(args: tuple) -> Any:
-        """``args`` bound by the compiled binder (None: not a plain shape)."""
-        if not compiled:
-            compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
-        return compiled[0](*args)
-
     @functools.wraps(fn)
     def gt(*args: Any, **kwargs: Any) -> int:
-        if not kwargs and not opens:
-            values = quick(args)
-            if values is not None:
-                return run(SESSION.core, values, _NO_KW, "", SESSION.last)
+        if not kwargs:
+            if compiled:
+                values = compiled[0](*args)  # None: not a plain shape (the table binder's)
+                if values is not None:
+                    return run(SESSION.core, values, _NO_KW, "", SESSION.last)
+            elif not opens:  # GT_Open: always the table path (its keyword options)
+                compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
+                return gt(*args)
         return call(_GT, args, kwargs)
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)

@@ -1026,13 +1026,19 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
     index = {p.name: i for i, p in enumerate(params)}
     for i, p in enumerate(params):
         if p.pointer and not p.text and not p.is_struct and p.count != 0:
-            k = f"v{index[p.count]}" if isinstance(p.count, str) else repr(p.count)
             v = f"v{i}"
-            body += [
-                f"if {v} is not None and not ({k} == 1 and {v}.elem is type({v}._keep) "
-                f"and {v}.nbytes == _sizeof({v}.elem)) and type({k}) is int and {k} > 0:",
-                f"    _check_room(P[{i}], {v}, {k})",
-            ]
+            one = f"{v}.elem is type({v}._keep) and {v}.nbytes == _sizeof({v}.elem)"
+            if isinstance(p.count, str):
+                k = f"v{index[p.count]}"
+                body += [
+                    f"if {v} is not None and not ({k} == 1 and {one}) and type({k}) is int "
+                    f"and {k} > 0:",
+                    f"    _check_room(P[{i}], {v}, {k})",
+                ]
+            elif p.count == 1:  # (the same test with the count known)
+                body += [f"if {v} is not None and not ({one}): _check_room(P[{i}], {v}, 1)"]
+            elif p.count > 0:
+                body += [f"if {v} is not None: _check_room(P[{i}], {v}, {p.count})"]
     lines = [f"def bind({', '.join([*sig, '*more'])}):", "    if more: return None", "    try:"]
     lines += [f"        {x}" for x in body] or ["        pass"]
     lines += [

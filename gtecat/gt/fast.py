@@ -50,6 +50,20 @@ def attr_getter(name: str) -> Callable[[Any], float]:
     return get
 
 
+def prf_mode_value(r: Any) -> int:
+    """GT_GetPrfMode's value (motion_calls)."""
+    return int(r.profile.mode)
+
+
+#: table 6-2 bit 10: the one bit of a profile's own (GT_GetPrfSts)
+_PRF_MOVING = int(AxisStatus.MOVING)
+
+
+def prf_sts_value(r: Any) -> int:
+    """GT_GetPrfSts's word (status_calls): the planner's bit of GT_GetSts's."""
+    return r.status() & _PRF_MOVING
+
+
 _INTS = frozenset({ctypes.c_int32, ctypes.c_long, ctypes.c_int64, ctypes.c_longlong})
 _DOUBLE = frozenset({ctypes.c_double})
 #: numpy arrays the fast path writes element 0 of (the table path's flat[:1] = [value])
@@ -70,6 +84,10 @@ READERS: dict[str, tuple[Callable[[Any], Any], frozenset]] = {
     "GT_GetAxisError": (attr_getter("axis_error"), _DOUBLE),
     "GT_GetEncPos": (attr_getter("enc_pos"), _DOUBLE),
     "GT_GetEncVel": (attr_getter("enc_vel"), _DOUBLE),
+    "GT_GetAxisPrfAcc": (attr_getter("axis_prf_acc"), _DOUBLE),
+    "GT_GetAxisEncAcc": (attr_getter("axis_enc_acc"), _DOUBLE),
+    "GT_GetPrfMode": (prf_mode_value, _INTS),
+    "GT_GetPrfSts": (prf_sts_value, _INTS),
 }
 
 

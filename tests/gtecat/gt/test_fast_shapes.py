@@ -20,11 +20,13 @@ import pstats
 import random
 from ctypes import byref
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from gtecat import gt
+from gtecat.controller.axis_status import AxisStatus
 from gtecat.gt import fast
 from gtecat.gt.table import FUNCTIONS, declared_only
 from tests.conftest import LONG
@@ -203,3 +205,28 @@ def test_every_raw_range_reads_as_the_table() -> None:
                 if got[0] != got[1]:
                     bad.append(f"{offset} {size} {type(buf).__name__}: {got}")
     assert not bad, "\n".join(bad[:10])
+
+
+def test_the_inline_status_word_is_the_resources_word() -> None:
+    """GT_GetSts's word of an axis the bank does not run, read inline by the fast path, is
+    :meth:`AxisResources.status`'s in every combination of what makes it."""
+    ctl = _open()
+    res = ctl.resources[1]
+    assert res.bank is None  # (GT_AxisOn gave it back; no cycle has run since)
+    kept = (res.latched, res.ax.servo_on, res.profile.planner, res.band.arrived)
+    s = ctypes.c_long()
+    bad = []
+    try:
+        for latched in (0, 0x2, int(AxisStatus.POSITIVE_LIMIT), AxisStatus.ALARM):
+            for servo in (False, True):
+                for done in (False, True):
+                    for arrived in (False, True):
+                        res.latched, res.ax.servo_on = latched, servo
+                        res.profile.planner = SimpleNamespace(done=done)
+                        res.band.arrived = arrived
+                        rc = gt.GT_GetSts(1, s)
+                        if rc != 0 or s.value != res.status():
+                            bad.append(f"{latched, servo, done, arrived}: {s.value} {res.status()}")
+    finally:
+        res.latched, res.ax.servo_on, res.profile.planner, res.band.arrived = kept
+    assert not bad, "\n".join(bad)
