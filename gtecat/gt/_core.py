@@ -379,7 +379,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 else:
                     rc = fn(ctl, *values)
             else:
-                rc = fn(*values, **extra)
+                rc = fn(*values, **extra) if extra else fn(*values)
             if rc is None:
                 rc = 0
             elif type(rc) is not int:
@@ -398,7 +398,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             return failed(e, ctl, core, before)
         if ctl is None:
             ctl = SESSION.controllers.get(core)
-        if ctl is not None:
+        if ctl is not None and ctl.clock.mode is not _LOCKSTEP:  # (advance: nothing then)
             rc = advance(ctl, name, rc)
         return rc
 

@@ -14,6 +14,7 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import re
 import struct
 from collections.abc import Callable
 from typing import Any
@@ -571,15 +572,16 @@ def fast_raw(
             return None
         runs = plan[0]
         if tp is bytearray or (write and tp is bytes):
-            check = []
+            ok = []
         elif tp is memoryview:
-            check = ['if p.format != "B" or p.ndim != 1: return False']
+            ok = ['p.format == "B"', "p.ndim == 1"]
         elif issubclass(tp, Array) and sizeof(tp) >= size:
-            check = []
+            ok = []
         elif tp is _NDARRAY:
-            check = ["if p.dtype != _BYTES_NP or p.ndim != 1: return False"]
+            ok = ["p.dtype == _BYTES_NP", "p.ndim == 1"]
         else:
             return None
+        check = [f"if not ({' and '.join(ok)}): return False"] if ok else []
         fmt = struct.Struct("".join(f"{n}s" for _, _, n in runs))
         env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP}
         cells = []
@@ -594,7 +596,9 @@ def fast_raw(
             move = [f"pack(p, 0, {', '.join(cells)})"]
         body = "\n    ".join([*check, *move, "return True"])
         exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
-        return env["copy"]
+        copy = env["copy"]
+        copy.spec = (ok, move[0], {k: v for k, v in env.items() if k != "copy"})
+        return copy
 
     def reset(image: Any) -> None:
         """Another process image (the bus was brought up again): every copier goes."""
@@ -602,10 +606,24 @@ def fast_raw(
         copiers.clear()
         seen[:] = [image, memoryview(image.buffer)]
         remember(-1, -1, None, -1, None)
+        entries.clear()
+        entry.__code__ = base_code
 
     def remember(offset: int, size: int, tp: Any, slave: int, copy: Any) -> None:
-        """The shape the next call is checked against first, and its copier."""
+        """The shape the next call is checked against first, and its copier; the public
+        function becomes the entry specialised for it (:data:`_RAW_ENTRY`)."""
         env["LAST"] = (offset, size, tp, slave, copy)
+        if copy is None:
+            return
+        key = (slave, offset, size, tp)
+        code = entries.get(key)
+        if code is None:
+            code = entries[key] = _raw_entry(env, io, len(entries), key, seen[0], copy.spec)
+        entry.__code__ = code
+
+    #: (slave, offset, size, buffer type) -> the code of the public function specialised
+    #: for that shape (the copy inline, behind the checks of the shape and the session)
+    entries: dict[tuple, Any] = {}
 
     env = {
         "LAST": (-1, -1, None, -1, None),
@@ -622,7 +640,11 @@ def fast_raw(
         "slow": slow,
     }
     gt = _compiled_raw(env, io)
+    env["generic"] = gt
     env["run"] = lambda *a: run(*a)
+    # the public function: until a shape is seen, the generic one; then specialised
+    entry = _raw_entry(env, io, -1, None, None, None)
+    base_code = entry.__code__
 
     def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)
@@ -672,8 +694,81 @@ def fast_raw(
             return advance(ctl, name, 0)
         return 0
 
-    gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    entry.slow = slow  # type: ignore[attr-defined]
+    entry.generic = gt  # type: ignore[attr-defined]
+    return entry
+
+
+#: the public raw function specialised for the shape of the latest call (a polling loop
+#: repeats its shape): that shape's checks, the session's, and its copy inline; any other
+#: call: the generic function (which specialises it again for its own shape)
+_RAW_ENTRY = """
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+    if (
+        type(p) is T{n}
+        and offset == {offset}
+        and size == {size}
+        and type(offset) is int
+        and type(size) is int{slave_guard}
+        and not extra
+        and not kw{ok}
+    ):
+        ctl = session.controllers.get(1)
+        if ctl is not None and session.remote is None and session.core == 1:
+            m = ctl.master
+            clock = ctl.clock
+            if (
+                m is not None
+                and m.image is IMG{n}
+                and m.opened
+                and not m.offline
+                and clock._thread is None
+            ):
+                try:
+                    {move}
+                except Exception:  # (the buffer's own refusal): the generic path answers
+                    pass
+                else:
+                    session.last = None
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+    return generic({slave_arg}offset, size, p, *extra, **kw)
+"""
+
+_RAW_BASE = """
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+    return generic({slave_arg}offset, size, p, *extra, **kw)
+"""
+
+
+def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec: Any) -> Any:
+    """The public function (``n`` -1: the generic one's front) or, for shape ``key`` of
+    ``image`` with its copier's ``spec``, the code of its specialised entry; the names it
+    uses go into ``env`` (its globals) with the suffix ``n``."""
+    fmt = {"slave": "slave=_NO, " if io else "", "slave_arg": "slave, " if io else ""}
+    if n < 0:
+        exec(compile(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>", "exec"), env)
+        return env.pop("gt")
+    slave, offset, size, tp = key
+    ok, move, names = spec
+    for k, v in names.items():
+        move = re.sub(rf"\b{k}\b", f"{k}_{n}", move)
+        ok = [re.sub(rf"\b{k}\b", f"{k}_{n}", x) for x in ok]
+        env[f"{k}_{n}"] = v
+    env[f"T{n}"], env[f"IMG{n}"] = tp, image
+    code = _RAW_ENTRY.format(
+        **fmt,
+        n=n,
+        offset=offset,
+        size=size,
+        slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
+        ok="".join(f"\n        and {x}" for x in ok),
+        move=move,
+    )
+    scratch: dict[str, Any] = {}
+    exec(compile(code, f"<gt fast raw {env['name']} shape {n}>", "exec"), env, scratch)
+    return scratch["gt"].__code__
 
 
 #: the raw image functions' common shapes in the fewest steps (the IO pair with the slave
