@@ -597,7 +597,8 @@ def fast_raw(
         body = "\n    ".join([*check, *move, "return True"])
         exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
         copy = env["copy"]
-        copy.spec = (ok, move[0], {k: v for k, v in env.items() if k != "copy"})
+        names = {k: v for k, v in env.items() if k != "copy" and not k.startswith("__")}
+        copy.spec = (ok, move[0], names)  # (for the specialised entry, _raw_entry)
         return copy
 
     def reset(image: Any) -> None:
