@@ -230,3 +230,40 @@ def test_the_inline_status_word_is_the_resources_word() -> None:
     finally:
         res.latched, res.ax.servo_on, res.profile.planner, res.band.arrived = kept
     assert not bad, "\n".join(bad)
+
+
+def test_the_specialised_raw_entry_answers_as_the_table() -> None:
+    """The raw functions specialise themselves for the latest call's shape: shapes that
+    alternate, a buffer of that shape's type that cannot take the bytes (too small, read
+    only, another dtype), and a bus brought up again all answer as the table path does."""
+    calls = [
+        (0, 8, lambda: bytearray(8)),
+        (0, 8, lambda: bytearray(2)),
+        (6, 4, lambda: bytearray(8)),
+        (0, 8, lambda: memoryview(bytes(8))),
+        (0, 8, lambda: memoryview(bytearray(8))),
+        (0, 8, lambda: np.zeros(8, np.int32)),
+        (0, 8, lambda: np.zeros(8, np.uint8)),
+        (0, 8, lambda: np.zeros(8, np.uint8)[::2]),
+        (0, 8, lambda: (ctypes.c_ubyte * 8)()),
+        (0, 8, lambda: bytearray(8)),
+    ]
+    bad = []
+    for _ in range(2):  # the second time on a bus brought up again (another image)
+        gt.GT_Close()
+        _open()
+        for offset, size, make in calls * 2:
+            got = []
+            for call in (gt.GT_GetEcatRawData, gt.GT_GetEcatRawData.slow):
+                buf = make()
+                rc = call(offset, size, buf)
+                got.append((rc, bytes(buf), gt.GTE_GetLastError() if rc else ""))
+            if got[0] != got[1]:
+                bad.append(f"{offset} {size} {type(buf).__name__}: {got}")
+        for data in (bytes([0x0F, 0]), bytearray([0x0F, 0]), bytes([1])):
+            rcs = []
+            for call in (gt.GT_SetEcatRawData, gt.GT_SetEcatRawData.slow):
+                rcs.append((call(0, 2, data), gt.GTE_GetLastError() if rcs else ""))
+            if rcs[0][0] != rcs[1][0]:
+                bad.append(f"set {data!r}: {rcs}")
+    assert not bad, "\n".join(bad)
