@@ -268,6 +268,22 @@ class Ref:
             raise ParameterError(f"{self.name}: cannot view as {cls.__name__}: {e}") from None
 
 
+_NEW = object.__new__
+
+
+def _ref(name: str, addr: int, nbytes: int, elem: Any, keep: Any, _new: Any = _NEW) -> Ref:
+    """``Ref(name, addr, nbytes, elem, keep)`` made without ``type.__call__`` (a third less:
+    the compiled binder makes one for each pointer it binds)."""
+    r = _new(Ref)
+    r.name = name
+    r.addr = addr
+    r.nbytes = nbytes
+    r.elem = elem
+    r._keep = keep
+    r.py = None
+    return r
+
+
 def _elem_name(elem: Any) -> str:
     if elem is None:
         return "bytes"
@@ -935,11 +951,11 @@ def _pointer_source(i: int, p: Param, a: str, v: str, env: dict[str, Any]) -> li
     else:
         lines += [f"    e = AK{i}.get(to)", f"    if e is None: e = L{i}(to)"]
     lines += [
-        f"    if e and {at} == _addressof(o): {v} = Ref({name}, _addressof(o), _sizeof(o), e, o)",
+        f"    if e and {at} == _addressof(o): {v} = _ref({name}, _addressof(o), _sizeof(o), e, o)",
         f"    else: {v} = C{i}({a})",
     ]
     if kind == "numbers":
-        lines.append(f"elif t in OK{i}: {v} = Ref({name}, _addressof({a}), _sizeof({a}), t, {a})")
+        lines.append(f"elif t in OK{i}: {v} = _ref({name}, _addressof({a}), _sizeof({a}), t, {a})")
     if kind == "bytes":
         lines.append(f"elif t is bytearray: {v} = Ref({name}, py={a})")
         if not writes:
@@ -952,7 +968,7 @@ def _pointer_source(i: int, p: Param, a: str, v: str, env: dict[str, Any]) -> li
         "else:",
         f"    e = AK{i}.get(t)",
         f"    if e is None: e = L{i}(t)",
-        f"    if e: {v} = Ref({name}, _addressof({a}), _sizeof({a}), e, {a})",
+        f"    if e: {v} = _ref({name}, _addressof({a}), _sizeof({a}), e, {a})",
         f"    else: {v} = C{i}({a})",
     ]
     return lines
@@ -975,6 +991,7 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         "_byref_address": byref_address,
         "_check_room": _check_room,
         "Ref": Ref,
+        "_ref": _ref,
         "_MISSING": _MISSING,
         "_INF": _INF,
         "P": params,
