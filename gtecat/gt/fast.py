@@ -848,7 +848,8 @@ SLOW_REASONS: dict[str, str] = {
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
     "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
-    "ecat_axis": "per-axis PDO readers and homing/probe status: table path (a few microseconds)",
+    "ecat_axis": "homing and probe status, the axis mode, analog inputs and the scale: table "
+    "path; the per-axis PDO readers that polling loops use are on the fast path",
     "ecat_io": "one output bit read: table path",
     "emulator": "emulator helpers for tests, not called in control loops",
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
@@ -868,4 +869,109 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW | {CLOCK}
+    return frozenset(READERS) | RAW | {CLOCK} | frozenset(ECAT_READERS)
+
+
+#: the per-axis PDO readers (axis_calls._reader): function -> the object it reads
+ECAT_READERS: dict[str, tuple[int, int]] = {
+    "GT_GetEcatEncPos": (0x6064, 0),
+    "GT_GetEcatEncVel": (0x606C, 0),
+    "GT_GetEcatAxisPE": (0x60F4, 0),
+    "GT_GetEcatAxisDI": (0x60FD, 0),
+    "GT_GetEcatAxisDO": (0x60FE, 1),
+    "GT_GetEcatAxisAtITorque": (0x6077, 0),
+    "GT_GetEcatAxisAtICurrent": (0x6078, 0),
+    "GT_GetEcatErrorCode": (0x603F, 0),
+}
+
+
+def fast_ecat_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetEcatEncPos(axis, p)`` and the other per-axis PDO readers with the fast path in
+    front of the table: ``p`` a ``byref`` (no offset) or the object itself of a number type
+    the pointer takes, holding the value; the axis on the in-process controller's bus (no
+    pulse card), its link up, the object mapped, and not run by the axis bank at the moment
+    (its objects are then its own: the table path gives it back first).  Anything else
+    (an error included) takes the table path, which gives the code and the reason."""
+    from ..controller.axis import Axis
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    index, subindex = ECAT_READERS[name]
+    param = FUNCTIONS[name].params[1]
+    ok = _scalar_types(param)
+    bounds = {}
+    for t in ok:
+        bits = 8 * ctypes.sizeof(t)
+        bounds[t] = (
+            (0, (1 << bits) - 1)
+            if t._type_.isupper()
+            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        )
+    env = {
+        "_NO": _NO,
+        "_CArg": _CArg,
+        "_LOCKSTEP": _LOCKSTEP,
+        "_addressof": _addressof,
+        "_AXIS": Axis,
+        "session": session,
+        "advance": advance,
+        "name": name,
+        "slow": slow,
+        "ok": ok,
+        "BOUNDS": bounds,
+        "INDEX": index,
+        "SUB": subindex,
+        "last": [None],
+    }
+    env.update(CARG_ENV)
+    code = _ECAT_READER.replace("{address}", carg_address_source("p"))
+    exec(compile(code, f"<gt fast ecat {name}>", "exec"), env)
+    gt = env["gt"]
+    gt.slow = slow
+    return gt
+
+
+_ECAT_READER = """
+def gt(n=_NO, p=_NO, /, *extra, **kw):
+    if type(n) is int and not kw and not extra:
+        ctl = session.controllers.get(1)
+        if ctl is not None and session.remote is None and session.core == 1:
+            ax = ctl.axes.get(n)
+            clock = ctl.clock
+            m = ctl.master
+            if (
+                type(ax) is _AXIS  # (a guarded axis, the bank's: the table path)
+                and clock._thread is None
+                and m is not None
+                and m.opened
+                and ctl.card is None
+                and not ax.link_lost
+            ):
+                acc = ax.io.get(INDEX, SUB)  # (None: not mapped; the table path says so)
+                if acc is not None:
+                    tp = type(p)
+                    if tp is _CArg:
+                        obj = p._obj
+                        if p is not last[0]:
+                            if type(obj) not in ok or {address} != _addressof(obj):
+                                return slow(n, p)  # (p is a byref here)
+                            last[0] = p
+                    elif tp in ok:
+                        obj = p
+                    else:
+                        return slow(*(a for a in (n, p) if a is not _NO))
+                    v = acc.get()
+                    lo, hi = BOUNDS[type(obj)]
+                    if lo <= v <= hi:  # (else store's refusal: the table path)
+                        obj.value = v
+                        session.last = None
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+    return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+"""

@@ -267,3 +267,48 @@ def test_the_specialised_raw_entry_answers_as_the_table() -> None:
             if rcs[0][0] != rcs[1][0]:
                 bad.append(f"set {data!r}: {rcs}")
     assert not bad, "\n".join(bad)
+
+
+def test_the_pdo_readers_answer_as_the_table() -> None:
+    """GT_GetEcatEncPos and the other per-axis PDO readers: each shape, fast and table path
+    agree (code, value, reason); a shape the fast path answers never reaches the table."""
+    _open()
+    makers = {
+        "byref": lambda t: (o := t(), byref(o), o),
+        "same byref": lambda t: (_HELD, _HELD_REF, _HELD) if t is ctypes.c_long else None,
+        "object": lambda t: (o := t(), o, o),
+        "array": lambda t: (o := (t * 2)(), o, o),
+        "narrow": lambda t: (o := ctypes.c_int8(), byref(o), o),
+        "double": lambda t: (o := ctypes.c_double(), byref(o), o),
+        "omitted": lambda t: (o := t(), None, o),
+    }
+    bad = []
+    for name in sorted(fast.ECAT_READERS):
+        for axis in (1, 2, 9):
+            for shape, make in makers.items():
+                for t in (ctypes.c_long, ctypes.c_int32, ctypes.c_uint32):
+                    got = []
+                    for which in ("fast", "slow"):
+                        made = make(t)
+                        if made is None:
+                            break
+                        _, arg, o = made
+                        fn = getattr(gt, name)
+                        call = fn if which == "fast" else fn.slow
+                        args = (axis,) if arg is None else (axis, arg)
+                        pr = cProfile.Profile()
+                        pr.enable()
+                        rc = call(*args)
+                        pr.disable()
+                        table = sum(
+                            v[1]
+                            for (file, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+                            if func in ("call", "run") and file.endswith("_core.py")
+                        )
+                        value = list(o) if isinstance(o, ctypes.Array) else o.value
+                        got.append((rc, value, gt.GTE_GetLastError() if rc else "", table))
+                    if got and got[0][:3] != got[1][:3]:
+                        bad.append(f"{name}({axis}) {shape} {t.__name__}: {got}")
+                    elif got and got[0][0] == 0 and shape in ("byref", "object") and got[0][3]:
+                        bad.append(f"{name}({axis}) {shape} {t.__name__}: took the table path")
+    assert not bad, "\n".join(bad[:10])
