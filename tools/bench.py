@@ -203,6 +203,10 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
         "GT_GetPrfPos(1, byref(d))": (lambda: gt.GT_GetPrfPos(1, pd), lambda: byref(c_double())),
         "GT_GetPrfMode(1, byref(s))": (lambda: gt.GT_GetPrfMode(1, p), lambda: byref(c_long())),
         "GT_GetClock(byref(s))": (lambda: gt.GT_GetClock(p), lambda: byref(c_long())),
+        "GT_GetEcatEncPos(1, byref(s))": (
+            lambda: gt.GT_GetEcatEncPos(1, p),
+            lambda: byref(c_long()),
+        ),
         "GTN_GetSts(1, 1, byref(s))": (lambda: gt.GTN_GetSts(1, 1, p), lambda: byref(c_long())),
         "GT_GetEcatRawData(0, 8, c_ubyte[8])": (
             lambda: raw_get(0, 8, buf8),
@@ -241,9 +245,9 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             lambda: gt.GT_GetTrapPrm(1, byref(trap)),
             lambda: byref(gt.TTrapPrm()),
         ),
-        "GT_GetEcatEncPos(1, byref(s))": (
-            lambda: gt.GT_GetEcatEncPos(1, p),
-            lambda: byref(c_long()),
+        "GT_GetEcatHomingStatus(1, byref(s))": (
+            lambda: gt.GT_GetEcatHomingStatus(1, ps),
+            lambda: byref(c_short()),
         ),
         "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
     }

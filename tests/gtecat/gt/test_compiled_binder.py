@@ -13,6 +13,7 @@ binding is all that is compared.
 from __future__ import annotations
 
 import ctypes
+import functools
 import inspect
 import random
 from ctypes import byref
@@ -116,6 +117,7 @@ def _bound(bind: Any, args: tuple) -> Any:
     return values
 
 
+@functools.cache
 def _binders() -> list[tuple[str, Any, Any, Any]]:
     out = []
     for name, proto in sorted(FUNCTIONS.items()):

@@ -283,7 +283,10 @@ def test_the_pdo_readers_answer_as_the_table() -> None:
         "omitted": lambda t: (o := t(), None, o),
     }
     bad = []
-    for name in sorted(fast.ECAT_READERS):
+    names = sorted(fast.ECAT_READERS)
+    if not LONG:  # two mapped objects and one the figure's drives do not map
+        names = ["GT_GetEcatAxisDI", "GT_GetEcatAxisPE", "GT_GetEcatEncPos"]
+    for name in names:
         for axis in (1, 2, 9):
             for shape, make in makers.items():
                 for t in (ctypes.c_long, ctypes.c_int32, ctypes.c_uint32):
