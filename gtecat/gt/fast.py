@@ -247,40 +247,42 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
             )
         )
     ):
-        ctl = session.controllers.get(1)
-        if ctl is not None and session.remote is None{session_core}:
-            res = ctl.resources.get(n)
-            clock = ctl.clock
-            if res is not None and clock._thread is None:
-                tp = type(p)
-                if tp is _CArg:
-                    obj = p._obj
-                    if p is not last[0]:
-                        # byref(obj), not byref(obj, offset); any doubt: the table path
-                        if type(obj) not in ok or {address} != _addressof(obj):
-                            return {fallback}
-                        last[0] = p  # checked: the same pointer object next time is fine
-                elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
-                    obj = p
-                elif (
-                    tp is _NDARRAY
-                    and p.dtype in np_ok
-                    and p.ndim == 1
-                    and p.size
-                    and p.flags.writeable
-                ) or is_array(tp):  # a numpy or ctypes array: its first element
-                    obj = None
-                else:
-                    return {fallback}
+        try:  # (two subscripts: cheaper than two get calls)
+            ctl = session.controllers[1]
+            res = ctl.resources[n]
+        except KeyError:  # no controller, or no such axis: the table path says why
+            return {fallback}
+        clock = ctl.clock
+        if session.remote is None{session_core} and clock._thread is None:
+            tp = type(p)
+            if tp is _CArg:
+                obj = p._obj
+                if p is not last[0]:
+                    # byref(obj), not byref(obj, offset); any doubt: the table path
+                    if type(obj) not in ok or {address} != _addressof(obj):
+                        return {fallback}
+                    last[0] = p  # checked: the same pointer object next time is fine
+            elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
+                obj = p
+            elif (
+                tp is _NDARRAY
+                and p.dtype in np_ok
+                and p.ndim == 1
+                and p.size
+                and p.flags.writeable
+            ) or is_array(tp):  # a numpy or ctypes array: its first element
+                obj = None
+            else:
+                return {fallback}
 {{value}}
-                if obj is None:
-                    p[0] = v
-                else:
-                    obj.value = v
-                session.last = None
-                if clock.mode is _LOCKSTEP:
-                    return 0
-                return advance(ctl, name, 0)
+            if obj is None:
+                p[0] = v
+            else:
+                obj.value = v
+            session.last = None
+            if clock.mode is _LOCKSTEP:
+                return 0
+            return advance(ctl, name, 0)
     return {fallback}
 """
 
@@ -323,7 +325,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
             "    lst = b._lists.get(key)",
             f"    v = get(res) if lst is None else {row}",
         ]
-    value = "\n".join("                " + line for line in lines)
+    value = "\n".join("            " + line for line in lines)
     code = code.replace("{value}", value)
     exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
     return env[fname]
@@ -939,39 +941,43 @@ def fast_ecat_reader(
 _ECAT_READER = """
 def gt(n=_NO, p=_NO, /, *extra, **kw):
     if type(n) is int and not kw and not extra:
-        ctl = session.controllers.get(1)
-        if ctl is not None and session.remote is None and session.core == 1:
-            ax = ctl.axes.get(n)
-            clock = ctl.clock
-            m = ctl.master
-            if (
-                type(ax) is _AXIS  # (a guarded axis, the bank's: the table path)
-                and clock._thread is None
-                and m is not None
-                and m.opened
-                and ctl.card is None
-                and not ax.link_lost
-            ):
-                acc = ax.io.get(INDEX, SUB)  # (None: not mapped; the table path says so)
-                if acc is not None:
-                    tp = type(p)
-                    if tp is _CArg:
-                        obj = p._obj
-                        if p is not last[0]:
-                            if type(obj) not in ok or {address} != _addressof(obj):
-                                return slow(n, p)  # (p is a byref here)
-                            last[0] = p
-                    elif tp in ok:
-                        obj = p
-                    else:
-                        return slow(*(a for a in (n, p) if a is not _NO))
-                    v = acc.get()
-                    lo, hi = BOUNDS[type(obj)]
-                    if lo <= v <= hi:  # (else store's refusal: the table path)
-                        obj.value = v
-                        session.last = None
-                        if clock.mode is _LOCKSTEP:
-                            return 0
-                        return advance(ctl, name, 0)
+        try:
+            ctl = session.controllers[1]
+            ax = ctl.axes[n]
+        except KeyError:  # no controller, or no such axis: the table path says why
+            return slow(*(a for a in (n, p) if a is not _NO))
+        clock = ctl.clock
+        m = ctl.master
+        if (
+            type(ax) is _AXIS  # (a guarded axis, the bank's: the table path)
+            and session.remote is None
+            and session.core == 1
+            and clock._thread is None
+            and m is not None
+            and m.opened
+            and ctl.card is None
+            and not ax.link_lost
+        ):
+            acc = ax.io.get(INDEX, SUB)  # (None: not mapped; the table path says so)
+            if acc is not None:
+                tp = type(p)
+                if tp is _CArg:
+                    obj = p._obj
+                    if p is not last[0]:
+                        if type(obj) not in ok or {address} != _addressof(obj):
+                            return slow(n, p)  # (p is a byref here)
+                        last[0] = p
+                elif tp in ok:
+                    obj = p
+                else:
+                    return slow(*(a for a in (n, p) if a is not _NO))
+                v = acc.get()
+                lo, hi = BOUNDS[type(obj)]
+                if lo <= v <= hi:  # (else store's refusal: the table path)
+                    obj.value = v
+                    session.last = None
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
     return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 """

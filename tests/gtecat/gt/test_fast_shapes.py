@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 from gtecat import gt
+from gtecat.controller.axis import Axis
 from gtecat.controller.axis_status import AxisStatus
 from gtecat.gt import fast
 from gtecat.gt.table import FUNCTIONS, declared_only
@@ -271,8 +272,9 @@ def test_the_specialised_raw_entry_answers_as_the_table() -> None:
 
 def test_the_pdo_readers_answer_as_the_table() -> None:
     """GT_GetEcatEncPos and the other per-axis PDO readers: each shape, fast and table path
-    agree (code, value, reason); a shape the fast path answers never reaches the table."""
-    _open()
+    agree (code, value, reason); a shape the fast path answers never reaches the table (on
+    an axis the bank does not run at that moment: the bank's axes are the table's)."""
+    ctl = _open()
     makers = {
         "byref": lambda t: (o := t(), byref(o), o),
         "same byref": lambda t: (_HELD, _HELD_REF, _HELD) if t is ctypes.c_long else None,
@@ -291,6 +293,7 @@ def test_the_pdo_readers_answer_as_the_table() -> None:
             for shape, make in makers.items():
                 for t in (ctypes.c_long, ctypes.c_int32, ctypes.c_uint32):
                     got = []
+                    own = type(ctl.axes.get(axis)) is Axis  # (not guarded by the bank)
                     for which in ("fast", "slow"):
                         made = make(t)
                         if made is None:
@@ -313,5 +316,7 @@ def test_the_pdo_readers_answer_as_the_table() -> None:
                     if got and got[0][:3] != got[1][:3]:
                         bad.append(f"{name}({axis}) {shape} {t.__name__}: {got}")
                     elif got and got[0][0] == 0 and shape in ("byref", "object") and got[0][3]:
+                        if not own:
+                            continue
                         bad.append(f"{name}({axis}) {shape} {t.__name__}: took the table path")
     assert not bad, "\n".join(bad[:10])
