@@ -716,26 +716,30 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
         and not extra
         and not kw{ok}
     ):
-        ctl = session.controllers.get(1)
-        if ctl is not None and session.remote is None and session.core == 1:
-            m = ctl.master
-            clock = ctl.clock
-            if (
-                m is not None
-                and m.image is IMG{n}
-                and m.opened
-                and not m.offline
-                and clock._thread is None
-            ):
-                try:
-                    {move}
-                except Exception:  # (the buffer's own refusal): the generic path answers
-                    pass
-                else:
-                    session.last = None
-                    if clock.mode is _LOCKSTEP:
-                        return 0
-                    return advance(ctl, name, 0)
+        try:
+            ctl = session.controllers[1]
+        except KeyError:  # no controller: the generic path says why
+            return generic({slave_arg}offset, size, p)
+        m = ctl.master
+        clock = ctl.clock
+        if (
+            session.remote is None
+            and session.core == 1
+            and m is not None
+            and m.image is IMG{n}
+            and m.opened
+            and not m.offline
+            and clock._thread is None
+        ):
+            try:
+                {move}
+            except Exception:  # (the buffer's own refusal): the generic path answers
+                pass
+            else:
+                session.last = None
+                if clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
     return generic({slave_arg}offset, size, p, *extra, **kw)
 """
 
@@ -928,6 +932,7 @@ def fast_ecat_reader(
         "BOUNDS": bounds,
         "INDEX": index,
         "SUB": subindex,
+        "ACCS": {},
         "last": [None],
     }
     env.update(CARG_ENV)
@@ -958,7 +963,12 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
             and ctl.card is None
             and not ax.link_lost
         ):
-            acc = ax.io.get(INDEX, SUB)  # (None: not mapped; the table path says so)
+            kept = ACCS.get(n)  # (the axis's entry, kept: AxisIo.get keeps it too)
+            if kept is None or kept[0] is not ax:
+                if len(ACCS) > 4096:
+                    ACCS.clear()
+                kept = ACCS[n] = (ax, ax.io.get(INDEX, SUB))
+            acc = kept[1]  # (None: not mapped; the table path says so)
             if acc is not None:
                 tp = type(p)
                 if tp is _CArg:
