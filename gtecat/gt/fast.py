@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 
 from ..controller.axis_status import AxisStatus
+from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
+from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
@@ -197,16 +199,17 @@ def fast_reader(
 
 
 #: a reader's value of an axis the bank does not run, inline (without the getter's call):
-#: GT_GetSts's word as :meth:`AxisResources.status` makes it (tests/gtecat/gt/test_fast.py
-#: holds the two to the same word in every state they combine)
+#: GT_GetSts's word as :meth:`AxisResources.status` makes it (the latched flags as they are:
+#: an int; tests/gtecat/gt/test_fast_shapes.py holds the two to the same word in every state
+#: they combine, a Trap planner's and another planner's)
 SCALAR_INLINE: dict[str, tuple[str, ...]] = {
     "GT_GetSts": (
         "v = res.latched",
-        "if type(v) is not int:",
-        "    v = int(v)",
         "if res.ax.servo_on:",
         "    v |= SERVO_ON",
-        "if not res.profile.planner.done:",
+        "pl = res.profile.planner",
+        # the planner's done (a Trap planner's own state read without the property's call)
+        "if (pl._mode != TRAP_IDLE) if type(pl) is TRAP else not pl.done:",
         "    v |= MOVING",
         "elif res.band.arrived:",
         "    v |= ARRIVED",
@@ -216,6 +219,8 @@ _STATUS_BITS = {
     "SERVO_ON": int(AxisStatus.SERVO_ON),
     "MOVING": int(AxisStatus.MOVING),
     "ARRIVED": int(AxisStatus.ARRIVED),
+    "TRAP": TrapPlanner,
+    "TRAP_IDLE": TRAP_IDLE,
 }
 
 #: the bank's list of each reader's value (AxisBank.value), read without the two calls

@@ -14,6 +14,7 @@ recorded reason.  The default run samples the shapes; GTECAT_LONG=1 runs them al
 
 from __future__ import annotations
 
+import copy
 import cProfile
 import ctypes
 import pstats
@@ -28,6 +29,7 @@ import pytest
 from gtecat import gt
 from gtecat.controller.axis import Axis
 from gtecat.controller.axis_status import AxisStatus
+from gtecat.controller.motion.trap import TrapPlanner
 from gtecat.gt import fast
 from gtecat.gt.table import FUNCTIONS, declared_only
 from tests.conftest import LONG
@@ -215,19 +217,25 @@ def test_the_inline_status_word_is_the_resources_word() -> None:
     res = ctl.resources[1]
     assert res.bank is None  # (GT_AxisOn gave it back; no cycle has run since)
     kept = (res.latched, res.ax.servo_on, res.profile.planner, res.band.arrived)
+    trap = res.profile.planner
+    assert type(trap) is TrapPlanner and trap.done
+    moving_trap = copy.copy(trap)
+    moving_trap._mode = 1  # (its state moving: done is False)
+    assert not moving_trap.done
+    planners = [SimpleNamespace(done=False), SimpleNamespace(done=True), trap, moving_trap]
     s = ctypes.c_long()
     bad = []
     try:
         for latched in (0, 0x2, int(AxisStatus.POSITIVE_LIMIT), AxisStatus.ALARM):
             for servo in (False, True):
-                for done in (False, True):
+                for planner in planners:
                     for arrived in (False, True):
                         res.latched, res.ax.servo_on = latched, servo
-                        res.profile.planner = SimpleNamespace(done=done)
+                        res.profile.planner = planner
                         res.band.arrived = arrived
                         rc = gt.GT_GetSts(1, s)
                         if rc != 0 or s.value != res.status():
-                            bad.append(f"{latched, servo, done, arrived}: {s.value} {res.status()}")
+                            bad.append(f"{latched, servo, planner, arrived}: {s.value}")
     finally:
         res.latched, res.ax.servo_on, res.profile.planner, res.band.arrived = kept
     assert not bad, "\n".join(bad)
