@@ -126,6 +126,7 @@ def fast_reader(
         "get": get,
         "ok": ctypes_ok,
         "last": last,
+        "LAST_P": None,
         "advance": advance,
         "name": name,
         "slow": slow,
@@ -238,6 +239,7 @@ BANK_LISTS = {
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
 _READER = """
 def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
+    global LAST_P  # the last byref object checked (kept alive, so never another's address)
     if (
         type(n) is int
         and not kw
@@ -262,11 +264,12 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
             tp = type(p)
             if tp is _CArg:
                 obj = p._obj
-                if p is not last[0]:
+                if p is not LAST_P:
                     # byref(obj), not byref(obj, offset); any doubt: the table path
-                    if type(obj) not in ok or {address} != _addressof(obj):
+                    kind = type(obj)
+                    if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
                         return {fallback}
-                    last[0] = p  # checked: the same pointer object next time is fine
+                    LAST_P = p  # checked: the same pointer object next time is fine
             elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
                 obj = p
             elif (
