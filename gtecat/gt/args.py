@@ -81,7 +81,8 @@ class Ref:
     """A checked pointer argument: the memory behind it and how much of it there is.
 
     ``addr``/``nbytes`` describe ctypes memory (``elem`` its element type, None
-    for plain bytes); ``py`` holds a Python container instead.
+    for plain bytes); ``py`` holds a Python container instead.  (:func:`_ref` makes one
+    without ``__init__``, for the compiled binder: the two set the same slots.)
     """
 
     __slots__ = ("_keep", "addr", "elem", "name", "nbytes", "py")
