@@ -113,8 +113,11 @@ class _Session:
         self.card = 0
         #: the current card's cores (``cards[card]``)
         self.controllers: dict[int, Controller] = self.cards[0]
-        #: the core the GT_* functions address (GT_SetCore; the GTN_* ones name theirs)
-        self.core = 1
+        self._core = 1
+        self._remote: Any = None
+        #: in this process (no controller process attached), and the GT_* functions address
+        #: core 1: what the fast paths answer (kept by the two properties below)
+        self.local = self.plain = True
         #: the options the first card was opened with (resolved): the other cards' base
         self.base_options: Any = None
         #: every card and core of the process shares one time
@@ -124,9 +127,28 @@ class _Session:
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
         #: a reason the running call leaves although it succeeds (:func:`note`)
         self.note: str | None = None
-        #: the controller process this session is attached to (``GT_Open(controller=...)``
-        #: or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process
-        self.remote: Any = None
+
+    @property
+    def core(self) -> int:
+        """The core the GT_* functions address (GT_SetCore; the GTN_* ones name theirs)."""
+        return self._core
+
+    @core.setter
+    def core(self, core: int) -> None:
+        self._core = core
+        self.plain = self.local and core == 1
+
+    @property
+    def remote(self) -> Any:
+        """The controller process this session is attached to (``GT_Open(controller=...)``
+        or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process."""
+        return self._remote
+
+    @remote.setter
+    def remote(self, remote: Any) -> None:
+        self._remote = remote
+        self.local = remote is None
+        self.plain = self.local and self._core == 1
 
     def select(self, card: int) -> None:
         """Make ``card`` the current card (GT_SetCardNo; checked by the caller)."""
@@ -354,7 +376,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if not needs_ctl and core != 1:  # GTN_Open/GTN_Close: no other core exists
                     raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
-                core = SESSION.core  # GT_SetCore: 1 unless the program chose another
+                core = SESSION._core  # GT_SetCore: 1 unless the program chose another
             values, extra = bind(args, kwargs)
         except Exception as e:
             return failed(e, None, core, before)
@@ -367,7 +389,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         ``GTN_`` twin was called)."""
         ctl = None
         try:
-            if address or SESSION.remote is not None:  # attached: the controller process runs it
+            if address or SESSION._remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
 
                 rc = remote_call(SESSION, name, gtn, core, values, extra, address)
@@ -440,7 +462,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             if compiled:
                 values = compiled[0](*args)  # None: not a plain shape (the table binder's)
                 if values is not None:
-                    return run(SESSION.core, values, _NO_KW, "", SESSION.last)
+                    return run(SESSION._core, values, _NO_KW, "", SESSION.last)
             elif not opens:  # GT_Open: always the table path (its keyword options)
                 compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
                 return gt(*args)
@@ -487,7 +509,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                         and args[0] == 1
                         and type(args[0]) is int
                         and not kwargs
-                        and SESSION.core == 1
+                        and SESSION.plain
                     ):
                         return fast(*args[1:])  # core 1: the GT_ function's fast path
                     return call(args[0], args[1:], kwargs)

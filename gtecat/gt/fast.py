@@ -137,7 +137,7 @@ def fast_reader(
         "to": float if ctypes_ok is _DOUBLE else None,
         "T0": ctypes.c_double if ctypes_ok is _DOUBLE else ctypes.c_long,  # the usual type
     }
-    gt = _compiled(_READER, "gt", env, core="", session_core=" and session.core == 1")
+    gt = _compiled(_READER, "gt", env, core="", session="session.plain")
 
     def general(n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict) -> int:
         """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
@@ -194,7 +194,7 @@ def fast_reader(
     env["gtn_general"] = gtn_general
     #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
     #: its core); every other shape: the table's GTN_ function (set by gt_function)
-    gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session_core="")  # type: ignore[attr-defined]
+    gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt
 
@@ -260,7 +260,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
         except KeyError:  # no controller, or no such axis: the table path says why
             return {fallback}
         clock = ctl.clock
-        if session.remote is None{session_core} and clock._thread is None:
+        if {session} and clock._thread is None:
             tp = type(p)
             if tp is _CArg:
                 obj = p._obj
@@ -295,7 +295,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
 """
 
 
-def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session_core: str) -> Any:
+def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
     env.update(CARG_ENV)
@@ -304,7 +304,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         fname=fname,
         core=core,
         core_check=" and type(core) is int and core == 1" if gtn else "",
-        session_core=session_core,
+        session=session,
         address=address,
         fallback=(
             "gtn_general(core, n, p, count, pClock, extra, kw)"
@@ -364,7 +364,7 @@ def fast_clock(
             and not extra
         ):
             ctl = session.controllers.get(1)
-            if ctl is not None and session.remote is None and session.core == 1:
+            if ctl is not None and session.plain:  # (in this process, core 1)
                 clock = ctl.clock
                 if clock._thread is None:
                     tp = type(pClock)
@@ -731,8 +731,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
         m = ctl.master
         clock = ctl.clock
         if (
-            session.remote is None
-            and session.core == 1
+            session.plain  # (in this process, core 1)
             and m is not None
             and m.image is IMG{n}
             and m.opened
@@ -797,8 +796,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
         ctl is not None
         and type(offset) is int
         and type(size) is int
-        and session.remote is None
-        and session.core == 1
+        and session.plain  # (in this process, core 1)
     ):
         m = ctl.master
         clock = ctl.clock
@@ -963,8 +961,7 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
         m = ctl.master
         if (
             type(ax) is _AXIS  # (a guarded axis, the bank's: the table path)
-            and session.remote is None
-            and session.core == 1
+            and session.plain  # (in this process, core 1)
             and clock._thread is None
             and m is not None
             and m.opened
