@@ -16,6 +16,7 @@ from __future__ import annotations
 import ctypes
 import re
 import struct
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -40,6 +41,22 @@ _AT = CARG_AT if CARG_AT is not None else -1
 
 
 _status = AxisResources.status
+
+
+def _kept_refs() -> int:
+    """References a pointer object has inside a fast reader when nothing else holds it (a
+    ``byref(c_long())`` made in the call): a checked ``byref`` is kept for the next call only
+    when the caller holds it too (a reused pointer), else keeping it alive would stop the next
+    fresh one from taking its memory, which costs more than the check it saves."""
+
+    def probe(p: Any) -> int:
+        return sys.getrefcount(p)
+
+    return probe(ctypes.byref(ctypes.c_long()))
+
+
+#: see :func:`_kept_refs`
+_KEPT = _kept_refs()
 _LOCKSTEP = ClockMode.LOCKSTEP
 
 
@@ -127,6 +144,8 @@ def fast_reader(
         "ok": ctypes_ok,
         "last": last,
         "LAST_P": None,
+        "_refs": sys.getrefcount,
+        "KEPT": _KEPT,
         "advance": advance,
         "name": name,
         "slow": slow,
@@ -269,7 +288,8 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
                     kind = type(obj)
                     if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
                         return {fallback}
-                    LAST_P = p  # checked: the same pointer object next time is fine
+                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
+                        LAST_P = p  # checked, the same object next time needs no check
             elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
                 obj = p
             elif (
@@ -940,6 +960,8 @@ def fast_ecat_reader(
         "SUB": subindex,
         "ACCS": {},
         "last": [None],
+        "_refs": sys.getrefcount,
+        "KEPT": _KEPT,
     }
     env.update(CARG_ENV)
     code = _ECAT_READER.replace("{address}", carg_address_source("p"))
@@ -981,7 +1003,8 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                     if p is not last[0]:
                         if type(obj) not in ok or {address} != _addressof(obj):
                             return slow(n, p)  # (p is a byref here)
-                        last[0] = p
+                        if _refs(p) > KEPT:  # (kept by the caller: see _KEPT)
+                            last[0] = p
                 elif tp in ok:
                     obj = p
                 else:
