@@ -59,6 +59,7 @@ from ..master.masterlog import MasterLog
 from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
+from .bank_kernel import prebuild as prebuild_kernel
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -228,6 +229,9 @@ class Controller:
                 "C, C++, C#, Python), or put it in the working folder as Gecat.eni "
                 "(Python may pass GT_Open(eni=...), the command line --eni)"
             )
+        banked = self.options.bank != "off" and self.options.backend == "emulated"
+        if banked:
+            prebuild_kernel()  # a first build on this machine runs beside the reading below
         try:
             config = read_eni(path, _eni_cache(path))
         except EniError:
@@ -257,7 +261,7 @@ class Controller:
             self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
         master.open()
         _put_back(backend, kept)
-        if self.options.bank != "off" and self.options.backend == "emulated":
+        if banked:
             self.bank = AxisBank(self, self.options.bank)
         for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
             hook(self)
