@@ -208,14 +208,17 @@ class Controller:
         paused = gc.isenabled()
         if paused:
             gc.disable()
+        _thaw_bus()
         try:
-            return self._init_ecat()
+            master = self._init_ecat()
         except Exception as e:
             self.init_error = e
             raise
         finally:
             if paused:
                 gc.enable()
+        _freeze_bus()
+        return master
 
     def _init_ecat(self) -> Master:
         path = self.eni_path()
@@ -519,6 +522,29 @@ def _put_back(backend: Any, kept: dict[tuple[int, Any, int], float]) -> None:
             pos = kept.get((slave.position, getattr(slave, "identity", None), k))
             if pos is not None:
                 ch.machine_position = pos
+
+
+#: whether this module moved a bus model out of the cyclic collector's walks (gc.freeze)
+_FROZEN: list[bool] = [False]
+
+
+def _freeze_bus() -> None:
+    """After a bring-up: what exists now (the bus model: hundreds of thousands of long-lived
+    objects, millions at a thousand axes) is never walked by the cyclic collector again, so
+    the running bus has no collector pauses and the process's end no last walk of it (half
+    a second at a thousand axes).  A process that froze objects itself is left as it is."""
+    if gc.get_freeze_count() == 0:
+        gc.freeze()
+        _FROZEN[0] = True
+
+
+def _thaw_bus() -> None:
+    """Before the next bring-up: the objects frozen after the last one go back to the
+    collector (a closed bus is garbage by then: its memory returns with the next
+    GT_InitEcatComm, or with the end of the process)."""
+    if _FROZEN[0]:
+        _FROZEN[0] = False
+        gc.unfreeze()
 
 
 #: ENI files from this size on keep their parsed model in the user's cache (a 64-axis file
