@@ -23,7 +23,7 @@ from .errors import EniError
 from .googol_reader import read_googol
 from .model import EniConfig
 from .xml_reader import read_xml
-from .xmltree import parse_xml, parse_xml_fast
+from .xmltree import parse_xml
 
 _GOOGOL = re.compile(rb"^\s*\[\s*(CommonInfo|SlaveStart|SlaveIndex|MasterInfo)\s*\]", re.I | re.M)
 _ROOT = re.compile(rb"<\s*(?:[A-Za-z_][\w.-]*:)?([A-Za-z_][\w.-]*)")
@@ -98,12 +98,6 @@ def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
     """Parse configuration text/bytes; ``source`` names it in error messages."""
     fmt = detect_format(text)
     if fmt == "xml":
-        root = parse_xml_fast(text, source, _NOT_READ)
-        if root is not None and root.tag == "EtherCATConfig":
-            try:
-                return read_xml(root, source)
-            except EniError:
-                pass  # read again below, with the line of every element for the message
         root = parse_xml(text, source, _NOT_READ)
         if root.tag == "EncryptedEtherCATConfig":
             fmt = "encrypted"

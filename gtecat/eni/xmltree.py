@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import codecs
 import re
-import xml.etree.ElementTree as ET
 from collections.abc import Iterator
-from itertools import islice
 from xml.parsers import expat
 
 from .errors import EniError
@@ -148,12 +146,6 @@ def _local(name: str) -> str:
     return name.rpartition(":")[2]
 
 
-def _attrib(attrs: dict[str, str]) -> dict[str, str]:
-    """Attributes by local name; namespace declarations (``xmlns``, ``xmlns:x``) are not
-    attributes of the element."""
-    return {_local(k): v for k, v in attrs.items() if not (k == "xmlns" or k.startswith("xmlns:"))}
-
-
 class _Refused(Exception):
     pass
 
@@ -196,7 +188,7 @@ def parse_xml(
             parser.StartElementHandler, parser.EndElementHandler = skipping
             parser.CharacterDataHandler = None  # type: ignore[assignment]
             return
-        attrib = _attrib(attrs) if attrs else _NO_ATTRS
+        attrib = {_local(k): v for k, v in attrs.items()} if attrs else _NO_ATTRS
         node = Node(name, attrib, parser.CurrentLineNumber)
         if parent is None:
             root.append(node)
@@ -276,112 +268,3 @@ def parse_xml(
     if not root:
         raise EniError("empty XML document", file=source)
     return root[0]
-
-
-#: elements converted to :class:`Node` as soon as they end, the parser's tree of them then
-#: emptied (a bus of a thousand drives is never held whole as both trees)
-_UNITS = frozenset({"Slave", "Variable"})
-_SLAVE_TAG = re.compile(r"<(?:[^\s<>/!?:]+:)?Slave[\s/>]")
-_SLAVE_TAG_B = re.compile(_SLAVE_TAG.pattern.encode())
-
-
-def parse_xml_fast(
-    data: bytes | str, source: str, skip: frozenset[tuple[str, str]] = frozenset()
-) -> Node | None:
-    """The tree :func:`parse_xml` builds, built by ElementTree's C parser (three times
-    faster on a large file), or None where this reader does not answer for the document:
-    it is not well formed (ElementTree's message names no line), it has a document type
-    declaration or entities (refused by :func:`parse_xml`, with their line), it is UTF-16
-    or UTF-32, or the lines of its ``Slave`` elements cannot be told for certain.
-
-    Every element's ``line`` is 0 except a ``Slave``'s (what the model keeps): the caller
-    reads the document again with :func:`parse_xml` when the tree turns out to be wrong,
-    so that the message names the line."""
-    if isinstance(data, bytes):
-        data = _decoded(data, source)
-    if isinstance(data, bytes):
-        if data[:2] in (b"\xff\xfe", b"\xfe\xff") or b"\x00" in data[:4]:
-            return None
-        if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
-            return None
-        starts = [m.start() for m in _SLAVE_TAG_B.finditer(data)]
-    else:
-        if "<!DOCTYPE" in data or "<!ENTITY" in data:
-            return None
-        starts = [m.start() for m in _SLAVE_TAG.finditer(data)]
-    parser = ET.XMLPullParser(events=("end",))
-    seen: dict[str, str] = {}
-    done: dict[int, Node] = {}  # id of a unit's (emptied) element -> its node
-    slaves: list[Node] = []
-    nested = False
-
-    def node_of(el: ET.Element) -> Node:
-        ready = done.pop(id(el), None)
-        if ready is not None:
-            return ready
-        tag = el.tag
-        if tag[0] == "{":
-            tag = tag.rpartition("}")[2]
-        a = el.attrib
-        attrib = (
-            {(k.rpartition("}")[2] if k[0] == "{" else k): v for k, v in a.items()}
-            if a
-            else _NO_ATTRS
-        )
-        node = Node(tag, attrib, 0)
-        text = el.text or ""
-        if len(el):
-            kids = []
-            for c in el:
-                ctag = c.tag
-                if ctag[0] == "{":
-                    ctag = ctag.rpartition("}")[2]
-                if not (skip and (tag, ctag) in skip):
-                    kids.append(node_of(c))
-                tail = c.tail
-                if tail:  # what parse_xml keeps of the text pieces between children
-                    if not text:
-                        text = tail
-                    elif not (tail.isspace() and text.isspace()):
-                        text += tail
-            if kids:
-                node.children = tuple(kids)
-        if text:
-            node.text = seen.setdefault(text, text) if len(text) <= 64 else text
-        return node
-
-    last: ET.Element | None = None
-
-    def take() -> None:
-        nonlocal last, nested
-        for _event, el in parser.read_events():
-            last = el
-            if el.tag in _UNITS:
-                if el.tag == "Slave":
-                    nested = nested or next(islice(el.iter("Slave"), 1, None), None) is not None
-                node = node_of(el)
-                if node.tag == "Slave":
-                    slaves.append(node)
-                tail = el.tail
-                el.clear()
-                el.tail = tail
-                done[id(el)] = node
-
-    try:
-        for at in range(0, len(data), _CHUNK):
-            parser.feed(data[at : at + _CHUNK])
-            take()
-        parser.close()
-        take()
-    except ET.ParseError:
-        return None
-    if last is None or nested or len(slaves) != len(starts):
-        return None
-    root = node_of(last)
-    line, pos = 1, 0
-    newline = b"\n" if isinstance(data, bytes) else "\n"
-    for node, at in zip(slaves, starts, strict=True):
-        line += data.count(newline, pos, at)  # type: ignore[arg-type]
-        pos = at
-        node.line = line
-    return root
