@@ -217,7 +217,7 @@ class Controller:
         finally:
             if paused:
                 gc.enable()
-        _freeze_bus()
+        _freeze_bus(len(master.layout.slaves))
         return master
 
     def _init_ecat(self) -> Master:
@@ -526,25 +526,30 @@ def _put_back(backend: Any, kept: dict[tuple[int, Any, int], float]) -> None:
 
 #: whether this module moved a bus model out of the cyclic collector's walks (gc.freeze)
 _FROZEN: list[bool] = [False]
+#: buses from this many slaves on are frozen (a small bus costs the collector little)
+FREEZE_MIN_SLAVES = 64
 
 
-def _freeze_bus() -> None:
-    """After a bring-up: what exists now (the bus model: hundreds of thousands of long-lived
-    objects, millions at a thousand axes) is never walked by the cyclic collector again, so
-    the running bus has no collector pauses and the process's end no last walk of it (half
-    a second at a thousand axes).  A process that froze objects itself is left as it is."""
-    if gc.get_freeze_count() == 0:
+def _freeze_bus(slaves: int) -> None:
+    """After the bring-up of a large bus: what exists now (the bus model: hundreds of
+    thousands of long-lived objects, millions at a thousand axes) is never walked by the
+    cyclic collector again, so the running bus has no long collector pauses and the
+    process's end no last walk of it (half a second at a thousand axes).  A process that
+    froze objects itself is left as it is."""
+    if slaves >= FREEZE_MIN_SLAVES and gc.get_freeze_count() == 0:
         gc.freeze()
         _FROZEN[0] = True
 
 
 def _thaw_bus() -> None:
     """Before the next bring-up: the objects frozen after the last one go back to the
-    collector (a closed bus is garbage by then: its memory returns with the next
-    GT_InitEcatComm, or with the end of the process)."""
+    collector, and the closed bus (garbage by then) is collected now, before the new one
+    would freeze it again: a closed large bus's memory returns with the next
+    GT_InitEcatComm, or with the end of the process."""
     if _FROZEN[0]:
         _FROZEN[0] = False
         gc.unfreeze()
+        gc.collect()
 
 
 #: ENI files from this size on keep their parsed model in the user's cache (a 64-axis file
