@@ -1,4 +1,4 @@
-"""gtecat benchmarks: prints one JSON object with every figure the issues ask for.
+"""gtecat benchmarks: prints one JSON object with every figure and its target.
 
     python3 tools/bench.py                  # all
     python3 tools/bench.py --quick          # fewer repetitions
@@ -535,12 +535,11 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument(
-        "--targets", "--issue17", action="store_true", help="only the many-axes figures"
-    )
-    ap.add_argument("--seconds", type=float, help="wall seconds per issue-17 figure (1.5)")
+    ap = argparse.ArgumentParser(description="Every benchmark figure, as one JSON object.")
+    ap.add_argument("--quick", action="store_true", help="shorter windows (noisier figures)")
+    ap.add_argument("--targets", action="store_true", help="only the many-axes figures")
+    ap.add_argument("--issue17", dest="targets", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--seconds", type=float, help="wall seconds per many-axes figure (1.5)")
     ap.add_argument("--repeat", type=int, default=3, help="windows per real-time factor")
     ap.add_argument("--rss-child", type=int, metavar="AXES", help=argparse.SUPPRESS)
     ap.add_argument("--eni", default="", help=argparse.SUPPRESS)
