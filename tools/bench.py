@@ -1,4 +1,4 @@
-"""gtecat benchmarks: prints one JSON object with every figure the issues ask for.
+"""gtecat benchmarks: prints one JSON object with every figure and its target.
 
     python3 tools/bench.py                  # all
     python3 tools/bench.py --quick          # fewer repetitions
@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -314,15 +315,16 @@ def rss_child(n: int, seconds: float, eni: str = "") -> int:
     return 0
 
 
-def _child(args: list[str]) -> dict[str, object]:
-    """Run this script with ``args`` in a fresh process: its last JSON line, with the
-    process's wall and CPU seconds from spawn to exit."""
+def _child(args: list[str], env: Mapping[str, str] | None = None) -> dict[str, object]:
+    """Run this script with ``args`` in a fresh process (``env``: its environment): its last
+    JSON line, with the process's wall and CPU seconds from spawn to exit (the CPU of the
+    processes it waited for included: a compiler it ran)."""
     import resource
 
     cmd = [sys.executable, __file__, *args]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600)
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
@@ -390,15 +392,58 @@ def bringup_child(eni: str) -> int:
     return 0
 
 
-def bench_bringup(n: int) -> dict[str, object]:
+COLD = (
+    "cold: a new, empty gtecat cache folder (GTECAT_CACHE_DIR) and no bytecode written by Python"
+    " (PYTHONDONTWRITEBYTECODE=1), as the first run on a fresh machine: the ENI parsed, gtecat's"
+    " modules compiled from source, the bank's C kernel built (its compiler's CPU counted)"
+)
+WARM = "warm: the same cache folder after one such run (the ENI's model, modules, kernel kept)"
+
+
+def bench_bringup(n: int, warm: bool = True) -> dict[str, object]:
     """A fresh process taking an ``n``-axis bus (written beforehand) to OP: the process's
-    wall and CPU seconds from spawn to exit (Python start and imports included)."""
+    wall and CPU seconds from spawn to exit (Python start and imports included), on a cold
+    cache (the figure); ``warm``: then again on the cache that run left, reported beside."""
     from tools.gen_axes_eni import write_axes_eni
 
     with tempfile.TemporaryDirectory() as tmp:
         eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
-        r = _child(["--bringup-child", str(eni)])
-    return {"axes": n, **r}
+        env = {**os.environ, "GTECAT_CACHE_DIR": str(Path(tmp) / "cache")}
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
+        env.pop("GTECAT_ENI_CACHE", None)
+        env.pop("GTECAT_PYC_CACHE", None)
+        r = _child(["--bringup-child", str(eni)], env)
+        out: dict[str, object] = {"axes": n, "cache": COLD, **r}
+        if warm and "error" not in r:
+            w = _child(["--bringup-child", str(eni)], env)
+            keep = ("process_wall_s", "process_cpu_s", "to_op_s", "import_s", "error")
+            out["warm"] = {"cache": WARM, **{k: v for k, v in w.items() if k in keep}}
+    return out
+
+
+def bench_bringup_growth(counts: Sequence[int] = (256, 512, 1024, 2048)) -> dict[str, object]:
+    """Bring-up on a cold cache at each axis count (:func:`bench_bringup`, ``counts``
+    doubling): whole-process CPU seconds, the CPU each step adds per axis it adds
+    (``ms_cpu_per_added_axis``: what is paid once, such as Python's start and the kernel's
+    build, drops out), and ``growth``: the last step's over the first's (1.0: linear)."""
+    rows: dict[str, object] = {}
+    cpus: list[float] = []
+    steps: list[float] = []
+    for k, n in enumerate(counts):
+        r = bench_bringup(n, warm=False)
+        if "error" in r:
+            return {"error": f"{n} axes: {r['error']}"}
+        cpus.append(float(r["process_cpu_s"]))  # type: ignore[arg-type]
+        row = {"process_wall_s": r["process_wall_s"], "process_cpu_s": r["process_cpu_s"]}
+        if k:
+            steps.append((cpus[k] - cpus[k - 1]) / (n - counts[k - 1]))
+            row["ms_cpu_per_added_axis"] = round(1000 * steps[-1], 3)
+        rows[str(n)] = row
+    return {
+        "cache": COLD,
+        "axes": rows,
+        "growth": round(steps[-1] / steps[0], 2) if len(steps) > 1 and steps[0] > 0 else None,
+    }
 
 
 GEAR = "per core: the first axis in Trap, the others in Gear on it (1:2)"
@@ -522,6 +567,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "bringup_1024_axes_to_op": lambda: _figure(
             bench_bringup(1024), "process_wall_s", 6.0, at_most=True
         ),
+        "bringup_growth": lambda: _figure(bench_bringup_growth(), "growth", 1.5, at_most=True),
     }
     unknown = sorted(set(only) - set(figures))
     if unknown:
@@ -534,12 +580,11 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument(
-        "--targets", "--issue17", action="store_true", help="only the many-axes figures"
-    )
-    ap.add_argument("--seconds", type=float, help="wall seconds per issue-17 figure (1.5)")
+    ap = argparse.ArgumentParser(description="Every benchmark figure, as one JSON object.")
+    ap.add_argument("--quick", action="store_true", help="shorter windows (noisier figures)")
+    ap.add_argument("--targets", action="store_true", help="only the many-axes figures")
+    ap.add_argument("--issue17", dest="targets", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--seconds", type=float, help="wall seconds per many-axes figure (1.5)")
     ap.add_argument("--repeat", type=int, default=3, help="windows per real-time factor")
     ap.add_argument("--rss-child", type=int, metavar="AXES", help=argparse.SUPPRESS)
     ap.add_argument("--eni", default="", help=argparse.SUPPRESS)
