@@ -266,8 +266,8 @@ typedef double v2d __attribute__((vector_size(16)));
 /* Samples kk and kk + 1 of bank_trap_fill's smoothed move (ts > 0) at once, two lanes of the
  * same operations in the same order (each lane its own IEEE result: the same bits), where
  * both lie in one raw piece, their smoothing windows start in that piece too and neither is
- * the end sample; 0 (nothing written) otherwise.  *pi, *pj: the
- * pieces of the last sample (moved on as the scalar loop would). */
+ * the end sample; 0 (nothing written) otherwise.  *pi, *pj: the pieces of the last sample
+ * (moved on as the scalar loop would). */
 INLINE int trap_pair(const double *sg, int64_t m, double cyc, const double *prm, double thr,
                      int64_t kk, int64_t *pi, int64_t *pj, double *po, double *vo, double *ao)
 {
@@ -322,8 +322,8 @@ INLINE int trap_pair(const double *sg, int64_t m, double cyc, const double *prm,
  * order of operations (TrapPlanner._sample): samples k0+1 .. k0+n of the move whose raw
  * pieces are sg[4*q .. 4*q+3] = (t0, p0, v0, a), q < m.  Writes min(end + 1, n) samples;
  * returns end, the index of the end sample (target, 0, 0), or n when the move goes on. */
-CLONES int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm, int64_t k0,
-                       int64_t n, double *po, double *vo, double *ao)
+CLONES int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm,
+                              int64_t k0, int64_t n, double *po, double *vo, double *ao)
 {
     const double t_done = prm[0], ts = prm[1], t_final = prm[2], tgt = prm[3], dir = prm[4];
     const double thr = t_done - 1e-9 * (1.0 + t_done * 1e-3); /* _EPS_T */
@@ -923,9 +923,16 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     const int64_t w2 = plain ? 0 : io[IN_W2], w16 = plain ? 0 : io[IN_W16];
     const int64_t w17 = plain ? 0 : io[IN_W17];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
-    double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r], q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r], q_a = F64(a_last)[r], q_enc_pos = F64(enc_pos)[r], q_step0 = F64(enc_step0)[r], q_step1 = F64(enc_step1)[r], q_jrp = F64(jrp)[r], q_jrv = F64(jrv)[r], q_jp = F64(jp)[r], q_jv = F64(jv)[r], q_ja = F64(ja)[r];
-    int64_t q_target = I64(c_target)[r], q_din = I64(c_din)[r], q_enc_prev = I64(enc_prev)[r], q_since = I64(since)[r], q_cur = I64(t_cur)[r], q_t_idx = I64(t_idx)[r], q_taken = I64(taken)[r], q_t_len = I64(t_len)[r], q_t_end = I64(t_end)[r];
-    uint8_t q_lim = U8(c_limited)[r], q_swl = U8(c_sw_limited)[r], q_arrived = U8(arrived)[r], q_moving = U8(moving)[r], q_ended = U8(ended)[r], q_fin = 0, q_refilled = 0;
+    double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r],
+        q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r],
+        q_a = F64(a_last)[r], q_enc_pos = F64(enc_pos)[r], q_step0 = F64(enc_step0)[r],
+        q_step1 = F64(enc_step1)[r], q_jrp = F64(jrp)[r], q_jrv = F64(jrv)[r], q_jp = F64(jp)[r],
+        q_jv = F64(jv)[r], q_ja = F64(ja)[r];
+    int64_t q_target = I64(c_target)[r], q_din = I64(c_din)[r], q_enc_prev = I64(enc_prev)[r],
+        q_since = I64(since)[r], q_cur = I64(t_cur)[r], q_t_idx = I64(t_idx)[r],
+        q_taken = I64(taken)[r], q_t_len = I64(t_len)[r], q_t_end = I64(t_end)[r];
+    uint8_t q_lim = U8(c_limited)[r], q_swl = U8(c_sw_limited)[r], q_arrived = U8(arrived)[r],
+        q_moving = U8(moving)[r], q_ended = U8(ended)[r], q_fin = 0, q_refilled = 0;
     int q_code = 0;
     int64_t c;
     for (c = 0; c < limit; c++) {
@@ -1289,7 +1296,6 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
                 rows = 0;
     }
     if (rows && maxc >= ROWS_FROM) {
-        void **ptr = lp; /* the local table for U8/I64/F64 */
         const uint8_t *buf = U8(buf);
         RowRun *rs;
         double *bk;
