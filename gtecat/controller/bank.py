@@ -80,6 +80,7 @@ from .crd.system import Delay, Motion
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
+from .motion.jog import ramp_step as jog_ramp_step
 from .motion.stop import StopKind
 from .motion.trap import _IDLE, _MOVE, TrapPlanner
 from .motion.trap_table import advance, trap_table
@@ -188,6 +189,10 @@ _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.MOVING),
     int(AxisStatus.ARRIVED),
 )
+_ALARM = int(AxisStatus.ALARM)
+_POS_LIMIT = int(AxisStatus.POSITIVE_LIMIT)
+_NEG_LIMIT = int(AxisStatus.NEGATIVE_LIMIT)
+_SW_FAULT = 0x0008  # 6041h bit 3: fault
 
 
 #: the modes whose planners a cluster steps ahead (gtecat.controller.bank_modes)
@@ -412,6 +417,7 @@ class AxisBank:
         self.enc_ratio, self.enc_off = z(n), z(n)
         self.soft_pos, self.soft_neg = z(n), z(n)
         self.pos_err = z(n)
+        self.latched = zi(n, np.int64)  # a frozen row's latched GT_GetSts flags
         self.external = zi(n, bool)
         self.sense = zi(n, np.int64)
         self.enc_prev = zi(n, np.int64)
@@ -429,6 +435,7 @@ class AxisBank:
         self.jrp, self.jrv = z(n), z(n)  # the raw ramp's position and speed
         self.jp, self.jv, self.ja = z(n), z(n), z(n)  # the filter output (the planned values)
         self.tau, self.jE = z(n), z(n)  # smoothing time constant, e^(-T/tau)
+        self.jgoal, self.jacc, self.jdec = z(n), z(n), z(n)  # target speed, its ramps
         self.taken = zi(n, np.int64)  # samples taken since the claim
         self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
         #: rows whose planners a cluster steps ahead (gtecat.controller.bank_modes)
@@ -573,8 +580,9 @@ class AxisBank:
                 return False
         elif prof.mode == PrfMode.JOG and pl is prof.jog and isinstance(pl, JogPlanner):
             if pl._mode == _JOG_MOVE:
-                # cruising (the raw ramp at its speed): the ramps themselves stay scalar
-                if pl._raw_v != pl._goal or pl._goal == 0.0 or pl._T != self.T:
+                # cruising or ramping toward a speed (a reversal included); a jog stopping
+                # (goal 0: it settles and ends) stays scalar
+                if pl._goal == 0.0 or pl._T != self.T or pl._prm is None:
                     return False
             elif pl._mode != _JOG_IDLE:
                 return False
@@ -603,7 +611,7 @@ class AxisBank:
         st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active):
             return False
-        if res.latched or ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
+        if ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
             return False
         if None in (res._act, ax._tp_acc, ax._pos_acc):
             return False
@@ -622,8 +630,18 @@ class AxisBank:
             return False  # 607Ah does not hold 6064h yet
         ch = self.csp.channels[r]
         s = res.safety
-        if s.active and (a > s.soft_positive or a < s.soft_negative or ch.digital_inputs & 3):
-            return False  # a flag would latch
+        if s.active:
+            # the flags its cycle would latch (AxisResources._post) are latched already - a
+            # drive alarm the application has not cleared yet - or the row stays scalar
+            would = 0
+            if s.alarm_on and res._alarm_sw is not None and res._alarm_sw.get() & _SW_FAULT:
+                would |= _ALARM
+            if a > s.soft_positive or ch.digital_inputs & 2:
+                would |= _POS_LIMIT
+            if a < s.soft_negative or ch.digital_inputs & 1:
+                would |= _NEG_LIMIT
+            if would & ~res.latched:
+                return False
         b = res.band
         if b.band > 0:
             err = a - res.enc_link.axis(enc.pos)
@@ -854,6 +872,8 @@ class AxisBank:
             tau = pl._tau
             self.tau[r] = tau
             self.jE[r] = math.exp(-pl._T / tau) if tau > 0.0 else 0.0
+            self.jgoal[r] = pl._goal
+            self.jacc[r], self.jdec[r] = pl._prm.acc, pl._prm.dec
         sampled = bool(self.sampled[r])  # stepped ahead by its cluster (bank_modes)
         if sampled:
             moving = not pl.done
@@ -896,6 +916,9 @@ class AxisBank:
             self.t_len[r], self.t_end[r] = 1, 0
         ch = self.csp.channels[r]
         self.frz[r] = frozen = not ax.servo_on
+        # GT_GetSts's latched flags: a frozen row's stay as they are (_eligible_frozen), any
+        # other row has none
+        self.latched[r] = int(res.latched) if frozen else 0
         if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
             self._frozen[r] = (
                 tuple(getattr(ch, name) for name in FROZEN_ATTRS),
@@ -1232,18 +1255,19 @@ class AxisBank:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
                 return [
-                    (_MOVING if m or j else _ARRIVED if a else 0) | (0 if f else _SERVO_ON)
-                    for m, j, a, f in zip(
+                    (_MOVING if m or j else _ARRIVED if a else 0) | (lt if f else _SERVO_ON)
+                    for m, j, a, f, lt in zip(
                         self.moving.tolist(),
                         self.jog.tolist(),
                         self.arrived.tolist(),
                         self.frz.tolist(),
+                        self.latched.tolist(),
                         strict=True,
                     )
                 ]
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | np.where(self.frz, 0, _SERVO_ON)).tolist()
+            return (sts | np.where(self.frz, self.latched, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             vel, acc = self._enc_rates()
             return (vel if name == "enc_vel" else acc).tolist()
@@ -1502,10 +1526,11 @@ class AxisBank:
         return vel, acc
 
     def _jog_step(self) -> tuple[np.ndarray, ...]:
-        """One cycle of every cruising Jog: :func:`~gtecat.controller.motion.jog.advance` with
-        the raw speed at its goal (a = 0, one piece of length T), then ``JogPlanner.step``'s
-        snap onto the goal; the same operations with the same zero constants, for the same
-        bits (``-0.0`` included)."""
+        """One cycle of every Jog: :func:`~gtecat.controller.motion.jog.advance` with the raw
+        speed at its goal (a = 0, one piece of length T), then ``JogPlanner.step``'s snap onto
+        the goal; the same operations with the same zero constants, for the same bits
+        (``-0.0`` included).  A row whose raw speed ramps takes the scalar step's own
+        arithmetic (:func:`~gtecat.controller.motion.jog.ramp_step`)."""
         h = self.T
         rp, v, fp, fv, fa = self.jrp, self.jrv, self.jp, self.jv, self.ja
         p1 = rp + h * (v + 0.5 * 0.0 * h)
@@ -1519,6 +1544,24 @@ class AxisBank:
         snap = (nfv != goal) & (np.abs(nfv - goal) <= 1e-9 * (1.0 + np.abs(goal)))
         nfv = np.where(snap, goal, nfv)
         nfa = np.where(snap, 0.0, nfa)
+        ramping = self.jog & self.alive & (v != self.jgoal)
+        if np.count_nonzero(ramping):
+            # a ramp (the raw speed not yet at its goal): JogPlanner.step's own operations,
+            # row by row (a rare cycle here: the compiled cycle runs them too)
+            for r in np.nonzero(ramping)[0].tolist():
+                out = jog_ramp_step(
+                    float(rp[r]),
+                    float(v[r]),
+                    float(self.jgoal[r]),
+                    float(self.jacc[r]),
+                    float(self.jdec[r]),
+                    h,
+                    float(tau[r]),
+                    float(fp[r]),
+                    float(fv[r]),
+                    float(fa[r]),
+                )
+                p1[r], v1[r], nfp[r], nfv[r], nfa[r] = out
         return p1, v1, nfp, nfv, nfa
 
     def _materialise(self) -> None:
