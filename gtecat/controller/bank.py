@@ -283,6 +283,7 @@ class AxisBank:
         self.dirty = True
         self._countdown = 0
         self._missed = False  # the last refresh found an eligible group it could not claim
+        self._settled = False  # the next cycle's first steps ran already (settle)
         #: GT axes kept off the bank (a fault trigger reads their drive every cycle)
         self.held: frozenset[int] = frozenset()
         self.n = 0
@@ -1286,8 +1287,15 @@ class AxisBank:
         return np.where(one, np.where(off != 0.0, x + off, x), ratio * x + off)
 
     # --- the cycle -------------------------------------------------------------------------
-    def cycle(self, t_ns: int, dt_ns: int) -> None:
-        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+    def settle(self) -> None:
+        """What :meth:`cycle` does first after a GT call or a release (claim what may come
+        back, re-index), done before a cycle is due: when every axis comes back, the
+        controller runs the cycles many at once (:meth:`Controller.run_cycles`)."""
+        if not self._settled:
+            self._begin()
+            self._settled = True
+
+    def _begin(self) -> None:
         self._countdown -= 1
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
@@ -1295,6 +1303,13 @@ class AxisBank:
             self.refresh()
         if self._stale:
             self._reindex()
+
+    def cycle(self, t_ns: int, dt_ns: int) -> None:
+        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        if self._settled:
+            self._settled = False  # its first steps ran just before (settle)
+        else:
+            self._begin()
         if not self.n_alive:
             return
         self._lists.clear()
@@ -1486,7 +1501,8 @@ class AxisBank:
                 return 0
         _, done = k.run(t_ns, dt, dt_ns, n)
         if done:
-            self._countdown -= done
+            self._countdown -= done - self._settled  # (the first one's count: in settle)
+            self._settled = False
             self._refill_in -= done
             self._lists.clear()
             self._after_kernel(k, done)
