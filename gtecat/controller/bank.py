@@ -2,9 +2,10 @@
 
 Per axis and cycle the scalar objects cost 15-25 µs of Python (planner, axis layer,
 drive state machine, mechanics, PDO codec, status and limit checks).  Most axes of a
-machine spend most cycles in one state: servo on, drive in CSP, Trap move or holding,
-no flag latched.  :class:`AxisBank` runs exactly that state for every such axis at
-once - the Trap samples (:func:`~gtecat.controller.motion.trap_table.trap_table`), the
+machine spend most cycles in one state: servo on, drive in CSP, Trap move, Jog (at speed
+or ramping toward one) or holding, no flag latched.  :class:`AxisBank` runs exactly that
+state for every such axis at once - the Trap samples
+(:func:`~gtecat.controller.motion.trap_table.trap_table`), the Jog's ramp, the
 axis layer's 607Ah, the drive (:class:`gtecat.drives.csp_bank.CspBank`), the encoder, the soft
 and hardware limits, the following error, the in-position band and the GT_GetSts word -
 and reads/writes the process image as array views.
