@@ -270,6 +270,9 @@ class _Group:
     drive: Cia402Drive
     rows: list[int]
     rx_bytes: np.ndarray  # buffer indices of its output bytes, 607Ah excluded
+    #: the entries the bank writes into the image: (buffer byte, bytes, an output, the
+    #: slave's rx (output) or tx (input) index of the first byte)
+    computed: list[tuple[int, int, bool, int]]
     claimed: bool = False
 
 
@@ -394,7 +397,13 @@ class AxisBank:
                 axes.append(ctl.axes[ref.axis])
                 chans.append(slave.channels[ref.channel])
             plc += g_plc
-            groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp)))
+            out0 = (sl.out_logical_bit or 0) >> 3
+            in0 = image.outputs_bytes + ((sl.in_logical_bit or 0) >> 3)
+            computed = [
+                (byte, size, name == "target", byte - (out0 if name == "target" else in0))
+                for _, byte, size, name in g_plc
+            ]
+            groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp), computed))
         if not axes:
             self.disabled_reason = "no drive the bank can run (mapping)"
             return
@@ -1077,6 +1086,16 @@ class AxisBank:
         self.csp.store(rows)
         for r in rows:
             self._store(r)
+        # the drive's process data buffers as its own steps would have left them: the entries
+        # the bank wrote into the image in them too (its other bytes are as they were, so a
+        # raw write or a changed constant still waits for a step of its own: _can_claim)
+        buf = self.ctl.master.image.buffer
+        for g in groups:
+            rx, tx = g.drive.rx, g.drive.tx
+            for byte, size, out, i in g.computed:
+                dst = rx if out else tx
+                if 0 <= i and i + size <= len(dst):
+                    dst[i : i + size] = buf[byte : byte + size].tobytes()
         for cl in clusters:
             # the planners stand where the scalar path has them (bank_modes.Cluster.rewind)
             cl.rewind(self)
