@@ -287,6 +287,9 @@ class AxisBank:
         self.dirty = True
         self._countdown = 0
         self._missed = False  # the last refresh found an eligible group it could not claim
+        #: cycles to the next look for rows to claim while some are out (doubled up to
+        #: RECHECK_CYCLES by each look that leaves some out; 1 again after a release)
+        self._wait = 1
         self._settled = False  # the next cycle's first steps ran already (settle)
         #: GT axes kept off the bank (a fault trigger reads their drive every cycle)
         self.held: frozenset[int] = frozenset()
@@ -428,7 +431,7 @@ class AxisBank:
         self.enc_ratio, self.enc_off = z(n), z(n)
         self.soft_pos, self.soft_neg = z(n), z(n)
         self.pos_err = z(n)
-        self.latched = zi(n, np.int64)  # a frozen row's latched GT_GetSts flags
+        self.latched = zi(n, np.int64)  # the latched GT_GetSts flags (constant in the bank)
         self.external = zi(n, bool)
         self.sense = zi(n, np.int64)
         self.enc_prev = zi(n, np.int64)
@@ -580,7 +583,9 @@ class AxisBank:
         st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active) or not res._csp:
             return False
-        if res.latched or ax.prf_pos != res._a_last:
+        if ax.prf_pos != res._a_last:
+            return False
+        if res.latched and not self._latched_standing(ax, res):
             return False
         prof = res.profile
         pl = prof.planner
@@ -609,6 +614,24 @@ class AxisBank:
         if not self._inputs_plain(ax, res):
             return False
         return not claimable(self.csp.channels[r])
+
+    @staticmethod
+    def _latched_standing(ax: Any, res: Any) -> bool:
+        """A servo-on row with latched GT_GetSts flags (a limit switch or a stop that halted
+        it, waiting for GT_ClrSts): while its profile stands no stop reacts to them
+        (AxisResources._post), so the bank keeps them as they are (its GT_GetSts word carries
+        them) and gives the row back before a cycle that would latch one; a row whose soft
+        limit or following error is still exceeded would leave at once and stays scalar."""
+        if not res.profile.planner.done:
+            return False
+        s = res.safety
+        if s.active:
+            a = ax.prf_pos
+            if a > s.soft_positive or a < s.soft_negative:
+                return False
+            if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
+                return False
+        return True
 
     def _eligible_frozen(self, r: int) -> bool:
         """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
@@ -750,6 +773,13 @@ class AxisBank:
             changed = True
         if changed:
             self._reindex()
+        if self.n_alive == self.n:
+            self._wait = 1
+        else:
+            # rows left out: look again soon (a drive settling after a call: a few cycles),
+            # then less and less often (a row out for long costs a look every RECHECK_CYCLES)
+            self._countdown = min(self._wait, RECHECK_CYCLES)
+            self._wait = min(2 * self._wait, RECHECK_CYCLES)
         if missed and not self._missed:
             # an eligible drive had not yet taken (or sent) what the image holds: its next
             # scalar step does, so look again after it rather than RECHECK_CYCLES later
@@ -927,9 +957,9 @@ class AxisBank:
             self.t_len[r], self.t_end[r] = 1, 0
         ch = self.csp.channels[r]
         self.frz[r] = frozen = not ax.servo_on
-        # GT_GetSts's latched flags: a frozen row's stay as they are (_eligible_frozen), any
-        # other row has none
-        self.latched[r] = int(res.latched) if frozen else 0
+        # GT_GetSts's latched flags stay as they are while the row is in the bank
+        # (_eligible_frozen, _latched_standing)
+        self.latched[r] = int(res.latched)
         if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
             self._frozen[r] = (
                 tuple(getattr(ch, name) for name in FROZEN_ATTRS),
@@ -1107,6 +1137,7 @@ class AxisBank:
                 self._cluster_of.pop(gi, None)
             self.sampled[cl.rows] = False
         self.dirty = True
+        self._wait = 1
         # the image addresses and run lists follow at the next cycle (_reindex), not once per
         # release: a loop of GT calls over many axes releases one slave per call
         self._stale = True
@@ -1276,7 +1307,7 @@ class AxisBank:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
                 return [
-                    (_MOVING if m or j else _ARRIVED if a else 0) | (lt if f else _SERVO_ON)
+                    (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
                     for m, j, a, f, lt in zip(
                         self.moving.tolist(),
                         self.jog.tolist(),
@@ -1288,7 +1319,7 @@ class AxisBank:
                 ]
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | np.where(self.frz, self.latched, _SERVO_ON)).tolist()
+            return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             vel, acc = self._enc_rates()
             return (vel if name == "enc_vel" else acc).tolist()

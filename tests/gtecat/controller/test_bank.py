@@ -24,6 +24,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
+from gtecat.controller.bank import AxisBank
 from gtecat.controller.motion.jog import JogPlanner
 from tests.conftest import examples
 
@@ -360,6 +361,39 @@ def test_jog_ramps_and_reversals_run_in_the_bank(
         for k, (a, b) in enumerate(zip(ref, got, strict=True)):
             assert a == b, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
         assert steps[0] < scalar // 10, kernel
+
+
+def test_an_axis_standing_with_a_latched_flag_runs_in_the_bank(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An axis stopped by its soft limit, the limit then moved away (the flag stays latched
+    until GT_ClrSts): the bank runs it standing, its GT_GetSts word with the flag, cycle by
+    cycle as the scalar path."""
+    machine = _machine_file(tmp_path)
+    taken = [0]
+    standing = AxisBank._latched_standing
+
+    def counted(ax: object, res: object) -> bool:
+        ok = standing(ax, res)
+        taken[0] += ok
+        return ok
+
+    monkeypatch.setattr(AxisBank, "_latched_standing", staticmethod(counted))
+    actions = [
+        (0, ("soft", 3, 2000, -60_000)),
+        (200, ("move", 3, 20_000, 20.0, 1.0, 1.0, 0.0, 0)),
+        (120, ("soft", 3, 60_000, -60_000)),  # the cause is gone, the flag stays
+        (60, ("clear",)),
+    ]
+    ref, ref_codes, _ = _run(actions, machine, "off")
+    assert any(sample[0][2] & 0x20 for sample in ref[200:320])  # bit 5 latched
+    for kernel in ("c", "numpy"):
+        taken[0] = 0
+        got, codes, _ = _run(actions, machine, "on", kernel)
+        assert codes == ref_codes
+        for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+            assert a == b, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
+        assert taken[0] >= 1, kernel
 
 
 def test_gt_calls_release_and_the_bank_claims_again(tmp_path: Path) -> None:
