@@ -361,7 +361,7 @@ def run_service(client: SdoClient, service: int, ca: bool, size: int) -> None:
         assert isinstance(e.code, int)
 
 
-@settings(max_examples=examples(400, 100), deadline=None)
+@settings(max_examples=examples(400, 50), deadline=None)
 @given(
     st.lists(replies() | st.none(), max_size=12),
     st.integers(0, 1),
@@ -380,7 +380,7 @@ def test_any_replies_give_data_or_an_abort(
 MAX = 2048
 
 
-@settings(max_examples=examples(200, 60), deadline=None)
+@settings(max_examples=examples(200, 30), deadline=None)
 @given(
     st.integers(0, 2**32 - 1),
     st.binary(max_size=112),
@@ -408,7 +408,7 @@ def test_an_endless_segment_stream_always_ends(
     assert len(slave.requests) <= math.ceil(MAX / MIN_SEGMENT_DATA) + 2
 
 
-@settings(max_examples=examples(200, 60), deadline=None)
+@settings(max_examples=examples(200, 30), deadline=None)
 @given(replies(), st.integers(0, 1), st.booleans(), st.integers(0, 600))
 def test_one_reply_repeated_for_ever_ends(reply: bytes, service: int, ca: bool, size: int) -> None:
     slave = FakeSlave(then=lambda _m: reply)

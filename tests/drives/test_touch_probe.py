@@ -239,7 +239,7 @@ def test_manual_example_5_3_continuous_refresh_logic() -> None:
     assert tp.status & 0x7 == 0 and tp.values[0] == 7000
 
 
-@settings(max_examples=examples(200, 50), deadline=None)
+@settings(max_examples=examples(200, 25), deadline=None)
 @given(
     lo=st.floats(-1e6, 1e6),
     width=st.floats(0.01, 5000.0),
@@ -274,7 +274,7 @@ windows_st = st.lists(
 )
 
 
-@settings(max_examples=examples(300, 75), deadline=None)
+@settings(max_examples=examples(300, 38), deadline=None)
 @given(windows=windows_st, p0=st.floats(-100, 100), p1=st.floats(-100, 100))
 def test_window_edges_replay_the_sampled_levels(windows, p0, p1) -> None:
     merged = merge_windows(windows)

@@ -461,7 +461,7 @@ def test_the_property_sees_every_family() -> None:
 
 
 @settings(
-    max_examples=examples(300, 60), deadline=None, suppress_health_check=[HealthCheck.too_slow]
+    max_examples=examples(300, 30), deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 @given(st.sampled_from(sorted(_TEXTS)), st.data())
 def test_mutated_numbers_give_a_layout_or_an_eni_error(name: str, data: st.DataObject) -> None:

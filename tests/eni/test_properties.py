@@ -91,7 +91,7 @@ def configs(draw: st.DrawFn) -> EniConfig:
     return cfg
 
 
-@settings(max_examples=examples(150, 40), deadline=None)
+@settings(max_examples=examples(150, 20), deadline=None)
 @given(configs())
 def test_layout_regions_contiguous_disjoint_and_entries_inside(cfg: EniConfig) -> None:
     layout = build_layout(cfg)

@@ -215,7 +215,7 @@ def test_malformed_frames_are_dropped_and_counted() -> None:
 commands = st.sampled_from(list(Command))
 
 
-@settings(max_examples=examples(300, 80), deadline=None)
+@settings(max_examples=examples(300, 40), deadline=None)
 @given(
     st.lists(
         st.builds(
@@ -245,7 +245,7 @@ def test_any_well_formed_frame_is_answered_and_nothing_raises(dgs: list[Datagram
     assert [d.command for d in back] == [d.command for d in dgs]
 
 
-@settings(max_examples=examples(300, 80), deadline=None)
+@settings(max_examples=examples(300, 40), deadline=None)
 @given(st.binary(min_size=0, max_size=200))
 def test_garbage_never_raises(raw: bytes) -> None:
     chain = mini_chain(2)

@@ -78,7 +78,7 @@ def test_walker_agrees_with_the_codec(dgs: list[Datagram]) -> None:
         assert struct.unpack_from("<H", raw, off + 6)[0] & 0x07FF == len(d.data)
 
 
-@settings(max_examples=examples(300, 80), deadline=None)  # a loaded CI box must not make it flaky
+@settings(max_examples=examples(300, 40), deadline=None)  # a loaded CI box must not make it flaky
 @given(frames, st.data())
 def test_truncated_frames_are_rejected_by_both(dgs: list[Datagram], data: st.DataObject) -> None:
     raw = encode_frame(dgs, pad=False)
@@ -89,7 +89,7 @@ def test_truncated_frames_are_rejected_by_both(dgs: list[Datagram], data: st.Dat
         decode_frame(short)
 
 
-@settings(max_examples=examples(500, 100), deadline=None)
+@settings(max_examples=examples(500, 50), deadline=None)
 @given(frames, st.data())
 def test_corrupted_frames_never_crash_and_both_agree(
     dgs: list[Datagram], data: st.DataObject

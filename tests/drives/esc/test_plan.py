@@ -135,7 +135,7 @@ cyclic_ops = st.one_of(
 )
 
 
-@settings(max_examples=examples(120, 40), deadline=None)
+@settings(max_examples=examples(120, 20), deadline=None)
 @given(st.lists(cyclic_ops, min_size=1, max_size=40))
 @pytest.mark.long
 def test_repeated_cyclic_frames_agree_with_the_general_path(sequence: list) -> None:

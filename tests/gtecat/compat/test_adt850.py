@@ -423,7 +423,7 @@ _VALUES = st.one_of(
 
 
 @settings(
-    max_examples=examples(150, 37),
+    max_examples=examples(150, 15),
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture],
 )

@@ -219,7 +219,7 @@ _ANY = st.one_of(st.integers(-(2**40), 2**40), st.floats(allow_nan=True), st.non
 
 
 @settings(
-    max_examples=examples(150, 37),
+    max_examples=examples(150, 15),
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture],
 )

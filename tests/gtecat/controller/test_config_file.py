@@ -230,7 +230,7 @@ def mutate(lines: list[str], mutations) -> list[str]:
     return out
 
 
-@settings(max_examples=examples(200, 50), deadline=None)
+@settings(max_examples=examples(200, 25), deadline=None)
 @given(st.sampled_from(FIXTURES), st.lists(_mutation, min_size=1, max_size=3))
 def test_mutated_fixtures_parse_or_fail_with_file_and_line(name, mutations):
     path = SHARED_FIXTURES / "googol" / name

@@ -101,7 +101,7 @@ def _value(o):
 
 
 @settings(
-    max_examples=examples(150, 37),
+    max_examples=examples(150, 19),
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.function_scoped_fixture],

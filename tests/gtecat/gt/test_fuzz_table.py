@@ -67,7 +67,9 @@ LONG = int(os.environ.get("GTECAT_LONG", "0") or 0)
 EXAMPLES = 15 * LONG if LONG else 1  # per GT_/GTE_ function
 TWIN_EXAMPLES = 8 * LONG if LONG else 1  # per GTN_ twin: the same code, mostly the core is new
 BATCH_TIMEOUT_S = 900 * LONG if LONG else 150  # a backstop: each call has its own 10 s alarm
-CALL_BATCHES = 2  # one per xdist worker (a child costs about 1 s before its first call)
+# GTECAT_LONG: one child per xdist worker; the default run's sample fits one (a child costs
+# about 1 s of CPU before its first call)
+CALL_BATCHES = 2 if LONG else 1
 
 
 #: declared-only functions fuzzed in a plain run (a seeded sample); GTECAT_LONG=1: every one

@@ -104,3 +104,31 @@ def test_csrc_is_package_data():
     root = Path(__file__).resolve().parents[3]
     cfg = tomllib.loads((root / "pyproject.toml").read_text())
     assert "native/csrc/*" in cfg["tool"]["setuptools"]["package-data"]["gtecat"]
+
+
+def test_every_declared_only_function_names_itself_and_answers_8(libgts):
+    """Each declared-only export of libgts (the assembled ones on x86-64 Linux, the C
+    bodies elsewhere) reaches ``gte_declared`` with its own table index and face: called
+    with no controller it answers 8 and ``GTE_GetLastError`` names that very function."""
+    import ctypes
+
+    from gtecat.native.protocol import plans
+
+    lib = ctypes.CDLL(str(libgts.library))
+    lib.GTE_GetLastError.argtypes = [ctypes.c_char_p, ctypes.c_short]
+    buf = ctypes.create_string_buffer(512)
+    names = []
+    for p in plans():
+        if p.declared:
+            names += [p.name, p.proto.twin_name] if p.proto.gtn else [p.name]
+    assert len(names) > 3000
+    wrong = []
+    for name in names:
+        fn = getattr(lib, name)
+        fn.restype = ctypes.c_short
+        rc = fn()
+        lib.GTE_GetLastError(buf, len(buf))
+        if rc != 8 or not buf.value.decode().startswith(f"{name} returned 8: {name} is declared"):
+            wrong.append((name, rc, buf.value.decode()))
+    assert not wrong, wrong[:5]
+    assert build.declared_units(build.compiler())  # the units of this machine's build

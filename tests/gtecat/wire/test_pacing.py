@@ -128,7 +128,7 @@ def test_periods_outside_the_predicted_range_are_left_to_poll() -> None:
         assert p.window() is None
 
 
-@settings(max_examples=examples(200, 50), deadline=None, derandomize=True)
+@settings(max_examples=examples(200, 25), deadline=None, derandomize=True)
 @given(
     period=st.integers(100_000, 20_000_000),
     jitter=st.lists(st.integers(-20_000, 20_000), min_size=STEADY_AFTER + 2, max_size=60),

@@ -13,7 +13,7 @@ from gtecat.controller.motion.trap_table import advance, trap_table
 from tests.conftest import examples
 
 
-@settings(max_examples=examples(150, 37), deadline=None, derandomize=True)
+@settings(max_examples=examples(150, 19), deadline=None, derandomize=True)
 @given(
     start=st.floats(-1e5, 1e5),
     target=st.integers(-200_000, 200_000),
