@@ -622,8 +622,9 @@ class AxisBank:
         (AxisResources._post), so the bank keeps them as they are (its GT_GetSts word carries
         them) and gives the row back before a cycle that would latch one; a row whose soft
         limit or following error is still exceeded would leave at once and stays scalar."""
-        if not res.profile.planner.done:
-            return False
+        prof = res.profile
+        if prof.mode not in (PrfMode.TRAP, PrfMode.JOG) or not prof.planner.done:
+            return False  # (a Gear or Follow slave may start with its master, no call on it)
         s = res.safety
         if s.active:
             a = ax.prf_pos
