@@ -365,12 +365,17 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if card_refused and ctl.card is not None:  # an EtherCAT function on a card
                     raise CommandError(ctl.card.refusal(name))
                 bank = ctl.bank
-                if bank is not None and not bank_read:
-                    bank.before_call(ctl, proto, values)  # the axes it names go back first
                 if ctl.clock._thread is not None:
-                    with ctl.clock.lock:  # atomic with respect to the cycle thread
+                    # atomic with respect to the cycle thread, the bank's release included:
+                    # given back while a cycle steps the bank, an axis's objects would miss
+                    # that cycle or get it twice
+                    with ctl.clock.lock:
+                        if bank is not None and not bank_read:
+                            bank.before_call(ctl, proto, values)
                         rc = fn(ctl, *values, **extra)
                 else:
+                    if bank is not None and not bank_read:
+                        bank.before_call(ctl, proto, values)  # the axes it names go back first
                     rc = fn(ctl, *values, **extra)
             else:
                 rc = fn(*values, **extra)

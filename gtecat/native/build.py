@@ -240,16 +240,12 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
         if build.base is not None:  # libgts_mc: one unit over libgts
             units = [(["gts_multicard.c"], (*CFLAGS, *STUB_CFLAGS))]
             link = [*build.base.libs(), "-ldl"]
-        procs = []
-        for names, flags in units:
-            for name in names:
-                cmd = [*cc, *flags, "-c", *inside, str(src / name)]
-                cmd += ["-o", str(src / object_name(name))]
-                procs.append((cmd, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
-        for cmd, proc in procs:
-            _, err = proc.communicate()
-            _check(cmd, proc.returncode, err)
-        objs = [str(src / object_name(n)) for names, _ in units for n in names]
+        objs = compile_units(
+            [(name, flags) for names, flags in units for name in names],
+            [*cc, *inside],
+            src,
+            "libgts",
+        )
         cmd = [
             *cc,
             *CFLAGS,
@@ -270,9 +266,27 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             shutil.rmtree(tmp)
 
 
-def object_name(source: str) -> str:
-    """``x.c`` / ``x.S`` -> ``x.o``."""
-    return source.rsplit(".", 1)[0] + ".o"
+def compile_units(
+    units: list[tuple[str, tuple[str, ...]]], base: list[str], folder: Path, what: str
+) -> list[str]:
+    """Compile each ``(source, flags)`` of ``folder`` into its object beside it, side by
+    side (``base``: the compiler and the flags every unit takes); the objects' paths.
+    NativeBuildError naming ``what`` when a unit fails or warns (a warning is a defect of
+    the generated sources)."""
+    procs = []
+    for name, flags in units:
+        obj = folder / (name.rsplit(".", 1)[0] + ".o")
+        cmd = [*base, *flags, "-c", str(folder / name), "-o", str(obj)]
+        procs.append((cmd, obj, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
+    errors = []
+    for cmd, _, proc in procs:
+        _, err = proc.communicate()
+        if proc.returncode != 0 or err.strip():
+            word = "failed" if proc.returncode else "warned (it must not)"
+            errors.append(f"building {what} {word} ({shlex.join(cmd)}):\n{err.strip()}")
+    if errors:
+        raise NativeBuildError(errors[0])
+    return [str(obj) for _, obj, _ in procs]
 
 
 def _check(cmd: list[str], returncode: int, stderr: str) -> None:
@@ -286,6 +300,7 @@ __all__ = [
     "Build",
     "NativeBuildError",
     "cache_root",
+    "compile_units",
     "compiler",
     "ensure_built",
     "multicard_sources",

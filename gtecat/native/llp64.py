@@ -242,25 +242,7 @@ def _compile(
             *_build.declared_units(cc, extra),
         )
         what = soname if not extra else f"the 32-bit {soname} ({' '.join(extra)})"
-        procs = []
-        for name, flags in units:
-            cmd = [
-                *base,
-                *flags,
-                "-c",
-                str(tmp / name),
-                "-o",
-                str(tmp / _build.object_name(name)),
-            ]
-            procs.append((cmd, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
-        for cmd, proc in procs:
-            _, err = proc.communicate()
-            if proc.returncode != 0 or err.strip():
-                word = "failed" if proc.returncode else "warned (it must not)"
-                raise NativeBuildError(
-                    f"building {what} {word} ({shlex.join(cmd)}):\n{err.strip()}"
-                )
-        objs = [str(tmp / _build.object_name(name)) for name, _ in units]
+        objs = _build.compile_units(list(units), base, tmp, what)
         cmd = [
             *cc,
             *extra,

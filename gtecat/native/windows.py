@@ -154,26 +154,7 @@ def _compile(build: WindowsBuild, files: dict[str, str], cc: list[str]) -> None:
             ("gts_stubs.c", (*CFLAGS, *_build.STUB_CFLAGS)),
             ("gts_declared.c", (*CFLAGS, *_build.STUB_CFLAGS)),
         ]
-        procs = []
-        for name, flags in units:
-            cmd = [
-                *cc,
-                *flags,
-                "-c",
-                f"-I{tmp}",
-                str(tmp / name),
-                "-o",
-                str(tmp / (name[:-2] + ".o")),
-            ]
-            procs.append((cmd, subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)))
-        for cmd, proc in procs:
-            _, err = proc.communicate()
-            if proc.returncode != 0 or err.strip():
-                word = "failed" if proc.returncode else "warned (it must not)"
-                raise NativeBuildError(
-                    f"building {what} {word} ({shlex.join(cmd)}):\n{err.strip()}"
-                )
-        objs = [str(tmp / (n[:-2] + ".o")) for n, _ in units]
+        objs = _build.compile_units(units, [*cc, f"-I{tmp}"], tmp, what)
         names = export_names(files)
         decorated = _decorated(build.target, cc, objs) if build.target == "x86" else {}
         missing = [n for n in names if build.target == "x86" and n not in decorated]
