@@ -102,8 +102,8 @@ def _ok(rc: int, what: str, core: int = 1) -> None:
     if core > 1 and f"core {core}" in reason:
         raise CoreUnavailable(
             f"{what}: {reason} - bus axes beyond {AXES_PER_CORE} are reached through "
-            f"core {core} (GTN_*({core}, axis)), which this controller does not offer yet "
-            "(issue 17 item 4); nothing was measured"
+            f"core {core} (GTN_*({core}, axis)), which this controller does not offer"
+            "; nothing was measured"
         )
     raise BenchError(f"{what}: {reason}")
 

@@ -122,6 +122,9 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: GT functions whose implementations read a claimed axis through the bank itself, or touch
 #: no axis object at all (the process image, the clock: a raw write to a claimed slave's
 #: outputs is seen by the bank's next cycle, which gives the slave back first)
+#: function -> whether it takes a ``count`` of axes (AxisBank.before_call)
+_COUNTED: dict[str, bool] = {}
+
 BANK_READS = frozenset(
     {
         "GT_GetSts",
@@ -1224,7 +1227,10 @@ class AxisBank:
                     return
                 values = (m & axis_bits, *values[1:])  # the axes of the mask, below
         if params and params[0].name in ("axis", "profile", "encoder") and values:
-            if not any(p.name == "count" for p in params):
+            counted = _COUNTED.get(proto.name)
+            if counted is None:  # (a function's parameters do not change: asked once)
+                counted = _COUNTED[proto.name] = any(p.name == "count" for p in params)
+            if not counted:
                 n = values[0]
                 ax = ctl.axes.get(n) if type(n) is int else None
                 if ax is not None:
