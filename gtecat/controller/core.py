@@ -351,8 +351,6 @@ class Controller:
         (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
         one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
         cycles run, 0 when the next one must go through :meth:`_cycle`."""
-        if self._run_axes:
-            return 0
         bank = self.bank
         if (
             bank is None
@@ -363,6 +361,10 @@ class Controller:
             or self._links_down
             or self.clock._run_cycle != self._cycle
         ):
+            return 0
+        if bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n):
+            bank.settle()  # what the next cycle does first: claim axes given back
+        if self._run_axes:
             return 0
         n = min(n, self.BATCH_CYCLES)
         for f in self.pre_cycle:

@@ -49,6 +49,7 @@
     X(soft_pos, f64) X(soft_neg, f64) X(pos_err, f64) X(band, f64) X(hold_ns, i64)         \
     X(since, i64) X(arrived, u8) X(a_last, f64)                                            \
     X(jrp, f64) X(jrv, f64) X(jp, f64) X(jv, f64) X(ja, f64) X(tau, f64) X(jE, f64)        \
+    X(jgoal, f64) X(jacc, f64) X(jdec, f64)                                                \
     X(c_pos, f64) X(c_vel, f64) X(c_acc, f64) X(c_dpos, f64) X(c_dvel, f64)                \
     X(c_fe_time, f64) X(c_limited, u8) X(c_sw_limited, u8) X(c_start, i64) X(c_din, i64)   \
     X(c_target, i64) X(c_vmax, f64) X(c_e, f64) X(c_c, f64) X(c_lim, f64) X(c_off, i64)   \
@@ -393,6 +394,74 @@ CLONES int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const dou
     return n;
 }
 
+/* gtecat.controller.motion.jog.ramp_step (advance, then the snap onto the goal) for a jog
+ * whose raw speed is not at its goal: the raw ramp in constant-acceleration pieces, a ramp
+ * end inside the cycle split there, each piece through the smoothing filter; the same
+ * operations in the same order (exp is the C library's, as Python's math.exp).
+ * o[0..4] = raw position, raw speed, output position, speed, acceleration. */
+static void jog_ramp(double p, double v, double goal, double acc, double dec, double dt,
+                     double tau, double fp, double fv, double fa, double *o)
+{
+    for (;;) {
+        double a, h, rate, aim = 0.0;
+        int reached;
+        if (v == goal) {
+            a = 0.0;
+            h = dt;
+            reached = 0;
+        } else {
+            if (v == 0.0 || ((v > 0.0) == (goal > 0.0) && fabs(goal) > fabs(v))) {
+                rate = acc; /* speeding up (from rest or in the same direction) */
+                aim = goal;
+            } else if ((v > 0.0) == (goal > 0.0) && goal != 0.0) {
+                rate = dec; /* slowing down to a lower speed */
+                aim = goal;
+            } else {
+                rate = dec; /* braking to reverse or to stop */
+                aim = 0.0;
+            }
+            a = aim > v ? rate : -rate;
+            h = (aim - v) / a;
+            reached = h <= dt;
+            if (!reached)
+                h = dt;
+        }
+        if (h > 0.0) {
+            const double p1 = p + h * (v + 0.5 * a * h);
+            const double v1 = v + a * h;
+            if (tau > 0.0) {
+                const double e = exp(-h / tau);
+                const double ta = tau * a;
+                fp = p1 - tau * (v1 - ta) + (fp - p + tau * (v - ta)) * e;
+                fv = v1 - ta + (fv - v + ta) * e;
+                fa = a + (fa - a) * e;
+            }
+            p = p1;
+            v = reached ? aim : v1;
+            dt -= h;
+        } else if (reached) {
+            v = aim;
+        }
+        if (!reached) {
+            if (tau <= 0.0) {
+                fp = p;
+                fv = v;
+                fa = a;
+            }
+            if (v == goal && fv != goal && fabs(fv - goal) <= 1e-9 * (1.0 + fabs(goal))) {
+                fv = goal;
+                fa = 0.0;
+            }
+            o[0] = p;
+            o[1] = v;
+            o[2] = fp;
+            o[3] = fv;
+            o[4] = fa;
+            return;
+        }
+    }
+}
+
 /* AxisBank._refill of row r in the kernel: the last sample taken moves to the row's spare
  * slot (TABLE), so a declined cycle still finds it; 0, or 1 when the row's pieces are not
  * here (the caller refills it) */
@@ -574,7 +643,12 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             }
             prf = F64(t_p)[I64(base)[r] + cur];
             ended = cur == I64(t_end)[r];
-            if (U8(jog)[r]) { /* AxisBank._jog_step */
+            if (U8(jog)[r] && F64(jrv)[r] != F64(jgoal)[r]) { /* a ramp: jog.ramp_step */
+                double *o = F64(s_jog) + 5 * r;
+                jog_ramp(F64(jrp)[r], F64(jrv)[r], F64(jgoal)[r], F64(jacc)[r], F64(jdec)[r], h,
+                         F64(tau)[r], F64(jp)[r], F64(jv)[r], F64(ja)[r], o);
+                prf = o[2];
+            } else if (U8(jog)[r]) { /* AxisBank._jog_step */
                 double rp = F64(jrp)[r], jv = F64(jrv)[r], fp_ = F64(jp)[r], fv = F64(jv)[r];
                 double fa = F64(ja)[r], tau = F64(tau)[r], e = F64(jE)[r];
                 double p1 = rp + h * (jv + 0.5 * 0.0 * h);
