@@ -1351,8 +1351,8 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
 /* Up to io[IN_MAXC] cycles from io[IN_T_NS], io[IN_DT_NS] apart; io[OUT_DONE] = cycles
  * committed.  Stops after a cycle that ended a Trap move (io[OUT_FIN]) and before one the
  * kernel declines (its code is returned, nothing of that cycle written).  Without a homing
- * row, ROWS_FROM cycles and more run row by row (run_rows), the image written once after the
- * last. */
+ * row or a ramping jog, ROWS_FROM cycles and more run row by row (run_rows), the image written
+ * once after the last. */
 int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
 {
     void *lp[N_FIELDS];
@@ -1364,9 +1364,11 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
     io[OUT_DONE] = 0;
     io[OUT_FIN] = 0;
     {
-        const uint8_t *alive = U8(alive), *frz = U8(frz), *hm = U8(hm);
+        const uint8_t *alive = U8(alive), *frz = U8(frz), *hm = U8(hm), *jog = U8(jog);
+        /* a homing row, or a jog whose raw speed still ramps to its goal (jog.ramp_step:
+         * row_cycles steps a cruising jog only), runs cycle by cycle */
         for (r = 0; r < n; r++)
-            if (alive[r] && !frz[r] && hm[r])
+            if (alive[r] && !frz[r] && (hm[r] || (jog[r] && F64(jrv)[r] != F64(jgoal)[r])))
                 rows = 0;
     }
     if (rows && maxc >= ROWS_FROM) {
