@@ -1,4 +1,4 @@
-"""gtecat benchmarks: prints one JSON object with every figure the issues ask for.
+"""gtecat benchmarks: prints one JSON object with every figure and its target.
 
     python3 tools/bench.py                  # all
     python3 tools/bench.py --quick          # fewer repetitions
@@ -29,13 +29,14 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_long, c_ubyte
+from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from dataclasses import replace
 from pathlib import Path
 
@@ -180,8 +181,11 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
     mv8 = memoryview(bytearray(8))
     out2 = bytes([0x0F, 0x00])
     sts, raw_get, raw_set = gt.GT_GetSts, gt.GT_GetEcatRawData, gt.GT_SetEcatRawData
-    io_read = gt.GT_EcatIOReadInput
+    io_read, io_write = gt.GT_EcatIOReadInput, gt.GT_EcatIOWriteOutput
     np1 = np.zeros(1, np.int32)
+    arr1 = (c_long * 1)()
+    held_d = c_double()
+    pd = byref(held_d)
     shapes = {
         # shape: (the call, building its arguments)
         "GT_GetSts(1, byref(s))": (lambda: sts(1, p), lambda: byref(c_long())),
@@ -190,8 +194,20 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             lambda: byref(c_long()),
         ),
         "GT_GetSts(1, byref(s), 1, 0)": (lambda: sts(1, p, 1, 0), lambda: byref(c_long())),
+        "GT_GetSts(1, byref(s), 1, None)": (
+            lambda: sts(1, p, 1, None),
+            lambda: byref(c_long()),
+        ),
         "GT_GetSts(1, s)": (lambda: sts(1, held), lambda: c_long()),
+        "GT_GetSts(1, c_long[1])": (lambda: sts(1, arr1), lambda: (c_long * 1)()),
         "GT_GetSts(1, numpy int32[1])": (lambda: sts(1, np1), lambda: np.zeros(1, np.int32)),
+        "GT_GetPrfPos(1, byref(d))": (lambda: gt.GT_GetPrfPos(1, pd), lambda: byref(c_double())),
+        "GT_GetPrfMode(1, byref(s))": (lambda: gt.GT_GetPrfMode(1, p), lambda: byref(c_long())),
+        "GT_GetClock(byref(s))": (lambda: gt.GT_GetClock(p), lambda: byref(c_long())),
+        "GT_GetEcatEncPos(1, byref(s))": (
+            lambda: gt.GT_GetEcatEncPos(1, p),
+            lambda: byref(c_long()),
+        ),
         "GTN_GetSts(1, 1, byref(s))": (lambda: gt.GTN_GetSts(1, 1, p), lambda: byref(c_long())),
         "GT_GetEcatRawData(0, 8, c_ubyte[8])": (
             lambda: raw_get(0, 8, buf8),
@@ -211,12 +227,37 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             lambda: io_read(2, 0, 4, buf8),
             lambda: (c_ubyte * 8)(),
         ),
+        "GT_EcatIOReadInput(2, 0, 4, bytearray)": (
+            lambda: io_read(2, 0, 4, ba8),
+            lambda: bytearray(8),
+        ),
+        "GT_EcatIOWriteOutput(2, 0, 2, bytes)": (
+            lambda: io_write(2, 0, 2, out2),
+            lambda: bytes([15, 0]),
+        ),
+    }
+    # the table path (every other function: its checks compiled, then the emulated function's
+    # own work, which these figures include): reported beside the fast path's, not in `worst`
+    trap = gt.TTrapPrm()
+    short = c_short()
+    ps = byref(short)
+    table = {
+        "GT_GetTrapPrm(1, byref(TTrapPrm))": (
+            lambda: gt.GT_GetTrapPrm(1, byref(trap)),
+            lambda: byref(gt.TTrapPrm()),
+        ),
+        "GT_GetEcatHomingStatus(1, byref(s))": (
+            lambda: gt.GT_GetEcatHomingStatus(1, ps),
+            lambda: byref(c_short()),
+        ),
+        "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
     }
     clock, rng = time.perf_counter, range(block)
     out: dict[str, object] = {}
-    worst = 0.0
-    per = seconds / len(shapes)
-    for name, (call, build) in shapes.items():
+    table_out: dict[str, object] = {}
+    worst = table_worst = 0.0
+    per = seconds / (len(shapes) + len(table))
+    for name, (call, build) in [*shapes.items(), *table.items()]:
         calls, args = [], []
         t_end = clock() + per
         while clock() < t_end:
@@ -231,10 +272,15 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             calls.append((t2 - t1) / block)
         c_us, a_us = statistics.median(calls) * 1e6, statistics.median(args) * 1e6
         ratio = round(c_us / a_us, 2)
-        worst = max(worst, ratio)
-        out[name] = {"call_us": round(c_us, 3), "argument_us": round(a_us, 3), "ratio": ratio}
+        row = {"call_us": round(c_us, 3), "argument_us": round(a_us, 3), "ratio": ratio}
+        if name in table:
+            table_worst = max(table_worst, ratio)
+            table_out[name] = row
+        else:
+            worst = max(worst, ratio)
+            out[name] = row
     gt.GT_Close()
-    return {"shapes": out, "worst": worst}
+    return {"shapes": out, "worst": worst, "table_path": table_out, "table_worst": table_worst}
 
 
 def _rss() -> dict[str, float]:
@@ -269,15 +315,16 @@ def rss_child(n: int, seconds: float, eni: str = "") -> int:
     return 0
 
 
-def _child(args: list[str]) -> dict[str, object]:
-    """Run this script with ``args`` in a fresh process: its last JSON line, with the
-    process's wall and CPU seconds from spawn to exit."""
+def _child(args: list[str], env: Mapping[str, str] | None = None) -> dict[str, object]:
+    """Run this script with ``args`` in a fresh process (``env``: its environment): its last
+    JSON line, with the process's wall and CPU seconds from spawn to exit (the CPU of the
+    processes it waited for included: a compiler it ran)."""
     import resource
 
     cmd = [sys.executable, __file__, *args]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600)
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
@@ -345,15 +392,58 @@ def bringup_child(eni: str) -> int:
     return 0
 
 
-def bench_bringup(n: int) -> dict[str, object]:
+COLD = (
+    "cold: a new, empty gtecat cache folder (GTECAT_CACHE_DIR) and no bytecode written by Python"
+    " (PYTHONDONTWRITEBYTECODE=1), as the first run on a fresh machine: the ENI parsed, gtecat's"
+    " modules compiled from source, the bank's C kernel built (its compiler's CPU counted)"
+)
+WARM = "warm: the same cache folder after one such run (the ENI's model, modules, kernel kept)"
+
+
+def bench_bringup(n: int, warm: bool = True) -> dict[str, object]:
     """A fresh process taking an ``n``-axis bus (written beforehand) to OP: the process's
-    wall and CPU seconds from spawn to exit (Python start and imports included)."""
+    wall and CPU seconds from spawn to exit (Python start and imports included), on a cold
+    cache (the figure); ``warm``: then again on the cache that run left, reported beside."""
     from tools.gen_axes_eni import write_axes_eni
 
     with tempfile.TemporaryDirectory() as tmp:
         eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
-        r = _child(["--bringup-child", str(eni)])
-    return {"axes": n, **r}
+        env = {**os.environ, "GTECAT_CACHE_DIR": str(Path(tmp) / "cache")}
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
+        env.pop("GTECAT_ENI_CACHE", None)
+        env.pop("GTECAT_PYC_CACHE", None)
+        r = _child(["--bringup-child", str(eni)], env)
+        out: dict[str, object] = {"axes": n, "cache": COLD, **r}
+        if warm and "error" not in r:
+            w = _child(["--bringup-child", str(eni)], env)
+            keep = ("process_wall_s", "process_cpu_s", "to_op_s", "import_s", "error")
+            out["warm"] = {"cache": WARM, **{k: v for k, v in w.items() if k in keep}}
+    return out
+
+
+def bench_bringup_growth(counts: Sequence[int] = (256, 512, 1024, 2048)) -> dict[str, object]:
+    """Bring-up on a cold cache at each axis count (:func:`bench_bringup`, ``counts``
+    doubling): whole-process CPU seconds, the CPU each step adds per axis it adds
+    (``ms_cpu_per_added_axis``: what is paid once, such as Python's start and the kernel's
+    build, drops out), and ``growth``: the last step's over the first's (1.0: linear)."""
+    rows: dict[str, object] = {}
+    cpus: list[float] = []
+    steps: list[float] = []
+    for k, n in enumerate(counts):
+        r = bench_bringup(n, warm=False)
+        if "error" in r:
+            return {"error": f"{n} axes: {r['error']}"}
+        cpus.append(float(r["process_cpu_s"]))  # type: ignore[arg-type]
+        row = {"process_wall_s": r["process_wall_s"], "process_cpu_s": r["process_cpu_s"]}
+        if k:
+            steps.append((cpus[k] - cpus[k - 1]) / (n - counts[k - 1]))
+            row["ms_cpu_per_added_axis"] = round(1000 * steps[-1], 3)
+        rows[str(n)] = row
+    return {
+        "cache": COLD,
+        "axes": rows,
+        "growth": round(steps[-1] / steps[0], 2) if len(steps) > 1 and steps[0] > 0 else None,
+    }
 
 
 GEAR = "per core: the first axis in Trap, the others in Gear on it (1:2)"
@@ -477,6 +567,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "bringup_1024_axes_to_op": lambda: _figure(
             bench_bringup(1024), "process_wall_s", 6.0, at_most=True
         ),
+        "bringup_growth": lambda: _figure(bench_bringup_growth(), "growth", 1.5, at_most=True),
     }
     unknown = sorted(set(only) - set(figures))
     if unknown:
@@ -489,12 +580,11 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument(
-        "--targets", "--issue17", action="store_true", help="only the many-axes figures"
-    )
-    ap.add_argument("--seconds", type=float, help="wall seconds per issue-17 figure (1.5)")
+    ap = argparse.ArgumentParser(description="Every benchmark figure, as one JSON object.")
+    ap.add_argument("--quick", action="store_true", help="shorter windows (noisier figures)")
+    ap.add_argument("--targets", action="store_true", help="only the many-axes figures")
+    ap.add_argument("--issue17", dest="targets", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--seconds", type=float, help="wall seconds per many-axes figure (1.5)")
     ap.add_argument("--repeat", type=int, default=3, help="windows per real-time factor")
     ap.add_argument("--rss-child", type=int, metavar="AXES", help=argparse.SUPPRESS)
     ap.add_argument("--eni", default="", help=argparse.SUPPRESS)

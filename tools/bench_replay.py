@@ -19,8 +19,13 @@ in turn): before and after in one run.  The CPU time a process gets done per sec
 what else the machine runs: ``reference_12_axes_trap_one_cycle_at_a_time`` measures, in the same
 run, a figure docs/performance.md took on a lightly loaded machine (219 times real time).
 
+``--rich`` records and replays tools/session_rich.py's session instead: an application that
+meets trouble (axis 1 homes, axis 2 jogs with a slow ramp and reverses every 3 s, Trap moves
+on the others, SDO reads, the drive of axis 5 faults at 20 s for 5 s and the application
+brings it back, the limit switch of axis 6 chatters at 30 s for 300 ms).
+
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
-                                 [--simple] [--json]
+                                 [--simple | --rich] [--json]
 """
 
 from __future__ import annotations
@@ -199,24 +204,36 @@ def replay_in(root: Path, path: Path) -> tuple[float, float, int, str | None]:
 
 
 def measure(
-    seconds: float, poll_ms: int, repeat: int, against: Path | None = None, simple: bool = False
+    seconds: float,
+    poll_ms: int,
+    repeat: int,
+    against: Path | None = None,
+    simple: bool = False,
+    rich: bool = False,
 ) -> dict[str, object]:
-    from gtecat import gt
+    from gtecat import faults, gt
     from gtecat.faults.record import Recorder, replay
+    from tools import session_rich
+
+    def run_session(machine: Path) -> None:
+        if rich:
+            session_rich.session(gt, faults, seconds, str(machine))
+        else:
+            session(gt, seconds, poll_ms, str(machine), simple)
 
     with tempfile.TemporaryDirectory() as tmp:
         machine = Path(tmp) / "machine.toml"
-        machine.write_text(MACHINE)
+        machine.write_text(session_rich.MACHINE if rich else MACHINE)
         path = Path(tmp) / "session.gtrec"
         plain = []
         for _ in range(repeat):
             t0, c0 = time.perf_counter(), time.process_time()
-            session(gt, seconds, poll_ms, str(machine), simple)
+            run_session(machine)
             plain.append((time.perf_counter() - t0, time.process_time() - c0))
         rec = Recorder(path).start()
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            session(gt, seconds, poll_ms, str(machine), simple)
+            run_session(machine)
         finally:
             rec.stop()
         recorded = (time.perf_counter() - t0, time.process_time() - c0)
@@ -249,9 +266,9 @@ def measure(
     wall, cpu = _best(runs)
     pw, pc = _best(plain)
     return {
-        "session": "simple" if simple else "full",
+        "session": "rich" if rich else "simple" if simple else "full",
         "virtual_s": seconds,
-        "poll_ms": poll_ms,
+        "poll_ms": 10 if rich else poll_ms,
         "load_average": round(os.getloadavg()[0], 2),
         "calls": n,
         "session_wall_s": round(pw, 3),
@@ -280,14 +297,23 @@ def main() -> int:
         type=Path,
         help="another checkout: replay the same recording with its gtecat too (before/after)",
     )
-    ap.add_argument(
+    kind = ap.add_mutually_exclusive_group()
+    kind.add_argument(
         "--simple",
         action="store_true",
         help="Trap moves and status polling only (no homing, jog, IO)",
     )
+    kind.add_argument(
+        "--rich",
+        action="store_true",
+        help="the session that meets trouble: a jog's ramps, a drive fault and its recovery, "
+        "a chattering limit switch, SDO reads (tools/session_rich.py)",
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    out = measure(args.seconds, args.poll_ms, max(1, args.repeat), args.against, args.simple)
+    out = measure(
+        args.seconds, args.poll_ms, max(1, args.repeat), args.against, args.simple, args.rich
+    )
     print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
     return 0 if out["diverged"] is None else 1
 

@@ -2,9 +2,10 @@
 
 Per axis and cycle the scalar objects cost 15-25 µs of Python (planner, axis layer,
 drive state machine, mechanics, PDO codec, status and limit checks).  Most axes of a
-machine spend most cycles in one state: servo on, drive in CSP, Trap move or holding,
-no flag latched.  :class:`AxisBank` runs exactly that state for every such axis at
-once - the Trap samples (:func:`~gtecat.controller.motion.trap_table.trap_table`), the
+machine spend most cycles in one state: servo on, drive in CSP, Trap move, Jog (at speed
+or ramping toward one) or holding, no flag latched.  :class:`AxisBank` runs exactly that
+state for every such axis at once - the Trap samples
+(:func:`~gtecat.controller.motion.trap_table.trap_table`), the Jog's ramp, the
 axis layer's 607Ah, the drive (:class:`gtecat.drives.csp_bank.CspBank`), the encoder, the soft
 and hardware limits, the following error, the in-position band and the GT_GetSts word -
 and reads/writes the process image as array views.
@@ -80,6 +81,7 @@ from .crd.system import Delay, Motion
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
+from .motion.jog import ramp_step as jog_ramp_step
 from .motion.stop import StopKind
 from .motion.trap import _IDLE, _MOVE, TrapPlanner
 from .motion.trap_table import advance, trap_table
@@ -120,6 +122,9 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: GT functions whose implementations read a claimed axis through the bank itself, or touch
 #: no axis object at all (the process image, the clock: a raw write to a claimed slave's
 #: outputs is seen by the bank's next cycle, which gives the slave back first)
+#: function -> whether it takes a ``count`` of axes (AxisBank.before_call)
+_COUNTED: dict[str, bool] = {}
+
 BANK_READS = frozenset(
     {
         "GT_GetSts",
@@ -188,6 +193,10 @@ _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.MOVING),
     int(AxisStatus.ARRIVED),
 )
+_ALARM = int(AxisStatus.ALARM)
+_POS_LIMIT = int(AxisStatus.POSITIVE_LIMIT)
+_NEG_LIMIT = int(AxisStatus.NEGATIVE_LIMIT)
+_SW_FAULT = 0x0008  # 6041h bit 3: fault
 
 
 #: the modes whose planners a cluster steps ahead (gtecat.controller.bank_modes)
@@ -264,6 +273,9 @@ class _Group:
     drive: Cia402Drive
     rows: list[int]
     rx_bytes: np.ndarray  # buffer indices of its output bytes, 607Ah excluded
+    #: the entries the bank writes into the image: (buffer byte, bytes, an output, the
+    #: slave's rx (output) or tx (input) index of the first byte)
+    computed: list[tuple[int, int, bool, int]]
     claimed: bool = False
 
 
@@ -278,6 +290,10 @@ class AxisBank:
         self.dirty = True
         self._countdown = 0
         self._missed = False  # the last refresh found an eligible group it could not claim
+        #: cycles to the next look for rows to claim while some are out (doubled up to
+        #: RECHECK_CYCLES by each look that leaves some out; 1 again after a release)
+        self._wait = 1
+        self._settled = False  # the next cycle's first steps ran already (settle)
         #: GT axes kept off the bank (a fault trigger reads their drive every cycle)
         self.held: frozenset[int] = frozenset()
         self.n = 0
@@ -387,7 +403,13 @@ class AxisBank:
                 axes.append(ctl.axes[ref.axis])
                 chans.append(slave.channels[ref.channel])
             plc += g_plc
-            groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp)))
+            out0 = (sl.out_logical_bit or 0) >> 3
+            in0 = image.outputs_bytes + ((sl.in_logical_bit or 0) >> 3)
+            computed = [
+                (byte, size, name == "target", byte - (out0 if name == "target" else in0))
+                for _, byte, size, name in g_plc
+            ]
+            groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp), computed))
         if not axes:
             self.disabled_reason = "no drive the bank can run (mapping)"
             return
@@ -412,6 +434,7 @@ class AxisBank:
         self.enc_ratio, self.enc_off = z(n), z(n)
         self.soft_pos, self.soft_neg = z(n), z(n)
         self.pos_err = z(n)
+        self.latched = zi(n, np.int64)  # the latched GT_GetSts flags (constant in the bank)
         self.external = zi(n, bool)
         self.sense = zi(n, np.int64)
         self.enc_prev = zi(n, np.int64)
@@ -429,6 +452,7 @@ class AxisBank:
         self.jrp, self.jrv = z(n), z(n)  # the raw ramp's position and speed
         self.jp, self.jv, self.ja = z(n), z(n), z(n)  # the filter output (the planned values)
         self.tau, self.jE = z(n), z(n)  # smoothing time constant, e^(-T/tau)
+        self.jgoal, self.jacc, self.jdec = z(n), z(n), z(n)  # target speed, its ramps
         self.taken = zi(n, np.int64)  # samples taken since the claim
         self.k0 = zi(n, np.int64)  # the planner's sample count at the claim
         #: rows whose planners a cluster steps ahead (gtecat.controller.bank_modes)
@@ -562,7 +586,9 @@ class AxisBank:
         st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active) or not res._csp:
             return False
-        if res.latched or ax.prf_pos != res._a_last:
+        if ax.prf_pos != res._a_last:
+            return False
+        if res.latched and not self._latched_standing(ax, res):
             return False
         prof = res.profile
         pl = prof.planner
@@ -573,8 +599,9 @@ class AxisBank:
                 return False
         elif prof.mode == PrfMode.JOG and pl is prof.jog and isinstance(pl, JogPlanner):
             if pl._mode == _JOG_MOVE:
-                # cruising (the raw ramp at its speed): the ramps themselves stay scalar
-                if pl._raw_v != pl._goal or pl._goal == 0.0 or pl._T != self.T:
+                # cruising or ramping toward a speed (a reversal included); a jog stopping
+                # (goal 0: it settles and ends) stays scalar
+                if pl._goal == 0.0 or pl._T != self.T or pl._prm is None:
                     return False
             elif pl._mode != _JOG_IDLE:
                 return False
@@ -591,6 +618,25 @@ class AxisBank:
             return False
         return not claimable(self.csp.channels[r])
 
+    @staticmethod
+    def _latched_standing(ax: Any, res: Any) -> bool:
+        """A servo-on row with latched GT_GetSts flags (a limit switch or a stop that halted
+        it, waiting for GT_ClrSts): while its profile stands no stop reacts to them
+        (AxisResources._post), so the bank keeps them as they are (its GT_GetSts word carries
+        them) and gives the row back before a cycle that would latch one; a row whose soft
+        limit or following error is still exceeded would leave at once and stays scalar."""
+        prof = res.profile
+        if prof.mode not in (PrfMode.TRAP, PrfMode.JOG) or not prof.planner.done:
+            return False  # (a Gear or Follow slave may start with its master, no call on it)
+        s = res.safety
+        if s.active:
+            a = ax.prf_pos
+            if a > s.soft_positive or a < s.soft_negative:
+                return False
+            if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
+                return False
+        return True
+
     def _eligible_frozen(self, r: int) -> bool:
         """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
         every value of its cycle stays as it is, so the compiled cycle skips the row (the
@@ -603,7 +649,7 @@ class AxisBank:
         st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active):
             return False
-        if res.latched or ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
+        if ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
             return False
         if None in (res._act, ax._tp_acc, ax._pos_acc):
             return False
@@ -622,8 +668,18 @@ class AxisBank:
             return False  # 607Ah does not hold 6064h yet
         ch = self.csp.channels[r]
         s = res.safety
-        if s.active and (a > s.soft_positive or a < s.soft_negative or ch.digital_inputs & 3):
-            return False  # a flag would latch
+        if s.active:
+            # the flags its cycle would latch (AxisResources._post) are latched already - a
+            # drive alarm the application has not cleared yet - or the row stays scalar
+            would = 0
+            if s.alarm_on and res._alarm_sw is not None and res._alarm_sw.get() & _SW_FAULT:
+                would |= _ALARM
+            if a > s.soft_positive or ch.digital_inputs & 2:
+                would |= _POS_LIMIT
+            if a < s.soft_negative or ch.digital_inputs & 1:
+                would |= _NEG_LIMIT
+            if would & ~res.latched:
+                return False
         b = res.band
         if b.band > 0:
             err = a - res.enc_link.axis(enc.pos)
@@ -721,6 +777,13 @@ class AxisBank:
             changed = True
         if changed:
             self._reindex()
+        if self.n_alive == self.n:
+            self._wait = 1
+        else:
+            # rows left out: look again soon (a drive settling after a call: a few cycles),
+            # then less and less often (a row out for long costs a look every RECHECK_CYCLES)
+            self._countdown = min(self._wait, RECHECK_CYCLES)
+            self._wait = min(2 * self._wait, RECHECK_CYCLES)
         if missed and not self._missed:
             # an eligible drive had not yet taken (or sent) what the image holds: its next
             # scalar step does, so look again after it rather than RECHECK_CYCLES later
@@ -854,6 +917,8 @@ class AxisBank:
             tau = pl._tau
             self.tau[r] = tau
             self.jE[r] = math.exp(-pl._T / tau) if tau > 0.0 else 0.0
+            self.jgoal[r] = pl._goal
+            self.jacc[r], self.jdec[r] = pl._prm.acc, pl._prm.dec
         sampled = bool(self.sampled[r])  # stepped ahead by its cluster (bank_modes)
         if sampled:
             moving = not pl.done
@@ -896,6 +961,9 @@ class AxisBank:
             self.t_len[r], self.t_end[r] = 1, 0
         ch = self.csp.channels[r]
         self.frz[r] = frozen = not ax.servo_on
+        # GT_GetSts's latched flags stay as they are while the row is in the bank
+        # (_eligible_frozen, _latched_standing)
+        self.latched[r] = int(res.latched)
         if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
             self._frozen[r] = (
                 tuple(getattr(ch, name) for name in FROZEN_ATTRS),
@@ -1053,6 +1121,16 @@ class AxisBank:
         self.csp.store(rows)
         for r in rows:
             self._store(r)
+        # the drive's process data buffers as its own steps would have left them: the entries
+        # the bank wrote into the image in them too (its other bytes are as they were, so a
+        # raw write or a changed constant still waits for a step of its own: _can_claim)
+        buf = self.ctl.master.image.buffer
+        for g in groups:
+            rx, tx = g.drive.rx, g.drive.tx
+            for byte, size, out, i in g.computed:
+                dst = rx if out else tx
+                if 0 <= i and i + size <= len(dst):
+                    dst[i : i + size] = buf[byte : byte + size].tobytes()
         for cl in clusters:
             # the planners stand where the scalar path has them (bank_modes.Cluster.rewind)
             cl.rewind(self)
@@ -1064,6 +1142,7 @@ class AxisBank:
                 self._cluster_of.pop(gi, None)
             self.sampled[cl.rows] = False
         self.dirty = True
+        self._wait = 1
         # the image addresses and run lists follow at the next cycle (_reindex), not once per
         # release: a loop of GT calls over many axes releases one slave per call
         self._stale = True
@@ -1149,7 +1228,10 @@ class AxisBank:
                     return
                 values = (m & axis_bits, *values[1:])  # the axes of the mask, below
         if params and params[0].name in ("axis", "profile", "encoder") and values:
-            if not any(p.name == "count" for p in params):
+            counted = _COUNTED.get(proto.name)
+            if counted is None:  # (a function's parameters do not change: asked once)
+                counted = _COUNTED[proto.name] = any(p.name == "count" for p in params)
+            if not counted:
                 n = values[0]
                 ax = ctl.axes.get(n) if type(n) is int else None
                 if ax is not None:
@@ -1233,18 +1315,19 @@ class AxisBank:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
                 return [
-                    (_MOVING if m or j else _ARRIVED if a else 0) | (0 if f else _SERVO_ON)
-                    for m, j, a, f in zip(
+                    (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
+                    for m, j, a, f, lt in zip(
                         self.moving.tolist(),
                         self.jog.tolist(),
                         self.arrived.tolist(),
                         self.frz.tolist(),
+                        self.latched.tolist(),
                         strict=True,
                     )
                 ]
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | np.where(self.frz, 0, _SERVO_ON)).tolist()
+            return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             vel, acc = self._enc_rates()
             return (vel if name == "enc_vel" else acc).tolist()
@@ -1263,8 +1346,15 @@ class AxisBank:
         return np.where(one, np.where(off != 0.0, x + off, x), ratio * x + off)
 
     # --- the cycle -------------------------------------------------------------------------
-    def cycle(self, t_ns: int, dt_ns: int) -> None:
-        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+    def settle(self) -> None:
+        """What :meth:`cycle` does first after a GT call or a release (claim what may come
+        back, re-index), done before a cycle is due: when every axis comes back, the
+        controller runs the cycles many at once (:meth:`Controller.run_cycles`)."""
+        if not self._settled:
+            self._begin()
+            self._settled = True
+
+    def _begin(self) -> None:
         self._countdown -= 1
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
@@ -1272,6 +1362,13 @@ class AxisBank:
             self.refresh()
         if self._stale:
             self._reindex()
+
+    def cycle(self, t_ns: int, dt_ns: int) -> None:
+        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        if self._settled:
+            self._settled = False  # its first steps ran just before (settle)
+        else:
+            self._begin()
         if not self.n_alive:
             return
         self._lists.clear()
@@ -1463,7 +1560,8 @@ class AxisBank:
                 return 0
         _, done = k.run(t_ns, dt, dt_ns, n)
         if done:
-            self._countdown -= done
+            self._countdown -= done - self._settled  # (the first one's count: in settle)
+            self._settled = False
             self._refill_in -= done
             self._lists.clear()
             self._after_kernel(k, done)
@@ -1503,10 +1601,11 @@ class AxisBank:
         return vel, acc
 
     def _jog_step(self) -> tuple[np.ndarray, ...]:
-        """One cycle of every cruising Jog: :func:`~gtecat.controller.motion.jog.advance` with
-        the raw speed at its goal (a = 0, one piece of length T), then ``JogPlanner.step``'s
-        snap onto the goal; the same operations with the same zero constants, for the same
-        bits (``-0.0`` included)."""
+        """One cycle of every Jog: :func:`~gtecat.controller.motion.jog.advance` with the raw
+        speed at its goal (a = 0, one piece of length T), then ``JogPlanner.step``'s snap onto
+        the goal; the same operations with the same zero constants, for the same bits
+        (``-0.0`` included).  A row whose raw speed ramps takes the scalar step's own
+        arithmetic (:func:`~gtecat.controller.motion.jog.ramp_step`)."""
         h = self.T
         rp, v, fp, fv, fa = self.jrp, self.jrv, self.jp, self.jv, self.ja
         p1 = rp + h * (v + 0.5 * 0.0 * h)
@@ -1520,6 +1619,24 @@ class AxisBank:
         snap = (nfv != goal) & (np.abs(nfv - goal) <= 1e-9 * (1.0 + np.abs(goal)))
         nfv = np.where(snap, goal, nfv)
         nfa = np.where(snap, 0.0, nfa)
+        ramping = self.jog & self.alive & (v != self.jgoal)
+        if np.count_nonzero(ramping):
+            # a ramp (the raw speed not yet at its goal): JogPlanner.step's own operations,
+            # row by row (a rare cycle here: the compiled cycle runs them too)
+            for r in np.nonzero(ramping)[0].tolist():
+                out = jog_ramp_step(
+                    float(rp[r]),
+                    float(v[r]),
+                    float(self.jgoal[r]),
+                    float(self.jacc[r]),
+                    float(self.jdec[r]),
+                    h,
+                    float(tau[r]),
+                    float(fp[r]),
+                    float(fv[r]),
+                    float(fa[r]),
+                )
+                p1[r], v1[r], nfp[r], nfv[r], nfa[r] = out
         return p1, v1, nfp, nfv, nfa
 
     def _materialise(self) -> None:

@@ -24,6 +24,7 @@ from __future__ import annotations
 import ctypes
 import logging
 import os
+import threading
 from importlib import resources
 from operator import attrgetter
 from pathlib import Path
@@ -76,6 +77,41 @@ _SCRATCH = (
 _LIB: Any = None
 _LIB_REASON = ""
 _FIELDS: list[tuple[str, Any]] = []
+#: the build started ahead (:func:`prebuild`): the thread, then its library path or error
+_AHEAD: list[Any] = []
+
+
+def prebuild() -> None:
+    """Start building the kernel in the background, where it is not built yet.
+
+    GT_InitEcatComm calls this before it reads the ENI: the first build on a machine (about
+    a second of the compiler) then runs beside the reading of the file and the making of the
+    drives, and :func:`library` (the bank, at the end of GT_InitEcatComm) waits for it.
+    The thread is not a daemon: a process that ends before it still finishes the build
+    (the next process finds it)."""
+    if _LIB is not None or _LIB_REASON or _AHEAD or wanted() == "numpy":
+        return
+
+    def run() -> None:
+        try:
+            _AHEAD.append(build(CFLAGS))
+        except Exception as e:  # library() reports it
+            _AHEAD.append(e)
+
+    thread = threading.Thread(target=run, name="gtecat bank kernel build")
+    _AHEAD.append(thread)
+    thread.start()
+
+
+def _built() -> Path:
+    """The kernel's library file: the build started ahead, else one built now."""
+    if not _AHEAD:
+        return build(CFLAGS)
+    _AHEAD[0].join()
+    result = _AHEAD[1]
+    if isinstance(result, Exception):
+        raise result
+    return result
 
 
 def library() -> tuple[Any, str]:
@@ -84,7 +120,7 @@ def library() -> tuple[Any, str]:
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
     try:
-        lib = ctypes.CDLL(str(build(CFLAGS)))
+        lib = ctypes.CDLL(str(_built()))
         lib.bank_kernel_fields.restype = ctypes.c_char_p
         lib.bank_kernel_abi.restype = ctypes.c_int
         lib.bank_kernel_cycle.restype = ctypes.c_int

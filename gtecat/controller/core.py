@@ -59,6 +59,7 @@ from ..master.masterlog import MasterLog
 from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
+from .bank_kernel import prebuild as prebuild_kernel
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -207,14 +208,17 @@ class Controller:
         paused = gc.isenabled()
         if paused:
             gc.disable()
+        _thaw_bus()
         try:
-            return self._init_ecat()
+            master = self._init_ecat()
         except Exception as e:
             self.init_error = e
             raise
         finally:
             if paused:
                 gc.enable()
+        _freeze_bus(len(master.layout.slaves))
+        return master
 
     def _init_ecat(self) -> Master:
         path = self.eni_path()
@@ -228,6 +232,9 @@ class Controller:
                 "C, C++, C#, Python), or put it in the working folder as Gecat.eni "
                 "(Python may pass GT_Open(eni=...), the command line --eni)"
             )
+        banked = self.options.bank != "off" and self.options.backend == "emulated"
+        if banked:
+            prebuild_kernel()  # a first build on this machine runs beside the reading below
         try:
             config = read_eni(path, _eni_cache(path))
         except EniError:
@@ -257,7 +264,7 @@ class Controller:
             self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
         master.open()
         _put_back(backend, kept)
-        if self.options.bank != "off" and self.options.backend == "emulated":
+        if banked:
             self.bank = AxisBank(self, self.options.bank)
         for hook in [*self.on_bus_up, *Controller.bus_up_hooks]:
             hook(self)
@@ -344,8 +351,6 @@ class Controller:
         (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
         one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
         cycles run, 0 when the next one must go through :meth:`_cycle`."""
-        if self._run_axes:
-            return 0
         bank = self.bank
         if (
             bank is None
@@ -356,6 +361,10 @@ class Controller:
             or self._links_down
             or self.clock._run_cycle != self._cycle
         ):
+            return 0
+        if bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n):
+            bank.settle()  # what the next cycle does first: claim axes given back
+        if self._run_axes:
             return 0
         n = min(n, self.BATCH_CYCLES)
         for f in self.pre_cycle:
@@ -392,7 +401,7 @@ class Controller:
                     )
                 ax.lose_link(reason)
                 if ax.motion is not None:
-                    ax.motion.latched |= AxisStatus.ALARM
+                    ax.motion.latched |= int(AxisStatus.ALARM)  # (the word stays a plain int)
             elif ax.link_lost:
                 ax.link_lost = ""  # reachable again; bit 1 stays until GT_ClrSts
                 self.log(f"Axis {ax.number}: slave {ax.io.slave} back; GT_ClrSts, GT_AxisOn.")
@@ -486,7 +495,7 @@ def _relatch_link_alarms(ctl: Controller) -> None:
     for ax in ctl.axes.values():
         if ax.link_lost:
             if ax.motion is not None:
-                ax.motion.latched |= AxisStatus.ALARM
+                ax.motion.latched |= int(AxisStatus.ALARM)  # (the word stays a plain int)
         else:
             ax.link_alarm = ""
 
@@ -515,6 +524,34 @@ def _put_back(backend: Any, kept: dict[tuple[int, Any, int], float]) -> None:
             pos = kept.get((slave.position, getattr(slave, "identity", None), k))
             if pos is not None:
                 ch.machine_position = pos
+
+
+#: whether this module moved a bus model out of the cyclic collector's walks (gc.freeze)
+_FROZEN: list[bool] = [False]
+#: buses from this many slaves on are frozen (a small bus costs the collector little)
+FREEZE_MIN_SLAVES = 64
+
+
+def _freeze_bus(slaves: int) -> None:
+    """After the bring-up of a large bus: what exists now (the bus model: hundreds of
+    thousands of long-lived objects, millions at a thousand axes) is never walked by the
+    cyclic collector again, so the running bus has no long collector pauses and the
+    process's end no last walk of it (half a second at a thousand axes).  A process that
+    froze objects itself is left as it is."""
+    if slaves >= FREEZE_MIN_SLAVES and gc.get_freeze_count() == 0:
+        gc.freeze()
+        _FROZEN[0] = True
+
+
+def _thaw_bus() -> None:
+    """Before the next bring-up: the objects frozen after the last one go back to the
+    collector, and the closed bus (garbage by then) is collected now, before the new one
+    would freeze it again: a closed large bus's memory returns with the next
+    GT_InitEcatComm, or with the end of the process."""
+    if _FROZEN[0]:
+        _FROZEN[0] = False
+        gc.unfreeze()
+        gc.collect()
 
 
 #: ENI files from this size on keep their parsed model in the user's cache (a 64-axis file

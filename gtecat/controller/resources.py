@@ -273,7 +273,9 @@ class AxisResources:
         b = self.bank
         if b is not None:
             return b.value("sts", self.bank_row)
-        s = int(self.latched)
+        s = self.latched
+        if type(s) is not int:
+            s = int(s)
         if self.ax.servo_on:
             s |= _SERVO_ON
         if not self.profile.planner.done:

@@ -119,8 +119,10 @@ def frozen_claimable(ch: Channel) -> str:
         return "controlword"
     if psm.state is not State.FAULT and TRANSITIONS.get((psm.state, COMMAND_OF[cw & 0xFF])):
         return "a transition is due"
-    if ch.faults.pending or ch.faults.injected:
-        return "fault"
+    if ch.faults.pending or (ch.faults.injected and psm.state is not State.FAULT):
+        return "fault"  # (in FAULT a persisting cause only refuses a reset: cw stays as it is)
+    if ch.field is not None:
+        return "field fault"  # (a switch forced, encoder noise: the values may change)
     if ch.mode_req != ch.mode_seen or ch.mode_due is not None:
         return "mode change pending"
     m = ch.mech

@@ -92,13 +92,15 @@ def detect_format(data: bytes | str) -> str:
 #: the register InitCmds (the master's and each slave's): the reader builds the bus from the
 #: rest, so their elements (most of a TwinCAT file's) are checked by expat but not kept
 _NOT_READ = frozenset({("Master", "InitCmds"), ("Slave", "InitCmds")})
+#: the subtrees a bus of like slaves repeats byte for byte: read once (see parse_xml)
+_SHARED = frozenset({("Slave", "Mailbox"), ("ProcessData", "RxPdo"), ("ProcessData", "TxPdo")})
 
 
 def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
     """Parse configuration text/bytes; ``source`` names it in error messages."""
     fmt = detect_format(text)
     if fmt == "xml":
-        root = parse_xml(text, source, _NOT_READ)
+        root = parse_xml(text, source, _NOT_READ, _SHARED)
         if root.tag == "EncryptedEtherCATConfig":
             fmt = "encrypted"
         elif root.tag != "EtherCATConfig":
@@ -106,7 +108,13 @@ def parse_eni(text: str | bytes, source: str = "<string>") -> EniConfig:
                 f"root element is <{root.tag}>, not <EtherCATConfig>", file=source, line=root.line
             )
         else:
-            return read_xml(root, source)
+            try:
+                return read_xml(root, source)
+            except EniError:
+                # the message's line may be that of a shared subtree's first occurrence:
+                # the same error from a tree with the line of every element
+                del root
+                return read_xml(parse_xml(text, source, _NOT_READ), source)
     if fmt == "encrypted":
         raise EniError(
             "this is an EncryptedEtherCATConfig (an encrypted ENI); export it unencrypted "

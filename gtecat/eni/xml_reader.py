@@ -98,6 +98,10 @@ class _Ctx:
     seen: dict[object, object] = field(default_factory=dict)
     #: an InitCmd element's content (attributes, children's tags, texts, attributes) -> its model
     init_cmds: dict[tuple[object, ...], InitCmd] = field(default_factory=dict)
+    #: id of a Mailbox node (the tree is alive while it is read) -> its init commands, layout
+    mailboxes: dict[int, tuple[tuple[InitCmd, ...], MailboxLayout | None]] = field(
+        default_factory=dict
+    )
 
     def shared(self, value: _T) -> _T:
         """``value``, or the equal one this file gave before (the model is immutable)."""
@@ -344,10 +348,20 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
 
     mailbox_node = snode.find("Mailbox")
     init_cmds: tuple[InitCmd, ...] = ()
+    layout: MailboxLayout | None = None
     if mailbox_node is not None:
-        init_cmds = ctx.shared(
-            tuple(_init_cmd_once(ctx, n) for n in mailbox_node.findall("CoE/InitCmds/InitCmd"))
-        )
+        # one node for the byte-identical mailbox elements of like slaves: read once
+        read = ctx.mailboxes.get(id(mailbox_node))
+        if read is None:
+            read = ctx.mailboxes[id(mailbox_node)] = (
+                ctx.shared(
+                    tuple(
+                        _init_cmd_once(ctx, n) for n in mailbox_node.findall("CoE/InitCmds/InitCmd")
+                    )
+                ),
+                _mailbox_layout(ctx, mailbox_node),
+            )
+        init_cmds, layout = read
     return Slave(
         position=pos,
         name=name,
@@ -362,7 +376,7 @@ def _slave(ctx: _Ctx, snode: Node, pos: int, var_index: _VarIndex) -> Slave:
         mailbox=mailbox_node is not None,
         line=snode.line,
         sync_managers=_sync_managers(ctx, pd) if pd is not None else (),
-        mailbox_layout=_mailbox_layout(ctx, mailbox_node) if mailbox_node is not None else None,
+        mailbox_layout=layout,
         product_revision=info.findtext("ProductRevision") or None,
     )
 

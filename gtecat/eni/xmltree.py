@@ -12,6 +12,7 @@ ETG.2100 files come with and without them.
 from __future__ import annotations
 
 import codecs
+import functools
 import re
 from collections.abc import Iterator
 from xml.parsers import expat
@@ -142,6 +143,62 @@ def _decoded(data: bytes, source: str) -> bytes | str:
     )
 
 
+def _cuts(raw: bytes, pairs: frozenset[tuple[str, str]]) -> list[int]:
+    """Where to end the pieces fed to expat: just after each start tag that may open a
+    skipped or shared subtree (``pairs``' elements, without a namespace prefix), so that the
+    handler that meets it can let the rest of the subtree pass with no handler at all (a
+    ``>`` in an attribute value only places the cut early: the subtree then passes with its
+    end tags, as one with a prefix does)."""
+    out = []
+    for name in {name for _, name in pairs if name.isascii()}:
+        opening = b"<" + name.encode()
+        n = len(opening)
+        at = raw.find(opening)
+        while at >= 0:
+            if raw[at + n : at + n + 1] in (b">", b" ", b"\t", b"\r", b"\n"):
+                gt = raw.find(b">", at + n)
+                if gt > 0:
+                    out.append(gt + 1)
+            at = raw.find(opening, at + n)
+    out.sort()
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _tag_patterns(tag: str) -> tuple[re.Pattern[bytes], re.Pattern[bytes]]:
+    """The end tag and the start tag of an element named ``tag`` (ASCII), as bytes."""
+    name = re.escape(tag.encode("ascii"))
+    return re.compile(rb"</" + name + rb"[\s>]"), re.compile(rb"<" + name + rb"[\s/>]")
+
+
+def _end_tag(raw: bytes, tag: str, at: int) -> int:
+    """Where the end tag of the element whose start tag is at ``at`` begins, or -1 where the
+    bytes do not tell it for certain.
+
+    The first ``</tag`` after ``at`` is that end tag when nothing between is a comment, a
+    CDATA section or a processing instruction (``<!``, ``<?``: the only places where ``<``
+    may stand outside markup) and no element of the same name starts in between (an
+    element closed by ``/>`` has no end tag: then one of the same name follows, or none).
+    Whether the document is well formed is expat's to say: it still reads every byte."""
+    if not tag.isascii():
+        return -1
+    end, start = _tag_patterns(tag)
+    m = end.search(raw, at)
+    if m is None:
+        return -1
+    stop = m.start()
+    if raw.find(b"<!", at, stop) >= 0 or raw.find(b"<?", at, stop) >= 0:
+        return -1
+    return -1 if start.search(raw, at + 1, stop) else stop
+
+
+def _add(parent: Node, node: Node) -> None:
+    if parent.children:
+        parent.children.append(node)  # type: ignore[union-attr]
+    else:
+        parent.children = [node]
+
+
 def _local(name: str) -> str:
     return name.rpartition(":")[2]
 
@@ -155,13 +212,24 @@ _CHUNK = 1 << 18
 
 
 def parse_xml(
-    data: bytes | str, source: str, skip: frozenset[tuple[str, str]] = frozenset()
+    data: bytes | str,
+    source: str,
+    skip: frozenset[tuple[str, str]] = frozenset(),
+    share: frozenset[tuple[str, str]] = frozenset(),
 ) -> Node:
     """Parse a whole document; any error becomes an :class:`EniError` with its line.
 
     ``skip``: (parent, element) local names whose subtrees are checked by expat but not
     built, for the parts a reader never looks at (an ENI's register InitCmds are most of
     its elements): inside one, only a depth counter runs, and no text is delivered.
+
+    ``share``: (parent, element) local names whose subtree, when its bytes (start tag to
+    end tag) are those of one built before, is that same node: expat still checks it, but
+    only its end tags reach Python (a bus of like drives repeats each drive's mailbox
+    element byte for byte).  The lines inside a shared subtree are those of its first
+    occurrence: a reader that finds an error reads the document again without sharing.
+    Only for a document given as bytes that expat decodes itself (its byte positions are
+    those of ``data``).
 
     An element's ``text`` is its character data; an element with children keeps the
     first piece only when the others are blank (the indentation between its children
@@ -176,6 +244,27 @@ def parse_xml(
     local: dict[str, str] = {}  # qualified name -> local name
     seen: dict[str, str] = {}  # short texts, one object each
     depth = 0  # inside a skipped subtree
+    #: the document's bytes where expat reads them as they are (not UTF-16 or UTF-32)
+    raw = data if isinstance(data, bytes) and b"\x00" not in data[:4] else None
+    #: a shared subtree's bytes -> its node; the bytes' first occurrence, until it ends
+    shared: dict[bytes, Node] = {}
+    opened: dict[int, tuple[Node, int, bytes]] = {}  # id(node) -> (node, start, end tag)
+    until = 0  # inside a skipped or shared subtree: the position of its end tag
+    fed = 0  # where the piece expat reads now ends
+    blind = 0  # the subtree's end tag, when expat reads up to it with no handler at all
+
+    def passing(stop: int) -> None:
+        """Let the subtree until ``stop`` (its end tag) pass: where it goes on beyond the piece
+        expat reads now, the rest of it is fed with no handler at all, otherwise only end
+        tags reach Python until its own."""
+        nonlocal until, blind
+        until = stop
+        parser.StartElementHandler = parser.CharacterDataHandler = None  # type: ignore[assignment]
+        if stop >= fed:
+            parser.EndElementHandler = None  # type: ignore[assignment]
+            blind = stop
+        else:
+            parser.EndElementHandler = until_end
 
     def start(tag: str, attrs: dict[str, str]) -> None:
         nonlocal depth
@@ -184,24 +273,50 @@ def parse_xml(
             name = local[tag] = _local(tag)
         parent = stack[-1] if stack else None
         if skip and parent is not None and (parent.tag, name) in skip:
-            depth = 1
-            parser.StartElementHandler, parser.EndElementHandler = skipping
-            parser.CharacterDataHandler = None  # type: ignore[assignment]
+            stop = _end_tag(raw, tag, parser.CurrentByteIndex) if raw is not None else -1
+            if stop < 0:
+                depth = 1
+                parser.StartElementHandler, parser.EndElementHandler = skipping
+                parser.CharacterDataHandler = None  # type: ignore[assignment]
+            else:
+                passing(stop)
             return
+        pending = None
+        if raw is not None and parent is not None and (parent.tag, name) in share:
+            at = parser.CurrentByteIndex
+            stop = _end_tag(raw, tag, at)
+            if stop > 0:
+                span = raw[at:stop]
+                same = shared.get(span)
+                if same is not None:  # its bytes and so its tree
+                    _add(parent, same)
+                    passing(stop)
+                    return
+                pending = (at, span)
         attrib = {_local(k): v for k, v in attrs.items()} if attrs else _NO_ATTRS
         node = Node(name, attrib, parser.CurrentLineNumber)
         if parent is None:
             root.append(node)
-        elif parent.children:
-            parent.children.append(node)  # type: ignore[union-attr]
         else:
-            parent.children = [node]
+            _add(parent, node)
         stack.append(node)
+        if pending is not None:
+            opened[id(node)] = (node, *pending)
 
     def end(tag: str) -> None:
         node = stack.pop()
         if node.children:  # read only from here on: a tuple is smaller than a list
             node.children = tuple(node.children)
+        if opened:
+            first = opened.pop(id(node), None)
+            if first is not None:
+                shared.setdefault(first[2], node)
+
+    def until_end(tag: str) -> None:
+        if parser.CurrentByteIndex == until:
+            parser.StartElementHandler, parser.EndElementHandler, parser.CharacterDataHandler = (
+                building
+            )
 
     def skip_start(tag: str, attrs: dict[str, str]) -> None:
         nonlocal depth
@@ -242,7 +357,24 @@ def parse_xml(
     parser.ExternalEntityRefHandler = refuse_entity  # type: ignore[assignment]
     parser.UnparsedEntityDeclHandler = refuse_entity
     try:
-        if isinstance(data, bytes) and len(data) > _CHUNK:
+        if raw is not None:
+            view = memoryview(raw)
+            cuts = _cuts(raw, skip | share)
+            k, pos, end = 0, 0, len(raw)
+            while pos < end:
+                if blind > pos:  # a subtree's rest: no handler at all
+                    fed = blind
+                else:
+                    while k < len(cuts) and cuts[k] <= pos:
+                        k += 1
+                    fed = min(cuts[k] if k < len(cuts) else end, pos + _CHUNK)
+                parser.Parse(view[pos:fed], False)
+                if blind == fed:  # from its end tag on: end tags, until its own
+                    blind = 0
+                    parser.EndElementHandler = until_end
+                pos = fed
+            parser.Parse(b"", True)
+        elif isinstance(data, bytes) and len(data) > _CHUNK:
             view = memoryview(data)
             for at in range(0, len(data), _CHUNK):
                 parser.Parse(view[at : at + _CHUNK], False)

@@ -41,7 +41,16 @@ from ..errors import (
 )
 from ..master.clock import ClockGroup, ClockMode
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder
-from .fast import CLOCK, RAW, READERS, fast_clock, fast_raw, fast_reader
+from .fast import (
+    CLOCK,
+    ECAT_READERS,
+    RAW,
+    READERS,
+    fast_clock,
+    fast_ecat_reader,
+    fast_raw,
+    fast_reader,
+)
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -104,8 +113,11 @@ class _Session:
         self.card = 0
         #: the current card's cores (``cards[card]``)
         self.controllers: dict[int, Controller] = self.cards[0]
-        #: the core the GT_* functions address (GT_SetCore; the GTN_* ones name theirs)
-        self.core = 1
+        self._core = 1
+        self._remote: Any = None
+        #: in this process (no controller process attached), and the GT_* functions address
+        #: core 1: what the fast paths answer (kept by the two properties below)
+        self.local = self.plain = True
         #: the options the first card was opened with (resolved): the other cards' base
         self.base_options: Any = None
         #: every card and core of the process shares one time
@@ -115,9 +127,28 @@ class _Session:
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
         #: a reason the running call leaves although it succeeds (:func:`note`)
         self.note: str | None = None
-        #: the controller process this session is attached to (``GT_Open(controller=...)``
-        #: or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process
-        self.remote: Any = None
+
+    @property
+    def core(self) -> int:
+        """The core the GT_* functions address (GT_SetCore; the GTN_* ones name theirs)."""
+        return self._core
+
+    @core.setter
+    def core(self, core: int) -> None:
+        self._core = core
+        self.plain = self.local and core == 1
+
+    @property
+    def remote(self) -> Any:
+        """The controller process this session is attached to (``GT_Open(controller=...)``
+        or GTECAT_CONTROLLER; :mod:`gtecat.native.client`), None: it runs in this process."""
+        return self._remote
+
+    @remote.setter
+    def remote(self, remote: Any) -> None:
+        self._remote = remote
+        self.local = remote is None
+        self.plain = self.local and self._core == 1
 
     def select(self, card: int) -> None:
         """Make ``card`` the current card (GT_SetCardNo; checked by the caller)."""
@@ -237,6 +268,7 @@ def close_all() -> None:
 
 
 _AUTO = ClockMode.AUTO
+_LOCKSTEP = ClockMode.LOCKSTEP
 REGISTRY: dict[str, Callable[..., int]] = {}
 #: the GT calls are being listened to (gtecat.faults: a recording, the application checks):
 #: a controller process then runs every call through REGISTRY, none on a fast path
@@ -289,7 +321,10 @@ def advance(ctl: Any, name: str, rc: int) -> int:
     """The host-call latency after a GT call (cycles may run, programs step): whatever they
     raise is turned into a code and a reason like the call's own errors, never let out."""
     clock = ctl.clock
-    if clock.mode is _AUTO and clock.group is None:
+    mode = clock.mode
+    if mode is _LOCKSTEP:  # (Clock.on_call does nothing in lockstep)
+        return rc
+    if mode is _AUTO and clock.group is None:
         # Clock.on_call in the common case, inline: the latency runs no cycle and no other
         # clock shares this one's time
         pending = clock._pending_ns + clock.call_latency_ns
@@ -341,7 +376,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if not needs_ctl and core != 1:  # GTN_Open/GTN_Close: no other core exists
                     raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
-                core = SESSION.core  # GT_SetCore: 1 unless the program chose another
+                core = SESSION._core  # GT_SetCore: 1 unless the program chose another
             values, extra = bind(args, kwargs)
         except Exception as e:
             return failed(e, None, core, before)
@@ -354,7 +389,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         ``GTN_`` twin was called)."""
         ctl = None
         try:
-            if address or SESSION.remote is not None:  # attached: the controller process runs it
+            if address or SESSION._remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
 
                 rc = remote_call(SESSION, name, gtn, core, values, extra, address)
@@ -376,10 +411,13 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 else:
                     if bank is not None and not bank_read:
                         bank.before_call(ctl, proto, values)  # the axes it names go back first
-                    rc = fn(ctl, *values, **extra)
+                    rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
             else:
-                rc = fn(*values, **extra)
-            rc = 0 if rc is None else int(rc)
+                rc = fn(*values, **extra) if extra else fn(*values)
+            if rc is None:
+                rc = 0
+            elif type(rc) is not int:
+                rc = int(rc)
             if rc == 0:
                 # GTE_GetLastError speaks of the most recent call only: nothing, or a note
                 # of something the call found wrong without failing (note())
@@ -394,7 +432,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             return failed(e, ctl, core, before)
         if ctl is None:
             ctl = SESSION.controllers.get(core)
-        if ctl is not None:
+        if ctl is not None and ctl.clock.mode is not _LOCKSTEP:  # (advance: nothing then)
             rc = advance(ctl, name, rc)
         return rc
 
@@ -418,25 +456,31 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     compiled: list[Any] = []  # the compiled binder, made at the first call (args.fast_binder)
 
-    def quick(args: tuple) -> Any:
-        """``args`` bound by the compiled binder (None: not a plain shape)."""
-        if not compiled:
-            compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
-        return compiled[0](*args)
-
     @functools.wraps(fn)
     def gt(*args: Any, **kwargs: Any) -> int:
-        if not kwargs and not opens:
-            values = quick(args)
-            if values is not None:
-                return run(SESSION.core, values, _NO_KW, "", SESSION.last)
+        if not kwargs:
+            if compiled:
+                values = compiled[0](*args)  # None: not a plain shape (the table binder's)
+                if values is not None:
+                    return run(SESSION._core, values, _NO_KW, "", SESSION.last)
+            elif not opens:  # GT_Open: always the table path (its keyword options)
+                compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
+                return gt(*args)
         return call(_GT, args, kwargs)
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    if name in READERS or name in RAW or name == CLOCK:  # common shapes up front (gt.fast)
-        slow = gt
-        make = fast_reader if name in READERS else fast_raw if name in RAW else fast_clock
+    if name in READERS or name in RAW or name == CLOCK or name in ECAT_READERS:
+        slow = gt  # (the common shapes up front: gt.fast)
+        make = (
+            fast_reader
+            if name in READERS
+            else fast_raw
+            if name in RAW
+            else fast_ecat_reader
+            if name in ECAT_READERS
+            else fast_clock
+        )
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn_sig)  # type: ignore[attr-defined]
@@ -465,7 +509,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                         and args[0] == 1
                         and type(args[0]) is int
                         and not kwargs
-                        and SESSION.core == 1
+                        and SESSION.plain
                     ):
                         return fast(*args[1:])  # core 1: the GT_ function's fast path
                     return call(args[0], args[1:], kwargs)

@@ -81,7 +81,8 @@ class Ref:
     """A checked pointer argument: the memory behind it and how much of it there is.
 
     ``addr``/``nbytes`` describe ctypes memory (``elem`` its element type, None
-    for plain bytes); ``py`` holds a Python container instead.
+    for plain bytes); ``py`` holds a Python container instead.  (:func:`_ref` makes one
+    without ``__init__``, for the compiled binder: the two set the same slots.)
     """
 
     __slots__ = ("_keep", "addr", "elem", "name", "nbytes", "py")
@@ -266,6 +267,22 @@ class Ref:
             return cls.from_buffer(self.py)
         except (TypeError, ValueError) as e:
             raise ParameterError(f"{self.name}: cannot view as {cls.__name__}: {e}") from None
+
+
+_NEW = object.__new__
+
+
+def _ref(name: str, addr: int, nbytes: int, elem: Any, keep: Any, _new: Any = _NEW) -> Ref:
+    """``Ref(name, addr, nbytes, elem, keep)`` made without ``type.__call__`` (a third less:
+    the compiled binder makes one for each pointer it binds)."""
+    r = _new(Ref)
+    r.name = name
+    r.addr = addr
+    r.nbytes = nbytes
+    r.elem = elem
+    r._keep = keep
+    r.py = None
+    return r
 
 
 def _elem_name(elem: Any) -> str:
@@ -788,11 +805,50 @@ CARG_AT = _carg_address_offset() if sys.implementation.name == "cpython" else No
 _from_address = ctypes.c_void_p.from_address
 
 
+def _machine_words() -> memoryview | None:
+    """The process's memory as machine words (``WORDS[address >> 3]``), to read the address
+    a ``byref()`` holds in one indexing instead of making a ``c_void_p`` for it (a third of
+    the cost of checking a fresh ``byref``).  Only an aligned word inside a live ``byref``
+    object is ever read.  None where it cannot be made or its reading disagrees with
+    ``c_void_p.from_address`` (the slower reader is used)."""
+    if CARG_AT is None or CARG_AT % 8 or ctypes.sizeof(ctypes.c_void_p) != 8:
+        return None
+    try:
+        words = memoryview((ctypes.c_ubyte * (1 << 62)).from_address(0)).cast("B").cast("Q")
+        for obj in (ctypes.c_long(), ctypes.c_double(), (ctypes.c_int * 4)()):
+            for off in (0, 8):
+                p = ctypes.byref(obj, off)
+                if words[(id(p) + CARG_AT) >> 3] != ctypes.addressof(obj) + off:
+                    return None
+        return words
+    except Exception:  # a platform where it cannot be made
+        return None
+
+
+#: see :func:`_machine_words`
+WORDS = _machine_words()
+
+
+def carg_address_source(a: str) -> str:
+    """Python source reading the address that the ``byref()`` named ``a`` passes, for the
+    compiled fast paths; its names (``_WORDS``, ``_from_address``, ``_byref_address``) are
+    in :data:`CARG_ENV`."""
+    if WORDS is not None:
+        return f"_WORDS[(id({a}) + {CARG_AT}) >> 3]"
+    if CARG_AT is not None:
+        return f"_from_address(id({a}) + {CARG_AT}).value"
+    return f"_byref_address({a})"
+
+
 def byref_address(p: Any) -> int:
     """The address ``byref(obj[, offset])`` passes (where ctypes keeps it, or memmove's)."""
     if CARG_AT is not None:
         return _from_address(id(p) + CARG_AT).value or 0
     return _address(p)
+
+
+#: the names :func:`carg_address_source`'s source uses
+CARG_ENV = {"_WORDS": WORDS, "_from_address": _from_address, "_byref_address": byref_address}
 
 
 def _numeric_types() -> list[type]:
@@ -826,6 +882,99 @@ def _scalar_types(p: Param) -> frozenset[type]:
     return frozenset(ok)
 
 
+#: pointer shapes the compiled binder leaves to the table's converter, and why (a test walks
+#: every pointer parameter of the table with every shape clients pass and fails on any other
+#: shape that does not bind inline: tests/gtecat/gt/test_compiled_binder.py)
+NOT_INLINE: dict[str, str] = {
+    "pointer to pointer": "a char ** that the call points at text of its own (GT_GetVersion, "
+    "called once): the converter resolves it",
+}
+
+
+def _pointer_kind(p: Param) -> str:
+    """What a one-star pointer parameter points to: ``numbers``, ``struct`` or ``bytes``."""
+    if p.is_struct:
+        return "struct"
+    return "bytes" if p.ctype in ("char", "unsigned char", "void") else "numbers"
+
+
+def _learn(kind: str, ok: frozenset, cache: dict, t: Any) -> Any:
+    """Whether the compiled binder takes a ctypes object of type ``t`` inline for a pointer
+    of ``kind`` (``ok``: the number types it takes): the element type its :class:`Ref` has,
+    as :func:`resolve` and :func:`check_kind` would make it, else False.  Kept in ``cache``."""
+    e: Any = False
+    if isinstance(t, type):
+        if kind == "struct":
+            e = t if issubclass(t, ctypes.Structure | ctypes.Union) else False
+        elif issubclass(t, ctypes.Array):
+            inner = t._type_
+            if kind == "bytes":
+                while issubclass(inner, ctypes.Array):
+                    inner = inner._type_
+                e = inner
+            elif inner in ok:  # a one-dimensional array of a number the pointer takes
+                e = inner
+    if len(cache) < 256:
+        cache[t] = e
+    return e
+
+
+def _pointer_source(i: int, p: Param, a: str, v: str, env: dict[str, Any]) -> list[str]:
+    """The compiled binder's lines for one pointer parameter ``p`` (argument ``a``, value
+    ``v``): the shapes clients pass, inline, each giving the :class:`Ref` that the table's
+    converter ``C{i}`` gives for it - ``byref(x)`` (no offset) and ``x`` itself of a number
+    the pointer takes, of a ctypes array of such numbers, of a structure; a ``bytearray``,
+    ``bytes`` (read only), a ctypes array or a numpy array for a byte buffer; a numpy array
+    of numbers; ``None`` or ``0`` for an optional NULL.  Any other shape: ``C{i}``."""
+    kind = _pointer_kind(p)
+    writes = p.direction != "in"
+    ok = _scalar_types(p) if kind == "numbers" else frozenset()
+    cache: dict[Any, Any] = {}
+    env[f"OK{i}"] = ok
+    env[f"AK{i}"] = cache
+    env[f"L{i}"] = lambda t: _learn(kind, ok, cache, t)
+    env["_NDARRAY"] = np.ndarray
+    name = repr(p.name)
+    at = carg_address_source(a)
+    numpy = f"t is _NDARRAY and not {a}.dtype.hasobject and {a}.flags.c_contiguous" + (
+        f" and {a}.flags.writeable" if writes else ""
+    )
+    if kind == "numbers":
+        numpy += f" and {a}.dtype.kind in 'biuf'"
+    lines = [f"t = type({a})", "if t is _CArg:", f"    o = {a}._obj", "    to = type(o)"]
+    if kind == "numbers":
+        lines += [
+            f"    if to in OK{i}: e = to",
+            "    else:",
+            f"        e = AK{i}.get(to)",
+            f"        if e is None: e = L{i}(to)",
+        ]
+    else:
+        lines += [f"    e = AK{i}.get(to)", f"    if e is None: e = L{i}(to)"]
+    lines += [
+        f"    if e and {at} == _addressof(o): {v} = _ref({name}, _addressof(o), _sizeof(o), e, o)",
+        f"    else: {v} = C{i}({a})",
+    ]
+    if kind == "numbers":
+        lines.append(f"elif t in OK{i}: {v} = _ref({name}, _addressof({a}), _sizeof({a}), t, {a})")
+    if kind == "bytes":
+        lines.append(f"elif t is bytearray: {v} = Ref({name}, py={a})")
+        if not writes:
+            lines.append(f"elif t is bytes: {v} = Ref({name}, py={a})")
+    if p.optional:  # NULL as None or 0 (False and NULL ctypes pointers: the converter)
+        lines.append(f"elif {a} is None or (t is int and {a} == 0): {v} = None")
+    if kind != "struct":
+        lines.append(f"elif {numpy}: {v} = Ref({name}, py={a})")
+    lines += [
+        "else:",
+        f"    e = AK{i}.get(t)",
+        f"    if e is None: e = L{i}(t)",
+        f"    if e: {v} = _ref({name}, _addressof({a}), _sizeof({a}), e, {a})",
+        f"    else: {v} = C{i}({a})",
+    ]
+    return lines
+
+
 def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
     """The table's checks of ``proto``'s arguments compiled into one function (declare once,
     generate the rest): ``bind(*args)`` -> the converted values, exactly what
@@ -843,16 +992,12 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         "_byref_address": byref_address,
         "_check_room": _check_room,
         "Ref": Ref,
+        "_ref": _ref,
         "_MISSING": _MISSING,
         "_INF": _INF,
         "P": params,
     }
-    env["_from_address"] = _from_address
-
-    def where(a: str) -> str:  # the address a byref() passes
-        if CARG_AT is None:
-            return f"_byref_address({a})"
-        return f"_from_address(id({a}) + {CARG_AT}).value"
+    env.update(CARG_ENV)
 
     sig, body, out = [], [], []
     for i, p in enumerate(params):
@@ -884,27 +1029,14 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
                 f"elif type({a}) is int and -{1 << 53} <= {a} <= {1 << 53}: {v} = float({a})",
                 f"else: {v} = C{i}({a})",
             ]
-        elif (
-            p.pointer
-            and not p.text
-            and not p.is_struct
-            and p.ctype not in ("char", "unsigned char", "void")
-            and p.stars == 1
-        ):
-            # a pointer to numbers: byref(x) or x itself of a plain number inline
-            env[f"OK{i}"] = _scalar_types(p)
+        elif p.pointer and p.text and p.direction == "in":
+            # text: a str as _text takes it (a file or variable name), inline
             body += [
-                f"t = type({a})",
-                "if t is _CArg:",
-                f"    o = {a}._obj",
-                f"    if type(o) in OK{i} and {where(a)} == _addressof(o):",
-                f"        {v} = Ref({p.name!r}, _addressof(o), _sizeof(o), type(o), o)",
-                f"    else: {v} = C{i}({a})",
-                f"elif t in OK{i}: {v} = Ref({p.name!r}, _addressof({a}), _sizeof({a}), t, {a})",
+                f"if type({a}) is str and len({a}) <= {_TEXT_MAX} and '\\0' not in {a}: {v} = {a}",
+                f"else: {v} = C{i}({a})",
             ]
-            if p.optional:  # NULL as None or 0 (False and NULL ctypes pointers: generic)
-                body.append(f"elif {a} is None or (t is int and {a} == 0): {v} = None")
-            body.append(f"else: {v} = C{i}({a})")
+        elif p.pointer and p.stars == 1:  # (text the call writes: a buffer of bytes)
+            body += _pointer_source(i, p, a, v, env)
         else:
             body.append(f"{v} = C{i}({a})")
         out.append(v)
@@ -912,13 +1044,19 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
     index = {p.name: i for i, p in enumerate(params)}
     for i, p in enumerate(params):
         if p.pointer and not p.text and not p.is_struct and p.count != 0:
-            k = f"v{index[p.count]}" if isinstance(p.count, str) else repr(p.count)
             v = f"v{i}"
-            body += [
-                f"if {v} is not None and not ({k} == 1 and {v}.elem is type({v}._keep) "
-                f"and {v}.nbytes == _sizeof({v}.elem)) and type({k}) is int and {k} > 0:",
-                f"    _check_room(P[{i}], {v}, {k})",
-            ]
+            one = f"{v}.elem is type({v}._keep) and {v}.nbytes == _sizeof({v}.elem)"
+            if isinstance(p.count, str):
+                k = f"v{index[p.count]}"
+                body += [
+                    f"if {v} is not None and not ({k} == 1 and {one}) and type({k}) is int "
+                    f"and {k} > 0:",
+                    f"    _check_room(P[{i}], {v}, {k})",
+                ]
+            elif p.count == 1:  # (the same test with the count known)
+                body += [f"if {v} is not None and not ({one}): _check_room(P[{i}], {v}, 1)"]
+            elif p.count > 0:
+                body += [f"if {v} is not None: _check_room(P[{i}], {v}, {p.count})"]
     lines = [f"def bind({', '.join([*sig, '*more'])}):", "    if more: return None", "    try:"]
     lines += [f"        {x}" for x in body] or ["        pass"]
     lines += [
@@ -963,4 +1101,15 @@ def core_arg(value: Any) -> int:
     return _integer(_CORE, value)
 
 
-__all__ = ["Ref", "binder", "byref_address", "core_arg", "fast_binder", "fit", "resolve"]
+__all__ = [
+    "CARG_ENV",
+    "NOT_INLINE",
+    "Ref",
+    "binder",
+    "byref_address",
+    "carg_address_source",
+    "core_arg",
+    "fast_binder",
+    "fit",
+    "resolve",
+]

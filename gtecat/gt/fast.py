@@ -14,16 +14,20 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import re
 import struct
+import sys
 from collections.abc import Callable
-from operator import itemgetter
 from typing import Any
 
 import numpy as np
 
+from ..controller.axis_status import AxisStatus
+from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
+from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import AxisResources
 from ..master.clock import ClockMode
-from .args import CARG_AT, byref_address
+from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
@@ -37,6 +41,22 @@ _AT = CARG_AT if CARG_AT is not None else -1
 
 
 _status = AxisResources.status
+
+
+def _kept_refs() -> int:
+    """References a pointer object has inside a fast reader when nothing else holds it (a
+    ``byref(c_long())`` made in the call): a checked ``byref`` is kept for the next call only
+    when the caller holds it too (a reused pointer), else keeping it alive would stop the next
+    fresh one from taking its memory, which costs more than the check it saves."""
+
+    def probe(p: Any) -> int:
+        return sys.getrefcount(p)
+
+    return probe(ctypes.byref(ctypes.c_long()))
+
+
+#: see :func:`_kept_refs`
+_KEPT = _kept_refs()
 _LOCKSTEP = ClockMode.LOCKSTEP
 
 
@@ -46,7 +66,22 @@ def attr_getter(name: str) -> Callable[[Any], float]:
     def get(r: Any) -> float:
         return float(getattr(r, name))
 
+    get.attr = name  # type: ignore[attr-defined]  # (the fast reader reads it inline)
     return get
+
+
+def prf_mode_value(r: Any) -> int:
+    """GT_GetPrfMode's value (motion_calls)."""
+    return int(r.profile.mode)
+
+
+#: table 6-2 bit 10: the one bit of a profile's own (GT_GetPrfSts)
+_PRF_MOVING = int(AxisStatus.MOVING)
+
+
+def prf_sts_value(r: Any) -> int:
+    """GT_GetPrfSts's word (status_calls): the planner's bit of GT_GetSts's."""
+    return r.status() & _PRF_MOVING
 
 
 _INTS = frozenset({ctypes.c_int32, ctypes.c_long, ctypes.c_int64, ctypes.c_longlong})
@@ -69,6 +104,10 @@ READERS: dict[str, tuple[Callable[[Any], Any], frozenset]] = {
     "GT_GetAxisError": (attr_getter("axis_error"), _DOUBLE),
     "GT_GetEncPos": (attr_getter("enc_pos"), _DOUBLE),
     "GT_GetEncVel": (attr_getter("enc_vel"), _DOUBLE),
+    "GT_GetAxisPrfAcc": (attr_getter("axis_prf_acc"), _DOUBLE),
+    "GT_GetAxisEncAcc": (attr_getter("axis_enc_acc"), _DOUBLE),
+    "GT_GetPrfMode": (prf_mode_value, _INTS),
+    "GT_GetPrfSts": (prf_sts_value, _INTS),
 }
 
 
@@ -104,6 +143,9 @@ def fast_reader(
         "get": get,
         "ok": ctypes_ok,
         "last": last,
+        "LAST_P": None,
+        "_refs": sys.getrefcount,
+        "KEPT": _KEPT,
         "advance": advance,
         "name": name,
         "slow": slow,
@@ -112,8 +154,9 @@ def fast_reader(
         "np_ok": np_ok,
         "is_array": is_array,
         "to": float if ctypes_ok is _DOUBLE else None,
+        "T0": ctypes.c_double if ctypes_ok is _DOUBLE else ctypes.c_long,  # the usual type
     }
-    gt = _compiled(_READER, "gt", env, core="", session_core=" and session.core == 1")
+    gt = _compiled(_READER, "gt", env, core="", session="session.plain")
 
     def general(n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict) -> int:
         """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
@@ -170,10 +213,35 @@ def fast_reader(
     env["gtn_general"] = gtn_general
     #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
     #: its core); every other shape: the table's GTN_ function (set by gt_function)
-    gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session_core="")  # type: ignore[attr-defined]
+    gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     return gt
 
+
+#: a reader's value of an axis the bank does not run, inline (without the getter's call):
+#: GT_GetSts's word as :meth:`AxisResources.status` makes it (the latched flags as they are:
+#: an int; tests/gtecat/gt/test_fast_shapes.py holds the two to the same word in every state
+#: they combine, a Trap planner's and another planner's)
+SCALAR_INLINE: dict[str, tuple[str, ...]] = {
+    "GT_GetSts": (
+        "v = res.latched",
+        "if res.ax.servo_on:",
+        "    v |= SERVO_ON",
+        "pl = res.profile.planner",
+        # the planner's done (a Trap planner's own state read without the property's call)
+        "if (pl._mode != TRAP_IDLE) if type(pl) is TRAP else not pl.done:",
+        "    v |= MOVING",
+        "elif res.band.arrived:",
+        "    v |= ARRIVED",
+    ),
+}
+_STATUS_BITS = {
+    "SERVO_ON": int(AxisStatus.SERVO_ON),
+    "MOVING": int(AxisStatus.MOVING),
+    "ARRIVED": int(AxisStatus.ARRIVED),
+    "TRAP": TrapPlanner,
+    "TRAP_IDLE": TRAP_IDLE,
+}
 
 #: the bank's list of each reader's value (AxisBank.value), read without the two calls
 BANK_LISTS = {
@@ -190,6 +258,7 @@ BANK_LISTS = {
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
 _READER = """
 def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
+    global LAST_P  # the last byref object checked (kept alive, so never another's address)
     if (
         type(n) is int
         and not kw
@@ -204,53 +273,58 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
             )
         )
     ):
-        ctl = session.controllers.get(1)
-        if ctl is not None and session.remote is None{session_core}:
-            res = ctl.resources.get(n)
-            clock = ctl.clock
-            if res is not None and clock._thread is None:
-                tp = type(p)
-                if tp is _CArg:
-                    obj = p._obj
-                    if p is not last[0]:
-                        # byref(obj), not byref(obj, offset); any doubt: the table path
-                        if type(obj) not in ok or {address} != _addressof(obj):
-                            return {fallback}
-                        last[0] = p  # checked: the same pointer object next time is fine
-                elif tp in ok:  # the ctypes object itself (passed by reference)
-                    obj = p
-                elif (
-                    tp is _NDARRAY
-                    and p.dtype in np_ok
-                    and p.ndim == 1
-                    and p.size
-                    and p.flags.writeable
-                ) or is_array(tp):  # a numpy or ctypes array: its first element
-                    obj = None
-                else:
-                    return {fallback}
+        try:  # (two subscripts: cheaper than two get calls)
+            ctl = session.controllers[1]
+            res = ctl.resources[n]
+        except KeyError:  # no controller, or no such axis: the table path says why
+            return {fallback}
+        clock = ctl.clock
+        if {session} and clock._thread is None:
+            tp = type(p)
+            if tp is _CArg:
+                obj = p._obj
+                if p is not LAST_P:
+                    # byref(obj), not byref(obj, offset); any doubt: the table path
+                    kind = type(obj)
+                    if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
+                        return {fallback}
+                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
+                        LAST_P = p  # checked, the same object next time needs no check
+            elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
+                obj = p
+            elif (
+                tp is _NDARRAY
+                and p.dtype in np_ok
+                and p.ndim == 1
+                and p.size
+                and p.flags.writeable
+            ) or is_array(tp):  # a numpy or ctypes array: its first element
+                obj = None
+            else:
+                return {fallback}
 {{value}}
-                if obj is None:
-                    p[0] = v
-                else:
-                    obj.value = v
-                session.last = None
-                if clock.mode is _LOCKSTEP:
-                    return 0
-                return advance(ctl, name, 0)
+            if obj is None:
+                p[0] = v
+            else:
+                obj.value = v
+            session.last = None
+            if clock.mode is _LOCKSTEP:
+                return 0
+            return advance(ctl, name, 0)
     return {fallback}
 """
 
 
-def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session_core: str) -> Any:
+def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
-    address = "_from_address(id(p) + _AT).value" if _AT >= 0 else "byref_address(p)"
+    address = carg_address_source("p")
+    env.update(CARG_ENV)
     gtn = bool(core)
     code = template.format(
         fname=fname,
         core=core,
         core_check=" and type(core) is int and core == 1" if gtn else "",
-        session_core=session_core,
+        session=session,
         address=address,
         fallback=(
             "gtn_general(core, n, p, count, pClock, extra, kw)"
@@ -259,18 +333,27 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         ),
     )
     env["_AT"] = _AT
+    attr = getattr(env["get"], "attr", None)
+    if env["name"] in SCALAR_INLINE:
+        scalar = list(SCALAR_INLINE[env["name"]])
+        env.update(_STATUS_BITS)
+    elif attr is None:
+        scalar = ["v = get(res)"]
+    else:  # the attribute itself (attr_getter's value, without the two calls)
+        scalar = [f"v = res.{attr}", "if type(v) is not float:", "    v = float(v)"]
     if env["key"] is None:
-        value = "                v = get(res)"
+        lines = scalar
     else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
         row = "lst[res.bank_row]" if env["to"] is None else "to(lst[res.bank_row])"
-        value = "\n".join(
-            "                " + line
-            for line in (
-                "b = res.bank",
-                "lst = b._lists.get(key) if b is not None else None",
-                f"v = get(res) if lst is None else {row}",
-            )
-        )
+        lines = [
+            "b = res.bank",
+            "if b is None:",
+            *("    " + x for x in scalar),
+            "else:",
+            "    lst = b._lists.get(key)",
+            f"    v = get(res) if lst is None else {row}",
+        ]
+    value = "\n".join("            " + line for line in lines)
     code = code.replace("{value}", value)
     exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
     return env[fname]
@@ -301,7 +384,7 @@ def fast_clock(
             and not extra
         ):
             ctl = session.controllers.get(1)
-            if ctl is not None and session.remote is None and session.core == 1:
+            if ctl is not None and session.plain:  # (in this process, core 1)
                 clock = ctl.clock
                 if clock._thread is None:
                     tp = type(pClock)
@@ -399,10 +482,12 @@ def _index(image: Any, offset: int, size: int, write: bool) -> np.ndarray | None
 
 #: a raw range of at most this many runs of the image buffer is copied run by run
 MAX_RUNS = 4
+#: ... and by a shape's compiled copier (one struct call for all its runs)
+COPY_RUNS = 64
 
 
 def _plan(
-    image: Any, offset: int, size: int, write: bool
+    image: Any, offset: int, size: int, write: bool, max_runs: int = MAX_RUNS
 ) -> tuple[tuple[tuple[int, int, int], ...], np.ndarray] | None:
     """How a raw range is copied: its runs of the image buffer ``(first byte in the range,
     first byte in the buffer, bytes)`` (empty: too many, numpy copies it) and its buffer
@@ -413,7 +498,7 @@ def _plan(
     cuts = np.flatnonzero(np.diff(idx) != 1) + 1
     starts = [0, *cuts.tolist()]
     ends = [*cuts.tolist(), size]
-    if len(starts) > MAX_RUNS:
+    if len(starts) > max_runs:
         return (), idx
     return tuple((a, int(idx[a]), b - a) for a, b in zip(starts, ends, strict=True)), idx
 
@@ -498,9 +583,11 @@ def fast_raw(
     def copier(slave: int, offset: int, size: int, tp: type, image: Any) -> Any:
         """``copy(p)`` for one shape (a range of the image, a buffer type): it moves the
         bytes and returns True, or False when this buffer cannot take them this way (the
-        general path decides); None: no copier for the shape.  Compiled from
-        :data:`_COPY` (one function: the checks of the buffer, then one slice per run or
-        one gather of the whole range)."""
+        general path decides); None: no copier for the shape.  Compiled from the range's
+        runs of the image buffer: each run is a ``c_char`` array over its bytes of the
+        image, and one ``struct`` call moves them all into or out of the caller's buffer
+        (``pack_into`` / ``unpack_from`` check that the buffer is big enough, writable for
+        a read, and C-contiguous; whatever they refuse goes to the general path)."""
         raw = offset
         if io:
             slaves = image.layout.slaves
@@ -510,92 +597,85 @@ def fast_raw(
             if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
                 return None
             raw = sl.gt_offset + offset
-        plan = _plan(image, raw, size, write)
+        plan = _plan(image, raw, size, write, COPY_RUNS)
         if plan is None or not plan[0]:
             return None
-        runs, idx = plan
-        if tp is bytearray or tp is memoryview or (write and tp is bytes):
-            get = "q = p"
-            check = ["if len(p) < size: return False"]
-            if tp is memoryview:
-                check.append(
-                    'if p.format != "B" or p.ndim != 1 or not p.c_contiguous: return False'
-                )
-                if not write:
-                    check.append("if p.readonly: return False")
+        runs = plan[0]
+        if tp is bytearray or (write and tp is bytes):
+            ok = []
+        elif tp is memoryview:
+            ok = ['p.format == "B"', "p.ndim == 1"]
         elif issubclass(tp, Array) and sizeof(tp) >= size:
-            # a ctypes array: its bytes, through a memoryview kept per object
-            get = "q = kept(p, True)\n    if q is None: return False"
-            check = []
+            ok = []
         elif tp is _NDARRAY:
-            check = [
-                "if (p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous "
-                "or p.size < size): return False"
-            ]
-            if not write:
-                check.append("if not p.flags.writeable: return False")
-            get = "q = kept(p, False)"
+            ok = ["p.dtype == _BYTES_NP", "p.ndim == 1"]
         else:
             return None
+        check = [f"if not ({' and '.join(ok)}): return False"] if ok else []
+        fmt = struct.Struct("".join(f"{n}s" for _, _, n in runs))
+        env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP}
+        cells = []
+        for k, (_, first, n) in enumerate(runs):
+            env[f"c{k}"] = (ctypes.c_char * n).from_buffer(image.buffer, first)
+            cells.append(f"c{k}.raw")
         if write:
-            move = [f"img[{first}:{first + n}] = q[{a}:{a + n}]" for a, first, n in runs]
-        elif len(runs) == 1:  # one slice
-            ((a, first, n),) = runs
-            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]"]
-        elif tp is bytearray and size <= 6 * len(runs):
-            # the bytes of the range in one C call (a bytearray takes the ints as they are):
-            # fewer steps than a slice per run while the runs are short
-            move = ["q[0:size] = gather(img)"]
-        elif size <= 2 * len(runs):
-            move = ["q[0:size] = bytes(gather(img))"]
-        else:  # a slice per run
-            move = [f"q[{a}:{a + n}] = img[{first}:{first + n}]" for a, first, n in runs]
-        body = "\n    ".join([*check, get, *move, "return True"])
-        env = {
-            "img": memoryview(image.buffer),
-            "size": size,
-            "gather": itemgetter(*idx.tolist()) if len(idx) > 1 else None,
-            "kept": kept,
-            "_BYTES_NP": _BYTES_NP,
-        }
+            env["unpack"] = fmt.unpack_from
+            move = [f"{', '.join(cells)}, = unpack(p)"]
+        else:
+            env["pack"] = fmt.pack_into
+            move = [f"pack(p, 0, {', '.join(cells)})"]
+        body = "\n    ".join([*check, *move, "return True"])
         exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
-        return env["copy"]
+        copy = env["copy"]
+        names = {k: v for k, v in env.items() if k != "copy" and not k.startswith("__")}
+        copy.spec = (ok, move[0], names)  # (for the specialised entry, _raw_entry)
+        return copy
 
-    casts: dict[int, memoryview] = {}  # byte views of buffers, the last few (kept alive)
+    def reset(image: Any) -> None:
+        """Another process image (the bus was brought up again): every copier goes."""
+        cache.clear()
+        copiers.clear()
+        seen[:] = [image, memoryview(image.buffer)]
+        remember(-1, -1, None, -1, None)
+        entries.clear()
+        entry.__code__ = base_code
 
-    def kept(p: Any, cast: bool) -> memoryview | None:
-        """A memoryview of the bytes of ``p`` (a ctypes array: cast to bytes), kept for the
-        next call with the same object; None: none can be made."""
-        v = casts.get(id(p))
-        if v is None or v.obj is not p:
-            if len(casts) >= 16:
-                casts.clear()
-            try:
-                v = memoryview(p).cast("B") if cast else memoryview(p)
-            except (TypeError, ValueError):  # a format memoryview cannot take
-                return None
-            casts[id(p)] = v
-        return v
+    def remember(offset: int, size: int, tp: Any, slave: int, copy: Any) -> None:
+        """The shape the next call is checked against first, and its copier; the public
+        function becomes the entry specialised for it (:data:`_RAW_ENTRY`)."""
+        env["LAST"] = (offset, size, tp, slave, copy)
+        if copy is None:
+            return
+        key = (slave, offset, size, tp)
+        code = entries.get(key)
+        if code is None:
+            code = entries[key] = _raw_entry(env, io, len(entries), key, seen[0], copy.spec)
+        entry.__code__ = code
+
+    #: (slave, offset, size, buffer type) -> the code of the public function specialised
+    #: for that shape (the copy inline, behind the checks of the shape and the session)
+    entries: dict[tuple, Any] = {}
 
     env = {
+        "LAST": (-1, -1, None, -1, None),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
         "session": session,
         "seen": seen,
         "copiers": copiers,
         "copier": copier,
-        "reset": lambda image: (
-            cache.clear(),
-            copiers.clear(),
-            casts.clear(),
-            seen.__setitem__(slice(None), [image, memoryview(image.buffer)]),
-        ),
+        "reset": reset,
+        "remember": remember,
         "advance": advance,
         "name": name,
         "slow": slow,
     }
     gt = _compiled_raw(env, io)
+    env["generic"] = gt
     env["run"] = lambda *a: run(*a)
+    # the public function: until a shape is seen, the generic one; then specialised
+    entry = _raw_entry(env, io, -1, None, None, None)
+    base_code = entry.__code__
 
     def run(slave: int, offset: Any, size: Any, p: Any, args: tuple) -> int:
         ctl = session.controllers.get(1)
@@ -645,8 +725,84 @@ def fast_raw(
             return advance(ctl, name, 0)
         return 0
 
-    gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    entry.slow = slow  # type: ignore[attr-defined]
+    entry.generic = gt  # type: ignore[attr-defined]
+    return entry
+
+
+#: the public raw function specialised for the shape of the latest call (a polling loop
+#: repeats its shape): that shape's checks, the session's, and its copy inline; any other
+#: call: the generic function (which specialises it again for its own shape)
+_RAW_ENTRY = """
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+    if (
+        type(p) is T{n}
+        and offset == {offset}
+        and size == {size}
+        and type(offset) is int
+        and type(size) is int{slave_guard}
+        and not extra
+        and not kw{ok}
+    ):
+        try:
+            ctl = session.controllers[1]
+        except KeyError:  # no controller: the generic path says why
+            return generic({slave_arg}offset, size, p)
+        m = ctl.master
+        clock = ctl.clock
+        if (
+            session.plain  # (in this process, core 1)
+            and m is not None
+            and m.image is IMG{n}
+            and m.opened
+            and not m.offline
+            and clock._thread is None
+        ):
+            try:
+                {move}
+            except Exception:  # (the buffer's own refusal): the generic path answers
+                pass
+            else:
+                session.last = None
+                if clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+    return generic({slave_arg}offset, size, p, *extra, **kw)
+"""
+
+_RAW_BASE = """
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+    return generic({slave_arg}offset, size, p, *extra, **kw)
+"""
+
+
+def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec: Any) -> Any:
+    """The public function (``n`` -1: the generic one's front) or, for shape ``key`` of
+    ``image`` with its copier's ``spec``, the code of its specialised entry; the names it
+    uses go into ``env`` (its globals) with the suffix ``n``."""
+    fmt = {"slave": "slave=_NO, " if io else "", "slave_arg": "slave, " if io else ""}
+    if n < 0:
+        exec(compile(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>", "exec"), env)
+        return env.pop("gt")
+    slave, offset, size, tp = key
+    ok, move, names = spec
+    for k, v in names.items():
+        move = re.sub(rf"\b{k}\b", f"{k}_{n}", move)
+        ok = [re.sub(rf"\b{k}\b", f"{k}_{n}", x) for x in ok]
+        env[f"{k}_{n}"] = v
+    env[f"T{n}"], env[f"IMG{n}"] = tp, image
+    code = _RAW_ENTRY.format(
+        **fmt,
+        n=n,
+        offset=offset,
+        size=size,
+        slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
+        ok="".join(f"\n        and {x}" for x in ok),
+        move=move,
+    )
+    scratch: dict[str, Any] = {}
+    exec(compile(code, f"<gt fast raw {env['name']} shape {n}>", "exec"), env, scratch)
+    return scratch["gt"].__code__
 
 
 #: the raw image functions' common shapes in the fewest steps (the IO pair with the slave
@@ -660,8 +816,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
         ctl is not None
         and type(offset) is int
         and type(size) is int
-        and session.remote is None
-        and session.core == 1
+        and session.plain  # (in this process, core 1)
     ):
         m = ctl.master
         clock = ctl.clock
@@ -669,10 +824,18 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
             image = m.image
             if image is not seen[0]:
                 reset(image)
-            key = ({slave_key}, offset, size, type(p))
-            copy = copiers.get(key, _NO)
-            if copy is _NO:
-                copy = copiers[key] = copier({slave_key}, offset, size, type(p), image)
+            tp = type(p)
+            # the shape of the previous call (a polling loop repeats its shape), else the
+            # copiers by shape
+            last = LAST  # (one read: another thread may replace it meanwhile)
+            if offset == last[0] and size == last[1] and tp is last[2]{slave_memo}:
+                copy = last[4]
+            else:
+                key = ({slave_key}, offset, size, tp)
+                copy = copiers.get(key, _NO)
+                if copy is _NO:
+                    copy = copiers[key] = copier({slave_key}, offset, size, tp, image)
+                remember(offset, size, tp, {slave_key}, copy)
             if copy is None:
                 done = False
             else:
@@ -695,6 +858,7 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
         slave_check=" or type(slave) is not int" if io else "",
         slave_arg="slave, " if io else "",
         slave_key="slave" if io else "-1",
+        slave_memo=" and slave == last[3]" if io else "",
     )
     exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
     return env["gt"]
@@ -716,7 +880,8 @@ SLOW_REASONS: dict[str, str] = {
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
     "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
-    "ecat_axis": "per-axis PDO readers and homing/probe status: table path (a few microseconds)",
+    "ecat_axis": "homing and probe status, the axis mode, analog inputs and the scale: table "
+    "path; the per-axis PDO readers that polling loops use are on the fast path",
     "ecat_io": "one output bit read: table path",
     "emulator": "emulator helpers for tests, not called in control loops",
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
@@ -736,4 +901,121 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW | {CLOCK}
+    return frozenset(READERS) | RAW | {CLOCK} | frozenset(ECAT_READERS)
+
+
+#: the per-axis PDO readers (axis_calls._reader): function -> the object it reads
+ECAT_READERS: dict[str, tuple[int, int]] = {
+    "GT_GetEcatEncPos": (0x6064, 0),
+    "GT_GetEcatEncVel": (0x606C, 0),
+    "GT_GetEcatAxisPE": (0x60F4, 0),
+    "GT_GetEcatAxisDI": (0x60FD, 0),
+    "GT_GetEcatAxisDO": (0x60FE, 1),
+    "GT_GetEcatAxisAtITorque": (0x6077, 0),
+    "GT_GetEcatAxisAtICurrent": (0x6078, 0),
+    "GT_GetEcatErrorCode": (0x603F, 0),
+}
+
+
+def fast_ecat_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetEcatEncPos(axis, p)`` and the other per-axis PDO readers with the fast path in
+    front of the table: ``p`` a ``byref`` (no offset) or the object itself of a number type
+    the pointer takes, holding the value; the axis on the in-process controller's bus (no
+    pulse card), its link up, the object mapped, and not run by the axis bank at the moment
+    (its objects are then its own: the table path gives it back first).  Anything else
+    (an error included) takes the table path, which gives the code and the reason."""
+    from ..controller.axis import Axis
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    index, subindex = ECAT_READERS[name]
+    param = FUNCTIONS[name].params[1]
+    ok = _scalar_types(param)
+    bounds = {}
+    for t in ok:
+        bits = 8 * ctypes.sizeof(t)
+        bounds[t] = (
+            (0, (1 << bits) - 1)
+            if t._type_.isupper()
+            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        )
+    env = {
+        "_NO": _NO,
+        "_CArg": _CArg,
+        "_LOCKSTEP": _LOCKSTEP,
+        "_addressof": _addressof,
+        "_AXIS": Axis,
+        "session": session,
+        "advance": advance,
+        "name": name,
+        "slow": slow,
+        "ok": ok,
+        "BOUNDS": bounds,
+        "INDEX": index,
+        "SUB": subindex,
+        "ACCS": {},
+        "last": [None],
+        "_refs": sys.getrefcount,
+        "KEPT": _KEPT,
+    }
+    env.update(CARG_ENV)
+    code = _ECAT_READER.replace("{address}", carg_address_source("p"))
+    exec(compile(code, f"<gt fast ecat {name}>", "exec"), env)
+    gt = env["gt"]
+    gt.slow = slow
+    return gt
+
+
+_ECAT_READER = """
+def gt(n=_NO, p=_NO, /, *extra, **kw):
+    if type(n) is int and not kw and not extra:
+        try:
+            ctl = session.controllers[1]
+            ax = ctl.axes[n]
+        except KeyError:  # no controller, or no such axis: the table path says why
+            return slow(*(a for a in (n, p) if a is not _NO))
+        clock = ctl.clock
+        m = ctl.master
+        if (
+            type(ax) is _AXIS  # (a guarded axis, the bank's: the table path)
+            and session.plain  # (in this process, core 1)
+            and clock._thread is None
+            and m is not None
+            and m.opened
+            and ctl.card is None
+            and not ax.link_lost
+        ):
+            kept = ACCS.get(n)  # (the axis's entry, kept: AxisIo.get keeps it too)
+            if kept is None or kept[0] is not ax:
+                if len(ACCS) > 4096:
+                    ACCS.clear()
+                kept = ACCS[n] = (ax, ax.io.get(INDEX, SUB))
+            acc = kept[1]  # (None: not mapped; the table path says so)
+            if acc is not None:
+                tp = type(p)
+                if tp is _CArg:
+                    obj = p._obj
+                    if p is not last[0]:
+                        if type(obj) not in ok or {address} != _addressof(obj):
+                            return slow(n, p)  # (p is a byref here)
+                        if _refs(p) > KEPT:  # (kept by the caller: see _KEPT)
+                            last[0] = p
+                elif tp in ok:
+                    obj = p
+                else:
+                    return slow(*(a for a in (n, p) if a is not _NO))
+                v = acc.get()
+                lo, hi = BOUNDS[type(obj)]
+                if lo <= v <= hi:  # (else store's refusal: the table path)
+                    obj.value = v
+                    session.last = None
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+    return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+"""

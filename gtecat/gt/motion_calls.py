@@ -42,7 +42,7 @@ from ..controller.profile import PrfMode
 from ..controller.resources import AxisResources, axes_in_mask, axis_resources, axis_span
 from ..errors import CommandError, ParameterError
 from ._core import check_range, gt_function, store, store_array, struct_arg
-from .fast import attr_getter
+from .fast import attr_getter, prf_mode_value
 from .structs import TJogPrm, TTrapPrm
 
 #: GT_Stop mask/option bit of coordinate system 1 (entry 131: bit 12 crd 1, bit 13 crd 2)
@@ -100,7 +100,7 @@ def GT_GetPrfMode(
     ctl: Controller, profile: int, pValue: Any, count: int = 1, pClock: Any = None
 ) -> int:
     """Motion mode: 0 Trap, 1 Jog, 2 PT, 3 Gear, 4 Follow, 5 interpolation, 6 PVT (entry 63)."""
-    return _read_many(ctl, profile, pValue, count, pClock, lambda r: int(r.profile.mode))
+    return _read_many(ctl, profile, pValue, count, pClock, prf_mode_value)
 
 
 # --- Trap ------------------------------------------------------------------------------------

@@ -41,12 +41,12 @@ from ..controller.scale import Scale
 from ..errors import BusError, CommandError, ParameterError
 from ._core import check_range, gt_function, load_bytes, store
 from .constants import MC_LIMIT_NEGATIVE, MC_LIMIT_POSITIVE
+from .fast import prf_sts_value
 from .motion_calls import _read_many, long_arg, real_arg
 
 #: GT_LoadConfig file names longer than this fail (manual 4.4 "注意")
 _CONFIG_NAME_MAX = 125
 _ENCODER_BITS = 12  # GT_EncSns: bit0..bit11 = encoders 1..12
-_PRF_MOVING = 1 << 10  # table 6-2 bit 10: the one bit of a profile's own (GT_GetPrfSts)
 
 
 # --- status ------------------------------------------------------------------------------------
@@ -72,7 +72,7 @@ def GT_GetPrfSts(
     controller has but no drive backs reads 0, as the field's ``GTN_GetPrfSts(1, 1, sts, 5)``
     expects on a machine of fewer axes; a span past the controller's profiles is 7.
     """
-    return _read_many(ctl, profile, pSts, count, pClock, lambda r: r.status() & _PRF_MOVING)
+    return _read_many(ctl, profile, pSts, count, pClock, prf_sts_value)
 
 
 @gt_function

@@ -133,10 +133,15 @@ class Clock:
                 return pred()
         budget = round(timeout_ms * 1_000_000)
         spent = 0
+        many = self.run_many
         while not pred():
             if spent >= budget:
                 return False
-            self.cycle()
+            if many is not None and many(1):  # the owner ran it its quick way
+                self.cycles += 1
+                self.now_ns += self.cycle_ns
+            else:
+                self.cycle()
             spent += self.cycle_ns
             if self.group is not None:
                 self.group.share(self, self.cycle_ns)

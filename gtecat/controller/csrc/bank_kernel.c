@@ -28,6 +28,18 @@
 #define INLINE static inline
 #endif
 
+/* The hot loops built twice, the processor picking at load time (glibc's ifunc): with SSE4.1
+ * rint is one instruction (roundsd, rounding as rint does: the same bits), else the baseline
+ * sequence.  Nothing else differs (no FMA: -ffp-contract=off either way). */
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__GLIBC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define CLONES __attribute__((target_clones("sse4.1", "default")))
+#endif
+#endif
+#ifndef CLONES
+#define CLONES
+#endif
+
 #define FIELDS                                                                          \
     X(alive, u8) X(moving, u8) X(jog, u8) X(ended, u8) X(base, i64) X(t_cur, i64)          \
     X(t_end, i64) X(t_idx, i64) X(taken, i64) X(t_p, f64)                                  \
@@ -37,6 +49,7 @@
     X(soft_pos, f64) X(soft_neg, f64) X(pos_err, f64) X(band, f64) X(hold_ns, i64)         \
     X(since, i64) X(arrived, u8) X(a_last, f64)                                            \
     X(jrp, f64) X(jrv, f64) X(jp, f64) X(jv, f64) X(ja, f64) X(tau, f64) X(jE, f64)        \
+    X(jgoal, f64) X(jacc, f64) X(jdec, f64)                                                \
     X(c_pos, f64) X(c_vel, f64) X(c_acc, f64) X(c_dpos, f64) X(c_dvel, f64)                \
     X(c_fe_time, f64) X(c_limited, u8) X(c_sw_limited, u8) X(c_start, i64) X(c_din, i64)   \
     X(c_target, i64) X(c_vmax, f64) X(c_e, f64) X(c_c, f64) X(c_lim, f64) X(c_off, i64)   \
@@ -236,12 +249,82 @@ INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *
 }
 
 
+/* bank_trap_fill's final approach of a sample (t - ts = ta): min(p, target) / max(p, target) */
+INLINE double final_approach(double p, double ta, double t_final, double tgt, double dir)
+{
+    if (ta >= t_final) {
+        if (dir > 0.0)
+            p = tgt < p ? tgt : p;
+        else
+            p = tgt > p ? tgt : p;
+    }
+    return p;
+}
+
+#if defined(__GNUC__)
+typedef double v2d __attribute__((vector_size(16)));
+
+/* Samples kk and kk + 1 of bank_trap_fill's smoothed move (ts > 0) at once, two lanes of the
+ * same operations in the same order (each lane its own IEEE result: the same bits), where
+ * both lie in one raw piece, their smoothing windows start in that piece too and neither is
+ * the end sample; 0 (nothing written) otherwise.  *pi, *pj: the pieces of the last sample
+ * (moved on as the scalar loop would). */
+INLINE int trap_pair(const double *sg, int64_t m, double cyc, const double *prm, double thr,
+                     int64_t kk, int64_t *pi, int64_t *pj, double *po, double *vo, double *ao)
+{
+    const double ts = prm[1], t_final = prm[2];
+    const double t0 = (double)kk * cyc, t1 = (double)(kk + 1) * cyc;
+    const double ta0 = t0 - ts, ta1 = t1 - ts;
+    int64_t i = *pi, j = *pj;
+    if (!(t0 < thr && t1 < thr))
+        return 0;
+    while (i + 1 < m && sg[4 * (i + 1)] <= t0)
+        i++;
+    while (j + 1 < m && sg[4 * (j + 1)] <= ta0)
+        j++;
+    *pi = i;
+    *pj = j;
+    if (i != j || (i + 1 < m && sg[4 * (i + 1)] <= t1) || !(t1 - ta1 > 0.0 && t0 - ta0 > 0.0))
+        return 0;
+    {
+        const v2d half = {0.5, 0.5}, six = {6.0, 6.0}, zero = {0.0, 0.0}, tsv = {ts, ts};
+        const v2d s0 = {sg[4 * i], sg[4 * i]}, s1 = {sg[4 * i + 1], sg[4 * i + 1]};
+        const v2d s2 = {sg[4 * i + 2], sg[4 * i + 2]}, s3 = {sg[4 * i + 3], sg[4 * i + 3]};
+        const v2d t = {t0, t1}, ta = {ta0, ta1};
+        v2d tau = t - s0;
+        v2d p = s1 + tau * (s2 + half * s3 * tau);
+        v2d v = s2 + s3 * tau;
+        v2d tk = ta - s0; /* the window's start, in the same piece */
+        v2d vk = s2 + s3 * tk;
+        v2d pk = s1 + tk * (s2 + half * s3 * tk) - p;
+        v2d span = t - ta;
+        /* the divisions that give a zero back are left out (a piece at constant speed):
+         * ak * span / 6.0 and (v - va) / ts of a zero are that zero (ts > 0) */
+        v2d as6 = s3[0] == 0.0 ? s3 * span : s3 * span / six;
+        v2d total = zero + span * (pk + span * (half * vk + as6));
+        v2d dist = zero + span * (vk + half * s3 * span);
+        v2d a = v - vk;
+        if (a[0] != 0.0 || a[1] != 0.0)
+            a = a / tsv;
+        p = p + total / tsv;
+        v = dist / tsv;
+        po[0] = final_approach(p[0], ta0, t_final, prm[3], prm[4]);
+        po[1] = final_approach(p[1], ta1, t_final, prm[3], prm[4]);
+        vo[0] = v[0];
+        vo[1] = v[1];
+        ao[0] = a[0];
+        ao[1] = a[1];
+    }
+    return 1;
+}
+#endif
+
 /* motion/trap_table.py's trap_table for one planner, sample by sample in the planner's own
  * order of operations (TrapPlanner._sample): samples k0+1 .. k0+n of the move whose raw
  * pieces are sg[4*q .. 4*q+3] = (t0, p0, v0, a), q < m.  Writes min(end + 1, n) samples;
  * returns end, the index of the end sample (target, 0, 0), or n when the move goes on. */
-int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm, int64_t k0,
-                       int64_t n, double *po, double *vo, double *ao)
+CLONES int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *prm,
+                              int64_t k0, int64_t n, double *po, double *vo, double *ao)
 {
     const double t_done = prm[0], ts = prm[1], t_final = prm[2], tgt = prm[3], dir = prm[4];
     const double thr = t_done - 1e-9 * (1.0 + t_done * 1e-3); /* _EPS_T */
@@ -249,6 +332,13 @@ int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *pr
     for (s = 0; s < n; s++) {
         double t = (double)(k0 + 1 + s) * cyc;
         double tau, p, v, a;
+#if defined(__GNUC__)
+        if (ts > 0.0 && s + 1 < n && trap_pair(sg, m, cyc, prm, thr, k0 + 1 + s, &i, &j, po + s,
+                                               vo + s, ao + s)) {
+            s++;
+            continue;
+        }
+#endif
         if (t >= thr) {
             po[s] = tgt;
             vo[s] = 0.0;
@@ -282,27 +372,94 @@ int64_t bank_trap_fill(const double *sg, int64_t m, double cyc, const double *pr
                 hi = k == i ? t : sg[4 * (k + 1)];
                 span = hi - lo;
                 if (span > 0.0) {
-                    total = total + span * (pk + span * (0.5 * vk + ak * span / 6.0));
+                    /* ak * span / 6.0, the division left out where it gives its zero back
+                     * (a piece at constant speed): the divider is this loop's bottleneck */
+                    const double as = ak * span, as6 = as == 0.0 ? as : as / 6.0;
+                    total = total + span * (pk + span * (0.5 * vk + as6));
                     dist = dist + span * (vk + 0.5 * ak * span);
                 }
                 if (k >= i)
                     break;
             }
             p = p + total / ts;
-            a = (v - va) / ts;
+            a = v - va; /* (v - va) / ts: a zero stays the same zero (ts > 0) */
+            if (a != 0.0)
+                a = a / ts;
             v = dist / ts;
         }
-        if (t - ts >= t_final) { /* the final approach: min(p, target) / max(p, target) */
-            if (dir > 0.0)
-                p = tgt < p ? tgt : p;
-            else
-                p = tgt > p ? tgt : p;
-        }
-        po[s] = p;
+        po[s] = final_approach(p, t - ts, t_final, tgt, dir);
         vo[s] = v;
         ao[s] = a;
     }
     return n;
+}
+
+/* gtecat.controller.motion.jog.ramp_step (advance, then the snap onto the goal) for a jog
+ * whose raw speed is not at its goal: the raw ramp in constant-acceleration pieces, a ramp
+ * end inside the cycle split there, each piece through the smoothing filter; the same
+ * operations in the same order (exp is the C library's, as Python's math.exp).
+ * o[0..4] = raw position, raw speed, output position, speed, acceleration. */
+static void jog_ramp(double p, double v, double goal, double acc, double dec, double dt,
+                     double tau, double fp, double fv, double fa, double *o)
+{
+    for (;;) {
+        double a, h, rate, aim = 0.0;
+        int reached;
+        if (v == goal) {
+            a = 0.0;
+            h = dt;
+            reached = 0;
+        } else {
+            if (v == 0.0 || ((v > 0.0) == (goal > 0.0) && fabs(goal) > fabs(v))) {
+                rate = acc; /* speeding up (from rest or in the same direction) */
+                aim = goal;
+            } else if ((v > 0.0) == (goal > 0.0) && goal != 0.0) {
+                rate = dec; /* slowing down to a lower speed */
+                aim = goal;
+            } else {
+                rate = dec; /* braking to reverse or to stop */
+                aim = 0.0;
+            }
+            a = aim > v ? rate : -rate;
+            h = (aim - v) / a;
+            reached = h <= dt;
+            if (!reached)
+                h = dt;
+        }
+        if (h > 0.0) {
+            const double p1 = p + h * (v + 0.5 * a * h);
+            const double v1 = v + a * h;
+            if (tau > 0.0) {
+                const double e = exp(-h / tau);
+                const double ta = tau * a;
+                fp = p1 - tau * (v1 - ta) + (fp - p + tau * (v - ta)) * e;
+                fv = v1 - ta + (fv - v + ta) * e;
+                fa = a + (fa - a) * e;
+            }
+            p = p1;
+            v = reached ? aim : v1;
+            dt -= h;
+        } else if (reached) {
+            v = aim;
+        }
+        if (!reached) {
+            if (tau <= 0.0) {
+                fp = p;
+                fv = v;
+                fa = a;
+            }
+            if (v == goal && fv != goal && fabs(fv - goal) <= 1e-9 * (1.0 + fabs(goal))) {
+                fv = goal;
+                fa = 0.0;
+            }
+            o[0] = p;
+            o[1] = v;
+            o[2] = fp;
+            o[3] = fv;
+            o[4] = fa;
+            return;
+        }
+    }
 }
 
 /* AxisBank._refill of row r in the kernel: the last sample taken moves to the row's spare
@@ -390,9 +547,52 @@ INLINE int commit_cursors(void **ptr, int64_t n)
     return fin_any;
 }
 
+/* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement) */
+INLINE void write_image(void **ptr, const int64_t *io)
+{
+    uint8_t *buf = U8(buf);
+    int64_t i;
+    for (i = 0; i < io[IN_N_PLC]; i++) {
+        int64_t row = I64(pl_row)[i], val;
+        uint32_t u;
+        switch (I64(pl_col)[i]) {
+        case 0: val = I64(c_target)[row]; break;
+        case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
+        case 2: val = I64(c_din)[row]; break;
+        case 3:
+            val = I64(c_sw_const)[row] +
+                  ((U8(c_limited)[row] | U8(c_sw_limited)[row]) ? 0x800 : 0);
+            break;
+        case 4: val = to_i64(rint(F64(c_dpos)[row] - (double)I64(c_off)[row])); break;
+        case 5: val = to_i64(rint(F64(c_vel)[row])); break;
+        case 6: val = to_i64(rint(F64(c_dpos)[row] - F64(c_pos)[row])); break;
+        default:
+            val = clip16(F64(c_acc)[row] / F64(c_a_rated)[row] * 1000.0 +
+                         F64(c_vel)[row] * F64(c_visc)[row]);
+        }
+        u = (uint32_t)(uint64_t)val;
+        {
+            int64_t k, off = I64(pl_off)[i], size = I64(pl_size)[i];
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            if (size == 4) { /* the PDO's little-endian bytes are the value's own */
+                memcpy(buf + off, &u, 4);
+                continue;
+            }
+            if (size == 2) {
+                uint16_t u16 = (uint16_t)u;
+                memcpy(buf + off, &u16, 2);
+                continue;
+            }
+#endif
+            for (k = 0; k < size; k++)
+                buf[off + k] = (uint8_t)(u >> (8 * k));
+        }
+    }
+}
+
 /* inlined where the field table is a local copy: the compiler then knows no store through a
  * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
-INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
+INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, int check_rx)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
@@ -403,8 +603,10 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
     int fin_any = 0, csp_hit = 0, hm_hit = 0;
     const uint8_t *hm = U8(hm);
 
-    /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back */
-    for (i = 0; i < io[IN_N_RX]; i++)
+    /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back (looked at
+     * in the first cycle of a call: nothing else writes them until it returns, the cycle
+     * itself writes no such byte) */
+    for (i = 0; check_rx && i < io[IN_N_RX]; i++)
         if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i])
             return 1;
 
@@ -441,7 +643,12 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
             }
             prf = F64(t_p)[I64(base)[r] + cur];
             ended = cur == I64(t_end)[r];
-            if (U8(jog)[r]) { /* AxisBank._jog_step */
+            if (U8(jog)[r] && F64(jrv)[r] != F64(jgoal)[r]) { /* a ramp: jog.ramp_step */
+                double *o = F64(s_jog) + 5 * r;
+                jog_ramp(F64(jrp)[r], F64(jrv)[r], F64(jgoal)[r], F64(jacc)[r], F64(jdec)[r], h,
+                         F64(tau)[r], F64(jp)[r], F64(jv)[r], F64(ja)[r], o);
+                prf = o[2];
+            } else if (U8(jog)[r]) { /* AxisBank._jog_step */
                 double rp = F64(jrp)[r], jv = F64(jrv)[r], fp_ = F64(jp)[r], fv = F64(jv)[r];
                 double fa = F64(ja)[r], tau = F64(tau)[r], e = F64(jE)[r];
                 double p1 = rp + h * (jv + 0.5 * 0.0 * h);
@@ -707,44 +914,414 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go)
 
     /* 8. the image: 607Ah out, the drives' TxPDO in */
 image:
-    for (i = 0; i < io[IN_N_PLC]; i++) {
-        int64_t row = I64(pl_row)[i], val;
-        uint32_t u;
-        switch (I64(pl_col)[i]) {
-        case 0: val = I64(c_target)[row]; break;
-        case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
-        case 2: val = I64(c_din)[row]; break;
-        case 3:
-            val = I64(c_sw_const)[row] +
-                  ((U8(c_limited)[row] | U8(c_sw_limited)[row]) ? 0x800 : 0);
-            break;
-        case 4: val = to_i64(rint(F64(c_dpos)[row] - (double)I64(c_off)[row])); break;
-        case 5: val = to_i64(rint(F64(c_vel)[row])); break;
-        case 6: val = to_i64(rint(F64(c_dpos)[row] - F64(c_pos)[row])); break;
-        default:
-            val = clip16(F64(c_acc)[row] / F64(c_a_rated)[row] * 1000.0 +
-                         F64(c_vel)[row] * F64(c_visc)[row]);
-        }
-        u = (uint32_t)(uint64_t)val;
-        {
-            int64_t k, off = I64(pl_off)[i], size = I64(pl_size)[i];
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-            if (size == 4) { /* the PDO's little-endian bytes are the value's own */
-                memcpy(buf + off, &u, 4);
-                continue;
-            }
-            if (size == 2) {
-                uint16_t u16 = (uint16_t)u;
-                memcpy(buf + off, &u16, 2);
-                continue;
-            }
-#endif
-            for (k = 0; k < size; k++)
-                buf[off + k] = (uint8_t)(u >> (8 * k));
-        }
-    }
+    write_image(ptr, io);
     io[OUT_FIN] = fin_any;
     return 0;
+}
+
+/* Many cycles row by row (bank_kernel_run when every stepping row is in CSP).  The rows of
+ * such a bank do not read each other: a row's cycles are its own chain, the same operations
+ * in the same order as in cycle_once's three passes and its commit, whichever row runs
+ * first.  So each row runs all the cycles of the call at once with its state in locals, and
+ * the call commits the cycles every row could run: a row stops before a cycle it declines
+ * (cycle_once would decline that cycle for the whole bank) and after the cycle that ends its
+ * Trap move (the run stops there).  A row that ran further than the shortest one is put back
+ * (its table as it was) and runs again to that length. */
+typedef struct {
+    double pos, vel, acc, dpos, dvel, fe_time, a, enc_pos, step0, step1;
+    double jrp, jrv, jp, jv, ja;
+    int64_t target, din, enc_prev, since, cur, t_idx, taken, t_len, t_end;
+    int64_t len; /* the cycles run */
+    int code;    /* 0, or why the next cycle is declined */
+    uint8_t lim, swl, arrived, moving, ended, fin, refilled;
+} RowRun;
+
+INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
+{
+    F64(c_pos)[r] = s->pos;
+    F64(c_vel)[r] = s->vel;
+    F64(c_acc)[r] = s->acc;
+    F64(c_dpos)[r] = s->dpos;
+    F64(c_dvel)[r] = s->dvel;
+    F64(c_fe_time)[r] = s->fe_time;
+    F64(a_last)[r] = s->a;
+    F64(enc_pos)[r] = s->enc_pos;
+    F64(enc_step0)[r] = s->step0;
+    F64(enc_step1)[r] = s->step1;
+    F64(jrp)[r] = s->jrp;
+    F64(jrv)[r] = s->jrv;
+    F64(jp)[r] = s->jp;
+    F64(jv)[r] = s->jv;
+    F64(ja)[r] = s->ja;
+    I64(c_target)[r] = s->target;
+    I64(c_din)[r] = s->din;
+    I64(enc_prev)[r] = s->enc_prev;
+    I64(since)[r] = s->since;
+    I64(t_cur)[r] = s->cur;
+    I64(t_idx)[r] = s->t_idx;
+    I64(taken)[r] = s->taken;
+    I64(t_len)[r] = s->t_len;
+    I64(t_end)[r] = s->t_end;
+    U8(c_limited)[r] = s->lim;
+    U8(c_sw_limited)[r] = s->swl;
+    U8(arrived)[r] = s->arrived;
+    U8(moving)[r] = s->moving;
+    U8(ended)[r] = s->ended;
+}
+
+/* Row r's cycles from the state in s, at most `limit` of them (see RowRun).  Before its first
+ * refill the row's table (TABLE + 1 samples of position, speed, acceleration) is kept in bk. */
+INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
+                         int64_t limit, double *bk, const int plain)
+{
+    const double dt = fp[FP_DT], h = fp[FP_T];
+    const double half_per_dt = 0.5 / dt;
+    const int64_t t0 = io[IN_T_NS], dt_ns = io[IN_DT_NS], table = io[IN_TABLE];
+    const int64_t base = I64(base)[r];
+    double *const tp = F64(t_p), *const tv = F64(t_v), *const ta = F64(t_a);
+    const int jog = plain ? 0 : U8(jog)[r];
+    const double tau = F64(tau)[r], e = F64(jE)[r];
+    const double prf_ratio = F64(prf_ratio)[r], prf_off = F64(prf_off)[r], unit2 = F64(unit2)[r];
+    const int64_t drive_offset = I64(drive_offset)[r], pos_offset = I64(c_pos_offset)[r];
+    const int64_t sw_min = I64(c_sw_min)[r], sw_max = I64(c_sw_max)[r], off = I64(c_off)[r];
+    const double vmax = F64(c_vmax)[r], ce = F64(c_e)[r], cc = F64(c_c)[r], lim = F64(c_lim)[r];
+    const int fe_check = U8(c_fe_check)[r];
+    const double fe_window = F64(c_fe_window)[r], fe_timeout = F64(c_fe_timeout)[r];
+    const double pl = F64(c_pl)[r], nl = F64(c_nl)[r];
+    const int external = U8(external)[r];
+    const int64_t sense = I64(sense)[r];
+    const double unit = F64(unit)[r], enc_ratio = F64(enc_ratio)[r], enc_off = F64(enc_off)[r];
+    const double soft_pos = F64(soft_pos)[r], soft_neg = F64(soft_neg)[r];
+    const double pos_err = F64(pos_err)[r], band = plain ? 0.0 : F64(band)[r];
+    const int64_t hold_ns = I64(hold_ns)[r];
+    const int64_t w2 = plain ? 0 : io[IN_W2], w16 = plain ? 0 : io[IN_W16];
+    const int64_t w17 = plain ? 0 : io[IN_W17];
+    /* the row's state in locals (from the committed arrays: a row run again starts there) */
+    double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r],
+        q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r],
+        q_a = F64(a_last)[r], q_enc_pos = F64(enc_pos)[r], q_step0 = F64(enc_step0)[r],
+        q_step1 = F64(enc_step1)[r], q_jrp = F64(jrp)[r], q_jrv = F64(jrv)[r], q_jp = F64(jp)[r],
+        q_jv = F64(jv)[r], q_ja = F64(ja)[r];
+    int64_t q_target = I64(c_target)[r], q_din = I64(c_din)[r], q_enc_prev = I64(enc_prev)[r],
+        q_since = I64(since)[r], q_cur = I64(t_cur)[r], q_t_idx = I64(t_idx)[r],
+        q_taken = I64(taken)[r], q_t_len = I64(t_len)[r], q_t_end = I64(t_end)[r];
+    uint8_t q_lim = U8(c_limited)[r], q_swl = U8(c_sw_limited)[r], q_arrived = U8(arrived)[r],
+        q_moving = U8(moving)[r], q_ended = U8(ended)[r], q_fin = 0, q_refilled = 0;
+    int q_code = 0;
+    int64_t c;
+    for (c = 0; c < limit; c++) {
+        const int64_t t_ns = t0 + c * dt_ns;
+        int64_t cur = q_cur, counts, x, target, pa, din, raw, since;
+        int32_t d32;
+        double prf, a, demand, dvel, p1 = 0.0, v1 = 0.0, nfp = 0.0, nfv = 0.0, nfa = 0.0;
+        double p, v0, vff, e1, v, dist, rel, vstop, dv, pos, fe, step, enc, err;
+        int swl = 0, ended, limited = 0, arr;
+        /* pass 1: the profile and the demand */
+        if (q_moving && cur >= q_t_len) { /* the table is used up: the next one (refill_row) */
+            const int64_t m = I64(nseg)[r];
+            int64_t end;
+            if (m <= 0) {
+                q_code = 4;
+                break;
+            }
+            if (!q_refilled) {
+                memcpy(bk, tp + base, (size_t)(table + 1) * sizeof(double));
+                memcpy(bk + table + 1, tv + base, (size_t)(table + 1) * sizeof(double));
+                memcpy(bk + 2 * (table + 1), ta + base, (size_t)(table + 1) * sizeof(double));
+                q_refilled = 1;
+            }
+            tp[base + table] = tp[q_t_idx];
+            tv[base + table] = tv[q_t_idx];
+            ta[base + table] = ta[q_t_idx];
+            q_t_idx = base + table;
+            end = bank_trap_fill(F64(seg) + 4 * MAXSEG * r, m, F64(tprm)[NTPRM * r + 5],
+                                 F64(tprm) + NTPRM * r, I64(k0)[r] + q_taken, table, tp + base,
+                                 tv + base, ta + base);
+            q_t_len = end < table ? end + 1 : table;
+            q_t_end = end < table ? end : -1;
+            q_cur = cur = 0;
+        }
+        prf = tp[base + cur];
+        ended = cur == q_t_end;
+        if (jog) { /* AxisBank._jog_step */
+            const double rp = q_jrp, jv = q_jrv, fp_ = q_jp, fv = q_jv, fa = q_ja;
+            p1 = rp + h * (jv + 0.5 * 0.0 * h);
+            v1 = jv + 0.0 * h;
+            if (tau > 0.0) {
+                nfp = p1 - tau * (v1 - 0.0) + (fp_ - rp + tau * (jv - 0.0)) * e;
+                nfv = v1 - 0.0 + (fv - jv + 0.0) * e;
+                nfa = 0.0 + (fa - 0.0) * e;
+            } else {
+                nfp = p1;
+                nfv = v1;
+                nfa = 0.0;
+            }
+            if (nfv != v1 && fabs(nfv - v1) <= 1e-9 * (1.0 + fabs(v1))) {
+                nfv = v1;
+                nfa = 0.0;
+            }
+            prf = nfp;
+        }
+        a = plain ? prf : link(prf, prf_ratio, prf_off);
+        {
+            double scaled = a * unit2;
+            if (!(fabs(scaled) < 4611686018427387904.0)) { /* 2**62, bank.HUGE_COUNTS */
+                q_code = 2;
+                break;
+            }
+            counts = to_i64(rint(scaled)) + drive_offset;
+        }
+        target = (int32_t)(uint32_t)(uint64_t)counts;
+        x = target + pos_offset;
+        if (x < sw_min || x > sw_max)
+            swl = 1;
+        if (x < sw_min)
+            x = sw_min;
+        if (x > sw_max)
+            x = sw_max;
+        x += off;
+        demand = (double)x;
+        dvel = (demand - q_dpos) / dt;
+        /* pass 2: Mechanics.track */
+        p = q_pos;
+        v0 = q_vel;
+        vff = dvel;
+        if (vff < -vmax)
+            vff = -vmax;
+        if (vff > vmax)
+            vff = vmax;
+        e1 = (demand - vff * dt - p) * ce + cc * vff;
+        v = (demand - e1 - p) / dt;
+        dist = demand - p;
+        rel = dist - vff * dt;
+        vstop = fabs(rel) * half_per_dt;
+        if (vstop > 0.5 * lim)
+            vstop = 0.5 * lim;
+        if (fabs(v - vff) > vstop) {
+            vstop = closing_speed(fabs(rel), lim, dt);
+            if (rel > 0.0 && v > vff + vstop) {
+                v = vff + vstop;
+                limited = 1;
+            } else if (rel < 0.0 && v < vff - vstop) {
+                v = vff - vstop;
+                limited = 1;
+            }
+        }
+        dv = v - v0;
+        if (dv > lim) {
+            v = v0 + lim;
+            limited = 1;
+        } else if (dv < -lim) {
+            v = v0 - lim;
+            limited = 1;
+        }
+        if (limited) {
+            if (rel > 0.0 && dist > 0.0 && v * dt > dist)
+                v = dist / dt;
+            else if (rel < 0.0 && dist < 0.0 && v * dt < dist)
+                v = dist / dt;
+        }
+        if (v > vmax) {
+            v = vmax;
+            limited = 1;
+        } else if (v < -vmax) {
+            v = -vmax;
+            limited = 1;
+        }
+        pos = p + v * dt;
+        /* pass 3: the feedback, the checks and the in-position band */
+        {
+            /* without a branch on the window: a following error near it comes and goes
+             * from cycle to cycle, which no branch predictor follows */
+            const int out = fe_check & (fabs(demand - pos) > fe_window);
+            const double fe_in = q_fe_time + dt;
+            fe = out ? fe_in : 0.0;
+            if (out && fe * 1000.0 > fe_timeout) {
+                q_code = 2;
+                break;
+            }
+        }
+        pa = to_i64(rint(pos - (double)off));
+        din = 2 * (pos >= pl) + (pos <= nl);
+        if (w2 && in_window(F64(w2_lo), F64(w2_hi), w2, r, pos))
+            din |= 1 << 2;
+        if (w16 && in_window(F64(w16_lo), F64(w16_hi), w16, r, pos))
+            din |= 1 << 16;
+        if (w17 && in_window(F64(w17_lo), F64(w17_hi), w17, r, pos))
+            din |= 1 << 17;
+        raw = external ? pa : target;
+        d32 = (int32_t)(uint32_t)(uint64_t)(raw - q_enc_prev);
+        step = (double)(sense * (int64_t)d32) * unit;
+        enc = q_enc_pos + step;
+        err = a - (plain ? enc : link(enc, enc_ratio, enc_off));
+        if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err) {
+            q_code = 2;
+            break;
+        }
+        since = q_since;
+        arr = q_arrived;
+        if (band > 0.0) {
+            const int standing = (ended || !q_moving) && !jog;
+            const int inb = standing && -band <= err && err <= band;
+            since = inb ? (since < 0 ? t_ns : since) : -1;
+            arr = inb && (arr || t_ns - since >= hold_ns);
+        }
+        /* the commit */
+        if (jog) {
+            q_jrp = p1;
+            q_jrv = v1;
+            q_jp = nfp;
+            q_jv = nfv;
+            q_ja = nfa;
+        }
+        q_pos = pos;
+        q_vel = v;
+        q_acc = (v - v0) / dt;
+        q_dpos = demand;
+        q_dvel = dvel;
+        q_fe_time = fe;
+        q_lim = (uint8_t)limited;
+        q_swl = (uint8_t)swl;
+        q_target = target;
+        q_din = din;
+        q_a = a;
+        q_t_idx = base + cur;
+        q_enc_prev = raw;
+        q_enc_pos = enc;
+        q_step0 = q_step1;
+        q_step1 = step;
+        q_since = since;
+        q_arrived = (uint8_t)arr;
+        q_taken += q_moving;
+        if (q_moving) {
+            if (ended) {
+                q_ended = 1;
+                q_moving = 0;
+                q_fin = 1;
+                c++;
+                break;
+            }
+            q_cur = cur + 1;
+        }
+    }
+    s->len = c;
+    s->code = q_code;
+    s->pos = q_pos;
+    s->vel = q_vel;
+    s->acc = q_acc;
+    s->dpos = q_dpos;
+    s->dvel = q_dvel;
+    s->fe_time = q_fe_time;
+    s->a = q_a;
+    s->enc_pos = q_enc_pos;
+    s->step0 = q_step0;
+    s->step1 = q_step1;
+    s->jrp = q_jrp;
+    s->jrv = q_jrv;
+    s->jp = q_jp;
+    s->jv = q_jv;
+    s->ja = q_ja;
+    s->target = q_target;
+    s->din = q_din;
+    s->enc_prev = q_enc_prev;
+    s->since = q_since;
+    s->cur = q_cur;
+    s->t_idx = q_t_idx;
+    s->taken = q_taken;
+    s->t_len = q_t_len;
+    s->t_end = q_t_end;
+    s->lim = q_lim;
+    s->swl = q_swl;
+    s->arrived = q_arrived;
+    s->moving = q_moving;
+    s->ended = q_ended;
+    s->fin = q_fin;
+    s->refilled = q_refilled;
+}
+
+/* a row with none of the rarer parts (see row_plain): the same cycles with less to look at */
+CLONES static void row_cycles_plain(void **ptr, const int64_t *io, const double *fp, int64_t r,
+                                    RowRun *s, int64_t limit, double *bk)
+{
+    row_cycles_t(ptr, io, fp, r, s, limit, bk, 1);
+}
+
+CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, int64_t r, RowRun *s,
+                              int64_t limit, double *bk)
+{
+    row_cycles_t(ptr, io, fp, r, s, limit, bk, 0);
+}
+
+/* row r has none of the rarer parts row_cycles_plain leaves out: no Jog, no switch windows
+ * (home switch, probes), its plan and encoder in pulses as they are (links of ratio 1 and
+ * offset 0) and no in-position band */
+INLINE int row_plain(void **ptr, const int64_t *io, int64_t r)
+{
+    return !U8(jog)[r] && !io[IN_W2] && !io[IN_W16] && !io[IN_W17] &&
+           F64(prf_ratio)[r] == 1.0 && F64(prf_off)[r] == 0.0 && F64(enc_ratio)[r] == 1.0 &&
+           F64(enc_off)[r] == 0.0 && !(F64(band)[r] > 0.0);
+}
+
+/* Row r back where it stood before row_cycles (its table refilled: the table kept in bk). */
+INLINE void row_undo(void **ptr, const int64_t *io, int64_t r, RowRun *s, const double *bk)
+{
+    const int64_t table = io[IN_TABLE], base = I64(base)[r];
+    if (s->refilled) {
+        memcpy(F64(t_p) + base, bk, (size_t)(table + 1) * sizeof(double));
+        memcpy(F64(t_v) + base, bk + table + 1, (size_t)(table + 1) * sizeof(double));
+        memcpy(F64(t_a) + base, bk + 2 * (table + 1), (size_t)(table + 1) * sizeof(double));
+    }
+}
+
+/* bank_kernel_run row by row (see RowRun); the cycles committed */
+static int64_t run_rows(void **ptr, int64_t *io, const double *fp, RowRun *rs, double *bk,
+                        int *rc)
+{
+    const int64_t n = io[IN_N], maxc = io[IN_MAXC], width = 3 * (io[IN_TABLE] + 1);
+    const uint8_t *alive = U8(alive), *frz = U8(frz);
+    int64_t r, lim = maxc, code_row = -1;
+    int fin_any = 0, filled = 0;
+    for (r = 0; r < n; r++) {
+        if (!alive[r] || frz[r])
+            continue;
+        if (row_plain(ptr, io, r))
+            row_cycles_plain(ptr, io, fp, r, rs + r, lim, bk + width * r);
+        else
+            row_cycles(ptr, io, fp, r, rs + r, lim, bk + width * r);
+        if (rs[r].len < lim) /* it stops there (declines the next cycle, or its move ended) */
+            lim = rs[r].len;
+    }
+    for (r = 0; r < n; r++) {
+        RowRun *s = rs + r;
+        if (!alive[r] || frz[r])
+            continue;
+        if (s->len > lim) { /* it ran past the cycles the bank commits: again, that far */
+            row_undo(ptr, io, r, s, bk + width * r);
+            if (row_plain(ptr, io, r))
+                row_cycles_plain(ptr, io, fp, r, s, lim, bk + width * r);
+            else
+                row_cycles(ptr, io, fp, r, s, lim, bk + width * r);
+        }
+        if (s->code && s->len == lim && code_row < 0)
+            code_row = r;
+        fin_any |= s->fin && s->len == lim;
+        filled |= s->refilled;
+    }
+    for (r = 0; r < n; r++) {
+        if (!alive[r]) {
+            I64(c_start)[r] += lim; /* a row left out did not step */
+            continue;
+        }
+        if (!frz[r])
+            row_store(ptr, r, rs + r);
+    }
+    if (lim)
+        write_image(ptr, io);
+    io[OUT_FIN] = fin_any;
+    if (filled)
+        io[OUT_FILLED] = 1;
+    *rc = code_row >= 0 ? rs[code_row].code : 0;
+    return lim;
 }
 
 /* the row flags of one cycle's passes (0: the row does not step, 1: it steps, 2: it steps
@@ -761,29 +1338,63 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
     io[OUT_FILLED] = 0;
     if (io[IN_N] > GO_STACK && !(go = malloc((size_t)io[IN_N])))
         return 5; /* no memory: the numpy cycle runs it */
-    rc = cycle_once(lp, io, fp, go);
+    rc = cycle_once(lp, io, fp, go, 1);
     if (go != stack)
         free(go);
     return rc;
 }
 
+/* the fewest cycles a call runs row by row: each row's run costs its loads and stores once,
+ * which a call of a few cycles does not win back (measured: 128 rows, even at 5-6) */
+#define ROWS_FROM 6
+
 /* Up to io[IN_MAXC] cycles from io[IN_T_NS], io[IN_DT_NS] apart; io[OUT_DONE] = cycles
  * committed.  Stops after a cycle that ended a Trap move (io[OUT_FIN]) and before one the
- * kernel declines (its code is returned, nothing of that cycle written). */
+ * kernel declines (its code is returned, nothing of that cycle written).  Without a homing
+ * row or a ramping jog, ROWS_FROM cycles and more run row by row (run_rows), the image written
+ * once after the last. */
 int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
 {
     void *lp[N_FIELDS];
     uint8_t stack[GO_STACK], *go = stack;
-    int64_t c, maxc = io[IN_MAXC], t0 = io[IN_T_NS];
-    int rc = 0;
+    int64_t c, r, maxc = io[IN_MAXC], t0 = io[IN_T_NS], n = io[IN_N];
+    int rc = 0, rows = 1;
     memcpy(lp, ptr, sizeof lp);
     io[OUT_FILLED] = 0;
     io[OUT_DONE] = 0;
+    io[OUT_FIN] = 0;
+    {
+        const uint8_t *alive = U8(alive), *frz = U8(frz), *hm = U8(hm), *jog = U8(jog);
+        /* a homing row, or a jog whose raw speed still ramps to its goal (jog.ramp_step:
+         * row_cycles steps a cruising jog only), runs cycle by cycle */
+        for (r = 0; r < n; r++)
+            if (alive[r] && !frz[r] && (hm[r] || (jog[r] && F64(jrv)[r] != F64(jgoal)[r])))
+                rows = 0;
+    }
+    if (rows && maxc >= ROWS_FROM) {
+        const uint8_t *buf = U8(buf);
+        RowRun *rs;
+        double *bk;
+        for (r = 0; r < io[IN_N_RX]; r++) /* a raw write to a claimed slave's outputs */
+            if (buf[I64(rx_idx)[r]] != U8(rx_ref)[r])
+                return 1;
+        rs = malloc((size_t)(n > 0 ? n : 1) * sizeof(RowRun));
+        bk = malloc((size_t)(n > 0 ? n : 1) * (size_t)(3 * (io[IN_TABLE] + 1)) * sizeof(double));
+        if (!rs || !bk) {
+            free(rs);
+            free(bk);
+            return 5; /* no memory: the numpy cycle runs it */
+        }
+        io[OUT_DONE] = run_rows(lp, io, fp, rs, bk, &rc);
+        free(rs);
+        free(bk);
+        return rc;
+    }
     if (io[IN_N] > GO_STACK && !(go = malloc((size_t)io[IN_N])))
         return 5; /* no memory: the numpy cycle runs it */
     for (c = 0; c < maxc; c++) {
         io[IN_T_NS] = t0 + c * io[IN_DT_NS];
-        rc = cycle_once(lp, io, fp, go);
+        rc = cycle_once(lp, io, fp, go, c == 0);
         if (rc)
             break;
         if (io[OUT_FIN]) {

@@ -128,6 +128,28 @@ def advance(
             return p, v, a, fp, fv, fa
 
 
+def ramp_step(
+    rp: float,
+    rv: float,
+    goal: float,
+    acc: float,
+    dec: float,
+    dt: float,
+    tau: float,
+    p: float,
+    v: float,
+    a: float,
+) -> tuple[float, float, float, float, float]:
+    """One cycle of a moving jog (:meth:`JogPlanner.step` without its settling, which a jog
+    heading for a speed other than 0 never reaches): the raw ramp's new position and speed
+    and the output ``(rp, rv, p, v, a)``.  The axis bank's rows take it (its compiled cycle
+    the same operations)."""
+    rp, rv, _, p, v, a = advance(rp, rv, goal, acc, dec, dt, tau, p, v, a)
+    if rv == goal and v != goal and abs(v - goal) <= 1e-9 * (1.0 + abs(goal)):
+        v, a = goal, 0.0
+    return rp, rv, p, v, a
+
+
 class JogPlanner:
     """One profile's Jog planner: ``start``/``update`` (GT_Update), ``step`` per cycle, ``stop``."""
 
@@ -255,7 +277,7 @@ class JogPlanner:
             prm = self._prm
             assert prm is not None
             goal = self._goal
-            rp, rv, _, p, v, a = advance(
+            rp, rv, p, v, a = ramp_step(
                 self._raw_p,
                 self._raw_v,
                 goal,
@@ -268,8 +290,6 @@ class JogPlanner:
                 self._acc,
             )
             self._raw_p, self._raw_v = rp, rv
-            if rv == goal and v != goal and abs(v - goal) <= 1e-9 * (1.0 + abs(goal)):
-                v, a = goal, 0.0
             self._pos, self._vel, self._acc = p, v, a
             if (
                 rv == 0.0

@@ -76,6 +76,9 @@ from .stop import StopKind, StopRamp
 SMOOTH_TIME_MAX = 50
 
 _IDLE, _MOVE, _STOP = 0, 1, 2
+#: a TrapPlanner's ``_mode`` when it stands still (``done``): the GT fast path reads the
+#: status word's bit 10 of a Trap axis without the property's call (gtecat.gt.fast)
+IDLE_MODE = _IDLE
 _EPS_T = 1e-9  # ms: a sample this close to the end time is the end sample
 
 

@@ -14,6 +14,7 @@ frames a real master would have exchanged are written to a capture
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -59,6 +60,8 @@ class EmulatedBackend(Backend):
         self._claimed: frozenset[int] = frozenset()
         self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
         self._claimed_wkc = 0
+        #: (the run plan and image it was made for, its rows): what steady() compares
+        self._steady_plan: tuple[Any, Any, list[tuple[Any, ...]]] | None = None
         self.capture = None
         self._source = ""  # the file the virtual slaves come from
         #: what the frame of a cycle meets on its way back (gtecat.faults): called with the
@@ -210,31 +213,51 @@ class EmulatedBackend(Backend):
         """An exchange now would change nothing: no hook, capture or cable pulled, and every
         slave it steps (the ones the axis bank does not run) is a plain IO slave at its fixed
         point - the image's outputs are its ``rx``, its step changes nothing, its ``tx`` is in
-        the image's inputs (byte-aligned areas; anything else: not steady)."""
+        the image's inputs (byte-aligned areas; anything else: not steady).  Asked before
+        every run of cycles at once: the areas' bytes are worked out once per run plan."""
         if self.answer_hook is not None or self.capture is not None or self.unplugged:
             return False
         image = self.image
         if image is None:
             return False
-        view, base = image.view, image.outputs_bytes
-        for slave, out, inp in self._run_plan:
+        plan = self._steady_plan
+        if plan is None or plan[0] is not self._run_plan or plan[1] is not image:
+            plan = self._steady_plan = (self._run_plan, image, self._steady_rows(image))
+        view = image.view
+        for slave, o_start, o_bytes, i_start, i_bytes in plan[2]:
             if type(slave).step is not _IO_STEP or not slave.settled():
                 return False
-            if out is not None:
-                if not out.aligned:
+            if o_bytes:
+                if o_bytes < 0:
+                    return False  # outputs not byte-aligned
+                rx = slave.rx
+                n = min(len(rx), o_bytes)
+                if view[o_start : o_start + n] != rx[:n]:
                     return False
-                start = out.logical_bit >> 3
-                n = min(len(slave.rx), out.raw_bytes)
-                if view[start : start + n] != slave.rx[:n]:
-                    return False
-            if inp is not None and slave.al_state >= AlState.SAFEOP:
-                if not inp.aligned or inp.bit_len & 7:
-                    return False
-                start = base + (inp.logical_bit >> 3)
-                n = min(len(slave.tx), inp.bit_len >> 3)
-                if view[start : start + n] != slave.tx[:n]:
+            if i_bytes and slave.al_state >= AlState.SAFEOP:
+                if i_bytes < 0:
+                    return False  # inputs not in whole bytes
+                tx = slave.tx
+                n = min(len(tx), i_bytes)
+                if view[i_start : i_start + n] != tx[:n]:
                     return False
         return True
+
+    def _steady_rows(self, image: ProcessImage) -> list[tuple[Any, int, int, int, int]]:
+        """Per slave of the run plan: (slave, first output byte, output bytes, first input
+        byte, input bytes); -1 bytes: an area :meth:`steady` cannot compare, 0: none."""
+        rows = []
+        base = image.outputs_bytes
+        for slave, out, inp in self._run_plan:
+            o_start = o_bytes = i_start = i_bytes = 0
+            if out is not None:
+                o_start = out.logical_bit >> 3
+                o_bytes = out.raw_bytes if out.aligned else -1
+            if inp is not None:
+                i_start = base + (inp.logical_bit >> 3)
+                i_bytes = inp.bit_len >> 3 if inp.aligned and not inp.bit_len & 7 else -1
+            rows.append((slave, o_start, o_bytes, i_start, i_bytes))
+        return rows
 
     def emergencies(self) -> list[tuple[int, object]]:
         out = []

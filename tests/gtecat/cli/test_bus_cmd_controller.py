@@ -165,7 +165,7 @@ def test_changes_through_a_controller_stay_on_its_bus(cli: Cli, address: str) ->
         (("cstruct", "-p", "4"), "no slave 4"),
     ],
 )
-@pytest.mark.sample(3)
+@pytest.mark.sample(2)
 def test_controller_refusals_are_one_line(cli: Cli, shared: str, argv, text) -> None:
     rc, out, err = cli(*argv, "--controller", shared)
     assert rc == 1 and out == "" and err.count("\n") == 1 and text in err, err

@@ -24,6 +24,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
+from gtecat.controller.bank import AxisBank
+from gtecat.controller.motion.jog import JogPlanner
 from tests.conftest import examples
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -325,6 +327,73 @@ def test_the_bank_runs_jogging_axes(tmp_path: Path) -> None:
     assert rows > 3 * 300
     assert got == ref
     _kernel_ran(KERNEL_CYCLES[0])
+
+
+def test_jog_ramps_and_reversals_run_in_the_bank(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Jogs that spend their time ramping (slow acceleration, a reversal, smoothing or not):
+    the compiled cycle and numpy alone against the scalar path, cycle by cycle, and the
+    bank's runs step the jogs themselves (the scalar planner only on the cycles of a call)."""
+    machine = _machine_file(tmp_path)
+    steps = [0]
+    step = JogPlanner.step
+
+    def counted(self: JogPlanner) -> tuple[float, float, float]:
+        steps[0] += 1
+        return step(self)
+
+    monkeypatch.setattr(JogPlanner, "step", counted)
+    actions = [
+        (0, ("jog", 1, 3.0, 0.05, 0.08, 0.0)),
+        (0, ("jog", 3, -2.5, 0.04, 0.1, 0.5)),
+        (60, ("jog", 4, 1.5, 0.03, 0.03, 0.9)),
+        (80, ("jog", 1, -2.0, 0.05, 0.08, 0.0)),  # a reversal: braking, then accelerating
+        (90, ("jog", 3, -1.0, 0.04, 0.1, 0.5)),  # down to a lower speed
+        (40, ("clear",)),
+    ]
+    ref, _, _ = _run(actions, machine, "off")
+    scalar = steps[0]
+    assert scalar > 600
+    for kernel in ("c", "numpy"):
+        steps[0] = 0
+        got, _, _ = _run(actions, machine, "on", kernel)
+        for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+            assert a == b, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
+        assert steps[0] < scalar // 10, kernel
+
+
+def test_an_axis_standing_with_a_latched_flag_runs_in_the_bank(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An axis stopped by its soft limit, the limit then moved away (the flag stays latched
+    until GT_ClrSts): the bank runs it standing, its GT_GetSts word with the flag, cycle by
+    cycle as the scalar path."""
+    machine = _machine_file(tmp_path)
+    taken = [0]
+    standing = AxisBank._latched_standing
+
+    def counted(ax: object, res: object) -> bool:
+        ok = standing(ax, res)
+        taken[0] += ok
+        return ok
+
+    monkeypatch.setattr(AxisBank, "_latched_standing", staticmethod(counted))
+    actions = [
+        (0, ("soft", 3, 2000, -60_000)),
+        (200, ("move", 3, 20_000, 20.0, 1.0, 1.0, 0.0, 0)),
+        (120, ("soft", 3, 60_000, -60_000)),  # the cause is gone, the flag stays
+        (60, ("clear",)),
+    ]
+    ref, ref_codes, _ = _run(actions, machine, "off")
+    assert any(sample[0][2] & 0x20 for sample in ref[200:320])  # bit 5 latched
+    for kernel in ("c", "numpy"):
+        taken[0] = 0
+        got, codes, _ = _run(actions, machine, "on", kernel)
+        assert codes == ref_codes
+        for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+            assert a == b, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
+        assert taken[0] >= 1, kernel
 
 
 def test_gt_calls_release_and_the_bank_claims_again(tmp_path: Path) -> None:

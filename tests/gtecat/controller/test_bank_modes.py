@@ -422,19 +422,24 @@ POLLED_CALLS: list[tuple[int, Callable[[], object]]] = [
 ]
 
 
-def _run_polled(machine: str, bank: str) -> tuple[list, list[tuple[bool, bool]], int]:
+def _run_polled(
+    machine: str, bank: str
+) -> tuple[list, list[tuple[bool, bool]], int, dict[int, bool]]:
     """The polled program's reads after every cycle; on the bank, whether each system was in
-    it at each poll, and (system 2 before, after) each call on system 1."""
+    it at each poll, the samples it stepped, and whether system 1 was still in it right after
+    each call (before the cycle that follows)."""
     _bring_up(machine, bank)
     ctl = gt.GTE_Controller()
     calls = dict(POLLED_CALLS)
     trace: list = []
     banked: list[tuple[bool, bool]] = []
+    after_call: dict[int, bool] = {}
     try:
         for k in range(540):
             action = calls.get(k)
             if action is not None:
                 trace.append(("call", action()))
+                after_call[k] = ctl.crd_bank.systems[1].banked
             gt.GTE_Wait(1)
             trace.append(_crd_reads())
             systems = ctl.crd_bank.systems
@@ -442,7 +447,7 @@ def _run_polled(machine: str, bank: str) -> tuple[list, list[tuple[bool, bool]],
         got = ctl.bank.sampled_samples if ctl.bank is not None else 0
     finally:
         gt.GT_Close()
-    return trace, banked, got
+    return trace, banked, got, after_call
 
 
 def test_crd_reads_polled_every_cycle_match_the_scalar_path_without_a_release(machine) -> None:
@@ -450,16 +455,18 @@ def test_crd_reads_polled_every_cycle_match_the_scalar_path_without_a_release(ma
     axes' GT_GetSts/GT_GetPrfPos/GT_GetPrfVel after every cycle: the bank's answers equal the
     scalar path's, and the polling keeps the systems in the bank (a call that changes one
     system's path gives back that system alone)."""
-    ref, _, _ = _run_polled(machine, "off")
-    got, banked, samples = _run_polled(machine, "on")
+    ref, _, _, _ = _run_polled(machine, "off")
+    got, banked, samples, after_call = _run_polled(machine, "on")
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"step {k}: the bank and the scalar path differ"
     assert samples >= 500, "the bank hardly ran the paths"
-    # system 1 is in the bank from its first cycles to its end but for the cycle after each
-    # call on it; system 2 from the end of its first lap (the GT_BufIO) to its stop
+    # system 1 is in the bank from its first cycles to its end (a call that gives it back:
+    # the bank takes it again before the next cycle); system 2 from the end of its first lap
+    # (the GT_BufIO) to its stop
     assert sum(b[0] for b in banked[:300]) >= 280
     assert sum(b[1] for b in banked[160:330]) >= 165
     assert banked[170][1] and banked[171][1], "a call on system 1 gave back system 2"
     for k in (100, 105, 110, 115, 120, 125, 131, 145, 150, 170):
-        assert banked[k - 1][0] and banked[k][0], f"the push at cycle {k} gave back system 1"
-    assert not banked[140][0], "a push into the FIFO that does not run stays in the bank"
+        assert banked[k - 1][0] and after_call[k], f"the push at cycle {k} gave back system 1"
+    assert not after_call[140], "a push into the FIFO that does not run stays in the bank"
+    assert banked[140][0], "system 1 given back by a call is not taken again"

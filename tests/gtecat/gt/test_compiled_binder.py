@@ -13,6 +13,7 @@ binding is all that is compared.
 from __future__ import annotations
 
 import ctypes
+import functools
 import inspect
 import random
 from ctypes import byref
@@ -23,7 +24,15 @@ import numpy as np
 from gtecat import gt
 from gtecat.errors import ParameterError
 from gtecat.gt._core import REGISTRY
-from gtecat.gt.args import Ref, binder, fast_binder
+from gtecat.gt.args import (
+    _CTYPES_OF,
+    NOT_INLINE,
+    Ref,
+    _pointer_kind,
+    _struct_types,
+    binder,
+    fast_binder,
+)
 from gtecat.gt.table import ENUMS, FUNCTIONS, SCALARS, Param
 
 _POINTERS = [
@@ -36,6 +45,9 @@ _POINTERS = [
     ctypes.c_ulong,
     ctypes.c_ubyte,
 ]
+
+
+_STRUCTS = _struct_types()
 
 
 def _odd(p: Param) -> list[Any]:
@@ -105,6 +117,7 @@ def _bound(bind: Any, args: tuple) -> Any:
     return values
 
 
+@functools.cache
 def _binders() -> list[tuple[str, Any, Any, Any]]:
     out = []
     for name, proto in sorted(FUNCTIONS.items()):
@@ -166,3 +179,104 @@ def test_the_compiled_binder_serves_the_public_call() -> None:
     assert "vel" in gt.GTE_GetLastError()
     assert gt.GT_SetVel(1, 2.0, 3) == 7  # one argument too many
     assert gt.GT_GetVel(1, byref(ctypes.c_short())) == 7  # narrower than a double
+
+
+# --- every shape of every pointer, inline ------------------------------------------------------
+def _shapes(p: Param) -> dict[str, Any]:
+    """The ways clients pass ``p`` (makers of a fresh argument), by name; a shape the
+    compiled binder leaves to the converter on purpose is named as in ``NOT_INLINE``."""
+    if p.stars != 1:
+        return {"pointer to pointer": None}
+    if p.text and p.direction == "in":
+        return {"str": lambda: "x"}
+    kind = _pointer_kind(p)
+    out: dict[str, Any]
+    if kind == "numbers":
+        t = (
+            ctypes.c_double
+            if p.ctype in ("double", "float")
+            else getattr(ctypes, _CTYPES_OF.get(p.ctype, "c_long"))
+        )
+        held = byref(t())
+        np_type = np.float64 if t is ctypes.c_double else np.int64
+        out = {
+            "byref": lambda: byref(t()),
+            "the same byref": lambda: held,
+            "the object": t,
+            "ctypes array": lambda: (t * 64)(),
+            "byref(array)": lambda: byref((t * 64)()),
+            "numpy array": lambda: np.zeros(64, np_type),
+        }
+    elif kind == "struct":
+        cls = _STRUCTS[p.ctype]
+        out = {"byref": lambda: byref(cls()), "the object": cls}
+    else:
+        out = {
+            "ctypes array": lambda: (ctypes.c_ubyte * 4096)(),
+            "bytearray": lambda: bytearray(4096),
+            "numpy array": lambda: np.zeros(4096, np.uint8),
+            "string buffer": lambda: ctypes.create_string_buffer(4096),
+        }
+        if p.direction == "in":
+            out["bytes"] = lambda: bytes(4096)
+    if p.optional:
+        out["NULL as None"] = lambda: None
+        out["NULL as 0"] = lambda: 0
+    return out
+
+
+def _spy(conv: Any, i: int, used: list[int]) -> Any:
+    """``conv`` noting in ``used`` that parameter ``i`` went through it."""
+
+    def spy(v: Any) -> Any:
+        used.append(i)
+        return conv(v)
+
+    return spy
+
+
+def test_every_shape_of_every_pointer_binds_inline_or_has_a_reason() -> None:
+    """Each pointer parameter of each emulated function, in each shape a client passes it
+    (``byref`` of a fresh or a reused object, the object itself, ctypes and numpy arrays,
+    structures, byte buffers, text, NULL as None or 0), the other arguments plain: the
+    compiled binder binds it without the table's converter of that parameter, or the table
+    refuses the shape too (a single number where the call needs several), or the shape
+    has a reason in ``NOT_INLINE``."""
+    bad, shapes = [], 0
+    for name, proto, bind, _ in _binders():
+        params = proto.params
+        if not any(p.pointer for p in params):
+            continue
+        used: list[int] = []
+        spies = [_spy(c, i, used) for i, c in enumerate(bind.convs)]
+        fast = fast_binder(proto, spies)
+        for i, p in enumerate(params):
+            if not p.pointer:
+                continue
+            for shape, make in _shapes(p).items():
+                if make is None:
+                    if not NOT_INLINE.get(shape, "").strip():
+                        bad.append(f"{name} {p.name}: {shape}, no reason")
+                    continue
+                args = [_plain(q) if j != i else make() for j, q in enumerate(params)]
+                for j, q in enumerate(params):  # other pointers: a big array of their kind
+                    if j != i and args[j] is NotImplemented:
+                        other = _shapes(q)
+                        maker = other.get("ctypes array") or other.get("byref") or other.get("str")
+                        args[j] = maker() if maker is not None else NotImplemented
+                if any(a is NotImplemented for a in args):
+                    bad.append(f"{name} {p.name}: {shape}, no plain call to try it in")
+                    continue
+                shapes += 1
+                want = _bound(bind, tuple(args))
+                used.clear()
+                got = fast(*args)
+                if want is ParameterError:
+                    if got is not None:
+                        bad.append(f"{name} {p.name}: {shape}: the table refuses, compiled binds")
+                elif got is None or i in used:
+                    bad.append(f"{name} {p.name}: {shape} left to the converter, no reason")
+                elif not _same(got[i], want[i]):
+                    bad.append(f"{name} {p.name}: {shape}: {got[i]!r} != {want[i]!r}")
+    assert not bad, "\n".join(bad[:20])
+    assert shapes > 1000

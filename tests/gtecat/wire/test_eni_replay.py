@@ -43,7 +43,7 @@ def test_every_example_carries_its_own_register_init_cmds(eni: Path) -> None:
 
 @pytest.mark.wire
 @pytest.mark.parametrize("eni", [p for p in ENIS if is_xml(p)], ids=lambda p: p.name)
-@pytest.mark.sample(2)
+@pytest.mark.sample(1)
 def test_replay_reaches_op(eni: Path, tmp_path: Path) -> None:
     reason = why_not_root()
     if reason:
