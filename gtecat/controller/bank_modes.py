@@ -297,10 +297,25 @@ _FOLLOW_STATE = ("_x _m_prev _pos _vel _acc _i _segs _loops_done _x0 _s0 _carry 
 _FOLLOW_STATE_OF = attrgetter(*_FOLLOW_STATE)
 
 
+#: ... and a Trap planner's in motion (TrapPlanner.step, _sample, _finish: its pieces are
+#: replaced by a new list, never changed in place)
+_TRAP_MOVING = object()
+_TRAP_STATE = ("_k", "_pos", "_vel", "_acc", "_mode", "_segs", "_i", "_j")
+_TRAP_STATE_OF = attrgetter(*_TRAP_STATE)
+_MOVING = {
+    _PT_MOVING: PT_STATE,
+    _GEAR_MOVING: _GEAR_STATE,
+    _FOLLOW_MOVING: _FOLLOW_STATE,
+    _TRAP_MOVING: _TRAP_STATE,
+}
+
+
 def keep(obj: Any) -> tuple:
-    """:func:`snapshot`, or for a PT planner moving through a static FIFO or a geared planner
-    only the slots its steps change."""
+    """:func:`snapshot`, or for a PT planner moving through a static FIFO, a geared planner,
+    a following one or a Trap master in motion only the slots its steps change."""
     t = type(obj).__mro__
+    if TrapPlanner in t and _get(obj, "_mode") == _TRAP_MOVE and obj.stopping == StopKind.NONE:
+        return (_TRAP_MOVING, _TRAP_STATE_OF(obj))
     if PtPlanner in t and _get(obj, "_state") == 1 and _get(obj, "_mode") == PtMode.STATIC:
         return (_PT_MOVING, _PT_STATE_OF(obj))
     if GearPlanner in t and _get(obj, "_state") == 1:
@@ -310,23 +325,33 @@ def keep(obj: Any) -> tuple:
     return snapshot(obj)
 
 
-def _trap_samples(bank: AxisBank, pl: TrapPlanner, n: int) -> tuple[Any, Any, Any, int]:
+def _trap_samples(
+    bank: AxisBank, pl: TrapPlanner, n: int, held: dict[int, tuple] | None = None
+) -> tuple[Any, Any, Any, int]:
     """:func:`~gtecat.controller.motion.trap_table.trap_table` of a Trap master, compiled
     where the kernel is (bank_kernel.trap_fill: the same samples; the arrays returned are
-    the bank's scratch, valid until the next call)."""
+    the bank's scratch, valid until the next call).  ``held``: the planner's pieces as the
+    kernel reads them, kept from one call to the next while the plan stays (a new plan is a
+    new list of pieces)."""
     lib = bank._kernel_lib
     k = len(pl._segs)
     if lib is None or k > MAXSEG:
         return trap_table(pl, n)
     sc = bank.__dict__.get("_trap_scratch")
     if sc is None or sc[0] is not lib or sc[1].shape[1] < n + 1:
-        segs, prm, out = np.zeros((MAXSEG, 4)), np.zeros(5), np.zeros((3, n + 1))
-        ptrs = (segs.ctypes.data, prm.ctypes.data, *(out[j].ctypes.data for j in range(3)))
-        sc = bank._trap_scratch = (lib, out, segs, prm, ptrs)
-    _, out, segs, prm, (p_segs, p_prm, p0, p1, p2) = sc
-    segs[:k] = pl._segs
+        prm, out = np.zeros(5), np.zeros((3, n + 1))
+        ptrs = (prm.ctypes.data, *(out[j].ctypes.data for j in range(3)))
+        sc = bank._trap_scratch = (lib, out, prm, ptrs)
+    _, out, prm, (p_prm, p0, p1, p2) = sc
+    segs = pl._segs
+    got = held.get(id(pl)) if held is not None else None
+    if got is None or got[0] is not segs or got[1] != k:
+        buf = np.array(segs, np.float64).reshape(-1, 4)
+        got = (segs, k, buf, buf.ctypes.data)
+        if held is not None:
+            held[id(pl)] = got
     prm[:] = (pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir)
-    end = lib.bank_trap_fill(p_segs, k, pl._T, p_prm, pl._k, n, p0, p1, p2)
+    end = lib.bank_trap_fill(got[3], k, pl._T, p_prm, pl._k, n, p0, p1, p2)
     m = end + 1 if end < n else n
     return out[0, :m], out[1, :m], out[2, :m], end
 
@@ -420,6 +445,7 @@ class Cluster:
         "stepped",
         "systems",
         "topo",
+        "trap_pieces",
     )
 
     def __init__(self, bank: AxisBank, rows: list[int], groups: list[int]) -> None:
@@ -434,6 +460,8 @@ class Cluster:
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
         self.rows_arr = np.array(self.rows, np.intp)
+        #: id(Trap master) -> its pieces as the compiled fill reads them (_trap_samples)
+        self.trap_pieces: dict[int, tuple] = {}
         #: the objects a fill keeps for the rewind; the planners it steps in Python (the
         #: others: the compiled slaves, bank_slaves)
         self.kept: list[Any] = [*self.planners, *systems]
@@ -650,7 +678,7 @@ class Cluster:
                 continue
             mi = self.masters[i]
             if TrapPlanner in type(pl).__mro__:
-                p, v, a, end = _trap_samples(bank, pl, n)
+                p, v, a, end = _trap_samples(bank, pl, n, self.trap_pieces)
                 m = len(p)
                 advance(pl, m, (float(p[-1]), float(v[-1]), float(a[-1])), end < n)
                 self._put(bank, r, p, v, a, end if end < n else -1)
@@ -908,10 +936,8 @@ class Cluster:
             return
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
-            if snap[0] is _PT_MOVING or snap[0] is _GEAR_MOVING or snap[0] is _FOLLOW_MOVING:
-                names = {_PT_MOVING: PT_STATE, _GEAR_MOVING: _GEAR_STATE}.get(
-                    snap[0], _FOLLOW_STATE
-                )
+            names = _MOVING.get(snap[0]) if type(snap[0]) is object else None
+            if names is not None:
                 for name, value in zip(names, snap[1], strict=True):
                     _set(obj, name, value)
                 if snap[0] is _FOLLOW_MOVING:

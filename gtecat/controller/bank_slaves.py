@@ -20,6 +20,7 @@ from __future__ import annotations
 import ctypes
 import logging
 from importlib import resources
+from operator import is_
 from typing import Any
 
 import numpy as np
@@ -166,7 +167,7 @@ class SlaveFill:
             bank.t_end,
         )
         a = self.args
-        if self._bound is None or any(x is not y for x, y in zip(arrays, self._bound, strict=True)):
+        if self._bound is None or not all(map(is_, arrays, self._bound)):
             for slot, arr in enumerate(arrays, 9):
                 want = np.bool_ if slot == 9 else np.float64 if slot < 13 else np.int64
                 if arr.dtype != want or not arr.flags.c_contiguous:
