@@ -205,6 +205,10 @@ class SlaveFill:
         self.drop(r)
 
     def drop(self, r: int) -> None:
+        """Row ``r`` leaves: the compiled fill skips it from now on (no planner kind), its
+        arrays go."""
+        self.st[r, 0] = 0.0
+        self.pts[r] = self.segs[r] = 0
         self._arrays.pop(r, None)
 
 

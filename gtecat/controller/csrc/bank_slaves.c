@@ -163,29 +163,32 @@ static int follow_advance(double *st, const double *pts, double *segs)
 }
 
 /* FollowPlanner.run in motion: n samples against the master positions ms; the index of the
- * end sample (the last pass completed) or -1 */
+ * end sample (the last pass completed) or -1.  The state is held in locals between the
+ * boundaries of segments (st[SL_I] is follow_advance's) and stored at the end. */
 static int64_t follow_run(double *st, const double *pts, double *segs, const double *ms,
                           int64_t n, double *po, double *vo, double *ao)
 {
     const double cyc = st[SL_T], dir = st[SL_DIR], origin = st[SL_ORIGIN];
-    int64_t j;
+    double x = st[SL_X], m_prev = st[SL_MPREV], pos = st[SL_POS], vel = st[SL_VEL];
+    double acc = st[SL_ACC], sd = st[SL_SD];
+    int64_t i = (int64_t)st[SL_I], j, end = -1;
+    const double *seg = segs + G_N * i;
     for (j = 0; j < n; j++) {
         const double m = ms[j];
-        const double x = st[SL_X] + passed(m - st[SL_MPREV], dir);
-        int64_t i = (int64_t)st[SL_I];
-        double sd = st[SL_SD], u, s, v;
-        const double *seg = segs + G_N * i;
-        st[SL_X] = x;
-        st[SL_MPREV] = m;
+        double u, s, v;
+        x += passed(m - m_prev, dir);
+        m_prev = m;
         while ((x - seg[G_X1]) * sd >= 0.0) {
+            st[SL_I] = (double)i;
             if (!follow_advance(st, pts, segs)) { /* _finish(origin + seg.s1) */
-                st[SL_POS] = origin + seg[G_S1];
-                st[SL_VEL] = st[SL_ACC] = 0.0;
+                pos = origin + seg[G_S1];
+                vel = acc = 0.0;
                 st[SL_STATE] = 0.0;
-                po[j] = st[SL_POS];
+                po[j] = pos;
                 vo[j] = 0.0;
                 ao[j] = 0.0;
-                return j;
+                end = j;
+                goto out;
             }
             i = (int64_t)st[SL_I];
             sd = st[SL_SD];
@@ -195,20 +198,26 @@ static int64_t follow_run(double *st, const double *pts, double *segs, const dou
             i -= 1;
             seg = segs + G_N * i;
         }
-        st[SL_I] = (double)i;
         u = x - seg[G_X0];
         if (u * sd < 0.0)
             u = 0.0; /* behind the start of the pass: wait there */
         s = origin + seg[G_S0] + u * (seg[G_RS] + seg[G_K] * u);
-        v = (s - st[SL_POS]) / cyc;
-        st[SL_ACC] = (v - st[SL_VEL]) / cyc;
-        st[SL_VEL] = v;
-        st[SL_POS] = s;
+        v = (s - pos) / cyc;
+        acc = (v - vel) / cyc;
+        vel = v;
+        pos = s;
         po[j] = s;
         vo[j] = v;
-        ao[j] = st[SL_ACC];
+        ao[j] = acc;
     }
-    return -1;
+    st[SL_I] = (double)i;
+out:
+    st[SL_X] = x;
+    st[SL_MPREV] = m_prev;
+    st[SL_POS] = pos;
+    st[SL_VEL] = vel;
+    st[SL_ACC] = acc;
+    return end;
 }
 
 /* The tables of a cluster's slaves at once (bank_modes.Cluster.fill): a[] holds the row
