@@ -1042,20 +1042,22 @@ class AxisBank:
         need = moving & (cur >= self.t_len)
         if np.count_nonzero(need):
             self._materialise()
-            filled: list[Cluster] = []
+            filled: set[int] = set()  # the rows of the clusters filled
             pt_rows: list[int] = []
-            for r in np.nonzero(need)[0].tolist():
-                if not self.sampled[r]:
+            group_of = self.group_of
+            flags = self.sampled[need].tolist()
+            for r, sampled in zip(np.nonzero(need)[0].tolist(), flags, strict=True):
+                if not sampled:
                     self._refill(r)
                     continue
-                cl = self._cluster_of[self.group_of[r]]
+                if r in filled:
+                    continue
+                cl = self._cluster_of[group_of[r]]
                 if cl.compiled_pt:  # a PT axis alone: all of them in one compiled call
                     pt_rows.append(r)
                     cl.snaps = []
                     continue
-                if cl in filled:
-                    continue
-                filled.append(cl)
+                filled.update(cl.rows)
                 # the planners step without their guards (a guarded attribute costs ~1 µs);
                 # the compiled slaves' (bank_slaves) are not touched
                 guarded = [(pl, type(pl)) for pl in cl.stepped]
