@@ -430,6 +430,7 @@ class Cluster:
         "compiled",
         "compiled_by_master",
         "compiled_pt",
+        "compiled_ptr",
         "compiled_rows",
         "ext",
         "groups",
@@ -471,6 +472,7 @@ class Cluster:
         #: reading the one before)
         self.compiled: list[int] = []
         self.compiled_rows = np.zeros(0, np.int64)
+        self.compiled_ptr = 0  # (its address)
         #: per master of compiled slaves: its position before a fill and after each cycle
         #: of it (what the slaves read, at addresses SlaveFill.mp holds)
         self.ext: dict[int, np.ndarray] = {}
@@ -558,6 +560,7 @@ class Cluster:
             sf.load(rows[i], self.planners[i])
         self.compiled = cand
         self.compiled_rows = np.array([rows[i] for i in cand], np.int64)
+        self.compiled_ptr = self.compiled_rows.ctypes.data
         for i in cand:
             mi = masters[i]
             ext = self.ext.get(mi)  # type: ignore[arg-type]
@@ -729,7 +732,8 @@ class Cluster:
             rs = np.array([f[0] for f in full], np.intp)
             self._put_rows(bank, rs, tuple([f[k + 1] for f in full] for k in range(3)), n)
         if self.compiled:  # the compiled slaves, all at once (bank_slaves)
-            bank.sampled_samples += bank._slave_fill.fill(bank, self.compiled_rows, n)
+            sf = bank._slave_fill
+            bank.sampled_samples += sf.fill(bank, self.compiled_rows, n, self.compiled_ptr)
 
     def _lead(self, i: int, start: float, ps: Any, seen: list[list[float] | None]) -> None:
         """Master ``i``'s positions in a fill (``ps``: its samples, a list or an array; it

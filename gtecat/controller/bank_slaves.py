@@ -115,10 +115,8 @@ class SlaveFill:
         self.samples = 0
         #: row -> its Follow FIFO's points and segments (the arrays the addresses point into)
         self._arrays: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        #: the bank's arrays whose addresses ``args`` holds, the rows array last passed
+        #: the bank's arrays whose addresses ``args`` holds
         self._bound: tuple | None = None
-        self._rows: np.ndarray | None = None
-        self._rows_ptr = 0
         a = self.args
         a[4], a[5] = self.st.ctypes.data, self.before.ctypes.data
         a[6], a[7], a[8] = self.pts.ctypes.data, self.segs.ctypes.data, self.mp.ctypes.data
@@ -151,10 +149,11 @@ class SlaveFill:
             self.pts[r], self.segs[r] = pts.ctypes.data, segs.ctypes.data
         self.st[r] = row
 
-    def fill(self, bank: Any, rows: np.ndarray, n: int) -> int:
-        """New tables of ``n`` samples for the moving ``rows`` (int64), each reading the
-        master positions at its :attr:`mp`; every row's state kept in :attr:`before` first.
-        Returns the samples written."""
+    def fill(self, bank: Any, rows: np.ndarray, n: int, rows_ptr: int = 0) -> int:
+        """New tables of ``n`` samples for the moving ``rows`` (int64; ``rows_ptr``: their
+        address, when the caller holds it), each reading the master positions at its
+        :attr:`mp`; every row's state kept in :attr:`before` first.  Returns the samples
+        written."""
         arrays = (
             bank.moving,
             bank.t_p,
@@ -174,10 +173,7 @@ class SlaveFill:
                     raise TypeError(f"slave fill: {FILL_ARGS[slot]} is {arr.dtype}")
                 a[slot] = arr.ctypes.data
             self._bound = arrays
-        if rows is not self._rows:
-            self._rows = rows
-            self._rows_ptr = rows.ctypes.data
-        a[0], a[1], a[2], a[3] = len(rows), n, bank.table, self._rows_ptr
+        a[0], a[1], a[2], a[3] = len(rows), n, bank.table, rows_ptr or rows.ctypes.data
         got = int(self.fn(self._args_ptr))
         self.samples += got
         return got
