@@ -18,6 +18,11 @@ its axes together.  The bank runs them so:
   order, so a slave reads the sample its master has in that cycle, exactly as in the scalar
   cycle), and the samples go into the rows' tables; the compiled kernel takes them one a
   cycle as it takes a Trap table's.
+* **Compiled slaves.**  A Gear or Follow slave in motion whose master reads nobody, and which
+  no slave reads, is not stepped in Python: :mod:`~gtecat.controller.bank_slaves` holds its
+  state while the cluster is claimed and fills the tables of all such slaves of the cluster
+  in one C call, from the positions its master holds in those cycles (the same operations as
+  its planner's ``step``).
 * **Given back exactly.**  Before the steps, the state of every planner (and coordinate
   system) of the cluster is kept.  A release puts it back and steps the planners again as
   many cycles as the bank ran since (never more than one table), so they stand where the
@@ -428,7 +433,6 @@ class Cluster:
         "alone",
         "before",
         "compiled",
-        "compiled_by_master",
         "compiled_pt",
         "compiled_ptr",
         "compiled_rows",
