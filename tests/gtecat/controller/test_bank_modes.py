@@ -320,18 +320,21 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
     return _machine_file(Path(tmp_path_factory.mktemp("modes")))
 
 
+_CHUNKED = pytest.mark.long("the script again in short waits")
+
+
 @pytest.mark.parametrize(
     ("script", "least", "chunked"),
     [
         (PT, 800, False),
-        (PT, 800, True),
+        pytest.param(PT, 800, True, marks=_CHUNKED),
         (GEAR, 1500, False),
-        (GEAR, 1500, True),
+        (GEAR, 1500, True),  # the default run's one script in short waits
         (CRD, 800, False),
-        (CRD, 800, True),
+        pytest.param(CRD, 800, True, marks=_CHUNKED),
         (EDGE, 300, False),
         (SLAVES, 2500, False),
-        (SLAVES, 2500, True),
+        pytest.param(SLAVES, 2500, True, marks=_CHUNKED),
     ],
     ids=[
         "pt",
