@@ -25,7 +25,7 @@ import numpy as np
 from ..controller.axis_status import AxisStatus
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
-from ..controller.resources import AxisResources
+from ..controller.resources import CONTROLLER_AXES, AxisResources
 from ..master.clock import ClockMode
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
 
@@ -162,6 +162,11 @@ def fast_reader(
         """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
         array, a numpy array, and anything the table path must answer."""
         ctl = session.controllers.get(1)
+        if type(count) is int and count > 1:
+            rc = many(ctl, n, p, count, pClock, extra, kw)
+            if rc is not None:
+                return rc
+            return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
         if (
             type(n) is not int
             or extra
@@ -199,6 +204,50 @@ def fast_reader(
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
         session.last = None
         if clock.mode is not _LOCKSTEP:
+            return advance(ctl, name, 0)
+        return 0
+
+    limit = READ_LIMITS.get(name, CONTROLLER_AXES)
+    bank_key = BANK_LISTS.get(name)
+    to = float if ctypes_ok is _DOUBLE else None
+
+    def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
+        """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
+        a poll of every axis in one call): the table path's values, or None when the shape
+        is any other (an axis no drive backs, a clock pointer, a numpy array: the table)."""
+        if (
+            ctl is None
+            or type(n) is not int
+            or extra
+            or kw
+            or count > limit
+            or not (pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0))
+            or session.remote is not None
+            or session.core != 1
+            or ctl.clock._thread is not None
+        ):
+            return None
+        tp = type(p)
+        if not (is_array(tp) and tp._length_ >= count):
+            return None
+        resources = ctl.resources
+        axes = ctl.axes
+        values = []
+        for k in range(n, n + count):
+            res = resources.get(k)
+            if res is None or axes.get(k) is not res.ax:
+                return None
+            b = res.bank
+            lst = b._lists.get(bank_key) if b is not None and bank_key is not None else None
+            if lst is None:
+                values.append(get(res))
+            elif to is None:
+                values.append(lst[res.bank_row])
+            else:
+                values.append(to(lst[res.bank_row]))
+        p[:count] = values
+        session.last = None
+        if ctl.clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)
         return 0
 
@@ -242,6 +291,9 @@ _STATUS_BITS = {
     "TRAP": TrapPlanner,
     "TRAP_IDLE": TRAP_IDLE,
 }
+
+#: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
+READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
 
 #: the bank's list of each reader's value (AxisBank.value), read without the two calls
 BANK_LISTS = {
