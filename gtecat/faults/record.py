@@ -30,9 +30,11 @@ import gzip
 import json
 import os
 import re
+import struct
 import threading
 from contextlib import contextmanager
-from dataclasses import dataclass
+from functools import lru_cache
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -528,6 +530,14 @@ class _Call:
     opens: bool  # GT_Open: the replay's own settings
     #: the call in one compiled function (:func:`_compiled`), None: the loop runs it
     run: Any = None
+    #: pooled arrays of numbers: (the array's bytes, the values it held at the call: vals[k]
+    #: packed as its memory holds them)
+    asets: list[tuple[Any, int]] = field(default_factory=list)
+    #: what the call leaves in them: (their bytes, vals[k], argument index, element type),
+    #: compared as bytes
+    aquick: list[tuple[Any, int, int, str]] = field(default_factory=list)
+    #: the slots of vals that hold arrays, and how a line's numbers become their bytes
+    packs: tuple[tuple[int, Any], ...] = ()
 
 
 def _prepare(
@@ -545,6 +555,9 @@ def _prepare(
     fresh: list[tuple[int, Any]] = []
     pooled: list[tuple[int, Any, int, Any]] = []  # (index, object, its slot, its encoding)
     checks: list[tuple[int | str, Any]] = []
+    asets: list[tuple[Any, int]] = []
+    arrays: list[tuple[int, Any, int, str, Any]] = []
+    packs: list[tuple[int, tuple[Any, ...]]] = []
     for i, x in enumerate(a):
         if not isinstance(x, dict):
             args.append(x)
@@ -560,15 +573,37 @@ def _prepare(
             vals.append(ref["v"])
             args.append(p)
             continue
+        kind = _kind(x)
+        if kind is not None and kind[0] == "arr":
+            packed = _pack(kind, x["v"])
+            out = outs.get(str(i))
+            out_packed = _pack(kind, out["v"]) if _kind(out) == kind else None
+            if packed is not None and (out is None or out_packed is not None):
+                # an array of numbers: one array per function and argument, its memory set
+                # to the recorded values before each call and compared with them after it
+                obj, mv = _pooled_array(pool, name, i, kind)
+                asets.append((mv, len(vals)))
+                packs.append((len(vals), kind))
+                vals.append(packed)
+                arrays.append((i, mv, len(vals) - 1, kind, out_packed))
+                args.append(obj)
+                continue
         fresh.append((i, x))
         args.append(None)
         if str(i) in outs or _round_trips(x):
             checks.append((i, outs.get(str(i), x)))  # not in "o": left as it was
     slots = {}
+    packed_outs = {str(i): (kind, b) for i, _, _, kind, b in arrays if b is not None}
     for k, w in outs.items():
         slots[k] = len(vals)
+        if k in packed_outs:
+            kind, b = packed_outs[k]
+            packs.append((len(vals), kind))
+            vals.append(b)
+            continue
         r = w.get("ref") if isinstance(w, dict) and len(w) == 1 else None
         vals.append(r.get("v") if isinstance(r, dict) else None)
+    aquick = [(mv, slots.get(str(i), slot), i, kind) for i, mv, slot, kind, _ in arrays]
     quick: list[tuple[Any, int, int, str]] = []
     for i, obj, slot, x in pooled:
         want = outs.get(str(i), x)  # not in "o": the call left the value as it was
@@ -603,6 +638,8 @@ def _prepare(
         e.get("b"),
         name in ("GT_Open", "GTN_Open"),
     )
+    call.asets, call.aquick = asets, aquick
+    call.packs = tuple(packs)
     if call.before is None and not fresh and kw is None and not call.opens and not checks:
         call.run = _compiled(call)
     return call, tuple(vals)
@@ -617,14 +654,14 @@ def _compiled(p: _Call) -> Any:
     into one function: None when everything matched, ``(rc,)`` when something may differ
     (the loop compares in full and reports), an exception when a value cannot be set."""
     fn, rc0, args = p.fn, p.rc, tuple(p.args)
-    if not p.sets and not p.quick:  # GTE_Wait(10), GT_Update(mask): no pointer at all
+    if not p.sets and not p.quick and not p.asets:  # GTE_Wait(10), GT_Update(mask): no pointer at all
 
         def run_plain(vals: Any) -> Any:
             rc = fn(*args)
             return None if rc == rc0 else (rc,)
 
         return run_plain
-    if len(p.sets) == 1 and len(p.quick) == 1:  # GT_GetSts(axis, &s): a polled reader
+    if len(p.sets) == 1 and len(p.quick) == 1 and not p.asets:  # GT_GetSts(axis, &s)
         ((obj, k),) = p.sets
         ((out, k_out, _, _),) = p.quick
 
@@ -639,21 +676,62 @@ def _compiled(p: _Call) -> Any:
         return run_one
     env: dict[str, Any] = {"fn": p.fn, "RC": p.rc, "_DAMAGED": _DAMAGED}
     lines = ["def run(vals):"]
-    if p.sets:
+    if p.sets or p.asets:
         lines.append("    try:")
         for j, (obj, k) in enumerate(p.sets):
             env[f"S{j}"] = obj
             lines.append(f"        S{j}.value = vals[{k}]")
+        for j, (mv, k) in enumerate(p.asets):  # an array's bytes (of the recorded length)
+            env[f"M{j}"] = mv
+            lines.append(f"        M{j}[:] = vals[{k}]")
         lines += ["    except _DAMAGED as err:", "        return err"]
     for j, a in enumerate(p.args):
         env[f"A{j}"] = a
     lines.append(f"    rc = fn({', '.join(f'A{j}' for j in range(len(p.args)))})")
-    same = ["rc != RC", *(f"Q{j}.value != vals[{k}]" for j, (_, k, _, _) in enumerate(p.quick))]
+    same = [
+        "rc != RC",
+        *(f"Q{j}.value != vals[{k}]" for j, (_, k, _, _) in enumerate(p.quick)),
+        *(f"N{j}.tobytes() != vals[{k}]" for j, (_, k, _, _) in enumerate(p.aquick)),
+    ]
+    for j, (mv, _, _, _) in enumerate(p.aquick):
+        env[f"N{j}"] = mv
     for j, (obj, _, _, _) in enumerate(p.quick):
         env[f"Q{j}"] = obj
     lines += [f"    if {' or '.join(same)}:", "        return (rc,)", "    return None"]
     exec(compile("\n".join(lines), f"<replay {p.name}>", "exec"), env)
     return env["run"]
+
+
+@lru_cache(maxsize=256)
+def _struct(kind: tuple[Any, ...]) -> struct.Struct:
+    """How an array of numbers of ``kind`` (``("arr", c, n)``) lies in memory."""
+    return struct.Struct(f"{kind[2]}{_ARRAY_CODE[kind[1]]}")
+
+
+def _pack(kind: tuple[Any, ...], values: list[Any]) -> bytes | None:
+    """The bytes of an array of ``kind`` holding ``values`` exactly, None when the type
+    cannot hold them (a number out of its range, a fraction in an integer array, a double
+    that a float would round: such an array is rebuilt and compared the general way)."""
+    st = _struct(kind)
+    try:
+        b = st.pack(*values)
+    except struct.error:
+        return None
+    if _ARRAY_CODE[kind[1]] in "fd" and st.unpack(b) != tuple(values):
+        return None
+    return b
+
+
+def _pooled_array(
+    pool: dict[Any, Any], name: str, i: int, kind: tuple[Any, ...]
+) -> tuple[Any, memoryview]:
+    """The array (and a view of its bytes) an array argument of ``kind`` uses in replay."""
+    key = (name, i, kind)
+    hit = pool.get(key)
+    if hit is None:
+        obj = (_SIMPLE[kind[1]] * kind[2])()
+        hit = pool[key] = (obj, memoryview(obj).cast("B"))
+    return hit
 
 
 def _pooled(
@@ -683,12 +761,50 @@ _NUMBER = re.compile(r"-?(?:0|[1-9]\d*)(\.\d+)?([eE][+-]?\d+)?")
 _V = '"v":'
 
 
+#: struct's code of each simple type an array of numbers may hold (the ctypes type's own)
+_ARRAY_CODE = {
+    name: cls._type_  # type: ignore[attr-defined]
+    for cls, name in _SIMPLE_NAME.items()
+    if cls._type_ in "bBhHiIlLqQfd?"  # type: ignore[attr-defined]
+}
+
+
+def _kind(x: Any) -> tuple[Any, ...] | None:
+    """What a recorded pointer argument is when one pooled object serves it: ``("ref", c)``
+    for a pointer to a simple value, ``("arr", c, n)`` for an array of numbers; else None."""
+    if type(x) is not dict or len(x) != 1 and len(x) != 3:
+        return None
+    if len(x) == 1:
+        ref = x.get("ref")
+        if (
+            type(ref) is dict
+            and len(ref) == 2
+            and type(ref.get("c")) is str
+            and _SIMPLE_NAME.get(_SIMPLE.get(ref["c"])) == ref["c"]  # type: ignore[arg-type]
+            and type(ref.get("v")) in (int, float)
+        ):
+            return ("ref", ref["c"])
+        return None
+    c, n, v = x.get("arr"), x.get("n"), x.get("v")
+    if (
+        type(c) is str
+        and c in _ARRAY_CODE
+        and type(n) is int
+        and type(v) is list
+        and len(v) == n
+        and all(type(e) is int or type(e) is float for e in v)
+    ):
+        return ("arr", c, n)
+    return None
+
+
 def _form(e: dict[str, Any]) -> int:
-    """How many values a call of this form has (``"v":`` numbers, in the order of the line),
-    or -1 when the entry is not of a simple form: plain arguments and pointers to simple
-    values (``{"ref": {"c": "c_long", "v": 5}}``), the values those hold after the call in
+    """How many values a call of this form has (``"v":`` numbers and arrays of numbers, in
+    the order of the line), or -1 when the entry is not of a simple form: plain arguments,
+    pointers to simple values (``{"ref": {"c": "c_long", "v": 5}}``) and arrays of numbers
+    (``{"arr": "c_long", "n": 12, "v": [...]}``), the values those hold after the call in
     ``"o"``, no keywords.  Such an entry's values all come from :func:`_prepare`'s pooled
-    pointers, in the same order, so one prepared call serves every line of the form."""
+    objects, in the same order, so one prepared call serves every line of the form."""
     if "k" in e or type(e.get("a")) is not list or type(e.get("r")) is not int:
         return -1
     keys = list(e)
@@ -698,15 +814,7 @@ def _form(e: dict[str, Any]) -> int:
     n = 0
     for x in a:
         if type(x) is dict:
-            ref = x.get("ref")
-            if (
-                len(x) != 1
-                or type(ref) is not dict
-                or len(ref) != 2
-                or type(ref.get("c")) is not str
-                or _SIMPLE_NAME.get(_SIMPLE.get(ref["c"])) != ref["c"]  # type: ignore[arg-type]
-                or type(ref.get("v")) not in (int, float)
-            ):
+            if _kind(x) is None:
                 return -1
             n += 1
     outs = e.get("o", {})
@@ -715,13 +823,7 @@ def _form(e: dict[str, Any]) -> int:
     for k, w in outs.items():
         if not k.isdigit() or int(k) >= len(a) or type(a[int(k)]) is not dict:
             return -1
-        ref = w.get("ref") if type(w) is dict and len(w) == 1 else None
-        if (
-            type(ref) is not dict
-            or len(ref) != 2
-            or ref.get("c") != a[int(k)]["ref"]["c"]
-            or type(ref.get("v")) not in (int, float)
-        ):
+        if _kind(w) is None or _kind(w) != _kind(a[int(k)]):
             return -1
         n += 1
     return n
@@ -797,7 +899,15 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
                     if call is not _Stop and not call.checks and not call.fresh:
                         form = forms[form_key] = call
             if form is not None:
-                return form, tuple(vals)
+                if not form.packs:
+                    return form, tuple(vals)
+                vals = list(vals)
+                for k, kind in form.packs:  # an array's numbers: its bytes
+                    b = vals[k] = _pack(kind, vals[k]) if type(vals[k]) is list else None
+                    if b is None:  # (a length or number the array cannot hold)
+                        break
+                else:
+                    return form, tuple(vals)
         e = parse(key)
         return (None, e) if "c" not in e else prepare(e)
 
@@ -817,37 +927,47 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
 _NUMBER_START = frozenset("-0123456789")
 
 
+#: a value of a call's line that a form takes out: a JSON number, or an array of numbers
+#: (``"v":[1,2.5]``); the group is the value's text, read by one JSON parse
+_VALUE = re.compile(r'"v":(\[[-0-9.eE+,]*\]|-?[0-9][-0-9.eE+]*)')
+#: the same, each kind on its own, replaced in the form's key by a mark of its kind (an
+#: array: \x02, a number: \x01; control characters never stand raw in JSON text)
+_ARRAY_SLOT = re.compile(r'"v":\[[-0-9.eE+,]*\]')
+_NUMBER_SLOT = re.compile(r'"v":-?[0-9][-0-9.eE+]*')
+
+
 def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
-    """(the form's key, the numbers) of each call's line, the numbers of all of them read
-    in one JSON parse (the numbers of pointers to simple values end at their ``}``); None
-    when any of them is not a plain JSON number (each line is then read on its own)."""
-    out: list[Any] = []
-    lits: list[str] = []
-    for key in calls:
-        parts = key.split(_V)
-        if len(parts) == 1:
-            out.append((key, []))
-            continue
-        first = len(lits)
-        for k in range(1, len(parts)):
-            part = parts[k]
-            j = part.find("}")
-            if j < 0 or part[:1] not in _NUMBER_START:  # a structure, an array, text
-                break
-            lits.append(part[:j])
-            parts[k] = part[j:]
-        else:
-            out.append((_V.join(parts), first, len(lits)))
-            continue
-        del lits[first:]
-        out.append(None)
+    """(the form's key, the values) of each call's line: its numbers and arrays of numbers
+    (``"v":``), all the lines' values read in one JSON parse, the keys made by one pass over
+    the lines' text; None for a line with another ``"v":`` (a structure, a value JSON keeps
+    as text: the line is read whole), None for all when a value is not plain JSON (each line
+    is then read on its own, where the damaged one is reported)."""
+    text = "\n".join(calls)
+    if "\x01" in text or "\x02" in text:  # (never raw in JSON text: a damaged line)
+        return None
+    lits = _VALUE.findall(text)
     try:
         values = json.loads("[" + ",".join(lits) + "]")
     except ValueError:
         return None
-    if len(values) != len(lits) or not all(type(v) is int or type(v) is float for v in values):
+    if len(values) != len(lits):
         return None
-    return [x if x is None or len(x) == 2 else (x[0], values[x[1] : x[2]]) for x in out]
+    for v in values:
+        if type(v) is list:
+            if not all(type(x) is int or type(x) is float for x in v):
+                return None
+        elif type(v) is not int and type(v) is not float:
+            return None
+    out: list[Any] = []
+    at = 0
+    for key in _NUMBER_SLOT.sub("\x01", _ARRAY_SLOT.sub("\x02", text)).split("\n"):
+        n = key.count("\x01") + key.count("\x02") if "\x02" in key else key.count("\x01")
+        if _V in key:  # a value of another kind
+            out.append(None)
+        else:
+            out.append((key, values[at : at + n]))
+        at += n
+    return out
 
 
 _NO: Any = object()
@@ -900,6 +1020,9 @@ def _replay(
                     got = encode(args[i])
                     if got != want:
                         return n, Divergence(n, p.name, f"argument {i + 1}", want, got)
+            for mv, k, i, kind in p.aquick:
+                if mv.tobytes() != vals[k]:
+                    return n, _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
             for where, want in p.checks:
                 got = encode(args[where] if type(where) is int else kw.get(where))
                 if got != want:
@@ -908,6 +1031,21 @@ def _replay(
     finally:
         gt.GT_Close()
     return n, None
+
+
+def _array_divergence(
+    n: int, name: str, i: int, kind: tuple[Any, ...], want: bytes, got: bytes
+) -> Divergence:
+    """The first element where an array a call left differs from the recorded one."""
+    size = _struct(kind).size // kind[2]
+    one = struct.Struct(_ARRAY_CODE[kind[1]])
+    for j in range(kind[2]):
+        w, g = want[j * size : (j + 1) * size], got[j * size : (j + 1) * size]
+        if w != g:
+            return Divergence(
+                n, name, f"argument {i + 1} element [{j}]", one.unpack(w)[0], one.unpack(g)[0]
+            )
+    return Divergence(n, name, f"argument {i + 1}", want.hex(), got.hex())  # (not reached)
 
 
 def _call(
@@ -924,6 +1062,8 @@ def _call(
     try:
         for obj, k in p.sets:
             obj.value = vals[k]
+        for mv, k in p.asets:
+            mv[:] = vals[k]
         if p.fresh:
             args = list(args)
             for i, x in p.fresh:

@@ -209,7 +209,6 @@ def fast_reader(
 
     limit = READ_LIMITS.get(name, CONTROLLER_AXES)
     bank_key = BANK_LISTS.get(name)
-    to = float if ctypes_ok is _DOUBLE else None
 
     def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
@@ -232,19 +231,27 @@ def fast_reader(
             return None
         resources = ctl.resources
         axes = ctl.axes
-        values = []
+        values: list[Any] = []
+        append = values.append
+        bank = lst = None
         for k in range(n, n + count):
             res = resources.get(k)
             if res is None or axes.get(k) is not res.ax:
                 return None
             b = res.bank
-            lst = b._lists.get(bank_key) if b is not None and bank_key is not None else None
-            if lst is None:
-                values.append(get(res))
-            elif to is None:
-                values.append(lst[res.bank_row])
-            else:
-                values.append(to(lst[res.bank_row]))
+            if b is None or bank_key is None:
+                append(get(res))
+                continue
+            if b is not bank:  # (a bank's list of the value: one look-up for its axes)
+                bank = b
+                lst = b._lists.get(bank_key)
+                if lst is None:  # not made yet this cycle: the getter makes it
+                    append(get(res))
+                    lst = b._lists.get(bank_key)
+                    if lst is None:
+                        bank = None
+                    continue
+            append(lst[res.bank_row])  # type: ignore[index]
         p[:count] = values
         session.last = None
         if ctl.clock.mode is not _LOCKSTEP:
@@ -415,6 +422,12 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
 CLOCK = "GT_GetClock"
 #: the largest value each integer type of ``_INTS`` holds
 _INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
+#: the clock's integer types: the vendor's ``unsigned long *pClock`` (a Python caller's
+#: ``c_ulong``) beside the signed ones
+_CLOCK_INTS = _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
+_INT_MAX.update(
+    {t: (1 << (8 * ctypes.sizeof(t))) - 1 for t in _CLOCK_INTS - _INTS}  # (unsigned)
+)
 
 
 def fast_clock(
@@ -443,7 +456,7 @@ def fast_clock(
                     if tp is _CArg:
                         obj = pClock._obj
                         if pClock is not last[0]:
-                            if type(obj) not in _INTS or (
+                            if type(obj) not in _CLOCK_INTS or (
                                 _from_address(id(pClock) + _AT).value
                                 if _AT >= 0
                                 else byref_address(pClock)
@@ -452,7 +465,7 @@ def fast_clock(
                             else:
                                 last[0] = pClock
                     else:
-                        obj = pClock if tp in _INTS else None
+                        obj = pClock if tp in _CLOCK_INTS else None
                     if obj is not None:
                         ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
                         if ms <= _INT_MAX[type(obj)]:
