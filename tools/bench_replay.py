@@ -24,8 +24,12 @@ meets trouble (axis 1 homes, axis 2 jogs with a slow ramp and reverses every 3 s
 on the others, SDO reads, the drive of axis 5 faults at 20 s for 5 s and the application
 brings it back, the limit switch of axis 6 chatters at 30 s for 300 ms).
 
+``--arrays`` records and replays tools/session_arrays.py's session: an application that polls
+every axis in one call (``GT_GetSts(1, sts, 12, NULL)``, the planned and encoder positions as
+arrays too) every 4 to 8 ms, Trap moves and two jogs.
+
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
-                                 [--simple | --rich] [--json]
+                                 [--simple | --rich | --arrays] [--json]
 """
 
 from __future__ import annotations
@@ -210,20 +214,25 @@ def measure(
     against: Path | None = None,
     simple: bool = False,
     rich: bool = False,
+    arrays: bool = False,
 ) -> dict[str, object]:
     from gtecat import faults, gt
     from gtecat.faults.record import Recorder, replay
-    from tools import session_rich
+    from tools import session_arrays, session_rich
 
     def run_session(machine: Path) -> None:
-        if rich:
+        if arrays:
+            session_arrays.session(gt, seconds, str(machine))
+        elif rich:
             session_rich.session(gt, faults, seconds, str(machine))
         else:
             session(gt, seconds, poll_ms, str(machine), simple)
 
     with tempfile.TemporaryDirectory() as tmp:
         machine = Path(tmp) / "machine.toml"
-        machine.write_text(session_rich.MACHINE if rich else MACHINE)
+        machine.write_text(
+            session_arrays.MACHINE if arrays else session_rich.MACHINE if rich else MACHINE
+        )
         path = Path(tmp) / "session.gtrec"
         plain = []
         for _ in range(repeat):
@@ -266,9 +275,9 @@ def measure(
     wall, cpu = _best(runs)
     pw, pc = _best(plain)
     return {
-        "session": "rich" if rich else "simple" if simple else "full",
+        "session": "arrays" if arrays else "rich" if rich else "simple" if simple else "full",
         "virtual_s": seconds,
-        "poll_ms": 10 if rich else poll_ms,
+        "poll_ms": "4-8" if arrays else 10 if rich else poll_ms,
         "load_average": round(os.getloadavg()[0], 2),
         "calls": n,
         "session_wall_s": round(pw, 3),
@@ -309,10 +318,22 @@ def main() -> int:
         help="the session that meets trouble: a jog's ramps, a drive fault and its recovery, "
         "a chattering limit switch, SDO reads (tools/session_rich.py)",
     )
+    kind.add_argument(
+        "--arrays",
+        action="store_true",
+        help="the session that polls all 12 axes in one call each (status, planned and "
+        "encoder positions as arrays) every 4 to 8 ms (tools/session_arrays.py)",
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
     out = measure(
-        args.seconds, args.poll_ms, max(1, args.repeat), args.against, args.simple, args.rich
+        args.seconds,
+        args.poll_ms,
+        max(1, args.repeat),
+        args.against,
+        args.simple,
+        args.rich,
+        args.arrays,
     )
     print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
     return 0 if out["diverged"] is None else 1

@@ -912,11 +912,17 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
         return (None, e) if "c" not in e else prepare(e)
 
     # a call's line without its time (from the comma after it), any other line whole
-    keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
+    keys = _TIME.sub("", "\n".join(lines)).split("\n")
     made = dict.fromkeys(keys)
     made.pop("", None)  # the empty line after the last
     calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
+    get = forms.get
     for key, split in zip(calls, _numbers(calls) or map(numbers, calls), strict=True):
+        if split is not None:  # the common case first: a known form without arrays
+            form = get(split[0])
+            if form is not None and not form.packs and split[1]:
+                made[key] = (form, split[1])
+                continue
         made[key] = step(key, split)
     for key in made:
         if made[key] is None and key.strip():
@@ -925,6 +931,8 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
 
 
 _NUMBER_START = frozenset("-0123456789")
+#: the time at the head of a call's line (as Recorder writes it: first)
+_TIME = re.compile(r'^\{"t":-?[0-9][-0-9.eE+]*(?=,)', re.M)
 
 
 #: a value of a call's line that a form takes out: a JSON number, or an array of numbers
@@ -952,6 +960,7 @@ def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
         return None
     if len(values) != len(lits):
         return None
+    values = tuple(values)
     for v in values:
         if type(v) is list:
             if not all(type(x) is int or type(x) is float for x in v):
@@ -965,7 +974,7 @@ def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
         if _V in key:  # a value of another kind
             out.append(None)
         else:
-            out.append((key, values[at : at + n]))
+            out.append((key, values[at : at + n]))  # (a tuple's slice: a tuple)
         at += n
     return out
 
