@@ -33,8 +33,8 @@ import re
 import struct
 import threading
 from contextlib import contextmanager
-from functools import lru_cache
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -654,7 +654,9 @@ def _compiled(p: _Call) -> Any:
     into one function: None when everything matched, ``(rc,)`` when something may differ
     (the loop compares in full and reports), an exception when a value cannot be set."""
     fn, rc0, args = p.fn, p.rc, tuple(p.args)
-    if not p.sets and not p.quick and not p.asets:  # GTE_Wait(10), GT_Update(mask): no pointer at all
+    if (
+        not p.sets and not p.quick and not p.asets
+    ):  # GTE_Wait(10), GT_Update(mask): no pointer at all
 
         def run_plain(vals: Any) -> Any:
             rc = fn(*args)
@@ -772,7 +774,7 @@ _ARRAY_CODE = {
 def _kind(x: Any) -> tuple[Any, ...] | None:
     """What a recorded pointer argument is when one pooled object serves it: ``("ref", c)``
     for a pointer to a simple value, ``("arr", c, n)`` for an array of numbers; else None."""
-    if type(x) is not dict or len(x) != 1 and len(x) != 3:
+    if type(x) is not dict or (len(x) != 1 and len(x) != 3):
         return None
     if len(x) == 1:
         ref = x.get("ref")

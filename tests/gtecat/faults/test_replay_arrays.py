@@ -95,12 +95,10 @@ def test_one_element_of_an_array_is_named_with_its_index(recorded: Path, tmp_pat
     assert div.recorded == e["a"][1]["v"][11] and div.now == div.recorded ^ 0x400
 
 
-def test_a_return_code_and_an_unholdable_element_are_caught(
-    recorded: Path, tmp_path: Path
-) -> None:
+def test_a_return_code_and_an_unholdable_element_are_caught(recorded: Path, tmp_path: Path) -> None:
     bad = tmp_path / "rc.gtrec"
     at, _ = _tampered(recorded, bad, "GT_GetSts", 2, lambda e: e.update(r=7))
-    n, div = replay(bad)
+    _, div = replay(bad)
     assert div is not None and (div.index, div.what, div.recorded, div.now) == (
         at,
         "return code",
@@ -112,7 +110,7 @@ def test_a_return_code_and_an_unholdable_element_are_caught(
         e["o"]["1"]["v"][2] = 0.5
 
     at, _ = _tampered(recorded, bad, "GT_GetSts", 2, fraction)
-    n, div = replay(bad)
+    _, div = replay(bad)
     assert div is not None and (div.index, div.call, div.what) == (at, "GT_GetSts", "argument 2")
 
 

@@ -162,7 +162,14 @@ def test_the_clock_reader_answers_as_the_table(moving_bus) -> None:
     for reset_ns in (ctl.reset_ns, ctl.clock.now_ns - (1 << 31) * 1_000_000):
         ctl.reset_ns = reset_ns
         for kind in ("byref", "byref_offset", "same_byref", "array", "obj", "int"):
-            for t in (ctypes.c_long, ctypes.c_int32, ctypes.c_int16, ctypes.c_double):
+            for t in (
+                ctypes.c_long,
+                ctypes.c_int32,
+                ctypes.c_int16,
+                ctypes.c_double,
+                ctypes.c_ulong,  # the vendor's unsigned long *pClock
+                ctypes.c_uint32,
+            ):
                 for loop in ("omitted", "none", "zero", "byref"):
                     results = []
                     for fn in (gt.GT_GetClock, gt.GT_GetClock.slow):
@@ -175,3 +182,48 @@ def test_the_clock_reader_answers_as_the_table(moving_bus) -> None:
                     if results[0] != results[1]:
                         bad.append(f"{kind} {t.__name__} {loop}: {results}")
     assert not bad, "\n".join(bad)
+
+
+def test_every_axis_in_one_call_answers_as_the_table(moving_bus) -> None:
+    """count > 1 into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``, a poll of every axis):
+    the fast answer is the table's, spans past the axes, the encoders' limit of 8, arrays
+    too short, other types, a clock pointer and numpy arrays included."""
+    import numpy as np
+
+    bad = []
+    for name in sorted(READERS):
+        for first, count in (
+            (1, 12),
+            (1, 2),
+            (5, 8),
+            (9, 4),
+            (1, 8),
+            (1, 9),
+            (6, 8),
+            (0, 3),
+            (12, 2),
+        ):
+            for kind in ("c_long", "c_int32", "c_double", "c_float", "short", "numpy", "clock"):
+                results = []
+                for fn in (getattr(gt, name), getattr(gt, name).slow):
+                    n = count - 1 if kind == "short" else 12
+                    t = {"c_int32": ctypes.c_int32, "c_double": ctypes.c_double}.get(kind)
+                    if kind == "c_float":
+                        t = ctypes.c_float
+                    if t is None:
+                        t = (
+                            ctypes.c_double
+                            if READERS[name][1] is READERS["GT_GetPrfPos"][1]
+                            else ctypes.c_long
+                        )
+                    o = np.zeros(12) if kind == "numpy" else (t * max(n, 1))()
+                    clk = ctypes.c_uint32()
+                    rc = fn(first, o, count, byref(clk) if kind == "clock" else None)
+                    err = gt.GTE_GetLastError() if rc else ""
+                    results.append((rc, list(o), err, clk.value))
+                if results[0] != results[1]:
+                    bad.append(f"{name}({first}, {kind}, {count}): {results}")
+    assert not bad, "\n".join(bad[:5])
+    sts = (ctypes.c_long * 12)()
+    assert gt.GT_GetSts(1, sts, 12, None) == 0
+    assert [sts[a - 1] & 0x600 for a in (1, 2, 5)] == [0x600] * 3  # servo on, moving
