@@ -952,6 +952,8 @@ def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
     the lines' text; None for a line with another ``"v":`` (a structure, a value JSON keeps
     as text: the line is read whole), None for all when a value is not plain JSON (each line
     is then read on its own, where the damaged one is reported)."""
+    if not calls:
+        return []
     text = "\n".join(calls)
     if "\x01" in text or "\x02" in text:  # (never raw in JSON text: a damaged line)
         return None

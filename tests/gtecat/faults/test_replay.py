@@ -198,7 +198,11 @@ def test_the_numbers_of_a_form_are_read_as_json_reads_them() -> None:
     st = ',"c":"GT_SetTrapPrm","a":[1,{"ref":{"st":"TTrapPrm","v":{"acc":0.5}}}],"r":0}'
     got = _numbers([ref.format("-1.5e-3"), ref.format("12"), st, ',"c":"GT_Reset","a":[],"r":0}'])
     assert got is not None
-    assert got[0][1] == [-1.5e-3] and type(got[1][1][0]) is int and got[1][1] == [12]
+    assert got[0][1] == (-1.5e-3,) and type(got[1][1][0]) is int and got[1][1] == (12,)
     assert got[0][0] == got[1][0]  # one form
-    assert got[2] is None and got[3] == (',"c":"GT_Reset","a":[],"r":0}', [])
+    assert got[2] is None and got[3] == (',"c":"GT_Reset","a":[],"r":0}', ())
     assert _numbers([ref.format("12"), ref.format("012")]) is None
+    arr = ',"c":"GT_GetSts","a":[1,{{"arr":"c_long","n":2,"v":[{}]}},2,null],"r":0}}'
+    got = _numbers([arr.format("1,-2"), arr.format("3,4"), ref.format("5")])
+    assert got is not None and got[0][0] == got[1][0] != got[2][0]  # an array's own form
+    assert got[0][1] == ([1, -2],) and got[1][1] == ([3, 4],) and got[2][1] == (5,)
