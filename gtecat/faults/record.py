@@ -35,6 +35,8 @@ import threading
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
+from itertools import accumulate, chain, compress, repeat
+from operator import contains, not_
 from pathlib import Path
 from typing import Any
 
@@ -914,18 +916,39 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
         return (None, e) if "c" not in e else prepare(e)
 
     # a call's line without its time (from the comma after it), any other line whole
-    keys = _TIME.sub("", "\n".join(lines)).split("\n")
+    keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
     made = dict.fromkeys(keys)
     made.pop("", None)  # the empty line after the last
     calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
-    get = forms.get
-    for key, split in zip(calls, _numbers(calls) or map(numbers, calls), strict=True):
-        if split is not None:  # the common case first: a known form without arrays
-            form = get(split[0])
-            if form is not None and not form.packs and split[1]:
-                made[key] = (form, split[1])
-                continue
-        made[key] = step(key, split)
+    split = _split(calls)
+    if split is None:  # a value JSON would refuse: each line read on its own
+        for key, one in zip(calls, map(numbers, calls), strict=True):
+            made[key] = step(key, one)
+    else:
+        form_keys, values = split
+        # the first line of each form made ready (its call, or None: not a form) ...
+        first = dict(zip(reversed(form_keys), range(len(form_keys) - 1, -1, -1), strict=False))
+        first.pop(None, None)
+        for fk, i in first.items():
+            made[calls[i]] = step(calls[i], (fk, values[i]))
+        # ... then every line of a form without arrays at once (the common polling call),
+        plain = {fk for fk, form in forms.items() if form is not None and not form.packs}
+        sel = list(map(plain.__contains__, form_keys))
+        made.update(
+            zip(
+                compress(calls, sel),
+                zip(
+                    map(forms.__getitem__, compress(form_keys, sel)),
+                    compress(values, sel),
+                    strict=False,
+                ),
+                strict=False,
+            )
+        )
+        # ... and the others one by one (arrays packed, lines of no form)
+        for key, fk, vals in compress(zip(calls, form_keys, values, strict=False), map(not_, sel)):
+            if made[key] is None:
+                made[key] = step(key, None if fk is None else (fk, vals))
     for key in made:
         if made[key] is None and key.strip():
             made[key] = step(key, None)
@@ -933,8 +956,8 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
 
 
 _NUMBER_START = frozenset("-0123456789")
-#: the time at the head of a call's line (as Recorder writes it: first)
-_TIME = re.compile(r'^\{"t":-?[0-9][-0-9.eE+]*(?=,)', re.M)
+_NUMBER_TYPES = frozenset({int, float})
+_VALUE_TYPES = frozenset({int, float, list})
 
 
 #: a value of a call's line that a form takes out: a JSON number, or an array of numbers
@@ -946,14 +969,24 @@ _ARRAY_SLOT = re.compile(r'"v":\[[-0-9.eE+,]*\]')
 _NUMBER_SLOT = re.compile(r'"v":-?[0-9][-0-9.eE+]*')
 
 
-def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
-    """(the form's key, the values) of each call's line: its numbers and arrays of numbers
+def _numbers(calls: list[str]) -> list[tuple[str, tuple[Any, ...]] | None] | None:
+    """(the form's key, the values) of each call's line (:func:`_split`), None for a line
+    of no form; None for all when a value is not plain JSON."""
+    split = _split(calls)
+    if split is None:
+        return None
+    return [None if k is None else (k, v) for k, v in zip(*split, strict=True)]
+
+
+def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] | None:
+    """(the form's key of each call's line, its values): its numbers and arrays of numbers
     (``"v":``), all the lines' values read in one JSON parse, the keys made by one pass over
-    the lines' text; None for a line with another ``"v":`` (a structure, a value JSON keeps
-    as text: the line is read whole), None for all when a value is not plain JSON (each line
-    is then read on its own, where the damaged one is reported)."""
+    the lines' text, the work per line done by the interpreter's own loops; the key is None
+    for a line with another ``"v":`` (a structure, a value JSON keeps as text: the line is
+    read whole); None for all when a value is not plain JSON (each line is then read on its
+    own, where the damaged one is reported)."""
     if not calls:
-        return []
+        return [], []
     text = "\n".join(calls)
     if "\x01" in text or "\x02" in text:  # (never raw in JSON text: a damaged line)
         return None
@@ -965,22 +998,20 @@ def _numbers(calls: list[str]) -> list[tuple[str, list[Any]] | None] | None:
     if len(values) != len(lits):
         return None
     values = tuple(values)
-    for v in values:
-        if type(v) is list:
-            if not all(type(x) is int or type(x) is float for x in v):
-                return None
-        elif type(v) is not int and type(v) is not float:
+    kinds = set(map(type, values))
+    if not kinds <= _VALUE_TYPES:
+        return None
+    if list in kinds:  # arrays: of numbers only
+        arrays = [v for v in values if type(v) is list]
+        if not set(map(type, chain.from_iterable(arrays))) <= _NUMBER_TYPES:
             return None
-    out: list[Any] = []
-    at = 0
-    for key in _NUMBER_SLOT.sub("\x01", _ARRAY_SLOT.sub("\x02", text)).split("\n"):
-        n = key.count("\x01") + key.count("\x02") if "\x02" in key else key.count("\x01")
-        if _V in key:  # a value of another kind
-            out.append(None)
-        else:
-            out.append((key, values[at : at + n]))  # (a tuple's slice: a tuple)
-        at += n
-    return out
+    # an array's mark is \x02\x01, a number's \x01: the values of a line are its \x01s
+    keys: list[Any] = _NUMBER_SLOT.sub("\x01", _ARRAY_SLOT.sub("\x02\x01", text)).split("\n")
+    ends = list(accumulate(map(str.count, keys, repeat("\x01"))))
+    vals = list(map(values.__getitem__, map(slice, [0, *ends[:-1]], ends)))
+    for i in compress(range(len(keys)), map(contains, keys, repeat(_V))):
+        keys[i] = None  # a value of another kind
+    return keys, vals
 
 
 _NO: Any = object()
