@@ -140,6 +140,30 @@ def test_fault_kinds_and_refusals(capsys: pytest.CaptureFixture[str]) -> None:
     assert "KEY=VALUE" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    ("values", "said"),
+    [
+        (["axis=1", "axis=2"], "axis= is given twice (axis=1 and axis=2): give it once"),
+        (["axis=1", "name="], "'name=': name has no value"),
+        (["axis=", "code=0x2310"], "'axis=': axis has no value"),
+    ],
+)
+def test_fault_inject_refuses_a_key_twice_or_empty(
+    values: list[str], said: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["fault", "inject", "drive_fault", *values]) == 1  # refused before connecting
+    err = capsys.readouterr().err
+    assert said in err and "no running gtecat" not in err, err
+
+
+def test_an_empty_fault_name_is_refused() -> None:
+    from gtecat import faults
+
+    with pytest.raises(faults.FaultSpecError, match="name must be text that names the fault"):
+        faults.spec_from_dict({"kind": "drive_fault", "axis": 1, "name": "  "})
+    assert faults.spec_from_dict({"kind": "drive_fault", "axis": 1, "name": "cut"}).name == "cut"
+
+
 PLUGIN_TESTS = textwrap.dedent(
     """
     from ctypes import byref, c_long
