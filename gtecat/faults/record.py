@@ -2,7 +2,8 @@
 
 A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
-* a header ``{"gtecat_recording": 1, ...}``;
+* a header ``{"gtecat_recording": 1, "calls": N, ...}``: N call lines follow (a replay
+  refuses a file that holds fewer, one cut short at a line's end, or more);
 * one line per GT call: ``{"t": controller time in ns, "c": NAME, "a": [arguments], "r":
   return code, "k": {keywords}, "o": {index: value written back}}``, and ``"b"``: the
   controller time when the call began, where time passed since the call before (a
@@ -13,7 +14,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
   every :data:`CHECKPOINT_MS` of controller time.
 
 Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
-structure field by field, an array as its values, a buffer as hex); replay builds fresh
+structure field by field, an array as its size and every value, which must agree, a buffer
+as hex); replay builds fresh
 objects of the same types, makes the same calls in the same order and compares every return
 code, every value the call leaves in its pointer arguments (written back or left as it was)
 and every checkpoint: the first difference is the
