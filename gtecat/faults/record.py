@@ -357,8 +357,10 @@ class Recorder(Listener):
         self.lines.append(self._dumps(entry))
 
     def write(self) -> Path:
-        head = {"gtecat_recording": 1, "calls": self.calls, **self.meta, **self.where}
-        text = json.dumps(head) + "\n" + "\n".join(self.lines) + ("\n" if self.lines else "")
+        lines = list(self.lines)  # (a client's call may still be adding one: these, counted)
+        calls = sum(1 for x in lines if x.startswith('{"t":'))  # a call's line, as after() writes
+        head = {"gtecat_recording": 1, "calls": calls, **self.meta, **self.where}
+        text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
             data = gzip.compress(data, 6)
