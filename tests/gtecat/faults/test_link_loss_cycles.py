@@ -250,6 +250,14 @@ def test_slave_counts_and_emergencies_follow_the_link(eni_io: Path, tmp_path: Pa
     assert wait(lambda: ready() == 1, 400)
     assert master.emergency_count == 1 and not master.backend.slaves[1].emergencies
     assert error_code(2) == 0x8130 and counts() == (3, 2, 1)
-    faults.inject("link_down", after_slave=-1)  # the cable at the master
+    faults.inject("link_down", after_slave=-1, duration_ms=50)  # the cable at the master
     gt.GTE_Wait(1)
     assert counts() == (0, 0, 0) and ready() == 0
+    # link faults overlap: each one's end mends only its own cut
+    faults.inject("link_down", after_slave=1, duration_ms=100)
+    gt.GTE_Wait(1)
+    assert counts() == (0, 0, 0)
+    assert wait(lambda: counts() == (2, 2, 0), 60)  # the first is over, the second is not
+    gt.GTE_Wait(20)
+    assert counts() == (2, 2, 0)
+    assert wait(lambda: counts() == (3, 2, 1), 60)
