@@ -429,7 +429,7 @@ def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
     lines = raw.decode("utf-8", "replace").split("\n")
     try:
         head = json.loads(lines[0] or "{}")
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")

@@ -67,3 +67,7 @@ def test_deep_nesting_is_a_damaged_line(tmp_path: Path, capsys: pytest.CaptureFi
     rc, text = replay(tmp_path, 2, [STS, line], capsys)
     assert rc == 1 and "damaged recording: line 3: nested too deeply" in text, text
     assert "internal error" not in text and "RecursionError" not in text
+    f = tmp_path / "deep_head.gtrec"
+    f.write_text(deep + "\n")
+    assert main(["replay", str(f)]) == 1
+    assert "is not a gtecat recording" in capsys.readouterr().err
