@@ -38,7 +38,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import accumulate, chain, compress, repeat
-from operator import contains, not_
+from operator import contains, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -1036,10 +1036,8 @@ _VALUE_TYPES = frozenset({int, float, list})
 #: a value of a call's line that a form takes out: a JSON number, or an array of numbers
 #: (``"v":[1,2.5]``); the group is the value's text, read by one JSON parse
 _VALUE = re.compile(r'"v":(\[[-0-9.eE+,]*\]|-?[0-9][-0-9.eE+]*)')
-#: the same, each kind on its own, replaced in the form's key by a mark of its kind (an
-#: array: \x02, a number: \x01; control characters never stand raw in JSON text)
-_ARRAY_SLOT = re.compile(r'"v":\[[-0-9.eE+,]*\]')
-_NUMBER_SLOT = re.compile(r'"v":-?[0-9][-0-9.eE+]*')
+#: the mark of a value in its form's key, by the value's first character
+_MARK = {"[": "\x02\x01", "-": "\x01", **dict.fromkeys("0123456789", "\x01")}
 
 
 def _numbers(calls: list[str]) -> list[tuple[str, tuple[Any, ...]] | None] | None:
@@ -1063,7 +1061,8 @@ def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] |
     text = "\n".join(calls)
     if "\x01" in text or "\x02" in text:  # (never raw in JSON text: a damaged line)
         return None
-    lits = _VALUE.findall(text)
+    parts = _VALUE.split(text)  # the text between the values, each value's own text
+    lits = parts[1::2]
     try:
         values = json.loads("[" + ",".join(lits) + "]")
     except ValueError:
@@ -1078,8 +1077,11 @@ def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] |
         arrays = [v for v in values if type(v) is list]
         if not set(map(type, chain.from_iterable(arrays))) <= _NUMBER_TYPES:
             return None
-    # an array's mark is \x02\x01, a number's \x01: the values of a line are its \x01s
-    keys: list[Any] = _NUMBER_SLOT.sub("\x01", _ARRAY_SLOT.sub("\x02\x01", text)).split("\n")
+    # the keys: each value replaced by a mark of its kind (an array's \x02\x01, a number's
+    # \x01: the values of a line are its \x01s; control characters never stand raw in JSON)
+    marks = list(map(_MARK.__getitem__, map(itemgetter(0), lits)))
+    marks.append("")
+    keys: list[Any] = "".join(chain.from_iterable(zip(parts[0::2], marks, strict=True))).split("\n")
     ends = list(accumulate(map(str.count, keys, repeat("\x01"))))
     vals = list(map(values.__getitem__, map(slice, [0, *ends[:-1]], ends)))
     for i in compress(range(len(keys)), map(contains, keys, repeat(_V))):
