@@ -5,8 +5,9 @@ only one ``gtecat ps`` lists: an application, a controller, or a ``gtecat serve`
 master on the wire then sees it): the same kinds and keys as a machine description's
 ``[[fault]]`` tables, a trigger among them (``at_ms=``, ``after_ms=``, ``after_cycles=``,
 ``when_position=AXIS,POS``, ``at_homing=AXIS,STAGE``, ``on_sdo=SLAVE,INDEX,N``; none: at
-once), ``duration_ms=`` for how long it lasts.  ``list`` shows what is armed or active,
-``clear [ID]`` ends one fault or all, ``kinds`` lists every kind with its values.
+once), ``duration_ms=`` for how long it lasts; each key once, with a value.  ``list``
+shows what is armed or active, ``clear [ID]`` ends one fault or all, ``kinds`` lists every
+kind with its values.
 """
 
 from __future__ import annotations
@@ -78,11 +79,21 @@ def _pairs(values: list[str]) -> dict[str, Any]:
         key, sep, value = text.partition("=")
         if not sep or not key:
             raise ParameterError(f"{text!r}: expected KEY=VALUE (e.g. axis=1)")
+        if key in out:
+            raise ParameterError(
+                f"{key}= is given twice ({key}={_shown(out[key])} and {text}): give it once"
+            )
+        if not value.strip():
+            raise ParameterError(f"{text!r}: {key} has no value (e.g. {key}=1)")
         if "," in value:
             out[key] = [v.strip() for v in value.split(",")]
         else:
             out[key] = value
     return out
+
+
+def _shown(value: Any) -> str:
+    return ",".join(value) if isinstance(value, list) else str(value)
 
 
 def _connect(args: argparse.Namespace) -> Any:

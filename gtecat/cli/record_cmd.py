@@ -7,6 +7,10 @@ controller time go into FILE (JSON lines; gzip when FILE ends in ``.gz``).  A Py
 runs as a child with ``GTECAT_RECORD=FILE`` in its environment: a Python program that
 imports gtecat records itself, and the controller that libgts starts for a C, C++ or C#
 program records that program's calls.  ``gtecat replay FILE`` re-runs the session.
+
+A script that raises is reported as ``python3`` would (its traceback, exit code 1) and its
+recording is written up to that point: it replays.  FILE is refused before anything runs
+when it cannot be written, with the reason.
 """
 
 from __future__ import annotations
@@ -17,9 +21,13 @@ import runpy
 import subprocess
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import ParameterError
 from . import output
+
+if TYPE_CHECKING:
+    from ..faults.record import Recorder
 
 EPILOG = """\
 examples:
@@ -67,10 +75,7 @@ def run(args: argparse.Namespace) -> int:
     if not command:
         raise ParameterError("no command to record: gtecat record -o FILE -- python3 SCRIPT.py")
     out: Path = args.output
-    if out.is_dir():
-        raise ParameterError(f"-o {out} is a folder; name the recording file")
-    if not out.parent.exists():
-        raise ParameterError(f"-o {out}: folder {out.parent} does not exist")
+    check_output(out)
     script = _script(command)
     if script is None:
         env = dict(os.environ, GTECAT_RECORD=str(out.resolve()))
@@ -102,6 +107,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"{path}: no such script")
     from .. import gt
     from ..faults.record import Recorder
+    from .run_cmd import script_traceback
 
     rec = Recorder(out, {"program": " ".join(command)}).start()
     saved_argv, saved_path = sys.argv, list(sys.path)
@@ -112,10 +118,51 @@ def run(args: argparse.Namespace) -> int:
         runpy.run_path(str(path), run_name="__main__")
     except SystemExit as e:
         rc = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
-    finally:
-        gt.GT_Close()
-        rec.stop()
-        sys.argv, sys.path[:] = saved_argv, saved_path
-    rec.write()
+        if isinstance(e.code, str):
+            print(e.code, file=sys.stderr)
+    except Exception as e:  # the script's own bug: its traceback, its exit code (as python's)
+        sys.stderr.write(script_traceback(e, path))
+        print(f"error: {path} raised {type(e).__name__}: {e}", file=sys.stderr)
+        rc = 1
+    finally:  # the session up to where the script ended (or was interrupted) is kept
+        try:
+            gt.GT_Close()
+        finally:
+            rec.stop()
+            sys.argv, sys.path[:] = saved_argv, saved_path
+            _write(rec, out)
     print(f"record: {rec.calls} GT calls -> {out}", file=sys.stderr)
     return rc
+
+
+def _write(rec: Recorder, out: Path) -> None:
+    try:
+        rec.write()
+    except OSError as e:
+        raise ParameterError(f"-o {out}: cannot write the recording: {e.strerror or e}") from None
+
+
+def check_output(out: Path) -> None:
+    """Refuse, before the program runs, a recording file that cannot be written (and say why)."""
+    if out.is_dir():
+        raise ParameterError(f"-o {out} is a folder; name the recording file")
+    folder = out.parent
+    if not folder.is_dir():
+        raise ParameterError(
+            f"-o {out}: the folder {folder} "
+            + ("is not a folder" if folder.exists() else "does not exist")
+        )
+    existed = out.exists()
+    try:
+        with open(out, "ab"):
+            pass
+    except OSError as e:
+        why = e.strerror or str(e)
+        if isinstance(e, FileNotFoundError):  # the folder is there but takes no new file
+            why = f"the folder {folder} does not take new files ({why})"
+        elif isinstance(e, PermissionError):
+            why = f"permission denied ({'the file is' if existed else f'the folder {folder} is'} "
+            why += "not writable)"
+        raise ParameterError(f"-o {out}: the recording cannot be written: {why}") from None
+    if not existed:
+        out.unlink(missing_ok=True)  # written when the program ends

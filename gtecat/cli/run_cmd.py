@@ -211,7 +211,7 @@ class _TraceFailed(BaseException):
     """
 
 
-def _script_traceback(e: BaseException, script: Path) -> str:
+def script_traceback(e: BaseException, script: Path) -> str:
     """The traceback from the script's first frame on (runpy and gtecat.cli frames dropped)."""
     tb = traceback.TracebackException.from_exception(e)
     frames = tb.stack
@@ -375,7 +375,7 @@ def run(args: argparse.Namespace) -> int:
         ) from None
     except Exception as e:  # the user's own bug: show where, in their script
         progress.done()
-        sys.stderr.write(_script_traceback(e, script))
+        sys.stderr.write(script_traceback(e, script))
         print(f"error: {script} raised {type(e).__name__}: {e}", file=sys.stderr)
         rc = 1
     finally:

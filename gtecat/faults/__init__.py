@@ -115,8 +115,10 @@ def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
             f"got {after!r}"
         )
     name = extra.get("name", "")
-    if not isinstance(name, str):
-        raise FaultSpecError(f"{prefix}name must be text, got {name!r}")
+    if not isinstance(name, str) or ("name" in extra and not name.strip()):
+        raise FaultSpecError(
+            f"{prefix}name must be text that names the fault (for another's after=), got {name!r}"
+        )
     return FaultSpec(fault, trigger, duration, after, name, where)
 
 

@@ -56,9 +56,35 @@ class FaultBus:
         pass
 
     def cut_after(self, position: int) -> None:
+        """A link fault starts: the cable behind ``position`` is pulled.  Link faults may
+        overlap: the bus is cut at the first of those active, and each one's end mends
+        only its own (:meth:`mend`)."""
+        links = self.__dict__.setdefault("_links", [])
+        before = min(links, default=None)
+        links.append(position)
+        if before is None or position < before:
+            self._open_link(position)
+
+    def mend(self, position: int | None = None) -> None:
+        """The link fault cut at ``position`` ends (None: every one): the bus is whole
+        again, or cut where another one still is."""
+        links = self.__dict__.setdefault("_links", [])
+        before = min(links, default=None)
+        if position is None:
+            links.clear()
+        elif position in links:
+            links.remove(position)
+        now = min(links, default=None)
+        if now is None:
+            self._close_link()
+        elif now != before:
+            self._open_link(now)
+
+    def _open_link(self, position: int) -> None:
+        """Cut the bus behind ``position`` (only there: a cut elsewhere is closed)."""
         raise NotImplementedError
 
-    def mend(self) -> None:
+    def _close_link(self) -> None:
         raise NotImplementedError
 
     def before_change(self) -> None:
@@ -207,15 +233,18 @@ class EmulatedBus(FaultBus):
         if bank is not None:
             bank.hold(axes)
 
-    def cut_after(self, position: int) -> None:
-        self.mend()
+    def _open_link(self, position: int) -> None:
         self.before_change()
-        for pos in range(position + 1, len(self.slaves)):
+        behind = range(position + 1, len(self.slaves))
+        for pos in [p for p in self._cut if p not in behind]:
+            self.backend.replug(pos)
+            self._cut.remove(pos)
+        for pos in behind:  # a slave already cut keeps its silence (its watchdog's count)
             if pos not in self.backend.unplugged:
                 self.backend.unplug(pos)
                 self._cut.append(pos)
 
-    def mend(self) -> None:
+    def _close_link(self) -> None:
         for pos in self._cut:
             self.backend.replug(pos)
         self._cut = []
@@ -256,10 +285,10 @@ class WireBus(FaultBus):
         if self._log is not None:
             self._log(message)
 
-    def cut_after(self, position: int) -> None:
+    def _open_link(self, position: int) -> None:
         self.chain.cut_after(position)
 
-    def mend(self) -> None:
+    def _close_link(self) -> None:
         self.chain.mend()
 
     def power_cycle(self, position: int) -> None:

@@ -17,9 +17,16 @@ The rules and where they come from:
   6.2: a mode change is made at standstill; drives refuse or jerk);
 * ``sdo-on-pdo`` - an SDO write, in OP, to an object that is mapped in an RxPDO: the next
   cycle overwrites it, many drives abort with 06010006h (ETG.1000.6 5.6.2; CiA 301);
-* ``ready-poll`` - ``GT_IsEcatReady`` polled from one line again and again (200 times) with no
-  ``GT_GetClock`` in between: a loop without a time limit hangs the program when the bus
-  never comes up (the manual's example 5-5 loops so; entry 80 gives no limit);
+* ``ready-poll`` - waiting for the bus without a time limit: ``GT_IsEcatReady`` polled from
+  one line 200 times in a row, each answered *not ready* (status not 1, or a non-zero
+  return), with no clock read in between.  Such a loop hangs the program when the bus never
+  comes up (the manual's example 5-5 loops so; entry 80 gives no limit).  What does not
+  count: a poll answered *ready* (the bus is up: a health check that watches it, not a
+  wait; it starts the count again); what ends the count: a clock read between two polls,
+  ``GT_GetClock`` or the program's own clock (``time.monotonic``, ``time.time``,
+  ``time.perf_counter`` and their ``_ns`` forms, called from the polling file), since a
+  loop that reads a clock can have a time limit.  A pause in the loop (``GTE_Wait``,
+  ``time.sleep``) paces it but does not end it: it still counts;
 * ``move-with-alarm`` - a move started (``GT_Update`` and the other start calls) on an axis
   whose status has the alarm bit set (manual 7.1, table 6-2 bit 1: clear it with GT_ClrSts
   once the cause is gone).
@@ -27,7 +34,10 @@ The rules and where they come from:
 
 from __future__ import annotations
 
+import ctypes
 import sys
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TextIO
 
@@ -44,14 +54,31 @@ SOURCES = {
     "ready-poll": "manual entry 80, example 5-5",
     "move-with-alarm": "manual table 6-2 bit 1",
 }
-#: GT_IsEcatReady calls in a row from one line with no clock read: a "poll without a limit"
+#: GT_IsEcatReady calls in a row from one line, answered "not ready", with no clock read:
+#: a "poll without a limit"
 READY_POLLS = 200
+#: the program's own clocks: a loop that reads one can have a time limit (``ready-poll``)
+_CLOCKS = ("monotonic", "monotonic_ns", "time", "time_ns", "perf_counter", "perf_counter_ns")
 _START_CALLS = frozenset({"GT_Update", "GT_MoveAbsolute", "GT_MoveRelative", "GT_MoveVelocity"})
 
 
 #: cycles a drive may take to make an SDO-written 6060h its mode (the finding then still
 #: names the SDO call, not the one running when the drive took it up)
 _MODE_TAKE_UP_CYCLES = 4
+
+
+def _pointee(x: Any) -> Any:
+    """The value a pointer argument holds (``byref(c_short())``, ``pointer(...)``, an array's
+    first element); None when it cannot be read."""
+    try:
+        x = getattr(x, "_obj", x)  # byref
+        if isinstance(x, ctypes._Pointer):  # type: ignore[attr-defined]
+            x = x.contents
+        if isinstance(x, ctypes.Array):
+            x = x[0]
+        return getattr(x, "value", x)
+    except (ValueError, IndexError, TypeError):
+        return None
 
 
 def _is_mode_index(index: int) -> bool:
@@ -110,6 +137,7 @@ class Checker(Listener):
         self._prev: dict[int, tuple[int, int, int, int]] = {}
         self._polls = 0
         self._poll_site: tuple[str, int] = ("", 0)
+        self._clocks: dict[str, Callable[[], float | int]] = {}
         self._cycles = 0
         #: (slave, 6060h of a channel) -> (call site, cycle it ended in): the call that wrote
         #: a mode by SDO; the drive takes it up a cycle or two later, maybe inside the next
@@ -119,10 +147,29 @@ class Checker(Listener):
 
     def start(self) -> Checker:
         tap(self)
+        for name in _CLOCKS:  # the program's clock reads end a ready-poll count
+            real = getattr(time, name)
+            if getattr(real, "__wrapped__", None) is None:
+                self._clocks[name] = real
+                setattr(time, name, self._clock(real))
         return self
+
+    def _clock(self, real: Callable[[], float | int]) -> Callable[[], float | int]:
+        def read() -> float | int:
+            if self._polls and sys._getframe(1).f_code.co_filename == self._poll_site[0]:
+                self._polls = 0
+            return real()
+
+        read.__wrapped__ = real  # type: ignore[attr-defined]
+        read.__name__ = real.__name__
+        return read
 
     def stop(self) -> None:
         untap(self)
+        for name, real in self._clocks.items():
+            if getattr(getattr(time, name), "__wrapped__", None) is real:
+                setattr(time, name, real)
+        self._clocks.clear()
         ctl = self._ctl
         if ctl is not None and self._cycle in ctl.pre_cycle:
             ctl.pre_cycle.remove(self._cycle)
@@ -151,17 +198,7 @@ class Checker(Listener):
         ctl = self._attach()
         if name.startswith("GTN_") and args:
             name, args = "GT_" + name[4:], args[1:]
-        if name == "GT_IsEcatReady":
-            self._polls = self._polls + 1 if site == self._poll_site else 1
-            self._poll_site = site
-            if self._polls == READY_POLLS:
-                self.report_here(
-                    "ready-poll",
-                    f"GT_IsEcatReady polled {READY_POLLS} times in a row without reading the "
-                    "clock: give the loop a time limit (GT_GetClock) so that a bus that never "
-                    "comes up (a cable, a slave missing) ends it instead of hanging",
-                )
-        elif name == "GT_GetClock":  # a loop that reads the clock can have a time limit
+        if name == "GT_GetClock":  # a loop that reads the clock can have a time limit
             self._polls = 0
         if ctl is None:
             return None
@@ -174,9 +211,30 @@ class Checker(Listener):
         return None
 
     def after(self, name: str, args: tuple, kwargs: dict, rc: Any, token: Any) -> None:
+        if name in ("GT_IsEcatReady", "GTN_IsEcatReady"):
+            status = args[1 if name[2] == "N" else 0] if len(args) > (name[2] == "N") else None
+            self._ready_poll(rc == 0 and _pointee(status) == 1)
         pending, self._pending_write = self._pending_write, None
         if pending is not None and rc == 0:
             self._mode_writes[pending[0]] = (pending[1], self._cycles)
+
+    def _ready_poll(self, ready: bool) -> None:
+        """One GT_IsEcatReady answer: ``ready-poll`` counts the "not ready" ones in a row."""
+        site = getattr(self, "_now", ("?", 0))
+        if ready:  # the bus is up: a health check, not a wait for the bus
+            self._polls = 0
+            return
+        self._polls = self._polls + 1 if site == self._poll_site else 1
+        self._poll_site = site
+        if self._polls == READY_POLLS:
+            self.report(
+                "ready-poll",
+                f"GT_IsEcatReady answered not ready {READY_POLLS} times in a row without a "
+                "clock read: give the wait a time limit (GT_GetClock, or the program's clock) "
+                "so that a bus that never comes up (a cable, a slave missing) ends it instead "
+                "of hanging",
+                site,
+            )
 
     def _attach(self) -> Any:
         from ..gt._core import SESSION

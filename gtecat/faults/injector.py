@@ -364,7 +364,7 @@ class Injector:
         if not f.once:
             bus.log(f"Fault {e.id} ended ({why}): {f.describe()}.")
         if isinstance(f, k.LinkDown):
-            bus.mend()
+            bus.mend(f.after_slave)
         elif isinstance(f, k.AlError):
             self._unlatch(f)
         elif isinstance(f, k.DriveFault):

@@ -2,7 +2,8 @@
 
 A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
-* a header ``{"gtecat_recording": 1, ...}``;
+* a header ``{"gtecat_recording": 1, "calls": N, ...}``: N call lines follow (a replay
+  refuses a file that holds fewer, one cut short at a line's end, or more);
 * one line per GT call: ``{"t": controller time in ns, "c": NAME, "a": [arguments], "r":
   return code, "k": {keywords}, "o": {index: value written back}}``, and ``"b"``: the
   controller time when the call began, where time passed since the call before (a
@@ -13,7 +14,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
   every :data:`CHECKPOINT_MS` of controller time.
 
 Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
-structure field by field, an array as its values, a buffer as hex); replay builds fresh
+structure field by field, an array as its size and every value, which must agree, a buffer
+as hex); replay builds fresh
 objects of the same types, makes the same calls in the same order and compares every return
 code, every value the call leaves in its pointer arguments (written back or left as it was)
 and every checkpoint: the first difference is the
@@ -153,7 +155,7 @@ def decode(v: Any) -> Any:
         return _SIMPLE.get(v["c"], ctypes.c_long)(_unscalar(v["v"]))
     if "arr" in v:
         et = _SIMPLE.get(v["arr"], ctypes.c_ubyte)
-        arr = (et * v["n"])()
+        arr = (et * _array_size(v))()
         if "hex" in v:
             ctypes.memmove(arr, bytes.fromhex(v["hex"]), min(v["n"], len(v["hex"]) // 2))
         else:
@@ -185,6 +187,38 @@ def decode(v: Any) -> Any:
     if "b" in v:
         return bytes.fromhex(v["b"])
     return None  # a value that cannot be rebuilt (an object of the caller's)
+
+
+def _array_size(v: dict[str, Any]) -> int:
+    """The size of a recorded array: its ``n``, which must be the number of values it holds
+    (as :func:`encode` writes it), so that a damaged size never makes a huge array."""
+    n = v.get("n")
+    if type(n) is not int or n < 0:
+        raise ValueError(f"an array's size {n!r} is not a count")
+    if "hex" in v:
+        held = v["hex"]
+        have = len(held) // 2 if type(held) is str else -1
+    else:
+        held = v.get("v")
+        have = len(held) if type(held) is list else -1
+    if have != n:
+        raise ValueError(
+            f"an array of {n} values holds {have if have >= 0 else 'no list of'} values"
+        )
+    return n
+
+
+def _check_arrays(x: Any) -> None:
+    """Every array inside a recorded value holds as many values as its size says (ValueError:
+    the one that does not)."""
+    if type(x) is dict:
+        if "arr" in x:
+            _array_size(x)
+        for y in x.values():
+            _check_arrays(y)
+    elif type(x) is list:
+        for y in x:
+            _check_arrays(y)
 
 
 def _set_field(obj: Any, name: str, fv: Any) -> None:
@@ -323,8 +357,10 @@ class Recorder(Listener):
         self.lines.append(self._dumps(entry))
 
     def write(self) -> Path:
-        head = {"gtecat_recording": 1, "calls": self.calls, **self.meta, **self.where}
-        text = json.dumps(head) + "\n" + "\n".join(self.lines) + ("\n" if self.lines else "")
+        lines = list(self.lines)  # (a client's call may still be adding one: these, counted)
+        calls = sum(1 for x in lines if x.startswith('{"t":'))  # a call's line, as after() writes
+        head = {"gtecat_recording": 1, "calls": calls, **self.meta, **self.where}
+        text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
             data = gzip.compress(data, 6)
@@ -393,7 +429,7 @@ def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
     lines = raw.decode("utf-8", "replace").split("\n")
     try:
         head = json.loads(lines[0] or "{}")
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
@@ -408,7 +444,13 @@ def _damaged(p: Path, lines: list[str]) -> ParameterError:
                 raise json.JSONDecodeError("not an entry (a JSON object)", line, 0)
         except json.JSONDecodeError as err:
             return ParameterError(f"{p}: damaged recording: line {no}: {err}")
+        except RecursionError:
+            return ParameterError(f"{p}: damaged recording: line {no}: {_TOO_DEEP}")
     return ParameterError(f"{p}: damaged recording")
+
+
+#: why a line nested deeper than JSON can be read here is refused (no entry nests so)
+_TOO_DEEP = "nested too deeply to be an entry"
 
 
 def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
@@ -434,7 +476,7 @@ def read(path: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         parsed = json.loads("[" + ",".join(texts) + "]")
         if len(parsed) != len(texts) or not all(type(x) is dict for x in parsed):
             raise json.JSONDecodeError("a line that is not one entry", "", 0)
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):
         raise _damaged(p, lines) from None
     return head, [parsed[k] for k in order]
 
@@ -493,6 +535,7 @@ def replay(
         if paused:
             gc.enable()
     del lines
+    _check_count(p, head, sum(1 for call, _ in steps if call is not None))
     freeze = gc.get_freeze_count() == 0  # (a process that froze its own objects: left so)
     if freeze:
         gc.freeze()
@@ -502,6 +545,25 @@ def replay(
     finally:
         if freeze:
             gc.unfreeze()
+
+
+def _check_count(p: Path, head: dict[str, Any], found: int) -> None:
+    """The recording holds the calls its header counts: a file cut short at a line's end
+    (a copy that stopped, ``head -1000``) is refused, never replayed as a pass."""
+    want = head.get("calls")
+    if want is None:  # a header that does not count them: nothing to compare
+        return
+    if type(want) is not int or want < 0:
+        raise ParameterError(f"{p}: damaged recording: line 1: calls {want!r} is not a count")
+    if found < want:
+        raise ParameterError(
+            f"{p}: the recording ends early: its header counts {want} calls, the file holds "
+            f"{found} (cut short: record it again, or copy the whole file)"
+        )
+    if found > want:
+        raise ParameterError(
+            f"{p}: damaged recording: its header counts {want} calls, the file holds {found}"
+        )
 
 
 @dataclass(slots=True)
@@ -752,21 +814,32 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
             raise ParameterError(
                 f"{p}: damaged recording: line {keys.index(key) + 2}: {err}"
             ) from None
+        except RecursionError:
+            raise ParameterError(
+                f"{p}: damaged recording: line {keys.index(key) + 2}: {_TOO_DEEP}"
+            ) from None
         if type(e) is not dict:
             raise ParameterError(
                 f"{p}: damaged recording: line {keys.index(key) + 2}: not an entry (a JSON object)"
             )
         return e
 
-    def prepare(e: dict[str, Any]) -> tuple[Any, Any]:
+    def prepare(e: dict[str, Any], key: str) -> tuple[Any, Any]:
         name = e.get("c")
         fn = getattr(gt, name, None) if type(name) is str else None
         if fn is None:
             return _Stop, ("missing", name)
         try:
+            _check_arrays(e.get("a"))
+            _check_arrays(e.get("k"))
+            _check_arrays(e.get("o"))
             return _prepare(e, fn, pool)
-        except (KeyError, TypeError, ValueError, AttributeError) as err:
-            return _Stop, ("damaged", f"({name}) cannot be made again: {type(err).__name__}: {err}")
+        except (KeyError, TypeError, ValueError, AttributeError, RecursionError) as err:
+            why = _TOO_DEEP if isinstance(err, RecursionError) else f"{type(err).__name__}: {err}"
+            return _Stop, (
+                "damaged",
+                f"({name}, line {keys.index(key) + 2}) cannot be made again: {why}",
+            )
 
     def numbers(key: str) -> tuple[str, list[Any]] | None:
         """(the form's key, the numbers) of a call's line, one number at a time."""
@@ -793,13 +866,13 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
                 form = forms[form_key] = None
                 e = parse(key)
                 if _form(e) == len(vals):
-                    call = prepare(e)[0]
+                    call = prepare(e, key)[0]
                     if call is not _Stop and not call.checks and not call.fresh:
                         form = forms[form_key] = call
             if form is not None:
                 return form, tuple(vals)
         e = parse(key)
-        return (None, e) if "c" not in e else prepare(e)
+        return (None, e) if "c" not in e else prepare(e, key)
 
     # a call's line without its time (from the comma after it), any other line whole
     keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]

@@ -266,17 +266,21 @@ def GT_IsEcatReady(ctl: Controller, pStatus: Any) -> int:
 
 @gt_function
 def GT_GetEcatSlaves(ctl: Controller, pSlaveCnt: Any, pIoSlaveCnt: Any = None) -> int:
-    """One pointer (manual): online slaves.  Two (vendor header): motion slaves, IO slaves."""
+    """The slaves online (entry 45: "在线的 EtherCAT 从站数目").  One pointer (manual): all of
+    them.  Two (vendor header): the motion slaves online, the IO slaves online - the same
+    count split, so both forms follow a link loss alike (a slave behind a cut is in neither)."""
     m = ctl.master
-    if m is None:
-        online, motion, io = 0, 0, 0
-    else:
+    motion = io = 0
+    if m is not None:
         states = m.refresh_states()
-        online = sum(1 for s in states if s not in (AlState.NONE,))
-        motion = sum(1 for s in m.layout.slaves if s.channels)
-        io = len(m.layout.slaves) - motion
+        for slave, state in zip(m.layout.slaves, states, strict=False):
+            if state != AlState.NONE:
+                if slave.channels:
+                    motion += 1
+                else:
+                    io += 1
     if pIoSlaveCnt is None:
-        store(pSlaveCnt, online)
+        store(pSlaveCnt, motion + io)
     else:
         store(pSlaveCnt, motion)
         store(pIoSlaveCnt, io)

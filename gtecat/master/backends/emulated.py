@@ -269,9 +269,16 @@ class EmulatedBackend(Backend):
         return rows
 
     def emergencies(self) -> list[tuple[int, object]]:
+        """The emergencies the master receives now.  A slave behind a pulled cable cannot
+        send one: what it raises stays in its queue (bounded, as its mailbox is) and
+        arrives once the cable is back (ETG.1000.6 5.6.4: an emergency is a mailbox
+        message the master collects from the slave)."""
         out = []
         claimed = self._claimed  # a claimed slave is not stepped: it raises none
+        unplugged = self.unplugged
         for slave in self.slaves if not claimed else (e[0] for e in self._run_plan):
+            if unplugged and slave.position in unplugged:
+                continue
             while slave.emergencies:
                 out.append((slave.position, slave.emergencies.popleft()))
         return out

@@ -74,7 +74,7 @@ ops = st.one_of(
 )
 
 
-@settings(max_examples=examples(60, 20), deadline=None)
+@settings(max_examples=examples(60, 10), deadline=None)
 @given(st.lists(ops, min_size=1, max_size=25))
 def test_plans_and_the_general_path_agree(sequence: list) -> None:
     fast, mf = configured(False)

@@ -103,7 +103,7 @@ READS = [
 
 @pytest.mark.parametrize("argv", READS, ids=[" ".join(a) for a in READS])
 @pytest.mark.parametrize("fmt", ["table", "json"])
-@pytest.mark.sample(6)
+@pytest.mark.sample(4)
 def test_a_verb_on_a_running_controller_prints_what_it_prints_for_a_bus_of_its_own(
     cli: Cli, shared: str, argv: tuple[str, ...], fmt: str
 ) -> None:

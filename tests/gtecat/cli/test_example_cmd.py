@@ -136,7 +136,7 @@ def clean_env(monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
 
 
 @pytest.mark.parametrize("name", SCRIPTS)
-@pytest.mark.sample(2)
+@pytest.mark.sample(1)
 def test_each_script_runs_where_it_was_copied_and_prints_what_it_promises(
     name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, clean_env: dict[str, str]
 ) -> None:

@@ -25,9 +25,12 @@ def _up(eni: Path) -> weakref.ref[object]:
     return weakref.ref(gt.GTE_Controller().master)
 
 
-def test_a_large_bus_is_frozen_and_a_closed_one_collected_at_the_next(tmp_path: Path) -> None:
+def test_a_large_bus_is_frozen_and_a_closed_one_collected_at_the_next(
+    tmp_path: Path, monkeypatch
+) -> None:
     if gc.get_freeze_count():  # a process that froze objects itself is left as it is
         gc.unfreeze()
+    monkeypatch.setattr(core, "FREEZE_MIN_SLAVES", 4)  # "large" from 4 slaves: a quick bus
     eni = write_axes_eni(core.FREEZE_MIN_SLAVES, tmp_path / "bus.eni")
     try:
         first = _up(eni)

@@ -243,4 +243,4 @@ def test_a_mode_change_names_the_sdo_call_and_the_check_exits_3(
         "raise SystemExit(5)\n"
     )
     assert main(["run", "--check", "--no-progress", str(app)]) == 5
-    assert "GT_IsEcatReady polled 200 times" in capsys.readouterr().err
+    assert "GT_IsEcatReady answered not ready 200 times" in capsys.readouterr().err

@@ -209,3 +209,55 @@ def test_the_error_register_follows_the_class_of_the_code(eni: Path, tmp_path: P
 )
 def test_error_register_classes(code: int, register: int) -> None:
     assert error_register(code) == register
+
+
+@pytest.fixture(scope="module")
+def eni_io(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Two drives and an IO slave behind them."""
+    d = tmp_path_factory.mktemp("linkloss_io")
+    topo = d / "three.toml"
+    topo.write_text(
+        "cycle_time_us = 1000\n"
+        + _SERVO.format(n=0)
+        + _SERVO.format(n=1)
+        + '[[slave]]\nkind = "io"\ndo = 8\ndi = 8\n'
+    )
+    path = d / "three.eni"
+    write_eni_file(load_topology(topo), path)
+    return path
+
+
+def counts() -> tuple[int, int, int]:
+    """GT_GetEcatSlaves both ways: (online, motion online, IO online)."""
+    n, motion, io = c_short(), c_short(), c_short()
+    assert gt.GT_GetEcatSlaves(byref(n)) == 0
+    assert gt.GT_GetEcatSlaves(byref(motion), byref(io)) == 0
+    return n.value, motion.value, io.value
+
+
+def test_slave_counts_and_emergencies_follow_the_link(eni_io: Path, tmp_path: Path) -> None:
+    """Both forms of GT_GetEcatSlaves count the slaves online (manual entry 45), split or not;
+    an emergency a drive raises behind the cut arrives once the cable is back."""
+    up(eni_io)
+    master = gt.GTE_Controller().master
+    assert counts() == (3, 2, 1)
+    faults.inject("link_down", after_slave=0, duration_ms=300)
+    gt.GTE_Wait(1)
+    assert counts() == (1, 1, 0)
+    # drive 1's watchdog runs out (about 100 ms): its 8130h waits behind the cut
+    assert wait(lambda: error_code(1) == 0 and master.backend.slaves[1].emergencies, 200)
+    assert master.emergency_count == 0 and counts() == (1, 1, 0)
+    assert wait(lambda: ready() == 1, 400)
+    assert master.emergency_count == 1 and not master.backend.slaves[1].emergencies
+    assert error_code(2) == 0x8130 and counts() == (3, 2, 1)
+    faults.inject("link_down", after_slave=-1, duration_ms=50)  # the cable at the master
+    gt.GTE_Wait(1)
+    assert counts() == (0, 0, 0) and ready() == 0
+    # link faults overlap: each one's end mends only its own cut
+    faults.inject("link_down", after_slave=1, duration_ms=100)
+    gt.GTE_Wait(1)
+    assert counts() == (0, 0, 0)
+    assert wait(lambda: counts() == (2, 2, 0), 60)  # the first is over, the second is not
+    gt.GTE_Wait(20)
+    assert counts() == (2, 2, 0)
+    assert wait(lambda: counts() == (3, 2, 1), 60)

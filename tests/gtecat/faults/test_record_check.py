@@ -127,7 +127,54 @@ def test_an_endless_ready_poll(tmp_path: Path, capsys: pytest.CaptureFixture[str
     )
     assert main(["run", "--check", "--no-progress", str(app)]) == 3
     err = capsys.readouterr().err
-    assert f"check: {app}:6: GT_IsEcatReady polled 200 times" in err, err
+    assert f"check: {app}:6: GT_IsEcatReady answered not ready 200 times" in err, err
+
+
+READY_LOOPS = f"""\
+import time
+from ctypes import byref, c_short, c_ulong
+from gtecat import faults, gt
+gt.GT_Open(eni={str(EXAMPLES / "full_servo.eni")!r}, log="")
+gt.GT_InitEcatComm()
+s, c = c_short(), c_ulong()
+gt.GT_GetClock(byref(c))
+t0 = c.value
+while True:  # the manual's wait, with a limit on the controller's clock
+    gt.GT_IsEcatReady(byref(s))
+    gt.GT_GetClock(byref(c))
+    if s.value == 1 or c.value - t0 > 5000:
+        break
+gt.GT_StartEcatComm()
+deadline = time.monotonic() + 60
+for _ in range(250):  # a health check of a bus that is up: not a wait
+    gt.GT_IsEcatReady(byref(s))
+    if s.value != 1 or time.monotonic() > deadline:
+        break
+    gt.GTE_Wait(1)
+faults.inject("link_down", after_slave=-1)  # the bus goes and stays away
+gt.GTE_Wait(1)
+for _ in range(210):  # a wait with a limit on the program's own clock
+    gt.GT_IsEcatReady(byref(s))
+    if s.value == 1 or time.monotonic() > deadline:
+        break
+for _ in range(210):  # a wait that only pauses: nothing would end it but the bus
+    gt.GT_IsEcatReady(byref(s))
+    if s.value == 1:
+        break
+    gt.GTE_Wait(1)
+"""
+
+
+def test_ready_poll_counts_only_waits_without_a_clock(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    app = tmp_path / "loops.py"
+    app.write_text(READY_LOOPS)
+    assert main(["run", "--check", "--no-progress", str(app)]) == 3
+    err = capsys.readouterr().err
+    found = [x for x in err.splitlines() if x.startswith("check: ")]
+    assert found[0].startswith(f"check: {app}:28: GT_IsEcatReady answered not ready"), err
+    assert len(found) == 2 and found[1] == "check: 1 finding", err
 
 
 def test_fault_kinds_and_refusals(capsys: pytest.CaptureFixture[str]) -> None:
@@ -138,6 +185,30 @@ def test_fault_kinds_and_refusals(capsys: pytest.CaptureFixture[str]) -> None:
     assert "unknown fault kind" in capsys.readouterr().err
     assert main(["fault", "inject", "drive_fault", "axis"]) == 1
     assert "KEY=VALUE" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("values", "said"),
+    [
+        (["axis=1", "axis=2"], "axis= is given twice (axis=1 and axis=2): give it once"),
+        (["axis=1", "name="], "'name=': name has no value"),
+        (["axis=", "code=0x2310"], "'axis=': axis has no value"),
+    ],
+)
+def test_fault_inject_refuses_a_key_twice_or_empty(
+    values: list[str], said: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["fault", "inject", "drive_fault", *values]) == 1  # refused before connecting
+    err = capsys.readouterr().err
+    assert said in err and "no running gtecat" not in err, err
+
+
+def test_an_empty_fault_name_is_refused() -> None:
+    from gtecat import faults
+
+    with pytest.raises(faults.FaultSpecError, match="name must be text that names the fault"):
+        faults.spec_from_dict({"kind": "drive_fault", "axis": 1, "name": "  "})
+    assert faults.spec_from_dict({"kind": "drive_fault", "axis": 1, "name": "cut"}).name == "cut"
 
 
 PLUGIN_TESTS = textwrap.dedent(

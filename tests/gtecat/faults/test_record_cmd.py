@@ -1,0 +1,66 @@
+"""``gtecat record -o FILE -- python3 SCRIPT``: a script that raises, an output that cannot be
+written."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from gtecat.cli.main import main
+from tests.conftest import EXAMPLES
+
+
+@pytest.fixture(autouse=True)
+def _closed():
+    gt.GT_Close()
+    yield
+    gt.GT_Close()
+
+
+def test_a_script_that_raises_keeps_its_recording_and_its_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    app = tmp_path / "crash.py"
+    app.write_text(
+        "from gtecat import gt\n"
+        f"gt.GT_Open(eni={str(EXAMPLES / 'full_servo.eni')!r}, log='')\n"
+        "gt.GT_InitEcatComm()\n"
+        "1/0\n"
+    )
+    out = tmp_path / "crash.gtrec"
+    assert main(["record", "-o", str(out), "--", "python3", str(app)]) == 1  # as python's
+    err = capsys.readouterr().err
+    assert "internal error" not in err, err
+    assert "Traceback" in err and f'"{app}", line 4' in err and "ZeroDivisionError" in err
+    assert f"error: {app} raised ZeroDivisionError" in err
+    head = json.loads(out.read_text().splitlines()[0])
+    assert head["calls"] >= 2  # GT_Open, GT_InitEcatComm (and the closing GT_Close)
+    assert main(["replay", str(out)]) == 0, capsys.readouterr().err
+    assert "calls match" in capsys.readouterr().out
+
+
+def test_an_output_that_cannot_be_written_is_refused_first_with_why(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    app = tmp_path / "never.py"
+    app.write_text("raise SystemExit('the script ran')\n")
+    cmd = ["--", "python3", str(app)]
+    assert main(["record", "-o", str(tmp_path / "no" / "x.gtrec"), *cmd]) == 1
+    assert "the folder" in (err := capsys.readouterr().err) and "does not exist" in err
+    assert main(["record", "-o", str(app / "x.gtrec"), *cmd]) == 1
+    assert "is not a folder" in capsys.readouterr().err
+    if Path("/proc/self").is_dir():  # a folder that exists and takes no new file
+        assert main(["record", "-o", "/proc/x.gtrec", *cmd]) == 1
+        err = capsys.readouterr().err
+        assert "cannot be written: the folder /proc does not take new files" in err, err
+    if os.geteuid() != 0:  # root writes anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        assert main(["record", "-o", str(locked / "x.gtrec"), *cmd]) == 1
+        assert "permission denied" in capsys.readouterr().err
+    assert "the script ran" not in capsys.readouterr().err
+    assert not (tmp_path / "x.gtrec").exists()

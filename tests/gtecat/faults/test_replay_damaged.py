@@ -1,0 +1,73 @@
+"""``gtecat replay`` of a recording that does not hold what it should: refused, never a pass,
+never a crash or a huge allocation; the line or the count named."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from gtecat.cli.main import main
+
+HEAD = {"gtecat_recording": 1, "program": "python3 app.py", "cwd": "/", "env": {}}
+STS = '{"t":0,"c":"GT_GetSts","a":[1,{"ref":{"c":"c_long","v":0}},1,null],"r":1}'
+
+
+@pytest.fixture(autouse=True)
+def _closed():
+    yield
+    gt.GT_Close()
+
+
+def replay(tmp_path: Path, calls: int, lines: list[str], capsys: pytest.CaptureFixture[str]):
+    f = tmp_path / "r.gtrec"
+    f.write_text("\n".join([json.dumps({**HEAD, "calls": calls}), *lines]) + "\n")
+    rc = main(["replay", str(f)])
+    out = capsys.readouterr()
+    return rc, out.out + out.err
+
+
+def test_a_recording_cut_at_a_line_end_is_not_a_pass(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rc, text = replay(tmp_path, 3, [STS, STS], capsys)
+    assert rc == 1 and "calls match" not in text
+    assert "the recording ends early: its header counts 3 calls, the file holds 2" in text
+    rc, text = replay(tmp_path, 58681, [], capsys)  # the header alone
+    assert rc == 1 and "header counts 58681 calls, the file holds 0" in text
+    rc, text = replay(tmp_path, 1, [STS, STS], capsys)  # lines added after the header's count
+    assert rc == 1 and "damaged recording" in text and "header counts 1 calls" in text
+    rc, text = replay(tmp_path, "many", [STS], capsys)  # type: ignore[arg-type]
+    assert rc == 1 and "line 1: calls 'many' is not a count" in text
+
+
+@pytest.mark.parametrize(
+    "arg",
+    [
+        '{"arr":"c_long","n":1000000000,"v":[]}',  # a size the values do not back
+        '{"arr":"c_ubyte","n":1000000000,"hex":"00"}',
+        '{"arr":"c_long","n":-1,"v":[]}',
+        '{"st":"TTrapPrm","v":{"acc":{"arr":"c_double","n":99999999999,"v":[1]}}}',
+    ],
+)
+def test_an_array_size_is_bounded_by_its_values(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], arg: str
+) -> None:
+    line = f'{{"t":0,"c":"GT_GetSts","a":[1,{arg},1,null],"r":0}}'
+    rc, text = replay(tmp_path, 2, [line, STS], capsys)
+    assert rc == 1 and "damaged recording" in text and "line 2" in text, text
+    assert "internal error" not in text
+
+
+def test_deep_nesting_is_a_damaged_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    deep = "[" * 100_000 + "]" * 100_000
+    line = f'{{"t":0,"c":"GT_GetSts","a":[1,{deep},1,null],"r":0}}'
+    rc, text = replay(tmp_path, 2, [STS, line], capsys)
+    assert rc == 1 and "damaged recording: line 3: nested too deeply" in text, text
+    assert "internal error" not in text and "RecursionError" not in text
+    f = tmp_path / "deep_head.gtrec"
+    f.write_text(deep + "\n")
+    assert main(["replay", str(f)]) == 1
+    assert "is not a gtecat recording" in capsys.readouterr().err
