@@ -147,6 +147,9 @@ class Controller:
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
         self.clock.run_many = self.run_cycles
+        #: a run of cycles at once is under way (:meth:`run_cycles`): the inspection
+        #: endpoint's idle path waits for its end (it runs no request beside cycles)
+        self.in_batch = False
         self._cycle_fixed = self.options.cycle_ms is not None
         self.log = MasterLog(self.options.log, clock_ms=lambda: self.clock.now_ms)
         self.machine = self._load_machine(self.options.machine)
@@ -350,7 +353,18 @@ class Controller:
         anything to do in them: every axis claimed by the bank, no hook, the bus steady
         (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
         one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
-        cycles run, 0 when the next one must go through :meth:`_cycle`."""
+        cycles run, 0 when the next one must go through :meth:`_cycle`.
+
+        :attr:`in_batch` is set before the clock's cycle is compared with ours: an endpoint
+        that wraps the cycle (so no run starts after that) and then sees it False knows no
+        run is under way, however long the compiled kernel holds this thread."""
+        self.in_batch = True
+        try:
+            return self._run_cycles(n)
+        finally:
+            self.in_batch = False
+
+    def _run_cycles(self, n: int) -> int:
         bank = self.bank
         if (
             bank is None

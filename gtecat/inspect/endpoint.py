@@ -29,8 +29,10 @@ application waiting for input, a lockstep test between steps, an idle ``gtecat
 controller``), the endpoint thread runs the request itself: with the lock every change of
 the controller takes (the controller server's call lock; the clock's lock in realtime),
 or, in-process in ``auto``/``lockstep``, after a handshake with the cycle so the two never
-overlap.  (A GT call the application makes in that instant, outside any cycle, is not
-held back: in those modes the GT layer takes no lock.  Requests are short.)
+overlap (a run of many cycles at once that began before the connection opened is waited
+for too: while a connection is open no new one begins).  (A GT call the application makes
+in that instant, outside any cycle, is not held back: in those modes the GT layer takes no
+lock.  Requests are short.)
 
 **When it publishes.**  :func:`publish` is called by ``GT_Open`` (and so by ``gtecat
 controller``, which opens through it); ``gtecat serve`` publishes the same endpoint over its
@@ -209,10 +211,13 @@ class Endpoint:
         if lock is None and clock.threaded:
             lock = clock.lock
         flags = self._flags
+        ctl = self.ctl
         with lock if lock is not None else contextlib.nullcontext(), self._gate:
             flags[1] = True
             try:
-                while flags[0]:
+                # a cycle, or a run of cycles at once that began before the cycle was
+                # wrapped (Controller.run_cycles: the compiled kernel lets go of the GIL)
+                while flags[0] or getattr(ctl, "in_batch", False):
                     time.sleep(0.0002)
                 _run(req, in_cycle=False)
             finally:

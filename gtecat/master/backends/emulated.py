@@ -60,6 +60,7 @@ class EmulatedBackend(Backend):
         self._claimed: frozenset[int] = frozenset()
         self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
         self._claimed_wkc = 0
+        self._claimed_slaves: tuple[VirtualSlave, ...] = ()  # what steady() asks for OP
         #: (the run plan and image it was made for, its rows): what steady() compares
         self._steady_plan: tuple[Any, Any, list[tuple[Any, ...]]] | None = None
         self.capture = None
@@ -106,6 +107,7 @@ class EmulatedBackend(Backend):
     def claimed(self, positions: set[int] | frozenset[int]) -> None:
         self._claimed = frozenset(positions)
         self._run_plan = [e for e in self._plan if e[0].position not in self._claimed]
+        self._claimed_slaves = tuple(e[0] for e in self._plan if e[0].position in self._claimed)
         self._claimed_wkc = sum(
             2 * (o is not None) + (i is not None)
             for sl, o, i in self._plan
@@ -213,19 +215,26 @@ class EmulatedBackend(Backend):
         """An exchange now would change nothing: no hook, capture or cable pulled, and every
         slave it steps (the ones the axis bank does not run) is a plain IO slave at its fixed
         point - the image's outputs are its ``rx``, its step changes nothing, its ``tx`` is in
-        the image's inputs (byte-aligned areas; anything else: not steady).  Asked before
-        every run of cycles at once: the areas' bytes are worked out once per run plan."""
+        the image's inputs (byte-aligned areas; anything else: not steady).  Every slave is in
+        OP, the ones the bank runs too: a slave an operator asked to PREOP (``gtecat states -p 2
+        PREOP``) is at a fixed point but leaves the working counter short, which only the
+        master's cycle sees (it logs the loss and reads the states).  Asked before every run
+        of cycles at once: the areas' bytes are worked out once per run plan."""
         if self.answer_hook is not None or self.capture is not None or self.unplugged:
             return False
         image = self.image
         if image is None:
             return False
+        op = AlState.OP
+        for slave in self._claimed_slaves:
+            if slave.al_state != op:
+                return False
         plan = self._steady_plan
         if plan is None or plan[0] is not self._run_plan or plan[1] is not image:
             plan = self._steady_plan = (self._run_plan, image, self._steady_rows(image))
         view = image.view
         for slave, o_start, o_bytes, i_start, i_bytes in plan[2]:
-            if type(slave).step is not _IO_STEP or not slave.settled():
+            if slave.al_state != op or type(slave).step is not _IO_STEP or not slave.settled():
                 return False
             if o_bytes:
                 if o_bytes < 0:
@@ -234,7 +243,7 @@ class EmulatedBackend(Backend):
                 n = min(len(rx), o_bytes)
                 if view[o_start : o_start + n] != rx[:n]:
                     return False
-            if i_bytes and slave.al_state >= AlState.SAFEOP:
+            if i_bytes:
                 if i_bytes < 0:
                     return False  # inputs not in whole bytes
                 tx = slave.tx

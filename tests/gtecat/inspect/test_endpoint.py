@@ -99,7 +99,12 @@ def test_a_state_asked_on_the_running_bus_holds(app, capsys) -> None:
     """`gtecat states -p 2 PREOP` beside a running application (ETG.1000.6 AL states): the
     master's recovery leaves the slave there until OP is asked."""
     gt = app
+    ep = endpoint.published(gt.GTE_Controller())
     assert main(["states", "-p", "2", "PREOP"]) == 0
+    for _ in range(2000):  # the verb's connection closed: the wait may run cycles at once
+        if not ep._watchers:
+            break
+        threading.Event().wait(0.001)
     gt.GTE_Wait(500)  # 5 recovery periods of the master
     with _attach() as c:
         states = c.call("snapshot")["states"]
@@ -110,6 +115,70 @@ def test_a_state_asked_on_the_running_bus_holds(app, capsys) -> None:
     capsys.readouterr()
     assert main(["slaves", "--json"]) == 0
     assert [r["state"] for r in json.loads(capsys.readouterr().out)] == ["OP"] * 4
+
+
+def test_a_slave_asked_below_op_stops_the_cycles_run_at_once(app) -> None:
+    """The bus runs many cycles at once only while every slave is in OP: an IO slave an
+    operator asked to PREOP stays at its fixed point, but the working counter it leaves short
+    is the master's to see (the loss logged, the states read) in the very next cycle."""
+    from gtecat.native import field
+
+    gt = app
+    ctl = gt.GTE_Controller()
+    gt.GTE_Wait(50)
+    assert ctl.run_cycles(5) == 5, "every axis in the bank and the bus steady: the batch runs"
+    rows = field.run(field.Context(ctl), "states", [2, "PREOP"])
+    assert [r["state"] for r in rows] == ["PREOP"]
+    assert not ctl.backend.steady() and ctl.run_cycles(5) == 0
+    gt.GTE_Wait(1)
+    assert ctl.master.states[2] == 2 and ctl.master.last.wkc < ctl.master.last.expected
+    gt.GTE_Wait(300)  # 3 recovery periods: the request holds
+    assert ctl.master.states == [8, 8, 2, 8]
+    assert field.run(field.Context(ctl), "states", [2, "OP"])[0]["state"] == "OP"
+    gt.GTE_Wait(20)
+    assert ctl.master.states == [8] * 4 and ctl.run_cycles(5) == 5
+
+
+def test_a_request_waits_for_a_run_of_cycles_that_began_before_the_panel_attached(app) -> None:
+    """The bus runs many cycles at once while nobody is attached; a panel that attaches
+    meanwhile (its request taken by the endpoint thread, no cycle coming for a while) is
+    answered after that run, never beside it."""
+    gt = app
+    ctl = gt.GTE_Controller()
+    gt.GTE_Wait(50)
+    bank = ctl.bank
+    batch = bank.run_cycles
+    in_run, release = threading.Event(), threading.Event()
+    order: list[str] = []
+
+    def held_run(t_ns: int, dt_ns: int, n: int) -> int:
+        if not in_run.is_set():
+            in_run.set()
+            release.wait(10)  # (the compiled kernel lets go of the interpreter as long)
+            order.append("run ended")
+        return batch(t_ns, dt_ns, n)
+
+    bank.run_cycles = held_run
+    waiter = threading.Thread(target=gt.GTE_Wait, args=(50,))
+    waiter.start()
+    ep = endpoint.published(ctl)
+    try:
+        assert in_run.wait(10)
+        with _attach() as c:
+            asked = threading.Thread(target=lambda: order.append(str(c.call("info") and "reply")))
+            asked.start()
+            for _ in range(2000):  # queued; the idle path takes it after IDLE_S
+                if ep._pending and ep._pending[0].claimed:
+                    break
+                threading.Event().wait(0.001)
+            asked.join(5 * endpoint.IDLE_S)
+            release.set()
+            asked.join(10)
+    finally:
+        release.set()
+        waiter.join(10)
+        del bank.run_cycles
+    assert order == ["run ended", "reply"]
 
 
 def test_the_verbs_attach_and_say_so_when_none_runs(runtime_dir: Path, capsys, monkeypatch) -> None:

@@ -208,13 +208,42 @@ def test_a_call_that_cannot_travel_checks_its_arguments_first_as_python_does(ser
 
 def test_a_long_wait_of_one_client_lets_the_others_in_between_its_slices(served):
     """GTE_Wait runs its time in slices; between them the server answers the other clients
-    (a client's day-long wait must not hold everyone for the hours it takes to compute)."""
+    (a client's day-long wait must not hold everyone for the hours it takes to compute).
+
+    The bus runs the wait's cycles many at a time: 30 s of controller time can pass in a few
+    milliseconds, before the other client's first call arrives.  So the first look between
+    two slices waits (a bounded while) until the other client's call is in the socket; from
+    there on the server must answer it inside the wait, however fast the slices run."""
     import threading
 
-    _, address = served
+    server, address = served
     waiter, other = WireClient(address), WireClient(address)
     assert waiter.call("GT_Open", 0, 1)[0] == 0 and other.call("GT_Open", 0, 1)[0] == 0
-    done = threading.Event()
+    started, sent, done = threading.Event(), threading.Event(), threading.Event()
+    looks, answered_during = [0], [0]
+    serve_others = server._serve_others
+
+    def between_slices() -> None:
+        looks[0] += 1
+        if not started.is_set():
+            started.set()
+            sent.wait(10)  # the other client's call is in the socket (or the test fails below)
+        calls = server.calls
+        serve_others()
+        answered_during[0] += server.calls - calls  # (counted here: the wait runs meanwhile)
+
+    class _Sock:  # the other client's socket, saying when a request has been sent
+        def __init__(self, sock: socket.socket) -> None:
+            self._sock = sock
+
+        def sendall(self, data: bytes) -> None:
+            self._sock.sendall(data)
+            sent.set()
+
+        def __getattr__(self, name: str):
+            return getattr(self._sock, name)
+
+    server._serve_others = between_slices  # (what the server gives the wait as its hook)
     result: list[int] = []
 
     def wait_long() -> None:
@@ -223,17 +252,19 @@ def test_a_long_wait_of_one_client_lets_the_others_in_between_its_slices(served)
 
     t = threading.Thread(target=wait_long)
     t.start()
-    answered_during = 0
     try:
+        assert started.wait(10), "the wait never reached its first slice's end"
+        other.sock = _Sock(other.sock)
         for _ in range(2000):
             if done.is_set():
                 break
             assert other.call("GT_GetSts", 1, 8, 1, None)[0] == 0
-            answered_during += not done.is_set()
     finally:
+        sent.set()
         t.join(60)
     assert result == [0]
-    assert answered_during > 0  # the other client was answered while the wait ran
+    assert answered_during[0] > 0  # the other client was answered while the wait ran
+    assert looks[0] == 299  # a look at the others between every two slices
 
 
 def test_the_socket_is_its_owners_and_its_folder_is_checked(served, tmp_path):
