@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..controller.axis_status import AxisStatus
+from ..controller.core_view import AXES_PER_CORE
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources
@@ -334,7 +335,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
     ):
         try:  # (two subscripts: cheaper than two get calls)
             ctl = session.controllers[1]
-            res = ctl.resources[n]
+            res = ctl.resources[{bus_axis}]
         except KeyError:  # no controller, or no such axis: the table path says why
             return {fallback}
         clock = ctl.clock
@@ -382,7 +383,16 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     code = template.format(
         fname=fname,
         core=core,
-        core_check=" and type(core) is int and core == 1" if gtn else "",
+        # core 1, or a core beyond 32 axes (a view of core 1's bus: its local axis n is bus
+        # axis n + 32·(core-1), gtecat.controller.core_view) where no controller of its own
+        # answers that core (a card's second core: the table path)
+        core_check=(
+            " and type(core) is int and (core == 1 or (core > 1 and 0 < n <= PER_CORE"
+            " and core not in session.controllers))"
+            if gtn
+            else ""
+        ),
+        bus_axis="n if core == 1 else n + PER_CORE * (core - 1)" if gtn else "n",
         session=session,
         address=address,
         fallback=(
@@ -392,6 +402,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         ),
     )
     env["_AT"] = _AT
+    env["PER_CORE"] = AXES_PER_CORE
     attr = getattr(env["get"], "attr", None)
     if env["name"] in SCALAR_INLINE:
         scalar = list(SCALAR_INLINE[env["name"]])

@@ -328,3 +328,99 @@ def test_the_pdo_readers_answer_as_the_table() -> None:
                             continue
                         bad.append(f"{name}({axis}) {shape} {t.__name__}: took the table path")
     assert not bad, "\n".join(bad[:10])
+
+
+#: bus axes on the bus beyond 32 axes: core 2 holds bus axes 33 and 34 as its axes 1 and 2
+_BEYOND = 34
+
+
+def _open_beyond_32(tmp_path: Path) -> object:
+    """A 34-axis bus in OP, bus axes 2, 33 and 34 moving in Trap (so the bank holds them)."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(_BEYOND, tmp_path / "axes34.eni")
+    assert gt.GT_Open(eni=str(eni), clock="lockstep", log="") == 0, gt.GTE_GetLastError()
+    assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+    ready = ctypes.c_short()
+    for _ in range(1000):
+        if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+            break
+        gt.GTE_Wait(1)
+    assert gt.GT_StartEcatComm() == 0, gt.GTE_GetLastError()
+    for core, local in ((1, 2), (2, 1), (2, 2)):
+        assert gt.GTN_AxisOn(core, local) == 0, gt.GTE_GetLastError()
+    gt.GTE_Wait(5)
+    for core, local in ((1, 2), (2, 1), (2, 2)):
+        prm = gt.TTrapPrm()
+        prm.acc = prm.dec = 0.5
+        assert gt.GTN_PrfTrap(core, local) == 0
+        assert gt.GTN_SetTrapPrm(core, local, byref(prm)) == 0
+        assert gt.GTN_SetPos(core, local, 50_000_000) == 0
+        assert gt.GTN_SetVel(core, local, 20) == 0
+        assert gt.GTN_Update(core, 1 << (local - 1)) == 0, gt.GTE_GetLastError()
+    gt.GTE_Wait(30)
+    return gt.GTE_Controller()
+
+
+def _gtn(name: str, shape: str, core: int, axis: int, which: str) -> tuple:
+    """``GTN_x(core, axis, ...)`` in ``shape`` through the public function (``fast``) or the
+    table path of the GTN_ twin (``slow``): (code, what it wrote, last error, table calls)."""
+    fn = getattr(gt, "GTN_" + name[3:])
+    call = fn if which == "fast" else getattr(gt, name).gtn_slow
+    t = ctypes.c_double if ctypes.c_double in fast.READERS[name][1] else ctypes.c_long
+    made = READER_SHAPES[shape](t)
+    extra, o = made if len(made) == 2 else made[1:]
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = call(core, axis, *extra)
+    pr.disable()
+    stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+    table = sum(
+        v[1]
+        for (file, _, func), v in stats
+        if (func in ("call", "run") and file.endswith("_core.py"))
+        or (func == "gtn_general" and file.endswith("fast.py"))
+    )
+    return rc, _value(o), gt.GTE_GetLastError() if rc else "", table
+
+
+def test_core_2_answers_as_the_table_fast_and_leaves_the_bank(tmp_path: Path) -> None:
+    """``GTN_x(2, axis, ...)`` on a bus beyond 32 axes: every shape answers as the table path
+    of core 2 (and as core 1 naming the bus axis), on the fast path; an axis core 2 does not
+    have answers as the table (7 and its reason); polling the axes the bank holds leaves them
+    there."""
+    ctl = _open_beyond_32(tmp_path)
+    banked = [ctl.resources[n] for n in (2, 33, 34)]
+    assert all(r.bank is not None for r in banked), "the bank holds the moving axes"
+    shapes = [s for s in READER_SHAPES if s != "same_byref"]
+    bad = []
+    for name in sorted(fast.READERS):
+        for shape in shapes:
+            for axis in (1, 2):
+                got = _gtn(name, shape, 2, axis, "fast")
+                want = _gtn(name, shape, 2, axis, "slow")
+                bus = _gtn(name, shape, 1, 32 + axis, "slow")
+                if got[:3] != want[:3] or got[:3] != bus[:3]:
+                    bad.append(f"{name} {shape} (2, {axis}): {got[:3]} != {want[:3]} / {bus[:3]}")
+                elif got[0] != 0 or got[3]:
+                    bad.append(f"{name} {shape} (2, {axis}): rc {got[0]}, table ran {got[3]}")
+        # not an axis of core 2: 7 with the table's reason; 3 (bus axis 35, which no drive
+        # backs) lies inside the controller's axes: the table's 0 (axis_span's rule)
+        for axis in (0, 3, 33, -1):
+            got, want = _gtn(name, "byref", 2, axis, "fast"), _gtn(name, "byref", 2, axis, "slow")
+            if got[:3] != want[:3] or got[0] != (0 if axis == 3 else 7):
+                bad.append(f"{name} (2, {axis}): {got[:3]} != {want[:3]}")
+    assert not bad, "\n".join(bad[:20])
+    # polling, on the fast path and the table's (count, pClock), keeps them in the bank
+    s = (ctypes.c_long * 2)()
+    clock = ctypes.c_ulong()
+    for _ in range(3):
+        for local in (1, 2):
+            assert gt.GTN_GetSts(2, local, byref(s)) == 0
+            assert gt.GTN_GetPrfPos(2, local, byref(ctypes.c_double())) == 0
+            assert gt.GTN_GetEncPos(2, local, ctypes.c_double()) == 0
+        assert gt.GTN_GetSts(2, 1, s, 2, byref(clock)) == 0
+        assert gt.GTN_GetSts(1, 2, byref(s)) == 0
+        gt.GTE_Wait(3)
+    assert all(r.bank is not None for r in banked), "polling gave an axis back"
+    assert all(v & (1 << 10) for v in s)  # both still moving
