@@ -887,6 +887,13 @@ _RAW = """
 def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
     if extra or kw or p is _NO{slave_check}:
         return slow(*(a for a in ({slave_arg}offset, size, p) if a is not _NO), *extra, **kw)
+    given = p  # (what the table path gets, if it answers)
+    if type(p) is _CArg:
+        # byref(array): the array itself (byref(array, offset), byref of anything else: the
+        # table path)
+        q = p._obj
+        if isinstance(q, _Array) and {address} == _addressof(q):
+            p = q
     ctl = session.controllers.get(1)
     if (
         ctl is not None
@@ -924,7 +931,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
                 if clock.mode is _LOCKSTEP:
                     return 0
                 return advance(ctl, name, 0)
-    return run({slave_key}, offset, size, p, ({slave_arg}offset, size, p))
+    return run({slave_key}, offset, size, p, ({slave_arg}offset, size, given))
 """
 
 
@@ -935,7 +942,10 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
         slave_arg="slave, " if io else "",
         slave_key="slave" if io else "-1",
         slave_memo=" and slave == last[3]" if io else "",
+        address=carg_address_source("p"),
     )
+    env.update(CARG_ENV)
+    env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof)
     exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
     return env["gt"]
 

@@ -68,6 +68,7 @@ RAW_SHAPES = {
     "bytearray": lambda n: (o := bytearray(n), o),
     "numpy": lambda n: (o := np.zeros(n, np.uint8), o),
     "memoryview": lambda n: (o := bytearray(n), memoryview(o)),
+    "byref_ctypes": lambda n: (o := (ctypes.c_ubyte * n)(), byref(o)),
 }
 
 
@@ -161,6 +162,29 @@ def test_raw_edges_answer_as_the_table(args: tuple[int, int]) -> None:
             rc = call(*args, buf)
             got.append((rc, bytes(buf), gt.GTE_GetLastError() if rc else ""))
         assert got[0] == got[1], name
+
+
+def test_byref_of_a_raw_array_answers_as_the_table_on_the_fast_path() -> None:
+    """``GT_GetEcatRawData(0, 4, byref(arr))``: the array's own fast path; ``byref(arr, 1)``
+    and a too small array: the table path, with its answer."""
+    ctl = _open()
+    bad = []
+    for name in sorted(fast.RAW):
+        rc, value, error, table = _call(name, "byref_ctypes", "fast")
+        image = bytes(ctl.master.image.buffer)
+        slow = _call(name, "byref_ctypes", "slow")
+        if (rc, value, error) != slow[:3] or image != bytes(ctl.master.image.buffer):
+            bad.append(f"{name}: {(rc, value, error)} != {slow[:3]}")
+        elif rc != 0 or table:
+            bad.append(f"{name}: rc {rc}, the table or general path ran {table} time(s)")
+    for make in (lambda: byref((ctypes.c_ubyte * 8)(), 1), lambda: byref((ctypes.c_ubyte * 2)())):
+        got = []
+        for call in (gt.GT_GetEcatRawData, gt.GT_GetEcatRawData.slow):
+            p = make()
+            got.append((call(0, 4, p), bytes(p._obj), gt.GTE_GetLastError()))
+        if got[0] != got[1]:
+            bad.append(f"{got[0]} != {got[1]}")
+    assert not bad, "\n".join(bad)
 
 
 def test_too_small_buffers_take_the_table_path() -> None:
