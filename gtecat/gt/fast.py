@@ -712,17 +712,18 @@ def fast_raw(
         cache.clear()
         copiers.clear()
         seen[:] = [image, memoryview(image.buffer)]
-        remember(-1, -1, None, -1, None)
+        remember(-1, -1, None, -1, None, False)
         entries.clear()
         entry.__code__ = base_code
 
-    def remember(offset: int, size: int, tp: Any, slave: int, copy: Any) -> None:
+    def remember(offset: int, size: int, tp: Any, slave: int, copy: Any, ref: bool) -> None:
         """The shape the next call is checked against first, and its copier; the public
-        function becomes the entry specialised for it (:data:`_RAW_ENTRY`)."""
-        env["LAST"] = (offset, size, tp, slave, copy)
+        function becomes the entry specialised for it (:data:`_RAW_ENTRY`; ``ref``: the
+        buffer came as ``byref(array)``, which that entry then takes too)."""
+        env["LAST"] = (offset, size, tp, slave, copy, ref)
         if copy is None:
             return
-        key = (slave, offset, size, tp)
+        key = (slave, offset, size, tp, ref)
         code = entries.get(key)
         if code is None:
             code = entries[key] = _raw_entry(env, io, len(entries), key, seen[0], copy.spec)
@@ -733,7 +734,7 @@ def fast_raw(
     entries: dict[tuple, Any] = {}
 
     env = {
-        "LAST": (-1, -1, None, -1, None),
+        "LAST": (-1, -1, None, -1, None, False),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
         "session": session,
@@ -810,7 +811,7 @@ def fast_raw(
 #: repeats its shape): that shape's checks, the session's, and its copy inline; any other
 #: call: the generic function (which specialises it again for its own shape)
 _RAW_ENTRY = """
-def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
+def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
     if (
         type(p) is T{n}
         and offset == {offset}
@@ -823,7 +824,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
         try:
             ctl = session.controllers[1]
         except KeyError:  # no controller: the generic path says why
-            return generic({slave_arg}offset, size, p)
+            return generic({slave_arg}offset, size, {given})
         m = ctl.master
         clock = ctl.clock
         if (
@@ -843,8 +844,16 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
                 if clock.mode is _LOCKSTEP:
                     return 0
                 return advance(ctl, name, 0)
-    return generic({slave_arg}offset, size, p, *extra, **kw)
+    return generic({slave_arg}offset, size, {given}, *extra, **kw)
 """
+
+#: the front of an entry specialised for ``byref(array)``: the array itself, the rest as for it
+_RAW_UNWRAP = """
+    given = p  # (what the generic path gets, if it answers)
+    if type(p) is _CArg:
+        q = p._obj
+        if type(q) is T{n} and {address} == _addressof(q):
+            p = q"""
 
 _RAW_BASE = """
 def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
@@ -860,7 +869,7 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
     if n < 0:
         exec(compile(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>", "exec"), env)
         return env.pop("gt")
-    slave, offset, size, tp = key
+    slave, offset, size, tp, ref = key
     ok, move, names = spec
     for k, v in names.items():
         move = re.sub(rf"\b{k}\b", f"{k}_{n}", move)
@@ -875,6 +884,8 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
         ok="".join(f"\n        and {x}" for x in ok),
         move=move,
+        unwrap=_RAW_UNWRAP.format(n=n, address=carg_address_source("p")) if ref else "",
+        given="given" if ref else "p",
     )
     scratch: dict[str, Any] = {}
     exec(compile(code, f"<gt fast raw {env['name']} shape {n}>", "exec"), env, scratch)
@@ -888,7 +899,8 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
     if extra or kw or p is _NO{slave_check}:
         return slow(*(a for a in ({slave_arg}offset, size, p) if a is not _NO), *extra, **kw)
     given = p  # (what the table path gets, if it answers)
-    if type(p) is _CArg:
+    ref = type(p) is _CArg
+    if ref:
         # byref(array): the array itself (byref(array, offset), byref of anything else: the
         # table path)
         q = p._obj
@@ -911,14 +923,19 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
             # the shape of the previous call (a polling loop repeats its shape), else the
             # copiers by shape
             last = LAST  # (one read: another thread may replace it meanwhile)
-            if offset == last[0] and size == last[1] and tp is last[2]{slave_memo}:
+            if (
+                offset == last[0]
+                and size == last[1]
+                and tp is last[2]
+                and ref is last[5]{slave_memo}
+            ):
                 copy = last[4]
             else:
                 key = ({slave_key}, offset, size, tp)
                 copy = copiers.get(key, _NO)
                 if copy is _NO:
                     copy = copiers[key] = copier({slave_key}, offset, size, tp, image)
-                remember(offset, size, tp, {slave_key}, copy)
+                remember(offset, size, tp, {slave_key}, copy, ref)
             if copy is None:
                 done = False
             else:

@@ -279,8 +279,15 @@ def test_the_specialised_raw_entry_answers_as_the_table() -> None:
         (0, 8, lambda: np.zeros(8, np.uint8)),
         (0, 8, lambda: np.zeros(8, np.uint8)[::2]),
         (0, 8, lambda: (ctypes.c_ubyte * 8)()),
+        (0, 8, lambda: byref((ctypes.c_ubyte * 8)())),
+        (0, 8, lambda: byref((ctypes.c_ubyte * 8)())),
+        (0, 8, lambda: (ctypes.c_ubyte * 8)()),
+        (0, 8, lambda: byref((ctypes.c_ubyte * 9)(), 1)),
+        (0, 8, lambda: byref((ctypes.c_ubyte * 2)())),
+        (0, 8, lambda: byref(ctypes.c_uint64())),
         (0, 8, lambda: bytearray(8)),
     ]
+    carg = type(byref(ctypes.c_int()))
     bad = []
     for _ in range(2):  # the second time on a bus brought up again (another image)
         gt.GT_Close()
@@ -290,7 +297,8 @@ def test_the_specialised_raw_entry_answers_as_the_table() -> None:
             for call in (gt.GT_GetEcatRawData, gt.GT_GetEcatRawData.slow):
                 buf = make()
                 rc = call(offset, size, buf)
-                got.append((rc, bytes(buf), gt.GTE_GetLastError() if rc else ""))
+                held = buf._obj if type(buf) is carg else buf
+                got.append((rc, bytes(held), gt.GTE_GetLastError() if rc else ""))
             if got[0] != got[1]:
                 bad.append(f"{offset} {size} {type(buf).__name__}: {got}")
         for data in (bytes([0x0F, 0]), bytearray([0x0F, 0]), bytes([1])):
