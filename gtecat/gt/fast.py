@@ -264,6 +264,25 @@ def fast_reader(
     def gtn_general(
         core: Any, n: Any, p: Any, count: Any, pClock: Any, extra: tuple, kw: dict
     ) -> int:
+        if (
+            type(core) is int
+            and core > 1
+            and type(n) is int
+            and type(count) is int
+            and 1 < count
+            and 0 < n
+            and n + count - 1 <= AXES_PER_CORE
+            and session.local
+            and core not in session.controllers
+        ):
+            # count axes of a core beyond 32 axes (a view of core 1's bus): core 1's own way
+            # with the bus axes, where it answers (else the table path of that core)
+            rc = many(
+                session.controllers.get(1), n + AXES_PER_CORE * (core - 1), p, count, pClock,
+                extra, kw,
+            )  # fmt: skip
+            if rc is not None:
+                return rc
         args = [a for a in (core, n, p, count, pClock) if a is not _NO]
         return gt.gtn_slow(*args, *extra, **kw)  # type: ignore[attr-defined]
 
