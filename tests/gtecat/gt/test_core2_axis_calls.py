@@ -198,3 +198,27 @@ def test_smart_homing_of_a_core_2_axis_completes(bus: None) -> None:
     assert gt.GTN_GetHomePrm(2, 2, byref(got)) == 0 and got.moveDir == -1
     pos = c_double()
     assert gt.GTN_GetPrfPos(2, 2, byref(pos)) == 0 and pos.value == status.targetPos
+
+
+def test_gantry_pair_of_core_2_axes_moves_the_slave_with_the_master(bus: None) -> None:
+    assert gt.GTN_SetGantryMode(2, 1, 0, 0, gt.GANTRY_MODE_NONE, 1000) == 0  # the walk's pair
+    for local in (3, 4):
+        _standing_in_trap(local)
+    assert gt.GTN_SetGantryMode(2, 1, 4, 3, 1, 500) == 0, gt.GTE_GetLastError()
+    got = [c_short(), c_short(), c_short(), c_long()]
+    assert gt.GTN_GetGantryMode(2, 1, *map(byref, got)) == 0
+    assert [v.value for v in got] == [4, 3, 1, 500]  # in core 2's numbering
+    # bus axis 36 is core 2's axis 4: in a pair already, whichever core names it
+    assert gt.GT_SetGantryMode(1, 36, 1, 1, 500) == 7
+    assert "gantry group 1 of core 2" in gt.GTE_GetLastError()
+    before = c_double()
+    assert gt.GTN_GetPrfPos(2, 3, byref(before)) == 0
+    trap = gt.TTrapPrm(acc=1.0, dec=1.0)
+    assert gt.GTN_SetTrapPrm(2, 4, byref(trap)) == 0
+    assert gt.GTN_SetPos(2, 4, 400) == 0 and gt.GTN_SetVel(2, 4, 20.0) == 0
+    assert gt.GTN_Update(2, 1 << 3) == 0, gt.GTE_GetLastError()
+    gt.GTE_Wait(60)
+    master, slave = c_double(), c_double()
+    assert gt.GTN_GetPrfPos(2, 4, byref(master)) == 0 and master.value == 400
+    assert gt.GTN_GetPrfPos(2, 3, byref(slave)) == 0 and slave.value == before.value + 400
+    assert gt.GTN_SetGantryMode(2, 1, 0, 0, gt.GANTRY_MODE_NONE, 500) == 0
