@@ -310,13 +310,20 @@ def capture_unit(ctl: Any, encoder: int) -> CaptureUnit:
     """The capture of ``encoder`` (= axis), made on first use; 7 when there is no such axis."""
     from .resources import axis_resources
 
-    res = axis_resources(ctl, encoder)
+    return unit_of(ctl, axis_resources(ctl, encoder))
+
+
+def unit_of(ctl: Any, res: AxisResources) -> CaptureUnit:
+    """The capture of the axis whose resources are ``res`` (no numbering involved: a core
+    beyond 1 has mapped its local axis to ``res`` already; the unit belongs to the bus
+    controller)."""
+    base = getattr(ctl, "_base", ctl)
     unit = _UNITS.get(res)
     if unit is None:
-        unit = _UNITS[res] = CaptureUnit(ctl, res)
-    if ctl not in _HOOKED:
-        _HOOKED.add(ctl)
-        ctl.on_reset.append(_reset_units)
+        unit = _UNITS[res] = CaptureUnit(base, res)
+    if base not in _HOOKED:
+        _HOOKED.add(base)
+        base.on_reset.append(_reset_units)
     return unit
 
 
@@ -335,4 +342,5 @@ __all__ = [
     "CaptureUnit",
     "SeenEdge",
     "capture_unit",
+    "unit_of",
 ]

@@ -101,7 +101,7 @@ from typing import Any
 
 from ..errors import CommandError, ParameterError
 from .axis_status import AxisStatus
-from .capture import CAPTURE_HOME, CAPTURE_INDEX, CaptureUnit, capture_unit
+from .capture import CAPTURE_HOME, CAPTURE_INDEX, CaptureUnit, capture_unit, unit_of
 from .digital_io import GPIO_COUNT, digital_io
 from .motion import StopKind, TrapParams
 from .motion.trap import SMOOTH_TIME_MAX
@@ -272,7 +272,7 @@ class SmartHome:
         self.ctl = ctl
         self.res = res
         self.number = res.number
-        self.unit = capture_unit(ctl, res.number)  # the axis's own encoder and capture
+        self.unit = unit_of(ctl, res)  # the axis's own encoder and capture
         self._din = res.ax.io.get(0x60FD)
         self.reset()
 
@@ -292,14 +292,18 @@ class SmartHome:
         return self._gen is not None
 
     # --- GT_GoHome ------------------------------------------------------------------------------
-    def start(self, prm: HomeParams) -> None:
-        """Start homing with ``prm`` (already range-checked); HomeRefused when it cannot."""
+    def start(self, prm: HomeParams, caller: Any = None) -> None:
+        """Start homing with ``prm`` (already range-checked); HomeRefused when it cannot.
+
+        ``caller``: the controller the call came through, whose numbering ``triggerIndex``
+        uses (a core beyond 1 names its own encoders 1..32); the bus controller when None."""
+        numbering = self.ctl if caller is None else caller
         if self.running:
             raise CommandError(
                 f"axis {self.number} is homing (stage {self.status.stage}); wait until "
                 "GT_GetHomeStatus reports run 0 (or GT_Stop it)"
             )
-        prm.check(len(self.ctl.axes))
+        prm.check(len(numbering.axes))
         res = self.res
         if res.profile.mode == PrfMode.JOG:
             self._leave_jog(res)
@@ -337,7 +341,7 @@ class SmartHome:
                 f"Axis {self.number}: GT_GoHome mode {int(mode)} reads the axis's own {side} "
                 "limit terminal: the configuration file wired none to the axis"
             )
-        trigger = self._trigger_unit(prm, mode)
+        trigger = self._trigger_unit(prm, mode, numbering)
         if mode in HOME_MODES or (mode in FORCED_MODES and prm.triggerIndex == -1):
             why = trigger.available(CAPTURE_HOME)
             if why:
@@ -393,10 +397,10 @@ class SmartHome:
             "the card does"
         )
 
-    def _trigger_unit(self, prm: HomeParams, mode: HomeMode) -> CaptureUnit:
+    def _trigger_unit(self, prm: HomeParams, mode: HomeMode, numbering: Any) -> CaptureUnit:
         if mode in FORCED_MODES or prm.triggerIndex == -1:
             return self.unit
-        return capture_unit(self.ctl, prm.triggerIndex)
+        return capture_unit(numbering, prm.triggerIndex)
 
     # --- the cycle ----------------------------------------------------------------------------
     def cycle(self) -> None:
@@ -771,16 +775,22 @@ _RUNNING: weakref.WeakKeyDictionary[Any, list[SmartHome]] = weakref.WeakKeyDicti
 
 
 def smart_home(ctl: Any, axis: int) -> SmartHome:
-    """The smart homing of ``axis`` (made on first use)."""
+    """The smart homing of ``axis`` (made on first use).
+
+    ``axis`` is in the caller's numbering: on a core beyond 1 (a
+    :class:`~gtecat.controller.core_view.CoreView`) its local axis, mapped to the bus axis
+    once, here.  The homing itself belongs to the bus controller and knows the axis by its
+    bus number only, so a core's axis 1 and core 1's axis 33 share one homing."""
     res = axis_resources(ctl, axis)
+    base = getattr(ctl, "_base", ctl)
     home = _HOMES.get(res)
     if home is None:
-        home = _HOMES[res] = SmartHome(ctl, res)
-    if ctl not in _RUNNING:
-        _RUNNING[ctl] = []
-        ref = weakref.ref(ctl)
-        ctl.post_cycle.append(lambda t, dt: _cycle(ref()))
-        ctl.on_reset.append(_reset)
+        home = _HOMES[res] = SmartHome(base, res)
+    if base not in _RUNNING:
+        _RUNNING[base] = []
+        ref = weakref.ref(base)
+        base.post_cycle.append(lambda t, dt: _cycle(ref()))
+        base.on_reset.append(_reset)
     return home
 
 

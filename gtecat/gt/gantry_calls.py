@@ -13,6 +13,9 @@ The vendor header's modes: ``GANTRY_MODE_NONE`` -1, ``GANTRY_MODE_OPEN_LOOP_GANT
   cycle).  ``syncErrorLimit`` (pulses, > 0) is kept and read back: the emulated drives
   follow their command exactly, so the two encoders never drift apart.
 * ``GT_GetGantryMode`` of a group never set reads master 0, slave 0, mode -1, limit 1000.
+* Each core has its own groups and names their axes in its own numbering (``GTN_x(2, ...)``
+  on a bus of more than 32 axes: core 2's axis 1 is bus axis 33); an axis is in one group
+  of one core at most.
 """
 
 from __future__ import annotations
@@ -40,13 +43,26 @@ class _Pair:
     slave: int = 0
     mode: int = GANTRY_MODE_NONE
     limit: int = 1000
+    bus: tuple[int, int] = (0, 0)  #: master and slave as bus axis numbers
 
 
 _GROUPS: weakref.WeakKeyDictionary[Any, dict[int, _Pair]] = weakref.WeakKeyDictionary()
 
 
 def _groups(ctl: Controller) -> dict[int, _Pair]:
-    return _GROUPS.setdefault(getattr(ctl, "_base", ctl), {})
+    """The groups of the core ``ctl`` (a core beyond 1 is a view of the bus controller)."""
+    return _GROUPS.setdefault(ctl, {})
+
+
+def _all_groups(ctl: Controller) -> list[tuple[str, int, _Pair]]:
+    """(core, group, pair) of every core of ``ctl``'s bus."""
+    base = getattr(ctl, "_base", ctl)
+    out = []
+    for owner, groups in list(_GROUPS.items()):
+        if getattr(owner, "_base", owner) is base:
+            core = f" of core {owner.core}" if owner is not base else ""
+            out += [(core, n, p) for n, p in groups.items()]
+    return out
 
 
 def _release(ctl: Controller, pair: _Pair) -> None:
@@ -84,15 +100,17 @@ def GT_SetGantryMode(
         return 0
     if m not in (GANTRY_MODE_OPEN_LOOP_GANTRY, GANTRY_MODE_DECOUPLE_POSITION_LOOP):
         raise ParameterError(f"mode={m}: -1 none, 1 open-loop gantry, 2 decoupled position loop")
-    a, b = axis_resources(ctl, master).number, axis_resources(ctl, slave).number
+    a, b = int(master), int(slave)  # the caller's numbering, as the calls below take it
+    bus = (axis_resources(ctl, a).number, axis_resources(ctl, b).number)
     if a == b:
         raise ParameterError(f"master={a}, slave={b}: two different axes")
     if int(syncErrorLimit) <= 0:
         raise ParameterError(f"syncErrorLimit={syncErrorLimit}: pulses, > 0")
-    for n, p in groups.items():
-        if n != g and p.mode != GANTRY_MODE_NONE and {a, b} & {p.master, p.slave}:
+    for core, n, p in _all_groups(ctl):
+        mine = p is groups.get(n)
+        if not (mine and n == g) and p.mode != GANTRY_MODE_NONE and set(bus) & set(p.bus):
             raise ParameterError(
-                f"axis in gantry group {n} already (master {p.master}, slave {p.slave})"
+                f"axis in gantry group {n}{core} already (master {p.master}, slave {p.slave})"
             )
     if old is not None and old.mode != GANTRY_MODE_NONE:
         _release(ctl, old)
@@ -101,7 +119,7 @@ def GT_SetGantryMode(
     GT_SetGearMaster.__wrapped__(ctl, b, a, _GEAR_MASTER_PROFILE, 0)
     GT_SetGearRatio.__wrapped__(ctl, b, 1, 1, 0)
     GT_GearStart.__wrapped__(ctl, 1 << (b - 1))
-    groups[g] = _Pair(a, b, m, int(syncErrorLimit))
+    groups[g] = _Pair(a, b, m, int(syncErrorLimit), bus)
     return 0
 
 

@@ -58,7 +58,7 @@ def GT_GoHome(ctl: Controller, axis: int, pHomePrm: Any) -> int:
     """Start smart homing of ``axis`` with THomePrm (the module docstring's returns)."""
     prm = struct_arg(pHomePrm, THomePrm, "pHomePrm")
     home = smart_home(ctl, axis)
-    home.start(HomeParams(**{name: getattr(prm, name) for name in _FIELDS}))
+    home.start(HomeParams(**{name: getattr(prm, name) for name in _FIELDS}), ctl)
     return 0
 
 

@@ -68,10 +68,13 @@ _STATES: weakref.WeakKeyDictionary[Controller, _State] = weakref.WeakKeyDictiona
 
 
 def _state(ctl: Controller) -> _State:
-    st = _STATES.get(ctl)
+    """The card's homing state: the bus controller's, whichever core the call names (the
+    armed indexes are kept by bus axis number)."""
+    base = getattr(ctl, "_base", ctl)
+    st = _STATES.get(base)
     if st is None:
-        st = _STATES[ctl] = _State()
-        ctl.on_reset.append(_reset)
+        st = _STATES[base] = _State()
+        base.on_reset.append(_reset)
     return st
 
 
@@ -94,8 +97,8 @@ def GT_HomeInit(ctl: Controller) -> int:
 @gt_function
 def GT_Index(ctl: Controller, axis: int, pos: int, offset: int) -> int:
     """Arm the index stage of the next GT_Home of ``axis`` (the module docstring)."""
-    axis_resources(ctl, axis)  # a bad axis is 7 now, not at GT_Home
-    _state(ctl).index[int(axis)] = _Index(int(pos), int(offset))
+    res = axis_resources(ctl, axis)  # a bad axis is 7 now, not at GT_Home
+    _state(ctl).index[res.number] = _Index(int(pos), int(offset))
     return 0
 
 
@@ -116,7 +119,7 @@ def _home(ctl: Controller, axis: int, pos: int, vel: Any, acc: Any, offset: int,
     if not state.init:
         ctl.log(f"{what}: axis {axis} homes without GT_HomeInit having been called")
     d = 1 if int(pos) > here else -1
-    idx = state.index.pop(int(axis), None)
+    idx = state.index.pop(res.number, None)
     prm = HomeParams(
         mode=HomeMode.HOME if idx is None else HomeMode.HOME_INDEX,
         moveDir=d,
