@@ -24,7 +24,8 @@ before anything else may look at or change them:
   drive's own following-error window) releases it *before* that cycle, so the scalar
   code runs that cycle and every later one until the axis is back in the common state;
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
-  the slave through :attr:`gtecat.drives.drive.Cia402Drive.on_touch`;
+  the axis by touching one of its objects: while claimed they carry a guard class
+  (:meth:`AxisBank._guarded_objects`) whose first attribute access gives the axis back;
 * per-cycle hooks the bank does not know (a recorder, motion programs, smart homing)
   turn it off.
 
@@ -880,7 +881,6 @@ class AxisBank:
             out += [self.csp.channels[r], self.axes[r], res.profile.planner, res.encoder]
             out.append(res.band)
         return out
-        g.drive.on_touch = self._touched
 
     def _load(self, r: int) -> None:
         ax, res = self.axes[r], self.res[r]
