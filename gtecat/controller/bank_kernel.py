@@ -173,16 +173,20 @@ def library() -> tuple[Any, str]:
     return _LIB, _LIB_REASON
 
 
-def build(cflags: tuple[str, ...]) -> Path:
-    """The kernel built with ``cflags``, else (the compiler refused them) with the plain flags
-    (NativeBuildError when that fails too)."""
+def build(
+    cflags: tuple[str, ...], stem: str = "bank_kernel", libs: tuple[str, ...] = ("-lm",)
+) -> Path:
+    """``csrc/<stem>.c`` (the kernel, or another of the bank's C units) built with ``cflags``,
+    else (the compiler refused them) with the plain flags (NativeBuildError when that fails
+    too)."""
+    source = _source(stem)
     try:
-        return shared_library("bank_kernel", _source(), cflags, ("-lm",))
+        return shared_library(stem, source, cflags, libs)
     except NativeBuildError as e:
         if cflags == PLAIN_CFLAGS:
             raise
-        log.info("bank kernel: the build with %s failed, built plain: %s", " ".join(cflags), e)
-        return shared_library("bank_kernel", _source(), PLAIN_CFLAGS, ("-lm",))
+        log.info("%s: the build with %s failed, built plain: %s", stem, " ".join(cflags), e)
+        return shared_library(stem, source, PLAIN_CFLAGS, libs)
 
 
 def _field_types() -> list[tuple[str, Any]]:
@@ -195,8 +199,8 @@ def _field_types() -> list[tuple[str, Any]]:
     return out
 
 
-def _source() -> str:
-    return (resources.files("gtecat.controller") / "csrc" / "bank_kernel.c").read_text("utf-8")
+def _source(stem: str = "bank_kernel") -> str:
+    return (resources.files("gtecat.controller") / "csrc" / f"{stem}.c").read_text("utf-8")
 
 
 def wanted() -> str:

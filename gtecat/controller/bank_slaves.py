@@ -19,14 +19,12 @@ from __future__ import annotations
 
 import ctypes
 import logging
-from importlib import resources
 from operator import is_
 from typing import Any
 
 import numpy as np
 
-from ..cbuild import NativeBuildError, shared_library
-from .bank_kernel import CFLAGS, PLAIN_CFLAGS
+from .bank_kernel import CFLAGS, build
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
 
@@ -63,13 +61,7 @@ def library() -> tuple[Any, str]:
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
     try:
-        src = (resources.files("gtecat.controller") / "csrc" / "bank_slaves.c").read_text("utf-8")
-        try:
-            path = shared_library("bank_slaves", src, CFLAGS, ())
-        except NativeBuildError as e:
-            log.info("bank slaves: the build with %s failed, built plain: %s", CFLAGS, e)
-            path = shared_library("bank_slaves", src, PLAIN_CFLAGS, ())
-        lib = ctypes.CDLL(str(path))
+        lib = ctypes.CDLL(str(build(CFLAGS, "bank_slaves", ())))
         lib.bank_slaves_state_size.restype = ctypes.c_int
         lib.bank_slaves_fill_args.restype = ctypes.c_int
         lib.bank_slaves_fill.restype = ctypes.c_int64
