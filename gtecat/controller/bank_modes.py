@@ -361,6 +361,20 @@ def _trap_samples(
     return out[0, :m], out[1, :m], out[2, :m], end
 
 
+def _master_travel(pl: Any, ms: list[float]) -> tuple[float, np.ndarray, np.ndarray]:
+    """(cycle time, master positions, the master's travel each cycle as the slaves of ``pl``'s
+    master take it: only in their follow direction), for the vectorised Gear/Follow rows;
+    every slave of one master shares ``pl``'s cycle, direction and last master position."""
+    cyc, dir_, m_prev = _get(pl, "_T"), _get(pl, "_dir"), _get(pl, "_m_prev")
+    m = np.array(ms, np.float64)
+    d = np.diff(m, prepend=m_prev)
+    if dir_ > 0:
+        d = np.where(d > 0.0, d, 0.0)
+    elif dir_ < 0:
+        d = np.where(d < 0.0, d, 0.0)
+    return cyc, m, d
+
+
 class SystemTrace:
     """A coordinate system's state in each cycle of a cluster's last fill: the read calls
     (GT_CrdStatus, GT_CrdSpace, GT_GetCrdPos, GT_GetCrdVel) answer from it while the bank
@@ -759,14 +773,7 @@ class Cluster:
         GearPlanner.step's operations for all of them at once (``pos += ratio·d`` summed in
         order, speed ``ds/T``, acceleration the change of speed over ``T``)."""
         pls = [self.planners[i] for i in slaves]
-        first = pls[0]
-        cyc, dir_, m_prev = _get(first, "_T"), _get(first, "_dir"), _get(first, "_m_prev")
-        m = np.array(ms, np.float64)
-        d = np.diff(m, prepend=m_prev)
-        if dir_ > 0:
-            d = np.where(d > 0.0, d, 0.0)
-        elif dir_ < 0:
-            d = np.where(d < 0.0, d, 0.0)
+        cyc, m, d = _master_travel(pls[0], ms)
         r1 = np.array([_get(pl, "_r1") for pl in pls])
         ds = r1[:, None] * d[None, :]
         pos0 = np.array([[_get(pl, "_pos")] for pl in pls])
@@ -794,14 +801,7 @@ class Cluster:
         travel leaves the segment within the table is stepped on from there by its ``run``;
         returns those rows' samples (row, positions, speeds, accelerations, end)."""
         pls = [self.planners[i] for i in slaves]
-        first = pls[0]
-        cyc, dir_, m_prev = _get(first, "_T"), _get(first, "_dir"), _get(first, "_m_prev")
-        m = np.array(ms, np.float64)
-        d = np.diff(m, prepend=m_prev)
-        if dir_ > 0:
-            d = np.where(d > 0.0, d, 0.0)
-        elif dir_ < 0:
-            d = np.where(d < 0.0, d, 0.0)
+        cyc, m, d = _master_travel(pls[0], ms)
         # each planner's travel, direction, segment (x0, x1, origin + s0, rs, k), position and
         # speed: one row per planner, read in one pass
         cols = []
