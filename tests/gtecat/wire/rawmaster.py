@@ -44,6 +44,34 @@ def why_not_root() -> str | None:
     return None
 
 
+#: how long a test's SOEM (pysoem) master waits for the answer to one frame: process data
+#: (``receive_processdata``) and every other frame (pysoem's ``settings.timeouts.ret``, SOEM's
+#: EC_TIMEOUTRET, 2 ms).  ``gtecat serve`` is Python beside the suite's workers; on a loaded
+#: 2-CPU machine it answers tens of milliseconds late now and then, and a late answer is then
+#: a lost cycle (working counter -1) or a mailbox frame SOEM sends again (whose exchange reads
+#: a stale answer).  These tests are about what the slaves answer, not how fast: only a frame
+#: that is really lost (a fault that drops answers) waits this long.
+SOEM_FRAME_US = 500_000
+
+
+@contextlib.contextmanager
+def patient_soem() -> Iterator[None]:
+    """pysoem's per-frame timeout at :data:`SOEM_FRAME_US` for the block (an older pysoem
+    without ``settings`` keeps its own)."""
+    import pysoem
+
+    settings = getattr(pysoem, "settings", None)
+    if settings is None:
+        yield
+        return
+    old = settings.timeouts.ret
+    settings.timeouts.ret = SOEM_FRAME_US
+    try:
+        yield
+    finally:
+        settings.timeouts.ret = old
+
+
 @contextlib.contextmanager
 def veth_pair(prefix: str = "gr") -> Iterator[tuple[str, str]]:
     """A fresh veth pair (master end, slave end), deleted on the way out."""

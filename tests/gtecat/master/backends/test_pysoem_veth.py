@@ -66,21 +66,13 @@ def frame_timeout_for_a_python_slave() -> Iterator[None]:
     Python on a shared VM and answered a frame in 5-10 ms now and then (its --stats-json
     showed it), after which SOEM's repeated mailbox exchanges read a stale answer (a mapping
     count of 4 for 6, an SDO with no abort code) and these tests failed about one run in
-    three. They test our pysoem backend, not the wire latency (issue 16 measures that), so
-    here a frame gets 20 ms."""
-    import pysoem
+    three; 20 ms was missed as well on a busier machine. They test our pysoem backend, not
+    the wire latency (issue 16 measures that), so here a frame gets
+    :data:`~tests.gtecat.wire.rawmaster.SOEM_FRAME_US`."""
+    from tests.gtecat.wire.rawmaster import patient_soem
 
-    settings = getattr(pysoem, "settings", None)  # an older pysoem has no settings
-    if settings is None:
+    with patient_soem():
         yield
-        return
-    t = settings.timeouts
-    old = t.ret
-    t.ret = 20_000
-    try:
-        yield
-    finally:
-        t.ret = old
 
 
 def _ip(*args: str, check: bool = True) -> subprocess.CompletedProcess:
