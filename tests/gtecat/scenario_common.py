@@ -284,7 +284,9 @@ def trap_move(gt: Any, r: dict[str, Any], axes: int, distance: int = 20000) -> N
         ),
         ms=20_000,
     )
-    gt.GTE_Wait(20)  # the drives follow the last set-point
+    # the drives follow the last set-point: waited for (bounded), not a fixed 20 ms, which a
+    # wire on a loaded machine (frames late, cycles lost) did not always give them
+    wait_until(gt, lambda: all(_enc(gt, a) == starts[a] + distance for a in starts))
     for item in res:
         a = item["axis"]
         item["stopped"] = stopped
