@@ -120,10 +120,17 @@ class NoAnswer(Exception):
     """No answer to a frame within the timeout (after the resends)."""
 
 
+#: how long :meth:`RawMaster.transact` waits for a frame's answer, resends included: the
+#: server is Python beside the suite's workers (in a thread of the test's own process in some
+#: tests), and on a loaded 2-CPU machine an answer took more than the 0.5 s this once was;
+#: only a frame that is never answered waits this long
+ANSWER_S = 5.0
+
+
 class RawMaster:
     """One datagram per frame, answers matched by the datagram index, like SOEM."""
 
-    def __init__(self, iface: str, *, timeout: float = 0.5, resend_after: float = 0.1) -> None:
+    def __init__(self, iface: str, *, timeout: float = ANSWER_S, resend_after: float = 0.1) -> None:
         self.sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETHERTYPE))
         self.sock.bind((iface, ETHERTYPE))
         self.timeout = timeout

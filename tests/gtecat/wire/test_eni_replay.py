@@ -57,7 +57,7 @@ def test_replay_reaches_op(eni: Path, tmp_path: Path) -> None:
     try:
         server = ServeProcess(eni, slave_if, tmp_path / "s.json", "--rt-priority", "10", cwd=ROOT)
         try:
-            with RawMaster(master_if, timeout=1.0) as master:
+            with RawMaster(master_if) as master:
                 replay = Replay(master, config)
                 failures = replay.run(cycles=50)
                 states = replay.states()
