@@ -28,6 +28,7 @@ from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources
 from ..master.clock import ClockMode
+from . import byref_target
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
@@ -361,14 +362,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
         if {session} and clock._thread is None:
             tp = type(p)
             if tp is _CArg:
-                obj = p._obj
-                if p is not LAST_P:
-                    # byref(obj), not byref(obj, offset); any doubt: the table path
-                    kind = type(obj)
-                    if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
-                        return {fallback}
-                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
-                        LAST_P = p  # checked, the same object next time needs no check
+{byref}
             elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
                 obj = p
             elif (
@@ -394,11 +388,46 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
 """
 
 
+#: the byref branch of a reader: its object when the pointer passes the object's own address
+#: and the type is one the reader writes (one C call, :mod:`gtecat.gt.byref_target`) ...
+_BYREF_C = """\
+                obj = TARGET(p)
+                if obj is p:  # byref(obj, offset), another type: the table path
+                    return {fallback}"""
+#: ... or, where that is not available, read from Python (a reused pointer checked once)
+_BYREF_PY = """\
+                obj = p._obj
+                if p is not LAST_P:
+                    # byref(obj), not byref(obj, offset); any doubt: the table path
+                    kind = type(obj)
+                    if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
+                        return {fallback}
+                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
+                        LAST_P = p  # checked, the same object next time needs no check"""
+
+
+def _byref_check(env: dict[str, Any], types: frozenset) -> str:
+    """The byref branch's source for a reader of ``types`` (its names go into ``env``)."""
+    env.update(CARG_ENV)
+    if BYREF_TARGET:
+        f = byref_target.target(types)
+        if f is not None:
+            env["TARGET"] = f
+            return _BYREF_C
+    return _BYREF_PY
+
+
+#: the byref check in C where it is available (tests turn it off to hold the Python one to
+#: the same answers)
+BYREF_TARGET = True
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
     env.update(CARG_ENV)
     gtn = bool(core)
+    template = template.replace("{byref}", _byref_check(env, env["ok"]))
     code = template.format(
         fname=fname,
         core=core,
@@ -471,6 +500,7 @@ def fast_clock(
     0, on the in-process controller; anything else (a value the type cannot hold included)
     takes the table path."""
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
+    target = byref_target.target(_CLOCK_INTS) if BYREF_TARGET else None
 
     def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if (
@@ -484,16 +514,21 @@ def fast_clock(
                 if clock._thread is None:
                     tp = type(pClock)
                     if tp is _CArg:
-                        obj = pClock._obj
-                        if pClock is not last[0]:
-                            if type(obj) not in _CLOCK_INTS or (
-                                _from_address(id(pClock) + _AT).value
-                                if _AT >= 0
-                                else byref_address(pClock)
-                            ) != _addressof(obj):
+                        if target is not None:  # (one C call: see _BYREF_C)
+                            obj = target(pClock)
+                            if obj is pClock:
                                 obj = None
-                            else:
-                                last[0] = pClock
+                        else:
+                            obj = pClock._obj
+                            if pClock is not last[0]:
+                                if type(obj) not in _CLOCK_INTS or (
+                                    _from_address(id(pClock) + _AT).value
+                                    if _AT >= 0
+                                    else byref_address(pClock)
+                                ) != _addressof(obj):
+                                    obj = None
+                                else:
+                                    last[0] = pClock
                     else:
                         obj = pClock if tp in _CLOCK_INTS else None
                     if obj is not None:
@@ -753,6 +788,7 @@ def fast_raw(
     entries: dict[tuple, Any] = {}
 
     env = {
+        "ARRAY_TARGET": byref_target.target([type(ctypes.Array)]) if BYREF_TARGET else None,
         "LAST": (-1, -1, None, -1, None, False),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
@@ -873,6 +909,13 @@ _RAW_UNWRAP = """
         q = p._obj
         if type(q) is T{n} and {address} == _addressof(q):
             p = q"""
+#: the same with the check in one C call (ARRAY_TARGET: an array that p points at, else p)
+_RAW_UNWRAP_C = """
+    given = p  # (what the generic path gets, if it answers)
+    if type(p) is _CArg:
+        q = ARRAY_TARGET(p)
+        if type(q) is T{n}:
+            p = q"""
 
 _RAW_BASE = """
 def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
@@ -903,7 +946,13 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
         ok="".join(f"\n        and {x}" for x in ok),
         move=move,
-        unwrap=_RAW_UNWRAP.format(n=n, address=carg_address_source("p")) if ref else "",
+        unwrap=(
+            ""
+            if not ref
+            else _RAW_UNWRAP_C.format(n=n)
+            if env.get("ARRAY_TARGET") is not None
+            else _RAW_UNWRAP.format(n=n, address=carg_address_source("p"))
+        ),
         given="given" if ref else "p",
     )
     scratch: dict[str, Any] = {}
@@ -922,9 +971,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
     if ref:
         # byref(array): the array itself (byref(array, offset), byref of anything else: the
         # table path)
-        q = p._obj
-        if isinstance(q, _Array) and {address} == _addressof(q):
-            p = q
+{unwrap}
     ctl = session.controllers.get(1)
     if (
         ctl is not None
@@ -978,8 +1025,15 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
         slave_arg="slave, " if io else "",
         slave_key="slave" if io else "-1",
         slave_memo=" and slave == last[3]" if io else "",
-        address=carg_address_source("p"),
+        unwrap=(
+            "        p = ARRAY_TARGET(p)  # (one C call: the array, else p itself)"
+            if env.get("ARRAY_TARGET") is not None
+            else "        q = p._obj\n"
+            "        if isinstance(q, _Array) and {address} == _addressof(q):\n"
+            "            p = q"
+        ),
     )
+    code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
     env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof)
     exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
@@ -1039,6 +1093,16 @@ ECAT_READERS: dict[str, tuple[int, int]] = {
 }
 
 
+def _pdo_entry(ax: Any, acc: Any) -> tuple[Any, Any, Any, Any, int]:
+    """A PDO reader's entry of one axis: ``(axis, accessor, unpack, buffer, offset)``; ``unpack``
+    and the rest are the accessor's own struct reading (what its ``get`` does for a whole-byte
+    entry, read inline), or None when it reads bits (its ``get`` then)."""
+    fmt = getattr(acc, "_fmt", None)
+    if acc is None or fmt is None:
+        return ax, acc, None, None, 0
+    return ax, acc, fmt.unpack_from, acc._buf, acc._off
+
+
 def fast_ecat_reader(
     name: str,
     slow: Callable[..., int],
@@ -1081,17 +1145,38 @@ def fast_ecat_reader(
         "INDEX": index,
         "SUB": subindex,
         "ACCS": {},
+        "_pdo_entry": _pdo_entry,
         "last": [None],
         "_refs": sys.getrefcount,
         "KEPT": _KEPT,
     }
+    target = byref_target.target(ok) if BYREF_TARGET else None
+    if target is not None:
+        env["TARGET"] = target
+        byref = _ECAT_BYREF_C
+    else:
+        byref = _ECAT_BYREF_PY.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
-    code = _ECAT_READER.replace("{address}", carg_address_source("p"))
+    code = _ECAT_READER.replace("{byref}", byref)
     exec(compile(code, f"<gt fast ecat {name}>", "exec"), env)
     gt = env["gt"]
     gt.slow = slow
     return gt
 
+
+#: the byref branch of a PDO reader: one C call (see _BYREF_C) ...
+_ECAT_BYREF_C = """\
+                    obj = TARGET(p)
+                    if obj is p:  # byref(obj, offset), another type: the table path
+                        return slow(n, p)"""
+#: ... else read from Python
+_ECAT_BYREF_PY = """\
+                    obj = p._obj
+                    if p is not last[0]:
+                        if type(obj) not in ok or {address} != _addressof(obj):
+                            return slow(n, p)  # (p is a byref here)
+                        if _refs(p) > KEPT:  # (kept by the caller: see _KEPT)
+                            last[0] = p"""
 
 _ECAT_READER = """
 def gt(n=_NO, p=_NO, /, *extra, **kw):
@@ -1116,22 +1201,17 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
             if kept is None or kept[0] is not ax:
                 if len(ACCS) > 4096:
                     ACCS.clear()
-                kept = ACCS[n] = (ax, ax.io.get(INDEX, SUB))
-            acc = kept[1]  # (None: not mapped; the table path says so)
+                kept = ACCS[n] = _pdo_entry(ax, ax.io.get(INDEX, SUB))
+            _, acc, unpack, buf, off = kept  # (acc None: not mapped; the table path says so)
             if acc is not None:
                 tp = type(p)
                 if tp is _CArg:
-                    obj = p._obj
-                    if p is not last[0]:
-                        if type(obj) not in ok or {address} != _addressof(obj):
-                            return slow(n, p)  # (p is a byref here)
-                        if _refs(p) > KEPT:  # (kept by the caller: see _KEPT)
-                            last[0] = p
+{byref}
                 elif tp in ok:
                     obj = p
                 else:
                     return slow(*(a for a in (n, p) if a is not _NO))
-                v = acc.get()
+                v = acc.get() if unpack is None else unpack(buf, off)[0]
                 lo, hi = BOUNDS[type(obj)]
                 if lo <= v <= hi:  # (else store's refusal: the table path)
                     obj.value = v
