@@ -74,9 +74,7 @@ def _layout() -> tuple[int, int, int, int]:
     size = sys.getsizeof(ctypes.byref(ctypes.c_int()))
     for k in range(head, size - _WORD + 1, _WORD):
         if k != CARG_AT and all(
-            _word(id(p) + k) == id(o)
-            for o in objs
-            for p in (ctypes.byref(o), ctypes.byref(o, 4))
+            _word(id(p) + k) == id(o) for o in objs for p in (ctypes.byref(o), ctypes.byref(o, 4))
         ):
             return CARG_AT, k, ob_type, b_ptr
     raise ValueError("where a byref keeps its object is not known")
@@ -126,7 +124,12 @@ def _self_test(make: Callable[[Iterable[type]], Callable[[Any], Any]]) -> str:
     f = make([ctypes.c_long, ctypes.c_double, type(long_arr)])
     held = long_arr()
     cases: list[tuple[Any, Any]] = []
-    for o in (ctypes.c_long(5), ctypes.c_double(), held, ctypes.c_long.from_address(ctypes.addressof(held))):
+    for o in (
+        ctypes.c_long(5),
+        ctypes.c_double(),
+        held,
+        ctypes.c_long.from_address(ctypes.addressof(held)),
+    ):
         cases.append((ctypes.byref(o), o))  # its own memory: the object
         cases.append((ctypes.byref(o, 8), None))  # an offset: the pointer itself
         cases.append((ctypes.byref(o, -8), None))
