@@ -177,7 +177,9 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
     gt.GT_AxisOn(1)
     held = c_long()
     p = byref(held)
-    buf8, ba8, np8 = (c_ubyte * 8)(), bytearray(8), np.zeros(8, np.uint8)
+    u8 = c_ubyte * 8
+    buf8, ba8, np8 = u8(), bytearray(8), np.zeros(8, np.uint8)
+    pbuf8 = byref(buf8)
     mv8 = memoryview(bytearray(8))
     out2 = bytes([0x0F, 0x00])
     sts, raw_get, raw_set = gt.GT_GetSts, gt.GT_GetEcatRawData, gt.GT_SetEcatRawData
@@ -193,6 +195,10 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             lambda: sts(1, byref(c_long())),
             lambda: byref(c_long()),
         ),
+        "GTN_GetSts(1, 1, byref(c_long()))": (
+            lambda: gt.GTN_GetSts(1, 1, byref(c_long())),
+            lambda: byref(c_long()),
+        ),
         "GT_GetSts(1, byref(s), 1, 0)": (lambda: sts(1, p, 1, 0), lambda: byref(c_long())),
         "GT_GetSts(1, byref(s), 1, None)": (
             lambda: sts(1, p, 1, None),
@@ -202,16 +208,36 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
         "GT_GetSts(1, c_long[1])": (lambda: sts(1, arr1), lambda: (c_long * 1)()),
         "GT_GetSts(1, numpy int32[1])": (lambda: sts(1, np1), lambda: np.zeros(1, np.int32)),
         "GT_GetPrfPos(1, byref(d))": (lambda: gt.GT_GetPrfPos(1, pd), lambda: byref(c_double())),
+        "GT_GetPrfPos(1, byref(c_double()))": (
+            lambda: gt.GT_GetPrfPos(1, byref(c_double())),
+            lambda: byref(c_double()),
+        ),
         "GT_GetPrfMode(1, byref(s))": (lambda: gt.GT_GetPrfMode(1, p), lambda: byref(c_long())),
         "GT_GetClock(byref(s))": (lambda: gt.GT_GetClock(p), lambda: byref(c_long())),
+        "GT_GetClock(byref(c_long()))": (
+            lambda: gt.GT_GetClock(byref(c_long())),
+            lambda: byref(c_long()),
+        ),
         "GT_GetEcatEncPos(1, byref(s))": (
             lambda: gt.GT_GetEcatEncPos(1, p),
+            lambda: byref(c_long()),
+        ),
+        "GT_GetEcatEncPos(1, byref(c_long()))": (
+            lambda: gt.GT_GetEcatEncPos(1, byref(c_long())),
             lambda: byref(c_long()),
         ),
         "GTN_GetSts(1, 1, byref(s))": (lambda: gt.GTN_GetSts(1, 1, p), lambda: byref(c_long())),
         "GT_GetEcatRawData(0, 8, c_ubyte[8])": (
             lambda: raw_get(0, 8, buf8),
             lambda: (c_ubyte * 8)(),
+        ),
+        "GT_GetEcatRawData(0, 8, byref(c_ubyte[8]))": (
+            lambda: raw_get(0, 8, pbuf8),
+            lambda: byref(u8()),
+        ),
+        "GT_GetEcatRawData(0, 8, byref(c_ubyte[8]()))": (
+            lambda: raw_get(0, 8, byref(u8())),
+            lambda: byref(u8()),
         ),
         "GT_GetEcatRawData(0, 8, bytearray)": (lambda: raw_get(0, 8, ba8), lambda: bytearray(8)),
         "GT_GetEcatRawData(0, 8, numpy uint8)": (
