@@ -42,10 +42,12 @@ from ..errors import (
 from ..master.clock import ClockGroup, ClockMode
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder
 from .fast import (
+    AXIS_VALUES,
     CLOCK,
     ECAT_READERS,
     RAW,
     READERS,
+    fast_axis_value,
     fast_clock,
     fast_ecat_reader,
     fast_raw,
@@ -470,7 +472,13 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    if name in READERS or name in RAW or name == CLOCK or name in ECAT_READERS:
+    if (
+        name in READERS
+        or name in RAW
+        or name == CLOCK
+        or name in ECAT_READERS
+        or name in AXIS_VALUES
+    ):
         slow = gt  # (the common shapes up front: gt.fast)
         make = (
             fast_reader
@@ -479,6 +487,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             if name in RAW
             else fast_ecat_reader
             if name in ECAT_READERS
+            else fast_axis_value
+            if name in AXIS_VALUES
             else fast_clock
         )
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))

@@ -1077,7 +1077,7 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW | {CLOCK} | frozenset(ECAT_READERS)
+    return frozenset(READERS) | RAW | {CLOCK} | frozenset(ECAT_READERS) | frozenset(AXIS_VALUES)
 
 
 #: the per-axis PDO readers (axis_calls._reader): function -> the object it reads
@@ -1221,3 +1221,112 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                     return advance(ctl, name, 0)
     return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 """
+
+
+def _homing_status() -> Callable[[Any], Any]:
+    """GT_GetEcatHomingStatus's value of an axis (homing_calls.homing_status), its common
+    cases without a weak reference made per call: each axis's own is kept (a run's state is
+    found by it in the same weak dictionary); every other case (the link lost, a run with a
+    reason to note): None, the table path answers."""
+    import weakref
+
+    from . import homing_calls as h
+
+    data = h._STATE.data  # (the weak dictionary's own: weak reference -> the run's state)
+    kept: dict[int, tuple[Any, Any, bool]] = {}
+    getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
+    in_progress = h.HOMING_IN_PROGRESS
+    failed = h.HOMING_FAILED
+
+    def value(ax: Any) -> Any:
+        if getattribute(ax, "link_lost"):
+            return None
+        k = kept.get(id(ax))
+        if k is None or k[0] is not ax:
+            if len(kept) > 4096:
+                kept.clear()
+            # 6041h mapped (else homing_status's 1 naming it: the table path)
+            io = getattribute(ax, "io")
+            k = kept[id(ax)] = (ax, weakref.ref(ax), io.get(0x6041) is not None)
+        st = data.get(k[1])
+        if st is None:
+            return failed if k[2] else None  # no run since the bus came up: not homed
+        if st.active:
+            return None if st.hint is not None else in_progress
+        return st.result
+
+    return value
+
+
+#: readers of one value of one bus axis that polling loops call, answered after the few checks
+#: their table path makes: function -> a maker of ``value(axis)`` (an
+#: :class:`~gtecat.controller.axis.Axis`), the table's value or None where the table path
+#: must answer (an error, a note)
+AXIS_VALUES: dict[str, Callable[[], Callable[[Any], Any]]] = {
+    "GT_GetEcatHomingStatus": _homing_status,
+}
+
+
+def fast_axis_value(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetEcatHomingStatus(axis, p)`` with the fast path in front of the table: ``p`` a
+    ``byref`` (no offset) or the object itself of an integer type the pointer takes, the
+    axis on the in-process controller's bus (core 1, no pulse card, the bus opened); the
+    value is the table's own function's (:data:`AXIS_VALUES`).  A value it raises for, a
+    note it leaves (GTE_GetLastError's reason beside a 0) or any other shape: the table path
+    answers."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    made: list[Any] = []  # value(axis), made at the first call (its module imports ours)
+    ok = _scalar_types(FUNCTIONS[name].params[1])
+    bounds = {}
+    for t in ok:
+        bits = 8 * ctypes.sizeof(t)
+        bounds[t] = (
+            (0, (1 << bits) - 1)
+            if t._type_.isupper()
+            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        )
+    target = byref_target.target(ok) if BYREF_TARGET else None
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra and session.plain:
+            ctl = session.controllers.get(1)
+            if ctl is not None and ctl.card is None and ctl.clock._thread is None:
+                ax = ctl.axes.get(n)
+                m = ctl.master
+                if ax is not None and m is not None and m.opened:
+                    tp = type(p)
+                    if tp is _CArg:
+                        if target is not None:
+                            obj = target(p)
+                            if obj is p:
+                                obj = None
+                        else:
+                            obj = p._obj
+                            if type(obj) not in ok or byref_address(p) != _addressof(obj):
+                                obj = None
+                    else:
+                        obj = p if tp in ok else None
+                    if obj is not None:
+                        if not made:
+                            made.append(AXIS_VALUES[name]())
+                        v = made[0](ax)
+                        if v is not None:
+                            lo, hi = bounds[type(obj)]
+                            if lo <= v <= hi:
+                                obj.value = v
+                                session.last = None
+                                clock = ctl.clock
+                                if clock.mode is _LOCKSTEP:
+                                    return 0
+                                return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt

@@ -476,3 +476,59 @@ def test_core_2_answers_as_the_table_fast_and_leaves_the_bank(tmp_path: Path) ->
         gt.GTE_Wait(3)
     assert all(r.bank is not None for r in banked), "polling gave an axis back"
     assert all(v & (1 << 10) for v in s)  # both still moving
+
+
+def test_the_homing_status_answers_as_the_table() -> None:
+    """GT_GetEcatHomingStatus on its fast path (a byref or the object, no offset, an integer
+    type the pointer takes): the table path's code, value and reason before any run, while
+    a run that cannot end is polled (its reason beside the 0: the table path answers), when
+    a run has ended, and for an axis that does not exist; its common shapes never reach
+    the table."""
+    from gtecat.drives.machine import AxisMachine, MachineDescription
+
+    from .conftest import bring_up
+
+    bring_up(machine=MachineDescription({1: AxisMachine(), 2: AxisMachine()}), log="")
+    makers = {
+        "byref": lambda: (o := ctypes.c_short(), byref(o), o),
+        "object": lambda: (o := ctypes.c_short(), o, o),
+        "long": lambda: (o := ctypes.c_long(), byref(o), o),
+        "offset": lambda: (o := (ctypes.c_short * 2)(), byref(o, 2), o),
+        "narrow": lambda: (o := ctypes.c_int8(), byref(o), o),
+        "unsigned": lambda: (o := ctypes.c_ushort(), byref(o), o),
+    }
+    fn = gt.GT_GetEcatHomingStatus
+    bad = []
+
+    def compare(when: str) -> None:
+        for axis in (1, 2, 3):
+            for shape, make in makers.items():
+                got = []
+                for call in (fn, fn.slow):
+                    _, p, o = make()
+                    pr = cProfile.Profile()
+                    pr.enable()
+                    rc = call(axis, p)
+                    pr.disable()
+                    table = sum(
+                        v[1]
+                        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+                        if func in ("call", "run") and f.endswith("_core.py")
+                    )
+                    got.append((rc, _value(o), gt.GTE_GetLastError(), table))
+                if got[0][:3] != got[1][:3]:
+                    bad.append(f"{when} axis {axis} {shape}: {got[0][:3]} != {got[1][:3]}")
+                elif axis == 2 and shape in ("byref", "object", "long") and got[0][3]:
+                    bad.append(f"{when} axis {axis} {shape}: took the table path")
+
+    compare("before any run")
+    assert gt.GT_AxisOn(1) == 0 and gt.GT_SetHomingMode(1, 6) == 0
+    assert gt.GT_SetEcatHomingPrm(1, 24, 50_000, 5_000, 1_000_000, 0, 0) == 0
+    assert gt.GT_StartEcatHoming(1) == 0  # (a home switch the machine lacks: never ends)
+    assert gt.GT_AxisOn(2) == 0 and gt.GT_SetHomingMode(2, 6) == 0
+    assert gt.GT_SetEcatHomingPrm(2, 35, 50_000, 5_000, 1_000_000, 0, 0) == 0
+    assert gt.GT_StartEcatHoming(2) == 0  # (the current position: ends at once)
+    compare("started")
+    gt.GTE_Wait(20)
+    compare("later")
+    assert not bad, "\n".join(bad[:10])
