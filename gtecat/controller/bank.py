@@ -1094,6 +1094,14 @@ class AxisBank:
                 self.release_axis_object(ax)
         self.dirty = True
 
+    def before_axis_call(self, ax: Any) -> None:
+        """What :meth:`before_call` does for a GT function naming one existing axis ``ax`` by
+        its first parameter (``axis``, ``profile`` or ``encoder``, no ``count``), for the
+        GT fast path: the bank looks again, and ``ax`` goes back."""
+        self.dirty = True
+        if self.n_alive:
+            self.release_axis_object(ax)
+
     def release_axis_object(self, ax: Any) -> None:
         r = self._row_of.get(id(ax))
         if r is not None and self.alive[r]:

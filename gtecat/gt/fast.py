@@ -1077,7 +1077,14 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW | {CLOCK} | frozenset(ECAT_READERS) | frozenset(AXIS_VALUES)
+    return (
+        frozenset(READERS)
+        | RAW
+        | {CLOCK}
+        | frozenset(ECAT_READERS)
+        | frozenset(AXIS_VALUES)
+        | frozenset(STRUCT_READERS)
+    )
 
 
 #: the per-axis PDO readers (axis_calls._reader): function -> the object it reads
@@ -1330,3 +1337,96 @@ def fast_axis_value(
 
     gt.slow = slow  # type: ignore[attr-defined]
     return gt
+
+
+def trap_prm_into(res: Any, s: Any) -> None:
+    """GT_GetTrapPrm's fields, from the profile's Trap parameters (its table path's too)."""
+    prm = res.profile.trap_prm
+    s.acc, s.dec, s.velStart, s.smoothTime = prm.acc, prm.dec, prm.vel_start, prm.smooth_time
+
+
+def _struct_readers() -> dict[str, tuple[type, Any, Callable[[Any, Any], None]]]:
+    from ..controller.profile import PrfMode
+    from .structs import TTrapPrm
+
+    return {"GT_GetTrapPrm": (TTrapPrm, PrfMode.TRAP, trap_prm_into)}
+
+
+#: readers of one structure of one axis's profile: function -> (the structure, the profile
+#: mode the function needs, ``fill(resources, structure)``: the table path's own)
+STRUCT_READERS = _struct_readers()
+
+
+def fast_struct_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetTrapPrm(profile, p)`` with the fast path in front of the table: ``p``
+    ``byref(s)`` (no offset) or ``s`` itself of the structure's own class, an axis of the
+    in-process controller (core 1, no pulse card) in the mode the function needs; the axis
+    bank is told of the call as the table path tells it (:meth:`AxisBank.before_call`), then
+    the table path's own ``fill`` writes the fields.  Any other shape, another mode, an
+    axis that does not exist: the table path, with its code and reason."""
+    from .table import FUNCTIONS
+
+    first = FUNCTIONS[name].params[0]
+    if first.name not in ("axis", "profile", "encoder") or any(
+        q.name == "count" for q in FUNCTIONS[name].params
+    ):  # (AxisBank.before_axis_call is before_call for these only)
+        raise ValueError(f"{name}: not a function of one axis")
+    cls, mode, fill = STRUCT_READERS[name]
+    target = byref_target.target([cls]) if BYREF_TARGET else None
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra and session.plain:
+            ctl = session.controllers.get(1)
+            if ctl is not None and ctl.card is None and ctl.clock._thread is None:
+                res = ctl.resources.get(n)
+                if res is not None and ctl.axes.get(n) is res.ax:
+                    tp = type(p)
+                    if tp is _CArg:
+                        if target is not None:
+                            s = target(p)
+                            if s is p:
+                                s = None
+                        else:
+                            s = p._obj
+                            if type(s) is not cls or byref_address(p) != _addressof(s):
+                                s = None
+                    else:
+                        s = p if tp is cls else None
+                    if s is not None:
+                        bank = ctl.bank
+                        if bank is not None:  # (what the table path does first)
+                            bank.before_axis_call(res.ax)
+                        if res.profile.mode is mode:
+                            fill(res, s)
+                            session.last = None
+                            clock = ctl.clock
+                            if clock.mode is _LOCKSTEP:
+                                return 0
+                            return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
+def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
+    out: dict[str, Callable[..., Callable[..., int]]] = {CLOCK: fast_clock}
+    for names, make in (
+        (READERS, fast_reader),
+        (RAW, fast_raw),
+        (ECAT_READERS, fast_ecat_reader),
+        (AXIS_VALUES, fast_axis_value),
+        (STRUCT_READERS, fast_struct_reader),
+    ):
+        out.update(dict.fromkeys(names, make))
+    return out
+
+
+#: function -> the maker of its fast path, ``make(name, slow, session, advance)`` (the GT
+#: layer puts it in front of the table-checked function)
+FAST_MAKERS = _makers()

@@ -532,3 +532,54 @@ def test_the_homing_status_answers_as_the_table() -> None:
     gt.GTE_Wait(20)
     compare("later")
     assert not bad, "\n".join(bad[:10])
+
+
+def test_the_trap_parameters_answer_as_the_table() -> None:
+    """GT_GetTrapPrm on its fast path (``byref(s)`` or ``s`` of TTrapPrm): the table path's
+    code, fields and reason for each shape, in Trap and in another mode, for an axis that
+    does not exist; a banked axis goes back as the table path gives it back."""
+    ctl = _open()
+    prm = gt.TTrapPrm(acc=0.25, dec=0.5, velStart=1.5, smoothTime=7)
+    assert gt.GT_SetTrapPrm(1, byref(prm)) == 0, gt.GTE_GetLastError()
+    makers = {
+        "byref": lambda: (o := gt.TTrapPrm(), byref(o), o),
+        "object": lambda: (o := gt.TTrapPrm(), o, o),
+        "offset": lambda: (o := (gt.TTrapPrm * 2)(), byref(o, 8), o),
+        "another structure": lambda: (o := gt.TJogPrm(), byref(o), o),
+        "bytes": lambda: (o := (ctypes.c_ubyte * 64)(), byref(o), o),
+        "too small": lambda: (o := (ctypes.c_ubyte * 8)(), byref(o), o),
+        "null": lambda: (o := gt.TTrapPrm(), None, o),
+    }
+    fn = gt.GT_GetTrapPrm
+    bad = []
+
+    def compare(when: str) -> None:
+        for axis in (1, 2, 9):
+            for shape, make in makers.items():
+                got = []
+                for call in (fn, fn.slow):
+                    _, p, o = make()
+                    rc = call(axis, p)
+                    got.append((rc, bytes(o), gt.GTE_GetLastError() if rc else ""))
+                if got[0] != got[1]:
+                    bad.append(f"{when} axis {axis} {shape}: {got[0]} != {got[1]}")
+
+    banked = [n for n in (1, 2) if ctl.resources[n].bank is not None]
+    assert banked, "an axis at rest is in the bank"
+    for n in banked:  # (the call gives it back, as the table path does)
+        assert fn(n, gt.TTrapPrm()) == 0 and ctl.resources[n].bank is None
+    compare("trap")
+    assert gt.GT_PrfJog(1) == 0, gt.GTE_GetLastError()
+    compare("jog")
+    s = gt.TTrapPrm()
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = fn(2, byref(s))
+    pr.disable()
+    table = sum(
+        v[1]
+        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        if func in ("call", "run") and f.endswith("_core.py")
+    )
+    assert rc == 0 and not table, "byref(TTrapPrm) took the table path"
+    assert not bad, "\n".join(bad[:10])
