@@ -1100,14 +1100,33 @@ ECAT_READERS: dict[str, tuple[int, int]] = {
 }
 
 
-def _pdo_entry(ax: Any, acc: Any) -> tuple[Any, Any, Any, Any, int]:
-    """A PDO reader's entry of one axis: ``(axis, accessor, unpack, buffer, offset)``; ``unpack``
-    and the rest are the accessor's own struct reading (what its ``get`` does for a whole-byte
-    entry, read inline), or None when it reads bits (its ``get`` then)."""
+def _pdo_entry(ax: Any, acc: Any, bounds: dict[type, tuple[int, int]]) -> tuple[Any, ...]:
+    """A PDO reader's entry of one axis: ``(axis, accessor, cell, fits)``: ``cell`` the
+    entry's bytes of the process image as a one-item memoryview of its integer type (what
+    the accessor's ``get`` reads for a whole-byte entry, read by one index), None where the
+    accessor reads bits or the machine is big-endian (its ``get`` then); ``fits`` the
+    pointer types that hold every value of the entry (no range check needed)."""
+    if acc is None:
+        return ax, None, None, frozenset()
+    lo, hi = (
+        (-(1 << (acc.bits - 1)), (1 << (acc.bits - 1)) - 1)
+        if acc.signed
+        else (0, (1 << acc.bits) - 1)
+    )
+    fits = frozenset(t for t, (a, b) in bounds.items() if a <= lo and hi <= b)
     fmt = getattr(acc, "_fmt", None)
-    if acc is None or fmt is None:
-        return ax, acc, None, None, 0
-    return ax, acc, fmt.unpack_from, acc._buf, acc._off
+    buf = getattr(acc, "_buf", None)
+    cell = None
+    if fmt is not None and sys.byteorder == "little" and isinstance(buf, memoryview):
+        code = fmt.format[-1]  # ("<i": little-endian, standard sizes)
+        size = fmt.size
+        try:
+            view = buf[acc._off : acc._off + size].cast("B").cast(code)
+        except (TypeError, ValueError):
+            view = None
+        if view is not None and view.itemsize == size and len(view) == 1:
+            cell = view
+    return ax, acc, cell, fits
 
 
 def fast_ecat_reader(
@@ -1208,8 +1227,8 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
             if kept is None or kept[0] is not ax:
                 if len(ACCS) > 4096:
                     ACCS.clear()
-                kept = ACCS[n] = _pdo_entry(ax, ax.io.get(INDEX, SUB))
-            _, acc, unpack, buf, off = kept  # (acc None: not mapped; the table path says so)
+                kept = ACCS[n] = _pdo_entry(ax, ax.io.get(INDEX, SUB), BOUNDS)
+            _, acc, cell, fits = kept  # (acc None: not mapped; the table path says so)
             if acc is not None:
                 tp = type(p)
                 if tp is _CArg:
@@ -1218,9 +1237,10 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                     obj = p
                 else:
                     return slow(*(a for a in (n, p) if a is not _NO))
-                v = acc.get() if unpack is None else unpack(buf, off)[0]
-                lo, hi = BOUNDS[type(obj)]
-                if lo <= v <= hi:  # (else store's refusal: the table path)
+                v = acc.get() if cell is None else cell[0]
+                kind = type(obj)
+                # (a value the type cannot hold: store's refusal, the table path)
+                if kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]:
                     obj.value = v
                     session.last = None
                     if clock.mode is _LOCKSTEP:
