@@ -1359,10 +1359,67 @@ def fast_axis_value(
     return gt
 
 
+def struct_packer(cls: type) -> Callable[..., None] | None:
+    """``pack(s, 0, *values)``: every field of structure class ``cls`` written at once, the
+    same bytes as setting the fields one by one (the same C type per field, its offset, the
+    trailing padding untouched); ``struct.error`` for a value a field's type cannot hold,
+    where the field's own setter would wrap it (the caller then sets the fields).  None for
+    a class with other fields than plain numbers, bit fields or padding between fields."""
+    codes = {1: "b", 2: "h", 4: "i", 8: "q"}
+    fmt, pos = "=", 0
+    try:
+        for field in cls._fields_:  # type: ignore[attr-defined]
+            if len(field) != 2:
+                return None  # (a bit field)
+            name, t = field
+            code = getattr(t, "_type_", None)
+            size = ctypes.sizeof(t)
+            if not isinstance(code, str) or code in "?cuzZPOv":
+                return None
+            if getattr(cls, name).offset != pos:
+                return None  # (padding between fields: struct's pad bytes would write it)
+            if code in "fd":
+                fmt += code
+            elif size in codes:
+                fmt += codes[size] if code.islower() else codes[size].upper()
+            else:
+                return None
+            pos += size
+    except (AttributeError, TypeError, ValueError):
+        return None
+    packer = struct.Struct(fmt)
+    if packer.size != pos or pos > ctypes.sizeof(cls):
+        return None
+    return packer.pack_into
+
+
 def trap_prm_into(res: Any, s: Any) -> None:
     """GT_GetTrapPrm's fields, from the profile's Trap parameters (its table path's too)."""
     prm = res.profile.trap_prm
-    s.acc, s.dec, s.velStart, s.smoothTime = prm.acc, prm.dec, prm.vel_start, prm.smooth_time
+    try:
+        _PACK_TRAP(s, 0, prm.acc, prm.dec, prm.vel_start, prm.smooth_time)  # type: ignore[misc]
+    except (struct.error, TypeError):  # (a value a field wraps: the fields' own setters)
+        s.acc, s.dec, s.velStart, s.smoothTime = prm.acc, prm.dec, prm.vel_start, prm.smooth_time
+
+
+def _pack_trap() -> Any:
+    from .structs import TTrapPrm
+
+    pack = struct_packer(TTrapPrm)
+    if pack is None or [f[0] for f in TTrapPrm._fields_] != [
+        "acc",
+        "dec",
+        "velStart",
+        "smoothTime",
+    ]:
+
+        def pack(s: Any, _: int, *values: Any) -> None:
+            raise TypeError  # (the fields' own setters)
+
+    return pack
+
+
+_PACK_TRAP = _pack_trap()
 
 
 def _struct_readers() -> dict[str, tuple[type, Any, Callable[[Any, Any], None]]]:

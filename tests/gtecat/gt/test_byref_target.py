@@ -169,3 +169,53 @@ def test_pointer_shapes_answer_as_the_table(in_c: bool, monkeypatch: pytest.Monk
             if got[0] != got[1]:
                 bad.append(f"{name} {shape}: {got[0]} != {got[1]}")
     assert not bad, "\n".join(bad)
+
+
+def test_a_structure_packed_at_once_is_the_structure_set_field_by_field() -> None:
+    """fast.struct_packer: for every structure of the GT module it can pack, random values
+    in each field's range give the bytes that setting the fields one by one gives; a value
+    a field would wrap is refused (struct.error: the caller sets the fields then)."""
+    import random
+    import struct
+
+    from gtecat.gt import structs
+
+    rnd = random.Random(5)
+    packed = 0
+    for name in dir(structs):
+        cls = getattr(structs, name)
+        if not (isinstance(cls, type) and issubclass(cls, ctypes.Structure)):
+            continue
+        pack = fast.struct_packer(cls)
+        if pack is None:
+            continue
+        packed += 1
+        for _ in range(50):
+            values = []
+            for _, t in cls._fields_:
+                if t._type_ in "fd":
+                    values.append(
+                        rnd.choice([0.0, -1.5, 1e300, float("inf"), rnd.uniform(-1e6, 1e6)])
+                    )
+                else:
+                    bits = 8 * ctypes.sizeof(t)
+                    lo, hi = (
+                        (0, (1 << bits) - 1)
+                        if t._type_.isupper()
+                        else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+                    )
+                    values.append(rnd.choice([lo, hi, 0, rnd.randint(lo, hi)]))
+            a, b = cls(), cls()
+            ctypes.memset(ctypes.addressof(a), 0xA5, ctypes.sizeof(a))
+            ctypes.memmove(ctypes.addressof(b), ctypes.addressof(a), ctypes.sizeof(a))
+            for (f, _), v in zip(cls._fields_, values, strict=True):
+                setattr(a, f, v)
+            pack(b, 0, *values)
+            assert bytes(a) == bytes(b), (name, values)
+        ints = [k for k, (_, t) in enumerate(cls._fields_) if t._type_ not in "fd"]
+        if ints:
+            values = [0] * len(cls._fields_)
+            values[ints[0]] = 1 << 64
+            with pytest.raises(struct.error):
+                pack(cls(), 0, *values)
+    assert packed >= 2  # TTrapPrm and TJogPrm at least
