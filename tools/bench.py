@@ -262,21 +262,33 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             lambda: bytes([15, 0]),
         ),
     }
-    # the table path (every other function: its checks compiled, then the emulated function's
-    # own work, which these figures include): reported beside the fast path's, not in `worst`
     trap = gt.TTrapPrm()
     short = c_short()
     ps = byref(short)
+    shapes.update(
+        {
+            "GT_GetTrapPrm(1, byref(TTrapPrm))": (
+                lambda: gt.GT_GetTrapPrm(1, byref(trap)),
+                lambda: byref(gt.TTrapPrm()),
+            ),
+            "GT_GetEcatHomingStatus(1, byref(s))": (
+                lambda: gt.GT_GetEcatHomingStatus(1, ps),
+                lambda: byref(c_short()),
+            ),
+            "GT_GetEcatHomingStatus(1, byref(c_short()))": (
+                lambda: gt.GT_GetEcatHomingStatus(1, byref(c_short())),
+                lambda: byref(c_short()),
+            ),
+        }
+    )
+    # the table path (every other function: its checks compiled, then the emulated function's
+    # own work, which these figures include): reported beside the fast path's, not in `worst`
     table = {
-        "GT_GetTrapPrm(1, byref(TTrapPrm))": (
-            lambda: gt.GT_GetTrapPrm(1, byref(trap)),
-            lambda: byref(gt.TTrapPrm()),
-        ),
-        "GT_GetEcatHomingStatus(1, byref(s))": (
-            lambda: gt.GT_GetEcatHomingStatus(1, ps),
-            lambda: byref(c_short()),
-        ),
         "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
+        "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": (
+            lambda: gt.GT_GetDi(0, p),
+            lambda: byref(c_long()),
+        ),
     }
     clock, rng = time.perf_counter, range(block)
     out: dict[str, object] = {}

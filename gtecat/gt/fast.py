@@ -1056,15 +1056,16 @@ SLOW_REASONS: dict[str, str] = {
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
     "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
-    "ecat_axis": "homing and probe status, the axis mode, analog inputs and the scale: table "
-    "path; the per-axis PDO readers that polling loops use are on the fast path",
+    "ecat_axis": "probe status, the axis mode, analog inputs and the scale: table path; the "
+    "per-axis PDO readers and the homing status that polling loops use are on the fast path",
     "ecat_io": "one output bit read: table path",
     "emulator": "emulator helpers for tests, not called in control loops",
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
     "gantry": "a mode query: table path",
-    "gts_card": "the pulse-card (GTS) layer: table path",
+    "gts_card": "the pulse-card (GTS) layer: table path (GT_GetDi and GT_GetDiRaw read every "
+    "axis's input and its configured sense per call: work that outweighs the arguments)",
     "motion": "profile set-up and parameter readers (called once per move); the position and "
-    "speed readers that polling loops use are on the fast path",
+    "speed readers that polling loops use, and GT_GetTrapPrm, are on the fast path",
     "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
     "programs": "motion programs, variables and MRAM: compile and download work outweighs "
     "the arguments",
