@@ -1081,7 +1081,7 @@ def fast_functions() -> frozenset[str]:
     return (
         frozenset(READERS)
         | RAW
-        | {CLOCK}
+        | {CLOCK, CORE}
         | frozenset(ECAT_READERS)
         | frozenset(AXIS_VALUES)
         | frozenset(STRUCT_READERS)
@@ -1492,8 +1492,56 @@ def fast_struct_reader(
     return gt
 
 
+#: the session's core reader on the fast path (it reads no controller)
+CORE = "GT_GetCore"
+
+
+def fast_core(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetCore(p)`` with the fast path in front of the table: ``p`` ``byref(x)`` (no
+    offset) or ``x`` of an integer type the pointer takes, in this process (attached: the
+    controller process answers, the table path); then the call's host latency as the table
+    path runs it (on the selected core's controller, none in lockstep)."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    ok = _scalar_types(FUNCTIONS[name].params[0])
+    target = byref_target.target(ok) if BYREF_TARGET else None
+
+    def gt(p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if not kw and not extra and session.local:
+            tp = type(p)
+            if tp is _CArg:
+                if target is not None:
+                    obj = target(p)
+                    if obj is p:
+                        obj = None
+                else:
+                    obj = p._obj
+                    if type(obj) not in ok or byref_address(p) != _addressof(obj):
+                        obj = None
+            else:
+                obj = p if tp in ok else None
+            if obj is not None and session.note is None:
+                core = session._core  # (1..4: every integer type the pointer takes holds it)
+                obj.value = core
+                session.last = None
+                ctl = session.controllers.get(core)
+                if ctl is None or ctl.clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+        return slow(*(a for a in (p,) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
-    out: dict[str, Callable[..., Callable[..., int]]] = {CLOCK: fast_clock}
+    out: dict[str, Callable[..., Callable[..., int]]] = {CLOCK: fast_clock, CORE: fast_core}
     for names, make in (
         (READERS, fast_reader),
         (RAW, fast_raw),

@@ -583,3 +583,49 @@ def test_the_trap_parameters_answer_as_the_table() -> None:
     )
     assert rc == 0 and not table, "byref(TTrapPrm) took the table path"
     assert not bad, "\n".join(bad[:10])
+
+
+def test_the_core_reader_answers_as_the_table() -> None:
+    """GT_GetCore on its fast path: the table path's code, value and reason in each shape,
+    with no controller open, on an open one, and after GT_SetCore(2)."""
+    makers = {
+        "byref": lambda: (o := ctypes.c_short(), byref(o), o),
+        "object": lambda: (o := ctypes.c_short(), o, o),
+        "long": lambda: (o := ctypes.c_long(), byref(o), o),
+        "offset": lambda: (o := (ctypes.c_short * 2)(), byref(o, 2), o),
+        "narrow": lambda: (o := ctypes.c_int8(), byref(o), o),
+        "null": lambda: (o := ctypes.c_short(), None, o),
+    }
+    fn = gt.GT_GetCore
+    bad = []
+
+    def compare(when: str) -> None:
+        for shape, make in makers.items():
+            got = []
+            for call in (fn, fn.slow):
+                _, p, o = make()
+                rc = call(p)
+                got.append((rc, _value(o), gt.GTE_GetLastError() if rc else ""))
+            if got[0] != got[1]:
+                bad.append(f"{when} {shape}: {got[0]} != {got[1]}")
+
+    compare("closed")
+    _open()
+    compare("open")
+    s = ctypes.c_short()
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = fn(byref(s))
+    pr.disable()
+    table = sum(
+        v[1]
+        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        if func in ("call", "run") and f.endswith("_core.py")
+    )
+    assert rc == 0 and s.value == 1 and not table
+    try:
+        if gt.GT_SetCore(2) == 0:
+            compare("core 2")
+    finally:
+        gt.GT_SetCore(1)
+    assert not bad, "\n".join(bad)
