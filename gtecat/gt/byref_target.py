@@ -94,10 +94,11 @@ def _load() -> tuple[Callable[[Iterable[type]], Callable[[Any], Any]] | None, st
 
         source = (resources.files("gtecat.gt") / "csrc" / "byref_target.c").read_text("utf-8")
         lib = ctypes.CDLL(str(shared_library("byref_target", source, CFLAGS, ())))
-        lib.gtecat_byref_layout.argtypes = [ctypes.c_ssize_t] * 4 + [ctypes.c_void_p]
+        lib.gtecat_byref_layout.argtypes = [ctypes.c_ssize_t] * 4 + [ctypes.c_void_p] * 2
         lib.gtecat_byref_layout.restype = ctypes.c_int
         incref = ctypes.cast(ctypes.pythonapi.Py_IncRef, ctypes.c_void_p).value
-        if lib.gtecat_byref_layout(*layout, incref) != 0:
+        carg = id(type(ctypes.byref(ctypes.c_int())))
+        if lib.gtecat_byref_layout(*layout, incref, carg) != 0:
             return None, "the library refused the layout"
         meth = ctypes.cast(lib.gtecat_byref_target, ctypes.c_void_p).value
         new = ctypes.pythonapi.PyCFunction_NewEx
@@ -136,14 +137,17 @@ def _self_test(make: Callable[[Iterable[type]], Callable[[Any], Any]]) -> str:
     for o in (ctypes.c_int(), ctypes.c_short(), ctypes.c_ulong(), (ctypes.c_ubyte * 8)()):
         cases.append((ctypes.byref(o), o if type(type(o)) is type(long_arr) else None))
     cases.append((ctypes.c_int.from_param(5), None))  # a pointer object with no ctypes object
+    for x in (held, ctypes.c_long(), object(), [5]):  # not pointer objects: themselves
+        cases.append((x, None))
     for p, want in cases:
-        before = (sys.getrefcount(p), sys.getrefcount(p._obj))
+        inner = getattr(p, "_obj", None)
+        before = (sys.getrefcount(p), sys.getrefcount(inner))
         for _ in range(3):
             got = f(p)
             if got is not (p if want is None else want):
                 return f"the byref check answered {got!r} for {p!r}"
             del got
-        if (sys.getrefcount(p), sys.getrefcount(p._obj)) != before:
+        if (sys.getrefcount(p), sys.getrefcount(inner)) != before:
             return "the byref check changed a reference count"
     return ""
 
@@ -154,8 +158,8 @@ if _MAKE is None:
 
 
 def target(types: Iterable[type]) -> Callable[[Any], Any] | None:
-    """``f(p)`` for a ``byref`` object ``p`` (the caller checks ``type(p)``): ``p``'s object
-    when its type (or its type's type: ``type(ctypes.Array)``'s for any array) is one of
-    ``types`` and ``p`` passes the address of that object's own memory; else ``p``.  None
-    where the C function is not available (:data:`REASON`)."""
+    """``f(p)``: for a ``byref`` object ``p``, ``p``'s object when its type (or its type's
+    type: ``type(ctypes.Array)``'s for any array) is one of ``types`` and ``p`` passes the
+    address of that object's own memory; else (any other argument too) ``p``.  None where
+    the C function is not available (:data:`REASON`)."""
     return None if _MAKE is None else _MAKE(types)

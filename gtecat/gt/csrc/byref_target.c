@@ -19,14 +19,16 @@ static ptrdiff_t carg_obj = -1;   /* the object it refers to (NULL for some poin
 static ptrdiff_t ob_type = -1;    /* an object's type */
 static ptrdiff_t b_ptr = -1;      /* a ctypes object's memory */
 static incref_fn incref;
+static void *carg_type;           /* the type of the pointer objects byref() makes */
 
 #define AT(base, off) (*(char **)((char *)(base) + (off)))
 
 int gtecat_byref_layout(ptrdiff_t value, ptrdiff_t obj, ptrdiff_t type, ptrdiff_t mem,
-                        incref_fn inc)
+                        incref_fn inc, void *carg)
 {
-    if (value < 0 || obj < 0 || type < 0 || mem < 0 || !inc)
+    if (value < 0 || obj < 0 || type < 0 || mem < 0 || !inc || !carg)
         return 1;
+    carg_type = carg;
     carg_value = value;
     carg_obj = obj;
     ob_type = type;
@@ -36,13 +38,13 @@ int gtecat_byref_layout(ptrdiff_t value, ptrdiff_t obj, ptrdiff_t type, ptrdiff_
 }
 
 /* A METH_O function whose self is a ctypes array of type addresses ended by 0: for a pointer
- * object p (the caller checked that p is one), p's object when that object's type, or its
- * type's type (an array type's metatype), is in the table and p passes the address of the
- * object's own memory; else p itself.  A new reference either way. */
+ * object p, p's object when that object's type, or its type's type (an array type's
+ * metatype), is in the table and p passes the address of the object's own memory; else
+ * (anything else too) p itself.  A new reference either way. */
 void *gtecat_byref_target(void *self, void *p)
 {
     char *out = p;
-    char *obj = AT(p, carg_obj);
+    char *obj = AT(p, ob_type) == carg_type ? AT(p, carg_obj) : NULL;
     if (obj) {
         char *tp = AT(obj, ob_type);
         char *meta = AT(tp, ob_type);
