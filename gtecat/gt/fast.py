@@ -1081,9 +1081,8 @@ def fast_functions() -> frozenset[str]:
     return (
         frozenset(READERS)
         | RAW
-        | {CLOCK, CORE}
+        | {CLOCK, CORE, HOMING}
         | frozenset(ECAT_READERS)
-        | frozenset(AXIS_VALUES)
         | frozenset(STRUCT_READERS)
     )
 
@@ -1251,51 +1250,11 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
 """
 
 
-def _homing_status() -> Callable[[Any], Any]:
-    """GT_GetEcatHomingStatus's value of an axis (homing_calls.homing_status), its common
-    cases without a weak reference made per call: each axis's own is kept (a run's state is
-    found by it in the same weak dictionary); every other case (the link lost, a run with a
-    reason to note): None, the table path answers."""
-    import weakref
-
-    from . import homing_calls as h
-
-    data = h._STATE.data  # (the weak dictionary's own: weak reference -> the run's state)
-    kept: dict[int, tuple[Any, Any, bool]] = {}
-    getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
-    in_progress = h.HOMING_IN_PROGRESS
-    failed = h.HOMING_FAILED
-
-    def value(ax: Any) -> Any:
-        if getattribute(ax, "link_lost"):
-            return None
-        k = kept.get(id(ax))
-        if k is None or k[0] is not ax:
-            if len(kept) > 4096:
-                kept.clear()
-            # 6041h mapped (else homing_status's 1 naming it: the table path)
-            io = getattribute(ax, "io")
-            k = kept[id(ax)] = (ax, weakref.ref(ax), io.get(0x6041) is not None)
-        st = data.get(k[1])
-        if st is None:
-            return failed if k[2] else None  # no run since the bus came up: not homed
-        if st.active:
-            return None if st.hint is not None else in_progress
-        return st.result
-
-    return value
+#: the homing status reader on the fast path (the vendor's homing loop polls it)
+HOMING = "GT_GetEcatHomingStatus"
 
 
-#: readers of one value of one bus axis that polling loops call, answered after the few checks
-#: their table path makes: function -> a maker of ``value(axis)`` (an
-#: :class:`~gtecat.controller.axis.Axis`), the table's value or None where the table path
-#: must answer (an error, a note)
-AXIS_VALUES: dict[str, Callable[[], Callable[[Any], Any]]] = {
-    "GT_GetEcatHomingStatus": _homing_status,
-}
-
-
-def fast_axis_value(
+def fast_homing_status(
     name: str,
     slow: Callable[..., int],
     session: Any,
@@ -1303,14 +1262,17 @@ def fast_axis_value(
 ) -> Callable[..., int]:
     """``GT_GetEcatHomingStatus(axis, p)`` with the fast path in front of the table: ``p`` a
     ``byref`` (no offset) or the object itself of an integer type the pointer takes, the
-    axis on the in-process controller's bus (core 1, no pulse card, the bus opened); the
-    value is the table's own function's (:data:`AXIS_VALUES`).  A value it raises for, a
-    note it leaves (GTE_GetLastError's reason beside a 0) or any other shape: the table path
-    answers."""
+    axis on the in-process controller's bus (core 1, no pulse card, the bus opened).  The
+    value is :func:`homing_calls.homing_status`'s, read the same way (past the axis bank's
+    guard: a banked axis stays banked) without a weak reference made per call: each axis's
+    own is kept, and a run's state found by it in the same weak dictionary.  Its other cases
+    (the link lost, 6041h not mapped, a run with a reason to note beside the 0) and any other
+    shape: the table path, with its code and reason."""
+    import weakref
+
     from .args import _scalar_types
     from .table import FUNCTIONS
 
-    made: list[Any] = []  # value(axis), made at the first call (its module imports ours)
     ok = _scalar_types(FUNCTIONS[name].params[1])
     bounds = {}
     for t in ok:
@@ -1321,39 +1283,76 @@ def fast_axis_value(
             else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
         )
     target = byref_target.target(ok) if BYREF_TARGET else None
+    getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
+    from ..controller.axis import Axis
+
+    axis_type = Axis  # (a guarded axis, the bank's, is of another class)
+
+    #: axis number -> [axis, a weak reference to it, 6041h mapped, its run's state or None];
+    #: homing_calls makes an axis's state once (its first run) and keeps it as long as the
+    #: axis lives, so a state found is the axis's for good
+    kept: dict[int, list[Any]] = {}
+    #: homing_calls' run states (its weak dictionary's own dict), the values; set at the
+    #: first call (homing_calls imports the GT layer, which imports this module)
+    h: list[Any] = []
 
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(n) is int and not kw and not extra and session.plain:
-            ctl = session.controllers.get(1)
-            if ctl is not None and ctl.card is None and ctl.clock._thread is None:
-                ax = ctl.axes.get(n)
-                m = ctl.master
-                if ax is not None and m is not None and m.opened:
-                    tp = type(p)
-                    if tp is _CArg:
-                        if target is not None:
-                            obj = target(p)
-                            if obj is p:
-                                obj = None
-                        else:
-                            obj = p._obj
-                            if type(obj) not in ok or byref_address(p) != _addressof(obj):
-                                obj = None
+        if type(n) is int and not kw and not extra:
+            try:
+                ctl = session.controllers[1]
+                ax = ctl.axes[n]
+            except KeyError:  # no controller, no such axis: the table path says why
+                return slow(*(a for a in (n, p) if a is not _NO))
+            clock = ctl.clock
+            m = ctl.master
+            if (
+                session.plain  # (in this process, core 1)
+                and clock._thread is None
+                and ctl.card is None
+                and m is not None
+                and m.opened
+            ):
+                tp = type(p)
+                if tp is _CArg:
+                    if target is not None:
+                        obj = target(p)
+                        if obj is p:
+                            obj = None
                     else:
-                        obj = p if tp in ok else None
-                    if obj is not None:
-                        if not made:
-                            made.append(AXIS_VALUES[name]())
-                        v = made[0](ax)
-                        if v is not None:
-                            lo, hi = bounds[type(obj)]
-                            if lo <= v <= hi:
-                                obj.value = v
-                                session.last = None
-                                clock = ctl.clock
-                                if clock.mode is _LOCKSTEP:
-                                    return 0
-                                return advance(ctl, name, 0)
+                        obj = p._obj
+                        if type(obj) not in ok or byref_address(p) != _addressof(obj):
+                            obj = None
+                else:
+                    obj = p if tp in ok else None
+                k = kept.get(n)
+                if k is None or k[0] is not ax:
+                    if not h:
+                        from . import homing_calls as hc
+
+                        h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED))
+                    if len(kept) > 4096:
+                        kept.clear()
+                    io = getattribute(ax, "io")
+                    k = kept[n] = [ax, weakref.ref(ax), io.get(0x6041) is not None, None]
+                st = k[3]
+                if st is None:
+                    st = k[3] = h[0].get(k[1])
+                lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
+                if obj is not None and not lost:
+                    if st is None:  # no run since the bus came up: not homed
+                        v = h[2] if k[2] else None
+                    elif st.active:
+                        v = None if st.hint is not None else h[1]
+                    else:
+                        v = st.result
+                    if v is not None:
+                        lo, hi = bounds[type(obj)]
+                        if lo <= v <= hi:
+                            obj.value = v
+                            session.last = None
+                            if clock.mode is _LOCKSTEP:
+                                return 0
+                            return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
@@ -1541,12 +1540,15 @@ def fast_core(
 
 
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
-    out: dict[str, Callable[..., Callable[..., int]]] = {CLOCK: fast_clock, CORE: fast_core}
+    out: dict[str, Callable[..., Callable[..., int]]] = {
+        CLOCK: fast_clock,
+        CORE: fast_core,
+        HOMING: fast_homing_status,
+    }
     for names, make in (
         (READERS, fast_reader),
         (RAW, fast_raw),
         (ECAT_READERS, fast_ecat_reader),
-        (AXIS_VALUES, fast_axis_value),
         (STRUCT_READERS, fast_struct_reader),
     ):
         out.update(dict.fromkeys(names, make))
