@@ -1479,7 +1479,10 @@ def fast_struct_reader(
                         if bank is not None:  # (what the table path does first)
                             bank.before_axis_call(res.ax)
                         if res.profile.mode is mode:
-                            fill(res, s)
+                            try:
+                                fill(res, s)
+                            except Exception:  # (the table path raises it again: its code)
+                                return slow(n, p)
                             session.last = None
                             clock = ctl.clock
                             if clock.mode is _LOCKSTEP:
