@@ -5,7 +5,7 @@ compiled cycle (:mod:`gtecat.controller.bank_kernel`) and the GT fast path's poi
 (:mod:`gtecat.gt.byref_target`) are built when first asked for, with
 ``$CC`` (else ``cc``, ``gcc``, ``clang``), into ``$GTECAT_CACHE_DIR`` (else
 ``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``) ``/<version>/``.  Here are the pieces
-both share: where the cache is, which compiler, and a one-file shared library build named by
+they share: where the cache is, which compiler, and a one-file shared library build named by
 the digest of its source and flags (a lock file serialises concurrent builders).
 """
 
