@@ -1288,9 +1288,10 @@ def fast_homing_status(
 
     axis_type = Axis  # (a guarded axis, the bank's, is of another class)
 
-    #: axis number -> [axis, a weak reference to it, 6041h mapped, its run's state or None];
-    #: homing_calls makes an axis's state once (its first run) and keeps it as long as the
-    #: axis lives, so a state found is the axis's for good
+    #: axis number -> [axis, a weak reference to it, 6041h mapped, its run's state or None,
+    #: how many states homing_calls had made when it looked]; homing_calls makes an axis's
+    #: state once (its first run) and keeps it as long as the axis lives, so a state found is
+    #: the axis's for good, and none found stays none until that count moves
     kept: dict[int, list[Any]] = {}
     #: homing_calls' run states (its weak dictionary's own dict), the values; set at the
     #: first call (homing_calls imports the GT layer, which imports this module)
@@ -1324,18 +1325,23 @@ def fast_homing_status(
                             obj = None
                 else:
                     obj = p if tp in ok else None
-                k = kept.get(n)
+                try:
+                    k = kept[n]
+                except KeyError:
+                    k = None
                 if k is None or k[0] is not ax:
                     if not h:
                         from . import homing_calls as hc
 
-                        h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED))
+                        h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
                     if len(kept) > 4096:
                         kept.clear()
                     io = getattribute(ax, "io")
-                    k = kept[n] = [ax, weakref.ref(ax), io.get(0x6041) is not None, None]
+                    mapped = io.get(0x6041) is not None
+                    k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
                 st = k[3]
-                if st is None:
+                if st is None and k[4] != h[3][0]:  # (a state made since: look again)
+                    k[4] = h[3][0]
                     st = k[3] = h[0].get(k[1])
                 lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
                 if obj is not None and not lost:
