@@ -1094,12 +1094,14 @@ class AxisBank:
                 self.release_axis_object(ax)
         self.dirty = True
 
-    def before_axis_call(self, ax: Any) -> None:
-        """What :meth:`before_call` does for a GT function naming one existing axis ``ax`` by
-        its first parameter (``axis``, ``profile`` or ``encoder``, no ``count``), for the
-        GT fast path: the bank looks again, and ``ax`` goes back."""
+    def before_axis_call(self, ax: Any, res: Any) -> None:
+        """What :meth:`before_call` does for a GT function naming one existing axis ``ax``
+        (its resources ``res``) by its first parameter (``axis``, ``profile`` or ``encoder``,
+        no ``count``), for the GT fast path: the bank looks again, and ``ax`` goes back.  A
+        row is alive exactly while its resources name this bank (:meth:`_load`,
+        :meth:`_store`), so an axis whose resources do not has nothing to give back."""
         self.dirty = True
-        if self.n_alive:
+        if self.n_alive and res.bank is self:
             self.release_axis_object(ax)
 
     def release_axis_object(self, ax: Any) -> None:

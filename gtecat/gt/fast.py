@@ -1463,37 +1463,44 @@ def fast_struct_reader(
     target = byref_target.target([cls]) if BYREF_TARGET else None
 
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(n) is int and not kw and not extra and session.plain:
-            ctl = session.controllers.get(1)
-            if ctl is not None and ctl.card is None and ctl.clock._thread is None:
-                res = ctl.resources.get(n)
-                if res is not None and ctl.axes.get(n) is res.ax:
-                    tp = type(p)
-                    if tp is _CArg:
-                        if target is not None:
-                            s = target(p)
-                            if s is p:
-                                s = None
-                        else:
-                            s = p._obj
-                            if type(s) is not cls or byref_address(p) != _addressof(s):
-                                s = None
+        if type(n) is int and not kw and not extra:
+            try:
+                ctl = session.controllers[1]
+                res = ctl.resources[n]
+            except KeyError:  # no controller, no such axis: the table path says why
+                return slow(*(a for a in (n, p) if a is not _NO))
+            if (
+                session.plain  # (in this process, core 1)
+                and ctl.card is None
+                and ctl.clock._thread is None
+                and ctl.axes.get(n) is res.ax
+            ):
+                tp = type(p)
+                if tp is _CArg:
+                    if target is not None:
+                        s = target(p)
+                        if s is p:
+                            s = None
                     else:
-                        s = p if tp is cls else None
-                    if s is not None:
-                        bank = ctl.bank
-                        if bank is not None:  # (what the table path does first)
-                            bank.before_axis_call(res.ax)
-                        if res.profile.mode is mode:
-                            try:
-                                fill(res, s)
-                            except Exception:  # (the table path raises it again: its code)
-                                return slow(n, p)
-                            session.last = None
-                            clock = ctl.clock
-                            if clock.mode is _LOCKSTEP:
-                                return 0
-                            return advance(ctl, name, 0)
+                        s = p._obj
+                        if type(s) is not cls or byref_address(p) != _addressof(s):
+                            s = None
+                else:
+                    s = p if tp is cls else None
+                if s is not None:
+                    bank = ctl.bank
+                    if bank is not None:  # (what the table path does first)
+                        bank.before_axis_call(res.ax, res)
+                    if res.profile.mode is mode:
+                        try:
+                            fill(res, s)
+                        except Exception:  # (the table path raises it again: its code)
+                            return slow(n, p)
+                        session.last = None
+                        clock = ctl.clock
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
