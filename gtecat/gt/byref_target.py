@@ -101,9 +101,11 @@ def _load() -> tuple[Callable[[Iterable[type]], Callable[[Any], Any]] | None, st
         if lib.gtecat_byref_layout(*layout, incref, carg) != 0:
             return None, "the library refused the layout"
         meth = ctypes.cast(lib.gtecat_byref_target, ctypes.c_void_p).value
-        new = ctypes.pythonapi.PyCFunction_NewEx
-        new.restype = ctypes.py_object
-        new.argtypes = [ctypes.c_void_p, ctypes.py_object, ctypes.py_object]
+        # (a prototype of our own: ctypes.pythonapi's function objects are shared)
+        proto = ctypes.PYFUNCTYPE(
+            ctypes.py_object, ctypes.c_void_p, ctypes.py_object, ctypes.py_object
+        )
+        new = proto(("PyCFunction_NewEx", ctypes.pythonapi))
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
 
