@@ -7,9 +7,11 @@ array, ``GTN_`` with core 1) and for the raw image (``GT_Get/SetEcatRawData``,
 memoryviews, bytes) are called through the public function and through its table path
 (``.slow``): return code, the memory written and GTE_GetLastError agree.  A profiler (not a
 clock) shows that neither the table path nor the fast path's general way (the shapes it
-checks one by one) ran for them: each is answered by its compiled common path.  Every
-function of the table that takes a pointer is on the fast path, declared only, or has a
-recorded reason.  The default run samples the shapes; GTECAT_LONG=1 runs them all.
+checks one by one) ran for them: each is answered by its compiled common path.  The
+homing status, the Trap parameters and the core reader are held to their table paths the
+same way, in each state that changes their answer.  Every function of the table that takes a
+pointer is on the fast path, declared only, or has a recorded reason.  The default run
+samples the shapes; GTECAT_LONG=1 runs them all.
 """
 
 from __future__ import annotations
