@@ -73,6 +73,7 @@ from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
+from .._attrs import own_dict
 from .axis_status import AxisStatus
 from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
@@ -226,22 +227,6 @@ def _wake(obj: object) -> None:
         bank._release_groups([bank.groups[gi]])
 
 
-def _own_dict(obj: object) -> None:
-    """Give ``obj`` an attribute dict of its own after its class was assigned.
-
-    CPython 3.11 keeps a plain object's attributes inline until something asks for its
-    ``__dict__``; assigning ``__class__`` makes that dict, sharing its class's keys, and the
-    interpreter's specialised attribute read then misses on every read of such a dict (each
-    read takes the generic way: about three times as long, for as long as the object lives,
-    banked or not).  The same attributes in a dict of its own are read the quick way again.
-    Objects with slots only have none."""
-    try:
-        d = _get(obj, "__dict__")
-    except AttributeError:
-        return
-    _set(obj, "__dict__", dict(d))
-
-
 def _guard_class(cls: type) -> type:
     """``cls`` whose every attribute access first releases the object from its bank."""
     g = _GUARDS.get(cls)
@@ -352,6 +337,7 @@ class AxisBank:
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
         self.sampled_samples = 0
+        own_dict(self)  # (the cycle reads these; its helpers look into vars(): gtecat._attrs)
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -887,7 +873,7 @@ class AxisBank:
         for obj in self._guarded_objects(g):
             _OWNER[id(obj)] = (self, gi)
             _set(obj, "__class__", _guard_class(type(obj)))
-            _own_dict(obj)
+            own_dict(obj)  # (a class assigned: see gtecat._attrs)
         return True
 
     def _guarded_objects(self, g: _Group) -> list[object]:

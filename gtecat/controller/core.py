@@ -52,6 +52,7 @@ from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
 from gtecat.eni.reader import read_eni
 
+from .._attrs import own_dict
 from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
 from ..master.clock import Clock, ClockMode
@@ -183,6 +184,8 @@ class Controller:
             from .card import open_card
 
             open_card(self, self.options.card)
+        # its attributes are read by every GT call; vars(ctl) elsewhere must not slow them
+        own_dict(self)  # (gtecat._attrs; before a cycle thread starts)
         if mode is ClockMode.REALTIME:
             self.clock.start_realtime()
 
