@@ -346,8 +346,9 @@ class Kernel:
         }
 
     def cycle(self, t_ns: int, dt: float) -> int:
-        """0: the cycle ran and is committed; 1/2: nothing was written (the numpy cycle
-        must run it: a raw write, a row leaving)."""
+        """0: the cycle ran and is committed; 1, 4, 5: nothing was written (the numpy cycle
+        must run it: a raw write, a table to fill, no memory); 3: nothing was written, the
+        rows marked in ``scratch["s_hit"]`` leave first (an event, a limit)."""
         if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
             self.bind()
         self.io[IN_T_NS] = t_ns

@@ -92,6 +92,13 @@ def _wrap32(d: int) -> int:
 class CaptureUnit:
     """The capture of encoder ``number`` (the module docstring says what it sees)."""
 
+    #: the axis bank may hold this unit's axis (:func:`gtecat.controller.bank.aware_hooks`):
+    #: while the home input keeps its level and the touch probe is idle, :meth:`_post` finds
+    #: no edge, so the bank runs the cycles and the unit catches up at the release
+    bank_post_hook = True
+    #: the 60FDh bits the unit samples every cycle: a change gives the axis back first
+    bank_watch = _HOME_BIT
+
     def __init__(self, ctl: Any, res: AxisResources) -> None:
         self.ctl = ctl
         self.res = res
@@ -109,6 +116,9 @@ class CaptureUnit:
         self._tp_pending = False
         self._tp_seen = 0
         self._tp_error = ""
+        #: settings changed by a call (arm, clear, sense, reset, wiring): a count a watcher
+        #: compares (smart homing: :meth:`SmartHome.quiet`)
+        self.changes = 0
         self.reset_settings()
         self.edges: list[SeenEdge] = []
         self.step = 0.0
@@ -118,6 +128,7 @@ class CaptureUnit:
     # --- settings --------------------------------------------------------------------------
     def reset_settings(self) -> None:
         """GT_Reset: no capture, status 0, every sense 0 (falling edge: switch reached)."""
+        self.changes += 1
         self.mode = CAPTURE_NONE
         self.status = 0
         self.value = 0
@@ -137,6 +148,7 @@ class CaptureUnit:
 
         reverse = switch_sense(self.ctl, "home", self.number)[1]  # the wiring it meets
         if reverse != self.home_reverse:
+            self.changes += 1
             self.home_reverse = reverse
             self._home_prev = self.home_level()
 
@@ -179,6 +191,7 @@ class CaptureUnit:
         if why:
             raise CommandError(why)
         self.refresh_wiring()
+        self.changes += 1
         self.mode = mode
         self.status = 0
         self._edge = edge
@@ -190,6 +203,7 @@ class CaptureUnit:
 
     def clear(self) -> None:
         """GT_ClearCaptureStatus: status 0, the mode armed again."""
+        self.changes += 1
         self.status = 0
 
     def set_sense(self, mode: int, sense: int) -> None:
@@ -197,6 +211,7 @@ class CaptureUnit:
             raise ParameterError(f"mode={mode}: 1 CAPTURE_HOME, 2 CAPTURE_INDEX or 3 CAPTURE_PROBE")
         if sense not in (0, 1):
             raise ParameterError(f"sense={sense}: 0 (falling edge) or 1 (rising edge)")
+        self.changes += 1
         self.sense[mode] = sense
 
     # --- levels -----------------------------------------------------------------------------
@@ -210,6 +225,23 @@ class CaptureUnit:
     def enc(self) -> float:
         """The encoder value of this cycle."""
         return self.res.encoder.pos
+
+    # --- the axis bank ------------------------------------------------------------------------
+    def bank_ready(self) -> bool:
+        """The next cycles' :meth:`_post` can find an edge only where the home input changes
+        its level (which the bank watches): no card latch, the touch probe neither armed nor
+        being written, the home level the one last seen."""
+        if self._card_edges is not None or self._tp_want or self._tp_sent or self._tp_pending:
+            return False
+        return self._home_prev == self.home_level()
+
+    def bank_released(self, cycles: int) -> None:
+        """The bank ran ``cycles`` cycles of the axis, in none of which the home input
+        changed: what :meth:`_post` would have left (this cycle's encoder step, no edge)."""
+        if cycles:
+            enc = self.res.encoder
+            self.step = enc.vel * self.res.cycle_ms if enc.active else 0.0
+            self.edges = []
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:

@@ -263,6 +263,7 @@ class _Abort(Exception):
 
 
 _Steps = Generator[None, None, Any]
+_get = object.__getattribute__  # a claimed axis's objects read without giving it back
 
 
 class SmartHome:
@@ -286,6 +287,15 @@ class SmartHome:
         self._before = 0
         self._raised = 0
         self._expect: int | None = None
+        #: the search waits in a loop that only its own axis can end (the end of the Trap
+        #: leg, a limit or home input of the axis: :meth:`quiet`)
+        self._waiting = False
+        #: (controller time, claim) up to which :meth:`quiet` found nothing to do
+        self._q_due = 0
+        self._q_claim = -1
+        #: what the last step saw of what a call may change (:meth:`quiet`)
+        self._seen_latched = -1
+        self._seen_changes: tuple[int, int] = (-1, -1)
 
     @property
     def running(self) -> bool:
@@ -359,6 +369,8 @@ class SmartHome:
         self._raised = 0
         self._failing = False
         self._expect = None
+        self._waiting = False
+        self._q_claim = -1
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
@@ -403,6 +415,40 @@ class SmartHome:
         return capture_unit(numbering, prm.triggerIndex)
 
     # --- the cycle ----------------------------------------------------------------------------
+    def quiet(self, bank: Any) -> int | None:
+        """None when the next :meth:`cycle` may have something to do; else the cycles after
+        the next one in which it surely has nothing either.
+
+        That holds while the search waits in a Trap leg (or a stop, or the move home) that
+        only its own axis can end and the axis bank runs that axis in the middle of the
+        move: no input of the axis changed (a limit, the home input of its capture unit:
+        each gives the axis back before its cycle), no flag latched, no call touched it
+        (that too gives it back), so the loop would only look and wait again.  The count
+        ends before the cycle that takes the move's end sample (:meth:`AxisBank.trap_quiet`)."""
+        if not self._waiting or self._failing or self._gen is None or bank is None:
+            return None
+        res = self.res
+        if res.bank is not bank:
+            return None
+        r = res.bank_row
+        if not (bank.alive[r] and bank.moving[r]):
+            return None
+        # what a call may have changed since the last step (a call gives the axis back
+        # first, and the bank may take it again before the next cycle): as the step saw it
+        if res.latched != self._seen_latched:
+            return None
+        if (self.unit.changes, self._trigger.changes) != self._seen_changes:
+            return None
+        prof = res.profile
+        if prof.mode != PrfMode.TRAP:
+            return None
+        trap = prof.trap
+        if _get(trap, "stopping") != StopKind.NONE or _get(trap, "_target") != self._expect:
+            return None
+        if not _get(res.ax, "servo_on") or self._limit(1) or self._limit(-1):
+            return None
+        return bank.trap_quiet(r)
+
     def cycle(self) -> None:
         """After every cycle (all axes have read their inputs)."""
         if self._gen is None:
@@ -424,6 +470,8 @@ class SmartHome:
             self._finish()
         except _Abort as a:
             self._fail(a.error, str(a))
+        self._seen_latched = res.latched
+        self._seen_changes = (self.unit.changes, self._trigger.changes)
 
     def _watch(self) -> tuple[HomeError, str] | None:
         res = self.res
@@ -525,11 +573,12 @@ class SmartHome:
     def _search_home(self, d: int, turn: bool) -> _Steps:
         p, st, unit = self.params, self.status, self._trigger
         unit.refresh_wiring()
+        own = unit is self.unit  # (another axis's capture: its edges come any cycle)
         dist = p.searchHomeDistance or UNLIMITED
         if p.edge == 0 and unit.home_level():
             st.stage = Stage.START  # on the switch: leave it first, backwards
             why, _ = yield from self._leg(
-                -d, dist, p.velHigh, lambda: not unit.home_level() or None
+                -d, dist, p.velHigh, lambda: not unit.home_level() or None, own
             )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the axis did not get off the home switch")
@@ -538,7 +587,7 @@ class SmartHome:
         for attempt in (0, 1):
             self._arm(unit, CAPTURE_HOME, p.edge)
             why, pos = yield from self._leg(
-                d, dist, p.velHigh, lambda: unit.pos if unit.status else None
+                d, dist, p.velHigh, lambda: unit.pos if unit.status else None, own
             )
             if why == "event":
                 st.capturePos = _long(round(pos))
@@ -546,7 +595,7 @@ class SmartHome:
                 return pos
             if why == "limit" and turn and attempt == 0:
                 yield from self._stop()  # the home is behind: back over the whole switch
-                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit))
+                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit), own)
                 if why != "event":
                     raise _Abort(HomeError.NO_HOME, "no home switch between the limits")
                 yield from self._stop()
@@ -584,7 +633,9 @@ class SmartHome:
             if not unit.on_card:
                 yield  # the drive's touch probe arms in two cycles (60B8h off, on)
                 yield
-            why, pos = yield from self._leg(d, dist, vel, lambda: unit.pos if unit.status else None)
+            why, pos = yield from self._leg(
+                d, dist, vel, lambda: unit.pos if unit.status else None, unit is self.unit
+            )
             if why == "event":
                 st.capturePos = _long(round(pos))
                 yield from self._stop()
@@ -606,7 +657,8 @@ class SmartHome:
 
     def _search_gpi(self, d: int) -> _Steps:
         p, st, unit = self.params, self.status, self.unit
-        if p.triggerIndex == -1:
+        own = p.triggerIndex == -1  # (a GPI of the IO: it may change in any cycle)
+        if own:
             unit.refresh_wiring()
             level: Callable[[], bool] = unit.home_level
         else:
@@ -617,13 +669,13 @@ class SmartHome:
         for attempt in (0, 1):
             if level():
                 break
-            why, _ = yield from self._leg(d, dist, p.velHigh, lambda: level() or None)
+            why, _ = yield from self._leg(d, dist, p.velHigh, lambda: level() or None, own)
             if why == "event":
                 break
             if why != "limit" or attempt:
                 raise _Abort(HomeError.NO_HOME, "the trigger did not become active")
             yield from self._stop()  # behind: back over the whole active zone, then again
-            why, _ = yield from self._leg(-d, dist, p.velHigh, _passed_level(level))
+            why, _ = yield from self._leg(-d, dist, p.velHigh, _passed_level(level), own)
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the trigger is not active between the limits")
             yield from self._stop()
@@ -633,7 +685,7 @@ class SmartHome:
         def gone() -> float | None:
             return None if level() else unit.enc - 0.5 * unit.step
 
-        why, pos = yield from self._leg(-d, dist, p.velLow, gone)
+        why, pos = yield from self._leg(-d, dist, p.velLow, gone, own)
         if why != "event":
             raise _Abort(HomeError.NO_HOME, "the trigger did not become inactive on the way back")
         st.capturePos = _long(round(pos))
@@ -669,27 +721,38 @@ class SmartHome:
         self._expect = target
 
     def _leg(
-        self, d: int, distance: float, vel: float, watch: Callable[[], Any] | None = None
+        self,
+        d: int,
+        distance: float,
+        vel: float,
+        watch: Callable[[], Any] | None = None,
+        own: bool = True,
     ) -> _Steps:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
-        position) when the limit in ``d`` is reached, or ("end", None)."""
+        position) when the limit in ``d`` is reached, or ("end", None).  ``own``: ``watch``
+        reads inputs of this axis only (its home input, its capture), so the wait may be
+        :meth:`quiet`."""
         trap = self.res.profile.trap
         if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc
         self._begin(d, _long(round(trap.pos + d * distance)), vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
-        while True:
-            yield
-            if watch is not None:
-                value = watch()
-                if value is not None:
-                    return "event", value
-            if self._limit(d) or self.res.latched & bit & ~before:
-                return "limit", self.unit.enc - 0.5 * self.unit.step
-            self._check_plan(trap)
-            if trap.done:
-                return "end", None
+        self._waiting = own
+        try:
+            while True:
+                yield
+                if watch is not None:
+                    value = watch()
+                    if value is not None:
+                        return "event", value
+                if self._limit(d) or self.res.latched & bit & ~before:
+                    return "limit", self.unit.enc - 0.5 * self.unit.step
+                self._check_plan(trap)
+                if trap.done:
+                    return "end", None
+        finally:
+            self._waiting = False
 
     def _check_plan(self, trap: Any) -> None:
         if trap.stopping != StopKind.NONE:
@@ -710,8 +773,12 @@ class SmartHome:
             target = math.ceil(x) if v > 0 else math.floor(x)
             trap.update(target=target)
             self._expect = target
-        while not trap.done:
-            yield
+        self._waiting = True
+        try:
+            while not trap.done:
+                yield
+        finally:
+            self._waiting = False
 
     def _goto(self, target: int, vel: float) -> _Steps:
         trap = self.res.profile.trap
@@ -721,13 +788,17 @@ class SmartHome:
         self._begin(d, target, vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
-        while True:
-            yield
-            if self._limit(d) or self.res.latched & bit & ~before:
-                raise _Abort(HomeError.STAGE, f"a limit on the way to {target}")
-            self._check_plan(trap)
-            if trap.done:
-                return
+        self._waiting = True
+        try:
+            while True:
+                yield
+                if self._limit(d) or self.res.latched & bit & ~before:
+                    raise _Abort(HomeError.STAGE, f"a limit on the way to {target}")
+                self._check_plan(trap)
+                if trap.done:
+                    return
+        finally:
+            self._waiting = False
 
     def _limit(self, d: int) -> bool | None:
         """The limit input in direction ``d``: as wired (module docstring, "Limits"), else
@@ -771,7 +842,98 @@ def _long(v: int) -> int:
 
 # --- the controller side ----------------------------------------------------------------------
 _HOMES: weakref.WeakKeyDictionary[AxisResources, SmartHome] = weakref.WeakKeyDictionary()
-_RUNNING: weakref.WeakKeyDictionary[Any, list[SmartHome]] = weakref.WeakKeyDictionary()
+_RUNNING: weakref.WeakKeyDictionary[Any, _Homings] = weakref.WeakKeyDictionary()
+
+
+class _Homings:
+    """The smart homings running on one controller, stepped after every cycle (its
+    ``post_cycle`` hook, :meth:`cycle`).
+
+    The axis bank may run their axes: a homing step reaches a claimed axis only through its
+    guards, which give it back first (``bank_safe``).  A homing whose axis the bank runs in
+    the middle of a Trap leg has nothing to do until the leg's end sample or an input of the
+    axis changes, which gives the axis back before that cycle (:meth:`SmartHome.quiet`).
+    Such homings are not stepped, and :meth:`quiet_cycles` tells the controller how many
+    cycles it may run at once (:func:`gtecat.controller.core._quiet_cycles`).  Times are the
+    controller's (ns): :attr:`_due` is the start of the first cycle after which some homing
+    may have to step, valid while the bank has released nothing since (:attr:`_seen`)."""
+
+    bank_safe = True
+
+    def __init__(self, ctl: Any) -> None:
+        self._ref = weakref.ref(ctl)
+        self.running: list[SmartHome] = []
+        self._due = 0
+        self._seen = -1
+
+    def add(self, home: SmartHome) -> None:
+        if home not in self.running:
+            self.running.append(home)
+        self._seen = -1
+
+    def clear(self) -> None:
+        self.running.clear()
+        self._seen = -1
+
+    def cycle(self, t: int, dt: int) -> None:
+        """After the cycle that started at ``t``: step every homing that may have to."""
+        running = self.running
+        if not running:
+            return
+        ctl = self._ref()
+        if ctl is None:
+            return
+        bank = ctl.bank
+        if bank is not None and self._seen == bank.releases and t < self._due:
+            return  # nothing to do for any of them in this cycle
+        self._settle(bank, t + dt, step=True)
+
+    def quiet_cycles(self, n: int) -> int:
+        """How many of the next ``n`` cycles no homing has anything to do in."""
+        if not self.running:
+            return n
+        ctl = self._ref()
+        if ctl is None:
+            return n
+        bank = ctl.bank
+        t0, dt = ctl.clock.now_ns, ctl.clock.cycle_ns
+        if bank is None or self._seen != bank.releases or t0 >= self._due:
+            self._settle(bank, t0, step=False)
+        return min(n, max(0, -((t0 - self._due) // dt)))
+
+    def _settle(self, bank: Any, t_next: int, step: bool) -> None:
+        """Find :attr:`_due` for the cycles from the one starting at ``t_next``; ``step``:
+        step the homings that may have something to do in the cycle that just ran."""
+        dt = self._ref().clock.cycle_ns
+        seen = bank.releases if bank is not None else -1
+        due = None
+        for home in list(self.running):
+            r = home.res.bank_row if bank is not None and home.res.bank is bank else -1
+            if (
+                r >= 0
+                and home._q_claim == bank.claim_id[r]
+                and bank.alive[r]
+                and t_next - dt < home._q_due
+            ):
+                d = home._q_due  # found quiet before, the same claim still holds it
+            else:
+                q = home.quiet(bank)
+                if q is None:
+                    home._q_claim = -1
+                    d = t_next
+                    if step:
+                        home.cycle()
+                        if not home.running:
+                            self.running.remove(home)
+                            continue
+                else:
+                    d = home._q_due = t_next + q * dt
+                    home._q_claim = int(bank.claim_id[r])
+            if due is None or d < due:
+                due = d
+        self._due = t_next if due is None else due
+        # a step that gave an axis back may have changed another homing's axis: look again
+        self._seen = seen if bank is not None and bank.releases == seen else -1
 
 
 def smart_home(ctl: Any, axis: int) -> SmartHome:
@@ -787,29 +949,14 @@ def smart_home(ctl: Any, axis: int) -> SmartHome:
     if home is None:
         home = _HOMES[res] = SmartHome(base, res)
     if base not in _RUNNING:
-        _RUNNING[base] = []
-        ref = weakref.ref(base)
-        base.post_cycle.append(lambda t, dt: _cycle(ref()))
+        homings = _RUNNING[base] = _Homings(base)
+        base.post_cycle.append(homings.cycle)
         base.on_reset.append(_reset)
     return home
 
 
 def _register(ctl: Any, home: SmartHome) -> None:
-    running = _RUNNING[ctl]
-    if home not in running:
-        running.append(home)
-
-
-def _cycle(ctl: Any) -> None:
-    if ctl is None:
-        return
-    running = _RUNNING.get(ctl)
-    if not running:
-        return
-    for home in list(running):
-        home.cycle()
-        if not home.running:
-            running.remove(home)
+    _RUNNING[ctl].add(home)
 
 
 def _reset(ctl: Any) -> None:
