@@ -437,6 +437,16 @@ class AxisBank:
             self.disabled_reason = "no drive the bank can run (mapping)"
             return
         self.groups = groups
+        #: every output byte of the bank's slaves (607Ah excluded), the row whose slave owns
+        #: it and what it held at the last re-index: the kernel's raw-write check of the
+        #: claimed ones (updated in place, so the kernel keeps its binding)
+        rx_all = [g.rx_bytes for g in groups]
+        self._rx_all = np.concatenate(rx_all) if rx_all else np.zeros(0, np.intp)
+        self._rx_row = np.concatenate(
+            [np.full(len(g.rx_bytes), g.rows[0], np.int64) for g in groups] or [np.zeros(0)]
+        ).astype(np.int64)
+        self._rx_snap = np.zeros(len(self._rx_all), np.uint8)
+        self._singles: list[tuple[list[_Group], list[int], bool]] | None = None
         self.group_of = [0] * len(axes)
         for gi, g in enumerate(groups):
             for r in g.rows:
@@ -464,9 +474,9 @@ class AxisBank:
         self.enc_pos, self.enc_vel, self.enc_acc = z(n), z(n), z(n)  # vel/acc: at the claim
         self.enc_step0, self.enc_step1 = z(n), z(n)  # the last two encoder steps, pulse
         self.claim_cycle = zi(n, np.int64)
-        #: a number for each claim of a row (a hook that counts on a row staying claimed
-        #: compares it: the same number, the same claim)
-        self.claim_id = zi(n, np.int64)
+        #: a number for each claim of a row, 0 while it is out (a hook that counts on a row
+        #: staying claimed compares it: the same number, the same claim)
+        self.claim_ids = [0] * n
         self._claims = 0
         self.bank_cycles = 0
         self.band, self.hold_ns = z(n), zi(n, np.int64)
@@ -551,6 +561,8 @@ class AxisBank:
         self._rx_idx = np.concatenate(rx) if rx else np.zeros(0, np.intp)
         buf = self.ctl.master.image.buffer
         self._rx_ref = buf.take(self._rx_idx).tobytes()
+        if len(self._rx_all):
+            np.take(buf, self._rx_all, out=self._rx_snap)
         claimed = {g.position for g in self.groups if g.claimed}
         self.ctl.backend.claimed = claimed
         banked = {id(self.axes[r]) for r in range(self.n) if alive[r]}
@@ -815,9 +827,9 @@ class AxisBank:
             if self.n_alive:
                 self.release_all()
             return
-        changed = missed = False
+        changed = missed = loaded = False
         for gs, srows, bad in self._components():
-            if all(g.claimed for g in gs):
+            if gs[0].claimed and (len(gs) == 1 or all(g.claimed for g in gs)):
                 continue
             held = [g for g in gs if g.claimed]
             if held:  # part of a cluster is out: the rest comes back too, then all together
@@ -836,6 +848,7 @@ class AxisBank:
                 self.sampled[r] = True
             for g in gs:
                 self._claim(g)
+            loaded = True
             if srows:
                 _Bypass.on = True
                 try:
@@ -847,6 +860,8 @@ class AxisBank:
                 for c in cl.systems:
                     c.banked = True
             changed = True
+        if loaded:
+            self.csp._flags()
         if changed:
             self._reindex()
         if self.n_alive == self.n:
@@ -876,7 +891,10 @@ class AxisBank:
         finally:
             _Bypass.on = False
         if not pairs and not sampled and not bad:
-            return [([g], [], False) for g in self.groups]
+            singles = self._singles
+            if singles is None:
+                singles = self._singles = [([g], [], False) for g in self.groups]
+            return singles
         group_of = self.group_of
         parent = list(range(len(self.groups)))
 
@@ -931,14 +949,14 @@ class AxisBank:
                 return False
         return True
 
-    def _claim(self, g: _Group) -> bool:
-        if not self._can_claim(g):
-            return False
+    def _claim(self, g: _Group) -> None:
+        """Take the group (the caller found :meth:`_can_claim`); the drives' flags follow
+        in :meth:`refresh`, once for every group it takes."""
         for r in g.rows:
-            self.csp.load(r)
+            self.csp.load(r, flags=False)
             self._load(r)
         g.claimed = True
-        gi = self.groups.index(g)
+        gi = self._gi[id(g)]
         for obj in self._guarded_objects(g):
             _OWNER[id(obj)] = (self, gi)
             _set(obj, "__class__", _guard_class(type(obj)))
@@ -984,7 +1002,7 @@ class AxisBank:
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
         self._claims += 1
-        self.claim_id[r] = self._claims
+        self.claim_ids[r] = self._claims
         b = res.band
         self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.since[r] = -1 if b._since is None else b._since
@@ -1267,6 +1285,7 @@ class AxisBank:
     def _store(self, r: int) -> None:
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = False
+        self.claim_ids[r] = 0
         res.bank = None
         a = float(self.a_last[r])
         ax.prf_pos = a

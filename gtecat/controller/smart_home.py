@@ -292,7 +292,8 @@ class SmartHome:
         self._waiting = False
         #: (controller time, claim) up to which :meth:`quiet` found nothing to do
         self._q_due = 0
-        self._q_claim = -1
+        self._q_claim = 0  # (0: none)
+        self._q_row = 0
         #: what the last step saw of what a call may change (:meth:`quiet`)
         self._seen_latched = -1
         self._seen_changes: tuple[int, int] = (-1, -1)
@@ -370,7 +371,7 @@ class SmartHome:
         self._failing = False
         self._expect = None
         self._waiting = False
-        self._q_claim = -1
+        self._q_claim = 0
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
@@ -906,20 +907,15 @@ class _Homings:
         step the homings that may have something to do in the cycle that just ran."""
         dt = self._ref().clock.cycle_ns
         seen = bank.releases if bank is not None else -1
+        ids = bank.claim_ids if bank is not None else ()
+        t_prev = t_next - dt
         due = None
         for home in list(self.running):
-            r = home.res.bank_row if bank is not None and home.res.bank is bank else -1
-            if (
-                r >= 0
-                and home._q_claim == bank.claim_id[r]
-                and bank.alive[r]
-                and t_next - dt < home._q_due
-            ):
-                d = home._q_due  # found quiet before, the same claim still holds it
-            else:
-                q = home.quiet(bank)
+            d = home._q_due
+            if not (t_prev < d and home._q_claim and ids[home._q_row] == home._q_claim):
+                q = home.quiet(bank)  # (not found quiet before, or another claim since)
                 if q is None:
-                    home._q_claim = -1
+                    home._q_claim = 0
                     d = t_next
                     if step:
                         home.cycle()
@@ -927,8 +923,9 @@ class _Homings:
                             self.running.remove(home)
                             continue
                 else:
+                    r = home.res.bank_row
                     d = home._q_due = t_next + q * dt
-                    home._q_claim = int(bank.claim_id[r])
+                    home._q_row, home._q_claim = r, ids[r]
             if due is None or d < due:
                 due = d
         self._due = t_next if due is None else due

@@ -194,8 +194,10 @@ class CspBank:
             self.windows.append((1 << bit, lo, hi))
         self._flags()
 
-    def load(self, r: int) -> None:
-        """Take row ``r``'s state from its channel (which must be :func:`claimable`)."""
+    def load(self, r: int, flags: bool = True) -> None:
+        """Take row ``r``'s state from its channel (which must be :func:`claimable`);
+        ``flags`` False: the caller calls :meth:`_flags` once after loading several rows,
+        before the next step or output."""
         ch = self.channels[r]
         m = ch.mech
         self.din[r] = ch.digital_inputs
@@ -222,7 +224,8 @@ class CspBank:
         self.fe_timeout[r] = ch.following_error_timeout
         self.nl[r], self.pl[r] = ch._nl, ch._pl
         self.sw_const[r] = _SW_BASE | SW12 | (_SW_REMOTE if ch._settings.remote else 0)
-        self._flags()
+        if flags:
+            self._flags()
 
     def _prepare(self, dt: float) -> None:
         """``Mechanics._prepare`` per row, with math.exp (numpy's exp may differ by an ulp)."""

@@ -73,7 +73,7 @@
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
     X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
     X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
-    X(dwatch, i64) X(lvel, u8) X(h_done, u8)
+    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64)
 
 enum {
 #define X(name, type) F_##name,
@@ -558,14 +558,18 @@ INLINE int commit_cursors(void **ptr, int64_t n)
     return fin_any;
 }
 
-/* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement) */
+/* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement of a
+ * claimed row; a frozen row's image keeps what its scalar objects wrote) */
 INLINE void write_image(void **ptr, const int64_t *io)
 {
     uint8_t *buf = U8(buf);
+    const uint8_t *alive = U8(alive), *frz = U8(frz);
     int64_t i;
     for (i = 0; i < io[IN_N_PLC]; i++) {
         int64_t row = I64(pl_row)[i], val;
         uint32_t u;
+        if (!alive[row] || frz[row])
+            continue;
         switch (I64(pl_col)[i]) {
         case 0: val = I64(c_target)[row]; break;
         case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
@@ -617,9 +621,9 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
 
     /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back (looked at
      * in the first cycle of a call: nothing else writes them until it returns, the cycle
-     * itself writes no such byte) */
+     * itself writes no such byte); rx_row: the row whose slave owns the byte */
     for (i = 0; check_rx && i < io[IN_N_RX]; i++)
-        if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i])
+        if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i] && alive[I64(rx_row)[i]])
             return 1;
 
     /* 2.-7. every claimed row, tentatively (scratch arrays s_*), in three passes over the
@@ -1405,7 +1409,7 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
         RowRun *rs;
         double *bk;
         for (r = 0; r < io[IN_N_RX]; r++) /* a raw write to a claimed slave's outputs */
-            if (buf[I64(rx_idx)[r]] != U8(rx_ref)[r])
+            if (buf[I64(rx_idx)[r]] != U8(rx_ref)[r] && U8(alive)[I64(rx_row)[r]])
                 return 1;
         rs = malloc((size_t)(n > 0 ? n : 1) * sizeof(RowRun));
         bk = malloc((size_t)(n > 0 ? n : 1) * (size_t)(3 * (io[IN_TABLE] + 1)) * sizeof(double));
