@@ -447,6 +447,8 @@ class AxisBank:
         ).astype(np.int64)
         self._rx_snap = np.zeros(len(self._rx_all), np.uint8)
         self._singles: list[tuple[list[_Group], list[int], bool]] | None = None
+        #: the bank row of each of the controller's axes (-1: not in the bank)
+        self._rows_of_axes: list[int] | None = None
         self.group_of = [0] * len(axes)
         for gi, g in enumerate(groups):
             for r in g.rows:
@@ -536,7 +538,7 @@ class AxisBank:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
         alive = self.alive
         self._stale = False
-        self.n_alive = int(alive.sum())
+        self.n_alive = int(np.count_nonzero(alive))
         self.any_prf_link = bool(np.count_nonzero((self.prf_ratio != 1.0) | (self.prf_off != 0.0)))
         self.any_enc_link = bool(np.count_nonzero((self.enc_ratio != 1.0) | (self.enc_off != 0.0)))
         self.any_drive_offset = bool(np.count_nonzero(self.drive_offset))
@@ -565,8 +567,14 @@ class AxisBank:
             np.take(buf, self._rx_all, out=self._rx_snap)
         claimed = {g.position for g in self.groups if g.claimed}
         self.ctl.backend.claimed = claimed
-        banked = {id(self.axes[r]) for r in range(self.n) if alive[r]}
-        self.ctl._run_axes = [ax for ax in self.ctl._axis_list if id(ax) not in banked]
+        rows = self._rows_of_axes
+        if rows is None or len(rows) != len(self.ctl._axis_list):
+            row_of = {id(ax): r for r, ax in enumerate(self.axes)}
+            rows = self._rows_of_axes = [row_of.get(id(ax), -1) for ax in self.ctl._axis_list]
+        out = alive.tolist()
+        self.ctl._run_axes = [
+            ax for ax, r in zip(self.ctl._axis_list, rows, strict=True) if r < 0 or not out[r]
+        ]
         self._lists.clear()
         if self.kernel is not None:
             self.kernel.bound = False
