@@ -354,6 +354,9 @@ class AxisBank:
         self.many_cycles = 0
         #: homing axis-cycles the compiled kernel ran (statistics)
         self.homing_rows_run = 0
+        #: of those, the cycles of drives resting in homing mode after their homing
+        self.rest_rows_run = 0
+        self.n_rest = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
@@ -548,6 +551,7 @@ class AxisBank:
         self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.n_hm = int(np.count_nonzero(self.hm & alive))
+        self.n_rest = int(np.count_nonzero(self.h_done & alive)) if self.n_hm else 0
         self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
         self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
@@ -1730,6 +1734,7 @@ class AxisBank:
         self.bank_cycles += cycles
         self.kernel_cycles += cycles
         self.homing_rows_run += self.n_hm * cycles
+        self.rest_rows_run += self.n_rest * cycles
         self.frozen_rows_run += self.n_frz * cycles
 
     def _count_standing(self) -> None:
