@@ -449,6 +449,14 @@ class AxisBank:
             [np.full(len(g.rx_bytes), g.rows[0], np.int64) for g in groups] or [np.zeros(0)]
         ).astype(np.int64)
         self._rx_snap = np.zeros(len(self._rx_all), np.uint8)
+        #: per output byte its group, per group whether it is claimed and its slave position
+        self._rx_group = np.concatenate(
+            [np.full(len(g.rx_bytes), gi, np.intp) for gi, g in enumerate(groups)]
+            or [np.zeros(0, np.intp)]
+        ).astype(np.intp)
+        self._g_claimed = np.zeros(len(groups), bool)
+        self._g_pos = np.array([g.position for g in groups], np.int64)
+        self._loaded = True  # the rows' constants changed (_reindex looks at them again)
         self._singles: list[tuple[list[_Group], list[int], bool]] | None = None
         #: the bank row of each of the controller's axes (-1: not in the bank)
         self._rows_of_axes: list[int] | None = None
@@ -542,12 +550,17 @@ class AxisBank:
         alive = self.alive
         self._stale = False
         self.n_alive = int(np.count_nonzero(alive))
-        self.any_prf_link = bool(np.count_nonzero((self.prf_ratio != 1.0) | (self.prf_off != 0.0)))
-        self.any_enc_link = bool(np.count_nonzero((self.enc_ratio != 1.0) | (self.enc_off != 0.0)))
-        self.any_drive_offset = bool(np.count_nonzero(self.drive_offset))
-        self.all_external = bool(self.external.all())
-        self.any_sense = bool(np.count_nonzero(self.sense != 1))
-        self.any_band = bool(np.count_nonzero(self.band > 0))
+        if self._loaded:  # the rows' constants (they change only when a row is taken)
+            self._loaded = False
+            ratio, off = self.prf_ratio, self.prf_off
+            self.any_prf_link = bool(np.count_nonzero((ratio != 1.0) | (off != 0.0)))
+            ratio, off = self.enc_ratio, self.enc_off
+            self.any_enc_link = bool(np.count_nonzero((ratio != 1.0) | (off != 0.0)))
+            self.any_drive_offset = bool(np.count_nonzero(self.drive_offset))
+            self.all_external = bool(self.external.all())
+            self.any_sense = bool(np.count_nonzero(self.sense != 1))
+            self.any_band = bool(np.count_nonzero(self.band > 0))
+            self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
         self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.n_hm = int(np.count_nonzero(self.hm & alive))
@@ -562,15 +575,13 @@ class AxisBank:
         self._c_fill = self.kernel is not None and not np.count_nonzero(
             self.moving & alive & (self.nseg <= 0)
         )
-        self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
-        rx = [g.rx_bytes for g in self.groups if g.claimed]
-        self._rx_idx = np.concatenate(rx) if rx else np.zeros(0, np.intp)
+        g_claimed = self._g_claimed
+        self._rx_idx = self._rx_all[g_claimed[self._rx_group]]
         buf = self.ctl.master.image.buffer
         self._rx_ref = buf.take(self._rx_idx).tobytes()
         if len(self._rx_all):
             np.take(buf, self._rx_all, out=self._rx_snap)
-        claimed = {g.position for g in self.groups if g.claimed}
-        self.ctl.backend.claimed = claimed
+        self.ctl.backend.claimed = set(self._g_pos[g_claimed].tolist())
         rows = self._rows_of_axes
         if rows is None or len(rows) != len(self.ctl._axis_list):
             row_of = {id(ax): r for r, ax in enumerate(self.axes)}
@@ -641,7 +652,7 @@ class AxisBank:
         """The scalar state the bank reproduces (module docstring)."""
         ax = self.axes[r]
         res = self.res[r]
-        if res is None or ax.number in self.held:
+        if res is None or ax.number in self.held or res.bank_hold:
             return False
         if not ax.servo_on:
             return self._eligible_frozen(r)
@@ -969,6 +980,8 @@ class AxisBank:
             self._load(r)
         g.claimed = True
         gi = self._gi[id(g)]
+        self._g_claimed[gi] = True
+        self._loaded = True
         for obj in self._guarded_objects(g):
             _OWNER[id(obj)] = (self, gi)
             _set(obj, "__class__", _guard_class(type(obj)))
@@ -1257,6 +1270,7 @@ class AxisBank:
                 if cls in _GUARDS.values():
                     _set(obj, "__class__", cls.__mro__[1])
             g.claimed = False
+            self._g_claimed[self._gi[id(g)]] = False
         self.csp.store(rows)
         for r in rows:
             self._store(r)
@@ -1739,6 +1753,9 @@ class AxisBank:
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""
+        if not self.any_band:
+            self.n_standing_banded = 0
+            return
         st = ~self.moving & ~self.jog & (self.band > 0) & self.alive
         self.n_standing_banded = int(np.count_nonzero(st))
 

@@ -302,6 +302,18 @@ class SmartHome:
     def running(self) -> bool:
         return self._gen is not None
 
+    @property
+    def _waiting(self) -> bool:
+        return self._wait
+
+    @_waiting.setter
+    def _waiting(self, on: bool) -> None:
+        """The search waits in a loop only its own axis can end (:meth:`quiet`); while it
+        runs otherwise, it steps every cycle, so the axis bank leaves the axis alone
+        (``bank_hold``) instead of taking it for a cycle and giving it back."""
+        self._wait = on
+        self.res.bank_hold = self._gen is not None and not on
+
     # --- GT_GoHome ------------------------------------------------------------------------------
     def start(self, prm: HomeParams, caller: Any = None) -> None:
         """Start homing with ``prm`` (already range-checked); HomeRefused when it cannot.
@@ -370,11 +382,11 @@ class SmartHome:
         self._raised = 0
         self._failing = False
         self._expect = None
-        self._waiting = False
         self._q_claim = 0
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
+        self._waiting = False  # (its first step comes after the next cycle)
         _register(self.ctl, self)
 
     def _refuse(self, error: HomeError, reason: str) -> None:
@@ -457,8 +469,7 @@ class SmartHome:
         res = self.res
         if self._failing:
             if res.profile.planner.done or not res.ax.servo_on:
-                self._gen = None
-                self.status.run = 0
+                self._end()
             return
         self._raised |= res.latched & (_POS | _NEG) & ~self._before
         error = self._watch()
@@ -492,14 +503,19 @@ class SmartHome:
             trap.stop(self._trap.dec)
         self._failing = True
         if self.res.profile.planner.done or not self.res.ax.servo_on:
-            self._gen = None
-            self.status.run = 0
+            self._end()
         self.ctl.log(f"Axis {self.number}: smart home error {int(error)}: {reason}")
+
+    def _end(self) -> None:
+        """The homing is over (status run 0); the axis bank may take the axis again."""
+        self._gen = None
+        self.status.run = 0
+        self.res.bank_hold = False
 
     def _finish(self) -> None:
         st = self.status
-        st.stage, st.run = Stage.END, 0
-        self._gen = None
+        st.stage = Stage.END
+        self._end()
         self._clear_raised(self._raised)
         self.res.profile.trap_target = round(self.res.profile.trap.pos)
 
