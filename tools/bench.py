@@ -16,7 +16,7 @@ clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ones holding), 128 axes moving, 12 axes in Trap on the scalar path (bank off: what the modes
 outside the bank compare with); 64 axes homing (method 17); 64 axes in smart homing
 (``GT_GoHome`` modes 20 and 11, each homing timed from start to end with the axes' statuses
-polled every 20 ms); 64 axes homed and left in homing mode 6 (all holding, and half of them
+polled every 100 ms); 64 axes homed and left in homing mode 6 (all holding, and half of them
 with the other half moving in Trap); 12 axes homing (reported); PT,
 Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (target 10:
 every motion mode); two coordinate systems polled every cycle (GT_CrdStatus, GT_GetPrfPos),
