@@ -77,7 +77,10 @@ def _sample(size: int) -> tuple:
     return tuple(sts), tuple(prf), tuple(enc), tuple(homes), bytes(raw)
 
 
-def _run(machine: str, bank: str) -> tuple[list, dict[str, int]]:
+def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
+    """The homings, sampled after every cycle (``step`` 0: one cycle at a time, now and then
+    seven) or after every ``step`` cycles run at once (a long wait: the controller runs
+    them in as few calls as the homings let it)."""
     gt.GT_Close()
     _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank=bank), "open")
     trace: list = []
@@ -102,11 +105,14 @@ def _run(machine: str, bank: str) -> tuple[list, dict[str, int]]:
             _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
         ctl = gt.GTE_Controller()
         size = ctl.layout.gt_raw_bytes
-        for k in range(CYCLES):
-            if k == STOP_AT:
+        k = 0
+        while k < CYCLES:
+            if k <= STOP_AT < k + max(step, 1):
                 _ok(gt.GT_Stop(1 << 9, 0), "stop")
             # mostly one cycle at a time, sometimes many at once (a polling loop)
-            gt.GTE_Wait(1 if k % 50 else 7)
+            wait = step or (1 if k % 50 else 7)
+            gt.GTE_Wait(wait)
+            k += wait
             trace.append(_sample(size))
         bank_ = ctl.bank
         stats = {
@@ -127,8 +133,12 @@ def _run(machine: str, bank: str) -> tuple[list, dict[str, int]]:
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory: pytest.TempPathFactory) -> tuple:
-    machine = _machine(tmp_path_factory.mktemp("smart_home"))
+def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
+    return _machine(tmp_path_factory.mktemp("smart_home"))
+
+
+@pytest.fixture(scope="module")
+def runs(machine: str) -> tuple:
     return _run(machine, "off"), _run(machine, "on")
 
 
@@ -153,3 +163,13 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
     assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
     if stats["kernel"]:
         assert stats["many"] > 20  # cycles the homings let the controller run at once
+
+
+def test_long_waits_give_the_same_homings(machine: str) -> None:
+    """Waits of 37 ms: the controller runs each in as few calls as the homings' quiet cycles
+    allow, the events one cycle at a time in between; every 37th cycle is the scalar one."""
+    (ref, _), (got, stats) = _run(machine, "off", 37), _run(machine, "on", 37)
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"after {37 * (k + 1)} cycles: the bank and the scalar path differ"
+    if stats["kernel"]:
+        assert stats["many"] > 20
