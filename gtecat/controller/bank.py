@@ -276,10 +276,10 @@ def _bank_safe(hook: Any) -> bool:
 def aware_hooks(ax: Any) -> list[Any]:
     """The objects of an axis's post hooks that know the bank (``bank_post_hook``: a capture
     unit, :mod:`gtecat.controller.capture`).  Such an object says when its axis may be held
-    (``bank_ready()``), which 60FDh bits it samples every cycle (``bank_watch``: a change
-    gives the row back before that cycle) and catches up when the row is given back
-    (``bank_released(cycles)``: the cycles the bank ran without it, in which none of those
-    inputs changed)."""
+    (``bank_ready()``), which 60FDh bits matter to it now (``bank_watch``: a change gives the
+    row back before that cycle; read at the claim, so an object whose bits grow gives its
+    row back itself) and catches up when the row is given back (``bank_released(cycles)``:
+    the cycles the bank ran without it, in which none of those bits changed)."""
     out = []
     for h in ax.post_hooks:
         obj = getattr(h, "__self__", None)

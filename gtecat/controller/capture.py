@@ -93,11 +93,11 @@ class CaptureUnit:
     """The capture of encoder ``number`` (the module docstring says what it sees)."""
 
     #: the axis bank may hold this unit's axis (:func:`gtecat.controller.bank.aware_hooks`):
-    #: while the home input keeps its level and the touch probe is idle, :meth:`_post` finds
-    #: no edge, so the bank runs the cycles and the unit catches up at the release
+    #: with the touch probe idle, :meth:`_post` only follows the home input, so the bank runs
+    #: the cycles and the unit catches up at the release; where an edge matters (a home
+    #: capture armed, a reader of the level: :attr:`bank_watch`) the bank gives the axis
+    #: back before the input changes
     bank_post_hook = True
-    #: the 60FDh bits the unit samples every cycle: a change gives the axis back first
-    bank_watch = _HOME_BIT
 
     def __init__(self, ctl: Any, res: AxisResources) -> None:
         self.ctl = ctl
@@ -119,6 +119,7 @@ class CaptureUnit:
         #: settings changed by a call (arm, clear, sense, reset, wiring): a count a watcher
         #: compares (smart homing: :meth:`SmartHome.quiet`)
         self.changes = 0
+        self._level_watch = 0  # readers of the home level or edges every cycle (watch_level)
         self.reset_settings()
         self.edges: list[SeenEdge] = []
         self.step = 0.0
@@ -196,6 +197,8 @@ class CaptureUnit:
         self.status = 0
         self._edge = edge
         self._accept = accept
+        if mode == CAPTURE_HOME:
+            self._watch_grew()
         if not self.on_card:
             self._want_probe(
                 _TP_INDEX if mode == CAPTURE_INDEX else _TP_PROBE if mode == CAPTURE_PROBE else 0
@@ -205,6 +208,8 @@ class CaptureUnit:
         """GT_ClearCaptureStatus: status 0, the mode armed again."""
         self.changes += 1
         self.status = 0
+        if self.mode == CAPTURE_HOME:
+            self._watch_grew()
 
     def set_sense(self, mode: int, sense: int) -> None:
         if mode not in MODE_NAMES:
@@ -227,6 +232,30 @@ class CaptureUnit:
         return self.res.encoder.pos
 
     # --- the axis bank ------------------------------------------------------------------------
+    @property
+    def bank_watch(self) -> int:
+        """The 60FDh bits whose change gives the axis back before its cycle: the home input
+        while a home capture is armed or someone reads its level or edges every cycle
+        (:meth:`watch_level`); else none (the unit takes the level up at the release, and
+        nobody reads the edges the cycles in between made)."""
+        if self._level_watch or (self.mode == CAPTURE_HOME and not self.status):
+            return _HOME_BIT
+        return 0
+
+    def watch_level(self, on: bool) -> None:
+        """A reader of the home level or edges after every cycle starts (stops): smart
+        homing's waits on the home input."""
+        self._level_watch += 1 if on else -1
+        if on:
+            self._watch_grew()
+
+    def _watch_grew(self) -> None:
+        """An axis the bank holds without watching the home input gives it back (its next
+        claim watches it)."""
+        bank = self.res.bank
+        if bank is not None:
+            bank.release_axis_object(self.ax)
+
     def bank_ready(self) -> bool:
         """The next cycles' :meth:`_post` can find an edge only where the home input changes
         its level (which the bank watches): no card latch, the touch probe neither armed nor
@@ -236,12 +265,14 @@ class CaptureUnit:
         return self._home_prev == self.home_level()
 
     def bank_released(self, cycles: int) -> None:
-        """The bank ran ``cycles`` cycles of the axis, in none of which the home input
-        changed: what :meth:`_post` would have left (this cycle's encoder step, no edge)."""
+        """The bank ran ``cycles`` cycles of the axis: what :meth:`_post` would have left (this
+        cycle's encoder step, the home level; no edge: the input did not change where it was
+        watched, and where it was not, nobody reads the edges)."""
         if cycles:
             enc = self.res.encoder
             self.step = enc.vel * self.res.cycle_ms if enc.active else 0.0
             self.edges = []
+            self._home_prev = self.home_level()
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:

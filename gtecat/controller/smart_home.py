@@ -595,7 +595,7 @@ class SmartHome:
         if p.edge == 0 and unit.home_level():
             st.stage = Stage.START  # on the switch: leave it first, backwards
             why, _ = yield from self._leg(
-                -d, dist, p.velHigh, lambda: not unit.home_level() or None, own
+                -d, dist, p.velHigh, lambda: not unit.home_level() or None, own, unit
             )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the axis did not get off the home switch")
@@ -612,7 +612,7 @@ class SmartHome:
                 return pos
             if why == "limit" and turn and attempt == 0:
                 yield from self._stop()  # the home is behind: back over the whole switch
-                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit), own)
+                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit), own, unit)
                 if why != "event":
                     raise _Abort(HomeError.NO_HOME, "no home switch between the limits")
                 yield from self._stop()
@@ -686,13 +686,17 @@ class SmartHome:
         for attempt in (0, 1):
             if level():
                 break
-            why, _ = yield from self._leg(d, dist, p.velHigh, lambda: level() or None, own)
+            why, _ = yield from self._leg(
+                d, dist, p.velHigh, lambda: level() or None, own, unit if own else None
+            )
             if why == "event":
                 break
             if why != "limit" or attempt:
                 raise _Abort(HomeError.NO_HOME, "the trigger did not become active")
             yield from self._stop()  # behind: back over the whole active zone, then again
-            why, _ = yield from self._leg(-d, dist, p.velHigh, _passed_level(level), own)
+            why, _ = yield from self._leg(
+                -d, dist, p.velHigh, _passed_level(level), own, unit if own else None
+            )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the trigger is not active between the limits")
             yield from self._stop()
@@ -702,7 +706,7 @@ class SmartHome:
         def gone() -> float | None:
             return None if level() else unit.enc - 0.5 * unit.step
 
-        why, pos = yield from self._leg(-d, dist, p.velLow, gone, own)
+        why, pos = yield from self._leg(-d, dist, p.velLow, gone, own, unit if own else None)
         if why != "event":
             raise _Abort(HomeError.NO_HOME, "the trigger did not become inactive on the way back")
         st.capturePos = _long(round(pos))
@@ -744,17 +748,21 @@ class SmartHome:
         vel: float,
         watch: Callable[[], Any] | None = None,
         own: bool = True,
+        levels: CaptureUnit | None = None,
     ) -> _Steps:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
         position) when the limit in ``d`` is reached, or ("end", None).  ``own``: ``watch``
         reads inputs of this axis only (its home input, its capture), so the wait may be
-        :meth:`quiet`."""
+        :meth:`quiet`; ``levels``: the capture unit whose home level or edges ``watch``
+        reads (:meth:`CaptureUnit.watch_level`)."""
         trap = self.res.profile.trap
         if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc
         self._begin(d, _long(round(trap.pos + d * distance)), vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
+        if levels is not None:
+            levels.watch_level(True)
         self._waiting = own
         try:
             while True:
@@ -770,6 +778,8 @@ class SmartHome:
                     return "end", None
         finally:
             self._waiting = False
+            if levels is not None:
+                levels.watch_level(False)
 
     def _check_plan(self, trap: Any) -> None:
         if trap.stopping != StopKind.NONE:
