@@ -313,6 +313,10 @@ class SmartHome:
         (``bank_hold``) instead of taking it for a cycle and giving it back."""
         self._wait = on
         self.res.bank_hold = self._gen is not None and not on
+        if on and self.res.bank is None:
+            bank = getattr(self.ctl, "bank", None)
+            if bank is not None:
+                bank.dirty = True  # the axis may be taken now: looked at before the next cycle
 
     # --- GT_GoHome ------------------------------------------------------------------------------
     def start(self, prm: HomeParams, caller: Any = None) -> None:
