@@ -317,6 +317,7 @@ class AxisBank:
         #: RECHECK_CYCLES by each look that leaves some out; 1 again after a release)
         self._wait = 1
         self._settled = False  # the next cycle's first steps ran already (settle)
+        self._declined = False  # the last run of many cycles stopped before a declined one
         #: GT axes kept off the bank (a fault trigger reads their drive every cycle)
         self.held: frozenset[int] = frozenset()
         self.n = 0
@@ -1724,7 +1725,12 @@ class AxisBank:
             n = min(n, self._refill_in - 1)  # no further than the shortest table goes
             if n <= 0:
                 return 0
-        _, done = k.run(t_ns, dt, dt_ns, n)
+        if self._declined:  # the last run stopped before a cycle the kernel declines
+            self._declined = False
+            return 0
+        rc, done = k.run(t_ns, dt, dt_ns, n)
+        # the next cycle is one it declines: cycle() runs it (a row leaving, a table to fill)
+        self._declined = bool(rc) and done > 0
         if done:
             self._countdown -= done - self._settled  # (the first one's count: in settle)
             self._settled = False
