@@ -14,7 +14,10 @@ generated buses of single-axis CSP drives (:mod:`tools.bench_scaling`, lockstep
 clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ``ok``: real-time factors of 12 axes moving in Trap, 64 axes (odd axes moving, even
 ones holding), 128 axes moving, 12 axes in Trap on the scalar path (bank off: what the modes
-outside the bank compare with); 64 axes homing (method 17); 12 axes homing (reported); PT,
+outside the bank compare with); 64 axes homing (method 17); 64 axes in smart homing
+(``GT_GoHome`` modes 20 and 11, each homing timed from start to end with the axes' statuses
+polled every 100 ms); 64 axes homed and left in homing mode 6 (all holding, and half of them
+with the other half moving in Trap); 12 axes homing (reported); PT,
 Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (target 10:
 every motion mode); two coordinate systems polled every cycle (GT_CrdStatus, GT_GetPrfPos),
 and the same with a segment streamed onto each every 10 cycles, bank against scalar path in
@@ -553,7 +556,7 @@ def bench_crd_poll(
 
 def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> dict[str, object]:
     """The many-axes figures, measured one after the other in this run (``only``: those)."""
-    from tools.bench_scaling import crd_plan, run_bus
+    from tools.bench_scaling import crd_plan, run_bus, run_gohome
 
     def rtf(
         n: int, plan: dict[int, str], target: float | None, what: str, bank: str | None = None
@@ -565,6 +568,13 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         return dict.fromkeys(range(1, n + 1), state)
 
     half = {a: "moving" if a % 2 else "idle" for a in range(1, 65)}
+    homed_half = {a: "moving" if a % 2 else "homed6" for a in range(1, 65)}
+
+    def gohome(n: int, mode: int, target: float | None) -> dict[str, object]:
+        r = {"axes": n, "what": f"smart homing (GT_GoHome) mode {mode}, start to end"}
+        r |= run_gohome(n, mode, repeat=repeat)
+        return r if target is None else _figure(r, "rtf", target)
+
     figures: dict[str, Callable[[], dict[str, object]]] = {
         "rtf_12_axes_trap": lambda: rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
         "rtf_64_axes_32_trap_32_holding": lambda: rtf(
@@ -575,6 +585,17 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
             12, every(12, "homing"), None, "drive homing method 17"
         ),
         "rtf_64_axes_homing_17": lambda: rtf(64, every(64, "homing"), 10, "drive homing method 17"),
+        "rtf_64_axes_gohome_20": lambda: gohome(64, 20, 10),
+        "rtf_64_axes_gohome_11": lambda: gohome(64, 11, 10),
+        "rtf_64_axes_homed_mode6": lambda: rtf(
+            64, every(64, "homed6"), 10, "homed (method 35), left in homing mode 6, holding"
+        ),
+        "rtf_64_axes_homed_mode6_32_trap": lambda: rtf(
+            64,
+            homed_half,
+            10,
+            "even axes homed and left in homing mode 6, odd axes moving in Trap",
+        ),
         "rtf_12_axes_trap_scalar": lambda: rtf(
             12, every(12, "moving"), None, "all 12 moving in Trap, scalar path (bank off)", "off"
         ),
