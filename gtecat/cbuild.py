@@ -107,7 +107,8 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
 #: the builder process of :class:`Background` (``python -I -S -c``: no site, no gtecat):
 #: argv[1] is a JSON list of (command, its output, the library's name) tried in turn until
 #: one builds; the first that does is renamed to its name; the lock serialises builders and
-#: a library already there ends the work; what failed goes to stderr (the parent's log file)
+#: a library already there ends the work; what failed goes to stderr (the parent's log file,
+#: removed here when the library is there)
 _BUILDER = r"""
 import json, os, shutil, subprocess, sys
 spec = json.loads(sys.argv[1])
@@ -119,12 +120,14 @@ try:
     import fcntl
 except ImportError:
     fcntl = None
+built = False
 try:
     with open(spec["lock"], "w") as lock:
         if fcntl is not None:
             fcntl.flock(lock, fcntl.LOCK_EX)
         for cmd, out, lib in spec["jobs"]:
             if os.path.isfile(lib):
+                built = True
                 break
             try:
                 r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
@@ -133,9 +136,15 @@ try:
                 continue
             if r.returncode == 0 and not r.stderr.strip():
                 os.replace(out, lib)
+                built = True
                 break
             sys.stderr.write(f"building failed ({' '.join(cmd)}):\n{r.stderr}\n")
 finally:
+    if built:  # else the log says why (the parent reads it)
+        try:
+            os.unlink(spec["log"])
+        except OSError:
+            pass
     shutil.rmtree(spec["tmp"], ignore_errors=True)
 """
 
@@ -173,7 +182,7 @@ class Background:
                 ([*cc, *cflags, "-shared", str(src), "-o", str(out), *libs], str(out), str(lib))
             )
         self._log = tmp.with_suffix(".log")
-        spec = {"lock": str(vdir / ".lock"), "tmp": str(tmp), "jobs": jobs}
+        spec = {"lock": str(vdir / ".lock"), "tmp": str(tmp), "jobs": jobs, "log": str(self._log)}
         with open(self._log, "wb") as err:
             self._proc = subprocess.Popen(
                 [sys.executable, "-I", "-S", "-c", _BUILDER, json.dumps(spec)],
