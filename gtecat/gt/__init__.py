@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import ctypes
 import importlib
-import os
-import sys
 
 from ._core import REGISTRY
 
@@ -105,6 +103,8 @@ def _arm_faults(ctl: object) -> None:
     """The machine TOML's ``[[fault]]`` tables are armed by :mod:`gtecat.faults` on every bus
     that comes up; that package (a tenth of this import's Python) is imported the first time
     a bus has them.  Once imported, its own hook does the arming."""
+    import sys
+
     if getattr(getattr(ctl, "machine", None), "faults", ()) and "gtecat.faults" not in sys.modules:
         from .. import faults
 
@@ -112,6 +112,8 @@ def _arm_faults(ctl: object) -> None:
 
 
 def _install_fault_hook() -> None:
+    import os
+
     from ..controller.core import Controller
 
     if _arm_faults not in Controller.bus_up_hooks:

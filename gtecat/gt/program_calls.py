@@ -56,19 +56,21 @@ import hashlib
 import os
 import weakref
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING as _TYPE_CHECKING
+from typing import Any
 
 from ..controller.core import Controller
 from ..errors import ParameterError
+from ..programs.model import MAX_FUNCTIONS
 from . import _core
 from ._core import fail, gt_function, store, store_array, store_bytes, struct_arg
 from .structs import TCompileInfo, TThreadSts, TVarInfo
 
-if TYPE_CHECKING:
+if _TYPE_CHECKING:
     from ..programs import mram, threads
 
-# (the motion programs' modules are imported by the calls that use them: an application
-# without programs does not pay for them at ``from gtecat import gt``)
+# (the motion programs' modules but their model are imported by the calls that use them: an
+# application without programs does not pay for them at ``from gtecat import gt``)
 
 _RUNTIMES: weakref.WeakKeyDictionary[Controller, threads.ProgramRuntime] = (
     weakref.WeakKeyDictionary()
@@ -213,7 +215,6 @@ def GT_Compile(pFileName: str, pWrongInfo: Any) -> int:
 def GT_Download(ctl: Controller, pFileName: str) -> int:
     """Load a program image (and the .ini beside it) into the controller (entry 10)."""
     from ..programs import image
-    from ..programs.model import MAX_FUNCTIONS
     from ..programs.verify import ImageInvalid, verify
 
     try:
