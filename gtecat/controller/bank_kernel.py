@@ -101,8 +101,10 @@ def prebuild() -> None:
                 ]
             )
         )
-    except Exception as e:  # no compiler, no cache folder: the numpy cycle alone
+    except NativeBuildError as e:  # no compiler, no cache folder: the numpy cycle alone
         _LIB_REASON = f"{type(e).__name__}: {e}"
+    except Exception as e:  # no builder process (no sys.executable): built here when asked
+        log.info("the bank kernel's build could not start beside the bus: %s", e)
 
 
 def settled() -> bool:
