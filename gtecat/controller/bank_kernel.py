@@ -310,7 +310,7 @@ class Kernel:
         windows = {value: (lo, hi) for value, lo, hi in csp.windows}
         key = (
             tuple((id(lo), id(hi), lo.shape) for lo, hi in windows.values()),
-            *self._placement_key(),
+            self._placement_key(),
         )
         if key == self._extra_key and self._extra_last is not None:
             return dict(self._extra_last)
@@ -330,33 +330,34 @@ class Kernel:
         return dict(extra)
 
     def _placement_key(self) -> tuple[Any, ...]:
-        """What :meth:`_placements` builds its arrays from."""
+        """What :meth:`_placements` builds its arrays from: every placement and every output
+        byte of the bank's slaves, fixed when the bank is built (the kernel skips the rows it
+        does not run: a frozen row's image keeps what its scalar objects wrote)."""
         bank = self.bank
-        alive, frz = bank.alive.tolist(), bank.frz.tolist()
-        # a frozen row's image keeps what its scalar objects wrote
-        plc = tuple(p for p in bank._plc if alive[p[0]] and not frz[p[0]])
-        return plc, tuple(bank._rx_idx), bytes(bank._rx_ref) if bank._rx_ref else b""
+        return id(bank._plc), id(bank._rx_all)
 
-    def _placements(self, plc: tuple[Any, ...]) -> dict[str, np.ndarray]:
-        """``plc``: the placements of the rows the kernel writes (:meth:`_placement_key`)."""
+    def _placements(self, key: tuple[Any, ...]) -> dict[str, np.ndarray]:
+        """The placements of every row and the output bytes a raw write may change, with
+        their rows and the bytes the last re-index saw (``rx_ref``: updated in place)."""
         bank = self.bank
+        plc = bank._plc
         self.io[IN_N_PLC] = len(plc)
-        rx = np.asarray(bank._rx_idx, np.int64)
+        rx = bank._rx_all
         self.io[IN_N_RX] = len(rx)
         return {
             "pl_row": np.array([p[0] for p in plc] or [0], np.int64),
             "pl_off": np.array([p[1] for p in plc] or [0], np.int64),
             "pl_size": np.array([p[2] for p in plc] or [0], np.int64),
             "pl_col": np.array([COLUMNS[p[3]] for p in plc] or [0], np.int64),
-            "rx_idx": rx if len(rx) else np.zeros(1, np.int64),
-            "rx_ref": np.frombuffer(bank._rx_ref, np.uint8).copy()
-            if bank._rx_ref
-            else np.zeros(1, np.uint8),
+            "rx_idx": rx.astype(np.int64) if len(rx) else np.zeros(1, np.int64),
+            "rx_row": bank._rx_row if len(rx) else np.zeros(1, np.int64),
+            "rx_ref": bank._rx_snap if len(rx) else np.zeros(1, np.uint8),
         }
 
     def cycle(self, t_ns: int, dt: float) -> int:
-        """0: the cycle ran and is committed; 1/2: nothing was written (the numpy cycle
-        must run it: a raw write, a row leaving)."""
+        """0: the cycle ran and is committed; 1, 4, 5: nothing was written (the numpy cycle
+        must run it: a raw write, a table to fill, no memory); 3: nothing was written, the
+        rows marked in ``scratch["s_hit"]`` leave first (an event, a limit)."""
         if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
             self.bind()
         self.io[IN_T_NS] = t_ns

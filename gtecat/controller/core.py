@@ -52,6 +52,7 @@ from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
 from gtecat.eni.reader import read_eni
 
+from .._attrs import own_dict
 from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
 from ..master.clock import Clock, ClockMode
@@ -187,6 +188,8 @@ class Controller:
             from .card import open_card
 
             open_card(self, self.options.card)
+        # its attributes are read by every GT call; vars(ctl) elsewhere must not slow them
+        own_dict(self)  # (gtecat._attrs; before a cycle thread starts)
         if mode is ClockMode.REALTIME:
             self.clock.start_realtime()
 
@@ -354,7 +357,8 @@ class Controller:
 
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has
-        anything to do in them: every axis claimed by the bank, no hook, the bus steady
+        anything to do in them: every axis claimed by the bank, no hook (or only hooks that
+        say they stay quiet that long: :func:`_quiet_cycles`), the bus steady
         (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
         one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
         cycles run, 0 when the next one must go through :meth:`_cycle`.
@@ -374,7 +378,6 @@ class Controller:
             bank is None
             or bank.kernel is None
             or self.before_cycle
-            or self.post_cycle
             or self.sample
             or self._links_down
             or self.clock._run_cycle != self._cycle
@@ -385,17 +388,18 @@ class Controller:
         if self._run_axes:
             return 0
         n = min(n, self.BATCH_CYCLES)
-        for f in self.pre_cycle:
-            n = _quiet_cycles(f, n)
-            if n <= 0:
-                return 0
+        for hooks in (self.pre_cycle, self.post_cycle):
+            for f in hooks:
+                n = _quiet_cycles(f, n)
+                if n <= 0:
+                    return 0
         master = self.master
         if master is None or not master.steady():
             return 0
         done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, n)
         master.cycles += done
         if done:
-            for f in self.pre_cycle:
+            for f in (*self.pre_cycle, *self.post_cycle):
                 passed = getattr(getattr(f, "__self__", None), "cycles_passed", None)
                 if passed is not None:
                     passed(done)
@@ -484,10 +488,11 @@ class Controller:
 
 
 def _quiet_cycles(hook: Callable[[int, int], None], n: int) -> int:
-    """How many of the next ``n`` cycles a ``pre_cycle`` hook has nothing to do in (0: it
-    must run in the next one); its object says so: ``quiet_cycles(n)`` (the fault
-    injector: until its first trigger is due), or ``bank_quiet()`` for all or none (the
-    coordinate systems while the axis bank steps every running one).  After cycles run
+    """How many of the next ``n`` cycles a ``pre_cycle`` or ``post_cycle`` hook has nothing
+    to do in (0: it must run in the next one); its object says so: ``quiet_cycles(n)`` (the
+    fault injector: until its first trigger is due; smart homing: until a homing's Trap leg
+    ends), or ``bank_quiet()`` for all or none (the coordinate systems while the axis bank
+    steps every running one).  After cycles run
     at once, the object's ``cycles_passed(k)``, if it has one, counts them."""
     obj = getattr(hook, "__self__", None)
     horizon = getattr(obj, "quiet_cycles", None)

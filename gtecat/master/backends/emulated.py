@@ -106,14 +106,25 @@ class EmulatedBackend(Backend):
 
     @claimed.setter
     def claimed(self, positions: set[int] | frozenset[int]) -> None:
-        self._claimed = frozenset(positions)
-        self._run_plan = [e for e in self._plan if e[0].position not in self._claimed]
-        self._claimed_slaves = tuple(e[0] for e in self._plan if e[0].position in self._claimed)
-        self._claimed_wkc = sum(
-            2 * (o is not None) + (i is not None)
-            for sl, o, i in self._plan
-            if sl.position in self._claimed
-        )
+        self._claimed = claimed = frozenset(positions)
+        plan = self._plan
+        if getattr(self, "_plan_of", None) is not plan or len(self._plan_pos) != len(plan):
+            self._plan_of = plan
+            self._plan_pos = [e[0].position for e in plan]
+            self._plan_wkc = [2 * (o is not None) + (i is not None) for _, o, i in plan]
+            self._claimed_memo: dict[frozenset[int], tuple] = {}
+        memo = self._claimed_memo.get(claimed)  # (the bank gives back and takes the same few)
+        if memo is None:
+            inside = [p in claimed for p in self._plan_pos]
+            memo = (
+                [e for e, c in zip(plan, inside, strict=True) if not c],
+                tuple(e[0] for e, c in zip(plan, inside, strict=True) if c),
+                sum(w for w, c in zip(self._plan_wkc, inside, strict=True) if c),
+            )
+            if len(self._claimed_memo) > 256:
+                self._claimed_memo.clear()
+            self._claimed_memo[claimed] = memo
+        self._run_plan, self._claimed_slaves, self._claimed_wkc = memo
 
     def _slave(self, position: int) -> VirtualSlave:
         if position in self.unplugged or not 0 <= position < len(self.slaves):
