@@ -76,9 +76,11 @@ from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
 from .._attrs import own_dict
+from ..master.clock import ClockMode
 from .axis_status import AxisStatus
 from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
+from .bank_kernel import settled as kernel_settled
 from .bank_kernel import wanted as kernel_wanted
 from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
 from .crd.system import Delay, Motion
@@ -330,23 +332,26 @@ class AxisBank:
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
         self.rows_run = 0
         #: the compiled plain cycle (gtecat.controller.bank_kernel), None: numpy alone; the
-        #: library is built (first use on a machine) and loaded here, at GT_InitEcatComm,
-        #: never inside a cycle
+        #: library is loaded here, at GT_InitEcatComm.  Its first build on a machine runs in
+        #: a process of its own (started by GT_Open): ``auto`` does not wait for it, the bank
+        #: runs numpy meanwhile and takes the kernel at the first cycle after the build
+        #: (:meth:`_take_kernel`); ``c`` and the realtime clock wait here
         self.kernel: Kernel | None = None
         self._kernel_lib: Any = None
+        self.kernel_due = False  # the build runs: the kernel is taken when it is there
         self.table = TABLE
         self._c_fill = False  # the kernel refills every moving row's table itself
         self._fill_out: np.ndarray | None = None
-        kmode = kernel_wanted()
+        self._kmode = kmode = kernel_wanted()
         if kmode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
         else:
-            self._kernel_lib, self.kernel_reason = kernel_library()
-            if self._kernel_lib is None and kmode == "c":
-                ctl.log(
-                    "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
-                    f"the bank ({self.kernel_reason})"
-                )
+            wait = kmode == "c" or ctl.clock.mode is ClockMode.REALTIME
+            self._kernel_lib, self.kernel_reason = kernel_library(wait)
+            if self._kernel_lib is None and not self.kernel_reason:
+                self.kernel_due = True
+                self.kernel_reason = "the compiled cycle is being built (numpy meanwhile)"
+            self._kernel_missing()
         #: the compiled fills of static PT tables (bank_modes), None without the kernel
         self.pt_run = PtRun(self._kernel_lib) if self._kernel_lib is not None else None
         self.pt_fill: PtFill | None = None  # (made with the rows)
@@ -364,6 +369,37 @@ class AxisBank:
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
         self.sampled_samples = 0
         own_dict(self)  # (the cycle reads these; its helpers look into vars(): gtecat._attrs)
+
+    def _kernel_missing(self) -> None:
+        if self._kernel_lib is None and not self.kernel_due and self._kmode == "c":
+            self.ctl.log(
+                "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
+                f"the bank ({self.kernel_reason})"
+            )
+
+    def _take_kernel(self) -> None:
+        """The kernel's build ended (:attr:`kernel_due`): every axis goes back to its objects
+        (exactly, as at any release) and the rows are made again for the compiled cycle
+        (its short tables, its homing and resting rows) at the next refresh; without a
+        library, numpy goes on and :attr:`kernel_reason` says why."""
+        self.kernel_due = False
+        lib, self.kernel_reason = kernel_library()
+        self._kernel_missing()
+        if lib is None:
+            return
+        if self.built:
+            self.release_all()
+            self.built = False
+            self.groups = []
+            self.n = self.n_alive = 0
+            self.alive = np.zeros(0, bool)
+            self.disabled_reason = ""
+            self.kernel = self.pt_fill = None
+            for name in ("_gi", "_cluster_of", "order"):
+                self.__dict__.pop(name, None)
+        self._kernel_lib = lib
+        self.pt_run = PtRun(lib)
+        self.dirty = True
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -1530,6 +1566,8 @@ class AxisBank:
             self._settled = True
 
     def _begin(self) -> None:
+        if self.kernel_due and kernel_settled():
+            self._take_kernel()
         self._countdown -= 1
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)

@@ -24,7 +24,6 @@ from __future__ import annotations
 import ctypes
 import logging
 import os
-import threading
 from importlib import resources
 from operator import attrgetter
 from pathlib import Path
@@ -32,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..cbuild import NativeBuildError, shared_library
+from ..cbuild import Background, NativeBuildError, shared_library
 
 if TYPE_CHECKING:
     from .bank import AxisBank
@@ -77,48 +76,58 @@ _SCRATCH = (
 _LIB: Any = None
 _LIB_REASON = ""
 _FIELDS: list[tuple[str, Any]] = []
-#: the build started ahead (:func:`prebuild`): the thread, then its library path or error
-_AHEAD: list[Any] = []
+#: the build started ahead (:func:`prebuild`), in a process of its own
+_AHEAD: list[Background] = []
 
 
 def prebuild() -> None:
-    """Start building the kernel in the background, where it is not built yet.
+    """Start building the kernel in a process of its own, where it is not built yet.
 
-    GT_InitEcatComm calls this before it reads the ENI: the first build on a machine (about
-    a second of the compiler) then runs beside the reading of the file and the making of the
-    drives, and :func:`library` (the bank, at the end of GT_InitEcatComm) waits for it.
-    The thread is not a daemon: a process that ends before it still finishes the build
-    (the next process finds it)."""
+    GT_Open calls this: the first build on a machine (about a second of the compiler) runs
+    beside everything else (Python compiling gtecat's modules on a first run, reading the
+    ENI, making the drives); a bank made meanwhile runs its numpy cycle and takes the kernel
+    when the build is there (:func:`library` with ``wait=False``, :func:`settled`).  The
+    builder finishes even when this process ends first: the next process finds it."""
+    global _LIB_REASON
     if _LIB is not None or _LIB_REASON or _AHEAD or wanted() == "numpy":
         return
+    try:
+        source = _source()
+        _AHEAD.append(
+            Background(
+                [
+                    ("bank_kernel", source, CFLAGS, ("-lm",)),
+                    ("bank_kernel", source, PLAIN_CFLAGS, ("-lm",)),
+                ]
+            )
+        )
+    except NativeBuildError as e:  # no compiler, no cache folder: the numpy cycle alone
+        _LIB_REASON = f"{type(e).__name__}: {e}"
+    except Exception as e:  # no builder process (no sys.executable): built here when asked
+        log.info("the bank kernel's build could not start beside the bus: %s", e)
 
-    def run() -> None:
-        try:
-            _AHEAD.append(build(CFLAGS))
-        except Exception as e:  # library() reports it
-            _AHEAD.append(e)
 
-    thread = threading.Thread(target=run, name="gtecat bank kernel build")
-    _AHEAD.append(thread)
-    thread.start()
+def settled() -> bool:
+    """Whether :func:`library` answers at once (the kernel loaded, refused, or its build
+    ended), never waiting; cheap enough to ask every cycle."""
+    return _LIB is not None or bool(_LIB_REASON) or not _AHEAD or _AHEAD[0].done()
 
 
 def _built() -> Path:
     """The kernel's library file: the build started ahead, else one built now."""
     if not _AHEAD:
         return build(CFLAGS)
-    _AHEAD[0].join()
-    result = _AHEAD[1]
-    if isinstance(result, Exception):
-        raise result
-    return result
+    return _AHEAD[0].wait()
 
 
-def library() -> tuple[Any, str]:
-    """(the loaded kernel or None, why not); built and loaded once per process."""
+def library(wait: bool = True) -> tuple[Any, str]:
+    """(the loaded kernel or None, why not); built and loaded once per process.
+    ``wait`` False: (None, "") while the build started ahead runs."""
     global _LIB, _LIB_REASON
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
+    if not wait and not settled():
+        return None, ""
     try:
         lib = ctypes.CDLL(str(_built()))
         lib.bank_kernel_fields.restype = ctypes.c_char_p

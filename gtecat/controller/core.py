@@ -140,6 +140,10 @@ class Controller:
             raise ParameterError(
                 f"backend {self.options.backend!r} unknown; use emulated or pysoem"
             )
+        if self.options.bank != "off" and self.options.backend == "emulated":
+            # a first build of the bank's compiled cycle on this machine runs in a process of
+            # its own beside the rest of the bring-up (the bank takes it when it is there)
+            prebuild_kernel()
         cycle_ns = round((self.options.cycle_ms or 1.0) * 1_000_000)
         self.clock = Clock(
             self._cycle,
@@ -240,7 +244,7 @@ class Controller:
             )
         banked = self.options.bank != "off" and self.options.backend == "emulated"
         if banked:
-            prebuild_kernel()  # a first build on this machine runs beside the reading below
+            prebuild_kernel()  # (GT_Open started it; again for options changed since)
         try:
             config = read_eni(path, _eni_cache(path))
         except EniError:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from gtecat.drives.coe import next_counter
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
@@ -338,9 +339,22 @@ class EmulatedBackend(Backend):
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
-        self._client(position).download(
-            index, subindex, bytes(data), complete_access=complete_access
-        )
+        client = self._client(position)
+        data = bytes(data)
+        if (
+            0 < len(data) <= 4
+            and 0 <= index <= 0xFFFF
+            and 0 <= subindex <= 0xFF
+            and self.capture is None
+            and getattr(slave.mailbox, "sdo_server_only", False)
+        ):
+            # nothing sees the frames: the server's own write, counters and abort, unframed
+            client.counter = next_counter(client.counter)
+            slave.sdo.download_in_process(  # type: ignore[attr-defined]
+                index, subindex, data, complete_access, slave.al_state
+            )
+            return
+        client.download(index, subindex, data, complete_access=complete_access)
 
 
 _IO_STEP = IoSlave.step
