@@ -120,10 +120,11 @@ class NoAnswer(Exception):
     """No answer to a frame within the timeout (after the resends)."""
 
 
-#: how long :meth:`RawMaster.transact` waits for a frame's answer, resends included: the
-#: server is Python beside the suite's workers (in a thread of the test's own process in some
-#: tests), and on a loaded 2-CPU machine an answer took more than the 0.5 s this once was;
-#: only a frame that is never answered waits this long
+#: how long :meth:`RawMaster.transact` waits for a frame's answer, resends included, and the
+#: slave side for what it does after a frame (an EEPROM read, a state change, a mailbox
+#: answer): the server is Python beside the suite's workers (in a thread of the test's own
+#: process in some tests), and on a loaded 2-CPU machine an answer took more than the 0.5 s
+#: this once was; only what never comes waits this long
 ANSWER_S = 5.0
 
 
@@ -230,10 +231,10 @@ class RawMaster:
             stations.append(station)
         return stations
 
-    def sii_word(self, station: int, word: int, timeout: float = 0.5) -> int:
+    def sii_word(self, station: int, word: int, timeout: float = ANSWER_S) -> int:
         return struct.unpack("<H", self.sii_read(station, word, timeout)[:2])[0]
 
-    def sii_read(self, station: int, word: int, timeout: float = 0.5) -> bytes:
+    def sii_read(self, station: int, word: int, timeout: float = ANSWER_S) -> bytes:
         """Four (or eight) bytes of the EEPROM from ``word`` on (ETG.1000.4 Table 48)."""
         self.fpwr(station, 0x0502, struct.pack("<HI", 0x0100, word))
         end = time.monotonic() + timeout
@@ -260,7 +261,7 @@ class RawMaster:
         data = self.fprd(station, 0x0130, 6).data
         return data[0], struct.unpack_from("<H", data, 4)[0]
 
-    def request_state(self, station: int, state: int, timeout: float = 2.0) -> tuple[int, int]:
+    def request_state(self, station: int, state: int, timeout: float = ANSWER_S) -> tuple[int, int]:
         self.fpwr(station, 0x0120, struct.pack("<H", state))
         end = time.monotonic() + timeout
         while True:
@@ -293,7 +294,7 @@ class RawMaster:
         return self.fpwr(station, start, msg.ljust(length, b"\0"))
 
     def mbx_read(
-        self, station: int, sm: tuple[int, int, int, int], timeout: float = 1.0
+        self, station: int, sm: tuple[int, int, int, int], timeout: float = ANSWER_S
     ) -> bytes | None:
         """Poll SM1 until it is full, then read it whole (None when nothing came)."""
         start, length = sm[2], sm[3]
