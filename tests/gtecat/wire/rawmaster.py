@@ -54,10 +54,14 @@ def why_not_root() -> str | None:
 SOEM_FRAME_US = 500_000
 
 
+#: SOEM's own EC_TIMEOUTRET (2 ms): for a test in which nothing answers by design
+SOEM_DEFAULT_FRAME_US = 2_000
+
+
 @contextlib.contextmanager
-def patient_soem() -> Iterator[None]:
-    """pysoem's per-frame timeout at :data:`SOEM_FRAME_US` for the block (an older pysoem
-    without ``settings`` keeps its own)."""
+def patient_soem(frame_us: int = SOEM_FRAME_US) -> Iterator[None]:
+    """pysoem's per-frame timeout at ``frame_us`` for the block (an older pysoem without
+    ``settings`` keeps its own)."""
     import pysoem
 
     settings = getattr(pysoem, "settings", None)
@@ -65,7 +69,7 @@ def patient_soem() -> Iterator[None]:
         yield
         return
     old = settings.timeouts.ret
-    settings.timeouts.ret = SOEM_FRAME_US
+    settings.timeouts.ret = frame_us
     try:
         yield
     finally:
