@@ -29,7 +29,7 @@ from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources
 from ..master.clock import ClockMode
 from . import byref_target
-from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
+from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source, holds_pointers
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
@@ -481,9 +481,14 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
 CLOCK = "GT_GetClock"
 #: the largest value each integer type of ``_INTS`` holds
 _INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
-#: the clock's integer types: the vendor's ``unsigned long *pClock`` (a Python caller's
-#: ``c_ulong``) beside the signed ones
-_CLOCK_INTS = _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
+#: the clock's integer types: those that hold every value of the vendor's ``unsigned long
+#: *pClock`` (a Python caller's ``c_ulong``; a signed type wider than 32 bits), as the
+#: table's rule decides by the type (``c_int32`` is refused there, whatever the clock)
+_CLOCK_INTS = frozenset(
+    t
+    for t in _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
+    if t._type_.isupper() or ctypes.sizeof(t) > 4
+)
 _INT_MAX.update(
     {t: (1 << (8 * ctypes.sizeof(t))) - 1 for t in _CLOCK_INTS - _INTS}  # (unsigned)
 )
@@ -663,7 +668,7 @@ def fast_raw(
         if v is not None and v[0] is p:
             return v[1]
         if issubclass(tp, Array):
-            if sizeof(p) < size:
+            if sizeof(p) < size or holds_pointers(tp):  # (py_object, pointers: the table's 7)
                 return None
             arr = frombuffer(p, u8, size)
         elif tp is _NDARRAY:
@@ -735,8 +740,8 @@ def fast_raw(
             ok = []
         elif tp is memoryview:
             ok = ['p.format == "B"', "p.ndim == 1"]
-        elif issubclass(tp, Array) and sizeof(tp) >= size:
-            ok = []
+        elif issubclass(tp, Array) and sizeof(tp) >= size and not holds_pointers(tp):
+            ok = []  # (an array of pointers or py_object is not raw memory: the table's 7)
         elif tp is _NDARRAY:
             ok = ["p.dtype == _BYTES_NP", "p.ndim == 1"]
         else:
@@ -844,8 +849,12 @@ def fast_raw(
             return slow(*args)
         runs, idx = plan
         tp = type(p)
-        if not runs or not copy_runs(p, tp, runs, size):
-            arr = view(p, tp, size)
+        try:
+            done = bool(runs) and copy_runs(p, tp, runs, size)
+            arr = None if done else view(p, tp, size)
+        except ValueError:  # (a released memoryview): the table path gives 7 and why
+            return slow(*args)
+        if not done:
             if arr is None:
                 return slow(*args)
             if write:
@@ -874,7 +883,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
         and type(offset) is int
         and type(size) is int{slave_guard}
         and not extra
-        and not kw{ok}
+        and not kw
     ):
         try:
             ctl = session.controllers[1]
@@ -890,7 +899,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
             and not m.offline
             and clock._thread is None
         ):
-            try:
+            try:{ok}
                 {move}
             except Exception:  # (the buffer's own refusal): the generic path answers
                 pass
@@ -901,6 +910,10 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
                 return advance(ctl, name, 0)
     return generic({slave_arg}offset, size, {given}, *extra, **kw)
 """
+
+class _NotThis(Exception):
+    """(A specialised raw entry's buffer is not of its shape: the generic path answers.)"""
+
 
 #: the front of an entry specialised for ``byref(array)``: the array itself, the rest as for it
 _RAW_UNWRAP = """
@@ -938,13 +951,15 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         ok = [re.sub(rf"\b{k}\b", f"{k}_{n}", x) for x in ok]
         env[f"{k}_{n}"] = v
     env[f"T{n}"], env[f"IMG{n}"] = tp, image
+    env["_NotThis"] = _NotThis
     code = _RAW_ENTRY.format(
         **fmt,
         n=n,
         offset=offset,
         size=size,
         slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
-        ok="".join(f"\n        and {x}" for x in ok),
+        # (inside the try: a released memoryview raises at its first attribute)
+        ok=f"\n                if not ({' and '.join(ok)}): raise _NotThis" if ok else "",
         move=move,
         unwrap=(
             ""
