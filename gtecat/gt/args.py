@@ -16,14 +16,16 @@ function:
   memoryview, numpy arrays, bytes for inputs) work too;
 * the element type of the memory must be the pointer's (the ctypes rule), decided by the
   element type and its size, never by the value: a ``double *`` takes 8-byte floats only
-  (``c_double``, a float64 numpy array or ``'d'`` memoryview), an integer pointer integers
-  that hold every value of its C type (for the vendor's 32-bit ``long *``: ``c_int``,
-  ``c_long`` - 64 bits on Linux -, int32 or int64 arrays; for ``unsigned long *``:
-  ``c_uint``, ``c_ulong``, uint32, uint64 or int64); floats for an integer, integers for a
-  double, narrower integers (a uint8 buffer, ``c_short`` for a ``long *``), unsigned for a
-  signed type of the same width (and the reverse), bools, chars and bytes/bytearrays are
-  refused - the same for ctypes objects, numpy arrays, memoryviews and buffers, for inputs
-  and outputs alike (Python lists are values, not memory: each value is checked);
+  (``c_double``, a float64 numpy array or ``'d'`` memoryview); an integer pointer takes
+  integers of its C type's width, of either sign (C's view of the same memory: the value's
+  bit pattern is stored, 40000 reads back as -25536 from a ``c_short`` for an ``unsigned
+  short *``), or wider ones that hold every value of the C type (for the vendor's 32-bit
+  ``long *``: ``c_int``, ``c_uint``, ``c_long`` - 64 bits on Linux -, int32, uint32 or
+  int64 arrays; a 64-bit unsigned one cannot hold a negative ``long``); floats for an
+  integer, integers for a double, narrower integers (a uint8 buffer for an ``unsigned long
+  *``, ``c_short`` for a ``long *``), bools, chars and bytes/bytearrays are refused - the
+  same for ctypes objects, numpy arrays, memoryviews and buffers, for inputs and outputs
+  alike (Python lists are values, not memory: each value is checked);
 * ``byref(s, offset)`` of a structure (C's ``&s.field``) points to the field at that
   offset: the call writes that field (its type must be the pointer's) and nothing else;
 * a byte pointer (``unsigned char *``, ``char *``, ``void *``: raw data) takes plain
@@ -181,6 +183,12 @@ class Ref:
                 flat = _numeric_array(self.name, t)
                 if flat.size < n:
                     raise ParameterError(f"{self.name}: array of {flat.size} too small for {n}")
+                if flat.dtype.kind in "iu":  # (the same width, the other sign: its bits)
+                    b = _int_bounds(flat.dtype.kind == "i", flat.dtype.itemsize)
+                    values = [
+                        _same_width(v, b) if isinstance(v, numbers.Integral) else v
+                        for v in values
+                    ]
                 try:
                     flat[:n] = values
                 except (OverflowError, TypeError, ValueError):  # narrower than the C type
@@ -330,11 +338,24 @@ def fit(ctype: Any, value: Any) -> Any:
             )
             _INT_BOUNDS[ctype] = bounds
         if not bounds[0] <= value <= bounds[1]:
+            value = _same_width(value, bounds)
+        if not bounds[0] <= value <= bounds[1]:
             raise ParameterError(
                 f"the value {shown(value)} does not fit the {ctype.__name__} behind the pointer "
                 f"({bounds[0]}..{bounds[1]}); pass the prototype's type"
             )
     return value
+
+
+def _same_width(value: int, bounds: tuple[int, int]) -> int:
+    """``value`` as the integer of ``bounds`` with its bit pattern, when it is an integer of
+    the same width and the other sign (65535 -> -1 in 16 bits, -1 -> 65535): C's view of
+    the same memory; any other value unchanged (its caller refuses it)."""
+    lo, hi = bounds
+    span = hi - lo + 1
+    if lo < 0:
+        return value - span if hi < value < span // 2 * 2 else value
+    return value + span if -(span // 2) <= value < 0 else value
 
 
 # --- resolving pointers --------------------------------------------------------------------------
@@ -563,8 +584,11 @@ def _element_fits(p: Param, kind: str, size: int) -> bool:
     if kind not in "iu" or not kind:
         return False
     _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]
-    elo, ehi = _int_bounds(kind == "i", size)
-    return elo <= lo and hi <= ehi
+    width = (hi - lo).bit_length() // 8
+    if size != width:  # (the same width, either sign: C's view of the same memory)
+        elo, ehi = _int_bounds(kind == "i", size)
+        return elo <= lo and hi <= ehi
+    return True
 
 
 def _what_to_pass(p: Param) -> str:
@@ -622,11 +646,13 @@ def check_kind(p: Param, ref: Ref) -> Ref:
             elif want_float:
                 why = f" ({size} bytes, a double is 8)"
             else:
-                width = _C_WIDTH.get(p.ctype) or ctypes.sizeof(
-                    getattr(ctypes, SCALARS["int" if p.ctype in ENUMS else p.ctype][0])
+                _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]
+                width = (hi - lo).bit_length() // 8
+                why = (
+                    f" ({size} bytes), narrower than {p.ctype} ({width} bytes)"
+                    if size < width
+                    else f" (unsigned, {size} bytes), which cannot hold a negative {p.ctype}"
                 )
-                why = f" ({'un' if kind == 'u' else ''}signed, {size} bytes)"
-                why += f", which cannot hold every {p.ctype} ({width} bytes)"
             raise ParameterError(
                 f"{p.name}: points to {elem.__name__}{why}, the prototype says {p.ctype} *; "
                 f"{_what_to_pass(p)}"

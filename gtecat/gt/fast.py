@@ -481,14 +481,10 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
 CLOCK = "GT_GetClock"
 #: the largest value each integer type of ``_INTS`` holds
 _INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
-#: the clock's integer types: those that hold every value of the vendor's ``unsigned long
-#: *pClock`` (a Python caller's ``c_ulong``; a signed type wider than 32 bits), as the
-#: table's rule decides by the type (``c_int32`` is refused there, whatever the clock)
-_CLOCK_INTS = frozenset(
-    t
-    for t in _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
-    if t._type_.isupper() or ctypes.sizeof(t) > 4
-)
+#: the clock's integer types: the vendor's ``unsigned long *pClock`` (a Python caller's
+#: ``c_ulong``) beside the signed ones (a clock past a ``c_int32``'s range: the table path,
+#: which stores its bit pattern)
+_CLOCK_INTS = _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
 _INT_MAX.update(
     {t: (1 << (8 * ctypes.sizeof(t))) - 1 for t in _CLOCK_INTS - _INTS}  # (unsigned)
 )
