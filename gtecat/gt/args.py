@@ -186,8 +186,7 @@ class Ref:
                 if flat.dtype.kind in "iu":  # (the same width, the other sign: its bits)
                     b = _int_bounds(flat.dtype.kind == "i", flat.dtype.itemsize)
                     values = [
-                        _same_width(v, b) if isinstance(v, numbers.Integral) else v
-                        for v in values
+                        _same_width(v, b) if isinstance(v, numbers.Integral) else v for v in values
                     ]
                 try:
                     flat[:n] = values
@@ -555,11 +554,7 @@ def _holds(t: Any, depth: int) -> bool:
     if issubclass(t, ctypes.Array):
         return _holds(t._type_, depth + 1)
     if issubclass(t, ctypes.Structure | ctypes.Union):
-        return any(
-            _holds(f[1], depth + 1)
-            for k in t.__mro__
-            for f in vars(k).get("_fields_", ())
-        )
+        return any(_holds(f[1], depth + 1) for k in t.__mro__ for f in vars(k).get("_fields_", ()))
     return False
 
 
@@ -608,6 +603,8 @@ def check_kind(p: Param, ref: Ref) -> Ref:
     whether it fits would depend on the value.  Memory holding pointers or Python objects is
     refused for a byte pointer (raw data).  7 with the type to pass."""
     byte_ptr = p.ctype in ("char", "unsigned char", "void")
+    if p.stars != 1:  # (char **pVersion: the call writes a pointer there)
+        return ref
     if byte_ptr or p.text:
         elem = ref.elem
         if ref.py is None and elem is not None and holds_pointers(elem):
@@ -635,7 +632,11 @@ def check_kind(p: Param, ref: Ref) -> Ref:
             )
         return ref
     elem = ref.elem
-    if isinstance(elem, type) and issubclass(elem, _SIMPLE) and elem._type_ not in _NOT_NUMERIC:
+    if isinstance(elem, type) and issubclass(elem, _SIMPLE) and elem._type_ in _NOT_NUMERIC:
+        raise ParameterError(
+            f"{p.name}: points to {_elem_name(elem)}, not to numbers; {_what_to_pass(p)}"
+        )
+    if isinstance(elem, type) and issubclass(elem, _SIMPLE):
         code = elem._type_
         kind = "f" if code in _FLOAT_CODES else "u" if code.isupper() else "i"
         size = ctypes.sizeof(elem)

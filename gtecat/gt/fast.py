@@ -907,6 +907,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
     return generic({slave_arg}offset, size, {given}, *extra, **kw)
 """
 
+
 class _NotThis(Exception):
     """(A specialised raw entry's buffer is not of its shape: the generic path answers.)"""
 

@@ -12,6 +12,7 @@ import ctypes
 from ctypes import byref
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -57,6 +58,11 @@ shape = st.sampled_from(
         "pointer",
         "obj",
         "int",
+        "struct_field",  # byref(s, S.field.offset): C's &s.field
+        "numpy",  # a numpy array of t's element type
+        "numpy_u8",  # a one-byte numpy array (narrower than any reader's type)
+        "memoryview_u8",
+        "released_memoryview",
     ]
 )
 _SAME: dict[type, tuple] = {}
@@ -89,12 +95,36 @@ def _arg(kind: str, t: type):
     if kind == "obj":
         o = t()
         return o, o
+    if kind == "struct_field":
+
+        class S(ctypes.Structure):
+            _fields_ = [("tag", ctypes.c_short), ("x", t), ("after", ctypes.c_short)]
+
+        o = S(tag=-3, after=-4)
+        return o, byref(o, S.x.offset)
+    if kind == "numpy":
+        o = np.zeros(2, np.dtype(t._type_))
+        return o, o
+    if kind == "numpy_u8":
+        o = np.zeros(8, np.uint8)
+        return o, o
+    if kind == "memoryview_u8":
+        o = bytearray(8)
+        return o, memoryview(o)
+    if kind == "released_memoryview":
+        m = memoryview(bytearray(8))
+        m.release()
+        return None, m
     return None, 12345
 
 
 def _value(o):
     if o is None:
         return None
+    if isinstance(o, ctypes.Structure):
+        return [getattr(o, f[0]) for f in o._fields_]
+    if isinstance(o, np.ndarray | bytearray):
+        return list(o)
     if isinstance(o, ctypes.Array):
         return [o[i] for i in range(len(o))]
     return o.value
