@@ -591,7 +591,8 @@ def _what_to_pass(p: Param) -> str:
         return "pass byref(c_double()), a c_double array or a float64 numpy array"
     right = _CTYPES_OF.get(p.ctype, "c_long")
     nps = [str(d) for d in _NP_CANDIDATES if _element_fits(p, d.kind, d.itemsize)]
-    return f"pass byref({right}()), an array of it or a numpy array of {' or '.join(nps)}"
+    kinds = ", ".join(nps[:-1]) + " or " + nps[-1] if len(nps) > 1 else "".join(nps)
+    return f"pass byref({right}()), an array of it or a numpy array of {kinds}"
 
 
 def check_kind(p: Param, ref: Ref) -> Ref:
