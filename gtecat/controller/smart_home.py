@@ -172,6 +172,8 @@ FORCED_MODES = (HomeMode.FORCED_HOME, HomeMode.FORCED_HOME_INDEX)
 _LONG = (-(1 << 31), (1 << 31) - 1)
 _POS, _NEG = int(AxisStatus.POSITIVE_LIMIT), int(AxisStatus.NEGATIVE_LIMIT)
 _ALARM = int(AxisStatus.ALARM)
+#: flags whose cause stops the axis (a stop input, the following error): the homing ends
+_STOPPED = int(AxisStatus.SMOOTH_STOP | AxisStatus.ABRUPT_STOP | AxisStatus.POS_ERROR)
 _LIMIT_POS_BIT, _LIMIT_NEG_BIT = 1 << 1, 1 << 0  # 60FDh
 
 
@@ -286,6 +288,7 @@ class SmartHome:
         self._failing = False
         self._before = 0
         self._raised = 0
+        self._stops = 0  # the axis's GT_Stop count when the homing started
         self._expect: int | None = None
         #: the search waits in a loop that only its own axis can end (the end of the Trap
         #: leg, a limit or home input of the axis: :meth:`quiet`)
@@ -384,6 +387,7 @@ class SmartHome:
         self._trap = prm.trap()
         self._before = res.latched
         self._raised = 0
+        self._stops = res.stops
         self._failing = False
         self._expect = None
         self._q_claim = 0
@@ -452,7 +456,7 @@ class SmartHome:
             return None
         # what a call may have changed since the last step (a call gives the axis back
         # first, and the bank may take it again before the next cycle): as the step saw it
-        if res.latched != self._seen_latched:
+        if res.latched != self._seen_latched or res.stops != self._stops:
             return None
         if (self.unit.changes, self._trigger.changes) != self._seen_changes:
             return None
@@ -497,6 +501,14 @@ class SmartHome:
             return HomeError.DISABLE, f"axis {self.number} was switched off"
         if res.profile.mode != PrfMode.TRAP:
             return HomeError.NOT_TRAP_MODE, f"axis {self.number} left Trap mode"
+        # a stop at any moment ends the homing, also one of an axis standing between two
+        # legs (nothing of the Trap profile shows it then) or in a stop of the search's own
+        if res.stops != self._stops:
+            return HomeError.STOP, f"axis {self.number} was stopped (GT_Stop)"
+        if res.latched & _STOPPED:
+            return HomeError.STOP, (
+                f"axis {self.number} was stopped (a stop input or the following error)"
+            )
         return None
 
     def _fail(self, error: HomeError, reason: str) -> None:
