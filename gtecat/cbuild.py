@@ -86,7 +86,7 @@ def _dirs_lock(vdir: Path) -> Any:
     unlike ``.lock``, which a builder holds for its whole compile); None without file locks."""
     if fcntl is None:
         return contextlib.nullcontext()
-    f = open(vdir / ".dirs.lock", "w")  # noqa: SIM115 - closed by the caller's with
+    f = open(vdir / ".dirs.lock", "w")
     fcntl.flock(f, fcntl.LOCK_EX)
     return f
 
@@ -155,7 +155,7 @@ class _BuildDir:
         with _dirs_lock(vdir):
             self.path = Path(tempfile.mkdtemp(prefix=_PREFIX, dir=vdir))
             self.log = self.path.with_suffix(".log")
-            self.owner = open(self.log, "wb")  # noqa: SIM115 - closed by close()
+            self.owner = open(self.log, "wb")
             if fcntl is not None:
                 fcntl.flock(self.owner, fcntl.LOCK_EX)
 

@@ -81,13 +81,13 @@ the machine has.  Only an axis with no limit terminal at all (no 60FDh) is refus
 
 **Errors** end the homing (the axis is stopped with ``dec``; ``run`` drops once it stands;
 ``stage`` stays where it failed): 1 not in Trap mode (a Jog is taken over instead:
-:meth:`SmartHome._leave_jog`), 2 servo off (at the start or on the
-way), 3 drive alarm, 4 stopped by someone else (GT_Stop, a stop input, the following
-error: at any moment, also while the axis stands between two legs or brakes at a limit;
-the axis does not move again) or a search refused by a latched flag, 5 another motion command or a limit where
-none belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input
-to capture, 8 no home (or no limit in mode 10) within the distance, 9 the index cannot be
-captured, 10 no index.  GT_GoHome returns 1 with the reason when it refuses to start (the
+:meth:`SmartHome._leave_jog`), 2 servo off (at the start or on the way), 3 drive alarm, 4
+stopped by someone else (GT_Stop, a stop input, the following error: at any moment, also
+while the axis stands between two legs or brakes at a limit; the axis does not move again)
+or a search refused by a latched flag, 5 another motion command or a limit where none
+belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input to
+capture, 8 no home (or no limit in mode 10) within the distance, 9 the index cannot be
+captured, 10 no index. GT_GoHome returns 1 with the reason when it refuses to start (the
 status says the same); 7 for a parameter out of range.
 """
 

@@ -4,13 +4,13 @@ Twelve EtherCAT axes home at once in different smart-home modes (home ahead or b
 limit that turns the search, starting on the switch, limit then home both ways, limit with
 escapes both ways, forced home, home and index through the touch probe, a search stopped by
 GT_Stop, one stopped by GT_Stop while it stands between two legs (the touch probe arming
-before the index search), one that does not end in the run) on switches close enough that every search meets
-its events in the run.  Each event (a home edge, a limit, a leg's end sample) sends an axis
-back to its scalar objects and the bank takes it again after, and between events the bank
-runs the cycles many at once while the homings say they stay quiet: that is where a
-difference would show.  Compared exactly with the bank off, every cycle: GT_GetSts, planned
-and encoder positions of every axis, every axis's THomeStatus and the whole GT raw image;
-the drives' mechanics at the end.
+before the index search), one that does not end in the run) on switches close enough that
+every search meets its events in the run. Each event (a home edge, a limit, a leg's end
+sample) sends an axis back to its scalar objects and the bank takes it again after, and
+between events the bank runs the cycles many at once while the homings say they stay quiet:
+that is where a difference would show. Compared exactly with the bank off, every cycle:
+GT_GetSts, planned and encoder positions of every axis, every axis's THomeStatus and the
+whole GT raw image; the drives' mechanics at the end.
 """
 
 from __future__ import annotations
