@@ -125,6 +125,9 @@ class Controller:
 
     #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
     bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
+    #: called with every controller whose bus is about to be brought up: its slaves are
+    #: there, the state walk with the InitCmds not yet run (the machine's faults arm here)
+    bus_opening_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - likewise
 
     def __init__(self, options: Options | None = None) -> None:
         self.options = (options or Options()).resolved()
@@ -272,6 +275,7 @@ class Controller:
         install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)
         if _relatch_link_alarms not in self.on_reset:
             self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
+        master.on_opened = lambda: [hook(self) for hook in list(Controller.bus_opening_hooks)]
         master.open()
         _put_back(backend, kept)
         if banked:

@@ -192,9 +192,30 @@ def injector_for(ctl: Any, create: bool = True) -> Injector | None:
     return inj
 
 
+def _bus_opening(ctl: Any) -> None:
+    """Arm the machine description's ``[[fault]]`` tables on every bus before it is brought
+    up (its slaves found, the state walk with the ENI's InitCmds to come): the machine is
+    faulty from the start, so the bring-up meets them as the application's own calls do (an
+    ``on_sdo`` trigger counts the InitCmds' SDOs, a mailbox fault can fail the bring-up).
+    The faults of a bus brought up before go with it.  Errors: :func:`_arm_machine`."""
+    _arm_machine(ctl)
+    ctl._faults_armed = ctl.backend
+
+
 def _bus_up(ctl: Any) -> None:
-    """Arm the machine description's ``[[fault]]`` tables on every bus that comes up (the
-    faults of a bus brought up before go with it).
+    """The bus is up: the axis bank, made after the bring-up, learns which axes the armed
+    faults watch; a bus that came up without :func:`_bus_opening` (a card's amplifiers) has
+    its faults armed now."""
+    if getattr(ctl, "_faults_armed", None) is not ctl.backend:
+        _arm_machine(ctl)
+        return
+    inj = injector_for(ctl, create=False)
+    if inj is not None:
+        inj.bus_ready()
+
+
+def _arm_machine(ctl: Any) -> None:
+    """Arm the machine description's ``[[fault]]`` tables on ``ctl``'s bus.
 
     Every error in them - a value out of range, an unknown kind, a slave or an axis the bus
     does not have (``link_down after_slave=5`` on a bus of three slaves), an ``after`` that
@@ -301,6 +322,8 @@ def _install() -> None:
 
     if _bus_up not in Controller.bus_up_hooks:
         Controller.bus_up_hooks.append(_bus_up)
+    if _bus_opening not in Controller.bus_opening_hooks:
+        Controller.bus_opening_hooks.append(_bus_opening)
 
 
 _install()

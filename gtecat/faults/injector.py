@@ -258,6 +258,14 @@ class Injector:
             return True
         return False
 
+    def bus_ready(self) -> None:
+        """The bus came up after these faults were armed (and the axis bank with it): tell
+        it again which axes they watch and whether it may run at all."""
+        self._watched = frozenset()
+        if not self.bank_safe:
+            self.bus.before_change()
+        self._refresh()
+
     def _refresh(self) -> None:
         """Frame faults routed while one is armed or active; bank-safe without position or
         homing triggers."""
