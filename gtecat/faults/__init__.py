@@ -197,8 +197,10 @@ def _bus_opening(ctl: Any) -> None:
     up (its slaves found, the state walk with the ENI's InitCmds to come): the machine is
     faulty from the start, so the bring-up meets them as the application's own calls do (an
     ``on_sdo`` trigger counts the InitCmds' SDOs, a mailbox fault can fail the bring-up).
-    The faults of a bus brought up before go with it.  Errors: :func:`_arm_machine`."""
-    _arm_machine(ctl)
+    Any other fault that starts at once waits until the bus is up (:func:`_bus_up`), where
+    it started before: the bring-up has no cycles for it.  The faults of a bus brought up
+    before go with it.  Errors: :func:`_arm_machine`."""
+    _arm_machine(ctl, holding=True)
     ctl._faults_armed = ctl.backend
 
 
@@ -214,8 +216,9 @@ def _bus_up(ctl: Any) -> None:
         inj.bus_ready()
 
 
-def _arm_machine(ctl: Any) -> None:
-    """Arm the machine description's ``[[fault]]`` tables on ``ctl``'s bus.
+def _arm_machine(ctl: Any, holding: bool = False) -> None:
+    """Arm the machine description's ``[[fault]]`` tables on ``ctl``'s bus (``holding``:
+    before it is brought up, :attr:`Injector.holding`).
 
     Every error in them - a value out of range, an unknown kind, a slave or an axis the bus
     does not have (``link_down after_slave=5`` on a bus of three slaves), an ``after`` that
@@ -237,7 +240,10 @@ def _arm_machine(ctl: Any) -> None:
         source = ctl.machine.source or "machine description"
         try:
             specs = specs_from_tables(list(tables), source)
-            arm(injector_for(ctl), specs)  # type: ignore[arg-type]
+            inj = injector_for(ctl)
+            assert inj is not None
+            inj.holding = holding
+            arm(inj, specs)
         except (FaultSpecError, ParameterError) as e:
             raise CommandError(str(e)) from None
 

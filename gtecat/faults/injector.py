@@ -95,6 +95,10 @@ class Injector:
         self._lbase: int | None = None
         self._started: set[int] = set()
         self._watched: frozenset[int] = frozenset()
+        #: the bus is being brought up (a machine description's faults, armed before it):
+        #: a fault that starts at once waits for the bus unless the bring-up can meet it (a
+        #: mailbox fault: the InitCmds are SDOs); :meth:`bus_ready` starts it then
+        self.holding = False
         self._wrap_mailboxes()
 
     # --- adding and clearing ----------------------------------------
@@ -122,9 +126,12 @@ class Injector:
         self.entries.append(e)
         self.bus.log(f"Fault {e.id} armed: {e.describe()}.")
         self._refresh()
-        if isinstance(trig, Now) and self._gate_open(e):
+        if isinstance(trig, Now) and self._gate_open(e) and not self._held(e):
             self._start(e)
         return e
+
+    def _held(self, e: Entry) -> bool:
+        return self.holding and e.fault.depth != "mailbox"
 
     def clear(self, ident: int | None = None) -> int:
         """End one fault (by id) or all; the number ended."""
@@ -259,8 +266,14 @@ class Injector:
         return False
 
     def bus_ready(self) -> None:
-        """The bus came up after these faults were armed (and the axis bank with it): tell
-        it again which axes they watch and whether it may run at all."""
+        """The bus came up after these faults were armed (and the axis bank with it): the
+        faults held while it was brought up start, as they would have been armed now, and
+        the bank learns again which axes they watch and whether it may run at all."""
+        if self.holding:
+            self.holding = False
+            for e in list(self.entries):
+                if e.state == "armed" and isinstance(e.trigger, Now) and self._gate_open(e):
+                    self._start(e)
         self._watched = frozenset()
         if not self.bank_safe:
             self.bus.before_change()
