@@ -4,8 +4,8 @@ Four ways in build the same objects (:mod:`.kinds`, :mod:`.triggers`):
 
 * Python - :func:`inject` on the open controller (``GT_Open`` + ``GT_InitEcatComm`` first),
   :func:`clear`, :func:`listing`; the ``gtecat_faults`` pytest fixture is the same;
-* the machine TOML - ``[[fault]]`` tables, armed each time the bus comes up
-  (:func:`specs_from_tables`);
+* the machine TOML - ``[[fault]]`` tables, armed each time the bus is brought up, before
+  its InitCmds (:func:`specs_from_tables`);
 * the command line on a running gtecat - ``gtecat fault inject|list|clear``;
 * the panel, over the same inspection endpoint.
 

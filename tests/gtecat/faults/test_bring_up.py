@@ -41,7 +41,7 @@ def _closed():
     gt.GT_Close()
 
 
-@pytest.mark.parametrize("pcap", [False, True], ids=["unframed", "pcap"])
+@pytest.mark.parametrize("pcap", [False, True], ids=["no capture", "pcap"])
 def test_the_nth_sdo_counts_the_bring_up_and_its_fault_fails_it(tmp_path: Path, pcap: bool):
     n = _bring_up_sdos(0x1C12)
     assert n >= 2
