@@ -42,6 +42,8 @@ _AT = CARG_AT if CARG_AT is not None else -1
 
 
 _status = AxisResources.status
+#: a C ``short`` argument's range (the table binder's check of ``axis`` and ``count``)
+_SHORT_MIN, _SHORT_MAX = -(1 << 15), (1 << 15) - 1
 
 
 def _kept_refs() -> int:
@@ -208,8 +210,17 @@ def fast_reader(
             return advance(ctl, name, 0)
         return 0
 
-    limit = READ_LIMITS.get(name, CONTROLLER_AXES)
+    own_limit = READ_LIMITS.get(name)  # the function's own (its table path refuses more)
+    limit = CONTROLLER_AXES if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
+
+    def refuse(ctl: Any, reason: str) -> int:
+        """The table path's refusal of a parameter (code 7 and the reason), then the call's
+        host latency."""
+        from ._core import CMD_PARAM, _record  # (the GT layer imports this module)
+
+        _record(name, CMD_PARAM, reason)
+        return advance(ctl, name, CMD_PARAM)
 
     def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
@@ -220,7 +231,6 @@ def fast_reader(
             or type(n) is not int
             or extra
             or kw
-            or count > limit
             or not (pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0))
             or session.remote is not None
             or session.core != 1
@@ -230,6 +240,15 @@ def fast_reader(
         tp = type(p)
         if not (is_array(tp) and tp._length_ >= count):
             return None
+        if count > limit:
+            if own_limit is None or ctl.card is not None:
+                return None
+            if not (_SHORT_MIN <= n <= _SHORT_MAX and count <= _SHORT_MAX):
+                return None
+            # more than the function reads at once (an encoder reader's 8): the table path
+            # binds these plain arguments and the function refuses the count, the first thing
+            # it checks (axis_span): the same code and reason without the table's steps
+            return refuse(ctl, f"count={count}: at most {own_limit} at once")
         resources = ctl.resources
         axes = ctl.axes
         values: list[Any] = []
@@ -269,7 +288,7 @@ def fast_reader(
             and core > 1
             and type(n) is int
             and type(count) is int
-            and 1 < count
+            and 1 < count <= limit  # (a count the function refuses: the table path)
             and 0 < n
             and n + count - 1 <= AXES_PER_CORE
             and session.local
