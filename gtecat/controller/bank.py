@@ -123,8 +123,10 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: GT functions whose implementations read a claimed axis through the bank itself, or touch
 #: no axis object at all (the process image, the clock: a raw write to a claimed slave's
 #: outputs is seen by the bank's next cycle, which gives the slave back first)
-#: function -> whether it takes a ``count`` of axes (AxisBank.before_call)
-_COUNTED: dict[str, bool] = {}
+#: function -> where it takes a ``count`` of axes, 0: it takes none (AxisBank.before_call)
+_COUNTED: dict[str, int] = {}
+#: the most axes a ``count`` names that go back one by one (more: every axis)
+_SPAN_MOST = 64
 
 BANK_READS = frozenset(
     {
@@ -1232,13 +1234,34 @@ class AxisBank:
         if params and params[0].name in ("axis", "profile", "encoder") and values:
             counted = _COUNTED.get(proto.name)
             if counted is None:  # (a function's parameters do not change: asked once)
-                counted = _COUNTED[proto.name] = any(p.name == "count" for p in params)
+                counted = _COUNTED[proto.name] = next(
+                    (k for k, p in enumerate(params) if p.name == "count"), 0
+                )
+            n = values[0]
             if not counted:
-                n = values[0]
                 ax = ctl.axes.get(n) if type(n) is int else None
                 if ax is not None:
                     self.release_axis_object(ax)
                     return
+            elif counted < len(values):
+                # GT_ClrSts(axis, count), GT_ZeroPos(axis, count): the axes of the span go
+                # back (what else the function reaches gives itself back through its guard)
+                count = values[counted]
+                if type(n) is int and type(count) is int and 0 < count <= _SPAN_MOST:
+                    axes = ctl.axes
+                    named = [ax for ax in map(axes.get, range(n, n + count)) if ax is not None]
+                    if named:
+                        for ax in named:
+                            self.release_axis_object(ax)
+                        return
+        if params and params[0].name == "slave_position" and values and type(values[0]) is int:
+            # an SDO to one slave: its axes go back (the drive's objects it reaches give
+            # themselves back through their guards too); no other axis is touched
+            slave = values[0]
+            mine = [g for g in self.groups if g.claimed and g.position == slave]
+            if mine:
+                self._release_groups(mine)
+            return
         if params and params[0].name == "mask" and values and type(values[0]) is int:
             # GT_Update(mask), GT_Stop(mask, option): only the axes of the mask go back
             mask = values[0]
