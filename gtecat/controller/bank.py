@@ -16,9 +16,10 @@ state written back into its objects exactly as if they had run every cycle thems
 before anything else may look at or change them:
 
 * any GT function except the bank-aware readers (:data:`BANK_READS`) releases the
-  axis it names (or every axis when it names several, a mask or none) before it runs; one
-  naming a coordinate system releases that system's cluster alone (:meth:`AxisBank.before_call`;
-  a segment pushed onto a running path the bank holds ahead may even stay: ``_push_ahead``);
+  axis it names (the axes of a mask or of a ``count`` span, a slave's axes for an SDO to
+  it, every axis when it names none) before it runs; one naming a coordinate system
+  releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
+  onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit, the following
   error, a new sample past a soft limit, a raw write to its slave's outputs, the
   drive's own following-error window) releases it *before* that cycle, so the scalar
