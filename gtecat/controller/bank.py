@@ -304,6 +304,11 @@ class AxisBank:
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
         self._lists: dict[str, list[Any]] = {}
+        #: counts the claims and releases of rows (an axis's resources point at the bank or
+        #: not): what the GT readers' plans of many axes at once check (gtecat.gt.fast)
+        self.layout = 0
+        #: those plans, by (value, first axis, count)
+        self.read_plans: dict[tuple[str, int, int], Any] = {}
         self.disabled_reason = ""
         self._stale = False
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
@@ -889,6 +894,7 @@ class AxisBank:
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = True
         res.bank, res.bank_row = self, r
+        self.layout += 1
         s = ax.pos_scale
         self.unit2[r] = float(1 << s)
         self.unit[r] = 1.0 / (1 << s)
@@ -1157,6 +1163,7 @@ class AxisBank:
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = False
         res.bank = None
+        self.layout += 1
         a = float(self.a_last[r])
         ax.prf_pos = a
         res._a_last = a

@@ -18,6 +18,7 @@ import re
 import struct
 import sys
 from collections.abc import Callable
+from operator import itemgetter
 from typing import Any
 
 import numpy as np
@@ -251,6 +252,36 @@ def fast_reader(
             return refuse(ctl, f"count={count}: at most {own_limit} at once")
         resources = ctl.resources
         axes = ctl.axes
+        b = ctl.bank
+        if bank_key is not None and b is not None:
+            # every axis of the span a row of the bank: its rows, found once while no row is
+            # claimed or released (the bank's layout) and the controller's axes are the same
+            key = (bank_key, n, count)
+            plan = b.read_plans.get(key)
+            if (
+                plan is None
+                or plan[0] != b.layout
+                or plan[1] is not resources
+                or plan[2] is not axes
+            ):
+                plan = b.read_plans[key] = _read_plan(b, resources, axes, n, count)
+            pick = plan[3]
+            if pick is not None:
+                lst = b._lists.get(bank_key)
+                if lst is not None:
+                    p[:count] = pick(lst)
+                else:  # not made yet this cycle: the first axis's getter makes it
+                    first = get(plan[4])
+                    lst = b._lists.get(bank_key)
+                    if lst is not None:
+                        values = list(pick(lst))
+                        values[0] = first
+                        p[:count] = values
+                if lst is not None:
+                    session.last = None
+                    if ctl.clock.mode is not _LOCKSTEP:
+                        return advance(ctl, name, 0)
+                    return 0
         values: list[Any] = []
         append = values.append
         bank = lst = None
@@ -351,6 +382,22 @@ BANK_LISTS = {
     "GT_GetEncPos": "enc_pos",
     "GT_GetEncVel": "enc_vel",
 }
+
+
+def _read_plan(b: Any, resources: Any, axes: Any, n: int, count: int) -> tuple[Any, ...]:
+    """(the bank's layout, the resources and axes looked at, a getter of the span's rows in a
+    list of the bank's values or None when some axis of the span is not a row of ``b``, the
+    first axis's resources)."""
+    if count < 2:  # (one value: no tuple to store)
+        return (b.layout, resources, axes, None, None)
+    rows = []
+    for k in range(n, n + count):
+        res = resources.get(k)
+        if res is None or axes.get(k) is not res.ax or res.bank is not b:
+            return (b.layout, resources, axes, None, None)
+        rows.append(res.bank_row)
+    return (b.layout, resources, axes, itemgetter(*rows), resources.get(n))
+
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
