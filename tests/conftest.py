@@ -219,6 +219,21 @@ def _no_controller_left_open():
         core.close_all()
 
 
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """The bank's compiled cycle is built (once per machine, on an empty cache) before the
+    first test of each process that runs tests.  An application's first run does not wait
+    for that build - its bank runs numpy meanwhile - so the tests that count the compiled
+    cycles would otherwise depend on when the build ends."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None and getattr(
+        session.config.option, "numprocesses", None
+    ):
+        return  # the controller of a pytest-xdist run runs no test
+    from gtecat.controller import bank_kernel
+
+    if bank_kernel.wanted() != "numpy":
+        bank_kernel.library()
+
+
 def pytest_configure(config: pytest.Config) -> None:
     """The controller of a pytest-xdist run rewrites the test modules' asserts once, before
     its workers start (:func:`_rewrite_ahead`)."""

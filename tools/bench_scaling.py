@@ -15,6 +15,8 @@ puts it in the state, then lets controller time pass with ``GTE_Wait`` and count
   ``GT_SetHomingMode`` / ``GT_SetEcatHomingPrm`` / ``GT_StartEcatHoming``; the machine
   description puts each axis's negative limit a billion counts away, so the search
   outlasts the measurement;
+* ``homed6`` (not in the default set): drive homing method 35 run to its end, the drives
+  left in homing mode 6 (an application that never switches back to CSP);
 * ``pt``, ``gear``, ``follow``, ``crd`` (not in the default set): PT over a static FIFO
   looped endlessly; per core a Trap master and the other axes in Gear / Follow on it;
   per core two XY coordinate systems on a path of lines and arcs, the other axes holding
@@ -52,7 +54,7 @@ from tools.gen_axes_eni import write_axes_eni  # noqa: E402
 AXES = (1, 2, 4, 8, 12, 16, 32, 64, 96, 128)
 STATES = ("idle", "moving", "homing")
 #: the other motion modes (``--states pt,gear,follow,crd``): see their ``start_*``
-MODES = ("pt", "gear", "follow", "crd")
+MODES = ("pt", "gear", "follow", "crd", "homed6")
 AXES_PER_CORE = 32
 #: axes per core that :func:`core_axis` uses; ``--addressing flat`` puts every axis on
 #: core 1 (the emulator's own extension before issue 17: no GT_Update beyond axis 32)
@@ -150,13 +152,15 @@ def machine(n: int) -> Any:
     return MachineDescription({a: AxisMachine(negative_limit=-FAR) for a in range(1, n + 1)})
 
 
-def bring_up(eni: Path, n: int, bank: str | None = None) -> None:
+def bring_up(eni: Path, n: int, bank: str | None = None, description: Any = None) -> None:
     """Open the controller on ``eni`` (lockstep clock) and take the bus to OP; ``bank``:
-    GT_Open's ``bank`` (None: its default, ``off``: the scalar path alone)."""
+    GT_Open's ``bank`` (None: its default, ``off``: the scalar path alone); ``description``:
+    the machine (None: :func:`machine`)."""
     gt = _gt()
     gt.GT_Close()
     opts = {} if bank is None else {"bank": bank}
-    rc = gt.GT_Open(eni=str(eni), machine=machine(n), clock="lockstep", log="", **opts)
+    mach = machine(n) if description is None else description
+    rc = gt.GT_Open(eni=str(eni), machine=mach, clock="lockstep", log="", **opts)
     _ok(rc, "GT_Open")
     _ok(gt.GT_InitEcatComm(), "GT_InitEcatComm")
     ready = c_short()
@@ -189,6 +193,23 @@ def start_homing(axes: Sequence[int]) -> None:
         gtn("SetEcatHomingPrm", a, HOMING_METHOD, 5000, 1000, 100000, 0, 0)
     for a in axes:
         gtn("StartEcatHoming", a)
+
+
+def start_homed_mode6(axes: Sequence[int]) -> None:
+    """Drive homing method 35 (the current position) on every axis, run to its end; the
+    drives are left in homing mode 6 (no ``GT_SetHomingMode(axis, 8)`` after it)."""
+    for a in axes:
+        gtn("SetHomingMode", a, 6)
+        gtn("SetEcatHomingPrm", a, 35, 4000, 800, 100000, 0, 0)
+    for a in axes:
+        gtn("StartEcatHoming", a)
+    _gt().GTE_Wait(100)
+    left = [a for a in axes if homing_status(a) != HOMING_DONE]
+    if left:
+        raise BenchError(f"{len(left)} axes did not finish homing: {left[:8]}")
+
+
+HOMING_DONE = 3
 
 
 def start_pt(axes: Sequence[int], points: int = 400) -> None:
@@ -334,6 +355,7 @@ def start_crd(axes: Sequence[int]) -> None:
 
 
 STARTERS: dict[str, Callable[[Sequence[int]], None]] = {
+    "homed6": start_homed_mode6,  # (first: the moving axes of a mixed plan start after it)
     "moving": start_trap,
     "homing": start_homing,
     "pt": start_pt,
@@ -351,6 +373,8 @@ def check(plan: Mapping[int, str]) -> None:
         ok = bool(sts & STS_SERVO_ON) and not sts & STS_ALARM
         if state == "idle":
             ok = ok and not sts & STS_MOVING
+        elif state == "homed6":
+            ok = ok and not sts & STS_MOVING and homing_status(a) == HOMING_DONE
         elif state == "homing":
             ok = ok and homing_status(a) == HOMING_IN_PROGRESS
         else:
@@ -448,6 +472,106 @@ def run_bus(
         "bringup_s": round(bring_s, 3),
         **extra,
     }
+
+
+#: smart homing (GT_GoHome) of the gohome figures: pulse, pulse/ms, pulse/ms²
+GOHOME_VEL_HIGH, GOHOME_VEL_LOW, GOHOME_ACC = 20.0, 2.0, 0.5
+#: how often the gohome figures look at every axis's THomeStatus (controller ms); each look
+#: is 64 GT calls of 7-20 µs (the GT layer's cost, not the homing's)
+GOHOME_POLL_MS = 100
+
+
+def gohome_machine(n: int) -> Any:
+    """Every axis at 0 with its own switches, a few hundred counts apart from axis to axis
+    (so their events fall in different cycles): a home switch [40000, 44000), a positive
+    limit at 70000 and a negative one at -70000, each shifted by 37 counts per axis."""
+    from gtecat.drives.machine import AxisMachine, MachineDescription
+
+    return MachineDescription(
+        {
+            a: AxisMachine(
+                home_switch=((40_000 + 37 * a, 44_000 + 37 * a),),
+                positive_limit=70_000 + 37 * a,
+                negative_limit=-70_000 - 37 * a,
+            )
+            for a in range(1, n + 1)
+        }
+    )
+
+
+def start_gohome(axes: Sequence[int], mode: int) -> None:
+    """GT_GoHome on every axis (Trap mode first) in smart-home ``mode``, toward the positive
+    side: mode 20 finds the home switch ahead (about 2 s of search), mode 11 the positive
+    limit first (3.5 s), then the home switch on the way back."""
+    gt = _gt()
+    for a in axes:
+        gtn("PrfTrap", a)
+        prm = gt.THomePrm()
+        prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = mode, 1, 1, 0, -1
+        prm.velHigh, prm.velLow = GOHOME_VEL_HIGH, GOHOME_VEL_LOW
+        prm.acc = prm.dec = GOHOME_ACC
+        prm.homeOffset, prm.escapeStep = 100, 1000
+        gtn("GoHome", a, byref(prm))
+
+
+def run_gohome(
+    n: int, mode: int, *, repeat: int = 3, bank: str | None = None, limit_ms: int = 30_000
+) -> dict[str, Any]:
+    """``n`` axes home with GT_GoHome in ``mode`` from start to end, ``repeat`` times (a
+    fresh controller each): controller time over wall and CPU time of the whole homing,
+    as an application waits for it (GTE_Wait of 20 ms, every axis's GT_GetHomeStatus every
+    :data:`GOHOME_POLL_MS`); the best run counts.  ``error`` when a homing does not end in
+    stage 100 without error."""
+    gt = _gt()
+    best: dict[str, Any] | None = None
+    with tempfile.TemporaryDirectory() as tmp:
+        eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
+        for _ in range(max(1, repeat)):
+            try:
+                bring_up(eni, n, bank, gohome_machine(n))
+                axes = list(range(1, n + 1))
+                for a in axes:
+                    gtn("AxisOn", a)
+                gt.GTE_Wait(WARM_UP_MS)
+                start_gohome(axes, mode)
+                hs = gt.THomeStatus()
+                ms0, _ = _clock()
+                t0, c0 = time.perf_counter(), time.process_time()
+                waited = 0
+                while True:
+                    gt.GTE_Wait(CHUNK_MS)
+                    waited += CHUNK_MS
+                    if waited % GOHOME_POLL_MS:
+                        continue
+                    running = 0
+                    for a in axes:
+                        gtn("GetHomeStatus", a, byref(hs))
+                        running += hs.run
+                    if not running or waited >= limit_ms:
+                        break
+                wall, cpu = time.perf_counter() - t0, max(time.process_time() - c0, 1e-9)
+                ms1, _ = _clock()
+                bad = []
+                for a in axes:
+                    gtn("GetHomeStatus", a, byref(hs))
+                    if hs.run or hs.stage != 100 or hs.error:
+                        bad.append(f"{a} (stage {hs.stage}, error {hs.error})")
+                if bad:
+                    raise BenchError(f"{len(bad)} axes did not home: {', '.join(bad[:8])}")
+            except BenchError as exc:
+                return {"error": str(exc)}
+            finally:
+                gt.GT_Close()
+            ms = ms1 - ms0
+            r = {
+                "controller_ms": ms,
+                "rtf": round(ms / 1000 / wall, 3),
+                "rtf_cpu": round(ms / 1000 / cpu, 3),
+            }
+            if best is None or r["rtf"] > best["rtf"]:
+                best = r
+    assert best is not None
+    return best
 
 
 def bench_point(n: int, state: str, *, seconds: float = 1.5, repeat: int = 3) -> dict[str, Any]:

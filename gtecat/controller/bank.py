@@ -67,16 +67,21 @@ from gtecat.drives.csp_bank import (
 from gtecat.drives.drive import Cia402Drive
 from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
 from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
-from gtecat.drives.homing_bank import homing_claimable
+from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable
+from gtecat.drives.homing_bank import rest_constants as homing_rest_constants
+from gtecat.drives.homing_bank import resting as homing_resting
 from gtecat.drives.homing_bank import row_constants as homing_constants
 from gtecat.drives.modes import SW12
 from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
+from .._attrs import own_dict
+from ..master.clock import ClockMode
 from .axis_status import AxisStatus
 from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
+from .bank_kernel import settled as kernel_settled
 from .bank_kernel import wanted as kernel_wanted
 from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
 from .crd.system import Delay, Motion
@@ -85,7 +90,7 @@ from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
 from .motion.jog import ramp_step as jog_ramp_step
 from .motion.stop import StopKind
-from .motion.trap import _IDLE, _MOVE, TrapPlanner
+from .motion.trap import _EPS_T, _IDLE, _MOVE, TrapPlanner
 from .motion.trap_table import advance, trap_table
 from .profile import PrfMode
 
@@ -156,6 +161,9 @@ BANK_READS = frozenset(
         "GT_GetVersion",
         "GT_IsEcatReady",
         "GT_GetEcatHomingStatus",
+        # a smart homing's parameters and status (gtecat.controller.smart_home): its own data
+        "GT_GetHomeStatus",
+        "GT_GetHomePrm",
         # a coordinate system's state, read from the cycle the bank records of it
         # (CoordSystem.now, bank_modes.SystemTrace), or its parameters (never stepped)
         "GT_CrdStatus",
@@ -191,7 +199,7 @@ _HOMING_MODE = 6
 _HM_ARRAYS = (
     "h_last h_el h_tr h_v h_p h_rest h_vt h_acc h_lo h_hi h_maxtr h_tmo h_fd h_from h_ilim"
 ).split()
-_HM_U8 = ("hm", "h_set", "h_idx", "frz")
+_HM_U8 = ("hm", "h_set", "h_idx", "frz", "h_done")
 _SERVO_ON, _MOVING, _ARRIVED = (
     int(AxisStatus.SERVO_ON),
     int(AxisStatus.MOVING),
@@ -260,13 +268,30 @@ def _guard_class(cls: type) -> type:
 
 
 def _bank_safe(hook: Any) -> bool:
-    """A ``pre_cycle`` hook that leaves the axes the bank runs alone: the function says so
-    (``bank_safe`` on it), else the object of a bound method (``bank_safe`` on it, which
-    may change: the fault injector while a trigger watches an axis every cycle)."""
+    """A ``pre_cycle`` or ``post_cycle`` hook that leaves the axes the bank runs alone, or
+    reaches them only through their guards (which give them back first: smart homing): the
+    function says so (``bank_safe`` on it), else the object of a bound method (``bank_safe``
+    on it, which may change: the fault injector while a trigger watches an axis every
+    cycle)."""
     safe = getattr(hook, "bank_safe", None)
     if safe is None:
         safe = getattr(getattr(hook, "__self__", None), "bank_safe", False)
     return bool(safe)
+
+
+def aware_hooks(ax: Any) -> list[Any]:
+    """The objects of an axis's post hooks that know the bank (``bank_post_hook``: a capture
+    unit, :mod:`gtecat.controller.capture`).  Such an object says when its axis may be held
+    (``bank_ready()``), which 60FDh bits matter to it now (``bank_watch``: a change gives the
+    row back before that cycle; read at the claim, so an object whose bits grow gives its
+    row back itself) and catches up when the row is given back (``bank_released(cycles)``:
+    the cycles the bank ran without it, in which none of those bits changed)."""
+    out = []
+    for h in ax.post_hooks:
+        obj = getattr(h, "__self__", None)
+        if getattr(obj, "bank_post_hook", False):
+            out.append(obj)
+    return out
 
 
 @dataclass
@@ -298,6 +323,7 @@ class AxisBank:
         #: RECHECK_CYCLES by each look that leaves some out; 1 again after a release)
         self._wait = 1
         self._settled = False  # the next cycle's first steps ran already (settle)
+        self._declined = False  # the last run of many cycles stopped before a declined one
         #: GT axes kept off the bank (a fault trigger reads their drive every cycle)
         self.held: frozenset[int] = frozenset()
         self.n = 0
@@ -314,23 +340,26 @@ class AxisBank:
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
         self.rows_run = 0
         #: the compiled plain cycle (gtecat.controller.bank_kernel), None: numpy alone; the
-        #: library is built (first use on a machine) and loaded here, at GT_InitEcatComm,
-        #: never inside a cycle
+        #: library is loaded here, at GT_InitEcatComm.  Its first build on a machine runs in
+        #: a process of its own (started by GT_Open): ``auto`` does not wait for it, the bank
+        #: runs numpy meanwhile and takes the kernel at the first cycle after the build
+        #: (:meth:`_take_kernel`); ``c`` and the realtime clock wait here
         self.kernel: Kernel | None = None
         self._kernel_lib: Any = None
+        self.kernel_due = False  # the build runs: the kernel is taken when it is there
         self.table = TABLE
         self._c_fill = False  # the kernel refills every moving row's table itself
         self._fill_out: np.ndarray | None = None
-        kmode = kernel_wanted()
+        self._kmode = kmode = kernel_wanted()
         if kmode == "numpy":
             self.kernel_reason = "GTECAT_BANK_KERNEL=numpy"
         else:
-            self._kernel_lib, self.kernel_reason = kernel_library()
-            if self._kernel_lib is None and kmode == "c":
-                ctl.log(
-                    "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
-                    f"the bank ({self.kernel_reason})"
-                )
+            wait = kmode == "c" or ctl.clock.mode is ClockMode.REALTIME
+            self._kernel_lib, self.kernel_reason = kernel_library(wait)
+            if self._kernel_lib is None and not self.kernel_reason:
+                self.kernel_due = True
+                self.kernel_reason = "the compiled cycle is being built (numpy meanwhile)"
+            self._kernel_missing()
         #: the compiled fills of static PT tables (bank_modes), None without the kernel
         self.pt_run = PtRun(self._kernel_lib) if self._kernel_lib is not None else None
         self.pt_fill: PtFill | None = None  # (made with the rows)
@@ -340,10 +369,45 @@ class AxisBank:
         self.many_cycles = 0
         #: homing axis-cycles the compiled kernel ran (statistics)
         self.homing_rows_run = 0
+        #: of those, the cycles of drives resting in homing mode after their homing
+        self.rest_rows_run = 0
+        self.n_rest = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
         self.sampled_samples = 0
+        own_dict(self)  # (the cycle reads these; its helpers look into vars(): gtecat._attrs)
+
+    def _kernel_missing(self) -> None:
+        if self._kernel_lib is None and not self.kernel_due and self._kmode == "c":
+            self.ctl.log(
+                "GTECAT_BANK_KERNEL=c: the compiled cycle is not available, numpy runs "
+                f"the bank ({self.kernel_reason})"
+            )
+
+    def _take_kernel(self) -> None:
+        """The kernel's build ended (:attr:`kernel_due`): every axis goes back to its objects
+        (exactly, as at any release) and the rows are made again for the compiled cycle
+        (its short tables, its homing and resting rows) at the next refresh; without a
+        library, numpy goes on and :attr:`kernel_reason` says why."""
+        self.kernel_due = False
+        lib, self.kernel_reason = kernel_library()
+        self._kernel_missing()
+        if lib is None:
+            return
+        if self.built:
+            self.release_all()
+            self.built = False
+            self.groups = []
+            self.n = self.n_alive = 0
+            self.alive = np.zeros(0, bool)
+            self.disabled_reason = ""
+            self.kernel = self.pt_fill = None
+            for name in ("_gi", "_cluster_of", "order"):
+                self.__dict__.pop(name, None)
+        self._kernel_lib = lib
+        self.pt_run = PtRun(lib)
+        self.dirty = True
 
     def auto_min_axes(self) -> int:
         """The crossover of ``auto``: the compiled cycle wins from one axis on (1 axis moving:
@@ -423,6 +487,26 @@ class AxisBank:
             self.disabled_reason = "no drive the bank can run (mapping)"
             return
         self.groups = groups
+        #: every output byte of the bank's slaves (607Ah excluded), the row whose slave owns
+        #: it and what it held at the last re-index: the kernel's raw-write check of the
+        #: claimed ones (updated in place, so the kernel keeps its binding)
+        rx_all = [g.rx_bytes for g in groups]
+        self._rx_all = np.concatenate(rx_all) if rx_all else np.zeros(0, np.intp)
+        self._rx_row = np.concatenate(
+            [np.full(len(g.rx_bytes), g.rows[0], np.int64) for g in groups] or [np.zeros(0)]
+        ).astype(np.int64)
+        self._rx_snap = np.zeros(len(self._rx_all), np.uint8)
+        #: per output byte its group, per group whether it is claimed and its slave position
+        self._rx_group = np.concatenate(
+            [np.full(len(g.rx_bytes), gi, np.intp) for gi, g in enumerate(groups)]
+            or [np.zeros(0, np.intp)]
+        ).astype(np.intp)
+        self._g_claimed = np.zeros(len(groups), bool)
+        self._g_pos = np.array([g.position for g in groups], np.int64)
+        self._loaded = True  # the rows' constants changed (_reindex looks at them again)
+        self._singles: list[tuple[list[_Group], list[int], bool]] | None = None
+        #: the bank row of each of the controller's axes (-1: not in the bank)
+        self._rows_of_axes: list[int] | None = None
         self.group_of = [0] * len(axes)
         for gi, g in enumerate(groups):
             for r in g.rows:
@@ -450,6 +534,10 @@ class AxisBank:
         self.enc_pos, self.enc_vel, self.enc_acc = z(n), z(n), z(n)  # vel/acc: at the claim
         self.enc_step0, self.enc_step1 = z(n), z(n)  # the last two encoder steps, pulse
         self.claim_cycle = zi(n, np.int64)
+        #: a number for each claim of a row, 0 while it is out (a hook that counts on a row
+        #: staying claimed compares it: the same number, the same claim)
+        self.claim_ids = [0] * n
+        self._claims = 0
         self.bank_cycles = 0
         self.band, self.hold_ns = z(n), zi(n, np.int64)
         self.since = zi(n, np.int64)
@@ -485,6 +573,16 @@ class AxisBank:
         for name in _HM_U8:
             setattr(self, name, zi(n, bool))
         self.n_hm = self.n_frz = 0
+        #: 60FDh bits whose change sends a row back before the cycle (an input a bank-aware
+        #: hook samples every cycle: a capture unit's home input)
+        self.dwatch = zi(n, np.int64)
+        #: a row moving in Trap with a limit flag latched: bit 0 positive, bit 1 negative;
+        #: a sample toward that side sends it back before the cycle (AxisResources._post)
+        self.lvel = zi(n, np.uint8)
+        #: the bank-aware axis hooks of a claimed row (:meth:`_axis_hooks`), told at its release
+        self._aware: dict[int, list[Any]] = {}
+        #: releases so far (a hook that counts on rows staying claimed looks at it)
+        self.releases = 0
         self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
         #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
         #: back in the same move, instead of computed again
@@ -498,17 +596,25 @@ class AxisBank:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
         alive = self.alive
         self._stale = False
-        self.n_alive = int(alive.sum())
-        self.any_prf_link = bool(np.count_nonzero((self.prf_ratio != 1.0) | (self.prf_off != 0.0)))
-        self.any_enc_link = bool(np.count_nonzero((self.enc_ratio != 1.0) | (self.enc_off != 0.0)))
-        self.any_drive_offset = bool(np.count_nonzero(self.drive_offset))
-        self.all_external = bool(self.external.all())
-        self.any_sense = bool(np.count_nonzero(self.sense != 1))
-        self.any_band = bool(np.count_nonzero(self.band > 0))
+        self.n_alive = int(np.count_nonzero(alive))
+        if self._loaded:  # the rows' constants (they change only when a row is taken)
+            self._loaded = False
+            ratio, off = self.prf_ratio, self.prf_off
+            self.any_prf_link = bool(np.count_nonzero((ratio != 1.0) | (off != 0.0)))
+            ratio, off = self.enc_ratio, self.enc_off
+            self.any_enc_link = bool(np.count_nonzero((ratio != 1.0) | (off != 0.0)))
+            self.any_drive_offset = bool(np.count_nonzero(self.drive_offset))
+            self.all_external = bool(self.external.all())
+            self.any_sense = bool(np.count_nonzero(self.sense != 1))
+            self.any_band = bool(np.count_nonzero(self.band > 0))
+            self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
         self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.n_hm = int(np.count_nonzero(self.hm & alive))
+        self.n_rest = int(np.count_nonzero(self.h_done & alive)) if self.n_hm else 0
         self.n_frz = int(np.count_nonzero(self.frz & alive))
+        self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
+        self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
         self.band_dirty = True
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
         self.n_moving = int(np.count_nonzero(self.moving & alive))
@@ -516,15 +622,21 @@ class AxisBank:
         self._c_fill = self.kernel is not None and not np.count_nonzero(
             self.moving & alive & (self.nseg <= 0)
         )
-        self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
-        rx = [g.rx_bytes for g in self.groups if g.claimed]
-        self._rx_idx = np.concatenate(rx) if rx else np.zeros(0, np.intp)
+        g_claimed = self._g_claimed
+        self._rx_idx = self._rx_all[g_claimed[self._rx_group]]
         buf = self.ctl.master.image.buffer
         self._rx_ref = buf.take(self._rx_idx).tobytes()
-        claimed = {g.position for g in self.groups if g.claimed}
-        self.ctl.backend.claimed = claimed
-        banked = {id(self.axes[r]) for r in range(self.n) if alive[r]}
-        self.ctl._run_axes = [ax for ax in self.ctl._axis_list if id(ax) not in banked]
+        if len(self._rx_all):
+            np.take(buf, self._rx_all, out=self._rx_snap)
+        self.ctl.backend.claimed = set(self._g_pos[g_claimed].tolist())
+        rows = self._rows_of_axes
+        if rows is None or len(rows) != len(self.ctl._axis_list):
+            row_of = {id(ax): r for r, ax in enumerate(self.axes)}
+            rows = self._rows_of_axes = [row_of.get(id(ax), -1) for ax in self.ctl._axis_list]
+        out = alive.tolist()
+        self.ctl._run_axes = [
+            ax for ax, r in zip(self.ctl._axis_list, rows, strict=True) if r < 0 or not out[r]
+        ]
         self._lists.clear()
         if self.kernel is not None:
             self.kernel.bound = False
@@ -551,9 +663,11 @@ class AxisBank:
         m = ctl.master
         if m is None or not m.opened or not m.ready:
             return "bus not in OP"
-        if ctl.before_cycle or ctl.post_cycle or ctl.sample:
-            return "per-cycle hooks (recorder, programs, smart homing)"
-        if not all(_bank_safe(f) for f in ctl.pre_cycle):
+        if ctl.before_cycle or ctl.sample:
+            return "per-cycle hooks (recorder, programs)"
+        if not all(_bank_safe(f) for f in ctl.pre_cycle) or not all(
+            _bank_safe(f) for f in ctl.post_cycle
+        ):
             return "per-cycle hooks"
         if ctl.backend.unplugged:
             return "a slave is unplugged"
@@ -564,25 +678,28 @@ class AxisBank:
     @staticmethod
     def _homing_hook(ax: Any, res: Any) -> Any:
         """The axis's hooks are the resources' own plus at most the GT layer's homing
-        follower (gtecat.gt.homing_calls): that follower, None without one, False when
-        some other hook runs."""
+        follower (gtecat.gt.homing_calls) and bank-aware hooks that may be held now (a
+        capture unit, :func:`aware_hooks`): that follower, None without one, False when
+        some other hook runs or an aware one must run its next cycle."""
         if len(ax.pre_hooks) != 1:
             return False
         hooks = ax.post_hooks
         if not hooks or hooks[0] != res._post:
             return False
-        if len(hooks) == 1:
-            return None
-        if len(hooks) != 2:
-            return False
-        st = getattr(hooks[1], "__self__", None)
-        return st if getattr(st, "bank_homing_hook", False) else False
+        st = None
+        for h in hooks[1:]:
+            obj = getattr(h, "__self__", None)
+            if st is None and getattr(obj, "bank_homing_hook", False):
+                st = obj
+            elif not (getattr(obj, "bank_post_hook", False) and obj.bank_ready()):
+                return False
+        return st
 
     def _eligible(self, r: int) -> bool:
         """The scalar state the bank reproduces (module docstring)."""
         ax = self.axes[r]
         res = self.res[r]
-        if res is None or ax.number in self.held:
+        if res is None or ax.number in self.held or res.bank_hold:
             return False
         if not ax.servo_on:
             return self._eligible_frozen(r)
@@ -597,7 +714,7 @@ class AxisBank:
             return False
         if ax.prf_pos != res._a_last:
             return False
-        if res.latched and not self._latched_standing(ax, res):
+        if res.latched and not (self._latched_standing(ax, res) or self._latched_away(ax, res)):
             return False
         prof = res.profile
         pl = prof.planner
@@ -637,6 +754,29 @@ class AxisBank:
         prof = res.profile
         if prof.mode not in (PrfMode.TRAP, PrfMode.JOG) or not prof.planner.done:
             return False  # (a Gear or Follow slave may start with its master, no call on it)
+        s = res.safety
+        if s.active:
+            a = ax.prf_pos
+            if a > s.soft_positive or a < s.soft_negative:
+                return False
+            if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
+                return False
+        return True
+
+    @staticmethod
+    def _latched_away(ax: Any, res: Any) -> bool:
+        """A row moving in Trap with limit flags latched and nothing else (a smart homing
+        leaving the limit it stopped on): AxisResources._post stops such a motion only at a
+        sample toward a latched side, and the bank gives the row back before that cycle
+        (:attr:`lvel`); a soft limit or following error still exceeded stays scalar."""
+        if res.latched & ~(_POS_LIMIT | _NEG_LIMIT):
+            return False
+        prof = res.profile
+        pl = prof.planner
+        if prof.mode != PrfMode.TRAP or pl is not prof.trap or not isinstance(pl, TrapPlanner):
+            return False
+        if pl._mode != _MOVE:
+            return False
         s = res.safety
         if s.active:
             a = ax.prf_pos
@@ -698,18 +838,22 @@ class AxisBank:
         return not frozen_claimable(ch)
 
     def _eligible_homing(self, r: int) -> bool:
-        """An axis whose drive runs a homing search (gtecat.drives.homing_bank): the axis
-        layer only follows it (607Ah = 6064h, the plan = the actual position, the
-        encoder), so the compiled cycle runs the row whole."""
+        """An axis whose drive runs a homing search, or rests in homing mode after one
+        (gtecat.drives.homing_bank): the axis layer only follows it (607Ah = 6064h, the plan
+        = the actual position, the encoder), so the compiled cycle runs the row whole."""
         if self.kernel is None:
             return False  # the numpy cycle has no homing rows
         ax, res = self.axes[r], self.res[r]
         if not ax.servo_on or ax.link_lost or res._csp:
             return False
-        if ax.cw != 0x1F or ax._cw_sent != 0x1F:
-            return False
         st = self._homing_hook(ax, res)
-        if not st or not st.active or not st.answered:
+        if st is False:
+            return False
+        searching = st is not None and st.active
+        if searching:
+            if ax.cw != 0x1F or ax._cw_sent != 0x1F or not st.answered:
+                return False
+        elif ax.cw not in (0x0F, 0x1F) or ax._cw_sent != ax.cw:
             return False
         if res.latched or ax.prf_pos != res._a_last:
             return False
@@ -720,7 +864,8 @@ class AxisBank:
             return False
         if not self._inputs_plain(ax, res):
             return False
-        return not homing_claimable(self.csp.channels[r])
+        ch = self.csp.channels[r]
+        return not (homing_claimable(ch) if searching else homing_rest_claimable(ch))
 
     @staticmethod
     def _inputs_plain(ax: Any, res: Any) -> bool:
@@ -752,9 +897,9 @@ class AxisBank:
             if self.n_alive:
                 self.release_all()
             return
-        changed = missed = False
+        changed = missed = loaded = False
         for gs, srows, bad in self._components():
-            if all(g.claimed for g in gs):
+            if gs[0].claimed and (len(gs) == 1 or all(g.claimed for g in gs)):
                 continue
             held = [g for g in gs if g.claimed]
             if held:  # part of a cluster is out: the rest comes back too, then all together
@@ -773,6 +918,7 @@ class AxisBank:
                 self.sampled[r] = True
             for g in gs:
                 self._claim(g)
+            loaded = True
             if srows:
                 _Bypass.on = True
                 try:
@@ -784,6 +930,8 @@ class AxisBank:
                 for c in cl.systems:
                     c.banked = True
             changed = True
+        if loaded:
+            self.csp._flags()
         if changed:
             self._reindex()
         if self.n_alive == self.n:
@@ -813,7 +961,10 @@ class AxisBank:
         finally:
             _Bypass.on = False
         if not pairs and not sampled and not bad:
-            return [([g], [], False) for g in self.groups]
+            singles = self._singles
+            if singles is None:
+                singles = self._singles = [([g], [], False) for g in self.groups]
+            return singles
         group_of = self.group_of
         parent = list(range(len(self.groups)))
 
@@ -868,17 +1019,20 @@ class AxisBank:
                 return False
         return True
 
-    def _claim(self, g: _Group) -> bool:
-        if not self._can_claim(g):
-            return False
+    def _claim(self, g: _Group) -> None:
+        """Take the group (the caller found :meth:`_can_claim`); the drives' flags follow
+        in :meth:`refresh`, once for every group it takes."""
         for r in g.rows:
-            self.csp.load(r)
+            self.csp.load(r, flags=False)
             self._load(r)
         g.claimed = True
-        gi = self.groups.index(g)
+        gi = self._gi[id(g)]
+        self._g_claimed[gi] = True
+        self._loaded = True
         for obj in self._guarded_objects(g):
             _OWNER[id(obj)] = (self, gi)
             _set(obj, "__class__", _guard_class(type(obj)))
+            own_dict(obj)  # (a class assigned: see gtecat._attrs)
         return True
 
     def _guarded_objects(self, g: _Group) -> list[object]:
@@ -893,6 +1047,15 @@ class AxisBank:
     def _load(self, r: int) -> None:
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = True
+        aware = aware_hooks(ax)
+        watch = 0
+        for obj in aware:
+            watch |= obj.bank_watch
+        self.dwatch[r] = watch
+        if aware:
+            self._aware[r] = aware
+        latched = res.latched
+        self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
         self.layout += 1
         s = ax.pos_scale
@@ -912,6 +1075,8 @@ class AxisBank:
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
+        self._claims += 1
+        self.claim_ids[r] = self._claims
         b = res.band
         self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.since[r] = -1 if b._since is None else b._since
@@ -983,18 +1148,21 @@ class AxisBank:
             self.hm[r] = False
             return
         self.hm[r] = homing = ax.mode_cmd == _HOMING_MODE
-        if homing:  # the drive's search (gtecat.drives.homing_bank)
+        if homing:  # the drive's search, or its rest after one (gtecat.drives.homing_bank)
             h = ch.homing
             for name, attr in HM_ROW_FIELDS:
                 getattr(self, name)[r] = getattr(h, attr)
             self.h_set[r] = h._settled
-            for name, value in homing_constants(h).items():
+            self.h_done[r] = done = homing_resting(h)
+            consts = homing_rest_constants(h) if done else homing_constants(h)
+            for name, value in consts.items():
                 getattr(self, name)[r] = value
-            bounds = homing_event_bounds(h, ch.mech.pos)
+            bounds = (-math.inf, math.inf) if done else homing_event_bounds(h, ch.mech.pos)
             assert bounds is not None  # homing_claimable checked it
             self.h_lo[r], self.h_hi[r] = bounds
-            # 6041h: the state bits and remote, no mode bits while searching (step_hm's oms 0)
-            self.csp.sw_const[r] -= SW12
+            # 6041h: the state bits and remote, step_hm's bits instead of CSP's (oms =
+            # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
+            self.csp.sw_const[r] += ch.hm_bits - SW12
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
         """A moving row leaves: remember its table (its samples stay in ``t_p``/``t_v``/``t_a``
@@ -1006,6 +1174,28 @@ class AxisBank:
             return
         first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
         self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
+
+    def trap_quiet(self, r: int) -> int:
+        """The cycles from the next one on in which claimed row ``r``'s Trap move surely goes
+        on (the cycle that takes its end sample is not among them); 0 when the row is not
+        a claimed Trap move.  From the planner's own end test (TrapPlanner.step): sample
+        ``k`` is the end sample when ``k * T >= t_done - eps``."""
+        if not (self.alive[r] and self.moving[r]) or self.sampled[r] or self.jog[r]:
+            return 0
+        if self.hm[r] or self.frz[r]:
+            return 0
+        pl = self.res[r].profile.planner
+        cyc, t_done = _get(pl, "_T"), _get(pl, "_t_done")
+        thr = t_done - _EPS_T * (1.0 + t_done * 1e-3)
+        k = int(self.k0[r] + self.taken[r])  # the samples taken so far
+        if not (cyc > 0.0 and math.isfinite(thr)):
+            return 0
+        end = max(k + 1, math.ceil(thr / cyc))
+        while end > k + 1 and (end - 1) * cyc >= thr:
+            end -= 1
+        while end * cyc < thr:
+            end += 1
+        return end - 1 - k
 
     def keep_last_sample(self, rows: Any) -> None:
         """Before a row's table is written anew: the last sample taken moves to the row's
@@ -1103,6 +1293,16 @@ class AxisBank:
                 self.release_axis_object(ax)
         self.dirty = True
 
+    def before_axis_call(self, ax: Any, res: Any) -> None:
+        """What :meth:`before_call` does for a GT function naming one existing axis ``ax``
+        (its resources ``res``) by its first parameter (``axis``, ``profile`` or ``encoder``,
+        no ``count``), for the GT fast path: the bank looks again, and ``ax`` goes back.  A
+        row is alive exactly while its resources name this bank (:meth:`_load`,
+        :meth:`_store`), so an axis whose resources do not has nothing to give back."""
+        self.dirty = True
+        if self.n_alive and res.bank is self:
+            self.release_axis_object(ax)
+
     def release_axis_object(self, ax: Any) -> None:
         r = self._row_of.get(id(ax))
         if r is not None and self.alive[r]:
@@ -1129,9 +1329,17 @@ class AxisBank:
                 if cls in _GUARDS.values():
                     _set(obj, "__class__", cls.__mro__[1])
             g.claimed = False
+            self._g_claimed[self._gi[id(g)]] = False
         self.csp.store(rows)
         for r in rows:
             self._store(r)
+        self.releases += 1
+        for r in rows:
+            aware = self._aware.pop(r, None)
+            if aware:  # their cycles ran in the bank: the hooks catch up (nothing happened)
+                ran = int(self.bank_cycles - self.claim_cycle[r])
+                for obj in aware:
+                    obj.bank_released(ran)
         # the drive's process data buffers as its own steps would have left them: the entries
         # the bank wrote into the image in them too (its other bytes are as they were, so a
         # raw write or a changed constant still waits for a step of its own: _can_claim)
@@ -1162,6 +1370,7 @@ class AxisBank:
     def _store(self, r: int) -> None:
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = False
+        self.claim_ids[r] = 0
         res.bank = None
         self.layout += 1
         a = float(self.a_last[r])
@@ -1189,9 +1398,9 @@ class AxisBank:
             ch.mech.torque, ch.mech.acc = torque, acc
             return
         if self.hm[r]:
-            self.hm[r] = False
+            self.hm[r] = self.h_done[r] = False
             ch = self.csp.channels[r]
-            ch.oms = 0  # step_hm: hm_bits (0 while searching), no following-error flag
+            ch.oms = ch.hm_bits  # step_hm (no following-error flag: the row would have left)
             h = ch.homing
             for name, attr in HM_ROW_FIELDS:
                 setattr(h, attr, float(getattr(self, name)[r]))
@@ -1388,6 +1597,8 @@ class AxisBank:
             self._settled = True
 
     def _begin(self) -> None:
+        if self.kernel_due and kernel_settled():
+            self._take_kernel()
         self._countdown -= 1
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
@@ -1419,8 +1630,8 @@ class AxisBank:
                 else:
                     self._refill_in -= 1
                 rc = k.cycle(t_ns, dt)
-                while rc == 3:  # homing rows meeting an event: back to their drives first
-                    self._release_rows(np.nonzero(k.scratch["s_hit"] & self.hm)[0])
+                while rc == 3:  # rows leaving (an event, a limit): back to the scalar path first
+                    self._release_rows(np.nonzero(k.scratch["s_hit"] & self.alive)[0])
                     if not self.n_alive:
                         return
                     c_fill = self._c_fill
@@ -1485,6 +1696,11 @@ class AxisBank:
         hit = a > self.soft_pos
         if din is not csp._din_zero:
             hit |= (din & 3) != 0
+        if self.any_watch:  # an input a bank-aware hook samples changes (kernel: dwatch)
+            hit |= ((din ^ csp.din) & self.dwatch) != 0
+        if self.any_lvel:  # a sample toward a latched limit (kernel: lvel)
+            v = self.prf_ratio * self.t_v.take(idx)
+            hit |= ((self.lvel & 1) != 0) & (v > 0.0) | ((self.lvel & 2) != 0) & (v < 0.0)
         hit |= a < self.soft_neg
         hit |= np.abs(err) > self.pos_err
         if events is not None:
@@ -1591,7 +1807,12 @@ class AxisBank:
             n = min(n, self._refill_in - 1)  # no further than the shortest table goes
             if n <= 0:
                 return 0
-        _, done = k.run(t_ns, dt, dt_ns, n)
+        if self._declined:  # the last run stopped before a cycle the kernel declines
+            self._declined = False
+            return 0
+        rc, done = k.run(t_ns, dt, dt_ns, n)
+        # the next cycle is one it declines: cycle() runs it (a row leaving, a table to fill)
+        self._declined = bool(rc) and done > 0
         if done:
             self._countdown -= done - self._settled  # (the first one's count: in settle)
             self._settled = False
@@ -1615,10 +1836,14 @@ class AxisBank:
         self.bank_cycles += cycles
         self.kernel_cycles += cycles
         self.homing_rows_run += self.n_hm * cycles
+        self.rest_rows_run += self.n_rest * cycles
         self.frozen_rows_run += self.n_frz * cycles
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""
+        if not self.any_band:
+            self.n_standing_banded = 0
+            return
         st = ~self.moving & ~self.jog & (self.band > 0) & self.alive
         self.n_standing_banded = int(np.count_nonzero(st))
 

@@ -24,7 +24,6 @@ from __future__ import annotations
 import ctypes
 import logging
 import os
-import threading
 from importlib import resources
 from operator import attrgetter
 from pathlib import Path
@@ -32,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..cbuild import NativeBuildError, shared_library
+from ..cbuild import Background, NativeBuildError, shared_library
 
 if TYPE_CHECKING:
     from .bank import AxisBank
@@ -77,48 +76,58 @@ _SCRATCH = (
 _LIB: Any = None
 _LIB_REASON = ""
 _FIELDS: list[tuple[str, Any]] = []
-#: the build started ahead (:func:`prebuild`): the thread, then its library path or error
-_AHEAD: list[Any] = []
+#: the build started ahead (:func:`prebuild`), in a process of its own
+_AHEAD: list[Background] = []
 
 
 def prebuild() -> None:
-    """Start building the kernel in the background, where it is not built yet.
+    """Start building the kernel in a process of its own, where it is not built yet.
 
-    GT_InitEcatComm calls this before it reads the ENI: the first build on a machine (about
-    a second of the compiler) then runs beside the reading of the file and the making of the
-    drives, and :func:`library` (the bank, at the end of GT_InitEcatComm) waits for it.
-    The thread is not a daemon: a process that ends before it still finishes the build
-    (the next process finds it)."""
+    GT_Open calls this: the first build on a machine (about a second of the compiler) runs
+    beside everything else (Python compiling gtecat's modules on a first run, reading the
+    ENI, making the drives); a bank made meanwhile runs its numpy cycle and takes the kernel
+    when the build is there (:func:`library` with ``wait=False``, :func:`settled`).  The
+    builder finishes even when this process ends first: the next process finds it."""
+    global _LIB_REASON
     if _LIB is not None or _LIB_REASON or _AHEAD or wanted() == "numpy":
         return
+    try:
+        source = _source()
+        _AHEAD.append(
+            Background(
+                [
+                    ("bank_kernel", source, CFLAGS, ("-lm",)),
+                    ("bank_kernel", source, PLAIN_CFLAGS, ("-lm",)),
+                ]
+            )
+        )
+    except NativeBuildError as e:  # no compiler, no cache folder: the numpy cycle alone
+        _LIB_REASON = f"{type(e).__name__}: {e}"
+    except Exception as e:  # no builder process (no sys.executable): built here when asked
+        log.info("the bank kernel's build could not start beside the bus: %s", e)
 
-    def run() -> None:
-        try:
-            _AHEAD.append(build(CFLAGS))
-        except Exception as e:  # library() reports it
-            _AHEAD.append(e)
 
-    thread = threading.Thread(target=run, name="gtecat bank kernel build")
-    _AHEAD.append(thread)
-    thread.start()
+def settled() -> bool:
+    """Whether :func:`library` answers at once (the kernel loaded, refused, or its build
+    ended), never waiting; cheap enough to ask every cycle."""
+    return _LIB is not None or bool(_LIB_REASON) or not _AHEAD or _AHEAD[0].done()
 
 
 def _built() -> Path:
     """The kernel's library file: the build started ahead, else one built now."""
     if not _AHEAD:
         return build(CFLAGS)
-    _AHEAD[0].join()
-    result = _AHEAD[1]
-    if isinstance(result, Exception):
-        raise result
-    return result
+    return _AHEAD[0].wait()
 
 
-def library() -> tuple[Any, str]:
-    """(the loaded kernel or None, why not); built and loaded once per process."""
+def library(wait: bool = True) -> tuple[Any, str]:
+    """(the loaded kernel or None, why not); built and loaded once per process.
+    ``wait`` False: (None, "") while the build started ahead runs."""
     global _LIB, _LIB_REASON
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
+    if not wait and not settled():
+        return None, ""
     try:
         lib = ctypes.CDLL(str(_built()))
         lib.bank_kernel_fields.restype = ctypes.c_char_p
@@ -301,7 +310,7 @@ class Kernel:
         windows = {value: (lo, hi) for value, lo, hi in csp.windows}
         key = (
             tuple((id(lo), id(hi), lo.shape) for lo, hi in windows.values()),
-            *self._placement_key(),
+            self._placement_key(),
         )
         if key == self._extra_key and self._extra_last is not None:
             return dict(self._extra_last)
@@ -321,33 +330,34 @@ class Kernel:
         return dict(extra)
 
     def _placement_key(self) -> tuple[Any, ...]:
-        """What :meth:`_placements` builds its arrays from."""
+        """What :meth:`_placements` builds its arrays from: every placement and every output
+        byte of the bank's slaves, fixed when the bank is built (the kernel skips the rows it
+        does not run: a frozen row's image keeps what its scalar objects wrote)."""
         bank = self.bank
-        alive, frz = bank.alive.tolist(), bank.frz.tolist()
-        # a frozen row's image keeps what its scalar objects wrote
-        plc = tuple(p for p in bank._plc if alive[p[0]] and not frz[p[0]])
-        return plc, tuple(bank._rx_idx), bytes(bank._rx_ref) if bank._rx_ref else b""
+        return id(bank._plc), id(bank._rx_all)
 
-    def _placements(self, plc: tuple[Any, ...]) -> dict[str, np.ndarray]:
-        """``plc``: the placements of the rows the kernel writes (:meth:`_placement_key`)."""
+    def _placements(self, key: tuple[Any, ...]) -> dict[str, np.ndarray]:
+        """The placements of every row and the output bytes a raw write may change, with
+        their rows and the bytes the last re-index saw (``rx_ref``: updated in place)."""
         bank = self.bank
+        plc = bank._plc
         self.io[IN_N_PLC] = len(plc)
-        rx = np.asarray(bank._rx_idx, np.int64)
+        rx = bank._rx_all
         self.io[IN_N_RX] = len(rx)
         return {
             "pl_row": np.array([p[0] for p in plc] or [0], np.int64),
             "pl_off": np.array([p[1] for p in plc] or [0], np.int64),
             "pl_size": np.array([p[2] for p in plc] or [0], np.int64),
             "pl_col": np.array([COLUMNS[p[3]] for p in plc] or [0], np.int64),
-            "rx_idx": rx if len(rx) else np.zeros(1, np.int64),
-            "rx_ref": np.frombuffer(bank._rx_ref, np.uint8).copy()
-            if bank._rx_ref
-            else np.zeros(1, np.uint8),
+            "rx_idx": rx.astype(np.int64) if len(rx) else np.zeros(1, np.int64),
+            "rx_row": bank._rx_row if len(rx) else np.zeros(1, np.int64),
+            "rx_ref": bank._rx_snap if len(rx) else np.zeros(1, np.uint8),
         }
 
     def cycle(self, t_ns: int, dt: float) -> int:
-        """0: the cycle ran and is committed; 1/2: nothing was written (the numpy cycle
-        must run it: a raw write, a row leaving)."""
+        """0: the cycle ran and is committed; 1, 4, 5: nothing was written (the numpy cycle
+        must run it: a raw write, a table to fill, no memory); 3: nothing was written, the
+        rows marked in ``scratch["s_hit"]`` leave first (an event, a limit)."""
         if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
             self.bind()
         self.io[IN_T_NS] = t_ns

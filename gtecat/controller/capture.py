@@ -92,6 +92,13 @@ def _wrap32(d: int) -> int:
 class CaptureUnit:
     """The capture of encoder ``number`` (the module docstring says what it sees)."""
 
+    #: the axis bank may hold this unit's axis (:func:`gtecat.controller.bank.aware_hooks`):
+    #: with the touch probe idle, :meth:`_post` only follows the home input, so the bank runs
+    #: the cycles and the unit catches up at the release; where an edge matters (a home
+    #: capture armed, a reader of the level: :attr:`bank_watch`) the bank gives the axis
+    #: back before the input changes
+    bank_post_hook = True
+
     def __init__(self, ctl: Any, res: AxisResources) -> None:
         self.ctl = ctl
         self.res = res
@@ -109,6 +116,10 @@ class CaptureUnit:
         self._tp_pending = False
         self._tp_seen = 0
         self._tp_error = ""
+        #: settings changed by a call (arm, clear, sense, reset, wiring): a count a watcher
+        #: compares (smart homing: :meth:`SmartHome.quiet`)
+        self.changes = 0
+        self._level_watch = 0  # readers of the home level or edges every cycle (watch_level)
         self.reset_settings()
         self.edges: list[SeenEdge] = []
         self.step = 0.0
@@ -118,6 +129,7 @@ class CaptureUnit:
     # --- settings --------------------------------------------------------------------------
     def reset_settings(self) -> None:
         """GT_Reset: no capture, status 0, every sense 0 (falling edge: switch reached)."""
+        self.changes += 1
         self.mode = CAPTURE_NONE
         self.status = 0
         self.value = 0
@@ -137,6 +149,7 @@ class CaptureUnit:
 
         reverse = switch_sense(self.ctl, "home", self.number)[1]  # the wiring it meets
         if reverse != self.home_reverse:
+            self.changes += 1
             self.home_reverse = reverse
             self._home_prev = self.home_level()
 
@@ -179,10 +192,13 @@ class CaptureUnit:
         if why:
             raise CommandError(why)
         self.refresh_wiring()
+        self.changes += 1
         self.mode = mode
         self.status = 0
         self._edge = edge
         self._accept = accept
+        if mode == CAPTURE_HOME:
+            self._watch_grew()
         if not self.on_card:
             self._want_probe(
                 _TP_INDEX if mode == CAPTURE_INDEX else _TP_PROBE if mode == CAPTURE_PROBE else 0
@@ -190,13 +206,17 @@ class CaptureUnit:
 
     def clear(self) -> None:
         """GT_ClearCaptureStatus: status 0, the mode armed again."""
+        self.changes += 1
         self.status = 0
+        if self.mode == CAPTURE_HOME:
+            self._watch_grew()
 
     def set_sense(self, mode: int, sense: int) -> None:
         if mode not in MODE_NAMES:
             raise ParameterError(f"mode={mode}: 1 CAPTURE_HOME, 2 CAPTURE_INDEX or 3 CAPTURE_PROBE")
         if sense not in (0, 1):
             raise ParameterError(f"sense={sense}: 0 (falling edge) or 1 (rising edge)")
+        self.changes += 1
         self.sense[mode] = sense
 
     # --- levels -----------------------------------------------------------------------------
@@ -210,6 +230,49 @@ class CaptureUnit:
     def enc(self) -> float:
         """The encoder value of this cycle."""
         return self.res.encoder.pos
+
+    # --- the axis bank ------------------------------------------------------------------------
+    @property
+    def bank_watch(self) -> int:
+        """The 60FDh bits whose change gives the axis back before its cycle: the home input
+        while a home capture is armed or someone reads its level or edges every cycle
+        (:meth:`watch_level`); else none (the unit takes the level up at the release, and
+        nobody reads the edges the cycles in between made)."""
+        if self._level_watch or (self.mode == CAPTURE_HOME and not self.status):
+            return _HOME_BIT
+        return 0
+
+    def watch_level(self, on: bool) -> None:
+        """A reader of the home level or edges after every cycle starts (stops): smart
+        homing's waits on the home input."""
+        self._level_watch += 1 if on else -1
+        if on:
+            self._watch_grew()
+
+    def _watch_grew(self) -> None:
+        """An axis the bank holds without watching the home input gives it back (its next
+        claim watches it)."""
+        bank = self.res.bank
+        if bank is not None:
+            bank.release_axis_object(self.ax)
+
+    def bank_ready(self) -> bool:
+        """The next cycles' :meth:`_post` can find an edge only where the home input changes
+        its level (which the bank watches): no card latch, the touch probe neither armed nor
+        being written, the home level the one last seen."""
+        if self._card_edges is not None or self._tp_want or self._tp_sent or self._tp_pending:
+            return False
+        return self._home_prev == self.home_level()
+
+    def bank_released(self, cycles: int) -> None:
+        """The bank ran ``cycles`` cycles of the axis: what :meth:`_post` would have left (this
+        cycle's encoder step, the home level; no edge: the input did not change where it was
+        watched, and where it was not, nobody reads the edges)."""
+        if cycles:
+            enc = self.res.encoder
+            self.step = enc.vel * self.res.cycle_ms if enc.active else 0.0
+            self.edges = []
+            self._home_prev = self.home_level()
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:

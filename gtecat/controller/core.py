@@ -52,6 +52,7 @@ from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
 from gtecat.eni.reader import read_eni
 
+from .._attrs import own_dict
 from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
 from ..master.clock import Clock, ClockMode
@@ -139,6 +140,10 @@ class Controller:
             raise ParameterError(
                 f"backend {self.options.backend!r} unknown; use emulated or pysoem"
             )
+        if self.options.bank != "off" and self.options.backend == "emulated":
+            # a first build of the bank's compiled cycle on this machine runs in a process of
+            # its own beside the rest of the bring-up (the bank takes it when it is there)
+            prebuild_kernel()
         cycle_ns = round((self.options.cycle_ms or 1.0) * 1_000_000)
         self.clock = Clock(
             self._cycle,
@@ -183,6 +188,8 @@ class Controller:
             from .card import open_card
 
             open_card(self, self.options.card)
+        # its attributes are read by every GT call; vars(ctl) elsewhere must not slow them
+        own_dict(self)  # (gtecat._attrs; before a cycle thread starts)
         if mode is ClockMode.REALTIME:
             self.clock.start_realtime()
 
@@ -237,7 +244,7 @@ class Controller:
             )
         banked = self.options.bank != "off" and self.options.backend == "emulated"
         if banked:
-            prebuild_kernel()  # a first build on this machine runs beside the reading below
+            prebuild_kernel()  # (GT_Open started it; again for options changed since)
         try:
             config = read_eni(path, _eni_cache(path))
         except EniError:
@@ -350,7 +357,8 @@ class Controller:
 
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has
-        anything to do in them: every axis claimed by the bank, no hook, the bus steady
+        anything to do in them: every axis claimed by the bank, no hook (or only hooks that
+        say they stay quiet that long: :func:`_quiet_way`), the bus steady
         (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
         one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
         cycles run, 0 when the next one must go through :meth:`_cycle`.
@@ -370,7 +378,6 @@ class Controller:
             bank is None
             or bank.kernel is None
             or self.before_cycle
-            or self.post_cycle
             or self.sample
             or self._links_down
             or self.clock._run_cycle != self._cycle
@@ -382,7 +389,7 @@ class Controller:
             return 0
         n = min(n, self.BATCH_CYCLES)
         hooks = ()
-        if self.pre_cycle:
+        if self.pre_cycle or self.post_cycle:
             hooks = self._hook_ways()
             for quiet, _ in hooks:
                 n = quiet(n)
@@ -400,10 +407,10 @@ class Controller:
         return done
 
     def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:
-        """Per ``pre_cycle`` hook: how many of the next cycles it is quiet in (``n`` ->
-        :func:`_quiet_way`), and its object's ``cycles_passed`` (None: it has none);
-        looked up once while the hooks stay the same."""
-        pre = tuple(self.pre_cycle)
+        """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles
+        it is quiet in (``n`` -> :func:`_quiet_way`), and its object's ``cycles_passed``
+        (None: it has none); looked up once while the hooks stay the same."""
+        pre = (*self.pre_cycle, *self.post_cycle)
         cached = self._hooks_seen
         if cached is not None and cached[0] == pre:
             return cached[1]
@@ -419,7 +426,7 @@ class Controller:
 
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
     BATCH_CYCLES = 1000
-    #: the pre_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
+    #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
     _hooks_seen: tuple[tuple[Any, ...], Any] | None = None
 
     def _watch_links(self, offline: dict[int, str]) -> None:
@@ -502,12 +509,12 @@ class Controller:
 
 
 def _quiet_way(hook: Callable[[int, int], None]) -> Callable[[int], int]:
-    """``quiet(n)``: how many of the next ``n`` cycles a ``pre_cycle`` hook has nothing to do
-    in (0: it must run in the next one); its object says so: ``quiet_cycles(n)`` (the fault
-    injector: until its first trigger is due), or ``bank_quiet()`` for all or none (the
-    coordinate systems while the axis bank steps every running one).  After cycles run
-    at once, the object's ``cycles_passed(k)``, if it has one, counts them
-    (:meth:`Controller._hook_ways`)."""
+    """``quiet(n)``: how many of the next ``n`` cycles a ``pre_cycle`` or ``post_cycle`` hook
+    has nothing to do in (0: it must run in the next one); its object says so:
+    ``quiet_cycles(n)`` (the fault injector: until its first trigger is due; smart homing:
+    until a homing's Trap leg ends), or ``bank_quiet()`` for all or none (the coordinate
+    systems while the axis bank steps every running one).  After cycles run at once, the
+    object's ``cycles_passed(k)``, if it has one, counts them (:meth:`Controller._hook_ways`)."""
     obj = getattr(hook, "__self__", None)
     horizon = getattr(obj, "quiet_cycles", None)
     if horizon is not None:

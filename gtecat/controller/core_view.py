@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .._attrs import own_dict
+
 if TYPE_CHECKING:
     from .axis import Axis
     from .core import Controller
@@ -39,6 +41,7 @@ class CoreView:
         self.axes: dict[int, Axis] = {}
         self.resources: dict[int, Any] = {}
         self._sync()
+        own_dict(self)  # (its own systems are found by vars(): gtecat._attrs)
 
     def _sync(self) -> None:
         """Renumber the bus axes of this core's range (again after a new bus bring-up)."""

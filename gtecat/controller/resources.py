@@ -164,6 +164,10 @@ class AxisResources:
         #: set, the readers below answer from the bank
         self.bank: Any = None
         self.bank_row = 0
+        #: something stepping this axis from outside every cycle for now (a smart homing
+        #: about to start its next leg): the bank does not take the axis, which it would
+        #: only have to give back at once
+        self.bank_hold = False
         ax.pre_hooks.append(self._pre)
         ax.post_hooks.append(self._post)
         ax.motion = self

@@ -263,6 +263,7 @@ class _Abort(Exception):
 
 
 _Steps = Generator[None, None, Any]
+_get = object.__getattribute__  # a claimed axis's objects read without giving it back
 
 
 class SmartHome:
@@ -286,10 +287,36 @@ class SmartHome:
         self._before = 0
         self._raised = 0
         self._expect: int | None = None
+        #: the search waits in a loop that only its own axis can end (the end of the Trap
+        #: leg, a limit or home input of the axis: :meth:`quiet`)
+        self._waiting = False
+        #: (controller time, claim) up to which :meth:`quiet` found nothing to do
+        self._q_due = 0
+        self._q_claim = 0  # (0: none)
+        self._q_row = 0
+        #: what the last step saw of what a call may change (:meth:`quiet`)
+        self._seen_latched = -1
+        self._seen_changes: tuple[int, int] = (-1, -1)
 
     @property
     def running(self) -> bool:
         return self._gen is not None
+
+    @property
+    def _waiting(self) -> bool:
+        return self._wait
+
+    @_waiting.setter
+    def _waiting(self, on: bool) -> None:
+        """The search waits in a loop only its own axis can end (:meth:`quiet`); while it
+        runs otherwise, it steps every cycle, so the axis bank leaves the axis alone
+        (``bank_hold``) instead of taking it for a cycle and giving it back."""
+        self._wait = on
+        self.res.bank_hold = self._gen is not None and not on
+        if on and self.res.bank is None:
+            bank = getattr(self.ctl, "bank", None)
+            if bank is not None:
+                bank.dirty = True  # the axis may be taken now: looked at before the next cycle
 
     # --- GT_GoHome ------------------------------------------------------------------------------
     def start(self, prm: HomeParams, caller: Any = None) -> None:
@@ -359,9 +386,11 @@ class SmartHome:
         self._raised = 0
         self._failing = False
         self._expect = None
+        self._q_claim = 0
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
+        self._waiting = False  # (its first step comes after the next cycle)
         _register(self.ctl, self)
 
     def _refuse(self, error: HomeError, reason: str) -> None:
@@ -403,6 +432,40 @@ class SmartHome:
         return capture_unit(numbering, prm.triggerIndex)
 
     # --- the cycle ----------------------------------------------------------------------------
+    def quiet(self, bank: Any) -> int | None:
+        """None when the next :meth:`cycle` may have something to do; else the cycles after
+        the next one in which it surely has nothing either.
+
+        That holds while the search waits in a Trap leg (or a stop, or the move home) that
+        only its own axis can end and the axis bank runs that axis in the middle of the
+        move: no input of the axis changed (a limit, the home input of its capture unit:
+        each gives the axis back before its cycle), no flag latched, no call touched it
+        (that too gives it back), so the loop would only look and wait again.  The count
+        ends before the cycle that takes the move's end sample (:meth:`AxisBank.trap_quiet`)."""
+        if not self._waiting or self._failing or self._gen is None or bank is None:
+            return None
+        res = self.res
+        if res.bank is not bank:
+            return None
+        r = res.bank_row
+        if not (bank.alive[r] and bank.moving[r]):
+            return None
+        # what a call may have changed since the last step (a call gives the axis back
+        # first, and the bank may take it again before the next cycle): as the step saw it
+        if res.latched != self._seen_latched:
+            return None
+        if (self.unit.changes, self._trigger.changes) != self._seen_changes:
+            return None
+        prof = res.profile
+        if prof.mode != PrfMode.TRAP:
+            return None
+        trap = prof.trap
+        if _get(trap, "stopping") != StopKind.NONE or _get(trap, "_target") != self._expect:
+            return None
+        if not _get(res.ax, "servo_on") or self._limit(1) or self._limit(-1):
+            return None
+        return bank.trap_quiet(r)
+
     def cycle(self) -> None:
         """After every cycle (all axes have read their inputs)."""
         if self._gen is None:
@@ -410,8 +473,7 @@ class SmartHome:
         res = self.res
         if self._failing:
             if res.profile.planner.done or not res.ax.servo_on:
-                self._gen = None
-                self.status.run = 0
+                self._end()
             return
         self._raised |= res.latched & (_POS | _NEG) & ~self._before
         error = self._watch()
@@ -424,6 +486,8 @@ class SmartHome:
             self._finish()
         except _Abort as a:
             self._fail(a.error, str(a))
+        self._seen_latched = res.latched
+        self._seen_changes = (self.unit.changes, self._trigger.changes)
 
     def _watch(self) -> tuple[HomeError, str] | None:
         res = self.res
@@ -443,14 +507,19 @@ class SmartHome:
             trap.stop(self._trap.dec)
         self._failing = True
         if self.res.profile.planner.done or not self.res.ax.servo_on:
-            self._gen = None
-            self.status.run = 0
+            self._end()
         self.ctl.log(f"Axis {self.number}: smart home error {int(error)}: {reason}")
+
+    def _end(self) -> None:
+        """The homing is over (status run 0); the axis bank may take the axis again."""
+        self._gen = None
+        self.status.run = 0
+        self.res.bank_hold = False
 
     def _finish(self) -> None:
         st = self.status
-        st.stage, st.run = Stage.END, 0
-        self._gen = None
+        st.stage = Stage.END
+        self._end()
         self._clear_raised(self._raised)
         self.res.profile.trap_target = round(self.res.profile.trap.pos)
 
@@ -525,11 +594,12 @@ class SmartHome:
     def _search_home(self, d: int, turn: bool) -> _Steps:
         p, st, unit = self.params, self.status, self._trigger
         unit.refresh_wiring()
+        own = unit is self.unit  # (another axis's capture: its edges come any cycle)
         dist = p.searchHomeDistance or UNLIMITED
         if p.edge == 0 and unit.home_level():
             st.stage = Stage.START  # on the switch: leave it first, backwards
             why, _ = yield from self._leg(
-                -d, dist, p.velHigh, lambda: not unit.home_level() or None
+                -d, dist, p.velHigh, lambda: not unit.home_level() or None, own, unit
             )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the axis did not get off the home switch")
@@ -538,7 +608,7 @@ class SmartHome:
         for attempt in (0, 1):
             self._arm(unit, CAPTURE_HOME, p.edge)
             why, pos = yield from self._leg(
-                d, dist, p.velHigh, lambda: unit.pos if unit.status else None
+                d, dist, p.velHigh, lambda: unit.pos if unit.status else None, own
             )
             if why == "event":
                 st.capturePos = _long(round(pos))
@@ -546,7 +616,7 @@ class SmartHome:
                 return pos
             if why == "limit" and turn and attempt == 0:
                 yield from self._stop()  # the home is behind: back over the whole switch
-                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit))
+                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit), own, unit)
                 if why != "event":
                     raise _Abort(HomeError.NO_HOME, "no home switch between the limits")
                 yield from self._stop()
@@ -584,7 +654,9 @@ class SmartHome:
             if not unit.on_card:
                 yield  # the drive's touch probe arms in two cycles (60B8h off, on)
                 yield
-            why, pos = yield from self._leg(d, dist, vel, lambda: unit.pos if unit.status else None)
+            why, pos = yield from self._leg(
+                d, dist, vel, lambda: unit.pos if unit.status else None, unit is self.unit
+            )
             if why == "event":
                 st.capturePos = _long(round(pos))
                 yield from self._stop()
@@ -606,7 +678,8 @@ class SmartHome:
 
     def _search_gpi(self, d: int) -> _Steps:
         p, st, unit = self.params, self.status, self.unit
-        if p.triggerIndex == -1:
+        own = p.triggerIndex == -1  # (a GPI of the IO: it may change in any cycle)
+        if own:
             unit.refresh_wiring()
             level: Callable[[], bool] = unit.home_level
         else:
@@ -617,13 +690,17 @@ class SmartHome:
         for attempt in (0, 1):
             if level():
                 break
-            why, _ = yield from self._leg(d, dist, p.velHigh, lambda: level() or None)
+            why, _ = yield from self._leg(
+                d, dist, p.velHigh, lambda: level() or None, own, unit if own else None
+            )
             if why == "event":
                 break
             if why != "limit" or attempt:
                 raise _Abort(HomeError.NO_HOME, "the trigger did not become active")
             yield from self._stop()  # behind: back over the whole active zone, then again
-            why, _ = yield from self._leg(-d, dist, p.velHigh, _passed_level(level))
+            why, _ = yield from self._leg(
+                -d, dist, p.velHigh, _passed_level(level), own, unit if own else None
+            )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the trigger is not active between the limits")
             yield from self._stop()
@@ -633,7 +710,7 @@ class SmartHome:
         def gone() -> float | None:
             return None if level() else unit.enc - 0.5 * unit.step
 
-        why, pos = yield from self._leg(-d, dist, p.velLow, gone)
+        why, pos = yield from self._leg(-d, dist, p.velLow, gone, own, unit if own else None)
         if why != "event":
             raise _Abort(HomeError.NO_HOME, "the trigger did not become inactive on the way back")
         st.capturePos = _long(round(pos))
@@ -669,27 +746,44 @@ class SmartHome:
         self._expect = target
 
     def _leg(
-        self, d: int, distance: float, vel: float, watch: Callable[[], Any] | None = None
+        self,
+        d: int,
+        distance: float,
+        vel: float,
+        watch: Callable[[], Any] | None = None,
+        own: bool = True,
+        levels: CaptureUnit | None = None,
     ) -> _Steps:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
-        position) when the limit in ``d`` is reached, or ("end", None)."""
+        position) when the limit in ``d`` is reached, or ("end", None).  ``own``: ``watch``
+        reads inputs of this axis only (its home input, its capture), so the wait may be
+        :meth:`quiet`; ``levels``: the capture unit whose home level or edges ``watch``
+        reads (:meth:`CaptureUnit.watch_level`)."""
         trap = self.res.profile.trap
         if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc
         self._begin(d, _long(round(trap.pos + d * distance)), vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
-        while True:
-            yield
-            if watch is not None:
-                value = watch()
-                if value is not None:
-                    return "event", value
-            if self._limit(d) or self.res.latched & bit & ~before:
-                return "limit", self.unit.enc - 0.5 * self.unit.step
-            self._check_plan(trap)
-            if trap.done:
-                return "end", None
+        if levels is not None:
+            levels.watch_level(True)
+        self._waiting = own
+        try:
+            while True:
+                yield
+                if watch is not None:
+                    value = watch()
+                    if value is not None:
+                        return "event", value
+                if self._limit(d) or self.res.latched & bit & ~before:
+                    return "limit", self.unit.enc - 0.5 * self.unit.step
+                self._check_plan(trap)
+                if trap.done:
+                    return "end", None
+        finally:
+            self._waiting = False
+            if levels is not None:
+                levels.watch_level(False)
 
     def _check_plan(self, trap: Any) -> None:
         if trap.stopping != StopKind.NONE:
@@ -710,8 +804,12 @@ class SmartHome:
             target = math.ceil(x) if v > 0 else math.floor(x)
             trap.update(target=target)
             self._expect = target
-        while not trap.done:
-            yield
+        self._waiting = True
+        try:
+            while not trap.done:
+                yield
+        finally:
+            self._waiting = False
 
     def _goto(self, target: int, vel: float) -> _Steps:
         trap = self.res.profile.trap
@@ -721,13 +819,17 @@ class SmartHome:
         self._begin(d, target, vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
-        while True:
-            yield
-            if self._limit(d) or self.res.latched & bit & ~before:
-                raise _Abort(HomeError.STAGE, f"a limit on the way to {target}")
-            self._check_plan(trap)
-            if trap.done:
-                return
+        self._waiting = True
+        try:
+            while True:
+                yield
+                if self._limit(d) or self.res.latched & bit & ~before:
+                    raise _Abort(HomeError.STAGE, f"a limit on the way to {target}")
+                self._check_plan(trap)
+                if trap.done:
+                    return
+        finally:
+            self._waiting = False
 
     def _limit(self, d: int) -> bool | None:
         """The limit input in direction ``d``: as wired (module docstring, "Limits"), else
@@ -771,7 +873,94 @@ def _long(v: int) -> int:
 
 # --- the controller side ----------------------------------------------------------------------
 _HOMES: weakref.WeakKeyDictionary[AxisResources, SmartHome] = weakref.WeakKeyDictionary()
-_RUNNING: weakref.WeakKeyDictionary[Any, list[SmartHome]] = weakref.WeakKeyDictionary()
+_RUNNING: weakref.WeakKeyDictionary[Any, _Homings] = weakref.WeakKeyDictionary()
+
+
+class _Homings:
+    """The smart homings running on one controller, stepped after every cycle (its
+    ``post_cycle`` hook, :meth:`cycle`).
+
+    The axis bank may run their axes: a homing step reaches a claimed axis only through its
+    guards, which give it back first (``bank_safe``).  A homing whose axis the bank runs in
+    the middle of a Trap leg has nothing to do until the leg's end sample or an input of the
+    axis changes, which gives the axis back before that cycle (:meth:`SmartHome.quiet`).
+    Such homings are not stepped, and :meth:`quiet_cycles` tells the controller how many
+    cycles it may run at once (:func:`gtecat.controller.core._quiet_way`).  Times are the
+    controller's (ns): :attr:`_due` is the start of the first cycle after which some homing
+    may have to step, valid while the bank has released nothing since (:attr:`_seen`)."""
+
+    bank_safe = True
+
+    def __init__(self, ctl: Any) -> None:
+        self._ref = weakref.ref(ctl)
+        self.running: list[SmartHome] = []
+        self._due = 0
+        self._seen = -1
+
+    def add(self, home: SmartHome) -> None:
+        if home not in self.running:
+            self.running.append(home)
+        self._seen = -1
+
+    def clear(self) -> None:
+        self.running.clear()
+        self._seen = -1
+
+    def cycle(self, t: int, dt: int) -> None:
+        """After the cycle that started at ``t``: step every homing that may have to."""
+        running = self.running
+        if not running:
+            return
+        ctl = self._ref()
+        if ctl is None:
+            return
+        bank = ctl.bank
+        if bank is not None and self._seen == bank.releases and t < self._due:
+            return  # nothing to do for any of them in this cycle
+        self._settle(bank, t + dt, step=True)
+
+    def quiet_cycles(self, n: int) -> int:
+        """How many of the next ``n`` cycles no homing has anything to do in."""
+        if not self.running:
+            return n
+        ctl = self._ref()
+        if ctl is None:
+            return n
+        bank = ctl.bank
+        t0, dt = ctl.clock.now_ns, ctl.clock.cycle_ns
+        if bank is None or self._seen != bank.releases or t0 >= self._due:
+            self._settle(bank, t0, step=False)
+        return min(n, max(0, -((t0 - self._due) // dt)))
+
+    def _settle(self, bank: Any, t_next: int, step: bool) -> None:
+        """Find :attr:`_due` for the cycles from the one starting at ``t_next``; ``step``:
+        step the homings that may have something to do in the cycle that just ran."""
+        dt = self._ref().clock.cycle_ns
+        seen = bank.releases if bank is not None else -1
+        ids = bank.claim_ids if bank is not None else ()
+        t_prev = t_next - dt
+        due = None
+        for home in list(self.running):
+            d = home._q_due
+            if not (t_prev < d and home._q_claim and ids[home._q_row] == home._q_claim):
+                q = home.quiet(bank)  # (not found quiet before, or another claim since)
+                if q is None:
+                    home._q_claim = 0
+                    d = t_next
+                    if step:
+                        home.cycle()
+                        if not home.running:
+                            self.running.remove(home)
+                            continue
+                else:
+                    r = home.res.bank_row
+                    d = home._q_due = t_next + q * dt
+                    home._q_row, home._q_claim = r, ids[r]
+            if due is None or d < due:
+                due = d
+        self._due = t_next if due is None else due
+        # a step that gave an axis back may have changed another homing's axis: look again
+        self._seen = seen if bank is not None and bank.releases == seen else -1
 
 
 def smart_home(ctl: Any, axis: int) -> SmartHome:
@@ -787,29 +976,14 @@ def smart_home(ctl: Any, axis: int) -> SmartHome:
     if home is None:
         home = _HOMES[res] = SmartHome(base, res)
     if base not in _RUNNING:
-        _RUNNING[base] = []
-        ref = weakref.ref(base)
-        base.post_cycle.append(lambda t, dt: _cycle(ref()))
+        homings = _RUNNING[base] = _Homings(base)
+        base.post_cycle.append(homings.cycle)
         base.on_reset.append(_reset)
     return home
 
 
 def _register(ctl: Any, home: SmartHome) -> None:
-    running = _RUNNING[ctl]
-    if home not in running:
-        running.append(home)
-
-
-def _cycle(ctl: Any) -> None:
-    if ctl is None:
-        return
-    running = _RUNNING.get(ctl)
-    if not running:
-        return
-    for home in list(running):
-        home.cycle()
-        if not home.running:
-            running.remove(home)
+    _RUNNING[ctl].add(home)
 
 
 def _reset(ctl: Any) -> None:

@@ -194,8 +194,10 @@ class CspBank:
             self.windows.append((1 << bit, lo, hi))
         self._flags()
 
-    def load(self, r: int) -> None:
-        """Take row ``r``'s state from its channel (which must be :func:`claimable`)."""
+    def load(self, r: int, flags: bool = True) -> None:
+        """Take row ``r``'s state from its channel (which must be :func:`claimable`);
+        ``flags`` False: the caller calls :meth:`_flags` once after loading several rows,
+        before the next step or output."""
         ch = self.channels[r]
         m = ch.mech
         self.din[r] = ch.digital_inputs
@@ -222,7 +224,8 @@ class CspBank:
         self.fe_timeout[r] = ch.following_error_timeout
         self.nl[r], self.pl[r] = ch._nl, ch._pl
         self.sw_const[r] = _SW_BASE | SW12 | (_SW_REMOTE if ch._settings.remote else 0)
-        self._flags()
+        if flags:
+            self._flags()
 
     def _prepare(self, dt: float) -> None:
         """``Mechanics._prepare`` per row, with math.exp (numpy's exp may differ by an ulp)."""
@@ -421,7 +424,14 @@ class CspBank:
             "digital_inputs",
             "statusword",
         )
-        out = {name: self.output(name) for name in names}
+        if rows is None or 4 * len(rows) >= self.n:
+            out = {name: self.output(name) for name in names}
+            at = list(range(self.n))
+        else:  # a few rows (one slave given back): their values alone, the same operations
+            out = self._row_outputs(np.asarray(rows, np.intp))
+            at = [0] * self.n
+            for k, r in enumerate(rows):
+                at[r] = k
         wrapped = {"position_actual", "position_demand", "velocity_actual"}
         wrapped.add("following_error_actual")
         for r in range(len(self.channels)) if rows is None else rows:
@@ -441,10 +451,36 @@ class CspBank:
             ch.cycle += self.cycles - int(self.start[r])
             self.start[r] = self.cycles
             ch.target_position = int(self.target[r])
+            k = at[r]
             for name, values in out.items():
-                x = int(values[r])
+                x = int(values[k])
                 setattr(ch, name, wrap32(x) if name in wrapped else x)
             ch.mode_display = ch.mode
+
+    def _row_outputs(self, idx: np.ndarray) -> dict[str, np.ndarray]:
+        """:meth:`output` of the committed state for the rows ``idx`` only (in that order):
+        element by element the same operations."""
+        pos, dpos, vel, acc = self.pos[idx], self.dpos[idx], self.vel[idx], self.acc[idx]
+        off = self.off[idx]
+        x = pos - off if self.any_off else pos
+        din = 2 * (pos >= self.pl[idx]) + (pos <= self.nl[idx])
+        for value, lo, hi in self.windows:
+            p = pos[:, None]
+            din = din | (((lo[idx] <= p) & (p < hi[idx])).any(axis=1) * value)
+        lim = self.limited[idx] | self.sw_limited[idx]
+        torque = acc / self.a_rated[idx] * 1000.0 + vel * self.visc[idx]
+        t = np.minimum(np.maximum(np.rint(torque), -32768), 32767).astype(np.int64)
+        return {
+            "position_actual": np.rint(x).astype(np.int64),
+            "position_demand": np.rint(dpos - off).astype(np.int64),
+            "velocity_actual": np.rint(vel).astype(np.int64),
+            "torque_actual": t,
+            "current_actual": t,
+            "torque_demand": t,
+            "following_error_actual": np.rint(dpos - pos).astype(np.int64),
+            "digital_inputs": din,
+            "statusword": self.sw_const[idx] + lim * _SW_INTERNAL_LIMIT,
+        }
 
 
 def closing_speed(dist: np.ndarray, lim: np.ndarray, dt: float) -> np.ndarray:

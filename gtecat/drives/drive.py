@@ -1107,6 +1107,10 @@ class Cia402Drive(VirtualSlave):
         """One whole mailbox message (with its 6-byte header) in, the whole answer out."""
         return self.sdo.handle(request, self.al_state)
 
+    #: the mailbox is the SDO server alone (the in-process backend may call the server's
+    #: ``download_in_process`` instead of framing an expedited download)
+    mailbox.sdo_server_only = True  # type: ignore[attr-defined]
+
     def on_state_change(self, old: AlState, new: AlState) -> AlStatusCode:
         if old == AlState.PREOP and new == AlState.SAFEOP:
             try:

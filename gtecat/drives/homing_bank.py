@@ -11,9 +11,16 @@ positions where ``_scan`` could find something, or a bound would be reached.  Th
 channel then runs that cycle (edges, reversals, the home point, RETURN, errors) and the
 bank may take the row again once the search is plain again.
 
-This module says when a channel may be such a row (:func:`homing_claimable`), where the
-nearest events lie (:func:`event_bounds`), and moves the search state between the
-:class:`Homing` object and a row (:data:`ROW_FIELDS`).
+After the procedure (completed, failed or interrupted) a drive left in homing mode rests:
+:meth:`Homing.step` scans nothing and counts no search time or travel, the demand stands and
+only the rest time grows; once that passed ``SETTLE_TIME_S`` the statusword bits can no
+longer change.  Such a channel is a row too (:func:`homing_rest_claimable`, the kernel's
+``h_done``): an application that homes and never switches back to CSP keeps its axes in the
+bank.
+
+This module says when a channel may be such a row (:func:`homing_claimable`,
+:func:`homing_rest_claimable`), where the nearest events lie (:func:`event_bounds`), and
+moves the search state between the :class:`Homing` object and a row (:data:`ROW_FIELDS`).
 """
 
 from __future__ import annotations
@@ -22,7 +29,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .csp_bank import running_reason
-from .homing import HomingPhase
+from .homing import SETTLE_TIME_S, HomingPhase
 from .homing_methods import Signal
 from .modes import OpMode
 
@@ -32,7 +39,10 @@ if TYPE_CHECKING:
 
 #: the controlword of a drive homing (enable operation + CW4 "homing operation start")
 CW_HOMING = 0x001F
+#: the controlwords of a drive resting in homing mode (CW4 still high, or dropped)
+CW_RESTING = (0x000F, CW_HOMING)
 _SEARCHING = (HomingPhase.SEARCH, HomingPhase.APPROACH, HomingPhase.INDEX)
+_ENDED = (HomingPhase.COMPLETED, HomingPhase.FAILED, HomingPhase.INTERRUPTED)
 #: (row array, Homing attribute): the search state that changes every cycle
 ROW_FIELDS = (
     ("h_last", "_last"),
@@ -59,6 +69,53 @@ def homing_claimable(ch: Channel) -> str:
     if event_bounds(h, ch.mech.pos) is None:
         return "at an event"
     return ""
+
+
+def resting(h: Homing) -> bool:
+    """The procedure is over and the drive rests for good: no phase, speed or statusword
+    bit of it changes any more (:meth:`Homing.step` of a phase in ``_ENDED`` at speed 0 only
+    adds to the rest time; past ``SETTLE_TIME_S`` the drive stays settled)."""
+    return (
+        h.phase in _ENDED
+        and h._v == 0.0
+        and h._settled
+        and h._rest_time >= SETTLE_TIME_S
+        and (h._stopping or h.phase is not HomingPhase.INTERRUPTED)
+    )
+
+
+def homing_rest_claimable(ch: Channel) -> str:
+    """Why ``ch`` cannot run as a resting homing row now ("" when it can): in homing mode,
+    its procedure over and at rest (:func:`resting`), the result applied."""
+    cw = ch.controlword
+    if cw not in CW_RESTING:
+        return "controlword"
+    why = running_reason(ch, OpMode.HOMING, cw, "not in homing mode")
+    if why:
+        return why
+    if ch.fe_flag or ch.fe_time:
+        return "following error"
+    h = ch.homing
+    if h is None or not ch.hm_applied or not resting(h):
+        return "not resting after a homing"
+    if ch.oms != ch.hm_bits:
+        return "statusword bits"
+    return ""
+
+
+def rest_constants(h: Homing) -> dict[str, float]:
+    """A resting row's constants: the speed target 0 of an ended procedure (``_move``), no
+    search bounds (the kernel checks none for ``h_done`` rows)."""
+    return {
+        "h_vt": 0.0,
+        "h_acc": h._acc,
+        "h_maxtr": math.inf,
+        "h_tmo": math.inf,
+        "h_idx": 0.0,
+        "h_fd": 0.0,
+        "h_from": 0.0,
+        "h_ilim": math.inf,
+    }
 
 
 def event_bounds(h: Homing, pos: float) -> tuple[float, float] | None:

@@ -263,6 +263,8 @@ class CoeIoSlave(IoSlave):
     def mailbox(self, request: bytes) -> bytes | None:
         return self.sdo.handle(request, self.al_state)
 
+    mailbox.sdo_server_only = True  # type: ignore[attr-defined]  (as Cia402Drive.mailbox)
+
     def on_state_change(self, old: AlState, new: AlState) -> AlStatusCode:
         if old == AlState.PREOP and new == AlState.SAFEOP:
             self._relayout()

@@ -122,6 +122,30 @@ class SdoServer:
             return None
         return self._respond(answer)
 
+    def download_in_process(
+        self, index: int, subindex: int, data: bytes, complete_access: bool, al_state: AlState
+    ) -> None:
+        """An expedited download (1 to 4 bytes) exactly as :meth:`handle` serves its frame,
+        for a client in the same process with nothing between the two (no capture of the
+        frames, no fault in front of the mailbox): the same object dictionary write, the
+        same counter, and the abort the client reads from the answer (its code, index and
+        subindex) raised.  A bus brought up runs 17 of these per drive."""
+        self._pending.clear()
+        self._upload = self._download = None
+        abort = None
+        try:
+            self.od.download(
+                index, subindex, data, complete_access=complete_access, al_state=al_state
+            )
+        except SdoAbort as err:
+            abort = SdoAbort(err.code, err.index, err.subindex)
+        except Exception:
+            log.exception("SDO request 0x%04X:%02X failed inside the slave", index, subindex)
+            abort = SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex)
+        self.counter = next_counter(self.counter)
+        if abort is not None:
+            raise abort
+
     def next_message(self) -> bytes | None:
         """The next fragment of a multi-message answer, or None when there is none."""
         return self._pending.popleft() if self._pending else None

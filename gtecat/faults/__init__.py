@@ -100,7 +100,7 @@ def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
         except FaultSpecError as e:
             raise FaultSpecError(f"{prefix}{e}") from None
     after = extra.get("after")
-    if isinstance(after, str) and after.strip().lstrip("-").isdigit():
+    if isinstance(after, str) and after.strip().lstrip("-").isdecimal():
         after = int(after)
     if isinstance(after, float) and after.is_integer():
         after = int(after)

@@ -98,4 +98,28 @@ def _vendor_surface() -> None:
 
 _vendor_surface()
 
-from .. import faults as _faults  # noqa: E402,F401  (arms the machine TOML's [[fault]] tables)
+
+def _arm_faults(ctl: object) -> None:
+    """The machine TOML's ``[[fault]]`` tables are armed by :mod:`gtecat.faults` on every bus
+    that comes up; that package (a tenth of this import's Python) is imported the first time
+    a bus has them.  Once imported, its own hook does the arming."""
+    import sys
+
+    if getattr(getattr(ctl, "machine", None), "faults", ()) and "gtecat.faults" not in sys.modules:
+        from .. import faults
+
+        faults._bus_up(ctl)
+
+
+def _install_fault_hook() -> None:
+    import os
+
+    from ..controller.core import Controller
+
+    if _arm_faults not in Controller.bus_up_hooks:
+        Controller.bus_up_hooks.append(_arm_faults)
+    if os.environ.get("GTECAT_RECORD"):
+        from .. import faults  # noqa: F401  (records this process's GT calls)
+
+
+_install_fault_hook()

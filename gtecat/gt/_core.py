@@ -41,16 +41,7 @@ from ..errors import (
 )
 from ..master.clock import ClockGroup, ClockMode
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder
-from .fast import (
-    CLOCK,
-    ECAT_READERS,
-    RAW,
-    READERS,
-    fast_clock,
-    fast_ecat_reader,
-    fast_raw,
-    fast_reader,
-)
+from .fast import FAST_MAKERS
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -470,17 +461,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    if name in READERS or name in RAW or name == CLOCK or name in ECAT_READERS:
+    make = FAST_MAKERS.get(name)
+    if make is not None:
         slow = gt  # (the common shapes up front: gt.fast)
-        make = (
-            fast_reader
-            if name in READERS
-            else fast_raw
-            if name in RAW
-            else fast_ecat_reader
-            if name in ECAT_READERS
-            else fast_clock
-        )
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
     gt.__signature__ = _signature(proto, fn_sig)  # type: ignore[attr-defined]

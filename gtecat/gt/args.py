@@ -806,19 +806,20 @@ _from_address = ctypes.c_void_p.from_address
 
 
 def _machine_words() -> memoryview | None:
-    """The process's memory as machine words (``WORDS[address >> 3]``), to read the address
-    a ``byref()`` holds in one indexing instead of making a ``c_void_p`` for it (a third of
-    the cost of checking a fresh ``byref``).  Only an aligned word inside a live ``byref``
-    object is ever read.  None where it cannot be made or its reading disagrees with
-    ``c_void_p.from_address`` (the slower reader is used)."""
+    """The process's memory from ``CARG_AT`` on as machine words (``WORDS[id(p) >> 3]`` is
+    the word ``CARG_AT`` bytes into the object ``p``: objects start on a word), to read the
+    address a ``byref()`` holds in one indexing instead of making a ``c_void_p`` for it (a
+    third of the cost of checking a fresh ``byref``).  Only an aligned word inside a live
+    ``byref`` object is ever read.  None where it cannot be made or its reading disagrees
+    with ``c_void_p.from_address`` (the slower reader is used)."""
     if CARG_AT is None or CARG_AT % 8 or ctypes.sizeof(ctypes.c_void_p) != 8:
         return None
     try:
-        words = memoryview((ctypes.c_ubyte * (1 << 62)).from_address(0)).cast("B").cast("Q")
+        words = memoryview((ctypes.c_ubyte * (1 << 62)).from_address(CARG_AT)).cast("B").cast("Q")
         for obj in (ctypes.c_long(), ctypes.c_double(), (ctypes.c_int * 4)()):
             for off in (0, 8):
                 p = ctypes.byref(obj, off)
-                if words[(id(p) + CARG_AT) >> 3] != ctypes.addressof(obj) + off:
+                if id(p) % 8 or words[id(p) >> 3] != ctypes.addressof(obj) + off:
                     return None
         return words
     except Exception:  # a platform where it cannot be made
@@ -834,7 +835,7 @@ def carg_address_source(a: str) -> str:
     compiled fast paths; its names (``_WORDS``, ``_from_address``, ``_byref_address``) are
     in :data:`CARG_ENV`."""
     if WORDS is not None:
-        return f"_WORDS[(id({a}) + {CARG_AT}) >> 3]"
+        return f"_WORDS[id({a}) >> 3]"
     if CARG_AT is not None:
         return f"_from_address(id({a}) + {CARG_AT}).value"
     return f"_byref_address({a})"

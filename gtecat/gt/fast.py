@@ -29,6 +29,7 @@ from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources
 from ..master.clock import ClockMode
+from . import byref_target
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
@@ -427,14 +428,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
         if {session} and clock._thread is None:
             tp = type(p)
             if tp is _CArg:
-                obj = p._obj
-                if p is not LAST_P:
-                    # byref(obj), not byref(obj, offset); any doubt: the table path
-                    kind = type(obj)
-                    if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
-                        return {fallback}
-                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
-                        LAST_P = p  # checked, the same object next time needs no check
+{byref}
             elif tp is T0 or tp in ok:  # the ctypes object itself (by reference)
                 obj = p
             elif (
@@ -460,11 +454,46 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
 """
 
 
+#: the byref branch of a reader: its object when the pointer passes the object's own address
+#: and the type is one the reader writes (one C call, :mod:`gtecat.gt.byref_target`) ...
+_BYREF_C = """\
+                obj = TARGET(p)
+                if obj is p:  # byref(obj, offset), another type: the table path
+                    return {fallback}"""
+#: ... or, where that is not available, read from Python (a reused pointer checked once)
+_BYREF_PY = """\
+                obj = p._obj
+                if p is not LAST_P:
+                    # byref(obj), not byref(obj, offset); any doubt: the table path
+                    kind = type(obj)
+                    if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
+                        return {fallback}
+                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
+                        LAST_P = p  # checked, the same object next time needs no check"""
+
+
+def _byref_check(env: dict[str, Any], types: frozenset) -> str:
+    """The byref branch's source for a reader of ``types`` (its names go into ``env``)."""
+    env.update(CARG_ENV)
+    if BYREF_TARGET:
+        f = byref_target.target(types)
+        if f is not None:
+            env["TARGET"] = f
+            return _BYREF_C
+    return _BYREF_PY
+
+
+#: the byref check in C where it is available (tests turn it off to hold the Python one to
+#: the same answers)
+BYREF_TARGET = True
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
     env.update(CARG_ENV)
     gtn = bool(core)
+    template = template.replace("{byref}", _byref_check(env, env["ok"]))
     code = template.format(
         fname=fname,
         core=core,
@@ -537,6 +566,7 @@ def fast_clock(
     0, on the in-process controller; anything else (a value the type cannot hold included)
     takes the table path."""
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
+    target = byref_target.target(_CLOCK_INTS) if BYREF_TARGET else None
 
     def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if (
@@ -550,16 +580,21 @@ def fast_clock(
                 if clock._thread is None:
                     tp = type(pClock)
                     if tp is _CArg:
-                        obj = pClock._obj
-                        if pClock is not last[0]:
-                            if type(obj) not in _CLOCK_INTS or (
-                                _from_address(id(pClock) + _AT).value
-                                if _AT >= 0
-                                else byref_address(pClock)
-                            ) != _addressof(obj):
+                        if target is not None:  # (one C call: see _BYREF_C)
+                            obj = target(pClock)
+                            if obj is pClock:
                                 obj = None
-                            else:
-                                last[0] = pClock
+                        else:
+                            obj = pClock._obj
+                            if pClock is not last[0]:
+                                if type(obj) not in _CLOCK_INTS or (
+                                    _from_address(id(pClock) + _AT).value
+                                    if _AT >= 0
+                                    else byref_address(pClock)
+                                ) != _addressof(obj):
+                                    obj = None
+                                else:
+                                    last[0] = pClock
                     else:
                         obj = pClock if tp in _CLOCK_INTS else None
                     if obj is not None:
@@ -819,6 +854,7 @@ def fast_raw(
     entries: dict[tuple, Any] = {}
 
     env = {
+        "ARRAY_TARGET": byref_target.target([type(ctypes.Array)]) if BYREF_TARGET else None,
         "LAST": (-1, -1, None, -1, None, False),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
@@ -939,6 +975,13 @@ _RAW_UNWRAP = """
         q = p._obj
         if type(q) is T{n} and {address} == _addressof(q):
             p = q"""
+#: the same with the check in one C call (ARRAY_TARGET: an array that p points at, else p)
+_RAW_UNWRAP_C = """
+    given = p  # (what the generic path gets, if it answers)
+    if type(p) is _CArg:
+        q = ARRAY_TARGET(p)
+        if type(q) is T{n}:
+            p = q"""
 
 _RAW_BASE = """
 def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
@@ -969,7 +1012,13 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
         ok="".join(f"\n        and {x}" for x in ok),
         move=move,
-        unwrap=_RAW_UNWRAP.format(n=n, address=carg_address_source("p")) if ref else "",
+        unwrap=(
+            ""
+            if not ref
+            else _RAW_UNWRAP_C.format(n=n)
+            if env.get("ARRAY_TARGET") is not None
+            else _RAW_UNWRAP.format(n=n, address=carg_address_source("p"))
+        ),
         given="given" if ref else "p",
     )
     scratch: dict[str, Any] = {}
@@ -988,9 +1037,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):
     if ref:
         # byref(array): the array itself (byref(array, offset), byref of anything else: the
         # table path)
-        q = p._obj
-        if isinstance(q, _Array) and {address} == _addressof(q):
-            p = q
+{unwrap}
     ctl = session.controllers.get(1)
     if (
         ctl is not None
@@ -1044,8 +1091,15 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
         slave_arg="slave, " if io else "",
         slave_key="slave" if io else "-1",
         slave_memo=" and slave == last[3]" if io else "",
-        address=carg_address_source("p"),
+        unwrap=(
+            "        p = ARRAY_TARGET(p)  # (one C call: the array, else p itself)"
+            if env.get("ARRAY_TARGET") is not None
+            else "        q = p._obj\n"
+            "        if isinstance(q, _Array) and {address} == _addressof(q):\n"
+            "            p = q"
+        ),
     )
+    code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
     env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof)
     exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
@@ -1068,15 +1122,16 @@ SLOW_REASONS: dict[str, str] = {
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
     "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
-    "ecat_axis": "homing and probe status, the axis mode, analog inputs and the scale: table "
-    "path; the per-axis PDO readers that polling loops use are on the fast path",
+    "ecat_axis": "probe status, the axis mode, analog inputs and the scale: table path; the "
+    "per-axis PDO readers and the homing status that polling loops use are on the fast path",
     "ecat_io": "one output bit read: table path",
     "emulator": "emulator helpers for tests, not called in control loops",
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
     "gantry": "a mode query: table path",
-    "gts_card": "the pulse-card (GTS) layer: table path",
+    "gts_card": "the pulse-card (GTS) layer: table path (GT_GetDi and GT_GetDiRaw read every "
+    "axis's input and its configured sense per call: work that outweighs the arguments)",
     "motion": "profile set-up and parameter readers (called once per move); the position and "
-    "speed readers that polling loops use are on the fast path",
+    "speed readers that polling loops use, and GT_GetTrapPrm, are on the fast path",
     "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
     "programs": "motion programs, variables and MRAM: compile and download work outweighs "
     "the arguments",
@@ -1089,7 +1144,13 @@ SLOW_REASONS: dict[str, str] = {
 
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
-    return frozenset(READERS) | RAW | {CLOCK} | frozenset(ECAT_READERS)
+    return (
+        frozenset(READERS)
+        | RAW
+        | {CLOCK, CORE, HOMING}
+        | frozenset(ECAT_READERS)
+        | frozenset(STRUCT_READERS)
+    )
 
 
 #: the per-axis PDO readers (axis_calls._reader): function -> the object it reads
@@ -1103,6 +1164,35 @@ ECAT_READERS: dict[str, tuple[int, int]] = {
     "GT_GetEcatAxisAtICurrent": (0x6078, 0),
     "GT_GetEcatErrorCode": (0x603F, 0),
 }
+
+
+def _pdo_entry(ax: Any, acc: Any, bounds: dict[type, tuple[int, int]]) -> tuple[Any, ...]:
+    """A PDO reader's entry of one axis: ``(axis, accessor, cell, fits)``: ``cell`` the
+    entry's bytes of the process image as a one-item memoryview of its integer type (what
+    the accessor's ``get`` reads for a whole-byte entry, read by one index), None where the
+    accessor reads bits or the machine is big-endian (its ``get`` then); ``fits`` the
+    pointer types that hold every value of the entry (no range check needed)."""
+    if acc is None:
+        return ax, None, None, frozenset()
+    lo, hi = (
+        (-(1 << (acc.bits - 1)), (1 << (acc.bits - 1)) - 1)
+        if acc.signed
+        else (0, (1 << acc.bits) - 1)
+    )
+    fits = frozenset(t for t, (a, b) in bounds.items() if a <= lo and hi <= b)
+    fmt = getattr(acc, "_fmt", None)
+    buf = getattr(acc, "_buf", None)
+    cell = None
+    if fmt is not None and sys.byteorder == "little" and isinstance(buf, memoryview):
+        code = fmt.format[-1]  # ("<i": little-endian, standard sizes)
+        size = fmt.size
+        try:
+            view = buf[acc._off : acc._off + size].cast("B").cast(code)
+        except (TypeError, ValueError):
+            view = None
+        if view is not None and view.itemsize == size and len(view) == 1:
+            cell = view
+    return ax, acc, cell, fits
 
 
 def fast_ecat_reader(
@@ -1147,17 +1237,38 @@ def fast_ecat_reader(
         "INDEX": index,
         "SUB": subindex,
         "ACCS": {},
+        "_pdo_entry": _pdo_entry,
         "last": [None],
         "_refs": sys.getrefcount,
         "KEPT": _KEPT,
     }
+    target = byref_target.target(ok) if BYREF_TARGET else None
+    if target is not None:
+        env["TARGET"] = target
+        byref = _ECAT_BYREF_C
+    else:
+        byref = _ECAT_BYREF_PY.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
-    code = _ECAT_READER.replace("{address}", carg_address_source("p"))
+    code = _ECAT_READER.replace("{byref}", byref)
     exec(compile(code, f"<gt fast ecat {name}>", "exec"), env)
     gt = env["gt"]
     gt.slow = slow
     return gt
 
+
+#: the byref branch of a PDO reader: one C call (see _BYREF_C) ...
+_ECAT_BYREF_C = """\
+                    obj = TARGET(p)
+                    if obj is p:  # byref(obj, offset), another type: the table path
+                        return slow(n, p)"""
+#: ... else read from Python
+_ECAT_BYREF_PY = """\
+                    obj = p._obj
+                    if p is not last[0]:
+                        if type(obj) not in ok or {address} != _addressof(obj):
+                            return slow(n, p)  # (p is a byref here)
+                        if _refs(p) > KEPT:  # (kept by the caller: see _KEPT)
+                            last[0] = p"""
 
 _ECAT_READER = """
 def gt(n=_NO, p=_NO, /, *extra, **kw):
@@ -1182,24 +1293,20 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
             if kept is None or kept[0] is not ax:
                 if len(ACCS) > 4096:
                     ACCS.clear()
-                kept = ACCS[n] = (ax, ax.io.get(INDEX, SUB))
-            acc = kept[1]  # (None: not mapped; the table path says so)
+                kept = ACCS[n] = _pdo_entry(ax, ax.io.get(INDEX, SUB), BOUNDS)
+            _, acc, cell, fits = kept  # (acc None: not mapped; the table path says so)
             if acc is not None:
                 tp = type(p)
                 if tp is _CArg:
-                    obj = p._obj
-                    if p is not last[0]:
-                        if type(obj) not in ok or {address} != _addressof(obj):
-                            return slow(n, p)  # (p is a byref here)
-                        if _refs(p) > KEPT:  # (kept by the caller: see _KEPT)
-                            last[0] = p
+{byref}
                 elif tp in ok:
                     obj = p
                 else:
                     return slow(*(a for a in (n, p) if a is not _NO))
-                v = acc.get()
-                lo, hi = BOUNDS[type(obj)]
-                if lo <= v <= hi:  # (else store's refusal: the table path)
+                v = acc.get() if cell is None else cell[0]
+                kind = type(obj)
+                # (a value the type cannot hold: store's refusal, the table path)
+                if kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]:
                     obj.value = v
                     session.last = None
                     if clock.mode is _LOCKSTEP:
@@ -1207,3 +1314,329 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                     return advance(ctl, name, 0)
     return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 """
+
+
+#: the homing status reader on the fast path (the vendor's homing loop polls it)
+HOMING = "GT_GetEcatHomingStatus"
+
+
+def fast_homing_status(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetEcatHomingStatus(axis, p)`` with the fast path in front of the table: ``p`` a
+    ``byref`` (no offset) or the object itself of an integer type the pointer takes, the
+    axis on the in-process controller's bus (core 1, no pulse card, the bus opened).  The
+    value is :func:`homing_calls.homing_status`'s, read the same way (past the axis bank's
+    guard: a banked axis stays banked) without a weak reference made per call: each axis's
+    own is kept, and a run's state found by it in the same weak dictionary.  Its other cases
+    (the link lost, 6041h not mapped, a run with a reason to note beside the 0) and any other
+    shape: the table path, with its code and reason."""
+    import weakref
+
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    ok = _scalar_types(FUNCTIONS[name].params[1])
+    bounds = {}
+    for t in ok:
+        bits = 8 * ctypes.sizeof(t)
+        bounds[t] = (
+            (0, (1 << bits) - 1)
+            if t._type_.isupper()
+            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        )
+    target = byref_target.target(ok) if BYREF_TARGET else None
+    getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
+    from ..controller.axis import Axis
+
+    axis_type = Axis  # (a guarded axis, the bank's, is of another class)
+
+    #: axis number -> [axis, a weak reference to it, 6041h mapped, its run's state or None,
+    #: how many states homing_calls had made when it looked]; homing_calls makes an axis's
+    #: state once (its first run) and keeps it as long as the axis lives, so a state found is
+    #: the axis's for good, and none found stays none until that count moves
+    kept: dict[int, list[Any]] = {}
+    #: homing_calls' run states (its weak dictionary's own dict), the values; set at the
+    #: first call (homing_calls imports the GT layer, which imports this module)
+    h: list[Any] = []
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra:
+            try:
+                ctl = session.controllers[1]
+                ax = ctl.axes[n]
+            except KeyError:  # no controller, no such axis: the table path says why
+                return slow(*(a for a in (n, p) if a is not _NO))
+            clock = ctl.clock
+            m = ctl.master
+            if (
+                session.plain  # (in this process, core 1)
+                and clock._thread is None
+                and ctl.card is None
+                and m is not None
+                and m.opened
+            ):
+                tp = type(p)
+                if tp is _CArg:
+                    if target is not None:
+                        obj = target(p)
+                        if obj is p:
+                            obj = None
+                    else:
+                        obj = p._obj
+                        if type(obj) not in ok or byref_address(p) != _addressof(obj):
+                            obj = None
+                else:
+                    obj = p if tp in ok else None
+                try:
+                    k = kept[n]
+                except KeyError:
+                    k = None
+                if k is None or k[0] is not ax:
+                    if not h:
+                        from . import homing_calls as hc
+
+                        h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
+                    if len(kept) > 4096:
+                        kept.clear()
+                    io = getattribute(ax, "io")
+                    mapped = io.get(0x6041) is not None
+                    k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
+                st = k[3]
+                if st is None and k[4] != h[3][0]:  # (a state made since: look again)
+                    k[4] = h[3][0]
+                    st = k[3] = h[0].get(k[1])
+                lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
+                if obj is not None and not lost:
+                    if st is None:  # no run since the bus came up: not homed
+                        v = h[2] if k[2] else None
+                    elif st.active:
+                        v = None if st.hint is not None else h[1]
+                    else:
+                        v = st.result
+                    if v is not None:
+                        lo, hi = bounds[type(obj)]
+                        if lo <= v <= hi:
+                            obj.value = v
+                            session.last = None
+                            if clock.mode is _LOCKSTEP:
+                                return 0
+                            return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
+def struct_packer(cls: type) -> Callable[..., None] | None:
+    """``pack(s, 0, *values)``: every field of structure class ``cls`` written at once, the
+    same bytes as setting the fields one by one (the same C type per field, its offset, the
+    trailing padding untouched); ``struct.error`` for a value a field's type cannot hold,
+    where the field's own setter would wrap it (the caller then sets the fields).  None for
+    a class with other fields than plain numbers, bit fields or padding between fields."""
+    codes = {1: "b", 2: "h", 4: "i", 8: "q"}
+    fmt, pos = "=", 0
+    try:
+        for field in cls._fields_:  # type: ignore[attr-defined]
+            if len(field) != 2:
+                return None  # (a bit field)
+            name, t = field
+            code = getattr(t, "_type_", None)
+            size = ctypes.sizeof(t)
+            if not isinstance(code, str) or code in "?cuzZPOv":
+                return None
+            if getattr(cls, name).offset != pos:
+                return None  # (padding between fields: struct's pad bytes would write it)
+            if code in "fd":
+                fmt += code
+            elif size in codes:
+                fmt += codes[size] if code.islower() else codes[size].upper()
+            else:
+                return None
+            pos += size
+    except (AttributeError, TypeError, ValueError):
+        return None
+    packer = struct.Struct(fmt)
+    if packer.size != pos or pos > ctypes.sizeof(cls):
+        return None
+    return packer.pack_into
+
+
+def trap_prm_into(res: Any, s: Any) -> None:
+    """GT_GetTrapPrm's fields, from the profile's Trap parameters (its table path's too)."""
+    prm = res.profile.trap_prm
+    try:
+        _PACK_TRAP(s, 0, prm.acc, prm.dec, prm.vel_start, prm.smooth_time)  # type: ignore[misc]
+    except (struct.error, TypeError):  # (a value a field wraps: the fields' own setters)
+        s.acc, s.dec, s.velStart, s.smoothTime = prm.acc, prm.dec, prm.vel_start, prm.smooth_time
+
+
+def _pack_trap() -> Any:
+    from .structs import TTrapPrm
+
+    pack = struct_packer(TTrapPrm)
+    if pack is None or [f[0] for f in TTrapPrm._fields_] != [
+        "acc",
+        "dec",
+        "velStart",
+        "smoothTime",
+    ]:
+
+        def pack(s: Any, _: int, *values: Any) -> None:
+            raise TypeError  # (the fields' own setters)
+
+    return pack
+
+
+_PACK_TRAP = _pack_trap()
+
+
+def _struct_readers() -> dict[str, tuple[type, Any, Callable[[Any, Any], None]]]:
+    from ..controller.profile import PrfMode
+    from .structs import TTrapPrm
+
+    return {"GT_GetTrapPrm": (TTrapPrm, PrfMode.TRAP, trap_prm_into)}
+
+
+#: readers of one structure of one axis's profile: function -> (the structure, the profile
+#: mode the function needs, ``fill(resources, structure)``: the table path's own)
+STRUCT_READERS = _struct_readers()
+
+
+def fast_struct_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetTrapPrm(profile, p)`` with the fast path in front of the table: ``p``
+    ``byref(s)`` (no offset) or ``s`` itself of the structure's own class, an axis of the
+    in-process controller (core 1, no pulse card) in the mode the function needs; the axis
+    bank is told of the call as the table path tells it (:meth:`AxisBank.before_call`), then
+    the table path's own ``fill`` writes the fields.  Any other shape, another mode, an
+    axis that does not exist: the table path, with its code and reason."""
+    from .table import FUNCTIONS
+
+    first = FUNCTIONS[name].params[0]
+    if first.name not in ("axis", "profile", "encoder") or any(
+        q.name == "count" for q in FUNCTIONS[name].params
+    ):  # (AxisBank.before_axis_call is before_call for these only)
+        raise ValueError(f"{name}: not a function of one axis")
+    cls, mode, fill = STRUCT_READERS[name]
+    target = byref_target.target([cls]) if BYREF_TARGET else None
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra:
+            try:
+                ctl = session.controllers[1]
+                res = ctl.resources[n]
+            except KeyError:  # no controller, no such axis: the table path says why
+                return slow(*(a for a in (n, p) if a is not _NO))
+            if (
+                session.plain  # (in this process, core 1)
+                and ctl.card is None
+                and ctl.clock._thread is None
+                and ctl.axes.get(n) is res.ax
+            ):
+                tp = type(p)
+                if tp is _CArg:
+                    if target is not None:
+                        s = target(p)
+                        if s is p:
+                            s = None
+                    else:
+                        s = p._obj
+                        if type(s) is not cls or byref_address(p) != _addressof(s):
+                            s = None
+                else:
+                    s = p if tp is cls else None
+                if s is not None:
+                    bank = ctl.bank
+                    if bank is not None:  # (what the table path does first)
+                        bank.before_axis_call(res.ax, res)
+                    if res.profile.mode is mode:
+                        try:
+                            fill(res, s)
+                        except Exception:  # (the table path raises it again: its code)
+                            return slow(n, p)
+                        session.last = None
+                        clock = ctl.clock
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
+#: the session's core reader on the fast path (it reads no controller)
+CORE = "GT_GetCore"
+
+
+def fast_core(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetCore(p)`` with the fast path in front of the table: ``p`` ``byref(x)`` (no
+    offset) or ``x`` of an integer type the pointer takes, in this process (attached: the
+    controller process answers, the table path); then the call's host latency as the table
+    path runs it (on the selected core's controller, none in lockstep)."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    ok = _scalar_types(FUNCTIONS[name].params[0])
+    target = byref_target.target(ok) if BYREF_TARGET else None
+
+    def gt(p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if not kw and not extra and session.local:
+            tp = type(p)
+            if tp is _CArg:
+                if target is not None:
+                    obj = target(p)
+                    if obj is p:
+                        obj = None
+                else:
+                    obj = p._obj
+                    if type(obj) not in ok or byref_address(p) != _addressof(obj):
+                        obj = None
+            else:
+                obj = p if tp in ok else None
+            if obj is not None and session.note is None:
+                core = session._core  # (1..4: every integer type the pointer takes holds it)
+                obj.value = core
+                session.last = None
+                ctl = session.controllers.get(core)
+                if ctl is None or ctl.clock.mode is _LOCKSTEP:
+                    return 0
+                return advance(ctl, name, 0)
+        return slow(*(a for a in (p,) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
+def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
+    out: dict[str, Callable[..., Callable[..., int]]] = {
+        CLOCK: fast_clock,
+        CORE: fast_core,
+        HOMING: fast_homing_status,
+    }
+    for names, make in (
+        (READERS, fast_reader),
+        (RAW, fast_raw),
+        (ECAT_READERS, fast_ecat_reader),
+        (STRUCT_READERS, fast_struct_reader),
+    ):
+        out.update(dict.fromkeys(names, make))
+    return out
+
+
+#: function -> the maker of its fast path, ``make(name, slow, session, advance)`` (the GT
+#: layer puts it in front of the table-checked function)
+FAST_MAKERS = _makers()

@@ -201,12 +201,16 @@ class _AxisHoming:
 
 
 _STATE: weakref.WeakKeyDictionary[Axis, _AxisHoming] = weakref.WeakKeyDictionary()
+#: how many run states :func:`_state` has made (an axis's is made once and kept while it
+#: lives; the GT fast path looks one up again only when this count moved)
+MADE = [0]
 
 
 def _state(ax: Axis) -> _AxisHoming:
     st = _STATE.get(ax)
     if st is None:
         st = _STATE[ax] = _AxisHoming()
+        MADE[0] += 1
         ax.post_hooks.append(st.post)
     return st
 

@@ -42,7 +42,7 @@ from ..controller.profile import PrfMode
 from ..controller.resources import AxisResources, axes_in_mask, axis_resources, axis_span
 from ..errors import CommandError, ParameterError
 from ._core import check_range, gt_function, store, store_array, struct_arg
-from .fast import attr_getter, prf_mode_value
+from .fast import attr_getter, prf_mode_value, trap_prm_into
 from .structs import TJogPrm, TTrapPrm
 
 #: GT_Stop mask/option bit of coordinate system 1 (entry 131: bit 12 crd 1, bit 13 crd 2)
@@ -120,9 +120,7 @@ def GT_SetTrapPrm(ctl: Controller, profile: int, pPrm: Any) -> int:
 def GT_GetTrapPrm(ctl: Controller, profile: int, pPrm: Any) -> int:
     res = axis_resources(ctl, profile)
     res.profile.require_mode("GT_GetTrapPrm", PrfMode.TRAP)
-    s = struct_arg(pPrm, TTrapPrm, "pPrm")
-    prm = res.profile.trap_prm
-    s.acc, s.dec, s.velStart, s.smoothTime = prm.acc, prm.dec, prm.vel_start, prm.smooth_time  # type: ignore[attr-defined]
+    trap_prm_into(res, struct_arg(pPrm, TTrapPrm, "pPrm"))
     return 0
 
 

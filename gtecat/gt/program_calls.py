@@ -56,16 +56,21 @@ import hashlib
 import os
 import weakref
 from pathlib import Path
+from typing import TYPE_CHECKING as _TYPE_CHECKING
 from typing import Any
 
 from ..controller.core import Controller
 from ..errors import ParameterError
-from ..programs import image, mram, threads
 from ..programs.model import MAX_FUNCTIONS
-from ..programs.verify import ImageInvalid, verify
 from . import _core
 from ._core import fail, gt_function, store, store_array, store_bytes, struct_arg
 from .structs import TCompileInfo, TThreadSts, TVarInfo
+
+if _TYPE_CHECKING:
+    from ..programs import mram, threads
+
+# (the motion programs' modules but their model are imported by the calls that use them: an
+# application without programs does not pay for them at ``from gtecat import gt``)
 
 _RUNTIMES: weakref.WeakKeyDictionary[Controller, threads.ProgramRuntime] = (
     weakref.WeakKeyDictionary()
@@ -75,6 +80,8 @@ _MRAMS: weakref.WeakKeyDictionary[Controller, mram.Mram] = weakref.WeakKeyDictio
 
 # --- the controller's program runtime ------------------------------------------------------
 def _speed_from_env() -> float:
+    from ..programs import threads
+
     text = os.environ.get("GTECAT_PROGRAM_SPEED", "")
     try:
         v = float(text) if text else threads.DEFAULT_SPEED
@@ -85,6 +92,8 @@ def _speed_from_env() -> float:
 
 def runtime(ctl: Controller, create: bool = True) -> threads.ProgramRuntime | None:
     """The program runtime of ``ctl`` (created, and hooked into its cycle, on first use)."""
+    from ..programs import threads
+
     rt = _RUNTIMES.get(ctl)
     if rt is None and create:
         rt = threads.ProgramRuntime(_caller(ctl), _speed_from_env())
@@ -156,6 +165,8 @@ def _downloaded(ctl: Controller) -> threads.ProgramRuntime:
 
 
 def _do(action, *args: Any) -> Any:
+    from ..programs import threads
+
     try:
         return action(*args)
     except threads.RuntimeRefusal as r:
@@ -181,7 +192,7 @@ def _report(info: Any, filename: str, line: int, message: str) -> None:
 def GT_Compile(pFileName: str, pWrongInfo: Any) -> int:
     """Compile a motion program; ``x.bin`` and ``x.ini`` beside ``x.c`` (entry 9, 10.3.2)."""
     # the compiler (and its parser, lark) loads on the first compile, not with gtecat.gt
-    from ..programs import compiler
+    from ..programs import compiler, image
 
     info = struct_arg(pWrongInfo, TCompileInfo, "pWrongInfo")
     try:
@@ -203,6 +214,9 @@ def GT_Compile(pFileName: str, pWrongInfo: Any) -> int:
 @gt_function
 def GT_Download(ctl: Controller, pFileName: str) -> int:
     """Load a program image (and the .ini beside it) into the controller (entry 10)."""
+    from ..programs import image
+    from ..programs.verify import ImageInvalid, verify
+
     try:
         program = image.load(pFileName)
     except image.ImageError as e:
@@ -331,6 +345,8 @@ def GTE_GetThreadError(ctl: Controller, thread: int, pText: Any) -> int:
 
 # --- MRAM (11.8) ---------------------------------------------------------------------------
 def _mram(ctl: Controller) -> mram.Mram:
+    from ..programs import mram
+
     m = _MRAMS.get(ctl)
     if m is None:
         path = ctl.options.mram or mram.default_path(ctl.options.log)  # option > GTECAT_MRAM
@@ -348,6 +364,8 @@ def _mram(ctl: Controller) -> mram.Mram:
 
 
 def _span(address: int, count: int) -> None:
+    from ..programs import mram
+
     if address + count > mram.WORDS:
         raise ParameterError(
             f"address={address}, count={count}: words {address}..{address + count - 1} run past "
@@ -375,6 +393,8 @@ def GT_GetMRAMData(ctl: Controller, address: int, pData: Any, count: int) -> int
 @gt_function
 def GT_StartAccessMRAM(ctl: Controller, address: int, count: int, mode: int) -> int:
     """Mode 1: buffer -> memory; mode 0: memory -> buffer; status 0 until done (entry 128)."""
+    from ..programs import mram
+
     _span(address, count)
     try:
         _mram(ctl).start(address, count, mode, ctl.clock.now_ns)

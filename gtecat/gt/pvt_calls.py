@@ -4,7 +4,10 @@ Decisions where the vendor header says no more (its manual of the advanced funct
 is not public):
 
 * Tables are the controller's (1..32, shared by every profile), 2..1024 points each; the
-  times (ms) rise strictly; positions are pulses, velocities pulse/ms.  Between two
+  times (ms) rise strictly, by :data:`MIN_STEP_MS` at least; positions are pulses,
+  velocities pulse/ms, every value within ±:data:`VALUE_LIMIT` (beyond both, the cubics'
+  velocities and accelerations leave the doubles' range: code 7 with the reason, never an
+  internal error while the table runs).  Between two
   points the position is the cubic that meets both points' positions and velocities.
 * ``GT_PvtTable(tableId, count, pTime, pPos, pVel)``: each point has one velocity.
   ``GT_PvtTableEx(..., pVelBegin, pVelEnd)``: segment ``k`` (point ``k`` to ``k+1``) starts at
@@ -42,6 +45,12 @@ from .motion_ext_calls import _long, _mask_axes, _planner, _require_free
 
 TABLES = 32
 POINTS = 1024
+#: the shortest time between two points of a table (ms): a nanosecond, far below any
+#: controller cycle, and long enough that a segment's acceleration stays a finite double
+MIN_STEP_MS = 1e-6
+#: the largest magnitude of a table value (time, position, velocity): 2^40 pulses is
+#: beyond any 32-bit position the controller reports
+VALUE_LIMIT = float(2**40)
 _TABLES: weakref.WeakKeyDictionary[Any, dict[int, tuple[PvtSegment, ...]]] = (
     weakref.WeakKeyDictionary()
 )
@@ -65,11 +74,16 @@ def _points(count: int, *arrays: Any) -> list[list[float]]:
         vals = [float(v) for v in ref.load_values(n)]
         if any(v != v or v in (float("inf"), float("-inf")) for v in vals):
             raise ParameterError("a table value is not a finite number")
+        if any(abs(v) > VALUE_LIMIT for v in vals):
+            raise ParameterError(f"a table value is beyond ±{VALUE_LIMIT:.0f}")
         out.append(vals)
     t = out[0]
     for k in range(1, n):
-        if t[k] <= t[k - 1]:
-            raise ParameterError(f"pTime[{k}]={t[k]} is not after pTime[{k - 1}]={t[k - 1]}")
+        if t[k] - t[k - 1] < MIN_STEP_MS:
+            raise ParameterError(
+                f"pTime[{k}]={t[k]} is not {MIN_STEP_MS:g} ms or more after "
+                f"pTime[{k - 1}]={t[k - 1]}"
+            )
     return out
 
 

@@ -4,15 +4,21 @@
  * (CspBank.step/commit/output) transcribed row by row: the same IEEE operations in the
  * same order (built with -ffp-contract=off, no fast-math), so every value is the same bit
  * pattern as numpy's and the scalar reference's.  It only runs the plain cycle: when a
- * raw write touched a claimed slave's outputs (return 1) or a row would leave the bank
- * (return 2: a limit switch, a soft limit, the following error, the drive's following
- * error window) nothing is written and the caller runs the numpy cycle, which releases
- * the rows.  Return 0: committed; io[OUT_FIN] says a Trap move ended.
+ * raw write touched a claimed slave's outputs (return 1) nothing is written and the caller
+ * runs the numpy cycle; when rows would leave the bank (return 3: a limit switch, a soft
+ * limit, the following error, the drive's following error window, a homing event) nothing
+ * is written, s_hit marks them and the caller releases them and runs the cycle again.
+ * Return 0: committed; io[OUT_FIN] says a Trap move ended.
  *
  * bank_kernel_run runs up to n such cycles back to back (t advancing by dt_ns each), for a
  * controller whose cycle has nothing else to do (AxisBank.run_cycles): it stops before the
  * first cycle that is not committed and returns the cycles committed; io[OUT_FIN] then says
  * whether any of them ended a Trap move.
+ *
+ * Two checks follow the scalar objects' hooks where the bank holds them: a row whose 60FDh
+ * bits in dwatch change (the home input a capture unit samples every cycle) and a Trap row
+ * whose sample runs toward a limit already latched (lvel: bit 0 the positive side, bit 1
+ * the negative; AxisResources._post stops such a motion) leave the bank before that cycle.
  *
  * Arrays arrive as one table of addresses in the order of FIELDS below (the Python side
  * binds them by these names and refuses a library whose list differs).
@@ -66,7 +72,8 @@
     X(h_rest, f64) X(h_set, u8) X(h_vt, f64) X(h_acc, f64) X(h_lo, f64) X(h_hi, f64)       \
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
     X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
-    X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)
+    X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
+    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64)
 
 enum {
 #define X(name, type) F_##name,
@@ -197,7 +204,9 @@ static int64_t clip16(double x)
  * h_lo < every position it has been at < h_hi, where h_lo/h_hi are the nearest positions at
  * which _scan would find something (a switch edge, a limit, an index pulse).  Returns 1 when
  * this cycle would leave that state (an event crossed, a search bound reached): nothing is
- * written and the row goes back to the scalar drive for this cycle. */
+ * written and the row goes back to the scalar drive for this cycle.  A row with h_done rests
+ * after its procedure (completed, failed or interrupted, at rest for good): Homing.step then
+ * scans nothing and counts no search time or travel, its speed stays 0 and it only settles. */
 INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
 {
     double pos = F64(c_pos)[r], p0 = F64(h_last)[r];
@@ -205,18 +214,20 @@ INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *
     double a_dt, p, rest = F64(h_rest)[r], x;
     double *sh = F64(s_hm) + 7 * r;
     int settled;
-    el += dt;
-    if (pos != p0) {
-        double lo = pos < p0 ? pos : p0, hi = pos < p0 ? p0 : pos;
-        tr += fabs(pos - p0);
-        if (!(F64(h_lo)[r] < lo && hi < F64(h_hi)[r]))
-            return 1; /* _scan would meet an event */
+    if (!U8(h_done)[r]) {
+        el += dt;
+        if (pos != p0) {
+            double lo = pos < p0 ? pos : p0, hi = pos < p0 ? p0 : pos;
+            tr += fabs(pos - p0);
+            if (!(F64(h_lo)[r] < lo && hi < F64(h_hi)[r]))
+                return 1; /* _scan would meet an event */
+        }
+        /* _check_bounds */
+        if (U8(h_idx)[r] && (pos - F64(h_from)[r]) * F64(h_fd)[r] > F64(h_ilim)[r])
+            return 1;
+        if (tr > F64(h_maxtr)[r] || el > F64(h_tmo)[r])
+            return 1;
     }
-    /* _check_bounds */
-    if (U8(h_idx)[r] && (pos - F64(h_from)[r]) * F64(h_fd)[r] > F64(h_ilim)[r])
-        return 1;
-    if (tr > F64(h_maxtr)[r] || el > F64(h_tmo)[r])
-        return 1;
     /* _move */
     a_dt = F64(h_acc)[r] * dt;
     if (v < vt) {
@@ -547,14 +558,18 @@ INLINE int commit_cursors(void **ptr, int64_t n)
     return fin_any;
 }
 
-/* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement) */
+/* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement of a
+ * claimed row; a frozen row's image keeps what its scalar objects wrote) */
 INLINE void write_image(void **ptr, const int64_t *io)
 {
     uint8_t *buf = U8(buf);
+    const uint8_t *alive = U8(alive), *frz = U8(frz);
     int64_t i;
     for (i = 0; i < io[IN_N_PLC]; i++) {
         int64_t row = I64(pl_row)[i], val;
         uint32_t u;
+        if (!alive[row] || frz[row])
+            continue;
         switch (I64(pl_col)[i]) {
         case 0: val = I64(c_target)[row]; break;
         case 1: val = to_i64(rint(F64(c_pos)[row] - (double)I64(c_off)[row])); break;
@@ -600,14 +615,15 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
     const uint8_t *alive = U8(alive);
     uint8_t *buf = U8(buf);
     int64_t r, i, n_csp = 0, n_jog = 0;
-    int fin_any = 0, csp_hit = 0, hm_hit = 0;
+    int fin_any = 0, any_hit = 0;
     const uint8_t *hm = U8(hm);
+    uint8_t *s_hit = U8(s_hit);
 
     /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back (looked at
      * in the first cycle of a call: nothing else writes them until it returns, the cycle
-     * itself writes no such byte) */
+     * itself writes no such byte); rx_row: the row whose slave owns the byte */
     for (i = 0; check_rx && i < io[IN_N_RX]; i++)
-        if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i])
+        if (buf[I64(rx_idx)[i]] != U8(rx_ref)[i] && alive[I64(rx_row)[i]])
             return 1;
 
     /* 2.-7. every claimed row, tentatively (scratch arrays s_*), in three passes over the
@@ -620,13 +636,13 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         double prf, a, demand, dvel;
         int swl = 0, hit = 0, ended;
         go[r] = 0;
+        s_hit[r] = 0;
         if (!alive[r] || U8(frz)[r]) /* a frozen row: nothing of its cycle changes */
             continue;
         if (hm[r]) {
-            U8(s_hit)[r] = 0;
             if (homing_row(ptr, r, dt, &demand, &dvel)) {
-                U8(s_hit)[r] = 1;
-                hm_hit = 1;
+                s_hit[r] = 1;
+                any_hit = 1;
                 continue;
             }
             /* Axis.pre: 607Ah follows 6064h (the value in the image since the last cycle) */
@@ -643,6 +659,14 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             }
             prf = F64(t_p)[I64(base)[r] + cur];
             ended = cur == I64(t_end)[r];
+            if (U8(lvel)[r]) { /* toward a latched limit: AxisResources._post stops it */
+                const double v = F64(prf_ratio)[r] * F64(t_v)[I64(base)[r] + cur];
+                if (((U8(lvel)[r] & 1) && v > 0.0) || ((U8(lvel)[r] & 2) && v < 0.0)) {
+                    s_hit[r] = 1;
+                    any_hit = 1;
+                    continue;
+                }
+            }
             if (U8(jog)[r] && F64(jrv)[r] != F64(jgoal)[r]) { /* a ramp: jog.ramp_step */
                 double *o = F64(s_jog) + 5 * r;
                 jog_ramp(F64(jrp)[r], F64(jrv)[r], F64(jgoal)[r], F64(jacc)[r], F64(jdec)[r], h,
@@ -682,8 +706,11 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
                     hit = 1;
                 counts = to_i64(rint(scaled)) + I64(drive_offset)[r];
             }
-            if (hit)
-                return 2; /* nothing written: the numpy cycle releases it */
+            if (hit) { /* it leaves: the scalar path's exact integers (bank.HUGE_COUNTS) */
+                s_hit[r] = 1;
+                any_hit = 1;
+                continue;
+            }
             target = (int32_t)(uint32_t)(uint64_t)counts;
             /* CspBank.step: step_csp */
             x = target + I64(c_pos_offset)[r];
@@ -801,6 +828,8 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             din |= 1 << 16;
         if (io[IN_W17] && in_window(F64(w17_lo), F64(w17_hi), io[IN_W17], r, pos))
             din |= 1 << 17;
+        if ((din ^ I64(c_din)[r]) & I64(dwatch)[r]) /* an input a hook samples changes */
+            hit = 1;
         if (hm[r]) /* AxisResources._post of an axis not in CSP: the plan follows 6064h */
             a = (double)((int64_t)(int32_t)(uint32_t)(uint64_t)pa - I64(drive_offset)[r]) /
                 F64(unit2)[r];
@@ -815,14 +844,10 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             hit = 1;
         if (fabs(err) > F64(pos_err)[r] && !hm[r]) /* the following error: in CSP only */
             hit = 1;
-        if (hit && hm[r]) {
-            U8(s_hit)[r] = 1;
-            hm_hit = 1;
-            continue;
-        }
         if (hit) {
-            csp_hit = 1;
-            break;
+            s_hit[r] = 1;
+            any_hit = 1;
+            continue;
         }
         /* 6. the in-position band (bit 11) */
         band = F64(band)[r];
@@ -843,10 +868,8 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         I64(s_since)[r] = since;
         U8(s_arr)[r] = (uint8_t)arr;
     }
-    if (csp_hit)
-        return 2; /* nothing written: the numpy cycle releases it */
-    if (hm_hit)
-        return 3; /* nothing written: the caller releases the homing rows in s_hit */
+    if (any_hit)
+        return 3; /* nothing written: the caller releases the rows in s_hit first */
 
     /* commit (CspBank.commit, the bank's state, the table cursors) */
     if (n_csp == n) {
@@ -996,6 +1019,8 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     const int64_t hold_ns = I64(hold_ns)[r];
     const int64_t w2 = plain ? 0 : io[IN_W2], w16 = plain ? 0 : io[IN_W16];
     const int64_t w17 = plain ? 0 : io[IN_W17];
+    const int64_t dwatch = I64(dwatch)[r];
+    const int lvel = U8(lvel)[r];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
     double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r],
         q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r],
@@ -1043,6 +1068,13 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         }
         prf = tp[base + cur];
         ended = cur == q_t_end;
+        if (lvel) { /* toward a latched limit: AxisResources._post stops it */
+            const double vl = prf_ratio * tv[base + cur];
+            if (((lvel & 1) && vl > 0.0) || ((lvel & 2) && vl < 0.0)) {
+                q_code = 2;
+                break;
+            }
+        }
         if (jog) { /* AxisBank._jog_step */
             const double rp = q_jrp, jv = q_jrv, fp_ = q_jp, fv = q_jv, fa = q_ja;
             p1 = rp + h * (jv + 0.5 * 0.0 * h);
@@ -1154,7 +1186,8 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         step = (double)(sense * (int64_t)d32) * unit;
         enc = q_enc_pos + step;
         err = a - (plain ? enc : link(enc, enc_ratio, enc_off));
-        if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err) {
+        if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err ||
+            ((din ^ q_din) & dwatch)) {
             q_code = 2;
             break;
         }
@@ -1376,7 +1409,7 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
         RowRun *rs;
         double *bk;
         for (r = 0; r < io[IN_N_RX]; r++) /* a raw write to a claimed slave's outputs */
-            if (buf[I64(rx_idx)[r]] != U8(rx_ref)[r])
+            if (buf[I64(rx_idx)[r]] != U8(rx_ref)[r] && U8(alive)[I64(rx_row)[r]])
                 return 1;
         rs = malloc((size_t)(n > 0 ? n : 1) * sizeof(RowRun));
         bk = malloc((size_t)(n > 0 ? n : 1) * (size_t)(3 * (io[IN_TABLE] + 1)) * sizeof(double));

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from gtecat.drives.coe import next_counter
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
@@ -105,14 +106,25 @@ class EmulatedBackend(Backend):
 
     @claimed.setter
     def claimed(self, positions: set[int] | frozenset[int]) -> None:
-        self._claimed = frozenset(positions)
-        self._run_plan = [e for e in self._plan if e[0].position not in self._claimed]
-        self._claimed_slaves = tuple(e[0] for e in self._plan if e[0].position in self._claimed)
-        self._claimed_wkc = sum(
-            2 * (o is not None) + (i is not None)
-            for sl, o, i in self._plan
-            if sl.position in self._claimed
-        )
+        self._claimed = claimed = frozenset(positions)
+        plan = self._plan
+        if getattr(self, "_plan_of", None) is not plan or len(self._plan_pos) != len(plan):
+            self._plan_of = plan
+            self._plan_pos = [e[0].position for e in plan]
+            self._plan_wkc = [2 * (o is not None) + (i is not None) for _, o, i in plan]
+            self._claimed_memo: dict[frozenset[int], tuple] = {}
+        memo = self._claimed_memo.get(claimed)  # (the bank gives back and takes the same few)
+        if memo is None:
+            inside = [p in claimed for p in self._plan_pos]
+            memo = (
+                [e for e, c in zip(plan, inside, strict=True) if not c],
+                tuple(e[0] for e, c in zip(plan, inside, strict=True) if c),
+                sum(w for w, c in zip(self._plan_wkc, inside, strict=True) if c),
+            )
+            if len(self._claimed_memo) > 256:
+                self._claimed_memo.clear()
+            self._claimed_memo[claimed] = memo
+        self._run_plan, self._claimed_slaves, self._claimed_wkc = memo
 
     def _slave(self, position: int) -> VirtualSlave:
         if position in self.unplugged or not 0 <= position < len(self.slaves):
@@ -327,9 +339,22 @@ class EmulatedBackend(Backend):
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
-        self._client(position).download(
-            index, subindex, bytes(data), complete_access=complete_access
-        )
+        client = self._client(position)
+        data = bytes(data)
+        if (
+            0 < len(data) <= 4
+            and 0 <= index <= 0xFFFF
+            and 0 <= subindex <= 0xFF
+            and self.capture is None
+            and getattr(slave.mailbox, "sdo_server_only", False)
+        ):
+            # nothing sees the frames: the server's own write, counters and abort, unframed
+            client.counter = next_counter(client.counter)
+            slave.sdo.download_in_process(  # type: ignore[attr-defined]
+                index, subindex, data, complete_access, slave.al_state
+            )
+            return
+        client.download(index, subindex, data, complete_access=complete_access)
 
 
 _IO_STEP = IoSlave.step

@@ -145,6 +145,11 @@ def _act(action: tuple) -> int:
         return hash((rc, bytes(data)[: size.value], abort.value))
     if kind == "on":
         return gt.GT_AxisOn(action[1])
+    if kind == "kernel":  # the compiled cycle's build ends now (no GT call)
+        KERNEL_BUILT[0] = True
+        bank = gt.GTE_Controller().bank
+        KERNEL_BUILT.append(bank.rows_run if bank is not None else 0)
+        return 0
     if kind == "raw":
         _, offset, value = action
         return gt.GT_SetEcatRawData(offset, 1, (c_ubyte * 1)(value))
@@ -191,8 +196,10 @@ def _run(
             else:
                 assert ctl.bank.kernel is not None, ctl.bank.kernel_reason
                 KERNEL_CYCLES.append(ctl.bank.kernel_cycles)
-        elif ctl.bank is not None:
+        elif ctl.bank is not None and kernel == "numpy":
             assert ctl.bank.kernel_cycles == 0
+        elif ctl.bank is not None:
+            KERNEL_CYCLES.append(ctl.bank.kernel_cycles)
         mech = [
             (ch.mech.pos, ch.mech.vel, ch.statusword)
             for s in ctl.backend.slaves
@@ -205,6 +212,8 @@ def _run(
 
 
 KERNEL_CYCLES: list[int] = []  # cycles the compiled kernel ran, per "c" run
+#: the "kernel" action: the build the bank waits for has ended; the bank's rows run by then
+KERNEL_BUILT: list = [False]
 MANY_CYCLES: list[int] = []  # cycles the kernel ran many at a time, per run
 HAS_CC = bool(os.environ.get("CC") or any(shutil.which(c) for c in ("cc", "gcc", "clang")))
 
@@ -291,6 +300,40 @@ def test_the_bank_runs_a_moving_twelve_axis_bus(tmp_path: Path) -> None:
     assert rows > 12 * 300
     assert got == ref
     _kernel_ran(KERNEL_CYCLES[0])
+
+
+def test_a_kernel_built_meanwhile_is_taken_mid_move_bit_for_bit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A first run on a machine does not wait for the compiled cycle's build: the bank runs
+    numpy, then at the first cycle after the build ends gives every axis back and claims
+    them again for the compiled cycle - mid-move, with no GT call - and the trace stays the
+    scalar path's."""
+    from gtecat.controller import bank as bank_mod
+    from gtecat.controller import bank_kernel
+
+    lib, reason = bank_kernel.library()
+    if lib is None:
+        pytest.skip(f"the compiled cycle did not build here: {reason}")
+    machine = _machine_file(tmp_path)
+    moves = [
+        (0, ("move", a, (-1) ** a * 30_000, 15.0 + a, 0.5, 0.4, 0.0, (0, 5, 25)[a % 3]))
+        for a in range(1, 13)
+    ]
+    actions = [*moves[:-1], (60, moves[-1][1]), (150, ("kernel",)), (60, ("stop", 0b11, 0))]
+    ref, ref_codes, _ = _run(actions, machine, "off")
+    KERNEL_BUILT[:] = [False]
+    monkeypatch.setattr(
+        bank_mod, "kernel_library", lambda wait=True: (lib, "") if KERNEL_BUILT[0] else (None, "")
+    )
+    monkeypatch.setattr(bank_mod, "kernel_settled", lambda: KERNEL_BUILT[0])
+    KERNEL_CYCLES.clear()
+    got, codes, rows = _run(actions, machine, "on", "auto")
+    assert codes == ref_codes
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    assert KERNEL_BUILT[1] > 12 * 40  # numpy ran the moves before
+    assert rows > 12 * 200 and 100 < KERNEL_CYCLES[0] < 210  # and the kernel after
 
 
 @pytest.mark.long

@@ -7,9 +7,11 @@ array, ``GTN_`` with core 1) and for the raw image (``GT_Get/SetEcatRawData``,
 memoryviews, bytes) are called through the public function and through its table path
 (``.slow``): return code, the memory written and GTE_GetLastError agree.  A profiler (not a
 clock) shows that neither the table path nor the fast path's general way (the shapes it
-checks one by one) ran for them: each is answered by its compiled common path.  Every
-function of the table that takes a pointer is on the fast path, declared only, or has a
-recorded reason.  The default run samples the shapes; GTECAT_LONG=1 runs them all.
+checks one by one) ran for them: each is answered by its compiled common path.  The
+homing status, the Trap parameters and the core reader are held to their table paths the
+same way, in each state that changes their answer.  Every function of the table that takes a
+pointer is on the fast path, declared only, or has a recorded reason.  The default run
+samples the shapes; GTECAT_LONG=1 runs them all.
 """
 
 from __future__ import annotations
@@ -476,3 +478,156 @@ def test_core_2_answers_as_the_table_fast_and_leaves_the_bank(tmp_path: Path) ->
         gt.GTE_Wait(3)
     assert all(r.bank is not None for r in banked), "polling gave an axis back"
     assert all(v & (1 << 10) for v in s)  # both still moving
+
+
+def test_the_homing_status_answers_as_the_table() -> None:
+    """GT_GetEcatHomingStatus on its fast path (a byref or the object, no offset, an integer
+    type the pointer takes): the table path's code, value and reason before any run, while
+    a run that cannot end is polled (its reason beside the 0: the table path answers), when
+    a run has ended, and for an axis that does not exist; its common shapes never reach
+    the table."""
+    from gtecat.drives.machine import AxisMachine, MachineDescription
+
+    from .conftest import bring_up
+
+    bring_up(machine=MachineDescription({1: AxisMachine(), 2: AxisMachine()}), log="")
+    makers = {
+        "byref": lambda: (o := ctypes.c_short(), byref(o), o),
+        "object": lambda: (o := ctypes.c_short(), o, o),
+        "long": lambda: (o := ctypes.c_long(), byref(o), o),
+        "offset": lambda: (o := (ctypes.c_short * 2)(), byref(o, 2), o),
+        "narrow": lambda: (o := ctypes.c_int8(), byref(o), o),
+        "unsigned": lambda: (o := ctypes.c_ushort(), byref(o), o),
+    }
+    fn = gt.GT_GetEcatHomingStatus
+    bad = []
+
+    def compare(when: str) -> None:
+        for axis in (1, 2, 3):
+            for shape, make in makers.items():
+                got = []
+                for call in (fn, fn.slow):
+                    _, p, o = make()
+                    pr = cProfile.Profile()
+                    pr.enable()
+                    rc = call(axis, p)
+                    pr.disable()
+                    table = sum(
+                        v[1]
+                        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+                        if func in ("call", "run") and f.endswith("_core.py")
+                    )
+                    got.append((rc, _value(o), gt.GTE_GetLastError(), table))
+                if got[0][:3] != got[1][:3]:
+                    bad.append(f"{when} axis {axis} {shape}: {got[0][:3]} != {got[1][:3]}")
+                elif axis == 2 and shape in ("byref", "object", "long") and got[0][3]:
+                    bad.append(f"{when} axis {axis} {shape}: took the table path")
+
+    compare("before any run")
+    assert gt.GT_AxisOn(1) == 0 and gt.GT_SetHomingMode(1, 6) == 0
+    assert gt.GT_SetEcatHomingPrm(1, 24, 50_000, 5_000, 1_000_000, 0, 0) == 0
+    assert gt.GT_StartEcatHoming(1) == 0  # (a home switch the machine lacks: never ends)
+    assert gt.GT_AxisOn(2) == 0 and gt.GT_SetHomingMode(2, 6) == 0
+    assert gt.GT_SetEcatHomingPrm(2, 35, 50_000, 5_000, 1_000_000, 0, 0) == 0
+    assert gt.GT_StartEcatHoming(2) == 0  # (the current position: ends at once)
+    compare("started")
+    gt.GTE_Wait(20)
+    compare("later")
+    assert not bad, "\n".join(bad[:10])
+
+
+def test_the_trap_parameters_answer_as_the_table() -> None:
+    """GT_GetTrapPrm on its fast path (``byref(s)`` or ``s`` of TTrapPrm): the table path's
+    code, fields and reason for each shape, in Trap and in another mode, for an axis that
+    does not exist; a banked axis goes back as the table path gives it back."""
+    ctl = _open()
+    prm = gt.TTrapPrm(acc=0.25, dec=0.5, velStart=1.5, smoothTime=7)
+    assert gt.GT_SetTrapPrm(1, byref(prm)) == 0, gt.GTE_GetLastError()
+    makers = {
+        "byref": lambda: (o := gt.TTrapPrm(), byref(o), o),
+        "object": lambda: (o := gt.TTrapPrm(), o, o),
+        "offset": lambda: (o := (gt.TTrapPrm * 2)(), byref(o, 8), o),
+        "another structure": lambda: (o := gt.TJogPrm(), byref(o), o),
+        "bytes": lambda: (o := (ctypes.c_ubyte * 64)(), byref(o), o),
+        "too small": lambda: (o := (ctypes.c_ubyte * 8)(), byref(o), o),
+        "null": lambda: (o := gt.TTrapPrm(), None, o),
+    }
+    fn = gt.GT_GetTrapPrm
+    bad = []
+
+    def compare(when: str) -> None:
+        for axis in (1, 2, 9):
+            for shape, make in makers.items():
+                got = []
+                for call in (fn, fn.slow):
+                    _, p, o = make()
+                    rc = call(axis, p)
+                    got.append((rc, bytes(o), gt.GTE_GetLastError() if rc else ""))
+                if got[0] != got[1]:
+                    bad.append(f"{when} axis {axis} {shape}: {got[0]} != {got[1]}")
+
+    banked = [n for n in (1, 2) if ctl.resources[n].bank is not None]
+    assert banked, "an axis at rest is in the bank"
+    for n in banked:  # (the call gives it back, as the table path does)
+        assert fn(n, gt.TTrapPrm()) == 0 and ctl.resources[n].bank is None
+    compare("trap")
+    assert gt.GT_PrfJog(1) == 0, gt.GTE_GetLastError()
+    compare("jog")
+    s = gt.TTrapPrm()
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = fn(2, byref(s))
+    pr.disable()
+    table = sum(
+        v[1]
+        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        if func in ("call", "run") and f.endswith("_core.py")
+    )
+    assert rc == 0 and not table, "byref(TTrapPrm) took the table path"
+    assert not bad, "\n".join(bad[:10])
+
+
+def test_the_core_reader_answers_as_the_table() -> None:
+    """GT_GetCore on its fast path: the table path's code, value and reason in each shape,
+    with no controller open, on an open one, and after GT_SetCore(2)."""
+    makers = {
+        "byref": lambda: (o := ctypes.c_short(), byref(o), o),
+        "object": lambda: (o := ctypes.c_short(), o, o),
+        "long": lambda: (o := ctypes.c_long(), byref(o), o),
+        "offset": lambda: (o := (ctypes.c_short * 2)(), byref(o, 2), o),
+        "narrow": lambda: (o := ctypes.c_int8(), byref(o), o),
+        "null": lambda: (o := ctypes.c_short(), None, o),
+    }
+    fn = gt.GT_GetCore
+    bad = []
+
+    def compare(when: str) -> None:
+        for shape, make in makers.items():
+            got = []
+            for call in (fn, fn.slow):
+                _, p, o = make()
+                rc = call(p)
+                got.append((rc, _value(o), gt.GTE_GetLastError() if rc else ""))
+            if got[0] != got[1]:
+                bad.append(f"{when} {shape}: {got[0]} != {got[1]}")
+
+    compare("closed")
+    _open()
+    compare("open")
+    s = ctypes.c_short()
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = fn(byref(s))
+    pr.disable()
+    table = sum(
+        v[1]
+        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        if func in ("call", "run") and f.endswith("_core.py")
+    )
+    assert rc == 0 and s.value == 1 and not table
+    try:
+        if gt.GT_SetCore(2) == 0:
+            compare("core 2")
+    finally:
+        gt.GT_SetCore(1)
+    assert not bad, "\n".join(bad)

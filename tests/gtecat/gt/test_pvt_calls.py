@@ -82,3 +82,32 @@ def test_stop_an_endless_table_and_the_refusals():
     assert gt.GT_PvtTableClear(5) == 0 and gt.GT_PvtStart(1) == 1
     assert gt.GT_PrfPvt(2) == 0 and gt.GT_PvtStart(0b10) == 1  # axis 2 is off, no table
     assert gt.GT_PrfTrap(1) == 0 and gt.GT_PvtTableSelect(1, 5) == 1  # not in PVT mode
+
+
+def test_points_too_close_or_too_large_are_7_with_the_reason_not_an_internal_error():
+    """Points a nanosecond apart made the spline's acceleration (1/h²) a division by zero
+    once h² left the doubles' range; the tables refuse them (module docstring)."""
+    assert gt.GT_Open(card="gts:2", clock="lockstep", log="") == 0
+    a, b, c = arr(0, 0), arr(0, 0), arr(0, 0)
+    tiny = 5e-324  # the smallest double after 0: h * h is 0
+    assert gt.GT_PvtTableComplete(1, 2, arr(0, tiny), arr(0, 1), a, b, c, 0.0, 0.0) == 7
+    assert "ms or more after" in gt.GTE_GetLastError()
+    assert gt.GT_PvtTable(1, 2, arr(0, tiny), arr(0, 1), arr(0, 0)) == 7
+    assert gt.GT_PvtTable(1, 2, arr(0, 1), arr(0, 1e300), arr(0, 0)) == 7
+    assert "beyond" in gt.GTE_GetLastError()
+    # a microsecond apart is a table, and the spline's values are finite
+    assert (
+        gt.GT_PvtTableComplete(
+            1,
+            3,
+            arr(0, 1e-3, 2e-3),
+            arr(0, 1, 0),
+            arr(0, 0, 0),
+            b3 := arr(0, 0, 0),
+            arr(0, 0, 0),
+            0.0,
+            0.0,
+        )
+        == 0
+    )
+    assert all(abs(v) < float("inf") for v in b3)

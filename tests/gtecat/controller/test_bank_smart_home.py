@@ -1,0 +1,175 @@
+"""Smart homing (GT_GoHome) in the axis bank against the scalar path, cycle by cycle.
+
+Twelve EtherCAT axes home at once in different smart-home modes (home ahead or behind, a
+limit that turns the search, starting on the switch, limit then home both ways, limit with
+escapes both ways, forced home, home and index through the touch probe, a search stopped by
+GT_Stop, one that does not end in the run) on switches close enough that every search meets
+its events in the run.  Each event (a home edge, a limit, a leg's end sample) sends an axis
+back to its scalar objects and the bank takes it again after, and between events the bank
+runs the cycles many at once while the homings say they stay quiet: that is where a
+difference would show.  Compared exactly with the bank off, every cycle: GT_GetSts, planned
+and encoder positions of every axis, every axis's THomeStatus and the whole GT raw image;
+the drives' mechanics at the end.
+"""
+
+from __future__ import annotations
+
+import os
+from ctypes import byref, c_double, c_long, c_short, c_ubyte
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from tests.gtecat.controller.test_bank import ENI, HAS_CC
+
+AXES = 12
+#: axis -> (THomePrm fields, machine keys); positions in counts (pulse = count here)
+SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
+    1: ({"mode": 20}, {"home_switch": [[3_000, 4_500]]}),
+    2: ({"mode": 20, "moveDir": -1, "edge": 1}, {"home_switch": [[-5_000, -3_500]]}),
+    3: ({"mode": 11}, {"positive_limit": 6_000, "home_switch": [[2_000, 3_000]]}),
+    4: ({"mode": 10, "moveDir": -1, "escapeStep": 400}, {"negative_limit": -4_000}),
+    5: ({"mode": 20}, {"position": 1_000, "home_switch": [[500, 2_500]]}),
+    6: ({"mode": 20}, {"positive_limit": 3_000, "home_switch": [[-3_000, -2_000]]}),
+    7: (
+        {"mode": 22, "homeOffset": -300},
+        {"home_switch": [[2_000, 3_000]], "index_offset": 100, "counts_per_rev": 1_000},
+    ),
+    8: ({"mode": 11, "moveDir": -1}, {"negative_limit": -3_500, "home_switch": [[-1_800, -900]]}),
+    9: ({"mode": 40}, {"home_switch": [[2_500, 7_000]]}),
+    10: ({"mode": 20, "homeOffset": 250}, {"home_switch": [[4_000, 6_000]]}),  # GT_Stop
+    11: ({"mode": 20}, {"home_switch": [[400_000, 410_000]]}),  # still searching at the end
+    12: ({"mode": 10, "escapeStep": 300}, {"positive_limit": 2_500}),
+}
+CYCLES = 650
+STOP_AT = 90  # GT_Stop of axis 10 in the middle of its search
+
+
+def _machine(tmp: Path) -> str:
+    lines = []
+    for axis, (_, keys) in SETUP.items():
+        lines.append(f"[axis.{axis}]")
+        lines += [f"{k} = {v}" for k, v in keys.items()]
+    path = tmp / "machine.toml"
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+def _ok(rc: int, what: str) -> None:
+    assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
+
+
+def _sample(size: int) -> tuple:
+    sts = (c_long * AXES)()
+    prf = (c_double * AXES)()
+    enc = (c_double * AXES)()
+    gt.GT_GetSts(1, sts, AXES)
+    gt.GT_GetPrfPos(1, prf, AXES)
+    gt.GT_GetEncPos(1, enc, AXES)
+    homes = []
+    hs = gt.THomeStatus()
+    for a in range(1, AXES + 1):
+        _ok(gt.GT_GetHomeStatus(a, byref(hs)), "status")
+        homes.append((hs.run, hs.stage, hs.error, hs.capturePos, hs.targetPos))
+    raw = (c_ubyte * size)()
+    gt.GT_GetEcatRawData(0, size, raw)
+    return tuple(sts), tuple(prf), tuple(enc), tuple(homes), bytes(raw)
+
+
+def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
+    """The homings, sampled after every cycle (``step`` 0: one cycle at a time, now and then
+    seven) or after every ``step`` cycles run at once (a long wait: the controller runs
+    them in as few calls as the homings let it)."""
+    gt.GT_Close()
+    _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank=bank), "open")
+    trace: list = []
+    try:
+        _ok(gt.GT_InitEcatComm(), "init")
+        ready = c_short()
+        for _ in range(200):
+            gt.GT_IsEcatReady(byref(ready))
+            if ready.value:
+                break
+            gt.GTE_Wait(1)
+        _ok(gt.GT_StartEcatComm(), "start")
+        for a, (fields, _) in SETUP.items():
+            _ok(gt.GT_AxisOn(a), f"axis on {a}")
+            _ok(gt.GT_PrfTrap(a), f"trap {a}")
+            prm = gt.THomePrm()
+            prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = 20, 1, -1, 0, -1
+            prm.velHigh, prm.velLow, prm.acc, prm.dec = 40.0, 4.0, 1.0, 1.0
+            prm.escapeStep = 1000
+            for name, value in fields.items():
+                setattr(prm, name, value)
+            _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
+        ctl = gt.GTE_Controller()
+        size = ctl.layout.gt_raw_bytes
+        k = 0
+        while k < CYCLES:
+            if k <= STOP_AT < k + max(step, 1):
+                _ok(gt.GT_Stop(1 << 9, 0), "stop")
+            # mostly one cycle at a time, sometimes many at once (a polling loop)
+            wait = step or (1 if k % 50 else 7)
+            gt.GTE_Wait(wait)
+            k += wait
+            trace.append(_sample(size))
+        bank_ = ctl.bank
+        stats = {
+            "rows": bank_.rows_run if bank_ is not None else 0,
+            "many": bank_.many_cycles if bank_ is not None else 0,
+            "kernel": bank_ is not None and bank_.kernel is not None,
+        }
+        trace.append(
+            tuple(
+                (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
+                for s in ctl.backend.slaves
+                for ch in getattr(s, "channels", [])
+            )
+        )
+    finally:
+        gt.GT_Close()
+    return trace, stats
+
+
+@pytest.fixture(scope="module")
+def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
+    return _machine(tmp_path_factory.mktemp("smart_home"))
+
+
+@pytest.fixture(scope="module")
+def runs(machine: str) -> tuple:
+    return _run(machine, "off"), _run(machine, "on")
+
+
+def test_smart_homing_in_the_bank_matches_the_scalar_path(runs: tuple) -> None:
+    (ref, ref_stats), (got, _) = runs
+    assert ref_stats["rows"] == 0
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    # every homing ended as planned: stage 100 without error, axis 10 stopped (error 4),
+    # axis 11 still searching
+    homes = ref[-2][3]
+    ended = {a: (run, stage, error) for a, (run, stage, error, _, _) in enumerate(homes, 1)}
+    assert ended[10] == (0, 20, 4)
+    assert ended[11] == (1, 20, 0)
+    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11)), ended
+
+
+def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
+    """Without this the differential test could pass with the bank never engaged."""
+    _, (_, stats) = runs
+    assert stats["rows"] > AXES * CYCLES * 0.4
+    assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
+    if stats["kernel"]:
+        assert stats["many"] > 20  # cycles the homings let the controller run at once
+
+
+def test_long_waits_give_the_same_homings(machine: str) -> None:
+    """Waits of 37 ms: the controller runs each in as few calls as the homings' quiet cycles
+    allow, the events one cycle at a time in between; every 37th cycle is the scalar one."""
+    (ref, _), (got, stats) = _run(machine, "off", 37), _run(machine, "on", 37)
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"after {37 * (k + 1)} cycles: the bank and the scalar path differ"
+    if stats["kernel"]:
+        assert stats["many"] > 20

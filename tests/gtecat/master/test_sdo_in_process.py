@@ -1,0 +1,106 @@
+"""The in-process backend serves an expedited SDO download (the bring-up's InitCmds, 17 per
+drive) by the slave's SDO server directly when nothing sees the frames: the same object
+dictionary, counters and aborts as the same download framed through the mailbox."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from gtecat.drives.abort import SdoAbort
+from gtecat.drives.sdo_server import SdoServer
+from gtecat.eni.layout import build_layout
+from gtecat.eni.reader import read_eni
+from gtecat.master.backends.emulated import EmulatedBackend
+from gtecat.master.bus import Master
+from tests.conftest import EXAMPLES
+
+
+class _Frames:
+    """A capture of the mailbox frames: its presence sends every download through them."""
+
+    def __init__(self) -> None:
+        self.frames = 0
+
+    def mailbox(self, position: int, request: bytes, answer: bytes | None) -> None:
+        self.frames += 1
+
+    def __getattr__(self, name: str) -> Any:
+        return lambda *args, **kw: None  # the cycles' frames, the scan: not looked at
+
+
+#: (slave, index, subindex, data, complete access): writes that take and writes refused
+DOWNLOADS = [
+    (0, 0x6060, 0, b"\x08", False),
+    (0, 0x6065, 0, (1234).to_bytes(4, "little"), False),
+    (1, 0x607D, 1, (-5000).to_bytes(4, "little", signed=True), False),
+    (0, 0x6041, 0, b"\x00\x00", False),  # read-only
+    (0, 0x5FFE, 0, b"\x01", False),  # no such object
+    (1, 0x6060, 7, b"\x01", False),  # no such subindex
+    (0, 0x1600, 1, (0x60400010).to_bytes(4, "little"), False),  # mapping, not in SAFEOP
+    (1, 0x6065, 0, b"\x01\x02\x03", False),  # a length the object does not have
+]
+
+
+def _bus(frames: bool, eni: str = "manual_fig5_2.eni") -> tuple[EmulatedBackend, Master, Any]:
+    backend = EmulatedBackend()
+    cap = _Frames() if frames else None
+    backend.capture = cap
+    master = Master(build_layout(read_eni(EXAMPLES / eni)), backend, op_delay_cycles=0)
+    master.open()  # the InitCmds: through the frames, or not
+    return backend, master, cap
+
+
+def _outcome(backend: EmulatedBackend, args: tuple) -> Any:
+    try:
+        backend.sdo_download(*args)
+    except SdoAbort as e:
+        return ("abort", int(e.code), e.index, e.subindex, str(e))
+    return "ok"
+
+
+def test_an_unframed_download_is_the_framed_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    framed, fm, cap = _bus(frames=True)
+    served: list[int] = []
+    handle = SdoServer.handle
+
+    def counting(self: SdoServer, message: bytes, al_state: Any = None) -> Any:
+        served.append(1)
+        return handle(self, message, al_state) if al_state is not None else handle(self, message)
+
+    monkeypatch.setattr(SdoServer, "handle", counting)
+    direct, dm, _ = _bus(frames=False)
+    assert not served  # the bring-up's InitCmds went to the servers directly
+    assert cap is not None and cap.frames > 0
+    for s in range(2):
+        assert direct.slaves[s].od.upload(0x1600, 1) == framed.slaves[s].od.upload(0x1600, 1)
+    got = []
+    for slave, index, sub, data, ca in DOWNLOADS:
+        a = _outcome(framed, (slave, index, sub, data, ca))
+        b = _outcome(direct, (slave, index, sub, data, ca))
+        assert a == b, (hex(index), sub)
+        got.append(a)
+    assert got.count("ok") == 3 and len(got) > 6
+    for s in range(2):
+        for index, sub in ((0x6060, 0), (0x6065, 0), (0x607D, 1)):
+            assert dm.sdo_upload(s, index, sub) == fm.sdo_upload(s, index, sub)
+        assert direct._clients[s].counter == framed._clients[s].counter
+        assert direct.slaves[s].sdo.counter == framed.slaves[s].sdo.counter
+
+
+def test_a_coe_io_slave_too() -> None:
+    framed, fm, _ = _bus(True, "manual_fig5_4.eni")  # the coupler has a mailbox
+    direct, dm, _ = _bus(False, "manual_fig5_4.eni")
+    outcomes = []
+    for index, sub, data in (
+        (0x7010, 1, b"\x5a\x00"),
+        (0x6000, 1, b"\x01\x00"),
+        (0x8000, 1, b"\x01"),
+    ):
+        a = _outcome(framed, (0, index, sub, data, False))
+        assert a == _outcome(direct, (0, index, sub, data, False))
+        outcomes.append(a)
+    assert outcomes[0] == "ok" and outcomes[2][0] == "abort"
+    assert dm.sdo_upload(0, 0x7010, 1) == fm.sdo_upload(0, 0x7010, 1) == b"\x5a\x00"
+    assert direct._clients[0].counter == framed._clients[0].counter

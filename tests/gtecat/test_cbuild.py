@@ -1,0 +1,96 @@
+"""Building a C part in a process of its own (gtecat/cbuild.py ``Background``): the library is
+named as a build in this process would name it, a refused flag falls back to the next build,
+a failure says why, and the build finishes after the process that started it has ended."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from gtecat import cbuild
+
+ROOT = Path(__file__).resolve().parents[2]
+SOURCE = "int f(void) { return 1; }\n"
+
+
+def _cc(tmp_path: Path, body: str) -> Path:
+    """A compiler: a shell script that logs its arguments and runs ``body``; ``$out`` is
+    its ``-o`` file."""
+    log = tmp_path / "cc.log"
+    cc = tmp_path / "fake-cc"
+    cc.write_text(
+        "#!/bin/sh\n"
+        f'echo "$@" >> "{log}"\n'
+        'out=""; for a in "$@"; do [ "$prev" = -o ] && out="$a"; prev="$a"; done\n'
+        f"{body}\n"
+    )
+    cc.chmod(0o755)
+    return cc
+
+
+@pytest.fixture
+def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    if sys.platform == "win32":
+        pytest.skip("the fake compiler is a POSIX shell script")
+    monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def test_builds_into_the_cache_under_the_name_of_a_build_here(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("CC", str(_cc(tmp_path, 'echo built > "$out"')))
+    job = ("part", SOURCE, ("-O3",), ("-lm",))
+    b = cbuild.Background([job])
+    assert b.wait() == cbuild.library_path(*job)
+    assert b.done() and b.wait().read_text() == "built\n"
+    assert [p.name for p in b.wait().parent.iterdir() if p.name.startswith(".build")] == []
+    again = cbuild.Background([job])  # there already: nothing started
+    assert again.done() and again.wait() == b.wait()
+    assert len((tmp_path / "cc.log").read_text().splitlines()) == 1
+
+
+def test_refused_flags_get_the_next_build_and_a_failure_says_why(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    refuse = 'case "$*" in *-O3*) echo "cc: error: bad -O3" >&2; exit 1;; esac\necho ok > "$out"'
+    monkeypatch.setenv("CC", str(_cc(tmp_path, refuse)))
+    plain = ("part", SOURCE, ("-O2",), ())
+    b = cbuild.Background([("part", SOURCE, ("-O3",), ()), plain])
+    assert b.wait() == cbuild.library_path(*plain)
+    monkeypatch.setenv("CC", str(_cc(tmp_path, 'echo "cc: error: no such file" >&2; exit 1')))
+    b = cbuild.Background([("other", SOURCE, ("-O3",), ())])
+    with pytest.raises(cbuild.NativeBuildError, match="no such file"):
+        b.wait()
+    assert b.done() and isinstance(b.result, cbuild.NativeBuildError)
+
+
+def test_the_build_outlives_the_process_that_started_it(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cc = _cc(tmp_path, 'sleep 0.3; echo late > "$out"')
+    program = (
+        "from gtecat import cbuild\n"
+        f"b = cbuild.Background([('part', {SOURCE!r}, (), ())])\n"
+        "print(b.libs[0])\n"
+    )
+    env = {**os.environ, "CC": str(cc), "PYTHONPATH": str(ROOT), "GTECAT_CACHE_DIR": str(cache)}
+    r = subprocess.run(
+        [sys.executable, "-W", "error", "-c", program],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 0 and not r.stderr, r.stderr  # no warning of a child left running
+    lib = Path(r.stdout.strip())
+    assert not lib.exists()  # the process ended first
+    end = time.monotonic() + 30
+    while not lib.exists() and time.monotonic() < end:
+        time.sleep(0.05)
+    assert lib.read_text() == "late\n"
