@@ -1308,6 +1308,16 @@ class AxisBank:
         if r is not None and self.alive[r]:
             self._release_groups([self.groups[self.group_of[r]]])
 
+    def _release_axes(self, axes: list[Any]) -> None:
+        """Give back the groups of ``axes`` that the bank runs, in one release."""
+        gis = set()
+        for ax in axes:
+            r = self._row_of.get(id(ax))
+            if r is not None and self.alive[r]:
+                gis.add(self.group_of[r])
+        if gis:
+            self._release_groups([self.groups[gi] for gi in sorted(gis)])
+
     def _release_groups(self, groups: list[_Group]) -> None:
         """Write the rows' committed state back into their objects; they leave the bank."""
         clusters: list[Cluster] = []
@@ -1468,8 +1478,7 @@ class AxisBank:
                     axes = ctl.axes
                     named = [ax for ax in map(axes.get, range(n, n + count)) if ax is not None]
                     if named:
-                        for ax in named:
-                            self.release_axis_object(ax)
+                        self._release_axes(named)
                         return
         if params and params[0].name == "slave_position" and values and type(values[0]) is int:
             # an SDO to one slave: its axes go back (the drive's objects it reaches give
