@@ -898,7 +898,7 @@ class _Homings:
     the middle of a Trap leg has nothing to do until the leg's end sample or an input of the
     axis changes, which gives the axis back before that cycle (:meth:`SmartHome.quiet`).
     Such homings are not stepped, and :meth:`quiet_cycles` tells the controller how many
-    cycles it may run at once (:func:`gtecat.controller.core._quiet_cycles`).  Times are the
+    cycles it may run at once (:func:`gtecat.controller.core._quiet_way`).  Times are the
     controller's (ns): :attr:`_due` is the start of the first cycle after which some homing
     may have to step, valid while the bank has released nothing since (:attr:`_seen`)."""
 

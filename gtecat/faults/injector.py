@@ -237,6 +237,8 @@ class Injector:
                     return 0
                 if e.duration_ms is not None:
                     t0, d = e.started_ms or 0.0, e.duration_ms
+                    if self.bus.t_ms(n - 1) - t0 < d:  # not over in the last of them: in none
+                        continue
                     left = d - (self.bus.t_ms() - t0)
                     over = lambda j, t0=t0, d=d: self.bus.t_ms(j) - t0 >= d  # noqa: E731
                     n = min(n, first_cycle(over, self.bus, left, n))
