@@ -141,6 +141,10 @@ def test_a_killed_builder_leaves_nothing_behind_for_the_next_build(
                     os.killpg(group, signal.SIGKILL)
         proc.wait()
     assert len(_leftovers(cache)) == 2  # what the killed build left
+    (log,) = vdir.glob(".build-*.log")
+    end = time.monotonic() + 30
+    while cbuild._owner_alive(log) and time.monotonic() < end:
+        time.sleep(0.02)  # (the kill takes effect a moment later)
     # a live build beside it: a folder whose owner file is locked
     live = vdir / ".build-live"
     live.mkdir()
