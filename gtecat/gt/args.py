@@ -694,15 +694,15 @@ def _integer(p: Param, value: Any) -> int:
 
 def _real(p: Param, value: Any) -> float:
     v = value
-    if isinstance(v, _SIMPLE) and v._type_ not in "zZPOc":
-        v = v.value
-    if isinstance(v, bool | np.bool_ | numbers.Real) and not isinstance(v, str):
-        try:
-            x = float(v)
-        except (OverflowError, ValueError, TypeError):
-            raise ParameterError(f"{p.name}={shown(value)} is not a number") from None
-    else:
-        raise ParameterError(f"{p.name}={shown(value)}: a number is needed (double)")
+    if type(v) is not float and type(v) is not int:  # (the common arguments: no ABC check)
+        if isinstance(v, _SIMPLE) and v._type_ not in "zZPOc":
+            v = v.value
+        if not isinstance(v, bool | np.bool_ | numbers.Real) or isinstance(v, str):
+            raise ParameterError(f"{p.name}={shown(value)}: a number is needed (double)")
+    try:
+        x = float(v)
+    except (OverflowError, ValueError, TypeError):
+        raise ParameterError(f"{p.name}={shown(value)} is not a number") from None
     if not math.isfinite(x):
         raise ParameterError(f"{p.name}={shown(value)} must be finite")
     if p.lo is not None and not p.lo <= x <= p.hi:  # type: ignore[operator]
