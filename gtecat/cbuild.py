@@ -8,11 +8,19 @@ compiled cycle (:mod:`gtecat.controller.bank_kernel`) and the GT fast path's poi
 they share: where the cache is, which compiler, and a one-file shared library build named by
 the digest of its source and flags (a lock file serialises concurrent builders), in this
 process (:func:`shared_library`) or in one of its own that outlives it (:class:`Background`).
+
+A build works in a folder ``<cache>/<version>/.build-XXXX/`` beside its owner file
+``.build-XXXX.log`` (the background builder's error output), and holds a lock on that file
+for as long as the build runs: the process that builds (and the background builder after
+it) keeps it open.  A builder killed on the way (the OOM killer, ``kill -9``, a reboot)
+leaves both behind with nobody holding the lock; every later build first removes such
+leftovers (:func:`sweep`), never the folder of a build that still runs.
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import hashlib
 import json
 import os
@@ -21,8 +29,10 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import warnings
 from pathlib import Path
+from typing import Any
 
 from . import __version__
 from ._cache import cache_root
@@ -65,6 +75,98 @@ def version_dir() -> Path:
     return d
 
 
+#: a build folder without an owner file (or, where there are no file locks, any build
+#: folder) is taken as left over once it is this old (seconds): no build runs that long
+STALE_AGE_S = 30 * 60
+_PREFIX = ".build-"
+
+
+def _dirs_lock(vdir: Path) -> Any:
+    """The lock under which build folders are made and leftovers removed (held briefly,
+    unlike ``.lock``, which a builder holds for its whole compile); None without file locks."""
+    if fcntl is None:
+        return contextlib.nullcontext()
+    f = open(vdir / ".dirs.lock", "w")
+    fcntl.flock(f, fcntl.LOCK_EX)
+    return f
+
+
+def _owner_alive(log: Path) -> bool:
+    """Someone holds the lock on the build's owner file (the build still runs)."""
+    if fcntl is None:
+        return True  # cannot tell: only the age decides
+    try:
+        fd = os.open(log, os.O_RDWR)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        return True
+    finally:
+        os.close(fd)  # (releases the lock taken just now)
+    return False
+
+
+def _old(path: Path, now: float) -> bool:
+    try:
+        return now - path.stat().st_mtime > STALE_AGE_S
+    except OSError:
+        return False
+
+
+def sweep(vdir: Path) -> list[Path]:
+    """Remove the build folders and owner files of builders that died on the way (module
+    docstring); returns what was removed.  Called by every builder before it starts."""
+    removed: list[Path] = []
+    now = time.time()
+    with _dirs_lock(vdir):
+        try:
+            names = [e.name for e in os.scandir(vdir) if e.name.startswith(_PREFIX)]
+        except OSError:
+            return removed
+        for stem in sorted({n.removesuffix(".log") for n in names}):
+            folder, log = vdir / stem, vdir / f"{stem}.log"
+            has_log = f"{stem}.log" in names
+            if has_log:
+                if _owner_alive(log):
+                    continue
+                if (fcntl is None or not folder.exists()) and not _old(log, now):
+                    continue  # (a failed build's log that its process has yet to read)
+            elif not _old(folder, now):
+                continue  # (a build of another kind in here, or one that just began)
+            for path in (folder, log):
+                if path.is_dir():
+                    shutil.rmtree(path, ignore_errors=True)
+                    removed.append(path)
+                elif path.exists():
+                    with contextlib.suppress(OSError):
+                        path.unlink()
+                        removed.append(path)
+    return removed
+
+
+class _BuildDir:
+    """A build folder and its owner file, locked (module docstring); made under the folders'
+    lock so that :func:`sweep` never sees it unowned."""
+
+    def __init__(self, vdir: Path) -> None:
+        sweep(vdir)
+        with _dirs_lock(vdir):
+            self.path = Path(tempfile.mkdtemp(prefix=_PREFIX, dir=vdir))
+            self.log = self.path.with_suffix(".log")
+            self.owner = open(self.log, "wb")
+            if fcntl is not None:
+                fcntl.flock(self.owner, fcntl.LOCK_EX)
+
+    def close(self) -> None:
+        """Remove the folder and the owner file, then let go of the owner file's lock."""
+        shutil.rmtree(self.path, ignore_errors=True)
+        with contextlib.suppress(OSError):
+            self.log.unlink()
+        self.owner.close()
+
+
 def library_path(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:
     """``<cache>/<version>/<stem>-<digest>.so``: where the build of the one C file ``source``
     (text) with this compiler and these flags is kept (NativeBuildError without a compiler)."""
@@ -87,7 +189,8 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
             fcntl.flock(lock, fcntl.LOCK_EX)
         if lib.is_file():
             return lib
-        tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=vdir))
+        build = _BuildDir(vdir)
+        tmp = build.path
         try:
             src = tmp / f"{stem}.c"
             src.write_text(source, encoding="utf-8")
@@ -101,7 +204,7 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
                 raise NativeBuildError(f"building {stem} failed ({shlex.join(cmd)}):\n{r.stderr}")
             out.rename(lib)
         finally:
-            shutil.rmtree(tmp, ignore_errors=True)
+            build.close()
     return lib
 
 
@@ -109,7 +212,8 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
 #: argv[1] is a JSON list of (command, its output, the library's name) tried in turn until
 #: one builds; the first that does is renamed to its name; the lock serialises builders and
 #: a library already there ends the work; what failed goes to stderr (the parent's log file,
-#: removed here when the library is there)
+#: removed here when the library is there); its stderr holds the lock on that log (the
+#: owner file: inherited from the parent, so the lock lasts while either of them runs)
 _BUILDER = r"""
 import json, os, shutil, subprocess, sys
 spec = json.loads(sys.argv[1])
@@ -141,12 +245,12 @@ try:
                 break
             sys.stderr.write(f"building failed ({' '.join(cmd)}):\n{r.stderr}\n")
 finally:
+    shutil.rmtree(spec["tmp"], ignore_errors=True)
     if built:  # else the log says why (the parent reads it)
         try:
             os.unlink(spec["log"])
         except OSError:
             pass
-    shutil.rmtree(spec["tmp"], ignore_errors=True)
 """
 
 
@@ -171,7 +275,8 @@ class Background:
             return
         cc = compiler()
         vdir = version_dir()
-        tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=vdir))
+        build = _BuildDir(vdir)
+        tmp = build.path
         jobs = []
         for k, ((stem, source, cflags, libs), lib) in enumerate(
             zip(builds, self.libs, strict=True)
@@ -182,17 +287,21 @@ class Background:
             jobs.append(
                 ([*cc, *cflags, "-shared", str(src), "-o", str(out), *libs], str(out), str(lib))
             )
-        self._log = tmp.with_suffix(".log")
+        self._log = build.log
         spec = {"lock": str(vdir / ".lock"), "tmp": str(tmp), "jobs": jobs, "log": str(self._log)}
-        with open(self._log, "wb") as err:
+        try:
             self._proc = subprocess.Popen(
                 [sys.executable, "-I", "-S", "-c", _BUILDER, json.dumps(spec)],
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,
-                stderr=err,
+                stderr=build.owner,  # (the owner file's lock goes with it)
                 start_new_session=True,  # an interrupt of this process leaves the build be
                 close_fds=True,
             )
+        except BaseException:
+            build.close()
+            raise
+        build.owner.close()  # the builder holds the lock from here on
         atexit.register(self._leave)
 
     def done(self) -> bool:

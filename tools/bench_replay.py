@@ -28,8 +28,16 @@ brings it back, the limit switch of axis 6 chatters at 30 s for 300 ms).
 every axis in one call (``GT_GetSts(1, sts, 12, NULL)``, the planned and encoder positions as
 arrays too) every 4 to 8 ms, Trap moves and two jogs.
 
+``--hard`` records tools/session_hard.py's HMI-like session twice - every axis polled every
+4 ms one by one (``single``), and as count-12 arrays (``arrays``): homing, jogs, Trap moves, a
+drive fault and a chattering limit switch with the application's error handler, SDO reads -
+and times each recording's replay in this process and as a whole ``gtecat replay FILE``
+process (the interpreter's start, the imports, reading the file and the replay: what a user
+waits for); ``--against CHECKOUT`` times the whole process with that checkout's gtecat too,
+the two in turn.
+
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
-                                 [--simple | --rich | --arrays] [--json]
+                                 [--simple | --rich | --arrays | --hard] [--json]
 """
 
 from __future__ import annotations
@@ -37,6 +45,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -207,6 +216,98 @@ def replay_in(root: Path, path: Path) -> tuple[float, float, int, str | None]:
     return wall, cpu, n, div
 
 
+def replay_process(root: Path, path: Path) -> tuple[float, float, str]:
+    """(wall, CPU, its last line) of a whole ``gtecat replay FILE`` process run with the gtecat
+    of checkout ``root``; RuntimeError when it does not exit 0."""
+    env = dict(os.environ, PYTHONPATH=str(root))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = subprocess.run(
+        [sys.executable, "-m", "gtecat", "replay", str(path)],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=str(path.parent),
+    )
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if out.returncode != 0:
+        raise RuntimeError(f"gtecat replay {path} ({root}): {out.stderr.strip()[-500:]}")
+    return wall, cpu, out.stdout.strip().splitlines()[-1]
+
+
+def measure_hard(
+    seconds: float, repeat: int, against: Path | None = None, keep: Path | None = None
+) -> dict[str, object]:
+    """The hard session (module docstring), recorded polling one by one and as arrays."""
+    from gtecat import faults, gt
+    from gtecat.faults.record import Recorder, replay
+    from tools import session_hard
+
+    out: dict[str, object] = {
+        "session": "hard",
+        "virtual_s": seconds,
+        "poll_ms": session_hard.POLL_MS,
+        "load_average_before": round(os.getloadavg()[0], 2),
+    }
+    diverged = None
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = keep if keep is not None else Path(tmp)
+        folder.mkdir(parents=True, exist_ok=True)
+        machine = folder / "hard.toml"
+        machine.write_text(session_hard.MACHINE)
+        for form, single in (("single", True), ("arrays", False)):
+            path = folder / f"hard_{form}.gtrec"
+            rec = Recorder(path).start()
+            t0, c0 = time.perf_counter(), time.process_time()
+            try:
+                session_hard.session(gt, faults, seconds, str(machine), single)
+            finally:
+                rec.stop()
+            recorded = (time.perf_counter() - t0, time.process_time() - c0)
+            rec.write()
+            runs, n, div = [], 0, None
+            for _ in range(repeat):
+                t0, c0 = time.perf_counter(), time.process_time()
+                n, div = replay(path)
+                runs.append((time.perf_counter() - t0, time.process_time() - c0))
+                if div is not None:
+                    diverged = diverged or f"{form}: {div}"
+                    break
+            wall, cpu = _best(runs)
+            row: dict[str, object] = {
+                "calls": n,
+                "file_bytes": path.stat().st_size,
+                "record_wall_s": round(recorded[0], 3),
+                "replay_wall_s": round(wall, 3),
+                "replay_cpu_s": round(cpu, 3),
+                "times_real_time": round(seconds / wall, 1),
+                "times_real_time_cpu": round(seconds / cpu, 1),
+                "diverged": str(div) if div else None,
+            }
+            sides = [("after", ROOT)] if against is None else [("before", against), ("after", ROOT)]
+            procs: dict[str, list[tuple[float, float]]] = {k: [] for k, _ in sides}
+            for _ in range(repeat):  # whole processes, the sides in turn
+                for key, root in sides:
+                    w, c, _ = replay_process(root, path)
+                    procs[key].append((w, c))
+            for key, root in sides:
+                w, c = _best(procs[key])
+                row[f"process_{key}" if against is not None else "process"] = {
+                    "checkout": str(root),
+                    "wall_s": round(w, 3),
+                    "cpu_s": round(c, 3),
+                    "times_real_time": round(seconds / w, 1),
+                    "times_real_time_cpu": round(seconds / c, 1),
+                }
+            out[form] = row
+    out["load_average_after"] = round(os.getloadavg()[0], 2)
+    out["diverged"] = diverged
+    out["reference_12_axes_trap_one_cycle_at_a_time"] = reference()
+    return out
+
+
 def measure(
     seconds: float,
     poll_ms: int,
@@ -319,13 +420,27 @@ def main() -> int:
         "a chattering limit switch, SDO reads (tools/session_rich.py)",
     )
     kind.add_argument(
+        "--hard",
+        action="store_true",
+        help="the HMI-like session that polls every axis every 4 ms, one by one and as "
+        "count-12 arrays (two recordings), each also replayed as a whole gtecat replay "
+        "process (tools/session_hard.py)",
+    )
+    kind.add_argument(
         "--arrays",
         action="store_true",
         help="the session that polls all 12 axes in one call each (status, planned and "
         "encoder positions as arrays) every 4 to 8 ms (tools/session_arrays.py)",
     )
+    ap.add_argument(
+        "--keep", type=Path, help="--hard: write the recordings into this folder and keep them"
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
+    if args.hard:
+        out = measure_hard(args.seconds, max(1, args.repeat), args.against, args.keep)
+        print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
+        return 0 if out["diverged"] is None else 1
     out = measure(
         args.seconds,
         args.poll_ms,

@@ -45,7 +45,10 @@ COMMANDS = (
 )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(verb: str | None = None) -> argparse.ArgumentParser:
+    """The whole command line; ``verb``: only that verb's module is imported and its parser
+    added, when its module (``VERB_cmd``) gives it (a run of one verb needs no other), else
+    every verb's."""
     parser = argparse.ArgumentParser(
         prog="gtecat",
         description="EtherCAT master emulator with virtual CiA-402 drives and the GT_* API.",
@@ -61,20 +64,38 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"gtecat {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    if verb is not None and f"{verb}_cmd" in COMMANDS:
+        _add_verbs(sub, f"{verb}_cmd")
+        if verb in sub.choices:
+            return parser
+        return build_parser()
     for name in COMMANDS:
-        try:
-            mod = importlib.import_module(f"gtecat.cli.{name}")
-        except ModuleNotFoundError as e:
-            if e.name != f"gtecat.cli.{name}":
-                raise
-            continue
-        before = set(sub.choices)
-        mod.add_parser(sub)
-        for verb in set(sub.choices) - before:
-            if sub.choices[verb].get_default("func") is None:
-                sub.choices[verb].set_defaults(func=mod.run)
-            _debug_anywhere(sub.choices[verb])
+        _add_verbs(sub, name)
     return parser
+
+
+def _add_verbs(sub: argparse._SubParsersAction, name: str) -> None:
+    """The verbs of module ``gtecat.cli.NAME`` added to ``sub``."""
+    try:
+        mod = importlib.import_module(f"gtecat.cli.{name}")
+    except ModuleNotFoundError as e:
+        if e.name != f"gtecat.cli.{name}":
+            raise
+        return
+    before = set(sub.choices)
+    mod.add_parser(sub)
+    for verb in set(sub.choices) - before:
+        if sub.choices[verb].get_default("func") is None:
+            sub.choices[verb].set_defaults(func=mod.run)
+        _debug_anywhere(sub.choices[verb])
+
+
+def _verb(argv: list[str]) -> str | None:
+    """The verb of a command line (its first word after ``--debug``), None when it has none."""
+    for word in argv:
+        if word != "--debug":
+            return None if word.startswith("-") else word
+    return None
 
 
 def _debug_anywhere(p: argparse.ArgumentParser) -> None:
@@ -130,7 +151,7 @@ def os_sentence(e: OSError) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     _tolerant_streams()
-    parser = build_parser()
+    parser = build_parser(_verb(sys.argv[1:] if argv is None else list(argv)))
     args = parser.parse_args(argv)
     if not getattr(args, "command", None) or not hasattr(args, "func"):
         parser.print_help()

@@ -16,9 +16,10 @@ state written back into its objects exactly as if they had run every cycle thems
 before anything else may look at or change them:
 
 * any GT function except the bank-aware readers (:data:`BANK_READS`) releases the
-  axis it names (or every axis when it names several, a mask or none) before it runs; one
-  naming a coordinate system releases that system's cluster alone (:meth:`AxisBank.before_call`;
-  a segment pushed onto a running path the bank holds ahead may even stay: ``_push_ahead``);
+  axis it names (the axes of a mask or of a ``count`` span, a slave's axes for an SDO to
+  it, every axis when it names none) before it runs; one naming a coordinate system
+  releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
+  onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit, the following
   error, a new sample past a soft limit, a raw write to its slave's outputs, the
   drive's own following-error window) releases it *before* that cycle, so the scalar
@@ -128,8 +129,10 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: GT functions whose implementations read a claimed axis through the bank itself, or touch
 #: no axis object at all (the process image, the clock: a raw write to a claimed slave's
 #: outputs is seen by the bank's next cycle, which gives the slave back first)
-#: function -> whether it takes a ``count`` of axes (AxisBank.before_call)
-_COUNTED: dict[str, bool] = {}
+#: function -> where it takes a ``count`` of axes, 0: it takes none (AxisBank.before_call)
+_COUNTED: dict[str, int] = {}
+#: the most axes a ``count`` names that go back one by one (more: every axis)
+_SPAN_MOST = 64
 
 BANK_READS = frozenset(
     {
@@ -327,6 +330,11 @@ class AxisBank:
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
         self._lists: dict[str, list[Any]] = {}
+        #: counts the claims and releases of rows (an axis's resources point at the bank or
+        #: not): what the GT readers' plans of many axes at once check (gtecat.gt.fast)
+        self.layout = 0
+        #: those plans, by (value, first axis, count)
+        self.read_plans: dict[tuple[str, int, int], Any] = {}
         self.disabled_reason = ""
         self._stale = False
         #: axis-cycles the bank ran (statistics; the differential tests check it worked)
@@ -1049,6 +1057,7 @@ class AxisBank:
         latched = res.latched
         self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
+        self.layout += 1
         s = ax.pos_scale
         self.unit2[r] = float(1 << s)
         self.unit[r] = 1.0 / (1 << s)
@@ -1299,6 +1308,16 @@ class AxisBank:
         if r is not None and self.alive[r]:
             self._release_groups([self.groups[self.group_of[r]]])
 
+    def _release_axes(self, axes: list[Any]) -> None:
+        """Give back the groups of ``axes`` that the bank runs, in one release."""
+        gis = set()
+        for ax in axes:
+            r = self._row_of.get(id(ax))
+            if r is not None and self.alive[r]:
+                gis.add(self.group_of[r])
+        if gis:
+            self._release_groups([self.groups[gi] for gi in sorted(gis)])
+
     def _release_groups(self, groups: list[_Group]) -> None:
         """Write the rows' committed state back into their objects; they leave the bank."""
         clusters: list[Cluster] = []
@@ -1363,6 +1382,7 @@ class AxisBank:
         self.alive[r] = False
         self.claim_ids[r] = 0
         res.bank = None
+        self.layout += 1
         a = float(self.a_last[r])
         ax.prf_pos = a
         res._a_last = a
@@ -1441,13 +1461,33 @@ class AxisBank:
         if params and params[0].name in ("axis", "profile", "encoder") and values:
             counted = _COUNTED.get(proto.name)
             if counted is None:  # (a function's parameters do not change: asked once)
-                counted = _COUNTED[proto.name] = any(p.name == "count" for p in params)
+                counted = _COUNTED[proto.name] = next(
+                    (k for k, p in enumerate(params) if p.name == "count"), 0
+                )
+            n = values[0]
             if not counted:
-                n = values[0]
                 ax = ctl.axes.get(n) if type(n) is int else None
                 if ax is not None:
                     self.release_axis_object(ax)
                     return
+            elif counted < len(values):
+                # GT_ClrSts(axis, count), GT_ZeroPos(axis, count): the axes of the span go
+                # back (what else the function reaches gives itself back through its guard)
+                count = values[counted]
+                if type(n) is int and type(count) is int and 0 < count <= _SPAN_MOST:
+                    axes = ctl.axes
+                    named = [ax for ax in map(axes.get, range(n, n + count)) if ax is not None]
+                    if named:
+                        self._release_axes(named)
+                        return
+        if params and params[0].name == "slave_position" and values and type(values[0]) is int:
+            # an SDO to one slave: its axes go back (the drive's objects it reaches give
+            # themselves back through their guards too); no other axis is touched
+            slave = values[0]
+            mine = [g for g in self.groups if g.claimed and g.position == slave]
+            if mine:
+                self._release_groups(mine)
+            return
         if params and params[0].name == "mask" and values and type(values[0]) is int:
             # GT_Update(mask), GT_Stop(mask, option): only the axes of the mask go back
             mask = values[0]

@@ -125,6 +125,9 @@ class Controller:
 
     #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
     bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
+    #: called with every controller whose bus is about to be brought up: its slaves are
+    #: there, the state walk with the InitCmds not yet run (the machine's faults arm here)
+    bus_opening_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - likewise
 
     def __init__(self, options: Options | None = None) -> None:
         self.options = (options or Options()).resolved()
@@ -272,6 +275,7 @@ class Controller:
         install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)
         if _relatch_link_alarms not in self.on_reset:
             self.on_reset.append(_relatch_link_alarms)  # after the resources' own reset
+        master.on_opened = lambda: [hook(self) for hook in list(Controller.bus_opening_hooks)]
         master.open()
         _put_back(backend, kept)
         if banked:
@@ -358,7 +362,7 @@ class Controller:
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has
         anything to do in them: every axis claimed by the bank, no hook (or only hooks that
-        say they stay quiet that long: :func:`_quiet_cycles`), the bus steady
+        say they stay quiet that long: :func:`_quiet_way`), the bus steady
         (:meth:`Master.steady`: a plain exchange would change nothing).  Each cycle is the
         one :meth:`_cycle` would run, bit for bit; the clock counts the time.  Returns the
         cycles run, 0 when the next one must go through :meth:`_cycle`.
@@ -388,9 +392,11 @@ class Controller:
         if self._run_axes:
             return 0
         n = min(n, self.BATCH_CYCLES)
-        for hooks in (self.pre_cycle, self.post_cycle):
-            for f in hooks:
-                n = _quiet_cycles(f, n)
+        hooks = ()
+        if self.pre_cycle or self.post_cycle:
+            hooks = self._hook_ways()
+            for quiet, _ in hooks:
+                n = quiet(n)
                 if n <= 0:
                     return 0
         master = self.master
@@ -399,14 +405,33 @@ class Controller:
         done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, n)
         master.cycles += done
         if done:
-            for f in (*self.pre_cycle, *self.post_cycle):
-                passed = getattr(getattr(f, "__self__", None), "cycles_passed", None)
+            for _, passed in hooks:
                 if passed is not None:
                     passed(done)
         return done
 
+    def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:
+        """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles
+        it is quiet in (``n`` -> :func:`_quiet_way`), and its object's ``cycles_passed``
+        (None: it has none); looked up once while the hooks stay the same."""
+        pre = (*self.pre_cycle, *self.post_cycle)
+        cached = self._hooks_seen
+        if cached is not None and cached[0] == pre:
+            return cached[1]
+        ways = tuple(
+            (
+                _quiet_way(f),
+                getattr(getattr(f, "__self__", None), "cycles_passed", None),
+            )
+            for f in pre
+        )
+        self._hooks_seen = (pre, ways)
+        return ways
+
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
     BATCH_CYCLES = 1000
+    #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
+    _hooks_seen: tuple[tuple[Any, ...], Any] | None = None
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
@@ -487,19 +512,21 @@ class Controller:
                 hook()
 
 
-def _quiet_cycles(hook: Callable[[int, int], None], n: int) -> int:
-    """How many of the next ``n`` cycles a ``pre_cycle`` or ``post_cycle`` hook has nothing
-    to do in (0: it must run in the next one); its object says so: ``quiet_cycles(n)`` (the
-    fault injector: until its first trigger is due; smart homing: until a homing's Trap leg
-    ends), or ``bank_quiet()`` for all or none (the coordinate systems while the axis bank
-    steps every running one).  After cycles run
-    at once, the object's ``cycles_passed(k)``, if it has one, counts them."""
+def _quiet_way(hook: Callable[[int, int], None]) -> Callable[[int], int]:
+    """``quiet(n)``: how many of the next ``n`` cycles a ``pre_cycle`` or ``post_cycle`` hook
+    has nothing to do in (0: it must run in the next one); its object says so:
+    ``quiet_cycles(n)`` (the fault injector: until its first trigger is due; smart homing:
+    until a homing's Trap leg ends), or ``bank_quiet()`` for all or none (the coordinate
+    systems while the axis bank steps every running one).  After cycles run at once, the
+    object's ``cycles_passed(k)``, if it has one, counts them (:meth:`Controller._hook_ways`)."""
     obj = getattr(hook, "__self__", None)
     horizon = getattr(obj, "quiet_cycles", None)
     if horizon is not None:
-        return min(n, horizon(n))
+        return lambda n: min(n, horizon(n))
     quiet = getattr(obj, "bank_quiet", None)
-    return n if quiet is not None and quiet() else 0
+    if quiet is None:
+        return lambda n: 0
+    return lambda n: n if quiet() else 0
 
 
 def folder_message(path: Path, how: str) -> str:

@@ -168,6 +168,9 @@ class AxisResources:
         #: about to start its next leg): the bank does not take the axis, which it would
         #: only have to give back at once
         self.bank_hold = False
+        #: GT_Stop calls on this axis so far, standing or not (a smart homing between two
+        #: legs ends on one: nothing of the profile shows a stop of an axis at rest)
+        self.stops = 0
         ax.pre_hooks.append(self._pre)
         ax.post_hooks.append(self._post)
         ax.motion = self
@@ -595,6 +598,7 @@ class AxisResources:
 
     def stop(self, abrupt: bool) -> None:
         """GT_Stop for this axis."""
+        self.stops += 1
         self.profile.stop(abrupt)
 
     # --- commands: positions -------------------------------------------------------------------

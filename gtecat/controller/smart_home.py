@@ -81,12 +81,13 @@ the machine has.  Only an axis with no limit terminal at all (no 60FDh) is refus
 
 **Errors** end the homing (the axis is stopped with ``dec``; ``run`` drops once it stands;
 ``stage`` stays where it failed): 1 not in Trap mode (a Jog is taken over instead:
-:meth:`SmartHome._leave_jog`), 2 servo off (at the start or on the
-way), 3 drive alarm, 4 stopped by someone else (GT_Stop, a stop input, the following
-error) or a search refused by a latched flag, 5 another motion command or a limit where
-none belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input
-to capture, 8 no home (or no limit in mode 10) within the distance, 9 the index cannot be
-captured, 10 no index.  GT_GoHome returns 1 with the reason when it refuses to start (the
+:meth:`SmartHome._leave_jog`), 2 servo off (at the start or on the way), 3 drive alarm, 4
+stopped by someone else (GT_Stop, a stop input, the following error: at any moment, also
+while the axis stands between two legs or brakes at a limit; the axis does not move again)
+or a search refused by a latched flag, 5 another motion command or a limit where none
+belongs (escape, return, go home), 6 unknown mode / no limit input, 7 no home input to
+capture, 8 no home (or no limit in mode 10) within the distance, 9 the index cannot be
+captured, 10 no index. GT_GoHome returns 1 with the reason when it refuses to start (the
 status says the same); 7 for a parameter out of range.
 """
 
@@ -172,6 +173,8 @@ FORCED_MODES = (HomeMode.FORCED_HOME, HomeMode.FORCED_HOME_INDEX)
 _LONG = (-(1 << 31), (1 << 31) - 1)
 _POS, _NEG = int(AxisStatus.POSITIVE_LIMIT), int(AxisStatus.NEGATIVE_LIMIT)
 _ALARM = int(AxisStatus.ALARM)
+#: flags whose cause stops the axis (a stop input, the following error): the homing ends
+_STOPPED = int(AxisStatus.SMOOTH_STOP | AxisStatus.ABRUPT_STOP | AxisStatus.POS_ERROR)
 _LIMIT_POS_BIT, _LIMIT_NEG_BIT = 1 << 1, 1 << 0  # 60FDh
 
 
@@ -286,6 +289,7 @@ class SmartHome:
         self._failing = False
         self._before = 0
         self._raised = 0
+        self._stops = 0  # the axis's GT_Stop count when the homing started
         self._expect: int | None = None
         #: the search waits in a loop that only its own axis can end (the end of the Trap
         #: leg, a limit or home input of the axis: :meth:`quiet`)
@@ -384,6 +388,7 @@ class SmartHome:
         self._trap = prm.trap()
         self._before = res.latched
         self._raised = 0
+        self._stops = res.stops
         self._failing = False
         self._expect = None
         self._q_claim = 0
@@ -452,7 +457,7 @@ class SmartHome:
             return None
         # what a call may have changed since the last step (a call gives the axis back
         # first, and the bank may take it again before the next cycle): as the step saw it
-        if res.latched != self._seen_latched:
+        if res.latched != self._seen_latched or res.stops != self._stops:
             return None
         if (self.unit.changes, self._trigger.changes) != self._seen_changes:
             return None
@@ -497,6 +502,14 @@ class SmartHome:
             return HomeError.DISABLE, f"axis {self.number} was switched off"
         if res.profile.mode != PrfMode.TRAP:
             return HomeError.NOT_TRAP_MODE, f"axis {self.number} left Trap mode"
+        # a stop at any moment ends the homing, also one of an axis standing between two
+        # legs (nothing of the Trap profile shows it then) or in a stop of the search's own
+        if res.stops != self._stops:
+            return HomeError.STOP, f"axis {self.number} was stopped (GT_Stop)"
+        if res.latched & _STOPPED:
+            return HomeError.STOP, (
+                f"axis {self.number} was stopped (a stop input or the following error)"
+            )
         return None
 
     def _fail(self, error: HomeError, reason: str) -> None:
@@ -885,7 +898,7 @@ class _Homings:
     the middle of a Trap leg has nothing to do until the leg's end sample or an input of the
     axis changes, which gives the axis back before that cycle (:meth:`SmartHome.quiet`).
     Such homings are not stepped, and :meth:`quiet_cycles` tells the controller how many
-    cycles it may run at once (:func:`gtecat.controller.core._quiet_cycles`).  Times are the
+    cycles it may run at once (:func:`gtecat.controller.core._quiet_way`).  Times are the
     controller's (ns): :attr:`_due` is the start of the first cycle after which some homing
     may have to step, valid while the bank has released nothing since (:attr:`_seen`)."""
 

@@ -4,8 +4,8 @@ Four ways in build the same objects (:mod:`.kinds`, :mod:`.triggers`):
 
 * Python - :func:`inject` on the open controller (``GT_Open`` + ``GT_InitEcatComm`` first),
   :func:`clear`, :func:`listing`; the ``gtecat_faults`` pytest fixture is the same;
-* the machine TOML - ``[[fault]]`` tables, armed each time the bus comes up
-  (:func:`specs_from_tables`);
+* the machine TOML - ``[[fault]]`` tables, armed each time the bus is brought up, before
+  its InitCmds (:func:`specs_from_tables`);
 * the command line on a running gtecat - ``gtecat fault inject|list|clear``;
 * the panel, over the same inspection endpoint.
 
@@ -192,9 +192,33 @@ def injector_for(ctl: Any, create: bool = True) -> Injector | None:
     return inj
 
 
+def _bus_opening(ctl: Any) -> None:
+    """Arm the machine description's ``[[fault]]`` tables on every bus before it is brought
+    up (its slaves found, the state walk with the ENI's InitCmds to come): the machine is
+    faulty from the start, so the bring-up meets them as the application's own calls do (an
+    ``on_sdo`` trigger counts the InitCmds' SDOs, a mailbox fault can fail the bring-up).
+    Any other fault that starts at once waits until the bus is up (:func:`_bus_up`), where
+    it started before: the bring-up has no cycles for it.  The faults of a bus brought up
+    before go with it.  Errors: :func:`_arm_machine`."""
+    _arm_machine(ctl, holding=True)
+    ctl._faults_armed = ctl.backend
+
+
 def _bus_up(ctl: Any) -> None:
-    """Arm the machine description's ``[[fault]]`` tables on every bus that comes up (the
-    faults of a bus brought up before go with it).
+    """The bus is up: the axis bank, made after the bring-up, learns which axes the armed
+    faults watch; a bus that came up without :func:`_bus_opening` (a card's amplifiers) has
+    its faults armed now."""
+    if getattr(ctl, "_faults_armed", None) is not ctl.backend:
+        _arm_machine(ctl)
+        return
+    inj = injector_for(ctl, create=False)
+    if inj is not None:
+        inj.bus_ready()
+
+
+def _arm_machine(ctl: Any, holding: bool = False) -> None:
+    """Arm the machine description's ``[[fault]]`` tables on ``ctl``'s bus (``holding``:
+    before it is brought up, :attr:`Injector.holding`).
 
     Every error in them - a value out of range, an unknown kind, a slave or an axis the bus
     does not have (``link_down after_slave=5`` on a bus of three slaves), an ``after`` that
@@ -216,7 +240,10 @@ def _bus_up(ctl: Any) -> None:
         source = ctl.machine.source or "machine description"
         try:
             specs = specs_from_tables(list(tables), source)
-            arm(injector_for(ctl), specs)  # type: ignore[arg-type]
+            inj = injector_for(ctl)
+            assert inj is not None
+            inj.holding = holding
+            arm(inj, specs)
         except (FaultSpecError, ParameterError) as e:
             raise CommandError(str(e)) from None
 
@@ -301,6 +328,8 @@ def _install() -> None:
 
     if _bus_up not in Controller.bus_up_hooks:
         Controller.bus_up_hooks.append(_bus_up)
+    if _bus_opening not in Controller.bus_opening_hooks:
+        Controller.bus_opening_hooks.append(_bus_opening)
 
 
 _install()

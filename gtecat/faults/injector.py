@@ -95,6 +95,10 @@ class Injector:
         self._lbase: int | None = None
         self._started: set[int] = set()
         self._watched: frozenset[int] = frozenset()
+        #: the bus is being brought up (a machine description's faults, armed before it):
+        #: a fault that starts at once waits for the bus unless the bring-up can meet it (a
+        #: mailbox fault: the InitCmds are SDOs); :meth:`bus_ready` starts it then
+        self.holding = False
         self._wrap_mailboxes()
 
     # --- adding and clearing ----------------------------------------
@@ -122,9 +126,12 @@ class Injector:
         self.entries.append(e)
         self.bus.log(f"Fault {e.id} armed: {e.describe()}.")
         self._refresh()
-        if isinstance(trig, Now) and self._gate_open(e):
+        if isinstance(trig, Now) and self._gate_open(e) and not self._held(e):
             self._start(e)
         return e
+
+    def _held(self, e: Entry) -> bool:
+        return self.holding and e.fault.depth != "mailbox"
 
     def clear(self, ident: int | None = None) -> int:
         """End one fault (by id) or all; the number ended."""
@@ -230,6 +237,8 @@ class Injector:
                     return 0
                 if e.duration_ms is not None:
                     t0, d = e.started_ms or 0.0, e.duration_ms
+                    if self.bus.t_ms(n - 1) - t0 < d:  # not over in the last of them: in none
+                        continue
                     left = d - (self.bus.t_ms() - t0)
                     over = lambda j, t0=t0, d=d: self.bus.t_ms(j) - t0 >= d  # noqa: E731
                     n = min(n, first_cycle(over, self.bus, left, n))
@@ -257,6 +266,20 @@ class Injector:
                     e.trigger.since = e.data["armed_ms"]  # type: ignore[attr-defined]
             return True
         return False
+
+    def bus_ready(self) -> None:
+        """The bus came up after these faults were armed (and the axis bank with it): the
+        faults held while it was brought up start, as they would have been armed now, and
+        the bank learns again which axes they watch and whether it may run at all."""
+        if self.holding:
+            self.holding = False
+            for e in list(self.entries):
+                if e.state == "armed" and isinstance(e.trigger, Now) and self._gate_open(e):
+                    self._start(e)
+        self._watched = frozenset()
+        if not self.bank_safe:
+            self.bus.before_change()
+        self._refresh()
 
     def _refresh(self) -> None:
         """Frame faults routed while one is armed or active; bank-safe without position or

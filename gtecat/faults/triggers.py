@@ -59,6 +59,8 @@ class AtTime(Trigger):
         return bus.now_ms() >= self.ms
 
     def quiet_cycles(self, bus: Any, n: int) -> int:
+        if n > 0 and bus.now_ms(n - 1) < self.ms:  # not due in the last of them: in none
+            return n
         return first_cycle(lambda k: bus.now_ms(k) >= self.ms, bus, self.ms - bus.now_ms(), n)
 
     def soon(self, bus: Any) -> bool:
@@ -83,6 +85,8 @@ class AfterTime(Trigger):
         return bus.t_ms() - self.since >= self.ms
 
     def quiet_cycles(self, bus: Any, n: int) -> int:
+        if n > 0 and bus.t_ms(n - 1) - self.since < self.ms:  # not due in the last: in none
+            return n
         return first_cycle(
             lambda k: bus.t_ms(k) - self.since >= self.ms,
             bus,

@@ -101,14 +101,14 @@ _vendor_surface()
 
 def _arm_faults(ctl: object) -> None:
     """The machine TOML's ``[[fault]]`` tables are armed by :mod:`gtecat.faults` on every bus
-    that comes up; that package (a tenth of this import's Python) is imported the first time
-    a bus has them.  Once imported, its own hook does the arming."""
+    before it is brought up; that package (a tenth of this import's Python) is imported the
+    first time a bus has them.  Once imported, its own hooks do the arming."""
     import sys
 
     if getattr(getattr(ctl, "machine", None), "faults", ()) and "gtecat.faults" not in sys.modules:
         from .. import faults
 
-        faults._bus_up(ctl)
+        faults._bus_opening(ctl)
 
 
 def _install_fault_hook() -> None:
@@ -116,8 +116,8 @@ def _install_fault_hook() -> None:
 
     from ..controller.core import Controller
 
-    if _arm_faults not in Controller.bus_up_hooks:
-        Controller.bus_up_hooks.append(_arm_faults)
+    if _arm_faults not in Controller.bus_opening_hooks:
+        Controller.bus_opening_hooks.append(_arm_faults)
     if os.environ.get("GTECAT_RECORD"):
         from .. import faults  # noqa: F401  (records this process's GT calls)
 

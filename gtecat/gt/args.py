@@ -13,11 +13,26 @@ function:
   ``create_string_buffer``, structures), so a write never goes past what that
   object owns; too small is refused with both sizes; a raw integer address is
   refused (its size cannot be known); Python containers (list, bytearray,
-  memoryview, numpy arrays, bytes for inputs) work too; memory of the other kind of
-  number (``byref(c_long())`` where the prototype says ``double *``, a ``c_double``
-  array for a ``long *``) is refused: C would not compile it, and the value would be
-  silently rounded; numpy arrays of Python objects and non-contiguous memoryviews are
-  refused (they are not C memory), numeric pointers take numpy arrays of numbers only;
+  memoryview, numpy arrays, bytes for inputs) work too;
+* the element type of the memory must be the pointer's (the ctypes rule), decided by the
+  element type and its size, never by the value: a ``double *`` takes 8-byte floats only
+  (``c_double``, a float64 numpy array or ``'d'`` memoryview); an integer pointer takes
+  integers of its C type's width, of either sign (C's view of the same memory: the value's
+  bit pattern is stored, 40000 reads back as -25536 from a ``c_short`` for an ``unsigned
+  short *``), or wider ones that hold every value of the C type (for the vendor's 32-bit
+  ``long *``: ``c_int``, ``c_uint``, ``c_long`` - 64 bits on Linux -, int32, uint32 or
+  int64 arrays; a 64-bit unsigned one cannot hold a negative ``long``); floats for an
+  integer, integers for a double, narrower integers (a uint8 buffer for an ``unsigned long
+  *``, ``c_short`` for a ``long *``), bools, chars and bytes/bytearrays are refused - the
+  same for ctypes objects, numpy arrays, memoryviews and buffers, for inputs and outputs
+  alike (Python lists are values, not memory: each value is checked);
+* ``byref(s, offset)`` of a structure (C's ``&s.field``) points to the field at that
+  offset: the call writes that field (its type must be the pointer's) and nothing else;
+* a byte pointer (``unsigned char *``, ``char *``, ``void *``: raw data) takes plain
+  memory only: memory holding pointers or Python objects (``py_object``, ``c_char_p``,
+  ``c_void_p``, ``POINTER`` values, ``byref(pointer(x))``, arrays or structures holding
+  such fields) is refused, as it is for numeric pointers; numpy arrays of Python
+  objects, released and non-contiguous memoryviews are refused (they are not C memory);
 * optional pointers accept ``None``, ``0`` and NULL ctypes pointers (they
   reach the implementation as ``None``); a required one given NULL is refused;
 * parameter names as the manual writes them work as keywords;
@@ -168,6 +183,11 @@ class Ref:
                 flat = _numeric_array(self.name, t)
                 if flat.size < n:
                     raise ParameterError(f"{self.name}: array of {flat.size} too small for {n}")
+                if flat.dtype.kind in "iu":  # (the same width, the other sign: its bits)
+                    b = _int_bounds(flat.dtype.kind == "i", flat.dtype.itemsize)
+                    values = [
+                        _same_width(v, b) if isinstance(v, numbers.Integral) else v for v in values
+                    ]
                 try:
                     flat[:n] = values
                 except (OverflowError, TypeError, ValueError):  # narrower than the C type
@@ -317,11 +337,24 @@ def fit(ctype: Any, value: Any) -> Any:
             )
             _INT_BOUNDS[ctype] = bounds
         if not bounds[0] <= value <= bounds[1]:
+            value = _same_width(value, bounds)
+        if not bounds[0] <= value <= bounds[1]:
             raise ParameterError(
                 f"the value {shown(value)} does not fit the {ctype.__name__} behind the pointer "
                 f"({bounds[0]}..{bounds[1]}); pass the prototype's type"
             )
     return value
+
+
+def _same_width(value: int, bounds: tuple[int, int]) -> int:
+    """``value`` as the integer of ``bounds`` with its bit pattern, when it is an integer of
+    the same width and the other sign (65535 -> -1 in 16 bits, -1 -> 65535): C's view of
+    the same memory; any other value unchanged (its caller refuses it)."""
+    lo, hi = bounds
+    span = hi - lo + 1
+    if lo < 0:
+        return value - span if hi < value < span // 2 * 2 else value
+    return value + span if -(span // 2) <= value < 0 else value
 
 
 # --- resolving pointers --------------------------------------------------------------------------
@@ -444,7 +477,13 @@ def _memoryview_array(name: str, view: memoryview) -> np.ndarray:
     """The memory of a memoryview as a numpy array over it (writable as the view is): one
     way to read and write it whatever its shape and format; a view with gaps (``[::2]``)
     or of Python objects is not C memory and is refused."""
-    if "O" in view.format:
+    try:
+        fmt = view.format
+    except ValueError:  # released: any attribute raises
+        raise ParameterError(
+            f"{name}: the memoryview is released (its memory is gone); pass a live buffer"
+        ) from None
+    if "O" in fmt:
         raise ParameterError(f"{name}: a memoryview of Python objects is not C memory")
     if not view.c_contiguous:
         raise ParameterError(
@@ -487,43 +526,138 @@ _CTYPES_OF = {
 }  # fmt: skip
 
 
+_HOLDS: dict[Any, bool] = {}
+
+
+def holds_pointers(t: Any) -> bool:
+    """Whether memory of ctypes type ``t`` holds pointers or Python objects (``py_object``,
+    ``c_char_p``, ``c_void_p``, ``POINTER`` values, function pointers, or arrays and
+    structures with such elements or fields): not raw memory, a write of bytes or numbers
+    over it would leave a wild pointer."""
+    r = _HOLDS.get(t)
+    if r is None:
+        r = _holds(t, 0)
+        if len(_HOLDS) < 1024:
+            _HOLDS[t] = r
+    return r
+
+
+def _holds(t: Any, depth: int) -> bool:
+    if depth > 64:  # (a structure nested this deep: not plain memory either)
+        return True
+    if not isinstance(t, type):
+        return False
+    if issubclass(t, _POINTER | ctypes._CFuncPtr):
+        return True
+    if issubclass(t, _SIMPLE):
+        return t._type_ in "zZPO"
+    if issubclass(t, ctypes.Array):
+        return _holds(t._type_, depth + 1)
+    if issubclass(t, ctypes.Structure | ctypes.Union):
+        return any(_holds(f[1], depth + 1) for k in t.__mro__ for f in vars(k).get("_fields_", ()))
+    return False
+
+
+def _int_bounds(signed: bool, size: int) -> tuple[int, int]:
+    bits = 8 * size
+    return (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+
+
+_NP_CANDIDATES = tuple(
+    np.dtype(t)
+    for t in (np.int8, np.int16, np.int32, np.int64, np.uint8, np.uint16, np.uint32, np.uint64)
+)
+
+
+def _element_fits(p: Param, kind: str, size: int) -> bool:
+    """Whether an element of ``kind`` (``f`` float, ``i`` signed, ``u`` unsigned integer,
+    anything else: not a number) and ``size`` bytes is the type of ``p``'s pointer: a float
+    of the double's 8 bytes for a ``double *``; for an integer pointer an integer that holds
+    every value of its C type (decided by the type, never by a value)."""
+    if p.ctype in ("double", "float"):
+        return kind == "f" and size == 8
+    if kind not in "iu" or not kind:
+        return False
+    _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]
+    width = (hi - lo).bit_length() // 8
+    if size != width:  # (the same width, either sign: C's view of the same memory)
+        elo, ehi = _int_bounds(kind == "i", size)
+        return elo <= lo and hi <= ehi
+    return True
+
+
+def _what_to_pass(p: Param) -> str:
+    if p.ctype in ("double", "float"):
+        return "pass byref(c_double()), a c_double array or a float64 numpy array"
+    right = _CTYPES_OF.get(p.ctype, "c_long")
+    nps = [str(d) for d in _NP_CANDIDATES if _element_fits(p, d.kind, d.itemsize)]
+    kinds = ", ".join(nps[:-1]) + " or " + nps[-1] if len(nps) > 1 else "".join(nps)
+    return f"pass byref({right}()), an array of it or a numpy array of {kinds}"
+
+
 def check_kind(p: Param, ref: Ref) -> Ref:
-    """Refuse ctypes memory of the other kind of number than the prototype's pointer (a
-    ``c_long`` where it says ``double *``, a ``c_double`` for a ``long *``): C would not
-    compile the call, and the value would be silently rounded or reinterpreted.  Integer
-    memory may be wider than the C type (``c_long`` is 64 bits on Linux, the vendor's
-    ``long`` 32; each value is checked to fit when it is stored), never narrower
-    (``c_short`` for a ``long *``): 7 with the type to pass."""
+    """Refuse memory whose element type is not the pointer's (the rule of the module's
+    docstring, for ctypes objects, numpy arrays, memoryviews and byte buffers alike): a
+    ``c_long`` or an int64 array where the prototype says ``double *``, a ``c_double`` or a
+    float64 array for a ``long *``, a uint8 buffer for an ``unsigned long *`` - C would not
+    compile the call, and the value would be silently rounded, cut or reinterpreted, or
+    whether it fits would depend on the value.  Memory holding pointers or Python objects is
+    refused for a byte pointer (raw data).  7 with the type to pass."""
+    byte_ptr = p.ctype in ("char", "unsigned char", "void")
+    if p.stars != 1:  # (char **pVersion: the call writes a pointer there)
+        return ref
+    if byte_ptr or p.text:
+        elem = ref.elem
+        if ref.py is None and elem is not None and holds_pointers(elem):
+            raise ParameterError(
+                f"{p.name}: points to {_elem_name(elem)}, which holds pointers or Python "
+                "objects, not raw memory; pass a buffer (create_string_buffer, a c_ubyte "
+                "array, a bytearray)"
+            )
+        return ref
+    if p.is_struct or (p.ctype not in SCALARS and p.ctype not in ENUMS):
+        return ref
+    t = ref.py
+    if t is not None:
+        if isinstance(t, np.ndarray):
+            d = t.dtype
+            if d.kind in _NUMERIC_KINDS and not _element_fits(p, d.kind, d.itemsize):
+                raise ParameterError(
+                    f"{p.name}: memory of {d} elements, the prototype says {p.ctype} *; "
+                    f"{_what_to_pass(p)}"
+                )
+        elif isinstance(t, bytes | bytearray):
+            raise ParameterError(
+                f"{p.name}: a {type(t).__name__} holds bytes, the prototype says {p.ctype} *; "
+                f"{_what_to_pass(p)}"
+            )
+        return ref
     elem = ref.elem
-    if (
-        ref.py is None
-        and isinstance(elem, type)
-        and issubclass(elem, _SIMPLE)
-        and elem._type_ not in _NOT_NUMERIC
-        and not p.is_struct
-        and not p.text
-        and p.ctype not in ("char", "unsigned char", "void")
-    ):
-        want_float = p.ctype in ("double", "float")
-        right = "c_double" if want_float else _CTYPES_OF.get(p.ctype, "c_long")
-        if (elem._type_ in _FLOAT_CODES) != want_float:
+    if isinstance(elem, type) and issubclass(elem, _SIMPLE) and elem._type_ in _NOT_NUMERIC:
+        raise ParameterError(
+            f"{p.name}: points to {_elem_name(elem)}, not to numbers; {_what_to_pass(p)}"
+        )
+    if isinstance(elem, type) and issubclass(elem, _SIMPLE):
+        code = elem._type_
+        kind = "f" if code in _FLOAT_CODES else "u" if code.isupper() else "i"
+        size = ctypes.sizeof(elem)
+        if not _element_fits(p, kind, size):
+            want_float = p.ctype in ("double", "float")
+            if (kind == "f") != want_float:
+                why = ""
+            elif want_float:
+                why = f" ({size} bytes, a double is 8)"
+            else:
+                _, lo, hi, _ = SCALARS["int" if p.ctype in ENUMS else p.ctype]
+                width = (hi - lo).bit_length() // 8
+                why = (
+                    f" ({size} bytes), narrower than {p.ctype} ({width} bytes)"
+                    if size < width
+                    else f" (unsigned, {size} bytes), which cannot hold a negative {p.ctype}"
+                )
             raise ParameterError(
-                f"{p.name}: points to {elem.__name__}, the prototype says {p.ctype} *; "
-                f"pass byref({right}()) or an array of it"
-            )
-        width = _C_WIDTH.get(p.ctype)
-        if not want_float and width is not None and ctypes.sizeof(elem) < width:
-            # narrower than the C type: a C compiler would refuse it, and whether a value
-            # fits would depend on the value (a status that grows past it one day)
-            raise ParameterError(
-                f"{p.name}: points to {elem.__name__} ({ctypes.sizeof(elem)} bytes), the "
-                f"prototype says {p.ctype} * ({width} bytes); pass byref({right}()) or an "
-                "array of it"
-            )
-        if want_float and ctypes.sizeof(elem) != ctypes.sizeof(ctypes.c_double):
-            raise ParameterError(
-                f"{p.name}: points to {elem.__name__}, the prototype says double *; "
-                "pass byref(c_double()) or an array of it"
+                f"{p.name}: points to {elem.__name__}{why}, the prototype says {p.ctype} *; "
+                f"{_what_to_pass(p)}"
             )
     return ref
 
@@ -560,15 +694,15 @@ def _integer(p: Param, value: Any) -> int:
 
 def _real(p: Param, value: Any) -> float:
     v = value
-    if isinstance(v, _SIMPLE) and v._type_ not in "zZPOc":
-        v = v.value
-    if isinstance(v, bool | np.bool_ | numbers.Real) and not isinstance(v, str):
-        try:
-            x = float(v)
-        except (OverflowError, ValueError, TypeError):
-            raise ParameterError(f"{p.name}={shown(value)} is not a number") from None
-    else:
-        raise ParameterError(f"{p.name}={shown(value)}: a number is needed (double)")
+    if type(v) is not float and type(v) is not int:  # (the common arguments: no ABC check)
+        if isinstance(v, _SIMPLE) and v._type_ not in "zZPOc":
+            v = v.value
+        if not isinstance(v, bool | np.bool_ | numbers.Real) or isinstance(v, str):
+            raise ParameterError(f"{p.name}={shown(value)}: a number is needed (double)")
+    try:
+        x = float(v)
+    except (OverflowError, ValueError, TypeError):
+        raise ParameterError(f"{p.name}={shown(value)} is not a number") from None
     if not math.isfinite(x):
         raise ParameterError(f"{p.name}={shown(value)} must be finite")
     if p.lo is not None and not p.lo <= x <= p.hi:  # type: ignore[operator]
@@ -628,6 +762,7 @@ def _int_converter(p: Param) -> Converter:
 
 def _pointer_converter(p: Param) -> Converter:
     name, optional, writes = p.name, p.optional, p.direction != "in"
+    numbers_kind = _pointer_kind(p) == "numbers" and not p.text
 
     def conv(v: Any) -> Any:
         if type(v) is _CArgObject:  # byref(x): the common case
@@ -636,6 +771,9 @@ def _pointer_converter(p: Param) -> Converter:
             start = ctypes.addressof(obj)
             size = ctypes.sizeof(obj)
             if start <= addr <= start + size:
+                if addr != start and numbers_kind and isinstance(obj, _STRUCTS):
+                    # byref(s, offset): C's &s.field, the field and nothing else
+                    return check_kind(p, _field_ref(name, obj, addr, addr - start))
                 elem = obj._type_ if isinstance(obj, ctypes.Array) else type(obj)
                 if isinstance(elem, type) and issubclass(elem, ctypes.Array):
                     elem = _element_type(obj)
@@ -653,6 +791,57 @@ def _pointer_converter(p: Param) -> Converter:
         return check_kind(p, ref)
 
     return conv
+
+
+_STRUCTS = (ctypes.Structure, ctypes.Union)
+
+
+def _field_at(cls: Any, off: int, depth: int = 0) -> tuple[Any, int] | None:
+    """The field of structure ``cls`` that starts ``off`` bytes into it: (its element type,
+    its bytes from there: an array field's rest), looking into nested structures and
+    arrays; None when ``off`` is not the start of a plain field (padding, the middle of a
+    field, a bit field)."""
+    if depth > 32:
+        return None
+    for k in cls.__mro__:
+        for f in vars(k).get("_fields_", ()):
+            if len(f) > 2:  # a bit field: no address of its own
+                continue
+            fname, ftype = f[0], f[1]
+            fo = getattr(cls, fname).offset
+            fsize = ctypes.sizeof(ftype)
+            if not fo <= off < fo + fsize:
+                continue
+            rel = off - fo
+            if issubclass(ftype, _STRUCTS):
+                found = _field_at(ftype, rel, depth + 1)
+            elif issubclass(ftype, ctypes.Array):
+                inner = ftype._type_
+                while issubclass(inner, ctypes.Array):
+                    inner = inner._type_
+                step = ctypes.sizeof(inner)
+                if issubclass(inner, _STRUCTS):
+                    found = _field_at(inner, rel % step, depth + 1)
+                else:
+                    found = (inner, fsize - rel) if rel % step == 0 else None
+            else:
+                found = (ftype, fsize) if rel == 0 else None
+            if found is not None:
+                return found
+    return None
+
+
+def _field_ref(name: str, obj: Any, addr: int, off: int) -> Ref:
+    """The :class:`Ref` of ``byref(obj, off)`` for a numeric pointer: the field there."""
+    found = _field_at(type(obj), off)
+    if found is None:
+        raise ParameterError(
+            f"{name}: byref of a {type(obj).__name__} at offset {off} is not the address of a "
+            f"field; pass byref(s, {type(obj).__name__}.field.offset) of a field of the "
+            "prototype's type"
+        )
+    elem, nbytes = found
+    return Ref(name, addr, nbytes, elem, obj)
 
 
 def _converter(p: Param) -> Converter:
@@ -912,7 +1101,7 @@ def _learn(kind: str, ok: frozenset, cache: dict, t: Any) -> Any:
             if kind == "bytes":
                 while issubclass(inner, ctypes.Array):
                     inner = inner._type_
-                e = inner
+                e = False if holds_pointers(inner) else inner  # (py_object: not raw memory)
             elif inner in ok:  # a one-dimensional array of a number the pointer takes
                 e = inner
     if len(cache) < 256:
@@ -940,8 +1129,13 @@ def _pointer_source(i: int, p: Param, a: str, v: str, env: dict[str, Any]) -> li
     numpy = f"t is _NDARRAY and not {a}.dtype.hasobject and {a}.flags.c_contiguous" + (
         f" and {a}.flags.writeable" if writes else ""
     )
-    if kind == "numbers":
-        numpy += f" and {a}.dtype.kind in 'biuf'"
+    if kind == "numbers":  # the element types the pointer takes (check_kind's rule)
+        env[f"NP{i}"] = frozenset(
+            d
+            for d in (*_NP_CANDIDATES, np.dtype(np.float32), np.dtype(np.float64))
+            if _element_fits(p, d.kind, d.itemsize)
+        )
+        numpy += f" and {a}.dtype in NP{i}"
     lines = [f"t = type({a})", "if t is _CArg:", f"    o = {a}._obj", "    to = type(o)"]
     if kind == "numbers":
         lines += [

@@ -18,6 +18,7 @@ import re
 import struct
 import sys
 from collections.abc import Callable
+from operator import itemgetter
 from typing import Any
 
 import numpy as np
@@ -29,7 +30,7 @@ from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources
 from ..master.clock import ClockMode
 from . import byref_target
-from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source
+from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source, holds_pointers
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
@@ -43,6 +44,8 @@ _AT = CARG_AT if CARG_AT is not None else -1
 
 
 _status = AxisResources.status
+#: a C ``short`` argument's range (the table binder's check of ``axis`` and ``count``)
+_SHORT_MIN, _SHORT_MAX = -(1 << 15), (1 << 15) - 1
 
 
 def _kept_refs() -> int:
@@ -209,8 +212,17 @@ def fast_reader(
             return advance(ctl, name, 0)
         return 0
 
-    limit = READ_LIMITS.get(name, CONTROLLER_AXES)
+    own_limit = READ_LIMITS.get(name)  # the function's own (its table path refuses more)
+    limit = CONTROLLER_AXES if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
+
+    def refuse(ctl: Any, reason: str) -> int:
+        """The table path's refusal of a parameter (code 7 and the reason), then the call's
+        host latency."""
+        from ._core import CMD_PARAM, _record  # (the GT layer imports this module)
+
+        _record(name, CMD_PARAM, reason)
+        return advance(ctl, name, CMD_PARAM)
 
     def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
@@ -221,7 +233,6 @@ def fast_reader(
             or type(n) is not int
             or extra
             or kw
-            or count > limit
             or not (pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0))
             or session.remote is not None
             or session.core != 1
@@ -231,8 +242,47 @@ def fast_reader(
         tp = type(p)
         if not (is_array(tp) and tp._length_ >= count):
             return None
+        if count > limit:
+            if own_limit is None or ctl.card is not None:
+                return None
+            if not (_SHORT_MIN <= n <= _SHORT_MAX and count <= _SHORT_MAX):
+                return None
+            # more than the function reads at once (an encoder reader's 8): the table path
+            # binds these plain arguments and the function refuses the count, the first thing
+            # it checks (axis_span): the same code and reason without the table's steps
+            return refuse(ctl, f"count={count}: at most {own_limit} at once")
         resources = ctl.resources
         axes = ctl.axes
+        b = ctl.bank
+        if bank_key is not None and b is not None:
+            # every axis of the span a row of the bank: its rows, found once while no row is
+            # claimed or released (the bank's layout) and the controller's axes are the same
+            key = (bank_key, n, count)
+            plan = b.read_plans.get(key)
+            if (
+                plan is None
+                or plan[0] != b.layout
+                or plan[1] is not resources
+                or plan[2] is not axes
+            ):
+                plan = b.read_plans[key] = _read_plan(b, resources, axes, n, count)
+            pick = plan[3]
+            if pick is not None:
+                lst = b._lists.get(bank_key)
+                if lst is not None:
+                    p[:count] = pick(lst)
+                else:  # not made yet this cycle: the first axis's getter makes it
+                    first = get(plan[4])
+                    lst = b._lists.get(bank_key)
+                    if lst is not None:
+                        values = list(pick(lst))
+                        values[0] = first
+                        p[:count] = values
+                if lst is not None:
+                    session.last = None
+                    if ctl.clock.mode is not _LOCKSTEP:
+                        return advance(ctl, name, 0)
+                    return 0
         values: list[Any] = []
         append = values.append
         bank = lst = None
@@ -270,7 +320,7 @@ def fast_reader(
             and core > 1
             and type(n) is int
             and type(count) is int
-            and 1 < count
+            and 1 < count <= limit  # (a count the function refuses: the table path)
             and 0 < n
             and n + count - 1 <= AXES_PER_CORE
             and session.local
@@ -333,6 +383,22 @@ BANK_LISTS = {
     "GT_GetEncPos": "enc_pos",
     "GT_GetEncVel": "enc_vel",
 }
+
+
+def _read_plan(b: Any, resources: Any, axes: Any, n: int, count: int) -> tuple[Any, ...]:
+    """(the bank's layout, the resources and axes looked at, a getter of the span's rows in a
+    list of the bank's values or None when some axis of the span is not a row of ``b``, the
+    first axis's resources)."""
+    if count < 2:  # (one value: no tuple to store)
+        return (b.layout, resources, axes, None, None)
+    rows = []
+    for k in range(n, n + count):
+        res = resources.get(k)
+        if res is None or axes.get(k) is not res.ax or res.bank is not b:
+            return (b.layout, resources, axes, None, None)
+        rows.append(res.bank_row)
+    return (b.layout, resources, axes, itemgetter(*rows), resources.get(n))
+
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
@@ -482,7 +548,8 @@ CLOCK = "GT_GetClock"
 #: the largest value each integer type of ``_INTS`` holds
 _INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
 #: the clock's integer types: the vendor's ``unsigned long *pClock`` (a Python caller's
-#: ``c_ulong``) beside the signed ones
+#: ``c_ulong``) beside the signed ones (a clock past a ``c_int32``'s range: the table path,
+#: which stores its bit pattern)
 _CLOCK_INTS = _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
 _INT_MAX.update(
     {t: (1 << (8 * ctypes.sizeof(t))) - 1 for t in _CLOCK_INTS - _INTS}  # (unsigned)
@@ -663,7 +730,7 @@ def fast_raw(
         if v is not None and v[0] is p:
             return v[1]
         if issubclass(tp, Array):
-            if sizeof(p) < size:
+            if sizeof(p) < size or holds_pointers(tp):  # (py_object, pointers: the table's 7)
                 return None
             arr = frombuffer(p, u8, size)
         elif tp is _NDARRAY:
@@ -735,8 +802,8 @@ def fast_raw(
             ok = []
         elif tp is memoryview:
             ok = ['p.format == "B"', "p.ndim == 1"]
-        elif issubclass(tp, Array) and sizeof(tp) >= size:
-            ok = []
+        elif issubclass(tp, Array) and sizeof(tp) >= size and not holds_pointers(tp):
+            ok = []  # (an array of pointers or py_object is not raw memory: the table's 7)
         elif tp is _NDARRAY:
             ok = ["p.dtype == _BYTES_NP", "p.ndim == 1"]
         else:
@@ -844,8 +911,12 @@ def fast_raw(
             return slow(*args)
         runs, idx = plan
         tp = type(p)
-        if not runs or not copy_runs(p, tp, runs, size):
-            arr = view(p, tp, size)
+        try:
+            done = bool(runs) and copy_runs(p, tp, runs, size)
+            arr = None if done else view(p, tp, size)
+        except ValueError:  # (a released memoryview): the table path gives 7 and why
+            return slow(*args)
+        if not done:
             if arr is None:
                 return slow(*args)
             if write:
@@ -874,7 +945,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
         and type(offset) is int
         and type(size) is int{slave_guard}
         and not extra
-        and not kw{ok}
+        and not kw
     ):
         try:
             ctl = session.controllers[1]
@@ -890,7 +961,7 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
             and not m.offline
             and clock._thread is None
         ):
-            try:
+            try:{ok}
                 {move}
             except Exception:  # (the buffer's own refusal): the generic path answers
                 pass
@@ -901,6 +972,11 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
                 return advance(ctl, name, 0)
     return generic({slave_arg}offset, size, {given}, *extra, **kw)
 """
+
+
+class _NotThis(Exception):
+    """(A specialised raw entry's buffer is not of its shape: the generic path answers.)"""
+
 
 #: the front of an entry specialised for ``byref(array)``: the array itself, the rest as for it
 _RAW_UNWRAP = """
@@ -938,13 +1014,15 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         ok = [re.sub(rf"\b{k}\b", f"{k}_{n}", x) for x in ok]
         env[f"{k}_{n}"] = v
     env[f"T{n}"], env[f"IMG{n}"] = tp, image
+    env["_NotThis"] = _NotThis
     code = _RAW_ENTRY.format(
         **fmt,
         n=n,
         offset=offset,
         size=size,
         slave_guard=f"\n        and slave == {slave}\n        and type(slave) is int" if io else "",
-        ok="".join(f"\n        and {x}" for x in ok),
+        # (inside the try: a released memoryview raises at its first attribute)
+        ok=f"\n                if not ({' and '.join(ok)}): raise _NotThis" if ok else "",
         move=move,
         unwrap=(
             ""

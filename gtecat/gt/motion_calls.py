@@ -65,6 +65,13 @@ def long_arg(name: str, value: Any) -> int:
     return check_range(name, value, -(1 << 31), (1 << 31) - 1)
 
 
+def mask_arg(name: str, value: Any) -> int:
+    """A ``long`` bit mask as its 32-bit word: bit 31 comes as the C ``long`` -2^31 or as
+    the unsigned word (the table's ``mask``: -2^31 .. 2^32-1, as the argument layer takes
+    every mask); a refusal quotes the value as given."""
+    return check_range(name, value, -(1 << 31), (1 << 32) - 1) & 0xFFFFFFFF
+
+
 def _read_many(
     ctl: Controller,
     first: int,
@@ -198,8 +205,8 @@ def GT_Stop(ctl: Controller, mask: int, option: int) -> int:
     system's GT_SetCrdStopDec abrupt deceleration), clear a smooth one.  A stopped
     system brakes along its path and drops the rest of its FIFO.
     """
-    m = long_arg("mask", mask)
-    opt = long_arg("option", option)
+    m = mask_arg("mask", mask)
+    opt = mask_arg("option", option)
     for r in axes_in_mask(ctl, m & 0xFFF, strict=False):
         r.stop(bool(opt >> (r.number - 1) & 1))
     crds = vars(ctl).get("crd_bank")  # this core's own systems (gtecat.controller.crd.bank)

@@ -92,6 +92,8 @@ class Master:
         #: cycles between recovery attempts while the working counter is short
         self.recover_every = 100
         self.opened = False
+        #: called once the scan found the ENI's slaves, before the state walk and its InitCmds
+        self.on_opened: Callable[[], None] | None = None
         self.target = AlState.INIT
         self._op_countdown = -1
         self.states: list[AlState] = [AlState.INIT] * len(layout.slaves)
@@ -149,6 +151,8 @@ class Master:
                 )
             )
         self.opened = True
+        if self.on_opened is not None:
+            self.on_opened()  # before the InitCmds: faults of the machine meet the bring-up
         self._walk(AlState.PREOP)
         self._walk(AlState.SAFEOP)
         self.target = AlState.OP

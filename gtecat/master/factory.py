@@ -46,6 +46,10 @@ def build_slave(
     return cls(cfg.position, cfg.name, cfg.identity, rx_pdos=cfg.rx_pdos, tx_pdos=cfg.tx_pdos)
 
 
+#: the manufacturer-specific objects (ETG.1000.6 5.6.7.4.1, the CoE object dictionary's areas)
+MANUFACTURER = (0x2000, 0x5FFF)
+
+
 def adopt_init_cmd_objects(slave: VirtualSlave, cmds: tuple[InitCmd, ...]) -> list[str]:
     """Give a virtual slave the objects its ENI's CoE InitCmds write but it lacks.
 
@@ -53,7 +57,11 @@ def adopt_init_cmd_objects(slave: VirtualSlave, cmds: tuple[InitCmd, ...]) -> li
     (vendor objects such as 0x8000:xx settings).  The virtual slave takes them
     as plain read-write parameters of the written size, so the bring-up works
     and an SDO upload reads the value back; the slave's behaviour ignores them.
-    Mapping and assignment objects are never invented.  Returns what was added.
+    Mapping and assignment objects are never invented, nor a subindex of an object the
+    slave has outside the manufacturer-specific range 0x2000-0x5FFF (a communication or
+    profile object as its profile defines it, such as 0x607D with subindices 1 and 2): a
+    write to one it lacks aborts as on a real slave (0x06090011), and the bring-up reports
+    the InitCmd with the slave and the abort code.  Returns what was added.
     """
     od = getattr(slave, "od", None)
     if od is None:
@@ -68,6 +76,8 @@ def adopt_init_cmd_objects(slave: VirtualSlave, cmds: tuple[InitCmd, ...]) -> li
         sub = 0 if cmd.complete_access else cmd.subindex
         if od.find(cmd.index, sub) is not None:
             continue
+        if cmd.index in od.objects and not MANUFACTURER[0] <= cmd.index <= MANUFACTURER[1]:
+            continue  # the profile's object, whole: the slave's SDO server aborts the write
         dtype = sizes.get(len(cmd.data), DataType.OCTET_STRING)
         default: object = 0 if dtype != DataType.OCTET_STRING else bytes(len(cmd.data))
         var = Variable(

@@ -4,6 +4,7 @@ a failure says why, and the build finishes after the process that started it has
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -94,3 +95,63 @@ def test_the_build_outlives_the_process_that_started_it(
     while not lib.exists() and time.monotonic() < end:
         time.sleep(0.05)
     assert lib.read_text() == "late\n"
+
+
+def _leftovers(cache: Path) -> list[str]:
+    return sorted(p.name for p in cache.rglob(".build-*"))
+
+
+@pytest.mark.parametrize("how", ["background", "in process"])
+def test_a_killed_builder_leaves_nothing_behind_for_the_next_build(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch, how: str
+) -> None:
+    """kill -9 of a build on the way (the OOM killer, a reboot) left its build folder and its
+    log in the cache for good: the next build removes them, never a live build's."""
+    import fcntl
+    import signal
+
+    slow = _cc(tmp_path, 'sleep 30; echo late > "$out"')
+    call = (
+        "print(cbuild.Background([('part', SRC, (), ())])._proc.pid, flush=True)"
+        if how == "background"
+        else "print(0, flush=True); cbuild.shared_library('part', SRC, (), ())"
+    )
+    program = f"from gtecat import cbuild\nSRC = {SOURCE!r}\n{call}\nimport time\ntime.sleep(60)\n"
+    env = {**os.environ, "CC": str(slow), "PYTHONPATH": str(ROOT), "GTECAT_CACHE_DIR": str(cache)}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", program],
+        env=env,
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # (killed with its compiler below)
+    )
+    builder = 0
+    try:
+        assert proc.stdout is not None
+        builder = int(proc.stdout.readline())  # the background builder's session
+        vdir = cbuild.version_dir()
+        end = time.monotonic() + 30
+        while not list(vdir.glob(".build-*/part*.c")) and time.monotonic() < end:
+            time.sleep(0.02)
+        assert len(_leftovers(cache)) == 2  # the folder and its owner file
+    finally:
+        for group in (proc.pid, builder):
+            if group:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(group, signal.SIGKILL)
+        proc.wait()
+    assert len(_leftovers(cache)) == 2  # what the killed build left
+    (log,) = vdir.glob(".build-*.log")
+    end = time.monotonic() + 30
+    while cbuild._owner_alive(log) and time.monotonic() < end:
+        time.sleep(0.02)  # (the kill takes effect a moment later)
+    # a live build beside it: a folder whose owner file is locked
+    live = vdir / ".build-live"
+    live.mkdir()
+    with open(vdir / ".build-live.log", "wb") as owner:
+        fcntl.flock(owner, fcntl.LOCK_EX)
+        monkeypatch.setenv("CC", str(_cc(tmp_path, 'echo built > "$out"')))
+        assert cbuild.Background([("other", SOURCE, (), ())]).wait().read_text() == "built\n"
+        assert _leftovers(cache) == [".build-live", ".build-live.log"]
+    assert cbuild.sweep(vdir) == [live, vdir / ".build-live.log"]  # its owner is gone now
+    assert _leftovers(cache) == []

@@ -349,6 +349,8 @@ class EmulatedBackend(Backend):
             and getattr(slave.mailbox, "sdo_server_only", False)
         ):
             # nothing sees the frames: the server's own write, counters and abort, unframed
+            # (a fault's stand-in in front of the mailbox, gtecat.faults, has no
+            # sdo_server_only: its SDOs take the framed path, counted and faulted there)
             client.counter = next_counter(client.counter)
             slave.sdo.download_in_process(  # type: ignore[attr-defined]
                 index, subindex, data, complete_access, slave.al_state

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 import shutil
-from ctypes import byref, c_double, c_long, c_short, c_ubyte
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong
 from pathlib import Path
 
 import pytest
@@ -135,6 +135,14 @@ def _act(action: tuple) -> int:
         return gt.GT_SetPosErr(axis, err)
     if kind == "clear":
         return gt.GT_ClrSts(1, AXES)
+    if kind == "clear_span":  # the axes of the span go back, the others stay in the bank
+        _, first, count = action
+        return gt.GT_ClrSts(first, min(count, AXES + 1 - first))
+    if kind == "sdo":  # an SDO to one slave: its axes go back, the others stay
+        _, slave, index = action
+        data, size, abort = (c_ubyte * 8)(), c_ulong(), c_ulong()
+        rc = gt.GT_EcatSDOUpload(slave, index, 0, data, 8, byref(size), byref(abort))
+        return hash((rc, bytes(data)[: size.value], abort.value))
     if kind == "on":
         return gt.GT_AxisOn(action[1])
     if kind == "kernel":  # the compiled cycle's build ends now (no GT call)
@@ -247,6 +255,8 @@ action = st.one_of(
     st.tuples(st.just("band"), axis, st.integers(0, 50), st.integers(0, 20)),
     st.tuples(st.just("poserr"), axis, st.integers(1, 200)),
     st.tuples(st.just("clear")),
+    st.tuples(st.just("clear_span"), axis, st.integers(1, 3)),
+    st.tuples(st.just("sdo"), st.integers(0, 7), st.sampled_from([0x6064, 0x6041, 0x603F, 0x1001])),
     st.tuples(st.just("on"), axis),
     st.tuples(st.just("raw"), st.integers(0, 40), st.integers(0, 255)),
 )

@@ -3,13 +3,14 @@
 Twelve EtherCAT axes home at once in different smart-home modes (home ahead or behind, a
 limit that turns the search, starting on the switch, limit then home both ways, limit with
 escapes both ways, forced home, home and index through the touch probe, a search stopped by
-GT_Stop, one that does not end in the run) on switches close enough that every search meets
-its events in the run.  Each event (a home edge, a limit, a leg's end sample) sends an axis
-back to its scalar objects and the bank takes it again after, and between events the bank
-runs the cycles many at once while the homings say they stay quiet: that is where a
-difference would show.  Compared exactly with the bank off, every cycle: GT_GetSts, planned
-and encoder positions of every axis, every axis's THomeStatus and the whole GT raw image;
-the drives' mechanics at the end.
+GT_Stop, one stopped by GT_Stop while it stands between two legs (the touch probe arming
+before the index search), one that does not end in the run) on switches close enough that
+every search meets its events in the run. Each event (a home edge, a limit, a leg's end
+sample) sends an axis back to its scalar objects and the bank takes it again after, and
+between events the bank runs the cycles many at once while the homings say they stay quiet:
+that is where a difference would show. Compared exactly with the bank off, every cycle:
+GT_GetSts, planned and encoder positions of every axis, every axis's THomeStatus and the
+whole GT raw image; the drives' mechanics at the end.
 """
 
 from __future__ import annotations
@@ -40,10 +41,16 @@ SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
     9: ({"mode": 40}, {"home_switch": [[2_500, 7_000]]}),
     10: ({"mode": 20, "homeOffset": 250}, {"home_switch": [[4_000, 6_000]]}),  # GT_Stop
     11: ({"mode": 20}, {"home_switch": [[400_000, 410_000]]}),  # still searching at the end
-    12: ({"mode": 10, "escapeStep": 300}, {"positive_limit": 2_500}),
+    12: (  # GT_Stop while it stands between the home return and the index search
+        {"mode": 22},
+        {"home_switch": [[1_500, 2_500]], "index_offset": 700, "counts_per_rev": 1_000},
+    ),
 }
 CYCLES = 650
 STOP_AT = 90  # GT_Stop of axis 10 in the middle of its search
+#: GT_Stop of axis 12 after this many cycles: it stands at the captured home, in stage 30,
+#: while the drive's touch probe arms (two cycles), before the index search moves it
+STAND_STOP_AT = 317
 
 
 def _machine(tmp: Path) -> str:
@@ -109,6 +116,14 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
         while k < CYCLES:
             if k <= STOP_AT < k + max(step, 1):
                 _ok(gt.GT_Stop(1 << 9, 0), "stop")
+            if k <= STAND_STOP_AT < k + max(step, 1):
+                if not step:  # (the one-cycle run: it must stand there now)
+                    hs = gt.THomeStatus()
+                    _ok(gt.GT_GetHomeStatus(12, byref(hs)), "status")
+                    sts = c_long()
+                    gt.GT_GetSts(12, byref(sts))
+                    assert (hs.run, hs.stage, sts.value & 1 << 10) == (1, 30, 0)
+                _ok(gt.GT_Stop(1 << 11, 0), "stop between legs")
             # mostly one cycle at a time, sometimes many at once (a polling loop)
             wait = step or (1 if k % 50 else 7)
             gt.GTE_Wait(wait)
@@ -148,12 +163,15 @@ def test_smart_homing_in_the_bank_matches_the_scalar_path(runs: tuple) -> None:
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"cycle {k}: the bank and the scalar path differ"
     # every homing ended as planned: stage 100 without error, axis 10 stopped (error 4),
-    # axis 11 still searching
+    # axis 11 still searching, axis 12 stopped where it stood (error 4, not moved again)
     homes = ref[-2][3]
     ended = {a: (run, stage, error) for a, (run, stage, error, _, _) in enumerate(homes, 1)}
     assert ended[10] == (0, 20, 4)
     assert ended[11] == (1, 20, 0)
-    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11)), ended
+    assert ended[12] == (0, 30, 4)
+    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11, 12)), ended
+    stood = {prf[11] for _, prf, _, homes_k, _ in ref[:-1] if homes_k[11][0] == 0}
+    assert len(stood) == 1, "axis 12 moved after GT_Stop"
 
 
 def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:

@@ -424,3 +424,18 @@ def test_gt_reset_ends_a_homing_and_restores_the_defaults():
     ctl.clock.advance(5)
     assert not home.running
     assert home.params == HomeParams() and home.status.stage == Stage.IDLE
+
+
+def test_gt_stop_while_the_search_stops_at_the_limit_ends_the_homing():
+    """GT_Stop in stage 11 (the axis braking at the limit it found, a stop of the search's
+    own): the homing ends with the stop error there, and the axis does not move again."""
+    ctl = open_card(START["below"])
+    home = smart_home(ctl, 1)
+    home.start(params(mode=10, moveDir=-1, escapeStep=1000))
+    assert ctl.clock.run_until(lambda: home.status.stage == Stage.SEARCH_LIMIT_STOP, 60_000)
+    assert gt.GT_Stop(1, 0) == 0
+    st = _finish(ctl, home)
+    assert (st.run, st.stage, st.error) == (0, Stage.SEARCH_LIMIT_STOP, HomeError.STOP)
+    here = home.res.profile.planner.pos
+    ctl.clock.advance(500)
+    assert home.res.profile.planner.pos == here and home.res.profile.planner.done

@@ -62,7 +62,19 @@ def _odd(p: Param) -> list[Any]:
     out += [byref((ctypes.c_long * 3)(), 8), byref(ctypes.c_long(), 4), bytearray(8)]
     out += [np.zeros(2), np.zeros(2, np.int32), [0], ctypes.pointer(ctypes.c_long())]
     out += [ctypes.c_char_p(b"x"), ctypes.create_string_buffer(8)]
+    # element types by the rule (the other width or sign, bools), memory holding pointers or
+    # Python objects, a released memoryview, a structure's field
+    out += [np.zeros(2, d) for d in (np.uint8, np.int16, np.uint32, np.int64, np.bool_)]
+    out += [memoryview(bytearray(8)), ctypes.py_object("x"), (ctypes.py_object * 2)()]
+    out += [(ctypes.c_void_p * 2)(), byref(ctypes.pointer(ctypes.c_long()))]
+    gone = memoryview(bytearray(8))
+    gone.release()
+    out += [gone, byref(_Field(), _Field.x.offset), byref(_Field(), _Field.d.offset)]
     return out
+
+
+class _Field(ctypes.Structure):
+    _fields_ = [("tag", ctypes.c_short), ("x", ctypes.c_long), ("d", ctypes.c_double)]
 
 
 def _plain(p: Param) -> Any:

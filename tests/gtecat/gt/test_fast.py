@@ -12,6 +12,7 @@ import ctypes
 from ctypes import byref
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -57,6 +58,11 @@ shape = st.sampled_from(
         "pointer",
         "obj",
         "int",
+        "struct_field",  # byref(s, S.field.offset): C's &s.field
+        "numpy",  # a numpy array of t's element type
+        "numpy_u8",  # a one-byte numpy array (narrower than any reader's type)
+        "memoryview_u8",
+        "released_memoryview",
     ]
 )
 _SAME: dict[type, tuple] = {}
@@ -89,12 +95,36 @@ def _arg(kind: str, t: type):
     if kind == "obj":
         o = t()
         return o, o
+    if kind == "struct_field":
+
+        class S(ctypes.Structure):
+            _fields_ = [("tag", ctypes.c_short), ("x", t), ("after", ctypes.c_short)]
+
+        o = S(tag=-3, after=-4)
+        return o, byref(o, S.x.offset)
+    if kind == "numpy":
+        o = np.zeros(2, np.dtype(t._type_))
+        return o, o
+    if kind == "numpy_u8":
+        o = np.zeros(8, np.uint8)
+        return o, o
+    if kind == "memoryview_u8":
+        o = bytearray(8)
+        return o, memoryview(o)
+    if kind == "released_memoryview":
+        m = memoryview(bytearray(8))
+        m.release()
+        return None, m
     return None, 12345
 
 
 def _value(o):
     if o is None:
         return None
+    if isinstance(o, ctypes.Structure):
+        return [getattr(o, f[0]) for f in o._fields_]
+    if isinstance(o, np.ndarray | bytearray):
+        return list(o)
     if isinstance(o, ctypes.Array):
         return [o[i] for i in range(len(o))]
     return o.value
@@ -227,3 +257,36 @@ def test_every_axis_in_one_call_answers_as_the_table(moving_bus) -> None:
     sts = (ctypes.c_long * 12)()
     assert gt.GT_GetSts(1, sts, 12, None) == 0
     assert [sts[a - 1] & 0x600 for a in (1, 2, 5)] == [0x600] * 3  # servo on, moving
+
+
+def test_many_axes_follow_the_bank_as_axes_leave_and_come_back(moving_bus) -> None:
+    """A read of many axes at once keeps the bank's rows of its span between calls: an axis
+    given back (switched off: it stays out while its status changes), switched on and
+    claimed again, and the cycles between all read as the table path reads them."""
+    ctl = gt.GTE_Controller()
+    assert ctl.bank is not None
+    for a in range(1, 13):
+        gt.GT_AxisOn(a)
+    gt.GTE_Wait(20)
+    assert ctl.bank.n_alive == 12
+    sts, prf = (ctypes.c_long * 12)(), (ctypes.c_double * 12)()
+    sts2, prf2 = (ctypes.c_long * 12)(), (ctypes.c_double * 12)()
+    seen = []
+    for step, act in enumerate(
+        [None, ("off", 7), ("wait", 5), ("on", 7), ("wait", 40), ("off", 1), ("wait", 3)]
+    ):
+        if act is not None and act[0] == "off":
+            assert gt.GT_AxisOff(act[1]) == 0  # gives the axis back; it stays out
+        elif act is not None and act[0] == "on":
+            assert gt.GT_AxisOn(act[1]) == 0
+        elif act is not None:
+            gt.GTE_Wait(act[1])  # cycles: new values, the axis claimed again once on
+        seen.append(ctl.bank.n_alive)
+        for fn, a, b in ((gt.GT_GetSts, sts, sts2), (gt.GT_GetPrfPos, prf, prf2)):
+            assert fn(1, a, 12, None) == 0
+            assert fn.slow(1, b, 12, None) == 0
+            assert list(a) == list(b), (step, fn.__name__)
+            assert fn(3, a, 8, None) == 0  # another span of the same bank
+            assert fn.slow(3, b, 8, None) == 0
+            assert list(a)[:8] == list(b)[:8], (step, fn.__name__)
+    assert seen[0] == 12 and min(seen) < 12 and 12 in seen[3:]  # out and back while read

@@ -260,6 +260,26 @@ def test_set_stop_dec_and_stop_mask_ignores_missing_axes():
     assert len(out) == 4  # 10 / 2.5
 
 
+def test_stop_takes_bit_31_of_its_mask_either_way():
+    """GT_Stop(long mask, long option): a bit pattern; bit 31 (axis 32) comes as the C long
+    -2^31 or as the word 2^31, as GT_Update takes it; past 32 bits, 7 quoting the value the
+    caller passed."""
+    up()
+    trap(1, 100000, 10, 1, 1)
+    assert gt.GT_Update(1) == 0
+    for mask in (-(1 << 31), 1 << 31, 0xAA000000, -1, (1 << 32) - 1):
+        assert gt.GT_Stop(mask, 0) == 0, gt.GTE_GetLastError()
+        assert gt.GT_Stop(0, mask) == 0, gt.GTE_GetLastError()
+    for mask in (1 << 32, -(1 << 31) - 1):
+        assert gt.GT_Stop(mask, 0) == 7
+        assert f"mask={mask} out of range" in gt.GTE_GetLastError()
+    assert gt.GT_Stop(1, 1 << 32) == 7 and "option=4294967296" in gt.GTE_GetLastError()
+    # the implementation itself (called with what the argument layer hands over, or not)
+    from gtecat.gt.motion_calls import mask_arg
+
+    assert mask_arg("mask", -(1 << 31)) == mask_arg("mask", 1 << 31) == 0x80000000
+
+
 # --- mode rules (chapter 13 return 1) ------------------------------------------------------------
 def test_mode_rules_refuse_with_a_reason():
     up()
