@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from hypothesis import settings
@@ -260,13 +262,34 @@ def _rewrite_ahead(config: pytest.Config) -> None:
         from _pytest.assertion.rewrite import assertstate_key
 
         state = config.stash[assertstate_key]
-        for fn in sorted(ROOT.joinpath("tests").rglob("*.py")):
-            if not (fn.name.startswith("test_") or fn.name == "conftest.py"):
-                continue
-            pyc = rewrite.get_cache_dir(fn) / (fn.name[:-3] + rewrite.PYC_TAIL)
-            if rewrite._read_pyc(fn, pyc) is not None or not rewrite.try_makedirs(pyc.parent):
-                continue
-            source_hash, co = rewrite._rewrite_test(fn, config)
-            rewrite._write_pyc(state, co, source_hash, pyc)
+        walk = rewrite.traverse_node
+        rewrite.traverse_node = _every_node  # a fifth of the rewriting's CPU (see there)
+        try:
+            for fn in sorted(ROOT.joinpath("tests").rglob("*.py")):
+                if not (fn.name.startswith("test_") or fn.name == "conftest.py"):
+                    continue
+                pyc = rewrite.get_cache_dir(fn) / (fn.name[:-3] + rewrite.PYC_TAIL)
+                if rewrite._read_pyc(fn, pyc) is not None or not rewrite.try_makedirs(pyc.parent):
+                    continue
+                source_hash, co = rewrite._rewrite_test(fn, config)
+                rewrite._write_pyc(state, co, source_hash, pyc)
+        finally:
+            rewrite.traverse_node = walk
     except (ImportError, AttributeError, KeyError, TypeError, OSError, SyntaxError):
         return
+
+
+def _every_node(node: Any) -> Iterator[Any]:
+    """Every node under ``node`` (itself included), without recursion.
+
+    pytest's rewriter walks each rewritten assert's new nodes recursively, one generator per
+    node, only to give the nodes that have no line number the assert's (an order-free loop);
+    this walk yields the same nodes in another order for about a fifth less CPU of the whole
+    rewriting (~2 s of a fresh checkout's ~10 s)."""
+    import ast
+
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        yield n
+        stack.extend(ast.iter_child_nodes(n))
