@@ -272,7 +272,21 @@ class Ref:
         return bytes(memoryview(t).cast("B")[:n])
 
     def struct(self, cls: type[ctypes.Structure]) -> ctypes.Structure:
-        """The memory seen as ``cls`` (the caller's own same-layout class works too)."""
+        """The memory seen as ``cls`` (the caller's own same-layout class works too, but not
+        one that holds pointers or Python objects where ``cls`` has numbers: the fields
+        written over them would leave wild pointers)."""
+        elem = self.elem
+        if (
+            self.py is None
+            and elem is not None
+            and elem is not cls
+            and holds_pointers(elem)
+            and not holds_pointers(cls)
+        ):
+            raise ParameterError(
+                f"{self.name}: points to {_elem_name(elem)}, which holds pointers or Python "
+                f"objects; pass a {cls.__name__} (or a structure of its layout)"
+            )
         need = ctypes.sizeof(cls)
         if self.byte_capacity() < need:
             raise ParameterError(

@@ -236,6 +236,26 @@ def test_raw_data_takes_plain_memory_only(bus) -> None:
     assert gt.GT_SetEcatRawData(0, 2, bytes(2)) == 0
 
 
+def test_a_structure_parameter_refuses_a_structure_holding_pointers(bus) -> None:
+    """A caller's own structure of the vendor layout is taken (``TTrapPrm`` as a user's
+    program declares it), but not one that holds pointers or Python objects where the
+    vendor structure has numbers: the doubles written over them left wild pointers (a
+    crash at the next look at the object)."""
+
+    class Evil(Structure):
+        _fields_ = [(k, py_object) for k in "abcd"]
+
+    class Mine(Structure):
+        _fields_ = [(k, c_double) for k in ("acc", "dec", "velStart")] + [("smooth", c_short)]
+
+    e = Evil("w", "x", "y", "z")
+    for arg in (byref(e), e, ctypes.pointer(e)):
+        _refused(gt.GT_GetTrapPrm(1, arg), "pPrm", "pointers or Python objects")
+    assert (e.a, e.d) == ("w", "z")
+    mine = Mine()
+    assert gt.GT_GetTrapPrm(1, byref(mine)) == 0 and mine.acc > 0
+
+
 def test_holds_pointers() -> None:
     for t in (py_object, ctypes.c_char_p, ctypes.c_void_p, POINTER(c_long), _WithPointer):
         assert holds_pointers(t) and holds_pointers(t * 2) and holds_pointers((t * 2) * 2)
