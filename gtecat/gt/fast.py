@@ -488,6 +488,27 @@ def _byref_check(env: dict[str, Any], types: frozenset) -> str:
 BYREF_TARGET = True
 
 
+def _target(types: Any) -> Callable[[Any], Any]:
+    """``f(p)`` with :func:`byref_target.target`'s answers (``p``'s object when ``p`` is a
+    ``byref`` of an object of one of ``types`` passing that object's own address, else
+    ``p``): the C check where it is available and :data:`BYREF_TARGET` is on, else the
+    same check in Python, so a fast path has one branch for both."""
+    f = byref_target.target(types) if BYREF_TARGET else None
+    if f is not None:
+        return f
+    ok = frozenset(types)
+
+    def target(p: Any) -> Any:
+        if type(p) is not _CArg:
+            return p
+        obj = p._obj
+        if type(obj) not in ok or byref_address(p) != _addressof(obj):
+            return p
+        return obj
+
+    return target
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
@@ -1360,7 +1381,7 @@ def fast_homing_status(
             if t._type_.isupper()
             else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
         )
-    target = byref_target.target(ok) if BYREF_TARGET else None
+    target = _target(ok)
     getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
     from ..controller.axis import Axis
 
@@ -1393,14 +1414,9 @@ def fast_homing_status(
             ):
                 tp = type(p)
                 if tp is _CArg:
-                    if target is not None:
-                        obj = target(p)
-                        if obj is p:
-                            obj = None
-                    else:
-                        obj = p._obj
-                        if type(obj) not in ok or byref_address(p) != _addressof(obj):
-                            obj = None
+                    obj = target(p)
+                    if obj is p:
+                        obj = None
                 else:
                     obj = p if tp in ok else None
                 try:
@@ -1538,7 +1554,7 @@ def fast_struct_reader(
     ):  # (AxisBank.before_axis_call is before_call for these only)
         raise ValueError(f"{name}: not a function of one axis")
     cls, mode, fill = STRUCT_READERS[name]
-    target = byref_target.target([cls]) if BYREF_TARGET else None
+    target = _target([cls])
 
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
@@ -1555,14 +1571,9 @@ def fast_struct_reader(
             ):
                 tp = type(p)
                 if tp is _CArg:
-                    if target is not None:
-                        s = target(p)
-                        if s is p:
-                            s = None
-                    else:
-                        s = p._obj
-                        if type(s) is not cls or byref_address(p) != _addressof(s):
-                            s = None
+                    s = target(p)
+                    if s is p:
+                        s = None
                 else:
                     s = p if tp is cls else None
                 if s is not None:
@@ -1603,20 +1614,15 @@ def fast_core(
     from .table import FUNCTIONS
 
     ok = _scalar_types(FUNCTIONS[name].params[0])
-    target = byref_target.target(ok) if BYREF_TARGET else None
+    target = _target(ok)
 
     def gt(p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if not kw and not extra and session.local:
             tp = type(p)
             if tp is _CArg:
-                if target is not None:
-                    obj = target(p)
-                    if obj is p:
-                        obj = None
-                else:
-                    obj = p._obj
-                    if type(obj) not in ok or byref_address(p) != _addressof(obj):
-                        obj = None
+                obj = target(p)
+                if obj is p:
+                    obj = None
             else:
                 obj = p if tp in ok else None
             if obj is not None and session.note is None:
