@@ -754,14 +754,7 @@ class AxisBank:
         prof = res.profile
         if prof.mode not in (PrfMode.TRAP, PrfMode.JOG) or not prof.planner.done:
             return False  # (a Gear or Follow slave may start with its master, no call on it)
-        s = res.safety
-        if s.active:
-            a = ax.prf_pos
-            if a > s.soft_positive or a < s.soft_negative:
-                return False
-            if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
-                return False
-        return True
+        return _within_safety(ax, res)
 
     @staticmethod
     def _latched_away(ax: Any, res: Any) -> bool:
@@ -777,14 +770,7 @@ class AxisBank:
             return False
         if pl._mode != _MOVE:
             return False
-        s = res.safety
-        if s.active:
-            a = ax.prf_pos
-            if a > s.soft_positive or a < s.soft_negative:
-                return False
-            if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
-                return False
-        return True
+        return _within_safety(ax, res)
 
     def _eligible_frozen(self, r: int) -> bool:
         """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
@@ -1935,3 +1921,16 @@ class AxisBank:
                 changed.append(g)
         self._release_groups(changed)
         self._reindex()
+
+
+def _within_safety(ax: Any, res: Any) -> bool:
+    """Neither a soft limit nor the following error is exceeded now (an axis latched with
+    one of them would leave the bank at once: it stays scalar)."""
+    s = res.safety
+    if s.active:
+        a = ax.prf_pos
+        if a > s.soft_positive or a < s.soft_negative:
+            return False
+        if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
+            return False
+    return True
