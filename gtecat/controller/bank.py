@@ -83,7 +83,14 @@ from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import settled as kernel_settled
 from .bank_kernel import wanted as kernel_wanted
-from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
+from .bank_modes import (
+    SAMPLED_TABLE,
+    Cluster,
+    kept_push,
+    links,
+    sampled_kind,
+    trap_steppable,
+)
 from .crd.system import Delay, Motion
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
@@ -1518,9 +1525,7 @@ class AxisBank:
         if cl.snaps is not None:  # (None: the system stands where the scalar path has it)
             for obj, snap in cl.snaps:
                 if obj is c:
-                    kept = snap[2]  # bank_modes.snapshot: the __dict__, containers by content
-                    kept["fifos"][1][fifo][1].append(entry)
-                    kept["tails"][1][fifo] = c.tails[fifo]
+                    kept_push(c, snap, entry, fifo)
             if c.trace is not None:
                 c.trace.pushed[fifo] += 1
                 c.trace.memo = None

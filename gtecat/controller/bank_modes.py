@@ -307,12 +307,58 @@ _FOLLOW_STATE_OF = attrgetter(*_FOLLOW_STATE)
 _TRAP_MOVING = object()
 _TRAP_STATE = ("_k", "_pos", "_vel", "_acc", "_mode", "_segs", "_i", "_j")
 _TRAP_STATE_OF = attrgetter(*_TRAP_STATE)
+#: ... and an axis slot's (the planner of a coordinate system's axis)
+_SLOT_MOVING = object()
+_SLOT_STATE = ("_pos", "_vel", "_acc", "_fresh", "stopping")
+_SLOT_STATE_OF = attrgetter(*_SLOT_STATE)
 _MOVING = {
     _PT_MOVING: PT_STATE,
     _GEAR_MOVING: _GEAR_STATE,
     _FOLLOW_MOVING: _FOLLOW_STATE,
     _TRAP_MOVING: _TRAP_STATE,
+    _SLOT_MOVING: _SLOT_STATE,
 }
+
+#: ... and a running coordinate system's (step, _next, _finish, _idle; its count of segments
+#: done changes in place, its FIFO loses entries at its head: CoordSystem.popped records them)
+_CRD_MOVING = object()
+_CRD_STATE = (
+    "running fifo stopping entry plan t s speed stop_acc waiting gears gears_next gear_entry"
+).split()
+_CRD_STATE_OF = attrgetter(*_CRD_STATE)
+
+
+def _keep_system(c: CoordSystem) -> tuple:
+    popped: list = []
+    c.popped = popped
+    return (_CRD_MOVING, _CRD_STATE_OF(c), c.segments_done, list(c.segments_done), list(c.tails))
+
+
+def kept_push(c: CoordSystem, snap: tuple, entry: Any, fifo: int) -> None:
+    """``entry`` was pushed onto ``fifo`` of ``c`` after its state was kept (``snap``, of
+    :func:`keep`): the state put back holds it too."""
+    if snap[0] is _CRD_MOVING:  # the entry stays on the FIFO: only its head is put back
+        snap[4][fifo] = c.tails[fifo]
+        return
+    kept = snap[2]  # snapshot: the __dict__, containers by content
+    kept["fifos"][1][fifo][1].append(entry)
+    kept["tails"][1][fifo] = c.tails[fifo]
+
+
+def _put_back_system(c: CoordSystem, snap: tuple) -> None:
+    """:func:`_keep_system`'s state back: the entries taken off the running FIFO since go back
+    to its head (those pushed since stay at its tail)."""
+    _, values, done, counts, tails = snap
+    popped = c.popped
+    for name, value in zip(_CRD_STATE, values, strict=True):
+        _set(c, name, value)
+    done[:] = counts
+    c.segments_done = done
+    c.tails[:] = tails
+    if popped:
+        q = c.fifos[c.fifo]
+        q.extendleft(reversed(popped))
+    c.popped = None
 
 
 def keep(obj: Any) -> tuple:
@@ -327,6 +373,12 @@ def keep(obj: Any) -> tuple:
         return (_GEAR_MOVING, _GEAR_STATE_OF(obj))
     if FollowPlanner in t and _get(obj, "_state") == 2 and not _get(obj, "_switch"):
         return (_FOLLOW_MOVING, _FOLLOW_STATE_OF(obj), len(_get(obj, "_segs")))
+    if AxisSlot in t:
+        return (_SLOT_MOVING, _SLOT_STATE_OF(obj))
+    if CoordSystem in t:
+        if obj.running and not obj.stopping:
+            return _keep_system(obj)
+        obj.popped = None
     return snapshot(obj)
 
 
@@ -396,7 +448,8 @@ class SystemTrace:
         self.start = c.state()
         self.speeds: list[float] = []
         self.marks: list[tuple[int, tuple]] = []
-        self.cols: list[list[tuple[float, float, float]]] | None = None
+        #: the slots' positions in each cycle (``cols[k][j]``: slot ``k``, cycle ``j``)
+        self.cols: Any = None
         #: entries pushed onto each FIFO since (AxisBank._pushed_ahead): not in the states
         self.pushed = [0, 0]
 
@@ -430,7 +483,7 @@ class SystemTrace:
         base = marks[k][1] if k >= 0 else self.start
         cols = self.cols
         assert cols is not None
-        pos = tuple(col[j][0] - o for col, o in zip(cols, c.origin, strict=True))
+        pos = tuple(float(col[j]) - o for col, o in zip(cols, c.origin, strict=True))
         return CrdNow(c, self._pushed((*base[:6], self.speeds[j], pos, base[8])))
 
     def _pushed(self, st: tuple) -> tuple:
@@ -619,15 +672,15 @@ class Cluster:
             c = self.systems[0]
             if c.running:
                 trace = SystemTrace(bank, rows, c)
-                cols, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks)
-                trace.cols = cols
+                out, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks)
+                m = end + 1 if end >= 0 else SAMPLED_TABLE
+                trace.cols = out[0]
                 c.trace = trace
                 at = {id(slot): k for k, slot in enumerate(c.slots)}
                 for i, r in enumerate(rows):
-                    col = cols[at[id(self.planners[i])]]
-                    if moving[r] and col:
-                        ps, vs, as_ = (list(x) for x in zip(*col, strict=True))
-                        self._put(bank, r, ps, vs, as_, end)
+                    if moving[r]:
+                        k = at[id(self.planners[i])]
+                        self._put(bank, r, out[0, k, :m], out[1, k, :m], out[2, k, :m], end)
                 return
         pls = self.planners
         systems = self.systems
@@ -945,7 +998,9 @@ class Cluster:
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
             names = _MOVING.get(snap[0]) if type(snap[0]) is object else None
-            if names is not None:
+            if snap[0] is _CRD_MOVING:
+                _put_back_system(obj, snap)
+            elif names is not None:
                 for name, value in zip(names, snap[1], strict=True):
                     _set(obj, name, value)
                 if snap[0] is _FOLLOW_MOVING:
@@ -963,6 +1018,7 @@ __all__ = [
     "SAMPLED_TABLE",
     "Cluster",
     "SystemTrace",
+    "kept_push",
     "links",
     "restore",
     "sampled_kind",
