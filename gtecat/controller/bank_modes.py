@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .bank_crd import crd_fill
 from .bank_kernel import MAXSEG, PT_STATE
 from .bank_slaves import compiled_kind, slave_fill
 from .crd.system import AxisSlot, CoordSystem, CrdNow, Delay, Motion
@@ -672,7 +673,9 @@ class Cluster:
             c = self.systems[0]
             if c.running:
                 trace = SystemTrace(bank, rows, c)
-                out, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks)
+                cf = crd_fill(bank)
+                seg = cf.segment if cf is not None else None
+                out, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks, seg)
                 m = end + 1 if end >= 0 else SAMPLED_TABLE
                 trace.cols = out[0]
                 c.trace = trace

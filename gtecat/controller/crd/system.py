@@ -456,6 +456,7 @@ class CoordSystem:
         n: int,
         speeds: list[float] | None = None,
         marks: list[tuple[int, tuple]] | None = None,
+        segment: Callable[..., int] | None = None,
     ) -> tuple[np.ndarray, int]:
         """``n`` cycles of :meth:`step`, each followed by every axis taking its slot's sample
         (``AxisSlot.step``), for the axis bank's tables: the samples (``out[0|1|2, k, j]``:
@@ -464,7 +465,9 @@ class CoordSystem:
         inside a motion segment are step's own common case, for a trapezoid along a line or
         an arc all of them at once (:meth:`_run_segment`, the same operations in the same
         order); any other is :meth:`step`.  ``speeds``/``marks``: the path speed after each
-        cycle, and (cycle, :meth:`state`) after each cycle that was not the common case."""
+        cycle, and (cycle, :meth:`state`) after each cycle that was not the common case;
+        ``segment``: :meth:`_run_segment` compiled, called with the system first
+        (:class:`gtecat.controller.bank_crd.CrdFill`)."""
         slots = self.slots
         rec = speeds is not None and marks is not None
         origin = self.origin
@@ -475,7 +478,10 @@ class CoordSystem:
             if not self.stopping and type(e) is Motion and self.waiting is None and not self.gears:
                 plan = self.plan
                 if type(plan) is Trapezoid and type(e.geom) in _VECTOR:
-                    j += self._run_segment(e, plan, out, j, speeds if rec else None)
+                    if segment is None:
+                        j += self._run_segment(e, plan, out, j, speeds if rec else None)
+                    else:
+                        j += segment(self, e, plan, out, j, speeds if rec else None)
                     if j >= n:
                         break
                 else:  # a segment's own speed plan: one cycle

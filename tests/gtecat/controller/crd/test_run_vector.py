@@ -1,11 +1,12 @@
-"""CoordSystem.run takes the cycles inside a segment many at a time (numpy): every sample,
-speed and state bit for bit those of the scalar cycle (CoordSystem.step, then each axis
-taking its slot's sample)."""
+"""CoordSystem.run takes the cycles inside a segment many at a time (numpy, or the compiled
+segment of bank_crd): every sample, speed and state bit for bit those of the scalar cycle
+(CoordSystem.step, then each axis taking its slot's sample)."""
 
 from __future__ import annotations
 
 import pytest
 
+from gtecat.controller import bank_crd
 from gtecat.controller.crd import CoordSystem, CrdParams, Line, make_arc
 from gtecat.controller.crd.path import CCW, CW
 from gtecat.controller.crd.system import AxisSlot, Delay, Motion
@@ -66,11 +67,23 @@ def _bits(x: object) -> object:
     return x
 
 
+@pytest.fixture(params=["numpy", "compiled"])
+def segment(request: pytest.FixtureRequest) -> object:
+    if request.param == "numpy":
+        return None
+    lib, reason = bank_crd.library()
+    if lib is None:
+        pytest.skip(f"the compiled segment did not build here: {reason}")
+    return bank_crd.CrdFill(lib).segment
+
+
 @pytest.mark.parametrize(
     ("override", "dims", "even_time", "table"),
     [(1.0, 2, 0, 32), (0.7, 2, 0, 32), (1.6, 3, 5, 32), (1.3, 2, 0, 7), (0.0, 2, 0, 32)],
 )
-def test_run_matches_the_scalar_cycles_bit_for_bit(override, dims, even_time, table) -> None:
+def test_run_matches_the_scalar_cycles_bit_for_bit(
+    override, dims, even_time, table, segment
+) -> None:
     ref, got = _system(override, dims, even_time), _system(override, dims, even_time)
     _fill(ref)
     _fill(got)
@@ -90,7 +103,7 @@ def test_run_matches_the_scalar_cycles_bit_for_bit(override, dims, even_time, ta
     cycles = 0
     while got.running and cycles < len(want[0]):
         run_marks: list = []
-        out, end = got.run(table, speeds, run_marks)
+        out, end = got.run(table, speeds, run_marks, segment)
         m = end + 1 if end >= 0 else table
         marks.extend((cycles + j, st) for j, st in run_marks)
         for j in range(m):
