@@ -24,6 +24,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
+from gtecat.controller import bank_crd
 from tests.gtecat.controller.test_bank import AXES, _bring_up, _machine_file, _ok, _sample
 
 Script = list[tuple[int, Callable[[], object]]]
@@ -306,6 +307,8 @@ def _run(
         got = ctl.bank.sampled_samples if ctl.bank is not None else 0
         sf = ctl.bank.__dict__.get("_slave_fill") if ctl.bank is not None else None
         COMPILED_SLAVES[0] = sf.samples if sf else 0
+        cf = ctl.bank.__dict__.get("_crd_fill") if ctl.bank is not None else None
+        COMPILED_CRD[0] = cf.samples if cf else 0
     finally:
         gt.GT_Close()
     return trace, got
@@ -313,6 +316,8 @@ def _run(
 
 #: the samples of the last _run's compiled slaves (bank_slaves.SlaveFill)
 COMPILED_SLAVES = [0]
+#: ... and of its compiled coordinate-system segments (bank_crd.CrdFill)
+COMPILED_CRD = [0]
 
 
 @pytest.fixture(scope="module")
@@ -357,6 +362,8 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
     assert samples >= least, "the bank hardly ran this mode"
     if script is SLAVES:
         assert COMPILED_SLAVES[0] >= 1500, "the compiled slaves hardly ran"
+    if script is CRD and bank_crd.library()[0] is not None:
+        assert COMPILED_CRD[0] >= 300, "the compiled segments hardly ran"
 
 
 @pytest.mark.parametrize("script", [PT, GEAR], ids=["pt", "gear-follow"])
