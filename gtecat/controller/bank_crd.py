@@ -108,6 +108,7 @@ class CrdFill:
         self.io = np.zeros(N_IO)
         self.io_ptr = self.io.ctypes.data
         self.speeds = np.zeros(64)
+        self.speeds_ptr = self.speeds.ctypes.data
         #: id(system) -> (its plan, its entry, the packed segment, its address)
         self.packed: dict[int, tuple[Any, Any, np.ndarray, int]] = {}
         #: samples written (statistics: the tests check the compiled fill ran)
@@ -124,18 +125,18 @@ class CrdFill:
         m = n - j
         if len(self.speeds) < m:
             self.speeds = np.zeros(m)
+            self.speeds_ptr = self.speeds.ctypes.data
         io = self.io
         slots = c.slots
+        cyc = c._cycle_ms()
         io[IO_T] = c.t
-        io[IO_DT] = c._cycle_ms() * c.override
-        io[IO_CYC] = c._cycle_ms()
+        io[IO_DT] = cyc * c.override
+        io[IO_CYC] = cyc
         io[IO_S] = c.s
         io[IO_SPEED] = c.speed
         io[IO_POS : IO_POS + d] = [s._pos for s in slots]
         io[IO_VEL : IO_VEL + d] = [s._vel for s in slots]
-        k = self.fn(
-            got[3], self.io_ptr, out.ctypes.data + 8 * j, d * n, n, m, self.speeds.ctypes.data
-        )
+        k = self.fn(got[3], self.io_ptr, out.ctypes.data + 8 * j, d * n, n, m, self.speeds_ptr)
         if k == 0:
             return 0
         st = io.tolist()

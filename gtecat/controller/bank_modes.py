@@ -514,6 +514,7 @@ class Cluster:
         "pts",
         "rows",
         "rows_arr",
+        "slot_of",
         "snaps",
         "stepped",
         "systems",
@@ -533,6 +534,8 @@ class Cluster:
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
         self.rows_arr = np.array(self.rows, np.intp)
+        #: a cluster of one coordinate system (``alone``): each row's slot in it
+        self.slot_of: np.ndarray | None = None
         #: id(Trap master) -> its pieces as the compiled fill reads them (_trap_samples)
         self.trap_pieces: dict[int, tuple] = {}
         #: the objects a fill keeps for the rewind; the planners it steps in Python (the
@@ -679,10 +682,23 @@ class Cluster:
                 m = end + 1 if end >= 0 else SAMPLED_TABLE
                 trace.cols = out[0]
                 c.trace = trace
-                at = {id(slot): k for k, slot in enumerate(c.slots)}
+                slot_of = self.slot_of
+                if slot_of is None:  # each row's slot (its coordinate) in the system
+                    at = {id(slot): k for k, slot in enumerate(c.slots)}
+                    slot_of = self.slot_of = np.array([at[id(pl)] for pl in self.planners])
+                ra = self.rows_arr
+                if moving[ra].all():  # the rows' new tables in one assignment per table
+                    bank.sampled_samples += m * len(ra)
+                    bank.keep_last_sample(ra)
+                    for t, q in zip((bank.t_p, bank.t_v, bank.t_a), out, strict=True):
+                        t[ra, :m] = q[slot_of, :m]
+                    bank.t_len[ra] = m
+                    bank.t_cur[ra] = 0
+                    bank.t_end[ra] = end
+                    return
                 for i, r in enumerate(rows):
                     if moving[r]:
-                        k = at[id(self.planners[i])]
+                        k = slot_of[i]
                         self._put(bank, r, out[0, k, :m], out[1, k, :m], out[2, k, :m], end)
                 return
         pls = self.planners
