@@ -514,6 +514,7 @@ class Cluster:
         "pts",
         "rows",
         "rows_arr",
+        "rows_sel",
         "slot_of",
         "snaps",
         "stepped",
@@ -534,8 +535,12 @@ class Cluster:
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
         self.rows_arr = np.array(self.rows, np.intp)
+        #: the rows as a slice where they follow each other (basic indexing, cheaper)
+        r0 = self.rows[0]
+        consecutive = self.rows == list(range(r0, r0 + len(self.rows)))
+        self.rows_sel: Any = slice(r0, r0 + len(self.rows)) if consecutive else self.rows_arr
         #: a cluster of one coordinate system (``alone``): each row's slot in it
-        self.slot_of: np.ndarray | None = None
+        self.slot_of: Any = None
         #: id(Trap master) -> its pieces as the compiled fill reads them (_trap_samples)
         self.trap_pieces: dict[int, tuple] = {}
         #: the objects a fill keeps for the rewind; the planners it steps in Python (the
@@ -665,7 +670,7 @@ class Cluster:
         self.snaps = [(o, keep(o)) for o in self.kept]
         rows = self.rows
         moving = bank.moving
-        ra = self.rows_arr
+        ra = self.rows_sel
         bank.fill_taken[ra] = bank.taken[ra]
         if self.topo is not None:
             self._fill_columns(bank)
@@ -685,10 +690,12 @@ class Cluster:
                 slot_of = self.slot_of
                 if slot_of is None:  # each row's slot (its coordinate) in the system
                     at = {id(slot): k for k, slot in enumerate(c.slots)}
-                    slot_of = self.slot_of = np.array([at[id(pl)] for pl in self.planners])
-                ra = self.rows_arr
+                    slot_of = [at[id(pl)] for pl in self.planners]
+                    # (a slice where they are in order: basic indexing, cheaper)
+                    in_order = slot_of == list(range(len(slot_of)))
+                    self.slot_of = slot_of = slice(None) if in_order else np.array(slot_of)
                 if moving[ra].all():  # the rows' new tables in one assignment per table
-                    bank.sampled_samples += m * len(ra)
+                    bank.sampled_samples += m * len(rows)
                     bank.keep_last_sample(ra)
                     for t, q in zip((bank.t_p, bank.t_v, bank.t_a), out, strict=True):
                         t[ra, :m] = q[slot_of, :m]
@@ -698,7 +705,7 @@ class Cluster:
                     return
                 for i, r in enumerate(rows):
                     if moving[r]:
-                        k = slot_of[i]
+                        k = i if type(slot_of) is slice else slot_of[i]
                         self._put(bank, r, out[0, k, :m], out[1, k, :m], out[2, k, :m], end)
                 return
         pls = self.planners

@@ -224,6 +224,7 @@ class CoordSystem:
         #: while not None, every entry taken off a FIFO is appended to it (the axis bank's
         #: record for putting the FIFO back as it was: bank_modes.keep)
         self.popped: list[Entry] | None = None
+        self._out: np.ndarray | None = None  # run's samples
         self.reset()
 
     def reset(self) -> None:
@@ -460,8 +461,9 @@ class CoordSystem:
     ) -> tuple[np.ndarray, int]:
         """``n`` cycles of :meth:`step`, each followed by every axis taking its slot's sample
         (``AxisSlot.step``), for the axis bank's tables: the samples (``out[0|1|2, k, j]``:
-        position, speed, acceleration of slot ``k`` in cycle ``j``) and the index of the cycle
-        the path ended in (-1: it goes on; the cycles after it are not filled).  The cycles
+        position, speed, acceleration of slot ``k`` in cycle ``j``; the system's own array,
+        which its next run overwrites) and the index of the cycle the path ended in (-1: it
+        goes on; the cycles after it are not filled).  The cycles
         inside a motion segment are step's own common case, for a trapezoid along a line or
         an arc all of them at once (:meth:`_run_segment`, the same operations in the same
         order); any other is :meth:`step`.  ``speeds``/``marks``: the path speed after each
@@ -471,7 +473,11 @@ class CoordSystem:
         slots = self.slots
         rec = speeds is not None and marks is not None
         origin = self.origin
-        out = np.empty((3, len(slots), n))
+        # the system's own array, used again by its next run (the axis bank copies the
+        # samples into its tables; its record of this run is replaced at the next)
+        out = self._out
+        if out is None or out.shape != (3, len(slots), n):
+            out = self._out = np.empty((3, len(slots), n))
         j = 0
         while j < n:
             e = self.entry
