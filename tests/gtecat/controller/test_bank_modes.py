@@ -366,7 +366,7 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
         assert COMPILED_CRD[0] >= 300, "the compiled segments hardly ran"
 
 
-@pytest.mark.parametrize("script", [PT, GEAR], ids=["pt", "gear-follow"])
+@pytest.mark.parametrize("script", [PT, GEAR, CRD], ids=["pt", "gear-follow", "crd"])
 @pytest.mark.sample(1)
 def test_modes_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
     """The same without the compiled cycle (no C compiler): numpy runs the bank's cycle and
