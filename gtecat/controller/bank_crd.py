@@ -19,7 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from .bank_kernel import CFLAGS, build
+from ..cbuild import Background
+from .bank_kernel import CFLAGS, PLAIN_CFLAGS, _source, build
 from .crd.path import Arc, Line
 from .crd.velocity import Trapezoid
 
@@ -45,13 +46,32 @@ _LIB: Any = None
 _LIB_REASON = ""
 
 
-def library() -> tuple[Any, str]:
-    """(the loaded library or None, why not); built and loaded once per process."""
+#: the build started in a process of its own (:func:`library` with ``wait`` False)
+_AHEAD: list[Background] = []
+
+
+def library(wait: bool = True) -> tuple[Any, str]:
+    """(the loaded library or None, why not); built and loaded once per process.  ``wait``
+    False: (None, "") while its build, started in a process of its own the first time (a
+    compiler's second on a machine's first run), goes on; the cycles meanwhile fill the tables
+    with numpy (the same samples)."""
     global _LIB, _LIB_REASON
     if _LIB is not None or _LIB_REASON:
         return _LIB, _LIB_REASON
+    if not wait:
+        if not _AHEAD:
+            try:
+                src = _source("bank_crd")
+                builds = [("bank_crd", src, f, ("-lm",)) for f in (CFLAGS, PLAIN_CFLAGS)]
+                _AHEAD.append(Background(builds))
+            except Exception as e:  # no compiler, no cache folder, no builder process
+                _LIB_REASON = f"{type(e).__name__}: {e}"
+                return None, _LIB_REASON
+        if not _AHEAD[0].done():
+            return None, ""
     try:
-        lib = ctypes.CDLL(str(build(CFLAGS, "bank_crd")))
+        path = _AHEAD[0].wait() if _AHEAD else build(CFLAGS, "bank_crd")
+        lib = ctypes.CDLL(str(path))
         lib.bank_crd_sizes.restype = ctypes.c_int
         fn = lib.bank_crd_segment
         fn.restype = ctypes.c_int64
@@ -160,15 +180,16 @@ class CrdFill:
 
 def crd_fill(bank: Any) -> CrdFill | None:
     """The bank's :class:`CrdFill` (made on first use), or None where the bank's cycle is not
-    compiled or this library does not build."""
+    compiled, this library does not build, or its build has not ended yet."""
     if bank._kernel_lib is None:
         return None
     cf = bank.__dict__.get("_crd_fill")
     if cf is None:
-        lib, reason = library()
+        lib, reason = library(wait=False)
         if lib is None:
-            log.info("bank crd: numpy fills the coordinate systems' tables (%s)", reason)
-            bank._crd_fill = False
+            if reason:  # (else: the build goes on; numpy until it is there)
+                log.info("bank crd: numpy fills the coordinate systems' tables (%s)", reason)
+                bank._crd_fill = False
             return None
         cf = bank._crd_fill = CrdFill(lib)
     return cf or None
