@@ -27,6 +27,12 @@ enum {
 
 int bank_crd_sizes(void) { return CR_N * 100 + IO_N; }
 
+/* cos and sin called as Python's math module calls them: through pointers the compiler cannot
+ * see through, so it does not merge the two into one sincos call (whose last bit the C
+ * library does not promise to be theirs) */
+static double (*volatile crd_cos)(double) = cos;
+static double (*volatile crd_sin)(double) = sin;
+
 /* Trapezoid.s and Trapezoid.v at t < duration */
 static void trapezoid(const double *g, double t, double *s, double *v)
 {
@@ -78,8 +84,8 @@ static void point(const double *g, int dims, double s, double *x)
     const double th = g[CR_TH0] + g[CR_SWEEP] * u;
     for (k = 0; k < dims; k++)
         x[k] = g[CR_START + k];
-    x[i] = g[CR_CX] + r * cos(th);
-    x[j] = g[CR_CY] + r * sin(th);
+    x[i] = g[CR_CX] + r * crd_cos(th);
+    x[j] = g[CR_CY] + r * crd_sin(th);
     if (k3 >= 0)
         x[k3] = g[CR_START + k3] + g[CR_RISE] * u;
 }
