@@ -61,6 +61,7 @@ from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
 from .bank_kernel import prebuild as prebuild_kernel
+from .input_sense import changed as sense_changed
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -185,6 +186,9 @@ class Controller:
         self.resources: dict = {}
         self.on_bus_up: list[Callable[[Controller], None]] = []
         self.on_reset: list[Callable[[Controller], None]] = []
+        #: GT_GetDi's combination of each input type's bits and sense, by type (+16: raw): kept
+        #: by the GT fast path while gtecat.controller.input_sense.EPOCH stays
+        self.input_plans: dict[int, Any] = {}
         #: the pulse card this controller is (None: an EtherCAT master)
         self.card: Card | None = None
         if self.options.card:
@@ -270,6 +274,7 @@ class Controller:
         }
         self._axis_list = list(self.axes.values())
         self._run_axes = self._axis_list
+        sense_changed()  # (other axes: their inputs' sense is looked up again)
         self.bank = None
         self._links_down = False
         install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)

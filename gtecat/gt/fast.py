@@ -1181,6 +1181,7 @@ def fast_functions() -> frozenset[str]:
         frozenset(READERS)
         | RAW
         | {CLOCK, CORE, HOMING}
+        | DI
         | frozenset(ECAT_READERS)
         | frozenset(STRUCT_READERS)
     )
@@ -1639,9 +1640,126 @@ def fast_core(
     return gt
 
 
+#: the card's input readers on the fast path (a type of input of every axis, or the GPI)
+DI = frozenset({"GT_GetDi", "GT_GetDiRaw"})
+
+
+def _int_bounds(types: Any) -> dict[type, tuple[int, int]]:
+    """The range of values each ctypes integer type of ``types`` holds."""
+    out = {}
+    for t in types:
+        bits = 8 * ctypes.sizeof(t)
+        out[t] = (
+            (0, (1 << bits) - 1)
+            if t._type_.isupper()
+            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        )
+    return out
+
+
+def fast_di(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetDi(diType, p)`` / ``GT_GetDiRaw`` with the fast path in front of the table:
+    ``diType`` one of the types they read, ``p`` a ``byref`` (no offset) or the object itself
+    of an integer type the pointer takes, or a ctypes or numpy array of one (its first
+    element), on the in-process controller (core 1).  The value is :func:`io_calls.read_di`'s:
+    each axis's bit read live from the process image, its sense from
+    :func:`io_calls.di_reader`'s combination, kept per controller and type until
+    :data:`gtecat.controller.input_sense.EPOCH` moves (every change of a configuration's
+    ``reverse``, of the bus's axes) or the controller has other axes.  The axis bank gives its
+    axes back first, as it does before the table path.  Any other shape, a value the type
+    cannot hold, another type: the table path, with its code and reason."""
+    from ..controller.input_sense import EPOCH
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    proto = FUNCTIONS[name]
+    ok = _scalar_types(proto.params[1])
+    bounds = _int_bounds(ok)
+    #: the types that hold every value (a signed 32-bit word): no range check
+    wide = frozenset(
+        t for t, (lo, hi) in bounds.items() if lo <= -(1 << 31) and (1 << 31) <= hi + 1
+    )
+    target = _target(ok)
+    raw = name == "GT_GetDiRaw"
+    kind = 16 if raw else 0  # (GT_GetDi and GT_GetDiRaw keep their combinations apart)
+    made: list[Any] = []  # io_calls.di_reader (io_calls imports the GT layer: at first use)
+    arrays: dict[type, bool] = {}
+
+    def first(p: Any, tp: type) -> bool:
+        """Whether ``p`` is an array whose first element the value goes into."""
+        if tp is _NDARRAY:
+            return p.dtype in _NP_INTS and p.ndim == 1 and bool(p.size) and p.flags.writeable
+        a = arrays.get(tp)
+        if a is None:
+            a = arrays[tp] = issubclass(tp, ctypes.Array) and tp._type_ in ok and tp._length_ >= 1
+        return a
+
+    def plan(ctl: Any, t: int) -> Any:
+        """The combination of type ``t`` on ``ctl`` (made again: the sense or the axes moved)."""
+        if not made:
+            from .io_calls import di_reader
+
+            made.append(di_reader)
+        kept = ctl.input_plans[t + kind] = (EPOCH[0], ctl.axes, made[0](ctl, t, raw))
+        return kept
+
+    def gt(t: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        # (0..6: io_calls._DI_TYPES, MC_LIMIT_POSITIVE 0 .. MC_MPG 6)
+        if type(t) is int and 0 <= t <= 6 and session.plain and not extra and not kw:
+            try:
+                ctl = session.controllers[1]
+            except KeyError:  # no controller: the table path says why
+                return slow(*(a for a in (t, p) if a is not _NO))
+            clock = ctl.clock
+            if clock._thread is None and session.note is None:
+                tp = type(p)
+                if tp is _CArg:
+                    obj = target(p)
+                    if obj is p:  # (byref(x, offset), another type: the table path)
+                        obj = _NO
+                elif tp in ok:
+                    obj = p
+                else:
+                    obj = None if first(p, tp) else _NO
+                if obj is not _NO:
+                    bank = ctl.bank
+                    if bank is not None:  # (what the table path does first)
+                        if bank.n_alive:
+                            bank.before_call(ctl, proto, (t, p))  # (its axes go back)
+                        else:  # (before_call without an axis in the bank: one flag)
+                            bank.dirty = True
+                    kept = ctl.input_plans.get(t + kind)
+                    if kept is None or kept[0] != EPOCH[0] or kept[1] is not ctl.axes:
+                        kept = plan(ctl, t)
+                    v = kept[2]()
+                    if obj is not None:
+                        k = type(obj)
+                        if not (k in wide or bounds[k][0] <= v <= bounds[k][1]):
+                            return slow(t, p)  # (the value refused: the table's code)
+                        obj.value = v
+                    elif tp is _NDARRAY or bounds[tp._type_][0] <= v <= bounds[tp._type_][1]:
+                        p[0] = v  # (an array's first element; numpy int32/int64 hold any)
+                    else:
+                        return slow(t, p)
+                    session.last = None
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+        return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
         CLOCK: fast_clock,
+        **dict.fromkeys(DI, fast_di),
         CORE: fast_core,
         HOMING: fast_homing_status,
     }

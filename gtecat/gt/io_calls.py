@@ -104,6 +104,62 @@ def read_di(ctl: Controller, di_type: int, raw: bool) -> int:
     return value
 
 
+def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
+    """The value GT_GetDi (``raw``: GT_GetDiRaw) stores for ``di_type`` (one of its types)
+    on ``ctl`` - ``_signed32(read_di(...))`` - as one call without the look-ups: each
+    axis's input bit read where it lies in the process image, their sense (configuration,
+    wiring) folded into one constant.  Valid while ``ctl.axes`` is the same dictionary and
+    :data:`gtecat.controller.input_sense.EPOCH` has not moved (the GT fast path keeps it
+    that long)."""
+    if di_type == MC_MPG:
+        return lambda: 0
+    if di_type == MC_GPI:
+        io = digital_io(ctl)
+        flip = 0
+        if not raw:
+            rev = _reversed(ctl, "gpi")
+            flip = sum(1 << (k - 1) for k in range(1, GPIO_COUNT + 1) if rev(k))
+        return lambda: io.gpi ^ flip
+    index, mask, kind = _AXIS_INPUTS[di_type]
+    settings = vendor_settings(ctl)
+    b = mask.bit_length() - 1
+    env: dict[str, Any] = {}
+    buffers: dict[int, str] = {}
+    terms: list[str] = []
+    flip = 0  # the axes read inverted (an axis that maps no object reads its sense alone)
+    for n, ax in ctl.axes.items():
+        if not 1 <= n <= 32:
+            continue
+        reverse = bool(settings.get((kind, n), {}).get("reverse", False))
+        if switch_sense(ctl, kind, n, reverse)[0 if raw else 1]:
+            flip |= 1 << (n - 1)
+        acc = ax.io.get(index)
+        if acc is None:
+            continue
+        at = acc.bit_at(b)
+        if at is None:  # (a bit past the entry's width: its get(), as read_di reads it)
+            env[f"A{n}"] = acc
+            terms.append(f"((A{n}.get() & {mask}) != 0) << {n - 1}")
+            continue
+        buf, byte, shift = at
+        name = buffers.get(id(buf))
+        if name is None:
+            name = buffers[id(buf)] = f"B{len(buffers)}"
+            env[name] = buf
+        move = n - 1 - shift
+        term = f"({name}[{byte}] & {1 << shift})"
+        terms.append(
+            term if not move else f"{term} << {move}" if move > 0 else f"{term} >> {-move}"
+        )
+    value = f"({' | '.join(terms)}) ^ {flip}" if terms else str(_signed32(flip))
+    if terms and 32 in ctl.axes:  # (axis 32's bit: the sign of GT_GetDi's long)
+        body = f"v = {value}\n    return v - {1 << 32} if v >> 31 else v"
+    else:
+        body = f"return {value}"
+    exec(compile(f"def read():\n    {body}\n", f"<GT_GetDi {kind}>", "exec"), env)
+    return env["read"]
+
+
 @gt_function
 def GT_GetDi(ctl: Controller, diType: int, pValue: Any) -> int:
     """The inputs of type ``diType``, 1 = active (the module docstring)."""
