@@ -282,16 +282,26 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
                 lambda: gt.GT_GetEcatHomingStatus(1, byref(c_short())),
                 lambda: byref(c_short()),
             ),
+            "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": (
+                lambda: gt.GT_GetDi(0, p),
+                lambda: byref(c_long()),
+            ),
+            "GT_GetDi(MC_HOME, byref(c_long()))": (
+                lambda: gt.GT_GetDi(3, byref(c_long())),
+                lambda: byref(c_long()),
+            ),
+            "GT_GetDi(MC_GPI, s)": (lambda: gt.GT_GetDi(4, held), lambda: c_long()),
+            "GT_GetDiRaw(MC_LIMIT_NEGATIVE, byref(s))": (
+                lambda: gt.GT_GetDiRaw(1, p),
+                lambda: byref(c_long()),
+            ),
         }
     )
     # the table path (every other function: its checks compiled, then the emulated function's
     # own work, which these figures include): reported beside the fast path's, not in `worst`
     table = {
         "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
-        "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": (
-            lambda: gt.GT_GetDi(0, p),
-            lambda: byref(c_long()),
-        ),
+        "GT_GetDo(MC_GPO, byref(s))": (lambda: gt.GT_GetDo(12, p), lambda: byref(c_long())),
     }
     clock, rng = time.perf_counter, range(block)
     out: dict[str, object] = {}

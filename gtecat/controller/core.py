@@ -186,8 +186,8 @@ class Controller:
         self.resources: dict = {}
         self.on_bus_up: list[Callable[[Controller], None]] = []
         self.on_reset: list[Callable[[Controller], None]] = []
-        #: GT_GetDi's combination of each input type's bits and sense, by type (+16: raw): kept
-        #: by the GT fast path while gtecat.controller.input_sense.EPOCH stays
+        #: the GT fast path's readers of GT_GetDi, GT_GetDiRaw and GT_GetDo, by type (+16, +32),
+        #: as (input_sense.EPOCH when it was made, the reader): kept while it holds
         self.input_plans: dict[int, Any] = {}
         #: the pulse card this controller is (None: an EtherCAT master)
         self.card: Card | None = None

@@ -1181,7 +1181,7 @@ def fast_functions() -> frozenset[str]:
         frozenset(READERS)
         | RAW
         | {CLOCK, CORE, HOMING}
-        | DI
+        | frozenset(IO_READERS)
         | frozenset(ECAT_READERS)
         | frozenset(STRUCT_READERS)
     )
@@ -1640,8 +1640,9 @@ def fast_core(
     return gt
 
 
-#: the card's input readers on the fast path (a type of input of every axis, or the GPI)
-DI = frozenset({"GT_GetDi", "GT_GetDiRaw"})
+#: the card's IO readers on the fast path: function -> (the types it reads, first and last,
+#: and where its readers are kept among a controller's ``input_plans``: type + this)
+IO_READERS = {"GT_GetDi": (0, 6, 0), "GT_GetDiRaw": (0, 6, 16), "GT_GetDo": (10, 12, 32)}
 
 
 def _int_bounds(types: Any) -> dict[type, tuple[int, int]]:
@@ -1657,22 +1658,23 @@ def _int_bounds(types: Any) -> dict[type, tuple[int, int]]:
     return out
 
 
-def fast_di(
+def fast_io_reader(
     name: str,
     slow: Callable[..., int],
     session: Any,
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
-    """``GT_GetDi(diType, p)`` / ``GT_GetDiRaw`` with the fast path in front of the table:
-    ``diType`` one of the types they read, ``p`` a ``byref`` (no offset) or the object itself
-    of an integer type the pointer takes, or a ctypes or numpy array of one (its first
-    element), on the in-process controller (core 1).  The value is :func:`io_calls.read_di`'s:
-    each axis's bit read live from the process image, its sense from
-    :func:`io_calls.di_reader`'s combination, kept per controller and type until
+    """``GT_GetDi(diType, p)``, ``GT_GetDiRaw`` and ``GT_GetDo(doType, p)`` with the fast
+    path in front of the table: the type one of those the function reads, ``p`` a ``byref``
+    (no offset) or the object itself of an integer type the pointer takes, or a ctypes or
+    numpy array of one (its first element), on the in-process controller (core 1).  The
+    value is the table path's (:func:`io_calls.read_di`, :func:`io_calls.read_do`) through a
+    reader of :func:`io_calls.io_reader` (for the inputs: each axis's bit read live from the
+    process image, its sense folded in), kept per controller and type until
     :data:`gtecat.controller.input_sense.EPOCH` moves (every change of a configuration's
-    ``reverse``, of the bus's axes) or the controller has other axes.  The axis bank gives its
-    axes back first, as it does before the table path.  Any other shape, a value the type
-    cannot hold, another type: the table path, with its code and reason."""
+    ``reverse``, a bus brought up with other axes).  The axis bank gives its axes back
+    first, as it does before the table path.  Any other shape, a value the type cannot
+    hold, another type: the table path, with its code and reason."""
     from ..controller.input_sense import EPOCH
     from .args import _scalar_types
     from .table import FUNCTIONS
@@ -1681,13 +1683,13 @@ def fast_di(
     ok = _scalar_types(proto.params[1])
     bounds = _int_bounds(ok)
     #: the types that hold every value (a signed 32-bit word): no range check
+    T0 = ctypes.c_long  # (the usual one)
     wide = frozenset(
         t for t, (lo, hi) in bounds.items() if lo <= -(1 << 31) and (1 << 31) <= hi + 1
     )
     target = _target(ok)
-    raw = name == "GT_GetDiRaw"
-    kind = 16 if raw else 0  # (GT_GetDi and GT_GetDiRaw keep their combinations apart)
-    made: list[Any] = []  # io_calls.di_reader (io_calls imports the GT layer: at first use)
+    lo_t, hi_t, kind = IO_READERS[name]
+    made: list[Any] = []  # io_calls.io_reader (io_calls imports the GT layer: at first use)
     arrays: dict[type, bool] = {}
 
     def first(p: Any, tp: type) -> bool:
@@ -1700,56 +1702,59 @@ def fast_di(
         return a
 
     def plan(ctl: Any, t: int) -> Any:
-        """The combination of type ``t`` on ``ctl`` (made again: the sense or the axes moved)."""
+        """The reader of type ``t`` on ``ctl`` (made again: the sense or the axes moved)."""
         if not made:
-            from .io_calls import di_reader
+            from .io_calls import io_reader
 
-            made.append(di_reader)
-        kept = ctl.input_plans[t + kind] = (EPOCH[0], ctl.axes, made[0](ctl, t, raw))
+            made.append(io_reader)
+        kept = ctl.input_plans[t + kind] = (EPOCH[0], made[0](ctl, name, t))
         return kept
 
     def gt(t: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        # (0..6: io_calls._DI_TYPES, MC_LIMIT_POSITIVE 0 .. MC_MPG 6)
-        if type(t) is int and 0 <= t <= 6 and session.plain and not extra and not kw:
+        if type(t) is int and lo_t <= t <= hi_t and session.plain and not extra and not kw:
             try:
                 ctl = session.controllers[1]
-            except KeyError:  # no controller: the table path says why
-                return slow(*(a for a in (t, p) if a is not _NO))
-            clock = ctl.clock
-            if clock._thread is None and session.note is None:
-                tp = type(p)
-                if tp is _CArg:
-                    obj = target(p)
-                    if obj is p:  # (byref(x, offset), another type: the table path)
-                        obj = _NO
-                elif tp in ok:
-                    obj = p
-                else:
-                    obj = None if first(p, tp) else _NO
-                if obj is not _NO:
-                    bank = ctl.bank
-                    if bank is not None:  # (what the table path does first)
-                        if bank.n_alive:
-                            bank.before_call(ctl, proto, (t, p))  # (its axes go back)
-                        else:  # (before_call without an axis in the bank: one flag)
-                            bank.dirty = True
-                    kept = ctl.input_plans.get(t + kind)
-                    if kept is None or kept[0] != EPOCH[0] or kept[1] is not ctl.axes:
-                        kept = plan(ctl, t)
-                    v = kept[2]()
-                    if obj is not None:
-                        k = type(obj)
-                        if not (k in wide or bounds[k][0] <= v <= bounds[k][1]):
-                            return slow(t, p)  # (the value refused: the table's code)
-                        obj.value = v
-                    elif tp is _NDARRAY or bounds[tp._type_][0] <= v <= bounds[tp._type_][1]:
-                        p[0] = v  # (an array's first element; numpy int32/int64 hold any)
+                kept = ctl.input_plans[t + kind]
+            except KeyError:  # none kept yet, or no controller (the table path says why)
+                ctl = session.controllers.get(1)
+                kept = None
+            if ctl is not None:
+                clock = ctl.clock
+                if clock._thread is None and session.note is None:
+                    tp = type(p)
+                    if tp is _CArg:
+                        obj = target(p)
+                        if obj is p:  # (byref(x, offset), another type: the table path)
+                            obj = _NO
+                    elif tp is T0 or tp in ok:
+                        obj = p
                     else:
-                        return slow(t, p)
-                    session.last = None
-                    if clock.mode is _LOCKSTEP:
-                        return 0
-                    return advance(ctl, name, 0)
+                        obj = None if first(p, tp) else _NO
+                    if obj is not _NO:
+                        bank = ctl.bank
+                        if bank is not None:  # (what the table path does first)
+                            if bank.n_alive:
+                                bank.before_call(ctl, proto, (t, p))  # (its axes go back)
+                            else:  # (before_call without an axis in the bank: one flag)
+                                bank.dirty = True
+                        if kept is None or kept[0] != EPOCH[0]:
+                            kept = plan(ctl, t)
+                        v = kept[1]()
+                        if obj is not None:
+                            k = type(obj)
+                            done = k is T0 or k in wide or bounds[k][0] <= v <= bounds[k][1]
+                            if done:
+                                obj.value = v
+                        else:  # an array's first element (numpy int32 and int64 hold any)
+                            e = tp._type_ if tp is not _NDARRAY else None
+                            done = e is None or bounds[e][0] <= v <= bounds[e][1]
+                            if done:
+                                p[0] = v
+                        if done:  # (else a value the type cannot hold: the table's code)
+                            session.last = None
+                            if clock.mode is _LOCKSTEP:
+                                return 0
+                            return advance(ctl, name, 0)
         return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
@@ -1759,7 +1764,7 @@ def fast_di(
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
         CLOCK: fast_clock,
-        **dict.fromkeys(DI, fast_di),
+        **dict.fromkeys(IO_READERS, fast_io_reader),
         CORE: fast_core,
         HOMING: fast_homing_status,
     }

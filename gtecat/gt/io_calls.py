@@ -108,9 +108,9 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
     """The value GT_GetDi (``raw``: GT_GetDiRaw) stores for ``di_type`` (one of its types)
     on ``ctl`` - ``_signed32(read_di(...))`` - as one call without the look-ups: each
     axis's input bit read where it lies in the process image, their sense (configuration,
-    wiring) folded into one constant.  Valid while ``ctl.axes`` is the same dictionary and
+    wiring) folded into one constant.  Valid while
     :data:`gtecat.controller.input_sense.EPOCH` has not moved (the GT fast path keeps it
-    that long)."""
+    that long; a bus brought up with other axes moves it too)."""
     if di_type == MC_MPG:
         return lambda: 0
     if di_type == MC_GPI:
@@ -158,6 +158,30 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
         body = f"return {value}"
     exec(compile(f"def read():\n    {body}\n", f"<GT_GetDi {kind}>", "exec"), env)
     return env["read"]
+
+
+def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
+    """The value GT_GetDo stores for ``do_type`` (one of its types) on ``ctl`` as one call;
+    valid while :data:`gtecat.controller.input_sense.EPOCH` has not moved (the axes of
+    ``MC_ENABLE``: a bus brought up again moves it)."""
+    io = digital_io(ctl)
+    if do_type == MC_GPO:
+        return lambda: io.gpo
+    if do_type == MC_CLEAR:
+        return lambda: io.clear
+    axes = [(1 << (n - 1), ax) for n, ax in ctl.axes.items() if 1 <= n <= 32]
+
+    def enabled() -> int:
+        return _signed32(sum(bit for bit, ax in axes if ax.servo_on))
+
+    return enabled
+
+
+def io_reader(ctl: Controller, name: str, t: int) -> Callable[[], int]:
+    """GT function ``name``'s reader of type ``t`` (:func:`di_reader`, :func:`do_reader`)."""
+    if name == "GT_GetDo":
+        return do_reader(ctl, t)
+    return di_reader(ctl, t, raw=name == "GT_GetDiRaw")
 
 
 @gt_function

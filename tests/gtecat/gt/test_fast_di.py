@@ -1,4 +1,4 @@
-"""GT_GetDi / GT_GetDiRaw on the fast path answer as their table path in every state.
+"""GT_GetDi / GT_GetDiRaw / GT_GetDo on the fast path answer as their table path in every state.
 
 The fast path keeps each input type's combination of axis bits and sense until the one counter
 of the inputs' sense (:data:`gtecat.controller.input_sense.EPOCH`) moves.  Each test reads
@@ -6,9 +6,10 @@ every type through both paths first (so a combination is kept), then changes one
 makes the value - a configuration's ``reverse`` (a vendor file, ``GT_SetSense``,
 ``GT_LmtSns``, ``GT_Reset``, gtecat's earlier format), the machine's switch wiring, the bus
 brought up again, a switch moved onto, stuck or chattering, a drive in fault, a GPI, an
-axis arrived, the axis bank holding the axes - and compares again: code, value and reason
-for every type and every shape a client passes.  A writer that forgot the counter would
-leave the fast path answering from a stale combination, which the last test shows.
+axis arrived, the axis bank holding the axes, the outputs GT_GetDo reads - and compares
+again: code, value and reason for every type and every shape a client passes.  A writer
+that forgot the counter would leave the fast path answering from a stale combination,
+which the last test shows.
 """
 
 from __future__ import annotations
@@ -48,7 +49,8 @@ SHAPES = {
 }
 #: the shapes the fast path answers without the table
 FAST_SHAPES = ("byref", "same byref", "object", "int32", "array", "numpy int32")
-TYPES = range(-1, 8)  # every input type, and the neighbours it refuses
+#: every type each function reads, and the neighbours it refuses
+TYPES = {"GT_GetDi": range(-1, 8), "GT_GetDiRaw": range(-1, 8), "GT_GetDo": range(9, 14)}
 
 
 def _made(shape: str) -> tuple:
@@ -74,9 +76,9 @@ def compare(when: str, *, shapes=tuple(SHAPES), profile: bool = False) -> list[s
     """Every type through the fast path and the table path: the differences (and, with
     ``profile``, a fast shape that reached the table)."""
     bad = []
-    for name in ("GT_GetDi", "GT_GetDiRaw"):
+    for name, types in TYPES.items():
         fn = getattr(gt, name)
-        for t in TYPES:
+        for t in types:
             for shape in shapes:
                 got = []
                 for call in (fn, fn.slow):
@@ -88,7 +90,7 @@ def compare(when: str, *, shapes=tuple(SHAPES), profile: bool = False) -> list[s
                     if pr is not None:
                         pr.disable()
                     got.append((rc, _written(o), gt.GTE_GetLastError() if rc else ""))
-                    if pr is not None and 0 <= t <= 6 and shape in FAST_SHAPES and rc == 0:
+                    if pr is not None and t in types[1:-1] and shape in FAST_SHAPES and rc == 0:
                         if _table_calls(pr):
                             bad.append(f"{when}: {name}({t}) {shape} took the table path")
                 if got[0] != got[1]:
@@ -97,10 +99,10 @@ def compare(when: str, *, shapes=tuple(SHAPES), profile: bool = False) -> list[s
 
 
 def _levels() -> dict[str, int]:
-    """GT_GetDi's value of each type (the table path), for the tests' own checks."""
+    """Each function's value of each type (the table path), for the tests' own checks."""
     out = {}
-    for name in ("GT_GetDi", "GT_GetDiRaw"):
-        for t in range(7):
+    for name, types in TYPES.items():
+        for t in types[1:-1]:
             v = ctypes.c_long()
             assert getattr(gt, name).slow(t, byref(v)) == 0
             out[f"{name}({t})"] = v.value
@@ -147,7 +149,9 @@ def test_every_type_and_shape_answers_as_the_table_in_every_state(tmp_path: Path
 
     steps: list[tuple[str, int]] = []
     epoch = input_sense.EPOCH[0]
-    cfg = "[limitPositive1]\nreverse=1\n[home2]\nreverse=1\n[alarm1]\nreverse=1\n[gpi3]\nreverse=1\n"
+    cfg = (
+        "[limitPositive1]\nreverse=1\n[home2]\nreverse=1\n[alarm1]\nreverse=1\n[gpi3]\nreverse=1\n"
+    )
     assert gt.GT_LoadConfig(_cfg(tmp_path, cfg)) == 0, gt.GTE_GetLastError()
     assert input_sense.EPOCH[0] != epoch, "a vendor file's reverse moves the counter"
     step("a vendor file")
@@ -159,6 +163,11 @@ def test_every_type_and_shape_answers_as_the_table_in_every_state(tmp_path: Path
     step("GT_LmtSns")
     assert gt.GTE_SetGpi(3, 1) == 0 and gt.GTE_SetGpi(5, 1) == 0
     step("a GPI")
+    assert gt.GT_SetDo(gt.MC_GPO, 0x8421) == 0 and gt.GT_SetDoBit(gt.MC_GPO, 16, 1) == 0
+    step("the outputs")
+    assert gt.GT_AxisOn(1) == 0 and gt.GT_SetDo(gt.MC_CLEAR, 0b10) == 0
+    gt.GTE_Wait(5)
+    step("an axis enabled, an alarm-clear output")
     _move(2, 3_000)  # onto axis 2's positive limit
     gt.GTE_Wait(200)
     step("a limit switch reached", shapes=tuple(SHAPES))
