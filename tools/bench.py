@@ -39,7 +39,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_double, c_long, c_short, c_ubyte
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong
 from dataclasses import replace
 from pathlib import Path
 
@@ -295,14 +295,23 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
                 lambda: gt.GT_GetDiRaw(1, p),
                 lambda: byref(c_long()),
             ),
+            "GT_GetDo(MC_GPO, byref(s))": (lambda: gt.GT_GetDo(12, p), lambda: byref(c_long())),
+            "GT_GetDo(MC_ENABLE, byref(c_long()))": (
+                lambda: gt.GT_GetDo(10, byref(c_long())),
+                lambda: byref(c_long()),
+            ),
         }
     )
     # the table path (every other function: its checks compiled, then the emulated function's
     # own work, which these figures include): reported beside the fast path's, not in `worst`
     table = {
         "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
-        "GT_GetDo(MC_GPO, byref(s))": (lambda: gt.GT_GetDo(12, p), lambda: byref(c_long())),
+        "GT_GetDiReverseCount(MC_HOME, 1, c_ulong[2], 2)": (
+            lambda: gt.GT_GetDiReverseCount(3, 1, counts, 2),
+            lambda: (c_ulong * 2)(),
+        ),
     }
+    counts = (c_ulong * 2)()
     clock, rng = time.perf_counter, range(block)
     out: dict[str, object] = {}
     table_out: dict[str, object] = {}

@@ -35,6 +35,7 @@ from ..controller.axis import PdsState
 from ..controller.config_file import switch_sense, vendor_settings
 from ..controller.core import Controller
 from ..controller.digital_io import GPIO_COUNT, digital_io
+from ..controller.input_sense import EPOCH
 from ..controller.resources import _fault_reset
 from ..errors import ParameterError
 from ._core import check_range, gt_function, store
@@ -158,6 +159,21 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
         body = f"return {value}"
     exec(compile(f"def read():\n    {body}\n", f"<GT_GetDi {kind}>", "exec"), env)
     return env["read"]
+
+
+def di_value(ctl: Controller, di_type: int, raw: bool = False) -> int:
+    """:func:`read_di`'s value of an input type (checked before) through the reader the GT
+    fast path keeps for ``ctl`` (made here when none is kept or the counter moved): the
+    same value without the look-ups (an input watched every cycle).  A view of a core
+    beyond 32 axes keeps none: :func:`read_di` itself."""
+    plans = vars(ctl).get("input_plans")  # (a CoreView's attributes are its base's)
+    if plans is None:
+        return read_di(ctl, di_type, raw)
+    key = di_type + (16 if raw else 0)  # (the GT fast path's keys: gt.fast.IO_READERS)
+    kept = plans.get(key)
+    if kept is None or kept[0] != EPOCH[0]:
+        kept = plans[key] = (EPOCH[0], di_reader(ctl, di_type, raw))
+    return kept[1]() & 0xFFFFFFFF
 
 
 def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:

@@ -232,3 +232,31 @@ def test_a_missing_counter_bump_is_seen(monkeypatch) -> None:
     monkeypatch.setattr(config_file, "sense_changed", lambda *_: None)
     assert gt.GT_SetSense(gt.MC_LIMIT_NEGATIVE, 1, 1) == 0
     assert compare("silenced", shapes=("byref",)), "a stale combination went unseen"
+
+
+def test_level_changes_counted_every_cycle_leave_the_bank_its_axes() -> None:
+    """GT_GetDiReverseCount samples GT_GetDi's view every cycle through the kept reader: a
+    home switch crossed again and again counts the same with the axis bank as without it,
+    and the bank keeps the moving axis (no look at its objects every cycle)."""
+    counts = {}
+    for bank in ("on", "off"):
+        gt.GT_Close()
+        windows = tuple((k * 500, k * 500 + 150) for k in range(1, 40))
+        bring_up(
+            clock="lockstep",
+            bank=bank,
+            machine=MachineDescription({1: AxisMachine(home_switch=windows)}),
+        )
+        ctl = gt.GTE_Controller()
+        c = (ctypes.c_ulong * 2)()
+        assert gt.GT_GetDiReverseCount(gt.MC_HOME, 1, c, 2) == 0  # (watched from here)
+        _move(1, 15_000)
+        held = []
+        for _ in range(16):
+            gt.GTE_Wait(25)
+            held.append(ctl.bank.n_alive if ctl.bank is not None else None)
+        assert gt.GT_GetDiReverseCount(gt.MC_HOME, 1, c, 2) == 0
+        counts[bank] = list(c)
+        if bank == "on":
+            assert all(held[2:]), f"the bank gave the axes back: {held}"
+    assert counts["on"] == counts["off"] and counts["on"][0] >= 20, counts
