@@ -1732,11 +1732,8 @@ def fast_io_reader(
                         obj = None if first(p, tp) else _NO
                     if obj is not _NO:
                         bank = ctl.bank
-                        if bank is not None:  # (what the table path does first)
-                            if bank.n_alive:
-                                bank.before_call(ctl, proto, (t, p))  # (its axes go back)
-                            else:  # (before_call without an axis in the bank: one flag)
-                                bank.dirty = True
+                        if bank is not None and bank.n_alive:  # (what the table path does
+                            bank.before_call(ctl, proto, (t, p))  # first: its axes go back)
                         if kept is None or kept[0] != EPOCH[0]:
                             kept = plan(ctl, t)
                         v = kept[1]()

@@ -185,12 +185,15 @@ def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
         return lambda: io.gpo
     if do_type == MC_CLEAR:
         return lambda: io.clear
-    axes = [(1 << (n - 1), ax) for n, ax in ctl.axes.items() if 1 <= n <= 32]
-
-    def enabled() -> int:
-        return _signed32(sum(bit for bit, ax in axes if ax.servo_on))
-
-    return enabled
+    env: dict[str, Any] = {}
+    terms = []
+    for n, ax in ctl.axes.items():
+        if 1 <= n <= 32:
+            env[f"a{n}"] = ax
+            terms.append(f"({_signed32(1 << (n - 1))} if a{n}.servo_on else 0)")
+    body = " | ".join(terms) or "0"  # (axis 32's bit as the sign of GT_GetDo's long)
+    exec(compile(f"def enabled():\n    return {body}\n", "<GT_GetDo enable>", "exec"), env)
+    return env["enabled"]
 
 
 def io_reader(ctl: Controller, name: str, t: int) -> Callable[[], int]:
