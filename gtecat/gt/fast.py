@@ -1161,15 +1161,17 @@ SLOW_REASONS: dict[str, str] = {
     "emulator": "emulator helpers for tests, not called in control loops",
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
     "gantry": "a mode query: table path",
-    "gts_card": "the pulse-card (GTS) layer: table path (GT_GetDi and GT_GetDiRaw read every "
-    "axis's input and its configured sense per call: work that outweighs the arguments)",
+    "gts_card": "the pulse-card (GTS) set-up, capture and smart-homing calls: table path; the "
+    "polled IO readers (GT_GetDi, GT_GetDiRaw, GT_GetDo) are on the fast path",
     "motion": "profile set-up and parameter readers (called once per move); the position and "
     "speed readers that polling loops use, and GT_GetTrapPrm, are on the fast path",
     "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
     "programs": "motion programs, variables and MRAM: compile and download work outweighs "
     "the arguments",
     "pt_gear_follow": "PT/gear/follow queue and set-up readers: table path",
-    "servo_loop": "servo-loop parameters and analog values: table path",
+    "servo_loop": "servo-loop parameters, analog values and the inputs' change counters "
+    "(GT_GetDiReverseCount: a span of counters, read through the kept input readers): table "
+    "path",
     "status": "status set-up readers (soft limits, bands, stop decelerations) and the "
     "configuration file: GT_GetSts, the polled one, is on the fast path",
 }

@@ -76,7 +76,7 @@ from .constants import (
     MC_PROFILE,
     MC_STEP,
 )
-from .io_calls import di_value, read_di
+from .io_calls import _DI_TYPES, di_value, read_di
 from .status_calls import GT_LmtsOff, GT_LmtsOn
 
 # vendor GTN header constants used here
@@ -338,7 +338,8 @@ _EdgeCounter.bank_safe = True  # type: ignore[attr-defined]  # reads inputs only
 
 
 def _edges(ctl: Controller, di_type: int) -> _EdgeCounter:
-    read_di(ctl, di_type, raw=False)  # 7 for a type that is not an input type
+    if type(di_type) is not int or di_type not in _DI_TYPES:
+        read_di(ctl, di_type, raw=False)  # 7 for a type that is not an input type, and why
     for f in ctl.pre_cycle:
         if isinstance(f, _EdgeCounter):
             f.watch(int(di_type))
