@@ -187,7 +187,7 @@ class Controller:
         self.on_bus_up: list[Callable[[Controller], None]] = []
         self.on_reset: list[Callable[[Controller], None]] = []
         #: the GT fast path's readers of GT_GetDi, GT_GetDiRaw and GT_GetDo, by type (+16, +32),
-        #: as (input_sense.EPOCH when it was made, the reader): kept while it holds
+        #: kept until the next change of the inputs' sense (gtecat.controller.input_sense)
         self.input_plans: dict[int, Any] = {}
         #: the pulse card this controller is (None: an EtherCAT master)
         self.card: Card | None = None

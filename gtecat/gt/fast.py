@@ -1672,12 +1672,12 @@ def fast_io_reader(
     numpy array of one (its first element), on the in-process controller (core 1).  The
     value is the table path's (:func:`io_calls.read_di`, :func:`io_calls.read_do`) through a
     reader of :func:`io_calls.io_reader` (for the inputs: each axis's bit read live from the
-    process image, its sense folded in), kept per controller and type until
-    :data:`gtecat.controller.input_sense.EPOCH` moves (every change of a configuration's
+    process image, its sense folded in), kept per controller and type until the next
+    :func:`gtecat.controller.input_sense.changed` (every change of a configuration's
     ``reverse``, a bus brought up with other axes).  The axis bank gives its axes back
     first, as it does before the table path.  Any other shape, a value the type cannot
     hold, another type: the table path, with its code and reason."""
-    from ..controller.input_sense import EPOCH
+    from ..controller.input_sense import keep
     from .args import _scalar_types
     from .table import FUNCTIONS
 
@@ -1704,22 +1704,21 @@ def fast_io_reader(
         return a
 
     def plan(ctl: Any, t: int) -> Any:
-        """The reader of type ``t`` on ``ctl`` (made again: the sense or the axes moved)."""
+        """The reader of type ``t`` on ``ctl``, made and kept (until the next change)."""
         if not made:
             from .io_calls import io_reader
 
             made.append(io_reader)
-        kept = ctl.input_plans[t + kind] = (EPOCH[0], made[0](ctl, name, t))
-        return kept
+        return keep(ctl, t + kind, made[0](ctl, name, t))
 
     def gt(t: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(t) is int and lo_t <= t <= hi_t and session.plain and not extra and not kw:
             try:
                 ctl = session.controllers[1]
-                kept = ctl.input_plans[t + kind]
-            except KeyError:  # none kept yet, or no controller (the table path says why)
+                read = ctl.input_plans[t + kind]
+            except KeyError:  # none kept (yet, or since a change), no controller
                 ctl = session.controllers.get(1)
-                kept = None
+                read = None
             if ctl is not None:
                 clock = ctl.clock
                 if clock._thread is None and session.note is None:
@@ -1736,9 +1735,9 @@ def fast_io_reader(
                         bank = ctl.bank
                         if bank is not None and bank.n_alive:  # (what the table path does
                             bank.before_call(ctl, proto, (t, p))  # first: its axes go back)
-                        if kept is None or kept[0] != EPOCH[0]:
-                            kept = plan(ctl, t)
-                        v = kept[1]()
+                        if read is None:
+                            read = plan(ctl, t)
+                        v = read()
                         if obj is not None:
                             k = type(obj)
                             done = k is T0 or k in wide or bounds[k][0] <= v <= bounds[k][1]

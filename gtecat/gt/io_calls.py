@@ -35,7 +35,7 @@ from ..controller.axis import PdsState
 from ..controller.config_file import switch_sense, vendor_settings
 from ..controller.core import Controller
 from ..controller.digital_io import GPIO_COUNT, digital_io
-from ..controller.input_sense import EPOCH
+from ..controller.input_sense import keep
 from ..controller.resources import _fault_reset
 from ..errors import ParameterError
 from ._core import check_range, gt_function, store
@@ -109,9 +109,9 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
     """The value GT_GetDi (``raw``: GT_GetDiRaw) stores for ``di_type`` (one of its types)
     on ``ctl`` - ``_signed32(read_di(...))`` - as one call without the look-ups: each
     axis's input bit read where it lies in the process image, their sense (configuration,
-    wiring) folded into one constant.  Valid while
-    :data:`gtecat.controller.input_sense.EPOCH` has not moved (the GT fast path keeps it
-    that long; a bus brought up with other axes moves it too)."""
+    wiring) folded into one constant.  Valid until the next
+    :func:`gtecat.controller.input_sense.changed` (the GT fast path keeps it that long; a
+    bus brought up with other axes is a change too)."""
     if di_type == MC_MPG:
         return lambda: 0
     if di_type == MC_GPI:
@@ -163,23 +163,23 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
 
 def di_value(ctl: Controller, di_type: int, raw: bool = False) -> int:
     """:func:`read_di`'s value of an input type (checked before) through the reader the GT
-    fast path keeps for ``ctl`` (made here when none is kept or the counter moved): the
+    fast path keeps for ``ctl`` (made and kept here when none is): the
     same value without the look-ups (an input watched every cycle).  A view of a core
     beyond 32 axes keeps none: :func:`read_di` itself."""
     plans = vars(ctl).get("input_plans")  # (a CoreView's attributes are its base's)
     if plans is None:
         return read_di(ctl, di_type, raw)
     key = di_type + (16 if raw else 0)  # (the GT fast path's keys: gt.fast.IO_READERS)
-    kept = plans.get(key)
-    if kept is None or kept[0] != EPOCH[0]:
-        kept = plans[key] = (EPOCH[0], di_reader(ctl, di_type, raw))
-    return kept[1]() & 0xFFFFFFFF
+    read = plans.get(key)
+    if read is None:
+        read = keep(ctl, key, di_reader(ctl, di_type, raw))
+    return read() & 0xFFFFFFFF
 
 
 def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
     """The value GT_GetDo stores for ``do_type`` (one of its types) on ``ctl`` as one call;
-    valid while :data:`gtecat.controller.input_sense.EPOCH` has not moved (the axes of
-    ``MC_ENABLE``: a bus brought up again moves it)."""
+    valid until the next :func:`gtecat.controller.input_sense.changed` (the axes of
+    ``MC_ENABLE``: a bus brought up again is one)."""
     io = digital_io(ctl)
     if do_type == MC_GPO:
         return lambda: io.gpo
