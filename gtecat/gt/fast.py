@@ -584,11 +584,16 @@ def fast_clock(
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
     """``GT_GetClock(pClock[, pLoop])`` with the fast path in front of the table: ``pClock``
-    ``byref(x)`` or ``x`` of an integer type of at least 32 bits, ``pLoop`` omitted, None or
-    0, on the in-process controller; anything else (a value the type cannot hold included)
+    ``byref(x)`` or ``x`` of an integer type of at least 32 bits (or a ctypes or numpy
+    array of one: its first element), ``pLoop`` omitted, None or 0, on the in-process
+    controller; anything else (a value the type cannot hold included)
     takes the table path."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
     target = byref_target.target(_CLOCK_INTS) if BYREF_TARGET else None
+    first = _array_first(_scalar_types(FUNCTIONS[name].params[0]))
 
     def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if (
@@ -617,8 +622,19 @@ def fast_clock(
                                     obj = None
                                 else:
                                     last[0] = pClock
-                    else:
-                        obj = pClock if tp in _CLOCK_INTS else None
+                    elif tp in _CLOCK_INTS:
+                        obj = pClock
+                    else:  # an array: its first element
+                        b = first(pClock, tp)
+                        if b is not None:
+                            ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
+                            if ms <= b[1]:
+                                pClock[0] = ms
+                                session.last = None
+                                if clock.mode is _LOCKSTEP:
+                                    return 0
+                                return advance(ctl, name, 0)
+                        obj = None
                     if obj is not None:
                         ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
                         if ms <= _INT_MAX[type(obj)]:
@@ -1274,6 +1290,7 @@ def fast_ecat_reader(
         "SUB": subindex,
         "ACCS": {},
         "_pdo_entry": _pdo_entry,
+        "first": _array_first(ok),
         "last": [None],
         "_refs": sys.getrefcount,
         "KEPT": _KEPT,
@@ -1338,12 +1355,22 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                 elif tp in ok:
                     obj = p
                 else:
-                    return slow(*(a for a in (n, p) if a is not _NO))
+                    b = first(p, tp)  # (an array: its first element)
+                    if b is None:
+                        return slow(*(a for a in (n, p) if a is not _NO))
+                    obj = None
                 v = acc.get() if cell is None else cell[0]
-                kind = type(obj)
                 # (a value the type cannot hold: store's refusal, the table path)
-                if kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]:
-                    obj.value = v
+                if obj is None:
+                    done = b[0] <= v <= b[1]
+                    if done:
+                        p[0] = v
+                else:
+                    kind = type(obj)
+                    done = kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]
+                    if done:
+                        obj.value = v
+                if done:
                     session.last = None
                     if clock.mode is _LOCKSTEP:
                         return 0
@@ -1385,6 +1412,7 @@ def fast_homing_status(
             else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
         )
     target = _target(ok)
+    first = _array_first(ok)
     getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
     from ..controller.axis import Axis
 
@@ -1416,12 +1444,16 @@ def fast_homing_status(
                 and m.opened
             ):
                 tp = type(p)
+                arr = None  # (an array: the range its first element holds)
                 if tp is _CArg:
                     obj = target(p)
                     if obj is p:
                         obj = None
+                elif tp in ok:
+                    obj = p
                 else:
-                    obj = p if tp in ok else None
+                    arr = first(p, tp)
+                    obj = None if arr is None else p
                 try:
                     k = kept[n]
                 except KeyError:
@@ -1449,9 +1481,12 @@ def fast_homing_status(
                     else:
                         v = st.result
                     if v is not None:
-                        lo, hi = bounds[type(obj)]
+                        lo, hi = bounds[type(obj)] if arr is None else arr
                         if lo <= v <= hi:
-                            obj.value = v
+                            if arr is None:
+                                obj.value = v
+                            else:
+                                p[0] = v
                             session.last = None
                             if clock.mode is _LOCKSTEP:
                                 return 0
@@ -1618,19 +1653,27 @@ def fast_core(
 
     ok = _scalar_types(FUNCTIONS[name].params[0])
     target = _target(ok)
+    first = _array_first(ok)
 
     def gt(p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if not kw and not extra and session.local:
             tp = type(p)
+            arr = None  # (an array: its first element, of a type that holds 1..4)
             if tp is _CArg:
                 obj = target(p)
                 if obj is p:
                     obj = None
+            elif tp in ok:
+                obj = p
             else:
-                obj = p if tp in ok else None
+                arr = first(p, tp)
+                obj = None if arr is None else p
             if obj is not None and session.note is None:
                 core = session._core  # (1..4: every integer type the pointer takes holds it)
-                obj.value = core
+                if arr is None:
+                    obj.value = core
+                else:
+                    p[0] = core
                 session.last = None
                 ctl = session.controllers.get(core)
                 if ctl is None or ctl.clock.mode is _LOCKSTEP:
@@ -1658,6 +1701,36 @@ def _int_bounds(types: Any) -> dict[type, tuple[int, int]]:
             else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
         )
     return out
+
+
+def _array_first(ok: Any) -> Callable[[Any, type], tuple[int, int] | None]:
+    """``first(p, type(p))`` for a fast reader of one integer into a pointer the table path
+    takes as the ctypes types ``ok``: the range of values the first element of ``p`` holds
+    when ``p`` is a ctypes array of one of ``ok`` (at least one element) or a writable
+    one-dimensional numpy array of an integer dtype of the size and sign of one of ``ok``
+    (the table path's ``flat[:1] = [value]``), else None (the table path decides)."""
+    bounds = _int_bounds(t for t in ok if t._type_ in "bBhHiIlLqQ")
+    dtypes = {
+        np.dtype(f"{'i' if t._type_.islower() else 'u'}{ctypes.sizeof(t)}"): b
+        for t, b in bounds.items()
+    }
+    arrays: dict[type, tuple[int, int] | None] = {}
+
+    def first(p: Any, tp: type) -> tuple[int, int] | None:
+        if tp is _NDARRAY:
+            b = dtypes.get(p.dtype)
+            if b is not None and p.ndim == 1 and p.size and p.flags.writeable:
+                return b
+            return None
+        try:
+            return arrays[tp]
+        except KeyError:
+            b = arrays[tp] = (
+                bounds.get(tp._type_) if issubclass(tp, ctypes.Array) and tp._length_ >= 1 else None
+            )
+            return b
+
+    return first
 
 
 def fast_io_reader(
@@ -1692,16 +1765,7 @@ def fast_io_reader(
     target = _target(ok)
     lo_t, hi_t, kind = IO_READERS[name]
     made: list[Any] = []  # io_calls.io_reader (io_calls imports the GT layer: at first use)
-    arrays: dict[type, bool] = {}
-
-    def first(p: Any, tp: type) -> bool:
-        """Whether ``p`` is an array whose first element the value goes into."""
-        if tp is _NDARRAY:
-            return p.dtype in _NP_INTS and p.ndim == 1 and bool(p.size) and p.flags.writeable
-        a = arrays.get(tp)
-        if a is None:
-            a = arrays[tp] = issubclass(tp, ctypes.Array) and tp._type_ in ok and tp._length_ >= 1
-        return a
+    first = _array_first(ok)
 
     def plan(ctl: Any, t: int) -> Any:
         """The reader of type ``t`` on ``ctl``, made and kept (until the next change)."""
@@ -1730,7 +1794,8 @@ def fast_io_reader(
                     elif tp is T0 or tp in ok:
                         obj = p
                     else:
-                        obj = None if first(p, tp) else _NO
+                        b = first(p, tp)  # (an array: its first element)
+                        obj = _NO if b is None else None
                     if obj is not _NO:
                         bank = ctl.bank
                         if bank is not None and bank.n_alive:  # (what the table path does
@@ -1743,9 +1808,8 @@ def fast_io_reader(
                             done = k is T0 or k in wide or bounds[k][0] <= v <= bounds[k][1]
                             if done:
                                 obj.value = v
-                        else:  # an array's first element (numpy int32 and int64 hold any)
-                            e = tp._type_ if tp is not _NDARRAY else None
-                            done = e is None or bounds[e][0] <= v <= bounds[e][1]
+                        else:  # an array's first element
+                            done = b[0] <= v <= b[1]
                             if done:
                                 p[0] = v
                         if done:  # (else a value the type cannot hold: the table's code)
