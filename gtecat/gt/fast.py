@@ -1193,6 +1193,17 @@ SLOW_REASONS: dict[str, str] = {
 }
 
 
+#: a client's shapes of a fast function's value pointer that the table path answers, and why
+#: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
+#: other that reaches the table)
+SLOW_SHAPES: dict[str, dict[str, str]] = {
+    "GT_GetTrapPrm": {
+        "array[1]": "an array of structures for one structure: the table path checks its "
+        "type and size (the fast path takes the structure, or byref of it)"
+    },
+}
+
+
 def fast_functions() -> frozenset[str]:
     """The functions whose common shapes the fast path answers."""
     return (
