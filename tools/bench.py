@@ -22,7 +22,9 @@ Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (tar
 every motion mode); two coordinate systems polled every cycle (GT_CrdStatus, GT_GetPrfPos),
 and the same with a segment streamed onto each every 10 cycles, bank against scalar path in
 pairs (target: the bank no slower); ``GT_GetSts`` against building its argument,
-interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4);
+interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4),
+and every function with a fast path in every way a client passes its value's pointer
+(``every_call_shape_vs_arguments``, the same bar);
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -341,6 +343,127 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             out[name] = row
     gt.GT_Close()
     return {"shapes": out, "worst": worst, "table_path": table_out, "table_worst": table_worst}
+
+
+def _time_pairs(
+    pairs: Mapping[str, tuple[Callable[[], object], Callable[[], object]]],
+    seconds: float,
+    block: int,
+) -> dict[str, dict[str, float]]:
+    """Per name, (the call, building its arguments) timed in alternating blocks of ``block``
+    for ``seconds`` in all: µs per call, µs per argument build, the ratio of the medians."""
+    clock, rng = time.perf_counter, range(block)
+    per = seconds / max(1, len(pairs))
+    out: dict[str, dict[str, float]] = {}
+    for name, (call, build) in pairs.items():
+        calls, args = [], []
+        t_end = clock() + per
+        while clock() < t_end or len(calls) < 3:
+            t0 = clock()
+            for _ in rng:
+                build()
+            t1 = clock()
+            for _ in rng:
+                call()
+            t2 = clock()
+            args.append((t1 - t0) / block)
+            calls.append((t2 - t1) / block)
+        c_us, a_us = statistics.median(calls) * 1e6, statistics.median(args) * 1e6
+        out[name] = {
+            "call_us": round(c_us, 3),
+            "argument_us": round(a_us, 3),
+            "ratio": round(c_us / a_us, 2),
+        }
+    return out
+
+
+def every_shape(
+    names: Sequence[str] | None = None,
+) -> dict[str, tuple[Callable[[], object], Callable[[], object]]]:
+    """Every function with a fast path (the raw image functions: :func:`bench_call_shapes`)
+    in every way a client passes its value's pointer, with what building that argument
+    costs: ``byref`` of a reused and of a fresh object, the ctypes object itself, a ctypes
+    and a numpy array of one element, and NULL (0, None) for the optional pointer after it
+    (``count`` 1 first for the readers of a span).  ``names``: these functions instead (a
+    comparison with another version).  The controller must be open."""
+    import numpy as np
+
+    from gtecat import gt
+    from gtecat.gt import fast
+    from gtecat.gt.args import _scalar_types
+    from gtecat.gt.table import FUNCTIONS
+
+    first = {"GT_GetDi": 3, "GT_GetDiRaw": 0, "GT_GetDo": 10}  # (a type; else axis 1)
+    dtypes = {c_double: np.float64, c_long: np.int64, c_short: np.int16}
+    out: dict[str, tuple[Callable[[], object], Callable[[], object]]] = {}
+    for name in names if names is not None else sorted(fast.fast_functions() - fast.RAW):
+        fn = getattr(gt, name)
+        params = FUNCTIONS[name].params
+        i = next(k for k, q in enumerate(params) if q.pointer)
+        if name in fast.STRUCT_READERS:
+            t: type = fast.STRUCT_READERS[name][0]
+        else:
+            ok = _scalar_types(params[i])
+            t = next(x for x in (c_double, c_long, c_short) if x in ok)
+        pre = (first.get(name, 1),) * i
+        held = t()
+        ref = byref(held)
+        arr = (t * 1)()
+        rest = params[i + 1 :]
+        null = bool(rest) and rest[-1].pointer and rest[-1].default is not None
+        count = (1,) if len(rest) == 2 else ()
+        label = f"{name}({'x, ' * i}"
+        shapes = {
+            "byref(s)": (lambda fn=fn, pre=pre, ref=ref: fn(*pre, ref), lambda t=t: byref(t())),
+            f"byref({t.__name__}())": (
+                lambda fn=fn, pre=pre, t=t: fn(*pre, byref(t())),
+                lambda t=t: byref(t()),
+            ),
+            "s": (lambda fn=fn, pre=pre, held=held: fn(*pre, held), lambda t=t: t()),
+            f"{t.__name__}[1]": (
+                lambda fn=fn, pre=pre, arr=arr: fn(*pre, arr),
+                lambda t=t: (t * 1)(),
+            ),
+        }
+        if t in dtypes:
+            dt = dtypes[t]
+            npa = np.zeros(1, dt)
+            shapes[f"numpy {np.dtype(dt).name}[1]"] = (
+                lambda fn=fn, pre=pre, npa=npa: fn(*pre, npa),
+                lambda dt=dt: np.zeros(1, dt),
+            )
+        if null:
+            for z in (0, None):
+                shapes[f"byref(s), {'1, ' * len(count)}{z}"] = (
+                    lambda fn=fn, pre=pre, ref=ref, count=count, z=z: fn(*pre, ref, *count, z),
+                    lambda t=t: byref(t()),
+                )
+        for shape, pair in shapes.items():
+            out[f"{label}{shape})"] = pair
+    return out
+
+
+def bench_every_shape(
+    seconds: float = 20.0, block: int = 200, names: Sequence[str] | None = None
+) -> dict[str, object]:
+    """:func:`every_shape` on figure 5-2's bus (lockstep, axis 1 on), each against building
+    its arguments in alternating blocks; ``worst`` the largest ratio, ``above_4`` the shapes
+    above the bar."""
+    from gtecat import gt
+
+    gt.GT_Close()
+    gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="")
+    gt.GT_InitEcatComm()
+    gt.GTE_Wait(60)
+    gt.GT_StartEcatComm()
+    gt.GT_AxisOn(1)
+    try:
+        shapes = _time_pairs(every_shape(names), seconds, block)
+    finally:
+        gt.GT_Close()
+    worst = max((r["ratio"] for r in shapes.values()), default=0.0)
+    above = {k: r["ratio"] for k, r in shapes.items() if r["ratio"] > 4}
+    return {"shapes": shapes, "count": len(shapes), "worst": worst, "above_4": above}
 
 
 def _rss() -> dict[str, float]:
@@ -669,6 +792,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "gt_get_sts_vs_argument": lambda: _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
         "call_shapes_vs_arguments": lambda: _figure(
             bench_call_shapes(2 * seconds), "worst", 4, at_most=True
+        ),
+        "every_call_shape_vs_arguments": lambda: _figure(
+            bench_every_shape(10 * seconds), "worst", 4, at_most=True
         ),
         "rss_128_axes_moving": lambda: _figure(
             bench_rss(128, min(seconds, 1.0)), "mb_per_axis", 0.1, at_most=True
