@@ -379,13 +379,16 @@ def _time_pairs(
 
 def every_shape(
     names: Sequence[str] | None = None,
-) -> dict[str, tuple[Callable[[], object], Callable[[], object]]]:
+) -> tuple[dict[str, tuple[Callable[[], object], Callable[[], object]]], dict[str, str]]:
     """Every function with a fast path (the raw image functions: :func:`bench_call_shapes`)
     in every way a client passes its value's pointer, with what building that argument
     costs: ``byref`` of a reused and of a fresh object, the ctypes object itself, a ctypes
     and a numpy array of one element, and NULL (0, None) for the optional pointer after it
-    (``count`` 1 first for the readers of a span).  ``names``: these functions instead (a
-    comparison with another version).  The controller must be open."""
+    (``count`` 1 first for the readers of a span); each call written out as a client writes
+    it (no ``*args``).  ``names``: these functions instead (a comparison with another
+    version).  The controller must be open.  Also the shapes not measured and why: a call
+    that does not return 0 on this bus (an object its drives do not map), a shape the table
+    path answers (``fast.SLOW_SHAPES``)."""
     import numpy as np
 
     from gtecat import gt
@@ -396,8 +399,8 @@ def every_shape(
     first = {"GT_GetDi": 3, "GT_GetDiRaw": 0, "GT_GetDo": 10}  # (a type; else axis 1)
     dtypes = {c_double: np.float64, c_long: np.int64, c_short: np.int16}
     out: dict[str, tuple[Callable[[], object], Callable[[], object]]] = {}
+    skipped: dict[str, str] = {}
     for name in names if names is not None else sorted(fast.fast_functions() - fast.RAW):
-        fn = getattr(gt, name)
         params = FUNCTIONS[name].params
         i = next(k for k, q in enumerate(params) if q.pointer)
         if name in fast.STRUCT_READERS:
@@ -405,42 +408,43 @@ def every_shape(
         else:
             ok = _scalar_types(params[i])
             t = next(x for x in (c_double, c_long, c_short) if x in ok)
-        pre = (first.get(name, 1),) * i
         held = t()
-        ref = byref(held)
-        arr = (t * 1)()
         rest = params[i + 1 :]
         null = bool(rest) and rest[-1].pointer and rest[-1].default is not None
-        count = (1,) if len(rest) == 2 else ()
-        label = f"{name}({'x, ' * i}"
-        shapes = {
-            "byref(s)": (lambda fn=fn, pre=pre, ref=ref: fn(*pre, ref), lambda t=t: byref(t())),
-            f"byref({t.__name__}())": (
-                lambda fn=fn, pre=pre, t=t: fn(*pre, byref(t())),
-                lambda t=t: byref(t()),
-            ),
-            "s": (lambda fn=fn, pre=pre, held=held: fn(*pre, held), lambda t=t: t()),
-            f"{t.__name__}[1]": (
-                lambda fn=fn, pre=pre, arr=arr: fn(*pre, arr),
-                lambda t=t: (t * 1)(),
-            ),
+        count = "1, " if len(rest) == 2 else ""
+        env = {
+            "fn": getattr(gt, name),
+            "t": t,
+            "held": held,
+            "ref": byref(held),
+            "arr": (t * 1)(),
+            "byref": byref,
+            "np": np,
+        }
+        x = f"{first.get(name, 1)}, " if i else ""
+        shapes = {  # shape: (the call's source, building its arguments' source)
+            "byref(s)": (f"fn({x}ref)", "byref(t())"),
+            f"byref({t.__name__}())": (f"fn({x}byref(t()))", "byref(t())"),
+            "s": (f"fn({x}held)", "t()"),
+            f"{t.__name__}[1]": (f"fn({x}arr)", "(t * 1)()"),
         }
         if t in dtypes:
-            dt = dtypes[t]
-            npa = np.zeros(1, dt)
-            shapes[f"numpy {np.dtype(dt).name}[1]"] = (
-                lambda fn=fn, pre=pre, npa=npa: fn(*pre, npa),
-                lambda dt=dt: np.zeros(1, dt),
-            )
+            env["npa"], env["dt"] = np.zeros(1, dtypes[t]), dtypes[t]
+            shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (f"fn({x}npa)", "np.zeros(1, dt)")
         if null:
-            for z in (0, None):
-                shapes[f"byref(s), {'1, ' * len(count)}{z}"] = (
-                    lambda fn=fn, pre=pre, ref=ref, count=count, z=z: fn(*pre, ref, *count, z),
-                    lambda t=t: byref(t()),
-                )
-        for shape, pair in shapes.items():
-            out[f"{label}{shape})"] = pair
-    return out
+            for z in ("0", "None"):
+                shapes[f"byref(s), {count}{z}"] = (f"fn({x}ref, {count}{z})", "byref(t())")
+        for shape, (call, build) in shapes.items():
+            label = f"{name}({'x, ' if i else ''}{shape})"
+            pair = (eval(f"lambda: {call}", env), eval(f"lambda: {build}", env))
+            rc = pair[0]()
+            if rc != 0:
+                skipped[label] = f"returns {rc} on this bus"
+            elif shape in fast.SLOW_SHAPES.get(name, {}):
+                skipped[label] = "on the table path: " + fast.SLOW_SHAPES[name][shape]
+            else:
+                out[label] = pair
+    return out, skipped
 
 
 def bench_every_shape(
@@ -458,12 +462,19 @@ def bench_every_shape(
     gt.GT_StartEcatComm()
     gt.GT_AxisOn(1)
     try:
-        shapes = _time_pairs(every_shape(names), seconds, block)
+        pairs, skipped = every_shape(names)
+        shapes = _time_pairs(pairs, seconds, block)
     finally:
         gt.GT_Close()
     worst = max((r["ratio"] for r in shapes.values()), default=0.0)
     above = {k: r["ratio"] for k, r in shapes.items() if r["ratio"] > 4}
-    return {"shapes": shapes, "count": len(shapes), "worst": worst, "above_4": above}
+    return {
+        "shapes": shapes,
+        "count": len(shapes),
+        "worst": worst,
+        "above_4": above,
+        "not_measured": skipped,
+    }
 
 
 def _rss() -> dict[str, float]:
