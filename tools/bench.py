@@ -400,6 +400,7 @@ def every_shape(
     dtypes = {c_double: np.float64, c_long: np.int64, c_short: np.int16}
     out: dict[str, tuple[Callable[[], object], Callable[[], object]]] = {}
     skipped: dict[str, str] = {}
+    slow = getattr(fast, "SLOW_SHAPES", {})  # (an earlier version has none)
     for name in names if names is not None else sorted(fast.fast_functions() - fast.RAW):
         params = FUNCTIONS[name].params
         i = next(k for k, q in enumerate(params) if q.pointer)
@@ -440,8 +441,8 @@ def every_shape(
             rc = pair[0]()
             if rc != 0:
                 skipped[label] = f"returns {rc} on this bus"
-            elif shape in fast.SLOW_SHAPES.get(name, {}):
-                skipped[label] = "on the table path: " + fast.SLOW_SHAPES[name][shape]
+            elif shape in slow.get(name, {}):
+                skipped[label] = "on the table path: " + slow[name][shape]
             else:
                 out[label] = pair
     return out, skipped
