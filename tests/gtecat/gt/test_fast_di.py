@@ -260,3 +260,23 @@ def test_level_changes_counted_every_cycle_leave_the_bank_its_axes() -> None:
         if bank == "on":
             assert all(held[2:]), f"the bank gave the axes back: {held}"
     assert counts["on"] == counts["off"] and counts["on"][0] >= 20, counts
+
+
+def test_a_pulse_card_answers_as_the_table(tmp_path: Path) -> None:
+    """The same readers on a GTS card's axes (their terminals from the machine description),
+    with a vendor file of normally-closed switches loaded."""
+    m = MachineDescription(
+        {
+            n: AxisMachine(negative_limit=0, positive_limit=30_000, home_switch=((-5, 5),))
+            for n in (1, 2, 3)
+        }
+    )
+    assert gt.GT_Open(card="gts:4", machine=m, clock="lockstep", log="") == 0
+    assert gt.GT_Reset() == 0
+    gt.GTE_Wait(3)
+    bad = compare("a card", shapes=("byref", "object", "array"), profile=True)
+    cfg = "[limitNegative1]\nreverse=1\n[home3]\nreverse=1\n[limitPositive2]\nreverse=1\n"
+    assert gt.GT_LoadConfig(_cfg(tmp_path, cfg)) == 0, gt.GTE_GetLastError()
+    gt.GTE_Wait(3)
+    bad += compare("a card, a file", shapes=("byref", "object", "array"))
+    assert not bad, "\n".join(bad[:20])
