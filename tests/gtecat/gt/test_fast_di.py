@@ -1,15 +1,15 @@
 """GT_GetDi / GT_GetDiRaw / GT_GetDo on the fast path answer as their table path in every state.
 
-The fast path keeps each input type's combination of axis bits and sense until the one counter
-of the inputs' sense (:data:`gtecat.controller.input_sense.EPOCH`) moves.  Each test reads
-every type through both paths first (so a combination is kept), then changes one thing that
-makes the value - a configuration's ``reverse`` (a vendor file, ``GT_SetSense``,
-``GT_LmtSns``, ``GT_Reset``, gtecat's earlier format), the machine's switch wiring, the bus
-brought up again, a switch moved onto, stuck or chattering, a drive in fault, a GPI, an
-axis arrived, the axis bank holding the axes, the outputs GT_GetDo reads - and compares
-again: code, value and reason for every type and every shape a client passes.  A writer
-that forgot the counter would leave the fast path answering from a stale combination,
-which the last test shows.
+The fast path keeps each input type's combination of axis bits and sense until the next
+change of the inputs' sense (:func:`gtecat.controller.input_sense.changed`, counted in its
+``EPOCH``).  Each test reads every type through both paths first (so a combination is kept),
+then changes one thing that makes the value - a configuration's ``reverse`` (a vendor file,
+``GT_SetSense``, ``GT_LmtSns``, ``GT_Reset``, gtecat's earlier format), the machine's switch
+wiring, the bus brought up again, a switch moved onto, stuck or chattering, an EtherCAT IO
+slave's input stuck, a drive in fault, a GPI, an axis arrived, the axis bank holding the
+axes, the outputs GT_GetDo reads, a pulse card's terminals - and compares again: code, value
+and reason for every type and every shape a client passes.  A writer that forgot the counter
+would leave the fast path answering from a stale combination, which a test shows.
 """
 
 from __future__ import annotations
@@ -181,6 +181,9 @@ def test_every_type_and_shape_answers_as_the_table_in_every_state(tmp_path: Path
     for k in range(3):
         gt.GTE_Wait(1)
         step(f"a chattering switch, cycle {k}")
+    faults.inject("io_stuck", slave=2, bit=0, value=1)  # (an EtherCAT IO slave's input)
+    gt.GTE_Wait(2)
+    step("an IO slave's input stuck")
     faults.inject("drive_fault", axis=1)
     gt.GTE_Wait(5)
     step("a drive in fault")
