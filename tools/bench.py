@@ -423,26 +423,36 @@ def every_shape(
             "np": np,
         }
         x = f"{first.get(name, 1)}, " if i else ""
-        shapes = {  # shape: (the call's source, building its arguments' source)
-            "byref(s)": (f"fn({x}ref)", "byref(t())"),
-            f"byref({t.__name__}())": (f"fn({x}byref(t()))", "byref(t())"),
-            "s": (f"fn({x}held)", "t()"),
-            f"{t.__name__}[1]": (f"fn({x}arr)", "(t * 1)()"),
+        # shape: (its kind, as fast.SLOW_SHAPES names it; the call's source; building its
+        # arguments' source)
+        shapes = {
+            "byref(s)": ("byref reused", f"fn({x}ref)", "byref(t())"),
+            f"byref({t.__name__}())": ("byref fresh", f"fn({x}byref(t()))", "byref(t())"),
+            "s": ("object", f"fn({x}held)", "t()"),
+            f"{t.__name__}[1]": ("array[1]", f"fn({x}arr)", "(t * 1)()"),
         }
         if t in dtypes:
             env["npa"], env["dt"] = np.zeros(1, dtypes[t]), dtypes[t]
-            shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (f"fn({x}npa)", "np.zeros(1, dt)")
+            shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (
+                "numpy[1]",
+                f"fn({x}npa)",
+                "np.zeros(1, dt)",
+            )
         if null:
             for z in ("0", "None"):
-                shapes[f"byref(s), {count}{z}"] = (f"fn({x}ref, {count}{z})", "byref(t())")
-        for shape, (call, build) in shapes.items():
+                shapes[f"byref(s), {count}{z}"] = (
+                    f"null {z}",
+                    f"fn({x}ref, {count}{z})",
+                    "byref(t())",
+                )
+        for shape, (kind, call, build) in shapes.items():
             label = f"{name}({'x, ' if i else ''}{shape})"
             pair = (eval(f"lambda: {call}", env), eval(f"lambda: {build}", env))
             rc = pair[0]()
             if rc != 0:
                 skipped[label] = f"returns {rc} on this bus"
-            elif shape in slow.get(name, {}):
-                skipped[label] = "on the table path: " + slow[name][shape]
+            elif kind in slow.get(name, {}):
+                skipped[label] = "on the table path: " + slow[name][kind]
             else:
                 out[label] = pair
     return out, skipped
