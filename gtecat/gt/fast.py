@@ -370,6 +370,35 @@ _STATUS_BITS = {
     "TRAP_IDLE": TRAP_IDLE,
 }
 
+#: the readers whose value is a link applied to a profile's or an encoder's value (the
+#: AxisResources property of the reader's name, its steps inline: the same operations):
+#: function -> (the bank's list of the value, the value of an axis the bank does not run,
+#: the value from the bank's ``x``); tests/gtecat/gt/test_fast_walk.py holds each to its
+#: property, banked and not
+DERIVED: dict[str, tuple[str, str, str]] = {
+    "GT_GetAxisPrfVel": (
+        "prf_v",
+        "res.prf_link.ratio * res.profile.planner.vel",
+        "res.prf_link.ratio * x",
+    ),
+    "GT_GetAxisPrfAcc": (
+        "prf_a",
+        "res.prf_link.ratio * res.profile.planner.acc",
+        "res.prf_link.ratio * x",
+    ),
+    "GT_GetAxisEncVel": (
+        "enc_vel",
+        "res.enc_link.ratio * res.encoder.vel",
+        "res.enc_link.ratio * x",
+    ),
+    "GT_GetAxisEncAcc": (
+        "enc_acc",
+        "res.enc_link.ratio * res.encoder.acc",
+        "res.enc_link.ratio * x",
+    ),
+    "GT_GetAxisEncPos": ("enc_pos", "res.enc_link.axis(res.encoder.pos)", "res.enc_link.axis(x)"),
+}
+
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
 
@@ -539,6 +568,23 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     env["_AT"] = _AT
     env["PER_CORE"] = AXES_PER_CORE
     attr = getattr(env["get"], "attr", None)
+    derived = DERIVED.get(env["name"])
+    if derived is not None:  # (AxisResources' property, its steps inline)
+        bank_list, own, from_bank = derived
+        lines = [
+            "b = res.bank",
+            "if b is None:",
+            f"    v = {own}",
+            "else:",
+            f"    lst = b._lists.get({bank_list!r})",
+            f"    x = b.value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
+            f"    v = {from_bank}",
+            "if type(v) is not float:",
+            "    v = float(v)",
+        ]
+        code = code.replace("{value}", "\n".join("            " + line for line in lines))
+        exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)
+        return env[fname]
     if env["name"] in SCALAR_INLINE:
         scalar = list(SCALAR_INLINE[env["name"]])
         env.update(_STATUS_BITS)

@@ -174,3 +174,33 @@ def test_every_client_shape_of_every_fast_function() -> None:
         assert name in fast.fast_functions(), name
         for shape, reason in shapes.items():
             assert shape in CLIENT and reason.strip(), (name, shape)
+
+
+def test_the_derived_readers_read_their_properties_inline() -> None:
+    """The readers fast.DERIVED reads inline give their AxisResources property's value, on
+    an axis the bank runs and on one it does not, with a profile and an encoder scale (a
+    ratio other than 1 and an offset)."""
+    from gtecat.gt.fast import DERIVED, READERS
+
+    for bank in ("on", "off"):
+        gt.GT_Close()
+        bring_up(clock="lockstep", bank=bank)
+        ctl = gt.GTE_Controller()
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        assert gt.GT_ProfileScale(1, 4, 3) == 0 and gt.GT_EncScale(1, 8, 5) == 0
+        for axis in (1, 2):
+            assert gt.GT_PrfTrap(axis) == 0
+            prm = gt.TTrapPrm(acc=0.25, dec=0.25, velStart=0, smoothTime=0)
+            assert gt.GT_SetTrapPrm(axis, byref(prm)) == 0
+            assert gt.GT_SetPos(axis, 30_000) == 0 and gt.GT_SetVel(axis, 7) == 0
+        assert gt.GT_Update(0b11) == 0
+        for _ in range(3):
+            gt.GTE_Wait(17)
+            for name in DERIVED:
+                attr = READERS[name][0].attr  # type: ignore[attr-defined]
+                for axis in (1, 2):
+                    v = ctypes.c_double()
+                    assert getattr(gt, name)(axis, byref(v)) == 0
+                    assert v.value == float(getattr(ctl.resources[axis], attr)), (name, axis)
+        if bank == "on":
+            assert any(ctl.resources[a].bank is not None for a in (1, 2)), "none in the bank"
