@@ -370,33 +370,53 @@ _STATUS_BITS = {
     "TRAP_IDLE": TRAP_IDLE,
 }
 
+
+def _linked(bank_list: str, own: str, from_bank: str) -> tuple[str, ...]:
+    """The steps of a reader's value ``own`` (an axis the bank does not run), else
+    ``from_bank`` of ``x``, the bank's value of the axis from its list ``bank_list``."""
+    return (
+        "b = res.bank",
+        "if b is None:",
+        f"    v = {own}",
+        "else:",
+        f"    lst = b._lists.get({bank_list!r})",
+        f"    x = b.value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
+        f"    v = {from_bank}",
+    )
+
+
 #: the readers whose value is a link applied to a profile's or an encoder's value (the
-#: AxisResources property of the reader's name, its steps inline: the same operations):
-#: function -> (the bank's list of the value, the value of an axis the bank does not run,
-#: the value from the bank's ``x``); tests/gtecat/gt/test_fast_walk.py holds each to its
-#: property, banked and not
-DERIVED: dict[str, tuple[str, str, str]] = {
-    "GT_GetAxisPrfVel": (
-        "prf_v",
-        "res.prf_link.ratio * res.profile.planner.vel",
-        "res.prf_link.ratio * x",
+#: AxisResources property of the reader's name, its steps inline: the same operations in
+#: the same order): function -> the steps that set ``v``; tests/gtecat/gt/test_fast_walk.py
+#: holds each to its property, banked and not
+DERIVED: dict[str, tuple[str, ...]] = {
+    "GT_GetAxisPrfVel": _linked(
+        "prf_v", "res.prf_link.ratio * res.profile.planner.vel", "res.prf_link.ratio * x"
     ),
-    "GT_GetAxisPrfAcc": (
-        "prf_a",
-        "res.prf_link.ratio * res.profile.planner.acc",
-        "res.prf_link.ratio * x",
+    "GT_GetAxisPrfAcc": _linked(
+        "prf_a", "res.prf_link.ratio * res.profile.planner.acc", "res.prf_link.ratio * x"
     ),
-    "GT_GetAxisEncVel": (
-        "enc_vel",
-        "res.enc_link.ratio * res.encoder.vel",
-        "res.enc_link.ratio * x",
+    "GT_GetAxisEncVel": _linked(
+        "enc_vel", "res.enc_link.ratio * res.encoder.vel", "res.enc_link.ratio * x"
     ),
-    "GT_GetAxisEncAcc": (
-        "enc_acc",
-        "res.enc_link.ratio * res.encoder.acc",
-        "res.enc_link.ratio * x",
+    "GT_GetAxisEncAcc": _linked(
+        "enc_acc", "res.enc_link.ratio * res.encoder.acc", "res.enc_link.ratio * x"
     ),
-    "GT_GetAxisEncPos": ("enc_pos", "res.enc_link.axis(res.encoder.pos)", "res.enc_link.axis(x)"),
+    "GT_GetAxisEncPos": _linked(
+        "enc_pos", "res.enc_link.axis(res.encoder.pos)", "res.enc_link.axis(x)"
+    ),
+    # the axis's planned position less its encoder's through the link (axis_error)
+    "GT_GetAxisError": (
+        "b = res.bank",
+        "if b is None:",
+        "    v = res.ax.prf_pos - res.enc_link.axis(res.encoder.pos)",
+        "else:",
+        "    row = res.bank_row",
+        "    lst = b._lists.get('a_last')",
+        "    x = b.value('a_last', row) if lst is None else lst[row]",
+        "    lst = b._lists.get('enc_pos')",
+        "    v = x - res.enc_link.axis(b.value('enc_pos', row) if lst is None else lst[row])",
+    ),
 }
 
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
@@ -570,18 +590,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     attr = getattr(env["get"], "attr", None)
     derived = DERIVED.get(env["name"])
     if derived is not None:  # (AxisResources' property, its steps inline)
-        bank_list, own, from_bank = derived
-        lines = [
-            "b = res.bank",
-            "if b is None:",
-            f"    v = {own}",
-            "else:",
-            f"    lst = b._lists.get({bank_list!r})",
-            f"    x = b.value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
-            f"    v = {from_bank}",
-            "if type(v) is not float:",
-            "    v = float(v)",
-        ]
+        lines = [*derived, "if type(v) is not float:", "    v = float(v)"]
         code = code.replace("{value}", "\n".join("            " + line for line in lines))
         exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)
         return env[fname]
