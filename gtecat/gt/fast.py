@@ -385,9 +385,10 @@ def _linked(bank_list: str, own: str, from_bank: str) -> tuple[str, ...]:
     )
 
 
-#: the readers whose value is a link applied to a profile's or an encoder's value (the
-#: AxisResources property of the reader's name, its steps inline: the same operations in
-#: the same order): function -> the steps that set ``v``; tests/gtecat/gt/test_fast_walk.py
+#: the readers whose value is a link applied to a profile's or an encoder's value, or a bit
+#: of the status word (the AxisResources property or method the reader's getter calls, its
+#: steps inline: the same operations in the same order): function -> the steps that set
+#: ``v``; tests/gtecat/gt/test_fast_walk.py
 #: holds each to its property, banked and not
 DERIVED: dict[str, tuple[str, ...]] = {
     "GT_GetAxisPrfVel": _linked(
@@ -404,6 +405,18 @@ DERIVED: dict[str, tuple[str, ...]] = {
     ),
     "GT_GetAxisEncPos": _linked(
         "enc_pos", "res.enc_link.axis(res.encoder.pos)", "res.enc_link.axis(x)"
+    ),
+    # GT_GetSts's word's planner bit (prf_sts_value: status() & MOVING)
+    "GT_GetPrfSts": (
+        "b = res.bank",
+        "if b is None:",
+        "    v = res.latched & MOVING",
+        "    pl = res.profile.planner",
+        "    if (pl._mode != TRAP_IDLE) if type(pl) is TRAP else not pl.done:",
+        "        v = MOVING",
+        "else:",
+        "    lst = b._lists.get('sts')",
+        "    v = (b.value('sts', res.bank_row) if lst is None else lst[res.bank_row]) & MOVING",
     ),
     # the axis's planned position less its encoder's through the link (axis_error)
     "GT_GetAxisError": (
@@ -590,7 +603,10 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     attr = getattr(env["get"], "attr", None)
     derived = DERIVED.get(env["name"])
     if derived is not None:  # (AxisResources' property, its steps inline)
-        lines = [*derived, "if type(v) is not float:", "    v = float(v)"]
+        lines = [*derived]
+        if env["to"] is float:
+            lines += ["if type(v) is not float:", "    v = float(v)"]
+        env.update(_STATUS_BITS)
         code = code.replace("{value}", "\n".join("            " + line for line in lines))
         exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)
         return env[fname]
