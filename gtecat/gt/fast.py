@@ -620,15 +620,16 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     if env["key"] is None:
         lines = scalar
     else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
-        row = "lst[res.bank_row]" if env["to"] is None else "to(lst[res.bank_row])"
         lines = [
             "b = res.bank",
             "if b is None:",
             *("    " + x for x in scalar),
             "else:",
             "    lst = b._lists.get(key)",
-            f"    v = get(res) if lst is None else {row}",
+            "    v = get(res) if lst is None else lst[res.bank_row]",
         ]
+        if env["to"] is not None:  # (a double: the list's float as it is, else float())
+            lines += ["    if type(v) is not float:", "        v = to(v)"]
     value = "\n".join("            " + line for line in lines)
     code = code.replace("{value}", value)
     exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
