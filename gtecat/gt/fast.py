@@ -385,6 +385,19 @@ def _linked(bank_list: str, own: str, from_bank: str) -> tuple[str, ...]:
     )
 
 
+#: a reader's value of an axis the bank does not run (``res.bank`` None): the branch of the
+#: AxisResources property of the reader's name for it (the planner's or the encoder's own
+#: value), read without the property's call
+UNBANKED: dict[str, str] = {
+    "GT_GetPrfPos": "res.profile.planner.pos",
+    "GT_GetPrfVel": "res.profile.planner.vel",
+    "GT_GetPrfAcc": "res.profile.planner.acc",
+    "GT_GetAxisPrfPos": "res.ax.prf_pos",
+    "GT_GetEncPos": "res.encoder.pos",
+    "GT_GetEncVel": "res.encoder.vel",
+}
+
+
 #: the readers whose value is a link applied to a profile's or an encoder's value, or a bit
 #: of the status word (the AxisResources property or method the reader's getter calls, its
 #: steps inline: the same operations in the same order): function -> the steps that set
@@ -616,7 +629,11 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     elif attr is None:
         scalar = ["v = get(res)"]
     else:  # the attribute itself (attr_getter's value, without the two calls)
-        scalar = [f"v = res.{attr}", "if type(v) is not float:", "    v = float(v)"]
+        # (of an axis the bank does not run: the property's own branch for it, inline)
+        own = f"res.{attr}"
+        if env["key"] is not None:  # (the bank's own list otherwise, below)
+            own = UNBANKED.get(env["name"], own)
+        scalar = [f"v = {own}", "if type(v) is not float:", "    v = float(v)"]
     if env["key"] is None:
         lines = scalar
     else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter

@@ -177,10 +177,10 @@ def test_every_client_shape_of_every_fast_function() -> None:
 
 
 def test_the_derived_readers_read_their_properties_inline() -> None:
-    """The readers fast.DERIVED reads inline give their getter's value, on
+    """The readers fast.DERIVED and fast.UNBANKED read inline give their getter's value, on
     an axis the bank runs and on one it does not, with a profile and an encoder scale (a
     ratio other than 1 and an offset)."""
-    from gtecat.gt.fast import DERIVED, READERS
+    from gtecat.gt.fast import DERIVED, READERS, UNBANKED
 
     for bank in ("on", "off"):
         gt.GT_Close()
@@ -196,7 +196,7 @@ def test_the_derived_readers_read_their_properties_inline() -> None:
         assert gt.GT_Update(0b11) == 0
         for _ in range(3):
             gt.GTE_Wait(17)
-            for name in DERIVED:
+            for name in [*DERIVED, *UNBANKED]:
                 get, types = READERS[name]
                 for axis in (1, 2):
                     v = ctypes.c_double() if ctypes.c_double in types else ctypes.c_long()
