@@ -204,3 +204,18 @@ def test_the_derived_readers_read_their_properties_inline() -> None:
                     assert v.value == get(ctl.resources[axis]), (name, axis)
         if bank == "on":
             assert any(ctl.resources[a].bank is not None for a in (1, 2)), "none in the bank"
+
+
+def test_the_clock_reads_the_controller_clock_after_a_reset() -> None:
+    """GT_GetClock's fast path reads the controller's milliseconds as ``clock_ms`` does,
+    counted from the last GT_Reset."""
+    bring_up(clock="lockstep")
+    ctl = gt.GTE_Controller()
+    for wait in (7, 0, 13):
+        gt.GTE_Wait(wait)
+        if wait == 0:
+            assert gt.GT_Reset() == 0
+            gt.GTE_Wait(3)
+        got, want = ctypes.c_long(), ctypes.c_long()
+        assert gt.GT_GetClock(byref(got)) == 0 and gt.GT_GetClock.slow(byref(want)) == 0
+        assert got.value == want.value == ctl.clock_ms() & 0xFFFFFFFF
