@@ -1879,52 +1879,79 @@ def fast_io_reader(
             made.append(io_reader)
         return keep(ctl, t + kind, made[0](ctl, name, t))
 
-    def gt(t: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(t) is int and lo_t <= t <= hi_t and session.plain and not extra and not kw:
-            try:
-                ctl = session.controllers[1]
-                read = ctl.input_plans[t + kind]
-            except KeyError:  # none kept (yet, or since a change), no controller
-                ctl = session.controllers.get(1)
-                read = None
-            if ctl is not None:
-                clock = ctl.clock
-                if clock._thread is None and session.note is None:
-                    tp = type(p)
-                    if tp is _CArg:
-                        obj = target(p)
-                        if obj is p:  # (byref(x, offset), another type: the table path)
-                            obj = _NO
-                    elif tp is T0 or tp in ok:
-                        obj = p
-                    else:
-                        b = first(p, tp)  # (an array: its first element)
-                        obj = _NO if b is None else None
-                    if obj is not _NO:
-                        bank = ctl.bank
-                        if bank is not None and bank.n_alive:  # (what the table path does
-                            bank.before_call(ctl, proto, (t, p))  # first: its axes go back)
-                        if read is None:
-                            read = plan(ctl, t)
-                        v = read()
-                        if obj is not None:
-                            k = type(obj)
-                            done = k is T0 or k in wide or bounds[k][0] <= v <= bounds[k][1]
-                            if done:
-                                obj.value = v
-                        else:  # an array's first element
-                            done = b[0] <= v <= b[1]
-                            if done:
-                                p[0] = v
-                        if done:  # (else a value the type cannot hold: the table's code)
-                            session.last = None
-                            if clock.mode is _LOCKSTEP:
-                                return 0
-                            return advance(ctl, name, 0)
-        return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
-
+    env = {
+        "_NO": _NO,
+        "_CArg": _CArg,
+        "_LOCKSTEP": _LOCKSTEP,
+        "session": session,
+        "slow": slow,
+        "advance": advance,
+        "name": name,
+        "proto": proto,
+        "target": target,
+        "ok": ok,
+        "T0": T0,
+        "wide": wide,
+        "bounds": bounds,
+        "first": first,
+        "plan": plan,
+    }
+    # (compiled with the function's type range and key offset as constants, its names as
+    # globals: the fewest steps per call)
+    code = _IO_READER.format(lo=lo_t, hi=hi_t, kind=kind)
+    exec(compile(code, f"<gt fast io {name}>", "exec"), env)
+    gt = env["gt"]
     gt.slow = slow  # type: ignore[attr-defined]
     return gt
+
+
+#: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'
+#: offset among a controller's ``input_plans``)
+_IO_READER = """
+def gt(t=_NO, p=_NO, /, *extra, **kw):
+    if type(t) is int and {lo} <= t <= {hi} and session.plain and not extra and not kw:
+        try:
+            ctl = session.controllers[1]
+            read = ctl.input_plans[t + {kind}]
+        except KeyError:  # none kept (yet, or since a change), no controller
+            ctl = session.controllers.get(1)
+            read = None
+        if ctl is not None:
+            clock = ctl.clock
+            if clock._thread is None and session.note is None:
+                tp = type(p)
+                if tp is _CArg:
+                    obj = target(p)
+                    if obj is p:  # (byref(x, offset), another type: the table path)
+                        obj = _NO
+                elif tp is T0 or tp in ok:
+                    obj = p
+                else:
+                    b = first(p, tp)  # (an array: its first element)
+                    obj = _NO if b is None else None
+                if obj is not _NO:
+                    bank = ctl.bank
+                    if bank is not None and bank.n_alive:  # (what the table path does
+                        bank.before_call(ctl, proto, (t, p))  # first: its axes go back)
+                    if read is None:
+                        read = plan(ctl, t)
+                    v = read()
+                    if obj is not None:
+                        k = type(obj)
+                        done = k is T0 or k in wide or bounds[k][0] <= v <= bounds[k][1]
+                        if done:
+                            obj.value = v
+                    else:  # an array's first element
+                        done = b[0] <= v <= b[1]
+                        if done:
+                            p[0] = v
+                    if done:  # (else a value the type cannot hold: the table's code)
+                        session.last = None
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+    return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
+"""
 
 
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
