@@ -907,10 +907,10 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
     core_first = proto.core_first_form
 
     tails = [tuple(defaults[n:]) for n in range(n_params + 1)]
-    first_missing = [
-        next((i for i in range(n, n_params) if defaults[i] is _MISSING), None)
-        for n in range(n_params + 1)
-    ]
+    # the first parameter from n on that has no default (None: none), for every n
+    first_missing: list[int | None] = [None] * (n_params + 1)
+    for i in range(n_params - 1, -1, -1):
+        first_missing[i] = i if defaults[i] is _MISSING else first_missing[i + 1]
 
     def missing(i: int) -> ParameterError:
         return ParameterError(

@@ -56,3 +56,22 @@ def test_every_name_is_found_in_a_fresh_process():
     assert got["vars_after"]
     assert got["enums"] > 0 and got["struct"]
     assert got["no_such"] is False
+
+
+def test_the_kept_table_is_the_table(tmp_path, monkeypatch):
+    """The function table kept between processes reads back as the groups read it: the same
+    prototypes in the same order, the enum names; a damaged file is read from the groups."""
+    from gtecat.gt import table
+
+    monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path))
+    key = table._cache_key(table.GROUPS)
+    assert key is not None and table._read_cache(key) is None  # nothing kept yet
+    fresh = table.collect(table.GROUPS)
+    table._write_cache(key, fresh)
+    enums, kept = table._read_cache(key)
+    assert list(kept) == list(fresh) and set(enums) == table.ENUMS
+    assert all(kept[k] == fresh[k] and kept[k].by_name == fresh[k].by_name for k in fresh)
+    table._cache_file(key).write_bytes(b"\x00damaged")
+    assert table._read_cache(key) is None
+    monkeypatch.setenv("GTECAT_PYC_CACHE", "0")
+    assert table._cache_key(table.GROUPS) is None
