@@ -122,10 +122,35 @@ def _dc_exec(source: Any, globals: Any = None, locals: Any = None) -> None:
             key = hashlib.sha1(source.encode("utf-8", "surrogatepass")).hexdigest()
             code = _DC_CODES.get(key)
             if code is None:
-                code = _DC_CODES[key] = _DC_NEW[key] = compile(source, "<string>", "exec")
+                # as exec compiles it there: no __future__ of this module's (annotations
+                # stay objects, not text)
+                code = compile(source, "<string>", "exec", dont_inherit=True)
+                _DC_CODES[key] = _DC_NEW[key] = code
             _builtin_exec(code, globals, locals)
             return
+    if type(source) is str:  # (a text exec'd here would take this module's __future__)
+        source = compile(source, "<string>", "exec", dont_inherit=True)
     _builtin_exec(source, globals, locals)
+
+
+def compiled(source: str, filename: str) -> CodeType:
+    """``compile(source, filename, "exec")`` as a gtecat module with ``from __future__ import
+    annotations`` compiles it, kept in the same store: the functions gtecat writes at run
+    time (the GT fast paths, the compiled binders, a replay's calls)."""
+    if not _DC_FILE:  # (the store is off)
+        return compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
+    if not _DC_FILE[1:]:
+        _DC_FILE.append(_DC_FILE[0])
+        _dc_load()
+    key = hashlib.sha1(f"{filename}\0{source}".encode("utf-8", "surrogatepass")).hexdigest()
+    code = _DC_CODES.get(key)
+    if code is None:
+        code = compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
+        _DC_CODES[key] = _DC_NEW[key] = code
+    return code
+
+
+_ANNOTATIONS = __import__("__future__").annotations.compiler_flag
 
 
 def _dc_load() -> None:
@@ -176,6 +201,6 @@ def install_dataclass_cache(version: str) -> None:
         return
     if vars(dataclasses).get("exec", _dc_exec) is not _dc_exec:
         return  # someone else's exec there: left alone
-    _DC_FILE.append(_cache_dir(version).parent / f"dataclass-{sys.implementation.cache_tag}")
+    _DC_FILE.append(_cache_dir(version).parent / f"dataclass-{sys.implementation.cache_tag}-2")
     dataclasses.exec = _dc_exec  # type: ignore[attr-defined]
     atexit.register(_dc_save)

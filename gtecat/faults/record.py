@@ -42,6 +42,7 @@ from operator import contains, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
+from .._bytecode import compiled as _compiled_code
 from ..errors import ParameterError
 from .tap import Listener, tap, untap
 
@@ -764,7 +765,7 @@ def _compiled(p: _Call) -> Any:
     for j, (obj, _, _, _) in enumerate(p.quick):
         env[f"Q{j}"] = obj
     lines += [f"    if {' or '.join(same)}:", "        return (rc,)", "    return None"]
-    exec(compile("\n".join(lines), f"<replay {p.name}>", "exec"), env)
+    exec(_compiled_code("\n".join(lines), f"<replay {p.name}>"), env)
     return env["run"]
 
 

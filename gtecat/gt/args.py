@@ -55,6 +55,7 @@ from typing import Any
 
 import numpy as np
 
+from .._bytecode import compiled as _compiled_code
 from ..errors import ParameterError
 from . import structs
 from .table import ENUMS, SCALARS, Param, Proto
@@ -1273,7 +1274,7 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         f"    return ({', '.join(out)}{',' if len(out) == 1 else ''})",
     ]
     code = "\n".join(lines)
-    exec(compile(code, f"<gt binder {proto.name}>", "exec"), env)
+    exec(_compiled_code(code, f"<gt binder {proto.name}>"), env)
     fn = env["bind"]
     fn.source = code  # type: ignore[attr-defined]
     return fn
