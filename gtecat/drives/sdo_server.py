@@ -146,6 +146,30 @@ class SdoServer:
         if abort is not None:
             raise abort
 
+    def upload_in_process(self, index: int, subindex: int) -> bytes:
+        """An expedited upload (an object of 1 to 4 bytes) exactly as :meth:`handle` serves
+        its frame, for a client in the same process with nothing between the two: the same
+        object dictionary read, the same counter, the abort the client reads from the answer
+        raised.  A controller that reads an unmapped object every cycle (a touch probe's
+        60B9h, a mode's 6061h) pays an object read, not two mailbox frames built and parsed.
+        The caller checks the size (:meth:`ObjectDictionary.size_of`) first: a longer
+        object is a segmented transfer, with more counters, and takes the framed path."""
+        self._pending.clear()
+        self._upload = self._download = None
+        abort = None
+        data = b""
+        try:
+            data = self.od.upload(index, subindex)
+        except SdoAbort as err:
+            abort = SdoAbort(err.code, err.index, err.subindex)
+        except Exception:
+            log.exception("SDO request 0x%04X:%02X failed inside the slave", index, subindex)
+            abort = SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex)
+        self.counter = next_counter(self.counter)
+        if abort is not None:
+            raise abort
+        return data
+
     def next_message(self) -> bytes | None:
         """The next fragment of a multi-message answer, or None when there is none."""
         return self._pending.popleft() if self._pending else None
