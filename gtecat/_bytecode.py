@@ -96,7 +96,7 @@ def install(version: str) -> None:
     sys.meta_path.insert(at, _Finder)
 
 
-# --- the methods dataclasses writes ------------------------------------------------------------
+# --- the methods dataclasses writes, the functions gtecat writes ---------------------------------
 # ``@dataclass`` writes each class's __init__, __repr__, __eq__ (and __setattr__ of a frozen one)
 # as source text and compiles it while the module is imported: for gtecat's ~180 dataclasses a
 # fifth of a process's import, every process.  The compiled text is kept here like the
@@ -135,18 +135,27 @@ def _dc_exec(source: Any, globals: Any = None, locals: Any = None) -> None:
 
 def compiled(source: str, filename: str) -> CodeType:
     """``compile(source, filename, "exec")`` as a gtecat module with ``from __future__ import
-    annotations`` compiles it, kept in the same store: the functions gtecat writes at run
-    time (the GT fast paths, the compiled binders, a replay's calls)."""
-    if not _DC_FILE:  # (the store is off)
+    annotations`` compiles it, kept in the cache one file per text (read only when asked
+    for): the functions gtecat writes at run time (the GT fast paths, the compiled binders,
+    a replay's calls)."""
+    if not _DC_FILE:  # (the caches are off)
         return compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
-    if not _DC_FILE[1:]:
-        _DC_FILE.append(_DC_FILE[0])
-        _dc_load()
     key = hashlib.sha1(f"{filename}\0{source}".encode("utf-8", "surrogatepass")).hexdigest()
-    code = _DC_CODES.get(key)
-    if code is None:
-        code = compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
-        _DC_CODES[key] = _DC_NEW[key] = code
+    path = _DC_FILE[0].parent / "gen" / f"{key}.code"
+    try:
+        code = marshal.loads(path.read_bytes())
+        if isinstance(code, CodeType) and code.co_filename == filename:
+            return code
+    except (OSError, EOFError, ValueError, TypeError):
+        pass
+    code = compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps(code))
+        os.replace(tmp, path)
+    except OSError:
+        pass  # a read-only home: compiled again next time
     return code
 
 
