@@ -217,13 +217,18 @@ def fast_reader(
     limit = CONTROLLER_AXES if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
 
+    core: list[Any] = []  # (CMD_PARAM, _record): the GT layer imports this module first
+
     def refuse(ctl: Any, reason: str) -> int:
         """The table path's refusal of a parameter (code 7 and the reason), then the call's
         host latency."""
-        from ._core import CMD_PARAM, _record  # (the GT layer imports this module)
+        if not core:
+            from ._core import CMD_PARAM, _record
 
-        _record(name, CMD_PARAM, reason)
-        return advance(ctl, name, CMD_PARAM)
+            core[:] = (CMD_PARAM, _record)
+        code, record = core
+        record(name, code, reason)
+        return advance(ctl, name, code)
 
     def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
