@@ -14,7 +14,6 @@ frames a real master would have exchanged are written to a capture
 from __future__ import annotations
 
 from collections.abc import Callable
-from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -239,8 +238,9 @@ class EmulatedBackend(Backend):
         if image is None:
             return False
         op = _OP
-        if not _OP_ONLY.issuperset(map(_AL_STATE, self._claimed_slaves)):
-            return False  # (one the bank runs is not in OP)
+        for slave in self._claimed_slaves:
+            if slave.al_state != op:
+                return False
         plan = self._steady_plan
         if plan is None or plan[0] is not self._run_plan or plan[1] is not image:
             plan = self._steady_plan = (self._run_plan, image, self._steady_rows(image))
@@ -373,5 +373,3 @@ class EmulatedBackend(Backend):
 
 _IO_STEP = IoSlave.step
 _OP = AlState.OP
-_OP_ONLY = frozenset({AlState.OP})
-_AL_STATE = attrgetter("al_state")
