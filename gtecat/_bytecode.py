@@ -210,6 +210,10 @@ def install_dataclass_cache(version: str) -> None:
         return
     if vars(dataclasses).get("exec", _dc_exec) is not _dc_exec:
         return  # someone else's exec there: left alone
-    _DC_FILE.append(_cache_dir(version).parent / f"dataclass-{sys.implementation.cache_tag}-2")
+    try:
+        folder = _cache_dir(version).parent
+    except (RuntimeError, KeyError, OSError):  # (no home folder to put a cache in)
+        return
+    _DC_FILE.append(folder / f"dataclass-{sys.implementation.cache_tag}-2")
     dataclasses.exec = _dc_exec  # type: ignore[attr-defined]
     atexit.register(_dc_save)

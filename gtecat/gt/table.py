@@ -454,8 +454,8 @@ def _write_cache(key: str | None, table: dict[str, Proto]) -> None:
         tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
         tmp.write_bytes(marshal.dumps((sorted(ENUMS), params, protos)))
         os.replace(tmp, path)
-    except (OSError, ValueError):
-        pass  # a read-only home: read from the groups again next time
+    except (OSError, ValueError, RuntimeError):
+        pass  # a read-only home, or none: read from the groups again next time
 
 
 #: every group of the table (:class:`gtecat.gt.groups.Group`), in file-name order
