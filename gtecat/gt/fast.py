@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
@@ -216,13 +217,18 @@ def fast_reader(
     limit = CONTROLLER_AXES if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
 
+    core: list[Any] = []  # (CMD_PARAM, _record): the GT layer imports this module first
+
     def refuse(ctl: Any, reason: str) -> int:
         """The table path's refusal of a parameter (code 7 and the reason), then the call's
         host latency."""
-        from ._core import CMD_PARAM, _record  # (the GT layer imports this module)
+        if not core:
+            from ._core import CMD_PARAM, _record
 
-        _record(name, CMD_PARAM, reason)
-        return advance(ctl, name, CMD_PARAM)
+            core[:] = (CMD_PARAM, _record)
+        code, record = core
+        record(name, code, reason)
+        return advance(ctl, name, code)
 
     def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
@@ -649,7 +655,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
             lines += ["    if type(v) is not float:", "        v = to(v)"]
     value = "\n".join("            " + line for line in lines)
     code = code.replace("{value}", value)
-    exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
+    exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]
 
 
@@ -952,7 +958,7 @@ def fast_raw(
             env["pack"] = fmt.pack_into
             move = [f"pack(p, 0, {', '.join(cells)})"]
         body = "\n    ".join([*check, *move, "return True"])
-        exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
+        exec(_compiled_code(f"def copy(p):\n    {body}\n", f"<gt copy {name}>"), env)
         copy = env["copy"]
         names = {k: v for k, v in env.items() if k != "copy" and not k.startswith("__")}
         copy.spec = (ok, move[0], names)  # (for the specialised entry, _raw_entry)
@@ -1135,7 +1141,7 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
     uses go into ``env`` (its globals) with the suffix ``n``."""
     fmt = {"slave": "slave=_NO, " if io else "", "slave_arg": "slave, " if io else ""}
     if n < 0:
-        exec(compile(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>", "exec"), env)
+        exec(_compiled_code(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>"), env)
         return env.pop("gt")
     slave, offset, size, tp, ref = key
     ok, move, names = spec
@@ -1164,7 +1170,7 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         given="given" if ref else "p",
     )
     scratch: dict[str, Any] = {}
-    exec(compile(code, f"<gt fast raw {env['name']} shape {n}>", "exec"), env, scratch)
+    exec(_compiled_code(code, f"<gt fast raw {env['name']} shape {n}>"), env, scratch)
     return scratch["gt"].__code__
 
 
@@ -1244,7 +1250,7 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
     code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
     env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof)
-    exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
+    exec(_compiled_code(code, f"<gt fast raw {env['name']}>"), env)  # env: its globals
     return env["gt"]
 
 
@@ -1407,7 +1413,7 @@ def fast_ecat_reader(
         byref = _ECAT_BYREF_PY.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
     code = _ECAT_READER.replace("{byref}", byref)
-    exec(compile(code, f"<gt fast ecat {name}>", "exec"), env)
+    exec(_compiled_code(code, f"<gt fast ecat {name}>"), env)
     gt = env["gt"]
     gt.slow = slow
     return gt
