@@ -330,6 +330,8 @@ _CRD_STATE_OF = attrgetter(*_CRD_STATE)
 
 
 def _keep_system(c: CoordSystem) -> tuple:
+    """What a running system's steps change (:func:`keep`); from now on it records the
+    entries it takes off its FIFOs."""
     popped: list = []
     c.popped = popped
     return (_CRD_MOVING, _CRD_STATE_OF(c), c.segments_done, list(c.segments_done), list(c.tails))

@@ -463,10 +463,10 @@ class CoordSystem:
         (``AxisSlot.step``), for the axis bank's tables: the samples (``out[0|1|2, k, j]``:
         position, speed, acceleration of slot ``k`` in cycle ``j``; the system's own array,
         which its next run overwrites) and the index of the cycle the path ended in (-1: it
-        goes on; the cycles after it are not filled).  The cycles
-        inside a motion segment are step's own common case, for a trapezoid along a line or
-        an arc all of them at once (:meth:`_run_segment`, the same operations in the same
-        order); any other is :meth:`step`.  ``speeds``/``marks``: the path speed after each
+        goes on; the cycles after it are not filled).  The cycles inside a motion segment are
+        step's own common case, for a trapezoid along a line or an arc all of them at once
+        (:meth:`_run_segment`, the same operations in the same order); any other is
+        :meth:`step`.  ``speeds``/``marks``: the path speed after each
         cycle, and (cycle, :meth:`state`) after each cycle that was not the common case;
         ``segment``: :meth:`_run_segment` compiled, called with the system first
         (:class:`gtecat.controller.bank_crd.CrdFill`)."""
