@@ -61,16 +61,23 @@ def _outcome(backend: EmulatedBackend, args: tuple) -> Any:
     return "ok"
 
 
-def test_an_unframed_download_is_the_framed_one(monkeypatch: pytest.MonkeyPatch) -> None:
-    framed, fm, cap = _bus(frames=True)
-    served: list[int] = []
+@pytest.fixture
+def served(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """One entry per mailbox request a slave's SDO server answers from now on."""
+    seen: list[int] = []
     handle = SdoServer.handle
 
     def counting(self: SdoServer, message: bytes, al_state: Any = None) -> Any:
-        served.append(1)
+        seen.append(1)
         return handle(self, message, al_state) if al_state is not None else handle(self, message)
 
     monkeypatch.setattr(SdoServer, "handle", counting)
+    return seen
+
+
+def test_an_unframed_download_is_the_framed_one(served: list[int]) -> None:
+    framed, fm, cap = _bus(frames=True)
+    served.clear()  # (the framed bring-up's)
     direct, dm, _ = _bus(frames=False)
     assert not served  # the bring-up's InitCmds went to the servers directly
     assert cap is not None and cap.frames > 0
@@ -127,17 +134,9 @@ def _upload(backend: EmulatedBackend, args: tuple) -> Any:
         return ("abort", int(e.code), e.index, e.subindex, str(e))
 
 
-def test_an_unframed_upload_is_the_framed_one(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_an_unframed_upload_is_the_framed_one(served: list[int]) -> None:
     framed, _, cap = _bus(frames=True)
     direct, _, _ = _bus(frames=False)
-    served: list[int] = []
-    handle = SdoServer.handle
-
-    def counting(self: SdoServer, message: bytes, al_state: Any = None) -> Any:
-        served.append(1)
-        return handle(self, message, al_state) if al_state is not None else handle(self, message)
-
-    monkeypatch.setattr(SdoServer, "handle", counting)
     got = []
     for slave, index, sub in UPLOADS:
         before = len(served)
