@@ -1161,6 +1161,13 @@ class AxisBank:
         first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
         self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
 
+    def holds(self, ax: Any) -> bool:
+        """Whether the bank runs ``ax`` now (asked without giving it back)."""
+        for r, a in enumerate(self.axes):
+            if a is ax:
+                return bool(self.alive[r])
+        return False
+
     def trap_quiet(self, r: int) -> int:
         """The cycles from the next one on in which claimed row ``r``'s Trap move surely goes
         on (the cycle that takes its end sample is not among them); 0 when the row is not

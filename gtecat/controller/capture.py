@@ -258,21 +258,45 @@ class CaptureUnit:
 
     def bank_ready(self) -> bool:
         """The next cycles' :meth:`_post` can find an edge only where the home input changes
-        its level (which the bank watches): no card latch, the touch probe neither armed nor
-        being written, the home level the one last seen."""
-        if self._card_edges is not None or self._tp_want or self._tp_sent or self._tp_pending:
+        its level (which the bank watches) or where the drive's touch probe latches one
+        (the bank gives the axis back before a cycle whose travel reaches such an edge:
+        ``CspBank.tp_lo``/``tp_hi``): no card latch, the touch probe off or armed with
+        nothing being written, its status read from the image or by SDO uploads the bus
+        can count without sending (:meth:`bank_released`), the home level the one last
+        seen."""
+        if self._card_edges is not None or self._tp_pending or self._tp_want != self._tp_sent:
+            return False
+        if self._tp_sent and self._tp_polled() is None:
             return False
         return self._home_prev == self.home_level()
+
+    def _tp_polled(self) -> tuple[Any, int] | None:
+        """How :meth:`_touch_probe` reads 60B9h: (None, 0) from the process image; (the
+        backend, the slave) by an SDO upload the backend can count without sending it
+        (``uploads_unframed``); None by one it must send."""
+        io = self.ax.io
+        if io.get(0x60B9) is not None:
+            return None, 0
+        backend = getattr(self.ctl, "backend", None)
+        unframed = getattr(backend, "uploads_unframed", None)
+        if unframed is None or not unframed(io.slave):
+            return None
+        return backend, io.slave
 
     def bank_released(self, cycles: int) -> None:
         """The bank ran ``cycles`` cycles of the axis: what :meth:`_post` would have left (this
         cycle's encoder step, the home level; no edge: the input did not change where it was
-        watched, and where it was not, nobody reads the edges)."""
+        watched, and where it was not, nobody reads the edges; the touch probe latched
+        nothing, and the 60B9h reads by SDO that found it so are counted)."""
         if cycles:
             enc = self.res.encoder
             self.step = enc.vel * self.res.cycle_ms if enc.active else 0.0
             self.edges = []
             self._home_prev = self.home_level()
+            if self._tp_sent:
+                polled = self._tp_polled()
+                if polled is not None and polled[0] is not None:
+                    polled[0].uploads_answered(polled[1], cycles)
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:

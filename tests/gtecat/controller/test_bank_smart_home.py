@@ -27,9 +27,23 @@ from tests.gtecat.controller.test_bank import ENI, HAS_CC
 AXES = 12
 #: axis -> (THomePrm fields, machine keys); positions in counts (pulse = count here)
 SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
-    1: ({"mode": 20}, {"home_switch": [[3_000, 4_500]]}),
-    2: ({"mode": 20, "moveDir": -1, "edge": 1}, {"home_switch": [[-5_000, -3_500]]}),
-    3: ({"mode": 11}, {"positive_limit": 6_000, "home_switch": [[2_000, 3_000]]}),
+    1: (  # the first index ahead, fast
+        {"mode": 30},
+        {"index_offset": 2_500, "counts_per_rev": 10_000},
+    ),
+    2: (  # forced home, then the first index beyond it
+        {"mode": 41, "homeOffset": 120, "velLow": 10.0},
+        {"home_switch": [[2_500, 7_000]], "index_offset": 650, "counts_per_rev": 2_000},
+    ),
+    3: (  # limit, home on the way back, back to it, the first index beyond it
+        {"mode": 13, "velHigh": 20.0, "velLow": 10.0},
+        {
+            "positive_limit": 3_600,
+            "home_switch": [[2_000, 3_000]],
+            "index_offset": 170,
+            "counts_per_rev": 1_000,
+        },
+    ),
     4: ({"mode": 10, "moveDir": -1, "escapeStep": 400}, {"negative_limit": -4_000}),
     5: ({"mode": 20}, {"position": 1_000, "home_switch": [[500, 2_500]]}),
     6: ({"mode": 20}, {"positive_limit": 3_000, "home_switch": [[-3_000, -2_000]]}),
@@ -37,8 +51,11 @@ SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
         {"mode": 22, "homeOffset": -300},
         {"home_switch": [[2_000, 3_000]], "index_offset": 100, "counts_per_rev": 1_000},
     ),
-    8: ({"mode": 11, "moveDir": -1}, {"negative_limit": -3_500, "home_switch": [[-1_800, -900]]}),
-    9: ({"mode": 40}, {"home_switch": [[2_500, 7_000]]}),
+    8: (  # the negative limit, then slowly up to the first index
+        {"mode": 12, "moveDir": -1, "indexDir": 1, "velHigh": 20.0, "homeOffset": 150},
+        {"negative_limit": -3_500, "index_offset": 600, "counts_per_rev": 1_000},
+    ),
+    9: ({"mode": 20, "moveDir": -1, "edge": 1}, {"home_switch": [[-5_000, -3_500]]}),
     10: ({"mode": 20, "homeOffset": 250}, {"home_switch": [[4_000, 6_000]]}),  # GT_Stop
     11: ({"mode": 20}, {"home_switch": [[400_000, 410_000]]}),  # still searching at the end
     12: (  # GT_Stop while it stands between the home return and the index search
@@ -112,7 +129,7 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
             _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
         ctl = gt.GTE_Controller()
         size = ctl.layout.gt_raw_bytes
-        k = 0
+        k = searching = banked = 0
         while k < CYCLES:
             if k <= STOP_AT < k + max(step, 1):
                 _ok(gt.GT_Stop(1 << 9, 0), "stop")
@@ -129,11 +146,17 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
             gt.GTE_Wait(wait)
             k += wait
             trace.append(_sample(size))
+            # an index search (stage 30) after its probe armed: which axes the bank runs
+            for a, (run, stage, *_) in enumerate(trace[-1][3], 1):
+                if run and stage == 30:
+                    searching += 1
+                    banked += ctl.bank is not None and ctl.bank.holds(ctl.axes[a])
         bank_ = ctl.bank
         stats = {
             "rows": bank_.rows_run if bank_ is not None else 0,
             "many": bank_.many_cycles if bank_ is not None else 0,
             "kernel": bank_ is not None and bank_.kernel is not None,
+            "index_search": (banked, searching),
         }
         trace.append(
             tuple(
@@ -169,7 +192,7 @@ def test_smart_homing_in_the_bank_matches_the_scalar_path(runs: tuple) -> None:
     assert ended[10] == (0, 20, 4)
     assert ended[11] == (1, 20, 0)
     assert ended[12] == (0, 30, 4)
-    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11, 12)), ended
+    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11, 12)), str(ended)
     stood = {prf[11] for _, prf, _, homes_k, _ in ref[:-1] if homes_k[11][0] == 0}
     assert len(stood) == 1, "axis 12 moved after GT_Stop"
 
@@ -181,6 +204,10 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
     assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
     if stats["kernel"]:
         assert stats["many"] > 20  # cycles the homings let the controller run at once
+        # the index searches too, their drives' touch probes armed (all but the cycles
+        # around their edges and the probe's arming)
+        banked, searching = stats["index_search"]
+        assert searching > 100 and banked > 0.7 * searching, stats["index_search"]
 
 
 def test_long_waits_give_the_same_homings(machine: str) -> None:
