@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -70,9 +71,9 @@ STOP_AT = 90  # GT_Stop of axis 10 in the middle of its search
 STAND_STOP_AT = 317
 
 
-def _machine(tmp: Path) -> str:
+def _machine(tmp: Path, setup: dict = SETUP) -> str:
     lines = []
-    for axis, (_, keys) in SETUP.items():
+    for axis, (_, keys) in setup.items():
         lines.append(f"[axis.{axis}]")
         lines += [f"{k} = {v}" for k, v in keys.items()]
     path = tmp / "machine.toml"
@@ -84,16 +85,16 @@ def _ok(rc: int, what: str) -> None:
     assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
 
 
-def _sample(size: int) -> tuple:
-    sts = (c_long * AXES)()
-    prf = (c_double * AXES)()
-    enc = (c_double * AXES)()
-    gt.GT_GetSts(1, sts, AXES)
-    gt.GT_GetPrfPos(1, prf, AXES)
-    gt.GT_GetEncPos(1, enc, AXES)
+def _sample(size: int, axes: int = AXES) -> tuple:
+    sts = (c_long * axes)()
+    prf = (c_double * axes)()
+    enc = (c_double * axes)()
+    gt.GT_GetSts(1, sts, axes)
+    gt.GT_GetPrfPos(1, prf, axes)
+    gt.GT_GetEncPos(1, enc, axes)
     homes = []
     hs = gt.THomeStatus()
-    for a in range(1, AXES + 1):
+    for a in range(1, axes + 1):
         _ok(gt.GT_GetHomeStatus(a, byref(hs)), "status")
         homes.append((hs.run, hs.stage, hs.error, hs.capturePos, hs.targetPos))
     raw = (c_ubyte * size)()
@@ -101,12 +102,21 @@ def _sample(size: int) -> tuple:
     return tuple(sts), tuple(prf), tuple(enc), tuple(homes), bytes(raw)
 
 
-def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
+def _run(
+    machine: str,
+    bank: str,
+    step: int = 0,
+    eni: Path = ENI,
+    setup: dict = SETUP,
+    cycles: int = CYCLES,
+) -> tuple[list, dict[str, Any]]:
     """The homings, sampled after every cycle (``step`` 0: one cycle at a time, now and then
     seven) or after every ``step`` cycles run at once (a long wait: the controller runs
-    them in as few calls as the homings let it)."""
+    them in as few calls as the homings let it); the stops of axes 10 and 12 with
+    :data:`SETUP` alone."""
+    stops = setup is SETUP
     gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank=bank), "open")
+    _ok(gt.GT_Open(eni=str(eni), machine=machine, clock="lockstep", log="", bank=bank), "open")
     trace: list = []
     try:
         _ok(gt.GT_InitEcatComm(), "init")
@@ -117,7 +127,7 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
                 break
             gt.GTE_Wait(1)
         _ok(gt.GT_StartEcatComm(), "start")
-        for a, (fields, _) in SETUP.items():
+        for a, (fields, _) in setup.items():
             _ok(gt.GT_AxisOn(a), f"axis on {a}")
             _ok(gt.GT_PrfTrap(a), f"trap {a}")
             prm = gt.THomePrm()
@@ -130,10 +140,10 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
         ctl = gt.GTE_Controller()
         size = ctl.layout.gt_raw_bytes
         k = searching = banked = 0
-        while k < CYCLES:
-            if k <= STOP_AT < k + max(step, 1):
+        while k < cycles:
+            if stops and k <= STOP_AT < k + max(step, 1):
                 _ok(gt.GT_Stop(1 << 9, 0), "stop")
-            if k <= STAND_STOP_AT < k + max(step, 1):
+            if stops and k <= STAND_STOP_AT < k + max(step, 1):
                 if not step:  # (the one-cycle run: it must stand there now)
                     hs = gt.THomeStatus()
                     _ok(gt.GT_GetHomeStatus(12, byref(hs)), "status")
@@ -145,7 +155,7 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
             wait = step or (1 if k % 50 else 7)
             gt.GTE_Wait(wait)
             k += wait
-            trace.append(_sample(size))
+            trace.append(_sample(size, len(setup)))
             # an index search (stage 30) after its probe armed: which axes the bank runs
             for a, (run, stage, *_) in enumerate(trace[-1][3], 1):
                 if run and stage == 30:
@@ -158,12 +168,20 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
             "kernel": bank_ is not None and bank_.kernel is not None,
             "index_search": (banked, searching),
         }
+        if bank_ is not None:
+            bank_.release_all()  # (the uploads of the cycles it ran are counted at a release)
+        backend = ctl.backend
+        mailboxes = [
+            (backend._clients[p].counter, backend.slaves[p].sdo.counter)
+            for p in sorted(backend._clients)
+        ]
         trace.append(
             tuple(
                 (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
-                for s in ctl.backend.slaves
+                for s in backend.slaves
                 for ch in getattr(s, "channels", [])
             )
+            + tuple(mailboxes)
         )
     finally:
         gt.GT_Close()
@@ -218,3 +236,39 @@ def test_long_waits_give_the_same_homings(machine: str) -> None:
         assert a == b, f"after {37 * (k + 1)} cycles: the bank and the scalar path differ"
     if stats["kernel"]:
         assert stats["many"] > 20
+
+
+#: a bus whose drives map no touch-probe object: the capture polls 60B9h by SDO every cycle
+SDO_SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
+    1: (
+        {"mode": 22, "indexDir": 1, "velLow": 10.0},
+        {"home_switch": [[1_500, 2_500]], "index_offset": 1_800, "counts_per_rev": 1_000},
+    ),
+    2: ({"mode": 30, "moveDir": -1}, {"index_offset": -1_900, "counts_per_rev": 4_000}),
+    3: (
+        {"mode": 12, "indexDir": -1, "velHigh": 20.0, "velLow": 10.0},
+        {"positive_limit": 2_500, "index_offset": 1_234, "counts_per_rev": 2_000},
+    ),
+}
+
+
+def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
+    """The capture reads the touch probe's 60B9h by SDO: the bank runs the index searches
+    and counts those uploads at each release, so the mailboxes' counters (both sides) end
+    where the scalar path's do, as does everything the differential test compares."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(len(SDO_SETUP), tmp_path / "axes.eni")
+    machine = _machine(tmp_path, SDO_SETUP)
+    out = []
+    for bank in ("off", "on"):
+        trace, stats = _run(machine, bank, 0, eni, SDO_SETUP, 420)
+        out.append((trace, stats))
+    (ref, _), (got, stats) = out
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    assert all(h[:3] == (0, 100, 0) for h in ref[-2][3]), ref[-2][3]
+    assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
+    if stats["kernel"]:
+        banked, searching = stats["index_search"]
+        assert searching > 100 and banked > 0.7 * searching, stats["index_search"]
