@@ -29,6 +29,8 @@ Where the edges come from, and how exact they are:
   drive without touch probe makes ``GT_SetCaptureMode(..., CAPTURE_INDEX)`` return 1.
   Arming the touch probe takes two cycles (60B8h off, then on).  An application's own
   ``GT_SetTouchProbeFunction`` and an armed capture share probe 1: the last writer wins.
+  The axis bank runs an axis whose probe is armed between two of the probe's edges
+  (:meth:`CaptureUnit.bank_ready`): a cycle that would latch one runs here.
 
 Edge senses (``GT_SetCaptureSense(encoder, mode, sense)``, THomePrm ``edge``): the
 vendor's 0 = falling edge, 1 = rising edge, of the card's terminal.  The card's inputs are
