@@ -76,8 +76,8 @@
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
     X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
     X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
-    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64)                              \
-    X(c_tpw, u8) X(c_tp_lo, f64) X(c_tp_hi, f64)
+    X(c_tpw, u8) X(c_tp_lo, f64) X(c_tp_hi, f64)                                           \
+    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64)
 
 enum {
 #define X(name, type) F_##name,
