@@ -301,6 +301,10 @@ class SmartHome:
         #: what the last step saw of what a call may change (:meth:`quiet`)
         self._seen_latched = -1
         self._seen_changes: tuple[int, int] = (-1, -1)
+        #: the controller's GPI registers while a forced homing's trigger is a GPI (only a
+        #: call changes them), and their value at the last step
+        self._gpio: Any = None
+        self._seen_gpi = -1
 
     @property
     def running(self) -> bool:
@@ -392,6 +396,7 @@ class SmartHome:
         self._failing = False
         self._expect = None
         self._q_claim = 0
+        self._gpio = None
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
@@ -461,6 +466,8 @@ class SmartHome:
             return None
         if (self.unit.changes, self._trigger.changes) != self._seen_changes:
             return None
+        if self._gpio is not None and self._gpio.gpi != self._seen_gpi:
+            return None
         prof = res.profile
         if prof.mode != PrfMode.TRAP:
             return None
@@ -493,6 +500,8 @@ class SmartHome:
             self._fail(a.error, str(a))
         self._seen_latched = res.latched
         self._seen_changes = (self.unit.changes, self._trigger.changes)
+        if self._gpio is not None:
+            self._seen_gpi = self._gpio.gpi
 
     def _watch(self) -> tuple[HomeError, str] | None:
         res = self.res
@@ -691,12 +700,16 @@ class SmartHome:
 
     def _search_gpi(self, d: int) -> _Steps:
         p, st, unit = self.params, self.status, self.unit
-        own = p.triggerIndex == -1  # (a GPI of the IO: it may change in any cycle)
+        own = p.triggerIndex == -1
         if own:
             unit.refresh_wiring()
             level: Callable[[], bool] = unit.home_level
         else:
-            io, k = digital_io(self.ctl), p.triggerIndex
+            # a GPI of the controller's IO: only a call (GTE_SetGpi) changes it, and a
+            # call gives every axis back first, so the waits stay quiet (:meth:`quiet`
+            # compares the registers with what the last step saw)
+            io = self._gpio = digital_io(self.ctl)
+            k = p.triggerIndex
             level = lambda: io.gpi_level(k)  # noqa: E731
         dist = p.searchHomeDistance or UNLIMITED
         st.stage = Stage.SEARCH_GPI
@@ -704,7 +717,7 @@ class SmartHome:
             if level():
                 break
             why, _ = yield from self._leg(
-                d, dist, p.velHigh, lambda: level() or None, own, unit if own else None
+                d, dist, p.velHigh, lambda: level() or None, True, unit if own else None
             )
             if why == "event":
                 break
@@ -712,7 +725,7 @@ class SmartHome:
                 raise _Abort(HomeError.NO_HOME, "the trigger did not become active")
             yield from self._stop()  # behind: back over the whole active zone, then again
             why, _ = yield from self._leg(
-                -d, dist, p.velHigh, _passed_level(level), own, unit if own else None
+                -d, dist, p.velHigh, _passed_level(level), True, unit if own else None
             )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the trigger is not active between the limits")
@@ -723,7 +736,7 @@ class SmartHome:
         def gone() -> float | None:
             return None if level() else unit.enc - 0.5 * unit.step
 
-        why, pos = yield from self._leg(-d, dist, p.velLow, gone, own, unit if own else None)
+        why, pos = yield from self._leg(-d, dist, p.velLow, gone, True, unit if own else None)
         if why != "event":
             raise _Abort(HomeError.NO_HOME, "the trigger did not become inactive on the way back")
         st.capturePos = _long(round(pos))
@@ -769,9 +782,9 @@ class SmartHome:
     ) -> _Steps:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
         position) when the limit in ``d`` is reached, or ("end", None).  ``own``: ``watch``
-        reads inputs of this axis only (its home input, its capture), so the wait may be
-        :meth:`quiet`; ``levels``: the capture unit whose home level or edges ``watch``
-        reads (:meth:`CaptureUnit.watch_level`)."""
+        reads inputs of this axis only (its home input, its capture) or a GPI (which only a
+        call changes), so the wait may be :meth:`quiet`; ``levels``: the capture unit whose
+        home level or edges ``watch`` reads (:meth:`CaptureUnit.watch_level`)."""
         trap = self.res.profile.trap
         if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc

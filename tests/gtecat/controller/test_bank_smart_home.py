@@ -109,11 +109,12 @@ def _run(
     eni: Path = ENI,
     setup: dict = SETUP,
     cycles: int = CYCLES,
+    calls: dict[int, Any] | None = None,
 ) -> tuple[list, dict[str, Any]]:
     """The homings, sampled after every cycle (``step`` 0: one cycle at a time, now and then
     seven) or after every ``step`` cycles run at once (a long wait: the controller runs
     them in as few calls as the homings let it); the stops of axes 10 and 12 with
-    :data:`SETUP` alone."""
+    :data:`SETUP` alone; ``calls``: cycle -> a call made before it (a GPI set)."""
     stops = setup is SETUP
     gt.GT_Close()
     _ok(gt.GT_Open(eni=str(eni), machine=machine, clock="lockstep", log="", bank=bank), "open")
@@ -141,6 +142,9 @@ def _run(
         size = ctl.layout.gt_raw_bytes
         k = searching = banked = 0
         while k < cycles:
+            for at, call in (calls or {}).items():
+                if k <= at < k + max(step, 1):
+                    call()
             if stops and k <= STOP_AT < k + max(step, 1):
                 _ok(gt.GT_Stop(1 << 9, 0), "stop")
             if stops and k <= STAND_STOP_AT < k + max(step, 1):
@@ -249,20 +253,28 @@ SDO_SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
         {"mode": 12, "indexDir": -1, "velHigh": 20.0, "velLow": 10.0},
         {"positive_limit": 2_500, "index_offset": 1_234, "counts_per_rev": 2_000},
     ),
+    4: (  # the trigger is GPI 3 (active from cycle 60 to 140), then the index beyond
+        {"mode": 41, "triggerIndex": 3, "indexDir": 1, "velLow": 10.0},
+        {"index_offset": 3_777, "counts_per_rev": 5_000},
+    ),
 }
+#: the GPI of axis 4: a sensor the axis passes (the test sets it, as a scenario would)
+GPI_CALLS = {60: lambda: gt.GTE_SetGpi(3, 1), 140: lambda: gt.GTE_SetGpi(3, 0)}
 
 
 def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
     """The capture reads the touch probe's 60B9h by SDO: the bank runs the index searches
     and counts those uploads at each release, so the mailboxes' counters (both sides) end
-    where the scalar path's do, as does everything the differential test compares."""
+    where the scalar path's do, as does everything the differential test compares.  Axis 4
+    homes on a GPI the test sets and clears (GTE_SetGpi gives the axes back; in between
+    its searches stay in the bank)."""
     from tools.gen_axes_eni import write_axes_eni
 
     eni = write_axes_eni(len(SDO_SETUP), tmp_path / "axes.eni")
     machine = _machine(tmp_path, SDO_SETUP)
     out = []
     for bank in ("off", "on"):
-        trace, stats = _run(machine, bank, 0, eni, SDO_SETUP, 420)
+        trace, stats = _run(machine, bank, 0, eni, SDO_SETUP, 420, GPI_CALLS)
         out.append((trace, stats))
     (ref, _), (got, stats) = out
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
