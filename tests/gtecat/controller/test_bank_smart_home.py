@@ -131,6 +131,8 @@ def _run(
         for a, (fields, _) in setup.items():
             _ok(gt.GT_AxisOn(a), f"axis on {a}")
             _ok(gt.GT_PrfTrap(a), f"trap {a}")
+            if fields is None:
+                continue  # (an axis moved by the test's calls)
             prm = gt.THomePrm()
             prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = 20, 1, -1, 0, -1
             prm.velHigh, prm.velLow, prm.acc, prm.dec = 40.0, 4.0, 1.0, 1.0
@@ -243,7 +245,7 @@ def test_long_waits_give_the_same_homings(machine: str) -> None:
 
 
 #: a bus whose drives map no touch-probe object: the capture polls 60B9h by SDO every cycle
-SDO_SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
+SDO_SETUP: dict[int, tuple[dict[str, object] | None, dict[str, object]]] = {
     1: (
         {"mode": 22, "indexDir": 1, "velLow": 10.0},
         {"home_switch": [[1_500, 2_500]], "index_offset": 1_800, "counts_per_rev": 1_000},
@@ -257,9 +259,30 @@ SDO_SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
         {"mode": 41, "triggerIndex": 3, "indexDir": 1, "velLow": 10.0},
         {"index_offset": 3_777, "counts_per_rev": 5_000},
     ),
+    5: (None, {"home_switch": [[1_500, 2_500]]}),  # moved by a call: axis 6's trigger
+    6: ({"mode": 20, "triggerIndex": 5, "velHigh": 10.0}, {}),
 }
-#: the GPI of axis 4: a sensor the axis passes (the test sets it, as a scenario would)
-GPI_CALLS = {60: lambda: gt.GTE_SetGpi(3, 1), 140: lambda: gt.GTE_SetGpi(3, 0)}
+
+
+def _move_axis_5() -> None:
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = 1.0, 1.0
+    for rc in (
+        gt.GT_SetTrapPrm(5, byref(prm)),
+        gt.GT_SetPos(5, 3_000),
+        gt.GT_SetVel(5, 10.0),
+        gt.GT_Update(1 << 4),
+    ):
+        _ok(rc, "move axis 5")
+
+
+#: GPI 3, axis 4's trigger, set and cleared (a sensor the axis passes, as a scenario would
+#: set it); axis 5 moved across its home switch, where axis 6's homing captures
+CALLS = {
+    20: _move_axis_5,
+    60: lambda: gt.GTE_SetGpi(3, 1),
+    140: lambda: gt.GTE_SetGpi(3, 0),
+}
 
 
 def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
@@ -267,19 +290,22 @@ def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
     and counts those uploads at each release, so the mailboxes' counters (both sides) end
     where the scalar path's do, as does everything the differential test compares.  Axis 4
     homes on a GPI the test sets and clears (GTE_SetGpi gives the axes back; in between
-    its searches stay in the bank)."""
+    its searches stay in the bank); axis 6 on axis 5's home capture (``triggerIndex`` 5)
+    while axis 5 moves in Trap across its home switch."""
     from tools.gen_axes_eni import write_axes_eni
 
     eni = write_axes_eni(len(SDO_SETUP), tmp_path / "axes.eni")
     machine = _machine(tmp_path, SDO_SETUP)
     out = []
     for bank in ("off", "on"):
-        trace, stats = _run(machine, bank, 0, eni, SDO_SETUP, 420, GPI_CALLS)
+        trace, stats = _run(machine, bank, 0, eni, SDO_SETUP, 420, CALLS)
         out.append((trace, stats))
     (ref, _), (got, stats) = out
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
         assert a == b, f"cycle {k}: the bank and the scalar path differ"
-    assert all(h[:3] == (0, 100, 0) for h in ref[-2][3]), ref[-2][3]
+    ended = ref[-2][3]
+    assert all(h[:3] == (0, 100, 0) for a, h in enumerate(ended, 1) if a != 5), ended
+    assert ended[5][3] == ended[4][3]  # (axis 6's capture: axis 5's encoder)
     assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
     if stats["kernel"]:
         banked, searching = stats["index_search"]
