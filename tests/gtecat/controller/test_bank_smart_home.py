@@ -305,7 +305,7 @@ def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
         assert a == b, f"cycle {k}: the bank and the scalar path differ"
     ended = ref[-2][3]
     assert all(h[:3] == (0, 100, 0) for a, h in enumerate(ended, 1) if a != 5), ended
-    assert ended[5][3] == ended[4][3]  # (axis 6's capture: axis 5's encoder)
+    assert 1_500 <= ended[5][3] <= 1_510  # (axis 6 captured axis 5 reaching its switch)
     assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
     if stats["kernel"]:
         banked, searching = stats["index_search"]
