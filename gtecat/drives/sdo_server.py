@@ -146,6 +146,35 @@ class SdoServer:
         if abort is not None:
             raise abort
 
+    def expedites(self, index: int, subindex: int) -> bool:
+        """Whether :meth:`handle` answers an upload of the entry expedited (1 to 4 bytes of a
+        fixed size: not a string, not 64 bits), or aborts it; :meth:`upload_in_process` may
+        stand for it then."""
+        var = self.od.find(index, subindex)
+        return var is None or 1 <= var.info.size <= 4
+
+    def upload_in_process(self, index: int, subindex: int) -> bytes:
+        """An upload of an entry :meth:`expedites` exactly as :meth:`handle` serves its
+        frame, for a client in the same process with nothing between the two: the same
+        object dictionary read, the same counter, the bytes of the answer or the abort the
+        client reads from it (its code, index and subindex) raised.  A capture unit reading
+        its drive's touch probe status by SDO does one every cycle."""
+        self._pending.clear()
+        self._upload = self._download = None
+        abort = None
+        data = b""
+        try:
+            data = self.od.upload(index, subindex)
+        except SdoAbort as err:
+            abort = SdoAbort(err.code, err.index, err.subindex)
+        except Exception:
+            log.exception("SDO request 0x%04X:%02X failed inside the slave", index, subindex)
+            abort = SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex)
+        self.counter = next_counter(self.counter)
+        if abort is not None:
+            raise abort
+        return data
+
     def next_message(self) -> bytes | None:
         """The next fragment of a multi-message answer, or None when there is none."""
         return self._pending.popleft() if self._pending else None

@@ -331,7 +331,20 @@ class EmulatedBackend(Backend):
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
-        return self._client(position).upload(index, subindex, complete_access=complete_access)
+        client = self._client(position)
+        if (
+            not complete_access
+            and 0 <= index <= 0xFFFF
+            and 0 <= subindex <= 0xFF
+            and self.capture is None
+            and getattr(slave.mailbox, "sdo_server_only", False)
+            and slave.sdo.expedites(index, subindex)  # type: ignore[attr-defined]
+        ):
+            # nothing sees the frames: the server's own read, counters and abort, unframed
+            # (as sdo_download below)
+            client.counter = next_counter(client.counter)
+            return slave.sdo.upload_in_process(index, subindex)  # type: ignore[attr-defined]
+        return client.upload(index, subindex, complete_access=complete_access)
 
     def sdo_download(
         self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False

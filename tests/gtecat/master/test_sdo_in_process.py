@@ -1,6 +1,7 @@
 """The in-process backend serves an expedited SDO download (the bring-up's InitCmds, 17 per
-drive) by the slave's SDO server directly when nothing sees the frames: the same object
-dictionary, counters and aborts as the same download framed through the mailbox."""
+drive) and an expedited upload (a capture polling the touch probe's status) by the slave's
+SDO server directly when nothing sees the frames: the same object dictionary, counters and
+aborts as the same transfer framed through the mailbox."""
 
 from __future__ import annotations
 
@@ -104,3 +105,51 @@ def test_a_coe_io_slave_too() -> None:
     assert outcomes[0] == "ok" and outcomes[2][0] == "abort"
     assert dm.sdo_upload(0, 0x7010, 1) == fm.sdo_upload(0, 0x7010, 1) == b"\x5a\x00"
     assert direct._clients[0].counter == framed._clients[0].counter
+
+
+#: (slave, index, subindex): reads answered expedited, refused, and ones that are not
+#: expedited (a string, the whole object: framed either way)
+UPLOADS = [
+    (0, 0x6041, 0),
+    (0, 0x60B9, 0),
+    (1, 0x6064, 0),
+    (0, 0x1018, 1),
+    (0, 0x5FFE, 0),  # no such object
+    (1, 0x6060, 7),  # no such subindex
+    (0, 0x1008, 0),  # a string
+]
+
+
+def _read(backend: EmulatedBackend, args: tuple) -> Any:
+    try:
+        return backend.sdo_upload(*args)
+    except SdoAbort as e:
+        return ("abort", int(e.code), e.index, e.subindex, str(e))
+
+
+def test_an_unframed_upload_is_the_framed_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    framed, _, _ = _bus(frames=True)
+    direct, _, _ = _bus(frames=False)
+    served: list[int] = []
+    handle = SdoServer.handle
+
+    def counting(self: SdoServer, message: bytes, al_state: Any = None) -> Any:
+        served.append(1)
+        return handle(self, message, al_state) if al_state is not None else handle(self, message)
+
+    monkeypatch.setattr(SdoServer, "handle", counting)
+    got = []
+    for slave, index, sub in UPLOADS:
+        before = len(served)
+        a = _read(framed, (slave, index, sub))
+        framed_msgs = len(served) - before
+        before = len(served)
+        b = _read(direct, (slave, index, sub))
+        assert a == b, (hex(index), sub)
+        assert (len(served) - before == 0) == (index != 0x1008), hex(index)  # (framed there)
+        assert framed_msgs > 0
+        got.append(a)
+    assert sum(isinstance(x, bytes) for x in got) == 5 and got[4][0] == "abort"
+    for s in range(2):
+        assert direct._clients[s].counter == framed._clients[s].counter
+        assert direct.slaves[s].sdo.counter == framed.slaves[s].sdo.counter
