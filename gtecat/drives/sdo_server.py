@@ -146,19 +146,14 @@ class SdoServer:
         if abort is not None:
             raise abort
 
-    def expedites(self, index: int, subindex: int) -> bool:
-        """Whether :meth:`handle` answers an upload of the entry expedited (1 to 4 bytes of a
-        fixed size: not a string, not 64 bits), or aborts it; :meth:`upload_in_process` may
-        stand for it then."""
-        var = self.od.find(index, subindex)
-        return var is None or 1 <= var.info.size <= 4
-
     def upload_in_process(self, index: int, subindex: int) -> bytes:
-        """An upload of an entry :meth:`expedites` exactly as :meth:`handle` serves its
-        frame, for a client in the same process with nothing between the two: the same
-        object dictionary read, the same counter, the bytes of the answer or the abort the
-        client reads from it (its code, index and subindex) raised.  A capture unit reading
-        its drive's touch probe status by SDO does one every cycle."""
+        """An expedited upload (an object of 1 to 4 bytes) exactly as :meth:`handle` serves
+        its frame, for a client in the same process with nothing between the two: the same
+        object dictionary read, the same counter, the abort the client reads from the answer
+        raised.  A controller that reads an unmapped object every cycle (a touch probe's
+        60B9h, a mode's 6061h) pays an object read, not two mailbox frames built and parsed.
+        The caller checks the size (:meth:`ObjectDictionary.size_of`) first: a longer
+        object is a segmented transfer, with more counters, and takes the framed path."""
         self._pending.clear()
         self._upload = self._download = None
         abort = None

@@ -334,14 +334,13 @@ class EmulatedBackend(Backend):
         client = self._client(position)
         if (
             not complete_access
-            and 0 <= index <= 0xFFFF
-            and 0 <= subindex <= 0xFF
             and self.capture is None
             and getattr(slave.mailbox, "sdo_server_only", False)
-            and slave.sdo.expedites(index, subindex)  # type: ignore[attr-defined]
+            and 0 <= index <= 0xFFFF
+            and 0 <= subindex <= 0xFF
+            and 0 < (slave.sdo.od.size_of(index, subindex) or 0) <= 4  # type: ignore[attr-defined]
         ):
-            # nothing sees the frames: the server's own read, counters and abort, unframed
-            # (as sdo_download below)
+            # an expedited upload nothing sees: as the download below, unframed
             client.counter = next_counter(client.counter)
             return slave.sdo.upload_in_process(index, subindex)  # type: ignore[attr-defined]
         return client.upload(index, subindex, complete_access=complete_access)
