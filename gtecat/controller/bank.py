@@ -1027,8 +1027,11 @@ class AxisBank:
         out: list[object] = []
         for r in g.rows:
             res = self.res[r]
-            out += [self.csp.channels[r], self.axes[r], res.profile.planner, res.encoder]
+            ch = self.csp.channels[r]
+            out += [ch, self.axes[r], res.profile.planner, res.encoder]
             out.append(res.band)
+            if self.csp.tpw[r]:
+                out.append(_get(ch, "probe"))  # (its source, function or values touched)
         return out
 
     def _load(self, r: int) -> None:

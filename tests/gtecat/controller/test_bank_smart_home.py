@@ -174,6 +174,12 @@ def _run(
             "kernel": bank_ is not None and bank_.kernel is not None,
             "index_search": (banked, searching),
         }
+        if bank_ is not None and not stops:
+            # axis 1's probe stays armed after its homing: the bank holds it, and touching
+            # the drive's probe (its source, its values) gives it back first
+            held = bank_.holds(ctl.axes[1])
+            ctl.backend.slaves[0].channels[0].probe.source_select  # noqa: B018
+            stats["probe_guard"] = (held, bank_.holds(ctl.axes[1]))
         if bank_ is not None:
             bank_.release_all()  # (the uploads of the cycles it ran are counted at a release)
         backend = ctl.backend
@@ -307,6 +313,7 @@ def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
     assert all(h[:3] == (0, 100, 0) for a, h in enumerate(ended, 1) if a != 5), ended
     assert 1_500 <= ended[5][3] <= 1_510  # (axis 6 captured axis 5 reaching its switch)
     assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
+    assert stats["probe_guard"] == (True, False)
     if stats["kernel"]:
         banked, searching = stats["index_search"]
         assert searching > 100 and banked > 0.7 * searching, stats["index_search"]
