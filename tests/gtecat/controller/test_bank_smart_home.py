@@ -175,10 +175,10 @@ def _run(
             "index_search": (banked, searching),
         }
         if bank_ is not None and not stops:
-            # axis 1's probe stays armed after its homing: the bank holds it, and touching
-            # the drive's probe (its source, its values) gives it back first
+            # axis 1's probe stays armed after its homing: the bank holds it, and a read of
+            # the drive's probe (its status, by the slave's object dictionary) gives it back
             held = bank_.holds(ctl.axes[1])
-            ctl.backend.slaves[0].channels[0].probe.source_select  # noqa: B018
+            ctl.backend.slaves[0].od.upload(0x60B9, 0)
             stats["probe_guard"] = (held, bank_.holds(ctl.axes[1]))
         if bank_ is not None:
             bank_.release_all()  # (the uploads of the cycles it ran are counted at a release)
