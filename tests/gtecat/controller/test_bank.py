@@ -525,3 +525,39 @@ def test_armed_touch_probes_run_in_the_bank(tmp_path: Path) -> None:
     ref, _, _ = _run(actions, machine, "off", chunked=True)
     got, _, _ = _run(actions, machine, "on", chunked=True)
     assert got == ref  # (the long waits: many cycles per kernel call up to each edge)
+
+
+def test_one_row_given_back_in_floats_is_the_numpy_one(tmp_path: Path) -> None:
+    """A release of one row computes its drive's process values in Python floats
+    (CspBank._one_row); the numpy operations of every other release (_row_outputs) give the
+    same integers, halves, negative zeros and the switch windows included, and the values
+    numpy converts otherwise (not a number, beyond 2**62) go to numpy."""
+    import math
+    import random
+
+    import numpy as np
+
+    _bring_up(_machine_file(tmp_path), "on")
+    try:
+        gt.GTE_Wait(5)
+        csp = gt.GTE_Controller().bank.csp
+        rnd = random.Random(7)
+        values = [0.5, -0.5, 1.5, 2.5, -2.5, -0.0, 0.0, 1e6 + 0.5, 2999.5, 3000.0, 9000.0]
+        checked = 0
+        for k in range(400):
+            r = rnd.randrange(csp.n)
+            for name in ("pos", "dpos", "vel", "acc"):
+                v = rnd.choice(values) if k % 2 else rnd.uniform(-1e5, 1e5)
+                getattr(csp, name)[r] = v
+            csp.limited[r], csp.sw_limited[r] = rnd.random() < 0.3, rnd.random() < 0.2
+            one = csp._one_row(r)
+            ref = csp._row_outputs(np.asarray([r], np.intp))
+            assert one is not None
+            assert one == {name: int(v[0]) for name, v in ref.items()}, (r, k)
+            checked += 1
+        for bad in (math.nan, math.inf, 2.0**63):
+            csp.pos[0] = bad
+            assert csp._one_row(0) is None
+        assert checked == 400
+    finally:
+        gt.GT_Close()
