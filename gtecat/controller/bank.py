@@ -194,6 +194,8 @@ def _crd_push(name: str) -> bool:
 
 #: rows up to which GT_GetSts's words are made row by row (fewer calls than numpy's)
 _SMALL_BANK = 32
+#: the planned values :meth:`AxisBank._materialise` makes: (its Trap table, its Jog value)
+_PLANNED = {"prf_p": ("t_p", "jp"), "prf_v": ("t_v", "jv"), "prf_a": ("t_a", "ja")}
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -1583,8 +1585,8 @@ class AxisBank:
             return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
         if name == "moving":
             return (self.moving | self.jog).tolist()
-        if name in ("prf_p", "prf_v", "prf_a"):
-            self._materialise()
+        if name in _PLANNED:
+            return self._planned(name).tolist()
         return getattr(self, name).tolist()
 
     @staticmethod
@@ -1916,6 +1918,22 @@ class AxisBank:
             for r in np.nonzero(self.hm & self.alive)[0].tolist():
                 self.prf_p[r] = self.res[r].prf_link.source(float(self.a_last[r]))
                 self.prf_v[r] = self.prf_a[r] = 0.0
+
+    def _planned(self, name: str) -> np.ndarray:
+        """One of :meth:`_materialise`'s three, made the same way (a reader of the planned
+        position after a run of cycles needs neither the speed nor the acceleration)."""
+        table, jog = _PLANNED[name]
+        out = getattr(self, table).take(self.t_idx)
+        if self.n_jog:
+            j = self.jog
+            out[j] = getattr(self, jog)[j]
+        if self.n_hm:  # a homing axis's plan holds its actual position
+            for r in np.nonzero(self.hm & self.alive)[0].tolist():
+                out[r] = (
+                    self.res[r].prf_link.source(float(self.a_last[r])) if name == "prf_p" else 0.0
+                )
+        setattr(self, name, out)
+        return out
 
     def _release_rows(self, rows: np.ndarray) -> None:
         """Release the groups of ``rows`` (before this cycle) and re-index."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ctypes
 import importlib
+import threading as _threading
 
 from ._core import REGISTRY
 
@@ -96,7 +97,37 @@ def _vendor_surface() -> None:
     typedefs.BUILT = built
 
 
-_vendor_surface()
+#: the vendor surface (:func:`_vendor_surface`: ~2,900 declared-only functions, the groups'
+#: structures, enums and constants) is made the first time anything asks for a name this
+#: module does not hold yet, or for the whole namespace (``dir()``, ``from gtecat.gt import
+#: *``, :func:`_whole`): a process that calls only emulated functions never pays for it
+_made: list[bool] = []
+_lock = _threading.RLock()
+
+
+def _whole() -> dict[str, object]:
+    """This module's namespace with the vendor surface made (what ``vars(gt)`` held before
+    it was made lazily): walk this, not ``vars(gt)``."""
+    if not _made:
+        with _lock:
+            if not _made:
+                _vendor_surface()
+                _made.append(True)
+    return globals()
+
+
+def __getattr__(name: str) -> object:
+    if name == "__all__":  # ``from gtecat.gt import *``: every public name, made first
+        return [k for k in _whole() if not k.startswith("_")]
+    if not name.startswith("__") and not _made:
+        g = _whole()
+        if name in g:
+            return g[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(_whole())
 
 
 def _arm_faults(ctl: object) -> None:

@@ -66,7 +66,7 @@ def constants() -> dict[str, int | float | str]:
     from .. import gt
 
     out = {}
-    for k, v in vars(gt).items():
+    for k, v in gt._whole().items():
         if k.startswith(("_", "GT_", "GTN_", "GTE_")) or not (k.isupper() and len(k) > 1):
             continue
         if isinstance(v, int | float | str) and not isinstance(v, bool):
@@ -80,7 +80,7 @@ def structures() -> tuple[str, ...]:
 
     return tuple(
         k
-        for k, v in vars(gt).items()
+        for k, v in gt._whole().items()
         if k.startswith("T")
         and isinstance(v, type)
         and issubclass(v, ctypes.Structure | ctypes.Union)

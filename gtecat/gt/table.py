@@ -355,8 +355,107 @@ def _load() -> tuple[tuple, dict[str, Proto]]:
     from .typedefs import enum_names
 
     found = _groups.groups()
+    key = _cache_key(found)
+    cached = _read_cache(key)
+    if cached is not None:
+        enums, table = cached
+        ENUMS.update(enums)
+        return found, table
     ENUMS.update(enum_names(found))
-    return found, collect(found)
+    table = collect(found)
+    _write_cache(key, table)
+    return found, table
+
+
+# --- the parsed table, kept between processes ---------------------------------------------
+# Reading the ~3,700 lines of the groups is most of what importing gtecat.gt costs beyond its
+# modules' code (every process pays it: a replay, a test worker, a native client's
+# controller).  The table read once is kept in gtecat's per-user cache folder as plain
+# values (marshal), named by the digest of everything it is read from: every group's text,
+# and the source of this module and of typedefs (the readers).  A changed group is a new
+# name; a file that is missing, unreadable or not of the expected shape is read again from
+# the groups.  ``GTECAT_PYC_CACHE=0`` turns it off, with gtecat's bytecode cache.
+
+
+def _cache_key(found: Iterable) -> str | None:
+    import hashlib
+    import os
+    import sys
+
+    if os.environ.get("GTECAT_PYC_CACHE", "1") == "0":
+        return None
+    h = hashlib.sha256(f"{sys.version}\0{_CACHE_FORMAT}\0".encode())
+    try:
+        from . import typedefs
+
+        for mod in (sys.modules[__name__], typedefs):
+            with open(mod.__file__, "rb") as f:
+                h.update(f.read())
+    except (OSError, TypeError, KeyError):
+        return None
+    for g in found:
+        for part in (g.name, g.module, str(g.declared_only), g.prototypes, g.structs):
+            h.update(part.encode("utf-8", "surrogatepass"))
+            h.update(b"\0")
+    return h.hexdigest()[:32]
+
+
+#: the shape of the cached values (raised when it changes)
+_CACHE_FORMAT = 1
+
+
+def _cache_file(key: str):
+    from .. import __version__
+    from .._cache import cache_root
+
+    return cache_root() / __version__ / "table" / f"functions-{key}.marshal"
+
+
+def _read_cache(key: str | None) -> tuple[list[str], dict[str, Proto]] | None:
+    import marshal
+
+    if key is None:
+        return None
+    try:
+        enums, params, protos = marshal.loads(_cache_file(key).read_bytes())
+        made = [Param(*p) for p in params]
+        out: dict[str, Proto] = {}
+        for name, idx, entry, core_first, group, twin, unknown in protos:
+            ps = tuple(made[i] for i in idx)
+            out[name] = Proto(
+                name, ps, entry, core_first, {p.name: p for p in ps}, group, twin, unknown
+            )
+        return list(enums), out
+    except Exception:  # (missing, unreadable, another shape: read from the groups)
+        return None
+
+
+def _write_cache(key: str | None, table: dict[str, Proto]) -> None:
+    import marshal
+    import os
+
+    if key is None:
+        return
+    index: dict[int, int] = {}  # id(Param) -> its place
+    params: list[tuple] = []
+    protos = []
+    for p in table.values():
+        idx = []
+        for q in p.params:
+            k = index.get(id(q))
+            if k is None:
+                k = index[id(q)] = len(params)
+                params.append(tuple(getattr(q, f) for f in Param.__slots__))
+            idx.append(k)
+        protos.append((p.name, tuple(idx), p.entry, p.core_first_form, p.group, p.twin, p.unknown))
+    try:
+        path = _cache_file(key)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps((sorted(ENUMS), params, protos)))
+        os.replace(tmp, path)
+    except (OSError, ValueError, RuntimeError):
+        pass  # a read-only home, or none: read from the groups again next time
 
 
 #: every group of the table (:class:`gtecat.gt.groups.Group`), in file-name order

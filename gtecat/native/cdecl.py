@@ -112,7 +112,7 @@ def _structures() -> tuple[type[ctypes.Structure], ...]:
 
     found = {
         v.__name__: v
-        for k, v in vars(gt).items()
+        for k, v in gt._whole().items()
         if k.startswith("T")
         and isinstance(v, type)
         and issubclass(v, ctypes.Structure | ctypes.Union)
@@ -198,7 +198,7 @@ def constants() -> list[Constant]:
 
     members = {n for td in typedefs.BUILT.enums.values() for n, _ in td.members}
     out = []
-    for k, v in vars(gt).items():
+    for k, v in gt._whole().items():
         if k.startswith("_") or k.startswith(("GT_", "GTN_", "GTE_")) or k in members:
             continue
         if k.isupper() and len(k) > 1 and isinstance(v, int | float | str):

@@ -237,7 +237,7 @@ class EmulatedBackend(Backend):
         image = self.image
         if image is None:
             return False
-        op = AlState.OP
+        op = _OP
         for slave in self._claimed_slaves:
             if slave.al_state != op:
                 return False
@@ -401,3 +401,4 @@ class EmulatedBackend(Backend):
 
 
 _IO_STEP = IoSlave.step
+_OP = AlState.OP
