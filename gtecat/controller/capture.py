@@ -121,6 +121,9 @@ class CaptureUnit:
         #: settings changed by a call (arm, clear, sense, reset, wiring): a count a watcher
         #: compares (smart homing: :meth:`SmartHome.quiet`)
         self.changes = 0
+        #: how the cycles the bank runs poll 60B9h (bank_ready): (None, 0) not by SDO, else
+        #: (the backend, the slave) that counts the uploads not sent (bank_released)
+        self._tp_uploads: tuple[Any, int] = (None, 0)
         self._level_watch = 0  # readers of the home level or edges every cycle (watch_level)
         self.reset_settings()
         self.edges: list[SeenEdge] = []
@@ -268,8 +271,12 @@ class CaptureUnit:
         seen."""
         if self._card_edges is not None or self._tp_pending or self._tp_want != self._tp_sent:
             return False
-        if self._tp_sent and self._tp_polled() is None:
+        polled = self._tp_polled() if self._tp_sent else (None, 0)
+        if polled is None:
             return False
+        # (the claim follows this answer: its release counts the uploads the way found now,
+        # whatever the bus looks like then - a pcap started meanwhile ends the bank's run)
+        self._tp_uploads = polled
         return self._home_prev == self.home_level()
 
     def _tp_polled(self) -> tuple[Any, int] | None:
@@ -295,10 +302,9 @@ class CaptureUnit:
             self.step = enc.vel * self.res.cycle_ms if enc.active else 0.0
             self.edges = []
             self._home_prev = self.home_level()
-            if self._tp_sent:
-                polled = self._tp_polled()
-                if polled is not None and polled[0] is not None:
-                    polled[0].uploads_answered(polled[1], cycles)
+            backend, slave = self._tp_uploads
+            if backend is not None:
+                backend.uploads_answered(slave, cycles)
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
