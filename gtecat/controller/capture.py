@@ -274,8 +274,8 @@ class CaptureUnit:
         polled = self._tp_polled() if self._tp_sent else (None, 0)
         if polled is None:
             return False
-        # (the claim follows this answer: its release counts the uploads the way found now,
-        # whatever the bus looks like then - a pcap started meanwhile ends the bank's run)
+        # (the claim follows this answer: its release counts the uploads of the cycles the
+        # bank ran the way found now, whatever the bus looks like at the release)
         self._tp_uploads = polled
         return self._home_prev == self.home_level()
 
