@@ -785,6 +785,12 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_64_axes_homing_17": lambda: rtf(64, every(64, "homing"), 10, "drive homing method 17"),
         "rtf_64_axes_gohome_20": lambda: gohome(64, 20, 10),
         "rtf_64_axes_gohome_11": lambda: gohome(64, 11, 10),
+        "rtf_64_axes_gohome_12": lambda: gohome(64, 12, 10),
+        "rtf_64_axes_gohome_13": lambda: gohome(64, 13, 10),
+        "rtf_64_axes_gohome_22": lambda: gohome(64, 22, 10),
+        "rtf_64_axes_gohome_30": lambda: gohome(64, 30, 10),
+        "rtf_64_axes_gohome_40": lambda: gohome(64, 40, 10),
+        "rtf_64_axes_gohome_41": lambda: gohome(64, 41, 10),
         "rtf_64_axes_homed_mode6": lambda: rtf(
             64, every(64, "homed6"), 10, "homed (method 35), left in homing mode 6, holding"
         ),

@@ -22,8 +22,9 @@ before anything else may look at or change them:
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit, the following
   error, a new sample past a soft limit, a raw write to its slave's outputs, the
-  drive's own following-error window) releases it *before* that cycle, so the scalar
-  code runs that cycle and every later one until the axis is back in the common state;
+  drive's own following-error window, a travel reaching an edge its armed touch probe
+  latches) releases it *before* that cycle, so the scalar code runs that cycle and every
+  later one until the axis is back in the common state;
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
   the axis by touching one of its objects: while claimed they carry a guard class
   (:meth:`AxisBank._guarded_objects`) whose first attribute access gives the axis back;
@@ -1035,8 +1036,11 @@ class AxisBank:
         out: list[object] = []
         for r in g.rows:
             res = self.res[r]
-            out += [self.csp.channels[r], self.axes[r], res.profile.planner, res.encoder]
+            ch = self.csp.channels[r]
+            out += [ch, self.axes[r], res.profile.planner, res.encoder]
             out.append(res.band)
+            if self.csp.tpw[r]:
+                out.append(_get(ch, "probe"))  # (its source, function or values touched)
         return out
 
     def _load(self, r: int) -> None:
@@ -1169,6 +1173,13 @@ class AxisBank:
             return
         first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
         self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
+
+    def holds(self, ax: Any) -> bool:
+        """Whether the bank runs ``ax`` now (asked without giving it back)."""
+        for r, a in enumerate(self.axes):
+            if a is ax:
+                return bool(self.alive[r])
+        return False
 
     def trap_quiet(self, r: int) -> int:
         """The cycles from the next one on in which claimed row ``r``'s Trap move surely goes
