@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import compress
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -640,13 +641,16 @@ class AxisBank:
             np.take(buf, self._rx_all, out=self._rx_snap)
         self.ctl.backend.claimed = set(self._g_pos[g_claimed].tolist())
         rows = self._rows_of_axes
-        if rows is None or len(rows) != len(self.ctl._axis_list):
+        axis_list = self.ctl._axis_list
+        if rows is None or len(rows) != len(axis_list):
             row_of = {id(ax): r for r, ax in enumerate(self.axes)}
-            rows = self._rows_of_axes = [row_of.get(id(ax), -1) for ax in self.ctl._axis_list]
-        out = alive.tolist()
-        self.ctl._run_axes = [
-            ax for ax, r in zip(self.ctl._axis_list, rows, strict=True) if r < 0 or not out[r]
-        ]
+            rows = self._rows_of_axes = [row_of.get(id(ax), -1) for ax in axis_list]
+            self._rows_np = np.array(rows, np.intp)
+            self._rows_in = self._rows_np >= 0
+        # the controller's axes the bank does not run now, in its order
+        rows_np = self._rows_np
+        run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
+        self.ctl._run_axes = list(compress(axis_list, run.tolist()))
         self._lists.clear()
         if self.kernel is not None:
             self.kernel.bound = False
@@ -1336,8 +1340,15 @@ class AxisBank:
                     out += [self.groups[gi] for gi in cl.groups if self.groups[gi] not in out]
             groups = [g for g in out if g.claimed]
         rows = [r for g in groups for r in g.rows]
-        self._materialise()
-        self._rates = self._enc_rates()
+        if 4 * len(rows) >= self.n:
+            self._materialise()
+            vel, acc = self._enc_rates()
+            p, v, a = self.prf_p, self.prf_v, self.prf_a
+            self._last = {r: (float(p[r]), float(v[r]), float(a[r])) for r in rows}
+            self._rates = {r: (float(vel[r]), float(acc[r])) for r in rows}
+        else:  # a few rows: theirs alone, the same operations in Python floats
+            self._last = {r: self._planned_row(r) for r in rows}
+            self._rates = {r: self._enc_rates_row(r) for r in rows}
         for g in groups:
             for obj in self._guarded_objects(g):
                 _OWNER.pop(id(obj), None)
@@ -1393,13 +1404,9 @@ class AxisBank:
         ax.prf_pos = a
         res._a_last = a
         enc = res.encoder
-        vel, acc = self._rates
         enc._prev = wrap32(int(self.enc_prev[r]))  # the 32-bit value the object holds
-        enc.pos, enc.vel, enc.acc = (
-            float(self.enc_pos[r]),
-            float(vel[r]),
-            float(acc[r]),
-        )
+        enc.pos = float(self.enc_pos[r])
+        enc.vel, enc.acc = self._rates[r]
         b = res.band
         since = int(self.since[r])
         b._since = None if since < 0 else since
@@ -1433,9 +1440,8 @@ class AxisBank:
             pl._pos, pl._vel, pl._acc = float(self.jp[r]), float(self.jv[r]), float(self.ja[r])
             self.jog[r] = False
             return
-        last = (float(self.prf_p[r]), float(self.prf_v[r]), float(self.prf_a[r]))
         if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
-            advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
+            advance(pl, int(self.taken[r]), self._last[r], bool(self.ended[r]))
             self._keep_table(r, pl)
 
     # --- the GT boundary ------------------------------------------------------------------------
@@ -1923,6 +1929,27 @@ class AxisBank:
             for r in np.nonzero(self.hm & self.alive)[0].tolist():
                 self.prf_p[r] = self.res[r].prf_link.source(float(self.a_last[r]))
                 self.prf_v[r] = self.prf_a[r] = 0.0
+
+    def _planned_row(self, r: int) -> tuple[float, float, float]:
+        """Row ``r``'s planned position, speed and acceleration, as :meth:`_materialise`
+        makes them."""
+        if self.hm[r] and self.alive[r]:
+            return self.res[r].prf_link.source(float(self.a_last[r])), 0.0, 0.0
+        if self.n_jog and self.jog[r]:
+            return float(self.jp[r]), float(self.jv[r]), float(self.ja[r])
+        i = int(self.t_idx[r])
+        return float(self.t_p.flat[i]), float(self.t_v.flat[i]), float(self.t_a.flat[i])
+
+    def _enc_rates_row(self, r: int) -> tuple[float, float]:
+        """Row ``r``'s encoder speed and acceleration, :meth:`_enc_rates`'s operations in
+        Python floats (the same IEEE divisions and subtraction)."""
+        t = self.T
+        cnt = self.bank_cycles - int(self.claim_cycle[r])
+        if cnt < 1:
+            return float(self.enc_vel[r]), float(self.enc_acc[r])
+        v1 = float(self.enc_step1[r]) / t
+        v0 = float(self.enc_step0[r]) / t if cnt >= 2 else float(self.enc_vel[r])
+        return v1, (v1 - v0) / t
 
     def _planned(self, name: str) -> np.ndarray:
         """One of :meth:`_materialise`'s three, made the same way (a reader of the planned
