@@ -964,7 +964,8 @@ class AxisBank:
             singles = self._singles
             if singles is None:
                 singles = self._singles = [([g], [], False) for g in self.groups]
-            return singles
+            # the groups out of the bank alone (refresh passes over the claimed ones)
+            return [singles[gi] for gi in np.flatnonzero(~self._g_claimed).tolist()]
         group_of = self.group_of
         parent = list(range(len(self.groups)))
 

@@ -136,6 +136,18 @@ def system_plain(c: CoordSystem) -> bool:
 _PLAIN: dict[int, tuple[int, Any, int]] = {}
 
 
+#: per planner class: 1 when :func:`links` looks at its planners (a slave, a coordinate
+#: system's axis, PT), 0 when they read nobody
+_LINK_KIND: dict[type, int] = {}
+
+
+def _link_kind(cls: type) -> int:
+    t = cls.__mro__
+    kind = int(SlavePlanner in t or AxisSlot in t or PtPlanner in t)
+    _LINK_KIND[cls] = kind
+    return kind
+
+
 def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
     """(pairs of rows that must stay together, rows stepped ahead in the bank, rows that must
     stay scalar because of a dependency the bank cannot follow); read with the guards off."""
@@ -144,10 +156,16 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
     bad: set[int] = set()
     row_of_ax = bank._row_of
     row_of_pl: dict[int, int] | None = None
+    kinds = _LINK_KIND
     for r, res in enumerate(bank.res):
         if res is None:
             continue
         pl = res.profile.planner
+        kind = kinds.get(type(pl))
+        if kind is None:
+            kind = _link_kind(type(pl))
+        if not kind:
+            continue  # a Trap, a Jog, a homing: reads nobody
         t = type(pl).__mro__
         if SlavePlanner in t:
             if _get(pl, "_state") == 0:
