@@ -14,6 +14,7 @@ frames a real master would have exchanged are written to a capture
 from __future__ import annotations
 
 from collections.abc import Callable
+from itertools import compress
 from typing import Any
 
 import numpy as np
@@ -115,11 +116,12 @@ class EmulatedBackend(Backend):
             self._claimed_memo: dict[frozenset[int], tuple] = {}
         memo = self._claimed_memo.get(claimed)  # (the bank gives back and takes the same few)
         if memo is None:
-            inside = [p in claimed for p in self._plan_pos]
+            inside = list(map(claimed.__contains__, self._plan_pos))
+            out = [not c for c in inside]
             memo = (
-                [e for e, c in zip(plan, inside, strict=True) if not c],
-                tuple(e[0] for e, c in zip(plan, inside, strict=True) if c),
-                sum(w for w, c in zip(self._plan_wkc, inside, strict=True) if c),
+                list(compress(plan, out)),
+                tuple(e[0] for e in compress(plan, inside)),
+                sum(compress(self._plan_wkc, inside)),
             )
             if len(self._claimed_memo) > 256:
                 self._claimed_memo.clear()
