@@ -598,6 +598,8 @@ class AxisBank:
         #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
         #: back in the same move, instead of computed again
         self._kept: dict[int, tuple] = {}
+        #: per row, the kind of its planner when bank_modes.links last looked (-1: not yet)
+        self._row_link: np.ndarray | None = None
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)

@@ -157,13 +157,22 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
     row_of_ax = bank._row_of
     row_of_pl: dict[int, int] | None = None
     kinds = _LINK_KIND
-    for r, res in enumerate(bank.res):
+    # the rows to look at: every row out of the bank, and the claimed rows whose planner was
+    # of a kind that reads or is read when last looked at (a claimed row's planner is the one
+    # it had at its claim: anything that could change it gives the row back first)
+    seen = bank._row_link
+    if seen is None or len(seen) != len(bank.res):
+        seen = bank._row_link = np.full(len(bank.res), -1, np.int8)
+    res_of = bank.res
+    for r in np.flatnonzero(~bank.alive | (seen != 0)).tolist():
+        res = res_of[r]
         if res is None:
             continue
         pl = res.profile.planner
         kind = kinds.get(type(pl))
         if kind is None:
             kind = _link_kind(type(pl))
+        seen[r] = kind
         if not kind:
             continue  # a Trap, a Jog, a homing: reads nobody
         t = type(pl).__mro__
