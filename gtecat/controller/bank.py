@@ -600,6 +600,7 @@ class AxisBank:
         self._kept: dict[int, tuple] = {}
         #: per row, the kind of its planner when bank_modes.links last looked (-1: not yet)
         self._row_link: np.ndarray | None = None
+        self._claimed_sets: dict[bytes, frozenset[int]] = {}
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -641,7 +642,15 @@ class AxisBank:
         self._rx_ref = buf.take(self._rx_idx).tobytes()
         if len(self._rx_all):
             np.take(buf, self._rx_all, out=self._rx_snap)
-        self.ctl.backend.claimed = set(self._g_pos[g_claimed].tolist())
+        # the slaves the bus leaves to the bank: one set per claimed pattern, kept (the bank
+        # gives back and takes the same few), so the bus finds its plan for it by identity
+        key = g_claimed.tobytes()
+        claimed = self._claimed_sets.get(key)
+        if claimed is None:
+            if len(self._claimed_sets) > 256:
+                self._claimed_sets.clear()
+            claimed = self._claimed_sets[key] = frozenset(self._g_pos[g_claimed].tolist())
+        self.ctl.backend.claimed = claimed
         rows = self._rows_of_axes
         axis_list = self.ctl._axis_list
         if rows is None or len(rows) != len(axis_list):
