@@ -230,27 +230,48 @@ def put_in_place(out: Path, lib: Path) -> None:
     seal(lib)
 
 
+def _flaw(lib: Path) -> str:
+    """'' when ``lib`` is intact (:func:`intact`), else what is wrong."""
+    try:
+        text = seal_path(lib).read_text(encoding="ascii")
+    except FileNotFoundError:
+        return "not there" if not lib.exists() else "not sealed"
+    except OSError as e:
+        return f"its seal cannot be read ({e.strerror})"
+    try:
+        word, size, digest = text.split()
+        want = int(size)
+    except ValueError:
+        return "its seal is damaged"
+    try:
+        got = lib.stat().st_size
+        if word != _SEAL:
+            return "its seal is of another kind"
+        if got != want:
+            return f"{got} bytes where {want} were built"
+        if _digest_file(lib) != digest:
+            return "its content changed since it was built"
+    except OSError as e:
+        return f"it cannot be read ({e.strerror})"
+    return ""
+
+
 def intact(lib: Path) -> bool:
     """``lib`` is there, sealed, and of the size and SHA-256 its seal records: safe to load.
     False for a missing library (or seal), one cut short or otherwise changed."""
-    try:
-        word, size, digest = seal_path(lib).read_text(encoding="ascii").split()
-        if word != _SEAL or lib.stat().st_size != int(size):
-            return False
-        return _digest_file(lib) == digest
-    except (OSError, ValueError):
-        return False
+    return not _flaw(lib)
 
 
 def damaged(lib: Path) -> bool:
-    """``lib`` is there but fails :func:`intact` (it is then built again); logged."""
+    """``lib`` is there but fails :func:`intact` (it is then built again); logged: a warning
+    for a library cut short or changed, a note for one without a seal (built before seals)."""
     if not lib.exists():
         return False
-    log.warning(
-        "%s in the build cache fails its check (cut short, changed, or not sealed): "
-        "it is built again",
-        lib,
-    )
+    why = _flaw(lib)
+    if not why:
+        return False
+    level = logging.INFO if why == "not sealed" else logging.WARNING
+    log.log(level, "%s in the build cache fails its check (%s): it is built again", lib, why)
     return True
 
 
@@ -351,8 +372,6 @@ try:
             if intact(lib):
                 built = True
                 break
-            if os.path.exists(lib):
-                sys.stderr.write(f"{lib} is damaged: built again\n")
             try:
                 r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
             except (OSError, subprocess.TimeoutExpired) as e:
