@@ -184,6 +184,7 @@ def test_a_damaged_libgts_is_built_again(tmp_path: Path, monkeypatch: pytest.Mon
     monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
     b = build.ensure_built()
     assert cbuild.intact(b.library) and b.library.read_bytes() == b"libgts"
+
     def links() -> int:
         return sum("-shared" in c for c in log.read_text().splitlines())
 
