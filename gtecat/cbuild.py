@@ -248,7 +248,7 @@ def _flaw(lib: Path) -> str:
         if word != _SEAL:
             return "its seal is of another kind"
         if got != want:
-            return f"{got} bytes where {want} were built"
+            return f"{got} bytes, built as {want}"
         if _digest_file(lib) != digest:
             return "its content changed since it was built"
     except OSError as e:

@@ -43,7 +43,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..cbuild import NativeBuildError, compiler, intact, put_in_place
+from ..cbuild import NativeBuildError, compiler, damaged, intact, put_in_place
 from . import build as _build
 
 LIBRARY = "libgts-llp64.so"
@@ -98,6 +98,7 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Path:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if intact(target) and not force:
             return target
+        damaged(target)
         _compile(build, target)
     return target
 
@@ -114,6 +115,7 @@ def _ensure_multicard(*, force: bool, abi: str) -> Path:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if intact(target) and not force:
             return target
+        damaged(target)
         _compile_multicard(build, base, target)
     return target
 
@@ -208,6 +210,7 @@ def ensure_built_m32(*, force: bool = False) -> M32Build:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if intact(m32.library) and not force:
             return m32
+        damaged(m32.library)
         files = llp64_sources(_build.sources(_build.python_executable()))
         m32.include_dir.mkdir(parents=True, exist_ok=True)
         m32.library.parent.mkdir(parents=True, exist_ok=True)

@@ -143,7 +143,7 @@ def test_a_background_build_replaces_a_cut_short_library(
     _cut(lib)
     with caplog.at_level("WARNING", "gtecat.cbuild"):
         again = cbuild.Background([job])
-    assert "5 bytes where 11 were built" in caplog.text
+    assert "5 bytes, built as 11" in caplog.text
     assert again.wait() == lib and cbuild.intact(lib) and lib.read_bytes() == b"built whole"
     assert len(log.read_text().splitlines()) == 2
 
@@ -158,7 +158,7 @@ def test_the_check_finds_every_kind_of_damage(tmp_path: Path) -> None:
     lib.write_bytes(b"\x7fELF" + bytes(59) + b"\1")  # same size, one byte changed
     assert cbuild._flaw(lib) == "its content changed since it was built"
     lib.write_bytes(b"\x7fELF")
-    assert cbuild._flaw(lib) == "4 bytes where 64 were built"
+    assert cbuild._flaw(lib) == "4 bytes, built as 64"
     cbuild.seal_path(lib).write_text("garbage")
     assert cbuild._flaw(lib) == "its seal is damaged"
     out = tmp_path / "out.so"
