@@ -224,10 +224,13 @@ def unseal(lib: Path) -> None:
 def put_in_place(out: Path, lib: Path) -> None:
     """Library ``out``, complete, becomes ``lib``: flushed, renamed over ``lib`` (a process
     that has the old file mapped keeps it), then sealed; call it under the build lock."""
-    flush(out)
-    unseal(lib)
-    os.replace(out, lib)
-    seal(lib)
+    try:
+        flush(out)
+        unseal(lib)
+        os.replace(out, lib)
+        seal(lib)
+    except OSError as e:  # (a full disk: the library is not taken, so built again next time)
+        raise NativeBuildError(f"cannot put {lib.name} in the build cache: {e}") from None
 
 
 def _flaw(lib: Path) -> str:
