@@ -1236,14 +1236,47 @@ def _other(e: dict[str, Any], n: int, faults: Any) -> Divergence | None:
         ctl = _controller()
         if ctl is None:
             return None
-        if e["f"] == "inject":
-            values = dict(e["v"])
-            if not e.get("sync") and "ms" in e:
-                values["at_ms"] = e["ms"]
-            faults.inject(faults.spec_from_dict(values), ctl=ctl)
-        elif e["f"] == "clear":
-            faults.clear(e["v"].get("id"), ctl=ctl)
+        t = e.get("t")
+        if type(t) is int and t > ctl.clock.now_ns:
+            # armed (or cleared) while a call ran, at a cycle of it: at that cycle again
+            _Later.add(ctl, t, lambda e=e, ctl=ctl: _fault(e, ctl, faults))
+        else:  # between two calls: here, with its own trigger (none: at once)
+            _fault(e, ctl, faults)
     return None
+
+
+def _fault(e: dict[str, Any], ctl: Any, faults: Any) -> None:
+    """A recorded fault injected (with the trigger it was given) or cleared again."""
+    if e["f"] == "inject":
+        faults.inject(faults.spec_from_dict(dict(e["v"])), ctl=ctl)
+    elif e["f"] == "clear":
+        faults.clear(e["v"].get("id"), ctl=ctl)
+
+
+class _Later:
+    """Faults injected or cleared from outside the session (``gtecat fault``, the panel)
+    while one of its calls ran: the controller's ``before_cycle`` hook that does each at
+    the first cycle at or after the controller time it was recorded at, first in that
+    cycle, where the request was served (:mod:`gtecat.inspect.endpoint`)."""
+
+    def __init__(self, ctl: Any) -> None:
+        self.ctl = ctl
+        self.due: list[tuple[int, Any]] = []
+
+    @classmethod
+    def add(cls, ctl: Any, t: int, do: Any) -> None:
+        hook = next((g for g in ctl.before_cycle if isinstance(g, _Later)), None)
+        if hook is None:
+            hook = cls(ctl)
+            ctl.before_cycle = [hook, *ctl.before_cycle]
+        hook.due.append((t, do))
+
+    def __call__(self) -> None:
+        now = self.ctl.clock.now_ns
+        while self.due and self.due[0][0] <= now:
+            self.due.pop(0)[1]()
+        if not self.due:  # a new list: the cycle goes on over the one it began with
+            self.ctl.before_cycle = [g for g in self.ctl.before_cycle if g is not self]
 
 
 __all__ = [
