@@ -1944,8 +1944,8 @@ class AxisBank:
 
     def _planned_row(self, r: int) -> tuple[float, float, float]:
         """Row ``r``'s planned position, speed and acceleration, as :meth:`_materialise`
-        makes them."""
-        if self.hm[r] and self.alive[r]:
+        makes them (the same tests, in the same order of precedence)."""
+        if self.n_hm and self.hm[r] and self.alive[r]:
             return self.res[r].prf_link.source(float(self.a_last[r])), 0.0, 0.0
         if self.n_jog and self.jog[r]:
             return float(self.jp[r]), float(self.jv[r]), float(self.ja[r])
