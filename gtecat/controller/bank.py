@@ -663,8 +663,8 @@ class AxisBank:
         run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
         self.ctl._run_axes = list(compress(axis_list, run.tolist()))
         self._lists.clear()
-        if self.kernel is not None:
-            self.kernel.bound = False
+        # the kernel keeps its binding: a claim and a release write the rows in place (only
+        # the numpy cycle replaces arrays, and it unbinds the kernel itself)
 
     def _image_indices(self) -> None:
         """The numpy cycle's scatter of the claimed rows' values into the image."""
