@@ -64,6 +64,9 @@ class EmulatedBackend(Backend):
         self._claimed_slaves: tuple[VirtualSlave, ...] = ()  # what steady() asks for OP
         #: (the run plan and image it was made for, its rows): what steady() compares
         self._steady_plan: tuple[Any, Any, list[tuple[Any, ...]]] | None = None
+        #: (VirtualSlave.al_changes, the claimed slaves, the steady plan, every slave
+        #: steady() asks in OP): the OP check of steady(), kept while no slave changes state
+        self._op_seen: tuple[int, Any, Any, bool] = (-1, None, None, False)
         self.capture = None
         self._source = ""  # the file the virtual slaves come from
         #: what the frame of a cycle meets on its way back (gtecat.faults): called with the
@@ -237,16 +240,28 @@ class EmulatedBackend(Backend):
         image = self.image
         if image is None:
             return False
-        op = _OP
-        for slave in self._claimed_slaves:
-            if slave.al_state != op:
-                return False
         plan = self._steady_plan
         if plan is None or plan[0] is not self._run_plan or plan[1] is not image:
             plan = self._steady_plan = (self._run_plan, image, self._steady_rows(image))
+        # every slave in OP: worked out again only after an AL state change of any slave
+        seen = self._op_seen
+        if (
+            seen[0] != VirtualSlave.al_changes
+            or seen[1] is not self._claimed_slaves
+            or seen[2] is not plan
+        ):
+            seen = self._op_seen = (
+                VirtualSlave.al_changes,
+                self._claimed_slaves,
+                plan,
+                all(s.al_state == _OP for s in self._claimed_slaves)
+                and all(row[0].al_state == _OP for row in plan[2]),
+            )
+        if not seen[3]:
+            return False
         view = image.view
         for slave, o_start, o_bytes, i_start, i_bytes in plan[2]:
-            if slave.al_state != op or type(slave).step is not _IO_STEP or not slave.settled():
+            if type(slave).step is not _IO_STEP or not slave.settled():
                 return False
             if o_bytes:
                 if o_bytes < 0:
