@@ -216,10 +216,10 @@ class EmulatedBackend(Backend):
             st = slave.al_state
             if out is not None:
                 image.to_slave(out, slave.rx)
-                if st == AlState.OP:
+                if st == _OP:
                     wkc += 2
             slave.step(t_ns, dt_ns)
-            if inp is not None and st >= AlState.SAFEOP:
+            if inp is not None and st >= _SAFEOP:
                 image.from_slave(inp, slave.tx)
                 wkc += 1
         if self.capture is not None:
@@ -260,29 +260,41 @@ class EmulatedBackend(Backend):
         if not seen[3]:
             return False
         view = image.view
-        for slave, o_start, o_bytes, i_start, i_bytes in plan[2]:
+        for slave, o_start, o_bytes, i_start, i_bytes, o_view, i_view in plan[2]:
             if type(slave).step is not _IO_STEP or not slave.settled():
                 return False
             if o_bytes:
                 if o_bytes < 0:
                     return False  # outputs not byte-aligned
                 rx = slave.rx
-                n = min(len(rx), o_bytes)
-                if view[o_start : o_start + n] != rx[:n]:
-                    return False
+                n = len(rx)
+                if n == o_bytes:  # (the usual case: the area's bytes, cut out once)
+                    if rx != o_view:
+                        return False
+                else:
+                    n = min(n, o_bytes)
+                    if view[o_start : o_start + n] != rx[:n]:
+                        return False
             if i_bytes:
                 if i_bytes < 0:
                     return False  # inputs not in whole bytes
                 tx = slave.tx
-                n = min(len(tx), i_bytes)
-                if view[i_start : i_start + n] != tx[:n]:
-                    return False
+                n = len(tx)
+                if n == i_bytes:
+                    if tx != i_view:
+                        return False
+                else:
+                    n = min(n, i_bytes)
+                    if view[i_start : i_start + n] != tx[:n]:
+                        return False
         return True
 
-    def _steady_rows(self, image: ProcessImage) -> list[tuple[Any, int, int, int, int]]:
+    def _steady_rows(self, image: ProcessImage) -> list[tuple[Any, ...]]:
         """Per slave of the run plan: (slave, first output byte, output bytes, first input
-        byte, input bytes); -1 bytes: an area :meth:`steady` cannot compare, 0: none."""
+        byte, input bytes, the image's output bytes, its input bytes); -1 bytes: an area
+        :meth:`steady` cannot compare, 0: none (and no bytes cut out)."""
         rows = []
+        view = image.view
         base = image.outputs_bytes
         for slave, out, inp in self._run_plan:
             o_start = o_bytes = i_start = i_bytes = 0
@@ -292,7 +304,9 @@ class EmulatedBackend(Backend):
             if inp is not None:
                 i_start = base + (inp.logical_bit >> 3)
                 i_bytes = inp.bit_len >> 3 if inp.aligned and not inp.bit_len & 7 else -1
-            rows.append((slave, o_start, o_bytes, i_start, i_bytes))
+            o_view = view[o_start : o_start + o_bytes] if o_bytes > 0 else None
+            i_view = view[i_start : i_start + i_bytes] if i_bytes > 0 else None
+            rows.append((slave, o_start, o_bytes, i_start, i_bytes, o_view, i_view))
         return rows
 
     def emergencies(self) -> list[tuple[int, object]]:
@@ -416,4 +430,5 @@ class EmulatedBackend(Backend):
 
 
 _IO_STEP = IoSlave.step
-_OP = AlState.OP
+_OP = AlState.OP  # (looked up once: an enum member costs more than a comparison)
+_SAFEOP = AlState.SAFEOP
