@@ -82,11 +82,13 @@ WAYS: dict[str, Callable[[Any, int], None]] = {
 }
 
 
-@pytest.mark.parametrize("way", list(WAYS))
-@pytest.mark.parametrize("position", [DRIVE, DIO])
+#: each way on a drive the bank runs and on the IO slave the bus steps (a drive's power cycle
+#: forgets its settings, so only the IO slave's is taken: the same write)
+CASES = [(w, p) for p in (DRIVE, DIO) for w in WAYS if (w, p) != ("fault power cycle", DRIVE)]
+
+
+@pytest.mark.parametrize(("way", "position"), CASES)
 def test_every_state_change_makes_the_bus_unsteady(ctl: Any, way: str, position: int) -> None:
-    if position == DRIVE and way == "fault power cycle":
-        pytest.skip("a drive's power cycle forgets its settings: the DIO slave's case covers it")
     _back_to_steady(ctl, position)
     assert ctl.backend.steady()
     before = VirtualSlave.al_changes
