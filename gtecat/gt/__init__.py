@@ -9,9 +9,21 @@ manual's codes and ``GTE_GetLastError()`` says why.
 from __future__ import annotations
 
 import ctypes
+import gc
 import importlib
 
-from ._core import REGISTRY
+# The import below makes some hundred thousand long-lived objects (the modules, the function
+# table, the GT functions, the vendor structures): the cyclic collector would walk them again
+# and again while they are made (a tenth of the import, more when the modules are compiled
+# from source).  Paused here, on again at the end of this module (as it was).
+_GC_WAS_ON = gc.isenabled()
+gc.disable()
+try:
+    from ._core import REGISTRY
+except BaseException:
+    if _GC_WAS_ON:
+        gc.enable()
+    raise
 
 _MODULES = (
     "bus_calls",
@@ -54,18 +66,19 @@ def _is_public(name: str, value: object) -> bool:
     return name.isupper() and len(name) > 1 and isinstance(value, int | float | str)
 
 
-for _name in _MODULES:
-    try:
-        _mod = importlib.import_module(f"{__name__}.{_name}")
-    except ModuleNotFoundError as _e:
-        if _e.name != f"{__name__}.{_name}":
-            raise
-        continue
-    for _k, _v in vars(_mod).items():
-        if _is_public(_k, _v):
-            globals()[_k] = _v
-
-globals().update(REGISTRY)
+def _load_modules() -> None:
+    g = globals()
+    for name in _MODULES:
+        try:
+            mod = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as e:
+            if e.name != f"{__name__}.{name}":
+                raise
+            continue
+        for k, v in vars(mod).items():
+            if _is_public(k, v):
+                g[k] = v
+    g.update(REGISTRY)
 
 
 def _vendor_surface() -> None:
@@ -96,9 +109,6 @@ def _vendor_surface() -> None:
     typedefs.BUILT = built
 
 
-_vendor_surface()
-
-
 def _arm_faults(ctl: object) -> None:
     """The machine TOML's ``[[fault]]`` tables are armed by :mod:`gtecat.faults` on every bus
     before it is brought up; that package (a tenth of this import's Python) is imported the
@@ -122,4 +132,10 @@ def _install_fault_hook() -> None:
         from .. import faults  # noqa: F401  (records this process's GT calls)
 
 
-_install_fault_hook()
+try:
+    _load_modules()
+    _vendor_surface()
+    _install_fault_hook()
+finally:
+    if _GC_WAS_ON:
+        gc.enable()
