@@ -40,6 +40,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 #: C scalar types: (ctypes name, lo, hi, is_float); ``long`` is the vendor's 32-bit long
 SCALARS: dict[str, tuple[str, int, int, bool]] = {
@@ -355,8 +356,76 @@ def _load() -> tuple[tuple, dict[str, Proto]]:
     from .typedefs import enum_names
 
     found = _groups.groups()
+    file = _cache_file(found)
+    kept = _read_kept(file) if file is not None else None
+    if kept is not None:
+        enums, functions = kept
+        ENUMS.update(enums)
+        return found, functions
     ENUMS.update(enum_names(found))
-    return found, collect(found)
+    functions = collect(found)
+    if file is not None:
+        _keep(file, (sorted(ENUMS), functions))
+    return found, functions
+
+
+# --- the table kept between processes ------------------------------------------------------
+# Reading the groups' 3,300 prototypes is a fifth of ``from gtecat import gt``; its result
+# depends only on the groups' text and on this reader, so the table read once is kept in
+# gtecat's per-user cache folder (beside the compiled modules, gtecat.cbuild) under the digest
+# of both, and the next process loads it in a quarter of the time.  A file that is absent,
+# unreadable or of another kind is ignored and the groups are read (and kept) again.
+
+
+def _cache_file(found: tuple) -> Any:
+    import hashlib
+    import sys
+    from pathlib import Path
+
+    try:
+        from .. import __version__
+        from .._cache import cache_root
+
+        h = hashlib.sha256(Path(__file__).read_bytes())
+        h.update(Path(__file__).with_name("typedefs.py").read_bytes())
+        for g in found:
+            for part in (g.name, g.module, g.prototypes, g.structs, str(g.declared_only)):
+                h.update(part.encode("utf-8", "surrogatepass"))
+                h.update(b"\0")
+        tag = f"py{sys.version_info[0]}{sys.version_info[1]}"
+        return cache_root() / __version__ / "table" / f"{tag}-{h.hexdigest()[:32]}.pickle"
+    except (OSError, RuntimeError):  # no home folder, an unreadable source: read the groups
+        return None
+
+
+def _read_kept(file: Any) -> tuple[set[str], dict[str, Proto]] | None:
+    import pickle
+
+    try:
+        with file.open("rb") as f:
+            enums, functions = pickle.load(f)
+    except Exception:  # absent, partial, foreign: read the groups instead
+        return None
+    if not (isinstance(functions, dict) and all(type(p) is Proto for p in functions.values())):
+        return None
+    return set(enums), functions
+
+
+def _keep(file: Any, value: object) -> None:
+    import os
+    import pickle
+
+    try:
+        file.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        tmp = file.with_name(f"{file.name}.{os.getpid()}.tmp")
+        with tmp.open("wb") as f:
+            pickle.dump(value, f, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, file)
+        kept = sorted(file.parent.glob("*.pickle"), key=lambda f: f.stat().st_mtime)
+        for old in kept[:-8]:  # tables of other sources (checkouts, versions): the newest 8
+            old.unlink(missing_ok=True)
+    except (OSError, pickle.PicklingError):  # a read-only home: read again next time
+        pass
 
 
 #: every group of the table (:class:`gtecat.gt.groups.Group`), in file-name order
