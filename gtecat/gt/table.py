@@ -353,19 +353,21 @@ def _merge(
 
 def _load() -> tuple[tuple, dict[str, Proto]]:
     from . import groups as _groups
-    from .typedefs import enum_names
+    from . import typedefs
 
     found = _groups.groups()
     file = _cache_file(found)
-    kept = _read_kept(file) if file is not None else None
+    kept = _read_kept(file, found) if file is not None else None
     if kept is not None:
         enums, functions = kept
         ENUMS.update(enums)
         return found, functions
-    ENUMS.update(enum_names(found))
+    ENUMS.update(typedefs.enum_names(found))
     functions = collect(found)
     if file is not None:
-        _keep(file, (sorted(ENUMS), functions))
+        # the groups' typedefs too (gtecat.gt builds their structures from them)
+        tds = [tuple(typedefs.parse(g.structs, g.name)) for g in found]
+        _keep(file, (sorted(ENUMS), functions, tds))
     return found, functions
 
 
@@ -373,7 +375,8 @@ def _load() -> tuple[tuple, dict[str, Proto]]:
 # Reading the groups' 3,300 prototypes is a fifth of ``from gtecat import gt``; its result
 # depends only on the groups' text and on this reader, so the table read once is kept in
 # gtecat's per-user cache folder (beside the compiled modules, gtecat.cbuild) under the digest
-# of both, and the next process loads it in a quarter of the time.  A file that is absent,
+# of both, and the next process loads it in a quarter of the time (with the groups' typedefs,
+# read for the vendor structures).  A file that is absent,
 # unreadable or of another kind is ignored and the groups are read (and kept) again.
 
 
@@ -398,16 +401,27 @@ def _cache_file(found: tuple) -> Any:
         return None
 
 
-def _read_kept(file: Any) -> tuple[set[str], dict[str, Proto]] | None:
+def _read_kept(file: Any, found: tuple) -> tuple[set[str], dict[str, Proto]] | None:
+    """The kept table (and the groups' typedefs, given to :mod:`gtecat.gt.typedefs`)."""
     import pickle
+
+    from . import typedefs
 
     try:
         with file.open("rb") as f:
-            enums, functions = pickle.load(f)
+            enums, functions, tds = pickle.load(f)
     except Exception:  # absent, partial, foreign: read the groups instead
         return None
-    if not (isinstance(functions, dict) and all(type(p) is Proto for p in functions.values())):
+    if not (
+        isinstance(functions, dict)
+        and all(type(p) is Proto for p in functions.values())
+        and isinstance(tds, list)
+        and len(tds) == len(found)
+        and all(type(t) is typedefs.Typedef for group in tds for t in group)
+    ):
         return None
+    for g, group in zip(found, tds, strict=True):
+        typedefs._PARSED.setdefault((g.structs, g.name), group)
     return set(enums), functions
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gtecat.gt import table
+from gtecat.gt import table, typedefs
 from gtecat.gt.groups import groups
 
 
@@ -15,7 +15,10 @@ def test_the_kept_table_is_the_table_read(tmp_path, monkeypatch):
     assert kept == read == table.collect(groups())
     assert list(kept) == list(read)
     assert all(kept[n].by_name == read[n].by_name for n in read)
-    assert table._read_kept(file) is not None
+    parsed = {k: list(v) for k, v in typedefs._PARSED.items()}
+    typedefs._PARSED.clear()
+    assert table._read_kept(file, found) is not None  # gives the typedefs back as well
+    assert all(typedefs.parse(g.structs, g.name) == parsed[g.structs, g.name] for g in found)
 
 
 def test_a_damaged_or_foreign_file_is_read_again(tmp_path, monkeypatch):
@@ -24,12 +27,12 @@ def test_a_damaged_or_foreign_file_is_read_again(tmp_path, monkeypatch):
     file = table._cache_file(found)
     file.parent.mkdir(parents=True)
     file.write_bytes(b"\x80\x05N.")  # a pickled None
-    assert table._read_kept(file) is None
+    assert table._read_kept(file, found) is None
     file.write_bytes(b"not a pickle")
-    assert table._read_kept(file) is None
+    assert table._read_kept(file, found) is None
     _, read = table._load()
     assert read == table.FUNCTIONS
-    assert table._read_kept(file) is not None  # written anew
+    assert table._read_kept(file, found) is not None  # written anew
 
 
 def test_the_key_is_the_groups_text(tmp_path, monkeypatch):
