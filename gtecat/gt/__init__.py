@@ -9,20 +9,21 @@ manual's codes and ``GTE_GetLastError()`` says why.
 from __future__ import annotations
 
 import ctypes
-import gc
+import gc as _gc
 import importlib
+import threading as _threading
 
 # The import below makes some hundred thousand long-lived objects (the modules, the function
 # table, the GT functions, the vendor structures): the cyclic collector would walk them again
 # and again while they are made (a tenth of the import, more when the modules are compiled
 # from source).  Paused here, on again at the end of this module (as it was).
-_GC_WAS_ON = gc.isenabled()
-gc.disable()
+_GC_WAS_ON = _gc.isenabled()
+_gc.disable()
 try:
     from ._core import REGISTRY
 except BaseException:
     if _GC_WAS_ON:
-        gc.enable()
+        _gc.enable()
     raise
 
 _MODULES = (
@@ -81,9 +82,60 @@ def _load_modules() -> None:
     g.update(REGISTRY)
 
 
+#: the vendor surface (:func:`_vendor_surface`) is built at the first look at a name this
+#: module does not hold yet: 0 not yet, 1 being built, 2 built
+_SURFACE = [0]
+_SURFACE_LOCK = _threading.RLock()
+
+
+def _complete() -> None:
+    """Build the vendor surface now, if it is not built yet: what looks at this module's
+    namespace as a whole (``vars(gt)``) calls this first; an attribute, ``dir()`` and
+    ``from gtecat.gt import *`` do it by themselves."""
+    if _SURFACE[0]:
+        return
+    with _SURFACE_LOCK:
+        if _SURFACE[0]:
+            return
+        _SURFACE[0] = 1
+        paused = _gc.isenabled()
+        _gc.disable()
+        try:
+            _vendor_surface()
+        except BaseException:
+            _SURFACE[0] = 0
+            raise
+        finally:
+            if paused:
+                _gc.enable()
+        _SURFACE[0] = 2
+
+
+def __getattr__(name: str) -> object:
+    # (PEP 562: only for names the module does not hold) the vendor's thousands of
+    # declared-only functions, structures and constants are made at the first look at one:
+    # most programs never name one, and making them is a fifth of this module's import
+    if not name.startswith("_"):
+        _complete()
+        try:
+            return globals()[name]
+        except KeyError:
+            pass
+    elif name == "__all__":  # from gtecat.gt import *: every public name, as without __all__
+        _complete()
+        return [k for k in globals() if not k.startswith("_")]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    _complete()
+    return sorted(globals())
+
+
 def _vendor_surface() -> None:
     """The groups' structures, enums and constants that no module above defines, and a
-    function for every declared-only name (it returns the declared code with a reason)."""
+    function for every declared-only name (it returns the declared code with a reason);
+    built by :func:`_complete`."""
     from . import typedefs
     from .declared import declared_function
     from .table import FUNCTIONS, GROUPS
@@ -134,8 +186,7 @@ def _install_fault_hook() -> None:
 
 try:
     _load_modules()
-    _vendor_surface()
     _install_fault_hook()
 finally:
     if _GC_WAS_ON:
-        gc.enable()
+        _gc.enable()

@@ -65,6 +65,8 @@ def constants() -> dict[str, int | float | str]:
     """Every constant ``gtecat.gt`` exports (``gts.h``'s defines and enum members)."""
     from .. import gt
 
+    gt._complete()
+
     out = {}
     for k, v in vars(gt).items():
         if k.startswith(("_", "GT_", "GTN_", "GTE_")) or not (k.isupper() and len(k) > 1):
@@ -77,6 +79,8 @@ def constants() -> dict[str, int | float | str]:
 @cache
 def structures() -> tuple[str, ...]:
     from .. import gt
+
+    gt._complete()
 
     return tuple(
         k

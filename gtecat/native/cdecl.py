@@ -107,8 +107,10 @@ def structures() -> list[type[ctypes.Structure]]:
 
 @functools.cache
 def _structures() -> tuple[type[ctypes.Structure], ...]:
-    """gt's structures are made once, at its import: walked once."""
+    """gt's structures are made once: walked once."""
     from .. import gt
+
+    gt._complete()
 
     found = {
         v.__name__: v
@@ -196,6 +198,7 @@ def constants() -> list[Constant]:
     from .. import gt
     from ..gt import typedefs
 
+    gt._complete()
     members = {n for td in typedefs.BUILT.enums.values() for n, _ in td.members}
     out = []
     for k, v in vars(gt).items():
@@ -209,8 +212,10 @@ def constants() -> list[Constant]:
 def enums() -> list[str]:
     """``typedef enum`` of every enum the groups declare (their members are not
     ``#define``d: C++ code passes them where the prototype names the enum)."""
-    from .. import gt  # noqa: F401 - builds typedefs.BUILT
+    from .. import gt
     from ..gt import typedefs
+
+    gt._complete()  # builds typedefs.BUILT
 
     return [typedefs.enum_decl(td) for td in typedefs.BUILT.enums.values()]
 
