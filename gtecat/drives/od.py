@@ -147,6 +147,12 @@ IDENTITY_TYPE = 0x0023
 PREOP_ONLY = frozenset({AlState.INIT, AlState.PREOP})
 
 
+#: a data type's value when an entry gives none: empty bytes, 0.0 or 0
+_DEFAULT_VALUE: dict[DataType, Any] = {
+    t: b"" if info.is_string else (0.0 if info.fmt == "f" else 0) for t, info in TYPE_INFO.items()
+}
+
+
 class Variable:
     """One entry (index, subindex) of the dictionary."""
 
@@ -186,8 +192,9 @@ class Variable:
         self.index = index
         self.subindex = subindex
         self.name = name
-        self.data_type = data_type if type(data_type) is DataType else DataType(data_type)
-        info = TYPE_INFO[self.data_type]
+        if type(data_type) is not DataType:
+            data_type = DataType(data_type)
+        self.data_type = data_type
         self.access = access
         self.pdo = pdo
         #: what few entries have (a range, allowed values, a string's size, a placeholder
@@ -203,13 +210,11 @@ class Variable:
         self.write_states = write_states
         self.getter = getter
         self.setter = setter
-        if info.is_string and max_size:
+        if max_size and TYPE_INFO[data_type].is_string:
             self.max_size = max_size
-        if pdo_bits is not None and pdo_bits != info.pdo_bits:
+        if pdo_bits is not None and pdo_bits != TYPE_INFO[data_type].pdo_bits:
             self.pdo_bits = pdo_bits
-        if default is None:
-            default = b"" if info.is_string else (0.0 if info.fmt == "f" else 0)
-        self.value = default
+        self.value = _DEFAULT_VALUE[data_type] if default is None else default
 
     @property
     def info(self) -> TypeInfo:
