@@ -153,6 +153,18 @@ _DEFAULT_VALUE: dict[DataType, Any] = {
 }
 
 
+def _interned_x(x: dict[str, Any]) -> dict[str, Any]:
+    """The one dict of these extras (never changed after): entries with the same extras (the
+    same object of drive after drive) share one."""
+    try:
+        shared = tuple(sorted((k, type(v).__name__, v) for k, v in x.items()))
+        if len(_XS) >= 4096:
+            _XS.clear()
+        return _XS.setdefault(shared, x)
+    except TypeError:  # an unhashable value: its own dict
+        return x
+
+
 class Variable:
     """One entry (index, subindex) of the dictionary."""
 
@@ -200,16 +212,24 @@ class Variable:
         #: what few entries have (a range, allowed values, a string's size, a placeholder
         #: mark): None or a dict of them, so that the hundreds of entries of a drive without
         #: them stay small (:attr:`low` and the others read it)
-        self._x: dict[str, Any] | None = None
-        if low is not None:
-            self.low = low
-        if high is not None:
-            self.high = high
-        if allowed is not None:
-            self.allowed = _shared(frozenset(allowed))
+        x: dict[str, Any] | None = None
+        if low is not None or high is not None or allowed is not None:
+            x = {}
+            if low is not None:
+                x["low"] = low
+            if high is not None:
+                x["high"] = high
+            if allowed is not None:
+                x["allowed"] = _shared(frozenset(allowed))
+            x = _interned_x(x)
+        self._x = x
         self.write_states = write_states
-        self.getter = getter
-        self.setter = setter
+        # (AttrVariable and SlotVariable answer getter/setter themselves: nothing to store)
+        plain = type(self) is Variable
+        if plain or getter is not None:
+            self.getter = getter
+        if plain or setter is not None:
+            self.setter = setter
         if max_size and TYPE_INFO[data_type].is_string:
             self.max_size = max_size
         if pdo_bits is not None and pdo_bits != TYPE_INFO[data_type].pdo_bits:
@@ -247,13 +267,7 @@ class Variable:
         # same object of drive after drive) share one
         x = dict(self._x) if self._x else {}
         x[key] = value
-        try:
-            shared = tuple(sorted((k, type(v).__name__, v) for k, v in x.items()))
-            if len(_XS) >= 4096:
-                _XS.clear()
-            self._x = _XS.setdefault(shared, x)
-        except TypeError:  # an unhashable value: its own dict
-            self._x = x
+        self._x = _interned_x(x)
 
     low = property(lambda self: self._get_x("low"), lambda self, v: self._set_x("low", v))
     high = property(lambda self: self._get_x("high"), lambda self, v: self._set_x("high", v))
