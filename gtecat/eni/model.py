@@ -180,10 +180,10 @@ class EniConfig:
     master_name: str = ""
 
 
-def _quick_pickling(cls: type) -> None:
-    """A model's state for pickle (the ENI cache keeps a large bus's model between
-    processes) as one tuple read by a C attribute getter; the dataclass default walks
-    ``fields()`` for every object of every slave."""
+def quick_pickling(cls: type) -> type:
+    """A frozen slotted dataclass's state for pickle as one tuple read by a C attribute
+    getter; the dataclass default walks ``fields()`` for every object (the ENI cache keeps
+    a large bus's model between processes: thousands of objects).  Returns ``cls``."""
     names = tuple(f.name for f in fields(cls))
     get = attrgetter(*names)
     put = object.__setattr__
@@ -204,6 +204,7 @@ def _quick_pickling(cls: type) -> None:
 
     cls.__getstate__ = getstate  # type: ignore[attr-defined]
     cls.__setstate__ = setstate  # type: ignore[attr-defined]
+    return cls
 
 
 for _cls in (
@@ -218,4 +219,4 @@ for _cls in (
     Variable,
     EniConfig,
 ):
-    _quick_pickling(_cls)
+    quick_pickling(_cls)

@@ -42,6 +42,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..eni.model import quick_pickling
+
 #: C scalar types: (ctypes name, lo, hi, is_float); ``long`` is the vendor's 32-bit long
 SCALARS: dict[str, tuple[str, int, int, bool]] = {
     "char": ("c_char", -128, 127, False),
@@ -349,6 +351,11 @@ def _merge(
         owner[name] = g
         if proto.gtn:
             twins[proto.twin_name] = proto
+
+
+# the table is kept by pickle (below): its thousands of objects as tuples, quickly
+quick_pickling(Param)
+quick_pickling(Proto)
 
 
 def _load() -> tuple[tuple, dict[str, Proto]]:

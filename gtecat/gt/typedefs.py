@@ -22,6 +22,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..eni.model import quick_pickling
+
 #: C field types -> ctypes, the vendor's (Windows) sizes
 FIELD_TYPES: dict[str, Any] = {
     "char": ctypes.c_char,
@@ -88,6 +90,10 @@ class Typedef:
     fields: tuple[Field, ...] = ()
     members: tuple[tuple[str, int], ...] = ()  #: enum members and their values
     group: str = ""
+
+
+quick_pickling(Field)  # (the function table keeps them: gtecat.gt.table)
+quick_pickling(Typedef)
 
 
 _COMMENT = re.compile(r"/\*.*?\*/|//[^\n]*", re.S)
