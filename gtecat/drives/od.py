@@ -305,6 +305,8 @@ class Variable:
 
     def check(self, value: Any) -> None:
         """Raise SdoAbort when ``value`` is outside this entry's range or allowed set."""
+        if self._x is None:  # no range, no allowed set (most entries)
+            return
         if self.allowed is not None and value not in self.allowed:
             raise SdoAbort(
                 SdoAbortCode.VALUE_RANGE_EXCEEDED,
