@@ -732,7 +732,10 @@ class ObjectDictionary:
         if complete_access and obj.code is not ObjectCode.VAR:
             self._download_complete(obj, subindex, bytes(data), al_state)
             return
-        var = self.variable(index, subindex)
+        try:
+            var = obj.subs[subindex]  # (self.variable, with the object already found)
+        except KeyError:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
         self._write(var, bytes(data), al_state)
 
     def _write(self, var: Variable, data: bytes, al_state: AlState) -> None:
