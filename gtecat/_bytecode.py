@@ -94,3 +94,126 @@ def install(version: str) -> None:
         len(sys.meta_path),
     )
     sys.meta_path.insert(at, _Finder)
+
+
+# --- the methods dataclasses writes, the functions gtecat writes ---------------------------------
+# ``@dataclass`` writes each class's __init__, __repr__, __eq__ (and __setattr__ of a frozen one)
+# as source text and compiles it while the module is imported: for gtecat's ~180 dataclasses a
+# fifth of a process's import, every process.  The compiled text is kept here like the
+# modules': the dataclasses module's ``exec`` (the one name it calls to compile) is looked up
+# in this module's store first, for classes of gtecat's own modules only (the globals passed
+# name the module); every other class is compiled as always.  The same text gives the same
+# code, so a class is what it would be without the store.  One file per Python version, read
+# at the first class; the codes compiled anew are added to it at exit.
+
+_DC_CODES: dict[str, CodeType] = {}
+_DC_NEW: dict[str, CodeType] = {}
+_DC_FILE: list[Path] = []
+_builtin_exec = exec
+
+
+def _dc_exec(source: Any, globals: Any = None, locals: Any = None) -> None:
+    if type(source) is str and type(globals) is dict:
+        name = globals.get("__name__")
+        if type(name) is str and name.startswith("gtecat."):
+            if not _DC_FILE[1:]:  # the store not read yet
+                _DC_FILE.append(_DC_FILE[0])
+                _dc_load()
+            key = hashlib.sha1(source.encode("utf-8", "surrogatepass")).hexdigest()
+            code = _DC_CODES.get(key)
+            if code is None:
+                # as exec compiles it there: no __future__ of this module's (annotations
+                # stay objects, not text)
+                code = compile(source, "<string>", "exec", dont_inherit=True)
+                _DC_CODES[key] = _DC_NEW[key] = code
+            _builtin_exec(code, globals, locals)
+            return
+    if type(source) is str:  # (a text exec'd here would take this module's __future__)
+        source = compile(source, "<string>", "exec", dont_inherit=True)
+    _builtin_exec(source, globals, locals)
+
+
+def compiled(source: str, filename: str) -> CodeType:
+    """``compile(source, filename, "exec")`` as a gtecat module with ``from __future__ import
+    annotations`` compiles it, kept in the cache one file per text (read only when asked
+    for): the functions gtecat writes at run time (the GT fast paths, the compiled binders,
+    a replay's calls)."""
+    if not _DC_FILE:  # (the caches are off)
+        return compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
+    key = hashlib.sha1(f"{filename}\0{source}".encode("utf-8", "surrogatepass")).hexdigest()
+    path = _DC_FILE[0].parent / "gen" / f"{key}.code"
+    try:
+        code = marshal.loads(path.read_bytes())
+        if isinstance(code, CodeType) and code.co_filename == filename:
+            return code
+    except (OSError, EOFError, ValueError, TypeError):
+        pass
+    code = compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps(code))
+        os.replace(tmp, path)
+    except OSError:
+        pass  # a read-only home: compiled again next time
+    return code
+
+
+_ANNOTATIONS = __import__("__future__").annotations.compiler_flag
+
+
+def _dc_load() -> None:
+    try:
+        codes = marshal.loads(_DC_FILE[0].read_bytes())
+    except (OSError, EOFError, ValueError, TypeError):
+        return
+    if type(codes) is dict:
+        _DC_CODES.update(
+            (k, v) for k, v in codes.items() if type(k) is str and isinstance(v, CodeType)
+        )
+
+
+def _dc_save() -> None:
+    """The codes compiled in this process added to the store (a store grown past what one
+    version of gtecat writes starts again: the classes changed many times)."""
+    if not _DC_NEW:
+        return
+    path = _DC_FILE[0]
+    try:
+        try:
+            kept = marshal.loads(path.read_bytes())
+        except (OSError, EOFError, ValueError, TypeError):
+            kept = {}
+        if type(kept) is not dict or len(kept) > _DC_MOST:
+            kept = {}
+        kept.update(_DC_NEW)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps(kept))
+        os.replace(tmp, path)
+    except (OSError, ValueError):
+        pass  # a read-only home: compiled again next time
+    _DC_NEW.clear()
+
+
+#: the most codes the store keeps (gtecat's classes write ~700)
+_DC_MOST = 4000
+
+
+def install_dataclass_cache(version: str) -> None:
+    """Keep the methods of gtecat's dataclasses compiled (once per process; ``GTECAT_PYC_CACHE=0``
+    turns it off with the bytecode cache)."""
+    import atexit
+    import dataclasses
+
+    if os.environ.get("GTECAT_PYC_CACHE", "1") == "0" or _DC_FILE:
+        return
+    if vars(dataclasses).get("exec", _dc_exec) is not _dc_exec:
+        return  # someone else's exec there: left alone
+    try:
+        folder = _cache_dir(version).parent
+    except (RuntimeError, KeyError, OSError):  # (no home folder to put a cache in)
+        return
+    _DC_FILE.append(folder / f"dataclass-{sys.implementation.cache_tag}-2")
+    dataclasses.exec = _dc_exec  # type: ignore[attr-defined]
+    atexit.register(_dc_save)

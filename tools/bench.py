@@ -22,7 +22,9 @@ Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (tar
 every motion mode); two coordinate systems polled every cycle (GT_CrdStatus, GT_GetPrfPos),
 and the same with a segment streamed onto each every 10 cycles, bank against scalar path in
 pairs (target: the bank no slower); ``GT_GetSts`` against building its argument,
-interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4);
+interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4),
+and every function with a fast path in every way a client passes its value's pointer
+(``every_call_shape_vs_arguments``, the same bar);
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -39,7 +41,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_double, c_long, c_short, c_ubyte
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong
 from dataclasses import replace
 from pathlib import Path
 
@@ -282,17 +284,36 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
                 lambda: gt.GT_GetEcatHomingStatus(1, byref(c_short())),
                 lambda: byref(c_short()),
             ),
+            "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": (
+                lambda: gt.GT_GetDi(0, p),
+                lambda: byref(c_long()),
+            ),
+            "GT_GetDi(MC_HOME, byref(c_long()))": (
+                lambda: gt.GT_GetDi(3, byref(c_long())),
+                lambda: byref(c_long()),
+            ),
+            "GT_GetDi(MC_GPI, s)": (lambda: gt.GT_GetDi(4, held), lambda: c_long()),
+            "GT_GetDiRaw(MC_LIMIT_NEGATIVE, byref(s))": (
+                lambda: gt.GT_GetDiRaw(1, p),
+                lambda: byref(c_long()),
+            ),
+            "GT_GetDo(MC_GPO, byref(s))": (lambda: gt.GT_GetDo(12, p), lambda: byref(c_long())),
+            "GT_GetDo(MC_ENABLE, byref(c_long()))": (
+                lambda: gt.GT_GetDo(10, byref(c_long())),
+                lambda: byref(c_long()),
+            ),
         }
     )
     # the table path (every other function: its checks compiled, then the emulated function's
     # own work, which these figures include): reported beside the fast path's, not in `worst`
     table = {
         "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
-        "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": (
-            lambda: gt.GT_GetDi(0, p),
-            lambda: byref(c_long()),
+        "GT_GetDiReverseCount(MC_HOME, 1, c_ulong[2], 2)": (
+            lambda: gt.GT_GetDiReverseCount(3, 1, counts, 2),
+            lambda: (c_ulong * 2)(),
         ),
     }
+    counts = (c_ulong * 2)()
     clock, rng = time.perf_counter, range(block)
     out: dict[str, object] = {}
     table_out: dict[str, object] = {}
@@ -322,6 +343,149 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
             out[name] = row
     gt.GT_Close()
     return {"shapes": out, "worst": worst, "table_path": table_out, "table_worst": table_worst}
+
+
+def _time_pairs(
+    pairs: Mapping[str, tuple[Callable[[], object], Callable[[], object]]],
+    seconds: float,
+    block: int,
+) -> dict[str, dict[str, float]]:
+    """Per name, (the call, building its arguments) timed in alternating blocks of ``block``
+    for ``seconds`` in all: µs per call, µs per argument build, the ratio of the medians."""
+    clock, rng = time.perf_counter, range(block)
+    per = seconds / max(1, len(pairs))
+    out: dict[str, dict[str, float]] = {}
+    for name, (call, build) in pairs.items():
+        calls, args = [], []
+        t_end = clock() + per
+        while clock() < t_end or len(calls) < 3:
+            t0 = clock()
+            for _ in rng:
+                build()
+            t1 = clock()
+            for _ in rng:
+                call()
+            t2 = clock()
+            args.append((t1 - t0) / block)
+            calls.append((t2 - t1) / block)
+        c_us, a_us = statistics.median(calls) * 1e6, statistics.median(args) * 1e6
+        out[name] = {
+            "call_us": round(c_us, 3),
+            "argument_us": round(a_us, 3),
+            "ratio": round(c_us / a_us, 2),
+        }
+    return out
+
+
+def every_shape(
+    names: Sequence[str] | None = None,
+) -> tuple[dict[str, tuple[Callable[[], object], Callable[[], object]]], dict[str, str]]:
+    """Every function with a fast path (the raw image functions: :func:`bench_call_shapes`)
+    in every way a client passes its value's pointer, with what building that argument
+    costs: ``byref`` of a reused and of a fresh object, the ctypes object itself, a ctypes
+    and a numpy array of one element, and NULL (0, None) for the optional pointer after it
+    (``count`` 1 first for the readers of a span); each call written out as a client writes
+    it (no ``*args``).  ``names``: these functions instead (a comparison with another
+    version).  The controller must be open.  Also the shapes not measured and why: a call
+    that does not return 0 on this bus (an object its drives do not map), a shape the table
+    path answers (``fast.SLOW_SHAPES``)."""
+    import numpy as np
+
+    from gtecat import gt
+    from gtecat.gt import fast
+    from gtecat.gt.args import _scalar_types
+    from gtecat.gt.table import FUNCTIONS
+
+    first = {"GT_GetDi": 3, "GT_GetDiRaw": 0, "GT_GetDo": 10}  # (a type; else axis 1)
+    dtypes = {c_double: np.float64, c_long: np.int64, c_short: np.int16}
+    out: dict[str, tuple[Callable[[], object], Callable[[], object]]] = {}
+    skipped: dict[str, str] = {}
+    slow = getattr(fast, "SLOW_SHAPES", {})  # (an earlier version has none)
+    for name in names if names is not None else sorted(fast.fast_functions() - fast.RAW):
+        params = FUNCTIONS[name].params
+        i = next(k for k, q in enumerate(params) if q.pointer)
+        if name in fast.STRUCT_READERS:
+            t: type = fast.STRUCT_READERS[name][0]
+        else:
+            ok = _scalar_types(params[i])
+            t = next(x for x in (c_double, c_long, c_short) if x in ok)
+        held = t()
+        rest = params[i + 1 :]
+        null = bool(rest) and rest[-1].pointer and rest[-1].default is not None
+        count = "1, " if len(rest) == 2 else ""
+        env = {
+            "fn": getattr(gt, name),
+            "t": t,
+            "held": held,
+            "ref": byref(held),
+            "arr": (t * 1)(),
+            "byref": byref,
+            "np": np,
+        }
+        x = f"{first.get(name, 1)}, " if i else ""
+        # shape: (its kind, as fast.SLOW_SHAPES names it; the call's source; building its
+        # arguments' source)
+        shapes = {
+            "byref(s)": ("byref reused", f"fn({x}ref)", "byref(t())"),
+            f"byref({t.__name__}())": ("byref fresh", f"fn({x}byref(t()))", "byref(t())"),
+            "s": ("object", f"fn({x}held)", "t()"),
+            f"{t.__name__}[1]": ("array[1]", f"fn({x}arr)", "(t * 1)()"),
+        }
+        if t in dtypes:
+            env["npa"], env["dt"] = np.zeros(1, dtypes[t]), dtypes[t]
+            shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (
+                "numpy[1]",
+                f"fn({x}npa)",
+                "np.zeros(1, dt)",
+            )
+        if null:
+            for z in ("0", "None"):
+                shapes[f"byref(s), {count}{z}"] = (
+                    f"null {z}",
+                    f"fn({x}ref, {count}{z})",
+                    "byref(t())",
+                )
+        for shape, (kind, call, build) in shapes.items():
+            label = f"{name}({'x, ' if i else ''}{shape})"
+            pair = (eval(f"lambda: {call}", env), eval(f"lambda: {build}", env))
+            rc = pair[0]()
+            if rc != 0:
+                skipped[label] = f"returns {rc} on this bus"
+            elif kind in slow.get(name, {}):
+                skipped[label] = "on the table path: " + slow[name][kind]
+            else:
+                out[label] = pair
+    return out, skipped
+
+
+def bench_every_shape(
+    seconds: float = 20.0, block: int = 200, names: Sequence[str] | None = None
+) -> dict[str, object]:
+    """:func:`every_shape` on figure 5-2's bus (lockstep, axis 1 on), each against building
+    its arguments in alternating blocks; ``worst`` the largest ratio, ``above_4`` the shapes
+    above the bar."""
+    from gtecat import gt
+
+    gt.GT_Close()
+    gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="")
+    gt.GT_InitEcatComm()
+    gt.GTE_Wait(60)
+    gt.GT_StartEcatComm()
+    gt.GT_AxisOn(1)
+    try:
+        pairs, skipped = every_shape(names)
+        shapes = _time_pairs(pairs, seconds, block)
+    finally:
+        gt.GT_Close()
+    worst = max((r["ratio"] for r in shapes.values()), default=0.0)
+    above = {k: r["ratio"] for k, r in shapes.items() if r["ratio"] > 4}
+    return {
+        "shapes": shapes,
+        "count": len(shapes),
+        "worst": worst,
+        "above_4": above,
+        "not_measured": skipped,
+    }
 
 
 def _rss() -> dict[str, float]:
@@ -621,6 +785,12 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_64_axes_homing_17": lambda: rtf(64, every(64, "homing"), 10, "drive homing method 17"),
         "rtf_64_axes_gohome_20": lambda: gohome(64, 20, 10),
         "rtf_64_axes_gohome_11": lambda: gohome(64, 11, 10),
+        "rtf_64_axes_gohome_12": lambda: gohome(64, 12, 10),
+        "rtf_64_axes_gohome_13": lambda: gohome(64, 13, 10),
+        "rtf_64_axes_gohome_22": lambda: gohome(64, 22, 10),
+        "rtf_64_axes_gohome_30": lambda: gohome(64, 30, 10),
+        "rtf_64_axes_gohome_40": lambda: gohome(64, 40, 10),
+        "rtf_64_axes_gohome_41": lambda: gohome(64, 41, 10),
         "rtf_64_axes_homed_mode6": lambda: rtf(
             64, every(64, "homed6"), 10, "homed (method 35), left in homing mode 6, holding"
         ),
@@ -650,6 +820,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "gt_get_sts_vs_argument": lambda: _figure(bench_get_sts(seconds), "ratio", 4, at_most=True),
         "call_shapes_vs_arguments": lambda: _figure(
             bench_call_shapes(2 * seconds), "worst", 4, at_most=True
+        ),
+        "every_call_shape_vs_arguments": lambda: _figure(
+            bench_every_shape(10 * seconds), "worst", 4, at_most=True
         ),
         "rss_128_axes_moving": lambda: _figure(
             bench_rss(128, min(seconds, 1.0)), "mb_per_axis", 0.1, at_most=True

@@ -484,7 +484,8 @@ GOHOME_POLL_MS = 100
 def gohome_machine(n: int) -> Any:
     """Every axis at 0 with its own switches, a few hundred counts apart from axis to axis
     (so their events fall in different cycles): a home switch [40000, 44000), a positive
-    limit at 70000 and a negative one at -70000, each shifted by 37 counts per axis."""
+    limit at 70000 and a negative one at -70000, an index pulse at 1500 and every 10000
+    counts, each shifted by 37 counts per axis."""
     from gtecat.drives.machine import AxisMachine, MachineDescription
 
     return MachineDescription(
@@ -493,6 +494,8 @@ def gohome_machine(n: int) -> Any:
                 home_switch=((40_000 + 37 * a, 44_000 + 37 * a),),
                 positive_limit=70_000 + 37 * a,
                 negative_limit=-70_000 - 37 * a,
+                counts_per_rev=10_000,
+                index_offset=1_500 + 37 * a,
             )
             for a in range(1, n + 1)
         }
@@ -502,12 +505,16 @@ def gohome_machine(n: int) -> Any:
 def start_gohome(axes: Sequence[int], mode: int) -> None:
     """GT_GoHome on every axis (Trap mode first) in smart-home ``mode``, toward the positive
     side: mode 20 finds the home switch ahead (about 2 s of search), mode 11 the positive
-    limit first (3.5 s), then the home switch on the way back."""
+    limit first (3.5 s), then the home switch on the way back; the index modes then look
+    for the next index pulse slowly in the positive direction (in the negative one in mode
+    12, which must search away from the limit), mode 30 fast for the first one ahead;
+    modes 40 and 41 take the home switch for their trigger."""
     gt = _gt()
     for a in axes:
         gtn("PrfTrap", a)
         prm = gt.THomePrm()
-        prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = mode, 1, 1, 0, -1
+        index_dir = -1 if mode == 12 else 1
+        prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = mode, 1, index_dir, 0, -1
         prm.velHigh, prm.velLow = GOHOME_VEL_HIGH, GOHOME_VEL_LOW
         prm.acc = prm.dec = GOHOME_ACC
         prm.homeOffset, prm.escapeStep = 100, 1000

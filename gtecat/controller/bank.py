@@ -22,8 +22,9 @@ before anything else may look at or change them:
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit, the following
   error, a new sample past a soft limit, a raw write to its slave's outputs, the
-  drive's own following-error window) releases it *before* that cycle, so the scalar
-  code runs that cycle and every later one until the axis is back in the common state;
+  drive's own following-error window, a travel reaching an edge its armed touch probe
+  latches) releases it *before* that cycle, so the scalar code runs that cycle and every
+  later one until the axis is back in the common state;
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
   the axis by touching one of its objects: while claimed they carry a guard class
   (:meth:`AxisBank._guarded_objects`) whose first attribute access gives the axis back;
@@ -83,7 +84,14 @@ from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import settled as kernel_settled
 from .bank_kernel import wanted as kernel_wanted
-from .bank_modes import SAMPLED_TABLE, Cluster, links, sampled_kind, trap_steppable
+from .bank_modes import (
+    SAMPLED_TABLE,
+    Cluster,
+    kept_push,
+    links,
+    sampled_kind,
+    trap_steppable,
+)
 from .crd.system import Delay, Motion
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
@@ -193,6 +201,8 @@ def _crd_push(name: str) -> bool:
 
 #: rows up to which GT_GetSts's words are made row by row (fewer calls than numpy's)
 _SMALL_BANK = 32
+#: the planned values :meth:`AxisBank._materialise` makes: (its Trap table, its Jog value)
+_PLANNED = {"prf_p": ("t_p", "jp"), "prf_v": ("t_v", "jv"), "prf_a": ("t_a", "ja")}
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -1026,8 +1036,11 @@ class AxisBank:
         out: list[object] = []
         for r in g.rows:
             res = self.res[r]
-            out += [self.csp.channels[r], self.axes[r], res.profile.planner, res.encoder]
+            ch = self.csp.channels[r]
+            out += [ch, self.axes[r], res.profile.planner, res.encoder]
             out.append(res.band)
+            if self.csp.tpw[r]:
+                out.append(_get(ch, "probe"))  # (its source, function or values touched)
         return out
 
     def _load(self, r: int) -> None:
@@ -1160,6 +1173,13 @@ class AxisBank:
             return
         first = int(self.k0[r] + self.taken[r] - self.t_cur[r])  # the planner's count at t_p[r, 0]
         self._kept[r] = (pl, _trap_key(pl), first, n, int(self.t_end[r]))
+
+    def holds(self, ax: Any) -> bool:
+        """Whether the bank runs ``ax`` now (asked without giving it back)."""
+        for r, a in enumerate(self.axes):
+            if a is ax:
+                return bool(self.alive[r])
+        return False
 
     def trap_quiet(self, r: int) -> int:
         """The cycles from the next one on in which claimed row ``r``'s Trap move surely goes
@@ -1518,9 +1538,7 @@ class AxisBank:
         if cl.snaps is not None:  # (None: the system stands where the scalar path has it)
             for obj, snap in cl.snaps:
                 if obj is c:
-                    kept = snap[2]  # bank_modes.snapshot: the __dict__, containers by content
-                    kept["fifos"][1][fifo][1].append(entry)
-                    kept["tails"][1][fifo] = c.tails[fifo]
+                    kept_push(c, snap, entry, fifo)
             if c.trace is not None:
                 c.trace.pushed[fifo] += 1
                 c.trace.memo = None
@@ -1572,8 +1590,8 @@ class AxisBank:
             return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
         if name == "moving":
             return (self.moving | self.jog).tolist()
-        if name in ("prf_p", "prf_v", "prf_a"):
-            self._materialise()
+        if name in _PLANNED:
+            return self._planned(name).tolist()
         return getattr(self, name).tolist()
 
     @staticmethod
@@ -1905,6 +1923,22 @@ class AxisBank:
             for r in np.nonzero(self.hm & self.alive)[0].tolist():
                 self.prf_p[r] = self.res[r].prf_link.source(float(self.a_last[r]))
                 self.prf_v[r] = self.prf_a[r] = 0.0
+
+    def _planned(self, name: str) -> np.ndarray:
+        """One of :meth:`_materialise`'s three, made the same way (a reader of the planned
+        position after a run of cycles needs neither the speed nor the acceleration)."""
+        table, jog = _PLANNED[name]
+        out = getattr(self, table).take(self.t_idx)
+        if self.n_jog:
+            j = self.jog
+            out[j] = getattr(self, jog)[j]
+        if self.n_hm:  # a homing axis's plan holds its actual position
+            for r in np.nonzero(self.hm & self.alive)[0].tolist():
+                out[r] = (
+                    self.res[r].prf_link.source(float(self.a_last[r])) if name == "prf_p" else 0.0
+                )
+        setattr(self, name, out)
+        return out
 
     def _release_rows(self, rows: np.ndarray) -> None:
         """Release the groups of ``rows`` (before this cycle) and re-index."""

@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .bank_crd import crd_fill
 from .bank_kernel import MAXSEG, PT_STATE
 from .bank_slaves import compiled_kind, slave_fill
 from .crd.system import AxisSlot, CoordSystem, CrdNow, Delay, Motion
@@ -307,12 +308,60 @@ _FOLLOW_STATE_OF = attrgetter(*_FOLLOW_STATE)
 _TRAP_MOVING = object()
 _TRAP_STATE = ("_k", "_pos", "_vel", "_acc", "_mode", "_segs", "_i", "_j")
 _TRAP_STATE_OF = attrgetter(*_TRAP_STATE)
+#: ... and an axis slot's (the planner of a coordinate system's axis)
+_SLOT_MOVING = object()
+_SLOT_STATE = ("_pos", "_vel", "_acc", "_fresh", "stopping")
+_SLOT_STATE_OF = attrgetter(*_SLOT_STATE)
 _MOVING = {
     _PT_MOVING: PT_STATE,
     _GEAR_MOVING: _GEAR_STATE,
     _FOLLOW_MOVING: _FOLLOW_STATE,
     _TRAP_MOVING: _TRAP_STATE,
+    _SLOT_MOVING: _SLOT_STATE,
 }
+
+#: ... and a running coordinate system's (step, _next, _finish, _idle; its count of segments
+#: done changes in place, its FIFO loses entries at its head: CoordSystem.popped records them)
+_CRD_MOVING = object()
+_CRD_STATE = (
+    "running fifo stopping entry plan t s speed stop_acc waiting gears gears_next gear_entry"
+).split()
+_CRD_STATE_OF = attrgetter(*_CRD_STATE)
+
+
+def _keep_system(c: CoordSystem) -> tuple:
+    """What a running system's steps change (:func:`keep`); from now on it records the
+    entries it takes off its FIFOs."""
+    popped: list = []
+    c.popped = popped
+    return (_CRD_MOVING, _CRD_STATE_OF(c), c.segments_done, list(c.segments_done), list(c.tails))
+
+
+def kept_push(c: CoordSystem, snap: tuple, entry: Any, fifo: int) -> None:
+    """``entry`` was pushed onto ``fifo`` of ``c`` after its state was kept (``snap``, of
+    :func:`keep`): the state put back holds it too."""
+    if snap[0] is _CRD_MOVING:  # the entry stays on the FIFO: only its head is put back
+        snap[4][fifo] = c.tails[fifo]
+        return
+    kept = snap[2]  # snapshot: the __dict__, containers by content
+    kept["fifos"][1][fifo][1].append(entry)
+    kept["tails"][1][fifo] = c.tails[fifo]
+
+
+def _put_back_system(c: CoordSystem, snap: tuple) -> None:
+    """:func:`_keep_system`'s state back: the entries taken off the running FIFO since go back
+    to its head (those pushed since stay at its tail)."""
+    _, values, done, counts, tails = snap
+    popped = c.popped
+    for name, value in zip(_CRD_STATE, values, strict=True):
+        _set(c, name, value)
+    done[:] = counts
+    c.segments_done = done
+    c.tails[:] = tails
+    if popped:
+        q = c.fifos[c.fifo]
+        q.extendleft(reversed(popped))
+    c.popped = None
 
 
 def keep(obj: Any) -> tuple:
@@ -327,6 +376,12 @@ def keep(obj: Any) -> tuple:
         return (_GEAR_MOVING, _GEAR_STATE_OF(obj))
     if FollowPlanner in t and _get(obj, "_state") == 2 and not _get(obj, "_switch"):
         return (_FOLLOW_MOVING, _FOLLOW_STATE_OF(obj), len(_get(obj, "_segs")))
+    if AxisSlot in t:
+        return (_SLOT_MOVING, _SLOT_STATE_OF(obj))
+    if CoordSystem in t:
+        if obj.running and not obj.stopping:
+            return _keep_system(obj)
+        obj.popped = None
     return snapshot(obj)
 
 
@@ -396,7 +451,8 @@ class SystemTrace:
         self.start = c.state()
         self.speeds: list[float] = []
         self.marks: list[tuple[int, tuple]] = []
-        self.cols: list[list[tuple[float, float, float]]] | None = None
+        #: the slots' positions in each cycle (``cols[k][j]``: slot ``k``, cycle ``j``)
+        self.cols: Any = None
         #: entries pushed onto each FIFO since (AxisBank._pushed_ahead): not in the states
         self.pushed = [0, 0]
 
@@ -430,7 +486,7 @@ class SystemTrace:
         base = marks[k][1] if k >= 0 else self.start
         cols = self.cols
         assert cols is not None
-        pos = tuple(col[j][0] - o for col, o in zip(cols, c.origin, strict=True))
+        pos = tuple(float(col[j]) - o for col, o in zip(cols, c.origin, strict=True))
         return CrdNow(c, self._pushed((*base[:6], self.speeds[j], pos, base[8])))
 
     def _pushed(self, st: tuple) -> tuple:
@@ -460,6 +516,8 @@ class Cluster:
         "pts",
         "rows",
         "rows_arr",
+        "rows_sel",
+        "slot_of",
         "snaps",
         "stepped",
         "systems",
@@ -479,6 +537,12 @@ class Cluster:
         self.systems = systems
         self.snaps: list[tuple[Any, tuple]] | None = None
         self.rows_arr = np.array(self.rows, np.intp)
+        #: the rows as a slice where they follow each other (basic indexing, cheaper)
+        r0 = self.rows[0]
+        consecutive = self.rows == list(range(r0, r0 + len(self.rows)))
+        self.rows_sel: Any = slice(r0, r0 + len(self.rows)) if consecutive else self.rows_arr
+        #: a cluster of one coordinate system (``alone``): each row's slot in it
+        self.slot_of: Any = None
         #: id(Trap master) -> its pieces as the compiled fill reads them (_trap_samples)
         self.trap_pieces: dict[int, tuple] = {}
         #: the objects a fill keeps for the rewind; the planners it steps in Python (the
@@ -608,7 +672,7 @@ class Cluster:
         self.snaps = [(o, keep(o)) for o in self.kept]
         rows = self.rows
         moving = bank.moving
-        ra = self.rows_arr
+        ra = self.rows_sel
         bank.fill_taken[ra] = bank.taken[ra]
         if self.topo is not None:
             self._fill_columns(bank)
@@ -619,15 +683,32 @@ class Cluster:
             c = self.systems[0]
             if c.running:
                 trace = SystemTrace(bank, rows, c)
-                cols, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks)
-                trace.cols = cols
+                cf = crd_fill(bank)
+                seg = cf.segment if cf is not None else None
+                out, end = c.run(SAMPLED_TABLE, trace.speeds, trace.marks, seg)
+                m = end + 1 if end >= 0 else SAMPLED_TABLE
+                trace.cols = out[0]
                 c.trace = trace
-                at = {id(slot): k for k, slot in enumerate(c.slots)}
+                slot_of = self.slot_of
+                if slot_of is None:  # each row's slot (its coordinate) in the system
+                    at = {id(slot): k for k, slot in enumerate(c.slots)}
+                    slot_of = [at[id(pl)] for pl in self.planners]
+                    # (a slice where they are in order: basic indexing, cheaper)
+                    in_order = slot_of == list(range(len(slot_of)))
+                    self.slot_of = slot_of = slice(None) if in_order else np.array(slot_of)
+                if moving[ra].all():  # the rows' new tables in one assignment per table
+                    bank.sampled_samples += m * len(rows)
+                    bank.keep_last_sample(ra)
+                    for t, q in zip((bank.t_p, bank.t_v, bank.t_a), out, strict=True):
+                        t[ra, :m] = q[slot_of, :m]
+                    bank.t_len[ra] = m
+                    bank.t_cur[ra] = 0
+                    bank.t_end[ra] = end
+                    return
                 for i, r in enumerate(rows):
-                    col = cols[at[id(self.planners[i])]]
-                    if moving[r] and col:
-                        ps, vs, as_ = (list(x) for x in zip(*col, strict=True))
-                        self._put(bank, r, ps, vs, as_, end)
+                    if moving[r]:
+                        k = i if type(slot_of) is slice else slot_of[i]
+                        self._put(bank, r, out[0, k, :m], out[1, k, :m], out[2, k, :m], end)
                 return
         pls = self.planners
         systems = self.systems
@@ -945,7 +1026,9 @@ class Cluster:
         n = max(int(bank.taken[r] - bank.fill_taken[r]) for r in self.rows)
         for obj, snap in self.snaps:
             names = _MOVING.get(snap[0]) if type(snap[0]) is object else None
-            if names is not None:
+            if snap[0] is _CRD_MOVING:
+                _put_back_system(obj, snap)
+            elif names is not None:
                 for name, value in zip(names, snap[1], strict=True):
                     _set(obj, name, value)
                 if snap[0] is _FOLLOW_MOVING:
@@ -963,6 +1046,7 @@ __all__ = [
     "SAMPLED_TABLE",
     "Cluster",
     "SystemTrace",
+    "kept_push",
     "links",
     "restore",
     "sampled_kind",

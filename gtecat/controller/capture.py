@@ -29,6 +29,8 @@ Where the edges come from, and how exact they are:
   drive without touch probe makes ``GT_SetCaptureMode(..., CAPTURE_INDEX)`` return 1.
   Arming the touch probe takes two cycles (60B8h off, then on).  An application's own
   ``GT_SetTouchProbeFunction`` and an armed capture share probe 1: the last writer wins.
+  The axis bank runs an axis whose probe is armed between two of the probe's edges
+  (:meth:`CaptureUnit.bank_ready`): a cycle that would latch one runs here.
 
 Edge senses (``GT_SetCaptureSense(encoder, mode, sense)``, THomePrm ``edge``): the
 vendor's 0 = falling edge, 1 = rising edge, of the card's terminal.  The card's inputs are
@@ -119,6 +121,9 @@ class CaptureUnit:
         #: settings changed by a call (arm, clear, sense, reset, wiring): a count a watcher
         #: compares (smart homing: :meth:`SmartHome.quiet`)
         self.changes = 0
+        #: how the cycles the bank runs poll 60B9h (bank_ready): (None, 0) not by SDO, else
+        #: (the backend, the slave) that counts the uploads not sent (bank_released)
+        self._tp_uploads: tuple[Any, int] = (None, 0)
         self._level_watch = 0  # readers of the home level or edges every cycle (watch_level)
         self.reset_settings()
         self.edges: list[SeenEdge] = []
@@ -258,21 +263,48 @@ class CaptureUnit:
 
     def bank_ready(self) -> bool:
         """The next cycles' :meth:`_post` can find an edge only where the home input changes
-        its level (which the bank watches): no card latch, the touch probe neither armed nor
-        being written, the home level the one last seen."""
-        if self._card_edges is not None or self._tp_want or self._tp_sent or self._tp_pending:
+        its level (which the bank watches) or where the drive's touch probe latches one
+        (the bank gives the axis back before a cycle whose travel reaches such an edge:
+        ``CspBank.tp_lo``/``tp_hi``): no card latch, the touch probe off or armed with
+        nothing being written, its status read from the image or by SDO uploads the bus
+        can count without sending (:meth:`bank_released`), the home level the one last
+        seen."""
+        if self._card_edges is not None or self._tp_pending or self._tp_want != self._tp_sent:
             return False
+        polled = self._tp_polled() if self._tp_sent else (None, 0)
+        if polled is None:
+            return False
+        # (the claim follows this answer: its release counts the uploads of the cycles the
+        # bank ran the way found now, whatever the bus looks like at the release)
+        self._tp_uploads = polled
         return self._home_prev == self.home_level()
+
+    def _tp_polled(self) -> tuple[Any, int] | None:
+        """How :meth:`_touch_probe` reads 60B9h: (None, 0) from the process image; (the
+        backend, the slave) by an SDO upload the backend can count without sending it
+        (``uploads_unframed``); None by one it must send."""
+        io = self.ax.io
+        if io.get(0x60B9) is not None:
+            return None, 0
+        backend = getattr(self.ctl, "backend", None)
+        unframed = getattr(backend, "uploads_unframed", None)
+        if unframed is None or not unframed(io.slave):
+            return None
+        return backend, io.slave
 
     def bank_released(self, cycles: int) -> None:
         """The bank ran ``cycles`` cycles of the axis: what :meth:`_post` would have left (this
         cycle's encoder step, the home level; no edge: the input did not change where it was
-        watched, and where it was not, nobody reads the edges)."""
+        watched, and where it was not, nobody reads the edges; the touch probe latched
+        nothing, and the 60B9h reads by SDO that found it so are counted)."""
         if cycles:
             enc = self.res.encoder
             self.step = enc.vel * self.res.cycle_ms if enc.active else 0.0
             self.edges = []
             self._home_prev = self.home_level()
+            backend, slave = self._tp_uploads
+            if backend is not None:
+                backend.uploads_answered(slave, cycles)
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:

@@ -32,6 +32,7 @@ from ..errors import BusError, CommandError
 from ..master.bus import Master
 from ..master.card import CardBackend, CardSpec, card_layout, parse_card
 from .axis import Axis, AxisIo
+from .input_sense import changed as sense_changed
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -96,6 +97,7 @@ def open_card(ctl: Controller, text: str) -> Card:
         for ref in layout.axes
     }
     ctl._axis_list = list(ctl.axes.values())
+    sense_changed()  # (other axes: their inputs' sense is looked up again)
     install_resources(ctl)
     master.open()
     clock = ctl.clock

@@ -95,6 +95,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ParameterError
+from .input_sense import changed as sense_changed
 from .motion import STOP_DEC_MAX, StopDecel
 from .safety import LIMIT_NEGATIVE_BIT, LIMIT_POSITIVE_BIT, POS_ERR_MAX, StopInput
 from .scale import Scale
@@ -764,6 +765,7 @@ def _state(ctl: Controller) -> _State:
     st = _STATES.get(ctl)
     if st is None or st.axes != _axes_id(ctl):  # none yet, or the bus was brought up anew
         st = _STATES[ctl] = _State(_axes_id(ctl))
+        sense_changed()
     if _forget not in ctl.on_reset:
         ctl.on_reset.append(_forget)
     return st
@@ -772,6 +774,7 @@ def _state(ctl: Controller) -> _State:
 def _forget(ctl: Controller) -> None:
     """GT_Reset: every resource back to table 4-4, the loaded settings forgotten."""
     _STATES.pop(ctl, None)
+    sense_changed()
 
 
 def vendor_settings(ctl: Controller) -> dict[tuple[str, int], dict[str, Any]]:
@@ -906,8 +909,11 @@ def _current_source(res: AxisResources, role: _Role) -> _Source | None:
 def apply_vendor(ctl: Controller, cfg: VendorConfig) -> None:
     """Apply a vendor ``*.cfg`` to the bus axes (the caller checked that none moves)."""
     st = _state(ctl)
-    for (kind, n), section in cfg.sections.items():
-        st.values.setdefault((kind, n), {}).update(section.values())
+    try:
+        for (kind, n), section in cfg.sections.items():
+            st.values.setdefault((kind, n), {}).update(section.values())
+    finally:
+        sense_changed()  # (the inputs' reverse, GT_GetDi's fast path)
     notes: list[str] = []
     for n, ax in sorted(ctl.axes.items()):
         res: AxisResources = ax.motion
@@ -1080,6 +1086,7 @@ def apply_legacy(ctl: Controller, cfg: Config) -> None:
         "(docs/config_file.md)"
     )
     _STATES.pop(ctl, None)  # its inputs replace any a vendor file set
+    sense_changed()
     for n, ax in ctl.axes.items():
         res = ax.motion
         a = cfg.get("axis", n)

@@ -61,6 +61,7 @@ from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
 from .bank_kernel import prebuild as prebuild_kernel
+from .input_sense import changed as sense_changed
 from .resources import install as install_resources
 
 if TYPE_CHECKING:
@@ -185,6 +186,9 @@ class Controller:
         self.resources: dict = {}
         self.on_bus_up: list[Callable[[Controller], None]] = []
         self.on_reset: list[Callable[[Controller], None]] = []
+        #: the GT fast path's readers of GT_GetDi, GT_GetDiRaw and GT_GetDo, by type (+16, +32),
+        #: kept until the next change of the inputs' sense (gtecat.controller.input_sense)
+        self.input_plans: dict[int, Any] = {}
         #: the pulse card this controller is (None: an EtherCAT master)
         self.card: Card | None = None
         if self.options.card:
@@ -270,6 +274,7 @@ class Controller:
         }
         self._axis_list = list(self.axes.values())
         self._run_axes = self._axis_list
+        sense_changed()  # (other axes: their inputs' sense is looked up again)
         self.bank = None
         self._links_down = False
         install_resources(self)  # profile, encoder, status and safety of every axis (chapter 4)

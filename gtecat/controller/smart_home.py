@@ -301,6 +301,12 @@ class SmartHome:
         #: what the last step saw of what a call may change (:meth:`quiet`)
         self._seen_latched = -1
         self._seen_changes: tuple[int, int] = (-1, -1)
+        #: the controller's GPI registers while a forced homing's trigger is a GPI (only a
+        #: call changes them), and their value at the last step
+        self._gpio: Any = None
+        self._seen_gpi = -1
+        #: the leg under way watches the trigger (its capture, its level or a GPI)
+        self._watching = False
 
     @property
     def running(self) -> bool:
@@ -392,6 +398,7 @@ class SmartHome:
         self._failing = False
         self._expect = None
         self._q_claim = 0
+        self._gpio = None
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
@@ -449,6 +456,10 @@ class SmartHome:
         ends before the cycle that takes the move's end sample (:meth:`AxisBank.trap_quiet`)."""
         if not self._waiting or self._failing or self._gen is None or bank is None:
             return None
+        trigger = self._trigger
+        foreign = self._watching and trigger is not self.unit
+        if foreign and not self._trigger_held(bank):
+            return None
         res = self.res
         if res.bank is not bank:
             return None
@@ -461,6 +472,10 @@ class SmartHome:
             return None
         if (self.unit.changes, self._trigger.changes) != self._seen_changes:
             return None
+        if self._gpio is not None and self._gpio.gpi != self._seen_gpi:
+            return None
+        if foreign and (trigger.status or trigger.edges):
+            return None  # (the trigger's axis ran a cycle of its own that saw an edge)
         prof = res.profile
         if prof.mode != PrfMode.TRAP:
             return None
@@ -470,6 +485,22 @@ class SmartHome:
         if not _get(res.ax, "servo_on") or self._limit(1) or self._limit(-1):
             return None
         return bank.trap_quiet(r)
+
+    def _trigger_held(self, bank: Any) -> bool:
+        """Another axis's capture is the trigger (``triggerIndex``): it latches, and its home
+        level changes, only in a cycle that axis runs on its scalar objects (the bank gives
+        it back before such a cycle while a home capture is armed, the level is watched or
+        the touch probe is armed), after which the homings look again
+        (:meth:`_Homings._settle`).  True while the bank runs that axis; otherwise this
+        homing steps every cycle, and its own axis stays out of the bank (``bank_hold``)
+        instead of being taken for a cycle and given back."""
+        tres = self._trigger.res
+        held = tres.bank is bank and bool(bank.alive[tres.bank_row])
+        if self.res.bank_hold == held:
+            self.res.bank_hold = not held
+            if held:
+                bank.dirty = True  # this axis may be taken now
+        return held
 
     def cycle(self) -> None:
         """After every cycle (all axes have read their inputs)."""
@@ -493,6 +524,8 @@ class SmartHome:
             self._fail(a.error, str(a))
         self._seen_latched = res.latched
         self._seen_changes = (self.unit.changes, self._trigger.changes)
+        if self._gpio is not None:
+            self._seen_gpi = self._gpio.gpi
 
     def _watch(self) -> tuple[HomeError, str] | None:
         res = self.res
@@ -607,12 +640,11 @@ class SmartHome:
     def _search_home(self, d: int, turn: bool) -> _Steps:
         p, st, unit = self.params, self.status, self._trigger
         unit.refresh_wiring()
-        own = unit is self.unit  # (another axis's capture: its edges come any cycle)
         dist = p.searchHomeDistance or UNLIMITED
         if p.edge == 0 and unit.home_level():
             st.stage = Stage.START  # on the switch: leave it first, backwards
             why, _ = yield from self._leg(
-                -d, dist, p.velHigh, lambda: not unit.home_level() or None, own, unit
+                -d, dist, p.velHigh, lambda: not unit.home_level() or None, unit
             )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the axis did not get off the home switch")
@@ -621,7 +653,7 @@ class SmartHome:
         for attempt in (0, 1):
             self._arm(unit, CAPTURE_HOME, p.edge)
             why, pos = yield from self._leg(
-                d, dist, p.velHigh, lambda: unit.pos if unit.status else None, own
+                d, dist, p.velHigh, lambda: unit.pos if unit.status else None
             )
             if why == "event":
                 st.capturePos = _long(round(pos))
@@ -629,7 +661,7 @@ class SmartHome:
                 return pos
             if why == "limit" and turn and attempt == 0:
                 yield from self._stop()  # the home is behind: back over the whole switch
-                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit), own, unit)
+                why, _ = yield from self._leg(-d, dist, p.velHigh, self._passed(unit), unit)
                 if why != "event":
                     raise _Abort(HomeError.NO_HOME, "no home switch between the limits")
                 yield from self._stop()
@@ -667,9 +699,7 @@ class SmartHome:
             if not unit.on_card:
                 yield  # the drive's touch probe arms in two cycles (60B8h off, on)
                 yield
-            why, pos = yield from self._leg(
-                d, dist, vel, lambda: unit.pos if unit.status else None, unit is self.unit
-            )
+            why, pos = yield from self._leg(d, dist, vel, lambda: unit.pos if unit.status else None)
             if why == "event":
                 st.capturePos = _long(round(pos))
                 yield from self._stop()
@@ -691,12 +721,16 @@ class SmartHome:
 
     def _search_gpi(self, d: int) -> _Steps:
         p, st, unit = self.params, self.status, self.unit
-        own = p.triggerIndex == -1  # (a GPI of the IO: it may change in any cycle)
+        own = p.triggerIndex == -1
         if own:
             unit.refresh_wiring()
             level: Callable[[], bool] = unit.home_level
         else:
-            io, k = digital_io(self.ctl), p.triggerIndex
+            # a GPI of the controller's IO: only a call (GTE_SetGpi) changes it, and a
+            # call gives every axis back first, so the waits stay quiet (:meth:`quiet`
+            # compares the registers with what the last step saw)
+            io = self._gpio = digital_io(self.ctl)
+            k = p.triggerIndex
             level = lambda: io.gpi_level(k)  # noqa: E731
         dist = p.searchHomeDistance or UNLIMITED
         st.stage = Stage.SEARCH_GPI
@@ -704,7 +738,7 @@ class SmartHome:
             if level():
                 break
             why, _ = yield from self._leg(
-                d, dist, p.velHigh, lambda: level() or None, own, unit if own else None
+                d, dist, p.velHigh, lambda: level() or None, unit if own else None
             )
             if why == "event":
                 break
@@ -712,7 +746,7 @@ class SmartHome:
                 raise _Abort(HomeError.NO_HOME, "the trigger did not become active")
             yield from self._stop()  # behind: back over the whole active zone, then again
             why, _ = yield from self._leg(
-                -d, dist, p.velHigh, _passed_level(level), own, unit if own else None
+                -d, dist, p.velHigh, _passed_level(level), unit if own else None
             )
             if why != "event":
                 raise _Abort(HomeError.NO_HOME, "the trigger is not active between the limits")
@@ -723,7 +757,7 @@ class SmartHome:
         def gone() -> float | None:
             return None if level() else unit.enc - 0.5 * unit.step
 
-        why, pos = yield from self._leg(-d, dist, p.velLow, gone, own, unit if own else None)
+        why, pos = yield from self._leg(-d, dist, p.velLow, gone, unit if own else None)
         if why != "event":
             raise _Abort(HomeError.NO_HOME, "the trigger did not become inactive on the way back")
         st.capturePos = _long(round(pos))
@@ -764,14 +798,14 @@ class SmartHome:
         distance: float,
         vel: float,
         watch: Callable[[], Any] | None = None,
-        own: bool = True,
         levels: CaptureUnit | None = None,
     ) -> _Steps:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
-        position) when the limit in ``d`` is reached, or ("end", None).  ``own``: ``watch``
-        reads inputs of this axis only (its home input, its capture), so the wait may be
-        :meth:`quiet`; ``levels``: the capture unit whose home level or edges ``watch``
-        reads (:meth:`CaptureUnit.watch_level`)."""
+        position) when the limit in ``d`` is reached, or ("end", None).  ``watch`` reads
+        the trigger's capture (this axis's or another's: ``triggerIndex``), its home level
+        or a GPI: what changes them is an input edge of a cycle run on the scalar objects
+        or a call, so the wait may be :meth:`quiet`; ``levels``: the capture unit whose
+        home level or edges ``watch`` reads (:meth:`CaptureUnit.watch_level`)."""
         trap = self.res.profile.trap
         if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc
@@ -780,7 +814,8 @@ class SmartHome:
         before = self.res.latched & bit
         if levels is not None:
             levels.watch_level(True)
-        self._waiting = own
+        self._watching = watch is not None
+        self._waiting = True
         try:
             while True:
                 yield
@@ -794,7 +829,7 @@ class SmartHome:
                 if trap.done:
                     return "end", None
         finally:
-            self._waiting = False
+            self._waiting = self._watching = False
             if levels is not None:
                 levels.watch_level(False)
 
@@ -955,8 +990,15 @@ class _Homings:
         due = None
         for home in list(self.running):
             d = home._q_due
-            if not (t_prev < d and home._q_claim and ids[home._q_row] == home._q_claim):
-                q = home.quiet(bank)  # (not found quiet before, or another claim since)
+            if not (
+                t_prev < d
+                and home._q_claim
+                and ids[home._q_row] == home._q_claim
+                and home._trigger is home.unit
+            ):
+                # not found quiet before, another claim since, or another axis's capture
+                # (that axis may have been given back for an edge: quiet() looks)
+                q = home.quiet(bank)
                 if q is None:
                     home._q_claim = 0
                     d = t_next

@@ -24,7 +24,9 @@ from __future__ import annotations
 
 import logging
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
 from gtecat.drives.coe import (
@@ -58,6 +60,7 @@ from gtecat.drives.sdo_info import SdoInformation, fragments
 from gtecat.drives.slave import AlState
 
 log = logging.getLogger(__name__)
+_T = TypeVar("_T")
 
 
 @dataclass(slots=True)
@@ -130,21 +133,40 @@ class SdoServer:
         frames, no fault in front of the mailbox): the same object dictionary write, the
         same counter, and the abort the client reads from the answer (its code, index and
         subindex) raised.  A bus brought up runs 17 of these per drive."""
+        self._in_process(
+            index,
+            subindex,
+            lambda: self.od.download(
+                index, subindex, data, complete_access=complete_access, al_state=al_state
+            ),
+        )
+
+    def upload_in_process(self, index: int, subindex: int) -> bytes:
+        """An expedited upload (an object of 1 to 4 bytes) as :meth:`download_in_process`
+        serves a download: the same object dictionary read, counter and abort as the framed
+        request.  A controller that reads an unmapped object every cycle (a touch probe's
+        60B9h, a mode's 6061h) pays an object read, not two mailbox frames built and parsed.
+        The caller checks the size (:meth:`ObjectDictionary.size_of`) first: a longer
+        object is a segmented transfer, with more counters, and takes the framed path."""
+        return self._in_process(index, subindex, lambda: self.od.upload(index, subindex))
+
+    def _in_process(self, index: int, subindex: int, serve: Callable[[], _T]) -> _T:
+        """``serve()`` as one expedited request served and answered: its result, or the
+        abort the answer would carry (raised after the answer's counter)."""
         self._pending.clear()
         self._upload = self._download = None
-        abort = None
         try:
-            self.od.download(
-                index, subindex, data, complete_access=complete_access, al_state=al_state
-            )
+            result = serve()
         except SdoAbort as err:
             abort = SdoAbort(err.code, err.index, err.subindex)
         except Exception:
             log.exception("SDO request 0x%04X:%02X failed inside the slave", index, subindex)
             abort = SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex)
+        else:
+            self.counter = next_counter(self.counter)
+            return result
         self.counter = next_counter(self.counter)
-        if abort is not None:
-            raise abort
+        raise abort
 
     def next_message(self) -> bytes | None:
         """The next fragment of a multi-message answer, or None when there is none."""

@@ -44,7 +44,7 @@ import math
 from gtecat.eni.errors import GtecatError
 
 from .machine import AxisMachine
-from .signal_edges import merge_windows, window_edges
+from .signal_edges import Window, merge_windows, window_edges
 
 __all__ = ["TOGGLE_BITS", "TouchProbe", "TouchProbeError"]
 
@@ -149,24 +149,66 @@ class TouchProbe:
                 else:
                     self._armed[slot] = False
 
-    def _edges(self, probe: int, source: int, p0: float, p1: float) -> list[tuple[float, bool]]:
+    def _signal(self, probe: int, source: int) -> tuple[Window, ...] | None:
+        """What ``probe`` with ``source`` (60B8h bits 3:2) latches: the windows of a probe
+        input, None for the encoder's index pulses, () for nothing (reserved, TP3/TP4)."""
         if source == SOURCE_60D0:
             sel = self.source_select[probe]
             if sel in (1, 2):
-                return window_edges(self._inputs[sel - 1], p0, p1)
+                return self._inputs[sel - 1]
             if sel in (5, 6):
-                source = SOURCE_INDEX
-            else:
-                return []  # TP3/TP4 inputs do not exist on this machine
+                return None
+            return ()  # TP3/TP4 inputs do not exist on this machine
         if source == SOURCE_INPUT:
-            return window_edges(self._inputs[probe], p0, p1)
+            return self._inputs[probe]
         if source == SOURCE_INDEX:
-            out: list[tuple[float, bool]] = []
-            for x in self._m.index_positions(p0, p1):
-                out.append((x, True))
-                out.append((x, False))
-            return out
-        return []  # reserved source: never triggers
+            return None
+        return ()  # reserved source: never triggers
+
+    def _edges(self, probe: int, source: int, p0: float, p1: float) -> list[tuple[float, bool]]:
+        windows = self._signal(probe, source)
+        if windows is not None:
+            return window_edges(windows, p0, p1) if windows else []
+        out: list[tuple[float, bool]] = []
+        for x in self._m.index_positions(p0, p1):
+            out.append((x, True))
+            out.append((x, False))
+        return out
+
+    def quiet_bounds(self, pos: float) -> tuple[float, float]:
+        """``(lo, hi)``: the nearest machine positions at or below and at or above ``pos``
+        where an edge of what the function latches lies (a probe input's window boundary,
+        an index pulse; -inf / inf: none).  A cycle whose travel stays strictly between the
+        two finds no edge in :meth:`step`, so it latches, counts and toggles nothing: the
+        axis bank runs a channel with an armed probe only while its travel does (and gives
+        it back before a cycle that would reach either bound)."""
+        fn = self._function
+        lo, hi = -math.inf, math.inf
+        for probe in (0, 1):
+            sh = 8 * probe
+            if not (fn >> sh) & 1 or not (fn >> (4 + sh)) & 0b11:
+                continue  # (step skips such a probe)
+            windows = self._signal(probe, (fn >> (2 + sh)) & 0b11)
+            if windows is None:
+                xs = self._index_near(pos)
+            else:
+                xs = [x for w in windows for x in w]
+            for x in xs:
+                if lo < x <= pos:
+                    lo = x
+                if pos <= x < hi:
+                    hi = x
+        return lo, hi
+
+    def _index_near(self, pos: float) -> list[float]:
+        """The index pulses around ``pos`` (at least the nearest one on either side), each
+        position computed as :meth:`AxisMachine.index_positions` computes it."""
+        m = self._m
+        if m.index_offset is None or m.counts_per_rev <= 0:
+            return []
+        cpr = m.counts_per_rev
+        k0 = math.floor((pos - m.index_offset) / cpr)
+        return [float(m.index_offset + k * cpr) for k in range(k0 - 1, k0 + 3)]
 
 
 def _int32(v: int) -> int:

@@ -456,11 +456,7 @@ class Injector:
                 continue
             inner = s.mailbox
             self._mailboxes[s.position] = inner
-
-            def stand_in(request: bytes, _pos: int = s.position, _inner: Any = inner) -> Any:
-                return self.mailbox(_pos, request, _inner)
-
-            s.mailbox = stand_in  # type: ignore[method-assign]
+            s.mailbox = _StandIn(self, s.position, inner)  # type: ignore[method-assign]
 
     def detach(self) -> None:
         """Take every stand-in away (the bus goes on without faults)."""
@@ -616,6 +612,27 @@ class Injector:
 
 # --- mailbox messages ----------------------------------------
 _STEP_OF_CCS = {1: "download_init", 0: "download_segment", 2: "upload_init", 3: "upload_segment"}
+
+
+class _StandIn:
+    """A slave's mailbox with the injector in front (:meth:`Injector.mailbox`).  While the
+    injector holds no fault at all it sees nothing of an SDO (no trigger counts them, no
+    fault answers them): it then says what the slave's own mailbox says of itself,
+    ``sdo_server_only``, and the in-process backend may hand an expedited transfer to the
+    slave's SDO server unframed, as it does without faults (a bus brought up with
+    ``gtecat.faults`` imported: every InitCmd SDO framed and parsed twice otherwise)."""
+
+    __slots__ = ("injector", "inner", "position")
+
+    def __init__(self, injector: Injector, position: int, inner: Any) -> None:
+        self.injector, self.position, self.inner = injector, position, inner
+
+    def __call__(self, request: bytes) -> bytes | None:
+        return self.injector.mailbox(self.position, request, self.inner)
+
+    @property
+    def sdo_server_only(self) -> bool:
+        return not self.injector.entries and getattr(self.inner, "sdo_server_only", False)
 
 
 def _sdo_request(request: bytes) -> tuple[str, int | None, int | None] | None:

@@ -42,6 +42,7 @@ from operator import contains, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
+from .._bytecode import compiled as _compiled_code
 from ..errors import ParameterError
 from .tap import Listener, tap, untap
 
@@ -423,6 +424,12 @@ def _show(v: Any) -> str:
 
 def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
     """(path, header, the lines after it) of a recording."""
+    p, head, body = _open_text(path)
+    return p, head, body.split("\n") if body is not None else []
+
+
+def _open_text(path: str | Path) -> tuple[Path, dict[str, Any], str | None]:
+    """(path, header, the text after its line: None when there is none) of a recording."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -430,14 +437,14 @@ def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
         raise ParameterError(f"{p}: no such recording") from None
     if raw[:2] == b"\x1f\x8b":
         raw = gzip.decompress(raw)
-    lines = raw.decode("utf-8", "replace").split("\n")
+    first, sep, body = raw.decode("utf-8", "replace").partition("\n")
     try:
-        head = json.loads(lines[0] or "{}")
+        head = json.loads(first or "{}")
     except (json.JSONDecodeError, RecursionError):
         head = {}
     if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
-    return p, head, lines[1:]
+    return p, head, body if sep else None
 
 
 def _damaged(p: Path, lines: list[str]) -> ParameterError:
@@ -529,16 +536,16 @@ def replay(
     objects made at once, none in a cycle: the collector would walk them again and again
     while they are made, as Controller.init_ecat says of the bus model), and they are kept
     out of its later walks while the calls run (``gc.freeze``)."""
-    p, head, lines = _open(path)
+    p, head, body = _open_text(path)
     paused = gc.isenabled()
     if paused:
         gc.disable()
     try:
-        steps = _steps(p, lines)
+        steps = _steps(p, body or "")
     finally:
         if paused:
             gc.enable()
-    del lines
+    del body
     _check_count(p, head, sum(1 for call, _ in steps if call is not None))
     freeze = gc.get_freeze_count() == 0  # (a process that froze its own objects: left so)
     if freeze:
@@ -764,7 +771,7 @@ def _compiled(p: _Call) -> Any:
     for j, (obj, _, _, _) in enumerate(p.quick):
         env[f"Q{j}"] = obj
     lines += [f"    if {' or '.join(same)}:", "        return (rc,)", "    return None"]
-    exec(compile("\n".join(lines), f"<replay {p.name}>", "exec"), env)
+    exec(_compiled_code("\n".join(lines), f"<replay {p.name}>"), env)
     return env["run"]
 
 
@@ -895,7 +902,7 @@ def _form(e: dict[str, Any]) -> int:
     return n
 
 
-def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
+def _steps(p: Path, lines: list[str] | str) -> list[tuple[Any, Any]]:
     """The recording's entries made ready to run: ``(call, its values)`` for a call,
     ``(None, entry)`` for a checkpoint or a fault, ``(_Stop, why)`` where a call cannot be
     made again (reported when the replay gets there).
@@ -988,8 +995,12 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
         e = parse(key)
         return (None, e) if "c" not in e else prepare(e, key)
 
-    # a call's line without its time (from the comma after it), any other line whole
-    keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
+    # a call's line without its time (from the comma after it), any other line whole; of a
+    # recording's text, every line's at once (:data:`_KEY`)
+    if type(lines) is str:
+        keys = _KEY.findall(lines)
+    else:
+        keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
     made = dict.fromkeys(keys)
     made.pop("", None)  # the empty line after the last
     calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
@@ -1027,6 +1038,12 @@ def _steps(p: Path, lines: list[str]) -> list[tuple[Any, Any]]:
             made[key] = step(key, None)
     return [s for s in map(made.get, keys) if s is not None]
 
+
+#: each line of a recording's text as :func:`_steps` keys it: a line that starts ``{"t":``
+#: from the first comma after that (``line[line.find(",", 5):]``: with no comma there, its
+#: last character), any other line whole; one pass of the regular-expression engine over
+#: the text instead of splitting it into lines and cutting each
+_KEY = re.compile(r'^(?:\{"t":[^,\n]*(?=,)|(?=\{"t":[^,\n]*$)[^\n]*?(?=[^\n]$))?(.*)$', re.M)
 
 _NUMBER_START = frozenset("-0123456789")
 _NUMBER_TYPES = frozenset({int, float})

@@ -83,8 +83,7 @@ def tap(listener: Listener) -> None:
     from ..gt import _core
 
     if not _saved:
-        gt._complete()  # the declared-only functions too
-        for name, fn in list(vars(gt).items()):
+        for name, fn in list(gt._whole().items()):
             if name.startswith(("GT_", "GTN_", "GTE_")) and callable(fn) and name not in SKIP:
                 if isinstance(fn, type):
                     continue

@@ -9,22 +9,10 @@ manual's codes and ``GTE_GetLastError()`` says why.
 from __future__ import annotations
 
 import ctypes
-import gc as _gc
 import importlib
 import threading as _threading
 
-# The import below makes some hundred thousand long-lived objects (the modules, the function
-# table, the GT functions, the vendor structures): the cyclic collector would walk them again
-# and again while they are made (a tenth of the import, more when the modules are compiled
-# from source).  Paused here, on again at the end of this module (as it was).
-_GC_WAS_ON = _gc.isenabled()
-_gc.disable()
-try:
-    from ._core import REGISTRY
-except BaseException:
-    if _GC_WAS_ON:
-        _gc.enable()
-    raise
+from ._core import REGISTRY
 
 _MODULES = (
     "bus_calls",
@@ -67,75 +55,23 @@ def _is_public(name: str, value: object) -> bool:
     return name.isupper() and len(name) > 1 and isinstance(value, int | float | str)
 
 
-def _load_modules() -> None:
-    g = globals()
-    for name in _MODULES:
-        try:
-            mod = importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as e:
-            if e.name != f"{__name__}.{name}":
-                raise
-            continue
-        for k, v in vars(mod).items():
-            if _is_public(k, v):
-                g[k] = v
-    g.update(REGISTRY)
-
-
-#: the vendor surface (:func:`_vendor_surface`) is built at the first look at a name this
-#: module does not hold yet: 0 not yet, 1 being built, 2 built
-_SURFACE = [0]
-_SURFACE_LOCK = _threading.RLock()
-
-
-def _complete() -> None:
-    """Build the vendor surface now, if it is not built yet: what looks at this module's
-    namespace as a whole (``vars(gt)``) calls this first; an attribute, ``dir()`` and
-    ``from gtecat.gt import *`` do it by themselves."""
-    if _SURFACE[0]:
-        return
-    with _SURFACE_LOCK:
-        if _SURFACE[0]:
-            return
-        _SURFACE[0] = 1
-        paused = _gc.isenabled()
-        _gc.disable()
-        try:
-            _vendor_surface()
-        except BaseException:
-            _SURFACE[0] = 0
+for _name in _MODULES:
+    try:
+        _mod = importlib.import_module(f"{__name__}.{_name}")
+    except ModuleNotFoundError as _e:
+        if _e.name != f"{__name__}.{_name}":
             raise
-        finally:
-            if paused:
-                _gc.enable()
-        _SURFACE[0] = 2
+        continue
+    for _k, _v in vars(_mod).items():
+        if _is_public(_k, _v):
+            globals()[_k] = _v
 
-
-def __getattr__(name: str) -> object:
-    # (PEP 562: only for names the module does not hold) the vendor's thousands of
-    # declared-only functions, structures and constants are made at the first look at one:
-    # most programs never name one, and making them is a fifth of this module's import
-    if not name.startswith("_"):
-        _complete()
-        try:
-            return globals()[name]
-        except KeyError:
-            pass
-    elif name == "__all__":  # from gtecat.gt import *: every public name, as without __all__
-        _complete()
-        return [k for k in globals() if not k.startswith("_")]
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    _complete()
-    return sorted(globals())
+globals().update(REGISTRY)
 
 
 def _vendor_surface() -> None:
     """The groups' structures, enums and constants that no module above defines, and a
-    function for every declared-only name (it returns the declared code with a reason);
-    built by :func:`_complete`."""
+    function for every declared-only name (it returns the declared code with a reason)."""
     from . import typedefs
     from .declared import declared_function
     from .table import FUNCTIONS, GROUPS
@@ -161,6 +97,39 @@ def _vendor_surface() -> None:
     typedefs.BUILT = built
 
 
+#: the vendor surface (:func:`_vendor_surface`: ~2,900 declared-only functions, the groups'
+#: structures, enums and constants) is made the first time anything asks for a name this
+#: module does not hold yet, or for the whole namespace (``dir()``, ``from gtecat.gt import
+#: *``, :func:`_whole`): a process that calls only emulated functions never pays for it
+_made: list[bool] = []
+_lock = _threading.RLock()
+
+
+def _whole() -> dict[str, object]:
+    """This module's namespace with the vendor surface made (what ``vars(gt)`` held before
+    it was made lazily): walk this, not ``vars(gt)``."""
+    if not _made:
+        with _lock:
+            if not _made:
+                _vendor_surface()
+                _made.append(True)
+    return globals()
+
+
+def __getattr__(name: str) -> object:
+    if name == "__all__":  # ``from gtecat.gt import *``: every public name, made first
+        return [k for k in _whole() if not k.startswith("_")]
+    if not name.startswith("__") and not _made:
+        g = _whole()
+        if name in g:
+            return g[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(_whole())
+
+
 def _arm_faults(ctl: object) -> None:
     """The machine TOML's ``[[fault]]`` tables are armed by :mod:`gtecat.faults` on every bus
     before it is brought up; that package (a tenth of this import's Python) is imported the
@@ -184,9 +153,4 @@ def _install_fault_hook() -> None:
         from .. import faults  # noqa: F401  (records this process's GT calls)
 
 
-try:
-    _load_modules()
-    _install_fault_hook()
-finally:
-    if _GC_WAS_ON:
-        _gc.enable()
+_install_fault_hook()

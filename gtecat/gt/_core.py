@@ -40,7 +40,7 @@ from ..errors import (
     ParameterError,
 )
 from ..master.clock import ClockGroup, ClockMode
-from .args import _NUMERIC, Ref, binder, core_arg, fast_binder
+from .args import _NUMERIC, Ref, binder, core_arg, fast_binder, impl_params
 from .fast import FAST_MAKERS
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
@@ -349,8 +349,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     proto = FUNCTIONS.get(name)
     if proto is None:
         raise RuntimeError(f"{name} is not in the function table (gtecat/gt/table.py)")
-    fn_sig = inspect.signature(fn)
-    params = list(fn_sig.parameters)
+    positional, keyword_only = impl_params(fn)
+    params = positional + keyword_only
     needs_ctl = bool(params) and params[0] == "ctl"
     bind = binder(proto, fn)
     card_refused = refused(name)
@@ -466,7 +466,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         slow = gt  # (the common shapes up front: gt.fast)
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
-    gt.__signature__ = _signature(proto, fn_sig)  # type: ignore[attr-defined]
+    gt.__signature__ = _signature(proto, fn, keyword_only)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt
     if proto.gtn:
@@ -529,7 +529,7 @@ def _attach_address(kwargs: dict) -> str:
     return "" if address == "local" else address
 
 
-def _signature(proto: Proto, fn_sig: inspect.Signature) -> inspect.Signature:
+def _signature(proto: Proto, fn: Callable[..., Any], keyword_only: list[str]) -> inspect.Signature:
     """The Python signature shown by help(): the table's parameters and defaults, then the
     implementation's keyword-only options (GT_Open's ``eni=...``)."""
     out = []
@@ -539,8 +539,9 @@ def _signature(proto: Proto, fn_sig: inspect.Signature) -> inspect.Signature:
         except KeyError:
             d = inspect.Parameter.empty
         out.append(inspect.Parameter(p.name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=d))
-    kw = inspect.Parameter.KEYWORD_ONLY
-    out += [q for q in fn_sig.parameters.values() if q.kind is kw]
+    if keyword_only:
+        kw = inspect.Parameter.KEYWORD_ONLY
+        out += [q for q in inspect.signature(fn).parameters.values() if q.kind is kw]
     return inspect.Signature(out)
 
 

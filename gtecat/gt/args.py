@@ -51,10 +51,12 @@ import math
 import numbers
 import sys
 from collections.abc import Callable
+from types import FunctionType
 from typing import Any
 
 import numpy as np
 
+from .._bytecode import compiled as _compiled_code
 from ..errors import ParameterError
 from . import structs
 from .table import ENUMS, SCALARS, Param, Proto
@@ -873,6 +875,33 @@ def _converter(p: Param) -> Converter:
 _INF = float("inf")
 
 
+def impl_params(fn: Callable[..., Any]) -> tuple[list[str], list[str]]:
+    """(the names of ``fn``'s parameters that are not keyword-only, with ``*args`` among them
+    as ``inspect.signature`` lists it; its keyword-only ones): from the function's code where
+    it is a plain function (nothing wraps it or states its signature), else from
+    ``inspect.signature`` (the GT layer asks this of each of its ~400 functions at import)."""
+    code = getattr(fn, "__code__", None)
+    if (
+        type(fn) is FunctionType
+        and code is not None
+        and not code.co_flags & (_CO_VARARGS | _CO_VARKEYWORDS)
+        and "__wrapped__" not in fn.__dict__
+        and "__signature__" not in fn.__dict__
+    ):
+        n, k = code.co_argcount, code.co_kwonlyargcount
+        return list(code.co_varnames[:n]), list(code.co_varnames[n : n + k])
+    sig = inspect.signature(fn)
+    kw = inspect.Parameter.KEYWORD_ONLY
+    return (
+        [n for n, q in sig.parameters.items() if q.kind is not kw],
+        [n for n, q in sig.parameters.items() if q.kind is kw],
+    )
+
+
+_CO_VARARGS = inspect.CO_VARARGS
+_CO_VARKEYWORDS = inspect.CO_VARKEYWORDS
+
+
 def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tuple[list, dict]]:
     """``bind(args, kwargs) -> (positional, extra keywords)`` for ``impl`` per ``proto``.
 
@@ -890,12 +919,10 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
             defaults.append(p.default_value())
         except KeyError:  # an optional pointer left out is NULL (Python callers omit them)
             defaults.append(None if p.optional else _MISSING)
-    sig = inspect.signature(impl)
-    impl_names = [
-        n for n, q in sig.parameters.items() if q.kind is not q.KEYWORD_ONLY and n != "ctl"
-    ]
+    positional, keyword_only = impl_params(impl)
+    impl_names = [n for n in positional if n != "ctl"]
     aliases = {a: names[i] for i, a in enumerate(impl_names[: len(names)]) if a != names[i]}
-    extra_kw = {n for n, q in sig.parameters.items() if q.kind is q.KEYWORD_ONLY}
+    extra_kw = set(keyword_only)
     # pointers whose room is checked after conversion: counted by another argument, or by a
     # fixed count; a byref() of one scalar holds one element by construction
     counted = [
@@ -907,10 +934,10 @@ def binder(proto: Proto, impl: Callable[..., Any]) -> Callable[[tuple, dict], tu
     core_first = proto.core_first_form
 
     tails = [tuple(defaults[n:]) for n in range(n_params + 1)]
-    first_missing = [
-        next((i for i in range(n, n_params) if defaults[i] is _MISSING), None)
-        for n in range(n_params + 1)
-    ]
+    # the first parameter from n on that has no default (None: none), for every n
+    first_missing: list[int | None] = [None] * (n_params + 1)
+    for i in range(n_params - 1, -1, -1):
+        first_missing[i] = i if defaults[i] is _MISSING else first_missing[i + 1]
 
     def missing(i: int) -> ParameterError:
         return ParameterError(
@@ -1273,7 +1300,7 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         f"    return ({', '.join(out)}{',' if len(out) == 1 else ''})",
     ]
     code = "\n".join(lines)
-    exec(compile(code, f"<gt binder {proto.name}>", "exec"), env)
+    exec(_compiled_code(code, f"<gt binder {proto.name}>"), env)
     fn = env["bind"]
     fn.source = code  # type: ignore[attr-defined]
     return fn

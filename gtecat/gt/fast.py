@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
@@ -216,13 +217,18 @@ def fast_reader(
     limit = CONTROLLER_AXES if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
 
+    core: list[Any] = []  # (CMD_PARAM, _record): the GT layer imports this module first
+
     def refuse(ctl: Any, reason: str) -> int:
         """The table path's refusal of a parameter (code 7 and the reason), then the call's
         host latency."""
-        from ._core import CMD_PARAM, _record  # (the GT layer imports this module)
+        if not core:
+            from ._core import CMD_PARAM, _record
 
-        _record(name, CMD_PARAM, reason)
-        return advance(ctl, name, CMD_PARAM)
+            core[:] = (CMD_PARAM, _record)
+        code, record = core
+        record(name, code, reason)
+        return advance(ctl, name, code)
 
     def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
@@ -368,6 +374,81 @@ _STATUS_BITS = {
     "ARRIVED": int(AxisStatus.ARRIVED),
     "TRAP": TrapPlanner,
     "TRAP_IDLE": TRAP_IDLE,
+}
+
+
+def _linked(bank_list: str, own: str, from_bank: str) -> tuple[str, ...]:
+    """The steps of a reader's value ``own`` (an axis the bank does not run), else
+    ``from_bank`` of ``x``, the bank's value of the axis from its list ``bank_list``."""
+    return (
+        "b = res.bank",
+        "if b is None:",
+        f"    v = {own}",
+        "else:",
+        f"    lst = b._lists.get({bank_list!r})",
+        f"    x = b.value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
+        f"    v = {from_bank}",
+    )
+
+
+#: a reader's value of an axis the bank does not run (``res.bank`` None): the branch of the
+#: AxisResources property of the reader's name for it (the planner's or the encoder's own
+#: value), read without the property's call
+UNBANKED: dict[str, str] = {
+    "GT_GetPrfPos": "res.profile.planner.pos",
+    "GT_GetPrfVel": "res.profile.planner.vel",
+    "GT_GetPrfAcc": "res.profile.planner.acc",
+    "GT_GetAxisPrfPos": "res.ax.prf_pos",
+    "GT_GetEncPos": "res.encoder.pos",
+    "GT_GetEncVel": "res.encoder.vel",
+}
+
+
+#: the readers whose value is a link applied to a profile's or an encoder's value, or a bit
+#: of the status word (the AxisResources property or method the reader's getter calls, its
+#: steps inline: the same operations in the same order): function -> the steps that set
+#: ``v``; tests/gtecat/gt/test_fast_walk.py
+#: holds each to its property, banked and not
+DERIVED: dict[str, tuple[str, ...]] = {
+    "GT_GetAxisPrfVel": _linked(
+        "prf_v", "res.prf_link.ratio * res.profile.planner.vel", "res.prf_link.ratio * x"
+    ),
+    "GT_GetAxisPrfAcc": _linked(
+        "prf_a", "res.prf_link.ratio * res.profile.planner.acc", "res.prf_link.ratio * x"
+    ),
+    "GT_GetAxisEncVel": _linked(
+        "enc_vel", "res.enc_link.ratio * res.encoder.vel", "res.enc_link.ratio * x"
+    ),
+    "GT_GetAxisEncAcc": _linked(
+        "enc_acc", "res.enc_link.ratio * res.encoder.acc", "res.enc_link.ratio * x"
+    ),
+    "GT_GetAxisEncPos": _linked(
+        "enc_pos", "res.enc_link.axis(res.encoder.pos)", "res.enc_link.axis(x)"
+    ),
+    # GT_GetSts's word's planner bit (prf_sts_value: status() & MOVING)
+    "GT_GetPrfSts": (
+        "b = res.bank",
+        "if b is None:",
+        "    v = res.latched & MOVING",
+        "    pl = res.profile.planner",
+        "    if (pl._mode != TRAP_IDLE) if type(pl) is TRAP else not pl.done:",
+        "        v = MOVING",
+        "else:",
+        "    lst = b._lists.get('sts')",
+        "    v = (b.value('sts', res.bank_row) if lst is None else lst[res.bank_row]) & MOVING",
+    ),
+    # the axis's planned position less its encoder's through the link (axis_error)
+    "GT_GetAxisError": (
+        "b = res.bank",
+        "if b is None:",
+        "    v = res.ax.prf_pos - res.enc_link.axis(res.encoder.pos)",
+        "else:",
+        "    row = res.bank_row",
+        "    lst = b._lists.get('a_last')",
+        "    x = b.value('a_last', row) if lst is None else lst[row]",
+        "    lst = b._lists.get('enc_pos')",
+        "    v = x - res.enc_link.axis(b.value('enc_pos', row) if lst is None else lst[row])",
+    ),
 }
 
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
@@ -539,28 +620,42 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     env["_AT"] = _AT
     env["PER_CORE"] = AXES_PER_CORE
     attr = getattr(env["get"], "attr", None)
+    derived = DERIVED.get(env["name"])
+    if derived is not None:  # (AxisResources' property, its steps inline)
+        lines = [*derived]
+        if env["to"] is float:
+            lines += ["if type(v) is not float:", "    v = float(v)"]
+        env.update(_STATUS_BITS)
+        code = code.replace("{value}", "\n".join("            " + line for line in lines))
+        exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)
+        return env[fname]
     if env["name"] in SCALAR_INLINE:
         scalar = list(SCALAR_INLINE[env["name"]])
         env.update(_STATUS_BITS)
     elif attr is None:
         scalar = ["v = get(res)"]
     else:  # the attribute itself (attr_getter's value, without the two calls)
-        scalar = [f"v = res.{attr}", "if type(v) is not float:", "    v = float(v)"]
+        # (of an axis the bank does not run: the property's own branch for it, inline)
+        own = f"res.{attr}"
+        if env["key"] is not None:  # (the bank's own list otherwise, below)
+            own = UNBANKED.get(env["name"], own)
+        scalar = [f"v = {own}", "if type(v) is not float:", "    v = float(v)"]
     if env["key"] is None:
         lines = scalar
     else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
-        row = "lst[res.bank_row]" if env["to"] is None else "to(lst[res.bank_row])"
         lines = [
             "b = res.bank",
             "if b is None:",
             *("    " + x for x in scalar),
             "else:",
             "    lst = b._lists.get(key)",
-            f"    v = get(res) if lst is None else {row}",
+            "    v = get(res) if lst is None else lst[res.bank_row]",
         ]
+        if env["to"] is not None:  # (a double: the list's float as it is, else float())
+            lines += ["    if type(v) is not float:", "        v = to(v)"]
     value = "\n".join("            " + line for line in lines)
     code = code.replace("{value}", value)
-    exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)  # env: its globals
+    exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]
 
 
@@ -584,11 +679,16 @@ def fast_clock(
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
     """``GT_GetClock(pClock[, pLoop])`` with the fast path in front of the table: ``pClock``
-    ``byref(x)`` or ``x`` of an integer type of at least 32 bits, ``pLoop`` omitted, None or
-    0, on the in-process controller; anything else (a value the type cannot hold included)
+    ``byref(x)`` or ``x`` of an integer type of at least 32 bits (or a ctypes or numpy
+    array of one: its first element), ``pLoop`` omitted, None or 0, on the in-process
+    controller; anything else (a value the type cannot hold included)
     takes the table path."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
     target = byref_target.target(_CLOCK_INTS) if BYREF_TARGET else None
+    first = _array_first(_scalar_types(FUNCTIONS[name].params[0]))
 
     def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if (
@@ -596,7 +696,10 @@ def fast_clock(
             and not kw
             and not extra
         ):
-            ctl = session.controllers.get(1)
+            try:
+                ctl = session.controllers[1]
+            except KeyError:  # no controller: the table path says why
+                ctl = None
             if ctl is not None and session.plain:  # (in this process, core 1)
                 clock = ctl.clock
                 if clock._thread is None:
@@ -617,10 +720,22 @@ def fast_clock(
                                     obj = None
                                 else:
                                     last[0] = pClock
-                    else:
-                        obj = pClock if tp in _CLOCK_INTS else None
+                    elif tp in _CLOCK_INTS:
+                        obj = pClock
+                    else:  # an array: its first element
+                        b = first(pClock, tp)
+                        if b is not None:
+                            ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
+                            if ms <= b[1]:
+                                pClock[0] = ms
+                                session.last = None
+                                if clock.mode is _LOCKSTEP:
+                                    return 0
+                                return advance(ctl, name, 0)
+                        obj = None
                     if obj is not None:
-                        ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
+                        # GT_GetClock's own value (Controller.clock_ms, inline)
+                        ms = ((clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
                         if ms <= _INT_MAX[type(obj)]:
                             obj.value = ms
                             session.last = None
@@ -843,7 +958,7 @@ def fast_raw(
             env["pack"] = fmt.pack_into
             move = [f"pack(p, 0, {', '.join(cells)})"]
         body = "\n    ".join([*check, *move, "return True"])
-        exec(compile(f"def copy(p):\n    {body}\n", f"<gt copy {name}>", "exec"), env)
+        exec(_compiled_code(f"def copy(p):\n    {body}\n", f"<gt copy {name}>"), env)
         copy = env["copy"]
         names = {k: v for k, v in env.items() if k != "copy" and not k.startswith("__")}
         copy.spec = (ok, move[0], names)  # (for the specialised entry, _raw_entry)
@@ -1026,7 +1141,7 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
     uses go into ``env`` (its globals) with the suffix ``n``."""
     fmt = {"slave": "slave=_NO, " if io else "", "slave_arg": "slave, " if io else ""}
     if n < 0:
-        exec(compile(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>", "exec"), env)
+        exec(_compiled_code(_RAW_BASE.format(**fmt), f"<gt fast raw {env['name']}>"), env)
         return env.pop("gt")
     slave, offset, size, tp, ref = key
     ok, move, names = spec
@@ -1055,7 +1170,7 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         given="given" if ref else "p",
     )
     scratch: dict[str, Any] = {}
-    exec(compile(code, f"<gt fast raw {env['name']} shape {n}>", "exec"), env, scratch)
+    exec(_compiled_code(code, f"<gt fast raw {env['name']} shape {n}>"), env, scratch)
     return scratch["gt"].__code__
 
 
@@ -1135,7 +1250,7 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
     code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
     env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof)
-    exec(compile(code, f"<gt fast raw {env['name']}>", "exec"), env)  # env: its globals
+    exec(_compiled_code(code, f"<gt fast raw {env['name']}>"), env)  # env: its globals
     return env["gt"]
 
 
@@ -1161,17 +1276,30 @@ SLOW_REASONS: dict[str, str] = {
     "emulator": "emulator helpers for tests, not called in control loops",
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
     "gantry": "a mode query: table path",
-    "gts_card": "the pulse-card (GTS) layer: table path (GT_GetDi and GT_GetDiRaw read every "
-    "axis's input and its configured sense per call: work that outweighs the arguments)",
+    "gts_card": "the pulse-card (GTS) set-up, capture and smart-homing calls: table path; the "
+    "polled IO readers (GT_GetDi, GT_GetDiRaw, GT_GetDo) are on the fast path",
     "motion": "profile set-up and parameter readers (called once per move); the position and "
     "speed readers that polling loops use, and GT_GetTrapPrm, are on the fast path",
     "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
     "programs": "motion programs, variables and MRAM: compile and download work outweighs "
     "the arguments",
     "pt_gear_follow": "PT/gear/follow queue and set-up readers: table path",
-    "servo_loop": "servo-loop parameters and analog values: table path",
+    "servo_loop": "servo-loop parameters, analog values and the inputs' change counters "
+    "(GT_GetDiReverseCount: a span of counters, read through the kept input readers): table "
+    "path",
     "status": "status set-up readers (soft limits, bands, stop decelerations) and the "
     "configuration file: GT_GetSts, the polled one, is on the fast path",
+}
+
+
+#: a client's shapes of a fast function's value pointer that the table path answers, and why
+#: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
+#: other that reaches the table)
+SLOW_SHAPES: dict[str, dict[str, str]] = {
+    "GT_GetTrapPrm": {
+        "array[1]": "an array of structures for one structure: the table path checks its "
+        "type and size (the fast path takes the structure, or byref of it)"
+    },
 }
 
 
@@ -1181,6 +1309,7 @@ def fast_functions() -> frozenset[str]:
         frozenset(READERS)
         | RAW
         | {CLOCK, CORE, HOMING}
+        | frozenset(IO_READERS)
         | frozenset(ECAT_READERS)
         | frozenset(STRUCT_READERS)
     )
@@ -1271,6 +1400,7 @@ def fast_ecat_reader(
         "SUB": subindex,
         "ACCS": {},
         "_pdo_entry": _pdo_entry,
+        "first": _array_first(ok),
         "last": [None],
         "_refs": sys.getrefcount,
         "KEPT": _KEPT,
@@ -1283,7 +1413,7 @@ def fast_ecat_reader(
         byref = _ECAT_BYREF_PY.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
     code = _ECAT_READER.replace("{byref}", byref)
-    exec(compile(code, f"<gt fast ecat {name}>", "exec"), env)
+    exec(_compiled_code(code, f"<gt fast ecat {name}>"), env)
     gt = env["gt"]
     gt.slow = slow
     return gt
@@ -1335,12 +1465,22 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                 elif tp in ok:
                     obj = p
                 else:
-                    return slow(*(a for a in (n, p) if a is not _NO))
+                    b = first(p, tp)  # (an array: its first element)
+                    if b is None:
+                        return slow(*(a for a in (n, p) if a is not _NO))
+                    obj = None
                 v = acc.get() if cell is None else cell[0]
-                kind = type(obj)
                 # (a value the type cannot hold: store's refusal, the table path)
-                if kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]:
-                    obj.value = v
+                if obj is None:
+                    done = b[0] <= v <= b[1]
+                    if done:
+                        p[0] = v
+                else:
+                    kind = type(obj)
+                    done = kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]
+                    if done:
+                        obj.value = v
+                if done:
                     session.last = None
                     if clock.mode is _LOCKSTEP:
                         return 0
@@ -1382,6 +1522,7 @@ def fast_homing_status(
             else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
         )
     target = _target(ok)
+    first = _array_first(ok)
     getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
     from ..controller.axis import Axis
 
@@ -1413,12 +1554,16 @@ def fast_homing_status(
                 and m.opened
             ):
                 tp = type(p)
+                arr = None  # (an array: the range its first element holds)
                 if tp is _CArg:
                     obj = target(p)
                     if obj is p:
                         obj = None
+                elif tp in ok:
+                    obj = p
                 else:
-                    obj = p if tp in ok else None
+                    arr = first(p, tp)
+                    obj = None if arr is None else p
                 try:
                     k = kept[n]
                 except KeyError:
@@ -1446,9 +1591,12 @@ def fast_homing_status(
                     else:
                         v = st.result
                     if v is not None:
-                        lo, hi = bounds[type(obj)]
+                        lo, hi = bounds[type(obj)] if arr is None else arr
                         if lo <= v <= hi:
-                            obj.value = v
+                            if arr is None:
+                                obj.value = v
+                            else:
+                                p[0] = v
                             session.last = None
                             if clock.mode is _LOCKSTEP:
                                 return 0
@@ -1615,19 +1763,27 @@ def fast_core(
 
     ok = _scalar_types(FUNCTIONS[name].params[0])
     target = _target(ok)
+    first = _array_first(ok)
 
     def gt(p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if not kw and not extra and session.local:
             tp = type(p)
+            arr = None  # (an array: its first element, of a type that holds 1..4)
             if tp is _CArg:
                 obj = target(p)
                 if obj is p:
                     obj = None
+            elif tp in ok:
+                obj = p
             else:
-                obj = p if tp in ok else None
+                arr = first(p, tp)
+                obj = None if arr is None else p
             if obj is not None and session.note is None:
                 core = session._core  # (1..4: every integer type the pointer takes holds it)
-                obj.value = core
+                if arr is None:
+                    obj.value = core
+                else:
+                    p[0] = core
                 session.last = None
                 ctl = session.controllers.get(core)
                 if ctl is None or ctl.clock.mode is _LOCKSTEP:
@@ -1639,9 +1795,175 @@ def fast_core(
     return gt
 
 
+#: the card's IO readers on the fast path: function -> (the types it reads, first and last,
+#: and where its readers are kept among a controller's ``input_plans``: type + this)
+IO_READERS = {"GT_GetDi": (0, 6, 0), "GT_GetDiRaw": (0, 6, 16), "GT_GetDo": (10, 12, 32)}
+
+
+def _int_bounds(types: Any) -> dict[type, tuple[int, int]]:
+    """The range of values each ctypes integer type of ``types`` holds."""
+    out = {}
+    for t in types:
+        bits = 8 * ctypes.sizeof(t)
+        out[t] = (
+            (0, (1 << bits) - 1)
+            if t._type_.isupper()
+            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        )
+    return out
+
+
+def _array_first(ok: Any) -> Callable[[Any, type], tuple[int, int] | None]:
+    """``first(p, type(p))`` for a fast reader of one integer into a pointer the table path
+    takes as the ctypes types ``ok``: the range of values the first element of ``p`` holds
+    when ``p`` is a ctypes array of one of ``ok`` (at least one element) or a writable
+    one-dimensional numpy array of an integer dtype of the size and sign of one of ``ok``
+    (the table path's ``flat[:1] = [value]``), else None (the table path decides)."""
+    bounds = _int_bounds(t for t in ok if t._type_ in "bBhHiIlLqQ")
+    dtypes = {
+        np.dtype(f"{'i' if t._type_.islower() else 'u'}{ctypes.sizeof(t)}"): b
+        for t, b in bounds.items()
+    }
+    arrays: dict[type, tuple[int, int] | None] = {}
+
+    def first(p: Any, tp: type) -> tuple[int, int] | None:
+        if tp is _NDARRAY:
+            b = dtypes.get(p.dtype)
+            if b is not None and p.ndim == 1 and p.size and p.flags.writeable:
+                return b
+            return None
+        try:
+            return arrays[tp]
+        except KeyError:
+            b = arrays[tp] = (
+                bounds.get(tp._type_) if issubclass(tp, ctypes.Array) and tp._length_ >= 1 else None
+            )
+            return b
+
+    return first
+
+
+def fast_io_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetDi(diType, p)``, ``GT_GetDiRaw`` and ``GT_GetDo(doType, p)`` with the fast
+    path in front of the table: the type one of those the function reads, ``p`` a ``byref``
+    (no offset) or the object itself of an integer type the pointer takes, or a ctypes or
+    numpy array of one (its first element), on the in-process controller (core 1).  The
+    value is the table path's (:func:`io_calls.read_di`, :func:`io_calls.read_do`) through a
+    reader of :func:`io_calls.io_reader` (for the inputs: each axis's bit read live from the
+    process image, its sense folded in), kept per controller and type until the next
+    :func:`gtecat.controller.input_sense.changed` (every change of a configuration's
+    ``reverse``, a bus brought up with other axes).  The axis bank gives its axes back
+    first, as it does before the table path.  Any other shape, a value the type cannot
+    hold, another type: the table path, with its code and reason."""
+    from ..controller.input_sense import keep
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    proto = FUNCTIONS[name]
+    ok = _scalar_types(proto.params[1])
+    bounds = _int_bounds(ok)
+    #: the types that hold every value (a signed 32-bit word): no range check
+    T0 = ctypes.c_long  # (the usual one)
+    wide = frozenset(
+        t for t, (lo, hi) in bounds.items() if lo <= -(1 << 31) and (1 << 31) <= hi + 1
+    )
+    target = _target(ok)
+    lo_t, hi_t, kind = IO_READERS[name]
+    made: list[Any] = []  # io_calls.io_reader (io_calls imports the GT layer: at first use)
+    first = _array_first(ok)
+
+    def plan(ctl: Any, t: int) -> Any:
+        """The reader of type ``t`` on ``ctl``, made and kept (until the next change)."""
+        if not made:
+            from .io_calls import io_reader
+
+            made.append(io_reader)
+        return keep(ctl, t + kind, made[0](ctl, name, t))
+
+    env = {
+        "_NO": _NO,
+        "_CArg": _CArg,
+        "_LOCKSTEP": _LOCKSTEP,
+        "session": session,
+        "slow": slow,
+        "advance": advance,
+        "name": name,
+        "proto": proto,
+        "target": target,
+        "ok": ok,
+        "T0": T0,
+        "wide": wide,
+        "bounds": bounds,
+        "first": first,
+        "plan": plan,
+    }
+    # (compiled with the function's type range and key offset as constants, its names as
+    # globals: the fewest steps per call)
+    code = _IO_READER.format(lo=lo_t, hi=hi_t, kind=kind)
+    exec(compile(code, f"<gt fast io {name}>", "exec"), env)
+    gt = env["gt"]
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
+#: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'
+#: offset among a controller's ``input_plans``)
+_IO_READER = """
+def gt(t=_NO, p=_NO, /, *extra, **kw):
+    if type(t) is int and {lo} <= t <= {hi} and session.plain and not extra and not kw:
+        try:
+            ctl = session.controllers[1]
+            read = ctl.input_plans[t + {kind}]
+        except KeyError:  # none kept (yet, or since a change), no controller
+            ctl = session.controllers.get(1)
+            read = None
+        if ctl is not None:
+            clock = ctl.clock
+            if clock._thread is None and session.note is None:
+                tp = type(p)
+                if tp is _CArg:
+                    obj = target(p)
+                    if obj is p:  # (byref(x, offset), another type: the table path)
+                        obj = _NO
+                elif tp is T0 or tp in ok:
+                    obj = p
+                else:
+                    b = first(p, tp)  # (an array: its first element)
+                    obj = _NO if b is None else None
+                if obj is not _NO:
+                    bank = ctl.bank
+                    if bank is not None and bank.n_alive:  # (what the table path does
+                        bank.before_call(ctl, proto, (t, p))  # first: its axes go back)
+                    if read is None:
+                        read = plan(ctl, t)
+                    v = read()
+                    if obj is not None:
+                        k = type(obj)
+                        done = k is T0 or k in wide or bounds[k][0] <= v <= bounds[k][1]
+                        if done:
+                            obj.value = v
+                    else:  # an array's first element
+                        done = b[0] <= v <= b[1]
+                        if done:
+                            p[0] = v
+                    if done:  # (else a value the type cannot hold: the table's code)
+                        session.last = None
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+    return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
+"""
+
+
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
         CLOCK: fast_clock,
+        **dict.fromkeys(IO_READERS, fast_io_reader),
         CORE: fast_core,
         HOMING: fast_homing_status,
     }

@@ -35,6 +35,7 @@ from ..controller.axis import PdsState
 from ..controller.config_file import switch_sense, vendor_settings
 from ..controller.core import Controller
 from ..controller.digital_io import GPIO_COUNT, digital_io
+from ..controller.input_sense import keep
 from ..controller.resources import _fault_reset
 from ..errors import ParameterError
 from ._core import check_range, gt_function, store
@@ -102,6 +103,104 @@ def read_di(ctl: Controller, di_type: int, raw: bool) -> int:
         if level != rev(n):
             value |= 1 << (n - 1)
     return value
+
+
+def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
+    """The value GT_GetDi (``raw``: GT_GetDiRaw) stores for ``di_type`` (one of its types)
+    on ``ctl`` - ``_signed32(read_di(...))`` - as one call without the look-ups: each
+    axis's input bit read where it lies in the process image, their sense (configuration,
+    wiring) folded into one constant.  Valid until the next
+    :func:`gtecat.controller.input_sense.changed` (the GT fast path keeps it that long; a
+    bus brought up with other axes is a change too)."""
+    if di_type == MC_MPG:
+        return lambda: 0
+    if di_type == MC_GPI:
+        io = digital_io(ctl)
+        flip = 0
+        if not raw:
+            rev = _reversed(ctl, "gpi")
+            flip = sum(1 << (k - 1) for k in range(1, GPIO_COUNT + 1) if rev(k))
+        return lambda: io.gpi ^ flip
+    index, mask, kind = _AXIS_INPUTS[di_type]
+    settings = vendor_settings(ctl)
+    b = mask.bit_length() - 1
+    env: dict[str, Any] = {}
+    buffers: dict[int, str] = {}
+    terms: list[str] = []
+    flip = 0  # the axes read inverted (an axis that maps no object reads its sense alone)
+    for n, ax in ctl.axes.items():
+        if not 1 <= n <= 32:
+            continue
+        reverse = bool(settings.get((kind, n), {}).get("reverse", False))
+        if switch_sense(ctl, kind, n, reverse)[0 if raw else 1]:
+            flip |= 1 << (n - 1)
+        acc = ax.io.get(index)
+        if acc is None:
+            continue
+        at = acc.bit_at(b)
+        if at is None:  # (a bit past the entry's width: its get(), as read_di reads it)
+            env[f"A{n}"] = acc
+            terms.append(f"((A{n}.get() & {mask}) != 0) << {n - 1}")
+            continue
+        buf, byte, shift = at
+        name = buffers.get(id(buf))
+        if name is None:
+            name = buffers[id(buf)] = f"B{len(buffers)}"
+            env[name] = buf
+        move = n - 1 - shift
+        term = f"({name}[{byte}] & {1 << shift})"
+        terms.append(
+            term if not move else f"{term} << {move}" if move > 0 else f"{term} >> {-move}"
+        )
+    value = f"({' | '.join(terms)}) ^ {flip}" if terms else str(_signed32(flip))
+    if terms and 32 in ctl.axes:  # (axis 32's bit: the sign of GT_GetDi's long)
+        body = f"v = {value}\n    return v - {1 << 32} if v >> 31 else v"
+    else:
+        body = f"return {value}"
+    exec(compile(f"def read():\n    {body}\n", f"<GT_GetDi {kind}>", "exec"), env)
+    return env["read"]
+
+
+def di_value(ctl: Controller, di_type: int, raw: bool = False) -> int:
+    """:func:`read_di`'s value of an input type (checked before) through the reader the GT
+    fast path keeps for ``ctl`` (made and kept here when none is): the
+    same value without the look-ups (an input watched every cycle).  A view of a core
+    beyond 32 axes keeps none: :func:`read_di` itself."""
+    plans = vars(ctl).get("input_plans")  # (a CoreView's attributes are its base's)
+    if plans is None:
+        return read_di(ctl, di_type, raw)
+    key = di_type + (16 if raw else 0)  # (the GT fast path's keys: gt.fast.IO_READERS)
+    read = plans.get(key)
+    if read is None:
+        read = keep(ctl, key, di_reader(ctl, di_type, raw))
+    return read() & 0xFFFFFFFF
+
+
+def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
+    """The value GT_GetDo stores for ``do_type`` (one of its types) on ``ctl`` as one call;
+    valid until the next :func:`gtecat.controller.input_sense.changed` (the axes of
+    ``MC_ENABLE``: a bus brought up again is one)."""
+    io = digital_io(ctl)
+    if do_type == MC_GPO:
+        return lambda: io.gpo
+    if do_type == MC_CLEAR:
+        return lambda: io.clear
+    env: dict[str, Any] = {}
+    terms = []
+    for n, ax in ctl.axes.items():
+        if 1 <= n <= 32:
+            env[f"a{n}"] = ax
+            terms.append(f"({_signed32(1 << (n - 1))} if a{n}.servo_on else 0)")
+    body = " | ".join(terms) or "0"  # (axis 32's bit as the sign of GT_GetDo's long)
+    exec(compile(f"def enabled():\n    return {body}\n", "<GT_GetDo enable>", "exec"), env)
+    return env["enabled"]
+
+
+def io_reader(ctl: Controller, name: str, t: int) -> Callable[[], int]:
+    """GT function ``name``'s reader of type ``t`` (:func:`di_reader`, :func:`do_reader`)."""
+    if name == "GT_GetDo":
+        return do_reader(ctl, t)
+    return di_reader(ctl, t, raw=name == "GT_GetDiRaw")
 
 
 @gt_function

@@ -76,7 +76,7 @@ from .constants import (
     MC_PROFILE,
     MC_STEP,
 )
-from .io_calls import read_di
+from .io_calls import _DI_TYPES, di_value, read_di
 from .status_calls import GT_LmtsOff, GT_LmtsOn
 
 # vendor GTN header constants used here
@@ -320,11 +320,11 @@ class _EdgeCounter:
 
     def watch(self, di_type: int) -> None:
         if di_type not in self.last:
-            self.last[di_type] = read_di(self.ctl, di_type, raw=False)
+            self.last[di_type] = di_value(self.ctl, di_type)
 
     def __call__(self, t: int, dt: int) -> None:
         for di_type, before in self.last.items():
-            now = read_di(self.ctl, di_type, raw=False)
+            now = di_value(self.ctl, di_type)  # (read_di's, without its look-ups)
             changed = now ^ before
             while changed:
                 bit = changed & -changed
@@ -338,7 +338,8 @@ _EdgeCounter.bank_safe = True  # type: ignore[attr-defined]  # reads inputs only
 
 
 def _edges(ctl: Controller, di_type: int) -> _EdgeCounter:
-    read_di(ctl, di_type, raw=False)  # 7 for a type that is not an input type
+    if type(di_type) is not int or di_type not in _DI_TYPES:
+        read_di(ctl, di_type, raw=False)  # 7 for a type that is not an input type, and why
     for f in ctl.pre_cycle:
         if isinstance(f, _EdgeCounter):
             f.watch(int(di_type))

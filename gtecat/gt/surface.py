@@ -65,10 +65,8 @@ def constants() -> dict[str, int | float | str]:
     """Every constant ``gtecat.gt`` exports (``gts.h``'s defines and enum members)."""
     from .. import gt
 
-    gt._complete()
-
     out = {}
-    for k, v in vars(gt).items():
+    for k, v in gt._whole().items():
         if k.startswith(("_", "GT_", "GTN_", "GTE_")) or not (k.isupper() and len(k) > 1):
             continue
         if isinstance(v, int | float | str) and not isinstance(v, bool):
@@ -80,11 +78,9 @@ def constants() -> dict[str, int | float | str]:
 def structures() -> tuple[str, ...]:
     from .. import gt
 
-    gt._complete()
-
     return tuple(
         k
-        for k, v in vars(gt).items()
+        for k, v in gt._whole().items()
         if k.startswith("T")
         and isinstance(v, type)
         and issubclass(v, ctypes.Structure | ctypes.Union)

@@ -40,9 +40,6 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any
-
-from ..eni.model import quick_pickling
 
 #: C scalar types: (ctypes name, lo, hi, is_float); ``long`` is the vendor's 32-bit long
 SCALARS: dict[str, tuple[str, int, int, bool]] = {
@@ -353,100 +350,112 @@ def _merge(
             twins[proto.twin_name] = proto
 
 
-# the table is kept by pickle (below): its thousands of objects as tuples, quickly
-quick_pickling(Param)
-quick_pickling(Proto)
-
-
 def _load() -> tuple[tuple, dict[str, Proto]]:
     from . import groups as _groups
-    from . import typedefs
+    from .typedefs import enum_names
 
     found = _groups.groups()
-    file = _cache_file(found)
-    kept = _read_kept(file, found) if file is not None else None
-    if kept is not None:
-        enums, functions = kept
+    key = _cache_key(found)
+    cached = _read_cache(key)
+    if cached is not None:
+        enums, table = cached
         ENUMS.update(enums)
-        return found, functions
-    ENUMS.update(typedefs.enum_names(found))
-    functions = collect(found)
-    if file is not None:
-        # the groups' typedefs too (gtecat.gt builds their structures from them)
-        tds = [tuple(typedefs.parse(g.structs, g.name)) for g in found]
-        _keep(file, (sorted(ENUMS), functions, tds))
-    return found, functions
+        return found, table
+    ENUMS.update(enum_names(found))
+    table = collect(found)
+    _write_cache(key, table)
+    return found, table
 
 
-# --- the table kept between processes ------------------------------------------------------
-# Reading the groups' 3,300 prototypes is a fifth of ``from gtecat import gt``; its result
-# depends only on the groups' text and on this reader, so the table read once is kept in
-# gtecat's per-user cache folder (beside the compiled modules, gtecat.cbuild) under the digest
-# of both, and the next process loads it in a quarter of the time (with the groups' typedefs,
-# read for the vendor structures).  A file that is absent,
-# unreadable or of another kind is ignored and the groups are read (and kept) again.
+# --- the parsed table, kept between processes ---------------------------------------------
+# Reading the ~3,700 lines of the groups is most of what importing gtecat.gt costs beyond its
+# modules' code (every process pays it: a replay, a test worker, a native client's
+# controller).  The table read once is kept in gtecat's per-user cache folder as plain
+# values (marshal), named by the digest of everything it is read from: every group's text,
+# and the source of this module and of typedefs (the readers).  A changed group is a new
+# name; a file that is missing, unreadable or not of the expected shape is read again from
+# the groups.  ``GTECAT_PYC_CACHE=0`` turns it off, with gtecat's bytecode cache.
 
 
-def _cache_file(found: tuple) -> Any:
+def _cache_key(found: Iterable) -> str | None:
     import hashlib
-    import sys
-    from pathlib import Path
-
-    try:
-        from .. import __version__
-        from .._cache import cache_root
-
-        h = hashlib.sha256(Path(__file__).read_bytes())
-        h.update(Path(__file__).with_name("typedefs.py").read_bytes())
-        for g in found:
-            for part in (g.name, g.module, g.prototypes, g.structs, str(g.declared_only)):
-                h.update(part.encode("utf-8", "surrogatepass"))
-                h.update(b"\0")
-        tag = f"py{sys.version_info[0]}{sys.version_info[1]}"
-        return cache_root() / __version__ / "table" / f"{tag}-{h.hexdigest()[:32]}.pickle"
-    except (OSError, RuntimeError):  # no home folder, an unreadable source: read the groups
-        return None
-
-
-def _read_kept(file: Any, found: tuple) -> tuple[set[str], dict[str, Proto]] | None:
-    """The kept table (and the groups' typedefs, given to :mod:`gtecat.gt.typedefs`)."""
-    import pickle
-
-    from . import typedefs
-
-    try:
-        with file.open("rb") as f:
-            enums, functions, tds = pickle.load(f)
-    except Exception:  # absent, partial, foreign: read the groups instead
-        return None
-    if not (
-        isinstance(functions, dict)
-        and all(type(p) is Proto for p in functions.values())
-        and isinstance(tds, list)
-        and len(tds) == len(found)
-        and all(type(t) is typedefs.Typedef for group in tds for t in group)
-    ):
-        return None
-    for g, group in zip(found, tds, strict=True):
-        typedefs._PARSED.setdefault((g.structs, g.name), group)
-    return set(enums), functions
-
-
-def _keep(file: Any, value: object) -> None:
     import os
-    import pickle
+    import sys
 
+    if os.environ.get("GTECAT_PYC_CACHE", "1") == "0":
+        return None
+    h = hashlib.sha256(f"{sys.version}\0{_CACHE_FORMAT}\0".encode())
     try:
-        file.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
-        tmp = file.with_name(f"{file.name}.{os.getpid()}.tmp")
-        with tmp.open("wb") as f:
-            pickle.dump(value, f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, file)
-        kept = sorted(file.parent.glob("*.pickle"), key=lambda f: f.stat().st_mtime)
-        for old in kept[:-8]:  # tables of other sources (checkouts, versions): the newest 8
-            old.unlink(missing_ok=True)
-    except (OSError, pickle.PicklingError):  # a read-only home: read again next time
-        pass
+        from . import typedefs
+
+        for mod in (sys.modules[__name__], typedefs):
+            with open(mod.__file__, "rb") as f:
+                h.update(f.read())
+    except (OSError, TypeError, KeyError):
+        return None
+    for g in found:
+        for part in (g.name, g.module, str(g.declared_only), g.prototypes, g.structs):
+            h.update(part.encode("utf-8", "surrogatepass"))
+            h.update(b"\0")
+    return h.hexdigest()[:32]
+
+
+#: the shape of the cached values (raised when it changes)
+_CACHE_FORMAT = 1
+
+
+def _cache_file(key: str):
+    from .. import __version__
+    from .._cache import cache_root
+
+    return cache_root() / __version__ / "table" / f"functions-{key}.marshal"
+
+
+def _read_cache(key: str | None) -> tuple[list[str], dict[str, Proto]] | None:
+    import marshal
+
+    if key is None:
+        return None
+    try:
+        enums, params, protos = marshal.loads(_cache_file(key).read_bytes())
+        made = [Param(*p) for p in params]
+        out: dict[str, Proto] = {}
+        for name, idx, entry, core_first, group, twin, unknown in protos:
+            ps = tuple(made[i] for i in idx)
+            out[name] = Proto(
+                name, ps, entry, core_first, {p.name: p for p in ps}, group, twin, unknown
+            )
+        return list(enums), out
+    except Exception:  # (missing, unreadable, another shape: read from the groups)
+        return None
+
+
+def _write_cache(key: str | None, table: dict[str, Proto]) -> None:
+    import marshal
+    import os
+
+    if key is None:
+        return
+    index: dict[int, int] = {}  # id(Param) -> its place
+    params: list[tuple] = []
+    protos = []
+    for p in table.values():
+        idx = []
+        for q in p.params:
+            k = index.get(id(q))
+            if k is None:
+                k = index[id(q)] = len(params)
+                params.append(tuple(getattr(q, f) for f in Param.__slots__))
+            idx.append(k)
+        protos.append((p.name, tuple(idx), p.entry, p.core_first_form, p.group, p.twin, p.unknown))
+    try:
+        path = _cache_file(key)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps((sorted(ENUMS), params, protos)))
+        os.replace(tmp, path)
+    except (OSError, ValueError, RuntimeError):
+        pass  # a read-only home, or none: read from the groups again next time
 
 
 #: every group of the table (:class:`gtecat.gt.groups.Group`), in file-name order

@@ -22,8 +22,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..eni.model import quick_pickling
-
 #: C field types -> ctypes, the vendor's (Windows) sizes
 FIELD_TYPES: dict[str, Any] = {
     "char": ctypes.c_char,
@@ -90,10 +88,6 @@ class Typedef:
     fields: tuple[Field, ...] = ()
     members: tuple[tuple[str, int], ...] = ()  #: enum members and their values
     group: str = ""
-
-
-quick_pickling(Field)  # (the function table keeps them: gtecat.gt.table)
-quick_pickling(Typedef)
 
 
 _COMMENT = re.compile(r"/\*.*?\*/|//[^\n]*", re.S)
@@ -236,8 +230,15 @@ class Built:
     typedefs: dict[str, Typedef] = field(default_factory=dict)
 
 
-#: what :func:`build` made of every group (set when ``gtecat.gt`` is imported)
-BUILT = Built()
+def __getattr__(name: str) -> Any:
+    # ``BUILT``: what :func:`build` made of every group, set when ``gtecat.gt`` makes its
+    # vendor surface (the first time it is asked for: ``gtecat.gt._whole``)
+    if name == "BUILT":
+        from . import _whole
+
+        _whole()
+        return globals()["BUILT"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def build(typedefs: Iterable[Typedef], existing: dict[str, Any]) -> Built:
@@ -298,10 +299,10 @@ def _make(td: Typedef, classes: dict[str, Any], enums: dict[str, Typedef]) -> An
 def enum_names(groups: Iterable[Any]) -> set[str]:
     """The enum type names the groups' ``STRUCTS`` define (scalar parameter types)."""
     out: set[str] = set()
-    for g in groups:
-        for td in parse(g.structs, g.name):
-            if td.kind == "enum":
-                out.add(td.name)
+    for g in groups:  # (the bodies are read when gtecat.gt makes its vendor surface)
+        for m in _TYPEDEF.finditer(strip_comments(g.structs)):
+            if m[1] == "enum":
+                out.add(m["names"].split(",")[0].strip())
     return out
 
 

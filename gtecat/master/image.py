@@ -73,6 +73,15 @@ class EntryAccess:
             return self._fmt.unpack_from(self._buf, self._off)[0]
         return get_bits(self._buf, self._off, self.bits, signed=self.signed)
 
+    def bit_at(self, b: int) -> tuple[memoryview, int, int] | None:
+        """Where bit ``b`` of the entry's value lies: ``(buffer, byte, shift)`` such that
+        ``buffer[byte] >> shift & 1 == get() >> b & 1`` (little-endian, LSB first, as
+        :meth:`get` reads it); None for a bit past the entry's width."""
+        if not 0 <= b < self.bits:
+            return None
+        bit = (self._off << 3 if self._fmt is not None else self._off) + b
+        return self._buf, bit >> 3, bit & 7
+
     def set(self, value: int) -> None:
         value = int(value)
         if self._fmt is not None:

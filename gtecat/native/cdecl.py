@@ -107,14 +107,12 @@ def structures() -> list[type[ctypes.Structure]]:
 
 @functools.cache
 def _structures() -> tuple[type[ctypes.Structure], ...]:
-    """gt's structures are made once: walked once."""
+    """gt's structures are made once, at its import: walked once."""
     from .. import gt
-
-    gt._complete()
 
     found = {
         v.__name__: v
-        for k, v in vars(gt).items()
+        for k, v in gt._whole().items()
         if k.startswith("T")
         and isinstance(v, type)
         and issubclass(v, ctypes.Structure | ctypes.Union)
@@ -198,10 +196,9 @@ def constants() -> list[Constant]:
     from .. import gt
     from ..gt import typedefs
 
-    gt._complete()
     members = {n for td in typedefs.BUILT.enums.values() for n, _ in td.members}
     out = []
-    for k, v in vars(gt).items():
+    for k, v in gt._whole().items():
         if k.startswith("_") or k.startswith(("GT_", "GTN_", "GTE_")) or k in members:
             continue
         if k.isupper() and len(k) > 1 and isinstance(v, int | float | str):
@@ -212,10 +209,8 @@ def constants() -> list[Constant]:
 def enums() -> list[str]:
     """``typedef enum`` of every enum the groups declare (their members are not
     ``#define``d: C++ code passes them where the prototype names the enum)."""
-    from .. import gt
+    from .. import gt  # noqa: F401 - builds typedefs.BUILT
     from ..gt import typedefs
-
-    gt._complete()  # builds typedefs.BUILT
 
     return [typedefs.enum_decl(td) for td in typedefs.BUILT.enums.values()]
 

@@ -48,3 +48,74 @@ def test_only_where_python_writes_no_bytecode(tmp_path: Path) -> None:
     env["GTECAT_PYC_CACHE"] = "0"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.stdout.strip() == "SourceFileLoader", out.stderr
+
+
+def test_dataclass_methods_kept_compiled(tmp_path: Path, monkeypatch) -> None:
+    """The methods @dataclass writes for a class of gtecat's are compiled once and read back;
+    the class behaves as one compiled afresh; a class of another module is left alone."""
+    import dataclasses
+    import types
+
+    if not _bytecode._DC_FILE:  # (GTECAT_PYC_CACHE=0 in this process)
+        _bytecode.install_dataclass_cache("test")
+    store = tmp_path / "dataclass-store"
+    monkeypatch.setattr(_bytecode, "_DC_FILE", [store, store])
+    monkeypatch.setattr(_bytecode, "_DC_CODES", {})
+    monkeypatch.setattr(_bytecode, "_DC_NEW", {})
+    source = (
+        "from dataclasses import dataclass\n"
+        "@dataclass(frozen=True, slots=True)\n"
+        "class P:\n    a: int\n    b: str = 'x'\n"
+    )
+
+    def define(name: str) -> type:
+        mod = types.ModuleType(name)
+        monkeypatch.setitem(sys.modules, name, mod)
+        exec(source, vars(mod))
+        return vars(mod)["P"]
+
+    def check(cls: type) -> None:
+        # as exec compiles it in the dataclasses module: annotations are objects, not text
+        assert cls.__init__.__annotations__["return"] is None
+        p = cls(1)
+        assert repr(p).endswith("P(a=1, b='x')") and p == cls(1, "x") and p != cls(2)
+        try:
+            p.a = 3  # type: ignore[misc]
+        except dataclasses.FrozenInstanceError:
+            pass
+        else:
+            raise AssertionError("a frozen class took an assignment")
+
+    assert vars(dataclasses)["exec"] is _bytecode._dc_exec
+    check(define("elsewhere_probe"))
+    assert not _bytecode._DC_NEW  # another module's class: compiled as always
+    check(define("gtecat._probe_dc"))
+    made = dict(_bytecode._DC_NEW)
+    assert made
+    _bytecode._dc_save()
+    _bytecode._DC_CODES.clear()
+    _bytecode._dc_load()  # read back from the store
+    assert set(made) <= set(_bytecode._DC_CODES)
+    check(define("gtecat._probe_dc2"))
+    assert not _bytecode._DC_NEW  # nothing compiled again
+    store.write_bytes(b"damaged")
+    _bytecode._DC_CODES.clear()
+    _bytecode._dc_load()
+    check(define("gtecat._probe_dc3"))  # compiled again
+
+
+def test_functions_written_at_run_time_kept_compiled(tmp_path: Path, monkeypatch) -> None:
+    """A function gtecat writes at run time is compiled as its module would (annotations as
+    text), kept one file per text, read back, and compiled again from a damaged file."""
+    monkeypatch.setattr(_bytecode, "_DC_FILE", [tmp_path / "store"])
+    source = "def f(x: int) -> int:\n    return x + 1\n"
+    ns: dict = {}
+    exec(_bytecode.compiled(source, "<probe>"), ns)
+    assert ns["f"](1) == 2 and ns["f"].__annotations__ == {"x": "int", "return": "int"}
+    (kept,) = (tmp_path / "gen").iterdir()
+    again = _bytecode.compiled(source, "<probe>")
+    assert again.co_filename == "<probe>" and list((tmp_path / "gen").iterdir()) == [kept]
+    kept.write_bytes(b"damaged")
+    ns = {}
+    exec(_bytecode.compiled(source, "<probe>"), ns)
+    assert ns["f"](2) == 3

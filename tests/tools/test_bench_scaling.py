@@ -90,6 +90,21 @@ def test_get_sts_ratio_is_well_formed() -> None:
     assert r["gt_get_sts_us"] > 0 and r["argument_us"] > 0 and r["blocks"] >= 1
 
 
+def test_every_shape_is_well_formed() -> None:
+    """Every function with a fast path in every client shape: each call answers 0 or is
+    reported apart with why (an object the bus does not map, a recorded slow shape)."""
+    from gtecat.gt import fast
+
+    r = bench.bench_every_shape(0.05, block=2)
+    assert r["count"] == len(r["shapes"]) > 100 and r["worst"] > 0
+    names = {k.split("(")[0] for k in [*r["shapes"], *r["not_measured"]]}
+    assert names == set(fast.fast_functions() - fast.RAW)
+    assert all(v["call_us"] > 0 and v["argument_us"] > 0 for v in r["shapes"].values())
+    assert set(r["above_4"]) <= set(r["shapes"])
+    apart = [k.split("(")[0] for k, why in r["not_measured"].items() if "table path" in why]
+    assert sorted(apart) == sorted(n for n, kinds in fast.SLOW_SHAPES.items() for _ in kinds)
+
+
 def test_figure_error_is_not_ok() -> None:
     assert bench._figure({"error": "x"}, "rtf", 10) == {"error": "x", "target": 10, "ok": False}
     assert bench._figure({"rtf": 12.0}, "rtf", 10)["ok"] is True

@@ -21,6 +21,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ...errors import ParameterError
 
 #: how far the end of an arc may lie off the circle through its start (pulse)
@@ -54,6 +56,19 @@ class Line:
             return self.end
         u = max(s, 0.0) / ln
         return tuple(a + d * u for a, d in zip(self.start, self._delta, strict=True))
+
+    def points(self, s: np.ndarray, out: np.ndarray) -> None:
+        """:meth:`point` of each path distance of ``s`` into ``out`` (one row per
+        coordinate): the same operations, so each value is bit for bit the scalar one."""
+        ln = self.length
+        if ln == 0.0:
+            out[:] = np.array(self.end)[:, None]
+            return
+        u = _fraction(s, ln)
+        for k, (a, d) in enumerate(zip(self.start, self._delta, strict=True)):
+            np.multiply(u, d, out=out[k])
+            out[k] += a
+        _ends(s, ln, self.end, out)
 
     def tangent(self, at_end: bool) -> Vec:
         ln = self.length
@@ -108,6 +123,35 @@ class Arc:
             out[k] = self.start[k] + self.rise * u
         return tuple(out)
 
+    def points(self, s: np.ndarray, out: np.ndarray) -> None:
+        """:meth:`point` of each path distance of ``s`` into ``out`` (one row per
+        coordinate): the same operations, so each value is bit for bit the scalar one (the
+        cosines and sines are ``math``'s, as :meth:`point` takes them: numpy's may differ in
+        the last bit)."""
+        ln = self.length
+        if ln == 0.0:
+            out[:] = np.array(self.end)[:, None]
+            return
+        u = _fraction(s, ln)
+        i, j = self.plane
+        r0 = self.r0
+        r = r0 + (self.r1 - r0) * u
+        th = (self.theta0 + self.sweep * u).tolist()
+        n = len(th)
+        cx, cy = self.center
+        for k, x in enumerate(self.start):
+            if k != i and k != j:
+                out[k] = x
+        np.multiply(r, np.fromiter(map(math.cos, th), np.float64, n), out=out[i])
+        out[i] += cx
+        np.multiply(r, np.fromiter(map(math.sin, th), np.float64, n), out=out[j])
+        out[j] += cy
+        if self.axis3 is not None:
+            k = self.axis3
+            np.multiply(u, self.rise, out=out[k])
+            out[k] += self.start[k]
+        _ends(s, ln, self.end, out)
+
     def tangent(self, at_end: bool) -> Vec:
         i, j = self.plane
         th = self.theta0 + (self.sweep if at_end else 0.0)
@@ -120,6 +164,18 @@ class Arc:
             t[self.axis3] = self.rise
         n = _norm(t) or 1.0
         return tuple(x / n for x in t)
+
+
+def _fraction(s: np.ndarray, ln: float) -> np.ndarray:
+    """``max(s, 0.0) / ln`` of each ``s`` (``max`` keeps ``s`` unless 0.0 is larger)."""
+    return np.where(0.0 > s, 0.0, s) / ln
+
+
+def _ends(s: np.ndarray, ln: float, end: Vec, out: np.ndarray) -> None:
+    """The points at or past the end of a segment are its end exactly."""
+    at_end = s >= ln
+    if at_end.any():
+        out[:, at_end] = np.array(end)[:, None]
 
 
 def arc_center(

@@ -57,10 +57,12 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from ...errors import CommandError, ParameterError
 from ..motion.stop import StopDecel, StopKind
 from ..profile import PrfMode
-from .path import Arc, Segment
+from .path import Arc, Line, Segment
 from .velocity import Trapezoid
 
 _get = object.__getattribute__
@@ -69,6 +71,8 @@ CRD_COUNT = 2
 FIFO_SIZE = 4096
 DIM_MAX = 4
 OVERRIDE_MAX = 2.0
+#: the geometries whose cycles :meth:`CoordSystem.run` takes many at a time
+_VECTOR = (Line, Arc)
 
 
 @dataclass(frozen=True, slots=True)
@@ -155,6 +159,8 @@ class LookAhead:
 class AxisSlot:
     """The planner of a profile in interpolation mode: its coordinate of one system."""
 
+    __slots__ = ("_acc", "_fresh", "_pos", "_vel", "coord", "crd", "stopping")
+
     def __init__(self, crd: CoordSystem, coord: int, pos: float) -> None:
         self.crd = crd
         self.coord = coord
@@ -215,6 +221,10 @@ class CoordSystem:
         #: set by the axis bank for one push onto the system it holds ahead (AxisBank.before_call):
         #: called with (system, entry, fifo) after the entry is in the FIFO
         self.push_hook: Callable[[CoordSystem, Entry, int], None] | None = None
+        #: while not None, every entry taken off a FIFO is appended to it (the axis bank's
+        #: record for putting the FIFO back as it was: bank_modes.keep)
+        self.popped: list[Entry] | None = None
+        self._out: np.ndarray | None = None  # run's samples
         self.reset()
 
     def reset(self) -> None:
@@ -397,7 +407,10 @@ class CoordSystem:
             s._vel = s._acc = 0.0
 
     def _drop_fifo(self) -> None:
-        self.fifos[self.fifo].clear()
+        q = self.fifos[self.fifo]
+        if self.popped is not None:
+            self.popped.extend(q)
+        q.clear()
         self.tails[self.fifo] = None
 
     def _end_stop(self) -> None:
@@ -444,47 +457,121 @@ class CoordSystem:
         n: int,
         speeds: list[float] | None = None,
         marks: list[tuple[int, tuple]] | None = None,
-    ) -> tuple[list[list[tuple[float, float, float]]], int]:
+        segment: Callable[..., int] | None = None,
+    ) -> tuple[np.ndarray, int]:
         """``n`` cycles of :meth:`step`, each followed by every axis taking its slot's sample
-        (``AxisSlot.step``), for the axis bank's tables: each slot's samples and the index of
-        the cycle the path ended in (-1: it goes on).  A cycle inside a motion segment is
-        step's own common case written out (the same operations in the same order); any
-        other is :meth:`step`.  ``speeds``/``marks``: the path speed after each cycle, and
-        (cycle, :meth:`state`) after each cycle that was not the common case."""
+        (``AxisSlot.step``), for the axis bank's tables: the samples (``out[0|1|2, k, j]``:
+        position, speed, acceleration of slot ``k`` in cycle ``j``; the system's own array,
+        which its next run overwrites) and the index of the cycle the path ended in (-1: it
+        goes on; the cycles after it are not filled).  The cycles inside a motion segment are
+        step's own common case, for a trapezoid along a line or an arc all of them at once
+        (:meth:`_run_segment`, the same operations in the same order); any other is
+        :meth:`step`.  ``speeds``/``marks``: the path speed after each
+        cycle, and (cycle, :meth:`state`) after each cycle that was not the common case;
+        ``segment``: :meth:`_run_segment` compiled, called with the system first
+        (:class:`gtecat.controller.bank_crd.CrdFill`)."""
         slots = self.slots
         rec = speeds is not None and marks is not None
         origin = self.origin
-        out: list[list[tuple[float, float, float]]] = [[] for _ in slots]
-        for j in range(n):
+        # the system's own array, used again by its next run (the axis bank copies the
+        # samples into its tables; its record of this run is replaced at the next)
+        out = self._out
+        if out is None or out.shape != (3, len(slots), n):
+            out = self._out = np.empty((3, len(slots), n))
+        j = 0
+        while j < n:
             e = self.entry
             if not self.stopping and type(e) is Motion and self.waiting is None and not self.gears:
-                cyc = self._cycle_ms()
-                t = self.t + cyc * self.override
                 plan = self.plan
-                if t < plan.duration:
-                    self.t = t
-                    s = plan.s(t)
-                    self.s = s
-                    self.speed = sp = plan.v(t)
-                    if rec:
-                        speeds.append(sp)  # type: ignore[union-attr]
-                    for col, slot, o, x in zip(out, slots, origin, e.geom.point(s), strict=True):
-                        p = o + x
-                        v = (p - slot._pos) / cyc
-                        a = (v - slot._vel) / cyc
-                        slot._pos, slot._vel, slot._acc = p, v, a
-                        slot._fresh = False  # the axis took it
-                        col.append((p, v, a))
-                    continue
+                if type(plan) is Trapezoid and type(e.geom) in _VECTOR:
+                    if segment is None:
+                        j += self._run_segment(e, plan, out, j, speeds if rec else None)
+                    else:
+                        j += segment(self, e, plan, out, j, speeds if rec else None)
+                    if j >= n:
+                        break
+                else:  # a segment's own speed plan: one cycle
+                    cyc = self._cycle_ms()
+                    t = self.t + cyc * self.override
+                    if t < plan.duration:
+                        self.t = t
+                        s = plan.s(t)
+                        self.s = s
+                        self.speed = sp = plan.v(t)
+                        if rec:
+                            speeds.append(sp)  # type: ignore[union-attr]
+                        for k, (slot, o, x) in enumerate(
+                            zip(slots, origin, e.geom.point(s), strict=True)
+                        ):
+                            p = o + x
+                            v = (p - slot._pos) / cyc
+                            a = (v - slot._vel) / cyc
+                            slot._pos, slot._vel, slot._acc = p, v, a
+                            slot._fresh = False  # the axis took it
+                            out[0, k, j], out[1, k, j], out[2, k, j] = p, v, a
+                        j += 1
+                        continue
             self.step()
-            for col, slot in zip(out, slots, strict=True):
-                col.append(slot.step())
+            for k, slot in enumerate(slots):
+                out[0, k, j], out[1, k, j], out[2, k, j] = slot.step()
             if rec:
                 speeds.append(self.speed)  # type: ignore[union-attr]
                 marks.append((j, self.state()))  # type: ignore[union-attr]
             if not self.running:
                 return out, j
+            j += 1
         return out, -1
+
+    def _run_segment(
+        self, e: Motion, plan: Trapezoid, out: np.ndarray, j: int, speeds: list[float] | None
+    ) -> int:
+        """The cycles from ``j`` on (at most to the end of ``out``) that stay inside the motion
+        segment ``e``, at once: their samples into ``out``; how many.  Every value is the
+        scalar cycle's bit for bit: the path time by repeated addition (a cumulative sum adds
+        one after the other, as the cycles do), the trapezoid's and the geometry's formulas
+        elementwise in the scalar order (:meth:`Trapezoid.s_v`, ``points``), then per slot
+        ``p = o + x``, ``v = (p - p_before) / cyc``, ``a = (v - v_before) / cyc``."""
+        cyc = self._cycle_ms()
+        dt = cyc * self.override
+        m = out.shape[2] - j
+        if not dt >= 0.0:  # (a NaN) the times would not rise: one cycle at a time
+            return 0
+        ts = np.full(m + 1, dt)
+        ts[0] = self.t
+        np.cumsum(ts, out=ts)
+        k = int(np.searchsorted(ts[1:], plan.duration))  # the times before the segment's end
+        if k == 0:
+            return 0
+        t = ts[1 : k + 1]
+        s, sp = plan.s_v(t)
+        slots = self.slots
+        d = len(slots)
+        # positions and speeds, each slot's before the first cycle in column 0
+        pe = np.empty((d, k + 1))
+        ve = np.empty((d, k + 1))
+        pe[:, 0] = [slot._pos for slot in slots]
+        ve[:, 0] = [slot._vel for slot in slots]
+        p, v = pe[:, 1:], ve[:, 1:]
+        e.geom.points(s, p)
+        p += np.array(self.origin)[:, None]
+        np.subtract(p, pe[:, :-1], out=v)
+        v /= cyc
+        a = out[2, :, j : j + k]
+        np.subtract(v, ve[:, :-1], out=a)
+        a /= cyc
+        out[0, :, j : j + k] = p
+        out[1, :, j : j + k] = v
+        for slot, pi, vi, ai in zip(
+            slots, pe[:, -1].tolist(), ve[:, -1].tolist(), a[:, -1].tolist(), strict=True
+        ):
+            slot._pos, slot._vel, slot._acc = pi, vi, ai
+            slot._fresh = False  # the axis took it
+        self.t = t[-1].item()
+        self.s = s[-1].item()
+        self.speed = sp[-1].item()
+        if speeds is not None:
+            speeds.extend(sp.tolist())
+        return k
 
     def _advance(self, dt: float) -> None:
         self.t += dt
@@ -535,6 +622,8 @@ class CoordSystem:
         q = self.fifos[self.fifo]
         while q:
             e = q.popleft()
+            if self.popped is not None:
+                self.popped.append(e)
             self.entry, self.t = e, leftover
             if isinstance(e, Motion):
                 if e.geom.length <= 0.0:
@@ -641,6 +730,8 @@ class CoordSystem:
             nxt = None
             while q:
                 cand = q.popleft()
+                if self.popped is not None:
+                    self.popped.append(cand)
                 if isinstance(cand, Motion) and cand.geom.length > 0.0:
                     nxt = cand
                     break

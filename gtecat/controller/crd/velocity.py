@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 
 class Trapezoid:
     __slots__ = ("acc", "d1", "dc", "duration", "length", "t1", "tc", "v0", "v_end", "vp")
@@ -82,3 +84,33 @@ class Trapezoid:
         if t2 < self.tc:
             return vp
         return vp - a * (t2 - self.tc)
+
+    def s_v(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`s` and :meth:`v` of each of the rising times ``t``, all before
+        ``duration``: the same operations in the same order, so each value is bit for bit
+        the scalar one.  Rising times meet the cases in their order (a rounded difference
+        rises with its operand), so each case is one stretch of ``t``."""
+        a, v0, vp, t1, tc = self.acc, self.v0, self.vp, self.t1, self.tc
+        s = np.empty(len(t))
+        v = np.empty(len(t))
+        i0 = int(np.searchsorted(t, 0.0, "right"))  # t <= 0.0: the start
+        s[:i0], v[:i0] = 0.0, v0
+        i1 = max(int(np.searchsorted(t, t1)), i0)  # t < t1: the first ramp
+        if i1 > i0:
+            x = t[i0:i1]
+            a1 = a if vp >= v0 else -a
+            s[i0:i1] = v0 * x + 0.5 * a1 * x * x
+            v[i0:i1] = v0 + a1 * x
+        if i1 == len(t):
+            return s, v
+        t2 = t[i1:] - t1
+        i2 = int(np.searchsorted(t2, tc))  # t2 < tc: the cruise
+        s[i1 : i1 + i2] = self.d1 + vp * t2[:i2]
+        v[i1 : i1 + i2] = vp
+        if i1 + i2 < len(t):  # the last ramp
+            t3 = t2[i2:] - tc
+            a3 = -a if self.v_end <= vp else a
+            s3 = self.d1 + self.dc + vp * t3 + 0.5 * a3 * t3 * t3
+            s[i1 + i2 :] = np.where(self.length < s3, self.length, s3)  # min(s3, length)
+            v[i1 + i2 :] = vp - a * t3
+        return s, v

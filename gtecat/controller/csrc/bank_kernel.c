@@ -19,6 +19,9 @@
  * bits in dwatch change (the home input a capture unit samples every cycle) and a Trap row
  * whose sample runs toward a limit already latched (lvel: bit 0 the positive side, bit 1
  * the negative; AxisResources._post stops such a motion) leave the bank before that cycle.
+ * A third follows the drive's touch probe: a row whose probe is armed (c_tpw) leaves before
+ * a cycle whose travel reaches c_tp_lo or c_tp_hi, the nearest edges the probe latches, so
+ * that the drive's TouchProbe.step of every cycle the bank runs finds nothing.
  *
  * Arrays arrive as one table of addresses in the order of FIELDS below (the Python side
  * binds them by these names and refuses a library whose list differs).
@@ -73,6 +76,7 @@
     X(h_maxtr, f64) X(h_tmo, f64) X(h_idx, u8) X(h_fd, f64) X(h_from, f64) X(h_ilim, f64)  \
     X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
     X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
+    X(c_tpw, u8) X(c_tp_lo, f64) X(c_tp_hi, f64)                                           \
     X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64)
 
 enum {
@@ -186,6 +190,13 @@ static int in_window(const double *lo, const double *hi, int64_t width, int64_t 
         if (lo[r * width + j] <= x && x < hi[r * width + j])
             return 1;
     return 0;
+}
+
+/* the travel p0 -> p1 lies strictly between row r's touch probe edges (CspBank.step) */
+INLINE int tp_inside(void **ptr, int64_t r, double p0, double p1)
+{
+    const double lo = p0 < p1 ? p0 : p1, hi = p0 < p1 ? p1 : p0;
+    return F64(c_tp_lo)[r] < lo && hi < F64(c_tp_hi)[r];
 }
 
 /* np.minimum(np.maximum(np.rint(x), -32768), 32767).astype(np.int64): NaN stays NaN */
@@ -830,6 +841,8 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             din |= 1 << 17;
         if ((din ^ I64(c_din)[r]) & I64(dwatch)[r]) /* an input a hook samples changes */
             hit = 1;
+        if (U8(c_tpw)[r] && pos != F64(c_pos)[r] && !tp_inside(ptr, r, F64(c_pos)[r], pos))
+            hit = 1; /* the travel reaches an edge the touch probe latches */
         if (hm[r]) /* AxisResources._post of an axis not in CSP: the plan follows 6064h */
             a = (double)((int64_t)(int32_t)(uint32_t)(uint64_t)pa - I64(drive_offset)[r]) /
                 F64(unit2)[r];
@@ -1021,6 +1034,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     const int64_t w17 = plain ? 0 : io[IN_W17];
     const int64_t dwatch = I64(dwatch)[r];
     const int lvel = U8(lvel)[r];
+    const int tpw = plain ? 0 : U8(c_tpw)[r];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
     double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r],
         q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r],
@@ -1187,7 +1201,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         enc = q_enc_pos + step;
         err = a - (plain ? enc : link(enc, enc_ratio, enc_off));
         if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err ||
-            ((din ^ q_din) & dwatch)) {
+            ((din ^ q_din) & dwatch) || (tpw && pos != p && !tp_inside(ptr, r, p, pos))) {
             q_code = 2;
             break;
         }
@@ -1285,12 +1299,13 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
     row_cycles_t(ptr, io, fp, r, s, limit, bk, 0);
 }
 
-/* row r has none of the rarer parts row_cycles_plain leaves out: no Jog, no switch windows
+/* row r has none of the rarer parts row_cycles_plain leaves out: no Jog, no touch probe
+ * armed, no switch windows
  * (home switch, probes), its plan and encoder in pulses as they are (links of ratio 1 and
  * offset 0) and no in-position band */
 INLINE int row_plain(void **ptr, const int64_t *io, int64_t r)
 {
-    return !U8(jog)[r] && !io[IN_W2] && !io[IN_W16] && !io[IN_W17] &&
+    return !U8(jog)[r] && !U8(c_tpw)[r] && !io[IN_W2] && !io[IN_W16] && !io[IN_W17] &&
            F64(prf_ratio)[r] == 1.0 && F64(prf_off)[r] == 0.0 && F64(enc_ratio)[r] == 1.0 &&
            F64(enc_off)[r] == 0.0 && !(F64(band)[r] > 0.0);
 }

@@ -38,6 +38,9 @@ MACHINE = {
         "5": {"home_switch": [[2000, 4000], [9000, 9500]]},
         "7": {"following_error_window": 50},
         "10": {"positive_limit": 25_000},
+        # touch probe edges (GT_SetTouchProbeFunction): probe inputs and index pulses
+        "3": {"probe1": [[1000, 1500], [6000, 6040]], "index_offset": 250},
+        "8": {"probe2": [[-3000, 3000]], "index_offset": -75, "counts_per_rev": 1000},
     }
 }
 
@@ -145,6 +148,8 @@ def _act(action: tuple) -> int:
         return hash((rc, bytes(data)[: size.value], abort.value))
     if kind == "on":
         return gt.GT_AxisOn(action[1])
+    if kind == "probe":  # the drive latches in the bank's cycles? it gives the axis back first
+        return gt.GT_SetTouchProbeFunction(action[1], action[2])
     if kind == "kernel":  # the compiled cycle's build ends now (no GT call)
         KERNEL_BUILT[0] = True
         bank = gt.GTE_Controller().bank
@@ -243,6 +248,9 @@ jog = st.tuples(
     st.floats(0.0, 5.0),
     st.sampled_from([0.0, 0.0, 0.5, 0.9]),
 )
+#: 60B8h patterns: probe 1 on its input (rising and falling, continuous), on the index pulse,
+#: both probes (probe 2 on its input, first event only), off
+PROBES = [0x33, 0x17, 0x3117, 0]
 action = st.one_of(
     move,
     move,
@@ -259,6 +267,8 @@ action = st.one_of(
     st.tuples(st.just("sdo"), st.integers(0, 7), st.sampled_from([0x6064, 0x6041, 0x603F, 0x1001])),
     st.tuples(st.just("on"), axis),
     st.tuples(st.just("raw"), st.integers(0, 40), st.integers(0, 255)),
+    # 60B8h: probe 1 on its input (both edges, continuous), on the index, probe 2 too, off
+    st.tuples(st.just("probe"), st.sampled_from([3, 8, 3, 8, 5]), st.sampled_from(PROBES)),
 )
 program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=10)
 
@@ -485,3 +495,67 @@ def test_unknown_bank_mode_is_refused() -> None:
     assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="", bank="fast") != 0
     assert "bank" in gt.GTE_GetLastError()
     gt.GT_Close()
+
+
+def test_armed_touch_probes_run_in_the_bank(tmp_path: Path) -> None:
+    """Axes 3 and 8 move with their drives' touch probes armed (GT_SetTouchProbeFunction) over
+    probe windows and index pulses, both directions, continuous and first-event latches: the
+    bank runs them between the edges and gives each back before a cycle that latches one
+    (60B9h/60BAh are in the raw image compared every cycle), compiled and numpy (long waits
+    with armed probes: test_bank_smart_home's index homings)."""
+    machine = _machine_file(tmp_path)
+    actions = [
+        (1, ("probe", 3, 0x33)),
+        (1, ("probe", 8, 0x3117)),
+        (0, ("move", 3, 7_000, 40.0, 1.0, 1.0, 0.0, 0)),
+        (120, ("move", 8, -4_000, 25.0, 1.0, 1.0, 0.0, 25)),
+        (200, ("probe", 3, 0x17)),
+        (0, ("move", 3, -500, 60.0, 2.0, 2.0, 0.0, 5)),
+        (200, ("clear",)),
+    ]
+    ref, ref_codes, _ = _run(actions, machine, "off")
+    cycles = len(ref) - 1
+    for kernel in ("c", "numpy"):
+        got, codes, rows = _run(actions, machine, "on", kernel)
+        assert codes == ref_codes
+        for k, (x, y) in enumerate(zip(ref, got, strict=True)):
+            assert x == y, f"cycle {k}: the bank ({kernel}) and the scalar path differ"
+        # the probe axes ran in the bank (axis 8 shares its drive with axes 5-7)
+        assert rows > 0.9 * AXES * cycles, (kernel, rows, cycles)
+
+
+def test_one_row_given_back_in_floats_is_the_numpy_one(tmp_path: Path) -> None:
+    """A release of one row computes its drive's process values in Python floats
+    (CspBank._one_row); the numpy operations of every other release (_row_outputs) give the
+    same integers, halves, negative zeros and the switch windows included, and the values
+    numpy converts otherwise (not a number, beyond 2**62) go to numpy."""
+    import math
+    import random
+
+    import numpy as np
+
+    _bring_up(_machine_file(tmp_path), "on")
+    try:
+        gt.GTE_Wait(5)
+        csp = gt.GTE_Controller().bank.csp
+        rnd = random.Random(7)
+        values = [0.5, -0.5, 1.5, 2.5, -2.5, -0.0, 0.0, 1e6 + 0.5, 2999.5, 3000.0, 9000.0]
+        checked = 0
+        for k in range(400):
+            r = rnd.randrange(csp.n)
+            for name in ("pos", "dpos", "vel", "acc"):
+                v = rnd.choice(values) if k % 2 else rnd.uniform(-1e5, 1e5)
+                getattr(csp, name)[r] = v
+            csp.limited[r], csp.sw_limited[r] = rnd.random() < 0.3, rnd.random() < 0.2
+            one = csp._one_row(r)
+            ref = csp._row_outputs(np.asarray([r], np.intp))
+            assert one is not None
+            assert one == {name: int(v[0]) for name, v in ref.items()}, (r, k)
+            checked += 1
+        for bad in (math.nan, math.inf, 2.0**63):
+            csp.pos[0] = bad
+            assert csp._one_row(0) is None
+        csp.pos[0] = 0.0  # (the release at the close converts it)
+        assert checked == 400
+    finally:
+        gt.GT_Close()

@@ -24,6 +24,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
+from gtecat.controller import bank_crd
 from tests.gtecat.controller.test_bank import AXES, _bring_up, _machine_file, _ok, _sample
 
 Script = list[tuple[int, Callable[[], object]]]
@@ -306,6 +307,8 @@ def _run(
         got = ctl.bank.sampled_samples if ctl.bank is not None else 0
         sf = ctl.bank.__dict__.get("_slave_fill") if ctl.bank is not None else None
         COMPILED_SLAVES[0] = sf.samples if sf else 0
+        cf = ctl.bank.__dict__.get("_crd_fill") if ctl.bank is not None else None
+        COMPILED_CRD[0] = cf.samples if cf else 0
     finally:
         gt.GT_Close()
     return trace, got
@@ -313,6 +316,8 @@ def _run(
 
 #: the samples of the last _run's compiled slaves (bank_slaves.SlaveFill)
 COMPILED_SLAVES = [0]
+#: ... and of its compiled coordinate-system segments (bank_crd.CrdFill)
+COMPILED_CRD = [0]
 
 
 @pytest.fixture(scope="module")
@@ -349,6 +354,8 @@ _CHUNKED = pytest.mark.long("the script again in short waits")
     ],
 )
 def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked) -> None:
+    if script is CRD:
+        bank_crd.library()  # (its build waited for: the bank takes it from its first table)
     ref, none = _run(script, machine, "off", chunked)
     assert none == 0
     got, samples = _run(script, machine, "on", chunked)
@@ -357,9 +364,11 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
     assert samples >= least, "the bank hardly ran this mode"
     if script is SLAVES:
         assert COMPILED_SLAVES[0] >= 1500, "the compiled slaves hardly ran"
+    if script is CRD and bank_crd.library()[0] is not None:
+        assert COMPILED_CRD[0] >= 300, "the compiled segments hardly ran"
 
 
-@pytest.mark.parametrize("script", [PT, GEAR], ids=["pt", "gear-follow"])
+@pytest.mark.parametrize("script", [PT, GEAR, CRD], ids=["pt", "gear-follow", "crd"])
 @pytest.mark.sample(1)
 def test_modes_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
     """The same without the compiled cycle (no C compiler): numpy runs the bank's cycle and

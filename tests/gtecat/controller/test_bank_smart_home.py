@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -27,9 +28,23 @@ from tests.gtecat.controller.test_bank import ENI, HAS_CC
 AXES = 12
 #: axis -> (THomePrm fields, machine keys); positions in counts (pulse = count here)
 SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
-    1: ({"mode": 20}, {"home_switch": [[3_000, 4_500]]}),
-    2: ({"mode": 20, "moveDir": -1, "edge": 1}, {"home_switch": [[-5_000, -3_500]]}),
-    3: ({"mode": 11}, {"positive_limit": 6_000, "home_switch": [[2_000, 3_000]]}),
+    1: (  # the first index ahead, fast
+        {"mode": 30},
+        {"index_offset": 2_500, "counts_per_rev": 10_000},
+    ),
+    2: (  # forced home, then the first index beyond it
+        {"mode": 41, "homeOffset": 120, "velLow": 10.0},
+        {"home_switch": [[2_500, 7_000]], "index_offset": 650, "counts_per_rev": 2_000},
+    ),
+    3: (  # limit, home on the way back, back to it, the first index beyond it
+        {"mode": 13, "velHigh": 20.0, "velLow": 10.0},
+        {
+            "positive_limit": 3_600,
+            "home_switch": [[2_000, 3_000]],
+            "index_offset": 170,
+            "counts_per_rev": 1_000,
+        },
+    ),
     4: ({"mode": 10, "moveDir": -1, "escapeStep": 400}, {"negative_limit": -4_000}),
     5: ({"mode": 20}, {"position": 1_000, "home_switch": [[500, 2_500]]}),
     6: ({"mode": 20}, {"positive_limit": 3_000, "home_switch": [[-3_000, -2_000]]}),
@@ -37,8 +52,11 @@ SETUP: dict[int, tuple[dict[str, object], dict[str, object]]] = {
         {"mode": 22, "homeOffset": -300},
         {"home_switch": [[2_000, 3_000]], "index_offset": 100, "counts_per_rev": 1_000},
     ),
-    8: ({"mode": 11, "moveDir": -1}, {"negative_limit": -3_500, "home_switch": [[-1_800, -900]]}),
-    9: ({"mode": 40}, {"home_switch": [[2_500, 7_000]]}),
+    8: (  # the negative limit, then slowly up to the first index
+        {"mode": 12, "moveDir": -1, "indexDir": 1, "velHigh": 20.0, "homeOffset": 150},
+        {"negative_limit": -3_500, "index_offset": 600, "counts_per_rev": 1_000},
+    ),
+    9: ({"mode": 20, "moveDir": -1, "edge": 1}, {"home_switch": [[-5_000, -3_500]]}),
     10: ({"mode": 20, "homeOffset": 250}, {"home_switch": [[4_000, 6_000]]}),  # GT_Stop
     11: ({"mode": 20}, {"home_switch": [[400_000, 410_000]]}),  # still searching at the end
     12: (  # GT_Stop while it stands between the home return and the index search
@@ -53,9 +71,9 @@ STOP_AT = 90  # GT_Stop of axis 10 in the middle of its search
 STAND_STOP_AT = 317
 
 
-def _machine(tmp: Path) -> str:
+def _machine(tmp: Path, setup: dict = SETUP) -> str:
     lines = []
-    for axis, (_, keys) in SETUP.items():
+    for axis, (_, keys) in setup.items():
         lines.append(f"[axis.{axis}]")
         lines += [f"{k} = {v}" for k, v in keys.items()]
     path = tmp / "machine.toml"
@@ -67,16 +85,16 @@ def _ok(rc: int, what: str) -> None:
     assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
 
 
-def _sample(size: int) -> tuple:
-    sts = (c_long * AXES)()
-    prf = (c_double * AXES)()
-    enc = (c_double * AXES)()
-    gt.GT_GetSts(1, sts, AXES)
-    gt.GT_GetPrfPos(1, prf, AXES)
-    gt.GT_GetEncPos(1, enc, AXES)
+def _sample(size: int, axes: int = AXES) -> tuple:
+    sts = (c_long * axes)()
+    prf = (c_double * axes)()
+    enc = (c_double * axes)()
+    gt.GT_GetSts(1, sts, axes)
+    gt.GT_GetPrfPos(1, prf, axes)
+    gt.GT_GetEncPos(1, enc, axes)
     homes = []
     hs = gt.THomeStatus()
-    for a in range(1, AXES + 1):
+    for a in range(1, axes + 1):
         _ok(gt.GT_GetHomeStatus(a, byref(hs)), "status")
         homes.append((hs.run, hs.stage, hs.error, hs.capturePos, hs.targetPos))
     raw = (c_ubyte * size)()
@@ -84,12 +102,22 @@ def _sample(size: int) -> tuple:
     return tuple(sts), tuple(prf), tuple(enc), tuple(homes), bytes(raw)
 
 
-def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
+def _run(
+    machine: str,
+    bank: str,
+    step: int = 0,
+    eni: Path = ENI,
+    setup: dict = SETUP,
+    cycles: int = CYCLES,
+    calls: dict[int, Any] | None = None,
+) -> tuple[list, dict[str, Any]]:
     """The homings, sampled after every cycle (``step`` 0: one cycle at a time, now and then
     seven) or after every ``step`` cycles run at once (a long wait: the controller runs
-    them in as few calls as the homings let it)."""
+    them in as few calls as the homings let it); the stops of axes 10 and 12 with
+    :data:`SETUP` alone; ``calls``: cycle -> a call made before it (a GPI set)."""
+    stops = setup is SETUP
     gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank=bank), "open")
+    _ok(gt.GT_Open(eni=str(eni), machine=machine, clock="lockstep", log="", bank=bank), "open")
     trace: list = []
     try:
         _ok(gt.GT_InitEcatComm(), "init")
@@ -100,9 +128,11 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
                 break
             gt.GTE_Wait(1)
         _ok(gt.GT_StartEcatComm(), "start")
-        for a, (fields, _) in SETUP.items():
+        for a, (fields, _) in setup.items():
             _ok(gt.GT_AxisOn(a), f"axis on {a}")
             _ok(gt.GT_PrfTrap(a), f"trap {a}")
+            if fields is None:
+                continue  # (an axis moved by the test's calls)
             prm = gt.THomePrm()
             prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = 20, 1, -1, 0, -1
             prm.velHigh, prm.velLow, prm.acc, prm.dec = 40.0, 4.0, 1.0, 1.0
@@ -112,11 +142,14 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
             _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
         ctl = gt.GTE_Controller()
         size = ctl.layout.gt_raw_bytes
-        k = 0
-        while k < CYCLES:
-            if k <= STOP_AT < k + max(step, 1):
+        k = searching = banked = 0
+        while k < cycles:
+            for at, call in (calls or {}).items():
+                if k <= at < k + max(step, 1):
+                    call()
+            if stops and k <= STOP_AT < k + max(step, 1):
                 _ok(gt.GT_Stop(1 << 9, 0), "stop")
-            if k <= STAND_STOP_AT < k + max(step, 1):
+            if stops and k <= STAND_STOP_AT < k + max(step, 1):
                 if not step:  # (the one-cycle run: it must stand there now)
                     hs = gt.THomeStatus()
                     _ok(gt.GT_GetHomeStatus(12, byref(hs)), "status")
@@ -128,19 +161,39 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, int]]:
             wait = step or (1 if k % 50 else 7)
             gt.GTE_Wait(wait)
             k += wait
-            trace.append(_sample(size))
+            trace.append(_sample(size, len(setup)))
+            # an index search (stage 30) after its probe armed: which axes the bank runs
+            for a, (run, stage, *_) in enumerate(trace[-1][3], 1):
+                if run and stage == 30:
+                    searching += 1
+                    banked += ctl.bank is not None and ctl.bank.holds(ctl.axes[a])
         bank_ = ctl.bank
         stats = {
             "rows": bank_.rows_run if bank_ is not None else 0,
             "many": bank_.many_cycles if bank_ is not None else 0,
             "kernel": bank_ is not None and bank_.kernel is not None,
+            "index_search": (banked, searching),
         }
+        if bank_ is not None and not stops:
+            # axis 1's probe stays armed after its homing: the bank holds it, and a read of
+            # the drive's probe (its status, by the slave's object dictionary) gives it back
+            held = bank_.holds(ctl.axes[1])
+            ctl.backend.slaves[0].od.upload(0x60B9, 0)
+            stats["probe_guard"] = (held, bank_.holds(ctl.axes[1]))
+        if bank_ is not None:
+            bank_.release_all()  # (the uploads of the cycles it ran are counted at a release)
+        backend = ctl.backend
+        mailboxes = [
+            (backend._clients[p].counter, backend.slaves[p].sdo.counter)
+            for p in sorted(backend._clients)
+        ]
         trace.append(
             tuple(
                 (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
-                for s in ctl.backend.slaves
+                for s in backend.slaves
                 for ch in getattr(s, "channels", [])
             )
+            + tuple(mailboxes)
         )
     finally:
         gt.GT_Close()
@@ -169,7 +222,7 @@ def test_smart_homing_in_the_bank_matches_the_scalar_path(runs: tuple) -> None:
     assert ended[10] == (0, 20, 4)
     assert ended[11] == (1, 20, 0)
     assert ended[12] == (0, 30, 4)
-    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11, 12)), ended
+    assert all(ended[a] == (0, 100, 0) for a in ended if a not in (10, 11, 12)), str(ended)
     stood = {prf[11] for _, prf, _, homes_k, _ in ref[:-1] if homes_k[11][0] == 0}
     assert len(stood) == 1, "axis 12 moved after GT_Stop"
 
@@ -181,6 +234,10 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
     assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
     if stats["kernel"]:
         assert stats["many"] > 20  # cycles the homings let the controller run at once
+        # the index searches too, their drives' touch probes armed (all but the cycles
+        # around their edges and the probe's arming)
+        banked, searching = stats["index_search"]
+        assert searching > 100 and banked > 0.7 * searching, stats["index_search"]
 
 
 def test_long_waits_give_the_same_homings(machine: str) -> None:
@@ -191,3 +248,72 @@ def test_long_waits_give_the_same_homings(machine: str) -> None:
         assert a == b, f"after {37 * (k + 1)} cycles: the bank and the scalar path differ"
     if stats["kernel"]:
         assert stats["many"] > 20
+
+
+#: a bus whose drives map no touch-probe object: the capture polls 60B9h by SDO every cycle
+SDO_SETUP: dict[int, tuple[dict[str, object] | None, dict[str, object]]] = {
+    1: (
+        {"mode": 22, "indexDir": 1, "velLow": 10.0},
+        {"home_switch": [[1_500, 2_500]], "index_offset": 1_800, "counts_per_rev": 1_000},
+    ),
+    2: ({"mode": 30, "moveDir": -1}, {"index_offset": -1_900, "counts_per_rev": 4_000}),
+    3: (
+        {"mode": 12, "indexDir": -1, "velHigh": 20.0, "velLow": 10.0},
+        {"positive_limit": 2_500, "index_offset": 1_234, "counts_per_rev": 2_000},
+    ),
+    4: (  # the trigger is GPI 3 (active from cycle 60 to 140), then the index beyond
+        {"mode": 41, "triggerIndex": 3, "indexDir": 1, "velLow": 10.0},
+        {"index_offset": 3_777, "counts_per_rev": 5_000},
+    ),
+    5: (None, {"home_switch": [[1_500, 2_500]]}),  # moved by a call: axis 6's trigger
+    6: ({"mode": 20, "triggerIndex": 5, "velHigh": 10.0}, {}),
+}
+
+
+def _move_axis_5() -> None:
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = 1.0, 1.0
+    for rc in (
+        gt.GT_SetTrapPrm(5, byref(prm)),
+        gt.GT_SetPos(5, 3_000),
+        gt.GT_SetVel(5, 10.0),
+        gt.GT_Update(1 << 4),
+    ):
+        _ok(rc, "move axis 5")
+
+
+#: GPI 3, axis 4's trigger, set and cleared (a sensor the axis passes, as a scenario would
+#: set it); axis 5 moved across its home switch, where axis 6's homing captures
+CALLS = {
+    20: _move_axis_5,
+    60: lambda: gt.GTE_SetGpi(3, 1),
+    140: lambda: gt.GTE_SetGpi(3, 0),
+}
+
+
+def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
+    """The capture reads the touch probe's 60B9h by SDO: the bank runs the index searches
+    and counts those uploads at each release, so the mailboxes' counters (both sides) end
+    where the scalar path's do, as does everything the differential test compares.  Axis 4
+    homes on a GPI the test sets and clears (GTE_SetGpi gives the axes back; in between
+    its searches stay in the bank); axis 6 on axis 5's home capture (``triggerIndex`` 5)
+    while axis 5 moves in Trap across its home switch."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(len(SDO_SETUP), tmp_path / "axes.eni")
+    machine = _machine(tmp_path, SDO_SETUP)
+    out = []
+    for bank in ("off", "on"):
+        trace, stats = _run(machine, bank, 0, eni, SDO_SETUP, 420, CALLS)
+        out.append((trace, stats))
+    (ref, _), (got, stats) = out
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    ended = ref[-2][3]
+    assert all(h[:3] == (0, 100, 0) for a, h in enumerate(ended, 1) if a != 5), ended
+    assert 1_500 <= ended[5][3] <= 1_510  # (axis 6 captured axis 5 reaching its switch)
+    assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
+    assert stats["probe_guard"] == (True, False)
+    if stats["kernel"]:
+        banked, searching = stats["index_search"]
+        assert searching > 100 and banked > 0.7 * searching, stats["index_search"]

@@ -1,6 +1,7 @@
 """The in-process backend serves an expedited SDO download (the bring-up's InitCmds, 17 per
 drive) by the slave's SDO server directly when nothing sees the frames: the same object
-dictionary, counters and aborts as the same download framed through the mailbox."""
+dictionary, counters and aborts as the same download framed through the mailbox; an
+expedited upload (a controller reading an unmapped object every cycle) likewise."""
 
 from __future__ import annotations
 
@@ -60,16 +61,23 @@ def _outcome(backend: EmulatedBackend, args: tuple) -> Any:
     return "ok"
 
 
-def test_an_unframed_download_is_the_framed_one(monkeypatch: pytest.MonkeyPatch) -> None:
-    framed, fm, cap = _bus(frames=True)
-    served: list[int] = []
+@pytest.fixture
+def served(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """One entry per mailbox request a slave's SDO server answers from now on."""
+    seen: list[int] = []
     handle = SdoServer.handle
 
     def counting(self: SdoServer, message: bytes, al_state: Any = None) -> Any:
-        served.append(1)
+        seen.append(1)
         return handle(self, message, al_state) if al_state is not None else handle(self, message)
 
     monkeypatch.setattr(SdoServer, "handle", counting)
+    return seen
+
+
+def test_an_unframed_download_is_the_framed_one(served: list[int]) -> None:
+    framed, fm, cap = _bus(frames=True)
+    served.clear()  # (the framed bring-up's)
     direct, dm, _ = _bus(frames=False)
     assert not served  # the bring-up's InitCmds went to the servers directly
     assert cap is not None and cap.frames > 0
@@ -104,3 +112,47 @@ def test_a_coe_io_slave_too() -> None:
     assert outcomes[0] == "ok" and outcomes[2][0] == "abort"
     assert dm.sdo_upload(0, 0x7010, 1) == fm.sdo_upload(0, 0x7010, 1) == b"\x5a\x00"
     assert direct._clients[0].counter == framed._clients[0].counter
+
+
+#: (slave, index, subindex): reads that answer (1, 2 and 4 bytes), and reads refused
+UPLOADS = [
+    (0, 0x6041, 0),
+    (0, 0x6061, 0),
+    (1, 0x6064, 0),
+    (0, 0x60B9, 0),  # the touch probe's status, read every cycle by a homing on the index
+    (0, 0x1008, 0),  # a string: segmented, framed either way
+    (0, 0x1600, 0),
+    (0, 0x5FFE, 0),  # no such object
+    (1, 0x6060, 7),  # no such subindex
+]
+
+
+def _upload(backend: EmulatedBackend, args: tuple) -> Any:
+    try:
+        return backend.sdo_upload(*args)
+    except SdoAbort as e:
+        return ("abort", int(e.code), e.index, e.subindex, str(e))
+
+
+def test_an_unframed_upload_is_the_framed_one(served: list[int]) -> None:
+    framed, _, cap = _bus(frames=True)
+    direct, _, _ = _bus(frames=False)
+    got = []
+    for slave, index, sub in UPLOADS:
+        before = len(served)
+        a = _upload(framed, (slave, index, sub))
+        framed_count = len(served) - before
+        before = len(served)
+        b = _upload(direct, (slave, index, sub))
+        direct_count = len(served) - before
+        assert a == b, (hex(index), sub)
+        assert framed_count >= 1
+        # 1 to 4 bytes go to the server directly; the rest is framed on both buses
+        assert direct_count == (0 if isinstance(b, bytes) and len(b) <= 4 else framed_count)
+        got.append(b)
+    assert [isinstance(g, bytes) for g in got] == [True] * 6 + [False] * 2
+    assert len(got[4]) > 4  # the string really took the segmented path
+    for s in range(2):
+        assert direct._clients[s].counter == framed._clients[s].counter
+        assert direct.slaves[s].sdo.counter == framed.slaves[s].sdo.counter
+    assert cap is not None and cap.frames > 0
