@@ -15,6 +15,13 @@ for as long as the build runs: the process that builds (and the background build
 it) keeps it open.  A builder killed on the way (the OOM killer, ``kill -9``, a reboot)
 leaves both behind with nobody holding the lock; every later build first removes such
 leftovers (:func:`sweep`), never the folder of a build that still runs.
+
+A library is put in place complete: built under another name, flushed to the disk, then
+renamed; beside it its seal, ``<name>.ok``, records its size and SHA-256 (:func:`seal`).
+Before a library is loaded :func:`intact` compares the two (a tenth of a millisecond for
+these files): a library cut short (a disk that filled up, a copy of the cache that broke
+off, a power cut) would otherwise crash the process that maps it, with no message.  A
+library that fails the check is built again (:func:`shared_library`).
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ import atexit
 import contextlib
 import hashlib
 import json
+import logging
 import os
 import shlex
 import shutil
@@ -42,6 +50,9 @@ try:
     import fcntl
 except ImportError:  # Windows: a controller runs there without these builds' lock
     fcntl = None  # type: ignore[assignment]
+
+
+log = logging.getLogger(__name__)
 
 
 class NativeBuildError(GtecatError):
@@ -167,6 +178,106 @@ class _BuildDir:
         self.owner.close()
 
 
+#: the first word of a seal (:func:`seal`)
+_SEAL = "gtecat-library-1"
+
+
+def seal_path(lib: Path) -> Path:
+    """The seal of library ``lib``: ``<lib>.ok``."""
+    return lib.with_name(lib.name + ".ok")
+
+
+def _digest_file(path: Path) -> str:
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
+
+
+def flush(path: Path) -> None:
+    """Write ``path``'s data to the disk (before it is renamed into place: a power cut
+    then leaves the old name or the whole file, not a short one)."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass  # (a file system without fsync: the rename alone)
+    finally:
+        os.close(fd)
+
+
+def seal(lib: Path) -> None:
+    """Record the size and SHA-256 of library ``lib`` (complete, in place) in its seal,
+    written under another name and renamed; call it under the build lock."""
+    st = lib.stat()
+    text = f"{_SEAL} {st.st_size} {_digest_file(lib)}\n"
+    ok = seal_path(lib)
+    tmp = ok.with_name(f".{ok.name}.{os.getpid()}")
+    tmp.write_text(text, encoding="ascii")
+    os.replace(tmp, ok)
+
+
+def unseal(lib: Path) -> None:
+    """Remove ``lib``'s seal (before the library is replaced: no old seal for a new file)."""
+    with contextlib.suppress(FileNotFoundError):
+        seal_path(lib).unlink()
+
+
+def put_in_place(out: Path, lib: Path) -> None:
+    """Library ``out``, complete, becomes ``lib``: flushed, renamed over ``lib`` (a process
+    that has the old file mapped keeps it), then sealed; call it under the build lock."""
+    try:
+        flush(out)
+        unseal(lib)
+        os.replace(out, lib)
+        seal(lib)
+    except OSError as e:  # (a full disk: the library is not taken, so built again next time)
+        raise NativeBuildError(f"cannot put {lib.name} in the build cache: {e}") from None
+
+
+def _flaw(lib: Path) -> str:
+    """'' when ``lib`` is intact (:func:`intact`), else what is wrong."""
+    try:
+        text = seal_path(lib).read_text(encoding="ascii")
+    except FileNotFoundError:
+        return "not there" if not lib.exists() else "not sealed"
+    except OSError as e:
+        return f"its seal cannot be read ({e.strerror})"
+    try:
+        word, size, digest = text.split()
+        want = int(size)
+    except ValueError:
+        return "its seal is damaged"
+    try:
+        got = lib.stat().st_size
+        if word != _SEAL:
+            return "its seal is of another kind"
+        if got != want:
+            return f"{got} bytes, built as {want}"
+        if _digest_file(lib) != digest:
+            return "its content changed since it was built"
+    except OSError as e:
+        return f"it cannot be read ({e.strerror})"
+    return ""
+
+
+def intact(lib: Path) -> bool:
+    """``lib`` is there, sealed, and of the size and SHA-256 its seal records: safe to load.
+    False for a missing library (or seal), one cut short or otherwise changed."""
+    return not _flaw(lib)
+
+
+def damaged(lib: Path) -> bool:
+    """``lib`` is there but fails :func:`intact` (it is then built again); logged: a warning
+    for a library cut short or changed, a note for one without a seal (built before seals)."""
+    if not lib.exists():
+        return False
+    why = _flaw(lib)
+    if not why:
+        return False
+    level = logging.INFO if why == "not sealed" else logging.WARNING
+    log.log(level, "%s in the build cache fails its check (%s): it is built again", lib, why)
+    return True
+
+
 def library_path(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:
     """``<cache>/<version>/<stem>-<digest>.so``: where the build of the one C file ``source``
     (text) with this compiler and these flags is kept (NativeBuildError without a compiler)."""
@@ -181,14 +292,15 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
     compiler and flags is there."""
     cc = compiler()
     lib = library_path(stem, source, cflags, libs)
-    if lib.is_file():
+    if intact(lib):
         return lib
     vdir = version_dir()
     with open(vdir / ".lock", "w") as lock:
         if fcntl is not None:
             fcntl.flock(lock, fcntl.LOCK_EX)
-        if lib.is_file():
+        if intact(lib):
             return lib
+        damaged(lib)
         build = _BuildDir(vdir)
         tmp = build.path
         try:
@@ -202,7 +314,7 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
                 raise NativeBuildError(f"building {stem}: {shlex.join(cmd)} ran 120 s") from None
             if r.returncode != 0 or r.stderr.strip():
                 raise NativeBuildError(f"building {stem} failed ({shlex.join(cmd)}):\n{r.stderr}")
-            out.rename(lib)
+            put_in_place(out, lib)
         finally:
             build.close()
     return lib
@@ -210,13 +322,42 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
 
 #: the builder process of :class:`Background` (``python -I -S -c``: no site, no gtecat):
 #: argv[1] is a JSON list of (command, its output, the library's name) tried in turn until
-#: one builds; the first that does is renamed to its name; the lock serialises builders and
-#: a library already there ends the work; what failed goes to stderr (the parent's log file,
+#: one builds; the first that does is flushed, renamed to its name and sealed (as
+#: :func:`shared_library` does); the lock serialises builders and an intact library already
+#: there ends the work; what failed goes to stderr (the parent's log file,
 #: removed here when the library is there); its stderr holds the lock on that log (the
 #: owner file: inherited from the parent, so the lock lasts while either of them runs)
 _BUILDER = r"""
-import json, os, shutil, subprocess, sys
+import hashlib, json, os, shutil, subprocess, sys
 spec = json.loads(sys.argv[1])
+SEAL = spec["seal"]
+def digest(path):
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
+def intact(lib):
+    try:
+        with open(lib + ".ok", encoding="ascii") as f:
+            word, size, sha = f.read().split()
+        return word == SEAL and os.stat(lib).st_size == int(size) and digest(lib) == sha
+    except (OSError, ValueError):
+        return False
+def put(out, lib):
+    fd = os.open(out, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+    try:
+        os.unlink(lib + ".ok")
+    except FileNotFoundError:
+        pass
+    os.replace(out, lib)
+    tmp = f"{os.path.dirname(lib)}/.{os.path.basename(lib)}.ok.{os.getpid()}"
+    with open(tmp, "w", encoding="ascii") as f:
+        f.write(f"{SEAL} {os.stat(lib).st_size} {digest(lib)}\n")
+    os.replace(tmp, lib + ".ok")
 try:
     os.nice(10)  # background work: the process that asked for it goes first
 except (AttributeError, OSError):
@@ -231,7 +372,7 @@ try:
         if fcntl is not None:
             fcntl.flock(lock, fcntl.LOCK_EX)
         for cmd, out, lib in spec["jobs"]:
-            if os.path.isfile(lib):
+            if intact(lib):
                 built = True
                 break
             try:
@@ -240,7 +381,7 @@ try:
                 sys.stderr.write(f"{' '.join(cmd)}: {e}\n")
                 continue
             if r.returncode == 0 and not r.stderr.strip():
-                os.replace(out, lib)
+                put(out, lib)
                 built = True
                 break
             sys.stderr.write(f"building failed ({' '.join(cmd)}):\n{r.stderr}\n")
@@ -270,7 +411,7 @@ class Background:
         self.result: Path | NativeBuildError | None = None
         self.libs = [library_path(*b) for b in builds]
         self._proc: subprocess.Popen[bytes] | None = None
-        if any(lib.is_file() for lib in self.libs):
+        if any(intact(lib) for lib in self.libs):
             self._finish()
             return
         cc = compiler()
@@ -288,7 +429,15 @@ class Background:
                 ([*cc, *cflags, "-shared", str(src), "-o", str(out), *libs], str(out), str(lib))
             )
         self._log = build.log
-        spec = {"lock": str(vdir / ".lock"), "tmp": str(tmp), "jobs": jobs, "log": str(self._log)}
+        for lib in self.libs:
+            damaged(lib)
+        spec = {
+            "lock": str(vdir / ".lock"),
+            "tmp": str(tmp),
+            "jobs": jobs,
+            "log": str(self._log),
+            "seal": _SEAL,
+        }
         try:
             self._proc = subprocess.Popen(
                 [sys.executable, "-I", "-S", "-c", _BUILDER, json.dumps(spec)],
@@ -332,7 +481,7 @@ class Background:
                 self._proc = None
 
     def _finish(self) -> None:
-        built = next((lib for lib in self.libs if lib.is_file()), None)
+        built = next((lib for lib in self.libs if intact(lib)), None)
         if built is not None:
             self.result = built
         else:

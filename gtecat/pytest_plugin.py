@@ -352,10 +352,14 @@ def gtecat_bus(
         rec = Recorder(tmp_path / "gtecat-recording.jsonl", {"test": request.node.nodeid})
         listeners.append(rec.start())
         request.node.stash[RECORD_KEY] = rec
+    checker = None
     if request.config.getoption("gtecat_check"):
+        import io
+
         from .faults.checks import Checker
 
-        listeners.append(Checker(sys.stderr).start())
+        checker = Checker(io.StringIO()).start()  # its findings: warnings, at the end
+        listeners.append(checker)
     request.node.stash[LISTENERS_KEY] = listeners
     rc = gt.GT_Open(
         eni=str(gtecat_eni),
@@ -383,6 +387,20 @@ def gtecat_bus(
         gt._core.close_all()  # every card the test opened
         for listener in listeners:
             listener.stop()
+        if checker is not None:
+            _warn_findings(checker.findings)
+
+
+def _warn_findings(findings: list[Any]) -> None:
+    """The checks' findings as pytest warnings at the application's file and line: pytest
+    shows them in its warnings summary, from every worker of an xdist run too (printed to
+    the test's stderr they were captured and shown only with ``-s`` or ``-rA``)."""
+    import warnings
+
+    from .faults.checks import GtecatCheckWarning
+
+    for f in findings:
+        warnings.warn_explicit(str(f), GtecatCheckWarning, f.file, f.line)
 
 
 @pytest.fixture

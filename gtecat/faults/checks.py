@@ -112,6 +112,12 @@ _ALLOWED = {
 }
 
 
+class GtecatCheckWarning(UserWarning):
+    """A finding of ``--gtecat-check`` in a pytest run: shown in the run's warnings summary
+    at the application's file and line; ``-W error::gtecat.faults.checks.GtecatCheckWarning``
+    makes a test with a finding fail at its teardown."""
+
+
 @dataclass
 class Finding:
     rule: str

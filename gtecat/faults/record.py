@@ -34,6 +34,7 @@ import os
 import re
 import struct
 import threading
+import zlib
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -47,6 +48,8 @@ from ..errors import ParameterError
 from .tap import Listener, tap, untap
 
 CHECKPOINT_MS = 100
+#: the recording format this gtecat writes and reads (the header's ``gtecat_recording``)
+FORMAT = 1
 #: the settings a recording keeps and a replay restores (what GT_Open reads)
 _ENV = (
     "GTECAT_ENI",
@@ -157,7 +160,7 @@ def decode(v: Any) -> Any:
     if "ref" in v:
         return ctypes.byref(decode(v["ref"]))
     if "c" in v:
-        return _SIMPLE.get(v["c"], ctypes.c_long)(_unscalar(v["v"]))
+        return _simple(v["c"])(_unscalar(v["v"]))
     if "arr" in v:
         et = _SIMPLE.get(v["arr"], ctypes.c_ubyte)
         arr = (et * _array_size(v))()
@@ -364,7 +367,7 @@ class Recorder(Listener):
     def write(self) -> Path:
         lines = list(self.lines)  # (a client's call may still be adding one: these, counted)
         calls = sum(1 for x in lines if x.startswith('{"t":'))  # a call's line, as after() writes
-        head = {"gtecat_recording": 1, "calls": calls, **self.meta, **self.where}
+        head = {"gtecat_recording": FORMAT, "calls": calls, **self.meta, **self.where}
         text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
@@ -407,10 +410,10 @@ class Divergence:
     now: Any
 
     def __str__(self) -> str:
-        return (
-            f"call {self.index} {self.call}: {self.what} recorded {_show(self.recorded)}, "
-            f"replay gives {_show(self.now)}"
-        )
+        recorded, now = _show(self.recorded), _show(self.now)
+        if recorded == now:  # the same value of another type (or shape): say which
+            recorded, now = _show_whole(self.recorded), _show_whole(self.now)
+        return f"call {self.index} {self.call}: {self.what} recorded {recorded}, replay gives {now}"
 
 
 def _show(v: Any) -> str:
@@ -420,6 +423,24 @@ def _show(v: Any) -> str:
         return _show(v["ref"])
     text = json.dumps(v) if not isinstance(v, str) else v
     return text if len(text) <= 200 else text[:197] + "..."
+
+
+def _show_whole(v: Any) -> str:
+    """A value with its type: ``c_long 5`` for a pointer to a simple value, else its JSON."""
+    if isinstance(v, dict) and "ref" in v and len(v) == 1:
+        return _show_whole(v["ref"])
+    if isinstance(v, dict) and set(v) == {"c", "v"}:
+        return f"{v['c']} {_show(v['v'])}"
+    text = json.dumps(v) if not isinstance(v, str) else repr(v)
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def _simple(c: Any) -> Any:
+    """The ctypes type a recording names (ValueError: a name that is none)."""
+    cls = _SIMPLE.get(c) if type(c) is str else None
+    if cls is None:
+        raise ValueError(f"the type {c!r} is not a ctypes type")
+    return cls
 
 
 def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
@@ -436,13 +457,29 @@ def _open_text(path: str | Path) -> tuple[Path, dict[str, Any], str | None]:
     except FileNotFoundError:
         raise ParameterError(f"{p}: no such recording") from None
     if raw[:2] == b"\x1f\x8b":
-        raw = gzip.decompress(raw)
+        try:
+            raw = gzip.decompress(raw)
+        except EOFError:  # the compressed stream stops before its end marker
+            raise ParameterError(
+                f"{p}: the recording ends early: the compressed file is cut short (record it "
+                "again, or copy the whole file)"
+            ) from None
+        except (OSError, zlib.error) as err:  # BadGzipFile, a wrong checksum, bad data
+            raise ParameterError(
+                f"{p}: damaged recording: the compressed file cannot be read ({err})"
+            ) from None
     first, sep, body = raw.decode("utf-8", "replace").partition("\n")
     try:
         head = json.loads(first or "{}")
     except (json.JSONDecodeError, RecursionError):
         head = {}
-    if not isinstance(head, dict) or head.get("gtecat_recording") != 1:
+    version = head.get("gtecat_recording") if isinstance(head, dict) else None
+    if type(version) is int and version > FORMAT:
+        raise ParameterError(
+            f"{p} was written by a newer gtecat (recording format {version}; this one reads "
+            f"up to format {FORMAT}): replay it with that gtecat, or update this one"
+        )
+    if version != FORMAT:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
     return p, head, body if sep else None
 
@@ -552,7 +589,7 @@ def replay(
         gc.freeze()
     try:
         with _where(head):
-            return _replay(steps, eni, machine)
+            return _replay(steps, eni, machine, head.get("cwd"))
     finally:
         if freeze:
             gc.unfreeze()
@@ -814,7 +851,10 @@ def _pooled(
     key = (name, i, c)
     hit = pool.get(key)
     if hit is None:
-        obj = _SIMPLE.get(c, ctypes.c_long)()
+        try:
+            obj = _simple(c)()
+        except ValueError as err:
+            raise ValueError(f"argument {i + 1}: {err}") from None
         hit = pool[key] = (obj, ctypes.byref(obj))
     return hit
 
@@ -1114,12 +1154,13 @@ class _Stop:
 
 
 def _replay(
-    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None
+    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
 ) -> tuple[int, Divergence | None]:
     from .. import faults, gt
 
     eni = str(Path(eni).resolve()) if eni else None
     machine = str(Path(machine).resolve()) if machine else None
+    _check_files(steps, eni, machine, cwd)
     gt.GT_Close()
     n = 0
     try:
@@ -1169,6 +1210,41 @@ def _replay(
     return n, None
 
 
+def _check_files(
+    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
+) -> None:
+    """Refuse, before anything runs, a replay whose session brought a bus up from an ENI file
+    or a machine description that is no longer where the recording found it (the folder it
+    ran in, or the file itself, moved or deleted): which file, and how to give it instead.
+    The files of an open whose bring-up failed in the recording too are not asked for."""
+    opened: list[tuple[str, str, str]] = []  # (what, the file as named, the option)
+    for p, _ in steps:
+        if p is None or p is _Stop:
+            continue
+        if p.opens:
+            kw = p.kw or {}
+            opened = []
+            if not eni:
+                name = kw.get("eni", os.environ.get("GTECAT_ENI"))
+                if type(name) is str and name:
+                    opened.append(("ENI file", name, "--eni FILE"))
+            if not machine:
+                name = kw.get("machine", os.environ.get("GTECAT_MACHINE"))
+                if type(name) is str and name:
+                    opened.append(("machine description", name, "--machine FILE"))
+        elif p.name in ("GT_InitEcatComm", "GTN_InitEcatComm") and p.rc == 0 and opened:
+            for what, name, option in opened:
+                if not Path(name).exists():
+                    where = Path(name).resolve()
+                    if not Path(name).is_absolute() and type(cwd) is str and cwd:
+                        where = Path(cwd) / name  # (its folder may be gone too)
+                    raise ParameterError(
+                        f"the {what} the recorded session used is missing: {where} (put it "
+                        f"back, or give it with {option})"
+                    )
+            opened = []
+
+
 def _array_divergence(
     n: int, name: str, i: int, kind: tuple[Any, ...], want: bytes, got: bytes
 ) -> Divergence:
@@ -1211,7 +1287,13 @@ def _call(
         ) from None
     if p.kw is None and not p.opens:
         return args, {}, p.fn(*args)
-    kw = {k: decode(v) for k, v in (p.kw or {}).items()}
+    try:
+        kw = {k: decode(v) for k, v in (p.kw or {}).items()}
+    except _DAMAGED as err:
+        raise ParameterError(
+            f"damaged recording: call {n} ({p.name}): a keyword cannot be made again: "
+            f"{type(err).__name__}: {err}"
+        ) from None
     if p.opens:
         if eni:
             kw["eni"] = str(eni)
@@ -1236,14 +1318,47 @@ def _other(e: dict[str, Any], n: int, faults: Any) -> Divergence | None:
         ctl = _controller()
         if ctl is None:
             return None
-        if e["f"] == "inject":
-            values = dict(e["v"])
-            if not e.get("sync") and "ms" in e:
-                values["at_ms"] = e["ms"]
-            faults.inject(faults.spec_from_dict(values), ctl=ctl)
-        elif e["f"] == "clear":
-            faults.clear(e["v"].get("id"), ctl=ctl)
+        t = e.get("t")
+        if type(t) is int and t > ctl.clock.now_ns:
+            # armed (or cleared) while a call ran, at a cycle of it: at that cycle again
+            _Later.add(ctl, t, lambda e=e, ctl=ctl: _fault(e, ctl, faults))
+        else:  # between two calls: here, with its own trigger (none: at once)
+            _fault(e, ctl, faults)
     return None
+
+
+def _fault(e: dict[str, Any], ctl: Any, faults: Any) -> None:
+    """A recorded fault injected (with the trigger it was given) or cleared again."""
+    if e["f"] == "inject":
+        faults.inject(faults.spec_from_dict(dict(e["v"])), ctl=ctl)
+    elif e["f"] == "clear":
+        faults.clear(e["v"].get("id"), ctl=ctl)
+
+
+class _Later:
+    """Faults injected or cleared from outside the session (``gtecat fault``, the panel)
+    while one of its calls ran: the controller's ``before_cycle`` hook that does each at
+    the first cycle at or after the controller time it was recorded at, first in that
+    cycle, where the request was served (:mod:`gtecat.inspect.endpoint`)."""
+
+    def __init__(self, ctl: Any) -> None:
+        self.ctl = ctl
+        self.due: list[tuple[int, Any]] = []
+
+    @classmethod
+    def add(cls, ctl: Any, t: int, do: Any) -> None:
+        hook = next((g for g in ctl.before_cycle if isinstance(g, _Later)), None)
+        if hook is None:
+            hook = cls(ctl)
+            ctl.before_cycle = [hook, *ctl.before_cycle]
+        hook.due.append((t, do))
+
+    def __call__(self) -> None:
+        now = self.ctl.clock.now_ns
+        while self.due and self.due[0][0] <= now:
+            self.due.pop(0)[1]()
+        if not self.due:  # a new list: the cycle goes on over the one it began with
+            self.ctl.before_cycle = [g for g in self.ctl.before_cycle if g is not self]
 
 
 __all__ = [

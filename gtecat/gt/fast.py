@@ -125,6 +125,8 @@ def fast_reader(
 ) -> Callable[..., int]:
     """``slow`` (the table-checked GT function) with the fast path in front of it;
     ``advance(ctl, name, rc)`` runs the call's host latency, catching what the cycle raises."""
+    from .table import FUNCTIONS
+
     get, ctypes_ok = READERS[name]
     np_ok = _NP_INTS if ctypes_ok is _INTS else _NP_DOUBLE
     last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
@@ -179,12 +181,13 @@ def fast_reader(
             or kw
             or ctl is None
             or (count is not _NO and (type(count) is not int or count != 1))
-            # pClock NULL: omitted, None or 0 (the manual's own form, GT_GetSts(1, &s, 1, 0))
-            or (pClock is not _NO and pClock is not None and (type(pClock) is not int or pClock))
             or session.remote is not None
             or session.core != 1  # GT_SetCore: another core
         ):
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
+        clk = clock_out(ctl, pClock)
+        if clk is False:
+            return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
         res = ctl.resources.get(n)
         clock = ctl.clock
         if res is None or clock._thread is not None:
@@ -208,10 +211,33 @@ def fast_reader(
             p[0] = get(res)
         else:
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
+        if clk is not None:
+            clk[0].value = clk[1]
         session.last = None
         if clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)
         return 0
+
+    clock_target = _target(_CLOCK_INTS)
+    takes_clock = [q.name for q in FUNCTIONS[name].params[3:4]] == ["pClock"]
+
+    def clock_out(ctl: Any, pClock: Any) -> Any:
+        """What a reader's ``pClock`` gets, as its table path stores it (the controller's
+        milliseconds since GT_Reset, 32 bits): None for NULL (omitted, None or 0, the
+        manual's own form), ``(object, value)`` for ``byref(x)`` or ``x`` of an integer type
+        that holds the value, False for anything else (the table path answers)."""
+        if pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0):
+            return None
+        if not takes_clock:
+            return False
+        obj = clock_target(pClock)
+        tp = type(obj)
+        if tp not in _CLOCK_INTS:
+            return False
+        ms = ctl.clock_ms() & 0xFFFFFFFF
+        if ms > _INT_MAX[tp]:
+            return False
+        return obj, ms
 
     own_limit = READ_LIMITS.get(name)  # the function's own (its table path refuses more)
     limit = CONTROLLER_AXES if own_limit is None else own_limit
@@ -239,11 +265,13 @@ def fast_reader(
             or type(n) is not int
             or extra
             or kw
-            or not (pClock is _NO or pClock is None or (type(pClock) is int and pClock == 0))
             or session.remote is not None
             or session.core != 1
             or ctl.clock._thread is not None
         ):
+            return None
+        clk = clock_out(ctl, pClock)
+        if clk is False:
             return None
         tp = type(p)
         if not (is_array(tp) and tp._length_ >= count):
@@ -285,6 +313,8 @@ def fast_reader(
                         values[0] = first
                         p[:count] = values
                 if lst is not None:
+                    if clk is not None:
+                        clk[0].value = clk[1]
                     session.last = None
                     if ctl.clock.mode is not _LOCKSTEP:
                         return advance(ctl, name, 0)
@@ -311,6 +341,8 @@ def fast_reader(
                     continue
             append(lst[res.bank_row])  # type: ignore[index]
         p[:count] = values
+        if clk is not None:
+            clk[0].value = clk[1]
         session.last = None
         if ctl.clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)

@@ -29,7 +29,7 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
-from ..cbuild import NativeBuildError, cache_root, compiler
+from ..cbuild import NativeBuildError, cache_root, compiler, damaged, flush, intact, seal
 from ..cbuild import version_dir as made_version_dir
 
 RUNTIME_SOURCES = ("gts_runtime.c", "gts_runtime.h", "gtecat_vendor.h")
@@ -165,7 +165,7 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Build:
     if not force:
         with contextlib.suppress(OSError):
             build = Build(version_dir / known.read_text(encoding="utf-8").strip(), abi, base)
-            if build.library.is_file() and build.header.is_file():
+            if intact(build.library) and build.header.is_file():
                 return build
     if abi:
         files = multicard_sources()
@@ -173,11 +173,13 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Build:
     else:
         files = sources(python)
     build = Build(version_dir / _digest(files, cc), abi, base)
-    if not (build.library.is_file() and build.header.is_file()) or force:
+    if not (intact(build.library) and build.header.is_file()) or force:
         version_dir = made_version_dir()
         with open(version_dir / ".lock", "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)
-            if not (build.library.is_file() and build.header.is_file()) or force:
+            if not (intact(build.library) and build.header.is_file()) or force:
+                if not force:
+                    damaged(build.library)
                 _compile(build, files, cc)
     _remember(known, build.root.name)
     return build
@@ -258,8 +260,13 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
         ]
         r = subprocess.run(cmd, capture_output=True, text=True)
         _check(cmd, r.returncode, r.stderr)
-        if build.root.exists():
-            shutil.rmtree(build.root)
+        built = lib / build.library.name
+        flush(built)
+        seal(built)  # (its seal goes with it: the folder is renamed into place whole)
+        if build.root.exists():  # (a process with the old library mapped keeps it)
+            old = Path(tempfile.mkdtemp(prefix=".build-old-", dir=build.root.parent))
+            build.root.rename(old / "build")
+            shutil.rmtree(old, ignore_errors=True)
         tmp.rename(build.root)
     finally:
         with contextlib.suppress(OSError):

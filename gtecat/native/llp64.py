@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
-import os
 import re
 import shlex
 import shutil
@@ -44,7 +43,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..cbuild import NativeBuildError, compiler
+from ..cbuild import NativeBuildError, compiler, damaged, intact, put_in_place
 from . import build as _build
 
 LIBRARY = "libgts-llp64.so"
@@ -93,12 +92,13 @@ def ensure_built(*, force: bool = False, abi: str = "") -> Path:
         return _ensure_multicard(force=force, abi=abi)
     build = _build.ensure_built(force=force)
     target = library(build)
-    if target.is_file() and not force:
+    if intact(target) and not force:
         return target
     with open(build.root.parent / ".lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if target.is_file() and not force:
+        if intact(target) and not force:
             return target
+        damaged(target)
         _compile(build, target)
     return target
 
@@ -109,12 +109,13 @@ def _ensure_multicard(*, force: bool, abi: str) -> Path:
     build = _build.ensure_built(force=force, abi=abi)
     base = ensure_built()  # libgts-llp64.so, the library the layer calls
     target = build.lib_dir / MULTICARD_LIBRARY
-    if target.is_file() and not force:
+    if intact(target) and not force:
         return target
     with open(build.root.parent / ".lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if target.is_file() and not force:
+        if intact(target) and not force:
             return target
+        damaged(target)
         _compile_multicard(build, base, target)
     return target
 
@@ -151,7 +152,7 @@ def _compile_multicard(build: _build.Build, base: Path, target: Path) -> None:
             str(out),
         ]
         _run(cmd, MULTICARD_LIBRARY)
-        os.replace(out, target)
+        put_in_place(out, target)
 
 
 @contextlib.contextmanager
@@ -203,12 +204,13 @@ def ensure_built_m32(*, force: bool = False) -> M32Build:
     """The 32-bit libgts (module docstring), compiled on first use beside libgts."""
     build = _build.ensure_built(force=force)
     m32 = M32Build(build.root / "m32")
-    if m32.library.is_file() and not force:
+    if intact(m32.library) and not force:
         return m32
     with open(build.root.parent / ".lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if m32.library.is_file() and not force:
+        if intact(m32.library) and not force:
             return m32
+        damaged(m32.library)
         files = llp64_sources(_build.sources(_build.python_executable()))
         m32.include_dir.mkdir(parents=True, exist_ok=True)
         m32.library.parent.mkdir(parents=True, exist_ok=True)
@@ -254,7 +256,7 @@ def _compile(
             str(out),
         ]
         _run(cmd, what)
-        os.replace(out, target)
+        put_in_place(out, target)
 
 
 __all__ = [

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
-from ..cbuild import NativeBuildError, cache_root
+from ..cbuild import NativeBuildError, cache_root, flush, intact, seal
 from ..cbuild import version_dir as made_version_dir
 from . import build as _build
 
@@ -120,12 +120,12 @@ def ensure_built(target: str, *, force: bool = False) -> WindowsBuild:
     h.update(" ".join([*cc, *CFLAGS, *LDFLAGS, *LIBS]).encode())
     h.update(Path(__file__).read_bytes())  # this recipe: a changed build builds again
     build = WindowsBuild(cache_root() / __version__ / f"win-{target}-{h.hexdigest()[:12]}", target)
-    if all(f.is_file() for f in build.files()) and not force:
+    if all(f.is_file() for f in build.files()) and intact(build.dll) and not force:
         return build
     vdir = made_version_dir()
     with open(vdir / ".lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if all(f.is_file() for f in build.files()) and not force:
+        if all(f.is_file() for f in build.files()) and intact(build.dll) and not force:
             return build
         _compile(build, files, cc)
     return build
@@ -184,6 +184,8 @@ def _compile(build: WindowsBuild, files: dict[str, str], cc: list[str]) -> None:
         out.mkdir()
         for name in OUTPUTS:
             shutil.copy2(tmp / name, out / name)
+        flush(out / "gts.dll")
+        seal(out / "gts.dll")  # (its seal goes with it: the folder is renamed into place whole)
         if build.root.exists():
             shutil.rmtree(build.root)
         out.rename(build.root)

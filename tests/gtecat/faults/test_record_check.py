@@ -366,3 +366,18 @@ def test_a_c_program_is_recorded_and_replayed(tmp_path: Path) -> None:
     assert "sts 512" in done.stdout, done.stdout + done.stderr
     assert "record: 7 GT calls" in done.stderr, done.stderr
     assert main(["replay", str(out)]) == 0
+
+
+def test_plugin_findings_are_warnings_at_the_application_line() -> None:
+    """``--gtecat-check`` in pytest: each finding a warning at the application's file and line
+    (pytest's warnings summary shows it, from xdist workers too), not text on the test's
+    captured stderr."""
+    from gtecat.faults.checks import Finding, GtecatCheckWarning
+    from gtecat.pytest_plugin import _warn_findings
+
+    found = [Finding("move-with-alarm", "/app/cell.py", 42, "axis 3: GT_Update with its alarm set")]
+    with pytest.warns(GtecatCheckWarning) as seen:
+        _warn_findings(found)
+    (w,) = seen.list
+    assert (w.filename, w.lineno) == ("/app/cell.py", 42)
+    assert str(w.message).startswith("check: /app/cell.py:42: axis 3: GT_Update")

@@ -3,6 +3,7 @@ never a crash or a huge allocation; the line or the count named."""
 
 from __future__ import annotations
 
+import gzip
 import json
 from pathlib import Path
 
@@ -10,6 +11,8 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli.main import main
+from gtecat.faults.record import Divergence
+from tests.conftest import EXAMPLES
 
 HEAD = {"gtecat_recording": 1, "program": "python3 app.py", "cwd": "/", "env": {}}
 STS = '{"t":0,"c":"GT_GetSts","a":[1,{"ref":{"c":"c_long","v":0}},1,null],"r":1}'
@@ -71,3 +74,67 @@ def test_deep_nesting_is_a_damaged_line(tmp_path: Path, capsys: pytest.CaptureFi
     f.write_text(deep + "\n")
     assert main(["replay", str(f)]) == 1
     assert "is not a gtecat recording" in capsys.readouterr().err
+
+
+def test_a_cut_compressed_recording_a_newer_format_an_unknown_type(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    whole = gzip.compress(
+        ("\n".join([json.dumps({**HEAD, "calls": 400}), *[STS] * 400]) + "\n").encode()
+    )
+    for name, data, want in [
+        ("cut.gtrec.gz", whole[: len(whole) // 2], "ends early: the compressed file is cut short"),
+        ("bad.gtrec.gz", whole[:12] + b"\xff" * 40, "damaged recording: the compressed file"),
+    ]:
+        f = tmp_path / name
+        f.write_bytes(data)
+        assert main(["replay", str(f)]) == 1
+        err = capsys.readouterr().err
+        assert want in err and "internal error" not in err, err
+    f = tmp_path / "v2.gtrec"
+    f.write_text(json.dumps({**HEAD, "gtecat_recording": 2, "calls": 1}) + "\n" + STS + "\n")
+    assert main(["replay", str(f)]) == 1
+    err = capsys.readouterr().err
+    assert (
+        "was written by a newer gtecat (recording format 2; this one reads up to format 1)" in err
+    )
+    bogus = '{"t":0,"c":"GT_GetClock","a":[{"ref":{"c":"c_bogus","v":0}}],"r":0}'
+    rc, text = replay(tmp_path, 1, [bogus], capsys)
+    assert rc == 1 and "damaged recording" in text and "argument 1: the type 'c_bogus'" in text
+    assert "recorded 0, replay gives 0" not in text
+
+
+def test_a_divergence_of_type_alone_names_the_types() -> None:
+    div = Divergence(
+        4,
+        "GT_GetClock",
+        "argument 1",
+        {"ref": {"c": "c_ulong", "v": 0}},
+        {"ref": {"c": "c_long", "v": 0}},
+    )
+    assert str(div) == "call 4 GT_GetClock: argument 1 recorded c_ulong 0, replay gives c_long 0"
+
+
+def test_a_missing_eni_is_named_before_the_replay(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    eni = tmp_path / "cell.eni"
+    eni.write_bytes((EXAMPLES / "full_servo.eni").read_bytes())
+    head = {**HEAD, "cwd": str(tmp_path), "calls": 3}
+    lines = [
+        '{"t":0,"c":"GT_Open","a":[],"r":0,"k":{"eni":"cell.eni"}}',
+        '{"t":0,"c":"GT_InitEcatComm","a":[],"r":0}',
+        '{"t":0,"c":"GT_Close","a":[],"r":0}',
+    ]
+    f = tmp_path / "r.gtrec"
+    f.write_text("\n".join([json.dumps(head), *lines]) + "\n")
+    assert main(["replay", str(f)]) == 0, capsys.readouterr().err
+    eni.rename(tmp_path / "moved.eni")
+    assert main(["replay", str(f)]) == 1
+    err = capsys.readouterr().err
+    assert err.strip() == (
+        f"error: the ENI file the recorded session used is missing: {eni} (put it back, or "
+        "give it with --eni FILE)"
+    ), err
+    assert main(["replay", str(f), "--eni", str(tmp_path / "moved.eni")]) == 0
+    capsys.readouterr()
