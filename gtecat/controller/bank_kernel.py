@@ -247,6 +247,10 @@ class Kernel:
         self._extra_key: Any = None
         self._extra_last: dict[str, np.ndarray] | None = None
         self._args = (self.ptrs.ctypes.data, self.io.ctypes.data, self.fp.ctypes.data)
+        # the same memory as io and fp: what a run of cycles sets and reads (a memoryview's
+        # item costs less than a numpy array's; the arrays are never replaced)
+        self._io = memoryview(self.io)
+        self._fp = memoryview(self.fp)
         self.buffer: np.ndarray | None = None
 
     def bind(self) -> None:
@@ -370,13 +374,13 @@ class Kernel:
         a Trap move and before one the kernel declines (nothing of it written)."""
         if not self.bound or self.bank.ctl.master.image.buffer is not self.buffer:
             self.bind()
-        io = self.io
+        io = self._io
         io[IN_T_NS] = t_ns
         io[IN_DT_NS] = dt_ns
         io[IN_MAXC] = most
-        self.fp[FP_DT] = dt
+        self._fp[FP_DT] = dt
         rc = self.run_fn(*self._args)
-        return rc, int(io[OUT_DONE])
+        return rc, io[OUT_DONE]
 
     @property
     def filled(self) -> bool:
@@ -387,7 +391,7 @@ class Kernel:
     def move_ended(self) -> bool:
         """The last committed cycle ended a Trap move (the bank recounts its moving rows);
         after :meth:`run`: any of its cycles did."""
-        return bool(self.io[OUT_FIN])
+        return bool(self._io[OUT_FIN])
 
 
 def trap_fill(

@@ -67,6 +67,8 @@ from .resources import install as install_resources
 if TYPE_CHECKING:
     from .card import Card
 
+_REALTIME = ClockMode.REALTIME  # (looked up once: every wait asks)
+
 
 @dataclass
 class Options:
@@ -503,7 +505,7 @@ class Controller:
             raise ParameterError("wait time must be >= 0")
         clock = self.clock
         total = round(ms * 1_000_000)
-        if clock.mode is ClockMode.REALTIME or total <= self.WAIT_SLICE_NS:
+        if clock.mode is _REALTIME or total <= self.WAIT_SLICE_NS:
             clock.advance_ns(total)
             return
         end = clock.now_ns + clock._pending_ns + total

@@ -110,6 +110,7 @@ DEFAULT_HOMING_METHODS = (0, *sorted(SUPPORTED_METHODS))
 
 _INT32_MIN, _INT32_MAX = -(1 << 31), (1 << 31) - 1
 _HALT = 0x100
+_OP = AlState.OP  # (looked up once: the cycle compares with it)
 _QUICK_STOP = 0x4  # controlword bit 2, active low
 _SW_WARNING = int(Sw.WARNING)
 _SW_REMOTE = int(Sw.REMOTE)
@@ -1138,7 +1139,7 @@ class Cia402Drive(VirtualSlave):
 
     def step(self, t_ns: int, dt_ns: int) -> None:
         codec = self.codec
-        op = self.al_state == AlState.OP
+        op = self.al_state == _OP
         if op and len(self.rx) >= codec.rx_bytes:
             codec.decode(self.rx)
         if dt_ns > 0:

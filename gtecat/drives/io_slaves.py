@@ -23,6 +23,11 @@ from gtecat.eni.model import Direction, Identity, Pdo
 from .pdo_mapping import is_gap
 from .slave import AlState, AlStatusCode, VirtualSlave
 
+# the states a cycle compares with, looked up once (an enum member's lookup costs more
+# than the comparison)
+_OP = AlState.OP
+_SAFEOP = AlState.SAFEOP
+
 _SIGNED_TYPES = {"SINT", "INT", "DINT", "LINT", "INT8", "INT16", "INT32", "INT64"}
 
 
@@ -151,7 +156,7 @@ class IoSlave(VirtualSlave):
 
     # --- cycle ------------------------------------------------------------------
     def step(self, t_ns: int, dt_ns: int) -> None:
-        if self.al_state == AlState.OP:
+        if self.al_state == _OP:
             self.field_outputs[:] = self.rx
         else:
             self.field_outputs[:] = bytes(len(self.field_outputs))
@@ -163,7 +168,7 @@ class IoSlave(VirtualSlave):
             for ob, ib, shift, mask in plan:
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 fi[ib] = (fi[ib] & ~mask) | (v & mask)
-        if self.al_state >= AlState.SAFEOP:
+        if self.al_state >= _SAFEOP:
             self.tx[:] = self.field_inputs
 
     def settled(self) -> bool:
@@ -172,7 +177,7 @@ class IoSlave(VirtualSlave):
         if self.emergencies:
             return False
         fo = self.field_outputs
-        if self.al_state == AlState.OP:
+        if self.al_state == _OP:
             if fo != self.rx:
                 return False
         elif any(fo):
@@ -186,7 +191,7 @@ class IoSlave(VirtualSlave):
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 if (fi[ib] ^ v) & mask:
                     return False
-        return self.al_state < AlState.SAFEOP or self.tx == fi
+        return self.al_state < _SAFEOP or self.tx == fi
 
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires

@@ -96,12 +96,24 @@ class VirtualSlave:
     """
 
     has_mailbox = False
+    #: counts the AL state changes of every slave: a reader that worked out something from
+    #: the states (``EmulatedBackend.steady``: every claimed slave in OP) keeps it while the
+    #: count stays the same.  Every write of ``al_state`` goes through :meth:`enter_state`.
+    al_changes = 0
+    #: the AL state (INIT at power-on); written only by :meth:`enter_state`
+    al_state: AlState
+
+    def enter_state(self, state: AlState) -> None:
+        """Set :attr:`al_state` (nothing else: the caller does the transition's work) and
+        count the change in :attr:`al_changes`."""
+        self.al_state = state
+        VirtualSlave.al_changes += 1
 
     def __init__(self, position: int, name: str, identity: Identity) -> None:
         self.position = position
         self.name = name
         self.identity = identity
-        self.al_state = AlState.INIT
+        self.enter_state(AlState.INIT)
         self.al_status_code = AlStatusCode.NO_ERROR
         self.al_error = False
         rx_bits, tx_bits = self.pdo_sizes()
@@ -170,7 +182,7 @@ class VirtualSlave:
         code = self.on_state_change(old, target)
         if code:
             return self._refuse(code)
-        self.al_state = target
+        self.enter_state(target)
         self.al_error = False
         self.al_status_code = AlStatusCode.NO_ERROR
         if target < AlState.SAFEOP or target == AlState.BOOT:
@@ -200,7 +212,7 @@ class VirtualSlave:
         if self.al_state == AlState.OP:
             old = self.al_state
             self.on_state_change(old, AlState.SAFEOP)
-            self.al_state = AlState.SAFEOP
+            self.enter_state(AlState.SAFEOP)
             self.outputs_valid = False
             self._refuse(AlStatusCode.SYNC_MANAGER_WATCHDOG)
 

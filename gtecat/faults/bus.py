@@ -150,7 +150,7 @@ class FaultBus:
         old = s.al_state
         if old != AlState.INIT:
             s.on_state_change(old, AlState.INIT)
-        s.al_state = AlState.INIT
+        s.enter_state(AlState.INIT)
         s.al_error = False
         s.al_status_code = AlStatusCode.NO_ERROR
         s.outputs_valid = False
@@ -172,7 +172,7 @@ class FaultBus:
         old = s.al_state
         if old > state:
             s.on_state_change(old, state)
-            s.al_state = state
+            s.enter_state(state)
             if state < AlState.OP:
                 s.outputs_valid = False
         if code:

@@ -35,6 +35,8 @@ from .triggers import AfterTime, AtTime, Now, Trigger, describe_after, first_cyc
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
+#: active faults that act in every cycle (no cycles at once while one is on)
+_EVERY_CYCLE = (k.SwitchChatter, k.IoStuck)
 
 
 #: called with ("inject", values) / ("clear", {"id": N}) for every fault a program or an
@@ -233,7 +235,7 @@ class Injector:
                 n = min(n, e.trigger.quiet_cycles(self.bus, n + 1) - 1)
             elif e.state == "active":
                 f = e.fault
-                if isinstance(f, k.SwitchChatter | k.IoStuck):
+                if isinstance(f, _EVERY_CYCLE):
                     return 0
                 if e.duration_ms is not None:
                     t0, d = e.started_ms or 0.0, e.duration_ms

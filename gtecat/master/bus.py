@@ -45,6 +45,10 @@ from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend
 from .image import ProcessImage
 
+#: looked up once: the cycle and :meth:`Master.steady` compare with it (an enum member's
+#: lookup costs more than the comparison)
+_OP = AlState.OP
+
 
 @dataclass
 class CycleResult:
@@ -241,17 +245,17 @@ class Master:
             return self.last
         wkc = self.backend.exchange(t_ns, dt_ns)
         self.cycles += 1
-        expected = self.backend.expected_wkc() if self.target == AlState.OP else wkc
+        expected = self.backend.expected_wkc() if self.target == _OP else wkc
         self.last = CycleResult(wkc, expected)
         if self._op_countdown >= 0:
             self._op_countdown -= 1
             if self._op_countdown < 0:
                 self.request_op()
-        elif self.target == AlState.OP and self.last.ok and not self.all_op():
+        elif self.target == _OP and self.last.ok and not self.all_op():
             # the working counter is whole again (a slave came back and the backend
             # recovered it): take the states as they are now
             self.refresh_states()
-        elif self.target == AlState.OP and not self.last.ok:
+        elif self.target == _OP and not self.last.ok:
             self.wkc_errors += 1
             if not self._wkc_bad:
                 self._wkc_bad = True
@@ -291,7 +295,7 @@ class Master:
             and self._op_countdown < 0
             and not self._wkc_bad
             and not self.offline
-            and self.target == AlState.OP
+            and self.target == _OP
             and self.last.ok
             and self.all_op()
             and self.backend.steady()
@@ -343,7 +347,7 @@ class Master:
 
     def all_op(self) -> bool:
         states = self.states
-        return states.count(AlState.OP) == len(states)  # (asked every cycle: no generator)
+        return states.count(_OP) == len(states)  # (asked every cycle: no generator)
 
     @property
     def ready(self) -> bool:

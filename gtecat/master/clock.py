@@ -32,6 +32,10 @@ class ClockMode(StrEnum):
     REALTIME = "realtime"
 
 
+#: looked up once: every advance asks (an enum member's lookup costs more than the ``is``)
+_REALTIME = ClockMode.REALTIME
+
+
 @dataclass
 class CycleStats:
     """Wall-clock cycle statistics (realtime mode): period and jitter in ns."""
@@ -86,7 +90,7 @@ class Clock:
 
     def advance_ns(self, ns: int) -> int:
         """Let ``ns`` of controller time pass (lockstep/auto); returns cycles run."""
-        if self.mode is ClockMode.REALTIME:
+        if self.mode is _REALTIME:
             self._sleep(max(0, ns) / 1e9)
             return 0
         self._pending_ns += int(ns)

@@ -64,6 +64,9 @@ class EmulatedBackend(Backend):
         self._claimed_slaves: tuple[VirtualSlave, ...] = ()  # what steady() asks for OP
         #: (the run plan and image it was made for, its rows): what steady() compares
         self._steady_plan: tuple[Any, Any, list[tuple[Any, ...]]] | None = None
+        #: (VirtualSlave.al_changes, the claimed slaves, the steady plan, every slave
+        #: steady() asks in OP): the OP check of steady(), kept while no slave changes state
+        self._op_seen: tuple[int, Any, Any, bool] = (-1, None, None, False)
         self.capture = None
         self._source = ""  # the file the virtual slaves come from
         #: what the frame of a cycle meets on its way back (gtecat.faults): called with the
@@ -213,10 +216,10 @@ class EmulatedBackend(Backend):
             st = slave.al_state
             if out is not None:
                 image.to_slave(out, slave.rx)
-                if st == AlState.OP:
+                if st == _OP:
                     wkc += 2
             slave.step(t_ns, dt_ns)
-            if inp is not None and st >= AlState.SAFEOP:
+            if inp is not None and st >= _SAFEOP:
                 image.from_slave(inp, slave.tx)
                 wkc += 1
         if self.capture is not None:
@@ -237,37 +240,61 @@ class EmulatedBackend(Backend):
         image = self.image
         if image is None:
             return False
-        op = _OP
-        for slave in self._claimed_slaves:
-            if slave.al_state != op:
-                return False
         plan = self._steady_plan
         if plan is None or plan[0] is not self._run_plan or plan[1] is not image:
             plan = self._steady_plan = (self._run_plan, image, self._steady_rows(image))
+        # every slave in OP: worked out again only after an AL state change of any slave
+        seen = self._op_seen
+        if (
+            seen[0] != VirtualSlave.al_changes
+            or seen[1] is not self._claimed_slaves
+            or seen[2] is not plan
+        ):
+            seen = self._op_seen = (
+                VirtualSlave.al_changes,
+                self._claimed_slaves,
+                plan,
+                all(s.al_state == _OP for s in self._claimed_slaves)
+                and all(row[0].al_state == _OP for row in plan[2]),
+            )
+        if not seen[3]:
+            return False
         view = image.view
-        for slave, o_start, o_bytes, i_start, i_bytes in plan[2]:
-            if slave.al_state != op or type(slave).step is not _IO_STEP or not slave.settled():
+        for slave, o_start, o_bytes, i_start, i_bytes, o_view, i_view in plan[2]:
+            if type(slave).step is not _IO_STEP or not slave.settled():
                 return False
             if o_bytes:
                 if o_bytes < 0:
                     return False  # outputs not byte-aligned
                 rx = slave.rx
-                n = min(len(rx), o_bytes)
-                if view[o_start : o_start + n] != rx[:n]:
-                    return False
+                n = len(rx)
+                if n == o_bytes:  # (the usual case: the area's bytes, cut out once)
+                    if rx != o_view:
+                        return False
+                else:
+                    n = min(n, o_bytes)
+                    if view[o_start : o_start + n] != rx[:n]:
+                        return False
             if i_bytes:
                 if i_bytes < 0:
                     return False  # inputs not in whole bytes
                 tx = slave.tx
-                n = min(len(tx), i_bytes)
-                if view[i_start : i_start + n] != tx[:n]:
-                    return False
+                n = len(tx)
+                if n == i_bytes:
+                    if tx != i_view:
+                        return False
+                else:
+                    n = min(n, i_bytes)
+                    if view[i_start : i_start + n] != tx[:n]:
+                        return False
         return True
 
-    def _steady_rows(self, image: ProcessImage) -> list[tuple[Any, int, int, int, int]]:
+    def _steady_rows(self, image: ProcessImage) -> list[tuple[Any, ...]]:
         """Per slave of the run plan: (slave, first output byte, output bytes, first input
-        byte, input bytes); -1 bytes: an area :meth:`steady` cannot compare, 0: none."""
+        byte, input bytes, the image's output bytes, its input bytes); -1 bytes: an area
+        :meth:`steady` cannot compare, 0: none (and no bytes cut out)."""
         rows = []
+        view = image.view
         base = image.outputs_bytes
         for slave, out, inp in self._run_plan:
             o_start = o_bytes = i_start = i_bytes = 0
@@ -277,7 +304,9 @@ class EmulatedBackend(Backend):
             if inp is not None:
                 i_start = base + (inp.logical_bit >> 3)
                 i_bytes = inp.bit_len >> 3 if inp.aligned and not inp.bit_len & 7 else -1
-            rows.append((slave, o_start, o_bytes, i_start, i_bytes))
+            o_view = view[o_start : o_start + o_bytes] if o_bytes > 0 else None
+            i_view = view[i_start : i_start + i_bytes] if i_bytes > 0 else None
+            rows.append((slave, o_start, o_bytes, i_start, i_bytes, o_view, i_view))
         return rows
 
     def emergencies(self) -> list[tuple[int, object]]:
@@ -401,4 +430,5 @@ class EmulatedBackend(Backend):
 
 
 _IO_STEP = IoSlave.step
-_OP = AlState.OP
+_OP = AlState.OP  # (looked up once: an enum member costs more than a comparison)
+_SAFEOP = AlState.SAFEOP
