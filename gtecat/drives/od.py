@@ -147,6 +147,24 @@ IDENTITY_TYPE = 0x0023
 PREOP_ONLY = frozenset({AlState.INIT, AlState.PREOP})
 
 
+#: a data type's value when an entry gives none: empty bytes, 0.0 or 0
+_DEFAULT_VALUE: dict[DataType, Any] = {
+    t: b"" if info.is_string else (0.0 if info.fmt == "f" else 0) for t, info in TYPE_INFO.items()
+}
+
+
+def _interned_x(x: dict[str, Any]) -> dict[str, Any]:
+    """The one dict of these extras (never changed after): entries with the same extras (the
+    same object of drive after drive) share one."""
+    try:
+        shared = tuple(sorted((k, type(v).__name__, v) for k, v in x.items()))
+        if len(_XS) >= 4096:
+            _XS.clear()
+        return _XS.setdefault(shared, x)
+    except TypeError:  # an unhashable value: its own dict
+        return x
+
+
 class Variable:
     """One entry (index, subindex) of the dictionary."""
 
@@ -186,30 +204,37 @@ class Variable:
         self.index = index
         self.subindex = subindex
         self.name = name
-        self.data_type = data_type if type(data_type) is DataType else DataType(data_type)
-        info = TYPE_INFO[self.data_type]
+        if type(data_type) is not DataType:
+            data_type = DataType(data_type)
+        self.data_type = data_type
         self.access = access
         self.pdo = pdo
         #: what few entries have (a range, allowed values, a string's size, a placeholder
         #: mark): None or a dict of them, so that the hundreds of entries of a drive without
         #: them stay small (:attr:`low` and the others read it)
-        self._x: dict[str, Any] | None = None
-        if low is not None:
-            self.low = low
-        if high is not None:
-            self.high = high
-        if allowed is not None:
-            self.allowed = _shared(frozenset(allowed))
+        x: dict[str, Any] | None = None
+        if low is not None or high is not None or allowed is not None:
+            x = {}
+            if low is not None:
+                x["low"] = low
+            if high is not None:
+                x["high"] = high
+            if allowed is not None:
+                x["allowed"] = _shared(frozenset(allowed))
+            x = _interned_x(x)
+        self._x = x
         self.write_states = write_states
-        self.getter = getter
-        self.setter = setter
-        if info.is_string and max_size:
+        # (AttrVariable and SlotVariable answer getter/setter themselves: nothing to store)
+        plain = type(self) is Variable
+        if plain or getter is not None:
+            self.getter = getter
+        if plain or setter is not None:
+            self.setter = setter
+        if max_size and TYPE_INFO[data_type].is_string:
             self.max_size = max_size
-        if pdo_bits is not None and pdo_bits != info.pdo_bits:
+        if pdo_bits is not None and pdo_bits != TYPE_INFO[data_type].pdo_bits:
             self.pdo_bits = pdo_bits
-        if default is None:
-            default = b"" if info.is_string else (0.0 if info.fmt == "f" else 0)
-        self.value = default
+        self.value = _DEFAULT_VALUE[data_type] if default is None else default
 
     @property
     def info(self) -> TypeInfo:
@@ -242,13 +267,7 @@ class Variable:
         # same object of drive after drive) share one
         x = dict(self._x) if self._x else {}
         x[key] = value
-        try:
-            shared = tuple(sorted((k, type(v).__name__, v) for k, v in x.items()))
-            if len(_XS) >= 4096:
-                _XS.clear()
-            self._x = _XS.setdefault(shared, x)
-        except TypeError:  # an unhashable value: its own dict
-            self._x = x
+        self._x = _interned_x(x)
 
     low = property(lambda self: self._get_x("low"), lambda self, v: self._set_x("low", v))
     high = property(lambda self: self._get_x("high"), lambda self, v: self._set_x("high", v))
@@ -286,6 +305,8 @@ class Variable:
 
     def check(self, value: Any) -> None:
         """Raise SdoAbort when ``value`` is outside this entry's range or allowed set."""
+        if self._x is None:  # no range, no allowed set (most entries)
+            return
         if self.allowed is not None and value not in self.allowed:
             raise SdoAbort(
                 SdoAbortCode.VALUE_RANGE_EXCEEDED,
@@ -711,7 +732,10 @@ class ObjectDictionary:
         if complete_access and obj.code is not ObjectCode.VAR:
             self._download_complete(obj, subindex, bytes(data), al_state)
             return
-        var = self.variable(index, subindex)
+        try:
+            var = obj.subs[subindex]  # (self.variable, with the object already found)
+        except KeyError:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
         self._write(var, bytes(data), al_state)
 
     def _write(self, var: Variable, data: bytes, al_state: AlState) -> None:

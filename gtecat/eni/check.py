@@ -12,6 +12,7 @@ image is one flat buffer per direction, DESIGN.md).
 from __future__ import annotations
 
 from itertools import pairwise
+from typing import NamedTuple
 
 from . import limits
 from .errors import EniError
@@ -55,14 +56,14 @@ def _check_ranges(cfg: EniConfig) -> None:
                     limits.BIT_LENGTH.check(area.bit_len, "BitLength")
                     limits.check_span(area.bit_start, area.bit_len, what)
             for p in (*s.rx_pdos, *s.tx_pdos):
-                label = f"PDO 0x{p.index & 0xFFFF:04X}"
+                label = "PDO"  # (named where a check fails: the labels cost more than checks)
                 limits.INDEX.check(p.index, "PDO index")
                 if p.sm is not None:
                     limits.SM.check(p.sm, "sync manager")
                 for e in p.entries:
                     limits.INDEX.check(e.index, "index")
                     limits.SUBINDEX.check(e.subindex, "subindex")
-                    label = f"PDO 0x{p.index:04X} entry {fmt_index(e.index, e.subindex)}"
+                    label = "entry"
                     limits.ENTRY_BITS.check(e.bit_len, "bit length")
                     if e.logical_bit is not None:
                         limits.BIT_OFFSET.check(e.logical_bit, "logical bit")
@@ -72,7 +73,23 @@ def _check_ranges(cfg: EniConfig) -> None:
                 limits.INDEX.check(c.index, "InitCmd index")
                 limits.SUBINDEX.check(c.subindex, "InitCmd subindex")
         except ValueError as exc:
+            if label == "PDO":
+                label = f"PDO 0x{p.index & 0xFFFF:04X}"
+            elif label == "entry":
+                label = f"PDO 0x{p.index:04X} entry {fmt_index(e.index, e.subindex)}"
             raise _err(cfg, s, str(exc), label) from None
+
+
+class _EntryLabel(NamedTuple):
+    """The label "PDO 0x1600 entry 0x6040:00", made into text only for a message (a bus of
+    a thousand drives has thousands of entries, and nearly every file none to report)."""
+
+    pdo: int
+    index: int
+    subindex: int
+
+    def __str__(self) -> str:
+        return f"PDO 0x{self.pdo:04X} entry {fmt_index(self.index, self.subindex)}"
 
 
 def check_config(cfg: EniConfig) -> None:
@@ -117,9 +134,9 @@ def check_config(cfg: EniConfig) -> None:
                         f"PDO 0x{p.index:04X}",
                     )
                 for e in p.entries:
-                    label = f"PDO 0x{p.index:04X} entry {fmt_index(e.index, e.subindex)}"
+                    label = _EntryLabel(p.index, e.index, e.subindex)
                     if e.bit_len <= 0:
-                        raise _err(cfg, s, "entry with no bits", label)
+                        raise _err(cfg, s, "entry with no bits", str(label))
                     if not e.is_padding:
                         key = (e.index, e.subindex)
                         if key in seen_obj:
@@ -128,7 +145,7 @@ def check_config(cfg: EniConfig) -> None:
                                 s,
                                 f"{fmt_index(*key)} is mapped twice as "
                                 f"{'output' if d == Direction.OUT else 'input'}",
-                                label,
+                                str(label),
                             )
                         seen_obj.add(key)
                     if e.logical_bit is not None:
@@ -152,5 +169,5 @@ def check_config(cfg: EniConfig) -> None:
                     sb,
                     f"bits {b0}..{b1 - 1} of the {image} image overlap slave {sa.position} "
                     f"({sa.name}) {la} at bits {a0}..{a1 - 1}",
-                    lb,
+                    str(lb),
                 )

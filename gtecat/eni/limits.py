@@ -68,9 +68,9 @@ class Limit:
 
     def check(self, value: int, field: str, text: str | None = None) -> int:
         """``value`` when it lies in the range, else :class:`RangeError` (``text`` as written)."""
-        if value not in self:
-            raise self.error(field, text if text is not None else value)
-        return value
+        if isinstance(value, int) and self.lo <= value <= self.hi:  # (value in self, inline)
+            return value
+        raise self.error(field, text if text is not None else value)
 
     def parse(self, text: str | int, field: str) -> int:
         """Parse an integer as :func:`gtecat.eni.numbers.parse_int` spells it and check it."""

@@ -31,6 +31,7 @@ variables inside its area; gaps become padding.
 
 from __future__ import annotations
 
+import copy
 import re
 from dataclasses import dataclass, field, replace
 from typing import TypeVar
@@ -98,6 +99,9 @@ class _Ctx:
     seen: dict[object, object] = field(default_factory=dict)
     #: an InitCmd element's content (attributes, children's tags, texts, attributes) -> its model
     init_cmds: dict[tuple[object, ...], InitCmd] = field(default_factory=dict)
+    #: (RxPdo/TxPdo node, its order) -> what it was read as: a subtree the tree shares
+    #: (:func:`gtecat.eni.xmltree.parse_xml`) is read once; each slave gets its own copy
+    pdos: dict[tuple[int, int], _PdoXml] = field(default_factory=dict)
     #: id of a Mailbox node (the tree is alive while it is read) -> its init commands, layout
     mailboxes: dict[int, tuple[tuple[InitCmd, ...], MailboxLayout | None]] = field(
         default_factory=dict
@@ -456,8 +460,13 @@ def _assigned_pdos(ctx: _Ctx, pd: Node) -> dict[Direction, list[_PdoXml] | None]
     ``None`` for a direction means "no PDO description to go by" (synthesise).
     """
     described: list[_PdoXml] = []
+    read = ctx.pdos
     for order, node in enumerate(c for c in pd.children if c.tag in ("RxPdo", "TxPdo")):
-        described.append(_pdo(ctx, node, order))
+        p = read.get((id(node), order))
+        if p is None or p.node is not node:
+            p = read[id(node), order] = _pdo(ctx, node, order)
+        # a copy: the assignment below sets sm_attr, per slave
+        described.append(copy.copy(p))
 
     sm_lists: list[tuple[int, str, list[tuple[int, Node]]]] = []
     for node in pd.children:

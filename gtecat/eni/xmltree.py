@@ -266,13 +266,17 @@ def parse_xml(
         else:
             parser.EndElementHandler = until_end
 
+    # (the elements' names first: a set lookup of the name the parser gives, no pair made)
+    skip_names = frozenset(name for _, name in skip)
+    share_names = frozenset(name for _, name in share)
+
     def start(tag: str, attrs: dict[str, str]) -> None:
         nonlocal depth
         name = local.get(tag)
         if name is None:
             name = local[tag] = _local(tag)
         parent = stack[-1] if stack else None
-        if skip and parent is not None and (parent.tag, name) in skip:
+        if name in skip_names and parent is not None and (parent.tag, name) in skip:
             stop = _end_tag(raw, tag, parser.CurrentByteIndex) if raw is not None else -1
             if stop < 0:
                 depth = 1
@@ -282,7 +286,12 @@ def parse_xml(
                 passing(stop)
             return
         pending = None
-        if raw is not None and parent is not None and (parent.tag, name) in share:
+        if (
+            name in share_names
+            and raw is not None
+            and parent is not None
+            and (parent.tag, name) in share
+        ):
             at = parser.CurrentByteIndex
             stop = _end_tag(raw, tag, at)
             if stop > 0:

@@ -76,3 +76,19 @@ def test_the_cache_folder_keeps_the_latest_models_only(tmp_path, monkeypatch) ->
         f.write_bytes(text + b"\n" * (k + 1))
         read_eni(f, cache)
     assert len(list(cache.rglob("*.pickle"))) == 2
+
+
+def test_the_model_pickles_as_tuples_and_comes_back_equal() -> None:
+    import pickle
+
+    from gtecat.eni import model
+    from gtecat.eni.reader import parse_eni
+
+    config = parse_eni(FIG52.read_bytes(), str(FIG52))
+    back = pickle.loads(pickle.dumps(config, protocol=pickle.HIGHEST_PROTOCOL))
+    assert back == config and back.slaves[0].init_cmds == config.slaves[0].init_cmds
+    shared = (config.slaves[0].identity,) * 2  # one object twice: still one after the trip
+    again = pickle.loads(pickle.dumps(shared))
+    assert again[0] is again[1] and again[0] == shared[0]
+    entry = model.PdoEntry(0x6040, 0, 16, "Controlword", "UINT")
+    assert entry.__getstate__() == (0x6040, 0, 16, "Controlword", "UINT", None)

@@ -331,13 +331,13 @@ class EmulatedBackend(Backend):
 
     # --- mailbox -----------------------------------------------------------------
     def _client(self, position: int):  # -> gtecat.drives.coe.SdoClient
-        from gtecat.drives.coe import SdoClient
-
         slave = self._slave(position)
         if not slave.has_mailbox:
             raise BusError(f"slave {position} ({slave.name}) has no CoE mailbox")
         client = self._clients.get(position)
         if client is None:
+            from gtecat.drives.coe import SdoClient
+
             capture = self.capture
 
             # the slave's mailbox looked up per message: a fault may stand in front of it
