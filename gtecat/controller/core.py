@@ -60,7 +60,9 @@ from ..master.masterlog import MasterLog
 from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
+from .bank_kernel import _DEFERRED as _KERNEL_DEFERRED
 from .bank_kernel import prebuild as prebuild_kernel
+from .bank_kernel import start_deferred as start_kernel_build
 from .input_sense import changed as sense_changed
 from .resources import install as install_resources
 
@@ -148,8 +150,8 @@ class Controller:
             )
         if self.options.bank != "off" and self.options.backend == "emulated":
             # a first build of the bank's compiled cycle on this machine runs in a process of
-            # its own beside the rest of the bring-up (the bank takes it when it is there)
-            prebuild_kernel()
+            # its own once the bus is in OP (the bank takes it when it is there)
+            prebuild_kernel(defer=True)
         cycle_ns = round((self.options.cycle_ms or 1.0) * 1_000_000)
         self.clock = Clock(
             self._cycle,
@@ -253,7 +255,7 @@ class Controller:
             )
         banked = self.options.bank != "off" and self.options.backend == "emulated"
         if banked:
-            prebuild_kernel()  # (GT_Open started it; again for options changed since)
+            prebuild_kernel(defer=True)  # (as GT_Open; again for options changed since)
         try:
             config = read_eni(path, _eni_cache(path))
         except EniError:
@@ -313,7 +315,11 @@ class Controller:
 
     @property
     def ready(self) -> bool:
-        return self.master is not None and self.master.ready
+        if self.master is None or not self.master.ready:
+            return False
+        if _KERNEL_DEFERRED:  # the bus is up: a first build of the bank's cycle starts now
+            start_kernel_build()
+        return True
 
     def start_ecat(self) -> None:
         """GT_StartEcatComm: start bus motion control; the bus must be in OP."""
@@ -323,6 +329,7 @@ class Controller:
                 "EtherCAT communication is not fully established yet "
                 f"({m.error or 'slaves not yet in OP'}); poll GT_IsEcatReady until it reports 1"
             )
+        start_kernel_build()  # (deferred by GT_Open until the bus is up)
         self.started = True
 
     def terminate_ecat(self) -> None:

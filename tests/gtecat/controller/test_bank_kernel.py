@@ -3,6 +3,7 @@ machine without a compiler runs the same bank on numpy alone, with the reason re
 
 from __future__ import annotations
 
+import ctypes
 import json
 import os
 import subprocess
@@ -142,3 +143,51 @@ def test_a_real_refused_flag_falls_back_to_a_working_plain_build() -> None:
     assert lib.bank_kernel_fields().decode().rstrip(",").split(",") == [
         n for n, _ in bank_kernel._field_types()
     ]
+
+
+class _Build:
+    """A build started (cbuild.Background's part the kernel module uses), never ending."""
+
+    def __init__(self, builds: list) -> None:
+        self.builds = builds
+
+    def done(self) -> bool:
+        return False
+
+
+def test_a_first_build_starts_once_the_bus_is_in_op(monkeypatch: pytest.MonkeyPatch) -> None:
+    """GT_Open defers a machine's first build of the kernel to OP (GT_IsEcatReady answering
+    1, or GT_StartEcatComm): a compiler beside the bring-up took a CPU it wanted; a build
+    already there is taken at once."""
+    from gtecat import gt
+
+    started: list[_Build] = []
+    monkeypatch.setattr(bank_kernel, "_LIB", None)
+    monkeypatch.setattr(bank_kernel, "_LIB_REASON", "")
+    monkeypatch.setattr(bank_kernel, "_AHEAD", [])
+    monkeypatch.setattr(
+        bank_kernel, "Background", lambda b: started.append(_Build(b)) or started[-1]
+    )
+    monkeypatch.setattr(bank_kernel, "library_path", lambda *b: Path("/nowhere/bank_kernel.so"))
+    monkeypatch.setattr(bank_kernel, "intact", lambda lib: False)
+    monkeypatch.delenv("GTECAT_BANK_KERNEL", raising=False)
+    try:
+        eni = ROOT / "examples" / "manual_fig5_2.eni"
+        assert gt.GT_Open(eni=str(eni), clock="lockstep", log="") == 0
+        assert gt.GT_InitEcatComm() == 0
+        assert bank_kernel._DEFERRED and not started and not bank_kernel.settled()
+        status = ctypes.c_short()
+        while not (gt.GT_IsEcatReady(ctypes.byref(status)) == 0 and status.value == 1):
+            assert not started  # not while the bus comes up
+            gt.GTE_Wait(1)
+        assert len(started) == 1 and not bank_kernel._DEFERRED  # at the first "ready"
+        assert gt.GT_StartEcatComm() == 0
+        assert len(started) == 1
+        gt.GT_Close()
+        bank_kernel._AHEAD.clear()
+        monkeypatch.setattr(bank_kernel, "intact", lambda lib: True)
+        bank_kernel.prebuild(defer=True)  # built before: taken at once
+        assert len(started) == 2 and not bank_kernel._DEFERRED
+    finally:
+        gt.GT_Close()
+        bank_kernel._DEFERRED.clear()
