@@ -314,33 +314,11 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
         ),
     }
     counts = (c_ulong * 2)()
-    clock, rng = time.perf_counter, range(block)
-    out: dict[str, object] = {}
-    table_out: dict[str, object] = {}
-    worst = table_worst = 0.0
     per = seconds / (len(shapes) + len(table))
-    for name, (call, build) in [*shapes.items(), *table.items()]:
-        calls, args = [], []
-        t_end = clock() + per
-        while clock() < t_end:
-            t0 = clock()
-            for _ in rng:
-                build()
-            t1 = clock()
-            for _ in rng:
-                call()
-            t2 = clock()
-            args.append((t1 - t0) / block)
-            calls.append((t2 - t1) / block)
-        c_us, a_us = statistics.median(calls) * 1e6, statistics.median(args) * 1e6
-        ratio = round(c_us / a_us, 2)
-        row = {"call_us": round(c_us, 3), "argument_us": round(a_us, 3), "ratio": ratio}
-        if name in table:
-            table_worst = max(table_worst, ratio)
-            table_out[name] = row
-        else:
-            worst = max(worst, ratio)
-            out[name] = row
+    out = _time_pairs(shapes, per * len(shapes), block)
+    table_out = _time_pairs(table, per * len(table), block)
+    worst = max((row["ratio"] for row in out.values()), default=0.0)
+    table_worst = max((row["ratio"] for row in table_out.values()), default=0.0)
     gt.GT_Close()
     return {"shapes": out, "worst": worst, "table_path": table_out, "table_worst": table_worst}
 
