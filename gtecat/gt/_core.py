@@ -456,8 +456,12 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     return run(SESSION._core, values, _NO_KW, "", SESSION.last)
             elif not opens:  # GT_Open: always the table path (its keyword options)
                 compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
-                return gt(*args)
+                return table(*args)
         return call(_GT, args, kwargs)
+
+    # (the table path itself: ``gt`` is the fast path's name once there is one, and the first
+    # call of ``gt.slow`` must not go round through the fast path)
+    table = gt
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None

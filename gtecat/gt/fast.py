@@ -140,6 +140,17 @@ def fast_reader(
             )
         return ok
 
+    pointer_types: dict[type, bool] = {}
+
+    def is_pointer(tp: type) -> bool:
+        """``pointer(x)`` (a ctypes pointer object) of a type ``*pValue`` takes."""
+        ok = pointer_types.get(tp)
+        if ok is None:
+            ok = pointer_types[tp] = (
+                issubclass(tp, ctypes._Pointer) and getattr(tp, "_type_", None) in ctypes_ok
+            )
+        return ok
+
     env = {
         "_NO": _NO,
         "_CArg": _CArg,
@@ -209,6 +220,8 @@ def fast_reader(
             p[0] = get(res)
         elif tp is _NDARRAY and p.dtype in np_ok and p.ndim == 1 and p.size and p.flags.writeable:
             p[0] = get(res)
+        elif is_pointer(tp) and p:  # pointer(x), not a NULL pointer: x
+            p.contents.value = get(res)
         else:
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
         if clk is not None:
