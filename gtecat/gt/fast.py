@@ -25,6 +25,7 @@ import numpy as np
 
 from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
+from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
@@ -1946,6 +1947,8 @@ def fast_io_reader(
         "bounds": bounds,
         "first": first,
         "plan": plan,
+        # the inputs' readers keep the bank's axes (bank.BANK_READS: they read the image)
+        "RELEASES": name not in BANK_READS,
     }
     # (compiled with the function's type range and key offset as constants, its names as
     # globals: the fewest steps per call)
@@ -1982,8 +1985,8 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
                     obj = _NO if b is None else None
                 if obj is not _NO:
                     bank = ctl.bank
-                    if bank is not None and bank.n_alive:  # (what the table path does
-                        bank.before_call(ctl, proto, (t, p))  # first: its axes go back)
+                    if RELEASES and bank is not None and bank.n_alive:  # (GT_GetDo: what
+                        bank.before_call(ctl, proto, (t, p))  # the table path does first)
                     if read is None:
                         read = plan(ctl, t)
                     v = read()

