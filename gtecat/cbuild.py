@@ -411,8 +411,9 @@ class Background:
         self.result: Path | NativeBuildError | None = None
         self.libs = [library_path(*b) for b in builds]
         self._proc: subprocess.Popen[bytes] | None = None
-        if any(intact(lib) for lib in self.libs):
-            self._finish()
+        built = next((lib for lib in self.libs if intact(lib)), None)
+        if built is not None:  # (checked once: its seal's digest is the cost)
+            self.result = built
             return
         cc = compiler()
         vdir = version_dir()

@@ -732,8 +732,7 @@ def fast_clock(
     from .args import _scalar_types
     from .table import FUNCTIONS
 
-    last: list[Any] = [None]  # the last byref object checked (kept alive, so never reused)
-    target = byref_target.target(_CLOCK_INTS) if BYREF_TARGET else None
+    target = _target(_CLOCK_INTS)
     first = _array_first(_scalar_types(FUNCTIONS[name].params[0]))
 
     def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
@@ -751,21 +750,9 @@ def fast_clock(
                 if clock._thread is None:
                     tp = type(pClock)
                     if tp is _CArg:
-                        if target is not None:  # (one C call: see _BYREF_C)
-                            obj = target(pClock)
-                            if obj is pClock:
-                                obj = None
-                        else:
-                            obj = pClock._obj
-                            if pClock is not last[0]:
-                                if type(obj) not in _CLOCK_INTS or (
-                                    _from_address(id(pClock) + _AT).value
-                                    if _AT >= 0
-                                    else byref_address(pClock)
-                                ) != _addressof(obj):
-                                    obj = None
-                                else:
-                                    last[0] = pClock
+                        obj = target(pClock)
+                        if obj is pClock:  # (byref(x, offset), another type: the table path)
+                            obj = None
                     elif tp in _CLOCK_INTS:
                         obj = pClock
                     else:  # an array: its first element
