@@ -60,9 +60,10 @@ def _ok(rc: int, what: str) -> None:
     assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
 
 
-def _bring_up(machine: str, bank: str) -> None:
+def open_bus(eni: str, machine: str, bank: str) -> None:
+    """The bank tests' bus: GT_Open in lockstep with ``bank``, brought to OP and started."""
     gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank=bank), "open")
+    _ok(gt.GT_Open(eni=eni, machine=machine, clock="lockstep", log="", bank=bank), "open")
     _ok(gt.GT_InitEcatComm(), "init")
     ready = c_short()
     for _ in range(200):
@@ -71,6 +72,10 @@ def _bring_up(machine: str, bank: str) -> None:
             break
         gt.GTE_Wait(1)
     _ok(gt.GT_StartEcatComm(), "start")
+
+
+def _bring_up(machine: str, bank: str) -> None:
+    open_bus(str(ENI), machine, bank)
     for a in range(1, AXES + 1):
         _ok(gt.GT_AxisOn(a), f"axis on {a}")
         _ok(gt.GT_PrfTrap(a), "trap")

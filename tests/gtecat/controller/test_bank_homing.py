@@ -19,7 +19,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.controller import bank_kernel
-from tests.gtecat.controller.test_bank import ENI, HAS_CC
+from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
 
 AXES = 12
 #: axis -> (method, machine keys)
@@ -50,23 +50,10 @@ def _machine(tmp: Path) -> str:
     return str(path)
 
 
-def _ok(rc: int, what: str) -> None:
-    assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
-
-
 def _run(machine: str, bank: str) -> tuple[list, tuple[int, int]]:
-    gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank=bank), "open")
     trace: list = []
     try:
-        _ok(gt.GT_InitEcatComm(), "init")
-        ready = c_short()
-        for _ in range(200):
-            gt.GT_IsEcatReady(byref(ready))
-            if ready.value:
-                break
-            gt.GTE_Wait(1)
-        _ok(gt.GT_StartEcatComm(), "start")
+        open_bus(str(ENI), machine, bank)
         for a, (method, _) in SETUP.items():
             _ok(gt.GT_AxisOn(a), f"axis on {a}")
             _ok(gt.GT_SetHomingMode(a, 6), f"homing mode {a}")

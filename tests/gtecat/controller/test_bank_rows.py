@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import os
 import shutil
-from ctypes import byref, c_double, c_long, c_short, c_ubyte
+from ctypes import byref, c_double, c_long, c_ubyte
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from tests.conftest import examples
+from tests.gtecat.controller.test_bank import _ok, open_bus
 from tools.gen_axes_eni import write_axes_eni
 
 AXES = 6
@@ -40,21 +41,8 @@ def bus(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str]:
     return str(eni), str(machine)
 
 
-def _ok(rc: int, what: str) -> None:
-    assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
-
-
 def _open(bus: tuple[str, str], bank: str) -> None:
-    gt.GT_Close()
-    _ok(gt.GT_Open(eni=bus[0], machine=bus[1], clock="lockstep", log="", bank=bank), "open")
-    _ok(gt.GT_InitEcatComm(), "init")
-    ready = c_short()
-    for _ in range(200):
-        gt.GT_IsEcatReady(byref(ready))
-        if ready.value:
-            break
-        gt.GTE_Wait(1)
-    _ok(gt.GT_StartEcatComm(), "start")
+    open_bus(bus[0], bus[1], bank)
     for a in range(1, AXES + 1):
         _ok(gt.GT_AxisOn(a), f"axis on {a}")
         _ok(gt.GT_PrfTrap(a), "trap")

@@ -16,14 +16,14 @@ whole GT raw image; the drives' mechanics at the end.
 from __future__ import annotations
 
 import os
-from ctypes import byref, c_double, c_long, c_short, c_ubyte
+from ctypes import byref, c_double, c_long, c_ubyte
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from gtecat import gt
-from tests.gtecat.controller.test_bank import ENI, HAS_CC
+from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
 
 AXES = 12
 #: axis -> (THomePrm fields, machine keys); positions in counts (pulse = count here)
@@ -81,10 +81,6 @@ def _machine(tmp: Path, setup: dict = SETUP) -> str:
     return str(path)
 
 
-def _ok(rc: int, what: str) -> None:
-    assert rc == 0, f"{what}: {rc} {gt.GTE_GetLastError()}"
-
-
 def _sample(size: int, axes: int = AXES) -> tuple:
     sts = (c_long * axes)()
     prf = (c_double * axes)()
@@ -116,18 +112,9 @@ def _run(
     them in as few calls as the homings let it); the stops of axes 10 and 12 with
     :data:`SETUP` alone; ``calls``: cycle -> a call made before it (a GPI set)."""
     stops = setup is SETUP
-    gt.GT_Close()
-    _ok(gt.GT_Open(eni=str(eni), machine=machine, clock="lockstep", log="", bank=bank), "open")
     trace: list = []
     try:
-        _ok(gt.GT_InitEcatComm(), "init")
-        ready = c_short()
-        for _ in range(200):
-            gt.GT_IsEcatReady(byref(ready))
-            if ready.value:
-                break
-            gt.GTE_Wait(1)
-        _ok(gt.GT_StartEcatComm(), "start")
+        open_bus(str(eni), machine, bank)
         for a, (fields, _) in setup.items():
             _ok(gt.GT_AxisOn(a), f"axis on {a}")
             _ok(gt.GT_PrfTrap(a), f"trap {a}")
