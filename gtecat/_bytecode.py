@@ -20,6 +20,7 @@ import importlib.util
 import marshal
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from types import CodeType
 from typing import Any
@@ -45,21 +46,28 @@ class _Loader(importlib.machinery.SourceFileLoader):
         h.update(b"\0")
         h.update(source)
         cached = _DIR[0] / f"{fullname}-{h.hexdigest()[:32]}.pyc"
-        try:
-            code = marshal.loads(cached.read_bytes())
-            if isinstance(code, CodeType) and code.co_filename == path:
-                return code
-        except (OSError, EOFError, ValueError, TypeError):
-            pass
-        code = self.source_to_code(source, path)
-        try:
-            cached.parent.mkdir(parents=True, exist_ok=True)
-            tmp = cached.with_name(f"{cached.name}.{os.getpid()}.tmp")
-            tmp.write_bytes(marshal.dumps(code))
-            os.replace(tmp, cached)
-        except OSError:
-            pass  # a read-only home: compiled again next time, as without this module
-        return code
+        return _kept(cached, path, lambda: self.source_to_code(source, path))
+
+
+def _kept(cached: Path, filename: str, make: Callable[[], CodeType]) -> CodeType:
+    """The code kept in file ``cached`` (compiled from ``filename``), else ``make()``'s, kept
+    there (written under another name and renamed); an unreadable or foreign file is made
+    again, a read-only home only costs the compiling next time."""
+    try:
+        code = marshal.loads(cached.read_bytes())
+        if isinstance(code, CodeType) and code.co_filename == filename:
+            return code
+    except (OSError, EOFError, ValueError, TypeError):
+        pass
+    code = make()
+    try:
+        cached.parent.mkdir(parents=True, exist_ok=True)
+        tmp = cached.with_name(f"{cached.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps(code))
+        os.replace(tmp, cached)
+    except OSError:
+        pass
+    return code
 
 
 class _Finder:
@@ -142,21 +150,11 @@ def compiled(source: str, filename: str) -> CodeType:
         return compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
     key = hashlib.sha1(f"{filename}\0{source}".encode("utf-8", "surrogatepass")).hexdigest()
     path = _DC_FILE[0].parent / "gen" / f"{key}.code"
-    try:
-        code = marshal.loads(path.read_bytes())
-        if isinstance(code, CodeType) and code.co_filename == filename:
-            return code
-    except (OSError, EOFError, ValueError, TypeError):
-        pass
-    code = compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(marshal.dumps(code))
-        os.replace(tmp, path)
-    except OSError:
-        pass  # a read-only home: compiled again next time
-    return code
+    return _kept(
+        path,
+        filename,
+        lambda: compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True),
+    )
 
 
 _ANNOTATIONS = __import__("__future__").annotations.compiler_flag
