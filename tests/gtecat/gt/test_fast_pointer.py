@@ -12,6 +12,7 @@ from gtecat import gt
 from gtecat.gt.fast import READERS
 
 from .conftest import bring_up
+from .test_fast_clock_out import _value
 
 
 def _shapes(ctype: type) -> list[tuple[str, object]]:
@@ -27,8 +28,7 @@ def _shapes(ctype: type) -> list[tuple[str, object]]:
 def _call(fn, maker) -> tuple:
     _, arg, obj = maker()
     rc = fn(1, arg)
-    value = None if obj is None else (obj.tolist() if isinstance(obj, np.ndarray) else obj.value)
-    return rc, value, gt.GTE_GetLastError() if rc else ""
+    return rc, _value(obj), gt.GTE_GetLastError() if rc else ""
 
 
 def test_a_pointer_object_answers_as_the_table() -> None:
