@@ -611,8 +611,8 @@ def bringup_child(eni: str) -> int:
 COLD = (
     "cold: a new, empty gtecat cache folder (GTECAT_CACHE_DIR) and no bytecode written by Python"
     " (PYTHONDONTWRITEBYTECODE=1), as the first run on a fresh machine: the ENI parsed, gtecat's"
-    " modules compiled from source, the bank's C kernel built beside the bring-up in a process"
-    " of its own (its compiler's CPU counted; background_s: how long it went on after the exit)"
+    " modules compiled from source, the bank's C kernel built in a process of its own once the"
+    " bus is in OP (its compiler's CPU counted; background_s: how long it went on after the exit)"
 )
 WARM = "warm: the same cache folder after one such run (the ENI's model, modules, kernel kept)"
 
