@@ -32,6 +32,8 @@ import sys
 from pathlib import Path
 from types import FrameType
 
+from .. import scheduling
+
 
 def default_address() -> str:
     from ..native.transport import DEFAULT_TCP_PORT, runtime_dir
@@ -77,11 +79,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="auto clock without the wall floor: controller time moves only by call latency "
         "and waits (deterministic; programs that sleep see no time pass)",
     )
+    p.add_argument(
+        "--rt-priority",
+        type=_rt_priority,
+        metavar="N|auto|off",
+        help="serve calls under SCHED_FIFO priority N (1-99); auto (the default, else "
+        f"{scheduling.RT_ENV}) takes priority {scheduling.AUTO_RT_PRIORITY} where the system "
+        "permits it (root or CAP_SYS_NICE), else runs normally; off never asks",
+    )
     # set by libgts when it starts a private controller
     p.add_argument("--ready-fd", type=int, help=argparse.SUPPRESS)
     p.add_argument("--lifeline-fd", type=int, help=argparse.SUPPRESS)
     p.add_argument("--private", action="store_true", help=argparse.SUPPRESS)
     p.set_defaults(func=run)
+
+
+def _rt_priority(text: str) -> int | str:
+    try:
+        return scheduling.parse_priority(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _token(args: argparse.Namespace) -> tuple[str, str]:
@@ -157,6 +174,11 @@ def run(args: argparse.Namespace) -> int:
         )
         if v is not None
     }
+    try:
+        rt_setting = scheduling.from_environment(args.rt_priority)
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
     server = Server(
         address,
         open_options=options,
@@ -179,6 +201,15 @@ def run(args: argparse.Namespace) -> int:
             return 1
         token_note = f"token: written to {token_path} (readable by you only)"
 
+    # the scheduling of the thread that serves, once the socket listens (a refusal of a
+    # priority asked for by number ends the controller here)
+    try:
+        taken = scheduling.take(rt_setting)
+    except scheduling.RealtimeRefused as e:
+        print(f"error: {e}", file=sys.stderr)
+        server.stop()
+        return 1
+
     def stop(signum: int, frame: FrameType | None) -> None:
         server.stop()
 
@@ -190,7 +221,14 @@ def run(args: argparse.Namespace) -> int:
             os.write(args.ready_fd, b"ready\n")
             os.close(args.ready_fd)
     else:
-        print(f"gtecat controller listening on {server.address}", file=sys.stderr, flush=True)
+        sched = taken.words
+        if taken.refused:
+            sched += ": run as root or give python CAP_SYS_NICE for real-time priority"
+        print(
+            f"gtecat controller listening on {server.address} ({sched})",
+            file=sys.stderr,
+            flush=True,
+        )
         if token_note:
             print(token_note, file=sys.stderr, flush=True)
     try:

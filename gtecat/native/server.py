@@ -53,6 +53,7 @@ from typing import Any
 
 from gtecat.eni.errors import GtecatError
 
+from .. import scheduling
 from ..gt import _core, declared
 from ..gt.fast import READERS, wire_reader
 from ..inspect import endpoint as _inspect
@@ -122,6 +123,7 @@ def default_spin_us() -> float:
     return DEFAULT_SPIN_US if cpus >= 2 else 0.0
 
 
+_RTBUSY = os.environ.get("GTECAT_X_RTBUSY") == "1"
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
 #: what a client sets for itself: its current card and the core of its GT_x calls
 _OWN_SETTINGS = frozenset({"GT_SetCardNo", "GT_GetCardNo", "GT_SetCore", "GT_GetCore"})
@@ -433,6 +435,7 @@ class Server:
         self.spin_s = max(0.0, spin_us) / 1e6
         self._budget = self.spin_s  # the adaptive spin (_spin_budget)
         self._busy, self._busy_next, self._since_probe = False, 0.0, 0
+        self._rt = False  # the serving thread runs under SCHED_FIFO (serve_forever)
         self.lock = threading.RLock()
         #: clients whose call is running (a GTE_Wait serving others between its slices
         #: runs their calls inside it: :meth:`_serve_others`)
@@ -463,6 +466,11 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
+        if scheduling.is_realtime():
+            # a real-time server's spin holds its CPU against everything else: bounded
+            self.spin_s = min(self.spin_s, scheduling.RT_SPIN_CAP_US / 1e6)
+            self._budget = min(self._budget, self.spin_s)
+            self._rt = True
         poller = self._poller
         poller.register(self._listener.fileno())
         poller.register(self._wake_r.fileno())
@@ -633,7 +641,7 @@ class Server:
         if now >= self._busy_next:
             self._busy_next = now + 0.01
             self._busy = _cpus_busy()
-        if self._busy:
+        if self._busy and not (self._rt and _RTBUSY):
             return 0.0
         if not self._budget:
             self._since_probe += 1
