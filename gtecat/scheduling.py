@@ -127,6 +127,60 @@ def from_environment(
         raise ValueError(f"{RT_ENV}={exc}") from None
 
 
+class WhenBusy:
+    """A server thread that runs under SCHED_FIFO ``priority`` only while the CPUs are busy
+    (more threads runnable than CPUs) and under its normal policy otherwise.
+
+    Why: on an idle machine a normal server wakes on the CPU of the client that woke it (the
+    kernel's affine wake-up) and both sides may spin for each other's next message, where a
+    real-time one is woken on the CPU it last ran on, which in a virtual machine may have to
+    be woken itself first (tens of microseconds); on a busy machine a normal server waits
+    for other programs' time slices (milliseconds), a real-time one does not, and it must not
+    spin (a real-time spin takes its CPU from everything else).  :meth:`busy` is called with
+    each new look at the load; it switches only on a change (one system call)."""
+
+    def __init__(
+        self,
+        priority: int,
+        set_fifo: Callable[[int], None] = realtime_priority,
+        set_normal: Callable[[tuple[int, int]], None] | None = None,
+        normal: tuple[int, int] | None = None,
+    ) -> None:
+        self.priority = priority
+        self._set_fifo = set_fifo
+        self._set_normal = set_normal or _set_policy
+        #: the policy and priority outside the busy times (SCHED_OTHER 0 unless given)
+        self.normal = normal if normal is not None else (getattr(os, "SCHED_OTHER", 0), 0)
+        self.realtime = False
+        #: why SCHED_FIFO was refused, once it was (then never asked again)
+        self.refused = ""
+        self.switches = 0
+
+    def busy(self, busy: bool) -> bool:
+        """Run real-time if ``busy`` (where permitted); True while real-time."""
+        if busy == self.realtime or (busy and self.refused):
+            return self.realtime
+        try:
+            if busy:
+                self._set_fifo(self.priority)
+            else:
+                self._set_normal(self.normal)
+        except RealtimeRefused as exc:
+            self.refused = str(exc)
+            return self.realtime
+        self.realtime = busy
+        self.switches += 1
+        return self.realtime
+
+
+def _set_policy(policy_priority: tuple[int, int]) -> None:
+    policy, prio = policy_priority
+    try:
+        os.sched_setscheduler(0, policy, os.sched_param(prio))
+    except (OSError, AttributeError, ValueError) as exc:
+        raise RealtimeRefused(f"cannot go back to policy {policy}: {exc}") from exc
+
+
 def is_realtime() -> bool:
     """The calling thread runs under SCHED_FIFO or SCHED_RR."""
     try:
@@ -167,6 +221,7 @@ __all__ = [
     "RT_SPIN_CAP_US",
     "RealtimeRefused",
     "Scheduling",
+    "WhenBusy",
     "from_environment",
     "is_realtime",
     "parse_priority",

@@ -201,14 +201,21 @@ def run(args: argparse.Namespace) -> int:
             return 1
         token_note = f"token: written to {token_path} (readable by you only)"
 
-    # the scheduling of the thread that serves, once the socket listens (a refusal of a
-    # priority asked for by number ends the controller here)
+    # the scheduling of the thread that serves, once the socket listens: asked for now (the
+    # line says what the system permits; a refusal of a number ends the controller here),
+    # then taken only while the CPUs are busy (scheduling.WhenBusy)
+    normal = scheduling.snapshot()
+    if rt_setting == "auto" and scheduling.is_realtime():  # started real-time: as it is
+        rt_setting = "off"
     try:
         taken = scheduling.take(rt_setting)
     except scheduling.RealtimeRefused as e:
         print(f"error: {e}", file=sys.stderr)
         server.stop()
         return 1
+    if taken.priority is not None:
+        server.realtime = scheduling.WhenBusy(taken.priority, normal=normal[:2] if normal else None)
+        server.realtime.realtime = True  # until the first look at the load
 
     def stop(signum: int, frame: FrameType | None) -> None:
         server.stop()

@@ -123,7 +123,6 @@ def default_spin_us() -> float:
     return DEFAULT_SPIN_US if cpus >= 2 else 0.0
 
 
-_RTBUSY = os.environ.get("GTECAT_X_RTBUSY") == "1"
 NOT_OPEN = "this client has not opened the controller: call GT_Open first"
 #: what a client sets for itself: its current card and the core of its GT_x calls
 _OWN_SETTINGS = frozenset({"GT_SetCardNo", "GT_GetCardNo", "GT_SetCore", "GT_GetCore"})
@@ -435,7 +434,9 @@ class Server:
         self.spin_s = max(0.0, spin_us) / 1e6
         self._budget = self.spin_s  # the adaptive spin (_spin_budget)
         self._busy, self._busy_next, self._since_probe = False, 0.0, 0
-        self._rt = False  # the serving thread runs under SCHED_FIFO (serve_forever)
+        #: SCHED_FIFO while the CPUs are busy (set by the controller process before it
+        #: serves; never for a server inside another program, a test's)
+        self.realtime: scheduling.WhenBusy | None = None
         self.lock = threading.RLock()
         #: clients whose call is running (a GTE_Wait serving others between its slices
         #: runs their calls inside it: :meth:`_serve_others`)
@@ -466,11 +467,10 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
-        if scheduling.is_realtime():
-            # a real-time server's spin holds its CPU against everything else: bounded
+        if self.realtime is None and scheduling.is_realtime():
+            # started real-time (chrt): its spin holds the CPU against everything else
             self.spin_s = min(self.spin_s, scheduling.RT_SPIN_CAP_US / 1e6)
             self._budget = min(self._budget, self.spin_s)
-            self._rt = True
         poller = self._poller
         poller.register(self._listener.fileno())
         poller.register(self._wake_r.fileno())
@@ -635,13 +635,13 @@ class Server:
         runnable than this process has CPUs (spinning would take the CPU the client waits
         for), half the last one after a spin that found nothing (a short probe every 256
         rounds once it is none), up to ``spin_s``."""
-        if not self.spin_s:
-            return 0.0
         now = time.monotonic()
         if now >= self._busy_next:
             self._busy_next = now + 0.01
             self._busy = _cpus_busy()
-        if self._busy and not (self._rt and _RTBUSY):
+            if self.realtime is not None:
+                self.realtime.busy(self._busy)
+        if not self.spin_s or self._busy:
             return 0.0
         if not self._budget:
             self._since_probe += 1
