@@ -17,6 +17,11 @@ In ``auto`` clock mode the controller keeps its time at or ahead of wall time (t
 floor, docs/native.md), so programs that sleep between polls see their sleeps pass;
 ``--no-wall-floor`` (GTECAT_WALL_FLOOR=0) keeps pure, deterministic ``auto``.
 
+While other programs keep every CPU busy, the controller serves calls under real-time
+priority (SCHED_FIFO 50) where the system permits it (root or CAP_SYS_NICE), so that a
+call does not wait for another program's time slice; ``--rt-priority off``
+(GTECAT_RT_PRIORITY=off) never asks for it.
+
 ``libgts.so`` starts a private one of these by itself on ``GT_Open`` when
 ``GTECAT_CONTROLLER`` is not set; it ends with the program.
 """
@@ -83,7 +88,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--rt-priority",
         type=_rt_priority,
         metavar="N|auto|off",
-        help="serve calls under SCHED_FIFO priority N (1-99); auto (the default, else "
+        help="while more threads are runnable than there are CPUs, serve calls under "
+        "SCHED_FIFO priority N (1-99); auto (the default, else "
         f"{scheduling.RT_ENV}) takes priority {scheduling.AUTO_RT_PRIORITY} where the system "
         "permits it (root or CAP_SYS_NICE), else runs normally; off never asks",
     )
@@ -229,6 +235,8 @@ def run(args: argparse.Namespace) -> int:
             os.close(args.ready_fd)
     else:
         sched = taken.words
+        if taken.priority is not None:
+            sched += " while the CPUs are busy"
         if taken.refused:
             sched += ": run as root or give python CAP_SYS_NICE for real-time priority"
         print(
