@@ -39,6 +39,8 @@ AUTO_RT_PRIORITY = 50
 RT_ENV = "GTECAT_RT_PRIORITY"
 #: the longest spin of a real-time server waiting for a client's next request (us)
 RT_SPIN_CAP_US = 50.0
+#: the system has real-time scheduling calls (Linux and other POSIX systems; not Windows)
+AVAILABLE = hasattr(os, "sched_setscheduler")
 
 
 class RealtimeRefused(GtecatError):
@@ -90,6 +92,7 @@ def take(
     *,
     spins_forever: bool = False,
     set_fifo: Callable[[int], None] = realtime_priority,
+    available: bool = AVAILABLE,
 ) -> Scheduling:
     """Take the scheduling ``setting`` asks for (``auto``, ``off`` or a priority).
 
@@ -97,9 +100,13 @@ def take(
     system refuses (``refused`` says why); a number asks for that priority and a refusal
     raises :class:`RealtimeRefused`.  ``spins_forever``: the caller will never sleep (a
     busy-polling loop), so ``auto`` keeps normal priority (a real-time task that never
-    sleeps is stopped by the kernel 50 ms of every second); a number takes FIFO anyway."""
+    sleeps is stopped by the kernel 50 ms of every second); a number takes FIFO anyway.
+    Where the system has no real-time scheduling (``available`` False: Windows), ``auto``
+    runs normally without a complaint."""
     if setting == "off" or (setting == "auto" and spins_forever):
         return NORMAL
+    if setting == "auto" and not available:
+        return Scheduling(None, "normal priority (no real-time scheduling on this system)")
     prio = AUTO_RT_PRIORITY if setting == "auto" else int(setting)
     try:
         set_fifo(prio)
@@ -216,6 +223,7 @@ def restore(before: tuple[int, int, set[int]] | None) -> None:
 
 __all__ = [
     "AUTO_RT_PRIORITY",
+    "AVAILABLE",
     "NORMAL",
     "RT_ENV",
     "RT_SPIN_CAP_US",

@@ -26,6 +26,12 @@ Decisions:
   client's own setting (two programs on one controller do not share it).
 * In ``auto`` mode the server keeps the wall floor (:mod:`gtecat.native.floor`)
   unless asked not to, so native clients that sleep between polls see time pass.
+* **Scheduling** (:mod:`gtecat.scheduling`): the controller process
+  (``gtecat controller``, the one libgts starts) gives :attr:`Server.realtime`, and the
+  server then serves under SCHED_FIFO while more threads are runnable than there are CPUs
+  (a normal process woken then may wait for another program's time slice) and under its
+  normal policy, with its spin, otherwise; it never spins while real-time.  A server inside
+  another program (a test's) leaves the program's scheduling alone.
 * Every client is served independently: its bytes are buffered until a frame is whole and
   its replies until it reads them, so a client that sends half a frame, or stops reading,
   delays nobody; it is dropped after :data:`IO_TIMEOUT_S`.
@@ -467,10 +473,7 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
-        if self.realtime is None and scheduling.is_realtime():
-            # started real-time (chrt): its spin holds the CPU against everything else
-            self.spin_s = min(self.spin_s, scheduling.RT_SPIN_CAP_US / 1e6)
-            self._budget = min(self._budget, self.spin_s)
+        self._bound_spin(scheduling.is_realtime())
         poller = self._poller
         poller.register(self._listener.fileno())
         poller.register(self._wake_r.fileno())
@@ -495,6 +498,13 @@ class Server:
                     self._event(fd, ev, self._readable)
         finally:
             self._cleanup()
+
+    def _bound_spin(self, started_realtime: bool) -> None:
+        """A server started real-time (``chrt``) and not switching by itself: its spin
+        holds its CPU against everything else, so it spins at most RT_SPIN_CAP_US."""
+        if self.realtime is None and started_realtime:
+            self.spin_s = min(self.spin_s, scheduling.RT_SPIN_CAP_US / 1e6)
+            self._budget = min(self._budget, self.spin_s)
 
     def _event(self, fd: int, ev: int, read: Callable[[_Client], None]) -> None:
         """One poller event: a client's (``read`` serves what it sent), a connection, the

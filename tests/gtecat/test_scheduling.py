@@ -79,6 +79,12 @@ def test_a_loop_that_never_sleeps_stays_normal_under_auto_but_a_number_is_obeyed
     assert system.calls == [("fifo", 10)]
 
 
+def test_auto_without_real_time_scheduling_runs_normally_without_a_complaint():
+    system = FakeSystem(permits=True)
+    got = take("auto", set_fifo=system.fifo, available=False)
+    assert got.priority is None and not got.refused and system.calls == []
+
+
 def test_a_number_refused_is_an_error():
     with pytest.raises(RealtimeRefused):
         take(10, set_fifo=FakeSystem(permits=False).fifo)
@@ -131,6 +137,14 @@ def test_the_controller_is_real_time_while_busy_and_then_never_spins(server, mon
     server._busy_next = 0.0  # the next look at the load is due
     assert server._spin_budget() == pytest.approx(100e-6)
     assert system.calls == [("fifo", 50), ("normal", (0, 0))]
+
+
+def test_a_server_started_real_time_spins_briefly(server):
+    """Started under chrt (no switching of its own): its spin is bounded."""
+    server._bound_spin(started_realtime=False)
+    assert server.spin_s == pytest.approx(100e-6)
+    server._bound_spin(started_realtime=True)
+    assert server.spin_s == pytest.approx(scheduling.RT_SPIN_CAP_US / 1e6)
 
 
 def test_the_controller_command_refuses_an_unreadable_setting(tmp_path, monkeypatch, capsys):
