@@ -211,7 +211,8 @@ def run(args: argparse.Namespace) -> int:
     # line says what the system permits; a refusal of a number ends the controller here),
     # then taken only while the CPUs are busy (scheduling.WhenBusy)
     normal = scheduling.snapshot()
-    if rt_setting == "auto" and scheduling.is_realtime():  # started real-time: as it is
+    started_rt = rt_setting == "auto" and scheduling.is_realtime()
+    if started_rt:  # started real-time (chrt): left as it is
         rt_setting = "off"
     try:
         taken = scheduling.take(rt_setting)
@@ -234,7 +235,7 @@ def run(args: argparse.Namespace) -> int:
             os.write(args.ready_fd, b"ready\n")
             os.close(args.ready_fd)
     else:
-        sched = taken.words
+        sched = "real-time priority as started" if started_rt else taken.words
         if taken.priority is not None:
             sched += " while the CPUs are busy"
         if taken.refused:
