@@ -110,15 +110,23 @@ MAX_PENDING = 256
 DEFAULT_SPIN_US = 100
 
 
-def _cpus_busy() -> bool:
-    """More threads runnable than this process may use CPUs (/proc/loadavg's 4th field)."""
+def _runnable_over_cpus() -> int:
+    """Threads runnable now (/proc/loadavg's 4th field, this server among them) less the
+    CPUs this process may use; 0 where it cannot be read."""
     try:
         with open("/proc/loadavg", encoding="ascii") as f:
             running = int(f.read().split()[3].split("/")[0])
         cpus = len(os.sched_getaffinity(0))
     except (OSError, ValueError, IndexError, AttributeError):
-        return False
-    return running > cpus
+        return 0
+    return running - cpus
+
+
+#: runnable threads beyond the CPUs from which the server runs real-time (Server.realtime):
+#: the server and its client count two while a client polls, so from here other programs
+#: alone can hold every CPU.  (From one on, as the spin stops, the p50 on a machine shared
+#: with lighter work rose from 10 to 24-31 us: a real-time wake-up costs more than a normal one.)
+REALTIME_OVER_CPUS = 2
 
 
 def default_spin_us() -> float:
@@ -641,16 +649,18 @@ class Server:
         c.sock.close()
 
     def _spin_budget(self) -> float:
-        """Seconds to spin for this client's next request: none while more threads are
+        """Seconds to spin for this client's next request (and, every 10 ms, the look at
+        the load that also switches :attr:`realtime`): none while more threads are
         runnable than this process has CPUs (spinning would take the CPU the client waits
         for), half the last one after a spin that found nothing (a short probe every 256
         rounds once it is none), up to ``spin_s``."""
         now = time.monotonic()
         if now >= self._busy_next:
             self._busy_next = now + 0.01
-            self._busy = _cpus_busy()
+            over = _runnable_over_cpus()
+            self._busy = over > 0
             if self.realtime is not None:
-                self.realtime.busy(self._busy)
+                self.realtime.busy(over >= REALTIME_OVER_CPUS)
         if not self.spin_s or self._busy:
             return 0.0
         if not self._budget:

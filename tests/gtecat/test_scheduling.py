@@ -129,13 +129,19 @@ def test_the_controller_is_real_time_while_busy_and_then_never_spins(server, mon
 
     system = FakeSystem(permits=True)
     server.realtime = WhenBusy(50, set_fifo=system.fifo, set_normal=system.normal, normal=(0, 0))
-    load = {"busy": True}
-    monkeypatch.setattr(server_module, "_cpus_busy", lambda: load["busy"])
-    assert server._spin_budget() == 0.0
+    load = {"over": 2}  # runnable threads beyond the CPUs
+    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
+
+    def look(over: int) -> float:
+        load["over"] = over
+        server._busy_next = 0.0  # the next look at the load is due
+        return server._spin_budget()
+
+    assert look(2) == 0.0
     assert system.calls == [("fifo", 50)]
-    load["busy"] = False
-    server._busy_next = 0.0  # the next look at the load is due
-    assert server._spin_budget() == pytest.approx(100e-6)
+    # busy, but not so busy that other programs alone hold every CPU: normal, no spin
+    assert look(1) == 0.0
+    assert look(0) == pytest.approx(100e-6)
     assert system.calls == [("fifo", 50), ("normal", (0, 0))]
 
 
