@@ -88,8 +88,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--rt-priority",
         type=_rt_priority,
         metavar="N|auto|off",
-        help="while more threads are runnable than there are CPUs, serve calls under "
-        "SCHED_FIFO priority N (1-99); auto (the default, else "
+        help="while other programs keep every CPU busy, serve calls under SCHED_FIFO "
+        "priority N (1-99); auto (the default, else "
         f"{scheduling.RT_ENV}) takes priority {scheduling.AUTO_RT_PRIORITY} where the system "
         "permits it (root or CAP_SYS_NICE), else runs normally; off never asks",
     )

@@ -28,8 +28,9 @@ Decisions:
   unless asked not to, so native clients that sleep between polls see time pass.
 * **Scheduling** (:mod:`gtecat.scheduling`): the controller process
   (``gtecat controller``, the one libgts starts) gives :attr:`Server.realtime`, and the
-  server then serves under SCHED_FIFO while more threads are runnable than there are CPUs
-  (a normal process woken then may wait for another program's time slice) and under its
+  server then serves under SCHED_FIFO while other programs could hold every CPU
+  (:data:`REALTIME_OVER_CPUS`; a normal process woken then may wait for another program's
+  time slice) and under its
   normal policy, with its spin, otherwise; it never spins while real-time.  A server inside
   another program (a test's) leaves the program's scheduling alone.
 * Every client is served independently: its bytes are buffered until a frame is whole and
