@@ -161,8 +161,8 @@ def ensure_built(target: str, *, force: bool = False) -> WindowsBuild:
     return build
 
 
-def _run(cmd: list[str], what: str) -> str:
-    r = subprocess.run(cmd, capture_output=True, text=True)
+def _run(cmd: list[str], what: str, cwd: Path | None = None) -> str:
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
     if r.returncode != 0:
         raise NativeBuildError(f"building {what} failed ({shlex.join(cmd)}):\n{r.stderr.strip()}")
     if r.stderr.strip():
@@ -209,7 +209,8 @@ def _compile(build: WindowsBuild, files: dict[str, str], cc: list[str]) -> None:
             "-l",
             str(tmp / "gts.lib"),
         ]
-        _run(cmd, what + " import library")
+        # (dlltool writes a temporary object per name into its working folder: the build's)
+        _run(cmd, what + " import library", cwd=tmp)
         out = tmp / "out"
         out.mkdir()
         for name in OUTPUTS:
