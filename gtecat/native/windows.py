@@ -30,6 +30,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import hashlib
+import os
 import re
 import shlex
 import shutil
@@ -209,8 +210,7 @@ def _compile(build: WindowsBuild, files: dict[str, str], cc: list[str]) -> None:
             "-l",
             str(tmp / "gts.lib"),
         ]
-        # (dlltool writes a temporary object per name into its working folder: the build's)
-        _run(cmd, what + " import library", cwd=tmp)
+        _import_library(cmd, what + " import library", tmp)
         out = tmp / "out"
         out.mkdir()
         for name in OUTPUTS:
@@ -223,6 +223,24 @@ def _compile(build: WindowsBuild, files: dict[str, str], cc: list[str]) -> None:
     finally:
         with contextlib.suppress(OSError):
             shutil.rmtree(tmp)
+
+
+#: a memory file system for dlltool's temporary objects, where there is one
+_SCRATCH = Path("/dev/shm")
+
+
+def _import_library(cmd: list[str], what: str, folder: Path) -> None:
+    """Run dlltool: it writes a temporary object per exported name (~2,900) into its working
+    folder, so it works in a folder of the memory file system where there is one (on a disk
+    creating and deleting them is two thirds of its time), else in the build's ``folder``."""
+    if _SCRATCH.is_dir() and os.access(_SCRATCH, os.W_OK | os.X_OK):
+        try:
+            with tempfile.TemporaryDirectory(prefix="gtecat-dlltool-", dir=_SCRATCH) as scratch:
+                _run(cmd, what, cwd=Path(scratch))
+            return
+        except (OSError, NativeBuildError):
+            pass  # full or unusable: again in the build's folder, which says why if it fails
+    _run(cmd, what, cwd=folder)
 
 
 def _decorated(target: str, cc: list[str], objs: list[str]) -> dict[str, str]:

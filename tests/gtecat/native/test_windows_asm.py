@@ -6,6 +6,7 @@ the stubs compute from the table.  The default run proves every ``N``: one C fun
 distinct list of parameter types of the table (pointers are one type), compiled by
 mingw-w64's gcc, must be decorated as the stubs decorate each function of that list.
 GTECAT_LONG=1 compares the symbols of the whole assembled unit with those of the C bodies.
+The import library's ~2,900 temporary objects go to a memory file system where there is one.
 (tests/gtecat/native/test_windows.py runs the DLLs' functions under Wine.)
 """
 
@@ -123,3 +124,19 @@ def test_without_an_assembler_the_dll_takes_the_c_bodies(monkeypatch):
     monkeypatch.setattr(windows.shutil, "which", lambda exe: None)
     fallback = windows.declared_units("x86", cc, files)
     assert fallback == [("gts_declared.c", (*windows.CFLAGS, *windows._build.STUB_CFLAGS))]
+
+
+def test_the_import_library_is_made_in_scratch_or_the_build_folder(tmp_path, monkeypatch):
+    dlltool = _tool("x86", "dlltool")
+    (tmp_path / "t.def").write_text("LIBRARY gts.dll\nEXPORTS\nGT_Open@8\n", encoding="ascii")
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    for where in (scratch, tmp_path / "missing"):  # a memory file system, or none
+        monkeypatch.setattr(windows, "_SCRATCH", where)
+        lib = tmp_path / f"{where.name}.lib"
+        cmd = [dlltool, "-k", "-d", str(tmp_path / "t.def"), "-D", "gts.dll", "-l", str(lib)]
+        windows._import_library(cmd, "gts.lib", tmp_path)
+        assert "_GT_Open@8" in _symbols("x86", lib)
+    assert not list(scratch.iterdir())  # its temporary folder gone
+    with pytest.raises(windows.NativeBuildError, match=r"gts\.lib failed"):
+        windows._import_library([dlltool, "-d", str(tmp_path / "none.def")], "gts.lib", tmp_path)
