@@ -52,6 +52,7 @@ status cycle by cycle).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import compress
 from typing import TYPE_CHECKING, Any
@@ -597,6 +598,8 @@ class AxisBank:
         self.lvel = zi(n, np.uint8)
         #: the bank-aware axis hooks of a claimed row (:meth:`_axis_hooks`), told at its release
         self._aware: dict[int, list[Any]] = {}
+        #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
+        self._stepping = -1
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
         self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
@@ -725,8 +728,9 @@ class AxisBank:
                 return False
         return st
 
-    def _eligible(self, r: int) -> bool:
-        """The scalar state the bank reproduces (module docstring)."""
+    def _eligible(self, r: int, drive: bool = True) -> bool:
+        """The scalar state the bank reproduces (module docstring); ``drive`` False: the
+        drive's own conditions left out (a claimed row whose drive stays in the bank)."""
         ax = self.axes[r]
         res = self.res[r]
         if res is None or ax.number in self.held or res.bank_hold:
@@ -772,7 +776,7 @@ class AxisBank:
             return False
         if not self._inputs_plain(ax, res):
             return False
-        return not claimable(self.csp.channels[r])
+        return not drive or not claimable(self.csp.channels[r])
 
     @staticmethod
     def _latched_standing(ax: Any, res: Any) -> bool:
@@ -1330,6 +1334,14 @@ class AxisBank:
         if self.n_alive and res.bank is self:
             self.release_axis_object(ax)
 
+    def watch_grew(self, ax: Any) -> None:
+        """A bank-aware hook of ``ax`` watches more 60FDh bits (:attr:`dwatch`, read at a
+        claim): a claimed row goes back, but the row a step runs on in place, which is
+        taken up again after the step (:meth:`step_claimed`)."""
+        r = self._row_of.get(id(ax))
+        if r is not None and r != self._stepping:
+            self.release_axis_object(ax)
+
     def release_axis_object(self, ax: Any) -> None:
         r = self._row_of.get(id(ax))
         if r is not None and self.alive[r]:
@@ -1412,11 +1424,17 @@ class AxisBank:
         self.n_alive = int(np.count_nonzero(self.alive))
 
     def _store(self, r: int) -> None:
-        ax, res = self.axes[r], self.res[r]
         self.alive[r] = False
         self.claim_ids[r] = 0
-        res.bank = None
+        self.res[r].bank = None
         self.layout += 1
+        if r != self._stepping:  # (a row stepped in place: its objects hold its state)
+            self._put_back(r)
+
+    def _put_back(self, r: int) -> None:
+        """Row ``r``'s state into its axis objects (its drive aside), as a release leaves them
+        (:attr:`_last` and :attr:`_rates` hold its planned values and encoder rates)."""
+        ax, res = self.axes[r], self.res[r]
         a = float(self.a_last[r])
         ax.prf_pos = a
         res._a_last = a
@@ -1989,6 +2007,95 @@ class AxisBank:
         gs = {self.group_of[r] for r in rows.tolist()}
         self._release_groups([self.groups[g] for g in sorted(gs)])
         self._reindex()
+
+    # --- a hook's step on a claimed row -----------------------------------------------------
+    def step_claimed(self, r: int, step: Callable[[], None]) -> None:
+        """Run ``step`` (a smart homing's step after a cycle, which reads and changes the
+        axis's objects) on row ``r`` exactly as a release before it and a claim after it
+        would, without giving the drive back: the row's state goes into its axis, planner,
+        encoder and band objects and is taken from them again (as a release and a claim do
+        it), those four objects lose their guards for the step, and after it the row takes
+        them up again (a new Trap move, flags cleared) when it is still what
+        :meth:`_eligible` asks for, else it goes back as at any release.  The drive's objects
+        keep their guards: a step that reaches them (an SDO to the drive) gives the row back
+        then.  A row of a drive with several channels, of a cluster or not in a plain Trap
+        or standing state simply goes back (the step runs on the scalar objects)."""
+        g = self.groups[self.group_of[r]]
+        if (
+            not self.alive[r]
+            or len(g.rows) != 1
+            or self.sampled[r]
+            or self.jog[r]
+            or self.hm[r]
+            or self.frz[r]
+        ):
+            step()
+            return
+        ax, res = self.axes[r], self.res[r]
+        prof = res.profile
+        pl = prof.planner
+        objs = (ax, pl, res.encoder, res.band)
+        _Bypass.on = True
+        try:
+            self._last = {r: self._planned_row(r)}
+            self._rates = {r: self._enc_rates_row(r)}
+            self._put_back(r)
+            aware = self._aware.pop(r, None)
+            if aware:  # (as at a release: the hooks catch up with the cycles the bank ran)
+                ran = int(self.bank_cycles - self.claim_cycle[r])
+                for obj in aware:
+                    obj.bank_released(ran)
+        finally:
+            _Bypass.on = False
+        for obj in objs:
+            cls = type(obj)
+            if _GUARDS.get(cls.__mro__[1]) is cls:
+                _set(obj, "__class__", cls.__mro__[1])
+        # the objects hold the row's state now: a release (within the step or after it)
+        # leaves them as they are
+        self._stepping = r
+        try:
+            self._step_claimed(r, g, step, pl, objs)
+        finally:
+            self._stepping = -1
+
+    def _step_claimed(
+        self, r: int, g: _Group, step: Callable[[], None], pl: Any, objs: tuple
+    ) -> None:
+        ok = False
+        try:
+            step()
+            if not g.claimed:
+                return  # the step reached the drive: given back
+            _Bypass.on = True
+            try:
+                ok = self.res[r].profile.planner is pl and self._eligible(r, drive=False)
+                if ok:
+                    self._load(r)
+                    ok = not (self.jog[r] or self.hm[r] or self.frz[r])
+            finally:
+                _Bypass.on = False
+        finally:
+            if g.claimed and not ok:
+                _OWNER.pop(id(pl), None)  # (another planner: the release looks at that one)
+                self._release_groups([g])
+        if not ok:
+            return
+        for obj in objs:
+            _set(obj, "__class__", _guard_class(type(obj)))
+            own_dict(obj)
+        # what _reindex counts and that a new move or the flags taken again may change
+        alive, moving = self.alive, self.moving
+        self.n_moving = int(np.count_nonzero(moving & alive))
+        self._refill_in = 0
+        self._c_fill = self.kernel is not None and not np.count_nonzero(
+            moving & alive & (self.nseg <= 0)
+        )
+        self._count_standing()
+        self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
+        self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
+        self.band_dirty = True
+        self._lists.clear()
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

@@ -259,7 +259,7 @@ class CaptureUnit:
         claim watches it)."""
         bank = self.res.bank
         if bank is not None:
-            bank.release_axis_object(self.ax)
+            bank.watch_grew(self.ax)
 
     def bank_ready(self) -> bool:
         """The next cycles' :meth:`_post` can find an edge only where the home input changes

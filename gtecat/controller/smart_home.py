@@ -1003,7 +1003,11 @@ class _Homings:
                     home._q_claim = 0
                     d = t_next
                     if step:
-                        home.cycle()
+                        if bank is not None and home.res.bank is bank:
+                            # its row stays claimed (a release and a claim, the drive kept)
+                            bank.step_claimed(home.res.bank_row, home.cycle)
+                        else:
+                            home.cycle()
                         if not home.running:
                             self.running.remove(home)
                             continue
