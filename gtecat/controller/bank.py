@@ -54,7 +54,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from itertools import compress
+from itertools import chain, compress
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -243,6 +243,9 @@ class _Bypass:
 
 
 _OWNER: dict[int, tuple[AxisBank, int]] = {}  # id(object) -> (bank, group index)
+#: id() of the objects given a dict of their own at a claim (it stays theirs: an id used
+#: again by a later object only costs that object its quick attribute reads)
+_OWN_DICT: set[int] = set()
 _GUARDS: dict[type, type] = {}
 _get, _set = object.__getattribute__, object.__setattr__
 
@@ -1051,9 +1054,12 @@ class AxisBank:
         self._g_claimed[gi] = True
         self._loaded = True
         for obj in self._guarded_objects(g):
-            _OWNER[id(obj)] = (self, gi)
+            key = id(obj)
+            _OWNER[key] = (self, gi)
             _set(obj, "__class__", _guard_class(type(obj)))
-            own_dict(obj)  # (a class assigned: see gtecat._attrs)
+            if key not in _OWN_DICT:  # (a class assigned: see gtecat._attrs; once is enough)
+                _OWN_DICT.add(key)
+                own_dict(obj)
         return True
 
     def _guarded_objects(self, g: _Group) -> list[object]:
@@ -1136,7 +1142,8 @@ class AxisBank:
         self.nseg[r] = 0
         if moving and not sampled and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
             m = len(pl._segs)
-            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = np.array(pl._segs, np.float64).ravel()
+            # (a flat list: numpy takes it several times faster than the list of tuples)
+            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = list(chain.from_iterable(pl._segs))
             self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
                 pl._t_done,
                 pl._ts,
@@ -2081,9 +2088,8 @@ class AxisBank:
                 self._release_groups([g])
         if not ok:
             return
-        for obj in objs:
+        for obj in objs:  # (their dicts are their own since their claim)
             _set(obj, "__class__", _guard_class(type(obj)))
-            own_dict(obj)
         # what _reindex counts and that a new move or the flags taken again may change
         alive, moving = self.alive, self.moving
         self.n_moving = int(np.count_nonzero(moving & alive))
