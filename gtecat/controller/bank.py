@@ -349,6 +349,12 @@ class AxisBank:
         self.n = 0
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
+        #: the rows whose hooks took a watched input's edge after the last cycle
+        #: (:meth:`_post_events`; cleared at the next): their smart homings step after it
+        self.evt_rows: set[int] = set()
+        self.any_post = False
+        #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
+        self._stepping = -1
         self._lists: dict[str, list[Any]] = {}
         #: counts the claims and releases of rows (an axis's resources point at the bank or
         #: not): what the GT readers' plans of many axes at once check (gtecat.gt.fast)
@@ -596,13 +602,15 @@ class AxisBank:
         #: 60FDh bits whose change sends a row back before the cycle (an input a bank-aware
         #: hook samples every cycle: a capture unit's home input)
         self.dwatch = zi(n, np.int64)
+        #: the same bits where the hooks take the edge after the cycle (bank_post_ready): the
+        #: cycle runs in the bank, then they do (:meth:`_post_events`)
+        self.dpost = zi(n, np.int64)
         #: a row moving in Trap with a limit flag latched: bit 0 positive, bit 1 negative;
         #: a sample toward that side sends it back before the cycle (AxisResources._post)
         self.lvel = zi(n, np.uint8)
         #: the bank-aware axis hooks of a claimed row (:meth:`_axis_hooks`), told at its release
         self._aware: dict[int, list[Any]] = {}
-        #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
-        self._stepping = -1
+
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
         self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
@@ -639,6 +647,7 @@ class AxisBank:
         self.n_rest = int(np.count_nonzero(self.h_done & alive)) if self.n_hm else 0
         self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
+        self.any_post = bool(np.count_nonzero(self.dpost[alive]))
         self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
         self.band_dirty = True
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
@@ -1082,6 +1091,7 @@ class AxisBank:
         for obj in aware:
             watch |= obj.bank_watch
         self.dwatch[r] = watch
+        self.dpost[r] = 0
         if aware:
             self._aware[r] = aware
         latched = res.latched
@@ -1194,6 +1204,17 @@ class AxisBank:
             # 6041h: the state bits and remote, step_hm's bits instead of CSP's (oms =
             # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
             self.csp.sw_const[r] += ch.hm_bits - SW12
+            return
+        watch = int(self.dwatch[r])
+        if (
+            watch
+            and not self.sampled[r]
+            and not self.jog[r]
+            and len(self.groups[self.group_of[r]].rows) == 1
+            and all(obj.bank_post_ready() for obj in aware if obj.bank_watch)
+        ):
+            # its hooks take such an edge after the cycle, the row staying (:meth:`_post_events`)
+            self.dwatch[r], self.dpost[r] = 0, watch
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
         """A moving row leaves: remember its table (its samples stay in ``t_p``/``t_v``/``t_a``
@@ -1670,6 +1691,8 @@ class AxisBank:
 
     def cycle(self, t_ns: int, dt_ns: int) -> None:
         """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        if self.evt_rows:
+            self.evt_rows.clear()
         if self._settled:
             self._settled = False  # its first steps ran just before (settle)
         else:
@@ -1699,6 +1722,10 @@ class AxisBank:
                     rc = k.cycle(t_ns, dt)
                 if rc == 0:
                     self._after_kernel(k)
+                    if self.any_post:
+                        evt = k.scratch["s_evt"]
+                        if np.count_nonzero(evt):
+                            self._post_events(np.flatnonzero(evt).tolist(), t_ns, dt_ns)
                     return
                 # declined: the numpy cycle looks at every table (the kernel may have
                 # refilled some, or left one for it: code 4)
@@ -1759,6 +1786,7 @@ class AxisBank:
             hit |= (din & 3) != 0
         if self.any_watch:  # an input a bank-aware hook samples changes (kernel: dwatch)
             hit |= ((din ^ csp.din) & self.dwatch) != 0
+        evt = ((din ^ csp.din) & self.dpost) != 0 if self.any_post else None
         if self.any_lvel:  # a sample toward a latched limit (kernel: lvel)
             v = self.prf_ratio * self.t_v.take(idx)
             hit |= ((self.lvel & 1) != 0) & (v > 0.0) | ((self.lvel & 2) != 0) & (v < 0.0)
@@ -1846,6 +1874,8 @@ class AxisBank:
             cols.append(csp.output(name, state))
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
+        if evt is not None and np.count_nonzero(evt & self.alive):
+            self._post_events(np.flatnonzero(evt & self.alive).tolist(), t_ns, dt_ns)
 
     def run_cycles(self, t_ns: int, dt_ns: int, n: int) -> int:
         """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
@@ -1858,6 +1888,8 @@ class AxisBank:
         k = self.kernel
         if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
             return 0
+        if self.evt_rows:
+            self.evt_rows.clear()
         dt = dt_ns * 1e-9
         if dt != self.csp._dt:
             return 0
@@ -2061,6 +2093,7 @@ class AxisBank:
         # the objects hold the row's state now: a release (within the step or after it)
         # leaves them as they are
         self._stepping = r
+        self.evt_rows.discard(r)  # (its step takes the edge its hooks took)
         try:
             self._step_claimed(r, g, step, pl, objs)
         finally:
@@ -2097,11 +2130,49 @@ class AxisBank:
         self._c_fill = self.kernel is not None and not np.count_nonzero(
             moving & alive & (self.nseg <= 0)
         )
+        self._after_loads()
+
+    def _after_loads(self) -> None:
+        """What :meth:`_reindex` counts that loading claimed rows again in place may change
+        (a new move, the flags and watched inputs taken again; the claimed set stays)."""
+        alive, moving = self.alive, self.moving
+        self.n_moving = int(np.count_nonzero(moving & alive))
+        self._refill_in = 0
+        self._c_fill = self.kernel is not None and not np.count_nonzero(
+            moving & alive & (self.nseg <= 0)
+        )
         self._count_standing()
         self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
+        self.any_post = bool(np.count_nonzero(self.dpost[alive]))
         self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
         self.band_dirty = True
         self._lists.clear()
+
+    def _post_events(self, rows: list[int], t_ns: int, dt_ns: int) -> None:
+        """After a committed cycle in which a watched input of ``rows`` changed (:attr:`dpost`):
+        each row's state into its axis objects (as at a release), its hooks catch up with the
+        cycles before and take this cycle's edge (``bank_posted``), and the row is taken up
+        again from the objects (as at a claim; the drive stays).  The result is the scalar
+        path's, which ran this cycle on the objects: the bank's cycle is theirs, and the
+        hooks' cycle is what the objects' one would have been."""
+        _Bypass.on = True
+        try:
+            for r in rows:
+                self._last = {r: self._planned_row(r)}
+                self._rates = {r: self._enc_rates_row(r)}
+                self._put_back(r)
+                ran = int(self.bank_cycles - self.claim_cycle[r])
+                post = int(self.dpost[r])
+                for obj in self._aware.pop(r, ()):
+                    if obj.bank_watch & post:
+                        obj.bank_posted(ran, t_ns, dt_ns)
+                    else:
+                        obj.bank_released(ran)
+                self._load(r)
+                self.evt_rows.add(r)
+        finally:
+            _Bypass.on = False
+        self._after_loads()
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

@@ -306,6 +306,20 @@ class CaptureUnit:
             if backend is not None:
                 backend.uploads_answered(slave, cycles)
 
+    def bank_post_ready(self) -> bool:
+        """The edge of a watched input (:attr:`bank_watch`) may be taken after a cycle the bank
+        ran (:meth:`bank_posted`) instead of in a cycle of the scalar objects: the edge is
+        what 60FDh in the image and the encoder show, and this cycle's :meth:`_post` reads
+        nothing else - no card latch, the touch probe off."""
+        return self._card_edges is None and not (self._tp_want or self._tp_sent)
+
+    def bank_posted(self, cycles: int, t_ns: int, dt_ns: int) -> None:
+        """The bank ran ``cycles`` cycles of the axis, the last of which changed a watched
+        input (its objects hold that cycle's state): the ones before as
+        :meth:`bank_released` leaves them (no edge; the touch probe is off), then the last
+        one's :meth:`_post`."""
+        self._post(self.ax, t_ns, dt_ns)
+
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
         enc = self.res.encoder

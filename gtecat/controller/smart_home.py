@@ -464,8 +464,8 @@ class SmartHome:
         if res.bank is not bank:
             return None
         r = res.bank_row
-        if not (bank.alive[r] and bank.moving[r]):
-            return None
+        if not (bank.alive[r] and bank.moving[r]) or r in bank.evt_rows:
+            return None  # (evt_rows: the bank ran a cycle that changed an input it watches)
         # what a call may have changed since the last step (a call gives the axis back
         # first, and the bank may take it again before the next cycle): as the step saw it
         if res.latched != self._seen_latched or res.stops != self._stops:
@@ -964,7 +964,8 @@ class _Homings:
             return
         bank = ctl.bank
         if bank is not None and self._seen == bank.releases and t < self._due:
-            return  # nothing to do for any of them in this cycle
+            if not bank.evt_rows:
+                return  # nothing to do for any of them in this cycle
         self._settle(bank, t + dt, step=True)
 
     def quiet_cycles(self, n: int) -> int:
