@@ -226,6 +226,12 @@ _ALARM = int(AxisStatus.ALARM)
 _POS_LIMIT = int(AxisStatus.POSITIVE_LIMIT)
 _NEG_LIMIT = int(AxisStatus.NEGATIVE_LIMIT)
 _SW_FAULT = 0x0008  # 6041h bit 3: fault
+#: dpost: the drive's touch probe takes an edge of a cycle's travel after that cycle
+#: (bank_kernel.c TP_POST; far above 60FDh's 32 bits)
+TP_POST = 1 << 62
+#: the touch probe's TxPDO objects: a row whose drive maps one keeps giving its row back
+#: before a probe edge (the bank leaves them in the image as they are)
+_TP_TX = (0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, *range(0x60D1, 0x60D9))
 
 
 #: the modes whose planners a cluster steps ahead (gtecat.controller.bank_modes)
@@ -1206,14 +1212,18 @@ class AxisBank:
             self.csp.sw_const[r] += ch.hm_bits - SW12
             return
         watch = int(self.dwatch[r])
+        tp = bool(self.csp.tpw[r])
         if (
-            watch
+            (watch or tp)
             and not self.sampled[r]
             and not self.jog[r]
             and len(self.groups[self.group_of[r]].rows) == 1
-            and all(obj.bank_post_ready() for obj in aware if obj.bank_watch)
+            and all(obj.bank_post_ready() for obj in aware)
         ):
-            # its hooks take such an edge after the cycle, the row staying (:meth:`_post_events`)
+            # its hooks (and its drive's probe) take such an edge after the cycle, the row
+            # staying (:meth:`_post_events`)
+            if tp and not any(ax.io.get(i) is not None for i in _TP_TX):
+                watch |= TP_POST
             self.dwatch[r], self.dpost[r] = 0, watch
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
@@ -1725,7 +1735,8 @@ class AxisBank:
                     if self.any_post:
                         evt = k.scratch["s_evt"]
                         if np.count_nonzero(evt):
-                            self._post_events(np.flatnonzero(evt).tolist(), t_ns, dt_ns)
+                            rows = np.flatnonzero(evt).tolist()
+                            self._post_events(rows, t_ns, dt_ns, k.scratch["s_p0"])
                     return
                 # declined: the numpy cycle looks at every table (the kernel may have
                 # refilled some, or left one for it: code 4)
@@ -1792,8 +1803,20 @@ class AxisBank:
             hit |= ((self.lvel & 1) != 0) & (v > 0.0) | ((self.lvel & 2) != 0) & (v < 0.0)
         hit |= a < self.soft_neg
         hit |= np.abs(err) > self.pos_err
+        p0 = None
         if events is not None:
-            hit |= events
+            tp_edge = csp.tp_edge
+            post = None
+            if self.any_post and tp_edge is not None:
+                post = tp_edge & ((self.dpost & TP_POST) != 0)
+            if post is None or not np.count_nonzero(post):
+                hit |= events
+            else:  # the probe takes these edges after the cycle (_post_events)
+                if csp.fe_event is not None:
+                    hit |= csp.fe_event
+                hit |= tp_edge & ~post
+                evt = post if evt is None else evt | post
+                p0 = csp.pos.copy()
         if np.count_nonzero(huge):
             hit |= huge
         # 6. the in-position band (bit 11)
@@ -1875,7 +1898,8 @@ class AxisBank:
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
         if evt is not None and np.count_nonzero(evt & self.alive):
-            self._post_events(np.flatnonzero(evt & self.alive).tolist(), t_ns, dt_ns)
+            rows = np.flatnonzero(evt & self.alive).tolist()
+            self._post_events(rows, t_ns, dt_ns, p0)
 
     def run_cycles(self, t_ns: int, dt_ns: int, n: int) -> int:
         """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
@@ -2148,26 +2172,36 @@ class AxisBank:
         self.band_dirty = True
         self._lists.clear()
 
-    def _post_events(self, rows: list[int], t_ns: int, dt_ns: int) -> None:
-        """After a committed cycle in which a watched input of ``rows`` changed (:attr:`dpost`):
-        each row's state into its axis objects (as at a release), its hooks catch up with the
-        cycles before and take this cycle's edge (``bank_posted``), and the row is taken up
-        again from the objects (as at a claim; the drive stays).  The result is the scalar
-        path's, which ran this cycle on the objects: the bank's cycle is theirs, and the
-        hooks' cycle is what the objects' one would have been."""
+    def _post_events(
+        self, rows: list[int], t_ns: int, dt_ns: int, p0: np.ndarray | None = None
+    ) -> None:
+        """After a committed cycle in which a watched input of ``rows`` changed, or their
+        travel reached an edge of their drive's touch probe (:attr:`dpost`; ``p0``: where
+        each row's travel started): the drive's probe takes the edge (TouchProbe.step, as the
+        drive's own step ends; its bounds follow), each row's state goes into its axis objects
+        (as at a release), its hooks catch up with the cycles before and run this one
+        (``bank_posted``: the capture unit reads the probe as its cycle does), and the row is
+        taken up again from the objects (as at a claim; the drive stays).  The result is the
+        scalar path's, which ran this cycle on the objects: the bank's cycle is theirs, and
+        the probe's and the hooks' part of it is what the objects' one would have been."""
+        csp = self.csp
         _Bypass.on = True
         try:
             for r in rows:
+                if p0 is not None and self.dpost[r] & TP_POST:
+                    ch = csp.channels[r]
+                    probe = ch.probe
+                    a, b = float(p0[r]), float(csp.pos[r])
+                    if probe.function:
+                        off = ch.enc_offset
+                        probe.step(a, b, a - off, b - off, t_ns, dt_ns)
+                    csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
                 self._last = {r: self._planned_row(r)}
                 self._rates = {r: self._enc_rates_row(r)}
                 self._put_back(r)
                 ran = int(self.bank_cycles - self.claim_cycle[r])
-                post = int(self.dpost[r])
                 for obj in self._aware.pop(r, ()):
-                    if obj.bank_watch & post:
-                        obj.bank_posted(ran, t_ns, dt_ns)
-                    else:
-                        obj.bank_released(ran)
+                    obj.bank_posted(ran, t_ns, dt_ns)
                 self._load(r)
                 self.evt_rows.add(r)
         finally:

@@ -307,17 +307,24 @@ class CaptureUnit:
                 backend.uploads_answered(slave, cycles)
 
     def bank_post_ready(self) -> bool:
-        """The edge of a watched input (:attr:`bank_watch`) may be taken after a cycle the bank
-        ran (:meth:`bank_posted`) instead of in a cycle of the scalar objects: the edge is
-        what 60FDh in the image and the encoder show, and this cycle's :meth:`_post` reads
-        nothing else - no card latch, the touch probe off."""
-        return self._card_edges is None and not (self._tp_want or self._tp_sent)
+        """An edge of a watched input (:attr:`bank_watch`) or of the drive's touch probe may
+        be taken after a cycle the bank ran (:meth:`bank_posted`) instead of in a cycle of the
+        scalar objects: this cycle's :meth:`_post` then reads what the image's 60FDh, the
+        encoder and the drive's probe (its objects, as the bank leaves them) show - no card
+        latch, nothing of the probe being written."""
+        return self._card_edges is None and not self._tp_pending and self._tp_want == self._tp_sent
 
     def bank_posted(self, cycles: int, t_ns: int, dt_ns: int) -> None:
         """The bank ran ``cycles`` cycles of the axis, the last of which changed a watched
-        input (its objects hold that cycle's state): the ones before as
-        :meth:`bank_released` leaves them (no edge; the touch probe is off), then the last
+        input or reached an edge of the drive's probe (its objects hold that cycle's state):
+        the ones before as :meth:`bank_released` leaves them (no edge: what changed was
+        watched, and the rest nobody reads; the 60B9h reads by SDO counted), then the last
         one's :meth:`_post`."""
+        backend, slave = self._tp_uploads
+        if backend is not None and cycles > 1:
+            backend.uploads_answered(slave, cycles - 1)
+        if not self.bank_watch:
+            self._home_prev = self.home_level()  # (an unwatched level: taken up, no edge)
         self._post(self.ax, t_ns, dt_ns)
 
     # --- the cycle ---------------------------------------------------------------------------

@@ -21,7 +21,8 @@
  * the negative; AxisResources._post stops such a motion) leave the bank before that cycle;
  * a change of the bits in dpost (the home input of a capture unit that can take the edge
  * after the cycle) is committed with the cycle and marked in s_evt for the caller (a run of
- * many cycles ends before it, as before the others).
+ * many cycles ends before it, as before the others).  A touch probe edge of a row whose
+ * dpost has TP_POST is committed and marked the same way (s_p0: where the travel started).
  * A third follows the drive's touch probe: a row whose probe is armed (c_tpw) leaves before
  * a cycle whose travel reaches c_tp_lo or c_tp_hi, the nearest edges the probe latches, so
  * that the drive's TouchProbe.step of every cycle the bank runs finds nothing.
@@ -80,7 +81,8 @@
     X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
     X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
     X(c_tpw, u8) X(c_tp_lo, f64) X(c_tp_hi, f64)                                           \
-    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64) X(dpost, i64) X(s_evt, u8)
+    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64) X(dpost, i64) X(s_evt, u8)   \
+    X(s_p0, f64)
 
 enum {
 #define X(name, type) F_##name,
@@ -94,6 +96,8 @@ enum {
     IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN,
     IN_TABLE, IN_MAXC, IN_DT_NS, OUT_DONE, OUT_FILLED, N_IO
 };
+/* dpost: the drive's touch probe takes an edge of the cycle's travel after the cycle */
+#define TP_POST ((int64_t)1 << 62)
 /* the segments a row's Trap move may hold for the kernel to fill its table itself */
 #define MAXSEG 16
 /* tprm per row: t_done, ts, t_final, target, dir, the planner's cycle (ms) */
@@ -853,8 +857,15 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             else
                 hit = 1; /* (a run of many cycles ends before it) */
         }
-        if (U8(c_tpw)[r] && pos != F64(c_pos)[r] && !tp_inside(ptr, r, F64(c_pos)[r], pos))
-            hit = 1; /* the travel reaches an edge the touch probe latches */
+        if (U8(c_tpw)[r] && pos != F64(c_pos)[r] && !tp_inside(ptr, r, F64(c_pos)[r], pos)) {
+            /* the travel reaches an edge the touch probe latches: the drive's probe takes it
+             * after the cycle where dpost says so (TP_POST), else the row leaves first */
+            if (post && (I64(dpost)[r] & TP_POST))
+                s_evt[r] = 1;
+            else
+                hit = 1;
+        }
+        F64(s_p0)[r] = F64(c_pos)[r]; /* (the travel's start, for the caller's probe) */
         if (hm[r]) /* AxisResources._post of an axis not in CSP: the plan follows 6064h */
             a = (double)((int64_t)(int32_t)(uint32_t)(uint64_t)pa - I64(drive_offset)[r]) /
                 F64(unit2)[r];
