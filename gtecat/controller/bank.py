@@ -361,6 +361,7 @@ class AxisBank:
         self.any_post = False
         #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
         self._stepping = -1
+        self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._lists: dict[str, list[Any]] = {}
         #: counts the claims and releases of rows (an axis's resources point at the bank or
         #: not): what the GT readers' plans of many axes at once check (gtecat.gt.fast)
@@ -450,6 +451,7 @@ class AxisBank:
     def _build(self) -> None:
         """Rows for every axis whose slave the bank can run (mapping and backend)."""
         self.built = True
+        self._tp_map = {}
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -1089,7 +1091,9 @@ class AxisBank:
                 out.append(_get(ch, "probe"))  # (its source, function or values touched)
         return out
 
-    def _load(self, r: int) -> None:
+    def _load(self, r: int, again: bool = False) -> None:
+        """Take row ``r`` from its objects; ``again``: a row loaded before whose scale, links,
+        limits and encoder settings nothing changed since (a step in place)."""
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = True
         aware = aware_hooks(ax)
@@ -1104,20 +1108,22 @@ class AxisBank:
         self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
         self.layout += 1
-        s = ax.pos_scale
-        self.unit2[r] = float(1 << s)
-        self.unit[r] = 1.0 / (1 << s)
-        self.drive_offset[r] = ax.drive_offset
-        self.prf_ratio[r], self.prf_off[r] = res.prf_link.ratio, res.prf_link.offset
-        self.enc_ratio[r], self.enc_off[r] = res.enc_link.ratio, res.enc_link.offset
-        sf = res.safety
-        on = sf.active
-        self.soft_pos[r] = sf.soft_positive if on else np.inf
-        self.soft_neg[r] = sf.soft_negative if on else -np.inf
-        self.pos_err[r] = sf.pos_err if on else np.inf
+        if not again:
+            s = ax.pos_scale
+            self.unit2[r] = float(1 << s)
+            self.unit[r] = 1.0 / (1 << s)
+            self.drive_offset[r] = ax.drive_offset
+            self.prf_ratio[r], self.prf_off[r] = res.prf_link.ratio, res.prf_link.offset
+            self.enc_ratio[r], self.enc_off[r] = res.enc_link.ratio, res.enc_link.offset
+            sf = res.safety
+            on = sf.active
+            self.soft_pos[r] = sf.soft_positive if on else np.inf
+            self.soft_neg[r] = sf.soft_negative if on else -np.inf
+            self.pos_err[r] = sf.pos_err if on else np.inf
         enc = res.encoder
-        self.external[r] = enc.external
-        self.sense[r] = enc.sense
+        if not again:
+            self.external[r] = enc.external
+            self.sense[r] = enc.sense
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
@@ -1222,9 +1228,17 @@ class AxisBank:
         ):
             # its hooks (and its drive's probe) take such an edge after the cycle, the row
             # staying (:meth:`_post_events`)
-            if tp and not any(ax.io.get(i) is not None for i in _TP_TX):
+            if tp and not self._tp_mapped(r):
                 watch |= TP_POST
             self.dwatch[r], self.dpost[r] = 0, watch
+
+    def _tp_mapped(self, r: int) -> bool:
+        """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""
+        got = self._tp_map.get(r)
+        if got is None:
+            io = self.axes[r].io
+            got = self._tp_map[r] = any(io.get(i) is not None for i in _TP_TX)
+        return got
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
         """A moving row leaves: remember its table (its samples stay in ``t_p``/``t_v``/``t_a``
@@ -2127,6 +2141,7 @@ class AxisBank:
         self, r: int, g: _Group, step: Callable[[], None], pl: Any, objs: tuple
     ) -> None:
         ok = False
+        was_moving = bool(self.moving[r])
         try:
             step()
             if not g.claimed:
@@ -2135,7 +2150,7 @@ class AxisBank:
             try:
                 ok = self.res[r].profile.planner is pl and self._eligible(r, drive=False)
                 if ok:
-                    self._load(r)
+                    self._load(r, again=True)
                     ok = not (self.jog[r] or self.hm[r] or self.frz[r])
             finally:
                 _Bypass.on = False
@@ -2147,28 +2162,26 @@ class AxisBank:
             return
         for obj in objs:  # (their dicts are their own since their claim)
             _set(obj, "__class__", _guard_class(type(obj)))
-        # what _reindex counts and that a new move or the flags taken again may change
-        alive, moving = self.alive, self.moving
-        self.n_moving = int(np.count_nonzero(moving & alive))
-        self._refill_in = 0
-        self._c_fill = self.kernel is not None and not np.count_nonzero(
-            moving & alive & (self.nseg <= 0)
-        )
-        self._after_loads()
+        self._after_load(r, was_moving)
 
-    def _after_loads(self) -> None:
-        """What :meth:`_reindex` counts that loading claimed rows again in place may change
-        (a new move, the flags and watched inputs taken again; the claimed set stays)."""
-        alive, moving = self.alive, self.moving
-        self.n_moving = int(np.count_nonzero(moving & alive))
+    def _after_load(self, r: int, was_moving: bool) -> None:
+        """What :meth:`_reindex` counts that loading claimed row ``r`` again in place may
+        change (a new move, the flags and watched inputs taken again; the claimed set stays).
+        A flag "some row has it" may stay set for a row that no longer has it: it only
+        makes the numpy cycle look (and find nothing)."""
+        moving = bool(self.moving[r])
+        self.n_moving += moving - was_moving
         self._refill_in = 0
-        self._c_fill = self.kernel is not None and not np.count_nonzero(
-            moving & alive & (self.nseg <= 0)
-        )
-        self._count_standing()
-        self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
-        self.any_post = bool(np.count_nonzero(self.dpost[alive]))
-        self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
+        if self.kernel is not None:
+            if not self._c_fill:
+                self._c_fill = not np.count_nonzero(self.moving & self.alive & (self.nseg <= 0))
+            elif moving and self.nseg[r] <= 0:
+                self._c_fill = False
+        if self.any_band:
+            self._count_standing()
+        self.any_watch = self.any_watch or bool(self.dwatch[r])
+        self.any_post = self.any_post or bool(self.dpost[r])
+        self.any_lvel = self.any_lvel or bool(self.lvel[r])
         self.band_dirty = True
         self._lists.clear()
 
@@ -2202,11 +2215,12 @@ class AxisBank:
                 ran = int(self.bank_cycles - self.claim_cycle[r])
                 for obj in self._aware.pop(r, ()):
                     obj.bank_posted(ran, t_ns, dt_ns)
-                self._load(r)
+                was_moving = bool(self.moving[r])
+                self._load(r, again=True)
+                self._after_load(r, was_moving)
                 self.evt_rows.add(r)
         finally:
             _Bypass.on = False
-        self._after_loads()
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

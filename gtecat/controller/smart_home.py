@@ -944,6 +944,8 @@ class _Homings:
         self.running: list[SmartHome] = []
         self._due = 0
         self._seen = -1
+        #: the last look found a homing that steps every cycle (:meth:`quiet_cycles`)
+        self._stepping = True
 
     def add(self, home: SmartHome) -> None:
         if home not in self.running:
@@ -978,6 +980,14 @@ class _Homings:
         bank = ctl.bank
         t0, dt = ctl.clock.now_ns, ctl.clock.cycle_ns
         if bank is None or self._seen != bank.releases or t0 >= self._due:
+            if (
+                t0 == self._due
+                and not self._stepping
+                and bank is not None
+                and self._seen == bank.releases
+                and not bank.evt_rows
+            ):
+                return 0  # a homing found quiet up to this cycle steps after it: as found
             self._settle(bank, t0, step=False)
         return min(n, max(0, -((t0 - self._due) // dt)))
 
@@ -989,6 +999,7 @@ class _Homings:
         ids = bank.claim_ids if bank is not None else ()
         t_prev = t_next - dt
         due = None
+        stepping = False  # some homing steps every cycle (not found quiet)
         for home in list(self.running):
             d = home._q_due
             if not (
@@ -1003,6 +1014,7 @@ class _Homings:
                 if q is None:
                     home._q_claim = 0
                     d = t_next
+                    stepping = True
                     if step:
                         if bank is not None and home.res.bank is bank:
                             # its row stays claimed (a release and a claim, the drive kept)
@@ -1019,6 +1031,7 @@ class _Homings:
             if due is None or d < due:
                 due = d
         self._due = t_next if due is None else due
+        self._stepping = stepping
         # a step that gave an axis back may have changed another homing's axis: look again
         self._seen = seen if bank is not None and bank.releases == seen else -1
 
