@@ -405,6 +405,11 @@ class AxisBank:
         #: of those, the cycles of drives resting in homing mode after their homing
         self.rest_rows_run = 0
         self.n_rest = 0
+        #: smart-homing steps run on a claimed row in place (:meth:`step_claimed`), and the
+        #: edges taken after a bank cycle (:meth:`_post_events`): a watched input's, a touch
+        #: probe's (statistics; the differential tests check they ran)
+        self.steps_in_place = 0
+        self.posted_inputs = self.posted_probes = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
@@ -2160,6 +2165,7 @@ class AxisBank:
                 self._release_groups([g])
         if not ok:
             return
+        self.steps_in_place += 1
         for obj in objs:  # (their dicts are their own since their claim)
             _set(obj, "__class__", _guard_class(type(obj)))
         self._after_load(r, was_moving)
@@ -2202,6 +2208,7 @@ class AxisBank:
         try:
             for r in rows:
                 if p0 is not None and self.dpost[r] & TP_POST:
+                    self.posted_probes += 1
                     ch = csp.channels[r]
                     probe = ch.probe
                     a, b = float(p0[r]), float(csp.pos[r])
@@ -2212,6 +2219,7 @@ class AxisBank:
                 self._last = {r: self._planned_row(r)}
                 self._rates = {r: self._enc_rates_row(r)}
                 self._put_back(r)
+                self.posted_inputs += bool(self.dpost[r] & ~TP_POST)
                 ran = int(self.bank_cycles - self.claim_cycle[r])
                 for obj in self._aware.pop(r, ()):
                     obj.bank_posted(ran, t_ns, dt_ns)
