@@ -1014,7 +1014,6 @@ class _Homings:
                 if q is None:
                     home._q_claim = 0
                     d = t_next
-                    stepping = True
                     if step:
                         if bank is not None and home.res.bank is bank:
                             # its row stays claimed (a release and a claim, the drive kept)
@@ -1024,7 +1023,12 @@ class _Homings:
                         if not home.running:
                             self.running.remove(home)
                             continue
-                else:
+                        # (a leg the step started in the bank: quiet from now on, as the
+                        # next look would find it)
+                        q = home.quiet(bank)
+                    if q is None:
+                        stepping = True
+                if q is not None:
                     r = home.res.bank_row
                     d = home._q_due = t_next + q * dt
                     home._q_row, home._q_claim = r, ids[r]
