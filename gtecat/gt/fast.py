@@ -29,7 +29,7 @@ from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
-from ..controller.resources import CONTROLLER_AXES, AxisResources
+from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_count
 from ..master.clock import ClockMode
 from . import byref_target
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source, holds_pointers
@@ -270,10 +270,21 @@ def fast_reader(
         record(name, code, reason)
         return advance(ctl, name, code)
 
-    def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
+    def many(
+        ctl: Any,
+        n: Any,
+        p: Any,
+        count: int,
+        pClock: Any,
+        extra: tuple,
+        kw: dict,
+        zeros: bool = True,
+    ) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
         a poll of every axis in one call): the table path's values, or None when the shape
-        is any other (an axis no drive backs, a clock pointer, a numpy array: the table)."""
+        is any other (a numpy array, a span past the controller's axes: the table).  An axis
+        of the controller's that no drive backs reads 0 where ``zeros`` (core 1's own axes;
+        a core view counts its axes its own way: the table path)."""
         if (
             ctl is None
             or type(n) is not int
@@ -336,7 +347,18 @@ def fast_reader(
         values: list[Any] = []
         append = values.append
         bank = lst = None
+        top = 0  # the controller's axis count, once an axis of the span has no drive
         for k in range(n, n + count):
+            if k not in axes and zeros:
+                # an axis the controller has but no drive backs reads as one at rest (0),
+                # as the table path's axis_span has it; a span past the controller's axes,
+                # or no axis at all yet: the table path says why
+                if not top:
+                    top = resource_count(ctl) if axes else -1
+                if not 1 <= n <= n + count - 1 <= top:
+                    return None
+                append(0)
+                continue
             res = resources.get(k)
             if res is None or axes.get(k) is not res.ax:
                 return None
@@ -382,7 +404,7 @@ def fast_reader(
             # with the bus axes, where it answers (else the table path of that core)
             rc = many(
                 session.controllers.get(1), n + AXES_PER_CORE * (core - 1), p, count, pClock,
-                extra, kw,
+                extra, kw, zeros=False,
             )  # fmt: skip
             if rc is not None:
                 return rc
