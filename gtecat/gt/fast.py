@@ -31,7 +31,7 @@ from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_count
 from ..master.clock import ClockMode
-from . import byref_target
+from . import byref_target, centry
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source, holds_pointers
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
@@ -409,14 +409,34 @@ def fast_reader(
             if rc is not None:
                 return rc
         args = [a for a in (core, n, p, count, pClock) if a is not _NO]
-        return gt.gtn_slow(*args, *extra, **kw)  # type: ignore[attr-defined]
+        return public[0].gtn_slow(*args, *extra, **kw)  # (set by gt_function)
 
     env["gtn_general"] = gtn_general
+    public: list[Any] = [None]  # the public function (the C entry, else gt below)
     #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
     #: its core); every other shape: the table's GTN_ function (set by gt_function)
     gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
-    return gt
+    public[0] = gt
+    if CENTRY:  # the common shape in C where it is available (gtecat.gt.centry)
+        env["NOPE"] = _NO
+        double = ctypes_ok is _DOUBLE
+        entry = centry.reader(
+            gt, _value_function(env, "value_gt", "session.plain"), _NO, ctypes_ok, double
+        )
+        entry_gtn = centry.reader(
+            gt.gtn, _value_function(env, "value_gtn", "session.local"), _NO, ctypes_ok, double,
+            core=True,
+        )  # fmt: skip
+        if entry is not None and entry_gtn is not None:
+            entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
+            public[0] = entry
+    return public[0]  # type: ignore[no-any-return]
+
+
+#: the C entry of the readers where it is available (tests turn it off to hold the Python
+#: fast functions to the same answers)
+CENTRY = True
 
 
 #: a reader's value of an axis the bank does not run, inline (without the getter's call):
@@ -687,6 +707,15 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     )
     env["_AT"] = _AT
     env["PER_CORE"] = AXES_PER_CORE
+    value = "\n".join("            " + line for line in _value_lines(env))
+    code = code.replace("{value}", value)
+    exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
+    return env[fname]
+
+
+def _value_lines(env: dict[str, Any]) -> list[str]:
+    """The steps that set ``v``, a reader's value of the axis ``res`` (the names they use
+    go into ``env``): the fast function's and its C entry's value function's."""
     attr = getattr(env["get"], "attr", None)
     derived = DERIVED.get(env["name"])
     if derived is not None:  # (AxisResources' property, its steps inline)
@@ -694,9 +723,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         if env["to"] is float:
             lines += ["if type(v) is not float:", "    v = float(v)"]
         env.update(_STATUS_BITS)
-        code = code.replace("{value}", "\n".join("            " + line for line in lines))
-        exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)
-        return env[fname]
+        return lines
     if env["name"] in SCALAR_INLINE:
         scalar = list(SCALAR_INLINE[env["name"]])
         env.update(_STATUS_BITS)
@@ -709,22 +736,47 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
             own = UNBANKED.get(env["name"], own)
         scalar = [f"v = {own}", "if type(v) is not float:", "    v = float(v)"]
     if env["key"] is None:
-        lines = scalar
-    else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
-        lines = [
-            "b = res.bank",
-            "if b is None:",
-            *("    " + x for x in scalar),
-            "else:",
-            "    lst = b._lists.get(key)",
-            "    v = get(res) if lst is None else lst[res.bank_row]",
-        ]
-        if env["to"] is not None:  # (a double: the list's float as it is, else float())
-            lines += ["    if type(v) is not float:", "        v = to(v)"]
-    value = "\n".join("            " + line for line in lines)
-    code = code.replace("{value}", value)
+        return scalar
+    # a banked axis's value from the bank's list (AxisBank.value), else the getter
+    lines = [
+        "b = res.bank",
+        "if b is None:",
+        *("    " + x for x in scalar),
+        "else:",
+        "    lst = b._lists.get(key)",
+        "    v = get(res) if lst is None else lst[res.bank_row]",
+    ]
+    if env["to"] is not None:  # (a double: the list's float as it is, else float())
+        lines += ["    if type(v) is not float:", "        v = to(v)"]
+    return lines
+
+
+#: a reader's value for its C entry (:mod:`gtecat.gt.centry`): the value of axis ``n`` of the
+#: in-process lockstep controller as the fast function writes it, with the fast function's
+#: side effect (the last error cleared); NOPE where the fast function must answer
+_VALUE = """
+def {fname}(n):
+    try:  # (two subscripts: cheaper than two get calls)
+        ctl = session.controllers[1]
+        res = ctl.resources[n]
+    except KeyError:  # no controller, or no such axis
+        return NOPE
+    # (a lockstep clock never runs a thread of its own: Clock.start runs one in real time only)
+    if {session} and ctl.clock.mode is _LOCKSTEP:
+{{value}}
+        session.last = None
+        return v
+    return NOPE
+"""
+
+
+def _value_function(env: dict[str, Any], fname: str, session: str) -> Callable[[Any], Any]:
+    """The value function of a reader's C entry (``session``: the GT_ or the GTN_ form's
+    check of the session)."""
+    value = "\n".join("        " + line for line in _value_lines(env))
+    code = _VALUE.format(fname=fname, session=session).replace("{value}", value)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
-    return env[fname]
+    return env[fname]  # type: ignore[no-any-return]
 
 
 #: the clock reader on the fast path (``pClock``, ``pLoop`` NULL or omitted)

@@ -1,0 +1,276 @@
+"""A GT fast reader's entry in C: the common call shape without a Python frame of its own.
+
+``GT_GetSts(1, byref(s))`` through the compiled Python fast function (:mod:`gtecat.gt.fast`)
+spends about half its time checking the shape of its arguments and writing the value through
+ctypes.  The entry here (``csrc/centry.c``) does those two parts in C: it checks the shape
+(an exact ``int`` axis, ``count`` absent or 1, ``pClock`` absent, None or 0, the value's
+pointer ``byref(x)`` of an accepted ``x`` with no offset, or ``x`` itself), asks one Python
+function of the reader for the value (``value(n)``: the number, or a sentinel when the entry
+must not answer - not the in-process lockstep controller, no such axis, any doubt), and
+writes the number into ``x``'s memory with ``x``'s width (a number the type does not hold:
+not written).  Every other case is the reader's Python fast function called with the very
+same arguments, keywords included, so the answers stay that function's.
+
+As :mod:`gtecat.gt.byref_target` (whose probe of the interpreter's layout this shares), the C
+file uses no Python header: a float's value is found by probing floats, the C API's
+functions are taken from the running interpreter, and the entry is tested against known
+answers (every kind of shape it must hand on, the widths, reference counts) before use.  Any
+disagreement, or no compiler: :data:`REASON` says why and :func:`reader` gives None (the
+Python fast function is then the public one, as before).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import logging
+import sys
+from collections.abc import Callable, Iterable
+from importlib import resources
+from typing import Any
+
+from . import byref_target
+
+log = logging.getLogger(__name__)
+
+_METH_FASTCALL_KEYWORDS = 0x0080 | 0x0002
+_MAX_TYPES = 8
+_VP = ctypes.c_void_p
+
+
+class _Api(ctypes.Structure):
+    """``struct api`` of csrc/centry.c."""
+
+    _fields_ = [
+        ("carg_value", ctypes.c_ssize_t),
+        ("carg_obj", ctypes.c_ssize_t),
+        ("ob_type", ctypes.c_ssize_t),
+        ("b_ptr", ctypes.c_ssize_t),
+        ("fval", ctypes.c_ssize_t),
+        ("carg_type", _VP),
+        ("int_type", _VP),
+        ("float_type", _VP),
+        ("none", _VP),
+        ("zero", _VP),
+        ("incref", _VP),
+        ("decref", _VP),
+        ("vectorcall", _VP),
+        ("as_ll", _VP),
+        ("err_occurred", _VP),
+        ("err_clear", _VP),
+    ]
+
+
+class _Entry(ctypes.Structure):
+    """``struct entry`` of csrc/centry.c: one reader's entry (the C function's self)."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("value", _VP),
+        ("sentinel", _VP),
+        ("core", ctypes.c_ssize_t),
+        ("kind", ctypes.c_ssize_t),
+        ("types", _VP * _MAX_TYPES),
+        ("sizes", ctypes.c_ssize_t * _MAX_TYPES),
+    ]
+
+
+def _float_at() -> int:
+    """Where a float keeps its value (ValueError when the probe disagrees)."""
+    at = object.__basicsize__
+    for x in (1.5, -2.25e300, 0.0, float("inf"), 3.0):
+        if ctypes.c_double.from_address(id(x) + at).value != x:
+            raise ValueError("a float's value is not where it is looked for")
+    return at
+
+
+def _address(name: str) -> int:
+    return ctypes.cast(getattr(ctypes.pythonapi, name), _VP).value or 0
+
+
+#: the entries made (kept alive: their C functions point at them)
+_KEEP: list[Any] = []
+#: (the reader maker, why it is not available)
+Maker = Callable[..., Any]
+
+
+def _load() -> tuple[Maker | None, str]:
+    if sys.implementation.name != "cpython":
+        return None, "not CPython"
+    try:
+        carg_value, carg_obj, ob_type, b_ptr = byref_target.layout()
+        fval = _float_at()
+    except ValueError as e:
+        return None, str(e)
+    try:
+        from ..cbuild import shared_library
+
+        source = (resources.files("gtecat.gt") / "csrc" / "centry.c").read_text("utf-8")
+        lib = ctypes.CDLL(str(shared_library("centry", source, byref_target.CFLAGS, ())))
+        api = _Api(
+            carg_value,
+            carg_obj,
+            ob_type,
+            b_ptr,
+            fval,
+            id(type(ctypes.byref(ctypes.c_int()))),
+            id(int),
+            id(float),
+            id(None),
+            id(0),
+            _address("Py_IncRef"),
+            _address("Py_DecRef"),
+            _address("PyObject_Vectorcall"),
+            _address("PyLong_AsLongLongAndOverflow"),
+            _address("PyErr_Occurred"),
+            _address("PyErr_Clear"),
+        )
+        lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
+        lib.gtecat_centry_api.restype = ctypes.c_int
+        if lib.gtecat_centry_api(ctypes.byref(api)) != 0:
+            return None, "the library refused the layout"
+        meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
+        new = byref_target.function_maker()
+    except Exception as e:  # no compiler, a failed build, no Python API in this process
+        return None, f"{type(e).__name__}: {e}"
+
+    def make(
+        fallback: Callable[..., Any],
+        value: Callable[[Any], Any],
+        sentinel: Any,
+        types: Iterable[type],
+        double: bool,
+        core: bool,
+    ) -> Any:
+        kinds = tuple(types)
+        if not 0 < len(kinds) < _MAX_TYPES:
+            raise ValueError("one to seven types")
+        e = _Entry(id(fallback), id(value), id(sentinel), int(core), int(double))
+        for k, t in enumerate(kinds):
+            e.types[k] = id(t)
+            e.sizes[k] = ctypes.sizeof(t)
+        fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, (fallback, value, sentinel, kinds))
+        # a partial: it passes its arguments straight on (no frame) and, unlike a built-in
+        # function, takes the attributes the GT layer gives its functions
+        return functools.partial(fn)
+
+    reason = _self_test(make)
+    return (make, "") if not reason else (None, reason)
+
+
+def _self_test(make: Maker) -> str:
+    """'' when entries give the known answers and keep reference counts, else what went
+    wrong."""
+    nope = object()
+    big = [1 << 40]  # (a value a 32-bit object does not hold: held to watch its count)
+
+    def value(n: Any) -> Any:
+        return {1: 7, 2: big[0], 3: 1 << 70, 4: 1.5, 5: nope, 6: -(1 << 31)}.get(n, nope)
+
+    def fvalue(n: Any) -> Any:
+        return {1: 2.5, 2: 3, 5: nope}.get(n, nope)
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    ints = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], False, False)
+    doubles = make(python, fvalue, nope, [ctypes.c_double], True, False)
+    gtn = make(python, value, nope, [ctypes.c_int64], False, True)
+    L, I, D = ctypes.c_int64, ctypes.c_int32, ctypes.c_double
+    held = L()
+    held_p = ctypes.byref(held)
+    arr = (L * 2)()
+    # (entry, arguments before the pointer, how the pointer is made, arguments after it,
+    #  the value written or None: the Python function answers)
+    cases: list[tuple[Any, tuple, Callable[[], Any], tuple, Any]] = [
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := I(), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := L(), o, o), (), 7),
+        (ints, (1,), lambda: (held, held_p, held), (1,), 7),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 0), 7),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, None), 7),
+        (ints, (2,), lambda: (o := L(), ctypes.byref(o), o), (), 1 << 40),
+        (ints, (6,), lambda: (o := I(), ctypes.byref(o), o), (), -(1 << 31)),
+        (ints, (2,), lambda: (o := I(), ctypes.byref(o), o), (), None),  # too wide
+        (ints, (3,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # too wide
+        (ints, (4,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # a float
+        (ints, (5,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # the sentinel
+        (ints, (9,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (True,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (1.0,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (o := (L * 2)(), ctypes.byref(o, 8), o), (), None),
+        (ints, (1,), lambda: (o := L.from_buffer(arr, 8), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := ctypes.c_short(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (o := D(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (o := (L * 1)(), o, o), (), None),
+        (ints, (1,), lambda: (o := L(), ctypes.pointer(o), o), (), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (2,), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (True,), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 5), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 0, 0), None),
+        (ints, (), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (None, None, None), (), None),
+        (doubles, (1,), lambda: (o := D(), ctypes.byref(o), o), (), 2.5),
+        (doubles, (1,), lambda: (o := D(), o, o), (1, 0), 2.5),
+        (doubles, (2,), lambda: (o := D(), ctypes.byref(o), o), (), None),  # an int
+        (doubles, (1,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (gtn, (1, 1), lambda: (o := L(), ctypes.byref(o), o), (), 7),
+        (gtn, (1, 2), lambda: (o := L(), o, o), (1, 0), 1 << 40),
+        (gtn, (2, 1), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (gtn, (1,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+    ]
+    for fn, before, made, after, want in cases:
+        o, p, shown = made()
+        args = (*before, p, *after)
+        watched = [p, o, big[0], nope, *before, *after]
+        counts = [sys.getrefcount(x) for x in watched]
+        for _ in range(3):
+            if shown is not None:
+                ctypes.memset(ctypes.addressof(shown), 0, ctypes.sizeof(shown))
+            got = fn(*args)
+            if want is None:
+                if got != ("python", args, {}):
+                    return f"the entry answered {got!r} for {args!r} (the Python function must)"
+            elif got != 0 or shown is None or shown.value != want:
+                return f"the entry answered {got!r} for {args!r}, not 0 with {want!r}"
+            del got
+        if fn(*args, kw=1) != ("python", args, {"kw": 1}):
+            return "the entry answered a call with a keyword"
+        if [sys.getrefcount(x) for x in watched] != counts:
+            return f"the entry changed a reference count ({args!r})"
+
+    def failing(n: Any) -> Any:
+        raise LookupError(n)
+
+    raising = make(python, failing, nope, [ctypes.c_int64], False, False)
+    try:
+        raising(1, ctypes.byref(L()))
+    except LookupError:
+        pass
+    else:
+        return "the value's error did not reach the caller"
+    return ""
+
+
+_MAKE, REASON = _load()
+if _MAKE is None:
+    log.debug("C entry of the fast readers not used: %s", REASON)
+
+
+def reader(
+    fallback: Callable[..., Any],
+    value: Callable[[Any], Any],
+    sentinel: Any,
+    types: Iterable[type],
+    double: bool,
+    core: bool = False,
+) -> Any:
+    """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
+    ``core``) writing ``value(n)`` into ``p``'s object (of one of ``types``: signed
+    integers, or doubles where ``double``) for the common shape, else ``fallback`` with the
+    same arguments; ``value`` gives ``sentinel`` where the entry must not answer.  A
+    ``functools.partial`` of the built-in function (it takes attributes); None where the C
+    entry is not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE(fallback, value, sentinel, types, double, core)

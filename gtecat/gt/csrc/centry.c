@@ -1,0 +1,163 @@
+/* The C entry of a GT fast reader (gtecat/gt/centry.py builds, binds and tests this file).
+ *
+ * GT_GetSts(1, byref(s)) and its kind: the shape of the call is checked here (an exact int
+ * for the axis, count absent or 1, pClock absent, None or 0, the value's pointer resolved to
+ * the memory of an accepted ctypes object as the byref check does), the reader's value comes
+ * from one Python call (value(n): a number, or a sentinel when the C entry must not answer),
+ * and the number is written into the object's memory with the object's width.  Anything
+ * else - another shape, the sentinel, a number the type does not hold, any doubt - is the
+ * reader's Python fast function called with the very same arguments, which answers as before.
+ *
+ * No Python header: where the interpreter keeps a pointer object's address and object, an
+ * object's type, a ctypes object's memory and a float's value, and the C API's functions, are
+ * handed over by the loader, which probed them on objects whose answers it knows and tests
+ * the entry against the Python path before using it.
+ */
+#include <stddef.h>
+#include <stdint.h>
+
+typedef void *obj;
+
+struct api {
+    ptrdiff_t carg_value; /* the address a byref() passes */
+    ptrdiff_t carg_obj;   /* the object it refers to (NULL for some pointer objects) */
+    ptrdiff_t ob_type;    /* an object's type */
+    ptrdiff_t b_ptr;      /* a ctypes object's memory */
+    ptrdiff_t fval;       /* a float's value */
+    obj carg_type;        /* the type of the pointer objects byref() makes */
+    obj int_type;
+    obj float_type;
+    obj none;
+    obj zero; /* the int 0 (the return code) */
+    void (*incref)(obj);
+    void (*decref)(obj);
+    obj (*vectorcall)(obj, obj const *, size_t, obj);
+    long long (*as_ll)(obj, int *); /* PyLong_AsLongLongAndOverflow */
+    obj (*err_occurred)(void);
+    void (*err_clear)(void);
+};
+
+#define MAX_TYPES 8
+
+/* one reader's entry: the memory of the ctypes object that is the C function's self */
+struct entry {
+    obj fallback;  /* the Python fast function: every shape this entry does not answer */
+    obj value;     /* value(n): the number to write, or sentinel */
+    obj sentinel;
+    ptrdiff_t core; /* 1: the GTN_ form, the core (which must be 1) first */
+    ptrdiff_t kind; /* 0: signed integers, 1: doubles */
+    obj types[MAX_TYPES]; /* the ctypes types *pValue may have, NULL-ended */
+    ptrdiff_t sizes[MAX_TYPES];
+};
+
+static struct api A;
+static int ready;
+
+#define AT(base, off) (*(char **)((char *)(base) + (off)))
+#define TYPE(o) AT(o, A.ob_type)
+
+int gtecat_centry_api(const struct api *api)
+{
+    if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
+        api->fval < 0 || !api->carg_type || !api->int_type || !api->float_type || !api->none ||
+        !api->zero || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
+        !api->err_occurred || !api->err_clear)
+        return 1;
+    A = *api;
+    ready = 1;
+    return 0;
+}
+
+/* an exact int equal to want (no error left behind) */
+static int int_is(obj o, long long want)
+{
+    int over = 0;
+    long long v;
+    if (TYPE(o) != A.int_type)
+        return 0;
+    v = A.as_ll(o, &over);
+    if (v == -1 && !over && A.err_occurred()) {
+        A.err_clear();
+        return 0;
+    }
+    return !over && v == want;
+}
+
+/* METH_FASTCALL | METH_KEYWORDS: self is the entry's ctypes object */
+obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    const struct entry *e = (const struct entry *)AT(self, A.b_ptr);
+    ptrdiff_t at = e->core;
+    obj p, target, tp, v;
+    char *mem;
+    int k, size = 0;
+
+    if (!ready || kwnames || nargs < 2 + at || nargs > 4 + at)
+        goto python;
+    if (at && !int_is(args[0], 1))
+        goto python;
+    if (TYPE(args[at]) != A.int_type)
+        goto python;
+    if (nargs >= 3 + at && !int_is(args[at + 2], 1))
+        goto python;
+    if (nargs == 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+        goto python;
+    p = args[at + 1];
+    tp = TYPE(p);
+    target = p;
+    if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
+        target = AT(p, A.carg_obj);
+        if (!target)
+            goto python;
+        tp = TYPE(target);
+    }
+    for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
+        if (e->types[k] == tp) {
+            size = (int)e->sizes[k];
+            break;
+        }
+    }
+    if (!size)
+        goto python;
+    mem = AT(target, A.b_ptr);
+    if (target != p && AT(p, A.carg_value) != mem)
+        goto python;
+
+    v = A.vectorcall(e->value, &args[at], 1, NULL);
+    if (!v)
+        return NULL; /* (the value's own error, as the Python path would raise it) */
+    if (v == e->sentinel) {
+        A.decref(v);
+        goto python;
+    }
+    if (e->kind == 1) {
+        if (TYPE(v) != A.float_type || size != 8) {
+            A.decref(v);
+            goto python;
+        }
+        *(double *)mem = *(double *)((char *)v + A.fval);
+    } else {
+        int over = 0;
+        long long x = A.as_ll(v, &over);
+        if (x == -1 && !over && A.err_occurred()) {
+            A.err_clear();
+            A.decref(v);
+            goto python;
+        }
+        if (over || (size == 4 && (x < INT32_MIN || x > INT32_MAX)) ||
+            (size != 4 && size != 8)) {
+            A.decref(v);
+            goto python;
+        }
+        if (size == 4)
+            *(int32_t *)mem = (int32_t)x;
+        else
+            *(int64_t *)mem = (int64_t)x;
+    }
+    A.decref(v);
+    A.incref(A.zero);
+    return A.zero;
+
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}

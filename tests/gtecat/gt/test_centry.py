@@ -1,0 +1,245 @@
+"""The fast readers' C entry (gtecat/gt/centry.py) answers as the Python fast functions and
+the table path do, and keeps reference counts.
+
+Each reader is built twice around its table path - with its C entry and without it (the
+Python fast function alone, as where no compiler is found) - and called in generated
+shapes: byref of each integer and floating type (fresh, reused, with an offset, into a
+structure's field), the object itself, arrays, pointers, numpy arrays and memoryviews,
+wrong types, axes out of range or of another type, count and pClock in each form,
+keywords, the GTN_ twin with core 1, 2 and a wrong core.  Return code, what was written and
+the last error agree among the three, on a bus whose axes the bank runs and on one where it
+does not.  The default run samples the shapes; GTECAT_LONG=1 runs them all.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import random
+import shutil
+import sys
+from ctypes import byref
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from gtecat import gt
+from gtecat.gt import _core, centry, fast
+from tests.conftest import LONG
+
+ENI = Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni"
+HAS_CC = any(shutil.which(c) for c in ("cc", "gcc", "clang"))
+needs_cc = pytest.mark.skipif(not HAS_CC, reason="no C compiler (cc, gcc or clang) on PATH")
+
+
+def _open(**options: str) -> Any:
+    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="", **options) == 0
+    assert gt.GT_InitEcatComm() == 0
+    gt.GTE_Wait(60)
+    assert gt.GT_StartEcatComm() == 0
+    assert gt.GT_AxisOn(1) == 0
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = 0.5, 0.5
+    gt.GT_PrfTrap(1)
+    gt.GT_SetTrapPrm(1, byref(prm))
+    gt.GT_SetPos(1, 50_000)
+    gt.GT_SetVel(1, 10)
+    gt.GT_Update(1)
+    gt.GTE_Wait(30)  # (moving: every reader's value non-zero)
+    return gt.GTE_Controller()
+
+
+def _built(name: str, in_c: bool, monkeypatch: pytest.MonkeyPatch) -> Any:
+    """``name``'s public function built again around its table path, with its C entry or
+    without it (its GTN_ twin's other shapes: the table's)."""
+    monkeypatch.setattr(fast, "CENTRY", in_c)
+    slow = getattr(gt, name).slow
+    fn = fast.fast_reader(name, slow, _core.SESSION, _core.advance)
+    fn.gtn_slow = getattr(gt, "GTN_" + name[3:]).__wrapped__
+    return fn
+
+
+class _S(ctypes.Structure):
+    _fields_ = [("tag", ctypes.c_short), ("x", ctypes.c_long), ("after", ctypes.c_short)]
+
+
+_HELD: dict[type, tuple] = {}
+TYPES = [ctypes.c_int32, ctypes.c_long, ctypes.c_int16, ctypes.c_double, ctypes.c_float]
+KINDS = [
+    "byref",
+    "reused",
+    "offset",
+    "field",
+    "obj",
+    "array",
+    "pointer",
+    "numpy",
+    "memoryview",
+    "int",
+    "none",
+]
+
+
+def _arg(kind: str, t: type) -> tuple[Any, Any]:
+    """(what shows what was written, the argument)."""
+    if kind == "byref":
+        o = t()
+        return o, byref(o)
+    if kind == "reused":
+        if t not in _HELD:
+            o = t()
+            _HELD[t] = (o, byref(o))
+        o, p = _HELD[t]
+        ctypes.memset(ctypes.addressof(o), 0, ctypes.sizeof(o))
+        return o, p
+    if kind == "offset":
+        o = (t * 3)()
+        return o, byref(o, ctypes.sizeof(t))
+    if kind == "field":
+        o = _S(tag=-3, after=-4)
+        return o, byref(o, _S.x.offset)
+    if kind == "obj":
+        o = t()
+        return o, o
+    if kind == "array":
+        o = (t * 2)()
+        return o, o
+    if kind == "pointer":
+        o = t()
+        return o, ctypes.pointer(o)
+    if kind == "numpy":
+        o = np.zeros(2, np.dtype(t._type_))
+        return o, o
+    if kind == "memoryview":
+        o = bytearray(8)
+        return o, memoryview(o)
+    return None, 5 if kind == "int" else None
+
+
+def _shown(o: Any) -> Any:
+    if o is None:
+        return None
+    if isinstance(o, ctypes.Structure | ctypes.Array):
+        return bytes(o)
+    if isinstance(o, np.ndarray | bytearray):
+        return bytes(o)
+    return o.value
+
+
+AXES = [1, 2, 0, 3, 13, -1, 1 << 40, True, 1.0, "1"]
+TAILS: list[tuple] = [(), (1,), (1, 0), (1, None), (2,), (0,), (1, 5), (1, 0, 0), (True,)]
+GTN_CORES = [None, 1, 2, True, 0]
+
+
+def _cases() -> list[tuple]:
+    out = [
+        (name, kind, t, axis, tail, core)
+        for name in sorted(fast.READERS)
+        for kind in KINDS
+        for t in TYPES
+        for axis in AXES
+        for tail in TAILS
+        for core in GTN_CORES
+    ]
+    if LONG:
+        return out
+    rnd = random.Random(30)
+    common = [c for c in out if c[1] in ("byref", "reused", "obj") and c[3] in (1, 2)]
+    return rnd.sample(common, 250) + rnd.sample(out, 350)
+
+
+def _call(fn: Any, gtn: bool, case: tuple, kw: bool) -> tuple:
+    name, kind, t, axis, tail, core = case
+    o, p = _arg(kind, t)
+    args = (axis, p, *tail)
+    if gtn:
+        call = fn.gtn
+        args = (core, *args)
+    else:
+        call = fn
+    rc = call(*args[:-1], pClock=args[-1]) if kw and len(args) > 3 else call(*args)
+    return rc, _shown(o), gt.GTE_GetLastError() if rc else ""
+
+
+@needs_cc
+def test_the_c_entry_is_built_and_is_the_public_reader() -> None:
+    assert centry.REASON == "", centry.REASON
+    for name in fast.READERS:
+        assert hasattr(getattr(gt, name), "python"), name  # (the C entry in front)
+
+
+@needs_cc
+@pytest.mark.parametrize("bank", ["on", "off"])
+def test_the_c_entry_answers_as_the_python_path_and_the_table(
+    bank: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _open(bank=bank)
+    with_c = {n: _built(n, True, monkeypatch) for n in fast.READERS}
+    without = {n: _built(n, False, monkeypatch) for n in fast.READERS}
+    assert all(hasattr(f, "python") for f in with_c.values())
+    assert not any(hasattr(f, "python") for f in without.values())
+    bad = []
+    for k, case in enumerate(_cases()):
+        name, kind, t, axis, tail, core = case
+        gtn = core is not None
+        kw = k % 7 == 0
+        got = [
+            _call(with_c[name], gtn, case, kw),
+            _call(without[name], gtn, case, kw),
+        ]
+        if gtn:  # the table's GTN_ twin
+            o, p = _arg(kind, t)
+            fn = getattr(gt, "GTN_" + name[3:]).__wrapped__
+            args = (core, axis, p, *tail)
+            rc = fn(*args[:-1], pClock=args[-1]) if kw and len(args) > 3 else fn(*args)
+            got.append((rc, _shown(o), gt.GTE_GetLastError() if rc else ""))
+        else:
+            got.append(_call(with_c[name].slow, False, case, kw))
+        if not got[0] == got[1] == got[2]:
+            bad.append(f"{case} kw={kw}: C {got[0]}, Python {got[1]}, table {got[2]}")
+    assert not bad, "\n".join(bad[:8])
+
+
+@needs_cc
+def test_the_c_entry_keeps_reference_counts() -> None:
+    """Answered, handed on and refused calls leave every count as it was."""
+    _open()
+    s, d = ctypes.c_long(), ctypes.c_double()
+    ps, pd = byref(s), byref(d)
+    axis = 1 << 40  # (not a cached small int: its count shows)
+    calls = [
+        (gt.GT_GetSts, (1, ps), [s, ps]),
+        (gt.GT_GetSts, (1, s, 1, None), [s]),
+        (gt.GT_GetPrfPos, (1, pd, 1, 0), [d, pd]),
+        (gt.GT_GetPrfPos, (1, d), [d]),
+        (gt.GT_GetSts, (axis, ps), [axis, ps, s]),  # no such axis: the table's 7
+        (gt.GT_GetSts, (1, byref(s, 4)), [s]),  # an offset: the Python path, the table
+        (gt.GTN_GetSts, (1, 1, ps), [ps, s]),
+        (gt.GTN_GetSts, (2, 1, ps), [ps, s]),
+    ]
+    for fn, args, watched in calls:
+        for _ in range(5):
+            fn(*args)
+        before = [sys.getrefcount(x) for x in (*watched, *args)]
+        for _ in range(50):
+            fn(*args)
+        assert [sys.getrefcount(x) for x in (*watched, *args)] == before, (fn, args)
+
+
+@needs_cc
+def test_a_value_the_object_cannot_hold_is_left_to_the_python_path() -> None:
+    """A status word past a 32-bit object's range (latched flags made up here; the word has
+    32 bits): the C entry leaves it to the Python path, whose answer it gives."""
+    ctl = _open(bank="off")
+    res = ctl.resources[1]
+    for latched in (1 << 31, 1 << 40, -(1 << 31) - 1):
+        res.latched = latched
+        got = []
+        for call in (gt.GT_GetSts, gt.GT_GetSts.python):
+            for t in (ctypes.c_int32, ctypes.c_long):
+                o = t()
+                rc = call(1, byref(o))
+                got.append((rc, o.value, gt.GTE_GetLastError() if rc else ""))
+        assert got[:2] == got[2:], (latched, got)
+    res.latched = 0
