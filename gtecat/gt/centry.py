@@ -176,7 +176,7 @@ def _self_test(make: Maker) -> str:
     ints = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], False, False)
     doubles = make(python, fvalue, nope, [ctypes.c_double], True, False)
     gtn = make(python, value, nope, [ctypes.c_int64], False, True)
-    L, I, D = ctypes.c_int64, ctypes.c_int32, ctypes.c_double
+    L, I32, D = ctypes.c_int64, ctypes.c_int32, ctypes.c_double
     held = L()
     held_p = ctypes.byref(held)
     arr = (L * 2)()
@@ -184,14 +184,14 @@ def _self_test(make: Maker) -> str:
     #  the value written or None: the Python function answers)
     cases: list[tuple[Any, tuple, Callable[[], Any], tuple, Any]] = [
         (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (), 7),
-        (ints, (1,), lambda: (o := I(), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := I32(), ctypes.byref(o), o), (), 7),
         (ints, (1,), lambda: (o := L(), o, o), (), 7),
         (ints, (1,), lambda: (held, held_p, held), (1,), 7),
         (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 0), 7),
         (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, None), 7),
         (ints, (2,), lambda: (o := L(), ctypes.byref(o), o), (), 1 << 40),
-        (ints, (6,), lambda: (o := I(), ctypes.byref(o), o), (), -(1 << 31)),
-        (ints, (2,), lambda: (o := I(), ctypes.byref(o), o), (), None),  # too wide
+        (ints, (6,), lambda: (o := I32(), ctypes.byref(o), o), (), -(1 << 31)),
+        (ints, (2,), lambda: (o := I32(), ctypes.byref(o), o), (), None),  # too wide
         (ints, (3,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # too wide
         (ints, (4,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # a float
         (ints, (5,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # the sentinel

@@ -150,7 +150,7 @@ def _cases() -> list[tuple]:
 
 
 def _call(fn: Any, gtn: bool, case: tuple, kw: bool) -> tuple:
-    name, kind, t, axis, tail, core = case
+    _, kind, t, axis, tail, core = case
     o, p = _arg(kind, t)
     args = (axis, p, *tail)
     if gtn:
