@@ -36,6 +36,7 @@ log = logging.getLogger(__name__)
 _METH_FASTCALL_KEYWORDS = 0x0080 | 0x0002
 _MAX_TYPES = 8
 _VP = ctypes.c_void_p
+_WORD = ctypes.sizeof(_VP)
 
 
 class _Api(ctypes.Structure):
@@ -47,9 +48,12 @@ class _Api(ctypes.Structure):
         ("ob_type", ctypes.c_ssize_t),
         ("b_ptr", ctypes.c_ssize_t),
         ("fval", ctypes.c_ssize_t),
+        ("bsize", ctypes.c_ssize_t),
+        ("bdata", ctypes.c_ssize_t),
         ("carg_type", _VP),
         ("int_type", _VP),
         ("float_type", _VP),
+        ("bytes_type", _VP),
         ("none", _VP),
         ("zero", _VP),
         ("incref", _VP),
@@ -70,9 +74,16 @@ class _Entry(ctypes.Structure):
         ("sentinel", _VP),
         ("core", ctypes.c_ssize_t),
         ("kind", ctypes.c_ssize_t),
+        ("most", ctypes.c_ssize_t),
         ("types", _VP * _MAX_TYPES),
         ("sizes", ctypes.c_ssize_t * _MAX_TYPES),
+        ("signs", ctypes.c_ssize_t * _MAX_TYPES),
     ]
+
+
+#: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
+#: a structure (``value(n)`` gives them, as many as the entry's size)
+INT, DOUBLE, BYTES = 0, 1, 2
 
 
 def _float_at() -> int:
@@ -82,6 +93,20 @@ def _float_at() -> int:
         if ctypes.c_double.from_address(id(x) + at).value != x:
             raise ValueError("a float's value is not where it is looked for")
     return at
+
+
+def _bytes_at() -> tuple[int, int]:
+    """Where a bytes object keeps its length and its first byte (ValueError when the probe
+    disagrees)."""
+    at = object.__basicsize__  # (a variable-size object's length follows its head)
+    samples = [bytes(range(3, 12)) * 3, b"\x07" * 5, bytes(range(40))]
+    for b in samples:
+        if ctypes.c_ssize_t.from_address(id(b) + at).value != len(b):
+            raise ValueError("a bytes object's length is not where it is looked for")
+    for k in range(at + _WORD, bytes.__basicsize__ + 1):
+        if all(ctypes.string_at(id(b) + k, len(b)) == b for b in samples):
+            return at, k
+    raise ValueError("a bytes object's bytes are not where they are looked for")
 
 
 def _address(name: str) -> int:
@@ -100,7 +125,8 @@ def _load() -> tuple[Maker | None, str]:
     try:
         carg_value, carg_obj, ob_type, b_ptr = byref_target.layout()
         fval = _float_at()
-    except ValueError as e:
+        bsize, bdata = _bytes_at()
+    except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
         from ..cbuild import shared_library
@@ -113,9 +139,12 @@ def _load() -> tuple[Maker | None, str]:
             ob_type,
             b_ptr,
             fval,
+            bsize,
+            bdata,
             id(type(ctypes.byref(ctypes.c_int()))),
             id(int),
             id(float),
+            id(bytes),
             id(None),
             id(0),
             _address("Py_IncRef"),
@@ -139,16 +168,19 @@ def _load() -> tuple[Maker | None, str]:
         value: Callable[[Any], Any],
         sentinel: Any,
         types: Iterable[type],
-        double: bool,
+        kind: int,
         core: bool,
+        most: int = 4,
+        size: int = 0,
     ) -> Any:
         kinds = tuple(types)
-        if not 0 < len(kinds) < _MAX_TYPES:
-            raise ValueError("one to seven types")
-        e = _Entry(id(fallback), id(value), id(sentinel), int(core), int(double))
+        if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
+            raise ValueError("one to seven types, two to four arguments")
+        e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
         for k, t in enumerate(kinds):
             e.types[k] = id(t)
-            e.sizes[k] = ctypes.sizeof(t)
+            e.sizes[k] = size or ctypes.sizeof(t)
+            e.signs[k] = int(kind != INT or not getattr(t, "_type_", "").isupper())
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, (fallback, value, sentinel, kinds))
         # a partial: it passes its arguments straight on (no frame) and, unlike a built-in
         # function, takes the attributes the GT layer gives its functions
@@ -173,9 +205,18 @@ def _self_test(make: Maker) -> str:
     def python(*a: Any, **kw: Any) -> Any:
         return ("python", a, kw)
 
-    ints = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], False, False)
-    doubles = make(python, fvalue, nope, [ctypes.c_double], True, False)
-    gtn = make(python, value, nope, [ctypes.c_int64], False, True)
+    ints = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], INT, False)
+    doubles = make(python, fvalue, nope, [ctypes.c_double], DOUBLE, False)
+    gtn = make(python, value, nope, [ctypes.c_int64], INT, True)
+    narrow = make(python, value, nope, [ctypes.c_int16, ctypes.c_uint16], INT, False, 2)
+
+    class Pair(ctypes.Structure):
+        _fields_ = [("a", ctypes.c_int32), ("b", ctypes.c_int16), ("pad", ctypes.c_int16)]
+
+    def svalue(n: Any) -> Any:
+        return {1: b"\x01\x00\x00\x00\xff\xff", 2: b"\x01"}.get(n, nope)
+
+    structs = make(python, svalue, nope, [Pair], BYTES, False, 2, 6)
     L, I32, D = ctypes.c_int64, ctypes.c_int32, ctypes.c_double
     held = L()
     held_p = ctypes.byref(held)
@@ -218,6 +259,15 @@ def _self_test(make: Maker) -> str:
         (gtn, (1, 2), lambda: (o := L(), o, o), (1, 0), 1 << 40),
         (gtn, (2, 1), lambda: (o := L(), ctypes.byref(o), o), (), None),
         (gtn, (1,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (narrow, (1,), lambda: (o := ctypes.c_int16(), ctypes.byref(o), o), (), 7),
+        (narrow, (1,), lambda: (o := ctypes.c_uint16(), o, o), (), 7),
+        (narrow, (6,), lambda: (o := ctypes.c_int16(), o, o), (), None),
+        (narrow, (6,), lambda: (o := ctypes.c_uint16(), o, o), (), None),
+        (narrow, (1,), lambda: (o := ctypes.c_int16(), o, o), (1,), None),  # two at most
+        (structs, (1,), lambda: (o := Pair(pad=9), ctypes.byref(o), o), (), (1, -1, 9)),
+        (structs, (1,), lambda: (o := Pair(pad=9), o, o), (), (1, -1, 9)),
+        (structs, (2,), lambda: (o := Pair(), o, o), (), None),  # too short
+        (structs, (1,), lambda: (o := Pair(), ctypes.byref(o, 2), o), (), None),
     ]
     for fn, before, made, after, want in cases:
         o, p, shown = made()
@@ -225,24 +275,32 @@ def _self_test(make: Maker) -> str:
         watched = [p, o, big[0], nope, *before, *after]
         counts = [sys.getrefcount(x) for x in watched]
         for _ in range(3):
-            if shown is not None:
+            if isinstance(shown, Pair):
+                shown.a, shown.b, shown.pad = 0, 0, 9
+            elif shown is not None:
                 ctypes.memset(ctypes.addressof(shown), 0, ctypes.sizeof(shown))
             got = fn(*args)
             if want is None:
                 if got != ("python", args, {}):
                     return f"the entry answered {got!r} for {args!r} (the Python function must)"
-            elif got != 0 or shown is None or shown.value != want:
-                return f"the entry answered {got!r} for {args!r}, not 0 with {want!r}"
+            else:
+                written = (
+                    (shown.a, shown.b, shown.pad) if isinstance(shown, Pair) else shown.value
+                )
+                if got != 0 or written != want:
+                    return f"the entry answered {got!r} for {args!r}, not 0 with {want!r}"
+                del written
             del got
         if fn(*args, kw=1) != ("python", args, {"kw": 1}):
             return "the entry answered a call with a keyword"
         if [sys.getrefcount(x) for x in watched] != counts:
-            return f"the entry changed a reference count ({args!r})"
+            now = [sys.getrefcount(x) for x in watched]
+            return f"the entry changed a reference count ({args!r}: {counts} -> {now})"
 
     def failing(n: Any) -> Any:
         raise LookupError(n)
 
-    raising = make(python, failing, nope, [ctypes.c_int64], False, False)
+    raising = make(python, failing, nope, [ctypes.c_int64], INT, False)
     try:
         raising(1, ctypes.byref(L()))
     except LookupError:
@@ -262,15 +320,19 @@ def reader(
     value: Callable[[Any], Any],
     sentinel: Any,
     types: Iterable[type],
-    double: bool,
+    kind: int,
     core: bool = False,
+    most: int = 4,
+    size: int = 0,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
-    ``core``) writing ``value(n)`` into ``p``'s object (of one of ``types``: signed
-    integers, or doubles where ``double``) for the common shape, else ``fallback`` with the
-    same arguments; ``value`` gives ``sentinel`` where the entry must not answer.  A
-    ``functools.partial`` of the built-in function (it takes attributes); None where the C
-    entry is not available (:data:`REASON`)."""
+    ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
+    (of one of ``types``) for the common shape, else ``fallback`` with the same arguments;
+    ``value`` gives ``sentinel`` where the entry must not answer.  ``kind``: :data:`INT`
+    (each type's width and sign), :data:`DOUBLE`, or :data:`BYTES` (``value`` gives
+    ``size`` bytes, copied to the start of the object).  A ``functools.partial`` of the
+    built-in function (it takes attributes); None where the C entry is not available
+    (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE(fallback, value, sentinel, types, double, core)
+    return _MAKE(fallback, value, sentinel, types, kind, core, most, size)

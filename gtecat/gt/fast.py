@@ -420,12 +420,12 @@ def fast_reader(
     public[0] = gt
     if CENTRY:  # the common shape in C where it is available (gtecat.gt.centry)
         env["NOPE"] = _NO
-        double = ctypes_ok is _DOUBLE
+        kind = centry.DOUBLE if ctypes_ok is _DOUBLE else centry.INT
         entry = centry.reader(
-            gt, _value_function(env, "value_gt", "session.plain"), _NO, ctypes_ok, double
+            gt, _value_function(env, "value_gt", "session.plain"), _NO, ctypes_ok, kind
         )
         entry_gtn = centry.reader(
-            gt.gtn, _value_function(env, "value_gtn", "session.local"), _NO, ctypes_ok, double,
+            gt.gtn, _value_function(env, "value_gtn", "session.local"), _NO, ctypes_ok, kind,
             core=True,
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:

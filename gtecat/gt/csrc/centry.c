@@ -4,7 +4,8 @@
  * for the axis, count absent or 1, pClock absent, None or 0, the value's pointer resolved to
  * the memory of an accepted ctypes object as the byref check does), the reader's value comes
  * from one Python call (value(n): a number, or a sentinel when the C entry must not answer),
- * and the number is written into the object's memory with the object's width.  Anything
+ * and the number is written into the object's memory with the object's width (a reader of
+ * a structure: value(n) gives its bytes, copied whole).  Anything
  * else - another shape, the sentinel, a number the type does not hold, any doubt - is the
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
@@ -24,9 +25,12 @@ struct api {
     ptrdiff_t ob_type;    /* an object's type */
     ptrdiff_t b_ptr;      /* a ctypes object's memory */
     ptrdiff_t fval;       /* a float's value */
+    ptrdiff_t bsize;      /* a bytes object's length */
+    ptrdiff_t bdata;      /* a bytes object's first byte */
     obj carg_type;        /* the type of the pointer objects byref() makes */
     obj int_type;
     obj float_type;
+    obj bytes_type;
     obj none;
     obj zero; /* the int 0 (the return code) */
     void (*incref)(obj);
@@ -42,12 +46,14 @@ struct api {
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
 struct entry {
     obj fallback;  /* the Python fast function: every shape this entry does not answer */
-    obj value;     /* value(n): the number to write, or sentinel */
+    obj value;     /* value(n): the number (or bytes) to write, or sentinel */
     obj sentinel;
     ptrdiff_t core; /* 1: the GTN_ form, the core (which must be 1) first */
-    ptrdiff_t kind; /* 0: signed integers, 1: doubles */
+    ptrdiff_t kind; /* 0: integers, 1: doubles, 2: bytes (a structure's, its whole size) */
+    ptrdiff_t most; /* arguments after the core: 2 (n, p), 4 (n, p, count 1, pClock NULL) */
     obj types[MAX_TYPES]; /* the ctypes types *pValue may have, NULL-ended */
     ptrdiff_t sizes[MAX_TYPES];
+    ptrdiff_t signs[MAX_TYPES]; /* an integer type: 1 signed, 0 unsigned */
 };
 
 static struct api A;
@@ -59,7 +65,8 @@ static int ready;
 int gtecat_centry_api(const struct api *api)
 {
     if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
-        api->fval < 0 || !api->carg_type || !api->int_type || !api->float_type || !api->none ||
+        api->fval < 0 || api->bsize < 0 || api->bdata < 0 || !api->carg_type ||
+        !api->int_type || !api->float_type || !api->bytes_type || !api->none ||
         !api->zero || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear)
         return 1;
@@ -90,9 +97,9 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
     ptrdiff_t at = e->core;
     obj p, target, tp, v;
     char *mem;
-    int k, size = 0;
+    int k, size = 0, sign = 1;
 
-    if (!ready || kwnames || nargs < 2 + at || nargs > 4 + at)
+    if (!ready || kwnames || nargs < 2 + at || nargs > e->most + at)
         goto python;
     if (at && !int_is(args[0], 1))
         goto python;
@@ -100,7 +107,7 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
         goto python;
     if (nargs >= 3 + at && !int_is(args[at + 2], 1))
         goto python;
-    if (nargs == 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+    if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
         goto python;
     p = args[at + 1];
     tp = TYPE(p);
@@ -114,6 +121,7 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
     for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
         if (e->types[k] == tp) {
             size = (int)e->sizes[k];
+            sign = (int)e->signs[k];
             break;
         }
     }
@@ -126,30 +134,42 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
     v = A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
-    if (v == e->sentinel) {
-        A.decref(v);
-        goto python;
-    }
+    if (v == e->sentinel)
+        goto drop;
     if (e->kind == 1) {
-        if (TYPE(v) != A.float_type || size != 8) {
-            A.decref(v);
-            goto python;
-        }
+        if (TYPE(v) != A.float_type || size != 8)
+            goto drop;
         *(double *)mem = *(double *)((char *)v + A.fval);
+    } else if (e->kind == 2) {
+        if (TYPE(v) != A.bytes_type || *(ptrdiff_t *)((char *)v + A.bsize) != size)
+            goto drop;
+        for (k = 0; k < size; k++)
+            mem[k] = ((char *)v + A.bdata)[k];
     } else {
         int over = 0;
         long long x = A.as_ll(v, &over);
+        long long lo, hi;
         if (x == -1 && !over && A.err_occurred()) {
             A.err_clear();
-            A.decref(v);
-            goto python;
+            goto drop;
         }
-        if (over || (size == 4 && (x < INT32_MIN || x > INT32_MAX)) ||
-            (size != 4 && size != 8)) {
-            A.decref(v);
-            goto python;
-        }
-        if (size == 4)
+        if (size == 1)
+            lo = sign ? INT8_MIN : 0, hi = sign ? INT8_MAX : UINT8_MAX;
+        else if (size == 2)
+            lo = sign ? INT16_MIN : 0, hi = sign ? INT16_MAX : UINT16_MAX;
+        else if (size == 4)
+            lo = sign ? INT32_MIN : 0, hi = sign ? INT32_MAX : (long long)UINT32_MAX;
+        else if (size == 8)
+            lo = sign ? INT64_MIN : 0, hi = INT64_MAX;
+        else
+            goto drop;
+        if (over || x < lo || x > hi) /* (a value the type does not hold: the Python path) */
+            goto drop;
+        if (size == 1)
+            *(int8_t *)mem = (int8_t)x;
+        else if (size == 2)
+            *(int16_t *)mem = (int16_t)x;
+        else if (size == 4)
             *(int32_t *)mem = (int32_t)x;
         else
             *(int64_t *)mem = (int64_t)x;
@@ -158,6 +178,8 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
     A.incref(A.zero);
     return A.zero;
 
+drop:
+    A.decref(v);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
