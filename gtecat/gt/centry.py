@@ -284,9 +284,7 @@ def _self_test(make: Maker) -> str:
                 if got != ("python", args, {}):
                     return f"the entry answered {got!r} for {args!r} (the Python function must)"
             else:
-                written = (
-                    (shown.a, shown.b, shown.pad) if isinstance(shown, Pair) else shown.value
-                )
+                written = (shown.a, shown.b, shown.pad) if isinstance(shown, Pair) else shown.value
                 if got != 0 or written != want:
                     return f"the entry answered {got!r} for {args!r}, not 0 with {want!r}"
                 del written

@@ -439,6 +439,25 @@ def fast_reader(
 CENTRY = True
 
 
+def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:
+    """A two-argument reader's public function: its C entry in front of its Python fast
+    function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
+    :data:`CENTRY` is on and the entry is available; else ``gt``."""
+    if not CENTRY:
+        return gt
+    if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
+        types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
+    entry = centry.reader(gt, value, _NO, sorted(types, key=str), kind, most=2, size=size)
+    if entry is None:
+        return gt
+    entry.slow, entry.python = gt.slow, gt
+    return entry
+
+
+#: the ctypes type codes of the integers an entry writes (of 1 to 8 bytes, either sign)
+_INT_CODES = frozenset("bBhHiIlLqQ")
+
+
 #: a reader's value of an axis the bank does not run, inline (without the getter's call):
 #: GT_GetSts's word as :meth:`AxisResources.status` makes it (the latched flags as they are:
 #: an int; tests/gtecat/gt/test_fast_shapes.py holds the two to the same word in every state
@@ -1523,7 +1542,37 @@ def fast_ecat_reader(
     exec(_compiled_code(code, f"<gt fast ecat {name}>"), env)
     gt = env["gt"]
     gt.slow = slow
-    return gt
+    exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
+    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
+
+
+#: a PDO reader's value for its C entry (the common case of ``_ECAT_READER``, the axis's
+#: entry kept by it); else _NO
+_ECAT_VALUE = """
+def value(n):
+    try:
+        ctl = session.controllers[1]
+        ax = ctl.axes[n]
+    except KeyError:  # no controller, or no such axis
+        return _NO
+    m = ctl.master
+    if (
+        type(ax) is _AXIS
+        and session.plain
+        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
+        and m is not None
+        and m.opened
+        and ctl.card is None
+        and not ax.link_lost
+    ):
+        kept = ACCS.get(n)
+        if kept is not None and kept[0] is ax and kept[1] is not None:
+            cell = kept[2]
+            v = kept[1].get() if cell is None else cell[0]
+            session.last = None
+            return v
+    return _NO
+"""
 
 
 #: the byref branch of a PDO reader: one C call (see _BYREF_C) ...
@@ -1644,74 +1693,92 @@ def fast_homing_status(
     #: first call (homing_calls imports the GT layer, which imports this module)
     h: list[Any] = []
 
+    def status(n: int) -> tuple[Any, Any] | None:
+        """(the controller, axis ``n``'s homing status) where the fast path answers it, else
+        None (the table path: no controller or axis, another session, a pulse card, the bus
+        closed, the link lost, a case with a reason to note)."""
+        try:
+            ctl = session.controllers[1]
+            ax = ctl.axes[n]
+        except KeyError:  # no controller, no such axis: the table path says why
+            return None
+        m = ctl.master
+        if not (
+            session.plain  # (in this process, core 1)
+            and ctl.clock._thread is None
+            and ctl.card is None
+            and m is not None
+            and m.opened
+        ):
+            return None
+        try:
+            k = kept[n]
+        except KeyError:
+            k = None
+        if k is None or k[0] is not ax:
+            if not h:
+                from . import homing_calls as hc
+
+                h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
+            if len(kept) > 4096:
+                kept.clear()
+            io = getattribute(ax, "io")
+            mapped = io.get(0x6041) is not None
+            k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
+        st = k[3]
+        if st is None and k[4] != h[3][0]:  # (a state made since: look again)
+            k[4] = h[3][0]
+            st = k[3] = h[0].get(k[1])
+        lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
+        if lost:
+            return None
+        if st is None:  # no run since the bus came up: not homed
+            v = h[2] if k[2] else None
+        elif st.active:
+            v = None if st.hint is not None else h[1]
+        else:
+            v = st.result
+        return None if v is None else (ctl, v)
+
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
-            try:
-                ctl = session.controllers[1]
-                ax = ctl.axes[n]
-            except KeyError:  # no controller, no such axis: the table path says why
-                return slow(*(a for a in (n, p) if a is not _NO))
-            clock = ctl.clock
-            m = ctl.master
-            if (
-                session.plain  # (in this process, core 1)
-                and clock._thread is None
-                and ctl.card is None
-                and m is not None
-                and m.opened
-            ):
-                tp = type(p)
-                arr = None  # (an array: the range its first element holds)
-                if tp is _CArg:
-                    obj = target(p)
-                    if obj is p:
-                        obj = None
-                elif tp in ok:
-                    obj = p
-                else:
-                    arr = first(p, tp)
-                    obj = None if arr is None else p
-                try:
-                    k = kept[n]
-                except KeyError:
-                    k = None
-                if k is None or k[0] is not ax:
-                    if not h:
-                        from . import homing_calls as hc
-
-                        h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
-                    if len(kept) > 4096:
-                        kept.clear()
-                    io = getattribute(ax, "io")
-                    mapped = io.get(0x6041) is not None
-                    k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
-                st = k[3]
-                if st is None and k[4] != h[3][0]:  # (a state made since: look again)
-                    k[4] = h[3][0]
-                    st = k[3] = h[0].get(k[1])
-                lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
-                if obj is not None and not lost:
-                    if st is None:  # no run since the bus came up: not homed
-                        v = h[2] if k[2] else None
-                    elif st.active:
-                        v = None if st.hint is not None else h[1]
-                    else:
-                        v = st.result
-                    if v is not None:
-                        lo, hi = bounds[type(obj)] if arr is None else arr
-                        if lo <= v <= hi:
-                            if arr is None:
-                                obj.value = v
-                            else:
-                                p[0] = v
-                            session.last = None
-                            if clock.mode is _LOCKSTEP:
-                                return 0
-                            return advance(ctl, name, 0)
+            tp = type(p)
+            arr = None  # (an array: the range its first element holds)
+            if tp is _CArg:
+                obj = target(p)
+                if obj is p:
+                    obj = None
+            elif tp in ok:
+                obj = p
+            else:
+                arr = first(p, tp)
+                obj = None if arr is None else p
+            if obj is not None:
+                got = status(n)
+                if got is not None:
+                    ctl, v = got
+                    lo, hi = bounds[type(obj)] if arr is None else arr
+                    if lo <= v <= hi:
+                        if arr is None:
+                            obj.value = v
+                        else:
+                            p[0] = v
+                        session.last = None
+                        if ctl.clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
+    def value(n: int) -> Any:
+        """The C entry's value: the status on the lockstep clock, else _NO."""
+        got = status(n)
+        if got is None or got[0].clock.mode is not _LOCKSTEP:
+            return _NO
+        session.last = None
+        return got[1]
+
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    return _entry(gt, value, ok, centry.INT)  # type: ignore[no-any-return]
 
 
 def struct_packer(cls: type) -> Callable[..., None] | None:
@@ -1777,6 +1844,25 @@ def _pack_trap() -> Any:
 _PACK_TRAP = _pack_trap()
 
 
+def _trap_bytes() -> tuple[Callable[[Any], bytes], int] | None:
+    """GT_GetTrapPrm's structure as bytes (what :func:`trap_prm_into` packs into it) and
+    how many, for its C entry; None where the structure is not packed at once."""
+    packer = getattr(_PACK_TRAP, "__self__", None)
+    if not isinstance(packer, struct.Struct):
+        return None
+    pack = packer.pack
+
+    def to_bytes(res: Any) -> bytes:
+        prm = res.profile.trap_prm
+        return pack(prm.acc, prm.dec, prm.vel_start, prm.smooth_time)
+
+    return to_bytes, packer.size
+
+
+#: a structure reader's structure as bytes: function -> (``to_bytes(resources)``, how many)
+STRUCT_BYTES = {k: v for k, v in {"GT_GetTrapPrm": _trap_bytes()}.items() if v is not None}
+
+
 def _struct_readers() -> dict[str, tuple[type, Any, Callable[[Any, Any], None]]]:
     from ..controller.profile import PrfMode
     from .structs import TTrapPrm
@@ -1811,44 +1897,75 @@ def fast_struct_reader(
     cls, mode, fill = STRUCT_READERS[name]
     target = _target([cls])
 
+    def ready(n: int) -> Any:
+        """(the controller, axis ``n``'s resources) where the fast path answers, else None
+        (the table path: no controller or axis, another session, a pulse card)."""
+        try:
+            ctl = session.controllers[1]
+            res = ctl.resources[n]
+        except KeyError:  # no controller, no such axis: the table path says why
+            return None
+        if (
+            session.plain  # (in this process, core 1)
+            and ctl.card is None
+            and ctl.clock._thread is None
+            and ctl.axes.get(n) is res.ax
+        ):
+            return ctl, res
+        return None
+
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
-            try:
-                ctl = session.controllers[1]
-                res = ctl.resources[n]
-            except KeyError:  # no controller, no such axis: the table path says why
-                return slow(*(a for a in (n, p) if a is not _NO))
-            if (
-                session.plain  # (in this process, core 1)
-                and ctl.card is None
-                and ctl.clock._thread is None
-                and ctl.axes.get(n) is res.ax
-            ):
-                tp = type(p)
-                if tp is _CArg:
-                    s = target(p)
-                    if s is p:
-                        s = None
-                else:
-                    s = p if tp is cls else None
-                if s is not None:
-                    bank = ctl.bank
-                    if bank is not None:  # (what the table path does first)
-                        bank.before_axis_call(res.ax, res)
-                    if res.profile.mode is mode:
-                        try:
-                            fill(res, s)
-                        except Exception:  # (the table path raises it again: its code)
-                            return slow(n, p)
-                        session.last = None
-                        clock = ctl.clock
-                        if clock.mode is _LOCKSTEP:
-                            return 0
-                        return advance(ctl, name, 0)
+            tp = type(p)
+            if tp is _CArg:
+                s = target(p)
+                if s is p:
+                    s = None
+            else:
+                s = p if tp is cls else None
+            got = None if s is None else ready(n)
+            if got is not None:
+                ctl, res = got
+                bank = ctl.bank
+                if bank is not None:  # (what the table path does first)
+                    bank.before_axis_call(res.ax, res)
+                if res.profile.mode is mode:
+                    try:
+                        fill(res, s)
+                    except Exception:  # (the table path raises it again: its code)
+                        return slow(n, p)
+                    session.last = None
+                    clock = ctl.clock
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    packed = STRUCT_BYTES.get(name)
+    if packed is None:
+        return gt
+    to_bytes, size = packed
+
+    def value(n: int) -> Any:
+        """The C entry's value: the structure's bytes on the lockstep clock, else _NO."""
+        got = ready(n)
+        if got is None or got[0].clock.mode is not _LOCKSTEP:
+            return _NO
+        ctl, res = got
+        bank = ctl.bank
+        if bank is not None:  # (what the table path does first)
+            bank.before_axis_call(res.ax, res)
+        if res.profile.mode is not mode:
+            return _NO
+        try:
+            b = to_bytes(res)
+        except Exception:  # (a value a field wraps: the Python path's field setters)
+            return _NO
+        session.last = None
+        return b
+
+    return _entry(gt, value, [cls], centry.BYTES, size)  # type: ignore[no-any-return]
 
 
 #: the session's core reader on the fast path (it reads no controller)
@@ -2017,7 +2134,8 @@ def fast_io_reader(
     exec(compile(code, f"<gt fast io {name}>", "exec"), env)
     gt = env["gt"]
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    exec(compile(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>", "exec"), env)
+    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
 
 
 #: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'
@@ -2066,6 +2184,28 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
                             return 0
                         return advance(ctl, name, 0)
     return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
+"""
+
+
+#: an IO reader's value for its C entry (the common case of ``_IO_READER``: a reader kept,
+#: the lockstep clock, no axis of the bank to give back first); else _NO
+_IO_VALUE = """
+def value(t):
+    if {lo} <= t <= {hi} and session.plain and session.note is None:
+        try:
+            ctl = session.controllers[1]
+            read = ctl.input_plans[t + {kind}]
+        except KeyError:  # none kept (yet, or since a change), no controller
+            return _NO
+        # (a lockstep clock never runs a thread of its own: Clock.start runs one in real
+        # time only)
+        if ctl.clock.mode is _LOCKSTEP:
+            bank = ctl.bank
+            if not (RELEASES and bank is not None and bank.n_alive):
+                v = read()
+                session.last = None
+                return v
+    return _NO
 """
 
 

@@ -243,3 +243,79 @@ def test_a_value_the_object_cannot_hold_is_left_to_the_python_path() -> None:
                 got.append((rc, o.value, gt.GTE_GetLastError() if rc else ""))
         assert got[:2] == got[2:], (latched, got)
     res.latched = 0
+
+
+#: the two-argument readers with a C entry: function -> first arguments to try
+TWO_ARG = {
+    **{n: [0, 3, 5, 6, 7, -1, 32, True, 1.0] for n in fast.IO_READERS},
+    **{n: [1, 2, 3, 0, True, 1.0] for n in fast.ECAT_READERS},
+    fast.HOMING: [1, 2, 3, 0, True, 1.0],
+    **{n: [1, 2, 3, 0, True, 1.0] for n in fast.STRUCT_READERS},
+}
+TWO_ARG_TYPES = [
+    ctypes.c_int32,
+    ctypes.c_long,
+    ctypes.c_int16,
+    ctypes.c_uint16,
+    ctypes.c_uint32,
+    ctypes.c_ulong,
+    ctypes.c_int8,
+    ctypes.c_double,
+]
+
+
+def _two_arg_cases() -> list[tuple]:
+    out = []
+    for name, firsts in sorted(TWO_ARG.items()):
+        types = [fast.STRUCT_READERS[name][0]] if name in fast.STRUCT_READERS else TWO_ARG_TYPES
+        for kind in KINDS:
+            if name in fast.STRUCT_READERS and kind in ("numpy", "field"):
+                continue
+            for t in types:
+                for first in firsts:
+                    for tail in [(), (1,), "kw"]:
+                        out.append((name, kind, t, first, tail))
+    if LONG:
+        return out
+    rnd = random.Random(31)
+    common = [c for c in out if c[1] in ("byref", "reused", "obj") and c[4] == ()]
+    return rnd.sample(common, 150) + rnd.sample(out, 250)
+
+
+@needs_cc
+def test_the_two_argument_readers_answer_as_their_python_path_and_the_table(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """GT_GetDi, GT_GetDiRaw, GT_GetDo, the PDO readers, the homing status and the Trap
+    parameters: with the C entry, without it, and the table path."""
+    _open()
+    gt.GT_PrfTrap(2)  # (axis 2 in Trap: its parameters readable; axis 1 moving in Trap)
+    built = {}
+    for in_c in (True, False):
+        monkeypatch.setattr(fast, "CENTRY", in_c)
+        for name in TWO_ARG:
+            slow = getattr(gt, name).slow
+            built[name, in_c] = fast.FAST_MAKERS[name](name, slow, _core.SESSION, _core.advance)
+    assert all(hasattr(built[n, True], "python") for n in TWO_ARG)
+    bad = []
+    for case in _two_arg_cases():
+        name, kind, t, first, tail = case
+        got = []
+        for fn in (built[name, True], built[name, False], getattr(gt, name).slow):
+            for _ in range(2):  # (the second call: with what the first one kept)
+                o, p = _arg(kind, t)
+                if tail == "kw":
+                    rc = fn(first, **{fast_param(name): p})
+                else:
+                    rc = fn(first, p, *tail)
+            got.append((rc, _shown(o), gt.GTE_GetLastError() if rc else ""))
+        if not got[0] == got[1] == got[2]:
+            bad.append(f"{case}: C {got[0]}, Python {got[1]}, table {got[2]}")
+    assert not bad, "\n".join(bad[:8])
+
+
+def fast_param(name: str) -> str:
+    """The name of ``name``'s pointer parameter (a keyword call)."""
+    from gtecat.gt.table import FUNCTIONS
+
+    return FUNCTIONS[name].params[1].name
