@@ -34,7 +34,7 @@ from . import byref_target
 log = logging.getLogger(__name__)
 
 _METH_FASTCALL_KEYWORDS = 0x0080 | 0x0002
-_MAX_TYPES = 8
+_MAX_TYPES = 16
 _VP = ctypes.c_void_p
 _WORD = ctypes.sizeof(_VP)
 
@@ -78,6 +78,7 @@ class _Entry(ctypes.Structure):
         ("types", _VP * _MAX_TYPES),
         ("sizes", ctypes.c_ssize_t * _MAX_TYPES),
         ("signs", ctypes.c_ssize_t * _MAX_TYPES),
+        ("derefs", ctypes.c_ssize_t * _MAX_TYPES),
     ]
 
 
@@ -172,15 +173,20 @@ def _load() -> tuple[Maker | None, str]:
         core: bool,
         most: int = 4,
         size: int = 0,
+        pointers: bool = False,
     ) -> Any:
         kinds = tuple(types)
+        if pointers:  # (pointer(x) too: x's memory, of x's type)
+            kinds += tuple(ctypes.POINTER(t) for t in kinds)
         if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
-            raise ValueError("one to seven types, two to four arguments")
+            raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
         for k, t in enumerate(kinds):
+            e.derefs[k] = int(issubclass(t, ctypes._Pointer))
+            x = t._type_ if e.derefs[k] else t
             e.types[k] = id(t)
-            e.sizes[k] = size or ctypes.sizeof(t)
-            e.signs[k] = int(kind != INT or not getattr(t, "_type_", "").isupper())
+            e.sizes[k] = size or ctypes.sizeof(x)
+            e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, (fallback, value, sentinel, kinds))
         # a partial: it passes its arguments straight on (no frame) and, unlike a built-in
         # function, takes the attributes the GT layer gives its functions
@@ -208,6 +214,7 @@ def _self_test(make: Maker) -> str:
     ints = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], INT, False)
     doubles = make(python, fvalue, nope, [ctypes.c_double], DOUBLE, False)
     gtn = make(python, value, nope, [ctypes.c_int64], INT, True)
+    ptrs = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], INT, False, 4, 0, True)
     narrow = make(python, value, nope, [ctypes.c_int16, ctypes.c_uint16], INT, False, 2)
 
     class Pair(ctypes.Structure):
@@ -259,6 +266,12 @@ def _self_test(make: Maker) -> str:
         (gtn, (1, 2), lambda: (o := L(), o, o), (1, 0), 1 << 40),
         (gtn, (2, 1), lambda: (o := L(), ctypes.byref(o), o), (), None),
         (gtn, (1,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ptrs, (1,), lambda: (o := L(), ctypes.pointer(o), o), (), 7),
+        (ptrs, (1,), lambda: (o := I32(), ctypes.pointer(o), o), (1, 0), 7),
+        (ptrs, (2,), lambda: (o := I32(), ctypes.pointer(o), o), (), None),  # too wide
+        (ptrs, (1,), lambda: (o := L(), ctypes.POINTER(L)(), o), (), None),  # NULL
+        (ptrs, (1,), lambda: (o := L(), ctypes.byref(ctypes.pointer(o)), o), (), None),
+        (ptrs, (1,), lambda: (o := D(), ctypes.pointer(o), o), (), None),
         (narrow, (1,), lambda: (o := ctypes.c_int16(), ctypes.byref(o), o), (), 7),
         (narrow, (1,), lambda: (o := ctypes.c_uint16(), o, o), (), 7),
         (narrow, (6,), lambda: (o := ctypes.c_int16(), o, o), (), None),
@@ -322,15 +335,17 @@ def reader(
     core: bool = False,
     most: int = 4,
     size: int = 0,
+    pointers: bool = False,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
     (of one of ``types``) for the common shape, else ``fallback`` with the same arguments;
     ``value`` gives ``sentinel`` where the entry must not answer.  ``kind``: :data:`INT`
     (each type's width and sign), :data:`DOUBLE`, or :data:`BYTES` (``value`` gives
-    ``size`` bytes, copied to the start of the object).  A ``functools.partial`` of the
+    ``size`` bytes, copied to the start of the object); ``pointers``: ``pointer(x)`` of
+    those types too (``x``'s memory; NULL: ``fallback``).  A ``functools.partial`` of the
     built-in function (it takes attributes); None where the C entry is not available
     (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE(fallback, value, sentinel, types, kind, core, most, size)
+    return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers)

@@ -421,12 +421,14 @@ def fast_reader(
     if CENTRY:  # the common shape in C where it is available (gtecat.gt.centry)
         env["NOPE"] = _NO
         kind = centry.DOUBLE if ctypes_ok is _DOUBLE else centry.INT
+        types = sorted(ctypes_ok, key=str)
         entry = centry.reader(
-            gt, _value_function(env, "value_gt", "session.plain"), _NO, ctypes_ok, kind
-        )
+            gt, _value_function(env, "value_gt", "session.plain"), _NO, types, kind,
+            pointers=True,  # (pointer(x): as general answers it)
+        )  # fmt: skip
         entry_gtn = centry.reader(
-            gt.gtn, _value_function(env, "value_gtn", "session.local"), _NO, ctypes_ok, kind,
-            core=True,
+            gt.gtn, _value_function(env, "value_gtn", "session.local"), _NO, types, kind,
+            core=True, pointers=True,
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]

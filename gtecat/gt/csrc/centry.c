@@ -41,7 +41,7 @@ struct api {
     void (*err_clear)(void);
 };
 
-#define MAX_TYPES 8
+#define MAX_TYPES 16
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
 struct entry {
@@ -54,6 +54,7 @@ struct entry {
     obj types[MAX_TYPES]; /* the ctypes types *pValue may have, NULL-ended */
     ptrdiff_t sizes[MAX_TYPES];
     ptrdiff_t signs[MAX_TYPES]; /* an integer type: 1 signed, 0 unsigned */
+    ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
 };
 
 static struct api A;
@@ -97,7 +98,7 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
     ptrdiff_t at = e->core;
     obj p, target, tp, v;
     char *mem;
-    int k, size = 0, sign = 1;
+    int k, size = 0, sign = 1, deref = 0;
 
     if (!ready || kwnames || nargs < 2 + at || nargs > e->most + at)
         goto python;
@@ -122,14 +123,19 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
         if (e->types[k] == tp) {
             size = (int)e->sizes[k];
             sign = (int)e->signs[k];
+            deref = (int)e->derefs[k];
             break;
         }
     }
     if (!size)
         goto python;
     mem = AT(target, A.b_ptr);
-    if (target != p && AT(p, A.carg_value) != mem)
+    if (deref) { /* pointer(x) itself (not a byref of it): x's memory, not NULL */
+        if (target != p || !mem || !(mem = *(char **)mem))
+            goto python;
+    } else if (target != p && AT(p, A.carg_value) != mem) {
         goto python;
+    }
 
     v = A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
