@@ -316,7 +316,8 @@ def fast_reader(
         if bank_key is not None and b is not None:
             # every axis of the span a row of the bank: its rows, found once while no row is
             # claimed or released (the bank's layout) and the controller's axes are the same
-            key = (bank_key, n, count)
+            # (an axis the controller has but no drive backs: 0, where ``zeros``)
+            key = (bank_key, n, count, zeros)
             plan = b.read_plans.get(key)
             if (
                 plan is None
@@ -324,7 +325,8 @@ def fast_reader(
                 or plan[1] is not resources
                 or plan[2] is not axes
             ):
-                plan = b.read_plans[key] = _read_plan(b, resources, axes, n, count)
+                top = resource_count(ctl) if zeros and axes else 0
+                plan = b.read_plans[key] = _read_plan(b, resources, axes, n, count, top)
             pick = plan[3]
             if pick is not None:
                 lst = b._lists.get(bank_key)
@@ -335,7 +337,7 @@ def fast_reader(
                     lst = b._lists.get(bank_key)
                     if lst is not None:
                         values = list(pick(lst))
-                        values[0] = first
+                        values[plan[5]] = first
                         p[:count] = values
                 if lst is not None:
                     if clk is not None:
@@ -575,19 +577,34 @@ BANK_LISTS = {
 }
 
 
-def _read_plan(b: Any, resources: Any, axes: Any, n: int, count: int) -> tuple[Any, ...]:
-    """(the bank's layout, the resources and axes looked at, a getter of the span's rows in a
-    list of the bank's values or None when some axis of the span is not a row of ``b``, the
-    first axis's resources)."""
+def _read_plan(
+    b: Any, resources: Any, axes: Any, n: int, count: int, top: int = 0
+) -> tuple[Any, ...]:
+    """(the bank's layout, the resources and axes looked at, a getter of the span's values
+    from a list of the bank's values or None when some axis of the span is neither a row of
+    ``b`` nor, within ``1..top``, an axis no drive backs (it reads 0), the first row's
+    resources, its place in the span)."""
+    none = (b.layout, resources, axes, None, None, 0)
     if count < 2:  # (one value: no tuple to store)
-        return (b.layout, resources, axes, None, None)
-    rows = []
+        return none
+    rows: list[int | None] = []
     for k in range(n, n + count):
+        if k not in axes and 1 <= n <= n + count - 1 <= top:
+            rows.append(None)
+            continue
         res = resources.get(k)
         if res is None or axes.get(k) is not res.ax or res.bank is not b:
-            return (b.layout, resources, axes, None, None)
+            return none
         rows.append(res.bank_row)
-    return (b.layout, resources, axes, itemgetter(*rows), resources.get(n))
+    at = next((i for i, r in enumerate(rows) if r is not None), None)
+    if at is None:
+        return none
+    if all(r is not None for r in rows):
+        pick = itemgetter(*rows)
+    else:  # (the rows and the zeros in one tuple)
+        items = ", ".join("0" if r is None else f"lst[{r}]" for r in rows)
+        pick = eval(f"lambda lst: ({items},)")  # (row numbers and zeros only)
+    return (b.layout, resources, axes, pick, resources.get(n + at), at)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
