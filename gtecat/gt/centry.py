@@ -24,6 +24,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import logging
+import struct
 import sys
 from collections.abc import Callable, Iterable
 from importlib import resources
@@ -54,6 +55,7 @@ class _Api(ctypes.Structure):
         ("int_type", _VP),
         ("float_type", _VP),
         ("bytes_type", _VP),
+        ("array_meta", _VP),
         ("none", _VP),
         ("zero", _VP),
         ("incref", _VP),
@@ -79,6 +81,18 @@ class _Entry(ctypes.Structure):
         ("sizes", ctypes.c_ssize_t * _MAX_TYPES),
         ("signs", ctypes.c_ssize_t * _MAX_TYPES),
         ("derefs", ctypes.c_ssize_t * _MAX_TYPES),
+    ]
+
+
+class _RawEntry(ctypes.Structure):
+    """``struct raw_entry`` of csrc/centry.c: a raw image function's entry."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("value", _VP),
+        ("sentinel", _VP),
+        ("io", ctypes.c_ssize_t),
+        ("write", ctypes.c_ssize_t),
     ]
 
 
@@ -146,6 +160,7 @@ def _load() -> tuple[Maker | None, str]:
             id(int),
             id(float),
             id(bytes),
+            id(type(ctypes.Array)),
             id(None),
             id(0),
             _address("Py_IncRef"),
@@ -160,6 +175,7 @@ def _load() -> tuple[Maker | None, str]:
         if lib.gtecat_centry_api(ctypes.byref(api)) != 0:
             return None, "the library refused the layout"
         meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
+        raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
         new = byref_target.function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
@@ -192,7 +208,21 @@ def _load() -> tuple[Maker | None, str]:
         # function, takes the attributes the GT layer gives its functions
         return functools.partial(fn)
 
-    reason = _self_test(make)
+    def make_raw(
+        fallback: Callable[..., Any],
+        value: Callable[..., Any],
+        sentinel: Any,
+        io: bool,
+        write: bool,
+    ) -> Any:
+        e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write))
+        fn = new(
+            b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, (fallback, value, sentinel)
+        )
+        return functools.partial(fn)
+
+    make.raw = make_raw  # type: ignore[attr-defined]
+    reason = _self_test(make) or _self_test_raw(make_raw)
     return (make, "") if not reason else (None, reason)
 
 
@@ -321,6 +351,74 @@ def _self_test(make: Maker) -> str:
     return ""
 
 
+def _self_test_raw(make_raw: Maker) -> str:
+    """'' when raw entries copy what they must, hand on the rest and keep reference counts."""
+    nope = object()
+    image = (ctypes.c_ubyte * 16)(*range(16))
+    base = ctypes.addressof(image)
+    U8 = ctypes.c_ubyte * 8
+
+    def value(*a: Any) -> Any:  # ([slave,] offset, size, type): inside the image, U8 only
+        offset, size, tp = a[-3:]
+        if tp is not U8 or offset + size > 16 or size > 8 or (len(a) == 4 and a[0] != 2):
+            return nope
+        if size == 5:  # (two runs: the image's bytes 0..1 and then 8..10)
+            return runs([(0, base, 2), (2, base + 8, 3)])
+        if size == 6:  # (a run past the buffer)
+            return runs([(4, base, 3)])
+        return runs([(0, base + offset, size)])
+
+    def runs(r: list[tuple[int, int, int]]) -> bytes:
+        return b"".join(struct.pack("=qqq", *x) for x in r)
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    get = make_raw(python, value, nope, False, False)
+    put = make_raw(python, value, nope, False, True)
+    io = make_raw(python, value, nope, True, False)
+    cases: list[tuple[Any, tuple, Any]] = [
+        (get, (4, 8), lambda: (o := U8(), o, bytes(range(4, 12)))),
+        (get, (4, 8), lambda: (o := U8(), ctypes.byref(o), bytes(range(4, 12)))),
+        (get, (0, 3), lambda: (o := U8(), o, bytes([0, 1, 2, 0, 0, 0, 0, 0]))),
+        (get, (0, 5), lambda: (o := U8(), o, bytes([0, 1, 8, 9, 10, 0, 0, 0]))),
+        (get, (0, 6), lambda: (o := U8(), o, None)),
+        (io, (2, 1, 2), lambda: (o := U8(), o, bytes([1, 2, 0, 0, 0, 0, 0, 0]))),
+        (io, (3, 1, 2), lambda: (o := U8(), o, None)),
+        (get, (12, 8), lambda: (o := U8(), o, None)),  # past the image
+        (get, (0, 0), lambda: (o := U8(), o, None)),
+        (get, (0, -1), lambda: (o := U8(), o, None)),
+        (get, (True, 2), lambda: (o := U8(), o, None)),
+        (get, (0, 2.0), lambda: (o := U8(), o, None)),
+        (get, (0, 1 << 70), lambda: (o := U8(), o, None)),
+        (get, (0, 2), lambda: (o := (ctypes.c_ubyte * 9)(), o, None)),  # another type
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), None)),
+        (get, (0, 2), lambda: (o := bytearray(8), o, None)),
+        (get, (0,), lambda: (o := U8(), o, None)),
+    ]
+    for fn, before, made in cases:
+        o, p, want = made()
+        args = (*before, p)
+        watched = [o, p, nope, *before]
+        counts = [sys.getrefcount(x) for x in watched]
+        for _ in range(3):
+            got = fn(*args)
+            if want is None:
+                if got != ("python", args, {}):
+                    return f"the raw entry answered {got!r} for {args!r} (Python must)"
+            elif got != 0 or bytes(o) != want:
+                return f"the raw entry answered {got!r}, {bytes(o)!r} for {args!r}"
+            del got
+        if fn(*args, kw=1) != ("python", args, {"kw": 1}):
+            return "the raw entry answered a call with a keyword"
+        if [sys.getrefcount(x) for x in watched] != counts:
+            return f"the raw entry changed a reference count ({args!r})"
+    src = U8(*range(50, 58))
+    if put(2, 4, src) != 0 or bytes(image)[:8] != bytes([0, 1, 50, 51, 52, 53, 6, 7]):
+        return "the raw entry did not write into the image"
+    return ""
+
+
 _MAKE, REASON = _load()
 if _MAKE is None:
     log.debug("C entry of the fast readers not used: %s", REASON)
@@ -349,3 +447,28 @@ def reader(
     if _MAKE is None:
         return None
     return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers)
+
+
+def raw(
+    fallback: Callable[..., Any], value: Callable[..., Any], sentinel: Any, io: bool, write: bool
+) -> Any:
+    """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
+    ctypes array (or ``byref`` of one, no offset) and plain ints copies the runs that
+    ``value([slave,] offset, size, type(array))`` gives between the array and the image
+    (into the image where ``write``): ``(first byte in the array, address, bytes)`` as
+    native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
+    where the entry must not answer (it checks the array's type and size); every other
+    call: ``fallback``.  None where the
+    C entry is not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE.raw(fallback, value, sentinel, io, write)  # type: ignore[attr-defined]
+
+
+_RUN = struct.Struct("=qqq")
+
+
+def runs(triples: Iterable[tuple[int, int, int]]) -> bytes:
+    """Runs of a copy as :func:`raw`'s ``value`` gives them: ``(first byte in the caller's
+    array, address in the image, bytes)`` each."""
+    return b"".join(_RUN.pack(*t) for t in triples)

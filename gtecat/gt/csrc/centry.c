@@ -9,6 +9,12 @@
  * else - another shape, the sentinel, a number the type does not hold, any doubt - is the
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
+ * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
+ * of their own: a ctypes array (or byref of one, no offset) and plain ints checked here, the
+ * runs of the range in the process image from one Python call (value(offset, size, type), as
+ * int64 triples in a bytes object: that function checks everything else, the array's type
+ * and size included), and the bytes copied run by run with memcpy.
+ *
  * No Python header: where the interpreter keeps a pointer object's address and object, an
  * object's type, a ctypes object's memory and a float's value, and the C API's functions, are
  * handed over by the loader, which probed them on objects whose answers it knows and tests
@@ -16,6 +22,7 @@
  */
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 typedef void *obj;
 
@@ -31,6 +38,7 @@ struct api {
     obj int_type;
     obj float_type;
     obj bytes_type;
+    obj array_meta; /* the type of ctypes array types */
     obj none;
     obj zero; /* the int 0 (the return code) */
     void (*incref)(obj);
@@ -67,7 +75,8 @@ int gtecat_centry_api(const struct api *api)
 {
     if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
         api->fval < 0 || api->bsize < 0 || api->bdata < 0 || !api->carg_type ||
-        !api->int_type || !api->float_type || !api->bytes_type || !api->none ||
+        !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
+        !api->none ||
         !api->zero || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear)
         return 1;
@@ -179,6 +188,82 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
             *(int32_t *)mem = (int32_t)x;
         else
             *(int64_t *)mem = (int64_t)x;
+    }
+    A.decref(v);
+    A.incref(A.zero);
+    return A.zero;
+
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* a raw image function's entry */
+struct raw_entry {
+    obj fallback; /* the Python fast function */
+    obj value;    /* value([slave,] offset, size, array type): the range's runs, or sentinel */
+    obj sentinel;
+    ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
+    ptrdiff_t write; /* 1: from the buffer into the image */
+};
+
+obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    const struct raw_entry *e = (const struct raw_entry *)AT(self, A.b_ptr);
+    ptrdiff_t at = e->io, k, n;
+    obj p, target, v, call[4];
+    const int64_t *runs;
+    long long size;
+    int over = 0;
+    char *mem;
+
+    if (!ready || kwnames || nargs != 3 + at)
+        goto python;
+    for (k = 0; k < 2 + at; k++)
+        if (TYPE(args[k]) != A.int_type)
+            goto python;
+    p = args[2 + at];
+    target = p;
+    if (TYPE(p) == A.carg_type) { /* byref(array) with no offset: the array */
+        target = AT(p, A.carg_obj);
+        if (!target || AT(p, A.carg_value) != AT(target, A.b_ptr))
+            goto python;
+    }
+    if (TYPE(TYPE(target)) != A.array_meta)
+        goto python;
+    size = A.as_ll(args[1 + at], &over);
+    if (over || size <= 0) {
+        if (size == -1 && !over && A.err_occurred())
+            A.err_clear();
+        goto python;
+    }
+    for (k = 0; k < 2 + at; k++)
+        call[k] = args[k];
+    call[2 + at] = TYPE(target);
+    v = A.vectorcall(e->value, call, (size_t)(3 + at), NULL);
+    if (!v)
+        return NULL; /* (the value's own error, as the Python path would raise it) */
+    if (v == e->sentinel || TYPE(v) != A.bytes_type)
+        goto drop;
+    /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
+    if (n <= 0 || n % 24)
+        goto drop;
+    runs = (const int64_t *)((char *)v + A.bdata);
+    mem = AT(target, A.b_ptr);
+    for (k = 0; k < n / 24; k++) {
+        const int64_t *r = runs + 3 * k;
+        if (r[0] < 0 || r[2] <= 0 || r[0] + r[2] > size || !r[1])
+            goto drop;
+    }
+    for (k = 0; k < n / 24; k++) {
+        const int64_t *r = runs + 3 * k;
+        char *image = (char *)(intptr_t)r[1];
+        if (e->write)
+            memcpy(image, mem + r[0], (size_t)r[2]);
+        else
+            memcpy(mem + r[0], image, (size_t)r[2]);
     }
     A.decref(v);
     A.incref(A.zero);

@@ -319,3 +319,61 @@ def fast_param(name: str) -> str:
     from gtecat.gt.table import FUNCTIONS
 
     return FUNCTIONS[name].params[1].name
+
+
+def _raw_buffers(size: int) -> list[tuple[str, Any]]:
+    n = max(size, 1)
+    return [
+        ("c_ubyte", lambda: (o := (ctypes.c_ubyte * n)(*range(7, 7 + n)), o)),
+        ("byref", lambda: (o := (ctypes.c_ubyte * n)(*range(7, 7 + n)), byref(o))),
+        ("byref offset", lambda: (o := (ctypes.c_ubyte * (n + 1))(), byref(o, 1))),
+        ("short", lambda: (o := (ctypes.c_ubyte * max(n - 1, 1))(), o)),
+        ("c_int32", lambda: (o := (ctypes.c_int32 * n)(*range(n)), o)),
+        ("c_void_p", lambda: (o := (ctypes.c_void_p * n)(), o)),
+        ("bytearray", lambda: (o := bytearray(range(3, 3 + n)), o)),
+        ("numpy", lambda: (o := np.arange(n, dtype=np.uint8), o)),
+        ("c_long", lambda: (o := ctypes.c_long(5), o)),
+    ]
+
+
+@needs_cc
+def test_the_raw_entries_answer_as_their_python_path_and_the_table(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """GT_Get/SetEcatRawData and GT_EcatIORead/WriteOutput with the C entry, without it, and
+    the table path: each range of figure 5-2's image (and past it), each buffer kind; the
+    buffer and the image alike afterwards."""
+    ctl = _open()
+    built = {}
+    for in_c in (True, False):
+        monkeypatch.setattr(fast, "CENTRY", in_c)
+        for name in fast.RAW:
+            slow = getattr(gt, name).slow
+            built[name, in_c] = fast.fast_raw(name, slow, _core.SESSION, _core.advance)
+    assert all(hasattr(built[n, True], "python") for n in fast.RAW)
+    rnd = random.Random(32)
+    bad = []
+    cases = []
+    for name in sorted(fast.RAW):
+        io = name in ("GT_EcatIOReadInput", "GT_EcatIOWriteOutput")
+        for offset in [-1, 0, 3, 6, 12, 30, 32, 38, 41, 44] if not io else [-1, 0, 1, 3, 6]:
+            for size in (0, 1, 2, 4, 8, 11):
+                for label, make in _raw_buffers(size):
+                    for slave in [2, 0, 5, True] if io else [None]:
+                        cases.append((name, offset, size, label, make, slave))
+    if not LONG:
+        cases = rnd.sample(cases, 400)
+    for k, (name, offset, size, label, make, slave) in enumerate(cases):
+        got = []
+        for fn in (built[name, True], built[name, False], getattr(gt, name).slow):
+            image = ctl.master.image.buffer
+            image[:] = np.arange(len(image), dtype=np.uint8)  # (the same image for each)
+            for _ in range(2):  # (the second call: with what the first one kept)
+                o, p = make()
+                args = (offset, size, p) if slave is None else (slave, offset, size, p)
+                rc = fn(*args[:-1], pValue=p) if k % 9 == 0 else fn(*args)
+            shown = bytes(o) if not isinstance(o, np.ndarray) else o.tobytes()
+            got.append((rc, shown, bytes(image), gt.GTE_GetLastError() if rc else ""))
+        if not got[0] == got[1] == got[2]:
+            bad.append(f"{name}{(slave, offset, size, label)}: {[g[0::3] for g in got]}")
+    assert not bad, "\n".join(bad[:8])
