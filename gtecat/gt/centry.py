@@ -51,11 +51,13 @@ class _Api(ctypes.Structure):
         ("fval", ctypes.c_ssize_t),
         ("bsize", ctypes.c_ssize_t),
         ("bdata", ctypes.c_ssize_t),
+        ("bastart", ctypes.c_ssize_t),
         ("carg_type", _VP),
         ("int_type", _VP),
         ("float_type", _VP),
         ("bytes_type", _VP),
         ("array_meta", _VP),
+        ("bytearray_type", _VP),
         ("none", _VP),
         ("zero", _VP),
         ("incref", _VP),
@@ -124,6 +126,23 @@ def _bytes_at() -> tuple[int, int]:
     raise ValueError("a bytes object's bytes are not where they are looked for")
 
 
+def _bytearray_at(size_at: int) -> int:
+    """Where a bytearray keeps the address of its first byte (its length where a bytes
+    object's is; ValueError when the probe disagrees)."""
+    samples = [bytearray(b"abcdefgh" * 3), bytearray(40), bytearray(b"0123456789")]
+    del samples[2][:3]  # (a bytearray whose first byte is not its allocation's)
+    firsts = [ctypes.addressof((ctypes.c_char * len(b)).from_buffer(b)) for b in samples]
+    for b in samples:
+        if ctypes.c_ssize_t.from_address(id(b) + size_at).value != len(b):
+            raise ValueError("a bytearray's length is not where it is looked for")
+    for k in range(size_at + _WORD, bytearray.__basicsize__, _WORD):
+        if all(
+            _VP.from_address(id(b) + k).value == a for b, a in zip(samples, firsts, strict=True)
+        ):
+            return k
+    raise ValueError("a bytearray's bytes are not where they are looked for")
+
+
 def _address(name: str) -> int:
     return ctypes.cast(getattr(ctypes.pythonapi, name), _VP).value or 0
 
@@ -141,6 +160,7 @@ def _load() -> tuple[Maker | None, str]:
         carg_value, carg_obj, ob_type, b_ptr = byref_target.layout()
         fval = _float_at()
         bsize, bdata = _bytes_at()
+        bastart = _bytearray_at(bsize)
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -156,11 +176,13 @@ def _load() -> tuple[Maker | None, str]:
             fval,
             bsize,
             bdata,
+            bastart,
             id(type(ctypes.byref(ctypes.c_int()))),
             id(int),
             id(float),
             id(bytes),
             id(type(ctypes.Array)),
+            id(bytearray),
             id(None),
             id(0),
             _address("Py_IncRef"),
@@ -360,7 +382,9 @@ def _self_test_raw(make_raw: Maker) -> str:
 
     def value(*a: Any) -> Any:  # ([slave,] offset, size, type): inside the image, U8 only
         offset, size, tp = a[-3:]
-        if tp is not U8 or offset + size > 16 or size > 8 or (len(a) == 4 and a[0] != 2):
+        if tp not in (U8, bytearray, bytes) or offset + size > 16 or size > 8:
+            return nope
+        if len(a) == 4 and a[0] != 2:
             return nope
         if size == 5:  # (two runs: the image's bytes 0..1 and then 8..10)
             return runs([(0, base, 2), (2, base + 8, 3)])
@@ -377,6 +401,7 @@ def _self_test_raw(make_raw: Maker) -> str:
     get = make_raw(python, value, nope, False, False)
     put = make_raw(python, value, nope, False, True)
     io = make_raw(python, value, nope, True, False)
+    bget = get
     cases: list[tuple[Any, tuple, Any]] = [
         (get, (4, 8), lambda: (o := U8(), o, bytes(range(4, 12)))),
         (get, (4, 8), lambda: (o := U8(), ctypes.byref(o), bytes(range(4, 12)))),
@@ -393,8 +418,11 @@ def _self_test_raw(make_raw: Maker) -> str:
         (get, (0, 1 << 70), lambda: (o := U8(), o, None)),
         (get, (0, 2), lambda: (o := (ctypes.c_ubyte * 9)(), o, None)),  # another type
         (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), None)),
-        (get, (0, 2), lambda: (o := bytearray(8), o, None)),
         (get, (0,), lambda: (o := U8(), o, None)),
+        (bget, (4, 8), lambda: (o := bytearray(9), o, bytes([*range(4, 12), 0]))),
+        (bget, (4, 8), lambda: (o := bytearray(7), o, None)),  # too short
+        (bget, (4, 3), lambda: (o := bytes(8), o, None)),  # (bytes: read only)
+        (bget, (4, 3), lambda: (o := memoryview(bytearray(8)), o, None)),
     ]
     for fn, before, made in cases:
         o, p, want = made()
@@ -416,6 +444,10 @@ def _self_test_raw(make_raw: Maker) -> str:
     src = U8(*range(50, 58))
     if put(2, 4, src) != 0 or bytes(image)[:8] != bytes([0, 1, 50, 51, 52, 53, 6, 7]):
         return "the raw entry did not write into the image"
+    if put(1, 2, b"\x09\x08\x07") != 0 or bytes(image)[:4] != bytes([0, 9, 8, 51]):
+        return "the raw entry did not write bytes into the image"
+    if get(0, 2, bytes(4)) != ("python", (0, 2, bytes(4)), {}):
+        return "the raw entry read into bytes"
     return ""
 
 
@@ -453,7 +485,8 @@ def raw(
     fallback: Callable[..., Any], value: Callable[..., Any], sentinel: Any, io: bool, write: bool
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
-    ctypes array (or ``byref`` of one, no offset) and plain ints copies the runs that
+    ctypes array (or ``byref`` of one, no offset), a bytearray of at least ``size`` bytes
+    (or bytes, where ``write``) and plain ints copies the runs that
     ``value([slave,] offset, size, type(array))`` gives between the array and the image
     (into the image where ``write``): ``(first byte in the array, address, bytes)`` as
     native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``

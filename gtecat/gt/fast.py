@@ -1218,8 +1218,9 @@ def fast_raw(
     addresses: dict[tuple[int, int, int], int | None] = {}
     addressed: list[Any] = [None]
     #: an array type -> its size where the C entry copies into or out of it (0: it holds
-    #: pointers, the table path's 7)
-    array_sizes: dict[type, int] = {}
+    #: pointers, the table path's 7); a bytearray's (and bytes', to write from) the C entry
+    #: checks itself
+    array_sizes: dict[type, int] = {bytearray: 1 << 62, bytes: 1 << 62 if write else 0}
 
     def address(slave: int, offset: int, size: int, image: Any) -> bytes | None:
         """Where a raw range (a slave's region: ``slave`` >= 0) lies in the image's buffer:

@@ -10,7 +10,8 @@
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
  * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
- * of their own: a ctypes array (or byref of one, no offset) and plain ints checked here, the
+ * of their own: a ctypes array (or byref of one, no offset), a bytearray (or, to write from,
+ * bytes) long enough, and plain ints checked here, the
  * runs of the range in the process image from one Python call (value(offset, size, type), as
  * int64 triples in a bytes object: that function checks everything else, the array's type
  * and size included), and the bytes copied run by run with memcpy.
@@ -34,11 +35,13 @@ struct api {
     ptrdiff_t fval;       /* a float's value */
     ptrdiff_t bsize;      /* a bytes object's length */
     ptrdiff_t bdata;      /* a bytes object's first byte */
+    ptrdiff_t bastart;    /* a bytearray's first byte (its length: where a bytes object's is) */
     obj carg_type;        /* the type of the pointer objects byref() makes */
     obj int_type;
     obj float_type;
     obj bytes_type;
     obj array_meta; /* the type of ctypes array types */
+    obj bytearray_type;
     obj none;
     obj zero; /* the int 0 (the return code) */
     void (*incref)(obj);
@@ -74,7 +77,8 @@ static int ready;
 int gtecat_centry_api(const struct api *api)
 {
     if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
-        api->fval < 0 || api->bsize < 0 || api->bdata < 0 || !api->carg_type ||
+        api->fval < 0 || api->bsize < 0 || api->bdata < 0 || api->bastart < 0 ||
+        !api->bytearray_type || !api->carg_type ||
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
         !api->zero || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
@@ -230,12 +234,19 @@ obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
         if (!target || AT(p, A.carg_value) != AT(target, A.b_ptr))
             goto python;
     }
-    if (TYPE(TYPE(target)) != A.array_meta)
-        goto python;
     size = A.as_ll(args[1 + at], &over);
     if (over || size <= 0) {
         if (size == -1 && !over && A.err_occurred())
             A.err_clear();
+        goto python;
+    }
+    if (TYPE(target) == A.bytearray_type || (e->write && TYPE(target) == A.bytes_type)) {
+        if (target != p || *(ptrdiff_t *)((char *)p + A.bsize) < size)
+            goto python;
+        mem = TYPE(p) == A.bytes_type ? (char *)p + A.bdata : AT(p, A.bastart);
+    } else if (TYPE(TYPE(target)) == A.array_meta) {
+        mem = AT(target, A.b_ptr);
+    } else {
         goto python;
     }
     for (k = 0; k < 2 + at; k++)
@@ -251,7 +262,6 @@ obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
-    mem = AT(target, A.b_ptr);
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         if (r[0] < 0 || r[2] <= 0 || r[0] + r[2] > size || !r[1])

@@ -331,6 +331,8 @@ def _raw_buffers(size: int) -> list[tuple[str, Any]]:
         ("c_int32", lambda: (o := (ctypes.c_int32 * n)(*range(n)), o)),
         ("c_void_p", lambda: (o := (ctypes.c_void_p * n)(), o)),
         ("bytearray", lambda: (o := bytearray(range(3, 3 + n)), o)),
+        ("short bytearray", lambda: (o := bytearray(max(n - 1, 0)), o)),
+        ("bytes", lambda: (o := bytes(range(3, 3 + n)), o)),
         ("numpy", lambda: (o := np.arange(n, dtype=np.uint8), o)),
         ("c_long", lambda: (o := ctypes.c_long(5), o)),
     ]
