@@ -83,6 +83,7 @@ class _Entry(ctypes.Structure):
         ("sizes", ctypes.c_ssize_t * _MAX_TYPES),
         ("signs", ctypes.c_ssize_t * _MAX_TYPES),
         ("derefs", ctypes.c_ssize_t * _MAX_TYPES),
+        ("noaxis", ctypes.c_ssize_t),
     ]
 
 
@@ -212,6 +213,7 @@ def _load() -> tuple[Maker | None, str]:
         most: int = 4,
         size: int = 0,
         pointers: bool = False,
+        noaxis: bool = False,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -219,6 +221,7 @@ def _load() -> tuple[Maker | None, str]:
         if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
             raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
+        e.noaxis = int(noaxis)
         for k, t in enumerate(kinds):
             e.derefs[k] = int(issubclass(t, ctypes._Pointer))
             x = t._type_ if e.derefs[k] else t
@@ -267,6 +270,7 @@ def _self_test(make: Maker) -> str:
     doubles = make(python, fvalue, nope, [ctypes.c_double], DOUBLE, False)
     gtn = make(python, value, nope, [ctypes.c_int64], INT, True)
     ptrs = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], INT, False, 4, 0, True)
+    clock = make(python, lambda: 7, nope, [ctypes.c_uint32], INT, False, 2, 0, False, True)
     narrow = make(python, value, nope, [ctypes.c_int16, ctypes.c_uint16], INT, False, 2)
 
     class Pair(ctypes.Structure):
@@ -324,6 +328,12 @@ def _self_test(make: Maker) -> str:
         (ptrs, (1,), lambda: (o := L(), ctypes.POINTER(L)(), o), (), None),  # NULL
         (ptrs, (1,), lambda: (o := L(), ctypes.byref(ctypes.pointer(o)), o), (), None),
         (ptrs, (1,), lambda: (o := D(), ctypes.pointer(o), o), (), None),
+        (clock, (), lambda: (o := ctypes.c_uint32(), ctypes.byref(o), o), (), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (None,), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (0,), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (1,), None),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (0, 0), None),
+        (clock, (), lambda: (o := ctypes.c_int32(), o, o), (), None),
         (narrow, (1,), lambda: (o := ctypes.c_int16(), ctypes.byref(o), o), (), 7),
         (narrow, (1,), lambda: (o := ctypes.c_uint16(), o, o), (), 7),
         (narrow, (6,), lambda: (o := ctypes.c_int16(), o, o), (), None),
@@ -466,6 +476,7 @@ def reader(
     most: int = 4,
     size: int = 0,
     pointers: bool = False,
+    noaxis: bool = False,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -473,12 +484,13 @@ def reader(
     ``value`` gives ``sentinel`` where the entry must not answer.  ``kind``: :data:`INT`
     (each type's width and sign), :data:`DOUBLE`, or :data:`BYTES` (``value`` gives
     ``size`` bytes, copied to the start of the object); ``pointers``: ``pointer(x)`` of
-    those types too (``x``'s memory; NULL: ``fallback``).  A ``functools.partial`` of the
-    built-in function (it takes attributes); None where the C entry is not available
-    (:data:`REASON`)."""
+    those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
+    ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``).
+    A ``functools.partial`` of the built-in function (it takes attributes); None where the
+    C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers)
+    return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis)
 
 
 def raw(

@@ -890,7 +890,29 @@ def fast_clock(
         return slow(*(a for a in (pClock, pLoop) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
-    return gt
+
+    def value() -> Any:
+        """The C entry's value: GT_GetClock's own on the lockstep clock, else _NO."""
+        try:
+            ctl = session.controllers[1]
+        except KeyError:  # no controller
+            return _NO
+        clock = ctl.clock
+        # (a lockstep clock never runs a thread of its own: real time only has one)
+        if session.plain and clock.mode is _LOCKSTEP:
+            ms = ((clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+            session.last = None
+            return ms
+        return _NO
+
+    if not CENTRY:
+        return gt
+    types = sorted(_CLOCK_INTS, key=str)
+    entry = centry.reader(gt, value, _NO, types, centry.INT, most=2, noaxis=True)
+    if entry is None:
+        return gt
+    entry.slow, entry.python = slow, gt
+    return entry
 
 
 def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], bytes | None]:

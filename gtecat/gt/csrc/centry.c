@@ -66,6 +66,7 @@ struct entry {
     ptrdiff_t sizes[MAX_TYPES];
     ptrdiff_t signs[MAX_TYPES]; /* an integer type: 1 signed, 0 unsigned */
     ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
+    ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
 };
 
 static struct api A;
@@ -113,17 +114,25 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
     char *mem;
     int k, size = 0, sign = 1, deref = 0;
 
-    if (!ready || kwnames || nargs < 2 + at || nargs > e->most + at)
+    if (!ready || kwnames)
         goto python;
-    if (at && !int_is(args[0], 1))
-        goto python;
-    if (TYPE(args[at]) != A.int_type)
-        goto python;
-    if (nargs >= 3 + at && !int_is(args[at + 2], 1))
-        goto python;
-    if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
-        goto python;
-    p = args[at + 1];
+    if (e->noaxis) {
+        if (nargs < 1 || nargs > 2 || (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
+            goto python;
+        p = args[0];
+    } else {
+        if (nargs < 2 + at || nargs > e->most + at)
+            goto python;
+        if (at && !int_is(args[0], 1))
+            goto python;
+        if (TYPE(args[at]) != A.int_type)
+            goto python;
+        if (nargs >= 3 + at && !int_is(args[at + 2], 1))
+            goto python;
+        if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+            goto python;
+        p = args[at + 1];
+    }
     tp = TYPE(p);
     target = p;
     if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
@@ -150,7 +159,8 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
         goto python;
     }
 
-    v = A.vectorcall(e->value, &args[at], 1, NULL);
+    v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
+                  : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)

@@ -379,3 +379,41 @@ def test_the_raw_entries_answer_as_their_python_path_and_the_table(
         if not got[0] == got[1] == got[2]:
             bad.append(f"{name}{(slave, offset, size, label)}: {[g[0::3] for g in got]}")
     assert not bad, "\n".join(bad[:8])
+
+
+@needs_cc
+def test_the_clock_answers_as_its_python_path_and_the_table(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """GT_GetClock(pClock[, pLoop]) with the C entry, without it, and the table path, a
+    clock past what a 32-bit signed pClock holds included."""
+    ctl = _open()
+    built = {}
+    for in_c in (True, False):
+        monkeypatch.setattr(fast, "CENTRY", in_c)
+        slow = gt.GT_GetClock.slow
+        built[in_c] = fast.fast_clock(fast.CLOCK, slow, _core.SESSION, _core.advance)
+    assert hasattr(built[True], "python")
+    types = [ctypes.c_uint32, ctypes.c_int32, ctypes.c_ulong, ctypes.c_long, ctypes.c_int16]
+    types.append(ctypes.c_double)
+    bad = []
+    for reset_ns in (ctl.reset_ns, ctl.clock.now_ns - (1 << 31) * 1_000_000):
+        ctl.reset_ns = reset_ns
+        for kind in KINDS:
+            for t in types:
+                for loop in [(), (None,), (0,), (1,), "byref", "kw"]:
+                    got = []
+                    for fn in (built[True], built[False], gt.GT_GetClock.slow):
+                        o, p = _arg(kind, t)
+                        loops = ctypes.c_uint32()
+                        if loop == "kw":
+                            rc = fn(pClock=p)
+                        elif loop == "byref":
+                            rc = fn(p, byref(loops))
+                        else:
+                            rc = fn(p, *loop)
+                        err = gt.GTE_GetLastError() if rc else ""
+                        got.append((rc, _shown(o), err, loops.value))
+                    if not got[0] == got[1] == got[2]:
+                        bad.append(f"{kind} {t.__name__} {loop}: {got}")
+    assert not bad, "\n".join(bad[:8])
