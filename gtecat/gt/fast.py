@@ -310,6 +310,21 @@ def fast_reader(
             # binds these plain arguments and the function refuses the count, the first thing
             # it checks (axis_span): the same code and reason without the table's steps
             return refuse(ctl, f"count={count}: at most {own_limit} at once")
+        values = span(ctl, n, count, zeros)
+        if values is None:
+            return None
+        p[:count] = values
+        if clk is not None:
+            clk[0].value = clk[1]
+        session.last = None
+        if ctl.clock.mode is not _LOCKSTEP:
+            return advance(ctl, name, 0)
+        return 0
+
+    def span(ctl: Any, n: int, count: int, zeros: bool) -> Any:
+        """The values of ``count`` axes from ``n`` (a sequence), None where the table path
+        answers (an axis of the span neither on the bus nor, where ``zeros``, one of the
+        controller's that no drive backs, which reads 0)."""
         resources = ctl.resources
         axes = ctl.axes
         b = ctl.bank
@@ -331,21 +346,14 @@ def fast_reader(
             if pick is not None:
                 lst = b._lists.get(bank_key)
                 if lst is not None:
-                    p[:count] = pick(lst)
-                else:  # not made yet this cycle: the first axis's getter makes it
-                    first = get(plan[4])
-                    lst = b._lists.get(bank_key)
-                    if lst is not None:
-                        values = list(pick(lst))
-                        values[plan[5]] = first
-                        p[:count] = values
+                    return pick(lst)
+                # not made yet this cycle: the first axis's getter makes it
+                first = get(plan[4])
+                lst = b._lists.get(bank_key)
                 if lst is not None:
-                    if clk is not None:
-                        clk[0].value = clk[1]
-                    session.last = None
-                    if ctl.clock.mode is not _LOCKSTEP:
-                        return advance(ctl, name, 0)
-                    return 0
+                    values = list(pick(lst))
+                    values[plan[5]] = first
+                    return values
         values: list[Any] = []
         append = values.append
         bank = lst = None
@@ -378,13 +386,7 @@ def fast_reader(
                         bank = None
                     continue
             append(lst[res.bank_row])  # type: ignore[index]
-        p[:count] = values
-        if clk is not None:
-            clk[0].value = clk[1]
-        session.last = None
-        if ctl.clock.mode is not _LOCKSTEP:
-            return advance(ctl, name, 0)
-        return 0
+        return values
 
     env["general"] = general
 
