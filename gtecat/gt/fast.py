@@ -422,17 +422,69 @@ def fast_reader(
     gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     public[0] = gt
+    packers: dict[tuple[type, int], Callable[..., bytes]] = {}
+
+    def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
+        """The C entry's values for a ctypes array: ``f(n, count, array type, pClock)``
+        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one, with
+        pClock NULL; ``spans``: a span of axes too, with a clock, as ``many`` answers it),
+        else _NO (the Python path answers)."""
+
+        def f(n: int, count: int, tp: type, pClock: Any) -> Any:
+            if not (is_array(tp) and 1 <= count <= tp._length_):
+                return _NO
+            clk = None
+            if count == 1:
+                if pClock is not None and not (type(pClock) is int and pClock == 0):
+                    return _NO
+                v = value(n)
+                if v is _NO:
+                    return _NO
+                values: Any = (v,)
+            else:
+                if not spans or count > limit:
+                    return _NO
+                try:
+                    ctl = session.controllers[1]
+                except KeyError:  # no controller
+                    return _NO
+                # (a lockstep clock never runs a thread of its own: real time only has one)
+                if not (session.plain and ctl.clock.mode is _LOCKSTEP):
+                    return _NO
+                clk = clock_out(ctl, pClock)
+                if clk is False:
+                    return _NO
+                values = span(ctl, n, count, True)
+                if values is None:
+                    return _NO
+            pack = packers.get((tp, count))
+            if pack is None:  # (the array's own element type, natively)
+                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
+            try:
+                out = pack(*values)
+            except struct.error:  # (a value the element does not hold: the Python path)
+                return _NO
+            if clk is not None:
+                clk[0].value = clk[1]
+            session.last = None
+            return out
+
+        return f
+
     if CENTRY:  # the common shape in C where it is available (gtecat.gt.centry)
         env["NOPE"] = _NO
         kind = centry.DOUBLE if ctypes_ok is _DOUBLE else centry.INT
         types = sorted(ctypes_ok, key=str)
+        value_gt = _value_function(env, "value_gt", "session.plain")
+        value_gtn = _value_function(env, "value_gtn", "session.local")
         entry = centry.reader(
-            gt, _value_function(env, "value_gt", "session.plain"), _NO, types, kind,
+            gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
+            array=array_value(value_gt, True),
         )  # fmt: skip
         entry_gtn = centry.reader(
-            gt.gtn, _value_function(env, "value_gtn", "session.local"), _NO, types, kind,
-            core=True, pointers=True,
+            gt.gtn, value_gtn, _NO, types, kind,
+            core=True, pointers=True, array=array_value(value_gtn, False),
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]

@@ -44,6 +44,7 @@ struct api {
     obj bytearray_type;
     obj none;
     obj zero; /* the int 0 (the return code) */
+    obj one;  /* the int 1 (an omitted count) */
     void (*incref)(obj);
     void (*decref)(obj);
     obj (*vectorcall)(obj, obj const *, size_t, obj);
@@ -67,6 +68,7 @@ struct entry {
     ptrdiff_t signs[MAX_TYPES]; /* an integer type: 1 signed, 0 unsigned */
     ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
     ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
+    obj avalue; /* NULL, or avalue(n, count, array type, pClock): a ctypes array's bytes */
 };
 
 static struct api A;
@@ -82,7 +84,7 @@ int gtecat_centry_api(const struct api *api)
         !api->bytearray_type || !api->carg_type ||
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
-        !api->zero || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
+        !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear)
         return 1;
     A = *api;
@@ -103,6 +105,34 @@ static int int_is(obj o, long long want)
         return 0;
     }
     return !over && v == want;
+}
+
+/* a reader's ctypes array (count from n): the bytes avalue gives copied to its start */
+static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+                 ptrdiff_t at)
+{
+    obj call[4], v;
+    ptrdiff_t n;
+    call[0] = args[at];
+    call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
+    call[2] = TYPE(args[at + 1]);
+    call[3] = nargs >= 4 + at ? args[at + 3] : A.none;
+    if (TYPE(call[1]) != A.int_type)
+        goto python;
+    v = A.vectorcall(e->avalue, call, 4, NULL);
+    if (!v)
+        return NULL;
+    if (TYPE(v) != A.bytes_type || (n = *(ptrdiff_t *)((char *)v + A.bsize)) <= 0) {
+        A.decref(v);
+        goto python;
+    }
+    /* (avalue checked the array's type and length: the bytes fit) */
+    memcpy(AT(args[at + 1], A.b_ptr), (char *)v + A.bdata, (size_t)n);
+    A.decref(v);
+    A.incref(A.zero);
+    return A.zero;
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 
 /* METH_FASTCALL | METH_KEYWORDS: self is the entry's ctypes object */
@@ -127,6 +157,8 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
             goto python;
         if (TYPE(args[at]) != A.int_type)
             goto python;
+        if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
+            return array(e, args, nargs, kwnames, at);
         if (nargs >= 3 + at && !int_is(args[at + 2], 1))
             goto python;
         if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))

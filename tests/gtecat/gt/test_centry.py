@@ -103,7 +103,7 @@ def _arg(kind: str, t: type) -> tuple[Any, Any]:
         o = t()
         return o, o
     if kind == "array":
-        o = (t * 2)()
+        o = (t * 12)()
         return o, o
     if kind == "pointer":
         o = t()
@@ -128,7 +128,21 @@ def _shown(o: Any) -> Any:
 
 
 AXES = [1, 2, 0, 3, 13, -1, 1 << 40, True, 1.0, "1"]
-TAILS: list[tuple] = [(), (1,), (1, 0), (1, None), (2,), (0,), (1, 5), (1, 0, 0), (True,)]
+_CLK = ctypes.c_uint32()
+TAILS: list[tuple] = [
+    (),
+    (1,),
+    (1, 0),
+    (1, None),
+    (2,),
+    (0,),
+    (1, 5),
+    (1, 0, 0),
+    (True,),
+    (2, byref(_CLK)),
+    (12, None),
+    (9,),
+]
 GTN_CORES = [None, 1, 2, True, 0]
 
 
