@@ -341,13 +341,14 @@ def fast_reader(
                 or plan[2] is not axes
             ):
                 top = resource_count(ctl) if zeros and axes else 0
-                plan = b.read_plans[key] = _read_plan(b, resources, axes, n, count, top)
+                plan = _read_plan(b, resources, axes, n, count, top, get)
+                b.read_plans[key] = plan
             pick = plan[3]
             if pick is not None:
                 lst = b._lists.get(bank_key)
-                if lst is not None:
+                if lst is not None or plan[4] is None:  # (no row of the bank: no list)
                     return pick(lst)
-                # not made yet this cycle: the first axis's getter makes it
+                # not made yet this cycle: the first row's getter makes it
                 first = get(plan[4])
                 lst = b._lists.get(bank_key)
                 if lst is not None:
@@ -632,33 +633,40 @@ BANK_LISTS = {
 
 
 def _read_plan(
-    b: Any, resources: Any, axes: Any, n: int, count: int, top: int = 0
+    b: Any, resources: Any, axes: Any, n: int, count: int, top: int = 0, get: Any = None
 ) -> tuple[Any, ...]:
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
-    from a list of the bank's values or None when some axis of the span is neither a row of
-    ``b`` nor, within ``1..top``, an axis no drive backs (it reads 0), the first row's
-    resources, its place in the span)."""
+    from a list of the bank's values or None, the first row's resources or None when no axis
+    of the span is a row of ``b``, that row's place in the span).  Each axis of the span is
+    a row of ``b``, an axis the bank does not run (its value ``get(resources)``, where
+    ``get`` is given) or, within ``1..top``, an axis no drive backs (it reads 0); any other
+    (another bank's axis, one not on the bus): no getter."""
     none = (b.layout, resources, axes, None, None, 0)
     if count < 2:  # (one value: no tuple to store)
         return none
-    rows: list[int | None] = []
-    for k in range(n, n + count):
+    items: list[str] = []
+    env: dict[str, Any] = {"g": get}
+    at = None
+    for i, k in enumerate(range(n, n + count)):
         if k not in axes and 1 <= n <= n + count - 1 <= top:
-            rows.append(None)
+            items.append("0")
             continue
         res = resources.get(k)
-        if res is None or axes.get(k) is not res.ax or res.bank is not b:
+        if res is None or axes.get(k) is not res.ax:
             return none
-        rows.append(res.bank_row)
-    at = next((i for i, r in enumerate(rows) if r is not None), None)
-    if at is None:
-        return none
-    if all(r is not None for r in rows):
-        pick = itemgetter(*rows)
-    else:  # (the rows and the zeros in one tuple)
-        items = ", ".join("0" if r is None else f"lst[{r}]" for r in rows)
-        pick = eval(f"lambda lst: ({items},)")  # (row numbers and zeros only)
-    return (b.layout, resources, axes, pick, resources.get(n + at), at)
+        if res.bank is b:
+            items.append(f"lst[{res.bank_row}]")
+            at = i if at is None else at
+        elif res.bank is None and get is not None:
+            items.append(f"g(r{i})")
+            env[f"r{i}"] = res
+        else:
+            return none
+    if at is not None and len(env) == 1 and "0" not in items:
+        pick = itemgetter(*(int(x[4:-1]) for x in items))
+    else:  # (the rows, the getters and the zeros in one tuple)
+        pick = eval(f"lambda lst: ({', '.join(items)},)", env)  # (row numbers, names, 0)
+    return (b.layout, resources, axes, pick, None if at is None else resources.get(n + at), at)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the

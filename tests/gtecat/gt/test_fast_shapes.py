@@ -636,10 +636,14 @@ def test_the_core_reader_answers_as_the_table() -> None:
 def test_a_span_over_axes_no_drive_backs_reads_as_the_table_on_the_fast_path() -> None:
     """``GT_GetSts(1, sts, 12, &clk)`` on figure 5-2's bus (2 drives): the controller's axes
     3..12 read as axes at rest (0) on the fast path, with the table path's values, clock and
-    refusals (a span past the controller's axes, axis 0)."""
+    refusals (a span past the controller's axes, axis 0); with axis 1 in the bank, and out
+    of it (a planner chosen: a span of a row, an axis the bank does not run and zeros)."""
     _open()
     bad = []
-    for name in sorted(fast.READERS):
+    for name in [*sorted(fast.READERS), "", *sorted(fast.READERS)]:
+        if not name:
+            gt.GT_PrfTrap(1)
+            continue
         t = ctypes.c_double if ctypes.c_double in fast.READERS[name][1] else ctypes.c_long
         for first, count in ((1, 12), (2, 5), (3, 8), (11, 2), (1, 13), (0, 3), (12, 2)):
             got = []
