@@ -52,6 +52,7 @@ class _Api(ctypes.Structure):
         ("bsize", ctypes.c_ssize_t),
         ("bdata", ctypes.c_ssize_t),
         ("bastart", ctypes.c_ssize_t),
+        ("vc_entry", ctypes.c_ssize_t),
         ("carg_type", _VP),
         ("int_type", _VP),
         ("float_type", _VP),
@@ -146,6 +147,93 @@ def _bytearray_at(size_at: int) -> int:
     raise ValueError("a bytearray's bytes are not where they are looked for")
 
 
+_HEAD = object.__basicsize__  # (PyObject_HEAD)
+
+
+class _MemberDef(ctypes.Structure):
+    """CPython's ``PyMemberDef`` (stable ABI)."""
+
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("type", ctypes.c_int),
+        ("offset", ctypes.c_ssize_t),
+        ("flags", ctypes.c_int),
+        ("doc", ctypes.c_char_p),
+    ]
+
+
+class _GetSetDef(ctypes.Structure):
+    """CPython's ``PyGetSetDef`` (stable ABI)."""
+
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("get", _VP),
+        ("set", _VP),
+        ("doc", ctypes.c_char_p),
+        ("closure", _VP),
+    ]
+
+
+class _TypeSlot(ctypes.Structure):
+    """CPython's ``PyType_Slot`` (stable ABI)."""
+
+    _fields_ = [("slot", ctypes.c_int), ("pfunc", _VP)]
+
+
+class _TypeSpec(ctypes.Structure):
+    """CPython's ``PyType_Spec`` (stable ABI)."""
+
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("basicsize", ctypes.c_int),
+        ("itemsize", ctypes.c_int),
+        ("flags", ctypes.c_uint),
+        ("slots", ctypes.POINTER(_TypeSlot)),
+    ]
+
+
+def _callable_type() -> type:
+    """A type whose instances are called the way built-in functions are (vectorcall: the
+    C function whose address an instance holds right after its head, the entry's address
+    after that) and take attributes (an instance dict after those two words).  Made with
+    ``PyType_FromSpec`` (stable ABI; the slot and flag numbers are the ABI's own): the
+    ``__vectorcalloffset__`` and ``__dictoffset__`` members, ``__dict__`` the interpreter's
+    generic one, ``tp_call`` the interpreter's ``PyVectorcall_Call``."""
+    T_PYSSIZET, READONLY = 19, 1
+    Py_tp_call, Py_tp_members, Py_tp_getset = 50, 72, 73
+    HAVE_VECTORCALL, DEFAULT = 1 << 11, 1 << 18
+    members = (_MemberDef * 3)(
+        _MemberDef(b"__vectorcalloffset__", T_PYSSIZET, _HEAD, READONLY, None),
+        _MemberDef(b"__dictoffset__", T_PYSSIZET, _HEAD + 2 * _WORD, READONLY, None),
+    )
+    getset = (_GetSetDef * 2)(
+        _GetSetDef(
+            b"__dict__",
+            _address("PyObject_GenericGetDict"),
+            _address("PyObject_GenericSetDict"),
+            None,
+            None,
+        )
+    )
+    slots = (_TypeSlot * 4)(
+        _TypeSlot(Py_tp_call, _address("PyVectorcall_Call")),
+        _TypeSlot(Py_tp_members, ctypes.addressof(members)),
+        _TypeSlot(Py_tp_getset, ctypes.addressof(getset)),
+    )
+    spec = _TypeSpec(
+        b"gtecat.gt.centry.entry", _HEAD + 3 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
+    )
+    make = ctypes.PYFUNCTYPE(ctypes.py_object, _VP)(("PyType_FromSpec", ctypes.pythonapi))
+    t = make(ctypes.addressof(spec))
+    _KEEP.append((members, getset, slots, spec, t))
+    t.__repr__ = lambda self: f"<GT function {getattr(self, '__name__', '?')} (C entry)>"
+    probe = t()
+    probe.attribute = 1  # (an instance dict)
+    if vars(probe) != {"attribute": 1}:
+        raise ValueError("an entry callable keeps no attributes")
+    return t  # type: ignore[no-any-return]
+
+
 def _address(name: str) -> int:
     return ctypes.cast(getattr(ctypes.pythonapi, name), _VP).value or 0
 
@@ -180,6 +268,7 @@ def _load() -> tuple[Maker | None, str]:
             bsize,
             bdata,
             bastart,
+            _HEAD + _WORD,  # (an entry callable's layout: _callable_type)
             id(type(ctypes.byref(ctypes.c_int()))),
             id(int),
             id(float),
@@ -202,9 +291,30 @@ def _load() -> tuple[Maker | None, str]:
             return None, "the library refused the layout"
         meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
         raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
+        vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value
+        raw_vc = ctypes.cast(lib.gtecat_centry_raw_vc, _VP).value
         new = byref_target.function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
+    try:
+        kind_of_callable: type | None = _callable_type()
+    except Exception as e:  # (the partial of a built-in function instead)
+        log.debug("entry callables: %s", e)
+        kind_of_callable = None
+
+    def public(fn: Any, address: int, e: Any, keep: Any) -> Any:
+        """The public function of an entry: a callable of :func:`_callable_type` calling the
+        C function at ``address`` with ``e``'s memory, where that type could be made; else a
+        ``functools.partial`` of the built-in function ``fn`` (it passes its arguments
+        straight on, no frame).  Either takes the attributes the GT layer gives its
+        functions, unlike a built-in function."""
+        if kind_of_callable is None:
+            return functools.partial(fn)
+        c = kind_of_callable()
+        _KEEP.append((e, keep, fn))
+        ctypes.c_void_p.from_address(id(c) + _HEAD).value = address
+        ctypes.c_void_p.from_address(id(c) + _HEAD + _WORD).value = ctypes.addressof(e)
+        return c
 
     def make(
         fallback: Callable[..., Any],
@@ -235,9 +345,7 @@ def _load() -> tuple[Maker | None, str]:
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
         keep = (fallback, value, sentinel, kinds, array)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
-        # a partial: it passes its arguments straight on (no frame) and, unlike a built-in
-        # function, takes the attributes the GT layer gives its functions
-        return functools.partial(fn)
+        return public(fn, vc, e, keep)
 
     def make_raw(
         fallback: Callable[..., Any],
@@ -247,10 +355,9 @@ def _load() -> tuple[Maker | None, str]:
         write: bool,
     ) -> Any:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write))
-        fn = new(
-            b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, (fallback, value, sentinel)
-        )
-        return functools.partial(fn)
+        keep = (fallback, value, sentinel)
+        fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
+        return public(fn, raw_vc, e, keep)
 
     make.raw = make_raw  # type: ignore[attr-defined]
     try:
@@ -522,8 +629,8 @@ def reader(
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), pClock)`` (``count`` an
     int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
     array's start (it checks the array's type and length), else anything but bytes.
-    A ``functools.partial`` of the built-in function (it takes attributes); None where the
-    C entry is not available (:data:`REASON`)."""
+    A callable that takes attributes (:func:`_callable_type`); None where the C entry is
+    not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
     return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array)

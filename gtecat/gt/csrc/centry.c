@@ -36,6 +36,7 @@ struct api {
     ptrdiff_t bsize;      /* a bytes object's length */
     ptrdiff_t bdata;      /* a bytes object's first byte */
     ptrdiff_t bastart;    /* a bytearray's first byte (its length: where a bytes object's is) */
+    ptrdiff_t vc_entry;   /* a vectorcall callable's entry address (see centry.py) */
     obj carg_type;        /* the type of the pointer objects byref() makes */
     obj int_type;
     obj float_type;
@@ -75,12 +76,15 @@ static struct api A;
 static int ready;
 
 #define AT(base, off) (*(char **)((char *)(base) + (off)))
+/* the flag a vectorcall's caller may set in nargsf (PY_VECTORCALL_ARGUMENTS_OFFSET) */
+#define VECTORCALL_OFFSET ((size_t)1 << (8 * sizeof(size_t) - 1))
 #define TYPE(o) AT(o, A.ob_type)
 
 int gtecat_centry_api(const struct api *api)
 {
     if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
         api->fval < 0 || api->bsize < 0 || api->bdata < 0 || api->bastart < 0 ||
+        api->vc_entry < 0 ||
         !api->bytearray_type || !api->carg_type ||
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
@@ -135,10 +139,24 @@ python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 
+/* the reader entry's work (both ways of calling it, below) */
+static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
 /* METH_FASTCALL | METH_KEYWORDS: self is the entry's ctypes object */
 obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
 {
-    const struct entry *e = (const struct entry *)AT(self, A.b_ptr);
+    return reader((const struct entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+/* a vectorcall function: the callable keeps its entry's address at A.vc_entry */
+obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return reader((const struct entry *)AT(callable, A.vc_entry), args,
+                  (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
     ptrdiff_t at = e->core;
     obj p, target, tp, v;
     char *mem;
@@ -254,9 +272,21 @@ struct raw_entry {
     ptrdiff_t write; /* 1: from the buffer into the image */
 };
 
+static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
 obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
 {
-    const struct raw_entry *e = (const struct raw_entry *)AT(self, A.b_ptr);
+    return raw((const struct raw_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return raw((const struct raw_entry *)AT(callable, A.vc_entry), args,
+               (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
     ptrdiff_t at = e->io, k, n;
     obj p, target, v, call[4];
     const int64_t *runs;
