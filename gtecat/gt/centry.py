@@ -297,10 +297,10 @@ def _load() -> tuple[Maker | None, str]:
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
     try:
-        kind_of_callable: type | None = _callable_type()
+        callables: list[type] = [_callable_type()]
     except Exception as e:  # (the partial of a built-in function instead)
         log.debug("entry callables: %s", e)
-        kind_of_callable = None
+        callables = []
 
     def public(fn: Any, address: int, e: Any, keep: Any) -> Any:
         """The public function of an entry: a callable of :func:`_callable_type` calling the
@@ -308,9 +308,9 @@ def _load() -> tuple[Maker | None, str]:
         ``functools.partial`` of the built-in function ``fn`` (it passes its arguments
         straight on, no frame).  Either takes the attributes the GT layer gives its
         functions, unlike a built-in function."""
-        if kind_of_callable is None:
+        if not callables:
             return functools.partial(fn)
-        c = kind_of_callable()
+        c = callables[0]()
         _KEEP.append((e, keep, fn))
         ctypes.c_void_p.from_address(id(c) + _HEAD).value = address
         ctypes.c_void_p.from_address(id(c) + _HEAD + _WORD).value = ctypes.addressof(e)
@@ -360,10 +360,15 @@ def _load() -> tuple[Maker | None, str]:
         return public(fn, raw_vc, e, keep)
 
     make.raw = make_raw  # type: ignore[attr-defined]
-    try:
-        reason = _self_test(make) or _self_test_raw(make_raw)
-    except Exception as e:  # (a self-test that cannot even run: not used either)
-        reason = f"the self-test failed: {type(e).__name__}: {e}"
+    for _ in range(2):
+        try:
+            reason = _self_test(make) or _self_test_raw(make_raw)
+        except Exception as e:  # (a self-test that cannot even run)
+            reason = f"the self-test failed: {type(e).__name__}: {e}"
+        if not reason or not callables:
+            break
+        log.debug("entry callables: %s; partials instead", reason)
+        callables.clear()  # (once more, each entry behind a functools.partial)
     return (make, "") if not reason else (None, reason)
 
 

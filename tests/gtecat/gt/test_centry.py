@@ -439,3 +439,22 @@ def test_the_clock_answers_as_its_python_path_and_the_table(
                     if not got[0] == got[1] == got[2]:
                         bad.append(f"{kind} {t.__name__} {loop}: {got}")
     assert not bad, "\n".join(bad[:8])
+
+
+@needs_cc
+def test_without_the_entry_type_the_entries_are_partials(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where the callable type cannot be made, each entry is a ``functools.partial`` of its
+    built-in function, tested and answering the same."""
+    import functools
+
+    def refuse() -> type:
+        raise ValueError("no type here")
+
+    monkeypatch.setattr(centry, "_callable_type", refuse)
+    make, reason = centry._load()
+    assert reason == "" and make is not None
+    nope = object()
+    fn = make(lambda *a, **k: "python", lambda n: 7, nope, [ctypes.c_long], centry.INT, False)
+    s = ctypes.c_long()
+    assert type(fn) is functools.partial
+    assert (fn(1, byref(s)), s.value, fn(1, byref(s), 2)) == (0, 7, "python")
