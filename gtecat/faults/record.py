@@ -668,6 +668,17 @@ def _load_plan(where: Path) -> tuple[dict[str, Any], Any] | None:
         data = where.read_bytes()
     except OSError:
         return None
+    kept = _plan_from_bytes(data)
+    if kept is not None:
+        try:
+            os.utime(where)  # (used: the last to go)
+        except OSError:
+            pass
+    return kept
+
+
+def _plan_from_bytes(data: bytes) -> tuple[dict[str, Any], Any] | None:
+    """(header, plan) of a plan's file, None when it is damaged."""
     start = len(_PLAN_MAGIC) + 32
     if not data.startswith(_PLAN_MAGIC) or len(data) < start:
         return None
@@ -679,10 +690,6 @@ def _load_plan(where: Path) -> tuple[dict[str, Any], Any] | None:
         return None
     if type(kept) is not tuple or len(kept) != 2 or type(kept[0]) is not dict:
         return None
-    try:
-        os.utime(where)  # (used: the last to go)
-    except OSError:
-        pass
     return kept
 
 
