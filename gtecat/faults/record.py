@@ -1243,9 +1243,10 @@ def _steps(
 
 
 #: the layout of a plan (:func:`_plan_of`); a plan of another is made again
-_PLAN = 1
-#: a unit of a plan that is no form: an entry (a checkpoint, a fault), a call made whole
-_ENTRY, _WHOLE = -1, -2
+_PLAN = 2
+#: a unit of a plan that is no form: an entry (a checkpoint, a fault), a call made whole;
+#: form ``f`` is ``f + _FORMS``
+_ENTRY, _WHOLE, _FORMS = 0, 1, 2
 
 
 def _plan_of(
@@ -1260,9 +1261,9 @@ def _plan_of(
     number = {}
     forms = []
     for call, key, n in form_lines.values():
-        number[id(call)] = len(forms)
+        number[id(call)] = len(forms) + _FORMS
         forms.append((key, n))
-    kinds = array("i")
+    kinds = array("I")
     values: list[Any] = []
     unit: dict[str, int] = {}
     for key, made_step in made.items():
@@ -1301,17 +1302,14 @@ def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
         if call is _Stop or call.checks or call.fresh:
             raise ValueError(f"a form is not made the same: {key[:60]}")
         calls.append(call)
-    kinds = array("i")
+    kinds = array("I")
     kinds.frombytes(kinds_b)
     order = array("I")
     order.frombytes(order_b)
-    if len(kinds) != len(values) or (
-        len(kinds) and (min(kinds) < _WHOLE or max(kinds) >= len(forms))
-    ):
+    if len(kinds) != len(values):
         raise ValueError("units of no form")
-    if len(order) and max(order) >= len(values):
-        raise ValueError("steps of no unit")
-    calls += (_Stop, None)  # (kinds -2 and -1 index the end: placeholders)
+    # (a number past the end: IndexError, as the steps of no unit below)
+    calls[:0] = (None, _Stop)  # (_ENTRY: no call, _WHOLE: made below)
     units = list(zip(map(calls.__getitem__, kinds), values, strict=True))
     for i in compress(range(len(kinds)), map(_WHOLE.__eq__, kinds)):
         key = values[i]
