@@ -1454,6 +1454,10 @@ def _replay(
     return n, None
 
 
+#: the calls that bring a bus up from the files an open named
+_BRING_UP = frozenset({"GT_InitEcatComm", "GTN_InitEcatComm"})
+
+
 def _check_files(
     steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
 ) -> None:
@@ -1462,9 +1466,15 @@ def _check_files(
     ran in, or the file itself, moved or deleted): which file, and how to give it instead.
     The files of an open whose bring-up failed in the recording too are not asked for."""
     opened: list[tuple[str, str, str]] = []  # (what, the file as named, the option)
-    for p, _ in steps:
-        if p is None or p is _Stop:
-            continue
+    # the opens and bring-ups only, picked from the distinct calls (a few among many steps)
+    calls = list(map(itemgetter(0), steps))
+    distinct = dict(zip(map(id, calls), calls, strict=True))
+    asked = {
+        i
+        for i, p in distinct.items()
+        if p is not None and p is not _Stop and (p.opens or p.name in _BRING_UP)
+    }
+    for p in compress(calls, map(asked.__contains__, map(id, calls))):
         if p.opens:
             kw = p.kw or {}
             opened = []
@@ -1476,7 +1486,7 @@ def _check_files(
                 name = kw.get("machine", os.environ.get("GTECAT_MACHINE"))
                 if type(name) is str and name:
                     opened.append(("machine description", name, "--machine FILE"))
-        elif p.name in ("GT_InitEcatComm", "GTN_InitEcatComm") and p.rc == 0 and opened:
+        elif p.rc == 0 and opened:
             for what, name, option in opened:
                 if not Path(name).exists():
                     where = Path(name).resolve()
