@@ -599,12 +599,14 @@ def replay(
     paused = gc.isenabled()
     if paused:
         gc.disable()
+    marks = None  # (a plan's: where the opens and bring-ups are)
     try:
         steps = None
         if kept is not None:
             head, plan = kept
             try:
                 steps = _steps(p, "", plan=plan)
+                marks = plan[5]
             except ValueError:  # (a plan this gtecat does not make the same: the text)
                 steps = None
         if steps is None:
@@ -624,7 +626,7 @@ def replay(
         gc.freeze()
     try:
         with _where(head):
-            return _replay(steps, eni, machine, head.get("cwd"))
+            return _replay(steps, eni, machine, head.get("cwd"), marks)
     finally:
         if freeze:
             gc.unfreeze()
@@ -1243,7 +1245,7 @@ def _steps(
 
 
 #: the layout of a plan (:func:`_plan_of`); a plan of another is made again
-_PLAN = 2
+_PLAN = 3
 #: a unit of a plan that is no form: an entry (a checkpoint, a fault), a call made whole;
 #: form ``f`` is ``f + _FORMS``
 _ENTRY, _WHOLE, _FORMS = 0, 1, 2
@@ -1282,7 +1284,14 @@ def _plan_of(
         kinds.append(kind)
         values.append(vals)
     order = array("I", map(unit.__getitem__, filter(unit.__contains__, keys)))
-    return (_PLAN, forms, kinds.tobytes(), values, order.tobytes())
+    # the steps :func:`_check_files` looks at (opens, bring-ups): found here once
+    asked = {
+        unit[key]
+        for key, made_step in made.items()
+        if made_step is not None and _asked(made_step[0])
+    }
+    marks = [i for i, u in enumerate(order) if u in asked] if asked else []
+    return (_PLAN, forms, kinds.tobytes(), values, order.tobytes(), marks)
 
 
 def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
@@ -1290,7 +1299,7 @@ def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
     and made ready as :func:`_steps` makes them (``parse``, ``prepare``: its own); ValueError
     (or LookupError, TypeError) for a plan that is not one, or one whose lines do not make
     the steps they made (another gtecat's functions)."""
-    version, forms, kinds_b, values, order_b = plan
+    version, forms, kinds_b, values, order_b, _ = plan
     if version != _PLAN or type(values) is not list:
         raise ValueError(f"plan layout {version!r}")
     calls: list[Any] = []
@@ -1398,13 +1407,17 @@ class _Stop:
 
 
 def _replay(
-    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
+    steps: list[tuple[Any, Any]],
+    eni: str | None,
+    machine: str | None,
+    cwd: Any = None,
+    marks: Any = None,
 ) -> tuple[int, Divergence | None]:
     from .. import faults, gt
 
     eni = str(Path(eni).resolve()) if eni else None
     machine = str(Path(machine).resolve()) if machine else None
-    _check_files(steps, eni, machine, cwd)
+    _check_files(steps, eni, machine, cwd, marks)
     gt.GT_Close()
     n = 0
     try:
@@ -1458,23 +1471,40 @@ def _replay(
 _BRING_UP = frozenset({"GT_InitEcatComm", "GTN_InitEcatComm"})
 
 
+def _asked(p: Any) -> bool:
+    """A step :func:`_check_files` looks at: an open, a bring-up."""
+    return p is not None and p is not _Stop and (p.opens or p.name in _BRING_UP)
+
+
 def _check_files(
-    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
+    steps: list[tuple[Any, Any]],
+    eni: str | None,
+    machine: str | None,
+    cwd: Any = None,
+    marks: Any = None,
 ) -> None:
     """Refuse, before anything runs, a replay whose session brought a bus up from an ENI file
     or a machine description that is no longer where the recording found it (the folder it
     ran in, or the file itself, moved or deleted): which file, and how to give it instead.
-    The files of an open whose bring-up failed in the recording too are not asked for."""
+    The files of an open whose bring-up failed in the recording too are not asked for.
+    ``marks``: where the opens and bring-ups are among the steps (a plan's), else found
+    here."""
     opened: list[tuple[str, str, str]] = []  # (what, the file as named, the option)
-    # the opens and bring-ups only, picked from the distinct calls (a few among many steps)
-    calls = list(map(itemgetter(0), steps))
-    distinct = dict(zip(map(id, calls), calls, strict=True))
-    asked = {
-        i
-        for i, p in distinct.items()
-        if p is not None and p is not _Stop and (p.opens or p.name in _BRING_UP)
-    }
-    for p in compress(calls, map(asked.__contains__, map(id, calls))):
+    picked = None
+    if type(marks) is list:
+        try:
+            picked = [steps[i][0] for i in marks]
+        except (IndexError, TypeError):
+            picked = None
+        if picked is not None and not all(map(_asked, picked)):
+            picked = None
+    if picked is None:
+        # the opens and bring-ups only, picked from the distinct calls (a few among many)
+        calls = list(map(itemgetter(0), steps))
+        distinct = dict(zip(map(id, calls), calls, strict=True))
+        asked = {i for i, p in distinct.items() if _asked(p)}
+        picked = list(compress(calls, map(asked.__contains__, map(id, calls))))
+    for p in picked:
         if p.opens:
             kw = p.kw or {}
             opened = []

@@ -9,6 +9,7 @@ fraction of a virtual second.
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import json
 import os
@@ -17,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
+from gtecat.errors import ParameterError
 from gtecat.faults import record as rec
 from tools import session_hard
 
@@ -91,9 +93,20 @@ def test_the_recorder_keeps_the_plan_and_it_makes_the_same_steps(recorded: Path)
     kinds = {p.name for p, _ in from_plan if p is not None}
     assert {"GT_GetSts", "GT_GetPrfPos", "GTE_Wait", "GT_Open"} <= kinds
     assert any(p is None and "cp" in e for p, e in from_plan)  # checkpoints
+    # where the opens and bring-ups are (what the check of the files looks at)
+    marks = [i for i, (p, _) in enumerate(from_text) if rec._asked(p)]
+    assert plan[5] == marks and len(marks) >= 2
     n, div = rec.replay(recorded)
     assert div is None, str(div)
     assert n == head["calls"]
+    # an ENI file the open named that is gone: named, with the plan's marks and without
+    i = marks[0]
+    gone = dataclasses.replace(from_plan[i][0], kw={"eni": str(recorded.parent / "gone.eni")})
+    steps = list(from_plan)
+    steps[i] = (gone, from_plan[i][1])
+    for way in (plan[5], None):
+        with pytest.raises(ParameterError, match=r"gone\.eni"):
+            rec._check_files(steps, None, None, None, way)
 
 
 def test_a_changed_recording_never_takes_the_plan_of_the_old(
