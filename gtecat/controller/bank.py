@@ -1995,9 +1995,8 @@ class AxisBank:
         position after a run of cycles needs neither the speed nor the acceleration)."""
         table, jog = _PLANNED[name]
         out = getattr(self, table).take(self.t_idx)
-        if self.n_jog:
-            j = self.jog
-            out[j] = getattr(self, jog)[j]
+        if self.n_jog:  # (the jogs' values where jog is set: one copy, no masked arrays)
+            np.copyto(out, getattr(self, jog), where=self.jog)
         if self.n_hm:  # a homing axis's plan holds its actual position
             for r in np.nonzero(self.hm & self.alive)[0].tolist():
                 out[r] = (
