@@ -43,7 +43,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import accumulate, chain, compress, repeat
-from operator import contains, itemgetter, not_
+from operator import contains, is_, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -595,12 +595,13 @@ def replay(
     p = Path(path)
     raw = _read_raw(p)
     where = _plan_file(raw)
-    kept = _load_plan(where) if where is not None else None
     paused = gc.isenabled()
     if paused:
         gc.disable()
     marks = None  # (a plan's: where the opens and bring-ups are)
+    freeze = False
     try:
+        kept = _load_plan(where) if where is not None else None
         steps = None
         if kept is not None:
             head, plan = kept
@@ -616,14 +617,17 @@ def replay(
             del body
             if keep and keep[0] is not None and where is not None:
                 _keep_plan(where, head, keep[0])
+        del raw
+        entries = sum(map(is_, map(itemgetter(0), steps), repeat(None)))  # (not calls)
+        _check_count(p, head, len(steps) - entries)
+        # frozen before the collector runs again: it would walk every object just made
+        # (all of them young) at its first collection
+        freeze = gc.get_freeze_count() == 0  # (a process that froze its own: left so)
+        if freeze:
+            gc.freeze()
     finally:
         if paused:
             gc.enable()
-    del raw
-    _check_count(p, head, sum(1 for call, _ in steps if call is not None))
-    freeze = gc.get_freeze_count() == 0  # (a process that froze its own objects: left so)
-    if freeze:
-        gc.freeze()
     try:
         with _where(head):
             return _replay(steps, eni, machine, head.get("cwd"), marks)
