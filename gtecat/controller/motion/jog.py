@@ -308,3 +308,4 @@ class JogPlanner:
         self._pos = self._raw_p = pos
         self._vel = self._acc = self._raw_v = 0.0
         self._mode = _IDLE
+        self.stopping = StopKind.NONE  # (a stop that has ended: TrapPlanner._finish)

@@ -373,9 +373,13 @@ class TrapPlanner:
 
     # ------------------------------------------------------------ internals
     def _finish(self, pos: float) -> None:
+        # at rest, a stop has ended: its kind is forgotten (as PvtPlanner does), so nothing
+        # that asks "is this axis stopping?" (the axis bank's claim among them) sees a stop
+        # that is over
         self._pos = pos
         self._vel = self._acc = 0.0
         self._mode = _IDLE
+        self.stopping = StopKind.NONE
         self._segs = []
         self._i = self._j = 0
 

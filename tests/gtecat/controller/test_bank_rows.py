@@ -89,6 +89,9 @@ def _act(action: tuple) -> int:
         return gt.GT_AxisOn(axis)
     if kind == "clear":
         return gt.GT_ClrSts(1, AXES)
+    if kind == "stop":  # GT_Stop(mask, option): smooth (0) or abrupt (the axis's bit)
+        mask = 1 << (axis - 1)
+        return gt.GT_Stop(mask, mask if action[2] else 0)
     raise AssertionError(kind)
 
 
@@ -157,6 +160,22 @@ def test_rows_stopping_at_different_cycles_of_one_call(bus: tuple[str, str]) -> 
     assert _check(bus, program) > 800  # most of the waits ran many cycles per kernel call
 
 
+def test_rows_back_in_the_bank_after_a_stop(bus: tuple[str, str]) -> None:
+    """GT_Stop mid-move, smooth and abrupt (Trap and Jog): once the stop ramp has ended the
+    axes stand, and the long wait after it runs in the bank again (a planner at rest is no
+    longer stopping), with the same answers as the scalar path."""
+    program = [
+        (2, ("move", 1, 30_000, 20.0, 0.5, 25)),
+        (2, ("move", 3, -30_000, 25.0, 0.6, 0)),
+        (2, ("jog", 6, -12.0, 0.3, 0.5)),
+        (200, ("stop", 1, False)),
+        (2, ("stop", 3, True)),
+        (200, ("stop", 6, False)),
+        (3000, ("clear", 0)),
+    ]
+    assert _check(bus, program) > 2500  # the last wait ran in the kernel, many at a time
+
+
 axis = st.integers(1, AXES)
 step = st.one_of(
     st.tuples(
@@ -178,6 +197,7 @@ step = st.one_of(
     st.tuples(st.just("soft"), axis, st.integers(0, 30_000)),
     st.tuples(st.just("band"), axis, st.integers(0, 30), st.integers(0, 10)),
     st.tuples(st.just("clear"), st.just(0)),
+    st.tuples(st.just("stop"), axis, st.booleans()),
 )
 
 

@@ -449,3 +449,17 @@ def test_random_on_the_fly_updates_end_exactly_on_new_target(
         assert np.max(np.abs(np.diff(v))) / cycle <= amax
         p = np.concatenate([[0.0], out[:, 0]])
         assert np.max(np.abs(np.diff(p))) <= vmax * cycle + 1e-9  # no position jump
+
+
+def test_a_stop_that_has_ended_is_forgotten() -> None:
+    """GT_Stop's ramp ends at rest: the planner is done and no longer stopping (as the PVT
+    planner), so the next GT_Update starts afresh and nothing sees a stop that is over."""
+    pl = TrapPlanner(1.0)
+    pl.start(0.0, 10_000, 20.0, TrapParams(acc=0.5, dec=0.5))
+    for _ in range(30):
+        pl.step()
+    pl.stop(0.5, abrupt=False)
+    assert pl.stopping == StopKind.SMOOTH and not pl.done
+    for _ in range(200):
+        pl.step()
+    assert pl.done and pl.stopping == StopKind.NONE
