@@ -378,7 +378,7 @@ class Recorder(Listener):
             data = gzip.compress(data, 6)
         self.path.write_bytes(data)
         del text, lines
-        plan_ahead(self.path, data)
+        _plan_ahead(self.path, data)
         return self.path
 
 
@@ -724,7 +724,7 @@ def _keep_plan(where: Path, head: dict[str, Any], plan: Any) -> None:
         pass
 
 
-def plan_ahead(path: Path, raw: bytes) -> None:
+def _plan_ahead(path: Path, raw: bytes) -> None:
     """Keep the plan of the recording just written to ``path`` (``raw``: its bytes), so
     that its first replay need not read its text (:func:`replay`)."""
     where = _plan_file(raw)
