@@ -638,8 +638,10 @@ def replay(
 
 #: what a plan's file starts with, before the SHA-256 of the rest
 _PLAN_MAGIC = b"gtecat replay plan\n"
-#: the plans kept at most (the least recently used go first)
-PLANS_KEPT = 16
+#: the plans kept at most, and their bytes at most (the least recently used go first; the
+#: newest stays whatever its size)
+PLANS_KEPT = 64
+PLAN_BYTES = 256 << 20
 
 
 def _plan_file(raw: bytes) -> Path | None:
@@ -701,8 +703,8 @@ def _plan_from_bytes(data: bytes) -> tuple[dict[str, Any], Any] | None:
 
 def _keep_plan(where: Path, head: dict[str, Any], plan: Any) -> None:
     """Keep a recording's plan in ``where`` (written under another name, then renamed);
-    only the :data:`PLANS_KEPT` most recently used stay.  A folder that takes no file
-    only costs the next replay the reading of the text."""
+    only the :data:`PLANS_KEPT` most recently used stay, :data:`PLAN_BYTES` at most.  A
+    folder that takes no file only costs the next replay the reading of the text."""
     try:
         payload = marshal.dumps((head, plan))
     except ValueError:  # (a value marshal does not take: none of JSON's)
@@ -715,11 +717,15 @@ def _keep_plan(where: Path, head: dict[str, Any], plan: Any) -> None:
         plans = []
         for f in where.parent.glob("*.plan"):
             try:
-                plans.append((f.stat().st_mtime_ns, f))
+                st = f.stat()
             except OSError:
                 continue
-        for _, f in sorted(plans, reverse=True)[PLANS_KEPT:]:
-            f.unlink(missing_ok=True)
+            plans.append((st.st_mtime_ns, st.st_size, f))
+        total = 0
+        for k, (_, size, f) in enumerate(sorted(plans, key=itemgetter(0), reverse=True)):
+            total += size
+            if k and (k >= PLANS_KEPT or total > PLAN_BYTES):
+                f.unlink(missing_ok=True)
     except OSError:
         pass
 

@@ -163,3 +163,8 @@ def test_plans_off_and_the_few_kept(tmp_path: Path, monkeypatch) -> None:
     rec._keep_plan(tmp_path / "3.plan", {}, None)
     assert sorted(f.name for f in tmp_path.glob("*.plan")) == ["2.plan", "3.plan"]
     assert rec._load_plan(tmp_path / "3.plan") == ({}, None)
+    # at most PLAN_BYTES: the newest stays whatever its size
+    monkeypatch.setattr(rec, "PLANS_KEPT", 10)
+    monkeypatch.setattr(rec, "PLAN_BYTES", 1000)
+    rec._keep_plan(tmp_path / "4.plan", {"x": "y" * 2000}, None)
+    assert sorted(f.name for f in tmp_path.glob("*.plan")) == ["4.plan"]
