@@ -2,7 +2,7 @@
 
     python tools/bench_native.py [--calls 20000] [--clock auto|lockstep|realtime]
                                  [--eni examples/manual_fig5_2.eni] [--no-wall-floor]
-                                 [--transport private|unix|tcp]
+                                 [--transport private|unix|tcp] [--rt-priority auto|off|N]
 
 A C program (compiled here with ``$(python3 -m gtecat lib --cflags --libs)``) opens a
 private controller, brings the bus up, enables axis 1 and then times each of
@@ -116,6 +116,12 @@ def main(argv: list[str] | None = None) -> int:
         help="GTECAT_SERVER_SPIN_US: the controller spins for the next request",
     )
     ap.add_argument(
+        "--rt-priority",
+        default=None,
+        help="GTECAT_RT_PRIORITY: the controller's real-time priority while the CPUs are "
+        "busy (auto, the default; off; 1-99)",
+    )
+    ap.add_argument(
         "--transport",
         default="private",
         choices=("private", "unix", "tcp"),
@@ -142,6 +148,8 @@ def main(argv: list[str] | None = None) -> int:
             env["GTECAT_SPIN_US"] = str(args.spin_us)
         if args.server_spin_us is not None:
             env["GTECAT_SERVER_SPIN_US"] = str(args.server_spin_us)
+        if args.rt_priority is not None:
+            env["GTECAT_RT_PRIORITY"] = args.rt_priority
         controller = None
         if args.transport != "private":
             address = f"unix:{tmp}/ctl.sock" if args.transport == "unix" else _free_tcp()
@@ -182,6 +190,7 @@ def main(argv: list[str] | None = None) -> int:
             "client": env.get("GTECAT_SPIN_US", "default"),
             "server": env.get("GTECAT_SERVER_SPIN_US", "default"),
         },
+        "rt_priority": env.get("GTECAT_RT_PRIORITY", "auto"),
         "calls": len(samples),
         "round_trip_us": stats,
         "calls_per_s": round(len(samples) / (total_ns / 1e9)),

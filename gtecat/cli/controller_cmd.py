@@ -17,6 +17,11 @@ In ``auto`` clock mode the controller keeps its time at or ahead of wall time (t
 floor, docs/native.md), so programs that sleep between polls see their sleeps pass;
 ``--no-wall-floor`` (GTECAT_WALL_FLOOR=0) keeps pure, deterministic ``auto``.
 
+While other programs keep every CPU busy, the controller serves calls under real-time
+priority (SCHED_FIFO 50) where the system permits it (root or CAP_SYS_NICE), so that a
+call does not wait for another program's time slice; ``--rt-priority off``
+(GTECAT_RT_PRIORITY=off) never asks for it.
+
 ``libgts.so`` starts a private one of these by itself on ``GT_Open`` when
 ``GTECAT_CONTROLLER`` is not set; it ends with the program.
 """
@@ -31,6 +36,8 @@ import socket
 import sys
 from pathlib import Path
 from types import FrameType
+
+from .. import scheduling
 
 
 def default_address() -> str:
@@ -77,11 +84,27 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="auto clock without the wall floor: controller time moves only by call latency "
         "and waits (deterministic; programs that sleep see no time pass)",
     )
+    p.add_argument(
+        "--rt-priority",
+        type=_rt_priority,
+        metavar="N|auto|off",
+        help="while other programs keep every CPU busy, serve calls under SCHED_FIFO "
+        "priority N (1-99); auto (the default, else "
+        f"{scheduling.RT_ENV}) takes priority {scheduling.AUTO_RT_PRIORITY} where the system "
+        "permits it (root or CAP_SYS_NICE), else runs normally; off never asks",
+    )
     # set by libgts when it starts a private controller
     p.add_argument("--ready-fd", type=int, help=argparse.SUPPRESS)
     p.add_argument("--lifeline-fd", type=int, help=argparse.SUPPRESS)
     p.add_argument("--private", action="store_true", help=argparse.SUPPRESS)
     p.set_defaults(func=run)
+
+
+def _rt_priority(text: str) -> int | str:
+    try:
+        return scheduling.parse_priority(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _token(args: argparse.Namespace) -> tuple[str, str]:
@@ -157,6 +180,11 @@ def run(args: argparse.Namespace) -> int:
         )
         if v is not None
     }
+    try:
+        rt_setting = scheduling.from_environment(args.rt_priority)
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
     server = Server(
         address,
         open_options=options,
@@ -179,6 +207,23 @@ def run(args: argparse.Namespace) -> int:
             return 1
         token_note = f"token: written to {token_path} (readable by you only)"
 
+    # the scheduling of the thread that serves, once the socket listens: asked for now (the
+    # line says what the system permits; a refusal of a number ends the controller here),
+    # then taken only while the CPUs are busy (scheduling.WhenBusy)
+    normal = scheduling.snapshot()
+    started_rt = rt_setting == "auto" and scheduling.is_realtime()
+    if started_rt:  # started real-time (chrt): left as it is
+        rt_setting = "off"
+    try:
+        taken = scheduling.take(rt_setting)
+    except scheduling.RealtimeRefused as e:
+        print(f"error: {e}", file=sys.stderr)
+        server.stop()
+        return 1
+    if taken.priority is not None:
+        server.realtime = scheduling.WhenBusy(taken.priority, normal=normal[:2] if normal else None)
+        server.realtime.realtime = True  # until the first look at the load
+
     def stop(signum: int, frame: FrameType | None) -> None:
         server.stop()
 
@@ -190,7 +235,16 @@ def run(args: argparse.Namespace) -> int:
             os.write(args.ready_fd, b"ready\n")
             os.close(args.ready_fd)
     else:
-        print(f"gtecat controller listening on {server.address}", file=sys.stderr, flush=True)
+        sched = "real-time priority as started" if started_rt else taken.words
+        if taken.priority is not None:
+            sched += " while the CPUs are busy"
+        if taken.refused:
+            sched += ": run as root or give python CAP_SYS_NICE for real-time priority"
+        print(
+            f"gtecat controller listening on {server.address} ({sched})",
+            file=sys.stderr,
+            flush=True,
+        )
         if token_note:
             print(token_note, file=sys.stderr, flush=True)
     try:

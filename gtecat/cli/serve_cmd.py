@@ -27,6 +27,7 @@ import sys
 from pathlib import Path
 from types import FrameType
 
+from .. import scheduling
 from . import output
 
 log = logging.getLogger("gtecat.wire.serve")
@@ -175,25 +176,15 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
     return chain, config
 
 
-#: the SCHED_FIFO priority ``--rt-priority auto`` asks for: above the kernel's threaded
-#: interrupt handlers of ordinary devices (50 is theirs too; a NIC's own stays above)
-AUTO_RT_PRIORITY = 50
+AUTO_RT_PRIORITY = scheduling.AUTO_RT_PRIORITY
 
 
-def _rt_priority(text: str) -> int | str | None:
+def _rt_priority(text: str) -> int | str:
     """``--rt-priority``: a number 1-99, ``auto`` or ``off`` (0 is off too)."""
-    t = text.strip().lower()
-    if t in ("auto", "off"):
-        return t
     try:
-        n = int(t)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: a priority 1-99, auto or off") from None
-    if n == 0:
-        return "off"
-    if not 1 <= n <= 99:
-        raise argparse.ArgumentTypeError(f"{n}: SCHED_FIFO priorities are 1-99")
-    return n
+        return scheduling.parse_priority(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def take_scheduling(rt: int | str, wait_given: str, cpu: int | None) -> tuple[int | None, str]:
@@ -210,23 +201,14 @@ def take_scheduling(rt: int | str, wait_given: str, cpu: int | None) -> tuple[in
     ``--wait spin`` keeps normal priority under ``auto`` (a task that never sleeps under
     SCHED_FIFO is stopped by the kernel for 50 ms of every second and takes the CPU from
     everything else); the number form takes FIFO anyway, as asked."""
-    from gtecat.wire.serve import WireError, realtime_priority
-
-    if rt == "off" or (rt == "auto" and wait_given == "spin"):
-        return None, "normal priority"
-    prio = AUTO_RT_PRIORITY if rt == "auto" else int(rt)
-    try:
-        realtime_priority(prio)
-    except WireError as exc:
-        if rt != "auto":
-            raise
+    taken = scheduling.take(rt, spins_forever=wait_given == "spin")
+    if taken.refused:
         print(
-            f"warning: running at normal priority ({exc}); on a busy host answers may come "
-            "later than a master's timeout: run as root or give python CAP_SYS_NICE",
+            f"warning: running at normal priority ({taken.refused}); on a busy host answers "
+            "may come later than a master's timeout: run as root or give python CAP_SYS_NICE",
             file=sys.stderr,
         )
-        return None, "normal priority (real-time refused)"
-    return prio, f"SCHED_FIFO {prio}"
+    return taken.priority, taken.words
 
 
 def preemption_words(realtime: bool) -> tuple[str, str | None]:
@@ -249,28 +231,6 @@ def preemption_words(realtime: bool) -> tuple[str, str | None]:
             "preempt=full (or a PREEMPT_RT kernel) for a bounded answer time"
         )
     return f", kernel preemption {model}", warning
-
-
-def _scheduling_now() -> tuple[int, int, set[int]] | None:
-    try:
-        return (
-            os.sched_getscheduler(0),
-            os.sched_getparam(0).sched_priority,
-            os.sched_getaffinity(0),
-        )
-    except (AttributeError, OSError):
-        return None
-
-
-def _restore_scheduling(before: tuple[int, int, set[int]] | None) -> None:
-    if before is None:
-        return
-    policy, prio, cpus = before
-    try:
-        os.sched_setscheduler(0, policy, os.sched_param(prio))
-        os.sched_setaffinity(0, cpus)
-    except (AttributeError, OSError):
-        pass
 
 
 def resolve_wait(wait: str, rt_priority: int | None = None) -> str:
@@ -356,10 +316,10 @@ def run(args: argparse.Namespace) -> int:
     _arm_faults(args, host)
     # the scheduling last, once everything that can fail has been checked; given back at
     # the end (a program that calls serve in-process keeps its own)
-    before = _scheduling_now()
-    rt, scheduling = take_scheduling(args.rt_priority, wait_given, args.cpu)
+    before = scheduling.snapshot()
+    rt, sched_words = take_scheduling(args.rt_priority, wait_given, args.cpu)
     words, warning = preemption_words(rt is not None)
-    scheduling += words
+    sched_words += words
     if warning:  # said right after the ready line (the first line is the ready line)
         server.early_messages.append(f"warning: {warning}")
     if rt is None and wants_rt and wait == "predict" and args.wait == "auto":
@@ -403,7 +363,7 @@ def run(args: argparse.Namespace) -> int:
         seen = f", id {endpoint.id} (gtecat ps)" if endpoint is not None else ""
         print(
             f"gtecat serve: {len(chain)} slaves on {args.iface} ({names}), --wait {wait}, "
-            f"{scheduling}{seen}; ready",
+            f"{sched_words}{seen}; ready",
             flush=True,
         )
         server.said_ready = True
@@ -415,7 +375,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if endpoint is not None:
             endpoint.close()
-        _restore_scheduling(before)
+        scheduling.restore(before)
         for s, h in old.items():
             signal.signal(s, h)
         server.close()

@@ -26,6 +26,13 @@ Decisions:
   client's own setting (two programs on one controller do not share it).
 * In ``auto`` mode the server keeps the wall floor (:mod:`gtecat.native.floor`)
   unless asked not to, so native clients that sleep between polls see time pass.
+* **Scheduling** (:mod:`gtecat.scheduling`): the controller process
+  (``gtecat controller``, the one libgts starts) gives :attr:`Server.realtime`, and the
+  server then serves under SCHED_FIFO while other programs could hold every CPU
+  (:data:`REALTIME_OVER_CPUS`; a normal process woken then may wait for another program's
+  time slice) and under its
+  normal policy, with its spin, otherwise; it never spins while real-time.  A server inside
+  another program (a test's) leaves the program's scheduling alone.
 * Every client is served independently: its bytes are buffered until a frame is whole and
   its replies until it reads them, so a client that sends half a frame, or stops reading,
   delays nobody; it is dropped after :data:`IO_TIMEOUT_S`.
@@ -53,6 +60,7 @@ from typing import Any
 
 from gtecat.eni.errors import GtecatError
 
+from .. import scheduling
 from ..gt import _core, declared
 from ..gt.fast import READERS, wire_reader
 from ..inspect import endpoint as _inspect
@@ -103,15 +111,23 @@ MAX_PENDING = 256
 DEFAULT_SPIN_US = 100
 
 
-def _cpus_busy() -> bool:
-    """More threads runnable than this process may use CPUs (/proc/loadavg's 4th field)."""
+def _runnable_over_cpus() -> int:
+    """Threads runnable now (/proc/loadavg's 4th field, this server among them) less the
+    CPUs this process may use; 0 where it cannot be read."""
     try:
         with open("/proc/loadavg", encoding="ascii") as f:
             running = int(f.read().split()[3].split("/")[0])
         cpus = len(os.sched_getaffinity(0))
     except (OSError, ValueError, IndexError, AttributeError):
-        return False
-    return running > cpus
+        return 0
+    return running - cpus
+
+
+#: runnable threads beyond the CPUs from which the server runs real-time (Server.realtime):
+#: the server and its client count two while a client polls, so from here other programs
+#: alone can hold every CPU.  (From one on, as the spin stops, the p50 on a machine shared
+#: with lighter work rose from 10 to 24-31 us: a real-time wake-up costs more than a normal one.)
+REALTIME_OVER_CPUS = 2
 
 
 def default_spin_us() -> float:
@@ -433,6 +449,9 @@ class Server:
         self.spin_s = max(0.0, spin_us) / 1e6
         self._budget = self.spin_s  # the adaptive spin (_spin_budget)
         self._busy, self._busy_next, self._since_probe = False, 0.0, 0
+        #: SCHED_FIFO while the CPUs are busy (set by the controller process before it
+        #: serves; never for a server inside another program, a test's)
+        self.realtime: scheduling.WhenBusy | None = None
         self.lock = threading.RLock()
         #: clients whose call is running (a GTE_Wait serving others between its slices
         #: runs their calls inside it: :meth:`_serve_others`)
@@ -463,6 +482,7 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
+        self._bound_spin(scheduling.is_realtime())
         poller = self._poller
         poller.register(self._listener.fileno())
         poller.register(self._wake_r.fileno())
@@ -487,6 +507,13 @@ class Server:
                     self._event(fd, ev, self._readable)
         finally:
             self._cleanup()
+
+    def _bound_spin(self, started_realtime: bool) -> None:
+        """A server started real-time (``chrt``) and not switching by itself: its spin
+        holds its CPU against everything else, so it spins at most RT_SPIN_CAP_US."""
+        if self.realtime is None and started_realtime:
+            self.spin_s = min(self.spin_s, scheduling.RT_SPIN_CAP_US / 1e6)
+            self._budget = min(self._budget, self.spin_s)
 
     def _event(self, fd: int, ev: int, read: Callable[[_Client], None]) -> None:
         """One poller event: a client's (``read`` serves what it sent), a connection, the
@@ -623,17 +650,19 @@ class Server:
         c.sock.close()
 
     def _spin_budget(self) -> float:
-        """Seconds to spin for this client's next request: none while more threads are
+        """Seconds to spin for this client's next request (and, every 10 ms, the look at
+        the load that also switches :attr:`realtime`): none while more threads are
         runnable than this process has CPUs (spinning would take the CPU the client waits
         for), half the last one after a spin that found nothing (a short probe every 256
         rounds once it is none), up to ``spin_s``."""
-        if not self.spin_s:
-            return 0.0
         now = time.monotonic()
         if now >= self._busy_next:
             self._busy_next = now + 0.01
-            self._busy = _cpus_busy()
-        if self._busy:
+            over = _runnable_over_cpus()
+            self._busy = over > 0
+            if self.realtime is not None:
+                self.realtime.busy(over >= REALTIME_OVER_CPUS)
+        if not self.spin_s or self._busy:
             return 0.0
         if not self._budget:
             self._since_probe += 1

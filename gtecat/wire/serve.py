@@ -39,7 +39,7 @@ Between frames the loop checks the sync manager watchdogs and stops within
 ``poll_s`` of :attr:`stop` being set (Ctrl-C / SIGTERM in the CLI).  Malformed
 frames are counted and dropped by the chain; nothing a frame contains can end
 the loop.  ``busy_poll`` spins instead of sleeping in ``poll`` (one core at
-100 %, no wake-up latency); :func:`realtime_priority` asks for SCHED_FIFO.
+100 %, no wake-up latency); :func:`gtecat.scheduling.take` asks for SCHED_FIFO.
 """
 
 from __future__ import annotations
@@ -201,14 +201,6 @@ def open_raw_socket(iface: str) -> socket.socket:
         pass
     sock.setblocking(False)
     return sock
-
-
-def realtime_priority(priority: int) -> None:
-    """Run this process under SCHED_FIFO ``priority`` (1-99); needs root or CAP_SYS_NICE."""
-    try:
-        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
-    except (OSError, AttributeError, ValueError) as exc:
-        raise WireError(f"cannot set SCHED_FIFO priority {priority}: {exc}") from exc
 
 
 def fine_timers() -> bool:

@@ -876,8 +876,13 @@ static int start_private(const char *fname)
         rmdir(dir);
         return -1;
     }
+    /* the scheduling setting may come from gtecat.ini, which the controller does not read */
+    const char *rt = setting("GTECAT_RT_PRIORITY");
+    char rt_arg[16];
+    snprintf(rt_arg, sizeof rt_arg, "%s", rt && strlen(rt) < sizeof rt_arg ? rt : "");
     char *argv[] = {(char *)python, "-m", "gtecat", "controller", "--listen", addr,
-                    "--private", "--ready-fd", "3", "--lifeline-fd", "4", NULL};
+                    "--private", "--ready-fd", "3", "--lifeline-fd", "4",
+                    rt_arg[0] ? "--rt-priority" : NULL, rt_arg, NULL};
     pid_t pid = fork();
     if (pid < 0) {
         set_err("%s returned -1: fork: %s", fname, strerror(errno));

@@ -93,19 +93,21 @@ def test_auto_scheduling_takes_fifo_where_permitted_and_is_given_back():
     explicit spin; serve gives it back at the end."""
     import os
 
-    from gtecat.cli.serve_cmd import _restore_scheduling, _scheduling_now, take_scheduling
+    from gtecat.cli.serve_cmd import take_scheduling
+    from gtecat.scheduling import restore, snapshot
 
-    before = _scheduling_now()
+    before = snapshot()
     try:
         assert take_scheduling("auto", "spin", None) == (None, "normal priority")
-        assert _scheduling_now() == before
+        assert snapshot() == before
         assert take_scheduling("off", "predict", None) == (None, "normal priority")
         rt, words = take_scheduling("auto", "predict", None)
         if rt is None:
             assert words == "normal priority (real-time refused)"
         else:
-            assert os.sched_getscheduler(0) == os.SCHED_FIFO and words == "SCHED_FIFO 50"
+            policy = os.sched_getscheduler(0) & ~os.SCHED_RESET_ON_FORK  # children run normally
+            assert policy == os.SCHED_FIFO and words == "SCHED_FIFO 50"
             assert os.sched_getaffinity(0) == before[2]  # type: ignore[index]
     finally:
-        _restore_scheduling(before)
-    assert _scheduling_now() == before
+        restore(before)
+    assert snapshot() == before

@@ -94,6 +94,19 @@ def test_the_private_controller_ends_with_the_program(gtn_sequence, tmp_path):
     assert not _controllers(tmp_path)
 
 
+def test_the_scheduling_setting_of_gtecat_ini_reaches_the_private_controller(
+    gtn_sequence, tmp_path
+):
+    """GTECAT_RT_PRIORITY may be written in gtecat.ini, which only the library reads: it
+    hands the setting to the controller it starts (an unreadable one: the controller says
+    so and does not start)."""
+    ini = tmp_path / "gtecat.ini"
+    ini.write_text("rt_priority = high\n")
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INI=str(ini)), cwd=tmp_path)
+    assert v.get("open") == "-1", r.stdout + r.stderr
+    assert "--rt-priority: 'high': a priority 1-99, auto or off" in r.stderr
+
+
 def _controllers(cwd: Path) -> set[int]:
     """Private controllers running in ``cwd``: the program's own (it inherits the program's
     folder), never another test's or another run's on the same machine (xdist workers and

@@ -1,0 +1,240 @@
+"""Real-time scheduling of gtecat's own server processes (``gtecat serve``, ``gtecat
+controller`` and the controller libgts starts).
+
+A server that answers requests must not wait behind other work on a busy host: a normal
+(``SCHED_OTHER``) task woken while other programs keep every CPU busy may wait for one of
+their time slices, milliseconds, where a ``SCHED_FIFO`` task runs at once.  So a server
+asks for ``SCHED_FIFO`` by default (``auto``) where the system permits it (root,
+``CAP_SYS_NICE`` or an ``RLIMIT_RTPRIO``), says what it got, and runs normally where it is
+refused.  ``off`` never asks; a number asks for that priority (and a refusal is an error).
+
+Decisions:
+
+* **Priority 50** for ``auto``: above the kernel's threaded interrupt handlers of ordinary
+  devices (50 is theirs too; a NIC's own stays above).
+* **SCHED_RESET_ON_FORK**: threads and processes the server starts (a compiler building the
+  cycle kernel, a background thread) run normally; only the serving thread is real-time.
+* **No CPU pinning**: a real-time task takes whichever CPU it wakes on from normal work, and
+  the kernel moves it to another when a real-time task already runs there, which it cannot
+  do for a pinned one.
+* **Bounded spins**: a real-time task that never sleeps is stopped by the kernel for 50 ms
+  of every second (``sched_rt_runtime_us``) and takes its CPU from everything else meanwhile;
+  a real-time server sleeps between requests and spins only for a bounded time
+  (:data:`RT_SPIN_CAP_US`).
+* The decision (:func:`take`) gets the call that sets the policy injected, so the whole
+  permitted / refused / off logic is tested without privileges.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from gtecat.eni.errors import GtecatError
+
+#: the SCHED_FIFO priority ``auto`` asks for
+AUTO_RT_PRIORITY = 50
+#: the environment variable the native controller and libgts read (auto, off or 1-99)
+RT_ENV = "GTECAT_RT_PRIORITY"
+#: the longest spin of a real-time server waiting for a client's next request (us)
+RT_SPIN_CAP_US = 50.0
+#: the system has real-time scheduling calls (Linux and other POSIX systems; not Windows)
+AVAILABLE = hasattr(os, "sched_setscheduler")
+
+
+class RealtimeRefused(GtecatError):
+    """The system refused SCHED_FIFO (the message says why)."""
+
+
+def parse_priority(text: str) -> int | str:
+    """``auto``, ``off`` (``0`` too) or a priority 1-99 -> ``"auto"``, ``"off"`` or the int;
+    ValueError with a sentence otherwise."""
+    t = text.strip().lower()
+    if t in ("auto", "off"):
+        return t
+    try:
+        n = int(t)
+    except ValueError:
+        raise ValueError(f"{text!r}: a priority 1-99, auto or off") from None
+    if n == 0:
+        return "off"
+    if not 1 <= n <= 99:
+        raise ValueError(f"{n}: SCHED_FIFO priorities are 1-99")
+    return n
+
+
+def realtime_priority(priority: int) -> None:
+    """Run the calling thread under SCHED_FIFO ``priority`` (1-99), its children and new
+    threads normally; :class:`RealtimeRefused` where the system does not permit it."""
+    try:
+        policy = os.SCHED_FIFO | getattr(os, "SCHED_RESET_ON_FORK", 0)
+        os.sched_setscheduler(0, policy, os.sched_param(priority))
+    except (OSError, AttributeError, ValueError) as exc:
+        raise RealtimeRefused(f"cannot set SCHED_FIFO priority {priority}: {exc}") from exc
+
+
+@dataclass(frozen=True, slots=True)
+class Scheduling:
+    """What :func:`take` got: the priority (None: normal) and words for a status line."""
+
+    priority: int | None
+    words: str
+    #: why real-time was asked for and refused ("" otherwise)
+    refused: str = ""
+
+
+NORMAL = Scheduling(None, "normal priority")
+
+
+def take(
+    setting: int | str,
+    *,
+    spins_forever: bool = False,
+    set_fifo: Callable[[int], None] = realtime_priority,
+    available: bool = AVAILABLE,
+) -> Scheduling:
+    """Take the scheduling ``setting`` asks for (``auto``, ``off`` or a priority).
+
+    ``auto`` asks for :data:`AUTO_RT_PRIORITY` and falls back to normal priority where the
+    system refuses (``refused`` says why); a number asks for that priority and a refusal
+    raises :class:`RealtimeRefused`.  ``spins_forever``: the caller will never sleep (a
+    busy-polling loop), so ``auto`` keeps normal priority (a real-time task that never
+    sleeps is stopped by the kernel 50 ms of every second); a number takes FIFO anyway.
+    Where the system has no real-time scheduling (``available`` False: Windows), ``auto``
+    runs normally without a complaint."""
+    if setting == "off" or (setting == "auto" and spins_forever):
+        return NORMAL
+    if setting == "auto" and not available:
+        return Scheduling(None, "normal priority (no real-time scheduling on this system)")
+    prio = AUTO_RT_PRIORITY if setting == "auto" else int(setting)
+    try:
+        set_fifo(prio)
+    except RealtimeRefused as exc:
+        if setting != "auto":
+            raise
+        return Scheduling(None, "normal priority (real-time refused)", refused=str(exc))
+    return Scheduling(prio, f"SCHED_FIFO {prio}")
+
+
+def from_environment(
+    given: int | str | None = None, environ: dict[str, str] | None = None
+) -> int | str:
+    """The setting: ``given`` (a command-line option) when not None, else
+    ``GTECAT_RT_PRIORITY``, else ``auto``; ValueError for an unreadable variable."""
+    if given is not None:
+        return given
+    env = os.environ if environ is None else environ
+    text = env.get(RT_ENV, "").strip()
+    if not text:
+        return "auto"
+    try:
+        return parse_priority(text)
+    except ValueError as exc:
+        raise ValueError(f"{RT_ENV}={exc}") from None
+
+
+class WhenBusy:
+    """A server thread that runs under SCHED_FIFO ``priority`` only while the CPUs are busy
+    (more threads runnable than CPUs) and under its normal policy otherwise.
+
+    Why: on an idle machine a normal server wakes on the CPU of the client that woke it (the
+    kernel's affine wake-up) and both sides may spin for each other's next message, where a
+    real-time one is woken on the CPU it last ran on, which in a virtual machine may have to
+    be woken itself first (tens of microseconds); on a busy machine a normal server waits
+    for other programs' time slices (milliseconds), a real-time one does not, and it must not
+    spin (a real-time spin takes its CPU from everything else).  :meth:`busy` is called with
+    each new look at the load; it switches only on a change (one system call)."""
+
+    def __init__(
+        self,
+        priority: int,
+        set_fifo: Callable[[int], None] = realtime_priority,
+        set_normal: Callable[[tuple[int, int]], None] | None = None,
+        normal: tuple[int, int] | None = None,
+    ) -> None:
+        self.priority = priority
+        self._set_fifo = set_fifo
+        self._set_normal = set_normal or _set_policy
+        #: the policy and priority outside the busy times (SCHED_OTHER 0 unless given)
+        self.normal = normal if normal is not None else (getattr(os, "SCHED_OTHER", 0), 0)
+        self.realtime = False
+        #: why SCHED_FIFO was refused, once it was (then never asked again)
+        self.refused = ""
+        self.switches = 0
+
+    def busy(self, busy: bool) -> bool:
+        """Run real-time if ``busy`` (where permitted); True while real-time."""
+        if busy == self.realtime or (busy and self.refused):
+            return self.realtime
+        try:
+            if busy:
+                self._set_fifo(self.priority)
+            else:
+                self._set_normal(self.normal)
+        except RealtimeRefused as exc:
+            self.refused = str(exc)
+            return self.realtime
+        self.realtime = busy
+        self.switches += 1
+        return self.realtime
+
+
+def _set_policy(policy_priority: tuple[int, int]) -> None:
+    policy, prio = policy_priority
+    try:
+        os.sched_setscheduler(0, policy, os.sched_param(prio))
+    except (OSError, AttributeError, ValueError) as exc:
+        raise RealtimeRefused(f"cannot go back to policy {policy}: {exc}") from exc
+
+
+def is_realtime() -> bool:
+    """The calling thread runs under SCHED_FIFO or SCHED_RR."""
+    try:
+        policy = os.sched_getscheduler(0) & ~getattr(os, "SCHED_RESET_ON_FORK", 0)
+        return policy in (os.SCHED_FIFO, os.SCHED_RR)
+    except (AttributeError, OSError):
+        return False
+
+
+def snapshot() -> tuple[int, int, set[int]] | None:
+    """This thread's policy, priority and CPUs (None where the system has no such calls)."""
+    try:
+        return (
+            os.sched_getscheduler(0),
+            os.sched_getparam(0).sched_priority,
+            os.sched_getaffinity(0),
+        )
+    except (AttributeError, OSError):
+        return None
+
+
+def restore(before: tuple[int, int, set[int]] | None) -> None:
+    """Give back what :func:`snapshot` saw."""
+    if before is None:
+        return
+    policy, prio, cpus = before
+    try:
+        os.sched_setscheduler(0, policy, os.sched_param(prio))
+        os.sched_setaffinity(0, cpus)
+    except (AttributeError, OSError):
+        pass
+
+
+__all__ = [
+    "AUTO_RT_PRIORITY",
+    "AVAILABLE",
+    "NORMAL",
+    "RT_ENV",
+    "RT_SPIN_CAP_US",
+    "RealtimeRefused",
+    "Scheduling",
+    "WhenBusy",
+    "from_environment",
+    "is_realtime",
+    "parse_priority",
+    "realtime_priority",
+    "restore",
+    "snapshot",
+    "take",
+]

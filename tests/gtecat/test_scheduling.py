@@ -1,0 +1,181 @@
+"""The real-time scheduling decisions (gtecat/scheduling.py) and where the native controller
+uses them, without privileges: the call that sets SCHED_FIFO is a fake that permits or
+refuses."""
+
+from __future__ import annotations
+
+import argparse
+
+import pytest
+
+from gtecat import scheduling
+from gtecat.scheduling import RealtimeRefused, WhenBusy, from_environment, parse_priority, take
+
+
+class FakeSystem:
+    """Records what was asked for; refuses SCHED_FIFO unless ``permits``."""
+
+    def __init__(self, permits: bool) -> None:
+        self.permits = permits
+        self.calls: list[object] = []
+
+    def fifo(self, prio: int) -> None:
+        self.calls.append(("fifo", prio))
+        if not self.permits:
+            raise RealtimeRefused(f"cannot set SCHED_FIFO priority {prio}: not permitted")
+
+    def normal(self, policy_prio: tuple[int, int]) -> None:
+        self.calls.append(("normal", policy_prio))
+
+
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [("auto", "auto"), (" AUTO ", "auto"), ("off", "off"), ("0", "off"), ("1", 1), ("99", 99)],
+)
+def test_priority_settings(text, value):
+    assert parse_priority(text) == value
+
+
+@pytest.mark.parametrize("text", ["100", "-1", "high", ""])
+def test_priority_settings_refused_with_a_sentence(text):
+    with pytest.raises(ValueError, match="1-99"):
+        parse_priority(text)
+
+
+def test_the_setting_comes_from_the_option_else_the_environment_else_auto():
+    assert from_environment(None, {}) == "auto"
+    assert from_environment(None, {"GTECAT_RT_PRIORITY": " "}) == "auto"
+    assert from_environment(None, {"GTECAT_RT_PRIORITY": "off"}) == "off"
+    assert from_environment(None, {"GTECAT_RT_PRIORITY": "20"}) == 20
+    assert from_environment("off", {"GTECAT_RT_PRIORITY": "20"}) == "off"
+    with pytest.raises(ValueError, match="GTECAT_RT_PRIORITY="):
+        from_environment(None, {"GTECAT_RT_PRIORITY": "high"})
+
+
+def test_auto_takes_fifo_where_permitted():
+    system = FakeSystem(permits=True)
+    got = take("auto", set_fifo=system.fifo)
+    assert got == scheduling.Scheduling(50, "SCHED_FIFO 50")
+    assert system.calls == [("fifo", 50)]
+
+
+def test_auto_runs_normally_where_refused_and_says_why():
+    system = FakeSystem(permits=False)
+    got = take("auto", set_fifo=system.fifo)
+    assert got.priority is None and got.words == "normal priority (real-time refused)"
+    assert "not permitted" in got.refused
+
+
+def test_off_never_asks():
+    system = FakeSystem(permits=True)
+    assert take("off", set_fifo=system.fifo) == scheduling.NORMAL
+    assert system.calls == []
+
+
+def test_a_loop_that_never_sleeps_stays_normal_under_auto_but_a_number_is_obeyed():
+    system = FakeSystem(permits=True)
+    assert take("auto", spins_forever=True, set_fifo=system.fifo) == scheduling.NORMAL
+    assert take(10, spins_forever=True, set_fifo=system.fifo).priority == 10
+    assert system.calls == [("fifo", 10)]
+
+
+def test_auto_without_real_time_scheduling_runs_normally_without_a_complaint():
+    system = FakeSystem(permits=True)
+    got = take("auto", set_fifo=system.fifo, available=False)
+    assert got.priority is None and not got.refused and system.calls == []
+
+
+def test_a_number_refused_is_an_error():
+    with pytest.raises(RealtimeRefused):
+        take(10, set_fifo=FakeSystem(permits=False).fifo)
+
+
+def test_when_busy_switches_on_a_change_only():
+    system = FakeSystem(permits=True)
+    rt = WhenBusy(50, set_fifo=system.fifo, set_normal=system.normal, normal=(0, 0))
+    assert rt.busy(False) is False and system.calls == []
+    assert rt.busy(True) is True
+    assert rt.busy(True) is True
+    assert rt.busy(False) is False
+    assert system.calls == [("fifo", 50), ("normal", (0, 0))]
+    assert rt.switches == 2
+
+
+def test_when_busy_refused_once_is_not_asked_again():
+    system = FakeSystem(permits=False)
+    rt = WhenBusy(50, set_fifo=system.fifo, set_normal=system.normal)
+    assert rt.busy(True) is False and "not permitted" in rt.refused
+    assert rt.busy(False) is False
+    assert rt.busy(True) is False
+    assert system.calls == [("fifo", 50)]
+
+
+@pytest.fixture
+def server(tmp_path):
+    from gtecat.native.server import Server
+
+    s = Server(f"unix:{tmp_path}/ctl.sock", spin_us=100)
+    try:
+        yield s
+    finally:
+        s._listener.close()
+        s._poller.close()
+
+
+def test_the_controller_is_real_time_while_busy_and_then_never_spins(server, monkeypatch):
+    """The native controller: SCHED_FIFO (and no spin) while more threads are runnable
+    than there are CPUs, its normal policy and its spin otherwise."""
+    from gtecat.native import server as server_module
+
+    system = FakeSystem(permits=True)
+    server.realtime = WhenBusy(50, set_fifo=system.fifo, set_normal=system.normal, normal=(0, 0))
+    load = {"over": 2}  # runnable threads beyond the CPUs
+    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
+
+    def look(over: int) -> float:
+        load["over"] = over
+        server._busy_next = 0.0  # the next look at the load is due
+        return server._spin_budget()
+
+    assert look(2) == 0.0
+    assert system.calls == [("fifo", 50)]
+    # busy, but not so busy that other programs alone hold every CPU: normal, no spin
+    assert look(1) == 0.0
+    assert look(0) == pytest.approx(100e-6)
+    assert system.calls == [("fifo", 50), ("normal", (0, 0))]
+
+
+def test_a_server_started_real_time_spins_briefly(server):
+    """Started under chrt (no switching of its own): its spin is bounded."""
+    server._bound_spin(started_realtime=False)
+    assert server.spin_s == pytest.approx(100e-6)
+    server._bound_spin(started_realtime=True)
+    assert server.spin_s == pytest.approx(scheduling.RT_SPIN_CAP_US / 1e6)
+
+
+def test_the_controller_command_refuses_an_unreadable_setting(tmp_path, monkeypatch, capsys):
+    from gtecat.cli import controller_cmd
+
+    with pytest.raises(SystemExit):
+        parser = argparse.ArgumentParser()
+        controller_cmd.add_parser(parser.add_subparsers())
+        parser.parse_args(["controller", "--rt-priority", "high"])
+    assert "a priority 1-99, auto or off" in capsys.readouterr().err
+    monkeypatch.setenv("GTECAT_RT_PRIORITY", "high")
+    args = argparse.Namespace(
+        listen=f"unix:{tmp_path}/ctl.sock",
+        token_file=None,
+        eni=None,
+        machine=None,
+        clock=None,
+        backend=None,
+        iface=None,
+        card=None,
+        no_wall_floor=False,
+        ready_fd=None,
+        lifeline_fd=None,
+        private=False,
+        rt_priority=None,
+    )
+    assert controller_cmd.run(args) == 1
+    assert "error: GTECAT_RT_PRIORITY='high': a priority 1-99" in capsys.readouterr().err
