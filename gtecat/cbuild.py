@@ -1,9 +1,9 @@
 """Compiling the package's small C parts on first use, into a per-version cache.
 
 ``pip install`` needs no C compiler: libgts (:mod:`gtecat.native.build`), the axis bank's
-compiled cycle (:mod:`gtecat.controller.bank_kernel`) and the GT fast path's pointer check
-(:mod:`gtecat.gt.byref_target`) are built when first asked for, with
-``$CC`` (else ``cc``, ``gcc``, ``clang``), into ``$GTECAT_CACHE_DIR`` (else
+compiled cycle (:mod:`gtecat.controller.bank_kernel`), the GT fast path's pointer check
+(:mod:`gtecat.gt.byref_target`) and its C entry (:mod:`gtecat.gt.centry`) are built when
+first asked for, with ``$CC`` (else ``cc``, ``gcc``, ``clang``), into ``$GTECAT_CACHE_DIR`` (else
 ``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``) ``/<version>/``.  Here are the pieces
 they share: where the cache is, which compiler, and a one-file shared library build named by
 the digest of its source and flags (a lock file serialises concurrent builders), in this

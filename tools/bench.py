@@ -41,7 +41,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong, pointer
 from dataclasses import replace
 from pathlib import Path
 
@@ -166,12 +166,133 @@ def bench_get_sts(seconds: float = 1.0, block: int = 200) -> dict[str, object]:
     }
 
 
-def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, object]:
-    """Each call shape of the fast path against building its arguments, in alternating
-    blocks on figure 5-2's bus (lockstep): µs per call, µs per argument build, their ratio
-    (medians); ``worst`` is the largest ratio."""
+#: the call shapes of the fast path and what building their arguments costs, as a client
+#: writes both: (the call statement, the statement that builds the same arguments); the names
+#: are those of :func:`_shape_env`
+CALL_SHAPES: dict[str, tuple[str, str]] = {
+    "GT_GetSts(1, byref(c_long()))": ("gt.GT_GetSts(1, byref(c_long()))", "byref(c_long())"),
+    "GT_GetSts(1, byref(s))": ("gt.GT_GetSts(1, byref(s))", "byref(s)"),
+    "GT_GetSts(1, ps), ps = byref(s) held": ("gt.GT_GetSts(1, ps)", "byref(c_long())"),
+    "GT_GetSts(1, s)": ("gt.GT_GetSts(1, s)", "c_long()"),
+    "GT_GetSts(1, byref(s), 1, 0)": ("gt.GT_GetSts(1, byref(s), 1, 0)", "byref(s)"),
+    "GT_GetSts(1, byref(s), 1, None)": ("gt.GT_GetSts(1, byref(s), 1, None)", "byref(s)"),
+    "GT_GetSts(1, byref(c_long()), 1, 0)": (
+        "gt.GT_GetSts(1, byref(c_long()), 1, 0)",
+        "byref(c_long())",
+    ),
+    "GTN_GetSts(1, 1, byref(s))": ("gt.GTN_GetSts(1, 1, byref(s))", "byref(s)"),
+    "GT_GetSts(1, pointer(s))": ("gt.GT_GetSts(1, pointer(s))", "pointer(s)"),
+    "GT_GetSts(1, c_long[1])": ("gt.GT_GetSts(1, arr1)", "(c_long * 1)()"),
+    "GT_GetSts(1, c_long[2], 2)": ("gt.GT_GetSts(1, sts2, 2)", "(c_long * 2)()"),
+    "GT_GetSts(1, c_long[12], 12, byref(clk))": (
+        "gt.GT_GetSts(1, sts12, 12, byref(clk))",
+        "byref(clk)",
+    ),
+    "GT_GetSts(1, numpy int32[1])": ("gt.GT_GetSts(1, np1)", "np.zeros(1, np.int32)"),
+    "GT_GetPrfPos(1, byref(c_double()))": (
+        "gt.GT_GetPrfPos(1, byref(c_double()))",
+        "byref(c_double())",
+    ),
+    "GT_GetEncPos(1, byref(d))": ("gt.GT_GetEncPos(1, byref(d))", "byref(d)"),
+    "GT_GetPrfMode(1, byref(s))": ("gt.GT_GetPrfMode(1, byref(s))", "byref(s)"),
+    "GT_GetClock(byref(clk))": ("gt.GT_GetClock(byref(clk))", "byref(clk)"),
+    "GT_GetEcatEncPos(1, byref(s))": ("gt.GT_GetEcatEncPos(1, byref(s))", "byref(s)"),
+    "GT_GetEcatRawData(0, 8, buf) c_ubyte[8]": ("gt.GT_GetEcatRawData(0, 8, buf)", "U8()"),
+    "GT_GetEcatRawData(0, 8, byref(buf))": ("gt.GT_GetEcatRawData(0, 8, byref(buf))", "byref(buf)"),
+    "GT_GetEcatRawData(0, 8, c_ubyte[8]()) fresh": ("gt.GT_GetEcatRawData(0, 8, U8())", "U8()"),
+    "GT_GetEcatRawData(0, 8, bytearray)": ("gt.GT_GetEcatRawData(0, 8, ba)", "bytearray(8)"),
+    "GT_GetEcatRawData(0, 8, numpy uint8)": (
+        "gt.GT_GetEcatRawData(0, 8, npu8)",
+        "np.zeros(8, np.uint8)",
+    ),
+    "GT_GetEcatRawData(0, 8, memoryview)": (
+        "gt.GT_GetEcatRawData(0, 8, mv8)",
+        "memoryview(bytearray(8))",
+    ),
+    "GT_SetEcatRawData(32, 2, bytes)": ("gt.GT_SetEcatRawData(32, 2, out2)", "bytes([15, 0])"),
+    "GT_SetEcatRawData(32, 2, c_ubyte[2](..)) fresh": (
+        "gt.GT_SetEcatRawData(32, 2, (c_ubyte * 2)(0x55, 0xAA))",
+        "(c_ubyte * 2)(0x55, 0xAA)",
+    ),
+    "GT_SetEcatRawData(32, 2, buf) c_ubyte[8]": ("gt.GT_SetEcatRawData(32, 2, buf)", "U8()"),
+    "GT_EcatIOReadInput(2, 0, 4, buf)": ("gt.GT_EcatIOReadInput(2, 0, 4, buf)", "U8()"),
+    "GT_EcatIOReadInput(2, 0, 4, bytearray)": (
+        "gt.GT_EcatIOReadInput(2, 0, 4, ba)",
+        "bytearray(8)",
+    ),
+    "GT_EcatIOWriteOutput(2, 0, 2, bytes)": (
+        "gt.GT_EcatIOWriteOutput(2, 0, 2, out2)",
+        "bytes([15, 0])",
+    ),
+    "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": ("gt.GT_GetDi(0, byref(s))", "byref(s)"),
+    "GT_GetDi(MC_HOME, byref(c_long()))": ("gt.GT_GetDi(3, byref(c_long()))", "byref(c_long())"),
+    "GT_GetDi(MC_GPI, s)": ("gt.GT_GetDi(4, s)", "c_long()"),
+    "GT_GetDiRaw(MC_LIMIT_NEGATIVE, byref(s))": ("gt.GT_GetDiRaw(1, byref(s))", "byref(s)"),
+    "GT_GetDo(MC_GPO, byref(s))": ("gt.GT_GetDo(12, byref(s))", "byref(s)"),
+    "GT_GetTrapPrm(1, byref(tp))": ("gt.GT_GetTrapPrm(1, byref(tp))", "byref(tp)"),
+    "GT_GetTrapPrm(1, byref(TTrapPrm()))": (
+        "gt.GT_GetTrapPrm(1, byref(gt.TTrapPrm()))",
+        "byref(gt.TTrapPrm())",
+    ),
+    "GT_GetEcatHomingStatus(1, byref(h))": ("gt.GT_GetEcatHomingStatus(1, byref(h))", "byref(h)"),
+    "GT_GetEcatHomingStatus(1, byref(c_short()))": (
+        "gt.GT_GetEcatHomingStatus(1, byref(c_short()))",
+        "byref(c_short())",
+    ),
+}
+#: the table path (every other function: its checks compiled, then the emulated function's
+#: own work, which these figures include): reported beside the fast path's, not in `worst`
+TABLE_SHAPES: dict[str, tuple[str, str]] = {
+    "GT_GetCore(byref(h))": ("gt.GT_GetCore(byref(h))", "byref(h)"),
+    "GT_GetDiReverseCount(MC_HOME, 1, c_ulong[2], 2)": (
+        "gt.GT_GetDiReverseCount(3, 1, counts, 2)",
+        "(c_ulong * 2)()",
+    ),
+}
+
+
+def _shape_env() -> dict[str, object]:
+    """The names :data:`CALL_SHAPES` uses (the controller open)."""
     import numpy as np
 
+    from gtecat import gt
+
+    return {
+        "gt": gt,
+        "np": np,
+        "byref": byref,
+        "pointer": pointer,
+        "c_long": c_long,
+        "c_short": c_short,
+        "c_double": c_double,
+        "c_ubyte": c_ubyte,
+        "c_ulong": c_ulong,
+        "s": c_long(),
+        "ps": byref(c_long()),
+        "d": c_double(),
+        "h": c_short(),
+        "clk": c_ulong(),
+        "U8": c_ubyte * 8,
+        "buf": (c_ubyte * 8)(),
+        "ba": bytearray(8),
+        "npu8": np.zeros(8, np.uint8),
+        "mv8": memoryview(bytearray(8)),
+        "np1": np.zeros(1, np.int32),
+        "arr1": (c_long * 1)(),
+        "sts2": (c_long * 2)(),
+        "sts12": (c_long * 12)(),
+        "out2": bytes([0x0F, 0x00]),
+        "tp": gt.TTrapPrm(),
+        "counts": (c_ulong * 2)(),
+    }
+
+
+def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, object]:
+    """Each call shape of the fast path (:data:`CALL_SHAPES`) against the statement that
+    builds the same arguments, each timed as a loop of its statement (no wrapper around
+    either), in alternating blocks on figure 5-2's bus (lockstep, axis 1 on and in Trap):
+    µs per call, µs per argument build, their ratio (medians); ``worst`` is the largest
+    ratio."""
     from gtecat import gt
 
     gt.GT_Close()
@@ -180,169 +301,51 @@ def bench_call_shapes(seconds: float = 1.0, block: int = 200) -> dict[str, objec
     gt.GTE_Wait(60)
     gt.GT_StartEcatComm()
     gt.GT_AxisOn(1)
-    held = c_long()
-    p = byref(held)
-    u8 = c_ubyte * 8
-    buf8, ba8, np8 = u8(), bytearray(8), np.zeros(8, np.uint8)
-    pbuf8 = byref(buf8)
-    mv8 = memoryview(bytearray(8))
-    out2 = bytes([0x0F, 0x00])
-    sts, raw_get, raw_set = gt.GT_GetSts, gt.GT_GetEcatRawData, gt.GT_SetEcatRawData
-    io_read, io_write = gt.GT_EcatIOReadInput, gt.GT_EcatIOWriteOutput
-    np1 = np.zeros(1, np.int32)
-    arr1 = (c_long * 1)()
-    held_d = c_double()
-    pd = byref(held_d)
-    shapes = {
-        # shape: (the call, building its arguments)
-        "GT_GetSts(1, byref(s))": (lambda: sts(1, p), lambda: byref(c_long())),
-        "GT_GetSts(1, byref(c_long()))": (
-            lambda: sts(1, byref(c_long())),
-            lambda: byref(c_long()),
-        ),
-        "GTN_GetSts(1, 1, byref(c_long()))": (
-            lambda: gt.GTN_GetSts(1, 1, byref(c_long())),
-            lambda: byref(c_long()),
-        ),
-        "GT_GetSts(1, byref(s), 1, 0)": (lambda: sts(1, p, 1, 0), lambda: byref(c_long())),
-        "GT_GetSts(1, byref(s), 1, None)": (
-            lambda: sts(1, p, 1, None),
-            lambda: byref(c_long()),
-        ),
-        "GT_GetSts(1, s)": (lambda: sts(1, held), lambda: c_long()),
-        "GT_GetSts(1, c_long[1])": (lambda: sts(1, arr1), lambda: (c_long * 1)()),
-        "GT_GetSts(1, numpy int32[1])": (lambda: sts(1, np1), lambda: np.zeros(1, np.int32)),
-        "GT_GetPrfPos(1, byref(d))": (lambda: gt.GT_GetPrfPos(1, pd), lambda: byref(c_double())),
-        "GT_GetPrfPos(1, byref(c_double()))": (
-            lambda: gt.GT_GetPrfPos(1, byref(c_double())),
-            lambda: byref(c_double()),
-        ),
-        "GT_GetPrfMode(1, byref(s))": (lambda: gt.GT_GetPrfMode(1, p), lambda: byref(c_long())),
-        "GT_GetClock(byref(s))": (lambda: gt.GT_GetClock(p), lambda: byref(c_long())),
-        "GT_GetClock(byref(c_long()))": (
-            lambda: gt.GT_GetClock(byref(c_long())),
-            lambda: byref(c_long()),
-        ),
-        "GT_GetEcatEncPos(1, byref(s))": (
-            lambda: gt.GT_GetEcatEncPos(1, p),
-            lambda: byref(c_long()),
-        ),
-        "GT_GetEcatEncPos(1, byref(c_long()))": (
-            lambda: gt.GT_GetEcatEncPos(1, byref(c_long())),
-            lambda: byref(c_long()),
-        ),
-        "GTN_GetSts(1, 1, byref(s))": (lambda: gt.GTN_GetSts(1, 1, p), lambda: byref(c_long())),
-        "GT_GetEcatRawData(0, 8, c_ubyte[8])": (
-            lambda: raw_get(0, 8, buf8),
-            lambda: (c_ubyte * 8)(),
-        ),
-        "GT_GetEcatRawData(0, 8, byref(c_ubyte[8]))": (
-            lambda: raw_get(0, 8, pbuf8),
-            lambda: byref(u8()),
-        ),
-        "GT_GetEcatRawData(0, 8, byref(c_ubyte[8]()))": (
-            lambda: raw_get(0, 8, byref(u8())),
-            lambda: byref(u8()),
-        ),
-        "GT_GetEcatRawData(0, 8, bytearray)": (lambda: raw_get(0, 8, ba8), lambda: bytearray(8)),
-        "GT_GetEcatRawData(0, 8, numpy uint8)": (
-            lambda: raw_get(0, 8, np8),
-            lambda: np.zeros(8, np.uint8),
-        ),
-        "GT_GetEcatRawData(0, 8, memoryview)": (
-            lambda: raw_get(0, 8, mv8),
-            lambda: memoryview(bytearray(8)),
-        ),
-        "GT_SetEcatRawData(0, 2, bytes)": (lambda: raw_set(0, 2, out2), lambda: bytes([15, 0])),
-        "GT_EcatIOReadInput(2, 0, 4, c_ubyte[8])": (
-            lambda: io_read(2, 0, 4, buf8),
-            lambda: (c_ubyte * 8)(),
-        ),
-        "GT_EcatIOReadInput(2, 0, 4, bytearray)": (
-            lambda: io_read(2, 0, 4, ba8),
-            lambda: bytearray(8),
-        ),
-        "GT_EcatIOWriteOutput(2, 0, 2, bytes)": (
-            lambda: io_write(2, 0, 2, out2),
-            lambda: bytes([15, 0]),
-        ),
-    }
-    trap = gt.TTrapPrm()
-    short = c_short()
-    ps = byref(short)
-    shapes.update(
-        {
-            "GT_GetTrapPrm(1, byref(TTrapPrm))": (
-                lambda: gt.GT_GetTrapPrm(1, byref(trap)),
-                lambda: byref(gt.TTrapPrm()),
-            ),
-            "GT_GetEcatHomingStatus(1, byref(s))": (
-                lambda: gt.GT_GetEcatHomingStatus(1, ps),
-                lambda: byref(c_short()),
-            ),
-            "GT_GetEcatHomingStatus(1, byref(c_short()))": (
-                lambda: gt.GT_GetEcatHomingStatus(1, byref(c_short())),
-                lambda: byref(c_short()),
-            ),
-            "GT_GetDi(MC_LIMIT_POSITIVE, byref(s))": (
-                lambda: gt.GT_GetDi(0, p),
-                lambda: byref(c_long()),
-            ),
-            "GT_GetDi(MC_HOME, byref(c_long()))": (
-                lambda: gt.GT_GetDi(3, byref(c_long())),
-                lambda: byref(c_long()),
-            ),
-            "GT_GetDi(MC_GPI, s)": (lambda: gt.GT_GetDi(4, held), lambda: c_long()),
-            "GT_GetDiRaw(MC_LIMIT_NEGATIVE, byref(s))": (
-                lambda: gt.GT_GetDiRaw(1, p),
-                lambda: byref(c_long()),
-            ),
-            "GT_GetDo(MC_GPO, byref(s))": (lambda: gt.GT_GetDo(12, p), lambda: byref(c_long())),
-            "GT_GetDo(MC_ENABLE, byref(c_long()))": (
-                lambda: gt.GT_GetDo(10, byref(c_long())),
-                lambda: byref(c_long()),
-            ),
-        }
-    )
-    # the table path (every other function: its checks compiled, then the emulated function's
-    # own work, which these figures include): reported beside the fast path's, not in `worst`
-    table = {
-        "GT_GetCore(byref(s))": (lambda: gt.GT_GetCore(ps), lambda: byref(c_short())),
-        "GT_GetDiReverseCount(MC_HOME, 1, c_ulong[2], 2)": (
-            lambda: gt.GT_GetDiReverseCount(3, 1, counts, 2),
-            lambda: (c_ulong * 2)(),
-        ),
-    }
-    counts = (c_ulong * 2)()
-    per = seconds / (len(shapes) + len(table))
-    out = _time_pairs(shapes, per * len(shapes), block)
-    table_out = _time_pairs(table, per * len(table), block)
+    gt.GT_PrfTrap(1)
+    gt.GTE_Wait(20)
+    env = _shape_env()
+    per = seconds / (len(CALL_SHAPES) + len(TABLE_SHAPES))
+    try:
+        out = _time_pairs(
+            {k: (*v, env) for k, v in CALL_SHAPES.items()}, per * len(CALL_SHAPES), block
+        )
+        table_out = _time_pairs(
+            {k: (*v, env) for k, v in TABLE_SHAPES.items()}, per * len(TABLE_SHAPES), block
+        )
+    finally:
+        gt.GT_Close()
     worst = max((row["ratio"] for row in out.values()), default=0.0)
     table_worst = max((row["ratio"] for row in table_out.values()), default=0.0)
-    gt.GT_Close()
     return {"shapes": out, "worst": worst, "table_path": table_out, "table_worst": table_worst}
 
 
+def _loop(stmt: str, env: dict[str, object]) -> Callable[[int], None]:
+    """``f(n)``: ``stmt`` run ``n`` times, its names ``env``'s globals (as timeit runs it)."""
+    ns = dict(env)
+    exec(compile(f"def _run(_n):\n    for _ in range(_n):\n        {stmt}\n", stmt, "exec"), ns)
+    return ns["_run"]  # type: ignore[return-value]
+
+
 def _time_pairs(
-    pairs: Mapping[str, tuple[Callable[[], object], Callable[[], object]]],
+    pairs: Mapping[str, tuple[str, str, dict[str, object]]],
     seconds: float,
     block: int,
 ) -> dict[str, dict[str, float]]:
-    """Per name, (the call, building its arguments) timed in alternating blocks of ``block``
-    for ``seconds`` in all: µs per call, µs per argument build, the ratio of the medians."""
-    clock, rng = time.perf_counter, range(block)
+    """Per name, (the call statement, the statement building its arguments, their names)
+    timed as loops of ``block`` runs, alternating, for ``seconds`` in all: µs per call, µs
+    per argument build, the ratio of the medians."""
+    clock = time.perf_counter
     per = seconds / max(1, len(pairs))
     out: dict[str, dict[str, float]] = {}
-    for name, (call, build) in pairs.items():
+    for name, (call_src, build_src, env) in pairs.items():
+        call, build = _loop(call_src, env), _loop(build_src, env)
         calls, args = [], []
         t_end = clock() + per
         while clock() < t_end or len(calls) < 3:
             t0 = clock()
-            for _ in rng:
-                build()
+            build(block)
             t1 = clock()
-            for _ in rng:
-                call()
+            call(block)
             t2 = clock()
             args.append((t1 - t0) / block)
             calls.append((t2 - t1) / block)
@@ -357,14 +360,15 @@ def _time_pairs(
 
 def every_shape(
     names: Sequence[str] | None = None,
-) -> tuple[dict[str, tuple[Callable[[], object], Callable[[], object]]], dict[str, str]]:
+) -> tuple[dict[str, tuple[str, str, dict[str, object]]], dict[str, str]]:
     """Every function with a fast path (the raw image functions: :func:`bench_call_shapes`)
     in every way a client passes its value's pointer, with what building that argument
     costs: ``byref`` of a reused and of a fresh object, the ctypes object itself, a ctypes
     and a numpy array of one element, and NULL (0, None) for the optional pointer after it
     (``count`` 1 first for the readers of a span); each call written out as a client writes
-    it (no ``*args``).  ``names``: these functions instead (a comparison with another
-    version).  The controller must be open.  Also the shapes not measured and why: a call
+    it (no ``*args``), with the statement that builds the same arguments and their names.
+    ``names``: these functions instead (a comparison with another version).  The controller
+    must be open.  Also the shapes not measured and why: a call
     that does not return 0 on this bus (an object its drives do not map), a shape the table
     path answers (``fast.SLOW_SHAPES``)."""
     import numpy as np
@@ -376,7 +380,7 @@ def every_shape(
 
     first = {"GT_GetDi": 3, "GT_GetDiRaw": 0, "GT_GetDo": 10}  # (a type; else axis 1)
     dtypes = {c_double: np.float64, c_long: np.int64, c_short: np.int16}
-    out: dict[str, tuple[Callable[[], object], Callable[[], object]]] = {}
+    out: dict[str, tuple[str, str, dict[str, object]]] = {}
     skipped: dict[str, str] = {}
     slow = getattr(fast, "SLOW_SHAPES", {})  # (an earlier version has none)
     for name in names if names is not None else sorted(fast.fast_functions() - fast.RAW):
@@ -404,7 +408,8 @@ def every_shape(
         # shape: (its kind, as fast.SLOW_SHAPES names it; the call's source; building its
         # arguments' source)
         shapes = {
-            "byref(s)": ("byref reused", f"fn({x}ref)", "byref(t())"),
+            "byref(s)": ("byref reused", f"fn({x}byref(held))", "byref(held)"),
+            "ps (byref(s) held)": ("byref reused", f"fn({x}ref)", "byref(t())"),
             f"byref({t.__name__}())": ("byref fresh", f"fn({x}byref(t()))", "byref(t())"),
             "s": ("object", f"fn({x}held)", "t()"),
             f"{t.__name__}[1]": ("array[1]", f"fn({x}arr)", "(t * 1)()"),
@@ -420,19 +425,18 @@ def every_shape(
             for z in ("0", "None"):
                 shapes[f"byref(s), {count}{z}"] = (
                     f"null {z}",
-                    f"fn({x}ref, {count}{z})",
-                    "byref(t())",
+                    f"fn({x}byref(held), {count}{z})",
+                    "byref(held)",
                 )
         for shape, (kind, call, build) in shapes.items():
             label = f"{name}({'x, ' if i else ''}{shape})"
-            pair = (eval(f"lambda: {call}", env), eval(f"lambda: {build}", env))
-            rc = pair[0]()
+            rc = eval(call, env)
             if rc != 0:
                 skipped[label] = f"returns {rc} on this bus"
             elif kind in slow.get(name, {}):
                 skipped[label] = "on the table path: " + slow[name][kind]
             else:
-                out[label] = pair
+                out[label] = (call, build, env)
     return out, skipped
 
 

@@ -52,8 +52,9 @@ status cycle by cycle).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from itertools import compress
+from itertools import chain, compress
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -225,6 +226,12 @@ _ALARM = int(AxisStatus.ALARM)
 _POS_LIMIT = int(AxisStatus.POSITIVE_LIMIT)
 _NEG_LIMIT = int(AxisStatus.NEGATIVE_LIMIT)
 _SW_FAULT = 0x0008  # 6041h bit 3: fault
+#: dpost: the drive's touch probe takes an edge of a cycle's travel after that cycle
+#: (bank_kernel.c TP_POST; far above 60FDh's 32 bits)
+TP_POST = 1 << 62
+#: the touch probe's TxPDO objects: a row whose drive maps one keeps giving its row back
+#: before a probe edge (the bank leaves them in the image as they are)
+_TP_TX = (0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, *range(0x60D1, 0x60D9))
 
 
 #: the modes whose planners a cluster steps ahead (gtecat.controller.bank_modes)
@@ -242,6 +249,9 @@ class _Bypass:
 
 
 _OWNER: dict[int, tuple[AxisBank, int]] = {}  # id(object) -> (bank, group index)
+#: id() of the objects given a dict of their own at a claim (it stays theirs: an id used
+#: again by a later object only costs that object its quick attribute reads)
+_OWN_DICT: set[int] = set()
 _GUARDS: dict[type, type] = {}
 _get, _set = object.__getattribute__, object.__setattr__
 
@@ -345,7 +355,17 @@ class AxisBank:
         self.n = 0
         self.alive = np.zeros(0, bool)
         self.n_alive = 0
+        #: the rows whose hooks took a watched input's edge after the last cycle
+        #: (:meth:`_post_events`; cleared at the next): their smart homings step after it
+        self.evt_rows: set[int] = set()
+        self.any_post = False
+        #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
+        self._stepping = -1
+        self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._lists: dict[str, list[Any]] = {}
+        #: the flags the last list of GT_GetSts words was made from (a few rows) and that
+        #: list: made again only when one changed (a move, a jog and a rest last many runs)
+        self._sts_last: tuple[tuple[bytes, ...], list[int]] | None = None
         #: counts the claims and releases of rows (an axis's resources point at the bank or
         #: not): what the GT readers' plans of many axes at once check (gtecat.gt.fast)
         self.layout = 0
@@ -388,6 +408,11 @@ class AxisBank:
         #: of those, the cycles of drives resting in homing mode after their homing
         self.rest_rows_run = 0
         self.n_rest = 0
+        #: smart-homing steps run on a claimed row in place (:meth:`step_claimed`), and the
+        #: edges taken after a bank cycle (:meth:`_post_events`): a watched input's, a touch
+        #: probe's (statistics; the differential tests check they ran)
+        self.steps_in_place = 0
+        self.posted_inputs = self.posted_probes = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
@@ -434,6 +459,7 @@ class AxisBank:
     def _build(self) -> None:
         """Rows for every axis whose slave the bank can run (mapping and backend)."""
         self.built = True
+        self._tp_map = {}
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -592,11 +618,15 @@ class AxisBank:
         #: 60FDh bits whose change sends a row back before the cycle (an input a bank-aware
         #: hook samples every cycle: a capture unit's home input)
         self.dwatch = zi(n, np.int64)
+        #: the same bits where the hooks take the edge after the cycle (bank_post_ready): the
+        #: cycle runs in the bank, then they do (:meth:`_post_events`)
+        self.dpost = zi(n, np.int64)
         #: a row moving in Trap with a limit flag latched: bit 0 positive, bit 1 negative;
         #: a sample toward that side sends it back before the cycle (AxisResources._post)
         self.lvel = zi(n, np.uint8)
         #: the bank-aware axis hooks of a claimed row (:meth:`_axis_hooks`), told at its release
         self._aware: dict[int, list[Any]] = {}
+
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
         self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
@@ -633,6 +663,7 @@ class AxisBank:
         self.n_rest = int(np.count_nonzero(self.h_done & alive)) if self.n_hm else 0
         self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
+        self.any_post = bool(np.count_nonzero(self.dpost[alive]))
         self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
         self.band_dirty = True
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
@@ -725,8 +756,9 @@ class AxisBank:
                 return False
         return st
 
-    def _eligible(self, r: int) -> bool:
-        """The scalar state the bank reproduces (module docstring)."""
+    def _eligible(self, r: int, drive: bool = True) -> bool:
+        """The scalar state the bank reproduces (module docstring); ``drive`` False: the
+        drive's own conditions left out (a claimed row whose drive stays in the bank)."""
         ax = self.axes[r]
         res = self.res[r]
         if res is None or ax.number in self.held or res.bank_hold:
@@ -772,7 +804,7 @@ class AxisBank:
             return False
         if not self._inputs_plain(ax, res):
             return False
-        return not claimable(self.csp.channels[r])
+        return not drive or not claimable(self.csp.channels[r])
 
     @staticmethod
     def _latched_standing(ax: Any, res: Any) -> bool:
@@ -1047,9 +1079,12 @@ class AxisBank:
         self._g_claimed[gi] = True
         self._loaded = True
         for obj in self._guarded_objects(g):
-            _OWNER[id(obj)] = (self, gi)
+            key = id(obj)
+            _OWNER[key] = (self, gi)
             _set(obj, "__class__", _guard_class(type(obj)))
-            own_dict(obj)  # (a class assigned: see gtecat._attrs)
+            if key not in _OWN_DICT:  # (a class assigned: see gtecat._attrs; once is enough)
+                _OWN_DICT.add(key)
+                own_dict(obj)
         return True
 
     def _guarded_objects(self, g: _Group) -> list[object]:
@@ -1064,7 +1099,9 @@ class AxisBank:
                 out.append(_get(ch, "probe"))  # (its source, function or values touched)
         return out
 
-    def _load(self, r: int) -> None:
+    def _load(self, r: int, again: bool = False) -> None:
+        """Take row ``r`` from its objects; ``again``: a row loaded before whose scale, links,
+        limits and encoder settings nothing changed since (a step in place)."""
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = True
         aware = aware_hooks(ax)
@@ -1072,26 +1109,29 @@ class AxisBank:
         for obj in aware:
             watch |= obj.bank_watch
         self.dwatch[r] = watch
+        self.dpost[r] = 0
         if aware:
             self._aware[r] = aware
         latched = res.latched
         self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
         self.layout += 1
-        s = ax.pos_scale
-        self.unit2[r] = float(1 << s)
-        self.unit[r] = 1.0 / (1 << s)
-        self.drive_offset[r] = ax.drive_offset
-        self.prf_ratio[r], self.prf_off[r] = res.prf_link.ratio, res.prf_link.offset
-        self.enc_ratio[r], self.enc_off[r] = res.enc_link.ratio, res.enc_link.offset
-        sf = res.safety
-        on = sf.active
-        self.soft_pos[r] = sf.soft_positive if on else np.inf
-        self.soft_neg[r] = sf.soft_negative if on else -np.inf
-        self.pos_err[r] = sf.pos_err if on else np.inf
+        if not again:
+            s = ax.pos_scale
+            self.unit2[r] = float(1 << s)
+            self.unit[r] = 1.0 / (1 << s)
+            self.drive_offset[r] = ax.drive_offset
+            self.prf_ratio[r], self.prf_off[r] = res.prf_link.ratio, res.prf_link.offset
+            self.enc_ratio[r], self.enc_off[r] = res.enc_link.ratio, res.enc_link.offset
+            sf = res.safety
+            on = sf.active
+            self.soft_pos[r] = sf.soft_positive if on else np.inf
+            self.soft_neg[r] = sf.soft_negative if on else -np.inf
+            self.pos_err[r] = sf.pos_err if on else np.inf
         enc = res.encoder
-        self.external[r] = enc.external
-        self.sense[r] = enc.sense
+        if not again:
+            self.external[r] = enc.external
+            self.sense[r] = enc.sense
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
@@ -1132,7 +1172,8 @@ class AxisBank:
         self.nseg[r] = 0
         if moving and not sampled and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
             m = len(pl._segs)
-            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = np.array(pl._segs, np.float64).ravel()
+            # (a flat list: numpy takes it several times faster than the list of tuples)
+            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = list(chain.from_iterable(pl._segs))
             self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
                 pl._t_done,
                 pl._ts,
@@ -1183,6 +1224,29 @@ class AxisBank:
             # 6041h: the state bits and remote, step_hm's bits instead of CSP's (oms =
             # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
             self.csp.sw_const[r] += ch.hm_bits - SW12
+            return
+        watch = int(self.dwatch[r])
+        tp = bool(self.csp.tpw[r])
+        if (
+            (watch or tp)
+            and not self.sampled[r]
+            and not self.jog[r]
+            and len(self.groups[self.group_of[r]].rows) == 1
+            and all(obj.bank_post_ready() for obj in aware)
+        ):
+            # its hooks (and its drive's probe) take such an edge after the cycle, the row
+            # staying (:meth:`_post_events`)
+            if tp and not self._tp_mapped(r):
+                watch |= TP_POST
+            self.dwatch[r], self.dpost[r] = 0, watch
+
+    def _tp_mapped(self, r: int) -> bool:
+        """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""
+        got = self._tp_map.get(r)
+        if got is None:
+            io = self.axes[r].io
+            got = self._tp_map[r] = any(io.get(i) is not None for i in _TP_TX)
+        return got
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
         """A moving row leaves: remember its table (its samples stay in ``t_p``/``t_v``/``t_a``
@@ -1330,6 +1394,14 @@ class AxisBank:
         if self.n_alive and res.bank is self:
             self.release_axis_object(ax)
 
+    def watch_grew(self, ax: Any) -> None:
+        """A bank-aware hook of ``ax`` watches more 60FDh bits (:attr:`dwatch`, read at a
+        claim): a claimed row goes back, but the row a step runs on in place, which is
+        taken up again after the step (:meth:`step_claimed`)."""
+        r = self._row_of.get(id(ax))
+        if r is not None and r != self._stepping:
+            self.release_axis_object(ax)
+
     def release_axis_object(self, ax: Any) -> None:
         r = self._row_of.get(id(ax))
         if r is not None and self.alive[r]:
@@ -1412,11 +1484,17 @@ class AxisBank:
         self.n_alive = int(np.count_nonzero(self.alive))
 
     def _store(self, r: int) -> None:
-        ax, res = self.axes[r], self.res[r]
         self.alive[r] = False
         self.claim_ids[r] = 0
-        res.bank = None
+        self.res[r].bank = None
         self.layout += 1
+        if r != self._stepping:  # (a row stepped in place: its objects hold its state)
+            self._put_back(r)
+
+    def _put_back(self, r: int) -> None:
+        """Row ``r``'s state into its axis objects (its drive aside), as a release leaves them
+        (:attr:`_last` and :attr:`_rates` hold its planned values and encoder rates)."""
+        ax, res = self.axes[r], self.res[r]
         a = float(self.a_last[r])
         ax.prf_pos = a
         res._a_last = a
@@ -1592,17 +1670,36 @@ class AxisBank:
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
-                return [
+                moving, jog, arrived, frz, latched = (
+                    self.moving,
+                    self.jog,
+                    self.arrived,
+                    self.frz,
+                    self.latched,
+                )
+                flags = (
+                    moving.tobytes(),
+                    jog.tobytes(),
+                    arrived.tobytes(),
+                    frz.tobytes(),
+                    latched.tobytes(),
+                )
+                last = self._sts_last
+                if last is not None and last[0] == flags:
+                    return last[1]  # (the same words: every reader only reads the list)
+                words = [
                     (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
                     for m, j, a, f, lt in zip(
-                        self.moving.tolist(),
-                        self.jog.tolist(),
-                        self.arrived.tolist(),
-                        self.frz.tolist(),
-                        self.latched.tolist(),
+                        moving.tolist(),
+                        jog.tolist(),
+                        arrived.tolist(),
+                        frz.tolist(),
+                        latched.tolist(),
                         strict=True,
                     )
                 ]
+                self._sts_last = (flags, words)
+                return words
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
@@ -1645,6 +1742,8 @@ class AxisBank:
 
     def cycle(self, t_ns: int, dt_ns: int) -> None:
         """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        if self.evt_rows:
+            self.evt_rows.clear()
         if self._settled:
             self._settled = False  # its first steps ran just before (settle)
         else:
@@ -1674,6 +1773,11 @@ class AxisBank:
                     rc = k.cycle(t_ns, dt)
                 if rc == 0:
                     self._after_kernel(k)
+                    if self.any_post:
+                        evt = k.scratch["s_evt"]
+                        if np.count_nonzero(evt):
+                            rows = np.flatnonzero(evt).tolist()
+                            self._post_events(rows, t_ns, dt_ns, k.scratch["s_p0"])
                     return
                 # declined: the numpy cycle looks at every table (the kernel may have
                 # refilled some, or left one for it: code 4)
@@ -1734,13 +1838,26 @@ class AxisBank:
             hit |= (din & 3) != 0
         if self.any_watch:  # an input a bank-aware hook samples changes (kernel: dwatch)
             hit |= ((din ^ csp.din) & self.dwatch) != 0
+        evt = ((din ^ csp.din) & self.dpost) != 0 if self.any_post else None
         if self.any_lvel:  # a sample toward a latched limit (kernel: lvel)
             v = self.prf_ratio * self.t_v.take(idx)
             hit |= ((self.lvel & 1) != 0) & (v > 0.0) | ((self.lvel & 2) != 0) & (v < 0.0)
         hit |= a < self.soft_neg
         hit |= np.abs(err) > self.pos_err
+        p0 = None
         if events is not None:
-            hit |= events
+            tp_edge = csp.tp_edge
+            post = None
+            if self.any_post and tp_edge is not None:
+                post = tp_edge & ((self.dpost & TP_POST) != 0)
+            if post is None or not np.count_nonzero(post):
+                hit |= events
+            else:  # the probe takes these edges after the cycle (_post_events)
+                if csp.fe_event is not None:
+                    hit |= csp.fe_event
+                hit |= tp_edge & ~post
+                evt = post if evt is None else evt | post
+                p0 = csp.pos.copy()
         if np.count_nonzero(huge):
             hit |= huge
         # 6. the in-position band (bit 11)
@@ -1821,6 +1938,9 @@ class AxisBank:
             cols.append(csp.output(name, state))
         vals = np.concatenate(cols).take(self._img_src)
         buf[self._img_dst] = vals.astype("<u4").view(np.uint8).take(self._img_bytes)
+        if evt is not None and np.count_nonzero(evt & self.alive):
+            rows = np.flatnonzero(evt & self.alive).tolist()
+            self._post_events(rows, t_ns, dt_ns, p0)
 
     def run_cycles(self, t_ns: int, dt_ns: int, n: int) -> int:
         """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
@@ -1833,6 +1953,8 @@ class AxisBank:
         k = self.kernel
         if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
             return 0
+        if self.evt_rows:
+            self.evt_rows.clear()
         dt = dt_ns * 1e-9
         if dt != self.csp._dt:
             return 0
@@ -1973,9 +2095,8 @@ class AxisBank:
         position after a run of cycles needs neither the speed nor the acceleration)."""
         table, jog = _PLANNED[name]
         out = getattr(self, table).take(self.t_idx)
-        if self.n_jog:
-            j = self.jog
-            out[j] = getattr(self, jog)[j]
+        if self.n_jog:  # (the jogs' values where jog is set: one copy, no masked arrays)
+            np.copyto(out, getattr(self, jog), where=self.jog)
         if self.n_hm:  # a homing axis's plan holds its actual position
             for r in np.nonzero(self.hm & self.alive)[0].tolist():
                 out[r] = (
@@ -1989,6 +2110,146 @@ class AxisBank:
         gs = {self.group_of[r] for r in rows.tolist()}
         self._release_groups([self.groups[g] for g in sorted(gs)])
         self._reindex()
+
+    # --- a hook's step on a claimed row -----------------------------------------------------
+    def step_claimed(self, r: int, step: Callable[[], None]) -> None:
+        """Run ``step`` (a smart homing's step after a cycle, which reads and changes the
+        axis's objects) on row ``r`` exactly as a release before it and a claim after it
+        would, without giving the drive back: the row's state goes into its axis, planner,
+        encoder and band objects and is taken from them again (as a release and a claim do
+        it), those four objects lose their guards for the step, and after it the row takes
+        them up again (a new Trap move, flags cleared) when it is still what
+        :meth:`_eligible` asks for, else it goes back as at any release.  The drive's objects
+        keep their guards: a step that reaches them (an SDO to the drive) gives the row back
+        then.  A row of a drive with several channels, of a cluster or not in a plain Trap
+        or standing state simply goes back (the step runs on the scalar objects)."""
+        g = self.groups[self.group_of[r]]
+        if (
+            not self.alive[r]
+            or len(g.rows) != 1
+            or self.sampled[r]
+            or self.jog[r]
+            or self.hm[r]
+            or self.frz[r]
+        ):
+            step()
+            return
+        ax, res = self.axes[r], self.res[r]
+        prof = res.profile
+        pl = prof.planner
+        objs = (ax, pl, res.encoder, res.band)
+        _Bypass.on = True
+        try:
+            self._last = {r: self._planned_row(r)}
+            self._rates = {r: self._enc_rates_row(r)}
+            self._put_back(r)
+            aware = self._aware.pop(r, None)
+            if aware:  # (as at a release: the hooks catch up with the cycles the bank ran)
+                ran = int(self.bank_cycles - self.claim_cycle[r])
+                for obj in aware:
+                    obj.bank_released(ran)
+        finally:
+            _Bypass.on = False
+        for obj in objs:
+            cls = type(obj)
+            if _GUARDS.get(cls.__mro__[1]) is cls:
+                _set(obj, "__class__", cls.__mro__[1])
+        # the objects hold the row's state now: a release (within the step or after it)
+        # leaves them as they are
+        self._stepping = r
+        self.evt_rows.discard(r)  # (its step takes the edge its hooks took)
+        try:
+            self._step_claimed(r, g, step, pl, objs)
+        finally:
+            self._stepping = -1
+
+    def _step_claimed(
+        self, r: int, g: _Group, step: Callable[[], None], pl: Any, objs: tuple
+    ) -> None:
+        ok = False
+        was_moving = bool(self.moving[r])
+        try:
+            step()
+            if not g.claimed:
+                return  # the step reached the drive: given back
+            _Bypass.on = True
+            try:
+                ok = self.res[r].profile.planner is pl and self._eligible(r, drive=False)
+                if ok:
+                    self._load(r, again=True)
+                    ok = not (self.jog[r] or self.hm[r] or self.frz[r])
+            finally:
+                _Bypass.on = False
+        finally:
+            if g.claimed and not ok:
+                _OWNER.pop(id(pl), None)  # (another planner: the release looks at that one)
+                self._release_groups([g])
+        if not ok:
+            return
+        self.steps_in_place += 1
+        for obj in objs:  # (their dicts are their own since their claim)
+            _set(obj, "__class__", _guard_class(type(obj)))
+        self._after_load(r, was_moving)
+
+    def _after_load(self, r: int, was_moving: bool) -> None:
+        """What :meth:`_reindex` counts that loading claimed row ``r`` again in place may
+        change (a new move, the flags and watched inputs taken again; the claimed set stays).
+        A flag "some row has it" may stay set for a row that no longer has it: it only
+        makes the numpy cycle look (and find nothing)."""
+        moving = bool(self.moving[r])
+        self.n_moving += moving - was_moving
+        self._refill_in = 0
+        if self.kernel is not None:
+            if not self._c_fill:
+                self._c_fill = not np.count_nonzero(self.moving & self.alive & (self.nseg <= 0))
+            elif moving and self.nseg[r] <= 0:
+                self._c_fill = False
+        if self.any_band:
+            self._count_standing()
+        self.any_watch = self.any_watch or bool(self.dwatch[r])
+        self.any_post = self.any_post or bool(self.dpost[r])
+        self.any_lvel = self.any_lvel or bool(self.lvel[r])
+        self.band_dirty = True
+        self._lists.clear()
+
+    def _post_events(
+        self, rows: list[int], t_ns: int, dt_ns: int, p0: np.ndarray | None = None
+    ) -> None:
+        """After a committed cycle in which a watched input of ``rows`` changed, or their
+        travel reached an edge of their drive's touch probe (:attr:`dpost`; ``p0``: where
+        each row's travel started): the drive's probe takes the edge (TouchProbe.step, as the
+        drive's own step ends; its bounds follow), each row's state goes into its axis objects
+        (as at a release), its hooks catch up with the cycles before and run this one
+        (``bank_posted``: the capture unit reads the probe as its cycle does), and the row is
+        taken up again from the objects (as at a claim; the drive stays).  The result is the
+        scalar path's, which ran this cycle on the objects: the bank's cycle is theirs, and
+        the probe's and the hooks' part of it is what the objects' one would have been."""
+        csp = self.csp
+        _Bypass.on = True
+        try:
+            for r in rows:
+                if p0 is not None and self.dpost[r] & TP_POST:
+                    self.posted_probes += 1
+                    ch = csp.channels[r]
+                    probe = ch.probe
+                    a, b = float(p0[r]), float(csp.pos[r])
+                    if probe.function:
+                        off = ch.enc_offset
+                        probe.step(a, b, a - off, b - off, t_ns, dt_ns)
+                    csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
+                self._last = {r: self._planned_row(r)}
+                self._rates = {r: self._enc_rates_row(r)}
+                self._put_back(r)
+                self.posted_inputs += bool(self.dpost[r] & ~TP_POST)
+                ran = int(self.bank_cycles - self.claim_cycle[r])
+                for obj in self._aware.pop(r, ()):
+                    obj.bank_posted(ran, t_ns, dt_ns)
+                was_moving = bool(self.moving[r])
+                self._load(r, again=True)
+                self._after_load(r, was_moving)
+                self.evt_rows.add(r)
+        finally:
+            _Bypass.on = False
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

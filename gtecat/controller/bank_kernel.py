@@ -254,6 +254,9 @@ class Kernel:
         self.scratch["s_jog"] = np.zeros(5 * n, _F64)
         self.scratch["s_hm"] = np.zeros(7 * n, _F64)  # a homing row's tentative search state
         self.scratch["s_hit"] = np.zeros(n, np.bool_)  # homing rows that must leave first
+        #: rows whose watched input changed in a committed cycle, for their hooks (AxisBank.dpost)
+        self.scratch["s_evt"] = np.zeros(n, np.bool_)
+        self.scratch["s_p0"] = np.zeros(n, _F64)  # where their travel started (a probe's edge)
         self.ptrs = np.zeros(len(_FIELDS), np.uint64)
         self.io = np.zeros(N_IO, np.int64)
         self.fp = np.zeros(N_FP, np.float64)

@@ -259,7 +259,7 @@ class CaptureUnit:
         claim watches it)."""
         bank = self.res.bank
         if bank is not None:
-            bank.release_axis_object(self.ax)
+            bank.watch_grew(self.ax)
 
     def bank_ready(self) -> bool:
         """The next cycles' :meth:`_post` can find an edge only where the home input changes
@@ -305,6 +305,27 @@ class CaptureUnit:
             backend, slave = self._tp_uploads
             if backend is not None:
                 backend.uploads_answered(slave, cycles)
+
+    def bank_post_ready(self) -> bool:
+        """An edge of a watched input (:attr:`bank_watch`) or of the drive's touch probe may
+        be taken after a cycle the bank ran (:meth:`bank_posted`) instead of in a cycle of the
+        scalar objects: this cycle's :meth:`_post` then reads what the image's 60FDh, the
+        encoder and the drive's probe (its objects, as the bank leaves them) show - no card
+        latch, nothing of the probe being written."""
+        return self._card_edges is None and not self._tp_pending and self._tp_want == self._tp_sent
+
+    def bank_posted(self, cycles: int, t_ns: int, dt_ns: int) -> None:
+        """The bank ran ``cycles`` cycles of the axis, the last of which changed a watched
+        input or reached an edge of the drive's probe (its objects hold that cycle's state):
+        the ones before as :meth:`bank_released` leaves them (no edge: what changed was
+        watched, and the rest nobody reads; the 60B9h reads by SDO counted), then the last
+        one's :meth:`_post`."""
+        backend, slave = self._tp_uploads
+        if backend is not None and cycles > 1:
+            backend.uploads_answered(slave, cycles - 1)
+        if not self.bank_watch:
+            self._home_prev = self.home_level()  # (an unwatched level: taken up, no edge)
+        self._post(self.ax, t_ns, dt_ns)
 
     # --- the cycle ---------------------------------------------------------------------------
     def _post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:

@@ -464,8 +464,8 @@ class SmartHome:
         if res.bank is not bank:
             return None
         r = res.bank_row
-        if not (bank.alive[r] and bank.moving[r]):
-            return None
+        if not (bank.alive[r] and bank.moving[r]) or r in bank.evt_rows:
+            return None  # (evt_rows: the bank ran a cycle that changed an input it watches)
         # what a call may have changed since the last step (a call gives the axis back
         # first, and the bank may take it again before the next cycle): as the step saw it
         if res.latched != self._seen_latched or res.stops != self._stops:
@@ -944,6 +944,8 @@ class _Homings:
         self.running: list[SmartHome] = []
         self._due = 0
         self._seen = -1
+        #: the last look found a homing that steps every cycle (:meth:`quiet_cycles`)
+        self._stepping = True
 
     def add(self, home: SmartHome) -> None:
         if home not in self.running:
@@ -964,7 +966,8 @@ class _Homings:
             return
         bank = ctl.bank
         if bank is not None and self._seen == bank.releases and t < self._due:
-            return  # nothing to do for any of them in this cycle
+            if not bank.evt_rows:
+                return  # nothing to do for any of them in this cycle
         self._settle(bank, t + dt, step=True)
 
     def quiet_cycles(self, n: int) -> int:
@@ -977,6 +980,14 @@ class _Homings:
         bank = ctl.bank
         t0, dt = ctl.clock.now_ns, ctl.clock.cycle_ns
         if bank is None or self._seen != bank.releases or t0 >= self._due:
+            if (
+                t0 == self._due
+                and not self._stepping
+                and bank is not None
+                and self._seen == bank.releases
+                and not bank.evt_rows
+            ):
+                return 0  # a homing found quiet up to this cycle steps after it: as found
             self._settle(bank, t0, step=False)
         return min(n, max(0, -((t0 - self._due) // dt)))
 
@@ -988,6 +999,7 @@ class _Homings:
         ids = bank.claim_ids if bank is not None else ()
         t_prev = t_next - dt
         due = None
+        stepping = False  # some homing steps every cycle (not found quiet)
         for home in list(self.running):
             d = home._q_due
             if not (
@@ -1003,17 +1015,27 @@ class _Homings:
                     home._q_claim = 0
                     d = t_next
                     if step:
-                        home.cycle()
+                        if bank is not None and home.res.bank is bank:
+                            # its row stays claimed (a release and a claim, the drive kept)
+                            bank.step_claimed(home.res.bank_row, home.cycle)
+                        else:
+                            home.cycle()
                         if not home.running:
                             self.running.remove(home)
                             continue
-                else:
+                        # (a leg the step started in the bank: quiet from now on, as the
+                        # next look would find it)
+                        q = home.quiet(bank)
+                    if q is None:
+                        stepping = True
+                if q is not None:
                     r = home.res.bank_row
                     d = home._q_due = t_next + q * dt
                     home._q_row, home._q_claim = r, ids[r]
             if due is None or d < due:
                 due = d
         self._due = t_next if due is None else due
+        self._stepping = stepping
         # a step that gave an axis back may have changed another homing's axis: look again
         self._seen = seen if bank is not None and bank.releases == seen else -1
 

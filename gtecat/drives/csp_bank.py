@@ -358,11 +358,15 @@ class CspBank:
                 self.fe_next = bool(np.count_nonzero(fe_time))
             else:
                 self.fe_next = False
+        #: this cycle's rows whose travel reaches an edge the touch probe would latch (None:
+        #: none looked at), and the following-error events (their owner tells them apart)
+        self.tp_edge = None
+        self.fe_event = events
         if self.any_tp:  # a travel reaching an edge the touch probe would latch
             moved = self.tpw & (pos != p)
             if np.count_nonzero(moved):
                 lo, hi = np.minimum(p, pos), np.maximum(p, pos)
-                edge = moved & ~((self.tp_lo < lo) & (hi < self.tp_hi))
+                edge = self.tp_edge = moved & ~((self.tp_lo < lo) & (hi < self.tp_hi))
                 events = edge if events is None else events | edge
         state = {
             "pos": pos,

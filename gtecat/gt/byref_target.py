@@ -51,7 +51,7 @@ def _word(address: int) -> int:
     return ctypes.c_void_p.from_address(address).value or 0
 
 
-def _layout() -> tuple[int, int, int, int]:
+def layout() -> tuple[int, int, int, int]:
     """(pointer's address, pointer's object, object's type, ctypes object's memory): byte
     offsets, each checked on objects whose answers are known (ValueError when one is not)."""
     if sys.implementation.name != "cpython" or CARG_AT is None:
@@ -83,10 +83,27 @@ def _layout() -> tuple[int, int, int, int]:
 _KEEP: list[Any] = []  # the method definitions and tables the functions point at
 
 
+def function_maker() -> Callable[..., Any]:
+    """``new(name, address, flags, self, keep)``: the C function at ``address`` (a
+    ``PyCFunction`` of calling convention ``flags``) bound to ``self`` (a ctypes object,
+    whose memory the function reads) as a Python built-in function; its method definition,
+    ``self`` and ``keep`` are kept alive for as long as the process runs."""
+    # (a prototype of our own: ctypes.pythonapi's function objects are shared)
+    proto = ctypes.PYFUNCTYPE(ctypes.py_object, ctypes.c_void_p, ctypes.py_object, ctypes.py_object)
+    bind = proto(("PyCFunction_NewEx", ctypes.pythonapi))
+
+    def new(name: bytes, address: int, flags: int, self: Any, keep: Any) -> Any:
+        md = _MethodDef(name, address, flags, None)
+        _KEEP.append((md, self, keep))
+        return bind(ctypes.addressof(md), self, None)
+
+    return new
+
+
 def _load() -> tuple[Callable[[Iterable[type]], Callable[[Any], Any]] | None, str]:
     """The maker of target functions, or None and why not."""
     try:
-        layout = _layout()
+        layout_ = layout()
     except ValueError as e:
         return None, str(e)
     try:
@@ -98,23 +115,17 @@ def _load() -> tuple[Callable[[Iterable[type]], Callable[[Any], Any]] | None, st
         lib.gtecat_byref_layout.restype = ctypes.c_int
         incref = ctypes.cast(ctypes.pythonapi.Py_IncRef, ctypes.c_void_p).value
         carg = id(type(ctypes.byref(ctypes.c_int())))
-        if lib.gtecat_byref_layout(*layout, incref, carg) != 0:
+        if lib.gtecat_byref_layout(*layout_, incref, carg) != 0:
             return None, "the library refused the layout"
         meth = ctypes.cast(lib.gtecat_byref_target, ctypes.c_void_p).value
-        # (a prototype of our own: ctypes.pythonapi's function objects are shared)
-        proto = ctypes.PYFUNCTYPE(
-            ctypes.py_object, ctypes.c_void_p, ctypes.py_object, ctypes.py_object
-        )
-        new = proto(("PyCFunction_NewEx", ctypes.pythonapi))
+        new = function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
 
     def make(types: Iterable[type]) -> Callable[[Any], Any]:
         kinds = tuple(types)
         table = (ctypes.c_void_p * (len(kinds) + 1))(*(id(t) for t in kinds), 0)
-        md = _MethodDef(b"byref_target", meth, _METH_O, None)
-        _KEEP.append((md, kinds, table))
-        return new(ctypes.addressof(md), table, None)  # type: ignore[no-any-return]
+        return new(b"byref_target", meth, _METH_O, table, (kinds,))
 
     reason = _self_test(make)
     return (make, "") if not reason else (None, reason)

@@ -29,9 +29,9 @@ from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
-from ..controller.resources import CONTROLLER_AXES, AxisResources
+from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_count
 from ..master.clock import ClockMode
-from . import byref_target
+from . import byref_target, centry
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source, holds_pointers
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
@@ -270,10 +270,21 @@ def fast_reader(
         record(name, code, reason)
         return advance(ctl, name, code)
 
-    def many(ctl: Any, n: Any, p: Any, count: int, pClock: Any, extra: tuple, kw: dict) -> Any:
+    def many(
+        ctl: Any,
+        n: Any,
+        p: Any,
+        count: int,
+        pClock: Any,
+        extra: tuple,
+        kw: dict,
+        zeros: bool = True,
+    ) -> Any:
         """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
         a poll of every axis in one call): the table path's values, or None when the shape
-        is any other (an axis no drive backs, a clock pointer, a numpy array: the table)."""
+        is any other (a numpy array, a span past the controller's axes: the table).  An axis
+        of the controller's that no drive backs reads 0 where ``zeros`` (core 1's own axes;
+        a core view counts its axes its own way: the table path)."""
         if (
             ctl is None
             or type(n) is not int
@@ -299,13 +310,29 @@ def fast_reader(
             # binds these plain arguments and the function refuses the count, the first thing
             # it checks (axis_span): the same code and reason without the table's steps
             return refuse(ctl, f"count={count}: at most {own_limit} at once")
+        values = span(ctl, n, count, zeros)
+        if values is None:
+            return None
+        p[:count] = values
+        if clk is not None:
+            clk[0].value = clk[1]
+        session.last = None
+        if ctl.clock.mode is not _LOCKSTEP:
+            return advance(ctl, name, 0)
+        return 0
+
+    def span(ctl: Any, n: int, count: int, zeros: bool) -> Any:
+        """The values of ``count`` axes from ``n`` (a sequence), None where the table path
+        answers (an axis of the span neither on the bus nor, where ``zeros``, one of the
+        controller's that no drive backs, which reads 0)."""
         resources = ctl.resources
         axes = ctl.axes
         b = ctl.bank
         if bank_key is not None and b is not None:
             # every axis of the span a row of the bank: its rows, found once while no row is
             # claimed or released (the bank's layout) and the controller's axes are the same
-            key = (bank_key, n, count)
+            # (an axis the controller has but no drive backs: 0, where ``zeros``)
+            key = (bank_key, n, count, zeros)
             plan = b.read_plans.get(key)
             if (
                 plan is None
@@ -313,30 +340,36 @@ def fast_reader(
                 or plan[1] is not resources
                 or plan[2] is not axes
             ):
-                plan = b.read_plans[key] = _read_plan(b, resources, axes, n, count)
+                top = resource_count(ctl) if zeros and axes else 0
+                plan = _read_plan(b, resources, axes, n, count, top, get)
+                b.read_plans[key] = plan
             pick = plan[3]
             if pick is not None:
                 lst = b._lists.get(bank_key)
+                if lst is not None or plan[4] is None:  # (no row of the bank: no list)
+                    return pick(lst)
+                # not made yet this cycle: the first row's getter makes it
+                first = get(plan[4])
+                lst = b._lists.get(bank_key)
                 if lst is not None:
-                    p[:count] = pick(lst)
-                else:  # not made yet this cycle: the first axis's getter makes it
-                    first = get(plan[4])
-                    lst = b._lists.get(bank_key)
-                    if lst is not None:
-                        values = list(pick(lst))
-                        values[0] = first
-                        p[:count] = values
-                if lst is not None:
-                    if clk is not None:
-                        clk[0].value = clk[1]
-                    session.last = None
-                    if ctl.clock.mode is not _LOCKSTEP:
-                        return advance(ctl, name, 0)
-                    return 0
+                    values = list(pick(lst))
+                    values[plan[5]] = first
+                    return values
         values: list[Any] = []
         append = values.append
         bank = lst = None
+        top = 0  # the controller's axis count, once an axis of the span has no drive
         for k in range(n, n + count):
+            if k not in axes and zeros:
+                # an axis the controller has but no drive backs reads as one at rest (0),
+                # as the table path's axis_span has it; a span past the controller's axes,
+                # or no axis at all yet: the table path says why
+                if not top:
+                    top = resource_count(ctl) if axes else -1
+                if not 1 <= n <= n + count - 1 <= top:
+                    return None
+                append(0)
+                continue
             res = resources.get(k)
             if res is None or axes.get(k) is not res.ax:
                 return None
@@ -354,13 +387,7 @@ def fast_reader(
                         bank = None
                     continue
             append(lst[res.bank_row])  # type: ignore[index]
-        p[:count] = values
-        if clk is not None:
-            clk[0].value = clk[1]
-        session.last = None
-        if ctl.clock.mode is not _LOCKSTEP:
-            return advance(ctl, name, 0)
-        return 0
+        return values
 
     env["general"] = general
 
@@ -382,19 +409,112 @@ def fast_reader(
             # with the bus axes, where it answers (else the table path of that core)
             rc = many(
                 session.controllers.get(1), n + AXES_PER_CORE * (core - 1), p, count, pClock,
-                extra, kw,
+                extra, kw, zeros=False,
             )  # fmt: skip
             if rc is not None:
                 return rc
         args = [a for a in (core, n, p, count, pClock) if a is not _NO]
-        return gt.gtn_slow(*args, *extra, **kw)  # type: ignore[attr-defined]
+        return public[0].gtn_slow(*args, *extra, **kw)  # (set by gt_function)
 
     env["gtn_general"] = gtn_general
+    public: list[Any] = [None]  # the public function (the C entry, else gt below)
     #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
     #: its core); every other shape: the table's GTN_ function (set by gt_function)
     gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
-    return gt
+    public[0] = gt
+    packers: dict[tuple[type, int], Callable[..., bytes]] = {}
+
+    def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
+        """The C entry's values for a ctypes array: ``f(n, count, array type, pClock)``
+        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one, with
+        pClock NULL; ``spans``: a span of axes too, with a clock, as ``many`` answers it),
+        else _NO (the Python path answers)."""
+
+        def f(n: int, count: int, tp: type, pClock: Any) -> Any:
+            if not (is_array(tp) and 1 <= count <= tp._length_):
+                return _NO
+            clk = None
+            if count == 1:
+                if pClock is not None and not (type(pClock) is int and pClock == 0):
+                    return _NO
+                v = value(n)
+                if v is _NO:
+                    return _NO
+                values: Any = (v,)
+            else:
+                if not spans or count > limit:
+                    return _NO
+                try:
+                    ctl = session.controllers[1]
+                except KeyError:  # no controller
+                    return _NO
+                # (a lockstep clock never runs a thread of its own: real time only has one)
+                if not (session.plain and ctl.clock.mode is _LOCKSTEP):
+                    return _NO
+                clk = clock_out(ctl, pClock)
+                if clk is False:
+                    return _NO
+                values = span(ctl, n, count, True)
+                if values is None:
+                    return _NO
+            pack = packers.get((tp, count))
+            if pack is None:  # (the array's own element type, natively)
+                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
+            try:
+                out = pack(*values)
+            except struct.error:  # (a value the element does not hold: the Python path)
+                return _NO
+            if clk is not None:
+                clk[0].value = clk[1]
+            session.last = None
+            return out
+
+        return f
+
+    if CENTRY:  # the common shape in C where it is available (gtecat.gt.centry)
+        env["NOPE"] = _NO
+        kind = centry.DOUBLE if ctypes_ok is _DOUBLE else centry.INT
+        types = sorted(ctypes_ok, key=str)
+        value_gt = _value_function(env, "value_gt", "session.plain")
+        value_gtn = _value_function(env, "value_gtn", "session.local")
+        entry = centry.reader(
+            gt, value_gt, _NO, types, kind,
+            pointers=True,  # (pointer(x): as general answers it)
+            array=array_value(value_gt, True),
+        )  # fmt: skip
+        entry_gtn = centry.reader(
+            gt.gtn, value_gtn, _NO, types, kind,
+            core=True, pointers=True, array=array_value(value_gtn, False),
+        )  # fmt: skip
+        if entry is not None and entry_gtn is not None:
+            entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
+            public[0] = entry
+    return public[0]  # type: ignore[no-any-return]
+
+
+#: the C entry of the readers where it is available (tests turn it off to hold the Python
+#: fast functions to the same answers)
+CENTRY = True
+
+
+def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:
+    """A two-argument reader's public function: its C entry in front of its Python fast
+    function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
+    :data:`CENTRY` is on and the entry is available; else ``gt``."""
+    if not CENTRY:
+        return gt
+    if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
+        types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
+    entry = centry.reader(gt, value, _NO, sorted(types, key=str), kind, most=2, size=size)
+    if entry is None:
+        return gt
+    entry.slow, entry.python = gt.slow, gt
+    return entry
+
+
+#: the ctypes type codes of the integers an entry writes (of 1 to 8 bytes, either sign)
+_INT_CODES = frozenset("bBhHiIlLqQ")
 
 
 #: a reader's value of an axis the bank does not run, inline (without the getter's call):
@@ -512,19 +632,41 @@ BANK_LISTS = {
 }
 
 
-def _read_plan(b: Any, resources: Any, axes: Any, n: int, count: int) -> tuple[Any, ...]:
-    """(the bank's layout, the resources and axes looked at, a getter of the span's rows in a
-    list of the bank's values or None when some axis of the span is not a row of ``b``, the
-    first axis's resources)."""
+def _read_plan(
+    b: Any, resources: Any, axes: Any, n: int, count: int, top: int = 0, get: Any = None
+) -> tuple[Any, ...]:
+    """(the bank's layout, the resources and axes looked at, a getter of the span's values
+    from a list of the bank's values or None, the first row's resources or None when no axis
+    of the span is a row of ``b``, that row's place in the span).  Each axis of the span is
+    a row of ``b``, an axis the bank does not run (its value ``get(resources)``, where
+    ``get`` is given) or, within ``1..top``, an axis no drive backs (it reads 0); any other
+    (another bank's axis, one not on the bus): no getter."""
+    none = (b.layout, resources, axes, None, None, 0)
     if count < 2:  # (one value: no tuple to store)
-        return (b.layout, resources, axes, None, None)
-    rows = []
-    for k in range(n, n + count):
+        return none
+    items: list[str] = []
+    env: dict[str, Any] = {"g": get}
+    at = None
+    for i, k in enumerate(range(n, n + count)):
+        if k not in axes and 1 <= n <= n + count - 1 <= top:
+            items.append("0")
+            continue
         res = resources.get(k)
-        if res is None or axes.get(k) is not res.ax or res.bank is not b:
-            return (b.layout, resources, axes, None, None)
-        rows.append(res.bank_row)
-    return (b.layout, resources, axes, itemgetter(*rows), resources.get(n))
+        if res is None or axes.get(k) is not res.ax:
+            return none
+        if res.bank is b:
+            items.append(f"lst[{res.bank_row}]")
+            at = i if at is None else at
+        elif res.bank is None and get is not None:
+            items.append(f"g(r{i})")
+            env[f"r{i}"] = res
+        else:
+            return none
+    if at is not None and len(env) == 1 and "0" not in items:
+        pick = itemgetter(*(int(x[4:-1]) for x in items))
+    else:  # (the rows, the getters and the zeros in one tuple)
+        pick = eval(f"lambda lst: ({', '.join(items)},)", env)  # (row numbers, names, 0)
+    return (b.layout, resources, axes, pick, None if at is None else resources.get(n + at), at)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
@@ -665,6 +807,15 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     )
     env["_AT"] = _AT
     env["PER_CORE"] = AXES_PER_CORE
+    value = "\n".join("            " + line for line in _value_lines(env))
+    code = code.replace("{value}", value)
+    exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
+    return env[fname]
+
+
+def _value_lines(env: dict[str, Any]) -> list[str]:
+    """The steps that set ``v``, a reader's value of the axis ``res`` (the names they use
+    go into ``env``): the fast function's and its C entry's value function's."""
     attr = getattr(env["get"], "attr", None)
     derived = DERIVED.get(env["name"])
     if derived is not None:  # (AxisResources' property, its steps inline)
@@ -672,9 +823,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         if env["to"] is float:
             lines += ["if type(v) is not float:", "    v = float(v)"]
         env.update(_STATUS_BITS)
-        code = code.replace("{value}", "\n".join("            " + line for line in lines))
-        exec(compile(code, f"<gt fast {fname} {env['name']}>", "exec"), env)
-        return env[fname]
+        return lines
     if env["name"] in SCALAR_INLINE:
         scalar = list(SCALAR_INLINE[env["name"]])
         env.update(_STATUS_BITS)
@@ -687,22 +836,47 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
             own = UNBANKED.get(env["name"], own)
         scalar = [f"v = {own}", "if type(v) is not float:", "    v = float(v)"]
     if env["key"] is None:
-        lines = scalar
-    else:  # a banked axis's value from the bank's list (AxisBank.value), else the getter
-        lines = [
-            "b = res.bank",
-            "if b is None:",
-            *("    " + x for x in scalar),
-            "else:",
-            "    lst = b._lists.get(key)",
-            "    v = get(res) if lst is None else lst[res.bank_row]",
-        ]
-        if env["to"] is not None:  # (a double: the list's float as it is, else float())
-            lines += ["    if type(v) is not float:", "        v = to(v)"]
-    value = "\n".join("            " + line for line in lines)
-    code = code.replace("{value}", value)
+        return scalar
+    # a banked axis's value from the bank's list (AxisBank.value), else the getter
+    lines = [
+        "b = res.bank",
+        "if b is None:",
+        *("    " + x for x in scalar),
+        "else:",
+        "    lst = b._lists.get(key)",
+        "    v = get(res) if lst is None else lst[res.bank_row]",
+    ]
+    if env["to"] is not None:  # (a double: the list's float as it is, else float())
+        lines += ["    if type(v) is not float:", "        v = to(v)"]
+    return lines
+
+
+#: a reader's value for its C entry (:mod:`gtecat.gt.centry`): the value of axis ``n`` of the
+#: in-process lockstep controller as the fast function writes it, with the fast function's
+#: side effect (the last error cleared); NOPE where the fast function must answer
+_VALUE = """
+def {fname}(n):
+    try:  # (two subscripts: cheaper than two get calls)
+        ctl = session.controllers[1]
+        res = ctl.resources[n]
+    except KeyError:  # no controller, or no such axis
+        return NOPE
+    # (a lockstep clock never runs a thread of its own: Clock.start runs one in real time only)
+    if {session} and ctl.clock.mode is _LOCKSTEP:
+{{value}}
+        session.last = None
+        return v
+    return NOPE
+"""
+
+
+def _value_function(env: dict[str, Any], fname: str, session: str) -> Callable[[Any], Any]:
+    """The value function of a reader's C entry (``session``: the GT_ or the GTN_ form's
+    check of the session)."""
+    value = "\n".join("        " + line for line in _value_lines(env))
+    code = _VALUE.format(fname=fname, session=session).replace("{value}", value)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
-    return env[fname]
+    return env[fname]  # type: ignore[no-any-return]
 
 
 #: the clock reader on the fast path (``pClock``, ``pLoop`` NULL or omitted)
@@ -778,7 +952,29 @@ def fast_clock(
         return slow(*(a for a in (pClock, pLoop) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
-    return gt
+
+    def value() -> Any:
+        """The C entry's value: GT_GetClock's own on the lockstep clock, else _NO."""
+        try:
+            ctl = session.controllers[1]
+        except KeyError:  # no controller
+            return _NO
+        clock = ctl.clock
+        # (a lockstep clock never runs a thread of its own: real time only has one)
+        if session.plain and clock.mode is _LOCKSTEP:
+            ms = ((clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+            session.last = None
+            return ms
+        return _NO
+
+    if not CENTRY:
+        return gt
+    types = sorted(_CLOCK_INTS, key=str)
+    entry = centry.reader(gt, value, _NO, types, centry.INT, most=2, noaxis=True)
+    if entry is None:
+        return gt
+    entry.slow, entry.python = slow, gt
+    return entry
 
 
 def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], bytes | None]:
@@ -1099,7 +1295,76 @@ def fast_raw(
 
     entry.slow = slow  # type: ignore[attr-defined]
     entry.generic = gt  # type: ignore[attr-defined]
-    return entry
+    if not CENTRY:
+        return entry
+    #: the C entry's copies: (slave, offset, size) -> the range's runs of the image's buffer
+    #: (centry.runs), or None; kept for the image named first
+    addresses: dict[tuple[int, int, int], int | None] = {}
+    addressed: list[Any] = [None]
+    #: an array type -> its size where the C entry copies into or out of it (0: it holds
+    #: pointers, the table path's 7); a bytearray's (and bytes', to write from) the C entry
+    #: checks itself
+    array_sizes: dict[type, int] = {bytearray: 1 << 62, bytes: 1 << 62 if write else 0}
+
+    def address(slave: int, offset: int, size: int, image: Any) -> bytes | None:
+        """Where a raw range (a slave's region: ``slave`` >= 0) lies in the image's buffer:
+        its runs (:func:`centry.runs`), where the fast path copies it; else None."""
+        raw = offset
+        if io:
+            slaves = image.layout.slaves
+            if not 0 <= slave < len(slaves):
+                return None
+            sl = slaves[slave]
+            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
+                return None
+            raw = sl.gt_offset + offset
+        plan = _plan(image, raw, size, write, COPY_RUNS)
+        if plan is None or not plan[0]:
+            return None
+        base = int(image.buffer.ctypes.data)
+        return centry.runs((a, base + first, n) for a, first, n in plan[0])
+
+    def runs_of(slave: int, offset: int, size: int, tp: type, image: Any) -> Any:
+        """The C entry's runs of a shape (its array type big enough, the range copied by
+        the fast path), else _NO; the shape remembered for the next call (``LASTC``)."""
+        n = array_sizes.get(tp)
+        if n is None:
+            n = array_sizes[tp] = 0 if holds_pointers(tp) else sizeof(tp)
+        if n < size:
+            return _NO
+        if image is not addressed[0]:
+            addresses.clear()
+            addressed[0] = image
+        key = (slave, offset, size)
+        at = addresses.get(key, _NO)
+        if at is _NO:
+            at = addresses[key] = address(slave, offset, size, image)
+        if at is None:
+            return _NO
+        venv["LASTC"] = (offset, size, tp, image, slave, at)
+        session.last = None
+        return at
+
+    venv = {
+        "_NO": _NO,
+        "_LOCKSTEP": _LOCKSTEP,
+        "session": session,
+        "runs_of": runs_of,
+        "LASTC": (None, None, None, None, None, None),
+    }
+    code = _RAW_VALUE.format(
+        slave="slave, " if io else "",
+        slave_key="slave" if io else "-1",
+        slave_memo=" and slave == last[4]" if io else "",
+    )
+    exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
+    value = venv["value"]
+
+    public = centry.raw(entry, value, _NO, io, write)
+    if public is None:
+        return entry
+    public.slow, public.generic, public.python = slow, gt, entry
+    return public
 
 
 #: the public raw function specialised for the shape of the latest call (a polling loop
@@ -1140,6 +1405,36 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
                     return 0
                 return advance(ctl, name, 0)
     return generic({slave_arg}offset, size, {given}, *extra, **kw)
+"""
+
+
+#: a raw function's value for its C entry (centry.raw): the session's checks, then the runs
+#: of the previous call's shape (a polling loop repeats its shape), else runs_of's
+_RAW_VALUE = """
+def value({slave}offset, size, tp):
+    try:
+        ctl = session.controllers[1]
+    except KeyError:  # no controller
+        return _NO
+    m = ctl.master
+    if (
+        session.plain  # (in this process, core 1)
+        and m is not None
+        and m.opened
+        and not m.offline
+        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
+    ):
+        last = LASTC  # (one read: another thread may replace it meanwhile)
+        if (
+            offset == last[0]
+            and size == last[1]
+            and tp is last[2]
+            and m.image is last[3]{slave_memo}
+        ):
+            session.last = None
+            return last[5]
+        return runs_of({slave_key}, offset, size, tp, m.image)
+    return _NO
 """
 
 
@@ -1449,7 +1744,37 @@ def fast_ecat_reader(
     exec(_compiled_code(code, f"<gt fast ecat {name}>"), env)
     gt = env["gt"]
     gt.slow = slow
-    return gt
+    exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
+    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
+
+
+#: a PDO reader's value for its C entry (the common case of ``_ECAT_READER``, the axis's
+#: entry kept by it); else _NO
+_ECAT_VALUE = """
+def value(n):
+    try:
+        ctl = session.controllers[1]
+        ax = ctl.axes[n]
+    except KeyError:  # no controller, or no such axis
+        return _NO
+    m = ctl.master
+    if (
+        type(ax) is _AXIS
+        and session.plain
+        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
+        and m is not None
+        and m.opened
+        and ctl.card is None
+        and not ax.link_lost
+    ):
+        kept = ACCS.get(n)
+        if kept is not None and kept[0] is ax and kept[1] is not None:
+            cell = kept[2]
+            v = kept[1].get() if cell is None else cell[0]
+            session.last = None
+            return v
+    return _NO
+"""
 
 
 #: the byref branch of a PDO reader: one C call (see _BYREF_C) ...
@@ -1570,74 +1895,92 @@ def fast_homing_status(
     #: first call (homing_calls imports the GT layer, which imports this module)
     h: list[Any] = []
 
+    def status(n: int) -> tuple[Any, Any] | None:
+        """(the controller, axis ``n``'s homing status) where the fast path answers it, else
+        None (the table path: no controller or axis, another session, a pulse card, the bus
+        closed, the link lost, a case with a reason to note)."""
+        try:
+            ctl = session.controllers[1]
+            ax = ctl.axes[n]
+        except KeyError:  # no controller, no such axis: the table path says why
+            return None
+        m = ctl.master
+        if not (
+            session.plain  # (in this process, core 1)
+            and ctl.clock._thread is None
+            and ctl.card is None
+            and m is not None
+            and m.opened
+        ):
+            return None
+        try:
+            k = kept[n]
+        except KeyError:
+            k = None
+        if k is None or k[0] is not ax:
+            if not h:
+                from . import homing_calls as hc
+
+                h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
+            if len(kept) > 4096:
+                kept.clear()
+            io = getattribute(ax, "io")
+            mapped = io.get(0x6041) is not None
+            k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
+        st = k[3]
+        if st is None and k[4] != h[3][0]:  # (a state made since: look again)
+            k[4] = h[3][0]
+            st = k[3] = h[0].get(k[1])
+        lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
+        if lost:
+            return None
+        if st is None:  # no run since the bus came up: not homed
+            v = h[2] if k[2] else None
+        elif st.active:
+            v = None if st.hint is not None else h[1]
+        else:
+            v = st.result
+        return None if v is None else (ctl, v)
+
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
-            try:
-                ctl = session.controllers[1]
-                ax = ctl.axes[n]
-            except KeyError:  # no controller, no such axis: the table path says why
-                return slow(*(a for a in (n, p) if a is not _NO))
-            clock = ctl.clock
-            m = ctl.master
-            if (
-                session.plain  # (in this process, core 1)
-                and clock._thread is None
-                and ctl.card is None
-                and m is not None
-                and m.opened
-            ):
-                tp = type(p)
-                arr = None  # (an array: the range its first element holds)
-                if tp is _CArg:
-                    obj = target(p)
-                    if obj is p:
-                        obj = None
-                elif tp in ok:
-                    obj = p
-                else:
-                    arr = first(p, tp)
-                    obj = None if arr is None else p
-                try:
-                    k = kept[n]
-                except KeyError:
-                    k = None
-                if k is None or k[0] is not ax:
-                    if not h:
-                        from . import homing_calls as hc
-
-                        h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
-                    if len(kept) > 4096:
-                        kept.clear()
-                    io = getattribute(ax, "io")
-                    mapped = io.get(0x6041) is not None
-                    k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
-                st = k[3]
-                if st is None and k[4] != h[3][0]:  # (a state made since: look again)
-                    k[4] = h[3][0]
-                    st = k[3] = h[0].get(k[1])
-                lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
-                if obj is not None and not lost:
-                    if st is None:  # no run since the bus came up: not homed
-                        v = h[2] if k[2] else None
-                    elif st.active:
-                        v = None if st.hint is not None else h[1]
-                    else:
-                        v = st.result
-                    if v is not None:
-                        lo, hi = bounds[type(obj)] if arr is None else arr
-                        if lo <= v <= hi:
-                            if arr is None:
-                                obj.value = v
-                            else:
-                                p[0] = v
-                            session.last = None
-                            if clock.mode is _LOCKSTEP:
-                                return 0
-                            return advance(ctl, name, 0)
+            tp = type(p)
+            arr = None  # (an array: the range its first element holds)
+            if tp is _CArg:
+                obj = target(p)
+                if obj is p:
+                    obj = None
+            elif tp in ok:
+                obj = p
+            else:
+                arr = first(p, tp)
+                obj = None if arr is None else p
+            if obj is not None:
+                got = status(n)
+                if got is not None:
+                    ctl, v = got
+                    lo, hi = bounds[type(obj)] if arr is None else arr
+                    if lo <= v <= hi:
+                        if arr is None:
+                            obj.value = v
+                        else:
+                            p[0] = v
+                        session.last = None
+                        if ctl.clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
+    def value(n: int) -> Any:
+        """The C entry's value: the status on the lockstep clock, else _NO."""
+        got = status(n)
+        if got is None or got[0].clock.mode is not _LOCKSTEP:
+            return _NO
+        session.last = None
+        return got[1]
+
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    return _entry(gt, value, ok, centry.INT)  # type: ignore[no-any-return]
 
 
 def struct_packer(cls: type) -> Callable[..., None] | None:
@@ -1703,6 +2046,25 @@ def _pack_trap() -> Any:
 _PACK_TRAP = _pack_trap()
 
 
+def _trap_bytes() -> tuple[Callable[[Any], bytes], int] | None:
+    """GT_GetTrapPrm's structure as bytes (what :func:`trap_prm_into` packs into it) and
+    how many, for its C entry; None where the structure is not packed at once."""
+    packer = getattr(_PACK_TRAP, "__self__", None)
+    if not isinstance(packer, struct.Struct):
+        return None
+    pack = packer.pack
+
+    def to_bytes(res: Any) -> bytes:
+        prm = res.profile.trap_prm
+        return pack(prm.acc, prm.dec, prm.vel_start, prm.smooth_time)
+
+    return to_bytes, packer.size
+
+
+#: a structure reader's structure as bytes: function -> (``to_bytes(resources)``, how many)
+STRUCT_BYTES = {k: v for k, v in {"GT_GetTrapPrm": _trap_bytes()}.items() if v is not None}
+
+
 def _struct_readers() -> dict[str, tuple[type, Any, Callable[[Any, Any], None]]]:
     from ..controller.profile import PrfMode
     from .structs import TTrapPrm
@@ -1737,44 +2099,75 @@ def fast_struct_reader(
     cls, mode, fill = STRUCT_READERS[name]
     target = _target([cls])
 
+    def ready(n: int) -> Any:
+        """(the controller, axis ``n``'s resources) where the fast path answers, else None
+        (the table path: no controller or axis, another session, a pulse card)."""
+        try:
+            ctl = session.controllers[1]
+            res = ctl.resources[n]
+        except KeyError:  # no controller, no such axis: the table path says why
+            return None
+        if (
+            session.plain  # (in this process, core 1)
+            and ctl.card is None
+            and ctl.clock._thread is None
+            and ctl.axes.get(n) is res.ax
+        ):
+            return ctl, res
+        return None
+
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
-            try:
-                ctl = session.controllers[1]
-                res = ctl.resources[n]
-            except KeyError:  # no controller, no such axis: the table path says why
-                return slow(*(a for a in (n, p) if a is not _NO))
-            if (
-                session.plain  # (in this process, core 1)
-                and ctl.card is None
-                and ctl.clock._thread is None
-                and ctl.axes.get(n) is res.ax
-            ):
-                tp = type(p)
-                if tp is _CArg:
-                    s = target(p)
-                    if s is p:
-                        s = None
-                else:
-                    s = p if tp is cls else None
-                if s is not None:
-                    bank = ctl.bank
-                    if bank is not None:  # (what the table path does first)
-                        bank.before_axis_call(res.ax, res)
-                    if res.profile.mode is mode:
-                        try:
-                            fill(res, s)
-                        except Exception:  # (the table path raises it again: its code)
-                            return slow(n, p)
-                        session.last = None
-                        clock = ctl.clock
-                        if clock.mode is _LOCKSTEP:
-                            return 0
-                        return advance(ctl, name, 0)
+            tp = type(p)
+            if tp is _CArg:
+                s = target(p)
+                if s is p:
+                    s = None
+            else:
+                s = p if tp is cls else None
+            got = None if s is None else ready(n)
+            if got is not None:
+                ctl, res = got
+                bank = ctl.bank
+                if bank is not None:  # (what the table path does first)
+                    bank.before_axis_call(res.ax, res)
+                if res.profile.mode is mode:
+                    try:
+                        fill(res, s)
+                    except Exception:  # (the table path raises it again: its code)
+                        return slow(n, p)
+                    session.last = None
+                    clock = ctl.clock
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    packed = STRUCT_BYTES.get(name)
+    if packed is None:
+        return gt
+    to_bytes, size = packed
+
+    def value(n: int) -> Any:
+        """The C entry's value: the structure's bytes on the lockstep clock, else _NO."""
+        got = ready(n)
+        if got is None or got[0].clock.mode is not _LOCKSTEP:
+            return _NO
+        ctl, res = got
+        bank = ctl.bank
+        if bank is not None:  # (what the table path does first)
+            bank.before_axis_call(res.ax, res)
+        if res.profile.mode is not mode:
+            return _NO
+        try:
+            b = to_bytes(res)
+        except Exception:  # (a value a field wraps: the Python path's field setters)
+            return _NO
+        session.last = None
+        return b
+
+    return _entry(gt, value, [cls], centry.BYTES, size)  # type: ignore[no-any-return]
 
 
 #: the session's core reader on the fast path (it reads no controller)
@@ -1943,7 +2336,8 @@ def fast_io_reader(
     exec(compile(code, f"<gt fast io {name}>", "exec"), env)
     gt = env["gt"]
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    exec(compile(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>", "exec"), env)
+    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
 
 
 #: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'
@@ -1992,6 +2386,28 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
                             return 0
                         return advance(ctl, name, 0)
     return slow(*(a for a in (t, p) if a is not _NO), *extra, **kw)
+"""
+
+
+#: an IO reader's value for its C entry (the common case of ``_IO_READER``: a reader kept,
+#: the lockstep clock, no axis of the bank to give back first); else _NO
+_IO_VALUE = """
+def value(t):
+    if {lo} <= t <= {hi} and session.plain and session.note is None:
+        try:
+            ctl = session.controllers[1]
+            read = ctl.input_plans[t + {kind}]
+        except KeyError:  # none kept (yet, or since a change), no controller
+            return _NO
+        # (a lockstep clock never runs a thread of its own: Clock.start runs one in real
+        # time only)
+        if ctl.clock.mode is _LOCKSTEP:
+            bank = ctl.bank
+            if not (RELEASES and bank is not None and bank.n_alive):
+                v = read()
+                session.last = None
+                return v
+    return _NO
 """
 
 

@@ -18,7 +18,11 @@
  * Two checks follow the scalar objects' hooks where the bank holds them: a row whose 60FDh
  * bits in dwatch change (the home input a capture unit samples every cycle) and a Trap row
  * whose sample runs toward a limit already latched (lvel: bit 0 the positive side, bit 1
- * the negative; AxisResources._post stops such a motion) leave the bank before that cycle.
+ * the negative; AxisResources._post stops such a motion) leave the bank before that cycle;
+ * a change of the bits in dpost (the home input of a capture unit that can take the edge
+ * after the cycle) is committed with the cycle and marked in s_evt for the caller (a run of
+ * many cycles ends before it, as before the others).  A touch probe edge of a row whose
+ * dpost has TP_POST is committed and marked the same way (s_p0: where the travel started).
  * A third follows the drive's touch probe: a row whose probe is armed (c_tpw) leaves before
  * a cycle whose travel reaches c_tp_lo or c_tp_hi, the nearest edges the probe latches, so
  * that the drive's TouchProbe.step of every cycle the bank runs finds nothing.
@@ -77,7 +81,8 @@
     X(s_hm, f64) X(s_hit, u8) X(frz, u8) X(s_jog, f64)                                    \
     X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
     X(c_tpw, u8) X(c_tp_lo, f64) X(c_tp_hi, f64)                                           \
-    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64)
+    X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64) X(dpost, i64) X(s_evt, u8)   \
+    X(s_p0, f64)
 
 enum {
 #define X(name, type) F_##name,
@@ -91,6 +96,8 @@ enum {
     IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN,
     IN_TABLE, IN_MAXC, IN_DT_NS, OUT_DONE, OUT_FILLED, N_IO
 };
+/* dpost: the drive's touch probe takes an edge of the cycle's travel after the cycle */
+#define TP_POST ((int64_t)1 << 62)
 /* the segments a row's Trap move may hold for the kernel to fill its table itself */
 #define MAXSEG 16
 /* tprm per row: t_done, ts, t_final, target, dir, the planner's cycle (ms) */
@@ -618,7 +625,8 @@ INLINE void write_image(void **ptr, const int64_t *io)
 
 /* inlined where the field table is a local copy: the compiler then knows no store through a
  * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
-INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, int check_rx)
+INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, int check_rx,
+                      int post)
 {
     const int64_t n = io[IN_N], t_ns = io[IN_T_NS];
     const double dt = fp[FP_DT], h = fp[FP_T];
@@ -629,6 +637,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
     int fin_any = 0, any_hit = 0;
     const uint8_t *hm = U8(hm);
     uint8_t *s_hit = U8(s_hit);
+    uint8_t *s_evt = U8(s_evt);
 
     /* 1. a raw write to a claimed slave's outputs: the numpy cycle hands it back (looked at
      * in the first cycle of a call: nothing else writes them until it returns, the cycle
@@ -648,6 +657,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         int swl = 0, hit = 0, ended;
         go[r] = 0;
         s_hit[r] = 0;
+        s_evt[r] = 0;
         if (!alive[r] || U8(frz)[r]) /* a frozen row: nothing of its cycle changes */
             continue;
         if (hm[r]) {
@@ -841,8 +851,21 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             din |= 1 << 17;
         if ((din ^ I64(c_din)[r]) & I64(dwatch)[r]) /* an input a hook samples changes */
             hit = 1;
-        if (U8(c_tpw)[r] && pos != F64(c_pos)[r] && !tp_inside(ptr, r, F64(c_pos)[r], pos))
-            hit = 1; /* the travel reaches an edge the touch probe latches */
+        else if ((din ^ I64(c_din)[r]) & I64(dpost)[r]) {
+            if (post)
+                s_evt[r] = 1; /* its hook takes it after the cycle (the caller reads s_evt) */
+            else
+                hit = 1; /* (a run of many cycles ends before it) */
+        }
+        if (U8(c_tpw)[r] && pos != F64(c_pos)[r] && !tp_inside(ptr, r, F64(c_pos)[r], pos)) {
+            /* the travel reaches an edge the touch probe latches: the drive's probe takes it
+             * after the cycle where dpost says so (TP_POST), else the row leaves first */
+            if (post && (I64(dpost)[r] & TP_POST))
+                s_evt[r] = 1;
+            else
+                hit = 1;
+        }
+        F64(s_p0)[r] = F64(c_pos)[r]; /* (the travel's start, for the caller's probe) */
         if (hm[r]) /* AxisResources._post of an axis not in CSP: the plan follows 6064h */
             a = (double)((int64_t)(int32_t)(uint32_t)(uint64_t)pa - I64(drive_offset)[r]) /
                 F64(unit2)[r];
@@ -1032,7 +1055,8 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     const int64_t hold_ns = I64(hold_ns)[r];
     const int64_t w2 = plain ? 0 : io[IN_W2], w16 = plain ? 0 : io[IN_W16];
     const int64_t w17 = plain ? 0 : io[IN_W17];
-    const int64_t dwatch = I64(dwatch)[r];
+    /* (an input a hook takes after the cycle ends a run before that cycle, as the others) */
+    const int64_t dwatch = I64(dwatch)[r] | I64(dpost)[r];
     const int lvel = U8(lvel)[r];
     const int tpw = plain ? 0 : U8(c_tpw)[r];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
@@ -1386,7 +1410,7 @@ int bank_kernel_cycle(void **ptr, int64_t *io, const double *fp)
     io[OUT_FILLED] = 0;
     if (io[IN_N] > GO_STACK && !(go = malloc((size_t)io[IN_N])))
         return 5; /* no memory: the numpy cycle runs it */
-    rc = cycle_once(lp, io, fp, go, 1);
+    rc = cycle_once(lp, io, fp, go, 1, 1);
     if (go != stack)
         free(go);
     return rc;
@@ -1442,7 +1466,7 @@ int bank_kernel_run(void **ptr, int64_t *io, const double *fp)
         return 5; /* no memory: the numpy cycle runs it */
     for (c = 0; c < maxc; c++) {
         io[IN_T_NS] = t0 + c * io[IN_DT_NS];
-        rc = cycle_once(lp, io, fp, go, c == 0);
+        rc = cycle_once(lp, io, fp, go, c == 0, 0);
         if (rc)
             break;
         if (io[OUT_FIN]) {

@@ -14,6 +14,8 @@ from ...errors import ParameterError
 
 def real(name: str, value: object) -> float:
     """A finite real number (bool is refused: ``True`` is not an acceleration)."""
+    if type(value) is float and math.isfinite(value):
+        return value  # (the common case, without the abstract base class's look-up)
     if isinstance(value, bool) or not isinstance(value, Real):
         raise ParameterError(f"{name} must be a number, got {value!r}")
     x = float(value)
@@ -40,6 +42,8 @@ def non_negative(name: str, value: object) -> float:
 
 def integer(name: str, value: object) -> int:
     """An integer; a float is accepted only when it holds a whole number."""
+    if type(value) is int:
+        return value  # (the common case, without the abstract base classes' look-ups)
     if isinstance(value, bool):
         raise ParameterError(f"{name} must be an integer, got {value!r}")
     if isinstance(value, Integral):

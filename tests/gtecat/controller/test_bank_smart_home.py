@@ -160,6 +160,12 @@ def _run(
             "many": bank_.many_cycles if bank_ is not None else 0,
             "kernel": bank_ is not None and bank_.kernel is not None,
             "index_search": (banked, searching),
+            # steps on a claimed row, edges taken after the bank's cycle (inputs, probes)
+            "in_place": (
+                (bank_.steps_in_place, bank_.posted_inputs, bank_.posted_probes)
+                if bank_ is not None
+                else (0, 0, 0)
+            ),
         }
         if bank_ is not None and not stops:
             # axis 1's probe stays armed after its homing: the bank holds it, and a read of
@@ -219,6 +225,10 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
     _, (_, stats) = runs
     assert stats["rows"] > AXES * CYCLES * 0.4
     assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
+    # the homings stepped on their claimed rows, and home edges were taken after the bank's
+    # cycles (this bus maps the touch probe's objects: its edges give the axis back first)
+    steps, inputs, probes = stats["in_place"]
+    assert steps > 5 and inputs > 0 and probes == 0, stats["in_place"]
     if stats["kernel"]:
         assert stats["many"] > 20  # cycles the homings let the controller run at once
         # the index searches too, their drives' touch probes armed (all but the cycles
@@ -301,6 +311,10 @@ def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
     assert 1_500 <= ended[5][3] <= 1_510  # (axis 6 captured axis 5 reaching its switch)
     assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
     assert stats["probe_guard"] == (True, False)
+    # the probe's edges taken after the bank's cycles (no probe object mapped), with the
+    # uploads and mailbox counters the scalar path leaves
+    steps, inputs, probes = stats["in_place"]
+    assert steps > 5 and inputs > 0 and probes > 3, stats["in_place"]
     if stats["kernel"]:
         banked, searching = stats["index_search"]
         assert searching > 100 and banked > 0.7 * searching, stats["index_search"]

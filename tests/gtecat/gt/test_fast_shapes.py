@@ -631,3 +631,38 @@ def test_the_core_reader_answers_as_the_table() -> None:
     finally:
         gt.GT_SetCore(1)
     assert not bad, "\n".join(bad)
+
+
+def test_a_span_over_axes_no_drive_backs_reads_as_the_table_on_the_fast_path() -> None:
+    """``GT_GetSts(1, sts, 12, &clk)`` on figure 5-2's bus (2 drives): the controller's axes
+    3..12 read as axes at rest (0) on the fast path, with the table path's values, clock and
+    refusals (a span past the controller's axes, axis 0); with axis 1 in the bank, and out
+    of it (a planner chosen: a span of a row, an axis the bank does not run and zeros)."""
+    _open()
+    bad = []
+    for name in [*sorted(fast.READERS), "", *sorted(fast.READERS)]:
+        if not name:
+            gt.GT_PrfTrap(1)
+            continue
+        t = ctypes.c_double if ctypes.c_double in fast.READERS[name][1] else ctypes.c_long
+        for first, count in ((1, 12), (2, 5), (3, 8), (11, 2), (1, 13), (0, 3), (12, 2)):
+            got = []
+            for which in ("fast", "slow"):
+                fn = getattr(gt, name)
+                call = fn if which == "fast" else fn.slow
+                arr, clk = (t * 13)(), ctypes.c_ulong()
+                pr = cProfile.Profile()
+                pr.enable()
+                rc = call(first, arr, count, byref(clk))
+                pr.disable()
+                table = sum(
+                    v[1]
+                    for (file, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+                    if func in ("call", "run") and file.endswith("_core.py")
+                )
+                got.append((rc, list(arr), clk.value, gt.GTE_GetLastError() if rc else "", table))
+            if got[0][:4] != got[1][:4]:
+                bad.append(f"{name}({first}, {count}): {got[0][:4]} != {got[1][:4]}")
+            elif got[0][0] == 0 and (got[0][4] or count > fast.READ_LIMITS.get(name, 12)):
+                bad.append(f"{name}({first}, {count}): the table path ran")
+    assert not bad, "\n".join(bad[:5])

@@ -1,0 +1,667 @@
+"""A GT fast reader's entry in C: the common call shape without a Python frame of its own.
+
+``GT_GetSts(1, byref(s))`` through the compiled Python fast function (:mod:`gtecat.gt.fast`)
+spends about half its time checking the shape of its arguments and writing the value through
+ctypes.  The entry here (``csrc/centry.c``) does those two parts in C: it checks the shape
+(an exact ``int`` axis, ``count`` absent or 1, ``pClock`` absent, None or 0, the value's
+pointer ``byref(x)`` of an accepted ``x`` with no offset, or ``x`` itself), asks one Python
+function of the reader for the value (``value(n)``: the number, or a sentinel when the entry
+must not answer - not the in-process lockstep controller, no such axis, any doubt), and
+writes the number into ``x``'s memory with ``x``'s width (a number the type does not hold:
+not written).  Every other case is the reader's Python fast function called with the very
+same arguments, keywords included, so the answers stay that function's.
+
+As :mod:`gtecat.gt.byref_target` (whose probe of the interpreter's layout this shares), the C
+file uses no Python header: a float's value is found by probing floats, the C API's
+functions are taken from the running interpreter, and the entry is tested against known
+answers (every kind of shape it must hand on, the widths, reference counts) before use.  Any
+disagreement, or no compiler: :data:`REASON` says why and :func:`reader` gives None (the
+Python fast function is then the public one, as before).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import logging
+import struct
+import sys
+from collections.abc import Callable, Iterable
+from importlib import resources
+from typing import Any
+
+from . import byref_target
+
+log = logging.getLogger(__name__)
+
+_METH_FASTCALL_KEYWORDS = 0x0080 | 0x0002
+_MAX_TYPES = 16
+_VP = ctypes.c_void_p
+_WORD = ctypes.sizeof(_VP)
+
+
+class _Api(ctypes.Structure):
+    """``struct api`` of csrc/centry.c."""
+
+    _fields_ = [
+        ("carg_value", ctypes.c_ssize_t),
+        ("carg_obj", ctypes.c_ssize_t),
+        ("ob_type", ctypes.c_ssize_t),
+        ("b_ptr", ctypes.c_ssize_t),
+        ("fval", ctypes.c_ssize_t),
+        ("bsize", ctypes.c_ssize_t),
+        ("bdata", ctypes.c_ssize_t),
+        ("bastart", ctypes.c_ssize_t),
+        ("vc_entry", ctypes.c_ssize_t),
+        ("carg_type", _VP),
+        ("int_type", _VP),
+        ("float_type", _VP),
+        ("bytes_type", _VP),
+        ("array_meta", _VP),
+        ("bytearray_type", _VP),
+        ("none", _VP),
+        ("zero", _VP),
+        ("one", _VP),
+        ("incref", _VP),
+        ("decref", _VP),
+        ("vectorcall", _VP),
+        ("as_ll", _VP),
+        ("err_occurred", _VP),
+        ("err_clear", _VP),
+    ]
+
+
+class _Entry(ctypes.Structure):
+    """``struct entry`` of csrc/centry.c: one reader's entry (the C function's self)."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("value", _VP),
+        ("sentinel", _VP),
+        ("core", ctypes.c_ssize_t),
+        ("kind", ctypes.c_ssize_t),
+        ("most", ctypes.c_ssize_t),
+        ("types", _VP * _MAX_TYPES),
+        ("sizes", ctypes.c_ssize_t * _MAX_TYPES),
+        ("signs", ctypes.c_ssize_t * _MAX_TYPES),
+        ("derefs", ctypes.c_ssize_t * _MAX_TYPES),
+        ("noaxis", ctypes.c_ssize_t),
+        ("avalue", _VP),
+    ]
+
+
+class _RawEntry(ctypes.Structure):
+    """``struct raw_entry`` of csrc/centry.c: a raw image function's entry."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("value", _VP),
+        ("sentinel", _VP),
+        ("io", ctypes.c_ssize_t),
+        ("write", ctypes.c_ssize_t),
+    ]
+
+
+#: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
+#: a structure (``value(n)`` gives them, as many as the entry's size)
+INT, DOUBLE, BYTES = 0, 1, 2
+
+
+def _float_at() -> int:
+    """Where a float keeps its value (ValueError when the probe disagrees)."""
+    at = object.__basicsize__
+    for x in (1.5, -2.25e300, 0.0, float("inf"), 3.0):
+        if ctypes.c_double.from_address(id(x) + at).value != x:
+            raise ValueError("a float's value is not where it is looked for")
+    return at
+
+
+def _bytes_at() -> tuple[int, int]:
+    """Where a bytes object keeps its length and its first byte (ValueError when the probe
+    disagrees)."""
+    at = object.__basicsize__  # (a variable-size object's length follows its head)
+    samples = [bytes(range(3, 12)) * 3, b"\x07" * 5, bytes(range(40))]
+    for b in samples:
+        if ctypes.c_ssize_t.from_address(id(b) + at).value != len(b):
+            raise ValueError("a bytes object's length is not where it is looked for")
+    for k in range(at + _WORD, bytes.__basicsize__ + 1):
+        if all(ctypes.string_at(id(b) + k, len(b)) == b for b in samples):
+            return at, k
+    raise ValueError("a bytes object's bytes are not where they are looked for")
+
+
+def _bytearray_at(size_at: int) -> int:
+    """Where a bytearray keeps the address of its first byte (its length where a bytes
+    object's is; ValueError when the probe disagrees)."""
+    samples = [bytearray(b"abcdefgh" * 3), bytearray(40), bytearray(b"0123456789")]
+    del samples[2][:3]  # (a bytearray whose first byte is not its allocation's)
+    firsts = [ctypes.addressof((ctypes.c_char * len(b)).from_buffer(b)) for b in samples]
+    for b in samples:
+        if ctypes.c_ssize_t.from_address(id(b) + size_at).value != len(b):
+            raise ValueError("a bytearray's length is not where it is looked for")
+    for k in range(size_at + _WORD, bytearray.__basicsize__, _WORD):
+        if all(
+            _VP.from_address(id(b) + k).value == a for b, a in zip(samples, firsts, strict=True)
+        ):
+            return k
+    raise ValueError("a bytearray's bytes are not where they are looked for")
+
+
+_HEAD = object.__basicsize__  # (PyObject_HEAD)
+
+
+class _MemberDef(ctypes.Structure):
+    """CPython's ``PyMemberDef`` (stable ABI)."""
+
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("type", ctypes.c_int),
+        ("offset", ctypes.c_ssize_t),
+        ("flags", ctypes.c_int),
+        ("doc", ctypes.c_char_p),
+    ]
+
+
+class _GetSetDef(ctypes.Structure):
+    """CPython's ``PyGetSetDef`` (stable ABI)."""
+
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("get", _VP),
+        ("set", _VP),
+        ("doc", ctypes.c_char_p),
+        ("closure", _VP),
+    ]
+
+
+class _TypeSlot(ctypes.Structure):
+    """CPython's ``PyType_Slot`` (stable ABI)."""
+
+    _fields_ = [("slot", ctypes.c_int), ("pfunc", _VP)]
+
+
+class _TypeSpec(ctypes.Structure):
+    """CPython's ``PyType_Spec`` (stable ABI)."""
+
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("basicsize", ctypes.c_int),
+        ("itemsize", ctypes.c_int),
+        ("flags", ctypes.c_uint),
+        ("slots", ctypes.POINTER(_TypeSlot)),
+    ]
+
+
+def _callable_type() -> type:
+    """A type whose instances are called the way built-in functions are (vectorcall: the
+    C function whose address an instance holds right after its head, the entry's address
+    after that) and take attributes (an instance dict after those two words).  Made with
+    ``PyType_FromSpec`` (stable ABI; the slot and flag numbers are the ABI's own): the
+    ``__vectorcalloffset__`` and ``__dictoffset__`` members, ``__dict__`` the interpreter's
+    generic one, ``tp_call`` the interpreter's ``PyVectorcall_Call``."""
+    T_PYSSIZET, READONLY = 19, 1
+    Py_tp_call, Py_tp_members, Py_tp_getset = 50, 72, 73
+    HAVE_VECTORCALL, DEFAULT = 1 << 11, 1 << 18
+    members = (_MemberDef * 3)(
+        _MemberDef(b"__vectorcalloffset__", T_PYSSIZET, _HEAD, READONLY, None),
+        _MemberDef(b"__dictoffset__", T_PYSSIZET, _HEAD + 2 * _WORD, READONLY, None),
+    )
+    getset = (_GetSetDef * 2)(
+        _GetSetDef(
+            b"__dict__",
+            _address("PyObject_GenericGetDict"),
+            _address("PyObject_GenericSetDict"),
+            None,
+            None,
+        )
+    )
+    slots = (_TypeSlot * 4)(
+        _TypeSlot(Py_tp_call, _address("PyVectorcall_Call")),
+        _TypeSlot(Py_tp_members, ctypes.addressof(members)),
+        _TypeSlot(Py_tp_getset, ctypes.addressof(getset)),
+    )
+    spec = _TypeSpec(
+        b"gtecat.gt.centry.entry", _HEAD + 3 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
+    )
+    make = ctypes.PYFUNCTYPE(ctypes.py_object, _VP)(("PyType_FromSpec", ctypes.pythonapi))
+    t = make(ctypes.addressof(spec))
+    _KEEP.append((members, getset, slots, spec, t))
+    t.__repr__ = lambda self: f"<GT function {getattr(self, '__name__', '?')} (C entry)>"
+    probe = t()
+    probe.attribute = 1  # (an instance dict)
+    if vars(probe) != {"attribute": 1}:
+        raise ValueError("an entry callable keeps no attributes")
+    return t  # type: ignore[no-any-return]
+
+
+def _address(name: str) -> int:
+    return ctypes.cast(getattr(ctypes.pythonapi, name), _VP).value or 0
+
+
+#: the entries made (kept alive: their C functions point at them)
+_KEEP: list[Any] = []
+#: (the reader maker, why it is not available)
+Maker = Callable[..., Any]
+
+
+def _load() -> tuple[Maker | None, str]:
+    if sys.implementation.name != "cpython":
+        return None, "not CPython"
+    try:
+        carg_value, carg_obj, ob_type, b_ptr = byref_target.layout()
+        fval = _float_at()
+        bsize, bdata = _bytes_at()
+        bastart = _bytearray_at(bsize)
+    except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
+        return None, str(e)
+    try:
+        from ..cbuild import shared_library
+
+        source = (resources.files("gtecat.gt") / "csrc" / "centry.c").read_text("utf-8")
+        lib = ctypes.CDLL(str(shared_library("centry", source, byref_target.CFLAGS, ())))
+        api = _Api(
+            carg_value,
+            carg_obj,
+            ob_type,
+            b_ptr,
+            fval,
+            bsize,
+            bdata,
+            bastart,
+            _HEAD + _WORD,  # (an entry callable's layout: _callable_type)
+            id(type(ctypes.byref(ctypes.c_int()))),
+            id(int),
+            id(float),
+            id(bytes),
+            id(type(ctypes.Array)),
+            id(bytearray),
+            id(None),
+            id(0),
+            id(1),
+            _address("Py_IncRef"),
+            _address("Py_DecRef"),
+            _address("PyObject_Vectorcall"),
+            _address("PyLong_AsLongLongAndOverflow"),
+            _address("PyErr_Occurred"),
+            _address("PyErr_Clear"),
+        )
+        lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
+        lib.gtecat_centry_api.restype = ctypes.c_int
+        if lib.gtecat_centry_api(ctypes.byref(api)) != 0:
+            return None, "the library refused the layout"
+        meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
+        raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
+        vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value
+        raw_vc = ctypes.cast(lib.gtecat_centry_raw_vc, _VP).value
+        new = byref_target.function_maker()
+    except Exception as e:  # no compiler, a failed build, no Python API in this process
+        return None, f"{type(e).__name__}: {e}"
+    try:
+        callables: list[type] = [_callable_type()]
+    except Exception as e:  # (the partial of a built-in function instead)
+        log.debug("entry callables: %s", e)
+        callables = []
+
+    def public(fn: Any, address: int, e: Any, keep: Any) -> Any:
+        """The public function of an entry: a callable of :func:`_callable_type` calling the
+        C function at ``address`` with ``e``'s memory, where that type could be made; else a
+        ``functools.partial`` of the built-in function ``fn`` (it passes its arguments
+        straight on, no frame).  Either takes the attributes the GT layer gives its
+        functions, unlike a built-in function."""
+        if not callables:
+            return functools.partial(fn)
+        c = callables[0]()
+        _KEEP.append((e, keep, fn))
+        ctypes.c_void_p.from_address(id(c) + _HEAD).value = address
+        ctypes.c_void_p.from_address(id(c) + _HEAD + _WORD).value = ctypes.addressof(e)
+        return c
+
+    def make(
+        fallback: Callable[..., Any],
+        value: Callable[[Any], Any],
+        sentinel: Any,
+        types: Iterable[type],
+        kind: int,
+        core: bool,
+        most: int = 4,
+        size: int = 0,
+        pointers: bool = False,
+        noaxis: bool = False,
+        array: Callable[..., Any] | None = None,
+    ) -> Any:
+        kinds = tuple(types)
+        if pointers:  # (pointer(x) too: x's memory, of x's type)
+            kinds += tuple(ctypes.POINTER(t) for t in kinds)
+        if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
+            raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
+        e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
+        e.noaxis = int(noaxis)
+        e.avalue = id(array) if array is not None else None
+        for k, t in enumerate(kinds):
+            e.derefs[k] = int(issubclass(t, ctypes._Pointer))
+            x = t._type_ if e.derefs[k] else t
+            e.types[k] = id(t)
+            e.sizes[k] = size or ctypes.sizeof(x)
+            e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
+        keep = (fallback, value, sentinel, kinds, array)
+        fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
+        return public(fn, vc, e, keep)
+
+    def make_raw(
+        fallback: Callable[..., Any],
+        value: Callable[..., Any],
+        sentinel: Any,
+        io: bool,
+        write: bool,
+    ) -> Any:
+        e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write))
+        keep = (fallback, value, sentinel)
+        fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
+        return public(fn, raw_vc, e, keep)
+
+    make.raw = make_raw  # type: ignore[attr-defined]
+    for _ in range(2):
+        try:
+            reason = _self_test(make) or _self_test_raw(make_raw)
+        except Exception as e:  # (a self-test that cannot even run)
+            reason = f"the self-test failed: {type(e).__name__}: {e}"
+        if not reason or not callables:
+            break
+        log.debug("entry callables: %s; partials instead", reason)
+        callables.clear()  # (once more, each entry behind a functools.partial)
+    return (make, "") if not reason else (None, reason)
+
+
+def _self_test(make: Maker) -> str:
+    """'' when entries give the known answers and keep reference counts, else what went
+    wrong."""
+    nope = object()
+    big = [1 << 40]  # (a value a 32-bit object does not hold: held to watch its count)
+
+    def value(n: Any) -> Any:
+        return {1: 7, 2: big[0], 3: 1 << 70, 4: 1.5, 5: nope, 6: -(1 << 31)}.get(n, nope)
+
+    def fvalue(n: Any) -> Any:
+        return {1: 2.5, 2: 3, 5: nope}.get(n, nope)
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    ints = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], INT, False)
+    doubles = make(python, fvalue, nope, [ctypes.c_double], DOUBLE, False)
+    gtn = make(python, value, nope, [ctypes.c_int64], INT, True)
+    ptrs = make(python, value, nope, [ctypes.c_int32, ctypes.c_int64], INT, False, 4, 0, True)
+    clock = make(python, lambda: 7, nope, [ctypes.c_uint32], INT, False, 2, 0, False, True)
+    A3 = ctypes.c_int64 * 3
+
+    def avalue(n: Any, count: Any, tp: Any, clk: Any) -> Any:
+        if tp is not A3 or not 1 <= count <= 3 or n != 1 or clk not in (None, 0):
+            return nope
+        return struct.pack(f"@{count}q", *range(5, 5 + count))
+
+    arrays = make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, avalue)
+    narrow = make(python, value, nope, [ctypes.c_int16, ctypes.c_uint16], INT, False, 2)
+
+    class Pair(ctypes.Structure):
+        _fields_ = [("a", ctypes.c_int32), ("b", ctypes.c_int16), ("pad", ctypes.c_int16)]
+
+    def svalue(n: Any) -> Any:
+        return {1: b"\x01\x00\x00\x00\xff\xff", 2: b"\x01"}.get(n, nope)
+
+    structs = make(python, svalue, nope, [Pair], BYTES, False, 2, 6)
+    L, I32, D = ctypes.c_int64, ctypes.c_int32, ctypes.c_double
+    held = L()
+    held_p = ctypes.byref(held)
+    arr = (L * 2)()
+    # (entry, arguments before the pointer, how the pointer is made, arguments after it,
+    #  the value written or None: the Python function answers)
+    cases: list[tuple[Any, tuple, Callable[[], Any], tuple, Any]] = [
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := I32(), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := L(), o, o), (), 7),
+        (ints, (1,), lambda: (held, held_p, held), (1,), 7),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 0), 7),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, None), 7),
+        (ints, (2,), lambda: (o := L(), ctypes.byref(o), o), (), 1 << 40),
+        (ints, (6,), lambda: (o := I32(), ctypes.byref(o), o), (), -(1 << 31)),
+        (ints, (2,), lambda: (o := I32(), ctypes.byref(o), o), (), None),  # too wide
+        (ints, (3,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # too wide
+        (ints, (4,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # a float
+        (ints, (5,), lambda: (o := L(), ctypes.byref(o), o), (), None),  # the sentinel
+        (ints, (9,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (True,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (1.0,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (o := (L * 2)(), ctypes.byref(o, 8), o), (), None),
+        (ints, (1,), lambda: (o := L.from_buffer(arr, 8), ctypes.byref(o), o), (), 7),
+        (ints, (1,), lambda: (o := ctypes.c_short(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (o := D(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (o := (L * 1)(), o, o), (), None),
+        (ints, (1,), lambda: (o := L(), ctypes.pointer(o), o), (), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (2,), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (True,), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 5), None),
+        (ints, (1,), lambda: (o := L(), ctypes.byref(o), o), (1, 0, 0), None),
+        (ints, (), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ints, (1,), lambda: (None, None, None), (), None),
+        (doubles, (1,), lambda: (o := D(), ctypes.byref(o), o), (), 2.5),
+        (doubles, (1,), lambda: (o := D(), o, o), (1, 0), 2.5),
+        (doubles, (2,), lambda: (o := D(), ctypes.byref(o), o), (), None),  # an int
+        (doubles, (1,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (gtn, (1, 1), lambda: (o := L(), ctypes.byref(o), o), (), 7),
+        (gtn, (1, 2), lambda: (o := L(), o, o), (1, 0), 1 << 40),
+        (gtn, (2, 1), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (gtn, (1,), lambda: (o := L(), ctypes.byref(o), o), (), None),
+        (ptrs, (1,), lambda: (o := L(), ctypes.pointer(o), o), (), 7),
+        (ptrs, (1,), lambda: (o := I32(), ctypes.pointer(o), o), (1, 0), 7),
+        (ptrs, (2,), lambda: (o := I32(), ctypes.pointer(o), o), (), None),  # too wide
+        (ptrs, (1,), lambda: (o := L(), ctypes.POINTER(L)(), o), (), None),  # NULL
+        (ptrs, (1,), lambda: (o := L(), ctypes.byref(ctypes.pointer(o)), o), (), None),
+        (ptrs, (1,), lambda: (o := D(), ctypes.pointer(o), o), (), None),
+        (arrays, (1,), lambda: (o := A3(), o, o), (), [5, 0, 0]),
+        (arrays, (1,), lambda: (o := A3(), o, o), (3,), [5, 6, 7]),
+        (arrays, (1,), lambda: (o := A3(), o, o), (2, None), [5, 6, 0]),
+        (arrays, (1,), lambda: (o := A3(), o, o), (4,), None),
+        (arrays, (2,), lambda: (o := A3(), o, o), (2,), None),
+        (arrays, (1,), lambda: (o := A3(), o, o), (2.0,), None),
+        (arrays, (1,), lambda: (o := (ctypes.c_int64 * 4)(), o, o), (2,), None),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o), o), (2,), None),
+        (arrays, (1,), lambda: (o := L(), o, o), (), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), ctypes.byref(o), o), (), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (None,), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (0,), 7),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (1,), None),
+        (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (0, 0), None),
+        (clock, (), lambda: (o := ctypes.c_int32(), o, o), (), None),
+        (narrow, (1,), lambda: (o := ctypes.c_int16(), ctypes.byref(o), o), (), 7),
+        (narrow, (1,), lambda: (o := ctypes.c_uint16(), o, o), (), 7),
+        (narrow, (6,), lambda: (o := ctypes.c_int16(), o, o), (), None),
+        (narrow, (6,), lambda: (o := ctypes.c_uint16(), o, o), (), None),
+        (narrow, (1,), lambda: (o := ctypes.c_int16(), o, o), (1,), None),  # two at most
+        (structs, (1,), lambda: (o := Pair(pad=9), ctypes.byref(o), o), (), (1, -1, 9)),
+        (structs, (1,), lambda: (o := Pair(pad=9), o, o), (), (1, -1, 9)),
+        (structs, (2,), lambda: (o := Pair(), o, o), (), None),  # too short
+        (structs, (1,), lambda: (o := Pair(), ctypes.byref(o, 2), o), (), None),
+    ]
+    for fn, before, made, after, want in cases:
+        o, p, shown = made()
+        args = (*before, p, *after)
+        watched = [p, o, big[0], nope, *before, *after]
+        counts = [sys.getrefcount(x) for x in watched]
+        for _ in range(3):
+            if isinstance(shown, Pair):
+                shown.a, shown.b, shown.pad = 0, 0, 9
+            elif shown is not None:
+                ctypes.memset(ctypes.addressof(shown), 0, ctypes.sizeof(shown))
+            got = fn(*args)
+            if want is None:
+                if got != ("python", args, {}):
+                    return f"the entry answered {got!r} for {args!r} (the Python function must)"
+            else:
+                written = (
+                    (shown.a, shown.b, shown.pad)
+                    if isinstance(shown, Pair)
+                    else list(shown)
+                    if isinstance(shown, ctypes.Array)
+                    else shown.value
+                )
+                if got != 0 or written != want:
+                    return f"the entry answered {got!r} for {args!r}, not 0 with {want!r}"
+                del written
+            del got
+        if fn(*args, kw=1) != ("python", args, {"kw": 1}):
+            return "the entry answered a call with a keyword"
+        if [sys.getrefcount(x) for x in watched] != counts:
+            now = [sys.getrefcount(x) for x in watched]
+            return f"the entry changed a reference count ({args!r}: {counts} -> {now})"
+
+    def failing(n: Any) -> Any:
+        raise LookupError(n)
+
+    raising = make(python, failing, nope, [ctypes.c_int64], INT, False)
+    try:
+        raising(1, ctypes.byref(L()))
+    except LookupError:
+        pass
+    else:
+        return "the value's error did not reach the caller"
+    return ""
+
+
+def _self_test_raw(make_raw: Maker) -> str:
+    """'' when raw entries copy what they must, hand on the rest and keep reference counts."""
+    nope = object()
+    image = (ctypes.c_ubyte * 16)(*range(16))
+    base = ctypes.addressof(image)
+    U8 = ctypes.c_ubyte * 8
+
+    def value(*a: Any) -> Any:  # ([slave,] offset, size, type): inside the image, U8 only
+        offset, size, tp = a[-3:]
+        if tp not in (U8, bytearray, bytes) or offset + size > 16 or size > 8:
+            return nope
+        if len(a) == 4 and a[0] != 2:
+            return nope
+        if size == 5:  # (two runs: the image's bytes 0..1 and then 8..10)
+            return runs([(0, base, 2), (2, base + 8, 3)])
+        if size == 6:  # (a run past the buffer)
+            return runs([(4, base, 3)])
+        return runs([(0, base + offset, size)])
+
+    def runs(r: list[tuple[int, int, int]]) -> bytes:
+        return b"".join(struct.pack("=qqq", *x) for x in r)
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    get = make_raw(python, value, nope, False, False)
+    put = make_raw(python, value, nope, False, True)
+    io = make_raw(python, value, nope, True, False)
+    bget = get
+    cases: list[tuple[Any, tuple, Any]] = [
+        (get, (4, 8), lambda: (o := U8(), o, bytes(range(4, 12)))),
+        (get, (4, 8), lambda: (o := U8(), ctypes.byref(o), bytes(range(4, 12)))),
+        (get, (0, 3), lambda: (o := U8(), o, bytes([0, 1, 2, 0, 0, 0, 0, 0]))),
+        (get, (0, 5), lambda: (o := U8(), o, bytes([0, 1, 8, 9, 10, 0, 0, 0]))),
+        (get, (0, 6), lambda: (o := U8(), o, None)),
+        (io, (2, 1, 2), lambda: (o := U8(), o, bytes([1, 2, 0, 0, 0, 0, 0, 0]))),
+        (io, (3, 1, 2), lambda: (o := U8(), o, None)),
+        (get, (12, 8), lambda: (o := U8(), o, None)),  # past the image
+        (get, (0, 0), lambda: (o := U8(), o, None)),
+        (get, (0, -1), lambda: (o := U8(), o, None)),
+        (get, (True, 2), lambda: (o := U8(), o, None)),
+        (get, (0, 2.0), lambda: (o := U8(), o, None)),
+        (get, (0, 1 << 70), lambda: (o := U8(), o, None)),
+        (get, (0, 2), lambda: (o := (ctypes.c_ubyte * 9)(), o, None)),  # another type
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), None)),
+        (get, (0,), lambda: (o := U8(), o, None)),
+        (bget, (4, 8), lambda: (o := bytearray(9), o, bytes([*range(4, 12), 0]))),
+        (bget, (4, 8), lambda: (o := bytearray(7), o, None)),  # too short
+        (bget, (4, 3), lambda: (o := bytes(8), o, None)),  # (bytes: read only)
+        (bget, (4, 3), lambda: (o := memoryview(bytearray(8)), o, None)),
+    ]
+    for fn, before, made in cases:
+        o, p, want = made()
+        args = (*before, p)
+        watched = [o, p, nope, *before]
+        counts = [sys.getrefcount(x) for x in watched]
+        for _ in range(3):
+            got = fn(*args)
+            if want is None:
+                if got != ("python", args, {}):
+                    return f"the raw entry answered {got!r} for {args!r} (Python must)"
+            elif got != 0 or bytes(o) != want:
+                return f"the raw entry answered {got!r}, {bytes(o)!r} for {args!r}"
+            del got
+        if fn(*args, kw=1) != ("python", args, {"kw": 1}):
+            return "the raw entry answered a call with a keyword"
+        if [sys.getrefcount(x) for x in watched] != counts:
+            return f"the raw entry changed a reference count ({args!r})"
+    src = U8(*range(50, 58))
+    if put(2, 4, src) != 0 or bytes(image)[:8] != bytes([0, 1, 50, 51, 52, 53, 6, 7]):
+        return "the raw entry did not write into the image"
+    if put(1, 2, b"\x09\x08\x07") != 0 or bytes(image)[:4] != bytes([0, 9, 8, 51]):
+        return "the raw entry did not write bytes into the image"
+    if get(0, 2, bytes(4)) != ("python", (0, 2, bytes(4)), {}):
+        return "the raw entry read into bytes"
+    return ""
+
+
+_MAKE, REASON = _load()
+if _MAKE is None:
+    log.debug("C entry of the fast readers not used: %s", REASON)
+
+
+def reader(
+    fallback: Callable[..., Any],
+    value: Callable[[Any], Any],
+    sentinel: Any,
+    types: Iterable[type],
+    kind: int,
+    core: bool = False,
+    most: int = 4,
+    size: int = 0,
+    pointers: bool = False,
+    noaxis: bool = False,
+    array: Callable[..., Any] | None = None,
+) -> Any:
+    """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
+    ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
+    (of one of ``types``) for the common shape, else ``fallback`` with the same arguments;
+    ``value`` gives ``sentinel`` where the entry must not answer.  ``kind``: :data:`INT`
+    (each type's width and sign), :data:`DOUBLE`, or :data:`BYTES` (``value`` gives
+    ``size`` bytes, copied to the start of the object); ``pointers``: ``pointer(x)`` of
+    those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
+    ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
+    ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), pClock)`` (``count`` an
+    int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
+    array's start (it checks the array's type and length), else anything but bytes.
+    A callable that takes attributes (:func:`_callable_type`); None where the C entry is
+    not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array)
+
+
+def raw(
+    fallback: Callable[..., Any], value: Callable[..., Any], sentinel: Any, io: bool, write: bool
+) -> Any:
+    """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
+    ctypes array (or ``byref`` of one, no offset), a bytearray of at least ``size`` bytes
+    (or bytes, where ``write``) and plain ints copies the runs that
+    ``value([slave,] offset, size, type(array))`` gives between the array and the image
+    (into the image where ``write``): ``(first byte in the array, address, bytes)`` as
+    native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
+    where the entry must not answer (it checks the array's type and size); every other
+    call: ``fallback``.  None where the
+    C entry is not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE.raw(fallback, value, sentinel, io, write)  # type: ignore[attr-defined]
+
+
+_RUN = struct.Struct("=qqq")
+
+
+def runs(triples: Iterable[tuple[int, int, int]]) -> bytes:
+    """Runs of a copy as :func:`raw`'s ``value`` gives them: ``(first byte in the caller's
+    array, address in the image, bytes)`` each."""
+    return b"".join(_RUN.pack(*t) for t in triples)

@@ -1,0 +1,358 @@
+/* The C entry of a GT fast reader (gtecat/gt/centry.py builds, binds and tests this file).
+ *
+ * GT_GetSts(1, byref(s)) and its kind: the shape of the call is checked here (an exact int
+ * for the axis, count absent or 1, pClock absent, None or 0, the value's pointer resolved to
+ * the memory of an accepted ctypes object as the byref check does), the reader's value comes
+ * from one Python call (value(n): a number, or a sentinel when the C entry must not answer),
+ * and the number is written into the object's memory with the object's width (a reader of
+ * a structure: value(n) gives its bytes, copied whole).  Anything
+ * else - another shape, the sentinel, a number the type does not hold, any doubt - is the
+ * reader's Python fast function called with the very same arguments, which answers as before.
+ *
+ * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
+ * of their own: a ctypes array (or byref of one, no offset), a bytearray (or, to write from,
+ * bytes) long enough, and plain ints checked here, the
+ * runs of the range in the process image from one Python call (value(offset, size, type), as
+ * int64 triples in a bytes object: that function checks everything else, the array's type
+ * and size included), and the bytes copied run by run with memcpy.
+ *
+ * No Python header: where the interpreter keeps a pointer object's address and object, an
+ * object's type, a ctypes object's memory and a float's value, and the C API's functions, are
+ * handed over by the loader, which probed them on objects whose answers it knows and tests
+ * the entry against the Python path before using it.
+ */
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+typedef void *obj;
+
+struct api {
+    ptrdiff_t carg_value; /* the address a byref() passes */
+    ptrdiff_t carg_obj;   /* the object it refers to (NULL for some pointer objects) */
+    ptrdiff_t ob_type;    /* an object's type */
+    ptrdiff_t b_ptr;      /* a ctypes object's memory */
+    ptrdiff_t fval;       /* a float's value */
+    ptrdiff_t bsize;      /* a bytes object's length */
+    ptrdiff_t bdata;      /* a bytes object's first byte */
+    ptrdiff_t bastart;    /* a bytearray's first byte (its length: where a bytes object's is) */
+    ptrdiff_t vc_entry;   /* a vectorcall callable's entry address (see centry.py) */
+    obj carg_type;        /* the type of the pointer objects byref() makes */
+    obj int_type;
+    obj float_type;
+    obj bytes_type;
+    obj array_meta; /* the type of ctypes array types */
+    obj bytearray_type;
+    obj none;
+    obj zero; /* the int 0 (the return code) */
+    obj one;  /* the int 1 (an omitted count) */
+    void (*incref)(obj);
+    void (*decref)(obj);
+    obj (*vectorcall)(obj, obj const *, size_t, obj);
+    long long (*as_ll)(obj, int *); /* PyLong_AsLongLongAndOverflow */
+    obj (*err_occurred)(void);
+    void (*err_clear)(void);
+};
+
+#define MAX_TYPES 16
+
+/* one reader's entry: the memory of the ctypes object that is the C function's self */
+struct entry {
+    obj fallback;  /* the Python fast function: every shape this entry does not answer */
+    obj value;     /* value(n): the number (or bytes) to write, or sentinel */
+    obj sentinel;
+    ptrdiff_t core; /* 1: the GTN_ form, the core (which must be 1) first */
+    ptrdiff_t kind; /* 0: integers, 1: doubles, 2: bytes (a structure's, its whole size) */
+    ptrdiff_t most; /* arguments after the core: 2 (n, p), 4 (n, p, count 1, pClock NULL) */
+    obj types[MAX_TYPES]; /* the ctypes types *pValue may have, NULL-ended */
+    ptrdiff_t sizes[MAX_TYPES];
+    ptrdiff_t signs[MAX_TYPES]; /* an integer type: 1 signed, 0 unsigned */
+    ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
+    ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
+    obj avalue; /* NULL, or avalue(n, count, array type, pClock): a ctypes array's bytes */
+};
+
+static struct api A;
+static int ready;
+
+#define AT(base, off) (*(char **)((char *)(base) + (off)))
+/* the flag a vectorcall's caller may set in nargsf (PY_VECTORCALL_ARGUMENTS_OFFSET) */
+#define VECTORCALL_OFFSET ((size_t)1 << (8 * sizeof(size_t) - 1))
+#define TYPE(o) AT(o, A.ob_type)
+
+int gtecat_centry_api(const struct api *api)
+{
+    if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
+        api->fval < 0 || api->bsize < 0 || api->bdata < 0 || api->bastart < 0 ||
+        api->vc_entry < 0 ||
+        !api->bytearray_type || !api->carg_type ||
+        !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
+        !api->none ||
+        !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
+        !api->err_occurred || !api->err_clear)
+        return 1;
+    A = *api;
+    ready = 1;
+    return 0;
+}
+
+/* an exact int equal to want (no error left behind) */
+static int int_is(obj o, long long want)
+{
+    int over = 0;
+    long long v;
+    if (TYPE(o) != A.int_type)
+        return 0;
+    v = A.as_ll(o, &over);
+    if (v == -1 && !over && A.err_occurred()) {
+        A.err_clear();
+        return 0;
+    }
+    return !over && v == want;
+}
+
+/* a reader's ctypes array (count from n): the bytes avalue gives copied to its start */
+static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+                 ptrdiff_t at)
+{
+    obj call[4], v;
+    ptrdiff_t n;
+    call[0] = args[at];
+    call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
+    call[2] = TYPE(args[at + 1]);
+    call[3] = nargs >= 4 + at ? args[at + 3] : A.none;
+    if (TYPE(call[1]) != A.int_type)
+        goto python;
+    v = A.vectorcall(e->avalue, call, 4, NULL);
+    if (!v)
+        return NULL;
+    if (TYPE(v) != A.bytes_type || (n = *(ptrdiff_t *)((char *)v + A.bsize)) <= 0) {
+        A.decref(v);
+        goto python;
+    }
+    /* (avalue checked the array's type and length: the bytes fit) */
+    memcpy(AT(args[at + 1], A.b_ptr), (char *)v + A.bdata, (size_t)n);
+    A.decref(v);
+    A.incref(A.zero);
+    return A.zero;
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* the reader entry's work (both ways of calling it, below) */
+static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
+/* METH_FASTCALL | METH_KEYWORDS: self is the entry's ctypes object */
+obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    return reader((const struct entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+/* a vectorcall function: the callable keeps its entry's address at A.vc_entry */
+obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return reader((const struct entry *)AT(callable, A.vc_entry), args,
+                  (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ptrdiff_t at = e->core;
+    obj p, target, tp, v;
+    char *mem;
+    int k, size = 0, sign = 1, deref = 0;
+
+    if (!ready || kwnames)
+        goto python;
+    if (e->noaxis) {
+        if (nargs < 1 || nargs > 2 || (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
+            goto python;
+        p = args[0];
+    } else {
+        if (nargs < 2 + at || nargs > e->most + at)
+            goto python;
+        if (at && !int_is(args[0], 1))
+            goto python;
+        if (TYPE(args[at]) != A.int_type)
+            goto python;
+        if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
+            return array(e, args, nargs, kwnames, at);
+        if (nargs >= 3 + at && !int_is(args[at + 2], 1))
+            goto python;
+        if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+            goto python;
+        p = args[at + 1];
+    }
+    tp = TYPE(p);
+    target = p;
+    if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
+        target = AT(p, A.carg_obj);
+        if (!target)
+            goto python;
+        tp = TYPE(target);
+    }
+    for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
+        if (e->types[k] == tp) {
+            size = (int)e->sizes[k];
+            sign = (int)e->signs[k];
+            deref = (int)e->derefs[k];
+            break;
+        }
+    }
+    if (!size)
+        goto python;
+    mem = AT(target, A.b_ptr);
+    if (deref) { /* pointer(x) itself (not a byref of it): x's memory, not NULL */
+        if (target != p || !mem || !(mem = *(char **)mem))
+            goto python;
+    } else if (target != p && AT(p, A.carg_value) != mem) {
+        goto python;
+    }
+
+    v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
+                  : A.vectorcall(e->value, &args[at], 1, NULL);
+    if (!v)
+        return NULL; /* (the value's own error, as the Python path would raise it) */
+    if (v == e->sentinel)
+        goto drop;
+    if (e->kind == 1) {
+        if (TYPE(v) != A.float_type || size != 8)
+            goto drop;
+        *(double *)mem = *(double *)((char *)v + A.fval);
+    } else if (e->kind == 2) {
+        if (TYPE(v) != A.bytes_type || *(ptrdiff_t *)((char *)v + A.bsize) != size)
+            goto drop;
+        for (k = 0; k < size; k++)
+            mem[k] = ((char *)v + A.bdata)[k];
+    } else {
+        int over = 0;
+        long long x = A.as_ll(v, &over);
+        long long lo, hi;
+        if (x == -1 && !over && A.err_occurred()) {
+            A.err_clear();
+            goto drop;
+        }
+        if (size == 1)
+            lo = sign ? INT8_MIN : 0, hi = sign ? INT8_MAX : UINT8_MAX;
+        else if (size == 2)
+            lo = sign ? INT16_MIN : 0, hi = sign ? INT16_MAX : UINT16_MAX;
+        else if (size == 4)
+            lo = sign ? INT32_MIN : 0, hi = sign ? INT32_MAX : (long long)UINT32_MAX;
+        else if (size == 8)
+            lo = sign ? INT64_MIN : 0, hi = INT64_MAX;
+        else
+            goto drop;
+        if (over || x < lo || x > hi) /* (a value the type does not hold: the Python path) */
+            goto drop;
+        if (size == 1)
+            *(int8_t *)mem = (int8_t)x;
+        else if (size == 2)
+            *(int16_t *)mem = (int16_t)x;
+        else if (size == 4)
+            *(int32_t *)mem = (int32_t)x;
+        else
+            *(int64_t *)mem = (int64_t)x;
+    }
+    A.decref(v);
+    A.incref(A.zero);
+    return A.zero;
+
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* a raw image function's entry */
+struct raw_entry {
+    obj fallback; /* the Python fast function */
+    obj value;    /* value([slave,] offset, size, array type): the range's runs, or sentinel */
+    obj sentinel;
+    ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
+    ptrdiff_t write; /* 1: from the buffer into the image */
+};
+
+static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
+obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    return raw((const struct raw_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return raw((const struct raw_entry *)AT(callable, A.vc_entry), args,
+               (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ptrdiff_t at = e->io, k, n;
+    obj p, target, v, call[4];
+    const int64_t *runs;
+    long long size;
+    int over = 0;
+    char *mem;
+
+    if (!ready || kwnames || nargs != 3 + at)
+        goto python;
+    for (k = 0; k < 2 + at; k++)
+        if (TYPE(args[k]) != A.int_type)
+            goto python;
+    p = args[2 + at];
+    target = p;
+    if (TYPE(p) == A.carg_type) { /* byref(array) with no offset: the array */
+        target = AT(p, A.carg_obj);
+        if (!target || AT(p, A.carg_value) != AT(target, A.b_ptr))
+            goto python;
+    }
+    size = A.as_ll(args[1 + at], &over);
+    if (over || size <= 0) {
+        if (size == -1 && !over && A.err_occurred())
+            A.err_clear();
+        goto python;
+    }
+    if (TYPE(target) == A.bytearray_type || (e->write && TYPE(target) == A.bytes_type)) {
+        if (target != p || *(ptrdiff_t *)((char *)p + A.bsize) < size)
+            goto python;
+        mem = TYPE(p) == A.bytes_type ? (char *)p + A.bdata : AT(p, A.bastart);
+    } else if (TYPE(TYPE(target)) == A.array_meta) {
+        mem = AT(target, A.b_ptr);
+    } else {
+        goto python;
+    }
+    for (k = 0; k < 2 + at; k++)
+        call[k] = args[k];
+    call[2 + at] = TYPE(target);
+    v = A.vectorcall(e->value, call, (size_t)(3 + at), NULL);
+    if (!v)
+        return NULL; /* (the value's own error, as the Python path would raise it) */
+    if (v == e->sentinel || TYPE(v) != A.bytes_type)
+        goto drop;
+    /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
+    if (n <= 0 || n % 24)
+        goto drop;
+    runs = (const int64_t *)((char *)v + A.bdata);
+    for (k = 0; k < n / 24; k++) {
+        const int64_t *r = runs + 3 * k;
+        if (r[0] < 0 || r[2] <= 0 || r[0] + r[2] > size || !r[1])
+            goto drop;
+    }
+    for (k = 0; k < n / 24; k++) {
+        const int64_t *r = runs + 3 * k;
+        char *image = (char *)(intptr_t)r[1];
+        if (e->write)
+            memcpy(image, mem + r[0], (size_t)r[2]);
+        else
+            memcpy(mem + r[0], image, (size_t)r[2]);
+    }
+    A.decref(v);
+    A.incref(A.zero);
+    return A.zero;
+
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
