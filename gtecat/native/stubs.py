@@ -319,7 +319,8 @@ def _i686_layout(t: type) -> tuple[int, int]:
     code = getattr(t, "_type_", None)
     if code in ("P", "z", "Z", "O") or not isinstance(code, str):
         return 4, 4  # c_void_p, c_char_p, POINTER(x): 32-bit pointers
-    size = 4 if code in ("l", "L") else ctypes.sizeof(t)  # Windows' long: 32 bits
+    # Windows' long is 32 bits, its wchar_t 16
+    size = {"l": 4, "L": 4, "u": 2}.get(code) or ctypes.sizeof(t)
     return size, size
 
 

@@ -231,8 +231,9 @@ _SCRATCH = Path("/dev/shm")
 
 def _import_library(cmd: list[str], what: str, folder: Path) -> None:
     """Run dlltool: it writes a temporary object per exported name (~2,900) into its working
-    folder, so it works in a folder of the memory file system where there is one (on a disk
-    creating and deleting them is two thirds of its time), else in the build's ``folder``."""
+    folder, so it works in a folder of the memory file system where there is one (on a disk,
+    creating and deleting them takes two to four times the system time), else in the build's
+    ``folder``."""
     if _SCRATCH.is_dir() and os.access(_SCRATCH, os.W_OK | os.X_OK):
         try:
             with tempfile.TemporaryDirectory(prefix="gtecat-dlltool-", dir=_SCRATCH) as scratch:
