@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from gtecat.native import stubs, windows
+from gtecat.native import cdecl, stubs, windows
 
 
 def _tool(target: str, tool: str) -> str:
@@ -71,6 +71,9 @@ def test_every_stdcall_byte_count_is_the_compilers(x86_sources):
     assert all(len(set(ns)) == 1 for ns in shapes.values())  # N is the shape's
     assert len(shapes) > 100  # (496 lists of types in the table of this writing)
     lines = ['#include "gts.h"']
+    for cls in cdecl.structures():  # every structure's size, should one go by value
+        size = stubs._i686_layout(cls)[0]
+        lines.append(f'_Static_assert(sizeof({cls.__name__}) == {size}, "{cls.__name__}");')
     for k, shape in enumerate(shapes):
         params = ", ".join(f"{t} a{j}" for j, t in enumerate(shape)) or "void"
         lines.append(f"short __stdcall S{k}({params}) {{ return 0; }}")
