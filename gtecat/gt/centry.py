@@ -53,6 +53,7 @@ class _Api(ctypes.Structure):
         ("bdata", ctypes.c_ssize_t),
         ("bastart", ctypes.c_ssize_t),
         ("vc_entry", ctypes.c_ssize_t),
+        ("b_objects", ctypes.c_ssize_t),
         ("carg_type", _VP),
         ("int_type", _VP),
         ("float_type", _VP),
@@ -62,12 +63,15 @@ class _Api(ctypes.Structure):
         ("none", _VP),
         ("zero", _VP),
         ("one", _VP),
+        ("dict_type", _VP),
+        ("key_one", _VP),
         ("incref", _VP),
         ("decref", _VP),
         ("vectorcall", _VP),
         ("as_ll", _VP),
         ("err_occurred", _VP),
         ("err_clear", _VP),
+        ("dict_get", _VP),
     ]
 
 
@@ -114,6 +118,19 @@ def _float_at() -> int:
         if ctypes.c_double.from_address(id(x) + at).value != x:
             raise ValueError("a float's value is not where it is looked for")
     return at
+
+
+def _objects_at() -> int:
+    """Where a ctypes object keeps the objects it keeps alive (``_objects``: ``pointer(x)``'s
+    ``{'1': x}``; ValueError when the probe disagrees)."""
+    xs = [ctypes.c_long(3), ctypes.c_double(2.5), ctypes.c_short(1)]
+    ps = [ctypes.pointer(x) for x in xs]
+    ps.append(ctypes.cast(ps[0], ctypes.POINTER(ctypes.c_int)))  # ({id: object})
+    for k in range(_HEAD, sys.getsizeof(ps[0]) - _WORD + 1, _WORD):
+        if all(_VP.from_address(id(p) + k).value == id(p._objects) for p in ps):
+            if all(p._objects["1"] is x for p, x in zip(ps, xs, strict=False)):
+                return k
+    raise ValueError("a ctypes object's kept objects are not where they are looked for")
 
 
 def _bytes_at() -> tuple[int, int]:
@@ -238,6 +255,8 @@ def _address(name: str) -> int:
     return ctypes.cast(getattr(ctypes.pythonapi, name), _VP).value or 0
 
 
+#: the key under which ``pointer(x)`` keeps ``x`` (the C entry looks it up; kept alive here)
+_KEY_ONE = "1"
 #: the entries made (kept alive: their C functions point at them)
 _KEEP: list[Any] = []
 #: (the reader maker, why it is not available)
@@ -252,6 +271,7 @@ def _load() -> tuple[Maker | None, str]:
         fval = _float_at()
         bsize, bdata = _bytes_at()
         bastart = _bytearray_at(bsize)
+        objects_at = _objects_at()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -269,6 +289,7 @@ def _load() -> tuple[Maker | None, str]:
             bdata,
             bastart,
             _HEAD + _WORD,  # (an entry callable's layout: _callable_type)
+            objects_at,
             id(type(ctypes.byref(ctypes.c_int()))),
             id(int),
             id(float),
@@ -278,12 +299,15 @@ def _load() -> tuple[Maker | None, str]:
             id(None),
             id(0),
             id(1),
+            id(dict),
+            id(_KEY_ONE),
             _address("Py_IncRef"),
             _address("Py_DecRef"),
             _address("PyObject_Vectorcall"),
             _address("PyLong_AsLongLongAndOverflow"),
             _address("PyErr_Occurred"),
             _address("PyErr_Clear"),
+            _address("PyDict_GetItem"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

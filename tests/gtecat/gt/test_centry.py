@@ -78,6 +78,8 @@ KINDS = [
     "obj",
     "array",
     "pointer",
+    "cast",
+    "address",
     "numpy",
     "memoryview",
     "int",
@@ -112,6 +114,12 @@ def _arg(kind: str, t: type) -> tuple[Any, Any]:
     if kind == "pointer":
         o = t()
         return o, ctypes.pointer(o)
+    if kind == "cast":  # a pointer cast from a smaller object: no size behind it is proved
+        big = (ctypes.c_ubyte * 16)()
+        return big, ctypes.cast((ctypes.c_ubyte * 2).from_buffer(big), ctypes.POINTER(t))
+    if kind == "address":  # a pointer cast from an address (numpy's data_as is one)
+        o = t()
+        return o, ctypes.cast(ctypes.addressof(o), ctypes.POINTER(t))
     if kind == "numpy":
         o = np.zeros(2, np.dtype(t._type_))
         return o, o
@@ -462,3 +470,31 @@ def test_without_the_entry_type_the_entries_are_partials(monkeypatch: pytest.Mon
     s = ctypes.c_long()
     assert type(fn) is functools.partial
     assert (fn(1, byref(s)), s.value, fn(1, byref(s), 2)) == (0, 7, "python")
+
+
+def test_a_pointer_to_memory_of_unproved_size_is_refused_not_written_through() -> None:
+    """A ``POINTER(c_double)`` cast over 2 bytes at the end of a mapped page (reading
+    or writing 8 there would crash the process), over numpy float32s (``data_as``), or over
+    a bare address: the manual's 7 with the table path's reason, the memory untouched;
+    ``pointer(x)`` itself is still answered."""
+    import mmap
+
+    _open()
+    page = mmap.mmap(-1, mmap.PAGESIZE)
+    end = (ctypes.c_ubyte * 2).from_buffer(page, mmap.PAGESIZE - 2)
+    f32 = np.zeros(3, np.float32)
+    held = ctypes.c_double(-1.0)
+    try:
+        for fn in (gt.GT_GetPrfPos, gt.GT_GetEncPos):
+            for p in (
+                ctypes.cast(end, ctypes.POINTER(ctypes.c_double)),
+                f32.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                ctypes.cast(ctypes.addressof(held), ctypes.POINTER(ctypes.c_double)),
+            ):
+                assert fn(1, p) == 7, gt.GTE_GetLastError()
+                assert "pValue" in gt.GTE_GetLastError()
+        assert bytes(end) == b"\0\0" and not f32.any() and held.value == -1.0
+        assert gt.GT_GetSts(1, ctypes.cast(end, ctypes.POINTER(ctypes.c_long))) == 7
+        assert gt.GT_GetPrfPos(1, ctypes.pointer(held)) == 0 and held.value > 0.0
+    finally:
+        gt.GT_Close()  # (the page is unmapped when nothing holds it)
