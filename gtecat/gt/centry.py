@@ -26,6 +26,7 @@ import functools
 import logging
 import struct
 import sys
+import types
 from collections.abc import Callable, Iterable
 from importlib import resources
 from typing import Any
@@ -209,6 +210,34 @@ class _TypeSpec(ctypes.Structure):
     ]
 
 
+def _pointer_type(t: type) -> type:
+    """``ctypes.POINTER(t)`` (:func:`_pointer_types_of_ctypes`)."""
+    p = ctypes.POINTER(t)
+    _pointer_types_of_ctypes()
+    return p
+
+
+def _pointer_types_of_ctypes() -> None:
+    """A pointer type ctypes made first for this module's code (its probes, its entries)
+    says it is ctypes': its repr would otherwise name this module in every ``pointer(x)``
+    of the user's."""
+    for p in list(ctypes._pointer_type_cache.values()):  # type: ignore[attr-defined]
+        if getattr(p, "__module__", None) == __name__:
+            p.__module__ = "ctypes"
+
+
+def by_name(name: str) -> Any:
+    """The public GT function ``name`` (how a pickled or copied one comes back: itself)."""
+    from .. import gt
+
+    return getattr(gt, name)
+
+
+def _bound(self: Any, obj: Any, cls: Any = None) -> Any:
+    """A function's ``__get__``: itself from a class, a bound method from an instance."""
+    return self if obj is None else types.MethodType(self, obj)
+
+
 def _callable_type() -> type:
     """A type whose instances are called the way built-in functions are (vectorcall: the
     C function whose address an instance holds right after its head, the entry's address
@@ -219,9 +248,10 @@ def _callable_type() -> type:
     T_PYSSIZET, READONLY = 19, 1
     Py_tp_call, Py_tp_members, Py_tp_getset = 50, 72, 73
     HAVE_VECTORCALL, DEFAULT = 1 << 11, 1 << 18
-    members = (_MemberDef * 3)(
+    members = (_MemberDef * 4)(
         _MemberDef(b"__vectorcalloffset__", T_PYSSIZET, _HEAD, READONLY, None),
         _MemberDef(b"__dictoffset__", T_PYSSIZET, _HEAD + 2 * _WORD, READONLY, None),
+        _MemberDef(b"__weaklistoffset__", T_PYSSIZET, _HEAD + 3 * _WORD, READONLY, None),
     )
     getset = (_GetSetDef * 2)(
         _GetSetDef(
@@ -238,12 +268,17 @@ def _callable_type() -> type:
         _TypeSlot(Py_tp_getset, ctypes.addressof(getset)),
     )
     spec = _TypeSpec(
-        b"gtecat.gt.centry.entry", _HEAD + 3 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
+        b"gtecat.gt.centry.entry", _HEAD + 4 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
     )
     make = ctypes.PYFUNCTYPE(ctypes.py_object, _VP)(("PyType_FromSpec", ctypes.pythonapi))
     t = make(ctypes.addressof(spec))
     _KEEP.append((members, getset, slots, spec, t))
     t.__repr__ = lambda self: f"<GT function {getattr(self, '__name__', '?')} (C entry)>"
+    # what a Python function does besides being called: pickled, copied and deep-copied as
+    # itself by its name (as a function is), bound as a method where a class holds it (so
+    # inspect.isroutine and pydoc take it for the function it is), weakly referenced
+    t.__reduce__ = lambda self: (by_name, (self.__name__,))
+    t.__get__ = _bound
     probe = t()
     probe.attribute = 1  # (an instance dict)
     if vars(probe) != {"attribute": 1}:
@@ -355,7 +390,7 @@ def _load() -> tuple[Maker | None, str]:
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
-            kinds += tuple(ctypes.POINTER(t) for t in kinds)
+            kinds += tuple(_pointer_type(t) for t in kinds)
         if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
             raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
@@ -630,6 +665,7 @@ def _self_test_raw(make_raw: Maker) -> str:
 
 
 _MAKE, REASON = _load()
+_pointer_types_of_ctypes()
 if _MAKE is None:
     log.debug("C entry of the fast readers not used: %s", REASON)
 

@@ -14,6 +14,7 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import os
 import re
 import struct
 import sys
@@ -506,9 +507,9 @@ def fast_reader(
     return public[0]  # type: ignore[no-any-return]
 
 
-#: the C entry of the readers where it is available (tests turn it off to hold the Python
-#: fast functions to the same answers)
-CENTRY = True
+#: the C entry of the readers where it is available (``GTECAT_CENTRY=0`` turns it off when
+#: gtecat is imported; tests turn it off to hold the Python fast functions to the same answers)
+CENTRY = os.environ.get("GTECAT_CENTRY", "1") != "0"
 
 
 def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:

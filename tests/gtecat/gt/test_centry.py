@@ -18,9 +18,12 @@ runs them all (a broad sample of the readers').
 from __future__ import annotations
 
 import ctypes
+import os
 import random
 import shutil
+import subprocess
 import sys
+import types
 from ctypes import byref
 from pathlib import Path
 from typing import Any
@@ -201,6 +204,44 @@ def test_the_c_entry_is_built_and_is_the_public_reader() -> None:
     made = type(gt.GT_GetSts)()  # (an object of the entry type without its C function)
     with pytest.raises(TypeError):
         made(1, ctypes.c_long())
+
+
+@needs_cc
+def test_an_entry_is_used_as_a_function_is() -> None:
+    """Pickled, copied, weakly referenced, a routine to inspect and pydoc (its signature
+    shown), bound as a method where a class holds it, as the Python function it stands for;
+    and the pointer types its probes made first are ctypes' (their repr)."""
+    import copy
+    import inspect
+    import pickle
+    import pydoc
+    import weakref
+
+    for fn in (gt.GT_GetSts, gt.GTN_GetPrfPos, gt.GT_GetEcatRawData):
+        assert type(fn) is not types.FunctionType, "the C entry is not in front"
+        assert pickle.loads(pickle.dumps(fn)) is fn
+        assert copy.copy(fn) is fn and copy.deepcopy(fn) is fn
+        assert weakref.ref(fn)() is fn
+        assert inspect.isroutine(fn)
+    assert ("GT_GetSts", gt.GT_GetSts) in inspect.getmembers(gt, inspect.isroutine)
+    assert "GT_GetSts(axis, pSts, count=1, pClock=None)" in pydoc.render_doc(
+        gt.GT_GetSts, renderer=pydoc.plaintext
+    )
+
+    class Holder:
+        read = gt.GT_GetSts
+
+    assert Holder.read is gt.GT_GetSts
+    assert Holder().read.__func__ is gt.GT_GetSts  # (a bound method, as a function gives)
+    assert ctypes.POINTER(ctypes.c_long).__module__ == "ctypes"
+
+
+def test_gtecat_centry_0_leaves_the_python_functions() -> None:
+    """``GTECAT_CENTRY=0``: the public readers are the Python functions (read at import)."""
+    code = "from gtecat import gt; import types; print(type(gt.GT_GetSts) is types.FunctionType)"
+    env = {**os.environ, "GTECAT_CENTRY": "0"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == "True", out.stderr
 
 
 @needs_cc
