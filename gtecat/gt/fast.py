@@ -476,16 +476,18 @@ def fast_reader(
         env["NOPE"] = _NO
         kind = centry.DOUBLE if ctypes_ok is _DOUBLE else centry.INT
         types = sorted(ctypes_ok, key=str)
-        value_gt = _value_function(env, "value_gt", "session.plain")
-        value_gtn = _value_function(env, "value_gtn", "session.local")
+        _gated(env)
+        value_gt = _value_function(env, "value_gt", "CTL")
+        value_gtn = _value_function(env, "value_gtn", "CTLN")
         entry = centry.reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
-            array=array_value(value_gt, True),
+            array=array_value(value_gt, True), gate=centry.GT_GATE,
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, False),
+            gate=centry.GTN_GATE,
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
@@ -496,6 +498,42 @@ def fast_reader(
 #: the C entry of the readers where it is available (tests turn it off to hold the Python
 #: fast functions to the same answers)
 CENTRY = True
+
+
+class _Off:
+    """The controller a gated value function sees while its gate is closed: no axis, no
+    input (its C entry does not ask it then; a direct call answers _NO)."""
+
+    resources: dict = {}  # noqa: RUF012 - never written
+    axes: dict = {}  # noqa: RUF012
+    input_plans: dict = {}  # noqa: RUF012
+
+
+_OFF = _Off()
+#: the controllers behind the two gates (centry.GATES): the GT_ functions', the GTN_ ones'
+#: (_OFF: closed); the globals ``CTL`` and ``CTLN`` of every gated value function's module
+GATED: list[Any] = [_OFF, _OFF]
+_GATED_ENVS: list[dict[str, Any]] = []
+
+
+def _gated(env: dict[str, Any]) -> dict[str, Any]:
+    """``env`` (a gated value function's globals) given the gates' controllers, and kept
+    up to date by :func:`set_gates`."""
+    env["CTL"], env["CTLN"] = GATED
+    _GATED_ENVS.append(env)
+    return env
+
+
+def set_gates(gt: Any, gtn: Any) -> None:
+    """The session's answer (gtecat.gt._core: wherever it can change): ``gt`` the
+    in-process lockstep controller the GT_ functions address with core 1, ``gtn`` the GTN_
+    functions' core 1, or None.  The gated value functions read it as ``CTL`` / ``CTLN``,
+    their C entries' gates open for it."""
+    centry.set_gates(False, False)
+    GATED[:] = [_OFF if gt is None else gt, _OFF if gtn is None else gtn]
+    for env in _GATED_ENVS:
+        env["CTL"], env["CTLN"] = GATED
+    centry.set_gates(gt is not None, gtn is not None)
 
 
 def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:
@@ -854,27 +892,24 @@ def _value_lines(env: dict[str, Any]) -> list[str]:
 #: a reader's value for its C entry (:mod:`gtecat.gt.centry`): the value of axis ``n`` of the
 #: in-process lockstep controller as the fast function writes it, with the fast function's
 #: side effect (the last error cleared); NOPE where the fast function must answer
+#: (the entry asks it only while its gate is open: ``{ctl}``, CTL or CTLN, is that controller)
 _VALUE = """
 def {fname}(n):
-    try:  # (two subscripts: cheaper than two get calls)
-        ctl = session.controllers[1]
-        res = ctl.resources[n]
-    except KeyError:  # no controller, or no such axis
+    try:
+        res = {ctl}.resources[n]
+    except KeyError:  # no such axis
         return NOPE
-    # (a lockstep clock never runs a thread of its own: Clock.start runs one in real time only)
-    if {session} and ctl.clock.mode is _LOCKSTEP:
 {{value}}
-        session.last = None
-        return v
-    return NOPE
+    session.last = None
+    return v
 """
 
 
-def _value_function(env: dict[str, Any], fname: str, session: str) -> Callable[[Any], Any]:
-    """The value function of a reader's C entry (``session``: the GT_ or the GTN_ form's
-    check of the session)."""
-    value = "\n".join("        " + line for line in _value_lines(env))
-    code = _VALUE.format(fname=fname, session=session).replace("{value}", value)
+def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any], Any]:
+    """The value function of a reader's C entry (``ctl``: the GT_ or the GTN_ form's gated
+    controller, ``CTL`` or ``CTLN``)."""
+    value = "\n".join("    " + line for line in _value_lines(env))
+    code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]  # type: ignore[no-any-return]
 
