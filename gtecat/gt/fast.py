@@ -507,6 +507,7 @@ class _Off:
     resources: dict = {}  # noqa: RUF012 - never written
     axes: dict = {}  # noqa: RUF012
     input_plans: dict = {}  # noqa: RUF012
+    master = bank = card = None
 
 
 _OFF = _Off()
@@ -536,15 +537,25 @@ def set_gates(gt: Any, gtn: Any) -> None:
     centry.set_gates(gt is not None, gtn is not None)
 
 
-def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:
+def _entry(
+    gt: Any,
+    value: Callable[[Any], Any],
+    types: Any,
+    kind: int,
+    size: int = 0,
+    gate: int = centry.NO_GATE,
+) -> Any:
     """A two-argument reader's public function: its C entry in front of its Python fast
     function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
-    :data:`CENTRY` is on and the entry is available; else ``gt``."""
+    :data:`CENTRY` is on and the entry is available; else ``gt``; ``gate``: as
+    :func:`centry.reader`'s."""
     if not CENTRY:
         return gt
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
-    entry = centry.reader(gt, value, _NO, sorted(types, key=str), kind, most=2, size=size)
+    entry = centry.reader(
+        gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate
+    )
     if entry is None:
         return gt
     entry.slow, entry.python = gt.slow, gt
@@ -1392,10 +1403,11 @@ def fast_raw(
         slave_key="slave" if io else "-1",
         slave_memo=" and slave == last[4]" if io else "",
     )
+    _gated(venv)
     exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
     value = venv["value"]
 
-    public = centry.raw(entry, value, _NO, io, write)
+    public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE)
     if public is None:
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
@@ -1445,20 +1457,11 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
 
 #: a raw function's value for its C entry (centry.raw): the session's checks, then the runs
 #: of the previous call's shape (a polling loop repeats its shape), else runs_of's
+#: (asked while the GT_ gate is open: CTL the in-process lockstep controller)
 _RAW_VALUE = """
 def value({slave}offset, size, tp):
-    try:
-        ctl = session.controllers[1]
-    except KeyError:  # no controller
-        return _NO
-    m = ctl.master
-    if (
-        session.plain  # (in this process, core 1)
-        and m is not None
-        and m.opened
-        and not m.offline
-        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
-    ):
+    m = CTL.master
+    if m is not None and m.opened and not m.offline:
         last = LASTC  # (one read: another thread may replace it meanwhile)
         if (
             offset == last[0]
@@ -1779,24 +1782,24 @@ def fast_ecat_reader(
     exec(_compiled_code(code, f"<gt fast ecat {name}>"), env)
     gt = env["gt"]
     gt.slow = slow
+    _gated(env)
     exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
-    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
+    return _entry(gt, env["value"], ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 #: a PDO reader's value for its C entry (the common case of ``_ECAT_READER``, the axis's
 #: entry kept by it); else _NO
+#: (asked while the GT_ gate is open: CTL the in-process lockstep controller)
 _ECAT_VALUE = """
 def value(n):
+    ctl = CTL
     try:
-        ctl = session.controllers[1]
         ax = ctl.axes[n]
-    except KeyError:  # no controller, or no such axis
+    except KeyError:  # no such axis
         return _NO
     m = ctl.master
     if (
         type(ax) is _AXIS
-        and session.plain
-        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
         and m is not None
         and m.opened
         and ctl.card is None
@@ -2006,16 +2009,44 @@ def fast_homing_status(
                         return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
+    gated = GATED
+
     def value(n: int) -> Any:
-        """The C entry's value: the status on the lockstep clock, else _NO."""
-        got = status(n)
-        if got is None or got[0].clock.mode is not _LOCKSTEP:
+        """The C entry's value (asked while the GT_ gate is open: ``GATED[0]`` the
+        in-process lockstep controller): ``status``'s steps past its session checks, for
+        an axis seen before (else _NO: the Python function looks at it first)."""
+        ctl = gated[0]
+        try:
+            ax = ctl.axes[n]
+            k = kept[n]
+        except KeyError:  # no such axis, or not seen yet
             return _NO
+        m = ctl.master
+        if k[0] is not ax or ctl.card is not None or m is None or not m.opened:
+            return _NO
+        st = k[3]
+        if st is None and k[4] != h[3][0]:  # (a state made since: look again)
+            k[4] = h[3][0]
+            st = k[3] = h[0].get(k[1])
+        if ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost"):
+            return _NO
+        if st is None:  # no run since the bus came up: not homed
+            if not k[2]:
+                return _NO
+            v = h[2]
+        elif st.active:
+            if st.hint is not None:
+                return _NO
+            v = h[1]
+        else:
+            v = st.result
+            if v is None:
+                return _NO
         session.last = None
-        return got[1]
+        return v
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return _entry(gt, value, ok, centry.INT)  # type: ignore[no-any-return]
+    return _entry(gt, value, ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 def struct_packer(cls: type) -> Callable[..., None] | None:
@@ -2184,15 +2215,24 @@ def fast_struct_reader(
         return gt
     to_bytes, size = packed
 
+    gated = GATED
+
     def value(n: int) -> Any:
-        """The C entry's value: the structure's bytes on the lockstep clock, else _NO."""
-        got = ready(n)
-        if got is None or got[0].clock.mode is not _LOCKSTEP:
+        """The C entry's value (asked while the GT_ gate is open: ``GATED[0]`` the
+        in-process lockstep controller): the structure's bytes, else _NO."""
+        ctl = gated[0]
+        try:
+            res = ctl.resources[n]
+        except KeyError:  # no such axis: the table path says why
             return _NO
-        ctl, res = got
+        ax = res.ax
+        if ctl.card is not None or ctl.axes.get(n) is not ax:
+            return _NO
         bank = ctl.bank
-        if bank is not None:  # (what the table path does first)
-            bank.before_axis_call(res.ax, res)
+        if bank is not None:  # (what the table path does first: before_axis_call, inline)
+            bank.dirty = True
+            if bank.n_alive and res.bank is bank:
+                bank.release_axis_object(ax)
         if res.profile.mode is not mode:
             return _NO
         try:
@@ -2202,7 +2242,7 @@ def fast_struct_reader(
         session.last = None
         return b
 
-    return _entry(gt, value, [cls], centry.BYTES, size)  # type: ignore[no-any-return]
+    return _entry(gt, value, [cls], centry.BYTES, size, centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 #: the session's core reader on the fast path (it reads no controller)
@@ -2371,8 +2411,9 @@ def fast_io_reader(
     exec(compile(code, f"<gt fast io {name}>", "exec"), env)
     gt = env["gt"]
     gt.slow = slow  # type: ignore[attr-defined]
+    _gated(env)
     exec(compile(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>", "exec"), env)
-    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
+    return _entry(gt, env["value"], ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 #: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'
@@ -2426,22 +2467,21 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
 
 #: an IO reader's value for its C entry (the common case of ``_IO_READER``: a reader kept,
 #: the lockstep clock, no axis of the bank to give back first); else _NO
+#: (asked while the GT_ gate is open: CTL the in-process lockstep controller)
 _IO_VALUE = """
 def value(t):
-    if {lo} <= t <= {hi} and session.plain and session.note is None:
+    if {lo} <= t <= {hi} and session.note is None:
         try:
-            ctl = session.controllers[1]
-            read = ctl.input_plans[t + {kind}]
-        except KeyError:  # none kept (yet, or since a change), no controller
+            read = CTL.input_plans[t + {kind}]
+        except KeyError:  # none kept (yet, or since a change)
             return _NO
-        # (a lockstep clock never runs a thread of its own: Clock.start runs one in real
-        # time only)
-        if ctl.clock.mode is _LOCKSTEP:
-            bank = ctl.bank
-            if not (RELEASES and bank is not None and bank.n_alive):
-                v = read()
-                session.last = None
-                return v
+        if RELEASES:
+            bank = CTL.bank
+            if bank is not None and bank.n_alive:
+                return _NO
+        v = read()
+        session.last = None
+        return v
     return _NO
 """
 
