@@ -2245,6 +2245,126 @@ def fast_struct_reader(
     return _entry(gt, value, [cls], centry.BYTES, size, centry.GT_GATE)  # type: ignore[no-any-return]
 
 
+#: the smart homing's status reader on the fast path (a homing loop polls it)
+HOME_STATUS = "GT_GetHomeStatus"
+#: THomeStatus's fields in order (run, stage, error, pad1, capturePos, targetPos), natively
+_HOME_STATUS = struct.Struct("@hhhhii")
+
+
+def fast_home_status(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetHomeStatus(axis, p)`` with the fast path in front of the table: ``p``
+    ``byref(s)`` (no offset) or ``s`` itself of THomeStatus, an axis of the in-process
+    controller (no pulse card) whose smart homing the table path has made before (its
+    first call, or GT_GoHome's); the fields as the table path sets them.  Any other shape,
+    a value a field would wrap, a homing not made yet: the table path (GTN_GetHomeStatus
+    with core 1 takes this path through the GT layer's twin)."""
+    from ..controller import smart_home as sh
+    from .home_structs import THomeStatus
+
+    fields = [(f[0], f[1]) for f in THomeStatus._fields_]
+    i16, i32 = ctypes.c_int16, ctypes.c_int32
+    want = [("run", i16), ("stage", i16), ("error", i16), ("pad1", i16)]
+    want += [("capturePos", i32), ("targetPos", i32)]
+    if fields != want or ctypes.sizeof(THomeStatus) != _HOME_STATUS.size:
+        # (another layout: the table path alone)
+        return slow
+    pack, pack_into = _HOME_STATUS.pack, _HOME_STATUS.pack_into
+    target = _target([THomeStatus])
+    homes, running = sh._HOMES, sh._RUNNING
+    #: axis number -> (its resources, their smart homing): smart_home makes a homing once
+    #: per resources and keeps it while they live, so one found is theirs for good
+    kept: dict[int, tuple[Any, Any]] = {}
+
+    def home_of(ctl: Any, n: int) -> Any:
+        """Axis ``n``'s smart homing on ``ctl`` where the fast path reads it, else None."""
+        try:
+            res = ctl.resources[n]
+        except KeyError:  # no such axis: the table path says why
+            return None
+        if ctl.axes.get(n) is not res.ax or ctl.card is not None:
+            return None
+        k = kept.get(n)
+        if k is not None and k[0] is res:
+            return k[1]
+        home = homes.get(res)
+        if home is None or ctl not in running:  # (the table path makes it, registered)
+            return None
+        if len(kept) > 4096:
+            kept.clear()
+        kept[n] = (res, home)
+        return home
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra:
+            tp = type(p)
+            if tp is _CArg:
+                s = target(p)
+                if s is p:
+                    s = None
+            else:
+                s = p if tp is THomeStatus else None
+            ctl = None if s is None else session.controllers.get(1)
+            if ctl is not None and session.plain and ctl.clock._thread is None:
+                home = home_of(ctl, n)
+                if home is not None:
+                    st = home.status
+                    try:
+                        pack_into(
+                            s, 0, int(st.run), int(st.stage), int(st.error), 0,
+                            int(st.capturePos), int(st.targetPos),
+                        )  # fmt: skip
+                    except Exception:  # (a value a field wraps, or no number: the table)
+                        return slow(n, p)
+                    session.last = None
+                    if ctl.clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    gated = GATED
+
+    def value(n: int) -> Any:
+        """The C entry's value (asked while the GT_ gate is open): the structure's bytes
+        (home_of's steps inline for an axis seen before)."""
+        ctl = gated[0]
+        try:
+            res = ctl.resources[n]
+            k = kept[n]
+        except KeyError:  # no such axis, or not seen: home_of looks
+            home = home_of(ctl, n)
+            if home is None:
+                return _NO
+        else:
+            if ctl.axes.get(n) is not res.ax or ctl.card is not None:
+                return _NO
+            home = k[1] if k[0] is res else home_of(ctl, n)
+            if home is None:
+                return _NO
+        st = home.status
+        try:  # (ints and IntEnums as they are: pack takes their value, as int() gives it)
+            b = pack(st.run, st.stage, st.error, 0, st.capturePos, st.targetPos)
+        except Exception:  # (a float, say: int() first, as the table path)
+            try:
+                b = pack(
+                    int(st.run), int(st.stage), int(st.error), 0,
+                    int(st.capturePos), int(st.targetPos),
+                )  # fmt: skip
+            except Exception:  # (a value a field wraps, or no number: the table path)
+                return _NO
+        session.last = None
+        return b
+
+    return _entry(  # type: ignore[no-any-return]
+        gt, value, [THomeStatus], centry.BYTES, _HOME_STATUS.size, centry.GT_GATE
+    )
+
+
 #: the session's core reader on the fast path (it reads no controller)
 CORE = "GT_GetCore"
 
@@ -2492,6 +2612,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         **dict.fromkeys(IO_READERS, fast_io_reader),
         CORE: fast_core,
         HOMING: fast_homing_status,
+        HOME_STATUS: fast_home_status,
     }
     for names, make in (
         (READERS, fast_reader),

@@ -107,7 +107,8 @@ def _agree(step: str) -> None:
 def test_the_c_entries_are_gated() -> None:
     if centry.REASON:
         pytest.skip(f"no C entry here: {centry.REASON}")
-    for name in ("GT_GetSts", "GT_GetDi", "GT_GetTrapPrm", fast.HOMING, "GT_GetEcatRawData"):
+    names = ("GT_GetSts", "GT_GetDi", "GT_GetTrapPrm", fast.HOMING, "GT_GetEcatRawData")
+    for name in (*names, fast.HOME_STATUS):
         assert hasattr(getattr(gt, name), "python"), name
 
 
@@ -181,3 +182,72 @@ def test_the_entries_follow_the_bank_rebuilding_its_lists(bank: str) -> None:
         if ctl.bank is not None:
             ctl.bank._lists.clear()  # (as at a cycle: made again at the next read)
             _agree(f"lists cleared {k}")
+
+
+def _home_calls() -> list[tuple[str, Any, Any]]:
+    """(label, function, how its arguments are made): GT_GetHomeStatus's shapes."""
+    T = gt.THomeStatus
+    return [
+        ("byref", gt.GT_GetHomeStatus, lambda: (o := T(), (1, byref(o)))),
+        ("obj", gt.GT_GetHomeStatus, lambda: (o := T(), (1, o))),
+        ("offset", gt.GT_GetHomeStatus, lambda: (o := (T * 2)(), (1, byref(o, 16)))),
+        ("other struct", gt.GT_GetHomeStatus, lambda: (o := gt.TTrapPrm(), (1, byref(o)))),
+        ("axis 2", gt.GT_GetHomeStatus, lambda: (o := T(), (2, byref(o)))),
+        ("axis 9", gt.GT_GetHomeStatus, lambda: (o := T(), (9, byref(o)))),
+        ("gtn", gt.GTN_GetHomeStatus, lambda: (o := T(), (1, 1, byref(o)))),
+    ]
+
+
+def _gtn_table(core: int, *args: Any) -> int:
+    """GTN_GetHomeStatus's table path: GT_GetHomeStatus's with ``core`` addressed."""
+    with _core.SESSION.selected(_core.SESSION.card, core):
+        return int(gt.GT_GetHomeStatus.slow(*args))
+
+
+def _home_agree(step: str) -> None:
+    bad = []
+    for label, public, make in _home_calls():
+        table = _gtn_table if label == "gtn" else public.slow
+        fns = [public, table]
+        if hasattr(public, "python"):
+            fns.append(public.python)
+        got = []
+        for fn in fns:
+            o, args = make()
+            rc = fn(*args)
+            got.append((rc, bytes(o), gt.GTE_GetLastError() if rc else ""))
+        if any(g != got[0] for g in got):
+            bad.append(f"{step}: {label}: {got}")
+    assert not bad, "\n".join(bad)
+
+
+def test_the_home_status_answers_as_the_table_through_a_smart_homing() -> None:
+    """GT_GetHomeStatus on its fast path (C entry and Python) and its table path, polled
+    through a smart homing of an EtherCAT drive from start to end; a value a field would
+    wrap; another session."""
+    from gtecat.controller.smart_home import smart_home
+
+    from .conftest import bring_up
+    from .test_home_calls import ecat_machine, home_prm
+
+    bring_up("homing_probe.eni", machine=ecat_machine(), clock="lockstep")
+    assert gt.GT_AxisOn(1) == 0
+    _home_agree("before any homing")  # (the table path makes it at its first call)
+    assert gt.GT_GoHome(1, byref(home_prm(mode=gt.HOME_MODE_HOME))) == 0
+    st = gt.THomeStatus()
+    seen = set()
+    for k in range(20_000):
+        if k % 50 == 0:
+            _home_agree(f"cycle {k}")
+        assert gt.GT_GetHomeStatus(1, byref(st)) == 0
+        seen.add((st.run, st.stage))
+        if not st.run:
+            break
+        gt.GTE_Wait(1)
+    assert not st.run and len(seen) > 2, seen
+    _home_agree("homed")
+    home = smart_home(gt.GTE_Controller(), 1)
+    home.status.capturePos = 1 << 40  # (a c_int32 field wraps it: the table path's own)
+    _home_agree("wrapping")
+    assert gt.GT_SetCore(2) == 0
+    _home_agree("core 2")
