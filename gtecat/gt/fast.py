@@ -445,12 +445,9 @@ def fast_reader(
             else:
                 if not spans or count > limit:
                     return _NO
-                try:
-                    ctl = session.controllers[1]
-                except KeyError:  # no controller
-                    return _NO
-                # (a lockstep clock never runs a thread of its own: real time only has one)
-                if not (session.plain and ctl.clock.mode is _LOCKSTEP):
+                # (the GT_ form's entry asks only while the GT_ gate is open: its controller)
+                ctl = GATED[0]
+                if ctl is _OFF:
                     return _NO
                 clk = clock_out(ctl, pClock)
                 if clk is False:
