@@ -2121,6 +2121,10 @@ def _trap_bytes() -> tuple[Callable[[Any], bytes], int] | None:
         prm = res.profile.trap_prm
         return pack(prm.acc, prm.dec, prm.vel_start, prm.smooth_time)
 
+    to_bytes.pack = pack  # type: ignore[attr-defined]  # (its C entry's value: inline)
+    to_bytes.inline = (
+        "prm = prof.trap_prm\nb = PACK(prm.acc, prm.dec, prm.vel_start, prm.smooth_time)"  # type: ignore[attr-defined]
+    )
     return to_bytes, packer.size
 
 
@@ -2212,34 +2216,42 @@ def fast_struct_reader(
         return gt
     to_bytes, size = packed
 
-    gated = GATED
+    env = {"_NO": _NO, "MODE": mode, "TO_BYTES": to_bytes, "session": session}
+    env["PACK"] = getattr(to_bytes, "pack", None)
+    inline = getattr(to_bytes, "inline", "b = TO_BYTES(res)")  # (to_bytes' steps inline)
+    code = _STRUCT_VALUE.replace("{bytes}", "\n".join("        " + x for x in inline.split("\n")))
+    exec(_compiled_code(code, f"<gt struct value {name}>"), _gated(env))
+    return _entry(gt, env["value"], [cls], centry.BYTES, size, centry.GT_GATE)  # type: ignore[no-any-return]
 
-    def value(n: int) -> Any:
-        """The C entry's value (asked while the GT_ gate is open: ``GATED[0]`` the
-        in-process lockstep controller): the structure's bytes, else _NO."""
-        ctl = gated[0]
-        try:
-            res = ctl.resources[n]
-        except KeyError:  # no such axis: the table path says why
-            return _NO
-        ax = res.ax
-        if ctl.card is not None or ctl.axes.get(n) is not ax:
-            return _NO
-        bank = ctl.bank
-        if bank is not None:  # (what the table path does first: before_axis_call, inline)
-            bank.dirty = True
-            if bank.n_alive and res.bank is bank:
-                bank.release_axis_object(ax)
-        if res.profile.mode is not mode:
-            return _NO
-        try:
-            b = to_bytes(res)
-        except Exception:  # (a value a field wraps: the Python path's field setters)
-            return _NO
-        session.last = None
-        return b
 
-    return _entry(gt, value, [cls], centry.BYTES, size, centry.GT_GATE)  # type: ignore[no-any-return]
+#: a structure reader's value for its C entry (asked while the GT_ gate is open: CTL the
+#: in-process lockstep controller): the structure's bytes (``{bytes}``: to_bytes' steps),
+#: else _NO
+_STRUCT_VALUE = """
+def value(n):
+    ctl = CTL
+    try:
+        res = ctl.resources[n]
+    except KeyError:  # no such axis: the table path says why
+        return _NO
+    ax = res.ax
+    if ctl.card is not None or ctl.axes.get(n) is not ax:
+        return _NO
+    bank = ctl.bank
+    if bank is not None:  # (what the table path does first: before_axis_call, inline)
+        bank.dirty = True
+        if bank.n_alive and res.bank is bank:
+            bank.release_axis_object(ax)
+    prof = res.profile
+    if prof.mode is not MODE:
+        return _NO
+    try:
+{bytes}
+    except Exception:  # (a value a field wraps: the Python path's field setters)
+        return _NO
+    session.last = None
+    return b
+"""
 
 
 #: the smart homing's status reader on the fast path (a homing loop polls it)

@@ -182,9 +182,11 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
             goto python;
         if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
             return array(e, args, nargs, kwnames, at);
-        if (nargs >= 3 + at && !int_is(args[at + 2], 1))
+        /* (the cached small ints 1 and 0 first: one compare for the common literals) */
+        if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
-        if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+        if (nargs >= 4 + at && args[at + 3] != A.none && args[at + 3] != A.zero &&
+            !int_is(args[at + 3], 0))
             goto python;
         p = args[at + 1];
     }
