@@ -188,9 +188,11 @@ class _Session:
 
     @core.setter
     def core(self, core: int) -> None:
+        changed = core != self._core
         self._core = core
         self.plain = self.local and core == 1
-        self.gates()
+        if changed:  # (a client's call names its core: most often the same one)
+            self.gates()
 
     @property
     def remote(self) -> Any:

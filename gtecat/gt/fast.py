@@ -527,8 +527,11 @@ def set_gates(gt: Any, gtn: Any) -> None:
     in-process lockstep controller the GT_ functions address with core 1, ``gtn`` the GTN_
     functions' core 1, or None.  The gated value functions read it as ``CTL`` / ``CTLN``,
     their C entries' gates open for it."""
+    new = [_OFF if gt is None else gt, _OFF if gtn is None else gtn]
+    if new[0] is GATED[0] and new[1] is GATED[1]:  # (the same: a client's call's select)
+        return
     centry.set_gates(False, False)
-    GATED[:] = [_OFF if gt is None else gt, _OFF if gtn is None else gtn]
+    GATED[:] = new
     for env in _GATED_ENVS:
         env["CTL"], env["CTLN"] = GATED
     centry.set_gates(gt is not None, gtn is not None)
