@@ -363,6 +363,9 @@ class AxisBank:
         self._stepping = -1
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._lists: dict[str, list[Any]] = {}
+        #: the flags the last list of GT_GetSts words was made from (a few rows) and that
+        #: list: made again only when one changed (a move, a jog and a rest last many runs)
+        self._sts_last: tuple[tuple[bytes, ...], list[int]] | None = None
         #: counts the claims and releases of rows (an axis's resources point at the bank or
         #: not): what the GT readers' plans of many axes at once check (gtecat.gt.fast)
         self.layout = 0
@@ -1667,17 +1670,36 @@ class AxisBank:
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
-                return [
+                moving, jog, arrived, frz, latched = (
+                    self.moving,
+                    self.jog,
+                    self.arrived,
+                    self.frz,
+                    self.latched,
+                )
+                flags = (
+                    moving.tobytes(),
+                    jog.tobytes(),
+                    arrived.tobytes(),
+                    frz.tobytes(),
+                    latched.tobytes(),
+                )
+                last = self._sts_last
+                if last is not None and last[0] == flags:
+                    return last[1]  # (the same words: every reader only reads the list)
+                words = [
                     (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
                     for m, j, a, f, lt in zip(
-                        self.moving.tolist(),
-                        self.jog.tolist(),
-                        self.arrived.tolist(),
-                        self.frz.tolist(),
-                        self.latched.tolist(),
+                        moving.tolist(),
+                        jog.tolist(),
+                        arrived.tolist(),
+                        frz.tolist(),
+                        latched.tolist(),
                         strict=True,
                     )
                 ]
+                self._sts_last = (flags, words)
+                return words
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
@@ -2073,9 +2095,8 @@ class AxisBank:
         position after a run of cycles needs neither the speed nor the acceleration)."""
         table, jog = _PLANNED[name]
         out = getattr(self, table).take(self.t_idx)
-        if self.n_jog:
-            j = self.jog
-            out[j] = getattr(self, jog)[j]
+        if self.n_jog:  # (the jogs' values where jog is set: one copy, no masked arrays)
+            np.copyto(out, getattr(self, jog), where=self.jog)
         if self.n_hm:  # a homing axis's plan holds its actual position
             for r in np.nonzero(self.hm & self.alive)[0].tolist():
                 out[r] = (

@@ -428,10 +428,11 @@ class Controller:
         """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles
         it is quiet in (``n`` -> :func:`_quiet_way`), and its object's ``cycles_passed``
         (None: it has none); looked up once while the hooks stay the same."""
-        pre = (*self.pre_cycle, *self.post_cycle)
         cached = self._hooks_seen
-        if cached is not None and cached[0] == pre:
-            return cached[1]
+        # (the lists compared as they stand: a hook added or taken away in place is seen)
+        if cached is not None and cached[0] == self.pre_cycle and cached[1] == self.post_cycle:
+            return cached[2]
+        pre = (*self.pre_cycle, *self.post_cycle)
         ways = tuple(
             (
                 _quiet_way(f),
@@ -439,13 +440,13 @@ class Controller:
             )
             for f in pre
         )
-        self._hooks_seen = (pre, ways)
+        self._hooks_seen = (list(self.pre_cycle), list(self.post_cycle), ways)
         return ways
 
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
     BATCH_CYCLES = 1000
     #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
-    _hooks_seen: tuple[tuple[Any, ...], Any] | None = None
+    _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle

@@ -29,17 +29,21 @@ from __future__ import annotations
 import ctypes
 import gc
 import gzip
+import hashlib
 import json
+import marshal
 import os
 import re
 import struct
+import sys
 import threading
 import zlib
+from array import array
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import accumulate, chain, compress, repeat
-from operator import contains, itemgetter, not_
+from operator import contains, is_, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -373,6 +377,8 @@ class Recorder(Listener):
         if self.path.suffix == ".gz":
             data = gzip.compress(data, 6)
         self.path.write_bytes(data)
+        del text, lines
+        _plan_ahead(self.path, data)
         return self.path
 
 
@@ -449,13 +455,22 @@ def _open(path: str | Path) -> tuple[Path, dict[str, Any], list[str]]:
     return p, head, body.split("\n") if body is not None else []
 
 
-def _open_text(path: str | Path) -> tuple[Path, dict[str, Any], str | None]:
-    """(path, header, the text after its line: None when there is none) of a recording."""
-    p = Path(path)
+def _read_raw(p: Path) -> bytes:
+    """A recording's bytes as they lie in its file."""
     try:
-        raw = p.read_bytes()
+        return p.read_bytes()
     except FileNotFoundError:
         raise ParameterError(f"{p}: no such recording") from None
+
+
+def _open_text(
+    path: str | Path, raw: bytes | None = None
+) -> tuple[Path, dict[str, Any], str | None]:
+    """(path, header, the text after its line: None when there is none) of a recording
+    (``raw``: its file's bytes, read already)."""
+    p = Path(path)
+    if raw is None:
+        raw = _read_raw(p)
     if raw[:2] == b"\x1f\x8b":
         try:
             raw = gzip.decompress(raw)
@@ -572,27 +587,169 @@ def replay(
     The recording's entries are read with the cyclic collector paused (a hundred thousand
     objects made at once, none in a cycle: the collector would walk them again and again
     while they are made, as Controller.init_ecat says of the bus model), and they are kept
-    out of its later walks while the calls run (``gc.freeze``)."""
-    p, head, body = _open_text(path)
+    out of its later walks while the calls run (``gc.freeze``).
+
+    The steps come from the recording's plan when one was kept for these very bytes
+    (:func:`_plan_file`: by ``gtecat record`` when it wrote the file, or by the replay
+    before), else from its text, and the plan is kept for the next replay."""
+    p = Path(path)
+    raw = _read_raw(p)
+    where = _plan_file(raw)
+    paused = gc.isenabled()
+    if paused:
+        gc.disable()
+    marks = None  # (a plan's: where the opens and bring-ups are)
+    freeze = False
+    try:
+        kept = _load_plan(where) if where is not None else None
+        steps = None
+        if kept is not None:
+            head, plan = kept
+            try:
+                steps = _steps(p, "", plan=plan)
+                marks = plan[5]
+            except ValueError:  # (a plan this gtecat does not make the same: the text)
+                steps = None
+        if steps is None:
+            p, head, body = _open_text(p, raw)
+            keep: list[Any] | None = [] if where is not None else None
+            steps = _steps(p, body or "", keep)
+            del body
+            if keep and keep[0] is not None and where is not None:
+                _keep_plan(where, head, keep[0])
+        del raw
+        entries = sum(map(is_, map(itemgetter(0), steps), repeat(None)))  # (not calls)
+        _check_count(p, head, len(steps) - entries)
+        # frozen before the collector runs again: it would walk every object just made
+        # (all of them young) at its first collection
+        freeze = gc.get_freeze_count() == 0  # (a process that froze its own: left so)
+        if freeze:
+            gc.freeze()
+    finally:
+        if paused:
+            gc.enable()
+    try:
+        with _where(head):
+            return _replay(steps, eni, machine, head.get("cwd"), marks)
+    finally:
+        if freeze:
+            gc.unfreeze()
+
+
+#: what a plan's file starts with, before the SHA-256 of the rest
+_PLAN_MAGIC = b"gtecat replay plan\n"
+#: the plans kept at most, and their bytes at most (the least recently used go first; the
+#: newest stays whatever its size)
+PLANS_KEPT = 64
+PLAN_BYTES = 256 << 20
+
+
+def _plan_file(raw: bytes) -> Path | None:
+    """Where the plan of a recording with these bytes is kept: gtecat's cache folder
+    (:func:`gtecat._cache.cache_root`), named by the SHA-256 of the bytes and of the
+    code that reads them (this module, the interpreter's version), so that a recording
+    changed by a single byte, or a gtecat that reads it another way, never finds the plan
+    of another; None when ``GTECAT_REPLAY_CACHE=0`` turns plans off."""
+    if os.environ.get("GTECAT_REPLAY_CACHE") == "0":
+        return None
+    from .._cache import cache_root
+
+    h = hashlib.sha256(_code_tag())
+    h.update(raw)
+    return cache_root() / "replay" / f"{h.hexdigest()[:48]}.plan"
+
+
+@lru_cache(maxsize=1)
+def _code_tag() -> bytes:
+    """The digest of the code that makes a plan: this module's source, the interpreter."""
+    h = hashlib.sha256(f"{sys.implementation.cache_tag} {FORMAT} {_PLAN}".encode())
+    try:
+        h.update(Path(__file__).read_bytes())
+    except OSError:
+        h.update(b"?")
+    return h.digest()
+
+
+def _load_plan(where: Path) -> tuple[dict[str, Any], Any] | None:
+    """(header, plan) kept in ``where``, None when there is none or it is damaged."""
+    try:
+        data = where.read_bytes()
+    except OSError:
+        return None
+    kept = _plan_from_bytes(data)
+    if kept is not None:
+        try:
+            os.utime(where)  # (used: the last to go)
+        except OSError:
+            pass
+    return kept
+
+
+def _plan_from_bytes(data: bytes) -> tuple[dict[str, Any], Any] | None:
+    """(header, plan) of a plan's file, None when it is damaged."""
+    start = len(_PLAN_MAGIC) + 32
+    if not data.startswith(_PLAN_MAGIC) or len(data) < start:
+        return None
+    if hashlib.sha256(memoryview(data)[start:]).digest() != data[len(_PLAN_MAGIC) : start]:
+        return None
+    try:
+        kept = marshal.loads(memoryview(data)[start:])
+    except (EOFError, ValueError, TypeError):
+        return None
+    if type(kept) is not tuple or len(kept) != 2 or type(kept[0]) is not dict:
+        return None
+    return kept
+
+
+def _keep_plan(where: Path, head: dict[str, Any], plan: Any) -> None:
+    """Keep a recording's plan in ``where`` (written under another name, then renamed);
+    only the :data:`PLANS_KEPT` most recently used stay, :data:`PLAN_BYTES` at most.  A
+    folder that takes no file only costs the next replay the reading of the text."""
+    try:
+        payload = marshal.dumps((head, plan))
+    except ValueError:  # (a value marshal does not take: none of JSON's)
+        return
+    try:
+        where.parent.mkdir(parents=True, exist_ok=True)
+        tmp = where.with_name(f"{where.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(_PLAN_MAGIC + hashlib.sha256(payload).digest() + payload)
+        os.replace(tmp, where)
+        plans = []
+        for f in where.parent.glob("*.plan"):
+            try:
+                st = f.stat()
+            except OSError:
+                continue
+            plans.append((st.st_mtime_ns, st.st_size, f))
+        total = 0
+        for k, (_, size, f) in enumerate(sorted(plans, key=itemgetter(0), reverse=True)):
+            total += size
+            if k and (k >= PLANS_KEPT or total > PLAN_BYTES):
+                f.unlink(missing_ok=True)
+    except OSError:
+        pass
+
+
+def _plan_ahead(path: Path, raw: bytes) -> None:
+    """Keep the plan of the recording just written to ``path`` (``raw``: its bytes), so
+    that its first replay need not read its text (:func:`replay`)."""
+    where = _plan_file(raw)
+    if where is None:
+        return
     paused = gc.isenabled()
     if paused:
         gc.disable()
     try:
-        steps = _steps(p, body or "")
+        p, head, body = _open_text(path, raw)
+        keep: list[Any] = []
+        _steps(p, body or "", keep)
+    except (ParameterError, ValueError, TypeError, RecursionError):
+        return  # (a replay reads the text and says what is wrong)
     finally:
         if paused:
             gc.enable()
-    del body
-    _check_count(p, head, sum(1 for call, _ in steps if call is not None))
-    freeze = gc.get_freeze_count() == 0  # (a process that froze its own objects: left so)
-    if freeze:
-        gc.freeze()
-    try:
-        with _where(head):
-            return _replay(steps, eni, machine, head.get("cwd"))
-    finally:
-        if freeze:
-            gc.unfreeze()
+    if keep and keep[0] is not None:
+        _keep_plan(where, head, keep[0])
 
 
 def _check_count(p: Path, head: dict[str, Any], found: int) -> None:
@@ -942,7 +1099,9 @@ def _form(e: dict[str, Any]) -> int:
     return n
 
 
-def _steps(p: Path, lines: list[str] | str) -> list[tuple[Any, Any]]:
+def _steps(
+    p: Path, lines: list[str] | str, keep: list[Any] | None = None, plan: Any = None
+) -> list[tuple[Any, Any]]:
     """The recording's entries made ready to run: ``(call, its values)`` for a call,
     ``(None, entry)`` for a checkpoint or a fault, ``(_Stop, why)`` where a call cannot be
     made again (reported when the replay gets there).
@@ -953,7 +1112,12 @@ def _steps(p: Path, lines: list[str] | str) -> list[tuple[Any, Any]]:
     clock and positions) share one prepared call: the line with those numbers taken out is
     the form's key, the numbers are read from the line (:data:`_NUMBER`, as JSON reads
     them) and the first line of each form is parsed and checked whole (:func:`_form`); a
-    line of any other form is parsed whole."""
+    line of any other form is parsed whole.
+
+    ``keep``: a list the steps' plan is appended to (:func:`_plan_of`: what a later replay
+    of the same text makes its steps from without reading the text again; None appended
+    when the recording has a step that stops the replay).  ``plan``: such a plan, made
+    ready instead of ``lines`` (ValueError: one this gtecat cannot take)."""
     from .. import gt
 
     pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
@@ -1022,6 +1186,7 @@ def _steps(p: Path, lines: list[str] | str) -> list[tuple[Any, Any]]:
                     call = prepare(e, key)[0]
                     if call is not _Stop and not call.checks and not call.fresh:
                         form = forms[form_key] = call
+                        form_lines[id(call)] = (call, key, len(vals))
             if form is not None:
                 if not form.packs:
                     return form, tuple(vals)
@@ -1035,6 +1200,13 @@ def _steps(p: Path, lines: list[str] | str) -> list[tuple[Any, Any]]:
         e = parse(key)
         return (None, e) if "c" not in e else prepare(e, key)
 
+    form_lines: dict[int, tuple[_Call, str, int]] = {}  # a form's call: (it, its line, values)
+    if plan is not None:
+        keys: list[str] = []  # (a plan's line that fails names no line: ValueError below)
+        try:
+            return _from_plan(plan, parse, prepare)
+        except (ParameterError, LookupError, TypeError, AttributeError) as err:
+            raise ValueError(f"a plan this gtecat cannot take: {err}") from None
     # a call's line without its time (from the comma after it), any other line whole; of a
     # recording's text, every line's at once (:data:`_KEY`)
     if type(lines) is str:
@@ -1076,7 +1248,98 @@ def _steps(p: Path, lines: list[str] | str) -> list[tuple[Any, Any]]:
     for key in made:
         if made[key] is None and key.strip():
             made[key] = step(key, None)
-    return [s for s in map(made.get, keys) if s is not None]
+    steps = [s for s in map(made.get, keys) if s is not None]
+    if keep is not None:
+        keep.append(_plan_of(made, keys, form_lines))
+    return steps
+
+
+#: the layout of a plan (:func:`_plan_of`); a plan of another is made again
+_PLAN = 3
+#: a unit of a plan that is no form: an entry (a checkpoint, a fault), a call made whole;
+#: form ``f`` is ``f + _FORMS``
+_ENTRY, _WHOLE, _FORMS = 0, 1, 2
+
+
+def _plan_of(
+    made: dict[str, Any], keys: list[str], form_lines: dict[int, tuple[_Call, str, int]]
+) -> tuple[Any, ...] | None:
+    """What :func:`_steps` made of a recording's text, as plain data a later replay makes the
+    same steps from (:func:`_from_plan`) without reading the text: the forms (their first
+    line, how many values), per distinct line (a *unit*) its form's number and values, or
+    the entry (:data:`_ENTRY`), or the line of a call made whole (:data:`_WHOLE`), and per
+    step its unit's number.  None when a step stops the replay (the text is read again, to
+    report it as it does)."""
+    number = {}
+    forms = []
+    for call, key, n in form_lines.values():
+        number[id(call)] = len(forms) + _FORMS
+        forms.append((key, n))
+    kinds = array("I")
+    values: list[Any] = []
+    unit: dict[str, int] = {}
+    for key, made_step in made.items():
+        if made_step is None:
+            continue
+        call, vals = made_step
+        if call is None:
+            kind = _ENTRY
+        elif call is _Stop:
+            return None
+        else:
+            kind = number.get(id(call), _WHOLE)
+            if kind == _WHOLE:
+                vals = key
+        unit[key] = len(values)
+        kinds.append(kind)
+        values.append(vals)
+    order = array("I", map(unit.__getitem__, filter(unit.__contains__, keys)))
+    # the steps :func:`_check_files` looks at (opens, bring-ups): found here once
+    asked = {
+        unit[key]
+        for key, made_step in made.items()
+        if made_step is not None and _asked(made_step[0])
+    }
+    marks = [i for i, u in enumerate(order) if u in asked] if asked else []
+    return (_PLAN, forms, kinds.tobytes(), values, order.tobytes(), marks)
+
+
+def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
+    """The steps of a plan (:func:`_plan_of`), each form's and each whole call's line parsed
+    and made ready as :func:`_steps` makes them (``parse``, ``prepare``: its own); ValueError
+    (or LookupError, TypeError) for a plan that is not one, or one whose lines do not make
+    the steps they made (another gtecat's functions)."""
+    version, forms, kinds_b, values, order_b, _ = plan
+    if version != _PLAN or type(values) is not list:
+        raise ValueError(f"plan layout {version!r}")
+    calls: list[Any] = []
+    for key, n in forms:
+        e = parse(key)
+        if _form(e) != n:
+            raise ValueError(f"a form of {n} values is not one: {key[:60]}")
+        call = prepare(e, key)[0]
+        if call is _Stop or call.checks or call.fresh:
+            raise ValueError(f"a form is not made the same: {key[:60]}")
+        calls.append(call)
+    kinds = array("I")
+    kinds.frombytes(kinds_b)
+    order = array("I")
+    order.frombytes(order_b)
+    if len(kinds) != len(values):
+        raise ValueError("units of no form")
+    # (a number past the end: IndexError, as the steps of no unit below)
+    calls[:0] = (None, _Stop)  # (_ENTRY: no call, _WHOLE: made below)
+    units = list(zip(map(calls.__getitem__, kinds), values, strict=True))
+    for i in compress(range(len(kinds)), map(_WHOLE.__eq__, kinds)):
+        key = values[i]
+        if type(key) is not str:
+            raise ValueError("a whole call's line is no text")
+        e = parse(key)
+        one = (None, e) if "c" not in e else prepare(e, key)
+        if one[0] is _Stop or one[0] is None:
+            raise ValueError(f"a call is not made the same: {key[:60]}")
+        units[i] = one
+    return list(map(units.__getitem__, order))
 
 
 #: each line of a recording's text as :func:`_steps` keys it: a line that starts ``{"t":``
@@ -1154,13 +1417,17 @@ class _Stop:
 
 
 def _replay(
-    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
+    steps: list[tuple[Any, Any]],
+    eni: str | None,
+    machine: str | None,
+    cwd: Any = None,
+    marks: Any = None,
 ) -> tuple[int, Divergence | None]:
     from .. import faults, gt
 
     eni = str(Path(eni).resolve()) if eni else None
     machine = str(Path(machine).resolve()) if machine else None
-    _check_files(steps, eni, machine, cwd)
+    _check_files(steps, eni, machine, cwd, marks)
     gt.GT_Close()
     n = 0
     try:
@@ -1210,17 +1477,44 @@ def _replay(
     return n, None
 
 
+#: the calls that bring a bus up from the files an open named
+_BRING_UP = frozenset({"GT_InitEcatComm", "GTN_InitEcatComm"})
+
+
+def _asked(p: Any) -> bool:
+    """A step :func:`_check_files` looks at: an open, a bring-up."""
+    return p is not None and p is not _Stop and (p.opens or p.name in _BRING_UP)
+
+
 def _check_files(
-    steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, cwd: Any = None
+    steps: list[tuple[Any, Any]],
+    eni: str | None,
+    machine: str | None,
+    cwd: Any = None,
+    marks: Any = None,
 ) -> None:
     """Refuse, before anything runs, a replay whose session brought a bus up from an ENI file
     or a machine description that is no longer where the recording found it (the folder it
     ran in, or the file itself, moved or deleted): which file, and how to give it instead.
-    The files of an open whose bring-up failed in the recording too are not asked for."""
+    The files of an open whose bring-up failed in the recording too are not asked for.
+    ``marks``: where the opens and bring-ups are among the steps (a plan's), else found
+    here."""
     opened: list[tuple[str, str, str]] = []  # (what, the file as named, the option)
-    for p, _ in steps:
-        if p is None or p is _Stop:
-            continue
+    picked = None
+    if type(marks) is list:
+        try:
+            picked = [steps[i][0] for i in marks]
+        except (IndexError, TypeError):
+            picked = None
+        if picked is not None and not all(map(_asked, picked)):
+            picked = None
+    if picked is None:
+        # the opens and bring-ups only, picked from the distinct calls (a few among many)
+        calls = list(map(itemgetter(0), steps))
+        distinct = dict(zip(map(id, calls), calls, strict=True))
+        asked = {i for i, p in distinct.items() if _asked(p)}
+        picked = list(compress(calls, map(asked.__contains__, map(id, calls))))
+    for p in picked:
         if p.opens:
             kw = p.kw or {}
             opened = []
@@ -1232,7 +1526,7 @@ def _check_files(
                 name = kw.get("machine", os.environ.get("GTECAT_MACHINE"))
                 if type(name) is str and name:
                     opened.append(("machine description", name, "--machine FILE"))
-        elif p.name in ("GT_InitEcatComm", "GTN_InitEcatComm") and p.rc == 0 and opened:
+        elif p.rc == 0 and opened:
             for what, name, option in opened:
                 if not Path(name).exists():
                     where = Path(name).resolve()

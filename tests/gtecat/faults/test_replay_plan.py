@@ -1,0 +1,170 @@
+"""A recording's plan: kept by the recorder, a replay makes its steps from it exactly as from
+the text (the same calls, values, entries, in the same order), and a recording that changed,
+a damaged plan or one this gtecat does not make the same is never used: the text is read
+(and a tampered call is reported as before).
+
+The session is tools/session_hard.py's (per-axis polling, a drive fault, SDO reads), for a
+fraction of a virtual second.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import gc
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from gtecat import gt
+from gtecat.errors import ParameterError
+from gtecat.faults import record as rec
+from tools import session_hard
+
+SECONDS = 0.4
+
+
+@pytest.fixture(autouse=True)
+def _closed():
+    gt.GT_Close()
+    yield
+    gt.GT_Close()
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory: pytest.TempPathFactory):
+    """gtecat's cache folder for these tests (its plans only)."""
+    folder = tmp_path_factory.mktemp("cache")
+    saved = {k: os.environ.get(k) for k in ("GTECAT_CACHE_DIR", "GTECAT_REPLAY_CACHE")}
+    os.environ["GTECAT_CACHE_DIR"] = str(folder)
+    os.environ.pop("GTECAT_REPLAY_CACHE", None)
+    yield folder
+    for k, v in saved.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
+
+
+@pytest.fixture(scope="module")
+def recorded(cache: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("plan") / "session.gtrec"
+    try:
+        session_hard.record(out, SECONDS, single=True)
+    finally:
+        gt.GT_Close()
+    return out
+
+
+def _where(path: Path) -> Path:
+    where = rec._plan_file(path.read_bytes())
+    assert where is not None
+    return where
+
+
+def _shape(steps: list) -> list:
+    """The steps as comparable data: an entry itself, a call by its name, values, code and
+    whether it runs compiled; the forms' sharing as the number of the first step of each."""
+    first: dict[int, int] = {}
+    out = []
+    for i, (p, vals) in enumerate(steps):
+        if p is None:
+            out.append(("entry", vals))
+        else:
+            out.append((p.name, vals, p.rc, p.run is None, first.setdefault(id(p), i)))
+    return out
+
+
+def test_the_recorder_keeps_the_plan_and_it_makes_the_same_steps(recorded: Path) -> None:
+    where = _where(recorded)
+    assert where.is_file()
+    head, plan = rec._load_plan(where)
+    p, head_text, body = rec._open_text(recorded)
+    assert head == head_text
+    gc.disable()
+    try:
+        from_text = rec._steps(p, body)
+        from_plan = rec._steps(p, "", plan=plan)
+    finally:
+        gc.enable()
+    assert len(from_plan) == len(from_text) > 1000
+    assert _shape(from_plan) == _shape(from_text)
+    kinds = {p.name for p, _ in from_plan if p is not None}
+    assert {"GT_GetSts", "GT_GetPrfPos", "GTE_Wait", "GT_Open"} <= kinds
+    assert any(p is None and "cp" in e for p, e in from_plan)  # checkpoints
+    # where the opens and bring-ups are (what the check of the files looks at)
+    marks = [i for i, (p, _) in enumerate(from_text) if rec._asked(p)]
+    assert plan[5] == marks and len(marks) >= 2
+    n, div = rec.replay(recorded)
+    assert div is None, str(div)
+    assert n == head["calls"]
+    # an ENI file the open named that is gone: named, with the plan's marks and without
+    i = marks[0]
+    gone = dataclasses.replace(from_plan[i][0], kw={"eni": str(recorded.parent / "gone.eni")})
+    steps = list(from_plan)
+    steps[i] = (gone, from_plan[i][1])
+    for way in (plan[5], None):
+        with pytest.raises(ParameterError, match=r"gone\.eni"):
+            rec._check_files(steps, None, None, None, way)
+
+
+def test_a_changed_recording_never_takes_the_plan_of_the_old(
+    recorded: Path, tmp_path: Path
+) -> None:
+    """One value of one call changed: another plan's name; the replay reads the text and
+    names the call (as it does without plans)."""
+    lines = recorded.read_text().splitlines()
+    k, e = next(
+        (i, json.loads(x))
+        for i, x in enumerate(lines)
+        if '"c":"GT_GetSts"' in x and '"o":' in x and i > len(lines) // 2
+    )
+    e["o"]["1"]["ref"]["v"] += 1
+    lines[k] = json.dumps(e, separators=(",", ":"))
+    bad = tmp_path / "bad.gtrec"
+    bad.write_text("\n".join(lines) + "\n")
+    assert _where(bad) != _where(recorded)
+    assert not _where(bad).exists()
+    div = rec.replay(bad)[1]
+    assert div is not None and div.call == "GT_GetSts" and "argument 2" in div.what
+    assert _where(bad).is_file()  # (kept for the next replay: the same report)
+    assert str(rec.replay(bad)[1]) == str(div)
+
+
+def test_a_damaged_or_foreign_plan_is_not_used(recorded: Path) -> None:
+    where = _where(recorded)
+    good = where.read_bytes()
+    try:
+        where.write_bytes(good[:-10] + bytes(10))  # (its digest no longer holds)
+        assert rec._load_plan(where) is None
+        # a plan that holds together but does not make the same steps (forms of one more
+        # value than their lines hold)
+        head, plan = rec._plan_from_bytes(good)
+        forms = [(key, n + 1) for key, n in plan[1]]
+        rec._keep_plan(where, head, (plan[0], forms, *plan[2:]))
+        with pytest.raises(ValueError):
+            rec._steps(Path("x"), "", plan=rec._load_plan(where)[1])
+        div = rec.replay(recorded)[1]
+        assert div is None, str(div)
+        assert rec._load_plan(where)[1][1] == plan[1]  # made again from the text
+    finally:
+        where.write_bytes(good)
+
+
+def test_plans_off_and_the_few_kept(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setenv("GTECAT_REPLAY_CACHE", "0")
+    assert rec._plan_file(b"x") is None
+    monkeypatch.delenv("GTECAT_REPLAY_CACHE")
+    monkeypatch.setattr(rec, "PLANS_KEPT", 2)
+    for k in range(3):
+        rec._keep_plan(tmp_path / f"{k}.plan", {}, None)
+        os.utime(tmp_path / f"{k}.plan", ns=(10**15 * (k + 1), 10**15 * (k + 1)))
+    rec._keep_plan(tmp_path / "3.plan", {}, None)
+    assert sorted(f.name for f in tmp_path.glob("*.plan")) == ["2.plan", "3.plan"]
+    assert rec._load_plan(tmp_path / "3.plan") == ({}, None)
+    # at most PLAN_BYTES: the newest stays whatever its size
+    monkeypatch.setattr(rec, "PLANS_KEPT", 10)
+    monkeypatch.setattr(rec, "PLAN_BYTES", 1000)
+    rec._keep_plan(tmp_path / "4.plan", {"x": "y" * 2000}, None)
+    assert sorted(f.name for f in tmp_path.glob("*.plan")) == ["4.plan"]
