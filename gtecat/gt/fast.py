@@ -432,8 +432,13 @@ def fast_reader(
         else _NO (the Python path answers)."""
 
         def f(n: int, count: int, tp: type, pClock: Any) -> Any:
-            if not (is_array(tp) and 1 <= count <= tp._length_):
-                return _NO
+            # (a shape seen before: its packer, kept only for an array the reader takes)
+            pack = packers.get((tp, count))
+            if pack is None:
+                if not (is_array(tp) and 1 <= count <= tp._length_):
+                    return _NO
+                # (the array's own element type, natively)
+                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
             clk = None
             if count == 1:
                 if pClock is not None and not (type(pClock) is int and pClock == 0):
@@ -449,15 +454,13 @@ def fast_reader(
                 ctl = GATED[0]
                 if ctl is _OFF:
                     return _NO
-                clk = clock_out(ctl, pClock)
-                if clk is False:
-                    return _NO
+                if pClock is not None and not (type(pClock) is int and pClock == 0):
+                    clk = clock_out(ctl, pClock)  # (NULL: None, without the call)
+                    if clk is False:
+                        return _NO
                 values = span(ctl, n, count, True)
                 if values is None:
                     return _NO
-            pack = packers.get((tp, count))
-            if pack is None:  # (the array's own element type, natively)
-                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
             try:
                 out = pack(*values)
             except struct.error:  # (a value the element does not hold: the Python path)
