@@ -42,6 +42,9 @@ def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
     # opening twice: -6 with Python's reason (bus_calls.GT_Open), the first open stays
     assert v["open_twice"] == "-6" and "already open" in v["open_twice_reason"]
     assert int(v["ready_polls"]) < 100
+    # declared-only functions (assembled on x86-64): each says which it is
+    assert v["declared_arc"] == v["declared_struct"] == "8" and v["declared_stack"] == "1"
+    assert "GTN_ArcXYCOverride2 is declared" in v["declared_arc_reason"]
     # a 200 ms usleep lets at least 200 ms of controller time pass (the wall floor)
     assert int(v["slept_ms"]) >= 200
     # raw data: slave 2's outputs at 32 read back; its inputs at 34 cannot be written

@@ -153,6 +153,15 @@ def _windows_programs(dll: windows.WindowsBuild, folder: Path, target: str) -> d
     return out
 
 
+def _assert_declared_calls(v: dict[str, str]) -> None:
+    """The DLL's assembled declared-only functions, as gtn_sequence.c called them: each says
+    its own name, and the stack is where it was (32-bit: each popped its argument bytes)."""
+    assert v["declared_arc"] == v["declared_struct"] == "8"
+    assert "GTN_ArcXYCOverride2 is declared" in v["declared_arc_reason"]
+    assert "GTN_SetScanPosSuperposeParameter is declared" in v["declared_struct_reason"]
+    assert v["declared_stack"] == "1"
+
+
 def test_windows_programs_under_wine_match_the_linux_library(
     dll_x86, tcp_controller, libgts, tmp_path
 ):
@@ -180,6 +189,7 @@ def test_windows_programs_under_wine_match_the_linux_library(
     assert (win["sdo_bad"], int(win["sdo_bad_abort"])) == ("1", 0x06020000)
     assert win["null_required"] == "7" and "pSts is NULL" in win["null_required_reason"]
     assert int(win["slept_ms"]) >= 200  # Sleep() in a Windows program lets controller time pass
+    _assert_declared_calls(win)
 
     r, v = _wine(programs["load"], env)
     assert (v.get("loaded"), v.get("found"), v.get("decorated")) == ("1", "1", "0"), r.stdout
@@ -331,6 +341,8 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
     for name in ("gtn", "load"):
         r, v = _wine(programs[name], env)
         assert r.returncode == 0 and v.get("done") == "1", r.stdout + r.stderr
+        if name == "gtn":
+            _assert_declared_calls(v)
     # a C++ application in the usual shape (a Motion class): bring-up, homing, a Trap move
     if shutil.which("x86_64-w64-mingw32-g++"):
         demo = programs["load"].parent / "motion_demo.exe"

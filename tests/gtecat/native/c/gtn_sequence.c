@@ -1,10 +1,11 @@
 /* The vendor demo's GTN sequence against gtecat's libgts, on examples/manual_fig5_2.eni:
  * bring-up polled with usleep, raw data, AxisOn, a Trap move, SDO with an abort code,
- * NULL optional pointers, a bad core.  Prints `key value` lines the test reads.
+ * NULL optional pointers, a bad core, declared-only functions.  Prints `key value` lines the test reads.
  *
  *     gcc gtn_sequence.c $(python3 -m gtecat lib --cflags --libs)
  */
 #define _DEFAULT_SOURCE /* usleep under -std=c99 too */
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -24,6 +25,14 @@ static const char *why(void)
 {
     GTE_GetLastError(reason, sizeof reason);
     return reason;
+}
+
+/* where this function's frame lies: the same before and after a call whose callee pops
+ * exactly the arguments it was given (32-bit Windows' __stdcall) */
+static intptr_t stack_mark(void)
+{
+    char here = 0;
+    return (intptr_t)&here;
 }
 
 int main(void)
@@ -138,6 +147,17 @@ int main(void)
     say("bad_core", GTN_GetSts(7, 1, &sts, 1, NULL));
     printf("bad_core_reason %s\n", why());
     say("bad_count", GTN_GetSts(CORE, 1, &sts, 0, NULL));
+
+    /* declared-only functions: a GTN twin (its core, longs and doubles), one taking a
+     * structure by value; each says which it is */
+    intptr_t mark = stack_mark();
+    say("declared_arc", GTN_ArcXYCOverride2(CORE, 1, 100, 200, 1.5, 2.5, 0, 10.0, 0.5, 0.0, 0));
+    printf("declared_arc_reason %s\n", why());
+    TScanPosSuperposeParamter superpose;
+    memset(&superpose, 0, sizeof superpose);
+    say("declared_struct", GTN_SetScanPosSuperposeParameter(CORE, 1, superpose));
+    printf("declared_struct_reason %s\n", why());
+    say("declared_stack", stack_mark() == mark);
 
     /* several values at once; GT_ spelling (core 1 implied) */
     long two[2] = {0, 0};
