@@ -180,6 +180,10 @@ class Controller:
         self.pre_cycle: list[Callable[[int, int], None]] = []
         self.post_cycle: list[Callable[[int, int], None]] = []
         self.sample: list[Callable[[int], None]] = []
+        #: looked at after every cycle *and* after every run of cycles at once
+        #: (:meth:`run_cycles`), so unlike ``sample`` it never stops such a run: for what only
+        #: reads the clock now and then (the status line of ``gtecat run``)
+        self.watch: list[Callable[[], None]] = []
         #: GT axes (1-based) once the bus is up
         self.axes: dict[int, Axis] = {}
         self._axis_list: list[Axis] = []
@@ -372,6 +376,8 @@ class Controller:
             f(t, dt)
         for f in self.sample:
             f(t + dt)  # stamped when the cycle's values become visible (= GT_GetClock after it)
+        for w in self.watch:
+            w()
 
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has
@@ -386,9 +392,13 @@ class Controller:
         run is under way, however long the compiled kernel holds this thread."""
         self.in_batch = True
         try:
-            return self._run_cycles(n)
+            done = self._run_cycles(n)
         finally:
             self.in_batch = False
+        if done:
+            for w in self.watch:
+                w()
+        return done
 
     def _run_cycles(self, n: int) -> int:
         bank = self.bank
