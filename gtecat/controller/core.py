@@ -272,6 +272,7 @@ class Controller:
         if self.master is not None:
             self.terminate_ecat()
         master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
+        master.mailbox_wait = self.clock.advance  # a lost SDO answer's wait: cycles run
         self.layout, self.backend, self.master = layout, backend, master
         self.started = False
         self.axes = {

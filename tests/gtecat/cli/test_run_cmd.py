@@ -222,7 +222,9 @@ def test_progress_line_during_a_long_run(
     monkeypatch.setattr(
         # (a wall clock a quarter second on per look: the axis bank runs up to 1000 cycles
         # between two looks, as many as make a quarter second of wall time on a slow machine)
-        run_cmd, "Progress", functools.partial(run_cmd.Progress, stream=tty, wall=_fake_wall(0.25))
+        run_cmd,
+        "Progress",
+        functools.partial(run_cmd.Progress, stream=tty, wall=_fake_wall(0.25)),
     )
     rc, _, _ = cli("run", str(_script(tmp_path, wait_ms=2000)), "--eni", FIG52)
     assert rc == 0
