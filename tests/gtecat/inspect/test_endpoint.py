@@ -254,3 +254,22 @@ def test_the_panel_ends_and_says_why_when_the_watched_gtecat_ends(app) -> None:
     app.GT_Close()
     t.join(20)
     assert not t.is_alive() and gone and gone[0]
+
+
+def test_the_fault_verbs_name_the_gtecat_they_act_on(app, capsys, monkeypatch) -> None:
+    # one account, several users: a fault injected without --attach says whose program it hit
+    (ep,) = runtime.endpoints()
+    assert main(["fault", "list"]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(f"attached to {ep.id} (pid {os.getpid()}, ") and "started 20" in err
+    assert main(["fault", "list", "--attach", ep.id]) == 0
+    assert capsys.readouterr().err == ""  # (named by the user)
+    # two running: none is taken, both are listed with pid, program and start time
+    other = runtime.EndpointInfo(**{**ep.__dict__, "id": "7", "pid": 7, "program": "cell.py"})
+    monkeypatch.setattr(runtime, "endpoints", lambda: [ep, other])
+    assert main(["fault", "inject", "drop_responses", "count=1"]) != 0
+    err = capsys.readouterr().err
+    assert "2 gtecats are running" in err and "7 (pid 7, cell.py, started 20" in err
+    assert f"{ep.id} (pid {os.getpid()}," in err
+    assert main(["fault", "list", "--attach", ep.id]) == 0
+    assert capsys.readouterr().out.strip() == "no fault armed or active"
