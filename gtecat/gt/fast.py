@@ -14,6 +14,7 @@ return codes and reasons stay the table's.  The fast answer is the table path's 
 from __future__ import annotations
 
 import ctypes
+import os
 import re
 import struct
 import sys
@@ -48,6 +49,19 @@ _AT = CARG_AT if CARG_AT is not None else -1
 _status = AxisResources.status
 #: a C ``short`` argument's range (the table binder's check of ``axis`` and ``count``)
 _SHORT_MIN, _SHORT_MAX = -(1 << 15), (1 << 15) - 1
+
+
+def pointee(p: Any) -> Any:
+    """``x`` for ``pointer(x)`` (or a pointer whose ``contents`` was set to ``x``) still
+    pointing at ``x``'s own memory, else None: a NULL pointer, or a cast of other memory (an
+    address, a smaller object, numpy's ``data_as``), whose size behind it nothing proves
+    (the table path refuses it with 7).  ctypes keeps that ``x`` in the pointer's own
+    ``_objects`` under ``'1'`` (its contents setter); the C entry checks the same."""
+    kept = p._objects
+    x = kept.get("1") if type(kept) is dict else None
+    if x is None or not p or ctypes.addressof(x) != ctypes.cast(p, ctypes.c_void_p).value:
+        return None
+    return x
 
 
 def _kept_refs() -> int:
@@ -221,8 +235,8 @@ def fast_reader(
             p[0] = get(res)
         elif tp is _NDARRAY and p.dtype in np_ok and p.ndim == 1 and p.size and p.flags.writeable:
             p[0] = get(res)
-        elif is_pointer(tp) and p:  # pointer(x), not a NULL pointer: x
-            p.contents.value = get(res)
+        elif is_pointer(tp) and (x := pointee(p)) is not None:  # pointer(x): x
+            x.value = get(res)
         else:
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
         if clk is not None:
@@ -493,9 +507,9 @@ def fast_reader(
     return public[0]  # type: ignore[no-any-return]
 
 
-#: the C entry of the readers where it is available (tests turn it off to hold the Python
-#: fast functions to the same answers)
-CENTRY = True
+#: the C entry of the readers where it is available (``GTECAT_CENTRY=0`` turns it off when
+#: gtecat is imported; tests turn it off to hold the Python fast functions to the same answers)
+CENTRY = os.environ.get("GTECAT_CENTRY", "1") != "0"
 
 
 def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:

@@ -37,6 +37,7 @@ struct api {
     ptrdiff_t bdata;      /* a bytes object's first byte */
     ptrdiff_t bastart;    /* a bytearray's first byte (its length: where a bytes object's is) */
     ptrdiff_t vc_entry;   /* a vectorcall callable's entry address (see centry.py) */
+    ptrdiff_t b_objects;  /* the objects a ctypes object keeps alive (pointer(x): {'1': x}) */
     obj carg_type;        /* the type of the pointer objects byref() makes */
     obj int_type;
     obj float_type;
@@ -46,12 +47,15 @@ struct api {
     obj none;
     obj zero; /* the int 0 (the return code) */
     obj one;  /* the int 1 (an omitted count) */
+    obj dict_type;
+    obj key_one; /* the str '1': where pointer(x) keeps x */
     void (*incref)(obj);
     void (*decref)(obj);
     obj (*vectorcall)(obj, obj const *, size_t, obj);
     long long (*as_ll)(obj, int *); /* PyLong_AsLongLongAndOverflow */
     obj (*err_occurred)(void);
     void (*err_clear)(void);
+    obj (*dict_get)(obj, obj); /* PyDict_GetItem: borrowed, no error left */
 };
 
 #define MAX_TYPES 16
@@ -84,7 +88,8 @@ int gtecat_centry_api(const struct api *api)
 {
     if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
         api->fval < 0 || api->bsize < 0 || api->bdata < 0 || api->bastart < 0 ||
-        api->vc_entry < 0 ||
+        api->vc_entry < 0 || api->b_objects < 0 || !api->dict_type || !api->key_one ||
+        !api->dict_get ||
         !api->bytearray_type || !api->carg_type ||
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
@@ -202,9 +207,24 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     if (!size)
         goto python;
     mem = AT(target, A.b_ptr);
-    if (deref) { /* pointer(x) itself (not a byref of it): x's memory, not NULL */
-        if (target != p || !mem || !(mem = *(char **)mem))
+    if (deref) {
+        /* pointer(x) itself (not a byref of it): x's memory, only where the pointer is
+         * pointer(x) (or p.contents = x) of an x it keeps and points at exactly; a cast of
+         * other memory (an address, a smaller object, numpy's data_as) cannot prove the size
+         * behind it: the Python path, and the table path's refusal */
+        char *to;
+        obj kept, x;
+        if (target != p || !mem || !(to = *(char **)mem))
             goto python;
+        kept = AT(p, A.b_objects);
+        if (!kept || TYPE(kept) != A.dict_type)
+            goto python;
+        x = A.dict_get(kept, A.key_one);
+        /* (x: what the contents setter kept, an instance of the pointer's type's _type_ or
+         * of a subclass, so at least size bytes; the pointer's own dict, never a base's) */
+        if (!x || AT(x, A.b_ptr) != to)
+            goto python;
+        mem = to;
     } else if (target != p && AT(p, A.carg_value) != mem) {
         goto python;
     }

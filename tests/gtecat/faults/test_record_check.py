@@ -18,7 +18,7 @@ from tests.conftest import EXAMPLES
 
 SCRIPT = textwrap.dedent(
     f"""
-    from ctypes import byref, c_long, c_short, c_ubyte, c_uint32
+    from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32
     from gtecat import faults, gt
 
     gt.GT_Open(eni={str(EXAMPLES / "full_servo.eni")!r}, clock="auto", log="")
@@ -46,6 +46,9 @@ SCRIPT = textwrap.dedent(
     gt.GT_Update(1)
     data, size, ab = (c_ubyte * 4)(), c_uint32(), c_uint32()
     gt.GT_EcatSDOUpload(0, 0x603F, 0, data, 4, byref(size), byref(ab))
+    enc = (c_double * 4)()
+    gt.GT_GetEncPos(1, byref(enc, 16), 1, None)  # C: &enc[2]
+    assert enc[2] != 0.0 and enc[0] == 0.0
     gt.GT_Close()
     """
 )
@@ -318,10 +321,17 @@ def test_recorded_values_come_back_as_they_were() -> None:
         float("-inf"),
         3,
         None,
+        ctypes.byref((ctypes.c_double * 4)(1, 2, 3, 4), 16),  # C: &arr[2]
+        ctypes.byref(ctypes.c_long(7), 0),
     ]
     for x in values:
         text = json.dumps(encode(x), allow_nan=False)
         assert json.dumps(encode(decode(json.loads(text))), allow_nan=False) == text
+    # the offset comes back: the same address into the same kind of object
+    from gtecat.gt.args import byref_address
+
+    again = decode(json.loads(json.dumps(encode(values[-2]))))
+    assert byref_address(again) - ctypes.addressof(again._obj) == 16
 
 
 C_PROGRAM = r"""
