@@ -404,20 +404,36 @@ class Master:
 
     # --- mailbox ------------------------------------------------------------------------
     def sdo_upload(
-        self, pos: int, index: int, subindex: int, complete_access: bool = False
+        self,
+        pos: int,
+        index: int,
+        subindex: int,
+        complete_access: bool = False,
+        *,
+        wait: bool = True,
     ) -> bytes:
+        """The object's bytes; ``wait=False``: a lost answer costs no controller time (the
+        inspection verbs, which run beside the application, never run its cycles)."""
         self._check_slave(pos)
-        lost = self._unanswered()
+        lost = self._unanswered() if wait else -1
         try:
             return self.backend.sdo_upload(pos, index, subindex, complete_access)
         finally:
             self._timed_out(lost)
 
     def sdo_download(
-        self, pos: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+        self,
+        pos: int,
+        index: int,
+        subindex: int,
+        data: bytes,
+        complete_access: bool = False,
+        *,
+        wait: bool = True,
     ) -> None:
+        """Write ``data`` to the object; ``wait`` as for :meth:`sdo_upload`."""
         self._check_slave(pos)
-        lost = self._unanswered()
+        lost = self._unanswered() if wait else -1
         try:
             self.backend.sdo_download(pos, index, subindex, data, complete_access)
         finally:

@@ -273,3 +273,17 @@ def test_the_fault_verbs_name_the_gtecat_they_act_on(app, capsys, monkeypatch) -
     assert f"{ep.id} (pid {os.getpid()}," in err
     assert main(["fault", "list", "--attach", ep.id]) == 0
     assert capsys.readouterr().out.strip() == "no fault armed or active"
+
+
+def test_a_lost_sdo_answer_over_the_endpoint_runs_none_of_the_applications_cycles(
+    app, capsys
+) -> None:
+    # the application's own SDO waits the master's mailbox timeout in its cycles; a verb
+    # beside it gets its 05040000h at once and leaves the application's clock alone
+    from gtecat import faults
+
+    faults.inject("mailbox_lost", slave=0, index=0x1018)
+    cycles = app.GTE_Controller().clock.cycles
+    assert main(["sdo", "upload", "0", "0x1018", "1"]) != 0
+    assert "0x05040000" in capsys.readouterr().err
+    assert app.GTE_Controller().clock.cycles == cycles
