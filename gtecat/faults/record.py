@@ -15,7 +15,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
 Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
 structure field by field, an array as its size and every value, which must agree, a buffer
-as hex); replay builds fresh
+as hex; a pointer into an object, ``byref(arr, 16)`` for C's ``&arr[2]``, with its byte
+offset: ``{"ref": ..., "off": 16}``); replay builds fresh
 objects of the same types, makes the same calls in the same order and compares every return
 code, every value the call leaves in its pointer arguments (written back or left as it was)
 and every checkpoint: the first difference is the
@@ -49,6 +50,7 @@ from typing import Any
 
 from .._bytecode import compiled as _compiled_code
 from ..errors import ParameterError
+from ..gt.args import byref_address
 from .tap import Listener, tap, untap
 
 CHECKPOINT_MS = 100
@@ -91,13 +93,29 @@ def _scalar(v: Any) -> Any:
 _INF = float("inf")
 
 
+def _offset(p: Any) -> int:
+    """The byte offset of ``byref(obj, offset)`` (0 for ``byref(obj)``, or a pointer object
+    that holds no ctypes object): a C program's ``&arr[8]``, kept so the replay passes the
+    same address into the same object."""
+    try:
+        return byref_address(p) - ctypes.addressof(p._obj)
+    except (TypeError, AttributeError):
+        return 0
+
+
 def encode(x: Any) -> Any:
-    """An argument as plain JSON (module docstring)."""
+    """An argument as plain JSON (module docstring); ``byref(obj, offset)`` keeps its offset
+    (``"off"``, bytes)."""
     if type(x) is _CArg:  # byref(c_long()), the usual pointer: the quick way to the same
+        off = _offset(x)
         name = _SIMPLE_NAME.get(type(x._obj))
-        if name is not None:
+        if name is not None and not off:
             v = x._obj.value
             return {"ref": {"c": name, "v": v if type(v) is int else _scalar(v)}}
+        out = {"ref": encode(x._obj)}
+        if off:
+            out["off"] = off
+        return out
     if x is None or isinstance(x, bool | int | str):
         return x
     if isinstance(x, float):
@@ -162,6 +180,9 @@ def decode(v: Any) -> Any:
     if "nan" in v or "inf" in v:
         return _unscalar(v)
     if "ref" in v:
+        off = v.get("off")
+        if type(off) is int and off:
+            return ctypes.byref(decode(v["ref"]), off)
         return ctypes.byref(decode(v["ref"]))
     if "c" in v:
         return _simple(v["c"])(_unscalar(v["v"]))

@@ -26,6 +26,7 @@ import functools
 import logging
 import struct
 import sys
+import types
 from collections.abc import Callable, Iterable
 from importlib import resources
 from typing import Any
@@ -53,6 +54,7 @@ class _Api(ctypes.Structure):
         ("bdata", ctypes.c_ssize_t),
         ("bastart", ctypes.c_ssize_t),
         ("vc_entry", ctypes.c_ssize_t),
+        ("b_objects", ctypes.c_ssize_t),
         ("carg_type", _VP),
         ("int_type", _VP),
         ("float_type", _VP),
@@ -62,12 +64,16 @@ class _Api(ctypes.Structure):
         ("none", _VP),
         ("zero", _VP),
         ("one", _VP),
+        ("dict_type", _VP),
+        ("key_one", _VP),
         ("incref", _VP),
         ("decref", _VP),
         ("vectorcall", _VP),
         ("as_ll", _VP),
         ("err_occurred", _VP),
         ("err_clear", _VP),
+        ("dict_get", _VP),
+        ("gate", _VP),
     ]
 
 
@@ -87,6 +93,7 @@ class _Entry(ctypes.Structure):
         ("derefs", ctypes.c_ssize_t * _MAX_TYPES),
         ("noaxis", ctypes.c_ssize_t),
         ("avalue", _VP),
+        ("gate", ctypes.c_ssize_t),
     ]
 
 
@@ -99,7 +106,22 @@ class _RawEntry(ctypes.Structure):
         ("sentinel", _VP),
         ("io", ctypes.c_ssize_t),
         ("write", ctypes.c_ssize_t),
+        ("gate", ctypes.c_ssize_t),
     ]
+
+
+#: the session's gates, read by every gated entry before it asks its value (written by
+#: :mod:`gtecat.gt._core` wherever their answer can change: :func:`set_gates`):
+#: [0] nonzero while the GT_ functions address the in-process lockstep controller of core 1,
+#: [1] while the GTN_ functions' core 1 is that controller
+GATES = (ctypes.c_ssize_t * 2)()
+#: an entry's gate: none, the GT_ functions', the GTN_ functions'
+NO_GATE, GT_GATE, GTN_GATE = 0, 1, 2
+
+
+def set_gates(gt: bool, gtn: bool) -> None:
+    """Open or close the two gates (:data:`GATES`)."""
+    GATES[0], GATES[1] = int(gt), int(gtn)
 
 
 #: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
@@ -114,6 +136,19 @@ def _float_at() -> int:
         if ctypes.c_double.from_address(id(x) + at).value != x:
             raise ValueError("a float's value is not where it is looked for")
     return at
+
+
+def _objects_at() -> int:
+    """Where a ctypes object keeps the objects it keeps alive (``_objects``: ``pointer(x)``'s
+    ``{'1': x}``; ValueError when the probe disagrees)."""
+    xs = [ctypes.c_long(3), ctypes.c_double(2.5), ctypes.c_short(1)]
+    ps = [ctypes.pointer(x) for x in xs]
+    ps.append(ctypes.cast(ps[0], ctypes.POINTER(ctypes.c_int)))  # ({id: object})
+    for k in range(_HEAD, sys.getsizeof(ps[0]) - _WORD + 1, _WORD):
+        if all(_VP.from_address(id(p) + k).value == id(p._objects) for p in ps):
+            if all(p._objects["1"] is x for p, x in zip(ps, xs, strict=False)):
+                return k
+    raise ValueError("a ctypes object's kept objects are not where they are looked for")
 
 
 def _bytes_at() -> tuple[int, int]:
@@ -192,6 +227,34 @@ class _TypeSpec(ctypes.Structure):
     ]
 
 
+def _pointer_type(t: type) -> type:
+    """``ctypes.POINTER(t)`` (:func:`_pointer_types_of_ctypes`)."""
+    p = ctypes.POINTER(t)
+    _pointer_types_of_ctypes()
+    return p
+
+
+def _pointer_types_of_ctypes() -> None:
+    """A pointer type ctypes made first for this module's code (its probes, its entries)
+    says it is ctypes': its repr would otherwise name this module in every ``pointer(x)``
+    of the user's."""
+    for p in list(ctypes._pointer_type_cache.values()):  # type: ignore[attr-defined]
+        if getattr(p, "__module__", None) == __name__:
+            p.__module__ = "ctypes"
+
+
+def by_name(name: str) -> Any:
+    """The public GT function ``name`` (how a pickled or copied one comes back: itself)."""
+    from .. import gt
+
+    return getattr(gt, name)
+
+
+def _bound(self: Any, obj: Any, cls: Any = None) -> Any:
+    """A function's ``__get__``: itself from a class, a bound method from an instance."""
+    return self if obj is None else types.MethodType(self, obj)
+
+
 def _callable_type() -> type:
     """A type whose instances are called the way built-in functions are (vectorcall: the
     C function whose address an instance holds right after its head, the entry's address
@@ -202,9 +265,10 @@ def _callable_type() -> type:
     T_PYSSIZET, READONLY = 19, 1
     Py_tp_call, Py_tp_members, Py_tp_getset = 50, 72, 73
     HAVE_VECTORCALL, DEFAULT = 1 << 11, 1 << 18
-    members = (_MemberDef * 3)(
+    members = (_MemberDef * 4)(
         _MemberDef(b"__vectorcalloffset__", T_PYSSIZET, _HEAD, READONLY, None),
         _MemberDef(b"__dictoffset__", T_PYSSIZET, _HEAD + 2 * _WORD, READONLY, None),
+        _MemberDef(b"__weaklistoffset__", T_PYSSIZET, _HEAD + 3 * _WORD, READONLY, None),
     )
     getset = (_GetSetDef * 2)(
         _GetSetDef(
@@ -221,12 +285,17 @@ def _callable_type() -> type:
         _TypeSlot(Py_tp_getset, ctypes.addressof(getset)),
     )
     spec = _TypeSpec(
-        b"gtecat.gt.centry.entry", _HEAD + 3 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
+        b"gtecat.gt.centry.entry", _HEAD + 4 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
     )
     make = ctypes.PYFUNCTYPE(ctypes.py_object, _VP)(("PyType_FromSpec", ctypes.pythonapi))
     t = make(ctypes.addressof(spec))
     _KEEP.append((members, getset, slots, spec, t))
     t.__repr__ = lambda self: f"<GT function {getattr(self, '__name__', '?')} (C entry)>"
+    # what a Python function does besides being called: pickled, copied and deep-copied as
+    # itself by its name (as a function is), bound as a method where a class holds it (so
+    # inspect.isroutine and pydoc take it for the function it is), weakly referenced
+    t.__reduce__ = lambda self: (by_name, (self.__name__,))
+    t.__get__ = _bound
     probe = t()
     probe.attribute = 1  # (an instance dict)
     if vars(probe) != {"attribute": 1}:
@@ -238,6 +307,8 @@ def _address(name: str) -> int:
     return ctypes.cast(getattr(ctypes.pythonapi, name), _VP).value or 0
 
 
+#: the key under which ``pointer(x)`` keeps ``x`` (the C entry looks it up; kept alive here)
+_KEY_ONE = "1"
 #: the entries made (kept alive: their C functions point at them)
 _KEEP: list[Any] = []
 #: (the reader maker, why it is not available)
@@ -252,6 +323,7 @@ def _load() -> tuple[Maker | None, str]:
         fval = _float_at()
         bsize, bdata = _bytes_at()
         bastart = _bytearray_at(bsize)
+        objects_at = _objects_at()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -269,6 +341,7 @@ def _load() -> tuple[Maker | None, str]:
             bdata,
             bastart,
             _HEAD + _WORD,  # (an entry callable's layout: _callable_type)
+            objects_at,
             id(type(ctypes.byref(ctypes.c_int()))),
             id(int),
             id(float),
@@ -278,12 +351,16 @@ def _load() -> tuple[Maker | None, str]:
             id(None),
             id(0),
             id(1),
+            id(dict),
+            id(_KEY_ONE),
             _address("Py_IncRef"),
             _address("Py_DecRef"),
             _address("PyObject_Vectorcall"),
             _address("PyLong_AsLongLongAndOverflow"),
             _address("PyErr_Occurred"),
             _address("PyErr_Clear"),
+            _address("PyDict_GetItem"),
+            ctypes.addressof(GATES),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -328,15 +405,17 @@ def _load() -> tuple[Maker | None, str]:
         pointers: bool = False,
         noaxis: bool = False,
         array: Callable[..., Any] | None = None,
+        gate: int = NO_GATE,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
-            kinds += tuple(ctypes.POINTER(t) for t in kinds)
+            kinds += tuple(_pointer_type(t) for t in kinds)
         if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
             raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
         e.noaxis = int(noaxis)
         e.avalue = id(array) if array is not None else None
+        e.gate = gate
         for k, t in enumerate(kinds):
             e.derefs[k] = int(issubclass(t, ctypes._Pointer))
             x = t._type_ if e.derefs[k] else t
@@ -353,8 +432,9 @@ def _load() -> tuple[Maker | None, str]:
         sentinel: Any,
         io: bool,
         write: bool,
+        gate: int = NO_GATE,
     ) -> Any:
-        e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write))
+        e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         keep = (fallback, value, sentinel)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
@@ -514,6 +594,24 @@ def _self_test(make: Maker) -> str:
             now = [sys.getrefcount(x) for x in watched]
             return f"the entry changed a reference count ({args!r}: {counts} -> {now})"
 
+    gated = [make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, None, g)
+             for g in (GT_GATE, GTN_GATE)]  # fmt: skip
+    before = tuple(GATES)
+    try:
+        for k, fn in enumerate(gated):
+            for on in (0, 1, 0):
+                GATES[k], GATES[1 - k] = on, 1 - on
+                o = L()
+                got = fn(1, ctypes.byref(o))
+                if not (
+                    (got == 0 and o.value == 7)
+                    if on
+                    else (type(got) is tuple and got[0] == "python" and o.value == 0)
+                ):
+                    return f"a gated entry answered {got!r} with its gate {on}"
+    finally:
+        GATES[0], GATES[1] = before
+
     def failing(n: Any) -> Any:
         raise LookupError(n)
 
@@ -606,6 +704,7 @@ def _self_test_raw(make_raw: Maker) -> str:
 
 
 _MAKE, REASON = _load()
+_pointer_types_of_ctypes()
 if _MAKE is None:
     log.debug("C entry of the fast readers not used: %s", REASON)
 
@@ -622,6 +721,7 @@ def reader(
     pointers: bool = False,
     noaxis: bool = False,
     array: Callable[..., Any] | None = None,
+    gate: int = NO_GATE,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -633,16 +733,26 @@ def reader(
     ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), pClock)`` (``count`` an
     int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
-    array's start (it checks the array's type and length), else anything but bytes.
+    array's start (it checks the array's type and length), else anything but bytes;
+    ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
+    that gate of :data:`GATES` is open (else ``fallback``), so they need not check the
+    session themselves.
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array)
+    return _MAKE(
+        fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array, gate
+    )
 
 
 def raw(
-    fallback: Callable[..., Any], value: Callable[..., Any], sentinel: Any, io: bool, write: bool
+    fallback: Callable[..., Any],
+    value: Callable[..., Any],
+    sentinel: Any,
+    io: bool,
+    write: bool,
+    gate: int = NO_GATE,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
     ctypes array (or ``byref`` of one, no offset), a bytearray of at least ``size`` bytes
@@ -651,11 +761,11 @@ def raw(
     (into the image where ``write``): ``(first byte in the array, address, bytes)`` as
     native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
     where the entry must not answer (it checks the array's type and size); every other
-    call: ``fallback``.  None where the
+    call: ``fallback``; ``gate``: as :func:`reader`'s.  None where the
     C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")

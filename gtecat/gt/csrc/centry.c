@@ -37,6 +37,7 @@ struct api {
     ptrdiff_t bdata;      /* a bytes object's first byte */
     ptrdiff_t bastart;    /* a bytearray's first byte (its length: where a bytes object's is) */
     ptrdiff_t vc_entry;   /* a vectorcall callable's entry address (see centry.py) */
+    ptrdiff_t b_objects;  /* the objects a ctypes object keeps alive (pointer(x): {'1': x}) */
     obj carg_type;        /* the type of the pointer objects byref() makes */
     obj int_type;
     obj float_type;
@@ -46,12 +47,19 @@ struct api {
     obj none;
     obj zero; /* the int 0 (the return code) */
     obj one;  /* the int 1 (an omitted count) */
+    obj dict_type;
+    obj key_one; /* the str '1': where pointer(x) keeps x */
     void (*incref)(obj);
     void (*decref)(obj);
     obj (*vectorcall)(obj, obj const *, size_t, obj);
     long long (*as_ll)(obj, int *); /* PyLong_AsLongLongAndOverflow */
     obj (*err_occurred)(void);
     void (*err_clear)(void);
+    obj (*dict_get)(obj, obj); /* PyDict_GetItem: borrowed, no error left */
+    /* the session's gates (gtecat.gt._core keeps them wherever their answer can change):
+     * [0] nonzero while the GT_ functions address the in-process lockstep controller of
+     * core 1, [1] while the GTN_ functions' core 1 is that controller */
+    const ptrdiff_t *gate;
 };
 
 #define MAX_TYPES 16
@@ -70,6 +78,7 @@ struct entry {
     ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
     ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
     obj avalue; /* NULL, or avalue(n, count, array type, pClock): a ctypes array's bytes */
+    ptrdiff_t gate; /* 0: none; k: value (and avalue) only while A.gate[k - 1] is nonzero */
 };
 
 static struct api A;
@@ -84,12 +93,13 @@ int gtecat_centry_api(const struct api *api)
 {
     if (api->carg_value < 0 || api->carg_obj < 0 || api->ob_type < 0 || api->b_ptr < 0 ||
         api->fval < 0 || api->bsize < 0 || api->bdata < 0 || api->bastart < 0 ||
-        api->vc_entry < 0 ||
+        api->vc_entry < 0 || api->b_objects < 0 || !api->dict_type || !api->key_one ||
+        !api->dict_get ||
         !api->bytearray_type || !api->carg_type ||
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
-        !api->err_occurred || !api->err_clear)
+        !api->err_occurred || !api->err_clear || !api->gate)
         return 1;
     A = *api;
     ready = 1;
@@ -162,7 +172,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     char *mem;
     int k, size = 0, sign = 1, deref = 0;
 
-    if (!ready || kwnames)
+    if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
     if (e->noaxis) {
         if (nargs < 1 || nargs > 2 || (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
@@ -177,9 +187,11 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
             goto python;
         if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
             return array(e, args, nargs, kwnames, at);
-        if (nargs >= 3 + at && !int_is(args[at + 2], 1))
+        /* (the cached small ints 1 and 0 first: one compare for the common literals) */
+        if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
-        if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+        if (nargs >= 4 + at && args[at + 3] != A.none && args[at + 3] != A.zero &&
+            !int_is(args[at + 3], 0))
             goto python;
         p = args[at + 1];
     }
@@ -202,9 +214,24 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     if (!size)
         goto python;
     mem = AT(target, A.b_ptr);
-    if (deref) { /* pointer(x) itself (not a byref of it): x's memory, not NULL */
-        if (target != p || !mem || !(mem = *(char **)mem))
+    if (deref) {
+        /* pointer(x) itself (not a byref of it): x's memory, only where the pointer is
+         * pointer(x) (or p.contents = x) of an x it keeps and points at exactly; a cast of
+         * other memory (an address, a smaller object, numpy's data_as) cannot prove the size
+         * behind it: the Python path, and the table path's refusal */
+        char *to;
+        obj kept, x;
+        if (target != p || !mem || !(to = *(char **)mem))
             goto python;
+        kept = AT(p, A.b_objects);
+        if (!kept || TYPE(kept) != A.dict_type)
+            goto python;
+        x = A.dict_get(kept, A.key_one);
+        /* (x: what the contents setter kept, an instance of the pointer's type's _type_ or
+         * of a subclass, so at least size bytes; the pointer's own dict, never a base's) */
+        if (!x || AT(x, A.b_ptr) != to)
+            goto python;
+        mem = to;
     } else if (target != p && AT(p, A.carg_value) != mem) {
         goto python;
     }
@@ -270,6 +297,7 @@ struct raw_entry {
     obj sentinel;
     ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
     ptrdiff_t write; /* 1: from the buffer into the image */
+    ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -294,7 +322,7 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     int over = 0;
     char *mem;
 
-    if (!ready || kwnames || nargs != 3 + at)
+    if (!ready || kwnames || nargs != 3 + at || (e->gate && !A.gate[e->gate - 1]))
         goto python;
     for (k = 0; k < 2 + at; k++)
         if (TYPE(args[k]) != A.int_type)

@@ -8,6 +8,7 @@ import subprocess
 import sys
 import textwrap
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -17,7 +18,7 @@ from tests.conftest import EXAMPLES
 
 SCRIPT = textwrap.dedent(
     f"""
-    from ctypes import byref, c_long, c_short, c_ubyte, c_uint32
+    from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32
     from gtecat import faults, gt
 
     gt.GT_Open(eni={str(EXAMPLES / "full_servo.eni")!r}, clock="auto", log="")
@@ -45,6 +46,9 @@ SCRIPT = textwrap.dedent(
     gt.GT_Update(1)
     data, size, ab = (c_ubyte * 4)(), c_uint32(), c_uint32()
     gt.GT_EcatSDOUpload(0, 0x603F, 0, data, 4, byref(size), byref(ab))
+    enc = (c_double * 4)()
+    gt.GT_GetEncPos(1, byref(enc, 16), 1, None)  # C: &enc[2]
+    assert enc[2] != 0.0 and enc[0] == 0.0
     gt.GT_Close()
     """
 )
@@ -317,10 +321,17 @@ def test_recorded_values_come_back_as_they_were() -> None:
         float("-inf"),
         3,
         None,
+        ctypes.byref((ctypes.c_double * 4)(1, 2, 3, 4), 16),  # C: &arr[2]
+        ctypes.byref(ctypes.c_long(7), 0),
     ]
     for x in values:
         text = json.dumps(encode(x), allow_nan=False)
         assert json.dumps(encode(decode(json.loads(text))), allow_nan=False) == text
+    # the offset comes back: the same address into the same kind of object
+    from gtecat.gt.args import byref_address
+
+    again = decode(json.loads(json.dumps(encode(values[-2]))))
+    assert byref_address(again) - ctypes.addressof(again._obj) == 16
 
 
 C_PROGRAM = r"""
@@ -381,3 +392,36 @@ def test_plugin_findings_are_warnings_at_the_application_line() -> None:
     (w,) = seen.list
     assert (w.filename, w.lineno) == ("/app/cell.py", 42)
     assert str(w.message).startswith("check: /app/cell.py:42: axis 3: GT_Update")
+
+
+def test_plugin_findings_fail_the_test_itself_when_warnings_are_errors() -> None:
+    """``-W error::...GtecatCheckWarning``: the findings of the test's call are warned as the
+    call ends, inside it, so pytest reports the test FAILED (not an ERROR of its teardown);
+    the ones warned there are not warned again at the teardown."""
+    import warnings
+
+    from gtecat import pytest_plugin as plugin
+    from gtecat.faults.checks import Finding, GtecatCheckWarning
+
+    class Outcome:
+        excinfo = None
+        forced: BaseException | None = None
+
+        def force_exception(self, e: BaseException) -> None:
+            self.forced = e
+
+    found = [Finding("cw-skip", "/app/t.py", n, f"axis {n}: skips") for n in (3, 4)]
+    item = SimpleNamespace(stash={plugin.CHECK_KEY: [SimpleNamespace(findings=found), 0]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GtecatCheckWarning)
+        hook = plugin.pytest_runtest_call(item)
+        next(hook)
+        outcome = Outcome()
+        with pytest.raises(StopIteration):
+            hook.send(outcome)
+    assert isinstance(outcome.forced, GtecatCheckWarning)
+    assert str(outcome.forced).splitlines() == [
+        "check: /app/t.py:3: axis 3: skips [CiA 402 state machine]",
+        "check: /app/t.py:4: axis 4: skips [CiA 402 state machine]",
+    ]
+    assert item.stash[plugin.CHECK_KEY][1] == 2  # the teardown warns from the third on

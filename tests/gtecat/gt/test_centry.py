@@ -18,9 +18,12 @@ runs them all (a broad sample of the readers').
 from __future__ import annotations
 
 import ctypes
+import os
 import random
 import shutil
+import subprocess
 import sys
+import types
 from ctypes import byref
 from pathlib import Path
 from typing import Any
@@ -78,6 +81,8 @@ KINDS = [
     "obj",
     "array",
     "pointer",
+    "cast",
+    "address",
     "numpy",
     "memoryview",
     "int",
@@ -112,6 +117,12 @@ def _arg(kind: str, t: type) -> tuple[Any, Any]:
     if kind == "pointer":
         o = t()
         return o, ctypes.pointer(o)
+    if kind == "cast":  # a pointer cast from a smaller object: no size behind it is proved
+        big = (ctypes.c_ubyte * 16)()
+        return big, ctypes.cast((ctypes.c_ubyte * 2).from_buffer(big), ctypes.POINTER(t))
+    if kind == "address":  # a pointer cast from an address (numpy's data_as is one)
+        o = t()
+        return o, ctypes.cast(ctypes.addressof(o), ctypes.POINTER(t))
     if kind == "numpy":
         o = np.zeros(2, np.dtype(t._type_))
         return o, o
@@ -183,7 +194,14 @@ def _call(fn: Any, gtn: bool, case: tuple, kw: bool) -> tuple:
 @needs_cc
 def test_the_c_entry_is_built_and_is_the_public_reader() -> None:
     assert centry.REASON == "", centry.REASON
-    for name in [*fast.READERS, *fast.RAW, fast.CLOCK, fast.HOMING, *fast.IO_READERS]:
+    for name in [
+        *fast.READERS,
+        *fast.RAW,
+        fast.CLOCK,
+        fast.HOMING,
+        fast.HOME_STATUS,
+        *fast.IO_READERS,
+    ]:
         fn = getattr(gt, name)
         assert hasattr(fn, "python"), name  # (the C entry in front)
         assert fn.__name__ == name and "(C entry)" in repr(fn) and fn.__doc__ == fn.slow.__doc__
@@ -193,6 +211,44 @@ def test_the_c_entry_is_built_and_is_the_public_reader() -> None:
     made = type(gt.GT_GetSts)()  # (an object of the entry type without its C function)
     with pytest.raises(TypeError):
         made(1, ctypes.c_long())
+
+
+@needs_cc
+def test_an_entry_is_used_as_a_function_is() -> None:
+    """Pickled, copied, weakly referenced, a routine to inspect and pydoc (its signature
+    shown), bound as a method where a class holds it, as the Python function it stands for;
+    and the pointer types its probes made first are ctypes' (their repr)."""
+    import copy
+    import inspect
+    import pickle
+    import pydoc
+    import weakref
+
+    for fn in (gt.GT_GetSts, gt.GTN_GetPrfPos, gt.GT_GetEcatRawData):
+        assert type(fn) is not types.FunctionType, "the C entry is not in front"
+        assert pickle.loads(pickle.dumps(fn)) is fn
+        assert copy.copy(fn) is fn and copy.deepcopy(fn) is fn
+        assert weakref.ref(fn)() is fn
+        assert inspect.isroutine(fn)
+    assert ("GT_GetSts", gt.GT_GetSts) in inspect.getmembers(gt, inspect.isroutine)
+    assert "GT_GetSts(axis, pSts, count=1, pClock=None)" in pydoc.render_doc(
+        gt.GT_GetSts, renderer=pydoc.plaintext
+    )
+
+    class Holder:
+        read = gt.GT_GetSts
+
+    assert Holder.read is gt.GT_GetSts
+    assert Holder().read.__func__ is gt.GT_GetSts  # (a bound method, as a function gives)
+    assert ctypes.POINTER(ctypes.c_long).__module__ == "ctypes"
+
+
+def test_gtecat_centry_0_leaves_the_python_functions() -> None:
+    """``GTECAT_CENTRY=0``: the public readers are the Python functions (read at import)."""
+    code = "from gtecat import gt; import types; print(type(gt.GT_GetSts) is types.FunctionType)"
+    env = {**os.environ, "GTECAT_CENTRY": "0"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == "True", out.stderr
 
 
 @needs_cc
@@ -277,6 +333,12 @@ TWO_ARG = {
     **{n: [1, 2, 3, 0, True, 1.0] for n in fast.ECAT_READERS},
     fast.HOMING: [1, 2, 3, 0, True, 1.0],
     **{n: [1, 2, 3, 0, True, 1.0] for n in fast.STRUCT_READERS},
+    fast.HOME_STATUS: [1, 2, 3, 0, True, 1.0],
+}
+#: the structure readers among them: function -> their structure
+STRUCTS = {
+    **{n: v[0] for n, v in fast.STRUCT_READERS.items()},
+    fast.HOME_STATUS: gt.THomeStatus,
 }
 TWO_ARG_TYPES = [
     ctypes.c_int32,
@@ -293,9 +355,9 @@ TWO_ARG_TYPES = [
 def _two_arg_cases() -> list[tuple]:
     out = []
     for name, firsts in sorted(TWO_ARG.items()):
-        types = [fast.STRUCT_READERS[name][0]] if name in fast.STRUCT_READERS else TWO_ARG_TYPES
+        types = [STRUCTS[name]] if name in STRUCTS else TWO_ARG_TYPES
         for kind in KINDS:
-            if name in fast.STRUCT_READERS and kind in ("numpy", "field"):
+            if name in STRUCTS and kind in ("numpy", "field"):
                 continue
             for t in types:
                 for first in firsts:
@@ -312,8 +374,9 @@ def _two_arg_cases() -> list[tuple]:
 def test_the_two_argument_readers_answer_as_their_python_path_and_the_table(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """GT_GetDi, GT_GetDiRaw, GT_GetDo, the PDO readers, the homing status and the Trap
-    parameters: with the C entry, without it, and the table path."""
+    """GT_GetDi, GT_GetDiRaw, GT_GetDo, the PDO readers, the homing status, the Trap
+    parameters and the smart homing's status: with the C entry, without it, and the table
+    path."""
     _open()
     gt.GT_PrfTrap(2)  # (axis 2 in Trap: its parameters readable; axis 1 moving in Trap)
     built = {}
@@ -462,3 +525,31 @@ def test_without_the_entry_type_the_entries_are_partials(monkeypatch: pytest.Mon
     s = ctypes.c_long()
     assert type(fn) is functools.partial
     assert (fn(1, byref(s)), s.value, fn(1, byref(s), 2)) == (0, 7, "python")
+
+
+def test_a_pointer_to_memory_of_unproved_size_is_refused_not_written_through() -> None:
+    """A ``POINTER(c_double)`` cast over 2 bytes at the end of a mapped page (reading
+    or writing 8 there would crash the process), over numpy float32s (``data_as``), or over
+    a bare address: the manual's 7 with the table path's reason, the memory untouched;
+    ``pointer(x)`` itself is still answered."""
+    import mmap
+
+    _open()
+    page = mmap.mmap(-1, mmap.PAGESIZE)
+    end = (ctypes.c_ubyte * 2).from_buffer(page, mmap.PAGESIZE - 2)
+    f32 = np.zeros(3, np.float32)
+    held = ctypes.c_double(-1.0)
+    try:
+        for fn in (gt.GT_GetPrfPos, gt.GT_GetEncPos):
+            for p in (
+                ctypes.cast(end, ctypes.POINTER(ctypes.c_double)),
+                f32.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                ctypes.cast(ctypes.addressof(held), ctypes.POINTER(ctypes.c_double)),
+            ):
+                assert fn(1, p) == 7, gt.GTE_GetLastError()
+                assert "pValue" in gt.GTE_GetLastError()
+        assert bytes(end) == b"\0\0" and not f32.any() and held.value == -1.0
+        assert gt.GT_GetSts(1, ctypes.cast(end, ctypes.POINTER(ctypes.c_long))) == 7
+        assert gt.GT_GetPrfPos(1, ctypes.pointer(held)) == 0 and held.value > 0.0
+    finally:
+        gt.GT_Close()  # (the page is unmapped when nothing holds it)
