@@ -142,18 +142,18 @@ def test_the_replay_process_ends_at_once_with_its_exit_handlers_run(
         "sys.argv = ['gtecat', 'replay', *sys.argv[1:]]\n"
         "sys.exit(main())\n"
     )
-    for path, code, said in ((recorded, 0, "calls match"), (bad, 1, "diverged at call")):
-        run = subprocess.run(
-            [sys.executable, "-c", program, str(path)],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-        )
-        assert run.returncode == code, run.stderr
-        assert said in run.stdout + run.stderr
-        assert run.stdout.rstrip().endswith("exit handler ran"), run.stdout
-        assert "taken apart" not in run.stdout  # (the normal exit would)
+    # (a divergence at the first status read: the same way out as a match, at less cost)
+    run = subprocess.run(
+        [sys.executable, "-c", program, str(bad)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert run.returncode == 1, run.stderr
+    assert "diverged at call" in run.stderr
+    assert run.stdout.rstrip().endswith("exit handler ran"), run.stdout
+    assert "taken apart" not in run.stdout  # (the normal exit would)
 
 
 def test_an_input_set_between_cycles_reaches_the_image() -> None:
