@@ -78,6 +78,8 @@ TRACE_KEY = pytest.StashKey[list]()
 ERRORS_KEY = pytest.StashKey[object]()
 RECORD_KEY = pytest.StashKey[Any]()
 LISTENERS_KEY = pytest.StashKey[list]()
+#: the ``--gtecat-check`` checker of a test, and how many of its findings were warned already
+CHECK_KEY = pytest.StashKey[list]()
 
 
 def _errors_seen() -> object:
@@ -360,6 +362,7 @@ def gtecat_bus(
 
         checker = Checker(io.StringIO()).start()  # its findings: warnings, at the end
         listeners.append(checker)
+        request.node.stash[CHECK_KEY] = [checker, 0]
     request.node.stash[LISTENERS_KEY] = listeners
     rc = gt.GT_Open(
         eni=str(gtecat_eni),
@@ -387,20 +390,51 @@ def gtecat_bus(
         gt._core.close_all()  # every card the test opened
         for listener in listeners:
             listener.stop()
-        if checker is not None:
-            _warn_findings(checker.findings)
+        if checker is not None:  # what the closing found (the test's own: at its end)
+            seen = request.node.stash.get(CHECK_KEY, [checker, 0])
+            _warn_findings(checker.findings[seen[1] :])
 
 
 def _warn_findings(findings: list[Any]) -> None:
     """The checks' findings as pytest warnings at the application's file and line: pytest
     shows them in its warnings summary, from every worker of an xdist run too (printed to
-    the test's stderr they were captured and shown only with ``-s`` or ``-rA``)."""
+    the test's stderr they were captured and shown only with ``-s`` or ``-rA``).  Where the
+    warnings filter makes them errors (``-W error::...GtecatCheckWarning``), one
+    GtecatCheckWarning raised with every finding, one per line."""
     import warnings
 
     from .faults.checks import GtecatCheckWarning
 
+    raised: list[str] = []
     for f in findings:
-        warnings.warn_explicit(str(f), GtecatCheckWarning, f.file, f.line)
+        try:
+            warnings.warn_explicit(str(f), GtecatCheckWarning, f.file, f.line)
+        except GtecatCheckWarning as e:
+            raised.append(str(e))
+    if raised:
+        raise GtecatCheckWarning("\n".join(raised))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_call(item: pytest.Item) -> Iterator[None]:
+    """A ``--gtecat-check`` test's findings are warned as its call ends, in the call itself:
+    turned into errors by the warnings filter, they fail the test (not its teardown); a
+    test that failed anyway has them warned at its teardown."""
+    outcome = yield
+    seen = item.stash.get(CHECK_KEY, None)
+    if seen is None or outcome.excinfo is not None:
+        return
+    checker, done = seen
+    seen[1] = len(checker.findings)
+    from .faults.checks import GtecatCheckWarning
+
+    try:
+        _warn_findings(checker.findings[done:])
+    except GtecatCheckWarning as e:
+        force = getattr(outcome, "force_exception", None)
+        if force is None:  # (pluggy before 1.1: raised from the wrapper)
+            raise
+        force(e)
 
 
 @pytest.fixture

@@ -16,7 +16,8 @@ clock, public GT API, axes beyond 32 on cores 2-4), each with its target and
 ones holding), 128 axes moving, 12 axes in Trap on the scalar path (bank off: what the modes
 outside the bank compare with); 64 axes homing (method 17); 64 axes in smart homing
 (``GT_GoHome`` modes 20 and 11, each homing timed from start to end with the axes' statuses
-polled every 100 ms); 64 axes homed and left in homing mode 6 (all holding, and half of them
+polled every 100 ms; every other mode likewise); the manual's figure 5-2 bus and one axis
+moving in Trap; 64 axes homed and left in homing mode 6 (all holding, and half of them
 with the other half moving in Trap); 12 axes homing (reported); PT,
 Gear, Follow and coordinated motion (crd) at 12 axes (reported) and 64 axes (target 10:
 every motion mode); two coordinate systems polled every cycle (GT_CrdStatus, GT_GetPrfPos),
@@ -48,6 +49,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 EXAMPLES = ROOT / "examples"
+#: the manual's figure 5-2 bus: 2 CSP drives and 2 IO slaves
+FIG5_2 = EXAMPLES / "manual_fig5_2.eni"
 
 
 def _bus(eni: Path, *, plain: bool):
@@ -755,7 +758,14 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         r |= run_gohome(n, mode, repeat=repeat)
         return r if target is None else _figure(r, "rtf", target)
 
+    def fig5_2() -> dict[str, object]:
+        r = {"axes": 2, "what": "the manual's figure 5-2 bus (2 drives, 2 IO slaves), both moving"}
+        r |= run_bus(2, every(2, "moving"), seconds=seconds, repeat=repeat, eni_file=FIG5_2)
+        return _figure(r, "rtf", 300)
+
     figures: dict[str, Callable[[], dict[str, object]]] = {
+        "rtf_fig5_2_trap": fig5_2,
+        "rtf_1_axis_trap": lambda: rtf(1, every(1, "moving"), 500, "one axis moving in Trap"),
         "rtf_12_axes_trap": lambda: rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
         "rtf_64_axes_32_trap_32_holding": lambda: rtf(
             64, half, 10, "odd axes moving in Trap, even axes enabled and holding"
@@ -765,6 +775,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
             12, every(12, "homing"), None, "drive homing method 17"
         ),
         "rtf_64_axes_homing_17": lambda: rtf(64, every(64, "homing"), 10, "drive homing method 17"),
+        "rtf_64_axes_gohome_10": lambda: gohome(64, 10, 10),
         "rtf_64_axes_gohome_20": lambda: gohome(64, 20, 10),
         "rtf_64_axes_gohome_11": lambda: gohome(64, 11, 10),
         "rtf_64_axes_gohome_12": lambda: gohome(64, 12, 10),

@@ -508,7 +508,8 @@ def start_gohome(axes: Sequence[int], mode: int) -> None:
     limit first (3.5 s), then the home switch on the way back; the index modes then look
     for the next index pulse slowly in the positive direction (in the negative one in mode
     12, which must search away from the limit), mode 30 fast for the first one ahead;
-    modes 40 and 41 take the home switch for their trigger."""
+    modes 40 and 41 take the home switch for their trigger; mode 10 the positive limit itself
+    (3.5 s), its home offset back off it."""
     gt = _gt()
     for a in axes:
         gtn("PrfTrap", a)
@@ -517,7 +518,8 @@ def start_gohome(axes: Sequence[int], mode: int) -> None:
         prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = mode, 1, index_dir, 0, -1
         prm.velHigh, prm.velLow = GOHOME_VEL_HIGH, GOHOME_VEL_LOW
         prm.acc = prm.dec = GOHOME_ACC
-        prm.homeOffset, prm.escapeStep = 100, 1000
+        # (mode 10's home is the positive limit itself: its offset goes back off it)
+        prm.homeOffset, prm.escapeStep = -100 if mode == 10 else 100, 1000
         gtn("GoHome", a, byref(prm))
 
 

@@ -2,7 +2,9 @@
 
 ``inject KIND key=value ...`` arms a fault on a running gtecat (``--attach ID``, else the
 only one ``gtecat ps`` lists: an application, a controller, or a ``gtecat serve``, whose
-master on the wire then sees it): the same kinds and keys as a machine description's
+master on the wire then sees it; taken without ``--attach``, the one it acts on is named on
+stderr, pid, program and start time, and with several running it acts on none and lists
+them): the same kinds and keys as a machine description's
 ``[[fault]]`` tables, a trigger among them (``at_ms=``, ``after_ms=``, ``after_cycles=``,
 ``when_position=AXIS,POS``, ``at_homing=AXIS,STAGE``, ``on_sdo=SLAVE,INDEX,N``; none: at
 once), ``duration_ms=`` for how long it lasts; each key once, with a value.  ``list``
@@ -13,6 +15,7 @@ kind with its values.
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from ..errors import BusError, ParameterError
@@ -105,6 +108,8 @@ def _connect(args: argparse.Namespace) -> Any:
             "no running gtecat to act on (gtecat ps lists them; an application publishes one "
             "when it calls GT_Open, a gtecat serve once it answers frames)"
         )
+    if not args.attach:  # the only one running: say which (another user's, on a shared id?)
+        print(f"attached to {found[0].who()}", file=sys.stderr)
     return found[1]
 
 

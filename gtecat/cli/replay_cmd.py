@@ -34,7 +34,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("file", type=Path, help="the recording")
     p.add_argument("--eni", help="replay on this ENI instead of the recorded one")
     p.add_argument("--machine", help="replay with this machine description")
-    p.set_defaults(func=run)
+    # (the process ends at once after the replay: its session is not taken apart)
+    p.set_defaults(func=run, leave_at_once=True)
 
 
 def run(args: argparse.Namespace) -> int:

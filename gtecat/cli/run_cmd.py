@@ -341,7 +341,10 @@ def run(args: argparse.Namespace) -> int:
                 recorders.append(Recorder(ctl, specs).start())
             except GtecatError as e:
                 raise _TraceFailed(str(e)) from None
-        ctl.sample.append(lambda _t: progress(ctl))
+        if progress.enabled:
+            # looked at after each cycle or run of cycles (Controller.watch), not a per-cycle
+            # sample: the axis bank keeps running many cycles at once under it
+            ctl.watch.append(lambda: progress(ctl))
 
     from .. import gt as gt_module
     from ..controller.core import Controller

@@ -180,6 +180,10 @@ class Controller:
         self.pre_cycle: list[Callable[[int, int], None]] = []
         self.post_cycle: list[Callable[[int, int], None]] = []
         self.sample: list[Callable[[int], None]] = []
+        #: looked at after every cycle *and* after every run of cycles at once
+        #: (:meth:`run_cycles`), so unlike ``sample`` it never stops such a run: for what only
+        #: reads the clock now and then (the status line of ``gtecat run``)
+        self.watch: list[Callable[[], None]] = []
         #: GT axes (1-based) once the bus is up
         self.axes: dict[int, Axis] = {}
         self._axis_list: list[Axis] = []
@@ -268,6 +272,7 @@ class Controller:
         if self.master is not None:
             self.terminate_ecat()
         master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
+        master.mailbox_wait = self._mailbox_wait
         self.layout, self.backend, self.master = layout, backend, master
         self.started = False
         self.axes = {
@@ -351,27 +356,45 @@ class Controller:
     # --- the cycle --------------------------------------------------------------------------
     def _cycle(self) -> None:
         for g in self.before_cycle:
-            g()
-        t = self.clock.now_ns
-        dt = self.clock.cycle_ns
-        bank = self.bank
-        if bank is not None:
-            bank.cycle(t, dt)  # the axes it runs, whole; the ones it lets go run below
-        for f in self.pre_cycle:
-            f(t, dt)
-        run = self._axis_list if bank is None else self._run_axes
-        for ax in run:
-            ax.pre(t, dt)
-        if self.master is not None:
-            self.master.cycle(t, dt)
-            if self.master.offline or self._links_down:
-                self._watch_links(self.master.offline)
-        for ax in run:
-            ax.post(t, dt)
-        for f in self.post_cycle:
-            f(t, dt)
-        for f in self.sample:
-            f(t + dt)  # stamped when the cycle's values become visible (= GT_GetClock after it)
+            g()  # (a motion program's GT call may wait for cycles here, as the application's)
+        self.cycling = True
+        try:
+            t = self.clock.now_ns
+            dt = self.clock.cycle_ns
+            bank = self.bank
+            if bank is not None:
+                bank.cycle(t, dt)  # the axes it runs, whole; the ones it lets go run below
+            for f in self.pre_cycle:
+                f(t, dt)
+            run = self._axis_list if bank is None else self._run_axes
+            for ax in run:
+                ax.pre(t, dt)
+            if self.master is not None:
+                self.master.cycle(t, dt)
+                if self.master.offline or self._links_down:
+                    self._watch_links(self.master.offline)
+            for ax in run:
+                ax.post(t, dt)
+            for f in self.post_cycle:
+                f(t, dt)
+            for f in self.sample:
+                # stamped when the cycle's values become visible (= GT_GetClock after it)
+                f(t + dt)
+            for w in self.watch:
+                w()
+        finally:
+            self.cycling = False
+
+    #: a cycle is running (:meth:`_cycle`, after its ``before_cycle`` hooks): an SDO made
+    #: inside it (a touch probe read by SDO) cannot wait for cycles
+    cycling = False
+
+    def _mailbox_wait(self, ms: float) -> None:
+        """A lost SDO answer: the master's mailbox timeout passes, cycles running
+        (:mod:`gtecat.master.bus` "Lost SDO answer"); not inside a cycle, where no cycle
+        can run (the next ones come after it anyway)."""
+        if not self.cycling:
+            self.clock.advance(ms)
 
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has
@@ -386,9 +409,13 @@ class Controller:
         run is under way, however long the compiled kernel holds this thread."""
         self.in_batch = True
         try:
-            return self._run_cycles(n)
+            done = self._run_cycles(n)
         finally:
             self.in_batch = False
+        if done:
+            for w in self.watch:
+                w()
+        return done
 
     def _run_cycles(self, n: int) -> int:
         bank = self.bank

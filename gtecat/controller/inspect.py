@@ -228,10 +228,15 @@ class BusView:
         return {"index": v.index, "subindex": v.subindex, "name": v.name, "type": v.data_type.name}
 
     def sdo_upload(self, slave: int, index: int, subindex: int) -> bytes:
-        return bytes(self.master.sdo_upload(self.check(slave), int(index), int(subindex)))
+        # (beside the application: a lost answer runs none of its cycles)
+        return bytes(
+            self.master.sdo_upload(self.check(slave), int(index), int(subindex), wait=False)
+        )
 
     def sdo_download(self, slave: int, index: int, subindex: int, data: bytes) -> None:
-        self.master.sdo_download(self.check(slave), int(index), int(subindex), bytes(data))
+        self.master.sdo_download(
+            self.check(slave), int(index), int(subindex), bytes(data), wait=False
+        )
 
     # --- sdos ----------------------------------------------------------------------------------
     def sdos(

@@ -488,6 +488,9 @@ class SdoClient:
         self.mailbox_size = mailbox_size
         self.max_size = max_size
         self.counter = 0
+        #: requests that got no answer (each ends the transfer with 0x05040000): a real
+        #: master waits its mailbox timeout for each (gtecat.master.bus.SDO_TIMEOUT_MS)
+        self.unanswered = 0
 
     # --- services -----------------------------------------------------------
     def upload(self, index: int, subindex: int, complete_access: bool = False) -> bytes:
@@ -530,6 +533,7 @@ class SdoClient:
         self.counter = next_counter(self.counter)
         answer = self._transfer(build_coe(CoeService.SDO_REQUEST, sdo, counter=self.counter))
         if answer is None:
+            self.unanswered += 1
             raise SdoAbort(SdoAbortCode.SDO_PROTOCOL_TIMED_OUT, index, subindex, "no answer")
         try:
             mbx = parse_mailbox(bytes(answer))

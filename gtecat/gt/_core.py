@@ -41,7 +41,7 @@ from ..errors import (
 )
 from ..master.clock import ClockGroup, ClockMode
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder, impl_params
-from .fast import FAST_MAKERS
+from .fast import FAST_MAKERS, set_gates
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -93,13 +93,64 @@ class LastError:
     clock_ms: int
 
 
+class _Cores(dict):
+    """A card's cores (core -> its controller): every change of it opens or closes the fast
+    readers' gates (:meth:`_Session.gates`)."""
+
+    __slots__ = ()
+
+    def __setitem__(self, key: Any, value: Any) -> None:
+        super().__setitem__(key, value)
+        _gates()
+
+    def __delitem__(self, key: Any) -> None:
+        super().__delitem__(key)
+        _gates()
+
+    def pop(self, *a: Any) -> Any:
+        try:
+            return super().pop(*a)
+        finally:
+            _gates()
+
+    def popitem(self) -> Any:
+        try:
+            return super().popitem()
+        finally:
+            _gates()
+
+    def clear(self) -> None:
+        super().clear()
+        _gates()
+
+    def setdefault(self, key: Any, default: Any = None) -> Any:
+        try:
+            return super().setdefault(key, default)
+        finally:
+            _gates()
+
+    def update(self, *a: Any, **kw: Any) -> None:
+        super().update(*a, **kw)
+        _gates()
+
+    def __ior__(self, other: Any) -> Any:
+        self.update(other)
+        return self
+
+
+def _gates() -> None:
+    session = globals().get("SESSION")
+    if session is not None:
+        session.gates()
+
+
 class _Session:
     """The open cards and cores (core 1 is the EtherCAT core), the current card, the
     error ring (:mod:`gtecat.controller.cards`)."""
 
     def __init__(self) -> None:
         #: card -> core -> its controller
-        self.cards: dict[int, dict[int, Controller]] = {0: {}}
+        self.cards: dict[int, dict[int, Controller]] = {0: _Cores()}
         #: the card GT_* calls address (GT_SetCardNo): one per process, as the vendor's
         self.card = 0
         #: the current card's cores (``cards[card]``)
@@ -118,6 +169,17 @@ class _Session:
         self.last: LastError | None = None  # the most recent call's failure; None after a 0
         #: a reason the running call leaves although it succeeds (:func:`note`)
         self.note: str | None = None
+        self.gates()
+
+    def gates(self) -> None:
+        """Open or close the fast readers' gates (:func:`fast.set_gates`): the controller
+        of core 1 of the current card where it runs in this process on the lockstep clock,
+        for the GT_ functions where they address core 1 too.  Called wherever one of those
+        can change (the card, the core, attaching, a card's cores; a controller's clock
+        mode is its own for good)."""
+        c = self.controllers.get(1)
+        on = c is not None and self._remote is None and c.clock.mode is ClockMode.LOCKSTEP
+        set_gates(c if on and self._core == 1 else None, c if on else None)
 
     @property
     def core(self) -> int:
@@ -126,8 +188,11 @@ class _Session:
 
     @core.setter
     def core(self, core: int) -> None:
+        changed = core != self._core
         self._core = core
         self.plain = self.local and core == 1
+        if changed:  # (a client's call names its core: most often the same one)
+            self.gates()
 
     @property
     def remote(self) -> Any:
@@ -140,12 +205,17 @@ class _Session:
         self._remote = remote
         self.local = remote is None
         self.plain = self.local and self._core == 1
+        self.gates()
 
     def select(self, card: int) -> None:
         """Make ``card`` the current card (GT_SetCardNo; checked by the caller)."""
         if card != self.card:
             self.card = card
-            self.controllers = self.cards.setdefault(card, {})
+            cores = self.cards.get(card)
+            if cores is None:
+                cores = self.cards[card] = _Cores()
+            self.controllers = cores
+            self.gates()
 
     @contextlib.contextmanager
     def selected(self, card: int, core: int | None = None) -> Iterator[None]:

@@ -33,6 +33,10 @@ Decisions where the manual is silent:
   multi-axis module ``object`` may be numbered as for channel 0 (0x6064) or as
   the axis's own channel (0x6864 on channel 1); another channel's object is
   refused (1), never read.
+* While the axis's slave is offline (comm loss) every read of one of its PDO objects
+  returns 1 naming the slave, by its own call (``GT_GetEcatEncPos`` ...) or by index
+  (``GT_GetEcatAxisPdoData``, ``GT_GetEcatAxisMode``, the torque reads): the bytes there
+  are the last received, not the drive's (:func:`reachable`).
 """
 
 from __future__ import annotations
@@ -143,20 +147,28 @@ def GT_SetEcatAxisMode(ctl: Controller, axis: int, mode: int) -> int:
 
 @gt_function
 def GT_GetEcatAxisMode(ctl: Controller, axis: int, pMode: Any) -> int:
-    store(pMode, bus_axis(ctl, axis).io.read(0x6061))
+    ax = bus_axis(ctl, axis)
+    reachable(ax, 0x6061)
+    store(pMode, ax.io.read(0x6061))
     return 0
+
+
+def reachable(ax: Axis, index: int) -> None:
+    """1 when the axis's slave is offline (comm loss): its PDO objects hold the last bytes
+    received, not the drive's; every GT read of an axis's PDO object asks this first."""
+    # read past the axis bank's guard: looking must not give a banked axis back
+    lost = object.__getattribute__(ax, "link_lost")
+    if lost:
+        raise CommandError(
+            f"axis {ax.number}: {lost}: 0x{index:04X} cannot be read (check the slave, its "
+            "cable and the EtherCAT communication)"
+        )
 
 
 def _reader(index: int, subindex: int = 0):
     def read(ctl: Controller, axis: int, ptr: Any) -> int:
         ax = bus_axis(ctl, axis)
-        # read past the axis bank's guard: looking must not give a banked axis back
-        lost = object.__getattribute__(ax, "link_lost")
-        if lost:  # the bytes there are the last received, not the drive's
-            raise CommandError(
-                f"axis {axis}: {lost}: 0x{index:04X} cannot be read (check the slave, its "
-                "cable and the EtherCAT communication)"
-            )
+        reachable(ax, index)
         store(ptr, ax.io.read(index, subindex))
         return 0
 
@@ -190,7 +202,10 @@ def GT_SetEcatAxisDO(ctl: Controller, axis: int, DoValue: int) -> int:
 def GT_GetEcatAxisAI(ctl: Controller, axis: int, channel: int, pValue: Any) -> int:
     """Analog input ``channel`` 1 -> 20F2h, 2 -> 20F9h (the objects entry 34 names)."""
     channel = check_range("channel", channel, 1, 2)
-    store(pValue, bus_axis(ctl, axis).io.read(0x20F2 if channel == 1 else 0x20F9))
+    ax = bus_axis(ctl, axis)
+    index = 0x20F2 if channel == 1 else 0x20F9
+    reachable(ax, index)
+    store(pValue, ax.io.read(index))
     return 0
 
 
@@ -241,6 +256,7 @@ def GT_GetEcatAxisPdoData(ctl: Controller, axis: int, object: int, pData: Any) -
     ax = bus_axis(ctl, axis)
     check_range("object", object, 0, 0xFFFF)
     acc = ax.io.require(int(object), 0)
+    reachable(ax, int(object))
     value = acc.get()
     n = (acc.bits + 7) // 8
     store_bytes(pData, (value & ((1 << (8 * n)) - 1)).to_bytes(n, "little"))

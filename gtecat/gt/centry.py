@@ -73,6 +73,7 @@ class _Api(ctypes.Structure):
         ("err_occurred", _VP),
         ("err_clear", _VP),
         ("dict_get", _VP),
+        ("gate", _VP),
     ]
 
 
@@ -92,6 +93,7 @@ class _Entry(ctypes.Structure):
         ("derefs", ctypes.c_ssize_t * _MAX_TYPES),
         ("noaxis", ctypes.c_ssize_t),
         ("avalue", _VP),
+        ("gate", ctypes.c_ssize_t),
     ]
 
 
@@ -104,7 +106,22 @@ class _RawEntry(ctypes.Structure):
         ("sentinel", _VP),
         ("io", ctypes.c_ssize_t),
         ("write", ctypes.c_ssize_t),
+        ("gate", ctypes.c_ssize_t),
     ]
+
+
+#: the session's gates, read by every gated entry before it asks its value (written by
+#: :mod:`gtecat.gt._core` wherever their answer can change: :func:`set_gates`):
+#: [0] nonzero while the GT_ functions address the in-process lockstep controller of core 1,
+#: [1] while the GTN_ functions' core 1 is that controller
+GATES = (ctypes.c_ssize_t * 2)()
+#: an entry's gate: none, the GT_ functions', the GTN_ functions'
+NO_GATE, GT_GATE, GTN_GATE = 0, 1, 2
+
+
+def set_gates(gt: bool, gtn: bool) -> None:
+    """Open or close the two gates (:data:`GATES`)."""
+    GATES[0], GATES[1] = int(gt), int(gtn)
 
 
 #: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
@@ -343,6 +360,7 @@ def _load() -> tuple[Maker | None, str]:
             _address("PyErr_Occurred"),
             _address("PyErr_Clear"),
             _address("PyDict_GetItem"),
+            ctypes.addressof(GATES),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -387,6 +405,7 @@ def _load() -> tuple[Maker | None, str]:
         pointers: bool = False,
         noaxis: bool = False,
         array: Callable[..., Any] | None = None,
+        gate: int = NO_GATE,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -396,6 +415,7 @@ def _load() -> tuple[Maker | None, str]:
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
         e.noaxis = int(noaxis)
         e.avalue = id(array) if array is not None else None
+        e.gate = gate
         for k, t in enumerate(kinds):
             e.derefs[k] = int(issubclass(t, ctypes._Pointer))
             x = t._type_ if e.derefs[k] else t
@@ -412,8 +432,9 @@ def _load() -> tuple[Maker | None, str]:
         sentinel: Any,
         io: bool,
         write: bool,
+        gate: int = NO_GATE,
     ) -> Any:
-        e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write))
+        e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         keep = (fallback, value, sentinel)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
@@ -573,6 +594,24 @@ def _self_test(make: Maker) -> str:
             now = [sys.getrefcount(x) for x in watched]
             return f"the entry changed a reference count ({args!r}: {counts} -> {now})"
 
+    gated = [make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, None, g)
+             for g in (GT_GATE, GTN_GATE)]  # fmt: skip
+    before = tuple(GATES)
+    try:
+        for k, fn in enumerate(gated):
+            for on in (0, 1, 0):
+                GATES[k], GATES[1 - k] = on, 1 - on
+                o = L()
+                got = fn(1, ctypes.byref(o))
+                if not (
+                    (got == 0 and o.value == 7)
+                    if on
+                    else (type(got) is tuple and got[0] == "python" and o.value == 0)
+                ):
+                    return f"a gated entry answered {got!r} with its gate {on}"
+    finally:
+        GATES[0], GATES[1] = before
+
     def failing(n: Any) -> Any:
         raise LookupError(n)
 
@@ -682,6 +721,7 @@ def reader(
     pointers: bool = False,
     noaxis: bool = False,
     array: Callable[..., Any] | None = None,
+    gate: int = NO_GATE,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -693,16 +733,26 @@ def reader(
     ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), pClock)`` (``count`` an
     int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
-    array's start (it checks the array's type and length), else anything but bytes.
+    array's start (it checks the array's type and length), else anything but bytes;
+    ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
+    that gate of :data:`GATES` is open (else ``fallback``), so they need not check the
+    session themselves.
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE(fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array)
+    return _MAKE(
+        fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array, gate
+    )
 
 
 def raw(
-    fallback: Callable[..., Any], value: Callable[..., Any], sentinel: Any, io: bool, write: bool
+    fallback: Callable[..., Any],
+    value: Callable[..., Any],
+    sentinel: Any,
+    io: bool,
+    write: bool,
+    gate: int = NO_GATE,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
     ctypes array (or ``byref`` of one, no offset), a bytearray of at least ``size`` bytes
@@ -711,11 +761,11 @@ def raw(
     (into the image where ``write``): ``(first byte in the array, address, bytes)`` as
     native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
     where the entry must not answer (it checks the array's type and size); every other
-    call: ``fallback``.  None where the
+    call: ``fallback``; ``gate``: as :func:`reader`'s.  None where the
     C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")

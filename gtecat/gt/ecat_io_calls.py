@@ -23,7 +23,7 @@ from ..controller.core import Controller
 from ..controller.digital_io import GPIO_COUNT, digital_io
 from ..errors import ParameterError
 from ._core import check_range, gt_function, store_bytes
-from .axis_calls import bus_axis
+from .axis_calls import bus_axis, reachable
 from .bus_calls import _region
 
 _DO = 0x60FE
@@ -108,6 +108,8 @@ def GT_RelateEcatSlaveToMcGpoBit(
 @gt_function
 def GT_GetEcatAxisDOBit(ctl: Controller, axis: int, bitIndex: int, pValue: Any) -> int:
     """Bit ``bitIndex`` of the 60FEh:01 sent to the drive of ``axis``."""
-    value = int(bus_axis(ctl, axis).io.read(_DO, 1)) & 0xFFFFFFFF
+    ax = bus_axis(ctl, axis)
+    reachable(ax, _DO)
+    value = int(ax.io.read(_DO, 1)) & 0xFFFFFFFF
     store_bytes(pValue, bytes([value >> int(bitIndex) & 1]))
     return 0

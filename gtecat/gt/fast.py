@@ -446,8 +446,13 @@ def fast_reader(
         else _NO (the Python path answers)."""
 
         def f(n: int, count: int, tp: type, pClock: Any) -> Any:
-            if not (is_array(tp) and 1 <= count <= tp._length_):
-                return _NO
+            # (a shape seen before: its packer, kept only for an array the reader takes)
+            pack = packers.get((tp, count))
+            if pack is None:
+                if not (is_array(tp) and 1 <= count <= tp._length_):
+                    return _NO
+                # (the array's own element type, natively)
+                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
             clk = None
             if count == 1:
                 if pClock is not None and not (type(pClock) is int and pClock == 0):
@@ -459,22 +464,17 @@ def fast_reader(
             else:
                 if not spans or count > limit:
                     return _NO
-                try:
-                    ctl = session.controllers[1]
-                except KeyError:  # no controller
+                # (the GT_ form's entry asks only while the GT_ gate is open: its controller)
+                ctl = GATED[0]
+                if ctl is _OFF:
                     return _NO
-                # (a lockstep clock never runs a thread of its own: real time only has one)
-                if not (session.plain and ctl.clock.mode is _LOCKSTEP):
-                    return _NO
-                clk = clock_out(ctl, pClock)
-                if clk is False:
-                    return _NO
+                if pClock is not None and not (type(pClock) is int and pClock == 0):
+                    clk = clock_out(ctl, pClock)  # (NULL: None, without the call)
+                    if clk is False:
+                        return _NO
                 values = span(ctl, n, count, True)
                 if values is None:
                     return _NO
-            pack = packers.get((tp, count))
-            if pack is None:  # (the array's own element type, natively)
-                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
             try:
                 out = pack(*values)
             except struct.error:  # (a value the element does not hold: the Python path)
@@ -490,16 +490,18 @@ def fast_reader(
         env["NOPE"] = _NO
         kind = centry.DOUBLE if ctypes_ok is _DOUBLE else centry.INT
         types = sorted(ctypes_ok, key=str)
-        value_gt = _value_function(env, "value_gt", "session.plain")
-        value_gtn = _value_function(env, "value_gtn", "session.local")
+        _gated(env)
+        value_gt = _value_function(env, "value_gt", "CTL")
+        value_gtn = _value_function(env, "value_gtn", "CTLN")
         entry = centry.reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
-            array=array_value(value_gt, True),
+            array=array_value(value_gt, True), gate=centry.GT_GATE,
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, False),
+            gate=centry.GTN_GATE,
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
@@ -512,15 +514,65 @@ def fast_reader(
 CENTRY = os.environ.get("GTECAT_CENTRY", "1") != "0"
 
 
-def _entry(gt: Any, value: Callable[[Any], Any], types: Any, kind: int, size: int = 0) -> Any:
+class _Off:
+    """The controller a gated value function sees while its gate is closed: no axis, no
+    input (its C entry does not ask it then; a direct call answers _NO)."""
+
+    resources: dict = {}  # noqa: RUF012 - never written
+    axes: dict = {}  # noqa: RUF012
+    input_plans: dict = {}  # noqa: RUF012
+    master = bank = card = None
+
+
+_OFF = _Off()
+#: the controllers behind the two gates (centry.GATES): the GT_ functions', the GTN_ ones'
+#: (_OFF: closed); the globals ``CTL`` and ``CTLN`` of every gated value function's module
+GATED: list[Any] = [_OFF, _OFF]
+_GATED_ENVS: list[dict[str, Any]] = []
+
+
+def _gated(env: dict[str, Any]) -> dict[str, Any]:
+    """``env`` (a gated value function's globals) given the gates' controllers, and kept
+    up to date by :func:`set_gates`."""
+    env["CTL"], env["CTLN"] = GATED
+    _GATED_ENVS.append(env)
+    return env
+
+
+def set_gates(gt: Any, gtn: Any) -> None:
+    """The session's answer (gtecat.gt._core: wherever it can change): ``gt`` the
+    in-process lockstep controller the GT_ functions address with core 1, ``gtn`` the GTN_
+    functions' core 1, or None.  The gated value functions read it as ``CTL`` / ``CTLN``,
+    their C entries' gates open for it."""
+    new = [_OFF if gt is None else gt, _OFF if gtn is None else gtn]
+    if new[0] is GATED[0] and new[1] is GATED[1]:  # (the same: a client's call's select)
+        return
+    centry.set_gates(False, False)
+    GATED[:] = new
+    for env in _GATED_ENVS:
+        env["CTL"], env["CTLN"] = GATED
+    centry.set_gates(gt is not None, gtn is not None)
+
+
+def _entry(
+    gt: Any,
+    value: Callable[[Any], Any],
+    types: Any,
+    kind: int,
+    size: int = 0,
+    gate: int = centry.NO_GATE,
+) -> Any:
     """A two-argument reader's public function: its C entry in front of its Python fast
     function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
-    :data:`CENTRY` is on and the entry is available; else ``gt``."""
+    :data:`CENTRY` is on and the entry is available; else ``gt``; ``gate``: as
+    :func:`centry.reader`'s."""
     if not CENTRY:
         return gt
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
-    entry = centry.reader(gt, value, _NO, sorted(types, key=str), kind, most=2, size=size)
+    entry = centry.reader(
+        gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate
+    )
     if entry is None:
         return gt
     entry.slow, entry.python = gt.slow, gt
@@ -868,27 +920,24 @@ def _value_lines(env: dict[str, Any]) -> list[str]:
 #: a reader's value for its C entry (:mod:`gtecat.gt.centry`): the value of axis ``n`` of the
 #: in-process lockstep controller as the fast function writes it, with the fast function's
 #: side effect (the last error cleared); NOPE where the fast function must answer
+#: (the entry asks it only while its gate is open: ``{ctl}``, CTL or CTLN, is that controller)
 _VALUE = """
 def {fname}(n):
-    try:  # (two subscripts: cheaper than two get calls)
-        ctl = session.controllers[1]
-        res = ctl.resources[n]
-    except KeyError:  # no controller, or no such axis
+    try:
+        res = {ctl}.resources[n]
+    except KeyError:  # no such axis
         return NOPE
-    # (a lockstep clock never runs a thread of its own: Clock.start runs one in real time only)
-    if {session} and ctl.clock.mode is _LOCKSTEP:
 {{value}}
-        session.last = None
-        return v
-    return NOPE
+    session.last = None
+    return v
 """
 
 
-def _value_function(env: dict[str, Any], fname: str, session: str) -> Callable[[Any], Any]:
-    """The value function of a reader's C entry (``session``: the GT_ or the GTN_ form's
-    check of the session)."""
-    value = "\n".join("        " + line for line in _value_lines(env))
-    code = _VALUE.format(fname=fname, session=session).replace("{value}", value)
+def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any], Any]:
+    """The value function of a reader's C entry (``ctl``: the GT_ or the GTN_ form's gated
+    controller, ``CTL`` or ``CTLN``)."""
+    value = "\n".join("    " + line for line in _value_lines(env))
+    code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]  # type: ignore[no-any-return]
 
@@ -1371,10 +1420,11 @@ def fast_raw(
         slave_key="slave" if io else "-1",
         slave_memo=" and slave == last[4]" if io else "",
     )
+    _gated(venv)
     exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
     value = venv["value"]
 
-    public = centry.raw(entry, value, _NO, io, write)
+    public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE)
     if public is None:
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
@@ -1424,20 +1474,11 @@ def gt({slave}offset=_NO, size=_NO, p=_NO, /, *extra, **kw):{unwrap}
 
 #: a raw function's value for its C entry (centry.raw): the session's checks, then the runs
 #: of the previous call's shape (a polling loop repeats its shape), else runs_of's
+#: (asked while the GT_ gate is open: CTL the in-process lockstep controller)
 _RAW_VALUE = """
 def value({slave}offset, size, tp):
-    try:
-        ctl = session.controllers[1]
-    except KeyError:  # no controller
-        return _NO
-    m = ctl.master
-    if (
-        session.plain  # (in this process, core 1)
-        and m is not None
-        and m.opened
-        and not m.offline
-        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
-    ):
+    m = CTL.master
+    if m is not None and m.opened and not m.offline:
         last = LASTC  # (one read: another thread may replace it meanwhile)
         if (
             offset == last[0]
@@ -1758,24 +1799,24 @@ def fast_ecat_reader(
     exec(_compiled_code(code, f"<gt fast ecat {name}>"), env)
     gt = env["gt"]
     gt.slow = slow
+    _gated(env)
     exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
-    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
+    return _entry(gt, env["value"], ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 #: a PDO reader's value for its C entry (the common case of ``_ECAT_READER``, the axis's
 #: entry kept by it); else _NO
+#: (asked while the GT_ gate is open: CTL the in-process lockstep controller)
 _ECAT_VALUE = """
 def value(n):
+    ctl = CTL
     try:
-        ctl = session.controllers[1]
         ax = ctl.axes[n]
-    except KeyError:  # no controller, or no such axis
+    except KeyError:  # no such axis
         return _NO
     m = ctl.master
     if (
         type(ax) is _AXIS
-        and session.plain
-        and ctl.clock.mode is _LOCKSTEP  # (no thread of its own: real time only has one)
         and m is not None
         and m.opened
         and ctl.card is None
@@ -1985,16 +2026,44 @@ def fast_homing_status(
                         return advance(ctl, name, 0)
         return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
 
+    gated = GATED
+
     def value(n: int) -> Any:
-        """The C entry's value: the status on the lockstep clock, else _NO."""
-        got = status(n)
-        if got is None or got[0].clock.mode is not _LOCKSTEP:
+        """The C entry's value (asked while the GT_ gate is open: ``GATED[0]`` the
+        in-process lockstep controller): ``status``'s steps past its session checks, for
+        an axis seen before (else _NO: the Python function looks at it first)."""
+        ctl = gated[0]
+        try:
+            ax = ctl.axes[n]
+            k = kept[n]
+        except KeyError:  # no such axis, or not seen yet
             return _NO
+        m = ctl.master
+        if k[0] is not ax or ctl.card is not None or m is None or not m.opened:
+            return _NO
+        st = k[3]
+        if st is None and k[4] != h[3][0]:  # (a state made since: look again)
+            k[4] = h[3][0]
+            st = k[3] = h[0].get(k[1])
+        if ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost"):
+            return _NO
+        if st is None:  # no run since the bus came up: not homed
+            if not k[2]:
+                return _NO
+            v = h[2]
+        elif st.active:
+            if st.hint is not None:
+                return _NO
+            v = h[1]
+        else:
+            v = st.result
+            if v is None:
+                return _NO
         session.last = None
-        return got[1]
+        return v
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return _entry(gt, value, ok, centry.INT)  # type: ignore[no-any-return]
+    return _entry(gt, value, ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 def struct_packer(cls: type) -> Callable[..., None] | None:
@@ -2072,6 +2141,10 @@ def _trap_bytes() -> tuple[Callable[[Any], bytes], int] | None:
         prm = res.profile.trap_prm
         return pack(prm.acc, prm.dec, prm.vel_start, prm.smooth_time)
 
+    to_bytes.pack = pack  # type: ignore[attr-defined]  # (its C entry's value: inline)
+    to_bytes.inline = (
+        "prm = prof.trap_prm\nb = PACK(prm.acc, prm.dec, prm.vel_start, prm.smooth_time)"  # type: ignore[attr-defined]
+    )
     return to_bytes, packer.size
 
 
@@ -2163,25 +2236,162 @@ def fast_struct_reader(
         return gt
     to_bytes, size = packed
 
-    def value(n: int) -> Any:
-        """The C entry's value: the structure's bytes on the lockstep clock, else _NO."""
-        got = ready(n)
-        if got is None or got[0].clock.mode is not _LOCKSTEP:
-            return _NO
-        ctl, res = got
-        bank = ctl.bank
-        if bank is not None:  # (what the table path does first)
-            bank.before_axis_call(res.ax, res)
-        if res.profile.mode is not mode:
-            return _NO
+    env = {"_NO": _NO, "MODE": mode, "TO_BYTES": to_bytes, "session": session}
+    env["PACK"] = getattr(to_bytes, "pack", None)
+    inline = getattr(to_bytes, "inline", "b = TO_BYTES(res)")  # (to_bytes' steps inline)
+    code = _STRUCT_VALUE.replace("{bytes}", "\n".join("        " + x for x in inline.split("\n")))
+    exec(_compiled_code(code, f"<gt struct value {name}>"), _gated(env))
+    return _entry(gt, env["value"], [cls], centry.BYTES, size, centry.GT_GATE)  # type: ignore[no-any-return]
+
+
+#: a structure reader's value for its C entry (asked while the GT_ gate is open: CTL the
+#: in-process lockstep controller): the structure's bytes (``{bytes}``: to_bytes' steps),
+#: else _NO
+_STRUCT_VALUE = """
+def value(n):
+    ctl = CTL
+    try:
+        res = ctl.resources[n]
+    except KeyError:  # no such axis: the table path says why
+        return _NO
+    ax = res.ax
+    if ctl.card is not None or ctl.axes.get(n) is not ax:
+        return _NO
+    bank = ctl.bank
+    if bank is not None:  # (what the table path does first: before_axis_call, inline)
+        bank.dirty = True
+        if bank.n_alive and res.bank is bank:
+            bank.release_axis_object(ax)
+    prof = res.profile
+    if prof.mode is not MODE:
+        return _NO
+    try:
+{bytes}
+    except Exception:  # (a value a field wraps: the Python path's field setters)
+        return _NO
+    session.last = None
+    return b
+"""
+
+
+#: the smart homing's status reader on the fast path (a homing loop polls it)
+HOME_STATUS = "GT_GetHomeStatus"
+#: THomeStatus's fields in order (run, stage, error, pad1, capturePos, targetPos), natively
+_HOME_STATUS = struct.Struct("@hhhhii")
+
+
+def fast_home_status(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetHomeStatus(axis, p)`` with the fast path in front of the table: ``p``
+    ``byref(s)`` (no offset) or ``s`` itself of THomeStatus, an axis of the in-process
+    controller (no pulse card) whose smart homing the table path has made before (its
+    first call, or GT_GoHome's); the fields as the table path sets them.  Any other shape,
+    a value a field would wrap, a homing not made yet: the table path (GTN_GetHomeStatus
+    with core 1 takes this path through the GT layer's twin)."""
+    from ..controller import smart_home as sh
+    from .home_structs import THomeStatus
+
+    fields = [(f[0], f[1]) for f in THomeStatus._fields_]
+    i16, i32 = ctypes.c_int16, ctypes.c_int32
+    want = [("run", i16), ("stage", i16), ("error", i16), ("pad1", i16)]
+    want += [("capturePos", i32), ("targetPos", i32)]
+    if fields != want or ctypes.sizeof(THomeStatus) != _HOME_STATUS.size:
+        # (another layout: the table path alone)
+        return slow
+    pack, pack_into = _HOME_STATUS.pack, _HOME_STATUS.pack_into
+    target = _target([THomeStatus])
+    homes, running = sh._HOMES, sh._RUNNING
+    #: axis number -> (its resources, their smart homing): smart_home makes a homing once
+    #: per resources and keeps it while they live, so one found is theirs for good
+    kept: dict[int, tuple[Any, Any]] = {}
+
+    def home_of(ctl: Any, n: int) -> Any:
+        """Axis ``n``'s smart homing on ``ctl`` where the fast path reads it, else None."""
         try:
-            b = to_bytes(res)
-        except Exception:  # (a value a field wraps: the Python path's field setters)
-            return _NO
+            res = ctl.resources[n]
+        except KeyError:  # no such axis: the table path says why
+            return None
+        if ctl.axes.get(n) is not res.ax or ctl.card is not None:
+            return None
+        k = kept.get(n)
+        if k is not None and k[0] is res:
+            return k[1]
+        home = homes.get(res)
+        if home is None or ctl not in running:  # (the table path makes it, registered)
+            return None
+        if len(kept) > 4096:
+            kept.clear()
+        kept[n] = (res, home)
+        return home
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra:
+            tp = type(p)
+            if tp is _CArg:
+                s = target(p)
+                if s is p:
+                    s = None
+            else:
+                s = p if tp is THomeStatus else None
+            ctl = None if s is None else session.controllers.get(1)
+            if ctl is not None and session.plain and ctl.clock._thread is None:
+                home = home_of(ctl, n)
+                if home is not None:
+                    st = home.status
+                    try:
+                        pack_into(
+                            s, 0, int(st.run), int(st.stage), int(st.error), 0,
+                            int(st.capturePos), int(st.targetPos),
+                        )  # fmt: skip
+                    except Exception:  # (a value a field wraps, or no number: the table)
+                        return slow(n, p)
+                    session.last = None
+                    if ctl.clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    gated = GATED
+
+    def value(n: int) -> Any:
+        """The C entry's value (asked while the GT_ gate is open): the structure's bytes
+        (home_of's steps inline for an axis seen before)."""
+        ctl = gated[0]
+        try:
+            res = ctl.resources[n]
+            k = kept[n]
+        except KeyError:  # no such axis, or not seen: home_of looks
+            home = home_of(ctl, n)
+            if home is None:
+                return _NO
+        else:
+            if ctl.axes.get(n) is not res.ax or ctl.card is not None:
+                return _NO
+            home = k[1] if k[0] is res else home_of(ctl, n)
+            if home is None:
+                return _NO
+        st = home.status
+        try:  # (ints and IntEnums as they are: pack takes their value, as int() gives it)
+            b = pack(st.run, st.stage, st.error, 0, st.capturePos, st.targetPos)
+        except Exception:  # (a float, say: int() first, as the table path)
+            try:
+                b = pack(
+                    int(st.run), int(st.stage), int(st.error), 0,
+                    int(st.capturePos), int(st.targetPos),
+                )  # fmt: skip
+            except Exception:  # (a value a field wraps, or no number: the table path)
+                return _NO
         session.last = None
         return b
 
-    return _entry(gt, value, [cls], centry.BYTES, size)  # type: ignore[no-any-return]
+    return _entry(  # type: ignore[no-any-return]
+        gt, value, [THomeStatus], centry.BYTES, _HOME_STATUS.size, centry.GT_GATE
+    )
 
 
 #: the session's core reader on the fast path (it reads no controller)
@@ -2350,8 +2560,9 @@ def fast_io_reader(
     exec(compile(code, f"<gt fast io {name}>", "exec"), env)
     gt = env["gt"]
     gt.slow = slow  # type: ignore[attr-defined]
+    _gated(env)
     exec(compile(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>", "exec"), env)
-    return _entry(gt, env["value"], ok, centry.INT)  # type: ignore[no-any-return]
+    return _entry(gt, env["value"], ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
 
 
 #: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'
@@ -2405,22 +2616,21 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
 
 #: an IO reader's value for its C entry (the common case of ``_IO_READER``: a reader kept,
 #: the lockstep clock, no axis of the bank to give back first); else _NO
+#: (asked while the GT_ gate is open: CTL the in-process lockstep controller)
 _IO_VALUE = """
 def value(t):
-    if {lo} <= t <= {hi} and session.plain and session.note is None:
+    if {lo} <= t <= {hi} and session.note is None:
         try:
-            ctl = session.controllers[1]
-            read = ctl.input_plans[t + {kind}]
-        except KeyError:  # none kept (yet, or since a change), no controller
+            read = CTL.input_plans[t + {kind}]
+        except KeyError:  # none kept (yet, or since a change)
             return _NO
-        # (a lockstep clock never runs a thread of its own: Clock.start runs one in real
-        # time only)
-        if ctl.clock.mode is _LOCKSTEP:
-            bank = ctl.bank
-            if not (RELEASES and bank is not None and bank.n_alive):
-                v = read()
-                session.last = None
-                return v
+        if RELEASES:
+            bank = CTL.bank
+            if bank is not None and bank.n_alive:
+                return _NO
+        v = read()
+        session.last = None
+        return v
     return _NO
 """
 
@@ -2431,6 +2641,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         **dict.fromkeys(IO_READERS, fast_io_reader),
         CORE: fast_core,
         HOMING: fast_homing_status,
+        HOME_STATUS: fast_home_status,
     }
     for names, make in (
         (READERS, fast_reader),

@@ -599,14 +599,18 @@ def GT_GetCore(pCore: Any) -> int:
 @gt_function
 def GT_GetAtlTorque(ctl: Controller, axis: int, pTorque: Any) -> int:
     """Torque actual value 6077h (per mille of rated torque), as GT_GetEcatAxisAtITorque."""
-    store(pTorque, axis_calls.bus_axis(ctl, axis).io.read(0x6077))
+    ax = axis_calls.bus_axis(ctl, axis)
+    axis_calls.reachable(ax, 0x6077)
+    store(pTorque, ax.io.read(0x6077))
     return 0
 
 
 @gt_function
 def GT_GetEcatAxisAtlTorque(ctl: Controller, axis: int, pTorque: Any) -> int:
     """GT_GetEcatAxisAtITorque as the vendor's GTN header spells it (6077h)."""
-    store(pTorque, axis_calls.bus_axis(ctl, axis).io.read(0x6077))
+    ax = axis_calls.bus_axis(ctl, axis)
+    axis_calls.reachable(ax, 0x6077)
+    store(pTorque, ax.io.read(0x6077))
     return 0
 
 

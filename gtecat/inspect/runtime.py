@@ -16,6 +16,7 @@ import contextlib
 import json
 import os
 import stat
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -65,6 +66,12 @@ class EndpointInfo:
     backend: str
     started: float
     socket: Path
+
+    def who(self) -> str:
+        """Which process it is, for a user who shares the machine (and the user id) with
+        others: ``ID (pid N, PROGRAM, started HH:MM:SS)``."""
+        started = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(self.started))
+        return f"{self.id} (pid {self.pid}, {self.program or self.kind}, started {started})"
 
     def as_dict(self) -> dict[str, Any]:
         d = dict(self.__dict__)
@@ -135,7 +142,8 @@ def find(wanted: str | None) -> EndpointInfo | None:
         raise BusError(f"no running gtecat with id {wanted!r} (running: {have}; see gtecat ps)")
     if len(eps) > 1:
         raise BusError(
-            f"{len(eps)} gtecats are running ({', '.join(e.id for e in eps)}): "
-            "choose one with --attach ID (gtecat ps lists them)"
+            f"{len(eps)} gtecats are running: "
+            + "; ".join(e.who() for e in eps)
+            + "; choose one with --attach ID (gtecat ps lists them)"
         )
     return eps[0] if eps else None

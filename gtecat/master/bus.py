@@ -29,6 +29,14 @@ again after :attr:`Master.loss_confirm_ns` (10 ms) and every
 :attr:`Master.recover_every` cycles from then on.  The controller stops the axes
 of offline slaves and the GT layer refuses process data that touches them
 (:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
+
+Lost SDO answer: a master that sends an SDO request and gets no answer waits its
+mailbox timeout before it gives up with 0x05040000 (SDO protocol timed out).  The
+manual and the ENI (CoE InitCmd ``Timeout`` 0: the master's default) name no value,
+so the emulated master waits what its hardware backend waits (SOEM's mailbox
+receive timeout, 700 ms: :data:`SDO_TIMEOUT_MS`), in controller time: the cycles
+run while the call waits (:attr:`Master.mailbox_wait`), in lockstep and auto
+alike, so a loop that polls by SDO sees the time a real one would.
 """
 
 from __future__ import annotations
@@ -48,6 +56,11 @@ from .image import ProcessImage
 #: looked up once: the cycle and :meth:`Master.steady` compare with it (an enum member's
 #: lookup costs more than the comparison)
 _OP = AlState.OP
+
+#: how long the master waits for an SDO answer before it reports 0x05040000 (module
+#: docstring "Lost SDO answer"): SOEM's mailbox receive timeout, which the pysoem
+#: backend waits on the wire
+SDO_TIMEOUT_MS = 700
 
 
 @dataclass
@@ -105,6 +118,9 @@ class Master:
         #: slaves out of the process-data exchange although the bus should be in OP:
         #: position -> reason ("slave 1 (Drive) does not answer"); empty while all is well
         self.offline: dict[int, str] = {}
+        #: lets ``ms`` of controller time pass, cycles running (set by the controller):
+        #: the wait for an SDO answer that never comes (module docstring "Lost SDO answer")
+        self.mailbox_wait: Callable[[float], None] | None = None
         #: a short working counter this long in a row is worth a second state read (the
         #: first is made in the first short cycle)
         self.loss_confirm_ns = 10_000_000
@@ -388,16 +404,54 @@ class Master:
 
     # --- mailbox ------------------------------------------------------------------------
     def sdo_upload(
-        self, pos: int, index: int, subindex: int, complete_access: bool = False
+        self,
+        pos: int,
+        index: int,
+        subindex: int,
+        complete_access: bool = False,
+        *,
+        wait: bool = True,
     ) -> bytes:
+        """The object's bytes; ``wait=False``: a lost answer costs no controller time (the
+        inspection verbs, which run beside the application, never run its cycles)."""
         self._check_slave(pos)
-        return self.backend.sdo_upload(pos, index, subindex, complete_access)
+        lost = self._unanswered() if wait else -1
+        try:
+            return self.backend.sdo_upload(pos, index, subindex, complete_access)
+        finally:
+            self._timed_out(lost)
 
     def sdo_download(
-        self, pos: int, index: int, subindex: int, data: bytes, complete_access: bool = False
+        self,
+        pos: int,
+        index: int,
+        subindex: int,
+        data: bytes,
+        complete_access: bool = False,
+        *,
+        wait: bool = True,
     ) -> None:
+        """Write ``data`` to the object; ``wait`` as for :meth:`sdo_upload`."""
         self._check_slave(pos)
-        self.backend.sdo_download(pos, index, subindex, data, complete_access)
+        lost = self._unanswered() if wait else -1
+        try:
+            self.backend.sdo_download(pos, index, subindex, data, complete_access)
+        finally:
+            self._timed_out(lost)
+
+    def _unanswered(self) -> int:
+        """The SDO requests the backend sent without an answer so far (-1: it cannot tell,
+        as on the wire, where the backend waits its timeout itself)."""
+        count = getattr(self.backend, "unanswered", None)
+        return count() if count is not None and self.mailbox_wait is not None else -1
+
+    def _timed_out(self, before: int) -> None:
+        """The master's mailbox timeout for each request of this call left unanswered."""
+        if before < 0 or self.mailbox_wait is None:
+            return
+        lost = self._unanswered() - before
+        if lost > 0:
+            self.mailbox_wait(lost * SDO_TIMEOUT_MS)
 
     def _check_slave(self, pos: int) -> None:
         if not self.opened:

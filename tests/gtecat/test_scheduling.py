@@ -118,8 +118,7 @@ def server(tmp_path):
     try:
         yield s
     finally:
-        s._listener.close()
-        s._poller.close()
+        s._cleanup()  # (its sockets closed and the process's endpoint kind given back)
 
 
 def test_the_controller_is_real_time_while_busy_and_then_never_spins(server, monkeypatch):

@@ -56,6 +56,10 @@ struct api {
     obj (*err_occurred)(void);
     void (*err_clear)(void);
     obj (*dict_get)(obj, obj); /* PyDict_GetItem: borrowed, no error left */
+    /* the session's gates (gtecat.gt._core keeps them wherever their answer can change):
+     * [0] nonzero while the GT_ functions address the in-process lockstep controller of
+     * core 1, [1] while the GTN_ functions' core 1 is that controller */
+    const ptrdiff_t *gate;
 };
 
 #define MAX_TYPES 16
@@ -74,6 +78,7 @@ struct entry {
     ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
     ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
     obj avalue; /* NULL, or avalue(n, count, array type, pClock): a ctypes array's bytes */
+    ptrdiff_t gate; /* 0: none; k: value (and avalue) only while A.gate[k - 1] is nonzero */
 };
 
 static struct api A;
@@ -94,7 +99,7 @@ int gtecat_centry_api(const struct api *api)
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
-        !api->err_occurred || !api->err_clear)
+        !api->err_occurred || !api->err_clear || !api->gate)
         return 1;
     A = *api;
     ready = 1;
@@ -167,7 +172,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     char *mem;
     int k, size = 0, sign = 1, deref = 0;
 
-    if (!ready || kwnames)
+    if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
     if (e->noaxis) {
         if (nargs < 1 || nargs > 2 || (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
@@ -182,9 +187,11 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
             goto python;
         if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
             return array(e, args, nargs, kwnames, at);
-        if (nargs >= 3 + at && !int_is(args[at + 2], 1))
+        /* (the cached small ints 1 and 0 first: one compare for the common literals) */
+        if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
-        if (nargs >= 4 + at && args[at + 3] != A.none && !int_is(args[at + 3], 0))
+        if (nargs >= 4 + at && args[at + 3] != A.none && args[at + 3] != A.zero &&
+            !int_is(args[at + 3], 0))
             goto python;
         p = args[at + 1];
     }
@@ -290,6 +297,7 @@ struct raw_entry {
     obj sentinel;
     ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
     ptrdiff_t write; /* 1: from the buffer into the image */
+    ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -314,7 +322,7 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     int over = 0;
     char *mem;
 
-    if (!ready || kwnames || nargs != 3 + at)
+    if (!ready || kwnames || nargs != 3 + at || (e->gate && !A.gate[e->gate - 1]))
         goto python;
     for (k = 0; k < 2 + at; k++)
         if (TYPE(args[k]) != A.int_type)

@@ -351,6 +351,11 @@ class EmulatedBackend(Backend):
             self._clients[position] = client
         return client
 
+    def unanswered(self) -> int:
+        """The SDO requests sent so far that got no answer (a fault lost it): the master
+        waits its mailbox timeout for each (:meth:`gtecat.master.bus.Master.sdo_upload`)."""
+        return sum(c.unanswered for c in self._clients.values())
+
     def close(self) -> None:
         if self.capture is not None:
             self.capture.close()

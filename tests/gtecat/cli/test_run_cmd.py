@@ -220,7 +220,11 @@ def test_progress_line_during_a_long_run(
     monkeypatch.chdir(tmp_path)
     tty = _Tty()
     monkeypatch.setattr(
-        run_cmd, "Progress", functools.partial(run_cmd.Progress, stream=tty, wall=_fake_wall(0.01))
+        # (a wall clock a quarter second on per look: the axis bank runs up to 1000 cycles
+        # between two looks, as many as make a quarter second of wall time on a slow machine)
+        run_cmd,
+        "Progress",
+        functools.partial(run_cmd.Progress, stream=tty, wall=_fake_wall(0.25)),
     )
     rc, _, _ = cli("run", str(_script(tmp_path, wait_ms=2000)), "--eni", FIG52)
     assert rc == 0
@@ -330,3 +334,36 @@ def test_trace_plot_layout_bits_bands_and_value_groups() -> None:
     names = [row[0] for row in rows]
     assert "axis1.sw 2: operation enabled" in names and "axis1.sw 10: target reached" in names
     assert not any("fault" in n for n in names)  # a bit never set gets no row
+
+
+HOOKS = textwrap.dedent(
+    """
+    from ctypes import byref, c_short
+    from gtecat import gt
+
+    gt.GT_Open(log="")
+    gt.GT_InitEcatComm()
+    st = c_short()
+    while gt.GT_IsEcatReady(byref(st)) == 0 and st.value != 1:
+        gt.GTE_Wait(1)
+    ctl = gt.GTE_Controller()
+    print("hooks", len(ctl.sample), len(ctl.watch))
+    gt.GT_Close()
+    """
+)
+
+
+def test_the_status_line_never_makes_the_cycles_run_one_by_one(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a per-cycle sample stops the axis bank's runs of many cycles at once (several times the
+    # CPU of `python SCRIPT`): the status line is no sample, and is not there when not shown
+    script = tmp_path / "hooks.py"
+    script.write_text(HOOKS)
+    rc, out, _ = cli("run", "--no-progress", str(script), "--eni", FIG52)
+    assert (rc, out.split("\n")[0]) == (0, "hooks 0 0")
+    monkeypatch.setattr(
+        run_cmd, "Progress", functools.partial(run_cmd.Progress, stream=_Tty(), wall=_fake_wall(1))
+    )
+    rc, out, _ = cli("run", str(script), "--eni", FIG52)
+    assert (rc, out.split("\n")[0]) == (0, "hooks 0 1")

@@ -9,7 +9,8 @@ Lockstep clock, two drives that map 603Fh (axis 2 is slave 1):
   servo off - no window of stale "healthy" reads;
 * one lost frame is no loss: in that cycle the reads keep their last values and return 0;
 * once the cable is back, the drive whose sync-manager watchdog ran out says why it
-  stopped: 603Fh 8130h (CiA 301 life guard / heartbeat error), cleared by the fault reset;
+  stopped: 603Fh 8130h (CiA 301 life guard / heartbeat error), cleared by the fault reset
+  (GT_ClrSts; GT_AxisOn enables afterwards);
 * the error register (1001h and the emergency) follows the class of the code (CiA 301).
 """
 
@@ -94,13 +95,17 @@ def up(eni: Path, log: Path | None = None) -> None:
 
 def reads(axis: int, raw_offset: int) -> dict[str, int]:
     """The return codes of the reads an error handler makes."""
-    enc, hs, ec = c_long(), c_ushort(), c_ushort()
-    raw = (c_ubyte * 2)()
+    enc, hs, ec, sw, mode = c_long(), c_ushort(), c_ushort(), c_ushort(), c_ushort()
+    raw, pos = (c_ubyte * 2)(), (c_ubyte * 4)()
     return {
         "enc": gt.GT_GetEcatEncPos(axis, byref(enc)),
         "homing": gt.GT_GetEcatHomingStatus(axis, byref(hs)),
         "error": gt.GT_GetEcatErrorCode(axis, byref(ec)),
         "raw": gt.GT_GetEcatRawData(raw_offset, 2, raw),
+        # the same PDO objects by index, as the vendor demos read them
+        "pdo": gt.GT_GetEcatAxisPdoData(axis, 0x6041, byref(sw))
+        | gt.GT_GetEcatAxisPdoData(axis, 0x6064, pos) << 1,
+        "mode": gt.GT_GetEcatAxisMode(axis, byref(mode)),
     }
 
 
@@ -121,8 +126,8 @@ def test_the_application_sees_the_loss_from_the_first_cycle(eni: Path, tmp_path:
     up(eni, log)
     image = gt.GTE_Controller().master.image
     offset = next(o for o in range(0, 512, 2) if _raw_slaves(image, o, 2) == [1])
-    healthy = {"enc": 0, "homing": 0, "error": 0, "raw": 0}
-    lost = {"enc": 1, "homing": 1, "error": 1, "raw": 1}
+    healthy = {"enc": 0, "homing": 0, "error": 0, "raw": 0, "pdo": 0, "mode": 0}
+    lost = {"enc": 1, "homing": 1, "error": 1, "raw": 1, "pdo": 3, "mode": 1}
     assert reads(2, offset) == healthy and sts(2) & SERVO_ON
 
     # one lost frame: not ready for that cycle, nothing else changes
@@ -143,6 +148,10 @@ def test_the_application_sees_the_loss_from_the_first_cycle(eni: Path, tmp_path:
         assert ready() == 0 and slaves() == 1, where
         assert reads(2, offset) == lost, where
         assert "slave 1" in gt.GTE_GetLastError(), where
+        for name, index in (("GT_GetEcatAxisPdoData", 0x6041), ("GT_GetEcatEncPos", 0x6064)):
+            args = (2, index, byref(c_ushort())) if "Pdo" in name else (2, byref(c_long()))
+            assert getattr(gt, name)(*args) == 1, where
+            assert f"slave 1 (Drive 1) does not answer: 0x{index:04X}" in gt.GTE_GetLastError()
         s2 = sts(2)
         assert s2 & ALARM and not s2 & SERVO_ON, where
         assert reads(1, 0) | {"raw": 0} == healthy, where  # slave 0 goes on
@@ -153,10 +162,13 @@ def test_the_application_sees_the_loss_from_the_first_cycle(eni: Path, tmp_path:
     assert error_code(2) == 0x8130
     assert sts(2) & ALARM and not sts(2) & SERVO_ON
     assert error_code(1) == 0
+    # the fault reset is GT_ClrSts (manual 9.3): GT_AxisOn in FAULT says so and leaves it
+    assert gt.GT_AxisOn(2) == 1 and "GT_ClrSts" in gt.GTE_GetLastError()
+    assert error_code(2) == 0x8130
     assert gt.GT_ClrSts(2, 1) == 0
-    assert gt.GT_AxisOn(2) == 0, gt.GTE_GetLastError()  # the fault reset
+    assert error_code(2) == 0  # FAULT -> switch on disabled, 8130h cleared
+    assert gt.GT_AxisOn(2) == 0, gt.GTE_GetLastError()
     assert wait(lambda: sts(2) & SERVO_ON and not sts(2) & ALARM, 100)
-    assert error_code(2) == 0
     gt.GT_Close()
     text = log.read_text()
     assert "CoE EMERGENCY 0x8130 0x11" in text  # generic + communication

@@ -8,6 +8,7 @@ import subprocess
 import sys
 import textwrap
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -391,3 +392,36 @@ def test_plugin_findings_are_warnings_at_the_application_line() -> None:
     (w,) = seen.list
     assert (w.filename, w.lineno) == ("/app/cell.py", 42)
     assert str(w.message).startswith("check: /app/cell.py:42: axis 3: GT_Update")
+
+
+def test_plugin_findings_fail_the_test_itself_when_warnings_are_errors() -> None:
+    """``-W error::...GtecatCheckWarning``: the findings of the test's call are warned as the
+    call ends, inside it, so pytest reports the test FAILED (not an ERROR of its teardown);
+    the ones warned there are not warned again at the teardown."""
+    import warnings
+
+    from gtecat import pytest_plugin as plugin
+    from gtecat.faults.checks import Finding, GtecatCheckWarning
+
+    class Outcome:
+        excinfo = None
+        forced: BaseException | None = None
+
+        def force_exception(self, e: BaseException) -> None:
+            self.forced = e
+
+    found = [Finding("cw-skip", "/app/t.py", n, f"axis {n}: skips") for n in (3, 4)]
+    item = SimpleNamespace(stash={plugin.CHECK_KEY: [SimpleNamespace(findings=found), 0]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GtecatCheckWarning)
+        hook = plugin.pytest_runtest_call(item)
+        next(hook)
+        outcome = Outcome()
+        with pytest.raises(StopIteration):
+            hook.send(outcome)
+    assert isinstance(outcome.forced, GtecatCheckWarning)
+    assert str(outcome.forced).splitlines() == [
+        "check: /app/t.py:3: axis 3: skips [CiA 402 state machine]",
+        "check: /app/t.py:4: axis 4: skips [CiA 402 state machine]",
+    ]
+    assert item.stash[plugin.CHECK_KEY][1] == 2  # the teardown warns from the third on

@@ -9,6 +9,8 @@ virtual seconds here, the whole minute under GTECAT_LONG=1.
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from ctypes import byref, c_short, c_ubyte
 from pathlib import Path
 
@@ -113,6 +115,45 @@ def test_a_tampered_recording_reports_its_first_divergence(
     assert f"call {second} " not in err
     assert main(["replay", str(recorded)]) == 0
     assert "calls match" in capsys.readouterr().out
+
+
+def test_the_replay_process_ends_at_once_with_its_exit_handlers_run(
+    recorded: Path, tmp_path: Path
+) -> None:
+    """``gtecat replay`` as a program ends right after its verb (no teardown of the session
+    object by object) with the exit code, the output flushed and every exit handler run."""
+    bad = tmp_path / "bad.gtrec"
+    lines = recorded.read_text().splitlines()
+    for i, line in enumerate(lines):
+        if '"c":"GT_GetSts"' in line:
+            e = json.loads(line)
+            e["r"] = 7
+            lines[i] = json.dumps(e)
+            break
+    bad.write_text("\n".join(lines) + "\n")
+    program = (
+        "import atexit, sys\n"
+        "atexit.register(lambda: print('exit handler ran'))\n"
+        "class Kept:\n"
+        "    def __del__(self):\n"
+        "        print('taken apart')\n"
+        "kept = Kept()\n"
+        "from gtecat.cli.main import main\n"
+        "sys.argv = ['gtecat', 'replay', *sys.argv[1:]]\n"
+        "sys.exit(main())\n"
+    )
+    # (a divergence at the first status read: the same way out as a match, at less cost)
+    run = subprocess.run(
+        [sys.executable, "-c", program, str(bad)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert run.returncode == 1, run.stderr
+    assert "diverged at call" in run.stderr
+    assert run.stdout.rstrip().endswith("exit handler ran"), run.stdout
+    assert "taken apart" not in run.stdout  # (the normal exit would)
 
 
 def test_an_input_set_between_cycles_reaches_the_image() -> None:

@@ -4,8 +4,8 @@ One small machine each (``full_servo.eni``: one drive with 603Fh and 60FDh mappe
 slave; ``manual_fig5_2.eni``: two drives and two IO slaves), lockstep clock: what the
 application reads is asserted - GT_GetSts bits (1 alarm, 5/6 limits, 9 servo on),
 GT_GetEcatErrorCode, GT_IsEcatReady, GT_GetEcatSlaves, the return codes of calls made
-while a slave is gone, the SDO abort codes - and that the manual's recovery (GT_ClrSts,
-GT_AxisOn: the fault reset) brings the axis back once the cause is gone.
+while a slave is gone, the SDO abort codes - and that the manual's recovery (GT_ClrSts: the
+fault reset, then GT_AxisOn) brings the axis back once the cause is gone.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import pytest
 from gtecat import faults, gt
 from gtecat.errors import ParameterError
 from gtecat.faults import FaultSpecError
+from gtecat.master.bus import SDO_TIMEOUT_MS
 from tests.conftest import EXAMPLES
 
 ALARM, POS_LIMIT, SERVO_ON = 1 << 1, 1 << 5, 1 << 9
@@ -325,13 +326,31 @@ def test_mailbox_abort_lost_answer_and_protocol_fault() -> None:
     assert rc != 0 and code == 0x06090030
     assert sdo_upload(0, 0x6060) == (0, 0)  # once
     faults.inject("mailbox_lost", slave=0, count=2)
-    assert sdo_upload(0, 0x6061)[1] == 0x05040000  # SDO protocol timed out
+    clock = gt.GTE_Controller().clock
+    t0, n0 = clock.now_ms, clock.cycles
+    assert sdo_upload(0, 0x6061)[1] == 0x05040000  # SDO protocol timed out ...
+    # ... once the master's mailbox timeout ran out, the cycles running meanwhile
+    assert (clock.now_ms - t0, clock.cycles - n0) == (SDO_TIMEOUT_MS, SDO_TIMEOUT_MS)
     assert sdo_upload(0, 0x6061)[1] == 0x05040000
+    t0 = clock.now_ms
     assert sdo_upload(0, 0x6061) == (0, 0)
+    assert clock.now_ms == t0  # an answer comes within the cycle
     faults.inject("mailbox_protocol", slave=0, variant="wrong_service")
     rc, code = sdo_upload(0, 0x6061)
     assert rc != 0 and code == 0x08000000
     assert "not SDO_RESPONSE" in gt.GTE_GetLastError()
+
+
+def test_a_lost_download_answer_costs_the_timeout_in_auto_too() -> None:
+    assert gt.GT_Open(eni=str(EXAMPLES / "full_servo.eni"), clock="auto", log="") == 0
+    assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+    assert wait(lambda: ready() == 1, 200)
+    faults.inject("mailbox_lost", slave=0, index=0x6081)
+    clock, abort = gt.GTE_Controller().clock, c_uint32()
+    t0 = clock.now_ms
+    rc = gt.GT_EcatSDODownload(0, 0x6081, 0, (c_ubyte * 4)(1), 4, byref(abort))
+    assert (rc, abort.value) == (1, 0x05040000)
+    assert SDO_TIMEOUT_MS <= clock.now_ms - t0 <= SDO_TIMEOUT_MS + 1  # (+ the call's latency)
 
 
 def test_an_abort_hits_its_step_only() -> None:

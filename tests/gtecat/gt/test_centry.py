@@ -194,7 +194,14 @@ def _call(fn: Any, gtn: bool, case: tuple, kw: bool) -> tuple:
 @needs_cc
 def test_the_c_entry_is_built_and_is_the_public_reader() -> None:
     assert centry.REASON == "", centry.REASON
-    for name in [*fast.READERS, *fast.RAW, fast.CLOCK, fast.HOMING, *fast.IO_READERS]:
+    for name in [
+        *fast.READERS,
+        *fast.RAW,
+        fast.CLOCK,
+        fast.HOMING,
+        fast.HOME_STATUS,
+        *fast.IO_READERS,
+    ]:
         fn = getattr(gt, name)
         assert hasattr(fn, "python"), name  # (the C entry in front)
         assert fn.__name__ == name and "(C entry)" in repr(fn) and fn.__doc__ == fn.slow.__doc__
@@ -326,6 +333,12 @@ TWO_ARG = {
     **{n: [1, 2, 3, 0, True, 1.0] for n in fast.ECAT_READERS},
     fast.HOMING: [1, 2, 3, 0, True, 1.0],
     **{n: [1, 2, 3, 0, True, 1.0] for n in fast.STRUCT_READERS},
+    fast.HOME_STATUS: [1, 2, 3, 0, True, 1.0],
+}
+#: the structure readers among them: function -> their structure
+STRUCTS = {
+    **{n: v[0] for n, v in fast.STRUCT_READERS.items()},
+    fast.HOME_STATUS: gt.THomeStatus,
 }
 TWO_ARG_TYPES = [
     ctypes.c_int32,
@@ -342,9 +355,9 @@ TWO_ARG_TYPES = [
 def _two_arg_cases() -> list[tuple]:
     out = []
     for name, firsts in sorted(TWO_ARG.items()):
-        types = [fast.STRUCT_READERS[name][0]] if name in fast.STRUCT_READERS else TWO_ARG_TYPES
+        types = [STRUCTS[name]] if name in STRUCTS else TWO_ARG_TYPES
         for kind in KINDS:
-            if name in fast.STRUCT_READERS and kind in ("numpy", "field"):
+            if name in STRUCTS and kind in ("numpy", "field"):
                 continue
             for t in types:
                 for first in firsts:
@@ -361,8 +374,9 @@ def _two_arg_cases() -> list[tuple]:
 def test_the_two_argument_readers_answer_as_their_python_path_and_the_table(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """GT_GetDi, GT_GetDiRaw, GT_GetDo, the PDO readers, the homing status and the Trap
-    parameters: with the C entry, without it, and the table path."""
+    """GT_GetDi, GT_GetDiRaw, GT_GetDo, the PDO readers, the homing status, the Trap
+    parameters and the smart homing's status: with the C entry, without it, and the table
+    path."""
     _open()
     gt.GT_PrfTrap(2)  # (axis 2 in Trap: its parameters readable; axis 1 moving in Trap)
     built = {}

@@ -37,6 +37,7 @@ print(json.dumps({
         and isinstance(v, type) for k, v in star.items()
     ),
     "no_such": hasattr(gt, "GT_NoSuchFunction"),
+    "hook_after": "__getattr__" in vars(gt),
 }))
 """
 
@@ -56,6 +57,7 @@ def test_every_name_is_found_in_a_fresh_process():
     assert got["vars_after"]
     assert got["enums"] > 0 and got["struct"]
     assert got["no_such"] is False
+    assert got["hook_after"] is False  # (every name made: attribute loads specialise)
 
 
 def test_the_kept_table_is_the_table(tmp_path, monkeypatch):

@@ -254,3 +254,36 @@ def test_the_panel_ends_and_says_why_when_the_watched_gtecat_ends(app) -> None:
     app.GT_Close()
     t.join(20)
     assert not t.is_alive() and gone and gone[0]
+
+
+def test_the_fault_verbs_name_the_gtecat_they_act_on(app, capsys, monkeypatch) -> None:
+    # one account, several users: a fault injected without --attach says whose program it hit
+    (ep,) = runtime.endpoints()
+    assert main(["fault", "list"]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(f"attached to {ep.id} (pid {os.getpid()}, ") and "started 20" in err
+    assert main(["fault", "list", "--attach", ep.id]) == 0
+    assert capsys.readouterr().err == ""  # (named by the user)
+    # two running: none is taken, both are listed with pid, program and start time
+    other = runtime.EndpointInfo(**{**ep.__dict__, "id": "7", "pid": 7, "program": "cell.py"})
+    monkeypatch.setattr(runtime, "endpoints", lambda: [ep, other])
+    assert main(["fault", "inject", "drop_responses", "count=1"]) != 0
+    err = capsys.readouterr().err
+    assert "2 gtecats are running" in err and "7 (pid 7, cell.py, started 20" in err
+    assert f"{ep.id} (pid {os.getpid()}," in err
+    assert main(["fault", "list", "--attach", ep.id]) == 0
+    assert capsys.readouterr().out.strip() == "no fault armed or active"
+
+
+def test_a_lost_sdo_answer_over_the_endpoint_runs_none_of_the_applications_cycles(
+    app, capsys
+) -> None:
+    # the application's own SDO waits the master's mailbox timeout in its cycles; a verb
+    # beside it gets its 05040000h at once and leaves the application's clock alone
+    from gtecat import faults
+
+    faults.inject("mailbox_lost", slave=0, index=0x1018)
+    cycles = app.GTE_Controller().clock.cycles
+    assert main(["sdo", "upload", "0", "0x1018", "1"]) != 0
+    assert "0x05040000" in capsys.readouterr().err
+    assert app.GTE_Controller().clock.cycles == cycles
