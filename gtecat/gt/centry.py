@@ -417,8 +417,9 @@ def _load() -> tuple[Maker | None, str]:
         e.avalue = id(array) if array is not None else None
         e.gate = gate
         for k, t in enumerate(kinds):
-            e.derefs[k] = int(issubclass(t, ctypes._Pointer))
-            x = t._type_ if e.derefs[k] else t
+            pointer = issubclass(t, ctypes._Pointer)
+            x = t._type_ if pointer else t
+            e.derefs[k] = id(x) if pointer else 0  # (the type a pointer's x must have)
             e.types[k] = id(t)
             e.sizes[k] = size or ctypes.sizeof(x)
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())

@@ -59,7 +59,12 @@ def pointee(p: Any) -> Any:
     ``_objects`` under ``'1'`` (its contents setter); the C entry checks the same."""
     kept = p._objects
     x = kept.get("1") if type(kept) is dict else None
-    if x is None or not p or ctypes.addressof(x) != ctypes.cast(p, ctypes.c_void_p).value:
+    if (
+        x is None
+        or type(x) is not type(p)._type_  # (a cast of pointer(y) to another type keeps y)
+        or not p
+        or ctypes.addressof(x) != ctypes.cast(p, ctypes.c_void_p).value
+    ):
         return None
     return x
 
@@ -233,7 +238,14 @@ def fast_reader(
             p.value = get(res)
         elif is_array(tp):
             p[0] = get(res)
-        elif tp is _NDARRAY and p.dtype in np_ok and p.ndim == 1 and p.size and p.flags.writeable:
+        elif (
+            tp is _NDARRAY
+            and p.dtype in np_ok
+            and p.ndim == 1
+            and p.size
+            and p.flags.writeable
+            and p.flags.c_contiguous  # (a strided view: the table path's 7)
+        ):
             p[0] = get(res)
         elif is_pointer(tp) and (x := pointee(p)) is not None:  # pointer(x): x
             x.value = get(res)
@@ -772,6 +784,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
                 and p.ndim == 1
                 and p.size
                 and p.flags.writeable
+                and p.flags.c_contiguous  # (a strided view: the table path's 7)
             ) or is_array(tp):  # a numpy or ctypes array: its first element
                 obj = None
             else:
@@ -2479,7 +2492,13 @@ def _array_first(ok: Any) -> Callable[[Any, type], tuple[int, int] | None]:
     def first(p: Any, tp: type) -> tuple[int, int] | None:
         if tp is _NDARRAY:
             b = dtypes.get(p.dtype)
-            if b is not None and p.ndim == 1 and p.size and p.flags.writeable:
+            if (
+                b is not None
+                and p.ndim == 1
+                and p.size
+                and p.flags.writeable
+                and p.flags.c_contiguous  # (a strided view: the table path's 7)
+            ):
                 return b
             return None
         try:

@@ -75,7 +75,7 @@ struct entry {
     obj types[MAX_TYPES]; /* the ctypes types *pValue may have, NULL-ended */
     ptrdiff_t sizes[MAX_TYPES];
     ptrdiff_t signs[MAX_TYPES]; /* an integer type: 1 signed, 0 unsigned */
-    ptrdiff_t derefs[MAX_TYPES]; /* 1: a ctypes pointer type (pointer(x) passed: x's memory) */
+    ptrdiff_t derefs[MAX_TYPES]; /* a ctypes pointer type: its _type_ (pointer(x): x's memory) */
     ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
     obj avalue; /* NULL, or avalue(n, count, array type, pClock): a ctypes array's bytes */
     ptrdiff_t gate; /* 0: none; k: value (and avalue) only while A.gate[k - 1] is nonzero */
@@ -165,12 +165,45 @@ obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kw
                   (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
+/* The memory a reader writes for p (target: p, or a byref's object), or NULL where this
+ * entry cannot prove it (the Python path decides).  Looked up before the value function, to
+ * know the shape, and again after it: the value function is Python, and meanwhile another
+ * thread or a collector callback may re-point a pointer (freeing its old object) or resize a
+ * ctypes object (ctypes.resize moves its memory); nothing of Python runs between the second
+ * look-up and the write. */
+static char *reader_mem(obj p, obj target, obj deref)
+{
+    char *mem = AT(target, A.b_ptr);
+    if (deref) {
+        /* pointer(x) itself (not a byref of it): x's memory, only where the pointer is
+         * pointer(x) (or p.contents = x) of an x of exactly the pointer's _type_ that it keeps
+         * and points at exactly; a cast (of other memory, an address, numpy's data_as, or of
+         * pointer(y) to another type: ctypes.cast hands the source's kept objects on) proves
+         * no size behind it */
+        char *to;
+        obj kept, x;
+        if (target != p || !mem || !(to = *(char **)mem))
+            return NULL;
+        kept = AT(p, A.b_objects);
+        if (!kept || TYPE(kept) != A.dict_type)
+            return NULL;
+        x = A.dict_get(kept, A.key_one);
+        if (!x || TYPE(x) != deref || AT(x, A.b_ptr) != to)
+            return NULL;
+        return to;
+    }
+    if (target != p && AT(p, A.carg_value) != mem)
+        return NULL; /* byref(x, offset), or x's memory moved since the byref was made */
+    return mem;
+}
+
 static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v;
     char *mem;
-    int k, size = 0, sign = 1, deref = 0;
+    obj deref = NULL;
+    int k, size = 0, sign = 1;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -207,40 +240,23 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
         if (e->types[k] == tp) {
             size = (int)e->sizes[k];
             sign = (int)e->signs[k];
-            deref = (int)e->derefs[k];
+            deref = (obj)e->derefs[k];
             break;
         }
     }
     if (!size)
         goto python;
-    mem = AT(target, A.b_ptr);
-    if (deref) {
-        /* pointer(x) itself (not a byref of it): x's memory, only where the pointer is
-         * pointer(x) (or p.contents = x) of an x it keeps and points at exactly; a cast of
-         * other memory (an address, a smaller object, numpy's data_as) cannot prove the size
-         * behind it: the Python path, and the table path's refusal */
-        char *to;
-        obj kept, x;
-        if (target != p || !mem || !(to = *(char **)mem))
-            goto python;
-        kept = AT(p, A.b_objects);
-        if (!kept || TYPE(kept) != A.dict_type)
-            goto python;
-        x = A.dict_get(kept, A.key_one);
-        /* (x: what the contents setter kept, an instance of the pointer's type's _type_ or
-         * of a subclass, so at least size bytes; the pointer's own dict, never a base's) */
-        if (!x || AT(x, A.b_ptr) != to)
-            goto python;
-        mem = to;
-    } else if (target != p && AT(p, A.carg_value) != mem) {
+    if (!reader_mem(p, target, deref))
         goto python;
-    }
 
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
                   : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)
+        goto drop;
+    mem = reader_mem(p, target, deref); /* (again: Python ran) */
+    if (!mem)
         goto drop;
     if (e->kind == 1) {
         if (TYPE(v) != A.float_type || size != 8)
@@ -362,6 +378,17 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
+    /* the buffer's memory again: the value function is Python, and meanwhile another thread
+     * or a collector callback may resize a bytearray or a ctypes array (ctypes.resize) */
+    if (TYPE(target) == A.bytearray_type) {
+        if (*(ptrdiff_t *)((char *)target + A.bsize) < size)
+            goto drop;
+        mem = AT(target, A.bastart);
+    } else if (TYPE(target) != A.bytes_type) {
+        mem = AT(target, A.b_ptr);
+        if (target != p && AT(p, A.carg_value) != mem)
+            goto drop;
+    }
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         if (r[0] < 0 || r[2] <= 0 || r[0] + r[2] > size || !r[1])

@@ -550,6 +550,73 @@ def test_a_pointer_to_memory_of_unproved_size_is_refused_not_written_through() -
                 assert "pValue" in gt.GTE_GetLastError()
         assert bytes(end) == b"\0\0" and not f32.any() and held.value == -1.0
         assert gt.GT_GetSts(1, ctypes.cast(end, ctypes.POINTER(ctypes.c_long))) == 7
+        # pointer(y) of a narrower y cast to a wider pointer type (the cast keeps y)
+        narrow = ctypes.c_int16.from_buffer(page, mmap.PAGESIZE - 4)
+        wide = ctypes.cast(ctypes.pointer(narrow), ctypes.POINTER(ctypes.c_double))
+        assert gt.GT_GetPrfPos(1, wide) == 7 and narrow.value == 0
+        as_long = ctypes.cast(ctypes.pointer(narrow), ctypes.POINTER(ctypes.c_long))
+        assert gt.GT_GetSts(1, as_long) == 7
         assert gt.GT_GetPrfPos(1, ctypes.pointer(held)) == 0 and held.value > 0.0
     finally:
         gt.GT_Close()  # (the page is unmapped when nothing holds it)
+
+
+def _while_collecting(act: Any) -> Any:
+    """Run ``act()`` in the first garbage collection from now on (the C entry's value
+    function is Python: a collector callback, or another thread, runs there)."""
+    import gc
+
+    armed = [True]
+
+    def callback(phase: str, info: Any) -> None:
+        if phase == "start" and armed[0]:
+            armed[0] = False
+            act()
+
+    old = gc.get_threshold()
+
+    def done() -> bool:
+        """Collections as before; whether the callback is still armed (False: it ran)."""
+        gc.set_threshold(*old)
+        gc.callbacks.remove(callback)
+        return armed[0]
+
+    gc.callbacks.append(callback)
+    gc.set_threshold(1)  # (from here on, nothing allocates before the call)
+    return done
+
+
+@needs_cc
+def test_an_argument_changed_while_the_value_is_made_is_looked_at_again() -> None:
+    """A pointer re-pointed (its old object freed) or a bytearray resized (its old buffer
+    freed) while the value function runs: the entry writes where the argument points after
+    it, never into the freed memory (other objects made meanwhile keep their values)."""
+    _open()
+    try:
+        p = ctypes.pointer(ctypes.c_double(-1.0))
+        victims: list[Any] = []
+
+        def repoint() -> None:
+            p.contents = ctypes.c_double(-2.0)
+            victims.extend(ctypes.c_double(-3.0) for _ in range(50))
+
+        done = _while_collecting(repoint)
+        assert gt.GT_GetPrfPos(1, p) == 0
+        assert done() is False  # (the callback ran)
+        assert all(v.value == -3.0 for v in victims) and p.contents.value > 0.0
+
+        ba = bytearray(b"\xee" * 4096)
+        held: list[bytearray] = []
+
+        def resize() -> None:
+            ba.extend(bytes(1 << 20))
+            held.append(bytearray(b"\x55" * 4096))
+
+        done = _while_collecting(resize)
+        assert gt.GT_GetEcatRawData(1, 16, ba) == 0
+        assert done() is False
+        assert held[0] == bytearray(b"\x55" * 4096)
+        ref = bytearray(16)
+        assert gt.GT_GetEcatRawData(1, 16, ref) == 0 and ba[:16] == ref
+    finally:
+        gt.GT_Close()
