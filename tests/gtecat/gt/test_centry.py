@@ -561,62 +561,44 @@ def test_a_pointer_to_memory_of_unproved_size_is_refused_not_written_through() -
         gt.GT_Close()  # (the page is unmapped when nothing holds it)
 
 
-def _while_collecting(act: Any) -> Any:
-    """Run ``act()`` in the first garbage collection from now on (the C entry's value
-    function is Python: a collector callback, or another thread, runs there)."""
-    import gc
-
-    armed = [True]
-
-    def callback(phase: str, info: Any) -> None:
-        if phase == "start" and armed[0]:
-            armed[0] = False
-            act()
-
-    old = gc.get_threshold()
-
-    def done() -> bool:
-        """Collections as before; whether the callback is still armed (False: it ran)."""
-        gc.set_threshold(*old)
-        gc.callbacks.remove(callback)
-        return armed[0]
-
-    gc.callbacks.append(callback)
-    gc.set_threshold(1)  # (from here on, nothing allocates before the call)
-    return done
-
-
 @needs_cc
 def test_an_argument_changed_while_the_value_is_made_is_looked_at_again() -> None:
-    """A pointer re-pointed (its old object freed) or a bytearray resized (its old buffer
-    freed) while the value function runs: the entry writes where the argument points after
-    it, never into the freed memory (other objects made meanwhile keep their values)."""
-    _open()
-    try:
-        p = ctypes.pointer(ctypes.c_double(-1.0))
-        victims: list[Any] = []
+    """The value function is Python, so another thread (or a collector callback) may
+    re-point a pointer (freeing its old object) or resize a bytearray (freeing its old
+    buffer) while it runs: the entry writes where the argument points after it, never into
+    the freed memory (objects made meanwhile keep their values)."""
+    p = ctypes.pointer(ctypes.c_double(-1.0))
+    victims: list[Any] = []
 
-        def repoint() -> None:
-            p.contents = ctypes.c_double(-2.0)
-            victims.extend(ctypes.c_double(-3.0) for _ in range(50))
+    def repointing(n: Any) -> Any:
+        p.contents = ctypes.c_double(-2.0)  # (the old object freed here)
+        victims.extend(ctypes.c_double(-3.0) for _ in range(50))
+        return 400.0
 
-        done = _while_collecting(repoint)
-        assert gt.GT_GetPrfPos(1, p) == 0
-        assert done() is False  # (the callback ran)
-        assert all(v.value == -3.0 for v in victims) and p.contents.value > 0.0
+    entry = centry.reader(
+        lambda *a: -1, repointing, _core, [ctypes.c_double], centry.DOUBLE, pointers=True
+    )
+    assert entry(1, p) == 0
+    assert p.contents.value == 400.0 and all(v.value == -3.0 for v in victims)
 
-        ba = bytearray(b"\xee" * 4096)
-        held: list[bytearray] = []
+    image = (ctypes.c_ubyte * 16)(*range(16))
+    ba = bytearray(b"\xee" * 4096)
+    held: list[bytearray] = []
 
-        def resize() -> None:
-            ba.extend(bytes(1 << 20))
-            held.append(bytearray(b"\x55" * 4096))
+    def resizing(offset: int, size: int, tp: Any) -> bytes:
+        ba.extend(bytes(1 << 20))  # (the old buffer freed here)
+        held.append(bytearray(b"\x55" * 4096))
+        return centry.runs([(0, ctypes.addressof(image), size)])
 
-        done = _while_collecting(resize)
-        assert gt.GT_GetEcatRawData(1, 16, ba) == 0
-        assert done() is False
-        assert held[0] == bytearray(b"\x55" * 4096)
-        ref = bytearray(16)
-        assert gt.GT_GetEcatRawData(1, 16, ref) == 0 and ba[:16] == ref
-    finally:
-        gt.GT_Close()
+    entry = centry.raw(lambda *a: -1, resizing, _core, io=False, write=False)
+    assert entry(0, 16, ba) == 0
+    assert ba[:16] == bytes(range(16)) and held[0] == bytearray(b"\x55" * 4096)
+
+    shrinking = centry.raw(
+        lambda *a: -1,
+        lambda offset, size, tp: (ba.clear(), centry.runs([(0, 1, size)]))[1],
+        _core,
+        io=False,
+        write=False,
+    )
+    assert shrinking(0, 16, ba) == -1  # (too small now: handed on, nothing copied)
