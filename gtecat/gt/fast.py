@@ -1214,6 +1214,22 @@ def fast_raw(
             return True
         return False  # ctypes and numpy buffers: one numpy copy through a cached view
 
+    def range_plan(slave: int, offset: int, size: int, image: Any) -> Any:
+        """The image buffer's plan of a raw range (:func:`_plan`; a slave's region where
+        ``io``: ``slave`` >= 0, the range within its inputs or outputs), or None where the
+        range is not one the fast paths copy (the general path says why)."""
+        raw = offset
+        if io:
+            slaves = image.layout.slaves
+            if not 0 <= slave < len(slaves):
+                return None
+            sl = slaves[slave]
+            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
+                return None
+            raw = sl.gt_offset + offset
+        plan = _plan(image, raw, size, write, COPY_RUNS)
+        return None if plan is None or not plan[0] else plan
+
     #: (slave or -1, offset, size, the buffer's type) -> a copier: ``copy(p)`` moves the
     #: bytes (False: this buffer cannot take them this way, the general path decides)
     copiers: dict[tuple[int, int, int, type], Callable[[Any], bool]] = {}
@@ -1226,17 +1242,8 @@ def fast_raw(
         image, and one ``struct`` call moves them all into or out of the caller's buffer
         (``pack_into`` / ``unpack_from`` check that the buffer is big enough, writable for
         a read, and C-contiguous; whatever they refuse goes to the general path)."""
-        raw = offset
-        if io:
-            slaves = image.layout.slaves
-            if not 0 <= slave < len(slaves):
-                return None
-            sl = slaves[slave]
-            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
-                return None
-            raw = sl.gt_offset + offset
-        plan = _plan(image, raw, size, write, COPY_RUNS)
-        if plan is None or not plan[0]:
+        plan = range_plan(slave, offset, size, image)
+        if plan is None:
             return None
         runs = plan[0]
         if tp is bytearray or (write and tp is bytes):
@@ -1385,17 +1392,8 @@ def fast_raw(
     def address(slave: int, offset: int, size: int, image: Any) -> bytes | None:
         """Where a raw range (a slave's region: ``slave`` >= 0) lies in the image's buffer:
         its runs (:func:`centry.runs`), where the fast path copies it; else None."""
-        raw = offset
-        if io:
-            slaves = image.layout.slaves
-            if not 0 <= slave < len(slaves):
-                return None
-            sl = slaves[slave]
-            if offset < 0 or offset + size > (sl.out_bytes if write else sl.gt_size):
-                return None
-            raw = sl.gt_offset + offset
-        plan = _plan(image, raw, size, write, COPY_RUNS)
-        if plan is None or not plan[0]:
+        plan = range_plan(slave, offset, size, image)
+        if plan is None:
             return None
         base = int(image.buffer.ctypes.data)
         return centry.runs((a, base + first, n) for a, first, n in plan[0])
