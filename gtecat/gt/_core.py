@@ -173,12 +173,17 @@ class _Session:
 
     def gates(self) -> None:
         """Open or close the fast readers' gates (:func:`fast.set_gates`): the controller
-        of core 1 of the current card where it runs in this process on the lockstep clock,
-        for the GT_ functions where they address core 1 too.  Called wherever one of those
-        can change (the card, the core, attaching, a card's cores; a controller's clock
-        mode is its own for good)."""
+        of core 1 of the current card where it runs in this process on the lockstep or the
+        auto clock (never a thread of its own: the realtime clock's cycles run beside the
+        calls), for the GT_ functions where they address core 1 too.  Called wherever one of
+        those can change (the card, the core, attaching, a card's cores; a controller's
+        clock mode is its own for good)."""
         c = self.controllers.get(1)
-        on = c is not None and self._remote is None and c.clock.mode is ClockMode.LOCKSTEP
+        on = (
+            c is not None
+            and self._remote is None
+            and c.clock.mode in (ClockMode.LOCKSTEP, ClockMode.AUTO)
+        )
         set_gates(c if on and self._core == 1 else None, c if on else None)
 
     @property

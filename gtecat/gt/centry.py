@@ -94,6 +94,7 @@ class _Entry(ctypes.Structure):
         ("noaxis", ctypes.c_ssize_t),
         ("avalue", _VP),
         ("gate", ctypes.c_ssize_t),
+        ("after", _VP),
     ]
 
 
@@ -107,20 +108,26 @@ class _RawEntry(ctypes.Structure):
         ("io", ctypes.c_ssize_t),
         ("write", ctypes.c_ssize_t),
         ("gate", ctypes.c_ssize_t),
+        ("after", _VP),
     ]
 
 
 #: the session's gates, read by every gated entry before it asks its value (written by
 #: :mod:`gtecat.gt._core` wherever their answer can change: :func:`set_gates`):
-#: [0] nonzero while the GT_ functions address the in-process lockstep controller of core 1,
-#: [1] while the GTN_ functions' core 1 is that controller
+#: [0] nonzero while the GT_ functions address an in-process controller of core 1 on the
+#: lockstep (:data:`LOCKSTEP`) or the auto clock (:data:`AUTO`: an entry's ``after`` runs
+#: the call's host latency once the value is written), [1] while the GTN_ functions' core 1
+#: is such a controller
 GATES = (ctypes.c_ssize_t * 2)()
 #: an entry's gate: none, the GT_ functions', the GTN_ functions'
 NO_GATE, GT_GATE, GTN_GATE = 0, 1, 2
+#: an open gate's value: its controller's clock
+CLOSED, LOCKSTEP, AUTO = 0, 1, 2
 
 
-def set_gates(gt: bool, gtn: bool) -> None:
-    """Open or close the two gates (:data:`GATES`)."""
+def set_gates(gt: int, gtn: int) -> None:
+    """Open (:data:`LOCKSTEP`, :data:`AUTO`) or close (:data:`CLOSED`) the two gates
+    (:data:`GATES`)."""
     GATES[0], GATES[1] = int(gt), int(gtn)
 
 
@@ -409,6 +416,7 @@ def _load() -> tuple[Maker | None, str]:
         noaxis: bool = False,
         array: Callable[..., Any] | None = None,
         gate: int = NO_GATE,
+        after: Callable[[], Any] | None = None,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -419,6 +427,7 @@ def _load() -> tuple[Maker | None, str]:
         e.noaxis = int(noaxis)
         e.avalue = id(array) if array is not None else None
         e.gate = gate
+        e.after = id(after) if after is not None else None
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -426,7 +435,7 @@ def _load() -> tuple[Maker | None, str]:
             e.types[k] = id(t)
             e.sizes[k] = size or ctypes.sizeof(x)
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
-        keep = (fallback, value, sentinel, kinds, array)
+        keep = (fallback, value, sentinel, kinds, array, after)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -437,9 +446,11 @@ def _load() -> tuple[Maker | None, str]:
         io: bool,
         write: bool,
         gate: int = NO_GATE,
+        after: Callable[[], Any] | None = None,
     ) -> Any:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
-        keep = (fallback, value, sentinel)
+        e.after = id(after) if after is not None else None
+        keep = (fallback, value, sentinel, after)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
 
@@ -735,6 +746,7 @@ def reader(
     noaxis: bool = False,
     array: Callable[..., Any] | None = None,
     gate: int = NO_GATE,
+    after: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -748,14 +760,27 @@ def reader(
     int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
     array's start (it checks the array's type and length), else anything but bytes;
     ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
-    that gate of :data:`GATES` is open (else ``fallback``), so they need not check the
-    session themselves.
+    that gate of :data:`GATES` is open (else ``fallback``; ``after()``, where given, the
+    call's return once its value is written while the gate says :data:`AUTO`), so they
+    need not check the session themselves.
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
     return _MAKE(
-        fallback, value, sentinel, types, kind, core, most, size, pointers, noaxis, array, gate
+        fallback,
+        value,
+        sentinel,
+        types,
+        kind,
+        core,
+        most,
+        size,
+        pointers,
+        noaxis,
+        array,
+        gate,
+        after,
     )
 
 
@@ -766,6 +791,7 @@ def raw(
     io: bool,
     write: bool,
     gate: int = NO_GATE,
+    after: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
     ctypes array (or ``byref`` of one, no offset), a bytearray of at least ``size`` bytes
@@ -778,7 +804,7 @@ def raw(
     C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write, gate)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")

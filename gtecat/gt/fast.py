@@ -509,11 +509,12 @@ def fast_reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
             array=array_value(value_gt, True), gate=centry.GT_GATE,
+            after=_after(advance, name, 0),
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, False),
-            gate=centry.GTN_GATE,
+            gate=centry.GTN_GATE, after=_after(advance, name, 1),
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
@@ -553,17 +554,35 @@ def _gated(env: dict[str, Any]) -> dict[str, Any]:
 
 def set_gates(gt: Any, gtn: Any) -> None:
     """The session's answer (gtecat.gt._core: wherever it can change): ``gt`` the
-    in-process lockstep controller the GT_ functions address with core 1, ``gtn`` the GTN_
+    in-process lockstep or auto controller the GT_ functions address with core 1, ``gtn`` the GTN_
     functions' core 1, or None.  The gated value functions read it as ``CTL`` / ``CTLN``,
     their C entries' gates open for it."""
     new = [_OFF if gt is None else gt, _OFF if gtn is None else gtn]
     if new[0] is GATED[0] and new[1] is GATED[1]:  # (the same: a client's call's select)
         return
-    centry.set_gates(False, False)
+    centry.set_gates(centry.CLOSED, centry.CLOSED)
     GATED[:] = new
     for env in _GATED_ENVS:
         env["CTL"], env["CTLN"] = GATED
-    centry.set_gates(gt is not None, gtn is not None)
+    centry.set_gates(_gate_value(gt), _gate_value(gtn))
+
+
+def _gate_value(ctl: Any) -> int:
+    """A gate's value for the controller behind it (None: closed)."""
+    if ctl is None:
+        return centry.CLOSED
+    return centry.LOCKSTEP if ctl.clock.mode is _LOCKSTEP else centry.AUTO
+
+
+def _after(advance: Callable[[Any, str, int], int], name: str, k: int) -> Callable[[], int]:
+    """An entry's ``after`` (:func:`centry.reader`): in the auto clock the call's host
+    latency once its value is written, as the Python path's ``advance`` runs it (its
+    cycles may run; what they raise becomes the call's code), on gate ``k``'s controller."""
+
+    def after() -> int:
+        return advance(GATED[k], name, 0)
+
+    return after
 
 
 def _entry(
@@ -573,6 +592,7 @@ def _entry(
     kind: int,
     size: int = 0,
     gate: int = centry.NO_GATE,
+    after: Callable[[], int] | None = None,
 ) -> Any:
     """A two-argument reader's public function: its C entry in front of its Python fast
     function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
@@ -583,7 +603,7 @@ def _entry(
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
     entry = centry.reader(
-        gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate
+        gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate, after=after
     )
     if entry is None:
         return gt
@@ -1435,7 +1455,7 @@ def fast_raw(
     exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
     value = venv["value"]
 
-    public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE)
+    public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE, _after(advance, name, 0))
     if public is None:
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
@@ -1812,7 +1832,9 @@ def fast_ecat_reader(
     gt.slow = slow
     _gated(env)
     exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
-    return _entry(gt, env["value"], ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
+    return _entry(  # type: ignore[no-any-return]
+        gt, env["value"], ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
+    )
 
 
 #: a PDO reader's value for its C entry (the common case of ``_ECAT_READER``, the axis's
@@ -2074,7 +2096,9 @@ def fast_homing_status(
         return v
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return _entry(gt, value, ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
+    return _entry(  # type: ignore[no-any-return]
+        gt, value, ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
+    )
 
 
 def struct_packer(cls: type) -> Callable[..., None] | None:
@@ -2252,7 +2276,9 @@ def fast_struct_reader(
     inline = getattr(to_bytes, "inline", "b = TO_BYTES(res)")  # (to_bytes' steps inline)
     code = _STRUCT_VALUE.replace("{bytes}", "\n".join("        " + x for x in inline.split("\n")))
     exec(_compiled_code(code, f"<gt struct value {name}>"), _gated(env))
-    return _entry(gt, env["value"], [cls], centry.BYTES, size, centry.GT_GATE)  # type: ignore[no-any-return]
+    return _entry(  # type: ignore[no-any-return]
+        gt, env["value"], [cls], centry.BYTES, size, centry.GT_GATE, _after(advance, name, 0)
+    )
 
 
 #: a structure reader's value for its C entry (asked while the GT_ gate is open: CTL the
@@ -2401,7 +2427,13 @@ def fast_home_status(
         return b
 
     return _entry(  # type: ignore[no-any-return]
-        gt, value, [THomeStatus], centry.BYTES, _HOME_STATUS.size, centry.GT_GATE
+        gt,
+        value,
+        [THomeStatus],
+        centry.BYTES,
+        _HOME_STATUS.size,
+        centry.GT_GATE,
+        _after(advance, name, 0),
     )
 
 
@@ -2579,7 +2611,9 @@ def fast_io_reader(
     gt.slow = slow  # type: ignore[attr-defined]
     _gated(env)
     exec(compile(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>", "exec"), env)
-    return _entry(gt, env["value"], ok, centry.INT, gate=centry.GT_GATE)  # type: ignore[no-any-return]
+    return _entry(  # type: ignore[no-any-return]
+        gt, env["value"], ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
+    )
 
 
 #: fast_io_reader's function (``{lo}``..``{hi}``: the types it reads; ``{kind}``: its readers'

@@ -79,6 +79,8 @@ struct entry {
     ptrdiff_t noaxis; /* 1: f(p[, q]) (GT_GetClock(pClock, pLoop)): q NULL, value() */
     obj avalue; /* NULL, or avalue(n, count, array type, pClock): a ctypes array's bytes */
     ptrdiff_t gate; /* 0: none; k: value (and avalue) only while A.gate[k - 1] is nonzero */
+    obj after; /* NULL, or after(): the call's return code once written, where A.gate[k - 1] is
+                * 2 (the auto clock: the call's host latency, which may run cycles) */
 };
 
 static struct api A;
@@ -122,6 +124,16 @@ static int int_is(obj o, long long want)
 }
 
 /* a reader's ctypes array (count from n): the bytes avalue gives copied to its start */
+/* A call's return once its value is written: 0, or in the auto clock (its gate says 2)
+ * what after() returns (the call's host latency, as the Python path's advance runs it). */
+static obj done(obj after, ptrdiff_t gate)
+{
+    if (after && gate && A.gate[gate - 1] == 2)
+        return A.vectorcall(after, NULL, 0, NULL);
+    A.incref(A.zero);
+    return A.zero;
+}
+
 static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                  ptrdiff_t at)
 {
@@ -143,8 +155,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     /* (avalue checked the array's type and length: the bytes fit) */
     memcpy(AT(args[at + 1], A.b_ptr), (char *)v + A.bdata, (size_t)n);
     A.decref(v);
-    A.incref(A.zero);
-    return A.zero;
+    return done(e->after, e->gate);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
@@ -297,8 +308,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
             *(int64_t *)mem = (int64_t)x;
     }
     A.decref(v);
-    A.incref(A.zero);
-    return A.zero;
+    return done(e->after, e->gate);
 
 drop:
     A.decref(v);
@@ -314,6 +324,7 @@ struct raw_entry {
     ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
     ptrdiff_t write; /* 1: from the buffer into the image */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
+    obj after;       /* as struct entry's */
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -403,8 +414,7 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
             memcpy(mem + r[0], image, (size_t)r[2]);
     }
     A.decref(v);
-    A.incref(A.zero);
-    return A.zero;
+    return done(e->after, e->gate);
 
 drop:
     A.decref(v);

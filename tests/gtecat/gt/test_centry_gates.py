@@ -47,7 +47,7 @@ def _session_says() -> tuple[Any, Any]:
     """The controllers the two gates must name (None: closed), from the session itself."""
     s = _core.SESSION
     c = s.controllers.get(1)
-    on = c is not None and s.remote is None and c.clock.mode is ClockMode.LOCKSTEP
+    on = c is not None and s.remote is None and c.clock.mode in (ClockMode.LOCKSTEP, ClockMode.AUTO)
     return (c if on and s.core == 1 else None), (c if on else None)
 
 
@@ -55,7 +55,14 @@ def _gates_follow() -> None:
     want = _session_says()
     got = tuple(None if c is fast._OFF else c for c in fast.GATED)
     assert got[0] is want[0] and got[1] is want[1], (got, want)
-    assert list(centry.GATES) == [int(want[0] is not None), int(want[1] is not None)]
+    assert list(centry.GATES) == [_gate(want[0]), _gate(want[1])]
+
+
+def _gate(c: Any) -> int:
+    """A gate's value for controller ``c`` (None: closed)."""
+    if c is None:
+        return centry.CLOSED
+    return centry.LOCKSTEP if c.clock.mode is ClockMode.LOCKSTEP else centry.AUTO
 
 
 def _shown(o: Any) -> Any:
@@ -134,7 +141,8 @@ def test_the_gates_follow_open_close_core_card_and_attach() -> None:
     gt.GT_Close()
     _open(clock="auto", move=False)
     _gates_follow()
-    assert list(centry.GATES) == [0, 0]
+    assert list(centry.GATES) == [centry.AUTO, centry.AUTO]
+    _agree("opened in auto (each call's host latency run by the entry's after)")
     gt.GT_Close()
     _open()
     _agree("reopened in lockstep")
@@ -251,3 +259,36 @@ def test_the_home_status_answers_as_the_table_through_a_smart_homing() -> None:
     _home_agree("wrapping")
     assert gt.GT_SetCore(2) == 0
     _home_agree("core 2")
+
+
+def _auto_session(use: str) -> list[Any]:
+    """A moving axis polled 600 times in the auto clock (each call costs host latency, a
+    cycle running every few calls) through the public functions (``use`` "public": their C
+    entries) or their Python paths: what each call answered and the controller's time."""
+    _open(clock="auto")
+    out: list[Any] = []
+    try:
+        ctl = gt.GTE_Controller()
+        for k in range(100):
+            for label, public, _table, make in _calls():
+                if label.startswith("gtn"):
+                    continue  # (a twin has no Python path of its own to call)
+                fn = public if use == "public" else public.python
+                o, args = make()
+                rc = fn(*args)
+                out.append((k, label, rc, _shown(o), ctl.clock.now_ns))
+    finally:
+        gt.GT_Close()
+    return out
+
+
+def test_in_the_auto_clock_the_entries_run_the_calls_latency_as_the_python_path() -> None:
+    """The auto clock: an entry answers, then runs the call's host latency (its cycles,
+    when one is due) as the Python path does: the same answers at the same controller
+    times, call by call."""
+    if centry.REASON:
+        pytest.skip(f"no C entry here: {centry.REASON}")
+    entry, python = _auto_session("public"), _auto_session("python")
+    bad = [f"{a} / {b}" for a, b in zip(entry, python, strict=True) if a != b]
+    assert not bad, "\n".join(bad[:5])
+    assert entry[-1][-1] > entry[0][-1]  # (time passed: cycles ran among the calls)
