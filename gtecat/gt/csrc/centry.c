@@ -340,6 +340,27 @@ obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnam
                (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
+/* The buffer a raw entry copies into or out of (target: p, or the array of a byref of one
+ * with no offset), or NULL where this entry does not take it.  Looked up before the value
+ * function (the shape) and again after it: the value function is Python, and meanwhile
+ * another thread or a collector callback may resize a bytearray or a ctypes array
+ * (ctypes.resize moves its memory); nothing of Python runs between the second look-up and
+ * the copy. */
+static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long size)
+{
+    obj t = TYPE(target);
+    if (t == A.bytearray_type || (e->write && t == A.bytes_type)) {
+        if (target != p || *(ptrdiff_t *)((char *)p + A.bsize) < size)
+            return NULL;
+        return t == A.bytes_type ? (char *)p + A.bdata : AT(p, A.bastart);
+    }
+    if (TYPE(t) != A.array_meta)
+        return NULL;
+    if (target != p && AT(p, A.carg_value) != AT(target, A.b_ptr))
+        return NULL; /* byref(array, offset), or the array's memory moved since */
+    return AT(target, A.b_ptr);
+}
+
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
 {
     ptrdiff_t at = e->io, k, n;
@@ -356,9 +377,9 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
             goto python;
     p = args[2 + at];
     target = p;
-    if (TYPE(p) == A.carg_type) { /* byref(array) with no offset: the array */
+    if (TYPE(p) == A.carg_type) { /* byref(array) with no offset: the array (raw_mem) */
         target = AT(p, A.carg_obj);
-        if (!target || AT(p, A.carg_value) != AT(target, A.b_ptr))
+        if (!target)
             goto python;
     }
     size = A.as_ll(args[1 + at], &over);
@@ -367,15 +388,8 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
             A.err_clear();
         goto python;
     }
-    if (TYPE(target) == A.bytearray_type || (e->write && TYPE(target) == A.bytes_type)) {
-        if (target != p || *(ptrdiff_t *)((char *)p + A.bsize) < size)
-            goto python;
-        mem = TYPE(p) == A.bytes_type ? (char *)p + A.bdata : AT(p, A.bastart);
-    } else if (TYPE(TYPE(target)) == A.array_meta) {
-        mem = AT(target, A.b_ptr);
-    } else {
+    if (!raw_mem(e, p, target, size))
         goto python;
-    }
     for (k = 0; k < 2 + at; k++)
         call[k] = args[k];
     call[2 + at] = TYPE(target);
@@ -389,17 +403,9 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
-    /* the buffer's memory again: the value function is Python, and meanwhile another thread
-     * or a collector callback may resize a bytearray or a ctypes array (ctypes.resize) */
-    if (TYPE(target) == A.bytearray_type) {
-        if (*(ptrdiff_t *)((char *)target + A.bsize) < size)
-            goto drop;
-        mem = AT(target, A.bastart);
-    } else if (TYPE(target) != A.bytes_type) {
-        mem = AT(target, A.b_ptr);
-        if (target != p && AT(p, A.carg_value) != mem)
-            goto drop;
-    }
+    mem = raw_mem(e, p, target, size); /* (again: Python ran) */
+    if (!mem)
+        goto drop;
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         if (r[0] < 0 || r[2] <= 0 || r[0] + r[2] > size || !r[1])
