@@ -234,13 +234,6 @@ class _TypeSpec(ctypes.Structure):
     ]
 
 
-def _pointer_type(t: type) -> type:
-    """``ctypes.POINTER(t)`` (:func:`_pointer_types_of_ctypes`)."""
-    p = ctypes.POINTER(t)
-    _pointer_types_of_ctypes()
-    return p
-
-
 def _pointer_types_of_ctypes() -> None:
     """A pointer type ctypes made first for this module's code (its probes, its entries)
     says it is ctypes': its repr would otherwise name this module in every ``pointer(x)``
@@ -420,7 +413,8 @@ def _load() -> tuple[Maker | None, str]:
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
-            kinds += tuple(_pointer_type(t) for t in kinds)
+            kinds += tuple(ctypes.POINTER(t) for t in kinds)
+            _pointer_types_of_ctypes()
         if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
             raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
