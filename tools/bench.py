@@ -51,6 +51,7 @@ sys.path.insert(0, str(ROOT))
 EXAMPLES = ROOT / "examples"
 #: the manual's figure 5-2 bus: 2 CSP drives and 2 IO slaves
 FIG5_2 = EXAMPLES / "manual_fig5_2.eni"
+FIG5_TEXT = "the manual's figure 5-2 bus (2 drives, 2 IO slaves), both moving"
 
 
 def _bus(eni: Path, *, plain: bool):
@@ -742,9 +743,19 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
     from tools.bench_scaling import crd_plan, run_bus, run_gohome
 
     def rtf(
-        n: int, plan: dict[int, str], target: float | None, what: str, bank: str | None = None
+        n: int,
+        plan: dict[int, str],
+        target: float | None,
+        what: str,
+        bank: str | None = None,
+        eni: Path | None = None,
     ) -> dict[str, object]:
-        r = {"axes": n, "what": what, **run_bus(n, plan, seconds=seconds, repeat=repeat, bank=bank)}
+        """``run_bus`` on ``n`` generated axes (``eni``: that bus instead)."""
+        r = {
+            "axes": n,
+            "what": what,
+            **run_bus(n, plan, seconds=seconds, repeat=repeat, bank=bank, eni_file=eni),
+        }
         return r if target is None else _figure(r, "rtf", target)
 
     def every(n: int, state: str) -> dict[int, str]:
@@ -758,13 +769,8 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         r |= run_gohome(n, mode, repeat=repeat)
         return r if target is None else _figure(r, "rtf", target)
 
-    def fig5_2() -> dict[str, object]:
-        r = {"axes": 2, "what": "the manual's figure 5-2 bus (2 drives, 2 IO slaves), both moving"}
-        r |= run_bus(2, every(2, "moving"), seconds=seconds, repeat=repeat, eni_file=FIG5_2)
-        return _figure(r, "rtf", 300)
-
     figures: dict[str, Callable[[], dict[str, object]]] = {
-        "rtf_fig5_2_trap": fig5_2,
+        "rtf_fig5_2_trap": lambda: rtf(2, every(2, "moving"), 300, FIG5_TEXT, eni=FIG5_2),
         "rtf_1_axis_trap": lambda: rtf(1, every(1, "moving"), 500, "one axis moving in Trap"),
         "rtf_12_axes_trap": lambda: rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
         "rtf_64_axes_32_trap_32_holding": lambda: rtf(
