@@ -832,6 +832,24 @@ def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:
 
 
 def _fault_reset(ctl: Controller, faulted: list[AxisResources]) -> None:
+    """Reset the drives of ``faulted`` (their drive in FAULT or FAULT REACTION ACTIVE): the
+    controlword's bit 7 low, then rising, a few cycles each, bounded.  The axes stay out of
+    the axis bank meanwhile (``bank_hold``): their state is read every cycle, and a drive at
+    rest in FAULT would be taken back before each cycle only to be given back by that read."""
+    held = [(r, r.bank_hold) for r in faulted]
+    for r in faulted:
+        r.bank_hold = True
+    try:
+        _fault_reset_steps(ctl, faulted)
+    finally:
+        for r, was in held:
+            r.bank_hold = was
+        bank = getattr(ctl, "bank", None)
+        if bank is not None:
+            bank.dirty = True  # the axes may be taken again: looked at before the next cycle
+
+
+def _fault_reset_steps(ctl: Controller, faulted: list[AxisResources]) -> None:
     clock = ctl.clock
     clock.run_until(
         lambda: all(r.ax.state != PdsState.FAULT_REACTION_ACTIVE for r in faulted),

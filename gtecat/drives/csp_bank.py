@@ -33,6 +33,7 @@ from .modes import SW12, OpMode
 
 if TYPE_CHECKING:
     from .drive import Channel
+    from .faults import FieldOverride
 
 _INT32_MIN, _INT32_MAX = -(1 << 31), (1 << 31) - 1
 _SW_BASE = STATE_BITS[State.OPERATION_ENABLED]
@@ -120,6 +121,16 @@ _UNPOWERED_IDLE = frozenset(
 )
 
 
+def _inert_at_rest(ff: FieldOverride) -> bool:
+    """The field's hands change nothing of an unpowered drive at rest: safe torque off and
+    a closed holding brake only take power or motion away, which such a drive has not
+    (Channel.step: ``powered`` is already False, the motor stands, ``dpos`` on it); a
+    forced input, a lost or noisy encoder, a quick-stop input or a silenced probe do."""
+    return not (
+        ff.din_set or ff.din_clear or ff.enc_shift or ff.enc_noise or ff.quick_stop or ff.probe_off
+    )
+
+
 def frozen_claimable(ch: Channel) -> str:
     """Why ``ch`` is not resting unpowered with nothing to change from cycle to cycle ("" when
     it is): its step would coast a standing motor, take no transition and write the same
@@ -134,7 +145,7 @@ def frozen_claimable(ch: Channel) -> str:
         return "a transition is due"
     if ch.faults.pending or (ch.faults.injected and psm.state is not State.FAULT):
         return "fault"  # (in FAULT a persisting cause only refuses a reset: cw stays as it is)
-    if ch.field is not None:
+    if ch.field is not None and not _inert_at_rest(ch.field):
         return "field fault"  # (a switch forced, encoder noise: the values may change)
     if ch.mode_req != ch.mode_seen or ch.mode_due is not None:
         return "mode change pending"

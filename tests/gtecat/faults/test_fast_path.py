@@ -148,3 +148,47 @@ def test_a_position_trigger_keeps_only_its_axis_off_the_bank() -> None:
     gt.GTE_Wait(5)
     assert 2 not in [ax.number for ax in ctl._run_axes]
     assert ctl.bank.held == frozenset()
+
+
+def _resting_session(way: str) -> list:
+    """A drive under safe torque off and one whose fault persists, reset by the application
+    every 50 ms while the cause lasts (each reset runs its cycles and gives up), then moved
+    again: what GT_ClrSts and GT_GetSts gave, where the axes ended, and how many of the cycles
+    the bank ran at once while the drives rested (the way it came only)."""
+    ctl = _up("off" if way == "no bank" else "auto")
+    if way == "one at a time":
+        ctl.clock.run_many = None
+    faults.inject("sto", axis=1, duration_ms=260)
+    faults.inject("drive_fault", axis=2, code=0x2310, duration_ms=180)
+    seen = []
+    s = c_long()
+    c0 = ctl.clock.cycles
+    b0 = ctl.bank.many_cycles if ctl.bank is not None else 0
+    for _ in range(8):
+        gt.GTE_Wait(50)
+        for a in (1, 2):
+            seen.append((gt.GT_ClrSts(a, 1), gt.GT_GetSts(a, byref(s)), s.value))
+    batched = (ctl.bank.many_cycles - b0) / (ctl.clock.cycles - c0) if way == "batched" else 0
+    seen += [gt.GT_AxisOn(1), gt.GT_AxisOn(2)]
+    gt.GTE_Wait(20)
+    seen += [_trap(1, 4000), _trap(2, -3000)]
+    gt.GTE_Wait(400)
+    for a in (1, 2):
+        p = c_double()
+        gt.GT_GetEncPos(a, byref(p))
+        gt.GT_GetSts(a, byref(s))
+        seen.append((p.value, s.value))
+    gt.GT_Close()
+    return [seen, batched]
+
+
+def test_drives_resting_in_a_fault_run_at_once_and_reset_alike() -> None:
+    """A drive at rest in FAULT under safe torque off rests in the bank (the field's hands
+    change nothing of it), and the axes of a fault reset stay off it while the reset runs:
+    the same codes, words and positions as one cycle at a time and without the bank."""
+    fast = _resting_session("batched")
+    assert fast[0][0][2] & ALARM and fast[0][1][2] & ALARM  # both drives faulted at first
+    assert fast[1] > 0.6  # most of the resting cycles ran at once (0.48 with STO scalar)
+    slow = _resting_session("one at a time")
+    assert fast[0] == slow[0]
+    assert fast[0] == _resting_session("no bank")[0]
