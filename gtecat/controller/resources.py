@@ -83,7 +83,7 @@ from typing import Any, Protocol
 from ..errors import BusError, CommandError, ParameterError
 from ..master.clock import Clock
 from ..master.image import EntryAccess
-from .axis import Axis, PdsState
+from .axis import Axis, PdsState, decode_state
 from .axis_status import BLOCKING, LATCHED, AxisStatus, InPosition
 from .encoder import Encoder
 from .motion import JogParams, Planner, TrapParams
@@ -473,6 +473,13 @@ class AxisResources:
     def drive_faulted(self) -> bool:
         return self.ax.state in (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
 
+    def drive_state(self) -> PdsState:
+        """The drive's state as 6041h in the image shows it (:attr:`Axis.state`), read
+        without touching the axis: an axis the bank runs stays there (its row writes 6041h
+        into the image every cycle it changes, like the scalar path's exchange)."""
+        sw = self._sw
+        return self.ax.state if sw is None else decode_state(sw.get())
+
     # --- commands: modes and parameters ----------------------------------------------------
     def prf_trap(self) -> None:
         """GT_PrfTrap."""
@@ -833,26 +840,15 @@ def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:
 
 def _fault_reset(ctl: Controller, faulted: list[AxisResources]) -> None:
     """Reset the drives of ``faulted`` (their drive in FAULT or FAULT REACTION ACTIVE): the
-    controlword's bit 7 low, then rising, a few cycles each, bounded.  The axes stay out of
-    the axis bank meanwhile (``bank_hold``): their state is read every cycle, and a drive at
-    rest in FAULT would be taken back before each cycle only to be given back by that read."""
-    held = [(r, r.bank_hold) for r in faulted]
-    for r in faulted:
-        r.bank_hold = True
-    try:
-        _fault_reset_steps(ctl, faulted)
-    finally:
-        for r, was in held:
-            r.bank_hold = was
-        bank = getattr(ctl, "bank", None)
-        if bank is not None:
-            bank.dirty = True  # the axes may be taken again: looked at before the next cycle
+    controlword's bit 7 low, then rising, a few cycles each, bounded.
 
-
-def _fault_reset_steps(ctl: Controller, faulted: list[AxisResources]) -> None:
+    The drives' state is watched every cycle in the 6041h the image holds
+    (:meth:`AxisResources.drive_state`), which leaves an axis the bank runs where it is: a
+    drive resting in FAULT while its cause persists (the reset refused) then rests in the bank
+    for those cycles instead of being given back at each look."""
     clock = ctl.clock
     clock.run_until(
-        lambda: all(r.ax.state != PdsState.FAULT_REACTION_ACTIVE for r in faulted),
+        lambda: all(r.drive_state() != PdsState.FAULT_REACTION_ACTIVE for r in faulted),
         FAULT_REACTION_TIMEOUT_MS,
     )
     for r in faulted:
@@ -860,10 +856,11 @@ def _fault_reset_steps(ctl: Controller, faulted: list[AxisResources]) -> None:
         r.ax.cw = 0x0000
     _run_cycles(ctl, 1)  # the drive sees bit 7 low ...
     for r in faulted:
-        if r.ax.state == PdsState.FAULT:
+        if r.drive_state() == PdsState.FAULT:
             r.ax.cw = _CW_FAULT_RESET  # ... then rising (transition 15)
     clock.run_until(
-        lambda: not any(r.ax.state == PdsState.FAULT for r in faulted), FAULT_RESET_TIMEOUT_MS
+        lambda: not any(r.drive_state() == PdsState.FAULT for r in faulted),
+        FAULT_RESET_TIMEOUT_MS,
     )
     for r in faulted:
         r.ax.cw = 0x0000
