@@ -1384,12 +1384,6 @@ class AxisBank:
                 self.release_axis_object(ax)
         self.dirty = True
 
-    def look_again(self) -> None:
-        """Rows kept out for a while may be taken now (a hold ended): look before the next
-        cycle, and soon after it again, as after a release (not RECHECK_CYCLES later)."""
-        self.dirty = True
-        self._wait = 1
-
     def before_axis_call(self, ax: Any, res: Any) -> None:
         """What :meth:`before_call` does for a GT function naming one existing axis ``ax``
         (its resources ``res``) by its first parameter (``axis``, ``profile`` or ``encoder``,
