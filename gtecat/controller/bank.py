@@ -1429,7 +1429,7 @@ class AxisBank:
                     out += [self.groups[gi] for gi in cl.groups if self.groups[gi] not in out]
             groups = [g for g in out if g.claimed]
         rows = [r for g in groups for r in g.rows]
-        if 4 * len(rows) >= self.n:
+        if len(rows) > 4 and 4 * len(rows) >= self.n:
             self._materialise()
             vel, acc = self._enc_rates()
             p, v, a = self.prf_p, self.prf_v, self.prf_a
