@@ -49,6 +49,13 @@ class FaultBus:
         """Time that never goes back (a GT_Reset does not move it): durations, ``after_ms``."""
         return self.now_ms(ahead)
 
+    def cycle_mark(self) -> tuple[int, ...] | None:
+        """(time ns, cycles run, cycle time ns, the time GT_Reset counts from, ns) where a
+        bus counts its cycles, so that a count of quiet cycles made at one mark holds at a
+        later one less the cycles between them (:meth:`Injector.quiet_cycles`); None: it
+        does not."""
+        return None
+
     def healthy(self) -> bool:
         return True
 
@@ -214,6 +221,10 @@ class EmulatedBus(FaultBus):
     def t_ms(self, ahead: int = 0) -> float:
         clock = self.ctl.clock
         return (clock.now_ns + ahead * clock.cycle_ns) / 1e6
+
+    def cycle_mark(self) -> tuple[int, ...] | None:
+        clock = self.ctl.clock
+        return (clock.now_ns, clock.cycles, clock.cycle_ns, self.ctl.reset_ns)
 
     def healthy(self) -> bool:
         m = self.ctl.master

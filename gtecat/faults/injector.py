@@ -31,12 +31,24 @@ from ..errors import ParameterError
 from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
 from . import kinds as k
 from .bus import FaultBus
-from .triggers import AfterTime, AtTime, Now, Trigger, describe_after, first_cycle
+from .triggers import AfterTime, AtTime, Now, OnSdo, Trigger, describe_after, first_cycle
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
 #: active faults that act in every cycle (no cycles at once while one is on)
 _EVERY_CYCLE = (k.SwitchChatter, k.IoStuck)
+#: a count of quiet cycles far beyond any run of cycles at once
+_FAR = 1 << 40
+
+
+def _by_time(e: Entry) -> bool:
+    """An entry whose next change depends on the time alone: armed on a time (or on an SDO,
+    which is no cycle's), or active with no cycle of its own to act in."""
+    if e.after is not None:
+        return False
+    if e.state == "armed":
+        return isinstance(e.trigger, AtTime | AfterTime | OnSdo)
+    return e.state == "active" and not isinstance(e.fault, _EVERY_CYCLE)
 
 
 #: called with ("inject", values) / ("clear", {"id": N}) for every fault a program or an
@@ -101,6 +113,11 @@ class Injector:
         #: a fault that starts at once waits for the bus unless the bring-up can meet it (a
         #: mailbox fault: the InitCmds are SDOs); :meth:`bus_ready` starts it then
         self.holding = False
+        #: counts every change of the entries; with the first cycle in which anything may
+        #: happen, as :meth:`quiet_cycles` last found it: (version, the bus's cycle mark,
+        #: that cycle's count)
+        self._version = 0
+        self._memo: tuple[int, ...] | None = None
         self._wrap_mailboxes()
 
     # --- adding and clearing ----------------------------------------
@@ -220,7 +237,28 @@ class Injector:
         """How many of the next ``n`` cycles :meth:`tick` surely does nothing in but count
         (the controller runs them at once, :meth:`Controller.run_cycles`): all of them
         without faults; up to the first trigger due or duration over; none while a
-        chattering switch or a stuck IO input needs every cycle, or a trigger watches one."""
+        chattering switch or a stuck IO input needs every cycle, or a trigger watches one.
+
+        Asked before every run of cycles at once, so where every entry waits for a time
+        alone (:data:`_BY_TIME`) the first cycle anything may happen in is kept, by the bus's
+        cycle count (:meth:`FaultBus.cycle_mark`), and the next asks count down to it: the
+        same answer, as long as no entry changed (:attr:`_version`), no cycle ran outside
+        the count and neither the cycle time nor the time GT_Reset counts from moved."""
+        mark = self.bus.cycle_mark()
+        memo = self._memo
+        if mark is not None and memo is not None and memo[0] == self._version:
+            _, ns0, c0, cyc0, reset0, until = memo
+            ns, c, cyc, reset = mark
+            if cyc == cyc0 and reset == reset0 and ns - ns0 == (c - c0) * cyc:
+                return max(0, min(n, until - c))
+        self._memo = None
+        if mark is None or not all(map(_by_time, self.entries)):
+            return self._quiet_cycles(n)
+        far = self._quiet_cycles(_FAR)
+        self._memo = (self._version, *mark, mark[1] + far)
+        return max(0, min(n, far))
+
+    def _quiet_cycles(self, n: int) -> int:
         for e in self.entries:
             if n <= 0:
                 return 0
@@ -286,6 +324,7 @@ class Injector:
     def _refresh(self) -> None:
         """Frame faults routed while one is armed or active; bank-safe without position or
         homing triggers."""
+        self._version += 1  # (called after every change of the entries)
         frame = any(
             e.state == "active" and e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown)
             for e in self.entries
@@ -325,6 +364,7 @@ class Injector:
 
     # --- start and end ----------------------------------------
     def _start(self, e: Entry) -> None:
+        self._version += 1
         e.state = "active"
         e.started_ms = self.bus.t_ms()
         self._started.add(e.id)
@@ -381,6 +421,7 @@ class Injector:
     def _end(self, e: Entry, why: str) -> None:
         if e.state == "ended":
             return
+        self._version += 1
         e.state = "ended"
         f = e.fault
         bus = self.bus

@@ -192,3 +192,29 @@ def test_drives_resting_in_a_fault_run_at_once_and_reset_alike() -> None:
     slow = _resting_session("one at a time")
     assert fast[0] == slow[0]
     assert fast[0] == _resting_session("no bank")[0]
+
+
+def _reset_session(way: str) -> list:
+    """Time triggers counted down across runs of cycles at once, the clock's origin moved
+    by GT_Reset between them (at_ms counts from it, a duration does not)."""
+    ctl = _up()
+    if way == "one at a time":
+        ctl.clock.run_many = None
+    t = c_long()
+    gt.GT_GetClock(byref(t))
+    faults.inject("drive_fault", axis=1, code=0x2310, at_ms=t.value + 150, duration_ms=40)
+    faults.inject("encoder_lost", axis=2, counts=5, after_ms=260)
+    gt.GTE_Wait(100)
+    assert gt.GT_Reset() == 0  # the clock reads 0: at_ms is further off than it was
+    gt.GTE_Wait(600)
+    inj = faults.injector_for(ctl)
+    cycle = ctl.clock.cycle_ns / 1e6
+    events = [(round(ms / cycle), what, ident) for ms, what, ident, _ in inj.events]
+    gt.GT_Close()
+    return events
+
+
+def test_time_triggers_fire_in_the_same_cycle_across_a_reset() -> None:
+    fast = _reset_session("batched")
+    assert sorted(e[1:] for e in fast) == [("end", 1), ("start", 1), ("start", 2)]
+    assert fast == _reset_session("one at a time")
