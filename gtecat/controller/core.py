@@ -437,9 +437,11 @@ class Controller:
         if self.pre_cycle or self.post_cycle:
             hooks = self._hook_ways()
             for quiet, _ in hooks:
-                n = quiet(n)
-                if n <= 0:
-                    return 0
+                q = quiet(n)
+                if q < n:  # (an answer above n stands for n)
+                    if q <= 0:
+                        return 0
+                    n = q
         master = self.master
         if master is None or not master.steady():
             return 0
@@ -564,7 +566,7 @@ def _quiet_way(hook: Callable[[int, int], None]) -> Callable[[int], int]:
     obj = getattr(hook, "__self__", None)
     horizon = getattr(obj, "quiet_cycles", None)
     if horizon is not None:
-        return lambda n: min(n, horizon(n))
+        return horizon  # (an answer above n: the caller takes n)
     quiet = getattr(obj, "bank_quiet", None)
     if quiet is None:
         return lambda n: 0
