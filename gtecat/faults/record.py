@@ -38,6 +38,7 @@ import re
 import struct
 import sys
 import threading
+import time
 import zlib
 from array import array
 from contextlib import contextmanager
@@ -614,15 +615,26 @@ def replay(
     (:func:`_plan_file`: by ``gtecat record`` when it wrote the file, or by the replay
     before), else from its text, and the plan is kept for the next replay."""
     p = Path(path)
-    raw = _read_raw(p)
-    where = _plan_file(raw)
+    # the file as it stands (named by its place, size and times): the plan its bytes had
+    # when a replay read them, without reading them again (:func:`_plan_ref`)
+    taken = time.time_ns()
+    seen = _file_key(p)
+    where = _plan_ref(seen) if seen is not None else None
+    kept = _load_plan(where) if where is not None else None
+    raw = None
+    if kept is None:
+        raw = _read_raw(p)
+        where = _plan_file(raw)
     paused = gc.isenabled()
     if paused:
         gc.disable()
     marks = None  # (a plan's: where the opens and bring-ups are)
     freeze = False
     try:
-        kept = _load_plan(where) if where is not None else None
+        if kept is None:
+            kept = _load_plan(where) if where is not None else None
+            if kept is not None and seen is not None and where is not None:
+                _keep_ref(p, seen, taken, where)
         steps = None
         if kept is not None:
             head, plan = kept
@@ -632,12 +644,17 @@ def replay(
             except ValueError:  # (a plan this gtecat does not make the same: the text)
                 steps = None
         if steps is None:
+            if raw is None:  # (a plan this gtecat no longer takes: the text, and its plan)
+                raw = _read_raw(p)
+                where = _plan_file(raw)
             p, head, body = _open_text(p, raw)
             keep: list[Any] | None = [] if where is not None else None
             steps = _steps(p, body or "", keep)
             del body
             if keep and keep[0] is not None and where is not None:
                 _keep_plan(where, head, keep[0])
+                if seen is not None:
+                    _keep_ref(p, seen, taken, where)
         del raw
         entries = sum(map(is_, map(itemgetter(0), steps), repeat(None)))  # (not calls)
         _check_count(p, head, len(steps) - entries)
@@ -663,6 +680,8 @@ _PLAN_MAGIC = b"gtecat replay plan\n"
 #: newest stays whatever its size)
 PLANS_KEPT = 64
 PLAN_BYTES = 256 << 20
+#: the notes of which file holds which plan kept at most (:func:`_keep_ref`)
+REFS_KEPT = 256
 
 
 def _plan_file(raw: bytes) -> Path | None:
@@ -678,6 +697,72 @@ def _plan_file(raw: bytes) -> Path | None:
     h = hashlib.sha256(_code_tag())
     h.update(raw)
     return cache_root() / "replay" / f"{h.hexdigest()[:48]}.plan"
+
+
+#: how recent a file's last change may be for its plan to be found by its name and times
+#: (a change within the clock's tick of the one read would leave the times as they were)
+_SETTLED_NS = 1_000_000_000
+
+
+def _file_key(p: Path) -> tuple[Any, ...] | None:
+    """The file ``p`` as it stands: its full name, device, inode, size, modification and
+    change times (ns), None when it cannot be stat'ed or plans are off."""
+    if os.environ.get("GTECAT_REPLAY_CACHE") == "0":
+        return None
+    try:
+        st = os.stat(p)
+        name = os.path.realpath(p)
+    except (OSError, ValueError):
+        return None
+    return (name, st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+
+
+def _ref_file(key: tuple[Any, ...]) -> Path:
+    from .._cache import cache_root
+
+    h = hashlib.sha256(_code_tag())
+    h.update(repr(key).encode("utf-8", "surrogatepass"))
+    return cache_root() / "replay" / "by-file" / f"{h.hexdigest()[:48]}.ref"
+
+
+def _plan_ref(key: tuple[Any, ...]) -> Path | None:
+    """The plan :func:`_keep_ref` noted for a file that still has this key (its name, size
+    and times: any write changes the change time), None when there is none."""
+    try:
+        name = _ref_file(key).read_text("ascii").strip()
+    except (OSError, UnicodeDecodeError):
+        return None
+    if len(name) != 48 or not all(c in "0123456789abcdef" for c in name):
+        return None
+    from .._cache import cache_root
+
+    return cache_root() / "replay" / f"{name}.plan"
+
+
+def _keep_ref(p: Path, key: tuple[Any, ...], taken: int, plan: Path) -> None:
+    """Note that the file with ``key`` holds the bytes whose plan is ``plan``: when the file
+    is still as it was when ``key`` was taken (at ``taken``, before its bytes were read) and
+    its last change was :data:`_SETTLED_NS` older than that (any later write then surely
+    moves its change time).  Only the most recent :data:`REFS_KEPT` notes stay."""
+    if taken - key[5] < _SETTLED_NS or _file_key(p) != key:
+        return
+    try:
+        ref = _ref_file(key)
+        ref.parent.mkdir(parents=True, exist_ok=True)
+        tmp = ref.with_name(f"{ref.name}.{os.getpid()}.tmp")
+        tmp.write_text(plan.stem, "ascii")
+        os.replace(tmp, ref)
+        refs = []
+        for f in ref.parent.glob("*.ref"):
+            try:
+                refs.append((f.stat().st_mtime_ns, f))
+            except OSError:
+                continue
+        if len(refs) > REFS_KEPT:
+            for _, f in sorted(refs, key=itemgetter(0), reverse=True)[REFS_KEPT:]:
+                f.unlink(missing_ok=True)
+    except OSError:
+        pass
 
 
 @lru_cache(maxsize=1)

@@ -168,3 +168,46 @@ def test_plans_off_and_the_few_kept(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.setattr(rec, "PLAN_BYTES", 1000)
     rec._keep_plan(tmp_path / "4.plan", {"x": "y" * 2000}, None)
     assert sorted(f.name for f in tmp_path.glob("*.plan")) == ["4.plan"]
+
+
+def test_a_settled_file_finds_its_plan_by_name_and_times(
+    recorded: Path, tmp_path: Path, monkeypatch
+) -> None:
+    """A replay notes which plan a recording's file holds (by its name, size and times): the
+    next replay of the same file reads none of its bytes; a file changed since (whatever its
+    size) is read again and a tampered call reported; a file changed a moment ago gets no
+    note (a change within the clock's tick could leave its times as they were)."""
+    copy = tmp_path / "copy.gtrec"
+    copy.write_bytes(recorded.read_bytes())
+    assert rec.replay(copy)[1] is None
+    assert rec._plan_ref(rec._file_key(copy)) is None  # changed a moment ago: no note
+    monkeypatch.setattr(rec, "_SETTLED_NS", 0)
+    assert rec.replay(copy)[1] is None  # (the bytes read, their plan noted)
+    assert rec._plan_ref(rec._file_key(copy)) == _where(recorded)
+    read = rec._read_raw
+
+    def unread(p: Path) -> bytes:
+        raise AssertionError("the recording's bytes were read")
+
+    monkeypatch.setattr(rec, "_read_raw", unread)
+    n, div = rec.replay(copy)
+    assert div is None and n == json.loads(recorded.read_text().split("\n", 1)[0])["calls"]
+    monkeypatch.setattr(rec, "_read_raw", read)
+    # the same size, one value changed; its times moved (as any write moves them)
+    text = copy.read_text()
+    k = text.index('"c":"GT_GetSts"', len(text) // 2)
+    line_end = text.index("\n", k)
+    line = text[text.rindex("\n", 0, k) + 1 : line_end]
+    e = json.loads(line)
+    if "o" not in e:
+        pytest.skip("no GT_GetSts with a value written back after the middle")
+    v = e["o"]["1"]["ref"]["v"]
+    w = v + 1 if v % 10 != 9 else v - 1  # (as many digits)
+    e["o"]["1"]["ref"]["v"] = w
+    bad = json.dumps(e, separators=(",", ":"))
+    assert len(bad) == len(line)
+    copy.write_text(text.replace(line, bad, 1))
+    st = copy.stat()
+    os.utime(copy, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+    div = rec.replay(copy)[1]
+    assert div is not None and div.call == "GT_GetSts" and "argument 2" in div.what
