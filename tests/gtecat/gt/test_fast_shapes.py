@@ -31,6 +31,7 @@ import pytest
 from gtecat import gt
 from gtecat.controller.axis import Axis
 from gtecat.controller.axis_status import AxisStatus
+from gtecat.controller.epoch import changed
 from gtecat.controller.motion.trap import TrapPlanner
 from gtecat.gt import fast
 from gtecat.gt.table import FUNCTIONS, declared_only
@@ -259,6 +260,7 @@ def test_the_inline_status_word_is_the_resources_word() -> None:
                         res.latched, res.ax.servo_on = latched, servo
                         res.profile.planner = planner
                         res.band.arrived = arrived
+                        changed()  # (the state changed by hand: the kept values ask again)
                         rc = gt.GT_GetSts(1, s)
                         if rc != 0 or s.value != res.status():
                             bad.append(f"{latched, servo, planner, arrived}: {s.value}")
