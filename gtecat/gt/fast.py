@@ -1127,9 +1127,13 @@ def _raw_code(code: str, name: str) -> str:
     if name not in RAW_WRITES:
         return code
     return re.sub(
-        r"^( *)session\.last = None$", r"\1session.last = None\n\1EPOCH.n += 1", code,
+        r"^( *)session\.last = None$",
+        r"\1session.last = None\n\1EPOCH.n += 1",
+        code,
         flags=re.M,
     )
+
+
 _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
 _CAST: Any = object()
 _NUMPY: Any = object()
