@@ -2230,16 +2230,16 @@ def fast_struct_reader(
 ) -> Callable[..., int]:
     """``GT_GetTrapPrm(profile, p)`` with the fast path in front of the table: ``p``
     ``byref(s)`` (no offset) or ``s`` itself of the structure's own class, an axis of the
-    in-process controller (core 1, no pulse card) in the mode the function needs; the axis
-    bank is told of the call as the table path tells it (:meth:`AxisBank.before_call`), then
-    the table path's own ``fill`` writes the fields.  Any other shape, another mode, an
-    axis that does not exist: the table path, with its code and reason."""
+    in-process controller (core 1, no pulse card) in the mode the function needs; the table
+    path's own ``fill`` writes the fields, a banked axis staying in the bank (what it reads
+    is set by GT calls only).  Any other shape, another mode, an axis that does not exist:
+    the table path, with its code and reason."""
     from .table import FUNCTIONS
 
     first = FUNCTIONS[name].params[0]
     if first.name not in ("axis", "profile", "encoder") or any(
         q.name == "count" for q in FUNCTIONS[name].params
-    ):  # (AxisBank.before_axis_call is before_call for these only)
+    ):  # (the readers of one axis's set-up only)
         raise ValueError(f"{name}: not a function of one axis")
     cls, mode, fill = STRUCT_READERS[name]
     target = _target([cls])
@@ -2273,9 +2273,9 @@ def fast_struct_reader(
             got = None if s is None else ready(n)
             if got is not None:
                 ctl, res = got
-                bank = ctl.bank
-                if bank is not None:  # (what the table path does first)
-                    bank.before_axis_call(res.ax, res)
+                # (no release from the axis bank, unlike the table path: the profile's mode
+                # and its Trap parameters are set by GT calls only, which give the axis back
+                # first, so a banked axis's are its own)
                 if res.profile.mode is mode:
                     try:
                         fill(res, s)
@@ -2317,12 +2317,7 @@ def value(n):
     ax = res.ax
     if ctl.card is not None or ctl.axes.get(n) is not ax:
         return _NO
-    bank = ctl.bank
-    if bank is not None:  # (what the table path does first: before_axis_call, inline)
-        bank.dirty = True
-        if bank.n_alive and res.bank is bank:
-            bank.release_axis_object(ax)
-    prof = res.profile
+    prof = res.profile  # (a banked axis's own: the fast function's note)
     if prof.mode is not MODE:
         return _NO
     try:
