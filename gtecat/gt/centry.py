@@ -137,6 +137,7 @@ class _RawEntry(ctypes.Structure):
         ("write", ctypes.c_ssize_t),
         ("gate", ctypes.c_ssize_t),
         ("after", _VP),
+        ("cache", ctypes.POINTER(_ASlot)),
     ]
 
 
@@ -507,10 +508,15 @@ def _load() -> tuple[Maker | None, str]:
         write: bool,
         gate: int = NO_GATE,
         after: Callable[[], Any] | None = None,
+        cache: bool = False,
     ) -> Any:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         e.after = id(after) if after is not None else None
-        keep = (fallback, value, sentinel, after)
+        slot = None
+        if cache and not write:  # (a writer's value makes the epoch grow: nothing kept)
+            slot = _ASlot()
+            e.cache = ctypes.pointer(slot)
+        keep = (fallback, value, sentinel, after, slot)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
 
@@ -841,6 +847,25 @@ def _self_test_raw(make_raw: Maker) -> str:
             return "the raw entry answered a call with a keyword"
         if [sys.getrefcount(x) for x in watched] != counts:
             return f"the raw entry changed a reference count ({args!r})"
+    asked: list[Any] = []
+
+    def counted(*a: Any) -> Any:
+        asked.append(a)
+        return value(*a)
+
+    kept = make_raw(python, counted, nope, False, False, NO_GATE, None, True)
+    for k, (args, want) in enumerate(
+        [((4, 2), 1), ((4, 2), 0), ((4, 3), 1), ((4, 3), 0), ((4, 3), 1), ((12, 8), 1),
+         ((12, 8), 1), ((4, 2), 1)]
+    ):  # fmt: skip
+        if k == 4:
+            changed()  # (the epoch grows: asked again)
+        del asked[:]
+        o = U8()
+        got = kept(*args, o)
+        ok = got == ("python", (*args, o), {}) if args[0] == 12 else got == 0
+        if not ok or len(asked) != want:
+            return f"a keeping raw entry answered {got!r} for {args!r}, asking {len(asked)}"
     src = U8(*range(50, 58))
     if put(2, 4, src) != 0 or bytes(image)[:8] != bytes([0, 1, 50, 51, 52, 53, 6, 7]):
         return "the raw entry did not write into the image"
@@ -936,7 +961,7 @@ def raw(
     C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")
