@@ -77,6 +77,10 @@ class _Api(ctypes.Structure):
         ("gate", _VP),
         ("epoch_obj", _VP),
         ("epoch_off", ctypes.c_ssize_t),
+        ("clock_dicts", _VP),
+        ("clock_keys", _VP * 4),
+        ("dict_set", _VP),
+        ("from_ll", _VP),
     ]
 
 
@@ -159,6 +163,26 @@ def set_gates(gt: int, gtn: int) -> None:
     (:data:`GATES`); what the entries kept was another session's."""
     GATES[0], GATES[1] = int(gt), int(gtn)
     EPOCH.n += 1
+
+
+#: per gate, the instance dictionary of its controller's clock where the gate says
+#: :data:`AUTO` (0: none): an entry adds the call's host latency there itself where that runs
+#: no cycle (gtecat.gt._core.advance's first branch), else calls its ``after``
+CLOCK_DICTS = (ctypes.c_ssize_t * 2)()
+#: the clock's attributes the entries read and write (the interned names its code uses)
+_CLOCK_KEYS = tuple(sys.intern(k) for k in ("_pending_ns", "call_latency_ns", "cycle_ns", "group"))
+_CLOCKS: list[Any] = [None, None]  # (the dictionaries, kept alive while named)
+
+
+def set_clocks(gt: Any, gtn: Any) -> None:
+    """The clocks behind the two gates (:data:`CLOCK_DICTS`; None: none), set while the gates
+    are closed."""
+    for k, clock in enumerate((gt, gtn)):
+        d = None if clock is None else vars(clock)  # (its dictionary, made if not yet)
+        if d is not None and not all(key in d for key in _CLOCK_KEYS):
+            d = None
+        _CLOCKS[k] = d
+        CLOCK_DICTS[k] = 0 if d is None else id(d)
 
 
 def _epoch_at() -> int:
@@ -415,6 +439,10 @@ def _load() -> tuple[Maker | None, str]:
             ctypes.addressof(GATES),
             id(EPOCH),
             epoch_at,
+            ctypes.addressof(CLOCK_DICTS),
+            (_VP * 4)(*(id(k) for k in _CLOCK_KEYS)),
+            _address("PyDict_SetItem"),
+            _address("PyLong_FromLongLong"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

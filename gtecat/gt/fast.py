@@ -562,7 +562,11 @@ def set_gates(gt: Any, gtn: Any) -> None:
     GATED[:] = new
     for env in _GATED_ENVS:
         env["CTL"], env["CTLN"] = GATED
-    centry.set_gates(_gate_value(gt), _gate_value(gtn))
+    gates = _gate_value(gt), _gate_value(gtn)
+    centry.set_clocks(
+        *(c.clock if g == centry.AUTO else None for c, g in zip(new, gates, strict=True))
+    )
+    centry.set_gates(*gates)
 
 
 def _gate_value(ctl: Any) -> int:

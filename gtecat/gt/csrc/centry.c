@@ -65,6 +65,13 @@ struct api {
      * is not a cached read, a fault, the session) */
     obj epoch_obj;
     ptrdiff_t epoch_off;
+    /* the auto clock's host latency in the common case (gtecat.gt._core.advance's first
+     * branch): per gate the instance dict of its controller's clock (0: none, after()
+     * runs it), the keys _pending_ns, call_latency_ns, cycle_ns and group */
+    const ptrdiff_t *clock_dicts;
+    obj clock_keys[4];
+    int (*dict_set)(obj, obj, obj);  /* PyDict_SetItem */
+    obj (*from_ll)(long long);       /* PyLong_FromLongLong */
 };
 
 #define MAX_TYPES 16
@@ -128,7 +135,9 @@ int gtecat_centry_api(const struct api *api)
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear || !api->gate || !api->epoch_obj ||
-        api->epoch_off <= 0)
+        api->epoch_off <= 0 || !api->clock_dicts || !api->clock_keys[0] ||
+        !api->clock_keys[1] || !api->clock_keys[2] || !api->clock_keys[3] || !api->dict_set ||
+        !api->from_ll)
         return 1;
     A = *api;
     ready = 1;
@@ -207,9 +216,54 @@ static void put(char *mem, long long x, int size)
 
 /* A call's return once its value is written: 0, or in the auto clock (its gate says 2)
  * what after() returns (the call's host latency, as the Python path's advance runs it). */
+/* An int's value in *v (0: not an exact int that a long long holds; no error left). */
+static int ll_of(obj o, long long *v)
+{
+    int over = 0;
+    if (!o || TYPE(o) != A.int_type)
+        return 0;
+    *v = A.as_ll(o, &over);
+    if (*v == -1 && !over && A.err_occurred()) {
+        A.err_clear();
+        return 0;
+    }
+    return !over;
+}
+
+/* The auto clock's host latency where it runs no cycle, as advance() does it first: the
+ * clock's _pending_ns grows by call_latency_ns while that stays below cycle_ns and the clock
+ * shares no time (group None).  1: done; 0: after() must run it (a cycle is due, or any
+ * doubt). */
+static int latency(ptrdiff_t gate)
+{
+    obj d = (obj)A.clock_dicts[gate - 1], n;
+    long long pend, lat, cyc;
+    int r;
+    if (!d || TYPE(d) != A.dict_type || A.dict_get(d, A.clock_keys[3]) != A.none)
+        return 0;
+    if (!ll_of(A.dict_get(d, A.clock_keys[0]), &pend) ||
+        !ll_of(A.dict_get(d, A.clock_keys[1]), &lat) ||
+        !ll_of(A.dict_get(d, A.clock_keys[2]), &cyc))
+        return 0;
+    if (pend < 0 || lat < 0 || pend > cyc || pend + lat >= cyc)
+        return 0;
+    n = A.from_ll(pend + lat);
+    if (!n) {
+        A.err_clear();
+        return 0;
+    }
+    r = A.dict_set(d, A.clock_keys[0], n);
+    A.decref(n);
+    if (r) {
+        A.err_clear();
+        return 0;
+    }
+    return 1;
+}
+
 static obj done(obj after, ptrdiff_t gate)
 {
-    if (after && gate && A.gate[gate - 1] == 2)
+    if (after && gate && A.gate[gate - 1] == 2 && !latency(gate))
         return A.vectorcall(after, NULL, 0, NULL);
     A.incref(A.zero);
     return A.zero;
