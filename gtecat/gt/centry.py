@@ -145,6 +145,37 @@ class _RawEntry(ctypes.Structure):
     ]
 
 
+_MAX_OUT, _MAX_OTYPES = 3, 8
+
+
+class _MultiEntry(ctypes.Structure):
+    """``struct multi_entry`` of csrc/centry.c: a reader of several values."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("value", _VP),
+        ("sentinel", _VP),
+        ("nout", ctypes.c_ssize_t),
+        ("nextra", ctypes.c_ssize_t),
+        ("extra", ctypes.c_ssize_t * 3),
+        ("types", (_VP * _MAX_OTYPES) * _MAX_OUT),
+        ("sizes", (ctypes.c_ssize_t * _MAX_OTYPES) * _MAX_OUT),
+        ("signs", (ctypes.c_ssize_t * _MAX_OTYPES) * _MAX_OUT),
+        ("kinds", ctypes.c_ssize_t * _MAX_OUT),
+        ("gate", ctypes.c_ssize_t),
+        ("after", _VP),
+        ("cache", ctypes.POINTER(_Slot)),
+        ("ncache", ctypes.c_ssize_t),
+        ("titems", ctypes.c_ssize_t),
+        ("tuple_type", _VP),
+    ]
+
+
+#: what an argument after a multi-value reader's outputs must be: the int 1 (a count), the
+#: int 0 (a FIFO, a mode), None or the int 0 (a NULL pointer)
+ONE, ZERO, NULL = 1, 0, 2
+
+
 #: the session's gates, read by every gated entry before it asks its value (written by
 #: :mod:`gtecat.gt._core` wherever their answer can change: :func:`set_gates`):
 #: [0] nonzero while the GT_ functions address an in-process controller of core 1 on the
@@ -242,6 +273,22 @@ def _bytes_at() -> tuple[int, int]:
         if all(ctypes.string_at(id(b) + k, len(b)) == b for b in samples):
             return at, k
     raise ValueError("a bytes object's bytes are not where they are looked for")
+
+
+def _tuple_at(size_at: int) -> int:
+    """Where a tuple keeps its first item (its length where a bytes object's is;
+    ValueError when the probe disagrees)."""
+    samples = [(object(), 2.5), (1 << 80, "x", None), tuple(range(300, 305))]
+    for t in samples:
+        if ctypes.c_ssize_t.from_address(id(t) + size_at).value != len(t):
+            raise ValueError("a tuple's length is not where it is looked for")
+    for k in range(size_at + _WORD, tuple.__basicsize__ + 1, _WORD):
+        if all(
+            all(_VP.from_address(id(t) + k + i * _WORD).value == id(x) for i, x in enumerate(t))
+            for t in samples
+        ):
+            return k
+    raise ValueError("a tuple's items are not where they are looked for")
 
 
 def _bytearray_at(size_at: int) -> int:
@@ -400,6 +447,7 @@ def _load() -> tuple[Maker | None, str]:
         bastart = _bytearray_at(bsize)
         objects_at = _objects_at()
         epoch_at = _epoch_at()
+        titems = _tuple_at(bsize)
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -452,6 +500,8 @@ def _load() -> tuple[Maker | None, str]:
         raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
         vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value
         raw_vc = ctypes.cast(lib.gtecat_centry_raw_vc, _VP).value
+        multi_meth = ctypes.cast(lib.gtecat_centry_multi, _VP).value
+        multi_vc = ctypes.cast(lib.gtecat_centry_multi_vc, _VP).value
         new = byref_target.function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
@@ -548,10 +598,49 @@ def _load() -> tuple[Maker | None, str]:
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
 
+    def make_multi(
+        fallback: Callable[..., Any],
+        value: Callable[[Any], Any],
+        sentinel: Any,
+        outs: list[tuple[Iterable[type], int]],
+        extras: Iterable[int] = (),
+        gate: int = NO_GATE,
+        after: Callable[[], Any] | None = None,
+        cache: bool = False,
+    ) -> Any:
+        more = tuple(extras)
+        if not 2 <= len(outs) <= _MAX_OUT or len(more) > 3:
+            raise ValueError(f"two to {_MAX_OUT} outputs, at most three arguments after them")
+        e = _MultiEntry(id(fallback), id(value), id(sentinel), len(outs), len(more))
+        for k, x in enumerate(more):
+            e.extra[k] = x
+        kinds = []
+        for k, (out_types, kind) in enumerate(outs):
+            ts = tuple(out_types)
+            if not 0 < len(ts) < _MAX_OTYPES or kind not in (INT, DOUBLE):
+                raise ValueError(f"one to {_MAX_OTYPES - 1} types of integers or doubles")
+            e.kinds[k] = kind
+            for j, t in enumerate(ts):
+                e.types[k][j], e.sizes[k][j] = id(t), ctypes.sizeof(t)
+                e.signs[k][j] = int(kind != INT or not t._type_.isupper())
+            kinds.append(ts)
+        e.gate = gate
+        e.after = id(after) if after is not None else None
+        e.titems, e.tuple_type = titems, id(tuple)
+        slots = None
+        if cache:
+            slots = (_Slot * CACHED)()
+            e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
+            e.ncache = CACHED
+        keep = (fallback, value, sentinel, kinds, after, slots)
+        fn = new(b"gt_centry_multi", multi_meth, _METH_FASTCALL_KEYWORDS, e, keep)
+        return public(fn, multi_vc, e, keep)
+
     make.raw = make_raw  # type: ignore[attr-defined]
+    make.multi = make_multi  # type: ignore[attr-defined]
     for _ in range(2):
         try:
-            reason = _self_test(make) or _self_test_raw(make_raw)
+            reason = _self_test(make) or _self_test_raw(make_raw) or _self_test_multi(make_multi)
         except Exception as e:  # (a self-test that cannot even run)
             reason = f"the self-test failed: {type(e).__name__}: {e}"
         if not reason or not callables:
@@ -807,6 +896,66 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
     return ""
 
 
+def _self_test_multi(make_multi: Maker) -> str:
+    """'' when a multi-value entry writes every value or none, takes only its shapes, keeps
+    values per epoch and reference counts, else what went wrong."""
+    nope = object()
+    asked: list[Any] = []
+
+    def value(n: Any) -> Any:
+        asked.append(n)
+        return {1: (1, -70000), 2: (1, 1 << 40), 3: (2, 1.5), 4: nope, 5: (1,)}.get(n, nope)
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    S, L, I32 = ctypes.c_short, ctypes.c_int64, ctypes.c_int32
+    f = make_multi(python, value, nope, [([S], INT), ([L, I32], INT)], [ONE, NULL], cache=True)
+    a, b = S(), L()
+    pa, pb = ctypes.byref(a), ctypes.byref(b)
+    cases: list[tuple[tuple, Any, int]] = [
+        ((1, pa, pb), (1, -70000), 1),
+        ((1, pa, pb), (1, -70000), 0),  # (kept)
+        ((1, a, b, 1), (1, -70000), 0),
+        ((1, pa, pb, 1, None), (1, -70000), 0),
+        ((1, pa, pb, 1, 0), (1, -70000), 0),
+        ((1, pa, pb, 2), None, 0),
+        ((1, pa, pb, 1, 5), None, 0),
+        ((1, pa, pb, 1, None, 0), None, 0),
+        ((1, pa), None, 0),
+        ((1, pb, pa), None, 0),
+        ((1, pa, ctypes.byref(I32())), (1, -70000), 0),
+        ((2, pa, ctypes.byref(I32())), None, 1),  # (too wide for a 32-bit one: none written)
+        ((3, pa, pb), None, 1),  # (a float for an integer)
+        ((4, pa, pb), None, 1),
+        ((5, pa, pb), None, 1),
+        ((True, pa, pb), None, 0),
+        ((1, ctypes.byref(a, 0), pb), (1, -70000), 0),
+        ((1, pa, ctypes.byref((L * 2)(), 8)), None, 0),
+    ]
+    for args, want, n_asked in cases:
+        del asked[:]
+        a.value, b.value = 9, 9
+        watched = _own([*args, nope])
+        counts = [sys.getrefcount(x) for x in watched]
+        got = f(*args)
+        if want is None:
+            ok = got == ("python", args, {}) and (a.value, b.value) == (9, 9)
+        else:
+            second = args[2]._obj if type(args[2]) is type(pb) else args[2]
+            ok = got == 0 and (a.value, second.value) == want
+        if not ok or len(asked) != n_asked:
+            return f"a multi-value entry answered {got!r} for {args!r}, asking {asked!r}"
+        del got
+        if [sys.getrefcount(x) for x in watched] != counts:
+            return f"a multi-value entry changed a reference count ({args!r})"
+    changed()
+    del asked[:]
+    if f(1, pa, pb) != 0 or asked != [1]:
+        return "a multi-value entry kept a value past its epoch"
+    return ""
+
+
 def _self_test_raw(make_raw: Maker) -> str:
     """'' when raw entries copy what they must, hand on the rest and keep reference counts."""
     nope = object()
@@ -990,6 +1139,27 @@ def raw(
     if _MAKE is None:
         return None
     return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
+
+
+def multi(
+    fallback: Callable[..., Any],
+    value: Callable[[Any], Any],
+    sentinel: Any,
+    outs: list[tuple[Iterable[type], int]],
+    extras: Iterable[int] = (),
+    gate: int = NO_GATE,
+    after: Callable[[], Any] | None = None,
+) -> Any:
+    """The C entry of a reader of several values: ``f(n, p1, p2[, p3][, extras...])`` with
+    each ``p`` ``byref(x)`` (no offset) or ``x`` of one of its output's types (``outs``: the
+    types and :data:`INT` or :data:`DOUBLE` per output) and each argument after them what
+    ``extras`` says (:data:`ONE`, :data:`ZERO`, :data:`NULL`) writes the tuple ``value(n)``
+    gives, each number checked to fit before any is written; else ``fallback`` with the same
+    arguments.  ``gate`` and ``after``: as :func:`reader`'s (a gated entry keeps its values
+    for their epoch).  None where the C entry is not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE.multi(fallback, value, sentinel, outs, extras, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")

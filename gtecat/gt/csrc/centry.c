@@ -684,3 +684,137 @@ drop:
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
+
+/* A reader of several values (GT_GetCaptureStatus(encoder, pStatus, pValue[, count,
+ * pClock]), GT_CrdStatus(crd, pRun, pSegment[, fifo])): n, then nout pointers (byref(x)
+ * with no offset, or x, of one of each output's types), then at most nextra arguments each
+ * of which must be what extra[] says; value(n) gives a tuple of nout numbers, kept per n for
+ * its epoch; every number is checked to fit before any is written.  Anything else: the
+ * fallback with the very same arguments. */
+#define MAX_OUT 3
+#define MAX_OTYPES 8
+
+struct multi_entry {
+    obj fallback;
+    obj value;
+    obj sentinel;
+    ptrdiff_t nout;
+    ptrdiff_t nextra;
+    ptrdiff_t extra[3]; /* 1: the int 1; 0: the int 0; 2: None or the int 0 */
+    obj types[MAX_OUT][MAX_OTYPES]; /* NULL-ended */
+    ptrdiff_t sizes[MAX_OUT][MAX_OTYPES];
+    ptrdiff_t signs[MAX_OUT][MAX_OTYPES];
+    ptrdiff_t kinds[MAX_OUT]; /* 0: integers, 1: doubles */
+    ptrdiff_t gate;
+    obj after;
+    struct slot *cache;
+    ptrdiff_t ncache;
+    ptrdiff_t titems; /* a tuple's first item (its length: where a bytes object's is) */
+    obj tuple_type;
+};
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
+obj gtecat_centry_multi_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args,
+                 (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    return multi((const struct multi_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+/* output k's memory, size and sign for p (NULL: not taken) */
+static char *out_mem(const struct multi_entry *e, ptrdiff_t k, obj p, int *size, int *sign)
+{
+    obj target = p, tp = TYPE(p);
+    int j;
+    if (tp == A.carg_type) {
+        target = AT(p, A.carg_obj);
+        if (!target)
+            return NULL;
+        tp = TYPE(target);
+    }
+    for (j = 0; j < MAX_OTYPES && e->types[k][j]; j++) {
+        if (e->types[k][j] == tp) {
+            *size = (int)e->sizes[k][j];
+            *sign = (int)e->signs[k][j];
+            return reader_mem(p, target, NULL);
+        }
+    }
+    return NULL;
+}
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ptrdiff_t k, nout = e->nout;
+    char *mem[MAX_OUT];
+    int size[MAX_OUT], sign[MAX_OUT];
+    long long ints[MAX_OUT], key = -1, ep = -1;
+    obj v, item;
+    int over = 0;
+
+    if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
+        goto python;
+    if (nargs < 1 + nout || nargs > 1 + nout + e->nextra || TYPE(args[0]) != A.int_type)
+        goto python;
+    for (k = 1 + nout; k < nargs; k++) {
+        obj a = args[k];
+        ptrdiff_t want = e->extra[k - 1 - nout];
+        if (want == 1 ? !(a == A.one || int_is(a, 1))
+                      : !(a == A.zero || int_is(a, 0) || (want == 2 && a == A.none)))
+            goto python;
+    }
+    for (k = 0; k < nout; k++)
+        if (!out_mem(e, k, args[1 + k], &size[k], &sign[k]))
+            goto python;
+    if (e->cache) {
+        key = A.as_ll(args[0], &over);
+        if (over || key < 0 || key >= e->ncache) {
+            if (key == -1 && !over && A.err_occurred())
+                A.err_clear();
+            key = -1;
+        } else if ((ep = epoch()) >= 0 && e->cache[key].value && e->cache[key].epoch == ep) {
+            v = e->cache[key].value;
+            A.incref(v);
+            goto have;
+        }
+    }
+    v = A.vectorcall(e->value, args, 1, NULL);
+    if (!v)
+        return NULL;
+    if (v == e->sentinel || TYPE(v) != e->tuple_type ||
+        *(ptrdiff_t *)((char *)v + A.bsize) != nout)
+        goto drop;
+    if (key >= 0 && ep >= 0)
+        keep(&e->cache[key], ep, v);
+have:
+    for (k = 0; k < nout; k++) { /* (every value checked before any is written) */
+        item = ((obj *)((char *)v + e->titems))[k];
+        if (e->kinds[k] == 1) {
+            if (TYPE(item) != A.float_type || size[k] != 8)
+                goto drop;
+        } else if (!ll_of(item, &ints[k]) || !fits(ints[k], size[k], sign[k])) {
+            goto drop;
+        }
+    }
+    for (k = 0; k < nout; k++) /* (again: Python ran) */
+        if (!(mem[k] = out_mem(e, k, args[1 + k], &size[k], &sign[k])))
+            goto drop;
+    for (k = 0; k < nout; k++) {
+        item = ((obj *)((char *)v + e->titems))[k];
+        if (e->kinds[k] == 1)
+            *(double *)mem[k] = *(double *)((char *)item + A.fval);
+        else
+            put(mem[k], ints[k], size[k]);
+    }
+    A.decref(v);
+    return done(e->after, e->gate);
+
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
