@@ -81,6 +81,13 @@ class _Api(ctypes.Structure):
         ("clock_keys", _VP * 4),
         ("dict_set", _VP),
         ("from_ll", _VP),
+        ("ndarray_type", _VP),
+        ("nd_data", ctypes.c_ssize_t),
+        ("nd_nd", ctypes.c_ssize_t),
+        ("nd_dims", ctypes.c_ssize_t),
+        ("nd_descr", ctypes.c_ssize_t),
+        ("nd_flags", ctypes.c_ssize_t),
+        ("nd_want", ctypes.c_int),
     ]
 
 
@@ -127,6 +134,9 @@ class _Entry(ctypes.Structure):
         ("csizes", ctypes.c_ssize_t * _MAX_TYPES),
         ("csigns", ctypes.c_ssize_t * _MAX_TYPES),
         ("acache", ctypes.POINTER(_ASlot)),
+        ("nptypes", _VP * 8),
+        ("npsizes", ctypes.c_ssize_t * 8),
+        ("npsigns", ctypes.c_ssize_t * 8),
     ]
 
 
@@ -273,6 +283,53 @@ def _bytes_at() -> tuple[int, int]:
         if all(ctypes.string_at(id(b) + k, len(b)) == b for b in samples):
             return at, k
     raise ValueError("a bytes object's bytes are not where they are looked for")
+
+
+#: numpy's array flags an entry's array must have: C_CONTIGUOUS, ALIGNED, WRITEABLE (numpy's
+#: public ndarraytypes.h values; the probe checks them on arrays that have and lack each)
+_ND_WANT = 0x0001 | 0x0100 | 0x0400
+
+
+def _numpy_at() -> tuple[int, int, int, int, int, int]:
+    """numpy's ndarray type and where an array keeps its data, its number of dimensions, its
+    dimensions, its dtype and its flags ((0, ...): no numpy; ValueError when the probe
+    disagrees).  The public ``PyArrayObject_fields`` layout, checked on known arrays."""
+    try:
+        import numpy as np
+    except ImportError:
+        return 0, 0, 0, 0, 0, 0
+    samples = [np.zeros(3, np.int32), np.arange(6.0).reshape(2, 3), np.ones(1, np.int64)[::1]]
+    ro = np.zeros(2, np.int64)
+    ro.flags.writeable = False
+    strided = np.zeros(8, np.int32)[::2]
+    at = object.__basicsize__
+
+    def ok(k_data: int, k_nd: int, k_dims: int, k_descr: int, k_flags: int) -> bool:
+        for a in [*samples, ro, strided]:
+            if _VP.from_address(id(a) + k_data).value != a.ctypes.data:
+                return False
+            if ctypes.c_int.from_address(id(a) + k_nd).value != a.ndim:
+                return False
+            dims = _VP.from_address(id(a) + k_dims).value
+            if not dims or list((ctypes.c_ssize_t * a.ndim).from_address(dims)) != list(a.shape):
+                return False
+            if _VP.from_address(id(a) + k_descr).value != id(a.dtype):
+                return False
+            f = ctypes.c_int.from_address(id(a) + k_flags).value
+            want = (
+                bool(f & 0x0001) == a.flags.c_contiguous
+                and bool(f & 0x0100) == a.flags.aligned
+                and bool(f & 0x0400) == a.flags.writeable
+            )
+            if not want:
+                return False
+        return True
+
+    # (PyArrayObject_fields: data, nd, dimensions, strides, base, descr, flags)
+    k = (at, at + _WORD, at + 2 * _WORD, at + 5 * _WORD, at + 6 * _WORD)
+    if not ok(*k):
+        raise ValueError("a numpy array's fields are not where they are looked for")
+    return (id(np.ndarray), *k)
 
 
 def _tuple_at(size_at: int) -> int:
@@ -448,6 +505,7 @@ def _load() -> tuple[Maker | None, str]:
         objects_at = _objects_at()
         epoch_at = _epoch_at()
         titems = _tuple_at(bsize)
+        numpy_at = _numpy_at()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -491,6 +549,8 @@ def _load() -> tuple[Maker | None, str]:
             (_VP * 4)(*(id(k) for k in _CLOCK_KEYS)),
             _address("PyDict_SetItem"),
             _address("PyLong_FromLongLong"),
+            *numpy_at,
+            _ND_WANT,
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -541,6 +601,7 @@ def _load() -> tuple[Maker | None, str]:
         after: Callable[[], Any] | None = None,
         cache: bool = False,
         clocks: Iterable[type] = (),
+        numpy: Iterable[Any] = (),
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -566,6 +627,12 @@ def _load() -> tuple[Maker | None, str]:
         for k, t in enumerate(cks):
             e.ctypes_[k], e.csizes[k] = id(t), ctypes.sizeof(t)
             e.csigns[k] = int(not t._type_.isupper())
+        dts = tuple(numpy) if api.ndarray_type else ()
+        if len(dts) >= 8:
+            raise ValueError("at most seven numpy dtypes")
+        for k, dt in enumerate(dts):  # (numpy's own dtype objects: compared by identity)
+            e.nptypes[k], e.npsizes[k] = id(dt), dt.itemsize
+            e.npsigns[k] = int(dt.kind != "u")
         slots = aslot = None
         if cache:  # (the memory the C function keeps values in, kept alive with it)
             slots = (_Slot * CACHED)()
@@ -574,7 +641,7 @@ def _load() -> tuple[Maker | None, str]:
             if array is not None:
                 aslot = _ASlot()
                 e.acache = ctypes.pointer(aslot)
-        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot)
+        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -801,6 +868,10 @@ def _self_test(make: Maker) -> str:
             now = [sys.getrefcount(x) for x in watched]
             return f"the entry changed a reference count ({args!r}: {counts} -> {now})"
 
+    reason = _self_test_numpy(make, python, value, nope)
+    if reason:
+        return reason
+
     gated = [make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, None, g)
              for g in (GT_GATE, GTN_GATE)]  # fmt: skip
     before = tuple(GATES)
@@ -833,6 +904,44 @@ def _self_test(make: Maker) -> str:
         pass
     else:
         return "the value's error did not reach the caller"
+    return ""
+
+
+def _self_test_numpy(make: Maker, python: Callable[..., Any], value: Any, nope: Any) -> str:
+    """'' when an entry writes the first element of the numpy arrays it takes and hands on
+    the others, else what went wrong."""
+    try:
+        import numpy as np
+    except ImportError:
+        return ""
+    i32, i64 = np.dtype(np.int32), np.dtype(np.int64)
+    f = make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, None,
+             NO_GATE, None, False, (), (i32, i64))  # fmt: skip
+    ro = np.zeros(2, np.int64)
+    ro.flags.writeable = False
+    cases: list[tuple[int, Any, Any]] = [
+        (1, np.zeros(1, np.int64), 7),
+        (1, np.zeros(3, np.int32), 7),
+        (6, np.zeros(2, np.int32), -(1 << 31)),
+        (2, np.zeros(1, np.int32), None),  # (too wide)
+        (1, np.zeros((1, 1), np.int64), None),
+        (1, np.zeros(0, np.int64), None),
+        (1, ro, None),
+        (1, np.zeros(4, np.int64)[::2], None),
+        (1, np.zeros(1, np.float64), None),
+        (1, np.zeros(1, np.int16), None),
+        (1, np.zeros(1, np.dtype(">i8")), None),
+        (4, np.zeros(1, np.int64), None),  # (a float value)
+    ]
+    for n, a, want in cases:
+        before = a.copy()
+        got = f(n, a)
+        if want is None:
+            ok = got == ("python", (n, a), {}) and np.array_equal(a, before)
+        else:
+            ok = got == 0 and int(a[0]) == want and np.array_equal(a[1:], before[1:])
+        if not ok:
+            return f"a numpy entry answered {got!r} for {a!r} (axis {n})"
     return ""
 
 
@@ -1074,13 +1183,17 @@ def reader(
     gate: int = NO_GATE,
     after: Callable[[], Any] | None = None,
     clocks: Iterable[type] = (),
+    numpy: Iterable[Any] = (),
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
     (of one of ``types``) for the common shape, else ``fallback`` with the same arguments;
     ``value`` gives ``sentinel`` where the entry must not answer.  ``kind``: :data:`INT`
     (each type's width and sign), :data:`DOUBLE`, or :data:`BYTES` (``value`` gives
-    ``size`` bytes, copied to the start of the object); ``pointers``: ``pointer(x)`` of
+    ``size`` bytes, copied to the start of the object); ``numpy``: numpy dtypes whose
+    one-dimensional, C-contiguous, aligned, writable arrays of at least one element take the
+    value in their first element (the Python fast function's numpy shape); ``pointers``:
+    ``pointer(x)`` of
     those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
     ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), clock)`` (``count`` an
@@ -1115,6 +1228,7 @@ def reader(
         after,
         gate != NO_GATE,
         clocks,
+        numpy,
     )
 
 

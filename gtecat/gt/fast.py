@@ -505,11 +505,13 @@ def fast_reader(
             array=array_value(value_gt, True), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
             clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, False),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
+            numpy=sorted(np_ok, key=str),
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]

@@ -72,6 +72,12 @@ struct api {
     obj clock_keys[4];
     int (*dict_set)(obj, obj, obj);  /* PyDict_SetItem */
     obj (*from_ll)(long long);       /* PyLong_FromLongLong */
+    /* numpy's arrays (numpy's public PyArrayObject fields, probed): the type, where an array
+     * keeps its data, its number of dimensions (int), its dimensions, its dtype and its flags
+     * (int); the flags a one-dimensional array an entry writes must have */
+    obj ndarray_type;
+    ptrdiff_t nd_data, nd_nd, nd_dims, nd_descr, nd_flags;
+    int nd_want;
 };
 
 #define MAX_TYPES 16
@@ -114,6 +120,11 @@ struct entry {
     ptrdiff_t csizes[MAX_TYPES];
     ptrdiff_t csigns[MAX_TYPES];
     struct aslot *acache; /* the last span's bytes (NULL: none kept) */
+    /* the numpy dtypes (their descr objects) whose one-dimensional arrays take the value in
+     * their first element, NULL-ended, with their sizes and signs */
+    obj nptypes[8];
+    ptrdiff_t npsizes[8];
+    ptrdiff_t npsigns[8];
 };
 
 static struct api A;
@@ -393,6 +404,28 @@ obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kw
                   (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
+/* The first element of a numpy array p an entry takes (one dimension, at least one element,
+ * C-contiguous, aligned, writable, of one of the entry's dtypes), its size and sign; NULL
+ * where the entry does not take it.  Looked up before and after the value function, as
+ * reader_mem is. */
+static char *np_mem(const struct entry *e, obj p, int *size, int *sign)
+{
+    obj d = (obj)AT(p, A.nd_descr);
+    int k;
+    if (*(int *)((char *)p + A.nd_nd) != 1 || !AT(p, A.nd_dims) ||
+        *(ptrdiff_t *)AT(p, A.nd_dims) < 1 ||
+        (*(int *)((char *)p + A.nd_flags) & A.nd_want) != A.nd_want)
+        return NULL;
+    for (k = 0; k < 8 && e->nptypes[k]; k++) {
+        if (e->nptypes[k] == d) {
+            *size = (int)e->npsizes[k];
+            *sign = (int)e->npsigns[k];
+            return AT(p, A.nd_data);
+        }
+    }
+    return NULL;
+}
+
 /* The memory a reader writes for p (target: p, or a byref's object), or NULL where this
  * entry cannot prove it (the Python path decides).  Looked up before the value function, to
  * know the shape, and again after it: the value function is Python, and meanwhile another
@@ -431,7 +464,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     obj p, target, tp, v;
     char *mem;
     obj deref = NULL;
-    int k, size = 0, sign = 1;
+    int k, size = 0, sign = 1, npy = 0;
     long long key = -1, ep = -1;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
@@ -459,24 +492,30 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     }
     tp = TYPE(p);
     target = p;
-    if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
-        target = AT(p, A.carg_obj);
-        if (!target)
+    if (tp == A.ndarray_type && e->nptypes[0]) { /* a numpy array: its first element */
+        if (!np_mem(e, p, &size, &sign))
             goto python;
-        tp = TYPE(target);
-    }
-    for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
-        if (e->types[k] == tp) {
-            size = (int)e->sizes[k];
-            sign = (int)e->signs[k];
-            deref = (obj)e->derefs[k];
-            break;
+        npy = 1;
+    } else {
+        if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
+            target = AT(p, A.carg_obj);
+            if (!target)
+                goto python;
+            tp = TYPE(target);
         }
+        for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
+            if (e->types[k] == tp) {
+                size = (int)e->sizes[k];
+                sign = (int)e->signs[k];
+                deref = (obj)e->derefs[k];
+                break;
+            }
+        }
+        if (!size)
+            goto python;
+        if (!reader_mem(p, target, deref))
+            goto python;
     }
-    if (!size)
-        goto python;
-    if (!reader_mem(p, target, deref))
-        goto python;
 
     /* the value kept for this epoch, else value(n)'s (kept for it) */
     if (e->cache) {
@@ -501,7 +540,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     if (key >= 0 && ep >= 0)
         keep(&e->cache[key], ep, v);
 have:
-    mem = reader_mem(p, target, deref); /* (again: Python ran) */
+    mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
     if (e->kind == 1) {
