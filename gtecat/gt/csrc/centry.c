@@ -60,7 +60,7 @@ struct api {
      * [0] nonzero while the GT_ functions address the in-process lockstep controller of
      * core 1, [1] while the GTN_ functions' core 1 is that controller */
     const ptrdiff_t *gate;
-    /* the values' epoch: an int at epoch_off in epoch_obj (gtecat.gt.centry.EPOCH.n), which
+    /* the values' epoch: an int at epoch_off in epoch_obj (gtecat.controller.epoch.EPOCH.n), which
      * Python makes larger wherever a value an entry caches may change (a cycle, a call that
      * is not a cached read, a fault, the session) */
     obj epoch_obj;
