@@ -356,6 +356,7 @@ def _load() -> tuple[tuple, dict[str, Proto]]:
 
     found = _groups.groups()
     key = _cache_key(found)
+    CACHE_KEY[:] = [key]
     cached = _read_cache(key)
     if cached is not None:
         enums, table = cached
@@ -394,7 +395,14 @@ def _cache_key(found: Iterable) -> str | None:
     except (OSError, TypeError, KeyError):
         return None
     for g in found:
-        for part in (g.name, g.module, str(g.declared_only), g.prototypes, g.structs):
+        for part in (
+            g.name,
+            g.module,
+            str(g.declared_only),
+            g.prototypes,
+            g.structs,
+            g.constants,
+        ):
             h.update(part.encode("utf-8", "surrogatepass"))
             h.update(b"\0")
     return h.hexdigest()[:32]
@@ -402,13 +410,16 @@ def _cache_key(found: Iterable) -> str | None:
 
 #: the shape of the cached values (raised when it changes)
 _CACHE_FORMAT = 1
+#: the key the groups were read under (None: the cache is off); the vendor surface's plain
+#: values are kept under it too (:func:`gtecat.gt.typedefs.surface`)
+CACHE_KEY: list[str | None] = [None]
 
 
-def _cache_file(key: str):
+def _cache_file(key: str, kind: str = "functions"):
     from .. import __version__
     from .._cache import cache_root
 
-    return cache_root() / __version__ / "table" / f"functions-{key}.marshal"
+    return cache_root() / __version__ / "table" / f"{kind}-{key}.marshal"
 
 
 def _read_cache(key: str | None) -> tuple[list[str], dict[str, Proto]] | None:
