@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterable
 from importlib import resources
 from typing import Any
 
+from ..controller.epoch import EPOCH, Epoch, changed
 from . import byref_target
 
 log = logging.getLogger(__name__)
@@ -74,6 +75,31 @@ class _Api(ctypes.Structure):
         ("err_clear", _VP),
         ("dict_get", _VP),
         ("gate", _VP),
+        ("epoch_obj", _VP),
+        ("epoch_off", ctypes.c_ssize_t),
+        ("clock_dicts", _VP),
+        ("clock_keys", _VP * 4),
+        ("dict_set", _VP),
+        ("from_ll", _VP),
+    ]
+
+
+class _Slot(ctypes.Structure):
+    """``struct slot`` of csrc/centry.c: a value kept for the epoch it was asked in."""
+
+    _fields_ = [("epoch", ctypes.c_longlong), ("value", _VP)]
+
+
+class _ASlot(ctypes.Structure):
+    """``struct aslot`` of csrc/centry.c: a span's bytes kept for their key and epoch."""
+
+    _fields_ = [
+        ("epoch", ctypes.c_longlong),
+        ("n", ctypes.c_longlong),
+        ("count", ctypes.c_longlong),
+        ("clock", ctypes.c_longlong),
+        ("tp", _VP),
+        ("value", _VP),
     ]
 
 
@@ -95,6 +121,12 @@ class _Entry(ctypes.Structure):
         ("avalue", _VP),
         ("gate", ctypes.c_ssize_t),
         ("after", _VP),
+        ("cache", ctypes.POINTER(_Slot)),
+        ("ncache", ctypes.c_ssize_t),
+        ("ctypes_", _VP * _MAX_TYPES),
+        ("csizes", ctypes.c_ssize_t * _MAX_TYPES),
+        ("csigns", ctypes.c_ssize_t * _MAX_TYPES),
+        ("acache", ctypes.POINTER(_ASlot)),
     ]
 
 
@@ -109,6 +141,7 @@ class _RawEntry(ctypes.Structure):
         ("write", ctypes.c_ssize_t),
         ("gate", ctypes.c_ssize_t),
         ("after", _VP),
+        ("cache", ctypes.POINTER(_ASlot)),
     ]
 
 
@@ -127,8 +160,47 @@ CLOSED, LOCKSTEP, AUTO = 0, 1, 2
 
 def set_gates(gt: int, gtn: int) -> None:
     """Open (:data:`LOCKSTEP`, :data:`AUTO`) or close (:data:`CLOSED`) the two gates
-    (:data:`GATES`)."""
+    (:data:`GATES`); what the entries kept was another session's."""
     GATES[0], GATES[1] = int(gt), int(gtn)
+    EPOCH.n += 1
+
+
+#: per gate, the instance dictionary of its controller's clock where the gate says
+#: :data:`AUTO` (0: none): an entry adds the call's host latency there itself where that runs
+#: no cycle (gtecat.gt._core.advance's first branch), else calls its ``after``
+CLOCK_DICTS = (ctypes.c_ssize_t * 2)()
+#: the clock's attributes the entries read and write (the interned names its code uses)
+_CLOCK_KEYS = tuple(sys.intern(k) for k in ("_pending_ns", "call_latency_ns", "cycle_ns", "group"))
+_CLOCKS: list[Any] = [None, None]  # (the dictionaries, kept alive while named)
+
+
+def set_clocks(gt: Any, gtn: Any) -> None:
+    """The clocks behind the two gates (:data:`CLOCK_DICTS`; None: none), set while the gates
+    are closed."""
+    for k, clock in enumerate((gt, gtn)):
+        d = None if clock is None else vars(clock)  # (its dictionary, made if not yet)
+        if d is not None and not all(key in d for key in _CLOCK_KEYS):
+            d = None
+        _CLOCKS[k] = d
+        CLOCK_DICTS[k] = 0 if d is None else id(d)
+
+
+def _epoch_at() -> int:
+    """Where an :class:`Epoch` keeps ``n`` (ValueError when the probe disagrees)."""
+    probe = Epoch()
+    marks = [1 << 90, 1 << 91]
+    for k in range(_HEAD, sys.getsizeof(probe) - _WORD + 1, _WORD):
+        for m in marks:
+            probe.n = m
+            if _VP.from_address(id(probe) + k).value != id(m):
+                break
+        else:
+            return k
+    raise ValueError("an epoch's number is not where it is looked for")
+
+
+#: the axes (or other first arguments) below this have a value kept per entry
+CACHED = 257
 
 
 #: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
@@ -327,6 +399,7 @@ def _load() -> tuple[Maker | None, str]:
         bsize, bdata = _bytes_at()
         bastart = _bytearray_at(bsize)
         objects_at = _objects_at()
+        epoch_at = _epoch_at()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -364,6 +437,12 @@ def _load() -> tuple[Maker | None, str]:
             _address("PyErr_Clear"),
             _address("PyDict_GetItem"),
             ctypes.addressof(GATES),
+            id(EPOCH),
+            epoch_at,
+            ctypes.addressof(CLOCK_DICTS),
+            (_VP * 4)(*(id(k) for k in _CLOCK_KEYS)),
+            _address("PyDict_SetItem"),
+            _address("PyLong_FromLongLong"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -410,6 +489,8 @@ def _load() -> tuple[Maker | None, str]:
         array: Callable[..., Any] | None = None,
         gate: int = NO_GATE,
         after: Callable[[], Any] | None = None,
+        cache: bool = False,
+        clocks: Iterable[type] = (),
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -429,7 +510,21 @@ def _load() -> tuple[Maker | None, str]:
             e.types[k] = id(t)
             e.sizes[k] = size or ctypes.sizeof(x)
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
-        keep = (fallback, value, sentinel, kinds, array, after)
+        cks = tuple(clocks)
+        if len(cks) >= _MAX_TYPES:
+            raise ValueError(f"at most {_MAX_TYPES - 1} clock types")
+        for k, t in enumerate(cks):
+            e.ctypes_[k], e.csizes[k] = id(t), ctypes.sizeof(t)
+            e.csigns[k] = int(not t._type_.isupper())
+        slots = aslot = None
+        if cache:  # (the memory the C function keeps values in, kept alive with it)
+            slots = (_Slot * CACHED)()
+            e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
+            e.ncache = CACHED
+            if array is not None:
+                aslot = _ASlot()
+                e.acache = ctypes.pointer(aslot)
+        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -441,10 +536,15 @@ def _load() -> tuple[Maker | None, str]:
         write: bool,
         gate: int = NO_GATE,
         after: Callable[[], Any] | None = None,
+        cache: bool = False,
     ) -> Any:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         e.after = id(after) if after is not None else None
-        keep = (fallback, value, sentinel, after)
+        slot = None
+        if cache and not write:  # (a writer's value makes the epoch grow: nothing kept)
+            slot = _ASlot()
+            e.cache = ctypes.pointer(slot)
+        keep = (fallback, value, sentinel, after, slot)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
 
@@ -630,6 +730,10 @@ def _self_test(make: Maker) -> str:
     finally:
         GATES[0], GATES[1] = before
 
+    reason = _self_test_cache(make, python, nope)
+    if reason:
+        return reason
+
     def failing(n: Any) -> Any:
         raise LookupError(n)
 
@@ -640,6 +744,66 @@ def _self_test(make: Maker) -> str:
         pass
     else:
         return "the value's error did not reach the caller"
+    return ""
+
+
+def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
+    """'' when an entry that keeps values asks again exactly when :data:`EPOCH` grows, per
+    axis, its spans per key, and writes a span's clock, else what went wrong."""
+    asked: list[Any] = []
+    gen = [0]
+    L, A3, U32 = ctypes.c_int64, ctypes.c_int64 * 3, ctypes.c_uint32
+
+    def value(n: Any) -> Any:
+        asked.append(n)
+        return nope if n == 9 else 100 * n + gen[0]
+
+    def avalue(n: Any, count: Any, tp: Any, clock: Any) -> Any:
+        asked.append((n, count, clock))
+        if tp is not A3 or not 1 <= count <= 3:
+            return nope
+        tail = struct.pack("@q", 1 << 33 if n == 2 else 70) if clock == 1 else b""
+        return struct.pack(f"@{count}q", *range(n, n + count)) + tail
+
+    f = make(python, value, nope, [L], INT, False, 4, 0, False, False, avalue,
+             NO_GATE, None, True, [U32])  # fmt: skip
+    o, a, c, c16 = L(), A3(), U32(), ctypes.c_uint16()
+    p = ctypes.byref(o)
+    steps: list[tuple[tuple, list[Any], Any]] = [
+        ((1, p), [1], 100),
+        ((1, p), [], 100),
+        ((2, p), [2], 200),
+        ((1, p, 1, 0), [], 100),
+        ((9, p), [9], None),
+        ((9, p), [9], None),
+        ((1, a, 2), [(1, 2, None)], [1, 2, 0]),
+        ((1, a, 2), [], [1, 2, 0]),
+        ((1, a, 3), [(1, 3, None)], [1, 2, 3]),
+        ((1, a, 3, ctypes.byref(c)), [(1, 3, 1)], ([1, 2, 3], 70)),
+        ((1, a, 3, c), [], ([1, 2, 3], 70)),
+        ((2, a, 1, c), [(2, 1, 1)], ([2, 2, 3], 70)),  # (a clock too large: Python)
+        ((1, a, 3, c16), [], None),  # (a clock type it does not take)
+    ]
+    for k, (args, want_asked, want) in enumerate(steps):
+        del asked[:]
+        if k == 3:
+            gen[0] = 1
+            changed()  # (the epoch grows: asked again)
+            want_asked, want = [1], 101
+        o.value, c.value = 0, 0
+        got = f(*args)
+        if want is None:
+            ok = got == ("python", args, {})
+        elif isinstance(want, tuple):
+            ok = got == 0 and (list(a), c.value) == (want[0], want[1])
+            if args[0] == 2:  # (its clock does not fit: the Python function answers)
+                ok = got == ("python", args, {})
+        elif isinstance(want, list):
+            ok = got == 0 and list(a) == want
+        else:
+            ok = got == 0 and o.value == want
+        if not ok or asked != want_asked:
+            return f"a keeping entry answered {got!r} for {args!r} asking {asked!r}"
     return ""
 
 
@@ -711,6 +875,25 @@ def _self_test_raw(make_raw: Maker) -> str:
             return "the raw entry answered a call with a keyword"
         if [sys.getrefcount(x) for x in watched] != counts:
             return f"the raw entry changed a reference count ({args!r})"
+    asked: list[Any] = []
+
+    def counted(*a: Any) -> Any:
+        asked.append(a)
+        return value(*a)
+
+    kept = make_raw(python, counted, nope, False, False, NO_GATE, None, True)
+    for k, (args, want) in enumerate(
+        [((4, 2), 1), ((4, 2), 0), ((4, 3), 1), ((4, 3), 0), ((4, 3), 1), ((12, 8), 1),
+         ((12, 8), 1), ((4, 2), 1)]
+    ):  # fmt: skip
+        if k == 4:
+            changed()  # (the epoch grows: asked again)
+        del asked[:]
+        o = U8()
+        got = kept(*args, o)
+        ok = got == ("python", (*args, o), {}) if args[0] == 12 else got == 0
+        if not ok or len(asked) != want:
+            return f"a keeping raw entry answered {got!r} for {args!r}, asking {len(asked)}"
     src = U8(*range(50, 58))
     if put(2, 4, src) != 0 or bytes(image)[:8] != bytes([0, 1, 50, 51, 52, 53, 6, 7]):
         return "the raw entry did not write into the image"
@@ -741,6 +924,7 @@ def reader(
     array: Callable[..., Any] | None = None,
     gate: int = NO_GATE,
     after: Callable[[], Any] | None = None,
+    clocks: Iterable[type] = (),
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -750,13 +934,18 @@ def reader(
     ``size`` bytes, copied to the start of the object); ``pointers``: ``pointer(x)`` of
     those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
     ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
-    ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), pClock)`` (``count`` an
-    int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
-    array's start (it checks the array's type and length), else anything but bytes;
+    ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), clock)`` (``count`` an
+    int, 1 where omitted; ``clock`` None where pClock is omitted, None or 0, and 1 where it
+    is ``byref(x)`` (no offset) or ``x`` of one of ``clocks``) gives the bytes written to the
+    array's start (it checks the array's type and length), then where ``clock`` is 1 the
+    clock's value (native int64; written into ``x`` where ``x``'s type holds it), else
+    anything but bytes;
     ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
     that gate of :data:`GATES` is open (else ``fallback``; ``after()``, where given, the
     call's return once its value is written while the gate says :data:`AUTO`), so they
-    need not check the session themselves.
+    need not check the session themselves; a gated entry keeps what ``value`` and
+    ``array`` give for the epoch they were asked in and writes it again while
+    :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`).
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -775,6 +964,8 @@ def reader(
         array,
         gate,
         after,
+        gate != NO_GATE,
+        clocks,
     )
 
 
@@ -798,7 +989,7 @@ def raw(
     C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")
