@@ -48,6 +48,10 @@ def _any_arguments(*args: Any, **kwargs: Any) -> int:
     return _core.CMD_DECLARED
 
 
+#: the signature every declared-only function shows (made once, when first asked for)
+_SIGNATURE: list[Any] = []
+
+
 class DeclaredFunction:
     """``GT_x`` (or its ``GTN_x`` twin) of a declared-only table line, as ``gtecat.gt`` holds it.
 
@@ -91,9 +95,11 @@ class DeclaredFunction:
 
     @property
     def __signature__(self) -> Any:
-        import inspect
+        if not _SIGNATURE:
+            import inspect
 
-        return inspect.signature(_any_arguments)
+            _SIGNATURE.append(inspect.signature(_any_arguments))
+        return _SIGNATURE[0]
 
     def __get__(self, obj: Any, cls: Any = None) -> Any:
         return self if obj is None else types.MethodType(self, obj)
