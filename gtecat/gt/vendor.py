@@ -39,8 +39,9 @@ def is_public(name: str, value: object) -> bool:
     return name.isupper() and len(name) > 1 and isinstance(value, int | float | str)
 
 
-#: what :func:`install` made: the plain typedefs it read and the classes it made of them
-_MADE: list[Any] = []
+#: the classes :func:`install` made (the plain values it read them from are not kept: ~1 MB,
+#: read again by :func:`built`)
+_MADE: dict[str, type] = {}
 
 
 def install(g: dict[str, Any], registry: Mapping[str, object]) -> None:
@@ -62,7 +63,8 @@ def install(g: dict[str, Any], registry: Mapping[str, object]) -> None:
             g[name] = DeclaredFunction(name)
             if proto.gtn:
                 g[proto.twin_name] = DeclaredFunction(proto.twin_name)
-    _MADE[:] = [tds, made]
+    _MADE.clear()
+    _MADE.update(made)
 
 
 def _existing(g: dict[str, Any], name: str) -> Any:
@@ -197,9 +199,8 @@ def built() -> typedefs.Built:
     ``gtecat.gt`` holds (made when it was imported)."""
     from .. import gt  # noqa: F401  (its import made them)
 
-    tds, made = _MADE
-    out = typedefs.Built(classes=dict(made))
-    for kind, name, group, fields, members in tds:
+    out = typedefs.Built(classes=dict(_MADE))
+    for kind, name, group, fields, members in typedefs.surface(GROUPS)[0]:
         if name in out.typedefs:
             continue
         td = typedefs.Typedef(kind, name, tuple(typedefs.Field(*f) for f in fields), members, group)
