@@ -505,11 +505,13 @@ def fast_reader(
             array=array_value(value_gt, True), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
             clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, False),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
+            numpy=sorted(np_ok, key=str),
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
@@ -1710,7 +1712,8 @@ SLOW_REASONS: dict[str, str] = {
     "pvt": "PVT tables and status: the table work outweighs the arguments",
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
-    "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
+    "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the "
+    "arguments; GT_CrdStatus, which a loop polls, has a C entry (MULTI_READERS)",
     "ecat_axis": "probe status, the axis mode, analog inputs and the scale: table path; the "
     "per-axis PDO readers and the homing status that polling loops use are on the fast path",
     "ecat_io": "one output bit read: table path",
@@ -1718,7 +1721,8 @@ SLOW_REASONS: dict[str, str] = {
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
     "gantry": "a mode query: table path",
     "gts_card": "the pulse-card (GTS) set-up, capture and smart-homing calls: table path; the "
-    "polled IO readers (GT_GetDi, GT_GetDiRaw, GT_GetDo) are on the fast path",
+    "polled IO readers (GT_GetDi, GT_GetDiRaw, GT_GetDo) are on the fast path, and "
+    "GT_GetCaptureStatus has a C entry (MULTI_READERS)",
     "motion": "profile set-up and parameter readers (called once per move); the position and "
     "speed readers that polling loops use, and GT_GetTrapPrm, are on the fast path",
     "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
@@ -2708,6 +2712,95 @@ def value(t):
 """
 
 
+#: readers of several values polled in loops (a capture's status and value, a coordinate
+#: system's run flag and segments): function -> what each argument after the outputs must be
+#: for the C entry (centry.multi: GT_GetCaptureStatus' count 1 and pClock NULL, GT_CrdStatus'
+#: FIFO 0)
+MULTI_READERS: dict[str, tuple[int, ...]] = {
+    "GT_GetCaptureStatus": (centry.ONE, centry.NULL),
+    "GT_CrdStatus": (centry.ZERO,),
+}
+
+
+def fast_multi(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """A reader of several values with its C entry in front of the table path
+    (:func:`centry.multi`): the common shape - the number, ``byref(x)`` or ``x`` of an
+    integer type each output takes, the arguments after them as :data:`MULTI_READERS` says
+    - on the in-process controller (the GT_ gate), an axis or system that exists and is
+    set up (a capture made by GT_SetCaptureMode or an earlier read, a system with its
+    parameters); its values as the table path stores them, a banked axis left in the bank
+    (what it reads is the capture unit's and the system's own, kept current by the bank's
+    cycles).  Every other call: the table path, with its code and reason."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    if not CENTRY:
+        return slow
+    params = FUNCTIONS[name].params
+    outs = []
+    for q in params[1:3]:
+        ts = [t for t in _scalar_types(q) if getattr(t, "_type_", "") in _INT_CODES]
+        outs.append((sorted(ts, key=str), centry.INT))
+    value = _MULTI_VALUES[name](session)
+    entry = centry.multi(
+        slow, value, _NO, outs, MULTI_READERS[name], centry.GT_GATE, _after(advance, name, 0)
+    )
+    if entry is None:
+        return slow
+    entry.python = slow  # type: ignore[attr-defined]  # (no Python fast function: the table)
+    return entry  # type: ignore[no-any-return]
+
+
+def _capture_value(session: Any) -> Callable[[Any], Any]:
+    """GT_GetCaptureStatus' (status, value) of a capture made already, else _NO."""
+    from ..controller.capture import _UNITS
+
+    def value(n: Any) -> Any:
+        ctl = GATED[0]
+        try:
+            res = ctl.resources[n]
+        except KeyError:  # no such axis: the table path says why
+            return _NO
+        if ctl.card is not None or ctl.axes.get(n) is not res.ax:
+            return _NO
+        unit = _UNITS.get(res)
+        if unit is None:  # (not made yet: the table path makes it)
+            return _NO
+        session.last = None
+        return (unit.status, unit.value)
+
+    return value
+
+
+def _crd_value(session: Any) -> Callable[[Any], Any]:
+    """GT_CrdStatus' (run, segments done) of FIFO 0 of a system with its parameters."""
+
+    def value(n: Any) -> Any:
+        ctl = GATED[0]
+        if ctl.card is not None:
+            return _NO
+        systems = vars(ctl).get("crd_bank")  # (made by the table path's first call)
+        c = None if systems is None else systems.systems.get(n)
+        if c is None or c.prm is None:  # (the table path says why)
+            return _NO
+        now = c.now()
+        session.last = None
+        return (1 if now.running and now.fifo == 0 else 0, now.segments_done[0])
+
+    return value
+
+
+_MULTI_VALUES: dict[str, Callable[[Any], Callable[[Any], Any]]] = {
+    "GT_GetCaptureStatus": _capture_value,
+    "GT_CrdStatus": _crd_value,
+}
+
+
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
         CLOCK: fast_clock,
@@ -2717,6 +2810,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         HOME_STATUS: fast_home_status,
     }
     for names, make in (
+        (MULTI_READERS, fast_multi),
         (READERS, fast_reader),
         (RAW, fast_raw),
         (ECAT_READERS, fast_ecat_reader),

@@ -60,7 +60,7 @@ struct api {
      * [0] nonzero while the GT_ functions address the in-process lockstep controller of
      * core 1, [1] while the GTN_ functions' core 1 is that controller */
     const ptrdiff_t *gate;
-    /* the values' epoch: an int at epoch_off in epoch_obj (gtecat.gt.centry.EPOCH.n), which
+    /* the values' epoch: an int at epoch_off in epoch_obj (gtecat.controller.epoch.EPOCH.n), which
      * Python makes larger wherever a value an entry caches may change (a cycle, a call that
      * is not a cached read, a fault, the session) */
     obj epoch_obj;
@@ -72,6 +72,12 @@ struct api {
     obj clock_keys[4];
     int (*dict_set)(obj, obj, obj);  /* PyDict_SetItem */
     obj (*from_ll)(long long);       /* PyLong_FromLongLong */
+    /* numpy's arrays (numpy's public PyArrayObject fields, probed): the type, where an array
+     * keeps its data, its number of dimensions (int), its dimensions, its dtype and its flags
+     * (int); the flags a one-dimensional array an entry writes must have */
+    obj ndarray_type;
+    ptrdiff_t nd_data, nd_nd, nd_dims, nd_descr, nd_flags;
+    int nd_want;
 };
 
 #define MAX_TYPES 16
@@ -114,6 +120,11 @@ struct entry {
     ptrdiff_t csizes[MAX_TYPES];
     ptrdiff_t csigns[MAX_TYPES];
     struct aslot *acache; /* the last span's bytes (NULL: none kept) */
+    /* the numpy dtypes (their descr objects) whose one-dimensional arrays take the value in
+     * their first element, NULL-ended, with their sizes and signs */
+    obj nptypes[8];
+    ptrdiff_t npsizes[8];
+    ptrdiff_t npsigns[8];
 };
 
 static struct api A;
@@ -393,6 +404,28 @@ obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kw
                   (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
+/* The first element of a numpy array p an entry takes (one dimension, at least one element,
+ * C-contiguous, aligned, writable, of one of the entry's dtypes), its size and sign; NULL
+ * where the entry does not take it.  Looked up before and after the value function, as
+ * reader_mem is. */
+static char *np_mem(const struct entry *e, obj p, int *size, int *sign)
+{
+    obj d = (obj)AT(p, A.nd_descr);
+    int k;
+    if (*(int *)((char *)p + A.nd_nd) != 1 || !AT(p, A.nd_dims) ||
+        *(ptrdiff_t *)AT(p, A.nd_dims) < 1 ||
+        (*(int *)((char *)p + A.nd_flags) & A.nd_want) != A.nd_want)
+        return NULL;
+    for (k = 0; k < 8 && e->nptypes[k]; k++) {
+        if (e->nptypes[k] == d) {
+            *size = (int)e->npsizes[k];
+            *sign = (int)e->npsigns[k];
+            return AT(p, A.nd_data);
+        }
+    }
+    return NULL;
+}
+
 /* The memory a reader writes for p (target: p, or a byref's object), or NULL where this
  * entry cannot prove it (the Python path decides).  Looked up before the value function, to
  * know the shape, and again after it: the value function is Python, and meanwhile another
@@ -431,7 +464,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     obj p, target, tp, v;
     char *mem;
     obj deref = NULL;
-    int k, size = 0, sign = 1;
+    int k, size = 0, sign = 1, npy = 0;
     long long key = -1, ep = -1;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
@@ -459,24 +492,30 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     }
     tp = TYPE(p);
     target = p;
-    if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
-        target = AT(p, A.carg_obj);
-        if (!target)
+    if (tp == A.ndarray_type && e->nptypes[0]) { /* a numpy array: its first element */
+        if (!np_mem(e, p, &size, &sign))
             goto python;
-        tp = TYPE(target);
-    }
-    for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
-        if (e->types[k] == tp) {
-            size = (int)e->sizes[k];
-            sign = (int)e->signs[k];
-            deref = (obj)e->derefs[k];
-            break;
+        npy = 1;
+    } else {
+        if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
+            target = AT(p, A.carg_obj);
+            if (!target)
+                goto python;
+            tp = TYPE(target);
         }
+        for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
+            if (e->types[k] == tp) {
+                size = (int)e->sizes[k];
+                sign = (int)e->signs[k];
+                deref = (obj)e->derefs[k];
+                break;
+            }
+        }
+        if (!size)
+            goto python;
+        if (!reader_mem(p, target, deref))
+            goto python;
     }
-    if (!size)
-        goto python;
-    if (!reader_mem(p, target, deref))
-        goto python;
 
     /* the value kept for this epoch, else value(n)'s (kept for it) */
     if (e->cache) {
@@ -501,7 +540,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     if (key >= 0 && ep >= 0)
         keep(&e->cache[key], ep, v);
 have:
-    mem = reader_mem(p, target, deref); /* (again: Python ran) */
+    mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
     if (e->kind == 1) {
@@ -675,6 +714,140 @@ have:
             memcpy(image, mem + r[0], (size_t)r[2]);
         else
             memcpy(mem + r[0], image, (size_t)r[2]);
+    }
+    A.decref(v);
+    return done(e->after, e->gate);
+
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* A reader of several values (GT_GetCaptureStatus(encoder, pStatus, pValue[, count,
+ * pClock]), GT_CrdStatus(crd, pRun, pSegment[, fifo])): n, then nout pointers (byref(x)
+ * with no offset, or x, of one of each output's types), then at most nextra arguments each
+ * of which must be what extra[] says; value(n) gives a tuple of nout numbers, kept per n for
+ * its epoch; every number is checked to fit before any is written.  Anything else: the
+ * fallback with the very same arguments. */
+#define MAX_OUT 3
+#define MAX_OTYPES 8
+
+struct multi_entry {
+    obj fallback;
+    obj value;
+    obj sentinel;
+    ptrdiff_t nout;
+    ptrdiff_t nextra;
+    ptrdiff_t extra[3]; /* 1: the int 1; 0: the int 0; 2: None or the int 0 */
+    obj types[MAX_OUT][MAX_OTYPES]; /* NULL-ended */
+    ptrdiff_t sizes[MAX_OUT][MAX_OTYPES];
+    ptrdiff_t signs[MAX_OUT][MAX_OTYPES];
+    ptrdiff_t kinds[MAX_OUT]; /* 0: integers, 1: doubles */
+    ptrdiff_t gate;
+    obj after;
+    struct slot *cache;
+    ptrdiff_t ncache;
+    ptrdiff_t titems; /* a tuple's first item (its length: where a bytes object's is) */
+    obj tuple_type;
+};
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
+obj gtecat_centry_multi_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args,
+                 (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    return multi((const struct multi_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+/* output k's memory, size and sign for p (NULL: not taken) */
+static char *out_mem(const struct multi_entry *e, ptrdiff_t k, obj p, int *size, int *sign)
+{
+    obj target = p, tp = TYPE(p);
+    int j;
+    if (tp == A.carg_type) {
+        target = AT(p, A.carg_obj);
+        if (!target)
+            return NULL;
+        tp = TYPE(target);
+    }
+    for (j = 0; j < MAX_OTYPES && e->types[k][j]; j++) {
+        if (e->types[k][j] == tp) {
+            *size = (int)e->sizes[k][j];
+            *sign = (int)e->signs[k][j];
+            return reader_mem(p, target, NULL);
+        }
+    }
+    return NULL;
+}
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ptrdiff_t k, nout = e->nout;
+    char *mem[MAX_OUT];
+    int size[MAX_OUT], sign[MAX_OUT];
+    long long ints[MAX_OUT], key = -1, ep = -1;
+    obj v, item;
+    int over = 0;
+
+    if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
+        goto python;
+    if (nargs < 1 + nout || nargs > 1 + nout + e->nextra || TYPE(args[0]) != A.int_type)
+        goto python;
+    for (k = 1 + nout; k < nargs; k++) {
+        obj a = args[k];
+        ptrdiff_t want = e->extra[k - 1 - nout];
+        if (want == 1 ? !(a == A.one || int_is(a, 1))
+                      : !(a == A.zero || int_is(a, 0) || (want == 2 && a == A.none)))
+            goto python;
+    }
+    for (k = 0; k < nout; k++)
+        if (!out_mem(e, k, args[1 + k], &size[k], &sign[k]))
+            goto python;
+    if (e->cache) {
+        key = A.as_ll(args[0], &over);
+        if (over || key < 0 || key >= e->ncache) {
+            if (key == -1 && !over && A.err_occurred())
+                A.err_clear();
+            key = -1;
+        } else if ((ep = epoch()) >= 0 && e->cache[key].value && e->cache[key].epoch == ep) {
+            v = e->cache[key].value;
+            A.incref(v);
+            goto have;
+        }
+    }
+    v = A.vectorcall(e->value, args, 1, NULL);
+    if (!v)
+        return NULL;
+    if (v == e->sentinel || TYPE(v) != e->tuple_type ||
+        *(ptrdiff_t *)((char *)v + A.bsize) != nout)
+        goto drop;
+    if (key >= 0 && ep >= 0)
+        keep(&e->cache[key], ep, v);
+have:
+    for (k = 0; k < nout; k++) { /* (every value checked before any is written) */
+        item = ((obj *)((char *)v + e->titems))[k];
+        if (e->kinds[k] == 1) {
+            if (TYPE(item) != A.float_type || size[k] != 8)
+                goto drop;
+        } else if (!ll_of(item, &ints[k]) || !fits(ints[k], size[k], sign[k])) {
+            goto drop;
+        }
+    }
+    for (k = 0; k < nout; k++) /* (again: Python ran) */
+        if (!(mem[k] = out_mem(e, k, args[1 + k], &size[k], &sign[k])))
+            goto drop;
+    for (k = 0; k < nout; k++) {
+        item = ((obj *)((char *)v + e->titems))[k];
+        if (e->kinds[k] == 1)
+            *(double *)mem[k] = *(double *)((char *)item + A.fval);
+        else
+            put(mem[k], ints[k], size[k]);
     }
     A.decref(v);
     return done(e->after, e->gate);
