@@ -310,7 +310,7 @@ def enum_names(groups: Iterable[Any]) -> set[str]:
 # ``gtecat.gt`` makes its vendor surface (the groups' classes, enum members and constants) when
 # it is imported.  Reading the groups' C text for it costs ~25 ms a process; the values read
 # are kept as plain values (marshal) beside the function table, under the table's name (its key
-# covers every group's text and the source of this module): read back in well under 1 ms.
+# covers every group's text and the source of this module): read back in ~2 ms.
 
 #: a typedef as plain values: (kind, name, group, fields, members), a field (ctype, name, dims,
 #: pointer), a member (name, value)
@@ -321,17 +321,18 @@ RawDefine = tuple[str, "int | float | None", str]
 
 
 def surface(
-    groups: Iterable[Any],
+    groups: Iterable[Any], *, kept: bool = True
 ) -> tuple[tuple[RawTypedef, ...], tuple[tuple[RawDefine, ...], ...]]:
     """Every group's typedefs (in group order, as :func:`parse` reads them) and its
     ``#define`` lines (one tuple per group) as plain values, from the cache when it holds
-    them (:data:`gtecat.gt.table.CACHE_KEY`)."""
+    them (:data:`gtecat.gt.table.CACHE_KEY`; ``kept`` False: read from the groups, and kept
+    again)."""
     import marshal
 
     from .table import CACHE_KEY, _cache_file
 
     key = CACHE_KEY[0]
-    if key is not None:
+    if key is not None and kept:
         try:
             tds, defines = marshal.loads(_cache_file(key, "surface").read_bytes())
             if type(tds) is tuple and type(defines) is tuple:

@@ -47,7 +47,14 @@ _MADE: dict[str, type] = {}
 def install(g: dict[str, Any], registry: Mapping[str, object]) -> None:
     """Put the vendor surface into the namespace ``g`` (``gtecat.gt``'s), whose own modules'
     names and ``registry`` (the emulated functions) are in it already."""
-    tds, defines = typedefs.surface(GROUPS)
+    try:
+        _install(g, registry, typedefs.surface(GROUPS))
+    except Exception:  # kept values of another shape (a damaged file): read from the groups
+        _install(g, registry, typedefs.surface(GROUPS, kept=False))
+
+
+def _install(g: dict[str, Any], registry: Mapping[str, object], surface: Any) -> None:
+    tds, defines = surface
     made, enums = _classes(tds, g)
     for name, cls in made.items():
         g.setdefault(name, cls)

@@ -9,6 +9,7 @@ import copy
 import ctypes
 import inspect
 import json
+import marshal
 import pickle
 import subprocess
 import sys
@@ -167,6 +168,14 @@ def test_the_kept_table_is_the_table(tmp_path, monkeypatch):
     assert typedefs.surface(table.GROUPS) == read
     monkeypatch.setattr(table, "CACHE_KEY", [None])
     assert typedefs.surface(table.GROUPS) == read
+    # kept values that read back but are not of the surface's shape: made from the groups
+    monkeypatch.setattr(table, "CACHE_KEY", [key])
+    surface.write_bytes(marshal.dumps(((("struct", "TBroken"),), ((1, 2),))))
+    ns: dict = {}
+    monkeypatch.setattr(vendor, "_MADE", {})  # (gtecat.gt's own stay as they are)
+    vendor.install(ns, _core.REGISTRY)
+    assert ns["TTrapPrm"]._fields_ and ns["GT_SetHSIOOpt"].declared and "TBroken" not in ns
+    assert typedefs.surface(table.GROUPS) == read  # (kept again)
 
     monkeypatch.setenv("GTECAT_PYC_CACHE", "0")
     assert table._cache_key(table.GROUPS) is None
