@@ -61,6 +61,7 @@ from typing import Any
 
 from ..controller.core import Controller
 from ..errors import ParameterError
+from ..programs.model import MAX_FUNCTIONS
 from . import _core
 from ._core import fail, gt_function, store, store_array, store_bytes, struct_arg
 from .structs import TCompileInfo, TThreadSts, TVarInfo
@@ -214,7 +215,6 @@ def GT_Compile(pFileName: str, pWrongInfo: Any) -> int:
 def GT_Download(ctl: Controller, pFileName: str) -> int:
     """Load a program image (and the .ini beside it) into the controller (entry 10)."""
     from ..programs import image
-    from ..programs.model import MAX_FUNCTIONS
     from ..programs.verify import ImageInvalid, verify
 
     try:
