@@ -241,7 +241,7 @@ class Injector:
         chattering switch or a stuck IO input needs every cycle, or a trigger watches one.
 
         Asked before every run of cycles at once, so where every entry waits for a time
-        alone (:data:`_BY_TIME`) the first cycle anything may happen in is kept, by the bus's
+        alone (:func:`_by_time`) the first cycle anything may happen in is kept, by the bus's
         cycle count (:meth:`FaultBus.cycle_mark`), and the next asks count down to it: the
         same answer, as long as no entry changed (:attr:`_version`), no cycle ran outside
         the count and neither the cycle time nor the time GT_Reset counts from moved."""
