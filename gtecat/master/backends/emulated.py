@@ -351,10 +351,15 @@ class EmulatedBackend(Backend):
             self._clients[position] = client
         return client
 
-    def unanswered(self) -> int:
+    def unanswered(self, position: int | None = None) -> int:
         """The SDO requests sent so far that got no answer (a fault lost it): the master
-        waits its mailbox timeout for each (:meth:`gtecat.master.bus.Master.sdo_upload`)."""
-        return sum(c.unanswered for c in self._clients.values())
+        waits its mailbox timeout for each (:meth:`gtecat.master.bus.Master.sdo_upload`);
+        ``position``: those sent to that slave alone (one SDO reaches one slave's mailbox,
+        so the master asks about that one: a bus of many slaves costs it nothing more)."""
+        if position is not None:
+            client = self._clients.get(position)
+            return client.unanswered if client is not None else 0  # type: ignore[attr-defined]
+        return sum(c.unanswered for c in self._clients.values())  # type: ignore[attr-defined]
 
     def close(self) -> None:
         if self.capture is not None:
