@@ -2242,11 +2242,10 @@ class AxisBank:
         _Bypass.on = True
         try:
             for r in rows:
-                # the axis objects without their guards while the row's state goes into them
-                # and is taken again (the same as under _Bypass, without a Python call per
+                # the row's objects without their guards while its state goes into them and
+                # is taken again (the same as under _Bypass, without a Python call per
                 # attribute); guarded again after, the row staying
-                res = self.res[r]
-                objs = (self.axes[r], res.profile.planner, res.encoder, res.band)
+                objs = tuple(self._guarded_objects(self.groups[self.group_of[r]]))
                 _unguard(objs)
                 try:
                     self._post_event(r, csp, p0, t_ns, dt_ns)
