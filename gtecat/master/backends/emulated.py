@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from gtecat.drives.coe import next_counter
+from gtecat.drives.coe import advance_counter, next_counter
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
@@ -436,9 +436,8 @@ class EmulatedBackend(Backend):
         server = self.slaves[position].sdo  # type: ignore[attr-defined]
         server._pending.clear()
         server._upload = server._download = None
-        for _ in range(count % 7 + 7 if count >= 7 else count):
-            client.counter = next_counter(client.counter)
-            server.counter = next_counter(server.counter)
+        client.counter = advance_counter(client.counter, count)
+        server.counter = advance_counter(server.counter, count)
 
 
 _IO_STEP = IoSlave.step
