@@ -63,6 +63,7 @@ from .bank import AxisBank
 from .bank_kernel import _DEFERRED as _KERNEL_DEFERRED
 from .bank_kernel import prebuild as prebuild_kernel
 from .bank_kernel import start_deferred as start_kernel_build
+from .epoch import EPOCH
 from .input_sense import changed as sense_changed
 from .resources import install as install_resources
 
@@ -384,6 +385,7 @@ class Controller:
                 w()
         finally:
             self.cycling = False
+            EPOCH.n += 1  # (what the readers read changed: epoch.py)
 
     #: a cycle is running (:meth:`_cycle`, after its ``before_cycle`` hooks): an SDO made
     #: inside it (a touch probe read by SDO) cannot wait for cycles
@@ -412,6 +414,7 @@ class Controller:
             done = self._run_cycles(n)
         finally:
             self.in_batch = False
+            EPOCH.n += 1  # (what the readers read changed: epoch.py)
         if done:
             for w in self.watch:
                 w()

@@ -27,6 +27,7 @@ from gtecat.drives.faults import ErrorCode
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.slave import AlState
 
+from ..controller.epoch import changed as readers_changed
 from ..errors import ParameterError
 from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
 from . import kinds as k
@@ -375,6 +376,7 @@ class Injector:
         # the cyclic answers pass the injector from now on (a frame fault); a trigger that
         # watched an axis no longer does
         self._refresh()
+        readers_changed()  # (what the GT readers answer may change now: controller/epoch.py)
         if f.once:
             self._end(e, "done")
 
@@ -418,6 +420,7 @@ class Injector:
         axis = getattr(f, "axis", None)
         if axis is not None and f.depth in ("drive", "field"):
             bus.forget_override(axis)
+        readers_changed()  # (what the GT readers answer may change now: controller/epoch.py)
 
     def _spend(self, e: Entry) -> None:
         """One hit of a counted fault; the last one ends it."""

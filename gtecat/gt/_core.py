@@ -31,6 +31,7 @@ from ..controller.card import refused
 from ..controller.cards import CARD_CORES
 from ..controller.core import Controller
 from ..controller.core_view import AXES_PER_CORE, CoreView
+from ..controller.epoch import EPOCH
 from ..errors import (
     BusError,
     CommandError,
@@ -357,6 +358,7 @@ def _record(name: str, code: int, reason: str) -> None:
         ms = c.clock_ms()
     SESSION.last = LastError(name, code, reason, ms)
     SESSION.errors.append(SESSION.last)
+    EPOCH.n += 1  # (a read the C entries keep clears it: they ask again)
 
 
 def note(reason: str) -> None:
@@ -495,7 +497,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             elif SESSION.last is before:  # no reason recorded by a call made inside
                 _record(name, rc, "no reason given")
         except Exception as e:
-            return failed(e, ctl, core, before)
+            return failed(e, ctl, core, before)  # (its _record: the epoch grows)
+        EPOCH.n += 1  # (what the call changed: the values the C entries keep ask again)
         if ctl is None:
             ctl = SESSION.controllers.get(core)
         if ctl is not None and ctl.clock.mode is not _LOCKSTEP:  # (advance: nothing then)

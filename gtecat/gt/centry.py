@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterable
 from importlib import resources
 from typing import Any
 
+from ..controller.epoch import EPOCH, Epoch, changed
 from . import byref_target
 
 log = logging.getLogger(__name__)
@@ -74,6 +75,38 @@ class _Api(ctypes.Structure):
         ("err_clear", _VP),
         ("dict_get", _VP),
         ("gate", _VP),
+        ("epoch_obj", _VP),
+        ("epoch_off", ctypes.c_ssize_t),
+        ("clock_dicts", _VP),
+        ("clock_keys", _VP * 4),
+        ("dict_set", _VP),
+        ("from_ll", _VP),
+        ("ndarray_type", _VP),
+        ("nd_data", ctypes.c_ssize_t),
+        ("nd_nd", ctypes.c_ssize_t),
+        ("nd_dims", ctypes.c_ssize_t),
+        ("nd_descr", ctypes.c_ssize_t),
+        ("nd_flags", ctypes.c_ssize_t),
+        ("nd_want", ctypes.c_int),
+    ]
+
+
+class _Slot(ctypes.Structure):
+    """``struct slot`` of csrc/centry.c: a value kept for the epoch it was asked in."""
+
+    _fields_ = [("epoch", ctypes.c_longlong), ("value", _VP)]
+
+
+class _ASlot(ctypes.Structure):
+    """``struct aslot`` of csrc/centry.c: a span's bytes kept for their key and epoch."""
+
+    _fields_ = [
+        ("epoch", ctypes.c_longlong),
+        ("n", ctypes.c_longlong),
+        ("count", ctypes.c_longlong),
+        ("clock", ctypes.c_longlong),
+        ("tp", _VP),
+        ("value", _VP),
     ]
 
 
@@ -95,6 +128,15 @@ class _Entry(ctypes.Structure):
         ("avalue", _VP),
         ("gate", ctypes.c_ssize_t),
         ("after", _VP),
+        ("cache", ctypes.POINTER(_Slot)),
+        ("ncache", ctypes.c_ssize_t),
+        ("ctypes_", _VP * _MAX_TYPES),
+        ("csizes", ctypes.c_ssize_t * _MAX_TYPES),
+        ("csigns", ctypes.c_ssize_t * _MAX_TYPES),
+        ("acache", ctypes.POINTER(_ASlot)),
+        ("nptypes", _VP * 8),
+        ("npsizes", ctypes.c_ssize_t * 8),
+        ("npsigns", ctypes.c_ssize_t * 8),
     ]
 
 
@@ -109,7 +151,39 @@ class _RawEntry(ctypes.Structure):
         ("write", ctypes.c_ssize_t),
         ("gate", ctypes.c_ssize_t),
         ("after", _VP),
+        ("cache", ctypes.POINTER(_ASlot)),
     ]
+
+
+_MAX_OUT, _MAX_OTYPES = 3, 8
+
+
+class _MultiEntry(ctypes.Structure):
+    """``struct multi_entry`` of csrc/centry.c: a reader of several values."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("value", _VP),
+        ("sentinel", _VP),
+        ("nout", ctypes.c_ssize_t),
+        ("nextra", ctypes.c_ssize_t),
+        ("extra", ctypes.c_ssize_t * 3),
+        ("types", (_VP * _MAX_OTYPES) * _MAX_OUT),
+        ("sizes", (ctypes.c_ssize_t * _MAX_OTYPES) * _MAX_OUT),
+        ("signs", (ctypes.c_ssize_t * _MAX_OTYPES) * _MAX_OUT),
+        ("kinds", ctypes.c_ssize_t * _MAX_OUT),
+        ("gate", ctypes.c_ssize_t),
+        ("after", _VP),
+        ("cache", ctypes.POINTER(_Slot)),
+        ("ncache", ctypes.c_ssize_t),
+        ("titems", ctypes.c_ssize_t),
+        ("tuple_type", _VP),
+    ]
+
+
+#: what an argument after a multi-value reader's outputs must be: the int 1 (a count), the
+#: int 0 (a FIFO, a mode), None or the int 0 (a NULL pointer)
+ONE, ZERO, NULL = 1, 0, 2
 
 
 #: the session's gates, read by every gated entry before it asks its value (written by
@@ -127,8 +201,47 @@ CLOSED, LOCKSTEP, AUTO = 0, 1, 2
 
 def set_gates(gt: int, gtn: int) -> None:
     """Open (:data:`LOCKSTEP`, :data:`AUTO`) or close (:data:`CLOSED`) the two gates
-    (:data:`GATES`)."""
+    (:data:`GATES`); what the entries kept was another session's."""
     GATES[0], GATES[1] = int(gt), int(gtn)
+    EPOCH.n += 1
+
+
+#: per gate, the instance dictionary of its controller's clock where the gate says
+#: :data:`AUTO` (0: none): an entry adds the call's host latency there itself where that runs
+#: no cycle (gtecat.gt._core.advance's first branch), else calls its ``after``
+CLOCK_DICTS = (ctypes.c_ssize_t * 2)()
+#: the clock's attributes the entries read and write (the interned names its code uses)
+_CLOCK_KEYS = tuple(sys.intern(k) for k in ("_pending_ns", "call_latency_ns", "cycle_ns", "group"))
+_CLOCKS: list[Any] = [None, None]  # (the dictionaries, kept alive while named)
+
+
+def set_clocks(gt: Any, gtn: Any) -> None:
+    """The clocks behind the two gates (:data:`CLOCK_DICTS`; None: none), set while the gates
+    are closed."""
+    for k, clock in enumerate((gt, gtn)):
+        d = None if clock is None else vars(clock)  # (its dictionary, made if not yet)
+        if d is not None and not all(key in d for key in _CLOCK_KEYS):
+            d = None
+        _CLOCKS[k] = d
+        CLOCK_DICTS[k] = 0 if d is None else id(d)
+
+
+def _epoch_at() -> int:
+    """Where an :class:`Epoch` keeps ``n`` (ValueError when the probe disagrees)."""
+    probe = Epoch()
+    marks = [1 << 90, 1 << 91]
+    for k in range(_HEAD, sys.getsizeof(probe) - _WORD + 1, _WORD):
+        for m in marks:
+            probe.n = m
+            if _VP.from_address(id(probe) + k).value != id(m):
+                break
+        else:
+            return k
+    raise ValueError("an epoch's number is not where it is looked for")
+
+
+#: the axes (or other first arguments) below this have a value kept per entry
+CACHED = 257
 
 
 #: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
@@ -170,6 +283,69 @@ def _bytes_at() -> tuple[int, int]:
         if all(ctypes.string_at(id(b) + k, len(b)) == b for b in samples):
             return at, k
     raise ValueError("a bytes object's bytes are not where they are looked for")
+
+
+#: numpy's array flags an entry's array must have: C_CONTIGUOUS, ALIGNED, WRITEABLE (numpy's
+#: public ndarraytypes.h values; the probe checks them on arrays that have and lack each)
+_ND_WANT = 0x0001 | 0x0100 | 0x0400
+
+
+def _numpy_at() -> tuple[int, int, int, int, int, int]:
+    """numpy's ndarray type and where an array keeps its data, its number of dimensions, its
+    dimensions, its dtype and its flags ((0, ...): no numpy; ValueError when the probe
+    disagrees).  The public ``PyArrayObject_fields`` layout, checked on known arrays."""
+    try:
+        import numpy as np
+    except ImportError:
+        return 0, 0, 0, 0, 0, 0
+    samples = [np.zeros(3, np.int32), np.arange(6.0).reshape(2, 3), np.ones(1, np.int64)[::1]]
+    ro = np.zeros(2, np.int64)
+    ro.flags.writeable = False
+    strided = np.zeros(8, np.int32)[::2]
+    at = object.__basicsize__
+
+    def ok(k_data: int, k_nd: int, k_dims: int, k_descr: int, k_flags: int) -> bool:
+        for a in [*samples, ro, strided]:
+            if _VP.from_address(id(a) + k_data).value != a.ctypes.data:
+                return False
+            if ctypes.c_int.from_address(id(a) + k_nd).value != a.ndim:
+                return False
+            dims = _VP.from_address(id(a) + k_dims).value
+            if not dims or list((ctypes.c_ssize_t * a.ndim).from_address(dims)) != list(a.shape):
+                return False
+            if _VP.from_address(id(a) + k_descr).value != id(a.dtype):
+                return False
+            f = ctypes.c_int.from_address(id(a) + k_flags).value
+            want = (
+                bool(f & 0x0001) == a.flags.c_contiguous
+                and bool(f & 0x0100) == a.flags.aligned
+                and bool(f & 0x0400) == a.flags.writeable
+            )
+            if not want:
+                return False
+        return True
+
+    # (PyArrayObject_fields: data, nd, dimensions, strides, base, descr, flags)
+    k = (at, at + _WORD, at + 2 * _WORD, at + 5 * _WORD, at + 6 * _WORD)
+    if not ok(*k):
+        raise ValueError("a numpy array's fields are not where they are looked for")
+    return (id(np.ndarray), *k)
+
+
+def _tuple_at(size_at: int) -> int:
+    """Where a tuple keeps its first item (its length where a bytes object's is;
+    ValueError when the probe disagrees)."""
+    samples = [(object(), 2.5), (1 << 80, "x", None), tuple(range(300, 305))]
+    for t in samples:
+        if ctypes.c_ssize_t.from_address(id(t) + size_at).value != len(t):
+            raise ValueError("a tuple's length is not where it is looked for")
+    for k in range(size_at + _WORD, tuple.__basicsize__ + 1, _WORD):
+        if all(
+            all(_VP.from_address(id(t) + k + i * _WORD).value == id(x) for i, x in enumerate(t))
+            for t in samples
+        ):
+            return k
+    raise ValueError("a tuple's items are not where they are looked for")
 
 
 def _bytearray_at(size_at: int) -> int:
@@ -327,6 +503,9 @@ def _load() -> tuple[Maker | None, str]:
         bsize, bdata = _bytes_at()
         bastart = _bytearray_at(bsize)
         objects_at = _objects_at()
+        epoch_at = _epoch_at()
+        titems = _tuple_at(bsize)
+        numpy_at = _numpy_at()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -364,6 +543,14 @@ def _load() -> tuple[Maker | None, str]:
             _address("PyErr_Clear"),
             _address("PyDict_GetItem"),
             ctypes.addressof(GATES),
+            id(EPOCH),
+            epoch_at,
+            ctypes.addressof(CLOCK_DICTS),
+            (_VP * 4)(*(id(k) for k in _CLOCK_KEYS)),
+            _address("PyDict_SetItem"),
+            _address("PyLong_FromLongLong"),
+            *numpy_at,
+            _ND_WANT,
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -373,6 +560,8 @@ def _load() -> tuple[Maker | None, str]:
         raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
         vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value
         raw_vc = ctypes.cast(lib.gtecat_centry_raw_vc, _VP).value
+        multi_meth = ctypes.cast(lib.gtecat_centry_multi, _VP).value
+        multi_vc = ctypes.cast(lib.gtecat_centry_multi_vc, _VP).value
         new = byref_target.function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
@@ -410,6 +599,9 @@ def _load() -> tuple[Maker | None, str]:
         array: Callable[..., Any] | None = None,
         gate: int = NO_GATE,
         after: Callable[[], Any] | None = None,
+        cache: bool = False,
+        clocks: Iterable[type] = (),
+        numpy: Iterable[Any] = (),
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -429,7 +621,27 @@ def _load() -> tuple[Maker | None, str]:
             e.types[k] = id(t)
             e.sizes[k] = size or ctypes.sizeof(x)
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
-        keep = (fallback, value, sentinel, kinds, array, after)
+        cks = tuple(clocks)
+        if len(cks) >= _MAX_TYPES:
+            raise ValueError(f"at most {_MAX_TYPES - 1} clock types")
+        for k, t in enumerate(cks):
+            e.ctypes_[k], e.csizes[k] = id(t), ctypes.sizeof(t)
+            e.csigns[k] = int(not t._type_.isupper())
+        dts = tuple(numpy) if api.ndarray_type else ()
+        if len(dts) >= 8:
+            raise ValueError("at most seven numpy dtypes")
+        for k, dt in enumerate(dts):  # (numpy's own dtype objects: compared by identity)
+            e.nptypes[k], e.npsizes[k] = id(dt), dt.itemsize
+            e.npsigns[k] = int(dt.kind != "u")
+        slots = aslot = None
+        if cache:  # (the memory the C function keeps values in, kept alive with it)
+            slots = (_Slot * CACHED)()
+            e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
+            e.ncache = CACHED
+            if array is not None:
+                aslot = _ASlot()
+                e.acache = ctypes.pointer(aslot)
+        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -441,17 +653,61 @@ def _load() -> tuple[Maker | None, str]:
         write: bool,
         gate: int = NO_GATE,
         after: Callable[[], Any] | None = None,
+        cache: bool = False,
     ) -> Any:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         e.after = id(after) if after is not None else None
-        keep = (fallback, value, sentinel, after)
+        slot = None
+        if cache and not write:  # (a writer's value makes the epoch grow: nothing kept)
+            slot = _ASlot()
+            e.cache = ctypes.pointer(slot)
+        keep = (fallback, value, sentinel, after, slot)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
 
+    def make_multi(
+        fallback: Callable[..., Any],
+        value: Callable[[Any], Any],
+        sentinel: Any,
+        outs: list[tuple[Iterable[type], int]],
+        extras: Iterable[int] = (),
+        gate: int = NO_GATE,
+        after: Callable[[], Any] | None = None,
+        cache: bool = False,
+    ) -> Any:
+        more = tuple(extras)
+        if not 2 <= len(outs) <= _MAX_OUT or len(more) > 3:
+            raise ValueError(f"two to {_MAX_OUT} outputs, at most three arguments after them")
+        e = _MultiEntry(id(fallback), id(value), id(sentinel), len(outs), len(more))
+        for k, x in enumerate(more):
+            e.extra[k] = x
+        kinds = []
+        for k, (out_types, kind) in enumerate(outs):
+            ts = tuple(out_types)
+            if not 0 < len(ts) < _MAX_OTYPES or kind not in (INT, DOUBLE):
+                raise ValueError(f"one to {_MAX_OTYPES - 1} types of integers or doubles")
+            e.kinds[k] = kind
+            for j, t in enumerate(ts):
+                e.types[k][j], e.sizes[k][j] = id(t), ctypes.sizeof(t)
+                e.signs[k][j] = int(kind != INT or not t._type_.isupper())
+            kinds.append(ts)
+        e.gate = gate
+        e.after = id(after) if after is not None else None
+        e.titems, e.tuple_type = titems, id(tuple)
+        slots = None
+        if cache:
+            slots = (_Slot * CACHED)()
+            e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
+            e.ncache = CACHED
+        keep = (fallback, value, sentinel, kinds, after, slots)
+        fn = new(b"gt_centry_multi", multi_meth, _METH_FASTCALL_KEYWORDS, e, keep)
+        return public(fn, multi_vc, e, keep)
+
     make.raw = make_raw  # type: ignore[attr-defined]
+    make.multi = make_multi  # type: ignore[attr-defined]
     for _ in range(2):
         try:
-            reason = _self_test(make) or _self_test_raw(make_raw)
+            reason = _self_test(make) or _self_test_raw(make_raw) or _self_test_multi(make_multi)
         except Exception as e:  # (a self-test that cannot even run)
             reason = f"the self-test failed: {type(e).__name__}: {e}"
         if not reason or not callables:
@@ -612,6 +868,10 @@ def _self_test(make: Maker) -> str:
             now = [sys.getrefcount(x) for x in watched]
             return f"the entry changed a reference count ({args!r}: {counts} -> {now})"
 
+    reason = _self_test_numpy(make, python, value, nope)
+    if reason:
+        return reason
+
     gated = [make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, None, g)
              for g in (GT_GATE, GTN_GATE)]  # fmt: skip
     before = tuple(GATES)
@@ -630,6 +890,10 @@ def _self_test(make: Maker) -> str:
     finally:
         GATES[0], GATES[1] = before
 
+    reason = _self_test_cache(make, python, nope)
+    if reason:
+        return reason
+
     def failing(n: Any) -> Any:
         raise LookupError(n)
 
@@ -640,6 +904,164 @@ def _self_test(make: Maker) -> str:
         pass
     else:
         return "the value's error did not reach the caller"
+    return ""
+
+
+def _self_test_numpy(make: Maker, python: Callable[..., Any], value: Any, nope: Any) -> str:
+    """'' when an entry writes the first element of the numpy arrays it takes and hands on
+    the others, else what went wrong."""
+    try:
+        import numpy as np
+    except ImportError:
+        return ""
+    i32, i64 = np.dtype(np.int32), np.dtype(np.int64)
+    f = make(python, value, nope, [ctypes.c_int64], INT, False, 4, 0, False, False, None,
+             NO_GATE, None, False, (), (i32, i64))  # fmt: skip
+    ro = np.zeros(2, np.int64)
+    ro.flags.writeable = False
+    cases: list[tuple[int, Any, Any]] = [
+        (1, np.zeros(1, np.int64), 7),
+        (1, np.zeros(3, np.int32), 7),
+        (6, np.zeros(2, np.int32), -(1 << 31)),
+        (2, np.zeros(1, np.int32), None),  # (too wide)
+        (1, np.zeros((1, 1), np.int64), None),
+        (1, np.zeros(0, np.int64), None),
+        (1, ro, None),
+        (1, np.zeros(4, np.int64)[::2], None),
+        (1, np.zeros(1, np.float64), None),
+        (1, np.zeros(1, np.int16), None),
+        (1, np.zeros(1, np.dtype(">i8")), None),
+        (4, np.zeros(1, np.int64), None),  # (a float value)
+    ]
+    for n, a, want in cases:
+        before = a.copy()
+        got = f(n, a)
+        if want is None:
+            ok = got == ("python", (n, a), {}) and np.array_equal(a, before)
+        else:
+            ok = got == 0 and int(a[0]) == want and np.array_equal(a[1:], before[1:])
+        if not ok:
+            return f"a numpy entry answered {got!r} for {a!r} (axis {n})"
+    return ""
+
+
+def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
+    """'' when an entry that keeps values asks again exactly when :data:`EPOCH` grows, per
+    axis, its spans per key, and writes a span's clock, else what went wrong."""
+    asked: list[Any] = []
+    gen = [0]
+    L, A3, U32 = ctypes.c_int64, ctypes.c_int64 * 3, ctypes.c_uint32
+
+    def value(n: Any) -> Any:
+        asked.append(n)
+        return nope if n == 9 else 100 * n + gen[0]
+
+    def avalue(n: Any, count: Any, tp: Any, clock: Any) -> Any:
+        asked.append((n, count, clock))
+        if tp is not A3 or not 1 <= count <= 3:
+            return nope
+        tail = struct.pack("@q", 1 << 33 if n == 2 else 70) if clock == 1 else b""
+        return struct.pack(f"@{count}q", *range(n, n + count)) + tail
+
+    f = make(python, value, nope, [L], INT, False, 4, 0, False, False, avalue,
+             NO_GATE, None, True, [U32])  # fmt: skip
+    o, a, c, c16 = L(), A3(), U32(), ctypes.c_uint16()
+    p = ctypes.byref(o)
+    steps: list[tuple[tuple, list[Any], Any]] = [
+        ((1, p), [1], 100),
+        ((1, p), [], 100),
+        ((2, p), [2], 200),
+        ((1, p, 1, 0), [], 100),
+        ((9, p), [9], None),
+        ((9, p), [9], None),
+        ((1, a, 2), [(1, 2, None)], [1, 2, 0]),
+        ((1, a, 2), [], [1, 2, 0]),
+        ((1, a, 3), [(1, 3, None)], [1, 2, 3]),
+        ((1, a, 3, ctypes.byref(c)), [(1, 3, 1)], ([1, 2, 3], 70)),
+        ((1, a, 3, c), [], ([1, 2, 3], 70)),
+        ((2, a, 1, c), [(2, 1, 1)], ([2, 2, 3], 70)),  # (a clock too large: Python)
+        ((1, a, 3, c16), [], None),  # (a clock type it does not take)
+    ]
+    for k, (args, want_asked, want) in enumerate(steps):
+        del asked[:]
+        if k == 3:
+            gen[0] = 1
+            changed()  # (the epoch grows: asked again)
+            want_asked, want = [1], 101
+        o.value, c.value = 0, 0
+        got = f(*args)
+        if want is None:
+            ok = got == ("python", args, {})
+        elif isinstance(want, tuple):
+            ok = got == 0 and (list(a), c.value) == (want[0], want[1])
+            if args[0] == 2:  # (its clock does not fit: the Python function answers)
+                ok = got == ("python", args, {})
+        elif isinstance(want, list):
+            ok = got == 0 and list(a) == want
+        else:
+            ok = got == 0 and o.value == want
+        if not ok or asked != want_asked:
+            return f"a keeping entry answered {got!r} for {args!r} asking {asked!r}"
+    return ""
+
+
+def _self_test_multi(make_multi: Maker) -> str:
+    """'' when a multi-value entry writes every value or none, takes only its shapes, keeps
+    values per epoch and reference counts, else what went wrong."""
+    nope = object()
+    asked: list[Any] = []
+
+    def value(n: Any) -> Any:
+        asked.append(n)
+        return {1: (1, -70000), 2: (1, 1 << 40), 3: (2, 1.5), 4: nope, 5: (1,)}.get(n, nope)
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    S, L, I32 = ctypes.c_short, ctypes.c_int64, ctypes.c_int32
+    f = make_multi(python, value, nope, [([S], INT), ([L, I32], INT)], [ONE, NULL], cache=True)
+    a, b = S(), L()
+    pa, pb = ctypes.byref(a), ctypes.byref(b)
+    cases: list[tuple[tuple, Any, int]] = [
+        ((1, pa, pb), (1, -70000), 1),
+        ((1, pa, pb), (1, -70000), 0),  # (kept)
+        ((1, a, b, 1), (1, -70000), 0),
+        ((1, pa, pb, 1, None), (1, -70000), 0),
+        ((1, pa, pb, 1, 0), (1, -70000), 0),
+        ((1, pa, pb, 2), None, 0),
+        ((1, pa, pb, 1, 5), None, 0),
+        ((1, pa, pb, 1, None, 0), None, 0),
+        ((1, pa), None, 0),
+        ((1, pb, pa), None, 0),
+        ((1, pa, ctypes.byref(I32())), (1, -70000), 0),
+        ((2, pa, ctypes.byref(I32())), None, 1),  # (too wide for a 32-bit one: none written)
+        ((3, pa, pb), None, 1),  # (a float for an integer)
+        ((4, pa, pb), None, 1),
+        ((5, pa, pb), None, 1),
+        ((True, pa, pb), None, 0),
+        ((1, ctypes.byref(a, 0), pb), (1, -70000), 0),
+        ((1, pa, ctypes.byref((L * 2)(), 8)), None, 0),
+    ]
+    for args, want, n_asked in cases:
+        del asked[:]
+        a.value, b.value = 9, 9
+        watched = _own([*args, nope])
+        counts = [sys.getrefcount(x) for x in watched]
+        got = f(*args)
+        if want is None:
+            ok = got == ("python", args, {}) and (a.value, b.value) == (9, 9)
+        else:
+            second = args[2]._obj if type(args[2]) is type(pb) else args[2]
+            ok = got == 0 and (a.value, second.value) == want
+        if not ok or len(asked) != n_asked:
+            return f"a multi-value entry answered {got!r} for {args!r}, asking {asked!r}"
+        del got
+        if [sys.getrefcount(x) for x in watched] != counts:
+            return f"a multi-value entry changed a reference count ({args!r})"
+    changed()
+    del asked[:]
+    if f(1, pa, pb) != 0 or asked != [1]:
+        return "a multi-value entry kept a value past its epoch"
     return ""
 
 
@@ -711,6 +1133,25 @@ def _self_test_raw(make_raw: Maker) -> str:
             return "the raw entry answered a call with a keyword"
         if [sys.getrefcount(x) for x in watched] != counts:
             return f"the raw entry changed a reference count ({args!r})"
+    asked: list[Any] = []
+
+    def counted(*a: Any) -> Any:
+        asked.append(a)
+        return value(*a)
+
+    kept = make_raw(python, counted, nope, False, False, NO_GATE, None, True)
+    for k, (args, want) in enumerate(
+        [((4, 2), 1), ((4, 2), 0), ((4, 3), 1), ((4, 3), 0), ((4, 3), 1), ((12, 8), 1),
+         ((12, 8), 1), ((4, 2), 1)]
+    ):  # fmt: skip
+        if k == 4:
+            changed()  # (the epoch grows: asked again)
+        del asked[:]
+        o = U8()
+        got = kept(*args, o)
+        ok = got == ("python", (*args, o), {}) if args[0] == 12 else got == 0
+        if not ok or len(asked) != want:
+            return f"a keeping raw entry answered {got!r} for {args!r}, asking {len(asked)}"
     src = U8(*range(50, 58))
     if put(2, 4, src) != 0 or bytes(image)[:8] != bytes([0, 1, 50, 51, 52, 53, 6, 7]):
         return "the raw entry did not write into the image"
@@ -741,22 +1182,32 @@ def reader(
     array: Callable[..., Any] | None = None,
     gate: int = NO_GATE,
     after: Callable[[], Any] | None = None,
+    clocks: Iterable[type] = (),
+    numpy: Iterable[Any] = (),
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
     (of one of ``types``) for the common shape, else ``fallback`` with the same arguments;
     ``value`` gives ``sentinel`` where the entry must not answer.  ``kind``: :data:`INT`
     (each type's width and sign), :data:`DOUBLE`, or :data:`BYTES` (``value`` gives
-    ``size`` bytes, copied to the start of the object); ``pointers``: ``pointer(x)`` of
+    ``size`` bytes, copied to the start of the object); ``numpy``: numpy dtypes whose
+    one-dimensional, C-contiguous, aligned, writable arrays of at least one element take the
+    value in their first element (the Python fast function's numpy shape); ``pointers``:
+    ``pointer(x)`` of
     those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
     ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
-    ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), pClock)`` (``count`` an
-    int, 1 where omitted; ``pClock`` None where omitted) gives the bytes written to the
-    array's start (it checks the array's type and length), else anything but bytes;
+    ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), clock)`` (``count`` an
+    int, 1 where omitted; ``clock`` None where pClock is omitted, None or 0, and 1 where it
+    is ``byref(x)`` (no offset) or ``x`` of one of ``clocks``) gives the bytes written to the
+    array's start (it checks the array's type and length), then where ``clock`` is 1 the
+    clock's value (native int64; written into ``x`` where ``x``'s type holds it), else
+    anything but bytes;
     ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
     that gate of :data:`GATES` is open (else ``fallback``; ``after()``, where given, the
     call's return once its value is written while the gate says :data:`AUTO`), so they
-    need not check the session themselves.
+    need not check the session themselves; a gated entry keeps what ``value`` and
+    ``array`` give for the epoch they were asked in and writes it again while
+    :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`).
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -775,6 +1226,9 @@ def reader(
         array,
         gate,
         after,
+        gate != NO_GATE,
+        clocks,
+        numpy,
     )
 
 
@@ -798,7 +1252,28 @@ def raw(
     C entry is not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
+
+
+def multi(
+    fallback: Callable[..., Any],
+    value: Callable[[Any], Any],
+    sentinel: Any,
+    outs: list[tuple[Iterable[type], int]],
+    extras: Iterable[int] = (),
+    gate: int = NO_GATE,
+    after: Callable[[], Any] | None = None,
+) -> Any:
+    """The C entry of a reader of several values: ``f(n, p1, p2[, p3][, extras...])`` with
+    each ``p`` ``byref(x)`` (no offset) or ``x`` of one of its output's types (``outs``: the
+    types and :data:`INT` or :data:`DOUBLE` per output) and each argument after them what
+    ``extras`` says (:data:`ONE`, :data:`ZERO`, :data:`NULL`) writes the tuple ``value(n)``
+    gives, each number checked to fit before any is written; else ``fallback`` with the same
+    arguments.  ``gate`` and ``after``: as :func:`reader`'s (a gated entry keeps its values
+    for their epoch).  None where the C entry is not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE.multi(fallback, value, sentinel, outs, extras, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
 
 
 _RUN = struct.Struct("=qqq")

@@ -28,6 +28,7 @@ from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE
+from ..controller.epoch import EPOCH
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_count
@@ -452,12 +453,13 @@ def fast_reader(
     packers: dict[tuple[type, int], Callable[..., bytes]] = {}
 
     def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
-        """The C entry's values for a ctypes array: ``f(n, count, array type, pClock)``
-        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one, with
-        pClock NULL; ``spans``: a span of axes too, with a clock, as ``many`` answers it),
-        else _NO (the Python path answers)."""
+        """The C entry's values for a ctypes array: ``f(n, count, array type, clock)``
+        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one;
+        ``spans``: a span of axes too, and the clock, as ``many`` answers them), then where
+        ``clock`` is 1 (pClock given) the clock's value as ``many`` writes it (int64), else
+        _NO (the Python path answers)."""
 
-        def f(n: int, count: int, tp: type, pClock: Any) -> Any:
+        def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
             pack = packers.get((tp, count))
             if pack is None:
@@ -465,10 +467,9 @@ def fast_reader(
                     return _NO
                 # (the array's own element type, natively)
                 pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
-            clk = None
+            if clock is not None and not spans:
+                return _NO
             if count == 1:
-                if pClock is not None and not (type(pClock) is int and pClock == 0):
-                    return _NO
                 v = value(n)
                 if v is _NO:
                     return _NO
@@ -477,23 +478,16 @@ def fast_reader(
                 if not spans or count > limit:
                     return _NO
                 # (the GT_ form's entry asks only while the GT_ gate is open: its controller)
-                ctl = GATED[0]
-                if ctl is _OFF:
-                    return _NO
-                if pClock is not None and not (type(pClock) is int and pClock == 0):
-                    clk = clock_out(ctl, pClock)  # (NULL: None, without the call)
-                    if clk is False:
-                        return _NO
-                values = span(ctl, n, count, True)
+                values = span(GATED[0], n, count, True)
                 if values is None:
                     return _NO
             try:
                 out = pack(*values)
             except struct.error:  # (a value the element does not hold: the Python path)
                 return _NO
-            if clk is not None:
-                clk[0].value = clk[1]
             session.last = None
+            if clock is not None:  # (the table path's value, clock_out's)
+                out += _CLOCK_VALUE.pack(GATED[0].clock_ms() & 0xFFFFFFFF)
             return out
 
         return f
@@ -510,17 +504,23 @@ def fast_reader(
             pointers=True,  # (pointer(x): as general answers it)
             array=array_value(value_gt, True), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
+            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, False),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
+            numpy=sorted(np_ok, key=str),
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
             public[0] = entry
     return public[0]  # type: ignore[no-any-return]
 
+
+#: a span's clock value after its values (:func:`centry.reader`'s ``array``)
+_CLOCK_VALUE = struct.Struct("@q")
 
 #: the C entry of the readers where it is available (``GTECAT_CENTRY=0`` turns it off when
 #: gtecat is imported; tests turn it off to hold the Python fast functions to the same answers)
@@ -564,7 +564,11 @@ def set_gates(gt: Any, gtn: Any) -> None:
     GATED[:] = new
     for env in _GATED_ENVS:
         env["CTL"], env["CTLN"] = GATED
-    centry.set_gates(_gate_value(gt), _gate_value(gtn))
+    gates = _gate_value(gt), _gate_value(gtn)
+    centry.set_clocks(
+        *(c.clock if g == centry.AUTO else None for c, g in zip(new, gates, strict=True))
+    )
+    centry.set_gates(*gates)
 
 
 def _gate_value(ctl: Any) -> int:
@@ -1119,6 +1123,23 @@ def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], byte
 RAW = frozenset(
     {"GT_GetEcatRawData", "GT_SetEcatRawData", "GT_EcatIOReadInput", "GT_EcatIOWriteOutput"}
 )
+#: the raw functions that write into the process image
+RAW_WRITES = frozenset({"GT_SetEcatRawData", "GT_EcatIOWriteOutput"})
+
+
+def _raw_code(code: str, name: str) -> str:
+    """A raw function's compiled code; a writer's makes the epoch grow where it has written
+    (a reader's C entry asks again: :mod:`gtecat.controller.epoch`)."""
+    if name not in RAW_WRITES:
+        return code
+    return re.sub(
+        r"^( *)session\.last = None$",
+        r"\1session.last = None\n\1EPOCH.n += 1",
+        code,
+        flags=re.M,
+    )
+
+
 _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
 _CAST: Any = object()
 _NUMPY: Any = object()
@@ -1174,7 +1195,7 @@ def fast_raw(
     Into or from a bytearray, memoryview or bytes, a range of a few runs of the process image
     (a slave's outputs, its inputs) is copied run by run as slices; otherwise one numpy copy
     through a cached view; anything else takes the table path."""
-    write = name in ("GT_SetEcatRawData", "GT_EcatIOWriteOutput")
+    write = name in RAW_WRITES
     io = name in _IO
     cache: dict[tuple[int, int], tuple[int, np.ndarray] | None] = {}
     #: the image the cache is of and its bytes as a memoryview
@@ -1392,6 +1413,8 @@ def fast_raw(
             else:
                 copyto(arr, image.buffer.take(idx))  # (np.take with out= costs microseconds)
         session.last = None
+        if write:
+            EPOCH.n += 1  # (the readers' C entries ask again: epoch.py)
         if ctl.clock.mode is not _LOCKSTEP:
             return advance(ctl, name, 0)
         return 0
@@ -1437,6 +1460,8 @@ def fast_raw(
             return _NO
         venv["LASTC"] = (offset, size, tp, image, slave, at)
         session.last = None
+        if write:
+            EPOCH.n += 1  # (the readers' C entries ask again: epoch.py)
         return at
 
     venv = {
@@ -1452,7 +1477,8 @@ def fast_raw(
         slave_memo=" and slave == last[4]" if io else "",
     )
     _gated(venv)
-    exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
+    venv["EPOCH"] = EPOCH
+    exec(_compiled_code(_raw_code(code, name), f"<gt raw value {name}>"), venv)
     value = venv["value"]
 
     public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE, _after(advance, name, 0))
@@ -1584,6 +1610,8 @@ def _raw_entry(env: dict[str, Any], io: bool, n: int, key: Any, image: Any, spec
         given="given" if ref else "p",
     )
     scratch: dict[str, Any] = {}
+    env["EPOCH"] = EPOCH
+    code = _raw_code(code, env["name"])
     exec(_compiled_code(code, f"<gt fast raw {env['name']} shape {n}>"), env, scratch)
     return scratch["gt"].__code__
 
@@ -1663,7 +1691,8 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
     )
     code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
-    env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof)
+    env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof, EPOCH=EPOCH)
+    code = _raw_code(code, env["name"])
     exec(_compiled_code(code, f"<gt fast raw {env['name']}>"), env)  # env: its globals
     return env["gt"]
 
@@ -1683,7 +1712,8 @@ SLOW_REASONS: dict[str, str] = {
     "pvt": "PVT tables and status: the table work outweighs the arguments",
     "bus": "bus set-up, identity and SDO calls (an SDO transfer costs far more than its "
     "arguments); the clock and version readers are answered after the table's checks",
-    "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the arguments",
+    "crd": "coordinated-motion set-up and queue calls: the planning work outweighs the "
+    "arguments; GT_CrdStatus, which a loop polls, has a C entry (MULTI_READERS)",
     "ecat_axis": "probe status, the axis mode, analog inputs and the scale: table path; the "
     "per-axis PDO readers and the homing status that polling loops use are on the fast path",
     "ecat_io": "one output bit read: table path",
@@ -1691,7 +1721,8 @@ SLOW_REASONS: dict[str, str] = {
     "ext_io": "extension-module IO: each call walks the module configuration (table path)",
     "gantry": "a mode query: table path",
     "gts_card": "the pulse-card (GTS) set-up, capture and smart-homing calls: table path; the "
-    "polled IO readers (GT_GetDi, GT_GetDiRaw, GT_GetDo) are on the fast path",
+    "polled IO readers (GT_GetDi, GT_GetDiRaw, GT_GetDo) are on the fast path, and "
+    "GT_GetCaptureStatus has a C entry (MULTI_READERS)",
     "motion": "profile set-up and parameter readers (called once per move); the position and "
     "speed readers that polling loops use, and GT_GetTrapPrm, are on the fast path",
     "plcopen": "PLCopen function blocks: each call plans or reads a block's state (table path)",
@@ -2207,16 +2238,16 @@ def fast_struct_reader(
 ) -> Callable[..., int]:
     """``GT_GetTrapPrm(profile, p)`` with the fast path in front of the table: ``p``
     ``byref(s)`` (no offset) or ``s`` itself of the structure's own class, an axis of the
-    in-process controller (core 1, no pulse card) in the mode the function needs; the axis
-    bank is told of the call as the table path tells it (:meth:`AxisBank.before_call`), then
-    the table path's own ``fill`` writes the fields.  Any other shape, another mode, an
-    axis that does not exist: the table path, with its code and reason."""
+    in-process controller (core 1, no pulse card) in the mode the function needs; the table
+    path's own ``fill`` writes the fields, a banked axis staying in the bank (what it reads
+    is set by GT calls only).  Any other shape, another mode, an axis that does not exist:
+    the table path, with its code and reason."""
     from .table import FUNCTIONS
 
     first = FUNCTIONS[name].params[0]
     if first.name not in ("axis", "profile", "encoder") or any(
         q.name == "count" for q in FUNCTIONS[name].params
-    ):  # (AxisBank.before_axis_call is before_call for these only)
+    ):  # (the readers of one axis's set-up only)
         raise ValueError(f"{name}: not a function of one axis")
     cls, mode, fill = STRUCT_READERS[name]
     target = _target([cls])
@@ -2250,9 +2281,9 @@ def fast_struct_reader(
             got = None if s is None else ready(n)
             if got is not None:
                 ctl, res = got
-                bank = ctl.bank
-                if bank is not None:  # (what the table path does first)
-                    bank.before_axis_call(res.ax, res)
+                # (no release from the axis bank, unlike the table path: the profile's mode
+                # and its Trap parameters are set by GT calls only, which give the axis back
+                # first, so a banked axis's are its own)
                 if res.profile.mode is mode:
                     try:
                         fill(res, s)
@@ -2294,12 +2325,7 @@ def value(n):
     ax = res.ax
     if ctl.card is not None or ctl.axes.get(n) is not ax:
         return _NO
-    bank = ctl.bank
-    if bank is not None:  # (what the table path does first: before_axis_call, inline)
-        bank.dirty = True
-        if bank.n_alive and res.bank is bank:
-            bank.release_axis_object(ax)
-    prof = res.profile
+    prof = res.profile  # (a banked axis's own: the fast function's note)
     if prof.mode is not MODE:
         return _NO
     try:
@@ -2686,6 +2712,95 @@ def value(t):
 """
 
 
+#: readers of several values polled in loops (a capture's status and value, a coordinate
+#: system's run flag and segments): function -> what each argument after the outputs must be
+#: for the C entry (centry.multi: GT_GetCaptureStatus' count 1 and pClock NULL, GT_CrdStatus'
+#: FIFO 0)
+MULTI_READERS: dict[str, tuple[int, ...]] = {
+    "GT_GetCaptureStatus": (centry.ONE, centry.NULL),
+    "GT_CrdStatus": (centry.ZERO,),
+}
+
+
+def fast_multi(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """A reader of several values with its C entry in front of the table path
+    (:func:`centry.multi`): the common shape - the number, ``byref(x)`` or ``x`` of an
+    integer type each output takes, the arguments after them as :data:`MULTI_READERS` says
+    - on the in-process controller (the GT_ gate), an axis or system that exists and is
+    set up (a capture made by GT_SetCaptureMode or an earlier read, a system with its
+    parameters); its values as the table path stores them, a banked axis left in the bank
+    (what it reads is the capture unit's and the system's own, kept current by the bank's
+    cycles).  Every other call: the table path, with its code and reason."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    if not CENTRY:
+        return slow
+    params = FUNCTIONS[name].params
+    outs = []
+    for q in params[1:3]:
+        ts = [t for t in _scalar_types(q) if getattr(t, "_type_", "") in _INT_CODES]
+        outs.append((sorted(ts, key=str), centry.INT))
+    value = _MULTI_VALUES[name](session)
+    entry = centry.multi(
+        slow, value, _NO, outs, MULTI_READERS[name], centry.GT_GATE, _after(advance, name, 0)
+    )
+    if entry is None:
+        return slow
+    entry.python = slow  # type: ignore[attr-defined]  # (no Python fast function: the table)
+    return entry  # type: ignore[no-any-return]
+
+
+def _capture_value(session: Any) -> Callable[[Any], Any]:
+    """GT_GetCaptureStatus' (status, value) of a capture made already, else _NO."""
+    from ..controller.capture import _UNITS
+
+    def value(n: Any) -> Any:
+        ctl = GATED[0]
+        try:
+            res = ctl.resources[n]
+        except KeyError:  # no such axis: the table path says why
+            return _NO
+        if ctl.card is not None or ctl.axes.get(n) is not res.ax:
+            return _NO
+        unit = _UNITS.get(res)
+        if unit is None:  # (not made yet: the table path makes it)
+            return _NO
+        session.last = None
+        return (unit.status, unit.value)
+
+    return value
+
+
+def _crd_value(session: Any) -> Callable[[Any], Any]:
+    """GT_CrdStatus' (run, segments done) of FIFO 0 of a system with its parameters."""
+
+    def value(n: Any) -> Any:
+        ctl = GATED[0]
+        if ctl.card is not None:
+            return _NO
+        systems = vars(ctl).get("crd_bank")  # (made by the table path's first call)
+        c = None if systems is None else systems.systems.get(n)
+        if c is None or c.prm is None:  # (the table path says why)
+            return _NO
+        now = c.now()
+        session.last = None
+        return (1 if now.running and now.fifo == 0 else 0, now.segments_done[0])
+
+    return value
+
+
+_MULTI_VALUES: dict[str, Callable[[Any], Callable[[Any], Any]]] = {
+    "GT_GetCaptureStatus": _capture_value,
+    "GT_CrdStatus": _crd_value,
+}
+
+
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
         CLOCK: fast_clock,
@@ -2695,6 +2810,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         HOME_STATUS: fast_home_status,
     }
     for names, make in (
+        (MULTI_READERS, fast_multi),
         (READERS, fast_reader),
         (RAW, fast_raw),
         (ECAT_READERS, fast_ecat_reader),

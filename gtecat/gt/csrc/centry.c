@@ -60,9 +60,40 @@ struct api {
      * [0] nonzero while the GT_ functions address the in-process lockstep controller of
      * core 1, [1] while the GTN_ functions' core 1 is that controller */
     const ptrdiff_t *gate;
+    /* the values' epoch: an int at epoch_off in epoch_obj (gtecat.controller.epoch.EPOCH.n), which
+     * Python makes larger wherever a value an entry caches may change (a cycle, a call that
+     * is not a cached read, a fault, the session) */
+    obj epoch_obj;
+    ptrdiff_t epoch_off;
+    /* the auto clock's host latency in the common case (gtecat.gt._core.advance's first
+     * branch): per gate the instance dict of its controller's clock (0: none, after()
+     * runs it), the keys _pending_ns, call_latency_ns, cycle_ns and group */
+    const ptrdiff_t *clock_dicts;
+    obj clock_keys[4];
+    int (*dict_set)(obj, obj, obj);  /* PyDict_SetItem */
+    obj (*from_ll)(long long);       /* PyLong_FromLongLong */
+    /* numpy's arrays (numpy's public PyArrayObject fields, probed): the type, where an array
+     * keeps its data, its number of dimensions (int), its dimensions, its dtype and its flags
+     * (int); the flags a one-dimensional array an entry writes must have */
+    obj ndarray_type;
+    ptrdiff_t nd_data, nd_nd, nd_dims, nd_descr, nd_flags;
+    int nd_want;
 };
 
 #define MAX_TYPES 16
+
+/* a value kept for the epoch it was asked in (value: a strong reference, NULL: none) */
+struct slot {
+    long long epoch;
+    obj value;
+};
+
+/* a span's bytes kept for its key and epoch (tp: a strong reference while kept) */
+struct aslot {
+    long long epoch, n, count, clock;
+    obj tp;
+    obj value;
+};
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
 struct entry {
@@ -81,6 +112,19 @@ struct entry {
     ptrdiff_t gate; /* 0: none; k: value (and avalue) only while A.gate[k - 1] is nonzero */
     obj after; /* NULL, or after(): the call's return code once written, where A.gate[k - 1] is
                 * 2 (the auto clock: the call's host latency, which may run cycles) */
+    struct slot *cache; /* value(n) kept per n below ncache for its epoch (NULL: none) */
+    ptrdiff_t ncache;
+    /* the integer types a span's pClock may point at (byref(x) or x), NULL-ended: none, the
+     * reader takes no clock */
+    obj ctypes_[MAX_TYPES];
+    ptrdiff_t csizes[MAX_TYPES];
+    ptrdiff_t csigns[MAX_TYPES];
+    struct aslot *acache; /* the last span's bytes (NULL: none kept) */
+    /* the numpy dtypes (their descr objects) whose one-dimensional arrays take the value in
+     * their first element, NULL-ended, with their sizes and signs */
+    obj nptypes[8];
+    ptrdiff_t npsizes[8];
+    ptrdiff_t npsigns[8];
 };
 
 static struct api A;
@@ -101,7 +145,10 @@ int gtecat_centry_api(const struct api *api)
         !api->int_type || !api->float_type || !api->bytes_type || !api->array_meta ||
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
-        !api->err_occurred || !api->err_clear || !api->gate)
+        !api->err_occurred || !api->err_clear || !api->gate || !api->epoch_obj ||
+        api->epoch_off <= 0 || !api->clock_dicts || !api->clock_keys[0] ||
+        !api->clock_keys[1] || !api->clock_keys[2] || !api->clock_keys[3] || !api->dict_set ||
+        !api->from_ll)
         return 1;
     A = *api;
     ready = 1;
@@ -123,39 +170,220 @@ static int int_is(obj o, long long want)
     return !over && v == want;
 }
 
-/* a reader's ctypes array (count from n): the bytes avalue gives copied to its start */
+/* The values' epoch now (-1: unknown, nothing is kept or used). */
+static long long epoch(void)
+{
+    obj o = (obj)AT(A.epoch_obj, A.epoch_off);
+    int over = 0;
+    long long v;
+    if (!o || TYPE(o) != A.int_type)
+        return -1;
+    v = A.as_ll(o, &over);
+    if (v == -1 && !over && A.err_occurred())
+        A.err_clear();
+    return over || v < 0 ? -1 : v;
+}
+
+/* Keep v in s for epoch ep (v: borrowed; s's old value given up). */
+static void keep(struct slot *s, long long ep, obj v)
+{
+    obj old = s->value;
+    A.incref(v);
+    s->value = v;
+    s->epoch = ep;
+    if (old)
+        A.decref(old);
+}
+
+/* x held by an integer of size bytes (sign: signed) */
+static int fits(long long x, int size, int sign)
+{
+    long long lo, hi;
+    if (size == 1)
+        lo = sign ? INT8_MIN : 0, hi = sign ? INT8_MAX : UINT8_MAX;
+    else if (size == 2)
+        lo = sign ? INT16_MIN : 0, hi = sign ? INT16_MAX : UINT16_MAX;
+    else if (size == 4)
+        lo = sign ? INT32_MIN : 0, hi = sign ? INT32_MAX : (long long)UINT32_MAX;
+    else if (size == 8)
+        lo = sign ? INT64_MIN : 0, hi = INT64_MAX;
+    else
+        return 0;
+    return x >= lo && x <= hi;
+}
+
+/* x (which fits) written with size bytes */
+static void put(char *mem, long long x, int size)
+{
+    if (size == 1)
+        *(int8_t *)mem = (int8_t)x;
+    else if (size == 2)
+        *(int16_t *)mem = (int16_t)x;
+    else if (size == 4)
+        *(int32_t *)mem = (int32_t)x;
+    else
+        *(int64_t *)mem = (int64_t)x;
+}
+
 /* A call's return once its value is written: 0, or in the auto clock (its gate says 2)
  * what after() returns (the call's host latency, as the Python path's advance runs it). */
+/* An int's value in *v (0: not an exact int that a long long holds; no error left). */
+static int ll_of(obj o, long long *v)
+{
+    int over = 0;
+    if (!o || TYPE(o) != A.int_type)
+        return 0;
+    *v = A.as_ll(o, &over);
+    if (*v == -1 && !over && A.err_occurred()) {
+        A.err_clear();
+        return 0;
+    }
+    return !over;
+}
+
+/* The auto clock's host latency where it runs no cycle, as advance() does it first: the
+ * clock's _pending_ns grows by call_latency_ns while that stays below cycle_ns and the clock
+ * shares no time (group None).  1: done; 0: after() must run it (a cycle is due, or any
+ * doubt). */
+static int latency(ptrdiff_t gate)
+{
+    obj d = (obj)A.clock_dicts[gate - 1], n;
+    long long pend, lat, cyc;
+    int r;
+    if (!d || TYPE(d) != A.dict_type || A.dict_get(d, A.clock_keys[3]) != A.none)
+        return 0;
+    if (!ll_of(A.dict_get(d, A.clock_keys[0]), &pend) ||
+        !ll_of(A.dict_get(d, A.clock_keys[1]), &lat) ||
+        !ll_of(A.dict_get(d, A.clock_keys[2]), &cyc))
+        return 0;
+    if (pend < 0 || lat < 0 || pend > cyc || pend + lat >= cyc)
+        return 0;
+    n = A.from_ll(pend + lat);
+    if (!n) {
+        A.err_clear();
+        return 0;
+    }
+    r = A.dict_set(d, A.clock_keys[0], n);
+    A.decref(n);
+    if (r) {
+        A.err_clear();
+        return 0;
+    }
+    return 1;
+}
+
 static obj done(obj after, ptrdiff_t gate)
 {
-    if (after && gate && A.gate[gate - 1] == 2)
+    if (after && gate && A.gate[gate - 1] == 2 && !latency(gate))
         return A.vectorcall(after, NULL, 0, NULL);
     A.incref(A.zero);
     return A.zero;
 }
 
+/* A span's pClock: NULL (omitted, None or 0: *clock 0) or the memory of byref(x) (no
+ * offset) or x of one of the entry's clock types (*clock 1, its size and sign); 0 where
+ * this entry does not take it. */
+static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *sign)
+{
+    obj target = pc, tp;
+    int k;
+    *mem = NULL;
+    if (pc == A.none || pc == A.zero || int_is(pc, 0))
+        return 1;
+    tp = TYPE(pc);
+    if (tp == A.carg_type) {
+        target = AT(pc, A.carg_obj);
+        if (!target)
+            return 0;
+        tp = TYPE(target);
+        if (AT(pc, A.carg_value) != AT(target, A.b_ptr))
+            return 0; /* byref(x, offset), or x's memory moved since */
+    }
+    for (k = 0; k < MAX_TYPES && e->ctypes_[k]; k++) {
+        if (e->ctypes_[k] == tp) {
+            *mem = AT(target, A.b_ptr);
+            *size = (int)e->csizes[k];
+            *sign = (int)e->csigns[k];
+            return *mem != NULL;
+        }
+    }
+    return 0;
+}
+
+/* A reader's ctypes array (count from n, pClock NULL or a clock's pointer): the bytes
+ * avalue(n, count, array type, clock) gives (clock None or 1: then the clock's value
+ * follows the values as an int64) copied to its start, kept for the epoch. */
 static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                  ptrdiff_t at)
 {
-    obj call[4], v;
+    obj call[4], v, tp = TYPE(args[at + 1]);
     ptrdiff_t n;
+    long long ep = -1, an, ac, clk = 0;
+    char *cmem = NULL, *mem;
+    int csize = 0, csign = 1, over = 0;
+    struct aslot *s = e->acache;
     call[0] = args[at];
     call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
-    call[2] = TYPE(args[at + 1]);
-    call[3] = nargs >= 4 + at ? args[at + 3] : A.none;
     if (TYPE(call[1]) != A.int_type)
         goto python;
-    v = A.vectorcall(e->avalue, call, 4, NULL);
-    if (!v)
-        return NULL;
-    if (TYPE(v) != A.bytes_type || (n = *(ptrdiff_t *)((char *)v + A.bsize)) <= 0) {
-        A.decref(v);
+    if (nargs >= 4 + at && !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
+        goto python;
+    an = A.as_ll(call[0], &over);
+    if (!over)
+        ac = A.as_ll(call[1], &over);
+    if (over || A.err_occurred()) {
+        if (A.err_occurred())
+            A.err_clear();
         goto python;
     }
+    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
+        s->count == ac && s->tp == tp && s->clock == (cmem != NULL)) {
+        v = s->value;
+        A.incref(v);
+    } else {
+        call[2] = tp;
+        call[3] = cmem ? A.one : A.none;
+        v = A.vectorcall(e->avalue, call, 4, NULL);
+        if (!v)
+            return NULL;
+        if (TYPE(v) != A.bytes_type) {
+            A.decref(v);
+            goto python;
+        }
+        if (s && ep >= 0) {
+            obj old = s->value, oldtp = s->tp;
+            A.incref(v);
+            A.incref(tp);
+            s->value = v, s->tp = tp, s->epoch = ep, s->n = an, s->count = ac;
+            s->clock = cmem != NULL;
+            if (old)
+                A.decref(old);
+            if (oldtp)
+                A.decref(oldtp);
+        }
+    }
+    n = *(ptrdiff_t *)((char *)v + A.bsize) - (cmem ? 8 : 0);
+    if (n <= 0)
+        goto drop;
+    if (cmem) {
+        memcpy(&clk, (char *)v + A.bdata + n, 8);
+        if (!fits(clk, csize, csign))
+            goto drop; /* (a clock the type does not hold: the Python path) */
+        /* (again: Python may have run) */
+        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem)
+            goto drop;
+    }
     /* (avalue checked the array's type and length: the bytes fit) */
-    memcpy(AT(args[at + 1], A.b_ptr), (char *)v + A.bdata, (size_t)n);
+    mem = AT(args[at + 1], A.b_ptr);
+    if (!mem)
+        goto drop;
+    memcpy(mem, (char *)v + A.bdata, (size_t)n);
+    if (cmem)
+        put(cmem, clk, csize);
     A.decref(v);
     return done(e->after, e->gate);
+drop:
+    A.decref(v);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
@@ -174,6 +402,28 @@ obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kw
 {
     return reader((const struct entry *)AT(callable, A.vc_entry), args,
                   (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+/* The first element of a numpy array p an entry takes (one dimension, at least one element,
+ * C-contiguous, aligned, writable, of one of the entry's dtypes), its size and sign; NULL
+ * where the entry does not take it.  Looked up before and after the value function, as
+ * reader_mem is. */
+static char *np_mem(const struct entry *e, obj p, int *size, int *sign)
+{
+    obj d = (obj)AT(p, A.nd_descr);
+    int k;
+    if (*(int *)((char *)p + A.nd_nd) != 1 || !AT(p, A.nd_dims) ||
+        *(ptrdiff_t *)AT(p, A.nd_dims) < 1 ||
+        (*(int *)((char *)p + A.nd_flags) & A.nd_want) != A.nd_want)
+        return NULL;
+    for (k = 0; k < 8 && e->nptypes[k]; k++) {
+        if (e->nptypes[k] == d) {
+            *size = (int)e->npsizes[k];
+            *sign = (int)e->npsigns[k];
+            return AT(p, A.nd_data);
+        }
+    }
+    return NULL;
 }
 
 /* The memory a reader writes for p (target: p, or a byref's object), or NULL where this
@@ -214,7 +464,8 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     obj p, target, tp, v;
     char *mem;
     obj deref = NULL;
-    int k, size = 0, sign = 1;
+    int k, size = 0, sign = 1, npy = 0;
+    long long key = -1, ep = -1;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -241,32 +492,55 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     }
     tp = TYPE(p);
     target = p;
-    if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
-        target = AT(p, A.carg_obj);
-        if (!target)
+    if (tp == A.ndarray_type && e->nptypes[0]) { /* a numpy array: its first element */
+        if (!np_mem(e, p, &size, &sign))
             goto python;
-        tp = TYPE(target);
+        npy = 1;
+    } else {
+        if (tp == A.carg_type) { /* byref(x) of an accepted x with no offset: x */
+            target = AT(p, A.carg_obj);
+            if (!target)
+                goto python;
+            tp = TYPE(target);
+        }
+        for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
+            if (e->types[k] == tp) {
+                size = (int)e->sizes[k];
+                sign = (int)e->signs[k];
+                deref = (obj)e->derefs[k];
+                break;
+            }
+        }
+        if (!size)
+            goto python;
+        if (!reader_mem(p, target, deref))
+            goto python;
     }
-    for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
-        if (e->types[k] == tp) {
-            size = (int)e->sizes[k];
-            sign = (int)e->signs[k];
-            deref = (obj)e->derefs[k];
-            break;
+
+    /* the value kept for this epoch, else value(n)'s (kept for it) */
+    if (e->cache) {
+        int over = 0;
+        key = e->noaxis ? 0 : A.as_ll(args[at], &over);
+        if (over || key < 0 || key >= e->ncache) {
+            if (key == -1 && !over && A.err_occurred())
+                A.err_clear();
+            key = -1;
+        } else if ((ep = epoch()) >= 0 && e->cache[key].value && e->cache[key].epoch == ep) {
+            v = e->cache[key].value;
+            A.incref(v);
+            goto have;
         }
     }
-    if (!size)
-        goto python;
-    if (!reader_mem(p, target, deref))
-        goto python;
-
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
                   : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)
         goto drop;
-    mem = reader_mem(p, target, deref); /* (again: Python ran) */
+    if (key >= 0 && ep >= 0)
+        keep(&e->cache[key], ep, v);
+have:
+    mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
     if (e->kind == 1) {
@@ -281,31 +555,13 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     } else {
         int over = 0;
         long long x = A.as_ll(v, &over);
-        long long lo, hi;
         if (x == -1 && !over && A.err_occurred()) {
             A.err_clear();
             goto drop;
         }
-        if (size == 1)
-            lo = sign ? INT8_MIN : 0, hi = sign ? INT8_MAX : UINT8_MAX;
-        else if (size == 2)
-            lo = sign ? INT16_MIN : 0, hi = sign ? INT16_MAX : UINT16_MAX;
-        else if (size == 4)
-            lo = sign ? INT32_MIN : 0, hi = sign ? INT32_MAX : (long long)UINT32_MAX;
-        else if (size == 8)
-            lo = sign ? INT64_MIN : 0, hi = INT64_MAX;
-        else
+        if (over || !fits(x, size, sign)) /* (a value the type does not hold: the Python path) */
             goto drop;
-        if (over || x < lo || x > hi) /* (a value the type does not hold: the Python path) */
-            goto drop;
-        if (size == 1)
-            *(int8_t *)mem = (int8_t)x;
-        else if (size == 2)
-            *(int16_t *)mem = (int16_t)x;
-        else if (size == 4)
-            *(int32_t *)mem = (int32_t)x;
-        else
-            *(int64_t *)mem = (int64_t)x;
+        put(mem, x, size);
     }
     A.decref(v);
     return done(e->after, e->gate);
@@ -325,6 +581,11 @@ struct raw_entry {
     ptrdiff_t write; /* 1: from the buffer into the image */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
+    /* a reader's last runs kept for their epoch (n: the offset, count: the size, clock: the
+     * slave or -1), NULL: none kept.  The runs address the process image's buffer, which the
+     * value function keeps alive while they are its last (and the image is replaced only by
+     * the calls that make the epoch grow); a sentinel empties the slot. */
+    struct aslot *cache;
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -366,9 +627,10 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     ptrdiff_t at = e->io, k, n;
     obj p, target, v, call[4];
     const int64_t *runs;
-    long long size;
+    long long size, off = 0, slave = -1, ep = -1;
     int over = 0;
     char *mem;
+    struct aslot *s = e->write ? NULL : e->cache; /* (a write's value makes the epoch grow) */
 
     if (!ready || kwnames || nargs != 3 + at || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -390,14 +652,48 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     }
     if (!raw_mem(e, p, target, size))
         goto python;
+    if (s) {
+        off = A.as_ll(args[at], &over);
+        if (!over && at)
+            slave = A.as_ll(args[0], &over);
+        if (over || A.err_occurred()) {
+            if (A.err_occurred())
+                A.err_clear();
+            s = NULL;
+        } else if ((ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == off &&
+                   s->count == size && s->clock == slave && s->tp == TYPE(target)) {
+            v = s->value;
+            A.incref(v);
+            goto have;
+        }
+    }
     for (k = 0; k < 2 + at; k++)
         call[k] = args[k];
     call[2 + at] = TYPE(target);
     v = A.vectorcall(e->value, call, (size_t)(3 + at), NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
-    if (v == e->sentinel || TYPE(v) != A.bytes_type)
+    if (v == e->sentinel || TYPE(v) != A.bytes_type) {
+        if (s && s->value) { /* (the slot empties: its runs may be of another image) */
+            obj old = s->value, oldtp = s->tp;
+            s->value = NULL, s->tp = NULL;
+            A.decref(old);
+            A.decref(oldtp);
+        }
         goto drop;
+    }
+    if (s && ep >= 0) {
+        obj old = s->value, oldtp = s->tp;
+        A.incref(v);
+        A.incref(TYPE(target));
+        s->value = v, s->tp = TYPE(target), s->epoch = ep;
+        s->n = off, s->count = size, s->clock = slave;
+        if (old)
+            A.decref(old);
+        if (oldtp)
+            A.decref(oldtp);
+    }
+have:
     /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
     n = *(ptrdiff_t *)((char *)v + A.bsize);
     if (n <= 0 || n % 24)
@@ -418,6 +714,140 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
             memcpy(image, mem + r[0], (size_t)r[2]);
         else
             memcpy(mem + r[0], image, (size_t)r[2]);
+    }
+    A.decref(v);
+    return done(e->after, e->gate);
+
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* A reader of several values (GT_GetCaptureStatus(encoder, pStatus, pValue[, count,
+ * pClock]), GT_CrdStatus(crd, pRun, pSegment[, fifo])): n, then nout pointers (byref(x)
+ * with no offset, or x, of one of each output's types), then at most nextra arguments each
+ * of which must be what extra[] says; value(n) gives a tuple of nout numbers, kept per n for
+ * its epoch; every number is checked to fit before any is written.  Anything else: the
+ * fallback with the very same arguments. */
+#define MAX_OUT 3
+#define MAX_OTYPES 8
+
+struct multi_entry {
+    obj fallback;
+    obj value;
+    obj sentinel;
+    ptrdiff_t nout;
+    ptrdiff_t nextra;
+    ptrdiff_t extra[3]; /* 1: the int 1; 0: the int 0; 2: None or the int 0 */
+    obj types[MAX_OUT][MAX_OTYPES]; /* NULL-ended */
+    ptrdiff_t sizes[MAX_OUT][MAX_OTYPES];
+    ptrdiff_t signs[MAX_OUT][MAX_OTYPES];
+    ptrdiff_t kinds[MAX_OUT]; /* 0: integers, 1: doubles */
+    ptrdiff_t gate;
+    obj after;
+    struct slot *cache;
+    ptrdiff_t ncache;
+    ptrdiff_t titems; /* a tuple's first item (its length: where a bytes object's is) */
+    obj tuple_type;
+};
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
+
+obj gtecat_centry_multi_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args,
+                 (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+}
+
+obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    return multi((const struct multi_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+/* output k's memory, size and sign for p (NULL: not taken) */
+static char *out_mem(const struct multi_entry *e, ptrdiff_t k, obj p, int *size, int *sign)
+{
+    obj target = p, tp = TYPE(p);
+    int j;
+    if (tp == A.carg_type) {
+        target = AT(p, A.carg_obj);
+        if (!target)
+            return NULL;
+        tp = TYPE(target);
+    }
+    for (j = 0; j < MAX_OTYPES && e->types[k][j]; j++) {
+        if (e->types[k][j] == tp) {
+            *size = (int)e->sizes[k][j];
+            *sign = (int)e->signs[k][j];
+            return reader_mem(p, target, NULL);
+        }
+    }
+    return NULL;
+}
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ptrdiff_t k, nout = e->nout;
+    char *mem[MAX_OUT];
+    int size[MAX_OUT], sign[MAX_OUT];
+    long long ints[MAX_OUT], key = -1, ep = -1;
+    obj v, item;
+    int over = 0;
+
+    if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
+        goto python;
+    if (nargs < 1 + nout || nargs > 1 + nout + e->nextra || TYPE(args[0]) != A.int_type)
+        goto python;
+    for (k = 1 + nout; k < nargs; k++) {
+        obj a = args[k];
+        ptrdiff_t want = e->extra[k - 1 - nout];
+        if (want == 1 ? !(a == A.one || int_is(a, 1))
+                      : !(a == A.zero || int_is(a, 0) || (want == 2 && a == A.none)))
+            goto python;
+    }
+    for (k = 0; k < nout; k++)
+        if (!out_mem(e, k, args[1 + k], &size[k], &sign[k]))
+            goto python;
+    if (e->cache) {
+        key = A.as_ll(args[0], &over);
+        if (over || key < 0 || key >= e->ncache) {
+            if (key == -1 && !over && A.err_occurred())
+                A.err_clear();
+            key = -1;
+        } else if ((ep = epoch()) >= 0 && e->cache[key].value && e->cache[key].epoch == ep) {
+            v = e->cache[key].value;
+            A.incref(v);
+            goto have;
+        }
+    }
+    v = A.vectorcall(e->value, args, 1, NULL);
+    if (!v)
+        return NULL;
+    if (v == e->sentinel || TYPE(v) != e->tuple_type ||
+        *(ptrdiff_t *)((char *)v + A.bsize) != nout)
+        goto drop;
+    if (key >= 0 && ep >= 0)
+        keep(&e->cache[key], ep, v);
+have:
+    for (k = 0; k < nout; k++) { /* (every value checked before any is written) */
+        item = ((obj *)((char *)v + e->titems))[k];
+        if (e->kinds[k] == 1) {
+            if (TYPE(item) != A.float_type || size[k] != 8)
+                goto drop;
+        } else if (!ll_of(item, &ints[k]) || !fits(ints[k], size[k], sign[k])) {
+            goto drop;
+        }
+    }
+    for (k = 0; k < nout; k++) /* (again: Python ran) */
+        if (!(mem[k] = out_mem(e, k, args[1 + k], &size[k], &sign[k])))
+            goto drop;
+    for (k = 0; k < nout; k++) {
+        item = ((obj *)((char *)v + e->titems))[k];
+        if (e->kinds[k] == 1)
+            *(double *)mem[k] = *(double *)((char *)item + A.fval);
+        else
+            put(mem[k], ints[k], size[k]);
     }
     A.decref(v);
     return done(e->after, e->gate);

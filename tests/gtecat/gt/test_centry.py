@@ -318,6 +318,7 @@ def test_a_value_the_object_cannot_hold_is_left_to_the_python_path() -> None:
     res = ctl.resources[1]
     for latched in (1 << 31, 1 << 40, -(1 << 31) - 1):
         res.latched = latched
+        centry.changed()  # (the state changed by hand: the kept values ask again)
         got = []
         for call in (gt.GT_GetSts, gt.GT_GetSts.python):
             for t in (ctypes.c_int32, ctypes.c_long):

@@ -1,0 +1,211 @@
+"""The readers' C entries keep a value for its epoch (gtecat/controller/epoch.py): what they
+answer after every kind of change - cycles, calls of the table path, a fault, a raw write,
+the session - is the Python fast function's answer, asked afresh; a value they keep is
+written again only while nothing that changes it has happened.  Figure 5-2's bus (manual
+section 5, figure 5-2), lockstep clock."""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Callable
+from ctypes import byref
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from gtecat import faults, gt
+from gtecat.controller.epoch import EPOCH, changed
+from gtecat.gt import centry
+
+ENI = Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni"
+pytestmark = pytest.mark.skipif(bool(centry.REASON), reason=f"no C entry: {centry.REASON}")
+
+#: (function, the arguments before the value's pointer, the value's type)
+READS: list[tuple[str, tuple, type]] = [
+    ("GT_GetSts", (1,), ctypes.c_long),
+    ("GT_GetSts", (2,), ctypes.c_int32),
+    ("GT_GetPrfPos", (1,), ctypes.c_double),
+    ("GT_GetPrfVel", (1,), ctypes.c_double),
+    ("GT_GetEncPos", (1,), ctypes.c_double),
+    ("GT_GetAxisError", (1,), ctypes.c_double),
+    ("GT_GetPrfMode", (1,), ctypes.c_long),
+    ("GT_GetEcatEncPos", (1,), ctypes.c_long),
+    ("GT_GetEcatErrorCode", (1,), ctypes.c_ushort),
+    ("GT_GetEcatHomingStatus", (1,), ctypes.c_short),
+    ("GT_GetDi", (0,), ctypes.c_long),  # MC_LIMIT_POSITIVE
+    ("GT_GetDi", (3,), ctypes.c_long),  # MC_HOME
+]
+
+
+def _open(**options: str) -> Any:
+    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="", **options) == 0
+    assert gt.GT_InitEcatComm() == 0
+    gt.GTE_Wait(60)
+    assert gt.GT_StartEcatComm() == 0
+    assert gt.GT_AxisOn(1) == 0
+    assert gt.GT_AxisOn(2) == 0
+    gt.GTE_Wait(10)
+    return gt.GTE_Controller()
+
+
+def _answers(kept: bool) -> list[Any]:
+    """Every reader's (code, value) through its public function (the C entry, called twice:
+    the second answer the kept one) or, ``kept`` False, its Python fast function."""
+    out = []
+    for name, before, tp in READS:
+        fn = getattr(gt, name)
+        for call in (fn, fn) if kept else (getattr(fn, "python", fn),):
+            o = tp()
+            rc = call(*before, byref(o))
+            out.append((name, before, rc, o.value))
+        if kept and out[-1] != out[-2]:
+            raise AssertionError(f"{name}{before}: kept {out[-1]}, asked {out[-2]}")
+        if kept:
+            out.pop()
+    arr, clk = (ctypes.c_long * 2)(), ctypes.c_ulong()
+    for call in (gt.GT_GetSts, gt.GT_GetSts) if kept else (gt.GT_GetSts.python,):
+        rc = call(1, arr, 2, byref(clk))
+        got = ("span", rc, list(arr), clk.value)
+    out.append(got)
+    trap = gt.TTrapPrm()
+    rc = (gt.GT_GetTrapPrm if kept else gt.GT_GetTrapPrm.python)(1, byref(trap))
+    out.append(("trap", rc, bytes(trap)))
+    return out
+
+
+def _trap_move() -> None:
+    prm = gt.TTrapPrm()
+    prm.acc, prm.dec = 0.5, 0.5
+    assert gt.GT_PrfTrap(1) == 0
+    assert gt.GT_SetTrapPrm(1, byref(prm)) == 0
+    assert gt.GT_SetVel(1, 10) == 0
+    assert gt.GT_SetPos(1, 40_000) == 0
+    assert gt.GT_Update(1) == 0
+
+
+#: each change a reader's kept value must not outlive (manual chapter 13's calls; a fault)
+CHANGES: list[tuple[str, Callable[[], Any]]] = [
+    ("a Trap move started", _trap_move),
+    ("cycles", lambda: gt.GTE_Wait(7)),
+    ("one more cycle", lambda: gt.GTE_Wait(1)),
+    ("a stop", lambda: gt.GT_Stop(1, 0)),
+    ("cycles after the stop", lambda: gt.GTE_Wait(40)),
+    ("positions zeroed", lambda: gt.GT_ZeroPos(1)),
+    ("a drive fault", lambda: faults.inject("drive_fault", axis=1, code=0x2310)),
+    ("cycles with the fault", lambda: gt.GTE_Wait(5)),
+    ("the fault cleared", lambda: faults.clear()),
+    ("the status cleared", lambda: gt.GT_ClrSts(1)),
+    ("a limit stuck", lambda: faults.inject("switch_stuck", axis=1, switch="positive", value=1)),
+    ("cycles with the limit", lambda: gt.GTE_Wait(3)),
+    ("a refused call", lambda: gt.GT_GetSts(99, byref(ctypes.c_long()))),
+    ("servo off", lambda: gt.GT_AxisOff(2)),
+    ("cycles", lambda: gt.GTE_Wait(4)),
+]
+
+
+def test_every_change_is_seen_as_the_python_path_sees_it() -> None:
+    _open()
+    try:
+        assert _answers(True) == _answers(False)
+        for what, change in CHANGES:
+            change()
+            assert _answers(True) == _answers(False), what
+    finally:
+        faults.clear()
+        gt.GT_Close()
+
+
+def test_the_epoch_grows_at_each_kind_of_change() -> None:
+    ctl = _open()
+    try:
+        s = ctypes.c_long()
+        steps: list[tuple[str, Callable[[], Any]]] = [
+            ("a cycle", lambda: gt.GTE_Wait(1)),
+            ("a table call", lambda: gt.GT_ClrSts(1)),
+            ("a raw write", lambda: gt.GT_SetEcatRawData(0, 1, (ctypes.c_ubyte * 1)())),
+            ("a fault", lambda: faults.inject("switch_stuck", axis=1, switch="home", value=1)),
+            ("a fault cleared", lambda: faults.clear()),
+            ("the controller's own cycle", ctl.clock.cycle),
+        ]
+        for what, step in steps:
+            gt.GT_GetSts(1, byref(s))
+            before = EPOCH.n
+            step()
+            assert EPOCH.n > before, what
+        before = EPOCH.n
+        for _ in range(3):  # (reads change nothing)
+            assert gt.GT_GetSts(1, byref(s)) == 0
+            gt.GT_GetPrfPos(1, byref(ctypes.c_double()))
+        assert EPOCH.n == before
+    finally:
+        faults.clear()
+        gt.GT_Close()
+
+
+def test_a_kept_value_is_written_again_until_the_epoch_grows() -> None:
+    """A change made by hand to the controller's objects (not a GT call, not a cycle) is not
+    seen by the C entry until :func:`changed`; the Python function sees it at once (an axis
+    the bank does not run: its latched flags are read where they are set here)."""
+    ctl = _open(bank="off")
+    try:
+        res = ctl.resources[2]
+        s = ctypes.c_long()
+        assert gt.GT_GetSts(2, byref(s)) == 0
+        word = s.value
+        kept = res.latched
+        res.latched = kept | 0x40  # (a made-up latched flag)
+        try:
+            assert gt.GT_GetSts(2, byref(s)) == 0 and s.value == word
+            assert gt.GT_GetSts.python(2, byref(s)) == 0 and s.value == word | 0x40
+            changed()
+            assert gt.GT_GetSts(2, byref(s)) == 0 and s.value == word | 0x40
+        finally:
+            res.latched = kept
+            changed()
+    finally:
+        gt.GT_Close()
+
+
+def test_last_error_is_cleared_by_a_kept_read() -> None:
+    """GTE_GetLastError speaks of the latest call: a refused call, then a read the C entry
+    answers from what it kept, leaves no error."""
+    _open()
+    try:
+        s = ctypes.c_long()
+        assert gt.GT_GetSts(1, byref(s)) == 0
+        assert gt.GT_GetSts(1, byref(s)) == 0
+        assert gt.GT_SetPos(99, 5) != 0
+        assert gt.GTE_GetLastError()
+        assert gt.GT_GetSts(1, byref(s)) == 0
+        assert gt.GTE_GetLastError() in ("", None)
+    finally:
+        gt.GT_Close()
+
+
+def test_a_polling_loop_in_the_auto_clock_sees_the_move() -> None:
+    """The default clock: each read costs its host latency and cycles run inside reads; a
+    loop polling GT_GetPrfPos and GT_GetSts through the C entries sees the move go on and end
+    (manual section 13: GT_GetSts' motion bit, GT_GetPrfPos)."""
+    assert gt.GT_Open(eni=str(ENI), clock="auto", log="") == 0
+    try:
+        assert gt.GT_InitEcatComm() == 0
+        ready = ctypes.c_short()
+        for _ in range(10_000):
+            if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+                break
+        assert gt.GT_StartEcatComm() == 0
+        assert gt.GT_AxisOn(1) == 0
+        _trap_move()
+        pos, sts = ctypes.c_double(), ctypes.c_long()
+        seen = set()
+        for _ in range(200_000):
+            assert gt.GT_GetPrfPos(1, byref(pos)) == 0
+            seen.add(pos.value)
+            assert gt.GT_GetSts(1, byref(sts)) == 0
+            if not sts.value & 0x400 and pos.value == 40_000:
+                break
+        assert pos.value == 40_000 and not sts.value & 0x400
+        assert len(seen) > 10
+    finally:
+        gt.GT_Close()
