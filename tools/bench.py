@@ -753,6 +753,9 @@ def compiled_parts() -> dict[str, object]:
         ("bank_crd", bank_crd.library),
         ("bank_slaves", bank_slaves.library),
     ):
+        if name == "bank_kernel" and bank_kernel.wanted() == "numpy":
+            out[name] = "not built: GTECAT_BANK_KERNEL=numpy"
+            continue
         why = lib()[1]
         if why:
             out[name] = why
