@@ -29,18 +29,15 @@ from __future__ import annotations
 import atexit
 import contextlib
 import hashlib
-import json
 import logging
 import os
-import shlex
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from . import __version__
 from ._cache import cache_root
@@ -51,6 +48,12 @@ try:
 except ImportError:  # Windows: a controller runs there without these builds' lock
     fcntl = None  # type: ignore[assignment]
 
+
+if TYPE_CHECKING:
+    import subprocess
+
+# (subprocess, shlex and json are imported where a build runs: a process whose libraries are
+# built already - every process but the first - never needs them)
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +66,8 @@ def compiler() -> list[str]:
     """The C compiler command (NativeBuildError when there is none)."""
     cc = os.environ.get("CC")
     if cc:
+        import shlex
+
         cmd = shlex.split(cc)
         if shutil.which(cmd[0]):
             return cmd
@@ -308,6 +313,9 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
             src.write_text(source, encoding="utf-8")
             out = tmp / lib.name
             cmd = [*cc, *cflags, "-shared", str(src), "-o", str(out), *libs]
+            import shlex
+            import subprocess
+
             try:
                 r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
             except subprocess.TimeoutExpired:
@@ -447,6 +455,9 @@ class Background:
             "log": str(self._log),
             "seal": _SEAL,
         }
+        import json
+        import subprocess
+
         try:
             self._proc = subprocess.Popen(
                 [sys.executable, "-I", "-S", "-c", _BUILDER, json.dumps(spec)],

@@ -61,6 +61,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..controller.crd import bank
+from ..controller.epoch import changed as readers_changed
 from ..controller.motion.scurve import SCurveParams
 from ._card import (
     AXES,
@@ -114,6 +115,7 @@ def _api(error: int = 1) -> Callable:
             except Exception as e:  # the manual's C API never raises
                 _set_error(f"{fn.__name__}: {e}")
                 rc = error
+            readers_changed()  # (the card changed without a GT call: controller/epoch.py)
             if card is not None:
                 card.tick()
             return 0 if rc is None else rc

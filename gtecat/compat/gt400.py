@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..controller.digital_io import digital_io
+from ..controller.epoch import changed as readers_changed
 from ..controller.motion.scurve import SCurveParams, SCurvePlanner
 from ..controller.profile import PrfMode
 from ..controller.resources import AxisResources, axis_resources
@@ -113,6 +114,7 @@ def _api(fn: Callable[..., int | None]) -> Callable[..., int]:
         except Exception as e:  # the vendor's C API never raises
             set_last_error(f"{fn.__name__}: {e}")
             rc = 1
+        readers_changed()  # (the card changed without a GT call: controller/epoch.py)
         card = _CARD[0]
         if card is not None:
             card.ctl.clock.on_call()

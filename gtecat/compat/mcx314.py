@@ -63,6 +63,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..controller.crd import bank
+from ..controller.epoch import changed as readers_changed
 from ..controller.motion.scurve import SCurveParams
 from ._card import (
     ALARM,
@@ -118,6 +119,7 @@ def _api(fn: Callable[..., Any]) -> Callable[..., Any]:
             _set_error(f"{fn.__name__}: {e}")
             raise CompatError(f"{fn.__name__}: {e}") from e
         finally:
+            readers_changed()  # (the card changed without a GT call: controller/epoch.py)
             if card is not None:
                 card.tick()
 

@@ -8,9 +8,10 @@ entries of the readers (:mod:`gtecat.gt.centry`) keep each value they write for 
 it was asked in and write it again while :data:`EPOCH` stays.  :data:`EPOCH` grows at the
 end of every cycle and every run of cycles (:class:`~gtecat.controller.core.Controller`),
 of every call of the table path and every error recorded (:mod:`gtecat.gt._core`), of every
-raw write into the process image, every change of the session's gates, and every fault
-injected or cleared.  Code that changes a controller's objects another way (a test's own
-hand on them) calls :func:`changed`.
+raw write into the process image, every change of the session's gates, every fault
+injected or cleared, every call of a compat layer (:mod:`gtecat.compat`) and every request
+of an inspection endpoint (a panel's control operations).  Code that changes a
+controller's objects another way (a test's own hand on them) calls :func:`changed`.
 """
 
 from __future__ import annotations

@@ -27,7 +27,6 @@ the machine it was written for (gtecat.controller.config_file.switch_sense).
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -242,6 +241,8 @@ def _numbered(data: Mapping[str, Any], name: str, source: str) -> dict[int, Mapp
 
 
 def load_machine(path: str | Path) -> MachineDescription:
+    import tomllib  # (read here: a bus without a machine description never needs it)
+
     p = Path(path)
     try:
         data = tomllib.loads(p.read_text(encoding="utf-8"))

@@ -58,7 +58,6 @@ from __future__ import annotations
 
 import os
 import re
-import tomllib
 import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
@@ -123,6 +122,8 @@ def load_topology(path: str | os.PathLike[str]) -> EniConfig:
 
 
 def parse_topology(text: str, source: str = "<topology>") -> EniConfig:
+    import tomllib  # (read here: a bus from an ENI file never needs it)
+
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -135,6 +136,7 @@ def parse_topology(text: str, source: str = "<topology>") -> EniConfig:
 
 def build_config(data: Mapping[str, Any], source: str = "<topology>") -> EniConfig:
     """Build the configuration from an already parsed topology mapping."""
+
     where = _Where(source)
     _known(where, data, {"cycle_time_us", "master", "slave"}, "topology")
     cycle_us = data.get("cycle_time_us", 1000)

@@ -17,7 +17,6 @@ step).  Starts and ends go to the master log.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -135,6 +134,8 @@ def specs_from_tables(tables: Any, source: str = "") -> list[FaultSpec]:
 
 def load(path: str | Path) -> list[FaultSpec]:
     """The ``[[fault]]`` tables of a TOML file (a machine description or a faults file)."""
+    import tomllib  # (read here: a replay or a recording without such a file never needs it)
+
     p = Path(path)
     try:
         data = tomllib.loads(p.read_text(encoding="utf-8"))

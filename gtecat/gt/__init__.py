@@ -8,11 +8,24 @@ manual's codes and ``GTE_GetLastError()`` says why.
 
 from __future__ import annotations
 
-import ctypes
+import gc as _gc
 import importlib
-import threading as _threading
 
-from ._core import REGISTRY
+# The cyclic garbage collector is paused while this module is imported: the import makes
+# ~100,000 objects that live as long as the process (classes, functions, tables, numpy's), and
+# the collector ran ~170 times during it (a full pass among them) to find almost nothing: ~40
+# ms of a ~300 ms import, ~20 ms with the pause (its first pass after the import walks them
+# once).  It runs as before once the import has ended (or failed).
+_gc_was_on = _gc.isenabled()
+_gc.disable()
+try:
+    from ._core import REGISTRY
+    from .vendor import install as _install_vendor_surface
+    from .vendor import is_public as _is_public
+except BaseException:
+    if _gc_was_on:
+        _gc.enable()
+    raise
 
 _MODULES = (
     "bus_calls",
@@ -44,96 +57,32 @@ _MODULES = (
 )
 
 
-def _is_public(name: str, value: object) -> bool:
-    """What the stable surface exports: functions, structures, constants (DESIGN.md)."""
-    if name.startswith("_"):
-        return False
-    if name.startswith(("GT_", "GTN_", "GTE_")):
-        return True
-    if name.startswith("T") and isinstance(value, type) and issubclass(value, ctypes.Structure):
-        return True  # TTrapPrm, TJogPrm, TSlaveInfo ...
-    return name.isupper() and len(name) > 1 and isinstance(value, int | float | str)
+try:
+    for _name in _MODULES:
+        try:
+            _mod = importlib.import_module(f"{__name__}.{_name}")
+        except ModuleNotFoundError as _e:
+            if _e.name != f"{__name__}.{_name}":
+                raise
+            continue
+        for _k, _v in vars(_mod).items():
+            if _is_public(_k, _v):
+                globals()[_k] = _v
 
-
-for _name in _MODULES:
-    try:
-        _mod = importlib.import_module(f"{__name__}.{_name}")
-    except ModuleNotFoundError as _e:
-        if _e.name != f"{__name__}.{_name}":
-            raise
-        continue
-    for _k, _v in vars(_mod).items():
-        if _is_public(_k, _v):
-            globals()[_k] = _v
-
-globals().update(REGISTRY)
-
-
-def _vendor_surface() -> None:
-    """The groups' structures, enums and constants that no module above defines, and a
-    function for every declared-only name (it returns the declared code with a reason)."""
-    from . import typedefs
-    from .declared import declared_function
-    from .table import FUNCTIONS, GROUPS
-
-    g = globals()
-    existing = {k: v for k, v in g.items() if _is_public(k, v) and isinstance(v, type)}
-    tds = [td for grp in GROUPS for td in typedefs.parse(grp.structs, grp.name)]
-    built = typedefs.build(tds, existing)
-    for name, cls in built.classes.items():
-        g.setdefault(name, cls)
-    known = {k: v for k, v in g.items() if _is_public(k, v) and isinstance(v, int)}
-    for td in built.enums.values():
-        for member, value in td.members:
-            g.setdefault(member, value)
-    for grp in GROUPS:
-        for name, value in typedefs.parse_constants(grp.constants, known).items():
-            if name not in g:
-                g[name] = known[name] = value
-    for name, proto in FUNCTIONS.items():
-        if name not in REGISTRY:
-            for fn in declared_function(proto):
-                g[fn.__name__] = fn
-    typedefs.BUILT = built
-
-
-#: the vendor surface (:func:`_vendor_surface`: ~2,900 declared-only functions, the groups'
-#: structures, enums and constants) is made the first time anything asks for a name this
-#: module does not hold yet, or for the whole namespace (``dir()``, ``from gtecat.gt import
-#: *``, :func:`_whole`): a process that calls only emulated functions never pays for it
-_made: list[bool] = []
-_lock = _threading.RLock()
+    globals().update(REGISTRY)
+    #: the vendor surface (:mod:`gtecat.gt.vendor`: the groups' structures, enum members and
+    #: constants, ~3,800 declared-only functions), every name in this namespace from here on
+    #: (no module ``__getattr__``: CPython specialises ``gt.X`` only without one)
+    _install_vendor_surface(globals(), REGISTRY)
+finally:
+    if _gc_was_on:
+        _gc.enable()
 
 
 def _whole() -> dict[str, object]:
-    """This module's namespace with the vendor surface made (what ``vars(gt)`` held before
-    it was made lazily): walk this, not ``vars(gt)``."""
-    if not _made:
-        with _lock:
-            if not _made:
-                _vendor_surface()
-                _made.append(True)
-                # every name made: the module's own __getattr__ is of no use now, and while
-                # a module has one CPython does not specialise the loads of its attributes
-                # (``gt.GT_GetSts``: about 30 ns a load instead of 11)
-                g = globals()
-                g["__all__"] = [k for k in g if not k.startswith("_")]
-                g.pop("__getattr__", None)
+    """This module's namespace: every name of the surface (the walkers' name for it from
+    when the vendor surface was made lazily)."""
     return globals()
-
-
-def __getattr__(name: str) -> object:
-    if name == "__all__":  # ``from gtecat.gt import *``: every public name, made first
-        return [k for k in _whole() if not k.startswith("_")]
-    if not name.startswith("__") and not _made:
-        g = _whole()
-        if name in g:
-            return g[name]
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(_whole())
 
 
 def _arm_faults(ctl: object) -> None:

@@ -42,6 +42,7 @@ Decisions where the manual is silent:
 from __future__ import annotations
 
 import ctypes
+import sys
 import time
 from typing import Any
 
@@ -52,8 +53,6 @@ from .. import __version__
 from ..controller.cards import options_for
 from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
-from ..inspect.endpoint import _PUBLISHED as _ENDPOINTS
-from ..inspect.endpoint import attached as _attached
 from ..master.clock import ClockMode
 from . import _core
 from ._core import (
@@ -535,7 +534,15 @@ def GTE_Wait(ctl: Controller, ms: float) -> int:
     nobody attached there is no yield: on a busy machine one hands the CPU to another
     process for a scheduler slice."""
     ctl.wait_ms(float(ms))
-    if _ENDPOINTS and ctl.clock.mode is not ClockMode.REALTIME and _attached():
+    # (the endpoint module is there once something published an endpoint: GT_Open, a
+    # controller process; a process that never did has nobody attached)
+    endpoints = sys.modules.get("gtecat.inspect.endpoint")
+    if (
+        endpoints is not None
+        and endpoints._PUBLISHED
+        and ctl.clock.mode is not ClockMode.REALTIME
+        and endpoints.attached()
+    ):
         time.sleep(0)
     return 0
 

@@ -1054,23 +1054,20 @@ def fast_clock(
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
 
     def value() -> Any:
-        """The C entry's value: GT_GetClock's own on the lockstep clock, else _NO."""
-        try:
-            ctl = session.controllers[1]
-        except KeyError:  # no controller
-            return _NO
-        clock = ctl.clock
-        # (a lockstep clock never runs a thread of its own: real time only has one)
-        if session.plain and clock.mode is _LOCKSTEP:
-            ms = ((clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
-            session.last = None
-            return ms
-        return _NO
+        """The C entry's value (asked while the GT_ gate is open: the in-process controller
+        of core 1 on the lockstep or the auto clock): GT_GetClock's own."""
+        ctl = GATED[0]
+        ms = ((ctl.clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+        session.last = None
+        return ms
 
     if not CENTRY:
         return gt
     types = sorted(_CLOCK_INTS, key=str)
-    entry = centry.reader(gt, value, _NO, types, centry.INT, most=2, noaxis=True)
+    entry = centry.reader(
+        gt, value, _NO, types, centry.INT, most=2, noaxis=True, gate=centry.GT_GATE,
+        after=_after(advance, name, 0),
+    )  # fmt: skip
     if entry is None:
         return gt
     entry.slow, entry.python = slow, gt

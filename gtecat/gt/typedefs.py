@@ -231,13 +231,13 @@ class Built:
 
 
 def __getattr__(name: str) -> Any:
-    # ``BUILT``: what :func:`build` made of every group, set when ``gtecat.gt`` makes its
-    # vendor surface (the first time it is asked for: ``gtecat.gt._whole``)
+    # ``BUILT``: what :func:`build` made of every group (the classes are those ``gtecat.gt``
+    # made when it was imported: :func:`gtecat.gt.vendor.built`), made when first asked for
     if name == "BUILT":
-        from . import _whole
+        from .vendor import built
 
-        _whole()
-        return globals()["BUILT"]
+        globals()["BUILT"] = made = built()
+        return made
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -306,6 +306,74 @@ def enum_names(groups: Iterable[Any]) -> set[str]:
     return out
 
 
+# --- every group's typedefs and defines as plain values, kept between processes ---------------
+# ``gtecat.gt`` makes its vendor surface (the groups' classes, enum members and constants) when
+# it is imported.  Reading the groups' C text for it costs ~25 ms a process; the values read
+# are kept as plain values (marshal) beside the function table, under the table's name (its key
+# covers every group's text and the source of this module): read back in ~2 ms.
+
+#: a typedef as plain values: (kind, name, group, fields, members), a field (ctype, name, dims,
+#: pointer), a member (name, value)
+RawTypedef = tuple[str, str, str, tuple[tuple[str, str, tuple[int, ...], bool], ...], tuple]
+#: a ``#define``: (name, value, expression); value None where the expression names other
+#: constants (evaluated against them when the surface is made: :func:`number`)
+RawDefine = tuple[str, "int | float | None", str]
+
+
+def surface(
+    groups: Iterable[Any], *, kept: bool = True
+) -> tuple[tuple[RawTypedef, ...], tuple[tuple[RawDefine, ...], ...]]:
+    """Every group's typedefs (in group order, as :func:`parse` reads them) and its
+    ``#define`` lines (one tuple per group) as plain values, from the cache when it holds
+    them (:data:`gtecat.gt.table.CACHE_KEY`; ``kept`` False: read from the groups, and kept
+    again)."""
+    import marshal
+
+    from .table import CACHE_KEY, _cache_file
+
+    key = CACHE_KEY[0]
+    if key is not None and kept:
+        try:
+            tds, defines = marshal.loads(_cache_file(key, "surface").read_bytes())
+            if type(tds) is tuple and type(defines) is tuple:
+                return tds, defines
+        except Exception:  # (missing, unreadable, another shape: read from the groups)
+            pass
+    groups = tuple(groups)
+    tds = tuple(
+        (
+            td.kind,
+            td.name,
+            td.group,
+            tuple((f.ctype, f.name, f.dims, f.pointer) for f in td.fields),
+            td.members,
+        )
+        for g in groups
+        for td in parse(g.structs, g.name)
+    )
+    defines = tuple(_defines(g.constants) for g in groups)
+    if key is not None:
+        _keep(_cache_file(key, "surface"), (tds, defines))
+    return tds, defines
+
+
+def _defines(text: str) -> tuple[RawDefine, ...]:
+    return tuple((m[1], number(m[2], {}), m[2]) for m in _DEFINE.finditer(strip_comments(text)))
+
+
+def _keep(path: Any, values: Any) -> None:
+    import marshal
+    import os
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(marshal.dumps(values))
+        os.replace(tmp, path)
+    except (OSError, ValueError):
+        pass  # a read-only home, or none: read from the groups again next time
+
+
 def enum_decl(td: Typedef) -> str:
     """``typedef enum ETimeElapse { ... } ETimeElapse;`` for ``gts.h``."""
     body = ",\n".join(f"    {n} = {v}" for n, v in td.members)
@@ -324,4 +392,5 @@ __all__ = [
     "parse",
     "parse_constants",
     "strip_comments",
+    "surface",
 ]

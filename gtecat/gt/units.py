@@ -152,14 +152,16 @@ def _matches(pattern: str, name: str) -> bool:
 
 
 @cache
-def _index() -> tuple[dict[str, list[int]], list[tuple[Callable[[str], object], int]]]:
-    """Row numbers by exact function name, and the wildcard patterns (compiled) with theirs."""
+def _index() -> tuple[dict[str, list[int]], list[tuple[str, Callable[[str], object], int]]]:
+    """Row numbers by exact function name, and the wildcard patterns (compiled, with their
+    longest literal part: a name without it is not matched against the pattern) with theirs."""
     exact: dict[str, list[int]] = {}
-    wild: list[tuple[Callable[[str], object], int]] = []
+    wild: list[tuple[str, Callable[[str], object], int]] = []
     for i, r in enumerate(ROWS):
         for p in r.functions:
             if "*" in p:
-                wild.append((re.compile(fnmatch.translate(p)).match, i))
+                part = max(p.split("*"), key=len)
+                wild.append((part, re.compile(fnmatch.translate(p)).match, i))
             else:
                 exact.setdefault(p, []).append(i)
     return exact, wild
@@ -169,12 +171,17 @@ def _index() -> tuple[dict[str, list[int]], list[tuple[Callable[[str], object], 
 def units_of(name: str) -> tuple[Row, ...]:
     """The rows that name the GT function ``name`` (a ``GTN_`` twin: its ``GT_``'s; a
     ``GTN_`` function of its own, with no ``GT_`` form: its own), in table order."""
+    return tuple(ROWS[i] for i in _rows_of(name))
+
+
+@cache
+def _rows_of(name: str) -> tuple[int, ...]:
     exact, wild = _index()
     if name.startswith("GTN_") and name not in exact:
         name = "GT_" + name[4:]
     hits = set(exact.get(name, ()))
-    hits.update(i for match, i in wild if match(name))
-    return tuple(ROWS[i] for i in sorted(hits))
+    hits.update(i for part, match, i in wild if part in name and match(name))
+    return tuple(sorted(hits))
 
 
 def _plain(text: str) -> str:
@@ -183,12 +190,18 @@ def _plain(text: str) -> str:
     return text.replace("**", "").replace("`", "")
 
 
+@cache
+def _row_text(i: int) -> str:
+    r = ROWS[i]
+    return f"{_plain(r.what)}: {_plain(r.unit)}"
+
+
 def units_text(name: str) -> str:
     """``Units: acc, dec: pulse/ms²; velStart: pulse/ms.`` ("" when nothing has a unit)."""
-    rows = units_of(name)
+    rows = _rows_of(name)
     if not rows:
         return ""
-    return "Units: " + "; ".join(f"{_plain(r.what)}: {_plain(r.unit)}" for r in rows) + "."
+    return "Units: " + "; ".join(_row_text(i) for i in rows) + "."
 
 
 def with_units(name: str, doc: str | None) -> str | None:

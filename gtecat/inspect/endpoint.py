@@ -60,6 +60,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..controller.epoch import changed as readers_changed
 from . import runtime
 
 log = logging.getLogger(__name__)
@@ -480,6 +481,9 @@ def _run(req: _Request, in_cycle: bool = True) -> None:
     except BaseException as e:
         req.error = e
     finally:
+        # (a control operation changes the controller without a GT call: what the GT
+        # readers' C entries kept is asked again, gtecat/controller/epoch.py)
+        readers_changed()
         if in_cycle:
             COST[1] += time.thread_time_ns() - t0
         req.done.set()

@@ -71,6 +71,9 @@ def _answers(kept: bool) -> list[Any]:
     trap = gt.TTrapPrm()
     rc = (gt.GT_GetTrapPrm if kept else gt.GT_GetTrapPrm.python)(1, byref(trap))
     out.append(("trap", rc, bytes(trap)))
+    clk = ctypes.c_ulong()
+    rc = (gt.GT_GetClock if kept else gt.GT_GetClock.python)(byref(clk))
+    out.append(("clock", rc, clk.value))
     return out
 
 

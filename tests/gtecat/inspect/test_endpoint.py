@@ -287,3 +287,25 @@ def test_a_lost_sdo_answer_over_the_endpoint_runs_none_of_the_applications_cycle
     assert main(["sdo", "upload", "0", "0x1018", "1"]) != 0
     assert "0x05040000" in capsys.readouterr().err
     assert app.GTE_Controller().clock.cycles == cycles
+
+
+def test_a_control_operation_is_seen_by_the_applications_next_read(app) -> None:
+    """A panel's Trap move of an idle lockstep application's axis (no GT call, no cycle
+    since): the application's next GT_GetSts, GT_GetPrfMode and GT_GetTrapPrm see it, as
+    their table paths do (the readers' kept values are asked again)."""
+    from gtecat import gt
+
+    def reads(fn: str) -> tuple:
+        m, st, t = ctypes.c_long(), ctypes.c_long(), gt.TTrapPrm()
+        call = (lambda f: getattr(gt, f)) if fn == "public" else (lambda f: getattr(gt, f).slow)
+        call("GT_GetPrfMode")(1, ctypes.byref(m))
+        call("GT_GetSts")(1, ctypes.byref(st))
+        call("GT_GetTrapPrm")(1, ctypes.byref(t))
+        return m.value, st.value, t.acc, t.dec
+
+    before = reads("public")
+    with _attach() as c:
+        c.call("trap", 1, 5000, 10.0, 0.25, 0.25)
+    after = reads("public")
+    assert after != before and after[2:] == (0.25, 0.25)
+    assert after == reads("table")
