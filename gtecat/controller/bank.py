@@ -2167,6 +2167,9 @@ class AxisBank:
                 ran = int(self.bank_cycles - self.claim_cycle[r])
                 for obj in aware:
                     obj.bank_released(ran)
+        except BaseException:
+            _reguard(objs)  # (still claimed: guarded as before)
+            raise
         finally:
             _Bypass.on = False
         # the objects hold the row's state now: a release (within the step or after it)
