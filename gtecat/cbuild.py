@@ -411,7 +411,15 @@ class Background:
     The builder is a small Python process (no site packages, not gtecat) in a session of its
     own, at a lower priority (nice 10: on a busy machine the work that asked for it goes
     first): it finishes and names the library even when this process ends first, and the next
-    process finds it.  :meth:`done` is cheap to ask every cycle; :attr:`result` is then the
+    process finds it.  Where Linux groups the scheduling by session (autogroup, the default
+    of most distributions), that session is a group of its own, and a task's nice orders it
+    only within its group: against the process that asked, the builder then takes a whole
+    group's share (with two busy loops in that process's session on two CPUs, it ran a
+    third of the time instead of two thirds, for the ~3 s of the build).  The group's nice
+    is left as it is on purpose: raised too, the build starved there (over 8 s) and the
+    bank ran its numpy cycle all that time, which cost far more than the build's CPU.
+
+    :meth:`done` is cheap to ask every cycle; :attr:`result` is then the
     library built (the first of ``builds`` that is there), or the NativeBuildError saying why
     not."""
 

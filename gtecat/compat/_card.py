@@ -69,6 +69,7 @@ from ..controller.crd import bank, make_arc
 from ..controller.crd.base_pulse import BaseSpeed, base_length
 from ..controller.crd.path import CCW, CW, Line, Segment
 from ..controller.crd.system import CoordSystem, CrdParams, Motion
+from ..controller.epoch import changed as readers_changed
 from ..controller.motion.scurve import SCurveParams, SCurvePlanner, plan_drive
 from ..controller.motion.stop import STOP_DEC_MAX, StopDecel
 from ..controller.profile import PrfMode
@@ -224,6 +225,7 @@ class PulseCard:
             r.clear_flags()
             self._limit_mode(n)
         ctl.post_cycle.append(self._post)
+        readers_changed()  # (the axes' flags changed without a GT call: controller/epoch.py)
 
     # --- access -------------------------------------------------------------------------
     def res(self, axis: int) -> AxisResources:

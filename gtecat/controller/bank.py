@@ -293,6 +293,22 @@ def _guard_class(cls: type) -> type:
     return g
 
 
+def _unguard(objs: tuple) -> None:
+    """The guarded ones of ``objs`` back in their own classes (their claim stays)."""
+    for obj in objs:
+        cls = type(obj)
+        if _GUARDS.get(cls.__mro__[1]) is cls:
+            _set(obj, "__class__", cls.__mro__[1])
+
+
+def _reguard(objs: tuple) -> None:
+    """``objs`` guarded again (their dicts are their own since their claim)."""
+    for obj in objs:
+        cls = type(obj)
+        if _GUARDS.get(cls.__mro__[1]) is not cls:
+            _set(obj, "__class__", _guard_class(cls))
+
+
 def _bank_safe(hook: Any) -> bool:
     """A ``pre_cycle`` or ``post_cycle`` hook that leaves the axes the bank runs alone, or
     reaches them only through their guards (which give them back first: smart homing): the
@@ -2138,6 +2154,9 @@ class AxisBank:
         prof = res.profile
         pl = prof.planner
         objs = (ax, pl, res.encoder, res.band)
+        # (their guards off first: the row's state goes into them without a guard's Python
+        # call on every attribute, as it would under _Bypass anyway)
+        _unguard(objs)
         _Bypass.on = True
         try:
             self._last = {r: self._planned_row(r)}
@@ -2148,12 +2167,11 @@ class AxisBank:
                 ran = int(self.bank_cycles - self.claim_cycle[r])
                 for obj in aware:
                     obj.bank_released(ran)
+        except BaseException:
+            _reguard(objs)  # (still claimed: guarded as before)
+            raise
         finally:
             _Bypass.on = False
-        for obj in objs:
-            cls = type(obj)
-            if _GUARDS.get(cls.__mro__[1]) is cls:
-                _set(obj, "__class__", cls.__mro__[1])
         # the objects hold the row's state now: a release (within the step or after it)
         # leaves them as they are
         self._stepping = r
@@ -2187,8 +2205,7 @@ class AxisBank:
         if not ok:
             return
         self.steps_in_place += 1
-        for obj in objs:  # (their dicts are their own since their claim)
-            _set(obj, "__class__", _guard_class(type(obj)))
+        _reguard(objs)
         self._after_load(r, was_moving)
 
     def _after_load(self, r: int, was_moving: bool) -> None:
@@ -2228,28 +2245,43 @@ class AxisBank:
         _Bypass.on = True
         try:
             for r in rows:
-                if p0 is not None and self.dpost[r] & TP_POST:
-                    self.posted_probes += 1
-                    ch = csp.channels[r]
-                    probe = ch.probe
-                    a, b = float(p0[r]), float(csp.pos[r])
-                    if probe.function:
-                        off = ch.enc_offset
-                        probe.step(a, b, a - off, b - off, t_ns, dt_ns)
-                    csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
-                self._last = {r: self._planned_row(r)}
-                self._rates = {r: self._enc_rates_row(r)}
-                self._put_back(r)
-                self.posted_inputs += bool(self.dpost[r] & ~TP_POST)
-                ran = int(self.bank_cycles - self.claim_cycle[r])
-                for obj in self._aware.pop(r, ()):
-                    obj.bank_posted(ran, t_ns, dt_ns)
-                was_moving = bool(self.moving[r])
-                self._load(r, again=True)
-                self._after_load(r, was_moving)
-                self.evt_rows.add(r)
+                # the row's objects without their guards while its state goes into them and
+                # is taken again (the same as under _Bypass, without a Python call per
+                # attribute); guarded again after, the row staying
+                objs = tuple(self._guarded_objects(self.groups[self.group_of[r]]))
+                _unguard(objs)
+                try:
+                    self._post_event(r, csp, p0, t_ns, dt_ns)
+                finally:
+                    if self.alive[r] and self.groups[self.group_of[r]].claimed:
+                        _reguard(objs)
         finally:
             _Bypass.on = False
+
+    def _post_event(
+        self, r: int, csp: CspBank, p0: np.ndarray | None, t_ns: int, dt_ns: int
+    ) -> None:
+        """:meth:`_post_events` for row ``r`` (its axis objects unguarded, _Bypass on)."""
+        if p0 is not None and self.dpost[r] & TP_POST:
+            self.posted_probes += 1
+            ch = csp.channels[r]
+            probe = ch.probe
+            a, b = float(p0[r]), float(csp.pos[r])
+            if probe.function:
+                off = ch.enc_offset
+                probe.step(a, b, a - off, b - off, t_ns, dt_ns)
+            csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
+        self._last = {r: self._planned_row(r)}
+        self._rates = {r: self._enc_rates_row(r)}
+        self._put_back(r)
+        self.posted_inputs += bool(self.dpost[r] & ~TP_POST)
+        ran = int(self.bank_cycles - self.claim_cycle[r])
+        for obj in self._aware.pop(r, ()):
+            obj.bank_posted(ran, t_ns, dt_ns)
+        was_moving = bool(self.moving[r])
+        self._load(r, again=True)
+        self._after_load(r, was_moving)
+        self.evt_rows.add(r)
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

@@ -64,6 +64,7 @@ from .bank_kernel import _DEFERRED as _KERNEL_DEFERRED
 from .bank_kernel import prebuild as prebuild_kernel
 from .bank_kernel import start_deferred as start_kernel_build
 from .epoch import EPOCH
+from .epoch import changed as readers_changed
 from .input_sense import changed as sense_changed
 from .resources import install as install_resources
 
@@ -161,6 +162,8 @@ class Controller:
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
         self.clock.run_many = self.run_cycles
+        # (the cycles' time counted: a reader's kept clock value is stale, epoch.py)
+        self.clock.counted = readers_changed
         #: a run of cycles at once is under way (:meth:`run_cycles`): the inspection
         #: endpoint's idle path waits for its end (it runs no request beside cycles)
         self.in_batch = False

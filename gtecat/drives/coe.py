@@ -419,6 +419,14 @@ def next_counter(counter: int) -> int:
     return 1 if counter >= 7 else counter + 1
 
 
+def advance_counter(counter: int, steps: int) -> int:
+    """``counter`` after ``steps`` calls of :func:`next_counter` (none: as it is); after the
+    first the counter is in 1..7, where it comes round every 7."""
+    if steps <= 0:
+        return counter
+    return (next_counter(counter) + steps - 2) % 7 + 1
+
+
 # --- client -------------------------------------------------------------------------
 #: largest object an upload accepts, bytes; a larger announced size ends in 0x05040005
 DEFAULT_MAX_SDO_SIZE = 4 * 1024 * 1024

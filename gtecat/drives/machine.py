@@ -121,8 +121,11 @@ class MachineDescription:
 
     def axis(self, n: int) -> AxisMachine:
         """The description of GT axis ``n`` (defaults when the file omits it)."""
-        return self.axes.get(n, AxisMachine())
+        got = self.axes.get(n)
+        return _DEFAULT_AXIS if got is None else got  # (frozen: one default serves every axis)
 
+
+_DEFAULT_AXIS = AxisMachine()
 
 _KEYS = {
     "position",

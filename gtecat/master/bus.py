@@ -415,11 +415,11 @@ class Master:
         """The object's bytes; ``wait=False``: a lost answer costs no controller time (the
         inspection verbs, which run beside the application, never run its cycles)."""
         self._check_slave(pos)
-        lost = self._unanswered() if wait else -1
+        lost = self._unanswered(pos) if wait else -1
         try:
             return self.backend.sdo_upload(pos, index, subindex, complete_access)
         finally:
-            self._timed_out(lost)
+            self._timed_out(lost, pos)
 
     def sdo_download(
         self,
@@ -433,23 +433,23 @@ class Master:
     ) -> None:
         """Write ``data`` to the object; ``wait`` as for :meth:`sdo_upload`."""
         self._check_slave(pos)
-        lost = self._unanswered() if wait else -1
+        lost = self._unanswered(pos) if wait else -1
         try:
             self.backend.sdo_download(pos, index, subindex, data, complete_access)
         finally:
-            self._timed_out(lost)
+            self._timed_out(lost, pos)
 
-    def _unanswered(self) -> int:
-        """The SDO requests the backend sent without an answer so far (-1: it cannot tell,
-        as on the wire, where the backend waits its timeout itself)."""
+    def _unanswered(self, pos: int) -> int:
+        """The SDO requests the backend sent to slave ``pos`` without an answer so far (-1: it
+        cannot tell, as on the wire, where the backend waits its timeout itself)."""
         count = getattr(self.backend, "unanswered", None)
-        return count() if count is not None and self.mailbox_wait is not None else -1
+        return count(pos) if count is not None and self.mailbox_wait is not None else -1
 
-    def _timed_out(self, before: int) -> None:
+    def _timed_out(self, before: int, pos: int) -> None:
         """The master's mailbox timeout for each request of this call left unanswered."""
         if before < 0 or self.mailbox_wait is None:
             return
-        lost = self._unanswered() - before
+        lost = self._unanswered(pos) - before
         if lost > 0:
             self.mailbox_wait(lost * SDO_TIMEOUT_MS)
 

@@ -80,6 +80,9 @@ class Clock:
         self._stop = threading.Event()
         #: the clocks this one shares time with (None: it runs alone)
         self.group: ClockGroup | None = None
+        #: called once cycles have run and their time is counted (the owner's: what was
+        #: read of the time before may be stale now)
+        self.counted: Callable[[], None] | None = None
 
     # --- virtual time ------------------------------------------------------
     def cycle(self) -> None:
@@ -87,6 +90,8 @@ class Clock:
         self._run_cycle()
         self.cycles += 1
         self.now_ns += self.cycle_ns
+        if self.counted is not None:
+            self.counted()
 
     def advance_ns(self, ns: int) -> int:
         """Let ``ns`` of controller time pass (lockstep/auto); returns cycles run."""
@@ -103,6 +108,8 @@ class Clock:
                     self._pending_ns -= k * self.cycle_ns
                     self.cycles += k
                     self.now_ns += k * self.cycle_ns
+                    if self.counted is not None:
+                        self.counted()
                     n += k
                     continue
             self._pending_ns -= self.cycle_ns
@@ -144,6 +151,8 @@ class Clock:
             if many is not None and many(1):  # the owner ran it its quick way
                 self.cycles += 1
                 self.now_ns += self.cycle_ns
+                if self.counted is not None:
+                    self.counted()
             else:
                 self.cycle()
             spent += self.cycle_ns

@@ -17,6 +17,7 @@ from gtecat.drives.coe import (
     SdoClient,
     SdoInitiateCommand,
     SdoSegmentCommand,
+    advance_counter,
     build_coe,
     build_mailbox,
     next_counter,
@@ -129,6 +130,14 @@ def test_command_bytes_parse_and_build_losslessly(byte: int) -> None:
     seg = SdoSegmentCommand.parse(bytes([byte]))
     assert seg.toggle == bool(byte & 0x10) and seg.last == bool(byte & 1)
     assert SdoSegmentCommand.build(seg) == bytes([byte])
+
+
+@pytest.mark.parametrize("start", range(9))
+def test_advancing_a_counter_is_stepping_it(start: int) -> None:
+    c = start
+    for steps in range(30):
+        assert advance_counter(start, steps) == c, (start, steps)
+        c = next_counter(c)
 
 
 def test_counter_runs_1_to_7() -> None:

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from gtecat.drives.coe import next_counter
+from gtecat.drives.coe import advance_counter, next_counter
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
@@ -351,10 +351,15 @@ class EmulatedBackend(Backend):
             self._clients[position] = client
         return client
 
-    def unanswered(self) -> int:
+    def unanswered(self, position: int | None = None) -> int:
         """The SDO requests sent so far that got no answer (a fault lost it): the master
-        waits its mailbox timeout for each (:meth:`gtecat.master.bus.Master.sdo_upload`)."""
-        return sum(c.unanswered for c in self._clients.values())
+        waits its mailbox timeout for each (:meth:`gtecat.master.bus.Master.sdo_upload`);
+        ``position``: those sent to that slave alone (one SDO reaches one slave's mailbox,
+        so the master asks about that one: a bus of many slaves costs it nothing more)."""
+        if position is not None:
+            client = self._clients.get(position)
+            return client.unanswered if client is not None else 0  # type: ignore[attr-defined]
+        return sum(c.unanswered for c in self._clients.values())  # type: ignore[attr-defined]
 
     def close(self) -> None:
         if self.capture is not None:
@@ -431,9 +436,8 @@ class EmulatedBackend(Backend):
         server = self.slaves[position].sdo  # type: ignore[attr-defined]
         server._pending.clear()
         server._upload = server._download = None
-        for _ in range(count % 7 + 7 if count >= 7 else count):
-            client.counter = next_counter(client.counter)
-            server.counter = next_counter(server.counter)
+        client.counter = advance_counter(client.counter, count)
+        server.counter = advance_counter(server.counter, count)
 
 
 _IO_STEP = IoSlave.step

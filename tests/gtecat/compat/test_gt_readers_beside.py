@@ -63,3 +63,22 @@ def test_gt400_calls_are_seen_by_the_next_gt_read() -> None:
         ],
         (1, 2),
     )
+
+
+def test_opening_a_layer_on_the_open_card_is_seen_by_the_next_gt_read() -> None:
+    """A card opened and driven through the GT layer, axis 3 into its negative limit; a
+    layer opened on it then sets its axes up (flags cleared): the next GT_GetSts says so."""
+    from gtecat.compat import mcx314
+
+    open_card(a3={"negative_limit": -50_000})
+    for a in (1, 2, 3, 4):
+        assert gt.GT_AxisOn(a) == 0
+    prm = gt.TTrapPrm(acc=1.0, dec=1.0)
+    assert gt.GT_PrfTrap(3) == 0 and gt.GT_SetTrapPrm(3, byref(prm)) == 0
+    assert gt.GT_SetVel(3, 100) == 0 and gt.GT_SetPos(3, -60_000) == 0
+    assert gt.GT_Update(1 << 2) == 0
+    gt.GTE_Wait(1000)
+    on_limit = _reads(3)
+    assert on_limit[1] & 0x40  # (the negative limit, table 6-2 bit 6)
+    mcx314.Open()
+    assert _reads(3) == _reads(3, table=True) != on_limit
