@@ -607,7 +607,7 @@ def _load() -> tuple[Maker | None, str]:
         if pointers:  # (pointer(x) too: x's memory, of x's type)
             kinds += tuple(ctypes.POINTER(t) for t in kinds)
             _pointer_types_of_ctypes()
-        if not 0 < len(kinds) < _MAX_TYPES or not 2 <= most <= 4:
+        if not 0 < len(kinds) < _MAX_TYPES or not (1 if noaxis else 2) <= most <= 4:
             raise ValueError(f"one to {_MAX_TYPES - 1} types, two to four arguments")
         e = _Entry(id(fallback), id(value), id(sentinel), int(core), kind, most)
         e.noaxis = int(noaxis)
@@ -1195,7 +1195,8 @@ def reader(
     value in their first element (the Python fast function's numpy shape); ``pointers``:
     ``pointer(x)`` of
     those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
-    ``q`` omitted, None or 0, writing ``value()`` (GT_GetClock's ``pClock``, ``pLoop``);
+    ``q`` omitted, None or 0 (where ``most`` is 2; 1: ``f(p)`` only), writing ``value()``
+    (GT_GetClock's ``pClock``, ``pLoop``; GT_IsEcatReady's ``pStatus``);
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), clock)`` (``count`` an
     int, 1 where omitted; ``clock`` None where pClock is omitted, None or 0, and 1 where it
     is ``byref(x)`` (no offset) or ``x`` of one of ``clocks``) gives the bytes written to the

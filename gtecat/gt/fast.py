@@ -1074,6 +1074,49 @@ def fast_clock(
     return entry
 
 
+#: GT_IsEcatReady, which a bring-up loop (and an HMI) polls
+READY = "GT_IsEcatReady"
+
+
+def fast_ready(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_IsEcatReady(pStatus)`` with its C entry in front of the table path: ``pStatus``
+    ``byref(x)`` (no offset) or ``x`` of an integer type the pointer takes, on the in-process
+    controller (the GT_ gate) whose bus is open and whose last GT_InitEcatComm did not fail;
+    the status as the table path stores it.  Every other case (no bus, a failed bring-up
+    and its reason): the table path."""
+    from .args import _scalar_types
+    from .table import FUNCTIONS
+
+    if not CENTRY:
+        return slow
+
+    def value() -> Any:
+        ctl = GATED[0]
+        if ctl.card is not None or ctl.init_error is not None:  # (the table says why)
+            return _NO
+        m = ctl.master
+        if m is None or not m.opened:
+            return _NO
+        v = 1 if ctl.ready else 0
+        session.last = None
+        return v
+
+    types = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
+    entry = centry.reader(
+        slow, value, _NO, sorted(types, key=str), centry.INT, most=1, noaxis=True,
+        gate=centry.GT_GATE, after=_after(advance, name, 0),
+    )  # fmt: skip
+    if entry is None:
+        return slow
+    entry.python = slow  # type: ignore[attr-defined]  # (no Python fast function: the table)
+    return entry  # type: ignore[no-any-return]
+
+
 def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], bytes | None]:
     """The same fast answer for a request that came over the controller socket
     (:mod:`gtecat.native.server`): ``body`` is the whole CALL message of ``name`` from a
@@ -2801,6 +2844,7 @@ _MULTI_VALUES: dict[str, Callable[[Any], Callable[[Any], Any]]] = {
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
         CLOCK: fast_clock,
+        READY: fast_ready,
         **dict.fromkeys(IO_READERS, fast_io_reader),
         CORE: fast_core,
         HOMING: fast_homing_status,

@@ -470,7 +470,8 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
     if (e->noaxis) {
-        if (nargs < 1 || nargs > 2 || (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
+        if (nargs < 1 || nargs > 2 || nargs > e->most ||
+            (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
             goto python;
         p = args[0];
     } else {

@@ -212,3 +212,42 @@ def test_a_polling_loop_in_the_auto_clock_sees_the_move() -> None:
         assert len(seen) > 10
     finally:
         gt.GT_Close()
+
+
+def test_gt_is_ecat_ready_answers_as_the_table_through_a_bring_up() -> None:
+    """Manual example 5-5's loop: GT_IsEcatReady polled from GT_InitEcatComm to OP, and
+    through a link loss, answers as its table path does, call by call (the status and the
+    code; 1 with its reason before GT_InitEcatComm)."""
+    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="") == 0
+    try:
+
+        def both() -> tuple:
+            out = []
+            for call in (gt.GT_IsEcatReady, gt.GT_IsEcatReady.slow):
+                s = ctypes.c_short(7)
+                rc = call(byref(s))
+                out.append((rc, s.value, gt.GTE_GetLastError() if rc else ""))
+            return tuple(out)
+
+        a, b = both()
+        assert a == b and a[0] != 0
+        assert gt.GT_InitEcatComm() == 0
+        seen = set()
+        for _ in range(80):
+            gt.GTE_Wait(1)
+            a, b = both()
+            assert a == b
+            seen.add(a[1])
+        assert seen == {0, 1}
+        faults.inject("link_down", after_slave=0)
+        gt.GTE_Wait(3)
+        a, b = both()
+        assert a == b and a[1] == 0
+        extra = [
+            gt.GT_IsEcatReady(byref(ctypes.c_short()), 0),
+            gt.GT_IsEcatReady.slow(byref(ctypes.c_short()), 0),
+        ]
+        assert extra[0] == extra[1] != 0  # (an argument too many: the table's refusal)
+    finally:
+        faults.clear()
+        gt.GT_Close()
