@@ -604,11 +604,14 @@ def _entry(
     :func:`centry.reader`'s."""
     if not CENTRY:
         return gt
+    numpy: list[Any] = []
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
+        numpy = _int_dtypes(types)  # (the Python path's numpy shape: _array_first)
     entry = centry.reader(
-        gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate, after=after
-    )
+        gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate,
+        after=after, numpy=numpy,
+    )  # fmt: skip
     if entry is None:
         return gt
     entry.slow, entry.python = gt.slow, gt
@@ -1092,9 +1095,6 @@ def fast_ready(
     from .args import _scalar_types
     from .table import FUNCTIONS
 
-    if not CENTRY:
-        return slow
-
     def value() -> Any:
         ctl = GATED[0]
         if ctl.card is not None or ctl.init_error is not None:  # (the table says why)
@@ -1106,15 +1106,8 @@ def fast_ready(
         session.last = None
         return v
 
-    types = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
-    entry = centry.reader(
-        slow, value, _NO, sorted(types, key=str), centry.INT, most=1, noaxis=True,
-        gate=centry.GT_GATE, after=_after(advance, name, 0),
-    )  # fmt: skip
-    if entry is None:
-        return slow
-    entry.python = slow  # type: ignore[attr-defined]  # (no Python fast function: the table)
-    return entry  # type: ignore[no-any-return]
+    # (no Python fast function: the table path is the entry's ``python`` too)
+    return _noaxis_entry(slow, value, _scalar_types(FUNCTIONS[name].params[0]), name, advance)  # type: ignore[no-any-return]
 
 
 def wire_reader(name: str, long_size: int, session: Any) -> Callable[[Any], bytes | None]:
@@ -2551,7 +2544,45 @@ def fast_core(
         return slow(*(a for a in (p,) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+
+    def value() -> Any:  # (asked while the GT_ gate is open: this process, core 1)
+        if session.note is not None:
+            return _NO
+        session.last = None
+        return session._core
+
+    return _noaxis_entry(gt, value, ok, name, advance)
+
+
+def _noaxis_entry(
+    gt: Any, value: Callable[[], Any], ok: Any, name: str, advance: Callable[..., int]
+) -> Any:
+    """A one-pointer reader's public function ``f(p)``: its C entry (gated by the GT_ gate,
+    ``value()`` the value; ``p`` ``byref(x)`` or ``x`` of an integer type of ``ok``, or a
+    one-dimensional numpy array of one: its first element) in front of its Python fast
+    function ``gt``, where :data:`CENTRY` is on and the entry is available; else ``gt``."""
+    if not CENTRY:
+        return gt
+    types = sorted((t for t in ok if getattr(t, "_type_", "") in _INT_CODES), key=str)
+    entry = centry.reader(
+        gt, value, _NO, types, centry.INT, most=1, noaxis=True, gate=centry.GT_GATE,
+        after=_after(advance, name, 0), numpy=_int_dtypes(types),
+    )  # fmt: skip
+    if entry is None:
+        return gt
+    entry.slow, entry.python = getattr(gt, "slow", gt), gt
+    return entry
+
+
+def _int_dtypes(types: Any) -> list[Any]:
+    """The numpy dtypes of the integer ctypes ``types`` (the same size and sign: the Python
+    fast paths' first element of a numpy array, :func:`_array_first`)."""
+    out = {
+        np.dtype(f"{'i' if t._type_.islower() else 'u'}{ctypes.sizeof(t)}")
+        for t in types
+        if getattr(t, "_type_", "") in _INT_CODES
+    }
+    return sorted(out, key=str)
 
 
 #: the card's IO readers on the fast path: function -> (the types it reads, first and last,

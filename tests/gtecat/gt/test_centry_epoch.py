@@ -12,6 +12,7 @@ from ctypes import byref
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from gtecat import faults, gt
@@ -224,9 +225,11 @@ def test_gt_is_ecat_ready_answers_as_the_table_through_a_bring_up() -> None:
         def both() -> tuple:
             out = []
             for call in (gt.GT_IsEcatReady, gt.GT_IsEcatReady.slow):
-                s = ctypes.c_short(7)
+                s, a = ctypes.c_short(7), np.full(2, 7, np.int16)
                 rc = call(byref(s))
-                out.append((rc, s.value, gt.GTE_GetLastError() if rc else ""))
+                got = [rc, s.value, gt.GTE_GetLastError() if rc else ""]
+                rc = call(a)  # (a numpy array: its first element)
+                out.append((*got, rc, list(a), gt.GTE_GetLastError() if rc else ""))
             return tuple(out)
 
         a, b = both()
