@@ -605,12 +605,14 @@ def _entry(
     if not CENTRY:
         return gt
     numpy: list[Any] = []
+    array = None
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
         numpy = _int_dtypes(types)  # (the Python path's numpy shape: _array_first)
+        array = _first_element(value, types)
     entry = centry.reader(
         gt, value, _NO, sorted(types, key=str), kind, most=2, size=size, gate=gate,
-        after=after, numpy=numpy,
+        after=after, numpy=numpy, array=array,
     )  # fmt: skip
     if entry is None:
         return gt
@@ -620,6 +622,32 @@ def _entry(
 
 #: the ctypes type codes of the integers an entry writes (of 1 to 8 bytes, either sign)
 _INT_CODES = frozenset("bBhHiIlLqQ")
+
+
+def _first_element(value: Callable[[Any], Any], types: Any) -> Callable[..., Any]:
+    """A two-argument reader's values for a ctypes array (:func:`centry.reader`'s ``array``):
+    an array of one of ``types`` with at least one element takes ``value(n)`` in its first
+    element, as the Python fast paths' :func:`_array_first` has it; else _NO."""
+    ok = frozenset(types)
+    packers: dict[type, Callable[..., bytes]] = {}
+
+    def f(n: Any, count: Any, tp: type, clock: Any) -> Any:
+        if count != 1 or clock is not None:
+            return _NO
+        pack = packers.get(tp)
+        if pack is None:
+            if not (issubclass(tp, ctypes.Array) and tp._length_ >= 1 and tp._type_ in ok):
+                return _NO
+            pack = packers[tp] = struct.Struct("@" + tp._type_._type_).pack
+        v = value(n)
+        if v is _NO:
+            return _NO
+        try:
+            return pack(v)
+        except struct.error:  # (a value the element does not hold: the Python path)
+            return _NO
+
+    return f
 
 
 #: a reader's value of an axis the bank does not run, inline (without the getter's call):
