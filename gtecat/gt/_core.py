@@ -433,6 +433,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     card_refused = refused(name)
     opens = name == "GT_Open"
     bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
+    #: a fast path whose first parameter is an axis (its GTN_ twin of core c > 1 takes the
+    #: bus axis on core 1's fast path; a coordinate system, a type, an offset: its table)
+    by_axis = bool(proto.params) and proto.params[0].name in ("axis", "profile", "encoder")
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
         before = SESSION.last
@@ -569,15 +572,31 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
             def gtn(*args: Any, **kwargs: Any) -> int:
                 if args:
-                    if (
-                        fast is not None
-                        and args[0] == 1
-                        and type(args[0]) is int
-                        and not kwargs
-                        and SESSION.plain
-                    ):
-                        return fast(*args[1:])  # core 1: the GT_ function's fast path
-                    return call(args[0], args[1:], kwargs)
+                    c = args[0]
+                    if fast is not None and type(c) is int and not kwargs and SESSION.plain:
+                        if c == 1:
+                            return fast(*args[1:])  # core 1: the GT_ function's fast path
+                        if (
+                            by_axis
+                            and len(args) > 1
+                            and type(args[1]) is int
+                            and 1 <= args[1] <= AXES_PER_CORE
+                        ):
+                            # core c's axis, where core c is a view of core 1's bus (made
+                            # already): the bus axis core 1 takes by its own number
+                            # (core_view: the same controller, only the numbering differs)
+                            base = SESSION.controllers.get(1)
+                            view = SESSION.views.get((SESSION.card, c))
+                            bus = args[1] + AXES_PER_CORE * (c - 1)
+                            if (
+                                base is not None
+                                and c not in SESSION.controllers  # (not a card's own core)
+                                and view is not None
+                                and view._base is base
+                                and bus in base.axes
+                            ):
+                                return fast(bus, *args[2:])
+                    return call(c, args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 
         if fast is not None and hasattr(fast, "gtn"):  # the reader's own GTN_ fast path
