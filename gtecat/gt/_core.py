@@ -400,7 +400,11 @@ def advance(ctl: Any, name: str, rc: int) -> int:
             clock._pending_ns = pending
             return rc
     try:
-        clock.on_call()
+        if mode is _AUTO:
+            with clock.lock:  # (its cycles: one thread's at a time, as a call's own)
+                clock.on_call()
+        else:  # (realtime: the call yields, the lock free for the cycle thread)
+            clock.on_call()
     except Exception as e:
         code = code_for(e)
         if code == CMD_NO_RESPONSE:
@@ -471,15 +475,12 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if card_refused and ctl.card is not None:  # an EtherCAT function on a card
                     raise CommandError(ctl.card.refusal(name))
                 bank = ctl.bank
-                if ctl.clock._thread is not None:
-                    # atomic with respect to the cycle thread, the bank's release included:
-                    # given back while a cycle steps the bank, an axis's objects would miss
-                    # that cycle or get it twice
-                    with ctl.clock.lock:
-                        if bank is not None and not bank_read:
-                            bank.before_call(ctl, proto, values)
-                        rc = fn(ctl, *values, **extra)
-                else:
+                # atomic with respect to the cycle thread (realtime) and to the calls of the
+                # application's other threads (their cycles, their releases): the bank's
+                # release included - given back while a cycle steps the bank, an axis's
+                # objects would miss that cycle or get it twice (the vendor's library
+                # serialises its callers' threads too)
+                with ctl.clock.lock:
                     if bank is not None and not bank_read:
                         bank.before_call(ctl, proto, values)  # the axes it names go back first
                     rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
