@@ -1098,6 +1098,7 @@ def fast_clock(
     entry = centry.reader(
         gt, value, _NO, types, centry.INT, most=2, noaxis=True, gate=centry.GT_GATE,
         after=_after(advance, name, 0),
+        numpy=_int_dtypes(_scalar_types(FUNCTIONS[name].params[0])),  # (as ``first``)
     )  # fmt: skip
     if entry is None:
         return gt
