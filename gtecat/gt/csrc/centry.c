@@ -195,6 +195,41 @@ static void keep(struct slot *s, long long ep, obj v)
         A.decref(old);
 }
 
+/* The value kept in cache (ncache slots) for the int n in this epoch, a new reference, else
+ * NULL; *key is n's slot (-1: n has none) and *ep the epoch (-1: unknown), for keep(). */
+static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, long long *ep)
+{
+    int over = 0;
+    *key = n ? A.as_ll(n, &over) : 0;
+    *ep = -1;
+    if (over || *key < 0 || *key >= ncache) {
+        if (*key == -1 && !over && A.err_occurred())
+            A.err_clear();
+        *key = -1;
+        return NULL;
+    }
+    *ep = epoch();
+    if (*ep >= 0 && cache[*key].value && cache[*key].epoch == *ep) {
+        A.incref(cache[*key].value);
+        return cache[*key].value;
+    }
+    return NULL;
+}
+
+/* Keep a span's (or a raw range's) bytes v with their key and type tp for epoch ep. */
+static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
+                      long long count, long long clock)
+{
+    obj old = s->value, oldtp = s->tp;
+    A.incref(v);
+    A.incref(tp);
+    s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
+    if (old)
+        A.decref(old);
+    if (oldtp)
+        A.decref(oldtp);
+}
+
 /* x held by an integer of size bytes (sign: signed) */
 static int fits(long long x, int size, int sign)
 {
@@ -350,17 +385,8 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
             A.decref(v);
             goto python;
         }
-        if (s && ep >= 0) {
-            obj old = s->value, oldtp = s->tp;
-            A.incref(v);
-            A.incref(tp);
-            s->value = v, s->tp = tp, s->epoch = ep, s->n = an, s->count = ac;
-            s->clock = cmem != NULL;
-            if (old)
-                A.decref(old);
-            if (oldtp)
-                A.decref(oldtp);
-        }
+        if (s && ep >= 0)
+            keep_span(s, ep, v, tp, an, ac, cmem != NULL);
     }
     n = *(ptrdiff_t *)((char *)v + A.bsize) - (cmem ? 8 : 0);
     if (n <= 0)
@@ -519,19 +545,9 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     }
 
     /* the value kept for this epoch, else value(n)'s (kept for it) */
-    if (e->cache) {
-        int over = 0;
-        key = e->noaxis ? 0 : A.as_ll(args[at], &over);
-        if (over || key < 0 || key >= e->ncache) {
-            if (key == -1 && !over && A.err_occurred())
-                A.err_clear();
-            key = -1;
-        } else if ((ep = epoch()) >= 0 && e->cache[key].value && e->cache[key].epoch == ep) {
-            v = e->cache[key].value;
-            A.incref(v);
-            goto have;
-        }
-    }
+    if (e->cache &&
+        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep)) != NULL)
+        goto have;
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
                   : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
@@ -683,17 +699,8 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
         }
         goto drop;
     }
-    if (s && ep >= 0) {
-        obj old = s->value, oldtp = s->tp;
-        A.incref(v);
-        A.incref(TYPE(target));
-        s->value = v, s->tp = TYPE(target), s->epoch = ep;
-        s->n = off, s->count = size, s->clock = slave;
-        if (old)
-            A.decref(old);
-        if (oldtp)
-            A.decref(oldtp);
-    }
+    if (s && ep >= 0)
+        keep_span(s, ep, v, TYPE(target), off, size, slave);
 have:
     /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
     n = *(ptrdiff_t *)((char *)v + A.bsize);
@@ -794,7 +801,6 @@ static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, 
     int size[MAX_OUT], sign[MAX_OUT];
     long long ints[MAX_OUT], key = -1, ep = -1;
     obj v, item;
-    int over = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -810,18 +816,8 @@ static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, 
     for (k = 0; k < nout; k++)
         if (!out_mem(e, k, args[1 + k], &size[k], &sign[k]))
             goto python;
-    if (e->cache) {
-        key = A.as_ll(args[0], &over);
-        if (over || key < 0 || key >= e->ncache) {
-            if (key == -1 && !over && A.err_occurred())
-                A.err_clear();
-            key = -1;
-        } else if ((ep = epoch()) >= 0 && e->cache[key].value && e->cache[key].epoch == ep) {
-            v = e->cache[key].value;
-            A.incref(v);
-            goto have;
-        }
-    }
+    if (e->cache && (v = kept(e->cache, e->ncache, args[0], &key, &ep)) != NULL)
+        goto have;
     v = A.vectorcall(e->value, args, 1, NULL);
     if (!v)
         return NULL;
