@@ -63,7 +63,6 @@ from .bank import AxisBank
 from .bank_kernel import _DEFERRED as _KERNEL_DEFERRED
 from .bank_kernel import prebuild as prebuild_kernel
 from .bank_kernel import start_deferred as start_kernel_build
-from .epoch import EPOCH
 from .epoch import changed as readers_changed
 from .input_sense import changed as sense_changed
 from .resources import install as install_resources
@@ -162,7 +161,8 @@ class Controller:
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
         self.clock.run_many = self.run_cycles
-        # (the cycles' time counted: a reader's kept clock value is stale, epoch.py)
+        # (every cycle and run of cycles goes through the clock: once their time is counted,
+        # what the readers kept is stale, their clock value included - epoch.py)
         self.clock.counted = readers_changed
         #: a run of cycles at once is under way (:meth:`run_cycles`): the inspection
         #: endpoint's idle path waits for its end (it runs no request beside cycles)
@@ -388,7 +388,6 @@ class Controller:
                 w()
         finally:
             self.cycling = False
-            EPOCH.n += 1  # (what the readers read changed: epoch.py)
 
     #: a cycle is running (:meth:`_cycle`, after its ``before_cycle`` hooks): an SDO made
     #: inside it (a touch probe read by SDO) cannot wait for cycles
@@ -417,7 +416,6 @@ class Controller:
             done = self._run_cycles(n)
         finally:
             self.in_batch = False
-            EPOCH.n += 1  # (what the readers read changed: epoch.py)
         if done:
             for w in self.watch:
                 w()

@@ -5,13 +5,14 @@ cycle left it and as the GT calls made since then changed it: the manual's contr
 updates its status in its servo cycle.  So what a reader answers stays the same while no
 cycle runs, no other call is made, no fault is injected and the session stays; the C
 entries of the readers (:mod:`gtecat.gt.centry`) keep each value they write for the epoch
-it was asked in and write it again while :data:`EPOCH` stays.  :data:`EPOCH` grows at the
-end of every cycle and every run of cycles (:class:`~gtecat.controller.core.Controller`),
-of every call of the table path and every error recorded (:mod:`gtecat.gt._core`), of every
-raw write into the process image, every change of the session's gates, every fault
-injected or cleared, every call of a compat layer (:mod:`gtecat.compat`) and every request
-of an inspection endpoint (a panel's control operations).  Code that changes a
-controller's objects another way (a test's own hand on them) calls :func:`changed`.
+it was asked in and write it again while :data:`EPOCH` stays.  :data:`EPOCH` grows after
+every cycle and every run of cycles, once its time is counted (the controller's clock calls
+:func:`changed`: ``Clock.counted``), and at the end of every call of the table path and
+every error recorded (:mod:`gtecat.gt._core`), every raw write into the process image,
+every change of the session's gates, every fault injected or cleared, every call of a
+compat layer (:mod:`gtecat.compat`) and every request of an inspection endpoint (a panel's
+control operations).  Code that changes a controller's objects another way (a test's own
+hand on them) calls :func:`changed`.
 """
 
 from __future__ import annotations
