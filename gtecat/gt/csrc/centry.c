@@ -315,34 +315,52 @@ static obj done(obj after, ptrdiff_t gate)
     return A.zero;
 }
 
+/* The index of tp among the NULL-ended types (at most n of them), its size and sign in
+ * *size and *sign; -1 where it is not among them. */
+static int find_type(obj const *types, const ptrdiff_t *sizes, const ptrdiff_t *signs, int n,
+                     obj tp, int *size, int *sign)
+{
+    int k;
+    for (k = 0; k < n && types[k]; k++) {
+        if (types[k] == tp) {
+            *size = (int)sizes[k];
+            *sign = (int)signs[k];
+            return k;
+        }
+    }
+    return -1;
+}
+
+static char *reader_mem(obj p, obj target, obj deref);
+
+/* The memory of p - byref(x) with no offset, or x itself - where x's type is one of the
+ * NULL-ended types (at most n), its size and sign in *size and *sign; NULL where it is not
+ * (reader_mem: what proves the memory). */
+static char *typed_mem(obj p, obj const *types, const ptrdiff_t *sizes, const ptrdiff_t *signs,
+                       int n, int *size, int *sign)
+{
+    obj target = p, tp = TYPE(p);
+    if (tp == A.carg_type) {
+        target = AT(p, A.carg_obj);
+        if (!target)
+            return NULL;
+        tp = TYPE(target);
+    }
+    if (find_type(types, sizes, signs, n, tp, size, sign) < 0)
+        return NULL;
+    return reader_mem(p, target, NULL);
+}
+
 /* A span's pClock: NULL (omitted, None or 0: *clock 0) or the memory of byref(x) (no
  * offset) or x of one of the entry's clock types (*clock 1, its size and sign); 0 where
  * this entry does not take it. */
 static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *sign)
 {
-    obj target = pc, tp;
-    int k;
     *mem = NULL;
     if (pc == A.none || pc == A.zero || int_is(pc, 0))
         return 1;
-    tp = TYPE(pc);
-    if (tp == A.carg_type) {
-        target = AT(pc, A.carg_obj);
-        if (!target)
-            return 0;
-        tp = TYPE(target);
-        if (AT(pc, A.carg_value) != AT(target, A.b_ptr))
-            return 0; /* byref(x, offset), or x's memory moved since */
-    }
-    for (k = 0; k < MAX_TYPES && e->ctypes_[k]; k++) {
-        if (e->ctypes_[k] == tp) {
-            *mem = AT(target, A.b_ptr);
-            *size = (int)e->csizes[k];
-            *sign = (int)e->csigns[k];
-            return *mem != NULL;
-        }
-    }
-    return 0;
+    *mem = typed_mem(pc, e->ctypes_, e->csizes, e->csigns, MAX_TYPES, size, sign);
+    return *mem != NULL;
 }
 
 /* A reader's ctypes array (count from n, pClock NULL or a clock's pointer): the bytes
@@ -436,20 +454,14 @@ obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kw
  * reader_mem is. */
 static char *np_mem(const struct entry *e, obj p, int *size, int *sign)
 {
-    obj d = (obj)AT(p, A.nd_descr);
-    int k;
     if (*(int *)((char *)p + A.nd_nd) != 1 || !AT(p, A.nd_dims) ||
         *(ptrdiff_t *)AT(p, A.nd_dims) < 1 ||
         (*(int *)((char *)p + A.nd_flags) & A.nd_want) != A.nd_want)
         return NULL;
-    for (k = 0; k < 8 && e->nptypes[k]; k++) {
-        if (e->nptypes[k] == d) {
-            *size = (int)e->npsizes[k];
-            *sign = (int)e->npsigns[k];
-            return AT(p, A.nd_data);
-        }
-    }
-    return NULL;
+    if (find_type(e->nptypes, e->npsizes, e->npsigns, 8, (obj)AT(p, A.nd_descr), size,
+                  sign) < 0)
+        return NULL;
+    return AT(p, A.nd_data);
 }
 
 /* The memory a reader writes for p (target: p, or a byref's object), or NULL where this
@@ -530,16 +542,10 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
                 goto python;
             tp = TYPE(target);
         }
-        for (k = 0; k < MAX_TYPES && e->types[k]; k++) {
-            if (e->types[k] == tp) {
-                size = (int)e->sizes[k];
-                sign = (int)e->signs[k];
-                deref = (obj)e->derefs[k];
-                break;
-            }
-        }
-        if (!size)
+        k = find_type(e->types, e->sizes, e->signs, MAX_TYPES, tp, &size, &sign);
+        if (k < 0)
             goto python;
+        deref = (obj)e->derefs[k];
         if (!reader_mem(p, target, deref))
             goto python;
     }
@@ -776,22 +782,7 @@ obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
 /* output k's memory, size and sign for p (NULL: not taken) */
 static char *out_mem(const struct multi_entry *e, ptrdiff_t k, obj p, int *size, int *sign)
 {
-    obj target = p, tp = TYPE(p);
-    int j;
-    if (tp == A.carg_type) {
-        target = AT(p, A.carg_obj);
-        if (!target)
-            return NULL;
-        tp = TYPE(target);
-    }
-    for (j = 0; j < MAX_OTYPES && e->types[k][j]; j++) {
-        if (e->types[k][j] == tp) {
-            *size = (int)e->sizes[k][j];
-            *sign = (int)e->signs[k][j];
-            return reader_mem(p, target, NULL);
-        }
-    }
-    return NULL;
+    return typed_mem(p, e->types[k], e->sizes[k], e->signs[k], MAX_OTYPES, size, sign);
 }
 
 static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
