@@ -494,6 +494,27 @@ _KEEP: list[Any] = []
 Maker = Callable[..., Any]
 
 
+def _type_table(ids: Any, sizes: Any, signs: Any, types: Iterable[type], kind: int) -> tuple:
+    """An entry's NULL-ended table of ctypes types (csrc/centry.c's find_type): each type,
+    its size and its sign (an unsigned integer's 0); the types, kept alive with the entry."""
+    ts = tuple(types)
+    if len(ts) >= len(ids):
+        raise ValueError(f"at most {len(ids) - 1} types")
+    for k, t in enumerate(ts):
+        ids[k], sizes[k] = id(t), ctypes.sizeof(t)
+        signs[k] = int(kind != INT or not t._type_.isupper())
+    return ts
+
+
+def _slots(e: Any) -> Any:
+    """The memory an entry keeps its values in per axis (:data:`CACHED` slots), given to
+    it; kept alive with the entry."""
+    slots = (_Slot * CACHED)()
+    e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
+    e.ncache = CACHED
+    return slots
+
+
 def _load() -> tuple[Maker | None, str]:
     if sys.implementation.name != "cpython":
         return None, "not CPython"
@@ -621,12 +642,7 @@ def _load() -> tuple[Maker | None, str]:
             e.types[k] = id(t)
             e.sizes[k] = size or ctypes.sizeof(x)
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
-        cks = tuple(clocks)
-        if len(cks) >= _MAX_TYPES:
-            raise ValueError(f"at most {_MAX_TYPES - 1} clock types")
-        for k, t in enumerate(cks):
-            e.ctypes_[k], e.csizes[k] = id(t), ctypes.sizeof(t)
-            e.csigns[k] = int(not t._type_.isupper())
+        cks = _type_table(e.ctypes_, e.csizes, e.csigns, clocks, INT)
         dts = tuple(numpy) if api.ndarray_type else ()
         if len(dts) >= 8:
             raise ValueError("at most seven numpy dtypes")
@@ -635,9 +651,7 @@ def _load() -> tuple[Maker | None, str]:
             e.npsigns[k] = int(dt.kind != "u")
         slots = aslot = None
         if cache:  # (the memory the C function keeps values in, kept alive with it)
-            slots = (_Slot * CACHED)()
-            e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
-            e.ncache = CACHED
+            slots = _slots(e)
             if array is not None:
                 aslot = _ASlot()
                 e.acache = ctypes.pointer(aslot)
@@ -683,22 +697,17 @@ def _load() -> tuple[Maker | None, str]:
             e.extra[k] = x
         kinds = []
         for k, (out_types, kind) in enumerate(outs):
-            ts = tuple(out_types)
-            if not 0 < len(ts) < _MAX_OTYPES or kind not in (INT, DOUBLE):
-                raise ValueError(f"one to {_MAX_OTYPES - 1} types of integers or doubles")
+            if kind not in (INT, DOUBLE):
+                raise ValueError("outputs of integers or doubles")
             e.kinds[k] = kind
-            for j, t in enumerate(ts):
-                e.types[k][j], e.sizes[k][j] = id(t), ctypes.sizeof(t)
-                e.signs[k][j] = int(kind != INT or not t._type_.isupper())
+            ts = _type_table(e.types[k], e.sizes[k], e.signs[k], out_types, kind)
+            if not ts:
+                raise ValueError("an output takes one type at least")
             kinds.append(ts)
         e.gate = gate
         e.after = id(after) if after is not None else None
         e.titems, e.tuple_type = titems, id(tuple)
-        slots = None
-        if cache:
-            slots = (_Slot * CACHED)()
-            e.cache = ctypes.cast(slots, ctypes.POINTER(_Slot))
-            e.ncache = CACHED
+        slots = _slots(e) if cache else None
         keep = (fallback, value, sentinel, kinds, after, slots)
         fn = new(b"gt_centry_multi", multi_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, multi_vc, e, keep)
