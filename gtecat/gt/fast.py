@@ -2125,17 +2125,7 @@ def fast_homing_status(
 
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
-            tp = type(p)
-            arr = None  # (an array: the range its first element holds)
-            if tp is _CArg:
-                obj = target(p)
-                if obj is p:
-                    obj = None
-            elif tp in ok:
-                obj = p
-            else:
-                arr = first(p, tp)
-                obj = None if arr is None else p
+            obj, arr = _value_target(p, target, ok, first)
             if obj is not None:
                 got = status(n)
                 if got is not None:
@@ -2548,17 +2538,8 @@ def fast_core(
 
     def gt(p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if not kw and not extra and session.local:
-            tp = type(p)
-            arr = None  # (an array: its first element, of a type that holds 1..4)
-            if tp is _CArg:
-                obj = target(p)
-                if obj is p:
-                    obj = None
-            elif tp in ok:
-                obj = p
-            else:
-                arr = first(p, tp)
-                obj = None if arr is None else p
+            # (an array: its first element, of a type that holds 1..4)
+            obj, arr = _value_target(p, target, ok, first)
             if obj is not None and session.note is None:
                 core = session._core  # (1..4: every integer type the pointer takes holds it)
                 if arr is None:
@@ -2617,6 +2598,23 @@ def _int_dtypes(types: Any) -> list[Any]:
 #: the card's IO readers on the fast path: function -> (the types it reads, first and last,
 #: and where its readers are kept among a controller's ``input_plans``: type + this)
 IO_READERS = {"GT_GetDi": (0, 6, 0), "GT_GetDiRaw": (0, 6, 16), "GT_GetDo": (10, 12, 32)}
+
+
+def _value_target(
+    p: Any, target: Callable[[Any], Any], ok: Any, first: Callable[[Any, type], Any]
+) -> tuple[Any, Any]:
+    """Where a one-value reader's Python path writes: ``(x, None)`` for ``byref(x)`` with no
+    offset (``target``) or ``x`` itself of one of ``ok``, ``(p, bounds)`` for an array whose
+    first element takes the value (``first``: the range that element holds), else
+    ``(None, None)`` (the table path answers)."""
+    tp = type(p)
+    if tp is _CArg:
+        obj = target(p)
+        return (None, None) if obj is p else (obj, None)
+    if tp in ok:
+        return p, None
+    arr = first(p, tp)
+    return (None, None) if arr is None else (p, arr)
 
 
 def _int_bounds(types: Any) -> dict[type, tuple[int, int]]:
