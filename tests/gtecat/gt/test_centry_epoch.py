@@ -19,6 +19,8 @@ from gtecat import faults, gt
 from gtecat.controller.epoch import EPOCH, changed
 from gtecat.gt import centry
 
+from .conftest import bring_up
+
 ENI = Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni"
 pytestmark = pytest.mark.skipif(bool(centry.REASON), reason=f"no C entry: {centry.REASON}")
 
@@ -40,10 +42,7 @@ READS: list[tuple[str, tuple, type]] = [
 
 
 def _open(**options: str) -> Any:
-    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="", **options) == 0
-    assert gt.GT_InitEcatComm() == 0
-    gt.GTE_Wait(60)
-    assert gt.GT_StartEcatComm() == 0
+    bring_up("manual_fig5_2.eni", clock="lockstep", **options)
     assert gt.GT_AxisOn(1) == 0
     assert gt.GT_AxisOn(2) == 0
     gt.GTE_Wait(10)
@@ -191,14 +190,8 @@ def test_a_polling_loop_in_the_auto_clock_sees_the_move() -> None:
     """The default clock: each read costs its host latency and cycles run inside reads; a
     loop polling GT_GetPrfPos and GT_GetSts through the C entries sees the move go on and end
     (manual section 13: GT_GetSts' motion bit, GT_GetPrfPos)."""
-    assert gt.GT_Open(eni=str(ENI), clock="auto", log="") == 0
+    bring_up("manual_fig5_2.eni", clock="auto")
     try:
-        assert gt.GT_InitEcatComm() == 0
-        ready = ctypes.c_short()
-        for _ in range(10_000):
-            if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
-                break
-        assert gt.GT_StartEcatComm() == 0
         assert gt.GT_AxisOn(1) == 0
         _trap_move()
         pos, sts = ctypes.c_double(), ctypes.c_long()

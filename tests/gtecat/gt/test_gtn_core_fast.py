@@ -17,6 +17,8 @@ from gtecat.controller.epoch import EPOCH
 from gtecat.drives.machine import AxisMachine, MachineDescription
 from tools.gen_axes_eni import write_axes_eni
 
+from .conftest import bring_up
+
 AXES = 40
 
 
@@ -39,13 +41,8 @@ def test_core_2s_axes_answer_as_the_table(tmp_path: Path) -> None:
     m = MachineDescription(
         {a: AxisMachine(home_switch=((3000, 5000),), positive_limit=1e9) for a in (33, 34)}
     )
-    assert gt.GT_Open(eni=str(eni), machine=m, clock="lockstep", log="") == 0
+    bring_up(str(eni), machine=m, clock="lockstep")  # (an absolute path: the file itself)
     try:
-        assert gt.GT_InitEcatComm() == 0
-        ready = c_short()
-        while gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value != 1:
-            gt.GTE_Wait(1)
-        assert gt.GT_StartEcatComm() == 0
         for a in (1, 2, 3):
             assert gt.GTN_AxisOn(2, a) == 0, gt.GTE_GetLastError()
         gt.GTE_Wait(20)

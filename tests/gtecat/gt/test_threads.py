@@ -8,33 +8,22 @@ from __future__ import annotations
 import sys
 import threading
 from ctypes import byref, c_long, c_short
-from pathlib import Path
 
 from gtecat import gt
 from gtecat.gt import _core
+from tests.conftest import EXAMPLES
 
-EXAMPLES = Path(__file__).resolve().parents[3] / "gtecat" / "examples"
+from .conftest import bring_up
 
 
 def test_a_polling_thread_beside_coordinated_motion() -> None:
-    assert (
-        gt.GT_Open(
-            eni=str(EXAMPLES / "homing_probe.eni"),
-            machine=str(EXAMPLES / "homing_probe_machine.toml"),
-            clock="auto",
-            log="",
-            bank="on",
-        )
-        == 0
+    bring_up(
+        "homing_probe.eni",
+        machine=str(EXAMPLES / "homing_probe_machine.toml"),
+        clock="auto",
+        bank="on",
     )
     try:
-        assert gt.GT_InitEcatComm() == 0
-        s = c_short()
-        for _ in range(300):
-            if gt.GT_IsEcatReady(byref(s)) == 0 and s.value == 1:
-                break
-            gt.GTE_Wait(1)
-        assert gt.GT_StartEcatComm() == 0
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
         bad: list[tuple[str, int, str]] = []
         done = threading.Event()
