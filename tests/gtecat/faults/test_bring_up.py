@@ -35,12 +35,6 @@ def _open(tmp: Path, n: int, pcap: bool, extra: str = "") -> int:
     return gt.GT_InitEcatComm()
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    yield
-    gt.GT_Close()
-
-
 @pytest.mark.parametrize("pcap", [False, True], ids=["no capture", "pcap"])
 def test_the_nth_sdo_counts_the_bring_up_and_its_fault_fails_it(tmp_path: Path, pcap: bool):
     n = _bring_up_sdos(0x1C12)

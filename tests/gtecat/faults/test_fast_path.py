@@ -12,8 +12,6 @@ from __future__ import annotations
 
 from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_uint32
 
-import pytest
-
 from gtecat import faults, gt
 from tests.conftest import EXAMPLES
 
@@ -81,13 +79,6 @@ def _session(way: str) -> tuple[list, list]:
         ends.append((p.value, s.value))
     gt.GT_Close()
     return events, ends + rcs
-
-
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
 
 
 def test_every_trigger_fires_in_the_same_cycle_batched_or_not() -> None:

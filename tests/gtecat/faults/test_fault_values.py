@@ -40,13 +40,6 @@ def _table(kind: str, name: str, value: object) -> dict[str, object]:
     return {"kind": kind, **needed, name: value}
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
-
-
 def test_every_integer_value_has_a_range() -> None:
     ints = {
         (kind, f.name)

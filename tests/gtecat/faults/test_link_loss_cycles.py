@@ -48,13 +48,6 @@ def eni(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
-
-
 def wait(pred, ms: int) -> bool:
     for _ in range(ms):
         if pred():

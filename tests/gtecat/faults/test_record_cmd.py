@@ -9,16 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from gtecat import gt
 from gtecat.cli.main import main
 from tests.conftest import EXAMPLES
-
-
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
 
 
 def test_a_script_that_raises_keeps_its_recording_and_its_traceback(

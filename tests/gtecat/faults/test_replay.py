@@ -27,13 +27,6 @@ from tools import bench_replay
 SECONDS = 60.0 if LONG else 3.0
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
-
-
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The session recorded with every cycle run one by one and every Trap table computed

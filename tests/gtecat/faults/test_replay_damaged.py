@@ -9,19 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from gtecat import gt
 from gtecat.cli.main import main
 from gtecat.faults.record import Divergence
 from tests.conftest import EXAMPLES
 
 HEAD = {"gtecat_recording": 1, "program": "python3 app.py", "cwd": "/", "env": {}}
 STS = '{"t":0,"c":"GT_GetSts","a":[1,{"ref":{"c":"c_long","v":0}},1,null],"r":1}'
-
-
-@pytest.fixture(autouse=True)
-def _closed():
-    yield
-    gt.GT_Close()
 
 
 def replay(tmp_path: Path, calls: int, lines: list[str], capsys: pytest.CaptureFixture[str]):

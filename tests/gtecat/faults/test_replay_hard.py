@@ -17,13 +17,6 @@ from tools import session_hard
 SECONDS = 0.25
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
-
-
 @pytest.mark.parametrize("single", [True, False], ids=["one_by_one", "arrays"])
 def test_the_session_replays_exactly(tmp_path: Path, single: bool) -> None:
     out = tmp_path / "hard.gtrec"

@@ -8,19 +8,10 @@ import threading
 from ctypes import byref, c_ubyte, c_ulong
 from pathlib import Path
 
-import pytest
-
 from gtecat import faults, gt
 from gtecat.faults.record import Recorder, replay
 from gtecat.gt._core import SESSION
 from tests.conftest import EXAMPLES
-
-
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
 
 
 def _sdo() -> int:

@@ -25,13 +25,6 @@ from tools import session_hard
 SECONDS = 0.4
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
-
-
 @pytest.fixture(scope="module")
 def cache(tmp_path_factory: pytest.TempPathFactory):
     """gtecat's cache folder for these tests (its plans only)."""

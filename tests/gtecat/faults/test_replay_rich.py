@@ -26,13 +26,6 @@ from tools import session_rich
 SECONDS = 60.0 if LONG else 3.0
 
 
-@pytest.fixture(autouse=True)
-def _closed():
-    gt.GT_Close()
-    yield
-    gt.GT_Close()
-
-
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("rich")
