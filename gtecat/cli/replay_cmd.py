@@ -11,6 +11,7 @@ a session that worked.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -38,7 +39,29 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run, leave_at_once=True)
 
 
+#: the variables that tell numpy's BLAS how many threads to start when it is loaded
+_BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
+
+
+def _numpy_one_thread() -> None:
+    """numpy imported with its BLAS on one thread (unless the user chose a number): a
+    replay does no linear algebra, and OpenBLAS starting a thread per CPU and its buffers
+    costs ~60 ms of a replay's start (a third of numpy's import).  The variables are put
+    back once numpy is loaded (the library reads them then), so no process started later
+    inherits them."""
+    if "numpy" in sys.modules or any(k in os.environ for k in _BLAS_THREADS):
+        return
+    os.environ["OPENBLAS_NUM_THREADS"] = "1"
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        pass
+    finally:
+        os.environ.pop("OPENBLAS_NUM_THREADS", None)
+
+
 def run(args: argparse.Namespace) -> int:
+    _numpy_one_thread()
     from ..faults.record import replay
 
     t0 = time.perf_counter()
