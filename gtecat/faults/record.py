@@ -620,18 +620,18 @@ def replay(
     taken = time.time_ns()
     seen = _file_key(p)
     where = _plan_ref(seen) if seen is not None else None
-    kept = _load_plan(where) if where is not None else None
-    raw = None
-    if kept is None:
-        raw = _read_raw(p)
-        where = _plan_file(raw)
+    # (paused from the plan's load on: unmarshalling it makes as many objects as its steps)
     paused = gc.isenabled()
     if paused:
         gc.disable()
     marks = None  # (a plan's: where the opens and bring-ups are)
     freeze = False
+    raw = None
     try:
+        kept = _load_plan(where) if where is not None else None
         if kept is None:
+            raw = _read_raw(p)
+            where = _plan_file(raw)
             kept = _load_plan(where) if where is not None else None
             if kept is not None and seen is not None and where is not None:
                 _keep_ref(p, seen, taken, where)
