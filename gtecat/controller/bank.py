@@ -17,7 +17,10 @@ before anything else may look at or change them:
 
 * any GT function except the bank-aware readers (:data:`BANK_READS`) releases the
   axis it names (the axes of a mask or of a ``count`` span, a slave's axes for an SDO to
-  it, every axis when it names none) before it runs; one naming a coordinate system
+  it, every axis when it names none) before it runs, but the calls of a Trap move's start
+  (:data:`IN_PLACE`), which run on their axis's row in place (:meth:`AxisBank.call_in_place`:
+  the row's state put into its objects, the call, the row taken up again from them, the
+  drive staying in the bank); one naming a coordinate system
   releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit, the following
@@ -139,6 +142,10 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: GT functions whose implementations read a claimed axis through the bank itself, or touch
 #: no axis object at all (the process image, the clock: a raw write to a claimed slave's
 #: outputs is seen by the bank's next cycle, which gives the slave back first)
+#: the GT functions of a Trap move's start that run on their axis's claimed row in place
+#: (:meth:`AxisBank.call_in_place`): they reach that axis's axis, planner, encoder and band
+#: objects and its profile (or, through their guards, anything else of its drive)
+IN_PLACE = frozenset({"GT_PrfTrap", "GT_SetTrapPrm", "GT_SetPos", "GT_SetVel", "GT_Update"})
 #: function -> where it takes a ``count`` of axes, 0: it takes none (AxisBank.before_call)
 _COUNTED: dict[str, int] = {}
 #: the most axes a ``count`` names that go back one by one (more: every axis)
@@ -1622,6 +1629,43 @@ class AxisBank:
                 return
         self.release_all()
 
+    def call_in_place(self, ctl: Any, proto: Any, values: tuple, call: Callable[[], Any]) -> Any:
+        """``call()``'s result, a GT function of :data:`IN_PLACE` with ``values`` on ``ctl``:
+        run on its axis's claimed row in place (:meth:`_in_place`, as a smart homing's step:
+        the row's state into its axis, planner, encoder and band objects, the call, the row
+        taken up again from them when it is still what :meth:`_eligible` asks for, else given
+        back) instead of giving its drive back before it and claiming it again at the next
+        cycle, which is what :meth:`before_call` does (and what happens here for any other
+        row).  A Trap move started again and again (GT_PrfTrap, GT_SetTrapPrm, GT_SetPos,
+        GT_SetVel, GT_Update of one axis) then leaves every drive in the bank; the values are
+        the same (a release and a claim put the same state into the objects and take it back)."""
+        self.dirty = True
+        r = self._in_place_row(ctl, proto, values)
+        if r < 0:
+            self.before_call(ctl, proto, values)
+            return call()
+        done: list[Any] = []
+        self._in_place(r, self.groups[self.group_of[r]], lambda: done.append(call()))
+        return done[0]
+
+    def _in_place_row(self, ctl: Any, proto: Any, values: tuple) -> int:
+        """The row a call of :data:`IN_PLACE` runs on in place, else -1: one axis (a mask of
+        one bit for GT_Update) whose row is claimed in a plain state, not stepping already."""
+        if not (self.n_alive and self.built and values) or self._stepping >= 0:
+            return -1
+        n = values[0]
+        if type(n) is not int:
+            return -1
+        if proto.name == "GT_Update":
+            if n <= 0 or n & (n - 1):
+                return -1
+            n = n.bit_length()
+        ax = ctl.axes.get(n)
+        r = self._row_of.get(id(ax)) if ax is not None else None
+        if r is None or not self._plain_row(r):
+            return -1
+        return r
+
     def _push_ahead(self, ctl: Any, proto: Any, values: tuple) -> bool:
         """A GT_LnXY, GT_ArcXY..., GT_HelixXY... or GT_BufDelay onto the running FIFO of a system
         the bank holds a window of cycles ahead may go onto the FIFO as it stands there: the
@@ -2140,16 +2184,22 @@ class AxisBank:
         then.  A row of a drive with several channels, of a cluster or not in a plain Trap
         or standing state simply goes back (the step runs on the scalar objects)."""
         g = self.groups[self.group_of[r]]
-        if (
-            not self.alive[r]
-            or len(g.rows) != 1
-            or self.sampled[r]
-            or self.jog[r]
-            or self.hm[r]
-            or self.frz[r]
-        ):
+        if len(g.rows) != 1 or not self._plain_row(r):
             step()
             return
+        self._in_place(r, g, step)
+
+    def _plain_row(self, r: int) -> bool:
+        """Row ``r`` is claimed in a plain Trap or standing state: a step may run on it in
+        place (:meth:`_in_place`)."""
+        return bool(self.alive[r]) and not (
+            self.sampled[r] or self.jog[r] or self.hm[r] or self.frz[r]
+        )
+
+    def _in_place(self, r: int, g: _Group, step: Callable[[], None]) -> None:
+        """:meth:`step_claimed`'s step on claimed row ``r`` of group ``g`` (its drive's
+        other rows, if any, stay claimed as they are: the step reaches their objects only
+        through their guards, which give the whole drive back)."""
         ax, res = self.axes[r], self.res[r]
         prof = res.profile
         pl = prof.planner

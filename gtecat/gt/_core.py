@@ -26,7 +26,7 @@ from gtecat.drives.abort import SdoAbort
 from gtecat.drives.machine import MachineError
 from gtecat.eni.errors import EniError, GtecatError
 
-from ..controller.bank import BANK_READS
+from ..controller.bank import BANK_READS, IN_PLACE
 from ..controller.card import refused
 from ..controller.cards import CARD_CORES
 from ..controller.core import Controller
@@ -437,6 +437,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     card_refused = refused(name)
     opens = name == "GT_Open"
     bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
+    in_place = name in IN_PLACE  # runs on its axis's claimed row in place
     #: a fast path whose first parameter is an axis (its GTN_ twin of core c > 1 takes the
     #: bus axis on core 1's fast path; a coordinate system, a type, an offset: its table)
     by_axis = bool(proto.params) and proto.params[0].name in ("axis", "profile", "encoder")
@@ -481,9 +482,13 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 # objects would miss that cycle or get it twice (the vendor's library
                 # serialises its callers' threads too)
                 with ctl.clock.lock:
-                    if bank is not None and not bank_read:
+                    if bank is None or bank_read:
+                        rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
+                    elif in_place and not extra:  # (a Trap move's start: its row in place)
+                        rc = bank.call_in_place(ctl, proto, values, lambda: fn(ctl, *values))
+                    else:
                         bank.before_call(ctl, proto, values)  # the axes it names go back first
-                    rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
+                        rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
             else:
                 rc = fn(*values, **extra) if extra else fn(*values)
             if rc is None:

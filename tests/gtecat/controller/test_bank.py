@@ -472,10 +472,15 @@ def test_gt_calls_release_and_the_bank_claims_again(tmp_path: Path) -> None:
         gt.GTE_Wait(40)
         bank = ctl.bank
         assert bank.n_alive == AXES
-        gt.GT_SetVel(3, 5.0)  # names one axis: its slave's rows leave, the others stay
+        gt.GT_ClrSts(3)  # names one axis: its slave's rows leave, the others stay
         assert bank.n_alive == AXES - 1
         gt.GTE_Wait(2)
         assert bank.n_alive == AXES
+        # a Trap move's start runs on its axis's row in place: no drive leaves
+        steps = bank.steps_in_place
+        gt.GT_SetVel(3, 5.0)
+        assert bank.n_alive == AXES
+        assert bank.steps_in_place == steps + 1
         # the field side touching a drive gives its slave back too
         ch = ctl.backend.slaves[0].channels[0]
         pos = ch.machine_position

@@ -37,16 +37,22 @@ def test_a_release_from_the_bank_holds_the_cycle_lock():
         _wait(lambda: ctl.bank.n_alive == 2, "both axes in the bank")
 
         held: list[bool] = []
-        before = ctl.bank.before_call
+        bank = ctl.bank
+        before, in_place = bank.before_call, bank.call_in_place
 
         def spy(*args):
             held.append(ctl.clock.lock._is_owned())
             return before(*args)
 
-        ctl.bank.before_call = spy
+        def spy_in_place(*args):  # (a Trap move's start runs on its row in place)
+            held.append(ctl.clock.lock._is_owned())
+            return in_place(*args)
+
+        bank.before_call, bank.call_in_place = spy, spy_in_place
         for _ in range(20):
-            assert gt.GT_SetVel(1, 6) == 0  # names axis 1: it goes back first
+            assert gt.GT_SetVel(1, 6) == 0  # names axis 1: it goes back first, or in place
             assert gt.GT_Update(1) == 0
+            assert gt.GT_SetSoftLimit(1, 2**30, -(2**30)) == 0  # names axis 1: it goes back
             pos = c_double()
             assert gt.GT_GetPrfPos(2, byref(pos)) == 0
             time.sleep(0.002)
