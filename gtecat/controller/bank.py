@@ -146,6 +146,10 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: (:meth:`AxisBank.call_in_place`): they reach that axis's axis, planner, encoder and band
 #: objects and its profile (or, through their guards, anything else of its drive)
 IN_PLACE = frozenset({"GT_PrfTrap", "GT_SetTrapPrm", "GT_SetPos", "GT_SetVel", "GT_Update"})
+#: those of :data:`IN_PLACE` that write their profile's values for the next GT_Update alone
+#: (the Trap target, the speed), which the bank keeps no copy of: they run with the row as
+#: it stands (anything else they reached would give the drive back through its guard)
+_PROFILE_ONLY = frozenset({"GT_SetPos", "GT_SetVel"})
 #: function -> where it takes a ``count`` of axes, 0: it takes none (AxisBank.before_call)
 _COUNTED: dict[str, int] = {}
 #: the most axes a ``count`` names that go back one by one (more: every axis)
@@ -1640,6 +1644,8 @@ class AxisBank:
         GT_SetVel, GT_Update of one axis) then leaves every drive in the bank; the values are
         the same (a release and a claim put the same state into the objects and take it back)."""
         self.dirty = True
+        if proto.name in _PROFILE_ONLY:  # (nothing of the row: as it stands, guards on)
+            return call()
         r = self._in_place_row(ctl, proto, values)
         if r < 0:
             self.before_call(ctl, proto, values)

@@ -478,9 +478,12 @@ def test_gt_calls_release_and_the_bank_claims_again(tmp_path: Path) -> None:
         assert bank.n_alive == AXES
         # a Trap move's start runs on its axis's row in place: no drive leaves
         steps = bank.steps_in_place
-        gt.GT_SetVel(3, 5.0)
-        assert bank.n_alive == AXES
-        assert bank.steps_in_place == steps + 1
+        assert gt.GT_SetVel(3, 5.0) == 0  # (the profile's speed alone: the row as it stands)
+        assert gt.GT_SetPos(3, 2000) == 0
+        assert bank.n_alive == AXES and bank.steps_in_place == steps
+        assert gt.GT_Update(1 << 2) == 0
+        assert bank.n_alive == AXES and bank.steps_in_place == steps + 1
+        assert bank.moving[bank._row_of[id(ctl.axes[3])]]
         # the field side touching a drive gives its slave back too
         ch = ctl.backend.slaves[0].channels[0]
         pos = ch.machine_position
