@@ -463,6 +463,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         """The call with its arguments bound (``core``: the core it addresses; ``gtn``: the
         ``GTN_`` twin was called)."""
         ctl = None
+        # (and before it: the cycles the call runs itself see what it changed before them -
+        # Controller._run_cycles keeps the bus's steadiness while the epoch stays)
+        EPOCH.n += 1
         try:
             if address or SESSION._remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
