@@ -392,12 +392,13 @@ def advance(ctl: Any, name: str, rc: int) -> int:
     mode = clock.mode
     if mode is _LOCKSTEP:  # (Clock.on_call does nothing in lockstep)
         return rc
-    if mode is _AUTO and clock.group is None:
+    if mode is _AUTO:
         # Clock.on_call in the common case, inline: the latency runs no cycle and no other
-        # clock shares this one's time
-        pending = clock._pending_ns + clock.call_latency_ns
-        if pending < clock.cycle_ns:
-            clock._pending_ns = pending
+        # clock shares this one's time (as the readers' C entries add it: centry.c latency)
+        q = clock.quick
+        pending = q[0] + q[1]
+        if q[3] and pending < q[2]:
+            q[0] = pending
             return rc
     try:
         if mode is _AUTO:
