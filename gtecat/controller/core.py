@@ -163,6 +163,9 @@ class Controller:
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
         self.clock.run_many = self.run_cycles
+        #: the clock's cycle as this controller gave it (one that wraps it, an inspection
+        #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
+        self._own_cycle = self.clock._run_cycle
         # (every cycle and run of cycles goes through the clock: once their time is counted,
         # what the readers kept is stale, their clock value included - epoch.py)
         self.clock.counted = readers_changed
@@ -431,7 +434,7 @@ class Controller:
             or self.before_cycle
             or self.sample
             or self._links_down
-            or self.clock._run_cycle != self._cycle
+            or self.clock._run_cycle is not self._own_cycle
         ):
             return 0
         settled = bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n)

@@ -403,7 +403,7 @@ def advance(ctl: Any, name: str, rc: int) -> int:
     try:
         if mode is _AUTO:
             with clock.lock:  # (its cycles: one thread's at a time, as a call's own)
-                clock.on_call()
+                clock.advance_ns(q[1])  # (Clock.on_call in the auto clock)
         else:  # (realtime: the call yields, the lock free for the cycle thread)
             clock.on_call()
     except Exception as e:
