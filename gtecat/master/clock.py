@@ -93,9 +93,10 @@ class Clock:
 
     @cycle_ns.setter
     def cycle_ns(self, ns: int) -> None:
+        ns = int(ns)
         if ns <= 0:
             raise ValueError("cycle time must be positive")
-        self.quick[2] = int(ns)
+        self.quick[2] = ns
 
     @property
     def call_latency_ns(self) -> int:

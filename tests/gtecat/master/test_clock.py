@@ -55,3 +55,18 @@ def test_a_group_of_clocks_shares_one_time():
     assert (a.cycles, b.cycles, a.group, b.group) == (8, 3, None, None)
     group.join(Clock(lambda: None, mode="realtime"))  # the wall clock is shared already
     assert group.clocks == [a]
+
+
+def test_a_cycle_under_one_nanosecond_is_refused_not_stored_as_zero():
+    """The setter converts to whole nanoseconds first, then refuses what is not positive
+    (0.5 ns was once stored as 0 and every later cycle divided by it)."""
+    import pytest
+
+    c = Clock(lambda: None, cycle_ns=1_000_000, mode="lockstep")
+    for bad in (0.5, 0, -1, 0.999):
+        with pytest.raises(ValueError, match="positive"):
+            c.cycle_ns = bad
+        assert c.cycle_ns == 1_000_000
+    c.cycle_ns = 1.5e6
+    assert c.cycle_ns == 1_500_000 and type(c.cycle_ns) is int
+    assert c.advance(3) == 2
