@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from gtecat.eni.bits import get_bits, set_bits
 from gtecat.eni.model import Direction, Identity, Pdo
@@ -62,6 +63,19 @@ def _place(
     return points
 
 
+class FieldInputs(bytearray):
+    """What an IO slave's terminals see on their inputs.  Written from outside the slave's
+    cycle (:meth:`IoSlave.set_input`, a test's ``slave.field_inputs[0] = 0x3C``, a fault),
+    each write counts as a change of the bus (:attr:`VirtualSlave.outside_changes`): a
+    controller that found the bus at a fixed point looks again."""
+
+    __slots__ = ()
+
+    def __setitem__(self, key: Any, value: Any) -> None:
+        bytearray.__setitem__(self, key, value)
+        VirtualSlave.outside_changes += 1
+
+
 class IoSlave(VirtualSlave):
     """A generic IO slave driven by its PDO mapping.
 
@@ -100,6 +114,16 @@ class IoSlave(VirtualSlave):
     def pdo_sizes(self) -> tuple[int, int]:
         return (sum(p.bit_len for p in self.rx_pdos), sum(p.bit_len for p in self.tx_pdos))
 
+    @property
+    def field_inputs(self) -> FieldInputs:
+        """What the terminals see on their inputs (:class:`FieldInputs`)."""
+        return self._field_inputs
+
+    @field_inputs.setter
+    def field_inputs(self, value: Any) -> None:
+        self._field_inputs = FieldInputs(value)
+        VirtualSlave.outside_changes += 1
+
     # --- field side -----------------------------------------------------------
     def point(self, direction: Direction, index: int, subindex: int) -> IoPoint:
         try:
@@ -119,14 +143,12 @@ class IoSlave(VirtualSlave):
         """Set what the terminal reads on an input object (reported from the next cycle)."""
         p = self.point(Direction.IN, index, subindex)
         set_bits(self.field_inputs, p.bit, p.bits, int(value))
-        VirtualSlave.field_changes += 1
 
     def get_output_bit(self, bit: int) -> bool:
         return bool(get_bits(self.field_outputs, bit, 1))
 
     def set_input_bit(self, bit: int, on: bool) -> None:
         set_bits(self.field_inputs, bit, 1, int(bool(on)))
-        VirtualSlave.field_changes += 1
 
     def wire(self, out_bit: int, in_bit: int) -> None:
         """Connect output bit ``out_bit`` (rx numbering) to input bit ``in_bit`` (tx numbering)."""
@@ -136,7 +158,7 @@ class IoSlave(VirtualSlave):
             raise ValueError(f"slave {self.position}: no input bit {in_bit}")
         self._wires.append((out_bit, in_bit))
         self._wire_plan = None
-        VirtualSlave.field_changes += 1
+        VirtualSlave.outside_changes += 1
 
     def wire_objects(
         self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None
