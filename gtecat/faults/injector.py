@@ -426,7 +426,7 @@ class Injector:
             if isinstance(s, IoSlave):
                 key = (f.slave, f.bit)
                 if key not in self._under:  # the first fault on this input: the field's value
-                    self._under[key] = _bit(s, f.bit)
+                    self._under[key] = max(0, _bit(s, f.bit))
                     self._watch_field(s)
                 self._hold_inputs()
         # the cyclic answers pass the injector from now on (a frame fault); a trigger that
@@ -508,6 +508,8 @@ class Injector:
             if not isinstance(s, IoSlave):
                 continue
             now = _bit(s, key[1])
+            if now < 0:
+                continue
             if key in self._applied and now != self._applied[key]:
                 self._under[key] = now
             if now != value:
@@ -530,7 +532,7 @@ class Injector:
             now = _bit(s, f.bit)
             if applied is not None and now != applied:  # set since the last cycle
                 under = now
-            if now != under:
+            if now >= 0 and now != under:
                 type(s).set_input_bit(s, f.bit, bool(under))
             if not any(p == f.slave for p, _ in self._under):
                 for name in ("set_input_bit", "set_input"):
@@ -777,8 +779,10 @@ class _StandIn:
 
 
 def _bit(s: IoSlave, bit: int) -> int:
-    """Input bit ``bit`` of the slave's field inputs."""
-    return s.field_inputs[bit >> 3] >> (bit & 7) & 1
+    """Input bit ``bit`` of the slave's field inputs (-1: it has no such bit, a CoE IO slave
+    given a shorter mapping since)."""
+    fi = s.field_inputs
+    return fi[bit >> 3] >> (bit & 7) & 1 if bit >> 3 < len(fi) else -1
 
 
 def _sdo_request(request: bytes) -> tuple[str, int | None, int | None] | None:
