@@ -58,6 +58,7 @@ from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
 from ..master.clock import Clock, ClockMode
 from ..master.masterlog import MasterLog
+from . import clock_options
 from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
@@ -138,7 +139,8 @@ class Controller:
     bus_opening_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - likewise
 
     def __init__(self, options: Options | None = None) -> None:
-        self.options = (options or Options()).resolved()
+        # (the clock options checked here too, for a controller made without GT_Open)
+        self.options = clock_options.check((options or Options()).resolved())
         try:
             mode = ClockMode(self.options.clock)
         except ValueError:
