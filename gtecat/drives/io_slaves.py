@@ -107,6 +107,11 @@ class IoSlave(VirtualSlave):
             for d, pdos in ((Direction.OUT, self.rx_pdos), (Direction.IN, self.tx_pdos))
         )
         self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
+        #: input bits a fault holds (a stuck input): bit -> 0 or 1, laid over the field inputs
+        #: on their way to ``tx`` (after the wires); the field inputs stay what the field puts
+        #: there, so an input let go reads the field's value at once (:meth:`hold_input_bit`)
+        self.held: dict[int, int] = {}
+        self._held_masks: tuple[bytes, bytes] | None = None
         self.field_outputs = bytearray(len(self.rx))  # what the terminals drive
         self._wires: list[tuple[int, int]] = []  # (output bit, input bit) in rx/tx numbering
         self._wire_plan: list[tuple[int, int, int, int]] | None = None  # see _plan_wires
@@ -149,6 +154,34 @@ class IoSlave(VirtualSlave):
 
     def set_input_bit(self, bit: int, on: bool) -> None:
         set_bits(self.field_inputs, bit, 1, int(bool(on)))
+
+    def hold_input_bit(self, bit: int, value: int | None) -> None:
+        """Hold input bit ``bit`` at ``value`` whatever the field puts there (a stuck input,
+        a broken terminal), or let it go (``value`` None): from the next cycle ``tx`` carries
+        the held value, then the field's again.  What the field puts there meanwhile
+        (:meth:`set_input_bit`, a wire) is kept in the field inputs underneath."""
+        if value is None:
+            self.held.pop(int(bit), None)
+        else:
+            self.held[int(bit)] = int(bool(value))
+        self._held_masks = None
+        VirtualSlave.outside_changes += 1
+
+    def _inputs(self) -> bytes | bytearray:
+        """What ``tx`` carries: the field inputs with the held bits laid over them."""
+        fi = self._field_inputs
+        if not self.held:
+            return fi
+        masks = self._held_masks
+        if masks is None or len(masks[0]) != len(fi):
+            keep, put = bytearray(b"\xff" * len(fi)), bytearray(len(fi))
+            for bit, v in self.held.items():
+                if 0 <= bit < 8 * len(fi):  # (a bit a new mapping no longer has: none)
+                    keep[bit >> 3] &= ~(1 << (bit & 7)) & 0xFF
+                    put[bit >> 3] |= v << (bit & 7)
+            masks = self._held_masks = (bytes(keep), bytes(put))
+        keep, put = masks
+        return bytes((b & k) | q for b, k, q in zip(fi, keep, put, strict=True))
 
     def wire(self, out_bit: int, in_bit: int) -> None:
         """Connect output bit ``out_bit`` (rx numbering) to input bit ``in_bit`` (tx numbering)."""
@@ -194,7 +227,7 @@ class IoSlave(VirtualSlave):
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 fi[ib] = (fi[ib] & ~mask) | (v & mask)
         if self.al_state >= _SAFEOP:
-            self.tx[:] = self.field_inputs
+            self.tx[:] = self._inputs()
 
     def settled(self) -> bool:
         """A :meth:`step` now would change nothing (its outputs reached the field, the wires
@@ -216,7 +249,7 @@ class IoSlave(VirtualSlave):
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 if (fi[ib] ^ v) & mask:
                     return False
-        return self.al_state < _SAFEOP or self.tx == fi
+        return self.al_state < _SAFEOP or self.tx == (fi if not self.held else self._inputs())
 
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires

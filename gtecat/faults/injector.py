@@ -9,13 +9,13 @@ end, chattering switches toggle, stuck IO inputs are held.  Mailbox requests pas
 master log (``fault 3 started: ...``) and kept in :attr:`events` (recordings read them).
 
 A stuck IO input (``io_stuck``) holds the input bit at its value over what the field puts
-there; when the fault ends (its ``duration_ms`` over, or cleared) the input is released: it
-reads what the field puts there *now*, which is the value it had before the fault unless
-something else set it meanwhile (the slave's ``set_input_bit`` / ``set_input``, the
-``gtecat`` field verbs, a wire from an output, a write of the slave's ``field_inputs`` that
-changed the bit), and then the last value so set.  What the field puts under a held input is
-kept per input bit (:attr:`Injector._under`), so two faults on one bit release it once, when
-the last of them ends, to the field's value, never to the other fault's.
+there (``IoSlave.hold_input_bit``: laid over the field inputs on their way to the process
+data, after the wires); when the fault ends (its ``duration_ms`` over, or cleared) the input
+is let go: it reads what the field puts there *now* - the value it had before the fault,
+unless something set it meanwhile (the slave's ``set_input_bit`` / ``set_input``, the
+``gtecat`` field verbs, a wire from an output, a write of its ``field_inputs``), which the
+field inputs underneath kept.  Of several faults on one bit the one added last holds it; the
+bit is let go when the last of them ends.
 """
 
 from __future__ import annotations
@@ -35,7 +35,6 @@ from gtecat.drives.coe import (
 from gtecat.drives.faults import ErrorCode
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.slave import AlState
-from gtecat.eni.model import Direction
 
 from ..controller.epoch import changed as readers_changed
 from ..errors import ParameterError
@@ -129,10 +128,6 @@ class Injector:
         #: that cycle's count)
         self._version = 0
         self._memo: tuple[int, ...] | None = None
-        #: (slave, bit) of every input a stuck fault holds -> what the field puts there
-        #: (module docstring); and the value the injector last wrote there
-        self._under: dict[tuple[int, int], int] = {}
-        self._applied: dict[tuple[int, int], int] = {}
         self._wrap_mailboxes()
 
     # --- adding and clearing ----------------------------------------
@@ -240,8 +235,6 @@ class Injector:
                     on = (self._chatter_cycle // f.period_cycles) % 2 == 0
                     ff.din_set = (ff.din_set | bit) if on else (ff.din_set & ~bit)
                     ff.din_clear = (ff.din_clear & ~bit) if on else (ff.din_clear | bit)
-        if self._under:
-            self._hold_inputs()
         if any(e.state == "ended" for e in self.entries):
             self.entries = [e for e in self.entries if e.state != "ended"]
         self._refresh()  # what the next cycle's triggers may change
@@ -422,13 +415,7 @@ class Injector:
             ff.probe_off = True
             ff.din_clear |= 3 << 16
         elif isinstance(f, k.IoStuck):
-            s = bus.slave(f.slave)
-            if isinstance(s, IoSlave):
-                key = (f.slave, f.bit)
-                if key not in self._under:  # the first fault on this input: the field's value
-                    self._under[key] = max(0, _bit(s, f.bit))
-                    self._watch_field(s)
-                self._hold_inputs()
+            self._hold(f.slave, f.bit)
         # the cyclic answers pass the injector from now on (a frame fault); a trigger that
         # watched an axis no longer does
         self._refresh()
@@ -475,7 +462,7 @@ class Injector:
             ff.probe_off = False
             ff.din_clear &= ~(3 << 16)
         elif isinstance(f, k.IoStuck):
-            self._release_input(f)
+            self._hold(f.slave, f.bit)
         axis = getattr(f, "axis", None)
         if axis is not None and f.depth in ("drive", "field"):
             bus.forget_override(axis)
@@ -489,83 +476,25 @@ class Injector:
                 self._end(e, "spent")
 
     # --- stuck IO inputs -------------------------------------------------------------------------
-    def _holding(self) -> dict[tuple[int, int], int]:
-        """(slave, bit) -> the value it is held at: of the active faults on one input bit,
-        the one added last wins."""
-        held: dict[tuple[int, int], int] = {}
+    def _hold(self, slave: int, bit: int) -> None:
+        """Input ``bit`` of ``slave`` held at the value of the active stuck fault on it added
+        last, or let go when none is left (module docstring)."""
+        value = None
         for e in self.entries:
             f = e.fault
-            if e.state == "active" and isinstance(f, k.IoStuck):
-                held[(f.slave, f.bit)] = int(bool(f.value))
-        return held
-
-    def _hold_inputs(self) -> None:
-        """Every cycle (and at a start): put the held values on their inputs; a bit found
-        other than the injector left it was set by something else, which is the field's
-        value from now on (module docstring)."""
-        for key, value in self._holding().items():
-            s = self.bus.slave(key[0])
-            if not isinstance(s, IoSlave):
-                continue
-            now = _bit(s, key[1])
-            if now < 0:
-                continue
-            if key in self._applied and now != self._applied[key]:
-                self._under[key] = now
-            if now != value:
-                type(s).set_input_bit(s, key[1], bool(value))  # (not the stand-in: no field)
-            self._applied[key] = value
-
-    def _release_input(self, f: k.IoStuck) -> None:
-        """An io_stuck fault ended: the input is the field's again, unless another fault
-        still holds it."""
-        key = (f.slave, f.bit)
-        if key not in self._under:
-            return
-        if key in self._holding():  # another fault on the same input goes on
-            self._hold_inputs()
-            return
-        s = self.bus.slave(f.slave)
-        under = self._under.pop(key)
-        applied = self._applied.pop(key, None)
+            if (
+                e.state == "active"
+                and isinstance(f, k.IoStuck)
+                and (f.slave, f.bit)
+                == (
+                    slave,
+                    bit,
+                )
+            ):
+                value = int(bool(f.value))
+        s = self.bus.slave(slave)
         if isinstance(s, IoSlave):
-            now = _bit(s, f.bit)
-            if applied is not None and now != applied:  # set since the last cycle
-                under = now
-            if now >= 0 and now != under:
-                type(s).set_input_bit(s, f.bit, bool(under))
-            if not any(p == f.slave for p, _ in self._under):
-                for name in ("set_input_bit", "set_input"):
-                    s.__dict__.pop(name, None)  # back to the class's methods
-
-    def _watch_field(self, s: IoSlave) -> None:
-        """Stand-ins for the slave's ``set_input_bit`` and ``set_input`` while one of its
-        inputs is held: what they set on a held bit is the field's value (kept for the
-        release; the input stays held)."""
-        if "set_input_bit" in s.__dict__:
-            return
-        pos, cls, under = s.position, type(s), self._under
-
-        def set_input_bit(bit: int, on: bool) -> None:
-            cls.set_input_bit(s, bit, on)
-            key = (pos, int(bit))
-            if key in under:
-                under[key] = int(bool(on))
-                self._hold_inputs()
-
-        def set_input(index: int, subindex: int, value: int) -> None:
-            cls.set_input(s, index, subindex, value)
-            p = s.point(Direction.IN, index, subindex)
-            held = False
-            for b in range(p.bit, p.bit + p.bits):
-                if (pos, b) in under:
-                    under[(pos, b)] = (int(value) >> (b - p.bit)) & 1
-                    held = True
-            if held:
-                self._hold_inputs()
-
-        s.set_input_bit = set_input_bit  # type: ignore[method-assign]
-        s.set_input = set_input  # type: ignore[method-assign]
+            s.hold_input_bit(bit, value)
 
     # --- AL errors ------------------------------------------------------------------------------
     def _latch(self, f: k.AlError) -> None:
@@ -776,13 +705,6 @@ class _StandIn:
     @property
     def sdo_server_only(self) -> bool:
         return not self.injector.entries and getattr(self.inner, "sdo_server_only", False)
-
-
-def _bit(s: IoSlave, bit: int) -> int:
-    """Input bit ``bit`` of the slave's field inputs (-1: it has no such bit, a CoE IO slave
-    given a shorter mapping since)."""
-    fi = s.field_inputs
-    return fi[bit >> 3] >> (bit & 7) & 1 if bit >> 3 < len(fi) else -1
 
 
 def _sdo_request(request: bytes) -> tuple[str, int | None, int | None] | None:

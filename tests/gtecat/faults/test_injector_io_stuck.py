@@ -46,7 +46,7 @@ def test_a_stuck_input_is_released_when_its_time_is_over():
     for _ in range(50):  # polling GT readers (the reader path) reads the same
         gt.GT_GetSts(1, byref(s))
     assert di(0) == 0
-    assert "set_input_bit" not in vars(gt.GTE_Slave(SLAVE))  # no stand-in left behind
+    assert not gt.GTE_Slave(SLAVE).held  # nothing laid over the field inputs any more
 
 
 def test_the_field_set_meanwhile_is_what_the_input_reads_after():
@@ -96,3 +96,17 @@ def test_two_faults_on_one_input_release_it_to_the_field():
     assert di(15) == 0  # the second and third are over, the first holds it still
     assert di(20) == 1
     assert faults.listing() == []
+
+
+def test_a_stuck_input_wired_from_an_output_holds_and_lets_go():
+    """A terminal's input wired from one of its outputs (a loop-back): the stuck fault holds
+    the input over the wire; let go, it reads the wire's value again."""
+    up()
+    slave = gt.GTE_Slave(SLAVE)
+    slave.wire(0, BIT)
+    assert gt.GT_EcatIOWriteOutput(SLAVE, 0, 1, bytes([1])) == 0
+    assert di(3) == 1  # output bit 0 on: the wire puts it on input bit BIT
+    fid = faults.inject("io_stuck", slave=SLAVE, bit=BIT, value=0)
+    assert di() == 0
+    faults.clear(fid)
+    assert di() == 1
