@@ -378,6 +378,7 @@ class AxisBank:
         #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
         self._stepping = -1
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
+        self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
         self._lists: dict[str, list[Any]] = {}
         #: the flags the last list of GT_GetSts words was made from (a few rows) and that
         #: list: made again only when one changed (a move, a jog and a rest last many runs)
@@ -476,6 +477,7 @@ class AxisBank:
         """Rows for every axis whose slave the bank can run (mapping and backend)."""
         self.built = True
         self._tp_map = {}
+        self._tp_objects: set[tuple[int, int]] | None = None
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -1260,8 +1262,14 @@ class AxisBank:
         """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""
         got = self._tp_map.get(r)
         if got is None:
+            # (what ``io.get(i) is not None`` finds for each, from one set of the layout's
+            # mapped objects instead of a placement lookup per object and row)
+            mapped = self._tp_objects
+            if mapped is None:
+                mapped = self._tp_objects = self.ctl.layout.mapped_objects()
             io = self.axes[r].io
-            got = self._tp_map[r] = any(io.get(i) is not None for i in _TP_TX)
+            off = CHANNEL_STRIDE * io.channel
+            got = self._tp_map[r] = any((io.slave, i + off) in mapped for i in _TP_TX)
         return got
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
