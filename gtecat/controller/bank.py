@@ -377,6 +377,8 @@ class AxisBank:
         self.any_post = False
         #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
         self._stepping = -1
+        #: rows a posted edge left open for the step after the cycle (:meth:`_post_event`)
+        self._open: set[int] = set()
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
         self._lists: dict[str, list[Any]] = {}
@@ -1509,6 +1511,7 @@ class AxisBank:
 
     def _store(self, r: int) -> None:
         self.alive[r] = False
+        self._open.discard(r)
         self.claim_ids[r] = 0
         self.res[r].bank = None
         self.layout += 1
@@ -2162,6 +2165,15 @@ class AxisBank:
         prof = res.profile
         pl = prof.planner
         objs = (ax, pl, res.encoder, res.band)
+        if r in self._open:  # (a posted edge's: its objects hold its state, unguarded)
+            self._open.discard(r)
+            self._stepping = r
+            self.evt_rows.discard(r)
+            try:
+                self._step_claimed(r, g, step, pl, objs)
+            finally:
+                self._stepping = -1
+            return
         # (their guards off first: the row's state goes into them without a guard's Python
         # call on every attribute, as it would under _Bypass anyway)
         _unguard(objs)
@@ -2262,6 +2274,10 @@ class AxisBank:
                     self._post_event(r, csp, p0, t_ns, dt_ns)
                 finally:
                     if self.alive[r] and self.groups[self.group_of[r]].claimed:
+                        if r in self._open:  # (its axis objects stay as step_claimed has them)
+                            res = self.res[r]
+                            axis = (self.axes[r], res.profile.planner, res.encoder, res.band)
+                            objs = tuple(o for o in objs if all(o is not a for a in axis))
                         _reguard(objs)
         finally:
             _Bypass.on = False
@@ -2286,10 +2302,46 @@ class AxisBank:
         ran = int(self.bank_cycles - self.claim_cycle[r])
         for obj in self._aware.pop(r, ()):
             obj.bank_posted(ran, t_ns, dt_ns)
+        self.evt_rows.add(r)
+        if self._stepped_after(r):
+            # a hook steps the row after this cycle (:meth:`step_claimed`), which puts its
+            # state into the same objects and takes it up from them: they hold it already,
+            # so the row stays open until then (its claim counted anew: a new claim)
+            self._open.add(r)
+            self._claims += 1
+            self.claim_ids[r] = self._claims
+            return
         was_moving = bool(self.moving[r])
         self._load(r, again=True)
         self._after_load(r, was_moving)
-        self.evt_rows.add(r)
+
+    def _stepped_after(self, r: int) -> bool:
+        """A ``post_cycle`` hook of the controller steps row ``r`` in place after this cycle
+        (``bank_steps_row(bank, r)`` on the hook's object says so: a smart homing waiting
+        for the edge its row's capture took; it then calls :meth:`step_claimed`)."""
+        for hook in self.ctl.post_cycle:
+            steps = getattr(getattr(hook, "__self__", None), "bank_steps_row", None)
+            if steps is not None and steps(self, r):
+                return True
+        return False
+
+    def close_open(self) -> None:
+        """The rows left open after a posted edge (:meth:`_post_event`) that no step took up:
+        taken from their objects again, as the post would have done."""
+        while self._open:
+            r = self._open.pop()
+            if not (self.alive[r] and self.groups[self.group_of[r]].claimed):
+                continue
+            res = self.res[r]
+            objs = (self.axes[r], res.profile.planner, res.encoder, res.band)
+            _Bypass.on = True
+            try:
+                was_moving = bool(self.moving[r])
+                self._load(r, again=True)
+                self._after_load(r, was_moving)
+            finally:
+                _Bypass.on = False
+            _reguard(objs)
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

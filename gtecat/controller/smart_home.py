@@ -947,6 +947,19 @@ class _Homings:
         #: the last look found a homing that steps every cycle (:meth:`quiet_cycles`)
         self._stepping = True
 
+    def bank_steps_row(self, bank: Any, r: int) -> bool:
+        """The axis bank's row ``r`` had an edge posted in this cycle: its homing steps it
+        after the cycle (:meth:`_settle`: a waiting homing whose row had an event is never
+        quiet), so the bank may leave the row open for that step (AxisBank._post_event)."""
+        home = _HOMES.get(bank.res[r])
+        return (
+            home is not None
+            and home._gen is not None
+            and not home._failing
+            and home in self.running
+            and home.res.bank is bank
+        )
+
     def add(self, home: SmartHome) -> None:
         if home not in self.running:
             self.running.append(home)
@@ -969,6 +982,8 @@ class _Homings:
             if not bank.evt_rows:
                 return  # nothing to do for any of them in this cycle
         self._settle(bank, t + dt, step=True)
+        if bank is not None and bank._open:
+            bank.close_open()  # (an open row whose homing did not step: as the post leaves it)
 
     def quiet_cycles(self, n: int) -> int:
         """How many of the next ``n`` cycles no homing has anything to do in."""
