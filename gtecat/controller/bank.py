@@ -1264,14 +1264,19 @@ class AxisBank:
         """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""
         got = self._tp_map.get(r)
         if got is None:
-            # (what ``io.get(i) is not None`` finds for each, from one set of the layout's
-            # mapped objects instead of a placement lookup per object and row)
-            mapped = self._tp_objects
-            if mapped is None:
-                mapped = self._tp_objects = self.ctl.layout.mapped_objects()
+            # (what ``io.get(i) is not None`` finds for one of them: the (slave, channel) pairs
+            # mapping one, from the layout's mapped objects once instead of a placement
+            # lookup per object and row)
+            pairs = self._tp_objects
+            if pairs is None:
+                tp = set(_TP_TX)
+                pairs = self._tp_objects = {
+                    (slave, (index - 0x6000) // CHANNEL_STRIDE)
+                    for slave, index in self.ctl.layout.mapped_objects()
+                    if 0x6000 <= index and 0x6000 + (index - 0x6000) % CHANNEL_STRIDE in tp
+                }
             io = self.axes[r].io
-            off = CHANNEL_STRIDE * io.channel
-            got = self._tp_map[r] = any((io.slave, i + off) in mapped for i in _TP_TX)
+            got = self._tp_map[r] = (io.slave, io.channel) in pairs
         return got
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
