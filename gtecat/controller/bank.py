@@ -1132,7 +1132,7 @@ class AxisBank:
         self.dpost[r] = 0
         if aware:
             self._aware[r] = aware
-        latched = res.latched
+        latched = int(res.latched)
         self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
         self.layout += 1
@@ -1155,8 +1155,8 @@ class AxisBank:
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
-        self._claims += 1
-        self.claim_ids[r] = self._claims
+        self._claims = claims = self._claims + 1
+        self.claim_ids[r] = claims
         b = res.band
         self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.since[r] = -1 if b._since is None else b._since
@@ -1218,7 +1218,7 @@ class AxisBank:
         self.frz[r] = frozen = not ax.servo_on
         # GT_GetSts's latched flags stay as they are while the row is in the bank
         # (_eligible_frozen, _latched_standing)
-        self.latched[r] = int(res.latched)
+        self.latched[r] = latched
         if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
             self._frozen[r] = (
                 tuple(getattr(ch, name) for name in FROZEN_ATTRS),
@@ -1245,12 +1245,11 @@ class AxisBank:
             # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
             self.csp.sw_const[r] += ch.hm_bits - SW12
             return
-        watch = int(self.dwatch[r])
         tp = bool(self.csp.tpw[r])
         if (
             (watch or tp)
-            and not self.sampled[r]
-            and not self.jog[r]
+            and not sampled
+            and not jog
             and len(self.groups[self.group_of[r]].rows) == 1
             and all(obj.bank_post_ready() for obj in aware)
         ):
