@@ -824,7 +824,18 @@ class AxisBank:
             return False
         if not self._inputs_plain(ax, res):
             return False
-        return not drive or not claimable(self.csp.channels[r])
+        ch = self.csp.channels[r]
+        # a drive on a limit switch: the compiled cycle runs it (its reaction included) while
+        # the flag of each switch it stands on is latched (nothing new for the controller);
+        # the numpy cycle gives such a row back (a claimed row's 60FDh: the bank's)
+        on = (ch.digital_inputs if drive else int(self.csp.din[r])) & 3
+        if on:
+            if self.kernel is None:
+                return False
+            need = (_POS_LIMIT if on & 2 else 0) | (_NEG_LIMIT if on & 1 else 0)
+            if res.latched & need != need:
+                return False
+        return not drive or not claimable(ch, limits=self.kernel is not None)
 
     @staticmethod
     def _latched_standing(ax: Any, res: Any) -> bool:
@@ -1867,6 +1878,8 @@ class AxisBank:
         hit = a > self.soft_pos
         if din is not csp._din_zero:
             hit |= (din & 3) != 0
+        if csp.din is not csp._din_zero:  # on a limit before the cycle: its reaction is compiled
+            hit |= (csp.din & 3) != 0
         if self.any_watch:  # an input a bank-aware hook samples changes (kernel: dwatch)
             hit |= ((din ^ csp.din) & self.dwatch) != 0
         evt = ((din ^ csp.din) & self.dpost) != 0 if self.any_post else None

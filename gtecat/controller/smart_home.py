@@ -307,6 +307,8 @@ class SmartHome:
         self._seen_gpi = -1
         #: the leg under way watches the trigger (its capture, its level or a GPI)
         self._watching = False
+        #: the direction whose limit the wait under way looks at (0: none, a stop)
+        self._dir = 0
 
     @property
     def running(self) -> bool:
@@ -482,7 +484,9 @@ class SmartHome:
         trap = prof.trap
         if _get(trap, "stopping") != StopKind.NONE or _get(trap, "_target") != self._expect:
             return None
-        if not _get(res.ax, "servo_on") or self._limit(1) or self._limit(-1):
+        # (a limit behind the move - the one a limit homing leaves - ends no wait: the bank
+        # gives the row back when a limit becomes active, or when a latched one's is not)
+        if not _get(res.ax, "servo_on") or (self._dir and self._limit(self._dir)):
             return None
         return bank.trap_quiet(r)
 
@@ -815,6 +819,7 @@ class SmartHome:
         if levels is not None:
             levels.watch_level(True)
         self._watching = watch is not None
+        self._dir = d
         self._waiting = True
         try:
             while True:
@@ -830,6 +835,7 @@ class SmartHome:
                     return "end", None
         finally:
             self._waiting = self._watching = False
+            self._dir = 0
             if levels is not None:
                 levels.watch_level(False)
 
@@ -867,6 +873,7 @@ class SmartHome:
         self._begin(d, target, vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
+        self._dir = d
         self._waiting = True
         try:
             while True:
@@ -878,6 +885,7 @@ class SmartHome:
                     return
         finally:
             self._waiting = False
+            self._dir = 0
 
     def _limit(self, d: int) -> bool | None:
         """The limit input in direction ``d``: as wired (module docstring, "Limits"), else
