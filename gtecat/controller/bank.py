@@ -20,11 +20,13 @@ before anything else may look at or change them:
   it, every axis when it names none) before it runs; one naming a coordinate system
   releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
-* a cycle in which a claimed axis would leave the state (a limit, the following
-  error, a new sample past a soft limit, a raw write to its slave's outputs, the
+* a cycle in which a claimed axis would leave the state (a limit switch reached, the
+  following error, a new sample past a soft limit, a raw write to its slave's outputs, the
   drive's own following-error window, a travel reaching an edge its armed touch probe
   latches) releases it *before* that cycle, so the scalar code runs that cycle and every
-  later one until the axis is back in the common state;
+  later one until the axis is back in the common state; a drive standing or braking on a
+  limit switch whose flag is latched (a limit homing escaping from it, a profile stopped
+  there) stays in the compiled cycle, which runs the drive's reaction;
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
   the axis by touching one of its objects: while claimed they carry a guard class
   (:meth:`AxisBank._guarded_objects`) whose first attribute access gives the axis back;

@@ -17,7 +17,11 @@ with numpy.
 
 A row whose next step would leave that state (a limit switch input, a following
 error timing out) is reported by :meth:`CspBank.step` in its ``events`` mask with its
-state untouched, so the owner hands it back to the scalar channel for that cycle.
+state untouched, so the owner hands it back to the scalar channel for that cycle.  The
+compiled cycle (``gtecat/controller/csrc/bank_kernel.c``) goes one step further: a drive
+standing on a limit switch, or braking on it (``Channel._limit_switches``: its demand into
+the switch braked with 6085h, ``limit_stop``, 6041h's warning bit instead of bit 12), stays
+a row (:func:`claimable` with ``limits``; :attr:`CspBank.lstop` carries ``limit_stop``).
 """
 
 from __future__ import annotations
