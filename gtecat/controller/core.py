@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gtecat.drives.machine import MachineDescription, load_machine
+from gtecat.drives.slave import VirtualSlave
 from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
 from gtecat.eni.reader import read_eni
@@ -63,6 +64,7 @@ from .bank import AxisBank
 from .bank_kernel import _DEFERRED as _KERNEL_DEFERRED
 from .bank_kernel import prebuild as prebuild_kernel
 from .bank_kernel import start_deferred as start_kernel_build
+from .epoch import EPOCH
 from .epoch import changed as readers_changed
 from .input_sense import changed as sense_changed
 from .resources import install as install_resources
@@ -161,6 +163,9 @@ class Controller:
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
         self.clock.run_many = self.run_cycles
+        #: the clock's cycle as this controller gave it (one that wraps it, an inspection
+        #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
+        self._own_cycle = self.clock._run_cycle
         # (every cycle and run of cycles goes through the clock: once their time is counted,
         # what the readers kept is stale, their clock value included - epoch.py)
         self.clock.counted = readers_changed
@@ -429,10 +434,11 @@ class Controller:
             or self.before_cycle
             or self.sample
             or self._links_down
-            or self.clock._run_cycle != self._cycle
+            or self.clock._run_cycle is not self._own_cycle
         ):
             return 0
-        if bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n):
+        settled = bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n)
+        if settled:
             bank.settle()  # what the next cycle does first: claim axes given back
         if self._run_axes:
             return 0
@@ -447,11 +453,18 @@ class Controller:
                         return 0
                     n = q
         master = self.master
-        if master is None or not master.steady():
+        if master is None:
             return 0
-        done = bank.run_cycles(self.clock.now_ns, self.clock.cycle_ns, n)
+        clock = self.clock
+        seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.field_changes)
+        if (settled or seen != self._steady_seen) and not master.steady():
+            return 0
+        done = bank.run_cycles(clock.now_ns, clock.cycle_ns, n)
         master.cycles += done
         if done:
+            # the bus stays steady through the bank's runs: the next run asks again only when
+            # something else happened in between (its marks are not these plus this run's)
+            self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
             for _, passed in hooks:
                 if passed is not None:
                     passed(done)
@@ -478,6 +491,15 @@ class Controller:
 
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
     BATCH_CYCLES = 1000
+    #: what the next run of cycles finds when nothing but runs of cycles happened since the
+    #: last one (:meth:`_run_cycles`): the readers' epoch grown once by the clock's count of
+    #: the run (``Clock.counted``), the clock's cycles, the slaves' AL changes and field
+    #: changes as they were.  Then the bus is as steady as the last run found it: the bank's
+    #: compiled cycles touch none of what :meth:`Master.steady` looks at (the IO slaves'
+    #: areas, the states, the hooks), and every other change makes one of the four grow
+    #: (a GT call, a raw write, a fault, an endpoint request, an AL change, an IO slave's
+    #: field inputs or wires set).
+    _steady_seen: tuple[int, int, int, int] = (0, 0, 0, 0)
     #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
     _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
 

@@ -119,12 +119,14 @@ class IoSlave(VirtualSlave):
         """Set what the terminal reads on an input object (reported from the next cycle)."""
         p = self.point(Direction.IN, index, subindex)
         set_bits(self.field_inputs, p.bit, p.bits, int(value))
+        VirtualSlave.field_changes += 1
 
     def get_output_bit(self, bit: int) -> bool:
         return bool(get_bits(self.field_outputs, bit, 1))
 
     def set_input_bit(self, bit: int, on: bool) -> None:
         set_bits(self.field_inputs, bit, 1, int(bool(on)))
+        VirtualSlave.field_changes += 1
 
     def wire(self, out_bit: int, in_bit: int) -> None:
         """Connect output bit ``out_bit`` (rx numbering) to input bit ``in_bit`` (tx numbering)."""
@@ -134,6 +136,7 @@ class IoSlave(VirtualSlave):
             raise ValueError(f"slave {self.position}: no input bit {in_bit}")
         self._wires.append((out_bit, in_bit))
         self._wire_plan = None
+        VirtualSlave.field_changes += 1
 
     def wire_objects(
         self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None

@@ -100,6 +100,10 @@ class VirtualSlave:
     #: the states (``EmulatedBackend.steady``: every claimed slave in OP) keeps it while the
     #: count stays the same.  Every write of ``al_state`` goes through :meth:`enter_state`.
     al_changes = 0
+    #: counts the changes made from outside to what a slave's terminals see or how they are
+    #: wired (an IO slave's field inputs, its wires): a reader that found the bus at a fixed
+    #: point (the controller's runs of cycles at once) keeps it while this count stays
+    field_changes = 0
     #: the AL state (INIT at power-on); written only by :meth:`enter_state`
     al_state: AlState
 

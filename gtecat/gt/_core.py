@@ -392,17 +392,18 @@ def advance(ctl: Any, name: str, rc: int) -> int:
     mode = clock.mode
     if mode is _LOCKSTEP:  # (Clock.on_call does nothing in lockstep)
         return rc
-    if mode is _AUTO and clock.group is None:
+    if mode is _AUTO:
         # Clock.on_call in the common case, inline: the latency runs no cycle and no other
-        # clock shares this one's time
-        pending = clock._pending_ns + clock.call_latency_ns
-        if pending < clock.cycle_ns:
-            clock._pending_ns = pending
+        # clock shares this one's time (as the readers' C entries add it: centry.c latency)
+        q = clock.quick
+        pending = q[0] + q[1]
+        if q[3] and pending < q[2]:
+            q[0] = pending
             return rc
     try:
         if mode is _AUTO:
             with clock.lock:  # (its cycles: one thread's at a time, as a call's own)
-                clock.on_call()
+                clock.advance_ns(q[1])  # (Clock.on_call in the auto clock)
         else:  # (realtime: the call yields, the lock free for the cycle thread)
             clock.on_call()
     except Exception as e:
@@ -463,6 +464,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         """The call with its arguments bound (``core``: the core it addresses; ``gtn``: the
         ``GTN_`` twin was called)."""
         ctl = None
+        # (and before it: the cycles the call runs itself see what it changed before them -
+        # Controller._run_cycles keeps the bus's steadiness while the epoch stays)
+        EPOCH.n += 1
         try:
             if address or SESSION._remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call

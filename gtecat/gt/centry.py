@@ -27,6 +27,7 @@ import logging
 import struct
 import sys
 import types
+from array import array
 from collections.abc import Callable, Iterable
 from importlib import resources
 from typing import Any
@@ -77,10 +78,7 @@ class _Api(ctypes.Structure):
         ("gate", _VP),
         ("epoch_obj", _VP),
         ("epoch_off", ctypes.c_ssize_t),
-        ("clock_dicts", _VP),
-        ("clock_keys", _VP * 4),
-        ("dict_set", _VP),
-        ("from_ll", _VP),
+        ("clock_quick", _VP),
         ("ndarray_type", _VP),
         ("nd_data", ctypes.c_ssize_t),
         ("nd_nd", ctypes.c_ssize_t),
@@ -206,24 +204,23 @@ def set_gates(gt: int, gtn: int) -> None:
     EPOCH.n += 1
 
 
-#: per gate, the instance dictionary of its controller's clock where the gate says
-#: :data:`AUTO` (0: none): an entry adds the call's host latency there itself where that runs
-#: no cycle (gtecat.gt._core.advance's first branch), else calls its ``after``
-CLOCK_DICTS = (ctypes.c_ssize_t * 2)()
-#: the clock's attributes the entries read and write (the interned names its code uses)
-_CLOCK_KEYS = tuple(sys.intern(k) for k in ("_pending_ns", "call_latency_ns", "cycle_ns", "group"))
-_CLOCKS: list[Any] = [None, None]  # (the dictionaries, kept alive while named)
+#: per gate, where its controller's clock keeps the numbers of a call's host latency
+#: (``Clock.quick``) where the gate says :data:`AUTO` (0: none): an entry adds the call's
+#: latency there itself where that runs no cycle (gtecat.gt._core.advance's first branch),
+#: else calls its ``after``
+CLOCK_QUICK = (ctypes.c_ssize_t * 2)()
+_CLOCKS: list[Any] = [None, None]  # (their arrays, kept alive while named)
 
 
 def set_clocks(gt: Any, gtn: Any) -> None:
-    """The clocks behind the two gates (:data:`CLOCK_DICTS`; None: none), set while the gates
+    """The clocks behind the two gates (:data:`CLOCK_QUICK`; None: none), set while the gates
     are closed."""
     for k, clock in enumerate((gt, gtn)):
-        d = None if clock is None else vars(clock)  # (its dictionary, made if not yet)
-        if d is not None and not all(key in d for key in _CLOCK_KEYS):
-            d = None
-        _CLOCKS[k] = d
-        CLOCK_DICTS[k] = 0 if d is None else id(d)
+        q = getattr(clock, "quick", None)
+        if not (isinstance(q, array) and q.typecode == "q" and len(q) == 4):
+            q = None
+        _CLOCKS[k] = q
+        CLOCK_QUICK[k] = 0 if q is None else q.buffer_info()[0]
 
 
 def _epoch_at() -> int:
@@ -566,10 +563,7 @@ def _load() -> tuple[Maker | None, str]:
             ctypes.addressof(GATES),
             id(EPOCH),
             epoch_at,
-            ctypes.addressof(CLOCK_DICTS),
-            (_VP * 4)(*(id(k) for k in _CLOCK_KEYS)),
-            _address("PyDict_SetItem"),
-            _address("PyLong_FromLongLong"),
+            ctypes.addressof(CLOCK_QUICK),
             *numpy_at,
             _ND_WANT,
         )

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import threading
 import time
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -65,24 +66,64 @@ class Clock:
         if cycle_ns <= 0:
             raise ValueError("cycle time must be positive")
         self.mode = ClockMode(mode)
-        self.cycle_ns = int(cycle_ns)
-        self.call_latency_ns = int(call_latency_ns)
+        #: the numbers a call's host latency needs, in memory compiled code reads and writes
+        #: (the GT readers' C entries add the latency themselves where it runs no cycle:
+        #: gtecat.gt.centry): the latency accumulated since the last cycle (auto), the
+        #: latency of a call, the cycle time, 1 while the clock shares its time with no other
+        self.quick = array("q", (0, int(call_latency_ns), int(cycle_ns), 1))
         self._run_cycle = run_cycle
         #: the owner's way to run up to N cycles at once (returns the cycles it ran, 0: run
         #: the next one through ``run_cycle``); virtual time only, None: one by one
         self.run_many: Callable[[int], int] | None = None
         self.now_ns = 0  # controller time since power-on
         self.cycles = 0
-        self._pending_ns = 0  # auto mode: latency accumulated since the last cycle
         self.lock = threading.RLock()
         self.stats = CycleStats()
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         #: the clocks this one shares time with (None: it runs alone)
-        self.group: ClockGroup | None = None
+        self._group: ClockGroup | None = None
         #: called once cycles have run and their time is counted (the owner's: what was
         #: read of the time before may be stale now)
         self.counted: Callable[[], None] | None = None
+
+    @property
+    def cycle_ns(self) -> int:
+        return self.quick[2]
+
+    @cycle_ns.setter
+    def cycle_ns(self, ns: int) -> None:
+        if ns <= 0:
+            raise ValueError("cycle time must be positive")
+        self.quick[2] = int(ns)
+
+    @property
+    def call_latency_ns(self) -> int:
+        """The controller time one GT call costs in the auto clock (its host round trip)."""
+        return self.quick[1]
+
+    @call_latency_ns.setter
+    def call_latency_ns(self, ns: int) -> None:
+        self.quick[1] = int(ns)
+
+    @property
+    def _pending_ns(self) -> int:
+        """Auto mode: the latency accumulated since the last cycle."""
+        return self.quick[0]
+
+    @_pending_ns.setter
+    def _pending_ns(self, ns: int) -> None:
+        self.quick[0] = int(ns)
+
+    @property
+    def group(self) -> ClockGroup | None:
+        """The clocks this one shares time with (None: it runs alone)."""
+        return self._group
+
+    @group.setter
+    def group(self, group: ClockGroup | None) -> None:
+        self._group = group
+        self.quick[3] = group is None
 
     # --- virtual time ------------------------------------------------------
     def cycle(self) -> None:
@@ -98,25 +139,27 @@ class Clock:
         if self.mode is _REALTIME:
             self._sleep(max(0, ns) / 1e9)
             return 0
-        self._pending_ns += int(ns)
+        q = self.quick
+        q[0] += int(ns)
         n = 0
         many = self.run_many
-        while self._pending_ns >= self.cycle_ns:
+        while q[0] >= q[2]:
+            cycle_ns = q[2]
             if many is not None:
-                k = many(self._pending_ns // self.cycle_ns)
+                k = many(q[0] // cycle_ns)
                 if k:
-                    self._pending_ns -= k * self.cycle_ns
+                    q[0] -= k * cycle_ns
                     self.cycles += k
-                    self.now_ns += k * self.cycle_ns
+                    self.now_ns += k * cycle_ns
                     if self.counted is not None:
                         self.counted()
                     n += k
                     continue
-            self._pending_ns -= self.cycle_ns
+            q[0] -= cycle_ns
             self.cycle()
             n += 1
-        if self.group is not None:
-            self.group.share(self, int(ns))
+        if self._group is not None:
+            self._group.share(self, int(ns))
         return n
 
     def advance(self, ms: float) -> int:
@@ -126,8 +169,8 @@ class Clock:
         """A GT call happened: in ``auto`` mode it costs virtual latency; in ``realtime``
         the caller yields the interpreter, so a tight polling loop cannot starve the
         cycle thread (the call itself ran with the cycle lock held)."""
-        if self.mode is ClockMode.AUTO and self.call_latency_ns:
-            self.advance_ns(self.call_latency_ns)
+        if self.mode is ClockMode.AUTO and self.quick[1]:
+            self.advance_ns(self.quick[1])
         elif self.mode is ClockMode.REALTIME:
             time.sleep(0)
 

@@ -66,12 +66,10 @@ struct api {
     obj epoch_obj;
     ptrdiff_t epoch_off;
     /* the auto clock's host latency in the common case (gtecat.gt._core.advance's first
-     * branch): per gate the instance dict of its controller's clock (0: none, after()
-     * runs it), the keys _pending_ns, call_latency_ns, cycle_ns and group */
-    const ptrdiff_t *clock_dicts;
-    obj clock_keys[4];
-    int (*dict_set)(obj, obj, obj);  /* PyDict_SetItem */
-    obj (*from_ll)(long long);       /* PyLong_FromLongLong */
+     * branch): per gate the numbers of its controller's clock (Clock.quick: the latency
+     * pending, a call's latency, the cycle time, 1 while it shares its time with no other
+     * clock), 0: none (after() runs it) */
+    const ptrdiff_t *clock_quick;
     /* numpy's arrays (numpy's public PyArrayObject fields, probed): the type, where an array
      * keeps its data, its number of dimensions (int), its dimensions, its dtype and its flags
      * (int); the flags a one-dimensional array an entry writes must have */
@@ -146,9 +144,7 @@ int gtecat_centry_api(const struct api *api)
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear || !api->gate || !api->epoch_obj ||
-        api->epoch_off <= 0 || !api->clock_dicts || !api->clock_keys[0] ||
-        !api->clock_keys[1] || !api->clock_keys[2] || !api->clock_keys[3] || !api->dict_set ||
-        !api->from_ll)
+        api->epoch_off <= 0 || !api->clock_quick)
         return 1;
     A = *api;
     ready = 1;
@@ -277,33 +273,19 @@ static int ll_of(obj o, long long *v)
 }
 
 /* The auto clock's host latency where it runs no cycle, as advance() does it first: the
- * clock's _pending_ns grows by call_latency_ns while that stays below cycle_ns and the clock
- * shares no time (group None).  1: done; 0: after() must run it (a cycle is due, or any
- * doubt). */
+ * clock's pending latency grows by a call's while that stays below the cycle time and the
+ * clock shares its time with no other.  1: done; 0: after() must run it (a cycle is due, or
+ * any doubt). */
 static int latency(ptrdiff_t gate)
 {
-    obj d = (obj)A.clock_dicts[gate - 1], n;
-    long long pend, lat, cyc;
-    int r;
-    if (!d || TYPE(d) != A.dict_type || A.dict_get(d, A.clock_keys[3]) != A.none)
+    long long *q = (long long *)A.clock_quick[gate - 1];
+    long long pend;
+    if (!q || !q[3])
         return 0;
-    if (!ll_of(A.dict_get(d, A.clock_keys[0]), &pend) ||
-        !ll_of(A.dict_get(d, A.clock_keys[1]), &lat) ||
-        !ll_of(A.dict_get(d, A.clock_keys[2]), &cyc))
+    pend = q[0] + q[1];
+    if (q[0] < 0 || q[1] < 0 || pend >= q[2])
         return 0;
-    if (pend < 0 || lat < 0 || pend > cyc || pend + lat >= cyc)
-        return 0;
-    n = A.from_ll(pend + lat);
-    if (!n) {
-        A.err_clear();
-        return 0;
-    }
-    r = A.dict_set(d, A.clock_keys[0], n);
-    A.decref(n);
-    if (r) {
-        A.err_clear();
-        return 0;
-    }
+    q[0] = pend;
     return 1;
 }
 
