@@ -2294,9 +2294,9 @@ class AxisBank:
                 finally:
                     if self.alive[r] and self.groups[self.group_of[r]].claimed:
                         if r in self._open:  # (its axis objects stay as step_claimed has them)
-                            res = self.res[r]
-                            axis = (self.axes[r], res.profile.planner, res.encoder, res.band)
-                            objs = tuple(o for o in objs if all(o is not a for a in axis))
+                            ch = self.csp.channels[r]
+                            probe = _get(ch, "probe")
+                            objs = tuple(o for o in objs if o is ch or o is probe)
                         _reguard(objs)
         finally:
             _Bypass.on = False
