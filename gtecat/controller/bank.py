@@ -255,6 +255,7 @@ _OWNER: dict[int, tuple[AxisBank, int]] = {}  # id(object) -> (bank, group index
 #: again by a later object only costs that object its quick attribute reads)
 _OWN_DICT: set[int] = set()
 _GUARDS: dict[type, type] = {}
+_GUARD_SET: set[type] = set()  # (the values of _GUARDS: a guarded object's class is one)
 _get, _set = object.__getattribute__, object.__setattr__
 
 
@@ -292,6 +293,7 @@ def _guard_class(cls: type) -> type:
             },
         )
         _GUARDS[cls] = g
+        _GUARD_SET.add(g)
     return g
 
 
@@ -299,15 +301,15 @@ def _unguard(objs: tuple) -> None:
     """The guarded ones of ``objs`` back in their own classes (their claim stays)."""
     for obj in objs:
         cls = type(obj)
-        if _GUARDS.get(cls.__mro__[1]) is cls:
-            _set(obj, "__class__", cls.__mro__[1])
+        if cls in _GUARD_SET:
+            _set(obj, "__class__", cls.__base__)
 
 
 def _reguard(objs: tuple) -> None:
     """``objs`` guarded again (their dicts are their own since their claim)."""
     for obj in objs:
         cls = type(obj)
-        if _GUARDS.get(cls.__mro__[1]) is not cls:
+        if cls not in _GUARD_SET:
             _set(obj, "__class__", _guard_class(cls))
 
 
@@ -1485,8 +1487,8 @@ class AxisBank:
             for obj in self._guarded_objects(g):
                 _OWNER.pop(id(obj), None)
                 cls = type(obj)
-                if cls in _GUARDS.values():
-                    _set(obj, "__class__", cls.__mro__[1])
+                if cls in _GUARD_SET:
+                    _set(obj, "__class__", cls.__base__)
             g.claimed = False
             self._g_claimed[self._gi[id(g)]] = False
         self.csp.store(rows)

@@ -458,7 +458,7 @@ class SmartHome:
         each gives the axis back before its cycle), no flag latched, no call touched it
         (that too gives it back), so the loop would only look and wait again.  The count
         ends before the cycle that takes the move's end sample (:meth:`AxisBank.trap_quiet`)."""
-        if not self._waiting or self._failing or self._gen is None or bank is None:
+        if not self._wait or self._failing or self._gen is None or bank is None:
             return None
         trigger = self._trigger
         foreign = self._watching and trigger is not self.unit
