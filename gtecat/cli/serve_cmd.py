@@ -57,8 +57,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--cycle-us",
-        type=_positive(int),
-        help="slave cycle for --step cycle (default: ENI, else 1000)",
+        type=_cycle_ns,
+        dest="cycle_ns",
+        metavar="US",
+        help="slave cycle for --step cycle, 31.25..1000000 us as in an ENI "
+        "(default: the ENI's, else 1000)",
     )
     p.add_argument(
         "--sm-watchdog",
@@ -126,6 +129,16 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         "description's own [[fault]] tables are armed too)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="log what the slaves do")
+
+
+def _cycle_ns(text: str) -> int:
+    """An argparse type: a cycle in microseconds, in the ENI's range -> nanoseconds."""
+    from gtecat.eni.limits import RangeError, cycle_ns_from_us
+
+    try:
+        return cycle_ns_from_us(text, "the cycle")
+    except RangeError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _positive(kind: type[int] | type[float]):
@@ -291,7 +304,7 @@ def run(args: argparse.Namespace) -> int:
         for esc in chain.escs:
             if esc.slave.has_mailbox:
                 esc.foe.files[name] = content
-    cycle_ns = (args.cycle_us * 1000) if args.cycle_us else (config.cycle_time_ns or 1_000_000)
+    cycle_ns = args.cycle_ns or config.cycle_time_ns or 1_000_000
     if interface_is_up(args.iface) is False:
         print(f"warning: interface {args.iface} is down", file=sys.stderr)
     from gtecat.master.pcap import PcapWriter

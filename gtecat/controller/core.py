@@ -58,6 +58,7 @@ from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
 from ..master.clock import Clock, ClockMode
 from ..master.masterlog import MasterLog
+from . import clock_options
 from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
@@ -138,7 +139,8 @@ class Controller:
     bus_opening_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - likewise
 
     def __init__(self, options: Options | None = None) -> None:
-        self.options = (options or Options()).resolved()
+        # (the clock options checked here too, for a controller made without GT_Open)
+        self.options = clock_options.check((options or Options()).resolved())
         try:
             mode = ClockMode(self.options.clock)
         except ValueError:
@@ -453,10 +455,10 @@ class Controller:
                         return 0
                     n = q
         master = self.master
-        if master is None:
+        if master is None or master.on_cycle:  # (the master's hooks: not kept, asked here)
             return 0
         clock = self.clock
-        seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.field_changes)
+        seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
         if (settled or seen != self._steady_seen) and not master.steady():
             return 0
         done = bank.run_cycles(clock.now_ns, clock.cycle_ns, n)
@@ -493,12 +495,13 @@ class Controller:
     BATCH_CYCLES = 1000
     #: what the next run of cycles finds when nothing but runs of cycles happened since the
     #: last one (:meth:`_run_cycles`): the readers' epoch grown once by the clock's count of
-    #: the run (``Clock.counted``), the clock's cycles, the slaves' AL changes and field
+    #: the run (``Clock.counted``), the clock's cycles, the slaves' AL changes and outside
     #: changes as they were.  Then the bus is as steady as the last run found it: the bank's
     #: compiled cycles touch none of what :meth:`Master.steady` looks at (the IO slaves'
     #: areas, the states, the hooks), and every other change makes one of the four grow
-    #: (a GT call, a raw write, a fault, an endpoint request, an AL change, an IO slave's
-    #: field inputs or wires set).
+    #: (a GT call, a raw write, a fault, an endpoint request, an AL change, a change from
+    #: outside a slave's cycle: its field inputs or wires, an emergency queued) or is asked
+    #: at every run (the master's ``on_cycle`` hooks).
     _steady_seen: tuple[int, int, int, int] = (0, 0, 0, 0)
     #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
     _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
@@ -507,10 +510,13 @@ class Controller:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
         while they are offline; mark the others reachable again."""
         down = False
+        bank = self.bank
         for ax in self._axis_list:
             reason = offline.get(ax.io.slave, "")
             if reason:
                 down = True
+                if bank is not None:  # (a row of the bank: its objects speak for it from now)
+                    bank.release_axis_object(ax)
                 if not ax.link_lost:
                     self.log(
                         f"Axis {ax.number}: {reason}; motion stopped, servo off, "

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from gtecat.eni.bits import get_bits, set_bits
 from gtecat.eni.model import Direction, Identity, Pdo
@@ -62,6 +63,19 @@ def _place(
     return points
 
 
+class FieldInputs(bytearray):
+    """What an IO slave's terminals see on their inputs.  Written from outside the slave's
+    cycle (:meth:`IoSlave.set_input`, a test's ``slave.field_inputs[0] = 0x3C``, a fault),
+    each write counts as a change of the bus (:attr:`VirtualSlave.outside_changes`): a
+    controller that found the bus at a fixed point looks again."""
+
+    __slots__ = ()
+
+    def __setitem__(self, key: Any, value: Any) -> None:
+        bytearray.__setitem__(self, key, value)
+        VirtualSlave.outside_changes += 1
+
+
 class IoSlave(VirtualSlave):
     """A generic IO slave driven by its PDO mapping.
 
@@ -93,12 +107,27 @@ class IoSlave(VirtualSlave):
             for d, pdos in ((Direction.OUT, self.rx_pdos), (Direction.IN, self.tx_pdos))
         )
         self.field_inputs = bytearray(len(self.tx))  # what the terminals see on their inputs
+        #: input bits a fault holds (a stuck input): bit -> 0 or 1, laid over the field inputs
+        #: on their way to ``tx`` (after the wires); the field inputs stay what the field puts
+        #: there, so an input let go reads the field's value at once (:meth:`hold_input_bit`)
+        self.held: dict[int, int] = {}
+        self._held_masks: tuple[bytes, bytes] | None = None
         self.field_outputs = bytearray(len(self.rx))  # what the terminals drive
         self._wires: list[tuple[int, int]] = []  # (output bit, input bit) in rx/tx numbering
         self._wire_plan: list[tuple[int, int, int, int]] | None = None  # see _plan_wires
 
     def pdo_sizes(self) -> tuple[int, int]:
         return (sum(p.bit_len for p in self.rx_pdos), sum(p.bit_len for p in self.tx_pdos))
+
+    @property
+    def field_inputs(self) -> FieldInputs:
+        """What the terminals see on their inputs (:class:`FieldInputs`)."""
+        return self._field_inputs
+
+    @field_inputs.setter
+    def field_inputs(self, value: Any) -> None:
+        self._field_inputs = FieldInputs(value)
+        VirtualSlave.outside_changes += 1
 
     # --- field side -----------------------------------------------------------
     def point(self, direction: Direction, index: int, subindex: int) -> IoPoint:
@@ -119,14 +148,40 @@ class IoSlave(VirtualSlave):
         """Set what the terminal reads on an input object (reported from the next cycle)."""
         p = self.point(Direction.IN, index, subindex)
         set_bits(self.field_inputs, p.bit, p.bits, int(value))
-        VirtualSlave.field_changes += 1
 
     def get_output_bit(self, bit: int) -> bool:
         return bool(get_bits(self.field_outputs, bit, 1))
 
     def set_input_bit(self, bit: int, on: bool) -> None:
         set_bits(self.field_inputs, bit, 1, int(bool(on)))
-        VirtualSlave.field_changes += 1
+
+    def hold_input_bit(self, bit: int, value: int | None) -> None:
+        """Hold input bit ``bit`` at ``value`` whatever the field puts there (a stuck input,
+        a broken terminal), or let it go (``value`` None): from the next cycle ``tx`` carries
+        the held value, then the field's again.  What the field puts there meanwhile
+        (:meth:`set_input_bit`, a wire) is kept in the field inputs underneath."""
+        if value is None:
+            self.held.pop(int(bit), None)
+        else:
+            self.held[int(bit)] = int(bool(value))
+        self._held_masks = None
+        VirtualSlave.outside_changes += 1
+
+    def _inputs(self) -> bytes | bytearray:
+        """What ``tx`` carries: the field inputs with the held bits laid over them."""
+        fi = self._field_inputs
+        if not self.held:
+            return fi
+        masks = self._held_masks
+        if masks is None or len(masks[0]) != len(fi):
+            keep, put = bytearray(b"\xff" * len(fi)), bytearray(len(fi))
+            for bit, v in self.held.items():
+                if 0 <= bit < 8 * len(fi):  # (a bit a new mapping no longer has: none)
+                    keep[bit >> 3] &= ~(1 << (bit & 7)) & 0xFF
+                    put[bit >> 3] |= v << (bit & 7)
+            masks = self._held_masks = (bytes(keep), bytes(put))
+        keep, put = masks
+        return bytes((b & k) | q for b, k, q in zip(fi, keep, put, strict=True))
 
     def wire(self, out_bit: int, in_bit: int) -> None:
         """Connect output bit ``out_bit`` (rx numbering) to input bit ``in_bit`` (tx numbering)."""
@@ -136,7 +191,7 @@ class IoSlave(VirtualSlave):
             raise ValueError(f"slave {self.position}: no input bit {in_bit}")
         self._wires.append((out_bit, in_bit))
         self._wire_plan = None
-        VirtualSlave.field_changes += 1
+        VirtualSlave.outside_changes += 1
 
     def wire_objects(
         self, out: tuple[int, int], inp: tuple[int, int], bits: int | None = None
@@ -172,7 +227,7 @@ class IoSlave(VirtualSlave):
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 fi[ib] = (fi[ib] & ~mask) | (v & mask)
         if self.al_state >= _SAFEOP:
-            self.tx[:] = self.field_inputs
+            self.tx[:] = self._inputs()
 
     def settled(self) -> bool:
         """A :meth:`step` now would change nothing (its outputs reached the field, the wires
@@ -194,7 +249,7 @@ class IoSlave(VirtualSlave):
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 if (fi[ib] ^ v) & mask:
                     return False
-        return self.al_state < _SAFEOP or self.tx == fi
+        return self.al_state < _SAFEOP or self.tx == (fi if not self.held else self._inputs())
 
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires

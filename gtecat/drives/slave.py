@@ -100,10 +100,10 @@ class VirtualSlave:
     #: the states (``EmulatedBackend.steady``: every claimed slave in OP) keeps it while the
     #: count stays the same.  Every write of ``al_state`` goes through :meth:`enter_state`.
     al_changes = 0
-    #: counts the changes made from outside to what a slave's terminals see or how they are
-    #: wired (an IO slave's field inputs, its wires): a reader that found the bus at a fixed
-    #: point (the controller's runs of cycles at once) keeps it while this count stays
-    field_changes = 0
+    #: counts the changes made to a slave from outside its cycle (an IO slave's field inputs
+    #: and wires, an emergency queued): a reader that found the bus at a fixed point (the
+    #: controller's runs of cycles at once) keeps that while this count stays
+    outside_changes = 0
     #: the AL state (INIT at power-on); written only by :meth:`enter_state`
     al_state: AlState
 
@@ -133,6 +133,7 @@ class VirtualSlave:
     def emit_emergency(self, code: int, register: int, data: bytes = bytes(5)) -> None:
         """Queue a CoE emergency; the master fetches it (and logs it like IgH does)."""
         self.emergencies.append(Emergency(code, register, bytes(data[:5]).ljust(5, b"\0")))
+        VirtualSlave.outside_changes += 1
 
     # --- hooks -------------------------------------------------------------
     def pdo_sizes(self) -> tuple[int, int]:

@@ -7,6 +7,15 @@ end, chattering switches toggle, stuck IO inputs are held.  Mailbox requests pas
 :meth:`mailbox` (a stand-in in front of every slave's mailbox), cyclic answers
 :meth:`answer` (emulated) or :meth:`frame` (wire).  Every start and end is written to the
 master log (``fault 3 started: ...``) and kept in :attr:`events` (recordings read them).
+
+A stuck IO input (``io_stuck``) holds the input bit at its value over what the field puts
+there (``IoSlave.hold_input_bit``: laid over the field inputs on their way to the process
+data, after the wires); when the fault ends (its ``duration_ms`` over, or cleared) the input
+is let go: it reads what the field puts there *now* - the value it had before the fault,
+unless something set it meanwhile (the slave's ``set_input_bit`` / ``set_input``, the
+``gtecat`` field verbs, a wire from an output, a write of its ``field_inputs``), which the
+field inputs underneath kept.  Of several faults on one bit the one added last holds it; the
+bit is let go when the last of them ends.
 """
 
 from __future__ import annotations
@@ -226,10 +235,6 @@ class Injector:
                     on = (self._chatter_cycle // f.period_cycles) % 2 == 0
                     ff.din_set = (ff.din_set | bit) if on else (ff.din_set & ~bit)
                     ff.din_clear = (ff.din_clear & ~bit) if on else (ff.din_clear | bit)
-            elif isinstance(f, k.IoStuck):
-                s = self.bus.slave(f.slave)
-                if isinstance(s, IoSlave):
-                    s.set_input_bit(f.bit, bool(f.value))
         if any(e.state == "ended" for e in self.entries):
             self.entries = [e for e in self.entries if e.state != "ended"]
         self._refresh()  # what the next cycle's triggers may change
@@ -410,9 +415,7 @@ class Injector:
             ff.probe_off = True
             ff.din_clear |= 3 << 16
         elif isinstance(f, k.IoStuck):
-            s = bus.slave(f.slave)
-            if isinstance(s, IoSlave):
-                s.set_input_bit(f.bit, bool(f.value))
+            self._hold(f.slave, f.bit)
         # the cyclic answers pass the injector from now on (a frame fault); a trigger that
         # watched an axis no longer does
         self._refresh()
@@ -458,6 +461,8 @@ class Injector:
             ff = bus.override(f.axis)
             ff.probe_off = False
             ff.din_clear &= ~(3 << 16)
+        elif isinstance(f, k.IoStuck):
+            self._hold(f.slave, f.bit)
         axis = getattr(f, "axis", None)
         if axis is not None and f.depth in ("drive", "field"):
             bus.forget_override(axis)
@@ -469,6 +474,27 @@ class Injector:
             e.left -= 1
             if e.left == 0:
                 self._end(e, "spent")
+
+    # --- stuck IO inputs -------------------------------------------------------------------------
+    def _hold(self, slave: int, bit: int) -> None:
+        """Input ``bit`` of ``slave`` held at the value of the active stuck fault on it added
+        last, or let go when none is left (module docstring)."""
+        value = None
+        for e in self.entries:
+            f = e.fault
+            if (
+                e.state == "active"
+                and isinstance(f, k.IoStuck)
+                and (f.slave, f.bit)
+                == (
+                    slave,
+                    bit,
+                )
+            ):
+                value = int(bool(f.value))
+        s = self.bus.slave(slave)
+        if isinstance(s, IoSlave):
+            s.hold_input_bit(bit, value)
 
     # --- AL errors ------------------------------------------------------------------------------
     def _latch(self, f: k.AlError) -> None:

@@ -488,6 +488,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     if bank is not None and not bank_read:
                         bank.before_call(ctl, proto, values)  # the axes it names go back first
                     rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
+                    # (and once more below: another thread's cycles, once the lock is free,
+                    # see what the call changed - Controller._run_cycles)
+                    EPOCH.n += 1
             else:
                 rc = fn(*values, **extra) if extra else fn(*values)
             if rc is None:

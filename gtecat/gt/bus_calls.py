@@ -50,6 +50,7 @@ from gtecat.drives.abort import SdoAbort
 from gtecat.drives.slave import AlState
 
 from .. import __version__
+from ..controller import clock_options
 from ..controller.cards import options_for
 from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
@@ -122,7 +123,12 @@ def GT_Open(
     ``pcap="bus.pcap"`` (GTECAT_PCAP) writes the frames the emulated bus stands for.
 
     ``card="gts:4"`` (GTECAT_CARD) opens a GTS pulse card with 4 axes instead of an
-    EtherCAT master (:mod:`gtecat.controller.card`)."""
+    EtherCAT master (:mod:`gtecat.controller.card`).
+
+    ``cycle_ms`` (0.03125..1000, the cycles an ENI may give; None: the ENI's, else 1 ms)
+    and ``call_latency_us`` (0 or 0.001..1000000) are checked here, before anything opens:
+    a bad one returns 7 naming it, its value and its range
+    (:mod:`gtecat.controller.clock_options`)."""
     card_kind, card = card, SESSION.card
     if 1 in SESSION.controllers:
         fail(
@@ -130,7 +136,7 @@ def GT_Open(
             (f"card {card} is" if card else "the controller is")
             + " already open (GT_Open called twice; call GT_Close first)",
         )
-    explicit = Options(
+    explicit = Options(  # (the clock options come from these keywords alone: checked here)
         eni=eni,
         machine=machine,
         clock=clock,
@@ -146,6 +152,7 @@ def GT_Open(
         pcap=pcap,
         bank=bank,
     )
+    explicit = clock_options.check(explicit)
     if card == 0 or SESSION.base_options is None:
         opts = SESSION.base_options = explicit.resolved()
         if card:

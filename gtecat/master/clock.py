@@ -63,7 +63,7 @@ class Clock:
         mode: ClockMode | str = ClockMode.AUTO,
         call_latency_ns: int = 50_000,
     ) -> None:
-        if cycle_ns <= 0:
+        if int(cycle_ns) <= 0:
             raise ValueError("cycle time must be positive")
         self.mode = ClockMode(mode)
         #: the numbers a call's host latency needs, in memory compiled code reads and writes
@@ -93,9 +93,10 @@ class Clock:
 
     @cycle_ns.setter
     def cycle_ns(self, ns: int) -> None:
+        ns = int(ns)
         if ns <= 0:
             raise ValueError("cycle time must be positive")
-        self.quick[2] = int(ns)
+        self.quick[2] = ns
 
     @property
     def call_latency_ns(self) -> int:

@@ -61,6 +61,7 @@ from typing import Any
 from gtecat.eni.errors import GtecatError
 
 from .. import scheduling
+from ..controller.epoch import changed as readers_changed
 from ..gt import _core, declared
 from ..gt.fast import READERS, wire_reader
 from ..inspect import endpoint as _inspect
@@ -936,6 +937,9 @@ class Server:
                 except Exception as e:  # a field operation never takes the controller down
                     log.exception("field operation %s failed", op)
                     status, result = 1, f"internal error in the emulator: {type(e).__name__}: {e}"
+                # (an SDO download, a register write, an input set: what the readers answer
+                # and whether the bus is steady may have changed - controller/epoch.py)
+                readers_changed()
         text = json.dumps(result, default=_jsonable).encode("utf-8")
         out = FIELD_REPLY.pack(status) + text
         return FRAME.pack(len(out)) + out

@@ -116,6 +116,7 @@ class EmulatedBackend(Backend):
             self._plan_of = plan
             self._plan_pos = [e[0].position for e in plan]
             self._plan_wkc = [2 * (o is not None) + (i is not None) for _, o, i in plan]
+            self._wkc_of = dict(zip(self._plan_pos, self._plan_wkc, strict=True))
             self._claimed_memo: dict[frozenset[int], tuple] = {}
         memo = self._claimed_memo.get(claimed)  # (the bank gives back and takes the same few)
         if memo is None:
@@ -140,10 +141,12 @@ class EmulatedBackend(Backend):
         """Cut the cable in front of ``position`` (a scenario's comm loss)."""
         self.unplugged.add(position)
         self._silent_ns[position] = 0
+        VirtualSlave.outside_changes += 1  # (a controller that found the bus steady looks again)
 
     def replug(self, position: int) -> None:
         self.unplugged.discard(position)
         self._silent_ns.pop(position, None)
+        VirtualSlave.outside_changes += 1
 
     def scan(self) -> list[FoundSlave]:
         found = []
@@ -206,6 +209,8 @@ class EmulatedBackend(Backend):
         assert image is not None
         wkc = self._claimed_wkc  # the bank's slaves, in OP
         unplugged = self.unplugged
+        if unplugged and self._claimed:  # (a bank's slave behind a pulled cable: no answer)
+            wkc -= sum(self._wkc_of[p] for p in unplugged if p in self._claimed)
         for slave, out, inp in self._run_plan:
             if unplugged and slave.position in unplugged:
                 # powered but cut off: it keeps running; its watchdog notices the silence
@@ -261,6 +266,9 @@ class EmulatedBackend(Backend):
             )
         if not seen[3]:
             return False
+        for s in self._claimed_slaves:  # an emergency the bank's drive queued: the master's
+            if s.emergencies:  # cycle fetches it (the bank runs no mailbox)
+                return False
         view = image.view
         for slave, o_start, o_bytes, i_start, i_bytes, o_view, i_view in plan[2]:
             if type(slave).step is not _IO_STEP or not slave.settled():
@@ -317,13 +325,17 @@ class EmulatedBackend(Backend):
         arrives once the cable is back (ETG.1000.6 5.6.4: an emergency is a mailbox
         message the master collects from the slave)."""
         out = []
-        claimed = self._claimed  # a claimed slave is not stepped: it raises none
+        claimed = self._claimed
         unplugged = self.unplugged
-        for slave in self.slaves if not claimed else (e[0] for e in self._run_plan):
+        # a claimed slave is not stepped here, but a scenario may queue one (emit_emergency)
+        stepped = (e[0] for e in self._run_plan)
+        for slave in self.slaves if not claimed else (*stepped, *self._claimed_slaves):
             if unplugged and slave.position in unplugged:
                 continue
             while slave.emergencies:
                 out.append((slave.position, slave.emergencies.popleft()))
+        if claimed and len(out) > 1:
+            out.sort(key=lambda e: e[0])  # (in the order of the bus, as without the bank)
         return out
 
     def expected_wkc(self) -> int:

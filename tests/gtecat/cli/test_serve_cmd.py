@@ -45,8 +45,13 @@ FIG52 = str(Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.en
 @pytest.mark.parametrize(
     ("args", "said"),
     [
-        (["--cycle-us", "-10"], "argument --cycle-us: -10 is not greater than 0"),
-        (["--cycle-us", "0"], "argument --cycle-us: 0 is not greater than 0"),
+        # the ENI's cycle range (31.25 us .. 1 s), from the one place it is written
+        (["--cycle-us", "-10"], "argument --cycle-us: the cycle -10 us is out of range: legal"),
+        (["--cycle-us", "0"], "argument --cycle-us: the cycle 0 us is out of range: legal"),
+        (["--cycle-us", "31"], "legal is 31.25..1000000 us"),
+        (["--cycle-us", "1e7"], "legal is 31.25..1000000 us"),
+        (["--cycle-us", "nan"], "the cycle nan us is out of range"),
+        (["--cycle-us", "x"], "the cycle 'x' is not a number of microseconds"),
         (["--duration", "-5"], "argument --duration: -5 is not greater than 0"),
         (["--duration", "nan"], "argument --duration: nan is not greater than 0"),
         (["--duration", "x"], "argument --duration: 'x' is not a number"),
@@ -111,3 +116,13 @@ def test_auto_scheduling_takes_fifo_where_permitted_and_is_given_back():
     finally:
         restore(before)
     assert snapshot() == before
+
+
+def test_a_cycle_in_the_enis_range_is_taken_in_nanoseconds() -> None:
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    serve_cmd.add_parser(parser.add_subparsers())
+    for text, ns in (("31.25", 31_250), ("250", 250_000), ("1000000", 10**9)):
+        args = parser.parse_args(["serve", "--iface", "lo", "--eni", "x", "--cycle-us", text])
+        assert args.cycle_ns == ns

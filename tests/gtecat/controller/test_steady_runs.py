@@ -62,3 +62,62 @@ def test_unplug_between_polls_is_seen(fig5_2):
         gt.GT_GetSts(1, byref(s))
     assert s.value & 0x2, hex(s.value)
     assert ctl.master.offline
+
+
+def _polls(n: int) -> int:
+    """``n`` reader polls (50 us of the auto clock each); the controller's clock after."""
+    s = c_long()
+    for _ in range(n):
+        gt.GT_GetSts(1, byref(s))
+    return gt.GTE_Controller().clock.now_ns
+
+
+def test_field_input_written_in_place_reaches_the_image(fig5_2):
+    """A test writing a terminal's input byte in place (``slave.field_inputs[0] = x``)."""
+    pos, slave = _io_slave(fig5_2)
+    _polls(200)
+    slave.field_inputs[0] = 0x3C
+    _polls(200)
+    buf = (c_ubyte * 1)()
+    assert gt.GT_EcatIOReadInput(pos, len(slave.rx), 1, buf) == 0
+    assert buf[0] == 0x3C
+
+
+@pytest.mark.parametrize("which", ["io", "drive"])
+def test_an_emergency_queued_between_polls_is_fetched(fig5_2, which):
+    """``emit_emergency`` on an IO slave or on a drive the axis bank runs: the master fetches
+    and logs it at the next cycle (ETG.1000.6 5.6.4), as it does with the bank off."""
+    ctl = fig5_2
+    _polls(200)
+    slave = _io_slave(ctl)[1] if which == "io" else ctl.master.backend.slaves[0]
+    before = ctl.master.emergency_count
+    slave.emit_emergency(0x2310, 0x01)
+    _polls(200)
+    assert ctl.master.emergency_count == before + 1
+    assert not slave.emergencies
+    assert any("CoE EMERGENCY 0x2310" in line for line in ctl.log.lines)
+
+
+def test_a_master_hook_added_between_polls_runs_every_cycle(fig5_2):
+    ctl = fig5_2
+    _polls(200)
+    seen: list[int] = []
+    ctl.master.on_cycle.append(lambda m: seen.append(1))
+    t0 = ctl.clock.cycles
+    _polls(400)
+    assert len(seen) == ctl.clock.cycles - t0 > 0
+
+
+def test_a_cable_pulled_by_hand_in_front_of_a_banked_drive(fig5_2):
+    """``backend.unplug`` (a scenario's own comm loss) in front of a drive the bank runs: the
+    working counter falls, the axis alarms (GT_GetSts bit 1) as with the bank off."""
+    ctl = fig5_2
+    _polls(200)
+    assert ctl.bank.n_alive
+    ctl.master.backend.unplug(0)
+    s = c_long()
+    for _ in range(2000):
+        gt.GT_GetSts(1, byref(s))
+        if s.value & 0x2:
+            break
+    assert s.value & 0x2, hex(s.value)

@@ -1,5 +1,7 @@
 """Clock modes (DESIGN.md "Time"): lockstep, auto (host-call latency), run_until bounds."""
 
+import pytest
+
 from gtecat.master.clock import Clock, ClockMode
 
 
@@ -55,3 +57,14 @@ def test_a_group_of_clocks_shares_one_time():
     assert (a.cycles, b.cycles, a.group, b.group) == (8, 3, None, None)
     group.join(Clock(lambda: None, mode="realtime"))  # the wall clock is shared already
     assert group.clocks == [a]
+
+
+@pytest.mark.parametrize("ns", [0, 0.5, -1])
+def test_a_cycle_time_below_one_nanosecond_is_refused(ns):
+    """The cycle time is whole nanoseconds: 0.5 is 0, no cycle time (never stored)."""
+    clock = Clock(lambda: None, cycle_ns=1_000_000, mode=ClockMode.AUTO)
+    with pytest.raises(ValueError, match="positive"):
+        clock.cycle_ns = ns
+    assert clock.cycle_ns == 1_000_000
+    with pytest.raises(ValueError, match="positive"):
+        Clock(lambda: None, cycle_ns=ns, mode=ClockMode.AUTO)
