@@ -23,11 +23,13 @@ before anything else may look at or change them:
   drive staying in the bank); one naming a coordinate system
   releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
-* a cycle in which a claimed axis would leave the state (a limit, the following
-  error, a new sample past a soft limit, a raw write to its slave's outputs, the
+* a cycle in which a claimed axis would leave the state (a limit switch reached, the
+  following error, a new sample past a soft limit, a raw write to its slave's outputs, the
   drive's own following-error window, a travel reaching an edge its armed touch probe
   latches) releases it *before* that cycle, so the scalar code runs that cycle and every
-  later one until the axis is back in the common state;
+  later one until the axis is back in the common state; a drive standing or braking on a
+  limit switch whose flag is latched (a limit homing escaping from it, a profile stopped
+  there) stays in the compiled cycle, which runs the drive's reaction;
 * the field side (a fault injected, the machine moved, an SDO to the drive) releases
   the axis by touching one of its objects: while claimed they carry a guard class
   (:meth:`AxisBank._guarded_objects`) whose first attribute access gives the axis back;
@@ -264,6 +266,7 @@ _OWNER: dict[int, tuple[AxisBank, int]] = {}  # id(object) -> (bank, group index
 #: again by a later object only costs that object its quick attribute reads)
 _OWN_DICT: set[int] = set()
 _GUARDS: dict[type, type] = {}
+_GUARD_SET: set[type] = set()  # (the values of _GUARDS: a guarded object's class is one)
 _get, _set = object.__getattribute__, object.__setattr__
 
 
@@ -301,6 +304,7 @@ def _guard_class(cls: type) -> type:
             },
         )
         _GUARDS[cls] = g
+        _GUARD_SET.add(g)
     return g
 
 
@@ -308,15 +312,15 @@ def _unguard(objs: tuple) -> None:
     """The guarded ones of ``objs`` back in their own classes (their claim stays)."""
     for obj in objs:
         cls = type(obj)
-        if _GUARDS.get(cls.__mro__[1]) is cls:
-            _set(obj, "__class__", cls.__mro__[1])
+        if cls in _GUARD_SET:
+            _set(obj, "__class__", cls.__base__)
 
 
 def _reguard(objs: tuple) -> None:
     """``objs`` guarded again (their dicts are their own since their claim)."""
     for obj in objs:
         cls = type(obj)
-        if _GUARDS.get(cls.__mro__[1]) is not cls:
+        if cls not in _GUARD_SET:
             _set(obj, "__class__", _guard_class(cls))
 
 
@@ -388,7 +392,10 @@ class AxisBank:
         self.any_post = False
         #: the row a hook's step runs on in place (:meth:`step_claimed`), -1: none
         self._stepping = -1
+        #: rows a posted edge left open for the step after the cycle (:meth:`_post_event`)
+        self._open: set[int] = set()
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
+        self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
         self._lists: dict[str, list[Any]] = {}
         #: the flags the last list of GT_GetSts words was made from (a few rows) and that
         #: list: made again only when one changed (a move, a jog and a rest last many runs)
@@ -487,6 +494,7 @@ class AxisBank:
         """Rows for every axis whose slave the bank can run (mapping and backend)."""
         self.built = True
         self._tp_map = {}
+        self._tp_objects: set[tuple[int, int]] | None = None
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -831,7 +839,18 @@ class AxisBank:
             return False
         if not self._inputs_plain(ax, res):
             return False
-        return not drive or not claimable(self.csp.channels[r])
+        ch = self.csp.channels[r]
+        # a drive on a limit switch: the compiled cycle runs it (its reaction included) while
+        # the flag of each switch it stands on is latched (nothing new for the controller);
+        # the numpy cycle gives such a row back (a claimed row's 60FDh: the bank's)
+        on = (ch.digital_inputs if drive else int(self.csp.din[r])) & 3
+        if on:
+            if self.kernel is None:
+                return False
+            need = (_POS_LIMIT if on & 2 else 0) | (_NEG_LIMIT if on & 1 else 0)
+            if res.latched & need != need:
+                return False
+        return not drive or not claimable(ch, limits=self.kernel is not None)
 
     @staticmethod
     def _latched_standing(ax: Any, res: Any) -> bool:
@@ -1139,7 +1158,7 @@ class AxisBank:
         self.dpost[r] = 0
         if aware:
             self._aware[r] = aware
-        latched = res.latched
+        latched = int(res.latched)
         self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
         self.layout += 1
@@ -1162,8 +1181,8 @@ class AxisBank:
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
-        self._claims += 1
-        self.claim_ids[r] = self._claims
+        self._claims = claims = self._claims + 1
+        self.claim_ids[r] = claims
         b = res.band
         self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.since[r] = -1 if b._since is None else b._since
@@ -1225,7 +1244,7 @@ class AxisBank:
         self.frz[r] = frozen = not ax.servo_on
         # GT_GetSts's latched flags stay as they are while the row is in the bank
         # (_eligible_frozen, _latched_standing)
-        self.latched[r] = int(res.latched)
+        self.latched[r] = latched
         if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
             self._frozen[r] = (
                 tuple(getattr(ch, name) for name in FROZEN_ATTRS),
@@ -1252,12 +1271,11 @@ class AxisBank:
             # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
             self.csp.sw_const[r] += ch.hm_bits - SW12
             return
-        watch = int(self.dwatch[r])
         tp = bool(self.csp.tpw[r])
         if (
             (watch or tp)
-            and not self.sampled[r]
-            and not self.jog[r]
+            and not sampled
+            and not jog
             and len(self.groups[self.group_of[r]].rows) == 1
             and all(obj.bank_post_ready() for obj in aware)
         ):
@@ -1271,8 +1289,19 @@ class AxisBank:
         """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""
         got = self._tp_map.get(r)
         if got is None:
+            # (what ``io.get(i) is not None`` finds for one of them: the (slave, channel) pairs
+            # mapping one, from the layout's mapped objects once instead of a placement
+            # lookup per object and row)
+            pairs = self._tp_objects
+            if pairs is None:
+                tp = set(_TP_TX)
+                pairs = self._tp_objects = {
+                    (slave, (index - 0x6000) // CHANNEL_STRIDE)
+                    for slave, index in self.ctl.layout.mapped_objects()
+                    if 0x6000 <= index and 0x6000 + (index - 0x6000) % CHANNEL_STRIDE in tp
+                }
             io = self.axes[r].io
-            got = self._tp_map[r] = any(io.get(i) is not None for i in _TP_TX)
+            got = self._tp_map[r] = (io.slave, io.channel) in pairs
         return got
 
     def _keep_table(self, r: int, pl: TrapPlanner) -> None:
@@ -1469,8 +1498,8 @@ class AxisBank:
             for obj in self._guarded_objects(g):
                 _OWNER.pop(id(obj), None)
                 cls = type(obj)
-                if cls in _GUARDS.values():
-                    _set(obj, "__class__", cls.__mro__[1])
+                if cls in _GUARD_SET:
+                    _set(obj, "__class__", cls.__base__)
             g.claimed = False
             self._g_claimed[self._gi[id(g)]] = False
         self.csp.store(rows)
@@ -1512,6 +1541,7 @@ class AxisBank:
 
     def _store(self, r: int) -> None:
         self.alive[r] = False
+        self._open.discard(r)
         self.claim_ids[r] = 0
         self.res[r].bank = None
         self.layout += 1
@@ -1902,6 +1932,8 @@ class AxisBank:
         hit = a > self.soft_pos
         if din is not csp._din_zero:
             hit |= (din & 3) != 0
+        if csp.din is not csp._din_zero:  # on a limit before the cycle: its reaction is compiled
+            hit |= (csp.din & 3) != 0
         if self.any_watch:  # an input a bank-aware hook samples changes (kernel: dwatch)
             hit |= ((din ^ csp.din) & self.dwatch) != 0
         evt = ((din ^ csp.din) & self.dpost) != 0 if self.any_post else None
@@ -2210,6 +2242,15 @@ class AxisBank:
         prof = res.profile
         pl = prof.planner
         objs = (ax, pl, res.encoder, res.band)
+        if r in self._open:  # (a posted edge's: its objects hold its state, unguarded)
+            self._open.discard(r)
+            self._stepping = r
+            self.evt_rows.discard(r)
+            try:
+                self._step_claimed(r, g, step, pl, objs)
+            finally:
+                self._stepping = -1
+            return
         # (their guards off first: the row's state goes into them without a guard's Python
         # call on every attribute, as it would under _Bypass anyway)
         _unguard(objs)
@@ -2310,6 +2351,10 @@ class AxisBank:
                     self._post_event(r, csp, p0, t_ns, dt_ns)
                 finally:
                     if self.alive[r] and self.groups[self.group_of[r]].claimed:
+                        if r in self._open:  # (its axis objects stay as step_claimed has them)
+                            ch = self.csp.channels[r]
+                            probe = _get(ch, "probe")
+                            objs = tuple(o for o in objs if o is ch or o is probe)
                         _reguard(objs)
         finally:
             _Bypass.on = False
@@ -2334,10 +2379,46 @@ class AxisBank:
         ran = int(self.bank_cycles - self.claim_cycle[r])
         for obj in self._aware.pop(r, ()):
             obj.bank_posted(ran, t_ns, dt_ns)
+        self.evt_rows.add(r)
+        if self._stepped_after(r):
+            # a hook steps the row after this cycle (:meth:`step_claimed`), which puts its
+            # state into the same objects and takes it up from them: they hold it already,
+            # so the row stays open until then (its claim counted anew: a new claim)
+            self._open.add(r)
+            self._claims += 1
+            self.claim_ids[r] = self._claims
+            return
         was_moving = bool(self.moving[r])
         self._load(r, again=True)
         self._after_load(r, was_moving)
-        self.evt_rows.add(r)
+
+    def _stepped_after(self, r: int) -> bool:
+        """A ``post_cycle`` hook of the controller steps row ``r`` in place after this cycle
+        (``bank_steps_row(bank, r)`` on the hook's object says so: a smart homing waiting
+        for the edge its row's capture took; it then calls :meth:`step_claimed`)."""
+        for hook in self.ctl.post_cycle:
+            steps = getattr(getattr(hook, "__self__", None), "bank_steps_row", None)
+            if steps is not None and steps(self, r):
+                return True
+        return False
+
+    def close_open(self) -> None:
+        """The rows left open after a posted edge (:meth:`_post_event`) that no step took up:
+        taken from their objects again, as the post would have done."""
+        while self._open:
+            r = self._open.pop()
+            if not (self.alive[r] and self.groups[self.group_of[r]].claimed):
+                continue
+            res = self.res[r]
+            objs = (self.axes[r], res.profile.planner, res.encoder, res.band)
+            _Bypass.on = True
+            try:
+                was_moving = bool(self.moving[r])
+                self._load(r, again=True)
+                self._after_load(r, was_moving)
+            finally:
+                _Bypass.on = False
+            _reguard(objs)
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []

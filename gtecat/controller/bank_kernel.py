@@ -70,7 +70,7 @@ COLUMNS = {
 #: others the bank's own attributes of the same name)
 _SCRATCH = (
     "s_target s_raw s_a s_enc s_step s_pos s_vel s_acc s_dpos s_dvel s_fe s_lim s_swl "
-    "s_din s_since s_arr"
+    "s_din s_since s_arr s_lstop"
 ).split()
 
 _LIB: Any = None

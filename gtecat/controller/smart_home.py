@@ -93,6 +93,7 @@ status says the same); 7 for a parameter out of range.
 
 from __future__ import annotations
 
+import heapq
 import math
 import weakref
 from collections.abc import Callable, Generator
@@ -298,6 +299,7 @@ class SmartHome:
         self._q_due = 0
         self._q_claim = 0  # (0: none)
         self._q_row = 0
+        self._h_due = -1  # (_Homings._settle: its time in the heap, -1: none)
         #: what the last step saw of what a call may change (:meth:`quiet`)
         self._seen_latched = -1
         self._seen_changes: tuple[int, int] = (-1, -1)
@@ -307,6 +309,8 @@ class SmartHome:
         self._seen_gpi = -1
         #: the leg under way watches the trigger (its capture, its level or a GPI)
         self._watching = False
+        #: the direction whose limit the wait under way looks at (0: none, a stop)
+        self._dir = 0
 
     @property
     def running(self) -> bool:
@@ -454,7 +458,7 @@ class SmartHome:
         each gives the axis back before its cycle), no flag latched, no call touched it
         (that too gives it back), so the loop would only look and wait again.  The count
         ends before the cycle that takes the move's end sample (:meth:`AxisBank.trap_quiet`)."""
-        if not self._waiting or self._failing or self._gen is None or bank is None:
+        if not self._wait or self._failing or self._gen is None or bank is None:
             return None
         trigger = self._trigger
         foreign = self._watching and trigger is not self.unit
@@ -482,7 +486,9 @@ class SmartHome:
         trap = prof.trap
         if _get(trap, "stopping") != StopKind.NONE or _get(trap, "_target") != self._expect:
             return None
-        if not _get(res.ax, "servo_on") or self._limit(1) or self._limit(-1):
+        # (a limit behind the move - the one a limit homing leaves - ends no wait: the bank
+        # gives the row back when a limit becomes active, or when a latched one's is not)
+        if not _get(res.ax, "servo_on") or (self._dir and self._limit(self._dir)):
             return None
         return bank.trap_quiet(r)
 
@@ -815,6 +821,7 @@ class SmartHome:
         if levels is not None:
             levels.watch_level(True)
         self._watching = watch is not None
+        self._dir = d
         self._waiting = True
         try:
             while True:
@@ -830,6 +837,7 @@ class SmartHome:
                     return "end", None
         finally:
             self._waiting = self._watching = False
+            self._dir = 0
             if levels is not None:
                 levels.watch_level(False)
 
@@ -867,6 +875,7 @@ class SmartHome:
         self._begin(d, target, vel)
         bit = _POS if d > 0 else _NEG
         before = self.res.latched & bit
+        self._dir = d
         self._waiting = True
         try:
             while True:
@@ -878,6 +887,7 @@ class SmartHome:
                     return
         finally:
             self._waiting = False
+            self._dir = 0
 
     def _limit(self, d: int) -> bool | None:
         """The limit input in direction ``d``: as wired (module docstring, "Limits"), else
@@ -946,15 +956,39 @@ class _Homings:
         self._seen = -1
         #: the last look found a homing that steps every cycle (:meth:`quiet_cycles`)
         self._stepping = True
+        #: (time, count, homing): when each quiet homing looks again (:meth:`_settle`)
+        self._heap: list[tuple[int, int, SmartHome]] = []
+        self._seq = 0
+        #: the homings not found quiet, those watching another axis's capture, and each
+        #: homing's bank row, as the last look at all of them found them
+        self._busy: list[SmartHome] = []
+        self._foreign: list[SmartHome] = []
+        self._by_row: dict[int, SmartHome] = {}
+        self._rows: dict[int, int] | None = None  # (the bank's rows they were found for)
+
+    def bank_steps_row(self, bank: Any, r: int) -> bool:
+        """The axis bank's row ``r`` had an edge posted in this cycle: its homing steps it
+        after the cycle (:meth:`_settle`: a waiting homing whose row had an event is never
+        quiet), so the bank may leave the row open for that step (AxisBank._post_event)."""
+        home = _HOMES.get(bank.res[r])
+        return (
+            home is not None
+            and home._gen is not None
+            and not home._failing
+            and home in self.running
+            and home.res.bank is bank
+        )
 
     def add(self, home: SmartHome) -> None:
         if home not in self.running:
             self.running.append(home)
         self._seen = -1
+        self._rows = None
 
     def clear(self) -> None:
         self.running.clear()
         self._seen = -1
+        self._rows = None
 
     def cycle(self, t: int, dt: int) -> None:
         """After the cycle that started at ``t``: step every homing that may have to."""
@@ -969,6 +1003,8 @@ class _Homings:
             if not bank.evt_rows:
                 return  # nothing to do for any of them in this cycle
         self._settle(bank, t + dt, step=True)
+        if bank is not None and bank._open:
+            bank.close_open()  # (an open row whose homing did not step: as the post leaves it)
 
     def quiet_cycles(self, n: int) -> int:
         """How many of the next ``n`` cycles no homing has anything to do in."""
@@ -993,14 +1029,54 @@ class _Homings:
 
     def _settle(self, bank: Any, t_next: int, step: bool) -> None:
         """Find :attr:`_due` for the cycles from the one starting at ``t_next``; ``step``:
-        step the homings that may have something to do in the cycle that just ran."""
+        step the homings that may have something to do in the cycle that just ran.
+
+        A homing found quiet up to some cycle, on a claim of its row that is still the row's,
+        has nothing to look at before then.  While the bank has released nothing since the
+        last look (a release may have given any row back and a claim taken it again), only
+        these look again: the ones due by now (:attr:`_heap`: each quiet homing's time, older
+        entries left behind and skipped), the ones not found quiet (:attr:`_busy`), the ones
+        whose rows had an event in the bank this cycle (a posted edge: a new claim) and the
+        ones watching another axis's capture; the others keep their times, unlooked at."""
         dt = self._ref().clock.cycle_ns
         seen = bank.releases if bank is not None else -1
         ids = bank.claim_ids if bank is not None else ()
         t_prev = t_next - dt
-        due = None
-        stepping = False  # some homing steps every cycle (not found quiet)
-        for home in list(self.running):
+        heap = self._heap
+        rows = getattr(bank, "_row_of", None)
+        if bank is not None and self._seen == seen and self._rows is rows is not None:
+            visit = self._busy
+            for home in visit:
+                home._h_due = -1  # (looked at once)
+            while heap and heap[0][0] <= t_prev:
+                d, _, home = heapq.heappop(heap)
+                if home._h_due == d and home._gen is not None:
+                    home._h_due = -1
+                    visit.append(home)
+            for home in self._foreign:
+                if home._h_due != -1 and home._gen is not None:
+                    home._h_due = -1
+                    visit.append(home)
+            if bank.evt_rows:
+                by_row = self._by_row
+                for r in bank.evt_rows:
+                    home = by_row.get(r)
+                    if home is not None and home._h_due != -1 and home._gen is not None:
+                        home._h_due = -1
+                        visit.append(home)
+        else:
+            visit = list(self.running)
+            heap.clear()
+            self._foreign = [h for h in visit if h._trigger is not h.unit]
+            # every homing's row, claimed now or later (the bank's rows: fixed when built)
+            self._rows = rows
+            self._by_row = (
+                {}
+                if rows is None
+                else {rows[id(h.res.ax)]: h for h in visit if id(h.res.ax) in rows}
+            )
+        busy: list[SmartHome] = []  # not found quiet: they look again next time
+        for home in visit:
             d = home._q_due
             if not (
                 t_prev < d
@@ -1013,7 +1089,6 @@ class _Homings:
                 q = home.quiet(bank)
                 if q is None:
                     home._q_claim = 0
-                    d = t_next
                     if step:
                         if bank is not None and home.res.bank is bank:
                             # its row stays claimed (a release and a claim, the drive kept)
@@ -1022,20 +1097,26 @@ class _Homings:
                             home.cycle()
                         if not home.running:
                             self.running.remove(home)
+                            home._h_due = -1
                             continue
                         # (a leg the step started in the bank: quiet from now on, as the
                         # next look would find it)
                         q = home.quiet(bank)
                     if q is None:
-                        stepping = True
-                if q is not None:
-                    r = home.res.bank_row
-                    d = home._q_due = t_next + q * dt
-                    home._q_row, home._q_claim = r, ids[r]
-            if due is None or d < due:
-                due = d
-        self._due = t_next if due is None else due
-        self._stepping = stepping
+                        home._h_due = -1
+                        busy.append(home)
+                        continue
+                r = home.res.bank_row
+                d = home._q_due = t_next + q * dt
+                home._q_row, home._q_claim = r, ids[r]
+            home._h_due = d
+            self._seq += 1
+            heapq.heappush(heap, (d, self._seq, home))
+        while heap and (heap[0][2]._h_due != heap[0][0] or heap[0][2]._gen is None):
+            heapq.heappop(heap)  # (entries left behind)
+        self._busy = busy
+        self._due = t_next if busy or not heap else heap[0][0]
+        self._stepping = bool(busy)  # some homing steps every cycle (not found quiet)
         # a step that gave an axis back may have changed another homing's axis: look again
         self._seen = seen if bank is not None and bank.releases == seen else -1
 

@@ -17,7 +17,11 @@ with numpy.
 
 A row whose next step would leave that state (a limit switch input, a following
 error timing out) is reported by :meth:`CspBank.step` in its ``events`` mask with its
-state untouched, so the owner hands it back to the scalar channel for that cycle.
+state untouched, so the owner hands it back to the scalar channel for that cycle.  The
+compiled cycle (``gtecat/controller/csrc/bank_kernel.c``) goes one step further: a drive
+standing on a limit switch, or braking on it (``Channel._limit_switches``: its demand into
+the switch braked with 6085h, ``limit_stop``, 6041h's warning bit instead of bit 12), stays
+a row (:func:`claimable` with ``limits``; :attr:`CspBank.lstop` carries ``limit_stop``).
 """
 
 from __future__ import annotations
@@ -39,13 +43,18 @@ _INT32_MIN, _INT32_MAX = -(1 << 31), (1 << 31) - 1
 _SW_BASE = STATE_BITS[State.OPERATION_ENABLED]
 _SW_REMOTE = int(Sw.REMOTE)
 _SW_INTERNAL_LIMIT = int(Sw.INTERNAL_LIMIT)
+#: 6041h of a CSP drive braking on a limit switch (Channel._refresh_status): the warning bit
+#: instead of "following the command value" (SW12)
+_SW_LIMIT_STOP = int(Sw.WARNING) - SW12
+#: Channel._limit_switches' reactions as the compiled cycle numbers them
+_LIMIT_REACTIONS = {"none": 0, "stop": 1, "fault": 2}
 _HALT = 0x100
 #: the controlword of an enabled drive the bank takes (enable operation, nothing else)
 CW_ENABLED = 0x000F
 
 
 def running_reason(
-    ch: Channel, mode: OpMode, cw: int, not_in_mode: str, probe: bool = False
+    ch: Channel, mode: OpMode, cw: int, not_in_mode: str, probe: bool = False, limits: bool = False
 ) -> str:
     """Why ``ch`` is not simply running in ``mode`` under controlword ``cw`` ("" when it
     is): what every kind of bank row (CSP here, homing searches in
@@ -63,9 +72,9 @@ def running_reason(
         return "fault"
     if ch.field is not None:
         return "field fault"
-    if ch.torque_ctl or ch.stopping or ch.limit_stop:
+    if ch.torque_ctl or ch.stopping or (ch.limit_stop and not limits):
         return "stopping"
-    if ch.digital_inputs & 3:
+    if ch.digital_inputs & 3 and not limits:
         return "on a limit switch"
     if not probe and (ch.tp_function or ch._tp_applied or ch.probe.function):
         return "touch probe"
@@ -79,13 +88,17 @@ def probe_steady(ch: Channel) -> bool:
     return ch.tp_function == ch._tp_applied == ch.probe.function
 
 
-def claimable(ch: Channel) -> str:
+def claimable(ch: Channel, limits: bool = False) -> str:
     """Why ``ch`` cannot be a bank row now ("" when it can); an armed touch probe may run
-    (the bank gives the row back before a cycle whose travel reaches one of its edges)."""
+    (the bank gives the row back before a cycle whose travel reaches one of its edges);
+    ``limits``: so may a drive on a limit switch, braking on it or not (the compiled cycle runs
+    its reaction, bank_kernel.c)."""
     s = ch._settings
     if not probe_steady(ch):
         return "touch probe being written"
-    why = running_reason(ch, OpMode.CYCLIC_SYNC_POSITION, CW_ENABLED, "not in CSP", probe=True)
+    why = running_reason(
+        ch, OpMode.CYCLIC_SYNC_POSITION, CW_ENABLED, "not in CSP", probe=True, limits=limits
+    )
     if why:
         return why
     if ch.homing is not None and getattr(ch.homing, "active", False):
@@ -197,6 +210,12 @@ class CspBank:
         self.tpw = np.zeros(n, bool)
         self.tp_lo, self.tp_hi = np.full(n, -np.inf), np.full(n, np.inf)
         self.any_tp = False
+        #: a row on a limit switch (the compiled cycle only: :func:`claimable` with
+        #: ``limits``): the drive's reaction (_LIMIT_REACTIONS: 0 none, 1 the quick-stop brake,
+        #: 2 a fault), its 6085h (or 1), and ``limit_stop`` of the last cycle
+        self.lreact = np.zeros(n, np.int64)
+        self.qsd = f(n)
+        self.lstop = np.zeros(n, bool)
         wins: list[tuple[int, int, tuple[tuple[float, float], ...]]] = []
         self.windows: list[tuple[int, np.ndarray, np.ndarray]] = []
         self._dt = 0.0
@@ -253,6 +272,9 @@ class CspBank:
         self.fe_timeout[r] = ch.following_error_timeout
         self.nl[r], self.pl[r] = ch._nl, ch._pl
         self.sw_const[r] = _SW_BASE | SW12 | (_SW_REMOTE if ch._settings.remote else 0)
+        self.lreact[r] = _LIMIT_REACTIONS[ch._settings.limit_reaction]
+        self.qsd[r] = float(ch.quick_stop_deceleration or 1)
+        self.lstop[r] = ch.limit_stop
         probe = ch.probe
         on = bool(probe.function & 0x0101)
         self.tpw[r] = on
@@ -399,11 +421,13 @@ class CspBank:
         """Make ``state`` (whose 60FDh is ``din``) the state of the rows in ``keep`` (None: all)."""
         self.fe_running = self.fe_next
         if keep is None:
+            self.lstop[:] = False  # (a row braking on a limit leaves before a numpy cycle)
             for name, value in state.items():
                 setattr(self, name, value)
             self.cycles += 1
             self.din = din
         else:
+            self.lstop[keep] = False
             for name, value in state.items():
                 getattr(self, name)[keep] = value[keep]
             self.cycles += 1
@@ -440,7 +464,11 @@ class CspBank:
         if name == "statusword":
             if state is not None and not self.limited_any and not self.any_sw:
                 return self.sw_const  # no row limited (so no 6041h bit 11)
+            stop = self.lstop if state is None else None  # (numpy's own cycles: none)
             lim = g("limited") | g("sw_limited")
+            if stop is not None and np.count_nonzero(stop):
+                lim = lim | stop
+                return self.sw_const + lim * _SW_INTERNAL_LIMIT + stop * _SW_LIMIT_STOP
             if not np.count_nonzero(lim):
                 return self.sw_const
             return self.sw_const + lim * _SW_INTERNAL_LIMIT
@@ -499,7 +527,7 @@ class CspBank:
             ch.fe_flag = False
             ch.sw_limited = bool(self.sw_limited[r])
             ch.stopping = False
-            ch.limit_stop = False
+            ch.limit_stop = bool(self.lstop[r])
             ch.oms = SW12
             ch.cycle += self.cycles - int(self.start[r])
             self.start[r] = self.cycles
@@ -533,7 +561,8 @@ class CspBank:
             if any(a <= pos < b for a, b in zip(lo[r].tolist(), hi[r].tolist(), strict=True)):
                 din |= value
         t = min(max(round(torque), -32768), 32767)
-        lim = bool(self.limited[r]) or bool(self.sw_limited[r])
+        stop = bool(self.lstop[r])
+        lim = bool(self.limited[r]) or bool(self.sw_limited[r]) or stop
         return {
             "position_actual": round(x),
             "position_demand": round(dem),
@@ -543,7 +572,9 @@ class CspBank:
             "torque_demand": t,
             "following_error_actual": round(fe),
             "digital_inputs": din,
-            "statusword": int(self.sw_const[r]) + (_SW_INTERNAL_LIMIT if lim else 0),
+            "statusword": int(self.sw_const[r])
+            + (_SW_INTERNAL_LIMIT if lim else 0)
+            + (_SW_LIMIT_STOP if stop else 0),
         }
 
     def _row_outputs(self, idx: np.ndarray) -> dict[str, np.ndarray]:
@@ -556,7 +587,8 @@ class CspBank:
         for value, lo, hi in self.windows:
             p = pos[:, None]
             din = din | (((lo[idx] <= p) & (p < hi[idx])).any(axis=1) * value)
-        lim = self.limited[idx] | self.sw_limited[idx]
+        stop = self.lstop[idx]
+        lim = self.limited[idx] | self.sw_limited[idx] | stop
         torque = acc / self.a_rated[idx] * 1000.0 + vel * self.visc[idx]
         t = np.minimum(np.maximum(np.rint(torque), -32768), 32767).astype(np.int64)
         return {
@@ -568,7 +600,7 @@ class CspBank:
             "torque_demand": t,
             "following_error_actual": np.rint(dpos - pos).astype(np.int64),
             "digital_inputs": din,
-            "statusword": self.sw_const[idx] + lim * _SW_INTERNAL_LIMIT,
+            "statusword": self.sw_const[idx] + lim * _SW_INTERNAL_LIMIT + stop * _SW_LIMIT_STOP,
         }
 
 

@@ -130,6 +130,11 @@ class Layout:
     def axis(self, axis: int) -> AxisRef | None:
         return self._axes.get(axis)
 
+    def mapped_objects(self) -> set[tuple[int, int]]:
+        """``(slave, index)`` of every object mapped at subindex 0 (either direction): the
+        ones :meth:`entry` finds, in one set for a caller asking about many."""
+        return {(slave, index) for slave, index, sub, _ in self._index if not sub}
+
     def to_json(self) -> dict[str, Any]:
         """The ``gtecat map --json`` document (DESIGN.md "The stable surface").
 

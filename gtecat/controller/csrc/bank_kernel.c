@@ -27,6 +27,12 @@
  * a cycle whose travel reaches c_tp_lo or c_tp_hi, the nearest edges the probe latches, so
  * that the drive's TouchProbe.step of every cycle the bank runs finds nothing.
  *
+ * A row standing on a limit switch (60FDh bit 0/1 in c_din: the drive's cycle reads the last
+ * value) stays while its flag is latched (lvel): the drive's own reaction runs here
+ * (Channel._limit_switches, c_lreact 1: a demand into the switch is braked with 6085h, c_qsd,
+ * c_lstop the drive's limit_stop; 2, a fault: the row leaves first); a switch reached anew, or
+ * one whose flag is not latched, sends the row back before that cycle as before.
+ *
  * Arrays arrive as one table of addresses in the order of FIELDS below (the Python side
  * binds them by these names and refuses a library whose list differs).
  */
@@ -82,7 +88,7 @@
     X(t_len, i64) X(k0, i64) X(nseg, i64) X(seg, f64) X(tprm, f64) X(t_v, f64) X(t_a, f64)    \
     X(c_tpw, u8) X(c_tp_lo, f64) X(c_tp_hi, f64)                                           \
     X(dwatch, i64) X(lvel, u8) X(h_done, u8) X(rx_row, i64) X(dpost, i64) X(s_evt, u8)   \
-    X(s_p0, f64)
+    X(s_p0, f64) X(c_lstop, u8) X(s_lstop, u8) X(c_qsd, f64) X(c_lreact, i64)
 
 enum {
 #define X(name, type) F_##name,
@@ -539,6 +545,7 @@ INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog)
     COPY(c_fe_time, s_fe, double);
     COPY(c_limited, s_lim, uint8_t);
     COPY(c_sw_limited, s_swl, uint8_t);
+    COPY(c_lstop, s_lstop, uint8_t);
     COPY(c_target, s_target, int64_t);
     COPY(c_din, s_din, int64_t);
     COPY(a_last, s_a, double);
@@ -594,7 +601,9 @@ INLINE void write_image(void **ptr, const int64_t *io)
         case 2: val = I64(c_din)[row]; break;
         case 3:
             val = I64(c_sw_const)[row] +
-                  ((U8(c_limited)[row] | U8(c_sw_limited)[row]) ? 0x800 : 0);
+                  ((U8(c_limited)[row] | U8(c_sw_limited)[row] | U8(c_lstop)[row]) ? 0x800 : 0);
+            if (U8(c_lstop)[row]) /* _refresh_status: no SW12, the warning bit */
+                val += 0x80 - 0x1000;
             break;
         case 4: val = to_i64(rint(F64(c_dpos)[row] - (double)I64(c_off)[row])); break;
         case 5: val = to_i64(rint(F64(c_vel)[row])); break;
@@ -621,6 +630,47 @@ INLINE void write_image(void **ptr, const int64_t *io)
                 buf[off + k] = (uint8_t)(u >> (8 * k));
         }
     }
+}
+
+/* Channel._limit_switches of a CSP row: din is 60FDh as the drive read it at the start of the
+ * cycle (the last one's value), p0 and v0 the motor's position and speed then, *demand and
+ * *dvel step_csp's.  0: no reaction; 1: braked (*demand, *dvel the drive's, limit_stop);
+ * -1: the drive would raise a fault (the row leaves first). */
+INLINE int limit_reaction(int64_t din, int64_t react, double p0, double v0, double dt,
+                          double qsd, double *demand, double *dvel)
+{
+    int into_pos, into_neg;
+    double step, v;
+    if (!(din & 3) || !react)
+        return 0;
+    into_pos = (din & 2) && (*demand > p0 || v0 > 0.0);
+    into_neg = (din & 1) && (*demand < p0 || v0 < 0.0);
+    if (!(into_pos || into_neg))
+        return 0;
+    if (react == 2)
+        return -1;
+    step = qsd * dt;
+    v = v0;
+    if (into_pos)
+        v = v > step ? v - step : (0.0 < v ? 0.0 : v); /* min(v, 0.0) */
+    else
+        v = v < -step ? v + step : (0.0 > v ? 0.0 : v); /* max(v, 0.0) */
+    *dvel = v;
+    *demand = p0 + v * dt;
+    return 1;
+}
+
+/* a limit switch active after the cycle (din) sends the row back first unless it was active
+ * before it too (c_din) and its flag is latched (lvel bit 0 the positive side, 1 the
+ * negative): nothing new for the controller (its flag, AxisResources._post) nor for a hook */
+INLINE int limit_leaves(int64_t din, int64_t before, int lvel)
+{
+    const int64_t on = din & 3;
+    if (!on)
+        return 0;
+    if (on & ~before)
+        return 1;
+    return ((on & 2) && !(lvel & 1)) || ((on & 1) && !(lvel & 2));
 }
 
 /* inlined where the field table is a local copy: the compiler then knows no store through a
@@ -654,7 +704,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
     for (r = 0; r < n; r++) {
         int64_t cur, counts, x, target;
         double prf, a, demand, dvel;
-        int swl = 0, hit = 0, ended;
+        int swl = 0, hit = 0, ended, lstop = 0;
         go[r] = 0;
         s_hit[r] = 0;
         s_evt[r] = 0;
@@ -744,7 +794,15 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             x += I64(c_off)[r];
             demand = (double)x;
             dvel = (demand - F64(c_dpos)[r]) / dt;
+            lstop = limit_reaction(I64(c_din)[r], I64(c_lreact)[r], F64(c_pos)[r],
+                                   F64(c_vel)[r], dt, F64(c_qsd)[r], &demand, &dvel);
+            if (lstop < 0) { /* the drive's fault reaction: the scalar path */
+                s_hit[r] = 1;
+                any_hit = 1;
+                continue;
+            }
         }
+        U8(s_lstop)[r] = (uint8_t)lstop;
         go[r] = (uint8_t)(1 + ended);
         n_csp += !hm[r];
         n_jog += U8(jog)[r];
@@ -833,7 +891,9 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         pos = F64(s_pos)[r];
         /* following-error window 6065h/6066h */
         fe = 0.0;
-        if (U8(c_fe_check)[r]) {
+        if (U8(s_lstop)[r]) /* no following-error check while the limit brakes it */
+            fe = F64(c_fe_time)[r];
+        else if (U8(c_fe_check)[r]) {
             if (fabs(demand - pos) > F64(c_fe_window)[r]) {
                 fe = F64(c_fe_time)[r] + dt;
                 if (fe * 1000.0 > F64(c_fe_timeout)[r])
@@ -876,7 +936,9 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         enc = F64(enc_pos)[r] + step;
         /* 5. limits and following error */
         err = a - link(enc, F64(enc_ratio)[r], F64(enc_off)[r]);
-        if (a > F64(soft_pos)[r] || (din & 3) != 0 || a < F64(soft_neg)[r])
+        if (a > F64(soft_pos)[r] || a < F64(soft_neg)[r])
+            hit = 1;
+        if (hm[r] ? (din & 3) != 0 : limit_leaves(din, I64(c_din)[r], U8(lvel)[r]))
             hit = 1;
         if (fabs(err) > F64(pos_err)[r] && !hm[r]) /* the following error: in CSP only */
             hit = 1;
@@ -937,6 +999,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         F64(c_fe_time)[r] = F64(s_fe)[r];
         U8(c_limited)[r] = U8(s_lim)[r];
         U8(c_sw_limited)[r] = U8(s_swl)[r];
+        U8(c_lstop)[r] = U8(s_lstop)[r];
         I64(c_target)[r] = I64(s_target)[r];
         I64(c_din)[r] = I64(s_din)[r];
         F64(a_last)[r] = F64(s_a)[r];
@@ -992,7 +1055,7 @@ typedef struct {
     int64_t target, din, enc_prev, since, cur, t_idx, taken, t_len, t_end;
     int64_t len; /* the cycles run */
     int code;    /* 0, or why the next cycle is declined */
-    uint8_t lim, swl, arrived, moving, ended, fin, refilled;
+    uint8_t lim, swl, arrived, moving, ended, fin, refilled, lstop;
 } RowRun;
 
 INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
@@ -1023,6 +1086,7 @@ INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
     I64(t_end)[r] = s->t_end;
     U8(c_limited)[r] = s->lim;
     U8(c_sw_limited)[r] = s->swl;
+    U8(c_lstop)[r] = s->lstop;
     U8(arrived)[r] = s->arrived;
     U8(moving)[r] = s->moving;
     U8(ended)[r] = s->ended;
@@ -1068,6 +1132,9 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     int64_t q_target = I64(c_target)[r], q_din = I64(c_din)[r], q_enc_prev = I64(enc_prev)[r],
         q_since = I64(since)[r], q_cur = I64(t_cur)[r], q_t_idx = I64(t_idx)[r],
         q_taken = I64(taken)[r], q_t_len = I64(t_len)[r], q_t_end = I64(t_end)[r];
+    const int64_t lreact = I64(c_lreact)[r];
+    const double qsd = F64(c_qsd)[r];
+    uint8_t q_lstop = U8(c_lstop)[r];
     uint8_t q_lim = U8(c_limited)[r], q_swl = U8(c_sw_limited)[r], q_arrived = U8(arrived)[r],
         q_moving = U8(moving)[r], q_ended = U8(ended)[r], q_fin = 0, q_refilled = 0;
     int q_code = 0;
@@ -1078,7 +1145,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         int32_t d32;
         double prf, a, demand, dvel, p1 = 0.0, v1 = 0.0, nfp = 0.0, nfv = 0.0, nfa = 0.0;
         double p, v0, vff, e1, v, dist, rel, vstop, dv, pos, fe, step, enc, err;
-        int swl = 0, ended, limited = 0, arr;
+        int swl = 0, ended, limited = 0, arr, lstop;
         /* pass 1: the profile and the demand */
         if (q_moving && cur >= q_t_len) { /* the table is used up: the next one (refill_row) */
             const int64_t m = I64(nseg)[r];
@@ -1152,6 +1219,11 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         x += off;
         demand = (double)x;
         dvel = (demand - q_dpos) / dt;
+        lstop = limit_reaction(q_din, lreact, q_pos, q_vel, dt, qsd, &demand, &dvel);
+        if (lstop < 0) { /* the drive's fault reaction: the scalar path */
+            q_code = 2;
+            break;
+        }
         /* pass 2: Mechanics.track */
         p = q_pos;
         v0 = q_vel;
@@ -1203,9 +1275,9 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         {
             /* without a branch on the window: a following error near it comes and goes
              * from cycle to cycle, which no branch predictor follows */
-            const int out = fe_check & (fabs(demand - pos) > fe_window);
+            const int out = (lstop == 0) & fe_check & (fabs(demand - pos) > fe_window);
             const double fe_in = q_fe_time + dt;
-            fe = out ? fe_in : 0.0;
+            fe = lstop ? q_fe_time : out ? fe_in : 0.0; /* (no check while the limit brakes) */
             if (out && fe * 1000.0 > fe_timeout) {
                 q_code = 2;
                 break;
@@ -1224,7 +1296,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         step = (double)(sense * (int64_t)d32) * unit;
         enc = q_enc_pos + step;
         err = a - (plain ? enc : link(enc, enc_ratio, enc_off));
-        if (a > soft_pos || (din & 3) != 0 || a < soft_neg || fabs(err) > pos_err ||
+        if (a > soft_pos || limit_leaves(din, q_din, lvel) || a < soft_neg || fabs(err) > pos_err ||
             ((din ^ q_din) & dwatch) || (tpw && pos != p && !tp_inside(ptr, r, p, pos))) {
             q_code = 2;
             break;
@@ -1253,6 +1325,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         q_fe_time = fe;
         q_lim = (uint8_t)limited;
         q_swl = (uint8_t)swl;
+        q_lstop = (uint8_t)lstop;
         q_target = target;
         q_din = din;
         q_a = a;
@@ -1303,6 +1376,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     s->t_end = q_t_end;
     s->lim = q_lim;
     s->swl = q_swl;
+    s->lstop = q_lstop;
     s->arrived = q_arrived;
     s->moving = q_moving;
     s->ended = q_ended;

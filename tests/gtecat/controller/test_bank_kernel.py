@@ -93,7 +93,7 @@ def test_built_beside_the_first_bring_up_into_the_cache_and_used(tmp_path: Path)
 def test_the_binding_reads_the_field_list_the_library_was_built_with() -> None:
     names = [n for n, _ in bank_kernel._field_types()]
     assert len(names) == len(set(names)) > 80
-    assert names[:2] == ["alive", "moving"] and names[-1] == "s_p0"
+    assert names[:2] == ["alive", "moving"] and names[-1] == "c_lreact"
     lib, reason = bank_kernel.library()
     if lib is None:
         pytest.skip(f"the kernel did not build here: {reason}")

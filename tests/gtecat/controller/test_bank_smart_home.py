@@ -129,7 +129,7 @@ def _run(
             _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
         ctl = gt.GTE_Controller()
         size = ctl.layout.gt_raw_bytes
-        k = searching = banked = 0
+        k = searching = banked = on_limit = braking = 0
         while k < cycles:
             for at, call in (calls or {}).items():
                 if k <= at < k + max(step, 1):
@@ -154,12 +154,19 @@ def _run(
                 if run and stage == 30:
                     searching += 1
                     banked += ctl.bank is not None and ctl.bank.holds(ctl.axes[a])
+            # the rows the bank holds on a limit switch (its 60FDh), braking on it or not
+            b = ctl.bank
+            if b is not None and b.n:
+                on = b.alive & ((b.csp.din & 3) != 0)
+                on_limit += int(on.sum())
+                braking += int((on & b.csp.lstop).sum())
         bank_ = ctl.bank
         stats = {
             "rows": bank_.rows_run if bank_ is not None else 0,
             "many": bank_.many_cycles if bank_ is not None else 0,
             "kernel": bank_ is not None and bank_.kernel is not None,
             "index_search": (banked, searching),
+            "on_limit": (on_limit, braking),
             # steps on a claimed row, edges taken after the bank's cycle (inputs, probes)
             "in_place": (
                 (bank_.steps_in_place, bank_.posted_inputs, bank_.posted_probes)
@@ -235,6 +242,10 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
         # around their edges and the probe's arming)
         banked, searching = stats["index_search"]
         assert searching > 100 and banked > 0.7 * searching, stats["index_search"]
+        # drives standing on a limit switch, and braking on it (the drive's own reaction to
+        # a demand into the switch), in the compiled cycle: the limit homings' escapes
+        on_limit, braking = stats["on_limit"]
+        assert on_limit > 20 and braking > 0, stats["on_limit"]
 
 
 def test_long_waits_give_the_same_homings(machine: str) -> None:
