@@ -373,6 +373,8 @@ class AxisBank:
         self.mode = mode
         self.built = False
         self.groups: list[_Group] = []
+        #: the claimed rows' output bytes as the last re-index saw them (:meth:`_reindex`)
+        self._rx_ref = b""
         self.dirty = True
         self._countdown = 0
         self._missed = False  # the last refresh found an eligible group it could not claim
@@ -678,6 +680,7 @@ class AxisBank:
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
+        self._release_written()
         alive = self.alive
         self._stale = False
         self.n_alive = int(np.count_nonzero(alive))
@@ -2419,6 +2422,24 @@ class AxisBank:
             finally:
                 _Bypass.on = False
             _reguard(objs)
+
+    def _release_written(self) -> None:
+        """Before the claimed rows' output bytes are seen afresh (:meth:`_reindex`): a group
+        claimed at the last look whose bytes a raw write changed since goes back first, as
+        the cycle would give it back (its drive decodes what the image holds), rather than
+        the new look taking the written bytes for the bank's own."""
+        ref = self._rx_ref
+        if not ref:
+            return
+        idx = self._rx_idx
+        now = self.ctl.master.image.buffer.take(idx)
+        if len(now) != len(ref) or now.tobytes() == ref:
+            return
+        hit = set(idx[now != np.frombuffer(ref, np.uint8)].tolist())
+        self._rx_ref = b""  # (seen: the release below re-indexes with what is claimed then)
+        changed = [g for g in self.groups if g.claimed and hit.intersection(g.rx_bytes.tolist())]
+        if changed:
+            self._release_groups(changed)
 
     def _release_changed(self, buf: np.ndarray) -> None:
         changed = []
