@@ -1388,7 +1388,8 @@ class AxisBank:
         """New Trap samples for the moving rows whose table ran out; :attr:`_refill_in`: the
         cycles until the next one runs out."""
         moving, cur = self.moving, self.t_cur
-        need = moving & (cur >= self.t_len)
+        # (a row given back keeps its flags until it is claimed again: not one to fill)
+        need = moving & self.alive & (cur >= self.t_len)
         if np.count_nonzero(need):
             self._materialise()
             filled: set[int] = set()  # the rows of the clusters filled
