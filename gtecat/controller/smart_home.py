@@ -309,6 +309,8 @@ class SmartHome:
         self._seen_gpi = -1
         #: the leg under way watches the trigger (its capture, its level or a GPI)
         self._watching = False
+        #: the leg under way has read its watch once since it started (:meth:`quiet`)
+        self._looked = True
         #: the direction whose limit the wait under way looks at (0: none, a stop)
         self._dir = 0
 
@@ -459,6 +461,10 @@ class SmartHome:
         (that too gives it back), so the loop would only look and wait again.  The count
         ends before the cycle that takes the move's end sample (:meth:`AxisBank.trap_quiet`)."""
         if not self._wait or self._failing or self._gen is None or bank is None:
+            return None
+        if not self._looked:
+            # the leg's watch may hold already (a level the stop before it left behind,
+            # which no edge will announce): the step after the move starts reads it
             return None
         trigger = self._trigger
         foreign = self._watching and trigger is not self.unit
@@ -821,6 +827,7 @@ class SmartHome:
         if levels is not None:
             levels.watch_level(True)
         self._watching = watch is not None
+        self._looked = watch is None
         self._dir = d
         self._waiting = True
         try:
@@ -830,6 +837,7 @@ class SmartHome:
                     value = watch()
                     if value is not None:
                         return "event", value
+                    self._looked = True
                 if self._limit(d) or self.res.latched & bit & ~before:
                     return "limit", self.unit.enc - 0.5 * self.unit.step
                 self._check_plan(trap)
@@ -837,6 +845,7 @@ class SmartHome:
                     return "end", None
         finally:
             self._waiting = self._watching = False
+            self._looked = True
             self._dir = 0
             if levels is not None:
                 levels.watch_level(False)

@@ -329,3 +329,33 @@ def test_index_homing_polled_by_sdo(tmp_path: Path) -> None:
     if stats["kernel"]:
         banked, searching = stats["index_search"]
         assert searching > 100 and banked > 0.7 * searching, stats["index_search"]
+
+
+#: forced home and the first index beyond it (mode 41), the trigger the axis's own home
+#: input: the stop after the switch is found ends beyond the switch, so the way back at
+#: velLow (stage 45) ends at its first step, the level already inactive (no edge says so)
+BEYOND_SETUP: dict[int, tuple[dict[str, object] | None, dict[str, object]]] = {
+    1: (
+        {"mode": 41, "indexDir": -1, "edge": 1, "velLow": 10.0, "acc": 2.0, "dec": 0.5},
+        {
+            "home_switch": [[1_000, 1_800]],
+            "index_offset": 600,
+            "counts_per_rev": 1_000,
+            "positive_limit": 3_500,
+        },
+    ),
+}
+
+
+def test_forced_home_stopped_beyond_the_switch(tmp_path: Path) -> None:
+    """The leg back to the switch's end starts with the level already inactive: the step
+    after the move starts reads it (the bank found the homing quiet there, waiting for an
+    edge that never came, and the homing stayed in stage 45)."""
+    machine = _machine(tmp_path, BEYOND_SETUP)
+    (ref, _), (got, stats) = (_run(machine, b, 0, ENI, BEYOND_SETUP, 260) for b in ("off", "on"))
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    run, stage, error, capture, target = ref[-2][3][0]
+    # (the index beyond the home the way back found; homeOffset 0)
+    assert (run, stage, error) == (0, 100, 0) and 1_800 < capture == target, ref[-2][3]
+    assert stats["rows"] > 0
