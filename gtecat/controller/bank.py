@@ -360,8 +360,8 @@ class _Group:
     rows: list[int]
     rx_bytes: np.ndarray  # buffer indices of its output bytes, 607Ah excluded
     #: the entries the bank writes into the image: (buffer byte, bytes, an output, the
-    #: slave's rx (output) or tx (input) index of the first byte)
-    computed: list[tuple[int, int, bool, int]]
+    #: slave's rx (output) or tx (input) index of the first byte, its row)
+    computed: list[tuple[int, int, bool, int, int]]
     claimed: bool = False
 
 
@@ -558,8 +558,8 @@ class AxisBank:
             out0 = (sl.out_logical_bit or 0) >> 3
             in0 = image.outputs_bytes + ((sl.in_logical_bit or 0) >> 3)
             computed = [
-                (byte, size, name == "target", byte - (out0 if name == "target" else in0))
-                for _, byte, size, name in g_plc
+                (byte, size, name == "target", byte - (out0 if name == "target" else in0), r)
+                for r, byte, size, name in g_plc
             ]
             groups.append(_Group(pos, slave, rows, np.array(rx_idx, np.intp), computed))
         if not axes:
@@ -1518,14 +1518,22 @@ class AxisBank:
                     obj.bank_released(ran)
         # the drive's process data buffers as its own steps would have left them: the entries
         # the bank wrote into the image in them too (its other bytes are as they were, so a
-        # raw write or a changed constant still waits for a step of its own: _can_claim)
+        # raw write or a changed constant still waits for a step of its own: _can_claim).
+        # 607Ah as the bank last sent it, not as the image holds it now: a raw write since
+        # (not looked at: the bank writes 607Ah itself) never reached the drive - one cut off
+        # by a pulled cable runs on what it last received, as on the scalar path
         buf = self.ctl.master.image.buffer
+        target = self.csp.target
         for g in groups:
             rx, tx = g.drive.rx, g.drive.tx
-            for byte, size, out, i in g.computed:
+            for byte, size, out, i, r in g.computed:
                 dst = rx if out else tx
                 if 0 <= i and i + size <= len(dst):
-                    dst[i : i + size] = buf[byte : byte + size].tobytes()
+                    if out:
+                        sent = (int(target[r]) & 0xFFFFFFFF).to_bytes(4, "little")
+                        dst[i : i + size] = sent[:size]
+                    else:
+                        dst[i : i + size] = buf[byte : byte + size].tobytes()
         for cl in clusters:
             # the planners stand where the scalar path has them (bank_modes.Cluster.rewind)
             cl.rewind(self)

@@ -165,6 +165,13 @@ def _act(action: tuple) -> int:
     if kind == "raw":
         _, offset, value = action
         return gt.GT_SetEcatRawData(offset, 1, (c_ubyte * 1)(value))
+    if kind == "raw4":  # a 32-bit value (607Ah's size) little-endian
+        _, offset, value = action
+        return gt.GT_SetEcatRawData(
+            offset, 4, (c_ubyte * 4)(*(value & 0xFFFFFFFF).to_bytes(4, "little"))
+        )
+    if kind == "unplug":  # the cable in front of a slave pulled (GTE_UnplugSlave)
+        return gt.GTE_UnplugSlave(action[1])
     raise AssertionError(kind)
 
 
@@ -292,6 +299,9 @@ program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=1
 @example(actions=[(1, ("raw", 0, 0)), (0, ("clear",)), (0, ("clear",))])
 # a moving axis switched off: given back with its Trap table, it is none of the numpy cycle's
 # tables to fill (an outside fuzz's -7 "internal error" with the numpy cycle)
+# a raw write of a claimed drive's 607Ah, then its cable pulled: the drive given back runs
+# on the 607Ah it last received (the bank's), not on the raw value it never received
+@example(actions=[(2, ("soft", 11, 17649, -12482)), (0, ("raw4", 269, 30039)), (3, ("unplug", 2))])
 @example(
     actions=[
         (0, ("move", 7, 1725, 14.0, 2.42, 1.89, 1.0, 25)),
