@@ -584,7 +584,8 @@ INLINE int commit_cursors(void **ptr, int64_t n)
 }
 
 /* 8. the image: 607Ah out, the drives' TxPDO in (the committed values of every placement of a
- * claimed row; a frozen row's image keeps what its scalar objects wrote) */
+ * claimed row; a frozen row's TxPDO keeps what its scalar objects wrote, its 607Ah is written
+ * as the scalar axis writes it every cycle, over a raw write since) */
 INLINE void write_image(void **ptr, const int64_t *io)
 {
     uint8_t *buf = U8(buf);
@@ -593,7 +594,7 @@ INLINE void write_image(void **ptr, const int64_t *io)
     for (i = 0; i < io[IN_N_PLC]; i++) {
         int64_t row = I64(pl_row)[i], val;
         uint32_t u;
-        if (!alive[row] || frz[row])
+        if (!alive[row] || (frz[row] && I64(pl_col)[i] != 0))
             continue;
         switch (I64(pl_col)[i]) {
         case 0: val = I64(c_target)[row]; break;

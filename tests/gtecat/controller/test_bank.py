@@ -302,6 +302,9 @@ program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=1
 # a raw write of a claimed drive's 607Ah, then its cable pulled: the drive given back runs
 # on the 607Ah it last received (the bank's), not on the raw value it never received
 @example(actions=[(2, ("soft", 11, 17649, -12482)), (0, ("raw4", 269, 30039)), (3, ("unplug", 2))])
+# a raw 607Ah write to an axis switched off (a frozen row): the next cycle writes 607Ah over it,
+# as the scalar axis does every cycle
+@example(actions=[(0, ("off", 11)), (0, ("probe", 3, 12567)), (3, ("raw4", 269, 18101))])
 @example(
     actions=[
         (0, ("move", 7, 1725, 14.0, 2.42, 1.89, 1.0, 25)),
