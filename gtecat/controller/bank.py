@@ -1898,7 +1898,7 @@ class AxisBank:
         buf = self.ctl.master.image.buffer
         # 1. raw writes to a claimed slave's outputs: back to the scalar drive first
         if self._rx_ref and buf.take(self._rx_idx).tobytes() != self._rx_ref:
-            self._release_changed(buf)
+            self._reindex()  # (its first step gives the written slaves back: _release_written)
             if not self.n_alive:
                 return
         # 2. this cycle's planner samples (a row at rest reads its hold slot)
@@ -2445,20 +2445,9 @@ class AxisBank:
         if len(now) != len(ref) or now.tobytes() == ref:
             return
         hit = set(idx[now != np.frombuffer(ref, np.uint8)].tolist())
-        self._rx_ref = b""  # (seen: the release below re-indexes with what is claimed then)
         changed = [g for g in self.groups if g.claimed and hit.intersection(g.rx_bytes.tolist())]
         if changed:
             self._release_groups(changed)
-
-    def _release_changed(self, buf: np.ndarray) -> None:
-        changed = []
-        now = buf[self._rx_idx]
-        diff = set(self._rx_idx[now != self._rx_ref].tolist())
-        for g in self.groups:
-            if g.claimed and diff.intersection(g.rx_bytes.tolist()):
-                changed.append(g)
-        self._release_groups(changed)
-        self._reindex()
 
 
 def _within_safety(ax: Any, res: Any) -> bool:

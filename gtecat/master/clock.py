@@ -63,14 +63,13 @@ class Clock:
         mode: ClockMode | str = ClockMode.AUTO,
         call_latency_ns: int = 50_000,
     ) -> None:
-        if int(cycle_ns) <= 0:
-            raise ValueError("cycle time must be positive")
-        self.mode = ClockMode(mode)
         #: the numbers a call's host latency needs, in memory compiled code reads and writes
         #: (the GT readers' C entries add the latency themselves where it runs no cycle:
         #: gtecat.gt.centry): the latency accumulated since the last cycle (auto), the
         #: latency of a call, the cycle time, 1 while the clock shares its time with no other
-        self.quick = array("q", (0, int(call_latency_ns), int(cycle_ns), 1))
+        self.quick = array("q", (0, int(call_latency_ns), 0, 1))
+        self.cycle_ns = cycle_ns  # (checked: whole nanoseconds, positive)
+        self.mode = ClockMode(mode)
         self._run_cycle = run_cycle
         #: the owner's way to run up to N cycles at once (returns the cycles it ran, 0: run
         #: the next one through ``run_cycle``); virtual time only, None: one by one
