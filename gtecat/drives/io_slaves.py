@@ -67,7 +67,8 @@ class FieldInputs(bytearray):
     """What an IO slave's terminals see on their inputs.  Written from outside the slave's
     cycle (:meth:`IoSlave.set_input`, a test's ``slave.field_inputs[0] = 0x3C``, a fault),
     each write counts as a change of the bus (:attr:`VirtualSlave.outside_changes`): a
-    controller that found the bus at a fixed point looks again."""
+    controller that found the bus at a fixed point looks again.  (The slave's own wires
+    count too: a cycle that steps the slave makes the controller look again anyway.)"""
 
     __slots__ = ()
 
@@ -249,7 +250,7 @@ class IoSlave(VirtualSlave):
                 v = fo[ob] << shift if shift >= 0 else fo[ob] >> -shift
                 if (fi[ib] ^ v) & mask:
                     return False
-        return self.al_state < _SAFEOP or self.tx == (fi if not self.held else self._inputs())
+        return self.al_state < _SAFEOP or self.tx == self._inputs()
 
     def _plan_wires(self) -> list[tuple[int, int, int, int]]:
         """The wires as byte operations ``(out byte, in byte, shift, in mask)``: the wires

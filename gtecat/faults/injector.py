@@ -45,8 +45,9 @@ from .triggers import AfterTime, AtTime, Now, OnSdo, Trigger, describe_after, fi
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
-#: active faults that act in every cycle (no cycles at once while one is on)
-_EVERY_CYCLE = (k.SwitchChatter, k.IoStuck)
+#: active faults that act in every cycle (no cycles at once while one is on); a stuck IO
+#: input is not one: the slave holds it (IoSlave.hold_input_bit) from its start to its end
+_EVERY_CYCLE = (k.SwitchChatter,)
 #: a count of quiet cycles far beyond any run of cycles at once
 _FAR = 1 << 40
 
