@@ -70,6 +70,10 @@ FAR = 1_000_000_000.0  # counts to the negative limit: the homing search never e
 #: gives up after gtecat.drives.homing.DEFAULT_TIMEOUT_S (300 s), which a fast machine
 #: reached within three windows of 1.5 s
 HOMING_WINDOW_MS = 240_000
+#: the shortest of start_trap's moves (50,000,000 counts at 31 counts/ms at the most) and
+#: the controller time the windows of a moving bus take together, well within it
+TRAP_MOVE_MS = 50_000_000 // 31
+TRAP_WINDOW_MS = TRAP_MOVE_MS // 2
 WARM_UP_MS = 50
 CHUNK_MS = 20
 
@@ -454,7 +458,13 @@ def run_bus(
             bring_s = time.perf_counter() - t0
             # a drive ends a homing search after DEFAULT_TIMEOUT_S of controller time: every
             # window of a homing bus stops short of it, however fast the machine runs
-            limit = HOMING_WINDOW_MS / max(1, repeat) if "homing" in full.values() else None
+            limit = None
+            if "homing" in full.values():
+                limit = HOMING_WINDOW_MS / max(1, repeat)
+            elif "moving" in full.values():
+                # a Trap move ends after TRAP_MOVE_MS at the least: every window of a moving
+                # bus stops short of it, however fast the machine runs
+                limit = TRAP_WINDOW_MS / max(1, repeat)
             m = measure(seconds, repeat, limit)
             check(full)
             extra = after() if after is not None else {}
