@@ -63,6 +63,11 @@ from .axis import Axis, AxisIo
 from .axis_status import AxisStatus
 from .bank import AxisBank
 from .bank_kernel import _DEFERRED as _KERNEL_DEFERRED
+from .bank_kernel import FP_DT as _FP_DT
+from .bank_kernel import IN_DT_NS as _IN_DT_NS
+from .bank_kernel import IN_MAXC as _IN_MAXC
+from .bank_kernel import IN_T_NS as _IN_T_NS
+from .bank_kernel import OUT_DONE as _OUT_DONE
 from .bank_kernel import prebuild as prebuild_kernel
 from .bank_kernel import start_deferred as start_kernel_build
 from .epoch import EPOCH
@@ -471,6 +476,99 @@ class Controller:
                 if passed is not None:
                     passed(done)
         return done
+
+    def due_cycle(self, pending: int) -> bool:
+        """The auto clock's one due cycle, run the quick way: ``pending`` (the host latency
+        accumulated with this call's, between one and two cycle times) reached a cycle on a
+        clock alone, the bank's compiled kernel runs every axis, nothing is hooked and the
+        bus is steady.  Then the cycle is exactly the one :meth:`run_cycles` runs for one
+        cycle, and its time is counted as :meth:`Clock.advance_ns` counts it - in one call,
+        without the layers between them (at ~20 calls a cycle they were most of a polling
+        call's cost).  False: nothing ran, nothing was counted; the caller takes the
+        general way (:meth:`Clock.advance_ns`).
+
+        Everything :meth:`_run_cycles` asks at every run is asked here too, in the same
+        terms: the hooks' lists as they stand (a hook added in place is seen), the bank's
+        flags, the kernel's binding, and the steady verdict's marks (:attr:`_steady_seen`;
+        :meth:`Master.steady` itself where they moved).  A cycle the kernel declines goes
+        the clock's one-cycle way (:meth:`Clock.cycle`), as the general way goes after it."""
+        clock = self.clock
+        bank = self.bank
+        master = self.master
+        if (
+            bank is None
+            or master is None
+            or self.before_cycle
+            or self.sample
+            or self.pre_cycle
+            or self.post_cycle
+            or self.watch
+            or self._links_down
+            or self._run_axes
+            or master.on_cycle
+            or clock.counted is not readers_changed
+        ):
+            return False
+        k = bank.kernel
+        if (
+            k is None
+            or bank.dirty
+            or bank._stale
+            or bank._declined
+            or bank.evt_rows
+            or not bank.n
+            or bank.n_alive != bank.n
+            or (bank.n_moving and not bank._c_fill)
+            or not k.bound
+            or master.image.buffer is not k.buffer
+        ):
+            return False
+        q = clock.quick
+        dt_ns = q[2]
+        dt = dt_ns * 1e-9
+        if dt != bank.csp._dt:
+            return False
+        seen = self._steady_seen
+        epoch = EPOCH.n
+        cycles = clock.cycles
+        al = VirtualSlave.al_changes
+        outside = VirtualSlave.outside_changes
+        if (
+            seen[0] != epoch or seen[1] != cycles or seen[2] != al or seen[3] != outside
+        ) and not master.steady():
+            return False
+        # Kernel.run for one cycle, bank.run_cycles's bookkeeping after it
+        io = k._io
+        t_ns = clock.now_ns
+        io[_IN_T_NS] = t_ns
+        io[_IN_DT_NS] = dt_ns
+        io[_IN_MAXC] = 1
+        k._fp[_FP_DT] = dt
+        # (in_batch before the clock's cycle is compared with ours, as in run_cycles)
+        self.in_batch = True
+        try:
+            if clock._run_cycle is not self._own_cycle:  # (an endpoint wrapped it)
+                return False
+            q[0] = pending - dt_ns
+            rc = k.run_fn(*k._args)
+        finally:
+            self.in_batch = False
+        if not io[_OUT_DONE]:  # declined: the numpy cycle runs it (bank.run_cycles's 0)
+            clock.cycle()
+            return True
+        bank._declined = bool(rc)
+        bank._countdown -= 1 - bank._settled
+        bank._settled = False
+        bank._refill_in -= 1
+        bank._lists.clear()
+        bank._after_kernel(k)
+        bank.many_cycles += 1
+        master.cycles += 1
+        self._steady_seen = (epoch + 1, cycles + 1, al, outside)
+        clock.cycles = cycles + 1
+        clock.now_ns = t_ns + dt_ns
+        EPOCH.n = epoch + 1  # (clock.counted: readers_changed)
+        return True
 
     def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:
         """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles

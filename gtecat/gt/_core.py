@@ -402,6 +402,13 @@ def advance(ctl: Any, name: str, rc: int) -> int:
             return rc
     try:
         if mode is _AUTO:
+            # one cycle due on a clock alone: the controller's quick way where it takes it
+            # (Controller.due_cycle), else the clock's general way
+            if q[3] and pending < 2 * q[2]:
+                with clock.lock:
+                    pending = q[0] + q[1]  # (as it stands with the lock held)
+                    if q[2] <= pending < 2 * q[2] and q[1] >= 0 and ctl.due_cycle(pending):
+                        return rc
             with clock.lock:  # (its cycles: one thread's at a time, as a call's own)
                 clock.advance_ns(q[1])  # (Clock.on_call in the auto clock)
         else:  # (realtime: the call yields, the lock free for the cycle thread)
