@@ -87,7 +87,7 @@ from gtecat.eni.model import Direction
 from .._attrs import own_dict
 from ..master.clock import ClockMode
 from .axis_status import AxisStatus
-from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
+from .bank_kernel import MAXSEG, NTPRM, OUT_FIN, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import settled as kernel_settled
 from .bank_kernel import wanted as kernel_wanted
@@ -2089,6 +2089,33 @@ class AxisBank:
             self._after_kernel(k, done)
             self.many_cycles += done
         return done
+
+    def quick_cycle_done(self, k: Kernel, rc: int) -> bool:
+        """The bookkeeping of :meth:`run_cycles` after one cycle the kernel committed in a
+        quick cycle (gtecat.controller.core.Controller.quick_book; ``rc`` its code), with
+        :meth:`_after_kernel`'s for one cycle inline.  True: the next cycle may be a quick
+        one too (none declined, no table for Python to fill)."""
+        self._declined = declined = bool(rc)
+        self._countdown -= 1 - self._settled
+        self._settled = False
+        self._refill_in -= 1
+        self._lists.clear()
+        csp = self.csp
+        csp.cycles += 1
+        csp._din_safe = 0
+        if csp.any_fe:
+            csp.fe_running = True
+        if k._io[OUT_FIN]:
+            self.n_moving = int(np.count_nonzero(self.moving))
+            self._count_standing()
+        self.rows_run += self.n_alive
+        self.bank_cycles += 1
+        self.kernel_cycles += 1
+        self.homing_rows_run += self.n_hm
+        self.rest_rows_run += self.n_rest
+        self.frozen_rows_run += self.n_frz
+        self.many_cycles += 1
+        return not declined and (not self.n_moving or self._c_fill)
 
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
         """What the numpy cycle does besides its arithmetic, after compiled cycles."""

@@ -264,6 +264,9 @@ class Kernel:
         self.io[IN_TABLE] = bank.table
         self.fp[FP_T] = bank.T
         self.run_fn = lib.bank_kernel_run
+        #: where the run function is (the GT readers' C entries call it for an armed cycle:
+        #: gtecat.controller.core.Controller.arm_quick)
+        self.run_address: int = ctypes.cast(lib.bank_kernel_run, ctypes.c_void_p).value or 0
         self.bound = False
         self._keep: list[Any] = []
         self._fields_plan: list[tuple[int, str, str | None, str | None, Any]] | None = None

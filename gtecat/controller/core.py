@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import gc
 import os
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -56,7 +57,7 @@ from gtecat.eni.reader import read_eni
 from .._attrs import own_dict
 from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
-from ..master.clock import Clock, ClockMode
+from ..master.clock import ARMS, Clock, ClockMode, hook_list
 from ..master.masterlog import MasterLog
 from . import clock_options
 from .axis import Axis, AxisIo
@@ -137,6 +138,14 @@ class Options:
 class Controller:
     """One core: clock, master and the per-cycle hooks of the axis layer."""
 
+    # the cycle hooks (lists whose changes, in place or by assignment, are seen:
+    # gtecat.master.clock.Hooks); set in __init__
+    before_cycle = hook_list("before_cycle")
+    pre_cycle = hook_list("pre_cycle")
+    post_cycle = hook_list("post_cycle")
+    sample = hook_list("sample")
+    watch = hook_list("watch")
+
     #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
     bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
     #: called with every controller whose bus is about to be brought up: its slaves are
@@ -170,6 +179,10 @@ class Controller:
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
         self.clock.run_many = self.run_cycles
+        #: the armed quick cycle's kernel call (:meth:`arm_quick`): the function's address,
+        #: its three arguments, the cycle time it was armed for
+        self._quick_call = array("q", bytes(8 * 5))
+        self._quick_armed: Any = None
         #: the clock's cycle as this controller gave it (one that wraps it, an inspection
         #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
         self._own_cycle = self.clock._run_cycle
@@ -488,11 +501,47 @@ class Controller:
         general way (:meth:`Clock.advance_ns`).
 
         Everything :meth:`_run_cycles` asks at every run is asked here too, in the same
-        terms: the hooks' lists as they stand (a hook added in place is seen), the bank's
-        flags, the kernel's binding, and the steady verdict's marks (:attr:`_steady_seen`;
-        :meth:`Master.steady` itself where they moved).  A cycle the kernel declines goes
-        the clock's one-cycle way (:meth:`Clock.cycle`), as the general way goes after it."""
+        terms: the hooks' lists as they stand, the bank's flags, the kernel's binding, and
+        the steady verdict's marks (:attr:`_steady_seen`; :meth:`Master.steady` itself where
+        they moved).  A cycle the kernel declines goes the clock's one-cycle way
+        (:meth:`Clock.cycle`), as the general way goes after it.  A cycle that ran whole
+        arms the next one for the GT readers' C entries (:meth:`arm_quick`)."""
+        k = self._quick_kernel()
+        if k is None:
+            return False
         clock = self.clock
+        seen = self._steady_seen
+        cycles = clock.cycles
+        if (
+            seen[0] != EPOCH.n
+            or seen[1] != cycles
+            or seen[2] != VirtualSlave.al_changes
+            or seen[3] != VirtualSlave.outside_changes
+        ) and not self.master.steady():  # type: ignore[union-attr]  # (_quick_kernel: a master)
+            return False
+        q = clock.quick
+        io = k._io
+        io[_IN_T_NS] = clock.now_ns
+        io[_IN_DT_NS] = q[2]
+        io[_IN_MAXC] = 1
+        k._fp[_FP_DT] = q[2] * 1e-9
+        # (in_batch before the clock's cycle is compared with ours, as in run_cycles)
+        self.in_batch = True
+        try:
+            if clock._cycle_fn is not self._own_cycle:  # (an endpoint wrapped it)
+                return False
+            q[0] = pending - q[2]
+            rc = k.run_fn(*k._args)
+        finally:
+            self.in_batch = False
+        self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
+        if q[4]:  # (with all else that it relies on, taken now)
+            self.arm_quick(k)
+        return True
+
+    def _quick_kernel(self) -> Any:
+        """The bank's kernel where a quick cycle (:meth:`due_cycle`) may run: what
+        :meth:`_run_cycles` and :meth:`AxisBank.run_cycles` ask, nothing hooked; else None."""
         bank = self.bank
         master = self.master
         if (
@@ -506,9 +555,9 @@ class Controller:
             or self._links_down
             or self._run_axes
             or master.on_cycle
-            or clock.counted is not readers_changed
+            or self.clock.counted is not readers_changed
         ):
-            return False
+            return None
         k = bank.kernel
         if (
             k is None
@@ -521,54 +570,68 @@ class Controller:
             or (bank.n_moving and not bank._c_fill)
             or not k.bound
             or master.image.buffer is not k.buffer
+            or self.clock.quick[2] * 1e-9 != bank.csp._dt
         ):
-            return False
-        q = clock.quick
-        dt_ns = q[2]
-        dt = dt_ns * 1e-9
-        if dt != bank.csp._dt:
-            return False
-        seen = self._steady_seen
-        epoch = EPOCH.n
-        cycles = clock.cycles
-        al = VirtualSlave.al_changes
-        outside = VirtualSlave.outside_changes
-        if (
-            seen[0] != epoch or seen[1] != cycles or seen[2] != al or seen[3] != outside
-        ) and not master.steady():
-            return False
-        # Kernel.run for one cycle, bank.run_cycles's bookkeeping after it
+            return None
+        return k
+
+    def quick_book(self, rc: int) -> None:
+        """What follows the kernel's run of a quick cycle (:meth:`due_cycle`, or a GT
+        reader's C entry that ran the armed cycle: :meth:`arm_quick`), the clock's lock held
+        and the pending latency already less the cycle: ``rc`` the kernel's code.  The
+        bookkeeping of :meth:`AxisBank.run_cycles` and :meth:`_run_cycles` for one cycle,
+        the clock's count, the readers' epoch; a declined cycle runs the numpy way.  Where
+        the next cycle may be a quick one too, it is armed again for the new epoch (what
+        else was armed stands: the entry that ran this one found it so)."""
+        clock = self.clock
+        bank = self.bank
+        k = bank.kernel  # type: ignore[union-attr]
         io = k._io
-        t_ns = clock.now_ns
-        io[_IN_T_NS] = t_ns
-        io[_IN_DT_NS] = dt_ns
-        io[_IN_MAXC] = 1
-        k._fp[_FP_DT] = dt
-        # (in_batch before the clock's cycle is compared with ours, as in run_cycles)
-        self.in_batch = True
-        try:
-            if clock._run_cycle is not self._own_cycle:  # (an endpoint wrapped it)
-                return False
-            q[0] = pending - dt_ns
-            rc = k.run_fn(*k._args)
-        finally:
-            self.in_batch = False
         if not io[_OUT_DONE]:  # declined: the numpy cycle runs it (bank.run_cycles's 0)
             clock.cycle()
-            return True
-        bank._declined = bool(rc)
-        bank._countdown -= 1 - bank._settled
-        bank._settled = False
-        bank._refill_in -= 1
-        bank._lists.clear()
-        bank._after_kernel(k)
-        bank.many_cycles += 1
-        master.cycles += 1
-        self._steady_seen = (epoch + 1, cycles + 1, al, outside)
-        clock.cycles = cycles + 1
-        clock.now_ns = t_ns + dt_ns
-        EPOCH.n = epoch + 1  # (clock.counted: readers_changed)
-        return True
+            return
+        again = bank.quick_cycle_done(k, rc)  # type: ignore[union-attr]
+        self.master.cycles += 1  # type: ignore[union-attr]
+        epoch = EPOCH.n + 1
+        cycles = clock.cycles + 1
+        self._steady_seen = (
+            epoch,
+            cycles,
+            VirtualSlave.al_changes,
+            VirtualSlave.outside_changes,
+        )
+        clock.cycles = cycles
+        q = clock.quick
+        clock.now_ns = now = clock.now_ns + q[2]
+        EPOCH.n = epoch  # (clock.counted: readers_changed)
+        if again:
+            io[_IN_T_NS] = now  # (the rest of the kernel's call as this one's)
+            q[4] = epoch
+
+    def arm_quick(self, k: Any) -> None:
+        """Arm the next due cycle for the GT readers' C entries (gtecat.gt.centry): right
+        after a quick cycle that ran whole, everything :meth:`_quick_kernel` asked holds,
+        and the bus is steady (the marks of :attr:`_steady_seen` are now's).  The entries
+        run it themselves - the clock's lock taken, the kernel's cycle called, then
+        :meth:`quick_book` - while the readers' epoch, the slaves' AL and
+        outside changes, the generation of :data:`~gtecat.master.clock.ARMS` (a hook added
+        or replaced anywhere, a cycle wrapped) and the clock's cycle time are the ones
+        armed here.  Every other change that could make :meth:`_quick_kernel` say no comes
+        with a new epoch: a GT call of the table, a cycle the general way, a fault, an
+        endpoint's request, a claim or a release of the bank."""
+        q = self.clock.quick
+        q[4] = 0  # (nothing armed while it is being armed)
+        call = self._quick_call
+        if self._quick_armed is not k:  # (a kernel's function and arguments stay its own)
+            call[0] = k.run_address
+            call[1], call[2], call[3] = k._args
+            self._quick_armed = k  # (its arrays live while the entries may call it)
+            q[8] = call.buffer_info()[0]
+        call[4] = q[2]  # (the kernel's call as due_cycle's: io and fp set for this cycle time)
+        q[5] = ARMS[0]
+        q[6] = VirtualSlave.al_changes
+        q[7] = VirtualSlave.outside_changes
+        q[4] = EPOCH.n
 
     def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:
         """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles

@@ -41,6 +41,7 @@ from ..errors import (
     ParameterError,
 )
 from ..master.clock import ClockGroup, ClockMode
+from . import fast as _fast
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder, impl_params
 from .fast import FAST_MAKERS, set_gates
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
@@ -414,14 +415,23 @@ def advance(ctl: Any, name: str, rc: int) -> int:
         else:  # (realtime: the call yields, the lock free for the cycle thread)
             clock.on_call()
     except Exception as e:
-        code = code_for(e)
-        if code == CMD_NO_RESPONSE:
-            log.error("%s: internal error in the cycle\n%s", name, traceback.format_exc())
-            _record(name, code, f"internal error in the emulator's cycle: {type(e).__name__}: {e}")
-        else:
-            _record(name, code, f"in the cycles after the call: {e}")
-        return rc or code
+        return cycle_failed(name, e, rc)
     return rc
+
+
+def cycle_failed(name: str, e: Exception, rc: int) -> int:
+    """What the cycles after call ``name`` raised, as its code and reason (``rc``: the call's
+    own code, which stands when it is not 0); inside an ``except``."""
+    code = code_for(e)
+    if code == CMD_NO_RESPONSE:
+        log.error("%s: internal error in the cycle\n%s", name, traceback.format_exc())
+        _record(name, code, f"internal error in the emulator's cycle: {type(e).__name__}: {e}")
+    else:
+        _record(name, code, f"in the cycles after the call: {e}")
+    return rc or code
+
+
+_fast.CYCLE_FAILED[:] = [cycle_failed]
 
 
 def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:

@@ -33,6 +33,7 @@ from importlib import resources
 from typing import Any
 
 from ..controller.epoch import EPOCH, Epoch, changed
+from ..master.clock import ARMS
 from . import byref_target
 
 log = logging.getLogger(__name__)
@@ -86,6 +87,12 @@ class _Api(ctypes.Structure):
         ("nd_descr", ctypes.c_ssize_t),
         ("nd_flags", ctypes.c_ssize_t),
         ("nd_want", ctypes.c_int),
+        ("clock_calls", _VP),
+        ("true_", _VP),
+        ("arms", _VP),
+        ("marks_dict", _VP),
+        ("key_al", _VP),
+        ("key_out", _VP),
     ]
 
 
@@ -212,15 +219,46 @@ CLOCK_QUICK = (ctypes.c_ssize_t * 2)()
 _CLOCKS: list[Any] = [None, None]  # (their arrays, kept alive while named)
 
 
-def set_clocks(gt: Any, gtn: Any) -> None:
-    """The clocks behind the two gates (:data:`CLOCK_QUICK`; None: none), set while the gates
-    are closed."""
+#: per gate, three callables of its controller for the armed quick cycle (0: none):
+#: ``book(after, rc)``, the clock's lock taken, the lock given back
+#: (gtecat.controller.core.Controller.arm_quick; gtecat.gt.fast.quick_calls)
+CLOCK_CALLS = (ctypes.c_ssize_t * 6)()
+_CALLS: list[Any] = [None, None]  # (kept alive while named)
+#: how many numbers a clock's quick array holds (gtecat.master.clock.Clock.quick)
+QUICK_LEN = 9
+#: the names of the slaves' marks, as the C entries look them up
+_KEY_AL, _KEY_OUT = "al_changes", "outside_changes"
+
+
+def set_clocks(gt: Any, gtn: Any, calls: tuple[Any, Any] = (None, None)) -> None:
+    """The clocks behind the two gates (:data:`CLOCK_QUICK`; None: none), and per gate the
+    callables of its armed quick cycle (:data:`CLOCK_CALLS`; None: none), set while the
+    gates are closed."""
     for k, clock in enumerate((gt, gtn)):
         q = getattr(clock, "quick", None)
-        if not (isinstance(q, array) and q.typecode == "q" and len(q) == 4):
+        if not (isinstance(q, array) and q.typecode == "q" and len(q) == QUICK_LEN):
             q = None
         _CLOCKS[k] = q
         CLOCK_QUICK[k] = 0 if q is None else q.buffer_info()[0]
+        three = calls[k] if q is not None else None
+        _CALLS[k] = three
+        for j in range(3):
+            CLOCK_CALLS[3 * k + j] = 0 if three is None else id(three[j])
+
+
+def _marks_dict() -> dict:
+    """VirtualSlave's own dict, where its class counts the slaves' AL and outside changes
+    (ValueError where the marks are not found there)."""
+    import gc
+
+    from gtecat.drives.slave import VirtualSlave
+
+    found = [d for d in gc.get_referents(VirtualSlave.__dict__) if type(d) is dict]
+    if len(found) != 1 or any(
+        found[0].get(key) is not getattr(VirtualSlave, key) for key in (_KEY_AL, _KEY_OUT)
+    ):
+        raise ValueError("the slaves' marks are not where they are looked for")
+    return found[0]
 
 
 def _epoch_at() -> int:
@@ -524,6 +562,7 @@ def _load() -> tuple[Maker | None, str]:
         epoch_at = _epoch_at()
         titems = _tuple_at(bsize)
         numpy_at = _numpy_at()
+        marks = _marks_dict()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
@@ -566,6 +605,12 @@ def _load() -> tuple[Maker | None, str]:
             ctypes.addressof(CLOCK_QUICK),
             *numpy_at,
             _ND_WANT,
+            ctypes.addressof(CLOCK_CALLS),
+            id(True),
+            ARMS.buffer_info()[0],
+            id(marks),
+            id(_KEY_AL),
+            id(_KEY_OUT),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

@@ -565,10 +565,37 @@ def set_gates(gt: Any, gtn: Any) -> None:
     for env in _GATED_ENVS:
         env["CTL"], env["CTLN"] = GATED
     gates = _gate_value(gt), _gate_value(gtn)
+    auto = [g == centry.AUTO for g in gates]
     centry.set_clocks(
-        *(c.clock if g == centry.AUTO else None for c, g in zip(new, gates, strict=True))
+        *(c.clock if a else None for c, a in zip(new, auto, strict=True)),
+        calls=tuple(_quick_calls(c) if a else None for c, a in zip(new, auto, strict=True)),  # type: ignore[arg-type]
     )
     centry.set_gates(*gates)
+
+
+#: the GT layer's turn of what a cycle raised into the call's code and reason
+#: (gtecat.gt._core.cycle_failed, set there): ``failed(name, exception, rc) -> code``
+CYCLE_FAILED: list[Callable[[str, Exception, int], int]] = []
+
+
+def _quick_calls(ctl: Any) -> tuple[Any, Any, Any] | None:
+    """The callables of ``ctl``'s armed quick cycle for the C entries (centry.CLOCK_CALLS):
+    ``book(after, rc)`` (Controller.quick_book, whatever it raises turned into the call's
+    code as advance turns it), the clock's lock taken, the lock given back."""
+    quick_book = getattr(ctl, "quick_book", None)
+    if quick_book is None or not CYCLE_FAILED:
+        return None
+    failed = CYCLE_FAILED[0]
+
+    def book(after: Any, rc: int) -> int:
+        try:
+            quick_book(rc)
+        except Exception as e:
+            return failed(getattr(after, "gt_name", "GT call"), e, 0)
+        return 0
+
+    lock = ctl.clock.lock
+    return book, lock.acquire, lock.release
 
 
 def _gate_value(ctl: Any) -> int:
@@ -586,6 +613,7 @@ def _after(advance: Callable[[Any, str, int], int], name: str, k: int) -> Callab
     def after() -> int:
         return advance(GATED[k], name, 0)
 
+    after.gt_name = name  # type: ignore[attr-defined]  # (a quick cycle's errors name the call)
     return after
 
 

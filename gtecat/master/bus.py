@@ -51,6 +51,7 @@ from gtecat.eni.model import InitCmd
 
 from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend
+from .clock import hook_list
 from .image import ProcessImage
 
 #: looked up once: the cycle and :meth:`Master.steady` compare with it (an enum member's
@@ -86,6 +87,9 @@ def _transition(a: AlState, b: AlState) -> str:
 
 class Master:
     """One EtherCAT master on one backend."""
+
+    #: called with the master after every cycle (a list whose changes are seen: Hooks)
+    on_cycle = hook_list("on_cycle")
 
     def __init__(
         self,
@@ -126,7 +130,7 @@ class Master:
         self.loss_confirm_ns = 10_000_000
         self._bad_ns = 0
         self._op_requested = False  # the OP walk ran: from now on below OP is offline
-        self.on_cycle: list[Callable[[Master], None]] = []  # recorders etc.
+        self.on_cycle: list[Callable[[Master], None]] = []  # recorders etc. (Hooks)
         #: states an operator asked of single slaves on the running bus (``gtecat states -p 2
         #: PREOP``): position -> state; recovery leaves them there until OP is asked again or
         #: the application brings the bus up anew (GT_InitEcatComm makes a new master)

@@ -25,6 +25,7 @@ from array import array
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import Any
 
 
 class ClockMode(StrEnum):
@@ -35,6 +36,64 @@ class ClockMode(StrEnum):
 
 #: looked up once: every advance asks (an enum member's lookup costs more than the ``is``)
 _REALTIME = ClockMode.REALTIME
+
+#: The generation of what a quick cycle armed for the GT readers' C entries relies on besides
+#: the readers' epoch and the slaves' marks (``Controller.arm_quick``): a cycle hook added,
+#: taken away or replaced, a clock's cycle wrapped.  It only grows; the C entries compare it
+#: with the one their clock was armed in (memory they read: gtecat.gt.centry).
+ARMS = array("q", (1,))
+
+
+def disarm() -> None:
+    """Whatever a C entry's quick cycle was armed with may be stale: it asks Python again."""
+    ARMS[0] += 1
+
+
+def _disarming(name: str) -> Callable[..., Any]:
+    """``list.<name>`` that disarms the quick cycles first (:class:`Hooks`)."""
+    base = getattr(list, name)
+
+    def changed(self: list, *args: Any, **kwargs: Any) -> Any:
+        disarm()
+        return base(self, *args, **kwargs)
+
+    changed.__name__ = name
+    return changed
+
+
+class Hooks(list):
+    """A list of cycle hooks whose every change disarms the quick cycles (:func:`disarm`):
+    a hook added in place between two calls runs in the next cycle, as with no quick way.
+    Reading and iterating are a plain list's."""
+
+    __slots__ = ()
+    append = _disarming("append")
+    extend = _disarming("extend")
+    insert = _disarming("insert")
+    remove = _disarming("remove")
+    pop = _disarming("pop")
+    clear = _disarming("clear")
+    sort = _disarming("sort")
+    reverse = _disarming("reverse")
+    __setitem__ = _disarming("__setitem__")
+    __delitem__ = _disarming("__delitem__")
+    __iadd__ = _disarming("__iadd__")
+    __imul__ = _disarming("__imul__")
+
+
+def hook_list(name: str) -> property:
+    """An attribute holding a :class:`Hooks` list (kept as ``_name``): a list assigned to it
+    becomes one, and the assignment disarms the quick cycles too."""
+    key = "_" + name
+
+    def get(self: Any) -> Hooks:
+        return self.__dict__[key]
+
+    def put(self: Any, value: Any) -> None:
+        self.__dict__[key] = value if type(value) is Hooks else Hooks(value)
+        disarm()
+
+    return property(get, put, doc=f"the {name} hooks (:class:`Hooks`)")
 
 
 @dataclass
@@ -67,10 +126,13 @@ class Clock:
         #: (the GT readers' C entries add the latency themselves where it runs no cycle:
         #: gtecat.gt.centry): the latency accumulated since the last cycle (auto), the
         #: latency of a call, the cycle time, 1 while the clock shares its time with no other
-        self.quick = array("q", (0, int(call_latency_ns), 0, 1))
+        #: [4:8] a quick cycle armed for them (gtecat.controller.core.Controller.arm_quick):
+        #: the readers' epoch it holds for (0: none), the generation of :data:`ARMS`, the
+        #: slaves' AL and outside changes, and the address of the armed kernel's call
+        self.quick = array("q", (0, int(call_latency_ns), 0, 1, 0, 0, 0, 0, 0))
         self.cycle_ns = cycle_ns  # (checked: whole nanoseconds, positive)
         self.mode = ClockMode(mode)
-        self._run_cycle = run_cycle
+        self._cycle_fn = run_cycle
         #: the owner's way to run up to N cycles at once (returns the cycles it ran, 0: run
         #: the next one through ``run_cycle``); virtual time only, None: one by one
         self.run_many: Callable[[int], int] | None = None
@@ -85,6 +147,16 @@ class Clock:
         #: called once cycles have run and their time is counted (the owner's: what was
         #: read of the time before may be stale now)
         self.counted: Callable[[], None] | None = None
+
+    @property
+    def _run_cycle(self) -> Callable[[], None]:
+        """What one cycle runs (the owner's; an inspection endpoint wraps it for a while)."""
+        return self._cycle_fn
+
+    @_run_cycle.setter
+    def _run_cycle(self, fn: Callable[[], None]) -> None:
+        self._cycle_fn = fn
+        disarm()  # (a wrapped cycle: no quick cycle runs past the wrapper)
 
     @property
     def cycle_ns(self) -> int:
@@ -128,7 +200,7 @@ class Clock:
     # --- virtual time ------------------------------------------------------
     def cycle(self) -> None:
         """Run exactly one cycle and count its time."""
-        self._run_cycle()
+        self._cycle_fn()
         self.cycles += 1
         self.now_ns += self.cycle_ns
         if self.counted is not None:

@@ -76,6 +76,18 @@ struct api {
     obj ndarray_type;
     ptrdiff_t nd_data, nd_nd, nd_dims, nd_descr, nd_flags;
     int nd_want;
+    /* the quick cycle (gtecat.controller.core.Controller.arm_quick): per gate three callables
+     * of its controller (0: none): book(after, rc) once the armed kernel ran, the clock's
+     * lock taken (True: taken), the lock given back */
+    const ptrdiff_t *clock_calls;
+    obj true_;
+    /* the generation of what an armed cycle relies on (gtecat.master.clock.ARMS) */
+    const long long *arms;
+    /* where the slaves' AL and outside changes are counted (VirtualSlave's own dict) and
+     * their names */
+    obj marks_dict;
+    obj key_al;
+    obj key_out;
 };
 
 #define MAX_TYPES 16
@@ -144,7 +156,8 @@ int gtecat_centry_api(const struct api *api)
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear || !api->gate || !api->epoch_obj ||
-        api->epoch_off <= 0 || !api->clock_quick)
+        api->epoch_off <= 0 || !api->clock_quick || !api->clock_calls || !api->true_ ||
+        !api->arms || !api->marks_dict || !api->key_al || !api->key_out)
         return 1;
     A = *api;
     ready = 1;
@@ -289,10 +302,83 @@ static int latency(ptrdiff_t gate)
     return 1;
 }
 
+/* the kernel's run of cycles (gtecat/controller/csrc/bank_kernel.c bank_kernel_run) */
+typedef int (*kernel_run)(void *, void *, void *);
+
+/* Whether the armed quick cycle (Controller.arm_quick) may run now: one cycle due on a clock
+ * alone (pending latency pend), armed for this epoch, this generation, these slaves' marks
+ * and this cycle time. */
+static int armed(const long long *q, long long pend)
+{
+    long long al, out;
+    const long long *call;
+    if (!q[3] || !q[4] || q[0] < 0 || q[1] < 0 || q[2] <= 0 || pend < q[2] || pend - q[2] >= q[2])
+        return 0;
+    if (q[5] != A.arms[0] || q[4] != epoch())
+        return 0;
+    call = (const long long *)q[8];
+    if (!call || !call[0] || call[4] != q[2])
+        return 0;
+    return ll_of(A.dict_get(A.marks_dict, A.key_al), &al) && al == q[6] &&
+           ll_of(A.dict_get(A.marks_dict, A.key_out), &out) && out == q[7];
+}
+
+/* The armed quick cycle where the call's latency makes a cycle due: the clock's lock taken
+ * (it may wait for another thread's call or cycles, as after() would), armed() asked again
+ * with the lock held, the kernel's cycle run here and book(after, rc) doing the rest (its
+ * answer, the call's code, in *res; NULL: an exception), the lock given back.  1: it ran;
+ * 0: nothing was done, after() runs the latency. */
+static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
+{
+    long long *q = (long long *)A.clock_quick[gate - 1];
+    const ptrdiff_t *calls = A.clock_calls + 3 * (gate - 1);
+    const long long *call;
+    obj r, args[2];
+    int rc;
+    if (!q || !calls[0] || !calls[1] || !calls[2] || !armed(q, q[0] + q[1]))
+        return 0;
+    r = A.vectorcall((obj)calls[1], NULL, 0, NULL);
+    if (r != A.true_) {
+        if (r)
+            A.decref(r);
+        else
+            A.err_clear();
+        return 0; /* (not taken: after() takes the general way) */
+    }
+    A.decref(r);
+    if (!armed(q, q[0] + q[1])) { /* (another thread's call or cycle came first) */
+        r = A.vectorcall((obj)calls[2], NULL, 0, NULL);
+        if (r)
+            A.decref(r);
+        else
+            A.err_clear();
+        return 0;
+    }
+    call = (const long long *)q[8];
+    q[4] = 0; /* (the book arms the next one) */
+    q[0] += q[1] - q[2];
+    rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
+    args[0] = after;
+    args[1] = rc ? A.one : A.zero;
+    *res = A.vectorcall((obj)calls[0], args, 2, NULL);
+    r = A.vectorcall((obj)calls[2], NULL, 0, NULL);
+    if (r)
+        A.decref(r);
+    else if (*res) { /* (the lock's error: the call's) */
+        A.decref(*res);
+        *res = NULL;
+    }
+    return 1;
+}
+
 static obj done(obj after, ptrdiff_t gate)
 {
-    if (after && gate && A.gate[gate - 1] == 2 && !latency(gate))
+    if (after && gate && A.gate[gate - 1] == 2 && !latency(gate)) {
+        obj res = NULL;
+        if (quick_cycle(gate, after, &res))
+            return res;
         return A.vectorcall(after, NULL, 0, NULL);
+    }
     A.incref(A.zero);
     return A.zero;
 }
