@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from ctypes import byref, c_long, c_ubyte
+from ctypes import byref, c_double, c_long, c_ubyte
 
 import pytest
 
@@ -121,3 +121,111 @@ def test_a_cable_pulled_by_hand_in_front_of_a_banked_drive(fig5_2):
         if s.value & 0x2:
             break
     assert s.value & 0x2, hex(s.value)
+
+
+# --- the quick cycle the readers' C entries run (Controller.arm_quick) -----------------------
+
+
+@pytest.mark.parametrize("hooks", ["before_cycle", "pre_cycle", "post_cycle", "sample", "watch"])
+@pytest.mark.parametrize("how", ["append", "assign"])
+def test_a_controller_hook_added_between_polls_runs_every_cycle(fig5_2, hooks, how):
+    """A cycle hook of the controller added in place or by assigning a new list, between
+    polls that only the readers' C entries make: it runs in every cycle from the next on."""
+    ctl = fig5_2
+    _polls(200)
+    seen: list[int] = []
+
+    def hook(*_args: object) -> None:
+        seen.append(1)
+
+    if how == "append":
+        getattr(ctl, hooks).append(hook)
+    else:
+        setattr(ctl, hooks, [*getattr(ctl, hooks), hook])
+    t0 = ctl.clock.cycles
+    _polls(400)
+    assert len(seen) == ctl.clock.cycles - t0 > 0
+
+
+def test_a_master_hook_list_assigned_between_polls_runs_every_cycle(fig5_2):
+    ctl = fig5_2
+    _polls(200)
+    seen: list[int] = []
+    ctl.master.on_cycle = [lambda m: seen.append(1)]
+    t0 = ctl.clock.cycles
+    _polls(400)
+    assert len(seen) == ctl.clock.cycles - t0 > 0
+
+
+def test_a_cycle_wrapped_between_polls_runs_through_the_wrapper(fig5_2):
+    """An inspection endpoint wraps the clock's cycle: the quick cycles stop at once."""
+    ctl = fig5_2
+    _polls(200)
+    own = ctl.clock._run_cycle
+    seen: list[int] = []
+
+    def wrapped() -> None:
+        seen.append(1)
+        own()
+
+    ctl.clock._run_cycle = wrapped
+    t0 = ctl.clock.cycles
+    _polls(400)
+    ctl.clock._run_cycle = own
+    assert len(seen) == ctl.clock.cycles - t0 > 0
+
+
+def _moves_and_polls(ctl, watch: bool) -> list:
+    """Trap moves of both axes polled through the C entries; what the readers saw."""
+    if watch:  # a hook that does nothing: every cycle then goes the general way
+        ctl.watch.append(lambda: None)
+    gt.GT_AxisOn(2)
+    s, d = c_long(), c_double()
+    seen = []
+    for rnd in range(4):
+        ax = 1 + rnd % 2
+        assert gt.GT_PrfTrap(ax) == 0
+        p = gt.TTrapPrm()
+        p.acc, p.dec = 0.5, 0.5
+        assert gt.GT_SetTrapPrm(ax, byref(p)) == 0
+        assert gt.GT_SetVel(ax, 20.0) == 0
+        assert gt.GT_SetPos(ax, 3000 * (rnd + 1)) == 0
+        assert gt.GT_Update(1 << (ax - 1)) == 0
+        for i in range(6000):
+            gt.GT_GetSts(ax, byref(s))
+            if i % 499 == 0:
+                gt.GT_GetPrfPos(ax, byref(d))
+                gt.GT_GetEncPos(3 - ax, byref(c_double()))
+                seen.append((s.value, d.value))
+    seen.append((ctl.clock.cycles, ctl.clock.now_ns, ctl.master.cycles))
+    return seen
+
+
+def test_quick_cycles_give_what_the_general_way_gives():
+    """The same calls with the quick cycles and with every cycle the general way (a watch
+    hook that does nothing): the same values read, the same clock, the same cycles."""
+    runs = []
+    for watch in (False, True):
+        bring_up()
+        assert gt.GT_AxisOn(1) == 0
+        ctl = gt.GTE_Controller()
+        many = ctl.bank.many_cycles
+        runs.append(_moves_and_polls(ctl, watch))
+        if not watch:
+            assert ctl.bank.many_cycles - many > 1000  # (the quick ones ran)
+        gt.GT_Close()
+    assert runs[0] == runs[1]
+
+
+def test_an_output_written_between_polls_reaches_the_io_slave(fig5_2):
+    """A raw write to an IO slave's outputs between polls: the next cycle takes it to the
+    slave (its fixed point, kept between runs, is not the image's)."""
+    ctl = fig5_2
+    pos, slave = _io_slave(ctl)
+    _polls(200)
+    start = sum(len(s.rx) + len(s.tx) for s in ctl.master.backend.slaves[:pos])
+    for value in (0x5A, 0xA5, 0x00):
+        assert gt.GT_SetEcatRawData(start, 1, (c_ubyte * 1)(value)) == 0
+        _polls(60)
+        assert slave.rx[0] == value
+        assert slave.field_outputs[0] == value
