@@ -547,17 +547,22 @@ class Controller:
         if (
             bank is None
             or master is None
-            or self.before_cycle
-            or self.sample
-            or self.pre_cycle
-            or self.post_cycle
-            or self.watch
             or self._links_down
             or self._run_axes
-            or master.on_cycle
             or self.clock.counted is not readers_changed
         ):
             return None
+        if self._unhooked != ARMS[0]:  # (no hook since: every change of them is a new one)
+            if (
+                self.before_cycle
+                or self.sample
+                or self.pre_cycle
+                or self.post_cycle
+                or self.watch
+                or master.on_cycle
+            ):
+                return None
+            self._unhooked = ARMS[0]
         k = bank.kernel
         if (
             k is None
@@ -664,6 +669,10 @@ class Controller:
     #: outside a slave's cycle: its field inputs or wires, an emergency queued) or is asked
     #: at every run (the master's ``on_cycle`` hooks).
     _steady_seen: tuple[int, int, int, int] = (0, 0, 0, 0)
+    #: the generation of :data:`~gtecat.master.clock.ARMS` in which no cycle hook was
+    #: found (:meth:`_quick_kernel`; a hook added, taken away or replaced, a master made
+    #: anew: a new generation)
+    _unhooked = 0
     #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
     _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
 

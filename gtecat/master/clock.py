@@ -25,6 +25,7 @@ from array import array
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
+from operator import attrgetter
 from typing import Any
 
 
@@ -86,14 +87,14 @@ def hook_list(name: str) -> property:
     becomes one, and the assignment disarms the quick cycles too."""
     key = "_" + name
 
-    def get(self: Any) -> Hooks:
-        return self.__dict__[key]
-
     def put(self: Any, value: Any) -> None:
-        self.__dict__[key] = value if type(value) is Hooks else Hooks(value)
+        # (a plain attribute's store: asking for the object's __dict__ would make every later
+        # read of its attributes take the slow way - gtecat._attrs)
+        setattr(self, key, value if type(value) is Hooks else Hooks(value))
         disarm()
 
-    return property(get, put, doc=f"the {name} hooks (:class:`Hooks`)")
+    # (read every cycle: a getter in C, not a Python frame)
+    return property(attrgetter(key), put, doc=f"the {name} hooks (:class:`Hooks`)")
 
 
 @dataclass
