@@ -57,6 +57,7 @@ status cycle by cycle).
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import chain, compress
@@ -111,6 +112,11 @@ from .profile import PrfMode
 
 if TYPE_CHECKING:
     from .core import Controller
+
+#: a moving row's raw pieces (up to MAXSEG of 4 doubles) and move constants, packed into the
+#: kernel's arrays (:meth:`AxisBank._load`)
+_SEG_PACK = [struct.Struct(f"={4 * m}d") for m in range(MAXSEG + 1)]
+_TPRM_PACK = struct.Struct(f"={NTPRM}d")
 
 #: the crossover of the numpy bank: below this many axes the scalar path is as fast
 #: (tools/bench_bank.py); with the compiled cycle the bank wins from one axis
@@ -1227,9 +1233,12 @@ class AxisBank:
         if moving and not sampled and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
             segs = pl._segs
             m = len(segs)
-            # (a flat list: numpy takes it several times faster than the list of tuples)
-            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = list(chain.from_iterable(segs))
-            self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
+            # (packed as doubles straight into the arrays' memory: numpy's conversion of a
+            # list costs several times more)
+            _SEG_PACK[m].pack_into(self.seg, r * MAXSEG * 32, *chain.from_iterable(segs))
+            _TPRM_PACK.pack_into(
+                self.tprm,
+                r * NTPRM * 8,
                 pl._t_done,
                 pl._ts,
                 pl._t_final,
@@ -1288,13 +1297,15 @@ class AxisBank:
             self.csp.sw_const[r] += ch.hm_bits - SW12
             return
         tp = bool(self.csp.tpw[r])
-        if (
-            (watch or tp)
-            and not sampled
-            and not jog
-            and len(self.groups[self.group_of[r]].rows) == 1
-            and all(obj.bank_post_ready() for obj in aware)
-        ):
+        post = (watch or tp) and not sampled and not jog
+        if post and len(self.groups[self.group_of[r]].rows) == 1:
+            for obj in aware:
+                if not obj.bank_post_ready():
+                    post = False
+                    break
+        else:
+            post = False
+        if post:
             # its hooks (and its drive's probe) take such an edge after the cycle, the row
             # staying (:meth:`_post_events`)
             if tp and not self._tp_mapped(r):
