@@ -143,17 +143,58 @@ def test_sto_removes_torque_and_shows_ff10() -> None:
     recover()
 
 
-def test_quick_stop_input_stops_the_drive() -> None:
+def pdo(index: int, axis: int = 1) -> int:
+    v = c_ushort()
+    assert gt.GT_GetEcatAxisPdoData(axis, index, byref(v)) == 0, gt.GTE_GetLastError()
+    return v.value
+
+
+QSA, SOD, OE = 0x07, 0x40, 0x27  # statusword & 0x6F: quick stop active, switch on disabled, ...
+
+
+def test_quick_stop_input_ramps_the_drive_down() -> None:
+    """The drive brakes on its quick-stop ramp (6085h: 5,000,000 counts/s², 605Ah 2) in quick
+    stop active, then goes to switch on disabled by itself: the controller lets it finish
+    (controlword "quick stop" 0002h meanwhile; disable voltage would make it coast)."""
     up()
-    trap(100_000)
-    gt.GTE_Wait(30)
-    faults.inject("quick_stop", axis=1)
-    assert wait(lambda: not sts() & SERVO_ON, 50)
+    trap(100_000, vel=50)  # 50,000 counts/s
+    gt.GTE_Wait(300)
     p = enc()
-    gt.GTE_Wait(200)
-    assert abs(enc() - p) < 500  # stopped on the quick-stop ramp
+    faults.inject("quick_stop", axis=1)
+    states, cws = [], []
+    for _ in range(30):
+        gt.GTE_Wait(1)
+        states.append(pdo(0x6041) & 0x6F)
+        cws.append(pdo(0x6040))
+    assert states[:8] == [QSA] * 8  # 10 ms of ramp (v/a), not one cycle
+    assert states[-1] == SOD and cws[-1] == 0x0000
+    assert 0x0002 in cws
+    assert not sts() & SERVO_ON
+    assert enc() - p < 300  # v²/2a = 250 counts (it coasted 5000 before)
+    gt.GTE_Wait(100)
+    assert enc() - p < 300
     faults.clear()
     recover()
+
+
+def test_a_quick_stop_that_stays_is_never_left_by_the_controller() -> None:
+    """605Ah 6: the drive stops and stays in quick stop active; the input released, the
+    controller's "quick stop" keeps it there (no transition 16 back to operation by itself):
+    GT_AxisOn brings it back."""
+    up()
+    ab = c_uint32()
+    assert gt.GT_EcatSDODownload(0, 0x605A, 0, (c_ubyte * 2)(6, 0), 2, byref(ab)) == 0
+    trap(100_000, vel=50)
+    gt.GTE_Wait(150)
+    faults.inject("quick_stop", axis=1)
+    gt.GTE_Wait(30)
+    assert pdo(0x6041) & 0x6F == QSA and pdo(0x6040) == 0x0002
+    faults.clear()
+    gt.GTE_Wait(10)
+    assert pdo(0x6041) & 0x6F == QSA
+    assert not sts() & SERVO_ON
+    assert gt.GT_AxisOn(1) == 0, gt.GTE_GetLastError()
+    assert wait(lambda: pdo(0x6041) & 0x6F == OE and sts() & SERVO_ON, 50)
 
 
 def test_a_closed_brake_ends_in_a_following_error(machine: Path) -> None:
