@@ -188,9 +188,27 @@ def injector_for(ctl: Any, create: bool = True) -> Injector | None:
     inj = getattr(backend, "injector", None)
     if inj is None and create:
         inj = Injector(EmulatedBus(ctl))
+        prev = getattr(ctl, "_fault_injector", None)
+        if prev is not None:
+            inj._next = prev._next  # (ids are never used twice in one session)
         backend.injector = inj
+        ctl._fault_injector = inj
         ctl.pre_cycle.append(inj.tick)
     return inj
+
+
+def _carry_over(ctl: Any, holding: bool = False) -> None:
+    """The bus is brought up again: the faults injected on the bus before stay
+    (:meth:`Injector.carry`); the machine description's tables are armed anew."""
+    old = getattr(ctl, "_fault_injector", None)
+    if old is None or getattr(old.bus, "backend", None) is ctl.backend:
+        return
+    if not any(e.state in ("armed", "active") and e.origin != "machine" for e in old.entries):
+        return
+    inj = injector_for(ctl)
+    assert inj is not None
+    inj.holding = holding
+    inj.carry(old)
 
 
 def _bus_opening(ctl: Any) -> None:
@@ -201,6 +219,7 @@ def _bus_opening(ctl: Any) -> None:
     Any other fault that starts at once waits until the bus is up (:func:`_bus_up`), where
     it started before: the bring-up has no cycles for it.  The faults of a bus brought up
     before go with it.  Errors: :func:`_arm_machine`."""
+    _carry_over(ctl, holding=True)
     _arm_machine(ctl, holding=True)
     ctl._faults_armed = ctl.backend
 
@@ -210,6 +229,7 @@ def _bus_up(ctl: Any) -> None:
     faults watch; a bus that came up without :func:`_bus_opening` (a card's amplifiers) has
     its faults armed now."""
     if getattr(ctl, "_faults_armed", None) is not ctl.backend:
+        _carry_over(ctl)
         _arm_machine(ctl)
         return
     inj = injector_for(ctl, create=False)
@@ -244,7 +264,8 @@ def _arm_machine(ctl: Any, holding: bool = False) -> None:
             inj = injector_for(ctl)
             assert inj is not None
             inj.holding = holding
-            arm(inj, specs)
+            for e in arm(inj, specs):
+                e.origin = "machine"
         except (FaultSpecError, ParameterError) as e:
             raise CommandError(str(e)) from None
 

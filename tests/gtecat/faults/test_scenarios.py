@@ -537,13 +537,47 @@ def test_homing_interrupted_by_a_link_loss() -> None:
     assert wait(lambda: gt.GT_GetEcatHomingStatus(1, byref(hs)) == 0 and hs.value == 5, 1000)
 
 
-def test_a_new_bus_starts_without_the_faults_of_the_old_one() -> None:
+def test_a_new_bus_keeps_the_injected_faults_and_ticks_them_once() -> None:
     up()
     faults.inject("drive_fault", axis=1, code=0x2310, at_ms=10**6)
     assert len(faults.listing()) == 1
-    assert gt.GT_InitEcatComm() == 0  # a new bus: the armed fault went with the old one
-    assert faults.listing() == []
+    assert gt.GT_InitEcatComm() == 0  # a re-initialisation repairs nothing
+    assert [(f["id"], f["state"], f["at_ms"]) for f in faults.listing()] == [(1, "armed", 10**6)]
     ctl = gt.GTE_Controller()
-    assert not [
-        f for f in ctl.pre_cycle if type(getattr(f, "__self__", None)).__name__ == "Injector"
-    ]
+    ticks = [f for f in ctl.pre_cycle if type(getattr(f, "__self__", None)).__name__ == "Injector"]
+    assert len(ticks) == 1 and ticks[0].__self__.bus.backend is ctl.backend
+
+
+def test_a_pulled_cable_stays_pulled_through_a_re_initialisation() -> None:
+    """GT_InitEcatComm again while a link is down: the cable is still out (the fault stays,
+    active, as one armed at once would start once the bus is up); a spent one-shot fault is
+    gone, a counted one goes on with what it has left; a new fault gets a new id."""
+    up("manual_fig5_2.eni", axes=2)
+    faults.inject("power_cycle", slave=3)  # once: over at once
+    cut = faults.inject("link_down", after_slave=0)
+    drops = faults.inject("drop_responses", count=5, at_ms=10**6)
+    gt.GTE_Wait(5)
+    n = c_short()
+    gt.GT_GetEcatSlaves(byref(n))
+    assert n.value == 1
+    assert gt.GT_InitEcatComm() == 0
+    assert [(f["id"], f["state"]) for f in faults.listing()] == [(cut, "active"), (drops, "armed")]
+    gt.GTE_Wait(200)
+    gt.GT_GetEcatSlaves(byref(n))
+    assert (ready(), n.value) == (0, 1)
+    assert sts(2) & ALARM
+    assert faults.inject("sto", axis=1) == drops + 1
+    assert faults.clear(cut) == 1
+    assert wait(lambda: ready() == 1, 500)
+
+
+def test_a_machine_fault_is_armed_anew_by_a_re_initialisation(tmp_path: Path) -> None:
+    """A ``[[fault]]`` table belongs to the bring-up: armed again (not kept and doubled),
+    beside an injected fault that is kept."""
+    m = tmp_path / "m.toml"
+    m.write_text('[[fault]]\nkind = "drive_fault"\naxis = 1\nat_ms = 1000000\nname = "late"\n')
+    up(machine=m)
+    faults.inject("brake", axis=1, at_ms=2 * 10**6)
+    assert [f["kind"] for f in faults.listing()] == ["drive_fault", "brake"]
+    assert gt.GT_InitEcatComm() == 0
+    assert [(f["id"], f["kind"]) for f in faults.listing()] == [(2, "brake"), (3, "drive_fault")]
