@@ -28,9 +28,9 @@ nothing goes offline.  While the working counter stays short the states are read
 again after :attr:`Master.loss_confirm_ns` (10 ms), every
 :attr:`Master.recover_every` cycles from then on, and in every cycle whose count
 differs from the cycle's before (slaves gone, or back behind a cut mended in part).
-``GT_GetEcatSlaves`` counts what these reads found, as the others do: no read of its own.  The controller stops the axes
-of offline slaves and the GT layer refuses process data that touches them
-(:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
+``GT_GetEcatSlaves`` counts what these reads found, as the others do: no read of its
+own.  The controller stops the axes of offline slaves and the GT layer refuses process
+data that touches them (:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
 
 Lost SDO answer: a master that sends an SDO request and gets no answer waits its
 mailbox timeout before it gives up with 0x05040000 (SDO protocol timed out).  The
