@@ -162,7 +162,40 @@ def _windows(raw: Any, where: str) -> tuple[Window, ...]:
     return tuple(sorted(out))
 
 
-def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescription:
+#: the tables of a machine description, as they are written in it
+TABLES = {
+    "axis": "[axis.N]",
+    "fault": "[[fault]]",
+    "ext": "[ext.N]",
+    "glink": "[glink.N]",
+    "card": "[card.N]",
+    "core": "[core.N]",
+}
+
+
+def refuse_unknown(keys: Any, known: Any, where: str, what: str = "key(s)", has: str = "") -> None:
+    """A key or table a description does not know is a typo that would be ignored: one
+    error naming it (``has``: what the description knows, said after it)."""
+    unknown = sorted(set(keys) - set(known))
+    if unknown:
+        names = ", ".join(f"[{k}]" if what.startswith("table") else k for k in unknown)
+        raise MachineError(f"{where}: unknown {what} {names}" + (f"; {has}" if has else ""))
+
+
+def machine_from_dict(
+    data: Mapping[str, Any], source: str = "", extra_keys: Any = ()
+) -> MachineDescription:
+    """The machine description of a TOML file's tables (or a dict of them); a table it does
+    not know is refused (``extra_keys``: other keys the caller reads beside them)."""
+    if not isinstance(data, Mapping):
+        raise MachineError(f"{source}: a machine description is a table of tables")
+    refuse_unknown(
+        data,
+        {*TABLES, *extra_keys},
+        source or "machine description",
+        "table(s)",
+        "a machine description has " + ", ".join(TABLES.values()),
+    )
     axes_raw = data.get("axis", {})
     if not isinstance(axes_raw, dict):
         raise MachineError(f"{source}: [axis.N] tables expected")
@@ -175,9 +208,7 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
             raise MachineError(f"{where}: axis number must be an integer") from None
         if n < 1:
             raise MachineError(f"{where}: axes are numbered from 1")
-        unknown = set(table) - _KEYS
-        if unknown:
-            raise MachineError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+        refuse_unknown(table, _KEYS, where)
 
         def num(name: str, default: Any = None, *, where: str = where, table: Any = table) -> Any:
             v = table.get(name, default)

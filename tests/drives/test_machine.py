@@ -42,6 +42,8 @@ def test_toml_loading(tmp_path):
         ({"axis": {"1": {"negative_limit": 5, "positive_limit": 1}}}, "below"),
         ({"axis": {"1": {"home_switch": [[3, 1]]}}}, "low < high"),
         ({"axis": {"1": {"counts_per_rev": "x"}}}, "number"),
+        # a misspelt table would be ignored: refused, with the tables there are
+        ({"axis": {}, "falt": {"kind": "sto"}}, r"unknown table\(s\) \[falt\]; .*\[\[fault\]\]"),
     ],
 )
 def test_bad_descriptions_are_refused(table, match):

@@ -182,6 +182,8 @@ def _open(machine: Path | None = None) -> int:
         ('kind = "sto"\naxis = 1\non_sdo = [7, 0x6060, 1]', "on_sdo: no slave 7"),
         ('kind = "sto"\naxis = 1\non_sdo = [1, 0x6060, 1]', "slave 1 (IO 1) has no mailbox"),
         ('kind = "wkc_offset"\narea = [1000, 1010]', "lies past the process image"),
+        # true is no axis 1 (only a yes-or-no value takes true/false)
+        ('kind = "drive_fault"\naxis = true', "axis must be an integer, got True"),
     ],
 )
 def test_the_machine_toml_refuses_with_one_code(tmp_path: Path, table: str, words: str) -> None:
@@ -190,6 +192,38 @@ def test_the_machine_toml_refuses_with_one_code(tmp_path: Path, table: str, word
     assert _open(m) == 1
     why = gt.GTE_GetLastError()
     assert words in why and f"{m} [[fault]] #1: " in why, why
+
+
+def test_two_tables_of_one_name_are_refused(tmp_path: Path) -> None:
+    m = tmp_path / "m.toml"
+    m.write_text('[[fault]]\nkind = "sto"\naxis = 1\nname = "a"\n' * 2)
+    assert _open(m) == 1
+    assert f"{m} [[fault]] #2: name 'a' names another fault already" in gt.GTE_GetLastError()
+
+
+def test_python_inputs_that_are_not_a_fault_are_told_so() -> None:
+    """What is no fault table is refused in words, before anything is armed: booleans as
+    numbers, a script that is no list of tables, a name used twice."""
+    assert _open() == 0
+    with pytest.raises(FaultSpecError, match="axis must be an integer, got True"):
+        faults.inject("drive_fault", axis=True)
+    with pytest.raises(FaultSpecError, match="slave must be an integer, got 'false'"):
+        faults.inject("io_stuck", slave="false", bit=0)
+    assert faults.describe({"kind": "switch_stuck", "axis": 1, "switch": "home", "value": True})
+    with pytest.raises(FaultSpecError, match="a script is a list of steps"):
+        faults.script("x")  # type: ignore[arg-type]
+    with pytest.raises(FaultSpecError, match="step 2: a fault is a table of its values"):
+        faults.script([{"kind": "sto", "axis": 1}, "link_down"])  # type: ignore[list-item]
+    with pytest.raises(FaultSpecError, match=r"a fault is a table of its values.*got 3"):
+        faults.describe(3)  # type: ignore[arg-type]
+    assert faults.listing() == []  # (the script's first step was not armed either)
+    faults.inject("sto", axis=1, at_ms=10**6, name="a")
+    with pytest.raises(FaultSpecError, match="name 'a' names another fault already"):
+        faults.inject("brake", axis=1, name="a")
+    faults.inject("drive_fault", axis=1, at_ms=10**6)
+    assert [type(f["code"]) for f in faults.listing() if "code" in f] == [int]
+    faults.inject(faults.kinds.DriveFault(axis=1), at_ms=10**6)
+    assert {type(f["code"]) for f in faults.listing() if "code" in f} == {int}
 
 
 def test_python_inject_refuses_and_after_slave_minus_1_takes_the_whole_bus() -> None:
