@@ -67,6 +67,7 @@ from gtecat.drives.faults import (
     FieldOverride,
     error_register,
     fault_code,
+    forced_level,
 )
 from gtecat.drives.homing import SUPPORTED_METHODS, Homing, HomingParams
 from gtecat.drives.machine import AxisMachine
@@ -705,7 +706,7 @@ class Channel:
                 acceleration=float(self.homing_acceleration),
                 home_offset=int(self.home_offset),
             )
-            self.homing = Homing(params, self.machine, self.mech.pos)
+            self.homing = Homing(params, self.machine, self.mech.pos, self.forced_switches)
         except GtecatError as err:  # the homing component refused the parameters
             log.warning("axis channel %d: homing cannot start: %s", self.k, err)
             self.homing = None
@@ -950,8 +951,15 @@ class Channel:
             din |= 1 << 17
         ff = self.field
         if ff is not None:
-            din = (din | ff.din_set) & ~ff.din_clear
+            din = forced_level(din, ff.din_set, ff.din_clear)
         return din
+
+    def forced_switches(self) -> tuple[int, int]:
+        """The 60FDh bits the field forces on and off now (``switch_stuck``,
+        ``switch_chatter``): what :meth:`_inputs` lays over the machine's switches, handed
+        to the homing so that it reads the switches as 60FDh shows them."""
+        ff = self.field
+        return (0, 0) if ff is None else (ff.din_set, ff.din_clear)
 
     def _outputs(self) -> None:
         mech = self.mech

@@ -157,6 +157,13 @@ class FaultMonitor:
         self.pending = 0
 
 
+def forced_level(din: int, on: int, off: int) -> int:
+    """The inputs ``din`` as the drive reads them while the field forces the bits ``on``
+    set and the bits ``off`` clear (a bit in both reads clear): the one rule for 60FDh,
+    the drive's homing and everything that reads a switch through them."""
+    return (din | on) & ~off
+
+
 class FieldOverride:
     """What the field does to one channel against the machine description: the scenario's
     hands on the wiring and the mechanics (set by :mod:`gtecat.faults`, read every cycle).
