@@ -254,6 +254,11 @@ class Homing:
             return None
         return self.home_machine_position - self.params.home_offset
 
+    def shift_demand(self, counts: float) -> None:
+        """The encoder slipped by ``counts`` (:meth:`Channel.lose_counts`): the demand, kept in
+        the drive's measured frame, now lies ``counts`` further on in machine counts."""
+        self._p += counts
+
     def halt(self, on: bool) -> None:
         """CW8: decelerate and hold; the search does not resume (module docstring)."""
         if not on or self._stopping:
