@@ -36,7 +36,7 @@ Decisions (the standard leaves them open; tested in ``tests/drives/test_homing.p
   (heading for the edge that leaves it) and never finds it; a chattering one gives an edge
   wherever it toggles, and the drive takes the first that fits the method, as a real
   drive would.  Limits likewise: a limit stuck inactive is never met (the search runs to
-  its travel bound), one stuck active at the start is a homing error at once.
+  its travel bound); one stuck active is met at once when the search heads into it.
 * **Errors** (SW13): a limit switch hit where the method does not reverse on it, a
   second hit of the reversal limit, no index pulse within one revolution after the
   reference edge, or the search exceeding ``max_travel`` or ``timeout_s``.  The axis
@@ -138,6 +138,11 @@ class HomingPhase(IntEnum):
 
 _SEARCHING = (HomingPhase.SEARCH, HomingPhase.APPROACH, HomingPhase.INDEX)
 
+#: the switches a search reads, without / with the home switch (the limits always)
+_SIGNALS_READ = (
+    (Signal.NEGATIVE_LIMIT, Signal.POSITIVE_LIMIT),
+    (Signal.HOME_SWITCH, Signal.NEGATIVE_LIMIT, Signal.POSITIVE_LIMIT),
+)
 #: 60FDh bits of the switches a search reads (bit n = :class:`Signal` n)
 SWITCH_BITS = 0b111
 #: (bits forced on, bits forced off) of 60FDh: nothing forced
@@ -365,10 +370,8 @@ class Homing:
         prev = self._forced
         sampled = prev[0] | prev[1] | forced[0] | forced[1]
         if sampled:
-            for sig in (spec.signal, Signal.NEGATIVE_LIMIT, Signal.POSITIVE_LIMIT):
-                if sig is None or not sampled & (1 << sig):
-                    continue
-                if sig is Signal.HOME_SWITCH and spec.signal is not sig:
+            for sig in _SIGNALS_READ[spec.signal is Signal.HOME_SWITCH]:
+                if not sampled & (1 << sig):
                     continue
                 now = self._signal_level(sig, p1, forced)
                 if now != self._signal_level(sig, p0, prev):
