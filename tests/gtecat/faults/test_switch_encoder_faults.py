@@ -180,6 +180,25 @@ def test_smart_homing_reads_the_faulted_home_switch(machine: Path, where, stuck)
         assert machine_pos() > 6000  # searched on, past the machine's switch
 
 
+def test_the_older_gt_home_of_a_card_reads_it_too() -> None:
+    desc = MachineDescription(
+        {1: AxisMachine(negative_limit=-20000, positive_limit=20000, home_switch=((5000, 20000),))}
+    )
+    assert gt.GT_Open(card="gts:1", machine=desc, clock="lockstep", log="") == 0
+    assert gt.GT_AxisOn(1) == 0
+    faults.inject("switch_stuck", axis=1, switch="home", value=0)
+    gt.GTE_Wait(2)
+    assert gt.GT_Home(1, 10000, 80, 4, 0) == 0, gt.GTE_GetLastError()
+    sts = c_short()
+    for _ in range(1000):
+        rc = gt.GT_HomeSts(1, byref(sts))
+        if rc or sts.value:
+            break
+        gt.GTE_Wait(1)
+    assert (rc, sts.value) == (1, 0)  # failed: no home before the end of the search
+    assert machine_pos() > 6000
+
+
 # --- the encoder ---------------------------------------------------------------------------------
 def test_counts_lost_beyond_the_window_show_in_60f4_and_fault_the_drive_8611(
     machine: Path,
