@@ -17,6 +17,22 @@ functions are taken from the running interpreter, and the entry is tested agains
 answers (every kind of shape it must hand on, the widths, reference counts) before use.  Any
 disagreement, or no compiler: :data:`REASON` says why and :func:`reader` gives None (the
 Python fast function is then the public one, as before).
+
+Another thread.  On the lockstep and auto clocks a cycle runs in whichever thread lets
+controller time pass (GTE_Wait, a call's host latency, a controller server's wall floor),
+holding the controller's clock lock, as every call of the table path does.  The entries answer
+without taking it, and the GIL alone does not make what they read whole: the interpreter hands
+it over between any two bytecodes of the other thread's cycle (so a read could find half the
+axes, half the slaves' inputs, of the next cycle), and the axis bank's compiled cycle runs with
+the GIL let go.  So an entry answers from what it read only where no other thread held the
+lock when it began and, where its value function (Python) ran, none held it afterwards and
+the epoch did not grow meanwhile; else it takes the lock itself (waiting with the GIL let go)
+and answers holding it, as the table path would (csrc/centry.c "Another thread and the
+clock", :data:`CLOCK_LOCK`).  The copy or write that follows the last look runs no Python.
+The common case costs one load of the lock's holder word.  Not covered: the Python fast
+functions (the shapes an entry hands on, and every shape where no entry is built) read
+without the lock as before, and the cycles a card runs for another card of one time
+(``ClockGroup.share``) do not take that card's lock.
 """
 
 from __future__ import annotations
