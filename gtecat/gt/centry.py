@@ -602,6 +602,11 @@ def _slots(e: Any) -> Any:
 def _load() -> tuple[Maker | None, str]:
     if sys.implementation.name != "cpython":
         return None, "not CPython"
+    gil = getattr(sys, "_is_gil_enabled", None)
+    if gil is not None and not gil():
+        # (an entry's reads and writes are whole against other threads only under the GIL:
+        # the module docstring, "Another thread")
+        return None, "the interpreter runs without a GIL"
     try:
         carg_value, carg_obj, ob_type, b_ptr = byref_target.layout()
         fval = _float_at()
