@@ -83,7 +83,7 @@ struct api {
      * call of the table path run with their controller's clock lock held, and another
      * thread of the program may run them (the lockstep and auto clocks run their cycles in
      * whichever thread lets time pass): an entry that finds the lock held by another thread
-     * takes it itself (waiting, the GIL let go) and answers while it holds it (see held()) */
+     * takes it itself (waiting, the GIL let go) and answers while it holds it (see ANSWER) */
     const ptrdiff_t *clock_lock;
     ptrdiff_t owner_off;
     unsigned long (*thread_ident)(void);
@@ -254,7 +254,7 @@ static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
  * when it began (elsewhere()), and, where Python ran for the value, none held it afterwards
  * and the epoch did not grow meanwhile (every cycle and every call of the table path makes it
  * grow once done: gtecat.controller.epoch); else it answers again holding the lock itself
- * (held()).  The write of the value, the copy of a raw range, follow the last look with no
+ * (ANSWER).  The write of the value, the copy of a raw range, follow the last look with no
  * Python in between. */
 
 /* a try's body inlined into its entry (the common case pays no call for the split) */
