@@ -209,7 +209,7 @@ def test_reads_hammered_beside_a_thread_that_runs_cycles_are_whole(bank):
             sys.setswitchinterval(old)
             t.join(10)
         assert not torn, f"{len(torn)} of {reads} reads were of half a cycle: {torn[:3]}"
-        assert reads > 30
+        assert reads > 30, reads
         assert len(set(_prf())) == 1 and _prf()[0] > 1000
     finally:
         gt.GT_Close()
