@@ -490,7 +490,8 @@ class Injector:
         elif isinstance(f, k.SwitchChatter):
             bus.override(f.axis)
         elif isinstance(f, k.EncoderLost):
-            bus.override(f.axis).enc_shift -= f.counts
+            bus.before_change()
+            bus.channel(f.axis).lose_counts(f.counts)
         elif isinstance(f, k.EncoderNoise):
             bus.override(f.axis).enc_noise = f.counts
         elif isinstance(f, k.ProbeMissing):
@@ -536,8 +537,6 @@ class Injector:
             bit = 1 << k.SWITCH_BITS[f.switch]
             ff.din_set &= ~bit
             ff.din_clear &= ~bit
-        elif isinstance(f, k.EncoderLost):
-            bus.override(f.axis).enc_shift += f.counts
         elif isinstance(f, k.EncoderNoise):
             bus.override(f.axis).enc_noise = 0
         elif isinstance(f, k.ProbeMissing):

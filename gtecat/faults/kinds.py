@@ -405,7 +405,11 @@ class SwitchChatter(Fault):
 class EncoderLost(Fault):
     kind: ClassVar[str] = "encoder_lost"
     depth: ClassVar[str] = "field"
-    summary: ClassVar[str] = "the encoder of AXIS loses COUNTS counts (6064h jumps by -COUNTS)"
+    once: ClassVar[bool] = True
+    summary: ClassVar[str] = (
+        "the encoder of AXIS loses COUNTS counts: 6064h jumps by -COUNTS and stays off until "
+        "homed again; the drive's loop sees the error (60F4h) and closes it, or faults 8611h"
+    )
     axis: int
     counts: int = 100
 
