@@ -354,12 +354,14 @@ class Axis:
         quick stop and 605Ah decides where it ends - 1..4 in *switch on disabled* by itself,
         5..8 standing in quick stop active.  The command never enables it again (transition 16
         needs "enable operation"), whatever 605Ah says and whenever the input is released.
-        The manual only says the controller turns the servo off (chapter 9.3); CiA 402 gives
-        the ramp to the drive.  Once the drive has left quick stop active, the controller
-        sends disable voltage (0000h), as for any other drive that dropped out
-        (:meth:`quick_stop_over`).  ``GT_AxisOn`` walks back from either state; GT_GetSts
-        shows bit 9 clear from the cycle the controller saw the drive leave operation
-        enabled.  Any other state: :meth:`request_disable`.
+        The manual says what the controller does on a drive alarm (chapter 9.3: servo off) and
+        nothing of a drive's quick stop (chapter 5 neither); CiA 402 gives the ramp to the
+        drive, and a servo off that cuts it short would be the controller's doing.  Once the
+        drive has left quick stop active, the controller sends disable voltage (0000h), as for
+        any other drive that dropped out (:meth:`quick_stop_over`).  ``GT_AxisOn`` walks back
+        from either state; GT_GetSts shows bit 9 clear (no alarm: the drive did not fault)
+        from the cycle the controller saw the drive leave operation enabled.  Any other
+        state: :meth:`request_disable`.
         """
         if self.statusword & _SW_STATE_MASK == _SW_QUICK_STOP_ACTIVE:
             self.servo_on = False
