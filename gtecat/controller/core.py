@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gtecat.drives.machine import MachineDescription, load_machine
+from gtecat.drives.machine import read_note as machine_read_note
 from gtecat.drives.slave import VirtualSlave
 from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
@@ -285,6 +286,9 @@ class Controller:
         master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
         master.mailbox_wait = self._mailbox_wait
         self.layout, self.backend, self.master = layout, backend, master
+        note = machine_read_note(self.machine)
+        if note:
+            self.log(note)  # (what the drives are built from: two runs' inputs compared)
         self.started = False
         self.axes = {
             ref.axis: Axis(
