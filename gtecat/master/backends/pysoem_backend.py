@@ -807,7 +807,7 @@ class PysoemBackend(Backend):
         with self.mailbox_lock:
             if position in self._mailbox_dirty:
                 self._forget_soem_errors(position)
-            t0 = time.monotonic()
+            t0 = self._monotonic()
             try:
                 try:
                     return bytes(
@@ -822,7 +822,7 @@ class PysoemBackend(Backend):
                         )
                     )
             except errors as e:
-                waited = time.monotonic() - t0
+                waited = self._monotonic() - t0
                 self._forget_soem_errors(position)
                 self._mailbox_dirty.add(position)
                 raise self._sdo_error(e, position, "upload", index, subindex, waited) from None
@@ -837,13 +837,13 @@ class PysoemBackend(Backend):
         with self.mailbox_lock:
             if position in self._mailbox_dirty:
                 self._forget_soem_errors(position)
-            t0 = time.monotonic()
+            t0 = self._monotonic()
             try:
                 self._past_emergencies(
                     position, write, index, subindex, bytes(data), ca=complete_access
                 )
             except errors as e:
-                waited = time.monotonic() - t0
+                waited = self._monotonic() - t0
                 self._forget_soem_errors(position)
                 self._mailbox_dirty.add(position)
                 raise self._sdo_error(e, position, "download", index, subindex, waited) from None
@@ -902,10 +902,16 @@ class PysoemBackend(Backend):
             sys.setswitchinterval(self._switch_interval)
             self._switch_interval = None
         if m is not None:
+            # an SDO another thread is waiting for ends first (by its answer or its timeout):
+            # SOEM must not lose its socket under it
+            held = self.mailbox_lock.acquire(timeout=2 * SDO_TIMEOUT_MS / 1000)
             try:
                 m.close()
             except Exception as e:
                 _log.debug("pysoem close: %s", e)
+            finally:
+                if held:
+                    self.mailbox_lock.release()
 
 
 def _describe_soem_error(e: Any, *, slave: bool = True) -> str:

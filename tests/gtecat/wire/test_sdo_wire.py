@@ -105,8 +105,7 @@ def wire(veth, tmp_path: Path) -> Iterator[object]:
     gt.GT_Close()
     try:
         assert (
-            gt.GT_Open(eni=str(ENI), backend="pysoem", iface=veth[0], clock="realtime", log="")
-            == 0
+            gt.GT_Open(eni=str(ENI), backend="pysoem", iface=veth[0], clock="realtime", log="") == 0
         )
         up: dict = {}
         assert scenario_common.bring_up(gt, up), (up, gt.GTE_GetLastError())
