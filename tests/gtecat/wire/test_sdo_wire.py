@@ -46,6 +46,11 @@ slave = 0
 index = 0x6068
 variant = "short"
 [[fault]]
+kind = "mailbox_protocol"
+slave = 0
+index = 0x6066
+variant = "wrong_service"
+[[fault]]
 kind = "mailbox_abort"
 slave = 0
 index = 0x6065
@@ -146,10 +151,14 @@ def test_cycles_run_while_an_sdo_waits_and_the_codes_are_the_emulated_ones(wire)
     assert not _sts(gt, 1) & ALARM, "the drive's SM watchdog ran out: process data stopped"
     # the next SDO to the same slave is answered
     assert _upload(gt, 0, 0x6067)[:2] == (0, 0)
-    # a protocol fault (an SDO response with no SDO in it) and an abort: their codes
-    rc, abort, why = _upload(gt, 0, 0x6068)
-    assert rc == 1 and abort == GENERAL_ERROR, why
-    assert _upload(gt, 0, 0x6068)[:2] == (0, 0)
+    # protocol faults (an SDO response with no SDO in it, another CoE service's answer)
+    # and an abort: their codes, at once
+    for index in (0x6068, 0x6066):
+        w0 = time.monotonic()
+        rc, abort, why = _upload(gt, 0, index)
+        assert rc == 1 and abort == GENERAL_ERROR, why
+        assert time.monotonic() - w0 < 0.5
+        assert _upload(gt, 0, index)[:2] == (0, 0)
     rc, abort, why = _upload(gt, 0, 0x6065)
     assert rc == 1 and abort == OUT_OF_RANGE, why
     assert _download(gt, 0, 0x6065)[:2] == (0, 0)
@@ -186,12 +195,14 @@ def test_the_emulated_bus_gives_the_same_codes() -> None:
         assert gt.GT_InitEcatComm() == 0
         faults.inject("mailbox_lost", slave=0, index=0x6067)
         faults.inject("mailbox_protocol", slave=0, index=0x6068, variant="short")
+        faults.inject("mailbox_protocol", slave=0, index=0x6066, variant="wrong_service")
         faults.inject("mailbox_protocol", slave=1, index=0x6068)
         faults.inject("mailbox_abort", slave=0, index=0x6065, code=OUT_OF_RANGE)
         c0 = _clock(gt)
         assert _upload(gt, 0, 0x6067)[:2] == (1, TIMED_OUT)
         assert _clock(gt) - c0 == 700
         assert _upload(gt, 0, 0x6068)[:2] == (1, GENERAL_ERROR)
+        assert _upload(gt, 0, 0x6066)[:2] == (1, GENERAL_ERROR)
         assert _upload(gt, 1, 0x6068)[:2] == (1, GENERAL_ERROR)
         assert _upload(gt, 0, 0x6065)[:2] == (1, OUT_OF_RANGE)
     finally:
