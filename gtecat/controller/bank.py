@@ -86,6 +86,7 @@ from gtecat.eni.model import Direction
 
 from .._attrs import own_dict
 from ..master.clock import ClockMode
+from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
 from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
@@ -890,8 +891,8 @@ class AxisBank:
         if self.kernel is None:
             return False
         ax, res = self.axes[r], self.res[r]
-        if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error:
-            return False
+        if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error or ax.cw == CW_QUICK_STOP:
+            return False  # (a quick stop the drive finishes: its controlword changes after it)
         st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active):
             return False

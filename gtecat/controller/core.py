@@ -50,6 +50,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from gtecat.drives.machine import MachineDescription, load_machine
+from gtecat.drives.machine import read_note as machine_read_note
 from gtecat.drives.slave import VirtualSlave
 from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
@@ -290,6 +291,9 @@ class Controller:
         master.mailbox_wait = self._mailbox_wait
         master.mailbox_transfer = self._mailbox_transfer
         self.layout, self.backend, self.master = layout, backend, master
+        note = machine_read_note(self.machine)
+        if note:
+            self.log(note)  # (what the drives are built from: two runs' inputs compared)
         self.started = False
         self.axes = {
             ref.axis: Axis(

@@ -25,10 +25,12 @@ reads of PDO objects give no delay), so there is none here: what
 objects return agree from the first cycle.  One lost frame, or a short stall of
 the wire, is still no loss: the state read is answered, every slave in OP, and
 nothing goes offline.  While the working counter stays short the states are read
-again after :attr:`Master.loss_confirm_ns` (10 ms) and every
-:attr:`Master.recover_every` cycles from then on.  The controller stops the axes
-of offline slaves and the GT layer refuses process data that touches them
-(:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
+again after :attr:`Master.loss_confirm_ns` (10 ms), every
+:attr:`Master.recover_every` cycles from then on, and in every cycle whose count
+differs from the cycle's before (slaves gone, or back behind a cut mended in part).
+``GT_GetEcatSlaves`` counts what these reads found, as the others do: no read of its
+own.  The controller stops the axes of offline slaves and the GT layer refuses process
+data that touches them (:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
 
 Lost SDO answer: a master that sends an SDO request and gets no answer waits its
 mailbox timeout before it gives up with 0x05040000 (SDO protocol timed out).  The
@@ -276,6 +278,7 @@ class Master:
         wkc = self.backend.exchange(t_ns, dt_ns)
         self.cycles += 1
         expected = self.backend.expected_wkc() if self.target == _OP else wkc
+        before = self.last.wkc
         self.last = CycleResult(wkc, expected)
         if self._op_countdown >= 0:
             self._op_countdown -= 1
@@ -296,8 +299,11 @@ class Master:
             periodic = confirmed and self.cycles % self.recover_every == 0
             if periodic and not self.backend.recovers_itself:
                 self.recover()
-            elif periodic or bad == 0 or bad < self.loss_confirm_ns <= self._bad_ns:
-                # who is gone, from the first short cycle on (comm loss, module docstring)
+            elif (
+                periodic or bad == 0 or bad < self.loss_confirm_ns <= self._bad_ns or wkc != before
+            ):
+                # who is gone, from the first short cycle on (comm loss, module docstring),
+                # and again whenever the count changes while short (slaves gone or back)
                 self.refresh_states()
         if self.last.ok:
             self._bad_ns = 0
