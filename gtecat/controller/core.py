@@ -42,8 +42,8 @@ from __future__ import annotations
 
 import gc
 import os
-import time
 from collections.abc import Callable
+from concurrent import futures
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -446,19 +446,8 @@ class Controller:
         if pool is None:
             pool = self._mailbox_pool = ThreadPoolExecutor(1, thread_name_prefix="gtecat-mbx")
         future = pool.submit(transfer)
-        due = time.perf_counter_ns() + clock.cycle_ns
-        while True:
-            wait_s = (due - time.perf_counter_ns()) / 1e9
-            try:
-                return future.result(timeout=max(0.0, wait_s))  # (its exception raised here)
-            except TimeoutError:
-                if future.done():
-                    raise  # (the transfer's own)
-            clock.advance_ns(clock.cycle_ns)  # one bus cycle of wall time passed
-            due += clock.cycle_ns
-            now = time.perf_counter_ns()
-            if now > due:  # a cycle overran a whole period: re-phase, no burst (realtime too)
-                due = now + clock.cycle_ns
+        clock.pace(lambda seconds: bool(futures.wait((future,), timeout=seconds).done))
+        return future.result()  # (or the transfer's exception)
 
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has

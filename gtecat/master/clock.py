@@ -215,6 +215,23 @@ class Clock:
             if owned:
                 self.lock.acquire()
 
+    def pace(self, done: Callable[[float], bool]) -> int:
+        """Virtual time at the wall clock's pace while something outside runs on the wall
+        clock (a mailbox transfer on a wire): one cycle each time a bus cycle of wall time
+        has passed, until ``done(seconds)``, which waits up to that long for the end of that
+        something, says it is over.  A cycle late by a whole period re-phases, as in
+        realtime (no burst).  Returns the cycles run."""
+        n = 0
+        due = time.perf_counter_ns() + self.cycle_ns
+        while not done(max(0, due - time.perf_counter_ns()) / 1e9):
+            self.advance_ns(self.cycle_ns)
+            n += 1
+            due += self.cycle_ns
+            now = time.perf_counter_ns()
+            if now > due:
+                due = now + self.cycle_ns
+        return n
+
     @contextlib.contextmanager
     def unlocked(self) -> Iterator[None]:
         """The cycle lock let go for the block, however many times this thread holds it, so
