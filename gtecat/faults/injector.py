@@ -827,7 +827,9 @@ def _protocol_fault(request: bytes, variant: str) -> bytes:
     if variant == "mailbox_error":
         return mailbox_error(MailboxError.SERVICE_NOT_SUPPORTED, counter=counter)
     if variant == "wrong_service":
-        return build_coe(CoeService.EMERGENCY, bytes(8), counter=counter)
+        # an answer of another CoE service, not an emergency: a master takes an emergency
+        # for what it is (ETG.1000.6 5.6.4: logged) and waits on for the SDO's answer
+        return build_coe(CoeService.SDO_INFORMATION, bytes(8), counter=counter)
     return build_coe(CoeService.SDO_RESPONSE, b"", counter=counter)  # "short": no SDO frame
 
 

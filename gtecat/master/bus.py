@@ -39,12 +39,21 @@ so the emulated master waits what its hardware backend waits (SOEM's mailbox
 receive timeout, 700 ms: :data:`SDO_TIMEOUT_MS`), in controller time: the cycles
 run while the call waits (:attr:`Master.mailbox_wait`), in lockstep and auto
 alike, so a loop that polls by SDO sees the time a real one would.
+
+Mailbox on a wire: a backend whose SDOs wait for a real slave's answer
+(:attr:`Backend.mailbox_on_wire`: pysoem) takes that time on the wall clock.  A real
+controller's firmware keeps the cyclic exchange going while a mailbox transfer is
+pending, so the master hands such a transfer to :attr:`Master.mailbox_transfer` (set
+by the controller), which keeps the cycles running at the bus cycle meanwhile and
+counts them on the controller's clock: a lost answer costs 700 ms of controller time
+in which the axes move and the slaves' watchdogs stay fed, on both backends.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from gtecat.drives.slave import AlState, AlStatusCode
 from gtecat.eni.errors import GtecatError
@@ -54,6 +63,8 @@ from gtecat.eni.model import InitCmd
 from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend
 from .image import ProcessImage
+
+_T = TypeVar("_T")
 
 #: looked up once: the cycle and :meth:`Master.steady` compare with it (an enum member's
 #: lookup costs more than the comparison)
@@ -123,6 +134,9 @@ class Master:
         #: lets ``ms`` of controller time pass, cycles running (set by the controller):
         #: the wait for an SDO answer that never comes (module docstring "Lost SDO answer")
         self.mailbox_wait: Callable[[float], None] | None = None
+        #: runs one mailbox transfer of a backend whose mailbox waits on a wire (module
+        #: docstring "Mailbox on a wire") while the cycles keep running; None: in place
+        self.mailbox_transfer: Callable[[Callable[[], Any]], Any] | None = None
         #: a short working counter this long in a row is worth a second state read (the
         #: first is made in the first short cycle)
         self.loss_confirm_ns = 10_000_000
@@ -421,9 +435,12 @@ class Master:
         """The object's bytes; ``wait=False``: a lost answer costs no controller time (the
         inspection verbs, which run beside the application, never run its cycles)."""
         self._check_slave(pos)
+        backend = self.backend
+        if wait and backend.mailbox_on_wire:
+            return self._on_wire(lambda: backend.sdo_upload(pos, index, subindex, complete_access))
         lost = self._unanswered(pos) if wait else -1
         try:
-            return self.backend.sdo_upload(pos, index, subindex, complete_access)
+            return backend.sdo_upload(pos, index, subindex, complete_access)
         finally:
             self._timed_out(lost, pos)
 
@@ -439,11 +456,21 @@ class Master:
     ) -> None:
         """Write ``data`` to the object; ``wait`` as for :meth:`sdo_upload`."""
         self._check_slave(pos)
+        backend = self.backend
+        if wait and backend.mailbox_on_wire:
+            self._on_wire(lambda: backend.sdo_download(pos, index, subindex, data, complete_access))
+            return
         lost = self._unanswered(pos) if wait else -1
         try:
-            self.backend.sdo_download(pos, index, subindex, data, complete_access)
+            backend.sdo_download(pos, index, subindex, data, complete_access)
         finally:
             self._timed_out(lost, pos)
+
+    def _on_wire(self, transfer: Callable[[], _T]) -> _T:
+        """A transfer of a mailbox on a wire: the cycles run while it waits (module
+        docstring "Mailbox on a wire"), as long as the slave takes to answer."""
+        run = self.mailbox_transfer
+        return transfer() if run is None else run(transfer)
 
     def _unanswered(self, pos: int) -> int:
         """The SDO requests the backend sent to slave ``pos`` without an answer so far (-1: it
