@@ -570,6 +570,9 @@ def set_gates(gt: Any, gtn: Any) -> None:
         *(c.clock if a else None for c, a in zip(new, auto, strict=True)),
         calls=tuple(_quick_calls(c) if a else None for c, a in zip(new, auto, strict=True)),  # type: ignore[arg-type]
     )
+    centry.set_locks(
+        *(c.clock if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
+    )
     centry.set_gates(*gates)
 
 
@@ -578,10 +581,10 @@ def set_gates(gt: Any, gtn: Any) -> None:
 CYCLE_FAILED: list[Callable[[str, Exception, int], int]] = []
 
 
-def _quick_calls(ctl: Any) -> tuple[Any, Any, Any] | None:
-    """The callables of ``ctl``'s armed quick cycle for the C entries (centry.CLOCK_CALLS):
+def _quick_calls(ctl: Any) -> Any:
+    """``ctl``'s book of its armed quick cycle for the C entries (centry.CLOCK_CALLS):
     ``book(after, rc)`` (Controller.quick_book, whatever it raises turned into the call's
-    code as advance turns it), the clock's lock taken, the lock given back."""
+    code as advance turns it); None: none."""
     quick_book = getattr(ctl, "quick_book", None)
     if quick_book is None or not CYCLE_FAILED:
         return None
@@ -594,8 +597,7 @@ def _quick_calls(ctl: Any) -> tuple[Any, Any, Any] | None:
             return failed(getattr(after, "gt_name", "GT call"), e, 0)
         return 0
 
-    lock = ctl.clock.lock
-    return book, lock.acquire, lock.release
+    return book
 
 
 def _gate_value(ctl: Any) -> int:
