@@ -65,6 +65,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from gtecat.drives.faults import forced_level
+
 from ..controller.crd import bank, make_arc
 from ..controller.crd.base_pulse import BaseSpeed, base_length
 from ..controller.crd.path import CCW, CW, Line, Segment
@@ -84,6 +86,7 @@ LMTP, LMTM, STOP0, STOP1, STOP2, INPOS, ALARM, GPIN = range(8)
 #: get_status bit while a drive waits without pulses (INPOS, Z/W after a broken interpolation)
 WAITING = 0x100
 LIMIT_NEG, LIMIT_POS, HOME = 0x1, 0x2, 0x4  # 60FDh bits
+_PROBE1 = 1 << 16  # 60FDh probe input 1
 #: the abrupt stop of "immediate" limits and sudden stops, pulse/ms² (GT_SetStopDec's maximum)
 IMMEDIATE = STOP_DEC_MAX
 
@@ -316,9 +319,10 @@ class PulseCard:
             return bool(self.din(axis) & HOME)
         if k == STOP1:
             return self._index_seen[axis]
-        if k == STOP2:
-            m, at = self._machine(axis)
-            return m.probe_active(1, at)
+        if k == STOP2:  # (the machine's mark, as the field leaves it: probe_missing)
+            ch = self.ctl.backend.drive(axis).channel(0)
+            on = _PROBE1 if ch.machine.probe_active(1, ch.machine_position) else 0
+            return bool(forced_level(on, *ch.forced_switches()) & _PROBE1)
         if k == INPOS:
             r = self.res(axis)
             return r.profile.planner.done and abs(r.axis_error) <= 1.0

@@ -76,6 +76,12 @@ def decode_state(sw: int) -> PdsState:
     return _decode_state(sw) or PdsState.NOT_READY_TO_SWITCH_ON
 
 
+#: controlword "quick stop" (bit 1 enable voltage set, bit 2 quick stop clear): what the
+#: controller sends a drive that went into quick stop active by itself (drive_left_operation)
+CW_QUICK_STOP = 0x0002
+#: statusword mask and pattern of quick stop active (cia402-facts 1.2)
+_SW_STATE_MASK, _SW_QUICK_STOP_ACTIVE = 0x006F, 0x0007
+
 # controlword the controller sends to move one step towards operation enabled
 _ENABLE_STEP = {
     PdsState.NOT_READY_TO_SWITCH_ON: 0x0000,
@@ -337,6 +343,38 @@ class Axis:
         self.link_lost = self.link_alarm = reason
         self.servo_on = False
         self.cw = 0x0000
+
+    def drive_left_operation(self) -> None:
+        """The drive left operation enabled by itself while the servo was on: servo off.
+
+        A drive in *quick stop active* (its quick-stop input, or a quick stop it started
+        itself) is braking on its quick-stop ramp (6085h, as 605Ah says).  Cutting its voltage
+        then (disable voltage, transition 12) would end the ramp and let the motor coast, so
+        the controller sends "quick stop" (controlword 0002h) instead: the drive finishes its
+        quick stop and 605Ah decides where it ends - 1..4 in *switch on disabled* by itself,
+        5..8 standing in quick stop active.  The command never enables it again (transition 16
+        needs "enable operation"), whatever 605Ah says and whenever the input is released.
+        The manual says what the controller does on a drive alarm (chapter 9.3: servo off) and
+        nothing of a drive's quick stop (chapter 5 neither); CiA 402 gives the ramp to the
+        drive, and a servo off that cuts it short would be the controller's doing.  Once the
+        drive has left quick stop active, the controller sends disable voltage (0000h), as for
+        any other drive that dropped out (:meth:`quick_stop_over`).  ``GT_AxisOn`` walks back
+        from either state; GT_GetSts shows bit 9 clear (no alarm: the drive did not fault)
+        from the cycle the controller saw the drive leave operation enabled.  Any other
+        state: :meth:`request_disable`.
+        """
+        if self.statusword & _SW_STATE_MASK == _SW_QUICK_STOP_ACTIVE:
+            self.servo_on = False
+            self.cw = CW_QUICK_STOP
+        else:
+            self.request_disable()
+
+    def quick_stop_over(self) -> None:
+        """After :meth:`drive_left_operation`: the drive no longer in quick stop active (its
+        ramp done, 605Ah 1..4) gets disable voltage, the controlword of a servo-off axis.
+        Called every cycle the controller holds "quick stop" with the servo off."""
+        if self.statusword & _SW_STATE_MASK != _SW_QUICK_STOP_ACTIVE:
+            self.cw = 0x0000
 
     def request_disable(self) -> None:
         self.servo_on = False

@@ -57,6 +57,7 @@ status cycle by cycle).
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import chain, compress
@@ -86,6 +87,7 @@ from gtecat.eni.model import Direction
 
 from .._attrs import own_dict
 from ..master.clock import ClockMode
+from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
 from .bank_kernel import MAXSEG, NTPRM, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
@@ -111,6 +113,11 @@ from .profile import PrfMode
 
 if TYPE_CHECKING:
     from .core import Controller
+
+#: a moving row's raw pieces (up to MAXSEG of 4 doubles) and move constants, packed into the
+#: kernel's arrays (:meth:`AxisBank._load`)
+_SEG_PACK = [struct.Struct(f"={4 * m}d") for m in range(MAXSEG + 1)]
+_TPRM_PACK = struct.Struct(f"={NTPRM}d")
 
 #: the crossover of the numpy bank: below this many axes the scalar path is as fast
 #: (tools/bench_bank.py); with the compiled cycle the bank wins from one axis
@@ -637,6 +644,8 @@ class AxisBank:
         self.ended = zi(n, bool)
         tl = self.table = KERNEL_TABLE if self._kernel_lib is not None else TABLE
         self.t_p, self.t_v, self.t_a = z((n, tl + 1)), z((n, tl + 1)), z((n, tl + 1))
+        # (flat views of the same memory: a row's slot written by one index)
+        self._t_p1, self._t_v1, self._t_a1 = (t.reshape(-1) for t in (self.t_p, self.t_v, self.t_a))
         self.base = np.arange(n, dtype=np.int64) * (tl + 1)
         # a moving row's raw pieces and move constants, for the kernel's own refills
         self.nseg = zi(n, np.int64)  # 0: none (the table is refilled here)
@@ -890,8 +899,8 @@ class AxisBank:
         if self.kernel is None:
             return False
         ax, res = self.axes[r], self.res[r]
-        if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error:
-            return False
+        if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error or ax.cw == CW_QUICK_STOP:
+            return False  # (a quick stop the drive finishes: its controlword changes after it)
         st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active):
             return False
@@ -976,8 +985,12 @@ class AxisBank:
         if s.positive_input not in (n, None) or s.negative_input not in (n, None):
             return False
         din = ax.io.get(0x60FD)
-        if any(e is not None and e is not din for e in (res._pos_din, res._neg_din)):
+        e = res._pos_din
+        if e is not None and e is not din:
             return False  # a configuration's reverse (SensedInput) or another source
+        e = res._neg_din
+        if e is not None and e is not din:
+            return False
         # the alarm read through a reverse: the kernel reads 6041h as it is
         return res._alarm_sw is res._sw
 
@@ -1150,21 +1163,24 @@ class AxisBank:
 
     def _load(self, r: int, again: bool = False) -> None:
         """Take row ``r`` from its objects; ``again``: a row loaded before whose scale, links,
-        limits and encoder settings nothing changed since (a step in place)."""
+        limits, band and encoder settings nothing changed since (a step in place).
+
+        (Called at every claim, step in place and posted edge: the attributes are read into
+        locals once and each array is indexed once.)"""
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = True
         aware = aware_hooks(ax)
         watch = 0
         for obj in aware:
             watch |= obj.bank_watch
-        self.dwatch[r] = watch
-        self.dpost[r] = 0
         if aware:
             self._aware[r] = aware
         latched = int(res.latched)
         self.lvel[r] = (1 if latched & _POS_LIMIT else 0) | (2 if latched & _NEG_LIMIT else 0)
         res.bank, res.bank_row = self, r
         self.layout += 1
+        enc = res.encoder
+        b = res.band
         if not again:
             s = ax.pos_scale
             self.unit2[r] = float(1 << s)
@@ -1177,18 +1193,16 @@ class AxisBank:
             self.soft_pos[r] = sf.soft_positive if on else np.inf
             self.soft_neg[r] = sf.soft_negative if on else -np.inf
             self.pos_err[r] = sf.pos_err if on else np.inf
-        enc = res.encoder
-        if not again:
             self.external[r] = enc.external
             self.sense[r] = enc.sense
+            self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
         self.claim_cycle[r] = self.bank_cycles
         self._claims = claims = self._claims + 1
         self.claim_ids[r] = claims
-        b = res.band
-        self.band[r], self.hold_ns[r] = b.band, b._hold_ns
-        self.since[r] = -1 if b._since is None else b._since
+        since = b._since
+        self.since[r] = -1 if since is None else since
         self.arrived[r] = b.arrived
         pl = res.profile.planner
         self.a_last[r] = ax.prf_pos
@@ -1211,19 +1225,21 @@ class AxisBank:
         self.taken[r] = 0
         self.k0[r] = pl._k if moving and not sampled else 0
         self.ended[r] = False
-        self.t_cur[r] = 0
         kept = self._kept.pop(r, None)
         if sampled:
             kept = None
         # the last sample so far sits in slot TABLE (moving: the first cycle fills the
         # table) or in slot 0, the hold slot of a row at rest
         slot = self.table if moving else 0
-        self.nseg[r] = 0
         if moving and not sampled and len(pl._segs) <= MAXSEG and self._kernel_lib is not None:
-            m = len(pl._segs)
-            # (a flat list: numpy takes it several times faster than the list of tuples)
-            self.seg[r * MAXSEG * 4 : (r * MAXSEG + m) * 4] = list(chain.from_iterable(pl._segs))
-            self.tprm[r * NTPRM : (r + 1) * NTPRM] = (
+            segs = pl._segs
+            m = len(segs)
+            # (packed as doubles straight into the arrays' memory: numpy's conversion of a
+            # list costs several times more)
+            _SEG_PACK[m].pack_into(self.seg, r * MAXSEG * 32, *chain.from_iterable(segs))
+            _TPRM_PACK.pack_into(
+                self.tprm,
+                r * NTPRM * 8,
                 pl._t_done,
                 pl._ts,
                 pl._t_final,
@@ -1232,23 +1248,29 @@ class AxisBank:
                 pl._T,
             )
             self.nseg[r] = m
-        self.t_p[r, slot], self.t_v[r, slot], self.t_a[r, slot] = pl._pos, pl._vel, pl._acc
-        self.t_idx[r] = self.base[r] + slot
+        else:
+            self.nseg[r] = 0
+        i = int(self.base[r]) + slot
+        # (the tables' flat views: one index instead of a row and a column)
+        self._t_p1[i], self._t_v1[i], self._t_a1[i] = pl._pos, pl._vel, pl._acc
+        self.t_idx[r] = i
         if moving:
-            self.t_len[r], self.t_end[r] = 0, -1
+            cur, n, end = 0, 0, -1
             if kept is not None and kept[0] is pl and kept[1] == _trap_key(pl):
                 # the same move as when the row left: its table is still in place
                 j = pl._k - kept[2]
                 if 0 <= j < kept[3]:
-                    self.t_cur[r], self.t_len[r], self.t_end[r] = j, kept[3], kept[4]
+                    cur, n, end = j, kept[3], kept[4]
+            self.t_cur[r], self.t_len[r], self.t_end[r] = cur, n, end
         else:
-            self.t_len[r], self.t_end[r] = 1, 0
+            self.t_cur[r], self.t_len[r], self.t_end[r] = 0, 1, 0
         ch = self.csp.channels[r]
         self.frz[r] = frozen = not ax.servo_on
         # GT_GetSts's latched flags stay as they are while the row is in the bank
         # (_eligible_frozen, _latched_standing)
         self.latched[r] = latched
         if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
+            self.dwatch[r], self.dpost[r] = watch, 0
             self._frozen[r] = (
                 tuple(getattr(ch, name) for name in FROZEN_ATTRS),
                 ch.mech.torque,
@@ -1259,6 +1281,7 @@ class AxisBank:
             return
         self.hm[r] = homing = ax.mode_cmd == _HOMING_MODE
         if homing:  # the drive's search, or its rest after one (gtecat.drives.homing_bank)
+            self.dwatch[r], self.dpost[r] = watch, 0
             h = ch.homing
             for name, attr in HM_ROW_FIELDS:
                 getattr(self, name)[r] = getattr(h, attr)
@@ -1275,18 +1298,22 @@ class AxisBank:
             self.csp.sw_const[r] += ch.hm_bits - SW12
             return
         tp = bool(self.csp.tpw[r])
-        if (
-            (watch or tp)
-            and not sampled
-            and not jog
-            and len(self.groups[self.group_of[r]].rows) == 1
-            and all(obj.bank_post_ready() for obj in aware)
-        ):
+        post = (watch or tp) and not sampled and not jog
+        if post and len(self.groups[self.group_of[r]].rows) == 1:
+            for obj in aware:
+                if not obj.bank_post_ready():
+                    post = False
+                    break
+        else:
+            post = False
+        if post:
             # its hooks (and its drive's probe) take such an edge after the cycle, the row
             # staying (:meth:`_post_events`)
             if tp and not self._tp_mapped(r):
                 watch |= TP_POST
             self.dwatch[r], self.dpost[r] = 0, watch
+        else:
+            self.dwatch[r], self.dpost[r] = watch, 0
 
     def _tp_mapped(self, r: int) -> bool:
         """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""

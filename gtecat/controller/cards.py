@@ -54,7 +54,12 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from gtecat.drives.machine import MachineDescription, MachineError, machine_from_dict
+from gtecat.drives.machine import (
+    MachineDescription,
+    MachineError,
+    machine_from_dict,
+    refuse_unknown,
+)
 
 from ..errors import ParameterError
 from .core import Controller, Options
@@ -125,9 +130,7 @@ def options_for(
     machine = _machine(base.machine)
     where = f"{machine.source or 'machine description'}: [{_where(card, core)}]"
     desc = dict(description(machine, card, core))
-    unknown = set(desc) - _KEYS - _MACHINE_KEYS
-    if unknown:
-        raise MachineError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+    refuse_unknown(desc, _KEYS | _MACHINE_KEYS, where)
     folder = Path(machine.source).parent if machine.source else Path()
 
     def path(key: str) -> str:
@@ -159,7 +162,7 @@ def options_for(
     if "machine" in desc:
         o.machine = path("machine")
     elif set(desc) & (_MACHINE_KEYS - {"card"}):
-        o.machine = machine_from_dict(desc, where)
+        o.machine = machine_from_dict(desc, where, extra_keys=_KEYS)
     else:  # the same machine; its faults stay with card 0, its tables describe the others
         o.machine = dataclasses.replace(machine, faults=(), cards={}, cores={})
     if explicit is not None:

@@ -43,11 +43,14 @@ from __future__ import annotations
 import gc
 import os
 from collections.abc import Callable
+from concurrent import futures
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from gtecat.drives.machine import MachineDescription, load_machine
+from gtecat.drives.machine import read_note as machine_read_note
 from gtecat.drives.slave import VirtualSlave
 from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
@@ -69,6 +72,8 @@ from .epoch import EPOCH
 from .epoch import changed as readers_changed
 from .input_sense import changed as sense_changed
 from .resources import install as install_resources
+
+_T = TypeVar("_T")
 
 if TYPE_CHECKING:
     from .card import Card
@@ -284,7 +289,11 @@ class Controller:
             self.terminate_ecat()
         master = Master(layout, backend, log=self.log, op_delay_cycles=self.options.op_delay_cycles)
         master.mailbox_wait = self._mailbox_wait
+        master.mailbox_transfer = self._mailbox_transfer
         self.layout, self.backend, self.master = layout, backend, master
+        note = machine_read_note(self.machine)
+        if note:
+            self.log(note)  # (what the drives are built from: two runs' inputs compared)
         self.started = False
         self.axes = {
             ref.axis: Axis(
@@ -361,6 +370,9 @@ class Controller:
 
     def close(self) -> None:
         self.clock.stop_realtime()
+        pool, self._mailbox_pool = self._mailbox_pool, None
+        if pool is not None:
+            pool.shutdown(wait=True)  # (a transfer under way ends by its own timeout)
         self.terminate_ecat()
         self.log.close()
 
@@ -406,6 +418,36 @@ class Controller:
         can run (the next ones come after it anyway)."""
         if not self.cycling:
             self.clock.advance(ms)
+
+    #: the worker thread of mailbox transfers on a wire in virtual time (made at the first)
+    _mailbox_pool: ThreadPoolExecutor | None = None
+
+    def _mailbox_transfer(self, transfer: Callable[[], _T]) -> _T:
+        """A mailbox transfer that waits for a slave on a wire (the pysoem backend): it takes
+        the time the slave takes to answer, and a lost answer the master's mailbox timeout
+        (700 ms).  A real controller's firmware keeps the cyclic exchange going while a
+        mailbox transfer is pending, so the cycles run meanwhile, one per bus cycle of the
+        wall clock, and the clock counts those that ran (:mod:`gtecat.master.bus` "Mailbox
+        on a wire"): the axes move on and the slaves' watchdogs stay fed.
+
+        - realtime: the cycle thread runs them; the call lets go of the cycle lock while it
+          waits (the transfer touches the mailbox only, never the process image);
+        - lockstep and auto: the transfer waits in a worker thread while this one runs a
+          cycle each time one bus cycle of wall time has passed;
+        - inside a cycle (an SDO a cycle's hook makes) no cycle can run: the transfer alone.
+        """
+        clock = self.clock
+        if self.cycling or clock.in_cycle_thread:
+            return transfer()
+        if clock.threaded:
+            with clock.unlocked():
+                return transfer()
+        pool = self._mailbox_pool
+        if pool is None:
+            pool = self._mailbox_pool = ThreadPoolExecutor(1, thread_name_prefix="gtecat-mbx")
+        future = pool.submit(transfer)
+        clock.pace(lambda seconds: bool(futures.wait((future,), timeout=seconds).done))
+        return future.result()  # (or the transfer's exception)
 
     def run_cycles(self, n: int) -> int:
         """Up to ``n`` cycles at once, when nothing but the axis bank's compiled cycle has

@@ -83,7 +83,7 @@ from typing import Any, Protocol
 from ..errors import BusError, CommandError, ParameterError
 from ..master.clock import Clock
 from ..master.image import EntryAccess
-from .axis import Axis, PdsState, decode_state
+from .axis import CW_QUICK_STOP, Axis, PdsState, decode_state
 from .axis_status import BLOCKING, LATCHED, AxisStatus, InPosition
 from .encoder import Encoder
 from .motion import JogParams, Planner, TrapParams
@@ -352,8 +352,11 @@ class AxisResources:
                 self.latched |= _ALARM
                 if ax.servo_on:
                     ax.request_disable()
-        if ax.servo_on and sw & _SW_STATE_MASK != _SW_ENABLED:
-            ax.request_disable()  # the drive dropped out of operation enabled by itself
+        if ax.servo_on:
+            if sw & _SW_STATE_MASK != _SW_ENABLED:
+                ax.drive_left_operation()  # by itself: a quick stop is let finish
+        elif ax.cw == CW_QUICK_STOP:
+            ax.quick_stop_over()
         if ax.plan_error and ax.servo_on:
             # the planned position left the numbers (checks off, a jog into infinity): 607Ah
             # held its last value; servo off and the alarm bit, as for a drive alarm, so the

@@ -665,7 +665,7 @@ class SmartHome:
         for attempt in (0, 1):
             self._arm(unit, CAPTURE_HOME, p.edge)
             why, pos = yield from self._leg(
-                d, dist, p.velHigh, lambda: unit.pos if unit.status else None
+                d, dist, p.velHigh, lambda: unit.pos if unit.status else None, latch=unit
             )
             if why == "event":
                 st.capturePos = _long(round(pos))
@@ -711,7 +711,9 @@ class SmartHome:
             if not unit.on_card:
                 yield  # the drive's touch probe arms in two cycles (60B8h off, on)
                 yield
-            why, pos = yield from self._leg(d, dist, vel, lambda: unit.pos if unit.status else None)
+            why, pos = yield from self._leg(
+                d, dist, vel, lambda: unit.pos if unit.status else None, latch=unit
+            )
             if why == "event":
                 st.capturePos = _long(round(pos))
                 yield from self._stop()
@@ -811,13 +813,18 @@ class SmartHome:
         vel: float,
         watch: Callable[[], Any] | None = None,
         levels: CaptureUnit | None = None,
+        latch: CaptureUnit | None = None,
     ) -> _Steps:
         """Move up to ``distance`` in ``d``; returns ("event", watch's value), ("limit",
         position) when the limit in ``d`` is reached, or ("end", None).  ``watch`` reads
         the trigger's capture (this axis's or another's: ``triggerIndex``), its home level
         or a GPI: what changes them is an input edge of a cycle run on the scalar objects
         or a call, so the wait may be :meth:`quiet`; ``levels``: the capture unit whose
-        home level or edges ``watch`` reads (:meth:`CaptureUnit.watch_level`)."""
+        home level or edges ``watch`` reads (:meth:`CaptureUnit.watch_level`); ``latch``:
+        the capture unit whose latch (its status) ``watch`` alone reads - a latch armed
+        and empty when the leg starts holds nothing until a cycle's edge sets it, which
+        the homings look at (a posted edge, a scalar cycle), so the step after the move
+        starts need not read it."""
         trap = self.res.profile.trap
         if self._limit(d):  # standing on that limit already: reached at once
             return "limit", self.unit.enc
@@ -827,7 +834,7 @@ class SmartHome:
         if levels is not None:
             levels.watch_level(True)
         self._watching = watch is not None
-        self._looked = watch is None
+        self._looked = watch is None or (latch is not None and not latch.status)
         self._dir = d
         self._waiting = True
         try:

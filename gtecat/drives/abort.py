@@ -8,7 +8,7 @@ the GT layer copies ``code`` into ``pAbort_code``.
 
 from __future__ import annotations
 
-from enum import IntEnum
+from enum import Enum, IntEnum
 
 from gtecat.eni.errors import GtecatError
 
@@ -135,3 +135,36 @@ class SdoAbort(GtecatError):
         if detail:
             text += f": {detail}"
         super().__init__(text)
+
+
+class MailboxFailure(Enum):
+    """How an SDO transfer ends without an abort frame from the slave (what the master saw)."""
+
+    #: the request got no answer within the master's mailbox timeout
+    NO_ANSWER = "no answer"
+    #: a mailbox error reply (ETG.1000.4 Table 30) instead of the SDO answer
+    ERROR_REPLY = "mailbox error reply"
+    #: an answer that is not the SDO answer: another mailbox type or CoE service, an SDO
+    #: frame cut short, an answer for another object
+    UNEXPECTED = "unexpected answer"
+    #: the answer announces more data than the master takes
+    TOO_BIG = "too big"
+
+
+#: The abort code the master reports in ``pAbort_code`` for each, on every backend: the
+#: emulated bus's SDO client (:class:`gtecat.drives.coe.SdoClient`) and the pysoem backend
+#: (SOEM's outcomes) both build their :class:`SdoAbort` from this table, so an
+#: application sees the same code whichever bus it runs on.
+MAILBOX_FAILURE_CODES: dict[MailboxFailure, SdoAbortCode] = {
+    MailboxFailure.NO_ANSWER: SdoAbortCode.SDO_PROTOCOL_TIMED_OUT,
+    MailboxFailure.ERROR_REPLY: SdoAbortCode.GENERAL_ERROR,
+    MailboxFailure.UNEXPECTED: SdoAbortCode.GENERAL_ERROR,
+    MailboxFailure.TOO_BIG: SdoAbortCode.OUT_OF_MEMORY,
+}
+
+
+def mailbox_failure(
+    failure: MailboxFailure, index: int, subindex: int, detail: str = ""
+) -> SdoAbort:
+    """The :class:`SdoAbort` the master raises for ``failure`` (:data:`MAILBOX_FAILURE_CODES`)."""
+    return SdoAbort(MAILBOX_FAILURE_CODES[failure], index, subindex, detail or failure.value)

@@ -35,7 +35,7 @@ from construct import (
     this,
 )
 
-from gtecat.drives.abort import SdoAbort, SdoAbortCode
+from gtecat.drives.abort import MailboxFailure, SdoAbort, SdoAbortCode, mailbox_failure
 
 log = logging.getLogger(__name__)
 
@@ -536,19 +536,21 @@ class SdoClient:
         """One request, the SDO frame of its answer (at least one byte)."""
 
         def fail(detail: str) -> SdoAbort:
-            return SdoAbort(SdoAbortCode.GENERAL_ERROR, index, subindex, detail)
+            return mailbox_failure(MailboxFailure.UNEXPECTED, index, subindex, detail)
 
         self.counter = next_counter(self.counter)
         answer = self._transfer(build_coe(CoeService.SDO_REQUEST, sdo, counter=self.counter))
         if answer is None:
             self.unanswered += 1
-            raise SdoAbort(SdoAbortCode.SDO_PROTOCOL_TIMED_OUT, index, subindex, "no answer")
+            raise mailbox_failure(MailboxFailure.NO_ANSWER, index, subindex)
         try:
             mbx = parse_mailbox(bytes(answer))
         except ValueError as e:
             raise fail(str(e)) from None
         if mbx.mbx_type == MailboxType.ERR:
-            raise fail(_mailbox_error_text(mbx.data))
+            raise mailbox_failure(
+                MailboxFailure.ERROR_REPLY, index, subindex, _mailbox_error_text(mbx.data)
+            )
         if mbx.mbx_type != MailboxType.COE:
             raise fail(f"answer has mailbox type {mbx.mbx_type}, not CoE")
         if len(mbx.data) < COE_HEADER_SIZE + 1:
@@ -582,16 +584,16 @@ class SdoClient:
         """Check an initiate answer: command specifier, length and the object it is for."""
         self._expect(body, scs, index, subindex)
         if len(body) < 8:
-            raise SdoAbort(
-                SdoAbortCode.GENERAL_ERROR,
+            raise mailbox_failure(
+                MailboxFailure.UNEXPECTED,
                 index,
                 subindex,
                 f"{scs.name} answer of {len(body)} bytes, 8 expected",
             )
         echo = (int.from_bytes(body[1:3], "little"), body[3])
         if echo != (index, subindex):
-            raise SdoAbort(
-                SdoAbortCode.GENERAL_ERROR,
+            raise mailbox_failure(
+                MailboxFailure.UNEXPECTED,
                 index,
                 subindex,
                 f"{scs.name} answer is for 0x{echo[0]:04X}:{echo[1]:02X}",
@@ -608,8 +610,8 @@ class SdoClient:
         resp = SdoNormal.parse(body)
         total = resp.complete_size
         if total > self.max_size:
-            raise SdoAbort(
-                SdoAbortCode.OUT_OF_MEMORY,
+            raise mailbox_failure(
+                MailboxFailure.TOO_BIG,
                 index,
                 subindex,
                 f"{total} bytes announced, at most {self.max_size} accepted",

@@ -139,9 +139,7 @@ def _inert_at_rest(ff: FieldOverride) -> bool:
     a closed holding brake only take power or motion away, which such a drive has not
     (Channel.step: ``powered`` is already False, the motor stands, ``dpos`` on it); a
     forced input, a lost or noisy encoder, a quick-stop input or a silenced probe do."""
-    return not (
-        ff.din_set or ff.din_clear or ff.enc_shift or ff.enc_noise or ff.quick_stop or ff.probe_off
-    )
+    return not (ff.din_set or ff.din_clear or ff.enc_noise or ff.quick_stop or ff.probe_off)
 
 
 def frozen_claimable(ch: Channel) -> str:

@@ -67,6 +67,7 @@ from gtecat.drives.faults import (
     FieldOverride,
     error_register,
     fault_code,
+    forced_level,
 )
 from gtecat.drives.homing import SUPPORTED_METHODS, Homing, HomingParams
 from gtecat.drives.machine import AxisMachine
@@ -262,6 +263,7 @@ class Channel:
         "mode_due",
         "mode_req",
         "mode_seen",
+        "noise_now",
         "oms",
         "pos_offset",
         "position_actual",
@@ -375,6 +377,7 @@ class Channel:
         self.mode_seen = 0
         self.mode_due: int | None = None
         self.enc_offset = 0  # machine position of encoder 0 (set by homing)
+        self.noise_now = 0  # the encoder's noise in this cycle's reading (encoder_noise), counts
         self.dpos = self.mech.pos
         self.dvel = 0.0
         self.dtorque = 0.0
@@ -684,6 +687,34 @@ class Channel:
         """The injected cause is gone; a fault reset (rising CW7) can now clear the fault."""
         self.faults.clear_injected()
 
+    def lose_counts(self, counts: int) -> None:
+        """The encoder loses ``counts`` counts (``encoder_lost`` of :mod:`gtecat.faults`).
+
+        Physically the encoder's count slips against the motor: the motor stays where it
+        is, the position the drive measures (6064h) jumps by ``-counts`` and stays off by
+        that much until a homing defines the position again (``enc_offset``, which relates
+        the two, grows by ``counts``).  The drive's demand lives in what it measures, so
+        it does not move with the slip (6062h unchanged): the control loop sees a
+        following error of ``counts`` at once (CiA 402 6.3.2 / 6.4.2 (60F4h = position
+        demand value - position actual value) and drives the motor by ``counts`` to close it,
+        as fast as its torque allows - a real drive jumps.  6064h, 60F4h and the
+        following-error supervision all start from that one measured position: an error
+        beyond 6065h for longer than 6066h faults the drive with 8611h (following error)
+        and it stops with its fault reaction, the motor short of the demand.  In CSP/CSV
+        the demand comes from 607Ah / keeps running; in PP, PV, homing and a stop ramp
+        the drive's own demand is shifted with the slip (it is the same place in the
+        drive's frame).
+        """
+        n = int(counts)
+        if not n:
+            return
+        self.enc_offset += n
+        self.dpos += n
+        h = self.homing
+        if h is not None:
+            h.shift_demand(n)
+        self._outputs()
+
     def set_analog_input(self, channel: int, value: int) -> None:
         """Analog input 1 (20F2h) or 2 (20F9h), raw INT16 counts."""
         if channel not in (1, 2):
@@ -705,7 +736,7 @@ class Channel:
                 acceleration=float(self.homing_acceleration),
                 home_offset=int(self.home_offset),
             )
-            self.homing = Homing(params, self.machine, self.mech.pos)
+            self.homing = Homing(params, self.machine, self.mech.pos, self.forced_switches)
         except GtecatError as err:  # the homing component refused the parameters
             log.warning("axis channel %d: homing cannot start: %s", self.k, err)
             self.homing = None
@@ -868,10 +899,12 @@ class Channel:
             mech.coast(dt)
             self.dpos = mech.pos
             self.dvel = mech.vel
-        # --- following error (position modes, powered, not stopped by a limit switch)
+        # --- the encoder's reading of this cycle (noise: encoder_noise) and the following
+        # error on it (position modes, powered, not stopped by a limit switch)
+        self.noise_now = ff.noise() if ff is not None and ff.enc_noise else 0
         if state is State.OPERATION_ENABLED and mode in POSITION_MODES and not self.limit_stop:
             window = self.following_error_window
-            if 0 < window < 0xFFFFFFFF and abs(self.dpos - mech.pos) > window:
+            if 0 < window < 0xFFFFFFFF and abs(self.dpos - mech.pos - self.noise_now) > window:
                 self.fe_time += dt
                 if self.fe_time * 1000.0 > self.following_error_timeout:
                     if not self.fe_flag:
@@ -950,26 +983,30 @@ class Channel:
             din |= 1 << 17
         ff = self.field
         if ff is not None:
-            din = (din | ff.din_set) & ~ff.din_clear
+            din = forced_level(din, ff.din_set, ff.din_clear)
         return din
+
+    def forced_switches(self) -> tuple[int, int]:
+        """The 60FDh bits the field forces on and off now (``switch_stuck``,
+        ``switch_chatter``): what :meth:`_inputs` lays over the machine's switches, handed
+        to the homing so that it reads the switches as 60FDh shows them."""
+        ff = self.field
+        return (0, 0) if ff is None else (ff.din_set, ff.din_clear)
 
     def _outputs(self) -> None:
         mech = self.mech
         pos = mech.pos
         off = self.enc_offset
+        noise = self.noise_now
         if self.faults.injected != ErrorCode.ENCODER:
-            ff = self.field
-            if ff is None:
-                self.position_actual = _wrap32(round(pos - off))
-            else:
-                self.position_actual = _wrap32(round(pos - off) + ff.enc_shift + ff.noise())
+            self.position_actual = _wrap32(round(pos - off) + noise)
         self.position_demand = _wrap32(round(self.dpos - off))
         self.velocity_actual = _wrap32(round(mech.vel))
         t = _clamp16(mech.torque)
         self.torque_actual = t
         self.current_actual = t
         self.torque_demand = _clamp16(self.dtorque) if self.torque_ctl else t
-        self.following_error_actual = _wrap32(round(self.dpos - pos))
+        self.following_error_actual = _wrap32(round(self.dpos - pos) - noise)
         self.digital_inputs = self._inputs(pos)
         self._refresh_status()
 

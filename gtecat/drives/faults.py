@@ -157,14 +157,24 @@ class FaultMonitor:
         self.pending = 0
 
 
+def forced_level(din: int, on: int, off: int) -> int:
+    """The inputs ``din`` as the drive reads them while the field forces the bits ``on``
+    set and the bits ``off`` clear (a bit in both reads clear): the one rule for 60FDh,
+    the drive's homing and everything that reads a switch through them."""
+    return (din | on) & ~off
+
+
 class FieldOverride:
     """What the field does to one channel against the machine description: the scenario's
     hands on the wiring and the mechanics (set by :mod:`gtecat.faults`, read every cycle).
 
     ``din_set`` / ``din_clear``: 60FDh bits forced on / off (a switch stuck, a chattering
-    one toggled every few cycles, a probe input that never switches); ``enc_shift``:
-    counts the encoder lost (added to 6064h); ``enc_noise``: +/- that many counts of noise
-    on 6064h (from ``rng``, seeded: runs repeat); ``quick_stop``: the drive's quick-stop
+    one toggled every few cycles, a probe input that never switches); ``enc_noise``: +/-
+    that many counts of noise on the encoder's reading (from ``rng``, seeded: runs repeat;
+    drawn once a cycle, :attr:`Channel.noise_now`: 6064h, 60F4h and the following-error
+    supervision read the same noisy position; the motor does not follow the noise, which
+    the drive's loop filters).  Counts lost are no override: the drive's encoder offset
+    moves for good (:meth:`Channel.lose_counts`); ``quick_stop``: the drive's quick-stop
     input is active (as controlword bit 2 clear); ``brake``: the holding brake stays
     closed (the motor cannot turn); ``sto``: safe torque off (no torque at all);
     ``probe_off``: the touch-probe inputs never switch.
@@ -175,7 +185,6 @@ class FieldOverride:
         "din_clear",
         "din_set",
         "enc_noise",
-        "enc_shift",
         "probe_off",
         "quick_stop",
         "rng",
@@ -187,7 +196,6 @@ class FieldOverride:
 
         self.din_set = 0
         self.din_clear = 0
-        self.enc_shift = 0
         self.enc_noise = 0
         self.quick_stop = False
         self.brake = False
@@ -200,7 +208,6 @@ class FieldOverride:
         return not (
             self.din_set
             or self.din_clear
-            or self.enc_shift
             or self.enc_noise
             or self.quick_stop
             or self.brake

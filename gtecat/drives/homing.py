@@ -26,6 +26,17 @@ Decisions (the standard leaves them open; tested in ``tests/drives/test_homing.p
   :meth:`encoder_offset` returns ``home_machine_position - 607Ch``.  Methods 35 and 37
   (identical here): the current position becomes the home point, so it reads 607Ch;
   they complete at once without motion.
+* **The switches read as the drive reads them** (its 60FDh bits 0..2): a switch the field
+  forces (``switch_stuck``, ``switch_chatter`` of :mod:`gtecat.faults`, handed in as the
+  ``forced`` masks) is what the search sees too.  A forced switch has no position: its
+  level is sampled once per cycle and an edge of it lies at the cycle's sample (where the
+  drive saw the input change), never at the machine description's window edge.  A home
+  switch stuck inactive gives no edge, so the search runs on to a limit (or its travel
+  bound) and ends in a homing error; stuck active, the method starts as on the switch
+  (heading for the edge that leaves it) and never finds it; a chattering one gives an edge
+  wherever it toggles, and the drive takes the first that fits the method, as a real
+  drive would.  Limits likewise: a limit stuck inactive is never met (the search runs to
+  its travel bound); one stuck active is met at once when the search heads into it.
 * **Errors** (SW13): a limit switch hit where the method does not reverse on it, a
   second hit of the reversal limit, no index pulse within one revolution after the
   reference edge, or the search exceeding ``max_travel`` or ``timeout_s``.  The axis
@@ -39,11 +50,13 @@ Decisions (the standard leaves them open; tested in ``tests/drives/test_homing.p
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
 
 from gtecat.eni.errors import GtecatError
 
+from .faults import forced_level
 from .homing_methods import SUPPORTED_METHODS, MethodKind, MethodSpec, Signal, method_spec
 from .machine import AxisMachine
 from .signal_edges import level, merge_windows, window_edges
@@ -125,6 +138,21 @@ class HomingPhase(IntEnum):
 
 _SEARCHING = (HomingPhase.SEARCH, HomingPhase.APPROACH, HomingPhase.INDEX)
 
+#: the switches a search reads, without / with the home switch (the limits always)
+_SIGNALS_READ = (
+    (Signal.NEGATIVE_LIMIT, Signal.POSITIVE_LIMIT),
+    (Signal.HOME_SWITCH, Signal.NEGATIVE_LIMIT, Signal.POSITIVE_LIMIT),
+)
+#: 60FDh bits of the switches a search reads (bit n = :class:`Signal` n)
+SWITCH_BITS = 0b111
+#: (bits forced on, bits forced off) of 60FDh: nothing forced
+NOT_FORCED: tuple[int, int] = (0, 0)
+
+
+def _not_forced() -> tuple[int, int]:
+    return NOT_FORCED
+
+
 # event kinds inside one cycle
 _EV_INDEX, _EV_NL, _EV_PL, _EV_HS = 0, 1, 2, 3
 _EV_OF_SIGNAL = {
@@ -137,11 +165,23 @@ _EV_OF_SIGNAL = {
 class Homing:
     """One homing procedure, from CW4 rising to done (see the module docstring)."""
 
-    def __init__(self, params: HomingParams, machine: AxisMachine, start_pos: float) -> None:
+    def __init__(
+        self,
+        params: HomingParams,
+        machine: AxisMachine,
+        start_pos: float,
+        forced: Callable[[], tuple[int, int]] | None = None,
+    ) -> None:
+        """``forced``: the 60FDh bits the field forces on and off now (the drive's
+        :meth:`~gtecat.drives.drive.Channel.forced_switches`; module docstring)."""
         self.params = params
         self._spec = spec = params.validate()
         self._m = machine
         self._hs = merge_windows(machine.home_switch)
+        self._forced_now = forced or _not_forced
+        #: the forced masks at the last sample scanned (``_last``)
+        self._forced = self._read_forced()
+        self._edge_sampled = False  # the reference edge found on the way out was a sampled one
         self._p = float(start_pos)  # demanded position (end of the last cycle)
         self._v = 0.0  # demanded velocity
         self._last = float(start_pos)  # actual position at the last step
@@ -219,6 +259,11 @@ class Homing:
             return None
         return self.home_machine_position - self.params.home_offset
 
+    def shift_demand(self, counts: float) -> None:
+        """The encoder slipped by ``counts`` (:meth:`Channel.lose_counts`): the demand, kept in
+        the drive's measured frame, now lies ``counts`` further on in machine counts."""
+        self._p += counts
+
     def halt(self, on: bool) -> None:
         """CW8: decelerate and hold; the search does not resume (module docstring)."""
         if not on or self._stopping:
@@ -237,7 +282,9 @@ class Homing:
             self._elapsed += dt
             if pos != p0:
                 self._travel += abs(pos - p0)
-                self._scan(p0, pos)
+                forced = self._read_forced()
+                self._scan(p0, pos, forced)
+                self._forced = forced
             if self.phase in _SEARCHING:
                 self._check_bounds(pos)
         self._move(dt)
@@ -287,45 +334,75 @@ class Homing:
         self._p += v * dt
 
     # --- events ------------------------------------------------------------
-    def _signal_level(self, sig: Signal, pos: float) -> bool:
-        if sig is Signal.NEGATIVE_LIMIT:
-            return self._m.negative_limit_active(pos)
-        if sig is Signal.POSITIVE_LIMIT:
-            return self._m.positive_limit_active(pos)
-        return level(self._hs, pos)
+    @property
+    def forced(self) -> bool:
+        """A switch the search reads was forced by the field at its last sample (the axis
+        bank, which knows only the machine description's edges, leaves such a search alone)."""
+        on, off = self._forced
+        return bool(on | off)
 
-    def _scan(self, p0: float, p1: float) -> None:
-        """Handle every relevant event crossed from p0 to p1, in the order met."""
+    def _read_forced(self) -> tuple[int, int]:
+        on, off = self._forced_now()
+        return (on & SWITCH_BITS, off & SWITCH_BITS)
+
+    def _signal_level(self, sig: Signal, pos: float, forced: tuple[int, int] | None = None) -> bool:
+        """The level the drive reads (60FDh): the machine's switch at ``pos``, unless the
+        field forces it (``forced`` masks, default: those of the last sample)."""
+        if sig is Signal.NEGATIVE_LIMIT:
+            active = self._m.negative_limit_active(pos)
+        elif sig is Signal.POSITIVE_LIMIT:
+            active = self._m.positive_limit_active(pos)
+        else:
+            active = level(self._hs, pos)
+        on, off = self._forced if forced is None else forced
+        bit = 1 << sig
+        return bool(forced_level(bit if active else 0, on, off) & bit)
+
+    def _scan(self, p0: float, p1: float, forced: tuple[int, int] = NOT_FORCED) -> None:
+        """Handle every relevant event crossed from p0 to p1, in the order met.
+
+        A switch forced at either sample (``self._forced`` at p0, ``forced`` at p1) is
+        sampled: an edge where its level differs, placed at p1 (module docstring)."""
         spec = self._spec
         d = 1 if p1 > p0 else -1
-        events: list[tuple[float, int, float, int, bool]] = []  # (dist, prio, pos, kind, rising)
-        if spec.signal is Signal.HOME_SWITCH:
+        # (dist, prio, pos, kind, rising, sampled)
+        events: list[tuple[float, int, float, int, bool, bool]] = []
+        prev = self._forced
+        sampled = prev[0] | prev[1] | forced[0] | forced[1]
+        if sampled:
+            for sig in _SIGNALS_READ[spec.signal is Signal.HOME_SWITCH]:
+                if not sampled & (1 << sig):
+                    continue
+                now = self._signal_level(sig, p1, forced)
+                if now != self._signal_level(sig, p0, prev):
+                    events.append((abs(p1 - p0), 1, p1, _EV_OF_SIGNAL[sig], now, True))
+        if spec.signal is Signal.HOME_SWITCH and not sampled & (1 << Signal.HOME_SWITCH):
             for x, rising in window_edges(self._hs, p0, p1):
-                events.append((abs(x - p0), 1, x, _EV_HS, rising))
+                events.append((abs(x - p0), 1, x, _EV_HS, rising, False))
         nl, pl = self._m.negative_limit, self._m.positive_limit
-        if nl is not None:
+        if nl is not None and not sampled & (1 << Signal.NEGATIVE_LIMIT):
             if d < 0 and p1 <= nl < p0:
-                events.append((p0 - nl, 1, nl, _EV_NL, True))
+                events.append((p0 - nl, 1, nl, _EV_NL, True, False))
             elif d > 0 and p0 <= nl < p1:
-                events.append((nl - p0, 1, nl, _EV_NL, False))
-        if pl is not None:
+                events.append((nl - p0, 1, nl, _EV_NL, False, False))
+        if pl is not None and not sampled & (1 << Signal.POSITIVE_LIMIT):
             if d > 0 and p0 < pl <= p1:
-                events.append((pl - p0, 1, pl, _EV_PL, True))
+                events.append((pl - p0, 1, pl, _EV_PL, True, False))
             elif d < 0 and p1 < pl <= p0:
-                events.append((p0 - pl, 1, pl, _EV_PL, False))
+                events.append((p0 - pl, 1, pl, _EV_PL, False, False))
         if spec.uses_index:
             # priority 0: a pulse exactly on the reference edge is not beyond it
             for x in self._m.index_positions(p0, p1):
-                events.append((abs(x - p0), 0, x, _EV_INDEX, True))
+                events.append((abs(x - p0), 0, x, _EV_INDEX, True, False))
         if not events:
             return
         events.sort()
-        for _, _, x, kind, rising in events:
-            self._on_event(kind, x, rising, d)
+        for _, _, x, kind, rising, at_sample in events:
+            self._on_event(kind, x, rising, d, at_sample)
             if self.phase not in _SEARCHING:
                 return
 
-    def _on_event(self, kind: int, x: float, rising: bool, d: int) -> None:
+    def _on_event(self, kind: int, x: float, rising: bool, d: int, sampled: bool = False) -> None:
         spec = self._spec
         fd = spec.final_dir
         if self.phase is HomingPhase.INDEX:
@@ -341,10 +418,18 @@ class Homing:
             if self.phase is HomingPhase.SEARCH and d != self._dir:
                 return  # still braking for a limit reversal
             if d == fd and rising == spec.active_after:
-                if self.phase is HomingPhase.SEARCH or x == self._edge:
+                # (in APPROACH the edge left on the way out: a forced switch's edges lie
+                # where it toggled, so any of its edges, or any after one, is taken)
+                if (
+                    self.phase is HomingPhase.SEARCH
+                    or x == self._edge
+                    or sampled
+                    or self._edge_sampled
+                ):
                     self._reference(x)
             elif d == -fd and rising != spec.active_after and self.phase is HomingPhase.SEARCH:
                 self._edge = x
+                self._edge_sampled = sampled
                 self.phase = HomingPhase.APPROACH
                 self._dir = fd
             return

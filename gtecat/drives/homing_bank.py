@@ -66,6 +66,8 @@ def homing_claimable(ch: Channel) -> str:
         return "no search running"
     if h.phase not in _SEARCHING or h._stopping or h.error or h.attained:
         return "not searching"
+    if h.forced or h._edge_sampled:
+        return "a switch forced by the field"  # (its edges are sampled: Homing._scan)
     if event_bounds(h, ch.mech.pos) is None:
         return "at an event"
     return ""

@@ -26,9 +26,10 @@ the machine it was written for (gtecat.controller.config_file.switch_sense).
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -118,6 +119,11 @@ class MachineDescription:
     #: controller (:mod:`gtecat.controller.cards` reads them)
     cards: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
     cores: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
+    #: the first 16 hex digits of the SHA-256 of the file's bytes as read (:func:`load_machine`;
+    #: "" for a description not read from a file): the master log names it, so two runs whose
+    #: results differ show whether they read the same description (not compared: the same
+    #: description read from two files is the same machine)
+    digest: str = field(default="", compare=False)
 
     def axis(self, n: int) -> AxisMachine:
         """The description of GT axis ``n`` (defaults when the file omits it)."""
@@ -162,7 +168,40 @@ def _windows(raw: Any, where: str) -> tuple[Window, ...]:
     return tuple(sorted(out))
 
 
-def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescription:
+#: the tables of a machine description, as they are written in it
+TABLES = {
+    "axis": "[axis.N]",
+    "fault": "[[fault]]",
+    "ext": "[ext.N]",
+    "glink": "[glink.N]",
+    "card": "[card.N]",
+    "core": "[core.N]",
+}
+
+
+def refuse_unknown(keys: Any, known: Any, where: str, what: str = "key(s)", has: str = "") -> None:
+    """A key or table a description does not know is a typo that would be ignored: one
+    error naming it (``has``: what the description knows, said after it)."""
+    unknown = sorted(set(keys) - set(known))
+    if unknown:
+        names = ", ".join(f"[{k}]" if what.startswith("table") else k for k in unknown)
+        raise MachineError(f"{where}: unknown {what} {names}" + (f"; {has}" if has else ""))
+
+
+def machine_from_dict(
+    data: Mapping[str, Any], source: str = "", extra_keys: Any = ()
+) -> MachineDescription:
+    """The machine description of a TOML file's tables (or a dict of them); a table it does
+    not know is refused (``extra_keys``: other keys the caller reads beside them)."""
+    if not isinstance(data, Mapping):
+        raise MachineError(f"{source}: a machine description is a table of tables")
+    refuse_unknown(
+        data,
+        {*TABLES, *extra_keys},
+        source or "machine description",
+        "table(s)",
+        "a machine description has " + ", ".join(TABLES.values()),
+    )
     axes_raw = data.get("axis", {})
     if not isinstance(axes_raw, dict):
         raise MachineError(f"{source}: [axis.N] tables expected")
@@ -175,9 +214,7 @@ def machine_from_dict(data: Mapping[str, Any], source: str = "") -> MachineDescr
             raise MachineError(f"{where}: axis number must be an integer") from None
         if n < 1:
             raise MachineError(f"{where}: axes are numbered from 1")
-        unknown = set(table) - _KEYS
-        if unknown:
-            raise MachineError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+        refuse_unknown(table, _KEYS, where)
 
         def num(name: str, default: Any = None, *, where: str = where, table: Any = table) -> Any:
             v = table.get(name, default)
@@ -245,9 +282,29 @@ def load_machine(path: str | Path) -> MachineDescription:
 
     p = Path(path)
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        raw = p.read_bytes()  # (one read: the digest is of the very bytes parsed)
+        data = tomllib.loads(raw.decode("utf-8"))
     except FileNotFoundError:
         raise MachineError(f"{p}: machine description not found") from None
+    except UnicodeDecodeError as e:
+        raise MachineError(f"{p}: not UTF-8 text: {e}") from None
     except tomllib.TOMLDecodeError as e:
         raise MachineError(f"{p}: not valid TOML: {e}") from None
-    return machine_from_dict(data, str(p))
+    digest = hashlib.sha256(raw).hexdigest()[:16]
+    return replace(machine_from_dict(data, str(p)), digest=digest)
+
+
+def read_note(machine: MachineDescription) -> str:
+    """The master log's line about a description read from a file: its path, digest and the
+    axes it describes.  A run's results follow from its program *and* its inputs: when two
+    runs of one program differ, this line shows whether they read the same description (a
+    file rewritten by another program while GT_Open read it may read empty).  "" for a
+    description not read from a file."""
+    if not machine.source or not machine.digest:
+        return ""
+    head = f"Machine description {machine.source} (sha256 {machine.digest})"
+    if not machine.axes and not machine.ext and not machine.glink and not machine.faults:
+        if not (machine.cards or machine.cores):
+            return f"{head} is empty: every axis has the defaults (no switches, no probe marks)."
+    axes = ", ".join(str(n) for n in sorted(machine.axes)) or "none"
+    return f"{head}: axes described: {axes}."

@@ -17,6 +17,7 @@ step).  Starts and ends go to the master log.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -84,6 +85,11 @@ def _tell(what: str, values: dict[str, Any]) -> None:
 def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
     """A ``[[fault]]`` table (or ``key=value`` pairs) as a :class:`FaultSpec`."""
     prefix = f"{where}: " if where else ""
+    if not isinstance(values, Mapping):
+        raise FaultSpecError(
+            f"{prefix}a fault is a table of its values, such as "
+            f"{{'kind': 'drive_fault', 'axis': 1}}; got {values!r}"
+        )
     vals = dict(values)
     extra = {k: vals.pop(k) for k in _EXTRA_KEYS if k in vals}
     trig = {k: vals.pop(k) for k in TRIGGER_KEYS if k in vals}
@@ -147,12 +153,32 @@ def load(path: str | Path) -> list[FaultSpec]:
         raise FaultSpecError(f"{p}: not valid TOML: {e}") from None
     if "fault" not in data:
         raise FaultSpecError(f"{p}: no [[fault]] table")
+    from ..drives.machine import TABLES, MachineError, refuse_unknown
+
+    try:  # (a machine description's other tables may be there: a file for both)
+        refuse_unknown(data, TABLES, str(p), "table(s)", "it takes [[fault]] tables")
+    except MachineError as e:
+        raise FaultSpecError(str(e)) from None
     return specs_from_tables(data["fault"], str(p))
 
 
-def arm(injector: Injector, specs: list[FaultSpec]) -> list[Entry]:
-    """Add the specs to an injector, a script's ``after`` names resolved to ids."""
+def arm(injector: Injector, specs: list[FaultSpec], origin: str = "") -> list[Entry]:
+    """Add the specs to an injector, a script's ``after`` names resolved to ids.
+
+    A name names one fault: two specs of one call (the tables of one file) with the same
+    name are refused, and so is an injected fault named as one armed already; a machine
+    description's tables (``origin="machine"``, armed anew by every bring-up) are checked
+    among themselves only."""
     names: dict[str, int] = {e.name: e.id for e in injector.entries if e.name}
+    taken: set[str] = set() if origin == "machine" else set(names)
+    for s in specs:
+        if s.name and s.name in taken:
+            prefix = f"{s.where}: " if s.where else ""
+            raise FaultSpecError(
+                f"{prefix}name {s.name!r} names another fault already; give each its own"
+            )
+        if s.name:
+            taken.add(s.name)
     out = []
     for s in specs:
         after = s.after
@@ -167,6 +193,7 @@ def arm(injector: Injector, specs: list[FaultSpec]) -> list[Entry]:
             if not s.where:
                 raise
             raise ParameterError(f"{s.where}: {err}") from None
+        e.origin = origin
         if s.name:
             names[s.name] = e.id
         out.append(e)
@@ -188,9 +215,27 @@ def injector_for(ctl: Any, create: bool = True) -> Injector | None:
     inj = getattr(backend, "injector", None)
     if inj is None and create:
         inj = Injector(EmulatedBus(ctl))
+        prev = getattr(ctl, "_fault_injector", None)
+        if prev is not None:
+            inj._next = prev._next  # (ids are never used twice in one session)
         backend.injector = inj
+        ctl._fault_injector = inj
         ctl.pre_cycle.append(inj.tick)
     return inj
+
+
+def _carry_over(ctl: Any, holding: bool = False) -> None:
+    """The bus is brought up again: the faults injected on the bus before stay
+    (:meth:`Injector.carry`); the machine description's tables are armed anew."""
+    old = getattr(ctl, "_fault_injector", None)
+    if old is None or getattr(old.bus, "backend", None) is ctl.backend:
+        return
+    if not any(e.state in ("armed", "active") and e.origin != "machine" for e in old.entries):
+        return
+    inj = injector_for(ctl)
+    assert inj is not None
+    inj.holding = holding
+    inj.carry(old)
 
 
 def _bus_opening(ctl: Any) -> None:
@@ -201,6 +246,7 @@ def _bus_opening(ctl: Any) -> None:
     Any other fault that starts at once waits until the bus is up (:func:`_bus_up`), where
     it started before: the bring-up has no cycles for it.  The faults of a bus brought up
     before go with it.  Errors: :func:`_arm_machine`."""
+    _carry_over(ctl, holding=True)
     _arm_machine(ctl, holding=True)
     ctl._faults_armed = ctl.backend
 
@@ -210,6 +256,7 @@ def _bus_up(ctl: Any) -> None:
     faults watch; a bus that came up without :func:`_bus_opening` (a card's amplifiers) has
     its faults armed now."""
     if getattr(ctl, "_faults_armed", None) is not ctl.backend:
+        _carry_over(ctl)
         _arm_machine(ctl)
         return
     inj = injector_for(ctl, create=False)
@@ -244,7 +291,7 @@ def _arm_machine(ctl: Any, holding: bool = False) -> None:
             inj = injector_for(ctl)
             assert inj is not None
             inj.holding = holding
-            arm(inj, specs)
+            arm(inj, specs, origin="machine")
         except (FaultSpecError, ParameterError) as e:
             raise CommandError(str(e)) from None
 
@@ -286,12 +333,18 @@ def inject(
 def script(steps: list[dict[str, Any]], *, core: int = 1, ctl: Any = None) -> list[int]:
     """Steps run in order: each is armed once the one before it has started (its trigger
     then counts from there: ``after_ms``, ``after_cycles``); the ids."""
+    if not isinstance(steps, list | tuple):
+        raise FaultSpecError(
+            "a script is a list of steps, each a table of a fault's values, such as "
+            f"[{{'kind': 'link_down', 'after_slave': 0}}, {{'kind': 'sto', 'axis': 1}}]; "
+            f"got {steps!r}"
+        )
+    specs = [spec_from_dict(step, f"step {i}") for i, step in enumerate(steps, 1)]
     ctl = ctl or _controller(core)
     inj = injector_for(ctl)
     assert inj is not None
     ids: list[int] = []
-    for i, step in enumerate(steps, 1):
-        spec = spec_from_dict(step, f"step {i}")
+    for spec in specs:
         if ids and spec.after is None:
             spec.after = ids[-1]
         ids.append(arm(inj, [spec])[0].id)

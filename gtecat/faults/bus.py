@@ -37,6 +37,11 @@ class FaultBus:
     name = "bus"
     cycle_ns = 1_000_000
 
+    def image_bytes(self) -> int | None:
+        """Size of the process image, bytes, where the bus knows it (a ``wkc_offset`` area
+        wholly past it would never act); None where it does not."""
+        return None
+
     @property
     def slaves(self) -> list[VirtualSlave]:
         raise NotImplementedError
@@ -193,6 +198,12 @@ class EmulatedBus(FaultBus):
     """The in-process emulated bus of one controller."""
 
     name = "emulated"
+
+    def image_bytes(self) -> int | None:
+        m = self.ctl.master
+        if m is None:
+            return None
+        return int(m.image.outputs_bytes + m.image.inputs_bytes)
 
     def __init__(self, ctl: Any) -> None:
         from ..master.backends.emulated import EmulatedBackend

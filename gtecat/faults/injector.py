@@ -80,6 +80,9 @@ class Entry:
     #: a step of a script: armed only once the fault with this id has started
     after: int | None = None
     name: str = ""
+    #: "machine" for a ``[[fault]]`` table of the machine description (armed again by every
+    #: bring-up), "" for one injected (Python, the command line, the panel, a fixture)
+    origin: str = ""
 
     def describe(self) -> str:
         if self.after is None:
@@ -142,6 +145,8 @@ class Injector:
         name: str = "",
     ) -> Entry:
         self._check_target(fault)
+        if trigger is not None:
+            self._check_trigger(trigger)
         if (
             after is not None
             and after not in self._started
@@ -162,6 +167,56 @@ class Injector:
 
     def _held(self, e: Entry) -> bool:
         return self.holding and e.fault.depth != "mailbox"
+
+    def carry(self, old: Injector) -> None:
+        """The bus was brought up again (``GT_InitEcatComm`` once more): the injected faults
+        of the bus before it stay, as they were - a re-initialisation repairs nothing.  An
+        active one acts on the new bus too (its duration and the answers it still has to hit
+        go on from where they were), an armed one keeps its trigger (a time, a count of
+        cycles, of SDOs: all counted on); what started once and is over (a power cycle) is
+        gone, and a machine description's tables are armed anew by the bring-up, not kept.
+        Ids go on from the bus before, so an id names one fault for the whole session.  A
+        fault on a slave or axis the new bus does not have (another ENI) is dropped, with a
+        line in the master log.  Called before the bring-up (:attr:`holding`): a fault that
+        was active starts as one armed at once would (:meth:`bus_ready`)."""
+        self._next = max(self._next, old._next)
+        kept_ids = set()
+        for e in old.entries:
+            if e.state not in ("armed", "active") or e.origin == "machine":
+                continue
+            why = ""
+            try:
+                self._check_target(e.fault)
+                self._check_trigger(e.trigger)
+            except ParameterError as err:
+                why = str(err)
+            if not why and e.after is not None and e.after not in old._started:
+                if e.after not in kept_ids:
+                    why = f"fault {e.after}, which it waits for, is gone"
+            if why:
+                self.bus.log(f"Fault {e.id} dropped with the bus brought up again: {why}.")
+                continue
+            n = Entry(e.id, e.fault, e.trigger, e.duration_ms, after=e.after, name=e.name)
+            n.data = dict(e.data)
+            if e.state == "active":
+                n.data["resume"] = (e.started_ms, e.left)
+            kept_ids.add(e.id)
+            self.entries.append(n)
+            self.bus.log(f"Fault {n.id} kept with the bus brought up again: {n.describe()}.")
+        self._started |= old._started
+        for n in self.entries:
+            if "resume" in n.data and not self._held(n):
+                self._resume(n)
+        self._refresh()
+
+    def _resume(self, e: Entry) -> None:
+        """A fault active on the bus before a re-initialisation starts on the new one."""
+        started, left = e.data.pop("resume")
+        self._start(e)
+        if e.state == "active":
+            e.started_ms = started
+            if left:
+                e.left = left
 
     def clear(self, ident: int | None = None) -> int:
         """End one fault (by id) or all; the number ended."""
@@ -197,11 +252,34 @@ class Injector:
                     raise ParameterError(f"slave {s.position} ({s.name}) is no IO slave")
                 if not 0 <= f.bit < len(s.field_inputs) * 8:
                     raise ParameterError(f"slave {s.position}: no input bit {f.bit}")
+        if isinstance(f, k.WkcOffset):
+            size = self.bus.image_bytes() if f.area is not None else None
+            if size is not None and f.area is not None and f.area[0] >= size:
+                raise ParameterError(
+                    f"wkc_offset: area [{f.area[0]}, {f.area[1]}) lies past the process "
+                    f"image (logical bytes 0..{size - 1}), so it would never act"
+                )
         if isinstance(f, k.LinkDown) and f.after_slave >= len(self.bus.slaves) - 1:
             raise ParameterError(
                 f"link_down after slave {f.after_slave}: nothing follows it (the bus has "
                 f"slaves 0..{len(self.bus.slaves) - 1})"
             )
+
+    def _check_trigger(self, trig: Trigger) -> None:
+        """Refuse a trigger watching a slave or axis the bus does not have (it would never
+        fire), as :meth:`_check_target` does for the fault's own."""
+        from .triggers import AtHomingStage, WhenPosition
+
+        try:
+            if isinstance(trig, WhenPosition | AtHomingStage):
+                self.bus.channel(int(trig.axis))
+            elif isinstance(trig, OnSdo):
+                s = self.bus.slave(int(trig.slave))
+                if not s.has_mailbox:
+                    raise ParameterError(f"slave {s.position} ({s.name}) has no mailbox")
+        except ParameterError as e:
+            key = {WhenPosition: "when_position", AtHomingStage: "at_homing", OnSdo: "on_sdo"}
+            raise ParameterError(f"{key[type(trig)]}: {e}") from None
 
     # --- the cycle ----------------------------------------
     def tick(self, _t_ns: int = 0, _dt_ns: int = 0, *, cycle: bool = True) -> None:
@@ -321,7 +399,11 @@ class Injector:
         if self.holding:
             self.holding = False
             for e in list(self.entries):
-                if e.state == "armed" and isinstance(e.trigger, Now) and self._gate_open(e):
+                if e.state != "armed":
+                    continue
+                if "resume" in e.data:
+                    self._resume(e)  # active before a re-initialisation (carry)
+                elif isinstance(e.trigger, Now) and self._gate_open(e):
                     self._start(e)
         self._watched = frozenset()
         if not self.bank_safe:
@@ -408,7 +490,8 @@ class Injector:
         elif isinstance(f, k.SwitchChatter):
             bus.override(f.axis)
         elif isinstance(f, k.EncoderLost):
-            bus.override(f.axis).enc_shift -= f.counts
+            bus.before_change()
+            bus.channel(f.axis).lose_counts(f.counts)
         elif isinstance(f, k.EncoderNoise):
             bus.override(f.axis).enc_noise = f.counts
         elif isinstance(f, k.ProbeMissing):
@@ -454,8 +537,6 @@ class Injector:
             bit = 1 << k.SWITCH_BITS[f.switch]
             ff.din_set &= ~bit
             ff.din_clear &= ~bit
-        elif isinstance(f, k.EncoderLost):
-            bus.override(f.axis).enc_shift += f.counts
         elif isinstance(f, k.EncoderNoise):
             bus.override(f.axis).enc_noise = 0
         elif isinstance(f, k.ProbeMissing):
@@ -746,7 +827,9 @@ def _protocol_fault(request: bytes, variant: str) -> bytes:
     if variant == "mailbox_error":
         return mailbox_error(MailboxError.SERVICE_NOT_SUPPORTED, counter=counter)
     if variant == "wrong_service":
-        return build_coe(CoeService.EMERGENCY, bytes(8), counter=counter)
+        # an answer of another CoE service, not an emergency: a master takes an emergency
+        # for what it is (ETG.1000.6 5.6.4: logged) and waits on for the SDO's answer
+        return build_coe(CoeService.SDO_INFORMATION, bytes(8), counter=counter)
     return build_coe(CoeService.SDO_RESPONSE, b"", counter=counter)  # "short": no SDO frame
 
 

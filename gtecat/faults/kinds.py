@@ -70,6 +70,8 @@ class Fault:
         d: dict[str, Any] = {"kind": self.kind}
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
+            if isinstance(v, int) and type(v) is not int:
+                v = int(v)  # (an enum member, ErrorCode.X: a listing shows plain numbers)
             if v is not None:
                 d[f.name] = list(v) if isinstance(v, tuple) else v
         return d
@@ -320,7 +322,7 @@ class DriveFault(Fault):
         "or a name); the cause lasts until cleared"
     )
     axis: int
-    code: int = ErrorCode.CONTINUOUS_OVER_CURRENT
+    code: int = int(ErrorCode.CONTINUOUS_OVER_CURRENT)
 
     def describe(self) -> str:
         return f"drive of axis {self.axis} faults with {_code_text(self.code)}"
@@ -403,7 +405,11 @@ class SwitchChatter(Fault):
 class EncoderLost(Fault):
     kind: ClassVar[str] = "encoder_lost"
     depth: ClassVar[str] = "field"
-    summary: ClassVar[str] = "the encoder of AXIS loses COUNTS counts (6064h jumps by -COUNTS)"
+    once: ClassVar[bool] = True
+    summary: ClassVar[str] = (
+        "the encoder of AXIS loses COUNTS counts: 6064h jumps by -COUNTS and stays off until "
+        "homed again; the drive's loop sees the error (60F4h) and closes it, or faults 8611h"
+    )
     axis: int
     counts: int = 100
 
@@ -481,21 +487,30 @@ _SWITCHES = {
 }
 
 
+#: the integer values that are a yes or no (0 or 1): these alone take true/false, on/off
+_FLAGS = frozenset({"value"})
+
+
 def _int(name: str, v: Any) -> int:
+    """The one check of an integer value from TOML, JSON, the command line or Python: an
+    integer, a float with no fraction, or text (decimal, 0x hex); true/false (on/off, yes/no)
+    only for a yes-or-no value (:data:`_FLAGS`), never as an axis 1 or a slave 0."""
+    flag = name in _FLAGS
     if isinstance(v, bool):
-        return int(v)
-    if isinstance(v, int):
+        if flag:
+            return int(v)
+    elif isinstance(v, int):
         return v
-    if isinstance(v, float) and v.is_integer():
+    elif isinstance(v, float) and v.is_integer():
         return int(v)
-    if isinstance(v, str):
+    elif isinstance(v, str):
         try:
             return int(v.strip().replace("_", ""), 0)
         except ValueError:
             pass
-        if v.strip().lower() in ("on", "true", "yes"):
+        if flag and v.strip().lower() in ("on", "true", "yes"):
             return 1
-        if v.strip().lower() in ("off", "false", "no"):
+        if flag and v.strip().lower() in ("off", "false", "no"):
             return 0
     raise FaultSpecError(f"{name} must be an integer, got {v!r}")
 

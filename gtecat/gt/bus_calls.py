@@ -274,12 +274,16 @@ def GT_IsEcatReady(ctl: Controller, pStatus: Any) -> int:
 def GT_GetEcatSlaves(ctl: Controller, pSlaveCnt: Any, pIoSlaveCnt: Any = None) -> int:
     """The slaves online (entry 45: "在线的 EtherCAT 从站数目").  One pointer (manual): all of
     them.  Two (vendor header): the motion slaves online, the IO slaves online - the same
-    count split, so both forms follow a link loss alike (a slave behind a cut is in neither)."""
+    count split, so both forms follow a link loss alike (a slave behind a cut is in neither).
+
+    The count is the master's, as its last cycle left it (the states it read then), not a
+    read of the bus of its own: a cable pulled since shows from the first cycle after the
+    cut on, in the very cycle GT_IsEcatReady, the axes' alarm bits and the reads of the
+    slaves behind it show it (a real controller's master counts the slaves in its cycle)."""
     m = ctl.master
     motion = io = 0
     if m is not None:
-        states = m.refresh_states()
-        for slave, state in zip(m.layout.slaves, states, strict=False):
+        for slave, state in zip(m.layout.slaves, m.states, strict=False):
             if state != AlState.NONE:
                 if slave.channels:
                     motion += 1

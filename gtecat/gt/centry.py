@@ -17,6 +17,22 @@ functions are taken from the running interpreter, and the entry is tested agains
 answers (every kind of shape it must hand on, the widths, reference counts) before use.  Any
 disagreement, or no compiler: :data:`REASON` says why and :func:`reader` gives None (the
 Python fast function is then the public one, as before).
+
+Another thread.  On the lockstep and auto clocks a cycle runs in whichever thread lets
+controller time pass (GTE_Wait, a call's host latency, a controller server's wall floor),
+holding the controller's clock lock, as every call of the table path does.  The entries answer
+without taking it, and the GIL alone does not make what they read whole: the interpreter hands
+it over between any two bytecodes of the other thread's cycle (so a read could find half the
+axes, half the slaves' inputs, of the next cycle), and the axis bank's compiled cycle runs with
+the GIL let go.  So an entry answers from what it read only where no other thread held the
+lock when it began and, where its value function (Python) ran, none held it afterwards and
+the epoch did not grow meanwhile; else it takes the lock itself (waiting with the GIL let go)
+and answers holding it, as the table path would (csrc/centry.c "Another thread and the
+clock", :data:`CLOCK_LOCK`).  The copy or write that follows the last look runs no Python.
+The common case costs one load of the lock's holder word.  Not covered: the Python fast
+functions (the shapes an entry hands on, and every shape where no entry is built) read
+without the lock as before, and the cycles a card runs for another card of one time
+(``ClockGroup.share``) do not take that card's lock.
 """
 
 from __future__ import annotations
@@ -26,6 +42,7 @@ import functools
 import logging
 import struct
 import sys
+import threading
 import types
 from array import array
 from collections.abc import Callable, Iterable
@@ -86,6 +103,13 @@ class _Api(ctypes.Structure):
         ("nd_descr", ctypes.c_ssize_t),
         ("nd_flags", ctypes.c_ssize_t),
         ("nd_want", ctypes.c_int),
+        ("clock_lock", _VP),
+        ("owner_off", ctypes.c_ssize_t),
+        ("thread_ident", _VP),
+        ("lock_acquire", _VP),
+        ("lock_release", _VP),
+        ("err_fetch", _VP),
+        ("err_restore", _VP),
     ]
 
 
@@ -221,6 +245,69 @@ def set_clocks(gt: Any, gtn: Any) -> None:
             q = None
         _CLOCKS[k] = q
         CLOCK_QUICK[k] = 0 if q is None else q.buffer_info()[0]
+
+
+#: per gate, its controller's clock lock (``Clock.lock``, a ``threading.RLock``) and that
+#: lock's bound ``acquire`` and ``release`` (0: none): an entry that finds the lock held by
+#: another thread answers holding it itself (csrc/centry.c "Another thread and the clock")
+CLOCK_LOCK = (ctypes.c_ssize_t * 2)()
+LOCK_ACQUIRE = (ctypes.c_ssize_t * 2)()
+LOCK_RELEASE = (ctypes.c_ssize_t * 2)()
+_LOCKS: list[Any] = [None, None]  # (the locks and their methods, kept alive while named)
+
+
+def set_locks(gt: Any, gtn: Any) -> None:
+    """The clocks behind the two gates, for their locks (None: none), set while the gates are
+    closed.  An entry that holds a lock keeps its own reference to its release (centry.c's
+    hold): the gates may change meanwhile."""
+    for k, clock in enumerate((gt, gtn)):
+        lock = getattr(clock, "lock", None)
+        if type(lock) is not _RLOCK:
+            lock = None
+        kept = None if lock is None else (lock, lock.acquire, lock.release)
+        _LOCKS[k] = kept
+        CLOCK_LOCK[k] = 0 if kept is None else id(kept[0])
+        LOCK_ACQUIRE[k] = 0 if kept is None else id(kept[1])
+        LOCK_RELEASE[k] = 0 if kept is None else id(kept[2])
+
+
+_RLOCK = type(threading.RLock())
+
+
+def _owner_at() -> int:
+    """Where a ``threading.RLock`` keeps the ident of the thread that holds it, 0 while
+    nobody does (ValueError when the probe disagrees): held once and twice here, then by
+    another thread, and let go."""
+    lock = threading.RLock()
+    if type(lock) is not _RLOCK or _RLOCK.__module__ != "_thread":
+        raise ValueError("threading.RLock is not the interpreter's lock")
+    words = range(_HEAD, _RLOCK.__basicsize__ - ctypes.sizeof(ctypes.c_ulong) + 1, _WORD)
+
+    def seen() -> list[int]:
+        return [ctypes.c_ulong.from_address(id(lock) + k).value for k in words]
+
+    me = threading.get_ident()
+    looks: list[tuple[int, list[int]]] = [(0, seen())]
+    with lock:
+        looks.append((me, seen()))
+        with lock:
+            looks.append((me, seen()))
+    looks.append((0, seen()))
+
+    def other() -> None:
+        with lock:
+            looks.append((threading.get_ident(), seen()))
+
+    t = threading.Thread(target=other, name="gtecat-probe")
+    t.start()
+    t.join()
+    looks.append((0, seen()))
+    if len({who for who, _ in looks}) != 3:
+        raise ValueError("no other thread to probe a lock's holder with")
+    for i, k in enumerate(words):
+        if all(got[i] == who for who, got in looks):
+            return k
+    raise ValueError("a lock's holder is not where it is looked for")
 
 
 def _epoch_at() -> int:
@@ -515,6 +602,11 @@ def _slots(e: Any) -> Any:
 def _load() -> tuple[Maker | None, str]:
     if sys.implementation.name != "cpython":
         return None, "not CPython"
+    gil = getattr(sys, "_is_gil_enabled", None)
+    if gil is not None and not gil():
+        # (an entry's reads and writes are whole against other threads only under the GIL:
+        # the module docstring, "Another thread")
+        return None, "the interpreter runs without a GIL"
     try:
         carg_value, carg_obj, ob_type, b_ptr = byref_target.layout()
         fval = _float_at()
@@ -522,6 +614,7 @@ def _load() -> tuple[Maker | None, str]:
         bastart = _bytearray_at(bsize)
         objects_at = _objects_at()
         epoch_at = _epoch_at()
+        owner_at = _owner_at()
         titems = _tuple_at(bsize)
         numpy_at = _numpy_at()
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
@@ -566,6 +659,13 @@ def _load() -> tuple[Maker | None, str]:
             ctypes.addressof(CLOCK_QUICK),
             *numpy_at,
             _ND_WANT,
+            ctypes.addressof(CLOCK_LOCK),
+            owner_at,
+            _address("PyThread_get_thread_ident"),
+            ctypes.addressof(LOCK_ACQUIRE),
+            ctypes.addressof(LOCK_RELEASE),
+            _address("PyErr_Fetch"),
+            _address("PyErr_Restore"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

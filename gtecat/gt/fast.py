@@ -568,6 +568,9 @@ def set_gates(gt: Any, gtn: Any) -> None:
     centry.set_clocks(
         *(c.clock if g == centry.AUTO else None for c, g in zip(new, gates, strict=True))
     )
+    centry.set_locks(
+        *(c.clock if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
+    )
     centry.set_gates(*gates)
 
 

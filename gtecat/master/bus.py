@@ -25,10 +25,12 @@ reads of PDO objects give no delay), so there is none here: what
 objects return agree from the first cycle.  One lost frame, or a short stall of
 the wire, is still no loss: the state read is answered, every slave in OP, and
 nothing goes offline.  While the working counter stays short the states are read
-again after :attr:`Master.loss_confirm_ns` (10 ms) and every
-:attr:`Master.recover_every` cycles from then on.  The controller stops the axes
-of offline slaves and the GT layer refuses process data that touches them
-(:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
+again after :attr:`Master.loss_confirm_ns` (10 ms), every
+:attr:`Master.recover_every` cycles from then on, and in every cycle whose count
+differs from the cycle's before (slaves gone, or back behind a cut mended in part).
+``GT_GetEcatSlaves`` counts what these reads found, as the others do: no read of its
+own.  The controller stops the axes of offline slaves and the GT layer refuses process
+data that touches them (:mod:`gtecat.controller.core`, :mod:`gtecat.gt.bus_calls`).
 
 Lost SDO answer: a master that sends an SDO request and gets no answer waits its
 mailbox timeout before it gives up with 0x05040000 (SDO protocol timed out).  The
@@ -37,12 +39,21 @@ so the emulated master waits what its hardware backend waits (SOEM's mailbox
 receive timeout, 700 ms: :data:`SDO_TIMEOUT_MS`), in controller time: the cycles
 run while the call waits (:attr:`Master.mailbox_wait`), in lockstep and auto
 alike, so a loop that polls by SDO sees the time a real one would.
+
+Mailbox on a wire: a backend whose SDOs wait for a real slave's answer
+(:attr:`Backend.mailbox_on_wire`: pysoem) takes that time on the wall clock.  A real
+controller's firmware keeps the cyclic exchange going while a mailbox transfer is
+pending, so the master hands such a transfer to :attr:`Master.mailbox_transfer` (set
+by the controller), which keeps the cycles running at the bus cycle meanwhile and
+counts them on the controller's clock: a lost answer costs 700 ms of controller time
+in which the axes move and the slaves' watchdogs stay fed, on both backends.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from gtecat.drives.slave import AlState, AlStatusCode
 from gtecat.eni.errors import GtecatError
@@ -52,6 +63,8 @@ from gtecat.eni.model import InitCmd
 from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend
 from .image import ProcessImage
+
+_T = TypeVar("_T")
 
 #: looked up once: the cycle and :meth:`Master.steady` compare with it (an enum member's
 #: lookup costs more than the comparison)
@@ -121,6 +134,9 @@ class Master:
         #: lets ``ms`` of controller time pass, cycles running (set by the controller):
         #: the wait for an SDO answer that never comes (module docstring "Lost SDO answer")
         self.mailbox_wait: Callable[[float], None] | None = None
+        #: runs one mailbox transfer of a backend whose mailbox waits on a wire (module
+        #: docstring "Mailbox on a wire") while the cycles keep running; None: in place
+        self.mailbox_transfer: Callable[[Callable[[], Any]], Any] | None = None
         #: a short working counter this long in a row is worth a second state read (the
         #: first is made in the first short cycle)
         self.loss_confirm_ns = 10_000_000
@@ -262,6 +278,7 @@ class Master:
         wkc = self.backend.exchange(t_ns, dt_ns)
         self.cycles += 1
         expected = self.backend.expected_wkc() if self.target == _OP else wkc
+        before = self.last.wkc
         self.last = CycleResult(wkc, expected)
         if self._op_countdown >= 0:
             self._op_countdown -= 1
@@ -282,8 +299,11 @@ class Master:
             periodic = confirmed and self.cycles % self.recover_every == 0
             if periodic and not self.backend.recovers_itself:
                 self.recover()
-            elif periodic or bad == 0 or bad < self.loss_confirm_ns <= self._bad_ns:
-                # who is gone, from the first short cycle on (comm loss, module docstring)
+            elif (
+                periodic or bad == 0 or bad < self.loss_confirm_ns <= self._bad_ns or wkc != before
+            ):
+                # who is gone, from the first short cycle on (comm loss, module docstring),
+                # and again whenever the count changes while short (slaves gone or back)
                 self.refresh_states()
         if self.last.ok:
             self._bad_ns = 0
@@ -415,9 +435,12 @@ class Master:
         """The object's bytes; ``wait=False``: a lost answer costs no controller time (the
         inspection verbs, which run beside the application, never run its cycles)."""
         self._check_slave(pos)
+        backend = self.backend
+        if wait and backend.mailbox_on_wire:
+            return self._on_wire(lambda: backend.sdo_upload(pos, index, subindex, complete_access))
         lost = self._unanswered(pos) if wait else -1
         try:
-            return self.backend.sdo_upload(pos, index, subindex, complete_access)
+            return backend.sdo_upload(pos, index, subindex, complete_access)
         finally:
             self._timed_out(lost, pos)
 
@@ -433,11 +456,21 @@ class Master:
     ) -> None:
         """Write ``data`` to the object; ``wait`` as for :meth:`sdo_upload`."""
         self._check_slave(pos)
+        backend = self.backend
+        if wait and backend.mailbox_on_wire:
+            self._on_wire(lambda: backend.sdo_download(pos, index, subindex, data, complete_access))
+            return
         lost = self._unanswered(pos) if wait else -1
         try:
-            self.backend.sdo_download(pos, index, subindex, data, complete_access)
+            backend.sdo_download(pos, index, subindex, data, complete_access)
         finally:
             self._timed_out(lost, pos)
+
+    def _on_wire(self, transfer: Callable[[], _T]) -> _T:
+        """A transfer of a mailbox on a wire: the cycles run while it waits (module
+        docstring "Mailbox on a wire"), as long as the slave takes to answer."""
+        run = self.mailbox_transfer
+        return transfer() if run is None else run(transfer)
 
     def _unanswered(self, pos: int) -> int:
         """The SDO requests the backend sent to slave ``pos`` without an answer so far (-1: it

@@ -19,10 +19,11 @@ clock is shared already.
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -213,6 +214,42 @@ class Clock:
         finally:
             if owned:
                 self.lock.acquire()
+
+    def pace(self, done: Callable[[float], bool]) -> int:
+        """Virtual time at the wall clock's pace while something outside runs on the wall
+        clock (a mailbox transfer on a wire): one cycle each time a bus cycle of wall time
+        has passed, until ``done(seconds)``, which waits up to that long for the end of that
+        something, says it is over.  A cycle late by a whole period re-phases, as in
+        realtime (no burst).  Returns the cycles run."""
+        n = 0
+        due = time.perf_counter_ns() + self.cycle_ns
+        while not done(max(0, due - time.perf_counter_ns()) / 1e9):
+            self.advance_ns(self.cycle_ns)
+            n += 1
+            due += self.cycle_ns
+            now = time.perf_counter_ns()
+            if now > due:
+                due = now + self.cycle_ns
+        return n
+
+    @contextlib.contextmanager
+    def unlocked(self) -> Iterator[None]:
+        """The cycle lock let go for the block, however many times this thread holds it, so
+        the cycle thread runs meanwhile; held again as before once the block ends."""
+        lock = self.lock
+        if not lock._is_owned():  # type: ignore[attr-defined]
+            yield
+            return
+        state = lock._release_save()  # type: ignore[attr-defined]
+        try:
+            yield
+        finally:
+            lock._acquire_restore(state)  # type: ignore[attr-defined]
+
+    @property
+    def in_cycle_thread(self) -> bool:
+        """The calling thread is the realtime cycle thread (a hook of its cycle)."""
+        return self._thread is not None and threading.current_thread() is self._thread
 
     @property
     def now_ms(self) -> int:

@@ -62,12 +62,15 @@ class WallFloor:
         if need > 0 and self.active:
             step = self.clock.cycle_ns
             deadline = time.perf_counter() + self.budget_s
-            while need > 0:
-                n = min(need, step)
-                cycles += self.clock.advance_ns(n)
-                need -= n
-                if time.perf_counter() > deadline:
-                    break
+            # (the clock's lock, as every call's cycles hold it: a reader of another thread
+            # of this process waits for it rather than read half a cycle - gtecat.gt.centry)
+            with self.clock.lock:
+                while need > 0:
+                    n = min(need, step)
+                    cycles += self.clock.advance_ns(n)
+                    need -= n
+                    if time.perf_counter() > deadline:
+                        break
         self.debt_ns = max(0, need) if self.active else 0
         self._virt_last = self._virtual()
         return cycles

@@ -42,6 +42,8 @@ def test_toml_loading(tmp_path):
         ({"axis": {"1": {"negative_limit": 5, "positive_limit": 1}}}, "below"),
         ({"axis": {"1": {"home_switch": [[3, 1]]}}}, "low < high"),
         ({"axis": {"1": {"counts_per_rev": "x"}}}, "number"),
+        # a misspelt table would be ignored: refused, with the tables there are
+        ({"axis": {}, "falt": {"kind": "sto"}}, r"unknown table\(s\) \[falt\]; .*\[\[fault\]\]"),
     ],
 )
 def test_bad_descriptions_are_refused(table, match):
@@ -52,3 +54,24 @@ def test_bad_descriptions_are_refused(table, match):
 def test_missing_file(tmp_path):
     with pytest.raises(MachineError, match="not found"):
         load_machine(tmp_path / "nope.toml")
+
+
+def test_a_loaded_description_carries_the_digest_of_its_bytes(tmp_path):
+    import hashlib
+
+    f = tmp_path / "m.toml"
+    f.write_bytes(b"[axis.2]\nprobe2 = [[-5, 5]]\n")
+    d = load_machine(f)
+    assert d.digest == hashlib.sha256(f.read_bytes()).hexdigest()[:16]
+    f.write_bytes(b"")
+    e = load_machine(f)
+    assert e.digest != d.digest and not e.axes
+    assert machine_from_dict({}).digest == ""  # (not read from a file)
+    assert e == machine_from_dict({}, str(f))  # (the digest is not compared)
+
+
+def test_a_description_that_is_not_utf8_is_a_clear_error(tmp_path):
+    f = tmp_path / "m.toml"
+    f.write_bytes(b"[axis.1]\nposition = 1 # \xff\n")
+    with pytest.raises(MachineError, match="not UTF-8 text"):
+        load_machine(f)

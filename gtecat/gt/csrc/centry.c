@@ -76,6 +76,21 @@ struct api {
     obj ndarray_type;
     ptrdiff_t nd_data, nd_nd, nd_dims, nd_descr, nd_flags;
     int nd_want;
+    /* the clocks' locks (gtecat.master.clock.Clock.lock, a threading.RLock), per gate: the
+     * lock object, 0: none; where an RLock keeps the ident of the thread that holds it (0:
+     * nobody; probed); the interpreter's PyThread_get_thread_ident; per gate the lock's
+     * acquire and release (bound methods); PyErr_Fetch and PyErr_Restore.  A cycle and a
+     * call of the table path run with their controller's clock lock held, and another
+     * thread of the program may run them (the lockstep and auto clocks run their cycles in
+     * whichever thread lets time pass): an entry that finds the lock held by another thread
+     * takes it itself (waiting, the GIL let go) and answers while it holds it (see ANSWER) */
+    const ptrdiff_t *clock_lock;
+    ptrdiff_t owner_off;
+    unsigned long (*thread_ident)(void);
+    const ptrdiff_t *lock_acquire;
+    const ptrdiff_t *lock_release;
+    void (*err_fetch)(obj *, obj *, obj *);
+    void (*err_restore)(obj, obj, obj);
 };
 
 #define MAX_TYPES 16
@@ -144,7 +159,9 @@ int gtecat_centry_api(const struct api *api)
         !api->none ||
         !api->zero || !api->one || !api->incref || !api->decref || !api->vectorcall || !api->as_ll ||
         !api->err_occurred || !api->err_clear || !api->gate || !api->epoch_obj ||
-        api->epoch_off <= 0 || !api->clock_quick)
+        api->epoch_off <= 0 || !api->clock_quick || !api->clock_lock || api->owner_off <= 0 ||
+        !api->thread_ident || !api->lock_acquire || !api->lock_release || !api->err_fetch ||
+        !api->err_restore)
         return 1;
     A = *api;
     ready = 1;
@@ -224,6 +241,99 @@ static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
         A.decref(old);
     if (oldtp)
         A.decref(oldtp);
+}
+
+/* Another thread and the clock.
+ *
+ * The readers answer without the clock lock: the GIL makes what an entry does in C atomic
+ * against the other threads' Python, but not against a cycle another thread is in the middle
+ * of - the interpreter hands the GIL over between any two bytecodes of that cycle (every
+ * switch interval, 5 ms by default), and the axis bank's compiled cycle runs with the GIL let
+ * go - nor against a cycle run whole while the entry's own value function (Python) let the
+ * GIL go.  So an entry answers from what it read only where no other thread held the lock
+ * when it began (elsewhere()), and, where Python ran for the value, none held it afterwards
+ * and the epoch did not grow meanwhile (every cycle and every call of the table path makes it
+ * grow once done: gtecat.controller.epoch); else it answers again holding the lock itself
+ * (ANSWER).  The write of the value, the copy of a raw range, follow the last look with no
+ * Python in between. */
+
+/* a try's body inlined into its entry (the common case pays no call for the split) */
+#if defined(__GNUC__) || defined(__clang__)
+#define TRY static inline __attribute__((always_inline)) obj
+#define RARE(x) __builtin_expect(!!(x), 0)
+#else
+#define TRY static inline obj
+#define RARE(x) (x)
+#endif
+
+/* a try's answer: not one that can stand, answer again holding the clock lock */
+static char again_mark;
+#define AGAIN ((obj)&again_mark)
+
+/* 1 where a thread other than this one holds the clock lock of gate g (its cycles run, or
+ * one of its calls): what the entry reads may be half of one state and half of the next */
+static inline int elsewhere(ptrdiff_t g)
+{
+    const char *lk;
+    unsigned long owner;
+    if (!g || !(lk = (const char *)A.clock_lock[g - 1]))
+        return 0;
+    owner = *(const unsigned long *)(lk + A.owner_off);
+    return owner && owner != A.thread_ident();
+}
+
+/* Gate g's clock lock taken (waiting, the GIL let go while another thread holds it): its
+ * release (a new reference, for let_go), or NULL with the error set. */
+static obj hold(ptrdiff_t g)
+{
+    obj acquire = (obj)A.lock_acquire[g - 1], release = (obj)A.lock_release[g - 1], r;
+    if (!acquire || !release) /* (the gate closed meanwhile: nothing to wait for) */
+        return A.none;
+    A.incref(release); /* (the release of the lock taken, whatever the gates become) */
+    r = A.vectorcall(acquire, NULL, 0, NULL);
+    if (!r) {
+        A.decref(release);
+        return NULL;
+    }
+    A.decref(r);
+    return release;
+}
+
+/* The lock hold() took let go (the call's own error, if any, kept as it was). */
+static void let_go(obj release)
+{
+    obj t, v, tb, r;
+    if (release == A.none)
+        return;
+    A.err_fetch(&t, &v, &tb);
+    r = A.vectorcall(release, NULL, 0, NULL);
+    if (r)
+        A.decref(r);
+    else
+        A.err_clear();
+    A.err_restore(t, v, tb);
+    A.decref(release);
+}
+
+/* An entry's answer: its try without the lock (inlined), else (AGAIN) its try holding the
+ * lock (ANSWER). */
+#define ANSWER(try_, e, g, args, nargs, kwnames)                                            \
+    do {                                                                                    \
+        obj r_ = try_(e, args, nargs, kwnames, 0), release_;                                \
+        if (!RARE(r_ == AGAIN))                                                             \
+            return r_;                                                                      \
+        if (!(release_ = hold(g)))                                                          \
+            return NULL;                                                                    \
+        r_ = try_##_locked(e, args, nargs, kwnames);                                        \
+        let_go(release_);                                                                   \
+        return r_;                                                                          \
+    } while (0)
+
+/* Whether what Python gave for the epoch ep0 may stand: the epoch the same and no other
+ * thread holding the lock (nothing of Python runs after this look before the write). */
+static int stands(ptrdiff_t g, long long ep0)
+{
+    return epoch() == ep0 && !elsewhere(g);
 }
 
 /* x held by an integer of size bytes (sign: signed) */
@@ -349,11 +459,11 @@ static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *
  * avalue(n, count, array type, clock) gives (clock None or 1: then the clock's value
  * follows the values as an int64) copied to its start, kept for the epoch. */
 static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
-                 ptrdiff_t at)
+                 ptrdiff_t at, int locked)
 {
     obj call[4], v, tp = TYPE(args[at + 1]);
     ptrdiff_t n;
-    long long ep = -1, an, ac, clk = 0;
+    long long ep = -1, ep0 = -1, an, ac, clk = 0;
     char *cmem = NULL, *mem;
     int csize = 0, csign = 1, over = 0;
     struct aslot *s = e->acache;
@@ -378,12 +488,18 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     } else {
         call[2] = tp;
         call[3] = cmem ? A.one : A.none;
+        if (!locked)
+            ep0 = epoch();
         v = A.vectorcall(e->avalue, call, 4, NULL);
         if (!v)
             return NULL;
         if (TYPE(v) != A.bytes_type) {
             A.decref(v);
             goto python;
+        }
+        if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
+            A.decref(v);
+            return AGAIN;
         }
         if (s && ep >= 0)
             keep_span(s, ep, v, tp, an, ac, cmem != NULL);
@@ -414,7 +530,7 @@ python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 
-/* the reader entry's work (both ways of calling it, below) */
+/* the reader entry's work (both ways of calling it, below): reader_try, then ANSWER */
 static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
 
 /* METH_FASTCALL | METH_KEYWORDS: self is the entry's ctypes object */
@@ -478,17 +594,20 @@ static char *reader_mem(obj p, obj target, obj deref)
     return mem;
 }
 
-static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+               int locked)
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v;
     char *mem;
     obj deref = NULL;
     int k, size = 0, sign = 1, npy = 0;
-    long long key = -1, ep = -1;
+    long long key = -1, ep = -1, ep0 = -1;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
+    if (!locked && elsewhere(e->gate))
+        return AGAIN; /* (the Python path too answers holding the lock then) */
     if (e->noaxis) {
         if (nargs < 1 || nargs > 2 || nargs > e->most ||
             (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
@@ -502,7 +621,7 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
         if (TYPE(args[at]) != A.int_type)
             goto python;
         if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
-            return array(e, args, nargs, kwnames, at);
+            return array(e, args, nargs, kwnames, at, locked);
         /* (the cached small ints 1 and 0 first: one compare for the common literals) */
         if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
@@ -536,12 +655,18 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     if (e->cache &&
         (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep)) != NULL)
         goto have;
+    if (!locked)
+        ep0 = epoch();
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
                   : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)
         goto drop;
+    if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
+        A.decref(v);
+        return AGAIN;
+    }
     if (key >= 0 && ep >= 0)
         keep(&e->cache[key], ep, v);
 have:
@@ -575,6 +700,17 @@ drop:
     A.decref(v);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+static obj reader_try_locked(const struct entry *e, obj const *args, ptrdiff_t nargs,
+                             obj kwnames)
+{
+    return reader_try(e, args, nargs, kwnames, 1);
+}
+
+static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ANSWER(reader_try, e, e->gate, args, nargs, kwnames);
 }
 
 /* a raw image function's entry */
@@ -627,18 +763,21 @@ static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long siz
     return AT(target, A.b_ptr);
 }
 
-static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+            int locked)
 {
     ptrdiff_t at = e->io, k, n;
     obj p, target, v, call[4];
     const int64_t *runs;
-    long long size, off = 0, slave = -1, ep = -1;
+    long long size, off = 0, slave = -1, ep = -1, ep0 = -1;
     int over = 0;
     char *mem;
     struct aslot *s = e->write ? NULL : e->cache; /* (a write's value makes the epoch grow) */
 
     if (!ready || kwnames || nargs != 3 + at || (e->gate && !A.gate[e->gate - 1]))
         goto python;
+    if (!locked && elsewhere(e->gate))
+        return AGAIN; /* (the Python path too answers holding the lock then) */
     for (k = 0; k < 2 + at; k++)
         if (TYPE(args[k]) != A.int_type)
             goto python;
@@ -675,6 +814,8 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
     for (k = 0; k < 2 + at; k++)
         call[k] = args[k];
     call[2 + at] = TYPE(target);
+    if (!locked)
+        ep0 = epoch();
     v = A.vectorcall(e->value, call, (size_t)(3 + at), NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
@@ -686,6 +827,12 @@ static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj 
             A.decref(oldtp);
         }
         goto drop;
+    }
+    /* (a read: the runs are of the image of the epoch it began in; a write's value makes the
+     * epoch grow itself) */
+    if (!locked && (e->write ? elsewhere(e->gate) : !stands(e->gate, ep0))) {
+        A.decref(v);
+        return AGAIN;
     }
     if (s && ep >= 0)
         keep_span(s, ep, v, TYPE(target), off, size, slave);
@@ -718,6 +865,17 @@ drop:
     A.decref(v);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+static obj raw_try_locked(const struct raw_entry *e, obj const *args, ptrdiff_t nargs,
+                          obj kwnames)
+{
+    return raw_try(e, args, nargs, kwnames, 1);
+}
+
+static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ANSWER(raw_try, e, e->gate, args, nargs, kwnames);
 }
 
 /* A reader of several values (GT_GetCaptureStatus(encoder, pStatus, pValue[, count,
@@ -767,16 +925,19 @@ static char *out_mem(const struct multi_entry *e, ptrdiff_t k, obj p, int *size,
     return typed_mem(p, e->types[k], e->sizes[k], e->signs[k], MAX_OTYPES, size, sign);
 }
 
-static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+TRY multi_try(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+              int locked)
 {
     ptrdiff_t k, nout = e->nout;
     char *mem[MAX_OUT];
     int size[MAX_OUT], sign[MAX_OUT];
-    long long ints[MAX_OUT], key = -1, ep = -1;
+    long long ints[MAX_OUT], key = -1, ep = -1, ep0 = -1;
     obj v, item;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
+    if (!locked && elsewhere(e->gate))
+        return AGAIN; /* (the Python path too answers holding the lock then) */
     if (nargs < 1 + nout || nargs > 1 + nout + e->nextra || TYPE(args[0]) != A.int_type)
         goto python;
     for (k = 1 + nout; k < nargs; k++) {
@@ -791,12 +952,18 @@ static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, 
             goto python;
     if (e->cache && (v = kept(e->cache, e->ncache, args[0], &key, &ep)) != NULL)
         goto have;
+    if (!locked)
+        ep0 = epoch();
     v = A.vectorcall(e->value, args, 1, NULL);
     if (!v)
         return NULL;
     if (v == e->sentinel || TYPE(v) != e->tuple_type ||
         *(ptrdiff_t *)((char *)v + A.bsize) != nout)
         goto drop;
+    if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
+        A.decref(v);
+        return AGAIN;
+    }
     if (key >= 0 && ep >= 0)
         keep(&e->cache[key], ep, v);
 have:
@@ -826,4 +993,15 @@ drop:
     A.decref(v);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+static obj multi_try_locked(const struct multi_entry *e, obj const *args, ptrdiff_t nargs,
+                            obj kwnames)
+{
+    return multi_try(e, args, nargs, kwnames, 1);
+}
+
+static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    ANSWER(multi_try, e, e->gate, args, nargs, kwnames);
 }

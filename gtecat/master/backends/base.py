@@ -33,6 +33,10 @@ class Backend(ABC):
     #: the backend brings lost slaves back itself (SOEM's recover/reconfig); otherwise the
     #: master re-walks them (:meth:`gtecat.master.bus.Master.recover`)
     recovers_itself = False
+    #: the mailbox waits for slaves on a wire (pysoem): an SDO takes the slave's answer time
+    #: on the wall clock, a lost answer the mailbox timeout; the master keeps the cycles
+    #: running meanwhile (:attr:`gtecat.master.bus.Master.mailbox_transfer`)
+    mailbox_on_wire = False
 
     @abstractmethod
     def open(self, layout: Layout, image: ProcessImage) -> None:

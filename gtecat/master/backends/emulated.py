@@ -58,6 +58,9 @@ class EmulatedBackend(Backend):
         #: process-data watchdog of the slaves (ESC default 100 ms)
         self.watchdog_ns = 100_000_000
         self._silent_ns: dict[int, int] = {}
+        #: (outside changes, claimed slaves) when every claimed slave's emergency queue was
+        #: last found empty (:meth:`emergencies`), or None
+        self._emcy_empty: tuple[int, tuple[VirtualSlave, ...]] | None = None
         self._clients: dict[int, object] = {}
         self._claimed: frozenset[int] = frozenset()
         self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
@@ -327,13 +330,24 @@ class EmulatedBackend(Backend):
         out = []
         claimed = self._claimed
         unplugged = self.unplugged
-        # a claimed slave is not stepped here, but a scenario may queue one (emit_emergency)
+        # a claimed slave is not stepped here, but a scenario may queue one (emit_emergency,
+        # which counts as an outside change): while nothing changed since a look that left
+        # every claimed slave's queue empty, there is none to fetch from them
         stepped = (e[0] for e in self._run_plan)
-        for slave in self.slaves if not claimed else (*stepped, *self._claimed_slaves):
+        mark = (VirtualSlave.outside_changes, self._claimed_slaves)
+        looked = self._emcy_empty
+        known = claimed and looked is not None and looked[0] == mark[0] and looked[1] is mark[1]
+        slaves: Any = self.slaves
+        if claimed:
+            slaves = stepped if known else (*stepped, *self._claimed_slaves)
+        for slave in slaves:
             if unplugged and slave.position in unplugged:
                 continue
             while slave.emergencies:
                 out.append((slave.position, slave.emergencies.popleft()))
+        if claimed and not known:  # (one left: behind a pulled cable, it stays queued)
+            left = any(s.emergencies for s in self._claimed_slaves)
+            self._emcy_empty = None if left else mark
         if claimed and len(out) > 1:
             out.sort(key=lambda e: e[0])  # (in the order of the bus, as without the bank)
         return out

@@ -25,6 +25,15 @@ slaves' buffers).  So ``GT_GetEcatRawData`` offsets are identical on both.
 SOEM packs slaves with fewer than 8 bits into shared bytes; :func:`soem_bit_starts`
 reproduces that packing so those slaves are read and written bit-exactly.
 
+Mailbox: an SDO waits for the slave's answer on the wire (SOEM's mailbox timeout, set to
+the master's 700 ms), with the GIL let go, while the cycles go on in another thread
+(:attr:`Backend.mailbox_on_wire`): SOEM sends and takes its process-data and mailbox
+frames under their own datagram indexes, so the two interleave.  One transfer at a time
+(:attr:`PysoemBackend.mailbox_lock`).  SOEM's outcomes become the abort codes the
+emulated bus gives (:data:`gtecat.drives.abort.MAILBOX_FAILURE_CODES`): an abort frame its
+code, no answer 05040000h, a mailbox error reply or an answer that is not the SDO's
+08000000h.
+
 Working counter: returned as data; a drop starts SOEM's supervision pattern
 (acknowledge SAFEOP+ERROR, re-request OP, reconfigure a slave that fell back
 to INIT/PREOP with its InitCmds re-applied, re-address a lost slave when it
@@ -36,6 +45,7 @@ from __future__ import annotations
 import logging
 import os
 import sys
+import threading
 import time
 from collections import deque
 from collections.abc import Callable
@@ -46,12 +56,13 @@ from typing import Any
 
 import numpy as np
 
-from gtecat.drives.abort import SdoAbort
+from gtecat.drives.abort import MailboxFailure, SdoAbort, mailbox_failure
 from gtecat.drives.slave import AlState, AlStatusCode, Emergency
 from gtecat.eni.layout import Layout
 from gtecat.eni.model import Direction, Identity, InitCmd
 
 from ...errors import BusError, ConfigMismatch, NoSlavesError, StateError
+from ..bus import SDO_TIMEOUT_MS
 from ..image import ProcessImage, Segment
 from .base import Backend, FoundSlave
 
@@ -62,6 +73,7 @@ ERROR_FLAG = 0x10  # AL status 0x0130 bit 4: error indication; AL control: ackno
 IOMAP_BYTES = 4096  # pysoem's static IO map (EC_IOMAPSIZE)
 _SDO_BIG = 1 << 16  # retry size for objects larger than pysoem's 256-byte default buffer
 _SII_MBX_PROTO = 0x001C  # SII word: mailbox protocols supported
+_PACKET_TOO_SMALL = 3  # SOEM packet error: the data container is too small for the answer
 #: GIL switch interval while the bus is open: a user thread polling GT functions in a
 #: tight loop (manual example 5-5) otherwise keeps the cycle thread waiting up to 5 ms
 SWITCH_INTERVAL_S = 0.0005
@@ -194,6 +206,7 @@ class PysoemBackend(Backend):
     """The bus on a network interface, through pysoem (SOEM)."""
 
     recovers_itself = True  # check_and_recover(): SOEM re-addresses and reconfigures
+    mailbox_on_wire = True  # an SDO waits for the slave's answer (module docstring "Mailbox")
 
     name = "pysoem"
 
@@ -247,6 +260,11 @@ class PysoemBackend(Backend):
         self._notes: dict[int, str] = {}
         self._coe: list[bool] = []
         self._switch_interval: float | None = None
+        #: one mailbox transfer at a time (the application's SDOs, which run beside the
+        #: cycles, and the InitCmds a recovery in the cycle re-applies)
+        self.mailbox_lock = threading.Lock()
+        #: slaves whose last transfer failed: their mailbox is emptied again before the next
+        self._mailbox_dirty: set[int] = set()
 
     # --- open / scan --------------------------------------------------------------
     def open(self, layout: Layout, image: ProcessImage) -> None:
@@ -275,6 +293,10 @@ class PysoemBackend(Backend):
         except ConnectionError as e:
             raise BusError(self._open_failure(self.iface)) from e
         self.master = m
+        # the master's mailbox timeout (gtecat.master.bus.SDO_TIMEOUT_MS), in µs
+        for attr in ("sdo_read_timeout", "sdo_write_timeout"):
+            if hasattr(m, attr):
+                setattr(m, attr, SDO_TIMEOUT_MS * 1000)
         self._switch_interval = sys.getswitchinterval()
         if self._switch_interval > SWITCH_INTERVAL_S:
             sys.setswitchinterval(SWITCH_INTERVAL_S)
@@ -725,21 +747,40 @@ class PysoemBackend(Backend):
         return s
 
     def _sdo_error(
-        self, e: Exception, position: int, what: str, index: int, subindex: int
+        self, e: Exception, position: int, what: str, index: int, subindex: int, waited_s: float
     ) -> Exception:
+        """SOEM's outcome as the emulated bus gives it (:data:`MAILBOX_FAILURE_CODES`)."""
         soem = self.soem
-        where = (
-            f"slave {position} ({self._name(position)}): SDO {what} 0x{index:04X}:{subindex:02X}"
-        )
+        where = f"slave {position} ({self._name(position)}): SDO {what}"
         if isinstance(e, soem.SdoError):
             return SdoAbort(int(e.abort_code), index, subindex)
         if isinstance(e, soem.WkcError):
-            return BusError(f"{where}: no answer (mailbox timeout)")
+            if waited_s * 1000 < SDO_TIMEOUT_MS * 0.9:
+                # SOEM could not even put the request into the slave's mailbox: the slave
+                # is gone, as the emulated bus reports one behind a pulled cable
+                return BusError(
+                    f"{where} 0x{index:04X}:{subindex:02X}: no answer (the slave did not take "
+                    f"the request; {waited_s * 1000:.0f} ms)"
+                )
+            why = f"no answer within the mailbox timeout ({SDO_TIMEOUT_MS} ms)"
+            return mailbox_failure(MailboxFailure.NO_ANSWER, index, subindex, f"{where}: {why}")
         if isinstance(e, soem.MailboxError):
-            return BusError(f"{where}: mailbox error {e.error_code} ({e.desc})")
+            return mailbox_failure(
+                MailboxFailure.ERROR_REPLY,
+                index,
+                subindex,
+                f"{where}: mailbox error {e.error_code} ({e.desc})",
+            )
         if isinstance(e, soem.PacketError):
-            return BusError(f"{where}: {_describe_soem_error(e)}")
-        return BusError(f"{where}: {e!r}")
+            failure = (
+                MailboxFailure.TOO_BIG
+                if getattr(e, "error_code", None) == _PACKET_TOO_SMALL
+                else MailboxFailure.UNEXPECTED
+            )
+            return mailbox_failure(
+                failure, index, subindex, f"{where}: {_describe_soem_error(e, slave=False)}"
+            )
+        return BusError(f"{where} 0x{index:04X}:{subindex:02X}: {e!r}")
 
     def _past_emergencies(
         self, position: int, call: Callable[..., Any], *args: Any, **kw: Any
@@ -762,23 +803,29 @@ class PysoemBackend(Backend):
         s = self._mailbox_slave(position, "upload", index, subindex)
         soem = self.soem
         errors = (soem.SdoError, soem.WkcError, soem.MailboxError, soem.PacketError)
-        try:
+        read = self._nogil(s.sdo_read)
+        with self.mailbox_lock:
+            if position in self._mailbox_dirty:
+                self._forget_soem_errors(position)
+            t0 = self._monotonic()
             try:
-                return bytes(
-                    self._past_emergencies(
-                        position, s.sdo_read, index, subindex, ca=complete_access
+                try:
+                    return bytes(
+                        self._past_emergencies(position, read, index, subindex, ca=complete_access)
                     )
-                )
-            except soem.PacketError as e:
-                if getattr(e, "error_code", None) != 3:  # 3: data container too small
-                    raise
-                return bytes(
-                    self._past_emergencies(
-                        position, s.sdo_read, index, subindex, _SDO_BIG, ca=complete_access
+                except soem.PacketError as e:
+                    if getattr(e, "error_code", None) != _PACKET_TOO_SMALL:
+                        raise
+                    return bytes(
+                        self._past_emergencies(
+                            position, read, index, subindex, _SDO_BIG, ca=complete_access
+                        )
                     )
-                )
-        except errors as e:
-            raise self._sdo_error(e, position, "upload", index, subindex) from None
+            except errors as e:
+                waited = self._monotonic() - t0
+                self._forget_soem_errors(position)
+                self._mailbox_dirty.add(position)
+                raise self._sdo_error(e, position, "upload", index, subindex, waited) from None
 
     def sdo_download(
         self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
@@ -786,12 +833,62 @@ class PysoemBackend(Backend):
         s = self._mailbox_slave(position, "download", index, subindex)
         soem = self.soem
         errors = (soem.SdoError, soem.WkcError, soem.MailboxError, soem.PacketError)
+        write = self._nogil(s.sdo_write)
+        with self.mailbox_lock:
+            if position in self._mailbox_dirty:
+                self._forget_soem_errors(position)
+            t0 = self._monotonic()
+            try:
+                self._past_emergencies(
+                    position, write, index, subindex, bytes(data), ca=complete_access
+                )
+            except errors as e:
+                waited = self._monotonic() - t0
+                self._forget_soem_errors(position)
+                self._mailbox_dirty.add(position)
+                raise self._sdo_error(e, position, "download", index, subindex, waited) from None
+
+    def _forget_soem_errors(self, position: int) -> None:
+        """Empty the slave's read mailbox and SOEM's error list after a failed transfer.
+
+        SOEM answers a mailbox error reply by reading the mailbox again until its timeout,
+        asking the slave to repeat its last message each time the mailbox is empty: the
+        same reply comes back every few ms (one error each), and may still wait in the
+        mailbox when the timeout ends.  pysoem raises the first error it pops and leaves
+        the rest; the next transfer, however healthy, would fail with them (and with the
+        reply it reads from the mailbox first).  Done again before the slave's next
+        transfer: a late frame of a slow slave may have put the reply back meanwhile."""
+        self._mailbox_dirty.discard(position)
+        receive = getattr(self.slaves[position], "mbx_receive", None)
+        collect = getattr(self.master, "_collect_mailbox_errors", None)
+        if receive is None or collect is None:  # an older pysoem (or a stand-in)
+            return
         try:
-            self._past_emergencies(
-                position, s.sdo_write, index, subindex, bytes(data), ca=complete_access
+            receive()  # (raises the stale reply it read, if any)
+        except Exception as e:
+            _log.debug("stale mailbox message: %s", e)
+        try:
+            left = collect()
+        except Exception as e:  # (nothing to forget is worth failing the transfer for)
+            _log.debug("pysoem error list: %s", e)
+            return
+        if left:
+            counts: dict[str, int] = {}
+            for x in left:
+                what = _describe_soem_error(x, slave=False)
+                counts[what] = counts.get(what, 0) + 1
+            self.log(
+                f"slave {position} ({self._name(position)}): after the failed SDO, SOEM also "
+                "reported: "
+                + "; ".join(f"{w} ({n} times)" if n > 1 else w for w, n in counts.items())
             )
-        except errors as e:
-            raise self._sdo_error(e, position, "download", index, subindex) from None
+
+    def _nogil(self, call: Callable[..., Any]) -> Callable[..., Any]:
+        """``call`` letting go of the GIL while SOEM waits (pysoem >= 1.1: ``release_gil``),
+        so the cycle thread runs during the transfer."""
+        if not hasattr(self.master, "always_release_gil"):  # an older pysoem (or a stand-in)
+            return call
+        return lambda *a, **kw: call(*a, release_gil=True, **kw)
 
     # --- close ----------------------------------------------------------------------------
     def close(self) -> None:
@@ -805,27 +902,40 @@ class PysoemBackend(Backend):
             sys.setswitchinterval(self._switch_interval)
             self._switch_interval = None
         if m is not None:
+            # an SDO another thread is waiting for ends first (by its answer or its timeout):
+            # SOEM must not lose its socket under it
+            held = self.mailbox_lock.acquire(timeout=2 * SDO_TIMEOUT_MS / 1000)
             try:
                 m.close()
             except Exception as e:
                 _log.debug("pysoem close: %s", e)
+            finally:
+                if held:
+                    self.mailbox_lock.release()
 
 
-def _describe_soem_error(e: Any) -> str:
+def _describe_soem_error(e: Any, *, slave: bool = True) -> str:
+    """A pysoem exception in words; ``slave``: led by SOEM's slave number (1-based)."""
+    who = f"slave {getattr(e, 'slave_pos', '?')}: " if slave else ""
     abort = getattr(e, "abort_code", None)
     if abort is not None:
         return (
-            f"slave {getattr(e, 'slave_pos', '?')}: 0x{getattr(e, 'index', 0):04X}:"
+            f"{who}0x{getattr(e, 'index', 0):04X}:"
             f"{getattr(e, 'subindex', 0):02X} SDO abort 0x{int(abort):08X} "
             f"{getattr(e, 'desc', '')}"
         ).strip()
     code = getattr(e, "error_code", None)
+    if code is None:
+        return f"{who}{e}"
     desc = ""
     try:
         desc = str(e.desc)
     except Exception:
         desc = ""
-    return f"slave {getattr(e, 'slave_pos', '?')}: error {code} {desc}".strip()
+    kind = {"MailboxError": "mailbox error", "PacketError": "packet error"}.get(
+        type(e).__name__, "error"
+    )
+    return f"{who}{kind} {code} {desc}".strip()
 
 
 def _emergency(e: Any) -> Emergency:

@@ -23,7 +23,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from gtecat import gt
+from gtecat import faults, gt
 from gtecat.controller.bank import AxisBank
 from gtecat.controller.motion.jog import JogPlanner
 from tests.conftest import examples
@@ -172,6 +172,10 @@ def _act(action: tuple) -> int:
         )
     if kind == "unplug":  # the cable in front of a slave pulled (GTE_UnplugSlave)
         return gt.GTE_UnplugSlave(action[1])
+    if kind == "quick_stop":  # the drive's quick-stop input (a fault), or all faults cleared
+        if action[1]:
+            return faults.inject("quick_stop", axis=action[1])
+        return faults.clear()
     raise AssertionError(kind)
 
 
@@ -305,6 +309,16 @@ program = st.lists(st.tuples(st.integers(0, 80), action), min_size=1, max_size=1
 # a raw 607Ah write to an axis switched off (a frozen row): the next cycle writes 607Ah over it,
 # as the scalar axis does every cycle
 @example(actions=[(0, ("off", 11)), (0, ("probe", 3, 12567)), (3, ("raw4", 269, 18101))])
+# the quick-stop input of a moving drive: it ramps down in quick stop active while the
+# controller sends "quick stop", then switch on disabled (controlword 0); input released, on
+@example(
+    actions=[
+        (30, ("move", 4, 60_000, 40.0, 2.0, 2.0, 0.0, 0)),
+        (20, ("quick_stop", 4)),
+        (0, ("quick_stop", 0)),
+        (0, ("on", 4)),
+    ]
+)
 @example(
     actions=[
         (0, ("move", 7, 1725, 14.0, 2.42, 1.89, 1.0, 25)),

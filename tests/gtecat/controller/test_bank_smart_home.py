@@ -359,3 +359,35 @@ def test_forced_home_stopped_beyond_the_switch(tmp_path: Path) -> None:
     # (the index beyond the home the way back found; homeOffset 0)
     assert (run, stage, error) == (0, 100, 0) and 1_800 < capture == target, ref[-2][3]
     assert stats["rows"] > 0
+
+
+#: searches whose capture latches in the first cycle of their leg: the leg is quiet from
+#: its start (nothing to read before an edge), so the edge of that very cycle must reach
+#: the homing - the index right ahead of an index search (the drive's touch probe, by SDO),
+#: the home switch right ahead of a home search, and the same from the other side
+FIRST_CYCLE_SETUP: dict[int, tuple[dict[str, object] | None, dict[str, object]]] = {
+    1: ({"mode": 30, "acc": 4.0}, {"index_offset": 1, "counts_per_rev": 1_000}),
+    2: ({"mode": 20, "acc": 4.0}, {"home_switch": [[1, 500]]}),
+    3: ({"mode": 20, "moveDir": -1, "acc": 4.0}, {"home_switch": [[-500, -1]]}),
+    4: (
+        {"mode": 22, "indexDir": 1, "acc": 4.0, "velLow": 10.0},
+        {"home_switch": [[1, 500]], "index_offset": 150},
+    ),
+}
+
+
+def test_captures_in_the_first_cycle_of_a_leg(tmp_path: Path) -> None:
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(len(FIRST_CYCLE_SETUP), tmp_path / "axes.eni")
+    machine = _machine(tmp_path, FIRST_CYCLE_SETUP)
+    (ref, _), (got, stats) = (
+        _run(machine, b, 0, eni, FIRST_CYCLE_SETUP, 200) for b in ("off", "on")
+    )
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"cycle {k}: the bank and the scalar path differ"
+    assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
+    ended = ref[-2][3]
+    assert all(h[:3] == (0, 100, 0) for h in ended), ended
+    assert ended[0][3] == 1 and ended[1][3] <= 2 and ended[2][3] >= -2, ended
+    assert stats["rows"] > 0

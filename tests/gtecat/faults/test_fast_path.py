@@ -207,5 +207,5 @@ def _reset_session(way: str) -> list:
 
 def test_time_triggers_fire_in_the_same_cycle_across_a_reset() -> None:
     fast = _reset_session("batched")
-    assert sorted(e[1:] for e in fast) == [("end", 1), ("start", 1), ("start", 2)]
+    assert sorted(e[1:] for e in fast) == [("end", 1), ("end", 2), ("start", 1), ("start", 2)]
     assert fast == _reset_session("one at a time")

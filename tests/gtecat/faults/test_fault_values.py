@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from gtecat import faults, gt
 from gtecat.cli.main import main
+from gtecat.errors import ParameterError
 from gtecat.faults import FaultSpecError
 from gtecat.faults.kinds import KINDS, fault_from_dict, field_range
 from gtecat.faults.triggers import trigger_from_dict
@@ -171,6 +172,18 @@ def _open(machine: Path | None = None) -> int:
         ('kind = "link_down"\nafter_slave = 5', "link_down after slave 5: nothing follows"),
         ('kind = "drop_responses"\nafter = "nosuch"', "after='nosuch': no fault named so"),
         ("axis = 1", "the fault kind is missing"),
+        # a trigger on what the bus does not have would never fire (full_servo: axis 1,
+        # slaves 0..1; the IO slave has no mailbox)
+        (
+            'kind = "drive_fault"\naxis = 1\nwhen_position = [3, 100]',
+            "when_position: no axis 3: the bus has axes 1..1",
+        ),
+        ('kind = "sto"\naxis = 1\nat_homing = [9, "search"]', "at_homing: no axis 9"),
+        ('kind = "sto"\naxis = 1\non_sdo = [7, 0x6060, 1]', "on_sdo: no slave 7"),
+        ('kind = "sto"\naxis = 1\non_sdo = [1, 0x6060, 1]', "slave 1 (IO 1) has no mailbox"),
+        ('kind = "wkc_offset"\narea = [1000, 1010]', "lies past the process image"),
+        # true is no axis 1 (only a yes-or-no value takes true/false)
+        ('kind = "drive_fault"\naxis = true', "axis must be an integer, got True"),
     ],
 )
 def test_the_machine_toml_refuses_with_one_code(tmp_path: Path, table: str, words: str) -> None:
@@ -181,6 +194,38 @@ def test_the_machine_toml_refuses_with_one_code(tmp_path: Path, table: str, word
     assert words in why and f"{m} [[fault]] #1: " in why, why
 
 
+def test_two_tables_of_one_name_are_refused(tmp_path: Path) -> None:
+    m = tmp_path / "m.toml"
+    m.write_text('[[fault]]\nkind = "sto"\naxis = 1\nname = "a"\n' * 2)
+    assert _open(m) == 1
+    assert f"{m} [[fault]] #2: name 'a' names another fault already" in gt.GTE_GetLastError()
+
+
+def test_python_inputs_that_are_not_a_fault_are_told_so() -> None:
+    """What is no fault table is refused in words, before anything is armed: booleans as
+    numbers, a script that is no list of tables, a name used twice."""
+    assert _open() == 0
+    with pytest.raises(FaultSpecError, match="axis must be an integer, got True"):
+        faults.inject("drive_fault", axis=True)
+    with pytest.raises(FaultSpecError, match="slave must be an integer, got 'false'"):
+        faults.inject("io_stuck", slave="false", bit=0)
+    assert faults.describe({"kind": "switch_stuck", "axis": 1, "switch": "home", "value": True})
+    with pytest.raises(FaultSpecError, match="a script is a list of steps"):
+        faults.script("x")  # type: ignore[arg-type]
+    with pytest.raises(FaultSpecError, match="step 2: a fault is a table of its values"):
+        faults.script([{"kind": "sto", "axis": 1}, "link_down"])  # type: ignore[list-item]
+    with pytest.raises(FaultSpecError, match=r"a fault is a table of its values.*got 3"):
+        faults.describe(3)  # type: ignore[arg-type]
+    assert faults.listing() == []  # (the script's first step was not armed either)
+    faults.inject("sto", axis=1, at_ms=10**6, name="a")
+    with pytest.raises(FaultSpecError, match="name 'a' names another fault already"):
+        faults.inject("brake", axis=1, name="a")
+    faults.inject("drive_fault", axis=1, at_ms=10**6)
+    assert [type(f["code"]) for f in faults.listing() if "code" in f] == [int]
+    faults.inject(faults.kinds.DriveFault(axis=1), at_ms=10**6)
+    assert {type(f["code"]) for f in faults.listing() if "code" in f} == {int}
+
+
 def test_python_inject_refuses_and_after_slave_minus_1_takes_the_whole_bus() -> None:
     assert _open() == 0
     with pytest.raises(FaultSpecError, match="code -0x1 is out of range"):
@@ -189,6 +234,16 @@ def test_python_inject_refuses_and_after_slave_minus_1_takes_the_whole_bus() -> 
         faults.inject("mailbox_abort", slave=0, index=0x1FFFF)
     with pytest.raises(FaultSpecError, match="on_sdo needs 3 values"):
         faults.inject("mailbox_abort", slave=0, index=0x6060, on_sdo=[0, 0x6060])
+    for trig, words in [
+        ({"when_position": [3, 100]}, "when_position: no axis 3: the bus has axes 1..1"),
+        ({"at_homing": [9, "search"]}, "at_homing: no axis 9"),
+        ({"on_sdo": [7, 0x6060, 1]}, "on_sdo: no slave 7"),
+    ]:
+        with pytest.raises(ParameterError, match=words):
+            faults.inject("drive_fault", axis=1, **trig)
+    with pytest.raises(ParameterError, match=r"area \[1000, 1010\) lies past the process"):
+        faults.inject("wkc_offset", area=[1000, 1010])
+    assert faults.listing() == []
     fid = faults.inject("link_down", after_slave=-1)
     ids = faults.script([{"kind": "drop_responses", "after_ms": 300}])
     words = {f["id"]: f["describe"] for f in faults.listing()}

@@ -273,6 +273,10 @@ def test_the_fault_verbs_name_the_gtecat_they_act_on(app, capsys, monkeypatch) -
     assert f"{ep.id} (pid {os.getpid()}," in err
     assert main(["fault", "list", "--attach", ep.id]) == 0
     assert capsys.readouterr().out.strip() == "no fault armed or active"
+    # a trigger on an axis the bus does not have would never fire: refused
+    words = ["drive_fault", "axis=1", "when_position=3,100"]
+    assert main(["fault", "inject", *words, "--attach", ep.id]) != 0
+    assert "when_position: no axis 3: the bus has axes 1..2" in capsys.readouterr().err
 
 
 def test_a_lost_sdo_answer_over_the_endpoint_runs_none_of_the_applications_cycles(

@@ -67,6 +67,10 @@ class FakeDevice:
         self.vs = vs
         self.od = dict(od or {})
         self.refuse: dict[tuple[int, int], int] = {}  # object -> abort code
+        #: object -> what SOEM reports for the next SDO to it: "lost" (no answer: WkcError
+        #: after the 700 ms timeout), "error" (a mailbox error reply, SOEM reads on until its
+        #: timeout), "unexpected" (an answer that is not the SDO's: packet error 1)
+        self.mbx_fault: dict[tuple[int, int], str] = {}
         self.present = True
         self.writes: list[tuple[int, int, bytes]] = []
         self.coe = True  # SII mailbox protocols include CoE
@@ -157,6 +161,15 @@ class FakeSlave:
     def _check_mbx(self, index: int, subindex: int) -> None:
         if not self.dev.present or self.dev.vs.al_state < AlState.PREOP:
             raise WkcError(wkc=0)
+        fault = self.dev.mbx_fault.pop((index, subindex), None)
+        if fault in ("lost", "error"):
+            self._bus.wall_s += 0.7  # SOEM's mailbox timeout passes
+        if fault == "lost":
+            raise WkcError(wkc=0)
+        if fault == "error":
+            raise MailboxError(self._pos + 1, 4, "The service is no supported")
+        if fault == "unexpected":
+            raise PacketError(self._pos + 1, 1)
         code = self.dev.refuse.get((index, subindex))
         if code is None and (index, subindex) not in self.dev.od:
             code = SdoAbortCode.OBJECT_DOES_NOT_EXIST
@@ -195,6 +208,7 @@ class FakeMaster:
         self.reconfigs: list[int] = []
         self.frames = 0
         self.t_ns = 0
+        self.wall_s = 0.0  # the wall clock SOEM's waits take (the backend's ``monotonic``)
 
     def open(self, iface: str) -> None:
         if iface == "missing0":
@@ -516,6 +530,53 @@ def test_sdo_without_answer_is_a_bus_error_not_an_abort():
     devices[0].present = False
     with pytest.raises(BusError, match="no answer"):
         master.sdo_upload(0, 0x1000, 0)
+
+
+@pytest.mark.parametrize(
+    ("fault", "code", "text"),
+    [
+        ("lost", SdoAbortCode.SDO_PROTOCOL_TIMED_OUT, "no answer within the mailbox timeout"),
+        ("error", SdoAbortCode.GENERAL_ERROR, "mailbox error 4"),
+        ("unexpected", SdoAbortCode.GENERAL_ERROR, "packet error 1"),
+    ],
+)
+def test_soem_outcomes_are_the_emulated_bus_codes(fault, code, text):
+    """What SOEM reports becomes the abort code the emulated bus gives for the same fault
+    (gtecat.drives.abort.MAILBOX_FAILURE_CODES), uploads and downloads alike."""
+    master, backend, devices, _ = make_bus()
+    backend._monotonic = lambda: backend.master.wall_s
+    bring_up(master)
+    devices[1].od[(0x1000, 0)] = b"\0\0\0\0"
+    for call in (
+        lambda: master.sdo_upload(1, 0x1000, 0),
+        lambda: master.sdo_download(1, 0x1000, 0, b"\1\0\0\0"),
+    ):
+        devices[1].mbx_fault[(0x1000, 0)] = fault
+        with pytest.raises(SdoAbort, match=text) as e:
+            call()
+        assert e.value.code == code and (e.value.index, e.value.subindex) == (0x1000, 0)
+    assert master.sdo_upload(1, 0x1000, 0) == b"\0\0\0\0"  # the next one is answered
+
+
+def test_a_transfer_on_the_wire_goes_through_the_controllers_runner():
+    """The master hands a wire backend's SDOs to ``mailbox_transfer`` (the controller keeps
+    the cycles running there); ``wait=False`` (the inspection verbs) runs them in place."""
+    master, backend, devices, _ = make_bus()
+    bring_up(master)
+    devices[1].od[(0x1000, 0)] = b"\7\0\0\0"
+    ran: list[bool] = []
+
+    def runner(transfer):
+        ran.append(True)
+        return transfer()
+
+    master.mailbox_transfer = runner
+    assert backend.mailbox_on_wire
+    assert master.sdo_upload(1, 0x1000, 0) == b"\7\0\0\0"
+    master.sdo_download(1, 0x1000, 0, b"\1\0\0\0")
+    assert len(ran) == 2
+    assert master.sdo_upload(1, 0x1000, 0, wait=False) == b"\1\0\0\0"
+    assert len(ran) == 2
 
 
 def test_init_cmd_abort_stops_the_bring_up_with_the_code():
