@@ -269,9 +269,10 @@ class EmulatedBackend(Backend):
             )
         if not seen[3]:
             return False
-        for s in self._claimed_slaves:  # an emergency the bank's drive queued: the master's
-            if s.emergencies:  # cycle fetches it (the bank runs no mailbox)
-                return False
+        if not self._claimed_emcy_empty():
+            for s in self._claimed_slaves:  # an emergency the bank's drive queued: the master's
+                if s.emergencies:  # cycle fetches it (the bank runs no mailbox)
+                    return False
         view = image.view
         for slave, o_start, o_bytes, i_start, i_bytes, o_view, i_view in plan[2]:
             if type(slave).step is not _IO_STEP or not slave.settled():
@@ -334,9 +335,7 @@ class EmulatedBackend(Backend):
         # which counts as an outside change): while nothing changed since a look that left
         # every claimed slave's queue empty, there is none to fetch from them
         stepped = (e[0] for e in self._run_plan)
-        mark = (VirtualSlave.outside_changes, self._claimed_slaves)
-        looked = self._emcy_empty
-        known = claimed and looked is not None and looked[0] == mark[0] and looked[1] is mark[1]
+        known = claimed and self._claimed_emcy_empty()
         slaves: Any = self.slaves
         if claimed:
             slaves = stepped if known else (*stepped, *self._claimed_slaves)
@@ -347,10 +346,24 @@ class EmulatedBackend(Backend):
                 out.append((slave.position, slave.emergencies.popleft()))
         if claimed and not known:  # (one left: behind a pulled cable, it stays queued)
             left = any(s.emergencies for s in self._claimed_slaves)
-            self._emcy_empty = None if left else mark
+            self._emcy_empty = (
+                None if left else (VirtualSlave.outside_changes, self._claimed_slaves)
+            )
         if claimed and len(out) > 1:
             out.sort(key=lambda e: e[0])  # (in the order of the bus, as without the bank)
         return out
+
+    def _claimed_emcy_empty(self) -> bool:
+        """A look at the claimed slaves' emergency queues (:meth:`emergencies`) found them all
+        empty, and nothing changed since: they are empty still (the bank's slaves are not
+        stepped here; a scenario that queues one counts as an outside change, and another
+        set of claimed slaves is another tuple)."""
+        looked = self._emcy_empty
+        return (
+            looked is not None
+            and looked[0] == VirtualSlave.outside_changes
+            and looked[1] is self._claimed_slaves
+        )
 
     def expected_wkc(self) -> int:
         return self._expected
