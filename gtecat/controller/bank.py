@@ -328,7 +328,7 @@ def _reguard(objs: tuple) -> None:
     for obj in objs:
         cls = type(obj)
         if cls not in _GUARD_SET:
-            _set(obj, "__class__", _guard_class(cls))
+            _set(obj, "__class__", _GUARDS.get(cls) or _guard_class(cls))
 
 
 def _bank_safe(hook: Any) -> bool:
