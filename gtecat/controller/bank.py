@@ -328,7 +328,7 @@ def _reguard(objs: tuple) -> None:
     for obj in objs:
         cls = type(obj)
         if cls not in _GUARD_SET:
-            _set(obj, "__class__", _guard_class(cls))
+            _set(obj, "__class__", _GUARDS.get(cls) or _guard_class(cls))
 
 
 def _bank_safe(hook: Any) -> bool:
@@ -1381,8 +1381,8 @@ class AxisBank:
         hitting a soft limit) reads it.  ``rows``: one row or an array of rows."""
         last = self.t_idx[rows]
         spare = self.base[rows] + self.table
-        for t in (self.t_p, self.t_v, self.t_a):
-            t.flat[spare] = t.flat[last]
+        for t in (self._t_p1, self._t_v1, self._t_a1):  # (the tables' flat views)
+            t[spare] = t[last]
         self.t_idx[rows] = spare
 
     def _refill(self, r: int) -> None:
@@ -2241,7 +2241,7 @@ class AxisBank:
         if self.n_jog and self.jog[r]:
             return float(self.jp[r]), float(self.jv[r]), float(self.ja[r])
         i = int(self.t_idx[r])
-        return float(self.t_p.flat[i]), float(self.t_v.flat[i]), float(self.t_a.flat[i])
+        return float(self._t_p1[i]), float(self._t_v1[i]), float(self._t_a1[i])
 
     def _enc_rates_row(self, r: int) -> tuple[float, float]:
         """Row ``r``'s encoder speed and acceleration, :meth:`_enc_rates`'s operations in

@@ -110,6 +110,11 @@ def claimable(ch: Channel, limits: bool = False) -> str:
     return ""
 
 
+#: the values :meth:`CspBank.store` gives back as the 32-bit objects hold them (wrapped)
+_WRAPPED = frozenset(
+    ("position_actual", "position_demand", "velocity_actual", "following_error_actual")
+)
+
 #: a channel's values that stay as they are while it rests unpowered (frozen rows)
 FROZEN_ATTRS = (
     "position_actual",
@@ -496,13 +501,14 @@ class CspBank:
             "statusword",
         )
         # a few rows (a drive given back, up to a 4-axis one): each in plain floats, a tenth
-        # of the numpy calls' cost per row (None: a row numpy must give, below)
+        # of the numpy calls' cost per row (None: a row numpy must give, below), its values
+        # (Python ints) set straight from its own dict
         ones = [self._one_row(r) for r in rows] if rows is not None and len(rows) <= 4 else None
+        per_row: dict[int, dict[str, int]] | None = None
+        out: dict[str, np.ndarray] = {}
+        at: list[int] = []
         if ones is not None and None not in ones:
-            out = {name: [one[name] for one in ones] for name in names}
-            at = [0] * self.n
-            for k, r in enumerate(rows):
-                at[r] = k
+            per_row = dict(zip(rows, ones, strict=True))  # type: ignore[arg-type]
         elif rows is None or 4 * len(rows) >= self.n:
             out = {name: self.output(name) for name in names}
             at = list(range(self.n))
@@ -511,8 +517,7 @@ class CspBank:
             at = [0] * self.n
             for k, r in enumerate(rows):
                 at[r] = k
-        wrapped = {"position_actual", "position_demand", "velocity_actual"}
-        wrapped.add("following_error_actual")
+        wrapped = _WRAPPED
         for r in range(len(self.channels)) if rows is None else rows:
             ch = self.channels[r]
             m = ch.mech
@@ -530,10 +535,14 @@ class CspBank:
             ch.cycle += self.cycles - int(self.start[r])
             self.start[r] = self.cycles
             ch.target_position = int(self.target[r])
-            k = at[r]
-            for name, values in out.items():
-                x = int(values[k])
-                setattr(ch, name, wrap32(x) if name in wrapped else x)
+            if per_row is not None:
+                for name, x in per_row[r].items():
+                    setattr(ch, name, wrap32(x) if name in wrapped else x)
+            else:
+                k = at[r]
+                for name, values in out.items():
+                    x = int(values[k])
+                    setattr(ch, name, wrap32(x) if name in wrapped else x)
             ch.mode_display = ch.mode
 
     def _one_row(self, r: int) -> dict[str, int] | None:

@@ -693,7 +693,10 @@ class ObjectDictionary:
         obj = self.obj(index, subindex)
         if complete_access and obj.code is not ObjectCode.VAR:
             return self._upload_complete(obj, subindex)
-        var = self.variable(index, subindex)
+        try:
+            var = obj.subs[subindex]  # (self.variable, with the object already found)
+        except KeyError:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
         if not var.access.readable:
             raise SdoAbort(SdoAbortCode.READ_OF_WRITE_ONLY, index, subindex)
         return var.encode(var.get())

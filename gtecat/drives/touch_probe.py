@@ -88,6 +88,9 @@ class TouchProbe:
         new = value & 0xFFFF
         old = self._function
         status = self.status
+        if new == old:  # (no enable or edge bit changes: nothing is armed or cleared)
+            self.status = status & 0xFFFF
+            return
         for probe in (0, 1):
             sh = 8 * probe
             en_old, en_new = (old >> sh) & 1, (new >> sh) & 1

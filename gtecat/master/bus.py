@@ -442,6 +442,11 @@ class Master:
         backend = self.backend
         if wait and backend.mailbox_on_wire:
             return self._on_wire(lambda: backend.sdo_upload(pos, index, subindex, complete_access))
+        if not complete_access:
+            # (served in this process: answered at once, nothing to count or wait for)
+            got = backend.sdo_in_process(pos, index, subindex, None)
+            if got is not None:
+                return got
         lost = self._unanswered(pos) if wait else -1
         try:
             return backend.sdo_upload(pos, index, subindex, complete_access)
@@ -464,6 +469,8 @@ class Master:
         if wait and backend.mailbox_on_wire:
             self._on_wire(lambda: backend.sdo_download(pos, index, subindex, data, complete_access))
             return
+        if backend.sdo_in_process(pos, index, subindex, data, complete_access):
+            return  # (served in this process: answered at once)
         lost = self._unanswered(pos) if wait else -1
         try:
             backend.sdo_download(pos, index, subindex, data, complete_access)

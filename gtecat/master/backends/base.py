@@ -95,6 +95,23 @@ class Backend(ABC):
     ) -> None:
         """CoE SDO download; raises :class:`gtecat.drives.abort.SdoAbort`."""
 
+    def sdo_in_process(
+        self,
+        position: int,
+        index: int,
+        subindex: int,
+        data: bytes | None,
+        complete_access: bool = False,
+    ) -> bytes | bool | None:
+        """An expedited SDO served in this process with nothing between master and slave:
+        ``data`` None an upload (its bytes), else a download (True); None when this one
+        takes the backend's :meth:`sdo_upload` / :meth:`sdo_download` (the only way unless
+        the backend serves its slaves itself).  What it leaves behind - the object, both
+        sides' counters, an abort raised - is what those leave, and it is never unanswered,
+        so the master skips its count of unanswered requests
+        (:meth:`gtecat.master.bus.Master.sdo_upload`)."""
+        return None
+
     def emergencies(self) -> list[tuple[int, object]]:
         """CoE emergencies received since the last call: ``(position, Emergency)``."""
         return []

@@ -278,9 +278,10 @@ class EmulatedBackend(Backend):
             )
         if not seen[3]:
             return False
-        for s in self._claimed_slaves:  # an emergency the bank's drive queued: the master's
-            if s.emergencies:  # cycle fetches it (the bank runs no mailbox)
-                return False
+        if not self._claimed_emcy_empty():
+            for s in self._claimed_slaves:  # an emergency the bank's drive queued: the master's
+                if s.emergencies:  # cycle fetches it (the bank runs no mailbox)
+                    return False
         view = image.view
         marks = (
             VirtualSlave.al_changes,
@@ -359,9 +360,7 @@ class EmulatedBackend(Backend):
         # which counts as an outside change): while nothing changed since a look that left
         # every claimed slave's queue empty, there is none to fetch from them
         stepped = (e[0] for e in self._run_plan)
-        mark = (VirtualSlave.outside_changes, self._claimed_slaves)
-        looked = self._emcy_empty
-        known = claimed and looked is not None and looked[0] == mark[0] and looked[1] is mark[1]
+        known = claimed and self._claimed_emcy_empty()
         slaves: Any = self.slaves
         if claimed:
             slaves = stepped if known else (*stepped, *self._claimed_slaves)
@@ -372,10 +371,24 @@ class EmulatedBackend(Backend):
                 out.append((slave.position, slave.emergencies.popleft()))
         if claimed and not known:  # (one left: behind a pulled cable, it stays queued)
             left = any(s.emergencies for s in self._claimed_slaves)
-            self._emcy_empty = None if left else mark
+            self._emcy_empty = (
+                None if left else (VirtualSlave.outside_changes, self._claimed_slaves)
+            )
         if claimed and len(out) > 1:
             out.sort(key=lambda e: e[0])  # (in the order of the bus, as without the bank)
         return out
+
+    def _claimed_emcy_empty(self) -> bool:
+        """A look at the claimed slaves' emergency queues (:meth:`emergencies`) found them all
+        empty, and nothing changed since: they are empty still (the bank's slaves are not
+        stepped here; a scenario that queues one counts as an outside change, and another
+        set of claimed slaves is another tuple)."""
+        looked = self._emcy_empty
+        return (
+            looked is not None
+            and looked[0] == VirtualSlave.outside_changes
+            and looked[1] is self._claimed_slaves
+        )
 
     def expected_wkc(self) -> int:
         return self._expected
@@ -417,52 +430,71 @@ class EmulatedBackend(Backend):
             self.capture.close()
             self.capture = None
 
+    def sdo_in_process(
+        self,
+        position: int,
+        index: int,
+        subindex: int,
+        data: bytes | None,
+        complete_access: bool = False,
+    ) -> bytes | bool | None:
+        """An expedited SDO nothing sees (no pcap, no fault's stand-in in front of the
+        mailbox, which has no ``sdo_server_only``: its SDOs take the framed path, counted and
+        faulted there), served unframed: the server's own read or write, counters and abort;
+        None for any other (:meth:`sdo_upload` / :meth:`sdo_download` frame it, or say why
+        the slave cannot take it)."""
+        self._mailbox_ops += 1  # (steady(): the slave's objects may change)
+        if self.capture is not None or position in self.unplugged:
+            return None
+        if not (
+            0 <= position < len(self.slaves) and 0 <= index <= 0xFFFF and 0 <= subindex <= 0xFF
+        ):
+            return None
+        slave = self.slaves[position]
+        if not slave.has_mailbox or slave.al_state < AlState.PREOP:
+            return None
+        if not getattr(slave.mailbox, "sdo_server_only", False):
+            return None
+        server = slave.sdo  # type: ignore[attr-defined]
+        if data is None:
+            # (a longer object is a segmented transfer, with more counters: framed)
+            if complete_access or not 0 < (server.od.size_of(index, subindex) or 0) <= 4:
+                return None
+        elif not 0 < len(data) <= 4:
+            return None
+        client = self._clients.get(position)
+        if client is None:
+            client = self._client(position)
+        client.counter = next_counter(client.counter)
+        if data is None:
+            return server.upload_in_process(index, subindex)
+        server.download_in_process(index, subindex, bytes(data), complete_access, slave.al_state)
+        return True
+
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False
     ) -> bytes:
         self._mailbox_ops += 1  # (steady(): the slave's objects may change)
+        if not complete_access:
+            got = self.sdo_in_process(position, index, subindex, None)
+            if got is not None:
+                return got  # type: ignore[return-value]
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
-        client = self._client(position)
-        if (
-            not complete_access
-            and self.capture is None
-            and getattr(slave.mailbox, "sdo_server_only", False)
-            and 0 <= index <= 0xFFFF
-            and 0 <= subindex <= 0xFF
-            and 0 < (slave.sdo.od.size_of(index, subindex) or 0) <= 4  # type: ignore[attr-defined]
-        ):
-            # an expedited upload nothing sees: as the download below, unframed
-            client.counter = next_counter(client.counter)
-            return slave.sdo.upload_in_process(index, subindex)  # type: ignore[attr-defined]
-        return client.upload(index, subindex, complete_access=complete_access)
+        return self._client(position).upload(index, subindex, complete_access=complete_access)
 
     def sdo_download(
         self, position: int, index: int, subindex: int, data: bytes, complete_access: bool = False
     ) -> None:
         self._mailbox_ops += 1  # (steady(): the slave's objects may change)
+        if self.sdo_in_process(position, index, subindex, data, complete_access):
+            return
         slave = self._slave(position)
         if slave.al_state < AlState.PREOP:
             raise BusError(f"slave {position}: mailbox not available in {slave.al_state.name}")
         client = self._client(position)
-        data = bytes(data)
-        if (
-            0 < len(data) <= 4
-            and 0 <= index <= 0xFFFF
-            and 0 <= subindex <= 0xFF
-            and self.capture is None
-            and getattr(slave.mailbox, "sdo_server_only", False)
-        ):
-            # nothing sees the frames: the server's own write, counters and abort, unframed
-            # (a fault's stand-in in front of the mailbox, gtecat.faults, has no
-            # sdo_server_only: its SDOs take the framed path, counted and faulted there)
-            client.counter = next_counter(client.counter)
-            slave.sdo.download_in_process(  # type: ignore[attr-defined]
-                index, subindex, data, complete_access, slave.al_state
-            )
-            return
-        client.download(index, subindex, data, complete_access=complete_access)
+        client.download(index, subindex, bytes(data), complete_access=complete_access)
 
     def uploads_unframed(self, position: int) -> bool:
         """Whether an expedited upload from ``position`` is its SDO server's answer alone:
