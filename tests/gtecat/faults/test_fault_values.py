@@ -201,6 +201,20 @@ def test_two_tables_of_one_name_are_refused(tmp_path: Path) -> None:
     assert f"{m} [[fault]] #2: name 'a' names another fault already" in gt.GTE_GetLastError()
 
 
+def test_a_machine_table_keeps_its_name_after_it_ended(tmp_path: Path) -> None:
+    """Every bring-up arms the machine's tables again, so a fault injected under the name of
+    one that has ended would stand beside it after GT_InitEcatComm: refused when injected."""
+    m = tmp_path / "m.toml"
+    m.write_text('[[fault]]\nkind = "brake"\naxis = 1\nduration_ms = 1\nname = "cut"\n')
+    assert _open(m) == 0
+    gt.GTE_Wait(5)
+    assert faults.listing() == []  # (it ran and ended)
+    with pytest.raises(FaultSpecError, match="name 'cut' belongs to a \\[\\[fault\\]\\] table"):
+        faults.inject("sto", axis=1, name="cut", at_ms=10**8)
+    assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+    assert [f["kind"] for f in faults.listing()] == ["brake"]  # (the table, armed again)
+
+
 def test_python_inputs_that_are_not_a_fault_are_told_so() -> None:
     """What is no fault table is refused in words, before anything is armed: booleans as
     numbers, a script that is no list of tables, a name used twice."""
