@@ -17,6 +17,8 @@ step).  Starts and ends go to the master log.
 
 from __future__ import annotations
 
+import numbers
+import operator
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -109,6 +111,8 @@ def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
         after = int(after)
     if isinstance(after, float) and after.is_integer():
         after = int(after)
+    if isinstance(after, numbers.Integral) and not isinstance(after, bool):
+        after = operator.index(after)  # (a NumPy integer, as _int takes one)
     if after is not None and (
         isinstance(after, bool)
         or not isinstance(after, int | str)

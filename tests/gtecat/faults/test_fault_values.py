@@ -51,6 +51,23 @@ def test_every_integer_value_has_a_range() -> None:
     assert ints <= {(k, n) for k, n, _, _ in INT_FIELDS}
 
 
+def test_an_integer_of_any_type_is_an_integer_and_a_bool_none() -> None:
+    """NumPy integers are integers, as 1.0 and "1" are (TOML, JSON and the command line
+    give those); a bool of either kind is a yes-or-no value only."""
+    import numpy as np
+
+    for axis in (np.int64(2), np.uint8(2), 2.0, "2", np.float32(2)):
+        assert fault_from_dict({"kind": "drive_fault", "axis": axis}).axis == 2
+        assert type(fault_from_dict({"kind": "drive_fault", "axis": axis}).axis) is int
+    for axis in (True, np.True_, 2.5, np.float64("nan")):
+        with pytest.raises(FaultSpecError, match="axis must be an integer"):
+            fault_from_dict({"kind": "drive_fault", "axis": axis})
+    on = {"kind": "switch_stuck", "axis": 1, "switch": "home", "value": np.True_}
+    assert fault_from_dict(on).value == 1
+    spec = faults.spec_from_dict({"kind": "sto", "axis": 1, "after": np.int64(3)})
+    assert spec.after == 3 and type(spec.after) is int
+
+
 @settings(max_examples=40)
 @given(
     which=st.sampled_from(INT_FIELDS),
