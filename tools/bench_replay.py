@@ -28,6 +28,12 @@ brings it back, the limit switch of axis 6 chatters at 30 s for 300 ms).
 every axis in one call (``GT_GetSts(1, sts, 12, NULL)``, the planned and encoder positions as
 arrays too) every 4 to 8 ms, Trap moves and two jogs.
 
+``--file FILE`` times an existing recording (an application's own: the outside check's 12-axis
+session) as whole ``gtecat replay FILE`` processes run in the file's folder, the best of
+``--repeat``, with the times real time against the recording's last call's controller time
+(the bar: the whole process at least 50 times real time); ``--against CHECKOUT`` times that
+checkout's gtecat too, the two in turn.
+
 ``--hard`` records tools/session_hard.py's HMI-like session twice - every axis polled every
 4 ms one by one (``single``), and as count-12 arrays (``arrays``): homing, jogs, Trap moves, a
 drive fault and a chattering limit switch with the application's error handler, SDO reads -
@@ -37,7 +43,8 @@ waits for); ``--against CHECKOUT`` times the whole process with that checkout's 
 the two in turn.
 
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
-                                 [--simple | --rich | --arrays | --hard] [--json]
+                                 [--simple | --rich | --arrays | --hard | --file FILE]
+                                 [--json]
 """
 
 from __future__ import annotations
@@ -237,6 +244,56 @@ def replay_process(root: Path, path: Path) -> tuple[float, float, str]:
     return wall, cpu, out.stdout.strip().splitlines()[-1]
 
 
+def recorded_seconds(path: Path) -> float:
+    """The controller time the recording reached, in seconds: the largest of its last calls'
+    ``"t"`` (ns; a GT_Close after the others has none left: 0)."""
+    with open(path, "rb") as f:
+        f.seek(0, os.SEEK_END)
+        size = f.tell()
+        f.seek(max(0, size - (1 << 16)))
+        tail = f.read().decode("utf-8", "replace")
+    times = [
+        int(line[5 : line.index(",")])
+        for line in tail.splitlines()[1:]
+        if line.startswith('{"t":') and "," in line
+    ]
+    if not times or max(times) <= 0:
+        raise ValueError(f"{path}: no call with a time in its last 64 KiB")
+    return max(times) / 1e9
+
+
+def measure_file(path: Path, repeat: int, against: Path | None = None) -> dict[str, object]:
+    """An existing recording replayed as whole ``gtecat replay FILE`` processes (``--file``)."""
+    path = path.resolve()
+    seconds = recorded_seconds(path)
+    out: dict[str, object] = {
+        "file": str(path),
+        "virtual_s": round(seconds, 3),
+        "load_average_before": round(os.getloadavg()[0], 2),
+    }
+    sides = [("after", ROOT)] if against is None else [("before", against), ("after", ROOT)]
+    procs: dict[str, list[tuple[float, float]]] = {k: [] for k, _ in sides}
+    last = ""
+    for _ in range(repeat):  # the sides in turn
+        for key, root in sides:
+            w, c, last = replay_process(root, path)
+            procs[key].append((w, c))
+    for key, root in sides:
+        w, c = _best(procs[key])
+        out[f"process_{key}" if against is not None else "process"] = {
+            "checkout": str(root),
+            "wall_s": round(w, 3),
+            "cpu_s": round(c, 3),
+            "times_real_time": round(seconds / w, 1),
+            "times_real_time_cpu": round(seconds / c, 1),
+            "walls_s": [round(x, 3) for x, _ in procs[key]],
+        }
+    out["replay_says"] = last
+    out["load_average_after"] = round(os.getloadavg()[0], 2)
+    out["diverged"] = None  # (replay_process raises when the replay does not exit 0)
+    return out
+
+
 def measure_hard(
     seconds: float, repeat: int, against: Path | None = None, keep: Path | None = None
 ) -> dict[str, object]:
@@ -432,11 +489,20 @@ def main() -> int:
         help="the session that polls all 12 axes in one call each (status, planned and "
         "encoder positions as arrays) every 4 to 8 ms (tools/session_arrays.py)",
     )
+    kind.add_argument(
+        "--file",
+        type=Path,
+        help="an existing recording: time whole gtecat replay FILE processes run in its folder",
+    )
     ap.add_argument(
         "--keep", type=Path, help="--hard: write the recordings into this folder and keep them"
     )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
+    if args.file is not None:
+        out = measure_file(args.file, max(1, args.repeat), args.against)
+        print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
+        return 0
     if args.hard:
         out = measure_hard(args.seconds, max(1, args.repeat), args.against, args.keep)
         print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))

@@ -722,9 +722,11 @@ def _thaw_bus() -> None:
         gc.collect()
 
 
-#: ENI files from this size on keep their parsed model in the user's cache (a 64-axis file
-#: is about 1 MB and parses in tens of milliseconds; a thousand axes, 20 MB, in a second)
-ENI_CACHE_MIN_BYTES = 1 << 20
+#: ENI files from this size on keep their parsed model in the user's cache: a 12-axis TwinCAT
+#: file (~250 KB) parses in tens of milliseconds and loads back in a few (a replay's or a
+#: script's process opens it every time), a thousand axes, 20 MB, parse in a second; the
+#: small files of the examples and tests parse in a few milliseconds and are not kept
+ENI_CACHE_MIN_BYTES = 128 << 10
 
 
 def _eni_cache(path: Path) -> Path | None:

@@ -773,11 +773,12 @@ _STEP_OF_CCS = {1: "download_init", 0: "download_segment", 2: "upload_init", 3: 
 
 class _StandIn:
     """A slave's mailbox with the injector in front (:meth:`Injector.mailbox`).  While the
-    injector holds no fault at all it sees nothing of an SDO (no trigger counts them, no
-    fault answers them): it then says what the slave's own mailbox says of itself,
-    ``sdo_server_only``, and the in-process backend may hand an expedited transfer to the
-    slave's SDO server unframed, as it does without faults (a bus brought up with
-    ``gtecat.faults`` imported: every InitCmd SDO framed and parsed twice otherwise)."""
+    injector holds no fault that concerns this slave's SDOs (:func:`_sees_sdos`: a mailbox
+    fault of this slave, a trigger counting its SDO requests) it sees nothing of them: it
+    then says what the slave's own mailbox says of itself, ``sdo_server_only``, and the
+    in-process backend may hand an expedited transfer to the slave's SDO server unframed, as
+    it does without faults (a bus brought up with ``gtecat.faults`` imported, or with a
+    machine description's faults armed: every InitCmd SDO framed and parsed twice otherwise)."""
 
     __slots__ = ("injector", "inner", "position")
 
@@ -789,7 +790,22 @@ class _StandIn:
 
     @property
     def sdo_server_only(self) -> bool:
-        return not self.injector.entries and getattr(self.inner, "sdo_server_only", False)
+        if not getattr(self.inner, "sdo_server_only", False):
+            return False
+        position = self.position
+        return not any(_sees_sdos(e, position) for e in self.injector.entries)
+
+
+def _sees_sdos(e: Entry, position: int) -> bool:
+    """Whether entry ``e``, in any state, may act on an SDO request to slave ``position`` in
+    :meth:`Injector.mailbox`: a mailbox fault of that slave, or a trigger that counts SDO
+    requests (its :meth:`Trigger.sdo` of its own) of that slave; a fault or trigger that
+    names no slave concerns every one."""
+    f = e.fault
+    if f.depth == "mailbox" and getattr(f, "slave", position) == position:
+        return True
+    t = e.trigger
+    return type(t).sdo is not Trigger.sdo and getattr(t, "slave", position) == position
 
 
 def _sdo_request(request: bytes) -> tuple[str, int | None, int | None] | None:

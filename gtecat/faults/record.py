@@ -49,6 +49,8 @@ from operator import contains, is_, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .._bytecode import compiled as _compiled_code
 from ..errors import ParameterError
 from ..gt.args import byref_address
@@ -636,11 +638,13 @@ def replay(
             if kept is not None and seen is not None and where is not None:
                 _keep_ref(p, seen, taken, where)
         steps = None
+        calls = -1  # (the steps that are calls, where the plan says it)
         if kept is not None:
             head, plan = kept
             try:
                 steps = _steps(p, "", plan=plan)
                 marks = plan[5]
+                calls = _plan_calls(plan)
             except ValueError:  # (a plan this gtecat does not make the same: the text)
                 steps = None
         if steps is None:
@@ -656,8 +660,9 @@ def replay(
                 if seen is not None:
                     _keep_ref(p, seen, taken, where)
         del raw
-        entries = sum(map(is_, map(itemgetter(0), steps), repeat(None)))  # (not calls)
-        _check_count(p, head, len(steps) - entries)
+        if calls < 0:
+            calls = len(steps) - sum(map(is_, map(itemgetter(0), steps), repeat(None)))
+        _check_count(p, head, calls)
         # frozen before the collector runs again: it would walk every object just made
         # (all of them young) at its first collection
         freeze = gc.get_freeze_count() == 0  # (a process that froze its own: left so)
@@ -1427,16 +1432,16 @@ def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
         if call is _Stop or call.checks or call.fresh:
             raise ValueError(f"a form is not made the same: {key[:60]}")
         calls.append(call)
-    kinds = array("I")
-    kinds.frombytes(kinds_b)
-    order = array("I")
-    order.frombytes(order_b)
+    # (the unsigned ints of array("I") that _plan_of wrote, read by numpy: the loops over the
+    # ~100,000 units and ~200,000 steps of a long recording in its compiled code)
+    kinds = np.frombuffer(kinds_b, np.uintc)
+    order = np.frombuffer(order_b, np.uintc)
     if len(kinds) != len(values):
         raise ValueError("units of no form")
     # (a number past the end: IndexError, as the steps of no unit below)
     calls[:0] = (None, _Stop)  # (_ENTRY: no call, _WHOLE: made below)
-    units = list(zip(map(calls.__getitem__, kinds), values, strict=True))
-    for i in compress(range(len(kinds)), map(_WHOLE.__eq__, kinds)):
+    units = list(zip(map(calls.__getitem__, kinds.tolist()), values, strict=True))
+    for i in np.flatnonzero(kinds == _WHOLE).tolist():
         key = values[i]
         if type(key) is not str:
             raise ValueError("a whole call's line is no text")
@@ -1445,7 +1450,14 @@ def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
         if one[0] is _Stop or one[0] is None:
             raise ValueError(f"a call is not made the same: {key[:60]}")
         units[i] = one
-    return list(map(units.__getitem__, order))
+    return np.fromiter(units, object, len(units))[order].tolist()
+
+
+def _plan_calls(plan: Any) -> int:
+    """How many of a plan's steps are calls (not a checkpoint or a fault: :data:`_ENTRY`)."""
+    kinds = np.frombuffer(plan[2], np.uintc)
+    order = np.frombuffer(plan[4], np.uintc)
+    return len(order) - int(np.count_nonzero(kinds[order] == _ENTRY))
 
 
 #: each line of a recording's text as :func:`_steps` keys it: a line that starts ``{"t":``

@@ -434,7 +434,9 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     positional, keyword_only = impl_params(fn)
     params = positional + keyword_only
     needs_ctl = bool(params) and params[0] == "ctl"
-    bind = binder(proto, fn)
+    # the table binder (args.binder): made by the first call that binds through it, not at
+    # import - most of the ~400 functions are never called in a process (see _binder below)
+    bind: Any = None
     card_refused = refused(name)
     opens = name == "GT_Open"
     bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
@@ -454,10 +456,17 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                     raise ParameterError(f"core={core}: the EtherCAT core is 1")
             else:
                 core = SESSION._core  # GT_SetCore: 1 unless the program chose another
-            values, extra = bind(args, kwargs)
+            values, extra = (bind or _binder())(args, kwargs)
         except Exception as e:
             return failed(e, None, core, before)
         return run(core, values, extra, address, before, gtn)
+
+    def _binder() -> Any:
+        """The table binder of ``fn``, made once (two threads may both make it: the same)."""
+        nonlocal bind
+        if bind is None:
+            bind = binder(proto, fn)
+        return bind
 
     def run(
         core: int, values: Any, extra: dict, address: str, before: Any, gtn: bool = False
@@ -549,7 +558,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if values is not None:
                     return run(SESSION._core, values, _NO_KW, "", SESSION.last)
             elif not opens:  # GT_Open: always the table path (its keyword options)
-                compiled.append(fast_binder(proto, bind.convs))  # type: ignore[attr-defined]
+                compiled.append(fast_binder(proto, (bind or _binder()).convs))  # type: ignore[attr-defined]
                 return table(*args)
         return call(_GT, args, kwargs)
 
@@ -643,16 +652,27 @@ def _attach_address(kwargs: dict) -> str:
     return "" if address == "local" else address
 
 
+#: (name, C++ default, is a double) -> its inspect.Parameter: the ~400 signatures made at
+#: import share ~300 parameters (``short axis`` in most), each made once (immutable)
+_PARAMETERS: dict[tuple[str, str | None, bool], inspect.Parameter] = {}
+
+
 def _signature(proto: Proto, fn: Callable[..., Any], keyword_only: list[str]) -> inspect.Signature:
     """The Python signature shown by help(): the table's parameters and defaults, then the
     implementation's keyword-only options (GT_Open's ``eni=...``)."""
     out = []
     for p in proto.params:
-        try:
-            d = p.default_value()
-        except KeyError:
-            d = inspect.Parameter.empty
-        out.append(inspect.Parameter(p.name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=d))
+        key = (p.name, p.default, p.is_float)
+        q = _PARAMETERS.get(key)
+        if q is None:
+            try:
+                d = p.default_value()
+            except KeyError:
+                d = inspect.Parameter.empty
+            q = _PARAMETERS[key] = inspect.Parameter(
+                p.name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=d
+            )
+        out.append(q)
     if keyword_only:
         kw = inspect.Parameter.KEYWORD_ONLY
         out += [q for q in inspect.signature(fn).parameters.values() if q.kind is kw]

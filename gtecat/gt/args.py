@@ -1102,15 +1102,24 @@ _NUMERIC = _numeric_types()
 
 def _scalar_types(p: Param) -> frozenset[type]:
     """The ctypes types whose ``byref(x)`` (or ``x`` itself) the table path takes for ``p``
-    as one plain value (:func:`check_kind` passes; :meth:`Ref.store_values` writes ``x.value``)."""
-    ok = set()
-    for t in _NUMERIC:
-        try:
-            check_kind(p, Ref(p.name, 0, ctypes.sizeof(t), t))
-        except ParameterError:
-            continue
-        ok.add(t)
-    return frozenset(ok)
+    as one plain value (:func:`check_kind` passes; :meth:`Ref.store_values` writes ``x.value``).
+    What decides it is the pointer's C type, stars and text-ness (the name only words the
+    refusals): one answer for each of those, found once (the fast paths ask at import)."""
+    key = (p.ctype, p.stars, p.text, p.ctype in ENUMS)
+    ok = _SCALAR_TYPES.get(key)
+    if ok is None:
+        found = set()
+        for t in _NUMERIC:
+            try:
+                check_kind(p, Ref(p.name, 0, ctypes.sizeof(t), t))
+            except ParameterError:
+                continue
+            found.add(t)
+        ok = _SCALAR_TYPES[key] = frozenset(found)
+    return ok
+
+
+_SCALAR_TYPES: dict[tuple[str, int, bool, bool], frozenset[type]] = {}
 
 
 #: pointer shapes the compiled binder leaves to the table's converter, and why (a test walks

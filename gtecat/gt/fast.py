@@ -2733,11 +2733,11 @@ def fast_io_reader(
     # (compiled with the function's type range and key offset as constants, its names as
     # globals: the fewest steps per call)
     code = _IO_READER.format(lo=lo_t, hi=hi_t, kind=kind)
-    exec(compile(code, f"<gt fast io {name}>", "exec"), env)
+    exec(_compiled_code(code, f"<gt fast io {name}>"), env)
     gt = env["gt"]
     gt.slow = slow  # type: ignore[attr-defined]
     _gated(env)
-    exec(compile(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>", "exec"), env)
+    exec(_compiled_code(_IO_VALUE.format(lo=lo_t, hi=hi_t, kind=kind), f"<gt io {name}>"), env)
     return _entry(  # type: ignore[no-any-return]
         gt, env["value"], ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
     )

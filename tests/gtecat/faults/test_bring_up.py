@@ -61,3 +61,31 @@ def test_past_the_bring_up_the_application_meets_it_and_at_once_waits_for_the_bu
     from gtecat import faults
 
     assert {f["kind"]: f["state"] for f in faults.listing()}["drive_fault"] == "active"
+
+
+def test_only_the_slaves_a_fault_concerns_take_their_sdos_framed(tmp_path: Path):
+    """A mailbox fault or an ``on_sdo`` trigger of one slave puts that slave's SDOs through
+    the injector (framed, counted, faulted); the other slaves' expedited SDOs go to their SDO
+    servers unframed, as on a bus without faults; a fault injected later is seen at once."""
+    from gtecat import faults
+    from gtecat.gt._core import SESSION
+
+    assert _open(tmp_path, _bring_up_sdos(0x1C12) + 1, False) == 0
+    slaves = SESSION.controllers[1].backend.slaves
+    mailboxes = [s.mailbox for s in slaves if s.has_mailbox]
+    assert len(mailboxes) >= 2
+    assert [m.sdo_server_only for m in mailboxes[:2]] == [False, True]
+    # a trigger counting the SDOs of slave 1 (the fault itself acts on an axis): framed
+    ident = faults.inject("drive_fault", axis=1, code=0x2310, on_sdo=[1, 0x1018, 2])
+    assert [m.sdo_server_only for m in mailboxes[:2]] == [False, False]
+    value, size, ab = (c_ubyte * 4)(), c_uint32(), c_uint32()
+    for _ in range(2):
+        assert gt.GT_EcatSDOUpload(1, 0x1018, 1, value, 4, byref(size), byref(ab)) == 0
+    assert any(e["id"] == ident and e["state"] == "active" for e in faults.listing())
+    faults.clear(ident)
+    assert [m.sdo_server_only for m in mailboxes[:2]] == [False, True]
+    # a mailbox fault of slave 1 injected now: its next SDO meets it
+    faults.inject("mailbox_abort", slave=1, index=0x1018, code=ABORT)
+    assert mailboxes[1].sdo_server_only is False
+    assert gt.GT_EcatSDOUpload(1, 0x1018, 1, value, 4, byref(size), byref(ab)) == 1
+    assert ab.value == ABORT

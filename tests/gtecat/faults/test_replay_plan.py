@@ -86,6 +86,8 @@ def test_the_recorder_keeps_the_plan_and_it_makes_the_same_steps(recorded: Path)
     kinds = {p.name for p, _ in from_plan if p is not None}
     assert {"GT_GetSts", "GT_GetPrfPos", "GTE_Wait", "GT_Open"} <= kinds
     assert any(p is None and "cp" in e for p, e in from_plan)  # checkpoints
+    # the calls the plan counts (the header's count is checked against it): the steps' calls
+    assert rec._plan_calls(plan) == sum(p is not None for p, _ in from_text) == head["calls"]
     # where the opens and bring-ups are (what the check of the files looks at)
     marks = [i for i, (p, _) in enumerate(from_text) if rec._asked(p)]
     assert plan[5] == marks and len(marks) >= 2
