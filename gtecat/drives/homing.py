@@ -36,7 +36,10 @@ Decisions (the standard leaves them open; tested in ``tests/drives/test_homing.p
   (heading for the edge that leaves it) and never finds it; a chattering one gives an edge
   wherever it toggles, and the drive takes the first that fits the method, as a real
   drive would.  Limits likewise: a limit stuck inactive is never met (the search runs to
-  its travel bound); one stuck active is met at once when the search heads into it.
+  its travel bound); one stuck active is met at once when the search heads into it.  A
+  limit counts only when it lies in the direction of travel (the positive one while moving
+  positive, the negative one while moving negative), as outside homing: a forced limit
+  behind the axis, stuck or chattering, is ignored.
 * **Errors** (SW13): a limit switch hit where the method does not reverse on it, a
   second hit of the reversal limit, no index pulse within one revolution after the
   reference edge, or the search exceeding ``max_travel`` or ``timeout_s``.  The axis
@@ -160,6 +163,8 @@ _EV_OF_SIGNAL = {
     Signal.POSITIVE_LIMIT: _EV_PL,
     Signal.HOME_SWITCH: _EV_HS,
 }
+#: the direction of travel that runs into each limit
+_LIMIT_DIR = {_EV_NL: -1, _EV_PL: 1}
 
 
 class Homing:
@@ -409,7 +414,7 @@ class Homing:
             if kind == _EV_INDEX:
                 if d == fd and (x - self._index_from) * fd > 0:
                     self._found(x)
-            elif kind in (_EV_NL, _EV_PL) and rising and d == self._dir:
+            elif kind in (_EV_NL, _EV_PL) and rising and d == self._dir == _LIMIT_DIR[kind]:
                 self._fail(f"{_limit_name(kind)} hit while searching the index pulse")
             return
         if kind == _EV_INDEX:
@@ -436,6 +441,8 @@ class Homing:
         if kind in (_EV_NL, _EV_PL) and rising:
             if d != self._dir:
                 return  # braking for a reversal already commanded
+            if d != _LIMIT_DIR[kind]:
+                return  # a limit behind the axis (only a forced one can rise there)
             lim = Signal.NEGATIVE_LIMIT if kind == _EV_NL else Signal.POSITIVE_LIMIT
             if (
                 self.phase is HomingPhase.SEARCH

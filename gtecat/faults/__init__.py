@@ -17,6 +17,8 @@ step).  Starts and ends go to the master log.
 
 from __future__ import annotations
 
+import numbers
+import operator
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -109,6 +111,8 @@ def spec_from_dict(values: dict[str, Any], where: str = "") -> FaultSpec:
         after = int(after)
     if isinstance(after, float) and after.is_integer():
         after = int(after)
+    if isinstance(after, numbers.Integral) and not isinstance(after, bool):
+        after = operator.index(after)  # (a NumPy integer, as _int takes one)
     if after is not None and (
         isinstance(after, bool)
         or not isinstance(after, int | str)
@@ -166,16 +170,25 @@ def arm(injector: Injector, specs: list[FaultSpec], origin: str = "") -> list[En
     """Add the specs to an injector, a script's ``after`` names resolved to ids.
 
     A name names one fault: two specs of one call (the tables of one file) with the same
-    name are refused, and so is an injected fault named as one armed already; a machine
+    name are refused, and so is an injected fault named as one armed already.  A machine
     description's tables (``origin="machine"``, armed anew by every bring-up) are checked
-    among themselves only."""
+    among themselves only, and their names stay theirs for the session: an injected fault
+    named as one of them is refused even once that one has ended, as the next
+    ``GT_InitEcatComm`` arms it again (two live faults of one name would follow, and an
+    ``after`` naming it would bind to one of them)."""
     names: dict[str, int] = {e.name: e.id for e in injector.entries if e.name}
-    taken: set[str] = set() if origin == "machine" else set(names)
+    machine = origin == "machine"
+    taken: set[str] = set() if machine else set(names)
     for s in specs:
+        prefix = f"{s.where}: " if s.where else ""
         if s.name and s.name in taken:
-            prefix = f"{s.where}: " if s.where else ""
             raise FaultSpecError(
                 f"{prefix}name {s.name!r} names another fault already; give each its own"
+            )
+        if s.name and not machine and s.name in injector.machine_names:
+            raise FaultSpecError(
+                f"{prefix}name {s.name!r} belongs to a [[fault]] table of the machine "
+                "description (armed again by every GT_InitEcatComm); give this fault another"
             )
         if s.name:
             taken.add(s.name)
@@ -196,6 +209,8 @@ def arm(injector: Injector, specs: list[FaultSpec], origin: str = "") -> list[En
         e.origin = origin
         if s.name:
             names[s.name] = e.id
+            if machine:
+                injector.machine_names.add(s.name)
         out.append(e)
     return out
 
@@ -315,7 +330,9 @@ def inject(
     at_ms=500, duration_ms=200)``, ``inject(DriveFault(axis=2), after_cycles=100)``.
     Trigger keys (``at_ms``, ``after_ms``, ``after_cycles``, ``when_position``,
     ``at_homing``, ``on_sdo``), ``duration_ms`` and ``after`` (an id) mix with the kind's
-    own values.  Raises :class:`FaultSpecError` / ParameterError for what cannot be."""
+    own values.  ``name`` names one fault (:func:`arm`: not one armed already, nor a
+    machine description's table's).  Raises :class:`FaultSpecError` / ParameterError for
+    what cannot be."""
     ctl = ctl or _controller(core)
     if isinstance(kind, FaultSpec):
         spec = kind

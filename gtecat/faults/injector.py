@@ -112,6 +112,9 @@ class Injector:
     def __init__(self, bus: FaultBus) -> None:
         self.bus = bus
         self.entries: list[Entry] = []
+        #: the names of the machine description's ``[[fault]]`` tables: theirs for good, as
+        #: every bring-up arms the tables again (:func:`gtecat.faults.arm`)
+        self.machine_names: set[str] = set()
         self._next = 1
         #: (time ms, "start" | "end", entry id, description): what happened, in order
         self.events: list[tuple[float, str, int, str]] = []

@@ -21,6 +21,9 @@ the machine TOML's ``[[fault]]`` tables, the command line and recordings share.
 from __future__ import annotations
 
 import dataclasses
+import math
+import numbers
+import operator
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -493,15 +496,21 @@ _FLAGS = frozenset({"value"})
 
 def _int(name: str, v: Any) -> int:
     """The one check of an integer value from TOML, JSON, the command line or Python: an
-    integer, a float with no fraction, or text (decimal, 0x hex); true/false (on/off, yes/no)
-    only for a yes-or-no value (:data:`_FLAGS`), never as an axis 1 or a slave 0."""
+    integer of any type (``numbers.Integral``: a NumPy one too), a float with no fraction, or
+    text (decimal, 0x hex); true/false (on/off, yes/no) only for a yes-or-no value
+    (:data:`_FLAGS`), never as an axis 1 or a slave 0.
+
+    Floats and text are taken, unlike an integer argument of a GT function (a C ``short``
+    or ``long`` of its prototype, :mod:`gtecat.gt.args`): a fault is a table of values that
+    comes as TOML, JSON (a panel's or a recording's, where 1.0 is 1) or command-line text
+    as often as from Python, and every source is checked alike."""
     flag = name in _FLAGS
-    if isinstance(v, bool):
+    if isinstance(v, bool) or getattr(getattr(v, "dtype", None), "kind", "") == "b":
         if flag:
             return int(v)
-    elif isinstance(v, int):
-        return v
-    elif isinstance(v, float) and v.is_integer():
+    elif isinstance(v, numbers.Integral):
+        return operator.index(v)
+    elif isinstance(v, numbers.Real) and math.isfinite(v) and float(v).is_integer():
         return int(v)
     elif isinstance(v, str):
         try:

@@ -51,6 +51,23 @@ def test_every_integer_value_has_a_range() -> None:
     assert ints <= {(k, n) for k, n, _, _ in INT_FIELDS}
 
 
+def test_an_integer_of_any_type_is_an_integer_and_a_bool_none() -> None:
+    """NumPy integers are integers, as 1.0 and "1" are (TOML, JSON and the command line
+    give those); a bool of either kind is a yes-or-no value only."""
+    import numpy as np
+
+    for axis in (np.int64(2), np.uint8(2), 2.0, "2", np.float32(2)):
+        assert fault_from_dict({"kind": "drive_fault", "axis": axis}).axis == 2
+        assert type(fault_from_dict({"kind": "drive_fault", "axis": axis}).axis) is int
+    for axis in (True, np.True_, 2.5, np.float64("nan")):
+        with pytest.raises(FaultSpecError, match="axis must be an integer"):
+            fault_from_dict({"kind": "drive_fault", "axis": axis})
+    on = {"kind": "switch_stuck", "axis": 1, "switch": "home", "value": np.True_}
+    assert fault_from_dict(on).value == 1
+    spec = faults.spec_from_dict({"kind": "sto", "axis": 1, "after": np.int64(3)})
+    assert spec.after == 3 and type(spec.after) is int
+
+
 @settings(max_examples=40)
 @given(
     which=st.sampled_from(INT_FIELDS),
@@ -199,6 +216,20 @@ def test_two_tables_of_one_name_are_refused(tmp_path: Path) -> None:
     m.write_text('[[fault]]\nkind = "sto"\naxis = 1\nname = "a"\n' * 2)
     assert _open(m) == 1
     assert f"{m} [[fault]] #2: name 'a' names another fault already" in gt.GTE_GetLastError()
+
+
+def test_a_machine_table_keeps_its_name_after_it_ended(tmp_path: Path) -> None:
+    """Every bring-up arms the machine's tables again, so a fault injected under the name of
+    one that has ended would stand beside it after GT_InitEcatComm: refused when injected."""
+    m = tmp_path / "m.toml"
+    m.write_text('[[fault]]\nkind = "brake"\naxis = 1\nduration_ms = 1\nname = "cut"\n')
+    assert _open(m) == 0
+    gt.GTE_Wait(5)
+    assert faults.listing() == []  # (it ran and ended)
+    with pytest.raises(FaultSpecError, match="name 'cut' belongs to a \\[\\[fault\\]\\] table"):
+        faults.inject("sto", axis=1, name="cut", at_ms=10**8)
+    assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+    assert [f["kind"] for f in faults.listing()] == ["brake"]  # (the table, armed again)
 
 
 def test_python_inputs_that_are_not_a_fault_are_told_so() -> None:

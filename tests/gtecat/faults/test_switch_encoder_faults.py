@@ -250,3 +250,13 @@ def _session(machine: Path, bank: str) -> tuple:
 
 def test_with_and_without_the_axis_bank_alike(machine: Path) -> None:
     assert _session(machine, "auto") == _session(machine, "off")
+
+
+@pytest.mark.parametrize("method", [1, 17])
+def test_a_chattering_limit_behind_the_search_is_not_met(machine: Path, method: int) -> None:
+    """Methods 1 and 17 search negative from 0: the positive limit lies behind them, so its
+    edges, forced while the search runs away from it, stop nothing (as outside homing)."""
+    up(machine)
+    faults.inject("switch_chatter", axis=1, switch="positive", period_cycles=7, duration_ms=200)
+    assert drive_homing(method) == HOMING_DONE, gt.GTE_GetLastError()
+    assert machine_pos() == pytest.approx(-19700 if method == 1 else -20000, abs=1)
