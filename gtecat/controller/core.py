@@ -185,8 +185,10 @@ class Controller:
         )
         self.clock.run_many = self.run_cycles
         #: the armed quick cycle's kernel call (:meth:`arm_quick`): the function's address,
-        #: its three arguments, the cycle time it was armed for
-        self._quick_call = array("q", bytes(8 * 5))
+        #: its three arguments, the cycle time it was armed for, the address of the field
+        #: inputs' watch (Backend.fields_watch: 0, none) - kept in _quick_fields
+        self._quick_call = array("q", bytes(8 * 6))
+        self._quick_fields: Any = None
         self._quick_armed: Any = None
         #: the clock's cycle as this controller gave it (one that wraps it, an inspection
         #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
@@ -518,6 +520,7 @@ class Controller:
         if master is None or master.on_cycle:  # (the master's hooks: not kept, asked here)
             return 0
         clock = self.clock
+        master.backend.look_at_fields()  # (a field write not counted: counted now)
         seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
         if (settled or seen != self._steady_seen) and not master.steady():
             return 0
@@ -552,6 +555,7 @@ class Controller:
         if k is None:
             return False
         clock = self.clock
+        self.master.backend.look_at_fields()  # type: ignore[union-attr]  # (as _run_cycles)
         seen = self._steady_seen
         cycles = clock.cycles
         if (
@@ -661,7 +665,8 @@ class Controller:
         and the bus is steady (the marks of :attr:`_steady_seen` are now's).  The entries
         run it themselves - the clock's lock taken, the kernel's cycle called, then
         :meth:`quick_book` - while the readers' epoch, the slaves' AL and
-        outside changes, the generation of :data:`~gtecat.master.clock.ARMS` (a hook added
+        outside changes, the IO slaves' field inputs (compared with a copy: a write through
+        the buffer protocol is not counted), the generation of :data:`~gtecat.master.clock.ARMS` (a hook added
         or replaced anywhere, a cycle wrapped) and the clock's cycle time are the ones
         armed here.  Every other change that could make :meth:`_quick_kernel` say no comes
         with a new epoch: a GT call of the table, a cycle the general way, a fault, an
@@ -675,6 +680,10 @@ class Controller:
             self._quick_armed = k  # (its arrays live while the entries may call it)
             q[8] = call.buffer_info()[0]
         call[4] = q[2]  # (the kernel's call as due_cycle's: io and fp set for this cycle time)
+        # the field inputs as the steady verdict saw them: a write the slaves could not count
+        # (through the buffer protocol) makes the entries decline the armed cycle
+        watch = self._quick_fields = self.master.backend.fields_watch()  # type: ignore[union-attr]
+        call[5] = 0 if watch is None else watch[0]
         q[5] = ARMS[0]
         q[6] = VirtualSlave.al_changes
         q[7] = VirtualSlave.outside_changes

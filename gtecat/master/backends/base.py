@@ -79,6 +79,17 @@ class Backend(ABC):
         backend can tell."""
         return False
 
+    def look_at_fields(self) -> None:
+        """Count what the field changed without it being counted (an emulated IO slave's
+        field inputs written through the buffer protocol) as a change of the bus: asked
+        before a bus found steady is taken as steady still.  Nothing here."""
+
+    def fields_watch(self) -> int:
+        """The address of what a compiled check compares to find the field inputs as the
+        last look saw them (:meth:`look_at_fields`): a count, then per buffer its address,
+        the address of its copy and its length; 0: nothing to compare."""
+        return 0
+
     @abstractmethod
     def expected_wkc(self) -> int:
         """The working counter of a healthy cycle with every slave in OP."""
