@@ -664,11 +664,11 @@ class Controller:
         after a quick cycle that ran whole, everything :meth:`_quick_kernel` asked holds,
         and the bus is steady (the marks of :attr:`_steady_seen` are now's).  The entries
         run it themselves - the clock's lock taken, the kernel's cycle called, then
-        :meth:`quick_book` - while the readers' epoch, the slaves' AL and
-        outside changes, the IO slaves' field inputs (compared with a copy: a write through
-        the buffer protocol is not counted), the generation of :data:`~gtecat.master.clock.ARMS` (a hook added
-        or replaced anywhere, a cycle wrapped) and the clock's cycle time are the ones
-        armed here.  Every other change that could make :meth:`_quick_kernel` say no comes
+        :meth:`quick_book` - while the readers' epoch, the slaves' AL and outside changes,
+        the IO slaves' field inputs (compared with a copy: a write through the buffer
+        protocol is not counted), the generation of :data:`~gtecat.master.clock.ARMS` (a
+        hook added or replaced anywhere, a cycle wrapped) and the clock's cycle time are
+        the ones armed here.  Every other change that could make :meth:`_quick_kernel` say no comes
         with a new epoch: a GT call of the table, a cycle the general way, a fault, an
         endpoint's request, a claim or a release of the bank."""
         q = self.clock.quick
