@@ -76,20 +76,27 @@ class FieldInputs(bytearray):
 
     __slots__ = ()
 
+    # (counted before the write, and where the length may change after it too: a compiled
+    # check that finds the count as it armed it reads the bytes where they were then)
     def __setitem__(self, key: Any, value: Any) -> None:
-        bytearray.__setitem__(self, key, value)
         VirtualSlave.outside_changes += 1
+        bytearray.__setitem__(self, key, value)
+        if type(key) is slice:
+            VirtualSlave.outside_changes += 1
 
     def __delitem__(self, key: Any) -> None:
+        VirtualSlave.outside_changes += 1
         bytearray.__delitem__(self, key)
         VirtualSlave.outside_changes += 1
 
     def __iadd__(self, other: Any) -> FieldInputs:
+        VirtualSlave.outside_changes += 1
         bytearray.__iadd__(self, other)
         VirtualSlave.outside_changes += 1
         return self
 
     def __imul__(self, n: Any) -> FieldInputs:
+        VirtualSlave.outside_changes += 1
         bytearray.__imul__(self, n)
         VirtualSlave.outside_changes += 1
         return self
@@ -99,9 +106,11 @@ def _counted(name: str) -> Callable[..., Any]:
     way = getattr(bytearray, name)
 
     def counted(self: FieldInputs, *args: Any) -> Any:
-        out = way(self, *args)
         VirtualSlave.outside_changes += 1
-        return out
+        try:
+            return way(self, *args)
+        finally:
+            VirtualSlave.outside_changes += 1
 
     counted.__name__ = name
     counted.__doc__ = way.__doc__

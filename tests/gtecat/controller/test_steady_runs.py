@@ -298,5 +298,5 @@ def test_field_inputs_counted_when_their_length_changes():
     ):
         before = VirtualSlave.outside_changes
         change()
-        assert VirtualSlave.outside_changes == before + 1
+        assert VirtualSlave.outside_changes > before
     assert type(s.field_inputs) is type(fi)
