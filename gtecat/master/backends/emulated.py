@@ -344,7 +344,15 @@ class EmulatedBackend(Backend):
         return seen[2]
 
     def look_at_fields(self) -> None:
-        look_at_fields(self._io_slaves())
+        seen = self._io_seen
+        slaves = self.slaves
+        if seen is None or seen[0] is not slaves or seen[1] != len(slaves):
+            self._io_slaves()
+            seen = self._io_seen
+        for s in seen[2]:  # type: ignore[index]  # (look_at_fields, in line: asked per run)
+            if s._field_inputs != s._fields_seen:
+                look_at_fields(seen[2])  # type: ignore[index]
+                return
 
     def fields_watch(self) -> Any:
         """What a compiled check compares (:meth:`Backend.fields_watch`) as ``(address,
