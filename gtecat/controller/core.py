@@ -520,8 +520,12 @@ class Controller:
         if master is None or master.on_cycle:  # (the master's hooks: not kept, asked here)
             return 0
         clock = self.clock
-        master.backend.look_at_fields()  # (a field write not counted: counted now)
         seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
+        if not settled and seen == self._steady_seen:
+            # (a field write not counted: counted now; steady() looks itself)
+            master.backend.look_at_fields()
+            if seen[3] != VirtualSlave.outside_changes:
+                seen = (*seen[:3], VirtualSlave.outside_changes)
         if (settled or seen != self._steady_seen) and not master.steady():
             return 0
         done = bank.run_cycles(clock.now_ns, clock.cycle_ns, n)
@@ -555,16 +559,21 @@ class Controller:
         if k is None:
             return False
         clock = self.clock
-        self.master.backend.look_at_fields()  # type: ignore[union-attr]  # (as _run_cycles)
         seen = self._steady_seen
         cycles = clock.cycles
+        master: Any = self.master  # (_quick_kernel: a master)
         if (
             seen[0] != EPOCH.n
             or seen[1] != cycles
             or seen[2] != VirtualSlave.al_changes
             or seen[3] != VirtualSlave.outside_changes
-        ) and not self.master.steady():  # type: ignore[union-attr]  # (_quick_kernel: a master)
-            return False
+        ):
+            if not master.steady():
+                return False
+        else:  # (a field write not counted: counted now, as in _run_cycles)
+            master.backend.look_at_fields()
+            if seen[3] != VirtualSlave.outside_changes and not master.steady():
+                return False
         q = clock.quick
         io = k._io
         io[_IN_T_NS] = clock.now_ns
