@@ -405,6 +405,10 @@ class AxisBank:
         self._open: set[int] = set()
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
+        #: the GT readers' lists of the claimed rows' values (:meth:`value`), made as they are
+        #: asked for; a new dict wherever they may change (a cycle, a claim, a release), never
+        #: one emptied in place: a reader that made its list from the state before another
+        #: thread's cycle keeps it in the dict of that state, which no reader sees after it
         self._lists: dict[str, list[Any]] = {}
         #: the flags the last list of GT_GetSts words was made from (a few rows) and that
         #: list: made again only when one changed (a move, a jog and a rest last many runs)
@@ -745,7 +749,7 @@ class AxisBank:
         rows_np = self._rows_np
         run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
         self.ctl._run_axes = list(compress(axis_list, run.tolist()))
-        self._lists.clear()
+        self._lists = {}  # (a new one: _lists' docs)
         # the kernel keeps its binding: a claim and a release write the rows in place (only
         # the numpy cycle replaces arrays, and it unbinds the kernel itself)
 
@@ -1797,9 +1801,10 @@ class AxisBank:
 
     # --- reading claimed axes (the fast path of the GT getters) ---------------------------------
     def value(self, name: str, r: int) -> Any:
-        lst = self._lists.get(name)
+        lists = self._lists  # (the dict of the state the list is made of: _lists)
+        lst = lists.get(name)
         if lst is None:
-            lst = self._lists[name] = self._make_list(name)
+            lst = lists[name] = self._make_list(name)
         return lst[r]
 
     def _make_list(self, name: str) -> list[Any]:
@@ -1885,7 +1890,7 @@ class AxisBank:
             self._begin()
         if not self.n_alive:
             return
-        self._lists.clear()
+        self._lists = {}  # (a new one: _lists' docs)
         k = self.kernel
         if k is not None:
             # the plain cycle compiled; a new cycle time goes through numpy, and so does a
@@ -2112,7 +2117,7 @@ class AxisBank:
             self._countdown -= done - self._settled  # (the first one's count: in settle)
             self._settled = False
             self._refill_in -= done
-            self._lists.clear()
+            self._lists = {}  # (a new one: _lists' docs)
             self._after_kernel(k, done)
             self.many_cycles += done
         return done
@@ -2126,7 +2131,7 @@ class AxisBank:
         self._countdown -= 1 - self._settled
         self._settled = False
         self._refill_in -= 1
-        self._lists.clear()
+        self._lists = {}  # (a new one: _lists' docs)
         csp = self.csp
         csp.cycles += 1
         csp._din_safe = 0
@@ -2390,7 +2395,7 @@ class AxisBank:
         self.any_post = self.any_post or bool(self.dpost[r])
         self.any_lvel = self.any_lvel or bool(self.lvel[r])
         self.band_dirty = True
-        self._lists.clear()
+        self._lists = {}  # (a new one: _lists' docs)
 
     def _post_events(
         self, rows: list[int], t_ns: int, dt_ns: int, p0: np.ndarray | None = None

@@ -213,3 +213,65 @@ def test_reads_hammered_beside_a_thread_that_runs_cycles_are_whole(bank):
         assert len(set(_prf())) == 1 and _prf()[0] > 1000
     finally:
         gt.GT_Close()
+
+
+@pytest.mark.parametrize("reader", ["GT_GetPrfPos", "GT_GetEncPos"])
+def test_a_value_made_before_another_threads_cycles_is_not_kept_past_them(reader):
+    """A reader's value function makes the bank's list of a value (the first read since a
+    cycle); right after it is made, another thread runs cycles (forced here: the list maker
+    starts the thread and waits for it).  The read answers again holding the lock, and
+    neither it nor the next read may answer from the list made before those cycles: both
+    answer the value as those cycles left it (a lockstep clock: no time passes after them)."""
+    fig = ROOT / "examples" / "manual_fig5_2.eni"
+    gt.GT_Close()
+    assert gt.GT_Open(eni=str(fig), clock="lockstep", log="", bank="on") == 0
+    try:
+        assert gt.GT_InitEcatComm() == 0
+        ready = c_short()
+        for _ in range(200):
+            if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+                break
+            gt.GTE_Wait(1)
+        assert gt.GT_StartEcatComm() == 0 and gt.GT_AxisOn(1) == 0
+        prm = gt.TTrapPrm()
+        prm.acc = prm.dec = 0.2
+        assert gt.GT_PrfTrap(1) == 0 and gt.GT_SetTrapPrm(1, byref(prm)) == 0
+        assert gt.GT_SetVel(1, 10.0) == 0 and gt.GT_SetPos(1, 200000) == 0
+        assert gt.GT_Update(1) == 0 and gt.GTE_Wait(100) == 0
+        res = gt.GTE_Controller().resources[1]
+        bank = res.bank
+        assert bank is not None
+        read = getattr(gt, reader)
+
+        def value() -> float:
+            v = c_double()
+            assert read(1, byref(v)) == 0
+            return v.value
+
+        made, other = bank._make_list, []
+
+        def cycles(name: str) -> None:
+            # (the value as the cycles left it, from a list made here and kept nowhere)
+            other.append((gt.GTE_Wait(50), float(made(name)[res.bank_row])))
+
+        def make_then_cycles(name: str) -> list:
+            out = made(name)
+            if not other:
+                t = threading.Thread(target=cycles, args=(name,), name="cycles")
+                t.start()
+                t.join(10)
+            return out
+
+        before = value()
+        assert gt.GTE_Wait(1) == 0  # (a cycle: the lists are made again at the next read)
+        bank._make_list = make_then_cycles
+        try:
+            hooked = value()
+        finally:
+            del bank._make_list
+        assert len(other) == 1 and other[0][0] == 0, other
+        after = other[0][1]
+        assert after > before + 400
+        assert (hooked, value()) == (after, after), (before, after)
+    finally:
+        gt.GT_Close()
