@@ -185,8 +185,10 @@ class Controller:
         )
         self.clock.run_many = self.run_cycles
         #: the armed quick cycle's kernel call (:meth:`arm_quick`): the function's address,
-        #: its three arguments, the cycle time it was armed for
-        self._quick_call = array("q", bytes(8 * 5))
+        #: its three arguments, the cycle time it was armed for, the address of the field
+        #: inputs' watch (Backend.fields_watch: 0, none) - kept in _quick_fields
+        self._quick_call = array("q", bytes(8 * 6))
+        self._quick_fields: Any = None
         self._quick_armed: Any = None
         #: the clock's cycle as this controller gave it (one that wraps it, an inspection
         #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
@@ -519,6 +521,11 @@ class Controller:
             return 0
         clock = self.clock
         seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
+        if not settled and seen == self._steady_seen:
+            # (a field write not counted: counted now; steady() looks itself)
+            master.backend.look_at_fields()
+            if seen[3] != VirtualSlave.outside_changes:
+                seen = (*seen[:3], VirtualSlave.outside_changes)
         if (settled or seen != self._steady_seen) and not master.steady():
             return 0
         done = bank.run_cycles(clock.now_ns, clock.cycle_ns, n)
@@ -554,13 +561,19 @@ class Controller:
         clock = self.clock
         seen = self._steady_seen
         cycles = clock.cycles
+        master: Any = self.master  # (_quick_kernel: a master)
         if (
             seen[0] != EPOCH.n
             or seen[1] != cycles
             or seen[2] != VirtualSlave.al_changes
             or seen[3] != VirtualSlave.outside_changes
-        ) and not self.master.steady():  # type: ignore[union-attr]  # (_quick_kernel: a master)
-            return False
+        ):
+            if not master.steady():
+                return False
+        else:  # (a field write not counted: counted now, as in _run_cycles)
+            master.backend.look_at_fields()
+            if seen[3] != VirtualSlave.outside_changes and not master.steady():
+                return False
         q = clock.quick
         io = k._io
         io[_IN_T_NS] = clock.now_ns
@@ -660,10 +673,11 @@ class Controller:
         after a quick cycle that ran whole, everything :meth:`_quick_kernel` asked holds,
         and the bus is steady (the marks of :attr:`_steady_seen` are now's).  The entries
         run it themselves - the clock's lock taken, the kernel's cycle called, then
-        :meth:`quick_book` - while the readers' epoch, the slaves' AL and
-        outside changes, the generation of :data:`~gtecat.master.clock.ARMS` (a hook added
-        or replaced anywhere, a cycle wrapped) and the clock's cycle time are the ones
-        armed here.  Every other change that could make :meth:`_quick_kernel` say no comes
+        :meth:`quick_book` - while the readers' epoch, the slaves' AL and outside changes,
+        the IO slaves' field inputs (compared with a copy: a write through the buffer
+        protocol is not counted), the generation of :data:`~gtecat.master.clock.ARMS` (a
+        hook added or replaced anywhere, a cycle wrapped) and the clock's cycle time are
+        the ones armed here.  Every other change that could make :meth:`_quick_kernel` say no comes
         with a new epoch: a GT call of the table, a cycle the general way, a fault, an
         endpoint's request, a claim or a release of the bank."""
         q = self.clock.quick
@@ -675,6 +689,10 @@ class Controller:
             self._quick_armed = k  # (its arrays live while the entries may call it)
             q[8] = call.buffer_info()[0]
         call[4] = q[2]  # (the kernel's call as due_cycle's: io and fp set for this cycle time)
+        # the field inputs as the steady verdict saw them: a write the slaves could not count
+        # (through the buffer protocol) makes the entries decline the armed cycle
+        watch = self._quick_fields = self.master.backend.fields_watch()  # type: ignore[union-attr]
+        call[5] = 0 if watch is None else watch[0]
         q[5] = ARMS[0]
         q[6] = VirtualSlave.al_changes
         q[7] = VirtualSlave.outside_changes

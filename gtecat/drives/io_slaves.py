@@ -14,7 +14,7 @@ Googol coupler of manual figure 5-4 (IBM337 + DI16/DO16/AI4/AO4) is one.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -68,12 +68,71 @@ class FieldInputs(bytearray):
     cycle (:meth:`IoSlave.set_input`, a test's ``slave.field_inputs[0] = 0x3C``, a fault),
     each write counts as a change of the bus (:attr:`VirtualSlave.outside_changes`): a
     controller that found the bus at a fixed point looks again.  (The slave's own wires
-    count too: a cycle that steps the slave makes the controller look again anyway.)"""
+    count too: a cycle that steps the slave makes the controller look again anyway.)
+    A write through the buffer protocol (``memoryview``, ``struct.pack_into``, ctypes'
+    ``from_buffer``) cannot be counted: the controller compares the bytes with the ones
+    its last look saw instead (:func:`look_at_fields`).  What changes the length counts
+    too, so the bytes stay where that look found them while nothing was counted."""
 
     __slots__ = ()
 
+    # (counted before the write, and where the length may change after it too: a compiled
+    # check that finds the count as it armed it reads the bytes where they were then)
     def __setitem__(self, key: Any, value: Any) -> None:
+        VirtualSlave.outside_changes += 1
         bytearray.__setitem__(self, key, value)
+        if type(key) is slice:
+            VirtualSlave.outside_changes += 1
+
+    def __delitem__(self, key: Any) -> None:
+        VirtualSlave.outside_changes += 1
+        bytearray.__delitem__(self, key)
+        VirtualSlave.outside_changes += 1
+
+    def __iadd__(self, other: Any) -> FieldInputs:
+        VirtualSlave.outside_changes += 1
+        bytearray.__iadd__(self, other)
+        VirtualSlave.outside_changes += 1
+        return self
+
+    def __imul__(self, n: Any) -> FieldInputs:
+        VirtualSlave.outside_changes += 1
+        bytearray.__imul__(self, n)
+        VirtualSlave.outside_changes += 1
+        return self
+
+
+def _counted(name: str) -> Callable[..., Any]:
+    way = getattr(bytearray, name)
+
+    def counted(self: FieldInputs, *args: Any) -> Any:
+        VirtualSlave.outside_changes += 1
+        try:
+            return way(self, *args)
+        finally:
+            VirtualSlave.outside_changes += 1
+
+    counted.__name__ = name
+    counted.__doc__ = way.__doc__
+    return counted
+
+
+for _name in ("append", "extend", "insert", "pop", "remove", "clear", "reverse"):
+    setattr(FieldInputs, _name, _counted(_name))
+
+
+def look_at_fields(slaves: Sequence[IoSlave]) -> None:
+    """Count a change of the bus (:attr:`VirtualSlave.outside_changes`) where an IO slave's
+    field inputs are no longer the bytes the last look saw (a write through the buffer
+    protocol, which :class:`FieldInputs` cannot count), and keep them as seen now.  A few
+    bytes compared per IO slave: asked before a steady bus is taken as still steady."""
+    moved = False
+    for s in slaves:
+        fi = s._field_inputs
+        if fi != s._fields_seen:
+            s._fields_seen = bytes(fi)
+            moved = True
+    if moved:
         VirtualSlave.outside_changes += 1
 
 
@@ -128,6 +187,7 @@ class IoSlave(VirtualSlave):
     @field_inputs.setter
     def field_inputs(self, value: Any) -> None:
         self._field_inputs = FieldInputs(value)
+        self._fields_seen = bytes(self._field_inputs)  # (what :func:`look_at_fields` saw)
         VirtualSlave.outside_changes += 1
 
     # --- field side -----------------------------------------------------------

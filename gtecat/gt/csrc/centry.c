@@ -418,8 +418,8 @@ typedef int (*kernel_run)(void *, void *, void *);
  * and this cycle time. */
 static int armed(const long long *q, long long pend)
 {
-    long long al, out;
-    const long long *call;
+    long long al, out, i;
+    const long long *call, *w;
     if (!q[3] || !q[4] || q[0] < 0 || q[1] < 0 || q[2] <= 0 || pend < q[2] || pend - q[2] >= q[2])
         return 0;
     if (q[5] != A.arms[0] || q[4] != epoch())
@@ -427,8 +427,18 @@ static int armed(const long long *q, long long pend)
     call = (const long long *)q[8];
     if (!call || !call[0] || call[4] != q[2])
         return 0;
-    return ll_of(A.dict_get(A.marks_dict, A.key_al), &al) && al == q[6] &&
-           ll_of(A.dict_get(A.marks_dict, A.key_out), &out) && out == q[7];
+    if (!(ll_of(A.dict_get(A.marks_dict, A.key_al), &al) && al == q[6] &&
+          ll_of(A.dict_get(A.marks_dict, A.key_out), &out) && out == q[7]))
+        return 0;
+    /* the IO slaves' field inputs as armed: a count, then per buffer its address, its copy's
+     * and its length (Backend.fields_watch; they hold while the outside changes do, asked
+     * above); a write through the buffer protocol is not counted, only seen here */
+    w = (const long long *)call[5];
+    if (w)
+        for (i = 0; i < w[0]; i++)
+            if (memcmp((const void *)w[1 + 3 * i], (const void *)w[2 + 3 * i], (size_t)w[3 + 3 * i]))
+                return 0;
+    return 1;
 }
 
 /* The armed quick cycle where the call's latency makes a cycle due: the clock's lock taken

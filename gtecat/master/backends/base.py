@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import Any
 
 from gtecat.drives.slave import AlState, AlStatusCode
 from gtecat.eni.errors import GtecatError
@@ -78,6 +79,19 @@ class Backend(ABC):
         many cycles at once, :meth:`gtecat.master.bus.Master.steady`); False unless the
         backend can tell."""
         return False
+
+    def look_at_fields(self) -> None:
+        """Count what the field changed without it being counted (an emulated IO slave's
+        field inputs written through the buffer protocol) as a change of the bus: asked
+        before a bus found steady is taken as steady still.  Nothing here."""
+        return None
+
+    def fields_watch(self) -> Any:
+        """What a compiled check compares to find the field inputs as the last look saw
+        them (:meth:`look_at_fields`), as ``(address, what it needs kept)``: at the address
+        a count, then per buffer its address, the address of its copy and its length.
+        None: nothing to compare."""
+        return None
 
     @abstractmethod
     def expected_wkc(self) -> int:

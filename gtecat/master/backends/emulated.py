@@ -13,6 +13,8 @@ frames a real master would have exchanged are written to a capture
 
 from __future__ import annotations
 
+import ctypes
+from array import array
 from collections.abc import Callable
 from itertools import compress
 from typing import Any
@@ -20,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from gtecat.drives.coe import advance_counter, next_counter
-from gtecat.drives.io_slaves import IoSlave
+from gtecat.drives.io_slaves import IoSlave, look_at_fields
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
 from gtecat.eni.layout import Layout
@@ -61,6 +63,10 @@ class EmulatedBackend(Backend):
         #: (outside changes, claimed slaves) when every claimed slave's emergency queue was
         #: last found empty (:meth:`emergencies`), or None
         self._emcy_empty: tuple[int, tuple[VirtualSlave, ...]] | None = None
+        #: (the slaves list, its length, its IO slaves): whose field inputs are looked at
+        self._io_seen: tuple[Any, int, tuple[IoSlave, ...]] | None = None
+        #: ((outside changes, IO slaves), what fields_watch gave): kept while they stand
+        self._watch: tuple[tuple[int, Any], Any] | None = None
         self._clients: dict[int, object] = {}
         self._claimed: frozenset[int] = frozenset()
         self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
@@ -256,6 +262,7 @@ class EmulatedBackend(Backend):
         of cycles at once: the areas' bytes are worked out once per run plan."""
         if self.answer_hook is not None or self.capture is not None or self.unplugged:
             return False
+        look_at_fields(self._io_slaves())  # (a field write not counted: counted now)
         image = self.image
         if image is None:
             return False
@@ -327,6 +334,50 @@ class EmulatedBackend(Backend):
                         return False
         self._settled_seen = marks
         return True
+
+    def _io_slaves(self) -> tuple[IoSlave, ...]:
+        slaves = self.slaves
+        seen = self._io_seen
+        if seen is None or seen[0] is not slaves or seen[1] != len(slaves):
+            io = tuple(s for s in slaves if isinstance(s, IoSlave))
+            seen = self._io_seen = (slaves, len(slaves), io)
+        return seen[2]
+
+    def look_at_fields(self) -> None:
+        seen = self._io_seen
+        slaves = self.slaves
+        if seen is None or seen[0] is not slaves or seen[1] != len(slaves):
+            self._io_slaves()
+            seen = self._io_seen
+        for s in seen[2]:  # type: ignore[index]  # (look_at_fields, in line: asked per run)
+            if s._field_inputs != s._fields_seen:
+                look_at_fields(seen[2])  # type: ignore[index]
+                return
+
+    def fields_watch(self) -> Any:
+        """What a compiled check compares (:meth:`Backend.fields_watch`) as ``(address,
+        what it needs kept)``, or None: the IO slaves' field inputs and copies of them as
+        :meth:`look_at_fields` sees them now.  The addresses hold while the slaves' outside
+        changes stay the same (a new buffer, a new length: counted), which a check asks
+        first; kept while they and the IO slaves stay the same."""
+        io = self._io_slaves()
+        watch = self._watch
+        if watch is not None and watch[0][0] == VirtualSlave.outside_changes:
+            if watch[0][1] is io:
+                return watch[1]
+        look_at_fields(io)  # (the copies: what it sees)
+        bufs = [s._field_inputs for s in io if len(s._field_inputs)]
+        got = None
+        if bufs:
+            copy = bytearray(b"".join(bufs))
+            table = array("q", [len(bufs)])
+            at = _address(copy)
+            for fi in bufs:
+                table.extend((_address(fi), at, len(fi)))
+                at += len(fi)
+            got = (table.buffer_info()[0], table, copy, bufs)
+        self._watch = ((VirtualSlave.outside_changes, io), got)
+        return got
 
     def _steady_rows(self, image: ProcessImage) -> list[tuple[Any, ...]]:
         """Per slave of the run plan: (slave, first output byte, output bytes, first input
@@ -529,3 +580,12 @@ class EmulatedBackend(Backend):
 _IO_STEP = IoSlave.step
 _OP = AlState.OP  # (looked up once: an enum member costs more than a comparison)
 _SAFEOP = AlState.SAFEOP
+
+
+def _address(buf: bytearray) -> int:
+    """Where a bytearray's bytes are now (they stay there while its length does)."""
+    view = (ctypes.c_char * len(buf)).from_buffer(buf)
+    try:
+        return ctypes.addressof(view)
+    finally:
+        del view  # (no export kept: the buffer may still change its length)

@@ -3,12 +3,15 @@
 
 from __future__ import annotations
 
+import struct
 from ctypes import byref, c_double, c_long, c_ubyte
 
 import pytest
 
 from gtecat import gt
 from gtecat.drives.io_slaves import IoSlave
+from gtecat.drives.slave import VirtualSlave
+from gtecat.eni.model import Identity
 from tests.gtecat.gt.conftest import bring_up
 
 
@@ -229,3 +232,71 @@ def test_an_output_written_between_polls_reaches_the_io_slave(fig5_2):
         _polls(60)
         assert slave.rx[0] == value
         assert slave.field_outputs[0] == value
+
+
+def _write_through_buffer(how: str, fi: bytearray, value: int) -> None:
+    if how == "memoryview":
+        memoryview(fi)[0] = value
+    elif how == "pack_into":
+        struct.pack_into("B", fi, 0, value)
+    else:
+        c_ubyte.from_buffer(fi).value = value  # (the export ends with the ctypes object)
+
+
+@pytest.mark.parametrize("clock", ["auto", "lockstep"])
+@pytest.mark.parametrize("how", ["memoryview", "pack_into", "ctypes"])
+def test_field_input_written_through_the_buffer_protocol_reaches_the_image(clock, how):
+    """A terminal's input byte written through the buffer protocol, which the field inputs
+    cannot count as they count an item's write: on a steady bus, in runs of cycles at once
+    (lockstep: GTE_Wait) or in the readers' C entries' quick cycles (auto: polls only), the
+    next cycles still carry it to the image - once, then again with another value."""
+    bring_up(clock=clock)
+    try:
+        assert gt.GT_AxisOn(1) == 0
+        ctl = gt.GTE_Controller()
+        pos, slave = _io_slave(ctl)
+        buf = (c_ubyte * 1)()
+        s = c_long()
+
+        def settle() -> None:
+            if clock == "lockstep":
+                gt.GTE_Wait(20)
+            else:
+                for _ in range(400):  # twenty cycles of polls (50 us each)
+                    gt.GT_GetSts(1, byref(s))
+
+        settle()
+        settle()
+        assert ctl.bank.many_cycles > 0  # (steady: runs of cycles at once)
+        for value in (0x5A, 0xA5):
+            _write_through_buffer(how, slave.field_inputs, value)
+            settle()
+            assert gt.GT_EcatIOReadInput(pos, len(slave.rx), 1, buf) == 0
+            assert buf[0] == value, (how, clock, hex(buf[0]))
+            assert slave.tx[0] == value
+    finally:
+        gt.GT_Close()
+
+
+def test_field_inputs_counted_when_their_length_changes():
+    """What moves the field inputs' bytes (a new length) counts as a write: the compiled
+    check's copy of them is only compared while nothing was counted."""
+    s = IoSlave(0, "io", Identity(vendor_id=0, product_code=0), tx_pdos=())
+    s.field_inputs = bytearray(2)
+    fi = s.field_inputs
+    for change in (
+        lambda: fi.append(1),
+        lambda: fi.extend(b"\x01"),
+        lambda: fi.insert(0, 1),
+        lambda: fi.pop(),
+        lambda: fi.remove(1),
+        lambda: fi.clear(),
+        lambda: fi.__iadd__(b"\x00\x01"),
+        lambda: fi.__imul__(2),
+        lambda: fi.__delitem__(0),
+        lambda: fi.reverse(),
+    ):
+        before = VirtualSlave.outside_changes
+        change()
+        assert VirtualSlave.outside_changes > before
+    assert type(s.field_inputs) is type(fi)
