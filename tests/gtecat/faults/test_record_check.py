@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -368,7 +369,12 @@ def test_a_c_program_is_recorded_and_replayed(tmp_path: Path) -> None:
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert "sts 512" in done.stdout, done.stdout + done.stderr
-    assert "record: 7 GT calls" in done.stderr, done.stderr
+    # (7 calls when the bus is ready at the first look; the library's controller follows the
+    # wall clock between its client's calls, so a slow start - a first build of the library -
+    # adds GT_IsEcatReady and GTE_Wait pairs, each recorded and replayed)
+    calls = re.search(r"record: (\d+) GT calls", done.stderr)
+    assert calls is not None, done.stderr
+    assert int(calls[1]) >= 7 and (int(calls[1]) - 7) % 2 == 0, done.stderr
     assert main(["replay", str(out)]) == 0
 
 
