@@ -13,12 +13,13 @@ file's digest, the axes it describes), so two runs that differ show whether thei
 
 from __future__ import annotations
 
-from ctypes import byref, c_long, c_short, c_ubyte
+from ctypes import byref, c_long, c_ubyte
 from pathlib import Path
 
 import pytest
 
 from gtecat import gt
+from tests.gtecat.gt.conftest import bring_up
 
 ROOT = Path(__file__).resolve().parents[3]
 ENI = ROOT / "examples" / "twelve_axes.eni"
@@ -45,16 +46,8 @@ def _first_sample(machine: str) -> tuple[bytes, list[int], list[str]]:
     """The outside check's program: bring-up with the bank off, every axis on in Trap, one
     GT call, one cycle; the GT raw image, the status words and the master log."""
     gt.GT_Close()
-    assert gt.GT_Open(eni=str(ENI), machine=machine, clock="lockstep", log="", bank="off") == 0
     try:
-        assert gt.GT_InitEcatComm() == 0
-        ready = c_short()
-        for _ in range(200):
-            gt.GT_IsEcatReady(byref(ready))
-            if ready.value:
-                break
-            gt.GTE_Wait(1)
-        assert gt.GT_StartEcatComm() == 0
+        bring_up(str(ENI), machine=machine, clock="lockstep", bank="off")
         for a in range(1, 13):
             assert gt.GT_AxisOn(a) == 0 and gt.GT_PrfTrap(a) == 0
         gt.GT_GetPos(1, byref(c_long()))

@@ -27,6 +27,8 @@ import pytest
 from gtecat import gt
 from gtecat.gt import centry
 
+from .conftest import bring_up
+
 ROOT = Path(__file__).resolve().parents[3]
 ENI = ROOT / "examples" / "twelve_axes.eni"
 AXES = 12
@@ -39,15 +41,7 @@ pytestmark = pytest.mark.skipif(
 def _jogging(bank: str) -> None:
     """Twelve axes on a lockstep bus, jogging alike (the same profile from the same cycle)."""
     gt.GT_Close()
-    assert gt.GT_Open(eni=str(ENI), clock="lockstep", log="", bank=bank) == 0
-    assert gt.GT_InitEcatComm() == 0
-    ready = c_short()
-    for _ in range(200):
-        gt.GT_IsEcatReady(byref(ready))
-        if ready.value:
-            break
-        gt.GTE_Wait(1)
-    assert gt.GT_StartEcatComm() == 0
+    bring_up(str(ENI), clock="lockstep", bank=bank)
     prm = gt.TJogPrm()
     prm.acc, prm.dec, prm.smooth = 0.5, 0.5, 0.0
     for a in range(1, AXES + 1):
