@@ -520,13 +520,8 @@ class Controller:
         if master is None or master.on_cycle:  # (the master's hooks: not kept, asked here)
             return 0
         clock = self.clock
-        seen = (EPOCH.n, clock.cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
-        if not settled and seen == self._steady_seen:
-            # (a field write not counted: counted now; steady() looks itself)
-            master.backend.look_at_fields()
-            if seen[3] != VirtualSlave.outside_changes:
-                seen = (*seen[:3], VirtualSlave.outside_changes)
-        if (settled or seen != self._steady_seen) and not master.steady():
+        seen = self._steady_marks(master, settled)
+        if seen is None:
             return 0
         done = bank.run_cycles(clock.now_ns, clock.cycle_ns, n)
         master.cycles += done
@@ -538,6 +533,20 @@ class Controller:
                 if passed is not None:
                     passed(done)
         return done
+
+    def _steady_marks(self, master: Any, settled: bool = False) -> tuple[int, ...] | None:
+        """The steady verdict's marks as they stand (readers' epoch, clock cycles, AL and
+        outside changes of the slaves), or None where the bus is not steady: the last
+        verdict (:attr:`_steady_seen`) stands while the marks are its own, else (or
+        ``settled``: the bank just settled) :meth:`Master.steady` is asked.  A field write
+        the slaves could not count (the buffer protocol) is counted first, so it moves them."""
+        seen = (EPOCH.n, self.clock.cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
+        if not settled and seen == self._steady_seen:
+            master.backend.look_at_fields()  # (steady() looks itself)
+            if seen[3] == VirtualSlave.outside_changes:
+                return seen
+            seen = (*seen[:3], VirtualSlave.outside_changes)
+        return seen if master.steady() else None
 
     def due_cycle(self, pending: int) -> bool:
         """The auto clock's one due cycle, run the quick way: ``pending`` (the host latency
@@ -559,21 +568,8 @@ class Controller:
         if k is None:
             return False
         clock = self.clock
-        seen = self._steady_seen
-        cycles = clock.cycles
-        master: Any = self.master  # (_quick_kernel: a master)
-        if (
-            seen[0] != EPOCH.n
-            or seen[1] != cycles
-            or seen[2] != VirtualSlave.al_changes
-            or seen[3] != VirtualSlave.outside_changes
-        ):
-            if not master.steady():
-                return False
-        else:  # (a field write not counted: counted now, as in _run_cycles)
-            master.backend.look_at_fields()
-            if seen[3] != VirtualSlave.outside_changes and not master.steady():
-                return False
+        if self._steady_marks(self.master) is None:  # (_quick_kernel: a master)
+            return False
         q = clock.quick
         io = k._io
         io[_IN_T_NS] = clock.now_ns
