@@ -84,23 +84,6 @@ class FieldInputs(bytearray):
         if type(key) is slice:
             VirtualSlave.outside_changes += 1
 
-    def __delitem__(self, key: Any) -> None:
-        VirtualSlave.outside_changes += 1
-        bytearray.__delitem__(self, key)
-        VirtualSlave.outside_changes += 1
-
-    def __iadd__(self, other: Any) -> FieldInputs:
-        VirtualSlave.outside_changes += 1
-        bytearray.__iadd__(self, other)
-        VirtualSlave.outside_changes += 1
-        return self
-
-    def __imul__(self, n: Any) -> FieldInputs:
-        VirtualSlave.outside_changes += 1
-        bytearray.__imul__(self, n)
-        VirtualSlave.outside_changes += 1
-        return self
-
 
 def _counted(name: str) -> Callable[..., Any]:
     way = getattr(bytearray, name)
@@ -117,7 +100,19 @@ def _counted(name: str) -> Callable[..., Any]:
     return counted
 
 
-for _name in ("append", "extend", "insert", "pop", "remove", "clear", "reverse"):
+# (bytearray's in-place operators give back the bytearray itself: counted alike)
+for _name in (
+    "__delitem__",
+    "__iadd__",
+    "__imul__",
+    "append",
+    "extend",
+    "insert",
+    "pop",
+    "remove",
+    "clear",
+    "reverse",
+):
     setattr(FieldInputs, _name, _counted(_name))
 
 
