@@ -39,7 +39,10 @@ Decisions (the standard leaves them open; tested in ``tests/drives/test_homing.p
   its travel bound); one stuck active is met at once when the search heads into it.  A
   limit counts only when it lies in the direction of travel (the positive one while moving
   positive, the negative one while moving negative), as outside homing: a forced limit
-  behind the axis, stuck or chattering, is ignored.
+  behind the axis, stuck or chattering, is ignored.  A limit is a level, not an edge: one
+  stuck active behind the axis is met as soon as the search turns toward it (a real drive
+  refuses travel into an active limit input), so a search that reverses or heads for the
+  index pulse toward it ends there.
 * **Errors** (SW13): a limit switch hit where the method does not reverse on it, a
   second hit of the reversal limit, no index pulse within one revolution after the
   reference edge, or the search exceeding ``max_travel`` or ``timeout_s``.  The axis
@@ -379,8 +382,13 @@ class Homing:
                 if not sampled & (1 << sig):
                     continue
                 now = self._signal_level(sig, p1, forced)
+                kind = _EV_OF_SIGNAL[sig]
                 if now != self._signal_level(sig, p0, prev):
-                    events.append((abs(p1 - p0), 1, p1, _EV_OF_SIGNAL[sig], now, True))
+                    events.append((abs(p1 - p0), 1, p1, kind, now, True))
+                elif now and _LIMIT_DIR.get(kind) == d:
+                    # a limit is a level: one held active ahead of the travel is met
+                    # although it gave no edge (it was active behind the axis before)
+                    events.append((abs(p1 - p0), 1, p1, kind, True, True))
         if spec.signal is Signal.HOME_SWITCH and not sampled & (1 << Signal.HOME_SWITCH):
             for x, rising in window_edges(self._hs, p0, p1):
                 events.append((abs(x - p0), 1, x, _EV_HS, rising, False))

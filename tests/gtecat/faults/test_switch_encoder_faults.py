@@ -6,7 +6,8 @@ homing method 3 no edge, so the search runs into the positive limit and ends in 
 error (GT_GetEcatHomingStatus 5); stuck active, the method starts as on the switch, heads
 for the edge that leaves it and meets the negative limit instead; a chattering one homes on
 the first edge the drive sees.  A negative limit stuck inactive is never found by method 1:
-the search ends at its travel bound.  The controller's smart homing (GT_GoHome) on an
+the search ends at its travel bound; a positive limit stuck active stops method 1 as soon as it
+turns back toward it (a limit is a level).  The controller's smart homing (GT_GoHome) on an
 EtherCAT axis and on a GTS card sees the same.  Counts an encoder loses move the drive's
 measured position for good: 60F4h shows the error at once, and beyond 6065h for longer
 than 6066h the drive faults with 8611h.  The axis bank gives such axes back to the scalar
@@ -111,8 +112,18 @@ def drive_homing(method: int, timeout_ms: int = 6000) -> int:
         ({"switch": "home", "value": 1}, 3, HOMING_FAILED, lambda x: x <= -20000),
         (None, 1, HOMING_DONE, lambda x: x == pytest.approx(-19700, abs=1)),
         ({"switch": "negative", "value": 0}, 1, HOMING_FAILED, lambda x: x < -60000),
+        # behind the axis while it heads for the negative limit, then ahead of it once
+        # method 1 turns back for the index pulse: a held limit input stops the search there
+        ({"switch": "positive", "value": 1}, 1, HOMING_FAILED, lambda x: -23000 < x < -19000),
     ],
-    ids=["healthy-3", "home-stuck-off", "home-stuck-on", "healthy-1", "negative-limit-stuck-off"],
+    ids=[
+        "healthy-3",
+        "home-stuck-off",
+        "home-stuck-on",
+        "healthy-1",
+        "negative-limit-stuck-off",
+        "positive-limit-stuck-on-behind",
+    ],
 )
 def test_the_drive_homing_reads_the_switches_as_60fd_shows_them(
     machine: Path, fault, method, status, where
