@@ -109,6 +109,7 @@ class CaptureUnit:
         #: the axis's process data and mailbox (fixed with the axis; kept here so that the
         #: unit reaches its drive's objects without touching the axis the bank may hold)
         self._io = io = self.ax.io
+        self._tp_pdo = io.get(0x60B9) is not None  # (60B9h mapped: fixed with the layout)
         self._din = io.get(0x60FD)
         self._act = io.get(0x6064)
         card = getattr(ctl, "card", None)
@@ -321,7 +322,7 @@ class CaptureUnit:
         backend, the slave) by an SDO upload the backend can count without sending it
         (``uploads_unframed``); None by one it must send."""
         io = self._io
-        if io.get(0x60B9) is not None:
+        if self._tp_pdo:
             return None, 0
         backend = getattr(self.ctl, "backend", None)
         unframed = getattr(backend, "uploads_unframed", None)
