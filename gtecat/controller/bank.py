@@ -1440,7 +1440,10 @@ class AxisBank:
             g = self.groups[self.group_of[r]]
             if not (self.alive[r] and g.claimed):
                 continue
-            unit = next(o for o in self._aware.get(r, ()) if getattr(o, "bank_post_next", False))
+            aware = self._aware.get(r, ())
+            unit = next((o for o in aware if getattr(o, "bank_post_next", False)), None)
+            if unit is None:  # (armed by a post of its own since: nothing pending)
+                continue
             ran = int(self.bank_cycles - self.claim_cycle[r])
             objs = self._open_drive(self.csp.channels[r])
             try:
