@@ -154,7 +154,9 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 #: the GT functions of a Trap move's start that run on their axis's claimed row in place
 #: (:meth:`AxisBank.call_in_place`): they reach that axis's axis, planner, encoder and band
 #: objects and its profile (or, through their guards, anything else of its drive)
-IN_PLACE = frozenset({"GT_PrfTrap", "GT_SetTrapPrm", "GT_SetPos", "GT_SetVel", "GT_Update"})
+IN_PLACE = frozenset(
+    {"GT_PrfTrap", "GT_SetTrapPrm", "GT_SetPos", "GT_SetVel", "GT_Update", "GT_GoHome"}
+)
 #: those of :data:`IN_PLACE` that write their profile's values for the next GT_Update alone
 #: (the Trap target, the speed), which the bank keeps no copy of: they run with the row as
 #: it stands (anything else they reached would give the drive back through its guard)
@@ -403,6 +405,14 @@ class AxisBank:
         self._stepping = -1
         #: rows a posted edge left open for the step after the cycle (:meth:`_post_event`)
         self._open: set[int] = set()
+        #: rows whose capture unit arms its drive's touch probe: the unit writes the function
+        #: after the next cycle (:meth:`_post_pending`), the drive applies it at the start of
+        #: the one after (:attr:`_tp_apply`, :meth:`_apply_probes`)
+        self._post_next: set[int] = set()
+        self._tp_apply: set[int] = set()
+        self._probe_rows: dict[int, bool] = {}  # (:meth:`probe_in_bank`)
+        #: touch probe functions the bank applied to drives it runs (:meth:`_apply_probes`)
+        self.probes_armed = 0
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
         #: the GT readers' lists of the claimed rows' values (:meth:`value`), made as they are
@@ -1301,8 +1311,20 @@ class AxisBank:
             # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
             self.csp.sw_const[r] += ch.hm_bits - SW12
             return
+        self._post_flags(r, watch, aware, sampled or jog)
+        if aware:
+            for obj in aware:
+                if getattr(obj, "bank_post_next", False):
+                    self._post_next.add(r)  # (probe_in_bank: the unit asked)
+                    break
+            else:
+                self._post_next.discard(r)
+
+    def _post_flags(self, r: int, watch: int, aware: list[Any], ahead: bool) -> None:
+        """Row ``r``'s dwatch and dpost from its hooks' watched bits and its drive's probe
+        (``ahead``: a row a cluster steps ahead, or a jog: its edges give it back)."""
         tp = bool(self.csp.tpw[r])
-        post = (watch or tp) and not sampled and not jog
+        post = (watch or tp) and not ahead
         if post and len(self.groups[self.group_of[r]].rows) == 1:
             for obj in aware:
                 if not obj.bank_post_ready():
@@ -1318,6 +1340,122 @@ class AxisBank:
             self.dwatch[r], self.dpost[r] = 0, watch
         else:
             self.dwatch[r], self.dpost[r] = watch, 0
+
+    # --- a capture unit arming its drive's touch probe -------------------------------------
+    def probe_in_bank(self, ax: Any) -> bool:
+        """The touch probe of ``ax``'s drive may be armed while the bank runs the axis: a
+        drive of one channel (:meth:`_post_pending` runs one row's unit), neither 60B8h
+        mapped as RxPDO (a write the image would carry) nor a probe object as TxPDO (the
+        image would have to show 60B9h change).  Fixed with the layout."""
+        r = self._row_of.get(id(ax)) if self.built else None
+        if r is None:
+            return False
+        ok = self._probe_rows.get(r)
+        if ok is None:
+            ok = self._probe_rows[r] = (
+                len(self.groups[self.group_of[r]].rows) == 1
+                and not self._tp_mapped(r)
+                and _get(ax, "io").get(0x60B8) is None
+            )
+        return ok
+
+    def write_probe(self, ax: Any, write: Callable[[], Any]) -> bool:
+        """``write()`` (a capture unit's SDO of 60B8h to ``ax``'s drive) with the row kept
+        when the bank runs ``ax`` in a plain state and :meth:`probe_in_bank`: the download
+        reaches the drive's objects as on the scalar path (60B8h's value), and the drive
+        applies a function that differs from its last one at the start of the next cycle,
+        as its own step does (:meth:`_apply_probes`).  False: not such a row (the caller
+        writes, and the drive's guard gives the row back)."""
+        r = self._row_of.get(id(ax)) if self.n_alive else None
+        if r is None or not self._plain_row(r) or not self.groups[self.group_of[r]].claimed:
+            return False
+        if not self.probe_in_bank(ax):
+            return False
+        ch = self.csp.channels[r]
+        objs = self._open_drive(ch)
+        try:
+            write()
+        finally:
+            if self.groups[self.group_of[r]].claimed:
+                _reguard(objs)
+        if _get(ch, "tp_function") != _get(ch, "_tp_applied"):
+            self._tp_apply.add(r)
+        return True
+
+    @staticmethod
+    def _open_drive(ch: Any) -> list[Any]:
+        """The guarded ones of a claimed channel and its probe, unguarded (the caller guards
+        them again): an SDO of the probe's objects reaches nothing else of the drive."""
+        objs = [o for o in (ch, _get(ch, "probe")) if type(o) in _GUARD_SET]
+        _unguard(tuple(objs))
+        return objs
+
+    def _apply_probes(self) -> None:
+        """Before a cycle: a touch probe function written to a claimed drive since its last
+        cycle (:meth:`write_probe`) applied as the drive's step applies it first thing
+        (TouchProbe.write_function), with the row's probe bounds, guard and post flags."""
+        csp = self.csp
+        for r in sorted(self._tp_apply):
+            g = self.groups[self.group_of[r]]
+            if not (self.alive[r] and g.claimed):
+                continue
+            ch = csp.channels[r]
+            objs = self._open_drive(ch)
+            f = _get(ch, "tp_function")
+            probe = _get(ch, "probe")
+            if f != _get(ch, "_tp_applied"):
+                _set(ch, "_tp_applied", f)
+                probe.write_function(f)
+                self.probes_armed += 1
+            on = bool(probe.function & 0x0101)
+            csp.tpw[r] = on
+            csp.tp_lo[r], csp.tp_hi[r] = (
+                probe.quiet_bounds(float(csp.pos[r])) if on else (-np.inf, np.inf)
+            )
+            if on and probe not in objs:  # (an armed probe carries the row's guard: _claim)
+                _OWNER[id(probe)] = (self, self._gi[id(g)])
+                if id(probe) not in _OWN_DICT:
+                    _OWN_DICT.add(id(probe))
+                    own_dict(probe)
+                objs.append(probe)
+            elif not on and probe in objs:
+                objs.remove(probe)
+                _OWNER.pop(id(probe), None)
+            _reguard(tuple(objs))
+            aware = self._aware.get(r, [])
+            watch = 0
+            for obj in aware:
+                watch |= obj.bank_watch
+            self._post_flags(r, watch, aware, bool(self.sampled[r] or self.jog[r]))
+            self.any_watch = self.any_watch or bool(self.dwatch[r])
+            self.any_post = self.any_post or bool(self.dpost[r])
+        self._tp_apply.clear()
+        csp.any_tp = bool(np.count_nonzero(csp.tpw & self.alive))
+
+    def _post_pending(self) -> None:
+        """After a committed cycle: the capture units of :attr:`_post_next` write their touch
+        probe's function and read 60B9h (CaptureUnit.bank_pending_post), as their own cycle
+        would; a unit whose later reads cannot be counted unsent gives its row back."""
+        for r in sorted(self._post_next):
+            g = self.groups[self.group_of[r]]
+            if not (self.alive[r] and g.claimed):
+                continue
+            aware = self._aware.get(r, ())
+            unit = next((o for o in aware if getattr(o, "bank_post_next", False)), None)
+            if unit is None:  # (armed by a post of its own since: nothing pending)
+                continue
+            ran = int(self.bank_cycles - self.claim_cycle[r])
+            objs = self._open_drive(self.csp.channels[r])
+            try:
+                ok = unit.bank_pending_post(ran)
+            finally:
+                if g.claimed:
+                    _reguard(tuple(objs))
+            if g.claimed and not ok:
+                self._release_groups([g])
+        self._post_next.clear()
+        if self._stale:
+            self._reindex()
 
     def _tp_mapped(self, r: int) -> bool:
         """Row ``r``'s drive maps a touch-probe object as TxPDO (fixed with the layout)."""
@@ -1585,6 +1723,10 @@ class AxisBank:
     def _store(self, r: int) -> None:
         self.alive[r] = False
         self._open.discard(r)
+        # (an arming under way goes on on the scalar objects: the unit writes the function at
+        # its next cycle, the drive applies one written at its next step)
+        self._post_next.discard(r)
+        self._tp_apply.discard(r)
         self.claim_ids[r] = 0
         self.res[r].bank = None
         self.layout += 1
@@ -1890,6 +2032,8 @@ class AxisBank:
             self._begin()
         if not self.n_alive:
             return
+        if self._tp_apply:
+            self._apply_probes()
         self._lists = {}  # (a new one: _lists' docs)
         k = self.kernel
         if k is not None:
@@ -1918,6 +2062,8 @@ class AxisBank:
                         if np.count_nonzero(evt):
                             rows = np.flatnonzero(evt).tolist()
                             self._post_events(rows, t_ns, dt_ns, k.scratch["s_p0"])
+                    if self._post_next:
+                        self._post_pending()
                     return
                 # declined: the numpy cycle looks at every table (the kernel may have
                 # refilled some, or left one for it: code 4)
@@ -2083,6 +2229,8 @@ class AxisBank:
         if evt is not None and np.count_nonzero(evt & self.alive):
             rows = np.flatnonzero(evt & self.alive).tolist()
             self._post_events(rows, t_ns, dt_ns, p0)
+        if self._post_next:
+            self._post_pending()
 
     def run_cycles(self, t_ns: int, dt_ns: int, n: int) -> int:
         """Up to ``n`` whole cycles from ``t_ns`` in one call of the compiled kernel, for a
@@ -2094,6 +2242,8 @@ class AxisBank:
         stops where the shortest table ends: the next call fills it)."""
         k = self.kernel
         if k is None or self.dirty or self._stale or not self.n or self.n_alive != self.n:
+            return 0
+        if self._post_next or self._tp_apply:  # (a probe arming: cycle() runs its parts)
             return 0
         if self.evt_rows:
             self.evt_rows.clear()

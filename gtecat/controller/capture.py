@@ -106,7 +106,10 @@ class CaptureUnit:
         self.res = res
         self.number = res.number
         self.ax: Axis = res.ax
-        io = self.ax.io
+        #: the axis's process data and mailbox (fixed with the axis; kept here so that the
+        #: unit reaches its drive's objects without touching the axis the bank may hold)
+        self._io = io = self.ax.io
+        self._tp_pdo = io.get(0x60B9) is not None  # (60B9h mapped: fixed with the layout)
         self._din = io.get(0x60FD)
         self._act = io.get(0x6064)
         card = getattr(ctl, "card", None)
@@ -124,6 +127,9 @@ class CaptureUnit:
         #: how the cycles the bank runs poll 60B9h (bank_ready): (None, 0) not by SDO, else
         #: (the backend, the slave) that counts the uploads not sent (bank_released)
         self._tp_uploads: tuple[Any, int] = (None, 0)
+        #: of the cycles the bank ran since it took the axis up, those whose 60B9h read was
+        #: made already (:meth:`bank_pending_post`): not counted again at the release
+        self._tp_read = 0
         self._level_watch = 0  # readers of the home level or edges every cycle (watch_level)
         self.reset_settings()
         self.edges: list[SeenEdge] = []
@@ -269,7 +275,13 @@ class CaptureUnit:
         nothing being written, its status read from the image or by SDO uploads the bus
         can count without sending (:meth:`bank_released`), the home level the one last
         seen."""
-        if self._card_edges is not None or self._tp_pending or self._tp_want != self._tp_sent:
+        if self._card_edges is not None:
+            return False
+        if self._tp_pending:  # (the bank writes the function after its next cycle, if it can)
+            bank = getattr(self.ctl, "bank", None)
+            if bank is None or not bank.probe_in_bank(self.ax):
+                return False
+        elif self._tp_want != self._tp_sent:
             return False
         polled = self._tp_polled() if self._tp_sent else (None, 0)
         if polled is None:
@@ -277,14 +289,40 @@ class CaptureUnit:
         # (the claim follows this answer: its release counts the uploads of the cycles the
         # bank ran the way found now, whatever the bus looks like at the release)
         self._tp_uploads = polled
+        self._tp_read = 0
         return self._home_prev == self.home_level()
+
+    @property
+    def bank_post_next(self) -> bool:
+        """The touch probe is being armed (60B8h off written, the function due at the next
+        cycle's :meth:`_post`): the bank runs that part of the unit's cycle after its own
+        (:meth:`bank_pending_post`) and holds the axis meanwhile."""
+        return self._tp_pending
+
+    def bank_pending_post(self, cycles: int) -> bool:
+        """The bank ran ``cycles`` cycles of the axis since it took it up, the last of which
+        is the one after which :meth:`_post` writes the touch probe's function (60B8h: its
+        drive's probe arms at the next cycle) and reads 60B9h; the cycles before it polled
+        nothing (the probe was being armed).  That write and read, as :meth:`_post` makes
+        them; the rest of that cycle's :meth:`_post` (its encoder step, the home level: no
+        edge of an input nobody watches) is what a release or a posted edge takes up, as for
+        any cycle the bank ran.  False: the reads from now on cannot be counted unsent (the
+        axis must go back)."""
+        out: list[SeenEdge] = []
+        self._touch_probe(out, 0.0)  # (the pending branch: no edge, no position)
+        self._tp_read = cycles
+        polled = self._tp_polled() if self._tp_sent else (None, 0)
+        if polled is None:
+            return False
+        self._tp_uploads = polled
+        return True
 
     def _tp_polled(self) -> tuple[Any, int] | None:
         """How :meth:`_touch_probe` reads 60B9h: (None, 0) from the process image; (the
         backend, the slave) by an SDO upload the backend can count without sending it
         (``uploads_unframed``); None by one it must send."""
-        io = self.ax.io
-        if io.get(0x60B9) is not None:
+        io = self._io
+        if self._tp_pdo:
             return None, 0
         backend = getattr(self.ctl, "backend", None)
         unframed = getattr(backend, "uploads_unframed", None)
@@ -304,7 +342,8 @@ class CaptureUnit:
             self._home_prev = self.home_level()
             backend, slave = self._tp_uploads
             if backend is not None:
-                backend.uploads_answered(slave, cycles)
+                backend.uploads_answered(slave, cycles - self._tp_read)
+        self._tp_read = 0
 
     def bank_post_ready(self) -> bool:
         """An edge of a watched input (:attr:`bank_watch`) or of the drive's touch probe may
@@ -322,7 +361,8 @@ class CaptureUnit:
         one's :meth:`_post`."""
         backend, slave = self._tp_uploads
         if backend is not None and cycles > 1:
-            backend.uploads_answered(slave, cycles - 1)
+            backend.uploads_answered(slave, cycles - 1 - self._tp_read)
+        self._tp_read = 0
         if not self.bank_watch:
             self._home_prev = self.home_level()  # (an unwatched level: taken up, no edge)
         self._post(self.ax, t_ns, dt_ns)
@@ -385,11 +425,15 @@ class CaptureUnit:
             raise CommandError(self._tp_error) from None
 
     def _write_tp(self, value: int) -> None:
-        self.ax.io.write_or_sdo(0x60B8, 0, value, 2)
+        io = self._io
+        bank = self.res.bank  # (a drive the bank runs keeps its row: AxisBank.write_probe)
+        write = lambda: io.write_or_sdo(0x60B8, 0, value, 2)  # noqa: E731
+        if bank is None or not bank.write_probe(self.ax, write):
+            write()
         self._tp_sent = value
 
     def _touch_probe(self, out: list[SeenEdge], now: float) -> None:
-        io = self.ax.io
+        io = self._io
         try:
             if self._tp_pending:
                 self._write_tp(self._tp_want)

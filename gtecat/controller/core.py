@@ -621,6 +621,8 @@ class Controller:
             or bank._stale
             or bank._declined
             or bank.evt_rows
+            or bank._post_next
+            or bank._tp_apply
             or not bank.n
             or bank.n_alive != bank.n
             or (bank.n_moving and not bank._c_fill)

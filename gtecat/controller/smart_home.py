@@ -313,6 +313,8 @@ class SmartHome:
         self._looked = True
         #: the direction whose limit the wait under way looks at (0: none, a stop)
         self._dir = 0
+        #: the clock's cycle count at which the touch probe's arming ends (0: none)
+        self._arm_due = 0
 
     @property
     def running(self) -> bool:
@@ -408,7 +410,9 @@ class SmartHome:
         self.reason = ""
         st.run, st.stage = 1, Stage.START
         self._gen = self._run()
-        self._waiting = False  # (its first step comes after the next cycle)
+        # its first step comes after the next cycle: an axis the bank runs (GT_GoHome ran on
+        # its row in place) stays there for it, any other stays scalar until the search waits
+        self._waiting = res.bank is not None
         _register(self.ctl, self)
 
     def _refuse(self, error: HomeError, reason: str) -> None:
@@ -474,6 +478,8 @@ class SmartHome:
         if res.bank is not bank:
             return None
         r = res.bank_row
+        if self._arm_due:
+            return self._arm_quiet(bank, r)
         if not (bank.alive[r] and bank.moving[r]) or r in bank.evt_rows:
             return None  # (evt_rows: the bank ran a cycle that changed an input it watches)
         # what a call may have changed since the last step (a call gives the axis back
@@ -497,6 +503,22 @@ class SmartHome:
         if not _get(res.ax, "servo_on") or (self._dir and self._limit(self._dir)):
             return None
         return bank.trap_quiet(r)
+
+    def _arm_quiet(self, bank: Any, r: int) -> int | None:
+        """:meth:`quiet` while the touch probe arms (:meth:`_arming`) on a row the bank
+        runs: the cycles before the step that goes on, unless something a step looks at
+        changed (a flag, a stop, a call's capture settings, an edge the bank took)."""
+        res = self.res
+        if not bank.alive[r] or r in bank.evt_rows or not _get(res.ax, "servo_on"):
+            return None
+        if res.latched != self._seen_latched or res.stops != self._stops:
+            return None
+        if (self.unit.changes, self._trigger.changes) != self._seen_changes:
+            return None
+        if res.profile.mode != PrfMode.TRAP:
+            return None
+        left = self._arm_due - self.ctl.clock.cycles
+        return None if left <= 0 else left - 1
 
     def _trigger_held(self, bank: Any) -> bool:
         """Another axis's capture is the trigger (``triggerIndex``): it latches, and its home
@@ -709,8 +731,7 @@ class SmartHome:
             accept = None if after is None else _beyond(after, d)
             self._arm(unit, CAPTURE_INDEX, None, accept)
             if not unit.on_card:
-                yield  # the drive's touch probe arms in two cycles (60B8h off, on)
-                yield
+                yield from self._arming()
             why, pos = yield from self._leg(
                 d, dist, vel, lambda: unit.pos if unit.status else None, latch=unit
             )
@@ -787,6 +808,21 @@ class SmartHome:
                 HomeError.SET_CAPTURE_HOME if mode == CAPTURE_HOME else HomeError.SET_CAPTURE_INDEX
             )
             raise _Abort(error, str(e)) from None
+
+    def _arming(self) -> _Steps:
+        """The drive's touch probe arms in two cycles (60B8h off, then on): the search
+        goes on at the second step after the one that armed it.  Counted in the clock's
+        cycles (a step comes after every cycle), so the wait is :meth:`quiet` where the
+        axis bank runs the axis: nothing but the cycles' count ends it."""
+        clock = self.ctl.clock
+        self._arm_due = clock.cycles + 2
+        self._waiting = True
+        try:
+            while clock.cycles < self._arm_due:
+                yield
+        finally:
+            self._waiting = False
+            self._arm_due = 0
 
     def _begin(self, d: int, target: int, vel: float) -> None:
         """Start a Trap move toward ``target`` (direction ``d``), as GT_Update would."""

@@ -173,6 +173,7 @@ def _run(
                 if bank_ is not None
                 else (0, 0, 0)
             ),
+            "armed": bank_.probes_armed if bank_ is not None else 0,
         }
         if bank_ is not None and not stops:
             # axis 1's probe stays armed after its homing: the bank holds it, and a read of
@@ -391,3 +392,74 @@ def test_captures_in_the_first_cycle_of_a_leg(tmp_path: Path) -> None:
     assert all(h[:3] == (0, 100, 0) for h in ended), ended
     assert ended[0][3] == 1 and ended[1][3] <= 2 and ended[2][3] >= -2, ended
     assert stats["rows"] > 0
+
+
+#: the first index ahead (mode 30) on a bus whose drives map no touch-probe object (the
+#: capture writes 60B8h and reads 60B9h/60BAh by SDO), GT_GoHome called on axes the bank
+#: runs: the touch probe armed while the bank keeps running them (60B8h off, then on, which
+#: the drive applies at its next cycle); the index at varied places, one where the axis
+#: stands, one behind the positive limit (the search turns there), one stopped in its
+#: search; later, homings started again from where they stood, one stopped after the first
+#: cycle of its probe's arming, one after the second, one still searching at the end
+ARM_SETUP: dict[int, tuple[dict[str, object] | None, dict[str, object]]] = {
+    1: ({"mode": 30}, {"index_offset": 1_537, "counts_per_rev": 10_000}),
+    2: ({"mode": 30, "moveDir": -1, "homeOffset": -75}, {"index_offset": 2_222}),
+    3: ({"mode": 30, "velHigh": 13.0}, {"index_offset": 0, "counts_per_rev": 3_000}),
+    4: (
+        {"mode": 30, "homeOffset": 40},
+        {"index_offset": -900, "counts_per_rev": 100_000, "positive_limit": 1_200},
+    ),
+    5: ({"mode": 30}, {"index_offset": 4_000, "counts_per_rev": 10_000}),
+    6: ({"mode": 30}, {"index_offset": 3_100, "counts_per_rev": 10_000}),  # GT_Stop, search
+    7: ({"mode": 30, "acc": 0.3, "dec": 0.2}, {"index_offset": 777, "counts_per_rev": 5_000}),
+    8: ({"mode": 30, "moveDir": -1}, {"index_offset": 9_999, "counts_per_rev": 10_000}),
+}
+
+
+def _go_home_again(axis: int) -> None:
+    """GT_GoHome on an axis whose homing ended, standing (in the bank): the first index
+    ahead of where it stands now."""
+    prm = gt.THomePrm()
+    _ok(gt.GT_GetHomePrm(axis, byref(prm)), "home prm")
+    _ok(gt.GT_GoHome(axis, byref(prm)), f"go home again {axis}")
+
+
+def _stop(axis: int) -> None:
+    _ok(gt.GT_Stop(1 << (axis - 1), 0), f"stop {axis}")
+
+
+ARM_CALLS = {
+    80: lambda: _stop(6),
+    420: lambda: (_go_home_again(1), _go_home_again(5)),
+    421: lambda: _stop(5),  # (after the cycle that wrote 60B8h off)
+    430: lambda: _go_home_again(3),
+    432: lambda: _stop(3),  # (after the cycle that wrote the function, before it applies)
+}
+
+
+@pytest.mark.parametrize("step", [0, 13])
+def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int) -> None:
+    """The bank and the scalar path cycle by cycle (or every 13 cycles), the mailbox
+    counters and mechanics at the end; the probes armed with the bank running the axes."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(len(ARM_SETUP), tmp_path / "axes.eni")
+    machine = _machine(tmp_path, ARM_SETUP)
+    out = [_run(machine, b, step, eni, ARM_SETUP, 700, ARM_CALLS) for b in ("off", "on")]
+    (ref, _), (got, stats) = out
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"sample {k}: the bank and the scalar path differ"
+    assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
+    ended = {a: h[:3] for a, h in enumerate(ref[-2][3], 1)}
+    assert ended[1][:2] == (1, 30) and ended[6] == (0, 30, 4), ended
+    assert ended[3][::2] == ended[5][::2] == (0, 4), ended
+    if not step:  # (stopped while their probes armed: the search had not begun)
+        assert ended[3][1] == ended[5][1] == 30, ended
+    assert all(ended[a] == (0, 100, 0) for a in (2, 4, 7, 8)), ended
+    caps = {a: h[3] for a, h in enumerate(ref[-2][3], 1)}
+    assert caps[2] == 2_222 - 10_000 and caps[4] == -900 and caps[7] == 777, caps
+    steps, _, probes = stats["in_place"]
+    assert steps > 20 and probes >= 6, stats["in_place"]
+    if stats["kernel"]:
+        # the probes armed while the bank ran their axes: the first homings' and axis 1's
+        assert stats["armed"] >= 8, stats
