@@ -14,12 +14,14 @@ folder; the recording names it, so it must stay there for the replay) and runs t
 * every 5 ms an HMI reads the clock and the status of each axis one by one, the planned and
   encoder positions as count-12 arrays (the encoder readers take 8 axes at most: 1-8, 9-12),
   and every 50 ms the positions one by one; every 2 s the first drive's 1001h by SDO;
-* the faults: from the machine description (``[[fault]]`` tables) a link loss behind slave 3
-  (axes 5-12) at 25 s for 300 ms, 150 ms into a second smart homing of axis 5; the positive
-  limit of axis 3 chattering at 35 s for 400 ms; the answer to the tenth SDO request to
-  1001h lost (the master waits its mailbox timeout); from Python (``gtecat.faults.inject``) an
-  overcurrent of axis 7 at 15 s for 3 s and safe torque off of axis 10 at 45 s for 1 s, both
-  in the middle of a Trap move;
+* the faults (at these times in a minute; a session of ``--seconds`` meets them at the same
+  fractions of it, for as long; the SDO's period and the second homing scale too): from the
+  machine description (``[[fault]]`` tables) a link loss behind slave 3 (axes 5-12) at 25 s for
+  300 ms, 150 ms into a second smart homing of axis 5; the positive limit of axis 3
+  chattering at 35 s for 400 ms; the answer to the fifth SDO request to 1001h lost (the master
+  waits its mailbox timeout); from Python (``gtecat.faults.inject``) an overcurrent of axis 7
+  at 15 s for 3 s and safe torque off of axis 10 at 45 s for 1 s, both in the middle of a
+  Trap move;
 * its error handler: an alarm read (GT_GetEcatErrorCode) then the drive reset every 100 ms
   (GT_ClrSts, GT_AxisOn) until it stays; a latched limit cleared; a bus not ready
   (GT_IsEcatReady, every 50 ms) waited for with a time limit of 2 s, then the axes behind it
@@ -51,22 +53,39 @@ _AXIS = (
     "[axis.{a}]\nposition = {p}\ncounts_per_rev = 10000\nindex_offset = 3000\n"
     "negative_limit = -2000000\npositive_limit = 2000000\nfollowing_error_window = 50000\n{sw}\n"
 )
-#: axis 1 starts on its home switch (the drive's method 3 leaves it), axis 5 below its own
-MACHINE = (
-    "".join(
-        _AXIS.format(
-            a=a,
-            p=150000 if a == DRIVE_HOMING else 0,
-            sw="home_switch = [[100000, 2000000]]\n" if a in (DRIVE_HOMING, SMART_HOMING) else "",
+
+
+def machine(seconds: float = 60.0) -> str:
+    """The machine description: axis 1 starts on its home switch (the drive's method 3
+    leaves it), axis 5 below its own; the ``[[fault]]`` tables at their times in a minute,
+    scaled to ``seconds`` (:func:`at`)."""
+    return (
+        "".join(
+            _AXIS.format(
+                a=a,
+                p=150000 if a == DRIVE_HOMING else 0,
+                sw="home_switch = [[100000, 2000000]]\n"
+                if a in (DRIVE_HOMING, SMART_HOMING)
+                else "",
+            )
+            for a in range(1, AXES + 1)
         )
-        for a in range(1, AXES + 1)
+        + '[[fault]]\nkind = "link_down"\nafter_slave = 3\n'
+        f"at_ms = {at(25000, seconds)}\nduration_ms = 300\n"
+        'name = "cut"\n\n'
+        '[[fault]]\nkind = "switch_chatter"\naxis = 3\nswitch = "positive"\nperiod_cycles = 3\n'
+        f"at_ms = {at(35000, seconds)}\nduration_ms = 400\n\n"
+        '[[fault]]\nkind = "mailbox_lost"\nslave = 0\nindex = 0x1001\non_sdo = [0, 0x1001, 5]\n'
     )
-    + '[[fault]]\nkind = "link_down"\nafter_slave = 3\nat_ms = 25000\nduration_ms = 300\n'
-    'name = "cut"\n\n'
-    '[[fault]]\nkind = "switch_chatter"\naxis = 3\nswitch = "positive"\nperiod_cycles = 3\n'
-    "at_ms = 35000\nduration_ms = 400\n\n"
-    '[[fault]]\nkind = "mailbox_lost"\nslave = 0\nindex = 0x1001\non_sdo = [0, 0x1001, 10]\n'
-)
+
+
+def at(ms: int, seconds: float) -> int:
+    """The time ``ms`` of the minute-long cell in a session of ``seconds`` (a fault then lasts
+    as long as in a minute: a shorter session meets every fault as the minute does)."""
+    return round(ms * seconds / 60.0)
+
+
+MACHINE = machine()
 
 
 def session(gt, faults, seconds: float = 60.0, machine: str | None = None) -> int:
@@ -94,8 +113,8 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None) -> in
     gt.GT_Reset()
     for a in range(1, AXES + 1):
         gt.GT_AxisOn(a)
-    faults.inject("drive_fault", axis=7, code=0x2310, at_ms=15000, duration_ms=3000)
-    faults.inject("sto", axis=10, at_ms=45000, duration_ms=1000)
+    faults.inject("drive_fault", axis=7, code=0x2310, at_ms=at(15000, seconds), duration_ms=3000)
+    faults.inject("sto", axis=10, at_ms=at(45000, seconds), duration_ms=1000)
     trap = gt.TTrapPrm()
     trap.acc = trap.dec = 0.25
     home = gt.THomePrm()
@@ -127,6 +146,7 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None) -> in
     start = now()
     t_end = seconds * 1000
     sdo_at = 0
+    sdo_ms = at(2000, seconds)
     second_homing = False
     k = 0
     while (t := now() - start) < t_end:
@@ -150,7 +170,7 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None) -> in
                     alarm.pop(a, None)
                 state[DRIVE_HOMING] = state[SMART_HOMING] = "rehome"
             continue
-        if not second_homing and t >= 24850 and state[SMART_HOMING] == "trap":
+        if not second_homing and t >= at(24850, seconds) and state[SMART_HOMING] == "trap":
             second_homing = True  # a new reference, which the cut interrupts
             smart_homing()
         for a in range(1, AXES + 1):
@@ -191,8 +211,8 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None) -> in
                 gt.GT_SetPos(a, target[a])
                 gt.GT_SetVel(a, 10.0 + a)
                 gt.GT_Update(1 << (a - 1))
-        if t - sdo_at >= 2000:
-            sdo_at += 2000
+        if t - sdo_at >= sdo_ms:
+            sdo_at += sdo_ms
             gt.GT_EcatSDOUpload(0, 0x1001, 0, sdo, 1, byref(size), byref(abort))
         gt.GTE_Wait(POLL_MS)
     gt.GT_Close()
@@ -208,7 +228,7 @@ def main() -> int:
     args = ap.parse_args()
     from gtecat import faults, gt
 
-    args.machine.write_text(MACHINE)
+    args.machine.write_text(machine(args.seconds))
     print("passes", session(gt, faults, args.seconds, str(args.machine.resolve())))
     return 0
 
