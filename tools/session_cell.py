@@ -41,7 +41,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tools.session_hard import AXES, ENI  # the 12-axis example bus
+from tools.session_hard import AXES, ENI, trap_move  # the 12-axis example bus, a Trap move
 
 POLL_MS = 5
 DRIVE_HOMING = 1  # CiA-402 method 3 in the drive
@@ -206,11 +206,7 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None) -> in
                 smart_homing()
             else:
                 target[a] = 30_000 + 2000 * a if target[a] == 0 else 0
-                gt.GT_PrfTrap(a)
-                gt.GT_SetTrapPrm(a, byref(trap))
-                gt.GT_SetPos(a, target[a])
-                gt.GT_SetVel(a, 10.0 + a)
-                gt.GT_Update(1 << (a - 1))
+                trap_move(gt, a, target[a], trap)
         if t - sdo_at >= sdo_ms:
             sdo_at += sdo_ms
             gt.GT_EcatSDOUpload(0, 0x1001, 0, sdo, 1, byref(size), byref(abort))

@@ -1,7 +1,8 @@
 """The 12-axis cell that meets trouble (tools/session_cell.py), recorded with every cycle run one
-at a time - no run of cycles at once, no quick cycle a call's latency makes due - and replayed
-the quick ways: every call's result the same.  Its faults and homings come at the same fractions
-of a shorter session: a few virtual seconds here, the whole minute under GTECAT_LONG=1.
+at a time - no run of cycles at once, no quick cycle a call's latency makes due (conftest's
+record_one_by_one) - and replayed the quick ways: every call's result the same.  Its faults
+and homings come at the same fractions of a shorter session: a few virtual seconds here, the
+whole minute under GTECAT_LONG=1.
 """
 
 from __future__ import annotations
@@ -12,10 +13,9 @@ from pathlib import Path
 import pytest
 
 from gtecat import faults, gt
-from gtecat.controller.bank import AxisBank
-from gtecat.controller.core import Controller
-from gtecat.faults.record import Recorder, replay
+from gtecat.faults.record import replay
 from tests.conftest import LONG
+from tests.gtecat.faults.conftest import record_one_by_one
 from tools import session_cell
 
 SECONDS = 60.0 if LONG else 4.0
@@ -26,20 +26,11 @@ def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("cell")
     machine = folder / "cell.toml"
     machine.write_text(session_cell.machine(SECONDS))
-    out = folder / "cell.gtrec"
-    mp = pytest.MonkeyPatch()
-    mp.setattr(Controller, "run_cycles", lambda self, n: 0)
-    mp.setattr(Controller, "due_cycle", lambda self, pending: False)
-    mp.setattr(AxisBank, "_keep_table", lambda self, r, pl: None)
-    rec = Recorder(out).start()
-    try:
-        session_cell.session(gt, faults, SECONDS, str(machine))
-    finally:
-        rec.stop()
-        mp.undo()
-        gt.GT_Close()
-    rec.write()
-    return out
+    return record_one_by_one(
+        folder / "cell.gtrec",
+        lambda: session_cell.session(gt, faults, SECONDS, str(machine)),
+        quick=False,
+    )
 
 
 def test_the_cell_meets_its_trouble(recorded: Path) -> None:
