@@ -34,6 +34,13 @@ session) as whole ``gtecat replay FILE`` processes run in the file's folder, the
 (the bar: the whole process at least 50 times real time); ``--against CHECKOUT`` times that
 checkout's gtecat too, the two in turn.
 
+``--cell`` records tools/session_cell.py's 12-axis cell the way an outside check records its
+own (``gtecat record -o FILE -- python tools/session_cell.py``: two homings, one of them
+interrupted by a link loss, a drive fault and safe torque off mid-Trap, a chattering limit, a
+lost SDO answer, polling every 5 ms one by one and as arrays, an error handler), times whole
+``gtecat replay FILE`` processes as ``--file`` does, and checks that a copy with one call's
+recorded return code changed diverges (exits non-zero).
+
 ``--hard`` records tools/session_hard.py's HMI-like session twice - every axis polled every
 4 ms one by one (``single``), and as count-12 arrays (``arrays``): homing, jogs, Trap moves, a
 drive fault and a chattering limit switch with the application's error handler, SDO reads -
@@ -43,7 +50,7 @@ waits for); ``--against CHECKOUT`` times the whole process with that checkout's 
 the two in turn.
 
     python tools/bench_replay.py [--seconds 60] [--poll-ms 10] [--repeat 3] [--against DIR]
-                                 [--simple | --rich | --arrays | --hard | --file FILE]
+                                 [--simple | --rich | --arrays | --hard | --cell | --file FILE]
                                  [--json]
 """
 
@@ -294,6 +301,63 @@ def measure_file(path: Path, repeat: int, against: Path | None = None) -> dict[s
     return out
 
 
+def tampered(path: Path, out: Path) -> str:
+    """Copy the recording ``path`` to ``out`` with the return code of one call in its middle
+    changed (a GT_GetSts that returned 0 now says 1); what was changed."""
+    lines = path.read_bytes().split(b"\n")
+    for i in range(len(lines) // 2, len(lines)):
+        if lines[i].startswith(b'{"t":') and b'"c":"GT_GetSts"' in lines[i]:
+            if b'"r":0' in lines[i]:
+                lines[i] = lines[i].replace(b'"r":0', b'"r":1', 1)
+                out.write_bytes(b"\n".join(lines))
+                return f"line {i + 1}: GT_GetSts's return code 0 -> 1"
+    raise ValueError(f"{path}: no GT_GetSts returning 0 in its second half")
+
+
+def measure_cell(
+    seconds: float, repeat: int, against: Path | None = None, keep: Path | None = None
+) -> dict[str, object]:
+    """tools/session_cell.py recorded by ``gtecat record`` in a child process, its whole
+    ``gtecat replay FILE`` processes timed (:func:`measure_file`), a tampered copy replayed."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = keep if keep is not None else Path(tmp)
+        folder.mkdir(parents=True, exist_ok=True)
+        path, machine = folder / "cell.gtrec", folder / "cell.toml"
+        env = dict(os.environ, PYTHONPATH=str(ROOT))
+        t0 = time.perf_counter()
+        session = [sys.executable, str(ROOT / "tools" / "session_cell.py")]
+        session += ["--seconds", str(seconds), "--machine", str(machine)]
+        subprocess.run(
+            [sys.executable, "-m", "gtecat", "record", "-o", str(path), "--", *session],
+            check=True,
+            capture_output=True,
+            env=env,
+            cwd=str(folder),
+        )
+        recorded = time.perf_counter() - t0
+        out = measure_file(path, repeat, against)
+        out = {"session": "cell", "record_wall_s": round(recorded, 3), **out}
+        out["file_bytes"] = path.stat().st_size
+        bad = folder / "cell_tampered.gtrec"
+        what = tampered(path, bad)
+        r = subprocess.run(
+            [sys.executable, "-m", "gtecat", "replay", str(bad)],
+            capture_output=True,
+            text=True,
+            env=env,
+            cwd=str(folder),
+        )
+        out["tampered"] = {
+            "changed": what,
+            "exit": r.returncode,
+            "says": (r.stdout.strip() or r.stderr.strip()).splitlines()[-1:],
+        }
+        if r.returncode == 0:
+            out["diverged"] = f"the tampered copy replayed without a divergence ({what})"
+        bad.unlink()
+    return out
+
+
 def measure_hard(
     seconds: float, repeat: int, against: Path | None = None, keep: Path | None = None
 ) -> dict[str, object]:
@@ -484,6 +548,12 @@ def main() -> int:
         "process (tools/session_hard.py)",
     )
     kind.add_argument(
+        "--cell",
+        action="store_true",
+        help="the 12-axis cell that meets trouble (tools/session_cell.py), recorded by "
+        "gtecat record and replayed as whole gtecat replay processes, and a tampered copy",
+    )
+    kind.add_argument(
         "--arrays",
         action="store_true",
         help="the session that polls all 12 axes in one call each (status, planned and "
@@ -495,7 +565,9 @@ def main() -> int:
         help="an existing recording: time whole gtecat replay FILE processes run in its folder",
     )
     ap.add_argument(
-        "--keep", type=Path, help="--hard: write the recordings into this folder and keep them"
+        "--keep",
+        type=Path,
+        help="--hard, --cell: write the recordings into this folder and keep them",
     )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
@@ -503,6 +575,10 @@ def main() -> int:
         out = measure_file(args.file, max(1, args.repeat), args.against)
         print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
         return 0
+    if args.cell:
+        out = measure_cell(args.seconds, max(1, args.repeat), args.against, args.keep)
+        print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))
+        return 0 if out["diverged"] is None else 1
     if args.hard:
         out = measure_hard(args.seconds, max(1, args.repeat), args.against, args.keep)
         print(json.dumps(out) if args.json else "\n".join(f"{k}: {v}" for k, v in out.items()))

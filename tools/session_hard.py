@@ -139,11 +139,7 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None, singl
                         state[a] = "trap"
             elif state[a] == "trap" and not s & 0x400:
                 target[a] = 30_000 + 2000 * a if target[a] == 0 else 0
-                gt.GT_PrfTrap(a)
-                gt.GT_SetTrapPrm(a, byref(prm))
-                gt.GT_SetPos(a, target[a])
-                gt.GT_SetVel(a, 10.0 + a)
-                gt.GT_Update(1 << (a - 1))
+                trap_move(gt, a, target[a], prm)
         if t - turn >= 3000:
             turn += 3000
             direction = -direction
@@ -158,6 +154,16 @@ def session(gt, faults, seconds: float = 60.0, machine: str | None = None, singl
         gt.GTE_Wait(POLL_MS)
     gt.GT_Close()
     return k
+
+
+def trap_move(gt, axis: int, target: int, prm) -> None:
+    """A Trap move of ``axis`` to ``target`` with ``prm`` at 10 + ``axis`` pulse/ms, as these
+    sessions start one as soon as an axis is at rest."""
+    gt.GT_PrfTrap(axis)
+    gt.GT_SetTrapPrm(axis, byref(prm))
+    gt.GT_SetPos(axis, target)
+    gt.GT_SetVel(axis, 10.0 + axis)
+    gt.GT_Update(1 << (axis - 1))
 
 
 def record(path: Path, seconds: float = 60.0, single: bool = False) -> Path:

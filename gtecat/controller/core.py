@@ -563,7 +563,11 @@ class Controller:
         the steady verdict's marks (:attr:`_steady_seen`; :meth:`Master.steady` itself where
         they moved).  A cycle the kernel declines goes the clock's one-cycle way
         (:meth:`Clock.cycle`), as the general way goes after it.  A cycle that ran whole
-        arms the next one for the GT readers' C entries (:meth:`arm_quick`)."""
+        arms the next one for the GT readers' C entries (:meth:`arm_quick`) - unless a
+        ``pre_cycle`` or ``post_cycle`` hook is there: one that says it is quiet in the next
+        cycle (:func:`_quiet_way`: the fault injector waiting for a time, smart homing with
+        no homing running) lets it run here as :meth:`_run_cycles` runs one cycle, counted
+        by its ``cycles_passed`` after it, but the entries (which count nothing) run none."""
         k = self._quick_kernel()
         if k is None:
             return False
@@ -585,14 +589,24 @@ class Controller:
             rc = k.run_fn(*k._args)
         finally:
             self.in_batch = False
-        self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
-        if q[4]:  # (with all else that it relies on, taken now)
-            self.arm_quick(k)
+        if self._unhooked == ARMS[0]:
+            self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
+            if q[4]:  # (with all else that it relies on, taken now)
+                self.arm_quick(k)
+            return True
+        ran = io[_OUT_DONE]  # (else quick_book runs it the clock's way, hooks and all)
+        self.quick_book(rc)
+        q[4] = 0  # (the entries' cycles would pass the hooks by)
+        if ran:
+            for _, passed in self._hook_ways():
+                if passed is not None:
+                    passed(1)
         return True
 
     def _quick_kernel(self) -> Any:
         """The bank's kernel where a quick cycle (:meth:`due_cycle`) may run: what
-        :meth:`_run_cycles` and :meth:`AxisBank.run_cycles` ask, nothing hooked; else None."""
+        :meth:`_run_cycles` and :meth:`AxisBank.run_cycles` ask, no hook but ``pre_cycle`` and
+        ``post_cycle`` ones quiet in the next cycle (:meth:`due_cycle`); else None."""
         bank = self.bank
         master = self.master
         if (
@@ -603,17 +617,13 @@ class Controller:
             or self.clock.counted is not readers_changed
         ):
             return None
+        hooked = False
         if self._unhooked != ARMS[0]:  # (no hook since: every change of them is a new one)
-            if (
-                self.before_cycle
-                or self.sample
-                or self.pre_cycle
-                or self.post_cycle
-                or self.watch
-                or master.on_cycle
-            ):
+            if self.before_cycle or self.sample or self.watch or master.on_cycle:
                 return None
-            self._unhooked = ARMS[0]
+            hooked = bool(self.pre_cycle or self.post_cycle)
+            if not hooked:
+                self._unhooked = ARMS[0]
         k = bank.kernel
         if (
             k is None
@@ -631,6 +641,10 @@ class Controller:
             or self.clock.quick[2] * 1e-9 != bank.csp._dt
         ):
             return None
+        if hooked:  # (asked last, as _run_cycles asks them after the bank's flags)
+            for quiet, _ in self._hook_ways():
+                if quiet(1) < 1:
+                    return None
         return k
 
     def quick_book(self, rc: int) -> None:

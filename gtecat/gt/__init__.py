@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import gc as _gc
 import importlib
+import sys as _sys
+import threading as _threading
 
 # The cyclic garbage collector is paused while this module is imported: the import makes
 # ~100,000 objects that live as long as the process (classes, functions, tables, numpy's), and
@@ -72,17 +74,56 @@ try:
     globals().update(REGISTRY)
     #: the vendor surface (:mod:`gtecat.gt.vendor`: the groups' structures, enum members and
     #: constants, ~3,800 declared-only functions), every name in this namespace from here on
-    #: (no module ``__getattr__``: CPython specialises ``gt.X`` only without one)
-    _install_vendor_surface(globals(), REGISTRY)
+    #: (no module ``__getattr__``: CPython specialises ``gt.X`` only without one) - unless the
+    #: process said it runs no program of its own (``gtecat._SURFACE_LATER``, set by ``gtecat
+    #: replay`` before it imports this module): then the first name asked of the module that it
+    #: does not hold makes it (:func:`__getattr__`), ~25 ms of such a process's start
+    _surface_later = bool(getattr(_sys.modules.get("gtecat"), "_SURFACE_LATER", False))
+    if not _surface_later:
+        _install_vendor_surface(globals(), REGISTRY)
 finally:
     if _gc_was_on:
         _gc.enable()
 
 
 def _whole() -> dict[str, object]:
-    """This module's namespace: every name of the surface (the walkers' name for it from
-    when the vendor surface was made lazily)."""
+    """This module's namespace: every name of the surface (the vendor surface made first
+    where it was left for later)."""
+    if _surface_later:
+        _make_surface()
     return globals()
+
+
+_surface_lock = _threading.Lock()
+
+
+def _make_surface() -> None:
+    """The vendor surface left for later, made once (the module's ``__getattr__`` and
+    ``__dir__`` then go: the namespace is the one an ordinary import makes)."""
+    global _surface_later
+    with _surface_lock:
+        if _surface_later:
+            _install_vendor_surface(globals(), REGISTRY)
+            for _k in ("__getattr__", "__dir__"):
+                globals().pop(_k, None)
+            _surface_later = False
+
+
+if _surface_later:
+
+    def __getattr__(name: str) -> object:
+        """A name of the vendor surface left for later: the surface made, then the name."""
+        if name.startswith("__"):  # (the import system's and pickle's questions)
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        _make_surface()
+        try:
+            return globals()[name]
+        except KeyError:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+
+    def __dir__() -> list[str]:
+        _make_surface()
+        return sorted(globals())
 
 
 def _arm_faults(ctl: object) -> None:

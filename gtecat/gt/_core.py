@@ -434,6 +434,10 @@ def cycle_failed(name: str, e: Exception, rc: int) -> int:
 _fast.CYCLE_FAILED[:] = [cycle_failed]
 
 
+#: the GT functions that change nothing but let controller time pass (their cycles count)
+_TIME_ONLY = frozenset({"GTE_Wait"})
+
+
 def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     """Make ``fn`` a GT function: never raises, returns a code, costs a host call.
 
@@ -461,6 +465,11 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     #: a fast path whose first parameter is an axis (its GTN_ twin of core c > 1 takes the
     #: bus axis on core 1's fast path; a coordinate system, a type, an offset: its table)
     by_axis = bool(proto.params) and proto.params[0].name in ("axis", "profile", "encoder")
+    #: what a call moves the readers' epoch by (:mod:`gtecat.controller.epoch`): 0 for a call
+    #: that changes nothing but lets time pass, whose cycles move it themselves (Clock.counted)
+    #: - a wait then leaves the steady verdict of the bus to the next run of cycles
+    #: (Controller._steady_marks) instead of asking Master.steady again at every wait
+    moves = 0 if name in _TIME_ONLY else 1
 
     def call(core: Any, args: tuple, kwargs: dict) -> int:
         before = SESSION.last
@@ -493,7 +502,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         ctl = None
         # (and before it: the cycles the call runs itself see what it changed before them -
         # Controller._run_cycles keeps the bus's steadiness while the epoch stays)
-        EPOCH.n += 1
+        EPOCH.n += moves
         try:
             if address or SESSION._remote is not None:  # attached: the controller process runs it
                 from ..native.client import remote_call
@@ -521,7 +530,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                         rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
                     # (and once more below: another thread's cycles, once the lock is free,
                     # see what the call changed - Controller._run_cycles)
-                    EPOCH.n += 1
+                    EPOCH.n += moves
             else:
                 rc = fn(*values, **extra) if extra else fn(*values)
             if rc is None:
@@ -540,7 +549,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 _record(name, rc, "no reason given")
         except Exception as e:
             return failed(e, ctl, core, before)  # (its _record: the epoch grows)
-        EPOCH.n += 1  # (what the call changed: the values the C entries keep ask again)
+        EPOCH.n += moves  # (what the call changed: the values the C entries keep ask again)
         if ctl is None:
             ctl = SESSION.controllers.get(core)
         if ctl is not None and ctl.clock.mode is not _LOCKSTEP:  # (advance: nothing then)

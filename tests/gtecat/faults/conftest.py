@@ -1,13 +1,39 @@
 """Every test of the fault vocabulary, recording and replay starts and ends with no GT
-session open (a failed test leaves none behind for the next)."""
+session open (a failed test leaves none behind for the next); :func:`record_one_by_one`
+records a session the reference way the replays are compared with."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import pytest
 
 from gtecat import gt
+from gtecat.controller.bank import AxisBank
+from gtecat.controller.core import Controller
+from gtecat.faults.record import Recorder
+
+
+def record_one_by_one(out: Path, session: Callable[[], object], quick: bool = True) -> Path:
+    """Record ``session()`` into ``out`` with every cycle run one by one (no run of cycles at
+    once; ``quick=False``: no quick cycle a call's latency makes due either) and every Trap
+    table computed afresh when an axis comes back to the bank: the reference a replay the
+    quick ways must reproduce exactly."""
+    mp = pytest.MonkeyPatch()
+    mp.setattr(Controller, "run_cycles", lambda self, n: 0)
+    if not quick:
+        mp.setattr(Controller, "due_cycle", lambda self, pending: False)
+    mp.setattr(AxisBank, "_keep_table", lambda self, r, pl: None)
+    rec = Recorder(out).start()
+    try:
+        session()
+    finally:
+        rec.stop()
+        mp.undo()
+        gt.GT_Close()
+    rec.write()
+    return out
 
 
 @pytest.fixture(autouse=True)

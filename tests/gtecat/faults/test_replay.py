@@ -18,10 +18,10 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli.main import main
-from gtecat.controller.bank import AxisBank
 from gtecat.controller.core import Controller
-from gtecat.faults.record import Recorder, replay
+from gtecat.faults.record import replay
 from tests.conftest import EXAMPLES, LONG
+from tests.gtecat.faults.conftest import record_one_by_one
 from tools import bench_replay
 
 SECONDS = 60.0 if LONG else 3.0
@@ -34,19 +34,9 @@ def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("replay")
     machine = folder / "machine.toml"
     machine.write_text(bench_replay.MACHINE)
-    out = folder / "session.gtrec"
-    mp = pytest.MonkeyPatch()
-    mp.setattr(Controller, "run_cycles", lambda self, n: 0)
-    mp.setattr(AxisBank, "_keep_table", lambda self, r, pl: None)
-    rec = Recorder(out).start()
-    try:
-        bench_replay.session(gt, SECONDS, 10, str(machine))
-    finally:
-        rec.stop()
-        mp.undo()
-        gt.GT_Close()
-    rec.write()
-    return out
+    return record_one_by_one(
+        folder / "session.gtrec", lambda: bench_replay.session(gt, SECONDS, 10, str(machine))
+    )
 
 
 def _calls(path: Path) -> list[dict]:

@@ -190,3 +190,38 @@ def test_a_define_may_name_another(text):
     g: dict = {"MC_NONE": 7}
     vendor._constants((kept,), g, set())
     assert (g["A"], g["B"], g["C"]) == (3, 4, 8)
+
+
+_LATER = r"""
+import json
+import gtecat
+gtecat._SURFACE_LATER = True  # (as gtecat replay sets it)
+from gtecat import gt
+from gtecat.gt import table
+
+before = {
+    "hook": "__getattr__" in vars(gt),
+    "declared_there": "GT_SetHSIOOpt" in vars(gt),
+    "own_there": "GT_GetSts" in vars(gt) and "TTrapPrm" in vars(gt),
+}
+fn = gt.GT_SetHSIOOpt  # (the first vendor name asked: the surface made)
+after = {
+    "hook": "__getattr__" in vars(gt) or "__dir__" in vars(gt),
+    "whole": all(n in vars(gt) for n in table.exported_names()),
+    "rc": fn(1, 2),
+    "no_such": hasattr(gt, "GT_NoSuchFunction"),
+}
+print(json.dumps([before, after]))
+"""
+
+
+def test_a_process_that_runs_no_program_makes_the_vendor_surface_at_its_first_name():
+    """``gtecat replay``'s start: with ``gtecat._SURFACE_LATER`` set before the import, the GT
+    layer's own functions and structures are there and the vendor surface is not; the first
+    vendor name asked makes it whole, and the namespace is then an ordinary import's."""
+    out = subprocess.run(
+        [sys.executable, "-c", _LATER], capture_output=True, text=True, cwd=ROOT, check=True
+    )
+    before, after = json.loads(out.stdout.strip().splitlines()[-1])
+    assert before == {"hook": True, "declared_there": False, "own_there": True}
+    assert after == {"hook": False, "whole": True, "rc": 8, "no_such": False}
