@@ -1844,9 +1844,17 @@ class AxisBank:
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
-            vel, acc = self._enc_rates()
-            return (vel if name == "enc_vel" else acc).tolist()
+            if self.n <= _SMALL_BANK:  # (a few rows: Python floats, no numpy temporaries)
+                vel, acc = self._enc_rates_lists()
+                self._lists["enc_acc" if name == "enc_vel" else "enc_vel"] = (
+                    acc if name == "enc_vel" else vel
+                )
+            else:
+                vel, acc = (x.tolist() for x in self._enc_rates())
+            return vel if name == "enc_vel" else acc
         if name == "axis_enc":
+            if self.n <= _SMALL_BANK:
+                return self._link_list(self.enc_pos, self.enc_ratio, self.enc_off)
             return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
         if name == "moving":
             return (self.moving | self.jog).tolist()
@@ -1859,6 +1867,40 @@ class AxisBank:
         """:meth:`AffineLink.axis` for every row (the same three cases)."""
         one = ratio == 1.0
         return np.where(one, np.where(off != 0.0, x + off, x), ratio * x + off)
+
+    @staticmethod
+    def _link_list(x: np.ndarray, ratio: np.ndarray, off: np.ndarray) -> list[float]:
+        """:meth:`_link` as a list of Python floats, row by row (the same IEEE operations
+        in the same cases; a few rows cost less so than numpy's temporaries)."""
+        return [
+            (v + o if o != 0.0 else v) if k == 1.0 else k * v + o
+            for v, k, o in zip(x.tolist(), ratio.tolist(), off.tolist(), strict=True)
+        ]
+
+    def _enc_rates_lists(self) -> tuple[list[float], list[float]]:
+        """:meth:`_enc_rates` as lists of Python floats, row by row (the same IEEE
+        divisions and subtraction as :meth:`_enc_rates_row`)."""
+        t = self.T
+        now = self.bank_cycles
+        vel: list[float] = []
+        acc: list[float] = []
+        for c, s1, s0, v, a in zip(
+            self.claim_cycle.tolist(),
+            self.enc_step1.tolist(),
+            self.enc_step0.tolist(),
+            self.enc_vel.tolist(),
+            self.enc_acc.tolist(),
+            strict=True,
+        ):
+            cnt = now - c
+            if cnt < 1:
+                vel.append(v)
+                acc.append(a)
+            else:
+                v1 = s1 / t
+                vel.append(v1)
+                acc.append((v1 - (s0 / t if cnt >= 2 else v)) / t)
+        return vel, acc
 
     # --- the cycle -------------------------------------------------------------------------
     def settle(self) -> None:

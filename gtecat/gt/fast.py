@@ -28,7 +28,7 @@ from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE
-from ..controller.epoch import EPOCH
+from ..controller.epoch import EPOCH, changed
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_count
@@ -1125,10 +1125,13 @@ def fast_clock(
     if not CENTRY:
         return gt
     types = sorted(_CLOCK_INTS, key=str)
+    # (an array of one of the types ``first`` takes: its first element)
+    elements = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
     entry = centry.reader(
         gt, value, _NO, types, centry.INT, most=2, noaxis=True, gate=centry.GT_GATE,
         after=_after(advance, name, 0),
         numpy=_int_dtypes(_scalar_types(FUNCTIONS[name].params[0])),  # (as ``first``)
+        array=_first_element(lambda _: value(), elements),
     )  # fmt: skip
     if entry is None:
         return gt
@@ -1523,6 +1526,7 @@ def fast_raw(
     #: pointers, the table path's 7); a bytearray's (and bytes', to write from) the C entry
     #: checks itself
     array_sizes: dict[type, int] = {bytearray: 1 << 62, bytes: 1 << 62 if write else 0}
+    array_sizes |= {memoryview: 1 << 62, _NDARRAY: 1 << 62}  # (checked in C too)
 
     def address(slave: int, offset: int, size: int, image: Any) -> bytes | None:
         """Where a raw range (a slave's region: ``slave`` >= 0) lies in the image's buffer:
@@ -1551,9 +1555,7 @@ def fast_raw(
         if at is None:
             return _NO
         venv["LASTC"] = (offset, size, tp, image, slave, at)
-        session.last = None
-        if write:
-            EPOCH.n += 1  # (the readers' C entries ask again: epoch.py)
+        session.last = None  # (a write: the C entry makes the epoch grow where it changed)
         return at
 
     venv = {
@@ -1569,11 +1571,14 @@ def fast_raw(
         slave_memo=" and slave == last[4]" if io else "",
     )
     _gated(venv)
-    venv["EPOCH"] = EPOCH
-    exec(_compiled_code(_raw_code(code, name), f"<gt raw value {name}>"), venv)
+    # (a write's value does not make the epoch grow: its C entry does, where the write
+    # changed a byte of the image - centry.raw's changed)
+    exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
     value = venv["value"]
 
-    public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE, _after(advance, name, 0))
+    public = centry.raw(
+        entry, value, _NO, io, write, centry.GT_GATE, _after(advance, name, 0), changed
+    )
     if public is None:
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
@@ -2607,6 +2612,7 @@ def _noaxis_entry(
     entry = centry.reader(
         gt, value, _NO, types, centry.INT, most=1, noaxis=True, gate=centry.GT_GATE,
         after=_after(advance, name, 0), numpy=_int_dtypes(types),
+        array=_first_element(lambda _: value(), types),  # (a ctypes array: its first element)
     )  # fmt: skip
     if entry is None:
         return gt

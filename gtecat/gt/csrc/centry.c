@@ -101,6 +101,12 @@ struct api {
     obj marks_dict;
     obj key_al;
     obj key_out;
+    /* the buffer protocol (PyObject_GetBuffer, PyBuffer_Release) for a raw entry's
+     * memoryview, the memoryview type, numpy's uint8 dtype (its descr object; NULL: none) */
+    int (*get_buffer)(obj, void *, int);
+    void (*release_buffer)(void *);
+    obj memoryview_type;
+    obj np_u8;
 };
 
 #define MAX_TYPES 16
@@ -172,7 +178,8 @@ int gtecat_centry_api(const struct api *api)
         api->epoch_off <= 0 || !api->clock_quick || !api->clock_lock || api->owner_off <= 0 ||
         !api->thread_ident || !api->lock_acquire || !api->lock_release || !api->err_fetch ||
         !api->err_restore || !api->clock_calls || !api->arms ||
-        !api->marks_dict || !api->key_al || !api->key_out)
+        !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
+        !api->release_buffer || !api->memoryview_type)
         return 1;
     A = *api;
     ready = 1;
@@ -613,6 +620,55 @@ python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 
+/* A one-pointer reader's ctypes array (f(p[, NULL]): noaxis): the bytes avalue(0, 1, array
+ * type, None) gives (its value in the first element; it checks the array's type and
+ * length) copied to the array's start, kept for the epoch as array()'s. */
+static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+                    int locked)
+{
+    obj call[4], v, tp = TYPE(args[0]);
+    long long ep = -1, ep0 = -1;
+    ptrdiff_t n;
+    char *mem;
+    struct aslot *s = e->acache;
+    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == 0 && s->count == 1 &&
+        s->tp == tp && s->clock == 0) {
+        v = s->value;
+        A.incref(v);
+    } else {
+        call[0] = A.zero;
+        call[1] = A.one;
+        call[2] = tp;
+        call[3] = A.none;
+        if (!locked)
+            ep0 = epoch();
+        v = A.vectorcall(e->avalue, call, 4, NULL);
+        if (!v)
+            return NULL;
+        if (TYPE(v) != A.bytes_type) {
+            A.decref(v);
+            goto python;
+        }
+        if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
+            A.decref(v);
+            return AGAIN;
+        }
+        if (s && ep >= 0)
+            keep_span(s, ep, v, tp, 0, 1, 0);
+    }
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
+    mem = AT(args[0], A.b_ptr); /* (again: Python may have run) */
+    if (n <= 0 || !mem) {
+        A.decref(v);
+        goto python;
+    }
+    memcpy(mem, (char *)v + A.bdata, (size_t)n);
+    A.decref(v);
+    return done(e->after, e->gate);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
 /* the reader entry's work (both ways of calling it, below): reader_try, then ANSWER */
 static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
 
@@ -696,6 +752,8 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
             goto python;
         p = args[0];
+        if (e->avalue && TYPE(TYPE(p)) == A.array_meta)
+            return first_of(e, args, nargs, kwnames, locked);
     } else {
         if (nargs < 2 + at || nargs > e->most + at)
             goto python;
@@ -805,11 +863,16 @@ struct raw_entry {
     ptrdiff_t write; /* 1: from the buffer into the image */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
-    /* a reader's last runs kept for their epoch (n: the offset, count: the size, clock: the
+    /* the last runs kept for their epoch (n: the offset, count: the size, clock: the
      * slave or -1), NULL: none kept.  The runs address the process image's buffer, which the
      * value function keeps alive while they are its last (and the image is replaced only by
      * the calls that make the epoch grow); a sentinel empties the slot. */
     struct aslot *cache;
+    /* a writer's changed(): called where the write changed a byte of the image (the epoch
+     * grows then, not in its value function, so a write of the bytes the image holds keeps
+     * the readers' values, its runs and the armed quick cycle); NULL: the value function
+     * makes the epoch grow at every write (nothing kept) */
+    obj changed;
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -825,15 +888,63 @@ obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnam
                (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
+/* Py_buffer (the buffer protocol's view, part of the stable ABI) and the request flags */
+struct pybuf {
+    void *buf;
+    obj obj;
+    ptrdiff_t len, itemsize;
+    int readonly, ndim;
+    char *format;
+    ptrdiff_t *shape, *strides, *suboffsets;
+    void *internal;
+};
+#define PYBUF_WRITABLE 0x0001
+#define PYBUF_FORMAT 0x0004
+#define PYBUF_C_CONTIGUOUS (0x0020 | 0x0010 | 0x0008)
+/* numpy's NPY_ARRAY_C_CONTIGUOUS and NPY_ARRAY_WRITEABLE (public ndarraytypes.h) */
+#define ND_C 0x0001
+#define ND_W 0x0400
+
+/* A memoryview's bytes as the Python fast path takes them (format "B", one dimension,
+ * C-contiguous, at least size bytes, writable to read into): the view held in *view (given
+ * back with A.release_buffer; while held the memoryview cannot be released nor its
+ * bytearray resized), its memory; NULL (nothing held, no error left) where it is not. */
+static char *view_mem(const struct raw_entry *e, obj p, long long size, struct pybuf *view)
+{
+    int flags = PYBUF_FORMAT | PYBUF_C_CONTIGUOUS | (e->write ? 0 : PYBUF_WRITABLE);
+    if (A.get_buffer(p, view, flags)) {
+        A.err_clear(); /* (released, read only, not contiguous: the Python path says) */
+        return NULL;
+    }
+    if (view->ndim != 1 || view->itemsize != 1 || view->len < size || !view->buf ||
+        !view->format || view->format[0] != 'B' || view->format[1]) {
+        A.release_buffer(view);
+        return NULL;
+    }
+    return (char *)view->buf;
+}
+
 /* The buffer a raw entry copies into or out of (target: p, or the array of a byref of one
  * with no offset), or NULL where this entry does not take it.  Looked up before the value
  * function (the shape) and again after it: the value function is Python, and meanwhile
  * another thread or a collector callback may resize a bytearray or a ctypes array
  * (ctypes.resize moves its memory); nothing of Python runs between the second look-up and
- * the copy. */
+ * the copy.  A numpy array is the Python fast path's: exactly an ndarray of numpy's uint8,
+ * one dimension, C-contiguous, at least size elements, writable to read into (a memoryview
+ * has its own look-up: view_mem). */
 static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long size)
 {
     obj t = TYPE(target);
+    if (t == A.ndarray_type && A.np_u8) {
+        int fl;
+        if (target != p || *(int *)((char *)p + A.nd_nd) != 1 || !AT(p, A.nd_dims) ||
+            *(ptrdiff_t *)AT(p, A.nd_dims) < size || (obj)AT(p, A.nd_descr) != A.np_u8)
+            return NULL;
+        fl = *(int *)((char *)p + A.nd_flags);
+        if (!(fl & ND_C) || (!e->write && !(fl & ND_W)))
+            return NULL;
+        return AT(p, A.nd_data);
+    }
     if (t == A.bytearray_type || (e->write && t == A.bytes_type)) {
         if (target != p || *(ptrdiff_t *)((char *)p + A.bsize) < size)
             return NULL;
@@ -850,12 +961,14 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             int locked)
 {
     ptrdiff_t at = e->io, k, n;
-    obj p, target, v, call[4];
+    obj p, target, v, call[4], res;
     const int64_t *runs;
     long long size, off = 0, slave = -1, ep = -1, ep0 = -1;
-    int over = 0;
+    int over = 0, mv = 0, diff = 0;
     char *mem;
-    struct aslot *s = e->write ? NULL : e->cache; /* (a write's value makes the epoch grow) */
+    struct pybuf view;
+    /* (a write's runs are kept only where the write makes the epoch grow itself) */
+    struct aslot *s = e->write && !e->changed ? NULL : e->cache;
 
     if (!ready || kwnames || nargs != 3 + at || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -877,8 +990,14 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             A.err_clear();
         goto python;
     }
-    if (!raw_mem(e, p, target, size))
+    if (TYPE(target) == A.memoryview_type) {
+        /* (held from here to the copy: nothing can release or resize it meanwhile) */
+        if (target != p || !view_mem(e, p, size, &view))
+            goto python;
+        mv = 1;
+    } else if (!raw_mem(e, p, target, size)) {
         goto python;
+    }
     if (s) {
         off = A.as_ll(args[at], &over);
         if (!over && at)
@@ -900,8 +1019,11 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
     if (!locked)
         ep0 = epoch();
     v = A.vectorcall(e->value, call, (size_t)(3 + at), NULL);
-    if (!v)
+    if (!v) {
+        if (mv)
+            A.release_buffer(&view);
         return NULL; /* (the value's own error, as the Python path would raise it) */
+    }
     if (v == e->sentinel || TYPE(v) != A.bytes_type) {
         if (s && s->value) { /* (the slot empties: its runs may be of another image) */
             obj old = s->value, oldtp = s->tp;
@@ -912,9 +1034,11 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
         goto drop;
     }
     /* (a read: the runs are of the image of the epoch it began in; a write's value makes the
-     * epoch grow itself) */
-    if (!locked && (e->write ? elsewhere(e->gate) : !stands(e->gate, ep0))) {
+     * epoch grow itself, or its changed() does once it has written) */
+    if (!locked && (e->write && !e->changed ? elsewhere(e->gate) : !stands(e->gate, ep0))) {
         A.decref(v);
+        if (mv)
+            A.release_buffer(&view);
         return AGAIN;
     }
     if (s && ep >= 0)
@@ -925,7 +1049,7 @@ have:
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
-    mem = raw_mem(e, p, target, size); /* (again: Python ran) */
+    mem = mv ? (char *)view.buf : raw_mem(e, p, target, size); /* (again: Python ran) */
     if (!mem)
         goto drop;
     for (k = 0; k < n / 24; k++) {
@@ -936,17 +1060,33 @@ have:
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         char *image = (char *)(intptr_t)r[1];
-        if (e->write)
-            memcpy(image, mem + r[0], (size_t)r[2]);
-        else
+        if (!e->write)
             memcpy(mem + r[0], image, (size_t)r[2]);
+        else if (!e->changed)
+            memcpy(image, mem + r[0], (size_t)r[2]);
+        else if (memcmp(image, mem + r[0], (size_t)r[2])) {
+            memcpy(image, mem + r[0], (size_t)r[2]);
+            diff = 1;
+        }
     }
     A.decref(v);
+    if (mv)
+        A.release_buffer(&view);
+    if (diff) { /* (the image changed: what the readers kept, the armed cycle, ask again) */
+        res = A.vectorcall(e->changed, NULL, 0, NULL);
+        if (!res)
+            return NULL;
+        A.decref(res);
+    }
     return done(e->after, e->gate);
 
 drop:
     A.decref(v);
 python:
+    if (mv) {
+        A.release_buffer(&view);
+        mv = 0;
+    }
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 
