@@ -230,6 +230,15 @@ def _crd_push(name: str) -> bool:
 _SMALL_BANK = 32
 #: the planned values :meth:`AxisBank._materialise` makes: (its Trap table, its Jog value)
 _PLANNED = {"prf_p": ("t_p", "jp"), "prf_v": ("t_v", "jv"), "prf_a": ("t_a", "ja")}
+#: AxisBank.row_value: the values made row by row (their place in the row's tuple, the maker)
+_ROW_VALUES: dict[str, tuple[int, Any]] = {
+    "enc_vel": (0, lambda b, r: b._enc_rates_row(r)),
+    "enc_acc": (1, lambda b, r: b._enc_rates_row(r)),
+}
+#: ... and the planned values (AxisBank._planned_one: which of the three)
+_ROW_PLANNED = {"prf_p": 0, "prf_v": 1, "prf_a": 2}
+#: ... and the arrays whose list is the array's own (AxisBank._make_list's last case)
+_ROW_ITEMS = frozenset({"a_last", "enc_pos"})
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -1807,6 +1816,31 @@ class AxisBank:
             lst = lists[name] = self._make_list(name)
         return lst[r]
 
+    def row_value(self, name: str, r: int) -> Any:
+        """``value(name, r)`` for a reader of one axis (the C entries ask it once a cycle
+        in the auto clock): in a bank of a few rows, row ``r``'s value alone in Python
+        scalars (the same operations as the list's, :meth:`_planned_row` and
+        :meth:`_enc_rates_row` as a release takes them), not every row's list; else, or
+        where the list is made already, the list's."""
+        lst = self._lists.get(name)
+        if lst is not None:
+            return lst[r]
+        if self.n > _SMALL_BANK:
+            return self.value(name, r)
+        if name == "sts":  # (the flags only tested: numpy's bools; the latched word an int)
+            m, j, a, f = self.moving[r], self.jog[r], self.arrived[r], self.frz[r]
+            lt = self.latched.item(r)
+            return (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
+        k = _ROW_PLANNED.get(name)
+        if k is not None:
+            return self._planned_one(r, k)
+        row = _ROW_VALUES.get(name)
+        if row is not None:
+            return row[1](self, r)[row[0]]
+        if name in _ROW_ITEMS:
+            return getattr(self, name).item(r)
+        return self.value(name, r)
+
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
@@ -2168,15 +2202,23 @@ class AxisBank:
         """The bookkeeping of :meth:`run_cycles` after one cycle the kernel committed in a
         quick cycle (gtecat.controller.core.Controller.quick_book; ``rc`` its code), with
         :meth:`_after_kernel`'s for one cycle inline.  True: the next cycle may be a quick
-        one too (none declined, no table for Python to fill)."""
-        self._declined = declined = bool(rc)
-        self._countdown -= 1 - self._settled
-        self._settled = False
+        one too (none declined, no table for Python to fill).  (A quick cycle runs only
+        where the last one was not declined: :meth:`Controller._quick_kernel` asks, and an
+        armed one was armed after a cycle that was not.)"""
+        # (each cycle of a polling loop in the auto clock runs this: the counts that stay
+        # as they are - a zero added, a flag already so - are not written)
+        if rc:
+            self._declined = True
+        if self._settled:  # (its count of the first cycle: in settle)
+            self._settled = False
+        else:
+            self._countdown -= 1
         self._refill_in -= 1
         self._lists = {}  # (a new one: _lists' docs)
         csp = self.csp
         csp.cycles += 1
-        csp._din_safe = 0
+        if csp._din_safe:
+            csp._din_safe = 0
         if csp.any_fe:
             csp.fe_running = True
         if k._io[OUT_FIN]:
@@ -2185,11 +2227,14 @@ class AxisBank:
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         self.kernel_cycles += 1
-        self.homing_rows_run += self.n_hm
-        self.rest_rows_run += self.n_rest
-        self.frozen_rows_run += self.n_frz
+        if self.n_hm:
+            self.homing_rows_run += self.n_hm
+        if self.n_rest:
+            self.rest_rows_run += self.n_rest
+        if self.n_frz:
+            self.frozen_rows_run += self.n_frz
         self.many_cycles += 1
-        return not declined and (not self.n_moving or self._c_fill)
+        return not rc and (not self.n_moving or self._c_fill)
 
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
         """What the numpy cycle does besides its arithmetic, after compiled cycles."""
@@ -2290,15 +2335,24 @@ class AxisBank:
         i = int(self.t_idx[r])
         return float(self._t_p1[i]), float(self._t_v1[i]), float(self._t_a1[i])
 
+    def _planned_one(self, r: int, k: int) -> float:
+        """``_planned_row(r)[k]`` alone (0: the position, 1: the speed, 2: the
+        acceleration): the same tests in the same order of precedence."""
+        if self.n_hm and self.hm.item(r) and self.alive.item(r):
+            return self.res[r].prf_link.source(self.a_last.item(r)) if k == 0 else 0.0
+        if self.n_jog and self.jog.item(r):
+            return (self.jp, self.jv, self.ja)[k].item(r)
+        return (self._t_p1, self._t_v1, self._t_a1)[k].item(self.t_idx.item(r))
+
     def _enc_rates_row(self, r: int) -> tuple[float, float]:
         """Row ``r``'s encoder speed and acceleration, :meth:`_enc_rates`'s operations in
         Python floats (the same IEEE divisions and subtraction)."""
         t = self.T
-        cnt = self.bank_cycles - int(self.claim_cycle[r])
+        cnt = self.bank_cycles - self.claim_cycle.item(r)
         if cnt < 1:
-            return float(self.enc_vel[r]), float(self.enc_acc[r])
-        v1 = float(self.enc_step1[r]) / t
-        v0 = float(self.enc_step0[r]) / t if cnt >= 2 else float(self.enc_vel[r])
+            return self.enc_vel.item(r), self.enc_acc.item(r)
+        v1 = self.enc_step1.item(r) / t
+        v0 = self.enc_step0.item(r) / t if cnt >= 2 else self.enc_vel.item(r)
         return v1, (v1 - v0) / t
 
     def _planned(self, name: str) -> np.ndarray:

@@ -649,14 +649,8 @@ class Controller:
         again = bank.quick_cycle_done(k, rc)  # type: ignore[union-attr]
         self.master.cycles += 1  # type: ignore[union-attr]
         epoch = EPOCH.n + 1
-        cycles = clock.cycles + 1
-        self._steady_seen = (
-            epoch,
-            cycles,
-            VirtualSlave.al_changes,
-            VirtualSlave.outside_changes,
-        )
-        clock.cycles = cycles
+        clock.cycles = cycles = clock.cycles + 1
+        self._steady_seen = (epoch, cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
         q = clock.quick
         clock.now_ns = now = clock.now_ns + q[2]
         EPOCH.n = epoch  # (clock.counted: readers_changed)

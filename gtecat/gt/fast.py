@@ -459,14 +459,23 @@ def fast_reader(
         ``clock`` is 1 (pClock given) the clock's value as ``many`` writes it (int64), else
         _NO (the Python path answers)."""
 
+        #: the last shape's array type, count and packer (a polling loop repeats its shape)
+        last: list[Any] = [None, 0, None]
+
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
-            pack = packers.get((tp, count))
-            if pack is None:
-                if not (is_array(tp) and 1 <= count <= tp._length_):
-                    return _NO
-                # (the array's own element type, natively)
-                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
+            seen = last  # (one read: another thread may replace it meanwhile)
+            if tp is seen[0] and count == seen[1]:
+                pack = seen[2]
+            else:
+                pack = packers.get((tp, count))
+                if pack is None:
+                    if not (is_array(tp) and 1 <= count <= tp._length_):
+                        return _NO
+                    # (the array's own element type, natively)
+                    pack = struct.Struct(f"@{count}{tp._type_._type_}").pack
+                    packers[tp, count] = pack
+                last[:] = [tp, count, pack]
             if clock is not None and not spans:
                 return _NO
             if count == 1:
@@ -486,8 +495,11 @@ def fast_reader(
             except struct.error:  # (a value the element does not hold: the Python path)
                 return _NO
             session.last = None
-            if clock is not None:  # (the table path's value, clock_out's)
-                out += _CLOCK_VALUE.pack(GATED[0].clock_ms() & 0xFFFFFFFF)
+            if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
+                ctl = GATED[0]
+                out += _CLOCK_VALUE.pack(
+                    ((ctl.clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+                )
             return out
 
         return f
@@ -715,7 +727,7 @@ def _linked(bank_list: str, own: str, from_bank: str) -> tuple[str, ...]:
         f"    v = {own}",
         "else:",
         f"    lst = b._lists.get({bank_list!r})",
-        f"    x = b.value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
+        f"    x = b.row_value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
         f"    v = {from_bank}",
     )
 
@@ -764,7 +776,7 @@ DERIVED: dict[str, tuple[str, ...]] = {
         "        v = MOVING",
         "else:",
         "    lst = b._lists.get('sts')",
-        "    v = (b.value('sts', res.bank_row) if lst is None else lst[res.bank_row]) & MOVING",
+        "    v = (b.row_value('sts', res.bank_row) if lst is None else lst[res.bank_row]) & MOVING",
     ),
     # the axis's planned position less its encoder's through the link (axis_error)
     "GT_GetAxisError": (
@@ -774,9 +786,9 @@ DERIVED: dict[str, tuple[str, ...]] = {
         "else:",
         "    row = res.bank_row",
         "    lst = b._lists.get('a_last')",
-        "    x = b.value('a_last', row) if lst is None else lst[row]",
+        "    x = b.row_value('a_last', row) if lst is None else lst[row]",
         "    lst = b._lists.get('enc_pos')",
-        "    v = x - res.enc_link.axis(b.value('enc_pos', row) if lst is None else lst[row])",
+        "    v = x - res.enc_link.axis(b.row_value('enc_pos', row) if lst is None else lst[row])",
     ),
 }
 
@@ -1008,7 +1020,7 @@ def _value_lines(env: dict[str, Any]) -> list[str]:
         *("    " + x for x in scalar),
         "else:",
         "    lst = b._lists.get(key)",
-        "    v = get(res) if lst is None else lst[res.bank_row]",
+        "    v = b.row_value(key, res.bank_row) if lst is None else lst[res.bank_row]",
     ]
     if env["to"] is not None:  # (a double: the list's float as it is, else float())
         lines += ["    if type(v) is not float:", "        v = to(v)"]
