@@ -230,13 +230,10 @@ def _crd_push(name: str) -> bool:
 _SMALL_BANK = 32
 #: the planned values :meth:`AxisBank._materialise` makes: (its Trap table, its Jog value)
 _PLANNED = {"prf_p": ("t_p", "jp"), "prf_v": ("t_v", "jv"), "prf_a": ("t_a", "ja")}
-#: AxisBank.row_value: the values made row by row (their place in the row's tuple, the maker)
-_ROW_VALUES: dict[str, tuple[int, Any]] = {
-    "enc_vel": (0, lambda b, r: b._enc_rates_row(r)),
-    "enc_acc": (1, lambda b, r: b._enc_rates_row(r)),
-}
-#: ... and the planned values (AxisBank._planned_one: which of the three)
+#: AxisBank.row_value: the values made row by row, their place in their row's tuple: the
+#: planned values (AxisBank._planned_one) and the encoder's rates (AxisBank._enc_rates_row)
 _ROW_PLANNED = {"prf_p": 0, "prf_v": 1, "prf_a": 2}
+_ROW_RATES = {"enc_vel": 0, "enc_acc": 1}
 #: ... and the arrays whose list is the array's own (AxisBank._make_list's last case)
 _ROW_ITEMS = frozenset({"a_last", "enc_pos"})
 #: the axis's mode while its drive homes (6060h = 6)
@@ -1834,9 +1831,9 @@ class AxisBank:
         k = _ROW_PLANNED.get(name)
         if k is not None:
             return self._planned_one(r, k)
-        row = _ROW_VALUES.get(name)
-        if row is not None:
-            return row[1](self, r)[row[0]]
+        k = _ROW_RATES.get(name)
+        if k is not None:
+            return self._enc_rates_row(r)[k]
         if name in _ROW_ITEMS:
             return getattr(self, name).item(r)
         return self.value(name, r)

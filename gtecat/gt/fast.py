@@ -375,13 +375,12 @@ def fast_reader(
                 lst = b._lists.get(bank_key)
                 if lst is not None or plan[4] is None:  # (no row of the bank: no list)
                     return pick(lst)
-                # not made yet this cycle: the first row's getter makes it
-                first = get(plan[4])
+                # not made yet this cycle: the bank makes it (the list the first row's
+                # getter reads its value from: AxisResources' properties of BANK_LISTS)
+                b.value(bank_key, plan[4].bank_row)
                 lst = b._lists.get(bank_key)
                 if lst is not None:
-                    values = list(pick(lst))
-                    values[plan[5]] = first
-                    return values
+                    return pick(lst)
         values: list[Any] = []
         append = values.append
         bank = lst = None
