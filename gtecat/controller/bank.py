@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import math
 import struct
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import chain, compress
@@ -378,10 +379,50 @@ class _Group:
     claimed: bool = False
 
 
+def _count(slot: int, doc: str) -> property:
+    """An int attribute kept in slot ``slot`` of the bank's :attr:`AxisBank.counts`."""
+
+    def get(self: AxisBank) -> int:
+        return self.counts[slot]
+
+    def put(self: AxisBank, n: int) -> None:
+        self.counts[slot] = n
+
+    return property(get, put, doc=doc)
+
+
+#: the bank's counts kept in :attr:`AxisBank.counts`, in this order (a quick cycle's book in
+#: C counts them: Controller.arm_quick's book)
+_COUNTS = (
+    "_countdown",
+    "_refill_in",
+    "rows_run",
+    "bank_cycles",
+    "kernel_cycles",
+    "many_cycles",
+    "homing_rows_run",
+    "rest_rows_run",
+    "frozen_rows_run",
+)
+
+
 class AxisBank:
     """The claimed axes of one controller and their cycle (module docstring)."""
 
+    _countdown = _count(0, "cycles until the next look for rows to claim (RECHECK_CYCLES)")
+    _refill_in = _count(1, "cycles until the next look for tables to fill")
+    rows_run = _count(2, "rows run, summed over the cycles")
+    bank_cycles = _count(3, "the bank's cycles")
+    kernel_cycles = _count(4, "the cycles the compiled cycle ran")
+    many_cycles = _count(5, "the cycles run many at once (runs of cycles, quick cycles)")
+    homing_rows_run = _count(6, "homing rows run, summed over the cycles")
+    rest_rows_run = _count(7, "rows at rest run, summed over the cycles")
+    frozen_rows_run = _count(8, "switched-off rows run, summed over the cycles")
+
     def __init__(self, ctl: Controller, mode: str = "auto") -> None:
+        #: the counts of :data:`_COUNTS` (their attributes), in memory compiled code adds to
+        #: (a quick cycle's book: gtecat.controller.core.Controller.arm_quick)
+        self.counts = array("q", bytes(8 * len(_COUNTS)))
         self.ctl = ctl
         self.mode = mode
         self.built = False

@@ -120,6 +120,13 @@ class _Api(ctypes.Structure):
         ("release_buffer", _VP),
         ("memoryview_type", _VP),
         ("np_u8", _VP),
+        ("clock_books", _VP),
+        ("long_from", _VP),
+        ("dict_new", _VP),
+        ("dict_set", _VP),
+        ("tuple_pack", _VP),
+        ("key_lists", _VP),
+        ("key_seen", _VP),
     ]
 
 
@@ -252,16 +259,31 @@ _CLOCKS: list[Any] = [None, None]  # (their arrays, kept alive while named)
 #: gtecat.gt.fast._quick_calls)
 CLOCK_CALLS = (ctypes.c_ssize_t * 2)()
 _CALLS: list[Any] = [None, None]  # (kept alive while named)
+#: per gate, its controller's book of the armed quick cycle in C (0: none): the int64 array
+#: gtecat.controller.core.Controller._book_in_c fills (where it says so, the entry that ran
+#: the cycle counts it itself instead of calling the book of CLOCK_CALLS)
+CLOCK_BOOKS = (ctypes.c_ssize_t * 2)()
+_BOOKS: list[Any] = [None, None]  # (kept alive while named)
 #: how many numbers a clock's quick array holds (gtecat.master.clock.Clock.quick)
-QUICK_LEN = 9
+QUICK_LEN = 11
+#: how many numbers a controller's book in C holds (Controller.quick_cbook)
+BOOK_LEN = 14
+#: the names the book in C sets in the bank's and the controller's own dicts (kept alive)
+_KEY_LISTS, _KEY_SEEN = sys.intern("_lists"), sys.intern("_steady_seen")
 #: the names of the slaves' marks, as the C entries look them up
 _KEY_AL, _KEY_OUT = "al_changes", "outside_changes"
 
 
-def set_clocks(gt: Any, gtn: Any, calls: tuple[Any, Any] = (None, None)) -> None:
+def set_clocks(
+    gt: Any,
+    gtn: Any,
+    calls: tuple[Any, Any] = (None, None),
+    books: tuple[Any, Any] = (None, None),
+) -> None:
     """The clocks behind the two gates (:data:`CLOCK_QUICK`; None: none), and per gate the
-    book of its armed quick cycle (:data:`CLOCK_CALLS`; None: none), set while the gates
-    are closed."""
+    book of its armed quick cycle (:data:`CLOCK_CALLS`; None: none) and that book in C
+    (:data:`CLOCK_BOOKS`: an int64 array of :data:`BOOK_LEN`; None: none), set while the
+    gates are closed."""
     for k, clock in enumerate((gt, gtn)):
         q = getattr(clock, "quick", None)
         if not (isinstance(q, array) and q.typecode == "q" and len(q) == QUICK_LEN):
@@ -271,6 +293,11 @@ def set_clocks(gt: Any, gtn: Any, calls: tuple[Any, Any] = (None, None)) -> None
         book = calls[k] if q is not None else None
         _CALLS[k] = book
         CLOCK_CALLS[k] = 0 if book is None else id(book)
+        cb = books[k] if book is not None else None
+        if not (isinstance(cb, array) and cb.typecode == "q" and len(cb) == BOOK_LEN):
+            cb = None
+        _BOOKS[k] = cb
+        CLOCK_BOOKS[k] = 0 if cb is None else cb.buffer_info()[0]
 
 
 def _marks_dict() -> dict:
@@ -727,6 +754,13 @@ def _load() -> tuple[Maker | None, str]:
             _address("PyBuffer_Release"),
             id(memoryview),
             _np_u8(),
+            ctypes.addressof(CLOCK_BOOKS),
+            _address("PyLong_FromLongLong"),
+            _address("PyDict_New"),
+            _address("PyDict_SetItem"),
+            _address("PyTuple_Pack"),
+            id(_KEY_LISTS),
+            id(_KEY_SEEN),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

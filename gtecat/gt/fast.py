@@ -580,6 +580,9 @@ def set_gates(gt: Any, gtn: Any) -> None:
     centry.set_clocks(
         *(c.clock if a else None for c, a in zip(new, auto, strict=True)),
         calls=tuple(_quick_calls(c) if a else None for c, a in zip(new, auto, strict=True)),  # type: ignore[arg-type]
+        books=tuple(
+            getattr(c, "quick_cbook", None) if a else None for c, a in zip(new, auto, strict=True)
+        ),  # type: ignore[arg-type]
     )
     centry.set_locks(
         *(c.clock if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))

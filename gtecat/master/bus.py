@@ -51,6 +51,7 @@ in which the axes move and the slaves' watchdogs stay fed, on both backends.
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
@@ -104,6 +105,15 @@ class Master:
     #: called with the master after every cycle (a list whose changes are seen: Hooks)
     on_cycle = hook_list("on_cycle")
 
+    @property
+    def cycles(self) -> int:
+        """The cycles run."""
+        return self.counts[0]
+
+    @cycles.setter
+    def cycles(self, n: int) -> None:
+        self.counts[0] = n
+
     def __init__(
         self,
         layout: Layout,
@@ -120,7 +130,9 @@ class Master:
         self.error: str = ""  # why the bus is not (or no longer) fully up
         self.last = CycleResult(0, 0)
         self.wkc_errors = 0
-        self.cycles = 0
+        #: [0] the cycles run (:attr:`cycles`), in memory compiled code adds to (a quick
+        #: cycle's book: gtecat.controller.core.Controller.arm_quick)
+        self.counts = array("q", (0,))
         self.emergency_count = 0
         self._wkc_bad = False
         #: cycles between recovery attempts while the working counter is short

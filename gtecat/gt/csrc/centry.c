@@ -107,6 +107,17 @@ struct api {
     void (*release_buffer)(void *);
     obj memoryview_type;
     obj np_u8;
+    /* the armed quick cycle's book in C (gtecat.controller.core.Controller._book_in_c): per
+     * gate its controller's book (0: none), and what it makes: PyLong_FromLongLong,
+     * PyDict_New, PyDict_SetItem, PyTuple_Pack and the names of the bank's lists and of the
+     * steady verdict's marks */
+    const ptrdiff_t *clock_books;
+    obj (*long_from)(long long);
+    obj (*dict_new)(void);
+    int (*dict_set)(obj, obj, obj);
+    obj (*tuple_pack)(ptrdiff_t, ...);
+    obj key_lists;
+    obj key_seen;
 };
 
 #define MAX_TYPES 16
@@ -179,7 +190,8 @@ int gtecat_centry_api(const struct api *api)
         !api->thread_ident || !api->lock_acquire || !api->lock_release || !api->err_fetch ||
         !api->err_restore || !api->clock_calls || !api->arms ||
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
-        !api->release_buffer || !api->memoryview_type)
+        !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
+        !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen)
         return 1;
     A = *api;
     ready = 1;
@@ -448,6 +460,76 @@ static int armed(const long long *q, long long pend)
     return 1;
 }
 
+/* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
+ * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
+ * objects made first (nothing counted where one cannot be), then the bank's lists anew, the
+ * steady verdict's marks, the readers' epoch, the counts, and the next cycle armed - what
+ * Controller.quick_book does in this case.  q: the clock's quick numbers (q[9] its time,
+ * q[10] its cycles).  1: booked; 0: nothing done, the Python book runs. */
+static int book_in_c(ptrdiff_t gate, long long *q)
+{
+    long long *b = (long long *)A.clock_books[gate - 1], *io, *cnt, ep, cycles, now;
+    obj lists, e, c, al, out, seen, old;
+    if (!b || b[0] != 1)
+        return 0;
+    io = (long long *)b[1];
+    if (!io[b[8]] || io[b[9]]) /* (declined, or a move ended: the Python book) */
+        return 0;
+    ep = epoch();
+    if (ep < 0)
+        return 0;
+    cycles = q[10] + 1;
+    now = q[9] + q[2];
+    lists = A.dict_new();
+    e = A.long_from(ep + 1);
+    c = A.long_from(cycles);
+    al = A.long_from(q[6]); /* (the slaves' marks as armed: armed() found them so) */
+    out = A.long_from(q[7]);
+    seen = lists && e && c && al && out ? A.tuple_pack(4, e, c, al, out) : NULL;
+    if (c)
+        A.decref(c);
+    if (al)
+        A.decref(al);
+    if (out)
+        A.decref(out);
+    if (!seen || A.dict_set((obj)b[5], A.key_lists, lists) < 0 ||
+        A.dict_set((obj)b[6], A.key_seen, seen) < 0) {
+        /* (only where memory ran out: the Python book makes them again) */
+        A.err_clear();
+        if (lists)
+            A.decref(lists);
+        if (e)
+            A.decref(e);
+        if (seen)
+            A.decref(seen);
+        return 0;
+    }
+    A.decref(lists);
+    A.decref(seen);
+    old = (obj)AT(A.epoch_obj, A.epoch_off); /* EPOCH.n = epoch + 1 (its reference: e's) */
+    *(obj *)((char *)A.epoch_obj + A.epoch_off) = e;
+    A.decref(old);
+    /* the bank's: countdown, refill, rows, cycles, the kernel's, many at once, and its
+     * homing, resting and switched-off rows */
+    cnt = (long long *)b[2];
+    cnt[0] -= 1;
+    cnt[1] -= 1;
+    cnt[2] += b[7];
+    cnt[3] += 1;
+    cnt[4] += 1;
+    cnt[5] += 1;
+    cnt[6] += b[11];
+    cnt[7] += b[12];
+    cnt[8] += b[13];
+    *(long long *)b[3] += 1; /* its drives' cycles */
+    *(long long *)b[4] += 1; /* the master's */
+    q[10] = cycles;
+    q[9] = now;
+    io[b[10]] = now; /* (the next cycle's call as this one's) */
+    q[4] = ep + 1;   /* armed again, for the new epoch */
+    return 1;
+}
+
 /* The armed quick cycle where the call's latency makes a cycle due: the clock's lock taken
  * (hold: it may wait for another thread's call or cycles, as after() would), armed() asked
  * again with the lock held, the kernel's cycle run here and book(after, rc) doing the rest
@@ -476,6 +558,12 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     q[4] = 0; /* (the book arms the next one) */
     q[0] += q[1] - q[2];
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
+    if (!rc && book_in_c(gate, q)) {
+        A.incref(A.zero);
+        *res = A.zero;
+        let_go(release);
+        return 1;
+    }
     args[0] = after;
     args[1] = rc ? A.one : A.zero;
     A.incref(book); /* (the gates may change while it runs) */

@@ -9,6 +9,7 @@ from ctypes import byref, c_double, c_long, c_ubyte
 import pytest
 
 from gtecat import gt
+from gtecat.controller.epoch import EPOCH
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.slave import VirtualSlave
 from gtecat.eni.model import Identity
@@ -200,13 +201,23 @@ def _moves_and_polls(ctl, watch: bool) -> list:
                 gt.GT_GetPrfPos(ax, byref(d))
                 gt.GT_GetEncPos(3 - ax, byref(c_double()))
                 seen.append((s.value, d.value))
+            if i % 97 == 0:  # (a span: read from the bank's lists of the cycle)
+                span = (c_double * 2)()
+                assert gt.GT_GetPrfPos(1, span, 2) == 0
+                seen.append(tuple(span))
     seen.append((ctl.clock.cycles, ctl.clock.now_ns, ctl.master.cycles))
+    bank = ctl.bank
+    seen.append((bank.rows_run, bank.bank_cycles, bank.frozen_rows_run, bank.csp.cycles))
+    seen.append(bytes(ctl.master.image.buffer))
     return seen
 
 
 def test_quick_cycles_give_what_the_general_way_gives():
     """The same calls with the quick cycles and with every cycle the general way (a watch
-    hook that does nothing): the same values read, the same clock, the same cycles."""
+    hook that does nothing): the same values read, the same clock, the same cycles, the
+    bank's and its drives' counts, the same process image.  The quick ones counted by the
+    entries themselves where nothing but counting was to do (Controller._book_in_c): the
+    readers' epoch one more a cycle, as the general way has it."""
     runs = []
     for watch in (False, True):
         bring_up()
@@ -216,6 +227,12 @@ def test_quick_cycles_give_what_the_general_way_gives():
         runs.append(_moves_and_polls(ctl, watch))
         if not watch:
             assert ctl.bank.many_cycles - many > 1000  # (the quick ones ran)
+            assert ctl.quick_cbook[0] == 1  # (booked in C)
+            s, cycles, epoch = c_long(), ctl.clock.cycles, EPOCH.n
+            for _ in range(2000):  # (a poll of an idle axis: every cycle a quick one)
+                gt.GT_GetSts(1, byref(s))
+            assert ctl.clock.cycles - cycles == EPOCH.n - epoch == 100
+            assert ctl.quick_cbook[0] == 1
         gt.GT_Close()
     assert runs[0] == runs[1]
 
