@@ -25,7 +25,9 @@ and the same with a segment streamed onto each every 10 cycles, bank against sca
 pairs (target: the bank no slower); ``GT_GetSts`` against building its argument,
 interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4),
 and every function with a fast path in every way a client passes its value's pointer
-(``every_call_shape_vs_arguments``, the same bar);
+(``every_call_shape_vs_arguments``, the same bar), that walk and the call shapes again with
+the controller on the auto clock (``every_call_shape_vs_arguments_auto``: each poll carries
+its share of the cycles; the same bar);
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """

@@ -460,6 +460,8 @@ def fast_reader(
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
         last: list[Any] = [None, 0, None]
+        #: the last integers packed: the packer, the values, their bytes
+        packed: list[Any] = [None, None, b""]
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -489,10 +491,16 @@ def fast_reader(
                 values = span(GATED[0], n, count, True)
                 if values is None:
                     return _NO
-            try:
-                out = pack(*values)
-            except struct.error:  # (a value the element does not hold: the Python path)
-                return _NO
+            memo = packed  # (one read: another thread may replace it meanwhile)
+            if pack is memo[0] and values == memo[1]:
+                out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)
+            else:
+                try:
+                    out = pack(*values)
+                except struct.error:  # (a value the element does not hold: the Python path)
+                    return _NO
+                if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
+                    packed[:] = [pack, values, out]
             session.last = None
             if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
                 ctl = GATED[0]
