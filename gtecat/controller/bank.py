@@ -103,6 +103,7 @@ from .bank_modes import (
     trap_steppable,
 )
 from .crd.system import Delay, Motion
+from .epoch import EPOCH
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -403,6 +404,7 @@ _COUNTS = (
     "homing_rows_run",
     "rest_rows_run",
     "frozen_rows_run",
+    "_sts_epoch",
 )
 
 
@@ -418,6 +420,11 @@ class AxisBank:
     homing_rows_run = _count(6, "homing rows run, summed over the cycles")
     rest_rows_run = _count(7, "rows at rest run, summed over the cycles")
     frozen_rows_run = _count(8, "switched-off rows run, summed over the cycles")
+    _sts_epoch = _count(
+        9,
+        "the readers' epoch the status words of _sts_last hold for (0: look at the flags); "
+        "a quick cycle booked in C that could change no flag carries it to its new epoch",
+    )
 
     def __init__(self, ctl: Controller, mode: str = "auto") -> None:
         #: the counts of :data:`_COUNTS` (their attributes), in memory compiled code adds to
@@ -797,6 +804,7 @@ class AxisBank:
         run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
         self.ctl._run_axes = list(compress(axis_list, run.tolist()))
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
         # the kernel keeps its binding: a claim and a release write the rows in place (only
         # the numpy cycle replaces arrays, and it unbinds the kernel itself)
 
@@ -1882,6 +1890,8 @@ class AxisBank:
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
+                if self._sts_epoch == EPOCH.n and self._sts_last is not None:
+                    return self._sts_last[1]  # (no flag changed since they were looked at)
                 moving, jog, arrived, frz, latched = (
                     self.moving,
                     self.jog,
@@ -1898,6 +1908,7 @@ class AxisBank:
                 )
                 last = self._sts_last
                 if last is not None and last[0] == flags:
+                    self._sts_epoch = EPOCH.n
                     return last[1]  # (the same words: every reader only reads the list)
                 words = [
                     (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
@@ -1911,6 +1922,7 @@ class AxisBank:
                     )
                 ]
                 self._sts_last = (flags, words)
+                self._sts_epoch = EPOCH.n
                 return words
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
@@ -2005,6 +2017,7 @@ class AxisBank:
         if not self.n_alive:
             return
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
         k = self.kernel
         if k is not None:
             # the plain cycle compiled; a new cycle time goes through numpy, and so does a
@@ -2232,6 +2245,7 @@ class AxisBank:
             self._settled = False
             self._refill_in -= done
             self._lists = {}  # (a new one: _lists' docs)
+            self._sts_epoch = 0  # (the status words made again)
             self._after_kernel(k, done)
             self.many_cycles += done
         return done
@@ -2253,6 +2267,7 @@ class AxisBank:
             self._countdown -= 1
         self._refill_in -= 1
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
         csp = self.csp
         csp.cycles += 1
         if csp._din_safe:
@@ -2530,6 +2545,7 @@ class AxisBank:
         self.any_lvel = self.any_lvel or bool(self.lvel[r])
         self.band_dirty = True
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
 
     def _post_events(
         self, rows: list[int], t_ns: int, dt_ns: int, p0: np.ndarray | None = None

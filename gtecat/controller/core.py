@@ -196,8 +196,9 @@ class Controller:
         #: [3] its drives' (CspBank.counts), [4] the master's, [5] the bank's and [6] this
         #: controller's own dicts (ids), [7] the bank's live rows, [8:11] io's places of the
         #: cycle done, a move ended and the next cycle's time, [11:14] its homing, resting
-        #: and switched-off rows; _quick_keep holds them
-        self.quick_cbook = array("q", bytes(8 * 14))
+        #: and switched-off rows, [14] 1 where such a cycle changes no status flag (no
+        #: in-position band); _quick_keep holds them
+        self.quick_cbook = array("q", bytes(8 * 15))
         self._quick_keep: Any = None
         #: the clock's cycle as this controller gave it (one that wraps it, an inspection
         #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
@@ -702,6 +703,9 @@ class Controller:
         b[7] = bank.n_alive  # type: ignore[union-attr]
         b[8], b[9], b[10] = _OUT_DONE, _OUT_FIN, _IN_T_NS
         b[11], b[12], b[13] = bank.n_hm, bank.n_rest, bank.n_frz  # type: ignore[union-attr]
+        # (no in-position band: a cycle that ends no move changes no status flag, so the
+        # status words the bank made stand for the next epoch: AxisBank._sts_epoch)
+        b[14] = not bank.any_band  # type: ignore[union-attr]
         b[0] = 1
 
     def arm_quick(self, k: Any) -> None:

@@ -267,7 +267,7 @@ _BOOKS: list[Any] = [None, None]  # (kept alive while named)
 #: how many numbers a clock's quick array holds (gtecat.master.clock.Clock.quick)
 QUICK_LEN = 11
 #: how many numbers a controller's book in C holds (Controller.quick_cbook)
-BOOK_LEN = 14
+BOOK_LEN = 15
 #: the names the book in C sets in the bank's and the controller's own dicts (kept alive)
 _KEY_LISTS, _KEY_SEEN = sys.intern("_lists"), sys.intern("_steady_seen")
 #: the names of the slaves' marks, as the C entries look them up

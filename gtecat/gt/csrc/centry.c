@@ -521,6 +521,8 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     cnt[6] += b[11];
     cnt[7] += b[12];
     cnt[8] += b[13];
+    if (b[14] && cnt[9] == ep) /* (the status words made for the epoch stand: no flag moved) */
+        cnt[9] = ep + 1;
     *(long long *)b[3] += 1; /* its drives' cycles */
     *(long long *)b[4] += 1; /* the master's */
     q[10] = cycles;

@@ -179,11 +179,15 @@ def test_a_cycle_wrapped_between_polls_runs_through_the_wrapper(fig5_2):
     assert len(seen) == ctl.clock.cycles - t0 > 0
 
 
-def _moves_and_polls(ctl, watch: bool) -> list:
-    """Trap moves of both axes polled through the C entries; what the readers saw."""
+def _moves_and_polls(ctl, watch: bool, band: bool = False) -> list:
+    """Trap moves of both axes polled through the C entries; what the readers saw
+    (``band``: axis 1 with an in-position band, its status word's bit 11 set in the
+    cycles, manual 11.7)."""
     if watch:  # a hook that does nothing: every cycle then goes the general way
         ctl.watch.append(lambda: None)
     gt.GT_AxisOn(2)
+    if band:
+        assert gt.GT_SetAxisBand(1, 20, 40) == 0
     s, d = c_long(), c_double()
     seen = []
     for rnd in range(4):
@@ -201,10 +205,11 @@ def _moves_and_polls(ctl, watch: bool) -> list:
                 gt.GT_GetPrfPos(ax, byref(d))
                 gt.GT_GetEncPos(3 - ax, byref(c_double()))
                 seen.append((s.value, d.value))
-            if i % 97 == 0:  # (a span: read from the bank's lists of the cycle)
-                span = (c_double * 2)()
+            if i % 97 == 0:  # (spans: read from the bank's lists of the cycle)
+                span, words = (c_double * 2)(), (c_long * 2)()
                 assert gt.GT_GetPrfPos(1, span, 2) == 0
-                seen.append(tuple(span))
+                assert gt.GT_GetSts(1, words, 2) == 0
+                seen.append((*span, *words))
     seen.append((ctl.clock.cycles, ctl.clock.now_ns, ctl.master.cycles))
     bank = ctl.bank
     seen.append((bank.rows_run, bank.bank_cycles, bank.frozen_rows_run, bank.csp.cycles))
@@ -212,7 +217,8 @@ def _moves_and_polls(ctl, watch: bool) -> list:
     return seen
 
 
-def test_quick_cycles_give_what_the_general_way_gives():
+@pytest.mark.parametrize("band", [False, True])
+def test_quick_cycles_give_what_the_general_way_gives(band):
     """The same calls with the quick cycles and with every cycle the general way (a watch
     hook that does nothing): the same values read, the same clock, the same cycles, the
     bank's and its drives' counts, the same process image.  The quick ones counted by the
@@ -224,7 +230,7 @@ def test_quick_cycles_give_what_the_general_way_gives():
         assert gt.GT_AxisOn(1) == 0
         ctl = gt.GTE_Controller()
         many = ctl.bank.many_cycles
-        runs.append(_moves_and_polls(ctl, watch))
+        runs.append(_moves_and_polls(ctl, watch, band))
         if not watch:
             assert ctl.bank.many_cycles - many > 1000  # (the quick ones ran)
             assert ctl.quick_cbook[0] == 1  # (booked in C)
