@@ -86,7 +86,7 @@ from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
-from .._attrs import own_dict
+from .._attrs import in_array, own_dict
 from ..master.clock import ClockMode
 from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
@@ -382,14 +382,7 @@ class _Group:
 
 def _count(slot: int, doc: str) -> property:
     """An int attribute kept in slot ``slot`` of the bank's :attr:`AxisBank.counts`."""
-
-    def get(self: AxisBank) -> int:
-        return self.counts[slot]
-
-    def put(self: AxisBank, n: int) -> None:
-        self.counts[slot] = n
-
-    return property(get, put, doc=doc)
+    return in_array("counts", slot, doc)
 
 
 #: the bank's counts kept in :attr:`AxisBank.counts`, in this order (a quick cycle's book in

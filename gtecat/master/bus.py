@@ -61,6 +61,7 @@ from gtecat.eni.errors import GtecatError
 from gtecat.eni.layout import Layout
 from gtecat.eni.model import InitCmd
 
+from .._attrs import in_array
 from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend
 from .clock import hook_list
@@ -105,14 +106,7 @@ class Master:
     #: called with the master after every cycle (a list whose changes are seen: Hooks)
     on_cycle = hook_list("on_cycle")
 
-    @property
-    def cycles(self) -> int:
-        """The cycles run."""
-        return self.counts[0]
-
-    @cycles.setter
-    def cycles(self, n: int) -> None:
-        self.counts[0] = n
+    cycles = in_array("counts", 0, "The cycles run.")
 
     def __init__(
         self,

@@ -29,6 +29,8 @@ from enum import StrEnum
 from operator import attrgetter
 from typing import Any
 
+from .._attrs import in_array
+
 
 class ClockMode(StrEnum):
     LOCKSTEP = "lockstep"
@@ -173,23 +175,8 @@ class Clock:
             raise ValueError("cycle time must be positive")
         self.quick[2] = ns
 
-    @property
-    def now_ns(self) -> int:
-        """Controller time since power-on, in ns."""
-        return self.quick[9]
-
-    @now_ns.setter
-    def now_ns(self, ns: int) -> None:
-        self.quick[9] = ns
-
-    @property
-    def cycles(self) -> int:
-        """The cycles this clock has run."""
-        return self.quick[10]
-
-    @cycles.setter
-    def cycles(self, n: int) -> None:
-        self.quick[10] = n
+    now_ns = in_array("quick", 9, "Controller time since power-on, in ns.")
+    cycles = in_array("quick", 10, "The cycles this clock has run.")
 
     @property
     def call_latency_ns(self) -> int:

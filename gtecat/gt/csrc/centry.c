@@ -638,15 +638,51 @@ static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *
 /* A reader's ctypes array (count from n, pClock NULL or a clock's pointer): the bytes
  * avalue(n, count, array type, clock) gives (clock None or 1: then the clock's value
  * follows the values as an int64) copied to its start, kept for the epoch. */
+/* avalue's answer where it must not stand (not bytes): the Python path answers */
+static char python_mark;
+#define PYTHON ((obj)&python_mark)
+
+/* The bytes avalue(call[0..3]) gives for a ctypes array of type call[2] (n an, count ac,
+ * clock asked: clk), kept in the entry's slot for the epoch: a new reference; PYTHON (not
+ * bytes: the Python path answers), AGAIN (another thread's cycle or call meanwhile), or NULL
+ * with the value's own error. */
+static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
+                       long long clk, int locked)
+{
+    struct aslot *s = e->acache;
+    long long ep = -1, ep0 = -1;
+    obj v, tp = call[2];
+    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
+        s->count == ac && s->tp == tp && s->clock == clk) {
+        A.incref(s->value);
+        return s->value;
+    }
+    if (!locked)
+        ep0 = epoch();
+    v = A.vectorcall(e->avalue, call, 4, NULL);
+    if (!v)
+        return NULL;
+    if (TYPE(v) != A.bytes_type) {
+        A.decref(v);
+        return PYTHON;
+    }
+    if (!locked && !stands(e->gate, ep0)) {
+        A.decref(v);
+        return AGAIN;
+    }
+    if (s && ep >= 0)
+        keep_span(s, ep, v, tp, an, ac, clk);
+    return v;
+}
+
 static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                  ptrdiff_t at, int locked)
 {
     obj call[4], v, tp = TYPE(args[at + 1]);
     ptrdiff_t n;
-    long long ep = -1, ep0 = -1, an, ac, clk = 0;
+    long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
     int csize = 0, csign = 1, over = 0;
-    struct aslot *s = e->acache;
     call[0] = args[at];
     call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
     if (TYPE(call[1]) != A.int_type)
@@ -661,29 +697,13 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
             A.err_clear();
         goto python;
     }
-    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
-        s->count == ac && s->tp == tp && s->clock == (cmem != NULL)) {
-        v = s->value;
-        A.incref(v);
-    } else {
-        call[2] = tp;
-        call[3] = cmem ? A.one : A.none;
-        if (!locked)
-            ep0 = epoch();
-        v = A.vectorcall(e->avalue, call, 4, NULL);
-        if (!v)
-            return NULL;
-        if (TYPE(v) != A.bytes_type) {
-            A.decref(v);
-            goto python;
-        }
-        if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
-            A.decref(v);
-            return AGAIN;
-        }
-        if (s && ep >= 0)
-            keep_span(s, ep, v, tp, an, ac, cmem != NULL);
-    }
+    call[2] = tp;
+    call[3] = cmem ? A.one : A.none;
+    v = array_value(e, call, an, ac, cmem != NULL, locked);
+    if (!v || v == AGAIN)
+        return v;
+    if (v == PYTHON)
+        goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize) - (cmem ? 8 : 0);
     if (n <= 0)
         goto drop;
@@ -716,36 +736,18 @@ python:
 static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                     int locked)
 {
-    obj call[4], v, tp = TYPE(args[0]);
-    long long ep = -1, ep0 = -1;
+    obj call[4], v;
     ptrdiff_t n;
     char *mem;
-    struct aslot *s = e->acache;
-    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == 0 && s->count == 1 &&
-        s->tp == tp && s->clock == 0) {
-        v = s->value;
-        A.incref(v);
-    } else {
-        call[0] = A.zero;
-        call[1] = A.one;
-        call[2] = tp;
-        call[3] = A.none;
-        if (!locked)
-            ep0 = epoch();
-        v = A.vectorcall(e->avalue, call, 4, NULL);
-        if (!v)
-            return NULL;
-        if (TYPE(v) != A.bytes_type) {
-            A.decref(v);
-            goto python;
-        }
-        if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
-            A.decref(v);
-            return AGAIN;
-        }
-        if (s && ep >= 0)
-            keep_span(s, ep, v, tp, 0, 1, 0);
-    }
+    call[0] = A.zero;
+    call[1] = A.one;
+    call[2] = TYPE(args[0]);
+    call[3] = A.none;
+    v = array_value(e, call, 0, 1, 0, locked);
+    if (!v || v == AGAIN)
+        return v;
+    if (v == PYTHON)
+        goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize);
     mem = AT(args[0], A.b_ptr); /* (again: Python may have run) */
     if (n <= 0 || !mem) {
