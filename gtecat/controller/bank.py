@@ -1883,7 +1883,7 @@ class AxisBank:
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
-                if self._sts_epoch == EPOCH.n and self._sts_last is not None:
+                if self.counts[9] == EPOCH.n and self._sts_last is not None:  # (_sts_epoch)
                     return self._sts_last[1]  # (no flag changed since they were looked at)
                 moving, jog, arrived, frz, latched = (
                     self.moving,

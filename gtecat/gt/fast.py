@@ -462,9 +462,9 @@ def fast_reader(
         last: list[Any] = [None, 0, None]
         #: the last integers packed: the packer, the values, their bytes
         packed: list[Any] = [None, None, b""]
-        #: the last span a plan of the bank answered (span()'s): the bank, n, count, the
-        #: layout, resources and axes it holds for, its first row's resources, its pick
-        lane: list[Any] = [None] * 8
+        #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
+        #: bank, n, count, the layout, resources and axes it holds for, its pick
+        lane: list[Any] = [None] * 7
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -505,11 +505,11 @@ def fast_reader(
                 ):
                     # the span of the last call, its plan as span() finds it (the same
                     # checks): the bank's list of the cycle, made where it is not yet
-                    lst = b._lists.get(bank_key)
-                    if lst is None:
-                        b.value(bank_key, ln[6].bank_row)
-                        lst = b._lists.get(bank_key)
-                    values = None if lst is None else ln[7](lst)
+                    lists = b._lists
+                    lst = lists.get(bank_key)
+                    if lst is None:  # (AxisBank.value's making of it, without its frame)
+                        lst = lists[bank_key] = b._make_list(bank_key)
+                    values = ln[6](lst)
                 else:
                     values = None
                 if values is None:
@@ -525,7 +525,7 @@ def fast_reader(
                         and plan[1] is ctl.resources
                         and plan[2] is ctl.axes
                     ):
-                        lane[:] = [b, n, count, plan[0], plan[1], plan[2], plan[4], plan[3]]
+                        lane[:] = [b, n, count, plan[0], plan[1], plan[2], plan[3]]
             memo = packed  # (one read: another thread may replace it meanwhile)
             if pack is memo[0] and values == memo[1]:
                 out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)
