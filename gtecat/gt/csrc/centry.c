@@ -10,11 +10,16 @@
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
  * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
- * of their own: a ctypes array (or byref of one, no offset), a bytearray (or, to write from,
- * bytes) long enough, and plain ints checked here, the
- * runs of the range in the process image from one Python call (value(offset, size, type), as
- * int64 triples in a bytes object: that function checks everything else, the array's type
- * and size included), and the bytes copied run by run with memcpy.
+ * of their own: a ctypes array (or byref of one, no offset), a bytearray, a numpy uint8
+ * array or a memoryview of bytes (or, to write from, bytes) long enough, and plain ints
+ * checked here, the runs of the range in the process image from one Python call
+ * (value(offset, size, type), as int64 triples in a bytes object: that function checks
+ * everything else, the array's type and size included), and the bytes copied run by run
+ * with memcpy; a write copies and makes the readers' epoch grow only where a byte differs.
+ *
+ * In the auto clock an entry whose call's latency makes a cycle due runs the armed quick
+ * cycle itself (quick_cycle), and books it itself where its controller's book says that
+ * only counting is to do (book_in_c); otherwise the controller's Python book follows.
  *
  * No Python header: where the interpreter keeps a pointer object's address and object, an
  * object's type, a ctypes object's memory and a float's value, and the C API's functions, are
