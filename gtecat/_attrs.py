@@ -11,6 +11,8 @@ quick way (18 ns), and a later ``vars()`` returns that dict without making anoth
 
 from __future__ import annotations
 
+from operator import attrgetter
+
 
 def own_dict(obj: object) -> None:
     """Give ``obj`` its attributes in a dict of its own (nothing for an object with slots
@@ -21,3 +23,18 @@ def own_dict(obj: object) -> None:
     except AttributeError:
         return
     object.__setattr__(obj, "__dict__", dict(d))
+
+
+def in_array(where: str, slot: int, doc: str) -> property:
+    """An int attribute kept in slot ``slot`` of the object's int64 array attribute ``where``
+    (``array('q')``): memory compiled code reads and adds to without Python (the auto
+    clock's quick cycle counts the clock's, the master's and the axis bank's cycles so)."""
+    arr = attrgetter(where)
+
+    def get(self: object) -> int:
+        return arr(self)[slot]  # type: ignore[no-any-return]
+
+    def put(self: object, n: int) -> None:
+        arr(self)[slot] = n
+
+    return property(get, put, doc=doc)

@@ -25,7 +25,9 @@ and the same with a segment streamed onto each every 10 cycles, bank against sca
 pairs (target: the bank no slower); ``GT_GetSts`` against building its argument,
 interleaved, and every call shape of the fast path likewise (the worst ratio is held to 4),
 and every function with a fast path in every way a client passes its value's pointer
-(``every_call_shape_vs_arguments``, the same bar);
+(``every_call_shape_vs_arguments``, the same bar), that walk and the call shapes again with
+the controller on the auto clock (``every_call_shape_vs_arguments_auto``: each poll carries
+its share of the cycles; the same bar);
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -445,21 +447,33 @@ def every_shape(
 
 
 def bench_every_shape(
-    seconds: float = 20.0, block: int = 200, names: Sequence[str] | None = None
+    seconds: float = 20.0,
+    block: int = 200,
+    names: Sequence[str] | None = None,
+    *,
+    clock: str = "lockstep",
+    raw: bool = False,
 ) -> dict[str, object]:
-    """:func:`every_shape` on figure 5-2's bus (lockstep, axis 1 on), each against building
-    its arguments in alternating blocks; ``worst`` the largest ratio, ``above_4`` the shapes
-    above the bar."""
+    """:func:`every_shape` on figure 5-2's bus (axis 1 on; ``clock``: the controller's clock,
+    ``raw``: with :data:`CALL_SHAPES` too - the raw image functions' shapes among them),
+    each against building its arguments in alternating blocks; ``worst`` the largest ratio,
+    ``above_4`` the shapes above the bar.  On the auto clock every call costs its host
+    latency of controller time, so a call's figure carries its share of the cycles that run
+    (one 1 ms cycle every 20 calls)."""
     from gtecat import gt
 
     gt.GT_Close()
-    gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock="lockstep", log="")
+    gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock=clock, log="")
     gt.GT_InitEcatComm()
     gt.GTE_Wait(60)
     gt.GT_StartEcatComm()
     gt.GT_AxisOn(1)
+    gt.GTE_Wait(20)
     try:
         pairs, skipped = every_shape(names)
+        if raw:
+            env = _shape_env()
+            pairs |= {k: (*v, env) for k, v in CALL_SHAPES.items()}
         shapes = _time_pairs(pairs, seconds, block)
     finally:
         gt.GT_Close()
@@ -851,6 +865,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         ),
         "every_call_shape_vs_arguments": lambda: _figure(
             bench_every_shape(10 * seconds), "worst", 4, at_most=True
+        ),
+        "every_call_shape_vs_arguments_auto": lambda: _figure(
+            bench_every_shape(12 * seconds, clock="auto", raw=True), "worst", 4, at_most=True
         ),
         "rss_128_axes_moving": lambda: _figure(
             bench_rss(128, min(seconds, 1.0)), "mb_per_axis", 0.1, at_most=True

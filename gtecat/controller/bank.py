@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import math
 import struct
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import chain, compress
@@ -85,7 +86,7 @@ from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
-from .._attrs import own_dict
+from .._attrs import in_array, own_dict
 from ..master.clock import ClockMode
 from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
@@ -102,6 +103,7 @@ from .bank_modes import (
     trap_steppable,
 )
 from .crd.system import Delay, Motion
+from .epoch import EPOCH
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -232,6 +234,12 @@ def _crd_push(name: str) -> bool:
 _SMALL_BANK = 32
 #: the planned values :meth:`AxisBank._materialise` makes: (its Trap table, its Jog value)
 _PLANNED = {"prf_p": ("t_p", "jp"), "prf_v": ("t_v", "jv"), "prf_a": ("t_a", "ja")}
+#: AxisBank.row_value: the values made row by row, their place in their row's tuple: the
+#: planned values (AxisBank._planned_one) and the encoder's rates (AxisBank._enc_rates_row)
+_ROW_PLANNED = {"prf_p": 0, "prf_v": 1, "prf_a": 2}
+_ROW_RATES = {"enc_vel": 0, "enc_acc": 1}
+#: ... and the arrays whose list is the array's own (AxisBank._make_list's last case)
+_ROW_ITEMS = frozenset({"a_last", "enc_pos"})
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -374,10 +382,49 @@ class _Group:
     claimed: bool = False
 
 
+def _count(slot: int, doc: str) -> property:
+    """An int attribute kept in slot ``slot`` of the bank's :attr:`AxisBank.counts`."""
+    return in_array("counts", slot, doc)
+
+
+#: the bank's counts kept in :attr:`AxisBank.counts`, in this order (a quick cycle's book in
+#: C counts them: Controller.arm_quick's book)
+_COUNTS = (
+    "_countdown",
+    "_refill_in",
+    "rows_run",
+    "bank_cycles",
+    "kernel_cycles",
+    "many_cycles",
+    "homing_rows_run",
+    "rest_rows_run",
+    "frozen_rows_run",
+    "_sts_epoch",
+)
+
+
 class AxisBank:
     """The claimed axes of one controller and their cycle (module docstring)."""
 
+    _countdown = _count(0, "cycles until the next look for rows to claim (RECHECK_CYCLES)")
+    _refill_in = _count(1, "cycles until the next look for tables to fill")
+    rows_run = _count(2, "rows run, summed over the cycles")
+    bank_cycles = _count(3, "the bank's cycles")
+    kernel_cycles = _count(4, "the cycles the compiled cycle ran")
+    many_cycles = _count(5, "the cycles run many at once (runs of cycles, quick cycles)")
+    homing_rows_run = _count(6, "homing rows run, summed over the cycles")
+    rest_rows_run = _count(7, "rows at rest run, summed over the cycles")
+    frozen_rows_run = _count(8, "switched-off rows run, summed over the cycles")
+    _sts_epoch = _count(
+        9,
+        "the readers' epoch the status words of _sts_last hold for (0: look at the flags); "
+        "a quick cycle booked in C that could change no flag carries it to its new epoch",
+    )
+
     def __init__(self, ctl: Controller, mode: str = "auto") -> None:
+        #: the counts of :data:`_COUNTS` (their attributes), in memory compiled code adds to
+        #: (a quick cycle's book: gtecat.controller.core.Controller.arm_quick)
+        self.counts = array("q", bytes(8 * len(_COUNTS)))
         self.ctl = ctl
         self.mode = mode
         self.built = False
@@ -760,6 +807,7 @@ class AxisBank:
         run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
         self.ctl._run_axes = list(compress(axis_list, run.tolist()))
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
         # the kernel keeps its binding: a claim and a release write the rows in place (only
         # the numpy cycle replaces arrays, and it unbinds the kernel itself)
 
@@ -1949,9 +1997,36 @@ class AxisBank:
             lst = lists[name] = self._make_list(name)
         return lst[r]
 
+    def row_value(self, name: str, r: int) -> Any:
+        """``value(name, r)`` for a reader of one axis (the C entries ask it once a cycle
+        in the auto clock): in a bank of a few rows, row ``r``'s value alone in Python
+        scalars (the same operations as the list's, :meth:`_planned_row` and
+        :meth:`_enc_rates_row` as a release takes them), not every row's list; else, or
+        where the list is made already, the list's."""
+        lst = self._lists.get(name)
+        if lst is not None:
+            return lst[r]
+        if self.n > _SMALL_BANK:
+            return self.value(name, r)
+        if name == "sts":  # (the flags only tested: numpy's bools; the latched word an int)
+            m, j, a, f = self.moving[r], self.jog[r], self.arrived[r], self.frz[r]
+            lt = self.latched.item(r)
+            return (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
+        k = _ROW_PLANNED.get(name)
+        if k is not None:
+            return self._planned_one(r, k)
+        k = _ROW_RATES.get(name)
+        if k is not None:
+            return self._enc_rates_row(r)[k]
+        if name in _ROW_ITEMS:
+            return getattr(self, name).item(r)
+        return self.value(name, r)
+
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
+                if self.counts[9] == EPOCH.n and self._sts_last is not None:  # (_sts_epoch)
+                    return self._sts_last[1]  # (no flag changed since they were looked at)
                 moving, jog, arrived, frz, latched = (
                     self.moving,
                     self.jog,
@@ -1968,6 +2043,7 @@ class AxisBank:
                 )
                 last = self._sts_last
                 if last is not None and last[0] == flags:
+                    self._sts_epoch = EPOCH.n
                     return last[1]  # (the same words: every reader only reads the list)
                 words = [
                     (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
@@ -1981,14 +2057,23 @@ class AxisBank:
                     )
                 ]
                 self._sts_last = (flags, words)
+                self._sts_epoch = EPOCH.n
                 return words
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
             return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
-            vel, acc = self._enc_rates()
-            return (vel if name == "enc_vel" else acc).tolist()
+            if self.n <= _SMALL_BANK:  # (a few rows: Python floats, no numpy temporaries)
+                vel, acc = self._enc_rates_lists()
+                self._lists["enc_acc" if name == "enc_vel" else "enc_vel"] = (
+                    acc if name == "enc_vel" else vel
+                )
+            else:
+                vel, acc = (x.tolist() for x in self._enc_rates())
+            return vel if name == "enc_vel" else acc
         if name == "axis_enc":
+            if self.n <= _SMALL_BANK:
+                return self._link_list(self.enc_pos, self.enc_ratio, self.enc_off)
             return self._link(self.enc_pos, self.enc_ratio, self.enc_off).tolist()
         if name == "moving":
             return (self.moving | self.jog).tolist()
@@ -2001,6 +2086,40 @@ class AxisBank:
         """:meth:`AffineLink.axis` for every row (the same three cases)."""
         one = ratio == 1.0
         return np.where(one, np.where(off != 0.0, x + off, x), ratio * x + off)
+
+    @staticmethod
+    def _link_list(x: np.ndarray, ratio: np.ndarray, off: np.ndarray) -> list[float]:
+        """:meth:`_link` as a list of Python floats, row by row (the same IEEE operations
+        in the same cases; a few rows cost less so than numpy's temporaries)."""
+        return [
+            (v + o if o != 0.0 else v) if k == 1.0 else k * v + o
+            for v, k, o in zip(x.tolist(), ratio.tolist(), off.tolist(), strict=True)
+        ]
+
+    def _enc_rates_lists(self) -> tuple[list[float], list[float]]:
+        """:meth:`_enc_rates` as lists of Python floats, row by row (the same IEEE
+        divisions and subtraction as :meth:`_enc_rates_row`)."""
+        t = self.T
+        now = self.bank_cycles
+        vel: list[float] = []
+        acc: list[float] = []
+        for c, s1, s0, v, a in zip(
+            self.claim_cycle.tolist(),
+            self.enc_step1.tolist(),
+            self.enc_step0.tolist(),
+            self.enc_vel.tolist(),
+            self.enc_acc.tolist(),
+            strict=True,
+        ):
+            cnt = now - c
+            if cnt < 1:
+                vel.append(v)
+                acc.append(a)
+            else:
+                v1 = s1 / t
+                vel.append(v1)
+                acc.append((v1 - (s0 / t if cnt >= 2 else v)) / t)
+        return vel, acc
 
     # --- the cycle -------------------------------------------------------------------------
     def settle(self) -> None:
@@ -2035,6 +2154,7 @@ class AxisBank:
         if self._tp_apply:
             self._apply_probes()
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
         k = self.kernel
         if k is not None:
             # the plain cycle compiled; a new cycle time goes through numpy, and so does a
@@ -2268,6 +2388,7 @@ class AxisBank:
             self._settled = False
             self._refill_in -= done
             self._lists = {}  # (a new one: _lists' docs)
+            self._sts_epoch = 0  # (the status words made again)
             self._after_kernel(k, done)
             self.many_cycles += done
         return done
@@ -2276,15 +2397,24 @@ class AxisBank:
         """The bookkeeping of :meth:`run_cycles` after one cycle the kernel committed in a
         quick cycle (gtecat.controller.core.Controller.quick_book; ``rc`` its code), with
         :meth:`_after_kernel`'s for one cycle inline.  True: the next cycle may be a quick
-        one too (none declined, no table for Python to fill)."""
-        self._declined = declined = bool(rc)
-        self._countdown -= 1 - self._settled
-        self._settled = False
+        one too (none declined, no table for Python to fill).  (A quick cycle runs only
+        where the last one was not declined: :meth:`Controller._quick_kernel` asks, and an
+        armed one was armed after a cycle that was not.)"""
+        # (each cycle of a polling loop in the auto clock runs this: the counts that stay
+        # as they are - a zero added, a flag already so - are not written)
+        if rc:
+            self._declined = True
+        if self._settled:  # (its count of the first cycle: in settle)
+            self._settled = False
+        else:
+            self._countdown -= 1
         self._refill_in -= 1
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
         csp = self.csp
         csp.cycles += 1
-        csp._din_safe = 0
+        if csp._din_safe:
+            csp._din_safe = 0
         if csp.any_fe:
             csp.fe_running = True
         if k._io[OUT_FIN]:
@@ -2293,11 +2423,14 @@ class AxisBank:
         self.rows_run += self.n_alive
         self.bank_cycles += 1
         self.kernel_cycles += 1
-        self.homing_rows_run += self.n_hm
-        self.rest_rows_run += self.n_rest
-        self.frozen_rows_run += self.n_frz
+        if self.n_hm:
+            self.homing_rows_run += self.n_hm
+        if self.n_rest:
+            self.rest_rows_run += self.n_rest
+        if self.n_frz:
+            self.frozen_rows_run += self.n_frz
         self.many_cycles += 1
-        return not declined and (not self.n_moving or self._c_fill)
+        return not rc and (not self.n_moving or self._c_fill)
 
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
         """What the numpy cycle does besides its arithmetic, after compiled cycles."""
@@ -2398,15 +2531,24 @@ class AxisBank:
         i = int(self.t_idx[r])
         return float(self._t_p1[i]), float(self._t_v1[i]), float(self._t_a1[i])
 
+    def _planned_one(self, r: int, k: int) -> float:
+        """``_planned_row(r)[k]`` alone (0: the position, 1: the speed, 2: the
+        acceleration): the same tests in the same order of precedence."""
+        if self.n_hm and self.hm.item(r) and self.alive.item(r):
+            return self.res[r].prf_link.source(self.a_last.item(r)) if k == 0 else 0.0
+        if self.n_jog and self.jog.item(r):
+            return (self.jp, self.jv, self.ja)[k].item(r)
+        return (self._t_p1, self._t_v1, self._t_a1)[k].item(self.t_idx.item(r))
+
     def _enc_rates_row(self, r: int) -> tuple[float, float]:
         """Row ``r``'s encoder speed and acceleration, :meth:`_enc_rates`'s operations in
         Python floats (the same IEEE divisions and subtraction)."""
         t = self.T
-        cnt = self.bank_cycles - int(self.claim_cycle[r])
+        cnt = self.bank_cycles - self.claim_cycle.item(r)
         if cnt < 1:
-            return float(self.enc_vel[r]), float(self.enc_acc[r])
-        v1 = float(self.enc_step1[r]) / t
-        v0 = float(self.enc_step0[r]) / t if cnt >= 2 else float(self.enc_vel[r])
+            return self.enc_vel.item(r), self.enc_acc.item(r)
+        v1 = self.enc_step1.item(r) / t
+        v0 = self.enc_step0.item(r) / t if cnt >= 2 else self.enc_vel.item(r)
         return v1, (v1 - v0) / t
 
     def _planned(self, name: str) -> np.ndarray:
@@ -2546,6 +2688,7 @@ class AxisBank:
         self.any_lvel = self.any_lvel or bool(self.lvel[r])
         self.band_dirty = True
         self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
 
     def _post_events(
         self, rows: list[int], t_ns: int, dt_ns: int, p0: np.ndarray | None = None

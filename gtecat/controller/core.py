@@ -72,6 +72,7 @@ from .bank_kernel import IN_DT_NS as _IN_DT_NS
 from .bank_kernel import IN_MAXC as _IN_MAXC
 from .bank_kernel import IN_T_NS as _IN_T_NS
 from .bank_kernel import OUT_DONE as _OUT_DONE
+from .bank_kernel import OUT_FIN as _OUT_FIN
 from .bank_kernel import prebuild as prebuild_kernel
 from .bank_kernel import start_deferred as start_kernel_build
 from .epoch import EPOCH
@@ -190,6 +191,15 @@ class Controller:
         self._quick_call = array("q", bytes(8 * 6))
         self._quick_fields: Any = None
         self._quick_armed: Any = None
+        #: the armed quick cycle's book in C (:meth:`_book_in_c`): [0] 1 while the entry that
+        #: runs the cycle may count it itself, [1] the kernel's io, [2] the bank's counts,
+        #: [3] its drives' (CspBank.counts), [4] the master's, [5] the bank's and [6] this
+        #: controller's own dicts (ids), [7] the bank's live rows, [8:11] io's places of the
+        #: cycle done, a move ended and the next cycle's time, [11:14] its homing, resting
+        #: and switched-off rows, [14] 1 where such a cycle changes no status flag (no
+        #: in-position band); _quick_keep holds them
+        self.quick_cbook = array("q", bytes(8 * 15))
+        self._quick_keep: Any = None
         #: the clock's cycle as this controller gave it (one that wraps it, an inspection
         #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
         self._own_cycle = self.clock._run_cycle
@@ -665,20 +675,54 @@ class Controller:
         again = bank.quick_cycle_done(k, rc)  # type: ignore[union-attr]
         self.master.cycles += 1  # type: ignore[union-attr]
         epoch = EPOCH.n + 1
-        cycles = clock.cycles + 1
-        self._steady_seen = (
-            epoch,
-            cycles,
-            VirtualSlave.al_changes,
-            VirtualSlave.outside_changes,
-        )
-        clock.cycles = cycles
+        clock.cycles = cycles = clock.cycles + 1
+        self._steady_seen = (epoch, cycles, VirtualSlave.al_changes, VirtualSlave.outside_changes)
         q = clock.quick
         clock.now_ns = now = clock.now_ns + q[2]
         EPOCH.n = epoch  # (clock.counted: readers_changed)
         if again:
             io[_IN_T_NS] = now  # (the rest of the kernel's call as this one's)
             q[4] = epoch
+            self._book_in_c(k)
+
+    def _book_in_c(self, k: Any) -> None:
+        """Whether the entry that runs the next armed cycle may count it itself, in C
+        (gtecat.gt.centry's quick cycle): where this book's Python would do no more than
+        count - the cycle not declined, no move ended (the entry looks at both), nothing
+        settled before it, no drive's input to count, the following-error timers looked at
+        already where there are any, no table for Python to fill - the entry adds to the
+        counts (the bank's,
+        its drives', the master's, the clock's), makes the bank's lists anew, sets the steady
+        verdict's marks and the readers' epoch, and arms the next cycle, as this book does.
+        These conditions change only with the epoch (a call, a cycle the general way), which
+        disarms the cycle; the book is made again at every arm."""
+        b = self.quick_cbook
+        bank = self.bank
+        csp = bank.csp  # type: ignore[union-attr]
+        master = self.master
+        if (
+            bank._settled  # type: ignore[union-attr]
+            or bank._declined  # type: ignore[union-attr]
+            or csp._din_safe
+            or (csp.any_fe and not csp.fe_running)  # (set already: it stays so)
+            or (bank.n_moving and not bank._c_fill)  # type: ignore[union-attr]
+            or master is None
+        ):
+            b[0] = 0
+            return
+        keep = (k, bank.counts, csp.counts, master.counts, vars(bank), vars(self))  # type: ignore[union-attr]
+        self._quick_keep = keep
+        b[0] = 0  # (nothing to book with while it is being made)
+        b[1] = k._args[1]
+        b[2], b[3], b[4] = (c.buffer_info()[0] for c in keep[1:4])
+        b[5], b[6] = id(keep[4]), id(keep[5])
+        b[7] = bank.n_alive  # type: ignore[union-attr]
+        b[8], b[9], b[10] = _OUT_DONE, _OUT_FIN, _IN_T_NS
+        b[11], b[12], b[13] = bank.n_hm, bank.n_rest, bank.n_frz  # type: ignore[union-attr]
+        # (no in-position band: a cycle that ends no move changes no status flag, so the
+        # status words the bank made stand for the next epoch: AxisBank._sts_epoch)
+        b[14] = not bank.any_band  # type: ignore[union-attr]
+        b[0] = 1
 
     def arm_quick(self, k: Any) -> None:
         """Arm the next due cycle for the GT readers' C entries (gtecat.gt.centry): right
@@ -708,6 +752,7 @@ class Controller:
         q[5] = ARMS[0]
         q[6] = VirtualSlave.al_changes
         q[7] = VirtualSlave.outside_changes
+        self._book_in_c(k)
         q[4] = EPOCH.n
 
     def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:

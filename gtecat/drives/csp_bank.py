@@ -27,6 +27,7 @@ a row (:func:`claimable` with ``limits``; :attr:`CspBank.lstop` carries ``limit_
 from __future__ import annotations
 
 import math
+from array import array
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -182,6 +183,15 @@ def frozen_claimable(ch: Channel) -> str:
 class CspBank:
     """The rows' state and constants as arrays; ``step`` runs one cycle of all of them."""
 
+    @property
+    def cycles(self) -> int:
+        """Cycles stepped; a row has stepped cycles - start[r] since its load."""
+        return self.counts[0]
+
+    @cycles.setter
+    def cycles(self, n: int) -> None:
+        self.counts[0] = n
+
     def __init__(self, channels: list[Channel]) -> None:
         self.channels = list(channels)
         n = len(self.channels)
@@ -191,7 +201,9 @@ class CspBank:
         self.dpos, self.dvel, self.fe_time = f(n), f(n), f(n)
         self.limited = np.zeros(n, bool)
         self.sw_limited = np.zeros(n, bool)
-        self.cycles = 0  # cycles stepped; a row has stepped cycles - start[r] since its load
+        #: [0] the cycles stepped (:attr:`cycles`), in memory compiled code adds to (the
+        #: controller's quick cycle)
+        self.counts = array("q", (0,))
         self.start = np.zeros(n, np.int64)
         self.din = np.zeros(n, np.int64)  # 60FDh of the last cycle
         self.target = np.zeros(n, np.int64)  # 607Ah of the last cycle

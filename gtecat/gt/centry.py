@@ -116,6 +116,17 @@ class _Api(ctypes.Structure):
         ("marks_dict", _VP),
         ("key_al", _VP),
         ("key_out", _VP),
+        ("get_buffer", _VP),
+        ("release_buffer", _VP),
+        ("memoryview_type", _VP),
+        ("np_u8", _VP),
+        ("clock_books", _VP),
+        ("long_from", _VP),
+        ("dict_new", _VP),
+        ("dict_set", _VP),
+        ("tuple_pack", _VP),
+        ("key_lists", _VP),
+        ("key_seen", _VP),
     ]
 
 
@@ -180,6 +191,7 @@ class _RawEntry(ctypes.Structure):
         ("gate", ctypes.c_ssize_t),
         ("after", _VP),
         ("cache", ctypes.POINTER(_ASlot)),
+        ("changed", _VP),
     ]
 
 
@@ -247,16 +259,31 @@ _CLOCKS: list[Any] = [None, None]  # (their arrays, kept alive while named)
 #: gtecat.gt.fast._quick_calls)
 CLOCK_CALLS = (ctypes.c_ssize_t * 2)()
 _CALLS: list[Any] = [None, None]  # (kept alive while named)
+#: per gate, its controller's book of the armed quick cycle in C (0: none): the int64 array
+#: gtecat.controller.core.Controller._book_in_c fills (where it says so, the entry that ran
+#: the cycle counts it itself instead of calling the book of CLOCK_CALLS)
+CLOCK_BOOKS = (ctypes.c_ssize_t * 2)()
+_BOOKS: list[Any] = [None, None]  # (kept alive while named)
 #: how many numbers a clock's quick array holds (gtecat.master.clock.Clock.quick)
-QUICK_LEN = 9
+QUICK_LEN = 11
+#: how many numbers a controller's book in C holds (Controller.quick_cbook)
+BOOK_LEN = 15
+#: the names the book in C sets in the bank's and the controller's own dicts (kept alive)
+_KEY_LISTS, _KEY_SEEN = sys.intern("_lists"), sys.intern("_steady_seen")
 #: the names of the slaves' marks, as the C entries look them up
 _KEY_AL, _KEY_OUT = "al_changes", "outside_changes"
 
 
-def set_clocks(gt: Any, gtn: Any, calls: tuple[Any, Any] = (None, None)) -> None:
+def set_clocks(
+    gt: Any,
+    gtn: Any,
+    calls: tuple[Any, Any] = (None, None),
+    books: tuple[Any, Any] = (None, None),
+) -> None:
     """The clocks behind the two gates (:data:`CLOCK_QUICK`; None: none), and per gate the
-    book of its armed quick cycle (:data:`CLOCK_CALLS`; None: none), set while the gates
-    are closed."""
+    book of its armed quick cycle (:data:`CLOCK_CALLS`; None: none) and that book in C
+    (:data:`CLOCK_BOOKS`: an int64 array of :data:`BOOK_LEN`; None: none), set while the
+    gates are closed."""
     for k, clock in enumerate((gt, gtn)):
         q = getattr(clock, "quick", None)
         if not (isinstance(q, array) and q.typecode == "q" and len(q) == QUICK_LEN):
@@ -266,6 +293,11 @@ def set_clocks(gt: Any, gtn: Any, calls: tuple[Any, Any] = (None, None)) -> None
         book = calls[k] if q is not None else None
         _CALLS[k] = book
         CLOCK_CALLS[k] = 0 if book is None else id(book)
+        cb = books[k] if book is not None else None
+        if not (isinstance(cb, array) and cb.typecode == "q" and len(cb) == BOOK_LEN):
+            cb = None
+        _BOOKS[k] = cb
+        CLOCK_BOOKS[k] = 0 if cb is None else cb.buffer_info()[0]
 
 
 def _marks_dict() -> dict:
@@ -450,6 +482,16 @@ def _numpy_at() -> tuple[int, int, int, int, int, int]:
     if not ok(*k):
         raise ValueError("a numpy array's fields are not where they are looked for")
     return (id(np.ndarray), *k)
+
+
+def _np_u8() -> int:
+    """numpy's uint8 dtype (the one object every array of bytes holds; 0: no numpy): a raw
+    entry copies into or out of such an array (csrc/centry.c raw_mem)."""
+    try:
+        import numpy as np
+    except ImportError:
+        return 0
+    return id(np.dtype(np.uint8))
 
 
 def _tuple_at(size_at: int) -> int:
@@ -708,6 +750,17 @@ def _load() -> tuple[Maker | None, str]:
             id(marks),
             id(_KEY_AL),
             id(_KEY_OUT),
+            _address("PyObject_GetBuffer"),
+            _address("PyBuffer_Release"),
+            id(memoryview),
+            _np_u8(),
+            ctypes.addressof(CLOCK_BOOKS),
+            _address("PyLong_FromLongLong"),
+            _address("PyDict_New"),
+            _address("PyDict_SetItem"),
+            _address("PyTuple_Pack"),
+            id(_KEY_LISTS),
+            id(_KEY_SEEN),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -804,14 +857,17 @@ def _load() -> tuple[Maker | None, str]:
         gate: int = NO_GATE,
         after: Callable[[], Any] | None = None,
         cache: bool = False,
+        changed: Callable[[], Any] | None = None,
     ) -> Any:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         e.after = id(after) if after is not None else None
+        e.changed = id(changed) if write and changed is not None else None
         slot = None
-        if cache and not write:  # (a writer's value makes the epoch grow: nothing kept)
+        # (a writer whose value makes the epoch grow itself: nothing kept)
+        if cache and (not write or changed is not None):
             slot = _ASlot()
             e.cache = ctypes.pointer(slot)
-        keep = (fallback, value, sentinel, after, slot)
+        keep = (fallback, value, sentinel, after, slot, changed)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
 
@@ -1217,9 +1273,15 @@ def _self_test_raw(make_raw: Maker) -> str:
     base = ctypes.addressof(image)
     U8 = ctypes.c_ubyte * 8
 
+    try:
+        import numpy as np
+    except ImportError:
+        np = None  # type: ignore[assignment]
+    taken = (U8, bytearray, bytes, memoryview, *(() if np is None else (np.ndarray,)))
+
     def value(*a: Any) -> Any:  # ([slave,] offset, size, type): inside the image, U8 only
         offset, size, tp = a[-3:]
-        if tp not in (U8, bytearray, bytes) or offset + size > 16 or size > 8:
+        if tp not in taken or offset + size > 16 or size > 8:
             return nope
         if len(a) == 4 and a[0] != 2:
             return nope
@@ -1259,8 +1321,24 @@ def _self_test_raw(make_raw: Maker) -> str:
         (bget, (4, 8), lambda: (o := bytearray(9), o, bytes([*range(4, 12), 0]))),
         (bget, (4, 8), lambda: (o := bytearray(7), o, None)),  # too short
         (bget, (4, 3), lambda: (o := bytes(8), o, None)),  # (bytes: read only)
-        (bget, (4, 3), lambda: (o := memoryview(bytearray(8)), o, None)),
+        (bget, (4, 8), lambda: (o := memoryview(bytearray(8)), o, bytes(range(4, 12)))),
+        (bget, (4, 8), lambda: (o := memoryview(bytearray(7)), o, None)),  # too short
+        (bget, (4, 3), lambda: (o := memoryview(bytes(8)), o, None)),  # (read only)
+        (bget, (4, 3), lambda: (o := memoryview(bytearray(16))[::2], o, None)),
+        (bget, (4, 2), lambda: (o := memoryview(bytearray(8)).cast("H"), o, None)),
+        (bget, (4, 3), lambda: (o := _released(), o, None)),
     ]
+    if np is not None:
+        ro = np.zeros(8, np.uint8)
+        ro.flags.writeable = False
+        cases += [
+            (bget, (4, 8), lambda: (o := np.zeros(8, np.uint8), o, bytes(range(4, 12)))),
+            (bget, (4, 8), lambda: (o := np.zeros(7, np.uint8), o, None)),  # too short
+            (bget, (4, 3), lambda: (o := np.zeros(8, np.int8), o, None)),  # another dtype
+            (bget, (4, 3), lambda: (o := np.zeros(16, np.uint8)[::2], o, None)),
+            (bget, (4, 3), lambda: (o := np.zeros((2, 8), np.uint8), o, None)),
+            (bget, (4, 3), lambda: (ro, ro, None)),  # (read only)
+        ]
     for fn, before, made in cases:
         o, p, want = made()
         args = (*before, p)
@@ -1304,7 +1382,31 @@ def _self_test_raw(make_raw: Maker) -> str:
         return "the raw entry did not write bytes into the image"
     if get(0, 2, bytes(4)) != ("python", (0, 2, bytes(4)), {}):
         return "the raw entry read into bytes"
+    # a writer that keeps its runs: the image changed (and changed() called) only where a
+    # byte differs; a write from a memoryview, a numpy array
+    hits: list[int] = []
+    del asked[:]
+    cput = make_raw(python, counted, nope, False, True, NO_GATE, None, True, lambda: hits.append(1))
+    for src, want_hits, want_asked in [
+        (bytes([9, 8]), 0, 1),  # (the bytes the image holds)
+        (bytes([9, 8]), 0, 0),  # (kept)
+        (bytes([7, 6]), 1, 0),
+        (memoryview(bytearray([5, 4])), 1, 1),
+        (memoryview(bytes([5, 4])), 0, 0),
+        *(() if np is None else [(np.array([3, 2], np.uint8), 1, 1)]),
+    ]:
+        del hits[:], asked[:]
+        got = cput(1, 2, src)
+        counts = (len(hits), len(asked))
+        if got != 0 or bytes(image)[1:3] != bytes(src) or counts != (want_hits, want_asked):
+            return f"a keeping raw writer answered {got!r} for {src!r}: {hits!r} {asked!r}"
     return ""
+
+
+def _released() -> memoryview:
+    m = memoryview(bytearray(8))
+    m.release()
+    return m
 
 
 _MAKE, REASON = _load()
@@ -1386,19 +1488,26 @@ def raw(
     write: bool,
     gate: int = NO_GATE,
     after: Callable[[], Any] | None = None,
+    changed: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
-    ctypes array (or ``byref`` of one, no offset), a bytearray of at least ``size`` bytes
-    (or bytes, where ``write``) and plain ints copies the runs that
-    ``value([slave,] offset, size, type(array))`` gives between the array and the image
-    (into the image where ``write``): ``(first byte in the array, address, bytes)`` as
+    ctypes array (or ``byref`` of one, no offset), a bytearray, a one-dimensional
+    C-contiguous numpy array of uint8 or a memoryview of format ``B`` (one dimension,
+    C-contiguous) of at least ``size`` bytes (or bytes, where ``write``; writable, where
+    not) and plain ints copies the runs that
+    ``value([slave,] offset, size, type(buffer))`` gives between the buffer and the image
+    (into the image where ``write``): ``(first byte in the buffer, address, bytes)`` as
     native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
-    where the entry must not answer (it checks the array's type and size); every other
-    call: ``fallback``; ``gate``: as :func:`reader`'s.  None where the
-    C entry is not available (:data:`REASON`)."""
+    where the entry must not answer (it checks a ctypes array's type and size); every other
+    call: ``fallback``; ``gate``: as :func:`reader`'s (a gated reader keeps its runs for
+    their epoch).  ``changed``: a writer's call where the write changed a byte of the image
+    (its ``value`` then must not make the epoch grow itself: a gated writer keeps its runs
+    for their epoch too, and a write of the bytes the image holds changes nothing); None: its
+    ``value`` makes the epoch grow.  None where the C entry is not available
+    (:data:`REASON`)."""
     if _MAKE is None:
         return None
-    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE)  # type: ignore[attr-defined]
+    return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE, changed)  # type: ignore[attr-defined]
 
 
 def multi(

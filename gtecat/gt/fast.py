@@ -28,7 +28,7 @@ from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE
-from ..controller.epoch import EPOCH
+from ..controller.epoch import EPOCH, changed
 from ..controller.motion.trap import IDLE_MODE as TRAP_IDLE
 from ..controller.motion.trap import TrapPlanner
 from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_count
@@ -375,13 +375,12 @@ def fast_reader(
                 lst = b._lists.get(bank_key)
                 if lst is not None or plan[4] is None:  # (no row of the bank: no list)
                     return pick(lst)
-                # not made yet this cycle: the first row's getter makes it
-                first = get(plan[4])
+                # not made yet this cycle: the bank makes it (the list the first row's
+                # getter reads its value from: AxisResources' properties of BANK_LISTS)
+                b.value(bank_key, plan[4].bank_row)
                 lst = b._lists.get(bank_key)
                 if lst is not None:
-                    values = list(pick(lst))
-                    values[plan[5]] = first
-                    return values
+                    return pick(lst)
         values: list[Any] = []
         append = values.append
         bank = lst = None
@@ -459,14 +458,28 @@ def fast_reader(
         ``clock`` is 1 (pClock given) the clock's value as ``many`` writes it (int64), else
         _NO (the Python path answers)."""
 
+        #: the last shape's array type, count and packer (a polling loop repeats its shape)
+        last: list[Any] = [None, 0, None]
+        #: the last integers packed: the packer, the values, their bytes
+        packed: list[Any] = [None, None, b""]
+        #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
+        #: bank, n, count, the layout, resources and axes it holds for, its pick
+        lane: list[Any] = [None] * 7
+
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
-            pack = packers.get((tp, count))
-            if pack is None:
-                if not (is_array(tp) and 1 <= count <= tp._length_):
-                    return _NO
-                # (the array's own element type, natively)
-                pack = packers[tp, count] = struct.Struct(f"@{count}{tp._type_._type_}").pack
+            seen = last  # (one read: another thread may replace it meanwhile)
+            if tp is seen[0] and count == seen[1]:
+                pack = seen[2]
+            else:
+                pack = packers.get((tp, count))
+                if pack is None:
+                    if not (is_array(tp) and 1 <= count <= tp._length_):
+                        return _NO
+                    # (the array's own element type, natively)
+                    pack = struct.Struct(f"@{count}{tp._type_._type_}").pack
+                    packers[tp, count] = pack
+                last[:] = [tp, count, pack]
             if clock is not None and not spans:
                 return _NO
             if count == 1:
@@ -478,16 +491,57 @@ def fast_reader(
                 if not spans or count > limit:
                     return _NO
                 # (the GT_ form's entry asks only while the GT_ gate is open: its controller)
-                values = span(GATED[0], n, count, True)
+                ctl = GATED[0]
+                b = ctl.bank
+                ln = lane  # (one read: another thread may replace it meanwhile)
+                if (
+                    ln[0] is b
+                    and b is not None
+                    and ln[1] == n
+                    and ln[2] == count
+                    and ln[3] == b.layout
+                    and ln[4] is ctl.resources
+                    and ln[5] is ctl.axes
+                ):
+                    # the span of the last call, its plan as span() finds it (the same
+                    # checks): the bank's list of the cycle, made where it is not yet
+                    lists = b._lists
+                    lst = lists.get(bank_key)
+                    if lst is None:  # (AxisBank.value's making of it, without its frame)
+                        lst = lists[bank_key] = b._make_list(bank_key)
+                    values = ln[6](lst)
+                else:
+                    values = None
                 if values is None:
+                    values = span(ctl, n, count, True)
+                    if values is None:
+                        return _NO
+                    plan = None if b is None else b.read_plans.get((bank_key, n, count, True))
+                    if (
+                        plan is not None
+                        and plan[3] is not None
+                        and plan[4] is not None
+                        and plan[0] == b.layout
+                        and plan[1] is ctl.resources
+                        and plan[2] is ctl.axes
+                    ):
+                        lane[:] = [b, n, count, plan[0], plan[1], plan[2], plan[3]]
+            memo = packed  # (one read: another thread may replace it meanwhile)
+            if pack is memo[0] and values == memo[1]:
+                out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)
+            else:
+                try:
+                    out = pack(*values)
+                except struct.error:  # (a value the element does not hold: the Python path)
                     return _NO
-            try:
-                out = pack(*values)
-            except struct.error:  # (a value the element does not hold: the Python path)
-                return _NO
+                if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
+                    packed[:] = [pack, values, out]
             session.last = None
-            if clock is not None:  # (the table path's value, clock_out's)
-                out += _CLOCK_VALUE.pack(GATED[0].clock_ms() & 0xFFFFFFFF)
+            if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
+                ctl = GATED[0]
+                out += _CLOCK_VALUE.pack(
+                    ((ctl.clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+                )
             return out
 
         return f
@@ -569,6 +623,9 @@ def set_gates(gt: Any, gtn: Any) -> None:
     centry.set_clocks(
         *(c.clock if a else None for c, a in zip(new, auto, strict=True)),
         calls=tuple(_quick_calls(c) if a else None for c, a in zip(new, auto, strict=True)),  # type: ignore[arg-type]
+        books=tuple(
+            getattr(c, "quick_cbook", None) if a else None for c, a in zip(new, auto, strict=True)
+        ),  # type: ignore[arg-type]
     )
     centry.set_locks(
         *(c.clock if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
@@ -715,7 +772,7 @@ def _linked(bank_list: str, own: str, from_bank: str) -> tuple[str, ...]:
         f"    v = {own}",
         "else:",
         f"    lst = b._lists.get({bank_list!r})",
-        f"    x = b.value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
+        f"    x = b.row_value({bank_list!r}, res.bank_row) if lst is None else lst[res.bank_row]",
         f"    v = {from_bank}",
     )
 
@@ -764,7 +821,7 @@ DERIVED: dict[str, tuple[str, ...]] = {
         "        v = MOVING",
         "else:",
         "    lst = b._lists.get('sts')",
-        "    v = (b.value('sts', res.bank_row) if lst is None else lst[res.bank_row]) & MOVING",
+        "    v = (b.row_value('sts', res.bank_row) if lst is None else lst[res.bank_row]) & MOVING",
     ),
     # the axis's planned position less its encoder's through the link (axis_error)
     "GT_GetAxisError": (
@@ -774,9 +831,9 @@ DERIVED: dict[str, tuple[str, ...]] = {
         "else:",
         "    row = res.bank_row",
         "    lst = b._lists.get('a_last')",
-        "    x = b.value('a_last', row) if lst is None else lst[row]",
+        "    x = b.row_value('a_last', row) if lst is None else lst[row]",
         "    lst = b._lists.get('enc_pos')",
-        "    v = x - res.enc_link.axis(b.value('enc_pos', row) if lst is None else lst[row])",
+        "    v = x - res.enc_link.axis(b.row_value('enc_pos', row) if lst is None else lst[row])",
     ),
 }
 
@@ -1008,7 +1065,7 @@ def _value_lines(env: dict[str, Any]) -> list[str]:
         *("    " + x for x in scalar),
         "else:",
         "    lst = b._lists.get(key)",
-        "    v = get(res) if lst is None else lst[res.bank_row]",
+        "    v = b.row_value(key, res.bank_row) if lst is None else lst[res.bank_row]",
     ]
     if env["to"] is not None:  # (a double: the list's float as it is, else float())
         lines += ["    if type(v) is not float:", "        v = to(v)"]
@@ -1125,10 +1182,13 @@ def fast_clock(
     if not CENTRY:
         return gt
     types = sorted(_CLOCK_INTS, key=str)
+    # (an array of one of the types ``first`` takes: its first element)
+    elements = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
     entry = centry.reader(
         gt, value, _NO, types, centry.INT, most=2, noaxis=True, gate=centry.GT_GATE,
         after=_after(advance, name, 0),
         numpy=_int_dtypes(_scalar_types(FUNCTIONS[name].params[0])),  # (as ``first``)
+        array=_first_element(lambda _: value(), elements),
     )  # fmt: skip
     if entry is None:
         return gt
@@ -1523,6 +1583,7 @@ def fast_raw(
     #: pointers, the table path's 7); a bytearray's (and bytes', to write from) the C entry
     #: checks itself
     array_sizes: dict[type, int] = {bytearray: 1 << 62, bytes: 1 << 62 if write else 0}
+    array_sizes |= {memoryview: 1 << 62, _NDARRAY: 1 << 62}  # (checked in C too)
 
     def address(slave: int, offset: int, size: int, image: Any) -> bytes | None:
         """Where a raw range (a slave's region: ``slave`` >= 0) lies in the image's buffer:
@@ -1551,9 +1612,7 @@ def fast_raw(
         if at is None:
             return _NO
         venv["LASTC"] = (offset, size, tp, image, slave, at)
-        session.last = None
-        if write:
-            EPOCH.n += 1  # (the readers' C entries ask again: epoch.py)
+        session.last = None  # (a write: the C entry makes the epoch grow where it changed)
         return at
 
     venv = {
@@ -1569,11 +1628,14 @@ def fast_raw(
         slave_memo=" and slave == last[4]" if io else "",
     )
     _gated(venv)
-    venv["EPOCH"] = EPOCH
-    exec(_compiled_code(_raw_code(code, name), f"<gt raw value {name}>"), venv)
+    # (a write's value does not make the epoch grow: its C entry does, where the write
+    # changed a byte of the image - centry.raw's changed)
+    exec(_compiled_code(code, f"<gt raw value {name}>"), venv)
     value = venv["value"]
 
-    public = centry.raw(entry, value, _NO, io, write, centry.GT_GATE, _after(advance, name, 0))
+    public = centry.raw(
+        entry, value, _NO, io, write, centry.GT_GATE, _after(advance, name, 0), changed
+    )
     if public is None:
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
@@ -2607,6 +2669,7 @@ def _noaxis_entry(
     entry = centry.reader(
         gt, value, _NO, types, centry.INT, most=1, noaxis=True, gate=centry.GT_GATE,
         after=_after(advance, name, 0), numpy=_int_dtypes(types),
+        array=_first_element(lambda _: value(), types),  # (a ctypes array: its first element)
     )  # fmt: skip
     if entry is None:
         return gt

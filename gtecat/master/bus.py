@@ -51,6 +51,7 @@ in which the axes move and the slaves' watchdogs stay fed, on both backends.
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
@@ -60,6 +61,7 @@ from gtecat.eni.errors import GtecatError
 from gtecat.eni.layout import Layout
 from gtecat.eni.model import InitCmd
 
+from .._attrs import in_array
 from ..errors import BusError, ConfigMismatch, NoSlavesError, StateError
 from .backends.base import Backend
 from .clock import hook_list
@@ -104,6 +106,8 @@ class Master:
     #: called with the master after every cycle (a list whose changes are seen: Hooks)
     on_cycle = hook_list("on_cycle")
 
+    cycles = in_array("counts", 0, "The cycles run.")
+
     def __init__(
         self,
         layout: Layout,
@@ -120,7 +124,9 @@ class Master:
         self.error: str = ""  # why the bus is not (or no longer) fully up
         self.last = CycleResult(0, 0)
         self.wkc_errors = 0
-        self.cycles = 0
+        #: [0] the cycles run (:attr:`cycles`), in memory compiled code adds to (a quick
+        #: cycle's book: gtecat.controller.core.Controller.arm_quick)
+        self.counts = array("q", (0,))
         self.emergency_count = 0
         self._wkc_bad = False
         #: cycles between recovery attempts while the working counter is short

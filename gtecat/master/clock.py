@@ -29,6 +29,8 @@ from enum import StrEnum
 from operator import attrgetter
 from typing import Any
 
+from .._attrs import in_array
+
 
 class ClockMode(StrEnum):
     LOCKSTEP = "lockstep"
@@ -130,8 +132,10 @@ class Clock:
         #: latency of a call, the cycle time, 1 while the clock shares its time with no other
         #: [4:8] a quick cycle armed for them (gtecat.controller.core.Controller.arm_quick):
         #: the readers' epoch it holds for (0: none), the generation of :data:`ARMS`, the
-        #: slaves' AL and outside changes, and the address of the armed kernel's call
-        self.quick = array("q", (0, int(call_latency_ns), 0, 1, 0, 0, 0, 0, 0))
+        #: slaves' AL and outside changes, and the address of the armed kernel's call;
+        #: [9] the controller time (:attr:`now_ns`) and [10] the cycles run (:attr:`cycles`),
+        #: which the entry that runs the armed cycle counts itself
+        self.quick = array("q", (0, int(call_latency_ns), 0, 1, 0, 0, 0, 0, 0, 0, 0))
         self.cycle_ns = cycle_ns  # (checked: whole nanoseconds, positive)
         self.mode = ClockMode(mode)
         self._cycle_fn = run_cycle
@@ -170,6 +174,9 @@ class Clock:
         if ns <= 0:
             raise ValueError("cycle time must be positive")
         self.quick[2] = ns
+
+    now_ns = in_array("quick", 9, "Controller time since power-on, in ns.")
+    cycles = in_array("quick", 10, "The cycles this clock has run.")
 
     @property
     def call_latency_ns(self) -> int:

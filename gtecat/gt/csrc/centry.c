@@ -10,11 +10,16 @@
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
  * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
- * of their own: a ctypes array (or byref of one, no offset), a bytearray (or, to write from,
- * bytes) long enough, and plain ints checked here, the
- * runs of the range in the process image from one Python call (value(offset, size, type), as
- * int64 triples in a bytes object: that function checks everything else, the array's type
- * and size included), and the bytes copied run by run with memcpy.
+ * of their own: a ctypes array (or byref of one, no offset), a bytearray, a numpy uint8
+ * array or a memoryview of bytes (or, to write from, bytes) long enough, and plain ints
+ * checked here, the runs of the range in the process image from one Python call
+ * (value(offset, size, type), as int64 triples in a bytes object: that function checks
+ * everything else, the array's type and size included), and the bytes copied run by run
+ * with memcpy; a write copies and makes the readers' epoch grow only where a byte differs.
+ *
+ * In the auto clock an entry whose call's latency makes a cycle due runs the armed quick
+ * cycle itself (quick_cycle), and books it itself where its controller's book says that
+ * only counting is to do (book_in_c); otherwise the controller's Python book follows.
  *
  * No Python header: where the interpreter keeps a pointer object's address and object, an
  * object's type, a ctypes object's memory and a float's value, and the C API's functions, are
@@ -101,6 +106,23 @@ struct api {
     obj marks_dict;
     obj key_al;
     obj key_out;
+    /* the buffer protocol (PyObject_GetBuffer, PyBuffer_Release) for a raw entry's
+     * memoryview, the memoryview type, numpy's uint8 dtype (its descr object; NULL: none) */
+    int (*get_buffer)(obj, void *, int);
+    void (*release_buffer)(void *);
+    obj memoryview_type;
+    obj np_u8;
+    /* the armed quick cycle's book in C (gtecat.controller.core.Controller._book_in_c): per
+     * gate its controller's book (0: none), and what it makes: PyLong_FromLongLong,
+     * PyDict_New, PyDict_SetItem, PyTuple_Pack and the names of the bank's lists and of the
+     * steady verdict's marks */
+    const ptrdiff_t *clock_books;
+    obj (*long_from)(long long);
+    obj (*dict_new)(void);
+    int (*dict_set)(obj, obj, obj);
+    obj (*tuple_pack)(ptrdiff_t, ...);
+    obj key_lists;
+    obj key_seen;
 };
 
 #define MAX_TYPES 16
@@ -172,7 +194,9 @@ int gtecat_centry_api(const struct api *api)
         api->epoch_off <= 0 || !api->clock_quick || !api->clock_lock || api->owner_off <= 0 ||
         !api->thread_ident || !api->lock_acquire || !api->lock_release || !api->err_fetch ||
         !api->err_restore || !api->clock_calls || !api->arms ||
-        !api->marks_dict || !api->key_al || !api->key_out)
+        !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
+        !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
+        !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen)
         return 1;
     A = *api;
     ready = 1;
@@ -441,6 +465,78 @@ static int armed(const long long *q, long long pend)
     return 1;
 }
 
+/* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
+ * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
+ * objects made first (nothing counted where one cannot be), then the bank's lists anew, the
+ * steady verdict's marks, the readers' epoch, the counts, and the next cycle armed - what
+ * Controller.quick_book does in this case.  q: the clock's quick numbers (q[9] its time,
+ * q[10] its cycles).  1: booked; 0: nothing done, the Python book runs. */
+static int book_in_c(ptrdiff_t gate, long long *q)
+{
+    long long *b = (long long *)A.clock_books[gate - 1], *io, *cnt, ep, cycles, now;
+    obj lists, e, c, al, out, seen, old;
+    if (!b || b[0] != 1)
+        return 0;
+    io = (long long *)b[1];
+    if (!io[b[8]] || io[b[9]]) /* (declined, or a move ended: the Python book) */
+        return 0;
+    ep = epoch();
+    if (ep < 0)
+        return 0;
+    cycles = q[10] + 1;
+    now = q[9] + q[2];
+    lists = A.dict_new();
+    e = A.long_from(ep + 1);
+    c = A.long_from(cycles);
+    al = A.long_from(q[6]); /* (the slaves' marks as armed: armed() found them so) */
+    out = A.long_from(q[7]);
+    seen = lists && e && c && al && out ? A.tuple_pack(4, e, c, al, out) : NULL;
+    if (c)
+        A.decref(c);
+    if (al)
+        A.decref(al);
+    if (out)
+        A.decref(out);
+    if (!seen || A.dict_set((obj)b[5], A.key_lists, lists) < 0 ||
+        A.dict_set((obj)b[6], A.key_seen, seen) < 0) {
+        /* (only where memory ran out: the Python book makes them again) */
+        A.err_clear();
+        if (lists)
+            A.decref(lists);
+        if (e)
+            A.decref(e);
+        if (seen)
+            A.decref(seen);
+        return 0;
+    }
+    A.decref(lists);
+    A.decref(seen);
+    old = (obj)AT(A.epoch_obj, A.epoch_off); /* EPOCH.n = epoch + 1 (its reference: e's) */
+    *(obj *)((char *)A.epoch_obj + A.epoch_off) = e;
+    A.decref(old);
+    /* the bank's: countdown, refill, rows, cycles, the kernel's, many at once, and its
+     * homing, resting and switched-off rows */
+    cnt = (long long *)b[2];
+    cnt[0] -= 1;
+    cnt[1] -= 1;
+    cnt[2] += b[7];
+    cnt[3] += 1;
+    cnt[4] += 1;
+    cnt[5] += 1;
+    cnt[6] += b[11];
+    cnt[7] += b[12];
+    cnt[8] += b[13];
+    if (b[14] && cnt[9] == ep) /* (the status words made for the epoch stand: no flag moved) */
+        cnt[9] = ep + 1;
+    *(long long *)b[3] += 1; /* its drives' cycles */
+    *(long long *)b[4] += 1; /* the master's */
+    q[10] = cycles;
+    q[9] = now;
+    io[b[10]] = now; /* (the next cycle's call as this one's) */
+    q[4] = ep + 1;   /* armed again, for the new epoch */
+    return 1;
+}
+
 /* The armed quick cycle where the call's latency makes a cycle due: the clock's lock taken
  * (hold: it may wait for another thread's call or cycles, as after() would), armed() asked
  * again with the lock held, the kernel's cycle run here and book(after, rc) doing the rest
@@ -469,6 +565,12 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     q[4] = 0; /* (the book arms the next one) */
     q[0] += q[1] - q[2];
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
+    if (!rc && book_in_c(gate, q)) {
+        A.incref(A.zero);
+        *res = A.zero;
+        let_go(release);
+        return 1;
+    }
     args[0] = after;
     args[1] = rc ? A.one : A.zero;
     A.incref(book); /* (the gates may change while it runs) */
@@ -541,15 +643,51 @@ static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *
 /* A reader's ctypes array (count from n, pClock NULL or a clock's pointer): the bytes
  * avalue(n, count, array type, clock) gives (clock None or 1: then the clock's value
  * follows the values as an int64) copied to its start, kept for the epoch. */
+/* avalue's answer where it must not stand (not bytes): the Python path answers */
+static char python_mark;
+#define PYTHON ((obj)&python_mark)
+
+/* The bytes avalue(call[0..3]) gives for a ctypes array of type call[2] (n an, count ac,
+ * clock asked: clk), kept in the entry's slot for the epoch: a new reference; PYTHON (not
+ * bytes: the Python path answers), AGAIN (another thread's cycle or call meanwhile), or NULL
+ * with the value's own error. */
+static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
+                       long long clk, int locked)
+{
+    struct aslot *s = e->acache;
+    long long ep = -1, ep0 = -1;
+    obj v, tp = call[2];
+    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
+        s->count == ac && s->tp == tp && s->clock == clk) {
+        A.incref(s->value);
+        return s->value;
+    }
+    if (!locked)
+        ep0 = epoch();
+    v = A.vectorcall(e->avalue, call, 4, NULL);
+    if (!v)
+        return NULL;
+    if (TYPE(v) != A.bytes_type) {
+        A.decref(v);
+        return PYTHON;
+    }
+    if (!locked && !stands(e->gate, ep0)) {
+        A.decref(v);
+        return AGAIN;
+    }
+    if (s && ep >= 0)
+        keep_span(s, ep, v, tp, an, ac, clk);
+    return v;
+}
+
 static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                  ptrdiff_t at, int locked)
 {
     obj call[4], v, tp = TYPE(args[at + 1]);
     ptrdiff_t n;
-    long long ep = -1, ep0 = -1, an, ac, clk = 0;
+    long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
     int csize = 0, csign = 1, over = 0;
-    struct aslot *s = e->acache;
     call[0] = args[at];
     call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
     if (TYPE(call[1]) != A.int_type)
@@ -564,29 +702,13 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
             A.err_clear();
         goto python;
     }
-    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
-        s->count == ac && s->tp == tp && s->clock == (cmem != NULL)) {
-        v = s->value;
-        A.incref(v);
-    } else {
-        call[2] = tp;
-        call[3] = cmem ? A.one : A.none;
-        if (!locked)
-            ep0 = epoch();
-        v = A.vectorcall(e->avalue, call, 4, NULL);
-        if (!v)
-            return NULL;
-        if (TYPE(v) != A.bytes_type) {
-            A.decref(v);
-            goto python;
-        }
-        if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
-            A.decref(v);
-            return AGAIN;
-        }
-        if (s && ep >= 0)
-            keep_span(s, ep, v, tp, an, ac, cmem != NULL);
-    }
+    call[2] = tp;
+    call[3] = cmem ? A.one : A.none;
+    v = array_value(e, call, an, ac, cmem != NULL, locked);
+    if (!v || v == AGAIN)
+        return v;
+    if (v == PYTHON)
+        goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize) - (cmem ? 8 : 0);
     if (n <= 0)
         goto drop;
@@ -609,6 +731,37 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     return done(e->after, e->gate);
 drop:
     A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* A one-pointer reader's ctypes array (f(p[, NULL]): noaxis): the bytes avalue(0, 1, array
+ * type, None) gives (its value in the first element; it checks the array's type and
+ * length) copied to the array's start, kept for the epoch as array()'s. */
+static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+                    int locked)
+{
+    obj call[4], v;
+    ptrdiff_t n;
+    char *mem;
+    call[0] = A.zero;
+    call[1] = A.one;
+    call[2] = TYPE(args[0]);
+    call[3] = A.none;
+    v = array_value(e, call, 0, 1, 0, locked);
+    if (!v || v == AGAIN)
+        return v;
+    if (v == PYTHON)
+        goto python;
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
+    mem = AT(args[0], A.b_ptr); /* (again: Python may have run) */
+    if (n <= 0 || !mem) {
+        A.decref(v);
+        goto python;
+    }
+    memcpy(mem, (char *)v + A.bdata, (size_t)n);
+    A.decref(v);
+    return done(e->after, e->gate);
 python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
@@ -696,6 +849,8 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
             goto python;
         p = args[0];
+        if (e->avalue && TYPE(TYPE(p)) == A.array_meta)
+            return first_of(e, args, nargs, kwnames, locked);
     } else {
         if (nargs < 2 + at || nargs > e->most + at)
             goto python;
@@ -805,11 +960,16 @@ struct raw_entry {
     ptrdiff_t write; /* 1: from the buffer into the image */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
-    /* a reader's last runs kept for their epoch (n: the offset, count: the size, clock: the
+    /* the last runs kept for their epoch (n: the offset, count: the size, clock: the
      * slave or -1), NULL: none kept.  The runs address the process image's buffer, which the
      * value function keeps alive while they are its last (and the image is replaced only by
      * the calls that make the epoch grow); a sentinel empties the slot. */
     struct aslot *cache;
+    /* a writer's changed(): called where the write changed a byte of the image (the epoch
+     * grows then, not in its value function, so a write of the bytes the image holds keeps
+     * the readers' values, its runs and the armed quick cycle); NULL: the value function
+     * makes the epoch grow at every write (nothing kept) */
+    obj changed;
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -825,15 +985,63 @@ obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnam
                (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
+/* Py_buffer (the buffer protocol's view, part of the stable ABI) and the request flags */
+struct pybuf {
+    void *buf;
+    obj obj;
+    ptrdiff_t len, itemsize;
+    int readonly, ndim;
+    char *format;
+    ptrdiff_t *shape, *strides, *suboffsets;
+    void *internal;
+};
+#define PYBUF_WRITABLE 0x0001
+#define PYBUF_FORMAT 0x0004
+#define PYBUF_C_CONTIGUOUS (0x0020 | 0x0010 | 0x0008)
+/* numpy's NPY_ARRAY_C_CONTIGUOUS and NPY_ARRAY_WRITEABLE (public ndarraytypes.h) */
+#define ND_C 0x0001
+#define ND_W 0x0400
+
+/* A memoryview's bytes as the Python fast path takes them (format "B", one dimension,
+ * C-contiguous, at least size bytes, writable to read into): the view held in *view (given
+ * back with A.release_buffer; while held the memoryview cannot be released nor its
+ * bytearray resized), its memory; NULL (nothing held, no error left) where it is not. */
+static char *view_mem(const struct raw_entry *e, obj p, long long size, struct pybuf *view)
+{
+    int flags = PYBUF_FORMAT | PYBUF_C_CONTIGUOUS | (e->write ? 0 : PYBUF_WRITABLE);
+    if (A.get_buffer(p, view, flags)) {
+        A.err_clear(); /* (released, read only, not contiguous: the Python path says) */
+        return NULL;
+    }
+    if (view->ndim != 1 || view->itemsize != 1 || view->len < size || !view->buf ||
+        !view->format || view->format[0] != 'B' || view->format[1]) {
+        A.release_buffer(view);
+        return NULL;
+    }
+    return (char *)view->buf;
+}
+
 /* The buffer a raw entry copies into or out of (target: p, or the array of a byref of one
  * with no offset), or NULL where this entry does not take it.  Looked up before the value
  * function (the shape) and again after it: the value function is Python, and meanwhile
  * another thread or a collector callback may resize a bytearray or a ctypes array
  * (ctypes.resize moves its memory); nothing of Python runs between the second look-up and
- * the copy. */
+ * the copy.  A numpy array is the Python fast path's: exactly an ndarray of numpy's uint8,
+ * one dimension, C-contiguous, at least size elements, writable to read into (a memoryview
+ * has its own look-up: view_mem). */
 static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long size)
 {
     obj t = TYPE(target);
+    if (t == A.ndarray_type && A.np_u8) {
+        int fl;
+        if (target != p || *(int *)((char *)p + A.nd_nd) != 1 || !AT(p, A.nd_dims) ||
+            *(ptrdiff_t *)AT(p, A.nd_dims) < size || (obj)AT(p, A.nd_descr) != A.np_u8)
+            return NULL;
+        fl = *(int *)((char *)p + A.nd_flags);
+        if (!(fl & ND_C) || (!e->write && !(fl & ND_W)))
+            return NULL;
+        return AT(p, A.nd_data);
+    }
     if (t == A.bytearray_type || (e->write && t == A.bytes_type)) {
         if (target != p || *(ptrdiff_t *)((char *)p + A.bsize) < size)
             return NULL;
@@ -850,12 +1058,14 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             int locked)
 {
     ptrdiff_t at = e->io, k, n;
-    obj p, target, v, call[4];
+    obj p, target, v, call[4], res;
     const int64_t *runs;
     long long size, off = 0, slave = -1, ep = -1, ep0 = -1;
-    int over = 0;
+    int over = 0, mv = 0, diff = 0;
     char *mem;
-    struct aslot *s = e->write ? NULL : e->cache; /* (a write's value makes the epoch grow) */
+    struct pybuf view;
+    /* (a write's runs are kept only where the write makes the epoch grow itself) */
+    struct aslot *s = e->write && !e->changed ? NULL : e->cache;
 
     if (!ready || kwnames || nargs != 3 + at || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -877,8 +1087,14 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             A.err_clear();
         goto python;
     }
-    if (!raw_mem(e, p, target, size))
+    if (TYPE(target) == A.memoryview_type) {
+        /* (held from here to the copy: nothing can release or resize it meanwhile) */
+        if (target != p || !view_mem(e, p, size, &view))
+            goto python;
+        mv = 1;
+    } else if (!raw_mem(e, p, target, size)) {
         goto python;
+    }
     if (s) {
         off = A.as_ll(args[at], &over);
         if (!over && at)
@@ -900,8 +1116,11 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
     if (!locked)
         ep0 = epoch();
     v = A.vectorcall(e->value, call, (size_t)(3 + at), NULL);
-    if (!v)
+    if (!v) {
+        if (mv)
+            A.release_buffer(&view);
         return NULL; /* (the value's own error, as the Python path would raise it) */
+    }
     if (v == e->sentinel || TYPE(v) != A.bytes_type) {
         if (s && s->value) { /* (the slot empties: its runs may be of another image) */
             obj old = s->value, oldtp = s->tp;
@@ -912,9 +1131,11 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
         goto drop;
     }
     /* (a read: the runs are of the image of the epoch it began in; a write's value makes the
-     * epoch grow itself) */
-    if (!locked && (e->write ? elsewhere(e->gate) : !stands(e->gate, ep0))) {
+     * epoch grow itself, or its changed() does once it has written) */
+    if (!locked && (e->write && !e->changed ? elsewhere(e->gate) : !stands(e->gate, ep0))) {
         A.decref(v);
+        if (mv)
+            A.release_buffer(&view);
         return AGAIN;
     }
     if (s && ep >= 0)
@@ -925,7 +1146,7 @@ have:
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
-    mem = raw_mem(e, p, target, size); /* (again: Python ran) */
+    mem = mv ? (char *)view.buf : raw_mem(e, p, target, size); /* (again: Python ran) */
     if (!mem)
         goto drop;
     for (k = 0; k < n / 24; k++) {
@@ -936,17 +1157,33 @@ have:
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         char *image = (char *)(intptr_t)r[1];
-        if (e->write)
-            memcpy(image, mem + r[0], (size_t)r[2]);
-        else
+        if (!e->write)
             memcpy(mem + r[0], image, (size_t)r[2]);
+        else if (!e->changed)
+            memcpy(image, mem + r[0], (size_t)r[2]);
+        else if (memcmp(image, mem + r[0], (size_t)r[2])) {
+            memcpy(image, mem + r[0], (size_t)r[2]);
+            diff = 1;
+        }
     }
     A.decref(v);
+    if (mv)
+        A.release_buffer(&view);
+    if (diff) { /* (the image changed: what the readers kept, the armed cycle, ask again) */
+        res = A.vectorcall(e->changed, NULL, 0, NULL);
+        if (!res)
+            return NULL;
+        A.decref(res);
+    }
     return done(e->after, e->gate);
 
 drop:
     A.decref(v);
 python:
+    if (mv) {
+        A.release_buffer(&view);
+        mv = 0;
+    }
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 

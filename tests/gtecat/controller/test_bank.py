@@ -96,11 +96,15 @@ def _sample(raw_size: int) -> tuple:
     gt.GT_GetPrfVel(1, pv, AXES)
     ev = (c_double * 8)()
     gt.GT_GetEncVel(1, ev, 8)
+    # (the encoder's acceleration and the axis's encoder position through its link)
+    ea, ae = (c_double * AXES)(), (c_double * AXES)()
+    gt.GT_GetAxisEncAcc(1, ea, AXES)
+    gt.GT_GetAxisEncPos(1, ae, AXES)
     raw = (c_ubyte * raw_size)()
     gt.GT_GetEcatRawData(0, raw_size, raw)
     one = c_long()
     gt.GT_GetSts(3, byref(one))  # the byref form too
-    vel = (tuple(pv), tuple(ev))
+    vel = (tuple(pv), tuple(ev), tuple(ea), tuple(ae))
     return (tuple(sts), tuple(prf), tuple(axp), tuple(enc), tuple(enc2), vel, bytes(raw), one.value)
 
 

@@ -9,6 +9,7 @@ from ctypes import byref, c_double, c_long, c_ubyte
 import pytest
 
 from gtecat import gt
+from gtecat.controller.epoch import EPOCH
 from gtecat.drives.io_slaves import IoSlave
 from gtecat.drives.slave import VirtualSlave
 from gtecat.eni.model import Identity
@@ -178,11 +179,15 @@ def test_a_cycle_wrapped_between_polls_runs_through_the_wrapper(fig5_2):
     assert len(seen) == ctl.clock.cycles - t0 > 0
 
 
-def _moves_and_polls(ctl, watch: bool) -> list:
-    """Trap moves of both axes polled through the C entries; what the readers saw."""
+def _moves_and_polls(ctl, watch: bool, band: bool = False) -> list:
+    """Trap moves of both axes polled through the C entries; what the readers saw
+    (``band``: axis 1 with an in-position band, its status word's bit 11 set in the
+    cycles, manual 11.7)."""
     if watch:  # a hook that does nothing: every cycle then goes the general way
         ctl.watch.append(lambda: None)
     gt.GT_AxisOn(2)
+    if band:
+        assert gt.GT_SetAxisBand(1, 20, 40) == 0
     s, d = c_long(), c_double()
     seen = []
     for rnd in range(4):
@@ -200,22 +205,40 @@ def _moves_and_polls(ctl, watch: bool) -> list:
                 gt.GT_GetPrfPos(ax, byref(d))
                 gt.GT_GetEncPos(3 - ax, byref(c_double()))
                 seen.append((s.value, d.value))
+            if i % 97 == 0:  # (spans: read from the bank's lists of the cycle)
+                span, words = (c_double * 2)(), (c_long * 2)()
+                assert gt.GT_GetPrfPos(1, span, 2) == 0
+                assert gt.GT_GetSts(1, words, 2) == 0
+                seen.append((*span, *words))
     seen.append((ctl.clock.cycles, ctl.clock.now_ns, ctl.master.cycles))
+    bank = ctl.bank
+    seen.append((bank.rows_run, bank.bank_cycles, bank.frozen_rows_run, bank.csp.cycles))
+    seen.append(bytes(ctl.master.image.buffer))
     return seen
 
 
-def test_quick_cycles_give_what_the_general_way_gives():
+@pytest.mark.parametrize("band", [False, True])
+def test_quick_cycles_give_what_the_general_way_gives(band):
     """The same calls with the quick cycles and with every cycle the general way (a watch
-    hook that does nothing): the same values read, the same clock, the same cycles."""
+    hook that does nothing): the same values read, the same clock, the same cycles, the
+    bank's and its drives' counts, the same process image.  The quick ones counted by the
+    entries themselves where nothing but counting was to do (Controller._book_in_c): the
+    readers' epoch one more a cycle, as the general way has it."""
     runs = []
     for watch in (False, True):
         bring_up()
         assert gt.GT_AxisOn(1) == 0
         ctl = gt.GTE_Controller()
         many = ctl.bank.many_cycles
-        runs.append(_moves_and_polls(ctl, watch))
+        runs.append(_moves_and_polls(ctl, watch, band))
         if not watch:
             assert ctl.bank.many_cycles - many > 1000  # (the quick ones ran)
+            assert ctl.quick_cbook[0] == 1  # (booked in C)
+            s, cycles, epoch = c_long(), ctl.clock.cycles, EPOCH.n
+            for _ in range(2000):  # (a poll of an idle axis: every cycle a quick one)
+                gt.GT_GetSts(1, byref(s))
+            assert ctl.clock.cycles - cycles == EPOCH.n - epoch == 100
+            assert ctl.quick_cbook[0] == 1
         gt.GT_Close()
     assert runs[0] == runs[1]
 

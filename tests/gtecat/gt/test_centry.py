@@ -425,8 +425,21 @@ def _raw_buffers(size: int) -> list[tuple[str, Any]]:
         ("short bytearray", lambda: (o := bytearray(max(n - 1, 0)), o)),
         ("bytes", lambda: (o := bytes(range(3, 3 + n)), o)),
         ("numpy", lambda: (o := np.arange(n, dtype=np.uint8), o)),
+        ("short numpy", lambda: (o := np.arange(max(n - 1, 0), dtype=np.uint8), o)),
+        ("numpy int8", lambda: (o := np.arange(n, dtype=np.int8), o)),
+        ("strided numpy", lambda: (o := np.arange(2 * n, dtype=np.uint8), o[::2])),
+        ("read-only numpy", lambda: (o := np.arange(n, dtype=np.uint8), _read_only(o))),
+        ("memoryview", lambda: (o := bytearray(range(5, 5 + n)), memoryview(o))),
+        ("read-only memoryview", lambda: (o := bytes(range(5, 5 + n)), memoryview(o))),
+        ("short memoryview", lambda: (o := bytearray(max(n - 1, 0)), memoryview(o))),
+        ("memoryview of H", lambda: (o := bytearray(2 * n), memoryview(o).cast("H"))),
         ("c_long", lambda: (o := ctypes.c_long(5), o)),
     ]
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
 
 
 @needs_cc

@@ -247,3 +247,73 @@ def test_gt_is_ecat_ready_answers_as_the_table_through_a_bring_up() -> None:
     finally:
         faults.clear()
         gt.GT_Close()
+
+
+def _buffers(b: bytes) -> list[Any]:
+    """``b`` in each kind of buffer a raw write takes through its C entry."""
+    return [
+        bytes(b),
+        (ctypes.c_ubyte * len(b))(*b),
+        np.frombuffer(b, np.uint8).copy(),
+        memoryview(bytearray(b)),
+        memoryview(bytes(b)),  # (read only: a write takes it)
+    ]
+
+
+def test_a_raw_write_grows_the_epoch_only_where_it_changes_the_image() -> None:
+    """A raw write of the bytes the image holds changes nothing a reader reads: the epoch
+    stays (what the readers kept stands); a write that changes a byte makes it grow and
+    reaches the slave in the next cycle (figure 5-2: slave 2's DO at raw offset 32, manual
+    5.2.2.5)."""
+    _open()
+    try:
+        io = gt.GTE_Slave(2)
+        s = ctypes.c_long()
+        for src in [bytes([0x5A, 0xA5]), bytes([0x5A, 0x01]), bytes([0, 0])]:
+            for j, buf in enumerate(_buffers(src)):
+                gt.GT_GetSts(1, byref(s))
+                before = EPOCH.n
+                assert gt.GT_SetEcatRawData(32, 2, buf) == 0
+                assert (EPOCH.n > before) == (j == 0), (src, j)  # (new bytes the first time)
+                got = (ctypes.c_ubyte * 2)()
+                assert gt.GT_GetEcatRawData(32, 2, got) == 0 and bytes(got) == src
+                gt.GT_GetSts(1, byref(s))
+                before = EPOCH.n
+                assert gt.GT_SetEcatRawData(32, 2, buf) == 0  # (the same bytes again)
+                assert gt.GT_EcatIOWriteOutput(2, 0, 2, buf) == 0
+                assert EPOCH.n == before
+            assert gt.GTE_Wait(1) == 0
+            assert bytes(io.field_outputs[:2]) == src
+    finally:
+        gt.GT_Close()
+
+
+def test_raw_writes_in_the_auto_clock_reach_the_slave_in_the_next_cycle() -> None:
+    """The default clock, cycles run inside the calls (the armed quick cycle among them): a
+    loop writing the IO slave's outputs, the same bytes several times and then new ones, and
+    polling GT_GetSts between, finds at every cycle the slave driving the bytes written
+    before it (figure 5-2: slave 2's DO at raw offset 32)."""
+    bring_up("manual_fig5_2.eni", clock="auto")
+    try:
+        assert gt.GT_AxisOn(1) == 0
+        gt.GTE_Wait(5)
+        ctl = gt.GTE_Controller()
+        io = gt.GTE_Slave(2)
+        s = ctypes.c_long()
+        seen = 0
+        written = bytes(2)
+        cycles = ctl.clock.cycles
+        for k in range(3_000):
+            if k % 37 == 0:
+                written = bytes([k % 251, (k // 37) % 7])
+            buf = _buffers(written)[k % 5]
+            for j in range(1 + k % 3):  # (the write, then 0 to 2 polls)
+                rc = gt.GT_SetEcatRawData(32, 2, buf) if j == 0 else gt.GT_GetSts(1, byref(s))
+                assert rc == 0
+                if ctl.clock.cycles != cycles:  # (its latency ran a cycle)
+                    cycles = ctl.clock.cycles
+                    seen += 1
+                    assert bytes(io.field_outputs[:2]) == written, (k, seen)
+        assert seen > 200
+    finally:
+        gt.GT_Close()

@@ -211,11 +211,12 @@ def test_reads_hammered_beside_a_thread_that_runs_cycles_are_whole(bank):
 
 @pytest.mark.parametrize("reader", ["GT_GetPrfPos", "GT_GetEncPos"])
 def test_a_value_made_before_another_threads_cycles_is_not_kept_past_them(reader):
-    """A reader's value function makes the bank's list of a value (the first read since a
-    cycle); right after it is made, another thread runs cycles (forced here: the list maker
-    starts the thread and waits for it).  The read answers again holding the lock, and
-    neither it nor the next read may answer from the list made before those cycles: both
-    answer the value as those cycles left it (a lockstep clock: no time passes after them)."""
+    """A reader's value function makes the bank's value of its row (the first read since
+    a cycle: AxisBank.row_value); right after it is made, another thread runs cycles (forced
+    here: the row's maker starts the thread and waits for it).  The read answers again
+    holding the lock, and neither it nor the next read may answer from the value made before
+    those cycles: both answer the value as those cycles left it (a lockstep clock: no time
+    passes after them)."""
     fig = ROOT / "examples" / "manual_fig5_2.eni"
     gt.GT_Close()
     assert gt.GT_Open(eni=str(fig), clock="lockstep", log="", bank="on") == 0
@@ -242,14 +243,14 @@ def test_a_value_made_before_another_threads_cycles_is_not_kept_past_them(reader
             assert read(1, byref(v)) == 0
             return v.value
 
-        made, other = bank._make_list, []
+        made, row, other = bank._make_list, bank.row_value, []
 
         def cycles(name: str) -> None:
             # (the value as the cycles left it, from a list made here and kept nowhere)
             other.append((gt.GTE_Wait(50), float(made(name)[res.bank_row])))
 
-        def make_then_cycles(name: str) -> list:
-            out = made(name)
+        def make_then_cycles(name: str, r: int) -> float:
+            out = row(name, r)
             if not other:
                 t = threading.Thread(target=cycles, args=(name,), name="cycles")
                 t.start()
@@ -257,12 +258,12 @@ def test_a_value_made_before_another_threads_cycles_is_not_kept_past_them(reader
             return out
 
         before = value()
-        assert gt.GTE_Wait(1) == 0  # (a cycle: the lists are made again at the next read)
-        bank._make_list = make_then_cycles
+        assert gt.GTE_Wait(1) == 0  # (a cycle: the values are made again at the next read)
+        bank.row_value = make_then_cycles
         try:
             hooked = value()
         finally:
-            del bank._make_list
+            del bank.row_value
         assert len(other) == 1 and other[0][0] == 0, other
         after = other[0][1]
         assert after > before + 400
