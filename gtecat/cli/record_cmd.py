@@ -125,10 +125,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: {path} raised {type(e).__name__}: {e}", file=sys.stderr)
         rc = 1
     finally:  # the session up to where the script ended (or was interrupted) is kept
+        # the recorder stops first: closing what the script left open is gtecat's own
+        # clean-up, not a call of the program (a recording lists the program's calls only)
+        rec.stop()
         try:
             gt.GT_Close()
         finally:
-            rec.stop()
             sys.argv, sys.path[:] = saved_argv, saved_path
             _write(rec, out)
     print(f"record: {rec.calls} GT calls -> {out}", file=sys.stderr)

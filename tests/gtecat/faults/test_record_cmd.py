@@ -30,9 +30,30 @@ def test_a_script_that_raises_keeps_its_recording_and_its_traceback(
     assert "Traceback" in err and f'"{app}", line 4' in err and "ZeroDivisionError" in err
     assert f"error: {app} raised ZeroDivisionError" in err
     head = json.loads(out.read_text().splitlines()[0])
-    assert head["calls"] >= 2  # GT_Open, GT_InitEcatComm (and the closing GT_Close)
+    assert head["calls"] >= 2  # GT_Open, GT_InitEcatComm
+    assert "GT_Close" not in out.read_text()  # gtecat's clean-up is not the program's call
     assert main(["replay", str(out)]) == 0, capsys.readouterr().err
     assert "calls match" in capsys.readouterr().out
+
+
+def test_a_recording_lists_the_program_s_calls_only(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The script's one GT_Close is recorded once: closing what a script leaves open when it
+    ends is gtecat's own clean-up, not a call of the program."""
+    app = tmp_path / "closes.py"
+    app.write_text(
+        "from gtecat import gt\n"
+        f"gt.GT_Open(eni={str(EXAMPLES / 'full_servo.eni')!r}, log='')\n"
+        "gt.GTE_Wait(3)\n"
+        "gt.GT_Close()\n"
+    )
+    out = tmp_path / "closes.gtrec"
+    assert main(["record", "-o", str(out), "--", "python3", str(app)]) == 0
+    lines = [json.loads(x) for x in out.read_text().splitlines()]
+    assert lines[0]["calls"] == 3
+    assert [x["c"] for x in lines[1:]] == ["GT_Open", "GTE_Wait", "GT_Close"]
+    assert main(["replay", str(out)]) == 0, capsys.readouterr().err
 
 
 def test_an_output_that_cannot_be_written_is_refused_first_with_why(
