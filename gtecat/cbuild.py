@@ -283,6 +283,19 @@ def damaged(lib: Path) -> bool:
     return True
 
 
+def c_source(package: str, stem: str) -> str:
+    """The text of the C file ``csrc/<stem>.c`` of gtecat package ``package`` (``"gtecat.gt"``),
+    read from the package's folder (``importlib.resources``, whose import with zipfile's is
+    ~5 ms of a process's start, only for a package that is not a folder)."""
+    root = Path(__file__).parent.joinpath(*package.split(".")[1:])
+    try:
+        return (root / "csrc" / f"{stem}.c").read_text("utf-8")
+    except OSError:
+        from importlib import resources
+
+        return (resources.files(package) / "csrc" / f"{stem}.c").read_text("utf-8")
+
+
 def library_path(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:
     """``<cache>/<version>/<stem>-<digest>.so``: where the build of the one C file ``source``
     (text) with this compiler and these flags is kept (NativeBuildError without a compiler)."""
