@@ -33,7 +33,6 @@ import logging
 import os
 import shutil
 import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -167,6 +166,8 @@ class _BuildDir:
     lock so that :func:`sweep` never sees it unowned."""
 
     def __init__(self, vdir: Path) -> None:
+        import tempfile  # (here: a process whose libraries are built never imports it, ~3 ms)
+
         sweep(vdir)
         with _dirs_lock(vdir):
             self.path = Path(tempfile.mkdtemp(prefix=_PREFIX, dir=vdir))
