@@ -33,7 +33,6 @@ import logging
 import os
 import shutil
 import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -167,6 +166,8 @@ class _BuildDir:
     lock so that :func:`sweep` never sees it unowned."""
 
     def __init__(self, vdir: Path) -> None:
+        import tempfile  # (here: a process whose libraries are built never imports it, ~3 ms)
+
         sweep(vdir)
         with _dirs_lock(vdir):
             self.path = Path(tempfile.mkdtemp(prefix=_PREFIX, dir=vdir))
@@ -281,6 +282,19 @@ def damaged(lib: Path) -> bool:
     level = logging.INFO if why == "not sealed" else logging.WARNING
     log.log(level, "%s in the build cache fails its check (%s): it is built again", lib, why)
     return True
+
+
+def c_source(package: str, stem: str) -> str:
+    """The text of the C file ``csrc/<stem>.c`` of gtecat package ``package`` (``"gtecat.gt"``),
+    read from the package's folder (``importlib.resources``, whose import with zipfile's is
+    ~5 ms of a process's start, only for a package that is not a folder)."""
+    root = Path(__file__).parent.joinpath(*package.split(".")[1:])
+    try:
+        return (root / "csrc" / f"{stem}.c").read_text("utf-8")
+    except OSError:
+        from importlib import resources
+
+        return (resources.files(package) / "csrc" / f"{stem}.c").read_text("utf-8")
 
 
 def library_path(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:

@@ -24,14 +24,13 @@ from __future__ import annotations
 import ctypes
 import logging
 import os
-from importlib import resources
 from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..cbuild import Background, NativeBuildError, intact, library_path, shared_library
+from ..cbuild import Background, NativeBuildError, c_source, intact, library_path, shared_library
 
 if TYPE_CHECKING:
     from .bank import AxisBank
@@ -229,7 +228,7 @@ def _field_types() -> list[tuple[str, Any]]:
 
 
 def _source(stem: str = "bank_kernel") -> str:
-    return (resources.files("gtecat.controller") / "csrc" / f"{stem}.c").read_text("utf-8")
+    return c_source("gtecat.controller", stem)
 
 
 def wanted() -> str:

@@ -44,8 +44,6 @@ import gc
 import os
 from array import array
 from collections.abc import Callable
-from concurrent import futures
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -83,6 +81,8 @@ from .resources import install as install_resources
 _T = TypeVar("_T")
 
 if TYPE_CHECKING:
+    from concurrent.futures import ThreadPoolExecutor
+
     from .card import Card
 
 _REALTIME = ClockMode.REALTIME  # (looked up once: every wait asks)
@@ -472,6 +472,10 @@ class Controller:
         if clock.threaded:
             with clock.unlocked():
                 return transfer()
+        # (imported here: only a wire's backend waits so; every other process skips them)
+        from concurrent import futures
+        from concurrent.futures import ThreadPoolExecutor
+
         pool = self._mailbox_pool
         if pool is None:
             pool = self._mailbox_pool = ThreadPoolExecutor(1, thread_name_prefix="gtecat-mbx")

@@ -18,12 +18,10 @@ import pickle
 import re
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from .errors import EniError
-from .googol_reader import read_googol
 from .model import EniConfig
-from .xml_reader import read_xml
-from .xmltree import parse_xml
 
 _GOOGOL = re.compile(rb"^\s*\[\s*(CommonInfo|SlaveStart|SlaveIndex|MasterInfo)\s*\]", re.I | re.M)
 _ROOT = re.compile(rb"<\s*(?:[A-Za-z_][\w.-]*:)?([A-Za-z_][\w.-]*)")
@@ -92,6 +90,37 @@ def detect_format(data: bytes | str) -> str:
 #: the register InitCmds (the master's and each slave's): the reader builds the bus from the
 #: rest, so their elements (most of a TwinCAT file's) are checked by expat but not kept
 _NOT_READ = frozenset({("Master", "InitCmds"), ("Slave", "InitCmds")})
+# The readers and the XML parser are imported at the first parse: a process whose model
+# comes from the cache folder (read_eni), as a replay's does, needs none of them (~5 ms of its
+# start).
+
+
+def parse_xml(
+    data: bytes | str,
+    source: str,
+    skip: frozenset[tuple[str, str]] = frozenset(),
+    share: frozenset[tuple[str, str]] = frozenset(),
+) -> Any:
+    """:func:`gtecat.eni.xmltree.parse_xml`."""
+    from .xmltree import parse_xml
+
+    return parse_xml(data, source, skip, share)
+
+
+def read_xml(root: Any, source: str) -> EniConfig:
+    """:func:`gtecat.eni.xml_reader.read_xml`."""
+    from .xml_reader import read_xml
+
+    return read_xml(root, source)
+
+
+def read_googol(text: str | bytes, source: str) -> EniConfig:
+    """:func:`gtecat.eni.googol_reader.read_googol`."""
+    from .googol_reader import read_googol
+
+    return read_googol(text, source)
+
+
 #: the subtrees a bus of like slaves repeats byte for byte: read once (see parse_xml)
 _SHARED = frozenset({("Slave", "Mailbox"), ("ProcessData", "RxPdo"), ("ProcessData", "TxPdo")})
 

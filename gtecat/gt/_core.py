@@ -681,14 +681,21 @@ def _attach_address(kwargs: dict) -> str:
 #: (name, C++ default, is a double) -> its inspect.Parameter: the ~400 signatures made at
 #: import share ~300 parameters (``short axis`` in most), each made once (immutable)
 _PARAMETERS: dict[tuple[str, str | None, bool], inspect.Parameter] = {}
+#: the signatures of the same parameters, each made once (immutable too): ~400 functions,
+#: ~190 distinct parameter lists
+_SIGNATURES: dict[tuple[tuple[str, str | None, bool], ...], inspect.Signature] = {}
 
 
 def _signature(proto: Proto, fn: Callable[..., Any], keyword_only: list[str]) -> inspect.Signature:
     """The Python signature shown by help(): the table's parameters and defaults, then the
     implementation's keyword-only options (GT_Open's ``eni=...``)."""
+    keys = tuple((p.name, p.default, p.is_float) for p in proto.params)
+    if not keyword_only:
+        sig = _SIGNATURES.get(keys)
+        if sig is not None:
+            return sig
     out = []
-    for p in proto.params:
-        key = (p.name, p.default, p.is_float)
+    for p, key in zip(proto.params, keys, strict=True):
         q = _PARAMETERS.get(key)
         if q is None:
             try:
@@ -702,7 +709,9 @@ def _signature(proto: Proto, fn: Callable[..., Any], keyword_only: list[str]) ->
     if keyword_only:
         kw = inspect.Parameter.KEYWORD_ONLY
         out += [q for q in inspect.signature(fn).parameters.values() if q.kind is kw]
-    return inspect.Signature(out)
+        return inspect.Signature(out)
+    sig = _SIGNATURES[keys] = inspect.Signature(out)
+    return sig
 
 
 def last_error() -> LastError | None:

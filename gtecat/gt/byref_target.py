@@ -23,7 +23,6 @@ import ctypes
 import logging
 import sys
 from collections.abc import Callable, Iterable
-from importlib import resources
 from typing import Any
 
 from .args import CARG_AT
@@ -107,9 +106,9 @@ def _load() -> tuple[Callable[[Iterable[type]], Callable[[Any], Any]] | None, st
     except ValueError as e:
         return None, str(e)
     try:
-        from ..cbuild import shared_library
+        from ..cbuild import c_source, shared_library
 
-        source = (resources.files("gtecat.gt") / "csrc" / "byref_target.c").read_text("utf-8")
+        source = c_source("gtecat.gt", "byref_target")
         lib = ctypes.CDLL(str(shared_library("byref_target", source, CFLAGS, ())))
         lib.gtecat_byref_layout.argtypes = [ctypes.c_ssize_t] * 4 + [ctypes.c_void_p] * 2
         lib.gtecat_byref_layout.restype = ctypes.c_int

@@ -46,7 +46,6 @@ import threading
 import types
 from array import array
 from collections.abc import Callable, Iterable
-from importlib import resources
 from typing import Any
 
 from ..controller.epoch import EPOCH, Epoch, changed
@@ -699,9 +698,9 @@ def _load() -> tuple[Maker | None, str]:
     except Exception as e:  # (a probe that disagrees, or cannot read what it probes)
         return None, str(e)
     try:
-        from ..cbuild import shared_library
+        from ..cbuild import c_source, shared_library
 
-        source = (resources.files("gtecat.gt") / "csrc" / "centry.c").read_text("utf-8")
+        source = c_source("gtecat.gt", "centry")
         lib = ctypes.CDLL(str(shared_library("centry", source, byref_target.CFLAGS, ())))
         api = _Api(
             carg_value,
