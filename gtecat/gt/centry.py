@@ -127,6 +127,7 @@ class _Api(ctypes.Structure):
         ("tuple_pack", _VP),
         ("key_lists", _VP),
         ("key_seen", _VP),
+        ("b_size", ctypes.c_ssize_t),
     ]
 
 
@@ -423,6 +424,25 @@ def _objects_at() -> int:
     raise ValueError("a ctypes object's kept objects are not where they are looked for")
 
 
+def _size_at() -> int:
+    """Where a ctypes object keeps its size in bytes (what ``ctypes.sizeof`` gives for the
+    object: a resized one's too; ValueError when the probe disagrees)."""
+    xs = [
+        ctypes.c_long(3),
+        ctypes.c_short(1),
+        (ctypes.c_double * 12)(),
+        (ctypes.c_ubyte * 3)(),
+        (ctypes.c_short * 5).from_buffer(bytearray(16), 2),
+    ]
+    grown = (ctypes.c_long * 2)()
+    ctypes.resize(grown, 40)
+    xs.append(grown)
+    for k in range(_HEAD, sys.getsizeof(xs[0]) - _WORD + 1, _WORD):
+        if all(ctypes.c_ssize_t.from_address(id(x) + k).value == ctypes.sizeof(x) for x in xs):
+            return k
+    raise ValueError("a ctypes object's size is not where it is looked for")
+
+
 def _bytes_at() -> tuple[int, int]:
     """Where a bytes object keeps its length and its first byte (ValueError when the probe
     disagrees)."""
@@ -691,6 +711,7 @@ def _load() -> tuple[Maker | None, str]:
         bsize, bdata = _bytes_at()
         bastart = _bytearray_at(bsize)
         objects_at = _objects_at()
+        size_at = _size_at()
         epoch_at = _epoch_at()
         owner_at = _owner_at()
         titems = _tuple_at(bsize)
@@ -761,6 +782,7 @@ def _load() -> tuple[Maker | None, str]:
             _address("PyTuple_Pack"),
             id(_KEY_LISTS),
             id(_KEY_SEEN),
+            size_at,
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -1019,7 +1041,14 @@ def _self_test(make: Maker) -> str:
         (arrays, (2,), lambda: (o := A3(), o, o), (2,), None),
         (arrays, (1,), lambda: (o := A3(), o, o), (2.0,), None),
         (arrays, (1,), lambda: (o := (ctypes.c_int64 * 4)(), o, o), (2,), None),
-        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o), o), (2,), None),
+        # byref(array[, offset]): C's &array[k], where count whole elements fit behind it
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o), o), (2,), [5, 6, 0]),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 8), o), (2,), [0, 5, 6]),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 16), o), (1, 0), [0, 0, 5]),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 16), o), (2,), None),  # past
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 24), o), (), None),  # at the end
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 4), o), (), None),  # mid-element
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 8), o), (3,), None),
         (arrays, (1,), lambda: (o := L(), o, o), (), 7),
         (clock, (), lambda: (o := ctypes.c_uint32(), ctypes.byref(o), o), (), 7),
         (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (None,), 7),
