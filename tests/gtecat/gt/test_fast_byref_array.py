@@ -75,7 +75,7 @@ def _paths(name: str) -> list:
     count=st.sampled_from([None, 1, 2, 3, 4, 8, 13]),
     clock=st.booleans(),
 )
-def test_byref_into_an_array_answers_as_the_table(  # noqa: PLR0913
+def test_byref_into_an_array_answers_as_the_table(
     moving_bus,  # noqa: F811
     fn,
     t,
