@@ -1345,7 +1345,11 @@ def _self_test_raw(make_raw: Maker) -> str:
         (get, (0, 2.0), lambda: (o := U8(), o, None)),
         (get, (0, 1 << 70), lambda: (o := U8(), o, None)),
         (get, (0, 2), lambda: (o := (ctypes.c_ubyte * 9)(), o, None)),  # another type
-        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), None)),
+        # byref(array, offset) (C's &buf[k]): the size's bytes from there, within the array
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), bytes([0, 0, 1, 0, 0, 0, 0, 0]))),
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 6), bytes([0] * 6 + [0, 1]))),
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 7), None)),  # past its end
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 8), None)),
         (get, (0,), lambda: (o := U8(), o, None)),
         (bget, (4, 8), lambda: (o := bytearray(9), o, bytes([*range(4, 12), 0]))),
         (bget, (4, 8), lambda: (o := bytearray(7), o, None)),  # too short
@@ -1520,7 +1524,8 @@ def raw(
     changed: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
-    ctypes array (or ``byref`` of one, no offset), a bytearray, a one-dimensional
+    ctypes array (or ``byref`` of one, with an offset too: C's ``&buf[k]``, where the
+    ``size`` bytes from there end within the array), a bytearray, a one-dimensional
     C-contiguous numpy array of uint8 or a memoryview of format ``B`` (one dimension,
     C-contiguous) of at least ``size`` bytes (or bytes, where ``write``; writable, where
     not) and plain ints copies the runs that

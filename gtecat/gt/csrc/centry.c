@@ -10,7 +10,7 @@
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
  * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
- * of their own: a ctypes array (or byref of one, no offset), a bytearray, a numpy uint8
+ * of their own: a ctypes array (or byref of one, with an offset too), a bytearray, a numpy uint8
  * array or a memoryview of bytes (or, to write from, bytes) long enough, and plain ints
  * checked here, the runs of the range in the process image from one Python call
  * (value(offset, size, type), as int64 triples in a bytes object: that function checks
@@ -1091,8 +1091,16 @@ static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long siz
     }
     if (TYPE(t) != A.array_meta)
         return NULL;
-    if (target != p && AT(p, A.carg_value) != AT(target, A.b_ptr))
-        return NULL; /* byref(array, offset), or the array's memory moved since */
+    if (target != p) {
+        /* byref(array[, offset]) (C's &array[k]): its address, where the size's bytes from
+         * there end within the object (the table path's room: ctypes.sizeof of it; any byte
+         * offset, as the table path's byte pointer takes it); else (past the end, before
+         * the start, the array's memory moved since) the Python path answers */
+        char *base = AT(target, A.b_ptr), *to = AT(p, A.carg_value);
+        if (!base || to < base || (to - base) + size > *(ptrdiff_t *)((char *)target + A.b_size))
+            return NULL;
+        return to;
+    }
     return AT(target, A.b_ptr);
 }
 
@@ -1118,7 +1126,7 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             goto python;
     p = args[2 + at];
     target = p;
-    if (TYPE(p) == A.carg_type) { /* byref(array) with no offset: the array (raw_mem) */
+    if (TYPE(p) == A.carg_type) { /* byref(array[, offset]): the array (raw_mem) */
         target = AT(p, A.carg_obj);
         if (!target)
             goto python;

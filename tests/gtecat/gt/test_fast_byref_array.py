@@ -2,9 +2,10 @@
 
 Generated arrays (element types the readers take and others, lengths 1..12), byte offsets
 (whole elements, between two, before the start, at and past the end) and counts (a span
-that fits behind the pointer, one that runs past the object's end): the public function
-(its C entry in front), its Python fast function and its table path each answer the same
-call - return code, every byte of the array, the clock written, GTE_GetLastError.
+that fits behind the pointer, one that runs past the object's end), and for the raw image
+functions buffers, byte offsets and sizes: the public function (its C entry in front), its
+Python fast function and its table path each answer the same call - return code, every
+byte of the array (and of the image), the clock written, GTE_GetLastError.
 """
 
 from __future__ import annotations
@@ -118,3 +119,61 @@ def test_the_span_lands_at_the_offset(moving_bus) -> None:  # noqa: F811
     assert gt.GT_GetPrfPos(1, byref(d, 32), 3, None) == 7
     assert "room for 2 value(s)" in gt.GTE_GetLastError()
     assert list(d) == [-1.0, -1.0, *want, -1.0]
+
+
+#: the raw image functions: (name, arguments before offset and size, a write into the image)
+RAW = [
+    ("GT_GetEcatRawData", (), False),
+    ("GT_SetEcatRawData", (), True),
+    ("GT_EcatIOReadInput", (2,), False),
+    ("GT_EcatIOWriteOutput", (2,), True),
+]
+
+
+@settings(
+    max_examples=examples(200, 25),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    fn=st.sampled_from(RAW),
+    t=st.sampled_from([ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_char, ctypes.c_uint16]),
+    length=st.integers(1, 12),
+    at=st.one_of(st.integers(0, 3), st.integers(-1, 13)),
+    where=st.sampled_from([0, 2, 4, 8, 32, 36, 60]),
+    size=st.integers(1, 6),
+)
+def test_byref_into_a_raw_buffer_answers_as_the_table(
+    moving_bus,  # noqa: F811
+    fn,
+    t,
+    length,
+    at,
+    where,
+    size,
+) -> None:
+    """The raw image functions with ``byref(buf, k)`` (C's ``&buf[k]``, any byte offset):
+    the same code, buffer and image as the table path, a range past the buffer's end
+    refused the same way."""
+    name, before, write = fn
+    if name in ("GT_EcatIOWriteOutput", "GT_EcatIOReadInput"):
+        where %= 4
+    elif write:
+        where = 32 + where % 6  # (the IO slaves' outputs: what a raw write may touch)
+    results = []
+    for f in _paths(name):
+        buf = (t * length)()
+        ctypes.memmove(buf, bytes(range(1, ctypes.sizeof(buf) + 1)), ctypes.sizeof(buf))
+        try:
+            p = byref(buf, at)
+        except (ValueError, TypeError):
+            pytest.skip("ctypes refuses the offset")
+        rc = f(*before, where, size, p)
+        image = (ctypes.c_ubyte * 64)()
+        assert gt.GT_GetEcatRawData.slow(0, 64, image) in (0, 7)
+        results.append((rc, bytes(buf), bytes(image), gt.GTE_GetLastError() if rc else ""))
+        if write and rc == 0:  # (the next path writes over other bytes: each its own)
+            zero = (ctypes.c_ubyte * size)()
+            assert getattr(gt, name).slow(*before, where, size, zero) == 0
+    assert all(r == results[-1] for r in results), (name, t, length, at, where, size, results)
