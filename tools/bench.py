@@ -219,6 +219,18 @@ CALL_SHAPES: dict[str, tuple[str, str]] = {
     "GT_GetEcatEncPos(1, byref(s))": ("gt.GT_GetEcatEncPos(1, byref(s))", "byref(s)"),
     "GT_GetEcatRawData(0, 8, buf) c_ubyte[8]": ("gt.GT_GetEcatRawData(0, 8, buf)", "U8()"),
     "GT_GetEcatRawData(0, 8, byref(buf))": ("gt.GT_GetEcatRawData(0, 8, byref(buf))", "byref(buf)"),
+    "GT_GetEcatRawData(0, 4, byref(buf, 3))": (
+        "gt.GT_GetEcatRawData(0, 4, byref(buf, 3))",
+        "byref(buf, 3)",
+    ),
+    "GT_SetEcatRawData(32, 2, byref(buf, 2))": (
+        "gt.GT_SetEcatRawData(32, 2, byref(buf, 2))",
+        "byref(buf, 2)",
+    ),
+    "GT_EcatIOReadInput(2, 0, 2, byref(buf, 1))": (
+        "gt.GT_EcatIOReadInput(2, 0, 2, byref(buf, 1))",
+        "byref(buf, 1)",
+    ),
     "GT_GetEcatRawData(0, 8, c_ubyte[8]()) fresh": ("gt.GT_GetEcatRawData(0, 8, U8())", "U8()"),
     "GT_GetEcatRawData(0, 8, bytearray)": ("gt.GT_GetEcatRawData(0, 8, ba)", "bytearray(8)"),
     "GT_GetEcatRawData(0, 8, numpy uint8)": (
