@@ -4,7 +4,9 @@
 spends about half its time checking the shape of its arguments and writing the value through
 ctypes.  The entry here (``csrc/centry.c``) does those two parts in C: it checks the shape
 (an exact ``int`` axis, ``count`` absent or 1, ``pClock`` absent, None or 0, the value's
-pointer ``byref(x)`` of an accepted ``x`` with no offset, or ``x`` itself), asks one Python
+pointer ``byref(x)`` of an accepted ``x`` with no offset, or ``x`` itself; a ctypes array, or
+``byref`` of one with an offset too - C's ``&arr[k]`` - takes the values from there where they
+fit before its end), asks one Python
 function of the reader for the value (``value(n)``: the number, or a sentinel when the entry
 must not answer - not the in-process lockstep controller, no such axis, any doubt), and
 writes the number into ``x``'s memory with ``x``'s width (a number the type does not hold:
