@@ -179,6 +179,7 @@ class _Entry(ctypes.Structure):
         ("nptypes", _VP * 8),
         ("npsizes", ctypes.c_ssize_t * 8),
         ("npsigns", ctypes.c_ssize_t * 8),
+        ("stride", ctypes.c_ssize_t),
     ]
 
 
@@ -848,6 +849,8 @@ def _load() -> tuple[Maker | None, str]:
         e.avalue = id(array) if array is not None else None
         e.gate = gate
         e.after = id(after) if after is not None else None
+        # (a structure's array: its elements sizeof apart, its value the fields' bytes)
+        e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t

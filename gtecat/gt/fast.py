@@ -736,15 +736,16 @@ def _entry(
     size: int = 0,
     gate: int = centry.NO_GATE,
     after: Callable[[], int] | None = None,
+    array: Callable[..., Any] | None = None,
 ) -> Any:
     """A two-argument reader's public function: its C entry in front of its Python fast
     function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
     :data:`CENTRY` is on and the entry is available; else ``gt``; ``gate``: as
-    :func:`centry.reader`'s."""
+    :func:`centry.reader`'s; ``array``: its ``array`` (an integer reader's: the first
+    element's, made here)."""
     if not CENTRY:
         return gt
     numpy: list[Any] = []
-    array = None
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
         numpy = _int_dtypes(types)  # (the Python path's numpy shape: _array_first)
@@ -1956,15 +1957,7 @@ SLOW_REASONS: dict[str, str] = {
 #: a client's shapes of a fast function's value pointer that the table path answers, and why
 #: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
 #: other that reaches the table)
-SLOW_SHAPES: dict[str, dict[str, str]] = {
-    "GT_GetTrapPrm": {
-        "array[1]": "an array of structures for one structure: the table path checks its "
-        "type and size (the fast path takes the structure, or byref of it)",
-        "byref array": "byref of an array of structures: as the array itself",
-        "byref array offset": "a pointer into an array of structures (C's &prm[k]): as the "
-        "array itself",
-    },
-}
+SLOW_SHAPES: dict[str, dict[str, str]] = {}
 
 
 def fast_functions() -> frozenset[str]:
@@ -2466,6 +2459,15 @@ def fast_struct_reader(
         raise ValueError(f"{name}: not a function of one axis")
     cls, mode, fill = STRUCT_READERS[name]
     target = _target([cls])
+    one = frozenset([cls])
+    arrays: dict[type, bool] = {}
+
+    def is_array(tp: type) -> bool:
+        """An array of the structure (at least one): its first element takes it."""
+        ok = arrays.get(tp)
+        if ok is None:
+            ok = arrays[tp] = issubclass(tp, ctypes.Array) and tp._type_ is cls and tp._length_ >= 1
+        return ok
 
     def ready(n: int) -> Any:
         """(the controller, axis ``n``'s resources) where the fast path answers, else None
@@ -2489,10 +2491,12 @@ def fast_struct_reader(
             tp = type(p)
             if tp is _CArg:
                 s = target(p)
-                if s is p:
-                    s = None
-            else:
-                s = p if tp is cls else None
+                if s is p:  # byref(array[, offset]): the structure there (C's &prm[k])
+                    s = element_at(p, one)
+            elif tp is cls:
+                s = p
+            else:  # an array of structures: its first (ctypes' element shares its memory)
+                s = p[0] if is_array(tp) else None
             got = None if s is None else ready(n)
             if got is not None:
                 ctl, res = got
@@ -2522,9 +2526,19 @@ def fast_struct_reader(
     inline = getattr(to_bytes, "inline", "b = TO_BYTES(res)")  # (to_bytes' steps inline)
     code = _STRUCT_VALUE.replace("{bytes}", "\n".join("        " + x for x in inline.split("\n")))
     exec(_compiled_code(code, f"<gt struct value {name}>"), _gated(env))
+    value = env["value"]
+
+    def first(n: Any, count: Any, tp: type, clock: Any) -> Any:
+        """The C entry's bytes for an array of the structure (or byref of one, with an
+        offset too: its entry checks the room): the first element's, as ``gt`` writes it."""
+        if count != 1 or clock is not None or not is_array(tp):
+            return _NO
+        return value(n)
+
     return _entry(  # type: ignore[no-any-return]
-        gt, env["value"], [cls], centry.BYTES, size, centry.GT_GATE, _after(advance, name, 0)
-    )
+        gt, value, [cls], centry.BYTES, size, centry.GT_GATE, _after(advance, name, 0),
+        array=first,
+    )  # fmt: skip
 
 
 #: a structure reader's value for its C entry (asked while the GT_ gate is open: CTL the

@@ -175,6 +175,9 @@ struct entry {
     obj nptypes[8];
     ptrdiff_t npsizes[8];
     ptrdiff_t npsigns[8];
+    /* an array's element stride where it is not the value's bytes per element (a structure
+     * reader: the structure's size, its value the fields' bytes); 0: the bytes' own */
+    ptrdiff_t stride;
 };
 
 static struct api A;
@@ -659,12 +662,13 @@ static obj array_of(obj p)
     return NULL;
 }
 
-/* Where n bytes (count whole elements of arr's) go for p (array_of(p) is arr): the array's
- * start, or the address byref(arr, offset) passes where that is inside the array at a whole
- * element and the n bytes end within the object (the table path's room check: ctypes.sizeof
+/* Where n bytes (count whole elements of arr's, each of stride bytes apart where stride is
+ * not 0) go for p (array_of(p) is arr): the array's start, or the address byref(arr, offset)
+ * passes where that is inside the array at a whole element and the n bytes end within the
+ * object (the table path's room check: ctypes.sizeof
  * of the object); NULL: not proven (the Python path answers, or refuses as the table does).
  * Looked up after the values: Python may have run. */
-static char *array_mem(obj p, obj arr, ptrdiff_t n, long long count)
+static char *array_mem(obj p, obj arr, ptrdiff_t n, long long count, ptrdiff_t stride)
 {
     char *base = AT(arr, A.b_ptr), *to;
     ptrdiff_t off;
@@ -677,7 +681,7 @@ static char *array_mem(obj p, obj arr, ptrdiff_t n, long long count)
         return NULL;
     to = AT(p, A.carg_value);
     off = to - base;
-    if (off < 0 || off % (n / (ptrdiff_t)count) ||
+    if (off < 0 || off % (stride ? stride : n / (ptrdiff_t)count) ||
         off + n > *(ptrdiff_t *)((char *)arr + A.b_size))
         return NULL;
     return to;
@@ -765,7 +769,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     }
     /* (avalue checked the array's type and length: the bytes fit its start; an offset's
      * room: array_mem) */
-    mem = array_mem(args[at + 1], arr, n, ac);
+    mem = array_mem(args[at + 1], arr, n, ac, e->stride);
     if (!mem)
         goto drop;
     memcpy(mem, (char *)v + A.bdata, (size_t)n);
@@ -798,7 +802,7 @@ static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     if (v == PYTHON)
         goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize);
-    mem = array_mem(args[0], arr, n, 1); /* (again: Python may have run) */
+    mem = array_mem(args[0], arr, n, 1, e->stride); /* (again: Python may have run) */
     if (n <= 0 || !mem) {
         A.decref(v);
         goto python;

@@ -177,3 +177,38 @@ def test_byref_into_a_raw_buffer_answers_as_the_table(
             zero = (ctypes.c_ubyte * size)()
             assert getattr(gt, name).slow(*before, where, size, zero) == 0
     assert all(r == results[-1] for r in results), (name, t, length, at, where, size, results)
+
+
+@settings(
+    max_examples=examples(100, 15),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    length=st.integers(1, 4),
+    k=st.integers(-1, 5),
+    between=st.sampled_from([0, 0, 8, 26]),
+    axis=st.sampled_from([1, 1, 3]),
+)
+def test_byref_into_an_array_of_structures_answers_as_the_table(
+    moving_bus,  # noqa: F811
+    length,
+    k,
+    between,
+    axis,
+) -> None:
+    """``GT_GetTrapPrm(axis, byref(prm, k * sizeof(TTrapPrm)))`` (C's ``&prm[k]``) and the
+    array itself: the structure there as the table path writes it, or its refusal."""
+    offset = k * ctypes.sizeof(gt.TTrapPrm) + between
+    results = []
+    for f in _paths("GT_GetTrapPrm"):
+        arr = (gt.TTrapPrm * length)()
+        ctypes.memset(arr, 0x5A, ctypes.sizeof(arr))  # (padding and fields: all compared)
+        try:
+            p = arr if k == -1 and between == 0 else byref(arr, offset)
+        except (ValueError, TypeError):
+            pytest.skip("ctypes refuses the offset")
+        rc = f(axis, p)
+        results.append((rc, bytes(arr), gt.GTE_GetLastError() if rc else ""))
+    assert all(r == results[-1] for r in results), (length, offset, axis, results)
