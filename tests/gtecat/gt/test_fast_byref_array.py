@@ -53,6 +53,16 @@ TYPES = [
 ]
 
 
+def _settings(long: int, default: int) -> settings:
+    """A property test's settings here: derandomized, no deadline, the bus fixture kept."""
+    return settings(
+        max_examples=examples(long, default),
+        deadline=None,
+        derandomize=True,
+        suppress_health_check=[HealthCheck.function_scoped_fixture],
+    )
+
+
 def _paths(name: str) -> list:
     """The public function, its Python fast function (where it has a C entry in front),
     its table path."""
@@ -61,12 +71,7 @@ def _paths(name: str) -> list:
     return [f for f in (fn, python, fn.slow) if f is not None]
 
 
-@settings(
-    max_examples=examples(200, 25),
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@_settings(200, 25)
 @given(
     fn=st.sampled_from(FUNCTIONS),
     t=st.one_of(st.none(), st.none(), st.sampled_from(TYPES)),  # (None: the client's type)
@@ -130,12 +135,7 @@ RAW = [
 ]
 
 
-@settings(
-    max_examples=examples(200, 25),
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@_settings(200, 25)
 @given(
     fn=st.sampled_from(RAW),
     t=st.sampled_from([ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_char, ctypes.c_uint16]),
@@ -179,12 +179,7 @@ def test_byref_into_a_raw_buffer_answers_as_the_table(
     assert all(r == results[-1] for r in results), (name, t, length, at, where, size, results)
 
 
-@settings(
-    max_examples=examples(100, 15),
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@_settings(100, 15)
 @given(
     length=st.integers(1, 4),
     k=st.integers(-1, 5),
