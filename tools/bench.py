@@ -44,7 +44,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong, pointer
+from ctypes import byref, c_double, c_long, c_short, c_ubyte, c_ulong, pointer, sizeof
 from dataclasses import replace
 from pathlib import Path
 
@@ -200,11 +200,37 @@ CALL_SHAPES: dict[str, tuple[str, str]] = {
         "byref(c_double())",
     ),
     "GT_GetEncPos(1, byref(d))": ("gt.GT_GetEncPos(1, byref(d))", "byref(d)"),
+    # a pointer into an array (C's &d12[k]): byref of the array, with and without an offset
+    "GT_GetEncPos(9, byref(d12, 64), 4, None)": (
+        "gt.GT_GetEncPos(9, byref(d12, 64), 4, None)",
+        "byref(d12, 64)",
+    ),
+    "GT_GetPrfPos(2, byref(d12, 8), 1, None)": (
+        "gt.GT_GetPrfPos(2, byref(d12, 8), 1, None)",
+        "byref(d12, 8)",
+    ),
+    "GT_GetPrfPos(1, byref(d12), 1, None)": (
+        "gt.GT_GetPrfPos(1, byref(d12), 1, None)",
+        "byref(d12)",
+    ),
+    "GT_GetSts(1, byref(sts12, 8), 2)": ("gt.GT_GetSts(1, byref(sts12, 8), 2)", "byref(sts12, 8)"),
     "GT_GetPrfMode(1, byref(s))": ("gt.GT_GetPrfMode(1, byref(s))", "byref(s)"),
     "GT_GetClock(byref(clk))": ("gt.GT_GetClock(byref(clk))", "byref(clk)"),
     "GT_GetEcatEncPos(1, byref(s))": ("gt.GT_GetEcatEncPos(1, byref(s))", "byref(s)"),
     "GT_GetEcatRawData(0, 8, buf) c_ubyte[8]": ("gt.GT_GetEcatRawData(0, 8, buf)", "U8()"),
     "GT_GetEcatRawData(0, 8, byref(buf))": ("gt.GT_GetEcatRawData(0, 8, byref(buf))", "byref(buf)"),
+    "GT_GetEcatRawData(0, 4, byref(buf, 3))": (
+        "gt.GT_GetEcatRawData(0, 4, byref(buf, 3))",
+        "byref(buf, 3)",
+    ),
+    "GT_SetEcatRawData(32, 2, byref(buf, 2))": (
+        "gt.GT_SetEcatRawData(32, 2, byref(buf, 2))",
+        "byref(buf, 2)",
+    ),
+    "GT_EcatIOReadInput(2, 0, 2, byref(buf, 1))": (
+        "gt.GT_EcatIOReadInput(2, 0, 2, byref(buf, 1))",
+        "byref(buf, 1)",
+    ),
     "GT_GetEcatRawData(0, 8, c_ubyte[8]()) fresh": ("gt.GT_GetEcatRawData(0, 8, U8())", "U8()"),
     "GT_GetEcatRawData(0, 8, bytearray)": ("gt.GT_GetEcatRawData(0, 8, ba)", "bytearray(8)"),
     "GT_GetEcatRawData(0, 8, numpy uint8)": (
@@ -287,6 +313,7 @@ def _shape_env() -> dict[str, object]:
         "arr1": (c_long * 1)(),
         "sts2": (c_long * 2)(),
         "sts12": (c_long * 12)(),
+        "d12": (c_double * 12)(),
         "out2": bytes([0x0F, 0x00]),
         "tp": gt.TTrapPrm(),
         "counts": (c_ulong * 2)(),
@@ -371,7 +398,9 @@ def every_shape(
     in every way a client passes its value's pointer, with what building that argument
     costs: ``byref`` of a reused and of a fresh object, the ctypes object itself, a ctypes
     and a numpy array of one element, and NULL (0, None) for the optional pointer after it
-    (``count`` 1 first for the readers of a span); each call written out as a client writes
+    (``count`` 1 first for the readers of a span), a pointer into an array (``byref(arr)``,
+    ``byref(arr, k * sizeof(elem))``: C's ``&arr[k]``; for the readers of a span, two values
+    there too); each call written out as a client writes
     it (no ``*args``), with the statement that builds the same arguments and their names.
     ``names``: these functions instead (a comparison with another version).  The controller
     must be open.  Also the shapes not measured and why: a call
@@ -407,6 +436,8 @@ def every_shape(
             "held": held,
             "ref": byref(held),
             "arr": (t * 1)(),
+            "arr4": (t * 4)(),
+            "k": sizeof(t),
             "byref": byref,
             "np": np,
         }
@@ -419,7 +450,15 @@ def every_shape(
             f"byref({t.__name__}())": ("byref fresh", f"fn({x}byref(t()))", "byref(t())"),
             "s": ("object", f"fn({x}held)", "t()"),
             f"{t.__name__}[1]": ("array[1]", f"fn({x}arr)", "(t * 1)()"),
+            "byref(arr)": ("byref array", f"fn({x}byref(arr4))", "byref(arr4)"),
+            "byref(arr, k)": ("byref array offset", f"fn({x}byref(arr4, k))", "byref(arr4, k)"),
         }
+        if name in fast.READERS:
+            shapes["byref(arr, k), 2, None"] = (
+                "byref array span",
+                f"fn({x}byref(arr4, k), 2, None)",
+                "byref(arr4, k)",
+            )
         if t in dtypes:
             env["npa"], env["dt"] = np.zeros(1, dtypes[t]), dtypes[t]
             shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (

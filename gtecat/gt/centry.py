@@ -4,7 +4,9 @@
 spends about half its time checking the shape of its arguments and writing the value through
 ctypes.  The entry here (``csrc/centry.c``) does those two parts in C: it checks the shape
 (an exact ``int`` axis, ``count`` absent or 1, ``pClock`` absent, None or 0, the value's
-pointer ``byref(x)`` of an accepted ``x`` with no offset, or ``x`` itself), asks one Python
+pointer ``byref(x)`` of an accepted ``x`` with no offset, or ``x`` itself; a ctypes array, or
+``byref`` of one with an offset too - C's ``&arr[k]`` - takes the values from there where they
+fit before its end), asks one Python
 function of the reader for the value (``value(n)``: the number, or a sentinel when the entry
 must not answer - not the in-process lockstep controller, no such axis, any doubt), and
 writes the number into ``x``'s memory with ``x``'s width (a number the type does not hold:
@@ -126,6 +128,7 @@ class _Api(ctypes.Structure):
         ("tuple_pack", _VP),
         ("key_lists", _VP),
         ("key_seen", _VP),
+        ("b_size", ctypes.c_ssize_t),
     ]
 
 
@@ -175,6 +178,7 @@ class _Entry(ctypes.Structure):
         ("nptypes", _VP * 8),
         ("npsizes", ctypes.c_ssize_t * 8),
         ("npsigns", ctypes.c_ssize_t * 8),
+        ("stride", ctypes.c_ssize_t),
     ]
 
 
@@ -420,6 +424,25 @@ def _objects_at() -> int:
             if all(p._objects["1"] is x for p, x in zip(ps, xs, strict=False)):
                 return k
     raise ValueError("a ctypes object's kept objects are not where they are looked for")
+
+
+def _size_at() -> int:
+    """Where a ctypes object keeps its size in bytes (what ``ctypes.sizeof`` gives for the
+    object: a resized one's too; ValueError when the probe disagrees)."""
+    xs = [
+        ctypes.c_long(3),
+        ctypes.c_short(1),
+        (ctypes.c_double * 12)(),
+        (ctypes.c_ubyte * 3)(),
+        (ctypes.c_short * 5).from_buffer(bytearray(16), 2),
+    ]
+    grown = (ctypes.c_long * 2)()
+    ctypes.resize(grown, 40)
+    xs.append(grown)
+    for k in range(_HEAD, sys.getsizeof(xs[0]) - _WORD + 1, _WORD):
+        if all(ctypes.c_ssize_t.from_address(id(x) + k).value == ctypes.sizeof(x) for x in xs):
+            return k
+    raise ValueError("a ctypes object's size is not where it is looked for")
 
 
 def _bytes_at() -> tuple[int, int]:
@@ -690,6 +713,7 @@ def _load() -> tuple[Maker | None, str]:
         bsize, bdata = _bytes_at()
         bastart = _bytearray_at(bsize)
         objects_at = _objects_at()
+        size_at = _size_at()
         epoch_at = _epoch_at()
         owner_at = _owner_at()
         titems = _tuple_at(bsize)
@@ -760,6 +784,7 @@ def _load() -> tuple[Maker | None, str]:
             _address("PyTuple_Pack"),
             id(_KEY_LISTS),
             id(_KEY_SEEN),
+            size_at,
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -823,6 +848,8 @@ def _load() -> tuple[Maker | None, str]:
         e.avalue = id(array) if array is not None else None
         e.gate = gate
         e.after = id(after) if after is not None else None
+        # (a structure's array: its elements sizeof apart, its value the fields' bytes)
+        e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1018,7 +1045,14 @@ def _self_test(make: Maker) -> str:
         (arrays, (2,), lambda: (o := A3(), o, o), (2,), None),
         (arrays, (1,), lambda: (o := A3(), o, o), (2.0,), None),
         (arrays, (1,), lambda: (o := (ctypes.c_int64 * 4)(), o, o), (2,), None),
-        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o), o), (2,), None),
+        # byref(array[, offset]): C's &array[k], where count whole elements fit behind it
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o), o), (2,), [5, 6, 0]),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 8), o), (2,), [0, 5, 6]),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 16), o), (1, 0), [0, 0, 5]),
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 16), o), (2,), None),  # past
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 24), o), (), None),  # at the end
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 4), o), (), None),  # mid-element
+        (arrays, (1,), lambda: (o := A3(), ctypes.byref(o, 8), o), (3,), None),
         (arrays, (1,), lambda: (o := L(), o, o), (), 7),
         (clock, (), lambda: (o := ctypes.c_uint32(), ctypes.byref(o), o), (), 7),
         (clock, (), lambda: (o := ctypes.c_uint32(), o, o), (None,), 7),
@@ -1315,7 +1349,11 @@ def _self_test_raw(make_raw: Maker) -> str:
         (get, (0, 2.0), lambda: (o := U8(), o, None)),
         (get, (0, 1 << 70), lambda: (o := U8(), o, None)),
         (get, (0, 2), lambda: (o := (ctypes.c_ubyte * 9)(), o, None)),  # another type
-        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), None)),
+        # byref(array, offset) (C's &buf[k]): the size's bytes from there, within the array
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 1), bytes([0, 0, 1, 0, 0, 0, 0, 0]))),
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 6), bytes([0] * 6 + [0, 1]))),
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 7), None)),  # past its end
+        (get, (0, 2), lambda: (o := U8(), ctypes.byref(o, 8), None)),
         (get, (0,), lambda: (o := U8(), o, None)),
         (bget, (4, 8), lambda: (o := bytearray(9), o, bytes([*range(4, 12), 0]))),
         (bget, (4, 8), lambda: (o := bytearray(7), o, None)),  # too short
@@ -1490,7 +1528,8 @@ def raw(
     changed: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
-    ctypes array (or ``byref`` of one, no offset), a bytearray, a one-dimensional
+    ctypes array (or ``byref`` of one, with an offset too: C's ``&buf[k]``, where the
+    ``size`` bytes from there end within the array), a bytearray, a one-dimensional
     C-contiguous numpy array of uint8 or a memoryview of format ``B`` (one dimension,
     C-contiguous) of at least ``size`` bytes (or bytes, where ``write``; writable, where
     not) and plain ints copies the runs that

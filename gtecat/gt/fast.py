@@ -47,6 +47,55 @@ _from_address = ctypes.c_void_p.from_address
 _AT = CARG_AT if CARG_AT is not None else -1
 
 
+_ARRAY_META = type(ctypes.Array)
+
+
+def array_at(p: Any) -> Any:
+    """The elements ``byref(array[, offset])`` points at (C's ``&array[k]``): the array itself
+    for no offset, else a ctypes array of its element type over its memory from the
+    pointer's address to the object's end (keeping the array alive), which a fast path
+    writes as it writes an array (its length is the table path's room behind the pointer);
+    None where ``p`` is not a byref of a ctypes array or its address is not at a whole
+    element inside it (the table path answers, or refuses: an offset outside the object)."""
+    if type(p) is not _CArg:
+        return None
+    arr = p._obj
+    tp = type(arr)
+    if type(tp) is not _ARRAY_META:
+        return None
+    off = (_from_address(id(p) + _AT).value if _AT >= 0 else byref_address(p)) - _addressof(arr)
+    if off == 0:
+        return arr
+    elem = tp._type_
+    size = ctypes.sizeof(elem)
+    total = ctypes.sizeof(arr)
+    if off < 0 or off % size or off >= total:
+        return None
+    try:
+        return (elem * ((total - off) // size)).from_buffer(arr, off)
+    except (TypeError, ValueError):  # (memory ctypes does not export writable: the table)
+        return None
+
+
+def element_at(p: Any, ok: Any) -> Any:
+    """The element ``byref(array[, offset])`` points at (C's ``&array[k]``), as a ctypes
+    object of the array's element type over that memory, where that type is one of ``ok``
+    and the address is at a whole element inside the array; else None (the table path)."""
+    arr = p._obj
+    tp = type(arr)
+    if type(tp) is not _ARRAY_META or tp._type_ not in ok:
+        return None
+    elem = tp._type_
+    off = (_from_address(id(p) + _AT).value if _AT >= 0 else byref_address(p)) - _addressof(arr)
+    size = ctypes.sizeof(elem)
+    if off < 0 or off % size or off + size > ctypes.sizeof(arr):
+        return None
+    try:
+        return elem.from_buffer(arr, off)
+    except (TypeError, ValueError):  # (memory ctypes does not export writable: the table)
+        return None
+
+
 _status = AxisResources.status
 #: a C ``short`` argument's range (the table binder's check of ``axis`` and ``count``)
 _SHORT_MIN, _SHORT_MAX = -(1 << 15), (1 << 15) - 1
@@ -202,8 +251,10 @@ def fast_reader(
         """Every other shape: count 1, pClock NULL (0 or None, the manual's own form), an
         array, a numpy array, and anything the table path must answer."""
         ctl = session.controllers.get(1)
+        # byref(array[, offset]) (C's &array[k]): its elements from there, as an array's
+        q = p if type(p) is not _CArg else (array_at(p) or p)
         if type(count) is int and count > 1:
-            rc = many(ctl, n, p, count, pClock, extra, kw)
+            rc = many(ctl, n, q, count, pClock, extra, kw)
             if rc is not None:
                 return rc
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO), *extra, **kw)
@@ -224,7 +275,7 @@ def fast_reader(
         clock = ctl.clock
         if res is None or clock._thread is not None:
             return slow(*(a for a in (n, p, count, pClock) if a is not _NO))
-        tp = type(p)
+        tp = type(q)
         if tp is _CArg:
             obj = p._obj
             if p is not last[0]:
@@ -238,7 +289,7 @@ def fast_reader(
         elif tp in ctypes_ok:  # the ctypes object itself (ctypes passes it by reference)
             p.value = get(res)
         elif is_array(tp):
-            p[0] = get(res)
+            q[0] = get(res)
         elif (
             tp is _NDARRAY
             and p.dtype in np_ok
@@ -433,8 +484,9 @@ def fast_reader(
         ):
             # count axes of a core beyond 32 axes (a view of core 1's bus): core 1's own way
             # with the bus axes, where it answers (else the table path of that core)
+            q = p if type(p) is not _CArg else (array_at(p) or p)  # (as general)
             rc = many(
-                session.controllers.get(1), n + AXES_PER_CORE * (core - 1), p, count, pClock,
+                session.controllers.get(1), n + AXES_PER_CORE * (core - 1), q, count, pClock,
                 extra, kw, zeros=False,
             )  # fmt: skip
             if rc is not None:
@@ -684,15 +736,16 @@ def _entry(
     size: int = 0,
     gate: int = centry.NO_GATE,
     after: Callable[[], int] | None = None,
+    array: Callable[..., Any] | None = None,
 ) -> Any:
     """A two-argument reader's public function: its C entry in front of its Python fast
     function ``gt`` (:func:`centry.reader`: ``value(n)`` the value, or ``_NO``), where
     :data:`CENTRY` is on and the entry is available; else ``gt``; ``gate``: as
-    :func:`centry.reader`'s."""
+    :func:`centry.reader`'s; ``array``: its ``array`` (an integer reader's: the first
+    element's, made here)."""
     if not CENTRY:
         return gt
     numpy: list[Any] = []
-    array = None
     if kind == centry.INT:  # (an integer reader: its integer types; any other, the Python)
         types = [t for t in types if getattr(t, "_type_", "") in _INT_CODES]
         numpy = _int_dtypes(types)  # (the Python path's numpy shape: _array_first)
@@ -948,8 +1001,10 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
 #: and the type is one the reader writes (one C call, :mod:`gtecat.gt.byref_target`) ...
 _BYREF_C = """\
                 obj = TARGET(p)
-                if obj is p:  # byref(obj, offset), another type: the table path
-                    return {fallback}"""
+                if obj is p:  # byref(array[, offset]): the element there (C's &array[k]) ...
+                    obj = element_at(p, ok)
+                    if obj is None:  # ... else byref(obj, offset), another type: the table
+                        return {fallback}"""
 #: ... or, where that is not available, read from Python (a reused pointer checked once)
 _BYREF_PY = """\
                 obj = p._obj
@@ -957,14 +1012,17 @@ _BYREF_PY = """\
                     # byref(obj), not byref(obj, offset); any doubt: the table path
                     kind = type(obj)
                     if (kind is not T0 and kind not in ok) or {address} != _addressof(obj):
-                        return {fallback}
-                    if _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
+                        obj = element_at(p, ok)  # (byref(array[, offset]): C's &array[k])
+                        if obj is None:
+                            return {fallback}
+                    elif _refs(p) > KEPT:  # the caller keeps it (a reused pointer):
                         LAST_P = p  # checked, the same object next time needs no check"""
 
 
 def _byref_check(env: dict[str, Any], types: frozenset) -> str:
     """The byref branch's source for a reader of ``types`` (its names go into ``env``)."""
     env.update(CARG_ENV)
+    env["element_at"] = element_at
     if BYREF_TARGET:
         f = byref_target.target(types)
         if f is not None:
@@ -1141,18 +1199,23 @@ def fast_clock(
                 clock = ctl.clock
                 if clock._thread is None:
                     tp = type(pClock)
+                    q = pClock
                     if tp is _CArg:
                         obj = target(pClock)
-                        if obj is pClock:  # (byref(x, offset), another type: the table path)
+                        if obj is pClock:  # byref(array[, offset]): its elements from there
+                            q = array_at(pClock)
                             obj = None
+                            tp = type(q)  # (None's: another byref, the table path)
                     elif tp in _CLOCK_INTS:
                         obj = pClock
-                    else:  # an array: its first element
-                        b = first(pClock, tp)
+                    else:
+                        obj = None
+                    if obj is None:  # an array: its first element
+                        b = first(q, tp)
                         if b is not None:
                             ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
                             if ms <= b[1]:
-                                pClock[0] = ms
+                                q[0] = ms
                                 session.last = None
                                 if clock.mode is _LOCKSTEP:
                                     return 0
@@ -1894,12 +1957,7 @@ SLOW_REASONS: dict[str, str] = {
 #: a client's shapes of a fast function's value pointer that the table path answers, and why
 #: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
 #: other that reaches the table)
-SLOW_SHAPES: dict[str, dict[str, str]] = {
-    "GT_GetTrapPrm": {
-        "array[1]": "an array of structures for one structure: the table path checks its "
-        "type and size (the fast path takes the structure, or byref of it)"
-    },
-}
+SLOW_SHAPES: dict[str, dict[str, str]] = {}
 
 
 def fast_functions() -> frozenset[str]:
@@ -2000,6 +2058,7 @@ def fast_ecat_reader(
         "ACCS": {},
         "_pdo_entry": _pdo_entry,
         "first": _array_first(ok),
+        "array_at": array_at,
         "last": [None],
         "_refs": sys.getrefcount,
         "KEPT": _KEPT,
@@ -2053,8 +2112,12 @@ def value(n):
 #: the byref branch of a PDO reader: one C call (see _BYREF_C) ...
 _ECAT_BYREF_C = """\
                     obj = TARGET(p)
-                    if obj is p:  # byref(obj, offset), another type: the table path
-                        return slow(n, p)"""
+                    if obj is p:  # byref(array[, offset]): its elements from there
+                        q = array_at(p)
+                        b = None if q is None else first(q, type(q))
+                        if b is None:  # (byref(x, offset), another type: the table path)
+                            return slow(n, p)
+                        obj = None"""
 #: ... else read from Python
 _ECAT_BYREF_PY = """\
                     obj = p._obj
@@ -2091,6 +2154,7 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
             _, acc, cell, fits = kept  # (acc None: not mapped; the table path says so)
             if acc is not None:
                 tp = type(p)
+                q = p
                 if tp is _CArg:
 {byref}
                 elif tp in ok:
@@ -2105,7 +2169,7 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
                 if obj is None:
                     done = b[0] <= v <= b[1]
                     if done:
-                        p[0] = v
+                        q[0] = v
                 else:
                     kind = type(obj)
                     done = kind in fits or BOUNDS[kind][0] <= v <= BOUNDS[kind][1]
@@ -2227,7 +2291,7 @@ def fast_homing_status(
                         if arr is None:
                             obj.value = v
                         else:
-                            p[0] = v
+                            obj[0] = v
                         session.last = None
                         if ctl.clock.mode is _LOCKSTEP:
                             return 0
@@ -2395,6 +2459,15 @@ def fast_struct_reader(
         raise ValueError(f"{name}: not a function of one axis")
     cls, mode, fill = STRUCT_READERS[name]
     target = _target([cls])
+    one = frozenset([cls])
+    arrays: dict[type, bool] = {}
+
+    def is_array(tp: type) -> bool:
+        """An array of the structure (at least one): its first element takes it."""
+        ok = arrays.get(tp)
+        if ok is None:
+            ok = arrays[tp] = issubclass(tp, ctypes.Array) and tp._type_ is cls and tp._length_ >= 1
+        return ok
 
     def ready(n: int) -> Any:
         """(the controller, axis ``n``'s resources) where the fast path answers, else None
@@ -2418,10 +2491,12 @@ def fast_struct_reader(
             tp = type(p)
             if tp is _CArg:
                 s = target(p)
-                if s is p:
-                    s = None
-            else:
-                s = p if tp is cls else None
+                if s is p:  # byref(array[, offset]): the structure there (C's &prm[k])
+                    s = element_at(p, one)
+            elif tp is cls:
+                s = p
+            else:  # an array of structures: its first (ctypes' element shares its memory)
+                s = p[0] if is_array(tp) else None
             got = None if s is None else ready(n)
             if got is not None:
                 ctl, res = got
@@ -2451,9 +2526,19 @@ def fast_struct_reader(
     inline = getattr(to_bytes, "inline", "b = TO_BYTES(res)")  # (to_bytes' steps inline)
     code = _STRUCT_VALUE.replace("{bytes}", "\n".join("        " + x for x in inline.split("\n")))
     exec(_compiled_code(code, f"<gt struct value {name}>"), _gated(env))
+    value = env["value"]
+
+    def first(n: Any, count: Any, tp: type, clock: Any) -> Any:
+        """The C entry's bytes for an array of the structure (or byref of one, with an
+        offset too: its entry checks the room): the first element's, as ``gt`` writes it."""
+        if count != 1 or clock is not None or not is_array(tp):
+            return _NO
+        return value(n)
+
     return _entry(  # type: ignore[no-any-return]
-        gt, env["value"], [cls], centry.BYTES, size, centry.GT_GATE, _after(advance, name, 0)
-    )
+        gt, value, [cls], centry.BYTES, size, centry.GT_GATE, _after(advance, name, 0),
+        array=first,
+    )  # fmt: skip
 
 
 #: a structure reader's value for its C entry (asked while the GT_ gate is open: CTL the
@@ -2637,7 +2722,7 @@ def fast_core(
                 if arr is None:
                     obj.value = core
                 else:
-                    p[0] = core
+                    obj[0] = core
                 session.last = None
                 ctl = session.controllers.get(core)
                 if ctl is None or ctl.clock.mode is _LOCKSTEP:
@@ -2697,13 +2782,19 @@ def _value_target(
     p: Any, target: Callable[[Any], Any], ok: Any, first: Callable[[Any, type], Any]
 ) -> tuple[Any, Any]:
     """Where a one-value reader's Python path writes: ``(x, None)`` for ``byref(x)`` with no
-    offset (``target``) or ``x`` itself of one of ``ok``, ``(p, bounds)`` for an array whose
-    first element takes the value (``first``: the range that element holds), else
-    ``(None, None)`` (the table path answers)."""
+    offset (``target``) or ``x`` itself of one of ``ok``, ``(array, bounds)`` for an array
+    whose first element takes the value (``first``: the range that element holds; ``p``, or
+    the elements ``byref(array[, offset])`` points at), else ``(None, None)`` (the table path
+    answers)."""
     tp = type(p)
     if tp is _CArg:
         obj = target(p)
-        return (None, None) if obj is p else (obj, None)
+        if obj is not p:
+            return obj, None
+        p = array_at(p)  # byref(array[, offset]): its elements from there
+        if p is None:
+            return None, None
+        tp = type(p)
     if tp in ok:
         return p, None
     arr = first(p, tp)
@@ -2816,6 +2907,7 @@ def fast_io_reader(
         "wide": wide,
         "bounds": bounds,
         "first": first,
+        "array_at": array_at,
         "plan": plan,
         # the inputs' readers keep the bank's axes (bank.BANK_READS: they read the image)
         "RELEASES": name not in BANK_READS,
@@ -2848,10 +2940,13 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
             clock = ctl.clock
             if clock._thread is None and session.note is None:
                 tp = type(p)
+                q = p
                 if tp is _CArg:
                     obj = target(p)
-                    if obj is p:  # (byref(x, offset), another type: the table path)
-                        obj = _NO
+                    if obj is p:  # byref(array[, offset]): its elements from there
+                        q = array_at(p)
+                        b = None if q is None else first(q, type(q))
+                        obj = _NO if b is None else None
                 elif tp is T0 or tp in ok:
                     obj = p
                 else:
@@ -2872,7 +2967,7 @@ def gt(t=_NO, p=_NO, /, *extra, **kw):
                     else:  # an array's first element
                         done = b[0] <= v <= b[1]
                         if done:
-                            p[0] = v
+                            q[0] = v
                     if done:  # (else a value the type cannot hold: the table's code)
                         session.last = None
                         if clock.mode is _LOCKSTEP:

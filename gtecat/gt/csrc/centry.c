@@ -2,7 +2,9 @@
  *
  * GT_GetSts(1, byref(s)) and its kind: the shape of the call is checked here (an exact int
  * for the axis, count absent or 1, pClock absent, None or 0, the value's pointer resolved to
- * the memory of an accepted ctypes object as the byref check does), the reader's value comes
+ * the memory of an accepted ctypes object as the byref check does; a ctypes array, or byref of
+ * one with or without an offset - C's &arr[k] - takes a span's values from that address where
+ * they end within the object: array_of, array_mem), the reader's value comes
  * from one Python call (value(n): a number, or a sentinel when the C entry must not answer),
  * and the number is written into the object's memory with the object's width (a reader of
  * a structure: value(n) gives its bytes, copied whole).  Anything
@@ -10,7 +12,7 @@
  * reader's Python fast function called with the very same arguments, which answers as before.
  *
  * The raw image functions (GT_GetEcatRawData(offset, size, buf) and their kind) have an entry
- * of their own: a ctypes array (or byref of one, no offset), a bytearray, a numpy uint8
+ * of their own: a ctypes array (or byref of one, with an offset too), a bytearray, a numpy uint8
  * array or a memoryview of bytes (or, to write from, bytes) long enough, and plain ints
  * checked here, the runs of the range in the process image from one Python call
  * (value(offset, size, type), as int64 triples in a bytes object: that function checks
@@ -123,6 +125,9 @@ struct api {
     obj (*tuple_pack)(ptrdiff_t, ...);
     obj key_lists;
     obj key_seen;
+    /* a ctypes object's size in bytes (b_size: what ctypes.sizeof gives for the object, the
+     * extent byref(x, offset) is checked against) */
+    ptrdiff_t b_size;
 };
 
 #define MAX_TYPES 16
@@ -170,6 +175,9 @@ struct entry {
     obj nptypes[8];
     ptrdiff_t npsizes[8];
     ptrdiff_t npsigns[8];
+    /* an array's element stride where it is not the value's bytes per element (a structure
+     * reader: the structure's size, its value the fields' bytes); 0: the bytes' own */
+    ptrdiff_t stride;
 };
 
 static struct api A;
@@ -196,7 +204,8 @@ int gtecat_centry_api(const struct api *api)
         !api->err_restore || !api->clock_calls || !api->arms ||
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
-        !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen)
+        !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
+        api->b_size <= 0)
         return 1;
     A = *api;
     ready = 1;
@@ -640,6 +649,44 @@ static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *
     return *mem != NULL;
 }
 
+/* The ctypes array a reader's value pointer p passes: p itself, or the array of
+ * byref(array[, offset]) (C's &array[k]); NULL where p is neither. */
+static obj array_of(obj p)
+{
+    obj t;
+    if (TYPE(TYPE(p)) == A.array_meta)
+        return p;
+    if (TYPE(p) == A.carg_type && (t = AT(p, A.carg_obj)) != NULL &&
+        TYPE(TYPE(t)) == A.array_meta)
+        return t;
+    return NULL;
+}
+
+/* Where n bytes (count whole elements of arr's, each of stride bytes apart where stride is
+ * not 0) go for p (array_of(p) is arr): the array's start, or the address byref(arr, offset)
+ * passes where that is inside the array at a whole element and the n bytes end within the
+ * object (the table path's room check: ctypes.sizeof
+ * of the object); NULL: not proven (the Python path answers, or refuses as the table does).
+ * Looked up after the values: Python may have run. */
+static char *array_mem(obj p, obj arr, ptrdiff_t n, long long count, ptrdiff_t stride)
+{
+    char *base = AT(arr, A.b_ptr), *to;
+    ptrdiff_t off;
+    if (!base)
+        return NULL;
+    if (p == arr)
+        return base;
+    if (TYPE(p) != A.carg_type || AT(p, A.carg_obj) != arr || count < 1 || n <= 0 ||
+        n % count)
+        return NULL;
+    to = AT(p, A.carg_value);
+    off = to - base;
+    if (off < 0 || off % (stride ? stride : n / (ptrdiff_t)count) ||
+        off + n > *(ptrdiff_t *)((char *)arr + A.b_size))
+        return NULL;
+    return to;
+}
+
 /* A reader's ctypes array (count from n, pClock NULL or a clock's pointer): the bytes
  * avalue(n, count, array type, clock) gives (clock None or 1: then the clock's value
  * follows the values as an int64) copied to its start, kept for the epoch. */
@@ -681,9 +728,9 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
 }
 
 static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
-                 ptrdiff_t at, int locked)
+                 ptrdiff_t at, obj arr, int locked)
 {
-    obj call[4], v, tp = TYPE(args[at + 1]);
+    obj call[4], v, tp = TYPE(arr);
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
@@ -720,8 +767,9 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
         if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem)
             goto drop;
     }
-    /* (avalue checked the array's type and length: the bytes fit) */
-    mem = AT(args[at + 1], A.b_ptr);
+    /* (avalue checked the array's type and length: the bytes fit its start; an offset's
+     * room: array_mem) */
+    mem = array_mem(args[at + 1], arr, n, ac, e->stride);
     if (!mem)
         goto drop;
     memcpy(mem, (char *)v + A.bdata, (size_t)n);
@@ -739,14 +787,14 @@ python:
  * type, None) gives (its value in the first element; it checks the array's type and
  * length) copied to the array's start, kept for the epoch as array()'s. */
 static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
-                    int locked)
+                    obj arr, int locked)
 {
     obj call[4], v;
     ptrdiff_t n;
     char *mem;
     call[0] = A.zero;
     call[1] = A.one;
-    call[2] = TYPE(args[0]);
+    call[2] = TYPE(arr);
     call[3] = A.none;
     v = array_value(e, call, 0, 1, 0, locked);
     if (!v || v == AGAIN)
@@ -754,7 +802,7 @@ static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     if (v == PYTHON)
         goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize);
-    mem = AT(args[0], A.b_ptr); /* (again: Python may have run) */
+    mem = array_mem(args[0], arr, n, 1, e->stride); /* (again: Python may have run) */
     if (n <= 0 || !mem) {
         A.decref(v);
         goto python;
@@ -834,7 +882,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
                int locked)
 {
     ptrdiff_t at = e->core;
-    obj p, target, tp, v;
+    obj p, target, tp, v, arr;
     char *mem;
     obj deref = NULL;
     int k, size = 0, sign = 1, npy = 0;
@@ -849,8 +897,8 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
             goto python;
         p = args[0];
-        if (e->avalue && TYPE(TYPE(p)) == A.array_meta)
-            return first_of(e, args, nargs, kwnames, locked);
+        if (e->avalue && (arr = array_of(p)) != NULL)
+            return first_of(e, args, nargs, kwnames, arr, locked);
     } else {
         if (nargs < 2 + at || nargs > e->most + at)
             goto python;
@@ -858,8 +906,8 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             goto python;
         if (TYPE(args[at]) != A.int_type)
             goto python;
-        if (e->avalue && TYPE(TYPE(args[at + 1])) == A.array_meta)
-            return array(e, args, nargs, kwnames, at, locked);
+        if (e->avalue && (arr = array_of(args[at + 1])) != NULL)
+            return array(e, args, nargs, kwnames, at, arr, locked);
         /* (the cached small ints 1 and 0 first: one compare for the common literals) */
         if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
@@ -1049,8 +1097,16 @@ static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long siz
     }
     if (TYPE(t) != A.array_meta)
         return NULL;
-    if (target != p && AT(p, A.carg_value) != AT(target, A.b_ptr))
-        return NULL; /* byref(array, offset), or the array's memory moved since */
+    if (target != p) {
+        /* byref(array[, offset]) (C's &array[k]): its address, where the size's bytes from
+         * there end within the object (the table path's room: ctypes.sizeof of it; any byte
+         * offset, as the table path's byte pointer takes it); else (past the end, before
+         * the start, the array's memory moved since) the Python path answers */
+        char *base = AT(target, A.b_ptr), *to = AT(p, A.carg_value);
+        if (!base || to < base || (to - base) + size > *(ptrdiff_t *)((char *)target + A.b_size))
+            return NULL;
+        return to;
+    }
     return AT(target, A.b_ptr);
 }
 
@@ -1076,7 +1132,7 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             goto python;
     p = args[2 + at];
     target = p;
-    if (TYPE(p) == A.carg_type) { /* byref(array) with no offset: the array (raw_mem) */
+    if (TYPE(p) == A.carg_type) { /* byref(array[, offset]): the array (raw_mem) */
         target = AT(p, A.carg_obj);
         if (!target)
             goto python;

@@ -73,6 +73,9 @@ def test_record_then_replay_matches(recorded: Path, capsys: pytest.CaptureFixtur
     assert any("cp" in e for e in entries)
     sts = [e for e in entries if e.get("c") == "GT_GetSts"]
     assert any(int(e["o"]["1"]["ref"]["v"]) & 2 for e in sts if "o" in e)  # the alarm was seen
+    # a pointer into an array (answered by the fast path): kept with its offset
+    enc = [e for e in entries if e.get("c") == "GT_GetEncPos"]
+    assert enc and enc[-1]["a"][1]["off"] == 16 and enc[-1]["r"] == 0
     assert main(["replay", str(recorded)]) == 0
     assert "calls match" in capsys.readouterr().out
 

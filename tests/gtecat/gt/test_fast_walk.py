@@ -5,9 +5,11 @@ pointer its value goes to is passed in each shape a client uses - ``byref`` of a
 of a fresh object, the ctypes object itself, a ctypes array and a numpy array (their first
 element), NULL (0 or None) for the optional pointers after it - and in shapes the table path
 refuses or converts (an offset, a narrower or a floating type, numpy dtypes of every width,
-a two-dimensional array).  Every call answers as the table path does (code, what was written,
-reason); a client's shape that reaches the table must be listed in ``fast.SLOW_SHAPES`` with
-its reason.
+a two-dimensional array), and a pointer into an array (``byref(arr)``, ``byref(arr, k *
+sizeof(elem))``: C's ``&arr[k]``, a span of values there for the readers of a span; past its
+end, between two elements or of a narrower element the table path refuses).  Every call
+answers as the table path does (code, what was written, reason); a client's shape that
+reaches the table must be listed in ``fast.SLOW_SHAPES`` with its reason.
 """
 
 from __future__ import annotations
@@ -29,10 +31,25 @@ from .conftest import bring_up
 #: the value a function reads first (an axis, an input or output type)
 FIRST = {"GT_GetDi": 3, "GT_GetDiRaw": 0, "GT_GetDo": 10}
 #: a client's shapes: each must be answered by the fast path (or listed in SLOW_SHAPES)
-CLIENT = ("byref reused", "byref fresh", "object", "array[1]", "numpy[1]", "null 0", "null None")
-#: other shapes: answered as the table answers them, by whichever path
+CLIENT = (
+    "byref reused",
+    "byref fresh",
+    "object",
+    "array[1]",
+    "numpy[1]",
+    "null 0",
+    "null None",
+    "byref array",
+    "byref array offset",
+)
+#: other shapes: answered as the table answers them, by whichever path (a span of the
+#: readers' values into an array: the fast path's, whose steps the walk's profile counts
+#: with the table's)
 OTHER = (
-    "offset",
+    "byref array span",
+    "byref array past",
+    "byref array mid",
+    "byref array narrow",
     "narrow",
     "double",
     "array[2] uint",
@@ -83,7 +100,12 @@ def _arg(shape: str, t: type) -> tuple[object, object, tuple]:
         "object": lambda: (o := t(), o),
         "array[1]": lambda: (o := (t * 1)(), o),
         "numpy[1]": lambda: (o := np.zeros(1, _NP.get(t, np.int64)), o),
-        "offset": lambda: (o := (t * 2)(), byref(o, ctypes.sizeof(t))),
+        "byref array": lambda: (o := (t * 2)(), byref(o)),
+        "byref array offset": lambda: (o := (t * 3)(), byref(o, ctypes.sizeof(t))),
+        "byref array span": lambda: (o := (t * 4)(), byref(o, ctypes.sizeof(t))),
+        "byref array past": lambda: (o := (t * 2)(), byref(o, 2 * ctypes.sizeof(t))),
+        "byref array mid": lambda: (o := (t * 2)(), byref(o, 1)),
+        "byref array narrow": lambda: (o := (ctypes.c_int8 * 8)(), byref(o, 1)),
         "narrow": lambda: (o := ctypes.c_int8(), byref(o)),
         "double": lambda: (o := ctypes.c_double(), byref(o)),
         "array[2] uint": lambda: (o := (ctypes.c_uint * 2)(), o),
@@ -138,8 +160,12 @@ def _walk(names: list[str]) -> list[str]:
         for shape in CLIENT + OTHER:
             if shape.startswith("null") and not _has_null_after(name):
                 continue
+            if shape == "byref array span" and name not in fast.READERS:
+                continue
             if shape.startswith("null") and name in fast.READERS:
                 shape_args = (1,)  # (count 1, then pClock NULL)
+            elif shape == "byref array span":
+                shape_args = (2, None)  # (two axes' values from the array's second element)
             else:
                 shape_args = ()
             got = []
