@@ -2023,9 +2023,11 @@ def fast_ecat_reader(
     """``GT_GetEcatEncPos(axis, p)`` and the other per-axis PDO readers with the fast path in
     front of the table: ``p`` a ``byref`` (no offset) or the object itself of a number type
     the pointer takes, holding the value; the axis on the in-process controller's bus (no
-    pulse card), its link up, the object mapped, and not run by the axis bank at the moment
-    (its objects are then its own: the table path gives it back first).  Anything else
-    (an error included) takes the table path, which gives the code and the reason."""
+    pulse card), its link up, the object mapped.  An axis the axis bank runs is read where
+    it is, past its guard (the table path would give it back, and the bank claim it again at
+    its next cycle): the bank writes its drives' TxPDO into the image every cycle it runs
+    them, and their other entries do not change while it does.  Anything else (an error
+    included) takes the table path, which gives the code and the reason."""
     from ..controller.axis import Axis
     from .args import _scalar_types
     from .table import FUNCTIONS
@@ -2047,6 +2049,7 @@ def fast_ecat_reader(
         "_LOCKSTEP": _LOCKSTEP,
         "_addressof": _addressof,
         "_AXIS": Axis,
+        "_get": object.__getattribute__,
         "session": session,
         "advance": advance,
         "name": name,
@@ -2093,11 +2096,10 @@ def value(n):
         return _NO
     m = ctl.master
     if (
-        type(ax) is _AXIS
-        and m is not None
+        m is not None
         and m.opened
         and ctl.card is None
-        and not ax.link_lost
+        and not (ax.link_lost if type(ax) is _AXIS else _get(ax, "link_lost"))
     ):
         kept = ACCS.get(n)
         if kept is not None and kept[0] is ax and kept[1] is not None:
@@ -2138,19 +2140,21 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
         clock = ctl.clock
         m = ctl.master
         if (
-            type(ax) is _AXIS  # (a guarded axis, the bank's: the table path)
-            and session.plain  # (in this process, core 1)
+            session.plain  # (in this process, core 1)
             and clock._thread is None
             and m is not None
             and m.opened
             and ctl.card is None
-            and not ax.link_lost
+            # (an axis the bank runs is read past its guard, which would give it back: the
+            # bank writes its drives' TxPDO into the image every cycle it runs them)
+            and not (ax.link_lost if type(ax) is _AXIS else _get(ax, "link_lost"))
         ):
             kept = ACCS.get(n)  # (the axis's entry, kept: AxisIo.get keeps it too)
             if kept is None or kept[0] is not ax:
                 if len(ACCS) > 4096:
                     ACCS.clear()
-                kept = ACCS[n] = _pdo_entry(ax, ax.io.get(INDEX, SUB), BOUNDS)
+                io = ax.io if type(ax) is _AXIS else _get(ax, "io")
+                kept = ACCS[n] = _pdo_entry(ax, io.get(INDEX, SUB), BOUNDS)
             _, acc, cell, fits = kept  # (acc None: not mapped; the table path says so)
             if acc is not None:
                 tp = type(p)

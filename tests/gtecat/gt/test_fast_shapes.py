@@ -35,7 +35,7 @@ from gtecat.controller.epoch import changed
 from gtecat.controller.motion.trap import TrapPlanner
 from gtecat.gt import fast
 from gtecat.gt.table import FUNCTIONS, declared_only
-from tests.conftest import LONG
+from tests.conftest import EXAMPLES, LONG
 
 ENI = Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni"
 
@@ -364,6 +364,54 @@ def test_the_pdo_readers_answer_as_the_table() -> None:
                             continue
                         bad.append(f"{name}({axis}) {shape} {t.__name__}: took the table path")
     assert not bad, "\n".join(bad[:10])
+
+
+def _poll_pdo_while_moving(read: str, clock: str) -> tuple[list[tuple[int, ...]], int]:
+    """A drive mapping every object the per-axis PDO readers read (6064h, 606Ch, 60F4h,
+    60FDh, 60FEh, 6077h, 6078h, 603Fh) in a Trap move, each read every cycle (``read``:
+    "fast", the functions, or "slow", their table path, which gives a banked axis back): the
+    values, and at how many polls the axis was still banked after them."""
+    assert gt.GT_Open(eni=str(EXAMPLES / "full_servo.eni"), clock=clock, log="") == 0
+    assert gt.GT_InitEcatComm() == 0
+    gt.GTE_Wait(200)
+    assert gt.GT_StartEcatComm() == 0
+    assert gt.GT_AxisOn(1) == 0
+    ctl = gt.GTE_Controller()
+    assert gt.GT_PrfTrap(1) == 0
+    prm = gt.TTrapPrm(acc=0.5, dec=0.5, velStart=0, smoothTime=0)
+    assert gt.GT_SetTrapPrm(1, byref(prm)) == 0
+    assert gt.GT_SetVel(1, 40) == 0
+    assert gt.GT_SetPos(1, 30_000) == 0
+    assert gt.GT_Update(1) == 0
+    names = sorted(fast.ECAT_READERS)
+    calls = [getattr(gt, n) if read == "fast" else getattr(gt, n).slow for n in names]
+    out, banked = [], 0
+    v, u = ctypes.c_long(), ctypes.c_uint32()
+    for _ in range(400):
+        gt.GTE_Wait(1)
+        row = []
+        for name, call in zip(names, calls, strict=True):
+            target = u if name in ("GT_GetEcatAxisDI", "GT_GetEcatAxisDO") else v
+            assert call(1, byref(target)) == 0, gt.GTE_GetLastError()
+            row.append(target.value)
+        out.append(tuple(row))
+        banked += type(ctl.axes[1]) is not Axis
+    gt.GT_Close()
+    return out, banked
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+def test_the_pdo_readers_read_a_banked_axis_where_it_is(clock: str) -> None:
+    """The per-axis PDO readers answer an axis the bank runs without giving it back (the
+    table path gives it back and the bank claims it again at its next cycle: a poll loop
+    then paid that at every call on the auto clock), with the values of a session whose
+    every read goes through the table path (so whose axes ran on their scalar drives)."""
+    fast_values, fast_banked = _poll_pdo_while_moving("fast", clock)
+    slow_values, slow_banked = _poll_pdo_while_moving("slow", clock)
+    assert fast_banked > 350, "the moving axis stays in the bank while polled"
+    assert slow_banked < 50  # (the auto clock: a call may make a cycle due that claims it)
+    assert fast_values == slow_values
+    assert len(set(fast_values)) > 300  # (the axes moved: the values changed every cycle)
 
 
 #: bus axes on the bus beyond 32 axes: core 2 holds bus axes 33 and 34 as its axes 1 and 2
