@@ -462,6 +462,7 @@ class AxisBank:
         self.probes_armed = 0
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
         self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
+        self._tp_tx: dict[int, list[tuple[Any, Callable[[], Any]]]] = {}  # (:meth:`_put_probe`)
         #: the GT readers' lists of the claimed rows' values (:meth:`value`), made as they are
         #: asked for; a new dict wherever they may change (a cycle, a claim, a release), never
         #: one emptied in place: a reader that made its list from the state before another
@@ -565,6 +566,7 @@ class AxisBank:
         self.built = True
         self._tp_map = {}
         self._tp_objects: set[tuple[int, int]] | None = None
+        self._tp_tx = {}
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -1383,7 +1385,7 @@ class AxisBank:
         if post:
             # its hooks (and its drive's probe) take such an edge after the cycle, the row
             # staying (:meth:`_post_events`)
-            if tp and not self._tp_mapped(r):
+            if tp:  # (a drive mapping the probe's objects: _post_event writes them)
                 watch |= TP_POST
             self.dwatch[r], self.dpost[r] = 0, watch
         else:
@@ -1400,11 +1402,7 @@ class AxisBank:
             return False
         ok = self._probe_rows.get(r)
         if ok is None:
-            ok = self._probe_rows[r] = (
-                len(self.groups[self.group_of[r]].rows) == 1
-                and not self._tp_mapped(r)
-                and _get(ax, "io").get(0x60B8) is None
-            )
+            ok = self._probe_rows[r] = len(self.groups[self.group_of[r]].rows) == 1
         return ok
 
     def write_probe(self, ax: Any, write: Callable[[], Any]) -> bool:
@@ -1422,13 +1420,54 @@ class AxisBank:
         ch = self.csp.channels[r]
         objs = self._open_drive(ch)
         try:
-            write()
+            pdo = write()
         finally:
             if self.groups[self.group_of[r]].claimed:
                 _reguard(objs)
-        if _get(ch, "tp_function") != _get(ch, "_tp_applied"):
+        if pdo:  # (60B8h in the image: the drive decodes it before the next cycle)
+            self._took_outputs(_get(ax, "io").get(0x60B8))
+            self._tp_apply.add(r)
+        elif _get(ch, "tp_function") != _get(ch, "_tp_applied"):
             self._tp_apply.add(r)
         return True
+
+    def _took_outputs(self, acc: Any) -> None:
+        """The output bytes of the image entry ``acc`` (aligned) were written for a drive
+        the bank runs, which takes them as its own decode would (:meth:`_apply_probes`):
+        the raw-write checks' references follow, so the write does not give the row back."""
+        size = acc.bits // 8
+        at = np.arange(acc._off, acc._off + size)
+        buf = self.ctl.master.image.buffer
+        hit = np.nonzero(np.isin(self._rx_all, at))[0]
+        self._rx_snap[hit] = buf[self._rx_all[hit]]
+        idx = self._rx_idx
+        hit = np.nonzero(np.isin(idx, at))[0]
+        if len(hit):
+            ref = bytearray(self._rx_ref)
+            for k in hit.tolist():
+                ref[k] = int(buf[idx[k]])
+            self._rx_ref = bytes(ref)
+
+    def _put_probe(self, r: int) -> None:
+        """Row ``r``'s drive's touch-probe objects mapped as TxPDO (60B9h-60BDh,
+        60D1h-60D8h) into the image, as the drive's encode after its step writes them: the
+        bank changed its probe (a function applied, an edge taken).  The probe unguarded."""
+        pairs = self._tp_tx.get(r)
+        if pairs is None:
+            pairs = []
+            if self._tp_mapped(r):
+                io = _get(self.axes[r], "io")
+                od = self.groups[self.group_of[r]].drive.od
+                b = io.channel * CHANNEL_STRIDE
+                for index in _TP_TX:
+                    acc = io.get(index)
+                    var = od.find(index + b, 0) if acc is not None else None
+                    if var is not None:
+                        get = var.getter or (lambda var=var: var.value)
+                        pairs.append((acc, get))
+            self._tp_tx[r] = pairs
+        for acc, get in pairs:
+            acc.set(get())
 
     @staticmethod
     def _open_drive(ch: Any) -> list[Any]:
@@ -1449,12 +1488,16 @@ class AxisBank:
                 continue
             ch = csp.channels[r]
             objs = self._open_drive(ch)
+            acc = _get(self.axes[r], "io").get(0x60B8)
+            if acc is not None:  # (the drive's decode of its RxPDO: Drive.step)
+                _set(ch, "tp_function", acc.get() & 0xFFFF)
             f = _get(ch, "tp_function")
             probe = _get(ch, "probe")
             if f != _get(ch, "_tp_applied"):
                 _set(ch, "_tp_applied", f)
                 probe.write_function(f)
                 self.probes_armed += 1
+                self._put_probe(r)
             on = bool(probe.function & 0x0101)
             csp.tpw[r] = on
             csp.tp_lo[r], csp.tp_hi[r] = (
@@ -1520,7 +1563,7 @@ class AxisBank:
                     for slave, index in self.ctl.layout.mapped_objects()
                     if 0x6000 <= index and 0x6000 + (index - 0x6000) % CHANNEL_STRIDE in tp
                 }
-            io = self.axes[r].io
+            io = _get(self.axes[r], "io")
             got = self._tp_map[r] = (io.slave, io.channel) in pairs
         return got
 
@@ -2735,6 +2778,7 @@ class AxisBank:
             if probe.function:
                 off = ch.enc_offset
                 probe.step(a, b, a - off, b - off, t_ns, dt_ns)
+                self._put_probe(r)
             csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
         self._last = {r: self._planned_row(r)}
         self._rates = {r: self._enc_rates_row(r)}

@@ -233,10 +233,10 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
     _, (_, stats) = runs
     assert stats["rows"] > AXES * CYCLES * 0.4
     assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
-    # the homings stepped on their claimed rows, and home edges were taken after the bank's
-    # cycles (this bus maps the touch probe's objects: its edges give the axis back first)
+    # the homings stepped on their claimed rows, and home edges and the touch probe's were
+    # taken after the bank's cycles (this bus maps the probe's objects: the image shows them)
     steps, inputs, probes = stats["in_place"]
-    assert steps > 5 and inputs > 0 and probes == 0, stats["in_place"]
+    assert steps > 5 and inputs > 0 and probes > 0, stats["in_place"]
     if stats["kernel"]:
         assert stats["many"] > 20  # cycles the homings let the controller run at once
         # the index searches too, their drives' touch probes armed (all but the cycles
@@ -437,13 +437,33 @@ ARM_CALLS = {
 }
 
 
-@pytest.mark.parametrize("step", [0, 13])
-def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int) -> None:
+def _probe_pdo_eni(n: int, path: Path) -> Path:
+    """``n`` drives that map the touch probe as PDO (60B8h out, 60B9h and 60BAh in), as
+    a common real ENI does."""
+    from gtecat.eni.topology import build_config
+    from gtecat.eni.writer import write_eni_file
+    from tools.gen_axes_eni import axes_topology
+
+    topo = axes_topology(n)
+    for slave in topo["slave"]:
+        slave["rx"] = [*slave["rx"], "0x60B8:0:16"]
+        slave["tx"] = [*slave["tx"], "0x60B9:0:16", "0x60BA:0:32"]
+    write_eni_file(build_config(topo, "<probe PDO>"), path)
+    return path
+
+
+@pytest.mark.parametrize(("step", "pdo"), [(0, False), (13, False), (0, True), (13, True)])
+def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int, pdo: bool) -> None:
     """The bank and the scalar path cycle by cycle (or every 13 cycles), the mailbox
-    counters and mechanics at the end; the probes armed with the bank running the axes."""
+    counters and mechanics at the end; the probes armed with the bank running the axes,
+    their objects read by SDO or (``pdo``) mapped as PDO: 60B8h written into the image,
+    60B9h/60BAh read from it (the whole GT raw image compared every sample)."""
     from tools.gen_axes_eni import write_axes_eni
 
-    eni = write_axes_eni(len(ARM_SETUP), tmp_path / "axes.eni")
+    if pdo:
+        eni = _probe_pdo_eni(len(ARM_SETUP), tmp_path / "axes.eni")
+    else:
+        eni = write_axes_eni(len(ARM_SETUP), tmp_path / "axes.eni")
     machine = _machine(tmp_path, ARM_SETUP)
     out = [_run(machine, b, step, eni, ARM_SETUP, 700, ARM_CALLS) for b in ("off", "on")]
     (ref, _), (got, stats) = out
@@ -463,3 +483,5 @@ def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int) -> None:
     if stats["kernel"]:
         # the probes armed while the bank ran their axes: the first homings' and axis 1's
         assert stats["armed"] >= 8, stats
+        # a read of axis 1's armed probe (mapped or not) gives its axis back
+        assert stats["probe_guard"] == (True, False), stats
