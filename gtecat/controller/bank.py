@@ -461,7 +461,8 @@ class AxisBank:
         #: touch probe functions the bank applied to drives it runs (:meth:`_apply_probes`)
         self.probes_armed = 0
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
-        self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
+        #: (slave, channel) -> its touch-probe objects mapped as TxPDO (:meth:`_tp_mapped`)
+        self._tp_objects: dict[tuple[int, int], list[int]] | None = None
         self._tp_tx: dict[int, list[tuple[Any, Callable[[], Any]]]] = {}  # (:meth:`_put_probe`)
         #: the GT readers' lists of the claimed rows' values (:meth:`value`), made as they are
         #: asked for; a new dict wherever they may change (a cycle, a claim, a release), never
@@ -565,7 +566,7 @@ class AxisBank:
         """Rows for every axis whose slave the bank can run (mapping and backend)."""
         self.built = True
         self._tp_map = {}
-        self._tp_objects: set[tuple[int, int]] | None = None
+        self._tp_objects = None
         self._tp_tx = {}
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
@@ -641,6 +642,8 @@ class AxisBank:
         #: claimed ones (updated in place, so the kernel keeps its binding)
         rx_all = [g.rx_bytes for g in groups]
         self._rx_all = np.concatenate(rx_all) if rx_all else np.zeros(0, np.intp)
+        #: where each group's bytes begin in _rx_all (:meth:`_took_outputs`)
+        self._rx_start = np.cumsum([0] + [len(b) for b in rx_all]).tolist()
         self._rx_row = np.concatenate(
             [np.full(len(g.rx_bytes), g.rows[0], np.int64) for g in groups] or [np.zeros(0)]
         ).astype(np.int64)
@@ -1425,28 +1428,29 @@ class AxisBank:
             if self.groups[self.group_of[r]].claimed:
                 _reguard(objs)
         if pdo:  # (60B8h in the image: the drive decodes it before the next cycle)
-            self._took_outputs(_get(ax, "io").get(0x60B8))
+            self._took_outputs(r, _get(ax, "io").get(0x60B8))
             self._tp_apply.add(r)
         elif _get(ch, "tp_function") != _get(ch, "_tp_applied"):
             self._tp_apply.add(r)
         return True
 
-    def _took_outputs(self, acc: Any) -> None:
-        """The output bytes of the image entry ``acc`` (aligned) were written for a drive
-        the bank runs, which takes them as its own decode would (:meth:`_apply_probes`):
+    def _took_outputs(self, r: int, acc: Any) -> None:
+        """The output bytes of the image entry ``acc`` (aligned) were written for row ``r``,
+        claimed, whose drive takes them as its own decode would (:meth:`_apply_probes`):
         the raw-write checks' references follow, so the write does not give the row back."""
-        size = acc.bits // 8
-        at = np.arange(acc._off, acc._off + size)
+        gi = self.group_of[r]
+        start = self._rx_start[gi]
+        mine = self.groups[gi].rx_bytes.tolist()
         buf = self.ctl.master.image.buffer
-        hit = np.nonzero(np.isin(self._rx_all, at))[0]
-        self._rx_snap[hit] = buf[self._rx_all[hit]]
-        idx = self._rx_idx
-        hit = np.nonzero(np.isin(idx, at))[0]
-        if len(hit):
-            ref = bytearray(self._rx_ref)
-            for k in hit.tolist():
-                ref[k] = int(buf[idx[k]])
-            self._rx_ref = bytes(ref)
+        # (a claimed group's bytes lie together in _rx_idx too, after the claimed ones before)
+        before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]]))
+        ref = bytearray(self._rx_ref)
+        for b in range(acc._off, acc._off + acc.bits // 8):
+            if b in mine:
+                k = mine.index(b)
+                self._rx_snap[start + k] = v = buf[b]
+                ref[before + k] = v
+        self._rx_ref = bytes(ref)
 
     def _put_probe(self, r: int) -> None:
         """Row ``r``'s drive's touch-probe objects mapped as TxPDO (60B9h-60BDh,
@@ -1459,7 +1463,8 @@ class AxisBank:
                 io = _get(self.axes[r], "io")
                 od = self.groups[self.group_of[r]].drive.od
                 b = io.channel * CHANNEL_STRIDE
-                for index in _TP_TX:
+                assert self._tp_objects is not None  # (_tp_mapped made it)
+                for index in self._tp_objects[(io.slave, io.channel)]:
                     acc = io.get(index)
                     var = od.find(index + b, 0) if acc is not None else None
                     if var is not None:
@@ -1558,11 +1563,11 @@ class AxisBank:
             pairs = self._tp_objects
             if pairs is None:
                 tp = set(_TP_TX)
-                pairs = self._tp_objects = {
-                    (slave, (index - 0x6000) // CHANNEL_STRIDE)
-                    for slave, index in self.ctl.layout.mapped_objects()
-                    if 0x6000 <= index and 0x6000 + (index - 0x6000) % CHANNEL_STRIDE in tp
-                }
+                pairs = self._tp_objects = {}
+                for slave, index in self.ctl.layout.mapped_objects():
+                    k, base = divmod(index - 0x6000, CHANNEL_STRIDE)
+                    if 0x6000 <= index and 0x6000 + base in tp:
+                        pairs.setdefault((slave, k), []).append(0x6000 + base)
             io = _get(self.axes[r], "io")
             got = self._tp_map[r] = (io.slave, io.channel) in pairs
         return got
