@@ -203,6 +203,9 @@ BANK_READS = frozenset(
         # a smart homing's parameters and status (gtecat.controller.smart_home): its own data
         "GT_GetHomeStatus",
         "GT_GetHomePrm",
+        # a capture's status cleared: the unit's own data (a home capture armed again gives
+        # its axis back itself, CaptureUnit.clear), the homings look again (look_again)
+        "GT_ClearCaptureStatus",
         # a coordinate system's state, read from the cycle the bank records of it
         # (CoordSystem.now, bank_modes.SystemTrace), or its parameters (never stepped)
         "GT_CrdStatus",
@@ -464,6 +467,7 @@ class AxisBank:
         #: (slave, channel) -> its touch-probe objects mapped as TxPDO (:meth:`_tp_mapped`)
         self._tp_objects: dict[tuple[int, int], list[int]] | None = None
         self._tp_tx: dict[int, list[tuple[Any, Callable[[], Any]]]] = {}  # (:meth:`_put_probe`)
+        self._tp_rx: dict[int, list[tuple[int, int]]] = {}  # (:meth:`_took_outputs`)
         #: the GT readers' lists of the claimed rows' values (:meth:`value`), made as they are
         #: asked for; a new dict wherever they may change (a cycle, a claim, a release), never
         #: one emptied in place: a reader that made its list from the state before another
@@ -568,6 +572,7 @@ class AxisBank:
         self._tp_map = {}
         self._tp_objects = None
         self._tp_tx = {}
+        self._tp_rx = {}
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -1428,8 +1433,10 @@ class AxisBank:
             if self.groups[self.group_of[r]].claimed:
                 _reguard(objs)
         if pdo:  # (60B8h in the image: the drive decodes it before the next cycle)
-            self._took_outputs(r, _get(ax, "io").get(0x60B8))
-            self._tp_apply.add(r)
+            acc = _get(ax, "io").get(0x60B8)
+            self._took_outputs(r, acc)
+            if acc.get() != _get(ch, "tp_function"):
+                self._tp_apply.add(r)
         elif _get(ch, "tp_function") != _get(ch, "_tp_applied"):
             self._tp_apply.add(r)
         return True
@@ -1438,18 +1445,26 @@ class AxisBank:
         """The output bytes of the image entry ``acc`` (aligned) were written for row ``r``,
         claimed, whose drive takes them as its own decode would (:meth:`_apply_probes`):
         the raw-write checks' references follow, so the write does not give the row back."""
-        gi = self.group_of[r]
-        start = self._rx_start[gi]
-        mine = self.groups[gi].rx_bytes.tolist()
-        buf = self.ctl.master.image.buffer
+        at = self._tp_rx.get(r)
+        if at is None:  # (fixed with the layout: where the entry's bytes lie in _rx_all)
+            gi = self.group_of[r]
+            mine = self.groups[gi].rx_bytes.tolist()
+            start = self._rx_start[gi]
+            at = self._tp_rx[r] = [
+                (start + mine.index(b), b)
+                for b in range(acc._off, acc._off + acc.bits // 8)
+                if b in mine
+            ]
+        buf, snap = self.ctl.master.image.buffer, self._rx_snap
+        changed = [(k, b) for k, b in at if snap[k] != buf[b]]
+        if not changed:
+            return
         # (a claimed group's bytes lie together in _rx_idx too, after the claimed ones before)
-        before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]]))
+        start = self._rx_start[self.group_of[r]]
+        before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
         ref = bytearray(self._rx_ref)
-        for b in range(acc._off, acc._off + acc.bits // 8):
-            if b in mine:
-                k = mine.index(b)
-                self._rx_snap[start + k] = v = buf[b]
-                ref[before + k] = v
+        for k, b in changed:
+            snap[k] = ref[before + k] = buf[b]
         self._rx_ref = bytes(ref)
 
     def _put_probe(self, r: int) -> None:
@@ -1718,6 +1733,31 @@ class AxisBank:
         self.dirty = True
         if self.n_alive and res.bank is self:
             self.release_axis_object(ax)
+
+    def look_again(self) -> None:
+        """A call changed what a bank-aware hook's watchers read without giving its axis
+        back (a capture cleared): they look again before the next cycle, as after a release
+        (:attr:`releases`)."""
+        self.releases += 1
+        self.dirty = True
+
+    def hook_added(self, ax: Any, obj: Any) -> None:
+        """``obj``, a bank-aware post hook (:func:`aware_hooks`), was just added to ``ax``'s:
+        a row the bank runs takes it among its own (it catches up at the release as the
+        others do) when it may be held and watches nothing (a capture unit made with nothing
+        armed), else the row goes back."""
+        r = self._row_of.get(id(ax))
+        if r is None or not self.alive[r]:
+            return
+        if obj.bank_watch or not obj.bank_ready():
+            if r != self._stepping:
+                self.release_axis_object(ax)
+            return
+        aware = self._aware.get(r)
+        if aware is None:
+            self._aware[r] = [obj]
+        elif obj not in aware:
+            aware.append(obj)
 
     def watch_grew(self, ax: Any) -> None:
         """A bank-aware hook of ``ax`` watches more 60FDh bits (:attr:`dwatch`, read at a
