@@ -523,6 +523,9 @@ class AxisBank:
         #: probe's (statistics; the differential tests check they ran)
         self.steps_in_place = 0
         self.posted_inputs = self.posted_probes = 0
+        #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
+        #: (:meth:`call_in_place`; statistics)
+        self.trap_holds = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
@@ -2001,9 +2004,43 @@ class AxisBank:
         if r < 0:
             self.before_call(ctl, proto, values)
             return call()
+        if proto.name == "GT_PrfTrap" and self._trap_held(r):
+            self.trap_holds += 1
+            # GT_PrfTrap of an axis already standing in Trap mode holds its planner where it
+            # stands (Profile.enter): the values it writes are the ones it finds, so the row
+            # is not put into the objects and taken up again around it
+            _Bypass.on = True
+            try:
+                return call()
+            finally:
+                _Bypass.on = False
         done: list[Any] = []
         self._in_place(r, self.groups[self.group_of[r]], lambda: done.append(call()))
         return done[0]
+
+    def _trap_held(self, r: int) -> bool:
+        """Claimed row ``r`` stands in Trap mode with its planner (the object and the row)
+        as :meth:`TrapPlanner.hold` leaves it where it stands: a hold there changes nothing."""
+        if self.moving[r] or self.jog[r] or self.hm[r] or self.frz[r] or self.sampled[r]:
+            return False
+        prof = self.res[r].profile
+        pl = prof.planner
+        cls = type(pl)  # (a claimed planner's class is its guard's: _guard_class)
+        if cls is not TrapPlanner and cls is not _GUARDS.get(TrapPlanner):
+            return False
+        if prof.mode != PrfMode.TRAP or not prof.active:
+            return False
+        g = lambda name: _get(pl, name)  # noqa: E731  (past the planner's guard)
+        return (
+            g("_mode") == _IDLE
+            and g("_vel") == g("_acc") == 0.0
+            and not g("_segs")
+            and g("_i") == g("_j") == g("_k") == 0
+            and g("_ts") == g("_t_done") == g("_t_final") == 0.0
+            and g("_dir") == 1.0
+            and g("stopping") == StopKind.NONE
+            and self._planned_row(r) == (g("_pos"), 0.0, 0.0)
+        )
 
     def _in_place_row(self, ctl: Any, proto: Any, values: tuple) -> int:
         """The row a call of :data:`IN_PLACE` runs on in place, else -1: one axis (a mask of
