@@ -262,8 +262,8 @@ _SW_FAULT = 0x0008  # 6041h bit 3: fault
 #: dpost: the drive's touch probe takes an edge of a cycle's travel after that cycle
 #: (bank_kernel.c TP_POST; far above 60FDh's 32 bits)
 TP_POST = 1 << 62
-#: the touch probe's TxPDO objects: a row whose drive maps one keeps giving its row back
-#: before a probe edge (the bank leaves them in the image as they are)
+#: the touch probe's TxPDO objects: the bank writes those a drive maps into the image where
+#: it changes the probe (AxisBank._put_probe), and leaves them as they are otherwise
 _TP_TX = (0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, *range(0x60D1, 0x60D9))
 
 
@@ -1405,9 +1405,10 @@ class AxisBank:
     # --- a capture unit arming its drive's touch probe -------------------------------------
     def probe_in_bank(self, ax: Any) -> bool:
         """The touch probe of ``ax``'s drive may be armed while the bank runs the axis: a
-        drive of one channel (:meth:`_post_pending` runs one row's unit), neither 60B8h
-        mapped as RxPDO (a write the image would carry) nor a probe object as TxPDO (the
-        image would have to show 60B9h change).  Fixed with the layout."""
+        drive of one channel (:meth:`_post_pending` runs one row's unit).  Its objects may be
+        mapped as PDO: a 60B8h written into the image is what the drive decodes before the
+        next cycle (:meth:`_apply_probes`), and the probe's TxPDO objects go into the image
+        wherever the bank changes the probe (:meth:`_put_probe`).  Fixed with the layout."""
         r = self._row_of.get(id(ax)) if self.built else None
         if r is None:
             return False
