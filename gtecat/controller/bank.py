@@ -203,6 +203,9 @@ BANK_READS = frozenset(
         # a smart homing's parameters and status (gtecat.controller.smart_home): its own data
         "GT_GetHomeStatus",
         "GT_GetHomePrm",
+        # a capture's status cleared: the unit's own data (a home capture armed again gives
+        # its axis back itself, CaptureUnit.clear), the homings look again (look_again)
+        "GT_ClearCaptureStatus",
         # a coordinate system's state, read from the cycle the bank records of it
         # (CoordSystem.now, bank_modes.SystemTrace), or its parameters (never stepped)
         "GT_CrdStatus",
@@ -259,8 +262,8 @@ _SW_FAULT = 0x0008  # 6041h bit 3: fault
 #: dpost: the drive's touch probe takes an edge of a cycle's travel after that cycle
 #: (bank_kernel.c TP_POST; far above 60FDh's 32 bits)
 TP_POST = 1 << 62
-#: the touch probe's TxPDO objects: a row whose drive maps one keeps giving its row back
-#: before a probe edge (the bank leaves them in the image as they are)
+#: the touch probe's TxPDO objects: the bank writes those a drive maps into the image where
+#: it changes the probe (AxisBank._put_probe), and leaves them as they are otherwise
 _TP_TX = (0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, *range(0x60D1, 0x60D9))
 
 
@@ -461,7 +464,10 @@ class AxisBank:
         #: touch probe functions the bank applied to drives it runs (:meth:`_apply_probes`)
         self.probes_armed = 0
         self._tp_map: dict[int, bool] = {}  # (:meth:`_tp_mapped`)
-        self._tp_objects: set[tuple[int, int]] | None = None  # (:meth:`_tp_mapped`)
+        #: (slave, channel) -> its touch-probe objects mapped as TxPDO (:meth:`_tp_mapped`)
+        self._tp_objects: dict[tuple[int, int], list[int]] | None = None
+        self._tp_tx: dict[int, list[tuple[Any, Callable[[], Any]]]] = {}  # (:meth:`_put_probe`)
+        self._tp_rx: dict[int, list[tuple[int, int]]] = {}  # (:meth:`_took_outputs`)
         #: the GT readers' lists of the claimed rows' values (:meth:`value`), made as they are
         #: asked for; a new dict wherever they may change (a cycle, a claim, a release), never
         #: one emptied in place: a reader that made its list from the state before another
@@ -517,6 +523,9 @@ class AxisBank:
         #: probe's (statistics; the differential tests check they ran)
         self.steps_in_place = 0
         self.posted_inputs = self.posted_probes = 0
+        #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
+        #: (:meth:`call_in_place`; statistics)
+        self.trap_holds = 0
         #: resting (servo-off) axis-cycles the compiled kernel skipped (statistics)
         self.frozen_rows_run = 0
         #: samples of PT, Gear, Follow and crd axes stepped ahead into tables (statistics)
@@ -564,7 +573,9 @@ class AxisBank:
         """Rows for every axis whose slave the bank can run (mapping and backend)."""
         self.built = True
         self._tp_map = {}
-        self._tp_objects: set[tuple[int, int]] | None = None
+        self._tp_objects = None
+        self._tp_tx = {}
+        self._tp_rx = {}
         ctl = self.ctl
         master, backend = ctl.master, ctl.backend
         if getattr(backend, "name", "") != "emulated" or backend.hardware is not None:
@@ -639,6 +650,8 @@ class AxisBank:
         #: claimed ones (updated in place, so the kernel keeps its binding)
         rx_all = [g.rx_bytes for g in groups]
         self._rx_all = np.concatenate(rx_all) if rx_all else np.zeros(0, np.intp)
+        #: where each group's bytes begin in _rx_all (:meth:`_took_outputs`)
+        self._rx_start = np.cumsum([0] + [len(b) for b in rx_all]).tolist()
         self._rx_row = np.concatenate(
             [np.full(len(g.rx_bytes), g.rows[0], np.int64) for g in groups] or [np.zeros(0)]
         ).astype(np.int64)
@@ -1383,7 +1396,7 @@ class AxisBank:
         if post:
             # its hooks (and its drive's probe) take such an edge after the cycle, the row
             # staying (:meth:`_post_events`)
-            if tp and not self._tp_mapped(r):
+            if tp:  # (a drive mapping the probe's objects: _post_event writes them)
                 watch |= TP_POST
             self.dwatch[r], self.dpost[r] = 0, watch
         else:
@@ -1392,19 +1405,16 @@ class AxisBank:
     # --- a capture unit arming its drive's touch probe -------------------------------------
     def probe_in_bank(self, ax: Any) -> bool:
         """The touch probe of ``ax``'s drive may be armed while the bank runs the axis: a
-        drive of one channel (:meth:`_post_pending` runs one row's unit), neither 60B8h
-        mapped as RxPDO (a write the image would carry) nor a probe object as TxPDO (the
-        image would have to show 60B9h change).  Fixed with the layout."""
+        drive of one channel (:meth:`_post_pending` runs one row's unit).  Its objects may be
+        mapped as PDO: a 60B8h written into the image is what the drive decodes before the
+        next cycle (:meth:`_apply_probes`), and the probe's TxPDO objects go into the image
+        wherever the bank changes the probe (:meth:`_put_probe`).  Fixed with the layout."""
         r = self._row_of.get(id(ax)) if self.built else None
         if r is None:
             return False
         ok = self._probe_rows.get(r)
         if ok is None:
-            ok = self._probe_rows[r] = (
-                len(self.groups[self.group_of[r]].rows) == 1
-                and not self._tp_mapped(r)
-                and _get(ax, "io").get(0x60B8) is None
-            )
+            ok = self._probe_rows[r] = len(self.groups[self.group_of[r]].rows) == 1
         return ok
 
     def write_probe(self, ax: Any, write: Callable[[], Any]) -> bool:
@@ -1422,13 +1432,66 @@ class AxisBank:
         ch = self.csp.channels[r]
         objs = self._open_drive(ch)
         try:
-            write()
+            pdo = write()
         finally:
             if self.groups[self.group_of[r]].claimed:
                 _reguard(objs)
-        if _get(ch, "tp_function") != _get(ch, "_tp_applied"):
+        if pdo:  # (60B8h in the image: the drive decodes it before the next cycle)
+            acc = _get(ax, "io").get(0x60B8)
+            self._took_outputs(r, acc)
+            if acc.get() != _get(ch, "tp_function"):
+                self._tp_apply.add(r)
+        elif _get(ch, "tp_function") != _get(ch, "_tp_applied"):
             self._tp_apply.add(r)
         return True
+
+    def _took_outputs(self, r: int, acc: Any) -> None:
+        """The output bytes of the image entry ``acc`` (aligned) were written for row ``r``,
+        claimed, whose drive takes them as its own decode would (:meth:`_apply_probes`):
+        the raw-write checks' references follow, so the write does not give the row back."""
+        at = self._tp_rx.get(r)
+        if at is None:  # (fixed with the layout: where the entry's bytes lie in _rx_all)
+            gi = self.group_of[r]
+            mine = self.groups[gi].rx_bytes.tolist()
+            start = self._rx_start[gi]
+            at = self._tp_rx[r] = [
+                (start + mine.index(b), b)
+                for b in range(acc._off, acc._off + acc.bits // 8)
+                if b in mine
+            ]
+        buf, snap = self.ctl.master.image.buffer, self._rx_snap
+        changed = [(k, b) for k, b in at if snap[k] != buf[b]]
+        if not changed:
+            return
+        # (a claimed group's bytes lie together in _rx_idx too, after the claimed ones before)
+        start = self._rx_start[self.group_of[r]]
+        before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
+        ref = bytearray(self._rx_ref)
+        for k, b in changed:
+            snap[k] = ref[before + k] = buf[b]
+        self._rx_ref = bytes(ref)
+
+    def _put_probe(self, r: int) -> None:
+        """Row ``r``'s drive's touch-probe objects mapped as TxPDO (60B9h-60BDh,
+        60D1h-60D8h) into the image, as the drive's encode after its step writes them: the
+        bank changed its probe (a function applied, an edge taken).  The probe unguarded."""
+        pairs = self._tp_tx.get(r)
+        if pairs is None:
+            pairs = []
+            if self._tp_mapped(r):
+                io = _get(self.axes[r], "io")
+                od = self.groups[self.group_of[r]].drive.od
+                b = io.channel * CHANNEL_STRIDE
+                assert self._tp_objects is not None  # (_tp_mapped made it)
+                for index in self._tp_objects[(io.slave, io.channel)]:
+                    acc = io.get(index)
+                    var = od.find(index + b, 0) if acc is not None else None
+                    if var is not None:
+                        get = var.getter or (lambda var=var: var.value)
+                        pairs.append((acc, get))
+            self._tp_tx[r] = pairs
+        for acc, get in pairs:
+            acc.set(get())
 
     @staticmethod
     def _open_drive(ch: Any) -> list[Any]:
@@ -1449,12 +1512,16 @@ class AxisBank:
                 continue
             ch = csp.channels[r]
             objs = self._open_drive(ch)
+            acc = _get(self.axes[r], "io").get(0x60B8)
+            if acc is not None:  # (the drive's decode of its RxPDO: Drive.step)
+                _set(ch, "tp_function", acc.get() & 0xFFFF)
             f = _get(ch, "tp_function")
             probe = _get(ch, "probe")
             if f != _get(ch, "_tp_applied"):
                 _set(ch, "_tp_applied", f)
                 probe.write_function(f)
                 self.probes_armed += 1
+                self._put_probe(r)
             on = bool(probe.function & 0x0101)
             csp.tpw[r] = on
             csp.tp_lo[r], csp.tp_hi[r] = (
@@ -1515,12 +1582,12 @@ class AxisBank:
             pairs = self._tp_objects
             if pairs is None:
                 tp = set(_TP_TX)
-                pairs = self._tp_objects = {
-                    (slave, (index - 0x6000) // CHANNEL_STRIDE)
-                    for slave, index in self.ctl.layout.mapped_objects()
-                    if 0x6000 <= index and 0x6000 + (index - 0x6000) % CHANNEL_STRIDE in tp
-                }
-            io = self.axes[r].io
+                pairs = self._tp_objects = {}
+                for slave, index in self.ctl.layout.mapped_objects():
+                    k, base = divmod(index - 0x6000, CHANNEL_STRIDE)
+                    if 0x6000 <= index and 0x6000 + base in tp:
+                        pairs.setdefault((slave, k), []).append(0x6000 + base)
+            io = _get(self.axes[r], "io")
             got = self._tp_map[r] = (io.slave, io.channel) in pairs
         return got
 
@@ -1670,6 +1737,31 @@ class AxisBank:
         self.dirty = True
         if self.n_alive and res.bank is self:
             self.release_axis_object(ax)
+
+    def look_again(self) -> None:
+        """A call changed what a bank-aware hook's watchers read without giving its axis
+        back (a capture cleared): they look again before the next cycle, as after a release
+        (:attr:`releases`)."""
+        self.releases += 1
+        self.dirty = True
+
+    def hook_added(self, ax: Any, obj: Any) -> None:
+        """``obj``, a bank-aware post hook (:func:`aware_hooks`), was just added to ``ax``'s:
+        a row the bank runs takes it among its own (it catches up at the release as the
+        others do) when it may be held and watches nothing (a capture unit made with nothing
+        armed), else the row goes back."""
+        r = self._row_of.get(id(ax))
+        if r is None or not self.alive[r]:
+            return
+        if obj.bank_watch or not obj.bank_ready():
+            if r != self._stepping:
+                self.release_axis_object(ax)
+            return
+        aware = self._aware.get(r)
+        if aware is None:
+            self._aware[r] = [obj]
+        elif obj not in aware:
+            aware.append(obj)
 
     def watch_grew(self, ax: Any) -> None:
         """A bank-aware hook of ``ax`` watches more 60FDh bits (:attr:`dwatch`, read at a
@@ -1913,9 +2005,43 @@ class AxisBank:
         if r < 0:
             self.before_call(ctl, proto, values)
             return call()
+        if proto.name == "GT_PrfTrap" and self._trap_held(r):
+            self.trap_holds += 1
+            # GT_PrfTrap of an axis already standing in Trap mode holds its planner where it
+            # stands (Profile.enter): the values it writes are the ones it finds, so the row
+            # is not put into the objects and taken up again around it
+            _Bypass.on = True
+            try:
+                return call()
+            finally:
+                _Bypass.on = False
         done: list[Any] = []
         self._in_place(r, self.groups[self.group_of[r]], lambda: done.append(call()))
         return done[0]
+
+    def _trap_held(self, r: int) -> bool:
+        """Claimed row ``r`` stands in Trap mode with its planner (the object and the row)
+        as :meth:`TrapPlanner.hold` leaves it where it stands: a hold there changes nothing."""
+        if self.moving[r] or self.jog[r] or self.hm[r] or self.frz[r] or self.sampled[r]:
+            return False
+        prof = self.res[r].profile
+        pl = prof.planner
+        cls = type(pl)  # (a claimed planner's class is its guard's: _guard_class)
+        if cls is not TrapPlanner and cls is not _GUARDS.get(TrapPlanner):
+            return False
+        if prof.mode != PrfMode.TRAP or not prof.active:
+            return False
+        g = lambda name: _get(pl, name)  # noqa: E731  (past the planner's guard)
+        return (
+            g("_mode") == _IDLE
+            and g("_vel") == g("_acc") == 0.0
+            and not g("_segs")
+            and g("_i") == g("_j") == g("_k") == 0
+            and g("_ts") == g("_t_done") == g("_t_final") == 0.0
+            and g("_dir") == 1.0
+            and g("stopping") == StopKind.NONE
+            and self._planned_row(r) == (g("_pos"), 0.0, 0.0)
+        )
 
     def _in_place_row(self, ctl: Any, proto: Any, values: tuple) -> int:
         """The row a call of :data:`IN_PLACE` runs on in place, else -1: one axis (a mask of
@@ -2735,6 +2861,7 @@ class AxisBank:
             if probe.function:
                 off = ch.enc_offset
                 probe.step(a, b, a - off, b - off, t_ns, dt_ns)
+                self._put_probe(r)
             csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
         self._last = {r: self._planned_row(r)}
         self._rates = {r: self._enc_rates_row(r)}

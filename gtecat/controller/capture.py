@@ -70,6 +70,7 @@ MODES = (CAPTURE_NONE, CAPTURE_HOME, CAPTURE_INDEX, CAPTURE_PROBE)
 MODE_NAMES = {CAPTURE_HOME: "home", CAPTURE_INDEX: "index", CAPTURE_PROBE: "probe"}
 _SIGNALS = {"home": CAPTURE_HOME, "index": CAPTURE_INDEX, "probe": CAPTURE_PROBE}
 
+_get = object.__getattribute__  # an axis the bank holds read without giving it back
 _HOME_BIT = 1 << 2  # 60FDh bit 2
 # 60B8h probe 1: enable | continuous | source (bits 3:2) | rising (4) | falling (5)
 _TP_INDEX = 0x0001 | 0x0002 | 0x0004 | 0x0010
@@ -108,7 +109,7 @@ class CaptureUnit:
         self.ax: Axis = res.ax
         #: the axis's process data and mailbox (fixed with the axis; kept here so that the
         #: unit reaches its drive's objects without touching the axis the bank may hold)
-        self._io = io = self.ax.io
+        self._io = io = _get(self.ax, "io")
         self._tp_pdo = io.get(0x60B9) is not None  # (60B9h mapped: fixed with the layout)
         self._din = io.get(0x60FD)
         self._act = io.get(0x6064)
@@ -135,7 +136,12 @@ class CaptureUnit:
         self.edges: list[SeenEdge] = []
         self.step = 0.0
         self._home_prev = self.home_level()
-        self.ax.post_hooks.append(self._post)
+        # (made while the bank runs the axis - a first GT_GetHomePrm, GT_SetCaptureMode -
+        # the hook joins the row's without giving it back: AxisBank.hook_added)
+        _get(self.ax, "post_hooks").append(self._post)
+        bank = res.bank
+        if bank is not None:
+            bank.hook_added(self.ax, self)
 
     # --- settings --------------------------------------------------------------------------
     def reset_settings(self) -> None:
@@ -221,6 +227,9 @@ class CaptureUnit:
         self.status = 0
         if self.mode == CAPTURE_HOME:
             self._watch_grew()
+        bank = self.res.bank
+        if bank is not None:  # (the call is one of the bank's readers: no release)
+            bank.look_again()
 
     def set_sense(self, mode: int, sense: int) -> None:
         if mode not in MODE_NAMES:

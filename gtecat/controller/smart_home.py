@@ -278,7 +278,7 @@ class SmartHome:
         self.res = res
         self.number = res.number
         self.unit = unit_of(ctl, res)  # the axis's own encoder and capture
-        self._din = res.ax.io.get(0x60FD)
+        self._din = _get(res.ax, "io").get(0x60FD)  # (the bank may hold the axis: kept)
         self.reset()
 
     def reset(self) -> None:

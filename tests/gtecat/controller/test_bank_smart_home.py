@@ -174,6 +174,7 @@ def _run(
                 else (0, 0, 0)
             ),
             "armed": bank_.probes_armed if bank_ is not None else 0,
+            "trap_holds": bank_.trap_holds if bank_ is not None else 0,
         }
         if bank_ is not None and not stops:
             # axis 1's probe stays armed after its homing: the bank holds it, and a read of
@@ -233,10 +234,10 @@ def test_the_bank_ran_the_homing_axes(runs: tuple) -> None:
     _, (_, stats) = runs
     assert stats["rows"] > AXES * CYCLES * 0.4
     assert stats["kernel"] or not HAS_CC or os.environ.get("GTECAT_BANK_KERNEL") == "numpy"
-    # the homings stepped on their claimed rows, and home edges were taken after the bank's
-    # cycles (this bus maps the touch probe's objects: its edges give the axis back first)
+    # the homings stepped on their claimed rows, and home edges and the touch probe's were
+    # taken after the bank's cycles (this bus maps the probe's objects: the image shows them)
     steps, inputs, probes = stats["in_place"]
-    assert steps > 5 and inputs > 0 and probes == 0, stats["in_place"]
+    assert steps > 5 and inputs > 0 and probes > 0, stats["in_place"]
     if stats["kernel"]:
         assert stats["many"] > 20  # cycles the homings let the controller run at once
         # the index searches too, their drives' touch probes armed (all but the cycles
@@ -421,6 +422,8 @@ def _go_home_again(axis: int) -> None:
     ahead of where it stands now."""
     prm = gt.THomePrm()
     _ok(gt.GT_GetHomePrm(axis, byref(prm)), "home prm")
+    _ok(gt.GT_ClearCaptureStatus(axis), "clear capture")  # (as a user's program does)
+    _ok(gt.GT_PrfTrap(axis), "trap again")  # (standing in Trap: a hold where it stands)
     _ok(gt.GT_GoHome(axis, byref(prm)), f"go home again {axis}")
 
 
@@ -437,13 +440,33 @@ ARM_CALLS = {
 }
 
 
-@pytest.mark.parametrize("step", [0, 13])
-def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int) -> None:
+def _probe_pdo_eni(n: int, path: Path) -> Path:
+    """``n`` drives that map the touch probe as PDO (60B8h out, 60B9h and 60BAh in), as
+    a common real ENI does."""
+    from gtecat.eni.topology import build_config
+    from gtecat.eni.writer import write_eni_file
+    from tools.gen_axes_eni import axes_topology
+
+    topo = axes_topology(n)
+    for slave in topo["slave"]:
+        slave["rx"] = [*slave["rx"], "0x60B8:0:16"]
+        slave["tx"] = [*slave["tx"], "0x60B9:0:16", "0x60BA:0:32"]
+    write_eni_file(build_config(topo, "<probe PDO>"), path)
+    return path
+
+
+@pytest.mark.parametrize(("step", "pdo"), [(0, False), (13, False), (0, True), (13, True)])
+def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int, pdo: bool) -> None:
     """The bank and the scalar path cycle by cycle (or every 13 cycles), the mailbox
-    counters and mechanics at the end; the probes armed with the bank running the axes."""
+    counters and mechanics at the end; the probes armed with the bank running the axes,
+    their objects read by SDO or (``pdo``) mapped as PDO: 60B8h written into the image,
+    60B9h/60BAh read from it (the whole GT raw image compared every sample)."""
     from tools.gen_axes_eni import write_axes_eni
 
-    eni = write_axes_eni(len(ARM_SETUP), tmp_path / "axes.eni")
+    if pdo:
+        eni = _probe_pdo_eni(len(ARM_SETUP), tmp_path / "axes.eni")
+    else:
+        eni = write_axes_eni(len(ARM_SETUP), tmp_path / "axes.eni")
     machine = _machine(tmp_path, ARM_SETUP)
     out = [_run(machine, b, step, eni, ARM_SETUP, 700, ARM_CALLS) for b in ("off", "on")]
     (ref, _), (got, stats) = out
@@ -463,3 +486,46 @@ def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int) -> None:
     if stats["kernel"]:
         # the probes armed while the bank ran their axes: the first homings' and axis 1's
         assert stats["armed"] >= 8, stats
+        # a read of axis 1's armed probe (mapped or not) gives its axis back
+        assert stats["probe_guard"] == (True, False), stats
+
+
+def _home_all_standing() -> None:
+    """What an application homing many axes does: for each axis (standing in Trap mode,
+    the bank running it) its parameters read, its capture cleared, GT_PrfTrap again, then
+    GT_GoHome with :data:`ARM_SETUP`'s fields."""
+    for a, (fields, _) in ARM_SETUP.items():
+        prm = gt.THomePrm()
+        _ok(gt.GT_GetHomePrm(a, byref(prm)), "home prm")
+        prm.mode, prm.moveDir, prm.indexDir, prm.edge, prm.triggerIndex = 20, 1, -1, 0, -1
+        prm.velHigh, prm.velLow, prm.acc, prm.dec = 40.0, 4.0, 1.0, 1.0
+        prm.escapeStep = 1000
+        for name, value in (fields or {}).items():
+            setattr(prm, name, value)
+        _ok(gt.GT_ClearCaptureStatus(a), "clear capture")
+        _ok(gt.GT_PrfTrap(a), "trap")
+        _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
+
+
+@pytest.mark.parametrize("pdo", [False, True])
+def test_homings_started_on_standing_axes(tmp_path: Path, pdo: bool) -> None:
+    """The index homings of :data:`ARM_SETUP` started on axes the bank runs standing (a
+    capture unit and homing made then, the capture cleared, GT_PrfTrap of an axis standing
+    in Trap mode, GT_GoHome in place), the touch probe read by SDO or mapped as PDO: the
+    bank and the scalar path cycle by cycle."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    n = len(ARM_SETUP)
+    eni = _probe_pdo_eni(n, tmp_path / "a.eni") if pdo else write_axes_eni(n, tmp_path / "a.eni")
+    machine = _machine(tmp_path, ARM_SETUP)
+    setup = {a: (None, keys) for a, (_, keys) in ARM_SETUP.items()}
+    calls = {10: _home_all_standing, 80: lambda: _stop(6)}
+    out = [_run(machine, b, 0, eni, setup, 400, calls) for b in ("off", "on")]
+    (ref, _), (got, stats) = out
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"sample {k}: the bank and the scalar path differ"
+    assert ref[-1] == got[-1]  # (the drives' mechanics, the mailbox counters)
+    ended = {a: h[:3] for a, h in enumerate(ref[-2][3], 1)}
+    assert ended[6] == (0, 30, 4) and all(ended[a] == (0, 100, 0) for a in (1, 3)), ended
+    if stats["kernel"]:
+        assert stats["trap_holds"] == n and stats["armed"] >= n, stats
