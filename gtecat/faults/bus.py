@@ -36,6 +36,9 @@ class FaultBus:
 
     name = "bus"
     cycle_ns = 1_000_000
+    #: :meth:`boundary` calls its hook after every cycle (else the triggers that watch the
+    #: machine are asked in each cycle's tick)
+    between = False
 
     def image_bytes(self) -> int | None:
         """Size of the process image, bytes, where the bus knows it (a ``wkc_offset`` area
@@ -153,6 +156,20 @@ class FaultBus:
         h = self.channel(axis).homing
         return "" if h is None else h.phase.name.lower()
 
+    def position_now(self, axis: int) -> float:
+        """:meth:`position` between two cycles, wherever the drive's state is kept (the
+        emulated bus: the axis bank's row, which it leaves there)."""
+        return self.position(axis)
+
+    def homing_stage_now(self, axis: int) -> str:
+        """:meth:`homing_stage` between two cycles (the emulated bus: of a drive the axis
+        bank runs too, without giving it back)."""
+        return self.homing_stage(axis)
+
+    def boundary(self, hook: Any) -> None:
+        """Call ``hook()`` after every cycle from now on (None: no longer): a trigger that
+        watches the machine looks at it there (:meth:`Injector.look`)."""
+
     # --- slaves ----------------------------------------
     def power_cycle(self, position: int) -> None:
         """Power gone and back: INIT, the AL error gone, the drive's settings at power-on
@@ -194,10 +211,28 @@ class FaultBus:
             )  # type: ignore[assignment]
 
 
+class _AfterCycle:
+    """A ``post_cycle`` hook that looks at the machine after every cycle and changes
+    nothing the axis bank runs (``bank_safe``), so it keeps no cycles from running at once
+    (``quiet_cycles``): the injector looks after those itself (``cycles_passed``)."""
+
+    bank_safe = True
+
+    def __init__(self, hook: Any) -> None:
+        self.hook = hook
+
+    def after(self, _t: int, _dt: int) -> None:
+        self.hook()
+
+    def quiet_cycles(self, n: int) -> int:
+        return n
+
+
 class EmulatedBus(FaultBus):
     """The in-process emulated bus of one controller."""
 
     name = "emulated"
+    between = True
 
     def image_bytes(self) -> int | None:
         m = self.ctl.master
@@ -216,6 +251,8 @@ class EmulatedBus(FaultBus):
         self.ctl = ctl
         self.backend = ctl.backend
         self._cut: list[int] = []
+        self._chans: dict[int, Channel] = {}
+        self._boundary: Any = None  # (the bound method in ctl.post_cycle)
 
     @property
     def cycle_ns(self) -> int:  # type: ignore[override]
@@ -254,6 +291,37 @@ class EmulatedBus(FaultBus):
         bank = self.ctl.bank
         if bank is not None:
             bank.hold(axes)
+
+    def _chan(self, axis: int) -> Channel:
+        ch = self._chans.get(axis)
+        if ch is None:
+            ch = self._chans[axis] = self.channel(axis)
+        return ch
+
+    def position_now(self, axis: int) -> float:
+        ch = self._chan(axis)
+        bank = self.ctl.bank
+        if bank is not None:
+            pos = bank.row_position(ch)
+            if pos is not None:
+                return pos
+        return ch.machine_position
+
+    def homing_stage_now(self, axis: int) -> str:
+        ch = self._chan(axis)
+        bank = self.ctl.bank
+        if bank is not None and bank.row_position(ch) is not None:
+            h = object.__getattribute__(ch, "homing")  # (read past its guard: it stays)
+            return "" if h is None else h.phase.name.lower()
+        return self.homing_stage(axis)
+
+    def boundary(self, hook: Any) -> None:
+        post = self.ctl.post_cycle
+        if self._boundary is not None and self._boundary in post:
+            post.remove(self._boundary)
+        self._boundary = None if hook is None else _AfterCycle(hook).after
+        if self._boundary is not None:
+            post.append(self._boundary)
 
     def _open_link(self, position: int) -> None:
         self.before_change()

@@ -3,7 +3,11 @@
 A trigger is asked once per cycle (:meth:`Trigger.due`) with the bus it watches
 (:class:`gtecat.faults.bus.FaultBus`), except :class:`OnSdo`, which counts the mailbox
 requests as they pass (:meth:`Trigger.sdo`), so the fault it arms meets the very request
-that fired it.  Every trigger has ``describe()`` in words and the plain-dict keys the
+that fired it.  One that watches the machine (:class:`WhenPosition`, :class:`AtHomingStage`)
+is asked between cycles instead (``look``): what it sees there is what the next cycle's
+``due`` would see, and the injector needs to know it before that cycle starts.
+
+Every trigger has ``describe()`` in words and the plain-dict keys the
 ``[[fault]]`` tables use (``at_ms``, ``after_cycles``, ``when_position``, ``at_homing``,
 ``on_sdo``); no key: at once.
 """
@@ -144,7 +148,15 @@ class WhenPosition(Trigger):
     _side: int | None = None
 
     def due(self, bus: Any) -> bool:
-        pos = bus.position(self.axis)
+        return self._due(bus.position(self.axis))
+
+    def look(self, bus: Any) -> bool:
+        """:meth:`due` asked between two cycles, of the drive's state wherever it is kept
+        (the axis bank's row: the axis stays on the bank), so the injector knows before
+        the next cycle whether its tick may fire (:meth:`Injector.look`)."""
+        return self._due(bus.position_now(self.axis))
+
+    def _due(self, pos: float) -> bool:
         side = (pos > self.position) - (pos < self.position)
         if side == 0:
             return True
@@ -169,6 +181,11 @@ class AtHomingStage(Trigger):
 
     def due(self, bus: Any) -> bool:
         return bus.homing_stage(self.axis) == self.stage
+
+    def look(self, bus: Any) -> bool:
+        """:meth:`due` between two cycles, of the drive wherever it runs (a row of the axis
+        bank keeps its homing's stage: it leaves the bank before anything could change it)."""
+        return bus.homing_stage_now(self.axis) == self.stage
 
     def describe(self) -> str:
         return f"when the homing of axis {self.axis} reaches its {self.stage} stage"

@@ -124,18 +124,20 @@ def test_a_cleared_fault_leaves_the_session_as_fast_as_none() -> None:
     assert gt.GT_GetSts(2, byref(s)) == 0 and s.value & ALARM  # read through the bank
 
 
-def test_a_position_trigger_keeps_only_its_axis_off_the_bank() -> None:
+def test_a_position_trigger_keeps_every_axis_on_the_bank_while_it_waits() -> None:
     ctl = _up()
     gt.GTE_Wait(5)
     assert not ctl._run_axes
     faults.inject("drive_fault", axis=1, code=0x2310, when_position=[1, 3000])
     gt.GTE_Wait(5)
-    assert [ax.number for ax in ctl._run_axes] == [1]  # axis 2 stays on the bank
+    assert not ctl._run_axes and ctl.bank.held == frozenset()  # the watched axis too
     assert _trap(1, 10_000) == 0
+    b0 = ctl.bank.many_cycles
     for _ in range(1000):
         gt.GTE_Wait(1)
         if faults.listing()[0]["state"] == "active":
             break
+    assert ctl.bank.many_cycles - b0 > 50  # the bank's compiled cycles, up to the one before
     gt.GTE_Wait(5)
     assert 2 not in [ax.number for ax in ctl._run_axes]
     assert ctl.bank.held == frozenset()
