@@ -17,6 +17,7 @@ done on its bus, so the same fault object means the same thing on both:
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -160,6 +161,11 @@ class FaultBus:
         """:meth:`position` between two cycles, wherever the drive's state is kept (the
         emulated bus: the axis bank's row, which it leaves there)."""
         return self.position(axis)
+
+    def max_step(self, axis: int) -> float:
+        """The most the mechanics of ``axis`` can move in one cycle, machine counts, with a
+        margin for rounding (inf: the bus cannot tell)."""
+        return math.inf
 
     def homing_stage_now(self, axis: int) -> str:
         """:meth:`homing_stage` between two cycles (the emulated bus: of a drive the axis
@@ -306,6 +312,12 @@ class EmulatedBus(FaultBus):
             if pos is not None:
                 return pos
         return ch.machine_position
+
+    def max_step(self, axis: int) -> float:
+        # (Mechanics.track, drive_torque and coast keep |vel| within vmax; the bank's rows
+        # do the same operations)
+        vmax = object.__getattribute__(self._chan(axis), "mech").vmax
+        return abs(vmax) * (self.ctl.clock.cycle_ns * 1e-9) * (1.0 + 1e-9) + 1e-6
 
     def homing_stage_now(self, axis: int) -> str:
         ch = self._chan(axis)

@@ -370,11 +370,12 @@ class Injector:
                 return 0
             if e.state == "armed":
                 if self._looks(e):
-                    # what it sees is known only after each cycle: one at a time (the
-                    # bank's compiled one), none once it saw its fault due
+                    # what it sees is known only after a cycle: none once it saw its fault
+                    # due; a position as many as surely end short of it; a stage one
                     if e.data.get("hit", True):
                         return 0
-                    n = min(n, 1)
+                    trig = e.trigger
+                    n = trig.cycles_short(self.bus, n) if isinstance(trig, WhenPosition) else 1
                     continue
                 if e.after is not None:
                     if e.after not in self._started:

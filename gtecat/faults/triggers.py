@@ -146,6 +146,8 @@ class WhenPosition(Trigger):
     axis: int
     position: float
     _side: int | None = None
+    #: the position :meth:`look` last saw
+    _seen: float = math.nan
 
     def due(self, bus: Any) -> bool:
         return self._due(bus.position(self.axis))
@@ -154,7 +156,20 @@ class WhenPosition(Trigger):
         """:meth:`due` asked between two cycles, of the drive's state wherever it is kept
         (the axis bank's row: the axis stays on the bank), so the injector knows before
         the next cycle whether its tick may fire (:meth:`Injector.look`)."""
-        return self._due(bus.position_now(self.axis))
+        self._seen = pos = bus.position_now(self.axis)
+        return self._due(pos)
+
+    def cycles_short(self, bus: Any, n: int) -> int:
+        """How many of the next ``n`` cycles may run at once after a :meth:`look` that saw
+        nothing (at least 1): the mechanics move at most their top speed per cycle
+        (:meth:`FaultBus.max_step`), so every cycle of the run but its last ends short of
+        the position (the position after the last one is looked at after the run)."""
+        step = bus.max_step(self.axis)
+        d = abs(self._seen - self.position)
+        if not step > 0.0:
+            return n if step == 0.0 and d > 0.0 else 1
+        m = math.ceil(d / step) - 1  # cycle ends surely short of it: m * step < d
+        return max(1, min(n, m + 1))
 
     def _due(self, pos: float) -> bool:
         side = (pos > self.position) - (pos < self.position)
