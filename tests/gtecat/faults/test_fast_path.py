@@ -141,6 +141,16 @@ def test_a_position_trigger_keeps_every_axis_on_the_bank_while_it_waits() -> Non
     gt.GTE_Wait(5)
     assert 2 not in [ax.number for ax in ctl._run_axes]
     assert ctl.bank.held == frozenset()
+    # a position far off: the mechanics cannot get there in a run of cycles, so the runs
+    # are as long as without it, and a link loss armed so keeps every axis on the bank too
+    faults.clear()
+    assert gt.GT_ClrSts(1, 2) == 0 and gt.GT_AxisOn(1) == 0
+    gt.GTE_Wait(50)
+    plain = _batched_cycles(ctl, 2000)
+    assert plain[0] == plain[1]
+    faults.inject("link_down", after_slave=0, when_position=[2, 1e9])
+    assert _batched_cycles(ctl, 2000) == plain
+    assert faults.listing()[0]["state"] == "armed"
 
 
 def _resting_session(way: str) -> list:
