@@ -167,6 +167,10 @@ class FaultBus:
         margin for rounding (inf: the bus cannot tell)."""
         return math.inf
 
+    def banked(self, axis: int) -> bool:
+        """Whether the axis bank runs the drive of ``axis`` now (the emulated bus)."""
+        return False
+
     def homing_stage_now(self, axis: int) -> str:
         """:meth:`homing_stage` between two cycles (the emulated bus: of a drive the axis
         bank runs too, without giving it back)."""
@@ -319,10 +323,13 @@ class EmulatedBus(FaultBus):
         vmax = object.__getattribute__(self._chan(axis), "mech").vmax
         return abs(vmax) * (self.ctl.clock.cycle_ns * 1e-9) * (1.0 + 1e-9) + 1e-6
 
-    def homing_stage_now(self, axis: int) -> str:
-        ch = self._chan(axis)
+    def banked(self, axis: int) -> bool:
         bank = self.ctl.bank
-        if bank is not None and bank.row_position(ch) is not None:
+        return bank is not None and bank.row_position(self._chan(axis)) is not None
+
+    def homing_stage_now(self, axis: int) -> str:
+        if self.banked(axis):
+            ch = self._chan(axis)
             h = object.__getattribute__(ch, "homing")  # (read past its guard: it stays)
             return "" if h is None else h.phase.name.lower()
         return self.homing_stage(axis)

@@ -371,11 +371,10 @@ class Injector:
             if e.state == "armed":
                 if self._looks(e):
                     # what it sees is known only after a cycle: none once it saw its fault
-                    # due; a position as many as surely end short of it; a stage one
+                    # due, else as many as surely change nothing it looks at (cycles_short)
                     if e.data.get("hit", True):
                         return 0
-                    trig = e.trigger
-                    n = trig.cycles_short(self.bus, n) if isinstance(trig, WhenPosition) else 1
+                    n = e.trigger.cycles_short(self.bus, n)  # type: ignore[attr-defined]
                     continue
                 if e.after is not None:
                     if e.after not in self._started:

@@ -202,6 +202,13 @@ class AtHomingStage(Trigger):
         bank keeps its homing's stage: it leaves the bank before anything could change it)."""
         return bus.homing_stage_now(self.axis) == self.stage
 
+    def cycles_short(self, bus: Any, n: int) -> int:
+        """How many of the next ``n`` cycles may run at once after a :meth:`look` that saw
+        nothing: all of them while the axis bank runs the drive (a banked homing leaves the
+        bank before any cycle that could change its stage, and that cycle is not one of a
+        run at once; a drive in another mode starts no homing without a call), else 1."""
+        return n if bus.banked(self.axis) else 1
+
     def describe(self) -> str:
         return f"when the homing of axis {self.axis} reaches its {self.stage} stage"
 
