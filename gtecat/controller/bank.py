@@ -1666,7 +1666,7 @@ class AxisBank:
 
     def hold(self, axes: frozenset[int]) -> None:
         """Keep the GT ``axes`` off the bank from now on, the others as they are (a fault
-        trigger watches their mechanics every cycle: :mod:`gtecat.faults`); an empty set
+        fault may meet them in the next cycle: :mod:`gtecat.faults`); an empty set
         lets them back at the next refresh."""
         axes = frozenset(axes)
         if axes == self.held:

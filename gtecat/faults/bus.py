@@ -110,8 +110,9 @@ class FaultBus:
         """Route the cyclic answers through ``injector`` (None: no longer)."""
 
     def watch_axes(self, axes: frozenset[int]) -> None:
-        """A trigger reads the drives of ``axes`` every cycle (the emulated bus keeps them
-        off the axis bank, the other axes stay on it)."""
+        """A fault may meet the drives of ``axes`` in the next cycle, or a script's step
+        reads them in every tick (the emulated bus keeps them off the axis bank, the other
+        axes stay on it)."""
 
     # --- what the faults reach ----------------------------------------
     def slave(self, position: int) -> VirtualSlave:

@@ -116,7 +116,7 @@ class Injector:
     """The faults of one bus (module docstring)."""
 
     #: the controller's pre_cycle protocol: the axis bank may run while faults are armed
-    #: (the axes a trigger watches every cycle are kept off it: :meth:`_refresh`)
+    #: (the axes a fault is about to meet are kept off it: :meth:`_refresh`)
     bank_safe = True
 
     def __init__(self, bus: FaultBus) -> None:
@@ -472,8 +472,9 @@ class Injector:
         self.look()
 
     def _refresh(self) -> None:
-        """Frame faults routed while one is armed or active; bank-safe without position or
-        homing triggers."""
+        """Frame faults routed while one is active; the axes a fault may meet in the next
+        cycle (all for a fault on the bus) kept off the axis bank, and the triggers that
+        watch the machine looked at after every cycle (:meth:`look`)."""
         self._version += 1  # (called after every change of the entries)
         frame = any(
             e.state == "active" and e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown)
