@@ -37,7 +37,7 @@ class FaultBus:
 
     name = "bus"
     cycle_ns = 1_000_000
-    #: :meth:`boundary` calls its hook after every cycle (else the triggers that watch the
+    #: :meth:`boundary` calls its hook before every cycle (else the triggers that watch the
     #: machine are asked in each cycle's tick)
     between = False
 
@@ -178,8 +178,10 @@ class FaultBus:
         return self.homing_stage(axis)
 
     def boundary(self, hook: Any) -> None:
-        """Call ``hook()`` after every cycle from now on (None: no longer): a trigger that
-        watches the machine looks at it there (:meth:`Injector.look`)."""
+        """Call ``hook()`` before every cycle from now on, before anything of it has run
+        (None: no longer); cycles run at once ask the injector's ``quiet_cycles`` first
+        instead: a trigger that watches the machine looks at it there
+        (:meth:`Injector.look`)."""
 
     # --- slaves ----------------------------------------
     def power_cycle(self, position: int) -> None:
@@ -222,23 +224,6 @@ class FaultBus:
             )  # type: ignore[assignment]
 
 
-class _AfterCycle:
-    """A ``post_cycle`` hook that looks at the machine after every cycle and changes
-    nothing the axis bank runs (``bank_safe``), so it keeps no cycles from running at once
-    (``quiet_cycles``): the injector looks after those itself (``cycles_passed``)."""
-
-    bank_safe = True
-
-    def __init__(self, hook: Any) -> None:
-        self.hook = hook
-
-    def after(self, _t: int, _dt: int) -> None:
-        self.hook()
-
-    def quiet_cycles(self, n: int) -> int:
-        return n
-
-
 class EmulatedBus(FaultBus):
     """The in-process emulated bus of one controller."""
 
@@ -263,7 +248,7 @@ class EmulatedBus(FaultBus):
         self.backend = ctl.backend
         self._cut: list[int] = []
         self._chans: dict[int, Channel] = {}
-        self._boundary: Any = None  # (the bound method in ctl.post_cycle)
+        self._boundary: Any = None  # (the hook in ctl.before_bank)
 
     @property
     def cycle_ns(self) -> int:  # type: ignore[override]
@@ -336,12 +321,12 @@ class EmulatedBus(FaultBus):
         return self.homing_stage(axis)
 
     def boundary(self, hook: Any) -> None:
-        post = self.ctl.post_cycle
-        if self._boundary is not None and self._boundary in post:
-            post.remove(self._boundary)
-        self._boundary = None if hook is None else _AfterCycle(hook).after
-        if self._boundary is not None:
-            post.append(self._boundary)
+        hooks = self.ctl.before_bank
+        if self._boundary is not None and self._boundary in hooks:
+            hooks.remove(self._boundary)
+        self._boundary = hook
+        if hook is not None:
+            hooks.append(hook)
 
     def _open_link(self, position: int) -> None:
         self.before_change()

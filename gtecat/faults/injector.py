@@ -136,7 +136,7 @@ class Injector:
         self._lbase: int | None = None
         self._started: set[int] = set()
         self._watched: frozenset[int] = frozenset()
-        #: :meth:`look` runs after every cycle (an armed trigger watches the machine)
+        #: :meth:`look` runs before every cycle (an armed trigger watches the machine)
         self._looking = False
         #: the bus is being brought up (a machine description's faults, armed before it):
         #: a fault that starts at once waits for the bus unless the bring-up can meet it (a
@@ -310,7 +310,7 @@ class Injector:
                 if not cycle and not isinstance(e.trigger, AtTime | AfterTime):
                     continue
                 if self._looks(e) and not e.data.get("hit", True):
-                    continue  # (it saw nothing after the cycle before: look)
+                    continue  # (it saw nothing before this cycle: look)
                 if e.trigger.due(self.bus):
                     self._start(e)
             elif e.state == "active" and e.duration_ms is not None:
@@ -364,7 +364,7 @@ class Injector:
 
     def _quiet_cycles(self, n: int) -> int:
         if self._looking:
-            self.look()  # (nothing moved the machine since the last cycle, as a rule)
+            self.look()
         for e in self.entries:
             if n <= 0:
                 return 0
@@ -408,12 +408,10 @@ class Injector:
         for e in self.entries:
             if e.state == "armed" and (e.after is None or e.after in self._started):
                 e.trigger.cycles_passed(self.bus, n)
-        if self._looking:
-            self.look()
 
     def _looks(self, e: Entry) -> bool:
         """An armed entry whose trigger watches the machine and is asked between cycles
-        (:meth:`look`), on a bus that has a hook after every cycle; a script's step waits
+        (:meth:`look`), on a bus that has a hook before every cycle; a script's step waits
         for another and is asked in its tick."""
         return (
             e.state == "armed"
@@ -423,14 +421,14 @@ class Injector:
         )
 
     def look(self) -> None:
-        """Between two cycles (after each: a ``post_cycle`` hook on the emulated bus, and
-        :meth:`cycles_passed`; at arming): the triggers that watch the machine look at it
-        (``look``: the axis bank's rows are read where they are), and what they see is what
-        the next tick's ``due`` would have seen, as nothing moves the machine between
-        cycles.  One that sees its fault due takes the watched axis and the fault's axes
-        off the bank before that cycle (:meth:`_refresh`): its tick asks ``due`` as ever,
-        and the fault meets them as on the scalar path.  Until then the watched axis
-        stays on the bank, and so do the others."""
+        """Between two cycles (before each: the emulated bus's ``before_bank`` hook, and
+        :meth:`quiet_cycles` before every run at once; at arming): the triggers that watch
+        the machine look at it (``look``: the axis bank's rows are read where they are), and
+        what they see is what the next tick's ``due`` would see.  One that sees its fault
+        due takes the watched axis and the fault's axes off the bank before that cycle
+        (:meth:`_refresh`): its tick asks ``due`` as ever, and the fault meets them as on
+        the scalar path.  Until then the watched axis stays on the bank, and so do the
+        others."""
         changed = False
         for e in self.entries:
             if self._looks(e):
@@ -474,7 +472,7 @@ class Injector:
     def _refresh(self) -> None:
         """Frame faults routed while one is active; the axes a fault may meet in the next
         cycle (all for a fault on the bus) kept off the axis bank, and the triggers that
-        watch the machine looked at after every cycle (:meth:`look`)."""
+        watch the machine looked at before every cycle (:meth:`look`)."""
         self._version += 1  # (called after every change of the entries)
         frame = any(
             e.state == "active" and e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown)
@@ -488,7 +486,7 @@ class Injector:
         # cycle) is kept off the bank from now on, so the fault meets it in the very cycle
         # the trigger fires, as on the scalar path; a fault on the bus or a slave: all axes.
         # A trigger that watches the machine says whether it fires in the next cycle only
-        # after the one before (look): it keeps its fault's axes on the bank until then.
+        # just before it (look): it keeps its fault's axes on the bank until then.
         held: set[int] = set()
         safe = True
         looking = False

@@ -221,3 +221,25 @@ def test_time_triggers_fire_in_the_same_cycle_across_a_reset() -> None:
     fast = _reset_session("batched")
     assert sorted(e[1:] for e in fast) == [("end", 1), ("end", 2), ("start", 1), ("start", 2)]
     assert fast == _reset_session("one at a time")
+
+
+def _pushed(way: str) -> list:
+    """A position trigger waiting while the mechanics are moved from outside between two
+    cycles (a scenario pushing the axis): the cycle its fault starts in."""
+    ctl = _up("off" if way == "no bank" else "auto")
+    if way == "one at a time":
+        ctl.clock.run_many = None
+    faults.inject("drive_fault", axis=2, code=0x2310, when_position=[1, 3000])
+    gt.GTE_Wait(10)
+    ctl.backend.slaves[0].channel(0).machine_position = 5000.0
+    gt.GTE_Wait(10)
+    cycle = ctl.clock.cycle_ns / 1e6
+    events = [(round(ms / cycle), what) for ms, what, _, _ in faults.injector_for(ctl).events]
+    gt.GT_Close()
+    return events
+
+
+def test_a_position_trigger_sees_the_mechanics_moved_between_cycles() -> None:
+    batched = _pushed("batched")
+    assert [what for _, what in batched] == ["start"]
+    assert batched == _pushed("one at a time") == _pushed("no bank")
