@@ -1713,10 +1713,27 @@ class AxisBank:
     def release_all(self) -> None:
         if self.n_alive:
             self._release_groups([g for g in self.groups if g.claimed])
+            self._settled = False  # (a release after settle: the next cycle looks again)
+
+    def row_position(self, ch: Any) -> float | None:
+        """The mechanics position of drive channel ``ch`` where a row of this bank runs it:
+        its committed state after the last cycle, read without giving the row back (a
+        fault trigger looks at it between cycles: :mod:`gtecat.faults`); None where the
+        channel's own object holds it."""
+        if type(ch) not in _GUARD_SET:
+            return None
+        entry = _OWNER.get(id(ch))
+        if entry is None or entry[0] is not self:
+            return None
+        csp = self.csp
+        for r, c in enumerate(csp.channels):
+            if c is ch:
+                return float(csp.pos[r]) if self.alive[r] else None
+        return None
 
     def hold(self, axes: frozenset[int]) -> None:
         """Keep the GT ``axes`` off the bank from now on, the others as they are (a fault
-        trigger watches their mechanics every cycle: :mod:`gtecat.faults`); an empty set
+        fault may meet them in the next cycle: :mod:`gtecat.faults`); an empty set
         lets them back at the next refresh."""
         axes = frozenset(axes)
         if axes == self.held:
@@ -1727,6 +1744,7 @@ class AxisBank:
             if ax is not None:
                 self.release_axis_object(ax)
         self.dirty = True
+        self._settled = False  # (a hold after settle: the next cycle looks again)
 
     def before_axis_call(self, ax: Any, res: Any) -> None:
         """What :meth:`before_call` does for a GT function naming one existing axis ``ax``

@@ -151,6 +151,7 @@ class Controller:
     post_cycle = hook_list("post_cycle")
     sample = hook_list("sample")
     watch = hook_list("watch")
+    before_bank = hook_list("before_bank")
 
     #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
     bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
@@ -230,6 +231,10 @@ class Controller:
         #: (:meth:`run_cycles`), so unlike ``sample`` it never stops such a run: for what only
         #: reads the clock now and then (the status line of ``gtecat run``)
         self.watch: list[Callable[[], None]] = []
+        #: called before every cycle :meth:`_cycle` runs, before the axis bank's part of it,
+        #: and never stopping cycles at once (whose hooks' ``quiet_cycles`` are asked before
+        #: every run instead): the fault triggers that watch the machine look at it here
+        self.before_bank: list[Callable[[], None]] = []
         #: GT axes (1-based) once the bus is up
         self.axes: dict[int, Axis] = {}
         self._axis_list: list[Axis] = []
@@ -412,6 +417,8 @@ class Controller:
             g()  # (a motion program's GT call may wait for cycles here, as the application's)
         self.cycling = True
         try:
+            for g in self.before_bank:
+                g()
             t = self.clock.now_ns
             dt = self.clock.cycle_ns
             bank = self.bank

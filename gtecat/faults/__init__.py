@@ -290,14 +290,15 @@ def _arm_machine(ctl: Any, holding: bool = False) -> None:
     "a parameter of this call is wrong", and the call's own parameters are right; 1 is "the
     command could not be carried out", which is what a bus that cannot be brought up as its
     description says is.  GTE_GetLastError gives the one line naming the file and table."""
-    ctl.pre_cycle[:] = [
-        f
-        for f in ctl.pre_cycle
-        if not (
-            isinstance(getattr(f, "__self__", None), Injector)
-            and getattr(f.__self__.bus, "backend", None) is not ctl.backend
-        )
-    ]
+    for hooks in (ctl.pre_cycle, ctl.before_bank):  # (the tick, the look: Injector)
+        hooks[:] = [
+            f
+            for f in hooks
+            if not (
+                isinstance(getattr(f, "__self__", None), Injector)
+                and getattr(f.__self__.bus, "backend", None) is not ctl.backend
+            )
+        ]
     tables = getattr(ctl.machine, "faults", ())
     if tables and ctl.options.backend == "emulated":
         source = ctl.machine.source or "machine description"

@@ -17,6 +17,7 @@ done on its bus, so the same fault object means the same thing on both:
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -36,6 +37,9 @@ class FaultBus:
 
     name = "bus"
     cycle_ns = 1_000_000
+    #: :meth:`boundary` calls its hook before every cycle (else the triggers that watch the
+    #: machine are asked in each cycle's tick)
+    between = False
 
     def image_bytes(self) -> int | None:
         """Size of the process image, bytes, where the bus knows it (a ``wkc_offset`` area
@@ -106,8 +110,9 @@ class FaultBus:
         """Route the cyclic answers through ``injector`` (None: no longer)."""
 
     def watch_axes(self, axes: frozenset[int]) -> None:
-        """A trigger reads the drives of ``axes`` every cycle (the emulated bus keeps them
-        off the axis bank, the other axes stay on it)."""
+        """A fault may meet the drives of ``axes`` in the next cycle, or a script's step
+        reads them in every tick (the emulated bus keeps them off the axis bank, the other
+        axes stay on it)."""
 
     # --- what the faults reach ----------------------------------------
     def slave(self, position: int) -> VirtualSlave:
@@ -152,6 +157,31 @@ class FaultBus:
     def homing_stage(self, axis: int) -> str:
         h = self.channel(axis).homing
         return "" if h is None else h.phase.name.lower()
+
+    def position_now(self, axis: int) -> float:
+        """:meth:`position` between two cycles, wherever the drive's state is kept (the
+        emulated bus: the axis bank's row, which it leaves there)."""
+        return self.position(axis)
+
+    def max_step(self, axis: int) -> float:
+        """The most the mechanics of ``axis`` can move in one cycle, machine counts, with a
+        margin for rounding (inf: the bus cannot tell)."""
+        return math.inf
+
+    def banked(self, axis: int) -> bool:
+        """Whether the axis bank runs the drive of ``axis`` now (the emulated bus)."""
+        return False
+
+    def homing_stage_now(self, axis: int) -> str:
+        """:meth:`homing_stage` between two cycles (the emulated bus: of a drive the axis
+        bank runs too, without giving it back)."""
+        return self.homing_stage(axis)
+
+    def boundary(self, hook: Any) -> None:
+        """Call ``hook()`` before every cycle from now on, before anything of it has run
+        (None: no longer); cycles run at once ask the injector's ``quiet_cycles`` first
+        instead: a trigger that watches the machine looks at it there
+        (:meth:`Injector.look`)."""
 
     # --- slaves ----------------------------------------
     def power_cycle(self, position: int) -> None:
@@ -198,6 +228,7 @@ class EmulatedBus(FaultBus):
     """The in-process emulated bus of one controller."""
 
     name = "emulated"
+    between = True
 
     def image_bytes(self) -> int | None:
         m = self.ctl.master
@@ -216,6 +247,8 @@ class EmulatedBus(FaultBus):
         self.ctl = ctl
         self.backend = ctl.backend
         self._cut: list[int] = []
+        self._chans: dict[int, Channel] = {}
+        self._boundary: Any = None  # (the hook in ctl.before_bank)
 
     @property
     def cycle_ns(self) -> int:  # type: ignore[override]
@@ -254,6 +287,46 @@ class EmulatedBus(FaultBus):
         bank = self.ctl.bank
         if bank is not None:
             bank.hold(axes)
+
+    def _chan(self, axis: int) -> Channel:
+        ch = self._chans.get(axis)
+        if ch is None:
+            ch = self._chans[axis] = self.channel(axis)
+        return ch
+
+    def position_now(self, axis: int) -> float:
+        ch = self._chan(axis)
+        bank = self.ctl.bank
+        if bank is not None:
+            pos = bank.row_position(ch)
+            if pos is not None:
+                return pos
+        return ch.machine_position
+
+    def max_step(self, axis: int) -> float:
+        # (Mechanics.track, drive_torque and coast keep |vel| within vmax; the bank's rows
+        # do the same operations)
+        vmax = object.__getattribute__(self._chan(axis), "mech").vmax
+        return abs(vmax) * (self.ctl.clock.cycle_ns * 1e-9) * (1.0 + 1e-9) + 1e-6
+
+    def banked(self, axis: int) -> bool:
+        bank = self.ctl.bank
+        return bank is not None and bank.row_position(self._chan(axis)) is not None
+
+    def homing_stage_now(self, axis: int) -> str:
+        if self.banked(axis):
+            ch = self._chan(axis)
+            h = object.__getattribute__(ch, "homing")  # (read past its guard: it stays)
+            return "" if h is None else h.phase.name.lower()
+        return self.homing_stage(axis)
+
+    def boundary(self, hook: Any) -> None:
+        hooks = self.ctl.before_bank
+        if self._boundary is not None and self._boundary in hooks:
+            hooks.remove(self._boundary)
+        self._boundary = hook
+        if hook is not None:
+            hooks.append(hook)
 
     def _open_link(self, position: int) -> None:
         self.before_change()

@@ -41,7 +41,17 @@ from ..errors import ParameterError
 from ..master.backends.emulated import ANSWERED, LOST, PREVIOUS
 from . import kinds as k
 from .bus import FaultBus
-from .triggers import AfterTime, AtTime, Now, OnSdo, Trigger, describe_after, first_cycle
+from .triggers import (
+    AfterTime,
+    AtHomingStage,
+    AtTime,
+    Now,
+    OnSdo,
+    Trigger,
+    WhenPosition,
+    describe_after,
+    first_cycle,
+)
 
 _LOGICAL = frozenset({"LRW", "LRD", "LWR"})
 _STATES = {"INIT": AlState.INIT, "PREOP": AlState.PREOP, "SAFEOP": AlState.SAFEOP}
@@ -106,7 +116,7 @@ class Injector:
     """The faults of one bus (module docstring)."""
 
     #: the controller's pre_cycle protocol: the axis bank may run while faults are armed
-    #: (the axes a trigger watches every cycle are kept off it: :meth:`_refresh`)
+    #: (the axes a fault is about to meet are kept off it: :meth:`_refresh`)
     bank_safe = True
 
     def __init__(self, bus: FaultBus) -> None:
@@ -126,6 +136,8 @@ class Injector:
         self._lbase: int | None = None
         self._started: set[int] = set()
         self._watched: frozenset[int] = frozenset()
+        #: :meth:`look` runs before every cycle (an armed trigger watches the machine)
+        self._looking = False
         #: the bus is being brought up (a machine description's faults, armed before it):
         #: a fault that starts at once waits for the bus unless the bring-up can meet it (a
         #: mailbox fault: the InitCmds are SDOs); :meth:`bus_ready` starts it then
@@ -163,6 +175,7 @@ class Injector:
             trig.since = self.bus.t_ms()  # type: ignore[attr-defined]
         self.entries.append(e)
         self.bus.log(f"Fault {e.id} armed: {e.describe()}.")
+        self.look()  # (before the refresh: it keeps the fault's axes on the bank)
         self._refresh()
         if isinstance(trig, Now) and self._gate_open(e) and not self._held(e):
             self._start(e)
@@ -211,6 +224,7 @@ class Injector:
             if "resume" in n.data and not self._held(n):
                 self._resume(n)
         self._refresh()
+        self.look()
 
     def _resume(self, e: Entry) -> None:
         """A fault active on the bus before a re-initialisation starts on the new one."""
@@ -295,6 +309,8 @@ class Injector:
             if e.state == "armed" and self._gate_open(e):
                 if not cycle and not isinstance(e.trigger, AtTime | AfterTime):
                     continue
+                if self._looks(e) and not e.data.get("hit", True):
+                    continue  # (it saw nothing before this cycle: look)
                 if e.trigger.due(self.bus):
                     self._start(e)
             elif e.state == "active" and e.duration_ms is not None:
@@ -347,10 +363,19 @@ class Injector:
         return max(0, min(n, far))
 
     def _quiet_cycles(self, n: int) -> int:
+        if self._looking:
+            self.look()
         for e in self.entries:
             if n <= 0:
                 return 0
             if e.state == "armed":
+                if self._looks(e):
+                    # what it sees is known only after a cycle: none once it saw its fault
+                    # due, else as many as surely change nothing it looks at (cycles_short)
+                    if e.data.get("hit", True):
+                        return 0
+                    n = e.trigger.cycles_short(self.bus, n)  # type: ignore[attr-defined]
+                    continue
                 if e.after is not None:
                     if e.after not in self._started:
                         continue  # its gate opens only in a tick that starts another
@@ -384,6 +409,36 @@ class Injector:
             if e.state == "armed" and (e.after is None or e.after in self._started):
                 e.trigger.cycles_passed(self.bus, n)
 
+    def _looks(self, e: Entry) -> bool:
+        """An armed entry whose trigger watches the machine and is asked between cycles
+        (:meth:`look`), on a bus that has a hook before every cycle; a script's step waits
+        for another and is asked in its tick."""
+        return (
+            e.state == "armed"
+            and e.after is None
+            and self.bus.between
+            and isinstance(e.trigger, WhenPosition | AtHomingStage)
+        )
+
+    def look(self) -> None:
+        """Between two cycles (before each: the emulated bus's ``before_bank`` hook, and
+        :meth:`quiet_cycles` before every run at once; at arming): the triggers that watch
+        the machine look at it (``look``: the axis bank's rows are read where they are), and
+        what they see is what the next tick's ``due`` would see.  One that sees its fault
+        due takes the watched axis and the fault's axes off the bank before that cycle
+        (:meth:`_refresh`): its tick asks ``due`` as ever, and the fault meets them as on
+        the scalar path.  Until then the watched axis stays on the bank, and so do the
+        others."""
+        changed = False
+        for e in self.entries:
+            if self._looks(e):
+                hit = bool(e.trigger.look(self.bus))  # type: ignore[attr-defined]
+                if hit != e.data.get("hit"):
+                    e.data["hit"] = hit
+                    changed = True
+        if changed:
+            self._refresh()
+
     def _gate_open(self, e: Entry) -> bool:
         if e.after is None:
             return True
@@ -412,10 +467,12 @@ class Injector:
         if not self.bank_safe:
             self.bus.before_change()
         self._refresh()
+        self.look()
 
     def _refresh(self) -> None:
-        """Frame faults routed while one is armed or active; bank-safe without position or
-        homing triggers."""
+        """Frame faults routed while one is active; the axes a fault may meet in the next
+        cycle (all for a fault on the bus) kept off the axis bank, and the triggers that
+        watch the machine looked at before every cycle (:meth:`look`)."""
         self._version += 1  # (called after every change of the entries)
         frame = any(
             e.state == "active" and e.fault.depth == "frame" and not isinstance(e.fault, k.LinkDown)
@@ -424,19 +481,25 @@ class Injector:
         if frame != self._frame_on:
             self._frame_on = frame
             self.bus.set_frame_faults(self if frame else None)
-        from .triggers import AtHomingStage, WhenPosition
-
         # The axis bank runs its axes' whole cycle before this tick: an axis a fault is
         # about to change (its trigger may fire in the next cycle, or is watched every
         # cycle) is kept off the bank from now on, so the fault meets it in the very cycle
         # the trigger fires, as on the scalar path; a fault on the bus or a slave: all axes.
+        # A trigger that watches the machine says whether it fires in the next cycle only
+        # just before it (look): it keeps its fault's axes on the bank until then.
         held: set[int] = set()
         safe = True
+        looking = False
         for e in self.entries:
             if e.state != "armed":
                 continue
             trig = e.trigger
-            if isinstance(trig, WhenPosition | AtHomingStage):
+            if self._looks(e):
+                looking = True
+                if not e.data.get("hit", True):
+                    continue
+                held.add(trig.axis)  # (its tick asks due() of the scalar drive, as before)
+            elif isinstance(trig, WhenPosition | AtHomingStage):
                 held.add(trig.axis)
             elif e.after is None and not trig.soon(self.bus):
                 continue
@@ -453,6 +516,9 @@ class Injector:
         if watched != self._watched:
             self._watched = watched
             self.bus.watch_axes(watched)  # the others stay on the bank
+        if looking != self._looking:
+            self._looking = looking
+            self.bus.boundary(self.look if looking else None)
 
     # --- start and end ----------------------------------------
     def _start(self, e: Entry) -> None:

@@ -3,7 +3,11 @@
 A trigger is asked once per cycle (:meth:`Trigger.due`) with the bus it watches
 (:class:`gtecat.faults.bus.FaultBus`), except :class:`OnSdo`, which counts the mailbox
 requests as they pass (:meth:`Trigger.sdo`), so the fault it arms meets the very request
-that fired it.  Every trigger has ``describe()`` in words and the plain-dict keys the
+that fired it.  One that watches the machine (:class:`WhenPosition`, :class:`AtHomingStage`)
+is asked between cycles instead (``look``): what it sees there is what the next cycle's
+``due`` would see, and the injector needs to know it before that cycle starts.
+
+Every trigger has ``describe()`` in words and the plain-dict keys the
 ``[[fault]]`` tables use (``at_ms``, ``after_cycles``, ``when_position``, ``at_homing``,
 ``on_sdo``); no key: at once.
 """
@@ -142,9 +146,32 @@ class WhenPosition(Trigger):
     axis: int
     position: float
     _side: int | None = None
+    #: the position :meth:`look` last saw
+    _seen: float = math.nan
 
     def due(self, bus: Any) -> bool:
-        pos = bus.position(self.axis)
+        return self._due(bus.position(self.axis))
+
+    def look(self, bus: Any) -> bool:
+        """:meth:`due` asked between two cycles, of the drive's state wherever it is kept
+        (the axis bank's row: the axis stays on the bank), so the injector knows before
+        the next cycle whether its tick may fire (:meth:`Injector.look`)."""
+        self._seen = pos = bus.position_now(self.axis)
+        return self._due(pos)
+
+    def cycles_short(self, bus: Any, n: int) -> int:
+        """How many of the next ``n`` cycles may run at once after a :meth:`look` that saw
+        nothing (at least 1): the mechanics move at most their top speed per cycle
+        (:meth:`FaultBus.max_step`), so every cycle of the run but its last ends short of
+        the position (the position after the last one is looked at after the run)."""
+        step = bus.max_step(self.axis)
+        d = abs(self._seen - self.position)
+        if not step > 0.0:
+            return n if step == 0.0 and d > 0.0 else 1
+        m = math.ceil(d / step) - 1  # cycle ends surely short of it: m * step < d
+        return max(1, min(n, m + 1))
+
+    def _due(self, pos: float) -> bool:
         side = (pos > self.position) - (pos < self.position)
         if side == 0:
             return True
@@ -169,6 +196,18 @@ class AtHomingStage(Trigger):
 
     def due(self, bus: Any) -> bool:
         return bus.homing_stage(self.axis) == self.stage
+
+    def look(self, bus: Any) -> bool:
+        """:meth:`due` between two cycles, of the drive wherever it runs (a row of the axis
+        bank keeps its homing's stage: it leaves the bank before anything could change it)."""
+        return bus.homing_stage_now(self.axis) == self.stage
+
+    def cycles_short(self, bus: Any, n: int) -> int:
+        """How many of the next ``n`` cycles may run at once after a :meth:`look` that saw
+        nothing: all of them while the axis bank runs the drive (a banked homing leaves the
+        bank before any cycle that could change its stage, and that cycle is not one of a
+        run at once; a drive in another mode starts no homing without a call), else 1."""
+        return n if bus.banked(self.axis) else 1
 
     def describe(self) -> str:
         return f"when the homing of axis {self.axis} reaches its {self.stage} stage"

@@ -124,21 +124,33 @@ def test_a_cleared_fault_leaves_the_session_as_fast_as_none() -> None:
     assert gt.GT_GetSts(2, byref(s)) == 0 and s.value & ALARM  # read through the bank
 
 
-def test_a_position_trigger_keeps_only_its_axis_off_the_bank() -> None:
+def test_a_position_trigger_keeps_every_axis_on_the_bank_while_it_waits() -> None:
     ctl = _up()
     gt.GTE_Wait(5)
     assert not ctl._run_axes
     faults.inject("drive_fault", axis=1, code=0x2310, when_position=[1, 3000])
     gt.GTE_Wait(5)
-    assert [ax.number for ax in ctl._run_axes] == [1]  # axis 2 stays on the bank
+    assert not ctl._run_axes and ctl.bank.held == frozenset()  # the watched axis too
     assert _trap(1, 10_000) == 0
+    b0 = ctl.bank.many_cycles
     for _ in range(1000):
         gt.GTE_Wait(1)
         if faults.listing()[0]["state"] == "active":
             break
+    assert ctl.bank.many_cycles - b0 > 50  # the bank's compiled cycles, up to the one before
     gt.GTE_Wait(5)
     assert 2 not in [ax.number for ax in ctl._run_axes]
     assert ctl.bank.held == frozenset()
+    # a position far off: the mechanics cannot get there in a run of cycles, so the runs
+    # are as long as without it, and a link loss armed so keeps every axis on the bank too
+    faults.clear()
+    assert gt.GT_ClrSts(1, 2) == 0 and gt.GT_AxisOn(1) == 0
+    gt.GTE_Wait(50)
+    plain = _batched_cycles(ctl, 2000)
+    assert plain[0] == plain[1]
+    faults.inject("link_down", after_slave=0, when_position=[2, 1e9])
+    assert _batched_cycles(ctl, 2000) == plain
+    assert faults.listing()[0]["state"] == "armed"
 
 
 def _resting_session(way: str) -> list:
@@ -209,3 +221,25 @@ def test_time_triggers_fire_in_the_same_cycle_across_a_reset() -> None:
     fast = _reset_session("batched")
     assert sorted(e[1:] for e in fast) == [("end", 1), ("end", 2), ("start", 1), ("start", 2)]
     assert fast == _reset_session("one at a time")
+
+
+def _pushed(way: str) -> list:
+    """A position trigger waiting while the mechanics are moved from outside between two
+    cycles (a scenario pushing the axis): the cycle its fault starts in."""
+    ctl = _up("off" if way == "no bank" else "auto")
+    if way == "one at a time":
+        ctl.clock.run_many = None
+    faults.inject("drive_fault", axis=2, code=0x2310, when_position=[1, 3000])
+    gt.GTE_Wait(10)
+    ctl.backend.slaves[0].channel(0).machine_position = 5000.0
+    gt.GTE_Wait(10)
+    cycle = ctl.clock.cycle_ns / 1e6
+    events = [(round(ms / cycle), what) for ms, what, _, _ in faults.injector_for(ctl).events]
+    gt.GT_Close()
+    return events
+
+
+def test_a_position_trigger_sees_the_mechanics_moved_between_cycles() -> None:
+    batched = _pushed("batched")
+    assert [what for _, what in batched] == ["start"]
+    assert batched == _pushed("one at a time") == _pushed("no bank")
