@@ -1402,6 +1402,13 @@ class AxisBank:
         else:
             self.dwatch[r], self.dpost[r] = watch, 0
 
+    def rests(self, ax: Any) -> bool:
+        """``ax``'s row is in the bank frozen (servo off, its drive resting unpowered:
+        :meth:`_eligible_frozen`): the compiled cycles skip it, so its process values in the
+        image - 6041h among them - stay as they are over every cycle the bank runs."""
+        r = self._row_of.get(id(ax)) if self.n_alive else None
+        return r is not None and bool(self.alive[r] and self.frz[r])
+
     # --- a capture unit arming its drive's touch probe -------------------------------------
     def probe_in_bank(self, ax: Any) -> bool:
         """The touch probe of ``ax``'s drive may be armed while the bank runs the axis: a

@@ -861,9 +861,14 @@ def _fault_reset(ctl: Controller, faulted: list[AxisResources]) -> None:
     for r in faulted:
         if r.drive_state() == PdsState.FAULT:
             r.ax.cw = _CW_FAULT_RESET  # ... then rising (transition 15)
+    # a drive that refused the reset rests in FAULT until something outside the bank's runs
+    # changes it (its cause going is an injector's event, which ends a run): while each
+    # faulted axis rests frozen in the bank (servo off), 6041h in the image stays as it is
+    bank = ctl.bank
     clock.run_until(
         lambda: not any(r.drive_state() == PdsState.FAULT for r in faulted),
         FAULT_RESET_TIMEOUT_MS,
+        None if bank is None else lambda: all(bank.rests(r.ax) for r in faulted),
     )
     for r in faulted:
         r.ax.cw = 0x0000

@@ -255,8 +255,19 @@ class Clock:
         elif self.mode is ClockMode.REALTIME:
             time.sleep(0)
 
-    def run_until(self, pred: Callable[[], bool], timeout_ms: float) -> bool:
-        """Run whole cycles until ``pred()`` holds or ``timeout_ms`` passes."""
+    def run_until(
+        self,
+        pred: Callable[[], bool],
+        timeout_ms: float,
+        still: Callable[[], bool] | None = None,
+    ) -> bool:
+        """Run whole cycles until ``pred()`` holds or ``timeout_ms`` passes.
+
+        ``still``: where it holds (asked before each run of cycles), ``pred``'s answer
+        cannot change over cycles the owner runs its quick way (:attr:`run_many`), so the
+        rest of the budget goes to the owner as one run: the cycles are the ones run one by
+        one would be, and ``pred`` is asked after the run (a clock of a group shares its
+        time cycle by cycle, so there it is not used)."""
         if self.mode is ClockMode.REALTIME:
             deadline = time.monotonic() + timeout_ms / 1000
             while time.monotonic() < deadline:
@@ -272,13 +283,21 @@ class Clock:
         while not pred():
             if spent >= budget:
                 return False
-            if many is not None and many(1):  # the owner ran it its quick way
-                self.cycles += 1
-                self.now_ns += self.cycle_ns
-                if self.counted is not None:
-                    self.counted()
-            else:
-                self.cycle()
+            if many is not None:
+                n = 1
+                if still is not None and self.group is None and still():
+                    n = -(-(budget - spent) // self.cycle_ns)  # (the cycles left, as one by one)
+                k = many(n)
+                if k:  # the owner ran them its quick way
+                    self.cycles += k
+                    self.now_ns += k * self.cycle_ns
+                    if self.counted is not None:
+                        self.counted()
+                    spent += k * self.cycle_ns
+                    if self.group is not None:
+                        self.group.share(self, k * self.cycle_ns)
+                    continue
+            self.cycle()
             spent += self.cycle_ns
             if self.group is not None:
                 self.group.share(self, self.cycle_ns)
