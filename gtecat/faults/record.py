@@ -951,9 +951,12 @@ def _prepare(
             continue
         kind = _kind(x)
         if kind is not None and kind[0] == "arr":
-            packed = _pack(kind, x["v"])
+            # (into the array: its values are the array's, the pointer is made once)
+            packed = _pack(kind, x["v"] if len(kind) == 3 else x["ref"]["v"])
             out = outs.get(str(i))
-            out_packed = _pack(kind, out["v"]) if _kind(out) == kind else None
+            out_packed = None
+            if _kind(out) == kind:
+                out_packed = _pack(kind, out["v"] if len(kind) == 3 else out["ref"]["v"])
             if packed is not None and (out is None or out_packed is not None):
                 # an array of numbers: one array per function and argument, its memory set
                 # to the recorded values before each call and compared with them after it
@@ -962,7 +965,7 @@ def _prepare(
                 packs.append((len(vals), kind))
                 vals.append(packed)
                 arrays.append((i, mv, len(vals) - 1, kind, out_packed))
-                args.append(obj)
+                args.append(obj if len(kind) == 3 else ctypes.byref(obj, kind[3]))
                 continue
         fresh.append((i, x))
         args.append(None)
@@ -1152,9 +1155,20 @@ _ARRAY_CODE = {
 
 def _kind(x: Any) -> tuple[Any, ...] | None:
     """What a recorded pointer argument is when one pooled object serves it: ``("ref", c)``
-    for a pointer to a simple value, ``("arr", c, n)`` for an array of numbers; else None."""
-    if type(x) is not dict or (len(x) != 1 and len(x) != 3):
+    for a pointer to a simple value, ``("arr", c, n)`` for an array of numbers,
+    ``("arr", c, n, off)`` for a pointer ``off`` bytes into one (a C program's ``&arr[8]``:
+    ``byref(arr, off)``, off on an element inside the array); else None."""
+    if type(x) is not dict or not 1 <= len(x) <= 3:
         return None
+    if len(x) == 2:
+        off = x.get("off")
+        kind = _kind(x.get("ref"))
+        if type(off) is not int or kind is None or kind[0] != "arr" or len(kind) != 3:
+            return None
+        size = _struct(kind).size
+        if not 0 < off < size or off % (size // kind[2]):
+            return None
+        return (*kind, off)
     if len(x) == 1:
         ref = x.get("ref")
         if (
@@ -1366,7 +1380,7 @@ def _steps(
 
 
 #: the layout of a plan (:func:`_plan_of`); a plan of another is made again
-_PLAN = 3
+_PLAN = 4
 #: a unit of a plan that is no form: an entry (a checkpoint, a fault), a call made whole;
 #: form ``f`` is ``f + _FORMS``
 _ENTRY, _WHOLE, _FORMS = 0, 1, 2

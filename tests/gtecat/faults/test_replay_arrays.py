@@ -120,3 +120,87 @@ def test_the_command_reports_the_element(
     out = capsys.readouterr()
     text = out.out + out.err
     assert f"call {at} GT_GetEncPos: argument 2 element [0] recorded -1.25" in text
+
+
+def _offset_session(gt, machine: str) -> None:
+    """Axes 1-8 into ``enc``, then 9-12 through a pointer into it (a C program's
+    ``GT_GetEncPos(9, &enc[8], 4, NULL)``), every 5 ms while axes 9 and 10 jog."""
+    from ctypes import byref, c_double, c_short
+
+    assert gt.GT_Open(eni=str(session_arrays.ENI), clock="auto", log="", machine=machine) == 0
+    assert gt.GT_InitEcatComm() == 0
+    st = c_short()
+    while gt.GT_IsEcatReady(byref(st)) == 0 and st.value != 1:
+        gt.GTE_Wait(1)
+    gt.GT_StartEcatComm()
+    jog = gt.TJogPrm()
+    jog.acc = jog.dec = 0.1
+    for a in (9, 10):
+        gt.GT_AxisOn(a)
+        gt.GT_PrfJog(a)
+        gt.GT_SetJogPrm(a, byref(jog))
+        gt.GT_SetVel(a, 3.0 + a)
+        gt.GT_Update(1 << (a - 1))
+    enc = (c_double * 12)()
+    for _ in range(60):
+        gt.GT_GetEncPos(1, enc, 8, None)
+        gt.GT_GetEncPos(9, byref(enc, 64), 4, None)
+        gt.GTE_Wait(5)
+    gt.GT_Close()
+
+
+@pytest.fixture(scope="module")
+def offsets(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from gtecat.faults.record import Recorder
+
+    out = tmp_path_factory.mktemp("offsets") / "session.gtrec"
+    machine = out.with_suffix(".toml")
+    machine.write_text(session_arrays.MACHINE)
+    rec = Recorder(out).start()
+    try:
+        _offset_session(gt, str(machine))
+    finally:
+        rec.stop()
+        gt.GT_Close()
+    return rec.write()
+
+
+def test_a_pointer_into_an_array_replays_as_one_form(offsets: Path, tmp_path: Path) -> None:
+    """The reads through ``&enc[8]`` share one prepared call with the array pooled (its
+    values, not the line, differ), replay exactly, and a changed element is named by its
+    index in the whole array."""
+    from gtecat.faults.record import _steps
+
+    lines = offsets.read_text().splitlines()
+    into = [x for x in lines if '"off":64' in x]
+    assert len(into) == 60 and sum('"o":' in x for x in into) > 50  # (the jog: new values)
+    steps = _steps(offsets, lines[1:])
+    calls = {id(p) for p, _ in steps if p is not None and getattr(p, "name", "") == "GT_GetEncPos"}
+    assert len(calls) <= 3  # (the two forms, a first line of each that may read as it stands)
+    n, div = replay(offsets)
+    assert div is None, str(div)
+    assert n == sum('"c":' in x for x in lines[1:])
+
+    bad = tmp_path / "into.gtrec"
+    was: list[float] = []
+
+    def nudge(e: dict) -> None:
+        v = e["o"]["1"]["ref"]["v"]
+        was.append(v[9])
+        v[9] += 1.0
+
+    seen = 0
+    for i, line in enumerate(lines):
+        if '"off":64' in line and '"o":' in line:
+            seen += 1
+            if seen == 20:
+                e = json.loads(line)
+                nudge(e)
+                lines[i] = json.dumps(e, separators=(",", ":"))
+                at = sum('"c":' in x for x in lines[1 : i + 1])
+                break
+    bad.write_text("\n".join(lines) + "\n")
+    n, div = replay(bad)
+    assert div is not None and n == at
+    assert (div.call, div.what) == ("GT_GetEncPos", "argument 2 element [9]")
+    assert div.recorded == was[0] + 1.0 and div.now == was[0]
