@@ -601,9 +601,9 @@ def fast_reader(
                     packed[:] = [pack, values, out]
             session.last = None
             if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
-                ctl = GATED[0]
+                ctl = GATED[0]  # (the clock's now_ns in its quick numbers: no frame)
                 out += _CLOCK_VALUE.pack(
-                    ((ctl.clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+                    ((ctl.clock.quick[9] - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
                 )
             return out
 
@@ -903,19 +903,19 @@ DERIVED: dict[str, tuple[str, ...]] = {
 
 #: a banked axis's value of each DERIVED reader, one row of the bank alone as the value
 #: function's DERIVED steps make it (AxisBank.row_value: the row's value, or the list's
-#: where it is made already): ``{R}`` the axis's resources, ``{r}`` its row; a span's plan
-#: (_read_plan) writes one per row, so a span after a cycle does not make every row's list
-#: of the value (tests/gtecat/gt/test_fast_span_rows.py)
+#: where it is made already; the encoder's rates of a row and the positions of one, read
+#: without row_value's frame, as it makes them in a bank of any size: the values its lists
+#: hold): ``{R}`` the axis's resources, ``{r}`` its row; a span's plan (_read_plan) writes
+#: one per row, so a span after a cycle does not make every row's list of the value
+#: (tests/gtecat/gt/test_fast_span_rows.py)
 BANK_ROWS: dict[str, str] = {
     "GT_GetAxisPrfVel": "{R}.prf_link.ratio * b.row_value('prf_v', {r})",
     "GT_GetAxisPrfAcc": "{R}.prf_link.ratio * b.row_value('prf_a', {r})",
-    "GT_GetAxisEncVel": "{R}.enc_link.ratio * b.row_value('enc_vel', {r})",
-    "GT_GetAxisEncAcc": "{R}.enc_link.ratio * b.row_value('enc_acc', {r})",
-    "GT_GetAxisEncPos": "{R}.enc_link.axis(b.row_value('enc_pos', {r}))",
+    "GT_GetAxisEncVel": "{R}.enc_link.ratio * b._enc_rates_row({r})[0]",
+    "GT_GetAxisEncAcc": "{R}.enc_link.ratio * b._enc_rates_row({r})[1]",
+    "GT_GetAxisEncPos": "{R}.enc_link.axis(b.enc_pos.item({r}))",
     "GT_GetPrfSts": "b.row_value('sts', {r}) & MOVING",
-    "GT_GetAxisError": (
-        "b.row_value('a_last', {r}) - {R}.enc_link.axis(b.row_value('enc_pos', {r}))"
-    ),
+    "GT_GetAxisError": "b.a_last.item({r}) - {R}.enc_link.axis(b.enc_pos.item({r}))",
 }
 
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
