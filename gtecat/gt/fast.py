@@ -519,11 +519,14 @@ def fast_reader(
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
         last: list[Any] = [None, 0, None]
-        #: the last integers packed: the packer, the values, their bytes
-        packed: list[Any] = [None, None, b""]
+        #: the last integers packed: the packer, the values, their bytes, and where they
+        #: were picked from a list of the bank by a plan of its rows and zeros alone: that
+        #: list and the plan's getter (else None)
+        packed: list[Any] = [None, None, b"", None, None]
         #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
-        #: bank, n, count, the layout, resources and axes it holds for, its pick
-        lane: list[Any] = [None] * 7
+        #: bank, n, count, the layout, resources and axes it holds for, its pick, whether
+        #: that picks the bank's rows and zeros alone (no other axis's getter)
+        lane: list[Any] = [None] * 8
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -541,6 +544,7 @@ def fast_reader(
                 last[:] = [tp, count, pack]
             if clock is not None and not spans:
                 return _NO
+            lst = pick = None  # (the bank's list and a plan's getter the values come from)
             if count == 1:
                 v = value(n)
                 if v is _NO:
@@ -572,7 +576,14 @@ def fast_reader(
                         lst = lists.get(bank_key)
                         if lst is None:  # (AxisBank.value's making of it, without its frame)
                             lst = lists[bank_key] = b._make_list(bank_key)
-                        values = ln[6](lst)
+                        memo = packed  # (one read: another thread may replace it meanwhile)
+                        if lst is memo[3] and ln[6] is memo[4] and pack is memo[0]:
+                            # the list the bank kept (its status words stand: AxisBank
+                            # _sts_epoch), the same plan of its rows and zeros: the same values
+                            values = memo[1]
+                        else:
+                            values = ln[6](lst)
+                            pick = ln[6] if ln[7] else None
                 else:
                     values = None
                 if values is None:
@@ -588,17 +599,19 @@ def fast_reader(
                         and plan[1] is ctl.resources
                         and plan[2] is ctl.axes
                     ):
-                        lane[:] = [b, n, count, plan[0], plan[1], plan[2], plan[3]]
+                        lane[:] = [b, n, count, *plan[:4], plan[6]]
             memo = packed  # (one read: another thread may replace it meanwhile)
-            if pack is memo[0] and values == memo[1]:
+            if pack is memo[0] and (values is memo[1] or values == memo[1]):
                 out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)
+                if pick is not None:  # (picked from another list: that list kept)
+                    packed[:] = [pack, values, out, lst, pick]
             else:
                 try:
                     out = pack(*values)
                 except struct.error:  # (a value the element does not hold: the Python path)
                     return _NO
                 if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
-                    packed[:] = [pack, values, out]
+                    packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
             if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
                 ctl = GATED[0]  # (the clock's now_ns in its quick numbers: no frame)
@@ -945,13 +958,14 @@ def _read_plan(
 ) -> tuple[Any, ...]:
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
-    of the span is a row of ``b``, that row's place in the span).  Each axis of the span is
+    of the span is a row of ``b``, that row's place in the span, whether the getter picks
+    rows of a list and zeros alone: the same list, the same values).  Each axis of the span is
     a row of ``b``, an axis the bank does not run (its value ``get(resources)``, where
     ``get`` is given) or, within ``1..top``, an axis no drive backs (it reads 0); any other
     (another bank's axis, one not on the bus): no getter.  ``row``: a row's value is that
     expression of BANK_ROWS (``{R}`` its resources, ``{r}`` its row) and the getter takes
     the bank itself, not a list."""
-    none = (b.layout, resources, axes, None, None, 0)
+    none = (b.layout, resources, axes, None, None, 0, False)
     if count < 2:  # (one value: no tuple to store)
         return none
     items: list[str] = []
@@ -976,13 +990,15 @@ def _read_plan(
             env[f"r{i}"] = res
         else:
             return none
-    if row is None and at is not None and len(env) == 1 and "0" not in items:
+    pure = row is None and len(env) == 1  # (rows and zeros alone: no getter of another axis)
+    if pure and at is not None and "0" not in items:
         pick = itemgetter(*(int(x[4:-1]) for x in items))
     else:  # (the rows, the getters and the zeros in one tuple)
         env["MOVING"] = _STATUS_BITS["MOVING"]
         arg = "lst" if row is None else "b"
         pick = eval(f"lambda {arg}: ({', '.join(items)},)", env)  # (row numbers, names, 0)
-    return (b.layout, resources, axes, pick, None if at is None else resources.get(n + at), at)
+    first = None if at is None else resources.get(n + at)
+    return (b.layout, resources, axes, pick, first, at, pure)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
