@@ -2695,7 +2695,7 @@ class AxisBank:
         """Row ``r``'s encoder speed and acceleration, :meth:`_enc_rates`'s operations in
         Python floats (the same IEEE divisions and subtraction)."""
         t = self.T
-        cnt = self.bank_cycles - self.claim_cycle.item(r)
+        cnt = self.counts[3] - self.claim_cycle.item(r)  # (bank_cycles, without its frame)
         if cnt < 1:
             return self.enc_vel.item(r), self.enc_acc.item(r)
         v1 = self.enc_step1.item(r) / t

@@ -334,6 +334,11 @@ def fast_reader(
     own_limit = READ_LIMITS.get(name)  # the function's own (its table path refuses more)
     limit = CONTROLLER_AXES if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
+    #: a reader whose value a row of the bank gives through a link or a bit (DERIVED): a
+    #: span's plan writes each row's value as BANK_ROWS' expression (that row alone, not
+    #: every row's list); its plans are kept under the reader's name
+    row_expr = BANK_ROWS.get(name) if bank_key is None else None
+    plan_key = bank_key if row_expr is None else name
 
     core: list[Any] = []  # (CMD_PARAM, _record): the GT layer imports this module first
 
@@ -406,11 +411,11 @@ def fast_reader(
         resources = ctl.resources
         axes = ctl.axes
         b = ctl.bank
-        if bank_key is not None and b is not None:
+        if plan_key is not None and b is not None:
             # every axis of the span a row of the bank: its rows, found once while no row is
             # claimed or released (the bank's layout) and the controller's axes are the same
             # (an axis the controller has but no drive backs: 0, where ``zeros``)
-            key = (bank_key, n, count, zeros)
+            key = (plan_key, n, count, zeros)
             plan = b.read_plans.get(key)
             if (
                 plan is None
@@ -419,9 +424,11 @@ def fast_reader(
                 or plan[2] is not axes
             ):
                 top = resource_count(ctl) if zeros and axes else 0
-                plan = _read_plan(b, resources, axes, n, count, top, get)
+                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr)
                 b.read_plans[key] = plan
             pick = plan[3]
+            if pick is not None and row_expr is not None:
+                return pick(b)  # (the rows' values from the bank itself)
             if pick is not None:
                 lst = b._lists.get(bank_key)
                 if lst is not None or plan[4] is None:  # (no row of the bank: no list)
@@ -512,11 +519,14 @@ def fast_reader(
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
         last: list[Any] = [None, 0, None]
-        #: the last integers packed: the packer, the values, their bytes
-        packed: list[Any] = [None, None, b""]
+        #: the last integers packed: the packer, the values, their bytes, and where they
+        #: were picked from a list of the bank by a plan of its rows and zeros alone: that
+        #: list and the plan's getter (else None)
+        packed: list[Any] = [None, None, b"", None, None]
         #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
-        #: bank, n, count, the layout, resources and axes it holds for, its pick
-        lane: list[Any] = [None] * 7
+        #: bank, n, count, the layout, resources and axes it holds for, its pick, whether
+        #: that picks the bank's rows and zeros alone (no other axis's getter)
+        lane: list[Any] = [None] * 8
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -534,6 +544,7 @@ def fast_reader(
                 last[:] = [tp, count, pack]
             if clock is not None and not spans:
                 return _NO
+            lst = pick = None  # (the bank's list and a plan's getter the values come from)
             if count == 1:
                 v = value(n)
                 if v is _NO:
@@ -556,19 +567,30 @@ def fast_reader(
                     and ln[5] is ctl.axes
                 ):
                     # the span of the last call, its plan as span() finds it (the same
-                    # checks): the bank's list of the cycle, made where it is not yet
-                    lists = b._lists
-                    lst = lists.get(bank_key)
-                    if lst is None:  # (AxisBank.value's making of it, without its frame)
-                        lst = lists[bank_key] = b._make_list(bank_key)
-                    values = ln[6](lst)
+                    # checks): the bank's list of the cycle, made where it is not yet (a
+                    # reader of BANK_ROWS: the rows' values from the bank itself)
+                    if row_expr is not None:
+                        values = ln[6](b)
+                    else:
+                        lists = b._lists
+                        lst = lists.get(bank_key)
+                        if lst is None:  # (AxisBank.value's making of it, without its frame)
+                            lst = lists[bank_key] = b._make_list(bank_key)
+                        memo = packed  # (one read: another thread may replace it meanwhile)
+                        if lst is memo[3] and ln[6] is memo[4] and pack is memo[0]:
+                            # the list the bank kept (its status words stand: AxisBank
+                            # _sts_epoch), the same plan of its rows and zeros: the same values
+                            values = memo[1]
+                        else:
+                            values = ln[6](lst)
+                            pick = ln[6] if ln[7] else None
                 else:
                     values = None
                 if values is None:
                     values = span(ctl, n, count, True)
                     if values is None:
                         return _NO
-                    plan = None if b is None else b.read_plans.get((bank_key, n, count, True))
+                    plan = None if b is None else b.read_plans.get((plan_key, n, count, True))
                     if (
                         plan is not None
                         and plan[3] is not None
@@ -577,22 +599,24 @@ def fast_reader(
                         and plan[1] is ctl.resources
                         and plan[2] is ctl.axes
                     ):
-                        lane[:] = [b, n, count, plan[0], plan[1], plan[2], plan[3]]
+                        lane[:] = [b, n, count, *plan[:4], plan[6]]
             memo = packed  # (one read: another thread may replace it meanwhile)
-            if pack is memo[0] and values == memo[1]:
+            if pack is memo[0] and (values is memo[1] or values == memo[1]):
                 out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)
+                if pick is not None:  # (picked from another list: that list kept)
+                    packed[:] = [pack, values, out, lst, pick]
             else:
                 try:
                     out = pack(*values)
                 except struct.error:  # (a value the element does not hold: the Python path)
                     return _NO
                 if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
-                    packed[:] = [pack, values, out]
+                    packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
             if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
-                ctl = GATED[0]
+                ctl = GATED[0]  # (the clock's now_ns in its quick numbers: no frame)
                 out += _CLOCK_VALUE.pack(
-                    ((ctl.clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+                    ((ctl.clock.quick[9] - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
                 )
             return out
 
@@ -890,6 +914,23 @@ DERIVED: dict[str, tuple[str, ...]] = {
     ),
 }
 
+#: a banked axis's value of each DERIVED reader, one row of the bank alone as the value
+#: function's DERIVED steps make it (AxisBank.row_value: the row's value, or the list's
+#: where it is made already; the encoder's rates of a row and the positions of one, read
+#: without row_value's frame, as it makes them in a bank of any size: the values its lists
+#: hold): ``{R}`` the axis's resources, ``{r}`` its row; a span's plan (_read_plan) writes
+#: one per row, so a span after a cycle does not make every row's list of the value
+#: (tests/gtecat/gt/test_fast_span_rows.py)
+BANK_ROWS: dict[str, str] = {
+    "GT_GetAxisPrfVel": "{R}.prf_link.ratio * b.row_value('prf_v', {r})",
+    "GT_GetAxisPrfAcc": "{R}.prf_link.ratio * b.row_value('prf_a', {r})",
+    "GT_GetAxisEncVel": "{R}.enc_link.ratio * b._enc_rates_row({r})[0]",
+    "GT_GetAxisEncAcc": "{R}.enc_link.ratio * b._enc_rates_row({r})[1]",
+    "GT_GetAxisEncPos": "{R}.enc_link.axis(b.enc_pos.item({r}))",
+    "GT_GetPrfSts": "b.row_value('sts', {r}) & MOVING",
+    "GT_GetAxisError": "b.a_last.item({r}) - {R}.enc_link.axis(b.enc_pos.item({r}))",
+}
+
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
 
@@ -906,15 +947,25 @@ BANK_LISTS = {
 
 
 def _read_plan(
-    b: Any, resources: Any, axes: Any, n: int, count: int, top: int = 0, get: Any = None
+    b: Any,
+    resources: Any,
+    axes: Any,
+    n: int,
+    count: int,
+    top: int = 0,
+    get: Any = None,
+    row: str | None = None,
 ) -> tuple[Any, ...]:
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
-    of the span is a row of ``b``, that row's place in the span).  Each axis of the span is
+    of the span is a row of ``b``, that row's place in the span, whether the getter picks
+    rows of a list and zeros alone: the same list, the same values).  Each axis of the span is
     a row of ``b``, an axis the bank does not run (its value ``get(resources)``, where
     ``get`` is given) or, within ``1..top``, an axis no drive backs (it reads 0); any other
-    (another bank's axis, one not on the bus): no getter."""
-    none = (b.layout, resources, axes, None, None, 0)
+    (another bank's axis, one not on the bus): no getter.  ``row``: a row's value is that
+    expression of BANK_ROWS (``{R}`` its resources, ``{r}`` its row) and the getter takes
+    the bank itself, not a list."""
+    none = (b.layout, resources, axes, None, None, 0, False)
     if count < 2:  # (one value: no tuple to store)
         return none
     items: list[str] = []
@@ -928,18 +979,26 @@ def _read_plan(
         if res is None or axes.get(k) is not res.ax:
             return none
         if res.bank is b:
-            items.append(f"lst[{res.bank_row}]")
+            if row is None:
+                items.append(f"lst[{res.bank_row}]")
+            else:
+                items.append(row.format(R=f"r{i}", r=res.bank_row))
+                env[f"r{i}"] = res
             at = i if at is None else at
         elif res.bank is None and get is not None:
             items.append(f"g(r{i})")
             env[f"r{i}"] = res
         else:
             return none
-    if at is not None and len(env) == 1 and "0" not in items:
+    pure = row is None and len(env) == 1  # (rows and zeros alone: no getter of another axis)
+    if pure and at is not None and "0" not in items:
         pick = itemgetter(*(int(x[4:-1]) for x in items))
     else:  # (the rows, the getters and the zeros in one tuple)
-        pick = eval(f"lambda lst: ({', '.join(items)},)", env)  # (row numbers, names, 0)
-    return (b.layout, resources, axes, pick, None if at is None else resources.get(n + at), at)
+        env["MOVING"] = _STATUS_BITS["MOVING"]
+        arg = "lst" if row is None else "b"
+        pick = eval(f"lambda {arg}: ({', '.join(items)},)", env)  # (row numbers, names, 0)
+    first = None if at is None else resources.get(n + at)
+    return (b.layout, resources, axes, pick, first, at, pure)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the

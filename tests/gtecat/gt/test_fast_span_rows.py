@@ -1,0 +1,69 @@
+"""A span of a reader whose value is a link or a bit of a banked axis's value (the readers
+of ``fast.BANK_ROWS``): after each cycle of the auto clock its C entry asks each row of the
+bank for its value alone, not every row's list; what it writes is what the table path
+writes, cycle by cycle, while both axes move, accelerate and stop."""
+
+from __future__ import annotations
+
+import ctypes
+from ctypes import byref, c_double, c_long
+
+from gtecat import gt
+from gtecat.gt import fast
+
+from .conftest import bring_up
+
+
+def _trap(ax: int, pos: int, vel: float) -> None:
+    assert gt.GT_PrfTrap(ax) == 0
+    p = gt.TTrapPrm()
+    p.acc, p.dec = 0.3, 0.2
+    assert gt.GT_SetTrapPrm(ax, byref(p)) == 0
+    assert gt.GT_SetVel(ax, vel) == 0
+    assert gt.GT_SetPos(ax, pos) == 0
+    assert gt.GT_Update(1 << (ax - 1)) == 0
+
+
+def _moves_read(table: bool) -> tuple[list, int]:
+    """Both axes' Trap moves, each cycle's spans read (``table``: through the table path):
+    what was read, at which cycle, and how many of the reads found axis 1 a row of the
+    bank."""
+    bring_up(clock="auto")
+    try:
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        ctl = gt.GTE_Controller()
+        s = c_long()
+        for _ in range(400):  # (polls: the bank claims both axes)
+            gt.GT_GetSts(1, byref(s))
+        _trap(1, 900, 12.0)
+        _trap(2, -600, 7.5)
+        seen: list = []
+        banked = 0
+        for _ in range(320):
+            banked += ctl.resources[1].bank is not None
+            for name in sorted(fast.BANK_ROWS):
+                fn = getattr(gt, name)
+                fn = fn.slow if table else fn
+                tp = c_long if name == "GT_GetPrfSts" else c_double
+                arr = (tp * 4)()
+                # &arr[1] and the array itself, 2 axes
+                assert fn(1, byref(arr, ctypes.sizeof(tp)), 2, None) == 0
+                assert fn(1, arr, 2) == 0
+                seen.append((ctl.clock.cycles, name, bytes(arr)))
+        enc = (c_double * 2)()
+        assert gt.GT_GetAxisEncVel(1, enc, 2) == 0
+        seen.append(tuple(enc))
+        return seen, banked
+    finally:
+        gt.GT_Close()
+
+
+def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
+    """Each span read through the C entries, from the rows of the bank, and through the
+    table path (which gives the axes back: the scalar objects' values), cycle by cycle."""
+    rows, banked = _moves_read(False)
+    table, _ = _moves_read(True)
+    assert banked == 320  # (every read from the bank's rows)
+    assert rows[-1] == (0.0, 0.0)  # (both moves ended)
+    assert len({c for c, *_ in rows[:-1]}) > 200  # (cycle by cycle)
+    assert rows == table
