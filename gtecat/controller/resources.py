@@ -474,7 +474,7 @@ class AxisResources:
         return bool(acc.get() & (LIMIT_POSITIVE_BIT if positive else LIMIT_NEGATIVE_BIT))
 
     def drive_faulted(self) -> bool:
-        return self.ax.state in (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
+        return self.ax.state in _FAULTED
 
     def drive_state(self) -> PdsState:
         """The drive's state as 6041h in the image shows it (:attr:`Axis.state`), read
@@ -831,6 +831,22 @@ def position_source(ctl: Controller, kind: int, index: int, item: int = 0) -> Ca
     return f
 
 
+_FAULTED = (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
+
+
+def needing_clear(axes: list[AxisResources]) -> list[AxisResources]:
+    """The axes of a GT_ClrSts that it may change: where no drive of ``axes`` is faulted (so
+    the call runs no cycle), an axis the bank runs with no flag latched and no link alarm is
+    left out - the call would change nothing of it, and touching it would give it back to its
+    scalar objects, which the bank would claim again at its next cycle (an error handler
+    that calls GT_ClrSts every few ms paid that for every axis).  Read past the bank's guard:
+    the latched flags stand still in the bank, 6041h is in the image."""
+    if any(r.drive_state() in _FAULTED for r in axes):
+        return axes
+    get = object.__getattribute__
+    return [r for r in axes if r.bank is None or r.latched or get(r.ax, "link_alarm")]
+
+
 def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:
     """GT_ClrSts: reset faulted drives (bounded), then clear the flags whose cause is gone."""
     axes = list(axes)
@@ -887,5 +903,6 @@ __all__ = [
     "axis_span",
     "clear_status",
     "install",
+    "needing_clear",
     "position_source",
 ]

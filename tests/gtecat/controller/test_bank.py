@@ -517,8 +517,11 @@ def test_gt_calls_release_and_the_bank_claims_again(tmp_path: Path) -> None:
         gt.GTE_Wait(40)
         bank = ctl.bank
         assert bank.n_alive == AXES
-        gt.GT_ClrSts(3)  # names one axis: its slave's rows leave, the others stay
-        assert bank.n_alive == AXES - 1
+        gt.GT_ClrSts(3)  # nothing to clear: the axis stays in the bank
+        assert bank.n_alive == AXES
+        lo, hi = c_long(), c_long()
+        assert gt.GT_GetSoftLimit(3, byref(hi), byref(lo)) == 0
+        assert bank.n_alive == AXES - 1  # names one axis: its slave's rows leave, the others stay
         gt.GTE_Wait(2)
         assert bank.n_alive == AXES
         # a Trap move's start runs on its axis's row in place: no drive leaves
