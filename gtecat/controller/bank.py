@@ -207,7 +207,7 @@ BANK_READS = frozenset(
         # its axis back itself, CaptureUnit.clear), the homings look again (look_again)
         "GT_ClearCaptureStatus",
         # latched flags cleared and faulted drives reset: an axis the bank runs with nothing
-        # to clear is left where it is (resources.needing_clear); the others give themselves
+        # to clear is left where it is (resources.clear_status); the others give themselves
         # back through their guards as the call touches them
         "GT_ClrSts",
         # a coordinate system's state, read from the cycle the bank records of it

@@ -834,27 +834,28 @@ def position_source(ctl: Controller, kind: int, index: int, item: int = 0) -> Ca
 _FAULTED = (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
 
 
-def needing_clear(axes: list[AxisResources]) -> list[AxisResources]:
-    """The axes of a GT_ClrSts that it may change: where no drive of ``axes`` is faulted (so
-    the call runs no cycle), an axis the bank runs with no flag latched and no link alarm is
-    left out - the call would change nothing of it, and touching it would give it back to its
-    scalar objects, which the bank would claim again at its next cycle (an error handler
-    that calls GT_ClrSts every few ms paid that for every axis).  Read past the bank's guard:
-    the latched flags stand still in the bank, 6041h is in the image."""
-    if any(r.drive_state() in _FAULTED for r in axes):
-        return axes
-    get = object.__getattribute__
-    return [r for r in axes if r.bank is None or r.latched or get(r.ax, "link_alarm")]
-
-
 def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:
-    """GT_ClrSts: reset faulted drives (bounded), then clear the flags whose cause is gone."""
+    """GT_ClrSts on ``axes`` (their link up): reset the faulted drives (bounded), then clear
+    the flags whose cause is gone and the link alarms.
+
+    An axis the bank runs with no flag latched and no link alarm (looked at once the resets'
+    cycles have run) is left where it is: the call would change nothing of it, and touching
+    it would give it back to its scalar objects, which the bank would claim again at its
+    next cycle (an error handler that calls GT_ClrSts every few ms paid that for every
+    axis).  Read past the bank's guard: the latched flags stand still in the bank, 6041h is
+    in the image (:meth:`AxisResources.drive_state`)."""
     axes = list(axes)
-    faulted = [r for r in axes if r.drive_faulted()]
+    faulted = [r for r in axes if r.drive_state() in _FAULTED]
     if faulted:
         _fault_reset(ctl, faulted)
-    for r in axes:
+    get = object.__getattribute__
+    needing = [r for r in axes if r.bank is None or r.latched or get(r.ax, "link_alarm")]
+    if needing and ctl.bank is not None:
+        ctl.bank.dirty = True  # (what the call changes may let the bank take an axis again)
+    for r in needing:
         r.clear_flags()
+    for r in needing:
+        r.ax.link_alarm = ""
 
 
 def _fault_reset(ctl: Controller, faulted: list[AxisResources]) -> None:
@@ -903,6 +904,5 @@ __all__ = [
     "axis_span",
     "clear_status",
     "install",
-    "needing_clear",
     "position_source",
 ]
