@@ -269,6 +269,34 @@ def recorded_seconds(path: Path) -> float:
     return max(times) / 1e9
 
 
+def processes(
+    path: Path, seconds: float, repeat: int, against: Path | None = None
+) -> tuple[dict[str, object], str]:
+    """``path`` replayed as whole ``gtecat replay FILE`` processes, ``repeat`` times, by this
+    checkout (and ``against``'s, the two in turn): each side's best wall and CPU seconds and
+    times real time against ``seconds`` (``process``, or ``process_before`` /
+    ``process_after``), and the last replay's last line."""
+    sides = [("after", ROOT)] if against is None else [("before", against), ("after", ROOT)]
+    procs: dict[str, list[tuple[float, float]]] = {k: [] for k, _ in sides}
+    last = ""
+    for _ in range(repeat):  # the sides in turn
+        for key, root in sides:
+            w, c, last = replay_process(root, path)
+            procs[key].append((w, c))
+    rows: dict[str, object] = {}
+    for key, root in sides:
+        w, c = _best(procs[key])
+        rows[f"process_{key}" if against is not None else "process"] = {
+            "checkout": str(root),
+            "wall_s": round(w, 3),
+            "cpu_s": round(c, 3),
+            "times_real_time": round(seconds / w, 1),
+            "times_real_time_cpu": round(seconds / c, 1),
+            "walls_s": [round(x, 3) for x, _ in procs[key]],
+        }
+    return rows, last
+
+
 def measure_file(path: Path, repeat: int, against: Path | None = None) -> dict[str, object]:
     """An existing recording replayed as whole ``gtecat replay FILE`` processes (``--file``)."""
     path = path.resolve()
@@ -278,23 +306,8 @@ def measure_file(path: Path, repeat: int, against: Path | None = None) -> dict[s
         "virtual_s": round(seconds, 3),
         "load_average_before": round(os.getloadavg()[0], 2),
     }
-    sides = [("after", ROOT)] if against is None else [("before", against), ("after", ROOT)]
-    procs: dict[str, list[tuple[float, float]]] = {k: [] for k, _ in sides}
-    last = ""
-    for _ in range(repeat):  # the sides in turn
-        for key, root in sides:
-            w, c, last = replay_process(root, path)
-            procs[key].append((w, c))
-    for key, root in sides:
-        w, c = _best(procs[key])
-        out[f"process_{key}" if against is not None else "process"] = {
-            "checkout": str(root),
-            "wall_s": round(w, 3),
-            "cpu_s": round(c, 3),
-            "times_real_time": round(seconds / w, 1),
-            "times_real_time_cpu": round(seconds / c, 1),
-            "walls_s": [round(x, 3) for x, _ in procs[key]],
-        }
+    rows, last = processes(path, seconds, repeat, against)
+    out |= rows
     out["replay_says"] = last
     out["load_average_after"] = round(os.getloadavg()[0], 2)
     out["diverged"] = None  # (replay_process raises when the replay does not exit 0)
@@ -407,21 +420,7 @@ def measure_hard(
                 "times_real_time_cpu": round(seconds / cpu, 1),
                 "diverged": str(div) if div else None,
             }
-            sides = [("after", ROOT)] if against is None else [("before", against), ("after", ROOT)]
-            procs: dict[str, list[tuple[float, float]]] = {k: [] for k, _ in sides}
-            for _ in range(repeat):  # whole processes, the sides in turn
-                for key, root in sides:
-                    w, c, _ = replay_process(root, path)
-                    procs[key].append((w, c))
-            for key, root in sides:
-                w, c = _best(procs[key])
-                row[f"process_{key}" if against is not None else "process"] = {
-                    "checkout": str(root),
-                    "wall_s": round(w, 3),
-                    "cpu_s": round(c, 3),
-                    "times_real_time": round(seconds / w, 1),
-                    "times_real_time_cpu": round(seconds / c, 1),
-                }
+            row |= processes(path, seconds, repeat, against)[0]
             out[form] = row
     out["load_average_after"] = round(os.getloadavg()[0], 2)
     out["diverged"] = diverged
