@@ -107,6 +107,8 @@ CSP = 8
 _SW_FAULT = 0x0008  # 6041h bit 3: fault (set in FAULT and FAULT REACTION ACTIVE)
 _SW_STATE_MASK, _SW_ENABLED = 0x6F, 0x27
 _CW_FAULT_RESET = 0x0080
+#: the drive states a GT_ClrSts resets (CiA 402 FAULT and FAULT REACTION ACTIVE)
+_FAULTED = (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
 #: controller time GT_ClrSts waits for a fault reaction to end, then for the reset to act
 FAULT_REACTION_TIMEOUT_MS = 500.0
 FAULT_RESET_TIMEOUT_MS = 20.0
@@ -829,9 +831,6 @@ def position_source(ctl: Controller, kind: int, index: int, item: int = 0) -> Ca
     # what the axis bank reads to keep a slave and its master together (gtecat.controller.bank)
     f.master = (res, kind)  # type: ignore[attr-defined]
     return f
-
-
-_FAULTED = (PdsState.FAULT, PdsState.FAULT_REACTION_ACTIVE)
 
 
 def clear_status(ctl: Controller, axes: Iterable[AxisResources]) -> None:
