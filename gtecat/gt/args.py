@@ -602,13 +602,26 @@ def _element_fits(p: Param, kind: str, size: int) -> bool:
     return True
 
 
+#: what to pass for a pointer of a C type, in a refusal's words (:func:`_what_to_pass`)
+_ADVICE: dict[str, str] = {}
+
+
 def _what_to_pass(p: Param) -> str:
+    """What to pass for ``p``'s pointer, in a refusal's words: the same for every pointer
+    of one C type, so made once per type (a program that polls with a wrong type pays a
+    refusal at every call, and naming the dtypes cost more than the rest of it)."""
+    advice = _ADVICE.get(p.ctype)
+    if advice is not None:
+        return advice
     if p.ctype in ("double", "float"):
-        return "pass byref(c_double()), a c_double array or a float64 numpy array"
-    right = _CTYPES_OF.get(p.ctype, "c_long")
-    nps = [str(d) for d in _NP_CANDIDATES if _element_fits(p, d.kind, d.itemsize)]
-    kinds = ", ".join(nps[:-1]) + " or " + nps[-1] if len(nps) > 1 else "".join(nps)
-    return f"pass byref({right}()), an array of it or a numpy array of {kinds}"
+        advice = "pass byref(c_double()), a c_double array or a float64 numpy array"
+    else:
+        right = _CTYPES_OF.get(p.ctype, "c_long")
+        nps = [str(d) for d in _NP_CANDIDATES if _element_fits(p, d.kind, d.itemsize)]
+        kinds = ", ".join(nps[:-1]) + " or " + nps[-1] if len(nps) > 1 else "".join(nps)
+        advice = f"pass byref({right}()), an array of it or a numpy array of {kinds}"
+    _ADVICE[p.ctype] = advice
+    return advice
 
 
 def check_kind(p: Param, ref: Ref) -> Ref:
