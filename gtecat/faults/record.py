@@ -14,7 +14,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
   every :data:`CHECKPOINT_MS` of controller time.
 
 Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
-structure field by field, an array as its size and every value, which must agree, a buffer
+structure field by field (a class of the application's own with its layout, ``"lay"``, so
+that the replay builds one like it), an array as its size and every value, which must agree, a buffer
 as hex; a pointer into an object, ``byref(arr, 16)`` for C's ``&arr[2]``, with its byte
 offset: ``{"ref": ..., "off": 16}``); replay builds fresh
 objects of the same types, makes the same calls in the same order and compares every return
@@ -140,7 +141,10 @@ def encode(x: Any) -> Any:
             "v": [encode(e) for e in x],
         }
     if isinstance(x, ctypes.Structure):
-        return {"st": type(x).__name__, "v": {f[0]: encode(getattr(x, f[0])) for f in x._fields_}}
+        out = {"st": type(x).__name__, "v": {f[0]: encode(getattr(x, f[0])) for f in x._fields_}}
+        if _gt_struct(type(x).__name__) is not type(x):
+            out["lay"] = _layout(type(x))  # (the application's own: rebuilt from its layout)
+        return out
     if isinstance(x, ctypes._Pointer):  # type: ignore[attr-defined]
         return {"ptr": encode(x.contents)} if x else None
     if isinstance(x, bytes):
@@ -199,9 +203,8 @@ def decode(v: Any) -> Any:
                 arr[i] = _unscalar(e["v"]) if isinstance(e, dict) and "v" in e else _unscalar(e)
         return arr
     if "st" in v:
-        from .. import gt
-
-        cls = getattr(gt, v["st"], None)
+        lay = v.get("lay")
+        cls = _rebuilt(v["st"], json.dumps(lay)) if lay is not None else _gt_struct(v["st"])
         if cls is None:
             raise ParameterError(f"structure {v['st']} is not part of gtecat.gt")
         obj = cls()
@@ -223,6 +226,88 @@ def decode(v: Any) -> Any:
     if "b" in v:
         return bytes.fromhex(v["b"])
     return None  # a value that cannot be rebuilt (an object of the caller's)
+
+
+def _gt_struct(name: Any) -> Any:
+    """gtecat.gt's structure of that name, or None."""
+    from .. import gt
+
+    cls = getattr(gt, name, None) if type(name) is str else None
+    return cls if isinstance(cls, type) and issubclass(cls, ctypes.Structure) else None
+
+
+def _layout(cls: Any) -> list[Any]:
+    """An application's own structure's fields as a recording keeps them: ``[name, type]``
+    (``[name, type, bits]`` for a bit field), a type being a simple type's name, ``{"arr":
+    type, "n": n}`` or ``{"st": name, "lay": [...]}``.  The GT layer takes a structure of
+    the prototype's layout whatever its class (a program defines its own, as the vendor's C#
+    wrappers do), so the replay must build one with the same layout."""
+    return [[f[0], _field_type(f[1]), *f[2:3]] for f in cls._fields_]
+
+
+def _field_type(t: Any) -> Any:
+    if issubclass(t, ctypes.Array):
+        return {"arr": _field_type(t._type_), "n": t._length_}
+    if issubclass(t, ctypes.Structure):
+        if _gt_struct(t.__name__) is t:
+            return {"st": t.__name__}
+        return {"st": t.__name__, "lay": _layout(t)}
+    for cls in t.__mro__:
+        if cls.__name__ in _SIMPLE and _SIMPLE[cls.__name__] is cls:
+            return cls.__name__
+    raise TypeError(f"a field of type {t.__name__} cannot be recorded")
+
+
+#: a rebuilt structure's fields at most, and its nesting (a damaged recording never makes a
+#: huge type)
+_MOST_FIELDS = 4096
+_MOST_BYTES = 1 << 20
+_MOST_DEPTH = 8
+
+
+@lru_cache(maxsize=256)
+def _rebuilt(name: Any, lay: str) -> Any:
+    """The structure class a recording's layout (:func:`_layout`, as JSON text) describes,
+    made once per layout (ValueError: a layout that is none)."""
+    return _struct_of(name, json.loads(lay), 0)
+
+
+def _struct_of(name: Any, lay: Any, depth: int) -> Any:
+    if type(name) is not str or not name.isidentifier() or depth > _MOST_DEPTH:
+        raise ValueError(f"a recorded structure {name!r} cannot be rebuilt")
+    if type(lay) is not list or not 0 < len(lay) <= _MOST_FIELDS:
+        raise ValueError(f"structure {name}: its recorded layout is not a list of fields")
+    fields: list[tuple[Any, ...]] = []
+    for f in lay:
+        if (
+            type(f) is not list
+            or len(f) not in (2, 3)
+            or type(f[0]) is not str
+            or not f[0].isidentifier()
+            or (len(f) == 3 and (type(f[2]) is not int or not 0 < f[2] <= 64))
+        ):
+            raise ValueError(f"structure {name}: a recorded field {f!r} is not one")
+        fields.append((f[0], _type_of(f[1], depth), *f[2:]))
+    return type(name, (ctypes.Structure,), {"_fields_": fields})
+
+
+def _type_of(t: Any, depth: int) -> Any:
+    if type(t) is str:
+        return _simple(t)
+    if type(t) is dict and "arr" in t:
+        n = t.get("n")
+        elem = _type_of(t["arr"], depth + 1)
+        if type(n) is not int or not 0 <= n * ctypes.sizeof(elem) <= _MOST_BYTES:
+            raise ValueError(f"a recorded field's array size {n!r} is not one")
+        return elem * n
+    if type(t) is dict and "st" in t:
+        if "lay" not in t:
+            cls = _gt_struct(t["st"])
+            if cls is None:
+                raise ValueError(f"structure {t['st']!r} is not part of gtecat.gt")
+            return cls
+        return _struct_of(t["st"], t["lay"], depth + 1)
+    raise ValueError(f"a recorded field's type {t!r} is not one")
 
 
 def _array_size(v: dict[str, Any]) -> int:
@@ -250,8 +335,9 @@ def _check_arrays(x: Any) -> None:
     if type(x) is dict:
         if "arr" in x:
             _array_size(x)
-        for y in x.values():
-            _check_arrays(y)
+        for k, y in x.items():
+            if k != "lay":  # (a structure's layout: sizes, no values; _type_of bounds them)
+                _check_arrays(y)
     elif type(x) is list:
         for y in x:
             _check_arrays(y)
@@ -939,7 +1025,12 @@ def _prepare(
             args.append(x)
             continue
         ref = x.get("ref")
-        if isinstance(ref, dict) and "c" in ref and not isinstance(ref.get("v"), dict):
+        if (
+            isinstance(ref, dict)
+            and "c" in ref
+            and not isinstance(ref.get("v"), dict)
+            and "off" not in x  # (a pointer into the value: made as recorded, below)
+        ):
             # a pointer to a simple value: one object per function and argument, set to the
             # recorded value before each call (an application polls with the same variable:
             # so does the replay, and the GT layer's fast path recognises it)
