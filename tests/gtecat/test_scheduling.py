@@ -159,9 +159,7 @@ class _Requests:
         raise BlockingIOError
 
 
-def test_without_a_spin_the_controller_goes_back_to_the_poller_after_a_reply(
-    server, monkeypatch
-):
+def test_without_a_spin_the_controller_goes_back_to_the_poller_after_a_reply(server, monkeypatch):
     """Busy CPUs (no spin): one request served, then no read that would find nothing yet
     (the poller reports the next request); with a spin it reads on for the next one."""
     from types import SimpleNamespace
