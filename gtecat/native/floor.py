@@ -50,14 +50,22 @@ class WallFloor:
 
     def _virtual(self) -> int:
         # time already charged but not yet run as a cycle counts as passed
-        return self.clock.now_ns + getattr(self.clock, "_pending_ns", 0)
+        q = self.clock.quick  # (Clock.now_ns, Clock._pending_ns)
+        return q[9] + q[0]
 
     def look(self) -> int:
         """Advance the clock to cover the wall time since the last look; returns cycles run."""
         wall = self._wall_ns()
-        virt = self._virtual()
+        q = self.clock.quick  # (now_ns and the pending latency read in place: once per call)
+        virt = q[9] + q[0]
         need = self.debt_ns + (wall - self._wall_last) - (virt - self._virt_last)
         self._wall_last = wall
+        if need <= 0:
+            # the usual case of a polling program: the calls' latency kept controller time
+            # ahead of the wall, nothing to run and no debt (what the general way gives)
+            self.debt_ns = 0
+            self._virt_last = virt
+            return 0
         cycles = 0
         if need > 0 and self.active:
             step = self.clock.cycle_ns

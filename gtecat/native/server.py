@@ -683,16 +683,16 @@ class Server:
         """Serve what ``c`` sent; then, for ``spin_s``, serve its next request at once
         (a client polling in a loop sends it within microseconds; answering it without
         a round through the poller, and without either side falling asleep, saves the
-        wake-up)."""
+        wake-up).  Without a spin (:meth:`_spin_budget` 0: the CPUs are busy) it goes back
+        to the poller at once after a reply: the read that would find nothing yet costs a
+        system call and an exception per call, and the poller reports the next request."""
         recv = c.sock.recv
         deadline = 0.0
-        budget = -1.0
+        budget = 0.0  # this round's spin; asked for once a request was served
         while True:
             try:
                 data = recv(CHUNK)
             except BlockingIOError:
-                if budget < 0.0:
-                    budget = self._spin_budget()
                 if not budget:
                     return
                 now = time.perf_counter()
@@ -711,9 +711,11 @@ class Server:
             if deadline:
                 self._spin_done(True)
             deadline = 0.0
-            budget = -1.0
             if not self._frames(c, data) or c.out or c.buf:
                 return  # dropped, or waiting for the client to read or to send the rest
+            budget = self._spin_budget()
+            if not budget:
+                return
 
     def _frames(self, c: _Client, data: bytes) -> bool:
         """Answer every whole frame in the client's buffer; False once it is dropped.  A

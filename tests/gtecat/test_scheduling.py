@@ -144,6 +144,38 @@ def test_the_controller_is_real_time_while_busy_and_then_never_spins(server, mon
     assert system.calls == [("fifo", 50), ("normal", (0, 0))]
 
 
+class _Requests:
+    """A client socket that holds ``n`` requests, then nothing yet (recv raises as a
+    non-blocking socket does)."""
+
+    def __init__(self, n: int) -> None:
+        self.left, self.reads = n, 0
+
+    def recv(self, size: int) -> bytes:
+        self.reads += 1
+        if self.left:
+            self.left -= 1
+            return b"request"
+        raise BlockingIOError
+
+
+def test_without_a_spin_the_controller_goes_back_to_the_poller_after_a_reply(server, monkeypatch):
+    """Busy CPUs (no spin): one request served, then no read that would find nothing yet
+    (the poller reports the next request); with a spin it reads on for the next one."""
+    from types import SimpleNamespace
+
+    served: list[bytes] = []
+    monkeypatch.setattr(server, "_frames", lambda c, data: served.append(data) or True)
+    sock = _Requests(2)
+    client = SimpleNamespace(sock=sock, out=b"", buf=b"")
+    monkeypatch.setattr(server, "_spin_budget", lambda: 0.0)
+    server._readable(client)
+    assert (served, sock.reads) == ([b"request"], 1)
+    monkeypatch.setattr(server, "_spin_budget", lambda: 1e-6)
+    server._readable(client)  # the second request, then a spin that ends empty-handed
+    assert len(served) == 2 and sock.reads >= 3
+
+
 def test_a_server_started_real_time_spins_briefly(server):
     """Started under chrt (no switching of its own): its spin is bounded."""
     server._bound_spin(started_realtime=False)

@@ -457,9 +457,16 @@ static int recv_msg(gte_sock fd, size_t *total, long long deadline)
 {
     size_t got = 0, need = 4;
     long long spin_until = 0;
-    long budget = -1; /* this call's spin, asked for when the reply is not there at once */
+    /* this call's spin; without one, the reply is waited for in poll at once (a read
+     * right after the request finds nothing yet and costs a system call) */
+    long budget = spin_allowed();
     int slept = 0;
     g_io_why = NULL;
+    if (budget <= 0) {
+        slept = 1;
+        if (wait_fd(fd, POLLIN, deadline) < 0)
+            return -1;
+    }
     while (got < need) {
         if (reserve(got + GTE_CHUNK) < 0) {
             g_io_why = "out of memory";
@@ -487,8 +494,6 @@ static int recv_msg(gte_sock fd, size_t *total, long long deadline)
         if (NET_INTR(e))
             continue;
         if (NET_WOULDBLOCK(e)) {
-            if (budget < 0)
-                budget = spin_allowed();
             if (budget > 0 && !slept) {
                 long long t = now_ns();
                 if (!spin_until)
