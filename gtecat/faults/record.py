@@ -13,17 +13,16 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 * ``{"cp": ns, "wkc": [got, expected], "states": [...], "ready": 0|1}`` checkpoints of the bus
   every :data:`CHECKPOINT_MS` of controller time.
 
-Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a
-structure field by field (a class of the application's own with its layout, ``"lay"``, so
-that the replay builds one like it), an array as its size and every value, which must agree, a buffer
+Pointer arguments are kept by value (a ``c_long`` as ``{"c": "c_long", "v": 5}``, a structure
+field by field (a class of the application's own with its layout, ``"lay"``, so that the
+replay builds one like it), an array as its size and every value, which must agree, a buffer
 as hex; a pointer into an object, ``byref(arr, 16)`` for C's ``&arr[2]``, with its byte
-offset: ``{"ref": ..., "off": 16}``); replay builds fresh
-objects of the same types, makes the same calls in the same order and compares every return
-code, every value the call leaves in its pointer arguments (written back or left as it was)
-and every checkpoint: the first difference is the
-divergence (call number, function, argument, recorded and new value).  Replays are
-deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session replays in
-``auto`` (the values its wall clock decided may then differ, and are reported so).
+offset: ``{"ref": ..., "off": 16}``); replay builds fresh objects of the same types, makes the
+same calls in the same order and compares every return code, every value the call leaves in
+its pointer arguments (written back or left as it was) and every checkpoint: the first
+difference is the divergence (call number, function, argument, recorded and new value).
+Replays are deterministic in the ``auto`` and ``lockstep`` clocks; a ``realtime`` session
+replays in ``auto`` (the values its wall clock decided may then differ, and are reported so).
 """
 
 from __future__ import annotations
