@@ -511,11 +511,11 @@ def fast_reader(
     packers: dict[tuple[type, int], Callable[..., bytes]] = {}
 
     def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
-        """The C entry's values for a ctypes array: ``f(n, count, array type, clock)``
+        """The C entry's values for a ctypes array: ``f(n, count, array type, None)``
         gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one;
-        ``spans``: a span of axes too, and the clock, as ``many`` answers them), then where
-        ``clock`` is 1 (pClock given) the clock's value as ``many`` writes it (int64), else
-        _NO (the Python path answers)."""
+        ``spans``: a span of axes too, as ``many`` answers them), else _NO (the Python path
+        answers).  A pClock's value the entry writes itself (GT_GetClock's: the
+        controller's time and GT_Reset's, ``centry.set_clock_ms``)."""
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
         last: list[Any] = [None, 0, None]
@@ -542,7 +542,7 @@ def fast_reader(
                     pack = struct.Struct(f"@{count}{tp._type_._type_}").pack
                     packers[tp, count] = pack
                 last[:] = [tp, count, pack]
-            if clock is not None and not spans:
+            if clock is not None:  # (the entry writes a pClock itself: asked without)
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
             if count == 1:
@@ -613,11 +613,6 @@ def fast_reader(
                 if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
-            if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
-                ctl = GATED[0]  # (the clock's now_ns in its quick numbers: no frame)
-                out += _CLOCK_VALUE.pack(
-                    ((ctl.clock.quick[9] - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
-                )
             return out
 
         return f
@@ -648,9 +643,6 @@ def fast_reader(
             public[0] = entry
     return public[0]  # type: ignore[no-any-return]
 
-
-#: a span's clock value after its values (:func:`centry.reader`'s ``array``)
-_CLOCK_VALUE = struct.Struct("@q")
 
 #: the C entry of the readers where it is available (``GTECAT_CENTRY=0`` turns it off when
 #: gtecat is imported; tests turn it off to hold the Python fast functions to the same answers)
@@ -705,6 +697,9 @@ def set_gates(gt: Any, gtn: Any) -> None:
     )
     centry.set_locks(
         *(c.clock if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
+    )
+    centry.set_clock_ms(
+        *(c if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
     )
     centry.set_gates(*gates)
 

@@ -649,6 +649,44 @@ static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *
     return *mem != NULL;
 }
 
+/* GT_GetClock's value, which a reader writes into its pClock (the milliseconds since the
+ * controller's GT_Reset, 32 bits: gtecat.controller.core.Controller.clock_ms): per gate the
+ * address of its controller's time in ns (Clock.now_ns) and of the time GT_Reset counted
+ * from (Controller.reset_ns), both int64 (0: none; set by gtecat_centry_clock_ms while the
+ * gates are closed).  Read with no Python between the read and the write, as the values. */
+static const ptrdiff_t *clock_ms_at;
+
+int gtecat_centry_clock_ms(const ptrdiff_t *at)
+{
+    clock_ms_at = at;
+    return 0;
+}
+
+/* Gate g's clock value in *ms (Python's ((now - reset) // 1000000) & 0xFFFFFFFF); 0 where
+ * the gate has none (the Python path answers). */
+static int clock_ms(ptrdiff_t g, long long *ms)
+{
+    const long long *now, *origin;
+    long long d, q;
+    if (!clock_ms_at || g < 1 || g > 2 || !(now = (const long long *)clock_ms_at[2 * g - 2]) ||
+        !(origin = (const long long *)clock_ms_at[2 * g - 1]))
+        return 0;
+    d = *now - *origin;
+    q = d / 1000000;
+    if (d % 1000000 < 0) /* (floor division, as Python's) */
+        q -= 1;
+    *ms = q & 0xFFFFFFFFLL;
+    return 1;
+}
+
+/* The clock value for a reader's pClock, or 0 where it must go the Python way: no clock
+ * known for the entry's gate, or a value the pClock's type does not hold (the table path
+ * refuses it). */
+static int clock_for(const struct entry *e, int csize, int csign, long long *ms)
+{
+    return clock_ms(e->gate, ms) && fits(*ms, csize, csign);
+}
+
 /* The ctypes array a reader's value pointer p passes: p itself, or the array of
  * byref(array[, offset]) (C's &array[k]); NULL where p is neither. */
 static obj array_of(obj p)
@@ -750,21 +788,18 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
         goto python;
     }
     call[2] = tp;
-    call[3] = cmem ? A.one : A.none;
-    v = array_value(e, call, an, ac, cmem != NULL, locked);
+    call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
+    v = array_value(e, call, an, ac, 0, locked);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
         goto python;
-    n = *(ptrdiff_t *)((char *)v + A.bsize) - (cmem ? 8 : 0);
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
     if (n <= 0)
         goto drop;
-    if (cmem) {
-        memcpy(&clk, (char *)v + A.bdata + n, 8);
-        if (!fits(clk, csize, csign))
-            goto drop; /* (a clock the type does not hold: the Python path) */
-        /* (again: Python may have run) */
-        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem)
+    if (cmem) { /* (again: Python may have run) */
+        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
+            !clock_for(e, csize, csign, &clk))
             goto drop;
     }
     /* (avalue checked the array's type and length: the bytes fit its start; an offset's
@@ -883,10 +918,10 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v, arr;
-    char *mem;
+    char *mem, *cmem = NULL;
     obj deref = NULL;
-    int k, size = 0, sign = 1, npy = 0;
-    long long key = -1, ep = -1, ep0 = -1;
+    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1;
+    long long key = -1, ep = -1, ep0 = -1, clk = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -911,8 +946,9 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         /* (the cached small ints 1 and 0 first: one compare for the common literals) */
         if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
+        /* pClock NULL (omitted, None, 0), or byref(x) or x of a clock type: written too */
         if (nargs >= 4 + at && args[at + 3] != A.none && args[at + 3] != A.zero &&
-            !int_is(args[at + 3], 0))
+            !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
             goto python;
         p = args[at + 1];
     }
@@ -959,6 +995,9 @@ have:
     mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
+    if (cmem && (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
+                 !clock_for(e, csize, csign, &clk)))
+        goto drop; /* (again, and its value: written after the value, as the Python path) */
     if (e->kind == 1) {
         if (TYPE(v) != A.float_type || size != 8)
             goto drop;
@@ -979,6 +1018,8 @@ have:
             goto drop;
         put(mem, x, size);
     }
+    if (cmem)
+        put(cmem, clk, csize);
     A.decref(v);
     return done(e->after, e->gate);
 
