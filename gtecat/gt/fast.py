@@ -915,14 +915,16 @@ DERIVED: dict[str, tuple[str, ...]] = {
 #: without row_value's frame, as it makes them in a bank of any size: the values its lists
 #: hold): ``{R}`` the axis's resources, ``{r}`` its row; a span's plan (_read_plan) writes
 #: one per row, so a span after a cycle does not make every row's list of the value
-#: (tests/gtecat/gt/test_fast_span_rows.py)
+#: (tests/gtecat/gt/test_fast_span_rows.py).  The status word comes from the bank's list
+#: (AxisBank.value): its words stand across a cycle that moves no flag (AxisBank
+#: _sts_epoch), cheaper than each row's word made from its flags for two rows already
 BANK_ROWS: dict[str, str] = {
     "GT_GetAxisPrfVel": "{R}.prf_link.ratio * b.row_value('prf_v', {r})",
     "GT_GetAxisPrfAcc": "{R}.prf_link.ratio * b.row_value('prf_a', {r})",
     "GT_GetAxisEncVel": "{R}.enc_link.ratio * b._enc_rates_row({r})[0]",
     "GT_GetAxisEncAcc": "{R}.enc_link.ratio * b._enc_rates_row({r})[1]",
     "GT_GetAxisEncPos": "{R}.enc_link.axis(b.enc_pos.item({r}))",
-    "GT_GetPrfSts": "b.row_value('sts', {r}) & MOVING",
+    "GT_GetPrfSts": "b.value('sts', {r}) & MOVING",
     "GT_GetAxisError": "b.a_last.item({r}) - {R}.enc_link.axis(b.enc_pos.item({r}))",
 }
 
