@@ -148,6 +148,8 @@ class _ASlot(ctypes.Structure):
         ("clock", ctypes.c_longlong),
         ("tp", _VP),
         ("value", _VP),
+        ("holds", ctypes.c_longlong),
+        ("keeps", ctypes.c_longlong),
     ]
 
 
@@ -179,6 +181,8 @@ class _Entry(ctypes.Structure):
         ("npsizes", ctypes.c_ssize_t * 8),
         ("npsigns", ctypes.c_ssize_t * 8),
         ("stride", ctypes.c_ssize_t),
+        ("tuple_type", _VP),
+        ("titems", ctypes.c_ssize_t),
     ]
 
 
@@ -875,6 +879,7 @@ def _load() -> tuple[Maker | None, str]:
         e.after = id(after) if after is not None else None
         # (a structure's array: its elements sizeof apart, its value the fields' bytes)
         e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
+        e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1220,7 +1225,9 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
         asked.append((n, count, clock))
         if tp is not A3 or not 1 <= count <= 3 or clock is not None:
             return nope
-        return struct.pack(f"@{count}q", *range(n, n + count))
+        first = n + gen[0] if n == 3 else n
+        out = struct.pack(f"@{count}q", *range(first, first + count))
+        return (out,) if n == 3 else out  # (status words alone: written as bytes)
 
     f = make(python, value, nope, [L], INT, False, 4, 0, False, False, avalue,
              GT_GATE, None, True, [U32, I32])  # fmt: skip
@@ -1249,6 +1256,9 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
         ((1, a, 2, c32), [(1, 2, None)], None),  # (the values kept: their epoch's)
         ((1, a, 2, c), [], (0, [1, 2, 0], 1 << 31, 0)),
         ((1, p, 1, c), [], (101, [0, 0, 0], (1 << 32) - 1, 0)),  # (before GT_Reset's: -1)
+        ((3, a, 2), [(3, 2, None)], (0, [4, 5, 0], 0, 0)),  # (a 1-tuple's bytes)
+        ((3, a, 2), [], (0, [4, 5, 0], 0, 0)),
+        ((3, a, 2), [(3, 2, None)], (0, [5, 6, 0], 0, 0)),  # (the epoch grown: asked again)
     ]
     before = tuple(GATES), tuple(CLOCK_MS)
     try:
@@ -1265,6 +1275,9 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
                 times[0] += 1
             if k == 19:
                 times[0] = times[1] - 1
+            if k == 22:
+                gen[0] = 2
+                changed()
             o.value, c.value, c32.value = 0, 0, 0
             ctypes.memset(a, 0, ctypes.sizeof(a))
             got = f(*args)

@@ -339,6 +339,9 @@ def fast_reader(
     #: every row's list); its plans are kept under the reader's name
     row_expr = BANK_ROWS.get(name) if bank_key is None else None
     plan_key = bank_key if row_expr is None else name
+    #: a span's values are status words alone (of the bank's rows, their flags): they stand
+    #: while every change is a cycle that keeps every flag (the C entry's array_value)
+    status = name in ("GT_GetSts", "GT_GetPrfSts")
 
     core: list[Any] = []  # (CMD_PARAM, _record): the GT layer imports this module first
 
@@ -545,6 +548,7 @@ def fast_reader(
             if clock is not None:  # (the entry writes a pClock itself: asked without)
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
+            words = False  # (status words of the bank's rows and zeros alone: (bytes,))
             if count == 1:
                 v = value(n)
                 if v is _NO:
@@ -569,6 +573,7 @@ def fast_reader(
                     # the span of the last call, its plan as span() finds it (the same
                     # checks): the bank's list of the cycle, made where it is not yet (a
                     # reader of BANK_ROWS: the rows' values from the bank itself)
+                    words = status and ln[7]
                     if row_expr is not None:
                         values = ln[6](b)
                     else:
@@ -613,7 +618,9 @@ def fast_reader(
                 if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
-            return out
+            # status words of the bank's rows and zeros alone stand across the cycles the C
+            # entry books that keep every flag (csrc/centry.c array_value)
+            return (out,) if words else out
 
         return f
 
@@ -956,9 +963,10 @@ def _read_plan(
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
     of the span is a row of ``b``, that row's place in the span, whether the getter picks
-    rows of a list and zeros alone: the same list, the same values).  Each axis of the span is
-    a row of ``b``, an axis the bank does not run (its value ``get(resources)``, where
-    ``get`` is given) or, within ``1..top``, an axis no drive backs (it reads 0); any other
+    rows (of a list, or the bank's own) and zeros alone: the same list, the same values).
+    Each axis of the span is a row of ``b``, an axis the bank does not run (its value
+    ``get(resources)``, where ``get`` is given) or, within ``1..top``, an axis no drive
+    backs (it reads 0); any other
     (another bank's axis, one not on the bus): no getter.  ``row``: a row's value is that
     expression of BANK_ROWS (``{R}`` its resources, ``{r}`` its row) and the getter takes
     the bank itself, not a list."""
@@ -987,8 +995,9 @@ def _read_plan(
             env[f"r{i}"] = res
         else:
             return none
-    pure = row is None and len(env) == 1  # (rows and zeros alone: no getter of another axis)
-    if pure and at is not None and "0" not in items:
+    # (rows and zeros alone: no getter of another axis)
+    pure = not any(x.startswith("g(") for x in items)
+    if pure and row is None and at is not None and "0" not in items:
         pick = itemgetter(*(int(x[4:-1]) for x in items))
     else:  # (the rows, the getters and the zeros in one tuple)
         env["MOVING"] = _STATUS_BITS["MOVING"]

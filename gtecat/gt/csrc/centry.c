@@ -138,11 +138,14 @@ struct slot {
     obj value;
 };
 
-/* a span's bytes kept for its key and epoch (tp: a strong reference while kept) */
+/* a span's bytes kept for its key and epoch (tp: a strong reference while kept); holds: 1
+ * where they stand across the cycles that keep every status flag (their value function gave
+ * them as such: status words alone), keeps: flag_keeping when they were last kept */
 struct aslot {
     long long epoch, n, count, clock;
     obj tp;
     obj value;
+    long long holds, keeps;
 };
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
@@ -178,6 +181,10 @@ struct entry {
     /* an array's element stride where it is not the value's bytes per element (a structure
      * reader: the structure's size, its value the fields' bytes); 0: the bytes' own */
     ptrdiff_t stride;
+    /* the tuple type and where a tuple keeps its first item: avalue's (bytes,) says its
+     * bytes are status words alone (NULL: avalue gives bytes only) */
+    obj tuple_type;
+    ptrdiff_t titems;
 };
 
 static struct api A;
@@ -281,6 +288,7 @@ static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
     A.incref(v);
     A.incref(tp);
     s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
+    s->holds = 0;
     if (old)
         A.decref(old);
     if (oldtp)
@@ -474,6 +482,12 @@ static int armed(const long long *q, long long pend)
     return 1;
 }
 
+/* The quick cycles booked in C that kept every status flag (no in-position band, no move
+ * ended: book_in_c's b[14]), each of which made the readers' epoch grow by one: where the
+ * epoch grew by as much as this count since a span of status words was kept, every change
+ * since was such a cycle and the words stand (array_value) */
+static long long flag_keeping;
+
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
  * objects made first (nothing counted where one cannot be), then the bank's lists anew, the
@@ -537,6 +551,8 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     cnt[8] += b[13];
     if (b[14] && cnt[9] == ep) /* (the status words made for the epoch stand: no flag moved) */
         cnt[9] = ep + 1;
+    if (b[14])
+        flag_keeping++;
     *(long long *)b[3] += 1; /* its drives' cycles */
     *(long long *)b[4] += 1; /* the master's */
     q[10] = cycles;
@@ -741,9 +757,14 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
 {
     struct aslot *s = e->acache;
     long long ep = -1, ep0 = -1;
+    int holds = 0;
     obj v, tp = call[2];
-    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
-        s->count == ac && s->tp == tp && s->clock == clk) {
+    if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
+        s->clock == clk &&
+        (s->epoch == ep ||
+         (s->holds && ep > s->epoch && ep - s->epoch == flag_keeping - s->keeps))) {
+        s->epoch = ep; /* (status words across cycles that kept every flag: the same) */
+        s->keeps = flag_keeping;
         A.incref(s->value);
         return s->value;
     }
@@ -752,6 +773,14 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
     v = A.vectorcall(e->avalue, call, 4, NULL);
     if (!v)
         return NULL;
+    if (e->tuple_type && TYPE(v) == e->tuple_type &&
+        *(ptrdiff_t *)((char *)v + A.bsize) == 1) { /* (bytes,): status words alone */
+        obj b = *(obj *)((char *)v + e->titems);
+        A.incref(b);
+        A.decref(v);
+        v = b;
+        holds = 1;
+    }
     if (TYPE(v) != A.bytes_type) {
         A.decref(v);
         return PYTHON;
@@ -760,8 +789,11 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         A.decref(v);
         return AGAIN;
     }
-    if (s && ep >= 0)
+    if (s && ep >= 0) {
         keep_span(s, ep, v, tp, an, ac, clk);
+        s->holds = holds;
+        s->keeps = flag_keeping;
+    }
     return v;
 }
 

@@ -67,3 +67,51 @@ def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
     assert rows[-1] == (0.0, 0.0)  # (both moves ended)
     assert len({c for c, *_ in rows[:-1]}) > 200  # (cycle by cycle)
     assert rows == table
+
+
+def _status_polls(general: bool) -> tuple[list, int, int]:
+    """Trap moves of both axes that start and end, every call a span of status words
+    (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) polled on the auto clock; ``general``:
+    a watch hook that does nothing, so every cycle goes the general way.  What was read,
+    the cycles run, and how often a span's value function was asked."""
+    import cProfile
+    import pstats
+
+    bring_up(clock="auto")
+    try:
+        ctl = gt.GTE_Controller()
+        if general:
+            ctl.watch.append(lambda: None)
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        words, prf = (c_long * 2)(), (c_long * 2)()
+        clk = ctypes.c_ulong()
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(4):
+            _trap(1 + rnd % 2, 300 * (rnd + 1) * (-1) ** rnd, 20.0)
+            pr.enable()
+            for _ in range(2500):
+                assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
+                assert gt.GT_GetPrfSts(1, prf, 2) == 0
+                seen.append((clk.value, *words, *prf))
+            pr.disable()
+        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        asked = sum(
+            v[1] for (file, _, func), v in stats if func == "f" and file.endswith("fast.py")
+        )
+        return seen, ctl.clock.cycles - t0, asked
+    finally:
+        gt.GT_Close()
+
+
+def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
+    """A span of status words is asked again only where a flag may have moved (a move's
+    start or end, anything but a quick cycle booked in C): what every call reads is what
+    it reads with every cycle the general way, while the axes start, move and stop."""
+    quick, cycles, asked = _status_polls(False)
+    general, _, asked_general = _status_polls(True)
+    assert quick == general
+    assert len({tuple(x[1:3]) for x in quick}) >= 3  # (each axis moving, and neither)
+    assert asked_general > cycles  # (every cycle: both spans asked again)
+    assert asked < cycles / 4  # (the words held across the quick cycles)
