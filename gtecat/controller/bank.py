@@ -1818,7 +1818,13 @@ class AxisBank:
             self._release_groups([self.groups[gi] for gi in sorted(gis)])
 
     def _release_groups(self, groups: list[_Group]) -> None:
-        """Write the rows' committed state back into their objects; they leave the bank."""
+        """Write the rows' committed state back into their objects; they leave the bank.
+        The readers' epoch grows (gtecat.controller.epoch): a release inside a fast
+        reader's call (a guarded object read: GT_GetDo's outputs) would otherwise leave the
+        quick cycle the readers' C entries run armed for a bank without those rows, and
+        their axes would stand still while time passes (Controller.arm_quick)."""
+        if groups:
+            EPOCH.n += 1
         clusters: list[Cluster] = []
         if getattr(self, "_cluster_of", None):
             out = list(groups)
