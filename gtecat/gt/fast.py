@@ -2978,8 +2978,10 @@ def fast_io_reader(
         "first": first,
         "array_at": array_at,
         "plan": plan,
-        # the inputs' readers keep the bank's axes (bank.BANK_READS: they read the image)
-        "RELEASES": name not in BANK_READS,
+        # the inputs' readers keep the bank's axes (bank.BANK_READS: they read the image),
+        # and so does GT_GetDo (its outputs are the controller's; the enabled axes' bits
+        # of the bank's rows from the rows: io_calls.do_reader)
+        "RELEASES": name not in BANK_READS and name != "GT_GetDo",
     }
     # (compiled with the function's type range and key offset as constants, its names as
     # globals: the fewest steps per call)
