@@ -337,7 +337,7 @@ def fast_reader(
     #: a reader whose value a row of the bank gives through a link or a bit (DERIVED): a
     #: span's plan writes each row's value as BANK_ROWS' expression (that row alone, not
     #: every row's list); its plans are kept under the reader's name
-    row_expr = BANK_ROWS.get(name) if bank_key is None else None
+    row_expr = BANK_ROWS.get(name) if bank_key is None else SPAN_ROWS.get(name)
     plan_key = bank_key if row_expr is None else name
     #: a span's values are status words alone (of the bank's rows, their flags): they stand
     #: while every change is a cycle that keeps every flag (the C entry's array_value)
@@ -934,6 +934,10 @@ BANK_ROWS: dict[str, str] = {
     "GT_GetPrfSts": "b.value('sts', {r}) & MOVING",
     "GT_GetAxisError": "b.a_last.item({r}) - {R}.enc_link.axis(b.enc_pos.item({r}))",
 }
+
+#: a reader of BANK_LISTS whose span is written from each row alone, as BANK_ROWS' are:
+#: the encoder's speed (the bank's list of it is made with every row's acceleration too)
+SPAN_ROWS: dict[str, str] = {"GT_GetEncVel": "b._enc_rates_row({r})[0]"}
 
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}

@@ -1,7 +1,9 @@
 """A span of a reader whose value is a link or a bit of a banked axis's value (the readers
-of ``fast.BANK_ROWS``): after each cycle of the auto clock its C entry asks each row of the
-bank for its value alone, not every row's list; what it writes is what the table path
-writes, cycle by cycle, while both axes move, accelerate and stop."""
+of ``fast.BANK_ROWS``, and the encoder's speed: ``fast.SPAN_ROWS``): after each cycle of the
+auto clock its C entry asks each row of the bank for its value alone, not every row's list;
+what it writes is what the table path writes, cycle by cycle, while both axes move,
+accelerate and stop.  A span of status words stands across the cycles that keep every
+flag."""
 
 from __future__ import annotations
 
@@ -41,7 +43,7 @@ def _moves_read(table: bool) -> tuple[list, int]:
         banked = 0
         for _ in range(320):
             banked += ctl.resources[1].bank is not None
-            for name in sorted(fast.BANK_ROWS):
+            for name in sorted(fast.BANK_ROWS | fast.SPAN_ROWS):
                 fn = getattr(gt, name)
                 fn = fn.slow if table else fn
                 tp = c_long if name == "GT_GetPrfSts" else c_double
