@@ -14,7 +14,7 @@ import pytest
 from gtecat import gt
 from gtecat.gt.fast import READERS
 
-from .conftest import bring_up
+from .conftest import bring_up, trap_move
 
 #: pClock shapes: (what, maker); None: NULL; the table path answers the rest the same
 CLOCKS = [
@@ -119,14 +119,8 @@ def _session(table: bool, clock: str) -> tuple[list, int]:
     bring_up(clock=clock, cycle_ms=0.25)  # (GT_Reset between two milliseconds)
     try:
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
-        for ax, pos, vel in ((1, 900, 12.0), (2, -600, 7.5)):
-            assert gt.GT_PrfTrap(ax) == 0
-            p = gt.TTrapPrm()
-            p.acc, p.dec = 0.3, 0.2
-            assert gt.GT_SetTrapPrm(ax, byref(p)) == 0
-            assert gt.GT_SetVel(ax, vel) == 0
-            assert gt.GT_SetPos(ax, pos) == 0
-            assert gt.GT_Update(1 << (ax - 1)) == 0
+        trap_move(1, 900, 12.0)
+        trap_move(2, -600, 7.5)
         ctl = gt.GTE_Controller()
         seen: list = []
         pr = cProfile.Profile()

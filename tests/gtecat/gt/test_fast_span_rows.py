@@ -13,17 +13,7 @@ from ctypes import byref, c_double, c_long
 from gtecat import gt
 from gtecat.gt import fast
 
-from .conftest import bring_up
-
-
-def _trap(ax: int, pos: int, vel: float) -> None:
-    assert gt.GT_PrfTrap(ax) == 0
-    p = gt.TTrapPrm()
-    p.acc, p.dec = 0.3, 0.2
-    assert gt.GT_SetTrapPrm(ax, byref(p)) == 0
-    assert gt.GT_SetVel(ax, vel) == 0
-    assert gt.GT_SetPos(ax, pos) == 0
-    assert gt.GT_Update(1 << (ax - 1)) == 0
+from .conftest import bring_up, trap_move
 
 
 def _moves_read(table: bool) -> tuple[list, int]:
@@ -37,8 +27,8 @@ def _moves_read(table: bool) -> tuple[list, int]:
         s = c_long()
         for _ in range(400):  # (polls: the bank claims both axes)
             gt.GT_GetSts(1, byref(s))
-        _trap(1, 900, 12.0)
-        _trap(2, -600, 7.5)
+        trap_move(1, 900, 12.0)
+        trap_move(2, -600, 7.5)
         seen: list = []
         banked = 0
         for _ in range(320):
@@ -91,7 +81,7 @@ def _status_polls(general: bool) -> tuple[list, int, int]:
         pr = cProfile.Profile()
         t0 = ctl.clock.cycles
         for rnd in range(4):
-            _trap(1 + rnd % 2, 300 * (rnd + 1) * (-1) ** rnd, 20.0)
+            trap_move(1 + rnd % 2, 300 * (rnd + 1) * (-1) ** rnd, 20.0)
             pr.enable()
             for _ in range(2500):
                 assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
