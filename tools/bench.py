@@ -400,7 +400,9 @@ def every_shape(
     and a numpy array of one element, and NULL (0, None) for the optional pointer after it
     (``count`` 1 first for the readers of a span), a pointer into an array (``byref(arr)``,
     ``byref(arr, k * sizeof(elem))``: C's ``&arr[k]``; for the readers of a span, two values
-    there too); each call written out as a client writes
+    there too), and for the readers that take ``pClock`` their shapes with a clock pointer
+    (``byref`` of it, the object itself, with one value and with a span); each call written
+    out as a client writes
     it (no ``*args``), with the statement that builds the same arguments and their names.
     ``names``: these functions instead (a comparison with another version).  The controller
     must be open.  Also the shapes not measured and why: a call
@@ -440,6 +442,7 @@ def every_shape(
             "k": sizeof(t),
             "byref": byref,
             "np": np,
+            "c_ulong": c_ulong,
         }
         x = f"{first.get(name, 1)}, " if i else ""
         # shape: (its kind, as fast.SLOW_SHAPES names it; the call's source; building its
@@ -459,6 +462,27 @@ def every_shape(
                 f"fn({x}byref(arr4, k), 2, None)",
                 "byref(arr4, k)",
             )
+        if [q.name for q in rest] == ["count", "pClock"]:
+            # the clock pointer too (the vendor's form of a loop that timestamps its reads)
+            env["clk"] = c_ulong()
+            shapes |= {
+                "byref(s), 1, byref(clk)": (
+                    "clock byref",
+                    f"fn({x}byref(held), 1, byref(clk))",
+                    "byref(held); byref(clk)",
+                ),
+                "s, 1, clk": ("clock object", f"fn({x}held, 1, clk)", "t(); c_ulong()"),
+                f"{t.__name__}[4], 2, byref(clk)": (
+                    "clock span",
+                    f"fn({x}arr4, 2, byref(clk))",
+                    "byref(clk)",
+                ),
+                "byref(arr, k), 2, clk": (
+                    "clock byref array span",
+                    f"fn({x}byref(arr4, k), 2, clk)",
+                    "byref(arr4, k)",
+                ),
+            }
         if t in dtypes:
             env["npa"], env["dt"] = np.zeros(1, dtypes[t]), dtypes[t]
             shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (

@@ -241,6 +241,8 @@ def _crd_push(name: str) -> bool:
 _SMALL_BANK = 32
 #: the planned values :meth:`AxisBank._materialise` makes: (its Trap table, its Jog value)
 _PLANNED = {"prf_p": ("t_p", "jp"), "prf_v": ("t_v", "jv"), "prf_a": ("t_a", "ja")}
+#: ... their Trap tables' flat views (AxisBank._make_list: where no row jogs or homes)
+_PLANNED_FLAT = {"prf_p": "_t_p1", "prf_v": "_t_v1", "prf_a": "_t_a1"}
 #: AxisBank.row_value: the values made row by row, their place in their row's tuple: the
 #: planned values (AxisBank._planned_one) and the encoder's rates (AxisBank._enc_rates_row)
 _ROW_PLANNED = {"prf_p": 0, "prf_v": 1, "prf_a": 2}
@@ -1816,7 +1818,13 @@ class AxisBank:
             self._release_groups([self.groups[gi] for gi in sorted(gis)])
 
     def _release_groups(self, groups: list[_Group]) -> None:
-        """Write the rows' committed state back into their objects; they leave the bank."""
+        """Write the rows' committed state back into their objects; they leave the bank.
+        The readers' epoch grows (gtecat.controller.epoch): a release inside a fast
+        reader's call (a guarded object read: GT_GetDo's outputs) would otherwise leave the
+        quick cycle the readers' C entries run armed for a bank without those rows, and
+        their axes would stand still while time passes (Controller.arm_quick)."""
+        if groups:
+            EPOCH.n += 1
         clusters: list[Cluster] = []
         if getattr(self, "_cluster_of", None):
             out = list(groups)
@@ -2233,6 +2241,8 @@ class AxisBank:
         if name == "moving":
             return (self.moving | self.jog).tolist()
         if name in _PLANNED:
+            if not (self.n_jog or self.n_hm):  # (the Trap tables' values alone: one gather)
+                return getattr(self, _PLANNED_FLAT[name])[self.t_idx].tolist()
             return self._planned(name).tolist()
         return getattr(self, name).tolist()
 

@@ -55,7 +55,7 @@ from gtecat.eni.errors import EniError
 from gtecat.eni.layout import Layout, build_layout
 from gtecat.eni.reader import read_eni
 
-from .._attrs import own_dict
+from .._attrs import in_array, own_dict
 from ..errors import BusError, NoEniError, ParameterError
 from ..master.bus import Master
 from ..master.clock import ARMS, Clock, ClockMode, hook_list
@@ -152,6 +152,7 @@ class Controller:
     sample = hook_list("sample")
     watch = hook_list("watch")
     before_bank = hook_list("before_bank")
+    reset_ns = in_array("origin", 0, "The controller time GT_GetClock counts from (GT_Reset's).")
 
     #: called with every controller whose bus comes up (``gtecat run --trace`` uses it)
     bus_up_hooks: list[Callable[[Controller], None]] = []  # noqa: RUF012 - a process-wide registry
@@ -220,7 +221,10 @@ class Controller:
         #: why the last GT_InitEcatComm failed (None: it succeeded, or none was made)
         self.init_error: Exception | None = None
         self._links_down = False  # some axis's slave was offline at the last cycle
-        self.reset_ns = 0
+        #: [0] the controller time GT_Reset last counted GT_GetClock from (:attr:`reset_ns`),
+        #: in memory compiled code reads: the GT readers' C entries write a ``pClock`` from it
+        #: and the clock's time (gtecat.gt.centry.set_clock_ms)
+        self.origin = array("q", (0,))
         #: run first in a cycle, before its time is read: motion programs, whose GT calls
         #: may themselves wait for cycles (GT_AxisOn), so the cycle then starts later
         self.before_cycle: list[Callable[[], None]] = []

@@ -148,6 +148,8 @@ class _ASlot(ctypes.Structure):
         ("clock", ctypes.c_longlong),
         ("tp", _VP),
         ("value", _VP),
+        ("holds", ctypes.c_longlong),
+        ("keeps", ctypes.c_longlong),
     ]
 
 
@@ -179,6 +181,8 @@ class _Entry(ctypes.Structure):
         ("npsizes", ctypes.c_ssize_t * 8),
         ("npsigns", ctypes.c_ssize_t * 8),
         ("stride", ctypes.c_ssize_t),
+        ("tuple_type", _VP),
+        ("titems", ctypes.c_ssize_t),
     ]
 
 
@@ -316,6 +320,29 @@ def _marks_dict() -> dict:
     ):
         raise ValueError("the slaves' marks are not where they are looked for")
     return found[0]
+
+
+#: per gate, where its controller's clock value (GT_GetClock's: the milliseconds since
+#: GT_Reset) is made from: the address of the controller's time in ns (``Clock.now_ns``)
+#: and of the time GT_Reset counted from (``Controller.reset_ns``), both int64 (0: none):
+#: a reader's entry writes its ``pClock`` from them (csrc/centry.c clock_ms)
+CLOCK_MS = (ctypes.c_ssize_t * 4)()
+_ORIGINS: list[Any] = [None, None]  # (their arrays, kept alive while named)
+
+
+def set_clock_ms(gt: Any, gtn: Any) -> None:
+    """The controllers behind the two gates, for their clock values (:data:`CLOCK_MS`;
+    None: none), set while the gates are closed."""
+    for k, ctl in enumerate((gt, gtn)):
+        q = getattr(getattr(ctl, "clock", None), "quick", None)
+        origin = getattr(ctl, "origin", None)
+        ok = all(
+            isinstance(a, array) and a.typecode == "q" and len(a) == n
+            for a, n in ((q, QUICK_LEN), (origin, 1))
+        )
+        _ORIGINS[k] = (q, origin) if ok else None
+        CLOCK_MS[2 * k] = q.buffer_info()[0] + 9 * q.itemsize if ok else 0  # (now_ns: [9])
+        CLOCK_MS[2 * k + 1] = origin.buffer_info()[0] if ok else 0
 
 
 #: per gate, its controller's clock lock (``Clock.lock``, a ``threading.RLock``) and that
@@ -790,6 +817,8 @@ def _load() -> tuple[Maker | None, str]:
         lib.gtecat_centry_api.restype = ctypes.c_int
         if lib.gtecat_centry_api(ctypes.byref(api)) != 0:
             return None, "the library refused the layout"
+        lib.gtecat_centry_clock_ms.argtypes = [_VP]
+        lib.gtecat_centry_clock_ms(ctypes.addressof(CLOCK_MS))
         meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
         raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
         vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value
@@ -850,6 +879,7 @@ def _load() -> tuple[Maker | None, str]:
         e.after = id(after) if after is not None else None
         # (a structure's array: its elements sizeof apart, its value the fields' bytes)
         e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
+        e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1181,10 +1211,11 @@ def _self_test_numpy(make: Maker, python: Callable[..., Any], value: Any, nope: 
 
 def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
     """'' when an entry that keeps values asks again exactly when :data:`EPOCH` grows, per
-    axis, its spans per key, and writes a span's clock, else what went wrong."""
+    axis, its spans per key, and writes a pClock's value from its gate's clock (a span's
+    and a value's: the kept values with the clock of the call), else what went wrong."""
     asked: list[Any] = []
     gen = [0]
-    L, A3, U32 = ctypes.c_int64, ctypes.c_int64 * 3, ctypes.c_uint32
+    L, A3, U32, I32 = ctypes.c_int64, ctypes.c_int64 * 3, ctypes.c_uint32, ctypes.c_int32
 
     def value(n: Any) -> Any:
         asked.append(n)
@@ -1192,50 +1223,73 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
 
     def avalue(n: Any, count: Any, tp: Any, clock: Any) -> Any:
         asked.append((n, count, clock))
-        if tp is not A3 or not 1 <= count <= 3:
+        if tp is not A3 or not 1 <= count <= 3 or clock is not None:
             return nope
-        tail = struct.pack("@q", 1 << 33 if n == 2 else 70) if clock == 1 else b""
-        return struct.pack(f"@{count}q", *range(n, n + count)) + tail
+        first = n + gen[0] if n == 3 else n
+        out = struct.pack(f"@{count}q", *range(first, first + count))
+        return (out,) if n == 3 else out  # (status words alone: written as bytes)
 
     f = make(python, value, nope, [L], INT, False, 4, 0, False, False, avalue,
-             NO_GATE, None, True, [U32])  # fmt: skip
-    o, a, c, c16 = L(), A3(), U32(), ctypes.c_uint16()
+             GT_GATE, None, True, [U32, I32])  # fmt: skip
+    o, a, c, c32, c16 = L(), A3(), U32(), I32(), ctypes.c_uint16()
     p = ctypes.byref(o)
+    times = array("q", (1_070_999_999, 1_000_000_000))  # (the time and GT_Reset's: 70 ms)
+    # (args, asked, (o, a, c, c32) written, or None: the Python function answers)
     steps: list[tuple[tuple, list[Any], Any]] = [
-        ((1, p), [1], 100),
-        ((1, p), [], 100),
-        ((2, p), [2], 200),
-        ((1, p, 1, 0), [], 100),
+        ((1, p), [1], (100, [0, 0, 0], 0, 0)),
+        ((1, p), [], (100, [0, 0, 0], 0, 0)),
+        ((2, p), [2], (200, [0, 0, 0], 0, 0)),
+        ((1, p, 1, 0), [1], (101, [0, 0, 0], 0, 0)),  # (the epoch grown: asked again)
         ((9, p), [9], None),
         ((9, p), [9], None),
-        ((1, a, 2), [(1, 2, None)], [1, 2, 0]),
-        ((1, a, 2), [], [1, 2, 0]),
-        ((1, a, 3), [(1, 3, None)], [1, 2, 3]),
-        ((1, a, 3, ctypes.byref(c)), [(1, 3, 1)], ([1, 2, 3], 70)),
-        ((1, a, 3, c), [], ([1, 2, 3], 70)),
-        ((2, a, 1, c), [(2, 1, 1)], ([2, 2, 3], 70)),  # (a clock too large: Python)
+        ((1, a, 2), [(1, 2, None)], (0, [1, 2, 0], 0, 0)),
+        ((1, a, 2), [], (0, [1, 2, 0], 0, 0)),
+        ((1, a, 3), [(1, 3, None)], (0, [1, 2, 3], 0, 0)),
+        ((1, a, 3, ctypes.byref(c)), [], (0, [1, 2, 3], 70, 0)),  # (kept; the clock's)
+        ((1, a, 3, c32), [], (0, [1, 2, 3], 0, 70)),
+        ((1, p, 1, ctypes.byref(c)), [], (101, [0, 0, 0], 70, 0)),
+        ((1, p, 1, c32), [], (101, [0, 0, 0], 0, 70)),
         ((1, a, 3, c16), [], None),  # (a clock type it does not take)
+        ((1, p, 1, c16), [], None),
+        ((1, p, 1, c32), [], (101, [0, 0, 0], 0, (1 << 31) - 1)),  # (the largest it holds)
+        ((1, p, 1, c32), [], None),  # (one more: a clock an int32 does not hold)
+        ((1, a, 2, c32), [(1, 2, None)], None),  # (the values kept: their epoch's)
+        ((1, a, 2, c), [], (0, [1, 2, 0], 1 << 31, 0)),
+        ((1, p, 1, c), [], (101, [0, 0, 0], (1 << 32) - 1, 0)),  # (before GT_Reset's: -1)
+        ((3, a, 2), [(3, 2, None)], (0, [4, 5, 0], 0, 0)),  # (a 1-tuple's bytes)
+        ((3, a, 2), [], (0, [4, 5, 0], 0, 0)),
+        ((3, a, 2), [(3, 2, None)], (0, [5, 6, 0], 0, 0)),  # (the epoch grown: asked again)
     ]
-    for k, (args, want_asked, want) in enumerate(steps):
-        del asked[:]
-        if k == 3:
-            gen[0] = 1
-            changed()  # (the epoch grows: asked again)
-            want_asked, want = [1], 101
-        o.value, c.value = 0, 0
-        got = f(*args)
-        if want is None:
-            ok = got == ("python", args, {})
-        elif isinstance(want, tuple):
-            ok = got == 0 and (list(a), c.value) == (want[0], want[1])
-            if args[0] == 2:  # (its clock does not fit: the Python function answers)
-                ok = got == ("python", args, {})
-        elif isinstance(want, list):
-            ok = got == 0 and list(a) == want
-        else:
-            ok = got == 0 and o.value == want
-        if not ok or asked != want_asked:
-            return f"a keeping entry answered {got!r} for {args!r} asking {asked!r}"
+    before = tuple(GATES), tuple(CLOCK_MS)
+    try:
+        GATES[0] = LOCKSTEP
+        CLOCK_MS[0], CLOCK_MS[1] = times.buffer_info()[0], times.buffer_info()[0] + 8
+        for k, (args, want_asked, want) in enumerate(steps):
+            del asked[:]
+            if k == 3:
+                gen[0] = 1
+                changed()
+            if k == 15:
+                times[0] = times[1] + ((1 << 31) - 1) * 1_000_000 + 999_999
+            if k == 16:
+                times[0] += 1
+            if k == 19:
+                times[0] = times[1] - 1
+            if k == 22:
+                gen[0] = 2
+                changed()
+            o.value, c.value, c32.value = 0, 0, 0
+            ctypes.memset(a, 0, ctypes.sizeof(a))
+            got = f(*args)
+            if want is None:
+                ok = got == ("python", args, {}) and (o.value, list(a), c.value) == (0, [0] * 3, 0)
+            else:
+                ok = got == 0 and (o.value, list(a), c.value, c32.value) == want
+            if not ok or asked != want_asked:
+                return f"a keeping entry answered {got!r} for {args!r} asking {asked!r}"
+    finally:
+        GATES[0], GATES[1] = before[0]
+        CLOCK_MS[:] = before[1]
     return ""
 
 

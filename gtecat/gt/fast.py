@@ -337,8 +337,11 @@ def fast_reader(
     #: a reader whose value a row of the bank gives through a link or a bit (DERIVED): a
     #: span's plan writes each row's value as BANK_ROWS' expression (that row alone, not
     #: every row's list); its plans are kept under the reader's name
-    row_expr = BANK_ROWS.get(name) if bank_key is None else None
+    row_expr = BANK_ROWS.get(name) if bank_key is None else SPAN_ROWS.get(name)
     plan_key = bank_key if row_expr is None else name
+    #: a span's values are status words alone (of the bank's rows, their flags): they stand
+    #: while every change is a cycle that keeps every flag (the C entry's array_value)
+    status = name in ("GT_GetSts", "GT_GetPrfSts")
 
     core: list[Any] = []  # (CMD_PARAM, _record): the GT layer imports this module first
 
@@ -511,11 +514,11 @@ def fast_reader(
     packers: dict[tuple[type, int], Callable[..., bytes]] = {}
 
     def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
-        """The C entry's values for a ctypes array: ``f(n, count, array type, clock)``
+        """The C entry's values for a ctypes array: ``f(n, count, array type, None)``
         gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one;
-        ``spans``: a span of axes too, and the clock, as ``many`` answers them), then where
-        ``clock`` is 1 (pClock given) the clock's value as ``many`` writes it (int64), else
-        _NO (the Python path answers)."""
+        ``spans``: a span of axes too, as ``many`` answers them), else _NO (the Python path
+        answers).  A pClock's value the entry writes itself (GT_GetClock's: the
+        controller's time and GT_Reset's, ``centry.set_clock_ms``)."""
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
         last: list[Any] = [None, 0, None]
@@ -542,9 +545,10 @@ def fast_reader(
                     pack = struct.Struct(f"@{count}{tp._type_._type_}").pack
                     packers[tp, count] = pack
                 last[:] = [tp, count, pack]
-            if clock is not None and not spans:
+            if clock is not None:  # (the entry writes a pClock itself: asked without)
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
+            words = False  # (status words of the bank's rows and zeros alone: (bytes,))
             if count == 1:
                 v = value(n)
                 if v is _NO:
@@ -569,6 +573,7 @@ def fast_reader(
                     # the span of the last call, its plan as span() finds it (the same
                     # checks): the bank's list of the cycle, made where it is not yet (a
                     # reader of BANK_ROWS: the rows' values from the bank itself)
+                    words = status and ln[7]
                     if row_expr is not None:
                         values = ln[6](b)
                     else:
@@ -613,12 +618,9 @@ def fast_reader(
                 if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
-            if clock is not None:  # (the table path's value, clock_out's: clock_ms inline)
-                ctl = GATED[0]  # (the clock's now_ns in its quick numbers: no frame)
-                out += _CLOCK_VALUE.pack(
-                    ((ctl.clock.quick[9] - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
-                )
-            return out
+            # status words of the bank's rows and zeros alone stand across the cycles the C
+            # entry books that keep every flag (csrc/centry.c array_value)
+            return (out,) if words else out
 
         return f
 
@@ -648,9 +650,6 @@ def fast_reader(
             public[0] = entry
     return public[0]  # type: ignore[no-any-return]
 
-
-#: a span's clock value after its values (:func:`centry.reader`'s ``array``)
-_CLOCK_VALUE = struct.Struct("@q")
 
 #: the C entry of the readers where it is available (``GTECAT_CENTRY=0`` turns it off when
 #: gtecat is imported; tests turn it off to hold the Python fast functions to the same answers)
@@ -705,6 +704,9 @@ def set_gates(gt: Any, gtn: Any) -> None:
     )
     centry.set_locks(
         *(c.clock if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
+    )
+    centry.set_clock_ms(
+        *(c if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
     )
     centry.set_gates(*gates)
 
@@ -920,16 +922,22 @@ DERIVED: dict[str, tuple[str, ...]] = {
 #: without row_value's frame, as it makes them in a bank of any size: the values its lists
 #: hold): ``{R}`` the axis's resources, ``{r}`` its row; a span's plan (_read_plan) writes
 #: one per row, so a span after a cycle does not make every row's list of the value
-#: (tests/gtecat/gt/test_fast_span_rows.py)
+#: (tests/gtecat/gt/test_fast_span_rows.py).  The status word comes from the bank's list
+#: (AxisBank.value): its words stand across a cycle that moves no flag (AxisBank
+#: _sts_epoch), cheaper than each row's word made from its flags for two rows already
 BANK_ROWS: dict[str, str] = {
     "GT_GetAxisPrfVel": "{R}.prf_link.ratio * b.row_value('prf_v', {r})",
     "GT_GetAxisPrfAcc": "{R}.prf_link.ratio * b.row_value('prf_a', {r})",
     "GT_GetAxisEncVel": "{R}.enc_link.ratio * b._enc_rates_row({r})[0]",
     "GT_GetAxisEncAcc": "{R}.enc_link.ratio * b._enc_rates_row({r})[1]",
     "GT_GetAxisEncPos": "{R}.enc_link.axis(b.enc_pos.item({r}))",
-    "GT_GetPrfSts": "b.row_value('sts', {r}) & MOVING",
+    "GT_GetPrfSts": "b.value('sts', {r}) & MOVING",
     "GT_GetAxisError": "b.a_last.item({r}) - {R}.enc_link.axis(b.enc_pos.item({r}))",
 }
+
+#: a reader of BANK_LISTS whose span is written from each row alone, as BANK_ROWS' are:
+#: the encoder's speed (the bank's list of it is made with every row's acceleration too)
+SPAN_ROWS: dict[str, str] = {"GT_GetEncVel": "b._enc_rates_row({r})[0]"}
 
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
@@ -959,9 +967,10 @@ def _read_plan(
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
     of the span is a row of ``b``, that row's place in the span, whether the getter picks
-    rows of a list and zeros alone: the same list, the same values).  Each axis of the span is
-    a row of ``b``, an axis the bank does not run (its value ``get(resources)``, where
-    ``get`` is given) or, within ``1..top``, an axis no drive backs (it reads 0); any other
+    rows (of a list, or the bank's own) and zeros alone: the same list, the same values).
+    Each axis of the span is a row of ``b``, an axis the bank does not run (its value
+    ``get(resources)``, where ``get`` is given) or, within ``1..top``, an axis no drive
+    backs (it reads 0); any other
     (another bank's axis, one not on the bus): no getter.  ``row``: a row's value is that
     expression of BANK_ROWS (``{R}`` its resources, ``{r}`` its row) and the getter takes
     the bank itself, not a list."""
@@ -990,8 +999,9 @@ def _read_plan(
             env[f"r{i}"] = res
         else:
             return none
-    pure = row is None and len(env) == 1  # (rows and zeros alone: no getter of another axis)
-    if pure and at is not None and "0" not in items:
+    # (rows and zeros alone: no getter of another axis)
+    pure = not any(x.startswith("g(") for x in items)
+    if pure and row is None and at is not None and "0" not in items:
         pick = itemgetter(*(int(x[4:-1]) for x in items))
     else:  # (the rows, the getters and the zeros in one tuple)
         env["MOVING"] = _STATUS_BITS["MOVING"]
@@ -2972,8 +2982,10 @@ def fast_io_reader(
         "first": first,
         "array_at": array_at,
         "plan": plan,
-        # the inputs' readers keep the bank's axes (bank.BANK_READS: they read the image)
-        "RELEASES": name not in BANK_READS,
+        # the inputs' readers keep the bank's axes (bank.BANK_READS: they read the image),
+        # and so does GT_GetDo (its outputs are the controller's; the enabled axes' bits
+        # of the bank's rows from the rows: io_calls.do_reader)
+        "RELEASES": name not in BANK_READS and name != "GT_GetDo",
     }
     # (compiled with the function's type range and key offset as constants, its names as
     # globals: the fewest steps per call)

@@ -190,10 +190,19 @@ def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
         return lambda: io.clear
     env: dict[str, Any] = {}
     terms = []
+    resources = getattr(ctl, "resources", {})
     for n, ax in ctl.axes.items():
         if 1 <= n <= 32:
             env[f"a{n}"] = ax
-            terms.append(f"({_signed32(1 << (n - 1))} if a{n}.servo_on else 0)")
+            on = f"a{n}.servo_on"
+            res = resources.get(n)
+            if res is not None and res.ax is ax:
+                # an axis the bank runs: its row's (a row is frozen exactly where its axis
+                # was off when claimed, and the axis cannot be switched while claimed), not
+                # its guarded object's, which would give the axis back
+                env[f"r{n}"] = res
+                on = f"(not r{n}.bank.frz.item(r{n}.bank_row) if r{n}.bank else {on})"
+            terms.append(f"({_signed32(1 << (n - 1))} if {on} else 0)")
     body = " | ".join(terms) or "0"  # (axis 32's bit as the sign of GT_GetDo's long)
     exec(compile(f"def enabled():\n    return {body}\n", "<GT_GetDo enable>", "exec"), env)
     return env["enabled"]

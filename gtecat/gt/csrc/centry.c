@@ -138,11 +138,14 @@ struct slot {
     obj value;
 };
 
-/* a span's bytes kept for its key and epoch (tp: a strong reference while kept) */
+/* a span's bytes kept for its key and epoch (tp: a strong reference while kept); holds: 1
+ * where they stand across the cycles that keep every status flag (their value function gave
+ * them as such: status words alone), keeps: flag_keeping when they were last kept */
 struct aslot {
     long long epoch, n, count, clock;
     obj tp;
     obj value;
+    long long holds, keeps;
 };
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
@@ -178,6 +181,10 @@ struct entry {
     /* an array's element stride where it is not the value's bytes per element (a structure
      * reader: the structure's size, its value the fields' bytes); 0: the bytes' own */
     ptrdiff_t stride;
+    /* the tuple type and where a tuple keeps its first item: avalue's (bytes,) says its
+     * bytes are status words alone (NULL: avalue gives bytes only) */
+    obj tuple_type;
+    ptrdiff_t titems;
 };
 
 static struct api A;
@@ -281,6 +288,7 @@ static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
     A.incref(v);
     A.incref(tp);
     s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
+    s->holds = 0;
     if (old)
         A.decref(old);
     if (oldtp)
@@ -474,6 +482,12 @@ static int armed(const long long *q, long long pend)
     return 1;
 }
 
+/* The quick cycles booked in C that kept every status flag (no in-position band, no move
+ * ended: book_in_c's b[14]), each of which made the readers' epoch grow by one: where the
+ * epoch grew by as much as this count since a span of status words was kept, every change
+ * since was such a cycle and the words stand (array_value) */
+static long long flag_keeping;
+
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
  * objects made first (nothing counted where one cannot be), then the bank's lists anew, the
@@ -537,6 +551,8 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     cnt[8] += b[13];
     if (b[14] && cnt[9] == ep) /* (the status words made for the epoch stand: no flag moved) */
         cnt[9] = ep + 1;
+    if (b[14])
+        flag_keeping++;
     *(long long *)b[3] += 1; /* its drives' cycles */
     *(long long *)b[4] += 1; /* the master's */
     q[10] = cycles;
@@ -649,6 +665,44 @@ static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *
     return *mem != NULL;
 }
 
+/* GT_GetClock's value, which a reader writes into its pClock (the milliseconds since the
+ * controller's GT_Reset, 32 bits: gtecat.controller.core.Controller.clock_ms): per gate the
+ * address of its controller's time in ns (Clock.now_ns) and of the time GT_Reset counted
+ * from (Controller.reset_ns), both int64 (0: none; set by gtecat_centry_clock_ms while the
+ * gates are closed).  Read with no Python between the read and the write, as the values. */
+static const ptrdiff_t *clock_ms_at;
+
+int gtecat_centry_clock_ms(const ptrdiff_t *at)
+{
+    clock_ms_at = at;
+    return 0;
+}
+
+/* Gate g's clock value in *ms (Python's ((now - reset) // 1000000) & 0xFFFFFFFF); 0 where
+ * the gate has none (the Python path answers). */
+static int clock_ms(ptrdiff_t g, long long *ms)
+{
+    const long long *now, *origin;
+    long long d, q;
+    if (!clock_ms_at || g < 1 || g > 2 || !(now = (const long long *)clock_ms_at[2 * g - 2]) ||
+        !(origin = (const long long *)clock_ms_at[2 * g - 1]))
+        return 0;
+    d = *now - *origin;
+    q = d / 1000000;
+    if (d % 1000000 < 0) /* (floor division, as Python's) */
+        q -= 1;
+    *ms = q & 0xFFFFFFFFLL;
+    return 1;
+}
+
+/* The clock value for a reader's pClock, or 0 where it must go the Python way: no clock
+ * known for the entry's gate, or a value the pClock's type does not hold (the table path
+ * refuses it). */
+static int clock_for(const struct entry *e, int csize, int csign, long long *ms)
+{
+    return clock_ms(e->gate, ms) && fits(*ms, csize, csign);
+}
+
 /* The ctypes array a reader's value pointer p passes: p itself, or the array of
  * byref(array[, offset]) (C's &array[k]); NULL where p is neither. */
 static obj array_of(obj p)
@@ -703,9 +757,14 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
 {
     struct aslot *s = e->acache;
     long long ep = -1, ep0 = -1;
+    int holds = 0;
     obj v, tp = call[2];
-    if (s && (ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == an &&
-        s->count == ac && s->tp == tp && s->clock == clk) {
+    if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
+        s->clock == clk &&
+        (s->epoch == ep ||
+         (s->holds && ep > s->epoch && ep - s->epoch == flag_keeping - s->keeps))) {
+        s->epoch = ep; /* (status words across cycles that kept every flag: the same) */
+        s->keeps = flag_keeping;
         A.incref(s->value);
         return s->value;
     }
@@ -714,6 +773,14 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
     v = A.vectorcall(e->avalue, call, 4, NULL);
     if (!v)
         return NULL;
+    if (e->tuple_type && TYPE(v) == e->tuple_type &&
+        *(ptrdiff_t *)((char *)v + A.bsize) == 1) { /* (bytes,): status words alone */
+        obj b = *(obj *)((char *)v + e->titems);
+        A.incref(b);
+        A.decref(v);
+        v = b;
+        holds = 1;
+    }
     if (TYPE(v) != A.bytes_type) {
         A.decref(v);
         return PYTHON;
@@ -722,8 +789,11 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         A.decref(v);
         return AGAIN;
     }
-    if (s && ep >= 0)
+    if (s && ep >= 0) {
         keep_span(s, ep, v, tp, an, ac, clk);
+        s->holds = holds;
+        s->keeps = flag_keeping;
+    }
     return v;
 }
 
@@ -750,21 +820,18 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
         goto python;
     }
     call[2] = tp;
-    call[3] = cmem ? A.one : A.none;
-    v = array_value(e, call, an, ac, cmem != NULL, locked);
+    call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
+    v = array_value(e, call, an, ac, 0, locked);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
         goto python;
-    n = *(ptrdiff_t *)((char *)v + A.bsize) - (cmem ? 8 : 0);
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
     if (n <= 0)
         goto drop;
-    if (cmem) {
-        memcpy(&clk, (char *)v + A.bdata + n, 8);
-        if (!fits(clk, csize, csign))
-            goto drop; /* (a clock the type does not hold: the Python path) */
-        /* (again: Python may have run) */
-        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem)
+    if (cmem) { /* (again: Python may have run) */
+        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
+            !clock_for(e, csize, csign, &clk))
             goto drop;
     }
     /* (avalue checked the array's type and length: the bytes fit its start; an offset's
@@ -883,10 +950,10 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v, arr;
-    char *mem;
+    char *mem, *cmem = NULL;
     obj deref = NULL;
-    int k, size = 0, sign = 1, npy = 0;
-    long long key = -1, ep = -1, ep0 = -1;
+    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1;
+    long long key = -1, ep = -1, ep0 = -1, clk = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -911,8 +978,9 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         /* (the cached small ints 1 and 0 first: one compare for the common literals) */
         if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
+        /* pClock NULL (omitted, None, 0), or byref(x) or x of a clock type: written too */
         if (nargs >= 4 + at && args[at + 3] != A.none && args[at + 3] != A.zero &&
-            !int_is(args[at + 3], 0))
+            !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
             goto python;
         p = args[at + 1];
     }
@@ -959,6 +1027,9 @@ have:
     mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
+    if (cmem && (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
+                 !clock_for(e, csize, csign, &clk)))
+        goto drop; /* (again, and its value: written after the value, as the Python path) */
     if (e->kind == 1) {
         if (TYPE(v) != A.float_type || size != 8)
             goto drop;
@@ -979,6 +1050,8 @@ have:
             goto drop;
         put(mem, x, size);
     }
+    if (cmem)
+        put(cmem, clk, csize);
     A.decref(v);
     return done(e->after, e->gate);
 

@@ -323,3 +323,45 @@ def test_field_inputs_counted_when_their_length_changes():
         change()
         assert VirtualSlave.outside_changes > before
     assert type(s.field_inputs) is type(fi)
+
+
+def _move_polled(ctl, with_do: bool) -> list:
+    """Axis 1's Trap move polled on the auto clock, ``with_do``: a GT_GetDo among the polls
+    (its reader reaches the drive's outputs, which gives the bank's axes back)."""
+    s, d = c_long(), c_double()
+    for _ in range(400):
+        gt.GT_GetSts(1, byref(s))
+    assert ctl.bank.n_alive == ctl.bank.n  # (banked: the quick cycles run)
+    assert gt.GT_PrfTrap(1) == 0
+    p = gt.TTrapPrm()
+    p.acc = p.dec = 0.1
+    assert gt.GT_SetTrapPrm(1, byref(p)) == 0
+    assert gt.GT_SetVel(1, 5.0) == 0
+    assert gt.GT_SetPos(1, 100_000) == 0
+    assert gt.GT_Update(1) == 0
+    seen = []
+    for i in range(6000):
+        if i == 400:  # (a call of the same latency without it)
+            fn = gt.GT_GetDo if with_do else gt.GT_GetDi
+            assert fn(12 if with_do else 4, byref(c_long())) == 0  # (MC_GPO, MC_GPI)
+        gt.GT_GetSts(1, byref(s))
+        if i % 250 == 0:
+            assert gt.GT_GetPrfPos(1, byref(d)) == 0
+            seen.append((ctl.clock.cycles, s.value, d.value))
+    return seen
+
+
+def test_a_release_inside_a_reader_call_stops_the_quick_cycles(fig5_2):
+    """A reader's call that gives the bank's axes back (GT_GetDo) while an axis moves: the
+    quick cycles the C entries ran for the bank stop (the axis moved by its objects then,
+    the bank claims it again), so the move goes on as without that call - it stood still
+    while time passed before."""
+    ctl = fig5_2
+    with_do = _move_polled(ctl, True)
+    assert ctl.bank.n_alive == ctl.bank.n  # (claimed again)
+    gt.GT_Close()
+    bring_up()
+    assert gt.GT_AxisOn(1) == 0
+    gt.GTE_Wait(20)
+    assert _move_polled(gt.GTE_Controller(), False) == with_do
+    assert with_do[-1][2] > with_do[len(with_do) // 2][2] > 100  # (it moved all along)

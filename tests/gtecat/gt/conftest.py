@@ -33,3 +33,14 @@ def bring_up(eni: str = "manual_fig5_2.eni", **options) -> None:
     else:
         raise AssertionError("bus never ready: " + gt.GTE_GetLastError())
     assert gt.GT_StartEcatComm() == 0, gt.GTE_GetLastError()
+
+
+def trap_move(ax: int, pos: int, vel: float) -> None:
+    """Axis ``ax`` to ``pos`` in Trap at ``vel`` (acc 0.3, dec 0.2), started."""
+    assert gt.GT_PrfTrap(ax) == 0
+    p = gt.TTrapPrm()
+    p.acc, p.dec = 0.3, 0.2
+    assert gt.GT_SetTrapPrm(ax, byref(p)) == 0
+    assert gt.GT_SetVel(ax, vel) == 0
+    assert gt.GT_SetPos(ax, pos) == 0
+    assert gt.GT_Update(1 << (ax - 1)) == 0

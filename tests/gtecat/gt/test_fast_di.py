@@ -324,3 +324,24 @@ def test_inputs_polled_every_cycle_read_the_same_with_the_bank_holding_the_axes(
             assert min(held[5:130]) >= 1, held
     assert seen["on"] == seen["off"]
     assert len({tuple(r) for r in seen["on"]}) >= 4  # the inputs did change on the way
+
+
+def test_get_do_reads_the_banks_rows_and_keeps_them() -> None:
+    """GT_GetDo on the auto clock while the bank runs the axes (one on, one off, then the
+    other way round): MC_ENABLE's bits from the rows, MC_CLEAR and MC_GPO the controller's,
+    each as the table path reads them, and the bank keeps its axes (the table path gives
+    them back; its guarded axis objects would too)."""
+    bring_up(clock="auto")
+    ctl = gt.GTE_Controller()
+    s = ctypes.c_long()
+    assert gt.GT_AxisOn(1) == 0
+    assert gt.GT_SetDo(12, 0x5A) == 0
+    for on, off in ((1, 2), (2, 1)):
+        assert gt.GT_AxisOn(on) == 0 and gt.GT_AxisOff(off) == 0
+        for _ in range(800):  # (polls: the bank claims both axes)
+            gt.GT_GetSts(1, byref(s))
+        assert ctl.bank.n_alive == ctl.bank.n == 2
+        fast = [(gt.GT_GetDo(t, byref(s)), s.value) for t in (10, 11, 12)]
+        assert ctl.bank.n_alive == 2  # (kept)
+        assert fast == [(gt.GT_GetDo.slow(t, byref(s)), s.value) for t in (10, 11, 12)]
+        assert fast[0] == (0, 1 << (on - 1)) and fast[2] == (0, 0x5A)

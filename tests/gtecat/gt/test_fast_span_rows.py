@@ -1,7 +1,9 @@
 """A span of a reader whose value is a link or a bit of a banked axis's value (the readers
-of ``fast.BANK_ROWS``): after each cycle of the auto clock its C entry asks each row of the
-bank for its value alone, not every row's list; what it writes is what the table path
-writes, cycle by cycle, while both axes move, accelerate and stop."""
+of ``fast.BANK_ROWS``, and the encoder's speed: ``fast.SPAN_ROWS``): after each cycle of the
+auto clock its C entry asks each row of the bank for its value alone, not every row's list;
+what it writes is what the table path writes, cycle by cycle, while both axes move,
+accelerate and stop.  A span of status words stands across the cycles that keep every
+flag."""
 
 from __future__ import annotations
 
@@ -11,17 +13,7 @@ from ctypes import byref, c_double, c_long
 from gtecat import gt
 from gtecat.gt import fast
 
-from .conftest import bring_up
-
-
-def _trap(ax: int, pos: int, vel: float) -> None:
-    assert gt.GT_PrfTrap(ax) == 0
-    p = gt.TTrapPrm()
-    p.acc, p.dec = 0.3, 0.2
-    assert gt.GT_SetTrapPrm(ax, byref(p)) == 0
-    assert gt.GT_SetVel(ax, vel) == 0
-    assert gt.GT_SetPos(ax, pos) == 0
-    assert gt.GT_Update(1 << (ax - 1)) == 0
+from .conftest import bring_up, trap_move
 
 
 def _moves_read(table: bool) -> tuple[list, int]:
@@ -35,13 +27,13 @@ def _moves_read(table: bool) -> tuple[list, int]:
         s = c_long()
         for _ in range(400):  # (polls: the bank claims both axes)
             gt.GT_GetSts(1, byref(s))
-        _trap(1, 900, 12.0)
-        _trap(2, -600, 7.5)
+        trap_move(1, 900, 12.0)
+        trap_move(2, -600, 7.5)
         seen: list = []
         banked = 0
         for _ in range(320):
             banked += ctl.resources[1].bank is not None
-            for name in sorted(fast.BANK_ROWS):
+            for name in sorted(fast.BANK_ROWS | fast.SPAN_ROWS):
                 fn = getattr(gt, name)
                 fn = fn.slow if table else fn
                 tp = c_long if name == "GT_GetPrfSts" else c_double
@@ -67,3 +59,51 @@ def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
     assert rows[-1] == (0.0, 0.0)  # (both moves ended)
     assert len({c for c, *_ in rows[:-1]}) > 200  # (cycle by cycle)
     assert rows == table
+
+
+def _status_polls(general: bool) -> tuple[list, int, int]:
+    """Trap moves of both axes that start and end, every call a span of status words
+    (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) polled on the auto clock; ``general``:
+    a watch hook that does nothing, so every cycle goes the general way.  What was read,
+    the cycles run, and how often a span's value function was asked."""
+    import cProfile
+    import pstats
+
+    bring_up(clock="auto")
+    try:
+        ctl = gt.GTE_Controller()
+        if general:
+            ctl.watch.append(lambda: None)
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        words, prf = (c_long * 2)(), (c_long * 2)()
+        clk = ctypes.c_ulong()
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(4):
+            trap_move(1 + rnd % 2, 300 * (rnd + 1) * (-1) ** rnd, 20.0)
+            pr.enable()
+            for _ in range(2500):
+                assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
+                assert gt.GT_GetPrfSts(1, prf, 2) == 0
+                seen.append((clk.value, *words, *prf))
+            pr.disable()
+        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        asked = sum(
+            v[1] for (file, _, func), v in stats if func == "f" and file.endswith("fast.py")
+        )
+        return seen, ctl.clock.cycles - t0, asked
+    finally:
+        gt.GT_Close()
+
+
+def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
+    """A span of status words is asked again only where a flag may have moved (a move's
+    start or end, anything but a quick cycle booked in C): what every call reads is what
+    it reads with every cycle the general way, while the axes start, move and stop."""
+    quick, cycles, asked = _status_polls(False)
+    general, _, asked_general = _status_polls(True)
+    assert quick == general
+    assert len({tuple(x[1:3]) for x in quick}) >= 3  # (each axis moving, and neither)
+    assert asked_general > cycles  # (every cycle: both spans asked again)
+    assert asked < cycles / 4  # (the words held across the quick cycles)
