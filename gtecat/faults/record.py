@@ -43,9 +43,10 @@ import zlib
 from array import array
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import lru_cache, partial
 from itertools import accumulate, chain, compress, repeat
-from operator import contains, is_, itemgetter, not_
+from operator import call as _call_with
+from operator import contains, is_, is_not, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -1652,8 +1653,42 @@ def _replay(
     _check_files(steps, eni, machine, cwd, marks)
     gt.GT_Close()
     n = 0
+    # the compiled calls (the most of a recording) are made by the interpreter's own loops
+    # (map, filter) in runs between the steps made one by one, each run stopping at its first
+    # call whose run says something may differ (:func:`_compiled`), which is then looked at
+    # here as the loop below looks at it; the calls made and their order are the same
+    total = len(steps)
+    runs = list(map(getattr, map(itemgetter(0), steps), repeat("run"), repeat(None)))
+    values = list(map(itemgetter(1), steps))
+    alone = np.flatnonzero(np.fromiter(map(is_, runs, repeat(None)), bool, total)).tolist()
+    alone.append(total)
+    said = partial(is_not, None)
+    at = 0  # the next step
     try:
-        for p, vals in steps:
+        for stop in alone:
+            while at < stop:  # the compiled calls up to the next step made alone
+                left = iter(runs[at:stop])
+                r = next(filter(said, map(_call_with, left, values[at:stop])), None)
+                if r is None:
+                    n += stop - at
+                    at = stop
+                    break
+                done = stop - at - left.__length_hint__()
+                n += done
+                at += done
+                p, vals = steps[at - 1]
+                if type(r) is not tuple:
+                    raise ParameterError(
+                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+                        f"again: {type(r).__name__}: {r}"
+                    )
+                div = _compare(p, vals, n, p.args, {}, r[0])
+                if div is not None:
+                    return n, div
+            if at == total:
+                break
+            p, vals = steps[at]
+            at += 1
             if p is None:
                 div = _other(vals, n, faults)
                 if div is not None:
@@ -1665,38 +1700,37 @@ def _replay(
                 if what == "missing":
                     return n, Divergence(n, text, "function", "present", "missing")
                 raise ParameterError(f"damaged recording: call {n} {text}")
-            run = p.run
-            if run is not None:  # the common call, compiled: compared in full only if it may differ
-                r = run(vals)
-                if r is None:
-                    continue
-                if type(r) is not tuple:
-                    raise ParameterError(
-                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                        f"again: {type(r).__name__}: {r}"
-                    )
-                args, kw, rc = p.args, {}, r[0]
-            else:
-                args, kw, rc = _call(p, vals, n, eni, machine)
-            if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
-                return n, Divergence(n, p.name, "return code", p.rc, rc)
-            for obj, k, i, c in p.quick:
-                if obj.value != vals[k]:
-                    want = {"ref": {"c": c, "v": vals[k]}}
-                    got = encode(args[i])
-                    if got != want:
-                        return n, Divergence(n, p.name, f"argument {i + 1}", want, got)
-            for mv, k, i, kind in p.aquick:
-                if mv.tobytes() != vals[k]:
-                    return n, _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
-            for where, want in p.checks:
-                got = encode(args[where] if type(where) is int else kw.get(where))
-                if got != want:
-                    what = f"argument {where + 1}" if type(where) is int else where
-                    return n, Divergence(n, p.name, what, want, got)
+            args, kw, rc = _call(p, vals, n, eni, machine)
+            div = _compare(p, vals, n, args, kw, rc)
+            if div is not None:
+                return n, div
     finally:
         gt.GT_Close()
     return n, None
+
+
+def _compare(
+    p: _Call, vals: Any, n: int, args: Any, kw: dict[str, Any], rc: Any
+) -> Divergence | None:
+    """Call ``n`` (``p`` with ``vals``, made: ``args``, ``kw``, its return code ``rc``)
+    compared in full with the recording: the first difference, or None."""
+    if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
+        return Divergence(n, p.name, "return code", p.rc, rc)
+    for obj, k, i, c in p.quick:
+        if obj.value != vals[k]:
+            want = {"ref": {"c": c, "v": vals[k]}}
+            got = encode(args[i])
+            if got != want:
+                return Divergence(n, p.name, f"argument {i + 1}", want, got)
+    for mv, k, i, kind in p.aquick:
+        if mv.tobytes() != vals[k]:
+            return _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
+    for where, want in p.checks:
+        got = encode(args[where] if type(where) is int else kw.get(where))
+        if got != want:
+            what = f"argument {where + 1}" if type(where) is int else where
+            return Divergence(n, p.name, what, want, got)
+    return None
 
 
 #: the calls that bring a bus up from the files an open named
