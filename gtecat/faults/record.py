@@ -1555,7 +1555,25 @@ def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
         if one[0] is _Stop or one[0] is None:
             raise ValueError(f"a call is not made the same: {key[:60]}")
         units[i] = one
-    return np.fromiter(units, object, len(units))[order].tolist()
+    steps = _Steps(np.fromiter(units, object, len(units))[order].tolist())
+    # (what the replay's loop takes of each step, made per unit and spread by the order in
+    # numpy's loops: _Steps)
+    runs = list(map(getattr, map(itemgetter(0), units), repeat("run"), repeat(None)))
+    steps.runs = np.fromiter(runs, object, len(runs))[order].tolist()
+    steps.values = np.fromiter(map(itemgetter(1), units), object, len(units))[order].tolist()
+    alone = np.fromiter(map(is_, runs, repeat(None)), bool, len(runs))
+    steps.alone = np.flatnonzero(alone[order]).tolist()
+    return steps
+
+
+class _Steps(list):  # type: ignore[type-arg]
+    """A plan's steps (:func:`_from_plan`) with what the replay's loop takes of them made
+    already: each step's compiled ``run`` (or None), its values, and where the steps
+    without a compiled run are (:func:`_replay` makes them from the steps otherwise)."""
+
+    runs: list[Any]
+    values: list[Any]
+    alone: list[int]
 
 
 def _plan_calls(plan: Any) -> int:
@@ -1646,6 +1664,20 @@ def _replay(
     cwd: Any = None,
     marks: Any = None,
 ) -> tuple[int, Divergence | None]:
+    """Make every step's call again, in order, and compare it: (calls made, the first
+    divergence or None).
+
+    Every call is made, one at a time, as the application made it.  Answering runs of
+    pure reads without making them (one snapshot of the readers' values per cycle, taken
+    through the readers' own array forms with the call latency set to 0, the recorded
+    values compared with it, the cycles made by the calls whose latency makes them due)
+    was built and measured on dense 12-axis recordings (1 ms polls of every axis): exact,
+    but slower - a one-axis read through its C entry costs about what a Python test of
+    it against a snapshot costs, and a snapshot costs what the array reads cost, five of
+    them each cycle for twenty calls.  Even with every pure read skipped outright (no
+    value, no comparison) the replay was only 10-30 % faster: its time is the cycles the
+    calls' latency makes due, the calls that change things, and the start (the
+    performance notes, "Batching a replay's pure reads")."""
     from .. import faults, gt
 
     eni = str(Path(eni).resolve()) if eni else None
@@ -1658,17 +1690,22 @@ def _replay(
     # call whose run says something may differ (:func:`_compiled`), which is then looked at
     # here as the loop below looks at it; the calls made and their order are the same
     total = len(steps)
-    runs = list(map(getattr, map(itemgetter(0), steps), repeat("run"), repeat(None)))
-    values = list(map(itemgetter(1), steps))
-    alone = np.flatnonzero(np.fromiter(map(is_, runs, repeat(None)), bool, total)).tolist()
+    if type(steps) is _Steps:
+        runs, values, alone = steps.runs, steps.values, list(steps.alone)
+    else:
+        runs = list(map(getattr, map(itemgetter(0), steps), repeat("run"), repeat(None)))
+        values = list(map(itemgetter(1), steps))
+        alone = np.flatnonzero(np.fromiter(map(is_, runs, repeat(None)), bool, total)).tolist()
     alone.append(total)
     said = partial(is_not, None)
     at = 0  # the next step
     try:
         for stop in alone:
-            while at < stop:  # the compiled calls up to the next step made alone
+            if at < stop:  # the compiled calls up to the next step made alone
                 left = iter(runs[at:stop])
-                r = next(filter(said, map(_call_with, left, values[at:stop])), None)
+                made = map(_call_with, left, values[at:stop])
+            while at < stop:
+                r = next(filter(said, made), None)  # (on from where it stopped)
                 if r is None:
                     n += stop - at
                     at = stop

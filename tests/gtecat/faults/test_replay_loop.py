@@ -45,13 +45,15 @@ def test_a_call_that_may_differ_but_matches_in_full_lets_the_run_go_on() -> None
     steps = [
         _step(log, "a", None),
         _step(log, "b", (0,)),  # (may differ: the same code, nothing else to compare)
+        _step(log, "c", (0,)),
         (None, {}),  # (an entry that is neither a checkpoint nor a fault)
-        _step(log, "c", None),
-        _alone(log, "d"),
-        _step(log, "e", None),
+        _step(log, "d", None),
+        _alone(log, "e"),
+        _step(log, "f", (0,)),
+        _step(log, "g", None),
     ]
-    assert rec._replay(steps, None, None) == (5, None)
-    assert log == ["a", "b", "c", "d", "e"]
+    assert rec._replay(steps, None, None) == (7, None)
+    assert log == ["a", "b", "c", "d", "e", "f", "g"]
 
 
 def test_the_first_divergence_in_a_run_stops_it_there() -> None:
