@@ -43,10 +43,9 @@ import zlib
 from array import array
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from functools import lru_cache, partial
+from functools import lru_cache
 from itertools import accumulate, chain, compress, repeat
-from operator import call as _call_with
-from operator import contains, is_, is_not, itemgetter, not_
+from operator import contains, is_, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -1555,25 +1554,7 @@ def _from_plan(plan: Any, parse: Any, prepare: Any) -> list[tuple[Any, Any]]:
         if one[0] is _Stop or one[0] is None:
             raise ValueError(f"a call is not made the same: {key[:60]}")
         units[i] = one
-    steps = _Steps(np.fromiter(units, object, len(units))[order].tolist())
-    # (what the replay's loop takes of each step, made per unit and spread by the order in
-    # numpy's loops: _Steps)
-    runs = list(map(getattr, map(itemgetter(0), units), repeat("run"), repeat(None)))
-    steps.runs = np.fromiter(runs, object, len(runs))[order].tolist()
-    steps.values = np.fromiter(map(itemgetter(1), units), object, len(units))[order].tolist()
-    alone = np.fromiter(map(is_, runs, repeat(None)), bool, len(runs))
-    steps.alone = np.flatnonzero(alone[order]).tolist()
-    return steps
-
-
-class _Steps(list):  # type: ignore[type-arg]
-    """A plan's steps (:func:`_from_plan`) with what the replay's loop takes of them made
-    already: each step's compiled ``run`` (or None), its values, and where the steps
-    without a compiled run are (:func:`_replay` makes them from the steps otherwise)."""
-
-    runs: list[Any]
-    values: list[Any]
-    alone: list[int]
+    return np.fromiter(units, object, len(units))[order].tolist()
 
 
 def _plan_calls(plan: Any) -> int:
@@ -1677,7 +1658,10 @@ def _replay(
     them each cycle for twenty calls.  Even with every pure read skipped outright (no
     value, no comparison) the replay was only 10-30 % faster: its time is the cycles the
     calls' latency makes due, the calls that change things, and the start (the
-    performance notes, "Batching a replay's pure reads")."""
+    performance notes, "Batching a replay's pure reads").  Nor does making the compiled
+    calls from the interpreter's own loops (``map``/``filter`` over the runs between the
+    steps made alone) pay: a call from C into each compiled run costs what the loop's
+    bytecodes cost (the same CPU, 1.7 % more instructions)."""
     from .. import faults, gt
 
     eni = str(Path(eni).resolve()) if eni else None
@@ -1685,47 +1669,8 @@ def _replay(
     _check_files(steps, eni, machine, cwd, marks)
     gt.GT_Close()
     n = 0
-    # the compiled calls (the most of a recording) are made by the interpreter's own loops
-    # (map, filter) in runs between the steps made one by one, each run stopping at its first
-    # call whose run says something may differ (:func:`_compiled`), which is then looked at
-    # here as the loop below looks at it; the calls made and their order are the same
-    total = len(steps)
-    if type(steps) is _Steps:
-        runs, values, alone = steps.runs, steps.values, list(steps.alone)
-    else:
-        runs = list(map(getattr, map(itemgetter(0), steps), repeat("run"), repeat(None)))
-        values = list(map(itemgetter(1), steps))
-        alone = np.flatnonzero(np.fromiter(map(is_, runs, repeat(None)), bool, total)).tolist()
-    alone.append(total)
-    said = partial(is_not, None)
-    at = 0  # the next step
     try:
-        for stop in alone:
-            if at < stop:  # the compiled calls up to the next step made alone
-                left = iter(runs[at:stop])
-                made = map(_call_with, left, values[at:stop])
-            while at < stop:
-                r = next(filter(said, made), None)  # (on from where it stopped)
-                if r is None:
-                    n += stop - at
-                    at = stop
-                    break
-                done = stop - at - left.__length_hint__()
-                n += done
-                at += done
-                p, vals = steps[at - 1]
-                if type(r) is not tuple:
-                    raise ParameterError(
-                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                        f"again: {type(r).__name__}: {r}"
-                    )
-                div = _compare(p, vals, n, p.args, {}, r[0])
-                if div is not None:
-                    return n, div
-            if at == total:
-                break
-            p, vals = steps[at]
-            at += 1
+        for p, vals in steps:
             if p is None:
                 div = _other(vals, n, faults)
                 if div is not None:
@@ -1737,37 +1682,38 @@ def _replay(
                 if what == "missing":
                     return n, Divergence(n, text, "function", "present", "missing")
                 raise ParameterError(f"damaged recording: call {n} {text}")
-            args, kw, rc = _call(p, vals, n, eni, machine)
-            div = _compare(p, vals, n, args, kw, rc)
-            if div is not None:
-                return n, div
+            run = p.run
+            if run is not None:  # the common call, compiled: compared in full only if it may differ
+                r = run(vals)
+                if r is None:
+                    continue
+                if type(r) is not tuple:
+                    raise ParameterError(
+                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+                        f"again: {type(r).__name__}: {r}"
+                    )
+                args, kw, rc = p.args, {}, r[0]
+            else:
+                args, kw, rc = _call(p, vals, n, eni, machine)
+            if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
+                return n, Divergence(n, p.name, "return code", p.rc, rc)
+            for obj, k, i, c in p.quick:
+                if obj.value != vals[k]:
+                    want = {"ref": {"c": c, "v": vals[k]}}
+                    got = encode(args[i])
+                    if got != want:
+                        return n, Divergence(n, p.name, f"argument {i + 1}", want, got)
+            for mv, k, i, kind in p.aquick:
+                if mv.tobytes() != vals[k]:
+                    return n, _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
+            for where, want in p.checks:
+                got = encode(args[where] if type(where) is int else kw.get(where))
+                if got != want:
+                    what = f"argument {where + 1}" if type(where) is int else where
+                    return n, Divergence(n, p.name, what, want, got)
     finally:
         gt.GT_Close()
     return n, None
-
-
-def _compare(
-    p: _Call, vals: Any, n: int, args: Any, kw: dict[str, Any], rc: Any
-) -> Divergence | None:
-    """Call ``n`` (``p`` with ``vals``, made: ``args``, ``kw``, its return code ``rc``)
-    compared in full with the recording: the first difference, or None."""
-    if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
-        return Divergence(n, p.name, "return code", p.rc, rc)
-    for obj, k, i, c in p.quick:
-        if obj.value != vals[k]:
-            want = {"ref": {"c": c, "v": vals[k]}}
-            got = encode(args[i])
-            if got != want:
-                return Divergence(n, p.name, f"argument {i + 1}", want, got)
-    for mv, k, i, kind in p.aquick:
-        if mv.tobytes() != vals[k]:
-            return _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
-    for where, want in p.checks:
-        got = encode(args[where] if type(where) is int else kw.get(where))
-        if got != want:
-            what = f"argument {where + 1}" if type(where) is int else where
-            return Divergence(n, p.name, what, want, got)
-    return None
 
 
 #: the calls that bring a bus up from the files an open named

@@ -1,6 +1,6 @@
-"""The replay's loop: the compiled calls made in runs by the interpreter's own loops stop at
-the first call that may differ, which is compared in full as a call made alone is; the run
-goes on after a call that matched in full, and no call after a divergence is made."""
+"""The replay's loop: a compiled call that says it may differ is compared in full as a call
+made alone is, the replay goes on after one that matched in full, and no call after the
+first divergence is made."""
 
 from __future__ import annotations
 
