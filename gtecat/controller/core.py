@@ -86,6 +86,8 @@ if TYPE_CHECKING:
     from .card import Card
 
 _REALTIME = ClockMode.REALTIME  # (looked up once: every wait asks)
+#: the armed quick cycles' budget where no hook counts them (Clock.quick[11]: never spent)
+_NO_BUDGET = 1 << 62
 
 
 @dataclass
@@ -413,6 +415,8 @@ class Controller:
 
     # --- the cycle --------------------------------------------------------------------------
     def _cycle(self) -> None:
+        if self._owed is not None:  # (the hooks count the cycle themselves: settled first)
+            self.settle_hooks()
         for g in self.before_cycle:
             g()  # (a motion program's GT call may wait for cycles here, as the application's)
         self.cycling = True
@@ -512,6 +516,8 @@ class Controller:
         return done
 
     def _run_cycles(self, n: int) -> int:
+        if self._owed is not None:
+            self.settle_hooks()
         bank = self.bank
         if (
             bank is None
@@ -572,8 +578,8 @@ class Controller:
     def due_cycle(self, pending: int) -> bool:
         """The auto clock's one due cycle, run the quick way: ``pending`` (the host latency
         accumulated with this call's, between one and two cycle times) reached a cycle on a
-        clock alone, the bank's compiled kernel runs every axis, nothing is hooked and the
-        bus is steady.  Then the cycle is exactly the one :meth:`run_cycles` runs for one
+        clock alone, the bank's compiled kernel runs every axis, no hook but quiet ones and
+        the bus is steady.  Then the cycle is exactly the one :meth:`run_cycles` runs for one
         cycle, and its time is counted as :meth:`Clock.advance_ns` counts it - in one call,
         without the layers between them (at ~20 calls a cycle they were most of a polling
         call's cost).  False: nothing ran, nothing was counted; the caller takes the
@@ -584,18 +590,28 @@ class Controller:
         the steady verdict's marks (:attr:`_steady_seen`; :meth:`Master.steady` itself where
         they moved).  A cycle the kernel declines goes the clock's one-cycle way
         (:meth:`Clock.cycle`), as the general way goes after it.  A cycle that ran whole
-        arms the next one for the GT readers' C entries (:meth:`arm_quick`) - unless a
-        ``pre_cycle`` or ``post_cycle`` hook is there: one that says it is quiet in the next
-        cycle (:func:`_quiet_way`: the fault injector waiting for a time, smart homing with
-        no homing running) lets it run here as :meth:`_run_cycles` runs one cycle, counted
-        by its ``cycles_passed`` after it, but the entries (which count nothing) run none."""
-        k = self._quick_kernel()
+        arms the next one for the GT readers' C entries (:meth:`arm_quick`).  A
+        ``pre_cycle`` or ``post_cycle`` hook that says it is quiet in the next cycle
+        (:func:`_quiet_way`: the fault injector waiting for a time, smart homing with no
+        homing running) lets it run here as :meth:`_run_cycles` runs one cycle, and the
+        entries run as many after it as the hooks say they stay quiet (:meth:`quick_book`);
+        the hooks count them (``cycles_passed``) when Python next looks
+        (:meth:`settle_hooks`).  This way takes them as the entries do: while the cycle
+        armed after the last one stands (nothing else happened since) and the budget is
+        not spent, the hooks are not asked again."""
+        clock = self.clock
+        q = clock.quick
+        quiet = False
+        if self._owed is not None:
+            if q[11] > 0 and q[4] == EPOCH.n and q[5] == ARMS[0]:
+                quiet = True  # (the budget says so for this cycle)
+            else:
+                self.settle_hooks()
+        k = self._quick_kernel(quiet)
         if k is None:
             return False
-        clock = self.clock
         if self._steady_marks(self.master) is None:  # (_quick_kernel: a master)
             return False
-        q = clock.quick
         io = k._io
         io[_IN_T_NS] = clock.now_ns
         io[_IN_DT_NS] = q[2]
@@ -607,27 +623,24 @@ class Controller:
             if clock._cycle_fn is not self._own_cycle:  # (an endpoint wrapped it)
                 return False
             q[0] = pending - q[2]
+            if quiet:
+                q[11] -= 1  # (one of the budget: the entries' count)
+            elif self._unhooked != ARMS[0]:  # (hooked: they count this cycle as owed)
+                self._owed = (q[10], self._passes())
+                q[11] = 0  # (the budget is asked after it)
             rc = k.run_fn(*k._args)
         finally:
             self.in_batch = False
-        if self._unhooked == ARMS[0]:
-            self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
-            if q[4]:  # (with all else that it relies on, taken now)
-                self.arm_quick(k)
-            return True
-        ran = io[_OUT_DONE]  # (else quick_book runs it the clock's way, hooks and all)
-        self.quick_book(rc)
-        q[4] = 0  # (the entries' cycles would pass the hooks by)
-        if ran:
-            for _, passed in self._hook_ways():
-                if passed is not None:
-                    passed(1)
+        self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
+        if q[4]:  # (with all else that it relies on, taken now)
+            self.arm_quick(k)
         return True
 
-    def _quick_kernel(self) -> Any:
+    def _quick_kernel(self, quiet: bool = False) -> Any:
         """The bank's kernel where a quick cycle (:meth:`due_cycle`) may run: what
         :meth:`_run_cycles` and :meth:`AxisBank.run_cycles` ask, no hook but ``pre_cycle`` and
-        ``post_cycle`` ones quiet in the next cycle (:meth:`due_cycle`); else None."""
+        ``post_cycle`` ones quiet in the next cycle (:meth:`due_cycle`; ``quiet``: their
+        budget says so); else None."""
         bank = self.bank
         master = self.master
         if (
@@ -662,11 +675,52 @@ class Controller:
             or self.clock.quick[2] * 1e-9 != bank.csp._dt
         ):
             return None
-        if hooked:  # (asked last, as _run_cycles asks them after the bank's flags)
+        if hooked and not quiet:  # (asked last, as _run_cycles asks them after the bank's flags)
             for quiet, _ in self._hook_ways():
                 if quiet(1) < 1:
                     return None
         return k
+
+    def _passes(self) -> tuple[Callable[[int], None], ...]:
+        """The hooks' ``cycles_passed`` (:meth:`_hook_ways`), those that have one."""
+        return tuple(p for _, p in self._hook_ways() if p is not None)
+
+    def settle_hooks(self) -> None:
+        """Count for the ``pre_cycle`` and ``post_cycle`` hooks the quick cycles run since
+        they said they were quiet (:meth:`quick_book`: the GT readers' C entries run them
+        without Python): ``cycles_passed(n)``, as after a run of ``n`` cycles at once, to
+        the hooks that said so.  Asked before anything asks the hooks again or runs a cycle
+        (:meth:`_cycle`, :meth:`_run_cycles`, :meth:`due_cycle`), and by a hook's owner
+        before it reads what they count (the fault injector: adding or clearing a fault).
+        The armed cycle is disarmed with it: cycles from now count themselves."""
+        owed = self._owed
+        if owed is None:
+            return
+        self._owed = None
+        q = self.clock.quick
+        q[4] = 0
+        q[11] = 0
+        n = q[10] - owed[0]
+        if n:
+            for passed in owed[1]:
+                passed(n)
+
+    def _quiet_budget(self) -> int:
+        """After a quick cycle with quiet hooks (:meth:`quick_book`): how many of the next
+        cycles every hook says it stays quiet in, as :meth:`_run_cycles` asks before a run
+        of cycles at once (at most :attr:`BATCH_CYCLES`, as such a run), the cycles run so
+        far counted first; the entries may run that many, owed to the hooks from now."""
+        self.settle_hooks()
+        n = self.BATCH_CYCLES
+        ways = self._hook_ways()
+        for quiet, _ in ways:
+            q = quiet(n)
+            if q < n:  # (an answer above n stands for n)
+                if q <= 0:
+                    return 0
+                n = q
+        self._owed = (self.clock.quick[10], self._passes())
+        return n
 
     def quick_book(self, rc: int) -> None:
         """What follows the kernel's run of a quick cycle (:meth:`due_cycle`, or a GT
@@ -692,6 +746,14 @@ class Controller:
         clock.now_ns = now = clock.now_ns + q[2]
         EPOCH.n = epoch  # (clock.counted: readers_changed)
         if again:
+            if self._owed is None:
+                q[11] = _NO_BUDGET
+            elif q[11] <= 0 or io[_OUT_FIN]:
+                # hooked, the budget spent (or a move ended, where a run of cycles at once
+                # stops and asks again): as many as the hooks stay quiet in from here
+                q[11] = self._quiet_budget()
+                if q[11] <= 0:
+                    return
             io[_IN_T_NS] = now  # (the rest of the kernel's call as this one's)
             q[4] = epoch
             self._book_in_c(k)
@@ -803,6 +865,10 @@ class Controller:
     _unhooked = 0
     #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
     _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
+    #: quick cycles owed to the quiet hooks (:meth:`settle_hooks`): the clock's cycles when
+    #: they last counted, and their ``cycles_passed``; None: nothing owed (no hook, or the
+    #: cycles count themselves)
+    _owed: tuple[int, tuple[Callable[[int], None], ...]] | None = None
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
