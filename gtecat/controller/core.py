@@ -86,6 +86,7 @@ if TYPE_CHECKING:
     from .card import Card
 
 _REALTIME = ClockMode.REALTIME  # (looked up once: every wait asks)
+_AUTO = ClockMode.AUTO
 #: the armed quick cycles' budget where no hook counts them (Clock.quick[11]: never spent)
 _NO_BUDGET = 1 << 62
 
@@ -827,6 +828,7 @@ class Controller:
         q[7] = VirtualSlave.outside_changes
         self._book_in_c(k)
         q[4] = EPOCH.n
+        self._armed_left = q[11]
 
     def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:
         """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles
@@ -869,6 +871,8 @@ class Controller:
     #: they last counted, and their ``cycles_passed``; None: nothing owed (no hook, or the
     #: cycles count themselves)
     _owed: tuple[int, tuple[Callable[[int], None], ...]] | None = None
+    #: the armed cycles' budget as :meth:`arm_quick` left it (:meth:`_arm_after_wait`)
+    _armed_left = -1
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
@@ -940,16 +944,51 @@ class Controller:
         total = round(ms * 1_000_000)
         if clock.mode is _REALTIME or total <= self.WAIT_SLICE_NS:
             clock.advance_ns(total)
+        else:
+            end = clock.now_ns + clock._pending_ns + total
+            while True:
+                left = end - (clock.now_ns + clock._pending_ns)
+                if left <= 0:
+                    break
+                clock.advance_ns(min(left, self.WAIT_SLICE_NS))
+                hook = self.slice_hook
+                if hook is not None and left > self.WAIT_SLICE_NS:
+                    hook()
+        if clock.mode is _AUTO:
+            self._arm_after_wait()
+
+    def _arm_after_wait(self) -> None:
+        """After a wait whose cycles ran (their last in a run at once, or one by one): the
+        next due cycle armed for the GT readers' C entries, as a quick cycle arms the one
+        after it (:meth:`due_cycle`; what :meth:`_quick_kernel` asks, the bus steady, the
+        hooks' budget), so that an application polling between waits (a pass every few
+        ms) has its calls' cycles run there from the first.  Only where the entries ran an
+        armed cycle since the last arming: a loop of waits alone arms nothing."""
+        clock = self.clock
+        q = clock.quick
+        if q[4] == EPOCH.n or q[11] == self._armed_left or not q[3]:
+            return  # (armed already, nothing of the last arming spent, or a clock's group)
+        if self._owed is not None:
+            self.settle_hooks()
+        k = self._quick_kernel(True)  # (the hooks asked below, for the budget)
+        if (
+            k is None
+            or clock._cycle_fn is not self._own_cycle
+            or self._steady_marks(self.master) is None
+        ):
             return
-        end = clock.now_ns + clock._pending_ns + total
-        while True:
-            left = end - (clock.now_ns + clock._pending_ns)
-            if left <= 0:
+        io = k._io
+        io[_IN_T_NS] = clock.now_ns
+        io[_IN_DT_NS] = q[2]
+        io[_IN_MAXC] = 1
+        k._fp[_FP_DT] = q[2] * 1e-9
+        if self._unhooked == ARMS[0]:
+            q[11] = _NO_BUDGET
+        else:
+            q[11] = self._quiet_budget()
+            if q[11] <= 0:
                 return
-            clock.advance_ns(min(left, self.WAIT_SLICE_NS))
-            hook = self.slice_hook
-            if hook is not None and left > self.WAIT_SLICE_NS:
-                hook()
+        self.arm_quick(k)
 
 
 def _quiet_way(hook: Callable[[int, int], None]) -> Callable[[int], int]:
