@@ -613,11 +613,7 @@ class Controller:
             return False
         if self._steady_marks(self.master) is None:  # (_quick_kernel: a master)
             return False
-        io = k._io
-        io[_IN_T_NS] = clock.now_ns
-        io[_IN_DT_NS] = q[2]
-        io[_IN_MAXC] = 1
-        k._fp[_FP_DT] = q[2] * 1e-9
+        _one_cycle(k, clock)
         # (in_batch before the clock's cycle is compared with ours, as in run_cycles)
         self.in_batch = True
         try:
@@ -977,11 +973,7 @@ class Controller:
             or self._steady_marks(self.master) is None
         ):
             return
-        io = k._io
-        io[_IN_T_NS] = clock.now_ns
-        io[_IN_DT_NS] = q[2]
-        io[_IN_MAXC] = 1
-        k._fp[_FP_DT] = q[2] * 1e-9
+        _one_cycle(k, clock)  # (a run at once left its own start and count there)
         if self._unhooked == ARMS[0]:
             q[11] = _NO_BUDGET
         else:
@@ -989,6 +981,17 @@ class Controller:
             if q[11] <= 0:
                 return
         self.arm_quick(k)
+
+
+def _one_cycle(k: Any, clock: Clock) -> None:
+    """The kernel's call set for one quick cycle from the clock's time now (Kernel.run's
+    inputs: the start, the cycle time, one cycle)."""
+    q = clock.quick
+    io = k._io
+    io[_IN_T_NS] = clock.now_ns
+    io[_IN_DT_NS] = q[2]
+    io[_IN_MAXC] = 1
+    k._fp[_FP_DT] = q[2] * 1e-9
 
 
 def _quiet_way(hook: Callable[[int, int], None]) -> Callable[[int], int]:
