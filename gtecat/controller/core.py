@@ -628,7 +628,7 @@ class Controller:
             rc = k.run_fn(*k._args)
         finally:
             self.in_batch = False
-        self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
+        self.quick_book(rc, False)  # (arms the next one again where it may: io[T_NS] too)
         if q[4]:  # (with all else that it relies on, taken now)
             self.arm_quick(k)
         return True
@@ -719,14 +719,15 @@ class Controller:
         self._owed = (self.clock.quick[10], self._passes())
         return n
 
-    def quick_book(self, rc: int) -> None:
+    def quick_book(self, rc: int, book: bool = True) -> None:
         """What follows the kernel's run of a quick cycle (:meth:`due_cycle`, or a GT
         reader's C entry that ran the armed cycle: :meth:`arm_quick`), the clock's lock held
         and the pending latency already less the cycle: ``rc`` the kernel's code.  The
         bookkeeping of :meth:`AxisBank.run_cycles` and :meth:`_run_cycles` for one cycle,
         the clock's count, the readers' epoch; a declined cycle runs the numpy way.  Where
         the next cycle may be a quick one too, it is armed again for the new epoch (what
-        else was armed stands: the entry that ran this one found it so)."""
+        else was armed stands: the entry that ran this one found it so), its book in C made
+        anew unless ``book`` is False (:meth:`due_cycle`: :meth:`arm_quick` makes it)."""
         clock = self.clock
         bank = self.bank
         k = bank.kernel  # type: ignore[union-attr]
@@ -753,7 +754,8 @@ class Controller:
                     return
             io[_IN_T_NS] = now  # (the rest of the kernel's call as this one's)
             q[4] = epoch
-            self._book_in_c(k)
+            if book:
+                self._book_in_c(k)
 
     def _book_in_c(self, k: Any) -> None:
         """Whether the entry that runs the next armed cycle may count it itself, in C
@@ -784,7 +786,11 @@ class Controller:
         self._quick_keep = keep
         b[0] = 0  # (nothing to book with while it is being made)
         b[1] = k._args[1]
-        b[2], b[3], b[4] = (c.buffer_info()[0] for c in keep[1:4])
+        b[2], b[3], b[4] = (
+            keep[1].buffer_info()[0],
+            keep[2].buffer_info()[0],
+            keep[3].buffer_info()[0],
+        )
         b[5], b[6] = id(keep[4]), id(keep[5])
         b[7] = bank.n_alive  # type: ignore[union-attr]
         b[8], b[9], b[10] = _OUT_DONE, _OUT_FIN, _IN_T_NS
