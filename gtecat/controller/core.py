@@ -673,14 +673,15 @@ class Controller:
         ):
             return None
         if hooked and not quiet:  # (asked last, as _run_cycles asks them after the bank's flags)
-            for quiet, _ in self._hook_ways():
-                if quiet(1) < 1:
+            for ask, _ in self._hook_ways():
+                if ask(1) < 1:
                     return None
         return k
 
     def _passes(self) -> tuple[Callable[[int], None], ...]:
         """The hooks' ``cycles_passed`` (:meth:`_hook_ways`), those that have one."""
-        return tuple(p for _, p in self._hook_ways() if p is not None)
+        self._hook_ways()
+        return self._hooks_seen[3]  # type: ignore[index]
 
     def settle_hooks(self) -> None:
         """Count for the ``pre_cycle`` and ``post_cycle`` hooks the quick cycles run since
@@ -695,8 +696,7 @@ class Controller:
             return
         self._owed = None
         q = self.clock.quick
-        q[4] = 0
-        q[11] = 0
+        q[4] = 0  # (its budget left as it is: what the entries spent of it stays seen)
         n = q[10] - owed[0]
         if n:
             for passed in owed[1]:
@@ -848,7 +848,8 @@ class Controller:
             )
             for f in pre
         )
-        self._hooks_seen = (list(self.pre_cycle), list(self.post_cycle), ways)
+        passes = tuple(p for _, p in ways if p is not None)  # (for _passes)
+        self._hooks_seen = (list(self.pre_cycle), list(self.post_cycle), ways, passes)
         return ways
 
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
@@ -867,8 +868,9 @@ class Controller:
     #: found (:meth:`_quick_kernel`; a hook added, taken away or replaced, a master made
     #: anew: a new generation)
     _unhooked = 0
-    #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
-    _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
+    #: the pre_cycle and post_cycle hooks last looked at, their ways and their
+    #: ``cycles_passed`` (:meth:`_hook_ways`)
+    _hooks_seen: tuple[list[Any], list[Any], Any, Any] | None = None
     #: quick cycles owed to the quiet hooks (:meth:`settle_hooks`): the clock's cycles when
     #: they last counted, and their ``cycles_passed``; None: nothing owed (no hook, or the
     #: cycles count themselves)
