@@ -280,7 +280,8 @@ class EmulatedBus(FaultBus):
         return m is not None and m.last.ok and m.last.expected > 0
 
     def settle(self) -> None:
-        self.ctl.settle_hooks()
+        with self.ctl.clock.lock:  # (another thread's calls may be running quick cycles)
+            self.ctl.settle_hooks()
 
     def log(self, message: str) -> None:
         self.ctl.log(message)
