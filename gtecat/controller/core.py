@@ -631,6 +631,7 @@ class Controller:
         self.quick_book(rc, False)  # (arms the next one again where it may: io[T_NS] too)
         if q[4]:  # (with all else that it relies on, taken now)
             self.arm_quick(k)
+        self._armed_left = -1  # (calls make cycles due: a wait arms the next one)
         return True
 
     def _quick_kernel(self, quiet: bool = False) -> Any:
@@ -875,7 +876,9 @@ class Controller:
     #: they last counted, and their ``cycles_passed``; None: nothing owed (no hook, or the
     #: cycles count themselves)
     _owed: tuple[int, tuple[Callable[[int], None], ...]] | None = None
-    #: the armed cycles' budget as :meth:`arm_quick` left it (:meth:`_arm_after_wait`)
+    #: the armed cycles' budget as :meth:`arm_quick` left it, -1 after a due cycle ran
+    #: here: where the entries spent none of it since, a wait arms nothing
+    #: (:meth:`_arm_after_wait`)
     _armed_left = -1
 
     def _watch_links(self, offline: dict[int, str]) -> None:
@@ -966,8 +969,8 @@ class Controller:
         next due cycle armed for the GT readers' C entries, as a quick cycle arms the one
         after it (:meth:`due_cycle`; what :meth:`_quick_kernel` asks, the bus steady, the
         hooks' budget), so that an application polling between waits (a pass every few
-        ms) has its calls' cycles run there from the first.  Only where the entries ran an
-        armed cycle since the last arming: a loop of waits alone arms nothing."""
+        ms) has its calls' cycles run there from the first.  Only where a call made a cycle
+        due since the last arming: a loop of waits alone arms nothing after its first."""
         clock = self.clock
         q = clock.quick
         if q[4] == EPOCH.n or q[11] == self._armed_left or not q[3]:
