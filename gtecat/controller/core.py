@@ -538,12 +538,9 @@ class Controller:
         hooks = ()
         if self.pre_cycle or self.post_cycle:
             hooks = self._hook_ways()
-            for quiet, _ in hooks:
-                q = quiet(n)
-                if q < n:  # (an answer above n stands for n)
-                    if q <= 0:
-                        return 0
-                    n = q
+            n = self._hooks_quiet(n)
+            if n <= 0:
+                return 0
         master = self.master
         if master is None or master.on_cycle:  # (the master's hooks: not kept, asked here)
             return 0
@@ -709,15 +706,20 @@ class Controller:
         of cycles at once (at most :attr:`BATCH_CYCLES`, as such a run), the cycles run so
         far counted first; the entries may run that many, owed to the hooks from now."""
         self.settle_hooks()
-        n = self.BATCH_CYCLES
-        ways = self._hook_ways()
-        for quiet, _ in ways:
+        n = self._hooks_quiet(self.BATCH_CYCLES)
+        if n > 0:
+            self._owed = (self.clock.quick[10], self._passes())
+        return n
+
+    def _hooks_quiet(self, n: int) -> int:
+        """How many of the next ``n`` cycles every ``pre_cycle`` and ``post_cycle`` hook
+        says it stays quiet in (:func:`_quiet_way`; 0: some hook must run in the next)."""
+        for quiet, _ in self._hook_ways():
             q = quiet(n)
             if q < n:  # (an answer above n stands for n)
                 if q <= 0:
                     return 0
                 n = q
-        self._owed = (self.clock.quick[10], self._passes())
         return n
 
     def quick_book(self, rc: int, book: bool = True) -> None:
