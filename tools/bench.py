@@ -753,6 +753,95 @@ FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-poi
 CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
 
 
+#: the cycle hooks :func:`bench_hooked_poll` compares with none: a ``[[fault]]`` table whose
+#: trigger is far off (the fault injector waits for its time) and the same with smart homing
+#: there too (a homing started and ended: its hook stays, with nothing to run)
+HOOKED_CASES = ("none", "far_fault", "far_fault_smart_homing")
+_FAR_FAULT = """
+[[fault]]
+kind = "drive_fault"
+axis = 12
+code = "overcurrent"
+at_ms = 100000000
+"""
+
+
+def _hooked_session(case: str, machine: Path, moving: bool) -> None:
+    """The 12-axis example bus in the auto clock, every axis on (``moving``: in long Trap
+    moves), with the cycle hooks of ``case`` (:data:`HOOKED_CASES`)."""
+    from gtecat import gt
+
+    gt.GT_Close()
+    mach = str(machine) if case != "none" else None
+    ok = gt.GT_Open(eni=str(EXAMPLES / "twelve_axes.eni"), machine=mach, clock="auto", log="")
+    assert ok == 0 and gt.GT_InitEcatComm() == 0
+    ready = c_short()
+    while gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value != 1:
+        gt.GTE_Wait(1)
+    assert gt.GT_StartEcatComm() == 0 and gt.GT_Reset() == 0
+    for a in range(1, 13):
+        gt.GT_AxisOn(a)
+    if case.endswith("smart_homing"):  # (a smart homing on axis 1, stopped: its hook stays)
+        prm = gt.THomePrm()
+        gt.GT_GetHomePrm(1, byref(prm))
+        prm.mode = 20
+        gt.GTE_Wait(20)
+        assert gt.GT_GoHome(1, byref(prm)) == 0
+        gt.GTE_Wait(20)
+        assert gt.GT_Stop(1, 0) == 0
+    gt.GTE_Wait(50)
+    if moving:
+        prm = gt.TTrapPrm()
+        prm.acc, prm.dec = 0.5, 0.5
+        for a in range(1, 13):
+            gt.GT_PrfTrap(a)
+            gt.GT_SetTrapPrm(a, byref(prm))
+            gt.GT_SetVel(a, 20)
+            gt.GT_SetPos(a, (-1) ** a * 50_000_000)
+        gt.GT_Update(0xFFF)
+    gt.GTE_Wait(20)
+
+
+def bench_hooked_poll(
+    seconds: float = 1.0, repeat: int = 3, block: int = 2000, moving: bool = False
+) -> dict[str, object]:
+    """µs per ``GT_GetSts(1, byref(s))`` on the auto clock (a cycle runs inside every
+    20th call) with cycle hooks that stay quiet (:data:`HOOKED_CASES`) and with none: by
+    the readers' C entry, and by its Python fast path (``.python``: what a replay calls);
+    the cases in turn, ``repeat`` rounds of ``seconds`` each, best block of each; ratios
+    to no hook."""
+    from gtecat import gt
+
+    clock = time.perf_counter
+    best: dict[str, float] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        machine = Path(tmp) / "far_fault.toml"
+        machine.write_text(_FAR_FAULT)
+        for _ in range(repeat):
+            for case in HOOKED_CASES:
+                _hooked_session(case, machine, moving)
+                s = c_long()
+                p = byref(s)
+                python = getattr(gt.GT_GetSts, "python", gt.GT_GetSts)  # (no C entry: itself)
+                for way, fn in (("c_entry", gt.GT_GetSts), ("python", python)):
+                    key = f"{case}_{way}_us"
+                    rng = range(block)
+                    t_end = clock() + seconds / 2
+                    while clock() < t_end:
+                        t0 = clock()
+                        for _ in rng:
+                            fn(1, p)
+                        us = (clock() - t0) / block * 1e6
+                        best[key] = min(best.get(key, us), us)
+                gt.GT_Close()
+    out: dict[str, object] = {k: round(v, 3) for k, v in best.items()}
+    for case in HOOKED_CASES[1:]:
+        for way in ("c_entry", "python"):
+            out[f"{case}_{way}_ratio"] = round(best[f"{case}_{way}_us"] / best[f"none_{way}_us"], 3)
+    out["moving"] = moving
+    return out
+
+
 def bench_crd_poll(
     seconds: float = 1.0, pairs: int = 3, n: int = 12, push_every: int = 0
 ) -> dict[str, object]:
@@ -957,6 +1046,11 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
 def main() -> int:
     ap = argparse.ArgumentParser(description="Every benchmark figure, as one JSON object.")
     ap.add_argument("--quick", action="store_true", help="shorter windows (noisier figures)")
+    ap.add_argument(
+        "--hooked",
+        action="store_true",
+        help="only a polling loop on the auto clock with quiet cycle hooks against none",
+    )
     ap.add_argument("--targets", action="store_true", help="only the many-axes figures")
     ap.add_argument("--issue17", dest="targets", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--seconds", type=float, help="wall seconds per many-axes figure (1.5)")
@@ -976,6 +1070,13 @@ def main() -> int:
         return bringup_child(args.bringup_child)
     secs = 0.5 if args.quick else 2.0
     secs17 = args.seconds or (0.6 if args.quick else 1.5)
+    if args.hooked:
+        hooked = {
+            "idle": bench_hooked_poll(secs / 2, args.repeat),
+            "moving": bench_hooked_poll(secs / 2, args.repeat, moving=True),
+        }
+        print(json.dumps({"hooked_poll": hooked}, indent=2))
+        return 0
     only = [x for x in args.only.split(",") if x]
     if args.targets or only:
         print(json.dumps({"targets": issue17(secs17, args.repeat, only)}, indent=2))

@@ -86,6 +86,9 @@ if TYPE_CHECKING:
     from .card import Card
 
 _REALTIME = ClockMode.REALTIME  # (looked up once: every wait asks)
+_AUTO = ClockMode.AUTO
+#: the armed quick cycles' budget where no hook counts them (Clock.quick[11]: never spent)
+_NO_BUDGET = 1 << 62
 
 
 @dataclass
@@ -417,6 +420,8 @@ class Controller:
 
     # --- the cycle --------------------------------------------------------------------------
     def _cycle(self) -> None:
+        if self._owed is not None:  # (the hooks count the cycle themselves: settled first)
+            self.settle_hooks()
         for g in self.before_cycle:
             g()  # (a motion program's GT call may wait for cycles here, as the application's)
         self.cycling = True
@@ -516,6 +521,8 @@ class Controller:
         return done
 
     def _run_cycles(self, n: int) -> int:
+        if self._owed is not None:
+            self.settle_hooks()
         bank = self.bank
         if (
             bank is None
@@ -535,12 +542,9 @@ class Controller:
         hooks = ()
         if self.pre_cycle or self.post_cycle:
             hooks = self._hook_ways()
-            for quiet, _ in hooks:
-                q = quiet(n)
-                if q < n:  # (an answer above n stands for n)
-                    if q <= 0:
-                        return 0
-                    n = q
+            n = self._hooks_quiet(n)
+            if n <= 0:
+                return 0
         master = self.master
         if master is None or master.on_cycle:  # (the master's hooks: not kept, asked here)
             return 0
@@ -576,8 +580,8 @@ class Controller:
     def due_cycle(self, pending: int) -> bool:
         """The auto clock's one due cycle, run the quick way: ``pending`` (the host latency
         accumulated with this call's, between one and two cycle times) reached a cycle on a
-        clock alone, the bank's compiled kernel runs every axis, nothing is hooked and the
-        bus is steady.  Then the cycle is exactly the one :meth:`run_cycles` runs for one
+        clock alone, the bank's compiled kernel runs every axis, no hook but quiet ones and
+        the bus is steady.  Then the cycle is exactly the one :meth:`run_cycles` runs for one
         cycle, and its time is counted as :meth:`Clock.advance_ns` counts it - in one call,
         without the layers between them (at ~20 calls a cycle they were most of a polling
         call's cost).  False: nothing ran, nothing was counted; the caller takes the
@@ -588,50 +592,54 @@ class Controller:
         the steady verdict's marks (:attr:`_steady_seen`; :meth:`Master.steady` itself where
         they moved).  A cycle the kernel declines goes the clock's one-cycle way
         (:meth:`Clock.cycle`), as the general way goes after it.  A cycle that ran whole
-        arms the next one for the GT readers' C entries (:meth:`arm_quick`) - unless a
-        ``pre_cycle`` or ``post_cycle`` hook is there: one that says it is quiet in the next
-        cycle (:func:`_quiet_way`: the fault injector waiting for a time, smart homing with
-        no homing running) lets it run here as :meth:`_run_cycles` runs one cycle, counted
-        by its ``cycles_passed`` after it, but the entries (which count nothing) run none."""
-        k = self._quick_kernel()
+        arms the next one for the GT readers' C entries (:meth:`arm_quick`).  A
+        ``pre_cycle`` or ``post_cycle`` hook that says it is quiet in the next cycle
+        (:func:`_quiet_way`: the fault injector waiting for a time, smart homing with no
+        homing running) lets it run here as :meth:`_run_cycles` runs one cycle, and the
+        entries run as many after it as the hooks say they stay quiet (:meth:`quick_book`);
+        the hooks count them (``cycles_passed``) when Python next looks
+        (:meth:`settle_hooks`).  This way takes them as the entries do: while the cycle
+        armed after the last one stands (nothing else happened since) and the budget is
+        not spent, the hooks are not asked again."""
+        clock = self.clock
+        q = clock.quick
+        quiet = False
+        if self._owed is not None:
+            if q[11] > 0 and q[4] == EPOCH.n and q[5] == ARMS[0]:
+                quiet = True  # (the budget says so for this cycle)
+            else:
+                self.settle_hooks()
+        k = self._quick_kernel(quiet)
         if k is None:
             return False
-        clock = self.clock
         if self._steady_marks(self.master) is None:  # (_quick_kernel: a master)
             return False
-        q = clock.quick
-        io = k._io
-        io[_IN_T_NS] = clock.now_ns
-        io[_IN_DT_NS] = q[2]
-        io[_IN_MAXC] = 1
-        k._fp[_FP_DT] = q[2] * 1e-9
+        _one_cycle(k, clock)
         # (in_batch before the clock's cycle is compared with ours, as in run_cycles)
         self.in_batch = True
         try:
             if clock._cycle_fn is not self._own_cycle:  # (an endpoint wrapped it)
                 return False
             q[0] = pending - q[2]
+            if quiet:
+                q[11] -= 1  # (one of the budget: the entries' count)
+            elif self._unhooked != ARMS[0]:  # (hooked: they count this cycle as owed)
+                self._owed = (q[10], self._passes())
+                q[11] = 0  # (the budget is asked after it)
             rc = k.run_fn(*k._args)
         finally:
             self.in_batch = False
-        if self._unhooked == ARMS[0]:
-            self.quick_book(rc)  # (arms the next one again where it may: io[T_NS] included)
-            if q[4]:  # (with all else that it relies on, taken now)
-                self.arm_quick(k)
-            return True
-        ran = io[_OUT_DONE]  # (else quick_book runs it the clock's way, hooks and all)
-        self.quick_book(rc)
-        q[4] = 0  # (the entries' cycles would pass the hooks by)
-        if ran:
-            for _, passed in self._hook_ways():
-                if passed is not None:
-                    passed(1)
+        self.quick_book(rc, False)  # (arms the next one again where it may: io[T_NS] too)
+        if q[4]:  # (with all else that it relies on, taken now)
+            self.arm_quick(k)
+        self._armed_left = -1  # (calls make cycles due: a wait arms the next one)
         return True
 
-    def _quick_kernel(self) -> Any:
+    def _quick_kernel(self, quiet: bool = False) -> Any:
         """The bank's kernel where a quick cycle (:meth:`due_cycle`) may run: what
         :meth:`_run_cycles` and :meth:`AxisBank.run_cycles` ask, no hook but ``pre_cycle`` and
-        ``post_cycle`` ones quiet in the next cycle (:meth:`due_cycle`); else None."""
+        ``post_cycle`` ones quiet in the next cycle (:meth:`due_cycle`; ``quiet``: their
+        budget says so); else None."""
         bank = self.bank
         master = self.master
         if (
@@ -666,20 +674,67 @@ class Controller:
             or self.clock.quick[2] * 1e-9 != bank.csp._dt
         ):
             return None
-        if hooked:  # (asked last, as _run_cycles asks them after the bank's flags)
-            for quiet, _ in self._hook_ways():
-                if quiet(1) < 1:
+        if hooked and not quiet:  # (asked last, as _run_cycles asks them after the bank's flags)
+            for ask, _ in self._hook_ways():
+                if ask(1) < 1:
                     return None
         return k
 
-    def quick_book(self, rc: int) -> None:
+    def _passes(self) -> tuple[Callable[[int], None], ...]:
+        """The hooks' ``cycles_passed`` (:meth:`_hook_ways`), those that have one."""
+        self._hook_ways()
+        return self._hooks_seen[3]  # type: ignore[index]
+
+    def settle_hooks(self) -> None:
+        """Count for the ``pre_cycle`` and ``post_cycle`` hooks the quick cycles run since
+        they said they were quiet (:meth:`quick_book`: the GT readers' C entries run them
+        without Python): ``cycles_passed(n)``, as after a run of ``n`` cycles at once, to
+        the hooks that said so.  Asked before anything asks the hooks again or runs a cycle
+        (:meth:`_cycle`, :meth:`_run_cycles`, :meth:`due_cycle`), and by a hook's owner
+        before it reads what they count (the fault injector: adding or clearing a fault).
+        The armed cycle is disarmed with it: cycles from now count themselves."""
+        owed = self._owed
+        if owed is None:
+            return
+        self._owed = None
+        q = self.clock.quick
+        q[4] = 0  # (its budget left as it is: what the entries spent of it stays seen)
+        n = q[10] - owed[0]
+        if n:
+            for passed in owed[1]:
+                passed(n)
+
+    def _quiet_budget(self) -> int:
+        """After a quick cycle with quiet hooks (:meth:`quick_book`): how many of the next
+        cycles every hook says it stays quiet in, as :meth:`_run_cycles` asks before a run
+        of cycles at once (at most :attr:`BATCH_CYCLES`, as such a run), the cycles run so
+        far counted first; the entries may run that many, owed to the hooks from now."""
+        self.settle_hooks()
+        n = self._hooks_quiet(self.BATCH_CYCLES)
+        if n > 0:
+            self._owed = (self.clock.quick[10], self._passes())
+        return n
+
+    def _hooks_quiet(self, n: int) -> int:
+        """How many of the next ``n`` cycles every ``pre_cycle`` and ``post_cycle`` hook
+        says it stays quiet in (:func:`_quiet_way`; 0: some hook must run in the next)."""
+        for quiet, _ in self._hook_ways():
+            q = quiet(n)
+            if q < n:  # (an answer above n stands for n)
+                if q <= 0:
+                    return 0
+                n = q
+        return n
+
+    def quick_book(self, rc: int, book: bool = True) -> None:
         """What follows the kernel's run of a quick cycle (:meth:`due_cycle`, or a GT
         reader's C entry that ran the armed cycle: :meth:`arm_quick`), the clock's lock held
         and the pending latency already less the cycle: ``rc`` the kernel's code.  The
         bookkeeping of :meth:`AxisBank.run_cycles` and :meth:`_run_cycles` for one cycle,
         the clock's count, the readers' epoch; a declined cycle runs the numpy way.  Where
         the next cycle may be a quick one too, it is armed again for the new epoch (what
-        else was armed stands: the entry that ran this one found it so)."""
+        else was armed stands: the entry that ran this one found it so), its book in C made
+        anew unless ``book`` is False (:meth:`due_cycle`: :meth:`arm_quick` makes it)."""
         clock = self.clock
         bank = self.bank
         k = bank.kernel  # type: ignore[union-attr]
@@ -696,9 +751,18 @@ class Controller:
         clock.now_ns = now = clock.now_ns + q[2]
         EPOCH.n = epoch  # (clock.counted: readers_changed)
         if again:
+            if self._owed is None:
+                q[11] = _NO_BUDGET
+            elif q[11] <= 0 or io[_OUT_FIN]:
+                # hooked, the budget spent (or a move ended, where a run of cycles at once
+                # stops and asks again): as many as the hooks stay quiet in from here
+                q[11] = self._quiet_budget()
+                if q[11] <= 0:
+                    return
             io[_IN_T_NS] = now  # (the rest of the kernel's call as this one's)
             q[4] = epoch
-            self._book_in_c(k)
+            if book:
+                self._book_in_c(k)
 
     def _book_in_c(self, k: Any) -> None:
         """Whether the entry that runs the next armed cycle may count it itself, in C
@@ -729,7 +793,11 @@ class Controller:
         self._quick_keep = keep
         b[0] = 0  # (nothing to book with while it is being made)
         b[1] = k._args[1]
-        b[2], b[3], b[4] = (c.buffer_info()[0] for c in keep[1:4])
+        b[2], b[3], b[4] = (
+            keep[1].buffer_info()[0],
+            keep[2].buffer_info()[0],
+            keep[3].buffer_info()[0],
+        )
         b[5], b[6] = id(keep[4]), id(keep[5])
         b[7] = bank.n_alive  # type: ignore[union-attr]
         b[8], b[9], b[10] = _OUT_DONE, _OUT_FIN, _IN_T_NS
@@ -769,6 +837,7 @@ class Controller:
         q[7] = VirtualSlave.outside_changes
         self._book_in_c(k)
         q[4] = EPOCH.n
+        self._armed_left = q[11]
 
     def _hook_ways(self) -> tuple[tuple[Callable[[int], int], Any], ...]:
         """Per ``pre_cycle`` hook, then per ``post_cycle`` hook: how many of the next cycles
@@ -786,7 +855,8 @@ class Controller:
             )
             for f in pre
         )
-        self._hooks_seen = (list(self.pre_cycle), list(self.post_cycle), ways)
+        passes = tuple(p for _, p in ways if p is not None)  # (for _passes)
+        self._hooks_seen = (list(self.pre_cycle), list(self.post_cycle), ways, passes)
         return ways
 
     #: the most cycles one call of :meth:`run_cycles` runs (a long wait stays interruptible)
@@ -805,8 +875,17 @@ class Controller:
     #: found (:meth:`_quick_kernel`; a hook added, taken away or replaced, a master made
     #: anew: a new generation)
     _unhooked = 0
-    #: the pre_cycle and post_cycle hooks last looked at and their ways (:meth:`_hook_ways`)
-    _hooks_seen: tuple[list[Any], list[Any], Any] | None = None
+    #: the pre_cycle and post_cycle hooks last looked at, their ways and their
+    #: ``cycles_passed`` (:meth:`_hook_ways`)
+    _hooks_seen: tuple[list[Any], list[Any], Any, Any] | None = None
+    #: quick cycles owed to the quiet hooks (:meth:`settle_hooks`): the clock's cycles when
+    #: they last counted, and their ``cycles_passed``; None: nothing owed (no hook, or the
+    #: cycles count themselves)
+    _owed: tuple[int, tuple[Callable[[int], None], ...]] | None = None
+    #: the armed cycles' budget as :meth:`arm_quick` left it, -1 after a due cycle ran
+    #: here: where the entries spent none of it since, a wait arms nothing
+    #: (:meth:`_arm_after_wait`)
+    _armed_left = -1
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
@@ -878,16 +957,58 @@ class Controller:
         total = round(ms * 1_000_000)
         if clock.mode is _REALTIME or total <= self.WAIT_SLICE_NS:
             clock.advance_ns(total)
+        else:
+            end = clock.now_ns + clock._pending_ns + total
+            while True:
+                left = end - (clock.now_ns + clock._pending_ns)
+                if left <= 0:
+                    break
+                clock.advance_ns(min(left, self.WAIT_SLICE_NS))
+                hook = self.slice_hook
+                if hook is not None and left > self.WAIT_SLICE_NS:
+                    hook()
+        if clock.mode is _AUTO:
+            self._arm_after_wait()
+
+    def _arm_after_wait(self) -> None:
+        """After a wait whose cycles ran (their last in a run at once, or one by one): the
+        next due cycle armed for the GT readers' C entries, as a quick cycle arms the one
+        after it (:meth:`due_cycle`; what :meth:`_quick_kernel` asks, the bus steady, the
+        hooks' budget), so that an application polling between waits (a pass every few
+        ms) has its calls' cycles run there from the first.  Only where a call made a cycle
+        due since the last arming: a loop of waits alone arms nothing after its first."""
+        clock = self.clock
+        q = clock.quick
+        if q[4] == EPOCH.n or q[11] == self._armed_left or not q[3]:
+            return  # (armed already, nothing of the last arming spent, or a clock's group)
+        if self._owed is not None:
+            self.settle_hooks()
+        k = self._quick_kernel(True)  # (the hooks asked below, for the budget)
+        if (
+            k is None
+            or clock._cycle_fn is not self._own_cycle
+            or self._steady_marks(self.master) is None
+        ):
             return
-        end = clock.now_ns + clock._pending_ns + total
-        while True:
-            left = end - (clock.now_ns + clock._pending_ns)
-            if left <= 0:
+        _one_cycle(k, clock)  # (a run at once left its own start and count there)
+        if self._unhooked == ARMS[0]:
+            q[11] = _NO_BUDGET
+        else:
+            q[11] = self._quiet_budget()
+            if q[11] <= 0:
                 return
-            clock.advance_ns(min(left, self.WAIT_SLICE_NS))
-            hook = self.slice_hook
-            if hook is not None and left > self.WAIT_SLICE_NS:
-                hook()
+        self.arm_quick(k)
+
+
+def _one_cycle(k: Any, clock: Clock) -> None:
+    """The kernel's call set for one quick cycle from the clock's time now (Kernel.run's
+    inputs: the start, the cycle time, one cycle)."""
+    q = clock.quick
+    io = k._io
+    io[_IN_T_NS] = clock.now_ns
+    io[_IN_DT_NS] = q[2]
+    io[_IN_MAXC] = 1
+    k._fp[_FP_DT] = q[2] * 1e-9
 
 
 def _quiet_way(hook: Callable[[int, int], None]) -> Callable[[int], int]:

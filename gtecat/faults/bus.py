@@ -68,6 +68,11 @@ class FaultBus:
     def healthy(self) -> bool:
         return True
 
+    def settle(self) -> None:
+        """Before the injector reads what it counts outside a cycle (a fault added or
+        cleared): the cycles the bus ran without asking it counted first
+        (``Controller.settle_hooks``; nothing on a bus that asks it every cycle)."""
+
     def log(self, message: str) -> None:
         pass
 
@@ -273,6 +278,10 @@ class EmulatedBus(FaultBus):
     def healthy(self) -> bool:
         m = self.ctl.master
         return m is not None and m.last.ok and m.last.expected > 0
+
+    def settle(self) -> None:
+        with self.ctl.clock.lock:  # (another thread's calls may be running quick cycles)
+            self.ctl.settle_hooks()
 
     def log(self, message: str) -> None:
         self.ctl.log(message)

@@ -159,6 +159,7 @@ class Injector:
         after: int | None = None,
         name: str = "",
     ) -> Entry:
+        self.bus.settle()  # (what it counted so far; the quick cycles armed: disarmed)
         self._check_target(fault)
         if trigger is not None:
             self._check_trigger(trigger)
@@ -195,6 +196,7 @@ class Injector:
         fault on a slave or axis the new bus does not have (another ENI) is dropped, with a
         line in the master log.  Called before the bring-up (:attr:`holding`): a fault that
         was active starts as one armed at once would (:meth:`bus_ready`)."""
+        old.bus.settle()
         self._next = max(self._next, old._next)
         kept_ids = set()
         for e in old.entries:
@@ -237,6 +239,7 @@ class Injector:
 
     def clear(self, ident: int | None = None) -> int:
         """End one fault (by id) or all; the number ended."""
+        self.bus.settle()
         n = 0
         for e in list(self.entries):
             if ident is not None and e.id != ident:
@@ -454,6 +457,7 @@ class Injector:
         """The bus came up after these faults were armed (and the axis bank with it): the
         faults held while it was brought up start, as they would have been armed now, and
         the bank learns again which axes they watch and whether it may run at all."""
+        self.bus.settle()
         if self.holding:
             self.holding = False
             for e in list(self.entries):

@@ -272,7 +272,7 @@ _CALLS: list[Any] = [None, None]  # (kept alive while named)
 CLOCK_BOOKS = (ctypes.c_ssize_t * 2)()
 _BOOKS: list[Any] = [None, None]  # (kept alive while named)
 #: how many numbers a clock's quick array holds (gtecat.master.clock.Clock.quick)
-QUICK_LEN = 11
+QUICK_LEN = 12
 #: how many numbers a controller's book in C holds (Controller.quick_cbook)
 BOOK_LEN = 15
 #: the names the book in C sets in the bank's and the controller's own dicts (kept alive)

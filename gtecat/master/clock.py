@@ -134,8 +134,10 @@ class Clock:
         #: the readers' epoch it holds for (0: none), the generation of :data:`ARMS`, the
         #: slaves' AL and outside changes, and the address of the armed kernel's call;
         #: [9] the controller time (:attr:`now_ns`) and [10] the cycles run (:attr:`cycles`),
-        #: which the entry that runs the armed cycle counts itself
-        self.quick = array("q", (0, int(call_latency_ns), 0, 1, 0, 0, 0, 0, 0, 0, 0))
+        #: which the entry that runs the armed cycle counts itself; [11] how many more cycles
+        #: the entries may run armed so (the cycle hooks' quiet budget: each such cycle takes
+        #: one; Controller.quick_book)
+        self.quick = array("q", (0, int(call_latency_ns), 0, 1, 0, 0, 0, 0, 0, 0, 0, 0))
         self.cycle_ns = cycle_ns  # (checked: whole nanoseconds, positive)
         self.mode = ClockMode(mode)
         self._cycle_fn = run_cycle

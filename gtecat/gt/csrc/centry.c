@@ -456,12 +456,14 @@ typedef int (*kernel_run)(void *, void *, void *);
 
 /* Whether the armed quick cycle (Controller.arm_quick) may run now: one cycle due on a clock
  * alone (pending latency pend), armed for this epoch, this generation, these slaves' marks
- * and this cycle time. */
+ * and this cycle time, with cycles left in its budget (q[11]: the cycle hooks' quiet ones). */
 static int armed(const long long *q, long long pend)
 {
     long long al, out, i;
     const long long *call, *w;
     if (!q[3] || !q[4] || q[0] < 0 || q[1] < 0 || q[2] <= 0 || pend < q[2] || pend - q[2] >= q[2])
+        return 0;
+    if (q[11] <= 0)
         return 0;
     if (q[5] != A.arms[0] || q[4] != epoch())
         return 0;
@@ -587,7 +589,8 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
         return 0;
     }
     call = (const long long *)q[8];
-    q[4] = 0; /* (the book arms the next one) */
+    q[4] = 0;  /* (the book arms the next one) */
+    q[11] -= 1; /* (one cycle of the budget it was armed with) */
     q[0] += q[1] - q[2];
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
     if (!rc && book_in_c(gate, q)) {

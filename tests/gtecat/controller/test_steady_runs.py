@@ -179,10 +179,11 @@ def test_a_cycle_wrapped_between_polls_runs_through_the_wrapper(fig5_2):
     assert len(seen) == ctl.clock.cycles - t0 > 0
 
 
-def _moves_and_polls(ctl, watch: bool, band: bool = False) -> list:
+def _moves_and_polls(ctl, watch: bool, band: bool = False, waits: bool = False) -> list:
     """Trap moves of both axes polled through the C entries; what the readers saw
     (``band``: axis 1 with an in-position band, its status word's bit 11 set in the
-    cycles, manual 11.7)."""
+    cycles, manual 11.7; ``waits``: a wait of 1 ms every 37 polls, after which the next
+    due cycle is armed for the entries too)."""
     if watch:  # a hook that does nothing: every cycle then goes the general way
         ctl.watch.append(lambda: None)
     gt.GT_AxisOn(2)
@@ -205,6 +206,8 @@ def _moves_and_polls(ctl, watch: bool, band: bool = False) -> list:
                 gt.GT_GetPrfPos(ax, byref(d))
                 gt.GT_GetEncPos(3 - ax, byref(c_double()))
                 seen.append((s.value, d.value))
+            if waits and i % 37 == 0:
+                gt.GTE_Wait(1)
             if i % 97 == 0:  # (spans: read from the bank's lists of the cycle)
                 span, words = (c_double * 2)(), (c_long * 2)()
                 assert gt.GT_GetPrfPos(1, span, 2) == 0
@@ -217,8 +220,8 @@ def _moves_and_polls(ctl, watch: bool, band: bool = False) -> list:
     return seen
 
 
-@pytest.mark.parametrize("band", [False, True])
-def test_quick_cycles_give_what_the_general_way_gives(band):
+@pytest.mark.parametrize(("band", "waits"), [(False, False), (True, False), (True, True)])
+def test_quick_cycles_give_what_the_general_way_gives(band, waits):
     """The same calls with the quick cycles and with every cycle the general way (a watch
     hook that does nothing): the same values read, the same clock, the same cycles, the
     bank's and its drives' counts, the same process image.  The quick ones counted by the
@@ -230,7 +233,7 @@ def test_quick_cycles_give_what_the_general_way_gives(band):
         assert gt.GT_AxisOn(1) == 0
         ctl = gt.GTE_Controller()
         many = ctl.bank.many_cycles
-        runs.append(_moves_and_polls(ctl, watch, band))
+        runs.append(_moves_and_polls(ctl, watch, band, waits))
         if not watch:
             assert ctl.bank.many_cycles - many > 1000  # (the quick ones ran)
             assert ctl.quick_cbook[0] == 1  # (booked in C)

@@ -292,3 +292,36 @@ def test_in_the_auto_clock_the_entries_run_the_calls_latency_as_the_python_path(
     bad = [f"{a} / {b}" for a, b in zip(entry, python, strict=True) if a != b]
     assert not bad, "\n".join(bad[:5])
     assert entry[-1][-1] > entry[0][-1]  # (time passed: cycles ran among the calls)
+
+
+def test_the_auto_clock_gives_the_entries_its_numbers(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A clock whose quick numbers are not the length the entries read (a slot added on one
+    side only) would leave the gate without a clock: every call's latency and cycle in
+    Python, silently.  The auto clock's gate has its clock, and its calls' cycles run in C
+    (none reaches the controller's Python way after the first, which arms the next)."""
+    if centry.REASON:
+        pytest.skip(f"no C entry here: {centry.REASON}")
+    from gtecat.controller.core import Controller
+
+    _open("auto")
+    try:
+        ctl = gt.GTE_Controller()
+        assert len(ctl.clock.quick) == centry.QUICK_LEN
+        assert centry.CLOCK_QUICK[0] == ctl.clock.quick.buffer_info()[0]
+        gt.GTE_Wait(20)
+        due = Controller.due_cycle
+        seen: list[int] = []
+
+        def counted(self: Controller, pending: int) -> bool:
+            seen.append(pending)
+            return due(self, pending)
+
+        monkeypatch.setattr(Controller, "due_cycle", counted)
+        s = ctypes.c_long()
+        cycles = ctl.clock.cycles
+        for _ in range(400):
+            gt.GT_GetSts(1, byref(s))
+        assert ctl.clock.cycles - cycles == 20
+        assert len(seen) <= 1
+    finally:
+        gt.GT_Close()
