@@ -1042,11 +1042,11 @@ def _prepare(
         kind = _kind(x)
         if kind is not None and kind[0] == "arr":
             # (into the array: its values are the array's, the pointer is made once)
-            packed = _pack(kind, x["v"] if len(kind) == 3 else x["ref"]["v"])
+            packed = _pack(kind, _held(x if len(kind) == 3 else x["ref"]))
             out = outs.get(str(i))
             out_packed = None
             if _kind(out) == kind:
-                out_packed = _pack(kind, out["v"] if len(kind) == 3 else out["ref"]["v"])
+                out_packed = _pack(kind, _held(out if len(kind) == 3 else out["ref"]))
             if packed is not None and (out is None or out_packed is not None):
                 # an array of numbers: one array per function and argument, its memory set
                 # to the recorded values before each call and compared with them after it
@@ -1173,17 +1173,29 @@ def _compiled(p: _Call) -> Any:
     return env["run"]
 
 
+def _held(x: dict[str, Any]) -> Any:
+    """A recorded array's values: its numbers, or a byte array's hex text."""
+    return x["v"] if "v" in x else x["hex"]
+
+
 @lru_cache(maxsize=256)
 def _struct(kind: tuple[Any, ...]) -> struct.Struct:
     """How an array of numbers of ``kind`` (``("arr", c, n)``) lies in memory."""
     return struct.Struct(f"{kind[2]}{_ARRAY_CODE[kind[1]]}")
 
 
-def _pack(kind: tuple[Any, ...], values: list[Any]) -> bytes | None:
+def _pack(kind: tuple[Any, ...], values: list[Any] | str) -> bytes | None:
     """The bytes of an array of ``kind`` holding ``values`` exactly, None when the type
     cannot hold them (a number out of its range, a fraction in an integer array, a double
-    that a float would round: such an array is rebuilt and compared the general way)."""
+    that a float would round: such an array is rebuilt and compared the general way).  A
+    byte array's values are its recorded hex text (:func:`encode`)."""
     st = _struct(kind)
+    if type(values) is str:
+        try:
+            b = bytes.fromhex(values)
+        except ValueError:
+            return None
+        return b if len(b) == st.size and len(values) == 2 * st.size else None
     try:
         b = st.pack(*values)
     except struct.error:
@@ -1280,7 +1292,23 @@ def _kind(x: Any) -> tuple[Any, ...] | None:
         and all(type(e) is int or type(e) is float for e in v)
     ):
         return ("arr", c, n)
+    h = x.get("hex")
+    if (
+        type(h) is str
+        and c in _HEX_ARRAYS
+        and type(n) is int
+        and 0 < n == len(h) // 2
+        and len(h) % 2 == 0
+        and _HEX.fullmatch(h)
+    ):
+        return ("arr", c, n)  # (a byte array: its hex text is its value)
     return None
+
+
+#: the byte arrays :func:`encode` keeps as hex text (GT_GetEcatRawData's buffer), which a
+#: form's pooled array takes as it takes an array of numbers
+_HEX_ARRAYS = frozenset({"c_ubyte", "c_byte"})
+_HEX = re.compile(r"[0-9a-f]*")
 
 
 def _form(e: dict[str, Any]) -> int:
@@ -1407,7 +1435,8 @@ def _steps(
                     return form, tuple(vals)
                 vals = list(vals)
                 for k, kind in form.packs:  # an array's numbers: its bytes
-                    b = vals[k] = _pack(kind, vals[k]) if type(vals[k]) is list else None
+                    v = vals[k]
+                    b = vals[k] = _pack(kind, v) if type(v) is list or type(v) is str else None
                     if b is None:  # (a length or number the array cannot hold)
                         break
                 else:
@@ -1572,14 +1601,22 @@ _KEY = re.compile(r'^(?:\{"t":[^,\n]*(?=,)|(?=\{"t":[^,\n]*$)[^\n]*?(?=[^\n]$))?
 
 _NUMBER_START = frozenset("-0123456789")
 _NUMBER_TYPES = frozenset({int, float})
-_VALUE_TYPES = frozenset({int, float, list})
+_VALUE_TYPES = frozenset({int, float, list, str})
 
 
-#: a value of a call's line that a form takes out: a JSON number, or an array of numbers
-#: (``"v":[1,2.5]``); the group is the value's text, read by one JSON parse
-_VALUE = re.compile(r'"v":(\[[-0-9.eE+,]*\]|-?[0-9][-0-9.eE+]*)')
+#: a value of a call's line that a form takes out: a JSON number, an array of numbers
+#: (``"v":[1,2.5]``) or a byte array's hex text (``"hex":"0f00"``); the group is the
+#: value's text, read by one JSON parse
+_VALUE = re.compile(
+    r'(?:"v":|"hex":(?="))(\[[-0-9.eE+,]*\]|-?[0-9][-0-9.eE+]*|(?<="hex":)"[0-9a-f]*")'
+)
 #: the mark of a value in its form's key, by the value's first character
-_MARK = {"[": "\x02\x01", "-": "\x01", **dict.fromkeys("0123456789", "\x01")}
+_MARK = {
+    "[": "\x02\x01",
+    '"': "\x03\x01",
+    "-": "\x01",
+    **dict.fromkeys("0123456789", "\x01"),
+}
 
 
 def _numbers(calls: list[str]) -> list[tuple[str, tuple[Any, ...]] | None] | None:
@@ -1601,7 +1638,7 @@ def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] |
     if not calls:
         return [], []
     text = "\n".join(calls)
-    if "\x01" in text or "\x02" in text:  # (never raw in JSON text: a damaged line)
+    if "\x01" in text or "\x02" in text or "\x03" in text:  # (never raw in JSON text)
         return None
     parts = _VALUE.split(text)  # the text between the values, each value's own text
     lits = parts[1::2]
@@ -1619,8 +1656,9 @@ def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] |
         arrays = [v for v in values if type(v) is list]
         if not set(map(type, chain.from_iterable(arrays))) <= _NUMBER_TYPES:
             return None
-    # the keys: each value replaced by a mark of its kind (an array's \x02\x01, a number's
-    # \x01: the values of a line are its \x01s; control characters never stand raw in JSON)
+    # the keys: each value replaced by a mark of its kind (an array's \x02\x01, a byte
+    # array's hex \x03\x01, a number's \x01: the values of a line are its \x01s; control
+    # characters never stand raw in JSON)
     marks = list(map(_MARK.__getitem__, map(itemgetter(0), lits)))
     marks.append("")
     keys: list[Any] = "".join(chain.from_iterable(zip(parts[0::2], marks, strict=True))).split("\n")
