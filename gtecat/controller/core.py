@@ -1060,23 +1060,31 @@ class Controller:
                 if seen is not None:
                     # Kernel.run for the run's cycles (bank.run_cycles), then its book and
                     # _after_kernel's, the counts in their arrays (AxisBank._COUNTS' order)
+                    # (as quick_cycle_done: a count that stays - a zero added, a flag
+                    # already so - is not written)
+                    n = pending // dt_ns
                     io = k._io
                     io[_IN_T_NS] = q[9]
                     io[_IN_DT_NS] = dt_ns
-                    io[_IN_MAXC] = min(pending // dt_ns, self.BATCH_CYCLES)
+                    io[_IN_MAXC] = n if n < self.BATCH_CYCLES else self.BATCH_CYCLES
                     k._fp[_FP_DT] = csp._dt
                     rc = k.run_fn(*k._args)
                     done = io[_OUT_DONE]
-                    bank._declined = bool(rc) and done > 0
+                    if rc:
+                        bank._declined = done > 0
                     if done:
                         c = bank.counts
-                        c[0] -= done - bank._settled
-                        bank._settled = False
+                        if bank._settled:  # (its count of the first cycle: in settle)
+                            c[0] -= done - 1
+                            bank._settled = False
+                        else:
+                            c[0] -= done
                         c[1] -= done
                         bank._lists = {}
                         c[9] = 0
                         csp.counts[0] += done
-                        csp._din_safe = 0
+                        if csp._din_safe:
+                            csp._din_safe = 0
                         if csp.any_fe:
                             csp.fe_running = True
                         if io[_OUT_FIN]:
@@ -1086,9 +1094,12 @@ class Controller:
                         c[3] += done
                         c[4] += done
                         c[5] += done
-                        c[6] += bank.n_hm * done
-                        c[7] += bank.n_rest * done
-                        c[8] += bank.n_frz * done
+                        if bank.n_hm:
+                            c[6] += bank.n_hm * done
+                        if bank.n_rest:
+                            c[7] += bank.n_rest * done
+                        if bank.n_frz:
+                            c[8] += bank.n_frz * done
                         master.counts[0] += done
                         self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
             finally:
@@ -1103,7 +1114,8 @@ class Controller:
                 clock.cycle()
             if q[0] >= dt_ns:
                 clock.advance_ns(0)  # the rest of the wait the general way, from here
-        if clock.mode is _AUTO:
+        # (_arm_after_wait's first look, inline: a loop of waits alone arms nothing)
+        if clock.mode is _AUTO and q[4] != EPOCH.n and q[11] != self._armed_left:
             self._arm_after_wait()
         return True
 
