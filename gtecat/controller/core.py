@@ -1008,6 +1008,7 @@ class Controller:
             or clock._cycle_fn is not self._own_cycle
             or clock.counted is not readers_changed
             or clock.run_many is not self._own_many
+            or self._own_many.__func__ is not _RUN_CYCLES  # (its layers as written here)
         ):
             return False
         if self._unhooked != ARMS[0]:  # (no hook since: every change of them is a new one)
@@ -1025,6 +1026,8 @@ class Controller:
         dt_ns = q[2]
         if (
             k is None
+            or type(bank).run_cycles is not _BANK_RUN_CYCLES  # (a run wrapped: it runs it)
+            or "run_cycles" in bank.__dict__
             or bank.dirty  # (and below: nothing for AxisBank.settle to do)
             or bank._stale
             or bank._declined
@@ -1147,6 +1150,12 @@ class Controller:
             if q[11] <= 0:
                 return
         self.arm_quick(k)
+
+
+#: the runs of cycles as :meth:`Controller.wait_quick` does them inline (a run wrapped or
+#: replaced - a test's, an endpoint's - is called the general way)
+_RUN_CYCLES = Controller.run_cycles
+_BANK_RUN_CYCLES = AxisBank.run_cycles
 
 
 def _one_cycle(k: Any, clock: Clock) -> None:
