@@ -3,6 +3,7 @@
     python3 tools/bench.py                  # all
     python3 tools/bench.py --quick          # fewer repetitions
     python3 tools/bench.py --targets        # only the many-axes figures and their targets
+    python3 tools/bench.py --wait           # only GTE_Wait's cost (fast against general)
 
 Figures: ENI read of a 64-slave file; emulated bus cycles per wall second on the
 manual's figure 5-2 topology (bus only: drives replaced by plain PDO slaves;
