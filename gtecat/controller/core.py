@@ -660,22 +660,8 @@ class Controller:
             hooked = bool(self.pre_cycle or self.post_cycle)
             if not hooked:
                 self._unhooked = ARMS[0]
-        k = bank.kernel
-        if (
-            k is None
-            or bank.dirty
-            or bank._stale
-            or bank._declined
-            or bank.evt_rows
-            or bank._post_next
-            or bank._tp_apply
-            or not bank.n
-            or bank.n_alive != bank.n
-            or (bank.n_moving and not bank._c_fill)
-            or not k.bound
-            or master.image.buffer is not k.buffer
-            or self.clock.quick[2] * 1e-9 != bank.csp._dt
-        ):
+        k = _kernel_runs(bank, master, self.clock.quick[2])
+        if k is None:
             return None
         if hooked and not quiet:  # (asked last, as _run_cycles asks them after the bank's flags)
             for ask, _ in self._hook_ways():
@@ -1022,28 +1008,16 @@ class Controller:
             ):
                 return False
             self._unhooked = ARMS[0]  # (as _quick_kernel finds it)
-        k = bank.kernel
         dt_ns = q[2]
         if (
-            k is None
-            or type(bank).run_cycles is not _BANK_RUN_CYCLES  # (a run wrapped: it runs it)
+            type(bank).run_cycles is not _BANK_RUN_CYCLES  # (a run wrapped: it runs it)
             or "run_cycles" in bank.__dict__
-            or bank.dirty  # (and below: nothing for AxisBank.settle to do)
-            or bank._stale
-            or bank._declined
-            or bank.evt_rows
-            or bank._post_next
-            or bank._tp_apply
-            or not bank.n
-            or bank.n_alive != bank.n
-            or (bank.n_moving and not bank._c_fill)
-            or not k.bound
-            or master.image.buffer is not k.buffer
         ):
             return False
-        csp = bank.csp  # (there with the bank's rows)
-        if dt_ns * 1e-9 != csp._dt:
+        k = _kernel_runs(bank, master, dt_ns)  # (and nothing for AxisBank.settle to do)
+        if k is None:
             return False
+        csp = bank.csp
         # the steady verdict's marks as _steady_marks reads them: the last run's, or the
         # general way asks Master.steady
         seen = (EPOCH.n, q[10], VirtualSlave.al_changes, VirtualSlave.outside_changes)
@@ -1150,6 +1124,32 @@ class Controller:
             if q[11] <= 0:
                 return
         self.arm_quick(k)
+
+
+def _kernel_runs(bank: AxisBank, master: Master, dt_ns: int) -> Any:
+    """The bank's kernel where its next cycles may run in one call of it with nothing else
+    to do first - what :meth:`Controller._run_cycles` and :meth:`AxisBank.run_cycles` ask of
+    the bank (nothing to settle, claim or release, no run stopped before a declined cycle,
+    no table for Python to fill, the kernel bound to the image, this cycle time) - else
+    None (:meth:`Controller._quick_kernel`, :meth:`Controller.wait_quick`)."""
+    k = bank.kernel
+    if (
+        k is None
+        or bank.dirty
+        or bank._stale
+        or bank._declined
+        or bank.evt_rows
+        or bank._post_next
+        or bank._tp_apply
+        or not bank.n
+        or bank.n_alive != bank.n
+        or (bank.n_moving and not bank._c_fill)
+        or not k.bound
+        or master.image.buffer is not k.buffer
+        or dt_ns * 1e-9 != bank.csp._dt
+    ):
+        return None
+    return k
 
 
 #: the runs of cycles as :meth:`Controller.wait_quick` does them inline (a run wrapped or
