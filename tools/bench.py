@@ -3,6 +3,7 @@
     python3 tools/bench.py                  # all
     python3 tools/bench.py --quick          # fewer repetitions
     python3 tools/bench.py --targets        # only the many-axes figures and their targets
+    python3 tools/bench.py --wait           # only GTE_Wait's cost (fast against general)
 
 Figures: ENI read of a 64-slave file; emulated bus cycles per wall second on the
 manual's figure 5-2 topology (bus only: drives replaced by plain PDO slaves;
@@ -910,6 +911,97 @@ def bench_crd_poll(
     }
 
 
+WAIT_BUSES = ("fig5_2", "12_axes")
+
+
+def _wait_session(bus: str, eni_dir: Path) -> None:
+    """A bus in the auto clock (GT_Open's default) brought up by GT_* calls, its axes on
+    and moving in the bank: ``fig5_2`` (the manual's figure 5-2 bus, axis 1 jogging, axis 2
+    on), ``12_axes`` (a generated 12-axis bus, odd axes in long Trap moves, even ones
+    jogging)."""
+    from gtecat import gt
+
+    gt.GT_Close()
+    if bus == "fig5_2":
+        eni, n = FIG5_2, 2
+    else:
+        from tools.gen_axes_eni import write_axes_eni
+
+        eni, n = write_axes_eni(12, eni_dir / "axes12.eni"), 12
+    assert gt.GT_Open(eni=str(eni), log="") == 0 and gt.GT_InitEcatComm() == 0
+    ready = c_short()
+    while gt.GT_IsEcatReady(byref(ready)) != 0 or ready.value != 1:
+        gt.GTE_Wait(1)
+    assert gt.GT_StartEcatComm() == 0
+    for a in range(1, n + 1):
+        assert gt.GT_AxisOn(a) == 0
+    gt.GTE_Wait(20)
+    jog = gt.TJogPrm()
+    jog.acc, jog.dec = 0.1, 0.1
+    trap = gt.TTrapPrm()
+    trap.acc, trap.dec = 0.5, 0.5
+    for a in (1,) if bus == "fig5_2" else range(1, n + 1):
+        if a % 2 or bus == "fig5_2":
+            assert gt.GT_PrfJog(a) == 0 and gt.GT_SetJogPrm(a, byref(jog)) == 0
+            assert gt.GT_SetVel(a, 10.0) == 0
+        else:
+            assert gt.GT_PrfTrap(a) == 0 and gt.GT_SetTrapPrm(a, byref(trap)) == 0
+            assert gt.GT_SetVel(a, 20.0) == 0 and gt.GT_SetPos(a, 50_000_000) == 0
+    assert gt.GT_Update(1 if bus == "fig5_2" else (1 << n) - 1) == 0
+    gt.GTE_Wait(200)  # (past the ramps: the moves' steady part)
+
+
+def bench_gte_wait(seconds: float = 1.0, repeat: int = 3, block: int = 500) -> dict[str, object]:
+    """µs per ``GTE_Wait(1)`` (and per ``GTE_Wait(10)``, whose difference is the cost of the
+    nine cycles more) on the auto clock, the axes moving in the bank (:func:`_wait_session`):
+    a wait's fixed cost, which a field application paced by waits pays every controller
+    millisecond.  ``fast``: the public function; ``general``: the table path with the quick
+    way off (``Controller.QUICK_WAIT``: what every wait took before it), in alternate blocks
+    of the same session, the best block of each (its CPU time); ``ratio``: general / fast;
+    ``cycles``: the
+    controller cycles one wait ran (1 ms cycle time, the calls' latency included)."""
+    from gtecat import gt
+    from gtecat.controller.core import Controller
+
+    clock = time.perf_counter
+    cpu = time.process_time  # (the blocks' own CPU: on a shared machine the wall's is noisier)
+    best: dict[str, float] = {}
+    cycles: dict[str, float] = {}
+    ways = (("fast", gt.GTE_Wait, True), ("general", gt.GTE_Wait.slow, False))
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeat):
+            for bus in WAIT_BUSES:
+                _wait_session(bus, Path(tmp))
+                ctl = gt.GTE_Controller()
+                for ms in (1, 10):
+                    t_end = clock() + seconds / 4
+                    while clock() < t_end:
+                        for way, wait, quick in ways:
+                            key = f"gte_wait_{ms}ms_{bus}_{way}"
+                            Controller.QUICK_WAIT = quick
+                            try:
+                                c0 = ctl.clock.cycles
+                                t0 = cpu()
+                                for _ in range(block):
+                                    wait(ms)
+                                us = (cpu() - t0) / block * 1e6
+                            finally:
+                                Controller.QUICK_WAIT = True
+                            best[f"{key}_us"] = min(best.get(f"{key}_us", us), us)
+                            cycles[f"{key}_cycles"] = (ctl.clock.cycles - c0) / block
+                gt.GT_Close()
+    out: dict[str, object] = {k: round(v, 3) for k, v in best.items()}
+    out.update(cycles)
+    for bus in WAIT_BUSES:
+        for ms in (1, 10):
+            key = f"gte_wait_{ms}ms_{bus}"
+            out[f"{key}_ratio"] = round(best[f"{key}_general_us"] / best[f"{key}_fast_us"], 2)
+        out[f"per_cycle_{bus}_fast_us"] = round(
+            (best[f"gte_wait_10ms_{bus}_fast_us"] - best[f"gte_wait_1ms_{bus}_fast_us"]) / 9, 3
+        )
+    return out
+
+
 def compiled_parts() -> dict[str, object]:
     """Build (or load) the bank's compiled parts before any figure is measured, and say how
     long that took: on a fresh machine or checkout the first controller would otherwise
@@ -1058,6 +1150,7 @@ def main() -> int:
         help="only a polling loop on the auto clock with quiet cycle hooks against none",
     )
     ap.add_argument("--targets", action="store_true", help="only the many-axes figures")
+    ap.add_argument("--wait", action="store_true", help="only GTE_Wait's cost (auto clock)")
     ap.add_argument("--issue17", dest="targets", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--seconds", type=float, help="wall seconds per many-axes figure (1.5)")
     ap.add_argument("--repeat", type=int, default=3, help="windows per real-time factor")
@@ -1083,6 +1176,9 @@ def main() -> int:
         }
         print(json.dumps({"hooked_poll": hooked}, indent=2))
         return 0
+    if args.wait:
+        print(json.dumps({"gte_wait": bench_gte_wait(secs / 2, args.repeat)}, indent=2))
+        return 0
     only = [x for x in args.only.split(",") if x]
     if args.targets or only:
         print(json.dumps({"targets": issue17(secs17, args.repeat, only)}, indent=2))
@@ -1102,6 +1198,7 @@ def main() -> int:
         out["cycles_per_s_12_axes_bus_only"] = round(bench_cycles(twelve, plain=True, seconds=secs))
         out["cycles_per_s_12_axes_drives"] = round(bench_cycles(twelve, plain=False, seconds=secs))
     out["gt_get_ecat_raw_data_us"] = round(bench_raw_call(2000 if args.quick else 20000), 2)
+    out["gte_wait"] = bench_gte_wait(secs / 2, args.repeat)
     ctl12 = bench_controller_12_axes(secs)
     if ctl12 is not None:
         out["cycles_per_s_12_axes_controller_moving"] = round(ctl12)

@@ -48,6 +48,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
+import numpy as np
+
 from gtecat.drives.machine import MachineDescription, load_machine
 from gtecat.drives.machine import read_note as machine_read_note
 from gtecat.drives.slave import VirtualSlave
@@ -189,7 +191,8 @@ class Controller:
             mode=mode,
             call_latency_ns=round(self.options.call_latency_us * 1000),
         )
-        self.clock.run_many = self.run_cycles
+        #: (the clock's way of many cycles: this one's, unless something replaced it)
+        self._own_many = self.clock.run_many = self.run_cycles
         #: the armed quick cycle's kernel call (:meth:`arm_quick`): the function's address,
         #: its three arguments, the cycle time it was armed for, the address of the field
         #: inputs' watch (Backend.fields_watch: 0, none) - kept in _quick_fields
@@ -657,22 +660,8 @@ class Controller:
             hooked = bool(self.pre_cycle or self.post_cycle)
             if not hooked:
                 self._unhooked = ARMS[0]
-        k = bank.kernel
-        if (
-            k is None
-            or bank.dirty
-            or bank._stale
-            or bank._declined
-            or bank.evt_rows
-            or bank._post_next
-            or bank._tp_apply
-            or not bank.n
-            or bank.n_alive != bank.n
-            or (bank.n_moving and not bank._c_fill)
-            or not k.bound
-            or master.image.buffer is not k.buffer
-            or self.clock.quick[2] * 1e-9 != bank.csp._dt
-        ):
+        k = _kernel_runs(bank, master, self.clock.quick[2])
+        if k is None:
             return None
         if hooked and not quiet:  # (asked last, as _run_cycles asks them after the bank's flags)
             for ask, _ in self._hook_ways():
@@ -955,6 +944,8 @@ class Controller:
             raise ParameterError("wait time must be >= 0")
         clock = self.clock
         total = round(ms * 1_000_000)
+        if total <= self.WAIT_SLICE_NS and clock.mode is not _REALTIME and self.wait_quick(total):
+            return
         if clock.mode is _REALTIME or total <= self.WAIT_SLICE_NS:
             clock.advance_ns(total)
         else:
@@ -969,6 +960,141 @@ class Controller:
                     hook()
         if clock.mode is _AUTO:
             self._arm_after_wait()
+
+    #: waits take :meth:`wait_quick` where it applies (False: always the general way, which
+    #: the tests compare it with)
+    QUICK_WAIT = True
+
+    def wait_quick(self, total: int) -> bool:
+        """A wait of ``total`` ns (at most :attr:`WAIT_SLICE_NS`) on the lockstep or the auto
+        clock, in its common case, in one call: every axis in the bank's compiled kernel, no
+        hook, the bus steady as the last run of cycles left it.  Then the wait is exactly
+        :meth:`wait_ms`'s general way - :meth:`Clock.advance_ns`, whose first run of cycles
+        (:meth:`run_cycles`, :meth:`AxisBank.run_cycles`) is this one's, then
+        :meth:`_arm_after_wait` - with what each of those layers asks and books done once,
+        inline: the kernel called for the run's cycles, the counts added in their arrays.  A
+        field application paced by waits (a pass every controller millisecond) paid those
+        layers at every wait.  Where the run stops short (a move ended, a cycle the kernel
+        declines) or the bus needs a look, the rest of the wait goes the clock's general way
+        from there, as it would have.  False: nothing was done (a hook, an axis out of the
+        bank, a link down, a bank to settle, a clock shared or wrapped, ...); the caller takes
+        the general way."""
+        clock = self.clock
+        q = clock.quick
+        bank = self.bank
+        master = self.master
+        if (
+            not self.QUICK_WAIT
+            or bank is None
+            or master is None
+            or not q[3]  # (a clock's group shares the time: Clock.advance_ns)
+            or self._owed is not None
+            or self._links_down
+            or self._run_axes
+            or clock._cycle_fn is not self._own_cycle
+            or clock.counted is not readers_changed
+            or clock.run_many is not self._own_many
+            or self._own_many.__func__ is not _RUN_CYCLES  # (its layers as written here)
+        ):
+            return False
+        if self._unhooked != ARMS[0]:  # (no hook since: every change of them is a new one)
+            if (
+                self.before_cycle
+                or self.pre_cycle
+                or self.post_cycle
+                or self.sample
+                or self.watch
+                or master.on_cycle
+            ):
+                return False
+            self._unhooked = ARMS[0]  # (as _quick_kernel finds it)
+        dt_ns = q[2]
+        if (
+            type(bank).run_cycles is not _BANK_RUN_CYCLES  # (a run wrapped: it runs it)
+            or "run_cycles" in bank.__dict__
+        ):
+            return False
+        k = _kernel_runs(bank, master, dt_ns)  # (and nothing for AxisBank.settle to do)
+        if k is None:
+            return False
+        csp = bank.csp
+        # the steady verdict's marks as _steady_marks reads them: the last run's, or the
+        # general way asks Master.steady
+        seen = (EPOCH.n, q[10], VirtualSlave.al_changes, VirtualSlave.outside_changes)
+        if seen != self._steady_seen:
+            return False
+        pending = q[0] + total  # (Clock.advance_ns)
+        q[0] = pending
+        if pending >= dt_ns:
+            done = 0
+            self.in_batch = True  # (run_cycles)
+            try:
+                master.backend.look_at_fields()  # (_steady_marks)
+                if seen[3] != VirtualSlave.outside_changes:
+                    seen = (*seen[:3], VirtualSlave.outside_changes)
+                    if not master.steady():
+                        seen = None  # type: ignore[assignment]
+                if seen is not None:
+                    # Kernel.run for the run's cycles (bank.run_cycles), then its book and
+                    # _after_kernel's, the counts in their arrays (AxisBank._COUNTS' order)
+                    # (as quick_cycle_done: a count that stays - a zero added, a flag
+                    # already so - is not written)
+                    n = pending // dt_ns
+                    io = k._io
+                    io[_IN_T_NS] = q[9]
+                    io[_IN_DT_NS] = dt_ns
+                    io[_IN_MAXC] = n if n < self.BATCH_CYCLES else self.BATCH_CYCLES
+                    k._fp[_FP_DT] = csp._dt
+                    rc = k.run_fn(*k._args)
+                    done = io[_OUT_DONE]
+                    if rc:
+                        bank._declined = done > 0
+                    if done:
+                        c = bank.counts
+                        if bank._settled:  # (its count of the first cycle: in settle)
+                            c[0] -= done - 1
+                            bank._settled = False
+                        else:
+                            c[0] -= done
+                        c[1] -= done
+                        bank._lists = {}
+                        c[9] = 0
+                        csp.counts[0] += done
+                        if csp._din_safe:
+                            csp._din_safe = 0
+                        if csp.any_fe:
+                            csp.fe_running = True
+                        if io[_OUT_FIN]:
+                            bank.n_moving = int(np.count_nonzero(bank.moving))
+                            bank._count_standing()
+                        c[2] += bank.n_alive * done
+                        c[3] += done
+                        c[4] += done
+                        c[5] += done
+                        if bank.n_hm:
+                            c[6] += bank.n_hm * done
+                        if bank.n_rest:
+                            c[7] += bank.n_rest * done
+                        if bank.n_frz:
+                            c[8] += bank.n_frz * done
+                        master.counts[0] += done
+                        self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
+            finally:
+                self.in_batch = False
+            if done:  # (Clock.advance_ns's count of a run)
+                q[0] = pending - done * dt_ns
+                q[10] += done
+                q[9] += done * dt_ns
+                EPOCH.n += 1  # (clock.counted)
+            else:  # (Clock.advance_ns's cycle where no run could start)
+                q[0] = pending - dt_ns
+                clock.cycle()
+            if q[0] >= dt_ns:
+                clock.advance_ns(0)  # the rest of the wait the general way, from here
+        # (_arm_after_wait's first look, inline: a loop of waits alone arms nothing)
+        if clock.mode is _AUTO and q[4] != EPOCH.n and q[11] != self._armed_left:
+            self._arm_after_wait()
+        return True
 
     def _arm_after_wait(self) -> None:
         """After a wait whose cycles ran (their last in a run at once, or one by one): the
@@ -998,6 +1124,38 @@ class Controller:
             if q[11] <= 0:
                 return
         self.arm_quick(k)
+
+
+def _kernel_runs(bank: AxisBank, master: Master, dt_ns: int) -> Any:
+    """The bank's kernel where its next cycles may run in one call of it with nothing else
+    to do first - what :meth:`Controller._run_cycles` and :meth:`AxisBank.run_cycles` ask of
+    the bank (nothing to settle, claim or release, no run stopped before a declined cycle,
+    no table for Python to fill, the kernel bound to the image, this cycle time) - else
+    None (:meth:`Controller._quick_kernel`, :meth:`Controller.wait_quick`)."""
+    k = bank.kernel
+    if (
+        k is None
+        or bank.dirty
+        or bank._stale
+        or bank._declined
+        or bank.evt_rows
+        or bank._post_next
+        or bank._tp_apply
+        or not bank.n
+        or bank.n_alive != bank.n
+        or (bank.n_moving and not bank._c_fill)
+        or not k.bound
+        or master.image.buffer is not k.buffer
+        or dt_ns * 1e-9 != bank.csp._dt
+    ):
+        return None
+    return k
+
+
+#: the runs of cycles as :meth:`Controller.wait_quick` does them inline (a run wrapped or
+#: replaced - a test's, an endpoint's - is called the general way)
+_RUN_CYCLES = Controller.run_cycles
+_BANK_RUN_CYCLES = AxisBank.run_cycles
 
 
 def _one_cycle(k: Any, clock: Clock) -> None:

@@ -434,6 +434,36 @@ def cycle_failed(name: str, e: Exception, rc: int) -> int:
 _fast.CYCLE_FAILED[:] = [cycle_failed]
 
 
+def call_failed(name: str, e: Exception, ctl: Any, core: Any) -> int:
+    """The code and reason of an exception GT call ``name`` raised (the GT layer never
+    raises), its host latency run after it; inside an ``except``."""
+    if isinstance(e, _Refusal):
+        rc = e.code
+        _record(name, rc, str(e))
+    else:
+        rc = code_for(e)
+        if rc == CMD_NO_RESPONSE:
+            log.error("%s: internal error\n%s", name, traceback.format_exc())
+            _record(name, rc, f"internal error in the emulator: {type(e).__name__}: {e}")
+        else:
+            _record(name, rc, str(e))
+    if ctl is None and isinstance(core, int):
+        ctl = SESSION.controllers.get(core)
+    if ctl is not None:
+        rc = advance(ctl, name, rc)
+    return rc
+
+
+def call_done(name: str) -> None:
+    """A call that returned 0: GTE_GetLastError speaks of the most recent call only -
+    nothing, or a note of something the call found wrong without failing (:func:`note`)."""
+    if SESSION.note is None:
+        SESSION.last = None
+    else:
+        note_text, SESSION.note = SESSION.note, None
+        SESSION.last = _note(name, note_text)
+
+
 #: the GT functions that change nothing but let controller time pass (their cycles count)
 _TIME_ONLY = frozenset({"GTE_Wait"})
 
@@ -538,13 +568,10 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
             elif type(rc) is not int:
                 rc = int(rc)
             if rc == 0:
-                # GTE_GetLastError speaks of the most recent call only: nothing, or a note
-                # of something the call found wrong without failing (note())
-                if SESSION.note is None:
+                if SESSION.note is None:  # (call_done, inline: every call asks)
                     SESSION.last = None
                 else:
-                    note_text, SESSION.note = SESSION.note, None
-                    SESSION.last = _note(name, note_text)
+                    call_done(name)
             elif SESSION.last is before:  # no reason recorded by a call made inside
                 _record(name, rc, "no reason given")
         except Exception as e:
@@ -557,22 +584,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         return rc
 
     def failed(e: Exception, ctl: Any, core: Any, before: Any) -> int:
-        """The code and reason of an exception the call raised (the GT layer never raises)."""
-        if isinstance(e, _Refusal):
-            rc = e.code
-            _record(name, rc, str(e))
-        else:
-            rc = code_for(e)
-            if rc == CMD_NO_RESPONSE:
-                log.error("%s: internal error\n%s", name, traceback.format_exc())
-                _record(name, rc, f"internal error in the emulator: {type(e).__name__}: {e}")
-            else:
-                _record(name, rc, str(e))
-        if ctl is None and isinstance(core, int):
-            ctl = SESSION.controllers.get(core)
-        if ctl is not None:
-            rc = advance(ctl, name, rc)
-        return rc
+        return call_failed(name, e, ctl, core)
 
     compiled: list[Any] = []  # the compiled binder, made at the first call (args.fast_binder)
 

@@ -42,8 +42,6 @@ Decisions where the manual is silent:
 from __future__ import annotations
 
 import ctypes
-import sys
-import time
 from typing import Any
 
 from gtecat.drives.abort import SdoAbort
@@ -54,7 +52,6 @@ from ..controller import clock_options
 from ..controller.cards import options_for
 from ..controller.core import Controller, Options
 from ..errors import BusError, CommandError, ParameterError
-from ..master.clock import ClockMode
 from . import _core
 from ._core import (
     SESSION,
@@ -65,6 +62,7 @@ from ._core import (
     store,
     store_bytes,
 )
+from .fast import wait_yield
 
 
 class TSlaveInfo(ctypes.Structure):
@@ -545,16 +543,7 @@ def GTE_Wait(ctl: Controller, ms: float) -> int:
     nobody attached there is no yield: on a busy machine one hands the CPU to another
     process for a scheduler slice."""
     ctl.wait_ms(float(ms))
-    # (the endpoint module is there once something published an endpoint: GT_Open, a
-    # controller process; a process that never did has nobody attached)
-    endpoints = sys.modules.get("gtecat.inspect.endpoint")
-    if (
-        endpoints is not None
-        and endpoints._PUBLISHED
-        and ctl.clock.mode is not ClockMode.REALTIME
-        and endpoints.attached()
-    ):
-        time.sleep(0)
+    wait_yield(ctl)
     return 0
 
 

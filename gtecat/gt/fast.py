@@ -18,6 +18,7 @@ import os
 import re
 import struct
 import sys
+import time
 from collections.abc import Callable
 from operator import itemgetter
 from typing import Any
@@ -3162,8 +3163,71 @@ _MULTI_VALUES: dict[str, Callable[[Any], Callable[[Any], Any]]] = {
 }
 
 
+WAIT = "GTE_Wait"
+_REALTIME = ClockMode.REALTIME
+
+
+def wait_yield(ctl: Any) -> None:
+    """The end of a GTE_Wait (its docstring): a yield in virtual time while a panel or
+    verb is attached to the inspection endpoint.  (The endpoint module is there once
+    something published an endpoint: GT_Open, a controller process; a process that never
+    did has nobody attached.)"""
+    endpoints = sys.modules.get("gtecat.inspect.endpoint")
+    if (
+        endpoints is not None
+        and endpoints._PUBLISHED
+        and ctl.clock.mode is not _REALTIME
+        and endpoints.attached()
+    ):
+        time.sleep(0)
+
+
+def fast_wait(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GTE_Wait(ms)`` with the fast path in front of the table: ``ms`` a plain int from 0
+    to one slice of a long wait (Controller.WAIT_SLICE_NS: its ns exact), on the in-process
+    controller of core 1 on the lockstep or the auto clock - the table path's call without
+    its binder and layers, the wait's common case in one call (Controller.wait_quick, else
+    Controller.wait_ms); anything else (a float, a negative or huge value, None, a
+    keyword) takes the table path, its code and reason."""
+    from ..controller.core import Controller
+    from ._core import call_done, call_failed
+
+    most = Controller.WAIT_SLICE_NS // 1_000_000
+
+    def gt(ms: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(ms) is int and 0 <= ms <= most and not extra and not kw and session.plain:
+            ctl = session.controllers.get(1)
+            if ctl is not None and ctl.card is None:
+                clock = ctl.clock
+                if clock.mode is not _REALTIME:
+                    try:
+                        with clock.lock:  # (the table path's: a call's cycles, one thread's)
+                            if not ctl.wait_quick(ms * 1_000_000):
+                                ctl.wait_ms(float(ms))
+                            wait_yield(ctl)
+                    except Exception as e:
+                        return call_failed(name, e, ctl, 1)
+                    if session.note is None:
+                        session.last = None
+                    else:
+                        call_done(name)
+                    if clock.mode is _LOCKSTEP:
+                        return 0
+                    return advance(ctl, name, 0)
+        return slow(*(a for a in (ms,) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
+    return gt
+
+
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
     out: dict[str, Callable[..., Callable[..., int]]] = {
+        WAIT: fast_wait,
         CLOCK: fast_clock,
         READY: fast_ready,
         **dict.fromkeys(IO_READERS, fast_io_reader),

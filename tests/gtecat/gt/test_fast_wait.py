@@ -1,0 +1,145 @@
+"""GTE_Wait's fast function and its quick way (Controller.wait_quick) against the general
+way (the table path, Clock.advance_ns's layers): the same session on the manual's figure
+5-2 bus in the auto clock - waits of 0, 1, 2 and 7 ms between polls, axis 1 jogging, Trap
+moves of axis 2 ending inside a wait, a link loss and axis 2 out of the bank until it is
+switched on again, at last an armed fault firing inside a wait - reads the same GT results
+after every wait, with the same controller counts (the clock's, the master's, the bank's
+and its drives', the readers' epoch, the quick cycles' arming).  Bad arguments keep the
+manual's code and reason."""
+
+from __future__ import annotations
+
+from ctypes import byref, c_double, c_long, c_ubyte, c_ulong
+from typing import Any
+
+import pytest
+
+from gtecat import faults, gt
+from gtecat.controller.core import Controller
+from gtecat.controller.epoch import EPOCH
+from gtecat.drives.slave import VirtualSlave
+
+from .conftest import bring_up, trap_move
+
+#: the waits between polls, in turn (ms)
+WAITS = (1, 0, 7, 1, 1, 2, 1, 0, 1)
+PASSES = 560
+
+
+def _counts(ctl: Any, marks0: tuple[int, ...]) -> tuple[Any, ...]:
+    """What the wait's layers count: the clock's time, cycles and pending latency, the
+    master's cycles, the bank's counts and flags, its drives' cycles, the readers' epoch and
+    the steady verdict's marks (the epoch's and the slaves' changes from the session's start:
+    ``marks0``), the quick cycles' arming."""
+    q = ctl.clock.quick
+    bank = ctl.bank
+    seen = [m - m0 for m, m0 in zip(ctl._steady_seen, marks0, strict=True)]
+    epoch0 = marks0[0]
+    out: tuple[Any, ...] = (
+        q[0], q[9], q[10], q[11], q[4] - epoch0 if q[4] else 0, ctl.master.cycles,
+        EPOCH.n - epoch0, *seen, ctl._armed_left, ctl.in_batch,
+        len(ctl._run_axes), ctl._links_down,
+    )  # fmt: skip
+    if bank is not None:
+        out += (
+            *bank.counts, bank.csp.cycles, bank._declined, bank._settled, bank.dirty,
+            bank.n_moving, bank.n_alive, bank.csp._din_safe, bank.csp.fe_running,
+        )  # fmt: skip
+    return out
+
+
+def _session(quick: bool, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], int]:
+    """The session (module docstring): what every pass read, and the waits that took the
+    quick way."""
+    monkeypatch.setattr(Controller, "QUICK_WAIT", quick)
+    took = [0]
+    own = Controller.wait_quick
+
+    def counted(self: Controller, total: int) -> bool:
+        ok = own(self, total)
+        took[0] += ok
+        return ok
+
+    monkeypatch.setattr(Controller, "wait_quick", counted)
+    wait = gt.GTE_Wait if quick else gt.GTE_Wait.slow
+    bring_up(clock="auto")
+    ctl = gt.GTE_Controller()
+    marks0 = (EPOCH.n, 0, VirtualSlave.al_changes, VirtualSlave.outside_changes)
+    for a in (1, 2):
+        assert gt.GT_AxisOn(a) == 0
+    wait(20)
+    jog = gt.TJogPrm()
+    jog.acc = jog.dec = 0.1
+    assert gt.GT_PrfJog(1) == 0 and gt.GT_SetJogPrm(1, byref(jog)) == 0
+    assert gt.GT_SetVel(1, 5.0) == 0 and gt.GT_Update(1) == 0
+    sts, pos, clk = c_long(), c_double(), c_ulong()
+    raw = (c_ubyte * 8)()
+    seen: list[Any] = []
+    target = 0
+    back = False
+    for k in range(PASSES):
+        if k % 60 == 10 and k < 200:  # a short move: it ends inside one of the waits
+            target += 200 if k % 120 == 10 else -200
+            trap_move(2, target, 4.0)
+        if k == 200:
+            assert gt.GTE_UnplugSlave(1) == 0  # axis 2's drive and the IO behind it
+        if k == 330:
+            assert gt.GTE_ReplugSlave(1) == 0
+        if k >= 350 and not back:  # the bus up again: its alarm cleared, on, in the bank
+            back = gt.GT_ClrSts(2) == 0 and gt.GT_AxisOn(2) == 0
+        if k == 480:  # armed now, fires inside a later wait
+            faults.inject("drive_fault", axis=2, code=0x2310, after_ms=13, duration_ms=20)
+        row: list[Any] = []
+        for a in (1, 2):
+            row += [gt.GT_GetSts(a, byref(sts)), sts.value]
+            row += [gt.GT_GetPrfPos(a, byref(pos)), pos.value]
+            row += [gt.GT_GetEncPos(a, byref(pos)), pos.value]
+        row += [gt.GT_GetClock(byref(clk)), clk.value, gt.GT_GetEcatRawData(0, 8, raw)]
+        row += [*raw, gt.GTE_GetLastError()]
+        row += [back, wait(WAITS[k % len(WAITS)]), *_counts(ctl, marks0)]
+        seen.append(row)
+    assert back, gt.GTE_GetLastError()
+    seen.append(ctl.log.text())
+    gt.GT_Close()
+    return seen, took[0]
+
+
+def test_fast_wait_is_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
+    general, none = _session(False, monkeypatch)
+    quick, took = _session(True, monkeypatch)
+    assert none == 0
+    assert took > PASSES // 2  # (the quick way ran: the bus steady, the axes in the bank)
+    assert len(quick) == len(general)
+    for k, (a, b) in enumerate(zip(general, quick, strict=True)):
+        assert a == b, f"pass {k}"
+    # the session went where the docstring says: axis 2 out of the bank, a link down
+    assert any(row[-17] for row in general[:-1])  # (len(_run_axes))
+    assert any(row[-16] for row in general[:-1])  # (_links_down)
+
+
+@pytest.mark.parametrize("ms", [-1, -0.5, 10**12, 2**63, 1.5, None, "1", float("nan")], ids=repr)
+def test_bad_arguments_keep_the_table_answer(ms: Any) -> None:
+    """Whatever the fast function does not take goes to the table path: the same code and
+    reason as the table-checked function's, and the same controller time after it."""
+    bring_up(clock="auto")
+    ctl = gt.GTE_Controller()
+    answers = []
+    q = ctl.clock.quick
+    for fn in (gt.GTE_Wait.slow, gt.GTE_Wait):
+        before = q[9] + q[0]  # (the time passed, the latency not yet run included)
+        rc = fn(ms)
+        answers.append((rc, gt.GTE_GetLastError(), q[9] + q[0] - before))
+    assert answers[0] == answers[1]
+    assert answers[0][0] != 0 or ms in (1.5, "1")
+
+
+def test_plain_waits_in_lockstep_and_realtime_forms() -> None:
+    """The lockstep clock takes the quick way too (no host latency after it); a wait with a
+    keyword goes to the table path."""
+    bring_up(clock="lockstep")
+    ctl = gt.GTE_Controller()
+    assert gt.GT_AxisOn(1) == 0
+    c0 = ctl.clock.cycles
+    assert gt.GTE_Wait(5) == 0 and ctl.clock.cycles == c0 + 5
+    assert gt.GTE_Wait(ms=3) == 0 and ctl.clock.cycles == c0 + 8
+    assert gt.GTE_Wait(0) == 0 and ctl.clock.cycles == c0 + 8
