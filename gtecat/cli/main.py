@@ -172,6 +172,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     _tolerant_streams()
     parser = build_parser(_verb(sys.argv[1:] if argv is None else list(argv)))
     args = parser.parse_args(argv)
+    # (the words as given: argparse drops the `--` that follows a positional, which a verb
+    # taking another program's arguments must tell from an option of its own)
+    args.raw_argv = list(sys.argv[1:] if argv is None else argv)
     if not getattr(args, "command", None) or not hasattr(args, "func"):
         parser.print_help()
         return 2

@@ -110,6 +110,15 @@ def split_arguments(args: argparse.Namespace) -> list[str]:
     rest = list(args.args)
     if rest and rest[0] == "--":
         return rest[1:]
+    raw = getattr(args, "raw_argv", None)
+    n = len(rest)
+    if (
+        rest
+        and type(raw) is list
+        and len(raw) >= n + 2
+        and raw[-n - 2 :][:2] == [args.script, "--"]
+    ):
+        return rest  # ``gtecat run s.py -- --seconds 1``: argparse took the `--` away
     if not rest or not rest[0].startswith("--"):
         return rest
     cut = rest.index("--") if "--" in rest else len(rest)

@@ -87,6 +87,9 @@ def test_options_after_the_script_and_script_arguments(
     assert rc == 0 and "argv ['-v', 'x']" in out
     rc, out, _ = cli("run", "--eni", FIG52, str(script), "a", "b")
     assert rc == 0 and "argv ['a', 'b']" in out
+    # the form the help gives, with `--` right after the script and options of the script's
+    rc, out, _ = cli("run", "--eni", FIG52, "--no-progress", str(script), "--", "--seconds", "1")
+    assert rc == 0 and "argv ['--seconds', '1']" in out
     rc, out, err = cli("run", str(script), "--eni", FIG52, "stray")
     assert rc == 1 and "stray after the script is not a run option" in err
     assert "--" in err  # says how to pass it
