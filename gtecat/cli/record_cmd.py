@@ -109,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
     from ..faults.record import Recorder
     from .run_cmd import script_traceback
 
-    rec = Recorder(out, {"program": " ".join(command)}).start()
+    # (every thread's calls: a program's HMI thread beside its motion thread is its session)
+    rec = Recorder(out, {"program": " ".join(command)}, any_thread=True).start()
     saved_argv, saved_path = sys.argv, list(sys.path)
     sys.argv = [str(path), *script_args]
     sys.path.insert(0, str(path.resolve().parent))

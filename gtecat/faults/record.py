@@ -375,7 +375,8 @@ def _mutable(x: Any) -> bool:
 
 # --- recording ----------------------------------------------------------------------------
 class Recorder(Listener):
-    """Writes the stream of the calls this thread makes (and the faults injected)."""
+    """Writes the stream of the calls this thread makes (``any_thread``: every thread's, in the
+    order they ran: the tap takes them one at a time) and the faults injected."""
 
     def __init__(
         self, path: str | Path, meta: dict[str, Any] | None = None, *, any_thread: bool = False

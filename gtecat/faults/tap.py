@@ -11,6 +11,7 @@ makes, with its arguments, what it wrote back and its return code.
 from __future__ import annotations
 
 import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -39,7 +40,26 @@ class Listener:
 
 _listeners: list[Listener] = []
 _saved: dict[str, Callable[..., Any]] = {}
-_depth = [0]
+#: per thread: inside a call (a GT call made by another, a motion program's: not the app's)
+_inside = threading.local()
+#: the application's calls one at a time, whichever thread makes them, so that the order the
+#: listeners see (a recording's) is the order they ran in and a replay in one thread gives the
+#: same results; a real controller takes one call at a time too
+_SERIAL = threading.RLock()
+#: calls that let time pass: on the realtime clock they sleep on the wall clock, and holding
+#: the other threads' calls for that long would change the program (its replay is not exact
+#: anyway: its wall clock decided the order)
+_WAITS = frozenset({"GTE_Wait"})
+
+
+def _waits_on_the_wall(name: str) -> bool:
+    if name not in _WAITS:
+        return False
+    from ..gt._core import SESSION
+    from ..master.clock import ClockMode
+
+    ctl = SESSION.controllers.get(1)
+    return ctl is not None and ctl.clock.mode is ClockMode.REALTIME
 
 
 def call_site() -> tuple[str, int]:
@@ -55,14 +75,20 @@ def call_site() -> tuple[str, int]:
 
 def _wrap(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
     def tapped(*args: Any, **kwargs: Any) -> Any:
-        if _depth[0]:  # a GT call made inside another (a motion program): not the app's
+        if getattr(_inside, "now", False):  # a GT call made inside another: not the app's
             return fn(*args, **kwargs)
+        if _waits_on_the_wall(name):
+            return heard(args, kwargs)
+        with _SERIAL:
+            return heard(args, kwargs)
+
+    def heard(args: tuple, kwargs: dict) -> Any:
         tokens = [lst.before(name, args, kwargs) for lst in _listeners]
-        _depth[0] += 1
+        _inside.now = True
         try:
             rc = fn(*args, **kwargs)
         finally:
-            _depth[0] -= 1
+            _inside.now = False
         for lst, tok in zip(_listeners, tokens, strict=True):
             lst.after(name, args, kwargs, rc, tok)
         return rc
@@ -70,6 +96,7 @@ def _wrap(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
     tapped.__name__ = name
     tapped.__doc__ = fn.__doc__
     tapped.__wrapped__ = fn  # type: ignore[attr-defined]
+    tapped.tap_of = fn  # type: ignore[attr-defined]  # (what a motion program calls instead)
     for attr in ("prototype", "__signature__"):
         if hasattr(fn, attr):
             setattr(tapped, attr, getattr(fn, attr))

@@ -103,6 +103,11 @@ def runtime(ctl: Controller, create: bool = True) -> threads.ProgramRuntime | No
     return rt
 
 
+def untapped(fn: object) -> object:
+    """The function a recording's tap wraps (:mod:`gtecat.faults.tap`), or ``fn``."""
+    return getattr(fn, "tap_of", fn)
+
+
 def _caller(ctl: Controller):
     """How a program calls a GT function: the registered function itself (same checks)."""
     ref = weakref.ref(ctl)
@@ -113,8 +118,11 @@ def _caller(ctl: Controller):
         if at is None:
             return _core.CMD_COMM, "the controller running the program is closed"
         card, core = at  # the program's own card and core, whatever the host addresses
-        fn = _core.REGISTRY[name]
+        # (the functions themselves, not a recording's tap: a program's calls are not the
+        # host application's, and on the realtime clock they run in the cycle's thread)
+        fn: Any = untapped(_core.REGISTRY[name])
         twin = _core.REGISTRY.get("GTN_" + name[3:]) if core != 1 else None
+        twin = untapped(twin) if twin is not None else None  # type: ignore[assignment]
         host_last = _core.SESSION.last  # the host's GTE_GetLastError is not the program's
         try:
             with _core.SESSION.selected(card):
