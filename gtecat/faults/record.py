@@ -532,6 +532,35 @@ class Divergence:
         return f"call {self.index} {self.call}: {self.what} recorded {recorded}, replay gives {now}"
 
 
+def _first_element(div: Divergence) -> Divergence:
+    """``div`` narrowed to the first element that differs where both values are arrays of
+    one type and size (a byte buffer as hex text, an array of numbers, or a pointer to
+    either): ``argument 3 element [100] recorded 0, replay gives 255``, as a form's arrays
+    are named, rather than two long texts that may read alike where they are cut."""
+    want, got = div.recorded, div.now
+    if type(want) is dict and type(got) is dict and "ref" in want and "ref" in got:
+        if want.get("off") != got.get("off"):
+            return div
+        want, got = want["ref"], got["ref"]
+    if not (type(want) is dict and type(got) is dict and "arr" in want):
+        return div
+    if (want.get("arr"), want.get("n")) != (got.get("arr"), got.get("n")):
+        return div
+    if type(want.get("hex")) is str and type(got.get("hex")) is str:
+        try:
+            w, g = list(bytes.fromhex(want["hex"])), list(bytes.fromhex(got["hex"]))
+        except ValueError:
+            return div
+    else:
+        w, g = want.get("v"), got.get("v")
+    if type(w) is not list or type(g) is not list or len(w) != len(g):
+        return div
+    for j, (a, b) in enumerate(zip(w, g, strict=True)):
+        if a != b:
+            return Divergence(div.index, div.call, f"{div.what} element [{j}]", a, b)
+    return div
+
+
 def _show(v: Any) -> str:
     if isinstance(v, dict) and "v" in v and len(v) <= 3:
         return _show(v["v"])
@@ -1749,7 +1778,7 @@ def _replay(
                 got = encode(args[where] if type(where) is int else kw.get(where))
                 if got != want:
                     what = f"argument {where + 1}" if type(where) is int else where
-                    return n, Divergence(n, p.name, what, want, got)
+                    return n, _first_element(Divergence(n, p.name, what, want, got))
     finally:
         gt.GT_Close()
     return n, None

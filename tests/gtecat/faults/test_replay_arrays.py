@@ -104,7 +104,12 @@ def test_a_return_code_and_an_unholdable_element_are_caught(recorded: Path, tmp_
 
     at, _ = _tampered(recorded, bad, "GT_GetSts", 2, fraction)
     _, div = replay(bad)
-    assert div is not None and (div.index, div.call, div.what) == (at, "GT_GetSts", "argument 2")
+    assert div is not None and (div.index, div.call, div.what) == (
+        at,
+        "GT_GetSts",
+        "argument 2 element [2]",
+    )
+    assert div.recorded == 0.5
 
 
 def test_the_command_reports_the_element(

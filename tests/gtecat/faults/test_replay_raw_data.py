@@ -116,14 +116,19 @@ def test_a_tampered_byte_is_named_with_its_index(recorded: Path, tmp_path: Path)
 def test_a_buffer_of_another_spelling_is_compared_the_general_way(
     recorded: Path, tmp_path: Path
 ) -> None:
-    """Upper-case hex is no form's value: the line is made whole and still compared (a
-    difference named with the whole buffer), the other lines of the form unchanged."""
+    """Upper-case hex is no form's value: the line is made whole and still compared, the
+    first byte that differs named as a form's would be; the other lines unchanged."""
     bad = tmp_path / "upper.gtrec"
     at = _tamper(
         recorded, bad, 200, lambda e: e["o"]["2"].update(hex="FF" + e["o"]["2"]["hex"][2:])
     )
     n, div = replay(bad)
-    assert div is not None and (n, div.call, div.what) == (at, "GT_GetEcatRawData", "argument 3")
+    assert div is not None and (n, div.call, div.what) == (
+        at,
+        "GT_GetEcatRawData",
+        "argument 3 element [0]",
+    )
+    assert div.recorded == 0xFF and div.now != 0xFF
     same = tmp_path / "same.gtrec"
     _tamper(recorded, same, 200, lambda e: e["o"]["2"].update(hex=e["o"]["2"]["hex"]))
     assert replay(same)[1] is None
