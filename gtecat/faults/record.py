@@ -635,6 +635,16 @@ def _open_text(
         )
     if version != FORMAT:
         raise ParameterError(f"{p} is not a gtecat recording (gtecat record -o FILE -- COMMAND)")
+    if body and not body.endswith("\n"):  # every entry the recorder writes ends its line
+        tail = body[body.rfind("\n") + 1 :]
+        try:
+            json.loads(tail)
+        except (ValueError, RecursionError):
+            raise ParameterError(
+                f"{p}: the recording is cut short: its last line ({body.count(chr(10)) + 2}) "
+                "stops in the middle of an entry (a copy that stopped, or a session killed "
+                "while its recording was written): record it again, or copy the whole file"
+            ) from None
     return p, head, body if sep else None
 
 

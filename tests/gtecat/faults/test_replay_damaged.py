@@ -39,6 +39,21 @@ def test_a_recording_cut_at_a_line_end_is_not_a_pass(
     assert rc == 1 and "line 1: calls 'many' is not a count" in text
 
 
+def test_a_recording_cut_in_the_middle_of_a_line_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    f = tmp_path / "r.gtrec"
+    f.write_text(json.dumps({**HEAD, "calls": 3}) + "\n" + STS + "\n" + STS + "\n" + STS[:57])
+    rc = main(["replay", str(f)])
+    text = "".join(capsys.readouterr())
+    assert rc == 1 and "calls match" not in text
+    assert "the recording is cut short: its last line (4) stops in the middle of an entry" in text
+    f.write_text(json.dumps({**HEAD, "calls": 2}) + "\n" + STS + "\n" + STS)  # no newline
+    main(["replay", str(f)])  # (a whole last entry, only its newline missing: replayed)
+    text = "".join(capsys.readouterr())
+    assert "cut short" not in text and "diverged at call 1" in text
+
+
 @pytest.mark.parametrize(
     "arg",
     [
