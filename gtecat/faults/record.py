@@ -1039,6 +1039,9 @@ class _Call:
     aquick: list[tuple[Any, int, int, str]] = field(default_factory=list)
     #: the slots of vals that hold arrays, and how a line's numbers become their bytes
     packs: tuple[tuple[int, Any], ...] = ()
+    #: the slot of vals that holds "b" (the time the call began at) where the line's form
+    #: takes it as a value (a controller process's calls: each has its own), else None
+    before_at: int | None = None
 
 
 def _prepare(
@@ -1112,6 +1115,10 @@ def _prepare(
             continue
         r = w.get("ref") if isinstance(w, dict) and len(w) == 1 else None
         vals.append(r.get("v") if isinstance(r, dict) else None)
+    before_at = None
+    if type(e.get("b")) is int and list(e)[-1] == "b":  # (last on its line: its value's place)
+        before_at = len(vals)
+        vals.append(e["b"])
     aquick = [(mv, slots.get(str(i), slot), i, kind) for i, mv, slot, kind, _ in arrays]
     quick: list[tuple[Any, int, int, str]] = []
     for i, obj, slot, x in pooled:
@@ -1144,10 +1151,11 @@ def _prepare(
         e["r"],
         quick,
         checks,
-        e.get("b"),
+        e.get("b") if before_at is None else None,
         name in ("GT_Open", "GTN_Open"),
     )
     call.asets, call.aquick = asets, aquick
+    call.before_at = before_at
     call.packs = tuple(packs)
     if call.before is None and not fresh and kw is None and not call.opens and not checks:
         call.run = _compiled(call)
@@ -1163,7 +1171,9 @@ def _compiled(p: _Call) -> Any:
     into one function: None when everything matched, ``(rc,)`` when something may differ
     (the loop compares in full and reports), an exception when a value cannot be set."""
     fn, rc0, args = p.fn, p.rc, tuple(p.args)
-    if (
+    if p.before_at is not None:
+        pass  # (the time it began at first: the general template below)
+    elif (
         not p.sets and not p.quick and not p.asets
     ):  # GTE_Wait(10), GT_Update(mask): no pointer at all
 
@@ -1172,7 +1182,7 @@ def _compiled(p: _Call) -> Any:
             return None if rc == rc0 else (rc,)
 
         return run_plain
-    if len(p.sets) == 1 and len(p.quick) == 1 and not p.asets:  # GT_GetSts(axis, &s)
+    elif len(p.sets) == 1 and len(p.quick) == 1 and not p.asets:  # GT_GetSts(axis, &s)
         ((obj, k),) = p.sets
         ((out, k_out, _, _),) = p.quick
 
@@ -1187,6 +1197,16 @@ def _compiled(p: _Call) -> Any:
         return run_one
     env: dict[str, Any] = {"fn": p.fn, "RC": p.rc, "_DAMAGED": _DAMAGED}
     lines = ["def run(vals):"]
+    if p.before_at is not None:  # time passed between the calls: it passes here too (_call)
+        env["CTL"] = _controller
+        lines += [
+            "    ctl = CTL()",
+            "    if ctl is not None:",
+            "        clock = ctl.clock",
+            f"        gap = vals[{p.before_at}] - clock.now_ns - clock._pending_ns",
+            "        if gap > 0:",
+            "            clock.advance_ns(gap)",
+        ]
     if p.sets or p.asets:
         lines.append("    try:")
         for j, (obj, k) in enumerate(p.sets):
@@ -1352,8 +1372,9 @@ _HEX = re.compile(r"[0-9a-f]*")
 
 
 def _form(e: dict[str, Any]) -> int:
-    """How many values a call of this form has (``"v":`` numbers and arrays of numbers, in
-    the order of the line), or -1 when the entry is not of a simple form: plain arguments,
+    """How many values a call of this form has (``"v":`` numbers and arrays of numbers, a
+    byte array's ``"hex":`` text, the ``"b":`` time, in the order of the line), or -1 when
+    the entry is not of a simple form: plain arguments,
     pointers to simple values (``{"ref": {"c": "c_long", "v": 5}}``) and arrays of numbers
     (``{"arr": "c_long", "n": 12, "v": [...]}``), the values those hold after the call in
     ``"o"``, no keywords.  Such an entry's values all come from :func:`_prepare`'s pooled
@@ -1377,6 +1398,10 @@ def _form(e: dict[str, Any]) -> int:
         if not k.isdigit() or int(k) >= len(a) or type(a[int(k)]) is not dict:
             return -1
         if _kind(w) is None or _kind(w) != _kind(a[int(k)]):
+            return -1
+        n += 1
+    if "b" in e:  # the time the call began at: a value, last on the line
+        if type(e["b"]) is not int or keys[-1] != "b":
             return -1
         n += 1
     return n
@@ -1645,10 +1670,13 @@ _VALUE_TYPES = frozenset({int, float, list, str})
 
 
 #: a value of a call's line that a form takes out: a JSON number, an array of numbers
-#: (``"v":[1,2.5]``) or a byte array's hex text (``"hex":"0f00"``); the group is the
-#: value's text, read by one JSON parse
+#: (``"v":[1,2.5]``), a byte array's hex text (``"hex":"0f00"``), or the time a call began
+#: at, the line's last (``,"b":123}``); the group is the value's text, read by one JSON
+#: parse (a literal quote first: the scan of a long text stays fast)
 _VALUE = re.compile(
-    r'(?:"v":|"hex":(?="))(\[[-0-9.eE+,]*\]|-?[0-9][-0-9.eE+]*|(?<="hex":)"[0-9a-f]*")'
+    r'"(?:v":|hex":(?=")|(?<=,")b":(?=-?[0-9]+}$))'
+    r'(\[[-0-9.eE+,]*\]|-?[0-9][-0-9.eE+]*|(?<="hex":)"[0-9a-f]*")',
+    re.M,
 )
 #: the mark of a value in its form's key, by the value's first character
 _MARK = {
@@ -1875,10 +1903,11 @@ def _call(
     p: _Call, vals: Any, n: int, eni: str | None, machine: str | None
 ) -> tuple[Any, dict[str, Any], Any]:
     """Call ``n`` made as recorded (the general way): (its arguments, keywords, code)."""
-    if p.before is not None:  # time passed between the calls: let it pass here too
+    before = p.before if p.before_at is None else vals[p.before_at]
+    if before is not None:  # time passed between the calls: let it pass here too
         ctl = _controller()
         if ctl is not None:
-            gap = p.before - ctl.clock.now_ns - ctl.clock._pending_ns
+            gap = before - ctl.clock.now_ns - ctl.clock._pending_ns
             if gap > 0:
                 ctl.clock.advance_ns(gap)
     args = p.args
