@@ -1,10 +1,12 @@
 """Every test of the fault vocabulary, recording and replay starts and ends with no GT
 session open (a failed test leaves none behind for the next); :func:`record_one_by_one`
-records a session the reference way the replays are compared with."""
+records a session the reference way the replays are compared with; :func:`fig5_2_up` brings
+the manual's figure 5-2 bus up as an application does, and :func:`recorded` records one."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from ctypes import byref, c_short
 from pathlib import Path
 
 import pytest
@@ -13,6 +15,29 @@ from gtecat import gt
 from gtecat.controller.bank import AxisBank
 from gtecat.controller.core import Controller
 from gtecat.faults.record import Recorder
+from tests.conftest import EXAMPLES
+
+
+def fig5_2_up() -> None:
+    """The manual's figure 5-2 bus brought up on the default clock, as an application does
+    (GT_Open, GT_InitEcatComm, GT_IsEcatReady until ready, GT_StartEcatComm)."""
+    assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), log="") == 0
+    gt.GT_InitEcatComm()
+    st = c_short()
+    while not (gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1):
+        gt.GTE_Wait(1)
+    gt.GT_StartEcatComm()
+
+
+def recorded(path: Path, session: Callable[[], object], any_thread: bool = False) -> Path:
+    """``session()`` recorded into ``path`` (the calls of every thread: ``any_thread``)."""
+    rec = Recorder(path, any_thread=any_thread).start()
+    try:
+        session()
+    finally:
+        rec.stop()
+        gt.GT_Close()
+    return rec.write()
 
 
 def record_one_by_one(out: Path, session: Callable[[], object], quick: bool = True) -> Path:

@@ -6,23 +6,17 @@ scheduler's, different in every run, which is what the recording must capture.""
 from __future__ import annotations
 
 import threading
-from ctypes import byref, c_double, c_long, c_short
+from ctypes import byref, c_double, c_long
 from pathlib import Path
 
 from gtecat import gt
-from gtecat.faults.record import Recorder, replay
-from tests.conftest import EXAMPLES
+from gtecat.faults.record import replay
 
-ENI = EXAMPLES / "manual_fig5_2.eni"
+from .conftest import fig5_2_up, recorded
 
 
 def _session() -> int:
-    assert gt.GT_Open(eni=str(ENI), log="") == 0
-    gt.GT_InitEcatComm()
-    st = c_short()
-    while not (gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1):
-        gt.GTE_Wait(1)
-    gt.GT_StartEcatComm()
+    fig5_2_up()
     gt.GT_AxisOn(1)
     gt.GT_AxisOn(2)
     stop = threading.Event()
@@ -56,16 +50,11 @@ def _session() -> int:
 
 def test_both_threads_are_recorded_in_order_and_replay(tmp_path: Path) -> None:
     path = tmp_path / "threads.gtrec"
-    rec = Recorder(path, any_thread=True).start()
-    try:
-        polls = _session()
-    finally:
-        rec.stop()
-        gt.GT_Close()
-    rec.write()
+    polls = []
+    recorded(path, lambda: polls.append(_session()), any_thread=True)
     text = path.read_text()
-    assert polls > 0
-    assert text.count('"c":"GT_GetPrfPos"') == polls  # every HMI call, none left out
+    assert polls[0] > 0
+    assert text.count('"c":"GT_GetPrfPos"') == polls[0]  # every HMI call, none left out
     n, div = replay(path)
     assert div is None, str(div)
     assert n == sum(line.startswith('{"t":') for line in text.splitlines())

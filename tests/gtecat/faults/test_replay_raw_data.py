@@ -6,25 +6,22 @@ GT_SetEcatRawData: the byte buffers, recorded as hex text, are values of their l
 from __future__ import annotations
 
 import json
-from ctypes import byref, c_short, c_ubyte, c_ulong
+from ctypes import byref, c_ubyte, c_ulong
 from pathlib import Path
 
 import pytest
 
 from gtecat import gt
-from gtecat.faults.record import Recorder, _open_text, _steps, replay
+from gtecat.faults.record import _open_text, _steps, replay
 from tests.conftest import EXAMPLES
+
+from .conftest import fig5_2_up, recorded
 
 POLLS = 400
 
 
 def _session() -> None:
-    assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), log="") == 0
-    gt.GT_InitEcatComm()
-    s = c_short()
-    while gt.GT_IsEcatReady(byref(s)) == 0 and s.value != 1:
-        pass
-    gt.GT_StartEcatComm()
+    fig5_2_up()
     gt.GT_AxisOn(1)
     gt.GT_PrfJog(1)
     gt.GT_SetVel(1, 5.0)
@@ -43,15 +40,8 @@ def _session() -> None:
 
 
 @pytest.fixture(scope="module")
-def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path = tmp_path_factory.mktemp("raw") / "raw.gtrec"
-    rec = Recorder(path).start()
-    try:
-        _session()
-    finally:
-        rec.stop()
-        gt.GT_Close()
-    return rec.write()
+def raw(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return recorded(tmp_path_factory.mktemp("raw") / "raw.gtrec", _session)
 
 
 def _raw_lines(path: Path) -> list[tuple[int, dict]]:
@@ -64,14 +54,14 @@ def _raw_lines(path: Path) -> list[tuple[int, dict]]:
     return out
 
 
-def test_the_session_replays_exactly_and_the_buffers_share_their_forms(recorded: Path) -> None:
-    raws = _raw_lines(recorded)
+def test_the_session_replays_exactly_and_the_buffers_share_their_forms(raw: Path) -> None:
+    raws = _raw_lines(raw)
     assert len(raws) == POLLS
     # (a buffer the call left as it was has no "o"; the encoder moves: many differ)
     assert len({e["o"]["2"]["hex"] for _, e in raws if "o" in e}) > POLLS // 4
-    _, div = replay(recorded, eni=str(EXAMPLES / "manual_fig5_2.eni"))
+    _, div = replay(raw, eni=str(EXAMPLES / "manual_fig5_2.eni"))
     assert div is None, str(div)
-    p, _, body = _open_text(recorded, recorded.read_bytes())
+    p, _, body = _open_text(raw, raw.read_bytes())
     calls = {id(c) for c, _ in _steps(p, body) if c is not None and c.name == "GT_GetEcatRawData"}
     # every line made by one of two prepared calls: the buffer written back, or left as it was
     assert len(calls) == 2
@@ -94,7 +84,7 @@ def _tamper(src: Path, dst: Path, nth: int, change) -> int:
     raise AssertionError(nth)
 
 
-def test_a_tampered_byte_is_named_with_its_index(recorded: Path, tmp_path: Path) -> None:
+def test_a_tampered_byte_is_named_with_its_index(raw: Path, tmp_path: Path) -> None:
     bad = tmp_path / "byte.gtrec"
     was = []
 
@@ -103,7 +93,7 @@ def test_a_tampered_byte_is_named_with_its_index(recorded: Path, tmp_path: Path)
         was.append(int(h[10:12], 16))
         e["o"]["2"]["hex"] = h[:10] + f"{int(h[10:12], 16) ^ 0xFF:02x}" + h[12:]
 
-    at = _tamper(recorded, bad, 123, flip)
+    at = _tamper(raw, bad, 123, flip)
     n, div = replay(bad)
     assert div is not None and (n, div.call, div.what) == (
         at,
@@ -114,14 +104,12 @@ def test_a_tampered_byte_is_named_with_its_index(recorded: Path, tmp_path: Path)
 
 
 def test_a_buffer_of_another_spelling_is_compared_the_general_way(
-    recorded: Path, tmp_path: Path
+    raw: Path, tmp_path: Path
 ) -> None:
     """Upper-case hex is no form's value: the line is made whole and still compared, the
     first byte that differs named as a form's would be; the other lines unchanged."""
     bad = tmp_path / "upper.gtrec"
-    at = _tamper(
-        recorded, bad, 200, lambda e: e["o"]["2"].update(hex="FF" + e["o"]["2"]["hex"][2:])
-    )
+    at = _tamper(raw, bad, 200, lambda e: e["o"]["2"].update(hex="FF" + e["o"]["2"]["hex"][2:]))
     n, div = replay(bad)
     assert div is not None and (n, div.call, div.what) == (
         at,
@@ -130,5 +118,5 @@ def test_a_buffer_of_another_spelling_is_compared_the_general_way(
     )
     assert div.recorded == 0xFF and div.now != 0xFF
     same = tmp_path / "same.gtrec"
-    _tamper(recorded, same, 200, lambda e: e["o"]["2"].update(hex=e["o"]["2"]["hex"]))
+    _tamper(raw, same, 200, lambda e: e["o"]["2"].update(hex=e["o"]["2"]["hex"]))
     assert replay(same)[1] is None

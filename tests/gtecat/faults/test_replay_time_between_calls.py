@@ -7,25 +7,21 @@ changed time is found where it changes a result."""
 from __future__ import annotations
 
 import json
-from ctypes import byref, c_double, c_long, c_short
+from ctypes import byref, c_double, c_long
 from pathlib import Path
 
 import pytest
 
 from gtecat import gt
-from gtecat.faults.record import Recorder, _open_text, _steps, replay
-from tests.conftest import EXAMPLES
+from gtecat.faults.record import _open_text, _steps, replay
+
+from .conftest import fig5_2_up, recorded
 
 POLLS = 300
 
 
 def _session() -> None:
-    assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), log="") == 0
-    gt.GT_InitEcatComm()
-    st = c_short()
-    while not (gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1):
-        gt.GTE_Wait(1)
-    gt.GT_StartEcatComm()
+    fig5_2_up()
     gt.GT_AxisOn(1)
     gt.GT_PrfJog(1)
     gt.GT_SetVel(1, 3.0)
@@ -41,30 +37,23 @@ def _session() -> None:
 
 
 @pytest.fixture(scope="module")
-def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path = tmp_path_factory.mktemp("gaps") / "gaps.gtrec"
-    rec = Recorder(path).start()
-    try:
-        _session()
-    finally:
-        rec.stop()
-        gt.GT_Close()
-    return rec.write()
+def gaps(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return recorded(tmp_path_factory.mktemp("gaps") / "gaps.gtrec", _session)
 
 
-def test_each_call_replays_with_its_own_time_and_the_lines_share_forms(recorded: Path) -> None:
-    lines = [x for x in recorded.read_text().splitlines()[1:] if '"c":"GT_GetSts"' in x]
+def test_each_call_replays_with_its_own_time_and_the_lines_share_forms(gaps: Path) -> None:
+    lines = [x for x in gaps.read_text().splitlines()[1:] if '"c":"GT_GetSts"' in x]
     assert sum('"b":' in x for x in lines) >= POLLS - 1  # (each poll began after a gap)
     assert len({x[x.find(",") :] for x in lines}) > POLLS // 2  # (distinct lines: the times)
-    _, div = replay(recorded)
+    _, div = replay(gaps)
     assert div is None, str(div)
-    p, _, body = _open_text(recorded, recorded.read_bytes())
+    p, _, body = _open_text(gaps, gaps.read_bytes())
     made = {id(c) for c, _ in _steps(p, body) if c is not None and c.name == "GT_GetSts"}
     assert len(made) <= 3  # (with and without a gap, written back or not)
 
 
-def test_a_changed_time_is_found(recorded: Path, tmp_path: Path) -> None:
-    text = recorded.read_text().splitlines()
+def test_a_changed_time_is_found(gaps: Path, tmp_path: Path) -> None:
+    text = gaps.read_text().splitlines()
     seen = calls = 0
     for i, line in enumerate(text[1:], 1):
         if '"c":' not in line:
