@@ -79,7 +79,8 @@ from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
 from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
 from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable
 from gtecat.drives.homing_bank import rest_constants as homing_rest_constants
-from gtecat.drives.homing_bank import resting as homing_resting
+from gtecat.drives.homing_bank import return_constants as homing_return_constants
+from gtecat.drives.homing_bank import row_kind as homing_row_kind
 from gtecat.drives.homing_bank import row_constants as homing_constants
 from gtecat.drives.modes import SW12
 from gtecat.drives.slave import AlState
@@ -740,6 +741,7 @@ class AxisBank:
             setattr(self, name, z(n))
         for name in _HM_U8:
             setattr(self, name, zi(n, bool))
+        self.h_done = zi(n, np.uint8)  # a homing row's kind (homing_bank.row_kind): 0, 1, 2
         self.n_hm = self.n_frz = 0
         #: 60FDh bits whose change sends a row back before the cycle (an input a bank-aware
         #: hook samples every cycle: a capture unit's home input)
@@ -787,7 +789,7 @@ class AxisBank:
         self._count_standing()
         self.n_jog = int(np.count_nonzero(self.jog & alive))
         self.n_hm = int(np.count_nonzero(self.hm & alive))
-        self.n_rest = int(np.count_nonzero(self.h_done & alive)) if self.n_hm else 0
+        self.n_rest = int(np.count_nonzero((self.h_done == 1) & alive)) if self.n_hm else 0
         self.n_frz = int(np.count_nonzero(self.frz & alive))
         self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
         self.any_post = bool(np.count_nonzero(self.dpost[alive]))
@@ -1042,8 +1044,22 @@ class AxisBank:
                 return False
         elif ax.cw not in (0x0F, 0x1F) or ax._cw_sent != ax.cw:
             return False
-        if res.latched or ax.prf_pos != res._a_last:
+        if ax.prf_pos != res._a_last:
             return False
+        latched = res.latched
+        if latched:
+            # limit flags latched (a search that met a limit switch, a home on one): in homing
+            # mode nothing reacts to them (the drive ignores its limit inputs, the plan follows
+            # the drive), so they only stand in GT_GetSts; any other flag, or a soft limit
+            # exceeded now, stays scalar
+            if latched & ~(_POS_LIMIT | _NEG_LIMIT) or not _within_soft_limits(ax, res):
+                return False
+        ch = self.csp.channels[r]
+        on = ch.digital_inputs & 3
+        if on:  # on a limit switch: the compiled cycle keeps the row while its flag is latched
+            need = (_POS_LIMIT if on & 2 else 0) | (_NEG_LIMIT if on & 1 else 0)
+            if latched & need != need:
+                return False
         if None in (res._act, res._cmd, ax._tp_acc, ax._pos_acc):
             return False
         pl = res.profile.planner
@@ -1051,8 +1067,10 @@ class AxisBank:
             return False
         if not self._inputs_plain(ax, res):
             return False
-        ch = self.csp.channels[r]
-        return not (homing_claimable(ch) if searching else homing_rest_claimable(ch))
+        h = ch.homing
+        if searching and (h is None or not homing_row_kind(h)):
+            return not homing_claimable(ch)
+        return not homing_rest_claimable(ch)  # (a run still followed: SW10 gives it back)
 
     @staticmethod
     def _inputs_plain(ax: Any, res: Any) -> bool:
@@ -1367,11 +1385,11 @@ class AxisBank:
             for name, attr in HM_ROW_FIELDS:
                 getattr(self, name)[r] = getattr(h, attr)
             self.h_set[r] = h._settled
-            self.h_done[r] = done = homing_resting(h)
-            consts = homing_rest_constants(h) if done else homing_constants(h)
+            self.h_done[r] = kind = homing_row_kind(h)  # 0 searching, 1 ended, 2 RETURN
+            consts = (homing_constants, homing_rest_constants, homing_return_constants)[kind](h)
             for name, value in consts.items():
                 getattr(self, name)[r] = value
-            bounds = (-math.inf, math.inf) if done else homing_event_bounds(h, ch.mech.pos)
+            bounds = (-math.inf, math.inf) if kind else homing_event_bounds(h, ch.mech.pos)
             assert bounds is not None  # homing_claimable checked it
             self.h_lo[r], self.h_hi[r] = bounds
             # 6041h: the state bits and remote, step_hm's bits instead of CSP's (oms =
@@ -2968,14 +2986,20 @@ class AxisBank:
             self._release_groups(changed)
 
 
+def _within_soft_limits(ax: Any, res: Any) -> bool:
+    """No soft limit is exceeded now (the row would leave the bank at once)."""
+    s = res.safety
+    return not s.active or s.soft_negative <= ax.prf_pos <= s.soft_positive
+
+
 def _within_safety(ax: Any, res: Any) -> bool:
     """Neither a soft limit nor the following error is exceeded now (an axis latched with
     one of them would leave the bank at once: it stays scalar)."""
+    if not _within_soft_limits(ax, res):
+        return False
     s = res.safety
     if s.active:
         a = ax.prf_pos
-        if a > s.soft_positive or a < s.soft_negative:
-            return False
         if not -s.pos_err <= a - res.enc_link.axis(res.encoder.pos) <= s.pos_err:
             return False
     return True

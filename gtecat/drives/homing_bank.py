@@ -11,12 +11,18 @@ positions where ``_scan`` could find something, or a bound would be reached.  Th
 channel then runs that cycle (edges, reversals, the home point, RETURN, errors) and the
 bank may take the row again once the search is plain again.
 
-After the procedure (completed, failed or interrupted) a drive left in homing mode rests:
-:meth:`Homing.step` scans nothing and counts no search time or travel, the demand stands and
-only the rest time grows; once that passed ``SETTLE_TIME_S`` the statusword bits can no
-longer change.  Such a channel is a row too (:func:`homing_rest_claimable`, the kernel's
-``h_done``): an application that homes and never switches back to CSP keeps its axes in the
-bank.
+A drive on a limit switch is such a row too: in homing mode it ignores its limit inputs
+(the search meets a switch as an event), so only the controller's limit flag, latched in
+GT_GetSts, sees the switch; the bank keeps the row while that flag is latched.
+
+After the procedure (completed, failed or interrupted) a drive left in homing mode brakes
+to rest and stays: :meth:`Homing.step` scans nothing and counts no search time or travel,
+the demand ramps to speed 0 and stands, only the rest time and the settled flag change.  Such
+a channel is a row too (:func:`homing_rest_claimable`, the kernel's ``h_done``), which leaves
+before a cycle that changes the settled flag (the statusword's SW10 and the homing's result
+follow it): an application that homes and never switches back to CSP keeps its axes in the
+bank, a failed search's braking included.  The move back onto a home point found (RETURN)
+is such a row too, until it settles there.
 
 This module says when a channel may be such a row (:func:`homing_claimable`,
 :func:`homing_rest_claimable`), where the nearest events lie (:func:`event_bounds`), and
@@ -29,7 +35,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .csp_bank import running_reason
-from .homing import SETTLE_TIME_S, HomingPhase
+from .homing import HomingPhase
 from .homing_methods import Signal
 from .modes import OpMode
 
@@ -56,7 +62,7 @@ ROW_FIELDS = (
 
 def homing_claimable(ch: Channel) -> str:
     """Why ``ch`` cannot run its homing search as a bank row now ("" when it can)."""
-    why = running_reason(ch, OpMode.HOMING, CW_HOMING, "not in homing mode")
+    why = running_reason(ch, OpMode.HOMING, CW_HOMING, "not in homing mode", limits=True)
     if why:
         return why
     if ch.fe_flag or ch.fe_time:
@@ -73,40 +79,53 @@ def homing_claimable(ch: Channel) -> str:
     return ""
 
 
-def resting(h: Homing) -> bool:
-    """The procedure is over and the drive rests for good: no phase, speed or statusword
-    bit of it changes any more (:meth:`Homing.step` of a phase in ``_ENDED`` at speed 0 only
-    adds to the rest time; past ``SETTLE_TIME_S`` the drive stays settled)."""
+def ended(h: Homing) -> bool:
+    """The procedure is over (completed, failed or interrupted): :meth:`Homing.step` scans
+    nothing and counts no search time or travel, the demand ramps to speed 0 at 609Ah and
+    stands; only the rest time and the settled flag change.  A row gives itself back before
+    a cycle that would change that flag (SW10, the drive's ``finish_homing`` and the
+    controller's homing status follow it), so braking after a failure and settling run in
+    the bank too."""
+    return h.phase in _ENDED and (h._stopping or h.phase is not HomingPhase.INTERRUPTED)
+
+
+def returning(h: Homing) -> bool:
+    """The home point is found and the drive moves back onto it (RETURN, not halted): no
+    scan, no search bound, a positioning move (``_toward``) until it settles there, when the
+    phase becomes COMPLETED (the kernel's row gives itself back before that cycle)."""
     return (
-        h.phase in _ENDED
-        and h._v == 0.0
-        and h._settled
-        and h._rest_time >= SETTLE_TIME_S
-        and (h._stopping or h.phase is not HomingPhase.INTERRUPTED)
+        h.phase is HomingPhase.RETURN and not h._stopping and h.home_machine_position is not None
     )
 
 
+def row_kind(h: Homing) -> int:
+    """The kernel's ``h_done`` of a row: 0 searching, 1 ended (:func:`ended`), 2 moving back
+    onto the home point (:func:`returning`)."""
+    return 1 if ended(h) else 2 if returning(h) else 0
+
+
 def homing_rest_claimable(ch: Channel) -> str:
-    """Why ``ch`` cannot run as a resting homing row now ("" when it can): in homing mode,
-    its procedure over and at rest (:func:`resting`), the result applied."""
+    """Why ``ch`` cannot run as a row past its search now ("" when it can): in homing mode,
+    returning onto its home point (:func:`returning`) or its procedure over (:func:`ended`),
+    its result applied as far as it is done."""
     cw = ch.controlword
     if cw not in CW_RESTING:
         return "controlword"
-    why = running_reason(ch, OpMode.HOMING, cw, "not in homing mode")
+    why = running_reason(ch, OpMode.HOMING, cw, "not in homing mode", limits=True)
     if why:
         return why
     if ch.fe_flag or ch.fe_time:
         return "following error"
     h = ch.homing
-    if h is None or not ch.hm_applied or not resting(h):
-        return "not resting after a homing"
+    if h is None or not (ended(h) or returning(h)) or ch.hm_applied != h.done:
+        return "not after a homing"
     if ch.oms != ch.hm_bits:
         return "statusword bits"
     return ""
 
 
 def rest_constants(h: Homing) -> dict[str, float]:
-    """A resting row's constants: the speed target 0 of an ended procedure (``_move``), no
+    """An ended row's constants: the speed target 0 of an ended procedure (``_move``), no
     search bounds (the kernel checks none for ``h_done`` rows)."""
     return {
         "h_vt": 0.0,
@@ -118,6 +137,14 @@ def rest_constants(h: Homing) -> dict[str, float]:
         "h_from": 0.0,
         "h_ilim": math.inf,
     }
+
+
+def return_constants(h: Homing) -> dict[str, float]:
+    """A returning row's constants: ``_toward``'s top speed 6099h:01 in ``h_vt`` and the home
+    point in ``h_from``; no search bounds."""
+    home = h.home_machine_position
+    assert home is not None
+    return {**rest_constants(h), "h_vt": float(h.params.speed_switch), "h_from": home}
 
 
 def event_bounds(h: Homing, pos: float) -> tuple[float, float] | None:

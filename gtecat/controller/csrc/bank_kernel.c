@@ -228,9 +228,43 @@ static int64_t clip16(double x)
  * h_lo < every position it has been at < h_hi, where h_lo/h_hi are the nearest positions at
  * which _scan would find something (a switch edge, a limit, an index pulse).  Returns 1 when
  * this cycle would leave that state (an event crossed, a search bound reached): nothing is
- * written and the row goes back to the scalar drive for this cycle.  A row with h_done rests
- * after its procedure (completed, failed or interrupted, at rest for good): Homing.step then
- * scans nothing and counts no search time or travel, its speed stays 0 and it only settles. */
+ * written and the row goes back to the scalar drive for this cycle.  A row with h_done is past
+ * its procedure (completed, failed or interrupted): Homing.step then scans nothing and counts
+ * no search time or travel, its speed ramps to 0 and stands; h_done 2 moves back onto the home
+ * point found (RETURN, _toward); a cycle that would change its settled flag (SW10) sends it
+ * back. */
+/* drives.homing._toward: one cycle of the move onto target (ramp a, top speed vmax), stopping
+ * exactly; the same operations in the same order */
+INLINE void toward(double *pp, double *pv, double target, double vmax, double a, double dt)
+{
+    double p = *pp, v = *pv, d, a_dt, s, half, v_stop, v_des, dv, step;
+    if (dt <= 0.0)
+        return;
+    d = target - p;
+    a_dt = a * dt;
+    if (fabs(d) <= 1e-9 && fabs(v) <= a_dt) {
+        *pp = target;
+        *pv = 0.0;
+        return;
+    }
+    s = d > 0 ? 1.0 : -1.0;
+    half = 0.5 * a_dt;
+    v_stop = sqrt(half * half + 2.0 * a * fabs(d)) - half;
+    v_des = s * (v_stop < vmax ? v_stop : vmax); /* min(vmax, v_stop) */
+    dv = v_des - v;
+    dv = dv < a_dt ? dv : a_dt;                  /* min(a_dt, v_des - v) */
+    dv = dv > -a_dt ? dv : -a_dt;                /* max(-a_dt, ...) */
+    v = v + dv;
+    step = v * dt;
+    if (step * s >= fabs(d)) {
+        *pp = target;
+        *pv = 0.0;
+        return;
+    }
+    *pp = p + step;
+    *pv = v;
+}
+
 INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *dvel)
 {
     double pos = F64(c_pos)[r], p0 = F64(h_last)[r];
@@ -253,23 +287,30 @@ INLINE int homing_row(void **ptr, int64_t r, double dt, double *demand, double *
             return 1;
     }
     /* _move */
-    a_dt = F64(h_acc)[r] * dt;
-    if (v < vt) {
-        x = v + a_dt;
-        v = vt < x ? vt : x; /* min(v + a_dt, v_target) */
-    } else if (v > vt) {
-        x = v - a_dt;
-        v = vt > x ? vt : x; /* max(v - a_dt, v_target) */
+    if (U8(h_done)[r] == 2) { /* RETURN: onto the home point (h_from), capped at h_vt */
+        p = F64(h_p)[r];
+        toward(&p, &v, F64(h_from)[r], vt, F64(h_acc)[r], dt);
+    } else {
+        a_dt = F64(h_acc)[r] * dt;
+        if (v < vt) {
+            x = v + a_dt;
+            v = vt < x ? vt : x; /* min(v + a_dt, v_target) */
+        } else if (v > vt) {
+            x = v - a_dt;
+            v = vt > x ? vt : x; /* max(v - a_dt, v_target) */
+        }
+        p = F64(h_p)[r] + v * dt;
     }
-    p = F64(h_p)[r] + v * dt;
-    /* settling (a search phase is never RETURN) */
-    if (v == 0.0) {
+    /* settling (RETURN: only on the home point) */
+    if (v == 0.0 && (U8(h_done)[r] != 2 || p == F64(h_from)[r])) {
         rest += dt;
         settled = fabs(pos - p) <= 1.0 || rest >= 0.05; /* POSITION_WINDOW, SETTLE_TIME_S */
     } else {
         rest = 0.0;
         settled = 0;
     }
+    if (U8(h_done)[r] && settled != U8(h_set)[r])
+        return 1; /* SW10, the phase (RETURN -> COMPLETED), the result: the scalar drive's */
     sh[0] = pos;
     sh[1] = el;
     sh[2] = tr;
@@ -674,6 +715,14 @@ INLINE int limit_leaves(int64_t din, int64_t before, int lvel)
     return ((on & 2) && !(lvel & 1)) || ((on & 1) && !(lvel & 2));
 }
 
+/* a homing row on a limit switch (the drive ignores its limit inputs in homing mode; the
+ * search met the switch as an event) stays while the flag of each switch it is on is latched
+ * (lvel: AxisResources._post latches nothing new) */
+INLINE int hm_limit_leaves(int64_t din, int lvel)
+{
+    return ((din & 2) && !(lvel & 1)) || ((din & 1) && !(lvel & 2));
+}
+
 /* inlined where the field table is a local copy: the compiler then knows no store through a
  * row's arrays changes it, and keeps the arrays' addresses instead of reloading them */
 INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, int check_rx,
@@ -939,7 +988,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         err = a - link(enc, F64(enc_ratio)[r], F64(enc_off)[r]);
         if (a > F64(soft_pos)[r] || a < F64(soft_neg)[r])
             hit = 1;
-        if (hm[r] ? (din & 3) != 0 : limit_leaves(din, I64(c_din)[r], U8(lvel)[r]))
+        if (hm[r] ? hm_limit_leaves(din, U8(lvel)[r]) : limit_leaves(din, I64(c_din)[r], U8(lvel)[r]))
             hit = 1;
         if (fabs(err) > F64(pos_err)[r] && !hm[r]) /* the following error: in CSP only */
             hit = 1;
