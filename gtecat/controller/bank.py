@@ -80,8 +80,8 @@ from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
 from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable
 from gtecat.drives.homing_bank import rest_constants as homing_rest_constants
 from gtecat.drives.homing_bank import return_constants as homing_return_constants
-from gtecat.drives.homing_bank import row_kind as homing_row_kind
 from gtecat.drives.homing_bank import row_constants as homing_constants
+from gtecat.drives.homing_bank import row_kind as homing_row_kind
 from gtecat.drives.modes import SW12
 from gtecat.drives.slave import AlState
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS

@@ -93,9 +93,7 @@ def returning(h: Homing) -> bool:
     """The home point is found and the drive moves back onto it (RETURN, not halted): no
     scan, no search bound, a positioning move (``_toward``) until it settles there, when the
     phase becomes COMPLETED (the kernel's row gives itself back before that cycle)."""
-    return (
-        h.phase is HomingPhase.RETURN and not h._stopping and h.home_machine_position is not None
-    )
+    return h.phase is HomingPhase.RETURN and not h._stopping and h.home_machine_position is not None
 
 
 def row_kind(h: Homing) -> int:

@@ -128,9 +128,9 @@ def test_the_bank_ran_the_searches(runs: tuple) -> None:
         pytest.skip("GTECAT_BANK_KERNEL=numpy: homing rows run only in the compiled cycle")
     _, (_, (rows, rest)) = runs
     assert rows > 800  # axis-cycles of searches between their events
-    # and of drives left resting in homing mode once their homing ended (no GT_SetHomingMode
-    # back to 8; a drive's channels are claimed together, and a home on a limit switch stays
-    # scalar: the drives whose channels all rest, for the last few hundred cycles)
+    # and of drives left in homing mode once their homing ended (no GT_SetHomingMode back to
+    # 8; a drive's channels are claimed together: the drives whose channels have all ended,
+    # for the last few hundred cycles)
     assert rest > 500
 
 
