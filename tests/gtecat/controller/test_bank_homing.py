@@ -40,9 +40,9 @@ SETUP: dict[int, tuple[int, dict[str, object]]] = {
 CYCLES = 900
 
 
-def _machine(tmp: Path) -> str:
+def _machine(tmp: Path, setup: dict[int, tuple[int, dict[str, object]]] = SETUP) -> str:
     lines = []
-    for axis, (_, keys) in SETUP.items():
+    for axis, (_, keys) in setup.items():
         lines.append(f"[axis.{axis}]")
         lines += [f"{k} = {v}" for k, v in keys.items()]
     path = tmp / "machine.toml"
@@ -75,16 +75,19 @@ def _run(machine: str, bank: str) -> tuple[list, tuple[int, int]]:
             trace.append(_sample(size))
         bank = ctl.bank
         bank_rows = (bank.homing_rows_run, bank.rest_rows_run) if bank is not None else (0, 0)
-        trace.append(
-            tuple(
-                (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
-                for s in ctl.backend.slaves
-                for ch in getattr(s, "channels", [])
-            )
-        )
+        trace.append(_mechanics(ctl))
     finally:
         gt.GT_Close()
     return trace, bank_rows
+
+
+def _mechanics(ctl: object) -> tuple:
+    """Every drive channel's mechanics and statusword (compared at the end of a run)."""
+    return tuple(
+        (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
+        for s in ctl.backend.slaves  # type: ignore[attr-defined]
+        for ch in getattr(s, "channels", [])
+    )
 
 
 def _sample(size: int) -> tuple:

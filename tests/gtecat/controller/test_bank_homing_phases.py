@@ -12,16 +12,13 @@ drives' mechanics at the end; and the bank must have held rows in each of those 
 
 from __future__ import annotations
 
-from ctypes import byref, c_double, c_long, c_short, c_ubyte
-from pathlib import Path
-
 import pytest
 
 from gtecat import gt
 from gtecat.controller import bank_kernel
 from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
+from tests.gtecat.controller.test_bank_homing import AXES, _machine, _mechanics, _sample
 
-AXES = 12
 _FAR = {"positive_limit": 20_000, "negative_limit": -20_000}
 #: axis -> (method, machine keys)
 SETUP: dict[int, tuple[int, dict[str, object]]] = {
@@ -46,16 +43,6 @@ SETUP: dict[int, tuple[int, dict[str, object]]] = {
 }
 CYCLES = 1_100
 CLEAR_AT = 900  # GT_ClrSts of every axis (flags whose switch is still active stay)
-
-
-def _machine(tmp: Path) -> str:
-    lines = []
-    for axis, (_, keys) in SETUP.items():
-        lines.append(f"[axis.{axis}]")
-        lines += [f"{k} = {v}" for k, v in keys.items()]
-    path = tmp / "machine.toml"
-    path.write_text("\n".join(lines) + "\n")
-    return str(path)
 
 
 def _held(ctl: object, seen: set) -> None:
@@ -99,38 +86,15 @@ def _run(machine: str, bank: str) -> tuple[list, set]:
             gt.GTE_Wait(1)
             trace.append(_sample(size))
             _held(ctl, seen)
-        trace.append(
-            tuple(
-                (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
-                for s in ctl.backend.slaves
-                for ch in getattr(s, "channels", [])
-            )
-        )
+        trace.append(_mechanics(ctl))
     finally:
         gt.GT_Close()
     return trace, seen
 
 
-def _sample(size: int) -> tuple:
-    sts = (c_long * AXES)()
-    prf = (c_double * AXES)()
-    enc = (c_double * AXES)()
-    gt.GT_GetSts(1, sts, AXES)
-    gt.GT_GetPrfPos(1, prf, AXES)
-    gt.GT_GetEncPos(1, enc, AXES)
-    homing = []
-    for a in range(1, AXES + 1):
-        st = c_short()
-        gt.GT_GetEcatHomingStatus(a, byref(st))
-        homing.append(st.value)
-    raw = (c_ubyte * size)()
-    gt.GT_GetEcatRawData(0, size, raw)
-    return tuple(sts), tuple(prf), tuple(enc), tuple(homing), bytes(raw)
-
-
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> tuple:
-    machine = _machine(tmp_path_factory.mktemp("homing_phases"))
+    machine = _machine(tmp_path_factory.mktemp("homing_phases"), SETUP)
     return _run(machine, "off"), _run(machine, "on")
 
 
