@@ -1031,7 +1031,7 @@ def compiled_parts() -> dict[str, object]:
 def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> dict[str, object]:
     """The many-axes figures, measured one after the other in this run (``only``: those),
     after the compiled parts are there (:func:`compiled_parts`, reported as ``build``)."""
-    from tools.bench_scaling import crd_plan, run_bus, run_gohome
+    from tools.bench_scaling import crd_plan, run_bus, run_drive_homing, run_gohome
 
     build = compiled_parts()
 
@@ -1062,6 +1062,11 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         r |= run_gohome(n, mode, repeat=repeat)
         return r if target is None else _figure(r, "rtf", target)
 
+    def drive_home(n: int, method: int, target: float | None) -> dict[str, object]:
+        r = {"axes": n, "what": f"drive homing (mode 6) method {method}, start to end"}
+        r |= run_drive_homing(n, method, repeat=repeat)
+        return r if target is None else _figure(r, "rtf", target)
+
     figures: dict[str, Callable[[], dict[str, object]]] = {
         "rtf_fig5_2_trap": lambda: rtf(2, every(2, "moving"), 300, FIG5_TEXT, eni=FIG5_2),
         "rtf_1_axis_trap": lambda: rtf(1, every(1, "moving"), 500, "one axis moving in Trap"),
@@ -1074,6 +1079,10 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
             12, every(12, "homing"), None, "drive homing method 17"
         ),
         "rtf_64_axes_homing_17": lambda: rtf(64, every(64, "homing"), 10, "drive homing method 17"),
+        **{
+            f"rtf_64_axes_drive_home_{m}": (lambda m=m: drive_home(64, m, 10))
+            for m in (1, 2, 17, 24, 27)
+        },
         "rtf_64_axes_gohome_10": lambda: gohome(64, 10, 10),
         "rtf_64_axes_gohome_20": lambda: gohome(64, 20, 10),
         "rtf_64_axes_gohome_11": lambda: gohome(64, 11, 10),

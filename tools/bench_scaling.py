@@ -542,6 +542,70 @@ def run_gohome(
     :data:`GOHOME_POLL_MS`); the best run counts.  ``error`` when a homing does not end in
     stage 100 without error."""
     gt = _gt()
+    hs = gt.THomeStatus()
+
+    def running(a: int) -> bool:
+        gtn("GetHomeStatus", a, byref(hs))
+        return bool(hs.run)
+
+    def bad(a: int) -> str:
+        gtn("GetHomeStatus", a, byref(hs))
+        ok = not hs.run and hs.stage == 100 and not hs.error
+        return "" if ok else f"{a} (stage {hs.stage}, error {hs.error})"
+
+    return _run_homing(
+        n, lambda axes: start_gohome(axes, mode), running, bad, repeat, bank, limit_ms
+    )
+
+
+#: drive homing (GT_SetEcatHomingPrm): 6099h:01, 6099h:02 (counts/s), 609Ah (counts/s²)
+DRIVE_HOMING_SPEEDS = (20_000, 2_000, 150_000)
+
+
+def run_drive_homing(
+    n: int, method: int, *, repeat: int = 3, bank: str | None = None, limit_ms: int = 30_000
+) -> dict[str, Any]:
+    """``n`` axes home by their drives (homing mode 6, CiA-402 ``method``) on the machine of
+    :func:`gohome_machine`, start to end, as :func:`run_gohome` (every axis's
+    GT_GetEcatHomingStatus every :data:`GOHOME_POLL_MS`); ``error`` when one does not end
+    homed (3)."""
+    st = c_short()
+    v1, v2, acc = DRIVE_HOMING_SPEEDS
+
+    def start(axes: Sequence[int]) -> None:
+        for a in axes:
+            gtn("SetHomingMode", a, 6)
+            gtn("SetEcatHomingPrm", a, method, v1, float(v2), acc, 0, 0)
+        for a in axes:
+            gtn("StartEcatHoming", a)
+
+    def status(a: int) -> int:
+        gtn("GetEcatHomingStatus", a, byref(st))
+        return st.value
+
+    return _run_homing(
+        n,
+        start,
+        lambda a: status(a) == 0,
+        lambda a: "" if (s := status(a)) == 3 else f"{a} (status {s})",
+        repeat,
+        bank,
+        limit_ms,
+    )
+
+
+def _run_homing(
+    n: int,
+    start: Callable[[Sequence[int]], None],
+    running: Callable[[int], bool],
+    bad: Callable[[int], str],
+    repeat: int,
+    bank: str | None,
+    limit_ms: int,
+) -> dict[str, Any]:
+    """The homings of :func:`run_gohome` and :func:`run_drive_homing`: ``start`` on every
+    axis, then wait until no axis is ``running``; ``bad`` names an axis that did not home."""
+    gt = _gt()
     best: dict[str, Any] | None = None
     with tempfile.TemporaryDirectory() as tmp:
         eni = write_axes_eni(n, Path(tmp) / f"axes{n}.eni")
@@ -552,8 +616,7 @@ def run_gohome(
                 for a in axes:
                     gtn("AxisOn", a)
                 gt.GTE_Wait(WARM_UP_MS)
-                start_gohome(axes, mode)
-                hs = gt.THomeStatus()
+                start(axes)
                 ms0, _ = _clock()
                 t0, c0 = time.perf_counter(), time.process_time()
                 waited = 0
@@ -562,21 +625,13 @@ def run_gohome(
                     waited += CHUNK_MS
                     if waited % GOHOME_POLL_MS:
                         continue
-                    running = 0
-                    for a in axes:
-                        gtn("GetHomeStatus", a, byref(hs))
-                        running += hs.run
-                    if not running or waited >= limit_ms:
+                    if not sum(running(a) for a in axes) or waited >= limit_ms:
                         break
                 wall, cpu = time.perf_counter() - t0, max(time.process_time() - c0, 1e-9)
                 ms1, _ = _clock()
-                bad = []
-                for a in axes:
-                    gtn("GetHomeStatus", a, byref(hs))
-                    if hs.run or hs.stage != 100 or hs.error:
-                        bad.append(f"{a} (stage {hs.stage}, error {hs.error})")
-                if bad:
-                    raise BenchError(f"{len(bad)} axes did not home: {', '.join(bad[:8])}")
+                failed = [why for why in map(bad, axes) if why]
+                if failed:
+                    raise BenchError(f"{len(failed)} axes did not home: {', '.join(failed[:8])}")
             except BenchError as exc:
                 return {"error": str(exc)}
             finally:
