@@ -109,3 +109,10 @@ def test_figure_error_is_not_ok() -> None:
     assert bench._figure({"error": "x"}, "rtf", 10) == {"error": "x", "target": 10, "ok": False}
     assert bench._figure({"rtf": 12.0}, "rtf", 10)["ok"] is True
     assert bench._rss()["VmRSS_mb"] > 0
+
+
+def test_drive_homing_runs_to_its_end() -> None:
+    """Two axes homed by their drives (method 17) from the start to the end."""
+    r = bench_scaling.run_drive_homing(2, 17, repeat=1)
+    assert "error" not in r
+    assert r["controller_ms"] > 0 and r["rtf"] > 0 and r["rtf_cpu"] > 0
