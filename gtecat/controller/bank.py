@@ -1027,9 +1027,10 @@ class AxisBank:
         return not frozen_claimable(ch)
 
     def _eligible_homing(self, r: int) -> bool:
-        """An axis whose drive runs a homing search, or rests in homing mode after one
-        (gtecat.drives.homing_bank): the axis layer only follows it (607Ah = 6064h, the plan
-        = the actual position, the encoder), so the compiled cycle runs the row whole."""
+        """An axis whose drive runs a homing search, moves back onto the home point found, or
+        brakes and rests in homing mode after its homing (gtecat.drives.homing_bank), limit
+        flags latched or not: the axis layer only follows it (607Ah = 6064h, the plan = the
+        actual position, the encoder), so the compiled cycle runs the row whole."""
         if self.kernel is None:
             return False  # the numpy cycle has no homing rows
         ax, res = self.axes[r], self.res[r]
