@@ -1547,13 +1547,17 @@ def reader(
     ``pointer(x)`` of
     those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
     ``q`` omitted, None or 0 (where ``most`` is 2; 1: ``f(p)`` only), writing ``value()``
-    (GT_GetClock's ``pClock``, ``pLoop``; GT_IsEcatReady's ``pStatus``);
+    (GT_GetClock's ``pClock``, ``pLoop``; GT_IsEcatReady's ``pStatus``), or, where
+    ``clocks`` are given, ``q`` of those (as a pClock below) taking the clock's cycles run
+    (GT_GetClock's ``pLoop``);
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), clock)`` (``count`` an
     int, 1 where omitted; ``clock`` None where pClock is omitted, None or 0, and 1 where it
-    is ``byref(x)`` (no offset) or ``x`` of one of ``clocks``) gives the bytes written to the
-    array's start (it checks the array's type and length), then where ``clock`` is 1 the
-    clock's value (native int64; written into ``x`` where ``x``'s type holds it), else
-    anything but bytes;
+    is ``byref(x)`` (no offset), ``x`` or ``pointer(x)`` of one of ``clocks``) gives the bytes
+    written to the array's start (it checks the array's type and length), then where
+    ``clock`` is 1 the clock's value (native int64; written into ``x`` where ``x``'s type
+    holds it), else anything but bytes; for ``p`` a numpy array of ``numpy``'s dtypes and a
+    ``count`` of 2 or more, ``array(n, count, p.dtype, None)`` (the entry checks its
+    length) likewise;
     ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
     that gate of :data:`GATES` is open (else ``fallback``; ``after()``, where given, the
     call's return once its value is written while the gate says :data:`AUTO`), so they

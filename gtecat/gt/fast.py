@@ -368,9 +368,10 @@ def fast_reader(
         kw: dict,
         zeros: bool = True,
     ) -> Any:
-        """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
-        a poll of every axis in one call): the table path's values, or None when the shape
-        is any other (a numpy array, a span past the controller's axes: the table).  An axis
+        """``count`` axes from ``n`` into a ctypes array or a numpy array of the reader's
+        dtypes (``GT_GetSts(1, sts, 12, NULL)``, a poll of every axis in one call): the table
+        path's values, or None when the shape is any other (a strided, read-only or short
+        numpy array, a span past the controller's axes: the table).  An axis
         of the controller's that no drive backs reads 0 where ``zeros`` (core 1's own axes;
         a core view counts its axes its own way: the table path)."""
         if (
@@ -1284,10 +1285,11 @@ def fast_clock(
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
     """``GT_GetClock(pClock[, pLoop])`` with the fast path in front of the table: ``pClock``
-    ``byref(x)`` or ``x`` of an integer type of at least 32 bits (or a ctypes or numpy
-    array of one: its first element), ``pLoop`` omitted, None or 0, on the in-process
-    controller; anything else (a value the type cannot hold included)
-    takes the table path."""
+    ``byref(x)``, ``x`` or ``pointer(x)`` of an integer type of at least 32 bits (or a ctypes
+    or numpy array of one: its first element), ``pLoop`` omitted, None or 0, or (the
+    vendor's two-pointer form) one of those scalar shapes taking the cycles run, on the
+    in-process controller; anything else (a value the type cannot hold included) takes the
+    table path."""
     from .args import _scalar_types
     from .table import FUNCTIONS
 

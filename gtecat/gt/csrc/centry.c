@@ -4,7 +4,9 @@
  * for the axis, count absent or 1, pClock absent, None or 0, the value's pointer resolved to
  * the memory of an accepted ctypes object as the byref check does; a ctypes array, or byref of
  * one with or without an offset - C's &arr[k] - takes a span's values from that address where
- * they end within the object: array_of, array_mem), the reader's value comes
+ * they end within the object: array_of, array_mem; a numpy array of several values:
+ * np_array), pClock also pointer(x), GT_GetClock's pLoop the clock's cycles run, the reader's
+ * value comes
  * from one Python call (value(n): a number, or a sentinel when the C entry must not answer),
  * and the number is written into the object's memory with the object's width (a reader of
  * a structure: value(n) gives its bytes, copied whole).  Anything
