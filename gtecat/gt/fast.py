@@ -527,12 +527,13 @@ def fast_reader(
     public[0] = gt
     packers: dict[tuple[Any, int, str], Callable[..., bytes]] = {}
 
-    def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
+    def array_value(value: Callable[[Any], Any], gate: int) -> Callable[..., Any]:
         """The C entry's values for a ctypes array: ``f(n, count, array type, None)``
-        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one;
-        ``spans``: a span of axes too, as ``many`` answers them), else _NO (the Python path
-        answers).  A pClock's value the entry writes itself (GT_GetClock's: the
-        controller's time and GT_Reset's, ``centry.set_clock_ms``)."""
+        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one; a span
+        of axes too, as ``many`` answers them, of the controller behind ``gate``: 0 the GT_
+        form's, 1 the GTN_ form's core 1), else _NO (the Python path answers).  A pClock's
+        value the entry writes itself (GT_GetClock's: the controller's time and GT_Reset's,
+        ``centry.set_clock_ms``)."""
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
         last: list[Any] = [None, 0, None, False]
@@ -577,10 +578,10 @@ def fast_reader(
                     return _NO
                 values: Any = (v,)
             else:
-                if not spans or count > limit:
+                if count > limit:
                     return _NO
-                # (the GT_ form's entry asks only while the GT_ gate is open: its controller)
-                ctl = GATED[0]
+                # (an entry asks only while its gate is open: that gate's controller)
+                ctl = GATED[gate]
                 b = ctl.bank
                 ln = lane  # (one read: another thread may replace it meanwhile)
                 if (
@@ -656,14 +657,15 @@ def fast_reader(
         entry = centry.reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
-            array=array_value(value_gt, True), gate=centry.GT_GATE,
+            array=array_value(value_gt, 0), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
             clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
-            core=True, pointers=True, array=array_value(value_gtn, False),
+            core=True, pointers=True, array=array_value(value_gtn, 1),
+            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
             numpy=sorted(np_ok, key=str),
         )  # fmt: skip

@@ -754,8 +754,11 @@ def _span_session(tmp_path: Path, clock: str, way: str) -> tuple[list, int]:
             if clock == "lockstep":
                 gt.GTE_Wait(1 + step % 4)
             for name in sorted(fast.READERS):
-                fn = getattr(gt, name)
-                fn = {"c": fn, "python": getattr(fn, "python", fn), "table": fn.slow}[way]
+                f = getattr(gt, name)
+                fn = {"c": f, "python": getattr(f, "python", f), "table": f.slow}[way]
+                # the GTN_ form with core 1 (its C entry; else its table path, which its Python
+                # function's spans are)
+                gtn = getattr(gt, "GTN_" + name[3:]) if way == "c" else f.gtn_slow
                 t = ctypes.c_double if ctypes.c_double in fast.READERS[name][1] else ctypes.c_long
                 dt = np.float64 if t is ctypes.c_double else np.int32
                 most = fast.READ_LIMITS.get(name, 16)
@@ -773,6 +776,16 @@ def _span_session(tmp_path: Path, clock: str, way: str) -> tuple[list, int]:
                         seen.append(
                             (step, name, first, count, kind, rc, bytes(arr), clk.value, why)
                         )
+                        if kind == "numpy" and step % 3:
+                            continue
+                        arr = (t * 16)() if kind == "ctypes" else np.zeros(16, dt)
+                        if span:
+                            pr.enable()
+                        rc = gtn(1, first, arr, count, ctypes.pointer(clk))
+                        pr.disable()
+                        why = gt.GTE_GetLastError() if rc else ""
+                        seen.append((step, "GTN", name, first, count, kind, rc, bytes(arr), why))
+                        seen.append(clk.value)
         stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
         python = sum(
             v[1]
@@ -792,13 +805,14 @@ def test_spans_past_twelve_axes_read_as_the_table_on_the_fast_path(
     """``GT_GetSts(1, sts, 16, &clk)`` on a controller of 16 axes (and every reader, from
     several axes, into ctypes and numpy arrays): the table path's values, clock, codes and
     refusals (a span past the controller's axes, axis 0, an encoder reader's more than 8),
-    step by step while every axis moves; the spans it answers with 0 never reach Python's
-    general way nor the table (the C entry), on both clocks."""
+    step by step while every axis moves, and the GTN_ form with core 1 (a ``pointer`` to the
+    clock); the spans it answers with 0 never reach Python's general way nor the table (the
+    C entry), on both clocks."""
     fast_seen, python = _span_session(tmp_path, clock, "c")
     table_seen, _ = _span_session(tmp_path, clock, "table")
     assert fast_seen == table_seen
     assert _span_session(tmp_path, clock, "python")[0] == table_seen
-    codes = {(name, first, count, rc) for _, name, first, count, _, rc, *_ in fast_seen}
+    codes = {(x[1], x[2], x[3], x[5]) for x in fast_seen if type(x) is tuple and x[1] != "GTN"}
     assert ("GT_GetSts", 1, 16, 0) in codes and ("GT_GetSts", 2, 16, 7) in codes
     assert ("GT_GetEncPos", 1, 16, 7) in codes
     assert python == 0
