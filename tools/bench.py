@@ -28,7 +28,7 @@ interleaved, and every call shape of the fast path likewise (the worst ratio is 
 and every function with a fast path in every way a client passes its value's pointer
 (``every_call_shape_vs_arguments``, the same bar), that walk and the call shapes again with
 the controller on the auto clock (``every_call_shape_vs_arguments_auto``: each poll carries
-its share of the cycles; the same bar);
+its share of the cycles; the same bar), both walks with the spans of a 16-axis controller;
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -401,8 +401,10 @@ def every_shape(
     and a numpy array of one element, and NULL (0, None) for the optional pointer after it
     (``count`` 1 first for the readers of a span), a pointer into an array (``byref(arr)``,
     ``byref(arr, k * sizeof(elem))``: C's ``&arr[k]``; for the readers of a span, two values
-    there too), and for the readers that take ``pClock`` their shapes with a clock pointer
-    (``byref`` of it, the object itself, with one value and with a span); each call written
+    there too; ``pointer(s)``; a numpy array of several values), and for the readers that
+    take ``pClock`` their shapes with a clock pointer (``byref`` of it, the object itself,
+    ``pointer`` of it, with one value and with a span), GT_GetClock's two pointers (pClock
+    and pLoop, the vendor's form); each call written
     out as a client writes
     it (no ``*args``), with the statement that builds the same arguments and their names.
     ``names``: these functions instead (a comparison with another version).  The controller
@@ -442,6 +444,7 @@ def every_shape(
             "arr4": (t * 4)(),
             "k": sizeof(t),
             "byref": byref,
+            "pointer": pointer,
             "np": np,
             "c_ulong": c_ulong,
         }
@@ -463,6 +466,23 @@ def every_shape(
                 f"fn({x}byref(arr4, k), 2, None)",
                 "byref(arr4, k)",
             )
+            shapes["pointer(s)"] = ("pointer", f"fn({x}pointer(held))", "pointer(held)")
+        if name == fast.CLOCK:
+            # the vendor's two-pointer form GT_GetClock(&clk, &loop), as clients pass it
+            env["loop"] = c_ulong()
+            shapes |= {
+                "byref(s), byref(loop)": (
+                    "loop byref",
+                    "fn(byref(held), byref(loop))",
+                    "byref(held); byref(loop)",
+                ),
+                "s, loop": ("loop object", "fn(held, loop)", "t(); c_ulong()"),
+                "pointer(s), pointer(loop)": (
+                    "loop pointer",
+                    "fn(pointer(held), pointer(loop))",
+                    "pointer(held); pointer(loop)",
+                ),
+            }
         if [q.name for q in rest] == ["count", "pClock"]:
             # the clock pointer too (the vendor's form of a loop that timestamps its reads)
             env["clk"] = c_ulong()
@@ -483,14 +503,26 @@ def every_shape(
                     f"fn({x}byref(arr4, k), 2, clk)",
                     "byref(arr4, k)",
                 ),
+                # the clock as pointer(x)
+                "byref(s), 1, pointer(clk)": (
+                    "clock pointer",
+                    f"fn({x}byref(held), 1, pointer(clk))",
+                    "byref(held); pointer(clk)",
+                ),
             }
         if t in dtypes:
             env["npa"], env["dt"] = np.zeros(1, dtypes[t]), dtypes[t]
-            shapes[f"numpy {np.dtype(dtypes[t]).name}[1]"] = (
-                "numpy[1]",
-                f"fn({x}npa)",
-                "np.zeros(1, dt)",
-            )
+            dn = np.dtype(dtypes[t]).name
+            shapes[f"numpy {dn}[1]"] = ("numpy[1]", f"fn({x}npa)", "np.zeros(1, dt)")
+            if name in fast.READERS:  # (numpy arrays of several values)
+                env["npa4"] = np.zeros(4, dtypes[t])
+                shapes[f"numpy {dn}[4], 2"] = ("numpy span", f"fn({x}npa4, 2)", "np.zeros(4, dt)")
+                if "clk" in env:
+                    shapes[f"numpy {dn}[4], 2, byref(clk)"] = (
+                        "numpy span clock",
+                        f"fn({x}npa4, 2, byref(clk))",
+                        "byref(clk)",
+                    )
         if null:
             for z in ("0", "None"):
                 shapes[f"byref(s), {count}{z}"] = (
@@ -510,6 +542,70 @@ def every_shape(
     return out, skipped
 
 
+#: spans of a controller of 16 axes (more than chapter 13's 12), every axis moving in Trap:
+#: a poll of every axis in one call, into ctypes and numpy arrays (:func:`bench_every_shape`)
+WIDE_SHAPES: dict[str, tuple[str, str]] = {
+    "GT_GetSts(1, c_long[16], 16, byref(clk))": (
+        "gt.GT_GetSts(1, sts16, 16, byref(clk))",
+        "byref(clk)",
+    ),
+    "GT_GetSts(1, c_long[16], 16)": ("gt.GT_GetSts(1, sts16, 16)", "(c_long * 16)()"),
+    "GT_GetSts(1, numpy int32[16], 16)": ("gt.GT_GetSts(1, np16, 16)", "np.zeros(16, np.int32)"),
+    "GT_GetPrfPos(1, c_double[16], 16, None)": (
+        "gt.GT_GetPrfPos(1, d16, 16, None)",
+        "(c_double * 16)()",
+    ),
+    "GT_GetPrfPos(1, numpy float64[16], 16, byref(clk))": (
+        "gt.GT_GetPrfPos(1, npd16, 16, byref(clk))",
+        "byref(clk)",
+    ),
+    "GT_GetSts(5, byref(sts16, 8), 12, pointer(clk))": (
+        "gt.GT_GetSts(5, byref(sts16, 8), 12, pointer(clk))",
+        "byref(sts16, 8); pointer(clk)",
+    ),
+}
+
+
+def _wide_pairs(clock: str) -> dict[str, tuple[str, str, dict[str, object]]]:
+    """:data:`WIDE_SHAPES` with their names, on a 16-axis bus opened on ``clock`` (every axis
+    on and moving in Trap; a shape that does not return 0: left out); the caller closes
+    it."""
+    import numpy as np
+
+    from gtecat import gt
+    from tools.gen_axes_eni import write_axes_eni
+
+    with tempfile.TemporaryDirectory() as tmp:  # (GT_InitEcatComm reads the ENI too)
+        eni = write_axes_eni(16, Path(tmp) / "axes16.eni")
+        gt.GT_Open(eni=str(eni), clock=clock, log="")
+        gt.GT_InitEcatComm()
+        ready = c_short()
+        for _ in range(10_000):
+            if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+                break
+            gt.GTE_Wait(1)
+        gt.GT_StartEcatComm()
+    for a in range(1, 17):
+        gt.GT_AxisOn(a)
+    gt.GTE_Wait(20)
+    for a in range(1, 17):
+        prm = gt.TTrapPrm()
+        prm.acc = prm.dec = 0.3
+        gt.GT_PrfTrap(a)
+        gt.GT_SetTrapPrm(a, byref(prm))
+        gt.GT_SetPos(a, 80_000_000 * (-1) ** a)
+        gt.GT_SetVel(a, 15 + a)
+    gt.GT_Update(0xFFFF)
+    gt.GTE_Wait(30)
+    env = _shape_env() | {
+        "sts16": (c_long * 16)(),
+        "d16": (c_double * 16)(),
+        "np16": np.zeros(16, np.int32),
+        "npd16": np.zeros(16, np.float64),
+    }
+    return {f"{k} (16 axes)": (*v, env) for k, v in WIDE_SHAPES.items() if eval(v[0], env) == 0}
+
+
 def bench_every_shape(
     seconds: float = 20.0,
     block: int = 200,
@@ -520,8 +616,9 @@ def bench_every_shape(
 ) -> dict[str, object]:
     """:func:`every_shape` on figure 5-2's bus (axis 1 on; ``clock``: the controller's clock,
     ``raw``: with :data:`CALL_SHAPES` too - the raw image functions' shapes among them),
-    each against building its arguments in alternating blocks; ``worst`` the largest ratio,
-    ``above_4`` the shapes above the bar.  On the auto clock every call costs its host
+    each against building its arguments in alternating blocks, then (the whole walk, no
+    ``names``) :data:`WIDE_SHAPES` on a 16-axis bus on the same clock; ``worst`` the largest
+    ratio, ``above_4`` the shapes above the bar.  On the auto clock every call costs its host
     latency of controller time, so a call's figure carries its share of the cycles that run
     (one 1 ms cycle every 20 calls)."""
     from gtecat import gt
@@ -539,6 +636,13 @@ def bench_every_shape(
             env = _shape_env()
             pairs |= {k: (*v, env) for k, v in CALL_SHAPES.items()}
         shapes = _time_pairs(pairs, seconds, block)
+        if names is None:  # (the spans of a controller of more than 12 axes)
+            gt.GT_Close()
+            wide = _wide_pairs(clock)
+            shapes |= _time_pairs(wide, seconds * len(wide) / max(1, len(pairs)), block)
+            for k in WIDE_SHAPES:
+                if f"{k} (16 axes)" not in wide:
+                    skipped[f"{k} (16 axes)"] = "does not return 0 on the 16-axis bus"
     finally:
         gt.GT_Close()
     worst = max((r["ratio"] for r in shapes.values()), default=0.0)

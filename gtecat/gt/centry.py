@@ -183,6 +183,7 @@ class _Entry(ctypes.Structure):
         ("stride", ctypes.c_ssize_t),
         ("tuple_type", _VP),
         ("titems", ctypes.c_ssize_t),
+        ("cderefs", ctypes.c_ssize_t * _MAX_TYPES),
     ]
 
 
@@ -341,7 +342,8 @@ def set_clock_ms(gt: Any, gtn: Any) -> None:
             for a, n in ((q, QUICK_LEN), (origin, 1))
         )
         _ORIGINS[k] = (q, origin) if ok else None
-        CLOCK_MS[2 * k] = q.buffer_info()[0] + 9 * q.itemsize if ok else 0  # (now_ns: [9])
+        # (now_ns: [9]; the cycles run, GT_GetClock's pLoop, the word after it: [10])
+        CLOCK_MS[2 * k] = q.buffer_info()[0] + 9 * q.itemsize if ok else 0
         CLOCK_MS[2 * k + 1] = origin.buffer_info()[0] if ok else 0
 
 
@@ -887,7 +889,18 @@ def _load() -> tuple[Maker | None, str]:
             e.types[k] = id(t)
             e.sizes[k] = size or ctypes.sizeof(x)
             e.signs[k] = int(kind != INT or not getattr(x, "_type_", "").isupper())
-        cks = _type_table(e.ctypes_, e.csizes, e.csigns, clocks, INT)
+        cks = tuple(clocks)
+        if cks:  # (pointer(x) too: x's memory, of x's type)
+            cks += tuple(ctypes.POINTER(t) for t in cks)
+            _pointer_types_of_ctypes()
+        if len(cks) >= _MAX_TYPES:
+            raise ValueError(f"at most {(_MAX_TYPES - 1) // 2} clock types")
+        for k, t in enumerate(cks):
+            pointer = issubclass(t, ctypes._Pointer)
+            x = t._type_ if pointer else t
+            e.ctypes_[k], e.csizes[k] = id(t), ctypes.sizeof(x)
+            e.csigns[k] = int(not x._type_.isupper())
+            e.cderefs[k] = id(x) if pointer else 0
         dts = tuple(numpy) if api.ndarray_type else ()
         if len(dts) >= 8:
             raise ValueError("at most seven numpy dtypes")
@@ -1534,13 +1547,17 @@ def reader(
     ``pointer(x)`` of
     those types too (``x``'s memory; NULL: ``fallback``); ``noaxis``: ``f(p[, q])`` with
     ``q`` omitted, None or 0 (where ``most`` is 2; 1: ``f(p)`` only), writing ``value()``
-    (GT_GetClock's ``pClock``, ``pLoop``; GT_IsEcatReady's ``pStatus``);
+    (GT_GetClock's ``pClock``, ``pLoop``; GT_IsEcatReady's ``pStatus``), or, where
+    ``clocks`` are given, ``q`` of those (as a pClock below) taking the clock's cycles run
+    (GT_GetClock's ``pLoop``);
     ``array``: for ``p`` a ctypes array, ``array(n, count, type(p), clock)`` (``count`` an
     int, 1 where omitted; ``clock`` None where pClock is omitted, None or 0, and 1 where it
-    is ``byref(x)`` (no offset) or ``x`` of one of ``clocks``) gives the bytes written to the
-    array's start (it checks the array's type and length), then where ``clock`` is 1 the
-    clock's value (native int64; written into ``x`` where ``x``'s type holds it), else
-    anything but bytes;
+    is ``byref(x)`` (no offset), ``x`` or ``pointer(x)`` of one of ``clocks``) gives the bytes
+    written to the array's start (it checks the array's type and length), then where
+    ``clock`` is 1 the clock's value (native int64; written into ``x`` where ``x``'s type
+    holds it), else anything but bytes; for ``p`` a numpy array of ``numpy``'s dtypes and a
+    ``count`` of 2 or more, ``array(n, count, p.dtype, None)`` (the entry checks its
+    length) likewise;
     ``gate``: :data:`GT_GATE` or :data:`GTN_GATE`, ``value`` and ``array`` asked only while
     that gate of :data:`GATES` is open (else ``fallback``; ``after()``, where given, the
     call's return once its value is written while the gate says :data:`AUTO`), so they

@@ -323,17 +323,19 @@ def fast_reader(
             return None
         if not takes_clock:
             return False
-        obj = clock_target(pClock)
-        tp = type(obj)
-        if tp not in _CLOCK_INTS:
+        obj = clock_scalar(clock_target, pClock)
+        if obj is None:
             return False
+        tp = type(obj)
         ms = ctl.clock_ms() & 0xFFFFFFFF
         if ms > _INT_MAX[tp]:
             return False
         return obj, ms
 
     own_limit = READ_LIMITS.get(name)  # the function's own (its table path refuses more)
-    limit = CONTROLLER_AXES if own_limit is None else own_limit
+    # (no limit of its own: a span of any length inside the controller's axes, which span()
+    # proves; a count no C short holds: the table path)
+    limit = _SHORT_MAX if own_limit is None else own_limit
     bank_key = BANK_LISTS.get(name)
     #: a reader whose value a row of the bank gives through a link or a bit (DERIVED): a
     #: span's plan writes each row's value as BANK_ROWS' expression (that row alone, not
@@ -367,9 +369,10 @@ def fast_reader(
         kw: dict,
         zeros: bool = True,
     ) -> Any:
-        """``count`` axes from ``n`` into a ctypes array (``GT_GetSts(1, sts, 12, NULL)``,
-        a poll of every axis in one call): the table path's values, or None when the shape
-        is any other (a numpy array, a span past the controller's axes: the table).  An axis
+        """``count`` axes from ``n`` into a ctypes array or a numpy array of the reader's
+        dtypes (``GT_GetSts(1, sts, 12, NULL)``, a poll of every axis in one call): the table
+        path's values, or None when the shape is any other (a strided, read-only or short
+        numpy array, a span past the controller's axes: the table).  An axis
         of the controller's that no drive backs reads 0 where ``zeros`` (core 1's own axes;
         a core view counts its axes its own way: the table path)."""
         if (
@@ -386,7 +389,16 @@ def fast_reader(
         if clk is False:
             return None
         tp = type(p)
-        if not (is_array(tp) and tp._length_ >= count):
+        if tp is _NDARRAY:  # (as the count-1 shape takes it: one C-contiguous writable row)
+            if not (
+                p.dtype in np_ok
+                and p.ndim == 1
+                and p.size >= count
+                and p.flags.writeable
+                and p.flags.c_contiguous
+            ):
+                return None
+        elif not (is_array(tp) and tp._length_ >= count):
             return None
         if count > limit:
             if own_limit is None or ctl.card is not None:
@@ -412,6 +424,8 @@ def fast_reader(
         """The values of ``count`` axes from ``n`` (a sequence), None where the table path
         answers (an axis of the span neither on the bus nor, where ``zeros``, one of the
         controller's that no drive backs, which reads 0)."""
+        if count > CONTROLLER_AXES and not 1 <= n <= n + count - 1 <= resource_count(ctl):
+            return None  # (past the controller's axes: the table path's 7 and reason)
         resources = ctl.resources
         axes = ctl.axes
         b = ctl.bank
@@ -512,17 +526,18 @@ def fast_reader(
     gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
     public[0] = gt
-    packers: dict[tuple[type, int], Callable[..., bytes]] = {}
+    packers: dict[tuple[Any, int, str], Callable[..., bytes]] = {}
 
-    def array_value(value: Callable[[Any], Any], spans: bool) -> Callable[..., Any]:
+    def array_value(value: Callable[[Any], Any], gate: int) -> Callable[..., Any]:
         """The C entry's values for a ctypes array: ``f(n, count, array type, None)``
-        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one;
-        ``spans``: a span of axes too, as ``many`` answers them), else _NO (the Python path
-        answers).  A pClock's value the entry writes itself (GT_GetClock's: the
-        controller's time and GT_Reset's, ``centry.set_clock_ms``)."""
+        gives the bytes of ``count`` values from axis ``n`` (``value(n)``'s for one; a span
+        of axes too, as ``many`` answers them, of the controller behind ``gate``: 0 the GT_
+        form's, 1 the GTN_ form's core 1), else _NO (the Python path answers).  A pClock's
+        value the entry writes itself (GT_GetClock's: the controller's time and GT_Reset's,
+        ``centry.set_clock_ms``)."""
 
         #: the last shape's array type, count and packer (a polling loop repeats its shape)
-        last: list[Any] = [None, 0, None]
+        last: list[Any] = [None, 0, None, False]
         #: the last integers packed: the packer, the values, their bytes, and where they
         #: were picked from a list of the bank by a plan of its rows and zeros alone: that
         #: list and the plan's getter (else None)
@@ -536,16 +551,24 @@ def fast_reader(
             # (a shape seen before: its packer, kept only for an array the reader takes)
             seen = last  # (one read: another thread may replace it meanwhile)
             if tp is seen[0] and count == seen[1]:
-                pack = seen[2]
+                pack, ints = seen[2], seen[3]
             else:
-                pack = packers.get((tp, count))
-                if pack is None:
+                if type(tp) is not _ARRAY_META:
+                    # a numpy array's dtype (the entry checked its array: one C-contiguous
+                    # writable row of at least ``count`` elements, as ``many`` takes it)
+                    if not (tp in np_ok and 2 <= count <= limit):
+                        return _NO
+                    code = tp.char
+                else:
                     if not (is_array(tp) and 1 <= count <= tp._length_):
                         return _NO
-                    # (the array's own element type, natively)
-                    pack = struct.Struct(f"@{count}{tp._type_._type_}").pack
-                    packers[tp, count] = pack
-                last[:] = [tp, count, pack]
+                    code = tp._type_._type_  # (the array's own element type, natively)
+                pack = packers.get((tp, count, code))
+                if pack is None:
+                    pack = struct.Struct(f"@{count}{code}").pack
+                    packers[tp, count, code] = pack
+                ints = code in _INT_CODES  # (not floats: -0.0 == 0.0)
+                last[:] = [tp, count, pack, ints]
             if clock is not None:  # (the entry writes a pClock itself: asked without)
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
@@ -556,10 +579,10 @@ def fast_reader(
                     return _NO
                 values: Any = (v,)
             else:
-                if not spans or count > limit:
+                if count > limit:
                     return _NO
-                # (the GT_ form's entry asks only while the GT_ gate is open: its controller)
-                ctl = GATED[0]
+                # (an entry asks only while its gate is open: that gate's controller)
+                ctl = GATED[gate]
                 b = ctl.bank
                 ln = lane  # (one read: another thread may replace it meanwhile)
                 if (
@@ -616,7 +639,7 @@ def fast_reader(
                     out = pack(*values)
                 except struct.error:  # (a value the element does not hold: the Python path)
                     return _NO
-                if tp._type_._type_ in _INT_CODES:  # (not floats: -0.0 == 0.0)
+                if ints:
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
             # status words of the bank's rows and zeros alone stand across the cycles the C
@@ -635,14 +658,15 @@ def fast_reader(
         entry = centry.reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
-            array=array_value(value_gt, True), gate=centry.GT_GATE,
+            array=array_value(value_gt, 0), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
             clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
-            core=True, pointers=True, array=array_value(value_gtn, False),
+            core=True, pointers=True, array=array_value(value_gtn, 1),
+            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
             numpy=sorted(np_ok, key=str),
         )  # fmt: skip
@@ -1238,6 +1262,25 @@ _INT_MAX.update(
 )
 
 
+_CLOCK_POINTERS: dict[type, bool] = {}
+
+
+def clock_scalar(target: Callable[[Any], Any], p: Any) -> Any:
+    """The integer a clock argument (``pClock``, GT_GetClock's ``pLoop``) writes: ``x`` for
+    ``byref(x)`` (``target``'s check), ``x`` itself or ``pointer(x)`` (:func:`pointee`) of
+    an integer type of :data:`_CLOCK_INTS`; None for anything else (the table path)."""
+    obj = target(p)
+    tp = type(obj)
+    if tp in _CLOCK_INTS:
+        return obj
+    ok = _CLOCK_POINTERS.get(tp)
+    if ok is None:
+        ok = _CLOCK_POINTERS[tp] = (
+            issubclass(tp, ctypes._Pointer) and getattr(tp, "_type_", None) in _CLOCK_INTS
+        )
+    return pointee(p) if ok else None
+
+
 def fast_clock(
     name: str,
     slow: Callable[..., int],
@@ -1245,10 +1288,11 @@ def fast_clock(
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
     """``GT_GetClock(pClock[, pLoop])`` with the fast path in front of the table: ``pClock``
-    ``byref(x)`` or ``x`` of an integer type of at least 32 bits (or a ctypes or numpy
-    array of one: its first element), ``pLoop`` omitted, None or 0, on the in-process
-    controller; anything else (a value the type cannot hold included)
-    takes the table path."""
+    ``byref(x)``, ``x`` or ``pointer(x)`` of an integer type of at least 32 bits (or a ctypes
+    or numpy array of one: its first element), ``pLoop`` omitted, None or 0, or (the
+    vendor's two-pointer form) one of those scalar shapes taking the cycles run, on the
+    in-process controller; anything else (a value the type cannot hold included) takes the
+    table path."""
     from .args import _scalar_types
     from .table import FUNCTIONS
 
@@ -1257,7 +1301,13 @@ def fast_clock(
 
     def gt(pClock: Any = _NO, pLoop: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if (
-            (pLoop is _NO or pLoop is None or (type(pLoop) is int and pLoop == 0))
+            (
+                pLoop is _NO
+                or pLoop is None
+                or (type(pLoop) is int and pLoop == 0)
+                # the vendor's two-pointer form: the cycles run into pLoop too
+                or (loop := clock_scalar(target, pLoop)) is not None
+            )
             and not kw
             and not extra
         ):
@@ -1279,27 +1329,34 @@ def fast_clock(
                     elif tp in _CLOCK_INTS:
                         obj = pClock
                     else:
-                        obj = None
+                        obj = clock_scalar(target, pClock)  # (pointer(x): x)
+                    # GT_GetClock's own values (Controller.clock_ms, inline; the cycles run)
+                    ms = ((clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
+                    if pLoop is _NO or pLoop is None or type(pLoop) is int:
+                        loop = None
+                    else:
+                        cycles = clock.cycles & 0xFFFFFFFF
+                        if cycles > _INT_MAX[type(loop)]:  # (its bit pattern: the table)
+                            obj = q = None
+                            tp = type(None)
                     if obj is None:  # an array: its first element
                         b = first(q, tp)
-                        if b is not None:
-                            ms = ctl.clock_ms() & 0xFFFFFFFF  # GT_GetClock's own value
-                            if ms <= b[1]:
-                                q[0] = ms
-                                session.last = None
-                                if clock.mode is _LOCKSTEP:
-                                    return 0
-                                return advance(ctl, name, 0)
-                        obj = None
-                    if obj is not None:
-                        # GT_GetClock's own value (Controller.clock_ms, inline)
-                        ms = ((clock.now_ns - ctl.reset_ns) // 1_000_000) & 0xFFFFFFFF
-                        if ms <= _INT_MAX[type(obj)]:
-                            obj.value = ms
+                        if b is not None and ms <= b[1]:
+                            q[0] = ms
+                            if loop is not None:
+                                loop.value = cycles
                             session.last = None
                             if clock.mode is _LOCKSTEP:
                                 return 0
                             return advance(ctl, name, 0)
+                    elif ms <= _INT_MAX[type(obj)]:
+                        obj.value = ms
+                        if loop is not None:
+                            loop.value = cycles
+                        session.last = None
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
         return slow(*(a for a in (pClock, pLoop) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
@@ -1319,6 +1376,8 @@ def fast_clock(
     elements = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
     entry = centry.reader(
         gt, value, _NO, types, centry.INT, most=2, noaxis=True, gate=centry.GT_GATE,
+        clocks=types,  # (pLoop's: byref(x), x or pointer(x), the cycles run written there)
+        pointers=True,  # (pointer(x) too, as the Python path)
         after=_after(advance, name, 0),
         numpy=_int_dtypes(_scalar_types(FUNCTIONS[name].params[0])),  # (as ``first``)
         array=_first_element(lambda _: value(), elements),

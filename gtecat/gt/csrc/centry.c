@@ -4,7 +4,9 @@
  * for the axis, count absent or 1, pClock absent, None or 0, the value's pointer resolved to
  * the memory of an accepted ctypes object as the byref check does; a ctypes array, or byref of
  * one with or without an offset - C's &arr[k] - takes a span's values from that address where
- * they end within the object: array_of, array_mem), the reader's value comes
+ * they end within the object: array_of, array_mem; a numpy array of several values:
+ * np_array), pClock also pointer(x), GT_GetClock's pLoop the clock's cycles run, the reader's
+ * value comes
  * from one Python call (value(n): a number, or a sentinel when the C entry must not answer),
  * and the number is written into the object's memory with the object's width (a reader of
  * a structure: value(n) gives its bytes, copied whole).  Anything
@@ -185,6 +187,8 @@ struct entry {
      * bytes are status words alone (NULL: avalue gives bytes only) */
     obj tuple_type;
     ptrdiff_t titems;
+    /* per clock type of ctypes_: a ctypes pointer type's _type_ (pointer(x): x's memory), 0 */
+    ptrdiff_t cderefs[MAX_TYPES];
 };
 
 static struct api A;
@@ -642,29 +646,30 @@ static char *reader_mem(obj p, obj target, obj deref);
  * NULL-ended types (at most n), its size and sign in *size and *sign; NULL where it is not
  * (reader_mem: what proves the memory). */
 static char *typed_mem(obj p, obj const *types, const ptrdiff_t *sizes, const ptrdiff_t *signs,
-                       int n, int *size, int *sign)
+                       const ptrdiff_t *derefs, int n, int *size, int *sign)
 {
     obj target = p, tp = TYPE(p);
+    int k;
     if (tp == A.carg_type) {
         target = AT(p, A.carg_obj);
         if (!target)
             return NULL;
         tp = TYPE(target);
     }
-    if (find_type(types, sizes, signs, n, tp, size, sign) < 0)
+    if ((k = find_type(types, sizes, signs, n, tp, size, sign)) < 0)
         return NULL;
-    return reader_mem(p, target, NULL);
+    return reader_mem(p, target, derefs ? (obj)derefs[k] : NULL);
 }
 
-/* A span's pClock: NULL (omitted, None or 0: *clock 0) or the memory of byref(x) (no
- * offset) or x of one of the entry's clock types (*clock 1, its size and sign); 0 where
- * this entry does not take it. */
+/* A span's pClock (or GT_GetClock's pLoop): NULL (omitted, None or 0: *mem NULL) or the
+ * memory of byref(x) (no offset), x or pointer(x) of one of the entry's clock types (its
+ * size and sign); 0 where this entry does not take it. */
 static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *sign)
 {
     *mem = NULL;
     if (pc == A.none || pc == A.zero || int_is(pc, 0))
         return 1;
-    *mem = typed_mem(pc, e->ctypes_, e->csizes, e->csigns, MAX_TYPES, size, sign);
+    *mem = typed_mem(pc, e->ctypes_, e->csizes, e->csigns, e->cderefs, MAX_TYPES, size, sign);
     return *mem != NULL;
 }
 
@@ -679,6 +684,18 @@ int gtecat_centry_clock_ms(const ptrdiff_t *at)
 {
     clock_ms_at = at;
     return 0;
+}
+
+/* Gate g's clock's cycles run in *cycles (Clock.cycles, the word after its now_ns in the
+ * clock's quick array: gtecat.master.clock), 32 bits as GT_GetClock's pLoop stores them; 0
+ * where the gate has none (the Python path answers). */
+static int clock_cycles(ptrdiff_t g, long long *cycles)
+{
+    const long long *now;
+    if (!clock_ms_at || g < 1 || g > 2 || !(now = (const long long *)clock_ms_at[2 * g - 2]))
+        return 0;
+    *cycles = now[1] & 0xFFFFFFFFLL;
+    return 1;
 }
 
 /* Gate g's clock value in *ms (Python's ((now - reset) // 1000000) & 0xFFFFFFFF); 0 where
@@ -853,6 +870,64 @@ python:
     return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
 }
 
+static char *np_mem(const struct entry *e, obj p, int *size, int *sign);
+
+/* A reader's numpy array of count >= 2 values from n (pClock NULL or a clock's pointer):
+ * the bytes avalue(n, count, the array's dtype, None) gives (of the entry's dtypes, one
+ * C-contiguous writable dimension of at least count elements: np_mem, before and after)
+ * copied to its start, kept for the epoch as array()'s. */
+static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
+                    ptrdiff_t at, int locked)
+{
+    obj call[4], v, p = args[at + 1];
+    ptrdiff_t n;
+    long long an, ac, clk = 0;
+    char *cmem = NULL, *mem;
+    int csize = 0, csign = 1, over = 0, size = 0, sign = 1;
+    call[0] = args[at];
+    call[1] = args[at + 2];
+    if (TYPE(call[1]) != A.int_type || !np_mem(e, p, &size, &sign))
+        goto python;
+    if (nargs >= 4 + at && !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
+        goto python;
+    an = A.as_ll(call[0], &over);
+    if (!over)
+        ac = A.as_ll(call[1], &over);
+    if (over || A.err_occurred()) {
+        if (A.err_occurred())
+            A.err_clear();
+        goto python;
+    }
+    if (ac < 2 || *(ptrdiff_t *)AT(p, A.nd_dims) < ac)
+        goto python;
+    call[2] = (obj)AT(p, A.nd_descr);
+    call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
+    v = array_value(e, call, an, ac, 0, locked);
+    if (!v || v == AGAIN)
+        return v;
+    if (v == PYTHON)
+        goto python;
+    n = *(ptrdiff_t *)((char *)v + A.bsize);
+    if (cmem) { /* (again: Python may have run) */
+        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
+            !clock_for(e, csize, csign, &clk))
+            goto drop;
+    }
+    mem = np_mem(e, p, &size, &sign); /* (again, and the bytes fit: count whole values) */
+    if (!mem || *(ptrdiff_t *)AT(p, A.nd_dims) < ac || (obj)AT(p, A.nd_descr) != call[2] ||
+        n != ac * (long long)size)
+        goto drop;
+    memcpy(mem, (char *)v + A.bdata, (size_t)n);
+    if (cmem)
+        put(cmem, clk, csize);
+    A.decref(v);
+    return done(e->after, e->gate);
+drop:
+    A.decref(v);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
 /* A one-pointer reader's ctypes array (f(p[, NULL]): noaxis): the bytes avalue(0, 1, array
  * type, None) gives (its value in the first element; it checks the array's type and
  * length) copied to the array's start, kept for the epoch as array()'s. */
@@ -953,22 +1028,29 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v, arr;
-    char *mem, *cmem = NULL;
+    char *mem, *cmem = NULL, *lmem = NULL;
     obj deref = NULL;
-    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1;
-    long long key = -1, ep = -1, ep0 = -1, clk = 0;
+    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1;
+    long long key = -1, ep = -1, ep0 = -1, clk = 0, loop = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
     if (!locked && elsewhere(e->gate))
         return AGAIN; /* (the Python path too answers holding the lock then) */
     if (e->noaxis) {
-        if (nargs < 1 || nargs > 2 || nargs > e->most ||
-            (nargs == 2 && args[1] != A.none && !int_is(args[1], 0)))
+        if (nargs < 1 || nargs > 2 || nargs > e->most)
+            goto python;
+        /* q NULL, or (the entry's clock types: GT_GetClock's pLoop) byref(x), x or pointer(x):
+         * the clock's cycles run written there too (clock_cycles) */
+        if (nargs == 2 && args[1] != A.none && !int_is(args[1], 0) &&
+            (!e->ctypes_[0] || !clock_mem(e, args[1], &lmem, &lsize, &lsign) || !lmem))
             goto python;
         p = args[0];
-        if (e->avalue && (arr = array_of(p)) != NULL)
+        if (e->avalue && (arr = array_of(p)) != NULL) {
+            if (lmem)
+                goto python;
             return first_of(e, args, nargs, kwnames, arr, locked);
+        }
     } else {
         if (nargs < 2 + at || nargs > e->most + at)
             goto python;
@@ -978,6 +1060,11 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             goto python;
         if (e->avalue && (arr = array_of(args[at + 1])) != NULL)
             return array(e, args, nargs, kwnames, at, arr, locked);
+        /* a numpy array of several values (count 2 or more) */
+        if (e->avalue && e->nptypes[0] && nargs >= 3 + at &&
+            TYPE(args[at + 1]) == A.ndarray_type && args[at + 2] != A.one &&
+            !int_is(args[at + 2], 1))
+            return np_array(e, args, nargs, kwnames, at, locked);
         /* (the cached small ints 1 and 0 first: one compare for the common literals) */
         if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
@@ -1027,6 +1114,10 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     if (key >= 0 && ep >= 0)
         keep(&e->cache[key], ep, v);
 have:
+    /* q: the cycles run (again: Python ran; a number the type does not hold: Python's) */
+    if (lmem && (!clock_cycles(e->gate, &loop) || !clock_mem(e, args[1], &lmem, &lsize, &lsign) ||
+                 !lmem || !fits(loop, lsize, lsign)))
+        goto drop;
     mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
@@ -1055,6 +1146,8 @@ have:
     }
     if (cmem)
         put(cmem, clk, csize);
+    if (lmem)
+        put(lmem, loop, lsize);
     A.decref(v);
     return done(e->after, e->gate);
 
@@ -1374,7 +1467,7 @@ obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
 /* output k's memory, size and sign for p (NULL: not taken) */
 static char *out_mem(const struct multi_entry *e, ptrdiff_t k, obj p, int *size, int *sign)
 {
-    return typed_mem(p, e->types[k], e->sizes[k], e->signs[k], MAX_OTYPES, size, sign);
+    return typed_mem(p, e->types[k], e->sizes[k], e->signs[k], NULL, MAX_OTYPES, size, sign);
 }
 
 TRY multi_try(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,

@@ -95,7 +95,55 @@ SHAPES = {
     "span, byref clock": lambda t, o, c, c32: ((t * 2)(), 2, byref(c)),
     "&arr[1], span, clock object": lambda t, o, c, c32: (byref((t * 4)(), ctypes.sizeof(t)), 2, c),
     "span, int32 clock": lambda t, o, c, c32: ((t * 2)(), 2, c32),
+    # the clock as pointer(x) (the value's too), and numpy arrays of several values
+    "byref, pointer clock": lambda t, o, c, c32: (byref(o), 1, ctypes.pointer(c)),
+    "pointer, pointer int32 clock": lambda t, o, c, c32: (
+        ctypes.pointer(o),
+        1,
+        ctypes.pointer(c32),
+    ),
+    "span, pointer clock": lambda t, o, c, c32: ((t * 2)(), 2, ctypes.pointer(c)),
+    "numpy span, byref clock": lambda t, o, c, c32: (np.zeros(3, _np(t)), 2, byref(c)),
+    "numpy span, int32 clock": lambda t, o, c, c32: (np.zeros(2, _np(t)), 2, c32),
+    "numpy span, NULL": lambda t, o, c, c32: (np.zeros(4, _np(t)), 4, None),
 }
+
+#: shapes the fast path refuses (the table path answers them: a code 7 and its reason, or
+#: its own values): a numpy array of another dtype, strided, read-only, too short or of two
+#: dimensions; a NULL pointer or one to another type as the clock
+REFUSED = {
+    "numpy span, other dtype": lambda t, o, c, c32: (np.zeros(2, np.float32), 2, byref(c)),
+    "numpy span, int16": lambda t, o, c, c32: (np.zeros(2, np.int16), 2, None),
+    "numpy span, strided": lambda t, o, c, c32: (np.zeros(4, _np(t))[::2], 2, byref(c)),
+    "numpy span, read-only": lambda t, o, c, c32: (_read_only(np.zeros(2, _np(t))), 2, c),
+    "numpy span, too short": lambda t, o, c, c32: (np.zeros(2, _np(t)), 3, byref(c)),
+    "numpy span, 2-D": lambda t, o, c, c32: (np.zeros((2, 2), _np(t)), 2, byref(c)),
+    "span, NULL pointer clock": lambda t, o, c, c32: (
+        (t * 2)(),
+        2,
+        ctypes.POINTER(ctypes.c_ulong)(),
+    ),
+    "byref, NULL pointer clock": lambda t, o, c, c32: (
+        byref(o),
+        1,
+        ctypes.POINTER(ctypes.c_ulong)(),
+    ),
+    "byref, pointer short clock": lambda t, o, c, c32: (
+        byref(o),
+        1,
+        ctypes.pointer(ctypes.c_short()),
+    ),
+    "NULL pointer value": lambda t, o, c, c32: (ctypes.POINTER(t)(), 1, byref(c)),
+}
+
+
+def _np(t: type) -> type:
+    return np.float64 if t is ctypes.c_double else np.int32
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
 
 
 def _written(p) -> bytes:
@@ -104,11 +152,19 @@ def _written(p) -> bytes:
     if type(p).__name__ == "CArgObject":
         p = p._obj
     elif isinstance(p, ctypes._Pointer):
+        if not p:
+            return b"NULL"
         p = p.contents
     return bytes(p)
 
 
-def _session(table: bool, clock: str) -> tuple[list, int]:
+def _way(fn, way: str):
+    """``fn`` itself (``c``: its C entry where there is one), its Python fast function
+    (``python``) or its table path (``table``)."""
+    return fn.slow if way == "table" else getattr(fn, "python", fn) if way == "python" else fn
+
+
+def _session(way: str, clock: str, shapes: dict = SHAPES, steps: int = 48) -> tuple[list, int]:
     """Both axes' Trap moves with GT_Reset now and then, each step's reads of every reader
     in every clock shape (``table``: through the table path): what was read and how many
     reads took the Python fast path's general way or the table path instead of the C
@@ -124,22 +180,22 @@ def _session(table: bool, clock: str) -> tuple[list, int]:
         ctl = gt.GTE_Controller()
         seen: list = []
         pr = cProfile.Profile()
-        for step in range(48):
+        for step in range(steps):
             if step % 11 == 5:
                 assert gt.GT_Reset() == 0  # (GT_GetClock from 0 again)
             if clock == "lockstep":
                 assert gt.GTE_Wait(1 + step % 3) == 0
             pr.enable()
             for name in sorted(READERS):
-                fn = getattr(gt, name)
-                fn = fn.slow if table else fn
+                fn = _way(getattr(gt, name), way)
                 t = ctypes.c_double if ctypes.c_double in READERS[name][1] else ctypes.c_long
-                for shape, make in SHAPES.items():
+                for shape, make in shapes.items():
                     o, c, c32 = t(), ctypes.c_ulong(), ctypes.c_int32()
                     p, count, pc = make(t, o, c, c32)
                     rc = fn(1, p, count, pc)
+                    why = gt.GTE_GetLastError() if rc else ""
                     seen.append(
-                        (ctl.clock.cycles, name, shape, rc, _written(p), c.value, c32.value)
+                        (ctl.clock.cycles, name, shape, rc, _written(p), c.value, c32.value, why)
                     )
             pr.disable()
         stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
@@ -160,10 +216,106 @@ def test_clock_shapes_read_the_table_values_across_reset_and_cycles(clock: str) 
     the clock written there) and through the table path, step by step while two axes move,
     over GT_Reset and cycles of a quarter millisecond: the values, the clocks and the codes
     agree."""
-    fast, python = _session(False, clock)
-    table, _ = _session(True, clock)
+    fast, python = _session("c", clock)
+    table, _ = _session("table", clock)
     assert python == 0
     assert len({c for c, *_ in fast}) > 40  # (cycles between the steps)
-    clocks = [ms for *_, ms, _ in fast]
+    clocks = [ms for *_, ms, _, _ in fast]
     assert any(b < a for a, b in pairwise(clocks))  # (GT_Reset seen)
     assert fast == table
+    assert {rc for _, _, _, rc, *_ in fast} == {0}
+    assert _session("python", clock)[0] == table  # (the Python fast functions: the same)
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+def test_refused_shapes_answer_as_the_table(clock: str) -> None:
+    """The shapes the fast path does not take (a numpy array it cannot write whole, a NULL
+    pointer, a clock pointer of another type) answer as the table path does, step by step:
+    the same codes, reasons and values."""
+    fast, _ = _session("c", clock, REFUSED, 16)
+    table, _ = _session("table", clock, REFUSED, 16)
+    assert fast == table
+    assert _session("python", clock, REFUSED, 16)[0] == table
+    codes = {(shape, rc) for _, _, shape, rc, *_ in fast}
+    # (a NULL pointer clock is C's NULL: no clock; a numpy array of two dimensions the table
+    # path writes flat)
+    assert ("numpy span, int16", 7) in codes and ("byref, NULL pointer clock", 0) in codes
+
+
+#: GT_GetClock's two pointers as clients pass them (the vendor's ``GT_GetClock(&clk, &loop)``):
+#: (pClock, pLoop) made from a clock and a loop object of the types given
+LOOPS = {
+    "byref, byref": lambda c, lp: (byref(c), byref(lp)),
+    "objects": lambda c, lp: (c, lp),
+    "pointers": lambda c, lp: (ctypes.pointer(c), ctypes.pointer(lp)),
+    "byref, pointer": lambda c, lp: (byref(c), ctypes.pointer(lp)),
+    "byref, NULL": lambda c, lp: (byref(c), None),
+    "byref, 0": lambda c, lp: (byref(c), 0),
+    "array, byref": lambda c, lp: ((ctypes.c_ulong * 2)(), byref(lp)),
+    "byref, NULL pointer": lambda c, lp: (byref(c), ctypes.POINTER(type(lp))()),
+    "byref, numpy": lambda c, lp: (byref(c), np.zeros(1, np.uint32)),
+    "byref, 5": lambda c, lp: (byref(c), 5),
+}
+#: the loop object's types: the vendor's, a wider and a signed one, too narrow, not an integer
+LOOP_TYPES = [ctypes.c_ulong, ctypes.c_uint32, ctypes.c_int32, ctypes.c_short, ctypes.c_double]
+
+
+def _clock_session(way: str, clock: str) -> tuple[list, int]:
+    """GT_GetClock in every two-pointer shape, step by step over cycles and GT_Reset (through
+    the table path where ``table``): what each wrote and returned, and how many calls took
+    the Python fast function or the table path instead of the C entry (``way``: _way's)."""
+    import cProfile
+    import pstats
+
+    bring_up(clock=clock, cycle_ms=0.25)
+    try:
+        seen: list = []
+        fast_forms = ("byref, byref", "objects", "pointers", "byref, pointer")
+        python = 0
+        for step in range(24):
+            if step % 9 == 4:
+                assert gt.GT_Reset() == 0
+            if clock == "lockstep":
+                assert gt.GTE_Wait(1 + step % 3) == 0
+            for lt in LOOP_TYPES:
+                for shape, make in LOOPS.items():
+                    c, lp = ctypes.c_ulong(), lt()
+                    a, b = make(c, lp)
+                    fn = _way(gt.GT_GetClock, way)
+                    pr = cProfile.Profile()
+                    pr.enable()
+                    rc = fn(a, b)
+                    pr.disable()
+                    if (
+                        shape in fast_forms
+                        and lt is not ctypes.c_short
+                        and lt is not ctypes.c_double
+                    ):
+                        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+                        python += sum(
+                            v[1]
+                            for (file, _, func), v in stats
+                            if (func in ("call", "run") and file.endswith("_core.py"))
+                            or (func == "gt" and file.endswith("fast.py"))
+                        )
+                    why = gt.GTE_GetLastError() if rc else ""
+                    seen.append((step, lt.__name__, shape, rc, c.value, _written(a), lp.value, why))
+        return seen, python
+    finally:
+        gt.GT_Close()
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+def test_the_clock_and_loop_pointers_answer_as_the_table(clock: str) -> None:
+    """``GT_GetClock(pClock, pLoop)`` in every shape writes what its table path writes (the
+    milliseconds since GT_Reset, the cycles run) and refuses what it refuses, across cycles
+    and GT_Reset; the vendor's two-pointer forms of an integer type that holds the values
+    never reach Python's fast function nor the table."""
+    fast, python = _clock_session("c", clock)
+    table, _ = _clock_session("table", clock)
+    assert fast == table
+    assert _clock_session("python", clock)[0] == table
+    assert python == 0
+    ok = {(t, shape) for _, t, shape, rc, *_ in fast if rc == 0}
+    assert ("c_ulong", "pointers") in ok and ("c_ulong", "byref, 5") not in ok
+    assert len({loop for _, t, shape, rc, _, _, loop, _ in fast if shape == "pointers"}) > 10

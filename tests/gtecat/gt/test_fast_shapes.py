@@ -717,3 +717,102 @@ def test_a_span_over_axes_no_drive_backs_reads_as_the_table_on_the_fast_path() -
             elif got[0][0] == 0 and (got[0][4] or count > fast.READ_LIMITS.get(name, 12)):
                 bad.append(f"{name}({first}, {count}): the table path ran")
     assert not bad, "\n".join(bad[:5])
+
+
+def _span_session(tmp_path: Path, clock: str, way: str) -> tuple[list, int]:
+    """A 16-axis bus (a controller of more axes than the 12 of chapter 13), every axis moving
+    in Trap; each reader's spans past the twelfth axis into a ctypes and a numpy array, step
+    by step through the public function (``c``), its Python fast function (``python``) or
+    its table path (``table``): what each wrote and returned, and how many reads took the
+    Python fast path's general way or the table path."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(16, tmp_path / "axes16.eni")
+    assert gt.GT_Open(eni=str(eni), clock=clock, log="") == 0, gt.GTE_GetLastError()
+    try:
+        assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+        ready = ctypes.c_short()
+        for _ in range(1000):
+            if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+                break
+            gt.GTE_Wait(1)
+        assert gt.GT_StartEcatComm() == 0, gt.GTE_GetLastError()
+        for a in range(1, 17):
+            assert gt.GT_AxisOn(a) == 0, gt.GTE_GetLastError()
+        gt.GTE_Wait(5)
+        for a in range(1, 17):
+            prm = gt.TTrapPrm()
+            prm.acc = prm.dec = 0.5
+            assert gt.GT_PrfTrap(a) == 0
+            assert gt.GT_SetTrapPrm(a, byref(prm)) == 0
+            assert gt.GT_SetPos(a, 200 * a * (-1) ** a) == 0
+            assert gt.GT_SetVel(a, 2 + a / 4) == 0
+        assert gt.GT_Update(0xFFFF) == 0, gt.GTE_GetLastError()
+        seen: list = []
+        pr = cProfile.Profile()
+        for step in range(12):
+            if clock == "lockstep":
+                gt.GTE_Wait(1 + step % 4)
+            for name in sorted(fast.READERS):
+                f = getattr(gt, name)
+                fn = {"c": f, "python": getattr(f, "python", f), "table": f.slow}[way]
+                # the GTN_ form with core 1 (its C entry; else its table path, which its Python
+                # function's spans are)
+                gtn = getattr(gt, "GTN_" + name[3:]) if way == "c" else f.gtn_slow
+                t = ctypes.c_double if ctypes.c_double in fast.READERS[name][1] else ctypes.c_long
+                dt = np.float64 if t is ctypes.c_double else np.int32
+                most = fast.READ_LIMITS.get(name, 16)
+                for first, count in ((1, 16), (3, 14), (5, 12), (1, 13), (16, 1), (2, 16), (0, 13)):
+                    for kind in ("ctypes", "numpy"):
+                        arr = (t * 16)() if kind == "ctypes" else np.zeros(16, dt)
+                        clk = ctypes.c_ulong()
+                        # (a span the function answers with 0: profiled)
+                        span = 1 <= first and first + count <= 17 and count <= most
+                        if span:
+                            pr.enable()
+                        rc = fn(first, arr, count, byref(clk))
+                        pr.disable()
+                        why = gt.GTE_GetLastError() if rc else ""
+                        seen.append(
+                            (step, name, first, count, kind, rc, bytes(arr), clk.value, why)
+                        )
+                        if kind == "numpy" and step % 3:
+                            continue
+                        arr = (t * 16)() if kind == "ctypes" else np.zeros(16, dt)
+                        if span:
+                            pr.enable()
+                        rc = gtn(1, first, arr, count, ctypes.pointer(clk))
+                        pr.disable()
+                        why = gt.GTE_GetLastError() if rc else ""
+                        seen.append((step, "GTN", name, first, count, kind, rc, bytes(arr), why))
+                        seen.append(clk.value)
+        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        python = sum(
+            v[1]
+            for (file, _, func), v in stats
+            if (func in ("call", "run") and file.endswith("_core.py"))
+            or (func in ("general", "many") and file.endswith("fast.py"))
+        )
+        return seen, python
+    finally:
+        gt.GT_Close()
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+def test_spans_past_twelve_axes_read_as_the_table_on_the_fast_path(
+    tmp_path: Path, clock: str
+) -> None:
+    """``GT_GetSts(1, sts, 16, &clk)`` on a controller of 16 axes (and every reader, from
+    several axes, into ctypes and numpy arrays): the table path's values, clock, codes and
+    refusals (a span past the controller's axes, axis 0, an encoder reader's more than 8),
+    step by step while every axis moves, and the GTN_ form with core 1 (a ``pointer`` to the
+    clock); the spans it answers with 0 never reach Python's general way nor the table (the
+    C entry), on both clocks."""
+    fast_seen, python = _span_session(tmp_path, clock, "c")
+    table_seen, _ = _span_session(tmp_path, clock, "table")
+    assert fast_seen == table_seen
+    assert _span_session(tmp_path, clock, "python")[0] == table_seen
+    codes = {(x[1], x[2], x[3], x[5]) for x in fast_seen if type(x) is tuple and x[1] != "GTN"}
+    assert ("GT_GetSts", 1, 16, 0) in codes and ("GT_GetSts", 2, 16, 7) in codes
+    assert ("GT_GetEncPos", 1, 16, 7) in codes
+    assert python == 0
