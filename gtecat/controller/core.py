@@ -968,17 +968,23 @@ class Controller:
     def wait_quick(self, total: int) -> bool:
         """A wait of ``total`` ns (at most :attr:`WAIT_SLICE_NS`) on the lockstep or the auto
         clock, in its common case, in one call: every axis in the bank's compiled kernel, no
-        hook, the bus steady as the last run of cycles left it.  Then the wait is exactly
-        :meth:`wait_ms`'s general way - :meth:`Clock.advance_ns`, whose first run of cycles
-        (:meth:`run_cycles`, :meth:`AxisBank.run_cycles`) is this one's, then
+        hook but quiet ones, the bus steady as the last run of cycles left it.  Then the wait
+        is exactly :meth:`wait_ms`'s general way - :meth:`Clock.advance_ns`, whose first run
+        of cycles (:meth:`run_cycles`, :meth:`AxisBank.run_cycles`) is this one's, then
         :meth:`_arm_after_wait` - with what each of those layers asks and books done once,
         inline: the kernel called for the run's cycles, the counts added in their arrays.  A
         field application paced by waits (a pass every controller millisecond) paid those
         layers at every wait.  Where the run stops short (a move ended, a cycle the kernel
         declines) or the bus needs a look, the rest of the wait goes the clock's general way
-        from there, as it would have.  False: nothing was done (a hook, an axis out of the
-        bank, a link down, a bank to settle, a clock shared or wrapped, ...); the caller takes
-        the general way."""
+        from there, as it would have.  ``pre_cycle`` and ``post_cycle`` hooks that say they
+        stay quiet (:func:`_quiet_way`: a fault armed for later, smart homing idle or in a
+        Trap leg) are asked and told as :meth:`_run_cycles` asks and tells them: the quick
+        cycles owed to them counted first (:meth:`settle_hooks`), the run no longer than
+        every hook stays quiet, its cycles counted to them (``cycles_passed``); the cycle a
+        hook is due in and the rest of the wait go the general way, so a fault fires in the
+        same cycle.  False: nothing was done (another hook, an axis out of the bank, a link
+        down, a bank to settle, a clock shared or wrapped, ...); the caller takes the
+        general way."""
         clock = self.clock
         q = clock.quick
         bank = self.bank
@@ -988,7 +994,6 @@ class Controller:
             or bank is None
             or master is None
             or not q[3]  # (a clock's group shares the time: Clock.advance_ns)
-            or self._owed is not None
             or self._links_down
             or self._run_axes
             or clock._cycle_fn is not self._own_cycle
@@ -997,17 +1002,13 @@ class Controller:
             or self._own_many.__func__ is not _RUN_CYCLES  # (its layers as written here)
         ):
             return False
+        hooked = False
         if self._unhooked != ARMS[0]:  # (no hook since: every change of them is a new one)
-            if (
-                self.before_cycle
-                or self.pre_cycle
-                or self.post_cycle
-                or self.sample
-                or self.watch
-                or master.on_cycle
-            ):
+            if self.before_cycle or self.sample or self.watch or master.on_cycle:
                 return False
-            self._unhooked = ARMS[0]  # (as _quick_kernel finds it)
+            hooked = bool(self.pre_cycle or self.post_cycle)  # (asked below, as _run_cycles)
+            if not hooked:
+                self._unhooked = ARMS[0]  # (as _quick_kernel finds it)
         dt_ns = q[2]
         if (
             type(bank).run_cycles is not _BANK_RUN_CYCLES  # (a run wrapped: it runs it)
@@ -1027,23 +1028,36 @@ class Controller:
         q[0] = pending
         if pending >= dt_ns:
             done = 0
+            n = pending // dt_ns
+            if n > self.BATCH_CYCLES:
+                n = self.BATCH_CYCLES
+            hooks: tuple[tuple[Callable[[int], int], Any], ...] = ()
             self.in_batch = True  # (run_cycles)
             try:
-                master.backend.look_at_fields()  # (_steady_marks)
-                if seen[3] != VirtualSlave.outside_changes:
-                    seen = (*seen[:3], VirtualSlave.outside_changes)
-                    if not master.steady():
-                        seen = None  # type: ignore[assignment]
+                if self._owed is not None:  # (_run_cycles: the quick cycles counted first)
+                    self.settle_hooks()
+                if hooked:
+                    # as many as every hook stays quiet in (_run_cycles): a hook due sooner
+                    # runs in the general way's cycle, as without this one
+                    hooks = self._hook_ways()
+                    n = self._hooks_quiet(n)
+                    # (asking may look at the machine: the marks as _run_cycles reads them)
+                    seen = self._steady_marks(master) if n > 0 else None  # type: ignore[assignment]
+                else:
+                    master.backend.look_at_fields()  # (_steady_marks)
+                    if seen[3] != VirtualSlave.outside_changes:
+                        seen = (*seen[:3], VirtualSlave.outside_changes)
+                        if not master.steady():
+                            seen = None  # type: ignore[assignment]
                 if seen is not None:
                     # Kernel.run for the run's cycles (bank.run_cycles), then its book and
                     # _after_kernel's, the counts in their arrays (AxisBank._COUNTS' order)
                     # (as quick_cycle_done: a count that stays - a zero added, a flag
                     # already so - is not written)
-                    n = pending // dt_ns
                     io = k._io
                     io[_IN_T_NS] = q[9]
                     io[_IN_DT_NS] = dt_ns
-                    io[_IN_MAXC] = n if n < self.BATCH_CYCLES else self.BATCH_CYCLES
+                    io[_IN_MAXC] = n
                     k._fp[_FP_DT] = csp._dt
                     rc = k.run_fn(*k._args)
                     done = io[_OUT_DONE]
@@ -1079,6 +1093,9 @@ class Controller:
                             c[8] += bank.n_frz * done
                         master.counts[0] += done
                         self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
+                        for _, passed in hooks:  # (_run_cycles: the hooks count the run)
+                            if passed is not None:
+                                passed(done)
             finally:
                 self.in_batch = False
             if done:  # (Clock.advance_ns's count of a run)

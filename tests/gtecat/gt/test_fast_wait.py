@@ -4,12 +4,16 @@ way (the table path, Clock.advance_ns's layers): the same session on the manual'
 moves of axis 2 ending inside a wait, a link loss and axis 2 out of the bank until it is
 switched on again, at last an armed fault firing inside a wait - reads the same GT results
 after every wait, with the same controller counts (the clock's, the master's, the bank's
-and its drives', the readers' epoch, the quick cycles' arming).  Bad arguments keep the
-manual's code and reason."""
+and its drives', the readers' epoch, the quick cycles' arming).  A second session on the
+twelve-axis bus waits between polls with cycle hooks there - faults armed at a time, after
+a count of cycles, at a position and at homing stages, firing inside waits, smart homing
+running and then idle - and reads the same too, with the same master log and fault events.
+Bad arguments keep the manual's code and reason."""
 
 from __future__ import annotations
 
-from ctypes import byref, c_double, c_long, c_ubyte, c_ulong
+from ctypes import byref, c_double, c_long, c_ubyte, c_ulong, c_ushort
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -115,6 +119,118 @@ def test_fast_wait_is_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     # the session went where the docstring says: axis 2 out of the bank, a link down
     assert any(row[-17] for row in general[:-1])  # (len(_run_axes))
     assert any(row[-16] for row in general[:-1])  # (_links_down)
+
+
+#: the twelve-axis bus of the hooked session: axis 1 homes in the drive, axis 5 by smart
+#: homing, axis 2 moves in Trap; a time and a count of cycles from the machine description
+HOOKED_MACHINE = (
+    "".join(
+        f"[axis.{a}]\ncounts_per_rev = 10000\nindex_offset = 3000\n"
+        "negative_limit = -2000000\npositive_limit = 2000000\n"
+        + ("position = 112000\nhome_switch = [[100000, 2000000]]\n" if a == 1 else "")
+        + ("home_switch = [[15000, 2000000]]\n" if a == 5 else "")
+        + "\n"
+        for a in range(1, 13)
+    )
+    + '[[fault]]\nkind = "drive_fault"\naxis = 7\ncode = 0x2310\nat_ms = 333\n'
+    "duration_ms = 40\n\n"
+    '[[fault]]\nkind = "switch_chatter"\naxis = 3\nswitch = "positive"\nperiod_cycles = 3\n'
+    "after_cycles = 517\nduration_ms = 45\n\n"
+)
+#: from Python: a position, a homing's stages, a far one (it stays armed to the end)
+HOOKED_INJECTED = (
+    {"kind": "drive_fault", "axis": 9, "code": 0x2310, "when_position": [2, 9000],
+     "duration_ms": 30},
+    {"kind": "link_down", "after_slave": 4, "at_homing": [1, "index"], "duration_ms": 25},
+    {"kind": "encoder_noise", "axis": 6, "counts": 4, "at_homing": [1, "completed"],
+     "duration_ms": 60},
+    {"kind": "sto", "axis": 11, "at_ms": 100_000},
+)  # fmt: skip
+
+
+def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[list[Any], int]:
+    """Waits between polls with cycle hooks: faults armed at a time, after a count of
+    cycles, at a position and at homing stages fire inside waits; smart homing runs, then
+    stays idle.  What every pass read, the log and the faults' events; the waits that took
+    the quick way with a hook there."""
+    from gtecat.faults.injector import Injector
+
+    mp.setattr(Controller, "QUICK_WAIT", quick)
+    took = [0]
+    own = Controller.wait_quick
+
+    def counted(self: Controller, total: int) -> bool:
+        ok = own(self, total)
+        took[0] += ok and bool(self.pre_cycle or self.post_cycle)
+        return ok
+
+    mp.setattr(Controller, "wait_quick", counted)
+    started: list[str] = []
+    start = Injector._start
+
+    def _start(inj: Injector, e: Any) -> None:
+        started.append(f"{inj.bus.now_ms():g} {e.describe()}")
+        start(inj, e)
+
+    mp.setattr(Injector, "_start", _start)
+    wait = gt.GTE_Wait if quick else gt.GTE_Wait.slow
+    machine = tmp / "cell.toml"
+    machine.write_text(HOOKED_MACHINE)
+    log = tmp / f"{quick}.log"
+    bring_up("twelve_axes.eni", machine=str(machine), clock="auto", log=str(log))
+    ctl = gt.GTE_Controller()
+    marks0 = (EPOCH.n, 0, VirtualSlave.al_changes, VirtualSlave.outside_changes)
+    for a in range(1, 13):
+        gt.GT_AxisOn(a)
+    wait(10)
+    for d in map(dict, HOOKED_INJECTED):
+        faults.inject(d.pop("kind"), **d)
+    gt.GT_SetHomingMode(1, 6)
+    gt.GT_SetEcatHomingPrm(1, 3, 40000, 20000, 400000, 0, 0)
+    gt.GT_StartEcatHoming(1)
+    home = gt.THomePrm()
+    gt.GT_GetHomePrm(5, byref(home))
+    home.mode, home.moveDir, home.velHigh, home.velLow = gt.HOME_MODE_HOME, 1, 40.0, 10.0
+    home.acc = home.dec = 1.0
+    gt.GT_PrfTrap(5)
+    assert gt.GT_GoHome(5, byref(home)) == 0
+    trap_move(2, 12_000, 10.0)
+    sts, clk, hs = c_long(), c_ulong(), c_ushort()
+    prf = (c_double * 12)()
+    home_st = gt.THomeStatus()
+    seen: list[Any] = []
+    for k in range(760):
+        row: list[Any] = [gt.GT_GetClock(byref(clk)), clk.value]
+        for a in range(1, 13):
+            row += [gt.GT_GetSts(a, byref(sts)), sts.value]
+            if sts.value & 0x62 and k % 10 == 0:  # an alarm, a limit: reset
+                gt.GT_ClrSts(a, 1)
+                gt.GT_AxisOn(a)
+        row += [gt.GT_GetPrfPos(1, prf, 12, None), *prf]
+        if k % 25 == 0:
+            row += [gt.GT_GetEcatHomingStatus(1, byref(hs)), hs.value]
+            row += [gt.GT_GetHomeStatus(5, byref(home_st)), home_st.run, home_st.stage]
+            row.append([f["describe"] + f["state"] for f in faults.listing()])
+        row += [wait(WAITS[k % len(WAITS)]), *_counts(ctl, marks0)]
+        seen.append(row)
+    seen.append(list(faults.injector_for(ctl).events))
+    seen.append(started)
+    gt.GT_Close()
+    seen.append(log.read_text())
+    return seen, took[0]
+
+
+def test_fast_wait_with_faults_armed_is_the_general_way(tmp_path: Path) -> None:
+    with pytest.MonkeyPatch.context() as mp:
+        general, none = _hooked_session(False, mp, tmp_path)
+    with pytest.MonkeyPatch.context() as mp:
+        quick, took = _hooked_session(True, mp, tmp_path)
+    assert none == 0
+    assert took > 300  # (the hooks quiet: the quick way ran)
+    assert len(general[-2]) == 5, general[-2]  # (every fault but the far one fired)
+    assert len(quick) == len(general)
+    for k, (a, b) in enumerate(zip(general, quick, strict=True)):
+        assert a == b, f"pass {k}"
 
 
 @pytest.mark.parametrize("ms", [-1, -0.5, 10**12, 2**63, 1.5, None, "1", float("nan")], ids=repr)
