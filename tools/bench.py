@@ -1015,24 +1015,30 @@ def bench_crd_poll(
     }
 
 
-WAIT_BUSES = ("fig5_2", "12_axes")
+WAIT_BUSES = ("fig5_2", "12_axes", "12_axes_far_fault")
 
 
 def _wait_session(bus: str, eni_dir: Path) -> None:
     """A bus in the auto clock (GT_Open's default) brought up by GT_* calls, its axes on
     and moving in the bank: ``fig5_2`` (the manual's figure 5-2 bus, axis 1 jogging, axis 2
     on), ``12_axes`` (a generated 12-axis bus, odd axes in long Trap moves, even ones
-    jogging)."""
+    jogging), ``12_axes_far_fault`` (the same with a machine description's ``[[fault]]``
+    far off: the fault injector's cycle hook, quiet)."""
     from gtecat import gt
 
     gt.GT_Close()
+    machine = None
     if bus == "fig5_2":
         eni, n = FIG5_2, 2
     else:
         from tools.gen_axes_eni import write_axes_eni
 
         eni, n = write_axes_eni(12, eni_dir / "axes12.eni"), 12
-    assert gt.GT_Open(eni=str(eni), log="") == 0 and gt.GT_InitEcatComm() == 0
+        if bus.endswith("far_fault"):
+            machine = eni_dir / "far_fault.toml"
+            machine.write_text(_FAR_FAULT)
+    opened = gt.GT_Open(eni=str(eni), machine=machine and str(machine), log="")
+    assert opened == 0 and gt.GT_InitEcatComm() == 0
     ready = c_short()
     while gt.GT_IsEcatReady(byref(ready)) != 0 or ready.value != 1:
         gt.GTE_Wait(1)
