@@ -1031,7 +1031,7 @@ class Controller:
             n = pending // dt_ns
             if n > self.BATCH_CYCLES:
                 n = self.BATCH_CYCLES
-            hooks: tuple[tuple[Callable[[int], int], Any], ...] = ()
+            passes: tuple[Callable[[int], None], ...] = ()
             self.in_batch = True  # (run_cycles)
             try:
                 if self._owed is not None:  # (_run_cycles: the quick cycles counted first)
@@ -1039,8 +1039,8 @@ class Controller:
                 if hooked:
                     # as many as every hook stays quiet in (_run_cycles): a hook due sooner
                     # runs in the general way's cycle, as without this one
-                    hooks = self._hook_ways()
                     n = self._hooks_quiet(n)
+                    passes = self._hooks_seen[3]  # type: ignore[index]  # (_passes: looked up)
                     # (asking may look at the machine: the marks as _run_cycles reads them)
                     seen = self._steady_marks(master) if n > 0 else None  # type: ignore[assignment]
                 else:
@@ -1093,9 +1093,8 @@ class Controller:
                             c[8] += bank.n_frz * done
                         master.counts[0] += done
                         self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
-                        for _, passed in hooks:  # (_run_cycles: the hooks count the run)
-                            if passed is not None:
-                                passed(done)
+                        for passed in passes:  # (_run_cycles: the hooks count the run)
+                            passed(done)
             finally:
                 self.in_batch = False
             if done:  # (Clock.advance_ns's count of a run)
