@@ -22,6 +22,7 @@ from gtecat import faults, gt
 from gtecat.controller.core import Controller
 from gtecat.controller.epoch import EPOCH
 from gtecat.drives.slave import VirtualSlave
+from tests.gtecat.faults.test_quiet_quick_cycles import INJECTED, MACHINE, _fired
 
 from .conftest import bring_up, trap_move
 
@@ -121,40 +122,11 @@ def test_fast_wait_is_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     assert any(row[-16] for row in general[:-1])  # (_links_down)
 
 
-#: the twelve-axis bus of the hooked session: axis 1 homes in the drive, axis 5 by smart
-#: homing, axis 2 moves in Trap; a time and a count of cycles from the machine description
-HOOKED_MACHINE = (
-    "".join(
-        f"[axis.{a}]\ncounts_per_rev = 10000\nindex_offset = 3000\n"
-        "negative_limit = -2000000\npositive_limit = 2000000\n"
-        + ("position = 112000\nhome_switch = [[100000, 2000000]]\n" if a == 1 else "")
-        + ("home_switch = [[15000, 2000000]]\n" if a == 5 else "")
-        + "\n"
-        for a in range(1, 13)
-    )
-    + '[[fault]]\nkind = "drive_fault"\naxis = 7\ncode = 0x2310\nat_ms = 333\n'
-    "duration_ms = 40\n\n"
-    '[[fault]]\nkind = "switch_chatter"\naxis = 3\nswitch = "positive"\nperiod_cycles = 3\n'
-    "after_cycles = 517\nduration_ms = 45\n\n"
-)
-#: from Python: a position, a homing's stages, a far one (it stays armed to the end)
-HOOKED_INJECTED = (
-    {"kind": "drive_fault", "axis": 9, "code": 0x2310, "when_position": [2, 9000],
-     "duration_ms": 30},
-    {"kind": "link_down", "after_slave": 4, "at_homing": [1, "index"], "duration_ms": 25},
-    {"kind": "encoder_noise", "axis": 6, "counts": 4, "at_homing": [1, "completed"],
-     "duration_ms": 60},
-    {"kind": "sto", "axis": 11, "at_ms": 100_000},
-)  # fmt: skip
-
-
 def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[list[Any], int]:
     """Waits between polls with cycle hooks: faults armed at a time, after a count of
     cycles, at a position and at homing stages fire inside waits; smart homing runs, then
     stays idle.  What every pass read, the log and the faults' events; the waits that took
     the quick way with a hook there."""
-    from gtecat.faults.injector import Injector
-
     mp.setattr(Controller, "QUICK_WAIT", quick)
     took = [0]
     own = Controller.wait_quick
@@ -165,17 +137,10 @@ def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[lis
         return ok
 
     mp.setattr(Controller, "wait_quick", counted)
-    started: list[str] = []
-    start = Injector._start
-
-    def _start(inj: Injector, e: Any) -> None:
-        started.append(f"{inj.bus.now_ms():g} {e.describe()}")
-        start(inj, e)
-
-    mp.setattr(Injector, "_start", _start)
+    started = _fired(mp)
     wait = gt.GTE_Wait if quick else gt.GTE_Wait.slow
     machine = tmp / "cell.toml"
-    machine.write_text(HOOKED_MACHINE)
+    machine.write_text(MACHINE)
     log = tmp / f"{quick}.log"
     bring_up("twelve_axes.eni", machine=str(machine), clock="auto", log=str(log))
     ctl = gt.GTE_Controller()
@@ -183,7 +148,7 @@ def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[lis
     for a in range(1, 13):
         gt.GT_AxisOn(a)
     wait(10)
-    for d in map(dict, HOOKED_INJECTED):
+    for d in map(dict, INJECTED):  # (a position, homing stages, a far one)
         faults.inject(d.pop("kind"), **d)
     gt.GT_SetHomingMode(1, 6)
     gt.GT_SetEcatHomingPrm(1, 3, 40000, 20000, 400000, 0, 0)
