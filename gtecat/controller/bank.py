@@ -2204,6 +2204,26 @@ class AxisBank:
             return getattr(self, name).item(r)
         return self.value(name, r)
 
+    def span_bytes(self, name: str, rows: slice) -> bytes | None:
+        """The native doubles of ``_make_list(name)[rows]``, a run of rows in order, from the
+        bank's arrays in one step (a span of doubles after a cycle: no list of every row,
+        no Python float per row), else None: the Trap tables' values where no row jogs or
+        homes, the arrays whose list is the array's own (float64)."""
+        flat = _PLANNED_FLAT.get(name)
+        if flat is not None:
+            if self.n_jog or self.n_hm:
+                return None
+            idx = self.t_idx
+            if rows.start or rows.stop != self.n:  # (the whole bank: no slice)
+                idx = idx[rows]
+            return getattr(self, flat)[idx].tobytes()  # type: ignore[no-any-return]
+        if name in _ROW_ITEMS:
+            x = getattr(self, name)
+            if x.dtype != np.float64:
+                return None
+            return x[rows].tobytes()  # type: ignore[no-any-return]
+        return None
+
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":
             if self.n <= _SMALL_BANK:  # a few rows: the four flags as lists, row by row
