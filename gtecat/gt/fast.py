@@ -546,8 +546,8 @@ def fast_reader(
         packed: list[Any] = [None, None, b"", None, None]
         #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
         #: bank, n, count, the layout, resources and axes it holds for, its pick, whether
-        #: that picks the bank's rows and zeros alone (no other axis's getter), the run of
-        #: rows it picks in order (_read_plan's, else None)
+        #: that picks the bank's rows and zeros alone (no other axis's getter), the getter of
+        #: the bytes of the run of rows it picks in order (AxisBank.span_bytes, else None)
         lane: list[Any] = [None] * 9
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
@@ -611,7 +611,7 @@ def fast_reader(
                             # a run of rows in order, not made yet this cycle: their bytes
                             # from the bank's arrays in one step (the same doubles as the
                             # list's, packed natively), no list of every row
-                            out = b.span_bytes(bank_key, ln[8])
+                            out = ln[8](b)
                             if out is not None:
                                 session.last = None
                                 return out
@@ -640,7 +640,11 @@ def fast_reader(
                         and plan[1] is ctl.resources
                         and plan[2] is ctl.axes
                     ):
-                        lane[:] = [b, n, count, *plan[:4], plan[6], plan[7]]
+                        run = plan[7]
+                        lane[:] = [
+                            *(b, n, count, *plan[:4], plan[6]),
+                            None if run is None else b.span_bytes(bank_key, run),
+                        ]
             memo = packed  # (one read: another thread may replace it meanwhile)
             if pack is memo[0] and (values is memo[1] or values == memo[1]):
                 out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)

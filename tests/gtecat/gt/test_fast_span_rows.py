@@ -18,7 +18,6 @@ from gtecat.gt import fast
 
 from .conftest import bring_up, trap_move
 
-
 #: the readers of the spans read: the rows' and the doubles of the bank's lists
 _SPANS = sorted(
     fast.BANK_ROWS | fast.SPAN_ROWS | {k: v for k, v in fast.BANK_LISTS.items() if k != "GT_GetSts"}
