@@ -40,6 +40,9 @@ def _moves_read(table: bool) -> tuple[list, int]:
         seen: list = []
         banked = 0
         for i in range(400):
+            if i == 30:  # (a new target while axis 2 moves)
+                assert gt.GT_SetPos(2, 600) == 0 and gt.GT_SetVel(2, 9.0) == 0
+                assert gt.GT_Update(2) == 0
             if i == 320:  # (a jog: the bank's rows read their own ways)
                 jog = gt.TJogPrm(acc=0.5, dec=0.5, smooth=0)
                 assert gt.GT_PrfJog(2) == 0 and gt.GT_SetJogPrm(2, byref(jog)) == 0
