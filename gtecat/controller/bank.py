@@ -62,6 +62,7 @@ from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import chain, compress
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -250,6 +251,8 @@ _ROW_PLANNED = {"prf_p": 0, "prf_v": 1, "prf_a": 2}
 _ROW_RATES = {"enc_vel": 0, "enc_acc": 1}
 #: ... and the arrays whose list is the array's own (AxisBank._make_list's last case)
 _ROW_ITEMS = frozenset({"a_last", "enc_pos"})
+#: the dtype of the bank's doubles (AxisBank.span_bytes: their bytes are the values packed)
+_F64 = np.dtype(np.float64)
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -2203,6 +2206,35 @@ class AxisBank:
         if name in _ROW_ITEMS:
             return getattr(self, name).item(r)
         return self.value(name, r)
+
+    def span_bytes(self, name: str, rows: slice) -> Callable[[AxisBank], bytes | None] | None:
+        """A getter of the native doubles of ``_make_list(name)[rows]``, a run of rows in
+        order, from a bank's arrays in one step (a span of doubles after a cycle: no list of
+        every row, no Python float per row), which gives None where it does not apply; None:
+        no such getter.  The Trap tables' values where no row jogs or homes, the arrays whose
+        list is the array's own (float64)."""
+        whole = not rows.start and rows.stop == self.n  # (the whole bank: no slice)
+        flat = _PLANNED_FLAT.get(name)
+        if flat is not None:
+            table = attrgetter(flat)
+
+            def planned(b: AxisBank) -> bytes | None:
+                if b.n_jog or b.n_hm:
+                    return None
+                return table(b)[b.t_idx if whole else b.t_idx[rows]].tobytes()  # type: ignore[no-any-return]
+
+            return planned
+        if name in _ROW_ITEMS:
+            values = attrgetter(name)
+
+            def items(b: AxisBank) -> bytes | None:
+                x = values(b)
+                if x.dtype is not _F64:
+                    return None
+                return (x if whole else x[rows]).tobytes()  # type: ignore[no-any-return]
+
+            return items
+        return None
 
     def _make_list(self, name: str) -> list[Any]:
         if name == "sts":

@@ -342,6 +342,7 @@ def fast_reader(
     #: every row's list); its plans are kept under the reader's name
     row_expr = BANK_ROWS.get(name) if bank_key is None else SPAN_ROWS.get(name)
     plan_key = bank_key if row_expr is None else name
+    quick = QUICK_ROWS.get(name)  # (its rows' values in fewer steps where it may)
     #: a span's values are status words alone (of the bank's rows, their flags): they stand
     #: while every change is a cycle that keeps every flag (the C entry's array_value)
     status = name in ("GT_GetSts", "GT_GetPrfSts")
@@ -442,7 +443,7 @@ def fast_reader(
                 or plan[2] is not axes
             ):
                 top = resource_count(ctl) if zeros and axes else 0
-                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr)
+                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr, quick)
                 b.read_plans[key] = plan
             pick = plan[3]
             if pick is not None and row_expr is not None:
@@ -536,22 +537,24 @@ def fast_reader(
         value the entry writes itself (GT_GetClock's: the controller's time and GT_Reset's,
         ``centry.set_clock_ms``)."""
 
-        #: the last shape's array type, count and packer (a polling loop repeats its shape)
-        last: list[Any] = [None, 0, None, False]
+        #: the last shape's array type, count and packer (a polling loop repeats its shape),
+        #: whether its values are integers, whether native doubles (a float64 array's bytes)
+        last: list[Any] = [None, 0, None, False, False]
         #: the last integers packed: the packer, the values, their bytes, and where they
         #: were picked from a list of the bank by a plan of its rows and zeros alone: that
         #: list and the plan's getter (else None)
         packed: list[Any] = [None, None, b"", None, None]
         #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
         #: bank, n, count, the layout, resources and axes it holds for, its pick, whether
-        #: that picks the bank's rows and zeros alone (no other axis's getter)
-        lane: list[Any] = [None] * 8
+        #: that picks the bank's rows and zeros alone (no other axis's getter), the getter of
+        #: the bytes of the run of rows it picks in order (AxisBank.span_bytes, else None)
+        lane: list[Any] = [None] * 9
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
             seen = last  # (one read: another thread may replace it meanwhile)
             if tp is seen[0] and count == seen[1]:
-                pack, ints = seen[2], seen[3]
+                pack, ints, doubles = seen[2], seen[3], seen[4]
             else:
                 if type(tp) is not _ARRAY_META:
                     # a numpy array's dtype (the entry checked its array: one C-contiguous
@@ -568,7 +571,8 @@ def fast_reader(
                     pack = struct.Struct(f"@{count}{code}").pack
                     packers[tp, count, code] = pack
                 ints = code in _INT_CODES  # (not floats: -0.0 == 0.0)
-                last[:] = [tp, count, pack, ints]
+                doubles = code == "d"
+                last[:] = [tp, count, pack, ints, doubles]
             if clock is not None:  # (the entry writes a pClock itself: asked without)
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
@@ -603,6 +607,14 @@ def fast_reader(
                     else:
                         lists = b._lists
                         lst = lists.get(bank_key)
+                        if lst is None and doubles and ln[8] is not None:
+                            # a run of rows in order, not made yet this cycle: their bytes
+                            # from the bank's arrays in one step (the same doubles as the
+                            # list's, packed natively), no list of every row
+                            out = ln[8](b)
+                            if out is not None:
+                                session.last = None
+                                return out
                         if lst is None:  # (AxisBank.value's making of it, without its frame)
                             lst = lists[bank_key] = b._make_list(bank_key)
                         memo = packed  # (one read: another thread may replace it meanwhile)
@@ -628,7 +640,11 @@ def fast_reader(
                         and plan[1] is ctl.resources
                         and plan[2] is ctl.axes
                     ):
-                        lane[:] = [b, n, count, *plan[:4], plan[6]]
+                        run = plan[7]
+                        lane[:] = [
+                            *(b, n, count, *plan[:4], plan[6]),
+                            None if run is None else b.span_bytes(bank_key, run),
+                        ]
             memo = packed  # (one read: another thread may replace it meanwhile)
             if pack is memo[0] and (values is memo[1] or values == memo[1]):
                 out = memo[2]  # (integers the same: the same bytes; a poll of idle axes)
@@ -964,6 +980,30 @@ BANK_ROWS: dict[str, str] = {
 #: the encoder's speed (the bank's list of it is made with every row's acceleration too)
 SPAN_ROWS: dict[str, str] = {"GT_GetEncVel": "b._enc_rates_row({r})[0]"}
 
+#: a quicker form of a span's row values of BANK_ROWS and SPAN_ROWS (a span after a cycle
+#: writes one per row): (the names it reads from the bank ``b``, what must hold of the whole
+#: bank, what must hold of a row ``{r}``, the row's value then): the same IEEE operations on
+#: the same doubles as the row's expression, in the case the guard names (the planned values
+#: of a bank where no row jogs or homes: AxisBank._planned_one; encoder rates of a row
+#: claimed two cycles ago or more: AxisBank._enc_rates_row), without its calls' frames; the
+#: row's expression where a guard fails (tests/gtecat/gt/test_fast_span_rows.py)
+_PRF_QUICK = "i = b.t_idx", "not (b.n_jog or b.n_hm)", "True"
+_ENC_QUICK = (
+    "T = b.T; now = b.counts[3]; c = b.claim_cycle; s1 = b.enc_step1; s0 = b.enc_step0",
+    "True",
+    "now - c.item({r}) >= 2",
+)
+QUICK_ROWS: dict[str, tuple[str, str, str, str]] = {
+    "GT_GetAxisPrfVel": (*_PRF_QUICK, "{R}.prf_link.ratio * b._t_v1.item(i.item({r}))"),
+    "GT_GetAxisPrfAcc": (*_PRF_QUICK, "{R}.prf_link.ratio * b._t_a1.item(i.item({r}))"),
+    "GT_GetAxisEncVel": (*_ENC_QUICK, "{R}.enc_link.ratio * (s1.item({r}) / T)"),
+    "GT_GetAxisEncAcc": (
+        *_ENC_QUICK,
+        "{R}.enc_link.ratio * ((s1.item({r}) / T - s0.item({r}) / T) / T)",
+    ),
+    "GT_GetEncVel": (*_ENC_QUICK, "s1.item({r}) / T"),
+}
+
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
 
@@ -988,26 +1028,31 @@ def _read_plan(
     top: int = 0,
     get: Any = None,
     row: str | None = None,
+    quick: tuple[str, str, str, str] | None = None,
 ) -> tuple[Any, ...]:
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
     of the span is a row of ``b``, that row's place in the span, whether the getter picks
-    rows (of a list, or the bank's own) and zeros alone: the same list, the same values).
-    Each axis of the span is a row of ``b``, an axis the bank does not run (its value
-    ``get(resources)``, where ``get`` is given) or, within ``1..top``, an axis no drive
-    backs (it reads 0); any other
-    (another bank's axis, one not on the bus): no getter.  ``row``: a row's value is that
-    expression of BANK_ROWS (``{R}`` its resources, ``{r}`` its row) and the getter takes
-    the bank itself, not a list."""
-    none = (b.layout, resources, axes, None, None, 0, False)
+    rows (of a list, or the bank's own) and zeros alone: the same list, the same values,
+    the slice of the list's rows it picks where they are a run in order, else None:
+    AxisBank.span_bytes).  Each axis of the span is a row of ``b``, an axis the bank does
+    not run (its value ``get(resources)``, where ``get`` is given) or, within ``1..top``,
+    an axis no drive backs (it reads 0); any other (another bank's axis, one not on the
+    bus): no getter.  ``row``: a row's value is that expression of BANK_ROWS (``{R}`` its
+    resources, ``{r}`` its row) and the getter takes the bank itself, not a list; ``quick``:
+    QUICK_ROWS' form of it, taken where its guards hold."""
+    none = (b.layout, resources, axes, None, None, 0, False, None)
     if count < 2:  # (one value: no tuple to store)
         return none
     items: list[str] = []
+    quick_items: list[str] = []
+    guards: list[str] = [] if quick is None else [quick[1]]
     env: dict[str, Any] = {"g": get}
     at = None
     for i, k in enumerate(range(n, n + count)):
         if k not in axes and 1 <= n <= n + count - 1 <= top:
             items.append("0")
+            quick_items.append("0")
             continue
         res = resources.get(k)
         if res is None or axes.get(k) is not res.ax:
@@ -1018,22 +1063,39 @@ def _read_plan(
             else:
                 items.append(row.format(R=f"r{i}", r=res.bank_row))
                 env[f"r{i}"] = res
+                if quick is not None:
+                    quick_items.append(quick[3].format(R=f"r{i}", r=res.bank_row))
+                    guards.append(quick[2].format(r=res.bank_row))
             at = i if at is None else at
         elif res.bank is None and get is not None:
             items.append(f"g(r{i})")
+            quick_items.append(f"g(r{i})")
             env[f"r{i}"] = res
         else:
             return none
     # (rows and zeros alone: no getter of another axis)
     pure = not any(x.startswith("g(") for x in items)
+    run = None
     if pure and row is None and at is not None and "0" not in items:
-        pick = itemgetter(*(int(x[4:-1]) for x in items))
+        rows = [int(x[4:-1]) for x in items]
+        pick = itemgetter(*rows)
+        if rows == list(range(rows[0], rows[0] + count)):
+            run = slice(rows[0], rows[0] + count)
     else:  # (the rows, the getters and the zeros in one tuple)
         env["MOVING"] = _STATUS_BITS["MOVING"]
         arg = "lst" if row is None else "b"
         pick = eval(f"lambda {arg}: ({', '.join(items)},)", env)  # (row numbers, names, 0)
+        if quick is not None and at is not None:
+            env["slow"] = pick
+            guard = " and ".join(x for x in guards if x != "True") or "True"
+            exec(
+                f"def quick(b):\n    {quick[0]}\n    if {guard}:\n"
+                f"        return ({', '.join(quick_items)},)\n    return slow(b)\n",
+                env,
+            )
+            pick = env["quick"]
     first = None if at is None else resources.get(n + at)
-    return (b.layout, resources, axes, pick, first, at, pure)
+    return (b.layout, resources, axes, pick, first, at, pure, run)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the

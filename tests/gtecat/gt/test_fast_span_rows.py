@@ -2,7 +2,10 @@
 of ``fast.BANK_ROWS``, and the encoder's speed: ``fast.SPAN_ROWS``): after each cycle of the
 auto clock its C entry asks each row of the bank for its value alone, not every row's list;
 what it writes is what the table path writes, cycle by cycle, while both axes move,
-accelerate and stop.  A span of status words stands across the cycles that keep every
+accelerate and stop.  The same of the spans of doubles of the bank's lists
+(``fast.BANK_LISTS``: a run of rows in order is written from the bank's arrays in one
+step) and of ``fast.QUICK_ROWS``' quicker rows, and of their own ways while an axis jogs
+(neither applies).  A span of status words stands across the cycles that keep every
 flag."""
 
 from __future__ import annotations
@@ -15,11 +18,16 @@ from gtecat.gt import fast
 
 from .conftest import bring_up, trap_move
 
+#: the readers of the spans read: the rows' and the doubles of the bank's lists
+_SPANS = sorted(
+    fast.BANK_ROWS | fast.SPAN_ROWS | {k: v for k, v in fast.BANK_LISTS.items() if k != "GT_GetSts"}
+)
+
 
 def _moves_read(table: bool) -> tuple[list, int]:
-    """Both axes' Trap moves, each cycle's spans read (``table``: through the table path):
-    what was read, at which cycle, and how many of the reads found axis 1 a row of the
-    bank."""
+    """Both axes' Trap moves, then axis 2's Jog, each cycle's spans read (``table``:
+    through the table path): what was read, at which cycle, and how many of the reads found
+    axis 1 a row of the bank."""
     bring_up(clock="auto")
     try:
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
@@ -31,9 +39,16 @@ def _moves_read(table: bool) -> tuple[list, int]:
         trap_move(2, -600, 7.5)
         seen: list = []
         banked = 0
-        for _ in range(320):
+        for i in range(400):
+            if i == 30:  # (a new target while axis 2 moves)
+                assert gt.GT_SetPos(2, 600) == 0 and gt.GT_SetVel(2, 9.0) == 0
+                assert gt.GT_Update(2) == 0
+            if i == 320:  # (a jog: the bank's rows read their own ways)
+                jog = gt.TJogPrm(acc=0.5, dec=0.5, smooth=0)
+                assert gt.GT_PrfJog(2) == 0 and gt.GT_SetJogPrm(2, byref(jog)) == 0
+                assert gt.GT_SetVel(2, 3.0) == 0 and gt.GT_Update(2) == 0
             banked += ctl.resources[1].bank is not None
-            for name in sorted(fast.BANK_ROWS | fast.SPAN_ROWS):
+            for name in _SPANS:
                 fn = getattr(gt, name)
                 fn = fn.slow if table else fn
                 tp = c_long if name == "GT_GetPrfSts" else c_double
@@ -42,6 +57,8 @@ def _moves_read(table: bool) -> tuple[list, int]:
                 assert fn(1, byref(arr, ctypes.sizeof(tp)), 2, None) == 0
                 assert fn(1, arr, 2) == 0
                 seen.append((ctl.clock.cycles, name, bytes(arr)))
+        assert gt.GT_Stop(2, 0) == 0
+        gt.GTE_Wait(200)
         enc = (c_double * 2)()
         assert gt.GT_GetAxisEncVel(1, enc, 2) == 0
         seen.append(tuple(enc))
@@ -55,7 +72,7 @@ def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
     table path (which gives the axes back: the scalar objects' values), cycle by cycle."""
     rows, banked = _moves_read(False)
     table, _ = _moves_read(True)
-    assert banked == 320  # (every read from the bank's rows)
+    assert banked == 400  # (every read from the bank's rows)
     assert rows[-1] == (0.0, 0.0)  # (both moves ended)
     assert len({c for c, *_ in rows[:-1]}) > 200  # (cycle by cycle)
     assert rows == table
