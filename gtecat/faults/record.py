@@ -1319,7 +1319,8 @@ def _kind(x: Any) -> tuple[Any, ...] | None:
     """What a recorded pointer argument is when one pooled object serves it: ``("ref", c)``
     for a pointer to a simple value, ``("arr", c, n)`` for an array of numbers,
     ``("arr", c, n, off)`` for a pointer ``off`` bytes into one (a C program's ``&arr[8]``:
-    ``byref(arr, off)``, off on an element inside the array); else None."""
+    ``byref(arr, off)``, off on an element inside the array; 0: ``byref(arr)``, as a
+    controller process records a C client's array); else None."""
     if type(x) is not dict or not 1 <= len(x) <= 3:
         return None
     if len(x) == 2:
@@ -1341,6 +1342,9 @@ def _kind(x: Any) -> tuple[Any, ...] | None:
             and type(ref.get("v")) in (int, float)
         ):
             return ("ref", ref["c"])
+        kind = _kind(ref) if type(ref) is dict and "arr" in ref else None
+        if kind is not None and len(kind) == 3:
+            return (*kind, 0)  # (a pointer to the array's start: a C client's double *)
         return None
     c, n, v = x.get("arr"), x.get("n"), x.get("v")
     if (
