@@ -723,6 +723,33 @@ static int clock_for(const struct entry *e, int csize, int csign, long long *ms)
     return clock_ms(e->gate, ms) && fits(*ms, csize, csign);
 }
 
+/* A pClock looked at again once the value is made (Python may have run: its memory may have
+ * moved, its type changed) and its value, clock_for's: 0 where the call must go the Python
+ * way. */
+static int clock_again(const struct entry *e, obj pc, char **mem, int *size, int *sign,
+                       long long *ms)
+{
+    return clock_mem(e, pc, mem, size, sign) && *mem && clock_for(e, *size, *sign, ms);
+}
+
+/* A span's first axis and count, both exact ints a long long holds: 0 where they are not
+ * (any error the conversion raised cleared; the Python way answers). */
+static int span_args(obj first, obj count, long long *an, long long *ac)
+{
+    int over = 0;
+    if (TYPE(count) != A.int_type)
+        return 0;
+    *an = A.as_ll(first, &over);
+    if (!over)
+        *ac = A.as_ll(count, &over);
+    if (over || A.err_occurred()) {
+        if (A.err_occurred())
+            A.err_clear();
+        return 0;
+    }
+    return 1;
+}
+
 /* The ctypes array a reader's value pointer p passes: p itself, or the array of
  * byref(array[, offset]) (C's &array[k]); NULL where p is neither. */
 static obj array_of(obj p)
@@ -824,21 +851,13 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
-    int csize = 0, csign = 1, over = 0;
+    int csize = 0, csign = 1;
     call[0] = args[at];
     call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
-    if (TYPE(call[1]) != A.int_type)
+    if (!span_args(call[0], call[1], &an, &ac))
         goto python;
     if (nargs >= 4 + at && !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
         goto python;
-    an = A.as_ll(call[0], &over);
-    if (!over)
-        ac = A.as_ll(call[1], &over);
-    if (over || A.err_occurred()) {
-        if (A.err_occurred())
-            A.err_clear();
-        goto python;
-    }
     call[2] = tp;
     call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
     v = array_value(e, call, an, ac, 0, locked);
@@ -849,11 +868,8 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     n = *(ptrdiff_t *)((char *)v + A.bsize);
     if (n <= 0)
         goto drop;
-    if (cmem) { /* (again: Python may have run) */
-        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
-            !clock_for(e, csize, csign, &clk))
-            goto drop;
-    }
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+        goto drop;
     /* (avalue checked the array's type and length: the bytes fit its start; an offset's
      * room: array_mem) */
     mem = array_mem(args[at + 1], arr, n, ac, e->stride);
@@ -883,21 +899,13 @@ static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
-    int csize = 0, csign = 1, over = 0, size = 0, sign = 1;
+    int csize = 0, csign = 1, size = 0, sign = 1;
     call[0] = args[at];
     call[1] = args[at + 2];
-    if (TYPE(call[1]) != A.int_type || !np_mem(e, p, &size, &sign))
+    if (!span_args(call[0], call[1], &an, &ac) || !np_mem(e, p, &size, &sign))
         goto python;
     if (nargs >= 4 + at && !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
         goto python;
-    an = A.as_ll(call[0], &over);
-    if (!over)
-        ac = A.as_ll(call[1], &over);
-    if (over || A.err_occurred()) {
-        if (A.err_occurred())
-            A.err_clear();
-        goto python;
-    }
     if (ac < 2 || *(ptrdiff_t *)AT(p, A.nd_dims) < ac)
         goto python;
     call[2] = (obj)AT(p, A.nd_descr);
@@ -908,11 +916,8 @@ static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     if (v == PYTHON)
         goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize);
-    if (cmem) { /* (again: Python may have run) */
-        if (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
-            !clock_for(e, csize, csign, &clk))
-            goto drop;
-    }
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+        goto drop;
     mem = np_mem(e, p, &size, &sign); /* (again, and the bytes fit: count whole values) */
     if (!mem || *(ptrdiff_t *)AT(p, A.nd_dims) < ac || (obj)AT(p, A.nd_descr) != call[2] ||
         n != ac * (long long)size)
@@ -1121,8 +1126,7 @@ have:
     mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
     if (!mem)
         goto drop;
-    if (cmem && (!clock_mem(e, args[at + 3], &cmem, &csize, &csign) || !cmem ||
-                 !clock_for(e, csize, csign, &clk)))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
         goto drop; /* (again, and its value: written after the value, as the Python path) */
     if (e->kind == 1) {
         if (TYPE(v) != A.float_type || size != 8)
