@@ -1,10 +1,12 @@
 """Every test of the fault vocabulary, recording and replay starts and ends with no GT
 session open (a failed test leaves none behind for the next); :func:`record_one_by_one`
 records a session the reference way the replays are compared with; :func:`fig5_2_up` brings
-the manual's figure 5-2 bus up as an application does, and :func:`recorded` records one."""
+the manual's figure 5-2 bus up as an application does, :func:`recorded` records one and
+:func:`changed` writes a tampered copy."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Iterator
 from ctypes import byref, c_short
 from pathlib import Path
@@ -27,6 +29,16 @@ def fig5_2_up() -> None:
     while not (gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1):
         gt.GTE_Wait(1)
     gt.GT_StartEcatComm()
+
+
+def fig5_2_jogging(vel: float) -> None:
+    """:func:`fig5_2_up`, and axis 1 on and jogging at ``vel`` pulse/ms (an encoder that moves:
+    every poll reads new values)."""
+    fig5_2_up()
+    gt.GT_AxisOn(1)
+    gt.GT_PrfJog(1)
+    gt.GT_SetVel(1, vel)
+    gt.GT_Update(1)
 
 
 def recorded(path: Path, session: Callable[[], object], any_thread: bool = False) -> Path:
@@ -59,6 +71,28 @@ def record_one_by_one(out: Path, session: Callable[[], object], quick: bool = Tr
         gt.GT_Close()
     rec.write()
     return out
+
+
+def changed(
+    src: Path, dst: Path, picked: Callable[[str], bool], nth: int, change: Callable[[dict], object]
+) -> int:
+    """``src`` written to ``dst`` with the ``nth`` call whose line ``picked`` takes changed by
+    ``change(entry)``, the line written as the recorder writes it; that call's number."""
+    lines = src.read_text().splitlines()
+    calls = seen = 0
+    for i, line in enumerate(lines[1:], 1):
+        if not line.startswith('{"t":'):
+            continue
+        calls += 1
+        if picked(line):
+            seen += 1
+            if seen == nth:
+                e = json.loads(line)
+                change(e)
+                lines[i] = json.dumps(e, separators=(",", ":"))
+                dst.write_text("\n".join(lines) + "\n")
+                return calls
+    raise AssertionError(f"{src}: no call {nth} of those picked")
 
 
 @pytest.fixture(autouse=True)

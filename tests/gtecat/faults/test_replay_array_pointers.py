@@ -4,7 +4,6 @@ call with its array pooled, the session replays exactly, and a changed element i
 
 from __future__ import annotations
 
-import json
 from ctypes import byref, c_double, c_long, c_ubyte
 from pathlib import Path
 
@@ -13,17 +12,13 @@ import pytest
 from gtecat import gt
 from gtecat.faults.record import _open_text, _steps, replay
 
-from .conftest import fig5_2_up, recorded
+from .conftest import changed, fig5_2_jogging, recorded
 
 POLLS = 200
 
 
 def _session() -> None:
-    fig5_2_up()
-    gt.GT_AxisOn(1)
-    gt.GT_PrfJog(1)
-    gt.GT_SetVel(1, 4.0)
-    gt.GT_Update(1)
+    fig5_2_jogging(4.0)
     enc = (c_double * 2)()
     sts = (c_long * 2)()
     raw = (c_ubyte * 8)()
@@ -56,21 +51,12 @@ def test_the_pointers_share_forms_and_replay_exactly(pointers: Path) -> None:
 
 
 def test_a_changed_element_behind_a_pointer_is_named(pointers: Path, tmp_path: Path) -> None:
-    lines = pointers.read_text().splitlines()
-    calls = seen = 0
-    for i, line in enumerate(lines[1:], 1):
-        if '"c":' not in line:
-            continue
-        calls += 1
-        if '"c":"GT_GetEncPos"' in line and '"o":' in line:
-            seen += 1
-            if seen == 120:
-                e = json.loads(line)
-                e["o"]["1"]["ref"]["v"][1] += 1.0
-                lines[i] = json.dumps(e, separators=(",", ":"))
-                break
+    def nudge(e: dict) -> None:
+        e["o"]["1"]["ref"]["v"][1] += 1.0
+
     bad = tmp_path / "bad.gtrec"
-    bad.write_text("\n".join(lines) + "\n")
+    picked = lambda line: '"c":"GT_GetEncPos"' in line and '"o":' in line  # noqa: E731
+    calls = changed(pointers, bad, picked, 120, nudge)
     n, div = replay(bad)
     assert div is not None and (n, div.call, div.what) == (
         calls,

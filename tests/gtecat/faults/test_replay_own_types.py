@@ -6,7 +6,6 @@ TCrdPrm themselves), and a pointer into a single value (``byref(x, 4)``, C's ``(
 from __future__ import annotations
 
 import ctypes
-import json
 from ctypes import byref, c_double, c_long, c_short
 from pathlib import Path
 
@@ -14,8 +13,10 @@ import pytest
 
 from gtecat import gt
 from gtecat.errors import ParameterError
-from gtecat.faults.record import Recorder, replay
+from gtecat.faults.record import replay
 from tests.conftest import EXAMPLES
+
+from .conftest import changed, recorded
 
 ENI = EXAMPLES / "manual_fig5_2.eni"
 
@@ -70,44 +71,29 @@ def _session() -> list[int]:
 
 
 @pytest.fixture(scope="module")
-def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path = tmp_path_factory.mktemp("own") / "own.gtrec"
-    rec = Recorder(path).start()
-    try:
-        codes = _session()
-    finally:
-        rec.stop()
-        gt.GT_Close()
+def own(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    codes: list[int] = []
+    path = recorded(tmp_path_factory.mktemp("own") / "own.gtrec", lambda: codes.extend(_session()))
     assert codes[-3] == 7 and codes.count(7) == 1  # (the pointer with no room: refused)
     assert set(codes) == {0, 7}
-    return rec.write()
+    return path
 
 
-def test_the_session_replays_exactly(recorded: Path) -> None:
-    n, div = replay(recorded)
+def test_the_session_replays_exactly(own: Path) -> None:
+    n, div = replay(own)
     assert div is None, str(div)
-    assert n == sum('"c":' in x for x in recorded.read_text().splitlines()[1:])
+    assert n == sum('"c":' in x for x in own.read_text().splitlines()[1:])
 
 
 def _changed(src: Path, dst: Path, name: str, change) -> int:
-    lines = src.read_text().splitlines()
-    calls = 0
-    for i, line in enumerate(lines[1:], 1):
-        if '"c":' in line:
-            calls += 1
-            e = json.loads(line)
-            if e["c"] == name:
-                change(e)
-                lines[i] = json.dumps(e, separators=(",", ":"))
-                dst.write_text("\n".join(lines) + "\n")
-                return calls
-    raise AssertionError(name)
+    """The first call of ``name``, changed."""
+    return changed(src, dst, lambda line: f'"c":"{name}"' in line, 1, change)
 
 
-def test_a_tampered_field_of_an_own_structure_is_found(recorded: Path, tmp_path: Path) -> None:
+def test_a_tampered_field_of_an_own_structure_is_found(own: Path, tmp_path: Path) -> None:
     bad = tmp_path / "bad.gtrec"
     at = _changed(
-        recorded,
+        own,
         bad,
         "GT_GetCrdPrm",
         lambda e: e["o"]["1"]["ref"]["v"]["prof"]["v"].__setitem__(1, 3),
@@ -116,11 +102,11 @@ def test_a_tampered_field_of_an_own_structure_is_found(recorded: Path, tmp_path:
     assert div is not None and (n, div.call, div.what) == (at, "GT_GetCrdPrm", "argument 2")
 
 
-def test_the_refused_pointer_into_a_value_is_refused_again(recorded: Path, tmp_path: Path) -> None:
+def test_the_refused_pointer_into_a_value_is_refused_again(own: Path, tmp_path: Path) -> None:
     """The recorded 7 stands only where the replay passes the pointer with its offset: the
     same recording with the offset dropped diverges there (0 against 7)."""
     bad = tmp_path / "nooff.gtrec"
-    at = _changed(recorded, bad, "GT_GetSts", lambda e: e["a"][1].pop("off"))
+    at = _changed(own, bad, "GT_GetSts", lambda e: e["a"][1].pop("off"))
     n, div = replay(bad)
     assert div is not None and (n, div.what, div.recorded, div.now) == (at, "return code", 7, 0)
 
@@ -134,11 +120,9 @@ def test_the_refused_pointer_into_a_value_is_refused_again(recorded: Path, tmp_p
     ],
 )
 def test_a_damaged_layout_is_refused_with_its_reason(
-    recorded: Path, tmp_path: Path, field: list
+    own: Path, tmp_path: Path, field: list
 ) -> None:
     bad = tmp_path / "lay.gtrec"
-    _changed(
-        recorded, bad, "GT_SetTrapPrm", lambda e: e["a"][1]["ref"]["lay"].__setitem__(3, field)
-    )
+    _changed(own, bad, "GT_SetTrapPrm", lambda e: e["a"][1]["ref"]["lay"].__setitem__(3, field))
     with pytest.raises(ParameterError, match=r"damaged recording.*GT_SetTrapPrm"):
         replay(bad)

@@ -15,17 +15,13 @@ from gtecat import gt
 from gtecat.faults.record import _open_text, _steps, replay
 from tests.conftest import EXAMPLES
 
-from .conftest import fig5_2_up, recorded
+from .conftest import changed, fig5_2_jogging, recorded
 
 POLLS = 400
 
 
 def _session() -> None:
-    fig5_2_up()
-    gt.GT_AxisOn(1)
-    gt.GT_PrfJog(1)
-    gt.GT_SetVel(1, 5.0)
-    gt.GT_Update(1)
+    fig5_2_jogging(5.0)
     buf = (c_ubyte * 8)()
     out = (c_ubyte * 2)()
     clk = c_ulong()
@@ -68,20 +64,10 @@ def test_the_session_replays_exactly_and_the_buffers_share_their_forms(raw: Path
 
 
 def _tamper(src: Path, dst: Path, nth: int, change) -> int:
-    lines = src.read_text().splitlines()
-    calls = seen = 0
-    for i, line in enumerate(lines[1:], 1):
-        if '"c":' in line:
-            calls += 1
-            if '"GT_GetEcatRawData"' in line and '"o":' in line:
-                seen += 1
-                if seen == nth:
-                    e = json.loads(line)
-                    change(e)
-                    lines[i] = json.dumps(e, separators=(",", ":"))
-                    dst.write_text("\n".join(lines) + "\n")
-                    return calls
-    raise AssertionError(nth)
+    """The ``nth`` GT_GetEcatRawData that wrote its buffer back, changed."""
+    return changed(
+        src, dst, lambda line: '"GT_GetEcatRawData"' in line and '"o":' in line, nth, change
+    )
 
 
 def test_a_tampered_byte_is_named_with_its_index(raw: Path, tmp_path: Path) -> None:

@@ -6,7 +6,6 @@ changed time is found where it changes a result."""
 
 from __future__ import annotations
 
-import json
 from ctypes import byref, c_double, c_long
 from pathlib import Path
 
@@ -15,17 +14,13 @@ import pytest
 from gtecat import gt
 from gtecat.faults.record import _open_text, _steps, replay
 
-from .conftest import fig5_2_up, recorded
+from .conftest import changed, fig5_2_jogging, recorded
 
 POLLS = 300
 
 
 def _session() -> None:
-    fig5_2_up()
-    gt.GT_AxisOn(1)
-    gt.GT_PrfJog(1)
-    gt.GT_SetVel(1, 3.0)
-    gt.GT_Update(1)
+    fig5_2_jogging(3.0)
     clock = gt.GTE_Controller().clock
     s, p, clk = c_long(), c_double(), c_long()
     for i in range(POLLS):
@@ -53,20 +48,12 @@ def test_each_call_replays_with_its_own_time_and_the_lines_share_forms(gaps: Pat
 
 
 def test_a_changed_time_is_found(gaps: Path, tmp_path: Path) -> None:
-    text = gaps.read_text().splitlines()
-    seen = calls = 0
-    for i, line in enumerate(text[1:], 1):
-        if '"c":' not in line:
-            continue
-        calls += 1
-        if '"c":"GT_GetSts"' in line and '"b":' in line:
-            seen += 1
-            if seen == 150:
-                e = json.loads(line)
-                e["b"] += 5_000_000  # 5 ms later: the clock read after it differs
-                text[i] = json.dumps(e, separators=(",", ":"))
-                break
+    def later(e: dict) -> None:
+        e["b"] += 5_000_000  # 5 ms later: the clock read after it differs
+
     bad = tmp_path / "late.gtrec"
-    bad.write_text("\n".join(text) + "\n")
+    calls = changed(
+        gaps, bad, lambda line: '"c":"GT_GetSts"' in line and '"b":' in line, 150, later
+    )
     n, div = replay(bad)
     assert div is not None and calls <= n <= calls + 2
