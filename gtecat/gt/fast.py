@@ -1401,18 +1401,16 @@ def fast_clock(
                         if cycles > _INT_MAX[type(loop)]:  # (its bit pattern: the table)
                             obj = q = None
                             tp = type(None)
+                    written = False
                     if obj is None:  # an array: its first element
                         b = first(q, tp)
                         if b is not None and ms <= b[1]:
                             q[0] = ms
-                            if loop is not None:
-                                loop.value = cycles
-                            session.last = None
-                            if clock.mode is _LOCKSTEP:
-                                return 0
-                            return advance(ctl, name, 0)
+                            written = True
                     elif ms <= _INT_MAX[type(obj)]:
                         obj.value = ms
+                        written = True
+                    if written:
                         if loop is not None:
                             loop.value = cycles
                         session.last = None
