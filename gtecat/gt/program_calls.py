@@ -103,8 +103,9 @@ def runtime(ctl: Controller, create: bool = True) -> threads.ProgramRuntime | No
     return rt
 
 
-def untapped(fn: object) -> object:
-    """The function a recording's tap wraps (:mod:`gtecat.faults.tap`), or ``fn``."""
+def untapped(fn: Any) -> Any:
+    """The function a recording's tap wraps (:mod:`gtecat.faults.tap`), or ``fn`` (None
+    stays None)."""
     return getattr(fn, "tap_of", fn)
 
 
@@ -120,9 +121,8 @@ def _caller(ctl: Controller):
         card, core = at  # the program's own card and core, whatever the host addresses
         # (the functions themselves, not a recording's tap: a program's calls are not the
         # host application's, and on the realtime clock they run in the cycle's thread)
-        fn: Any = untapped(_core.REGISTRY[name])
-        twin = _core.REGISTRY.get("GTN_" + name[3:]) if core != 1 else None
-        twin = untapped(twin) if twin is not None else None  # type: ignore[assignment]
+        fn = untapped(_core.REGISTRY[name])
+        twin = untapped(_core.REGISTRY.get("GTN_" + name[3:])) if core != 1 else None
         host_last = _core.SESSION.last  # the host's GTE_GetLastError is not the program's
         try:
             with _core.SESSION.selected(card):
