@@ -676,13 +676,13 @@ def fast_reader(
             pointers=True,  # (pointer(x): as general answers it)
             array=array_value(value_gt, 0), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
-            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            clocks=CLOCK_ORDER if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, 1),
-            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            clocks=CLOCK_ORDER if takes_clock else (),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
             numpy=sorted(np_ok, key=str),
         )  # fmt: skip
@@ -1322,6 +1322,11 @@ _CLOCK_INTS = _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.
 _INT_MAX.update(
     {t: (1 << (8 * ctypes.sizeof(t))) - 1 for t in _CLOCK_INTS - _INTS}  # (unsigned)
 )
+#: the clock's types in the order a C entry looks for them: the vendor's ``c_ulong`` and
+#: ``c_uint32`` first (a poll's clock is found in one step), then the others
+CLOCK_ORDER = sorted(
+    _CLOCK_INTS, key=lambda t: (t is not ctypes.c_ulong, t is not ctypes.c_uint32, str(t))
+)
 
 
 _CLOCK_POINTERS: dict[type, bool] = {}
@@ -1431,7 +1436,7 @@ def fast_clock(
 
     if not CENTRY:
         return gt
-    types = sorted(_CLOCK_INTS, key=str)
+    types = CLOCK_ORDER
     # (an array of one of the types ``first`` takes: its first element)
     elements = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
     entry = centry.reader(

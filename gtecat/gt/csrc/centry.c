@@ -702,16 +702,23 @@ static int clock_cycles(ptrdiff_t g, long long *cycles)
  * the gate has none (the Python path answers). */
 static int clock_ms(ptrdiff_t g, long long *ms)
 {
+    /* (the last difference and its value: a poll asks again before the clock moves on) */
+    static long long last_d = -1, last_ms;
     const long long *now, *origin;
     long long d, q;
     if (!clock_ms_at || g < 1 || g > 2 || !(now = (const long long *)clock_ms_at[2 * g - 2]) ||
         !(origin = (const long long *)clock_ms_at[2 * g - 1]))
         return 0;
     d = *now - *origin;
+    if (d == last_d && d >= 0) {
+        *ms = last_ms;
+        return 1;
+    }
     q = d / 1000000;
     if (d % 1000000 < 0) /* (floor division, as Python's) */
         q -= 1;
     *ms = q & 0xFFFFFFFFLL;
+    last_d = d, last_ms = *ms;
     return 1;
 }
 
@@ -723,13 +730,15 @@ static int clock_for(const struct entry *e, int csize, int csign, long long *ms)
     return clock_ms(e->gate, ms) && fits(*ms, csize, csign);
 }
 
-/* A pClock looked at again once the value is made (Python may have run: its memory may have
- * moved, its type changed) and its value, clock_for's: 0 where the call must go the Python
- * way. */
+/* A pClock looked at again once the value is made where Python ran for it (ran: its memory
+ * may have moved, its type changed; where no Python ran nothing could change it: the first
+ * look stands) and its value, clock_for's: 0 where the call must go the Python way. */
 static int clock_again(const struct entry *e, obj pc, char **mem, int *size, int *sign,
-                       long long *ms)
+                       long long *ms, int ran)
 {
-    return clock_mem(e, pc, mem, size, sign) && *mem && clock_for(e, *size, *sign, ms);
+    if (ran && !(clock_mem(e, pc, mem, size, sign) && *mem))
+        return 0;
+    return clock_for(e, *size, *sign, ms);
 }
 
 /* A span's first axis and count, both exact ints a long long holds: 0 where they are not
@@ -800,12 +809,13 @@ static char python_mark;
  * bytes: the Python path answers), AGAIN (another thread's cycle or call meanwhile), or NULL
  * with the value's own error. */
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
-                       long long clk, int locked)
+                       long long clk, int locked, int *ran)
 {
     struct aslot *s = e->acache;
     long long ep = -1, ep0 = -1;
     int holds = 0;
     obj v, tp = call[2];
+    *ran = 0;
     if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk &&
         (s->epoch == ep ||
@@ -817,6 +827,7 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
     }
     if (!locked)
         ep0 = epoch();
+    *ran = 1;
     v = A.vectorcall(e->avalue, call, 4, NULL);
     if (!v)
         return NULL;
@@ -851,7 +862,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
-    int csize = 0, csign = 1;
+    int csize = 0, csign = 1, ran;
     call[0] = args[at];
     call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
     if (!span_args(call[0], call[1], &an, &ac))
@@ -860,7 +871,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
         goto python;
     call[2] = tp;
     call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
-    v = array_value(e, call, an, ac, 0, locked);
+    v = array_value(e, call, an, ac, 0, locked, &ran);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
@@ -868,7 +879,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     n = *(ptrdiff_t *)((char *)v + A.bsize);
     if (n <= 0)
         goto drop;
-    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk, ran))
         goto drop;
     /* (avalue checked the array's type and length: the bytes fit its start; an offset's
      * room: array_mem) */
@@ -899,10 +910,10 @@ static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
-    int csize = 0, csign = 1, size = 0, sign = 1;
+    int csize = 0, csign = 1, size = 0, sign = 1, ran;
     call[0] = args[at];
     call[1] = args[at + 2];
-    if (!span_args(call[0], call[1], &an, &ac) || !np_mem(e, p, &size, &sign))
+    if (!span_args(call[0], call[1], &an, &ac) || !(mem = np_mem(e, p, &size, &sign)))
         goto python;
     if (nargs >= 4 + at && !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
         goto python;
@@ -910,15 +921,17 @@ static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
         goto python;
     call[2] = (obj)AT(p, A.nd_descr);
     call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
-    v = array_value(e, call, an, ac, 0, locked);
+    v = array_value(e, call, an, ac, 0, locked, &ran);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
         goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize);
-    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk, ran))
         goto drop;
-    mem = np_mem(e, p, &size, &sign); /* (again, and the bytes fit: count whole values) */
+    if (ran) /* (again where Python ran: the array may have changed meanwhile) */
+        mem = np_mem(e, p, &size, &sign);
+    /* (and the bytes fit: count whole values) */
     if (!mem || *(ptrdiff_t *)AT(p, A.nd_dims) < ac || (obj)AT(p, A.nd_descr) != call[2] ||
         n != ac * (long long)size)
         goto drop;
@@ -942,11 +955,12 @@ static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     obj call[4], v;
     ptrdiff_t n;
     char *mem;
+    int ran;
     call[0] = A.zero;
     call[1] = A.one;
     call[2] = TYPE(arr);
     call[3] = A.none;
-    v = array_value(e, call, 0, 1, 0, locked);
+    v = array_value(e, call, 0, 1, 0, locked, &ran);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
@@ -1033,9 +1047,9 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v, arr;
-    char *mem, *cmem = NULL, *lmem = NULL;
+    char *mem = NULL, *cmem = NULL, *lmem = NULL;
     obj deref = NULL;
-    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1;
+    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1, ran = 0;
     long long key = -1, ep = -1, ep0 = -1, clk = 0, loop = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
@@ -1082,7 +1096,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     tp = TYPE(p);
     target = p;
     if (tp == A.ndarray_type && e->nptypes[0]) { /* a numpy array: its first element */
-        if (!np_mem(e, p, &size, &sign))
+        if (!(mem = np_mem(e, p, &size, &sign)))
             goto python;
         npy = 1;
     } else {
@@ -1096,7 +1110,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         if (k < 0)
             goto python;
         deref = (obj)e->derefs[k];
-        if (!reader_mem(p, target, deref))
+        if (!(mem = reader_mem(p, target, deref)))
             goto python;
     }
 
@@ -1106,6 +1120,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         goto have;
     if (!locked)
         ep0 = epoch();
+    ran = 1;
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
                   : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
@@ -1123,10 +1138,11 @@ have:
     if (lmem && (!clock_cycles(e->gate, &loop) || !clock_mem(e, args[1], &lmem, &lsize, &lsign) ||
                  !lmem || !fits(loop, lsize, lsign)))
         goto drop;
-    mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
+    if (ran) /* (again where Python ran: see reader_mem) */
+        mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref);
     if (!mem)
         goto drop;
-    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk, ran))
         goto drop; /* (again, and its value: written after the value, as the Python path) */
     if (e->kind == 1) {
         if (TYPE(v) != A.float_type || size != 8)
