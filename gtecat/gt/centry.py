@@ -330,6 +330,15 @@ def _marks_dict() -> dict:
 CLOCK_MS = (ctypes.c_ssize_t * 4)()
 _ORIGINS: list[Any] = [None, None]  # (their arrays, kept alive while named)
 
+#: the quick cycles' timer (csrc/centry.c cycle_timer): [0] nonzero while on, [1] the
+#: nanoseconds the quick cycles the entries ran took (the kernel's cycle and its book), [2]
+#: how many; for a benchmark that tells a call's own cost from the controller's cycles its
+#: host latency runs inside it (tools/bench.py); off, it costs a cycle one load
+CYCLE_TIMER = (ctypes.c_longlong * 3)()
+#: whether the entries time their quick cycles when :data:`CYCLE_TIMER` is on (a monotonic
+#: clock known to the C file)
+CYCLE_TIMED = False
+
 
 def set_clock_ms(gt: Any, gtn: Any) -> None:
     """The controllers behind the two gates, for their clock values (:data:`CLOCK_MS`;
@@ -821,6 +830,9 @@ def _load() -> tuple[Maker | None, str]:
             return None, "the library refused the layout"
         lib.gtecat_centry_clock_ms.argtypes = [_VP]
         lib.gtecat_centry_clock_ms(ctypes.addressof(CLOCK_MS))
+        lib.gtecat_centry_cycle_timer.argtypes = [_VP]
+        global CYCLE_TIMED
+        CYCLE_TIMED = lib.gtecat_centry_cycle_timer(ctypes.addressof(CYCLE_TIMER)) == 0
         meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
         raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
         vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value

@@ -30,6 +30,10 @@
  * handed over by the loader, which probed them on objects whose answers it knows and tests
  * the entry against the Python path before using it.
  */
+#if !defined(_WIN32)
+#define _POSIX_C_SOURCE 199309L /* (clock_gettime: the cycles' timer, cycle_timer) */
+#include <time.h>
+#endif
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -568,6 +572,44 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     return 1;
 }
 
+/* The cycles' timer (gtecat.gt.centry.CYCLE_TIMER, for a benchmark that tells a call's own
+ * cost from the cycles a call's latency runs inside it): [0] nonzero while on, [1] the
+ * nanoseconds the quick cycles took (the kernel's cycle and its book, in C or Python), [2]
+ * how many; NULL: none (no monotonic clock known here) */
+static long long *cycle_timer;
+
+int gtecat_centry_cycle_timer(long long *t)
+{
+#if defined(_WIN32)
+    (void)t;
+    return 1;
+#else
+    cycle_timer = t;
+    return 0;
+#endif
+}
+
+static long long timer_ns(void)
+{
+#if defined(_WIN32)
+    return 0;
+#else
+    struct timespec t;
+    if (clock_gettime(CLOCK_MONOTONIC, &t))
+        return 0;
+    return (long long)t.tv_sec * 1000000000LL + t.tv_nsec;
+#endif
+}
+
+/* A quick cycle timed (started at t0) where the timer is on. */
+static void timed(long long t0)
+{
+    if (t0) {
+        cycle_timer[1] += timer_ns() - t0;
+        cycle_timer[2] += 1;
+    }
+}
+
 /* The armed quick cycle where the call's latency makes a cycle due: the clock's lock taken
  * (hold: it may wait for another thread's call or cycles, as after() would), armed() asked
  * again with the lock held, the kernel's cycle run here and book(after, rc) doing the rest
@@ -578,6 +620,7 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     long long *q = (long long *)A.clock_quick[gate - 1];
     obj book = (obj)A.clock_calls[gate - 1], release, args[2];
     const long long *call;
+    long long t0;
     int rc;
     if (!q || !book || !armed(q, q[0] + q[1]))
         return 0;
@@ -593,11 +636,13 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
         return 0;
     }
     call = (const long long *)q[8];
+    t0 = cycle_timer && cycle_timer[0] ? timer_ns() : 0;
     q[4] = 0;  /* (the book arms the next one) */
     q[11] -= 1; /* (one cycle of the budget it was armed with) */
     q[0] += q[1] - q[2];
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
     if (!rc && book_in_c(gate, q)) {
+        timed(t0);
         A.incref(A.zero);
         *res = A.zero;
         let_go(release);
@@ -608,6 +653,7 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     A.incref(book); /* (the gates may change while it runs) */
     *res = A.vectorcall(book, args, 2, NULL);
     A.decref(book);
+    timed(t0);
     let_go(release);
     return 1;
 }
