@@ -129,6 +129,7 @@ class _Api(ctypes.Structure):
         ("key_lists", _VP),
         ("key_seen", _VP),
         ("b_size", ctypes.c_ssize_t),
+        ("bytes_new", _VP),
     ]
 
 
@@ -150,6 +151,10 @@ class _ASlot(ctypes.Structure):
         ("value", _VP),
         ("holds", ctypes.c_longlong),
         ("keeps", ctypes.c_longlong),
+        ("src", _VP),
+        ("idx", _VP),
+        ("start", ctypes.c_longlong),
+        ("booked", ctypes.c_longlong),
     ]
 
 
@@ -823,6 +828,7 @@ def _load() -> tuple[Maker | None, str]:
             id(_KEY_LISTS),
             id(_KEY_SEEN),
             size_at,
+            _address("PyBytes_FromStringAndSize"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

@@ -610,11 +610,13 @@ def fast_reader(
                         if lst is None and doubles and ln[8] is not None:
                             # a run of rows in order, not made yet this cycle: their bytes
                             # from the bank's arrays in one step (the same doubles as the
-                            # list's, packed natively), no list of every row
-                            out = ln[8](b)
-                            if out is not None:
+                            # list's, packed natively), no list of every row; with the
+                            # arrays they come from (the entry gathers them again after
+                            # the cycles it books itself: csrc/centry.c gather)
+                            got = ln[8](b)
+                            if got is not None:
                                 session.last = None
-                                return out
+                                return got if got[1] is not None else got[0]
                         if lst is None:  # (AxisBank.value's making of it, without its frame)
                             lst = lists[bank_key] = b._make_list(bank_key)
                         memo = packed  # (one read: another thread may replace it meanwhile)

@@ -134,6 +134,8 @@ struct api {
     /* a ctypes object's size in bytes (b_size: what ctypes.sizeof gives for the object, the
      * extent byref(x, offset) is checked against) */
     ptrdiff_t b_size;
+    /* PyBytes_FromStringAndSize: a span's values gathered here (gather) */
+    obj (*bytes_new)(const char *, ptrdiff_t);
 };
 
 #define MAX_TYPES 16
@@ -152,6 +154,11 @@ struct aslot {
     obj tp;
     obj value;
     long long holds, keeps;
+    /* where the bytes come from, as avalue said (strong references while kept; NULL: not
+     * said): src[idx[start + k]] (idx NULL: src[start + k]) for each of count doubles, the
+     * same across the cycles booked in C (gather); booked: c_booked when they were kept */
+    obj src, idx;
+    long long start, booked;
 };
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
@@ -220,7 +227,7 @@ int gtecat_centry_api(const struct api *api)
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
         !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
-        api->b_size <= 0)
+        api->b_size <= 0 || !api->bytes_new)
         return 1;
     A = *api;
     ready = 1;
@@ -292,15 +299,20 @@ static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, lon
 static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
                       long long count, long long clock)
 {
-    obj old = s->value, oldtp = s->tp;
+    obj old = s->value, oldtp = s->tp, src = s->src, idx = s->idx;
     A.incref(v);
     A.incref(tp);
     s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
     s->holds = 0;
+    s->src = s->idx = NULL;
     if (old)
         A.decref(old);
     if (oldtp)
         A.decref(oldtp);
+    if (src)
+        A.decref(src);
+    if (idx)
+        A.decref(idx);
 }
 
 /* Another thread and the clock.
@@ -498,6 +510,13 @@ static int armed(const long long *q, long long pend)
  * since was such a cycle and the words stand (array_value) */
 static long long flag_keeping;
 
+/* The quick cycles booked in C (each made the readers' epoch grow by one): where the epoch
+ * grew by as much as this count since a span's bytes were kept with their source, every
+ * change since was such a cycle - the bank's arrays the same objects, its rows the same,
+ * their values moved in place by the kernel - and the bytes are gathered from the source
+ * again (array_value, gather) */
+static long long c_booked;
+
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
  * objects made first (nothing counted where one cannot be), then the bank's lists anew, the
@@ -563,6 +582,7 @@ static int book_in_c(ptrdiff_t gate, long long *q)
         cnt[9] = ep + 1;
     if (b[14])
         flag_keeping++;
+    c_booked++;
     *(long long *)b[3] += 1; /* its drives' cycles */
     *(long long *)b[4] += 1; /* the master's */
     q[10] = cycles;
@@ -854,13 +874,56 @@ static char python_mark;
  * clock asked: clk), kept in the entry's slot for the epoch: a new reference; PYTHON (not
  * bytes: the Python path answers), AGAIN (another thread's cycle or call meanwhile), or NULL
  * with the value's own error. */
+/* One dimension of int64 or float64 (what the source was said to be): its data and length,
+ * NULL where it is not an array of one dimension */
+static const char *vector(obj a, ptrdiff_t *len)
+{
+    if (!A.ndarray_type || TYPE(a) != A.ndarray_type || *(int *)((char *)a + A.nd_nd) != 1 ||
+        !AT(a, A.nd_dims))
+        return NULL;
+    *len = *(ptrdiff_t *)AT(a, A.nd_dims);
+    return AT(a, A.nd_data);
+}
+
+/* A span's count doubles from the source its slot keeps (src[idx[start + k]], or
+ * src[start + k]) as a new bytes object; NULL (no error left) where an index falls outside
+ * (the Python way answers). */
+static obj gather(const struct aslot *s, long long count)
+{
+    ptrdiff_t slen = 0, ilen = 0;
+    const double *src = (const double *)vector(s->src, &slen);
+    const int64_t *idx = NULL;
+    double *out;
+    long long k, i;
+    obj v;
+    if (!src || s->start < 0 || count < 1)
+        return NULL;
+    if (s->idx && (!(idx = (const int64_t *)vector(s->idx, &ilen)) || s->start + count > ilen))
+        return NULL;
+    v = A.bytes_new(NULL, (ptrdiff_t)(count * 8));
+    if (!v) {
+        A.err_clear();
+        return NULL;
+    }
+    out = (double *)((char *)v + A.bdata);
+    for (k = 0; k < count; k++) {
+        i = idx ? idx[s->start + k] : s->start + k;
+        if (i < 0 || i >= slen) {
+            A.decref(v);
+            return NULL;
+        }
+        out[k] = src[i];
+    }
+    return v;
+}
+
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
                        long long clk, int locked, int *ran)
 {
     struct aslot *s = e->acache;
-    long long ep = -1, ep0 = -1;
+    long long ep = -1, ep0 = -1, start = 0;
     int holds = 0;
-    obj v, tp = call[2];
+    obj v, tp = call[2], src = NULL, idx = NULL;
     *ran = 0;
     if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk &&
@@ -870,6 +933,18 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         s->keeps = flag_keeping;
         A.incref(s->value);
         return s->value;
+    }
+    if (s && ep >= 0 && s->src && s->value && s->n == an && s->count == ac && s->tp == tp &&
+        s->clock == clk && ep > s->epoch && ep - s->epoch == c_booked - s->booked &&
+        (v = gather(s, ac)) != NULL) {
+        /* (the doubles of the same rows after cycles booked in C: from the same arrays) */
+        obj old = s->value;
+        s->value = v;
+        s->epoch = ep;
+        s->booked = c_booked;
+        A.decref(old);
+        A.incref(v);
+        return v;
     }
     if (!locked)
         ep0 = epoch();
@@ -884,19 +959,43 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         A.decref(v);
         v = b;
         holds = 1;
-    }
-    if (TYPE(v) != A.bytes_type) {
+    } else if (e->tuple_type && TYPE(v) == e->tuple_type &&
+               *(ptrdiff_t *)((char *)v + A.bsize) == 4) {
+        /* (bytes, src, idx or None, start): doubles gathered from there (gather) */
+        obj *items = (obj *)((char *)v + e->titems), b = items[0];
+        ptrdiff_t len;
+        if (TYPE(b) == A.bytes_type && *(ptrdiff_t *)((char *)b + A.bsize) == ac * 8 &&
+            vector(items[1], &len) &&
+            (items[2] == A.none || vector(items[2], &len)) && ll_of(items[3], &start)) {
+            src = items[1];
+            idx = items[2] == A.none ? NULL : items[2];
+            A.incref(src);
+            if (idx)
+                A.incref(idx);
+        }
+        A.incref(b);
         A.decref(v);
-        return PYTHON;
+        v = b;
     }
-    if (!locked && !stands(e->gate, ep0)) {
+    if (TYPE(v) != A.bytes_type || (!locked && !stands(e->gate, ep0))) {
+        obj r = TYPE(v) != A.bytes_type ? PYTHON : AGAIN;
         A.decref(v);
-        return AGAIN;
+        if (src)
+            A.decref(src);
+        if (idx)
+            A.decref(idx);
+        return r;
     }
     if (s && ep >= 0) {
         keep_span(s, ep, v, tp, an, ac, clk);
         s->holds = holds;
         s->keeps = flag_keeping;
+        s->src = src, s->idx = idx, s->start = start, s->booked = c_booked;
+    } else {
+        if (src)
+            A.decref(src);
+        if (idx)
+            A.decref(idx);
     }
     return v;
 }

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import ctypes
 from ctypes import byref, c_double, c_long
+from typing import Any
 
 from gtecat import gt
 from gtecat.gt import fast
@@ -78,13 +79,21 @@ def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
     assert rows == table
 
 
+def _asked(pr: Any) -> int:
+    """How often a profile ``pr`` saw a span's value function asked (the C entries'
+    ``avalue``: gtecat.gt.fast's ``f``)."""
+    import pstats
+
+    stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+    return sum(v[1] for (file, _, func), v in stats if func == "f" and file.endswith("fast.py"))
+
+
 def _status_polls(general: bool) -> tuple[list, int, int]:
     """Trap moves of both axes that start and end, every call a span of status words
     (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) polled on the auto clock; ``general``:
     a watch hook that does nothing, so every cycle goes the general way.  What was read,
     the cycles run, and how often a span's value function was asked."""
     import cProfile
-    import pstats
 
     bring_up(clock="auto")
     try:
@@ -105,11 +114,7 @@ def _status_polls(general: bool) -> tuple[list, int, int]:
                 assert gt.GT_GetPrfSts(1, prf, 2) == 0
                 seen.append((clk.value, *words, *prf))
             pr.disable()
-        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        asked = sum(
-            v[1] for (file, _, func), v in stats if func == "f" and file.endswith("fast.py")
-        )
-        return seen, ctl.clock.cycles - t0, asked
+        return seen, ctl.clock.cycles - t0, _asked(pr)
     finally:
         gt.GT_Close()
 
@@ -124,3 +129,60 @@ def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
     assert len({tuple(x[1:3]) for x in quick}) >= 3  # (each axis moving, and neither)
     assert asked_general > cycles  # (every cycle: both spans asked again)
     assert asked < cycles / 4  # (the words held across the quick cycles)
+
+
+def _double_polls(general: bool, eni: str, first: int, count: int) -> tuple[list, int, int]:
+    """Trap moves of the axes ``first``.. ``first + count - 1`` that start and end, every call
+    a span of doubles of each reader whose span is a run of the bank's rows (the planned
+    values, the encoder's and the axis's positions) polled on the auto clock, each in one
+    shape (a numpy array and a ctypes array, with and without the clock, C's ``&arr[1]``);
+    ``general``: a watch hook that does nothing, so every cycle goes the general way.  What
+    was read, the cycles run, and how often a span's value function was asked."""
+    import cProfile
+
+    import numpy as np
+
+    bring_up(eni, clock="auto")
+    try:
+        ctl = gt.GTE_Controller()
+        if general:
+            ctl.watch.append(lambda: None)
+        for a in range(first, first + count):
+            assert gt.GT_AxisOn(a) == 0
+        clk = ctypes.c_ulong()
+        pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
+        vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(3):
+            for k, a in enumerate(range(first, first + count)):  # (ends apart)
+                trap_move(a, (200 + 90 * k) * (rnd + 1) * (-1) ** rnd, 15.0 + k)
+            pr.enable()
+            for _ in range(2500):
+                assert gt.GT_GetPrfPos(first, pos, count, byref(clk)) == 0
+                assert gt.GT_GetPrfVel(first, vel, count) == 0
+                assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
+                assert gt.GT_GetEncPos(first, enc, count) == 0
+                assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
+                seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
+                seen.append(apos.tobytes())
+            pr.disable()
+        return seen, ctl.clock.cycles - t0, _asked(pr)
+    finally:
+        gt.GT_Close()
+
+
+def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
+    """A span of doubles that is a run of the bank's rows is gathered again in C from the
+    bank's arrays after each cycle the entries book themselves (not asked in Python): what
+    every call reads is what it reads with every cycle the general way, while the axes
+    start, accelerate, move and stop; the whole bank (figure 5-2's two axes) and a run
+    inside a larger one (axes 2-4 of twelve)."""
+    for eni, first, count in (("manual_fig5_2.eni", 1, 2), ("twelve_axes.eni", 2, 3)):
+        quick, cycles, asked = _double_polls(False, eni, first, count)
+        general, _, asked_general = _double_polls(True, eni, first, count)
+        assert quick == general
+        assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
+        assert asked_general > cycles  # (every cycle: each span asked again)
+        assert asked < cycles / 2  # (five spans: gathered across the quick cycles)
