@@ -2218,42 +2218,43 @@ class AxisBank:
 
     def span_bytes(
         self, name: str, rows: slice
-    ) -> Callable[[AxisBank], tuple[bytes, Any, Any, int] | None] | None:
+    ) -> Callable[[AxisBank], tuple[Any, ...] | None] | None:
         """A getter of the native doubles of ``_make_list(name)[rows]``, a run of rows in
         order, from a bank's arrays in one step (a span of doubles after a cycle: no list of
         every row, no Python float per row), which gives None where it does not apply; None:
         no such getter.  The Trap tables' values where no row jogs or homes, the arrays whose
         list is the array's own (float64).  With the bytes, where they come from: ``(bytes,
-        source, index, start)``, the doubles ``source[index[start + k]]`` (``index`` None:
-        ``source[start + k]``) for each row k of the run, both arrays the bank's own, of one
-        C-contiguous dimension (float64, int64), which the compiled cycle moves in place and
-        only Python replaces: a reader's C entry gathers them again after a cycle booked in
-        C (gtecat/gt/csrc/centry.c gather); the source None where it cannot say."""
+        0, source, index, rows, None, 0.0)``, the doubles ``source[index[r]]`` (``index``
+        None: ``source[r]``) for each row r of the run (``rows``: their int64 bytes), both
+        arrays the bank's own, of one C-contiguous dimension (float64, int64), which the
+        compiled cycle moves in place and only Python replaces: a reader's C entry makes
+        them again after a cycle booked in C (gtecat/gt/csrc/centry.c gather); ``(bytes,)``
+        where it cannot say."""
         whole = not rows.start and rows.stop == self.n  # (the whole bank: no slice)
-        start = rows.start or 0
+        run = array("q", range(rows.start or 0, rows.stop)).tobytes()
         flat = _PLANNED_FLAT.get(name)
         if flat is not None:
             table = attrgetter(flat)
 
-            def planned(b: AxisBank) -> tuple[bytes, Any, Any, int] | None:
+            def planned(b: AxisBank) -> tuple[Any, ...] | None:
                 if b.n_jog or b.n_hm:
                     return None
                 t, i = table(b), b.t_idx
                 out = t[i if whole else i[rows]].tobytes()
                 if t.dtype is _F64 and i.dtype is _I64 and _flat(t) and _flat(i):
-                    return out, t, i, start
-                return out, None, None, 0
+                    return out, 0, t, i, run, None, 0.0
+                return (out,)
 
             return planned
         if name in _ROW_ITEMS:
             values = attrgetter(name)
 
-            def items(b: AxisBank) -> tuple[bytes, Any, Any, int] | None:
+            def items(b: AxisBank) -> tuple[Any, ...] | None:
                 x = values(b)
                 if x.dtype is not _F64:
                     return None
                 out = (x if whole else x[rows]).tobytes()
-                return (out, x, None, start) if _flat(x) else (out, None, None, 0)
+                return (out, 0, x, None, run, None, 0.0) if _flat(x) else (out,)
 
             return items
         return None

@@ -153,8 +153,11 @@ class _ASlot(ctypes.Structure):
         ("keeps", ctypes.c_longlong),
         ("src", _VP),
         ("idx", _VP),
-        ("start", ctypes.c_longlong),
+        ("rows", _VP),
+        ("ratios", _VP),
+        ("op", ctypes.c_longlong),
         ("booked", ctypes.c_longlong),
+        ("t", ctypes.c_double),
     ]
 
 

@@ -19,6 +19,7 @@ import re
 import struct
 import sys
 import time
+from array import array
 from collections.abc import Callable
 from operator import itemgetter
 from typing import Any
@@ -343,6 +344,7 @@ def fast_reader(
     row_expr = BANK_ROWS.get(name) if bank_key is None else SPAN_ROWS.get(name)
     plan_key = bank_key if row_expr is None else name
     quick = QUICK_ROWS.get(name)  # (its rows' values in fewer steps where it may)
+    source = QUICK_SOURCES.get(name)  # (and where those values come from: the C entry's)
     #: a span's values are status words alone (of the bank's rows, their flags): they stand
     #: while every change is a cycle that keeps every flag (the C entry's array_value)
     status = name in ("GT_GetSts", "GT_GetPrfSts")
@@ -443,7 +445,7 @@ def fast_reader(
                 or plan[2] is not axes
             ):
                 top = resource_count(ctl) if zeros and axes else 0
-                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr, quick)
+                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr, quick, source)
                 b.read_plans[key] = plan
             pick = plan[3]
             if pick is not None and row_expr is not None:
@@ -547,8 +549,9 @@ def fast_reader(
         #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
         #: bank, n, count, the layout, resources and axes it holds for, its pick, whether
         #: that picks the bank's rows and zeros alone (no other axis's getter), the getter of
-        #: the bytes of the run of rows it picks in order (AxisBank.span_bytes, else None)
-        lane: list[Any] = [None] * 9
+        #: the bytes of the run of rows it picks in order (AxisBank.span_bytes, else None),
+        #: the plan's getter of where its rows' values come from (_read_plan's, else None)
+        lane: list[Any] = [None] * 10
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -577,6 +580,7 @@ def fast_reader(
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
             words = False  # (status words of the bank's rows and zeros alone: (bytes,))
+            recipe = None  # (a getter of where the values come from: the entry's gather)
             if count == 1:
                 v = value(n)
                 if v is _NO:
@@ -604,6 +608,7 @@ def fast_reader(
                     words = status and ln[7]
                     if row_expr is not None:
                         values = ln[6](b)
+                        recipe = ln[9]
                     else:
                         lists = b._lists
                         lst = lists.get(bank_key)
@@ -616,7 +621,7 @@ def fast_reader(
                             got = ln[8](b)
                             if got is not None:
                                 session.last = None
-                                return got if got[1] is not None else got[0]
+                                return got if len(got) > 1 else got[0]
                         if lst is None:  # (AxisBank.value's making of it, without its frame)
                             lst = lists[bank_key] = b._make_list(bank_key)
                         memo = packed  # (one read: another thread may replace it meanwhile)
@@ -646,6 +651,7 @@ def fast_reader(
                         lane[:] = [
                             *(b, n, count, *plan[:4], plan[6]),
                             None if run is None else b.span_bytes(bank_key, run),
+                            plan[8],
                         ]
             memo = packed  # (one read: another thread may replace it meanwhile)
             if pack is memo[0] and (values is memo[1] or values == memo[1]):
@@ -660,6 +666,10 @@ def fast_reader(
                 if ints:
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
+            if recipe is not None and doubles:  # (the entry makes them again: gather)
+                got = recipe(b)
+                if got is not None:
+                    return (out, *got)
             # status words of the bank's rows and zeros alone stand across the cycles the C
             # entry books that keep every flag (csrc/centry.c array_value)
             return (out,) if words else out
@@ -1006,6 +1016,20 @@ QUICK_ROWS: dict[str, tuple[str, str, str, str]] = {
     "GT_GetEncVel": (*_ENC_QUICK, "s1.item({r}) / T"),
 }
 
+#: the QUICK_ROWS values a span's C entry makes again itself after the cycles it books
+#: (csrc/centry.c gather: the same IEEE operations in the same order on the bank's arrays,
+#: which the compiled cycle moves in place): (its op - 0 ``src[idx[r]]``, 1 ``src[r] / T``,
+#: 2 ``(src[r] / T - idx[r] / T) / T`` -, the bank's arrays src and idx, the factor of the
+#: axis's resources or None); asked where QUICK_ROWS' guards hold (which hold on across
+#: such cycles: no row jogs or homes, a row claimed two cycles ago or more)
+QUICK_SOURCES: dict[str, tuple[int, str, str | None, str | None]] = {
+    "GT_GetAxisPrfVel": (0, "_t_v1", "t_idx", "prf_link.ratio"),
+    "GT_GetAxisPrfAcc": (0, "_t_a1", "t_idx", "prf_link.ratio"),
+    "GT_GetAxisEncVel": (1, "enc_step1", None, "enc_link.ratio"),
+    "GT_GetAxisEncAcc": (2, "enc_step1", "enc_step0", "enc_link.ratio"),
+    "GT_GetEncVel": (1, "enc_step1", None, None),
+}
+
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
 
@@ -1031,6 +1055,7 @@ def _read_plan(
     get: Any = None,
     row: str | None = None,
     quick: tuple[str, str, str, str] | None = None,
+    source: tuple[int, str, str | None, str | None] | None = None,
 ) -> tuple[Any, ...]:
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
@@ -1042,8 +1067,11 @@ def _read_plan(
     an axis no drive backs (it reads 0); any other (another bank's axis, one not on the
     bus): no getter.  ``row``: a row's value is that expression of BANK_ROWS (``{R}`` its
     resources, ``{r}`` its row) and the getter takes the bank itself, not a list; ``quick``:
-    QUICK_ROWS' form of it, taken where its guards hold."""
-    none = (b.layout, resources, axes, None, None, 0, False, None)
+    QUICK_ROWS' form of it, taken where its guards hold; ``source``: QUICK_SOURCES' for it,
+    and the plan's last item a function of the bank giving where the values come from where
+    those guards hold (``(op, src, idx, rows, ratios, T)``, csrc/centry.c gather), else
+    None."""
+    none = (b.layout, resources, axes, None, None, 0, False, None, None)
     if count < 2:  # (one value: no tuple to store)
         return none
     items: list[str] = []
@@ -1051,6 +1079,7 @@ def _read_plan(
     guards: list[str] = [] if quick is None else [quick[1]]
     env: dict[str, Any] = {"g": get}
     at = None
+    rows: list[int] = []  # (the bank's rows of the span, in order: a source's)
     for i, k in enumerate(range(n, n + count)):
         if k not in axes and 1 <= n <= n + count - 1 <= top:
             items.append("0")
@@ -1068,6 +1097,7 @@ def _read_plan(
                 if quick is not None:
                     quick_items.append(quick[3].format(R=f"r{i}", r=res.bank_row))
                     guards.append(quick[2].format(r=res.bank_row))
+            rows.append(res.bank_row)
             at = i if at is None else at
         elif res.bank is None and get is not None:
             items.append(f"g(r{i})")
@@ -1096,8 +1126,32 @@ def _read_plan(
                 env,
             )
             pick = env["quick"]
+    from_source = None
+    if source is not None and quick is not None and pure and len(rows) == count:
+        op, src, idx, factor = source
+        ratios = ", ".join(f"r{i}.{factor}" for i in range(count)) if factor else ""
+        env |= {"ROWS": array("q", rows).tobytes(), "_pack": struct.Struct(f"@{count}d").pack}
+        env |= {"_num": (int, float)}
+        guard = " and ".join(x for x in guards if x != "True") or "True"
+        exec(
+            f"def from_source(b):\n    {quick[0]}\n    if not ({guard}):\n        return None\n"
+            + (
+                f"    f = ({ratios},)\n"
+                "    if not all(type(x) in _num for x in f):\n        return None\n"
+                "    f = _pack(*f)\n"
+                if factor
+                else "    f = None\n"
+            )
+            + "    t = b.T if "
+            + str(op)
+            + " else 0.0\n"
+            + "    if type(t) is not float:\n        return None\n"
+            + f"    return {op}, b.{src}, {'b.' + idx if idx else 'None'}, ROWS, f, t\n",
+            env,
+        )
+        from_source = env["from_source"]
     first = None if at is None else resources.get(n + at)
-    return (b.layout, resources, axes, pick, first, at, pure, run)
+    return (b.layout, resources, axes, pick, first, at, pure, run, from_source)
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the

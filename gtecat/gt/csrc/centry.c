@@ -154,11 +154,14 @@ struct aslot {
     obj tp;
     obj value;
     long long holds, keeps;
-    /* where the bytes come from, as avalue said (strong references while kept; NULL: not
-     * said): src[idx[start + k]] (idx NULL: src[start + k]) for each of count doubles, the
-     * same across the cycles booked in C (gather); booked: c_booked when they were kept */
-    obj src, idx;
-    long long start, booked;
+    /* where the bytes come from, as avalue said (strong references while kept; src NULL:
+     * not said), for each of count doubles the same operations on the bank's arrays across
+     * the cycles booked in C (gather): rows (int64) the rows, ratios (float64, NULL: none)
+     * a factor per value, op what is read of src and idx at a row; booked: c_booked when
+     * they were kept */
+    obj src, idx, rows, ratios;
+    long long op, booked;
+    double t;
 };
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
@@ -295,24 +298,35 @@ static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, lon
     return NULL;
 }
 
-/* Keep a span's (or a raw range's) bytes v with their key and type tp for epoch ep. */
-static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
-                      long long count, long long clock)
+/* A recipe's references given up (NULL: none) */
+static void let_recipe_go(obj src, obj idx, obj rows, obj ratios)
 {
-    obj old = s->value, oldtp = s->tp, src = s->src, idx = s->idx;
-    A.incref(v);
-    A.incref(tp);
-    s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
-    s->holds = 0;
-    s->src = s->idx = NULL;
-    if (old)
-        A.decref(old);
-    if (oldtp)
-        A.decref(oldtp);
     if (src)
         A.decref(src);
     if (idx)
         A.decref(idx);
+    if (rows)
+        A.decref(rows);
+    if (ratios)
+        A.decref(ratios);
+}
+
+/* Keep a span's (or a raw range's) bytes v with their key and type tp for epoch ep. */
+static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
+                      long long count, long long clock)
+{
+    obj old = s->value, oldtp = s->tp, src = s->src, idx = s->idx, rows = s->rows;
+    obj ratios = s->ratios;
+    A.incref(v);
+    A.incref(tp);
+    s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
+    s->holds = 0;
+    s->src = s->idx = s->rows = s->ratios = NULL;
+    if (old)
+        A.decref(old);
+    if (oldtp)
+        A.decref(oldtp);
+    let_recipe_go(src, idx, rows, ratios);
 }
 
 /* Another thread and the clock.
@@ -874,31 +888,49 @@ static char python_mark;
  * clock asked: clk), kept in the entry's slot for the epoch: a new reference; PYTHON (not
  * bytes: the Python path answers), AGAIN (another thread's cycle or call meanwhile), or NULL
  * with the value's own error. */
-/* One dimension of int64 or float64 (what the source was said to be): its data and length,
- * NULL where it is not an array of one dimension */
+/* One C-contiguous dimension of int64 or float64 (what the source was said to be): its data
+ * and length, NULL where it is not such an array */
 static const char *vector(obj a, ptrdiff_t *len)
 {
     if (!A.ndarray_type || TYPE(a) != A.ndarray_type || *(int *)((char *)a + A.nd_nd) != 1 ||
-        !AT(a, A.nd_dims))
+        !AT(a, A.nd_dims) || (*(int *)((char *)a + A.nd_flags) & A.nd_want) != A.nd_want)
         return NULL;
     *len = *(ptrdiff_t *)AT(a, A.nd_dims);
     return AT(a, A.nd_data);
 }
 
-/* A span's count doubles from the source its slot keeps (src[idx[start + k]], or
- * src[start + k]) as a new bytes object; NULL (no error left) where an index falls outside
- * (the Python way answers). */
+/* A span's count doubles made again from the arrays its slot keeps, as avalue made them (the
+ * same IEEE operations in the same order), as a new bytes object: for the k-th, its row r
+ * (rows[k]) and x =
+ *   op 0: src[idx[r]] (idx NULL: src[r])   (a planned value of the Trap table, a row's own)
+ *   op 1: src[r] / t                       (an encoder's speed: its last step over a cycle)
+ *   op 2: (src[r] / t - idx[r] / t) / t    (its acceleration: the last two steps)
+ * then ratios[k] * x where ratios are given.  NULL (no error left) where an index falls
+ * outside an array (the Python way answers). */
 static obj gather(const struct aslot *s, long long count)
 {
     ptrdiff_t slen = 0, ilen = 0;
-    const double *src = (const double *)vector(s->src, &slen);
-    const int64_t *idx = NULL;
-    double *out;
-    long long k, i;
+    const double *src = (const double *)vector(s->src, &slen), *fidx = NULL, *ratios = NULL;
+    const int64_t *idx = NULL, *rows;
+    double *out, x;
+    long long k, r, i;
     obj v;
-    if (!src || s->start < 0 || count < 1)
+    if (!src || count < 1 || s->op < 0 || s->op > 2 || TYPE(s->rows) != A.bytes_type ||
+        *(ptrdiff_t *)((char *)s->rows + A.bsize) != count * 8)
         return NULL;
-    if (s->idx && (!(idx = (const int64_t *)vector(s->idx, &ilen)) || s->start + count > ilen))
+    rows = (const int64_t *)((char *)s->rows + A.bdata);
+    if (s->ratios) {
+        if (TYPE(s->ratios) != A.bytes_type ||
+            *(ptrdiff_t *)((char *)s->ratios + A.bsize) != count * 8)
+            return NULL;
+        ratios = (const double *)((char *)s->ratios + A.bdata);
+    }
+    if (s->idx) {
+        const char *d = vector(s->idx, &ilen);
+        if (!d)
+            return NULL;
+        idx = (const int64_t *)d, fidx = (const double *)d;
+    } else if (s->op == 2)
         return NULL;
     v = A.bytes_new(NULL, (ptrdiff_t)(count * 8));
     if (!v) {
@@ -907,23 +939,34 @@ static obj gather(const struct aslot *s, long long count)
     }
     out = (double *)((char *)v + A.bdata);
     for (k = 0; k < count; k++) {
-        i = idx ? idx[s->start + k] : s->start + k;
-        if (i < 0 || i >= slen) {
-            A.decref(v);
-            return NULL;
-        }
-        out[k] = src[i];
+        r = rows[k];
+        if (r < 0 || r >= slen || (idx && r >= ilen))
+            goto outside;
+        if (s->op == 0) {
+            i = idx ? idx[r] : r;
+            if (i < 0 || i >= slen)
+                goto outside;
+            x = src[i];
+        } else if (s->op == 1)
+            x = src[r] / s->t;
+        else
+            x = (src[r] / s->t - fidx[r] / s->t) / s->t;
+        out[k] = ratios ? ratios[k] * x : x;
     }
     return v;
+outside:
+    A.decref(v);
+    return NULL;
 }
 
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
                        long long clk, int locked, int *ran)
 {
     struct aslot *s = e->acache;
-    long long ep = -1, ep0 = -1, start = 0;
+    long long ep = -1, ep0 = -1, op = 0;
+    double t = 0;
     int holds = 0;
-    obj v, tp = call[2], src = NULL, idx = NULL;
+    obj v, tp = call[2], src = NULL, idx = NULL, rows = NULL, ratios = NULL;
     *ran = 0;
     if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk &&
@@ -960,18 +1003,27 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         v = b;
         holds = 1;
     } else if (e->tuple_type && TYPE(v) == e->tuple_type &&
-               *(ptrdiff_t *)((char *)v + A.bsize) == 4) {
-        /* (bytes, src, idx or None, start): doubles gathered from there (gather) */
+               *(ptrdiff_t *)((char *)v + A.bsize) == 7) {
+        /* (bytes, op, src, idx or None, rows, ratios or None, t): doubles made again from
+         * there (gather) */
         obj *items = (obj *)((char *)v + e->titems), b = items[0];
         ptrdiff_t len;
         if (TYPE(b) == A.bytes_type && *(ptrdiff_t *)((char *)b + A.bsize) == ac * 8 &&
-            vector(items[1], &len) &&
-            (items[2] == A.none || vector(items[2], &len)) && ll_of(items[3], &start)) {
-            src = items[1];
-            idx = items[2] == A.none ? NULL : items[2];
+            ll_of(items[1], &op) && vector(items[2], &len) &&
+            (items[3] == A.none || vector(items[3], &len)) && TYPE(items[4]) == A.bytes_type &&
+            (items[5] == A.none || TYPE(items[5]) == A.bytes_type) &&
+            TYPE(items[6]) == A.float_type) {
+            src = items[2];
+            idx = items[3] == A.none ? NULL : items[3];
+            rows = items[4];
+            ratios = items[5] == A.none ? NULL : items[5];
+            t = *(double *)((char *)items[6] + A.fval);
             A.incref(src);
+            A.incref(rows);
             if (idx)
                 A.incref(idx);
+            if (ratios)
+                A.incref(ratios);
         }
         A.incref(b);
         A.decref(v);
@@ -980,23 +1032,17 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
     if (TYPE(v) != A.bytes_type || (!locked && !stands(e->gate, ep0))) {
         obj r = TYPE(v) != A.bytes_type ? PYTHON : AGAIN;
         A.decref(v);
-        if (src)
-            A.decref(src);
-        if (idx)
-            A.decref(idx);
+        let_recipe_go(src, idx, rows, ratios);
         return r;
     }
     if (s && ep >= 0) {
         keep_span(s, ep, v, tp, an, ac, clk);
         s->holds = holds;
         s->keeps = flag_keeping;
-        s->src = src, s->idx = idx, s->start = start, s->booked = c_booked;
-    } else {
-        if (src)
-            A.decref(src);
-        if (idx)
-            A.decref(idx);
-    }
+        s->src = src, s->idx = idx, s->rows = rows, s->ratios = ratios;
+        s->op = op, s->t = t, s->booked = c_booked;
+    } else
+        let_recipe_go(src, idx, rows, ratios);
     return v;
 }
 

@@ -131,18 +131,22 @@ def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
     assert asked < cycles / 4  # (the words held across the quick cycles)
 
 
-def _double_polls(general: bool, eni: str, first: int, count: int) -> tuple[list, int, int]:
+def _double_polls(
+    general: bool, eni: str, first: int, count: int, cycle_ms: float | None
+) -> tuple[list, int, int]:
     """Trap moves of the axes ``first``.. ``first + count - 1`` that start and end, every call
     a span of doubles of each reader whose span is a run of the bank's rows (the planned
-    values, the encoder's and the axis's positions) polled on the auto clock, each in one
-    shape (a numpy array and a ctypes array, with and without the clock, C's ``&arr[1]``);
+    values, the encoder's and the axis's positions, and the values of fast.QUICK_SOURCES:
+    the axis's planned speed and acceleration, the encoder's speed and acceleration)
+    polled on the auto clock, each in one shape (a numpy array and a ctypes array, with and
+    without the clock, C's ``&arr[1]``);
     ``general``: a watch hook that does nothing, so every cycle goes the general way.  What
     was read, the cycles run, and how often a span's value function was asked."""
     import cProfile
 
     import numpy as np
 
-    bring_up(eni, clock="auto")
+    bring_up(eni, clock="auto", cycle_ms=cycle_ms)
     try:
         ctl = gt.GTE_Controller()
         if general:
@@ -152,6 +156,7 @@ def _double_polls(general: bool, eni: str, first: int, count: int) -> tuple[list
         clk = ctypes.c_ulong()
         pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
         vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
+        rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
         seen: list = []
         pr = cProfile.Profile()
         t0 = ctl.clock.cycles
@@ -167,6 +172,9 @@ def _double_polls(general: bool, eni: str, first: int, count: int) -> tuple[list
                 assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
                 seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
                 seen.append(apos.tobytes())
+                for name, arr in rows.items():
+                    assert getattr(gt, name)(first, arr, count, clk) == 0
+                    seen.append(arr.tobytes())
             pr.disable()
         return seen, ctl.clock.cycles - t0, _asked(pr)
     finally:
@@ -178,11 +186,15 @@ def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
     bank's arrays after each cycle the entries book themselves (not asked in Python): what
     every call reads is what it reads with every cycle the general way, while the axes
     start, accelerate, move and stop; the whole bank (figure 5-2's two axes) and a run
-    inside a larger one (axes 2-4 of twelve)."""
-    for eni, first, count in (("manual_fig5_2.eni", 1, 2), ("twelve_axes.eni", 2, 3)):
-        quick, cycles, asked = _double_polls(False, eni, first, count)
-        general, _, asked_general = _double_polls(True, eni, first, count)
+    inside a larger one (axes 2-4 of twelve, cycles of 0.75 ms: the rates' divisions are not
+    exact)."""
+    for eni, first, count, ms in (
+        ("manual_fig5_2.eni", 1, 2, None),
+        ("twelve_axes.eni", 2, 3, 0.75),
+    ):
+        quick, cycles, asked = _double_polls(False, eni, first, count, ms)
+        general, _, asked_general = _double_polls(True, eni, first, count, ms)
         assert quick == general
         assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
         assert asked_general > cycles  # (every cycle: each span asked again)
-        assert asked < cycles / 2  # (five spans: gathered across the quick cycles)
+        assert asked < cycles / 2  # (ten spans: made again in C across the quick cycles)
