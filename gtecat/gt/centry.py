@@ -136,7 +136,7 @@ class _Api(ctypes.Structure):
 class _Slot(ctypes.Structure):
     """``struct slot`` of csrc/centry.c: a value kept for the epoch it was asked in."""
 
-    _fields_ = [("epoch", ctypes.c_longlong), ("value", _VP)]
+    _fields_ = [("epoch", ctypes.c_longlong), ("value", _VP), ("booked", ctypes.c_longlong)]
 
 
 class _ASlot(ctypes.Structure):
@@ -192,6 +192,7 @@ class _Entry(ctypes.Structure):
         ("tuple_type", _VP),
         ("titems", ctypes.c_ssize_t),
         ("cderefs", ctypes.c_ssize_t * _MAX_TYPES),
+        ("steady", ctypes.c_ssize_t),
     ]
 
 
@@ -888,6 +889,7 @@ def _load() -> tuple[Maker | None, str]:
         cache: bool = False,
         clocks: Iterable[type] = (),
         numpy: Iterable[Any] = (),
+        steady: bool = False,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -903,6 +905,7 @@ def _load() -> tuple[Maker | None, str]:
         # (a structure's array: its elements sizeof apart, its value the fields' bytes)
         e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
         e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
+        e.steady = int(steady)
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1556,6 +1559,7 @@ def reader(
     after: Callable[[], Any] | None = None,
     clocks: Iterable[type] = (),
     numpy: Iterable[Any] = (),
+    steady: bool = False,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -1584,7 +1588,9 @@ def reader(
     call's return once its value is written while the gate says :data:`AUTO`), so they
     need not check the session themselves; a gated entry keeps what ``value`` and
     ``array`` give for the epoch they were asked in and writes it again while
-    :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`).
+    :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`); ``steady``:
+    and across the quick cycles the entries book themselves (no Python runs in those: what
+    an attribute no cycle changes gives, a profile's mode).
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -1606,6 +1612,7 @@ def reader(
         gate != NO_GATE,
         clocks,
         numpy,
+        steady,
     )
 
 

@@ -690,13 +690,14 @@ def fast_reader(
             after=_after(advance, name, 0),
             clocks=CLOCK_ORDER if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
+            steady=name in STEADY,
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, 1),
             clocks=CLOCK_ORDER if takes_clock else (),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
-            numpy=sorted(np_ok, key=str),
+            numpy=sorted(np_ok, key=str), steady=name in STEADY,
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
@@ -1015,6 +1016,11 @@ QUICK_ROWS: dict[str, tuple[str, str, str, str]] = {
     ),
     "GT_GetEncVel": (*_ENC_QUICK, "s1.item({r}) / T"),
 }
+
+#: the readers whose values no cycle changes (a Python attribute: a cycle the C entries book
+#: themselves runs no Python): their entries keep them across such cycles (centry.reader's
+#: ``steady``)
+STEADY = frozenset({"GT_GetPrfMode"})
 
 #: the QUICK_ROWS values a span's C entry makes again itself after the cycles it books
 #: (csrc/centry.c gather: the same IEEE operations in the same order on the bank's arrays,

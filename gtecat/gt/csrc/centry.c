@@ -144,6 +144,7 @@ struct api {
 struct slot {
     long long epoch;
     obj value;
+    long long booked; /* c_booked when it was kept */
 };
 
 /* a span's bytes kept for its key and epoch (tp: a strong reference while kept); holds: 1
@@ -203,10 +204,21 @@ struct entry {
     ptrdiff_t titems;
     /* per clock type of ctypes_: a ctypes pointer type's _type_ (pointer(x): x's memory), 0 */
     ptrdiff_t cderefs[MAX_TYPES];
+    /* 1: its values stand across the cycles booked in C (an attribute no cycle changes: a
+     * profile's mode), see c_booked */
+    ptrdiff_t steady;
 };
 
 static struct api A;
 static int ready;
+
+/* The quick cycles booked in C (book_in_c; each made the readers' epoch grow by one): where
+ * the epoch grew by as much as this count since a value was kept, every change since was
+ * such a cycle - no Python ran in them: the bank's arrays the same objects, its rows the
+ * same, their values moved in place by the kernel, every Python attribute as it was - and a
+ * span's bytes are made again from where they came from (array_value, gather), and a
+ * steady entry's values (an attribute's: GT_GetPrfMode) stand (kept, array_value) */
+static long long c_booked;
 
 #define AT(base, off) (*(char **)((char *)(base) + (off)))
 /* the flag a vectorcall's caller may set in nargsf (PY_VECTORCALL_ARGUMENTS_OFFSET) */
@@ -273,14 +285,17 @@ static void keep(struct slot *s, long long ep, obj v)
     A.incref(v);
     s->value = v;
     s->epoch = ep;
+    s->booked = c_booked;
     if (old)
         A.decref(old);
 }
 
 /* The value kept in cache (ncache slots) for the int n in this epoch, a new reference, else
  * NULL; *key is n's slot (-1: n has none) and *ep the epoch (-1: unknown), for keep(). */
-static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, long long *ep)
+static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, long long *ep,
+                int steady)
 {
+    struct slot *s;
     int over = 0;
     *key = n ? A.as_ll(n, &over) : 0;
     *ep = -1;
@@ -291,9 +306,13 @@ static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, lon
         return NULL;
     }
     *ep = epoch();
-    if (*ep >= 0 && cache[*key].value && cache[*key].epoch == *ep) {
-        A.incref(cache[*key].value);
-        return cache[*key].value;
+    s = &cache[*key];
+    if (*ep >= 0 && s->value &&
+        (s->epoch == *ep ||
+         (steady && *ep > s->epoch && *ep - s->epoch == c_booked - s->booked))) {
+        s->epoch = *ep, s->booked = c_booked; /* (a steady value across cycles booked in C) */
+        A.incref(s->value);
+        return s->value;
     }
     return NULL;
 }
@@ -523,13 +542,6 @@ static int armed(const long long *q, long long pend)
  * epoch grew by as much as this count since a span of status words was kept, every change
  * since was such a cycle and the words stand (array_value) */
 static long long flag_keeping;
-
-/* The quick cycles booked in C (each made the readers' epoch grow by one): where the epoch
- * grew by as much as this count since a span's bytes were kept with their source, every
- * change since was such a cycle - the bank's arrays the same objects, its rows the same,
- * their values moved in place by the kernel - and the bytes are gathered from the source
- * again (array_value, gather) */
-static long long c_booked;
 
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
@@ -971,9 +983,13 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
     if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk &&
         (s->epoch == ep ||
-         (s->holds && ep > s->epoch && ep - s->epoch == flag_keeping - s->keeps))) {
-        s->epoch = ep; /* (status words across cycles that kept every flag: the same) */
+         (s->holds && ep > s->epoch && ep - s->epoch == flag_keeping - s->keeps) ||
+         (e->steady && ep > s->epoch && ep - s->epoch == c_booked - s->booked))) {
+        /* (status words across cycles that kept every flag, a steady entry's values across
+         * cycles booked in C: the same) */
+        s->epoch = ep;
         s->keeps = flag_keeping;
+        s->booked = c_booked;
         A.incref(s->value);
         return s->value;
     }
@@ -1307,7 +1323,8 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 
     /* the value kept for this epoch, else value(n)'s (kept for it) */
     if (e->cache &&
-        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep)) != NULL)
+        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep, (int)e->steady)) !=
+            NULL)
         goto have;
     if (!locked)
         ep0 = epoch();
@@ -1706,7 +1723,7 @@ TRY multi_try(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj
     for (k = 0; k < nout; k++)
         if (!out_mem(e, k, args[1 + k], &size[k], &sign[k]))
             goto python;
-    if (e->cache && (v = kept(e->cache, e->ncache, args[0], &key, &ep)) != NULL)
+    if (e->cache && (v = kept(e->cache, e->ncache, args[0], &key, &ep, 0)) != NULL)
         goto have;
     if (!locked)
         ep0 = epoch();

@@ -79,13 +79,18 @@ def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
     assert rows == table
 
 
-def _asked(pr: Any) -> int:
-    """How often a profile ``pr`` saw a span's value function asked (the C entries'
-    ``avalue``: gtecat.gt.fast's ``f``)."""
+def _calls(pr: Any, names: tuple[str, ...]) -> int:
+    """How often a profile ``pr`` saw gtecat.gt.fast's functions ``names`` called."""
     import pstats
 
     stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-    return sum(v[1] for (file, _, func), v in stats if func == "f" and file.endswith("fast.py"))
+    return sum(v[1] for (file, _, func), v in stats if func in names and file.endswith("fast.py"))
+
+
+def _asked(pr: Any) -> int:
+    """How often a profile ``pr`` saw a span's value function asked (the C entries'
+    ``avalue``: gtecat.gt.fast's ``f``)."""
+    return _calls(pr, ("f",))
 
 
 def _status_polls(general: bool) -> tuple[list, int, int]:
@@ -198,3 +203,52 @@ def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
         assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
         assert asked_general > cycles  # (every cycle: each span asked again)
         assert asked < cycles / 2  # (ten spans: made again in C across the quick cycles)
+
+
+def _mode_polls(general: bool) -> tuple[list, int, int]:
+    """Both axes moving in Trap on the auto clock, their profile modes polled every call
+    (``GT_GetPrfMode``: one axis, and both in a span with the clock) while the modes change
+    between polls (axis 2 to Jog and back to Trap); ``general``: a watch hook that does
+    nothing, so every cycle goes the general way.  What was read, the cycles run, and how
+    often a value function was asked."""
+    import cProfile
+
+    bring_up(clock="auto")
+    try:
+        ctl = gt.GTE_Controller()
+        if general:
+            ctl.watch.append(lambda: None)
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        trap_move(1, 40_000, 10.0)
+        mode, modes, clk = c_long(), (c_long * 2)(), ctypes.c_ulong()
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(4):
+            if rnd % 2:
+                jog = gt.TJogPrm(acc=0.5, dec=0.5, smooth=0)
+                assert gt.GT_PrfJog(2) == 0 and gt.GT_SetJogPrm(2, byref(jog)) == 0
+            else:
+                trap_move(2, 500 * (rnd + 1), 8.0)
+            pr.enable()
+            for _ in range(2000):
+                assert gt.GT_GetPrfMode(2, byref(mode)) == 0
+                assert gt.GT_GetPrfMode(1, modes, 2, byref(clk)) == 0
+                seen.append((mode.value, *modes, clk.value))
+            pr.disable()
+        values = _calls(pr, ("f", "value_gt"))
+        return seen, ctl.clock.cycles - t0, values
+    finally:
+        gt.GT_Close()
+
+
+def test_profile_modes_stand_across_cycles_booked_in_c() -> None:
+    """A profile's mode, which no cycle changes, is not asked again after each cycle the
+    entries book themselves: every poll reads what it reads with every cycle the general
+    way, the modes' changes between polls included."""
+    quick, cycles, asked = _mode_polls(False)
+    general, _, asked_general = _mode_polls(True)
+    assert quick == general
+    assert len({x[:3] for x in quick}) >= 2  # (axis 2 in Trap and in Jog)
+    assert asked_general > cycles  # (every cycle: both asked again)
+    assert asked < cycles / 10
