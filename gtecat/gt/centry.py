@@ -136,7 +136,13 @@ class _Api(ctypes.Structure):
 class _Slot(ctypes.Structure):
     """``struct slot`` of csrc/centry.c: a value kept for the epoch it was asked in."""
 
-    _fields_ = [("epoch", ctypes.c_longlong), ("value", _VP), ("booked", ctypes.c_longlong)]
+    _fields_ = [
+        ("epoch", ctypes.c_longlong),
+        ("value", _VP),
+        ("booked", ctypes.c_longlong),
+        ("holds", ctypes.c_longlong),
+        ("keeps", ctypes.c_longlong),
+    ]
 
 
 class _ASlot(ctypes.Structure):

@@ -585,7 +585,7 @@ def fast_reader(
                 v = value(n)
                 if v is _NO:
                     return _NO
-                values: Any = (v,)
+                values: Any = v if type(v) is tuple else (v,)  # ((word,): a bank's status)
             else:
                 if count > limit:
                     return _NO
@@ -1360,7 +1360,7 @@ def {fname}(n):
         return NOPE
 {{value}}
     session.last = None
-    return v
+    return v{{mark}}
 """
 
 
@@ -1368,7 +1368,11 @@ def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any]
     """The value function of a reader's C entry (``ctl``: the GT_ or the GTN_ form's gated
     controller, ``CTL`` or ``CTLN``)."""
     value = "\n".join("    " + line for line in _value_lines(env))
+    # a status word of the bank's as (word,): it stands across the quick cycles that keep
+    # every flag (csrc/centry.c kept), as a span of them does
+    mark = " if res.bank is None else (v,)" if env["name"] == "GT_GetSts" else ""
     code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value)
+    code = code.replace("{mark}", mark)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]  # type: ignore[no-any-return]
 

@@ -145,6 +145,9 @@ struct slot {
     long long epoch;
     obj value;
     long long booked; /* c_booked when it was kept */
+    /* holds: 1 where the value is a status word of the bank's (value(n) gave (word,)), which
+     * stands across the cycles that keep every flag; keeps: flag_keeping when it was kept */
+    long long holds, keeps;
 };
 
 /* a span's bytes kept for its key and epoch (tp: a strong reference while kept); holds: 1
@@ -211,6 +214,13 @@ struct entry {
 
 static struct api A;
 static int ready;
+
+/* The quick cycles booked in C that kept every status flag (no in-position band, no move
+ * ended: book_in_c's b[14]), each of which made the readers' epoch grow by one: where the
+ * epoch grew by as much as this count since a span of status words, or one axis's word of
+ * the bank, was kept, every change since was such a cycle and the words stand (array_value,
+ * kept) */
+static long long flag_keeping;
 
 /* The quick cycles booked in C (book_in_c; each made the readers' epoch grow by one): where
  * the epoch grew by as much as this count since a value was kept, every change since was
@@ -286,6 +296,8 @@ static void keep(struct slot *s, long long ep, obj v)
     s->value = v;
     s->epoch = ep;
     s->booked = c_booked;
+    s->holds = 0;
+    s->keeps = flag_keeping;
     if (old)
         A.decref(old);
 }
@@ -309,8 +321,11 @@ static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, lon
     s = &cache[*key];
     if (*ep >= 0 && s->value &&
         (s->epoch == *ep ||
-         (steady && *ep > s->epoch && *ep - s->epoch == c_booked - s->booked))) {
-        s->epoch = *ep, s->booked = c_booked; /* (a steady value across cycles booked in C) */
+         (steady && *ep > s->epoch && *ep - s->epoch == c_booked - s->booked) ||
+         (s->holds && *ep > s->epoch && *ep - s->epoch == flag_keeping - s->keeps))) {
+        /* (a steady value across cycles booked in C, a status word across those that kept
+         * every flag: the same) */
+        s->epoch = *ep, s->booked = c_booked, s->keeps = flag_keeping;
         A.incref(s->value);
         return s->value;
     }
@@ -537,11 +552,6 @@ static int armed(const long long *q, long long pend)
     return 1;
 }
 
-/* The quick cycles booked in C that kept every status flag (no in-position band, no move
- * ended: book_in_c's b[14]), each of which made the readers' epoch grow by one: where the
- * epoch grew by as much as this count since a span of status words was kept, every change
- * since was such a cycle and the words stand (array_value) */
-static long long flag_keeping;
 
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
@@ -1257,6 +1267,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     char *mem = NULL, *cmem = NULL, *lmem = NULL;
     obj deref = NULL;
     int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1, ran = 0;
+    int holds = 0;
     long long key = -1, ep = -1, ep0 = -1, clk = 0, loop = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
@@ -1335,12 +1346,22 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)
         goto drop;
+    if (e->kind == 0 && e->tuple_type && TYPE(v) == e->tuple_type &&
+        *(ptrdiff_t *)((char *)v + A.bsize) == 1) { /* (word,): a status word of the bank's */
+        obj w = *(obj *)((char *)v + e->titems);
+        A.incref(w);
+        A.decref(v);
+        v = w;
+        holds = 1;
+    }
     if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
         A.decref(v);
         return AGAIN;
     }
-    if (key >= 0 && ep >= 0)
+    if (key >= 0 && ep >= 0) {
         keep(&e->cache[key], ep, v);
+        e->cache[key].holds = holds;
+    }
 have:
     /* q: the cycles run (again: Python ran; a number the type does not hold: Python's) */
     if (lmem && (!clock_cycles(e->gate, &loop) || !clock_mem(e, args[1], &lmem, &lsize, &lsign) ||
