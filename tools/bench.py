@@ -28,7 +28,9 @@ interleaved, and every call shape of the fast path likewise (the worst ratio is 
 and every function with a fast path in every way a client passes its value's pointer
 (``every_call_shape_vs_arguments``, the same bar), that walk and the call shapes again with
 the controller on the auto clock (``every_call_shape_vs_arguments_auto``: each poll carries
-its share of the cycles; the same bar), both walks with the spans of a 16-axis controller;
+its share of the cycles, the bar on the whole call; each shape also with the share the
+controller's cycles took, timed where they run, and its ratio without it), both walks with
+the spans of a 16-axis controller;
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
