@@ -130,6 +130,20 @@ class _Api(ctypes.Structure):
         ("key_seen", _VP),
         ("b_size", ctypes.c_ssize_t),
         ("bytes_new", _VP),
+        ("float_new", _VP),
+    ]
+
+
+class _Recipe(ctypes.Structure):
+    """``struct recipe`` of csrc/centry.c: where a value's doubles come from."""
+
+    _fields_ = [
+        ("src", _VP),
+        ("idx", _VP),
+        ("rows", _VP),
+        ("ratios", _VP),
+        ("op", ctypes.c_longlong),
+        ("t", ctypes.c_double),
     ]
 
 
@@ -142,6 +156,7 @@ class _Slot(ctypes.Structure):
         ("booked", ctypes.c_longlong),
         ("holds", ctypes.c_longlong),
         ("keeps", ctypes.c_longlong),
+        ("rc", _Recipe),
     ]
 
 
@@ -157,13 +172,8 @@ class _ASlot(ctypes.Structure):
         ("value", _VP),
         ("holds", ctypes.c_longlong),
         ("keeps", ctypes.c_longlong),
-        ("src", _VP),
-        ("idx", _VP),
-        ("rows", _VP),
-        ("ratios", _VP),
-        ("op", ctypes.c_longlong),
+        ("rc", _Recipe),
         ("booked", ctypes.c_longlong),
-        ("t", ctypes.c_double),
     ]
 
 
@@ -839,6 +849,7 @@ def _load() -> tuple[Maker | None, str]:
             id(_KEY_SEEN),
             size_at,
             _address("PyBytes_FromStringAndSize"),
+            _address("PyFloat_FromDouble"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int

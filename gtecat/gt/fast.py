@@ -585,7 +585,8 @@ def fast_reader(
                 v = value(n)
                 if v is _NO:
                     return _NO
-                values: Any = v if type(v) is tuple else (v,)  # ((word,): a bank's status)
+                # ((word,): a bank's status word; (x, ...): a double and where it comes from)
+                values: Any = (v[0] if type(v) is tuple else v,)
             else:
                 if count > limit:
                     return _NO
@@ -1022,6 +1023,36 @@ QUICK_ROWS: dict[str, tuple[str, str, str, str]] = {
 #: ``steady``)
 STEADY = frozenset({"GT_GetPrfMode"})
 
+#: one banked axis's double that its C entry makes again itself after the cycles it books
+#: (csrc/centry.c kept: the operations of QUICK_SOURCES on the axis's row ``res.bank_row``):
+#: (op, the bank's arrays src and idx, the factor or None, where the value function's
+#: value is that: its guard, which holds on across such cycles)
+_NO_JOG = "not (b.n_jog or b.n_hm)"
+_CLAIMED = "b.counts[3] - b.claim_cycle.item(res.bank_row) >= 2"
+SCALAR_SOURCES: dict[str, tuple[int, str, str | None, str | None, str]] = {
+    "GT_GetPrfPos": (0, "_t_p1", "t_idx", None, _NO_JOG),
+    "GT_GetPrfVel": (0, "_t_v1", "t_idx", None, _NO_JOG),
+    "GT_GetPrfAcc": (0, "_t_a1", "t_idx", None, _NO_JOG),
+    "GT_GetAxisPrfPos": (0, "a_last", None, None, "True"),
+    "GT_GetEncPos": (0, "enc_pos", None, None, "True"),
+    "GT_GetEncVel": (1, "enc_step1", None, None, _CLAIMED),
+    "GT_GetAxisPrfVel": (0, "_t_v1", "t_idx", "res.prf_link.ratio", _NO_JOG),
+    "GT_GetAxisPrfAcc": (0, "_t_a1", "t_idx", "res.prf_link.ratio", _NO_JOG),
+    "GT_GetAxisEncVel": (1, "enc_step1", None, "res.enc_link.ratio", _CLAIMED),
+    "GT_GetAxisEncAcc": (2, "enc_step1", "enc_step0", "res.enc_link.ratio", _CLAIMED),
+}
+_PACK_D = struct.Struct("@d").pack
+_ROWS8: dict[int, bytes] = {}
+
+
+def _row8(r: int) -> bytes:
+    """Row ``r`` as the int64 bytes a C entry reads (SCALAR_SOURCES' rows)."""
+    b = _ROWS8.get(r)
+    if b is None:
+        b = _ROWS8[r] = array("q", (r,)).tobytes()
+    return b
+
+
 #: the QUICK_ROWS values a span's C entry makes again itself after the cycles it books
 #: (csrc/centry.c gather: the same IEEE operations in the same order on the bank's arrays,
 #: which the compiled cycle moves in place): (its op - 0 ``src[idx[r]]``, 1 ``src[r] / T``,
@@ -1360,7 +1391,7 @@ def {fname}(n):
         return NOPE
 {{value}}
     session.last = None
-    return v{{mark}}
+    {{tail}}
 """
 
 
@@ -1370,9 +1401,24 @@ def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any]
     value = "\n".join("    " + line for line in _value_lines(env))
     # a status word of the bank's as (word,): it stands across the quick cycles that keep
     # every flag (csrc/centry.c kept), as a span of them does
-    mark = " if res.bank is None else (v,)" if env["name"] == "GT_GetSts" else ""
-    code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value)
-    code = code.replace("{mark}", mark)
+    tail = "return v if res.bank is None else (v,)" if env["name"] == "GT_GetSts" else "return v"
+    source = SCALAR_SOURCES.get(env["name"])
+    if source is not None:  # a double of the bank's with where it comes from (kept)
+        op, src, idx, factor, guard = source
+        t = "b.T" if op else "0.0"
+        env |= {"_ROW8": _row8, "_D": _PACK_D, "_NUM": (int, float)}
+        tail = "\n".join(
+            [
+                f"if b is not None and {guard} and type({t}) is float:",
+                f"    f = {factor or 'None'}",
+                "    if f is None or type(f) in _NUM:",
+                "        f = None if f is None else _D(f)",
+                f"        return v, {op}, b.{src}, {'b.' + idx if idx else 'None'}, "
+                f"_ROW8(res.bank_row), f, {t}",
+                "return v",
+            ]
+        ).replace("\n", "\n    ")
+    code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value).replace("{tail}", tail)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]  # type: ignore[no-any-return]
 

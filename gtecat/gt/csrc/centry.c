@@ -136,9 +136,22 @@ struct api {
     ptrdiff_t b_size;
     /* PyBytes_FromStringAndSize: a span's values gathered here (gather) */
     obj (*bytes_new)(const char *, ptrdiff_t);
+    /* PyFloat_FromDouble: one axis's double made again (kept) */
+    obj (*float_new)(double);
 };
 
 #define MAX_TYPES 16
+
+/* Where a value's doubles come from, as its value function says it (strong references while
+ * kept; src NULL: not said): for each of its doubles the same operations on the bank's
+ * arrays across the cycles booked in C (make_doubles): rows (int64 bytes) the rows, ratios
+ * (float64 bytes, NULL: none) a factor per value, op what is read of src and idx at a row,
+ * t the cycle time op 1 and 2 divide by. */
+struct recipe {
+    obj src, idx, rows, ratios;
+    long long op;
+    double t;
+};
 
 /* a value kept for the epoch it was asked in (value: a strong reference, NULL: none) */
 struct slot {
@@ -148,7 +161,12 @@ struct slot {
     /* holds: 1 where the value is a status word of the bank's (value(n) gave (word,)), which
      * stands across the cycles that keep every flag; keeps: flag_keeping when it was kept */
     long long holds, keeps;
+    struct recipe rc; /* where a double comes from: made again after cycles booked in C */
 };
+
+static int make_doubles(const struct recipe *rc, long long count, double *out);
+static const char *vector(obj a, ptrdiff_t *len);
+static int ll_of(obj o, long long *v);
 
 /* a span's bytes kept for its key and epoch (tp: a strong reference while kept); holds: 1
  * where they stand across the cycles that keep every status flag (their value function gave
@@ -158,14 +176,9 @@ struct aslot {
     obj tp;
     obj value;
     long long holds, keeps;
-    /* where the bytes come from, as avalue said (strong references while kept; src NULL:
-     * not said), for each of count doubles the same operations on the bank's arrays across
-     * the cycles booked in C (gather): rows (int64) the rows, ratios (float64, NULL: none)
-     * a factor per value, op what is read of src and idx at a row; booked: c_booked when
-     * they were kept */
-    obj src, idx, rows, ratios;
-    long long op, booked;
-    double t;
+    /* where the bytes come from, as avalue said (gather); booked: c_booked when kept */
+    struct recipe rc;
+    long long booked;
 };
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
@@ -252,7 +265,7 @@ int gtecat_centry_api(const struct api *api)
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
         !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
-        api->b_size <= 0 || !api->bytes_new)
+        api->b_size <= 0 || !api->bytes_new || !api->float_new)
         return 1;
     A = *api;
     ready = 1;
@@ -288,7 +301,21 @@ static long long epoch(void)
     return over || v < 0 ? -1 : v;
 }
 
-/* Keep v in s for epoch ep (v: borrowed; s's old value given up). */
+/* A recipe's references given up (NULL: none), a copy of it (rc emptied first: Python may
+ * run in a decref) */
+static void let_recipe_go(struct recipe *rc)
+{
+    struct recipe was = *rc;
+    obj refs[4];
+    int k;
+    rc->src = rc->idx = rc->rows = rc->ratios = NULL;
+    refs[0] = was.src, refs[1] = was.idx, refs[2] = was.rows, refs[3] = was.ratios;
+    for (k = 0; k < 4; k++)
+        if (refs[k])
+            A.decref(refs[k]);
+}
+
+/* Keep v in s for epoch ep (v: borrowed; s's old value, and where it came from, given up). */
 static void keep(struct slot *s, long long ep, obj v)
 {
     obj old = s->value;
@@ -298,6 +325,7 @@ static void keep(struct slot *s, long long ep, obj v)
     s->booked = c_booked;
     s->holds = 0;
     s->keeps = flag_keeping;
+    let_recipe_go(&s->rc);
     if (old)
         A.decref(old);
 }
@@ -329,38 +357,41 @@ static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, lon
         A.incref(s->value);
         return s->value;
     }
+    if (*ep >= 0 && s->value && s->rc.src && *ep > s->epoch &&
+        *ep - s->epoch == c_booked - s->booked) {
+        /* (a double of the bank's after cycles booked in C: made again where it comes from) */
+        double x;
+        obj f, old;
+        if (make_doubles(&s->rc, 1, &x) &&
+            (f = A.float_new(x)) != NULL) {
+            old = s->value;
+            s->value = f;
+            s->epoch = *ep, s->booked = c_booked, s->keeps = flag_keeping;
+            A.decref(old);
+            A.incref(f);
+            return f;
+        }
+        if (A.err_occurred())
+            A.err_clear();
+    }
     return NULL;
 }
 
-/* A recipe's references given up (NULL: none) */
-static void let_recipe_go(obj src, obj idx, obj rows, obj ratios)
-{
-    if (src)
-        A.decref(src);
-    if (idx)
-        A.decref(idx);
-    if (rows)
-        A.decref(rows);
-    if (ratios)
-        A.decref(ratios);
-}
 
 /* Keep a span's (or a raw range's) bytes v with their key and type tp for epoch ep. */
 static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
                       long long count, long long clock)
 {
-    obj old = s->value, oldtp = s->tp, src = s->src, idx = s->idx, rows = s->rows;
-    obj ratios = s->ratios;
+    obj old = s->value, oldtp = s->tp;
     A.incref(v);
     A.incref(tp);
     s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
     s->holds = 0;
-    s->src = s->idx = s->rows = s->ratios = NULL;
+    let_recipe_go(&s->rc);
     if (old)
         A.decref(old);
     if (oldtp)
         A.decref(oldtp);
-    let_recipe_go(src, idx, rows, ratios);
 }
 
 /* Another thread and the clock.
@@ -921,74 +952,105 @@ static const char *vector(obj a, ptrdiff_t *len)
     return AT(a, A.nd_data);
 }
 
-/* A span's count doubles made again from the arrays its slot keeps, as avalue made them (the
- * same IEEE operations in the same order), as a new bytes object: for the k-th, its row r
+/* count doubles made again from the arrays a value was kept with, as its value function made
+ * them (the same IEEE operations in the same order), into out: for the k-th, its row r
  * (rows[k]) and x =
  *   op 0: src[idx[r]] (idx NULL: src[r])   (a planned value of the Trap table, a row's own)
  *   op 1: src[r] / t                       (an encoder's speed: its last step over a cycle)
  *   op 2: (src[r] / t - idx[r] / t) / t    (its acceleration: the last two steps)
- * then ratios[k] * x where ratios are given.  NULL (no error left) where an index falls
- * outside an array (the Python way answers). */
+ * then ratios[k] * x where ratios are given.  0 where an index falls outside an array (the
+ * Python way answers).  gather: a span's, as a new bytes object (NULL, no error left: the
+ * Python way). */
+static int make_doubles(const struct recipe *rc, long long count, double *out)
+{
+    obj src_ = rc->src, idx_ = rc->idx, rows_ = rc->rows, ratios_ = rc->ratios;
+    long long op = rc->op;
+    double t = rc->t;
+    ptrdiff_t slen = 0, ilen = 0;
+    const double *src = (const double *)vector(src_, &slen), *fidx = NULL, *ratios = NULL;
+    const int64_t *idx = NULL, *rows;
+    double x;
+    long long k, r, i;
+    if (!src || count < 1 || op < 0 || op > 2 || TYPE(rows_) != A.bytes_type ||
+        *(ptrdiff_t *)((char *)rows_ + A.bsize) != count * 8)
+        return 0;
+    rows = (const int64_t *)((char *)rows_ + A.bdata);
+    if (ratios_) {
+        if (TYPE(ratios_) != A.bytes_type || *(ptrdiff_t *)((char *)ratios_ + A.bsize) != count * 8)
+            return 0;
+        ratios = (const double *)((char *)ratios_ + A.bdata);
+    }
+    if (idx_) {
+        const char *d = vector(idx_, &ilen);
+        if (!d)
+            return 0;
+        idx = (const int64_t *)d, fidx = (const double *)d;
+    } else if (op == 2)
+        return 0;
+    for (k = 0; k < count; k++) {
+        r = rows[k];
+        if (r < 0 || r >= slen || (idx && r >= ilen))
+            return 0;
+        if (op == 0) {
+            i = idx ? idx[r] : r;
+            if (i < 0 || i >= slen)
+                return 0;
+            x = src[i];
+        } else if (op == 1)
+            x = src[r] / t;
+        else
+            x = (src[r] / t - fidx[r] / t) / t;
+        out[k] = ratios ? ratios[k] * x : x;
+    }
+    return 1;
+}
+
 static obj gather(const struct aslot *s, long long count)
 {
-    ptrdiff_t slen = 0, ilen = 0;
-    const double *src = (const double *)vector(s->src, &slen), *fidx = NULL, *ratios = NULL;
-    const int64_t *idx = NULL, *rows;
-    double *out, x;
-    long long k, r, i;
-    obj v;
-    if (!src || count < 1 || s->op < 0 || s->op > 2 || TYPE(s->rows) != A.bytes_type ||
-        *(ptrdiff_t *)((char *)s->rows + A.bsize) != count * 8)
-        return NULL;
-    rows = (const int64_t *)((char *)s->rows + A.bdata);
-    if (s->ratios) {
-        if (TYPE(s->ratios) != A.bytes_type ||
-            *(ptrdiff_t *)((char *)s->ratios + A.bsize) != count * 8)
-            return NULL;
-        ratios = (const double *)((char *)s->ratios + A.bdata);
-    }
-    if (s->idx) {
-        const char *d = vector(s->idx, &ilen);
-        if (!d)
-            return NULL;
-        idx = (const int64_t *)d, fidx = (const double *)d;
-    } else if (s->op == 2)
-        return NULL;
-    v = A.bytes_new(NULL, (ptrdiff_t)(count * 8));
+    obj v = A.bytes_new(NULL, (ptrdiff_t)(count * 8));
     if (!v) {
         A.err_clear();
         return NULL;
     }
-    out = (double *)((char *)v + A.bdata);
-    for (k = 0; k < count; k++) {
-        r = rows[k];
-        if (r < 0 || r >= slen || (idx && r >= ilen))
-            goto outside;
-        if (s->op == 0) {
-            i = idx ? idx[r] : r;
-            if (i < 0 || i >= slen)
-                goto outside;
-            x = src[i];
-        } else if (s->op == 1)
-            x = src[r] / s->t;
-        else
-            x = (src[r] / s->t - fidx[r] / s->t) / s->t;
-        out[k] = ratios ? ratios[k] * x : x;
+    if (!make_doubles(&s->rc, count, (double *)((char *)v + A.bdata))) {
+        A.decref(v);
+        return NULL;
     }
     return v;
-outside:
-    A.decref(v);
-    return NULL;
+}
+
+/* The recipe in a value function's (value, op, src, idx or None, rows, ratios or None, t)
+ * (items: the tuple's), its references taken: 1; 0 where it is not one (nothing taken). */
+static int take_recipe(obj *items, struct recipe *rc)
+{
+    ptrdiff_t len;
+    if (!(ll_of(items[1], &rc->op) && vector(items[2], &len) &&
+          (items[3] == A.none || vector(items[3], &len)) && TYPE(items[4]) == A.bytes_type &&
+          (items[5] == A.none || TYPE(items[5]) == A.bytes_type) &&
+          TYPE(items[6]) == A.float_type))
+        return 0;
+    rc->src = items[2];
+    rc->idx = items[3] == A.none ? NULL : items[3];
+    rc->rows = items[4];
+    rc->ratios = items[5] == A.none ? NULL : items[5];
+    rc->t = *(double *)((char *)items[6] + A.fval);
+    A.incref(rc->src);
+    A.incref(rc->rows);
+    if (rc->idx)
+        A.incref(rc->idx);
+    if (rc->ratios)
+        A.incref(rc->ratios);
+    return 1;
 }
 
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
                        long long clk, int locked, int *ran)
 {
     struct aslot *s = e->acache;
-    long long ep = -1, ep0 = -1, op = 0;
-    double t = 0;
+    struct recipe rc = {0};
+    long long ep = -1, ep0 = -1;
     int holds = 0;
-    obj v, tp = call[2], src = NULL, idx = NULL, rows = NULL, ratios = NULL;
+    obj v, tp = call[2];
     *ran = 0;
     if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk &&
@@ -1003,7 +1065,7 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         A.incref(s->value);
         return s->value;
     }
-    if (s && ep >= 0 && s->src && s->value && s->n == an && s->count == ac && s->tp == tp &&
+    if (s && ep >= 0 && s->rc.src && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk && ep > s->epoch && ep - s->epoch == c_booked - s->booked &&
         (v = gather(s, ac)) != NULL) {
         /* (the doubles of the same rows after cycles booked in C: from the same arrays) */
@@ -1033,24 +1095,9 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         /* (bytes, op, src, idx or None, rows, ratios or None, t): doubles made again from
          * there (gather) */
         obj *items = (obj *)((char *)v + e->titems), b = items[0];
-        ptrdiff_t len;
-        if (TYPE(b) == A.bytes_type && *(ptrdiff_t *)((char *)b + A.bsize) == ac * 8 &&
-            ll_of(items[1], &op) && vector(items[2], &len) &&
-            (items[3] == A.none || vector(items[3], &len)) && TYPE(items[4]) == A.bytes_type &&
-            (items[5] == A.none || TYPE(items[5]) == A.bytes_type) &&
-            TYPE(items[6]) == A.float_type) {
-            src = items[2];
-            idx = items[3] == A.none ? NULL : items[3];
-            rows = items[4];
-            ratios = items[5] == A.none ? NULL : items[5];
-            t = *(double *)((char *)items[6] + A.fval);
-            A.incref(src);
-            A.incref(rows);
-            if (idx)
-                A.incref(idx);
-            if (ratios)
-                A.incref(ratios);
-        }
+        if (!(TYPE(b) == A.bytes_type && *(ptrdiff_t *)((char *)b + A.bsize) == ac * 8 &&
+              take_recipe(items, &rc)))
+            rc.src = NULL;
         A.incref(b);
         A.decref(v);
         v = b;
@@ -1058,17 +1105,17 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
     if (TYPE(v) != A.bytes_type || (!locked && !stands(e->gate, ep0))) {
         obj r = TYPE(v) != A.bytes_type ? PYTHON : AGAIN;
         A.decref(v);
-        let_recipe_go(src, idx, rows, ratios);
+        let_recipe_go(&rc);
         return r;
     }
     if (s && ep >= 0) {
         keep_span(s, ep, v, tp, an, ac, clk);
         s->holds = holds;
         s->keeps = flag_keeping;
-        s->src = src, s->idx = idx, s->rows = rows, s->ratios = ratios;
-        s->op = op, s->t = t, s->booked = c_booked;
+        s->rc = rc; /* (its references the slot's now) */
+        s->booked = c_booked;
     } else
-        let_recipe_go(src, idx, rows, ratios);
+        let_recipe_go(&rc);
     return v;
 }
 
@@ -1268,6 +1315,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     obj deref = NULL;
     int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1, ran = 0;
     int holds = 0;
+    struct recipe rc = {0};
     long long key = -1, ep = -1, ep0 = -1, clk = 0, loop = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
@@ -1353,15 +1401,29 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         A.decref(v);
         v = w;
         holds = 1;
+    } else if (e->kind == 1 && e->tuple_type && TYPE(v) == e->tuple_type &&
+               *(ptrdiff_t *)((char *)v + A.bsize) == 7) {
+        /* (x, op, src, idx, rows, ratios, t): a double of the bank's and where it comes from */
+        obj *items = (obj *)((char *)v + e->titems), w = items[0];
+        if (TYPE(w) != A.float_type || !take_recipe(items, &rc))
+            rc.src = NULL;
+        A.incref(w);
+        A.decref(v);
+        v = w;
     }
     if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
         A.decref(v);
+        let_recipe_go(&rc);
         return AGAIN;
     }
     if (key >= 0 && ep >= 0) {
-        keep(&e->cache[key], ep, v);
-        e->cache[key].holds = holds;
+        struct slot *sl = &e->cache[key];
+        keep(sl, ep, v);
+        sl->holds = holds;
+        sl->rc = rc; /* (its references the slot's now) */
+        rc.src = rc.idx = rc.rows = rc.ratios = NULL;
     }
+    let_recipe_go(&rc);
 have:
     /* q: the cycles run (again: Python ran; a number the type does not hold: Python's) */
     if (lmem && (!clock_cycles(e->gate, &loop) || !clock_mem(e, args[1], &lmem, &lsize, &lsign) ||

@@ -94,12 +94,6 @@ def _calls(pr: Any, names: tuple[str, ...]) -> int:
     )
 
 
-def _asked(pr: Any) -> int:
-    """How often a profile ``pr`` saw a span's value function asked (the C entries'
-    ``avalue``: gtecat.gt.fast's ``f``)."""
-    return _calls(pr, ("f",))
-
-
 @contextmanager
 def _auto(general: bool, eni: str = "manual_fig5_2.eni", **options: Any) -> Iterator[Any]:
     """The bus ``eni`` brought up on the auto clock, its controller (``general``: with a
@@ -176,6 +170,7 @@ def _double_polls(
         pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
         vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
         rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
+        one = c_double()
         seen: list = []
         pr = cProfile.Profile()
         t0 = ctl.clock.cycles
@@ -183,7 +178,7 @@ def _double_polls(
             for k, a in enumerate(range(first, first + count)):  # (ends apart)
                 trap_move(a, (200 + 90 * k) * (rnd + 1) * (-1) ** rnd, 15.0 + k)
             pr.enable()
-            for _ in range(1000):
+            for _ in range(600):
                 assert gt.GT_GetPrfPos(first, pos, count, byref(clk)) == 0
                 assert gt.GT_GetPrfVel(first, vel, count) == 0
                 assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
@@ -194,8 +189,11 @@ def _double_polls(
                 for name, arr in rows.items():
                     assert getattr(gt, name)(first, arr, count, clk) == 0
                     seen.append(arr.tobytes())
+                for name in fast.SCALAR_SOURCES:  # (one axis's, into byref(x))
+                    assert getattr(gt, name)(first + 1, byref(one)) == 0
+                    seen.append((name, one.value))
             pr.disable()
-        return seen, ctl.clock.cycles - t0, _asked(pr)
+        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt"))
 
 
 def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
