@@ -581,12 +581,18 @@ def fast_reader(
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
             words = False  # (status words of the bank's rows and zeros alone: (bytes,))
             recipe = None  # (a getter of where the values come from: the entry's gather)
+            source = None  # (... or where they come from)
             if count == 1:
                 v = value(n)
                 if v is _NO:
                     return _NO
-                # ((word,): a bank's status word; (x, ...): a double and where it comes from)
-                values: Any = (v[0] if type(v) is tuple else v,)
+                if type(v) is tuple:
+                    # (word,): a bank's status word, which stands as a span of them does;
+                    # (x, op, ...): a double and where it comes from, made again as a span's
+                    words = len(v) == 1
+                    source = v[1:] if len(v) == 7 and doubles else None
+                    v = v[0]
+                values: Any = (v,)
             else:
                 if count > limit:
                     return _NO
@@ -668,9 +674,9 @@ def fast_reader(
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
             if recipe is not None and doubles:  # (the entry makes them again: gather)
-                got = recipe(b)
-                if got is not None:
-                    return (out, *got)
+                source = recipe(b)
+            if source is not None:
+                return (out, *source)
             # status words of the bank's rows and zeros alone stand across the cycles the C
             # entry books that keep every flag (csrc/centry.c array_value)
             return (out,) if words else out

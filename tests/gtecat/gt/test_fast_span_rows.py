@@ -119,6 +119,7 @@ def _status_polls(general: bool) -> tuple[list, int, int]:
     with _auto(general) as ctl:
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
         words, prf, one, two = (c_long * 2)(), (c_long * 2)(), c_long(), ctypes.c_int32()
+        three = (c_long * 2)()
         clk = ctypes.c_ulong()
         seen: list = []
         pr = cProfile.Profile()
@@ -130,9 +131,10 @@ def _status_polls(general: bool) -> tuple[list, int, int]:
                 assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
                 assert gt.GT_GetPrfSts(1, prf, 2) == 0
                 assert gt.GT_GetSts(1, byref(one)) == 0 and gt.GT_GetSts(2, two) == 0
-                seen.append((clk.value, *words, *prf, one.value, two.value))
+                assert gt.GTN_GetSts(1, 2, byref(three, ctypes.sizeof(c_long))) == 0
+                seen.append((clk.value, *words, *prf, one.value, two.value, three[1]))
             pr.disable()
-        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt"))
+        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
 
 
 def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
@@ -170,7 +172,7 @@ def _double_polls(
         pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
         vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
         rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
-        one = c_double()
+        one, two = c_double(), (c_double * 2)()
         seen: list = []
         pr = cProfile.Profile()
         t0 = ctl.clock.cycles
@@ -189,11 +191,15 @@ def _double_polls(
                 for name, arr in rows.items():
                     assert getattr(gt, name)(first, arr, count, clk) == 0
                     seen.append(arr.tobytes())
-                for name in fast.SCALAR_SOURCES:  # (one axis's, into byref(x))
+                for name in fast.SCALAR_SOURCES:
+                    # one axis's, into byref(x), and into &two[1] by the GTN_ twin (its entry
+                    # keeps a span of its own: not this loop's spans')
                     assert getattr(gt, name)(first + 1, byref(one)) == 0
-                    seen.append((name, one.value))
+                    gtn = getattr(gt, name.replace("GT_", "GTN_"))
+                    assert gtn(1, first, byref(two, 8)) == 0
+                    seen.append((name, one.value, two[1]))
             pr.disable()
-        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt"))
+        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
 
 
 def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
@@ -242,7 +248,7 @@ def _mode_polls(general: bool) -> tuple[list, int, int]:
                 assert gt.GT_GetPrfMode(1, modes, 2, byref(clk)) == 0
                 seen.append((mode.value, *modes, clk.value))
             pr.disable()
-        values = _calls(pr, ("f", "value_gt"))
+        values = _calls(pr, ("f", "value_gt", "value_gtn"))
         return seen, ctl.clock.cycles - t0, values
 
 
