@@ -180,7 +180,7 @@ def _double_polls(
             for k, a in enumerate(range(first, first + count)):  # (ends apart)
                 trap_move(a, (200 + 90 * k) * (rnd + 1) * (-1) ** rnd, 15.0 + k)
             pr.enable()
-            for _ in range(600):
+            for _ in range(300):
                 assert gt.GT_GetPrfPos(first, pos, count, byref(clk)) == 0
                 assert gt.GT_GetPrfVel(first, vel, count) == 0
                 assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
