@@ -1046,8 +1046,11 @@ SCALAR_SOURCES: dict[str, tuple[int, str, str | None, str | None, str]] = {
     "GT_GetAxisPrfAcc": (0, "_t_a1", "t_idx", "res.prf_link.ratio", _NO_JOG),
     "GT_GetAxisEncVel": (1, "enc_step1", None, "res.enc_link.ratio", _CLAIMED),
     "GT_GetAxisEncAcc": (2, "enc_step1", "enc_step0", "res.enc_link.ratio", _CLAIMED),
+    "GT_GetAxisEncPos": (3, "enc_pos", None, "res.enc_link", "True"),
+    "GT_GetAxisError": (4, "a_last", "enc_pos", "res.enc_link", "True"),
 }
 _PACK_D = struct.Struct("@d").pack
+_PACK_D2 = struct.Struct("@2d").pack
 _ROWS8: dict[int, bytes] = {}
 
 
@@ -1071,6 +1074,10 @@ QUICK_SOURCES: dict[str, tuple[int, str, str | None, str | None]] = {
     "GT_GetAxisEncVel": (1, "enc_step1", None, "enc_link.ratio"),
     "GT_GetAxisEncAcc": (2, "enc_step1", "enc_step0", "enc_link.ratio"),
     "GT_GetEncVel": (1, "enc_step1", None, None),
+    # 3 ``axis(src[r])``, 4 ``src[r] - axis(idx[r])``: the encoder's link (AffineLink.axis,
+    # its two branches) of each axis, its ratio and offset
+    "GT_GetAxisEncPos": (3, "enc_pos", None, "enc_link"),
+    "GT_GetAxisError": (4, "a_last", "enc_pos", "enc_link"),
 }
 
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
@@ -1170,24 +1177,28 @@ def _read_plan(
             )
             pick = env["quick"]
     from_source = None
-    if source is not None and quick is not None and pure and len(rows) == count:
+    if source is not None and pure and len(rows) == count:
         op, src, idx, factor = source
-        ratios = ", ".join(f"r{i}.{factor}" for i in range(count)) if factor else ""
-        env |= {"ROWS": array("q", rows).tobytes(), "_pack": struct.Struct(f"@{count}d").pack}
+        if factor is not None and factor.endswith("_link"):  # (a link's axis(): both)
+            f = ", ".join(f"r{i}.{factor}.ratio, r{i}.{factor}.offset" for i in range(count))
+            width = 2 * count
+        else:
+            f = ", ".join(f"r{i}.{factor}" for i in range(count)) if factor else ""
+            width = count
+        env |= {"ROWS": array("q", rows).tobytes(), "_pack": struct.Struct(f"@{width}d").pack}
         env |= {"_num": (int, float)}
         guard = " and ".join(x for x in guards if x != "True") or "True"
         exec(
-            f"def from_source(b):\n    {quick[0]}\n    if not ({guard}):\n        return None\n"
+            f"def from_source(b):\n    {quick[0] if quick is not None else 'pass'}\n"
+            f"    if not ({guard}):\n        return None\n"
             + (
-                f"    f = ({ratios},)\n"
+                f"    f = ({f},)\n"
                 "    if not all(type(x) in _num for x in f):\n        return None\n"
                 "    f = _pack(*f)\n"
                 if factor
                 else "    f = None\n"
             )
-            + "    t = b.T if "
-            + str(op)
-            + " else 0.0\n"
+            + f"    t = b.T if {op} in (1, 2) else 0.0\n"
             + "    if type(t) is not float:\n        return None\n"
             + f"    return {op}, b.{src}, {'b.' + idx if idx else 'None'}, ROWS, f, t\n",
             env,
@@ -1411,14 +1422,24 @@ def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any]
     source = SCALAR_SOURCES.get(env["name"])
     if source is not None:  # a double of the bank's with where it comes from (kept)
         op, src, idx, factor, guard = source
-        t = "b.T" if op else "0.0"
-        env |= {"_ROW8": _row8, "_D": _PACK_D, "_NUM": (int, float)}
+        t = "b.T" if op in (1, 2) else "0.0"
+        env |= {"_ROW8": _row8, "_D": _PACK_D, "_D2": _PACK_D2, "_NUM": (int, float)}
+        link = factor is not None and factor.endswith("_link")  # (a link's axis(): both)
         tail = "\n".join(
             [
                 f"if b is not None and {guard} and type({t}) is float:",
                 f"    f = {factor or 'None'}",
-                "    if f is None or type(f) in _NUM:",
-                "        f = None if f is None else _D(f)",
+                *(
+                    [
+                        "    if type(f.ratio) in _NUM and type(f.offset) in _NUM:",
+                        "        f = _D2(f.ratio, f.offset)",
+                    ]
+                    if link
+                    else [
+                        "    if f is None or type(f) in _NUM:",
+                        "        f = None if f is None else _D(f)",
+                    ]
+                ),
                 f"        return v, {op}, b.{src}, {'b.' + idx if idx else 'None'}, "
                 f"_ROW8(res.bank_row), f, {t}",
                 "return v",

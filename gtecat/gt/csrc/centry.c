@@ -958,7 +958,11 @@ static const char *vector(obj a, ptrdiff_t *len)
  *   op 0: src[idx[r]] (idx NULL: src[r])   (a planned value of the Trap table, a row's own)
  *   op 1: src[r] / t                       (an encoder's speed: its last step over a cycle)
  *   op 2: (src[r] / t - idx[r] / t) / t    (its acceleration: the last two steps)
- * then ratios[k] * x where ratios are given.  0 where an index falls outside an array (the
+ * then ratios[k] * x where ratios are given; or, ratios giving each value's link (ratio,
+ * offset) and axis(e) its AffineLink.axis (ratio 1: e + offset where offset is not 0,
+ * else e; else ratio * e + offset):
+ *   op 3: axis(src[r])                     (the axis's encoder position)
+ *   op 4: src[r] - axis(idx[r])            (the axis's error: planned less encoder)  0 where an index falls outside an array (the
  * Python way answers).  gather: a span's, as a new bytes object (NULL, no error left: the
  * Python way). */
 static int make_doubles(const struct recipe *rc, long long count, double *out)
@@ -971,12 +975,15 @@ static int make_doubles(const struct recipe *rc, long long count, double *out)
     const int64_t *idx = NULL, *rows;
     double x;
     long long k, r, i;
-    if (!src || count < 1 || op < 0 || op > 2 || TYPE(rows_) != A.bytes_type ||
+    if (!src || count < 1 || op < 0 || op > 4 || TYPE(rows_) != A.bytes_type ||
         *(ptrdiff_t *)((char *)rows_ + A.bsize) != count * 8)
         return 0;
     rows = (const int64_t *)((char *)rows_ + A.bdata);
+    if (op >= 3 && !ratios_) /* (a link's ratio and offset per value) */
+        return 0;
     if (ratios_) {
-        if (TYPE(ratios_) != A.bytes_type || *(ptrdiff_t *)((char *)ratios_ + A.bsize) != count * 8)
+        if (TYPE(ratios_) != A.bytes_type ||
+            *(ptrdiff_t *)((char *)ratios_ + A.bsize) != count * (op >= 3 ? 16 : 8))
             return 0;
         ratios = (const double *)((char *)ratios_ + A.bdata);
     }
@@ -985,7 +992,7 @@ static int make_doubles(const struct recipe *rc, long long count, double *out)
         if (!d)
             return 0;
         idx = (const int64_t *)d, fidx = (const double *)d;
-    } else if (op == 2)
+    } else if (op == 2 || op == 4)
         return 0;
     for (k = 0; k < count; k++) {
         r = rows[k];
@@ -998,8 +1005,14 @@ static int make_doubles(const struct recipe *rc, long long count, double *out)
             x = src[i];
         } else if (op == 1)
             x = src[r] / t;
-        else
+        else if (op == 2)
             x = (src[r] / t - fidx[r] / t) / t;
+        else { /* (AffineLink.axis of the encoder's position, its two branches) */
+            double ratio = ratios[2 * k], offset = ratios[2 * k + 1], e = op == 3 ? src[r] : fidx[r];
+            double ax = ratio == 1.0 ? (offset != 0.0 ? e + offset : e) : ratio * e + offset;
+            out[k] = op == 3 ? ax : src[r] - ax;
+            continue;
+        }
         out[k] = ratios ? ratios[k] * x : x;
     }
     return 1;

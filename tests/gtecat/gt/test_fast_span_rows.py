@@ -168,6 +168,10 @@ def _double_polls(
     with _auto(general, eni, cycle_ms=cycle_ms) as ctl:
         for a in range(first, first + count):
             assert gt.GT_AxisOn(a) == 0
+        # the encoder's links of both branches (AffineLink.axis): a ratio of 3/7 and an
+        # offset, an offset alone
+        assert gt.GT_EncScale(first, 7, 3) == 0 and gt.GT_SetEncPos(first, 500) == 0
+        assert gt.GT_SetEncPos(first + 1, 1234) == 0
         clk = ctypes.c_ulong()
         pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
         vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
