@@ -1418,7 +1418,8 @@ def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any]
     value = "\n".join("    " + line for line in _value_lines(env))
     # a status word of the bank's as (word,): it stands across the quick cycles that keep
     # every flag (csrc/centry.c kept), as a span of them does
-    tail = "return v if res.bank is None else (v,)" if env["name"] == "GT_GetSts" else "return v"
+    status = env["name"] in ("GT_GetSts", "GT_GetPrfSts")  # (GT_GetPrfSts: a bit of it)
+    tail = "return v if res.bank is None else (v,)" if status else "return v"
     source = SCALAR_SOURCES.get(env["name"])
     if source is not None:  # a double of the bank's with where it comes from (kept)
         op, src, idx, factor, guard = source

@@ -110,16 +110,16 @@ def _auto(general: bool, eni: str = "manual_fig5_2.eni", **options: Any) -> Iter
 
 def _status_polls(general: bool) -> tuple[list, int, int]:
     """Trap moves of both axes that start and end, every call a span of status words
-    (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) and each axis's word (``GT_GetSts``)
-    polled on the auto clock; ``general``: a watch hook that does nothing, so every cycle
-    goes the general way.  What was read, the cycles run, and how often a value function
-    was asked."""
+    (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) and each axis's word (``GT_GetSts``,
+    ``GT_GetPrfSts``) polled on the auto clock; ``general``: a watch hook that does nothing,
+    so every cycle goes the general way.  What was read, the cycles run, and how often a
+    value function was asked."""
     import cProfile
 
     with _auto(general) as ctl:
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
         words, prf, one, two = (c_long * 2)(), (c_long * 2)(), c_long(), ctypes.c_int32()
-        three = (c_long * 2)()
+        three, four = (c_long * 2)(), c_long()
         clk = ctypes.c_ulong()
         seen: list = []
         pr = cProfile.Profile()
@@ -132,7 +132,8 @@ def _status_polls(general: bool) -> tuple[list, int, int]:
                 assert gt.GT_GetPrfSts(1, prf, 2) == 0
                 assert gt.GT_GetSts(1, byref(one)) == 0 and gt.GT_GetSts(2, two) == 0
                 assert gt.GTN_GetSts(1, 2, byref(three, ctypes.sizeof(c_long))) == 0
-                seen.append((clk.value, *words, *prf, one.value, two.value, three[1]))
+                assert gt.GTN_GetPrfSts(1, 2, byref(four)) == 0
+                seen.append((clk.value, *words, *prf, one.value, two.value, three[1], four.value))
             pr.disable()
         return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
 
