@@ -156,7 +156,7 @@ def _first_alarm_at(at_ms: int, elsewhere: bool) -> int:
             if alarms[0]:
                 return t
             if t >= at_ms - 100:
-                armed.wait(timeout=60)  # (armed before its time, whatever the scheduler did)
+                assert armed.wait(timeout=60)  # (armed before its time, whatever the scheduler did)
     finally:
         if elsewhere:
             th.join(timeout=60)
