@@ -19,9 +19,12 @@ from any thread of the application (a watchdog, a test harness) while another on
 the controller (its GT calls, ``GTE_Wait``, the realtime clock's cycle thread): each holds
 the controller's clock lock, as every GT call does (:func:`_between_cycles`), so what it
 does falls whole between two cycles - every step of a script armed, every fault cleared -
-and the next cycle is the first to act on it.  A fault armed at once starts there; one with
-``at_ms`` starts at that controller time whichever thread armed it, provided it was armed
-before that time.  The cycles pay nothing for this: they hold the lock already.
+and the next cycle is the first to act on it.  It is taken as a GT call of that thread
+would be: after the call another thread has under way (a long ``GTE_Wait`` on the auto
+clock included: its cycles are that call's), or the realtime cycle under way.  A fault armed
+at once starts there; one with ``at_ms`` starts at that controller time whichever thread
+armed it, provided it was armed before that time.  The cycles pay nothing for this: they
+hold the lock already.
 """
 
 from __future__ import annotations
