@@ -218,7 +218,14 @@ class Controller:
         #: endpoint's idle path waits for its end (it runs no request beside cycles)
         self.in_batch = False
         self._cycle_fixed = self.options.cycle_ms is not None
-        self.log = MasterLog(self.options.log, clock_ms=lambda: self.clock.now_ms)
+        #: [0] the controller time GT_Reset last counted GT_GetClock from (:attr:`reset_ns`),
+        #: in memory compiled code reads: the GT readers' C entries write a ``pClock`` from it
+        #: and the clock's time (gtecat.gt.centry.set_clock_ms)
+        self.origin = array("q", (0,))
+        # the master log is the controller's: its lines carry the controller's time, what
+        # GT_GetClock reads (counted from GT_Reset, chapter 13: GT_Reset resets the
+        # controller, GT_GetClock reads its clock), so a line and a clock read agree
+        self.log = MasterLog(self.options.log, clock_ms=self.clock_ms)
         self.machine = self._load_machine(self.options.machine)
         self.layout: Layout | None = None
         self.master: Master | None = None
@@ -227,10 +234,6 @@ class Controller:
         #: why the last GT_InitEcatComm failed (None: it succeeded, or none was made)
         self.init_error: Exception | None = None
         self._links_down = False  # some axis's slave was offline at the last cycle
-        #: [0] the controller time GT_Reset last counted GT_GetClock from (:attr:`reset_ns`),
-        #: in memory compiled code reads: the GT readers' C entries write a ``pClock`` from it
-        #: and the clock's time (gtecat.gt.centry.set_clock_ms)
-        self.origin = array("q", (0,))
         #: run first in a cycle, before its time is read: motion programs, whose GT calls
         #: may themselves wait for cycles (GT_AxisOn), so the cycle then starts later
         self.before_cycle: list[Callable[[], None]] = []
@@ -919,6 +922,11 @@ class Controller:
 
     # --- time -------------------------------------------------------------------------------
     def reset_clock(self) -> None:
+        """GT_Reset: GT_GetClock, and the master log's time with it, count from now; the log
+        says so, as its time goes back to 0 there."""
+        if self.reset_ns != self.clock.now_ns:
+            was = self.clock_ms()
+            self.log(f"GT_Reset: the controller's clock counts from 0 again (it read {was} ms).")
         self.reset_ns = self.clock.now_ns
 
     def clock_ms(self) -> int:

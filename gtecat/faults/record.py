@@ -4,6 +4,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
 * a header ``{"gtecat_recording": 1, "calls": N, ...}``: N call lines follow (a replay
   refuses a file that holds fewer, one cut short at a line's end, or more);
+  ``bus_config``: the ENI files and machine descriptions the session's buses were brought up
+  from, compared before a replay runs (:mod:`gtecat.faults.bus_config`);
 * one line per GT call: ``{"t": controller time in ns, "c": NAME, "a": [arguments], "r":
   return code, "k": {keywords}, "o": {index: value written back}}``, and ``"b"``: the
   controller time when the call began, where time passed since the call before (a
@@ -396,20 +398,36 @@ class Recorder(Listener):
             "cwd": os.getcwd(),
             "env": {k: v for k, v in os.environ.items() if k in _ENV},
         }
+        #: the configuration files of every bus brought up (gtecat.faults.bus_config): the
+        #: header's ``bus_config``, which the replay compares before it runs
+        self.bus_config: list[dict[str, str]] = []
 
     def start(self) -> Recorder:
+        from ..controller.core import Controller
         from . import injector
 
         tap(self)
         injector.OBSERVERS.append(self.fault_event)
+        Controller.bus_up_hooks.append(self.bus_up)
         return self
 
     def stop(self) -> None:
+        from ..controller.core import Controller
         from . import injector
 
         untap(self)
         if self.fault_event in injector.OBSERVERS:
             injector.OBSERVERS.remove(self.fault_event)
+        if self.bus_up in Controller.bus_up_hooks:
+            Controller.bus_up_hooks.remove(self.bus_up)
+
+    def bus_up(self, ctl: Any) -> None:
+        """A bus came up (``Controller.bus_up_hooks``): its configuration files noted."""
+        from .bus_config import noted
+
+        for note in noted(ctl):
+            if note not in self.bus_config:
+                self.bus_config.append(note)
 
     def before(self, name: str, args: tuple, kwargs: dict) -> Any:
         if self.thread is not None and threading.get_ident() != self.thread:
@@ -482,6 +500,8 @@ class Recorder(Listener):
         lines = list(self.lines)  # (a client's call may still be adding one: these, counted)
         calls = sum(1 for x in lines if x.startswith('{"t":'))  # a call's line, as after() writes
         head = {"gtecat_recording": FORMAT, "calls": calls, **self.meta, **self.where}
+        if self.bus_config:
+            head["bus_config"] = self.bus_config
         text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
@@ -798,6 +818,9 @@ def replay(
             gc.enable()
     try:
         with _where(head):
+            from .bus_config import check  # (the files as recorded: before anything runs)
+
+            check(head.get("bus_config"), eni, machine)
             return _replay(steps, eni, machine, head.get("cwd"), marks)
     finally:
         if freeze:
