@@ -159,8 +159,9 @@ def build_config(data: Mapping[str, Any], source: str = "<topology>") -> EniConf
         )
 
     slaves = []
+    shared: dict[object, Any] = {}
     for pos, table in enumerate(tables):
-        slaves.append(_slave(_Where(source, pos), pos, table))
+        slaves.append(_slave(_Where(source, pos), pos, table, shared))
     cfg = lay_out(
         EniConfig(
             source=source,
@@ -282,7 +283,10 @@ def _bool(where: _Where, table: Mapping[str, Any], key: str, default: bool) -> b
     return value
 
 
-def _slave(where: _Where, pos: int, t: Mapping[str, Any]) -> Slave:
+def _slave(where: _Where, pos: int, t: Mapping[str, Any], shared: dict[object, Any]) -> Slave:
+    """Slave ``pos``; ``shared`` holds the identities and init commands of the slaves before it,
+    so equal ones are one object (the model is immutable; a bus of 64 535 like drives would
+    otherwise hold 64 535 copies of them, as the XML reader never does)."""
     kind = t.get("kind")
     if kind not in _KIND_KEYS:
         raise where.error(f"kind must be one of servo, io, coupler, generic (got {kind!r})", "kind")
@@ -315,10 +319,15 @@ def _slave(where: _Where, pos: int, t: Mapping[str, Any]) -> Slave:
         revision_no=_int(where, t, "revision", 0),
         serial_no=_int(where, t, "serial", 0),
     )
+    identity = shared.setdefault(identity, identity)
     want_cmds = _bool(where, t, "init_cmds", kind == "servo")
     if want_cmds and not mailbox:
         raise where.error("init_cmds need a mailbox (mailbox = true)", "init_cmds")
-    cmds = assignment_cmds(rx, tx) if want_cmds else ()
+    cmds: tuple[InitCmd, ...] = ()
+    if want_cmds:
+        cmds = shared.get((rx, tx), ())
+        if not cmds:
+            cmds = shared[rx, tx] = assignment_cmds(rx, tx)
     return Slave(
         position=pos,
         name=name,
