@@ -331,7 +331,7 @@ def _cyclic(x: XmlOut, cfg: EniConfig, bases: dict[Direction, int]) -> None:
 
 
 #: ProcessImage variables written between two flushes
-_VARIABLES_PER_FLUSH = 512
+_VARIABLES_PER_FLUSH = 128
 
 
 def _process_image(x: XmlOut, cfg: EniConfig) -> None:
