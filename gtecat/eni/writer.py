@@ -94,46 +94,47 @@ class XmlOut:
     ``leaf`` one with only text.  Text collects in a list that :meth:`flush` hands to
     ``write`` (the writer flushes after each slave and every few hundred variables)."""
 
-    __slots__ = ("_buf", "_open", "_pending", "_write")
+    __slots__ = ("_buf", "_indent", "_open", "_pending", "_write")
 
     def __init__(self, write: Callable[[str], object]) -> None:
         self._write = write
         self._buf: list[str] = []
         self._open: list[str] = []
+        self._indent = _INDENT[0]  # before a child of the innermost open element
         self._pending = False  # the last start tag still lacks its ">" (no child yet)
 
-    def _start(self, tag: str, attrib: dict[str, str]) -> str:
+    def open(self, tag: str, **attrib: str) -> None:
+        buf = self._buf
+        if self._pending:
+            buf.append(">")
+        attrs = "".join(f' {k}="{_attr(v)}"' for k, v in attrib.items()) if attrib else ""
+        buf.append(f"{self._indent if self._open else ''}<{tag}{attrs}")
+        self._open.append(tag)
+        self._indent = _INDENT[len(self._open)]
+        self._pending = True
+
+    def leaf(self, tag: str, text: object = None) -> None:
+        """An element holding ``text`` only (``<Tag />`` for none); an ``int`` as it is,
+        anything else as its escaped ``str``. (A few hundred of these make a slave.)"""
         buf = self._buf
         if self._pending:
             buf.append(">")
             self._pending = False
-        if self._open:
-            buf.append(_INDENT[len(self._open)])
-        if not attrib:
-            return f"<{tag}"
-        return f"<{tag}" + "".join(f' {k}="{_attr(v)}"' for k, v in attrib.items())
-
-    def open(self, tag: str, **attrib: str) -> None:
-        self._buf.append(self._start(tag, attrib))
-        self._open.append(tag)
-        self._pending = True
-
-    def leaf(self, tag: str, text: object = None, **attrib: str) -> None:
-        start = self._start(tag, attrib)
         if text is None or text == "":
-            self._buf.append(start + " />")
+            buf.append(f"{self._indent}<{tag} />")
         elif type(text) is int:
-            self._buf.append(f"{start}>{text}</{tag}>")
+            buf.append(f"{self._indent}<{tag}>{text}</{tag}>")
         else:
-            self._buf.append(f"{start}>{_text(text)}</{tag}>")
+            buf.append(f"{self._indent}<{tag}>{_text(text)}</{tag}>")
 
     def close(self) -> None:
         tag = self._open.pop()
+        self._indent = _INDENT[len(self._open)]
         if self._pending:
             self._buf.append(" />")
             self._pending = False
         else:
-            self._buf.append(f"{_INDENT[len(self._open)]}</{tag}>")
+            self._buf.append(f"{self._indent}</{tag}>")
 
     def flush(self) -> None:
         if self._buf:
