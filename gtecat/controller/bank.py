@@ -78,7 +78,7 @@ from gtecat.drives.csp_bank import (
 from gtecat.drives.drive import Cia402Drive
 from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
 from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
-from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable
+from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable, idle_claimable
 from gtecat.drives.homing_bank import rest_constants as homing_rest_constants
 from gtecat.drives.homing_bank import return_constants as homing_return_constants
 from gtecat.drives.homing_bank import row_constants as homing_constants
@@ -745,6 +745,9 @@ class AxisBank:
         for name in _HM_U8:
             setattr(self, name, zi(n, bool))
         self.h_done = zi(n, np.uint8)  # a homing row's kind (homing_bank.row_kind): 0, 1, 2
+        #: the frozen rows (frz) whose servo is off: GT_GetSts's word without its servo-on bit
+        #: (the others stand in homing mode before a homing, the servo on)
+        self.frz_off = zi(n, bool)
         self.n_hm = self.n_frz = 0
         #: 60FDh bits whose change sends a row back before the cycle (an input a bank-aware
         #: hook samples every cycle: a capture unit's home input)
@@ -978,10 +981,12 @@ class AxisBank:
             return False
         return _within_safety(ax, res)
 
-    def _eligible_frozen(self, r: int) -> bool:
-        """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
-        every value of its cycle stays as it is, so the compiled cycle skips the row (the
-        image keeps the values the scalar objects wrote)."""
+    def _eligible_frozen(self, r: int, powered: bool = False) -> bool:
+        """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable),
+        or (``powered``) a servo-on axis whose drive stands in homing mode before a homing
+        (gtecat.drives.homing_bank.idle_claimable; the axis layer follows the drive as for a
+        servo-off one: AxisResources._post): every value of its cycle stays as it is, so the
+        compiled cycle skips the row (the image keeps the values the scalar objects wrote)."""
         if self.kernel is None:
             return False
         ax, res = self.axes[r], self.res[r]
@@ -1027,7 +1032,7 @@ class AxisBank:
             inside = -b.band <= err <= b.band
             if (inside and not b.arrived) or (not inside and (b._since is not None or b.arrived)):
                 return False  # bit 11 still changes with time
-        return not frozen_claimable(ch)
+        return not (idle_claimable(ch) if powered else frozen_claimable(ch))
 
     def _eligible_homing(self, r: int) -> bool:
         """An axis whose drive runs a homing search, moves back onto the home point found, or
@@ -1039,6 +1044,8 @@ class AxisBank:
         ax, res = self.axes[r], self.res[r]
         if not ax.servo_on or ax.link_lost or res._csp:
             return False
+        if self.csp.channels[r].homing is None:  # standing before a homing: frozen, powered
+            return self._eligible_frozen(r, powered=True)
         st = self._homing_hook(ax, res)
         if st is False:
             return False
@@ -1368,7 +1375,10 @@ class AxisBank:
         else:
             self.t_cur[r], self.t_len[r], self.t_end[r] = 0, 1, 0
         ch = self.csp.channels[r]
-        self.frz[r] = frozen = not ax.servo_on
+        # servo off, or on and standing in homing mode before a homing (_eligible_frozen)
+        off = not ax.servo_on
+        self.frz_off[r] = off
+        self.frz[r] = frozen = off or (ax.mode_cmd == _HOMING_MODE and ch.homing is None)
         # GT_GetSts's latched flags stay as they are while the row is in the bank
         # (_eligible_frozen, _latched_standing)
         self.latched[r] = latched
@@ -1949,7 +1959,7 @@ class AxisBank:
         b.arrived = bool(self.arrived[r])
         pl = res.profile.planner
         if self.frz[r]:
-            self.frz[r] = False
+            self.frz[r] = self.frz_off[r] = False
             ch = self.csp.channels[r]
             values, torque, acc = self._frozen.pop(r)
             for name, value in zip(FROZEN_ATTRS, values, strict=True):
@@ -2194,7 +2204,7 @@ class AxisBank:
         if self.n > _SMALL_BANK:
             return self.value(name, r)
         if name == "sts":  # (the flags only tested: numpy's bools; the latched word an int)
-            m, j, a, f = self.moving[r], self.jog[r], self.arrived[r], self.frz[r]
+            m, j, a, f = self.moving[r], self.jog[r], self.arrived[r], self.frz_off[r]
             lt = self.latched.item(r)
             return (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
         k = _ROW_PLANNED.get(name)
@@ -2245,7 +2255,7 @@ class AxisBank:
                     self.moving,
                     self.jog,
                     self.arrived,
-                    self.frz,
+                    self.frz_off,
                     self.latched,
                 )
                 flags = (
@@ -2275,7 +2285,7 @@ class AxisBank:
                 return words
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
+            return (sts | self.latched | np.where(self.frz_off, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             if self.n <= _SMALL_BANK:  # (a few rows: Python floats, no numpy temporaries)
                 vel, acc = self._enc_rates_lists()
