@@ -69,7 +69,6 @@ import numpy as np
 
 from gtecat.drives.csp_bank import (
     CW_ENABLED,
-    FROZEN_ATTRS,
     CspBank,
     claimable,
     frozen_claimable,
@@ -763,7 +762,8 @@ class AxisBank:
 
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
-        self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
+        #: row -> the constants of its last load that _reindex's flags read (_load)
+        self._consts: dict[int, tuple] = {}
         #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
         #: back in the same move, instead of computed again
         self._kept: dict[int, tuple] = {}
@@ -808,7 +808,9 @@ class AxisBank:
             self.moving & alive & (self.nseg <= 0)
         )
         g_claimed = self._g_claimed
-        self._rx_idx = self._rx_all[g_claimed[self._rx_group]]
+        sel = g_claimed[self._rx_group]
+        self._rx_idx = self._rx_all[sel]
+        self._rx_gi = self._rx_group[sel]  # (the group of each: _release_written)
         buf = self.ctl.master.image.buffer
         self._rx_ref = buf.take(self._rx_idx).tobytes()
         if len(self._rx_all):
@@ -1249,7 +1251,6 @@ class AxisBank:
         g.claimed = True
         gi = self._gi[id(g)]
         self._g_claimed[gi] = True
-        self._loaded = True
         for obj in self._guarded_objects(g):
             key = id(obj)
             _OWNER[key] = (self, gi)
@@ -1293,6 +1294,22 @@ class AxisBank:
         b = res.band
         if not again:
             s = ax.pos_scale
+            # the constants _reindex's flags look at: looked at again only when a row's changed
+            # (a drive given back and taken again mostly brings the same)
+            key = (
+                s,
+                ax.drive_offset,
+                res.prf_link.ratio,
+                res.prf_link.offset,
+                res.enc_link.ratio,
+                res.enc_link.offset,
+                enc.external,
+                enc.sense,
+                b.band,
+            )
+            if self._consts.get(r) != key:
+                self._consts[r] = key
+                self._loaded = True
             self.unit2[r] = float(1 << s)
             self.unit[r] = 1.0 / (1 << s)
             self.drive_offset[r] = ax.drive_offset
@@ -1382,13 +1399,8 @@ class AxisBank:
         # GT_GetSts's latched flags stay as they are while the row is in the bank
         # (_eligible_frozen, _latched_standing)
         self.latched[r] = latched
-        if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
+        if frozen:  # nothing of its cycle changes (_eligible_frozen): CspBank.rested at release
             self.dwatch[r], self.dpost[r] = watch, 0
-            self._frozen[r] = (
-                tuple(getattr(ch, name) for name in FROZEN_ATTRS),
-                ch.mech.torque,
-                ch.mech.acc,
-            )
             self.enc_step0[r] = self.enc_step1[r] = 0.0  # the encoder stands: speed 0
             self.hm[r] = False
             return
@@ -1884,7 +1896,18 @@ class AxisBank:
                     _set(obj, "__class__", cls.__base__)
             g.claimed = False
             self._g_claimed[self._gi[id(g)]] = False
-        self.csp.store(rows)
+        frz = self.frz
+        if any(frz[r] for r in rows):
+            # a frozen row's channel holds what its skipped cycles would have left
+            csp = self.csp
+            moved = [r for r in rows if not frz[r]]
+            if moved:
+                csp.store(moved)
+            for r in rows:
+                if frz[r]:
+                    csp.rested(r)
+        else:
+            self.csp.store(rows)
         for r in rows:
             self._store(r)
         self.releases += 1
@@ -1958,13 +1981,8 @@ class AxisBank:
         b._since = None if since < 0 else since
         b.arrived = bool(self.arrived[r])
         pl = res.profile.planner
-        if self.frz[r]:
+        if self.frz[r]:  # (its channel as it was: CspBank.rested)
             self.frz[r] = self.frz_off[r] = False
-            ch = self.csp.channels[r]
-            values, torque, acc = self._frozen.pop(r)
-            for name, value in zip(FROZEN_ATTRS, values, strict=True):
-                setattr(ch, name, value)
-            ch.mech.torque, ch.mech.acc = torque, acc
             return
         if self.hm[r]:
             self.hm[r] = self.h_done[r] = False
@@ -3023,8 +3041,8 @@ class AxisBank:
         now = self.ctl.master.image.buffer.take(idx)
         if len(now) != len(ref) or now.tobytes() == ref:
             return
-        hit = set(idx[now != np.frombuffer(ref, np.uint8)].tolist())
-        changed = [g for g in self.groups if g.claimed and hit.intersection(g.rx_bytes.tolist())]
+        hit = sorted(set(self._rx_gi[now != np.frombuffer(ref, np.uint8)].tolist()))
+        changed = [g for g in map(self.groups.__getitem__, hit) if g.claimed]
         if changed:
             self._release_groups(changed)
 

@@ -116,7 +116,6 @@ _WRAPPED = frozenset(
     ("position_actual", "position_demand", "velocity_actual", "following_error_actual")
 )
 
-#: a channel's values that stay as they are while it rests unpowered (frozen rows)
 FROZEN_ATTRS = (
     "position_actual",
     "position_demand",
@@ -556,6 +555,16 @@ class CspBank:
                     x = int(values[k])
                     setattr(ch, name, wrap32(x) if name in wrapped else x)
             ch.mode_display = ch.mode
+
+    def rested(self, r: int) -> None:
+        """Give row ``r`` back after cycles the bank skipped whole (a frozen row: its channel
+        rests unpowered, :func:`frozen_claimable`, or stands in homing mode before a homing,
+        :func:`gtecat.drives.homing_bank.idle_claimable`): each of those steps would have
+        left every value of the channel as it is, and nothing touched the channel meanwhile
+        (the bank's guard gives a row back first), so its objects hold them already; only
+        its count of cycles moves on."""
+        self.channels[r].cycle += self.cycles - int(self.start[r])
+        self.start[r] = self.cycles
 
     def _one_row(self, r: int) -> dict[str, int] | None:
         """:meth:`_row_outputs` of row ``r`` alone in Python floats: the same IEEE operations
