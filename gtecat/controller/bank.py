@@ -769,7 +769,9 @@ class AxisBank:
         self._kept: dict[int, tuple] = {}
         #: per row, the kind of its planner when bank_modes.links last looked (-1: not yet)
         self._row_link: np.ndarray | None = None
-        self._claimed_sets: dict[bytes, frozenset[int]] = {}
+        #: per claimed pattern, what follows from it alone (_reindex)
+        self._claimed_sets: dict[bytes, tuple] = {}
+        self._axes_seen: list[Any] | None = None
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -793,13 +795,14 @@ class AxisBank:
             self.any_band = bool(np.count_nonzero(self.band > 0))
             self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
         self._count_standing()
-        self.n_jog = int(np.count_nonzero(self.jog & alive))
-        self.n_hm = int(np.count_nonzero(self.hm & alive))
-        self.n_rest = int(np.count_nonzero((self.h_done == 1) & alive)) if self.n_hm else 0
-        self.n_frz = int(np.count_nonzero(self.frz & alive))
-        self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
-        self.any_post = bool(np.count_nonzero(self.dpost[alive]))
-        self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
+        # (a row given back has these cleared: _put_back, _store)
+        self.n_jog = int(np.count_nonzero(self.jog))
+        self.n_hm = int(np.count_nonzero(self.hm))
+        self.n_rest = int(np.count_nonzero(self.h_done == 1)) if self.n_hm else 0
+        self.n_frz = int(np.count_nonzero(self.frz))
+        self.any_watch = bool(np.count_nonzero(self.dwatch))
+        self.any_post = bool(np.count_nonzero(self.dpost))
+        self.any_lvel = bool(np.count_nonzero(self.lvel))
         self.band_dirty = True
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
         self.n_moving = int(np.count_nonzero(self.moving & alive))
@@ -808,22 +811,6 @@ class AxisBank:
             self.moving & alive & (self.nseg <= 0)
         )
         g_claimed = self._g_claimed
-        sel = g_claimed[self._rx_group]
-        self._rx_idx = self._rx_all[sel]
-        self._rx_gi = self._rx_group[sel]  # (the group of each: _release_written)
-        buf = self.ctl.master.image.buffer
-        self._rx_ref = buf.take(self._rx_idx).tobytes()
-        if len(self._rx_all):
-            np.take(buf, self._rx_all, out=self._rx_snap)
-        # the slaves the bus leaves to the bank: one set per claimed pattern, kept (the bank
-        # gives back and takes the same few), so the bus finds its plan for it by identity
-        key = g_claimed.tobytes()
-        claimed = self._claimed_sets.get(key)
-        if claimed is None:
-            if len(self._claimed_sets) > 256:
-                self._claimed_sets.clear()
-            claimed = self._claimed_sets[key] = frozenset(self._g_pos[g_claimed].tolist())
-        self.ctl.backend.claimed = claimed
         rows = self._rows_of_axes
         axis_list = self.ctl._axis_list
         if rows is None or len(rows) != len(axis_list):
@@ -831,10 +818,34 @@ class AxisBank:
             rows = self._rows_of_axes = [row_of.get(id(ax), -1) for ax in axis_list]
             self._rows_np = np.array(rows, np.intp)
             self._rows_in = self._rows_np >= 0
-        # the controller's axes the bank does not run now, in its order
-        rows_np = self._rows_np
-        run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
-        self.ctl._run_axes = list(compress(axis_list, run.tolist()))
+            self._claimed_sets.clear()
+        elif axis_list is not self._axes_seen:
+            self._claimed_sets.clear()  # (its axes' run list: another list of the same axes)
+        self._axes_seen = axis_list
+        # what follows from the claimed pattern alone, kept per pattern (the bank gives back
+        # and takes the same few): the slaves the bus leaves to the bank (one set per
+        # pattern, so the bus finds its plan for it by identity), the claimed output bytes
+        # and their groups, the controller's axes the bank does not run, in its order
+        key = g_claimed.tobytes() + alive.tobytes()
+        kept = self._claimed_sets.get(key)
+        if kept is None:
+            if len(self._claimed_sets) > 256:
+                self._claimed_sets.clear()
+            sel = g_claimed[self._rx_group]
+            run = ~(self._rows_in & alive.take(np.maximum(self._rows_np, 0)))
+            kept = self._claimed_sets[key] = (
+                frozenset(self._g_pos[g_claimed].tolist()),
+                self._rx_all[sel],
+                self._rx_group[sel],  # (the group of each byte: _release_written)
+                list(compress(axis_list, run.tolist())),
+            )
+        claimed, self._rx_idx, self._rx_gi, run_axes = kept
+        buf = self.ctl.master.image.buffer
+        self._rx_ref = buf.take(self._rx_idx).tobytes()
+        if len(self._rx_all):
+            np.take(buf, self._rx_all, out=self._rx_snap)
+        self.ctl.backend.claimed = claimed
+        self.ctl._run_axes = run_axes.copy()
         self._lists = {}  # (a new one: _lists' docs)
         self._sts_epoch = 0  # (the status words made again)
         # the kernel keeps its binding: a claim and a release write the rows in place (only
@@ -1964,6 +1975,9 @@ class AxisBank:
         self.layout += 1
         if r != self._stepping:  # (a row stepped in place: its objects hold its state)
             self._put_back(r)
+        # (_reindex counts these over every row: a row given back has them clear; jog, hm,
+        # h_done and frz are cleared by _put_back, and a row stepped in place has none)
+        self.dwatch[r] = self.dpost[r] = self.lvel[r] = 0
 
     def _put_back(self, r: int) -> None:
         """Row ``r``'s state into its axis objects (its drive aside), as a release leaves them
