@@ -1164,7 +1164,7 @@ class AxisBank:
                     c.banked = True
             changed = True
         if loaded:
-            self.csp._flags()
+            self.csp.after_loads()
         if changed:
             self._reindex()
         if self.n_alive == self.n:
@@ -1198,7 +1198,7 @@ class AxisBank:
             if singles is None:
                 singles = self._singles = [([g], [], False) for g in self.groups]
             # the groups out of the bank alone (refresh passes over the claimed ones)
-            return [singles[gi] for gi in np.flatnonzero(~self._g_claimed).tolist()]
+            return [singles[gi] for gi in (~self._g_claimed).nonzero()[0].tolist()]
         group_of = self.group_of
         parent = list(range(len(self.groups)))
 
@@ -1592,6 +1592,7 @@ class AxisBank:
                 self._put_probe(r)
             on = bool(probe.function & 0x0101)
             csp.tpw[r] = on
+            csp.row_changed(r)
             csp.tp_lo[r], csp.tp_hi[r] = (
                 probe.quiet_bounds(float(csp.pos[r])) if on else (-np.inf, np.inf)
             )

@@ -237,6 +237,11 @@ class CspBank:
         self.lim, self.nlim, self.half_lim = f(n), f(n), f(n)
         self.fe_running = self.fe_next = False  # some row's following-error timer runs
         self._din_safe = 0  # cycles in which no row can reach a limit switch
+        #: a load changed what :meth:`_flags` looks at (the values of each row's last load)
+        self._flags_due = True
+        self._row_flags: dict[int, tuple] = {}
+        self._din_zero: np.ndarray | None = None
+        self.nvmax = f(n)
         for r, ch in enumerate(self.channels):
             self.load(r)
             for bit, win in ((2, ch._hs), (16, ch._p1), (17, ch._p2)):
@@ -262,6 +267,8 @@ class CspBank:
         before the next step or output."""
         ch = self.channels[r]
         m = ch.mech
+        if self.din is self._din_zero:  # (the shared zeros of cycles off every switch)
+            self.din = self._din_zero.copy()
         self.din[r] = ch.digital_inputs
         self.target[r] = ch.target_position
         self._din_safe = 0
@@ -273,6 +280,7 @@ class CspBank:
         self.limited[r] = m.limited
         self.sw_limited[r] = ch.sw_limited
         self.vmax[r], self.amax[r], self.a_rated[r] = m.vmax, m.amax, m.a_rated
+        self.nvmax[r] = -self.vmax[r]
         self.visc[r], self.kp[r], self.kff[r] = m.visc, m.kp, m.kff
         if self._dt:
             self._prepare_row(r, self._dt)
@@ -293,7 +301,24 @@ class CspBank:
         on = bool(probe.function & 0x0101)
         self.tpw[r] = on
         self.tp_lo[r], self.tp_hi[r] = probe.quiet_bounds(m.pos) if on else (-np.inf, np.inf)
+        # what _flags looks at of this row: looked at again only when it changed (a drive
+        # given back and taken again mostly brings the same)
+        key = (ch.pos_offset, ch.enc_offset, lo, hi, w, on)
+        if self._row_flags.get(r) != key:
+            self._row_flags[r] = key
+            self._flags_due = True
         if flags:
+            self._flags()
+
+    def row_changed(self, r: int) -> None:
+        """Row ``r``'s values that :meth:`_flags` reads were changed outside :meth:`load`
+        (its touch probe armed in the bank): its next load looks at them again."""
+        self._row_flags.pop(r, None)
+
+    def after_loads(self) -> None:
+        """:meth:`_flags` after loads with ``flags`` False, when one changed what it looks at
+        (the values it reads change only at a load)."""
+        if self._flags_due:
             self._flags()
 
     def _prepare(self, dt: float) -> None:
@@ -314,6 +339,7 @@ class CspBank:
 
     def _flags(self) -> None:
         """Which optional parts of the cycle any row needs (skipped when none does)."""
+        self._flags_due = False
         self.any_pos_offset = bool(np.count_nonzero(self.pos_offset))
         self.any_off = bool(np.count_nonzero(self.off))
         # 607Ah is an int32: limits at (or beyond) the int32 range never clamp it
