@@ -1002,6 +1002,9 @@ class AxisBank:
         compiled cycle skips the row (the image keeps the values the scalar objects wrote)."""
         if self.kernel is None:
             return False
+        ch = self.csp.channels[r]
+        if powered and idle_claimable(ch):
+            return False  # (first: an axis just switched waits for its drive's 6061h here)
         ax, res = self.axes[r], self.res[r]
         if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error or ax.cw == CW_QUICK_STOP:
             return False  # (a quick stop the drive finishes: its controlword changes after it)
@@ -1025,7 +1028,6 @@ class AxisBank:
             return False  # the plan does not follow 6064h yet
         if ax._tp_acc.get() != ax._pos_acc.get():
             return False  # 607Ah does not hold 6064h yet
-        ch = self.csp.channels[r]
         s = res.safety
         if s.active:
             # the flags its cycle would latch (AxisResources._post) are latched already - a
@@ -1045,7 +1047,7 @@ class AxisBank:
             inside = -b.band <= err <= b.band
             if (inside and not b.arrived) or (not inside and (b._since is not None or b.arrived)):
                 return False  # bit 11 still changes with time
-        return not (idle_claimable(ch) if powered else frozen_claimable(ch))
+        return powered or not frozen_claimable(ch)
 
     def _eligible_homing(self, r: int) -> bool:
         """An axis whose drive runs a homing search, moves back onto the home point found, or

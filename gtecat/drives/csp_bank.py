@@ -240,6 +240,8 @@ class CspBank:
         #: a load changed what :meth:`_flags` looks at (the values of each row's last load)
         self._flags_due = True
         self._row_flags: dict[int, tuple] = {}
+        #: the (kp, kff, amax, dt) each row's _prepare_row last computed with
+        self._prepared: dict[int, tuple] = {}
         self._din_zero: np.ndarray | None = None
         self.nvmax = f(n)
         for r, ch in enumerate(self.channels):
@@ -283,7 +285,10 @@ class CspBank:
         self.nvmax[r] = -self.vmax[r]
         self.visc[r], self.kp[r], self.kff[r] = m.visc, m.kp, m.kff
         if self._dt:
-            self._prepare_row(r, self._dt)
+            key = (m.kp, m.kff, m.amax, self._dt)
+            if self._prepared.get(r) != key:  # (a drive taken again mostly brings the same)
+                self._prepare_row(r, self._dt)
+                self._prepared[r] = key
         self.off[r] = ch.enc_offset
         self.pos_offset[r] = ch.pos_offset
         lo, hi = ch.sw_limit_min, ch.sw_limit_max
@@ -325,6 +330,7 @@ class CspBank:
         """``Mechanics._prepare`` per row, with math.exp (numpy's exp may differ by an ulp)."""
         self._dt = dt
         self._din_safe = 0
+        self._prepared.clear()
         for r in range(len(self.channels)):
             self._prepare_row(r, dt)
 
