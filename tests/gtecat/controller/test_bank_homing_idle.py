@@ -8,13 +8,14 @@ different cycles (methods 35 and 37 at once, a limit and a home-switch search), 
 write of its controlword, one is switched back to CSP, one switched off and on again, one
 stands on its negative limit switch (its flag latched, GT_ClrSts on it), one gets its
 parameters again while it stands.  Compared exactly with the bank off: every axis's
-GT_GetSts word, planned and encoder positions, GT_GetEcatHomingStatus and the whole GT raw
-image after every cycle the loop sees, and the drives' mechanics at the end.
+GT_GetSts word, planned and encoder positions, GT_GetEcatHomingStatus, the enable outputs
+(GT_GetDo) and the whole GT raw image after every cycle the loop sees, and the drives'
+mechanics at the end.
 """
 
 from __future__ import annotations
 
-from ctypes import c_ubyte
+from ctypes import byref, c_long, c_ubyte
 
 import pytest
 
@@ -86,7 +87,9 @@ def _run(machine: str, bank: str) -> tuple[list, int]:
             if k == 330:
                 _ok(gt.GT_SetHomingMode(1, 8), "axis 1 back to CSP")
             gt.GTE_Wait(1)
-            trace.append(_sample(size))
+            enabled = c_long()  # the axes' enable outputs (servo on): the rows' own bit
+            _ok(gt.GT_GetDo(gt.MC_ENABLE, byref(enabled)), "enable outputs")
+            trace.append((*_sample(size), enabled.value))
         bank = ctl.bank
         frozen = bank.frozen_rows_run if bank is not None else 0
         trace.append(_mechanics(ctl))
