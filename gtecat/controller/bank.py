@@ -805,10 +805,11 @@ class AxisBank:
         self.any_lvel = bool(np.count_nonzero(self.lvel))
         self.band_dirty = True
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
-        self.n_moving = int(np.count_nonzero(self.moving & alive))
+        moving = self.moving & alive
+        self.n_moving = int(np.count_nonzero(moving))
         self._refill_in = 0  # look for tables to fill at the next cycle
-        self._c_fill = self.kernel is not None and not np.count_nonzero(
-            self.moving & alive & (self.nseg <= 0)
+        self._c_fill = self.kernel is not None and not (
+            self.n_moving and np.count_nonzero(moving & (self.nseg <= 0))
         )
         g_claimed = self._g_claimed
         rows = self._rows_of_axes
@@ -843,7 +844,7 @@ class AxisBank:
         buf = self.ctl.master.image.buffer
         self._rx_ref = buf.take(self._rx_idx).tobytes()
         if len(self._rx_all):
-            np.take(buf, self._rx_all, out=self._rx_snap)
+            buf.take(self._rx_all, out=self._rx_snap)
         self.ctl.backend.claimed = claimed
         self.ctl._run_axes = run_axes.copy()
         self._lists = {}  # (a new one: _lists' docs)
