@@ -1467,9 +1467,10 @@ class AxisBank:
             self.dwatch[r], self.dpost[r] = watch, 0
 
     def rests(self, ax: Any) -> bool:
-        """``ax``'s row is in the bank frozen (servo off, its drive resting unpowered:
-        :meth:`_eligible_frozen`): the compiled cycles skip it, so its process values in the
-        image - 6041h among them - stay as they are over every cycle the bank runs."""
+        """``ax``'s row is in the bank frozen (servo off, its drive resting unpowered, or
+        standing in homing mode before a homing: :meth:`_eligible_frozen`): the compiled
+        cycles skip it, so its process values in the image - 6041h among them - stay as they
+        are over every cycle the bank runs."""
         r = self._row_of.get(id(ax)) if self.n_alive else None
         return r is not None and bool(self.alive[r] and self.frz[r])
 
