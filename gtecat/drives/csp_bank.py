@@ -170,7 +170,14 @@ def frozen_claimable(ch: Channel) -> str:
         return "moving"
     if m.limited or (m.pos == 0.0 and math.copysign(1.0, m.pos) < 0):
         return "moving"
-    if ch.dpos != m.pos or ch.dvel != 0.0:
+    return standing_reason(ch)
+
+
+def standing_reason(ch: Channel) -> str:
+    """What a channel whose cycle changes nothing needs besides its own state's conditions
+    (:func:`frozen_claimable`, :func:`gtecat.drives.homing_bank.idle_claimable`): the
+    demand on the motor at rest, no touch probe, 607Ah on 6064h ("" when so)."""
+    if ch.dpos != ch.mech.pos or ch.dvel != 0.0:
         return "moving"
     if ch.tp_function or ch._tp_applied or ch.probe.function:
         return "touch probe"

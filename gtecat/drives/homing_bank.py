@@ -45,7 +45,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .cia402 import State
-from .csp_bank import CW_ENABLED, running_reason
+from .csp_bank import CW_ENABLED, running_reason, standing_reason
 from .homing import HomingPhase
 from .homing_methods import Signal
 from .modes import OpMode
@@ -169,13 +169,7 @@ def idle_claimable(ch: Channel) -> str:
             return "moving"
     if m.vel != 0.0 or m.acc != 0.0 or m.torque != 0.0 or m.limited:
         return "moving"
-    if ch.dpos != m.pos or ch.dvel != 0.0:
-        return "moving"
-    if ch.tp_function or ch._tp_applied or ch.probe.function:
-        return "touch probe"
-    if ch.target_position != ch.position_actual:
-        return "607Ah not yet on 6064h"
-    return ""
+    return standing_reason(ch)
 
 
 def rest_constants(h: Homing) -> dict[str, float]:
