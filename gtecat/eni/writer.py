@@ -307,7 +307,7 @@ def _cyclic(x: XmlOut, cfg: EniConfig, bases: dict[Direction, int]) -> None:
     us = cfg.cycle_time_ns / 1000
     x.leaf("CycleTime", int(us) if us == int(us) else us)
     size = {Direction.OUT: cfg.outputs_bytes, Direction.IN: cfg.inputs_bytes}
-    for frame in cyclic_frames(cfg, bases):
+    for frame in cyclic_frames(cfg, bases) or [[]]:  # (no process data: an empty Frame)
         x.open("Frame")
         for c in frame:
             kind = KIND[c.direction]
