@@ -99,7 +99,9 @@ def _cut(starts: Sequence[int], ends: Sequence[int], pos: int, limit: int) -> tu
     return limit, False  # one cluster larger than the room: cut inside it
 
 
-def _wkc(cmds: list[tuple[Direction, int, int]], spans: dict[Direction, list[tuple[int, int]]]):
+def _wkc(
+    cmds: list[tuple[Direction, int, int]], spans: dict[Direction, list[tuple[int, int]]]
+) -> list[int]:
     """Per command (direction, start, end): how many slaves' spans it overlaps."""
     counts = [0] * len(cmds)
     for d in (Direction.OUT, Direction.IN):

@@ -122,7 +122,7 @@ def check_frames(cfg: EniConfig) -> list[list[Any]]:
 
 
 @settings(
-    max_examples=examples(150, 15), deadline=None, suppress_health_check=[HealthCheck.too_slow]
+    max_examples=examples(150, 10), deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 @given(buses())
 def test_every_frame_fits_and_the_commands_cover_each_image_once(cfg: EniConfig) -> None:
