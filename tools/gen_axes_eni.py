@@ -9,7 +9,10 @@ leaves 6060h/6061h out (the controller then reaches them by SDO).  The file is
 built by :mod:`gtecat.eni.topology` and written by :mod:`gtecat.eni.writer`, the same path as
 ``gtecat eni new``, slave by slave as it is made: any count from 1 to 65 535 (the most an
 EtherCAT bus holds) is written in memory that grows with the model only (about 6 kB a
-drive; 65 535 drives: 1.3 GB of XML).  The benchmarks import :func:`write_axes_eni`.
+drive; 65 535 drives: 1.3 GB of XML).  The cyclic process data goes in one ``Frame`` up to
+81 drives (7 output + 11 input bytes each, 1,498 bytes of EtherCAT in an Ethernet frame),
+in several beyond (:mod:`gtecat.eni.cyclic`: 300 drives take four).  The benchmarks import
+:func:`write_axes_eni`.
 """
 
 from __future__ import annotations

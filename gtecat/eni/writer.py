@@ -16,7 +16,9 @@ topology builder makes (source and lines aside):
   (:mod:`gtecat.eni.register_cmds`) - and the master's ``BeforeSlave`` commands in
   ``Config/Master/InitCmds``; the readers ignore them (they follow from the rest);
 * ``Cyclic`` (cycle time in microseconds; an LWR of the output image and an LRD of the input
-  image, at separate logical addresses: :func:`gtecat.eni.register_cmds.logical_bases`);
+  image, at separate logical addresses: :func:`gtecat.eni.register_cmds.logical_bases`), in
+  one ``Frame``, or cut into several where they would not fit one Ethernet frame (1,498
+  bytes of EtherCAT: :mod:`gtecat.eni.cyclic`);
 * ``ProcessImage`` with ``ByteSize`` and one ``Variable`` per mapped entry.
 
 The text is written while it is made, element by element, laid out as
@@ -34,11 +36,12 @@ from io import StringIO
 from pathlib import Path
 from typing import Protocol
 
+from .cyclic import cyclic_frames
 from .model import Direction, EniConfig, InitCmd, Pdo, Slave, Variable
 from .register_cmds import (
+    KIND,
     MAILBOX,
     SM_DEFAULT,
-    Command,
     RegisterCmd,
     has_mailbox,
     logical_bases,
@@ -279,12 +282,6 @@ def _register_cmds(x: XmlOut, cmds: Iterable[RegisterCmd]) -> None:
     x.close()
 
 
-def _wkc(slaves: Iterable[Slave], direction: Direction) -> int:
-    """Expected working counter of the LWR (outputs) or LRD (inputs): +1 per slave that
-    takes or gives data in that direction (ETG.1000.4 5.4)."""
-    return sum(1 for s in slaves if (s.outputs if direction == Direction.OUT else s.inputs))
-
-
 def _slave(x: XmlOut, s: Slave, bases: dict[Direction, int]) -> None:
     x.open("Slave")
     x.open("Info")
@@ -309,25 +306,27 @@ def _cyclic(x: XmlOut, cfg: EniConfig, bases: dict[Direction, int]) -> None:
     x.open("Cyclic")
     us = cfg.cycle_time_ns / 1000
     x.leaf("CycleTime", int(us) if us == int(us) else us)
-    x.open("Frame")
-    for direction, command, size, comment in (
-        (Direction.OUT, Command.LWR, cfg.outputs_bytes, "outputs"),
-        (Direction.IN, Command.LRD, cfg.inputs_bytes, "inputs"),
-    ):
-        if not size:
-            continue
-        x.open("Cmd")
-        x.leaf("State", "SAFEOP")
-        x.leaf("State", "OP")
-        x.leaf("Comment", f"process data {comment}")
-        x.leaf("Cmd", int(command))
-        x.leaf("Addr", bases[direction])
-        x.leaf("DataLength", size)
-        x.leaf("Cnt", _wkc(cfg.slaves, direction))
-        x.leaf("InputOffs", 0)
-        x.leaf("OutputOffs", 0)
+    size = {Direction.OUT: cfg.outputs_bytes, Direction.IN: cfg.inputs_bytes}
+    for frame in cyclic_frames(cfg, bases) or [[]]:  # (no process data: an empty Frame)
+        x.open("Frame")
+        for c in frame:
+            kind = KIND[c.direction]
+            x.open("Cmd")
+            x.leaf("State", "SAFEOP")
+            x.leaf("State", "OP")
+            if c.length == size[c.direction]:
+                x.leaf("Comment", f"process data {kind}")
+            else:
+                last = c.offset + c.length - 1
+                x.leaf("Comment", f"process data {kind} {c.offset}..{last}")
+            x.leaf("Cmd", int(c.command))
+            x.leaf("Addr", c.address)
+            x.leaf("DataLength", c.length)
+            x.leaf("Cnt", c.wkc)
+            x.leaf("InputOffs", c.offset)
+            x.leaf("OutputOffs", c.offset)
+            x.close()
         x.close()
-    x.close()
     x.close()
 
 

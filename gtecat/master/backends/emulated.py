@@ -25,6 +25,7 @@ from gtecat.drives.coe import advance_counter, next_counter
 from gtecat.drives.io_slaves import IoSlave, look_at_fields
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
+from gtecat.eni.cyclic import MAX_DATAGRAM_DATA
 from gtecat.eni.layout import Layout
 from gtecat.eni.model import Direction
 
@@ -248,8 +249,27 @@ class EmulatedBackend(Backend):
                 image.from_slave(inp, slave.tx)
                 wkc += 1
         if self.capture is not None:
-            self.capture.cycle(t_ns, bytes(image.view), image.outputs_bytes, wkc)
+            self._capture_cycle(t_ns, image, wkc)
         return wkc
+
+    def _capture_cycle(self, t_ns: int, image: ProcessImage, wkc: int) -> None:
+        """The cycle into the capture, with each answering slave's share of the working
+        counter where its bytes lie (what a capture in several frames counts per frame)."""
+        assert self.capture is not None
+        view = bytes(image.view)
+        shares = []
+        if len(view) > MAX_DATAGRAM_DATA:
+            base = {Direction.OUT: 0, Direction.IN: image.outputs_bytes}
+            for slave, out, inp in self._plan:
+                if slave.position in self.unplugged:
+                    continue
+                claimed = slave.position in self._claimed  # the bank's: in OP
+                st = slave.al_state
+                for seg, add, counted in ((out, 2, st == _OP), (inp, 1, st >= _SAFEOP)):
+                    if seg is not None and (claimed or counted):
+                        a = base[seg.direction] + seg.logical_bit // 8
+                        shares.append((a, a + (seg.logical_bit % 8 + seg.bit_len + 7) // 8, add))
+        self.capture.cycle(t_ns, view, image.outputs_bytes, wkc, shares)
 
     def steady(self) -> bool:
         """An exchange now would change nothing: no hook, capture or cable pulled, and every
