@@ -467,6 +467,7 @@ static void spin_done(int answered_while_spinning, long budget)
  * a refusal (older kernels: EINVAL, E2BIG; a sandbox: EPERM) is silent.  The controller's
  * serving thread asks for the same (gtecat/scheduling.py: short_slice). */
 #define GTE_DEFAULT_SLICE_US 100
+#if !defined(_WIN32) /* gts.dll asks for nothing: Windows has no such slice */
 static long slice_us(void)
 {
     const char *v = setting("GTECAT_SLICE_US");
@@ -478,6 +479,7 @@ static long slice_us(void)
     }
     return GTE_DEFAULT_SLICE_US;
 }
+#endif
 
 #if defined(__linux__) && defined(SYS_sched_setattr) && defined(SYS_sched_getattr)
 struct gte_sched_attr { /* the kernel's struct sched_attr, version 0 (48 bytes) */
