@@ -1,4 +1,4 @@
-"""Real-time scheduling of gtecat's own server processes (``gtecat serve``, ``gtecat
+"""Real-time scheduling and time slices of gtecat's own server processes (``gtecat serve``, ``gtecat
 controller`` and the controller libgts starts).
 
 A server that answers requests must not wait behind other work on a busy host: a normal
@@ -21,6 +21,10 @@ Decisions:
   of every second (``sched_rt_runtime_us``) and takes its CPU from everything else meanwhile;
   a real-time server sleeps between requests and spins only for a bounded time
   (:data:`RT_SPIN_CAP_US`).
+* **A short time slice** (:func:`short_slice`, Linux 6.12 and later, no privilege needed):
+  the serving thread asks for 100 us; libgts asks the same for each thread of a program
+  that calls it.  A woken thread with a shorter slice than the running one gets the CPU at
+  once where it has not used more than its share; its share itself does not change.
 * The decision (:func:`take`) gets the call that sets the policy injected, so the whole
   permitted / refused / off logic is tested without privileges.
 """
