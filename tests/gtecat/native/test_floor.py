@@ -44,7 +44,7 @@ def test_an_idle_controller_looks_every_ten_ms_and_at_once_while_in_debt():
     debt left over from a long sleep it looks again at once."""
     from gtecat.native.floor import IDLE_LOOK_S
 
-    clock, floor, wall, _ = _floor()
+    _, floor, wall, _ = _floor()
     assert floor.idle_timeout() == IDLE_LOOK_S == 0.01
     floor.budget_s = 0.0  # one cycle per look: a long sleep leaves a debt
     wall[0] += 5_000_000
