@@ -247,7 +247,9 @@ def _sched_attr_calls() -> SliceCalls | None:
     return get, put
 
 
-def short_slice(us: int, calls: SliceCalls | bool | None = None) -> str:
+def short_slice(
+    us: int, calls: SliceCalls | bool | None = None, *, reset_on_fork: bool = False
+) -> str:
     """Ask the kernel for a time slice of ``us`` microseconds for the calling thread (its
     ``sched_attr.sched_runtime``; Linux 6.12 and later, no privilege needed); words for a
     status line, "" where nothing changed.
@@ -261,7 +263,8 @@ def short_slice(us: int, calls: SliceCalls | bool | None = None) -> str:
     its CPU is preempted more often; not its share (its nice value, its weight).
 
     Asked only of a SCHED_OTHER thread whose slice is longer (a shorter one chosen by the
-    program is kept); its nice value and reset-on-fork flag stay.  A kernel without custom
+    program is kept); its nice value and reset-on-fork flag stay (``reset_on_fork``: set it,
+    so that threads and processes the thread starts get the default slice).  A kernel without custom
     slices reports none and is not asked; a refusal (EINVAL or E2BIG from an older kernel,
     EPERM from a sandbox) is not an error.  ``calls`` (sched_getattr, sched_setattr) are
     the system's unless given (tests; False: a system without them)."""
@@ -278,7 +281,8 @@ def short_slice(us: int, calls: SliceCalls | bool | None = None) -> str:
     if policy != getattr(os, "SCHED_OTHER", 0) or runtime <= us * 1000:
         return ""
     try:
-        put((_SCHED_ATTR.size, policy, flags & _RESET_ON_FORK, nice, prio, us * 1000, 0, 0))
+        keep = flags & _RESET_ON_FORK | (_RESET_ON_FORK if reset_on_fork else 0)
+        put((_SCHED_ATTR.size, policy, keep, nice, prio, us * 1000, 0, 0))
     except OSError:
         return ""
     return f"{us} us slice"

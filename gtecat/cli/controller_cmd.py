@@ -232,7 +232,8 @@ def run(args: argparse.Namespace) -> int:
     # line says what the system permits; a refusal of a number ends the controller here),
     # then taken only while the CPUs are busy (scheduling.WhenBusy)
     slice_us = args.slice_us if args.slice_us is not None else scheduling.slice_from_environment()
-    slice_words = scheduling.short_slice(slice_us)
+    # (the compiler it may start builds with the default slice, as it runs normally)
+    slice_words = scheduling.short_slice(slice_us, reset_on_fork=True)
     normal = scheduling.snapshot()
     started_rt = rt_setting == "auto" and scheduling.is_realtime()
     if started_rt:  # started real-time (chrt): left as it is

@@ -240,6 +240,12 @@ def test_a_normal_thread_asks_for_a_short_slice_keeping_its_nice_and_flags():
     assert system.set == [(48, 0, 0x01, 5, 0, 100_000, 0, 0)]
 
 
+def test_the_controller_s_threads_and_children_get_the_default_slice():
+    system = FakeSliceCalls(nice=0, flags=0)
+    assert scheduling.short_slice(100, system.calls(), reset_on_fork=True) == "100 us slice"
+    assert system.set == [(48, 0, 0x01, 0, 0, 100_000, 0, 0)]
+
+
 @pytest.mark.parametrize(
     "system",
     [
