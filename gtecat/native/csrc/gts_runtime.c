@@ -949,16 +949,20 @@ static int start_private(const char *fname)
     const char *rt = setting("GTECAT_RT_PRIORITY");
     char rt_arg[16];
     snprintf(rt_arg, sizeof rt_arg, "%s", rt && strlen(rt) < sizeof rt_arg ? rt : "");
-    /* and so may the time slice (slice_us) */
+    /* and so may the time slice (slice_us: a number read here) */
     char slice_arg[24];
+    const char *sl = setting("GTECAT_SLICE_US");
     snprintf(slice_arg, sizeof slice_arg, "%ld", slice_us());
     char *argv[16] = {(char *)python, "-m", "gtecat", "controller", "--listen", addr,
-                      "--private", "--ready-fd", "3", "--lifeline-fd", "4", "--slice-us",
-                      slice_arg};
-    int argc = 13;
+                      "--private", "--ready-fd", "3", "--lifeline-fd", "4"};
+    int argc = 11;
     if (rt_arg[0]) {
         argv[argc++] = "--rt-priority";
         argv[argc++] = rt_arg;
+    }
+    if (sl && *sl) {
+        argv[argc++] = "--slice-us";
+        argv[argc++] = slice_arg;
     }
     argv[argc] = NULL;
     pid_t pid = fork();
