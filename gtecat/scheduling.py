@@ -21,10 +21,11 @@ Decisions:
   of every second (``sched_rt_runtime_us``) and takes its CPU from everything else meanwhile;
   a real-time server sleeps between requests and spins only for a bounded time
   (:data:`RT_SPIN_CAP_US`).
-* **A short time slice** (:func:`short_slice`, Linux 6.12 and later, no privilege needed):
-  the serving thread asks for 100 us; libgts asks the same for each thread of a program
-  that calls it.  A woken thread with a shorter slice than the running one gets the CPU at
-  once where it has not used more than its share; its share itself does not change.
+* **A short time slice, where asked for** (:func:`short_slice`, ``GTECAT_SLICE_US``, Linux
+  6.12 and later, no privilege needed): the serving thread asks for it, and libgts for each
+  thread of a program that calls it.  A woken thread with a shorter slice than the running
+  one gets the CPU at once where it has not used more than its share; its share itself does
+  not change.  Off by default (:data:`DEFAULT_SLICE_US`: it did not help where measured).
 * The decision (:func:`take`) gets the call that sets the policy injected, so the whole
   permitted / refused / off logic is tested without privileges.
 """
@@ -195,8 +196,10 @@ def _set_policy(policy_priority: tuple[int, int]) -> None:
 
 
 #: the time slice (us) the controller's serving thread asks for, and libgts for each thread
-#: of a program that calls it (GTECAT_SLICE_US; 0: none): the shortest the kernel grants
-DEFAULT_SLICE_US = 100
+#: of a program that calls it (GTECAT_SLICE_US; 100 is the shortest the kernel grants): 0,
+#: none, by default.  Measured on a loaded 2-vCPU VM (docs/performance.md) a 100 us slice did
+#: not help the round trip's p50 or p99, with or without the real-time priority
+DEFAULT_SLICE_US = 0
 SLICE_ENV = "GTECAT_SLICE_US"
 #: (sched_setattr, sched_getattr) by machine: glibc before 2.41 has no wrapper
 _SCHED_ATTR_CALLS = {

@@ -20,9 +20,9 @@ floor, docs/native.md), so programs that sleep between polls see their sleeps pa
 While other programs keep every CPU busy, the controller serves calls under real-time
 priority (SCHED_FIFO 50) where the system permits it (root or CAP_SYS_NICE), so that a
 call does not wait for another program's time slice; ``--rt-priority off``
-(GTECAT_RT_PRIORITY=off) never asks for it.  The serving thread also asks for a short time
-slice (``--slice-us``, GTECAT_SLICE_US, 100 us by default; Linux 6.12 and later), so that,
-at normal priority, a request that wakes it runs it at once.
+(GTECAT_RT_PRIORITY=off) never asks for it.  ``--slice-us 100`` (GTECAT_SLICE_US=100;
+Linux 6.12 and later) makes the serving thread ask for a short time slice, so that at
+normal priority a request that wakes it tends to run it at once (off by default).
 
 ``libgts.so`` starts a private one of these by itself on ``GT_Open`` when
 ``GTECAT_CONTROLLER`` is not set; it ends with the program.
@@ -99,10 +99,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--slice-us",
         type=_slice_us,
         metavar="US",
-        help="the time slice the serving thread asks for (Linux 6.12 and later), so that it "
-        "runs at once when a request wakes it while other programs keep the CPUs busy: "
-        f"default {scheduling.DEFAULT_SLICE_US} (else {scheduling.SLICE_ENV}); 0 leaves it "
-        "alone",
+        help="a time slice the serving thread asks for (Linux 6.12 and later; 100 is the "
+        "shortest), so that it runs sooner when a request wakes it while other programs "
+        f"keep the CPUs busy; else {scheduling.SLICE_ENV}, else "
+        f"{scheduling.DEFAULT_SLICE_US}: the thread is left alone",
     )
     # set by libgts when it starts a private controller
     p.add_argument("--ready-fd", type=int, help=argparse.SUPPRESS)

@@ -281,7 +281,8 @@ def test_the_slice_setting_comes_from_the_environment():
     assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "0"}) == 0
     assert scheduling.slice_from_environment({"GTECAT_SLICE_US": " 200 "}) == 200
     assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "-5"}) == 0
-    assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "short"}) == 100
+    assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "short"}) == 0
+    assert scheduling.DEFAULT_SLICE_US == 0  # off unless asked for (docs/performance.md)
 
 
 def test_the_slice_of_a_thread_on_this_system():

@@ -452,21 +452,24 @@ static void spin_done(int answered_while_spinning, long budget)
 }
 
 /* ---- the calling thread's time slice (Linux 6.12 and later) ---------------------------
- * Once, at its first call, each thread that calls into this library asks the kernel for a
- * short time slice (GTECAT_SLICE_US, default 100 us, the shortest the kernel grants; 0
- * leaves every thread alone).  Why: the thread sleeps while the controller works and is
- * woken by the reply; with other programs keeping the CPUs busy, a woken thread with the
- * default slice (milliseconds) may wait for another program's slice to end, where one with
- * a shorter slice gets the earlier deadline and, as long as it has not used more than its
- * share of the CPU, the CPU at once (EEVDF).  What it changes for the thread: how soon it
- * gets a CPU back after waking, and that while it computes and others want its CPU it is
- * preempted every slice; not its share of the CPU (its nice value, its weight).  Threads
- * and processes it starts afterwards inherit the slice, as they inherit its nice value.
- * Asked only where the thread runs SCHED_OTHER with a longer slice (a shorter one chosen by
- * the program is kept); a kernel without custom slices reports none and is not asked, and
- * a refusal (older kernels: EINVAL, E2BIG; a sandbox: EPERM) is silent.  The controller's
- * serving thread asks for the same (gtecat/scheduling.py: short_slice). */
-#define GTE_DEFAULT_SLICE_US 100
+ * Where GTECAT_SLICE_US names one (100 us is the shortest the kernel grants; 0, the
+ * default, leaves every thread alone), each thread that calls into this library asks the
+ * kernel for that time slice once, at its first call.  Why one may want it: the thread
+ * sleeps while the controller works and is woken by the reply; with other programs keeping
+ * the CPUs busy, a woken thread with the default slice (milliseconds) may wait for another
+ * program's slice to end, where one with a shorter slice gets the earlier deadline and, as
+ * long as it has not used more than its share of the CPU, the CPU at once (EEVDF).  What it
+ * changes for the thread: how soon it gets a CPU back after waking, and that while it
+ * computes and others want its CPU it is preempted every slice; not its share of the CPU
+ * (its nice value, its weight).  Threads and processes it starts afterwards inherit the
+ * slice, as they inherit its nice value.  Asked only where the thread runs SCHED_OTHER with
+ * a longer slice (a shorter one chosen by the program is kept); a kernel without custom
+ * slices reports none and is not asked, and a refusal (older kernels: EINVAL, E2BIG; a
+ * sandbox: EPERM) is silent.  The controller's serving thread asks for the same
+ * (gtecat/scheduling.py: short_slice).  Off by default: measured on a loaded 2-vCPU VM
+ * (docs/performance.md), it did not help the round trip's p50 or p99, with or without the
+ * controller's real-time priority. */
+#define GTE_DEFAULT_SLICE_US 0
 #if !defined(_WIN32) /* gts.dll asks for nothing: Windows has no such slice */
 static long slice_us(void)
 {

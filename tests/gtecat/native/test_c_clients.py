@@ -204,20 +204,22 @@ def _kernel_slices() -> bool:
     return bool(attr and attr[1] == 0 and attr[5])
 
 
-def test_each_calling_thread_asks_for_a_short_slice(slice_probe, tmp_path):
-    """libgts asks once per thread, at its first call, for a 100 us slice (where the kernel
-    has custom slices; elsewhere the thread is left as it was), which threads the thread
-    starts afterwards inherit; GTECAT_SLICE_US=0, or slice_us = 0 in gtecat.ini, leaves
-    every thread alone."""
-    r, v = run_client(slice_probe, env=native_env(), cwd=tmp_path)
-    assert r.returncode == 0 and v["call"] == v["thread_call"] == "0", r.stdout + r.stderr
-    if not _kernel_slices():
-        assert (v["after"], v["thread_after"]) == (v["before"], v["thread_before"])
-        return
-    assert int(v["thread_before"]) > 100000 and int(v["before"]) > 100000  # the default
-    assert (v["after"], v["thread_after"], v["child_thread"]) == ("100000",) * 3
+def test_each_calling_thread_asks_for_the_slice_it_is_given(slice_probe, tmp_path):
+    """With GTECAT_SLICE_US=100 (or slice_us = 100 in gtecat.ini) libgts asks once per
+    thread, at its first call, for a 100 us slice (where the kernel has custom slices;
+    elsewhere the thread is left as it was), which threads the thread starts afterwards
+    inherit; by default, or with 0, every thread is left alone."""
     ini = tmp_path / "gtecat.ini"
-    ini.write_text("slice_us = 0\n")
-    for env in (native_env(GTECAT_SLICE_US="0"), native_env(GTECAT_INI=str(ini))):
+    ini.write_text("slice_us = 100\n")
+    for env in (native_env(GTECAT_SLICE_US="100"), native_env(GTECAT_INI=str(ini))):
+        r, v = run_client(slice_probe, env=env, cwd=tmp_path)
+        assert r.returncode == 0 and v["call"] == v["thread_call"] == "0", r.stdout + r.stderr
+        if not _kernel_slices():
+            assert (v["after"], v["thread_after"]) == (v["before"], v["thread_before"])
+            return
+        assert int(v["thread_before"]) > 100000 and int(v["before"]) > 100000  # the default
+        assert (v["after"], v["thread_after"], v["child_thread"]) == ("100000",) * 3
+    for env in (native_env(), native_env(GTECAT_SLICE_US="0")):
         r, v = run_client(slice_probe, env=env, cwd=tmp_path)
         assert (v["after"], v["thread_after"]) == (v["before"], v["thread_before"]), r.stdout
+        assert v["child_thread"] == v["before"]
