@@ -3307,26 +3307,36 @@ def fast_wait(
     session: Any,
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
-    """``GTE_Wait(ms)`` with the fast path in front of the table: ``ms`` a plain int from 0
-    to one slice of a long wait (Controller.WAIT_SLICE_NS: its ns exact), on the in-process
+    """``GTE_Wait(ms)`` with the fast path in front of the table: ``ms`` a plain int or float
+    from 0 to one slice of a long wait (Controller.WAIT_SLICE_NS), on the in-process
     controller of core 1 on the lockstep or the auto clock - the table path's call without
     its binder and layers, the wait's common case in one call (Controller.wait_quick, else
-    Controller.wait_ms); anything else (a float, a negative or huge value, None, a
-    keyword) takes the table path, its code and reason."""
+    Controller.wait_ms); anything else (a negative, NaN or huge value, None, a keyword)
+    takes the table path, its code and reason."""
     from ..controller.core import Controller
     from ._core import call_done, call_failed
 
     most = Controller.WAIT_SLICE_NS // 1_000_000
 
     def gt(ms: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(ms) is int and 0 <= ms <= most and not extra and not kw and session.plain:
+        tp = type(ms)
+        if (
+            (tp is int or tp is float)
+            and 0 <= ms <= most  # (a float's NaN: never)
+            and not extra
+            and not kw
+            and session.plain
+        ):
             ctl = session.controllers.get(1)
             if ctl is not None and ctl.card is None:
                 clock = ctl.clock
                 if clock.mode is not _REALTIME:
                     try:
                         with clock.lock:  # (the table path's: a call's cycles, one thread's)
-                            if not ctl.wait_quick(ms * 1_000_000):
+                            # (a float's ns as wait_ms rounds them: GTE_Wait(1.0), as a
+                            # program that computes its wait passes it)
+                            total = ms * 1_000_000 if tp is int else round(ms * 1_000_000)
+                            if not ctl.wait_quick(total):
                                 ctl.wait_ms(float(ms))
                             wait_yield(ctl)
                     except Exception as e:
