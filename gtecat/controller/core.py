@@ -1032,11 +1032,22 @@ class Controller:
             if n > self.BATCH_CYCLES:
                 n = self.BATCH_CYCLES
             passes: tuple[Callable[[int], None], ...] = ()
+            # the cycle armed for the readers' C entries stands (nothing but their reads and
+            # quick cycles since it was armed) and the hooks' quiet budget holds the whole run:
+            # the hooks are not asked, they said so (the entries and due_cycle run such cycles
+            # on it); the run is counted to them with what they are owed, after it
+            spent = (
+                hooked
+                and self._owed is not None
+                and q[11] >= n
+                and q[4] == seen[0]
+                and q[5] == ARMS[0]
+            )
             self.in_batch = True  # (run_cycles)
             try:
-                if self._owed is not None:  # (_run_cycles: the quick cycles counted first)
+                if self._owed is not None and not spent:  # (_run_cycles: counted first)
                     self.settle_hooks()
-                if hooked:
+                if hooked and not spent:
                     # as many as every hook stays quiet in (_run_cycles): a hook due sooner
                     # runs in the general way's cycle, as without this one
                     n = self._hooks_quiet(n)
@@ -1102,6 +1113,8 @@ class Controller:
                 q[10] += done
                 q[9] += done * dt_ns
                 EPOCH.n += 1  # (clock.counted)
+                if spent:  # (the owed cycles and the run's: cycles_passed, the arming off)
+                    self.settle_hooks()
             else:  # (Clock.advance_ns's cycle where no run could start)
                 q[0] = pending - dt_ns
                 clock.cycle()
