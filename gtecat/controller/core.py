@@ -872,9 +872,13 @@ class Controller:
     #: cycles count themselves)
     _owed: tuple[int, tuple[Callable[[int], None], ...]] | None = None
     #: the armed cycles' budget as :meth:`arm_quick` left it, -1 after a due cycle ran
-    #: here: where the entries spent none of it since, a wait arms nothing
-    #: (:meth:`_arm_after_wait`)
+    #: here: where the entries spent none of it since, a wait arms again only a few times
+    #: in a row (:meth:`_arm_after_wait`)
     _armed_left = -1
+    #: the armings after waits in a row that found none of the arming before spent
+    #: (:meth:`_arm_after_wait`), and how many such a wait still makes
+    _idle_arms = 0
+    IDLE_ARMS = 3
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
@@ -1121,7 +1125,11 @@ class Controller:
             if q[0] >= dt_ns:
                 clock.advance_ns(0)  # the rest of the wait the general way, from here
         # (_arm_after_wait's first look, inline: a loop of waits alone arms nothing)
-        if clock.mode is _AUTO and q[4] != EPOCH.n and q[11] != self._armed_left:
+        if (
+            clock.mode is _AUTO
+            and q[4] != EPOCH.n
+            and (q[11] != self._armed_left or self._idle_arms < self.IDLE_ARMS)
+        ):
             self._arm_after_wait()
         return True
 
@@ -1131,11 +1139,20 @@ class Controller:
         after it (:meth:`due_cycle`; what :meth:`_quick_kernel` asks, the bus steady, the
         hooks' budget), so that an application polling between waits (a pass every few
         ms) has its calls' cycles run there from the first.  Only where a call made a cycle
-        due since the last arming: a loop of waits alone arms nothing after its first."""
+        due since one of the last :attr:`IDLE_ARMS` armings: a loop of waits alone arms
+        nothing after its first few, and a program whose calls make a cycle due in most of
+        its passes between waits (the latency of a pass a little below the cycle time) has
+        every one armed, not every other."""
         clock = self.clock
         q = clock.quick
-        if q[4] == EPOCH.n or q[11] == self._armed_left or not q[3]:
-            return  # (armed already, nothing of the last arming spent, or a clock's group)
+        if q[4] == EPOCH.n or not q[3]:
+            return  # (armed already, or a clock's group)
+        if q[11] != self._armed_left:  # (some of the last arming spent: a call's cycle)
+            self._idle_arms = 0
+        elif self._idle_arms >= self.IDLE_ARMS:
+            return  # (none of the last ones spent: waits alone)
+        else:
+            self._idle_arms += 1
         if self._owed is not None:
             self.settle_hooks()
         k = self._quick_kernel(True)  # (the hooks asked below, for the budget)
