@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import ctypes
 import gc
-import gzip
 import hashlib
 import json
 import marshal
@@ -485,6 +484,8 @@ class Recorder(Listener):
         text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
+            import gzip  # (here: a replay of a plain recording never needs it)
+
             data = gzip.compress(data, 6)
         self.path.write_bytes(data)
         del text, lines
@@ -611,6 +612,8 @@ def _open_text(
     if raw is None:
         raw = _read_raw(p)
     if raw[:2] == b"\x1f\x8b":
+        import gzip
+
         try:
             raw = gzip.decompress(raw)
         except EOFError:  # the compressed stream stops before its end marker
