@@ -1013,7 +1013,8 @@ def _load() -> tuple[Maker | None, str]:
     def make_replay() -> ReplayLoop:
         t = _RTable(0, None, None, titems, id(tuple))
         loop = ReplayLoop(t)
-        loop.run = new(b"gt_centry_replay", replay_meth, _METH_FASTCALL_KEYWORDS, t, loop)
+        # (the table kept with the function, the loop not: its calls go with the replay)
+        loop.run = new(b"gt_centry_replay", replay_meth, _METH_FASTCALL_KEYWORDS, t, None)
         return loop
 
     make.raw = make_raw  # type: ignore[attr-defined]
