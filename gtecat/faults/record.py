@@ -1789,7 +1789,15 @@ def _replay(
         if loop is None:
             n = 0
             for p, vals in steps:
-                n, div = _step(p, vals, n, eni, machine, faults)
+                run = p.run if type(p) is _Call else None
+                if run is not None:  # (the common call, compiled: _step's first way, inline)
+                    n += 1
+                    r = run(vals)
+                    if r is None:
+                        continue
+                    div = _ran(p, vals, n, r)
+                else:
+                    n, div = _step(p, vals, n, eni, machine, faults)
                 if div is not None:
                     return n, div
             return n, None
@@ -1869,17 +1877,20 @@ def _step(
     run = p.run
     if run is not None:  # the common call, compiled: compared in full only if it may differ
         r = run(vals)
-        if r is None:
-            return n, None
-        if type(r) is not tuple:
-            raise ParameterError(
-                f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                f"again: {type(r).__name__}: {r}"
-            )
-        args, kw, rc = p.args, {}, r[0]
-    else:
-        args, kw, rc = _call(p, vals, n, eni, machine)
+        return n, None if r is None else _ran(p, vals, n, r)
+    args, kw, rc = _call(p, vals, n, eni, machine)
     return n, _compared(p, vals, n, args, kw, rc)
+
+
+def _ran(p: _Call, vals: Any, n: int, r: Any) -> Divergence | None:
+    """Call ``n`` after its compiled run said it may differ (``(rc,)``) or that an argument
+    could not be set (the exception): compared in full, or the damage reported."""
+    if type(r) is not tuple:
+        raise ParameterError(
+            f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+            f"again: {type(r).__name__}: {r}"
+        )
+    return _compared(p, vals, n, p.args, {}, r[0])
 
 
 def _compared(
