@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import ctypes
 import gc
-import gzip
 import hashlib
 import json
 import marshal
@@ -505,6 +504,8 @@ class Recorder(Listener):
         text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
+            import gzip  # (here: a replay of a plain recording never needs it)
+
             data = gzip.compress(data, 6)
         self.path.write_bytes(data)
         del text, lines
@@ -631,6 +632,8 @@ def _open_text(
     if raw is None:
         raw = _read_raw(p)
     if raw[:2] == b"\x1f\x8b":
+        import gzip
+
         try:
             raw = gzip.decompress(raw)
         except EOFError:  # the compressed stream stops before its end marker
@@ -1781,7 +1784,9 @@ def _replay(
     """Make every step's call again, in order, and compare it: (calls made, the first
     divergence or None).
 
-    Every call is made, one at a time, as the application made it.  Answering runs of
+    Every call is made, one at a time, as the application made it: those of the simple
+    forms (their compiled runs) by the C entries' loop where it is available
+    (:func:`_replay_in_c`: no Python frame per call), the others here.  Answering runs of
     pure reads without making them (one snapshot of the readers' values per cycle, taken
     through the readers' own array forms with the call latency set to 0, the recorded
     values compared with it, the cycles made by the calls whose latency makes them due)
@@ -1796,57 +1801,142 @@ def _replay(
     steps made alone) pay: a call from C into each compiled run costs what the loop's
     bytecodes cost (the same CPU, 1.7 % more instructions)."""
     from .. import faults, gt
+    from ..gt.centry import replay_loop
 
     eni = str(Path(eni).resolve()) if eni else None
     machine = str(Path(machine).resolve()) if machine else None
     _check_files(steps, eni, machine, cwd, marks)
     gt.GT_Close()
-    n = 0
+    loop = replay_loop() if C_LOOP else None
     try:
-        for p, vals in steps:
-            if p is None:
-                div = _other(vals, n, faults)
+        if loop is None:
+            n = 0
+            for p, vals in steps:
+                run = p.run if type(p) is _Call else None
+                if run is not None:  # (the common call, compiled: _step's first way, inline)
+                    n += 1
+                    r = run(vals)
+                    if r is None:
+                        continue
+                    div = _ran(p, vals, n, r)
+                else:
+                    n, div = _step(p, vals, n, eni, machine, faults)
                 if div is not None:
                     return n, div
-                continue
-            n += 1
-            if p is _Stop:
-                what, text = vals
-                if what == "missing":
-                    return n, Divergence(n, text, "function", "present", "missing")
-                raise ParameterError(f"damaged recording: call {n} {text}")
-            run = p.run
-            if run is not None:  # the common call, compiled: compared in full only if it may differ
-                r = run(vals)
-                if r is None:
-                    continue
-                if type(r) is not tuple:
-                    raise ParameterError(
-                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                        f"again: {type(r).__name__}: {r}"
-                    )
-                args, kw, rc = p.args, {}, r[0]
-            else:
-                args, kw, rc = _call(p, vals, n, eni, machine)
-            if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
-                return n, Divergence(n, p.name, "return code", p.rc, rc)
-            for obj, k, i, c in p.quick:
-                if obj.value != vals[k]:
-                    want = {"ref": {"c": c, "v": vals[k]}}
-                    got = encode(args[i])
-                    if got != want:
-                        return n, Divergence(n, p.name, f"argument {i + 1}", want, got)
-            for mv, k, i, kind in p.aquick:
-                if mv.tobytes() != vals[k]:
-                    return n, _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
-            for where, want in p.checks:
-                got = encode(args[where] if type(where) is int else kw.get(where))
-                if got != want:
-                    what = f"argument {where + 1}" if type(where) is int else where
-                    return n, _first_element(Divergence(n, p.name, what, want, got))
+            return n, None
+        return _replay_in_c(loop, steps, eni, machine, faults)
     finally:
         gt.GT_Close()
+
+
+#: a replay makes the calls of the simple forms in the C entries' loop where it is available
+#: (:func:`gtecat.gt.centry.replay_loop`); False: every call from Python (tests compare both)
+C_LOOP = True
+
+
+def _replay_in_c(
+    loop: Any, steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, faults: Any
+) -> tuple[int, Divergence | None]:
+    """:func:`_replay`'s loop with the C entries' loop making the calls it was taught (each
+    compiled form's call, the first time it stops there: :func:`_teach`); every other step,
+    and a call whose code or left value may differ, here as :func:`_step` makes it."""
+    run = loop.run
+    whole = tuple(steps)
+    total = len(whole)
+    n = i = 0
+    while i < total:
+        r = run(whole, i)
+        if type(r) is int:
+            j, made = r, None
+        else:
+            j, made = r[0], r
+        n += j - i  # (each step the loop made is a call that matched)
+        if j >= total:
+            break
+        p, vals = whole[j]
+        if made is not None:  # (made: compared in full)
+            n += 1
+            div = _compared(p, vals, n, p.args, {}, made[1])
+        elif p is not None and p is not _Stop and not loop.knows(p) and _teach(loop, p):
+            i = j  # (taught: the loop makes it from here)
+            continue
+        else:
+            n, div = _step(p, vals, n, eni, machine, faults)
+        if div is not None:
+            return n, div
+        i = j + 1
     return n, None
+
+
+def _teach(loop: Any, p: _Call) -> bool:
+    """Tell the C loop how to make ``p``'s call as its compiled run makes it (the values its
+    pooled objects are set to and left with), or to leave it to Python (no compiled run, a
+    time it began at, an object the loop does not take); True where the loop makes it."""
+    if p.run is None or p.before_at is not None:
+        return loop.teach(p)  # type: ignore[no-any-return]
+    return loop.teach(  # type: ignore[no-any-return]
+        p,
+        p.fn,
+        tuple(p.args),
+        p.rc,
+        [*p.sets, *p.asets],
+        [(obj, k) for obj, k, _, _ in p.quick] + [(mv, k) for mv, k, _, _ in p.aquick],
+    )
+
+
+def _step(
+    p: Any, vals: Any, n: int, eni: str | None, machine: str | None, faults: Any
+) -> tuple[int, Divergence | None]:
+    """One step of the replay (a call made and compared, a checkpoint compared, a fault
+    injected or cleared): (calls made so far, the divergence or None)."""
+    if p is None:
+        return n, _other(vals, n, faults)
+    n += 1
+    if p is _Stop:
+        what, text = vals
+        if what == "missing":
+            return n, Divergence(n, text, "function", "present", "missing")
+        raise ParameterError(f"damaged recording: call {n} {text}")
+    run = p.run
+    if run is not None:  # the common call, compiled: compared in full only if it may differ
+        r = run(vals)
+        return n, None if r is None else _ran(p, vals, n, r)
+    args, kw, rc = _call(p, vals, n, eni, machine)
+    return n, _compared(p, vals, n, args, kw, rc)
+
+
+def _ran(p: _Call, vals: Any, n: int, r: Any) -> Divergence | None:
+    """Call ``n`` after its compiled run said it may differ (``(rc,)``) or that an argument
+    could not be set (the exception): compared in full, or the damage reported."""
+    if type(r) is not tuple:
+        raise ParameterError(
+            f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+            f"again: {type(r).__name__}: {r}"
+        )
+    return _compared(p, vals, n, p.args, {}, r[0])
+
+
+def _compared(
+    p: _Call, vals: Any, n: int, args: Any, kw: dict[str, Any], rc: Any
+) -> Divergence | None:
+    """Call ``n`` compared in full: its code, the values it left in its pointers."""
+    if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
+        return Divergence(n, p.name, "return code", p.rc, rc)
+    for obj, k, i, c in p.quick:
+        if obj.value != vals[k]:
+            want = {"ref": {"c": c, "v": vals[k]}}
+            got = encode(args[i])
+            if got != want:
+                return Divergence(n, p.name, f"argument {i + 1}", want, got)
+    for mv, k, i, kind in p.aquick:
+        if mv.tobytes() != vals[k]:
+            return _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
+    for where, want in p.checks:
+        got = encode(args[where] if type(where) is int else kw.get(where))
+        if got != want:
+            what = f"argument {where + 1}" if type(where) is int else where
+            return _first_element(Divergence(n, p.name, what, want, got))
+    return None
 
 
 #: the calls that bring a bus up from the files an open named
