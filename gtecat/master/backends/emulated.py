@@ -428,7 +428,8 @@ class EmulatedBackend(Backend):
         # a slave queues one only through emit_emergency, which counts as an outside change:
         # while nothing changed since a look that left every queue empty, there is none (the
         # bank's slaves are not stepped here, and whichever of them it holds does not matter)
-        if self._emcy_empty == VirtualSlave.outside_changes:
+        seen = VirtualSlave.outside_changes  # (before the look: one queued during it counts)
+        if self._emcy_empty == seen:
             return []
         out = []
         claimed = self._claimed
@@ -443,7 +444,7 @@ class EmulatedBackend(Backend):
                 out.append((slave.position, slave.emergencies.popleft()))
         # (one left: behind a pulled cable, it stays queued, and the next look looks again)
         left = unplugged and any(s.emergencies for s in slaves if s.position in unplugged)
-        self._emcy_empty = None if left else VirtualSlave.outside_changes
+        self._emcy_empty = None if left else seen
         if claimed and len(out) > 1:
             out.sort(key=lambda e: e[0])  # (in the order of the bus, as without the bank)
         return out
