@@ -1,4 +1,4 @@
-"""Real-time scheduling of gtecat's own server processes (``gtecat serve``, ``gtecat
+"""Real-time scheduling and time slices of gtecat's own server processes (``gtecat serve``, ``gtecat
 controller`` and the controller libgts starts).
 
 A server that answers requests must not wait behind other work on a busy host: a normal
@@ -21,6 +21,11 @@ Decisions:
   of every second (``sched_rt_runtime_us``) and takes its CPU from everything else meanwhile;
   a real-time server sleeps between requests and spins only for a bounded time
   (:data:`RT_SPIN_CAP_US`).
+* **A short time slice, where asked for** (:func:`short_slice`, ``GTECAT_SLICE_US``, Linux
+  6.12 and later, no privilege needed): the serving thread asks for it, and libgts for each
+  thread of a program that calls it.  A woken thread with a shorter slice than the running
+  one gets the CPU at once where it has not used more than its share; its share itself does
+  not change.  Off by default (:data:`DEFAULT_SLICE_US`: it did not help where measured).
 * The decision (:func:`take`) gets the call that sets the policy injected, so the whole
   permitted / refused / off logic is tested without privileges.
 """
@@ -28,6 +33,8 @@ Decisions:
 from __future__ import annotations
 
 import os
+import struct
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -188,6 +195,112 @@ def _set_policy(policy_priority: tuple[int, int]) -> None:
         raise RealtimeRefused(f"cannot go back to policy {policy}: {exc}") from exc
 
 
+#: the time slice (us) the controller's serving thread asks for, and libgts for each thread
+#: of a program that calls it (GTECAT_SLICE_US; 100 is the shortest the kernel grants): 0,
+#: none, by default.  Measured on a loaded 2-vCPU VM (docs/performance.md) a 100 us slice did
+#: not help the round trip's p50 or p99, with or without the real-time priority
+DEFAULT_SLICE_US = 0
+SLICE_ENV = "GTECAT_SLICE_US"
+#: (sched_setattr, sched_getattr) by machine: glibc before 2.41 has no wrapper
+_SCHED_ATTR_CALLS = {
+    "x86_64": (314, 315),
+    "aarch64": (274, 275),
+    "riscv64": (274, 275),
+    "i686": (351, 352),
+    "armv7l": (380, 381),
+    "ppc64le": (355, 356),
+    "s390x": (345, 346),
+}
+#: struct sched_attr, version 0 (48 bytes): size, policy, flags, nice, priority, runtime
+#: (a SCHED_OTHER thread's slice, ns), deadline, period
+_SCHED_ATTR = struct.Struct("=IIQiIQQQ")
+_RESET_ON_FORK = 0x01
+#: the calling thread's sched_attr fields (None where refused), and the call that sets them
+#: (OSError where refused)
+SliceCalls = tuple[Callable[[], tuple | None], Callable[[tuple], None]]
+
+
+def _sched_attr_calls() -> SliceCalls | None:
+    """sched_getattr and sched_setattr of the calling thread, None where the system has no
+    such calls (not Linux, a machine not in :data:`_SCHED_ATTR_CALLS`)."""
+    import ctypes
+    import platform
+
+    numbers = _SCHED_ATTR_CALLS.get(platform.machine())
+    if not sys.platform.startswith("linux") or numbers is None:
+        return None
+    try:
+        syscall = ctypes.CDLL(None, use_errno=True).syscall
+    except (OSError, AttributeError):
+        return None
+    set_nr, get_nr = numbers
+
+    def get() -> tuple | None:
+        buf = ctypes.create_string_buffer(_SCHED_ATTR.size)
+        if syscall(get_nr, 0, buf, _SCHED_ATTR.size, 0) != 0:
+            return None
+        return _SCHED_ATTR.unpack(buf.raw)
+
+    def put(fields: tuple) -> None:
+        buf = ctypes.create_string_buffer(_SCHED_ATTR.pack(*fields), _SCHED_ATTR.size)
+        if syscall(set_nr, 0, buf, 0) != 0:
+            err = ctypes.get_errno()
+            raise OSError(err, os.strerror(err))
+
+    return get, put
+
+
+def short_slice(
+    us: int, calls: SliceCalls | bool | None = None, *, reset_on_fork: bool = False
+) -> str:
+    """Ask the kernel for a time slice of ``us`` microseconds for the calling thread (its
+    ``sched_attr.sched_runtime``; Linux 6.12 and later, no privilege needed); words for a
+    status line, "" where nothing changed.
+
+    Why: a thread that sleeps until a message wakes it (the controller between requests,
+    a program waiting for its reply) and wakes while other programs keep the CPUs busy
+    may wait for one of their time slices (milliseconds).  Under EEVDF a thread with a
+    shorter slice gets an earlier deadline and, where it has not used more than its share
+    of the CPU, preempts the longer-slice thread at once.  What it changes: how soon the
+    thread gets a CPU after waking, and that a thread computing for long while others want
+    its CPU is preempted more often; not its share (its nice value, its weight).
+
+    Asked only of a SCHED_OTHER thread whose slice is longer (a shorter one chosen by the
+    program is kept); its nice value and reset-on-fork flag stay (``reset_on_fork``: set it,
+    so that threads and processes the thread starts get the default slice).  A kernel without custom
+    slices reports none and is not asked; a refusal (EINVAL or E2BIG from an older kernel,
+    EPERM from a sandbox) is not an error.  ``calls`` (sched_getattr, sched_setattr) are
+    the system's unless given (tests; False: a system without them)."""
+    if us <= 0:
+        return ""
+    found = _sched_attr_calls() if calls is None else calls
+    if not found:
+        return ""
+    get, put = found  # type: ignore[misc]
+    attr = get()
+    if attr is None:
+        return ""
+    _size, policy, flags, nice, prio, runtime, _deadline, _period = attr
+    if policy != getattr(os, "SCHED_OTHER", 0) or runtime <= us * 1000:
+        return ""
+    try:
+        keep = flags & _RESET_ON_FORK | (_RESET_ON_FORK if reset_on_fork else 0)
+        put((_SCHED_ATTR.size, policy, keep, nice, prio, us * 1000, 0, 0))
+    except OSError:
+        return ""
+    return f"{us} us slice"
+
+
+def slice_from_environment(environ: dict[str, str] | None = None) -> int:
+    """GTECAT_SLICE_US in microseconds (0: none; the default where unset or unreadable)."""
+    env = os.environ if environ is None else environ
+    text = env.get(SLICE_ENV, "").strip()
+    try:
+        return max(0, int(text)) if text else DEFAULT_SLICE_US
+    except ValueError:
+        return DEFAULT_SLICE_US
+
+
 def is_realtime() -> bool:
     """The calling thread runs under SCHED_FIFO or SCHED_RR."""
     try:
@@ -224,9 +337,11 @@ def restore(before: tuple[int, int, set[int]] | None) -> None:
 __all__ = [
     "AUTO_RT_PRIORITY",
     "AVAILABLE",
+    "DEFAULT_SLICE_US",
     "NORMAL",
     "RT_ENV",
     "RT_SPIN_CAP_US",
+    "SLICE_ENV",
     "RealtimeRefused",
     "Scheduling",
     "WhenBusy",
@@ -235,6 +350,8 @@ __all__ = [
     "parse_priority",
     "realtime_priority",
     "restore",
+    "short_slice",
+    "slice_from_environment",
     "snapshot",
     "take",
 ]

@@ -1209,9 +1209,12 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         r |= run_gohome(n, mode, repeat=repeat)
         return r if target is None else _figure(r, "rtf", target)
 
-    def drive_home(n: int, method: int, target: float | None) -> dict[str, object]:
-        r = {"axes": n, "what": f"drive homing (mode 6) method {method}, start to end"}
-        r |= run_drive_homing(n, method, repeat=repeat)
+    def drive_home(
+        n: int, method: int, target: float | None, setup: bool = False
+    ) -> dict[str, object]:
+        what = "set-up (homing mode, parameters) and start" if setup else "start"
+        r = {"axes": n, "what": f"drive homing (mode 6) method {method}, {what} to end"}
+        r |= run_drive_homing(n, method, repeat=repeat, setup=setup)
         return r if target is None else _figure(r, "rtf", target)
 
     figures: dict[str, Callable[[], dict[str, object]]] = {
@@ -1230,6 +1233,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
             f"rtf_64_axes_drive_home_{m}": (lambda m=m: drive_home(64, m, 10))
             for m in (1, 2, 17, 24, 27)
         },
+        "rtf_64_axes_drive_home_35_setup": lambda: drive_home(64, 35, 10, setup=True),
         "rtf_64_axes_gohome_10": lambda: gohome(64, 10, 10),
         "rtf_64_axes_gohome_20": lambda: gohome(64, 20, 10),
         "rtf_64_axes_gohome_11": lambda: gohome(64, 11, 10),

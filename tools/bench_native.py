@@ -174,6 +174,12 @@ def main(argv: list[str] | None = None) -> int:
         help="GTECAT_SERVER_SPIN_US: the controller spins for the next request",
     )
     ap.add_argument(
+        "--slice-us",
+        type=int,
+        default=None,
+        help="GTECAT_SLICE_US: the time slice the calling thread and the controller ask for",
+    )
+    ap.add_argument(
         "--rt-priority",
         default=None,
         help="GTECAT_RT_PRIORITY: the controller's real-time priority while the CPUs are "
@@ -209,6 +215,8 @@ def main(argv: list[str] | None = None) -> int:
         env["GTECAT_SERVER_SPIN_US"] = str(args.server_spin_us)
     if args.rt_priority is not None:
         env["GTECAT_RT_PRIORITY"] = args.rt_priority
+    if args.slice_us is not None:
+        env["GTECAT_SLICE_US"] = str(args.slice_us)
     tcp = args.transport == "tcp"
     target = {"p50_us": 60, "p99_us": 300} if tcp else {"p50_us": 30, "p99_us": 200}
     with tempfile.TemporaryDirectory() as tmp:
@@ -240,6 +248,7 @@ def main(argv: list[str] | None = None) -> int:
             "server": env.get("GTECAT_SERVER_SPIN_US", "default"),
         },
         "rt_priority": env.get("GTECAT_RT_PRIORITY", "auto"),
+        "slice_us": env.get("GTECAT_SLICE_US", "default"),
         "target": target,
         "machine": {
             "cpus": os.cpu_count(),

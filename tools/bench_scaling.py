@@ -563,12 +563,19 @@ DRIVE_HOMING_SPEEDS = (20_000, 2_000, 150_000)
 
 
 def run_drive_homing(
-    n: int, method: int, *, repeat: int = 3, bank: str | None = None, limit_ms: int = 30_000
+    n: int,
+    method: int,
+    *,
+    repeat: int = 3,
+    bank: str | None = None,
+    limit_ms: int = 30_000,
+    setup: bool = False,
 ) -> dict[str, Any]:
     """``n`` axes home by their drives (homing mode 6, CiA-402 ``method``) on the machine of
     :func:`gohome_machine`, start to end, as :func:`run_gohome` (every axis's
     GT_GetEcatHomingStatus every :data:`GOHOME_POLL_MS`); ``error`` when one does not end
-    homed (3)."""
+    homed (3).  ``setup``: timed from the first GT_SetHomingMode (each axis switched to
+    homing mode and given its parameters, then each started, as an application does)."""
     st = c_short()
     v1, v2, acc = DRIVE_HOMING_SPEEDS
 
@@ -591,6 +598,7 @@ def run_drive_homing(
         repeat,
         bank,
         limit_ms,
+        setup,
     )
 
 
@@ -602,9 +610,11 @@ def _run_homing(
     repeat: int,
     bank: str | None,
     limit_ms: int,
+    setup: bool = False,
 ) -> dict[str, Any]:
     """The homings of :func:`run_gohome` and :func:`run_drive_homing`: ``start`` on every
-    axis, then wait until no axis is ``running``; ``bad`` names an axis that did not home."""
+    axis, then wait until no axis is ``running``; ``bad`` names an axis that did not home.
+    ``setup``: ``start`` timed too."""
     gt = _gt()
     best: dict[str, Any] | None = None
     with tempfile.TemporaryDirectory() as tmp:
@@ -616,9 +626,13 @@ def _run_homing(
                 for a in axes:
                     gtn("AxisOn", a)
                 gt.GTE_Wait(WARM_UP_MS)
+                if setup:
+                    ms0, _ = _clock()
+                    t0, c0 = time.perf_counter(), time.process_time()
                 start(axes)
-                ms0, _ = _clock()
-                t0, c0 = time.perf_counter(), time.process_time()
+                if not setup:
+                    ms0, _ = _clock()
+                    t0, c0 = time.perf_counter(), time.process_time()
                 waited = 0
                 while True:
                     gt.GTE_Wait(CHUNK_MS)

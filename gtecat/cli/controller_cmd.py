@@ -20,7 +20,9 @@ floor, docs/native.md), so programs that sleep between polls see their sleeps pa
 While other programs keep every CPU busy, the controller serves calls under real-time
 priority (SCHED_FIFO 50) where the system permits it (root or CAP_SYS_NICE), so that a
 call does not wait for another program's time slice; ``--rt-priority off``
-(GTECAT_RT_PRIORITY=off) never asks for it.
+(GTECAT_RT_PRIORITY=off) never asks for it.  ``--slice-us 100`` (GTECAT_SLICE_US=100;
+Linux 6.12 and later) makes the serving thread ask for a short time slice, so that at
+normal priority a request that wakes it tends to run it at once (off by default).
 
 ``libgts.so`` starts a private one of these by itself on ``GT_Open`` when
 ``GTECAT_CONTROLLER`` is not set; it ends with the program.
@@ -93,6 +95,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         f"{scheduling.RT_ENV}) takes priority {scheduling.AUTO_RT_PRIORITY} where the system "
         "permits it (root or CAP_SYS_NICE), else runs normally; off never asks",
     )
+    p.add_argument(
+        "--slice-us",
+        type=_slice_us,
+        metavar="US",
+        help="a time slice the serving thread asks for (Linux 6.12 and later; 100 is the "
+        "shortest), so that it runs sooner when a request wakes it while other programs "
+        f"keep the CPUs busy; else {scheduling.SLICE_ENV}, else "
+        f"{scheduling.DEFAULT_SLICE_US}: the thread is left alone",
+    )
     # set by libgts when it starts a private controller
     p.add_argument("--ready-fd", type=int, help=argparse.SUPPRESS)
     p.add_argument("--lifeline-fd", type=int, help=argparse.SUPPRESS)
@@ -105,6 +116,16 @@ def _rt_priority(text: str) -> int | str:
         return scheduling.parse_priority(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _slice_us(text: str) -> int:
+    try:
+        us = int(text)
+    except ValueError:
+        us = -1
+    if us < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: microseconds, 0 or more")
+    return us
 
 
 def _token(args: argparse.Namespace) -> tuple[str, str]:
@@ -210,6 +231,9 @@ def run(args: argparse.Namespace) -> int:
     # the scheduling of the thread that serves, once the socket listens: asked for now (the
     # line says what the system permits; a refusal of a number ends the controller here),
     # then taken only while the CPUs are busy (scheduling.WhenBusy)
+    slice_us = args.slice_us if args.slice_us is not None else scheduling.slice_from_environment()
+    # (the compiler it may start builds with the default slice, as it runs normally)
+    slice_words = scheduling.short_slice(slice_us, reset_on_fork=True)
     normal = scheduling.snapshot()
     started_rt = rt_setting == "auto" and scheduling.is_realtime()
     if started_rt:  # started real-time (chrt): left as it is
@@ -238,6 +262,8 @@ def run(args: argparse.Namespace) -> int:
         sched = "real-time priority as started" if started_rt else taken.words
         if taken.priority is not None:
             sched += " while the CPUs are busy"
+        if slice_words:
+            sched += f", {slice_words}"
         if taken.refused:
             sched += ": run as root or give python CAP_SYS_NICE for real-time priority"
         print(

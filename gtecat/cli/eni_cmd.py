@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 from typing import Any
 
 from gtecat.eni.errors import GtecatError
 from gtecat.eni.layout import build_layout
 from gtecat.eni.topology import load_topology
-from gtecat.eni.writer import write_eni
+from gtecat.eni.writer import write_eni_file, write_eni_to
 
 
 def add_parser(subparsers: Any) -> None:
@@ -50,7 +49,6 @@ def run(args: argparse.Namespace) -> int:
     check_toml_kind(args.topology, "topology")
     try:
         cfg = load_topology(args.topology)
-        text = write_eni(cfg)
         layout = build_layout(cfg)
     except GtecatError as exc:
         if getattr(args, "debug", False):
@@ -58,10 +56,10 @@ def run(args: argparse.Namespace) -> int:
         print("error: " + " ".join(str(exc).split()), file=sys.stderr)
         return 1
     if not args.output or args.output == "-":
-        sys.stdout.write(text)
+        write_eni_to(cfg, sys.stdout)  # (as it is made: 65 535 drives are 1.3 GB of XML)
         return 0
     try:
-        Path(args.output).write_text(text, encoding="utf-8")
+        write_eni_file(cfg, args.output)
     except OSError as exc:
         print(f"error: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
         return 1

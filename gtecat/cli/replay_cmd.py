@@ -5,7 +5,9 @@ machine description, or ``--eni`` / ``--machine``), with the faults at their pla
 return code, every value written back and every bus checkpoint is compared.  Exit 0 when
 all match; 1 with the first divergence: the call, the argument, the recorded and the new
 value.  Replaying against another ENI or machine description shows what a change does to
-a session that worked.
+a session that worked.  A recorded ENI or machine description replaced at its name since
+the recording is named before anything runs (exit 1); give it with ``--eni`` /
+``--machine`` to replay against it on purpose.
 """
 
 from __future__ import annotations

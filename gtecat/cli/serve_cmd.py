@@ -24,6 +24,7 @@ import logging
 import os
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from types import FrameType
 
@@ -169,10 +170,17 @@ def _writable(path: Path, option: str) -> None:
         raise GtecatError(f"{option} {path}: {exc.strerror or exc}") from None
 
 
-def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool = False):
+def build_chain(
+    eni: Path,
+    machine: Path | None = None,
+    *,
+    watchdog_trips: bool = False,
+    clock: Callable[[], int] | None = None,
+):
     # -> tuple[Chain, EniConfig]
     """The ENI's slaves behind ESCs (what ``serve`` puts on the wire), each with the SII
-    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.drives.esc.sii_eni`)."""
+    the ENI describes (SM layout, mailbox, product name: :mod:`gtecat.drives.esc.sii_eni`);
+    ``clock``: the ESCs' time in ns (default the monotonic clock; a test's virtual one)."""
     from gtecat.drives.esc import Chain
     from gtecat.drives.esc.sii_eni import sii_for
     from gtecat.drives.machine import MachineDescription, load_machine
@@ -185,7 +193,8 @@ def build_chain(eni: Path, machine: Path | None = None, *, watchdog_trips: bool 
     desc = load_machine(machine) if machine else MachineDescription()
     slaves = build_slaves(layout, desc)
     sii = [sii_for(slave, s) for slave, s in zip(slaves, config.slaves, strict=True)]
-    chain = Chain(slaves, sii=sii, watchdog_trips=watchdog_trips)
+    kw = {} if clock is None else {"clock": clock}
+    chain = Chain(slaves, sii=sii, watchdog_trips=watchdog_trips, **kw)
     return chain, config
 
 

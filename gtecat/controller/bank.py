@@ -69,7 +69,6 @@ import numpy as np
 
 from gtecat.drives.csp_bank import (
     CW_ENABLED,
-    FROZEN_ATTRS,
     CspBank,
     claimable,
     frozen_claimable,
@@ -78,7 +77,7 @@ from gtecat.drives.csp_bank import (
 from gtecat.drives.drive import Cia402Drive
 from gtecat.drives.homing_bank import ROW_FIELDS as HM_ROW_FIELDS
 from gtecat.drives.homing_bank import event_bounds as homing_event_bounds
-from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable
+from gtecat.drives.homing_bank import homing_claimable, homing_rest_claimable, idle_claimable
 from gtecat.drives.homing_bank import rest_constants as homing_rest_constants
 from gtecat.drives.homing_bank import return_constants as homing_return_constants
 from gtecat.drives.homing_bank import row_constants as homing_constants
@@ -754,6 +753,9 @@ class AxisBank:
         for name in _HM_U8:
             setattr(self, name, zi(n, bool))
         self.h_done = zi(n, np.uint8)  # a homing row's kind (homing_bank.row_kind): 0, 1, 2
+        #: the frozen rows (frz) whose servo is off: GT_GetSts's word without its servo-on bit
+        #: (the others stand in homing mode before a homing, the servo on)
+        self.frz_off = zi(n, bool)
         self.n_hm = self.n_frz = 0
         #: 60FDh bits whose change sends a row back before the cycle (an input a bank-aware
         #: hook samples every cycle: a capture unit's home input)
@@ -769,13 +771,16 @@ class AxisBank:
 
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
-        self._frozen: dict[int, tuple] = {}  # row -> its channel's values while frozen
+        #: row -> the constants of its last load that _reindex's flags read (_load)
+        self._consts: dict[int, tuple] = {}
         #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
         #: back in the same move, instead of computed again
         self._kept: dict[int, tuple] = {}
         #: per row, the kind of its planner when bank_modes.links last looked (-1: not yet)
         self._row_link: np.ndarray | None = None
-        self._claimed_sets: dict[bytes, frozenset[int]] = {}
+        #: per claimed pattern, what follows from it alone (_reindex)
+        self._claimed_sets: dict[bytes, tuple] = {}
+        self._axes_seen: list[Any] | None = None
         self._reindex()
         if self._kernel_lib is not None:
             self.kernel = Kernel(self, self._kernel_lib)
@@ -799,35 +804,23 @@ class AxisBank:
             self.any_band = bool(np.count_nonzero(self.band > 0))
             self.any_scale = bool(np.count_nonzero(self.unit2 != 1.0))
         self._count_standing()
-        self.n_jog = int(np.count_nonzero(self.jog & alive))
-        self.n_hm = int(np.count_nonzero(self.hm & alive))
-        self.n_rest = int(np.count_nonzero((self.h_done == 1) & alive)) if self.n_hm else 0
-        self.n_frz = int(np.count_nonzero(self.frz & alive))
-        self.any_watch = bool(np.count_nonzero(self.dwatch[alive]))
-        self.any_post = bool(np.count_nonzero(self.dpost[alive]))
-        self.any_lvel = bool(np.count_nonzero(self.lvel[alive]))
+        # (a row given back has these cleared: _put_back, _store)
+        self.n_jog = int(np.count_nonzero(self.jog))
+        self.n_hm = int(np.count_nonzero(self.hm))
+        self.n_rest = int(np.count_nonzero(self.h_done == 1)) if self.n_hm else 0
+        self.n_frz = int(np.count_nonzero(self.frz))
+        self.any_watch = bool(np.count_nonzero(self.dwatch))
+        self.any_post = bool(np.count_nonzero(self.dpost))
+        self.any_lvel = bool(np.count_nonzero(self.lvel))
         self.band_dirty = True
         self._img_stale = True  # the numpy cycle's image indices follow when it runs
-        self.n_moving = int(np.count_nonzero(self.moving & alive))
+        moving = self.moving & alive
+        self.n_moving = int(np.count_nonzero(moving))
         self._refill_in = 0  # look for tables to fill at the next cycle
-        self._c_fill = self.kernel is not None and not np.count_nonzero(
-            self.moving & alive & (self.nseg <= 0)
+        self._c_fill = self.kernel is not None and not (
+            self.n_moving and np.count_nonzero(moving & (self.nseg <= 0))
         )
         g_claimed = self._g_claimed
-        self._rx_idx = self._rx_all[g_claimed[self._rx_group]]
-        buf = self.ctl.master.image.buffer
-        self._rx_ref = buf.take(self._rx_idx).tobytes()
-        if len(self._rx_all):
-            np.take(buf, self._rx_all, out=self._rx_snap)
-        # the slaves the bus leaves to the bank: one set per claimed pattern, kept (the bank
-        # gives back and takes the same few), so the bus finds its plan for it by identity
-        key = g_claimed.tobytes()
-        claimed = self._claimed_sets.get(key)
-        if claimed is None:
-            if len(self._claimed_sets) > 256:
-                self._claimed_sets.clear()
-            claimed = self._claimed_sets[key] = frozenset(self._g_pos[g_claimed].tolist())
-        self.ctl.backend.claimed = claimed
         rows = self._rows_of_axes
         axis_list = self.ctl._axis_list
         if rows is None or len(rows) != len(axis_list):
@@ -835,10 +828,34 @@ class AxisBank:
             rows = self._rows_of_axes = [row_of.get(id(ax), -1) for ax in axis_list]
             self._rows_np = np.array(rows, np.intp)
             self._rows_in = self._rows_np >= 0
-        # the controller's axes the bank does not run now, in its order
-        rows_np = self._rows_np
-        run = ~(self._rows_in & alive.take(np.maximum(rows_np, 0)))
-        self.ctl._run_axes = list(compress(axis_list, run.tolist()))
+            self._claimed_sets.clear()
+        elif axis_list is not self._axes_seen:
+            self._claimed_sets.clear()  # (its axes' run list: another list of the same axes)
+        self._axes_seen = axis_list
+        # what follows from the claimed pattern alone, kept per pattern (the bank gives back
+        # and takes the same few): the slaves the bus leaves to the bank (one set per
+        # pattern, so the bus finds its plan for it by identity), the claimed output bytes
+        # and their groups, the controller's axes the bank does not run, in its order
+        key = g_claimed.tobytes() + alive.tobytes()
+        kept = self._claimed_sets.get(key)
+        if kept is None:
+            if len(self._claimed_sets) > 256:
+                self._claimed_sets.clear()
+            sel = g_claimed[self._rx_group]
+            run = ~(self._rows_in & alive.take(np.maximum(self._rows_np, 0)))
+            kept = self._claimed_sets[key] = (
+                frozenset(self._g_pos[g_claimed].tolist()),
+                self._rx_all[sel],
+                self._rx_group[sel],  # (the group of each byte: _release_written)
+                list(compress(axis_list, run.tolist())),
+            )
+        claimed, self._rx_idx, self._rx_gi, run_axes = kept
+        buf = self.ctl.master.image.buffer
+        self._rx_ref = buf.take(self._rx_idx).tobytes()
+        if len(self._rx_all):
+            buf.take(self._rx_all, out=self._rx_snap)
+        self.ctl.backend.claimed = claimed
+        self.ctl._run_axes = run_axes.copy()
         self._lists = {}  # (a new one: _lists' docs)
         self._sts_epoch = 0  # (the status words made again)
         # the kernel keeps its binding: a claim and a release write the rows in place (only
@@ -987,12 +1004,17 @@ class AxisBank:
             return False
         return _within_safety(ax, res)
 
-    def _eligible_frozen(self, r: int) -> bool:
-        """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable):
-        every value of its cycle stays as it is, so the compiled cycle skips the row (the
-        image keeps the values the scalar objects wrote)."""
+    def _eligible_frozen(self, r: int, powered: bool = False) -> bool:
+        """A servo-off axis whose drive rests unpowered (gtecat.drives.csp_bank.frozen_claimable),
+        or (``powered``) a servo-on axis whose drive stands in homing mode before a homing
+        (gtecat.drives.homing_bank.idle_claimable; the axis layer follows the drive as for a
+        servo-off one: AxisResources._post): every value of its cycle stays as it is, so the
+        compiled cycle skips the row (the image keeps the values the scalar objects wrote)."""
         if self.kernel is None:
             return False
+        ch = self.csp.channels[r]
+        if powered and idle_claimable(ch):
+            return False  # (first: an axis just switched waits for its drive's 6061h here)
         ax, res = self.axes[r], self.res[r]
         if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error or ax.cw == CW_QUICK_STOP:
             return False  # (a quick stop the drive finishes: its controlword changes after it)
@@ -1016,7 +1038,6 @@ class AxisBank:
             return False  # the plan does not follow 6064h yet
         if ax._tp_acc.get() != ax._pos_acc.get():
             return False  # 607Ah does not hold 6064h yet
-        ch = self.csp.channels[r]
         s = res.safety
         if s.active:
             # the flags its cycle would latch (AxisResources._post) are latched already - a
@@ -1036,7 +1057,7 @@ class AxisBank:
             inside = -b.band <= err <= b.band
             if (inside and not b.arrived) or (not inside and (b._since is not None or b.arrived)):
                 return False  # bit 11 still changes with time
-        return not frozen_claimable(ch)
+        return powered or not frozen_claimable(ch)
 
     def _eligible_homing(self, r: int) -> bool:
         """An axis whose drive runs a homing search, moves back onto the home point found, or
@@ -1048,6 +1069,8 @@ class AxisBank:
         ax, res = self.axes[r], self.res[r]
         if not ax.servo_on or ax.link_lost or res._csp:
             return False
+        if self.csp.channels[r].homing is None:  # standing before a homing: frozen, powered
+            return self._eligible_frozen(r, powered=True)
         st = self._homing_hook(ax, res)
         if st is False:
             return False
@@ -1153,7 +1176,7 @@ class AxisBank:
                     c.banked = True
             changed = True
         if loaded:
-            self.csp._flags()
+            self.csp.after_loads()
         if changed:
             self._reindex()
         if self.n_alive == self.n:
@@ -1187,7 +1210,7 @@ class AxisBank:
             if singles is None:
                 singles = self._singles = [([g], [], False) for g in self.groups]
             # the groups out of the bank alone (refresh passes over the claimed ones)
-            return [singles[gi] for gi in np.flatnonzero(~self._g_claimed).tolist()]
+            return [singles[gi] for gi in (~self._g_claimed).nonzero()[0].tolist()]
         group_of = self.group_of
         parent = list(range(len(self.groups)))
 
@@ -1251,7 +1274,6 @@ class AxisBank:
         g.claimed = True
         gi = self._gi[id(g)]
         self._g_claimed[gi] = True
-        self._loaded = True
         for obj in self._guarded_objects(g):
             key = id(obj)
             _OWNER[key] = (self, gi)
@@ -1295,6 +1317,22 @@ class AxisBank:
         b = res.band
         if not again:
             s = ax.pos_scale
+            # the constants _reindex's flags look at: looked at again only when a row's changed
+            # (a drive given back and taken again mostly brings the same)
+            key = (
+                s,
+                ax.drive_offset,
+                res.prf_link.ratio,
+                res.prf_link.offset,
+                res.enc_link.ratio,
+                res.enc_link.offset,
+                enc.external,
+                enc.sense,
+                b.band,
+            )
+            if self._consts.get(r) != key:
+                self._consts[r] = key
+                self._loaded = True
             self.unit2[r] = float(1 << s)
             self.unit[r] = 1.0 / (1 << s)
             self.drive_offset[r] = ax.drive_offset
@@ -1377,17 +1415,15 @@ class AxisBank:
         else:
             self.t_cur[r], self.t_len[r], self.t_end[r] = 0, 1, 0
         ch = self.csp.channels[r]
-        self.frz[r] = frozen = not ax.servo_on
+        # servo off, or on and standing in homing mode before a homing (_eligible_frozen)
+        off = not ax.servo_on
+        self.frz_off[r] = off
+        self.frz[r] = frozen = off or (ax.mode_cmd == _HOMING_MODE and ch.homing is None)
         # GT_GetSts's latched flags stay as they are while the row is in the bank
         # (_eligible_frozen, _latched_standing)
         self.latched[r] = latched
-        if frozen:  # nothing of its cycle changes (_eligible_frozen): kept, given back at release
+        if frozen:  # nothing of its cycle changes (_eligible_frozen): CspBank.rested at release
             self.dwatch[r], self.dpost[r] = watch, 0
-            self._frozen[r] = (
-                tuple(getattr(ch, name) for name in FROZEN_ATTRS),
-                ch.mech.torque,
-                ch.mech.acc,
-            )
             self.enc_step0[r] = self.enc_step1[r] = 0.0  # the encoder stands: speed 0
             self.hm[r] = False
             return
@@ -1440,9 +1476,10 @@ class AxisBank:
             self.dwatch[r], self.dpost[r] = watch, 0
 
     def rests(self, ax: Any) -> bool:
-        """``ax``'s row is in the bank frozen (servo off, its drive resting unpowered:
-        :meth:`_eligible_frozen`): the compiled cycles skip it, so its process values in the
-        image - 6041h among them - stay as they are over every cycle the bank runs."""
+        """``ax``'s row is in the bank frozen (servo off, its drive resting unpowered, or
+        standing in homing mode before a homing: :meth:`_eligible_frozen`): the compiled
+        cycles skip it, so its process values in the image - 6041h among them - stay as they
+        are over every cycle the bank runs."""
         r = self._row_of.get(id(ax)) if self.n_alive else None
         return r is not None and bool(self.alive[r] and self.frz[r])
 
@@ -1568,6 +1605,7 @@ class AxisBank:
                 self._put_probe(r)
             on = bool(probe.function & 0x0101)
             csp.tpw[r] = on
+            csp.row_changed(r)
             csp.tp_lo[r], csp.tp_hi[r] = (
                 probe.quiet_bounds(float(csp.pos[r])) if on else (-np.inf, np.inf)
             )
@@ -1883,7 +1921,18 @@ class AxisBank:
                     _set(obj, "__class__", cls.__base__)
             g.claimed = False
             self._g_claimed[self._gi[id(g)]] = False
-        self.csp.store(rows)
+        frz = self.frz
+        if any(frz[r] for r in rows):
+            # a frozen row's channel holds what its skipped cycles would have left
+            csp = self.csp
+            moved = [r for r in rows if not frz[r]]
+            if moved:
+                csp.store(moved)
+            for r in rows:
+                if frz[r]:
+                    csp.rested(r)
+        else:
+            self.csp.store(rows)
         for r in rows:
             self._store(r)
         self.releases += 1
@@ -1940,6 +1989,9 @@ class AxisBank:
         self.layout += 1
         if r != self._stepping:  # (a row stepped in place: its objects hold its state)
             self._put_back(r)
+        # (_reindex counts these over every row: a row given back has them clear; jog, hm,
+        # h_done and frz are cleared by _put_back, and a row stepped in place has none)
+        self.dwatch[r] = self.dpost[r] = self.lvel[r] = 0
 
     def _put_back(self, r: int) -> None:
         """Row ``r``'s state into its axis objects (its drive aside), as a release leaves them
@@ -1957,13 +2009,8 @@ class AxisBank:
         b._since = None if since < 0 else since
         b.arrived = bool(self.arrived[r])
         pl = res.profile.planner
-        if self.frz[r]:
-            self.frz[r] = False
-            ch = self.csp.channels[r]
-            values, torque, acc = self._frozen.pop(r)
-            for name, value in zip(FROZEN_ATTRS, values, strict=True):
-                setattr(ch, name, value)
-            ch.mech.torque, ch.mech.acc = torque, acc
+        if self.frz[r]:  # (its channel as it was: CspBank.rested)
+            self.frz[r] = self.frz_off[r] = False
             return
         if self.hm[r]:
             self.hm[r] = self.h_done[r] = False
@@ -2203,7 +2250,7 @@ class AxisBank:
         if self.n > _SMALL_BANK:
             return self.value(name, r)
         if name == "sts":  # (the flags only tested: numpy's bools; the latched word an int)
-            m, j, a, f = self.moving[r], self.jog[r], self.arrived[r], self.frz[r]
+            m, j, a, f = self.moving[r], self.jog[r], self.arrived[r], self.frz_off[r]
             lt = self.latched.item(r)
             return (_MOVING if m or j else _ARRIVED if a else 0) | lt | (0 if f else _SERVO_ON)
         k = _ROW_PLANNED.get(name)
@@ -2268,7 +2315,7 @@ class AxisBank:
                     self.moving,
                     self.jog,
                     self.arrived,
-                    self.frz,
+                    self.frz_off,
                     self.latched,
                 )
                 flags = (
@@ -2298,7 +2345,7 @@ class AxisBank:
                 return words
             run = self.moving | self.jog
             sts = np.where(run, _MOVING, np.where(self.arrived, _ARRIVED, 0))
-            return (sts | self.latched | np.where(self.frz, 0, _SERVO_ON)).tolist()
+            return (sts | self.latched | np.where(self.frz_off, 0, _SERVO_ON)).tolist()
         if name in ("enc_vel", "enc_acc"):
             if self.n <= _SMALL_BANK:  # (a few rows: Python floats, no numpy temporaries)
                 vel, acc = self._enc_rates_lists()
@@ -3036,8 +3083,8 @@ class AxisBank:
         now = self.ctl.master.image.buffer.take(idx)
         if len(now) != len(ref) or now.tobytes() == ref:
             return
-        hit = set(idx[now != np.frombuffer(ref, np.uint8)].tolist())
-        changed = [g for g in self.groups if g.claimed and hit.intersection(g.rx_bytes.tolist())]
+        hit = sorted(set(self._rx_gi[now != np.frombuffer(ref, np.uint8)].tolist()))
+        changed = [g for g in map(self.groups.__getitem__, hit) if g.claimed]
         if changed:
             self._release_groups(changed)
 

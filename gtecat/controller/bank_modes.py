@@ -164,7 +164,12 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
     if seen is None or len(seen) != len(bank.res):
         seen = bank._row_link = np.full(len(bank.res), -1, np.int8)
     res_of = bank.res
-    for r in np.flatnonzero(~bank.alive | (seen != 0)).tolist():
+    # (np.flatnonzero and ndarray.any cost several times the ufuncs underneath on a bank's
+    # few rows: this runs at every look of the bank)
+    out = ~bank.alive
+    if np.count_nonzero(seen):
+        out |= seen != 0
+    for r in out.nonzero()[0].tolist():
         res = res_of[r]
         if res is None:
             continue

@@ -218,7 +218,14 @@ class Controller:
         #: endpoint's idle path waits for its end (it runs no request beside cycles)
         self.in_batch = False
         self._cycle_fixed = self.options.cycle_ms is not None
-        self.log = MasterLog(self.options.log, clock_ms=lambda: self.clock.now_ms)
+        #: [0] the controller time GT_Reset last counted GT_GetClock from (:attr:`reset_ns`),
+        #: in memory compiled code reads: the GT readers' C entries write a ``pClock`` from it
+        #: and the clock's time (gtecat.gt.centry.set_clock_ms)
+        self.origin = array("q", (0,))
+        # the master log is the controller's: its lines carry the controller's time, what
+        # GT_GetClock reads (counted from GT_Reset, chapter 13: GT_Reset resets the
+        # controller, GT_GetClock reads its clock), so a line and a clock read agree
+        self.log = MasterLog(self.options.log, clock_ms=self.clock_ms)
         self.machine = self._load_machine(self.options.machine)
         self.layout: Layout | None = None
         self.master: Master | None = None
@@ -227,10 +234,6 @@ class Controller:
         #: why the last GT_InitEcatComm failed (None: it succeeded, or none was made)
         self.init_error: Exception | None = None
         self._links_down = False  # some axis's slave was offline at the last cycle
-        #: [0] the controller time GT_Reset last counted GT_GetClock from (:attr:`reset_ns`),
-        #: in memory compiled code reads: the GT readers' C entries write a ``pClock`` from it
-        #: and the clock's time (gtecat.gt.centry.set_clock_ms)
-        self.origin = array("q", (0,))
         #: run first in a cycle, before its time is read: motion programs, whose GT calls
         #: may themselves wait for cycles (GT_AxisOn), so the cycle then starts later
         self.before_cycle: list[Callable[[], None]] = []
@@ -872,9 +875,13 @@ class Controller:
     #: cycles count themselves)
     _owed: tuple[int, tuple[Callable[[int], None], ...]] | None = None
     #: the armed cycles' budget as :meth:`arm_quick` left it, -1 after a due cycle ran
-    #: here: where the entries spent none of it since, a wait arms nothing
-    #: (:meth:`_arm_after_wait`)
+    #: here: where the entries spent none of it since, a wait arms again only a few times
+    #: in a row (:meth:`_arm_after_wait`)
     _armed_left = -1
+    #: the armings after waits in a row that found none of the arming before spent
+    #: (:meth:`_arm_after_wait`), and how many such a wait still makes
+    _idle_arms = 0
+    IDLE_ARMS = 3
 
     def _watch_links(self, offline: dict[int, str]) -> None:
         """Stop the axes of offline slaves (module docstring "Comm loss"), every cycle
@@ -919,6 +926,11 @@ class Controller:
 
     # --- time -------------------------------------------------------------------------------
     def reset_clock(self) -> None:
+        """GT_Reset: GT_GetClock, and the master log's time with it, count from now; the log
+        says so, as its time goes back to 0 there."""
+        if self.reset_ns != self.clock.now_ns:
+            was = self.clock_ms()
+            self.log(f"GT_Reset: the controller's clock counts from 0 again (it read {was} ms).")
         self.reset_ns = self.clock.now_ns
 
     def clock_ms(self) -> int:
@@ -1032,11 +1044,22 @@ class Controller:
             if n > self.BATCH_CYCLES:
                 n = self.BATCH_CYCLES
             passes: tuple[Callable[[int], None], ...] = ()
+            # the cycle armed for the readers' C entries stands (nothing but their reads and
+            # quick cycles since it was armed) and the hooks' quiet budget holds the whole run:
+            # the hooks are not asked, they said so (the entries and due_cycle run such cycles
+            # on it); the run is counted to them with what they are owed, after it
+            spent = (
+                hooked
+                and self._owed is not None
+                and q[11] >= n
+                and q[4] == seen[0]
+                and q[5] == ARMS[0]
+            )
             self.in_batch = True  # (run_cycles)
             try:
-                if self._owed is not None:  # (_run_cycles: the quick cycles counted first)
+                if self._owed is not None and not spent:  # (_run_cycles: counted first)
                     self.settle_hooks()
-                if hooked:
+                if hooked and not spent:
                     # as many as every hook stays quiet in (_run_cycles): a hook due sooner
                     # runs in the general way's cycle, as without this one
                     n = self._hooks_quiet(n)
@@ -1102,13 +1125,19 @@ class Controller:
                 q[10] += done
                 q[9] += done * dt_ns
                 EPOCH.n += 1  # (clock.counted)
+                if spent:  # (the owed cycles and the run's: cycles_passed, the arming off)
+                    self.settle_hooks()
             else:  # (Clock.advance_ns's cycle where no run could start)
                 q[0] = pending - dt_ns
                 clock.cycle()
             if q[0] >= dt_ns:
                 clock.advance_ns(0)  # the rest of the wait the general way, from here
         # (_arm_after_wait's first look, inline: a loop of waits alone arms nothing)
-        if clock.mode is _AUTO and q[4] != EPOCH.n and q[11] != self._armed_left:
+        if (
+            clock.mode is _AUTO
+            and q[4] != EPOCH.n
+            and (q[11] != self._armed_left or self._idle_arms < self.IDLE_ARMS)
+        ):
             self._arm_after_wait()
         return True
 
@@ -1118,11 +1147,20 @@ class Controller:
         after it (:meth:`due_cycle`; what :meth:`_quick_kernel` asks, the bus steady, the
         hooks' budget), so that an application polling between waits (a pass every few
         ms) has its calls' cycles run there from the first.  Only where a call made a cycle
-        due since the last arming: a loop of waits alone arms nothing after its first."""
+        due since one of the last :attr:`IDLE_ARMS` armings: a loop of waits alone arms
+        nothing after its first few, and a program whose calls make a cycle due in most of
+        its passes between waits (the latency of a pass a little below the cycle time) has
+        every one armed, not every other."""
         clock = self.clock
         q = clock.quick
-        if q[4] == EPOCH.n or q[11] == self._armed_left or not q[3]:
-            return  # (armed already, nothing of the last arming spent, or a clock's group)
+        if q[4] == EPOCH.n or not q[3]:
+            return  # (armed already, or a clock's group)
+        if q[11] != self._armed_left:  # (some of the last arming spent: a call's cycle)
+            self._idle_arms = 0
+        elif self._idle_arms >= self.IDLE_ARMS:
+            return  # (none of the last ones spent: waits alone)
+        else:
+            self._idle_arms += 1
         if self._owed is not None:
             self.settle_hooks()
         k = self._quick_kernel(True)  # (the hooks asked below, for the budget)

@@ -116,7 +116,6 @@ _WRAPPED = frozenset(
     ("position_actual", "position_demand", "velocity_actual", "following_error_actual")
 )
 
-#: a channel's values that stay as they are while it rests unpowered (frozen rows)
 FROZEN_ATTRS = (
     "position_actual",
     "position_demand",
@@ -171,7 +170,14 @@ def frozen_claimable(ch: Channel) -> str:
         return "moving"
     if m.limited or (m.pos == 0.0 and math.copysign(1.0, m.pos) < 0):
         return "moving"
-    if ch.dpos != m.pos or ch.dvel != 0.0:
+    return standing_reason(ch)
+
+
+def standing_reason(ch: Channel) -> str:
+    """What a channel whose cycle changes nothing needs besides its own state's conditions
+    (:func:`frozen_claimable`, :func:`gtecat.drives.homing_bank.idle_claimable`): the
+    demand on the motor at rest, no touch probe, 607Ah on 6064h ("" when so)."""
+    if ch.dpos != ch.mech.pos or ch.dvel != 0.0:
         return "moving"
     if ch.tp_function or ch._tp_applied or ch.probe.function:
         return "touch probe"
@@ -238,6 +244,13 @@ class CspBank:
         self.lim, self.nlim, self.half_lim = f(n), f(n), f(n)
         self.fe_running = self.fe_next = False  # some row's following-error timer runs
         self._din_safe = 0  # cycles in which no row can reach a limit switch
+        #: a load changed what :meth:`_flags` looks at (the values of each row's last load)
+        self._flags_due = True
+        self._row_flags: dict[int, tuple] = {}
+        #: the (kp, kff, amax, dt) each row's _prepare_row last computed with
+        self._prepared: dict[int, tuple] = {}
+        self._din_zero: np.ndarray | None = None
+        self.nvmax = f(n)
         for r, ch in enumerate(self.channels):
             self.load(r)
             for bit, win in ((2, ch._hs), (16, ch._p1), (17, ch._p2)):
@@ -263,6 +276,8 @@ class CspBank:
         before the next step or output."""
         ch = self.channels[r]
         m = ch.mech
+        if self.din is self._din_zero:  # (the shared zeros of cycles off every switch)
+            self.din = self._din_zero.copy()
         self.din[r] = ch.digital_inputs
         self.target[r] = ch.target_position
         self._din_safe = 0
@@ -274,9 +289,13 @@ class CspBank:
         self.limited[r] = m.limited
         self.sw_limited[r] = ch.sw_limited
         self.vmax[r], self.amax[r], self.a_rated[r] = m.vmax, m.amax, m.a_rated
+        self.nvmax[r] = -self.vmax[r]
         self.visc[r], self.kp[r], self.kff[r] = m.visc, m.kp, m.kff
         if self._dt:
-            self._prepare_row(r, self._dt)
+            key = (m.kp, m.kff, m.amax, self._dt)
+            if self._prepared.get(r) != key:  # (a drive taken again mostly brings the same)
+                self._prepare_row(r, self._dt)
+                self._prepared[r] = key
         self.off[r] = ch.enc_offset
         self.pos_offset[r] = ch.pos_offset
         lo, hi = ch.sw_limit_min, ch.sw_limit_max
@@ -294,13 +313,31 @@ class CspBank:
         on = bool(probe.function & 0x0101)
         self.tpw[r] = on
         self.tp_lo[r], self.tp_hi[r] = probe.quiet_bounds(m.pos) if on else (-np.inf, np.inf)
+        # what _flags looks at of this row: looked at again only when it changed (a drive
+        # given back and taken again mostly brings the same)
+        key = (ch.pos_offset, ch.enc_offset, lo, hi, w, on)
+        if self._row_flags.get(r) != key:
+            self._row_flags[r] = key
+            self._flags_due = True
         if flags:
+            self._flags()
+
+    def row_changed(self, r: int) -> None:
+        """Row ``r``'s values that :meth:`_flags` reads were changed outside :meth:`load`
+        (its touch probe armed in the bank): its next load looks at them again."""
+        self._row_flags.pop(r, None)
+
+    def after_loads(self) -> None:
+        """:meth:`_flags` after loads with ``flags`` False, when one changed what it looks at
+        (the values it reads change only at a load)."""
+        if self._flags_due:
             self._flags()
 
     def _prepare(self, dt: float) -> None:
         """``Mechanics._prepare`` per row, with math.exp (numpy's exp may differ by an ulp)."""
         self._dt = dt
         self._din_safe = 0
+        self._prepared.clear()
         for r in range(len(self.channels)):
             self._prepare_row(r, dt)
 
@@ -315,6 +352,7 @@ class CspBank:
 
     def _flags(self) -> None:
         """Which optional parts of the cycle any row needs (skipped when none does)."""
+        self._flags_due = False
         self.any_pos_offset = bool(np.count_nonzero(self.pos_offset))
         self.any_off = bool(np.count_nonzero(self.off))
         # 607Ah is an int32: limits at (or beyond) the int32 range never clamp it
@@ -556,6 +594,16 @@ class CspBank:
                     x = int(values[k])
                     setattr(ch, name, wrap32(x) if name in wrapped else x)
             ch.mode_display = ch.mode
+
+    def rested(self, r: int) -> None:
+        """Give row ``r`` back after cycles the bank skipped whole (a frozen row: its channel
+        rests unpowered, :func:`frozen_claimable`, or stands in homing mode before a homing,
+        :func:`gtecat.drives.homing_bank.idle_claimable`): each of those steps would have
+        left every value of the channel as it is, and nothing touched the channel meanwhile
+        (the bank's guard gives a row back first), so its objects hold them already; only
+        its count of cycles moves on."""
+        self.channels[r].cycle += self.cycles - int(self.start[r])
+        self.start[r] = self.cycles
 
     def _one_row(self, r: int) -> dict[str, int] | None:
         """:meth:`_row_outputs` of row ``r`` alone in Python floats: the same IEEE operations

@@ -24,9 +24,19 @@ follow it): an application that homes and never switches back to CSP keeps its a
 bank, a failed search's braking included.  The move back onto a home point found (RETURN)
 is such a row too, until it settles there.
 
+Before its homing a drive switched to homing mode stands: with no procedure started
+(``homing`` None) :func:`gtecat.drives.modes.step_hm` only holds the demand where the motor
+stands, so its cycle changes nothing.  Such a channel is a row whose cycle the compiled
+kernel skips, as a switched-off drive's (the bank's ``frz`` rows, here with the servo on:
+:func:`idle_claimable`); a GT call on its axis (GT_StartEcatHoming raising CW4 among
+them) gives it back before anything of it changes.  An application that switches many
+axes to homing mode one after the other, then starts them, no longer steps every switched
+axis in Python while each next one waits for its 6061h.
+
 This module says when a channel may be such a row (:func:`homing_claimable`,
-:func:`homing_rest_claimable`), where the nearest events lie (:func:`event_bounds`), and
-moves the search state between the :class:`Homing` object and a row (:data:`ROW_FIELDS`).
+:func:`homing_rest_claimable`, :func:`idle_claimable`), where the nearest events lie
+(:func:`event_bounds`), and moves the search state between the :class:`Homing` object and
+a row (:data:`ROW_FIELDS`).
 """
 
 from __future__ import annotations
@@ -34,7 +44,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from .csp_bank import running_reason
+from .cia402 import State
+from .csp_bank import CW_ENABLED, running_reason, standing_reason
 from .homing import HomingPhase
 from .homing_methods import Signal
 from .modes import OpMode
@@ -120,6 +131,45 @@ def homing_rest_claimable(ch: Channel) -> str:
     if ch.oms != ch.hm_bits:
         return "statusword bits"
     return ""
+
+
+def idle_claimable(ch: Channel) -> str:
+    """Why ``ch`` is not standing in homing mode before a homing ("" when it is): operation
+    enabled, mode 6 shown, no procedure (``homing`` None), controlword "enable operation"
+    with CW4 low as in the cycles before, nothing pending, and the state its step keeps
+    (:func:`gtecat.drives.modes.step_hm`: ``stop_ramp`` at speed 0, the motor tracking a
+    demand it stands on, no following error), so that its cycle changes nothing and a bank
+    row may skip it whole (the bank's ``frz`` rows with the servo on)."""
+    psm = ch.psm
+    if psm.state is not State.OPERATION_ENABLED:
+        return "not operation enabled"
+    if ch.mode != OpMode.HOMING or ch.mode_req != ch.mode or ch.mode_display != ch.mode:
+        return "not in homing mode"
+    if ch.mode_due is not None or ch.mode_seen != ch.mode:
+        return "mode change pending"
+    if ch.homing is not None:
+        return "a homing"
+    cw = ch.controlword
+    if cw != CW_ENABLED or ch.prev_cw != cw or psm.last_cw != cw:
+        return "controlword"
+    if ch.faults.pending or ch.faults.injected or ch.faults.cause_active:
+        return "fault"
+    if ch.field is not None:
+        return "field fault"
+    # stop_ramp holds dvel at +0.0 and dpos where it is (stopping already set)
+    if not ch.stopping or ch.torque_ctl or ch.limit_stop:
+        return "not holding"
+    if ch.fe_flag or ch.fe_time or ch.oms != ch.hm_bits:
+        return "following error"
+    m = ch.mech
+    # Mechanics.track onto the demand it stands on gives +0.0 speed, acceleration and
+    # torque and leaves the position: the values must be those already
+    for x in (m.vel, m.acc, m.torque, ch.dvel, m.pos, ch.dpos):
+        if x == 0.0 and math.copysign(1.0, x) < 0:
+            return "moving"
+    if m.vel != 0.0 or m.acc != 0.0 or m.torque != 0.0 or m.limited:
+        return "moving"
+    return standing_reason(ch)
 
 
 def rest_constants(h: Homing) -> dict[str, float]:

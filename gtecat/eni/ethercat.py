@@ -10,6 +10,17 @@ from __future__ import annotations
 
 from enum import IntEnum
 
+#: Ethernet II header (destination, source, EtherType); no VLAN tag (masters send none)
+ETH_HEADER_LEN = 14
+#: the EtherCAT frame header: length 11 bits, reserved 1, type 4 (ETG.1000.4 5.3)
+ECAT_HEADER_LEN = 2
+#: a datagram's header (Cmd, Idx, ADP, ADO, Len/R/C/M, IRQ) and its working counter (5.4)
+DATAGRAM_HEADER_LEN = 10
+WKC_LEN = 2
+#: an Ethernet frame carries at most 1500 bytes (1514 without FCS): the EtherCAT header and
+#: its datagrams
+MAX_ECAT_LEN = 1498
+
 
 class Command(IntEnum):
     """Datagram commands (ETG.1000.4 5.4: Table 14 is APRD, the other commands follow it)."""

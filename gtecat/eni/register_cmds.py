@@ -89,7 +89,8 @@ FmmuRegister = Struct(
     Padding(3),
 )
 _FMMU_TYPE = {Direction.OUT: 2, Direction.IN: 1}
-_KIND = {Direction.OUT: "outputs", Direction.IN: "inputs"}
+#: what each direction's image holds, in comments
+KIND = {Direction.OUT: "outputs", Direction.IN: "inputs"}
 
 
 @dataclass(frozen=True, slots=True)
@@ -278,11 +279,11 @@ def slave_cmds(s: Slave, bases: dict[Direction, int]) -> list[RegisterCmd]:
     for m in maps:
         start, control = SM_DEFAULT[m.direction]
         data = SmRegister.build({"start": start, "length": m.length, "control": control})
-        what = f"set sm {m.number} ({_KIND[m.direction]})"
+        what = f"set sm {m.number} ({KIND[m.direction]})"
         cmds.append(RegisterCmd(ps, what, Command.FPWR, fp, Reg.SM0 + 8 * m.number, data, cnt=1))
     mapped = sorted((m for m in maps if m.logical_bit is not None), key=lambda m: m.direction)
     for k, m in enumerate(mapped):
-        what = f"set fmmu {k} ({_KIND[m.direction]})"
+        what = f"set fmmu {k} ({KIND[m.direction]})"
         data = fmmu_bytes(m, bases[m.direction])
         cmds.append(RegisterCmd(ps, what, Command.FPWR, fp, Reg.FMMU0 + 16 * k, data, cnt=1))
     up, down_mask = AL_STATUS_MASK, AL_STATE_MASK  # up: without error; down: the state only

@@ -51,7 +51,9 @@ the CiA-402 object table, else ``0xIIII:SS`` and an unsigned type of the size.
 The logical images are laid out zero-based (acontis/Elmo style): slaves in
 bus order, each slave's outputs byte-aligned in the output image, its inputs
 likewise; every non-padding entry gets a ``ProcessImage`` variable named
-``<slave>.<pdo>.<entry>``.
+``<slave>.<pdo>.<entry>``.  Station addresses (``PhysAddr``) are 1001 + position, as
+TwinCAT numbers them, and past FFFFh the addresses below 1001: a topology holds up to
+65 535 slaves, as many as an EtherCAT bus.
 """
 
 from __future__ import annotations
@@ -75,7 +77,7 @@ from .datatypes import (
     type_bits,
 )
 from .errors import EniError
-from .limits import cycle_ns_from_us
+from .limits import SLAVE_COUNT, cycle_ns_from_us
 from .model import (
     Direction,
     EniConfig,
@@ -90,6 +92,11 @@ from .model import (
 from .numbers import fmt_index, parse_int
 
 GTEC_VENDOR_ID = 0x47544543  # "GTEC": the emulator's own vendor id, not a real ETG one
+#: the station address (ENI ``PhysAddr``) of the slave at position 0, as TwinCAT numbers them
+FIRST_STATION = 1001
+#: the most slaves one bus holds: station and auto-increment addresses are 16 bits (ETG.1000.4,
+#: ETG.2100 ``PhysAddr``), and 0 is the station address of a slave not given one
+MAX_SLAVES = SLAVE_COUNT.hi
 _PRODUCT = {"servo": 0x00010001, "io": 0x00020001, "coupler": 0x00030001, "generic": 0x00040001}
 _MODULE = re.compile(r"^(DI|DO|AI|AO)(\d+)$")
 #: manual figure 5-2, GTHD default mapping
@@ -157,10 +164,17 @@ def build_config(data: Mapping[str, Any], source: str = "<topology>") -> EniConf
             "(gtecat example manual_fig5_2 writes one to start from)",
             "slave",
         )
+    if len(tables) > MAX_SLAVES:
+        raise where.error(
+            f"the topology has {len(tables)} slaves: an EtherCAT bus holds at most "
+            f"{MAX_SLAVES} (16-bit station addresses, 0 being that of a slave not given one)",
+            "slave",
+        )
 
     slaves = []
+    shared: dict[object, Any] = {}
     for pos, table in enumerate(tables):
-        slaves.append(_slave(_Where(source, pos), pos, table))
+        slaves.append(_slave(_Where(source, pos), pos, table, shared))
     cfg = lay_out(
         EniConfig(
             source=source,
@@ -282,7 +296,10 @@ def _bool(where: _Where, table: Mapping[str, Any], key: str, default: bool) -> b
     return value
 
 
-def _slave(where: _Where, pos: int, t: Mapping[str, Any]) -> Slave:
+def _slave(where: _Where, pos: int, t: Mapping[str, Any], shared: dict[object, Any]) -> Slave:
+    """Slave ``pos``; ``shared`` holds the identities and init commands of the slaves before it,
+    so equal ones are one object (the model is immutable; a bus of 65 535 like drives would
+    otherwise hold 65 535 copies of them, as the XML reader never does)."""
     kind = t.get("kind")
     if kind not in _KIND_KEYS:
         raise where.error(f"kind must be one of servo, io, coupler, generic (got {kind!r})", "kind")
@@ -315,21 +332,33 @@ def _slave(where: _Where, pos: int, t: Mapping[str, Any]) -> Slave:
         revision_no=_int(where, t, "revision", 0),
         serial_no=_int(where, t, "serial", 0),
     )
+    identity = shared.setdefault(identity, identity)
     want_cmds = _bool(where, t, "init_cmds", kind == "servo")
     if want_cmds and not mailbox:
         raise where.error("init_cmds need a mailbox (mailbox = true)", "init_cmds")
-    cmds = assignment_cmds(rx, tx) if want_cmds else ()
+    cmds: tuple[InitCmd, ...] = ()
+    if want_cmds:
+        cmds = shared.get((rx, tx), ())
+        if not cmds:
+            cmds = shared[rx, tx] = assignment_cmds(rx, tx)
     return Slave(
         position=pos,
         name=name,
         identity=identity,
-        phys_addr=1001 + pos,
+        phys_addr=station_address(pos),
         auto_inc_addr=(-pos) & 0xFFFF,
         rx_pdos=rx,
         tx_pdos=tx,
         init_cmds=cmds,
         mailbox=mailbox,
     )
+
+
+def station_address(pos: int) -> int:
+    """The station address of bus position ``pos``: 1001, 1002, ... up to FFFFh, then the
+    ones left below 1001 (1, 2, ...), so each of :data:`MAX_SLAVES` slaves has its own."""
+    station = FIRST_STATION + pos
+    return station if station <= 0xFFFF else station - 0xFFFF
 
 
 def parse_entry(where: _Where, spec: Any, element: str) -> PdoEntry:

@@ -13,6 +13,18 @@ A fault is armed with a trigger (at once, ``at_ms``, ``after_ms``, ``after_cycle
 ``when_position = [axis, position]``, ``at_homing = [axis, stage]``, ``on_sdo = [slave,
 index, n]``), may last ``duration_ms``, and may wait for another (``after = id``: a script's
 step).  Starts and ends go to the master log.
+
+Threads.  :func:`inject`, :func:`script`, :func:`clear` and :func:`listing` may be called
+from any thread of the application (a watchdog, a test harness) while another one cycles
+the controller (its GT calls, ``GTE_Wait``, the realtime clock's cycle thread): each holds
+the controller's clock lock, as every GT call does (:func:`_between_cycles`), so what it
+does falls whole between two cycles - every step of a script armed, every fault cleared -
+and the next cycle is the first to act on it.  It is taken as a GT call of that thread
+would be: after the call another thread has under way (a long ``GTE_Wait`` on the auto
+clock included: its cycles are that call's), or the realtime cycle under way.  A fault armed
+at once starts there; one with ``at_ms`` starts at that controller time whichever thread
+armed it, provided it was armed before that time.  The cycles pay nothing for this: they
+hold the lock already.
 """
 
 from __future__ import annotations
@@ -20,6 +32,7 @@ from __future__ import annotations
 import numbers
 import operator
 from collections.abc import Mapping
+from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -312,6 +325,14 @@ def _arm_machine(ctl: Any, holding: bool = False) -> None:
             raise CommandError(str(e)) from None
 
 
+def _between_cycles(ctl: Any) -> AbstractContextManager[Any]:
+    """``ctl``'s clock lock (module docstring "Threads"): held, no cycle runs and no other
+    thread's GT call is under way, so a fault added or ended is seen whole by the next cycle.
+    A ``gtecat serve`` has none: its faults change between two frames, in its own loop."""
+    lock = getattr(getattr(ctl, "clock", None), "lock", None)
+    return nullcontext() if lock is None else lock
+
+
 def _controller(core: int = 1) -> Any:
     from ..gt._core import SESSION
 
@@ -341,10 +362,11 @@ def inject(
         spec = spec_from_dict({**kind.as_dict(), **values})
     else:
         spec = spec_from_dict({"kind": kind, **values})
-    inj = injector_for(ctl)
-    assert inj is not None
-    fid = arm(inj, [spec])[0].id
-    _tell("inject", spec.as_dict())
+    with _between_cycles(ctl):
+        inj = injector_for(ctl)
+        assert inj is not None
+        fid = arm(inj, [spec])[0].id
+        _tell("inject", spec.as_dict())
     return fid
 
 
@@ -359,35 +381,38 @@ def script(steps: list[dict[str, Any]], *, core: int = 1, ctl: Any = None) -> li
         )
     specs = [spec_from_dict(step, f"step {i}") for i, step in enumerate(steps, 1)]
     ctl = ctl or _controller(core)
-    inj = injector_for(ctl)
-    assert inj is not None
     ids: list[int] = []
-    for spec in specs:
-        if ids and spec.after is None:
-            spec.after = ids[-1]
-        ids.append(arm(inj, [spec])[0].id)
-        _tell("inject", spec.as_dict())
+    with _between_cycles(ctl):  # (every step armed before the next cycle: one change)
+        inj = injector_for(ctl)
+        assert inj is not None
+        for spec in specs:
+            if ids and spec.after is None:
+                spec.after = ids[-1]
+            ids.append(arm(inj, [spec])[0].id)
+            _tell("inject", spec.as_dict())
     return ids
 
 
 def clear(ident: int | None = None, *, core: int = 1, ctl: Any = None) -> int:
     """End one fault (its id) or every fault; how many."""
     ctl = ctl or _controller(core)
-    inj = injector_for(ctl, create=False)
-    if inj is None:
-        if ident is not None:
-            raise ParameterError(f"no fault {ident}: none was injected")
-        return 0
-    n = inj.clear(ident)
-    _tell("clear", {"id": ident})
+    with _between_cycles(ctl):
+        inj = injector_for(ctl, create=False)
+        if inj is None:
+            if ident is not None:
+                raise ParameterError(f"no fault {ident}: none was injected")
+            return 0
+        n = inj.clear(ident)
+        _tell("clear", {"id": ident})
     return n
 
 
 def listing(*, core: int = 1, ctl: Any = None) -> list[dict[str, Any]]:
     """The armed and active faults: id, kind, values, trigger, state and ``describe``."""
     ctl = ctl or _controller(core)
-    inj = injector_for(ctl, create=False)
-    return [] if inj is None else inj.listing()
+    with _between_cycles(ctl):  # (as one moment of the faults: no cycle halfway through)
+        inj = injector_for(ctl, create=False)
+        return [] if inj is None else inj.listing()
 
 
 def describe(values: dict[str, Any]) -> str:

@@ -4,6 +4,8 @@ A recording is one JSON-lines file (gzip when its name ends in ``.gz``):
 
 * a header ``{"gtecat_recording": 1, "calls": N, ...}``: N call lines follow (a replay
   refuses a file that holds fewer, one cut short at a line's end, or more);
+  ``bus_config``: the ENI files and machine descriptions the session's buses were brought up
+  from, compared before a replay runs (:mod:`gtecat.faults.bus_config`);
 * one line per GT call: ``{"t": controller time in ns, "c": NAME, "a": [arguments], "r":
   return code, "k": {keywords}, "o": {index: value written back}}``, and ``"b"``: the
   controller time when the call began, where time passed since the call before (a
@@ -29,7 +31,6 @@ from __future__ import annotations
 
 import ctypes
 import gc
-import gzip
 import hashlib
 import json
 import marshal
@@ -396,20 +397,36 @@ class Recorder(Listener):
             "cwd": os.getcwd(),
             "env": {k: v for k, v in os.environ.items() if k in _ENV},
         }
+        #: the configuration files of every bus brought up (gtecat.faults.bus_config): the
+        #: header's ``bus_config``, which the replay compares before it runs
+        self.bus_config: list[dict[str, str]] = []
 
     def start(self) -> Recorder:
+        from ..controller.core import Controller
         from . import injector
 
         tap(self)
         injector.OBSERVERS.append(self.fault_event)
+        Controller.bus_up_hooks.append(self.bus_up)
         return self
 
     def stop(self) -> None:
+        from ..controller.core import Controller
         from . import injector
 
         untap(self)
         if self.fault_event in injector.OBSERVERS:
             injector.OBSERVERS.remove(self.fault_event)
+        if self.bus_up in Controller.bus_up_hooks:
+            Controller.bus_up_hooks.remove(self.bus_up)
+
+    def bus_up(self, ctl: Any) -> None:
+        """A bus came up (``Controller.bus_up_hooks``): its configuration files noted."""
+        from .bus_config import noted
+
+        for note in noted(ctl):
+            if note not in self.bus_config:
+                self.bus_config.append(note)
 
     def before(self, name: str, args: tuple, kwargs: dict) -> Any:
         if self.thread is not None and threading.get_ident() != self.thread:
@@ -482,9 +499,13 @@ class Recorder(Listener):
         lines = list(self.lines)  # (a client's call may still be adding one: these, counted)
         calls = sum(1 for x in lines if x.startswith('{"t":'))  # a call's line, as after() writes
         head = {"gtecat_recording": FORMAT, "calls": calls, **self.meta, **self.where}
+        if self.bus_config:
+            head["bus_config"] = self.bus_config
         text = json.dumps(head) + "\n" + "\n".join(lines) + ("\n" if lines else "")
         data = text.encode()
         if self.path.suffix == ".gz":
+            import gzip  # (here: a replay of a plain recording never needs it)
+
             data = gzip.compress(data, 6)
         self.path.write_bytes(data)
         del text, lines
@@ -611,6 +632,8 @@ def _open_text(
     if raw is None:
         raw = _read_raw(p)
     if raw[:2] == b"\x1f\x8b":
+        import gzip
+
         try:
             raw = gzip.decompress(raw)
         except EOFError:  # the compressed stream stops before its end marker
@@ -798,6 +821,9 @@ def replay(
             gc.enable()
     try:
         with _where(head):
+            from .bus_config import check  # (the files as recorded: before anything runs)
+
+            check(head.get("bus_config"), eni, machine)
             return _replay(steps, eni, machine, head.get("cwd"), marks)
     finally:
         if freeze:
@@ -1758,7 +1784,9 @@ def _replay(
     """Make every step's call again, in order, and compare it: (calls made, the first
     divergence or None).
 
-    Every call is made, one at a time, as the application made it.  Answering runs of
+    Every call is made, one at a time, as the application made it: those of the simple
+    forms (their compiled runs) by the C entries' loop where it is available
+    (:func:`_replay_in_c`: no Python frame per call), the others here.  Answering runs of
     pure reads without making them (one snapshot of the readers' values per cycle, taken
     through the readers' own array forms with the call latency set to 0, the recorded
     values compared with it, the cycles made by the calls whose latency makes them due)
@@ -1773,57 +1801,142 @@ def _replay(
     steps made alone) pay: a call from C into each compiled run costs what the loop's
     bytecodes cost (the same CPU, 1.7 % more instructions)."""
     from .. import faults, gt
+    from ..gt.centry import replay_loop
 
     eni = str(Path(eni).resolve()) if eni else None
     machine = str(Path(machine).resolve()) if machine else None
     _check_files(steps, eni, machine, cwd, marks)
     gt.GT_Close()
-    n = 0
+    loop = replay_loop() if C_LOOP else None
     try:
-        for p, vals in steps:
-            if p is None:
-                div = _other(vals, n, faults)
+        if loop is None:
+            n = 0
+            for p, vals in steps:
+                run = p.run if type(p) is _Call else None
+                if run is not None:  # (the common call, compiled: _step's first way, inline)
+                    n += 1
+                    r = run(vals)
+                    if r is None:
+                        continue
+                    div = _ran(p, vals, n, r)
+                else:
+                    n, div = _step(p, vals, n, eni, machine, faults)
                 if div is not None:
                     return n, div
-                continue
-            n += 1
-            if p is _Stop:
-                what, text = vals
-                if what == "missing":
-                    return n, Divergence(n, text, "function", "present", "missing")
-                raise ParameterError(f"damaged recording: call {n} {text}")
-            run = p.run
-            if run is not None:  # the common call, compiled: compared in full only if it may differ
-                r = run(vals)
-                if r is None:
-                    continue
-                if type(r) is not tuple:
-                    raise ParameterError(
-                        f"damaged recording: call {n} ({p.name}): an argument cannot be made "
-                        f"again: {type(r).__name__}: {r}"
-                    )
-                args, kw, rc = p.args, {}, r[0]
-            else:
-                args, kw, rc = _call(p, vals, n, eni, machine)
-            if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
-                return n, Divergence(n, p.name, "return code", p.rc, rc)
-            for obj, k, i, c in p.quick:
-                if obj.value != vals[k]:
-                    want = {"ref": {"c": c, "v": vals[k]}}
-                    got = encode(args[i])
-                    if got != want:
-                        return n, Divergence(n, p.name, f"argument {i + 1}", want, got)
-            for mv, k, i, kind in p.aquick:
-                if mv.tobytes() != vals[k]:
-                    return n, _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
-            for where, want in p.checks:
-                got = encode(args[where] if type(where) is int else kw.get(where))
-                if got != want:
-                    what = f"argument {where + 1}" if type(where) is int else where
-                    return n, _first_element(Divergence(n, p.name, what, want, got))
+            return n, None
+        return _replay_in_c(loop, steps, eni, machine, faults)
     finally:
         gt.GT_Close()
+
+
+#: a replay makes the calls of the simple forms in the C entries' loop where it is available
+#: (:func:`gtecat.gt.centry.replay_loop`); False: every call from Python (tests compare both)
+C_LOOP = True
+
+
+def _replay_in_c(
+    loop: Any, steps: list[tuple[Any, Any]], eni: str | None, machine: str | None, faults: Any
+) -> tuple[int, Divergence | None]:
+    """:func:`_replay`'s loop with the C entries' loop making the calls it was taught (each
+    compiled form's call, the first time it stops there: :func:`_teach`); every other step,
+    and a call whose code or left value may differ, here as :func:`_step` makes it."""
+    run = loop.run
+    whole = tuple(steps)
+    total = len(whole)
+    n = i = 0
+    while i < total:
+        r = run(whole, i)
+        if type(r) is int:
+            j, made = r, None
+        else:
+            j, made = r[0], r
+        n += j - i  # (each step the loop made is a call that matched)
+        if j >= total:
+            break
+        p, vals = whole[j]
+        if made is not None:  # (made: compared in full)
+            n += 1
+            div = _compared(p, vals, n, p.args, {}, made[1])
+        elif p is not None and p is not _Stop and not loop.knows(p) and _teach(loop, p):
+            i = j  # (taught: the loop makes it from here)
+            continue
+        else:
+            n, div = _step(p, vals, n, eni, machine, faults)
+        if div is not None:
+            return n, div
+        i = j + 1
     return n, None
+
+
+def _teach(loop: Any, p: _Call) -> bool:
+    """Tell the C loop how to make ``p``'s call as its compiled run makes it (the values its
+    pooled objects are set to and left with), or to leave it to Python (no compiled run, a
+    time it began at, an object the loop does not take); True where the loop makes it."""
+    if p.run is None or p.before_at is not None:
+        return loop.teach(p)  # type: ignore[no-any-return]
+    return loop.teach(  # type: ignore[no-any-return]
+        p,
+        p.fn,
+        tuple(p.args),
+        p.rc,
+        [*p.sets, *p.asets],
+        [(obj, k) for obj, k, _, _ in p.quick] + [(mv, k) for mv, k, _, _ in p.aquick],
+    )
+
+
+def _step(
+    p: Any, vals: Any, n: int, eni: str | None, machine: str | None, faults: Any
+) -> tuple[int, Divergence | None]:
+    """One step of the replay (a call made and compared, a checkpoint compared, a fault
+    injected or cleared): (calls made so far, the divergence or None)."""
+    if p is None:
+        return n, _other(vals, n, faults)
+    n += 1
+    if p is _Stop:
+        what, text = vals
+        if what == "missing":
+            return n, Divergence(n, text, "function", "present", "missing")
+        raise ParameterError(f"damaged recording: call {n} {text}")
+    run = p.run
+    if run is not None:  # the common call, compiled: compared in full only if it may differ
+        r = run(vals)
+        return n, None if r is None else _ran(p, vals, n, r)
+    args, kw, rc = _call(p, vals, n, eni, machine)
+    return n, _compared(p, vals, n, args, kw, rc)
+
+
+def _ran(p: _Call, vals: Any, n: int, r: Any) -> Divergence | None:
+    """Call ``n`` after its compiled run said it may differ (``(rc,)``) or that an argument
+    could not be set (the exception): compared in full, or the damage reported."""
+    if type(r) is not tuple:
+        raise ParameterError(
+            f"damaged recording: call {n} ({p.name}): an argument cannot be made "
+            f"again: {type(r).__name__}: {r}"
+        )
+    return _compared(p, vals, n, p.args, {}, r[0])
+
+
+def _compared(
+    p: _Call, vals: Any, n: int, args: Any, kw: dict[str, Any], rc: Any
+) -> Divergence | None:
+    """Call ``n`` compared in full: its code, the values it left in its pointers."""
+    if rc != p.rc and (type(rc) is int or encode(rc) != p.rc):
+        return Divergence(n, p.name, "return code", p.rc, rc)
+    for obj, k, i, c in p.quick:
+        if obj.value != vals[k]:
+            want = {"ref": {"c": c, "v": vals[k]}}
+            got = encode(args[i])
+            if got != want:
+                return Divergence(n, p.name, f"argument {i + 1}", want, got)
+    for mv, k, i, kind in p.aquick:
+        if mv.tobytes() != vals[k]:
+            return _array_divergence(n, p.name, i, kind, vals[k], mv.tobytes())
+    for where, want in p.checks:
+        got = encode(args[where] if type(where) is int else kw.get(where))
+        if got != want:
+            what = f"argument {where + 1}" if type(where) is int else where
+            return _first_element(Divergence(n, p.name, what, want, got))
+    return None
 
 
 #: the calls that bring a bus up from the files an open named

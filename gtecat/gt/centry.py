@@ -254,6 +254,42 @@ class _MultiEntry(ctypes.Structure):
     ]
 
 
+_R_MAX = 6
+
+
+class _RPut(ctypes.Structure):
+    """``struct rput`` of csrc/centry.c: a value a replayed call sets or leaves."""
+
+    _fields_ = [("mem", _VP), ("kind", ctypes.c_longlong), ("k", ctypes.c_longlong)]
+
+
+class _Runner(ctypes.Structure):
+    """``struct runner`` of csrc/centry.c: one recorded call's form, made by the replay's loop."""
+
+    _fields_ = [
+        ("fn", _VP),
+        ("args", _VP),
+        ("rc", _VP),
+        ("python", ctypes.c_longlong),
+        ("nsets", ctypes.c_longlong),
+        ("nouts", ctypes.c_longlong),
+        ("sets", _RPut * _R_MAX),
+        ("outs", _RPut * _R_MAX),
+    ]
+
+
+class _RTable(ctypes.Structure):
+    """``struct rtable`` of csrc/centry.c: the replay loop's calls (the C function's self)."""
+
+    _fields_ = [
+        ("mask", ctypes.c_longlong),
+        ("keys", ctypes.POINTER(_VP)),
+        ("runners", ctypes.POINTER(_VP)),
+        ("titems", ctypes.c_ssize_t),
+        ("tuple_type", _VP),
+    ]
+
+
 #: what an argument after a multi-value reader's outputs must be: the int 1 (a count), the
 #: int 0 (a FIFO, a mode), None or the int 0 (a NULL pointer)
 ONE, ZERO, NULL = 1, 0, 2
@@ -866,6 +902,7 @@ def _load() -> tuple[Maker | None, str]:
         raw_vc = ctypes.cast(lib.gtecat_centry_raw_vc, _VP).value
         multi_meth = ctypes.cast(lib.gtecat_centry_multi, _VP).value
         multi_vc = ctypes.cast(lib.gtecat_centry_multi_vc, _VP).value
+        replay_meth = ctypes.cast(lib.gtecat_centry_replay, _VP).value
         new = byref_target.function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
@@ -1014,8 +1051,16 @@ def _load() -> tuple[Maker | None, str]:
         fn = new(b"gt_centry_multi", multi_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, multi_vc, e, keep)
 
+    def make_replay() -> ReplayLoop:
+        t = _RTable(0, None, None, titems, id(tuple))
+        loop = ReplayLoop(t)
+        # (the table kept with the function, the loop not: its calls go with the replay)
+        loop.run = new(b"gt_centry_replay", replay_meth, _METH_FASTCALL_KEYWORDS, t, None)
+        return loop
+
     make.raw = make_raw  # type: ignore[attr-defined]
     make.multi = make_multi  # type: ignore[attr-defined]
+    make.replay = make_replay  # type: ignore[attr-defined]
     for _ in range(2):
         try:
             reason = _self_test(make) or _self_test_raw(make_raw) or _self_test_multi(make_multi)
@@ -1692,3 +1737,124 @@ def runs(triples: Iterable[tuple[int, int, int]]) -> bytes:
     """Runs of a copy as :func:`raw`'s ``value`` gives them: ``(first byte in the caller's
     array, address in the image, bytes)`` each."""
     return b"".join(_RUN.pack(*t) for t in triples)
+
+
+#: the kind csrc/centry.c's replay loop gives each simple ctypes type's values (struct rput)
+_R_KINDS = {
+    **{code: ctypes.sizeof(getattr(ctypes, name)) for code, name in (
+        ("b", "c_byte"), ("h", "c_short"), ("i", "c_int"), ("l", "c_long"), ("q", "c_longlong"),
+    )},
+    **{code: 16 + ctypes.sizeof(getattr(ctypes, name)) for code, name in (
+        ("B", "c_ubyte"), ("H", "c_ushort"), ("I", "c_uint"), ("L", "c_ulong"),
+        ("Q", "c_ulonglong"),
+    )},
+    "d": 100,
+    "f": 101,
+}  # fmt: skip
+
+
+class ReplayLoop:
+    """A replay's loop in C (csrc/centry.c ``replay_run``): ``run(steps, start)`` makes the
+    calls of ``steps`` (a tuple of ``(call, values)``) from ``start`` whose calls were
+    taught it (:meth:`teach`), as the replay's compiled runs make them, and stops at the
+    first it cannot: its index (nothing of that call made), or ``(index, code)`` where the
+    call was made and its code or a value it left may differ from the recorded one (the
+    replay compares in full).  A call it was not taught stops it, every time one it was
+    told to leave to Python."""
+
+    def __init__(self, table: Any) -> None:
+        self._table = table
+        self._keys: Any = None
+        self._runners: Any = None
+        self._held: dict[int, tuple[Any, ...]] = {}  # id(call) -> (call, its runner, keep)
+        self.run: Callable[[tuple, int], Any] = lambda steps, start: start
+        self._grow(1024)
+
+    def _grow(self, slots: int) -> None:
+        keys, runners = (_VP * slots)(), (_VP * slots)()
+        mask = slots - 1
+        for key, (_, runner, _) in self._held.items():
+            h = (key >> 4) & mask
+            while keys[h]:
+                h = (h + 1) & mask
+            keys[h], runners[h] = key, ctypes.addressof(runner)
+        t = self._table
+        t.mask = 0  # (no slot while they are replaced: one only, the first, looked at)
+        self._keys, self._runners = keys, runners
+        t.keys = ctypes.cast(keys, ctypes.POINTER(_VP))
+        t.runners = ctypes.cast(runners, ctypes.POINTER(_VP))
+        t.mask = mask
+
+    def knows(self, call: Any) -> bool:
+        return id(call) in self._held
+
+    def teach(
+        self,
+        call: Any,
+        fn: Any = None,
+        args: tuple = (),
+        rc: Any = None,
+        sets: Iterable[tuple[Any, int]] = (),
+        outs: Iterable[tuple[Any, int]] = (),
+    ) -> bool:
+        """``call`` made here: ``fn(*args)``, its code ``rc`` (an int), the values
+        ``values[k]`` set into each object of ``sets`` before it and compared with each of
+        ``outs`` after it (a simple ctypes object, or a writable memoryview of an array's
+        bytes); or, with ``fn`` None, or an object of another kind, left to Python.  True
+        where this loop makes it."""
+        r = _Runner()
+        keep: list[Any] = [call, fn, args, rc]
+        puts = [_r_put(x, k, keep) for x, k in sets], [_r_put(x, k, keep) for x, k in outs]
+        if (
+            fn is None
+            or type(rc) is not int
+            or type(args) is not tuple
+            or None in puts[0]
+            or None in puts[1]
+            or len(puts[0]) > _R_MAX
+            or len(puts[1]) > _R_MAX
+        ):
+            r.python = 1
+        else:
+            r.fn, r.args, r.rc = id(fn), id(args), id(rc)
+            r.nsets, r.nouts = len(puts[0]), len(puts[1])
+            for into, got in zip((r.sets, r.outs), puts, strict=True):
+                for j, put in enumerate(got):
+                    into[j] = put
+        if 2 * (len(self._held) + 1) > self._table.mask + 1:
+            self._grow(2 * (self._table.mask + 1))
+        key = id(call)
+        self._held[key] = (call, r, keep)
+        mask = self._table.mask
+        h = (key >> 4) & mask
+        while self._keys[h] and self._keys[h] != key:
+            h = (h + 1) & mask
+        self._runners[h] = ctypes.addressof(r)
+        self._keys[h] = key  # (the key last: the runner is there when it is found)
+        return not r.python
+
+
+def _r_put(x: Any, k: int, keep: list[Any]) -> Any:
+    """A value of the replay loop (``struct rput``): where ``x`` keeps it and its kind, None
+    where the loop does not take it."""
+    if type(x) is memoryview:
+        if x.readonly or not x.contiguous or not x.nbytes:
+            return None
+        c = ctypes.c_ubyte.from_buffer(x)  # (its first byte; kept: the memory stays there)
+        keep.append(c)
+        return _RPut(ctypes.addressof(c), -x.nbytes, k)
+    kind = _R_KINDS.get(getattr(type(x), "_type_", None))  # type: ignore[arg-type]
+    if kind is None or not isinstance(x, ctypes._SimpleCData):  # type: ignore[attr-defined]
+        return None
+    if (kind % 16 or 8) != ctypes.sizeof(x) and kind < 100:
+        return None
+    keep.append(x)
+    return _RPut(ctypes.addressof(x), kind, k)
+
+
+def replay_loop() -> ReplayLoop | None:
+    """A new replay loop in C (:class:`ReplayLoop`), None where the C entries are not
+    available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE.replay()  # type: ignore[attr-defined, no-any-return]

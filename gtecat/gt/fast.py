@@ -546,12 +546,14 @@ def fast_reader(
         #: were picked from a list of the bank by a plan of its rows and zeros alone: that
         #: list and the plan's getter (else None)
         packed: list[Any] = [None, None, b"", None, None]
-        #: the last span a plan of the bank answered (span()'s, with a row of the bank): the
-        #: bank, n, count, the layout, resources and axes it holds for, its pick, whether
-        #: that picks the bank's rows and zeros alone (no other axis's getter), the getter of
-        #: the bytes of the run of rows it picks in order (AxisBank.span_bytes, else None),
-        #: the plan's getter of where its rows' values come from (_read_plan's, else None)
-        lane: list[Any] = [None] * 10
+        #: per span (n, count) a plan of the bank answered last (span()'s, with a row of the
+        #: bank): the bank, n, count, the layout, resources and axes it holds for, its pick,
+        #: whether that picks the bank's rows and zeros alone (no other axis's getter), the
+        #: getter of the bytes of the run of rows it picks in order (AxisBank.span_bytes,
+        #: else None), the plan's getter of where its rows' values come from (_read_plan's,
+        #: else None).  A span each: a program that reads two spans in turn
+        #: (``GT_GetEncPos(1, a, 8)``, ``GT_GetEncPos(9, byref(a, 64), 4)``) finds both
+        lanes: dict[tuple[int, int], list[Any]] = {}
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -599,12 +601,10 @@ def fast_reader(
                 # (an entry asks only while its gate is open: that gate's controller)
                 ctl = GATED[gate]
                 b = ctl.bank
-                ln = lane  # (one read: another thread may replace it meanwhile)
+                ln = lanes.get((n, count), _NO_LANE)  # (each lane is replaced whole)
                 if (
                     ln[0] is b
                     and b is not None
-                    and ln[1] == n
-                    and ln[2] == count
                     and ln[3] == b.layout
                     and ln[4] is ctl.resources
                     and ln[5] is ctl.axes
@@ -655,7 +655,9 @@ def fast_reader(
                         and plan[2] is ctl.axes
                     ):
                         run = plan[7]
-                        lane[:] = [
+                        if len(lanes) >= _LANES:  # (a program of many spans: the latest)
+                            lanes.clear()
+                        lanes[n, count] = [
                             *(b, n, count, *plan[:4], plan[6]),
                             None if run is None else b.span_bytes(bank_key, run),
                             plan[8],
@@ -1080,6 +1082,11 @@ QUICK_SOURCES: dict[str, tuple[int, str, str | None, str | None]] = {
     "GT_GetAxisError": (4, "a_last", "enc_pos", "enc_link"),
 }
 
+#: a span's lane that holds for nothing (a reader's array_value: no span answered yet)
+_NO_LANE = (None,) * 10
+#: the spans a reader's array_value keeps lanes of at most
+_LANES = 16
+
 #: the most axes a reader answers in one call (the encoder readers: 8, section 8.2)
 READ_LIMITS = {"GT_GetEncPos": 8, "GT_GetEncVel": 8}
 
@@ -1166,13 +1173,16 @@ def _read_plan(
     else:  # (the rows, the getters and the zeros in one tuple)
         env["MOVING"] = _STATUS_BITS["MOVING"]
         arg = "lst" if row is None else "b"
-        pick = eval(f"lambda {arg}: ({', '.join(items)},)", env)  # (row numbers, names, 0)
+        pick = eval(_plan_code(f"lambda {arg}: ({', '.join(items)},)", "eval"), env)
         if quick is not None and at is not None:
             env["slow"] = pick
             guard = " and ".join(x for x in guards if x != "True") or "True"
             exec(
-                f"def quick(b):\n    {quick[0]}\n    if {guard}:\n"
-                f"        return ({', '.join(quick_items)},)\n    return slow(b)\n",
+                _plan_code(
+                    f"def quick(b):\n    {quick[0]}\n    if {guard}:\n"
+                    f"        return ({', '.join(quick_items)},)\n    return slow(b)\n",
+                    "exec",
+                ),
                 env,
             )
             pick = env["quick"]
@@ -1189,23 +1199,42 @@ def _read_plan(
         env |= {"_num": (int, float)}
         guard = " and ".join(x for x in guards if x != "True") or "True"
         exec(
-            f"def from_source(b):\n    {quick[0] if quick is not None else 'pass'}\n"
-            f"    if not ({guard}):\n        return None\n"
-            + (
-                f"    f = ({f},)\n"
-                "    if not all(type(x) in _num for x in f):\n        return None\n"
-                "    f = _pack(*f)\n"
-                if factor
-                else "    f = None\n"
-            )
-            + f"    t = b.T if {op} in (1, 2) else 0.0\n"
-            + "    if type(t) is not float:\n        return None\n"
-            + f"    return {op}, b.{src}, {'b.' + idx if idx else 'None'}, ROWS, f, t\n",
+            _plan_code(
+                f"def from_source(b):\n    {quick[0] if quick is not None else 'pass'}\n"
+                f"    if not ({guard}):\n        return None\n"
+                + (
+                    f"    f = ({f},)\n"
+                    "    if not all(type(x) in _num for x in f):\n        return None\n"
+                    "    f = _pack(*f)\n"
+                    if factor
+                    else "    f = None\n"
+                )
+                + f"    t = b.T if {op} in (1, 2) else 0.0\n"
+                + "    if type(t) is not float:\n        return None\n"
+                + f"    return {op}, b.{src}, {'b.' + idx if idx else 'None'}, ROWS, f, t\n",
+                "exec",
+            ),
             env,
         )
         from_source = env["from_source"]
     first = None if at is None else resources.get(n + at)
     return (b.layout, resources, axes, pick, first, at, pure, run, from_source)
+
+
+#: the plans' getters compiled, by their text (:func:`_plan_code`)
+_PLAN_CODES: dict[tuple[str, str], Any] = {}
+
+
+def _plan_code(text: str, mode: str) -> Any:
+    """A plan's getter compiled once per text: a bank whose layout changes back and forth
+    (axes claimed and released as links go down and come back, homings start and end) makes
+    the same plans again, each a compile of ~50-100 us where the code is kept."""
+    code = _PLAN_CODES.get((text, mode))
+    if code is None:
+        if len(_PLAN_CODES) >= 512:
+            _PLAN_CODES.clear()
+        code = _PLAN_CODES[text, mode] = compile(text, "<read plan>", mode)
+    return code
 
 
 #: the common shape of a reader (``GT_GetSts(axis, p)``, ``p`` a byref or the object) in the
@@ -3452,26 +3481,36 @@ def fast_wait(
     session: Any,
     advance: Callable[[Any, str, int], int],
 ) -> Callable[..., int]:
-    """``GTE_Wait(ms)`` with the fast path in front of the table: ``ms`` a plain int from 0
-    to one slice of a long wait (Controller.WAIT_SLICE_NS: its ns exact), on the in-process
+    """``GTE_Wait(ms)`` with the fast path in front of the table: ``ms`` a plain int or float
+    from 0 to one slice of a long wait (Controller.WAIT_SLICE_NS), on the in-process
     controller of core 1 on the lockstep or the auto clock - the table path's call without
     its binder and layers, the wait's common case in one call (Controller.wait_quick, else
-    Controller.wait_ms); anything else (a float, a negative or huge value, None, a
-    keyword) takes the table path, its code and reason."""
+    Controller.wait_ms); anything else (a negative, NaN or huge value, None, a keyword)
+    takes the table path, its code and reason."""
     from ..controller.core import Controller
     from ._core import call_done, call_failed
 
     most = Controller.WAIT_SLICE_NS // 1_000_000
 
     def gt(ms: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(ms) is int and 0 <= ms <= most and not extra and not kw and session.plain:
+        tp = type(ms)
+        if (
+            (tp is int or tp is float)
+            and 0 <= ms <= most  # (a float's NaN: never)
+            and not extra
+            and not kw
+            and session.plain
+        ):
             ctl = session.controllers.get(1)
             if ctl is not None and ctl.card is None:
                 clock = ctl.clock
                 if clock.mode is not _REALTIME:
                     try:
                         with clock.lock:  # (the table path's: a call's cycles, one thread's)
-                            if not ctl.wait_quick(ms * 1_000_000):
+                            # (a float's ns as wait_ms rounds them: GTE_Wait(1.0), as a
+                            # program that computes its wait passes it)
+                            total = ms * 1_000_000 if tp is int else round(ms * 1_000_000)
+                            if not ctl.wait_quick(total):
                                 ctl.wait_ms(float(ms))
                             wait_yield(ctl)
                     except Exception as e:

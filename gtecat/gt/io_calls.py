@@ -197,11 +197,11 @@ def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
             on = f"a{n}.servo_on"
             res = resources.get(n)
             if res is not None and res.ax is ax:
-                # an axis the bank runs: its row's (a row is frozen exactly where its axis
-                # was off when claimed, and the axis cannot be switched while claimed), not
-                # its guarded object's, which would give the axis back
+                # an axis the bank runs: its row's (a row is frozen servo-off exactly where
+                # its axis was off when claimed, and the axis cannot be switched while
+                # claimed), not its guarded object's, which would give the axis back
                 env[f"r{n}"] = res
-                on = f"(not r{n}.bank.frz.item(r{n}.bank_row) if r{n}.bank else {on})"
+                on = f"(not r{n}.bank.frz_off.item(r{n}.bank_row) if r{n}.bank else {on})"
             terms.append(f"({_signed32(1 << (n - 1))} if {on} else 0)")
     body = " | ".join(terms) or "0"  # (axis 32's bit as the sign of GT_GetDo's long)
     exec(compile(f"def enabled():\n    return {body}\n", "<GT_GetDo enable>", "exec"), env)

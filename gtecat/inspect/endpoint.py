@@ -27,12 +27,14 @@ is open the cycle pays a few attribute checks when nothing is queued.  When no c
 for :data:`IDLE_S` (an
 application waiting for input, a lockstep test between steps, an idle ``gtecat
 controller``), the endpoint thread runs the request itself: with the lock every change of
-the controller takes (the controller server's call lock; the clock's lock in realtime),
-or, in-process in ``auto``/``lockstep``, after a handshake with the cycle so the two never
-overlap (a run of many cycles at once that began before the connection opened is waited
-for too: while a connection is open no new one begins).  (A GT call the application makes
-in that instant, outside any cycle, is not held back: in those modes the GT layer takes no
-lock.  Requests are short.)
+the controller takes (the controller server's call lock; else the clock's lock, which every
+GT call and every cycle holds, in every clock mode), and after a handshake with the cycle so
+the two never overlap (a cycle run for another card of one time, which takes no lock of
+this one; a run of many cycles at once that began before the connection opened is waited
+for too: while a connection is open no new one begins).  The clock's lock is taken before
+the handshake, as a cycle holds it before it: a request that takes it again (a fault
+injected, :mod:`gtecat.faults`) cannot wait for a cycle that waits for the request.
+(Requests are short.)
 
 **When it publishes.**  :func:`publish` is called by ``GT_Open`` (and so by ``gtecat
 controller``, which opens through it); ``gtecat serve`` publishes the same endpoint over its
@@ -209,7 +211,7 @@ class Endpoint:
     def _direct_run(self, req: _Request) -> None:
         lock = self.lock
         clock = self.ctl.clock
-        if lock is None and clock.threaded:
+        if lock is None:
             lock = clock.lock
         flags = self._flags
         ctl = self.ctl

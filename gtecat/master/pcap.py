@@ -15,8 +15,11 @@ from __future__ import annotations
 
 import struct
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import BinaryIO
+
+from gtecat.eni.cyclic import MAX_DATAGRAM_DATA
 
 #: nanosecond-resolution pcap magic (the microsecond one is A1B2C3D4)
 MAGIC_NS = 0xA1B23C4D
@@ -110,7 +113,8 @@ class BusCapture:
     * a state request: ``FPWR 0120h`` (AL control) then ``FPRD 0130h`` (AL status,
       code);
     * a cycle: one ``LRW`` over the logical image (outputs, then inputs: SOEM's
-      non-overlapped map at logical address 0), answered with the inputs and the WKC;
+      non-overlapped map at logical address 0), answered with the inputs and the WKC; an
+      image larger than one frame carries (1,484 bytes) in several frames;
     * a mailbox exchange: ``FPWR`` of the request into SM0 (1000h), ``FPRD`` of the
       SM1 status (080Dh) and ``FPRD`` of the answer from SM1 (1080h).
 
@@ -190,9 +194,27 @@ class BusCapture:
         status = struct.pack("<HHH", state | (0x10 if error else 0), 0, code)
         self._pair(4, station, 0x0130, bytes(6), status, 1)
 
-    def cycle(self, t_ns: int, image: bytes, outputs_bytes: int, wkc: int) -> None:
+    def cycle(
+        self,
+        t_ns: int,
+        image: bytes,
+        outputs_bytes: int,
+        wkc: int,
+        shares: Sequence[tuple[int, int, int]] = (),
+    ) -> None:
+        """One cycle's LRW.  An image larger than one datagram carries
+        (:data:`~gtecat.eni.cyclic.MAX_DATAGRAM_DATA`) goes out in several frames, an LRW
+        of consecutive bytes each (as SOEM splits its IO map), whose working counters come
+        from ``shares``: (first byte, end, counter) of each slave's area that answered."""
         request = bytes(image[:outputs_bytes]) + bytes(len(image) - outputs_bytes)
-        self._pair(12, 0, 0, request, bytes(image), wkc, t_ns)
+        if len(image) <= MAX_DATAGRAM_DATA:
+            self._pair(12, 0, 0, request, bytes(image), wkc, t_ns)
+            return
+        for start in range(0, len(image), MAX_DATAGRAM_DATA):
+            end = min(start + MAX_DATAGRAM_DATA, len(image))
+            n = sum(add for a, b, add in shares if a < end and start < b)
+            at = t_ns if start == 0 else None
+            self._pair(12, start, start >> 16, request[start:end], bytes(image[start:end]), n, at)
 
     def mailbox(self, position: int, request: bytes, answer: bytes | None) -> None:
         station, size = 0x1001 + position, self.mailbox_size

@@ -9,7 +9,14 @@ import pytest
 from gtecat.eni.errors import EniError
 from gtecat.eni.layout import build_layout
 from gtecat.eni.model import Direction
-from gtecat.eni.topology import GTEC_VENDOR_ID, load_topology, parse_topology
+from gtecat.eni.topology import (
+    GTEC_VENDOR_ID,
+    MAX_SLAVES,
+    build_config,
+    load_topology,
+    parse_topology,
+    station_address,
+)
 
 OUT, IN = Direction.OUT, Direction.IN
 
@@ -145,3 +152,16 @@ def test_invalid_toml_names_the_line(tmp_path: Path) -> None:
     assert info.value.line == 3 and info.value.file == str(p)
     with pytest.raises(EniError, match="cannot read"):
         load_topology(tmp_path / "nope.toml")
+
+
+def test_station_addresses_reach_every_slave_a_bus_holds() -> None:
+    # 1001 + position as TwinCAT numbers them, then the 16-bit addresses left below 1001
+    assert MAX_SLAVES == 0xFFFF
+    stations = [station_address(p) for p in range(MAX_SLAVES)]
+    assert stations[:2] == [1001, 1002] and stations[64534:64536] == [0xFFFF, 1]
+    assert stations[-1] == 1000 and sorted(stations) == list(range(1, 0x10000))
+
+
+def test_more_slaves_than_a_bus_holds_is_refused_before_building() -> None:
+    with pytest.raises(EniError, match=r"65536 slaves: an EtherCAT bus holds at most 65535"):
+        build_config({"slave": [{"kind": "io"}] * (MAX_SLAVES + 1)})

@@ -207,6 +207,103 @@ def test_the_controller_command_refuses_an_unreadable_setting(tmp_path, monkeypa
         lifeline_fd=None,
         private=False,
         rt_priority=None,
+        slice_us=None,
     )
     assert controller_cmd.run(args) == 1
     assert "error: GTECAT_RT_PRIORITY='high': a priority 1-99" in capsys.readouterr().err
+
+
+class FakeSliceCalls:
+    """sched_getattr / sched_setattr of a thread: reports ``attr``, records what was set,
+    refuses when ``refuse`` is an errno."""
+
+    def __init__(self, policy=0, nice=0, runtime=1_400_000, flags=0, refuse=0, readable=True):
+        self.attr = (48, policy, flags, nice, 0, runtime, 0, 0)
+        self.readable, self.refuse = readable, refuse
+        self.set: list[tuple] = []
+
+    def calls(self):
+        def get():
+            return self.attr if self.readable else None
+
+        def put(fields):
+            self.set.append(fields)
+            if self.refuse:
+                raise OSError(self.refuse, "refused")
+
+        return get, put
+
+
+def test_a_normal_thread_asks_for_a_short_slice_keeping_its_nice_and_flags():
+    system = FakeSliceCalls(nice=5, flags=0x01 | 0x20)  # reset-on-fork kept, util clamp not
+    assert scheduling.short_slice(100, system.calls()) == "100 us slice"
+    assert system.set == [(48, 0, 0x01, 5, 0, 100_000, 0, 0)]
+
+
+def test_the_controller_s_threads_and_children_get_the_default_slice():
+    system = FakeSliceCalls(nice=0, flags=0)
+    assert scheduling.short_slice(100, system.calls(), reset_on_fork=True) == "100 us slice"
+    assert system.set == [(48, 0, 0x01, 0, 0, 100_000, 0, 0)]
+
+
+@pytest.mark.parametrize(
+    "system",
+    [
+        FakeSliceCalls(policy=1),  # SCHED_FIFO: no slice to shorten
+        FakeSliceCalls(runtime=0),  # a kernel without custom slices reports none
+        FakeSliceCalls(runtime=100_000),  # the program chose one as short
+        FakeSliceCalls(readable=False),  # sched_getattr refused
+    ],
+    ids=["fifo", "old-kernel", "short-already", "unreadable"],
+)
+def test_the_slice_is_not_asked_for_where_it_would_change_nothing(system):
+    assert scheduling.short_slice(100, system.calls()) == ""
+    assert system.set == []
+
+
+@pytest.mark.parametrize("errno", [22, 7, 1])  # EINVAL, E2BIG, EPERM
+def test_a_refused_slice_is_silent(errno):
+    system = FakeSliceCalls(refuse=errno)
+    assert scheduling.short_slice(100, system.calls()) == ""
+    assert len(system.set) == 1
+
+
+def test_no_slice_without_the_system_calls_or_when_turned_off():
+    system = FakeSliceCalls()
+    assert scheduling.short_slice(0, system.calls()) == ""
+    assert system.set == []
+    # a system without sched_setattr (Windows, an unknown machine): nothing asked
+    assert scheduling.short_slice(100, calls=False) == ""
+
+
+def test_the_slice_setting_comes_from_the_environment():
+    assert scheduling.slice_from_environment({}) == scheduling.DEFAULT_SLICE_US
+    assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "0"}) == 0
+    assert scheduling.slice_from_environment({"GTECAT_SLICE_US": " 200 "}) == 200
+    assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "-5"}) == 0
+    assert scheduling.slice_from_environment({"GTECAT_SLICE_US": "short"}) == 0
+    assert scheduling.DEFAULT_SLICE_US == 0  # off unless asked for (docs/performance.md)
+
+
+def test_the_slice_of_a_thread_on_this_system():
+    """The real calls, in a thread of its own (the test's threads keep theirs): where the
+    kernel has custom slices the thread runs with the one asked for, elsewhere nothing."""
+    import threading
+
+    calls = scheduling._sched_attr_calls()
+    got: dict[str, object] = {}
+
+    def thread() -> None:
+        got["before"] = calls[0]() if calls else None
+        got["words"] = scheduling.short_slice(100)
+        got["after"] = calls[0]() if calls else None
+
+    t = threading.Thread(target=thread)
+    t.start()
+    t.join()
+    before, after = got["before"], got["after"]
+    if before is None or before[1] != 0 or not before[5] or before[5] <= 100_000:
+        assert got["words"] == ""
+        return
+    assert got["words"] == "100 us slice"
+    assert after[5] == 100_000 and after[3] == before[3]  # the slice; the nice as it was

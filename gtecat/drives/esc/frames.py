@@ -39,18 +39,19 @@ from construct import (
 )
 
 from gtecat.eni.errors import GtecatError
+from gtecat.eni.ethercat import (
+    DATAGRAM_HEADER_LEN,
+    ECAT_HEADER_LEN,
+    ETH_HEADER_LEN,
+    MAX_ECAT_LEN,
+    WKC_LEN,
+)
 
 ETHERTYPE_ECAT = 0x88A4
 #: frame header type of EtherCAT DLPDUs (ETG.1000.4 5.3); 4 = network variables, 5 = mailbox
 FRAME_TYPE_DLPDU = 1
-ETH_HEADER_LEN = 14
-ECAT_HEADER_LEN = 2
-DATAGRAM_HEADER_LEN = 10
-WKC_LEN = 2
 #: smallest Ethernet frame without FCS; shorter frames are padded with zeros
 MIN_ETH_FRAME = 60
-#: the Ethernet payload is at most 1500 bytes: 2 header bytes + datagrams
-MAX_ECAT_LEN = 1498
 BROADCAST_MAC = b"\xff" * 6
 #: the source address SOEM uses for its primary port
 MASTER_MAC = b"\x01\x01\x01\x01\x01\x01"

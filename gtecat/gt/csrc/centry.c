@@ -1874,3 +1874,166 @@ static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, 
 {
     ANSWER(multi_try, e, e->gate, args, nargs, kwnames);
 }
+
+/* A replay's loop (gtecat.faults.record._replay): the recorded calls of the simple forms made
+ * one after another without a Python frame per call.  A step is a tuple (call, values); its
+ * call's runner (found by the call object's address in the table Python fills) says what the
+ * replay's compiled run does for it: the values to set into the pooled objects before the call
+ * (an integer of 1, 2, 4 or 8 bytes, signed or not, a double, a float, the bytes of an
+ * array), the GT function and its arguments, the recorded return code, and the values the
+ * objects must hold after it.  The loop stops at the first step it cannot make so (a call the
+ * table does not know or leaves to Python, a value of another type or one the object does not
+ * hold: nothing of the call made) and gives its index; a call made whose return code or left
+ * value differs from the recorded one - or may: not an exact int, a NaN - stops it with (index,
+ * the code): Python compares in full and reports, as after its own run of the call. */
+#define R_MAX 6
+#define R_DOUBLE 100
+#define R_FLOAT 101
+#define R_UNSIGNED 16
+
+/* a value set before the call or compared after it: where it lies, what it is (1, 2, 4, 8:
+ * a signed integer of that size; R_UNSIGNED + size: unsigned; R_DOUBLE, R_FLOAT; -n: n
+ * bytes of an array), its place among the step's values */
+struct rput {
+    char *mem;
+    long long kind, k;
+};
+
+struct runner {
+    obj fn, args, rc; /* the GT function, its arguments (a tuple), the recorded code (an int) */
+    long long python; /* 1: the replay's Python makes this call */
+    long long nsets, nouts;
+    struct rput sets[R_MAX], outs[R_MAX];
+};
+
+struct rtable {
+    long long mask; /* the table's slots less one (a power of two) */
+    obj *keys;      /* per slot the call it is for (NULL: free) */
+    struct runner **runners;
+    ptrdiff_t titems; /* where a tuple keeps its items */
+    obj tuple_type;
+};
+
+#define R_ITEM(t, i) (((obj *)((char *)(t) + T->titems))[i])
+#define R_SIZE(t) (*(ptrdiff_t *)((char *)(t) + A.bsize))
+
+static int r_set(const struct rput *s, obj x)
+{
+    long long v;
+    double d;
+    float f;
+    if (s->kind < 0) {
+        if (TYPE(x) != A.bytes_type || R_SIZE(x) != -s->kind)
+            return 0;
+        memcpy(s->mem, (char *)x + A.bdata, (size_t)-s->kind);
+        return 1;
+    }
+    if (s->kind == R_DOUBLE || s->kind == R_FLOAT) {
+        if (TYPE(x) != A.float_type)
+            return 0;
+        memcpy(&d, (char *)x + A.fval, sizeof d);
+        if (s->kind == R_DOUBLE) {
+            memcpy(s->mem, &d, sizeof d);
+            return 1;
+        }
+        if (d != d || d > 3.4028234663852886e38 || d < -3.4028234663852886e38)
+            return 0; /* (NaN, past a float's range: ctypes' own conversion) */
+        f = (float)d;
+        memcpy(s->mem, &f, sizeof f);
+        return 1;
+    }
+    if (!ll_of(x, &v) || !fits(v, (int)(s->kind % R_UNSIGNED), s->kind < R_UNSIGNED))
+        return 0;
+    put(s->mem, v, (int)(s->kind % R_UNSIGNED));
+    return 1;
+}
+
+static int r_same(const struct rput *s, obj x)
+{
+    long long v, m;
+    double d, e;
+    float f;
+    int size = (int)(s->kind % R_UNSIGNED);
+    if (s->kind < 0)
+        return TYPE(x) == A.bytes_type && R_SIZE(x) == -s->kind &&
+               !memcmp(s->mem, (char *)x + A.bdata, (size_t)-s->kind);
+    if (s->kind == R_DOUBLE || s->kind == R_FLOAT) {
+        if (TYPE(x) != A.float_type)
+            return 0;
+        memcpy(&e, (char *)x + A.fval, sizeof e);
+        if (s->kind == R_DOUBLE)
+            memcpy(&d, s->mem, sizeof d);
+        else
+            memcpy(&f, s->mem, sizeof f), d = (double)f;
+        return d == e;
+    }
+    if (!ll_of(x, &v))
+        return 0;
+    if (s->kind < R_UNSIGNED)
+        m = size == 1 ? *(int8_t *)s->mem : size == 2 ? *(int16_t *)s->mem
+            : size == 4 ? *(int32_t *)s->mem : *(int64_t *)s->mem;
+    else if (size == 8) {
+        if (*(uint64_t *)s->mem > (uint64_t)INT64_MAX)
+            return 0;
+        m = (long long)*(uint64_t *)s->mem;
+    } else
+        m = size == 1 ? *(uint8_t *)s->mem : size == 2 ? *(uint16_t *)s->mem
+            : (long long)*(uint32_t *)s->mem;
+    return m == v;
+}
+
+static obj replay_run(const struct rtable *T, obj const *args, ptrdiff_t nargs)
+{
+    obj steps, st, p, vals, res, at, out;
+    ptrdiff_t n, nv, i;
+    long long start, h, k;
+    const struct runner *r;
+    if (nargs != 2 || TYPE(args[0]) != T->tuple_type || !ll_of(args[1], &start) || start < 0)
+        return A.long_from(-1);
+    steps = args[0];
+    n = R_SIZE(steps);
+    for (i = (ptrdiff_t)start; i < n; i++) {
+        st = R_ITEM(steps, i);
+        if (TYPE(st) != T->tuple_type || R_SIZE(st) != 2)
+            break;
+        p = R_ITEM(st, 0);
+        vals = R_ITEM(st, 1);
+        h = (long long)(((size_t)p >> 4) & (size_t)T->mask);
+        while (T->keys[h] && T->keys[h] != p)
+            h = (h + 1) & T->mask;
+        if (!T->keys[h])
+            break;
+        r = T->runners[h];
+        if (r->python || TYPE(vals) != T->tuple_type)
+            break;
+        nv = R_SIZE(vals);
+        for (k = 0; k < r->nsets; k++)
+            if (r->sets[k].k >= nv || !r_set(&r->sets[k], R_ITEM(vals, r->sets[k].k)))
+                goto stop;
+        res = A.vectorcall(r->fn, &R_ITEM(r->args, 0), (size_t)R_SIZE(r->args), NULL);
+        if (!res)
+            return NULL;
+        if (res != r->rc && !(ll_of(res, &h) && ll_of(r->rc, &k) && h == k))
+            goto made;
+        for (k = 0; k < r->nouts; k++)
+            if (r->outs[k].k >= nv || !r_same(&r->outs[k], R_ITEM(vals, r->outs[k].k)))
+                goto made;
+        A.decref(res);
+    }
+stop:
+    return A.long_from(i);
+made:
+    at = A.long_from(i);
+    out = at ? A.tuple_pack(2, at, res) : NULL;
+    if (at)
+        A.decref(at);
+    A.decref(res);
+    return out;
+}
+
+/* METH_FASTCALL | METH_KEYWORDS: self is the table's ctypes object; run(steps, start) */
+obj gtecat_centry_replay(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    (void)kwnames;
+    return replay_run((const struct rtable *)AT(self, A.b_ptr), args, nargs);
+}

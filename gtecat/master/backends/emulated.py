@@ -25,6 +25,7 @@ from gtecat.drives.coe import advance_counter, next_counter
 from gtecat.drives.io_slaves import IoSlave, look_at_fields
 from gtecat.drives.machine import MachineDescription
 from gtecat.drives.slave import AlState, AlStatusCode, VirtualSlave
+from gtecat.eni.cyclic import MAX_DATAGRAM_DATA
 from gtecat.eni.layout import Layout
 from gtecat.eni.model import Direction
 
@@ -60,9 +61,9 @@ class EmulatedBackend(Backend):
         #: process-data watchdog of the slaves (ESC default 100 ms)
         self.watchdog_ns = 100_000_000
         self._silent_ns: dict[int, int] = {}
-        #: (outside changes, claimed slaves) when every claimed slave's emergency queue was
-        #: last found empty (:meth:`emergencies`), or None
-        self._emcy_empty: tuple[int, tuple[VirtualSlave, ...]] | None = None
+        #: the outside changes when a look (:meth:`emergencies`) left every slave's emergency
+        #: queue empty, or None
+        self._emcy_empty: int | None = None
         #: (the slaves list, its length, its IO slaves): whose field inputs are looked at
         self._io_seen: tuple[Any, int, tuple[IoSlave, ...]] | None = None
         #: ((outside changes, IO slaves), what fields_watch gave): kept while they stand
@@ -104,6 +105,7 @@ class EmulatedBackend(Backend):
         self._source = (self.hardware or layout).config.source
         self.image = image
         self._clients = {}
+        self._emcy_empty = None
         segs: dict[tuple[int, Direction], Segment] = {
             (s.slave, s.direction): s for s in image.segments
         }
@@ -248,8 +250,27 @@ class EmulatedBackend(Backend):
                 image.from_slave(inp, slave.tx)
                 wkc += 1
         if self.capture is not None:
-            self.capture.cycle(t_ns, bytes(image.view), image.outputs_bytes, wkc)
+            self._capture_cycle(t_ns, image, wkc)
         return wkc
+
+    def _capture_cycle(self, t_ns: int, image: ProcessImage, wkc: int) -> None:
+        """The cycle into the capture, with each answering slave's share of the working
+        counter where its bytes lie (what a capture in several frames counts per frame)."""
+        assert self.capture is not None
+        view = bytes(image.view)
+        shares = []
+        if len(view) > MAX_DATAGRAM_DATA:
+            base = {Direction.OUT: 0, Direction.IN: image.outputs_bytes}
+            for slave, out, inp in self._plan:
+                if slave.position in self.unplugged:
+                    continue
+                claimed = slave.position in self._claimed  # the bank's: in OP
+                st = slave.al_state
+                for seg, add, counted in ((out, 2, st == _OP), (inp, 1, st >= _SAFEOP)):
+                    if seg is not None and (claimed or counted):
+                        a = base[seg.direction] + seg.logical_bit // 8
+                        shares.append((a, a + (seg.logical_bit % 8 + seg.bit_len + 7) // 8, add))
+        self.capture.cycle(t_ns, view, image.outputs_bytes, wkc, shares)
 
     def steady(self) -> bool:
         """An exchange now would change nothing: no hook, capture or cable pulled, and every
@@ -404,42 +425,34 @@ class EmulatedBackend(Backend):
         send one: what it raises stays in its queue (bounded, as its mailbox is) and
         arrives once the cable is back (ETG.1000.6 5.6.4: an emergency is a mailbox
         message the master collects from the slave)."""
+        # a slave queues one only through emit_emergency, which counts as an outside change:
+        # while nothing changed since a look that left every queue empty, there is none (the
+        # bank's slaves are not stepped here, and whichever of them it holds does not matter)
+        seen = VirtualSlave.outside_changes  # (before the look: one queued during it counts)
+        if self._emcy_empty == seen:
+            return []
         out = []
         claimed = self._claimed
         unplugged = self.unplugged
-        # a claimed slave is not stepped here, but a scenario may queue one (emit_emergency,
-        # which counts as an outside change): while nothing changed since a look that left
-        # every claimed slave's queue empty, there is none to fetch from them
-        stepped = (e[0] for e in self._run_plan)
-        known = claimed and self._claimed_emcy_empty()
         slaves: Any = self.slaves
         if claimed:
-            slaves = stepped if known else (*stepped, *self._claimed_slaves)
+            slaves = (*(e[0] for e in self._run_plan), *self._claimed_slaves)
         for slave in slaves:
             if unplugged and slave.position in unplugged:
                 continue
             while slave.emergencies:
                 out.append((slave.position, slave.emergencies.popleft()))
-        if claimed and not known:  # (one left: behind a pulled cable, it stays queued)
-            left = any(s.emergencies for s in self._claimed_slaves)
-            self._emcy_empty = (
-                None if left else (VirtualSlave.outside_changes, self._claimed_slaves)
-            )
+        # (one left: behind a pulled cable, it stays queued, and the next look looks again)
+        left = unplugged and any(s.emergencies for s in slaves if s.position in unplugged)
+        self._emcy_empty = None if left else seen
         if claimed and len(out) > 1:
             out.sort(key=lambda e: e[0])  # (in the order of the bus, as without the bank)
         return out
 
     def _claimed_emcy_empty(self) -> bool:
-        """A look at the claimed slaves' emergency queues (:meth:`emergencies`) found them all
-        empty, and nothing changed since: they are empty still (the bank's slaves are not
-        stepped here; a scenario that queues one counts as an outside change, and another
-        set of claimed slaves is another tuple)."""
-        looked = self._emcy_empty
-        return (
-            looked is not None
-            and looked[0] == VirtualSlave.outside_changes
-            and looked[1] is self._claimed_slaves
-        )
+        """A look at the emergency queues (:meth:`emergencies`) left them all empty, and nothing
+        changed since: the claimed slaves' queues are empty still."""
+        return self._emcy_empty == VirtualSlave.outside_changes
 
     def expected_wkc(self) -> int:
         return self._expected

@@ -45,6 +45,7 @@
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -449,6 +450,72 @@ static void spin_done(int answered_while_spinning, long budget)
     else
         g_budget = g_budget / 2 < 1000 ? 0 : g_budget / 2;
 }
+
+/* ---- the calling thread's time slice (Linux 6.12 and later) ---------------------------
+ * Where GTECAT_SLICE_US names one (100 us is the shortest the kernel grants; 0, the
+ * default, leaves every thread alone), each thread that calls into this library asks the
+ * kernel for that time slice once, at its first call.  Why one may want it: the thread
+ * sleeps while the controller works and is woken by the reply; with other programs keeping
+ * the CPUs busy, a woken thread with the default slice (milliseconds) may wait for another
+ * program's slice to end, where one with a shorter slice gets the earlier deadline and, as
+ * long as it has not used more than its share of the CPU, the CPU at once (EEVDF).  What it
+ * changes for the thread: how soon it gets a CPU back after waking, and that while it
+ * computes and others want its CPU it is preempted every slice; not its share of the CPU
+ * (its nice value, its weight).  Threads and processes it starts afterwards inherit the
+ * slice, as they inherit its nice value.  Asked only where the thread runs SCHED_OTHER with
+ * a longer slice (a shorter one chosen by the program is kept); a kernel without custom
+ * slices reports none and is not asked, and a refusal (older kernels: EINVAL, E2BIG; a
+ * sandbox: EPERM) is silent.  The controller's serving thread asks for the same
+ * (gtecat/scheduling.py: short_slice).  Off by default: measured on a loaded 2-vCPU VM
+ * (docs/performance.md), it did not help the round trip's p50 or p99, with or without the
+ * controller's real-time priority. */
+#define GTE_DEFAULT_SLICE_US 0
+#if !defined(_WIN32) /* gts.dll asks for nothing: Windows has no such slice */
+static long slice_us(void)
+{
+    const char *v = setting("GTECAT_SLICE_US");
+    if (v && *v) {
+        char *end;
+        long x = strtol(v, &end, 10);
+        if (*end == '\0' && x >= 0)
+            return x;
+    }
+    return GTE_DEFAULT_SLICE_US;
+}
+#endif
+
+#if defined(__linux__) && defined(SYS_sched_setattr) && defined(SYS_sched_getattr)
+struct gte_sched_attr { /* the kernel's struct sched_attr, version 0 (48 bytes) */
+    uint32_t size, policy;
+    uint64_t flags;
+    int32_t nice;
+    uint32_t priority;
+    uint64_t runtime, deadline, period; /* runtime: a SCHED_OTHER thread's slice (ns) */
+};
+static __thread int t_slice_asked;
+static void ask_short_slice(void)
+{
+    struct gte_sched_attr a;
+    long us;
+    if (t_slice_asked)
+        return;
+    t_slice_asked = 1;
+    us = slice_us();
+    if (us <= 0)
+        return;
+    memset(&a, 0, sizeof a);
+    if (syscall(SYS_sched_getattr, 0, &a, (unsigned)sizeof a, 0u) != 0)
+        return;
+    if (a.policy != SCHED_OTHER || a.runtime <= (uint64_t)us * 1000u)
+        return; /* not a normal thread, a kernel without slices (0), or short already */
+    a.size = sizeof a;
+    a.flags &= 0x01; /* SCHED_FLAG_RESET_ON_FORK as it was; policy and nice as they were */
+    a.runtime = (uint64_t)us * 1000u;
+    (void)syscall(SYS_sched_setattr, 0, &a, 0u);
+}
+#else
+static void ask_short_slice(void) {}
+#endif
 
 /* Receive one message (frame header included) into g_buf, always offering a read at least
  * GTE_CHUNK bytes of room, so one recv takes a whole record (SOCK_SEQPACKET; usually the
@@ -885,9 +952,22 @@ static int start_private(const char *fname)
     const char *rt = setting("GTECAT_RT_PRIORITY");
     char rt_arg[16];
     snprintf(rt_arg, sizeof rt_arg, "%s", rt && strlen(rt) < sizeof rt_arg ? rt : "");
-    char *argv[] = {(char *)python, "-m", "gtecat", "controller", "--listen", addr,
-                    "--private", "--ready-fd", "3", "--lifeline-fd", "4",
-                    rt_arg[0] ? "--rt-priority" : NULL, rt_arg, NULL};
+    /* and so may the time slice (slice_us: a number read here) */
+    char slice_arg[24];
+    const char *sl = setting("GTECAT_SLICE_US");
+    snprintf(slice_arg, sizeof slice_arg, "%ld", slice_us());
+    char *argv[16] = {(char *)python, "-m", "gtecat", "controller", "--listen", addr,
+                      "--private", "--ready-fd", "3", "--lifeline-fd", "4"};
+    int argc = 11;
+    if (rt_arg[0]) {
+        argv[argc++] = "--rt-priority";
+        argv[argc++] = rt_arg;
+    }
+    if (sl && *sl) {
+        argv[argc++] = "--slice-us";
+        argv[argc++] = slice_arg;
+    }
+    argv[argc] = NULL;
     pid_t pid = fork();
     if (pid < 0) {
         set_err("%s returned -1: fork: %s", fname, strerror(errno));
@@ -1245,6 +1325,7 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
     short card = t_card; /* the multi-card ABI's card for this one call, else the current */
     t_card = -1;
     LOCK();
+    ask_short_slice(); /* once per thread (it reads the settings: under the lock) */
     if (f->flags & (GTE_F_CARDNO | GTE_F_GETCARDNO | GTE_F_SETCORE | GTE_F_GETCORE)) {
         short rc = own_setting(f, gtn, core, a);
         UNLOCK();

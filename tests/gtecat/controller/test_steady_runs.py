@@ -368,3 +368,29 @@ def test_a_release_inside_a_reader_call_stops_the_quick_cycles(fig5_2):
     gt.GTE_Wait(20)
     assert _move_polled(gt.GTE_Controller(), False) == with_do
     assert with_do[-1][2] > with_do[len(with_do) // 2][2] > 100  # (it moved all along)
+
+
+def test_emergencies_arrive_whichever_slaves_the_bank_holds(fig5_2):
+    """The master's look at the queues (EmulatedBackend.emergencies) skips them while nothing
+    was queued since a look that left them empty: one queued on a slave the bank takes
+    afterwards, or behind a pulled cable until it is back, still arrives, once."""
+    be = fig5_2.master.backend
+    _polls(200)
+    kept = be.claimed
+    try:
+        be.claimed = set()
+        assert be.emergencies() == []
+        be.slaves[0].emit_emergency(0x2310, 0x01)
+        be.claimed = {0}  # taken by the bank after it queued one
+        assert [(p, e.code) for p, e in be.emergencies()] == [(0, 0x2310)]
+        assert be.emergencies() == []
+        be.claimed = set()
+        assert be.emergencies() == []
+        be.unplug(0)
+        be.slaves[0].emit_emergency(0x7500, 0x01)
+        assert be.emergencies() == [] and be.emergencies() == []
+        be.replug(0)
+        assert [(p, e.code) for p, e in be.emergencies()] == [(0, 0x7500)]
+        assert be.emergencies() == []
+    finally:
+        be.claimed = kept

@@ -1,12 +1,20 @@
 """The replay's loop: a compiled call that says it may differ is compared in full as a call
 made alone is, the replay goes on after one that matched in full, and no call after the
-first divergence is made."""
+first divergence is made (the Python loop: these calls' compiled runs say what they say;
+the C entries' loop, which makes the calls themselves, in test_replay_c_loop)."""
 
 from __future__ import annotations
 
 from typing import Any
 
+import pytest
+
 from gtecat.faults import record as rec
+
+
+@pytest.fixture(autouse=True)
+def _python_loop(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(rec, "C_LOOP", False)
 
 
 def _step(log: list[str], name: str, said: Any, rc: int = 0) -> tuple[Any, Any]:

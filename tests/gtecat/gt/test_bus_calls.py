@@ -8,6 +8,7 @@ Manual chapter 5: 5.2.2.1 (communication), 5.2.2.4 (PDO raw data, figure 5-2 off
 from __future__ import annotations
 
 import ctypes
+import re
 from ctypes import byref, c_short, c_ubyte, c_uint32, c_ulong, c_ushort
 
 import pytest
@@ -245,6 +246,46 @@ def test_master_log_reads_like_the_real_one():
     assert "Scanning bus" in text
     assert "Slave states: PREOP" in text
     assert "All slaves are in OP mode" in text
+
+
+def _stamp(line: str) -> int:
+    m = re.match(r"\[\s*(\d+) ms\] EtherCAT: ", line)
+    assert m, line
+    return int(m.group(1))
+
+
+def test_master_log_time_is_what_gt_get_clock_reads():
+    """The master log is the controller's, GT_GetClock reads the controller's clock and
+    GT_Reset resets the controller (chapter 13): the log's time counts from GT_Reset as
+    GT_GetClock does (example 5-5's GT_Reset comes after the bus is up, some ms after power-on),
+    and GT_Reset says in the log that its time goes back to 0."""
+    from gtecat import faults
+
+    assert gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), log="") == 0
+    assert gt.GT_InitEcatComm() == 0
+    status = c_short(0)
+    while not (gt.GT_IsEcatReady(byref(status)) == 0 and status.value == 1):
+        pass
+    assert gt.GT_StartEcatComm() == 0
+    clock = c_ulong()
+    assert gt.GT_GetClock(byref(clock)) == 0
+    before = clock.value
+    assert before > 0  # (the bring-up took controller time)
+    assert gt.GT_Reset() == 0
+    log = gt.GTE_Controller().log
+    assert _stamp(log.lines[-1]) == before
+    assert f"clock counts from 0 again (it read {before} ms)" in log.lines[-1]
+    faults.inject("drive_fault", axis=1, at_ms=200)
+    gt.GTE_Wait(150)
+    assert gt.GT_GetClock(byref(clock)) == 0
+    assert gt.GT_Reset() == 0  # (from a time that is not a whole cycle's start too)
+    assert _stamp(log.lines[-1]) == clock.value
+    gt.GTE_Wait(300)
+    started = [line for line in log.lines if "Fault 1 started" in line]
+    assert [_stamp(line) for line in started] == [200]  # (at_ms: GT_GetClock's time too)
+    assert gt.GT_GetClock(byref(clock)) == 0
+    assert clock.value == 300
+    gt.GT_Close()
 
 
 def test_pointers_of_the_other_kind_of_number_are_7_with_a_reason():

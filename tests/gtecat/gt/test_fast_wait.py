@@ -53,9 +53,11 @@ def _counts(ctl: Any, marks0: tuple[int, ...]) -> tuple[Any, ...]:
     return out
 
 
-def _session(quick: bool, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], int]:
+def _session(
+    quick: bool, monkeypatch: pytest.MonkeyPatch, form: Any = int
+) -> tuple[list[Any], int]:
     """The session (module docstring): what every pass read, and the waits that took the
-    quick way."""
+    quick way; ``form``: how the program passes its waits (``float``: ``GTE_Wait(1.0)``)."""
     monkeypatch.setattr(Controller, "QUICK_WAIT", quick)
     took = [0]
     own = Controller.wait_quick
@@ -101,7 +103,7 @@ def _session(quick: bool, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], i
             row += [gt.GT_GetEncPos(a, byref(pos)), pos.value]
         row += [gt.GT_GetClock(byref(clk)), clk.value, gt.GT_GetEcatRawData(0, 8, raw)]
         row += [*raw, gt.GTE_GetLastError()]
-        row += [back, wait(WAITS[k % len(WAITS)]), *_counts(ctl, marks0)]
+        row += [back, wait(form(WAITS[k % len(WAITS)])), *_counts(ctl, marks0)]
         seen.append(row)
     assert back, gt.GTE_GetLastError()
     seen.append(ctl.log.text())
@@ -111,12 +113,14 @@ def _session(quick: bool, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], i
 
 def test_fast_wait_is_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     general, none = _session(False, monkeypatch)
-    quick, took = _session(True, monkeypatch)
     assert none == 0
-    assert took > PASSES // 2  # (the quick way ran: the bus steady, the axes in the bank)
-    assert len(quick) == len(general)
-    for k, (a, b) in enumerate(zip(general, quick, strict=True)):
-        assert a == b, f"pass {k}"
+    # (a wait of whole milliseconds as a float - GTE_Wait(1.0) - is the int's, and so fast)
+    for form in (int, float):
+        quick, took = _session(True, monkeypatch, form)
+        assert took > PASSES // 2  # (the quick way ran: the bus steady, the axes in the bank)
+        assert len(quick) == len(general)
+        for k, (a, b) in enumerate(zip(general, quick, strict=True)):
+            assert a == b, f"{form.__name__} pass {k}"
     # the session went where the docstring says: axis 2 out of the bank, a link down
     assert any(row[-17] for row in general[:-1])  # (len(_run_axes))
     assert any(row[-16] for row in general[:-1])  # (_links_down)
@@ -198,9 +202,14 @@ def test_fast_wait_with_faults_armed_is_the_general_way(tmp_path: Path) -> None:
         assert a == b, f"pass {k}"
 
 
-@pytest.mark.parametrize("ms", [-1, -0.5, 10**12, 2**63, 1.5, None, "1", float("nan")], ids=repr)
+@pytest.mark.parametrize(
+    "ms",
+    [-1, -0.5, -0.0, 10**12, 2**63, 1.5, 0.0004, 2.0000001, 1e300, None, "1", float("nan")],
+    ids=repr,
+)
 def test_bad_arguments_keep_the_table_answer(ms: Any) -> None:
-    """Whatever the fast function does not take goes to the table path: the same code and
+    """Whatever the fast function does not take goes to the table path, and a float it takes
+    (a fraction of a millisecond, -0.0) waits as the table path waits: the same code and
     reason as the table-checked function's, and the same controller time after it."""
     bring_up(clock="auto")
     ctl = gt.GTE_Controller()
@@ -211,7 +220,7 @@ def test_bad_arguments_keep_the_table_answer(ms: Any) -> None:
         rc = fn(ms)
         answers.append((rc, gt.GTE_GetLastError(), q[9] + q[0] - before))
     assert answers[0] == answers[1]
-    assert answers[0][0] != 0 or ms in (1.5, "1")
+    assert answers[0][0] != 0 or ms in (1.5, "1", -0.0, 0.0004, 2.0000001)
 
 
 def test_plain_waits_in_lockstep_and_realtime_forms() -> None:

@@ -154,3 +154,37 @@ def test_emulated_bus_capture_decodes_without_malformed(tmp_path: Path) -> None:
     upload = [f for f in sent if f[16] == 5 and struct.unpack_from("<H", f, 20)[0] == 0x1000]
     assert upload and upload[-1][26 + 6 + 2] == 0x40  # an SDO upload request in SM0
     tshark_check(pcap)
+
+
+def test_an_image_larger_than_a_frame_is_captured_in_several(tmp_path: Path) -> None:
+    """90 drives: 630 output and 990 input bytes, 1,620 bytes of LRW: two frames, 1,484 bytes
+    (the most one datagram holds) and 136.  Each answer's working counter counts the slaves
+    whose bytes it carries: all 90 outputs (+2 each) and inputs of drives 0..77 (+1), then
+    drives 77..89 (drive 77's 11 input bytes straddle the cut: it answers in both)."""
+    import ctypes
+
+    from gtecat import gt
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(90, tmp_path / "axes90.eni")
+    pcap = tmp_path / "big.pcap"
+    assert gt.GT_Open(eni=str(eni), clock="lockstep", log="", pcap=str(pcap)) == 0
+    try:
+        assert gt.GT_InitEcatComm() == 0, gt.GTE_GetLastError()
+        status = ctypes.c_short()
+        for _ in range(200):
+            assert gt.GTE_Wait(10) == 0, gt.GTE_GetLastError()
+            if gt.GT_IsEcatReady(ctypes.byref(status)) == 0 and status.value == 1:
+                break
+        assert status.value == 1
+        assert gt.GTE_Wait(2) == 0
+    finally:
+        gt.GT_Close()
+    frames = [f for _, f in read_pcap(pcap)]
+    assert max(len(f) for f in frames) <= 1514
+    lrw = [f for f in frames if f[16] == 12 and f[6] & 0x02]
+    last = lrw[-2:]
+    addresses = [struct.unpack_from("<I", f, 18)[0] for f in last]
+    lengths = [struct.unpack_from("<H", f, 22)[0] & 0x07FF for f in last]
+    assert (addresses, lengths) == ([0, 1484], [1484, 136])
+    assert [_wkc(f) for f in last] == [90 * 2 + 78, 13]

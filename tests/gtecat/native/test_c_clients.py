@@ -187,3 +187,39 @@ def test_the_vendor_gtn_open_close_and_pdo_data_shapes_compile_and_run(libgts, t
     assert (v["open5"], v["init"], v["ready"], v["start"]) == ("0", "0", "1", "0")
     assert (v["pdo_rc"], v["sw_nonzero"]) == ("0", "1")
     assert (v["close"], v["open_default"], v["close2"]) == ("0", "0", "0")
+
+
+@pytest.fixture(scope="module")
+def slice_probe(libgts, tmp_path_factory):
+    out = tmp_path_factory.mktemp("c") / "slice_probe"
+    return compile_client(C_DIR / "slice_probe.c", out, "gcc")
+
+
+def _kernel_slices() -> bool:
+    """This kernel reports a SCHED_OTHER thread's slice (Linux 6.12 and later)."""
+    from gtecat import scheduling
+
+    calls = scheduling._sched_attr_calls()
+    attr = calls[0]() if calls else None
+    return bool(attr and attr[1] == 0 and attr[5])
+
+
+def test_each_calling_thread_asks_for_the_slice_it_is_given(slice_probe, tmp_path):
+    """With GTECAT_SLICE_US=100 (or slice_us = 100 in gtecat.ini) libgts asks once per
+    thread, at its first call, for a 100 us slice (where the kernel has custom slices;
+    elsewhere the thread is left as it was), which threads the thread starts afterwards
+    inherit; by default, or with 0, every thread is left alone."""
+    ini = tmp_path / "gtecat.ini"
+    ini.write_text("slice_us = 100\n")
+    for env in (native_env(GTECAT_SLICE_US="100"), native_env(GTECAT_INI=str(ini))):
+        r, v = run_client(slice_probe, env=env, cwd=tmp_path)
+        assert r.returncode == 0 and v["call"] == v["thread_call"] == "0", r.stdout + r.stderr
+        if not _kernel_slices():
+            assert (v["after"], v["thread_after"]) == (v["before"], v["thread_before"])
+            return
+        assert int(v["thread_before"]) > 100000 and int(v["before"]) > 100000  # the default
+        assert (v["after"], v["thread_after"], v["child_thread"]) == ("100000",) * 3
+    for env in (native_env(), native_env(GTECAT_SLICE_US="0")):
+        r, v = run_client(slice_probe, env=env, cwd=tmp_path)
+        assert (v["after"], v["thread_after"]) == (v["before"], v["thread_before"]), r.stdout
+        assert v["child_thread"] == v["before"]

@@ -36,3 +36,19 @@ def test_wall_time_beyond_the_calls_runs_the_cycles_it_covers():
     assert floor.look() == 0
     assert clock.now_ns + clock._pending_ns == 3_060_000
     assert len(ran) == 3
+
+
+def test_an_idle_controller_looks_every_ten_ms_and_at_once_while_in_debt():
+    """Idle, the controller looks every IDLE_LOOK_S (a wait longer than a scheduler tick
+    costs a polling client's calls nothing), or every cycle where cycles are longer; with a
+    debt left over from a long sleep it looks again at once."""
+    from gtecat.native.floor import IDLE_LOOK_S
+
+    _, floor, wall, _ = _floor()
+    assert floor.idle_timeout() == IDLE_LOOK_S == 0.01
+    floor.budget_s = 0.0  # one cycle per look: a long sleep leaves a debt
+    wall[0] += 5_000_000
+    floor.look()
+    assert floor.debt_ns > 0 and floor.idle_timeout() == 0.0
+    slow = Clock(lambda: None, cycle_ns=20_000_000, mode="auto")
+    assert WallFloor(slow, wall_ns=lambda: 0).idle_timeout() == 0.02

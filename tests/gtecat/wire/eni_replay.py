@@ -16,8 +16,9 @@ has a mailbox (PS, SO), after the whole list for IP (the mailbox starts in
 PREOP) - then the master's other commands.  A command with ``Cnt`` is repeated
 (``Retries``, within ``Timeout``) until the working counter matches; a
 ``Validate`` read is repeated until the masked data matches or its timeout
-passes.  Between SAFEOP and OP, and in OP, the cyclic frames run and their
-working counters are checked against ``Cnt``.
+passes.  Between SAFEOP and OP, and in OP, the cyclic frames run - each ``Frame`` one
+Ethernet frame of its ``Cmd`` datagrams, refused when no Ethernet frame could carry it - and
+their working counters are checked against ``Cnt``.
 
 Nothing is made up: a slave whose InitCmds do not request a transition's target
 state is a failure (a replaying master would leave it where it is).
@@ -30,7 +31,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tests.gtecat.wire.rawmaster import NoAnswer, RawMaster, SdoAbortSeen
+from tests.gtecat.wire.rawmaster import FrameTooLong, NoAnswer, RawMaster, SdoAbortSeen
 
 APWR, FPWR, BWR = 2, 5, 8  # ETG.1000.4 Table 9
 _TARGET = {"I": 1, "P": 2, "B": 3, "S": 4, "O": 8}
@@ -97,7 +98,7 @@ class Eni:
     path: Path
     master: list[RegCmd]
     slaves: list[SlaveCfg]
-    cyclic: list[CyclicCmd]
+    cyclic: list[list[CyclicCmd]]  #: per ``Frame``, its commands
 
 
 def _reg(node: ET.Element) -> RegCmd:
@@ -167,22 +168,22 @@ def parse(path: Path) -> Eni:
                 box,
             )
         )
-    cyclic = []
-    for c in config.findall("Cyclic/Frame/Cmd"):
-        addr = c.findtext("Addr")
-        a = _int(addr) if addr is not None else None
-        cnt = c.findtext("Cnt")
-        cyclic.append(
-            CyclicCmd(
-                tuple(t.text or "" for t in c.findall("State")),
-                _int(c.findtext("Cmd")),
-                (a & 0xFFFF) if a is not None else _int(c.findtext("Adp")),
-                (a >> 16) if a is not None else _int(c.findtext("Ado")),
-                _int(c.findtext("DataLength")),
-                _int(cnt) if cnt is not None else None,
-            )
-        )
+    cyclic = [[_cyclic(c) for c in f.findall("Cmd")] for f in config.findall("Cyclic/Frame")]
     return Eni(path, master, slaves, cyclic)
+
+
+def _cyclic(c: ET.Element) -> CyclicCmd:
+    addr = c.findtext("Addr")
+    a = _int(addr) if addr is not None else None
+    cnt = c.findtext("Cnt")
+    return CyclicCmd(
+        tuple(t.text or "" for t in c.findall("State")),
+        _int(c.findtext("Cmd")),
+        (a & 0xFFFF) if a is not None else _int(c.findtext("Adp")),
+        (a >> 16) if a is not None else _int(c.findtext("Ado")),
+        _int(c.findtext("DataLength")),
+        _int(cnt) if cnt is not None else None,
+    )
 
 
 # --- the replay ----------------------------------------------------------------------------------
@@ -193,6 +194,7 @@ class Replay:
         self.failures: list[str] = []
         self.commands = 0
         self.sdos = 0
+        self.cyclic_frames = 0
 
     def fail(self, what: str) -> None:
         self.failures.append(what)
@@ -301,13 +303,21 @@ class Replay:
             self.fail(f"{s.name}: {c.comment!r}: {err}")
 
     def cyclic(self, state: str, cycles: int) -> None:
-        cmds = [c for c in self.eni.cyclic if state in c.states]
+        """Each ``Frame`` as one Ethernet frame, its commands as its datagrams, every cycle."""
+        frames = [[c for c in f if state in c.states] for f in self.eni.cyclic]
+        frames = [f for f in frames if f]
         for n in range(cycles):
-            for c in cmds:
-                got = self.m.transact(c.cmd, c.adp, c.ado, bytes(c.length))
-                if state == "OP" and c.cnt is not None and got.wkc != c.cnt:
-                    self.fail(f"cycle {n}: cmd {c.cmd} wkc {got.wkc}, {c.cnt} expected")
+            for k, f in enumerate(frames):
+                try:
+                    got = self.m.transact_frame([(c.cmd, c.adp, c.ado, bytes(c.length)) for c in f])
+                except FrameTooLong as err:
+                    self.fail(f"frame {k}: {err}")
                     return
+                self.cyclic_frames += 1
+                for c, r in zip(f, got, strict=True):
+                    if state == "OP" and c.cnt is not None and r.wkc != c.cnt:
+                        self.fail(f"cycle {n} frame {k}: cmd {c.cmd} wkc {r.wkc}, {c.cnt} expected")
+                        return
 
     def states(self) -> list[tuple[int, int]]:
         return [self.m.state(s.phys_addr) for s in self.eni.slaves]

@@ -23,9 +23,10 @@ import struct
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 ETHERTYPE = 0x88A4
 SRC = b"\x04\x00\x00\x00\x00\x07"
@@ -124,6 +125,14 @@ class NoAnswer(Exception):
     """No answer to a frame within the timeout (after the resends)."""
 
 
+class FrameTooLong(Exception):
+    """Datagrams that no Ethernet frame carries."""
+
+
+#: an Ethernet frame without FCS: 14 bytes of header and at most 1500 of payload
+MAX_FRAME = 1514
+
+
 #: how long :meth:`RawMaster.transact` waits for a frame's answer, resends included, and the
 #: slave side for what it does after a frame (an EEPROM read, a state change, a mailbox
 #: answer): the server is Python beside the suite's workers (in a thread of the test's own
@@ -158,17 +167,43 @@ class RawMaster:
     @staticmethod
     def frame(cmd: int, index: int, adp: int, ado: int, data: bytes) -> bytes:
         """ETG.1000.4: Ethernet header, frame header (length | type 1), one datagram."""
-        dgram = struct.pack("<BBHHHH", cmd, index, adp & 0xFFFF, ado & 0xFFFF, len(data), 0)
-        dgram += bytes(data) + b"\0\0"
+        return RawMaster.frame_of([(cmd, adp, ado, data)], index)
+
+    @staticmethod
+    def frame_of(datagrams: list[tuple[int, int, int, bytes]], index: int) -> bytes:
+        """Several datagrams (cmd, adp, ado, data) in one frame, chained by their M bit, the
+        first carrying ``index`` (ETG.1000.4 5.3, 5.4)."""
+        body = b""
+        for k, (cmd, adp, ado, data) in enumerate(datagrams):
+            more = 0x8000 if k + 1 < len(datagrams) else 0
+            flags = len(data) | more
+            body += struct.pack("<BBHHHH", cmd, index, adp & 0xFFFF, ado & 0xFFFF, flags, 0)
+            body += bytes(data) + b"\0\0"
         raw = b"\xff" * 6 + SRC + struct.pack(">H", ETHERTYPE)
-        raw += struct.pack("<H", 0x1000 | len(dgram)) + dgram
+        raw += struct.pack("<H", 0x1000 | len(body)) + body
         return raw.ljust(60, b"\0")
 
     def send_raw(self, raw: bytes) -> None:
         self.sock.send(raw)
         self.frames_sent += 1
 
-    def receive(self, index: int, deadline: float) -> Reply | None:
+    @staticmethod
+    def replies(raw: bytes) -> list[Reply]:
+        """Every datagram of an answered frame: its data and working counter."""
+        out = []
+        pos = 16
+        while pos + 12 <= len(raw):
+            (length,) = struct.unpack_from("<H", raw, pos + 6)
+            adp = struct.unpack_from("<H", raw, pos + 2)[0]
+            data = raw[pos + 10 : pos + 10 + (length & 0x07FF)]
+            wkc = struct.unpack_from("<H", raw, pos + 10 + (length & 0x07FF))[0]
+            out.append(Reply(data, wkc, adp))
+            if not length & 0x8000:
+                break
+            pos += 12 + (length & 0x07FF)
+        return out
+
+    def receive_all(self, index: int, deadline: float) -> list[Reply] | None:
         """The answer whose first datagram carries ``index`` (others are stale: dropped)."""
         while True:
             left = deadline - time.monotonic()
@@ -182,23 +217,31 @@ class RawMaster:
                 continue  # our own frame seen on the way out, or not EtherCAT
             if raw[17] != index:
                 continue
-            length = struct.unpack_from("<H", raw, 22)[0] & 0x07FF
-            adp = struct.unpack_from("<H", raw, 18)[0]
-            data = raw[26 : 26 + length]
-            wkc = struct.unpack_from("<H", raw, 26 + length)[0]
-            return Reply(data, wkc, adp)
+            return self.replies(raw)
+
+    def receive(self, index: int, deadline: float) -> Reply | None:
+        got = self.receive_all(index, deadline)
+        return got[0] if got else None
 
     def transact(self, cmd: int, adp: int, ado: int, data: bytes) -> Reply:
         """Send; resend the same frame (same index) when the answer is late, like SOEM."""
+        return self.transact_frame([(cmd, adp, ado, data)])[0]
+
+    def transact_frame(self, datagrams: list[tuple[int, int, int, bytes]]) -> list[Reply]:
+        """Several datagrams in one frame (an ENI's cyclic ``Frame``); a frame that an
+        Ethernet link cannot carry (more than 1514 bytes without FCS) is refused."""
         self.index = (self.index + 1) & 0xFF
-        raw = self.frame(cmd, self.index, adp, ado, data)
+        raw = self.frame_of(datagrams, self.index)
+        if len(raw) > MAX_FRAME:
+            raise FrameTooLong(f"{len(raw)} bytes, an Ethernet frame carries {MAX_FRAME}")
         end = time.monotonic() + self.timeout
         while True:
             self.send_raw(raw)
-            got = self.receive(self.index, min(end, time.monotonic() + self.resend_after))
+            got = self.receive_all(self.index, min(end, time.monotonic() + self.resend_after))
             if got is not None:
                 return got
             if time.monotonic() >= end:
+                cmd, adp, ado, _ = datagrams[0]
                 raise NoAnswer(f"cmd {cmd} adp 0x{adp:04X} ado 0x{ado:04X}: no answer")
             self.resends += 1
 
@@ -444,3 +487,38 @@ class ServeProcess:
             out, _ = self.proc.communicate(timeout=10)
         self.output = out or ""
         return self.proc.returncode
+
+
+class ChainMaster(RawMaster):
+    """The same master with no socket: each frame goes to a line of ESCs in this process
+    (anything with ``process(bytearray) -> bool`` and ``service()``, as
+    :class:`gtecat.drives.esc.Chain` has), answered before ``send_raw`` returns; ``tick``
+    is called after each frame (a virtual clock's 100 us on the wire)."""
+
+    def __init__(self, chain: Any, tick: Callable[[], object] = lambda: None) -> None:
+        # (no socket: RawMaster.__init__ is not run)
+        self.chain = chain
+        self.tick = tick
+        self.timeout = ANSWER_S
+        self.resend_after = 0.1
+        self.index = 0
+        self.mbx_counter: dict[int, int] = {}
+        self.frames_sent = 0
+        self.resends = 0
+        self._answer: bytes | None = None
+
+    def close(self) -> None:
+        pass
+
+    def send_raw(self, raw: bytes) -> None:
+        self.frames_sent += 1
+        buf = bytearray(raw)
+        self._answer = bytes(buf) if self.chain.process(buf) else None
+        self.chain.service()
+        self.tick()
+
+    def receive_all(self, index: int, deadline: float) -> list[Reply] | None:
+        raw, self._answer = self._answer, None
+        if raw is None or raw[17] != index:
+            return None
+        return self.replies(raw)

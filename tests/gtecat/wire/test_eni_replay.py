@@ -6,13 +6,20 @@ SAFEOP -> OP)."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from tests.conftest import needs_fixture
 from tests.gtecat.wire.eni_replay import Replay, parse
-from tests.gtecat.wire.rawmaster import RawMaster, ServeProcess, veth_pair, why_not_root
+from tests.gtecat.wire.rawmaster import (
+    ChainMaster,
+    RawMaster,
+    ServeProcess,
+    veth_pair,
+    why_not_root,
+)
 
 ROOT = Path(__file__).resolve().parents[3]
 ENIS = sorted((ROOT / "examples").glob("*.eni")) + sorted(
@@ -105,3 +112,33 @@ def test_an_eni_without_register_init_cmds_fails_clearly(tmp_path: Path) -> None
     assert replay.failures == [
         f"{name}: no IP InitCmd requests state 2" for name in ("GTHD 0", "GTHD 1", "IO 2", "IO 3")
     ]
+
+
+def test_a_bus_of_several_frames_is_replayed_frame_by_frame(tmp_path: Path) -> None:
+    """200 generated drives (1,400 output and 2,200 input bytes) reach OP under a master that
+    runs the file word for word, in this process: every cyclic ``Frame`` goes out as one
+    Ethernet frame (none longer than 1514 bytes) and each of its commands comes back with its
+    ``Cnt``.  The same commands in one frame, as the writer once wrote them, cannot be sent."""
+    from gtecat.cli.serve_cmd import build_chain
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(200, tmp_path / "axes200.eni")
+    config = parse(eni)
+    assert [[(c.cmd, c.length, c.cnt) for c in f] for f in config.cyclic] == [
+        [(11, 1400, 200), (10, 66, 6)],
+        [(10, 1474, 134)],
+        [(10, 660, 60)],
+    ]
+    now = [0]
+    chain, _ = build_chain(eni, clock=lambda: now[0])
+    master = ChainMaster(chain, tick=lambda: now.__setitem__(0, now[0] + 100_000))
+    replay = Replay(master, config)
+    failures = replay.run(cycles=3)
+    assert not failures, "\n".join(failures[:20])
+    assert replay.states() == [(8, 0)] * 200
+    assert replay.cyclic_frames == 3 * (5 + 3)  # 5 cycles in SAFEOP, 3 in OP
+    assert master.resends == 0
+
+    one = Replay(master, replace(config, cyclic=[[c for f in config.cyclic for c in f]]))
+    one.cyclic("OP", 1)
+    assert one.failures == ["frame 0: 3664 bytes, an Ethernet frame carries 1514"]
