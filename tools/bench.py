@@ -28,7 +28,9 @@ interleaved, and every call shape of the fast path likewise (the worst ratio is 
 and every function with a fast path in every way a client passes its value's pointer
 (``every_call_shape_vs_arguments``, the same bar), that walk and the call shapes again with
 the controller on the auto clock (``every_call_shape_vs_arguments_auto``: each poll carries
-its share of the cycles; the same bar), both walks with the spans of a 16-axis controller;
+its share of the cycles, the bar on the whole call; each shape also with the share the
+controller's cycles took, timed where they run, and its ratio without it), both walks with
+the spans of a 16-axis controller;
 the RSS of a fresh process with a 128-axis controller open and moving.  A figure that cannot be
 measured (for example core 2 missing) has ``error`` and ``ok: false``.
 """
@@ -364,31 +366,47 @@ def _time_pairs(
     pairs: Mapping[str, tuple[str, str, dict[str, object]]],
     seconds: float,
     block: int,
+    cycles: Sequence[int] | None = None,
 ) -> dict[str, dict[str, float]]:
     """Per name, (the call statement, the statement building its arguments, their names)
     timed as loops of ``block`` runs, alternating, for ``seconds`` in all: µs per call, µs
-    per argument build, the ratio of the medians."""
+    per argument build, the ratio of the medians.  ``cycles``: the quick cycles' timer
+    (``centry.CYCLE_TIMER``, on): also the µs per call the controller's cycles took inside
+    the calls (``cycle_us``: the kernel's cycle and its book, which the call's host latency
+    runs on the auto clock), the call less them (``less_cycles_us``, median of each block's
+    difference: the call's own work, the values it makes again after a cycle included) and
+    that against the arguments (``ratio_less_cycles``)."""
     clock = time.perf_counter
     per = seconds / max(1, len(pairs))
     out: dict[str, dict[str, float]] = {}
     for name, (call_src, build_src, env) in pairs.items():
         call, build = _loop(call_src, env), _loop(build_src, env)
-        calls, args = [], []
+        calls, args, cyc = [], [], []
         t_end = clock() + per
         while clock() < t_end or len(calls) < 3:
             t0 = clock()
             build(block)
             t1 = clock()
+            ns0 = cycles[1] if cycles is not None else 0
             call(block)
             t2 = clock()
             args.append((t1 - t0) / block)
             calls.append((t2 - t1) / block)
+            if cycles is not None:
+                cyc.append((cycles[1] - ns0) * 1e-9 / block)
         c_us, a_us = statistics.median(calls) * 1e6, statistics.median(args) * 1e6
         out[name] = {
             "call_us": round(c_us, 3),
             "argument_us": round(a_us, 3),
             "ratio": round(c_us / a_us, 2),
         }
+        if cycles is not None:
+            own = statistics.median(c - y for c, y in zip(calls, cyc, strict=True)) * 1e6
+            out[name] |= {
+                "cycle_us": round(statistics.median(cyc) * 1e6, 3),
+                "less_cycles_us": round(own, 3),
+                "ratio_less_cycles": round(own / a_us, 2),
+            }
     return out
 
 
@@ -620,8 +638,15 @@ def bench_every_shape(
     ``names``) :data:`WIDE_SHAPES` on a 16-axis bus on the same clock; ``worst`` the largest
     ratio, ``above_4`` the shapes above the bar.  On the auto clock every call costs its host
     latency of controller time, so a call's figure carries its share of the cycles that run
-    (one 1 ms cycle every 20 calls)."""
+    (one 1 ms cycle every 20 calls): each shape says how much of it the controller's cycles
+    took (``cycle_us``, the readers' C entries' quick cycles timed where they run: the
+    kernel's cycle and its book) and its ratio without them (``ratio_less_cycles``: the call's
+    own work, the values it makes again after a cycle included); ``worst_less_cycles`` the
+    largest of those (``worst`` stays the whole call's)."""
     from gtecat import gt
+    from gtecat.gt import centry
+
+    timer = centry.CYCLE_TIMER if clock == "auto" and centry.CYCLE_TIMED else None
 
     gt.GT_Close()
     gt.GT_Open(eni=str(EXAMPLES / "manual_fig5_2.eni"), clock=clock, log="")
@@ -635,25 +660,37 @@ def bench_every_shape(
         if raw:
             env = _shape_env()
             pairs |= {k: (*v, env) for k, v in CALL_SHAPES.items()}
-        shapes = _time_pairs(pairs, seconds, block)
+        if timer is not None:
+            timer[0] = 1
+        shapes = _time_pairs(pairs, seconds, block, timer)
         if names is None:  # (the spans of a controller of more than 12 axes)
             gt.GT_Close()
             wide = _wide_pairs(clock)
-            shapes |= _time_pairs(wide, seconds * len(wide) / max(1, len(pairs)), block)
+            shapes |= _time_pairs(wide, seconds * len(wide) / max(1, len(pairs)), block, timer)
             for k in WIDE_SHAPES:
                 if f"{k} (16 axes)" not in wide:
                     skipped[f"{k} (16 axes)"] = "does not return 0 on the 16-axis bus"
     finally:
+        if timer is not None:
+            timer[0] = 0
         gt.GT_Close()
     worst = max((r["ratio"] for r in shapes.values()), default=0.0)
     above = {k: r["ratio"] for k, r in shapes.items() if r["ratio"] > 4}
-    return {
+    out: dict[str, object] = {
         "shapes": shapes,
         "count": len(shapes),
         "worst": worst,
         "above_4": above,
-        "not_measured": skipped,
     }
+    if timer is not None:
+        less = {k: r["ratio_less_cycles"] for k, r in shapes.items()}
+        top = max(less, key=less.__getitem__, default=None)
+        out |= {
+            "worst_less_cycles": less[top] if top is not None else 0.0,
+            "worst_less_cycles_shape": top,
+            "worst_shape": max(shapes, key=lambda k: shapes[k]["ratio"], default=None),
+        }
+    return out | {"not_measured": skipped}
 
 
 def _rss() -> dict[str, float]:

@@ -252,6 +252,15 @@ _ROW_RATES = {"enc_vel": 0, "enc_acc": 1}
 _ROW_ITEMS = frozenset({"a_last", "enc_pos"})
 #: the dtype of the bank's doubles (AxisBank.span_bytes: their bytes are the values packed)
 _F64 = np.dtype(np.float64)
+#: ... and of its table indices (AxisBank.t_idx)
+_I64 = np.dtype(np.int64)
+
+
+def _flat(a: np.ndarray) -> bool:
+    """One C-contiguous dimension (AxisBank.span_bytes: an array a C entry reads again)."""
+    return a.ndim == 1 and a.flags.c_contiguous  # type: ignore[no-any-return]
+
+
 #: the axis's mode while its drive homes (6060h = 6)
 _HOMING_MODE = 6
 #: the bank's arrays of homing rows (gtecat.drives.homing_bank), floats unless named in _HM_U8
@@ -2254,31 +2263,45 @@ class AxisBank:
             return getattr(self, name).item(r)
         return self.value(name, r)
 
-    def span_bytes(self, name: str, rows: slice) -> Callable[[AxisBank], bytes | None] | None:
+    def span_bytes(
+        self, name: str, rows: slice
+    ) -> Callable[[AxisBank], tuple[Any, ...] | None] | None:
         """A getter of the native doubles of ``_make_list(name)[rows]``, a run of rows in
         order, from a bank's arrays in one step (a span of doubles after a cycle: no list of
         every row, no Python float per row), which gives None where it does not apply; None:
         no such getter.  The Trap tables' values where no row jogs or homes, the arrays whose
-        list is the array's own (float64)."""
+        list is the array's own (float64).  With the bytes, where they come from: ``(bytes,
+        0, source, index, rows, None, 0.0)``, the doubles ``source[index[r]]`` (``index``
+        None: ``source[r]``) for each row r of the run (``rows``: their int64 bytes), both
+        arrays the bank's own, of one C-contiguous dimension (float64, int64), which the
+        compiled cycle moves in place and only Python replaces: a reader's C entry makes
+        them again after a cycle booked in C (gtecat/gt/csrc/centry.c gather); ``(bytes,)``
+        where it cannot say."""
         whole = not rows.start and rows.stop == self.n  # (the whole bank: no slice)
+        run = array("q", range(rows.start or 0, rows.stop)).tobytes()
         flat = _PLANNED_FLAT.get(name)
         if flat is not None:
             table = attrgetter(flat)
 
-            def planned(b: AxisBank) -> bytes | None:
+            def planned(b: AxisBank) -> tuple[Any, ...] | None:
                 if b.n_jog or b.n_hm:
                     return None
-                return table(b)[b.t_idx if whole else b.t_idx[rows]].tobytes()  # type: ignore[no-any-return]
+                t, i = table(b), b.t_idx
+                out = t[i if whole else i[rows]].tobytes()
+                if t.dtype is _F64 and i.dtype is _I64 and _flat(t) and _flat(i):
+                    return out, 0, t, i, run, None, 0.0
+                return (out,)
 
             return planned
         if name in _ROW_ITEMS:
             values = attrgetter(name)
 
-            def items(b: AxisBank) -> bytes | None:
+            def items(b: AxisBank) -> tuple[Any, ...] | None:
                 x = values(b)
                 if x.dtype is not _F64:
                     return None
-                return (x if whole else x[rows]).tobytes()  # type: ignore[no-any-return]
+                out = (x if whole else x[rows]).tobytes()
+                return (out, 0, x, None, run, None, 0.0) if _flat(x) else (out,)
 
             return items
         return None

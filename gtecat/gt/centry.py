@@ -129,13 +129,35 @@ class _Api(ctypes.Structure):
         ("key_lists", _VP),
         ("key_seen", _VP),
         ("b_size", ctypes.c_ssize_t),
+        ("bytes_new", _VP),
+        ("float_new", _VP),
+    ]
+
+
+class _Recipe(ctypes.Structure):
+    """``struct recipe`` of csrc/centry.c: where a value's doubles come from."""
+
+    _fields_ = [
+        ("src", _VP),
+        ("idx", _VP),
+        ("rows", _VP),
+        ("ratios", _VP),
+        ("op", ctypes.c_longlong),
+        ("t", ctypes.c_double),
     ]
 
 
 class _Slot(ctypes.Structure):
     """``struct slot`` of csrc/centry.c: a value kept for the epoch it was asked in."""
 
-    _fields_ = [("epoch", ctypes.c_longlong), ("value", _VP)]
+    _fields_ = [
+        ("epoch", ctypes.c_longlong),
+        ("value", _VP),
+        ("booked", ctypes.c_longlong),
+        ("holds", ctypes.c_longlong),
+        ("keeps", ctypes.c_longlong),
+        ("rc", _Recipe),
+    ]
 
 
 class _ASlot(ctypes.Structure):
@@ -150,6 +172,8 @@ class _ASlot(ctypes.Structure):
         ("value", _VP),
         ("holds", ctypes.c_longlong),
         ("keeps", ctypes.c_longlong),
+        ("rc", _Recipe),
+        ("booked", ctypes.c_longlong),
     ]
 
 
@@ -184,6 +208,7 @@ class _Entry(ctypes.Structure):
         ("tuple_type", _VP),
         ("titems", ctypes.c_ssize_t),
         ("cderefs", ctypes.c_ssize_t * _MAX_TYPES),
+        ("steady", ctypes.c_ssize_t),
     ]
 
 
@@ -365,6 +390,15 @@ def _marks_dict() -> dict:
 #: a reader's entry writes its ``pClock`` from them (csrc/centry.c clock_ms)
 CLOCK_MS = (ctypes.c_ssize_t * 4)()
 _ORIGINS: list[Any] = [None, None]  # (their arrays, kept alive while named)
+
+#: the quick cycles' timer (csrc/centry.c cycle_timer): [0] nonzero while on, [1] the
+#: nanoseconds the quick cycles the entries ran took (the kernel's cycle and its book), [2]
+#: how many; for a benchmark that tells a call's own cost from the controller's cycles its
+#: host latency runs inside it (tools/bench.py); off, it costs a cycle one load
+CYCLE_TIMER = (ctypes.c_longlong * 3)()
+#: whether the entries time their quick cycles when :data:`CYCLE_TIMER` is on (a monotonic
+#: clock known to the C file)
+CYCLE_TIMED = False
 
 
 def set_clock_ms(gt: Any, gtn: Any) -> None:
@@ -850,6 +884,8 @@ def _load() -> tuple[Maker | None, str]:
             id(_KEY_LISTS),
             id(_KEY_SEEN),
             size_at,
+            _address("PyBytes_FromStringAndSize"),
+            _address("PyFloat_FromDouble"),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -857,6 +893,9 @@ def _load() -> tuple[Maker | None, str]:
             return None, "the library refused the layout"
         lib.gtecat_centry_clock_ms.argtypes = [_VP]
         lib.gtecat_centry_clock_ms(ctypes.addressof(CLOCK_MS))
+        lib.gtecat_centry_cycle_timer.argtypes = [_VP]
+        global CYCLE_TIMED
+        CYCLE_TIMED = lib.gtecat_centry_cycle_timer(ctypes.addressof(CYCLE_TIMER)) == 0
         meth = ctypes.cast(lib.gtecat_centry_reader, _VP).value
         raw_meth = ctypes.cast(lib.gtecat_centry_raw, _VP).value
         vc = ctypes.cast(lib.gtecat_centry_reader_vc, _VP).value
@@ -904,6 +943,7 @@ def _load() -> tuple[Maker | None, str]:
         cache: bool = False,
         clocks: Iterable[type] = (),
         numpy: Iterable[Any] = (),
+        steady: bool = False,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -919,6 +959,7 @@ def _load() -> tuple[Maker | None, str]:
         # (a structure's array: its elements sizeof apart, its value the fields' bytes)
         e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
         e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
+        e.steady = int(steady)
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1580,6 +1621,7 @@ def reader(
     after: Callable[[], Any] | None = None,
     clocks: Iterable[type] = (),
     numpy: Iterable[Any] = (),
+    steady: bool = False,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -1608,7 +1650,9 @@ def reader(
     call's return once its value is written while the gate says :data:`AUTO`), so they
     need not check the session themselves; a gated entry keeps what ``value`` and
     ``array`` give for the epoch they were asked in and writes it again while
-    :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`).
+    :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`); ``steady``:
+    and across the quick cycles the entries book themselves (no Python runs in those: what
+    an attribute no cycle changes gives, a profile's mode).
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -1630,6 +1674,7 @@ def reader(
         gate != NO_GATE,
         clocks,
         numpy,
+        steady,
     )
 
 

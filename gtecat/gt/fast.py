@@ -19,6 +19,7 @@ import re
 import struct
 import sys
 import time
+from array import array
 from collections.abc import Callable
 from operator import itemgetter
 from typing import Any
@@ -343,6 +344,7 @@ def fast_reader(
     row_expr = BANK_ROWS.get(name) if bank_key is None else SPAN_ROWS.get(name)
     plan_key = bank_key if row_expr is None else name
     quick = QUICK_ROWS.get(name)  # (its rows' values in fewer steps where it may)
+    source = QUICK_SOURCES.get(name)  # (and where those values come from: the C entry's)
     #: a span's values are status words alone (of the bank's rows, their flags): they stand
     #: while every change is a cycle that keeps every flag (the C entry's array_value)
     status = name in ("GT_GetSts", "GT_GetPrfSts")
@@ -443,7 +445,7 @@ def fast_reader(
                 or plan[2] is not axes
             ):
                 top = resource_count(ctl) if zeros and axes else 0
-                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr, quick)
+                plan = _read_plan(b, resources, axes, n, count, top, get, row_expr, quick, source)
                 b.read_plans[key] = plan
             pick = plan[3]
             if pick is not None and row_expr is not None:
@@ -548,6 +550,7 @@ def fast_reader(
         #: bank): the bank, n, count, the layout, resources and axes it holds for, its pick,
         #: whether that picks the bank's rows and zeros alone (no other axis's getter), the
         #: getter of the bytes of the run of rows it picks in order (AxisBank.span_bytes,
+        #: else None), the plan's getter of where its rows' values come from (_read_plan's,
         #: else None).  A span each: a program that reads two spans in turn
         #: (``GT_GetEncPos(1, a, 8)``, ``GT_GetEncPos(9, byref(a, 64), 4)``) finds both
         lanes: dict[tuple[int, int], list[Any]] = {}
@@ -579,10 +582,18 @@ def fast_reader(
                 return _NO
             lst = pick = None  # (the bank's list and a plan's getter the values come from)
             words = False  # (status words of the bank's rows and zeros alone: (bytes,))
+            recipe = None  # (a getter of where the values come from: the entry's gather)
+            source = None  # (... or where they come from)
             if count == 1:
                 v = value(n)
                 if v is _NO:
                     return _NO
+                if type(v) is tuple:
+                    # (word,): a bank's status word, which stands as a span of them does;
+                    # (x, op, ...): a double and where it comes from, made again as a span's
+                    words = len(v) == 1
+                    source = v[1:] if len(v) == 7 and doubles else None
+                    v = v[0]
                 values: Any = (v,)
             else:
                 if count > limit:
@@ -604,17 +615,20 @@ def fast_reader(
                     words = status and ln[7]
                     if row_expr is not None:
                         values = ln[6](b)
+                        recipe = ln[9]
                     else:
                         lists = b._lists
                         lst = lists.get(bank_key)
                         if lst is None and doubles and ln[8] is not None:
                             # a run of rows in order, not made yet this cycle: their bytes
                             # from the bank's arrays in one step (the same doubles as the
-                            # list's, packed natively), no list of every row
-                            out = ln[8](b)
-                            if out is not None:
+                            # list's, packed natively), no list of every row; with the
+                            # arrays they come from (the entry gathers them again after
+                            # the cycles it books itself: csrc/centry.c gather)
+                            got = ln[8](b)
+                            if got is not None:
                                 session.last = None
-                                return out
+                                return got if len(got) > 1 else got[0]
                         if lst is None:  # (AxisBank.value's making of it, without its frame)
                             lst = lists[bank_key] = b._make_list(bank_key)
                         memo = packed  # (one read: another thread may replace it meanwhile)
@@ -646,6 +660,7 @@ def fast_reader(
                         lanes[n, count] = [
                             *(b, n, count, *plan[:4], plan[6]),
                             None if run is None else b.span_bytes(bank_key, run),
+                            plan[8],
                         ]
             memo = packed  # (one read: another thread may replace it meanwhile)
             if pack is memo[0] and (values is memo[1] or values == memo[1]):
@@ -660,6 +675,10 @@ def fast_reader(
                 if ints:
                     packed[:] = [pack, values, out, lst if pick is not None else None, pick]
             session.last = None
+            if recipe is not None and doubles:  # (the entry makes them again: gather)
+                source = recipe(b)
+            if source is not None:
+                return (out, *source)
             # status words of the bank's rows and zeros alone stand across the cycles the C
             # entry books that keep every flag (csrc/centry.c array_value)
             return (out,) if words else out
@@ -678,15 +697,16 @@ def fast_reader(
             pointers=True,  # (pointer(x): as general answers it)
             array=array_value(value_gt, 0), gate=centry.GT_GATE,
             after=_after(advance, name, 0),
-            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            clocks=CLOCK_ORDER if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
+            steady=name in STEADY,
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
             core=True, pointers=True, array=array_value(value_gtn, 1),
-            clocks=sorted(_CLOCK_INTS, key=str) if takes_clock else (),
+            clocks=CLOCK_ORDER if takes_clock else (),
             gate=centry.GTN_GATE, after=_after(advance, name, 1),
-            numpy=sorted(np_ok, key=str),
+            numpy=sorted(np_ok, key=str), steady=name in STEADY,
         )  # fmt: skip
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
@@ -1006,8 +1026,64 @@ QUICK_ROWS: dict[str, tuple[str, str, str, str]] = {
     "GT_GetEncVel": (*_ENC_QUICK, "s1.item({r}) / T"),
 }
 
+#: the readers whose values no cycle changes (a Python attribute: a cycle the C entries book
+#: themselves runs no Python): their entries keep them across such cycles (centry.reader's
+#: ``steady``)
+STEADY = frozenset({"GT_GetPrfMode"})
+
+#: one banked axis's double that its C entry makes again itself after the cycles it books
+#: (csrc/centry.c kept: the operations of QUICK_SOURCES on the axis's row ``res.bank_row``):
+#: (op, the bank's arrays src and idx, the factor or None, where the value function's
+#: value is that: its guard, which holds on across such cycles)
+_NO_JOG = "not (b.n_jog or b.n_hm)"
+_CLAIMED = "b.counts[3] - b.claim_cycle.item(res.bank_row) >= 2"
+SCALAR_SOURCES: dict[str, tuple[int, str, str | None, str | None, str]] = {
+    "GT_GetPrfPos": (0, "_t_p1", "t_idx", None, _NO_JOG),
+    "GT_GetPrfVel": (0, "_t_v1", "t_idx", None, _NO_JOG),
+    "GT_GetPrfAcc": (0, "_t_a1", "t_idx", None, _NO_JOG),
+    "GT_GetAxisPrfPos": (0, "a_last", None, None, "True"),
+    "GT_GetEncPos": (0, "enc_pos", None, None, "True"),
+    "GT_GetEncVel": (1, "enc_step1", None, None, _CLAIMED),
+    "GT_GetAxisPrfVel": (0, "_t_v1", "t_idx", "res.prf_link.ratio", _NO_JOG),
+    "GT_GetAxisPrfAcc": (0, "_t_a1", "t_idx", "res.prf_link.ratio", _NO_JOG),
+    "GT_GetAxisEncVel": (1, "enc_step1", None, "res.enc_link.ratio", _CLAIMED),
+    "GT_GetAxisEncAcc": (2, "enc_step1", "enc_step0", "res.enc_link.ratio", _CLAIMED),
+    "GT_GetAxisEncPos": (3, "enc_pos", None, "res.enc_link", "True"),
+    "GT_GetAxisError": (4, "a_last", "enc_pos", "res.enc_link", "True"),
+}
+_PACK_D = struct.Struct("@d").pack
+_PACK_D2 = struct.Struct("@2d").pack
+_ROWS8: dict[int, bytes] = {}
+
+
+def _row8(r: int) -> bytes:
+    """Row ``r`` as the int64 bytes a C entry reads (SCALAR_SOURCES' rows)."""
+    b = _ROWS8.get(r)
+    if b is None:
+        b = _ROWS8[r] = array("q", (r,)).tobytes()
+    return b
+
+
+#: the QUICK_ROWS values a span's C entry makes again itself after the cycles it books
+#: (csrc/centry.c gather: the same IEEE operations in the same order on the bank's arrays,
+#: which the compiled cycle moves in place): (its op - 0 ``src[idx[r]]``, 1 ``src[r] / T``,
+#: 2 ``(src[r] / T - idx[r] / T) / T`` -, the bank's arrays src and idx, the factor of the
+#: axis's resources or None); asked where QUICK_ROWS' guards hold (which hold on across
+#: such cycles: no row jogs or homes, a row claimed two cycles ago or more)
+QUICK_SOURCES: dict[str, tuple[int, str, str | None, str | None]] = {
+    "GT_GetAxisPrfVel": (0, "_t_v1", "t_idx", "prf_link.ratio"),
+    "GT_GetAxisPrfAcc": (0, "_t_a1", "t_idx", "prf_link.ratio"),
+    "GT_GetAxisEncVel": (1, "enc_step1", None, "enc_link.ratio"),
+    "GT_GetAxisEncAcc": (2, "enc_step1", "enc_step0", "enc_link.ratio"),
+    "GT_GetEncVel": (1, "enc_step1", None, None),
+    # 3 ``axis(src[r])``, 4 ``src[r] - axis(idx[r])``: the encoder's link (AffineLink.axis,
+    # its two branches) of each axis, its ratio and offset
+    "GT_GetAxisEncPos": (3, "enc_pos", None, "enc_link"),
+    "GT_GetAxisError": (4, "a_last", "enc_pos", "enc_link"),
+}
+
 #: a span's lane that holds for nothing (a reader's array_value: no span answered yet)
-_NO_LANE = (None,) * 9
+_NO_LANE = (None,) * 10
 #: the spans a reader's array_value keeps lanes of at most
 _LANES = 16
 
@@ -1036,6 +1112,7 @@ def _read_plan(
     get: Any = None,
     row: str | None = None,
     quick: tuple[str, str, str, str] | None = None,
+    source: tuple[int, str, str | None, str | None] | None = None,
 ) -> tuple[Any, ...]:
     """(the bank's layout, the resources and axes looked at, a getter of the span's values
     from a list of the bank's values or None, the first row's resources or None when no axis
@@ -1047,8 +1124,11 @@ def _read_plan(
     an axis no drive backs (it reads 0); any other (another bank's axis, one not on the
     bus): no getter.  ``row``: a row's value is that expression of BANK_ROWS (``{R}`` its
     resources, ``{r}`` its row) and the getter takes the bank itself, not a list; ``quick``:
-    QUICK_ROWS' form of it, taken where its guards hold."""
-    none = (b.layout, resources, axes, None, None, 0, False, None)
+    QUICK_ROWS' form of it, taken where its guards hold; ``source``: QUICK_SOURCES' for it,
+    and the plan's last item a function of the bank giving where the values come from where
+    those guards hold (``(op, src, idx, rows, ratios, T)``, csrc/centry.c gather), else
+    None."""
+    none = (b.layout, resources, axes, None, None, 0, False, None, None)
     if count < 2:  # (one value: no tuple to store)
         return none
     items: list[str] = []
@@ -1056,6 +1136,7 @@ def _read_plan(
     guards: list[str] = [] if quick is None else [quick[1]]
     env: dict[str, Any] = {"g": get}
     at = None
+    rows: list[int] = []  # (the bank's rows of the span, in order: a source's)
     for i, k in enumerate(range(n, n + count)):
         if k not in axes and 1 <= n <= n + count - 1 <= top:
             items.append("0")
@@ -1073,6 +1154,7 @@ def _read_plan(
                 if quick is not None:
                     quick_items.append(quick[3].format(R=f"r{i}", r=res.bank_row))
                     guards.append(quick[2].format(r=res.bank_row))
+            rows.append(res.bank_row)
             at = i if at is None else at
         elif res.bank is None and get is not None:
             items.append(f"g(r{i})")
@@ -1104,8 +1186,39 @@ def _read_plan(
                 env,
             )
             pick = env["quick"]
+    from_source = None
+    if source is not None and pure and len(rows) == count:
+        op, src, idx, factor = source
+        if factor is not None and factor.endswith("_link"):  # (a link's axis(): both)
+            f = ", ".join(f"r{i}.{factor}.ratio, r{i}.{factor}.offset" for i in range(count))
+            width = 2 * count
+        else:
+            f = ", ".join(f"r{i}.{factor}" for i in range(count)) if factor else ""
+            width = count
+        env |= {"ROWS": array("q", rows).tobytes(), "_pack": struct.Struct(f"@{width}d").pack}
+        env |= {"_num": (int, float)}
+        guard = " and ".join(x for x in guards if x != "True") or "True"
+        exec(
+            _plan_code(
+                f"def from_source(b):\n    {quick[0] if quick is not None else 'pass'}\n"
+                f"    if not ({guard}):\n        return None\n"
+                + (
+                    f"    f = ({f},)\n"
+                    "    if not all(type(x) in _num for x in f):\n        return None\n"
+                    "    f = _pack(*f)\n"
+                    if factor
+                    else "    f = None\n"
+                )
+                + f"    t = b.T if {op} in (1, 2) else 0.0\n"
+                + "    if type(t) is not float:\n        return None\n"
+                + f"    return {op}, b.{src}, {'b.' + idx if idx else 'None'}, ROWS, f, t\n",
+                "exec",
+            ),
+            env,
+        )
+        from_source = env["from_source"]
     first = None if at is None else resources.get(n + at)
-    return (b.layout, resources, axes, pick, first, at, pure, run)
+    return (b.layout, resources, axes, pick, first, at, pure, run, from_source)
 
 
 #: the plans' getters compiled, by their text (:func:`_plan_code`)
@@ -1324,7 +1437,7 @@ def {fname}(n):
         return NOPE
 {{value}}
     session.last = None
-    return v
+    {{tail}}
 """
 
 
@@ -1332,7 +1445,37 @@ def _value_function(env: dict[str, Any], fname: str, ctl: str) -> Callable[[Any]
     """The value function of a reader's C entry (``ctl``: the GT_ or the GTN_ form's gated
     controller, ``CTL`` or ``CTLN``)."""
     value = "\n".join("    " + line for line in _value_lines(env))
-    code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value)
+    # a status word of the bank's as (word,): it stands across the quick cycles that keep
+    # every flag (csrc/centry.c kept), as a span of them does
+    status = env["name"] in ("GT_GetSts", "GT_GetPrfSts")  # (GT_GetPrfSts: a bit of it)
+    tail = "return v if res.bank is None else (v,)" if status else "return v"
+    source = SCALAR_SOURCES.get(env["name"])
+    if source is not None:  # a double of the bank's with where it comes from (kept)
+        op, src, idx, factor, guard = source
+        t = "b.T" if op in (1, 2) else "0.0"
+        env |= {"_ROW8": _row8, "_D": _PACK_D, "_D2": _PACK_D2, "_NUM": (int, float)}
+        link = factor is not None and factor.endswith("_link")  # (a link's axis(): both)
+        tail = "\n".join(
+            [
+                f"if b is not None and {guard} and type({t}) is float:",
+                f"    f = {factor or 'None'}",
+                *(
+                    [
+                        "    if type(f.ratio) in _NUM and type(f.offset) in _NUM:",
+                        "        f = _D2(f.ratio, f.offset)",
+                    ]
+                    if link
+                    else [
+                        "    if f is None or type(f) in _NUM:",
+                        "        f = None if f is None else _D(f)",
+                    ]
+                ),
+                f"        return v, {op}, b.{src}, {'b.' + idx if idx else 'None'}, "
+                f"_ROW8(res.bank_row), f, {t}",
+                "return v",
+            ]
+        ).replace("\n", "\n    ")
+    code = _VALUE.format(fname=fname, ctl=ctl).replace("{value}", value).replace("{tail}", tail)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
     return env[fname]  # type: ignore[no-any-return]
 
@@ -1347,6 +1490,11 @@ _INT_MAX = {t: (1 << (8 * ctypes.sizeof(t) - 1)) - 1 for t in _INTS}
 _CLOCK_INTS = _INTS | {ctypes.c_uint32, ctypes.c_ulong, ctypes.c_uint64, ctypes.c_ulonglong}
 _INT_MAX.update(
     {t: (1 << (8 * ctypes.sizeof(t))) - 1 for t in _CLOCK_INTS - _INTS}  # (unsigned)
+)
+#: the clock's types in the order a C entry looks for them: the vendor's ``c_ulong`` and
+#: ``c_uint32`` first (a poll's clock is found in one step), then the others
+CLOCK_ORDER = sorted(
+    _CLOCK_INTS, key=lambda t: (t is not ctypes.c_ulong, t is not ctypes.c_uint32, str(t))
 )
 
 
@@ -1457,7 +1605,7 @@ def fast_clock(
 
     if not CENTRY:
         return gt
-    types = sorted(_CLOCK_INTS, key=str)
+    types = CLOCK_ORDER
     # (an array of one of the types ``first`` takes: its first element)
     elements = [t for t in _scalar_types(FUNCTIONS[name].params[0]) if t._type_ in _INT_CODES]
     entry = centry.reader(

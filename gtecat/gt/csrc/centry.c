@@ -30,6 +30,10 @@
  * handed over by the loader, which probed them on objects whose answers it knows and tests
  * the entry against the Python path before using it.
  */
+#if !defined(_WIN32)
+#define _POSIX_C_SOURCE 199309L /* (clock_gettime: the cycles' timer, cycle_timer) */
+#include <time.h>
+#endif
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -130,15 +134,39 @@ struct api {
     /* a ctypes object's size in bytes (b_size: what ctypes.sizeof gives for the object, the
      * extent byref(x, offset) is checked against) */
     ptrdiff_t b_size;
+    /* PyBytes_FromStringAndSize: a span's values gathered here (gather) */
+    obj (*bytes_new)(const char *, ptrdiff_t);
+    /* PyFloat_FromDouble: one axis's double made again (kept) */
+    obj (*float_new)(double);
 };
 
 #define MAX_TYPES 16
+
+/* Where a value's doubles come from, as its value function says it (strong references while
+ * kept; src NULL: not said): for each of its doubles the same operations on the bank's
+ * arrays across the cycles booked in C (make_doubles): rows (int64 bytes) the rows, ratios
+ * (float64 bytes, NULL: none) a factor per value, op what is read of src and idx at a row,
+ * t the cycle time op 1 and 2 divide by. */
+struct recipe {
+    obj src, idx, rows, ratios;
+    long long op;
+    double t;
+};
 
 /* a value kept for the epoch it was asked in (value: a strong reference, NULL: none) */
 struct slot {
     long long epoch;
     obj value;
+    long long booked; /* c_booked when it was kept */
+    /* holds: 1 where the value is a status word of the bank's (value(n) gave (word,)), which
+     * stands across the cycles that keep every flag; keeps: flag_keeping when it was kept */
+    long long holds, keeps;
+    struct recipe rc; /* where a double comes from: made again after cycles booked in C */
 };
+
+static int make_doubles(const struct recipe *rc, long long count, double *out);
+static const char *vector(obj a, ptrdiff_t *len);
+static int ll_of(obj o, long long *v);
 
 /* a span's bytes kept for its key and epoch (tp: a strong reference while kept); holds: 1
  * where they stand across the cycles that keep every status flag (their value function gave
@@ -148,6 +176,9 @@ struct aslot {
     obj tp;
     obj value;
     long long holds, keeps;
+    /* where the bytes come from, as avalue said (gather); booked: c_booked when kept */
+    struct recipe rc;
+    long long booked;
 };
 
 /* one reader's entry: the memory of the ctypes object that is the C function's self */
@@ -189,10 +220,28 @@ struct entry {
     ptrdiff_t titems;
     /* per clock type of ctypes_: a ctypes pointer type's _type_ (pointer(x): x's memory), 0 */
     ptrdiff_t cderefs[MAX_TYPES];
+    /* 1: its values stand across the cycles booked in C (an attribute no cycle changes: a
+     * profile's mode), see c_booked */
+    ptrdiff_t steady;
 };
 
 static struct api A;
 static int ready;
+
+/* The quick cycles booked in C that kept every status flag (no in-position band, no move
+ * ended: book_in_c's b[14]), each of which made the readers' epoch grow by one: where the
+ * epoch grew by as much as this count since a span of status words, or one axis's word of
+ * the bank, was kept, every change since was such a cycle and the words stand (array_value,
+ * kept) */
+static long long flag_keeping;
+
+/* The quick cycles booked in C (book_in_c; each made the readers' epoch grow by one): where
+ * the epoch grew by as much as this count since a value was kept, every change since was
+ * such a cycle - no Python ran in them: the bank's arrays the same objects, its rows the
+ * same, their values moved in place by the kernel, every Python attribute as it was - and a
+ * span's bytes are made again from where they came from (array_value, gather), and a
+ * steady entry's values (an attribute's: GT_GetPrfMode) stand (kept, array_value) */
+static long long c_booked;
 
 #define AT(base, off) (*(char **)((char *)(base) + (off)))
 /* the flag a vectorcall's caller may set in nargsf (PY_VECTORCALL_ARGUMENTS_OFFSET) */
@@ -216,7 +265,7 @@ int gtecat_centry_api(const struct api *api)
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
         !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
-        api->b_size <= 0)
+        api->b_size <= 0 || !api->bytes_new || !api->float_new)
         return 1;
     A = *api;
     ready = 1;
@@ -252,21 +301,41 @@ static long long epoch(void)
     return over || v < 0 ? -1 : v;
 }
 
-/* Keep v in s for epoch ep (v: borrowed; s's old value given up). */
+/* A recipe's references given up (NULL: none), a copy of it (rc emptied first: Python may
+ * run in a decref) */
+static void let_recipe_go(struct recipe *rc)
+{
+    struct recipe was = *rc;
+    obj refs[4];
+    int k;
+    rc->src = rc->idx = rc->rows = rc->ratios = NULL;
+    refs[0] = was.src, refs[1] = was.idx, refs[2] = was.rows, refs[3] = was.ratios;
+    for (k = 0; k < 4; k++)
+        if (refs[k])
+            A.decref(refs[k]);
+}
+
+/* Keep v in s for epoch ep (v: borrowed; s's old value, and where it came from, given up). */
 static void keep(struct slot *s, long long ep, obj v)
 {
     obj old = s->value;
     A.incref(v);
     s->value = v;
     s->epoch = ep;
+    s->booked = c_booked;
+    s->holds = 0;
+    s->keeps = flag_keeping;
+    let_recipe_go(&s->rc);
     if (old)
         A.decref(old);
 }
 
 /* The value kept in cache (ncache slots) for the int n in this epoch, a new reference, else
  * NULL; *key is n's slot (-1: n has none) and *ep the epoch (-1: unknown), for keep(). */
-static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, long long *ep)
+static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, long long *ep,
+                int steady)
 {
+    struct slot *s;
     int over = 0;
     *key = n ? A.as_ll(n, &over) : 0;
     *ep = -1;
@@ -277,12 +346,37 @@ static obj kept(struct slot *cache, ptrdiff_t ncache, obj n, long long *key, lon
         return NULL;
     }
     *ep = epoch();
-    if (*ep >= 0 && cache[*key].value && cache[*key].epoch == *ep) {
-        A.incref(cache[*key].value);
-        return cache[*key].value;
+    s = &cache[*key];
+    if (*ep >= 0 && s->value &&
+        (s->epoch == *ep ||
+         (steady && *ep > s->epoch && *ep - s->epoch == c_booked - s->booked) ||
+         (s->holds && *ep > s->epoch && *ep - s->epoch == flag_keeping - s->keeps))) {
+        /* (a steady value across cycles booked in C, a status word across those that kept
+         * every flag: the same) */
+        s->epoch = *ep, s->booked = c_booked, s->keeps = flag_keeping;
+        A.incref(s->value);
+        return s->value;
+    }
+    if (*ep >= 0 && s->value && s->rc.src && *ep > s->epoch &&
+        *ep - s->epoch == c_booked - s->booked) {
+        /* (a double of the bank's after cycles booked in C: made again where it comes from) */
+        double x;
+        obj f, old;
+        if (make_doubles(&s->rc, 1, &x) &&
+            (f = A.float_new(x)) != NULL) {
+            old = s->value;
+            s->value = f;
+            s->epoch = *ep, s->booked = c_booked, s->keeps = flag_keeping;
+            A.decref(old);
+            A.incref(f);
+            return f;
+        }
+        if (A.err_occurred())
+            A.err_clear();
     }
     return NULL;
 }
+
 
 /* Keep a span's (or a raw range's) bytes v with their key and type tp for epoch ep. */
 static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
@@ -293,6 +387,7 @@ static void keep_span(struct aslot *s, long long ep, obj v, obj tp, long long n,
     A.incref(tp);
     s->value = v, s->tp = tp, s->epoch = ep, s->n = n, s->count = count, s->clock = clock;
     s->holds = 0;
+    let_recipe_go(&s->rc);
     if (old)
         A.decref(old);
     if (oldtp)
@@ -488,11 +583,6 @@ static int armed(const long long *q, long long pend)
     return 1;
 }
 
-/* The quick cycles booked in C that kept every status flag (no in-position band, no move
- * ended: book_in_c's b[14]), each of which made the readers' epoch grow by one: where the
- * epoch grew by as much as this count since a span of status words was kept, every change
- * since was such a cycle and the words stand (array_value) */
-static long long flag_keeping;
 
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
@@ -559,6 +649,7 @@ static int book_in_c(ptrdiff_t gate, long long *q)
         cnt[9] = ep + 1;
     if (b[14])
         flag_keeping++;
+    c_booked++;
     *(long long *)b[3] += 1; /* its drives' cycles */
     *(long long *)b[4] += 1; /* the master's */
     q[10] = cycles;
@@ -566,6 +657,44 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     io[b[10]] = now; /* (the next cycle's call as this one's) */
     q[4] = ep + 1;   /* armed again, for the new epoch */
     return 1;
+}
+
+/* The cycles' timer (gtecat.gt.centry.CYCLE_TIMER, for a benchmark that tells a call's own
+ * cost from the cycles a call's latency runs inside it): [0] nonzero while on, [1] the
+ * nanoseconds the quick cycles took (the kernel's cycle and its book, in C or Python), [2]
+ * how many; NULL: none (no monotonic clock known here) */
+static long long *cycle_timer;
+
+int gtecat_centry_cycle_timer(long long *t)
+{
+#if defined(_WIN32)
+    (void)t;
+    return 1;
+#else
+    cycle_timer = t;
+    return 0;
+#endif
+}
+
+static long long timer_ns(void)
+{
+#if defined(_WIN32)
+    return 0;
+#else
+    struct timespec t;
+    if (clock_gettime(CLOCK_MONOTONIC, &t))
+        return 0;
+    return (long long)t.tv_sec * 1000000000LL + t.tv_nsec;
+#endif
+}
+
+/* A quick cycle timed (started at t0) where the timer is on. */
+static void timed(long long t0)
+{
+    if (t0) {
+        cycle_timer[1] += timer_ns() - t0;
+        cycle_timer[2] += 1;
+    }
 }
 
 /* The armed quick cycle where the call's latency makes a cycle due: the clock's lock taken
@@ -578,6 +707,7 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     long long *q = (long long *)A.clock_quick[gate - 1];
     obj book = (obj)A.clock_calls[gate - 1], release, args[2];
     const long long *call;
+    long long t0;
     int rc;
     if (!q || !book || !armed(q, q[0] + q[1]))
         return 0;
@@ -593,11 +723,13 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
         return 0;
     }
     call = (const long long *)q[8];
+    t0 = cycle_timer && cycle_timer[0] ? timer_ns() : 0;
     q[4] = 0;  /* (the book arms the next one) */
     q[11] -= 1; /* (one cycle of the budget it was armed with) */
     q[0] += q[1] - q[2];
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
     if (!rc && book_in_c(gate, q)) {
+        timed(t0);
         A.incref(A.zero);
         *res = A.zero;
         let_go(release);
@@ -608,6 +740,7 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     A.incref(book); /* (the gates may change while it runs) */
     *res = A.vectorcall(book, args, 2, NULL);
     A.decref(book);
+    timed(t0);
     let_go(release);
     return 1;
 }
@@ -702,16 +835,23 @@ static int clock_cycles(ptrdiff_t g, long long *cycles)
  * the gate has none (the Python path answers). */
 static int clock_ms(ptrdiff_t g, long long *ms)
 {
+    /* (the last difference and its value: a poll asks again before the clock moves on) */
+    static long long last_d = -1, last_ms;
     const long long *now, *origin;
     long long d, q;
     if (!clock_ms_at || g < 1 || g > 2 || !(now = (const long long *)clock_ms_at[2 * g - 2]) ||
         !(origin = (const long long *)clock_ms_at[2 * g - 1]))
         return 0;
     d = *now - *origin;
+    if (d == last_d && d >= 0) {
+        *ms = last_ms;
+        return 1;
+    }
     q = d / 1000000;
     if (d % 1000000 < 0) /* (floor division, as Python's) */
         q -= 1;
     *ms = q & 0xFFFFFFFFLL;
+    last_d = d, last_ms = *ms;
     return 1;
 }
 
@@ -723,13 +863,15 @@ static int clock_for(const struct entry *e, int csize, int csign, long long *ms)
     return clock_ms(e->gate, ms) && fits(*ms, csize, csign);
 }
 
-/* A pClock looked at again once the value is made (Python may have run: its memory may have
- * moved, its type changed) and its value, clock_for's: 0 where the call must go the Python
- * way. */
+/* A pClock looked at again once the value is made where Python ran for it (ran: its memory
+ * may have moved, its type changed; where no Python ran nothing could change it: the first
+ * look stands) and its value, clock_for's: 0 where the call must go the Python way. */
 static int clock_again(const struct entry *e, obj pc, char **mem, int *size, int *sign,
-                       long long *ms)
+                       long long *ms, int ran)
 {
-    return clock_mem(e, pc, mem, size, sign) && *mem && clock_for(e, *size, *sign, ms);
+    if (ran && !(clock_mem(e, pc, mem, size, sign) && *mem))
+        return 0;
+    return clock_for(e, *size, *sign, ms);
 }
 
 /* A span's first axis and count, both exact ints a long long holds: 0 where they are not
@@ -799,24 +941,158 @@ static char python_mark;
  * clock asked: clk), kept in the entry's slot for the epoch: a new reference; PYTHON (not
  * bytes: the Python path answers), AGAIN (another thread's cycle or call meanwhile), or NULL
  * with the value's own error. */
+/* One C-contiguous dimension of int64 or float64 (what the source was said to be): its data
+ * and length, NULL where it is not such an array */
+static const char *vector(obj a, ptrdiff_t *len)
+{
+    if (!A.ndarray_type || TYPE(a) != A.ndarray_type || *(int *)((char *)a + A.nd_nd) != 1 ||
+        !AT(a, A.nd_dims) || (*(int *)((char *)a + A.nd_flags) & A.nd_want) != A.nd_want)
+        return NULL;
+    *len = *(ptrdiff_t *)AT(a, A.nd_dims);
+    return AT(a, A.nd_data);
+}
+
+/* count doubles made again from the arrays a value was kept with, as its value function made
+ * them (the same IEEE operations in the same order), into out: for the k-th, its row r
+ * (rows[k]) and x =
+ *   op 0: src[idx[r]] (idx NULL: src[r])   (a planned value of the Trap table, a row's own)
+ *   op 1: src[r] / t                       (an encoder's speed: its last step over a cycle)
+ *   op 2: (src[r] / t - idx[r] / t) / t    (its acceleration: the last two steps)
+ * then ratios[k] * x where ratios are given; or, ratios giving each value's link (ratio,
+ * offset) and axis(e) its AffineLink.axis (ratio 1: e + offset where offset is not 0,
+ * else e; else ratio * e + offset):
+ *   op 3: axis(src[r])                     (the axis's encoder position)
+ *   op 4: src[r] - axis(idx[r])            (the axis's error: planned less encoder)  0 where an index falls outside an array (the
+ * Python way answers).  gather: a span's, as a new bytes object (NULL, no error left: the
+ * Python way). */
+static int make_doubles(const struct recipe *rc, long long count, double *out)
+{
+    obj src_ = rc->src, idx_ = rc->idx, rows_ = rc->rows, ratios_ = rc->ratios;
+    long long op = rc->op;
+    double t = rc->t;
+    ptrdiff_t slen = 0, ilen = 0;
+    const double *src = (const double *)vector(src_, &slen), *fidx = NULL, *ratios = NULL;
+    const int64_t *idx = NULL, *rows;
+    double x;
+    long long k, r, i;
+    if (!src || count < 1 || op < 0 || op > 4 || TYPE(rows_) != A.bytes_type ||
+        *(ptrdiff_t *)((char *)rows_ + A.bsize) != count * 8)
+        return 0;
+    rows = (const int64_t *)((char *)rows_ + A.bdata);
+    if (op >= 3 && !ratios_) /* (a link's ratio and offset per value) */
+        return 0;
+    if (ratios_) {
+        if (TYPE(ratios_) != A.bytes_type ||
+            *(ptrdiff_t *)((char *)ratios_ + A.bsize) != count * (op >= 3 ? 16 : 8))
+            return 0;
+        ratios = (const double *)((char *)ratios_ + A.bdata);
+    }
+    if (idx_) {
+        const char *d = vector(idx_, &ilen);
+        if (!d)
+            return 0;
+        idx = (const int64_t *)d, fidx = (const double *)d;
+    } else if (op == 2 || op == 4)
+        return 0;
+    for (k = 0; k < count; k++) {
+        r = rows[k];
+        if (r < 0 || r >= slen || (idx && r >= ilen))
+            return 0;
+        if (op == 0) {
+            i = idx ? idx[r] : r;
+            if (i < 0 || i >= slen)
+                return 0;
+            x = src[i];
+        } else if (op == 1)
+            x = src[r] / t;
+        else if (op == 2)
+            x = (src[r] / t - fidx[r] / t) / t;
+        else { /* (AffineLink.axis of the encoder's position, its two branches) */
+            double ratio = ratios[2 * k], offset = ratios[2 * k + 1], e = op == 3 ? src[r] : fidx[r];
+            double ax = ratio == 1.0 ? (offset != 0.0 ? e + offset : e) : ratio * e + offset;
+            out[k] = op == 3 ? ax : src[r] - ax;
+            continue;
+        }
+        out[k] = ratios ? ratios[k] * x : x;
+    }
+    return 1;
+}
+
+static obj gather(const struct aslot *s, long long count)
+{
+    obj v = A.bytes_new(NULL, (ptrdiff_t)(count * 8));
+    if (!v) {
+        A.err_clear();
+        return NULL;
+    }
+    if (!make_doubles(&s->rc, count, (double *)((char *)v + A.bdata))) {
+        A.decref(v);
+        return NULL;
+    }
+    return v;
+}
+
+/* The recipe in a value function's (value, op, src, idx or None, rows, ratios or None, t)
+ * (items: the tuple's), its references taken: 1; 0 where it is not one (nothing taken). */
+static int take_recipe(obj *items, struct recipe *rc)
+{
+    ptrdiff_t len;
+    if (!(ll_of(items[1], &rc->op) && vector(items[2], &len) &&
+          (items[3] == A.none || vector(items[3], &len)) && TYPE(items[4]) == A.bytes_type &&
+          (items[5] == A.none || TYPE(items[5]) == A.bytes_type) &&
+          TYPE(items[6]) == A.float_type))
+        return 0;
+    rc->src = items[2];
+    rc->idx = items[3] == A.none ? NULL : items[3];
+    rc->rows = items[4];
+    rc->ratios = items[5] == A.none ? NULL : items[5];
+    rc->t = *(double *)((char *)items[6] + A.fval);
+    A.incref(rc->src);
+    A.incref(rc->rows);
+    if (rc->idx)
+        A.incref(rc->idx);
+    if (rc->ratios)
+        A.incref(rc->ratios);
+    return 1;
+}
+
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
-                       long long clk, int locked)
+                       long long clk, int locked, int *ran)
 {
     struct aslot *s = e->acache;
+    struct recipe rc = {0};
     long long ep = -1, ep0 = -1;
     int holds = 0;
     obj v, tp = call[2];
+    *ran = 0;
     if (s && (ep = epoch()) >= 0 && s->value && s->n == an && s->count == ac && s->tp == tp &&
         s->clock == clk &&
         (s->epoch == ep ||
-         (s->holds && ep > s->epoch && ep - s->epoch == flag_keeping - s->keeps))) {
-        s->epoch = ep; /* (status words across cycles that kept every flag: the same) */
+         (s->holds && ep > s->epoch && ep - s->epoch == flag_keeping - s->keeps) ||
+         (e->steady && ep > s->epoch && ep - s->epoch == c_booked - s->booked))) {
+        /* (status words across cycles that kept every flag, a steady entry's values across
+         * cycles booked in C: the same) */
+        s->epoch = ep;
         s->keeps = flag_keeping;
+        s->booked = c_booked;
         A.incref(s->value);
         return s->value;
     }
+    if (s && ep >= 0 && s->rc.src && s->value && s->n == an && s->count == ac && s->tp == tp &&
+        s->clock == clk && ep > s->epoch && ep - s->epoch == c_booked - s->booked &&
+        (v = gather(s, ac)) != NULL) {
+        /* (the doubles of the same rows after cycles booked in C: from the same arrays) */
+        obj old = s->value;
+        s->value = v;
+        s->epoch = ep;
+        s->booked = c_booked;
+        A.decref(old);
+        A.incref(v);
+        return v;
+    }
     if (!locked)
         ep0 = epoch();
+    *ran = 1;
     v = A.vectorcall(e->avalue, call, 4, NULL);
     if (!v)
         return NULL;
@@ -827,20 +1103,32 @@ static obj array_value(const struct entry *e, obj *call, long long an, long long
         A.decref(v);
         v = b;
         holds = 1;
-    }
-    if (TYPE(v) != A.bytes_type) {
+    } else if (e->tuple_type && TYPE(v) == e->tuple_type &&
+               *(ptrdiff_t *)((char *)v + A.bsize) == 7) {
+        /* (bytes, op, src, idx or None, rows, ratios or None, t): doubles made again from
+         * there (gather) */
+        obj *items = (obj *)((char *)v + e->titems), b = items[0];
+        if (!(TYPE(b) == A.bytes_type && *(ptrdiff_t *)((char *)b + A.bsize) == ac * 8 &&
+              take_recipe(items, &rc)))
+            rc.src = NULL;
+        A.incref(b);
         A.decref(v);
-        return PYTHON;
+        v = b;
     }
-    if (!locked && !stands(e->gate, ep0)) {
+    if (TYPE(v) != A.bytes_type || (!locked && !stands(e->gate, ep0))) {
+        obj r = TYPE(v) != A.bytes_type ? PYTHON : AGAIN;
         A.decref(v);
-        return AGAIN;
+        let_recipe_go(&rc);
+        return r;
     }
     if (s && ep >= 0) {
         keep_span(s, ep, v, tp, an, ac, clk);
         s->holds = holds;
         s->keeps = flag_keeping;
-    }
+        s->rc = rc; /* (its references the slot's now) */
+        s->booked = c_booked;
+    } else
+        let_recipe_go(&rc);
     return v;
 }
 
@@ -851,7 +1139,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
-    int csize = 0, csign = 1;
+    int csize = 0, csign = 1, ran;
     call[0] = args[at];
     call[1] = nargs >= 3 + at ? args[at + 2] : A.one;
     if (!span_args(call[0], call[1], &an, &ac))
@@ -860,7 +1148,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
         goto python;
     call[2] = tp;
     call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
-    v = array_value(e, call, an, ac, 0, locked);
+    v = array_value(e, call, an, ac, 0, locked, &ran);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
@@ -868,7 +1156,7 @@ static obj array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kw
     n = *(ptrdiff_t *)((char *)v + A.bsize);
     if (n <= 0)
         goto drop;
-    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk, ran))
         goto drop;
     /* (avalue checked the array's type and length: the bytes fit its start; an offset's
      * room: array_mem) */
@@ -899,10 +1187,10 @@ static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     ptrdiff_t n;
     long long an, ac, clk = 0;
     char *cmem = NULL, *mem;
-    int csize = 0, csign = 1, size = 0, sign = 1;
+    int csize = 0, csign = 1, size = 0, sign = 1, ran;
     call[0] = args[at];
     call[1] = args[at + 2];
-    if (!span_args(call[0], call[1], &an, &ac) || !np_mem(e, p, &size, &sign))
+    if (!span_args(call[0], call[1], &an, &ac) || !(mem = np_mem(e, p, &size, &sign)))
         goto python;
     if (nargs >= 4 + at && !clock_mem(e, args[at + 3], &cmem, &csize, &csign))
         goto python;
@@ -910,15 +1198,17 @@ static obj np_array(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
         goto python;
     call[2] = (obj)AT(p, A.nd_descr);
     call[3] = A.none; /* (the values alone: a pClock's value is written here, clock_for) */
-    v = array_value(e, call, an, ac, 0, locked);
+    v = array_value(e, call, an, ac, 0, locked, &ran);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
         goto python;
     n = *(ptrdiff_t *)((char *)v + A.bsize);
-    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk, ran))
         goto drop;
-    mem = np_mem(e, p, &size, &sign); /* (again, and the bytes fit: count whole values) */
+    if (ran) /* (again where Python ran: the array may have changed meanwhile) */
+        mem = np_mem(e, p, &size, &sign);
+    /* (and the bytes fit: count whole values) */
     if (!mem || *(ptrdiff_t *)AT(p, A.nd_dims) < ac || (obj)AT(p, A.nd_descr) != call[2] ||
         n != ac * (long long)size)
         goto drop;
@@ -942,11 +1232,12 @@ static obj first_of(const struct entry *e, obj const *args, ptrdiff_t nargs, obj
     obj call[4], v;
     ptrdiff_t n;
     char *mem;
+    int ran;
     call[0] = A.zero;
     call[1] = A.one;
     call[2] = TYPE(arr);
     call[3] = A.none;
-    v = array_value(e, call, 0, 1, 0, locked);
+    v = array_value(e, call, 0, 1, 0, locked, &ran);
     if (!v || v == AGAIN)
         return v;
     if (v == PYTHON)
@@ -1033,9 +1324,11 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 {
     ptrdiff_t at = e->core;
     obj p, target, tp, v, arr;
-    char *mem, *cmem = NULL, *lmem = NULL;
+    char *mem = NULL, *cmem = NULL, *lmem = NULL;
     obj deref = NULL;
-    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1;
+    int k, size = 0, sign = 1, npy = 0, csize = 0, csign = 1, lsize = 0, lsign = 1, ran = 0;
+    int holds = 0;
+    struct recipe rc = {0};
     long long key = -1, ep = -1, ep0 = -1, clk = 0, loop = 0;
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
@@ -1082,7 +1375,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     tp = TYPE(p);
     target = p;
     if (tp == A.ndarray_type && e->nptypes[0]) { /* a numpy array: its first element */
-        if (!np_mem(e, p, &size, &sign))
+        if (!(mem = np_mem(e, p, &size, &sign)))
             goto python;
         npy = 1;
     } else {
@@ -1096,37 +1389,64 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         if (k < 0)
             goto python;
         deref = (obj)e->derefs[k];
-        if (!reader_mem(p, target, deref))
+        if (!(mem = reader_mem(p, target, deref)))
             goto python;
     }
 
     /* the value kept for this epoch, else value(n)'s (kept for it) */
     if (e->cache &&
-        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep)) != NULL)
+        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep, (int)e->steady)) !=
+            NULL)
         goto have;
     if (!locked)
         ep0 = epoch();
+    ran = 1;
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
                   : A.vectorcall(e->value, &args[at], 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)
         goto drop;
+    if (e->kind == 0 && e->tuple_type && TYPE(v) == e->tuple_type &&
+        *(ptrdiff_t *)((char *)v + A.bsize) == 1) { /* (word,): a status word of the bank's */
+        obj w = *(obj *)((char *)v + e->titems);
+        A.incref(w);
+        A.decref(v);
+        v = w;
+        holds = 1;
+    } else if (e->kind == 1 && e->tuple_type && TYPE(v) == e->tuple_type &&
+               *(ptrdiff_t *)((char *)v + A.bsize) == 7) {
+        /* (x, op, src, idx, rows, ratios, t): a double of the bank's and where it comes from */
+        obj *items = (obj *)((char *)v + e->titems), w = items[0];
+        if (TYPE(w) != A.float_type || !take_recipe(items, &rc))
+            rc.src = NULL;
+        A.incref(w);
+        A.decref(v);
+        v = w;
+    }
     if (!locked && !stands(e->gate, ep0)) { /* (another thread's cycle or call meanwhile) */
         A.decref(v);
+        let_recipe_go(&rc);
         return AGAIN;
     }
-    if (key >= 0 && ep >= 0)
-        keep(&e->cache[key], ep, v);
+    if (key >= 0 && ep >= 0) {
+        struct slot *sl = &e->cache[key];
+        keep(sl, ep, v);
+        sl->holds = holds;
+        sl->rc = rc; /* (its references the slot's now) */
+        rc.src = rc.idx = rc.rows = rc.ratios = NULL;
+    }
+    let_recipe_go(&rc);
 have:
     /* q: the cycles run (again: Python ran; a number the type does not hold: Python's) */
     if (lmem && (!clock_cycles(e->gate, &loop) || !clock_mem(e, args[1], &lmem, &lsize, &lsign) ||
                  !lmem || !fits(loop, lsize, lsign)))
         goto drop;
-    mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref); /* (again) */
+    if (ran) /* (again where Python ran: see reader_mem) */
+        mem = npy ? np_mem(e, p, &size, &sign) : reader_mem(p, target, deref);
     if (!mem)
         goto drop;
-    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk))
+    if (cmem && !clock_again(e, args[at + 3], &cmem, &csize, &csign, &clk, ran))
         goto drop; /* (again, and its value: written after the value, as the Python path) */
     if (e->kind == 1) {
         if (TYPE(v) != A.float_type || size != 8)
@@ -1499,7 +1819,7 @@ TRY multi_try(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj
     for (k = 0; k < nout; k++)
         if (!out_mem(e, k, args[1 + k], &size[k], &sign[k]))
             goto python;
-    if (e->cache && (v = kept(e->cache, e->ncache, args[0], &key, &ep)) != NULL)
+    if (e->cache && (v = kept(e->cache, e->ncache, args[0], &key, &ep, 0)) != NULL)
         goto have;
     if (!locked)
         ep0 = epoch();

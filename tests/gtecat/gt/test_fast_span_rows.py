@@ -11,7 +11,10 @@ flag."""
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Iterator
+from contextlib import contextmanager
 from ctypes import byref, c_double, c_long
+from typing import Any
 
 from gtecat import gt
 from gtecat.gt import fast
@@ -78,21 +81,45 @@ def test_row_spans_read_what_the_table_path_reads_cycle_by_cycle() -> None:
     assert rows == table
 
 
-def _status_polls(general: bool) -> tuple[list, int, int]:
-    """Trap moves of both axes that start and end, every call a span of status words
-    (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) polled on the auto clock; ``general``:
-    a watch hook that does nothing, so every cycle goes the general way.  What was read,
-    the cycles run, and how often a span's value function was asked."""
-    import cProfile
+def _calls(pr: Any, names: tuple[str, ...]) -> int:
+    """How often a profile ``pr`` saw gtecat.gt.fast's functions ``names`` called (those it
+    compiles from source too: a reader's value function)."""
     import pstats
 
-    bring_up(clock="auto")
+    stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+    return sum(
+        v[1]
+        for (file, _, func), v in stats
+        if func in names and (file.endswith("fast.py") or file.startswith("<gt fast "))
+    )
+
+
+@contextmanager
+def _auto(general: bool, eni: str = "manual_fig5_2.eni", **options: Any) -> Iterator[Any]:
+    """The bus ``eni`` brought up on the auto clock, its controller (``general``: with a
+    watch hook that does nothing, so every cycle goes the general way), closed after."""
+    bring_up(eni, clock="auto", **options)
     try:
         ctl = gt.GTE_Controller()
         if general:
             ctl.watch.append(lambda: None)
+        yield ctl
+    finally:
+        gt.GT_Close()
+
+
+def _status_polls(general: bool) -> tuple[list, int, int]:
+    """Trap moves of both axes that start and end, every call a span of status words
+    (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) and each axis's word (``GT_GetSts``,
+    ``GT_GetPrfSts``) polled on the auto clock; ``general``: a watch hook that does nothing,
+    so every cycle goes the general way.  What was read, the cycles run, and how often a
+    value function was asked."""
+    import cProfile
+
+    with _auto(general) as ctl:
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
-        words, prf = (c_long * 2)(), (c_long * 2)()
+        words, prf, one, two = (c_long * 2)(), (c_long * 2)(), c_long(), ctypes.c_int32()
+        three, four = (c_long * 2)(), c_long()
         clk = ctypes.c_ulong()
         seen: list = []
         pr = cProfile.Profile()
@@ -103,24 +130,140 @@ def _status_polls(general: bool) -> tuple[list, int, int]:
             for _ in range(2500):
                 assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
                 assert gt.GT_GetPrfSts(1, prf, 2) == 0
-                seen.append((clk.value, *words, *prf))
+                assert gt.GT_GetSts(1, byref(one)) == 0 and gt.GT_GetSts(2, two) == 0
+                assert gt.GTN_GetSts(1, 2, byref(three, ctypes.sizeof(c_long))) == 0
+                assert gt.GTN_GetPrfSts(1, 2, byref(four)) == 0
+                seen.append((clk.value, *words, *prf, one.value, two.value, three[1], four.value))
             pr.disable()
-        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        asked = sum(
-            v[1] for (file, _, func), v in stats if func == "f" and file.endswith("fast.py")
-        )
-        return seen, ctl.clock.cycles - t0, asked
-    finally:
-        gt.GT_Close()
+        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
 
 
 def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
-    """A span of status words is asked again only where a flag may have moved (a move's
-    start or end, anything but a quick cycle booked in C): what every call reads is what
-    it reads with every cycle the general way, while the axes start, move and stop."""
+    """A span of status words, and an axis's word of the bank's, is asked again only where
+    a flag may have moved (a move's start or end, anything but a quick cycle booked in C):
+    what every call reads is what it reads with every cycle the general way, while the axes
+    start, move and stop."""
     quick, cycles, asked = _status_polls(False)
     general, _, asked_general = _status_polls(True)
     assert quick == general
     assert len({tuple(x[1:3]) for x in quick}) >= 3  # (each axis moving, and neither)
-    assert asked_general > cycles  # (every cycle: both spans asked again)
+    assert asked_general > cycles  # (every cycle: each asked again)
     assert asked < cycles / 4  # (the words held across the quick cycles)
+
+
+def _double_polls(
+    general: bool, eni: str, first: int, count: int, cycle_ms: float | None
+) -> tuple[list, int, int]:
+    """Trap moves of the axes ``first``.. ``first + count - 1`` that start and end, every call
+    a span of doubles of each reader whose span is a run of the bank's rows (the planned
+    values, the encoder's and the axis's positions, and the values of fast.QUICK_SOURCES:
+    the axis's planned speed and acceleration, the encoder's speed and acceleration)
+    polled on the auto clock, each in one shape (a numpy array and a ctypes array, with and
+    without the clock, C's ``&arr[1]``);
+    ``general``: a watch hook that does nothing, so every cycle goes the general way.  What
+    was read, the cycles run, and how often a span's value function was asked."""
+    import cProfile
+
+    import numpy as np
+
+    with _auto(general, eni, cycle_ms=cycle_ms) as ctl:
+        for a in range(first, first + count):
+            assert gt.GT_AxisOn(a) == 0
+        # the encoder's links of both branches (AffineLink.axis): a ratio of 3/7 and an
+        # offset, an offset alone
+        assert gt.GT_EncScale(first, 7, 3) == 0 and gt.GT_SetEncPos(first, 500) == 0
+        assert gt.GT_SetEncPos(first + 1, 1234) == 0
+        clk = ctypes.c_ulong()
+        pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
+        vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
+        rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
+        one, two = c_double(), (c_double * 2)()
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(3):
+            for k, a in enumerate(range(first, first + count)):  # (ends apart)
+                trap_move(a, (200 + 90 * k) * (rnd + 1) * (-1) ** rnd, 15.0 + k)
+            pr.enable()
+            for _ in range(300):
+                assert gt.GT_GetPrfPos(first, pos, count, byref(clk)) == 0
+                assert gt.GT_GetPrfVel(first, vel, count) == 0
+                assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
+                assert gt.GT_GetEncPos(first, enc, count) == 0
+                assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
+                seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
+                seen.append(apos.tobytes())
+                for name, arr in rows.items():
+                    assert getattr(gt, name)(first, arr, count, clk) == 0
+                    seen.append(arr.tobytes())
+                for name in fast.SCALAR_SOURCES:
+                    # one axis's, into byref(x), and into &two[1] by the GTN_ twin (its entry
+                    # keeps a span of its own: not this loop's spans')
+                    assert getattr(gt, name)(first + 1, byref(one)) == 0
+                    gtn = getattr(gt, name.replace("GT_", "GTN_"))
+                    assert gtn(1, first, byref(two, 8)) == 0
+                    seen.append((name, one.value, two[1]))
+            pr.disable()
+        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
+
+
+def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
+    """A span of doubles that is a run of the bank's rows is gathered again in C from the
+    bank's arrays after each cycle the entries book themselves (not asked in Python): what
+    every call reads is what it reads with every cycle the general way, while the axes
+    start, accelerate, move and stop; the whole bank (figure 5-2's two axes) and a run
+    inside a larger one (axes 2-4 of twelve, cycles of 0.75 ms: the rates' divisions are not
+    exact)."""
+    for eni, first, count, ms in (
+        ("manual_fig5_2.eni", 1, 2, None),
+        ("twelve_axes.eni", 2, 3, 0.75),
+    ):
+        quick, cycles, asked = _double_polls(False, eni, first, count, ms)
+        general, _, asked_general = _double_polls(True, eni, first, count, ms)
+        assert quick == general
+        assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
+        assert asked_general > cycles  # (every cycle: each span asked again)
+        assert asked < cycles / 2  # (ten spans: made again in C across the quick cycles)
+
+
+def _mode_polls(general: bool) -> tuple[list, int, int]:
+    """Both axes moving in Trap on the auto clock, their profile modes polled every call
+    (``GT_GetPrfMode``: one axis, and both in a span with the clock) while the modes change
+    between polls (axis 2 to Jog and back to Trap); ``general``: a watch hook that does
+    nothing, so every cycle goes the general way.  What was read, the cycles run, and how
+    often a value function was asked."""
+    import cProfile
+
+    with _auto(general) as ctl:
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        trap_move(1, 40_000, 10.0)
+        mode, modes, clk = c_long(), (c_long * 2)(), ctypes.c_ulong()
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(4):
+            if rnd % 2:
+                jog = gt.TJogPrm(acc=0.5, dec=0.5, smooth=0)
+                assert gt.GT_PrfJog(2) == 0 and gt.GT_SetJogPrm(2, byref(jog)) == 0
+            else:
+                trap_move(2, 500 * (rnd + 1), 8.0)
+            pr.enable()
+            for _ in range(2000):
+                assert gt.GT_GetPrfMode(2, byref(mode)) == 0
+                assert gt.GT_GetPrfMode(1, modes, 2, byref(clk)) == 0
+                seen.append((mode.value, *modes, clk.value))
+            pr.disable()
+        values = _calls(pr, ("f", "value_gt", "value_gtn"))
+        return seen, ctl.clock.cycles - t0, values
+
+
+def test_profile_modes_stand_across_cycles_booked_in_c() -> None:
+    """A profile's mode, which no cycle changes, is not asked again after each cycle the
+    entries book themselves: every poll reads what it reads with every cycle the general
+    way, the modes' changes between polls included."""
+    quick, cycles, asked = _mode_polls(False)
+    general, _, asked_general = _mode_polls(True)
+    assert quick == general
+    assert len({x[:3] for x in quick}) >= 2  # (axis 2 in Trap and in Jog)
+    assert asked_general > cycles  # (every cycle: both asked again)
+    assert asked < cycles / 10
