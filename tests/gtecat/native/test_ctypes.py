@@ -14,6 +14,7 @@ import subprocess
 import sys
 import time
 from ctypes import byref, c_char_p, c_double, c_long, c_short, c_ulong, create_string_buffer
+from pathlib import Path
 
 import pytest
 
@@ -27,7 +28,26 @@ pytestmark = needs_cc
 @pytest.fixture(scope="module")
 def lib(libgts):
     dll = ctypes.CDLL(str(libgts.library))
-    return dll
+    yield dll
+    _end_private_controllers()
+
+
+def _end_private_controllers() -> None:
+    """End the controllers the library started for this process.  GT_Close detaches, and a
+    private controller runs its bus until the program ends, as a card does: here the
+    program is the test process, whose run goes on for minutes after this module.  (A
+    later GT_Open of the library finds its controller gone and starts another.)"""
+    me = os.getpid()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            ppid = int(stat.read_text().rsplit(")", 1)[1].split()[1])
+            if ppid != me or b"--private" not in stat.with_name("cmdline").read_bytes():
+                continue
+            pid = int(stat.parent.name)
+            os.kill(pid, signal.SIGTERM)
+            os.waitpid(pid, 0)
+        except (OSError, ValueError, IndexError, ChildProcessError):
+            continue
 
 
 @pytest.fixture
