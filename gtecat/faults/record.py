@@ -765,6 +765,10 @@ def replay(
     (:func:`_plan_file`: by ``gtecat record`` when it wrote the file, or by the replay
     before), else from its text, and the plan is kept for the next replay."""
     p = Path(path)
+    # files given to the replay are named from the folder it was started in, as a command
+    # line's names are; the replay itself runs in the recorded folder (_where), so a name
+    # found only there is left for it to find, as before
+    eni, machine = _from_here(eni), _from_here(machine)
     # the file as it stands (named by its place, size and times): the plan its bytes had
     # when a replay read them, without reading them again (:func:`_plan_ref`)
     taken = time.time_ns()
@@ -828,6 +832,13 @@ def replay(
     finally:
         if freeze:
             gc.unfreeze()
+
+
+def _from_here(name: str | None) -> str | None:
+    """``name`` made absolute when it is a relative name of a file in the current folder."""
+    if name and not os.path.isabs(name) and os.path.isfile(name):
+        return os.path.abspath(name)
+    return name
 
 
 #: what a plan's file starts with, before the SHA-256 of the rest

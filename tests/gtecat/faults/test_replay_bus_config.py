@@ -117,3 +117,19 @@ def test_a_recording_without_the_configuration_replays_as_before(
     rc, err = _replay(capsys, str(old))
     assert "is not the one the session was recorded with" not in err
     assert rc == 1 and "diverged at call" in err  # (found out later, as before)
+
+
+def test_a_relative_eni_is_named_from_where_the_replay_starts(
+    session: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch
+) -> None:
+    """``gtecat replay DIR/cell.gtrec --eni other.eni`` from another folder takes that
+    folder's other.eni (a command line's names are the user's), though the replay runs in the
+    recorded folder: the session replays exactly on an equal copy, and diverges on another bus."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    shutil.copy(session.parent / "cell.eni", "other.eni")
+    assert _replay(capsys, str(session), "--eni", "other.eni") == (0, "")
+    shutil.copy(EXAMPLES / "full_servo.eni", "other.eni")
+    rc, err = _replay(capsys, str(session), "--eni", "other.eni")
+    assert rc == 1 and "diverge" in err, err
