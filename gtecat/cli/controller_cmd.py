@@ -247,6 +247,8 @@ def run(args: argparse.Namespace) -> int:
     if taken.priority is not None:
         server.realtime = scheduling.WhenBusy(taken.priority, normal=normal[:2] if normal else None)
         server.realtime.realtime = True  # until the first look at the load
+        if normal:  # and on its client's CPU while real-time
+            server.beside = scheduling.Beside(normal[2])
 
     def stop(signum: int, frame: FrameType | None) -> None:
         server.stop()

@@ -31,7 +31,10 @@ Decisions:
   server then serves under SCHED_FIFO while other programs could hold every CPU
   (:data:`REALTIME_OVER_CPUS`; a normal process woken then may wait for another program's
   time slice) and under its
-  normal policy, with its spin, otherwise; it never spins while real-time.  A server inside
+  normal policy, with its spin, otherwise; it never spins while real-time.  While
+  real-time it also runs on the CPU of the client it served last (:attr:`Server.beside`,
+  the client's process from the Unix socket), so that other programs, not the client,
+  take the other CPUs.  A server inside
   another program (a test's) leaves the program's scheduling alone.
 * Every client is served independently: its bytes are buffered until a frame is whole and
   its replies until it reads them, so a client that sends half a frame, or stops reading,
@@ -299,6 +302,19 @@ class _Client:
     #: replies, 0: none pending
     deadline: float = 0.0
     why_late: str = ""
+    #: the client's process id where the socket tells it (Unix socket on Linux), else 0
+    pid: int = 0
+
+
+def _peer_pid(sock: socket.socket) -> int:
+    """The process id at the other end of a Unix socket (SO_PEERCRED); 0 where unknown."""
+    opt = getattr(socket, "SO_PEERCRED", None)
+    if opt is None or sock.family != getattr(socket, "AF_UNIX", None):
+        return 0
+    try:
+        return struct.unpack("3i", sock.getsockopt(socket.SOL_SOCKET, opt, 12))[0]
+    except (OSError, struct.error):
+        return 0
 
 
 class _DropLog:
@@ -453,6 +469,9 @@ class Server:
         #: SCHED_FIFO while the CPUs are busy (set by the controller process before it
         #: serves; never for a server inside another program, a test's)
         self.realtime: scheduling.WhenBusy | None = None
+        #: on the client's CPU while real-time (set with :attr:`realtime`)
+        self.beside: scheduling.Beside | None = None
+        self._served_pid = 0  # the process of the client served last
         self.lock = threading.RLock()
         #: clients whose call is running (a GTE_Wait serving others between its slices
         #: runs their calls inside it: :meth:`_serve_others`)
@@ -620,7 +639,7 @@ class Server:
                 return
             sock.setblocking(False)
             peer = transport.peer_name(sock, f"fd {sock.fileno()}")
-            client = _Client(sock, peer=peer)
+            client = _Client(sock, peer=peer, pid=_peer_pid(sock))
             if self.token is not None:
                 transport.tune(sock)
                 pending = sum(1 for c in self._clients.values() if not c.authed)
@@ -662,7 +681,14 @@ class Server:
             over = _runnable_over_cpus()
             self._busy = over > 0
             if self.realtime is not None:
-                self.realtime.busy(over >= REALTIME_OVER_CPUS)
+                rt = self.realtime.busy(over >= REALTIME_OVER_CPUS)
+                if self.beside is not None:
+                    pid = self._served_pid
+                    self.beside.look(
+                        rt and pid > 0,
+                        scheduling.thread_cpu() if rt and pid else None,
+                        scheduling.thread_cpu(pid) if rt and pid else None,
+                    )
         if not self.spin_s or self._busy:
             return 0.0
         if not self._budget:
@@ -687,6 +713,7 @@ class Server:
         to the poller at once after a reply: the read that would find nothing yet costs a
         system call and an exception per call, and the poller reports the next request."""
         recv = c.sock.recv
+        self._served_pid = c.pid
         deadline = 0.0
         budget = 0.0  # this round's spin; asked for once a request was served
         while True:

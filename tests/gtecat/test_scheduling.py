@@ -9,7 +9,14 @@ import argparse
 import pytest
 
 from gtecat import scheduling
-from gtecat.scheduling import RealtimeRefused, WhenBusy, from_environment, parse_priority, take
+from gtecat.scheduling import (
+    Beside,
+    RealtimeRefused,
+    WhenBusy,
+    from_environment,
+    parse_priority,
+    take,
+)
 
 
 class FakeSystem:
@@ -144,6 +151,76 @@ def test_the_controller_is_real_time_while_busy_and_then_never_spins(server, mon
     assert system.calls == [("fifo", 50), ("normal", (0, 0))]
 
 
+def test_beside_takes_the_clients_cpu_after_two_looks_apart_while_busy():
+    moves: list[set[int]] = []
+    b = Beside({0, 1}, set_affinity=moves.append)
+    assert b.look(True, 1, 1) is None  # together: nothing to do
+    assert b.look(True, 1, 0) is None  # apart once
+    assert b.look(True, 1, 1) is None  # together again: the count starts over
+    assert b.look(True, 1, 0) is None
+    assert b.look(True, 1, 0) == {0}  # apart twice in a row: onto the client's CPU
+    assert b.look(True, 0, 1) == {0}  # the client moved: apart once
+    assert b.look(True, 0, 1) == {1}  # twice: it follows
+    assert b.look(True, None, 0) == {1}  # unreadable: left as it is
+    assert b.look(False, 1, 0) is None  # idle: its CPUs back
+    assert b.look(False, 1, 0) is None
+    assert moves == [{0}, {1}, {0, 1}] and b.moves == 2
+
+
+def test_beside_never_takes_a_cpu_it_may_not_use_and_survives_a_refusal():
+    def refuse(cpus: set[int]) -> None:
+        raise OSError("not permitted")
+
+    b = Beside({1}, set_affinity=refuse, after=1)
+    assert b.look(True, 1, 0) is None  # CPU 0 is not the server's
+    b.cpus = {0, 1}
+    assert b.look(True, 1, 0) is None and b.moves == 0
+
+
+def test_the_controller_follows_the_client_it_served_while_real_time(server, monkeypatch):
+    """The look at the load reads the CPU of the client served last (its process id from
+    the Unix socket) and the server's own; apart while real-time: the server moves."""
+    import os
+    import socket
+
+    from gtecat.native import server as server_module
+
+    a, b = socket.socketpair()
+    with a, b:
+        assert server_module._peer_pid(a) == os.getpid()
+    system = FakeSystem(permits=True)
+    server.realtime = WhenBusy(50, set_fifo=system.fifo, set_normal=system.normal, normal=(0, 0))
+    moves: list[set[int]] = []
+    server.beside = Beside({0, 1}, set_affinity=moves.append, after=1)
+    cpus = {"thread-self": 1, 4242: 0}
+    monkeypatch.setattr(scheduling, "thread_cpu", lambda pid="thread-self": cpus[pid])
+    load = {"over": 2}
+    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
+    server._served_pid = 4242
+
+    def look(over: int) -> None:
+        load["over"] = over
+        server._busy_next = 0.0
+        server._spin_budget()
+
+    look(2)
+    assert moves == [{0}]
+    look(0)  # idle: normal policy, its CPUs back
+    assert moves == [{0}, {0, 1}]
+    server._served_pid = 0  # a client of unknown process: never moved
+    look(2)
+    assert moves == [{0}, {0, 1}]
+
+
+def test_thread_cpu_reads_a_cpu_number():
+    import os
+
+    if not os.path.exists("/proc/self/stat"):
+        pytest.skip("no /proc")
+    assert scheduling.thread_cpu() in os.sched_getaffinity(0) | set(range(os.cpu_count() or 1))
+    assert scheduling.thread_cpu(2**31 - 1) is None
+
+
 class _Requests:
     """A client socket that holds ``n`` requests, then nothing yet (recv raises as a
     non-blocking socket does)."""
@@ -167,7 +244,7 @@ def test_without_a_spin_the_controller_goes_back_to_the_poller_after_a_reply(ser
     served: list[bytes] = []
     monkeypatch.setattr(server, "_frames", lambda c, data: served.append(data) or True)
     sock = _Requests(2)
-    client = SimpleNamespace(sock=sock, out=b"", buf=b"")
+    client = SimpleNamespace(sock=sock, out=b"", buf=b"", pid=0)
     monkeypatch.setattr(server, "_spin_budget", lambda: 0.0)
     server._readable(client)
     assert (served, sock.reads) == ([b"request"], 1)
