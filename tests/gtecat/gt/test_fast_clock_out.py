@@ -15,6 +15,7 @@ from gtecat import gt
 from gtecat.gt.fast import READERS
 
 from .conftest import bring_up, trap_move
+from .profiled import table_calls
 
 #: pClock shapes: (what, maker); None: NULL; the table path answers the rest the same
 CLOCKS = [
@@ -170,7 +171,6 @@ def _session(way: str, clock: str, shapes: dict = SHAPES, steps: int = 48) -> tu
     reads took the Python fast path's general way or the table path instead of the C
     entry."""
     import cProfile
-    import pstats
 
     bring_up(clock=clock, cycle_ms=0.25)  # (GT_Reset between two milliseconds)
     try:
@@ -202,13 +202,7 @@ def _session(way: str, clock: str, shapes: dict = SHAPES, steps: int = 48) -> tu
                 pr.disable()
         if pr is None:
             return seen, 0
-        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        python = sum(
-            v[1]
-            for (file, _, func), v in stats
-            if (func in ("call", "run") and file.endswith("_core.py"))
-            or (func in ("general", "many") and file.endswith("fast.py"))
-        )
+        python = table_calls(pr, ("general", "many"))
         return seen, python
     finally:
         gt.GT_Close()
@@ -269,7 +263,6 @@ def _clock_session(way: str, clock: str) -> tuple[list, int]:
     the table path where ``table``): what each wrote and returned, and how many calls took
     the Python fast function or the table path instead of the C entry (``way``: _way's)."""
     import cProfile
-    import pstats
 
     bring_up(clock=clock, cycle_ms=0.25)
     try:
@@ -298,13 +291,7 @@ def _clock_session(way: str, clock: str) -> tuple[list, int]:
                     rc = fn(a, b)
                     if pr:
                         pr.disable()
-                        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-                        python += sum(
-                            v[1]
-                            for (file, _, func), v in stats
-                            if (func in ("call", "run") and file.endswith("_core.py"))
-                            or (func == "gt" and file.endswith("fast.py"))
-                        )
+                        python += table_calls(pr, ("gt",))
                     why = gt.GTE_GetLastError() if rc else ""
                     seen.append((step, lt.__name__, shape, rc, c.value, _written(a), lp.value, why))
         return seen, python

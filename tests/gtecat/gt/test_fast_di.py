@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import cProfile
 import ctypes
-import pstats
 from ctypes import byref
 from pathlib import Path
 
@@ -27,6 +26,7 @@ from gtecat.controller import config_file, input_sense
 from gtecat.drives.machine import AxisMachine, MachineDescription
 
 from .conftest import bring_up
+from .profiled import table_calls
 
 _HELD = ctypes.c_long()
 _HELD_REF = byref(_HELD)
@@ -65,11 +65,7 @@ def _written(o) -> object:
 
 
 def _table_calls(pr: cProfile.Profile) -> int:
-    return sum(
-        v[1]
-        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        if func in ("call", "run") and f.endswith("_core.py")
-    )
+    return table_calls(pr)
 
 
 def compare(when: str, *, shapes=tuple(SHAPES), profile: bool = False) -> list[str]:

@@ -37,6 +37,8 @@ from gtecat.gt import fast
 from gtecat.gt.table import FUNCTIONS, declared_only
 from tests.conftest import EXAMPLES, LONG
 
+from .profiled import table_calls
+
 ENI = Path(__file__).resolve().parents[3] / "examples" / "manual_fig5_2.eni"
 
 
@@ -123,14 +125,8 @@ def _call(name: str, shape: str, which: str) -> tuple:
     pr.enable()
     rc = call(*args)
     pr.disable()
-    stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
     # the table path, or the fast path's own second way (the shapes it checks one by one)
-    table = sum(
-        v[1]
-        for (file, _, func), v in stats
-        if (func in ("call", "run") and file.endswith("_core.py"))
-        or (func in ("general", "gtn_general", "run") and file.endswith("fast.py"))
-    )
+    table = table_calls(pr, ("general", "gtn_general", "run"))
     return rc, _value(o), gt.GTE_GetLastError() if rc else "", table
 
 
@@ -350,11 +346,7 @@ def test_the_pdo_readers_answer_as_the_table() -> None:
                         pr.enable()
                         rc = call(*args)
                         pr.disable()
-                        table = sum(
-                            v[1]
-                            for (file, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-                            if func in ("call", "run") and file.endswith("_core.py")
-                        )
+                        table = table_calls(pr)
                         value = list(o) if isinstance(o, ctypes.Array) else o.value
                         got.append((rc, value, gt.GTE_GetLastError() if rc else "", table))
                     if got and got[0][:3] != got[1][:3]:
@@ -458,13 +450,7 @@ def _gtn(name: str, shape: str, core: int, axis: int, which: str) -> tuple:
     pr.enable()
     rc = call(core, axis, *extra)
     pr.disable()
-    stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-    table = sum(
-        v[1]
-        for (file, _, func), v in stats
-        if (func in ("call", "run") and file.endswith("_core.py"))
-        or (func == "gtn_general" and file.endswith("fast.py"))
-    )
+    table = table_calls(pr, ("gtn_general",))
     return rc, _value(o), gt.GTE_GetLastError() if rc else "", table
 
 
@@ -562,11 +548,7 @@ def test_the_homing_status_answers_as_the_table() -> None:
                     pr.enable()
                     rc = call(axis, p)
                     pr.disable()
-                    table = sum(
-                        v[1]
-                        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-                        if func in ("call", "run") and f.endswith("_core.py")
-                    )
+                    table = table_calls(pr)
                     got.append((rc, _value(o), gt.GTE_GetLastError(), table))
                 if got[0][:3] != got[1][:3]:
                     bad.append(f"{when} axis {axis} {shape}: {got[0][:3]} != {got[1][:3]}")
@@ -629,11 +611,7 @@ def test_the_trap_parameters_answer_as_the_table() -> None:
     pr.enable()
     rc = fn(2, byref(s))
     pr.disable()
-    table = sum(
-        v[1]
-        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        if func in ("call", "run") and f.endswith("_core.py")
-    )
+    table = table_calls(pr)
     assert rc == 0 and not table, "byref(TTrapPrm) took the table path"
     assert not bad, "\n".join(bad[:10])
 
@@ -670,11 +648,7 @@ def test_the_core_reader_answers_as_the_table() -> None:
     pr.enable()
     rc = fn(byref(s))
     pr.disable()
-    table = sum(
-        v[1]
-        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        if func in ("call", "run") and f.endswith("_core.py")
-    )
+    table = table_calls(pr)
     assert rc == 0 and s.value == 1 and not table
     try:
         if gt.GT_SetCore(2) == 0:
@@ -706,11 +680,7 @@ def test_a_span_over_axes_no_drive_backs_reads_as_the_table_on_the_fast_path() -
                 pr.enable()
                 rc = call(first, arr, count, byref(clk))
                 pr.disable()
-                table = sum(
-                    v[1]
-                    for (file, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-                    if func in ("call", "run") and file.endswith("_core.py")
-                )
+                table = table_calls(pr)
                 got.append((rc, list(arr), clk.value, gt.GTE_GetLastError() if rc else "", table))
             if got[0][:4] != got[1][:4]:
                 bad.append(f"{name}({first}, {count}): {got[0][:4]} != {got[1][:4]}")
@@ -789,13 +759,7 @@ def _span_session(tmp_path: Path, clock: str, way: str) -> tuple[list, int]:
                         seen.append(clk.value)
         if way != "c":
             return seen, 0
-        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        python = sum(
-            v[1]
-            for (file, _, func), v in stats
-            if (func in ("call", "run") and file.endswith("_core.py"))
-            or (func in ("general", "many") and file.endswith("fast.py"))
-        )
+        python = table_calls(pr, ("general", "many"))
         return seen, python
     finally:
         gt.GT_Close()

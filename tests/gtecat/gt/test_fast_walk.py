@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import cProfile
 import ctypes
-import pstats
 from ctypes import byref
 
 import numpy as np
@@ -27,6 +26,7 @@ from gtecat.gt.args import _scalar_types
 from gtecat.gt.table import FUNCTIONS
 
 from .conftest import bring_up
+from .profiled import table_calls
 
 #: the value a function reads first (an axis, an input or output type)
 FIRST = {"GT_GetDi": 3, "GT_GetDiRaw": 0, "GT_GetDo": 10}
@@ -135,12 +135,7 @@ def _call(fn, args: tuple, profile: bool) -> tuple[int, int]:
     if pr is None:
         return rc, 0
     pr.disable()
-    table = sum(
-        v[1]
-        for (f, _, func), v in pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
-        if (func in ("call", "run") and f.endswith("_core.py"))
-        or (func in ("general", "gtn_general") and f.endswith("fast.py"))
-    )
+    table = table_calls(pr, ("general", "gtn_general"))
     return rc, table
 
 
