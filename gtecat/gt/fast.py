@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from .._attrs import own_dict
 from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
@@ -771,6 +772,7 @@ def set_gates(gt: Any, gtn: Any) -> None:
     centry.set_clock_ms(
         *(c if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
     )
+    centry.set_wait(gt if gates[0] != centry.CLOSED else None)
     centry.set_gates(*gates)
 
 
@@ -3525,7 +3527,49 @@ def fast_wait(
         return slow(*(a for a in (ms,) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
-    return gt
+    return _wait_entry(gt, name, session, advance)
+
+
+def _wait_entry(
+    gt: Callable[..., int], name: str, session: Any, advance: Callable[[Any, str, int], int]
+) -> Callable[..., int]:
+    """GTE_Wait's public function: its C entry (:func:`centry.wait`: the wait run on the
+    quick cycle armed for the readers' entries, on the lockstep and the auto clock) in
+    front of the fast function ``gt``, where :data:`CENTRY` is on and the entry is
+    available; else ``gt``."""
+    if not CENTRY:
+        return gt
+    from ..controller.bank_kernel import IN_MAXC
+    from ..controller.core import Controller
+    from ._core import call_done, call_failed
+
+    def rest(rc: int, pending: int) -> int:
+        # (the entry ran the wait's cycles on the armed call, its book in C declined them:
+        # the controller's book and the rest of the wait, then the fast function's end)
+        ctl = GATED[0]
+        try:
+            ctl.waited(rc, pending)
+            wait_yield(ctl)
+        except Exception as e:
+            return call_failed(name, e, ctl, 1)
+        if session.note is None:
+            session.last = None
+        else:
+            call_done(name)
+        if ctl.clock.mode is _LOCKSTEP:
+            return 0
+        return advance(ctl, name, 0)
+
+    own_dict(session)  # (its attributes read quick; the entry reads its dict)
+    entry = centry.wait(
+        gt, _after(advance, name, 0), rest, vars(session),
+        Controller.WAIT_SLICE_NS // 1_000_000, Controller.BATCH_CYCLES, IN_MAXC,
+    )  # fmt: skip
+    if entry is None:
+        return gt
+    Controller.C_WAITS = True  # (a wait arms the next cycle for it, lockstep too)
+    entry.slow, entry.python = gt.slow, gt  # type: ignore[attr-defined]
+    return entry  # type: ignore[no-any-return]
 
 
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
