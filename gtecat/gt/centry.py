@@ -1150,6 +1150,7 @@ def _self_test_wait(make_wait: Callable[..., Any]) -> str:
     """'' when GTE_Wait's entry hands every call it does not make to its fallback with the
     very same arguments and keeps reference counts, else what went wrong.  (Its waits are
     held to the Python path's by the tests: a wait needs a controller.)"""
+
     def python(*a: Any, **kw: Any) -> Any:
         return ("python", a, kw)
 
