@@ -1190,11 +1190,12 @@ class Controller:
         :meth:`_arm_after_wait`'s first look, inline (a loop of waits alone arms nothing),
         on the auto clock, or on either where GTE_Wait has its C entry (:attr:`C_WAITS`);
         there a wait that found the epoch the last one left (nothing but reads between:
-        the entry would have taken it armed) arms again whatever the armings before."""
+        the entry would have taken it armed, where the last arming said it may) arms again
+        whatever the armings before."""
         clock = self.clock
         q = clock.quick
         if self.C_WAITS:
-            if e0 == self._wait_epoch:
+            if e0 == self._wait_epoch and self.quick_cbook[15]:
                 self._idle_arms = 0
         elif clock.mode is not _AUTO:
             return
