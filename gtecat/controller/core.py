@@ -798,17 +798,17 @@ class Controller:
         # (no in-position band: a cycle that ends no move changes no status flag, so the
         # status words the bank made stand for the next epoch: AxisBank._sts_epoch)
         b[14] = not bank.any_band  # type: ignore[union-attr]
-        b[15] = self._waits_in_c(bank)
+        self._c_waits = self._waits_in_c(bank)
+        b[15] = self.QUICK_WAIT and self._c_waits
         b[0] = 1
 
     def _waits_in_c(self, bank: Any) -> bool:
         """Whether GTE_Wait's C entry (gtecat.gt.centry's wait) may run a wait's cycles
-        on the armed call, as :meth:`wait_quick` would run them (its checks that the armed
-        cycle's do not make: the quick way on, the clock alone, an EtherCAT master, the
-        runs of cycles as written here)."""
+        on the armed call, as :meth:`wait_quick` would run them where its quick way is on
+        (its checks that the armed cycle's do not make: the clock alone, an EtherCAT master,
+        the runs of cycles as written here)."""
         return (
-            self.QUICK_WAIT
-            and self.card is None
+            self.card is None
             and bool(self.clock.quick[3])
             and self.clock.run_many is self._own_many
             and self._own_many.__func__ is _RUN_CYCLES
@@ -1001,6 +1001,9 @@ class Controller:
     C_WAITS = False
     #: the readers' epoch the last wait in Python left (:meth:`_wait_end`)
     _wait_epoch = -1
+    #: the last arming found that the C entry's waits may run on it (:meth:`_waits_in_c`;
+    #: its book says so where the quick way is on too)
+    _c_waits = False
 
     def wait_quick(self, total: int) -> bool:
         """A wait of ``total`` ns (at most :attr:`WAIT_SLICE_NS`) on the lockstep or the auto
@@ -1109,8 +1112,27 @@ class Controller:
                     done = self._wait_book(k, k.run_fn(*k._args), seen, passes)
             finally:
                 self.in_batch = False
-            self._wait_counted(done, pending, spent)
-        self._wait_end(e0)
+            # (_wait_counted, inline: a wait's every call in Python counts)
+            if done:  # (Clock.advance_ns's count of a run)
+                q[0] = pending - done * dt_ns
+                q[10] += done
+                q[9] += done * dt_ns
+                EPOCH.n += 1  # (clock.counted)
+                if spent:  # (the owed cycles and the run's: cycles_passed, the arming off)
+                    self.settle_hooks()
+            else:  # (Clock.advance_ns's cycle where no run could start)
+                q[0] = pending - dt_ns
+                clock.cycle()
+            if q[0] >= dt_ns:
+                clock.advance_ns(0)  # the rest of the wait the general way, from here
+        if self.C_WAITS:
+            self._wait_end(e0)
+        elif (  # (_wait_end's look on the auto clock, inline: a loop of waits alone arms nothing)
+            clock.mode is _AUTO
+            and q[4] != EPOCH.n
+            and (q[11] != self._armed_left or self._idle_arms < self.IDLE_ARMS)
+        ):
+            self._arm_after_wait()
         return True
 
     def _wait_book(
@@ -1195,7 +1217,7 @@ class Controller:
         clock = self.clock
         q = clock.quick
         if self.C_WAITS:
-            if e0 == self._wait_epoch and self.quick_cbook[15]:
+            if e0 == self._wait_epoch and self._c_waits:
                 self._idle_arms = 0
         elif clock.mode is not _AUTO:
             return
