@@ -309,3 +309,67 @@ def test_plain_waits_in_lockstep_and_realtime_forms() -> None:
     assert gt.GTE_Wait(5) == 0 and ctl.clock.cycles == c0 + 5
     assert gt.GTE_Wait(ms=3) == 0 and ctl.clock.cycles == c0 + 8
     assert gt.GTE_Wait(0) == 0 and ctl.clock.cycles == c0 + 8
+
+
+def test_the_entry_rounds_a_float_as_the_python_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A float's milliseconds in ns, rounded half to even as ``round`` rounds them, by the C
+    entry (the waits ran there: armed, nothing but waits between): the controller time
+    passed is the Python path's."""
+    if not hasattr(gt.GTE_Wait, "python"):
+        pytest.skip("no C entry here")
+    bring_up(clock="lockstep")
+    ctl = gt.GTE_Controller()
+    assert gt.GT_AxisOn(1) == 0
+    for _ in range(3):
+        gt.GTE_Wait(1)  # (the cycle armed, the loop's waits in C)
+    q = ctl.clock.quick
+    ended = _counting(monkeypatch, ENTRY)  # (less the waits that ended in Python)
+    xs = [0.0, 0.5e-6, 1.5e-6, 2.5e-6, 0.0004, 0.0015, 0.1234565, 1.0000005, 2.0000001,
+          0.3, 0.7, 0.9999999, 99.9999995, 100.0, 12.5e-6, 1e-300, 5e-324]  # fmt: skip
+    for x in xs:
+        before = q[9] + q[0]
+        assert gt.GTE_Wait(x) == 0, gt.GTE_GetLastError()
+        assert q[9] + q[0] - before == round(x * 1_000_000), x
+    assert -ended[0] < len(xs) // 2, ended  # (most of them in C)
+
+
+def test_a_failed_call_before_a_wait_is_forgotten_after_it() -> None:
+    """A wait clears the last error as every call that returns 0 does (the entry leaves a
+    wait after an error to the Python path, which clears it)."""
+    bring_up(clock="lockstep")
+    assert gt.GT_AxisOn(1) == 0
+    for _ in range(3):
+        gt.GTE_Wait(1)
+    s = c_long()
+    assert gt.GT_GetSts(99, byref(s)) != 0 and gt.GTE_GetLastError()
+    assert gt.GTE_Wait(1) == 0 and gt.GTE_GetLastError() == ""
+    assert gt.GTE_Wait(1) == 0 and gt.GTE_GetLastError() == ""
+
+
+def test_waits_of_two_threads_add_up() -> None:
+    """Two threads waiting on one lockstep controller (the entry takes the clock's lock as
+    the Python path does): every millisecond of both passes, the readers' values of the
+    last cycle."""
+    import threading
+
+    bring_up(clock="lockstep")
+    ctl = gt.GTE_Controller()
+    assert gt.GT_AxisOn(1) == 0
+    trap_move(1, 1_000_000, 2.0)
+    c0 = ctl.clock.cycles
+
+    def waits() -> None:
+        pos = c_double()
+        for _ in range(400):
+            gt.GTE_Wait(1)
+            gt.GT_GetPrfPos(1, byref(pos))
+
+    ts = [threading.Thread(target=waits) for _ in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join(60)
+    assert ctl.clock.cycles - c0 == 800
+    pos, slow = c_double(), c_double()
+    assert gt.GT_GetPrfPos(1, byref(pos)) == 0
+    assert gt.GT_GetPrfPos.slow(1, byref(slow)) == 0 and pos.value == slow.value > 0
