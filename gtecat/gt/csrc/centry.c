@@ -860,11 +860,13 @@ static obj wait_call(const struct wait_entry *e, obj const *args, ptrdiff_t narg
     }
     if (release == A.none) /* (no lock known for the gate: the Python path) */
         goto python;
+    /* (with the lock held: another thread's call or cycles may have come first, its
+     * session another controller) */
+    if (!A.gate[0] || (long long *)e->at[0] != q || (long long *)e->at[1] != b || b[0] != 1 ||
+        !b[15] || !armed_now(q))
+        goto unlock;
     dt = q[2];
     pend = q[0] + total;
-    /* (with the lock held: another thread's call or cycles may have come first) */
-    if (!A.gate[0] || b[0] != 1 || !b[15] || !armed_now(q))
-        goto unlock;
     if (pend < dt) {
         q[0] = pend;
         let_go(release);
