@@ -20,6 +20,10 @@ answers (every kind of shape it must hand on, the widths, reference counts) befo
 disagreement, or no compiler: :data:`REASON` says why and :func:`reader` gives None (the
 Python fast function is then the public one, as before).
 
+``GTE_Wait`` has an entry of its own (:func:`wait`): a wait run in C on the quick cycle armed
+for the readers' entries, its cycles in one call of the kernel and counted in C where the run
+went whole (csrc/centry.c ``wait_call``).
+
 Another thread.  On the lockstep and auto clocks a cycle runs in whichever thread lets
 controller time pass (GTE_Wait, a call's host latency, a controller server's wall floor),
 holding the controller's clock lock, as every call of the table path does.  The entries answer
