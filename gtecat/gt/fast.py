@@ -712,6 +712,7 @@ def fast_reader(
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
             public[0] = entry
+            env["GTN_ENTRY"][0] = entry_gtn  # (a view core's axis: gt.gtn hands it there)
     return public[0]  # type: ignore[no-any-return]
 
 
@@ -1280,7 +1281,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
             ) or is_array(tp):  # a numpy or ctypes array: its first element
                 obj = None
             else:
-                return {fallback}
+                return {fallback}{delegate}
 {{value}}
             if obj is None:
                 p[0] = v
@@ -1354,6 +1355,22 @@ def _target(types: Any) -> Callable[[Any], Any]:
     return target
 
 
+#: the GTN_ form of a core beyond 32 axes (a view of core 1's bus), its shape one the Python
+#: path takes: the GTN_ form's C entry with core 1 and the bus axis answers it (the same
+#: controller, resources and value; its kept value, its cycles in C), where there is one;
+#: a shape that entry hands on comes back here with core 1, which answers it as this core
+#: would
+_DELEGATE = """
+            if core != 1:
+                entry = GTN_ENTRY[0]
+                if entry is not None:
+                    if count is _NO:
+                        return entry(1, n + PER_CORE * (core - 1), p)
+                    if pClock is _NO:
+                        return entry(1, n + PER_CORE * (core - 1), p, count)
+                    return entry(1, n + PER_CORE * (core - 1), p, count, pClock)"""
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
@@ -1373,6 +1390,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
             else ""
         ),
         bus_axis="n if core == 1 else n + PER_CORE * (core - 1)" if gtn else "n",
+        delegate=_DELEGATE if gtn else "",
         session=session,
         address=address,
         fallback=(
@@ -1383,6 +1401,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     )
     env["_AT"] = _AT
     env["PER_CORE"] = AXES_PER_CORE
+    env.setdefault("GTN_ENTRY", [None])  # (the GTN_ form's C entry, once made)
     value = "\n".join("            " + line for line in _value_lines(env))
     code = code.replace("{value}", value)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
