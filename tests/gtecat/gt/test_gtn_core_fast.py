@@ -138,7 +138,8 @@ def test_a_view_cores_axes_read_through_core_1s_entry_as_the_table(tmp_path: Pat
         for name in fast.READERS:
             twin = getattr(gt, "GTN_" + name[3:])
             slow = getattr(gt, name).slow
-            kind = c_double if name not in ("GT_GetSts", "GT_GetPrfMode", "GT_GetPrfSts") else c_long
+            ints = name in ("GT_GetSts", "GT_GetPrfMode", "GT_GetPrfSts")
+            kind = c_long if ints else c_double
             for core, axis in axes:
                 bus = 32 * (core - 1) + axis
                 for shape in ("byref", "obj", "count", "array"):
