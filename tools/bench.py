@@ -1102,11 +1102,13 @@ def bench_gte_wait(seconds: float = 1.0, repeat: int = 3, block: int = 500) -> d
     """µs per ``GTE_Wait(1)`` (and per ``GTE_Wait(10)``, whose difference is the cost of the
     nine cycles more) on the auto clock, the axes moving in the bank (:func:`_wait_session`):
     a wait's fixed cost, which a field application paced by waits pays every controller
-    millisecond.  ``fast``: the public function; ``general``: the table path with the quick
-    way off (``Controller.QUICK_WAIT``: what every wait took before it), in alternate blocks
-    of the same session, the best block of each (its CPU time); ``ratio``: general / fast;
-    ``cycles``: the
-    controller cycles one wait ran (1 ms cycle time, the calls' latency included)."""
+    millisecond.  ``fast``: the public function (its C entry, where there is one);
+    ``python``: the Python fast function behind that entry (what the public function is
+    without one: ``GTECAT_CENTRY=0``); ``general``: the table path with the quick way off
+    (``Controller.QUICK_WAIT``: what every wait took before it), in alternate blocks of the
+    same session, the best block of each (its CPU time); ``ratio``: general / fast;
+    ``cycles``: the controller cycles one wait ran (1 ms cycle time, the calls' latency
+    included)."""
     from gtecat import gt
     from gtecat.controller.core import Controller
 
@@ -1114,7 +1116,9 @@ def bench_gte_wait(seconds: float = 1.0, repeat: int = 3, block: int = 500) -> d
     cpu = time.process_time  # (the blocks' own CPU: on a shared machine the wall's is noisier)
     best: dict[str, float] = {}
     cycles: dict[str, float] = {}
-    ways = (("fast", gt.GTE_Wait, True), ("general", gt.GTE_Wait.slow, False))
+    ways = [("fast", gt.GTE_Wait, True), ("general", gt.GTE_Wait.slow, False)]
+    if hasattr(gt.GTE_Wait, "python"):
+        ways.insert(1, ("python", gt.GTE_Wait.python, True))
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(repeat):
             for bus in WAIT_BUSES:

@@ -205,8 +205,9 @@ class Controller:
         #: controller's own dicts (ids), [7] the bank's live rows, [8:11] io's places of the
         #: cycle done, a move ended and the next cycle's time, [11:14] its homing, resting
         #: and switched-off rows, [14] 1 where such a cycle changes no status flag (no
-        #: in-position band); _quick_keep holds them
-        self.quick_cbook = array("q", bytes(8 * 15))
+        #: in-position band), [15] 1 where GTE_Wait's C entry may run a wait's cycles on
+        #: the armed call and count them so (:meth:`_book_in_c`); _quick_keep holds them
+        self.quick_cbook = array("q", bytes(8 * 16))
         self._quick_keep: Any = None
         #: the clock's cycle as this controller gave it (one that wraps it, an inspection
         #: endpoint's, stops the runs of cycles at once: :meth:`_run_cycles`)
@@ -797,7 +798,23 @@ class Controller:
         # (no in-position band: a cycle that ends no move changes no status flag, so the
         # status words the bank made stand for the next epoch: AxisBank._sts_epoch)
         b[14] = not bank.any_band  # type: ignore[union-attr]
+        self._c_waits = self._waits_in_c(bank)
+        b[15] = self.QUICK_WAIT and self._c_waits
         b[0] = 1
+
+    def _waits_in_c(self, bank: Any) -> bool:
+        """Whether GTE_Wait's C entry (gtecat.gt.centry's wait) may run a wait's cycles
+        on the armed call, as :meth:`wait_quick` would run them where its quick way is on
+        (its checks that the armed cycle's do not make: the clock alone, an EtherCAT master,
+        the runs of cycles as written here)."""
+        return (
+            self.card is None
+            and bool(self.clock.quick[3])
+            and self.clock.run_many is self._own_many
+            and self._own_many.__func__ is _RUN_CYCLES
+            and type(bank).run_cycles is _BANK_RUN_CYCLES
+            and "run_cycles" not in bank.__dict__
+        )
 
     def arm_quick(self, k: Any) -> None:
         """Arm the next due cycle for the GT readers' C entries (gtecat.gt.centry): right
@@ -956,6 +973,7 @@ class Controller:
             raise ParameterError("wait time must be >= 0")
         clock = self.clock
         total = round(ms * 1_000_000)
+        e0 = EPOCH.n
         if total <= self.WAIT_SLICE_NS and clock.mode is not _REALTIME and self.wait_quick(total):
             return
         if clock.mode is _REALTIME or total <= self.WAIT_SLICE_NS:
@@ -970,12 +988,22 @@ class Controller:
                 hook = self.slice_hook
                 if hook is not None and left > self.WAIT_SLICE_NS:
                     hook()
-        if clock.mode is _AUTO:
-            self._arm_after_wait()
+        if clock.mode is not _REALTIME:
+            self._wait_end(e0)
 
     #: waits take :meth:`wait_quick` where it applies (False: always the general way, which
     #: the tests compare it with)
     QUICK_WAIT = True
+    #: GTE_Wait has its C entry (gtecat.gt.fast sets it where the entry is made): a wait
+    #: runs there on the cycle armed for the readers' entries, so a wait arms the next one
+    #: on the lockstep clock too (:meth:`_arm_after_wait`), and where nothing but reads
+    #: happened since the last wait
+    C_WAITS = False
+    #: the readers' epoch the last wait in Python left (:meth:`_wait_end`)
+    _wait_epoch = -1
+    #: the last arming found that the C entry's waits may run on it (:meth:`_waits_in_c`;
+    #: its book says so where the quick way is on too)
+    _c_waits = False
 
     def wait_quick(self, total: int) -> bool:
         """A wait of ``total`` ns (at most :attr:`WAIT_SLICE_NS`) on the lockstep or the auto
@@ -1001,6 +1029,7 @@ class Controller:
         q = clock.quick
         bank = self.bank
         master = self.master
+        e0 = EPOCH.n
         if (
             not self.QUICK_WAIT
             or bank is None
@@ -1074,52 +1103,16 @@ class Controller:
                             seen = None  # type: ignore[assignment]
                 if seen is not None:
                     # Kernel.run for the run's cycles (bank.run_cycles), then its book and
-                    # _after_kernel's, the counts in their arrays (AxisBank._COUNTS' order)
-                    # (as quick_cycle_done: a count that stays - a zero added, a flag
-                    # already so - is not written)
+                    # _after_kernel's (_wait_book)
                     io = k._io
                     io[_IN_T_NS] = q[9]
                     io[_IN_DT_NS] = dt_ns
                     io[_IN_MAXC] = n
                     k._fp[_FP_DT] = csp._dt
-                    rc = k.run_fn(*k._args)
-                    done = io[_OUT_DONE]
-                    if rc:
-                        bank._declined = done > 0
-                    if done:
-                        c = bank.counts
-                        if bank._settled:  # (its count of the first cycle: in settle)
-                            c[0] -= done - 1
-                            bank._settled = False
-                        else:
-                            c[0] -= done
-                        c[1] -= done
-                        bank._lists = {}
-                        c[9] = 0
-                        csp.counts[0] += done
-                        if csp._din_safe:
-                            csp._din_safe = 0
-                        if csp.any_fe:
-                            csp.fe_running = True
-                        if io[_OUT_FIN]:
-                            bank.n_moving = int(np.count_nonzero(bank.moving))
-                            bank._count_standing()
-                        c[2] += bank.n_alive * done
-                        c[3] += done
-                        c[4] += done
-                        c[5] += done
-                        if bank.n_hm:
-                            c[6] += bank.n_hm * done
-                        if bank.n_rest:
-                            c[7] += bank.n_rest * done
-                        if bank.n_frz:
-                            c[8] += bank.n_frz * done
-                        master.counts[0] += done
-                        self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
-                        for passed in passes:  # (_run_cycles: the hooks count the run)
-                            passed(done)
+                    done = self._wait_book(k, k.run_fn(*k._args), seen, passes)
             finally:
                 self.in_batch = False
+            # (_wait_counted, inline: a wait's every call in Python counts)
             if done:  # (Clock.advance_ns's count of a run)
                 q[0] = pending - done * dt_ns
                 q[10] += done
@@ -1132,14 +1125,123 @@ class Controller:
                 clock.cycle()
             if q[0] >= dt_ns:
                 clock.advance_ns(0)  # the rest of the wait the general way, from here
-        # (_arm_after_wait's first look, inline: a loop of waits alone arms nothing)
-        if (
+        if self.C_WAITS:
+            self._wait_end(e0)
+        elif (  # (_wait_end's look on the auto clock, inline: a loop of waits alone arms nothing)
             clock.mode is _AUTO
             and q[4] != EPOCH.n
             and (q[11] != self._armed_left or self._idle_arms < self.IDLE_ARMS)
         ):
             self._arm_after_wait()
         return True
+
+    def _wait_book(
+        self, k: Any, rc: int, seen: tuple[int, ...], passes: tuple[Callable[[int], None], ...]
+    ) -> int:
+        """The book of a wait's run of cycles the kernel ran (:meth:`wait_quick`, or
+        GTE_Wait's C entry: :meth:`waited`; ``rc`` its code, ``seen`` the steady verdict's
+        marks before it): :meth:`AxisBank.run_cycles`'s and :meth:`_after_kernel`'s, the
+        counts in their arrays (AxisBank._COUNTS' order), the hooks told (``passes``), as
+        :meth:`_run_cycles` tells them.  The cycles it ran."""
+        # (as quick_cycle_done: a count that stays - a zero added, a flag already so - is
+        # not written)
+        bank = self.bank
+        csp = bank.csp  # type: ignore[union-attr]
+        io = k._io
+        done = io[_OUT_DONE]
+        if rc:
+            bank._declined = done > 0  # type: ignore[union-attr]
+        if done:
+            c = bank.counts  # type: ignore[union-attr]
+            if bank._settled:  # type: ignore[union-attr]  # (its count of the first cycle: in settle)
+                c[0] -= done - 1
+                bank._settled = False  # type: ignore[union-attr]
+            else:
+                c[0] -= done
+            c[1] -= done
+            bank._lists = {}  # type: ignore[union-attr]
+            c[9] = 0
+            csp.counts[0] += done
+            if csp._din_safe:
+                csp._din_safe = 0
+            if csp.any_fe:
+                csp.fe_running = True
+            if io[_OUT_FIN]:
+                bank.n_moving = int(np.count_nonzero(bank.moving))  # type: ignore[union-attr]
+                bank._count_standing()  # type: ignore[union-attr]
+            c[2] += bank.n_alive * done  # type: ignore[union-attr]
+            c[3] += done
+            c[4] += done
+            c[5] += done
+            if bank.n_hm:  # type: ignore[union-attr]
+                c[6] += bank.n_hm * done  # type: ignore[union-attr]
+            if bank.n_rest:  # type: ignore[union-attr]
+                c[7] += bank.n_rest * done  # type: ignore[union-attr]
+            if bank.n_frz:  # type: ignore[union-attr]
+                c[8] += bank.n_frz * done  # type: ignore[union-attr]
+            self.master.counts[0] += done  # type: ignore[union-attr]
+            self._steady_seen = (seen[0] + 1, seen[1] + done, seen[2], seen[3])
+            for passed in passes:  # (_run_cycles: the hooks count the run)
+                passed(done)
+        return done
+
+    def _wait_counted(self, done: int, pending: int, spent: bool) -> None:
+        """After a wait's run of cycles (:meth:`_wait_book`; ``pending`` the latency with
+        the wait's time before it): the clock's count of the run as
+        :meth:`Clock.advance_ns` counts it - or its one cycle where no run could start -,
+        the hooks' owed cycles counted where the run was taken on their budget
+        (``spent``), and the rest of the wait the clock's general way."""
+        clock = self.clock
+        q = clock.quick
+        dt_ns = q[2]
+        if done:  # (Clock.advance_ns's count of a run)
+            q[0] = pending - done * dt_ns
+            q[10] += done
+            q[9] += done * dt_ns
+            EPOCH.n += 1  # (clock.counted)
+            if spent:  # (the owed cycles and the run's: cycles_passed, the arming off)
+                self.settle_hooks()
+        else:  # (Clock.advance_ns's cycle where no run could start)
+            q[0] = pending - dt_ns
+            clock.cycle()
+        if q[0] >= dt_ns:
+            clock.advance_ns(0)  # the rest of the wait the general way, from here
+
+    def _wait_end(self, e0: int) -> None:
+        """The end of a wait in Python that began at the readers' epoch ``e0``:
+        :meth:`_arm_after_wait`'s first look, inline (a loop of waits alone arms nothing),
+        on the auto clock, or on either where GTE_Wait has its C entry (:attr:`C_WAITS`);
+        there a wait that found the epoch the last one left (nothing but reads between:
+        the entry would have taken it armed, where the last arming said it may) arms again
+        whatever the armings before."""
+        clock = self.clock
+        q = clock.quick
+        if self.C_WAITS:
+            if e0 == self._wait_epoch and self._c_waits:
+                self._idle_arms = 0
+        elif clock.mode is not _AUTO:
+            return
+        if q[4] != EPOCH.n and (q[11] != self._armed_left or self._idle_arms < self.IDLE_ARMS):
+            self._arm_after_wait()
+        self._wait_epoch = EPOCH.n
+
+    def waited(self, rc: int, pending: int) -> None:
+        """The rest of a wait whose run of cycles GTE_Wait's C entry ran on the armed call
+        (gtecat.gt.centry's wait: the clock's lock held, the cycle disarmed, the pending
+        latency ``pending`` with the wait's time; the kernel's code ``rc``) where its book
+        in C does not count it (a move ended, a cycle declined, the run stopped short):
+        :meth:`wait_quick`'s book of it and the rest of the wait, as there where the armed
+        budget held the run (the hooks not asked, their owed cycles counted after it)."""
+        k = self.bank.kernel  # type: ignore[union-attr]
+        e0 = EPOCH.n
+        spent = self._owed is not None
+        self.in_batch = True
+        try:
+            done = self._wait_book(k, rc, self._steady_seen, ())
+        finally:
+            self.in_batch = False
+        self._wait_counted(done, pending, spent)
+        self._wait_end(e0)
 
     def _arm_after_wait(self) -> None:
         """After a wait whose cycles ran (their last in a run at once, or one by one): the

@@ -20,6 +20,10 @@ answers (every kind of shape it must hand on, the widths, reference counts) befo
 disagreement, or no compiler: :data:`REASON` says why and :func:`reader` gives None (the
 Python fast function is then the public one, as before).
 
+``GTE_Wait`` has an entry of its own (:func:`wait`): a wait run in C on the quick cycle armed
+for the readers' entries, its cycles in one call of the kernel and counted in C where the run
+went whole (csrc/centry.c ``wait_call``).
+
 Another thread.  On the lockstep and auto clocks a cycle runs in whichever thread lets
 controller time pass (GTE_Wait, a call's host latency, a controller server's wall floor),
 holding the controller's clock lock, as every call of the table path does.  The entries answer
@@ -254,6 +258,23 @@ class _MultiEntry(ctypes.Structure):
     ]
 
 
+class _WaitEntry(ctypes.Structure):
+    """``struct wait_entry`` of csrc/centry.c: GTE_Wait's entry."""
+
+    _fields_ = [
+        ("fallback", _VP),
+        ("after", _VP),
+        ("rest", _VP),
+        ("session", _VP),
+        ("key_last", _VP),
+        ("key_note", _VP),
+        ("most", ctypes.c_longlong),
+        ("batch", ctypes.c_longlong),
+        ("maxc", ctypes.c_longlong),
+        ("at", _VP),
+    ]
+
+
 _R_MAX = 6
 
 
@@ -336,7 +357,7 @@ _BOOKS: list[Any] = [None, None]  # (kept alive while named)
 #: how many numbers a clock's quick array holds (gtecat.master.clock.Clock.quick)
 QUICK_LEN = 12
 #: how many numbers a controller's book in C holds (Controller.quick_cbook)
-BOOK_LEN = 15
+BOOK_LEN = 16
 #: the names the book in C sets in the bank's and the controller's own dicts (kept alive)
 _KEY_LISTS, _KEY_SEEN = sys.intern("_lists"), sys.intern("_steady_seen")
 #: the names of the slaves' marks, as the C entries look them up
@@ -367,6 +388,32 @@ def set_clocks(
             cb = None
         _BOOKS[k] = cb
         CLOCK_BOOKS[k] = 0 if cb is None else cb.buffer_info()[0]
+
+
+#: the GT_ gate's controller for GTE_Wait's entry (csrc/centry.c wait_call): [0] its
+#: clock's quick numbers, [1] its armed quick cycle's book in C (Controller.quick_cbook), on
+#: the lockstep and the auto clock alike; 0: the entry waits nowhere (:func:`set_wait`)
+WAIT_AT = (ctypes.c_ssize_t * 2)()
+_WAIT_KEPT: list[Any] = [None]  # (their arrays, kept alive while named)
+
+
+def set_wait(ctl: Any) -> None:
+    """The controller behind the GT_ gate for GTE_Wait's entry (:data:`WAIT_AT`; None:
+    none: an EtherCAT master's only), set while the gates are closed."""
+    q = getattr(getattr(ctl, "clock", None), "quick", None)
+    b = getattr(ctl, "quick_cbook", None)
+    ok = (
+        ctl is not None
+        and getattr(ctl, "card", None) is None
+        and all(
+            isinstance(a, array) and a.typecode == "q" and len(a) == n
+            for a, n in ((q, QUICK_LEN), (b, BOOK_LEN))
+        )
+    )
+    WAIT_AT[0] = WAIT_AT[1] = 0
+    _WAIT_KEPT[0] = (q, b) if ok else None
+    if ok:
+        WAIT_AT[0], WAIT_AT[1] = q.buffer_info()[0], b.buffer_info()[0]  # type: ignore[union-attr]
 
 
 def _marks_dict() -> dict:
@@ -903,6 +950,8 @@ def _load() -> tuple[Maker | None, str]:
         multi_meth = ctypes.cast(lib.gtecat_centry_multi, _VP).value
         multi_vc = ctypes.cast(lib.gtecat_centry_multi_vc, _VP).value
         replay_meth = ctypes.cast(lib.gtecat_centry_replay, _VP).value
+        wait_meth = ctypes.cast(lib.gtecat_centry_wait, _VP).value
+        wait_vc = ctypes.cast(lib.gtecat_centry_wait_vc, _VP).value
         new = byref_target.function_maker()
     except Exception as e:  # no compiler, a failed build, no Python API in this process
         return None, f"{type(e).__name__}: {e}"
@@ -1058,12 +1107,34 @@ def _load() -> tuple[Maker | None, str]:
         loop.run = new(b"gt_centry_replay", replay_meth, _METH_FASTCALL_KEYWORDS, t, None)
         return loop
 
+    def make_wait(
+        fallback: Callable[..., Any],
+        after: Callable[[], Any],
+        rest: Callable[[int, int], Any],
+        session: dict,
+        most: int,
+        batch: int,
+        maxc: int,
+    ) -> Any:
+        e = _WaitEntry(id(fallback), id(after), id(rest), id(session), id(_KEY_LAST))
+        e.key_note, e.most, e.batch, e.maxc = id(_KEY_NOTE), most, batch, maxc
+        e.at = ctypes.addressof(WAIT_AT)
+        keep = (fallback, after, rest, session)
+        fn = new(b"gt_centry_wait", wait_meth, _METH_FASTCALL_KEYWORDS, e, keep)
+        return public(fn, wait_vc, e, keep)
+
     make.raw = make_raw  # type: ignore[attr-defined]
     make.multi = make_multi  # type: ignore[attr-defined]
     make.replay = make_replay  # type: ignore[attr-defined]
+    make.wait = make_wait  # type: ignore[attr-defined]
     for _ in range(2):
         try:
-            reason = _self_test(make) or _self_test_raw(make_raw) or _self_test_multi(make_multi)
+            reason = (
+                _self_test(make)
+                or _self_test_raw(make_raw)
+                or _self_test_multi(make_multi)
+                or _self_test_wait(make_wait)
+            )
         except Exception as e:  # (a self-test that cannot even run)
             reason = f"the self-test failed: {type(e).__name__}: {e}"
         if not reason or not callables:
@@ -1073,6 +1144,66 @@ def _load() -> tuple[Maker | None, str]:
         PARTIALS = reason
         callables.clear()  # (once more, each entry behind a functools.partial)
     return (make, "") if not reason else (None, reason)
+
+
+#: the names of the session's last error and note, as GTE_Wait's entry looks them up
+_KEY_LAST, _KEY_NOTE = sys.intern("last"), sys.intern("note")
+
+
+def _self_test_wait(make_wait: Callable[..., Any]) -> str:
+    """'' when GTE_Wait's entry hands every call it does not make to its fallback with the
+    very same arguments and keeps reference counts, else what went wrong.  (Its waits are
+    held to the Python path's by the tests: a wait needs a controller.)"""
+
+    def python(*a: Any, **kw: Any) -> Any:
+        return ("python", a, kw)
+
+    def after() -> int:
+        return 0
+
+    def rest(rc: int, pending: int) -> int:
+        return 0
+
+    session = {"last": None, "note": None}
+    w = make_wait(python, after, rest, session, 100, 1000, 9)
+    big, huge = 1.5, 1 << 70
+    shapes: list[tuple[tuple[Any, ...], dict[str, Any]]] = [
+        ((1,), {}), ((1.0,), {}), ((0,), {}), ((big,), {}), ((-1,), {}), ((huge,), {}),
+        ((float("nan"),), {}), ((True,), {}), ((None,), {}), ((), {}), ((1, 2), {}),
+        ((), {"ms": 1}), ((1,), {"x": 2}),
+    ]  # fmt: skip
+    watched = _own([big, python, after, rest, session])
+    counts = [sys.getrefcount(x) for x in watched]
+    for _ in range(3):
+        for a, kw in shapes:
+            if w(*a, **kw) != ("python", a, kw):
+                return f"GTE_Wait's entry answered {a} {kw} itself with no controller"
+    if [sys.getrefcount(x) for x in watched] != counts:
+        return "GTE_Wait's entry changed reference counts"
+    return ""
+
+
+def wait(
+    fallback: Callable[..., Any],
+    after: Callable[[], Any],
+    rest: Callable[[int, int], Any],
+    session: dict,
+    most: int,
+    batch: int,
+    maxc: int,
+) -> Any:
+    """GTE_Wait's C entry (csrc/centry.c ``wait_call``): a wait of ``ms`` (an exact int or
+    float from 0 to ``most``) on the GT_ gate's controller (:data:`WAIT_AT`) run on the
+    quick cycle armed for the readers' entries, its cycles (at most ``batch``) in one call of
+    the kernel (``maxc``: the kernel's io slot of the cycles to run), booked in C where the
+    run went whole; ``rest(rc, pending)`` where it did not (the controller's Python book and
+    the rest of the wait, the call's code); ``after()``: the call's host latency on the auto
+    clock, as a reader's.  ``session``: the GT session's own dict (its ``last`` and
+    ``note`` must be None).  Every other call: ``fallback`` with the same arguments.  None
+    where the C entry is not available (:data:`REASON`)."""
+    if _MAKE is None:
+        return None
+    return _MAKE.wait(fallback, after, rest, session, most, batch, maxc)  # type: ignore[attr-defined]
 
 
 def _own(objects: list[Any]) -> list[Any]:

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from .._attrs import own_dict
 from .._bytecode import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
@@ -711,6 +712,7 @@ def fast_reader(
         if entry is not None and entry_gtn is not None:
             entry.gtn, entry.slow, entry.python = entry_gtn, slow, gt  # type: ignore[attr-defined]
             public[0] = entry
+            env["GTN_ENTRY"][0] = entry_gtn  # (a view core's axis: gt.gtn hands it there)
     return public[0]  # type: ignore[no-any-return]
 
 
@@ -771,6 +773,7 @@ def set_gates(gt: Any, gtn: Any) -> None:
     centry.set_clock_ms(
         *(c if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
     )
+    centry.set_wait(gt if gates[0] != centry.CLOSED else None)
     centry.set_gates(*gates)
 
 
@@ -1278,7 +1281,7 @@ def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
             ) or is_array(tp):  # a numpy or ctypes array: its first element
                 obj = None
             else:
-                return {fallback}
+                return {fallback}{delegate}
 {{value}}
             if obj is None:
                 p[0] = v
@@ -1352,6 +1355,22 @@ def _target(types: Any) -> Callable[[Any], Any]:
     return target
 
 
+#: the GTN_ form of a core beyond 32 axes (a view of core 1's bus), its shape one the Python
+#: path takes: the GTN_ form's C entry with core 1 and the bus axis answers it (the same
+#: controller, resources and value; its kept value, its cycles in C), where there is one;
+#: a shape that entry hands on comes back here with core 1, which answers it as this core
+#: would
+_DELEGATE = """
+            if core != 1:
+                entry = GTN_ENTRY[0]
+                if entry is not None:
+                    if count is _NO:
+                        return entry(1, n + PER_CORE * (core - 1), p)
+                    if pClock is _NO:
+                        return entry(1, n + PER_CORE * (core - 1), p, count)
+                    return entry(1, n + PER_CORE * (core - 1), p, count, pClock)"""
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
@@ -1371,6 +1390,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
             else ""
         ),
         bus_axis="n if core == 1 else n + PER_CORE * (core - 1)" if gtn else "n",
+        delegate=_DELEGATE if gtn else "",
         session=session,
         address=address,
         fallback=(
@@ -1381,6 +1401,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
     )
     env["_AT"] = _AT
     env["PER_CORE"] = AXES_PER_CORE
+    env.setdefault("GTN_ENTRY", [None])  # (the GTN_ form's C entry, once made)
     value = "\n".join("            " + line for line in _value_lines(env))
     code = code.replace("{value}", value)
     exec(_compiled_code(code, f"<gt fast {fname} {env['name']}>"), env)  # env: its globals
@@ -3525,7 +3546,49 @@ def fast_wait(
         return slow(*(a for a in (ms,) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]  # the table path (tests compare both)
-    return gt
+    return _wait_entry(gt, name, session, advance)
+
+
+def _wait_entry(
+    gt: Callable[..., int], name: str, session: Any, advance: Callable[[Any, str, int], int]
+) -> Callable[..., int]:
+    """GTE_Wait's public function: its C entry (:func:`centry.wait`: the wait run on the
+    quick cycle armed for the readers' entries, on the lockstep and the auto clock) in
+    front of the fast function ``gt``, where :data:`CENTRY` is on and the entry is
+    available; else ``gt``."""
+    if not CENTRY:
+        return gt
+    from ..controller.bank_kernel import IN_MAXC
+    from ..controller.core import Controller
+    from ._core import call_done, call_failed
+
+    def rest(rc: int, pending: int) -> int:
+        # (the entry ran the wait's cycles on the armed call, its book in C declined them:
+        # the controller's book and the rest of the wait, then the fast function's end)
+        ctl = GATED[0]
+        try:
+            ctl.waited(rc, pending)
+            wait_yield(ctl)
+        except Exception as e:
+            return call_failed(name, e, ctl, 1)
+        if session.note is None:
+            session.last = None
+        else:
+            call_done(name)
+        if ctl.clock.mode is _LOCKSTEP:
+            return 0
+        return advance(ctl, name, 0)
+
+    own_dict(session)  # (its attributes read quick; the entry reads its dict)
+    entry = centry.wait(
+        gt, _after(advance, name, 0), rest, vars(session),
+        Controller.WAIT_SLICE_NS // 1_000_000, Controller.BATCH_CYCLES, IN_MAXC,
+    )  # fmt: skip
+    if entry is None:
+        return gt
+    Controller.C_WAITS = True  # (a wait arms the next cycle for it, lockstep too)
+    entry.slow, entry.python = gt.slow, gt  # type: ignore[attr-defined]
+    return entry  # type: ignore[no-any-return]
 
 
 def _makers() -> dict[str, Callable[..., Callable[..., int]]]:

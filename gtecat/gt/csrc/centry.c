@@ -556,13 +556,25 @@ typedef int (*kernel_run)(void *, void *, void *);
 /* Whether the armed quick cycle (Controller.arm_quick) may run now: one cycle due on a clock
  * alone (pending latency pend), armed for this epoch, this generation, these slaves' marks
  * and this cycle time, with cycles left in its budget (q[11]: the cycle hooks' quiet ones). */
+static int armed_now(const long long *q);
+
 static int armed(const long long *q, long long pend)
 {
-    long long al, out, i;
-    const long long *call, *w;
     if (!q[3] || !q[4] || q[0] < 0 || q[1] < 0 || q[2] <= 0 || pend < q[2] || pend - q[2] >= q[2])
         return 0;
     if (q[11] <= 0)
+        return 0;
+    return armed_now(q);
+}
+
+/* Whether the quick cycle armed on the clock's numbers q stands now: armed for this epoch,
+ * this generation, these slaves' marks, their field inputs and this cycle time (armed()
+ * without the latency's and the budget's looks; a wait asks them its own way). */
+static int armed_now(const long long *q)
+{
+    long long al, out, i;
+    const long long *call, *w;
+    if (!q[3] || !q[4] || q[0] < 0 || q[2] <= 0)
         return 0;
     if (q[5] != A.arms[0] || q[4] != epoch())
         return 0;
@@ -590,9 +602,19 @@ static int armed(const long long *q, long long pend)
  * steady verdict's marks, the readers' epoch, the counts, and the next cycle armed - what
  * Controller.quick_book does in this case.  q: the clock's quick numbers (q[9] its time,
  * q[10] its cycles).  1: booked; 0: nothing done, the Python book runs. */
+static int book_n(long long *b, long long *q, long long n);
+
 static int book_in_c(ptrdiff_t gate, long long *q)
 {
-    long long *b = (long long *)A.clock_books[gate - 1], *io, *cnt, ep, cycles, now;
+    return book_n((long long *)A.clock_books[gate - 1], q, 1);
+}
+
+/* book_in_c's book of n cycles the kernel ran whole at once (b: the controller's book in C;
+ * a wait's run: the counts of n cycles, the readers' epoch grown once, as a run of cycles
+ * grows it). */
+static int book_n(long long *b, long long *q, long long n)
+{
+    long long *io, *cnt, ep, cycles, now;
     obj lists, e, c, al, out, seen, old;
     if (!b || b[0] != 1)
         return 0;
@@ -602,8 +624,8 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     ep = epoch();
     if (ep < 0)
         return 0;
-    cycles = q[10] + 1;
-    now = q[9] + q[2];
+    cycles = q[10] + n;
+    now = q[9] + n * q[2];
     lists = A.dict_new();
     e = A.long_from(ep + 1);
     c = A.long_from(cycles);
@@ -636,22 +658,22 @@ static int book_in_c(ptrdiff_t gate, long long *q)
     /* the bank's: countdown, refill, rows, cycles, the kernel's, many at once, and its
      * homing, resting and switched-off rows */
     cnt = (long long *)b[2];
-    cnt[0] -= 1;
-    cnt[1] -= 1;
-    cnt[2] += b[7];
-    cnt[3] += 1;
-    cnt[4] += 1;
-    cnt[5] += 1;
-    cnt[6] += b[11];
-    cnt[7] += b[12];
-    cnt[8] += b[13];
+    cnt[0] -= n;
+    cnt[1] -= n;
+    cnt[2] += n * b[7];
+    cnt[3] += n;
+    cnt[4] += n;
+    cnt[5] += n;
+    cnt[6] += n * b[11];
+    cnt[7] += n * b[12];
+    cnt[8] += n * b[13];
     if (b[14] && cnt[9] == ep) /* (the status words made for the epoch stand: no flag moved) */
         cnt[9] = ep + 1;
     if (b[14])
         flag_keeping++;
     c_booked++;
-    *(long long *)b[3] += 1; /* its drives' cycles */
-    *(long long *)b[4] += 1; /* the master's */
+    *(long long *)b[3] += n; /* its drives' cycles */
+    *(long long *)b[4] += n; /* the master's */
     q[10] = cycles;
     q[9] = now;
     io[b[10]] = now; /* (the next cycle's call as this one's) */
@@ -755,6 +777,150 @@ static obj done(obj after, ptrdiff_t gate)
     }
     A.incref(A.zero);
     return A.zero;
+}
+
+/* GTE_Wait(ms): the wait's common case in C.
+ *
+ * A program paced by waits (a pass of reads, GTE_Wait(1)) runs every millisecond's cycle in
+ * its wait; in Python (gtecat.gt.fast's wait, Controller.wait_quick) each cost ~7-11 us
+ * besides the kernel's cycles: the checks of the clock's and the bank's layers, the book, the
+ * arming of the next due cycle for the readers' entries.  Here the wait runs on that armed
+ * quick cycle (Controller.arm_quick; on the lockstep clock too, where a C entry waits): ms an
+ * exact int or float from 0 to one slice of a long wait, its ns as the Python path makes them
+ * (a float's rounded half to even, as round()), the GT_ gate open with its wait's numbers
+ * (at: set by gtecat.gt.fast.set_gates), the session's last error and note None (a wait
+ * clears the one and would report the other), the armed cycle standing (armed_now, asked
+ * again with the clock's lock held) with its book in C and the wait's own conditions met
+ * (b[15]: Controller._waits_in_c), the cycles due no more than one run and the cycle hooks'
+ * quiet budget.  Then the latency pending grows by the wait's time and the cycles it makes due
+ * run in one call of the kernel; a run that went whole (no move ended, none declined) is
+ * counted by book_n - the counts of n cycles, the epoch grown once - and stays armed for
+ * the next; any other is counted by the controller's waited(rc, pending) in Python with
+ * the rest of the wait (wait_python), which answers the call.  Every other call, any doubt:
+ * the Python fast function with the same arguments, which answers as before.  On the auto
+ * clock the call's host latency follows, as a reader's (done). */
+struct wait_entry {
+    obj fallback; /* the Python fast function */
+    obj after;    /* the call's host latency on the auto clock (a reader's after()) */
+    obj rest;     /* rest(rc, pending): the Python book and the rest of a wait, its code */
+    obj session;  /* the GT session's own dict: its last error and note */
+    obj key_last, key_note;
+    long long most;  /* the longest wait in ms (one slice of a long wait) */
+    long long batch; /* the most cycles of one run (Controller.BATCH_CYCLES) */
+    long long maxc;  /* the kernel's io slot of the cycles a call runs (IN_MAXC) */
+    /* the GT_ gate's controller: [0] its clock's quick numbers, [1] its armed cycle's book in
+     * C (Controller.quick_cbook); 0: no wait here (gtecat.gt.fast.set_gates) */
+    const ptrdiff_t *at;
+};
+
+/* A wait's ms (an exact int or float from 0 to most) in ns, as the Python path makes them;
+ * 0: not such a number. */
+static int wait_ns(const struct wait_entry *e, obj x, long long *ns)
+{
+    long long v;
+    double d, t, f;
+    if (TYPE(x) == A.int_type) {
+        if (!ll_of(x, &v) || v < 0 || v > e->most)
+            return 0;
+        *ns = v * 1000000;
+        return 1;
+    }
+    if (TYPE(x) != A.float_type)
+        return 0;
+    memcpy(&d, (char *)x + A.fval, sizeof d);
+    if (!(d >= 0.0 && d <= (double)e->most)) /* (NaN: never) */
+        return 0;
+    t = d * 1000000.0;
+    v = (long long)t; /* (t >= 0: its floor; t - v exact below 2^52) */
+    f = t - (double)v;
+    if (f > 0.5 || (f == 0.5 && (v & 1)))
+        v++;
+    *ns = v;
+    return 1;
+}
+
+static obj wait_call(const struct wait_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    long long total, *q, *b, *io, pend, dt, n, rc;
+    const long long *call;
+    obj release, res, v[2], last, note;
+    if (!ready || kwnames || nargs != 1 || !A.gate[0] || !e->at[0] || !e->at[1] ||
+        !wait_ns(e, args[0], &total))
+        goto python;
+    q = (long long *)e->at[0];
+    b = (long long *)e->at[1];
+    last = A.dict_get(e->session, e->key_last);
+    note = A.dict_get(e->session, e->key_note);
+    if (last != A.none || note != A.none || b[0] != 1 || !b[15] || !armed_now(q))
+        goto python;
+    release = hold(1);
+    if (!release) {
+        A.err_clear();
+        goto python;
+    }
+    if (release == A.none) /* (no lock known for the gate: the Python path) */
+        goto python;
+    /* (with the lock held: another thread's call or cycles may have come first, its
+     * session another controller) */
+    if (!A.gate[0] || (long long *)e->at[0] != q || (long long *)e->at[1] != b || b[0] != 1 ||
+        !b[15] || !armed_now(q))
+        goto unlock;
+    dt = q[2];
+    pend = q[0] + total;
+    if (pend < dt) {
+        q[0] = pend;
+        let_go(release);
+        goto after;
+    }
+    n = pend / dt;
+    call = (const long long *)q[8];
+    io = (long long *)b[1];
+    if (n > e->batch || q[11] < n || !io || (long long)io != call[2])
+        goto unlock;
+    q[4] = 0; /* (the book arms the next one) */
+    q[0] = pend;
+    io[b[10]] = q[9];
+    io[e->maxc] = n;
+    rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
+    io[e->maxc] = 1; /* (the armed call's: one cycle) */
+    if (!rc && io[b[8]] == n && book_n(b, q, n)) {
+        q[0] = pend - n * dt;
+        q[11] -= n;
+        let_go(release);
+        goto after;
+    }
+    /* (a move ended, a cycle declined, the run short: the Python book and the rest) */
+    v[0] = A.long_from(rc);
+    v[1] = v[0] ? A.long_from(pend) : NULL;
+    if (!v[1]) {
+        if (v[0])
+            A.decref(v[0]);
+        let_go(release);
+        return NULL;
+    }
+    res = A.vectorcall(e->rest, v, 2, NULL);
+    A.decref(v[0]);
+    A.decref(v[1]);
+    let_go(release);
+    return res;
+after:
+    return done(e->after, 1);
+unlock:
+    let_go(release);
+python:
+    return A.vectorcall(e->fallback, args, (size_t)nargs, kwnames);
+}
+
+/* METH_FASTCALL | METH_KEYWORDS: self is the entry's ctypes object */
+obj gtecat_centry_wait(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
+{
+    return wait_call((const struct wait_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
+}
+
+obj gtecat_centry_wait_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
+{
+    return wait_call((const struct wait_entry *)AT(callable, A.vc_entry), args,
+                     (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
 }
 
 /* The index of tp among the NULL-ended types (at most n of them), its size and sign in

@@ -53,23 +53,76 @@ def _counts(ctl: Any, marks0: tuple[int, ...]) -> tuple[Any, ...]:
     return out
 
 
-def _session(
-    quick: bool, monkeypatch: pytest.MonkeyPatch, form: Any = int
-) -> tuple[list[Any], int]:
-    """The session (module docstring): what every pass read, and the waits that took the
-    quick way; ``form``: how the program passes its waits (``float``: ``GTE_Wait(1.0)``)."""
-    monkeypatch.setattr(Controller, "QUICK_WAIT", quick)
+#: the ways a session waits: the table path with the quick way off (the general way), the
+#: Python fast function, the public function (GTE_Wait's C entry in front of that one)
+SLOW, PYTHON, ENTRY = "slow", "python", "entry"
+
+
+def _wait_fn(way: str) -> Any:
+    if way == SLOW:
+        return gt.GTE_Wait.slow
+    if way == PYTHON:
+        return getattr(gt.GTE_Wait, "python", gt.GTE_Wait)
+    return gt.GTE_Wait
+
+
+def _counting(mp: pytest.MonkeyPatch, way: str, hooked: bool = False) -> list[int]:
+    """[0]: the waits that took a quick way - the Python one's (:meth:`Controller.wait_quick`
+    answered; ``hooked``: with a cycle hook there), or for the C entry (``ENTRY``) minus the
+    waits that ended in Python (:meth:`Controller._wait_end`: the fast function's, the
+    general way's, the entry's Python book) - counted as negative."""
     took = [0]
+    if way == ENTRY:
+        end = Controller._wait_end
+
+        def ended(self: Controller, e0: int) -> None:
+            took[0] -= 1
+            end(self, e0)
+
+        mp.setattr(Controller, "_wait_end", ended)
+        return took
     own = Controller.wait_quick
 
     def counted(self: Controller, total: int) -> bool:
         ok = own(self, total)
-        took[0] += ok
+        took[0] += ok and (not hooked or bool(self.pre_cycle or self.post_cycle))
         return ok
 
-    monkeypatch.setattr(Controller, "wait_quick", counted)
-    wait = gt.GTE_Wait if quick else gt.GTE_Wait.slow
-    bring_up(clock="auto")
+    mp.setattr(Controller, "wait_quick", counted)
+    return took
+
+
+#: the places of :func:`_counts` where the armed quick cycle's own numbers lie (its budget,
+#: its epoch, what it was armed with) and the bank's status words' epoch: GTE_Wait's C entry
+#: keeps the cycle armed after its run (its budget spent by its cycles, the words kept), the
+#: Python way arms it anew; the rest is the same
+ARMING = (3, 4, 11, 24)
+
+
+def _unarmed(rows: list[Any]) -> list[Any]:
+    """The session's rows without the armed cycle's own numbers (:data:`ARMING`): each row
+    ends with :func:`_counts`."""
+    n = 33
+    out: list[Any] = []
+    for row in rows:
+        if not isinstance(row, list) or len(row) < n:
+            out.append(row)
+            continue
+        head, counts = row[:-n], row[-n:]
+        out.append(head + [x for k, x in enumerate(counts) if k not in ARMING])
+    return out
+
+
+def _session(
+    way: str, monkeypatch: pytest.MonkeyPatch, form: Any = int, clock: str = "auto"
+) -> tuple[list[Any], int]:
+    """The session (module docstring): what every pass read, and the waits that took the
+    quick way (:func:`_counting`); ``form``: how the program passes its waits (``float``:
+    ``GTE_Wait(1.0)``)."""
+    monkeypatch.setattr(Controller, "QUICK_WAIT", way != SLOW)
+    took = _counting(monkeypatch, way)
+    wait = _wait_fn(way)
+    bring_up(clock=clock)
     ctl = gt.GTE_Controller()
     marks0 = (EPOCH.n, 0, VirtualSlave.al_changes, VirtualSlave.outside_changes)
     for a in (1, 2):
@@ -108,15 +161,15 @@ def _session(
     assert back, gt.GTE_GetLastError()
     seen.append(ctl.log.text())
     gt.GT_Close()
-    return seen, took[0]
+    return seen, took[0] + (PASSES + 1 if way == ENTRY else 0)
 
 
 def test_fast_wait_is_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
-    general, none = _session(False, monkeypatch)
+    general, none = _session(SLOW, monkeypatch)
     assert none == 0
     # (a wait of whole milliseconds as a float - GTE_Wait(1.0) - is the int's, and so fast)
     for form in (int, float):
-        quick, took = _session(True, monkeypatch, form)
+        quick, took = _session(PYTHON, monkeypatch, form)
         assert took > PASSES // 2  # (the quick way ran: the bus steady, the axes in the bank)
         assert len(quick) == len(general)
         for k, (a, b) in enumerate(zip(general, quick, strict=True)):
@@ -126,26 +179,36 @@ def test_fast_wait_is_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     assert any(row[-16] for row in general[:-1])  # (_links_down)
 
 
-def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[list[Any], int]:
+@pytest.mark.parametrize("clock", ["auto", "lockstep"])
+def test_the_c_entry_waits_as_the_fast_function(
+    clock: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """GTE_Wait's C entry and the Python fast function (``GTECAT_CENTRY=0``'s public one):
+    the same results, clock and counts after every wait, but for the armed cycle's own
+    numbers (:data:`ARMING`), on either clock; most waits ran in C."""
+    if not hasattr(gt.GTE_Wait, "python"):
+        pytest.skip("no C entry here")
+    python, _ = _session(PYTHON, monkeypatch, clock=clock)
+    for form in (int, float):
+        entry, in_c = _session(ENTRY, monkeypatch, form, clock)
+        assert in_c > PASSES // 2, in_c
+        assert len(entry) == len(python)
+        for k, (a, b) in enumerate(zip(_unarmed(python), _unarmed(entry), strict=True)):
+            assert a == b, f"{form.__name__} pass {k}"
+
+
+def _hooked_session(way: str, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[list[Any], int]:
     """Waits between polls with cycle hooks: faults armed at a time, after a count of
     cycles, at a position and at homing stages fire inside waits; smart homing runs, then
     stays idle.  What every pass read, the log and the faults' events; the waits that took
     the quick way with a hook there."""
-    mp.setattr(Controller, "QUICK_WAIT", quick)
-    took = [0]
-    own = Controller.wait_quick
-
-    def counted(self: Controller, total: int) -> bool:
-        ok = own(self, total)
-        took[0] += ok and bool(self.pre_cycle or self.post_cycle)
-        return ok
-
-    mp.setattr(Controller, "wait_quick", counted)
+    mp.setattr(Controller, "QUICK_WAIT", way != SLOW)
+    took = _counting(mp, way, hooked=True)
     started = _fired(mp)
-    wait = gt.GTE_Wait if quick else gt.GTE_Wait.slow
+    wait = _wait_fn(way)
     machine = tmp / "cell.toml"
     machine.write_text(MACHINE)
-    log = tmp / f"{quick}.log"
+    log = tmp / f"{way}.log"
     bring_up("twelve_axes.eni", machine=str(machine), clock="auto", log=str(log))
     ctl = gt.GTE_Controller()
     marks0 = (EPOCH.n, 0, VirtualSlave.al_changes, VirtualSlave.outside_changes)
@@ -168,7 +231,7 @@ def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[lis
     prf = (c_double * 12)()
     home_st = gt.THomeStatus()
     seen: list[Any] = []
-    for k in range(760):
+    for k in range(HOOKED_PASSES):
         row: list[Any] = [gt.GT_GetClock(byref(clk)), clk.value]
         for a in range(1, 13):
             row += [gt.GT_GetSts(a, byref(sts)), sts.value]
@@ -186,20 +249,33 @@ def _hooked_session(quick: bool, mp: pytest.MonkeyPatch, tmp: Path) -> tuple[lis
     seen.append(started)
     gt.GT_Close()
     seen.append(log.read_text())
-    return seen, took[0]
+    return seen, took[0] + (HOOKED_PASSES + 1 if way == ENTRY else 0)
+
+
+HOOKED_PASSES = 760
 
 
 def test_fast_wait_with_faults_armed_is_the_general_way(tmp_path: Path) -> None:
     with pytest.MonkeyPatch.context() as mp:
-        general, none = _hooked_session(False, mp, tmp_path)
+        general, none = _hooked_session(SLOW, mp, tmp_path)
     with pytest.MonkeyPatch.context() as mp:
-        quick, took = _hooked_session(True, mp, tmp_path)
+        quick, took = _hooked_session(PYTHON, mp, tmp_path)
     assert none == 0
     assert took > 300  # (the hooks quiet: the quick way ran)
     assert len(general[-2]) == 5, general[-2]  # (every fault but the far one fired)
     assert len(quick) == len(general)
     for k, (a, b) in enumerate(zip(general, quick, strict=True)):
         assert a == b, f"pass {k}"
+    if not hasattr(gt.GTE_Wait, "python"):
+        return
+    # the C entry: the same, the armed cycle's own numbers aside (_unarmed); its waits ran
+    # on the hooks' quiet budget
+    with pytest.MonkeyPatch.context() as mp:
+        entry, in_c = _hooked_session(ENTRY, mp, tmp_path)
+    assert in_c > 300, in_c
+    assert len(entry) == len(quick)
+    for k, (a, b) in enumerate(zip(_unarmed(quick), _unarmed(entry), strict=True)):
+        assert a == b, f"entry, pass {k}"
 
 
 @pytest.mark.parametrize(
@@ -233,3 +309,67 @@ def test_plain_waits_in_lockstep_and_realtime_forms() -> None:
     assert gt.GTE_Wait(5) == 0 and ctl.clock.cycles == c0 + 5
     assert gt.GTE_Wait(ms=3) == 0 and ctl.clock.cycles == c0 + 8
     assert gt.GTE_Wait(0) == 0 and ctl.clock.cycles == c0 + 8
+
+
+def test_the_entry_rounds_a_float_as_the_python_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A float's milliseconds in ns, rounded half to even as ``round`` rounds them, by the C
+    entry (the waits ran there: armed, nothing but waits between): the controller time
+    passed is the Python path's."""
+    if not hasattr(gt.GTE_Wait, "python"):
+        pytest.skip("no C entry here")
+    bring_up(clock="lockstep")
+    ctl = gt.GTE_Controller()
+    assert gt.GT_AxisOn(1) == 0
+    for _ in range(3):
+        gt.GTE_Wait(1)  # (the cycle armed, the loop's waits in C)
+    q = ctl.clock.quick
+    ended = _counting(monkeypatch, ENTRY)  # (less the waits that ended in Python)
+    xs = [0.0, 0.5e-6, 1.5e-6, 2.5e-6, 0.0004, 0.0015, 0.1234565, 1.0000005, 2.0000001,
+          0.3, 0.7, 0.9999999, 99.9999995, 100.0, 12.5e-6, 1e-300, 5e-324]  # fmt: skip
+    for x in xs:
+        before = q[9] + q[0]
+        assert gt.GTE_Wait(x) == 0, gt.GTE_GetLastError()
+        assert q[9] + q[0] - before == round(x * 1_000_000), x
+    assert -ended[0] < len(xs) // 2, ended  # (most of them in C)
+
+
+def test_a_failed_call_before_a_wait_is_forgotten_after_it() -> None:
+    """A wait clears the last error as every call that returns 0 does (the entry leaves a
+    wait after an error to the Python path, which clears it)."""
+    bring_up(clock="lockstep")
+    assert gt.GT_AxisOn(1) == 0
+    for _ in range(3):
+        gt.GTE_Wait(1)
+    s = c_long()
+    assert gt.GT_GetSts(99, byref(s)) != 0 and gt.GTE_GetLastError()
+    assert gt.GTE_Wait(1) == 0 and gt.GTE_GetLastError() == ""
+    assert gt.GTE_Wait(1) == 0 and gt.GTE_GetLastError() == ""
+
+
+def test_waits_of_two_threads_add_up() -> None:
+    """Two threads waiting on one lockstep controller (the entry takes the clock's lock as
+    the Python path does): every millisecond of both passes, the readers' values of the
+    last cycle."""
+    import threading
+
+    bring_up(clock="lockstep")
+    ctl = gt.GTE_Controller()
+    assert gt.GT_AxisOn(1) == 0
+    trap_move(1, 1_000_000, 2.0)
+    c0 = ctl.clock.cycles
+
+    def waits() -> None:
+        pos = c_double()
+        for _ in range(400):
+            gt.GTE_Wait(1)
+            gt.GT_GetPrfPos(1, byref(pos))
+
+    ts = [threading.Thread(target=waits) for _ in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join(60)
+    assert ctl.clock.cycles - c0 == 800
+    pos, slow = c_double(), c_double()
+    assert gt.GT_GetPrfPos(1, byref(pos)) == 0
+    assert gt.GT_GetPrfPos.slow(1, byref(slow)) == 0 and pos.value == slow.value > 0

@@ -98,3 +98,57 @@ def test_a_pulse_cards_own_second_core_is_not_a_view(tmp_path: Path) -> None:
         assert got != 0  # (a pulse card has no EtherCAT PDO: the table's refusal)
     finally:
         gt.GT_Close()
+
+
+def test_a_view_cores_axes_read_through_core_1s_entry_as_the_table(tmp_path: Path) -> None:
+    """Each reader of :data:`gtecat.gt.fast.READERS` as ``GTN_<name>(core, axis, p)`` with a
+    core beyond 1 (its shape one the Python path takes: ``byref(x)``, ``x``, count 1 and a
+    NULL clock, a ctypes array) goes to core 1's C entry with the bus axis: the code, the
+    value and the reason of the table path for that bus axis, between waits of axes moving
+    in Trap and jogging, a servo-off axis and one in homing mode."""
+    from ctypes import c_double
+
+    from gtecat.gt import fast
+
+    eni = write_axes_eni(72, tmp_path / "axes72.eni")
+    bring_up(str(eni), clock="lockstep")
+    for bus in range(33, 73):
+        if bus != 40:
+            assert gt.GT_AxisOn(bus) == 0, gt.GTE_GetLastError()
+    gt.GTE_Wait(20)
+    prm = gt.TTrapPrm()
+    prm.acc = prm.dec = 0.5
+    for bus in range(33, 73, 3):
+        assert gt.GT_PrfTrap(bus) == 0 and gt.GT_SetTrapPrm(bus, byref(prm)) == 0
+        assert gt.GT_SetPos(bus, 40_000 * (1 if bus % 2 else -1)) == 0
+        assert gt.GT_SetVel(bus, 5.0 + bus % 7) == 0
+        assert gt.GTN_Update((bus - 1) // 32 + 1, 1 << (bus - 1) % 32) == 0
+    jog = gt.TJogPrm()
+    jog.acc = jog.dec = 0.2
+    for bus in range(34, 73, 3):
+        if bus == 40:  # (servo off)
+            continue
+        assert gt.GT_PrfJog(bus) == 0 and gt.GT_SetJogPrm(bus, byref(jog)) == 0
+        assert gt.GT_SetVel(bus, -3.0) == 0
+        assert gt.GTN_Update((bus - 1) // 32 + 1, 1 << (bus - 1) % 32) == 0
+    assert gt.GT_SetHomingMode(35, 6) == 0
+    axes = [(2, 1), (2, 2), (2, 3), (2, 8), (3, 1), (3, 5), (3, 8)]
+    for step in range(12):
+        gt.GTE_Wait((1, 7, 40)[step % 3])
+        for name in fast.READERS:
+            twin = getattr(gt, "GTN_" + name[3:])
+            slow = getattr(gt, name).slow
+            ints = name in ("GT_GetSts", "GT_GetPrfMode", "GT_GetPrfSts")
+            kind = c_long if ints else c_double
+            for core, axis in axes:
+                bus = 32 * (core - 1) + axis
+                for shape in ("byref", "obj", "count", "array"):
+                    got, want = [], []
+                    for call, first in ((twin, (core, axis)), (slow, (bus,))):
+                        x = (kind * 1)() if shape == "array" else kind()
+                        p = byref(x) if shape in ("byref", "count") else x
+                        more = (1, None) if shape == "count" else ()
+                        rc = call(*first, p, *more)
+                        out = got if call is twin else want
+                        out += [rc, bytes(x), gt.GTE_GetLastError() if rc else ""]
+                    assert got == want, (step, name, core, axis, shape)

@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from gtecat.cli.main import main
+from gtecat.controller.epoch import changed
 from gtecat.errors import BusError
 from gtecat.inspect import client, endpoint, runtime
 
@@ -168,6 +169,7 @@ def test_a_request_waits_for_a_run_of_cycles_that_began_before_the_panel_attache
         return batch(t_ns, dt_ns, n)
 
     bank.run_cycles = held_run
+    changed()  # (the bank changed by hand: the cycle armed for the C entries goes with it)
     waiter = threading.Thread(target=gt.GTE_Wait, args=(50,))
     waiter.start()
     ep = endpoint.published(ctl)
