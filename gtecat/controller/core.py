@@ -628,6 +628,10 @@ class Controller:
             if clock._cycle_fn is not self._own_cycle:  # (an endpoint wrapped it)
                 return False
             q[0] = pending - q[2]
+            # nothing armed while it runs, as the entries' quick cycle: only its book arms the
+            # next one (a cycle declined went the general way, which may release rows the
+            # kernel would then leave standing, their drives not stepped)
+            q[4] = 0
             if quiet:
                 q[11] -= 1  # (one of the budget: the entries' count)
             elif self._unhooked != ARMS[0]:  # (hooked: they count this cycle as owed)
@@ -637,7 +641,7 @@ class Controller:
         finally:
             self.in_batch = False
         self.quick_book(rc, False)  # (arms the next one again where it may: io[T_NS] too)
-        if q[4]:  # (with all else that it relies on, taken now)
+        if q[4]:  # (quick_book armed it: with all else that it relies on, taken now)
             self.arm_quick(k)
         self._armed_left = -1  # (calls make cycles due: a wait arms the next one)
         return True
