@@ -359,13 +359,15 @@ class Beside:
     no longer busy it takes its CPUs back.
 
     A server at normal priority (no right to real-time) is kept beside its client too.
-    Apart, each side then shares a CPU with another program at an equal share, and the
-    server of a program that calls in a tight loop needs more than half a CPU: once over
-    its share it is not woken ahead of the other program and waits for the scheduler's
-    next tick (4 ms at 250 Hz).  Together, the pair asks for one CPU, which the kernel's
-    balancing leaves to it more often than not; measured, loaded runs meeting the bar went
-    from about one in two to about three in four.  :meth:`look` gets the CPU numbers (the
-    caller reads them), so the decision is tested with faked ones."""
+    Apart, each side then shares a CPU with another program at an equal share; each call
+    spends some of it (sleeping earns none back), so for a program that calls in a tight
+    loop every few hundred calls a side is not woken ahead of the other program and waits
+    for the scheduler's next tick (4 ms at 250 Hz).  Together, the pair asks for one CPU,
+    which the kernel's balancing leaves to it more often than not; measured on 2 CPUs with
+    two busy programs (docs/performance.md), loaded runs meeting the bar went from about
+    four in ten to six.
+    :meth:`look` gets the CPU numbers (the caller reads them), so the decision is tested
+    with faked ones."""
 
     def __init__(
         self,
