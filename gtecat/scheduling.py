@@ -17,9 +17,9 @@ Decisions:
 * **No fixed CPU pinning**: a real-time task takes whichever CPU it wakes on from normal
   work, and the kernel moves it to another when a real-time task already runs there, which
   it cannot do for a pinned one.  The one exception is :class:`Beside`: while the CPUs are
-  busy, the controller's serving thread takes its client's CPU as its only one (a client
-  waiting for its reply and the server answering it are one chain of work), and its CPUs
-  back as soon as they are not.
+  busy, the controller's serving thread, real-time or not, takes its client's CPU as its
+  only one (a client waiting for its reply and the server answering it are one chain of
+  work), and its CPUs back as soon as they are not.
 * **Bounded spins**: a real-time task that never sleeps is stopped by the kernel for 50 ms
   of every second (``sched_rt_runtime_us``) and takes its CPU from everything else meanwhile;
   a real-time server sleeps between requests and spins only for a bounded time
@@ -343,7 +343,7 @@ BESIDE_AFTER = 2
 
 
 class Beside:
-    """Keeps a real-time server on its client's CPU while the CPUs are busy.
+    """Keeps a server on its client's CPU while the CPUs are busy, real-time or not.
 
     Why: a client waiting for its reply and the server answering it are one chain of work.
     On two CPUs each kept busy by another program, each side shares its CPU with one of
@@ -356,8 +356,18 @@ class Beside:
     moves itself: after :data:`BESIDE_AFTER` looks in a row that find it on another CPU
     than its client while busy, it takes the client's CPU as its only one
     (``sched_setaffinity``; it follows the client when the client moves); when the CPUs are
-    no longer busy it takes its CPUs back.  :meth:`look` gets the CPU numbers (the caller
-    reads them), so the decision is tested with faked ones."""
+    no longer busy it takes its CPUs back.
+
+    A server at normal priority (no right to real-time) is kept beside its client too.
+    Apart, each side then shares a CPU with another program at an equal share; each call
+    spends some of it (sleeping earns none back), so for a program that calls in a tight
+    loop every few hundred calls a side is not woken ahead of the other program and waits
+    for the scheduler's next tick (4 ms at 250 Hz).  Together, the pair asks for one CPU,
+    which the kernel's balancing leaves to it more often than not; measured on 2 CPUs with
+    two busy programs (docs/performance.md), loaded runs meeting the bar went from about
+    four in ten to six.
+    :meth:`look` gets the CPU numbers (the caller reads them), so the decision is tested
+    with faked ones."""
 
     def __init__(
         self,

@@ -3,7 +3,7 @@
     python tools/bench_native.py [--calls 20000] [--clock auto|lockstep|realtime]
                                  [--eni examples/manual_fig5_2.eni] [--no-wall-floor]
                                  [--transport private|unix|tcp] [--rt-priority auto|off|N]
-                                 [--burners N] [--repeat K]
+                                 [--burners N] [--repeat K] [--drop-sys-nice]
 
 A C program (compiled here with ``$(python3 -m gtecat lib --cflags --libs)``) opens a
 private controller, brings the bus up, enables axis 1 and then times each of
@@ -23,6 +23,10 @@ turns, ``quiet`` (the machine as it is: its load average is reported with each r
 mean and the percentiles of the calls, the calls per second, and the CPU time per call of
 the program and of its private controller (``/proc``): on a busy machine a low p50 bought
 with a spinning client can still lose calls per second, and these figures show it.
+
+``--drop-sys-nice`` runs the program, and so the controller it starts, without
+``CAP_SYS_NICE`` (``setpriv``): what an ordinary user gets where the bench runs as root (no
+real-time priority, no nice below 0; a short time slice is still permitted).
 """
 
 from __future__ import annotations
@@ -200,6 +204,12 @@ def main(argv: list[str] | None = None) -> int:
         "repeat runs quiet and loaded in turns",
     )
     ap.add_argument("--repeat", type=int, default=1, help="runs (or quiet/loaded turns)")
+    ap.add_argument(
+        "--drop-sys-nice",
+        action="store_true",
+        help="run the program and its controller without CAP_SYS_NICE (setpriv), as an "
+        "ordinary user runs them",
+    )
     args = ap.parse_args(argv)
 
     from gtecat.native.build import ensure_built
@@ -248,6 +258,7 @@ def main(argv: list[str] | None = None) -> int:
             "server": env.get("GTECAT_SERVER_SPIN_US", "default"),
         },
         "rt_priority": env.get("GTECAT_RT_PRIORITY", "auto"),
+        "sys_nice": not args.drop_sys_nice,
         "slice_us": env.get("GTECAT_SLICE_US", "default"),
         "target": target,
         "machine": {
@@ -290,9 +301,10 @@ def _run(exe: Path, env: dict[str, str], args: argparse.Namespace, tmp: str, bur
             wait_for(address, 60)
             env["GTECAT_CONTROLLER"] = address
         load_before = os.getloadavg()[0]
-        r = subprocess.run(
-            [str(exe), str(args.calls)], capture_output=True, text=True, env=env, cwd=tmp
-        )
+        cmd = [str(exe), str(args.calls)]
+        if getattr(args, "drop_sys_nice", False):
+            cmd = ["setpriv", "--bounding-set", "-sys_nice", "--inh-caps", "-sys_nice", *cmd]
+        r = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=tmp)
         load_after = os.getloadavg()[0]
     finally:
         if controller is not None:

@@ -38,8 +38,12 @@ import socket
 import sys
 from pathlib import Path
 from types import FrameType
+from typing import TYPE_CHECKING
 
 from .. import scheduling
+
+if TYPE_CHECKING:
+    from ..native.server import Server
 
 
 def default_address() -> str:
@@ -142,6 +146,26 @@ def _token(args: argparse.Namespace) -> tuple[str, str]:
     return transport.make_token(), ""
 
 
+def _take_scheduling(server: Server, rt_setting: int | str) -> tuple[scheduling.Scheduling, bool]:
+    """Give the serving thread what ``rt_setting`` asks for: real-time while the CPUs are busy
+    where permitted (:class:`scheduling.WhenBusy`), and in every case its client's CPU while
+    they are busy (:class:`scheduling.Beside`: a normal-priority controller beside its client
+    met the bar under load more often than one left where the kernel puts it).  Returns what
+    was taken and whether the controller was started real-time (``chrt``: then left as it
+    is); :class:`scheduling.RealtimeRefused` for a priority number the system refuses."""
+    normal = scheduling.snapshot()
+    started_rt = rt_setting == "auto" and scheduling.is_realtime()
+    if started_rt:
+        rt_setting = "off"
+    taken = scheduling.take(rt_setting)
+    if taken.priority is not None:
+        server.realtime = scheduling.WhenBusy(taken.priority, normal=normal[:2] if normal else None)
+        server.realtime.realtime = True  # until the first look at the load
+    if normal:
+        server.beside = scheduling.Beside(normal[2])
+    return taken, started_rt
+
+
 def _wall_floor(args: argparse.Namespace) -> bool:
     if args.no_wall_floor:
         return False
@@ -234,21 +258,12 @@ def run(args: argparse.Namespace) -> int:
     slice_us = args.slice_us if args.slice_us is not None else scheduling.slice_from_environment()
     # (the compiler it may start builds with the default slice, as it runs normally)
     slice_words = scheduling.short_slice(slice_us, reset_on_fork=True)
-    normal = scheduling.snapshot()
-    started_rt = rt_setting == "auto" and scheduling.is_realtime()
-    if started_rt:  # started real-time (chrt): left as it is
-        rt_setting = "off"
     try:
-        taken = scheduling.take(rt_setting)
+        taken, started_rt = _take_scheduling(server, rt_setting)
     except scheduling.RealtimeRefused as e:
         print(f"error: {e}", file=sys.stderr)
         server.stop()
         return 1
-    if taken.priority is not None:
-        server.realtime = scheduling.WhenBusy(taken.priority, normal=normal[:2] if normal else None)
-        server.realtime.realtime = True  # until the first look at the load
-        if normal:  # and on its client's CPU while real-time
-            server.beside = scheduling.Beside(normal[2])
 
     def stop(signum: int, frame: FrameType | None) -> None:
         server.stop()

@@ -31,10 +31,10 @@ Decisions:
   server then serves under SCHED_FIFO while other programs could hold every CPU
   (:data:`REALTIME_OVER_CPUS`; a normal process woken then may wait for another program's
   time slice) and under its
-  normal policy, with its spin, otherwise; it never spins while real-time.  While
-  real-time it also runs on the CPU of the client it served last (:attr:`Server.beside`,
-  the client's process from the Unix socket), so that other programs, not the client,
-  take the other CPUs.  A server inside
+  normal policy, with its spin, otherwise; it never spins while real-time.  While the
+  CPUs are that busy it also runs on the CPU of the client it served last, real-time or
+  not (:attr:`Server.beside`, the client's process from the Unix socket), so that other
+  programs, not the client, take the other CPUs.  A server inside
   another program (a test's) leaves the program's scheduling alone.
 * Every client is served independently: its bytes are buffered until a frame is whole and
   its replies until it reads them, so a client that sends half a frame, or stops reading,
@@ -469,7 +469,7 @@ class Server:
         #: SCHED_FIFO while the CPUs are busy (set by the controller process before it
         #: serves; never for a server inside another program, a test's)
         self.realtime: scheduling.WhenBusy | None = None
-        #: on the client's CPU while real-time (set with :attr:`realtime`)
+        #: on the client's CPU while the CPUs are busy (set by the controller process)
         self.beside: scheduling.Beside | None = None
         self._served_pid = 0  # the process of the client served last
         self.lock = threading.RLock()
@@ -680,15 +680,16 @@ class Server:
             self._busy_next = now + 0.01
             over = _runnable_over_cpus()
             self._busy = over > 0
+            crowded = over >= REALTIME_OVER_CPUS
             if self.realtime is not None:
-                rt = self.realtime.busy(over >= REALTIME_OVER_CPUS)
-                if self.beside is not None:
-                    pid = self._served_pid
-                    self.beside.look(
-                        rt and pid > 0,
-                        scheduling.thread_cpu() if rt and pid else None,
-                        scheduling.thread_cpu(pid) if rt and pid else None,
-                    )
+                self.realtime.busy(crowded)
+            if self.beside is not None:
+                pid = self._served_pid if crowded else 0
+                self.beside.look(
+                    pid > 0,
+                    scheduling.thread_cpu() if pid else None,
+                    scheduling.thread_cpu(pid) if pid else None,
+                )
         if not self.spin_s or self._busy:
             return 0.0
         if not self._budget:

@@ -212,6 +212,58 @@ def test_the_controller_follows_the_client_it_served_while_real_time(server, mon
     assert moves == [{0}, {0, 1}]
 
 
+def test_a_normal_priority_controller_follows_its_client_too(server, monkeypatch):
+    """Without real-time rights (no WhenBusy) the server still takes its client's CPU while
+    other programs could hold every CPU, and gives its CPUs back when they cannot."""
+    from gtecat.native import server as server_module
+
+    assert server.realtime is None
+    moves: list[set[int]] = []
+    server.beside = Beside({0, 1}, set_affinity=moves.append, after=1)
+    cpus = {"thread-self": 1, 4242: 0}
+    monkeypatch.setattr(scheduling, "thread_cpu", lambda pid="thread-self": cpus[pid])
+    load = {"over": 2}
+    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
+    server._served_pid = 4242
+
+    def look(over: int) -> None:
+        load["over"] = over
+        server._busy_next = 0.0
+        server._spin_budget()
+
+    look(1)  # busy, but the server and its client count two of those threads: left alone
+    assert moves == []
+    look(2)
+    assert moves == [{0}]
+    look(0)
+    assert moves == [{0}, {0, 1}]
+
+
+@pytest.mark.parametrize("permits", [True, False])
+def test_the_controller_command_puts_its_server_beside_the_client_real_time_or_not(
+    server, monkeypatch, permits
+):
+    from gtecat.cli import controller_cmd
+
+    system = FakeSystem(permits=permits)
+    monkeypatch.setattr(scheduling, "take", lambda setting: take(setting, set_fifo=system.fifo))
+    monkeypatch.setattr(scheduling, "snapshot", lambda: (0, 0, {0, 1}))
+    monkeypatch.setattr(scheduling, "is_realtime", lambda: False)
+    taken, started_rt = controller_cmd._take_scheduling(server, "auto")
+    assert not started_rt
+    assert taken.priority == (50 if permits else None)
+    assert (server.realtime is not None) == permits
+    assert isinstance(server.beside, Beside) and server.beside.cpus == {0, 1}
+
+
+def test_the_controller_command_moves_nothing_where_it_cannot_read_its_cpus(server, monkeypatch):
+    from gtecat.cli import controller_cmd
+
+    monkeypatch.setattr(scheduling, "snapshot", lambda: None)
+    controller_cmd._take_scheduling(server, "off")
+    assert server.realtime is None and server.beside is None
+
+
 def test_thread_cpu_reads_a_cpu_number():
     import os
 
