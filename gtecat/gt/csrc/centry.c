@@ -223,6 +223,10 @@ struct entry {
     /* 1: its values stand across the cycles booked in C (an attribute no cycle changes: a
      * profile's mode), see c_booked */
     ptrdiff_t steady;
+    /* the slots of acache: a lane per span (n, count, type, clock) a program reads in turn
+     * (GT_GetEncPos(1, a, 8) then GT_GetEncPos(9, byref(a, 64), 4)), each kept with where its
+     * bytes come from; 0 or 1: the last span's alone */
+    ptrdiff_t nacache;
 };
 
 static struct api A;
@@ -1056,10 +1060,29 @@ static int take_recipe(obj *items, struct recipe *rc)
     return 1;
 }
 
+/* The entry's slot for the span (an, ac, tp, clk): its lane, else the lane to keep it in (a
+ * free one, else the one asked least recently: the lowest epoch), NULL where none is kept. */
+static struct aslot *lane(const struct entry *e, long long an, long long ac, obj tp,
+                          long long clk)
+{
+    struct aslot *s = e->acache, *pick;
+    ptrdiff_t k, n = e->nacache > 1 ? e->nacache : 1;
+    if (!s)
+        return NULL;
+    pick = s;
+    for (k = 0; k < n; k++) {
+        if (s[k].value && s[k].n == an && s[k].count == ac && s[k].tp == tp && s[k].clock == clk)
+            return &s[k];
+        if (pick->value && (!s[k].value || s[k].epoch < pick->epoch))
+            pick = &s[k];
+    }
+    return pick;
+}
+
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
                        long long clk, int locked, int *ran)
 {
-    struct aslot *s = e->acache;
+    struct aslot *s = lane(e, an, ac, call[2], clk);
     struct recipe rc = {0};
     long long ep = -1, ep0 = -1;
     int holds = 0;

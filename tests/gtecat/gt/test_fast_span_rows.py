@@ -176,6 +176,7 @@ def _double_polls(
         clk = ctypes.c_ulong()
         pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
         vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
+        enc2 = (c_double * (count + 1))()
         rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
         one, two = c_double(), (c_double * 2)()
         seen: list = []
@@ -190,8 +191,11 @@ def _double_polls(
                 assert gt.GT_GetPrfVel(first, vel, count) == 0
                 assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
                 assert gt.GT_GetEncPos(first, enc, count) == 0
+                # (a second span of the same reader, read in turn: each kept in its lane)
+                assert gt.GT_GetEncPos(first + 1, byref(enc2, 8), count - 1) == 0
                 assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
                 seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
+                seen.append(bytes(enc2))
                 seen.append(apos.tobytes())
                 for name, arr in rows.items():
                     assert getattr(gt, name)(first, arr, count, clk) == 0
@@ -223,7 +227,7 @@ def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
         assert quick == general
         assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
         assert asked_general > cycles  # (every cycle: each span asked again)
-        assert asked < cycles / 2  # (ten spans: made again in C across the quick cycles)
+        assert asked < cycles / 2  # (eleven spans: made again in C across the quick cycles)
 
 
 def _mode_polls(general: bool) -> tuple[list, int, int]:
