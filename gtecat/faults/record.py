@@ -46,7 +46,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import accumulate, chain, compress, repeat
-from operator import contains, is_, itemgetter, not_
+from operator import contains, is_, is_not, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -645,7 +645,13 @@ def _open_text(
             raise ParameterError(
                 f"{p}: damaged recording: the compressed file cannot be read ({err})"
             ) from None
-    first, sep, body = raw.decode("utf-8", "replace").partition("\n")
+    # (the header's line and the rest decoded apart: the text of the calls made once, from
+    # the bytes as they lie, not from a decoded copy of the whole; a newline's byte is never
+    # inside another character's, so the text is the same)
+    end = raw.find(b"\n")
+    sep = end >= 0
+    first = str(memoryview(raw)[: end if sep else len(raw)], "utf-8", "replace")
+    body = str(memoryview(raw)[end + 1 :], "utf-8", "replace") if sep else ""
     try:
         head = json.loads(first or "{}")
     except (json.JSONDecodeError, RecursionError):
@@ -804,9 +810,11 @@ def replay(
                 raw = _read_raw(p)
                 where = _plan_file(raw)
             p, head, body = _open_text(p, raw)
+            raw = None  # (read: the bytes go before the text is made steps)
             keep: list[Any] | None = [] if where is not None else None
-            steps = _steps(p, body or "", keep)
+            text = [body or ""]
             del body
+            steps = _steps(p, text.pop(), keep)  # (the text held by _steps alone: let go once read)
             if keep and keep[0] is not None and where is not None:
                 _keep_plan(where, head, keep[0])
                 if seen is not None:
@@ -1581,6 +1589,7 @@ def _steps(
         keys = _KEY.findall(lines)
     else:
         keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
+    del lines  # (each line is its key now: the text goes where the caller let it go)
     made = dict.fromkeys(keys)
     made.pop("", None)  # the empty line after the last
     calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
@@ -1638,37 +1647,34 @@ def _plan_of(
     the entry (:data:`_ENTRY`), or the line of a call made whole (:data:`_WHOLE`), and per
     step its unit's number.  None when a step stops the replay (the text is read again, to
     report it as it does)."""
-    number = {}
+    number: dict[int, int] = {id(None): _ENTRY}  # (each call's unit kind, by its identity)
     forms = []
     for call, key, n in form_lines.values():
         number[id(call)] = len(forms) + _FORMS
         forms.append((key, n))
-    kinds = array("I")
-    values: list[Any] = []
-    unit: dict[str, int] = {}
-    for key, made_step in made.items():
-        if made_step is None:
-            continue
-        call, vals = made_step
-        if call is None:
-            kind = _ENTRY
-        elif call is _Stop:
-            return None
-        else:
-            kind = number.get(id(call), _WHOLE)
-            if kind == _WHOLE:
-                vals = key
-        unit[key] = len(values)
-        kinds.append(kind)
-        values.append(vals)
+    # (the work per unit done by the interpreter's own loops: a long recording has ~300,000)
+    made_steps = list(made.values())
+    present = list(map(is_not, made_steps, repeat(None)))
+    ukeys = list(compress(made, present))
+    usteps = list(compress(made_steps, present))
+    del made_steps, present
+    ucalls = list(map(itemgetter(0), usteps))
+    if any(map(is_, ucalls, repeat(_Stop))):
+        return None
+    kinds = array("I", map(number.get, map(id, ucalls), repeat(_WHOLE)))
+    values: list[Any] = list(map(itemgetter(1), usteps))
+    for i in compress(range(len(kinds)), map(_WHOLE.__eq__, kinds)):
+        values[i] = ukeys[i]  # (a call made whole: its line)
+    unit = dict(zip(ukeys, range(len(ukeys)), strict=True))
     order = array("I", map(unit.__getitem__, filter(unit.__contains__, keys)))
     # the steps :func:`_check_files` looks at (opens, bring-ups): found here once
-    asked = {
-        unit[key]
-        for key, made_step in made.items()
-        if made_step is not None and _asked(made_step[0])
-    }
-    marks = [i for i, u in enumerate(order) if u in asked] if asked else []
+    distinct = dict(zip(map(id, ucalls), ucalls, strict=True))
+    asked_ids = {i for i, c in distinct.items() if _asked(c)}
+    asked = list(compress(range(len(ucalls)), map(asked_ids.__contains__, map(id, ucalls))))
+    marks = []
+    if asked:
+        at = np.isin(np.frombuffer(order, np.uintc), np.array(asked, np.uintc))
+        marks = np.flatnonzero(at).tolist()
     return (_PLAN, forms, kinds.tobytes(), values, order.tobytes(), marks)
 
 
