@@ -226,6 +226,7 @@ class _RawEntry(ctypes.Structure):
         ("after", _VP),
         ("cache", ctypes.POINTER(_ASlot)),
         ("changed", _VP),
+        ("ncache", ctypes.c_ssize_t),
     ]
 
 
@@ -1016,9 +1017,10 @@ def _load() -> tuple[Maker | None, str]:
         e.changed = id(changed) if write and changed is not None else None
         slot = None
         # (a writer whose value makes the epoch grow itself: nothing kept)
-        if cache and (not write or changed is not None):
-            slot = _ASlot()
-            e.cache = ctypes.pointer(slot)
+        if cache and (not write or changed is not None):  # (a lane per range read in turn)
+            slot = (_ASlot * SPAN_LANES)()
+            e.cache = ctypes.cast(slot, ctypes.POINTER(_ASlot))
+            e.ncache = SPAN_LANES
         keep = (fallback, value, sentinel, after, slot, changed)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)

@@ -1060,15 +1060,18 @@ static int take_recipe(obj *items, struct recipe *rc)
     return 1;
 }
 
-/* The entry's slot for the span (an, ac, tp, clk): its lane, else the lane to keep it in (a
- * free one, else the one asked least recently: the lowest epoch), NULL where none is kept. */
-static struct aslot *lane(const struct entry *e, long long an, long long ac, obj tp,
+/* The slot among the lanes s (n of them) for the span (an, ac, tp, clk): its lane, else the
+ * lane to keep it in (a free one, else the one asked least recently: the lowest epoch), NULL
+ * where none is kept. */
+static struct aslot *lane(struct aslot *s, ptrdiff_t n, long long an, long long ac, obj tp,
                           long long clk)
 {
-    struct aslot *s = e->acache, *pick;
-    ptrdiff_t k, n = e->nacache > 1 ? e->nacache : 1;
+    struct aslot *pick;
+    ptrdiff_t k;
     if (!s)
         return NULL;
+    if (n < 1)
+        n = 1;
     pick = s;
     for (k = 0; k < n; k++) {
         if (s[k].value && s[k].n == an && s[k].count == ac && s[k].tp == tp && s[k].clock == clk)
@@ -1082,7 +1085,7 @@ static struct aslot *lane(const struct entry *e, long long an, long long ac, obj
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
                        long long clk, int locked, int *ran)
 {
-    struct aslot *s = lane(e, an, ac, call[2], clk);
+    struct aslot *s = lane(e->acache, e->nacache, an, ac, call[2], clk);
     struct recipe rc = {0};
     long long ep = -1, ep0 = -1;
     int holds = 0;
@@ -1534,6 +1537,8 @@ struct raw_entry {
      * the readers' values, its runs and the armed quick cycle); NULL: the value function
      * makes the epoch grow at every write (nothing kept) */
     obj changed;
+    /* the slots of cache: a lane per range a program reads in turn (0 or 1: the last's) */
+    ptrdiff_t ncache;
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -1675,8 +1680,15 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             if (A.err_occurred())
                 A.err_clear();
             s = NULL;
-        } else if ((ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == off &&
-                   s->count == size && s->clock == slave && s->tp == TYPE(target)) {
+        } else if ((s = lane(e->cache, e->ncache, off, size, TYPE(target), slave)) != NULL &&
+                   (ep = epoch()) >= 0 && s->value && s->n == off && s->count == size &&
+                   s->clock == slave && s->tp == TYPE(target) &&
+                   (s->epoch == ep ||
+                    (ep > s->epoch && ep - s->epoch == c_booked - s->booked))) {
+            /* (the runs of the epoch they were asked in, and across cycles booked in C: those
+             * move the image's bytes, never its buffer, nor take a slave off the bus) */
+            s->epoch = ep;
+            s->booked = c_booked;
             v = s->value;
             A.incref(v);
             goto have;
@@ -1694,11 +1706,17 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
         return NULL; /* (the value's own error, as the Python path would raise it) */
     }
     if (v == e->sentinel || TYPE(v) != A.bytes_type) {
-        if (s && s->value) { /* (the slot empties: its runs may be of another image) */
-            obj old = s->value, oldtp = s->tp;
-            s->value = NULL, s->tp = NULL;
-            A.decref(old);
-            A.decref(oldtp);
+        if (s) { /* (the lanes empty: their runs may be of another image) */
+            ptrdiff_t j;
+            for (j = 0; j < (e->ncache > 1 ? e->ncache : 1); j++) {
+                struct aslot *x = &e->cache[j];
+                obj old = x->value, oldtp = x->tp;
+                if (!old)
+                    continue;
+                x->value = NULL, x->tp = NULL;
+                A.decref(old);
+                A.decref(oldtp);
+            }
         }
         goto drop;
     }
@@ -1710,8 +1728,10 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             A.release_buffer(&view);
         return AGAIN;
     }
-    if (s && ep >= 0)
+    if (s && ep >= 0) {
         keep_span(s, ep, v, TYPE(target), off, size, slave);
+        s->booked = c_booked;
+    }
 have:
     /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
     n = *(ptrdiff_t *)((char *)v + A.bsize);

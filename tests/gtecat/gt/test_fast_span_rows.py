@@ -271,3 +271,43 @@ def test_profile_modes_stand_across_cycles_booked_in_c() -> None:
     assert len({x[:3] for x in quick}) >= 2  # (axis 2 in Trap and in Jog)
     assert asked_general > cycles  # (every cycle: both asked again)
     assert asked < cycles / 10
+
+
+def _raw_polls(general: bool) -> tuple[list, int, int]:
+    """Both axes moving in Trap on the auto clock, the whole raw image and one slave's
+    inputs read every call (``GT_GetEcatRawData``: into a ctypes array and a bytearray);
+    ``general``: a watch hook that does nothing, so every cycle goes the general way.  What
+    was read, the cycles run, and how often the raw reader's value function was asked."""
+    import cProfile
+    import pstats
+
+    with _auto(general) as ctl:
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        whole, inputs = (ctypes.c_ubyte * 40)(), bytearray(10)
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(3):
+            trap_move(1, 400 * (rnd + 1) * (-1) ** rnd, 12.0)
+            trap_move(2, -300 * (rnd + 1), 9.0)
+            pr.enable()
+            for _ in range(2500):  # (the moves end inside a round)
+                assert gt.GT_GetEcatRawData(0, 40, whole) == 0
+                assert gt.GT_GetEcatRawData(22, 10, inputs) == 0
+                seen.append((bytes(whole), bytes(inputs)))
+            pr.disable()
+        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        asked = sum(v[1] for (file, _, _), v in stats if file.startswith("<gt raw value "))
+        return seen, ctl.clock.cycles - t0, asked
+
+
+def test_raw_ranges_stand_across_cycles_booked_in_c() -> None:
+    """Where a raw range lies in the process image is not asked again after each cycle the
+    entries book themselves (the cycle moves the image's bytes, never its buffer): every
+    read copies what it copies with every cycle the general way, while the axes move."""
+    quick, cycles, asked = _raw_polls(False)
+    general, _, asked_general = _raw_polls(True)
+    assert quick == general
+    assert len(set(quick)) > cycles / 2  # (positions that move cycle by cycle)
+    assert asked_general > cycles  # (every cycle: both ranges asked again)
+    assert asked < cycles / 10
