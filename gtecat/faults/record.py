@@ -1497,6 +1497,19 @@ def _steps(
     # references: half the bytes to read, check and load)
     same_bytes: dict[bytes, bytes] = {}
     shared = same_bytes.setdefault
+    # an array's values packed once per kind (the lines' equal arrays are one list:
+    # :func:`_split`): id -> (the values, kept so the id stays theirs, the kind, the bytes)
+    packs: dict[int, tuple[Any, Any, bytes | None]] = {}
+
+    def pack(kind: tuple[Any, ...], v: Any) -> bytes | None:
+        hit = packs.get(id(v))
+        if hit is not None and hit[0] is v and hit[1] == kind:
+            return hit[2]
+        b = _pack(kind, v)
+        if b is not None:
+            b = shared(b, b)
+        packs[id(v)] = (v, kind, b)
+        return b
 
     def parse(key: str) -> Any:
         try:
@@ -1567,10 +1580,10 @@ def _steps(
                 vals = list(vals)
                 for k, kind in form.packs:  # an array's numbers: its bytes
                     v = vals[k]
-                    b = _pack(kind, v) if type(v) is list or type(v) is str else None
+                    b = pack(kind, v) if type(v) is list or type(v) is str else None
                     if b is None:  # (a length or number the array cannot hold)
                         break
-                    vals[k] = shared(b, b)
+                    vals[k] = b
                 else:
                     return form, tuple(vals)
         e = parse(key)
@@ -1775,18 +1788,21 @@ def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] |
         return None
     parts = _VALUE.split(text)  # the text between the values, each value's own text
     lits = parts[1::2]
+    # each distinct text read once, equal texts one value (a polling loop's array before a
+    # call is the text the call before left in it: about half a recording's arrays)
+    distinct = list(dict.fromkeys(lits))
     try:
-        values = json.loads("[" + ",".join(lits) + "]")
+        read = json.loads("[" + ",".join(distinct) + "]")
     except ValueError:
         return None
-    if len(values) != len(lits):
+    if len(read) != len(distinct):
         return None
-    values = tuple(values)
-    kinds = set(map(type, values))
+    values = tuple(map(dict(zip(distinct, read, strict=True)).__getitem__, lits))
+    kinds = set(map(type, read))
     if not kinds <= _VALUE_TYPES:
         return None
     if list in kinds:  # arrays: of numbers only
-        arrays = [v for v in values if type(v) is list]
+        arrays = [v for v in read if type(v) is list]
         if not set(map(type, chain.from_iterable(arrays))) <= _NUMBER_TYPES:
             return None
     # the keys: each value replaced by a mark of its kind (an array's \x02\x01, a byte
