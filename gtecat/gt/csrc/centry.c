@@ -205,7 +205,7 @@ struct entry {
     obj ctypes_[MAX_TYPES];
     ptrdiff_t csizes[MAX_TYPES];
     ptrdiff_t csigns[MAX_TYPES];
-    struct aslot *acache; /* the last span's bytes (NULL: none kept) */
+    struct aslot *acache; /* the spans' bytes, a lane each (nacache; NULL: none kept) */
     /* the numpy dtypes (their descr objects) whose one-dimensional arrays take the value in
      * their first element, NULL-ended, with their sizes and signs */
     obj nptypes[8];
@@ -1527,10 +1527,11 @@ struct raw_entry {
     ptrdiff_t write; /* 1: from the buffer into the image */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
-    /* the last runs kept for their epoch (n: the offset, count: the size, clock: the
-     * slave or -1), NULL: none kept.  The runs address the process image's buffer, which the
-     * value function keeps alive while they are its last (and the image is replaced only by
-     * the calls that make the epoch grow); a sentinel empties the slot. */
+    /* the runs kept for their epoch, a lane per range (ncache of them; n: the offset,
+     * count: the size, clock: the slave or -1), and across the cycles booked in C; NULL: none
+     * kept.  The runs address the process image's buffer, which the value function keeps
+     * alive while it is its image (and the image is replaced only by the calls that make the
+     * epoch grow, so a lane of another image is never used); a sentinel empties the lanes. */
     struct aslot *cache;
     /* a writer's changed(): called where the write changed a byte of the image (the epoch
      * grows then, not in its value function, so a write of the bytes the image holds keeps
