@@ -46,7 +46,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import accumulate, chain, compress, repeat
-from operator import contains, is_, itemgetter, not_
+from operator import contains, is_, is_not, itemgetter, not_
 from pathlib import Path
 from typing import Any
 
@@ -645,7 +645,13 @@ def _open_text(
             raise ParameterError(
                 f"{p}: damaged recording: the compressed file cannot be read ({err})"
             ) from None
-    first, sep, body = raw.decode("utf-8", "replace").partition("\n")
+    # (the header's line and the rest decoded apart: the text of the calls made once, from
+    # the bytes as they lie, not from a decoded copy of the whole; a newline's byte is never
+    # inside another character's, so the text is the same)
+    end = raw.find(b"\n")
+    sep = end >= 0
+    first = str(memoryview(raw)[: end if sep else len(raw)], "utf-8", "replace")
+    body = str(memoryview(raw)[end + 1 :], "utf-8", "replace") if sep else ""
     try:
         head = json.loads(first or "{}")
     except (json.JSONDecodeError, RecursionError):
@@ -804,9 +810,11 @@ def replay(
                 raw = _read_raw(p)
                 where = _plan_file(raw)
             p, head, body = _open_text(p, raw)
+            raw = None  # (read: the bytes go before the text is made steps)
             keep: list[Any] | None = [] if where is not None else None
-            steps = _steps(p, body or "", keep)
+            text = [body or ""]
             del body
+            steps = _steps(p, text.pop(), keep)  # (the text held by _steps alone: let go once read)
             if keep and keep[0] is not None and where is not None:
                 _keep_plan(where, head, keep[0])
                 if seen is not None:
@@ -841,8 +849,16 @@ def _from_here(name: str | None) -> str | None:
     return name
 
 
-#: what a plan's file starts with, before the SHA-256 of the rest
-_PLAN_MAGIC = b"gtecat replay plan\n"
+#: what a plan's file starts with, before its length and check (:data:`_PLAN_CHECK`)
+_PLAN_MAGIC = b"gtecat replay plan 2\n"
+#: a plan's length and CRC-32 (little-endian) after its magic.  The check guards against a
+#: damaged file (a disk's or another program's fault: a plan is written under another name
+#: and renamed, so a replay never reads one half written); it is no seal - whoever can write
+#: the cache folder can write a matching digest of any kind beside a plan - so a
+#: cryptographic digest (SHA-256, as before) bought nothing over a CRC, which detects every
+#: burst of up to 32 bits and all but 2**-32 of other damage, at twice its speed (a 1 ms
+#: 12-axis minute's plan: 27 MB)
+_PLAN_CHECK = struct.Struct("<QI")
 #: the plans kept at most, and their bytes at most (the least recently used go first; the
 #: newest stays whatever its size)
 PLANS_KEPT = 64
@@ -960,13 +976,15 @@ def _load_plan(where: Path) -> tuple[dict[str, Any], Any] | None:
 
 def _plan_from_bytes(data: bytes) -> tuple[dict[str, Any], Any] | None:
     """(header, plan) of a plan's file, None when it is damaged."""
-    start = len(_PLAN_MAGIC) + 32
+    start = len(_PLAN_MAGIC) + _PLAN_CHECK.size
     if not data.startswith(_PLAN_MAGIC) or len(data) < start:
         return None
-    if hashlib.sha256(memoryview(data)[start:]).digest() != data[len(_PLAN_MAGIC) : start]:
+    size, crc = _PLAN_CHECK.unpack_from(data, len(_PLAN_MAGIC))
+    payload = memoryview(data)[start:]
+    if size != len(payload) or zlib.crc32(payload) != crc:
         return None
     try:
-        kept = marshal.loads(memoryview(data)[start:])
+        kept = marshal.loads(payload)
     except (EOFError, ValueError, TypeError):
         return None
     if type(kept) is not tuple or len(kept) != 2 or type(kept[0]) is not dict:
@@ -985,7 +1003,8 @@ def _keep_plan(where: Path, head: dict[str, Any], plan: Any) -> None:
     try:
         where.parent.mkdir(parents=True, exist_ok=True)
         tmp = where.with_name(f"{where.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(_PLAN_MAGIC + hashlib.sha256(payload).digest() + payload)
+        check = _PLAN_CHECK.pack(len(payload), zlib.crc32(payload))
+        tmp.write_bytes(_PLAN_MAGIC + check + payload)
         os.replace(tmp, where)
         plans = []
         for f in where.parent.glob("*.plan"):
@@ -1472,6 +1491,25 @@ def _steps(
     pool: dict[tuple[str, int, str], tuple[Any, Any]] = {}
     forms: dict[str, Any] = {}  # a line without its time and values -> its call (or None)
     number = _NUMBER.match
+    # an array's bytes, one object for equal ones: what a call left in an array is what the
+    # next call of its form finds there (a polling loop), so half of a recording's arrays are
+    # equal to another; shared, the plan holds each once (marshal writes the others as
+    # references: half the bytes to read, check and load)
+    same_bytes: dict[bytes, bytes] = {}
+    shared = same_bytes.setdefault
+    # an array's values packed once per kind (the lines' equal arrays are one list:
+    # :func:`_split`): id -> (the values, kept so the id stays theirs, the kind, the bytes)
+    packs: dict[int, tuple[Any, Any, bytes | None]] = {}
+
+    def pack(kind: tuple[Any, ...], v: Any) -> bytes | None:
+        hit = packs.get(id(v))
+        if hit is not None and hit[0] is v and hit[1] == kind:
+            return hit[2]
+        b = _pack(kind, v)
+        if b is not None:
+            b = shared(b, b)
+        packs[id(v)] = (v, kind, b)
+        return b
 
     def parse(key: str) -> Any:
         try:
@@ -1542,9 +1580,10 @@ def _steps(
                 vals = list(vals)
                 for k, kind in form.packs:  # an array's numbers: its bytes
                     v = vals[k]
-                    b = vals[k] = _pack(kind, v) if type(v) is list or type(v) is str else None
+                    b = pack(kind, v) if type(v) is list or type(v) is str else None
                     if b is None:  # (a length or number the array cannot hold)
                         break
+                    vals[k] = b
                 else:
                     return form, tuple(vals)
         e = parse(key)
@@ -1563,6 +1602,7 @@ def _steps(
         keys = _KEY.findall(lines)
     else:
         keys = [x[x.find(",", 5) :] if x.startswith('{"t":') else x for x in lines]
+    del lines  # (each line is its key now: the text goes where the caller let it go)
     made = dict.fromkeys(keys)
     made.pop("", None)  # the empty line after the last
     calls = [key for key in made if key[:5] == ',"c":']  # as Recorder writes a call
@@ -1620,37 +1660,34 @@ def _plan_of(
     the entry (:data:`_ENTRY`), or the line of a call made whole (:data:`_WHOLE`), and per
     step its unit's number.  None when a step stops the replay (the text is read again, to
     report it as it does)."""
-    number = {}
+    number: dict[int, int] = {id(None): _ENTRY}  # (each call's unit kind, by its identity)
     forms = []
     for call, key, n in form_lines.values():
         number[id(call)] = len(forms) + _FORMS
         forms.append((key, n))
-    kinds = array("I")
-    values: list[Any] = []
-    unit: dict[str, int] = {}
-    for key, made_step in made.items():
-        if made_step is None:
-            continue
-        call, vals = made_step
-        if call is None:
-            kind = _ENTRY
-        elif call is _Stop:
-            return None
-        else:
-            kind = number.get(id(call), _WHOLE)
-            if kind == _WHOLE:
-                vals = key
-        unit[key] = len(values)
-        kinds.append(kind)
-        values.append(vals)
+    # (the work per unit done by the interpreter's own loops: a long recording has ~300,000)
+    made_steps = list(made.values())
+    present = list(map(is_not, made_steps, repeat(None)))
+    ukeys = list(compress(made, present))
+    usteps = list(compress(made_steps, present))
+    del made_steps, present
+    ucalls = list(map(itemgetter(0), usteps))
+    if any(map(is_, ucalls, repeat(_Stop))):
+        return None
+    kinds = array("I", map(number.get, map(id, ucalls), repeat(_WHOLE)))
+    values: list[Any] = list(map(itemgetter(1), usteps))
+    for i in compress(range(len(kinds)), map(_WHOLE.__eq__, kinds)):
+        values[i] = ukeys[i]  # (a call made whole: its line)
+    unit = dict(zip(ukeys, range(len(ukeys)), strict=True))
     order = array("I", map(unit.__getitem__, filter(unit.__contains__, keys)))
     # the steps :func:`_check_files` looks at (opens, bring-ups): found here once
-    asked = {
-        unit[key]
-        for key, made_step in made.items()
-        if made_step is not None and _asked(made_step[0])
-    }
-    marks = [i for i, u in enumerate(order) if u in asked] if asked else []
+    distinct = dict(zip(map(id, ucalls), ucalls, strict=True))
+    asked_ids = {i for i, c in distinct.items() if _asked(c)}
+    asked = list(compress(range(len(ucalls)), map(asked_ids.__contains__, map(id, ucalls))))
+    marks = []
+    if asked:
+        at = np.isin(np.frombuffer(order, np.uintc), np.array(asked, np.uintc))
+        marks = np.flatnonzero(at).tolist()
     return (_PLAN, forms, kinds.tobytes(), values, order.tobytes(), marks)
 
 
@@ -1751,18 +1788,21 @@ def _split(calls: list[str]) -> tuple[list[str | None], list[tuple[Any, ...]]] |
         return None
     parts = _VALUE.split(text)  # the text between the values, each value's own text
     lits = parts[1::2]
+    # each distinct text read once, equal texts one value (a polling loop's array before a
+    # call is the text the call before left in it: about half a recording's arrays)
+    distinct = list(dict.fromkeys(lits))
     try:
-        values = json.loads("[" + ",".join(lits) + "]")
+        read = json.loads("[" + ",".join(distinct) + "]")
     except ValueError:
         return None
-    if len(values) != len(lits):
+    if len(read) != len(distinct):
         return None
-    values = tuple(values)
-    kinds = set(map(type, values))
+    values = tuple(map(dict(zip(distinct, read, strict=True)).__getitem__, lits))
+    kinds = set(map(type, read))
     if not kinds <= _VALUE_TYPES:
         return None
     if list in kinds:  # arrays: of numbers only
-        arrays = [v for v in values if type(v) is list]
+        arrays = [v for v in read if type(v) is list]
         if not set(map(type, chain.from_iterable(arrays))) <= _NUMBER_TYPES:
             return None
     # the keys: each value replaced by a mark of its kind (an array's \x02\x01, a byte

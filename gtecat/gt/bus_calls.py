@@ -160,19 +160,24 @@ def GT_Open(
     ctl = Controller(opts)
     SESSION.controllers[1] = ctl
     SESSION.time.join(ctl.clock)
-    from ..inspect.endpoint import publish  # gtecat ps / the bus verbs / gtecat panel see it
+    from ..inspect import enabled
 
-    publish(ctl)
+    if enabled():  # (off: nothing published, the endpoint's module not even loaded)
+        from ..inspect.endpoint import publish  # gtecat ps / the bus verbs / gtecat panel see it
+
+        publish(ctl)
     return 0
 
 
 @gt_function
 def GT_Close() -> int:
     """Close the current card (every core of it); the other cards keep running."""
-    from ..inspect.endpoint import unpublish
+    import sys
 
+    endpoints = sys.modules.get("gtecat.inspect.endpoint")  # (not loaded: none published)
     for ctl in SESSION.close_card():
-        unpublish(ctl)
+        if endpoints is not None:
+            endpoints.unpublish(ctl)
         ctl.close()
     return 0
 

@@ -213,6 +213,7 @@ class _Entry(ctypes.Structure):
         ("titems", ctypes.c_ssize_t),
         ("cderefs", ctypes.c_ssize_t * _MAX_TYPES),
         ("steady", ctypes.c_ssize_t),
+        ("nacache", ctypes.c_ssize_t),
     ]
 
 
@@ -229,6 +230,7 @@ class _RawEntry(ctypes.Structure):
         ("after", _VP),
         ("cache", ctypes.POINTER(_ASlot)),
         ("changed", _VP),
+        ("ncache", ctypes.c_ssize_t),
     ]
 
 
@@ -543,6 +545,9 @@ def _epoch_at() -> int:
 
 #: the axes (or other first arguments) below this have a value kept per entry
 CACHED = 257
+#: the spans of an array reader kept at once, each with where its bytes come from (a
+#: program that reads two spans in turn finds both after the cycles booked in C)
+SPAN_LANES = 4
 
 
 #: what an entry writes: integers (of each type's width and sign), doubles, or the bytes of
@@ -1037,9 +1042,10 @@ def _load() -> tuple[Maker | None, str]:
         slots = aslot = None
         if cache:  # (the memory the C function keeps values in, kept alive with it)
             slots = _slots(e)
-            if array is not None:
-                aslot = _ASlot()
-                e.acache = ctypes.pointer(aslot)
+            if array is not None:  # (a lane per span a program reads in turn)
+                aslot = (_ASlot * SPAN_LANES)()
+                e.acache = ctypes.cast(aslot, ctypes.POINTER(_ASlot))
+                e.nacache = SPAN_LANES
         keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
@@ -1060,9 +1066,10 @@ def _load() -> tuple[Maker | None, str]:
         e.changed = id(changed) if write and changed is not None else None
         slot = None
         # (a writer whose value makes the epoch grow itself: nothing kept)
-        if cache and (not write or changed is not None):
-            slot = _ASlot()
-            e.cache = ctypes.pointer(slot)
+        if cache and (not write or changed is not None):  # (a lane per range read in turn)
+            slot = (_ASlot * SPAN_LANES)()
+            e.cache = ctypes.cast(slot, ctypes.POINTER(_ASlot))
+            e.ncache = SPAN_LANES
         keep = (fallback, value, sentinel, after, slot, changed)
         fn = new(b"gt_centry_raw", raw_meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, raw_vc, e, keep)
@@ -1483,7 +1490,7 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
         ((1, p, 1, c16), [], None),
         ((1, p, 1, c32), [], (101, [0, 0, 0], 0, (1 << 31) - 1)),  # (the largest it holds)
         ((1, p, 1, c32), [], None),  # (one more: a clock an int32 does not hold)
-        ((1, a, 2, c32), [(1, 2, None)], None),  # (the values kept: their epoch's)
+        ((1, a, 2, c32), [], None),  # (the span (1, 2) kept in its lane beside (1, 3))
         ((1, a, 2, c), [], (0, [1, 2, 0], 1 << 31, 0)),
         ((1, p, 1, c), [], (101, [0, 0, 0], (1 << 32) - 1, 0)),  # (before GT_Reset's: -1)
         ((3, a, 2), [(3, 2, None)], (0, [4, 5, 0], 0, 0)),  # (a 1-tuple's bytes)

@@ -6,3 +6,12 @@ publishes an endpoint (:mod:`.endpoint`) in a per-user runtime folder (:mod:`.ru
 shows one in a browser (:mod:`.panel`).  The endpoint reads what the master and the
 controller already hold; it keeps no model of the machine of its own.
 """
+
+import os as _os
+
+
+def enabled() -> bool:
+    """Whether this process publishes its endpoints (``GTECAT_INSPECT``, on unless 0, no,
+    off or false): asked before the endpoint's module is loaded, which a process that
+    publishes nothing (a replay) never needs."""
+    return _os.environ.get("GTECAT_INSPECT", "1").strip().lower() not in ("0", "no", "off", "false")

@@ -63,7 +63,7 @@ from pathlib import Path
 from typing import Any
 
 from ..controller.epoch import changed as readers_changed
-from . import runtime
+from . import enabled, runtime
 
 log = logging.getLogger(__name__)
 
@@ -501,10 +501,6 @@ _PUBLISHED: dict[int, Endpoint] = {}  # id(controller) -> its endpoint
 #: what this process is (``gtecat controller`` says "controller") and the lock its changes take
 KIND = "python"
 LOCK: Any = None
-
-
-def enabled() -> bool:
-    return os.environ.get("GTECAT_INSPECT", "1").strip().lower() not in ("0", "no", "off", "false")
 
 
 def publish(ctl: Any) -> Endpoint | None:

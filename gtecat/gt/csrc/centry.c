@@ -205,7 +205,7 @@ struct entry {
     obj ctypes_[MAX_TYPES];
     ptrdiff_t csizes[MAX_TYPES];
     ptrdiff_t csigns[MAX_TYPES];
-    struct aslot *acache; /* the last span's bytes (NULL: none kept) */
+    struct aslot *acache; /* the spans' bytes, a lane each (nacache; NULL: none kept) */
     /* the numpy dtypes (their descr objects) whose one-dimensional arrays take the value in
      * their first element, NULL-ended, with their sizes and signs */
     obj nptypes[8];
@@ -223,6 +223,10 @@ struct entry {
     /* 1: its values stand across the cycles booked in C (an attribute no cycle changes: a
      * profile's mode), see c_booked */
     ptrdiff_t steady;
+    /* the slots of acache: a lane per span (n, count, type, clock) a program reads in turn
+     * (GT_GetEncPos(1, a, 8) then GT_GetEncPos(9, byref(a, 64), 4)), each kept with where its
+     * bytes come from; 0 or 1: the last span's alone */
+    ptrdiff_t nacache;
 };
 
 static struct api A;
@@ -1222,10 +1226,32 @@ static int take_recipe(obj *items, struct recipe *rc)
     return 1;
 }
 
+/* The slot among the lanes s (n of them) for the span (an, ac, tp, clk): its lane, else the
+ * lane to keep it in (a free one, else the one asked least recently: the lowest epoch), NULL
+ * where none is kept. */
+static struct aslot *lane(struct aslot *s, ptrdiff_t n, long long an, long long ac, obj tp,
+                          long long clk)
+{
+    struct aslot *pick;
+    ptrdiff_t k;
+    if (!s)
+        return NULL;
+    if (n < 1)
+        n = 1;
+    pick = s;
+    for (k = 0; k < n; k++) {
+        if (s[k].value && s[k].n == an && s[k].count == ac && s[k].tp == tp && s[k].clock == clk)
+            return &s[k];
+        if (pick->value && (!s[k].value || s[k].epoch < pick->epoch))
+            pick = &s[k];
+    }
+    return pick;
+}
+
 static obj array_value(const struct entry *e, obj *call, long long an, long long ac,
                        long long clk, int locked, int *ran)
 {
-    struct aslot *s = e->acache;
+    struct aslot *s = lane(e->acache, e->nacache, an, ac, call[2], clk);
     struct recipe rc = {0};
     long long ep = -1, ep0 = -1;
     int holds = 0;
@@ -1667,16 +1693,19 @@ struct raw_entry {
     ptrdiff_t write; /* 1: from the buffer into the image */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
-    /* the last runs kept for their epoch (n: the offset, count: the size, clock: the
-     * slave or -1), NULL: none kept.  The runs address the process image's buffer, which the
-     * value function keeps alive while they are its last (and the image is replaced only by
-     * the calls that make the epoch grow); a sentinel empties the slot. */
+    /* the runs kept for their epoch, a lane per range (ncache of them; n: the offset,
+     * count: the size, clock: the slave or -1), and across the cycles booked in C; NULL: none
+     * kept.  The runs address the process image's buffer, which the value function keeps
+     * alive while it is its image (and the image is replaced only by the calls that make the
+     * epoch grow, so a lane of another image is never used); a sentinel empties the lanes. */
     struct aslot *cache;
     /* a writer's changed(): called where the write changed a byte of the image (the epoch
      * grows then, not in its value function, so a write of the bytes the image holds keeps
      * the readers' values, its runs and the armed quick cycle); NULL: the value function
      * makes the epoch grow at every write (nothing kept) */
     obj changed;
+    /* the slots of cache: a lane per range a program reads in turn (0 or 1: the last's) */
+    ptrdiff_t ncache;
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -1818,8 +1847,15 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             if (A.err_occurred())
                 A.err_clear();
             s = NULL;
-        } else if ((ep = epoch()) >= 0 && s->value && s->epoch == ep && s->n == off &&
-                   s->count == size && s->clock == slave && s->tp == TYPE(target)) {
+        } else if ((s = lane(e->cache, e->ncache, off, size, TYPE(target), slave)) != NULL &&
+                   (ep = epoch()) >= 0 && s->value && s->n == off && s->count == size &&
+                   s->clock == slave && s->tp == TYPE(target) &&
+                   (s->epoch == ep ||
+                    (ep > s->epoch && ep - s->epoch == c_booked - s->booked))) {
+            /* (the runs of the epoch they were asked in, and across cycles booked in C: those
+             * move the image's bytes, never its buffer, nor take a slave off the bus) */
+            s->epoch = ep;
+            s->booked = c_booked;
             v = s->value;
             A.incref(v);
             goto have;
@@ -1837,11 +1873,17 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
         return NULL; /* (the value's own error, as the Python path would raise it) */
     }
     if (v == e->sentinel || TYPE(v) != A.bytes_type) {
-        if (s && s->value) { /* (the slot empties: its runs may be of another image) */
-            obj old = s->value, oldtp = s->tp;
-            s->value = NULL, s->tp = NULL;
-            A.decref(old);
-            A.decref(oldtp);
+        if (s) { /* (the lanes empty: their runs may be of another image) */
+            ptrdiff_t j;
+            for (j = 0; j < (e->ncache > 1 ? e->ncache : 1); j++) {
+                struct aslot *x = &e->cache[j];
+                obj old = x->value, oldtp = x->tp;
+                if (!old)
+                    continue;
+                x->value = NULL, x->tp = NULL;
+                A.decref(old);
+                A.decref(oldtp);
+            }
         }
         goto drop;
     }
@@ -1853,8 +1895,10 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             A.release_buffer(&view);
         return AGAIN;
     }
-    if (s && ep >= 0)
+    if (s && ep >= 0) {
         keep_span(s, ep, v, TYPE(target), off, size, slave);
+        s->booked = c_booked;
+    }
 have:
     /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
     n = *(ptrdiff_t *)((char *)v + A.bsize);

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import gc
 import json
+import marshal
 import os
 from pathlib import Path
 
@@ -206,3 +207,31 @@ def test_a_settled_file_finds_its_plan_by_name_and_times(
     os.utime(copy, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
     div = rec.replay(copy)[1]
     assert div is not None and div.call == "GT_GetSts" and "argument 2" in div.what
+
+
+def test_equal_arrays_are_one_object_in_the_steps_and_the_plan() -> None:
+    """A polling loop's array before a call holds what the call before left in it: equal
+    arrays are one bytes object in the steps and in the plan (marshal keeps it once), and the
+    plan makes the same steps."""
+    line = (
+        '{{"t":{t},"c":"GT_GetEncPos","a":[1,{{"arr":"c_double","n":2,"v":[{a}]}},2,null],'
+        '"r":0,"o":{{"1":{{"arr":"c_double","n":2,"v":[{b}]}}}}}}'
+    )
+    vals = ["0.0,0.0", "1.5,2.0", "3.0,-4.25", "3.0,-4.25"]
+    text = "\n".join(
+        line.format(t=k * 1_000_000, a=vals[k], b=vals[k + 1]) for k in range(len(vals) - 1)
+    )
+    keep: list = []
+    gc.disable()
+    try:
+        steps = rec._steps(Path("x"), text + "\n", keep)
+    finally:
+        gc.enable()
+    (p0, v0), (p1, v1), (p2, v2) = steps
+    assert p0 is p1 is p2  # (one form)
+    assert v0[1] is v1[0] and v1[1] is v2[0] is v2[1]  # (what a call left: the next one's)
+    assert len({id(b) for v in (v0, v1, v2) for b in v}) == 3
+    plan = marshal.loads(marshal.dumps(keep[0]))
+    again = rec._steps(Path("x"), "", plan=plan)
+    assert [v for _, v in again] == [v0, v1, v2]
+    assert again[0][1][1] is again[1][1][0]  # (kept once in the plan, one object loaded)

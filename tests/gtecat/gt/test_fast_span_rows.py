@@ -176,6 +176,7 @@ def _double_polls(
         clk = ctypes.c_ulong()
         pos, acc = np.zeros(count + 1), (c_double * (count + 1))()
         vel, enc, apos = (c_double * count)(), (c_double * count)(), np.zeros(count)
+        enc2 = (c_double * (count + 1))()
         rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
         one, two = c_double(), (c_double * 2)()
         seen: list = []
@@ -190,8 +191,11 @@ def _double_polls(
                 assert gt.GT_GetPrfVel(first, vel, count) == 0
                 assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
                 assert gt.GT_GetEncPos(first, enc, count) == 0
+                # (a second span of the same reader, read in turn: each kept in its lane)
+                assert gt.GT_GetEncPos(first + 1, byref(enc2, 8), count - 1) == 0
                 assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
                 seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
+                seen.append(bytes(enc2))
                 seen.append(apos.tobytes())
                 for name, arr in rows.items():
                     assert getattr(gt, name)(first, arr, count, clk) == 0
@@ -223,7 +227,7 @@ def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
         assert quick == general
         assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
         assert asked_general > cycles  # (every cycle: each span asked again)
-        assert asked < cycles / 2  # (ten spans: made again in C across the quick cycles)
+        assert asked < cycles / 2  # (eleven spans: made again in C across the quick cycles)
 
 
 def _mode_polls(general: bool) -> tuple[list, int, int]:
@@ -266,4 +270,44 @@ def test_profile_modes_stand_across_cycles_booked_in_c() -> None:
     assert quick == general
     assert len({x[:3] for x in quick}) >= 2  # (axis 2 in Trap and in Jog)
     assert asked_general > cycles  # (every cycle: both asked again)
+    assert asked < cycles / 10
+
+
+def _raw_polls(general: bool) -> tuple[list, int, int]:
+    """Both axes moving in Trap on the auto clock, the whole raw image and one slave's
+    inputs read every call (``GT_GetEcatRawData``: into a ctypes array and a bytearray);
+    ``general``: a watch hook that does nothing, so every cycle goes the general way.  What
+    was read, the cycles run, and how often the raw reader's value function was asked."""
+    import cProfile
+    import pstats
+
+    with _auto(general) as ctl:
+        assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
+        whole, inputs = (ctypes.c_ubyte * 40)(), bytearray(10)
+        seen: list = []
+        pr = cProfile.Profile()
+        t0 = ctl.clock.cycles
+        for rnd in range(3):
+            trap_move(1, 400 * (rnd + 1) * (-1) ** rnd, 12.0)
+            trap_move(2, -300 * (rnd + 1), 9.0)
+            pr.enable()
+            for _ in range(2500):  # (the moves end inside a round)
+                assert gt.GT_GetEcatRawData(0, 40, whole) == 0
+                assert gt.GT_GetEcatRawData(22, 10, inputs) == 0
+                seen.append((bytes(whole), bytes(inputs)))
+            pr.disable()
+        stats = pstats.Stats(pr).stats.items()  # type: ignore[attr-defined]
+        asked = sum(v[1] for (file, _, _), v in stats if file.startswith("<gt raw value "))
+        return seen, ctl.clock.cycles - t0, asked
+
+
+def test_raw_ranges_stand_across_cycles_booked_in_c() -> None:
+    """Where a raw range lies in the process image is not asked again after each cycle the
+    entries book themselves (the cycle moves the image's bytes, never its buffer): every
+    read copies what it copies with every cycle the general way, while the axes move."""
+    quick, cycles, asked = _raw_polls(False)
+    general, _, asked_general = _raw_polls(True)
+    assert quick == general
+    assert len(set(quick)) > cycles / 2  # (positions that move cycle by cycle)
+    assert asked_general > cycles  # (every cycle: both ranges asked again)
     assert asked < cycles / 10
