@@ -160,6 +160,10 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 IN_PLACE = frozenset(
     {"GT_PrfTrap", "GT_SetTrapPrm", "GT_SetPos", "GT_SetVel", "GT_Update", "GT_GoHome"}
 )
+#: the GT functions of a drive homing's set-up and start (manual 5.2.2.2) that take their axis
+#: out of the bank for the call alone (:meth:`AxisBank.call_opened`): the cycles they wait for
+#: step its drive on the scalar objects, and the row is taken again when the call returns
+OPENED = frozenset({"GT_SetHomingMode", "GT_SetEcatHomingPrm", "GT_StartEcatHoming"})
 #: those of :data:`IN_PLACE` that write their profile's values for the next GT_Update alone
 #: (the Trap target, the speed), which the bank keeps no copy of: they run with the row as
 #: it stands (anything else they reached would give the drive back through its guard)
@@ -473,6 +477,11 @@ class AxisBank:
         self._stepping = -1
         #: rows a posted edge left open for the step after the cycle (:meth:`_post_event`)
         self._open: set[int] = set()
+        #: the row a call of :data:`OPENED` runs on, out of the bank for the call
+        #: (:meth:`call_opened`): the bank does not look for rows to claim meanwhile
+        self._opened: set[int] = set()
+        #: the frozen row such a call runs on with its guards off, not given back (-1: none)
+        self._in_place_row = -1
         #: rows whose capture unit arms its drive's touch probe: the unit writes the function
         #: after the next cycle (:meth:`_post_pending`), the drive applies it at the start of
         #: the one after (:attr:`_tp_apply`, :meth:`_apply_probes`)
@@ -1143,9 +1152,12 @@ class AxisBank:
                 self.release_all()
             return
         changed = missed = loaded = False
+        opened = self._opened
         for gs, srows, bad in self._components():
             if gs[0].claimed and (len(gs) == 1 or all(g.claimed for g in gs)):
                 continue
+            if opened and any(r in opened for g in gs for r in g.rows):
+                continue  # (out for a call: call_opened takes it when the call returns)
             held = [g for g in gs if g.claimed]
             if held:  # part of a cluster is out: the rest comes back too, then all together
                 self._release_groups(held)
@@ -2134,6 +2146,136 @@ class AxisBank:
         self._in_place(r, self.groups[self.group_of[r]], lambda: done.append(call()))
         return done[0]
 
+    def call_opened(self, ctl: Any, proto: Any, values: tuple, call: Callable[[], Any]) -> Any:
+        """``call()``'s result, a GT function of :data:`OPENED` with ``values`` on ``ctl``:
+        its axis's drive goes back to the scalar objects for the call alone, as
+        :meth:`before_call` gives it back, and is taken again as the call returns when it is
+        in a state the bank runs (the cycles the call waits for - the drive's answer to a
+        new 6060h or to CW4 - step it on the scalar objects).  Before the call and after it
+        the same as a release before it and a claim at the next cycle, but the bank does not
+        look for rows to claim while the call runs (the call changes nothing of the other
+        rows), and the claim needs no look over every row.
+
+        A frozen row (:meth:`_eligible_frozen`: servo off, or standing in homing mode
+        before its homing) is not given back at all unless a cycle comes: its objects hold
+        its state already (nothing of its cycles changes), so the call runs on them without
+        their guards, and the row stays when the call returns with no cycle run and the row
+        still frozen (a drive's homing parameters written by SDO: GT_SetEcatHomingPrm).  A
+        cycle due meanwhile gives it back first (:meth:`_begin`, :meth:`_give_back_in_place`),
+        the objects as the call left them."""
+        ax = ctl.axes.get(values[0]) if values and type(values[0]) is int else None
+        r = self._row_of.get(id(ax)) if ax is not None and self.n_alive else None
+        if (
+            r is None
+            or not self.alive[r]
+            or self._stepping >= 0
+            or self._opened
+            or self._in_place_row >= 0
+        ):
+            self.before_call(ctl, proto, values)
+            return call()
+        g = self.groups[self.group_of[r]]
+        if len(g.rows) != 1 or self.sampled[r] or not g.claimed:
+            self.before_call(ctl, proto, values)
+            return call()
+        clock = ctl.clock
+        c0 = clock.cycles
+        if self.frz[r] and r not in self._aware:
+            objs = tuple(self._guarded_objects(g))
+            _unguard(objs)
+            stale = self._stale
+            self._stale = True  # (no cycle runs many at once: the next one's _begin looks)
+            self._in_place_row = r
+            try:
+                return call()
+            finally:
+                if self._in_place_row == r:  # no cycle came: the row as the call left it
+                    self._in_place_row = -1
+                    self._stale = stale
+                    self._close_in_place(r, g, objs)
+                else:
+                    self._opened.discard(r)
+                    self._close(r, g, True)
+        dirty, stale = self.dirty, self._stale
+        wait, countdown = self._wait, self._countdown
+        self._release_groups([g])
+        # (what the release asks of the next cycle, for the rows a call gives back: nothing
+        # of the other rows changes while this call runs)
+        self.dirty, self._wait, self._countdown = dirty, wait, countdown
+        self._opened.add(r)
+        try:
+            return call()
+        finally:
+            self._opened.discard(r)
+            self._close(r, g, stale or clock.cycles != c0)
+
+    def _close_in_place(self, r: int, g: _Group, objs: tuple) -> None:
+        """After :meth:`call_opened`'s call on frozen row ``r`` with no cycle run: guarded
+        again when it is still such a row (what a claim takes of it stays as it was: the
+        calls change a drive's homing objects, its mode, its controlword, none of them
+        without a cycle), else given back as the call left its objects."""
+        buf = self.ctl.master.image.buffer
+        if (
+            g.claimed
+            and self._eligible(r)
+            and (self.frz_off[r] == (not self.axes[r].servo_on))
+            and buf.take(self._rx_idx).tobytes() == self._rx_ref
+        ):
+            _reguard(objs)
+            EPOCH.n += 1
+            return
+        self._give_back(r, g)
+        self.dirty = True
+        self._wait = 1
+
+    def _give_back(self, r: int, g: _Group) -> None:
+        """Release frozen row ``r`` (group ``g``) whose objects the call changed: they hold
+        its state as the call left it (no put back from the row)."""
+        self._stepping = r
+        try:
+            self._release_groups([g])
+        finally:
+            self._stepping = -1
+        self.frz[r] = self.frz_off[r] = False  # (what _put_back clears)
+
+    def _give_back_in_place(self) -> None:
+        """A cycle comes while a call runs on frozen row :attr:`_in_place_row` with its
+        guards off (:meth:`call_opened`): the row goes back first, its objects as the call
+        left them, and the call's cycles step it on them (it is taken again as the call
+        returns)."""
+        r = self._in_place_row
+        self._in_place_row = -1
+        dirty, wait, countdown = self.dirty, self._wait, self._countdown
+        self._give_back(r, self.groups[self.group_of[r]])
+        self.dirty, self._wait, self._countdown = dirty, wait, countdown
+        self._opened.add(r)
+
+    def _close(self, r: int, g: _Group, stale: bool) -> None:
+        """After :meth:`call_opened`'s call: its row taken again when :meth:`refresh` would
+        take it now, else the bank looks again at the next cycle as after any release
+        (``stale``: cycles ran while it was out, or the bank was to re-index anyway)."""
+        if (
+            not g.claimed
+            and g.drive.al_state == AlState.OP
+            and not self._global_reason()
+            and self._eligible(r)
+            and self._can_claim(g)
+        ):
+            self._claim(g)
+            self.csp.after_loads()
+            self.n_alive += 1
+            if stale:
+                self._stale = True
+            else:
+                # the same rows claimed as before the call: the image's references stand
+                # when the call wrote none of the row's outputs (else the re-index looks)
+                self._stale = self.ctl.master.image.buffer.take(self._rx_idx).tobytes() != (
+                    self._rx_ref
+                )
+            return
+        self.dirty = True
+        self._wait = 1
+
     def _trap_held(self, r: int) -> bool:
         """Claimed row ``r`` stands in Trap mode with its planner (the object and the row)
         as :meth:`TrapPlanner.hold` leaves it where it stands: a hold there changes nothing."""
@@ -2417,12 +2559,16 @@ class AxisBank:
             self._settled = True
 
     def _begin(self) -> None:
+        if self._in_place_row >= 0:
+            self._give_back_in_place()
         if self.kernel_due and kernel_settled():
             self._take_kernel()
         self._countdown -= 1
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
-        if self.dirty or (self._countdown <= 0 and self.n_alive != self.n):
+        if self.dirty or (
+            self._countdown <= 0 and self.n_alive + len(self._opened) != self.n
+        ):
             self.refresh()
         if self._stale:
             self._reindex()
