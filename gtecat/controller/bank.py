@@ -481,7 +481,7 @@ class AxisBank:
         #: (:meth:`call_opened`): the bank does not look for rows to claim meanwhile
         self._opened: set[int] = set()
         #: the frozen row such a call runs on with its guards off, not given back (-1: none)
-        self._in_place_row = -1
+        self._frozen_call = -1
         #: rows whose capture unit arms its drive's touch probe: the unit writes the function
         #: after the next cycle (:meth:`_post_pending`), the drive applies it at the start of
         #: the one after (:attr:`_tp_apply`, :meth:`_apply_probes`)
@@ -2170,7 +2170,7 @@ class AxisBank:
             or not self.alive[r]
             or self._stepping >= 0
             or self._opened
-            or self._in_place_row >= 0
+            or self._frozen_call >= 0
         ):
             self.before_call(ctl, proto, values)
             return call()
@@ -2185,12 +2185,12 @@ class AxisBank:
             _unguard(objs)
             stale = self._stale
             self._stale = True  # (no cycle runs many at once: the next one's _begin looks)
-            self._in_place_row = r
+            self._frozen_call = r
             try:
                 return call()
             finally:
-                if self._in_place_row == r:  # no cycle came: the row as the call left it
-                    self._in_place_row = -1
+                if self._frozen_call == r:  # no cycle came: the row as the call left it
+                    self._frozen_call = -1
                     self._stale = stale
                     self._close_in_place(r, g, objs)
                 else:
@@ -2239,12 +2239,12 @@ class AxisBank:
         self.frz[r] = self.frz_off[r] = False  # (what _put_back clears)
 
     def _give_back_in_place(self) -> None:
-        """A cycle comes while a call runs on frozen row :attr:`_in_place_row` with its
+        """A cycle comes while a call runs on frozen row :attr:`_frozen_call` with its
         guards off (:meth:`call_opened`): the row goes back first, its objects as the call
         left them, and the call's cycles step it on them (it is taken again as the call
         returns)."""
-        r = self._in_place_row
-        self._in_place_row = -1
+        r = self._frozen_call
+        self._frozen_call = -1
         dirty, wait, countdown = self.dirty, self._wait, self._countdown
         self._give_back(r, self.groups[self.group_of[r]])
         self.dirty, self._wait, self._countdown = dirty, wait, countdown
@@ -2559,7 +2559,7 @@ class AxisBank:
             self._settled = True
 
     def _begin(self) -> None:
-        if self._in_place_row >= 0:
+        if self._frozen_call >= 0:
             self._give_back_in_place()
         if self.kernel_due and kernel_settled():
             self._take_kernel()
