@@ -477,11 +477,18 @@ class AxisBank:
         self._stepping = -1
         #: rows a posted edge left open for the step after the cycle (:meth:`_post_event`)
         self._open: set[int] = set()
-        #: the row a call of :data:`OPENED` runs on, out of the bank for the call
-        #: (:meth:`call_opened`): the bank does not look for rows to claim meanwhile
-        self._opened: set[int] = set()
-        #: the frozen row such a call runs on with its guards off, not given back (-1: none)
+        #: the row a call of :data:`OPENED` runs on, opened for the call (:meth:`call_opened`),
+        #: and the cycles that stepped it since
+        self._opened: dict[int, int] = {}
+        #: the frozen row such a call runs on with its guards off, not opened (-1: none),
+        #: and whether the bank was to re-index before it
         self._frozen_call = -1
+        self._frozen_stale = False
+        #: where a group's output bytes lie in the raw-write checks' references, per
+        #: claimed pattern (:meth:`_took_group`)
+        self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
+        #: the row such a call gave back where per-cycle hooks run (:meth:`_open_released`)
+        self._held_out = -1
         #: rows whose capture unit arms its drive's touch probe: the unit writes the function
         #: after the next cycle (:meth:`_post_pending`), the drive applies it at the start of
         #: the one after (:attr:`_tp_apply`, :meth:`_apply_probes`)
@@ -797,10 +804,19 @@ class AxisBank:
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
+        for r in self._opened:  # (its outputs are its objects', not a raw write)
+            self._took_group(self.group_of[r])
         self._release_written()
         alive = self.alive
         self._stale = False
         self.n_alive = int(np.count_nonzero(alive))
+        self._recount()
+        self._patterns()
+
+    def _recount(self) -> None:
+        """What the cycle looks at of the claimed rows' flags, counted again (after a claim or
+        a release; a row opened for a call or taken again after it: :meth:`call_opened`)."""
+        alive = self.alive
         if self._loaded:  # the rows' constants (they change only when a row is taken)
             self._loaded = False
             ratio, off = self.prf_ratio, self.prf_off
@@ -829,6 +845,29 @@ class AxisBank:
         self._c_fill = self.kernel is not None and not (
             self.n_moving and np.count_nonzero(moving & (self.nseg <= 0))
         )
+        self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
+
+    def _counted(self) -> None:
+        """After a row opened for a call or taken again from its objects (the claimed set
+        stays; its counts moved with it): what :meth:`_recount` does besides the counts."""
+        if self._loaded:
+            self._recount()
+            return
+        if self.any_band:
+            self._count_standing()
+        self.band_dirty = True
+        self._img_stale = True
+        self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
+
+    def _patterns(self) -> None:
+        """:meth:`_reindex`'s part that follows from the claimed pattern alone (a row opened
+        for a call counts as the bank's: it steps the row itself, :meth:`_step_opened`)."""
+        alive = self.alive
+        if self._opened:
+            alive = alive.copy()
+            alive[sorted(self._opened)] = True
         g_claimed = self._g_claimed
         rows = self._rows_of_axes
         axis_list = self.ctl._axis_list
@@ -1152,11 +1191,10 @@ class AxisBank:
                 self.release_all()
             return
         changed = missed = loaded = False
-        opened = self._opened
         for gs, srows, bad in self._components():
             if gs[0].claimed and (len(gs) == 1 or all(g.claimed for g in gs)):
                 continue
-            if opened and any(r in opened for g in gs for r in g.rows):
+            if self._held_out >= 0 and any(r == self._held_out for g in gs for r in g.rows):
                 continue  # (out for a call: call_opened takes it when the call returns)
             held = [g for g in gs if g.claimed]
             if held:  # part of a cluster is out: the rest comes back too, then all together
@@ -1933,6 +1971,9 @@ class AxisBank:
                     _set(obj, "__class__", cls.__base__)
             g.claimed = False
             self._g_claimed[self._gi[id(g)]] = False
+        opened = self._opened
+        if opened:  # (a row opened for a call: its objects hold its state, nothing to store)
+            rows = [r for r in rows if r not in opened]
         frz = self.frz
         if any(frz[r] for r in rows):
             # a frozen row's channel holds what its skipped cycles would have left
@@ -1954,24 +1995,10 @@ class AxisBank:
                 ran = int(self.bank_cycles - self.claim_cycle[r])
                 for obj in aware:
                     obj.bank_released(ran)
-        # the drive's process data buffers as its own steps would have left them: the entries
-        # the bank wrote into the image in them too (its other bytes are as they were, so a
-        # raw write or a changed constant still waits for a step of its own: _can_claim).
-        # 607Ah as the bank last sent it, not as the image holds it now: a raw write since
-        # (not looked at: the bank writes 607Ah itself) never reached the drive - one cut off
-        # by a pulled cable runs on what it last received, as on the scalar path
-        buf = self.ctl.master.image.buffer
-        target = self.csp.target
         for g in groups:
-            rx, tx = g.drive.rx, g.drive.tx
-            for byte, size, out, i, r in g.computed:
-                dst = rx if out else tx
-                if 0 <= i and i + size <= len(dst):
-                    if out:
-                        sent = (int(target[r]) & 0xFFFFFFFF).to_bytes(4, "little")
-                        dst[i : i + size] = sent[:size]
-                    else:
-                        dst[i : i + size] = buf[byte : byte + size].tobytes()
+            if opened and not self.alive[g.rows[0]] and g.rows[0] in opened:
+                continue  # (its drive stepped itself: its buffers are its own)
+            self._drive_buffers(g)
         for cl in clusters:
             # the planners stand where the scalar path has them (bank_modes.Cluster.rewind)
             cl.rewind(self)
@@ -1988,6 +2015,25 @@ class AxisBank:
         # release: a loop of GT calls over many axes releases one slave per call
         self._stale = True
         self.n_alive = int(np.count_nonzero(self.alive))
+
+    def _drive_buffers(self, g: _Group) -> None:
+        """Group ``g``'s drive's process data buffers as its own steps would have left them:
+        the entries the bank wrote into the image in them too (its other bytes are as they
+        were, so a raw write or a changed constant still waits for a step of its own:
+        _can_claim).  607Ah as the bank last sent it, not as the image holds it now: a raw
+        write since (not looked at: the bank writes 607Ah itself) never reached the drive -
+        one cut off by a pulled cable runs on what it last received, as on the scalar path."""
+        buf = self.ctl.master.image.buffer
+        target = self.csp.target
+        rx, tx = g.drive.rx, g.drive.tx
+        for byte, size, out, i, r in g.computed:
+            dst = rx if out else tx
+            if 0 <= i and i + size <= len(dst):
+                if out:
+                    sent = (int(target[r]) & 0xFFFFFFFF).to_bytes(4, "little")
+                    dst[i : i + size] = sent[:size]
+                else:
+                    dst[i : i + size] = buf[byte : byte + size].tobytes()
 
     def _store(self, r: int) -> None:
         self.alive[r] = False
@@ -2147,22 +2193,29 @@ class AxisBank:
         return done[0]
 
     def call_opened(self, ctl: Any, proto: Any, values: tuple, call: Callable[[], Any]) -> Any:
-        """``call()``'s result, a GT function of :data:`OPENED` with ``values`` on ``ctl``:
-        its axis's drive goes back to the scalar objects for the call alone, as
-        :meth:`before_call` gives it back, and is taken again as the call returns when it is
-        in a state the bank runs (the cycles the call waits for - the drive's answer to a
-        new 6060h or to CW4 - step it on the scalar objects).  Before the call and after it
-        the same as a release before it and a claim at the next cycle, but the bank does not
-        look for rows to claim while the call runs (the call changes nothing of the other
-        rows), and the claim needs no look over every row.
+        """``call()``'s result, a GT function of :data:`OPENED` with ``values`` on ``ctl``.
+
+        Its axis's row (a drive of one channel the bank runs) is *opened* for the call: its
+        state goes into its objects as at a release and their guards come off, the compiled
+        cycle leaves the row out, and each cycle the call waits for (the drive's answer to a
+        new 6060h or to CW4) steps the row's objects as the scalar path steps them - the
+        axis's pre step, its drive's exchange, the axis's post step (:meth:`_step_opened`).
+        When the call returns the row is taken again from its objects if it is in a state
+        the bank runs (as :meth:`refresh` would take it at the next cycle), else given back.
+        The bus and the controller keep the slave and the axis as the bank's meanwhile
+        (nothing re-indexed), and nothing else is looked at: a drive homing's set-up cost
+        per axis on a bus of 64 axes standing in the bank a release, a re-index, a look
+        over every row and a claim before.  Where the controller has per-cycle hooks (which
+        run between the bank's cycle and the axes' steps) the row goes back for the call
+        instead and is taken again as it returns (:meth:`_open_released`).
 
         A frozen row (:meth:`_eligible_frozen`: servo off, or standing in homing mode
-        before its homing) is not given back at all unless a cycle comes: its objects hold
-        its state already (nothing of its cycles changes), so the call runs on them without
+        before its homing) is not even opened unless a cycle comes: its objects hold its
+        state already (nothing of its cycles changes), so the call runs on them without
         their guards, and the row stays when the call returns with no cycle run and the row
         still frozen (a drive's homing parameters written by SDO: GT_SetEcatHomingPrm).  A
-        cycle due meanwhile gives it back first (:meth:`_begin`, :meth:`_give_back_in_place`),
-        the objects as the call left them."""
+        cycle due meanwhile opens it first (:meth:`_begin`), its objects as the call left
+        them."""
         ax = ctl.axes.get(values[0]) if values and type(values[0]) is int else None
         r = self._row_of.get(id(ax)) if ax is not None and self.n_alive else None
         if (
@@ -2171,42 +2224,184 @@ class AxisBank:
             or self._stepping >= 0
             or self._opened
             or self._frozen_call >= 0
+            or self.kernel is None
         ):
             self.before_call(ctl, proto, values)
             return call()
         g = self.groups[self.group_of[r]]
-        if len(g.rows) != 1 or self.sampled[r] or not g.claimed:
+        if len(g.rows) != 1 or self.sampled[r] or not g.claimed or r in self._open:
             self.before_call(ctl, proto, values)
             return call()
         clock = ctl.clock
         c0 = clock.cycles
+        if ctl.pre_cycle or ctl.post_cycle:
+            return self._open_released(r, g, clock, call)
         if self.frz[r] and r not in self._aware:
             objs = tuple(self._guarded_objects(g))
             _unguard(objs)
-            stale = self._stale
-            self._stale = True  # (no cycle runs many at once: the next one's _begin looks)
             self._frozen_call = r
+            self._frozen_stale = self._stale
+            self._stale = True  # (no cycle runs many at once: the next one's _begin opens it)
             try:
                 return call()
             finally:
                 if self._frozen_call == r:  # no cycle came: the row as the call left it
                     self._frozen_call = -1
-                    self._stale = stale
+                    self._stale = self._frozen_stale
                     self._close_in_place(r, g, objs)
                 else:
-                    self._opened.discard(r)
-                    self._close(r, g, True)
+                    self._close_opened(r, g)
+        self._open_row(r, g, True)
+        try:
+            return call()
+        finally:
+            self._close_opened(r, g)
+
+    def _open_row(self, r: int, g: _Group, put_back: bool) -> None:
+        """Open claimed row ``r`` (group ``g``, one channel) for :meth:`call_opened`:
+        ``put_back``: its state goes into its objects as a release puts it (else they hold
+        it: a frozen row a call ran on in place, its objects as the call left them)."""
+        EPOCH.n += 1
+        objs = self._guarded_objects(g)
+        _unguard(tuple(objs))
+        for obj in objs:
+            _OWNER.pop(id(obj), None)
+        csp = self.csp
+        # (the counts the cycle looks at, less this row's: its flags are cleared below)
+        hm = bool(self.hm[r])
+        self.n_jog -= bool(self.jog[r])
+        self.n_hm -= hm
+        self.n_rest -= hm and self.h_done[r] == 1
+        self.n_frz -= bool(self.frz[r])
+        self.n_moving -= bool(self.moving[r])
+        if put_back:
+            if self.frz[r]:
+                csp.rested(r)
+            else:
+                self._last = {r: self._planned_row(r)}
+                self._rates = {r: self._enc_rates_row(r)}
+                csp.store([r])
+            self._store(r)
+            aware = self._aware.pop(r, None)
+            if aware:  # (as at a release: the hooks catch up with the cycles the bank ran)
+                ran = int(self.bank_cycles - self.claim_cycle[r])
+                for obj in aware:
+                    obj.bank_released(ran)
+        else:
+            csp.rested(r)
+            self._stepping = r  # (its objects hold its state: nothing put back)
+            try:
+                self._store(r)
+            finally:
+                self._stepping = -1
+            self.frz[r] = self.frz_off[r] = False  # (what _put_back clears)
+        self.releases += 1
+        self._opened[r] = 0  # (the cycles that stepped it: _step_opened, _close_opened)
+        self.n_alive -= 1
+        self._counted()
+
+    def _step_opened(self, t_ns: int, dt_ns: int) -> None:
+        """The cycle of each row opened for a call (:meth:`call_opened`) on its objects, as
+        the scalar path runs it: the axis's pre step, its drive's exchange, its post step.
+        The claimed rows' output references follow what the axis wrote (the raw-write checks
+        look at the others)."""
+        backend = self.ctl.backend
+        for r in sorted(self._opened):
+            g = self.groups[self.group_of[r]]
+            if not g.claimed or self.alive[r]:
+                continue  # (given back meanwhile: the scalar path runs it)
+            ax = self.axes[r]
+            ax.pre(t_ns, dt_ns)
+            backend.exchange_one(g.position, t_ns, dt_ns)
+            ax.post(t_ns, dt_ns)
+            self._took_group(self.group_of[r])
+            self._opened[r] += 1
+
+    def _took_group(self, gi: int) -> None:
+        """The output bytes of group ``gi`` (claimed, its row opened) as the image holds
+        them now are the raw-write checks' references (the row's own objects wrote them)."""
+        at = self._took_at.get(gi)
+        if at is None or at[0] is not self._rx_idx:
+            start, stop = self._rx_start[gi], self._rx_start[gi + 1]
+            before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
+            at = self._took_at[gi] = (
+                self._rx_idx,
+                [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
+            )
+        view = self.ctl.master.image.view
+        snap = self._rx_snap
+        ref: bytearray | None = None
+        for k, b, j in at[1]:
+            v = view[b]
+            if snap[k] != v:
+                snap[k] = v
+            if ref is None and self._rx_ref[j] != v:
+                ref = bytearray(self._rx_ref)
+            if ref is not None:
+                ref[j] = v
+        if ref is not None:
+            self._rx_ref = bytes(ref)
+
+    def _close_opened(self, r: int, g: _Group) -> None:
+        """After :meth:`call_opened`'s call on opened row ``r``: taken again from its objects
+        when :meth:`refresh` would take it now, else given back (its objects as they are)."""
+        if not g.claimed or self.alive[r]:  # (given back meanwhile: as any released row)
+            self._opened.pop(r, None)
+            self._close(r, g, True)
+            return
+        gi = self.group_of[r]
+        self._took_group(gi)
+        if not self._opened[r]:  # (no cycle stepped it: its buffers as a release leaves them)
+            self._drive_buffers(g)
+        if (
+            g.drive.al_state == AlState.OP
+            and not self._global_reason()
+            and self._eligible(r)
+            and self._can_claim(g)
+        ):
+            self._opened.pop(r, None)
+            self.csp.load(r, flags=False)
+            self._load(r)
+            self.csp.after_loads()
+            hm = bool(self.hm[r])
+            self.n_jog += bool(self.jog[r])
+            self.n_hm += hm
+            self.n_rest += hm and self.h_done[r] == 1
+            self.n_frz += bool(self.frz[r])
+            self._after_load(r, False)
+            for obj in self._guarded_objects(g):
+                key = id(obj)
+                _OWNER[key] = (self, gi)
+                _set(obj, "__class__", _guard_class(type(obj)))
+                if key not in _OWN_DICT:
+                    _OWN_DICT.add(key)
+                    own_dict(obj)
+            self.n_alive += 1
+            self._counted()
+            return
+        try:
+            self._release_groups([g])  # (opened: nothing put back, the objects hold it)
+        finally:
+            self._opened.pop(r, None)
+        self._reindex()
+        self.dirty = True
+
+    def _open_released(self, r: int, g: _Group, clock: Any, call: Callable[[], Any]) -> Any:
+        """:meth:`call_opened` where per-cycle hooks run: the row goes back for the call (as
+        :meth:`before_call` gives it back), and is taken again as the call returns when
+        :meth:`refresh` would take it."""
+        c0 = clock.cycles
         dirty, stale = self.dirty, self._stale
         wait, countdown = self._wait, self._countdown
         self._release_groups([g])
         # (what the release asks of the next cycle, for the rows a call gives back: nothing
         # of the other rows changes while this call runs)
         self.dirty, self._wait, self._countdown = dirty, wait, countdown
-        self._opened.add(r)
+        self._held_out = r
         try:
             return call()
         finally:
-            self._opened.discard(r)
+            self._held_out = -1
             self._close(r, g, stale or clock.cycles != c0)
 
     def _close_in_place(self, r: int, g: _Group, objs: tuple) -> None:
@@ -2224,36 +2419,23 @@ class AxisBank:
             _reguard(objs)
             EPOCH.n += 1
             return
-        self._give_back(r, g)
-        self.dirty = True
-        self._wait = 1
+        self._open_row(r, g, False)
+        self._close_opened(r, g)
 
-    def _give_back(self, r: int, g: _Group) -> None:
-        """Release frozen row ``r`` (group ``g``) whose objects the call changed: they hold
-        its state as the call left it (no put back from the row)."""
-        self._stepping = r
-        try:
-            self._release_groups([g])
-        finally:
-            self._stepping = -1
-        self.frz[r] = self.frz_off[r] = False  # (what _put_back clears)
-
-    def _give_back_in_place(self) -> None:
+    def _open_in_place(self) -> None:
         """A cycle comes while a call runs on frozen row :attr:`_frozen_call` with its
-        guards off (:meth:`call_opened`): the row goes back first, its objects as the call
-        left them, and the call's cycles step it on them (it is taken again as the call
-        returns)."""
+        guards off (:meth:`call_opened`): the row is opened first, its objects as the call
+        left them."""
         r = self._frozen_call
         self._frozen_call = -1
-        dirty, wait, countdown = self.dirty, self._wait, self._countdown
-        self._give_back(r, self.groups[self.group_of[r]])
-        self.dirty, self._wait, self._countdown = dirty, wait, countdown
-        self._opened.add(r)
+        self._stale = self._frozen_stale
+        self._open_row(r, self.groups[self.group_of[r]], False)
 
     def _close(self, r: int, g: _Group, stale: bool) -> None:
-        """After :meth:`call_opened`'s call: its row taken again when :meth:`refresh` would
-        take it now, else the bank looks again at the next cycle as after any release
-        (``stale``: cycles ran while it was out, or the bank was to re-index anyway)."""
+        """After a call whose row went back (:meth:`_open_released`, or given back while
+        opened): taken again when :meth:`refresh` would take it now, else the bank looks
+        again at the next cycle as after any release (``stale``: cycles ran while it was
+        out, or the bank was to re-index anyway)."""
         if (
             not g.claimed
             and g.drive.al_state == AlState.OP
@@ -2560,21 +2742,28 @@ class AxisBank:
 
     def _begin(self) -> None:
         if self._frozen_call >= 0:
-            self._give_back_in_place()
+            self._open_in_place()
         if self.kernel_due and kernel_settled():
             self._take_kernel()
         self._countdown -= 1
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
         if self.dirty or (
-            self._countdown <= 0 and self.n_alive + len(self._opened) != self.n
+            self._countdown <= 0
+            and self.n_alive + len(self._opened) + (self._held_out >= 0) != self.n
         ):
             self.refresh()
         if self._stale:
             self._reindex()
 
     def cycle(self, t_ns: int, dt_ns: int) -> None:
-        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        """Run the claimed axes' whole cycle; release (before it) the ones that leave; then
+        the rows opened for a call on their objects (:meth:`_step_opened`)."""
+        self._cycle(t_ns, dt_ns)
+        if self._opened:
+            self._step_opened(t_ns, dt_ns)
+
+    def _cycle(self, t_ns: int, dt_ns: int) -> None:
         if self.evt_rows:
             self.evt_rows.clear()
         if self._settled:

@@ -539,6 +539,8 @@ class Controller:
             or self.clock._run_cycle is not self._own_cycle
         ):
             return 0
+        if bank._opened or bank._frozen_call >= 0:
+            return 0  # (a row opened for a call steps in Python: AxisBank.call_opened)
         settled = bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n)
         if settled:
             bank.settle()  # what the next cycle does first: claim axes given back

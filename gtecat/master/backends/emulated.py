@@ -71,6 +71,8 @@ class EmulatedBackend(Backend):
         self._clients: dict[int, object] = {}
         self._claimed: frozenset[int] = frozenset()
         self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
+        #: the plan and its entries by position (:meth:`exchange_one`)
+        self._one_plan: tuple[list[Any], dict[int, Any]] | None = None
         self._claimed_wkc = 0
         self._claimed_slaves: tuple[VirtualSlave, ...] = ()  # what steady() asks for OP
         #: (the run plan and image it was made for, its rows): what steady() compares
@@ -252,6 +254,25 @@ class EmulatedBackend(Backend):
         if self.capture is not None:
             self._capture_cycle(t_ns, image, wkc)
         return wkc
+
+    def exchange_one(self, position: int, t_ns: int, dt_ns: int) -> None:
+        """Slave ``position``'s part of this cycle's exchange (one the controller's axis bank
+        claims, which it steps on its own objects in the bank's cycle: a row opened for a
+        call, gtecat.controller.bank): its outputs from the image, its step, its inputs into
+        the image, as :meth:`exchange` does it (the working counter counts a claimed slave
+        in OP already)."""
+        plan = self._one_plan
+        if plan is None or plan[0] is not self._plan:
+            plan = self._one_plan = (self._plan, {e[0].position: e for e in self._plan})
+        slave, out, inp = plan[1][position]
+        image = self.image
+        assert image is not None
+        if out is not None:
+            image.to_slave(out, slave.rx)
+        st = slave.al_state
+        slave.step(t_ns, dt_ns)
+        if inp is not None and st >= _SAFEOP:
+            image.from_slave(inp, slave.tx)
 
     def _capture_cycle(self, t_ns: int, image: ProcessImage, wkc: int) -> None:
         """The cycle into the capture, with each answering slave's share of the working
