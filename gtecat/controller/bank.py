@@ -2233,7 +2233,6 @@ class AxisBank:
             self.before_call(ctl, proto, values)
             return call()
         clock = ctl.clock
-        c0 = clock.cycles
         if ctl.pre_cycle or ctl.post_cycle:
             return self._open_released(r, g, clock, call)
         if self.frz[r] and r not in self._aware:
