@@ -2247,7 +2247,8 @@ class AxisBank:
                 if self._frozen_call == r:  # no cycle came: the row as the call left it
                     self._frozen_call = -1
                     self._stale = self._frozen_stale
-                    self._close_in_place(r, g, objs)
+                    homing_objects = proto.name == "GT_SetEcatHomingPrm" and values[-1] == 0
+                    self._close_in_place(r, g, objs, homing_objects)
                 else:
                     self._close_opened(r, g)
         self._open_row(r, g, True)
@@ -2319,18 +2320,10 @@ class AxisBank:
     def _took_group(self, gi: int) -> None:
         """The output bytes of group ``gi`` (claimed, its row opened) as the image holds
         them now are the raw-write checks' references (the row's own objects wrote them)."""
-        at = self._took_at.get(gi)
-        if at is None or at[0] is not self._rx_idx:
-            start, stop = self._rx_start[gi], self._rx_start[gi + 1]
-            before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
-            at = self._took_at[gi] = (
-                self._rx_idx,
-                [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
-            )
         view = self.ctl.master.image.view
         snap = self._rx_snap
         ref: bytearray | None = None
-        for k, b, j in at[1]:
+        for k, b, j in self._took_entries(gi):
             v = view[b]
             if snap[k] != v:
                 snap[k] = v
@@ -2340,6 +2333,25 @@ class AxisBank:
                 ref[j] = v
         if ref is not None:
             self._rx_ref = bytes(ref)
+
+    def _outputs_kept(self, gi: int) -> bool:
+        """Claimed group ``gi``'s output bytes in the image are the raw-write checks'
+        references (nothing wrote them since the bank looked)."""
+        view, ref = self.ctl.master.image.view, self._rx_ref
+        return all(view[b] == ref[j] for _, b, j in self._took_entries(gi))
+
+    def _took_entries(self, gi: int) -> list[tuple[int, int, int]]:
+        """Claimed group ``gi``'s output bytes: (index in the references of every output
+        byte, its byte in the image, its index in those of the claimed ones), per pattern."""
+        at = self._took_at.get(gi)
+        if at is None or at[0] is not self._rx_idx:
+            start, stop = self._rx_start[gi], self._rx_start[gi + 1]
+            before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
+            at = self._took_at[gi] = (
+                self._rx_idx,
+                [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
+            )
+        return at[1]
 
     def _close_opened(self, r: int, g: _Group) -> None:
         """After :meth:`call_opened`'s call on opened row ``r``: taken again from its objects
@@ -2403,17 +2415,24 @@ class AxisBank:
             self._held_out = -1
             self._close(r, g, stale or clock.cycles != c0)
 
-    def _close_in_place(self, r: int, g: _Group, objs: tuple) -> None:
+    def _close_in_place(self, r: int, g: _Group, objs: tuple, homing_objects: bool) -> None:
         """After :meth:`call_opened`'s call on frozen row ``r`` with no cycle run: guarded
         again when it is still such a row (what a claim takes of it stays as it was: the
         calls change a drive's homing objects, its mode, its controlword, none of them
-        without a cycle), else given back as the call left its objects."""
-        buf = self.ctl.master.image.buffer
+        without a cycle) and its outputs in the image are as the bank left them, else
+        opened as the call left its objects and taken again from them or given back.
+        ``homing_objects``: the call wrote the drive's homing objects and nothing else
+        (GT_SetEcatHomingPrm without a probe function: 6098h, 6099h:01/02, 609Ah, 607Ch,
+        which a drive takes at CW4's rising edge only, and the GT layer's record of the
+        homing, which the bank allows while no run is active), so the row is what it was."""
+        gi = self.group_of[r]
         if (
             g.claimed
-            and self._eligible(r)
-            and (self.frz_off[r] == (not self.axes[r].servo_on))
-            and buf.take(self._rx_idx).tobytes() == self._rx_ref
+            and self._outputs_kept(gi)
+            and (
+                homing_objects
+                or (self._eligible(r) and self.frz_off[r] == (not self.axes[r].servo_on))
+            )
         ):
             _reguard(objs)
             EPOCH.n += 1

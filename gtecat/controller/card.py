@@ -92,7 +92,15 @@ def open_card(ctl: Controller, text: str) -> Card:
     ctl.layout, ctl.backend, ctl.master = layout, backend, master
     ctl.axes = {
         ref.axis: Axis(
-            ref.axis, AxisIo(master.image, layout, ref, master.sdo_upload, master.sdo_download)
+            ref.axis,
+            AxisIo(
+                master.image,
+                layout,
+                ref,
+                master.sdo_upload,
+                master.sdo_download,
+                master.sdo_download_many,
+            ),
         )
         for ref in layout.axes
     }

@@ -345,7 +345,15 @@ class Controller:
         self.started = False
         self.axes = {
             ref.axis: Axis(
-                ref.axis, AxisIo(master.image, layout, ref, master.sdo_upload, master.sdo_download)
+                ref.axis,
+                AxisIo(
+                    master.image,
+                    layout,
+                    ref,
+                    master.sdo_upload,
+                    master.sdo_download,
+                    master.sdo_download_many,
+                ),
             )
             for ref in layout.axes
         }

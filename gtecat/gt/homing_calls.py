@@ -346,13 +346,24 @@ def set_homing_parameters(
         )
     st = _state(ax)
     st.params_set = False
-    _write(ax, 0x6098, 0, method, 1)
-    _write(ax, 0x6099, 1, values[0], 4)
-    _write(ax, 0x6099, 2, values[1], 4)
-    _write(ax, 0x609A, 0, values[2], 4)
-    _write(ax, 0x607C, 0, offset, 4)
+    items = [
+        (0x6098, 0, method, 1),
+        (0x6099, 1, values[0], 4),
+        (0x6099, 2, values[1], 4),
+        (0x609A, 0, values[2], 4),
+        (0x607C, 0, offset, 4),
+    ]
     if probe_function:
-        _write(ax, 0x60B8, 0, probe_function, 2)
+        items.append((0x60B8, 0, probe_function, 2))
+    try:
+        ax.io.write_all_or_sdo(items)
+    except SdoAbort as e:
+        value = next(
+            (v for i, k, v, _ in items if ax.io.index(i) == e.index and k == e.subindex), "?"
+        )
+        raise CommandError(
+            f"axis {ax.number}: writing {value} to 0x{e.index:04X}:{e.subindex:02X} failed: {e}"
+        ) from None
     st.params_set = True
 
 

@@ -52,7 +52,7 @@ in which the axes move and the slaves' watchdogs stay fed, on both backends.
 from __future__ import annotations
 
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
@@ -482,6 +482,16 @@ class Master:
             backend.sdo_download(pos, index, subindex, data, complete_access)
         finally:
             self._timed_out(lost, pos)
+
+    def sdo_download_many(self, pos: int, items: Sequence[tuple[int, int, bytes]]) -> None:
+        """Write several objects of slave ``pos`` in order, each one SDO download as
+        :meth:`sdo_download` sends it (served in this process in one go where the backend
+        can: :meth:`Backend.sdo_downloads_in_process`), stopping at the first abort (raised)."""
+        self._check_slave(pos)
+        backend = self.backend
+        done = 0 if backend.mailbox_on_wire else backend.sdo_downloads_in_process(pos, items)
+        for index, subindex, data in items[done:]:
+            self.sdo_download(pos, index, subindex, data)
 
     def _on_wire(self, transfer: Callable[[], _T]) -> _T:
         """A transfer of a mailbox on a wire: the cycles run while it waits (module

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import ctypes
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from itertools import compress
 from typing import Any
 
@@ -555,6 +555,37 @@ class EmulatedBackend(Backend):
             return server.upload_in_process(index, subindex)
         server.download_in_process(index, subindex, bytes(data), complete_access, slave.al_state)
         return True
+
+    def sdo_downloads_in_process(
+        self, position: int, items: Sequence[tuple[int, int, bytes]]
+    ) -> int:
+        """Several expedited downloads to one slave as :meth:`sdo_in_process` serves each
+        (the same checks once: nothing sees the frames, the slave's mailbox is its SDO
+        server's, up): each one the server's own write, counters and abort, in order (a
+        drive's homing parameters: five objects in one call)."""
+        if self.capture is not None or position in self.unplugged:
+            return 0
+        if not 0 <= position < len(self.slaves):
+            return 0
+        slave = self.slaves[position]
+        if not slave.has_mailbox or slave.al_state < AlState.PREOP:
+            return 0
+        if not getattr(slave.mailbox, "sdo_server_only", False):
+            return 0
+        server = slave.sdo  # type: ignore[attr-defined]
+        client = self._clients.get(position)
+        if client is None:
+            client = self._client(position)
+        state = slave.al_state
+        done = 0
+        for index, subindex, data in items:
+            if not (0 <= index <= 0xFFFF and 0 <= subindex <= 0xFF and 0 < len(data) <= 4):
+                break
+            self._mailbox_ops += 1  # (steady(): the slave's objects may change)
+            client.counter = next_counter(client.counter)
+            server.download_in_process(index, subindex, bytes(data), False, state)
+            done += 1
+        return done
 
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False
