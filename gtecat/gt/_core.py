@@ -262,7 +262,8 @@ class _Session:
         if core > 1 and 1 in cores:
             c = self._core_view(core)  # the bus's axes of that core, where it has them
             if c is not None:
-                own = cores.pop(core, None)
+                # (a pop of nothing would move the gates too: every call of a core's twin)
+                own = cores.pop(core) if core in cores else None
                 if own is not None:  # a second core opened before the bus came up
                     self.time.leave(own.clock)
                     own.close()
@@ -659,6 +660,15 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                                 and bus in base.axes
                             ):
                                 return fast(bus, *args[2:])
+                    if type(c) is int and not kwargs and -0x8000 <= c <= 0x7FFF:
+                        # a plain core (core_arg's check) and the GT_ function's compiled
+                        # binder of the rest, as for GT_x (made at the twin's first call)
+                        if compiled:
+                            values = compiled[0](*args[1:])
+                            if values is not None and (needs_ctl or c == 1):
+                                return run(c, values, _NO_KW, "", SESSION.last, True)
+                        elif not opens:
+                            compiled.append(fast_binder(proto, (bind or _binder()).convs))  # type: ignore[attr-defined]
                     return call(c, args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 
