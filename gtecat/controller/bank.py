@@ -83,7 +83,7 @@ from gtecat.drives.homing_bank import return_constants as homing_return_constant
 from gtecat.drives.homing_bank import row_constants as homing_constants
 from gtecat.drives.homing_bank import row_kind as homing_row_kind
 from gtecat.drives.modes import SW12
-from gtecat.drives.slave import AlState
+from gtecat.drives.slave import AlState, VirtualSlave
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
@@ -484,6 +484,8 @@ class AxisBank:
         #: and whether the bank was to re-index before it
         self._frozen_call = -1
         self._frozen_stale = False
+        #: the bank's cycles and the outside marks after the last step of an opened row
+        self._opened_marks: tuple[int, tuple[int, int]] = (-1, (-1, -1))
         #: where a group's output bytes lie in the raw-write checks' references, per
         #: claimed pattern (:meth:`_took_group`)
         self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
@@ -2316,6 +2318,8 @@ class AxisBank:
             ax.post(t_ns, dt_ns)
             self._took_group(self.group_of[r])
             self._opened[r] += 1
+        # (what the drives' buffers may have changed by since: _close_opened)
+        self._opened_marks = (self.bank_cycles, _outside_marks(backend))
 
     def _took_group(self, gi: int) -> None:
         """The output bytes of group ``gi`` (claimed, its row opened) as the image holds
@@ -2361,14 +2365,22 @@ class AxisBank:
             self._close(r, g, True)
             return
         gi = self.group_of[r]
-        self._took_group(gi)
+        stepped = self._opened[r] and self._opened_marks == (
+            self.bank_cycles,
+            _outside_marks(self.ctl.backend),
+        )
         if not self._opened[r]:  # (no cycle stepped it: its buffers as a release leaves them)
             self._drive_buffers(g)
+        # stepped in the last cycle, nothing written to its outputs since (its references,
+        # taken after the step) and no SDO or field change since: its drive decoded what the
+        # image holds and sent what its objects hold, as _can_claim looks for
+        kept = stepped and self._outputs_kept(gi)
+        self._took_group(gi)
         if (
             g.drive.al_state == AlState.OP
             and not self._global_reason()
             and self._eligible(r)
-            and self._can_claim(g)
+            and (kept or self._can_claim(g))
         ):
             self._opened.pop(r, None)
             self.csp.load(r, flags=False)
@@ -3440,6 +3452,13 @@ class AxisBank:
         changed = [g for g in map(self.groups.__getitem__, hit) if g.claimed]
         if changed:
             self._release_groups(changed)
+
+
+def _outside_marks(backend: Any) -> tuple[int, int]:
+    """What moves whenever a slave's objects may change outside its own step: an SDO served
+    (the emulated backend's count of mailbox operations), a field write or an emergency
+    (:attr:`VirtualSlave.outside_changes`)."""
+    return getattr(backend, "_mailbox_ops", -1), VirtualSlave.outside_changes
 
 
 def _within_soft_limits(ax: Any, res: Any) -> bool:
