@@ -428,6 +428,11 @@ _COUNTS = (
 )
 
 
+#: the slots of some of :data:`_COUNTS`, for code that adds to them in the array itself
+_ROWS_RUN, _BANK_CYCLES, _KERNEL_CYCLES = (_COUNTS.index(n) for n in _COUNTS[2:5])
+_HOMING_ROWS_RUN, _REST_ROWS_RUN, _FROZEN_ROWS_RUN = (_COUNTS.index(n) for n in _COUNTS[6:9])
+
+
 class AxisBank:
     """The claimed axes of one controller and their cycle (module docstring)."""
 
@@ -2775,12 +2780,12 @@ class AxisBank:
             self._open_in_place()
         if self.kernel_due and kernel_settled():
             self._take_kernel()
-        self._countdown -= 1
+        c = self.counts
+        c[0] -= 1  # (_countdown, in its array: a property's get and set are Python calls)
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
         if self.dirty or (
-            self._countdown <= 0
-            and self.n_alive + len(self._opened) + (self._held_out >= 0) != self.n
+            c[0] <= 0 and self.n_alive + len(self._opened) + (self._held_out >= 0) != self.n
         ):
             self.refresh()
         if self._stale:
@@ -2805,7 +2810,8 @@ class AxisBank:
         if self._tp_apply:
             self._apply_probes()
         self._lists = {}  # (a new one: _lists' docs)
-        self._sts_epoch = 0  # (the status words made again)
+        counts = self.counts
+        counts[9] = 0  # (_sts_epoch: the status words made again)
         k = self.kernel
         if k is not None:
             # the plain cycle compiled; a new cycle time goes through numpy, and so does a
@@ -2815,10 +2821,10 @@ class AxisBank:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
             c_fill = self._c_fill  # the kernel refills the tables itself
             if dt == self.csp._dt:
-                if not c_fill and self.n_moving and self._refill_in <= 1:
+                if not c_fill and self.n_moving and counts[1] <= 1:  # (_refill_in)
                     self._fill_tables()  # as the numpy cycle would first (its step 2)
                 else:
-                    self._refill_in -= 1
+                    counts[1] -= 1
                 rc = k.cycle(t_ns, dt)
                 while rc == 3:  # rows leaving (an event, a limit): back to the scalar path first
                     self._release_rows(np.nonzero(k.scratch["s_hit"] & self.alive)[0])
@@ -3084,21 +3090,26 @@ class AxisBank:
         return not rc and (not self.n_moving or self._c_fill)
 
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
-        """What the numpy cycle does besides its arithmetic, after compiled cycles."""
+        """What the numpy cycle does besides its arithmetic, after compiled cycles (the
+        counts added in their array itself: each property's get and set is a Python call)."""
         csp = self.csp
-        csp.cycles += cycles
+        csp.counts[0] += cycles  # (CspBank.cycles)
         csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's
         if csp.any_fe:
             csp.fe_running = True  # the numpy cycle then looks at every row's timer
-        if k.move_ended:
+        if k._io[OUT_FIN]:  # (Kernel.move_ended)
             self.n_moving = int(np.count_nonzero(self.moving))
             self._count_standing()
-        self.rows_run += self.n_alive * cycles
-        self.bank_cycles += cycles
-        self.kernel_cycles += cycles
-        self.homing_rows_run += self.n_hm * cycles
-        self.rest_rows_run += self.n_rest * cycles
-        self.frozen_rows_run += self.n_frz * cycles
+        c = self.counts
+        c[_ROWS_RUN] += self.n_alive * cycles
+        c[_BANK_CYCLES] += cycles
+        c[_KERNEL_CYCLES] += cycles
+        if self.n_hm:
+            c[_HOMING_ROWS_RUN] += self.n_hm * cycles
+            if self.n_rest:
+                c[_REST_ROWS_RUN] += self.n_rest * cycles
+        if self.n_frz:
+            c[_FROZEN_ROWS_RUN] += self.n_frz * cycles
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""

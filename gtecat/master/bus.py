@@ -290,15 +290,16 @@ class Master:
         expected = self.backend.expected_wkc() if self.target == _OP else wkc
         before = self.last.wkc
         self.last = CycleResult(wkc, expected)
+        ok = wkc == expected  # (CycleResult.ok, asked once)
         if self._op_countdown >= 0:
             self._op_countdown -= 1
             if self._op_countdown < 0:
                 self.request_op()
-        elif self.target == _OP and self.last.ok and not self.all_op():
+        elif self.target == _OP and ok and not self.all_op():
             # the working counter is whole again (a slave came back and the backend
             # recovered it): take the states as they are now
             self.refresh_states()
-        elif self.target == _OP and not self.last.ok:
+        elif self.target == _OP and not ok:
             self.wkc_errors += 1
             if not self._wkc_bad:
                 self._wkc_bad = True
@@ -315,9 +316,9 @@ class Master:
                 # who is gone, from the first short cycle on (comm loss, module docstring),
                 # and again whenever the count changes while short (slaves gone or back)
                 self.refresh_states()
-        if self.last.ok:
+        if ok:
             self._bad_ns = 0
-        if self._wkc_bad and self.last.ok and self.all_op():
+        if self._wkc_bad and ok and self.all_op():
             self._wkc_bad = False
             self.error = ""
             self.log(f"Working counter changed to {wkc}/{expected}. All slaves are in OP mode.")
