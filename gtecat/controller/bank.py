@@ -494,6 +494,8 @@ class AxisBank:
         #: where a group's output bytes lie in the raw-write checks' references, per
         #: claimed pattern (:meth:`_took_group`)
         self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
+        #: each group's output bytes in the image (607Ah aside), as a list (made when asked)
+        self._grp_pos: dict[int, list[int]] = {}
         #: the row such a call gave back where per-cycle hooks run (:meth:`_open_released`)
         self._held_out = -1
         #: rows whose capture unit arms its drive's touch probe: the unit writes the function
@@ -686,6 +688,7 @@ class AxisBank:
             self.disabled_reason = "no drive the bank can run (mapping)"
             return
         self.groups = groups
+        self._grp_pos = {}
         #: every output byte of the bank's slaves (607Ah excluded), the row whose slave owns
         #: it and what it held at the last re-index: the kernel's raw-write check of the
         #: claimed ones (updated in place, so the kernel keeps its binding)
@@ -2329,25 +2332,31 @@ class AxisBank:
     def _took_group(self, gi: int) -> None:
         """The output bytes of group ``gi`` (claimed, its row opened) as the image holds
         them now are the raw-write checks' references (the row's own objects wrote them)."""
-        view = self.ctl.master.image.view
+        now, start, stop = self._group_outputs(gi)
         snap = self._rx_snap
-        ref: bytearray | None = None
-        for k, b, j in self._took_entries(gi):
-            v = view[b]
-            if snap[k] != v:
-                snap[k] = v
-            if ref is None and self._rx_ref[j] != v:
-                ref = bytearray(self._rx_ref)
-            if ref is not None:
-                ref[j] = v
-        if ref is not None:
-            self._rx_ref = bytes(ref)
+        if now == snap[start:stop].tobytes():
+            return
+        snap[start:stop] = np.frombuffer(now, np.uint8)
+        ref = bytearray(self._rx_ref)
+        for k, _, j in self._took_entries(gi):
+            ref[j] = now[k - start]
+        self._rx_ref = bytes(ref)
+
+    def _group_outputs(self, gi: int) -> tuple[bytes, int, int]:
+        """Group ``gi``'s output bytes (607Ah aside) as the image holds them now, and where
+        they lie in the references of every group's (:attr:`_rx_snap`)."""
+        pos = self._grp_pos.get(gi)
+        if pos is None:
+            pos = self._grp_pos[gi] = self.groups[gi].rx_bytes.tolist()
+        view = self.ctl.master.image.view
+        start = self._rx_start[gi]
+        return bytes([view[b] for b in pos]), start, start + len(pos)
 
     def _outputs_kept(self, gi: int) -> bool:
         """Claimed group ``gi``'s output bytes in the image are the raw-write checks'
         references (nothing wrote them since the bank looked)."""
-        view, ref = self.ctl.master.image.view, self._rx_ref
-        return all(view[b] == ref[j] for _, b, j in self._took_entries(gi))
+        now, start, stop = self._group_outputs(gi)
+        return now == self._rx_snap[start:stop].tobytes()
 
     def _took_entries(self, gi: int) -> list[tuple[int, int, int]]:
         """Claimed group ``gi``'s output bytes: (index in the references of every output
@@ -3469,7 +3478,7 @@ def _outside_marks(backend: Any) -> tuple[int, int]:
     """What moves whenever a slave's objects may change outside its own step: an SDO served
     (the emulated backend's count of mailbox operations), a field write or an emergency
     (:attr:`VirtualSlave.outside_changes`)."""
-    return getattr(backend, "_mailbox_ops", -1), VirtualSlave.outside_changes
+    return backend.__dict__.get("_mailbox_ops", -1), VirtualSlave.outside_changes
 
 
 def _within_soft_limits(ax: Any, res: Any) -> bool:
