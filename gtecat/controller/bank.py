@@ -566,6 +566,10 @@ class AxisBank:
         #: probe's (statistics; the differential tests check they ran)
         self.steps_in_place = 0
         self.posted_inputs = self.posted_probes = 0
+        #: calls of :data:`OPENED` that opened their row (:meth:`call_opened`), that ran on a
+        #: frozen row and left it claimed, that gave it back for the call where per-cycle
+        #: hooks run (statistics; the differential tests check each way ran)
+        self.calls_opened = self.calls_kept = self.calls_held_out = 0
         #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
         #: (:meth:`call_in_place`; statistics)
         self.trap_holds = 0
@@ -2306,6 +2310,7 @@ class AxisBank:
                 self._stepping = -1
             self.frz[r] = self.frz_off[r] = False  # (what _put_back clears)
         self.releases += 1
+        self.calls_opened += 1
         self._opened[r] = 0  # (the cycles that stepped it: _step_opened, _close_opened)
         self.n_alive -= 1
         self._counted()
@@ -2435,6 +2440,7 @@ class AxisBank:
         # of the other rows changes while this call runs)
         self.dirty, self._wait, self._countdown = dirty, wait, countdown
         self._held_out = r
+        self.calls_held_out += 1
         try:
             return call()
         finally:
@@ -2462,6 +2468,7 @@ class AxisBank:
         ):
             _reguard(objs)
             EPOCH.n += 1
+            self.calls_kept += 1
             return
         self._open_row(r, g, False)
         self._close_opened(r, g)
