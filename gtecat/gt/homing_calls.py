@@ -207,11 +207,18 @@ MADE = [0]
 
 
 def _state(ax: Axis) -> _AxisHoming:
+    # (kept on the axis too, read past a claimed axis's guard: a weak dictionary's lookup
+    # makes a weak reference every time; the dictionary stays what the GT fast path reads)
+    try:
+        return object.__getattribute__(ax, "_homing_run")  # type: ignore[no-any-return]
+    except AttributeError:
+        pass
     st = _STATE.get(ax)
     if st is None:
         st = _STATE[ax] = _AxisHoming()
         MADE[0] += 1
         ax.post_hooks.append(st.post)
+    object.__setattr__(ax, "_homing_run", st)
     return st
 
 
