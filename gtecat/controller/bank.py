@@ -20,7 +20,10 @@ before anything else may look at or change them:
   it, every axis when it names none) before it runs, but the calls of a Trap move's start
   (:data:`IN_PLACE`), which run on their axis's row in place (:meth:`AxisBank.call_in_place`:
   the row's state put into its objects, the call, the row taken up again from them, the
-  drive staying in the bank); one naming a coordinate system
+  drive staying in the bank) and the calls of a drive homing's set-up and start
+  (:data:`OPENED`), which run on their axis's row opened for the call
+  (:meth:`AxisBank.call_opened`: the cycles they wait for step the row's objects in the
+  bank's cycle, the row taken up again as the call returns); one naming a coordinate system
   releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit switch reached, the
