@@ -499,6 +499,8 @@ class AxisBank:
         self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
         #: each group's output bytes in the image (607Ah aside), as a list (made when asked)
         self._grp_pos: dict[int, list[int]] = {}
+        #: a slave's outputs in the image (start, stop), by position (:meth:`_decoded`)
+        self._out_area: dict[int, tuple[int, int]] = {}
         #: the row such a call gave back where per-cycle hooks run (:meth:`_open_released`)
         self._held_out = -1
         #: rows whose capture unit arms its drive's touch probe: the unit writes the function
@@ -696,6 +698,7 @@ class AxisBank:
             return
         self.groups = groups
         self._grp_pos = {}
+        self._out_area = {}
         #: every output byte of the bank's slaves (607Ah excluded), the row whose slave owns
         #: it and what it held at the last re-index: the kernel's raw-write check of the
         #: claimed ones (updated in place, so the kernel keeps its binding)
@@ -2321,8 +2324,9 @@ class AxisBank:
     def _step_opened(self, t_ns: int, dt_ns: int) -> None:
         """The cycle of each row opened for a call (:meth:`call_opened`) on its objects, as
         the scalar path runs it: the axis's pre step, its drive's exchange, its post step.
-        The claimed rows' output references follow what the axis wrote (the raw-write checks
-        look at the others)."""
+        (The raw-write checks' references of its outputs follow what the axis wrote when the
+        bank looks at them, or takes it again: the compiled cycle's check leaves out the rows
+        it does not run, and a re-index takes an opened row's bytes first.)"""
         backend = self.ctl.backend
         for r in sorted(self._opened):
             g = self.groups[self.group_of[r]]
@@ -2332,7 +2336,6 @@ class AxisBank:
             ax.pre(t_ns, dt_ns)
             backend.exchange_one(g.position, t_ns, dt_ns)
             ax.post(t_ns, dt_ns)
-            self._took_group(self.group_of[r])
             self._opened[r] += 1
         # (what the drives' buffers may have changed by since: _close_opened)
         self._opened_marks = (self.bank_cycles, _outside_marks(backend))
@@ -2359,6 +2362,18 @@ class AxisBank:
         view = self.ctl.master.image.view
         start = self._rx_start[gi]
         return bytes([view[b] for b in pos]), start, start + len(pos)
+
+    def _decoded(self, g: _Group) -> bool:
+        """Group ``g``'s drive took in its last exchange the output bytes the image holds now
+        (:meth:`_can_claim`'s first look)."""
+        at = self._out_area.get(g.position)
+        if at is None:
+            sl = self.ctl.layout.slaves[g.position]
+            start = (sl.out_logical_bit or 0) >> 3
+            at = self._out_area[g.position] = (start, start + sl.out_bytes)
+        start, stop = at
+        rx = g.drive.rx
+        return self.ctl.master.image.view[start:stop] == rx[: stop - start]
 
     def _outputs_kept(self, gi: int) -> bool:
         """Claimed group ``gi``'s output bytes in the image are the raw-write checks'
@@ -2393,10 +2408,10 @@ class AxisBank:
         )
         if not self._opened[r]:  # (no cycle stepped it: its buffers as a release leaves them)
             self._drive_buffers(g)
-        # stepped in the last cycle, nothing written to its outputs since (its references,
-        # taken after the step) and no SDO or field change since: its drive decoded what the
-        # image holds and sent what its objects hold, as _can_claim looks for
-        kept = stepped and self._outputs_kept(gi)
+        # stepped in the last cycle, nothing written to its outputs since (the image's are
+        # what its drive took in that exchange) and no SDO or field change since: its drive
+        # decoded what the image holds and sent what its objects hold, as _can_claim looks for
+        kept = stepped and self._decoded(g)
         self._took_group(gi)
         if (
             g.drive.al_state == AlState.OP
