@@ -117,6 +117,18 @@ class AxisIo:
         self._sdo_download = sdo_download
         self._sdo_download_many = sdo_download_many
 
+    @classmethod
+    def on(cls, master: Any, layout: Layout, ref: AxisRef) -> AxisIo:
+        """The channel ``ref`` of ``master``'s bus, its SDOs through the master."""
+        return cls(
+            master.image,
+            layout,
+            ref,
+            master.sdo_upload,
+            master.sdo_download,
+            master.sdo_download_many,
+        )
+
     def index(self, index: int) -> int:
         """Object index of this channel (channel 0 index + 0x800*k for 0x6000-0x67FF)."""
         if 0x6000 <= index < 0x6800:

@@ -2010,11 +2010,7 @@ class AxisBank:
             self._store(r)
         self.releases += 1
         for r in rows:
-            aware = self._aware.pop(r, None)
-            if aware:  # their cycles ran in the bank: the hooks catch up (nothing happened)
-                ran = int(self.bank_cycles - self.claim_cycle[r])
-                for obj in aware:
-                    obj.bank_released(ran)
+            self._catch_up(r)
         for g in groups:
             if opened and not self.alive[g.rows[0]] and g.rows[0] in opened:
                 continue  # (its drive stepped itself: its buffers are its own)
@@ -2035,6 +2031,15 @@ class AxisBank:
         # release: a loop of GT calls over many axes releases one slave per call
         self._stale = True
         self.n_alive = int(np.count_nonzero(self.alive))
+
+    def _catch_up(self, r: int) -> None:
+        """Row ``r``'s bank-aware hooks catch up with the cycles the bank ran since its claim
+        (they ran in the bank: nothing they watch happened), as the row leaves it."""
+        aware = self._aware.pop(r, None)
+        if aware:
+            ran = int(self.bank_cycles - self.claim_cycle[r])
+            for obj in aware:
+                obj.bank_released(ran)
 
     def _drive_buffers(self, g: _Group) -> None:
         """Group ``g``'s drive's process data buffers as its own steps would have left them:
@@ -2302,11 +2307,7 @@ class AxisBank:
                 self._rates = {r: self._enc_rates_row(r)}
                 csp.store([r])
             self._store(r)
-            aware = self._aware.pop(r, None)
-            if aware:  # (as at a release: the hooks catch up with the cycles the bank ran)
-                ran = int(self.bank_cycles - self.claim_cycle[r])
-                for obj in aware:
-                    obj.bank_released(ran)
+            self._catch_up(r)
         else:
             csp.rested(r)
             self._stepping = r  # (its objects hold its state: nothing put back)
@@ -3318,11 +3319,7 @@ class AxisBank:
             self._last = {r: self._planned_row(r)}
             self._rates = {r: self._enc_rates_row(r)}
             self._put_back(r)
-            aware = self._aware.pop(r, None)
-            if aware:  # (as at a release: the hooks catch up with the cycles the bank ran)
-                ran = int(self.bank_cycles - self.claim_cycle[r])
-                for obj in aware:
-                    obj.bank_released(ran)
+            self._catch_up(r)
         except BaseException:
             _reguard(objs)  # (still claimed: guarded as before)
             raise

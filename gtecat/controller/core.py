@@ -344,18 +344,7 @@ class Controller:
             self.log(note)  # (what the drives are built from: two runs' inputs compared)
         self.started = False
         self.axes = {
-            ref.axis: Axis(
-                ref.axis,
-                AxisIo(
-                    master.image,
-                    layout,
-                    ref,
-                    master.sdo_upload,
-                    master.sdo_download,
-                    master.sdo_download_many,
-                ),
-            )
-            for ref in layout.axes
+            ref.axis: Axis(ref.axis, AxisIo.on(master, layout, ref)) for ref in layout.axes
         }
         self._axis_list = list(self.axes.values())
         self._run_axes = self._axis_list
