@@ -885,9 +885,12 @@ class AxisBank:
         """:meth:`_reindex`'s part that follows from the claimed pattern alone (a row opened
         for a call counts as the bank's: it steps the row itself, :meth:`_step_opened`)."""
         alive = self.alive
-        if self._opened:
-            alive = alive.copy()
-            alive[sorted(self._opened)] = True
+        if self._opened:  # (one given back meanwhile is the controller's, as any released row)
+            group_of, claimed = self.group_of, self._g_claimed
+            mine = [r for r in self._opened if claimed[group_of[r]]]
+            if mine:
+                alive = alive.copy()
+                alive[mine] = True
         g_claimed = self._g_claimed
         rows = self._rows_of_axes
         axis_list = self.ctl._axis_list
@@ -1214,7 +1217,9 @@ class AxisBank:
         for gs, srows, bad in self._components():
             if gs[0].claimed and (len(gs) == 1 or all(g.claimed for g in gs)):
                 continue
-            if self._held_out >= 0 and any(r == self._held_out for g in gs for r in g.rows):
+            if (self._held_out >= 0 or self._opened) and any(
+                r == self._held_out or r in self._opened for g in gs for r in g.rows
+            ):
                 continue  # (out for a call: call_opened takes it when the call returns)
             held = [g for g in gs if g.claimed]
             if held:  # part of a cluster is out: the rest comes back too, then all together

@@ -22,6 +22,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.controller import bank_kernel
+from gtecat.controller.bank import AxisBank
 from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
 from tests.gtecat.controller.test_bank_homing import _machine, _mechanics, _sample
 
@@ -139,3 +140,27 @@ def test_the_bank_opened_kept_and_gave_back_rows(runs: tuple) -> None:
         pytest.skip("GTECAT_BANK_KERNEL=numpy: homing rows run only in the compiled cycle")
     _, (_, (opened, kept, held_out)) = runs
     assert opened >= 8 and kept >= 2 and held_out >= 3
+
+
+def test_a_row_given_back_while_opened_runs_on_the_scalar_path(
+    runs: tuple, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """Every row given back in the middle of a call on an opened row (what a bank that must
+    stop does: a hook added, the bus leaving OP) leaves that row to the controller and the
+    bus for the rest of the call, and the call's end takes it as any released row."""
+    step = AxisBank._step_opened
+    given: list[int] = []
+
+    def step_then_give_back(bank: AxisBank, t_ns: int, dt_ns: int) -> None:
+        step(bank, t_ns, dt_ns)
+        if bank._opened and len(given) < 4:
+            given.append(next(iter(bank._opened)))
+            bank.release_all()
+
+    monkeypatch.setattr(AxisBank, "_step_opened", step_then_give_back)
+    (ref, _), _ = runs
+    got, _ = _run(_machine(tmp_path_factory.mktemp("given"), SETUP), "on")
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"step {k}: the bank and the scalar drives differ"
+    if HAS_CC and bank_kernel.wanted() != "numpy":
+        assert len(given) == 4
