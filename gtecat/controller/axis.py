@@ -105,6 +105,7 @@ class AxisIo:
         ref: AxisRef,
         sdo_upload: Callable[[int, int, int], bytes] | None = None,
         sdo_download: Callable[[int, int, int, bytes], None] | None = None,
+        sdo_download_many: Callable[[int, list[tuple[int, int, bytes]]], None] | None = None,
     ) -> None:
         self.ref = ref
         self.slave = ref.slave
@@ -114,6 +115,19 @@ class AxisIo:
         self._cache: dict[tuple[int, int], EntryAccess | None] = {}
         self._sdo_upload = sdo_upload
         self._sdo_download = sdo_download
+        self._sdo_download_many = sdo_download_many
+
+    @classmethod
+    def on(cls, master: Any, layout: Layout, ref: AxisRef) -> AxisIo:
+        """The channel ``ref`` of ``master``'s bus, its SDOs through the master."""
+        return cls(
+            master.image,
+            layout,
+            ref,
+            master.sdo_upload,
+            master.sdo_download,
+            master.sdo_download_many,
+        )
 
     def index(self, index: int) -> int:
         """Object index of this channel (channel 0 index + 0x800*k for 0x6000-0x67FF)."""
@@ -179,6 +193,28 @@ class AxisIo:
             raise CommandError("no mailbox on this backend")
         data = int(value).to_bytes(size, "little", signed=value < 0)
         self._sdo_download(self.slave, self.index(index), subindex, data)
+
+    def write_all_or_sdo(self, items: list[tuple[int, int, int, int]]) -> None:
+        """Write ``(index, subindex, value, size)`` objects in order, each by PDO if mapped,
+        else by SDO (the SDOs one after the other in one call where the master takes them
+        so: every one a download of its own, the first that fails raised)."""
+        many = self._sdo_download_many
+        sdo: list[tuple[int, int, bytes]] = []
+        for index, subindex, value, size in items:
+            acc = self.get(index, subindex)
+            if acc is None and many is not None:
+                data = int(value).to_bytes(size, "little", signed=value < 0)
+                sdo.append((self.index(index), subindex, data))
+                continue
+            if sdo:  # (in order: the SDOs before this object first)
+                many(self.slave, sdo)  # type: ignore[misc]
+                sdo = []
+            if acc is not None:
+                acc.set(value)
+            else:
+                self.sdo_write(index, subindex, value, size)
+        if sdo:
+            many(self.slave, sdo)  # type: ignore[misc]
 
     def read_or_sdo(self, index: int, subindex: int, size: int, signed: bool = False) -> int:
         """PDO if mapped, else SDO (manual 5.2.2.2 for 6060h/6061h)."""

@@ -20,7 +20,10 @@ before anything else may look at or change them:
   it, every axis when it names none) before it runs, but the calls of a Trap move's start
   (:data:`IN_PLACE`), which run on their axis's row in place (:meth:`AxisBank.call_in_place`:
   the row's state put into its objects, the call, the row taken up again from them, the
-  drive staying in the bank); one naming a coordinate system
+  drive staying in the bank) and the calls of a drive homing's set-up and start
+  (:data:`OPENED`), which run on their axis's row opened for the call
+  (:meth:`AxisBank.call_opened`: the cycles they wait for step the row's objects in the
+  bank's cycle, the row taken up again as the call returns); one naming a coordinate system
   releases that system's cluster alone (:meth:`AxisBank.before_call`; a segment pushed
   onto a running path the bank holds ahead may even stay: ``_push_ahead``);
 * a cycle in which a claimed axis would leave the state (a limit switch reached, the
@@ -83,7 +86,7 @@ from gtecat.drives.homing_bank import return_constants as homing_return_constant
 from gtecat.drives.homing_bank import row_constants as homing_constants
 from gtecat.drives.homing_bank import row_kind as homing_row_kind
 from gtecat.drives.modes import SW12
-from gtecat.drives.slave import AlState
+from gtecat.drives.slave import AlState, VirtualSlave
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.model import Direction
 
@@ -160,6 +163,10 @@ CONSTANT_TX |= set(range(0x60D1, 0x60D9))
 IN_PLACE = frozenset(
     {"GT_PrfTrap", "GT_SetTrapPrm", "GT_SetPos", "GT_SetVel", "GT_Update", "GT_GoHome"}
 )
+#: the GT functions of a drive homing's set-up and start (manual 5.2.2.2) that take their axis
+#: out of the bank for the call alone (:meth:`AxisBank.call_opened`): the cycles they wait for
+#: step its drive on the scalar objects, and the row is taken again when the call returns
+OPENED = frozenset({"GT_SetHomingMode", "GT_SetEcatHomingPrm", "GT_StartEcatHoming"})
 #: those of :data:`IN_PLACE` that write their profile's values for the next GT_Update alone
 #: (the Trap target, the speed), which the bank keeps no copy of: they run with the row as
 #: it stands (anything else they reached would give the drive back through its guard)
@@ -424,6 +431,11 @@ _COUNTS = (
 )
 
 
+#: the slots of some of :data:`_COUNTS`, for code that adds to them in the array itself
+_ROWS_RUN, _BANK_CYCLES, _KERNEL_CYCLES = (_COUNTS.index(n) for n in _COUNTS[2:5])
+_HOMING_ROWS_RUN, _REST_ROWS_RUN, _FROZEN_ROWS_RUN = (_COUNTS.index(n) for n in _COUNTS[6:9])
+
+
 class AxisBank:
     """The claimed axes of one controller and their cycle (module docstring)."""
 
@@ -473,6 +485,24 @@ class AxisBank:
         self._stepping = -1
         #: rows a posted edge left open for the step after the cycle (:meth:`_post_event`)
         self._open: set[int] = set()
+        #: the row a call of :data:`OPENED` runs on, opened for the call (:meth:`call_opened`),
+        #: and the cycles that stepped it since
+        self._opened: dict[int, int] = {}
+        #: the frozen row such a call runs on with its guards off, not opened (-1: none),
+        #: and whether the bank was to re-index before it
+        self._frozen_call = -1
+        self._frozen_stale = False
+        #: the bank's cycles and the outside marks after the last step of an opened row
+        self._opened_marks: tuple[int, tuple[int, int]] = (-1, (-1, -1))
+        #: where a group's output bytes lie in the raw-write checks' references, per
+        #: claimed pattern (:meth:`_took_group`)
+        self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
+        #: each group's output bytes in the image (607Ah aside), as a list (made when asked)
+        self._grp_pos: dict[int, list[int]] = {}
+        #: a slave's outputs in the image (start, stop), by position (:meth:`_decoded`)
+        self._out_area: dict[int, tuple[int, int]] = {}
+        #: the row such a call gave back where per-cycle hooks run (:meth:`_open_released`)
+        self._held_out = -1
         #: rows whose capture unit arms its drive's touch probe: the unit writes the function
         #: after the next cycle (:meth:`_post_pending`), the drive applies it at the start of
         #: the one after (:attr:`_tp_apply`, :meth:`_apply_probes`)
@@ -541,6 +571,10 @@ class AxisBank:
         #: probe's (statistics; the differential tests check they ran)
         self.steps_in_place = 0
         self.posted_inputs = self.posted_probes = 0
+        #: calls of :data:`OPENED` that opened their row (:meth:`call_opened`), that ran on a
+        #: frozen row and left it claimed, that gave it back for the call where per-cycle
+        #: hooks run (statistics; the differential tests check each way ran)
+        self.calls_opened = self.calls_kept = self.calls_held_out = 0
         #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
         #: (:meth:`call_in_place`; statistics)
         self.trap_holds = 0
@@ -663,6 +697,8 @@ class AxisBank:
             self.disabled_reason = "no drive the bank can run (mapping)"
             return
         self.groups = groups
+        self._grp_pos = {}
+        self._out_area = {}
         #: every output byte of the bank's slaves (607Ah excluded), the row whose slave owns
         #: it and what it held at the last re-index: the kernel's raw-write check of the
         #: claimed ones (updated in place, so the kernel keeps its binding)
@@ -788,10 +824,19 @@ class AxisBank:
 
     def _reindex(self) -> None:
         """Image addresses and run lists of the claimed rows (after a claim or release)."""
+        for r in self._opened:  # (its outputs are its objects', not a raw write)
+            self._took_group(self.group_of[r])
         self._release_written()
         alive = self.alive
         self._stale = False
         self.n_alive = int(np.count_nonzero(alive))
+        self._recount()
+        self._patterns()
+
+    def _recount(self) -> None:
+        """What the cycle looks at of the claimed rows' flags, counted again (after a claim or
+        a release; a row opened for a call or taken again after it: :meth:`call_opened`)."""
+        alive = self.alive
         if self._loaded:  # the rows' constants (they change only when a row is taken)
             self._loaded = False
             ratio, off = self.prf_ratio, self.prf_off
@@ -820,6 +865,32 @@ class AxisBank:
         self._c_fill = self.kernel is not None and not (
             self.n_moving and np.count_nonzero(moving & (self.nseg <= 0))
         )
+        self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
+
+    def _counted(self) -> None:
+        """After a row opened for a call or taken again from its objects (the claimed set
+        stays; its counts moved with it): what :meth:`_recount` does besides the counts."""
+        if self._loaded:
+            self._recount()
+            return
+        if self.any_band:
+            self._count_standing()
+        self.band_dirty = True
+        self._img_stale = True
+        self._lists = {}  # (a new one: _lists' docs)
+        self._sts_epoch = 0  # (the status words made again)
+
+    def _patterns(self) -> None:
+        """:meth:`_reindex`'s part that follows from the claimed pattern alone (a row opened
+        for a call counts as the bank's: it steps the row itself, :meth:`_step_opened`)."""
+        alive = self.alive
+        if self._opened:  # (one given back meanwhile is the controller's, as any released row)
+            group_of, claimed = self.group_of, self._g_claimed
+            mine = [r for r in self._opened if claimed[group_of[r]]]
+            if mine:
+                alive = alive.copy()
+                alive[mine] = True
         g_claimed = self._g_claimed
         rows = self._rows_of_axes
         axis_list = self.ctl._axis_list
@@ -1146,6 +1217,10 @@ class AxisBank:
         for gs, srows, bad in self._components():
             if gs[0].claimed and (len(gs) == 1 or all(g.claimed for g in gs)):
                 continue
+            if (self._held_out >= 0 or self._opened) and any(
+                r == self._held_out or r in self._opened for g in gs for r in g.rows
+            ):
+                continue  # (out for a call: call_opened takes it when the call returns)
             held = [g for g in gs if g.claimed]
             if held:  # part of a cluster is out: the rest comes back too, then all together
                 self._release_groups(held)
@@ -1921,6 +1996,9 @@ class AxisBank:
                     _set(obj, "__class__", cls.__base__)
             g.claimed = False
             self._g_claimed[self._gi[id(g)]] = False
+        opened = self._opened
+        if opened:  # (a row opened for a call: its objects hold its state, nothing to store)
+            rows = [r for r in rows if r not in opened]
         frz = self.frz
         if any(frz[r] for r in rows):
             # a frozen row's channel holds what its skipped cycles would have left
@@ -1937,29 +2015,11 @@ class AxisBank:
             self._store(r)
         self.releases += 1
         for r in rows:
-            aware = self._aware.pop(r, None)
-            if aware:  # their cycles ran in the bank: the hooks catch up (nothing happened)
-                ran = int(self.bank_cycles - self.claim_cycle[r])
-                for obj in aware:
-                    obj.bank_released(ran)
-        # the drive's process data buffers as its own steps would have left them: the entries
-        # the bank wrote into the image in them too (its other bytes are as they were, so a
-        # raw write or a changed constant still waits for a step of its own: _can_claim).
-        # 607Ah as the bank last sent it, not as the image holds it now: a raw write since
-        # (not looked at: the bank writes 607Ah itself) never reached the drive - one cut off
-        # by a pulled cable runs on what it last received, as on the scalar path
-        buf = self.ctl.master.image.buffer
-        target = self.csp.target
+            self._catch_up(r)
         for g in groups:
-            rx, tx = g.drive.rx, g.drive.tx
-            for byte, size, out, i, r in g.computed:
-                dst = rx if out else tx
-                if 0 <= i and i + size <= len(dst):
-                    if out:
-                        sent = (int(target[r]) & 0xFFFFFFFF).to_bytes(4, "little")
-                        dst[i : i + size] = sent[:size]
-                    else:
-                        dst[i : i + size] = buf[byte : byte + size].tobytes()
+            if opened and not self.alive[g.rows[0]] and g.rows[0] in opened:
+                continue  # (its drive stepped itself: its buffers are its own)
+            self._drive_buffers(g)
         for cl in clusters:
             # the planners stand where the scalar path has them (bank_modes.Cluster.rewind)
             cl.rewind(self)
@@ -1976,6 +2036,34 @@ class AxisBank:
         # release: a loop of GT calls over many axes releases one slave per call
         self._stale = True
         self.n_alive = int(np.count_nonzero(self.alive))
+
+    def _catch_up(self, r: int) -> None:
+        """Row ``r``'s bank-aware hooks catch up with the cycles the bank ran since its claim
+        (they ran in the bank: nothing they watch happened), as the row leaves it."""
+        aware = self._aware.pop(r, None)
+        if aware:
+            ran = int(self.bank_cycles - self.claim_cycle[r])
+            for obj in aware:
+                obj.bank_released(ran)
+
+    def _drive_buffers(self, g: _Group) -> None:
+        """Group ``g``'s drive's process data buffers as its own steps would have left them:
+        the entries the bank wrote into the image in them too (its other bytes are as they
+        were, so a raw write or a changed constant still waits for a step of its own:
+        _can_claim).  607Ah as the bank last sent it, not as the image holds it now: a raw
+        write since (not looked at: the bank writes 607Ah itself) never reached the drive -
+        one cut off by a pulled cable runs on what it last received, as on the scalar path."""
+        buf = self.ctl.master.image.buffer
+        target = self.csp.target
+        rx, tx = g.drive.rx, g.drive.tx
+        for byte, size, out, i, r in g.computed:
+            dst = rx if out else tx
+            if 0 <= i and i + size <= len(dst):
+                if out:
+                    sent = (int(target[r]) & 0xFFFFFFFF).to_bytes(4, "little")
+                    dst[i : i + size] = sent[:size]
+                else:
+                    dst[i : i + size] = buf[byte : byte + size].tobytes()
 
     def _store(self, r: int) -> None:
         self.alive[r] = False
@@ -2133,6 +2221,317 @@ class AxisBank:
         done: list[Any] = []
         self._in_place(r, self.groups[self.group_of[r]], lambda: done.append(call()))
         return done[0]
+
+    def call_opened(self, ctl: Any, proto: Any, values: tuple, call: Callable[[], Any]) -> Any:
+        """``call()``'s result, a GT function of :data:`OPENED` with ``values`` on ``ctl``.
+
+        Its axis's row (a drive of one channel the bank runs) is *opened* for the call: its
+        state goes into its objects as at a release and their guards come off, the compiled
+        cycle leaves the row out, and each cycle the call waits for (the drive's answer to a
+        new 6060h or to CW4) steps the row's objects as the scalar path steps them - the
+        axis's pre step, its drive's exchange, the axis's post step (:meth:`_step_opened`).
+        When the call returns the row is taken again from its objects if it is in a state
+        the bank runs (as :meth:`refresh` would take it at the next cycle), else given back.
+        The bus and the controller keep the slave and the axis as the bank's meanwhile
+        (nothing re-indexed), and nothing else is looked at: a drive homing's set-up cost
+        per axis on a bus of 64 axes standing in the bank a release, a re-index, a look
+        over every row and a claim before.  Where the controller has per-cycle hooks (which
+        run between the bank's cycle and the axes' steps) the row goes back for the call
+        instead and is taken again as it returns (:meth:`_open_released`).
+
+        A frozen row (:meth:`_eligible_frozen`: servo off, or standing in homing mode
+        before its homing) is not even opened unless a cycle comes: its objects hold its
+        state already (nothing of its cycles changes), so the call runs on them without
+        their guards, and the row stays when the call returns with no cycle run and the row
+        still frozen (a drive's homing parameters written by SDO: GT_SetEcatHomingPrm).  A
+        cycle due meanwhile opens it first (:meth:`_begin`), its objects as the call left
+        them."""
+        ax = ctl.axes.get(values[0]) if values and type(values[0]) is int else None
+        r = self._row_of.get(id(ax)) if ax is not None and self.n_alive else None
+        if (
+            r is None
+            or not self.alive[r]
+            or self._stepping >= 0
+            or self._opened
+            or self._frozen_call >= 0
+            or self.kernel is None
+        ):
+            self.before_call(ctl, proto, values)
+            return call()
+        g = self.groups[self.group_of[r]]
+        if len(g.rows) != 1 or self.sampled[r] or not g.claimed or r in self._open:
+            self.before_call(ctl, proto, values)
+            return call()
+        clock = ctl.clock
+        if ctl.pre_cycle or ctl.post_cycle:
+            return self._open_released(r, g, clock, call)
+        if self.frz[r] and r not in self._aware:
+            objs = tuple(self._guarded_objects(g))
+            _unguard(objs)
+            self._frozen_call = r
+            self._frozen_stale = self._stale
+            self._stale = True  # (no cycle runs many at once: the next one's _begin opens it)
+            try:
+                return call()
+            finally:
+                if self._frozen_call == r:  # no cycle came: the row as the call left it
+                    self._frozen_call = -1
+                    self._stale = self._frozen_stale
+                    homing_objects = proto.name == "GT_SetEcatHomingPrm" and values[-1] == 0
+                    self._close_in_place(r, g, objs, homing_objects)
+                else:
+                    self._close_opened(r, g)
+        self._open_row(r, g, True)
+        try:
+            return call()
+        finally:
+            self._close_opened(r, g)
+
+    def _open_row(self, r: int, g: _Group, put_back: bool) -> None:
+        """Open claimed row ``r`` (group ``g``, one channel) for :meth:`call_opened`:
+        ``put_back``: its state goes into its objects as a release puts it (else they hold
+        it: a frozen row a call ran on in place, its objects as the call left them)."""
+        EPOCH.n += 1
+        objs = self._guarded_objects(g)
+        _unguard(tuple(objs))
+        for obj in objs:
+            _OWNER.pop(id(obj), None)
+        csp = self.csp
+        # (the counts the cycle looks at, less this row's: its flags are cleared below)
+        hm = bool(self.hm[r])
+        self.n_jog -= bool(self.jog[r])
+        self.n_hm -= hm
+        self.n_rest -= hm and self.h_done[r] == 1
+        self.n_frz -= bool(self.frz[r])
+        self.n_moving -= bool(self.moving[r])
+        if put_back:
+            if self.frz[r]:
+                csp.rested(r)
+            else:
+                self._last = {r: self._planned_row(r)}
+                self._rates = {r: self._enc_rates_row(r)}
+                csp.store([r])
+            self._store(r)
+            self._catch_up(r)
+        else:
+            csp.rested(r)
+            self._stepping = r  # (its objects hold its state: nothing put back)
+            try:
+                self._store(r)
+            finally:
+                self._stepping = -1
+            self.frz[r] = self.frz_off[r] = False  # (what _put_back clears)
+        self.releases += 1
+        self.calls_opened += 1
+        self._opened[r] = 0  # (the cycles that stepped it: _step_opened, _close_opened)
+        self.n_alive -= 1
+        self._counted()
+
+    def _step_opened(self, t_ns: int, dt_ns: int) -> None:
+        """The cycle of each row opened for a call (:meth:`call_opened`) on its objects, as
+        the scalar path runs it: the axis's pre step, its drive's exchange, its post step.
+        (The raw-write checks' references of its outputs follow what the axis wrote when the
+        bank looks at them, or takes it again: the compiled cycle's check leaves out the rows
+        it does not run, and a re-index takes an opened row's bytes first.)"""
+        backend = self.ctl.backend
+        for r in sorted(self._opened):
+            g = self.groups[self.group_of[r]]
+            if not g.claimed or self.alive[r]:
+                continue  # (given back meanwhile: the scalar path runs it)
+            ax = self.axes[r]
+            ax.pre(t_ns, dt_ns)
+            backend.exchange_one(g.position, t_ns, dt_ns)
+            ax.post(t_ns, dt_ns)
+            self._opened[r] += 1
+        # (what the drives' buffers may have changed by since: _close_opened)
+        self._opened_marks = (self.bank_cycles, _outside_marks(backend))
+
+    def _took_group(self, gi: int) -> None:
+        """The output bytes of group ``gi`` (claimed, its row opened) as the image holds
+        them now are the raw-write checks' references (the row's own objects wrote them)."""
+        now, start, stop = self._group_outputs(gi)
+        snap = self._rx_snap
+        if now == snap[start:stop].tobytes():
+            return
+        snap[start:stop] = np.frombuffer(now, np.uint8)
+        ref = bytearray(self._rx_ref)
+        for k, _, j in self._took_entries(gi):
+            ref[j] = now[k - start]
+        self._rx_ref = bytes(ref)
+
+    def _group_outputs(self, gi: int) -> tuple[bytes, int, int]:
+        """Group ``gi``'s output bytes (607Ah aside) as the image holds them now, and where
+        they lie in the references of every group's (:attr:`_rx_snap`)."""
+        pos = self._grp_pos.get(gi)
+        if pos is None:
+            pos = self._grp_pos[gi] = self.groups[gi].rx_bytes.tolist()
+        view = self.ctl.master.image.view
+        start = self._rx_start[gi]
+        return bytes([view[b] for b in pos]), start, start + len(pos)
+
+    def _decoded(self, g: _Group) -> bool:
+        """Group ``g``'s drive took in its last exchange the output bytes the image holds now
+        (:meth:`_can_claim`'s first look)."""
+        at = self._out_area.get(g.position)
+        if at is None:
+            sl = self.ctl.layout.slaves[g.position]
+            start = (sl.out_logical_bit or 0) >> 3
+            at = self._out_area[g.position] = (start, start + sl.out_bytes)
+        start, stop = at
+        rx = g.drive.rx
+        return self.ctl.master.image.view[start:stop] == rx[: stop - start]
+
+    def _outputs_kept(self, gi: int) -> bool:
+        """Claimed group ``gi``'s output bytes in the image are the raw-write checks'
+        references (nothing wrote them since the bank looked)."""
+        now, start, stop = self._group_outputs(gi)
+        return now == self._rx_snap[start:stop].tobytes()
+
+    def _took_entries(self, gi: int) -> list[tuple[int, int, int]]:
+        """Claimed group ``gi``'s output bytes: (index in the references of every output
+        byte, its byte in the image, its index in those of the claimed ones), per pattern."""
+        at = self._took_at.get(gi)
+        if at is None or at[0] is not self._rx_idx:
+            start, stop = self._rx_start[gi], self._rx_start[gi + 1]
+            before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
+            at = self._took_at[gi] = (
+                self._rx_idx,
+                [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
+            )
+        return at[1]
+
+    def _close_opened(self, r: int, g: _Group) -> None:
+        """After :meth:`call_opened`'s call on opened row ``r``: taken again from its objects
+        when :meth:`refresh` would take it now, else given back (its objects as they are)."""
+        if not g.claimed or self.alive[r]:  # (given back meanwhile: as any released row)
+            self._opened.pop(r, None)
+            self._close(r, g, True)
+            return
+        gi = self.group_of[r]
+        stepped = self._opened[r] and self._opened_marks == (
+            self.bank_cycles,
+            _outside_marks(self.ctl.backend),
+        )
+        if not self._opened[r]:  # (no cycle stepped it: its buffers as a release leaves them)
+            self._drive_buffers(g)
+        # stepped in the last cycle, nothing written to its outputs since (the image's are
+        # what its drive took in that exchange) and no SDO or field change since: its drive
+        # decoded what the image holds and sent what its objects hold, as _can_claim looks for
+        kept = stepped and self._decoded(g)
+        self._took_group(gi)
+        if (
+            g.drive.al_state == AlState.OP
+            and not self._global_reason()
+            and self._eligible(r)
+            and (kept or self._can_claim(g))
+        ):
+            self._opened.pop(r, None)
+            self.csp.load(r, flags=False)
+            self._load(r)
+            self.csp.after_loads()
+            hm = bool(self.hm[r])
+            self.n_jog += bool(self.jog[r])
+            self.n_hm += hm
+            self.n_rest += hm and self.h_done[r] == 1
+            self.n_frz += bool(self.frz[r])
+            self._after_load(r, False)
+            for obj in self._guarded_objects(g):
+                key = id(obj)
+                _OWNER[key] = (self, gi)
+                _set(obj, "__class__", _guard_class(type(obj)))
+                if key not in _OWN_DICT:
+                    _OWN_DICT.add(key)
+                    own_dict(obj)
+            self.n_alive += 1
+            self._counted()
+            return
+        try:
+            self._release_groups([g])  # (opened: nothing put back, the objects hold it)
+        finally:
+            self._opened.pop(r, None)
+        self._reindex()
+        self.dirty = True
+
+    def _open_released(self, r: int, g: _Group, clock: Any, call: Callable[[], Any]) -> Any:
+        """:meth:`call_opened` where per-cycle hooks run: the row goes back for the call (as
+        :meth:`before_call` gives it back), and is taken again as the call returns when
+        :meth:`refresh` would take it."""
+        c0 = clock.cycles
+        dirty, stale = self.dirty, self._stale
+        wait, countdown = self._wait, self._countdown
+        self._release_groups([g])
+        # (what the release asks of the next cycle, for the rows a call gives back: nothing
+        # of the other rows changes while this call runs)
+        self.dirty, self._wait, self._countdown = dirty, wait, countdown
+        self._held_out = r
+        self.calls_held_out += 1
+        try:
+            return call()
+        finally:
+            self._held_out = -1
+            self._close(r, g, stale or clock.cycles != c0)
+
+    def _close_in_place(self, r: int, g: _Group, objs: tuple, homing_objects: bool) -> None:
+        """After :meth:`call_opened`'s call on frozen row ``r`` with no cycle run: guarded
+        again when it is still such a row (what a claim takes of it stays as it was: the
+        calls change a drive's homing objects, its mode, its controlword, none of them
+        without a cycle) and its outputs in the image are as the bank left them, else
+        opened as the call left its objects and taken again from them or given back.
+        ``homing_objects``: the call wrote the drive's homing objects and nothing else
+        (GT_SetEcatHomingPrm without a probe function: 6098h, 6099h:01/02, 609Ah, 607Ch,
+        which a drive takes at CW4's rising edge only, and the GT layer's record of the
+        homing, which the bank allows while no run is active), so the row is what it was."""
+        gi = self.group_of[r]
+        if (
+            g.claimed
+            and self._outputs_kept(gi)
+            and (
+                homing_objects
+                or (self._eligible(r) and self.frz_off[r] == (not self.axes[r].servo_on))
+            )
+        ):
+            _reguard(objs)
+            EPOCH.n += 1
+            self.calls_kept += 1
+            return
+        self._open_row(r, g, False)
+        self._close_opened(r, g)
+
+    def _open_in_place(self) -> None:
+        """A cycle comes while a call runs on frozen row :attr:`_frozen_call` with its
+        guards off (:meth:`call_opened`): the row is opened first, its objects as the call
+        left them."""
+        r = self._frozen_call
+        self._frozen_call = -1
+        self._stale = self._frozen_stale
+        self._open_row(r, self.groups[self.group_of[r]], False)
+
+    def _close(self, r: int, g: _Group, stale: bool) -> None:
+        """After a call whose row went back (:meth:`_open_released`, or given back while
+        opened): taken again when :meth:`refresh` would take it now, else the bank looks
+        again at the next cycle as after any release (``stale``: cycles ran while it was
+        out, or the bank was to re-index anyway)."""
+        if (
+            not g.claimed
+            and g.drive.al_state == AlState.OP
+            and not self._global_reason()
+            and self._eligible(r)
+            and self._can_claim(g)
+        ):
+            self._claim(g)
+            self.csp.after_loads()
+            self.n_alive += 1
+            if stale:
+                self._stale = True
+            else:
+                # the same rows claimed as before the call: the image's references stand
+                # when the call wrote none of the row's outputs (else the re-index looks)
+                self._stale = self.ctl.master.image.buffer.take(self._rx_idx).tobytes() != (
+                    self._rx_ref
+                )
+            return
+        self.dirty = True
+        self._wait = 1
 
     def _trap_held(self, r: int) -> bool:
         """Claimed row ``r`` stands in Trap mode with its planner (the object and the row)
@@ -2417,18 +2816,29 @@ class AxisBank:
             self._settled = True
 
     def _begin(self) -> None:
+        if self._frozen_call >= 0:
+            self._open_in_place()
         if self.kernel_due and kernel_settled():
             self._take_kernel()
-        self._countdown -= 1
+        c = self.counts
+        c[0] -= 1  # (_countdown, in its array: a property's get and set are Python calls)
         # with every slave claimed and nothing touched, there is nothing to look for (a hook or
         # anything else reaching a claimed object goes through a guard, which sets dirty)
-        if self.dirty or (self._countdown <= 0 and self.n_alive != self.n):
+        if self.dirty or (
+            c[0] <= 0 and self.n_alive + len(self._opened) + (self._held_out >= 0) != self.n
+        ):
             self.refresh()
         if self._stale:
             self._reindex()
 
     def cycle(self, t_ns: int, dt_ns: int) -> None:
-        """Run the claimed axes' whole cycle; release (before it) the ones that leave."""
+        """Run the claimed axes' whole cycle; release (before it) the ones that leave; then
+        the rows opened for a call on their objects (:meth:`_step_opened`)."""
+        self._cycle(t_ns, dt_ns)
+        if self._opened:
+            self._step_opened(t_ns, dt_ns)
+
+    def _cycle(self, t_ns: int, dt_ns: int) -> None:
         if self.evt_rows:
             self.evt_rows.clear()
         if self._settled:
@@ -2440,7 +2850,8 @@ class AxisBank:
         if self._tp_apply:
             self._apply_probes()
         self._lists = {}  # (a new one: _lists' docs)
-        self._sts_epoch = 0  # (the status words made again)
+        counts = self.counts
+        counts[9] = 0  # (_sts_epoch: the status words made again)
         k = self.kernel
         if k is not None:
             # the plain cycle compiled; a new cycle time goes through numpy, and so does a
@@ -2450,10 +2861,10 @@ class AxisBank:
                 self.csp._prepare(dt)  # the drives' constants of this cycle time, as numpy would
             c_fill = self._c_fill  # the kernel refills the tables itself
             if dt == self.csp._dt:
-                if not c_fill and self.n_moving and self._refill_in <= 1:
+                if not c_fill and self.n_moving and counts[1] <= 1:  # (_refill_in)
                     self._fill_tables()  # as the numpy cycle would first (its step 2)
                 else:
-                    self._refill_in -= 1
+                    counts[1] -= 1
                 rc = k.cycle(t_ns, dt)
                 while rc == 3:  # rows leaving (an event, a limit): back to the scalar path first
                     self._release_rows(np.nonzero(k.scratch["s_hit"] & self.alive)[0])
@@ -2719,21 +3130,26 @@ class AxisBank:
         return not rc and (not self.n_moving or self._c_fill)
 
     def _after_kernel(self, k: Kernel, cycles: int = 1) -> None:
-        """What the numpy cycle does besides its arithmetic, after compiled cycles."""
+        """What the numpy cycle does besides its arithmetic, after compiled cycles (the
+        counts added in their array itself: each property's get and set is a Python call)."""
         csp = self.csp
-        csp.cycles += cycles
+        csp.counts[0] += cycles  # (CspBank.cycles)
         csp._din_safe = 0  # its count of safe cycles is numpy's, not the kernel's
         if csp.any_fe:
             csp.fe_running = True  # the numpy cycle then looks at every row's timer
-        if k.move_ended:
+        if k._io[OUT_FIN]:  # (Kernel.move_ended)
             self.n_moving = int(np.count_nonzero(self.moving))
             self._count_standing()
-        self.rows_run += self.n_alive * cycles
-        self.bank_cycles += cycles
-        self.kernel_cycles += cycles
-        self.homing_rows_run += self.n_hm * cycles
-        self.rest_rows_run += self.n_rest * cycles
-        self.frozen_rows_run += self.n_frz * cycles
+        c = self.counts
+        c[_ROWS_RUN] += self.n_alive * cycles
+        c[_BANK_CYCLES] += cycles
+        c[_KERNEL_CYCLES] += cycles
+        if self.n_hm:
+            c[_HOMING_ROWS_RUN] += self.n_hm * cycles
+            if self.n_rest:
+                c[_REST_ROWS_RUN] += self.n_rest * cycles
+        if self.n_frz:
+            c[_FROZEN_ROWS_RUN] += self.n_frz * cycles
 
     def _count_standing(self) -> None:
         """Claimed rows with a band whose profile stands (their bit 11 can change)."""
@@ -2908,11 +3324,7 @@ class AxisBank:
             self._last = {r: self._planned_row(r)}
             self._rates = {r: self._enc_rates_row(r)}
             self._put_back(r)
-            aware = self._aware.pop(r, None)
-            if aware:  # (as at a release: the hooks catch up with the cycles the bank ran)
-                ran = int(self.bank_cycles - self.claim_cycle[r])
-                for obj in aware:
-                    obj.bank_released(ran)
+            self._catch_up(r)
         except BaseException:
             _reguard(objs)  # (still claimed: guarded as before)
             raise
@@ -3087,6 +3499,13 @@ class AxisBank:
         changed = [g for g in map(self.groups.__getitem__, hit) if g.claimed]
         if changed:
             self._release_groups(changed)
+
+
+def _outside_marks(backend: Any) -> tuple[int, int]:
+    """What moves whenever a slave's objects may change outside its own step: an SDO served
+    (the emulated backend's count of mailbox operations), a field write or an emergency
+    (:attr:`VirtualSlave.outside_changes`)."""
+    return backend.__dict__.get("_mailbox_ops", -1), VirtualSlave.outside_changes
 
 
 def _within_soft_limits(ax: Any, res: Any) -> bool:

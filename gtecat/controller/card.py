@@ -90,12 +90,7 @@ def open_card(ctl: Controller, text: str) -> Card:
     backend = CardBackend(spec, ctl.machine, layout)
     master = Master(layout, backend, op_delay_cycles=ctl.options.op_delay_cycles)
     ctl.layout, ctl.backend, ctl.master = layout, backend, master
-    ctl.axes = {
-        ref.axis: Axis(
-            ref.axis, AxisIo(master.image, layout, ref, master.sdo_upload, master.sdo_download)
-        )
-        for ref in layout.axes
-    }
+    ctl.axes = {ref.axis: Axis(ref.axis, AxisIo.on(master, layout, ref)) for ref in layout.axes}
     ctl._axis_list = list(ctl.axes.values())
     sense_changed()  # (other axes: their inputs' sense is looked up again)
     install_resources(ctl)

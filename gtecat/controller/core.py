@@ -345,10 +345,7 @@ class Controller:
             self.log(note)  # (what the drives are built from: two runs' inputs compared)
         self.started = False
         self.axes = {
-            ref.axis: Axis(
-                ref.axis, AxisIo(master.image, layout, ref, master.sdo_upload, master.sdo_download)
-            )
-            for ref in layout.axes
+            ref.axis: Axis(ref.axis, AxisIo.on(master, layout, ref)) for ref in layout.axes
         }
         self._axis_list = list(self.axes.values())
         self._run_axes = self._axis_list
@@ -540,6 +537,8 @@ class Controller:
             or self.clock._run_cycle is not self._own_cycle
         ):
             return 0
+        if bank._opened or bank._frozen_call >= 0:
+            return 0  # (a row opened for a call steps in Python: AxisBank.call_opened)
         settled = bank.dirty or bank._stale or (bank._countdown <= 1 and bank.n_alive != bank.n)
         if settled:
             bank.settle()  # what the next cycle does first: claim axes given back

@@ -36,6 +36,9 @@ class CoreView:
     def __init__(self, base: Controller, core: int) -> None:
         self._base = base
         self.core = core
+        #: the controller's clock, which is its own for its life (every call through a view
+        #: reads it: its lock, its cycles), read here without __getattr__
+        self.clock = base.clock
         self.first = AXES_PER_CORE * (core - 1) + 1
         self._source: dict[int, Axis] | None = None
         self.axes: dict[int, Axis] = {}

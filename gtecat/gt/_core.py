@@ -26,7 +26,7 @@ from gtecat.drives.abort import SdoAbort
 from gtecat.drives.machine import MachineError
 from gtecat.eni.errors import EniError, GtecatError
 
-from ..controller.bank import BANK_READS, IN_PLACE
+from ..controller.bank import BANK_READS, IN_PLACE, OPENED
 from ..controller.card import refused
 from ..controller.cards import CARD_CORES
 from ..controller.core import Controller
@@ -262,7 +262,8 @@ class _Session:
         if core > 1 and 1 in cores:
             c = self._core_view(core)  # the bus's axes of that core, where it has them
             if c is not None:
-                own = cores.pop(core, None)
+                # (a pop of nothing would move the gates too: every call of a core's twin)
+                own = cores.pop(core) if core in cores else None
                 if own is not None:  # a second core opened before the bus came up
                     self.time.leave(own.clock)
                     own.close()
@@ -492,6 +493,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     opens = name == "GT_Open"
     bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
     in_place = name in IN_PLACE  # runs on its axis's claimed row in place
+    opened = name in OPENED  # takes its axis out of the bank for the call alone
     #: a fast path whose first parameter is an axis (its GTN_ twin of core c > 1 takes the
     #: bus axis on core 1's fast path; a coordinate system, a type, an offset: its table)
     by_axis = bool(proto.params) and proto.params[0].name in ("axis", "profile", "encoder")
@@ -555,6 +557,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                         rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
                     elif in_place and not extra:  # (a Trap move's start: its row in place)
                         rc = bank.call_in_place(ctl, proto, values, lambda: fn(ctl, *values))
+                    elif opened and not extra:  # (a drive homing's set-up: out for the call)
+                        rc = bank.call_opened(ctl, proto, values, lambda: fn(ctl, *values))
                     else:
                         bank.before_call(ctl, proto, values)  # the axes it names go back first
                         rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
@@ -656,6 +660,15 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                                 and bus in base.axes
                             ):
                                 return fast(bus, *args[2:])
+                    if type(c) is int and not kwargs and -0x8000 <= c <= 0x7FFF:
+                        # a plain core (core_arg's check) and the GT_ function's compiled
+                        # binder of the rest, as for GT_x (made at the twin's first call)
+                        if compiled:
+                            values = compiled[0](*args[1:])
+                            if values is not None and (needs_ctl or c == 1):
+                                return run(c, values, _NO_KW, "", SESSION.last, True)
+                        elif not opens:
+                            compiled.append(fast_binder(proto, (bind or _binder()).convs))  # type: ignore[attr-defined]
                     return call(c, args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 

@@ -207,11 +207,18 @@ MADE = [0]
 
 
 def _state(ax: Axis) -> _AxisHoming:
+    # (kept on the axis too, read past a claimed axis's guard: a weak dictionary's lookup
+    # makes a weak reference every time; the dictionary stays what the GT fast path reads)
+    try:
+        return object.__getattribute__(ax, "_homing_run")  # type: ignore[no-any-return]
+    except AttributeError:
+        pass
     st = _STATE.get(ax)
     if st is None:
         st = _STATE[ax] = _AxisHoming()
         MADE[0] += 1
         ax.post_hooks.append(st.post)
+    object.__setattr__(ax, "_homing_run", st)
     return st
 
 
@@ -346,13 +353,24 @@ def set_homing_parameters(
         )
     st = _state(ax)
     st.params_set = False
-    _write(ax, 0x6098, 0, method, 1)
-    _write(ax, 0x6099, 1, values[0], 4)
-    _write(ax, 0x6099, 2, values[1], 4)
-    _write(ax, 0x609A, 0, values[2], 4)
-    _write(ax, 0x607C, 0, offset, 4)
+    items = [
+        (0x6098, 0, method, 1),
+        (0x6099, 1, values[0], 4),
+        (0x6099, 2, values[1], 4),
+        (0x609A, 0, values[2], 4),
+        (0x607C, 0, offset, 4),
+    ]
     if probe_function:
-        _write(ax, 0x60B8, 0, probe_function, 2)
+        items.append((0x60B8, 0, probe_function, 2))
+    try:
+        ax.io.write_all_or_sdo(items)
+    except SdoAbort as e:
+        value = next(
+            (v for i, k, v, _ in items if ax.io.index(i) == e.index and k == e.subindex), "?"
+        )
+        raise CommandError(
+            f"axis {ax.number}: writing {value} to 0x{e.index:04X}:{e.subindex:02X} failed: {e}"
+        ) from None
     st.params_set = True
 
 

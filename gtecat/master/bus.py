@@ -52,7 +52,7 @@ in which the axes move and the slaves' watchdogs stay fed, on both backends.
 from __future__ import annotations
 
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
@@ -290,15 +290,16 @@ class Master:
         expected = self.backend.expected_wkc() if self.target == _OP else wkc
         before = self.last.wkc
         self.last = CycleResult(wkc, expected)
+        ok = wkc == expected  # (CycleResult.ok, asked once)
         if self._op_countdown >= 0:
             self._op_countdown -= 1
             if self._op_countdown < 0:
                 self.request_op()
-        elif self.target == _OP and self.last.ok and not self.all_op():
+        elif self.target == _OP and ok and not self.all_op():
             # the working counter is whole again (a slave came back and the backend
             # recovered it): take the states as they are now
             self.refresh_states()
-        elif self.target == _OP and not self.last.ok:
+        elif self.target == _OP and not ok:
             self.wkc_errors += 1
             if not self._wkc_bad:
                 self._wkc_bad = True
@@ -315,9 +316,9 @@ class Master:
                 # who is gone, from the first short cycle on (comm loss, module docstring),
                 # and again whenever the count changes while short (slaves gone or back)
                 self.refresh_states()
-        if self.last.ok:
+        if ok:
             self._bad_ns = 0
-        if self._wkc_bad and self.last.ok and self.all_op():
+        if self._wkc_bad and ok and self.all_op():
             self._wkc_bad = False
             self.error = ""
             self.log(f"Working counter changed to {wkc}/{expected}. All slaves are in OP mode.")
@@ -482,6 +483,16 @@ class Master:
             backend.sdo_download(pos, index, subindex, data, complete_access)
         finally:
             self._timed_out(lost, pos)
+
+    def sdo_download_many(self, pos: int, items: Sequence[tuple[int, int, bytes]]) -> None:
+        """Write several objects of slave ``pos`` in order, each one SDO download as
+        :meth:`sdo_download` sends it (served in this process in one go where the backend
+        can: :meth:`Backend.sdo_downloads_in_process`), stopping at the first abort (raised)."""
+        self._check_slave(pos)
+        backend = self.backend
+        done = 0 if backend.mailbox_on_wire else backend.sdo_downloads_in_process(pos, items)
+        for index, subindex, data in items[done:]:
+            self.sdo_download(pos, index, subindex, data)
 
     def _on_wire(self, transfer: Callable[[], _T]) -> _T:
         """A transfer of a mailbox on a wire: the cycles run while it waits (module

@@ -9,6 +9,7 @@ cycle returns what happened (the working counter is data, as in ethercrab's
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -125,6 +126,15 @@ class Backend(ABC):
         so the master skips its count of unanswered requests
         (:meth:`gtecat.master.bus.Master.sdo_upload`)."""
         return None
+
+    def sdo_downloads_in_process(
+        self, position: int, items: Sequence[tuple[int, int, bytes]]
+    ) -> int:
+        """Expedited downloads ``(index, subindex, data)`` to one slave, in order, each served
+        as :meth:`sdo_in_process` serves one: how many of the first it served (0: none, the
+        caller sends them one by one); an abort is raised where one fails, after the ones
+        before it."""
+        return 0
 
     def emergencies(self) -> list[tuple[int, object]]:
         """CoE emergencies received since the last call: ``(position, Emergency)``."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import ctypes
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from itertools import compress
 from typing import Any
 
@@ -71,6 +71,8 @@ class EmulatedBackend(Backend):
         self._clients: dict[int, object] = {}
         self._claimed: frozenset[int] = frozenset()
         self._run_plan: list[tuple[VirtualSlave, Segment | None, Segment | None]] = []
+        #: the plan and its entries by position (:meth:`exchange_one`)
+        self._one_plan: tuple[list[Any], dict[int, Any]] | None = None
         self._claimed_wkc = 0
         self._claimed_slaves: tuple[VirtualSlave, ...] = ()  # what steady() asks for OP
         #: (the run plan and image it was made for, its rows): what steady() compares
@@ -252,6 +254,25 @@ class EmulatedBackend(Backend):
         if self.capture is not None:
             self._capture_cycle(t_ns, image, wkc)
         return wkc
+
+    def exchange_one(self, position: int, t_ns: int, dt_ns: int) -> None:
+        """Slave ``position``'s part of this cycle's exchange (one the controller's axis bank
+        claims, which it steps on its own objects in the bank's cycle: a row opened for a
+        call, gtecat.controller.bank): its outputs from the image, its step, its inputs into
+        the image, as :meth:`exchange` does it (the working counter counts a claimed slave
+        in OP already)."""
+        plan = self._one_plan
+        if plan is None or plan[0] is not self._plan:
+            plan = self._one_plan = (self._plan, {e[0].position: e for e in self._plan})
+        slave, out, inp = plan[1][position]
+        image = self.image
+        assert image is not None
+        if out is not None:
+            image.to_slave(out, slave.rx)
+        st = slave.al_state
+        slave.step(t_ns, dt_ns)
+        if inp is not None and st >= _SAFEOP:
+            image.from_slave(inp, slave.tx)
 
     def _capture_cycle(self, t_ns: int, image: ProcessImage, wkc: int) -> None:
         """The cycle into the capture, with each answering slave's share of the working
@@ -534,6 +555,37 @@ class EmulatedBackend(Backend):
             return server.upload_in_process(index, subindex)
         server.download_in_process(index, subindex, bytes(data), complete_access, slave.al_state)
         return True
+
+    def sdo_downloads_in_process(
+        self, position: int, items: Sequence[tuple[int, int, bytes]]
+    ) -> int:
+        """Several expedited downloads to one slave as :meth:`sdo_in_process` serves each
+        (the same checks once: nothing sees the frames, the slave's mailbox is its SDO
+        server's, up): each one the server's own write, counters and abort, in order (a
+        drive's homing parameters: five objects in one call)."""
+        if self.capture is not None or position in self.unplugged:
+            return 0
+        if not 0 <= position < len(self.slaves):
+            return 0
+        slave = self.slaves[position]
+        if not slave.has_mailbox or slave.al_state < AlState.PREOP:
+            return 0
+        if not getattr(slave.mailbox, "sdo_server_only", False):
+            return 0
+        server = slave.sdo  # type: ignore[attr-defined]
+        client = self._clients.get(position)
+        if client is None:
+            client = self._client(position)
+        state = slave.al_state
+        done = 0
+        for index, subindex, data in items:
+            if not (0 <= index <= 0xFFFF and 0 <= subindex <= 0xFF and 0 < len(data) <= 4):
+                break
+            self._mailbox_ops += 1  # (steady(): the slave's objects may change)
+            client.counter = next_counter(client.counter)
+            server.download_in_process(index, subindex, bytes(data), False, state)
+            done += 1
+        return done
 
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False
