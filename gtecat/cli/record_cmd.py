@@ -9,8 +9,9 @@ imports gtecat records itself, and the controller that libgts starts for a C, C+
 program records that program's calls.  ``gtecat replay FILE`` re-runs the session.
 
 A script that raises is reported as ``python3`` would (its traceback, exit code 1) and its
-recording is written up to that point: it replays.  FILE is refused before anything runs
-when it cannot be written, with the reason.
+recording is written up to that point: it replays.  So is a program ended by SIGTERM or
+SIGHUP (a CI job's time-out, ``kill``): exit code 128 + the signal, as a shell reports it.
+FILE is refused before anything runs when it cannot be written, with the reason.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import runpy
 import subprocess
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ParameterError
 from . import output
@@ -80,10 +81,7 @@ def run(args: argparse.Namespace) -> int:
     if script is None:
         env = dict(os.environ, GTECAT_RECORD=str(out.resolve()))
         env["GTECAT_RECORD_PROGRAM"] = " ".join(command)
-        try:
-            rc = subprocess.call(command, env=env)
-        except OSError as e:
-            raise ParameterError(f"cannot run {command[0]}: {e.strerror or e}") from None
+        rc = _run_child(command, env)
         from ..faults.record import read
 
         calls = 0
@@ -106,12 +104,14 @@ def run(args: argparse.Namespace) -> int:
     if not path.is_file():
         raise ParameterError(f"{path}: no such script")
     from .. import gt
-    from ..faults.record import Recorder
+    from ..faults.record import Recorder, end_on_signals
     from .run_cmd import script_traceback
 
     # (every thread's calls: a program's HMI thread beside its motion thread is its session)
     rec = Recorder(out, {"program": " ".join(command)}, any_thread=True).start()
     saved_argv, saved_path = sys.argv, list(sys.path)
+    saved_signals = _signals()
+    end_on_signals()  # a time-out's SIGTERM ends the script as SystemExit: the file is written
     sys.argv = [str(path), *script_args]
     sys.path.insert(0, str(path.resolve().parent))
     rc = 0
@@ -134,8 +134,52 @@ def run(args: argparse.Namespace) -> int:
         finally:
             sys.argv, sys.path[:] = saved_argv, saved_path
             _write(rec, out)
+            _restore(saved_signals)
     print(f"record: {rec.calls} GT calls -> {out}", file=sys.stderr)
     return rc
+
+
+def _run_child(command: list[str], env: dict[str, str]) -> int:
+    """Run the command and wait for it; SIGTERM and SIGHUP sent to ``gtecat record`` (a
+    time-out, ``kill``) are passed on to it, so it ends the way it ends when sent them
+    itself (a Python program writes its recording, see ``end_on_signals``) instead of
+    being left running without its recorder's parent."""
+    import signal
+
+    from ..faults.record import ENDING_SIGNALS
+
+    try:
+        child = subprocess.Popen(command, env=env)
+    except OSError as e:
+        raise ParameterError(f"cannot run {command[0]}: {e.strerror or e}") from None
+    saved = _signals()
+    for name in ENDING_SIGNALS:
+        signal.signal(getattr(signal, name), lambda num, _f: child.send_signal(num))
+    try:
+        while True:
+            try:
+                return child.wait()
+            except KeyboardInterrupt:  # Ctrl-C reaches the child too (same process group)
+                continue
+    finally:
+        _restore(saved)
+
+
+def _signals() -> dict[int, Any]:
+    import signal
+
+    from ..faults.record import ENDING_SIGNALS
+
+    nums = [getattr(signal, n) for n in ENDING_SIGNALS if hasattr(signal, n)]
+    return {n: signal.getsignal(n) for n in nums}
+
+
+def _restore(saved: dict[int, Any]) -> None:
+    import signal
+
+    for num, handler in saved.items():
+        if handler is not None:
+            signal.signal(num, handler)
 
 
 def _write(rec: Recorder, out: Path) -> None:

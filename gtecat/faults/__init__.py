@@ -457,18 +457,19 @@ __all__ = [
 
 def _record_from_environment() -> None:
     """``GTECAT_RECORD=FILE`` (set by ``gtecat record`` for a program it starts): record this
-    process's GT calls into FILE, written when the process ends."""
+    process's GT calls into FILE, written when the process ends (SIGTERM and SIGHUP included)."""
     import atexit
     import os
 
     path = os.environ.get("GTECAT_RECORD")
     if not path:
         return
-    from .record import Recorder
+    from .record import Recorder, end_on_signals
 
     program = os.environ.get("GTECAT_RECORD_PROGRAM", "")
     rec = Recorder(path, {"program": program}, any_thread=True).start()
     atexit.register(rec.write)
+    end_on_signals()  # SIGTERM from a time-out: the recording is still written
 
 
 _record_from_environment()

@@ -513,6 +513,34 @@ class Recorder(Listener):
         return self.path
 
 
+#: the signals by which a supervisor ends a program (a CI job's time-out, ``kill``, a closed
+#: terminal); Ctrl-C (SIGINT) already raises KeyboardInterrupt
+ENDING_SIGNALS = ("SIGTERM", "SIGHUP")
+
+
+def end_on_signals() -> None:
+    """Make SIGTERM and SIGHUP end this program as ``sys.exit(128 + signal)`` does.
+
+    Python's default for them kills the process at once: a recording kept in memory until
+    the program ends would be lost with it (a CI job's time-out sends SIGTERM).  As a
+    SystemExit, the program's ``finally`` blocks and exit handlers run and the recording is
+    written up to the call the signal interrupted, which replays.  Only a signal still at
+    its default is taken, and only from the main thread (where Python runs handlers); a
+    program that installs its own handler later keeps it."""
+    import signal
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for name in ENDING_SIGNALS:
+        num = getattr(signal, name, None)
+        if num is not None and signal.getsignal(num) is signal.SIG_DFL:
+            signal.signal(num, _exit_on_signal)
+
+
+def _exit_on_signal(num: int, _frame: Any) -> None:
+    raise SystemExit(128 + num)
+
+
 def _controller() -> Any:
     session = _SESSION[0]
     if session is None:

@@ -77,3 +77,50 @@ def test_an_output_that_cannot_be_written_is_refused_first_with_why(
         assert "permission denied" in capsys.readouterr().err
     assert "the script ran" not in capsys.readouterr().err
     assert not (tmp_path / "x.gtrec").exists()
+
+
+_FOREVER = (
+    "import sys\n"
+    "from gtecat import gt\n"
+    "gt.GT_Open(eni={eni!r}, log='')\n"
+    "gt.GT_InitEcatComm()\n"
+    "print('ready', flush=True)\n"
+    "while True:\n"
+    "    gt.GTE_Wait(10)\n"
+)
+
+
+@pytest.mark.parametrize("how", ["script", "child"])
+def test_a_recording_ended_by_sigterm_is_written_and_replays(
+    tmp_path: Path, how: str
+) -> None:
+    """A CI job's time-out sends SIGTERM: the session up to there is kept (before, nothing
+    was written).  ``script``: run inside gtecat record; ``child``: a command it starts."""
+    import signal
+    import subprocess
+    import sys
+
+    app = tmp_path / "forever.py"
+    app.write_text(_FOREVER.format(eni=str(EXAMPLES / "full_servo.eni")))
+    out = tmp_path / "t.gtrec"
+    cmd = [sys.executable, str(app)]
+    if how == "child":  # not a Python script by its name: started as a child
+        cmd = ["sh", "-c", f'exec "{sys.executable}" "{app}"']
+    rec = subprocess.Popen(
+        [sys.executable, "-m", "gtecat", "record", "-o", str(out), "--", *cmd],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    try:
+        assert rec.stdout is not None
+        assert rec.stdout.readline().strip() == "ready"
+        rec.send_signal(signal.SIGTERM)
+        _, err = rec.communicate(timeout=60)
+    finally:
+        if rec.poll() is None:
+            rec.kill()
+            rec.wait(10)
+    assert rec.returncode == 128 + signal.SIGTERM, err
+    assert "Traceback" not in err, err
+    head = json.loads(out.read_text().splitlines()[0])
+    assert head["calls"] >= 2, head  # GT_Open, GT_InitEcatComm (and the waits it made)
+    assert main(["replay", str(out)]) == 0
