@@ -3,7 +3,7 @@
     python tools/bench_native.py [--calls 20000] [--clock auto|lockstep|realtime]
                                  [--eni examples/manual_fig5_2.eni] [--no-wall-floor]
                                  [--transport private|unix|tcp] [--rt-priority auto|off|N]
-                                 [--burners N] [--repeat K]
+                                 [--inprocess on|off] [--burners N] [--repeat K]
 
 A C program (compiled here with ``$(python3 -m gtecat lib --cflags --libs)``) opens a
 private controller, brings the bus up, enables axis 1 and then times each of
@@ -23,6 +23,10 @@ turns, ``quiet`` (the machine as it is: its load average is reported with each r
 mean and the percentiles of the calls, the calls per second, and the CPU time per call of
 the program and of its private controller (``/proc``): on a busy machine a low p50 bought
 with a spinning client can still lose calls per second, and these figures show it.
+
+``--inprocess on`` runs the private controller inside the program (``GTECAT_INPROCESS=1``:
+each call a function call into the Python runtime the library loads), ``off`` as a
+process of its own; the controller's CPU time is then the program's.
 """
 
 from __future__ import annotations
@@ -186,6 +190,13 @@ def main(argv: list[str] | None = None) -> int:
         "busy (auto, the default; off; 1-99)",
     )
     ap.add_argument(
+        "--inprocess",
+        choices=("on", "off"),
+        default=None,
+        help="GTECAT_INPROCESS: the private controller inside the program (on) or as a "
+        "process of its own (off); else the library's default",
+    )
+    ap.add_argument(
         "--transport",
         default="private",
         choices=("private", "unix", "tcp"),
@@ -217,6 +228,8 @@ def main(argv: list[str] | None = None) -> int:
         env["GTECAT_RT_PRIORITY"] = args.rt_priority
     if args.slice_us is not None:
         env["GTECAT_SLICE_US"] = str(args.slice_us)
+    if args.inprocess is not None:
+        env["GTECAT_INPROCESS"] = "1" if args.inprocess == "on" else "0"
     tcp = args.transport == "tcp"
     target = {"p50_us": 60, "p99_us": 300} if tcp else {"p50_us": 30, "p99_us": 200}
     with tempfile.TemporaryDirectory() as tmp:
@@ -249,6 +262,7 @@ def main(argv: list[str] | None = None) -> int:
         },
         "rt_priority": env.get("GTECAT_RT_PRIORITY", "auto"),
         "slice_us": env.get("GTECAT_SLICE_US", "default"),
+        "inprocess": env.get("GTECAT_INPROCESS", "default"),
         "target": target,
         "machine": {
             "cpus": os.cpu_count(),

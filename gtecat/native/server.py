@@ -490,6 +490,7 @@ class Server:
         self._wake_r.setblocking(False)
         self._drop_log = _DropLog()
         self._thread: threading.Thread | None = None
+        self._serving = 0  # the thread that serves the sockets (serve_forever's)
         self._clients: dict[int, _Client] = {}  # by file descriptor
         self._decoders: dict[tuple[int, int], _Decoder] = {}  # (long size, fid)
         self._poller = _Poller()
@@ -503,6 +504,7 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
+        self._serving = threading.get_ident()
         self._bound_spin(scheduling.is_realtime())
         poller = self._poller
         poller.register(self._listener.fileno())
@@ -563,7 +565,7 @@ class Server:
         is running is left for later, and a wait inside such a call serves nobody."""
         if len(self._running) != 1 or self._stop.is_set():
             return
-        if threading.current_thread() is not self._thread:
+        if threading.get_ident() != self._serving:
             return  # a call of an in-process program: the serving thread reads the sockets
         busy = self._running[0]
         for fd, ev in self._poller.poll(0):

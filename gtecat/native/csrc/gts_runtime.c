@@ -1428,6 +1428,13 @@ static int open_inproc(const char *fname, long long deadline)
     if (tried || !inproc_wanted(&asked))
         return 1;
     tried = 1;
+    const char *rt = setting("GTECAT_RT_PRIORITY");
+    if (rt && *rt && strcasecmp(rt, "off") != 0) { /* the priority of a controller process */
+        if (asked)
+            fprintf(stderr, "gtecat: the in-process controller is not used (GTECAT_RT_PRIORITY "
+                    "is the priority of the controller process): starting that process\n");
+        return 1;
+    }
     char dir[160], addr[200];
     if (private_socket(fname, dir, addr) < 0)
         return -1;
