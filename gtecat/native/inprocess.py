@@ -77,7 +77,7 @@ def ask(path: list[str] | None = None) -> dict[str, object]:
         "shared": bool(cfg("Py_ENABLE_SHARED")),
         "libs": [p for p in libs if os.path.exists(p)],
         "home": sys.base_prefix,
-        "version": "%d.%d" % sys.version_info[:2],
+        "version": f"{sys.version_info[0]}.{sys.version_info[1]}",
         "root": root,
         "path": path,
         "prefix": sys.prefix,

@@ -60,7 +60,7 @@ def test_without_a_runtime_to_load_the_controller_process_is_started(gtn_sequenc
 
 def test_ask_names_the_runtime_and_the_folder_gtecat_is_in():
     a = inprocess.ask()
-    assert a["version"] == "%d.%d" % sys.version_info[:2]
+    assert a["version"] == f"{sys.version_info[0]}.{sys.version_info[1]}"
     assert os.path.isfile(os.path.join(str(a["root"]), "gtecat", "__init__.py"))
     assert a["path"][0] == a["root"]  # type: ignore[index]
 
