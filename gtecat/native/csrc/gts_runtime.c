@@ -106,7 +106,7 @@ static pid_t g_child;              /* that controller's pid */
 static int g_lifeline = -1;        /* its lifeline: EOF when this process ends */
 #endif
 static int g_inproc;               /* the connection is to the in-process controller */
-static int inproc_call(size_t size, size_t *total);
+static int inproc_call(size_t size, size_t *total, int opening);
 static char g_lost[1300];          /* why the connection was lost ("" if it was not) */
 /* the current card of the process (GT_SetCardNo; gtecat/controller/cards.py), the cards it
  * has open (bit n: card n; the connection ends when the last one closes), and a card one
@@ -765,7 +765,7 @@ static int hello(gte_sock fd, const char *token, const char *fname, long long de
         if (reserve(4 + body) < 0)
             return -1;
         memcpy(g_buf, msg, 4 + body);
-        r = inproc_call(4 + body, &total);
+        r = inproc_call(4 + body, &total, 1);
     } else {
         if (send_all(fd, msg, 4 + body, deadline) < 0) {
             set_err("%s returned -1: cannot greet the controller at %s: %s", fname, g_addr,
@@ -1343,11 +1343,27 @@ static int inproc_start(const char *addr, long long deadline)
     return 0;
 }
 
+/* SIGPIPE blocked in the calling thread (the threads Python starts meanwhile inherit it:
+ * the server's, the inspection endpoint's), so that a client that goes away while the
+ * controller writes to it is an error of the write, not the end of the program (a Python
+ * program ignores SIGPIPE; the runtime was started without touching the program's
+ * signals) */
+static void block_sigpipe(sigset_t *old)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &set, old);
+}
+
 /* One request frame in g_buf (size bytes) -> the reply frame in g_buf; 0 ok, -1 with
- * g_io_why set */
-static int inproc_call(size_t size, size_t *total)
+ * g_io_why set.  opening: a call that may start threads (GT_Open) */
+static int inproc_call(size_t size, size_t *total, int opening)
 {
     static char why[800];
+    sigset_t old;
+    if (opening)
+        block_sigpipe(&old);
     int st = py_enter();
     pyobj req = py.BytesFrom((const char *)g_buf, (ssize_t)size);
     pyobj r = req ? py.CallObjArgs(g_host_call, req, NULL) : NULL;
@@ -1374,6 +1390,8 @@ static int inproc_call(size_t size, size_t *total)
     if (r)
         py.DecRef(r);
     py.GILRelease(st);
+    if (opening)
+        pthread_sigmask(SIG_SETMASK, &old, NULL);
     return rc;
 }
 
@@ -1402,10 +1420,11 @@ static int inproc_connect(const char *fname)
     return 0;
 }
 #else
-static int inproc_call(size_t size, size_t *total)
+static int inproc_call(size_t size, size_t *total, int opening)
 {
     (void)size;
     (void)total;
+    (void)opening;
     return -1;
 }
 #endif
@@ -1438,7 +1457,11 @@ static int open_inproc(const char *fname, long long deadline)
     char dir[160], addr[200];
     if (private_socket(fname, dir, addr) < 0)
         return -1;
-    if (inproc_start(addr, deadline) == 0) {
+    sigset_t old;
+    block_sigpipe(&old);
+    int started = inproc_start(addr, deadline);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (started == 0) {
         snprintf(g_private_addr, sizeof g_private_addr, "%s", addr);
         snprintf(g_addr, sizeof g_addr, "%s", addr);
         return inproc_connect(fname);
@@ -1623,7 +1646,7 @@ connected:;
     }
     size_t total = 0;
     if (g_inproc) { /* a function call: the controller runs in this process */
-        if (inproc_call(size, &total) < 0) {
+        if (inproc_call(size, &total, f->flags & GTE_F_OPEN) < 0) {
             set_err("%s returned -1: %s", f->name, g_io_why);
             return CMD_COMM;
         }
