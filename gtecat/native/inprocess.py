@@ -17,6 +17,7 @@ as the forked controller serialises its clients.
 
 from __future__ import annotations
 
+import atexit
 import importlib.util
 import json
 import logging
@@ -53,6 +54,13 @@ class Host:
     def stop(self) -> None:
         self.server.forget(self.client)
         self.server.stop()
+
+    def end(self) -> None:
+        """The program ends (libgts's exit handler): the server stops and what this Python
+        would do at its exit is done (files of the inspection endpoint removed, recordings
+        written), as when the controller process ends."""
+        self.stop()
+        atexit._run_exitfuncs()
 
 
 def start(address: str) -> Host:

@@ -26,6 +26,7 @@
 #include <windows.h>
 #endif
 #include <errno.h>
+#include <locale.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -1233,7 +1234,7 @@ static void inproc_cleanup(void)
     if (g_inproc_pid != getpid() || !g_host)
         return;
     int st = py_enter(); /* the program's atexit: the session ends as a Python program's */
-    pyobj r = py_method(g_host, "stop");
+    pyobj r = py_method(g_host, "end");
     if (r)
         py.DecRef(r);
     else
@@ -1308,7 +1309,13 @@ static int inproc_start(const char *addr, long long deadline)
         return -1;
     }
     py.SetPythonHome(home_w);
+    /* the program's character locale stays its own (the runtime sets it from the
+     * environment while it starts; its encodings are decided by then) */
+    char *ctype = setlocale(LC_CTYPE, NULL);
+    char saved[200];
+    snprintf(saved, sizeof saved, "%s", ctype ? ctype : "C");
     py.InitializeEx(0); /* 0: the program's signal handlers stay its own */
+    setlocale(LC_CTYPE, saved);
     g_inproc_pid = getpid();
     t_py_state = 1; /* this thread's state is the main one: kept */
     /* the environment's modules first: the folder gtecat is in, then settle() */
