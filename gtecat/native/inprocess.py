@@ -98,7 +98,7 @@ def main() -> int:
     line: the runtime library ("" where this interpreter has none to share), its home, its
     version, the folder gtecat is in, then all of it as JSON (for :func:`settle`)."""
     a = ask(sys.path[1:])  # (not the folder `-m` was run from: the program's, not ours)
-    libs = a["libs"] if a["shared"] else []
+    libs = a["libs"]  # (an interpreter linked statically may have its library beside it)
     print(libs[0] if libs else "")  # type: ignore[index]
     for key in ("home", "version", "root"):
         print(a[key])
