@@ -8,7 +8,9 @@
  * GTE_GetLastError says why.
  *
  * Where the controller is: GTECAT_CONTROLLER (unix:/path, or tcp:HOST:PORT /
- * tcp://HOST:PORT), else a private controller this library starts (Linux).  A TCP
+ * tcp://HOST:PORT), else a private controller this library starts (Linux): as a process
+ * of its own, or inside this program (GTECAT_INPROCESS, the in-process controller below).
+ * A TCP
  * controller wants a token: GTECAT_TOKEN, else the file GTECAT_TOKEN_FILE names, else the
  * controller's default token file (same user, same machine).  Every GTECAT_x setting may
  * also be written `x = value` in a gtecat.ini beside the program's executable (or the
@@ -763,8 +765,10 @@ static int hello(gte_sock fd, const char *token, const char *fname, long long de
     size_t total = 0;
     int r;
     if (g_inproc) { /* the in-process controller: the same greeting, as a call */
-        if (reserve(4 + body) < 0)
+        if (reserve(4 + body) < 0) {
+            set_err("%s returned -1: out of memory", fname);
             return -1;
+        }
         memcpy(g_buf, msg, 4 + body);
         r = inproc_call(4 + body, &total, 1);
     } else {
@@ -930,8 +934,6 @@ static int connect_to(const char *addr, const char *fname, long long deadline)
 }
 
 #if !defined(_WIN32)
-/* Start `python -m gtecat controller` on a socket of our own; it ends with this process
- * (its lifeline pipe reaches EOF when we exit).  0 once it listens. */
 /* a folder of our own for a private controller's socket (dir[160]) and the socket's
  * address in it (addr[200]); 0 ok */
 static int private_socket(const char *fname, char *dir, char *addr)
@@ -949,6 +951,8 @@ static int private_socket(const char *fname, char *dir, char *addr)
     return 0;
 }
 
+/* Start `python -m gtecat controller` on a socket of our own; it ends with this process
+ * (its lifeline pipe reaches EOF when we exit).  0 once it listens. */
 static int start_private(const char *fname)
 {
     const char *python = getenv("GTECAT_PYTHON");
@@ -1185,8 +1189,9 @@ static int ask_python(const char *python, char *out, size_t cap, long long deadl
         close(p[1]);
         return -1;
     }
-    if (pid == 0) {
-        if (dup2(p[1], 1) < 0)
+    if (pid == 0) { /* (its errors: the controller process, started next, says them) */
+        int null = open("/dev/null", O_WRONLY);
+        if (dup2(p[1], 1) < 0 || null < 0 || dup2(null, 2) < 0)
             _exit(126);
         execv(python, argv);
         _exit(127);
@@ -1244,7 +1249,7 @@ static void inproc_cleanup(void)
 
 /* Load the runtime and start the controller in it at addr; 0 ok, else -1 with
  * g_inproc_why set (nothing of the program changed but a library loaded). */
-static int inproc_start(const char *addr, long long deadline)
+static int inproc_start(const char *addr)
 {
     static char answer[65536];
     static wchar_t *home_w;
@@ -1256,7 +1261,8 @@ static int inproc_start(const char *addr, long long deadline)
                  "this program runs a Python interpreter of its own");
         return -1;
     }
-    if (ask_python(python, answer, sizeof answer, deadline) < 0)
+    if (ask_python(python, answer, sizeof answer,
+                   now_ms() + env_ms("GTECAT_START_TIMEOUT_MS", 60000)) < 0)
         return -1;
     char *rest = answer;
     char *lib = next_line(&rest), *home = next_line(&rest), *version = next_line(&rest);
@@ -1466,7 +1472,7 @@ static int open_inproc(const char *fname, long long deadline)
         return -1;
     sigset_t old;
     block_sigpipe(&old);
-    int started = inproc_start(addr, deadline);
+    int started = inproc_start(addr);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     if (started == 0) {
         snprintf(g_private_addr, sizeof g_private_addr, "%s", addr);
