@@ -1,6 +1,6 @@
 """The in-process controller: libgts's private controller inside the program itself.
 
-Where ``GTECAT_INPROCESS`` asks for it, libgts does not start ``gtecat controller`` as a
+Where ``GTECAT_INPROCESS`` allows it, libgts does not start ``gtecat controller`` as a
 process of its own: it loads the Python runtime gtecat was installed for into the
 program (:func:`ask` tells it where that runtime and its packages are), and hands every
 GT call's request frame to :meth:`Host.call`, which answers it with the controller
@@ -20,12 +20,9 @@ from __future__ import annotations
 import atexit
 import importlib.util
 import json
-import logging
 import os
 import sys
 import sysconfig
-
-log = logging.getLogger("gtecat.native.inprocess")
 
 
 class Host:
@@ -48,7 +45,7 @@ class Host:
 
     def call(self, frame: bytes) -> bytes:
         """One request frame (hello or call, length prefix included) -> its reply frame.
-        A request the protocol does not allow ends the connection (b"": libgts says why)."""
+        A request the protocol does not allow gives b"" (logged; the call returns -1)."""
         return self.server.answer(self.client, frame)
 
     def stop(self) -> None:
@@ -113,6 +110,11 @@ def settle(env: bytes) -> None:
     sys.path[:] = a["path"]
     sys.prefix = sys.exec_prefix = a["prefix"]
     sys.executable = a["executable"]
+    try:  # the program's command line (gtecat ps names the program by it)
+        with open("/proc/self/cmdline", "rb") as f:
+            sys.argv = [os.fsdecode(w) for w in f.read().split(b"\0")[:-1]]
+    except OSError:
+        pass
 
 
 if __name__ == "__main__":

@@ -41,6 +41,15 @@ def test_a_c_program_runs_its_controller_in_process(gtn_sequence, tmp_path):
 
 
 @needs_cc
+def test_inprocess_0_starts_the_controller_process(gtn_sequence, tmp_path):
+    """The controller process, as a program gets it where the runtime cannot be loaded."""
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert (v["open"], v["ready"], v["prfpos"]) == ("0", "1", "20000")
+    assert int(v["slept_ms"]) >= 200
+
+
+@needs_cc
 def test_without_a_runtime_to_load_the_controller_process_is_started(gtn_sequence, tmp_path):
     """An interpreter without a shared runtime (built without --enable-shared): the program
     runs as before, on the controller process, and says why on stderr."""
