@@ -8,9 +8,9 @@
  * GTE_GetLastError says why.
  *
  * Where the controller is: GTECAT_CONTROLLER (unix:/path, or tcp:HOST:PORT /
- * tcp://HOST:PORT), else a private controller this library starts (Linux): as a process
- * of its own, or inside this program (GTECAT_INPROCESS, the in-process controller below).
- * A TCP
+ * tcp://HOST:PORT), else a private controller this library starts (Linux): inside this
+ * program where it can (GTECAT_INPROCESS, the in-process controller below), else as a
+ * process of its own.  A TCP
  * controller wants a token: GTECAT_TOKEN, else the file GTECAT_TOKEN_FILE names, else the
  * controller's default token file (same user, same machine).  Every GTECAT_x setting may
  * also be written `x = value` in a gtecat.ini beside the program's executable (or the
@@ -1121,9 +1121,10 @@ static char g_inproc_why[1000];     /* why the in-process controller was not sta
 static __thread int t_py_state;    /* this thread has a Python thread state of its own */
 
 /* GTECAT_INPROCESS: 1 (or on/yes/true) in-process, 0 (off/no/false) the process;
- * unset: GTE_DEFAULT_INPROCESS.  *asked: the setting was given */
+ * unset: GTE_DEFAULT_INPROCESS (in-process; where it cannot be, the process, silently).
+ * *asked: the setting was given */
 #ifndef GTE_DEFAULT_INPROCESS
-#define GTE_DEFAULT_INPROCESS 0
+#define GTE_DEFAULT_INPROCESS 1
 #endif
 static int inproc_wanted(int *asked)
 {
