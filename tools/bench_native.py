@@ -3,7 +3,8 @@
     python tools/bench_native.py [--calls 20000] [--clock auto|lockstep|realtime]
                                  [--eni examples/manual_fig5_2.eni] [--no-wall-floor]
                                  [--transport private|unix|tcp] [--rt-priority auto|off|N]
-                                 [--burners N] [--repeat K] [--drop-sys-nice]
+                                 [--inprocess on|off] [--burners N] [--repeat K]
+                                 [--drop-sys-nice]
 
 A C program (compiled here with ``$(python3 -m gtecat lib --cflags --libs)``) opens a
 private controller, brings the bus up, enables axis 1 and then times each of
@@ -27,6 +28,9 @@ with a spinning client can still lose calls per second, and these figures show i
 ``--drop-sys-nice`` runs the program, and so the controller it starts, without
 ``CAP_SYS_NICE`` (``setpriv``): what an ordinary user gets where the bench runs as root (no
 real-time priority, no nice below 0; a short time slice is still permitted).
+``--inprocess on`` runs the private controller inside the program (``GTECAT_INPROCESS=1``:
+each call a function call into the Python runtime the library loads), ``off`` as a
+process of its own; the controller's CPU time is then the program's.
 """
 
 from __future__ import annotations
@@ -190,6 +194,13 @@ def main(argv: list[str] | None = None) -> int:
         "busy (auto, the default; off; 1-99)",
     )
     ap.add_argument(
+        "--inprocess",
+        choices=("on", "off"),
+        default=None,
+        help="GTECAT_INPROCESS: the private controller inside the program (on) or as a "
+        "process of its own (off); else the library's default",
+    )
+    ap.add_argument(
         "--transport",
         default="private",
         choices=("private", "unix", "tcp"),
@@ -227,6 +238,8 @@ def main(argv: list[str] | None = None) -> int:
         env["GTECAT_RT_PRIORITY"] = args.rt_priority
     if args.slice_us is not None:
         env["GTECAT_SLICE_US"] = str(args.slice_us)
+    if args.inprocess is not None:
+        env["GTECAT_INPROCESS"] = "1" if args.inprocess == "on" else "0"
     tcp = args.transport == "tcp"
     target = {"p50_us": 60, "p99_us": 300} if tcp else {"p50_us": 30, "p99_us": 200}
     with tempfile.TemporaryDirectory() as tmp:
@@ -260,6 +273,7 @@ def main(argv: list[str] | None = None) -> int:
         "rt_priority": env.get("GTECAT_RT_PRIORITY", "auto"),
         "sys_nice": not args.drop_sys_nice,
         "slice_us": env.get("GTECAT_SLICE_US", "default"),
+        "inprocess": env.get("GTECAT_INPROCESS", "default"),
         "target": target,
         "machine": {
             "cpus": os.cpu_count(),

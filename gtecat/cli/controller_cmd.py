@@ -166,11 +166,14 @@ def _take_scheduling(server: Server, rt_setting: int | str) -> tuple[scheduling.
     return taken, started_rt
 
 
-def _wall_floor(args: argparse.Namespace) -> bool:
-    if args.no_wall_floor:
-        return False
+def wall_floor_setting() -> bool:
+    """GTECAT_WALL_FLOOR: the wall floor unless it says 0/off/no/false."""
     env = os.environ.get("GTECAT_WALL_FLOOR", "1").strip().lower()
     return env not in ("0", "off", "no", "false")
+
+
+def _wall_floor(args: argparse.Namespace) -> bool:
+    return not args.no_wall_floor and wall_floor_setting()
 
 
 def _close_inherited(keep: set[int]) -> None:

@@ -228,7 +228,7 @@ def _compile(build: Build, files: dict[str, str], cc: list[str]) -> None:
             target = inc / name if name in INCLUDE_FILES else src / name
             target.write_text(text, encoding="utf-8")
         inside = [f"-I{inc}", f"-I{src}"]
-        link: list[str] = []
+        link: list[str] = ["-ldl"]  # (the in-process controller loads the Python runtime)
         # units compiled side by side: the transport optimised; the emulated functions'
         # stubs (each copies its arguments into an array and calls the transport) and the
         # ~3,800 one-line declared-only functions not: they have nothing to optimise, and

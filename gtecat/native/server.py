@@ -285,6 +285,7 @@ class _Decoder:
 
 @dataclass(eq=False)
 class _Client:
+    #: None for the program's own connection to an in-process controller (answer)
     sock: socket.socket
     peer: str
     buf: bytearray = field(default_factory=bytearray)
@@ -489,6 +490,7 @@ class Server:
         self._wake_r.setblocking(False)
         self._drop_log = _DropLog()
         self._thread: threading.Thread | None = None
+        self._serving = 0  # the thread that serves the sockets (serve_forever's)
         self._clients: dict[int, _Client] = {}  # by file descriptor
         self._decoders: dict[tuple[int, int], _Decoder] = {}  # (long size, fid)
         self._poller = _Poller()
@@ -502,6 +504,7 @@ class Server:
 
     # --- the loop ------------------------------------------------------------------------
     def serve_forever(self) -> None:
+        self._serving = threading.get_ident()
         self._bound_spin(scheduling.is_realtime())
         poller = self._poller
         poller.register(self._listener.fileno())
@@ -562,6 +565,8 @@ class Server:
         is running is left for later, and a wait inside such a call serves nobody."""
         if len(self._running) != 1 or self._stop.is_set():
             return
+        if threading.get_ident() != self._serving:
+            return  # a call of an in-process program: the serving thread reads the sockets
         busy = self._running[0]
         for fd, ev in self._poller.poll(0):
             if self._clients.get(fd) is not busy:
@@ -668,6 +673,31 @@ class Server:
                 for ctx in c.fields.values():
                     ctx.stop_traces()
         c.sock.close()
+
+    # --- the program's own connection (an in-process controller: gtecat.native.inprocess) -
+    def local_client(self) -> _Client:
+        """A connection of this process that sends its frames by :meth:`answer`."""
+        return _Client(None, peer="this program", pid=os.getpid())  # type: ignore[arg-type]
+
+    def answer(self, c: _Client, frame: bytes) -> bytes:
+        """The reply frame to one request frame of ``c`` (length prefix included) on the
+        caller's thread; b"" for a frame the protocol does not allow (logged)."""
+        try:
+            if len(frame) < 4 or FRAME.unpack_from(frame, 0)[0] != len(frame) - 4:
+                raise ProtocolError("a frame whose length is not its size")
+            return self._message(c, memoryview(frame)[4:])
+        except ProtocolError as e:
+            log.warning("client %s: %s", c.peer, e)
+            return b""
+
+    def forget(self, c: _Client) -> None:
+        """``c`` closed its connection: its traces stop (its cards go with it)."""
+        if c.fields:
+            with self.lock:
+                for ctx in c.fields.values():
+                    ctx.stop_traces()
+        c.fields.clear()
+        c.cards.clear()
 
     def _spin_budget(self) -> float:
         """Seconds to spin for this client's next request (and, every 10 ms, the look at

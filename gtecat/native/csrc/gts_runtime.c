@@ -8,7 +8,9 @@
  * GTE_GetLastError says why.
  *
  * Where the controller is: GTECAT_CONTROLLER (unix:/path, or tcp:HOST:PORT /
- * tcp://HOST:PORT), else a private controller this library starts (Linux).  A TCP
+ * tcp://HOST:PORT), else a private controller this library starts (Linux): inside this
+ * program where it can (GTECAT_INPROCESS, the in-process controller below), else as a
+ * process of its own.  A TCP
  * controller wants a token: GTECAT_TOKEN, else the file GTECAT_TOKEN_FILE names, else the
  * controller's default token file (same user, same machine).  Every GTECAT_x setting may
  * also be written `x = value` in a gtecat.ini beside the program's executable (or the
@@ -26,6 +28,7 @@
 #include <windows.h>
 #endif
 #include <errno.h>
+#include <locale.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -35,6 +38,7 @@
 #include <sys/types.h>
 #include <time.h>
 #if !defined(_WIN32)
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -43,12 +47,14 @@
 #include <pthread.h>
 #include <sched.h>
 #include <signal.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <wchar.h>
 #endif
 
 #include "gts.h"
@@ -102,6 +108,8 @@ static char g_private_addr[300];   /* unix:/path of the controller this library 
 static pid_t g_child;              /* that controller's pid */
 static int g_lifeline = -1;        /* its lifeline: EOF when this process ends */
 #endif
+static int g_inproc;               /* the connection is to the in-process controller */
+static int inproc_call(size_t size, size_t *total, int opening);
 static char g_lost[1300];          /* why the connection was lost ("" if it was not) */
 /* the current card of the process (GT_SetCardNo; gtecat/controller/cards.py), the cards it
  * has open (bit n: card n; the connection ends when the last one closes), and a card one
@@ -620,6 +628,7 @@ static void drop(const char *why)
     if (g_fd != GTE_NO_SOCK)
         sock_close(g_fd);
     g_fd = GTE_NO_SOCK;
+    g_inproc = 0;
     snprintf(g_lost, sizeof g_lost, "%s%s", why, child_fate());
 }
 
@@ -753,13 +762,23 @@ static int hello(gte_sock fd, const char *token, const char *fname, long long de
         body += 2 + toklen;
     }
     put_u32(msg, (uint32_t)body);
-    if (send_all(fd, msg, 4 + body, deadline) < 0) {
-        set_err("%s returned -1: cannot greet the controller at %s: %s", fname, g_addr,
-                io_error());
-        return -1;
-    }
     size_t total = 0;
-    int r = recv_msg(fd, &total, deadline);
+    int r;
+    if (g_inproc) { /* the in-process controller: the same greeting, as a call */
+        if (reserve(4 + body) < 0) {
+            set_err("%s returned -1: out of memory", fname);
+            return -1;
+        }
+        memcpy(g_buf, msg, 4 + body);
+        r = inproc_call(4 + body, &total, 1);
+    } else {
+        if (send_all(fd, msg, 4 + body, deadline) < 0) {
+            set_err("%s returned -1: cannot greet the controller at %s: %s", fname, g_addr,
+                    io_error());
+            return -1;
+        }
+        r = recv_msg(fd, &total, deadline);
+    }
     if (r < 0 || total < 8) {
         set_err("%s returned -1: the controller at %s did not answer the greeting (%s)", fname,
                 g_addr, r == -2 ? (toklen ? "connection closed" :
@@ -915,6 +934,23 @@ static int connect_to(const char *addr, const char *fname, long long deadline)
 }
 
 #if !defined(_WIN32)
+/* a folder of our own for a private controller's socket (dir[160]) and the socket's
+ * address in it (addr[200]); 0 ok */
+static int private_socket(const char *fname, char *dir, char *addr)
+{
+    const char *tmp = getenv("TMPDIR");
+    if (!tmp || !*tmp || strlen(tmp) > 80)
+        tmp = "/tmp";
+    snprintf(dir, 160, "%s/gtecat-XXXXXX", tmp);
+    if (!mkdtemp(dir)) {
+        set_err("%s returned -1: cannot make a directory for the controller socket in %s: %s",
+                fname, tmp, strerror(errno));
+        return -1;
+    }
+    snprintf(addr, 200, "unix:%s/controller.sock", dir);
+    return 0;
+}
+
 /* Start `python -m gtecat controller` on a socket of our own; it ends with this process
  * (its lifeline pipe reaches EOF when we exit).  0 once it listens. */
 static int start_private(const char *fname)
@@ -922,18 +958,9 @@ static int start_private(const char *fname)
     const char *python = getenv("GTECAT_PYTHON");
     if (!python || !*python)
         python = gte_default_python;
-    const char *tmp = getenv("TMPDIR");
-    char dir[160];
-    if (!tmp || !*tmp || strlen(tmp) > 80)
-        tmp = "/tmp";
-    snprintf(dir, sizeof dir, "%s/gtecat-XXXXXX", tmp);
-    if (!mkdtemp(dir)) {
-        set_err("%s returned -1: cannot make a directory for the controller socket in %s: %s",
-                fname, tmp, strerror(errno));
+    char dir[160], addr[200];
+    if (private_socket(fname, dir, addr) < 0)
         return -1;
-    }
-    char addr[200];
-    snprintf(addr, sizeof addr, "unix:%s/controller.sock", dir);
 
     int ready[2], life[2];
     if (pipe2(ready, O_CLOEXEC) < 0) {
@@ -1056,14 +1083,423 @@ static int start_private(const char *fname)
 }
 #endif
 
+#if defined(__linux__)
+/* ---- the in-process controller (GTECAT_INPROCESS) -------------------------------------
+ * Instead of starting `python -m gtecat controller`, load the Python runtime gtecat was
+ * installed for into this program (dlopen, RTLD_GLOBAL), start the same controller server
+ * there (gtecat/native/inprocess.py: it listens on the private socket too, and keeps the
+ * wall floor from its own thread), and hand each request frame to it as a function call
+ * under the interpreter's lock: no process to wake, twice per call.  Where the runtime
+ * cannot be found or started, the private controller process is started instead.  Not in
+ * a program that runs a Python interpreter already (its own, or ctypes from Python), and
+ * a forked child reaches its parent's in-process controller over the socket. */
+typedef void *pyobj;
+static struct {
+    int (*IsInitialized)(void);
+    void (*InitializeEx)(int);
+    void (*SetPythonHome)(const wchar_t *);
+    wchar_t *(*DecodeLocale)(const char *, size_t *);
+    void *(*SaveThread)(void);
+    int (*GILEnsure)(void);
+    void (*GILRelease)(int);
+    pyobj (*ImportModule)(const char *);
+    pyobj (*GetAttrString)(pyobj, const char *);
+    pyobj (*CallObjArgs)(pyobj, ...);
+    pyobj (*BytesFrom)(const char *, ssize_t);
+    int (*BytesAs)(pyobj, char **, ssize_t *);
+    pyobj (*UnicodeFrom)(const char *);
+    void (*DecRef)(pyobj);
+    void (*ErrFetch)(pyobj *, pyobj *, pyobj *);
+    pyobj (*Str)(pyobj);
+    const char *(*Utf8)(pyobj);
+    pyobj (*SysGet)(const char *);
+    int (*ListInsert)(pyobj, ssize_t, pyobj);
+} py;
+static pid_t g_inproc_pid;         /* the process the runtime was started in (0: none) */
+static pyobj g_host, g_host_call;  /* gtecat.native.inprocess.Host and its call */
+static char g_inproc_why[1000];     /* why the in-process controller was not started */
+static __thread int t_py_state;    /* this thread has a Python thread state of its own */
+
+/* GTECAT_INPROCESS: 1 (or on/yes/true) in-process, 0 (off/no/false) the process;
+ * unset: GTE_DEFAULT_INPROCESS (in-process; where it cannot be, the process, silently).
+ * *asked: the setting was given */
+#ifndef GTE_DEFAULT_INPROCESS
+#define GTE_DEFAULT_INPROCESS 1
+#endif
+static int inproc_wanted(int *asked)
+{
+    const char *v = setting("GTECAT_INPROCESS");
+    *asked = v && *v;
+    if (!*asked)
+        return GTE_DEFAULT_INPROCESS;
+    return !(strcmp(v, "0") == 0 || strcasecmp(v, "off") == 0 || strcasecmp(v, "no") == 0 ||
+             strcasecmp(v, "false") == 0);
+}
+
+/* the text of the Python exception set now (cleared) */
+static void py_error(char *out, size_t cap)
+{
+    pyobj t = NULL, v = NULL, tb = NULL;
+    py.ErrFetch(&t, &v, &tb);
+    pyobj s = (v || t) ? py.Str(v ? v : t) : NULL;
+    const char *u = s ? py.Utf8(s) : NULL;
+    snprintf(out, cap, "%s", u ? u : "a Python error without text");
+    if (!u)
+        py.ErrFetch(&t, &v, &tb); /* (an error of Str itself: cleared too) */
+    pyobj all[] = {s, t, v, tb};
+    for (int i = 0; i < 4; i++)
+        if (all[i])
+            py.DecRef(all[i]);
+}
+
+/* the interpreter's lock for this thread; every thread keeps its Python thread state */
+static int py_enter(void)
+{
+    if (!t_py_state) {
+        py.GILEnsure(); /* a thread state of its own, then the lock released: kept */
+        py.SaveThread();
+        t_py_state = 1;
+    }
+    return py.GILEnsure();
+}
+
+/* obj.name() (a new reference; NULL with the error set) */
+static pyobj py_method(pyobj obj, const char *name)
+{
+    pyobj m = py.GetAttrString(obj, name);
+    if (!m)
+        return NULL;
+    pyobj r = py.CallObjArgs(m, NULL);
+    py.DecRef(m);
+    return r;
+}
+
+/* run `python -m gtecat.native.inprocess` and read its answer into out; 0 ok */
+static int ask_python(const char *python, char *out, size_t cap, long long deadline)
+{
+    int p[2];
+    if (pipe2(p, O_CLOEXEC) < 0) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "pipe: %s", strerror(errno));
+        return -1;
+    }
+    char *argv[] = {(char *)python, "-m", "gtecat.native.inprocess", NULL};
+    pid_t pid = fork();
+    if (pid < 0) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "fork: %s", strerror(errno));
+        close(p[0]);
+        close(p[1]);
+        return -1;
+    }
+    if (pid == 0) { /* (its errors: the controller process, started next, says them) */
+        int null = open("/dev/null", O_WRONLY);
+        if (dup2(p[1], 1) < 0 || null < 0 || dup2(null, 2) < 0)
+            _exit(126);
+        execv(python, argv);
+        _exit(127);
+    }
+    close(p[1]);
+    size_t got = 0;
+    while (got < cap - 1 && wait_fd(p[0], POLLIN, deadline) == 0) {
+        ssize_t r = read(p[0], out + got, cap - 1 - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            break;
+        got += (size_t)r;
+    }
+    out[got] = '\0';
+    close(p[0]);
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == 0) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "%s -m gtecat.native.inprocess failed "
+                 "(status %d)", python, WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+        return -1;
+    }
+    return 0;
+}
+
+/* the next line of *text (NUL-terminated in place) */
+static char *next_line(char **text)
+{
+    char *line = *text, *nl = strchr(line, '\n');
+    if (nl) {
+        *nl = '\0';
+        *text = nl + 1;
+    } else {
+        *text = line + strlen(line);
+    }
+    return line;
+}
+
+static void inproc_cleanup(void)
+{
+    if (g_inproc_pid != getpid() || !g_host)
+        return;
+    int st = py_enter(); /* the program's atexit: the session ends as a Python program's */
+    pyobj r = py_method(g_host, "end");
+    if (r)
+        py.DecRef(r);
+    else
+        py_error(g_inproc_why, sizeof g_inproc_why);
+    py.GILRelease(st);
+}
+
+/* Load the runtime and start the controller in it at addr; 0 ok, else -1 with
+ * g_inproc_why set (nothing of the program changed but a library loaded). */
+static int inproc_start(const char *addr)
+{
+    static char answer[65536];
+    static wchar_t *home_w;
+    const char *python = getenv("GTECAT_PYTHON");
+    if (!python || !*python)
+        python = gte_default_python;
+    if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
+        snprintf(g_inproc_why, sizeof g_inproc_why,
+                 "this program runs a Python interpreter of its own");
+        return -1;
+    }
+    if (ask_python(python, answer, sizeof answer,
+                   now_ms() + env_ms("GTECAT_START_TIMEOUT_MS", 60000)) < 0)
+        return -1;
+    char *rest = answer;
+    char *lib = next_line(&rest), *home = next_line(&rest), *version = next_line(&rest);
+    char *root = next_line(&rest), *env = next_line(&rest);
+    if (!*lib) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "%s has no shared Python library to load "
+                 "(an interpreter built without --enable-shared)", python);
+        return -1;
+    }
+    char stdlib[700];
+    struct stat st;
+    snprintf(stdlib, sizeof stdlib, "%s/lib/python%s/os.py", home, version);
+    if (stat(stdlib, &st) != 0) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "no standard library at %s", stdlib);
+        return -1;
+    }
+    void *h = dlopen(lib, RTLD_NOW | RTLD_GLOBAL);
+    if (!h) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "cannot load %s: %s", lib, dlerror());
+        return -1;
+    }
+    struct { void *slot; const char *name; } syms[] = {
+        {&py.IsInitialized, "Py_IsInitialized"}, {&py.InitializeEx, "Py_InitializeEx"},
+        {&py.SetPythonHome, "Py_SetPythonHome"}, {&py.DecodeLocale, "Py_DecodeLocale"},
+        {&py.SaveThread, "PyEval_SaveThread"}, {&py.GILEnsure, "PyGILState_Ensure"},
+        {&py.GILRelease, "PyGILState_Release"}, {&py.ImportModule, "PyImport_ImportModule"},
+        {&py.GetAttrString, "PyObject_GetAttrString"},
+        {&py.CallObjArgs, "PyObject_CallFunctionObjArgs"},
+        {&py.BytesFrom, "PyBytes_FromStringAndSize"},
+        {&py.BytesAs, "PyBytes_AsStringAndSize"}, {&py.UnicodeFrom, "PyUnicode_DecodeFSDefault"},
+        {&py.DecRef, "Py_DecRef"}, {&py.ErrFetch, "PyErr_Fetch"}, {&py.Str, "PyObject_Str"},
+        {&py.Utf8, "PyUnicode_AsUTF8"}, {&py.SysGet, "PySys_GetObject"},
+        {&py.ListInsert, "PyList_Insert"},
+    };
+    for (size_t i = 0; i < sizeof syms / sizeof syms[0]; i++) {
+        void *f = dlsym(h, syms[i].name);
+        if (!f) {
+            snprintf(g_inproc_why, sizeof g_inproc_why, "%s has no %s", lib, syms[i].name);
+            return -1;
+        }
+        memcpy(syms[i].slot, &f, sizeof f);
+    }
+    if (py.IsInitialized()) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "%s is started already in this program", lib);
+        return -1;
+    }
+    home_w = py.DecodeLocale(home, NULL);
+    if (!home_w) {
+        snprintf(g_inproc_why, sizeof g_inproc_why, "cannot decode %s", home);
+        return -1;
+    }
+    py.SetPythonHome(home_w);
+    /* the program's character locale stays its own (the runtime sets it from the
+     * environment while it starts; its encodings are decided by then) */
+    char *ctype = setlocale(LC_CTYPE, NULL);
+    char saved[200];
+    snprintf(saved, sizeof saved, "%s", ctype ? ctype : "C");
+    py.InitializeEx(0); /* 0: the program's signal handlers stay its own */
+    setlocale(LC_CTYPE, saved);
+    g_inproc_pid = getpid();
+    t_py_state = 1; /* this thread's state is the main one: kept */
+    /* the environment's modules first: the folder gtecat is in, then settle() */
+    pyobj path = py.SysGet("path"), dir = py.UnicodeFrom(root);
+    if (dir) {
+        py.ListInsert(path, 0, dir);
+        py.DecRef(dir);
+    }
+    pyobj mod = py.ImportModule("gtecat.native.inprocess"), r = NULL;
+    pyobj settle = mod ? py.GetAttrString(mod, "settle") : NULL;
+    pyobj envb = settle ? py.BytesFrom(env, (ssize_t)strlen(env)) : NULL;
+    r = envb ? py.CallObjArgs(settle, envb, NULL) : NULL;
+    pyobj start = r ? py.GetAttrString(mod, "start") : NULL;
+    pyobj where = start ? py.UnicodeFrom(addr) : NULL;
+    pyobj host = where ? py.CallObjArgs(start, where, NULL) : NULL;
+    pyobj call = host ? py.GetAttrString(host, "call") : NULL;
+    if (!call)
+        py_error(g_inproc_why, sizeof g_inproc_why);
+    pyobj refs[] = {mod, settle, envb, r, start, where};
+    for (size_t i = 0; i < sizeof refs / sizeof refs[0]; i++)
+        if (refs[i])
+            py.DecRef(refs[i]);
+    py.SaveThread(); /* the lock is taken per call from now on */
+    if (!call) {
+        if (host)
+            py.DecRef(host); /* (the runtime stays loaded: it cannot be unloaded) */
+        return -1;
+    }
+    g_host = host;
+    g_host_call = call;
+    atexit(inproc_cleanup);
+    return 0;
+}
+
+/* SIGPIPE blocked in the calling thread (the threads Python starts meanwhile inherit it:
+ * the server's, the inspection endpoint's), so that a client that goes away while the
+ * controller writes to it is an error of the write, not the end of the program (a Python
+ * program ignores SIGPIPE; the runtime was started without touching the program's
+ * signals) */
+static void block_sigpipe(sigset_t *old)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &set, old);
+}
+
+/* One request frame in g_buf (size bytes) -> the reply frame in g_buf; 0 ok, -1 with
+ * g_io_why set.  opening: a call that may start threads (GT_Open) */
+static int inproc_call(size_t size, size_t *total, int opening)
+{
+    static char why[800];
+    sigset_t old;
+    if (opening)
+        block_sigpipe(&old);
+    int st = py_enter();
+    pyobj req = py.BytesFrom((const char *)g_buf, (ssize_t)size);
+    pyobj r = req ? py.CallObjArgs(g_host_call, req, NULL) : NULL;
+    int rc = -1;
+    char *p;
+    ssize_t n = 0;
+    if (req)
+        py.DecRef(req);
+    if (r && py.BytesAs(r, &p, &n) == 0) {
+        if (n < 4) {
+            g_io_why = "the controller refused the request (its log says why)";
+        } else if (reserve((size_t)n) < 0) {
+            g_io_why = "out of memory";
+        } else {
+            memcpy(g_buf, p, (size_t)n);
+            *total = (size_t)n;
+            rc = 0;
+        }
+    } else {
+        snprintf(why, sizeof why, "the in-process controller failed: ");
+        py_error(why + strlen(why), sizeof why - strlen(why));
+        g_io_why = why;
+    }
+    if (r)
+        py.DecRef(r);
+    py.GILRelease(st);
+    if (opening)
+        pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return rc;
+}
+
+/* a new connection of this process to its in-process controller, greeted; 0 ok */
+static int inproc_connect(const char *fname)
+{
+    int st = py_enter();
+    pyobj r = py_method(g_host, "connect");
+    char why[1000] = "";
+    if (r)
+        py.DecRef(r);
+    else
+        py_error(why, sizeof why);
+    py.GILRelease(st);
+    if (!r) {
+        set_err("%s returned -1: the in-process controller failed: %s", fname, why);
+        return -1;
+    }
+    g_inproc = 1;
+    g_fd_pid = getpid();
+    if (hello(GTE_NO_SOCK, "", fname, 0) < 0) {
+        g_inproc = 0;
+        return -1;
+    }
+    g_lost[0] = '\0';
+    return 0;
+}
+#else
+static int inproc_call(size_t size, size_t *total, int opening)
+{
+    (void)size;
+    (void)total;
+    (void)opening;
+    return -1;
+}
+#endif
+
+#if defined(__linux__)
+/* the in-process controller where it is wanted and can be started (else 1: start the
+ * controller process instead; the reason on stderr where GTECAT_INPROCESS asked for it);
+ * 0 connected, -1 failed */
+static int open_inproc(const char *fname, long long deadline)
+{
+    static int tried;
+    int asked;
+    if (g_inproc_pid == getpid())
+        return inproc_connect(fname);
+    if (g_inproc_pid) { /* a forked child: its parent's controller, over the socket */
+        if (g_private_addr[0] && connect_to(g_private_addr, fname, deadline) == 0)
+            return 0;
+        return 1;
+    }
+    if (tried || !inproc_wanted(&asked))
+        return 1;
+    tried = 1;
+    const char *rt = setting("GTECAT_RT_PRIORITY");
+    if (rt && *rt && strcasecmp(rt, "off") != 0) { /* the priority of a controller process */
+        if (asked)
+            fprintf(stderr, "gtecat: the in-process controller is not used (GTECAT_RT_PRIORITY "
+                    "is the priority of the controller process): starting that process\n");
+        return 1;
+    }
+    char dir[160], addr[200];
+    if (private_socket(fname, dir, addr) < 0)
+        return -1;
+    sigset_t old;
+    block_sigpipe(&old);
+    int started = inproc_start(addr);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (started == 0) {
+        snprintf(g_private_addr, sizeof g_private_addr, "%s", addr);
+        snprintf(g_addr, sizeof g_addr, "%s", addr);
+        return inproc_connect(fname);
+    }
+    char sock[200];
+    snprintf(sock, sizeof sock, "%s/controller.sock", dir);
+    unlink(sock);
+    rmdir(dir);
+    if (asked)
+        fprintf(stderr, "gtecat: the in-process controller is not used (%s): starting the "
+                "controller process instead\n", g_inproc_why);
+    return 1;
+}
+#endif
+
 static int ensure_open(const char *fname)
 {
-    if (g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid())
+    if ((g_fd != GTE_NO_SOCK || g_inproc) && g_fd_pid == gte_getpid())
         return 0;
     if (g_fd != GTE_NO_SOCK) { /* a forked child: leave the parent's connection to the parent */
         sock_close(g_fd);
         g_fd = GTE_NO_SOCK;
     }
+    g_inproc = 0;
 #if defined(_WIN32)
     static int wsa_ready;
     if (!wsa_ready) {
@@ -1086,6 +1522,11 @@ static int ensure_open(const char *fname)
             g_ini_path[0] ? g_ini_path : "gtecat.ini beside the program");
     return -1;
 #else
+#if defined(__linux__)
+    int in = open_inproc(fname, deadline);
+    if (in <= 0)
+        return in;
+#endif
     if (g_private_addr[0] && g_child > 0) {
         if (kill(g_child, 0) == 0 && connect_to(g_private_addr, fname, deadline) == 0)
             return 0;
@@ -1121,12 +1562,14 @@ static short invoke_locked(const gte_function *f, int gtn, short core, short car
     if (f->flags & GTE_F_OPEN) {
         if (ensure_open(f->name) < 0)
             return CMD_COMM;
-    } else if (g_fd == GTE_NO_SOCK || g_fd_pid != gte_getpid()) {
-        if ((f->flags & GTE_F_CLOSE) && g_fd == GTE_NO_SOCK)
+    } else if ((g_fd == GTE_NO_SOCK && !g_inproc) || g_fd_pid != gte_getpid()) {
+        if ((f->flags & GTE_F_CLOSE) && g_fd == GTE_NO_SOCK && !g_inproc)
             return 0; /* closing what is not open: nothing to do (as in Python) */
-        if (g_fd != GTE_NO_SOCK && g_fd_pid != gte_getpid()) {
-            sock_close(g_fd); /* forked child: reconnect to the same controller */
+        if ((g_fd != GTE_NO_SOCK || g_inproc) && g_fd_pid != gte_getpid()) {
+            if (g_fd != GTE_NO_SOCK)
+                sock_close(g_fd); /* forked child: reconnect to the same controller */
             g_fd = GTE_NO_SOCK;
+            g_inproc = 0; /* (the parent's in-process one: over its socket) */
             if (g_addr[0] && connect_to(g_addr, f->name,
                                         now_ms() + env_ms("GTECAT_TIMEOUT_MS", 30000)) == 0)
                 goto connected;
@@ -1215,6 +1658,14 @@ connected:;
         }
         }
     }
+    size_t total = 0;
+    if (g_inproc) { /* a function call: the controller runs in this process */
+        if (inproc_call(size, &total, f->flags & GTE_F_OPEN) < 0) {
+            set_err("%s returned -1: %s", f->name, g_io_why);
+            return CMD_COMM;
+        }
+        goto replied;
+    }
     long timeout = env_ms("GTECAT_TIMEOUT_MS", 30000);
     long long deadline = now_ms() + timeout;
     if (send_all(g_fd, g_buf, size, deadline) < 0) {
@@ -1225,7 +1676,6 @@ connected:;
         return CMD_COMM;
     }
     /* ---- reply ---- */
-    size_t total = 0;
     int r = recv_msg(g_fd, &total, deadline);
     if (r < 0) {
         char why[1024];
@@ -1241,6 +1691,7 @@ connected:;
         set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
         return CMD_COMM;
     }
+replied:
     if (total < 4 + 6) {
         drop("a malformed reply");
         set_err("%s returned -1: controller not responding: %s", f->name, g_lost);
@@ -1340,12 +1791,14 @@ short gte_invoke(const gte_function *f, int gtn, short core, const gte_arg *a)
         g_cards_open |= 1u << (card & 15);
     if (f->flags & GTE_F_CLOSE)
         g_cards_open &= ~(1u << (card & 15));
-    if ((f->flags & GTE_F_CLOSE) && !g_cards_open && g_fd != GTE_NO_SOCK &&
+    if ((f->flags & GTE_F_CLOSE) && !g_cards_open && (g_fd != GTE_NO_SOCK || g_inproc) &&
         g_fd_pid == gte_getpid()) {
         /* the last card's GT_Close ends this connection; a private controller lives on
          * until the program ends, so the next GT_Open finds it again */
-        sock_close(g_fd);
+        if (g_fd != GTE_NO_SOCK)
+            sock_close(g_fd);
         g_fd = GTE_NO_SOCK;
+        g_inproc = 0;
         g_lost[0] = '\0';
     }
     UNLOCK();
@@ -1378,7 +1831,7 @@ short gte_declared(int index, int gtn, short core)
     snprintf(name, sizeof name, "%s%s", gtn ? "GTN_" : "", gtn ? d->name + 3 : d->name);
     LOCK();
     short rc = -1;
-    if (g_fd != GTE_NO_SOCK && g_fd_pid == gte_getpid())
+    if ((g_fd != GTE_NO_SOCK || g_inproc) && g_fd_pid == gte_getpid())
         rc = invoke_locked(&f, gtn, core, g_card, NULL); /* the controller logs it, says why */
     if (rc != GTE_CMD_DECLARED)
         set_err("%s returned %d: %s is declared but not emulated (group: %s)", name,

@@ -1,0 +1,102 @@
+"""The in-process controller (``GTECAT_INPROCESS``): a C program's GT calls answered by the
+controller server's dispatcher inside the program, and the controller process instead
+where the Python runtime cannot be loaded."""
+
+from __future__ import annotations
+
+import os
+import socket
+import stat
+import sys
+
+import pytest
+
+from gtecat.native import inprocess
+from gtecat.native.protocol import FRAME, HELLO, PROTOCOL_VERSION, table_digest
+from gtecat.native.transport import SOCKET_TYPE
+
+from .conftest import C_DIR, compile_client, native_env, needs_cc, run_client
+
+
+@pytest.fixture(scope="module")
+def gtn_sequence(libgts, tmp_path_factory):
+    out = tmp_path_factory.mktemp("c") / "gtn_sequence"
+    return compile_client(C_DIR / "gtn_sequence.c", out, "gcc")
+
+
+#: a Python built without a shared runtime (no --enable-shared, and none installed beside a
+#: statically linked one) cannot be loaded into a program: libgts starts the process instead
+needs_runtime = pytest.mark.skipif(
+    not inprocess.ask()["libs"],
+    reason="this Python has no shared runtime library (libpython) to load into a program; "
+    "programs get the controller process (tested below)",
+)
+
+
+@needs_cc
+@needs_runtime
+def test_a_c_program_runs_its_controller_in_process(gtn_sequence, tmp_path):
+    """The vendor sequence as with the controller process: bring-up, the wall floor over a
+    usleep, a move, the reasons of refused calls; no controller process is started."""
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="1"), cwd=tmp_path)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "in-process controller is not used" not in r.stderr, r.stderr
+    assert v["done"] == "1", r.stdout + r.stderr
+    assert (v["open"], v["init"], v["ready"], v["start"]) == ("0", "0", "1", "0")
+    assert v["open_twice"] == "-6" and "already open" in v["open_twice_reason"]
+    assert int(v["slept_ms"]) >= 200
+    assert v["prfpos"] == "20000"
+    assert v["null_required"] == "7" and "pSts is NULL" in v["null_required_reason"]
+    assert (v["close"], v["after_close"], v["reopen"], v["reopen_sts"]) == ("0", "-1", "0", "0")
+
+
+@needs_cc
+def test_inprocess_0_starts_the_controller_process(gtn_sequence, tmp_path):
+    """The controller process, as a program gets it where the runtime cannot be loaded."""
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=tmp_path)
+    assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
+    assert (v["open"], v["ready"], v["prfpos"]) == ("0", "1", "20000")
+    assert int(v["slept_ms"]) >= 200
+
+
+@needs_cc
+def test_without_a_runtime_to_load_the_controller_process_is_started(gtn_sequence, tmp_path):
+    """An interpreter without a shared runtime (built without --enable-shared): the program
+    runs as before, on the controller process, and says why on stderr."""
+    fake = tmp_path / "python"
+    fake.write_text(
+        "#!/bin/sh\n"
+        'if [ "$2" = gtecat.native.inprocess ]; then printf "\\n/nowhere\\n3.11\\n\\n{}\\n"; '
+        "exit 0; fi\n"
+        f'exec {sys.executable} "$@"\n'
+    )
+    fake.chmod(fake.stat().st_mode | stat.S_IXUSR)
+    env = native_env(GTECAT_INPROCESS="1", GTECAT_PYTHON=str(fake))
+    r, v = run_client(gtn_sequence, env=env, cwd=tmp_path)
+    assert "has no shared Python library" in r.stderr, r.stderr
+    assert v["done"] == "1" and v["open"] == "0", r.stdout + r.stderr
+
+
+def test_ask_names_the_runtime_and_the_folder_gtecat_is_in():
+    a = inprocess.ask()
+    assert a["version"] == f"{sys.version_info[0]}.{sys.version_info[1]}"
+    assert os.path.isfile(os.path.join(str(a["root"]), "gtecat", "__init__.py"))
+    assert a["path"][0] == a["root"]  # type: ignore[index]
+
+
+@pytest.mark.skipif(not hasattr(socket, "AF_UNIX"), reason="a Unix socket")
+def test_the_host_answers_frames_and_listens(tmp_path):
+    """Host.call answers the frames libgts sends (the server's own dispatcher); a frame
+    whose length is wrong is refused with b""; the socket takes other clients."""
+    address = f"unix:{tmp_path}/controller.sock"
+    host = inprocess.start(address)
+    try:
+        body = HELLO.pack(1, PROTOCOL_VERSION, 8, table_digest().encode())
+        reply = host.call(FRAME.pack(len(body)) + body)
+        assert reply[4:6] == b"\0\0"  # status 0: greeted
+        assert host.call(b"\x09\0\0\0" + body) == b""
+        with socket.socket(socket.AF_UNIX, SOCKET_TYPE) as s:
+            s.connect(str(tmp_path / "controller.sock"))
+    finally:
+        host.stop()
+    assert not (tmp_path / "controller.sock").exists()
