@@ -65,7 +65,7 @@ from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import chain, compress
-from operator import attrgetter
+from operator import attrgetter, itemgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -497,8 +497,9 @@ class AxisBank:
         #: where a group's output bytes lie in the raw-write checks' references, per
         #: claimed pattern (:meth:`_took_group`)
         self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
-        #: each group's output bytes in the image (607Ah aside), as a list (made when asked)
-        self._grp_pos: dict[int, list[int]] = {}
+        #: each group's output bytes in the image (607Ah aside): their count and a function
+        #: giving their values from the image (made when asked)
+        self._grp_pos: dict[int, tuple[int, Callable[[Any], Any]]] = {}
         #: a slave's outputs in the image (start, stop), by position (:meth:`_decoded`)
         self._out_area: dict[int, tuple[int, int]] = {}
         #: the row such a call gave back where per-cycle hooks run (:meth:`_open_released`)
@@ -2362,12 +2363,18 @@ class AxisBank:
     def _group_outputs(self, gi: int) -> tuple[bytes, int, int]:
         """Group ``gi``'s output bytes (607Ah aside) as the image holds them now, and where
         they lie in the references of every group's (:attr:`_rx_snap`)."""
-        pos = self._grp_pos.get(gi)
-        if pos is None:
-            pos = self._grp_pos[gi] = self.groups[gi].rx_bytes.tolist()
-        view = self.ctl.master.image.view
+        at = self._grp_pos.get(gi)
+        if at is None:
+            pos = self.groups[gi].rx_bytes.tolist()
+            # (one itemgetter call, not a list made byte by byte: three or four times a call)
+            if len(pos) > 1:
+                get = itemgetter(*pos)
+            else:  # (itemgetter of one index gives the value, of none refuses)
+                get = (lambda v, p=pos[0]: (v[p],)) if pos else (lambda v: ())
+            at = self._grp_pos[gi] = (len(pos), get)
+        n, get = at
         start = self._rx_start[gi]
-        return bytes([view[b] for b in pos]), start, start + len(pos)
+        return bytes(get(self.ctl.master.image.view)), start, start + n
 
     def _decoded(self, g: _Group) -> bool:
         """Group ``g``'s drive took in its last exchange the output bytes the image holds now

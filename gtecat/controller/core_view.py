@@ -30,8 +30,32 @@ if TYPE_CHECKING:
 AXES_PER_CORE = 32
 
 
+class _Shared:
+    """The controller's attribute of this name, read through a view as :meth:`CoreView.__getattr__`
+    reads it, without the failed lookup before it: each of those makes and drops an
+    AttributeError, and every call through core 2 reads several of these (a drive homing's
+    set-up on 64 axes: about 700 per pass).  A non-data descriptor: a value set on the view
+    itself is found first, as before."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, view: Any, owner: type | None = None) -> Any:
+        if view is None:
+            return self
+        return getattr(view._base, self.name)
+
+
 class CoreView:
     """Core ``core`` of ``base``: its local axes 1..32 are the bus axes of that range."""
+
+    # the controller's parts a call reads on each axis (the rest through __getattr__)
+    bank = _Shared()
+    master = _Shared()
+    backend = _Shared()
+    card = _Shared()
+    pre_cycle = _Shared()
+    post_cycle = _Shared()
 
     def __init__(self, base: Controller, core: int) -> None:
         self._base = base

@@ -26,7 +26,7 @@ import logging
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from gtecat.drives.abort import SdoAbort, SdoAbortCode
 from gtecat.drives.coe import (
@@ -134,11 +134,7 @@ class SdoServer:
         same counter, and the abort the client reads from the answer (its code, index and
         subindex) raised.  A bus brought up runs 17 of these per drive."""
         self._in_process(
-            index,
-            subindex,
-            lambda: self.od.download(
-                index, subindex, data, complete_access=complete_access, al_state=al_state
-            ),
+            index, subindex, self.od.download, index, subindex, data, complete_access, al_state
         )
 
     def upload_in_process(self, index: int, subindex: int) -> bytes:
@@ -148,15 +144,16 @@ class SdoServer:
         60B9h, a mode's 6061h) pays an object read, not two mailbox frames built and parsed.
         The caller checks the size (:meth:`ObjectDictionary.size_of`) first: a longer
         object is a segmented transfer, with more counters, and takes the framed path."""
-        return self._in_process(index, subindex, lambda: self.od.upload(index, subindex))
+        return self._in_process(index, subindex, self.od.upload, index, subindex)
 
-    def _in_process(self, index: int, subindex: int, serve: Callable[[], _T]) -> _T:
-        """``serve()`` as one expedited request served and answered: its result, or the
-        abort the answer would carry (raised after the answer's counter)."""
+    def _in_process(self, index: int, subindex: int, serve: Callable[..., _T], *args: Any) -> _T:
+        """``serve(*args)`` as one expedited request served and answered: its result, or the
+        abort the answer would carry (raised after the answer's counter).  (The arguments
+        passed on, not a function made per request: a drive homing's set-up downloads five.)"""
         self._pending.clear()
         self._upload = self._download = None
         try:
-            result = serve()
+            result = serve(*args)
         except SdoAbort as err:
             abort = SdoAbort(err.code, err.index, err.subindex)
         except Exception:
