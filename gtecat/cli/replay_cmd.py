@@ -13,10 +13,12 @@ the recording is named before anything runs (exit 1); give it with ``--eni`` /
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import gtecat
 
@@ -64,12 +66,35 @@ def _numpy_one_thread() -> None:
         os.environ.pop("OPENBLAS_NUM_THREADS", None)
 
 
+def _imported_paused() -> Any:
+    """The replay's modules imported (numpy on one thread, the GT layer, the faults), with
+    the cyclic collector paused: the import makes ~200,000 objects that live as long as the
+    process, and the collector ran ~80 times while they were made (~25 ms of a replay's
+    start) to find a few hundred.  Once imported they are put in its oldest generation as a
+    pass would leave them (``gc.freeze`` then ``gc.unfreeze``: moved, not walked), so the
+    replay's own pause and freeze (:func:`gtecat.faults.record.replay`) start from none
+    young.  Returns the replay function."""
+    paused = gc.isenabled()
+    if paused:
+        gc.disable()
+    try:
+        _numpy_one_thread()
+        # a replay runs no program of its own: the GT layer's vendor surface (its ~600
+        # structures, declared-only functions, constants) is made only if the recording names
+        # one of them
+        gtecat._SURFACE_LATER = True
+        from ..faults.record import replay
+    finally:
+        if paused:
+            if gc.get_freeze_count() == 0:  # (a process that froze its own: left so)
+                gc.freeze()
+                gc.unfreeze()
+            gc.enable()
+    return replay
+
+
 def run(args: argparse.Namespace) -> int:
-    _numpy_one_thread()
-    # a replay runs no program of its own: the GT layer's vendor surface (its ~600 structures,
-    # declared-only functions, constants) is made only if the recording names one of them
-    gtecat._SURFACE_LATER = True
-    from ..faults.record import replay
+    replay = _imported_paused()
 
     t0 = time.perf_counter()
     n, div = replay(args.file, eni=args.eni, machine=args.machine)

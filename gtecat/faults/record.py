@@ -142,7 +142,7 @@ def encode(x: Any) -> Any:
         }
     if isinstance(x, ctypes.Structure):
         out = {"st": type(x).__name__, "v": {f[0]: encode(getattr(x, f[0])) for f in x._fields_}}
-        if _gt_struct(type(x).__name__) is not type(x):
+        if not _of_gt(type(x)) or _gt_struct(type(x).__name__) is not type(x):
             out["lay"] = _layout(type(x))  # (the application's own: rebuilt from its layout)
         return out
     if isinstance(x, ctypes._Pointer):  # type: ignore[attr-defined]
@@ -226,6 +226,13 @@ def decode(v: Any) -> Any:
     if "b" in v:
         return bytes.fromhex(v["b"])
     return None  # a value that cannot be rebuilt (an object of the caller's)
+
+
+def _of_gt(cls: type) -> bool:
+    """``cls`` was made by gtecat.gt (a module of it, or its vendor surface): only such a
+    class can be one of its structures, so another's name is not asked of it (which, in a
+    process that left the GT layer's surface for later, would make all of it)."""
+    return f"{cls.__module__}.".startswith("gtecat.gt.")
 
 
 def _gt_struct(name: Any) -> Any:

@@ -59,26 +59,55 @@ _MODULES = (
 )
 
 
-try:
-    for _name in _MODULES:
+#: the modules of :data:`_MODULES` a process that runs no program of its own
+#: (``gtecat._SURFACE_LATER``: ``gtecat replay``) imports at once: the replay's own calls
+#: (``GT_Open``, ``GT_Close``) and those a recorded session of axes mostly makes - its bus
+#: brought up, its axes enabled, homed, moved in Trap and polled; the others (their
+#: functions' making ~30 ms of such a process's start) with the vendor surface, at the first
+#: name asked of the module that it does not hold (:func:`_make_surface`)
+_FIRST = frozenset(
+    (
+        "bus_calls",
+        "constants",
+        "structs",
+        "axis_calls",
+        "homing_calls",
+        "motion_calls",
+        "status_calls",
+    )
+)
+
+
+def _import_modules(names: tuple[str, ...] | frozenset[str]) -> None:
+    """The modules of :data:`_MODULES` among ``names`` imported, in that order, and their
+    public names (then every registered function) put in this namespace in that order: a
+    name two modules define is the later one's, however many were imported before."""
+    g = globals()
+    for name in _MODULES:
+        if name not in names:
+            continue
         try:
-            _mod = importlib.import_module(f"{__name__}.{_name}")
-        except ModuleNotFoundError as _e:
-            if _e.name != f"{__name__}.{_name}":
+            mod = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as e:
+            if e.name != f"{__name__}.{name}":
                 raise
             continue
-        for _k, _v in vars(_mod).items():
-            if _is_public(_k, _v):
-                globals()[_k] = _v
+        for k, v in vars(mod).items():
+            if _is_public(k, v):
+                g[k] = v
+    g.update(REGISTRY)
 
-    globals().update(REGISTRY)
+
+try:
+    _surface_later = bool(getattr(_sys.modules.get("gtecat"), "_SURFACE_LATER", False))
+    _import_modules(_FIRST if _surface_later else _MODULES)
     #: the vendor surface (:mod:`gtecat.gt.vendor`: the groups' structures, enum members and
     #: constants, ~3,800 declared-only functions), every name in this namespace from here on
     #: (no module ``__getattr__``: CPython specialises ``gt.X`` only without one) - unless the
     #: process said it runs no program of its own (``gtecat._SURFACE_LATER``, set by ``gtecat
     #: replay`` before it imports this module): then the first name asked of the module that it
-    #: does not hold makes it (:func:`__getattr__`), ~25 ms of such a process's start
-    _surface_later = bool(getattr(_sys.modules.get("gtecat"), "_SURFACE_LATER", False))
+    #: does not hold makes it (:func:`__getattr__`), ~25 ms of such a process's start, with
+    #: the GT modules not in :data:`_FIRST`
     if not _surface_later:
         _install_vendor_surface(globals(), REGISTRY)
 finally:
@@ -94,19 +123,29 @@ def _whole() -> dict[str, object]:
     return globals()
 
 
-_surface_lock = _threading.Lock()
+_surface_lock = _threading.RLock()
+#: the surface is being made by the thread holding the lock (a name asked of this module by
+#: the modules it imports meanwhile is looked for as during an import: not made again)
+_making = False
 
 
 def _make_surface() -> None:
-    """The vendor surface left for later, made once (the module's ``__getattr__`` and
-    ``__dir__`` then go: the namespace is the one an ordinary import makes)."""
-    global _surface_later
+    """The GT modules and the vendor surface left for later, made once (the module's
+    ``__getattr__`` and ``__dir__`` then go: the namespace is the one an ordinary import
+    makes)."""
+    global _surface_later, _making
     with _surface_lock:
-        if _surface_later:
-            _install_vendor_surface(globals(), REGISTRY)
-            for _k in ("__getattr__", "__dir__"):
-                globals().pop(_k, None)
-            _surface_later = False
+        if _surface_later and not _making:
+            _making = True
+            try:
+                # (every module again, in order: the names an ordinary import leaves)
+                _import_modules(_MODULES)
+                _install_vendor_surface(globals(), REGISTRY)
+                for k in ("__getattr__", "__dir__"):
+                    globals().pop(k, None)
+                _surface_later = False
+            finally:
+                _making = False
 
 
 if _surface_later:

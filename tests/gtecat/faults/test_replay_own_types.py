@@ -126,3 +126,16 @@ def test_a_damaged_layout_is_refused_with_its_reason(
     _changed(own, bad, "GT_SetTrapPrm", lambda e: e["a"][1]["ref"]["lay"].__setitem__(3, field))
     with pytest.raises(ParameterError, match=r"damaged recording.*GT_SetTrapPrm"):
         replay(bad)
+
+
+def test_a_structure_is_recorded_with_its_layout_unless_it_is_the_gt_layers():
+    """gtecat.gt's own structure is recorded by its name; an application's, also one named
+    as gtecat.gt's (as the C# wrappers name TTrapPrm), with its layout."""
+    from gtecat.faults.record import encode
+
+    class TTrapPrm(ctypes.Structure):  # (the application's own, the GT layer's name)
+        _fields_ = list(MyTrap._fields_)
+
+    assert "lay" not in encode(gt.TTrapPrm())
+    assert "lay" in encode(TTrapPrm())
+    assert "lay" in encode(MyTrap())

@@ -203,6 +203,7 @@ before = {
     "hook": "__getattr__" in vars(gt),
     "declared_there": "GT_SetHSIOOpt" in vars(gt),
     "own_there": "GT_GetSts" in vars(gt) and "TTrapPrm" in vars(gt),
+    "later_module_there": "GT_GetDi" in vars(gt),
 }
 fn = gt.GT_SetHSIOOpt  # (the first vendor name asked: the surface made)
 after = {
@@ -214,6 +215,21 @@ after = {
 print(json.dumps([before, after]))
 """
 
+#: the GT layer's public names, and which of them are its registered functions
+_NAMES = r"""
+import json
+import sys
+import gtecat
+gtecat._SURFACE_LATER = sys.argv[1] == "later"
+from gtecat import gt
+from gtecat.gt import _core
+
+if gtecat._SURFACE_LATER:
+    gt.GT_SetHSIOOpt  # (the surface made)
+names = sorted(k for k in vars(gt) if not k.startswith("_"))
+print(json.dumps([names, [k for k in names if _core.REGISTRY.get(k) is getattr(gt, k)]]))
+"""
+
 
 def test_a_process_that_runs_no_program_makes_the_vendor_surface_at_its_first_name():
     """``gtecat replay``'s start: with ``gtecat._SURFACE_LATER`` set before the import, the GT
@@ -223,5 +239,27 @@ def test_a_process_that_runs_no_program_makes_the_vendor_surface_at_its_first_na
         [sys.executable, "-c", _LATER], capture_output=True, text=True, cwd=ROOT, check=True
     )
     before, after = json.loads(out.stdout.strip().splitlines()[-1])
-    assert before == {"hook": True, "declared_there": False, "own_there": True}
+    assert before == {
+        "hook": True,
+        "declared_there": False,
+        "own_there": True,
+        "later_module_there": False,  # (its module left for later too)
+    }
     assert after == {"hook": False, "whole": True, "rc": 8, "no_such": False}
+
+
+def test_the_surface_made_later_is_an_ordinary_imports():
+    """The GT modules and vendor surface a replay's process makes at its first name are the
+    namespace an ordinary import makes: the same names, the same registered functions."""
+    got = {}
+    for how in ("later", "now"):
+        out = subprocess.run(
+            [sys.executable, "-c", _NAMES, how],
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+            check=True,
+        )
+        got[how] = json.loads(out.stdout.strip().splitlines()[-1])
+    assert got["later"] == got["now"]
+    assert len(got["now"][1]) > 500
