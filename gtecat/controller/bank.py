@@ -464,6 +464,7 @@ class AxisBank:
         self.groups: list[_Group] = []
         #: the claimed rows' output bytes as the last re-index saw them (:meth:`_reindex`)
         self._rx_ref = b""
+        self._rx_gi = np.zeros(0, np.intp)  # (the group of each of those bytes)
         self.dirty = True
         self._countdown = 0
         self._missed = False  # the last refresh found an eligible group it could not claim
@@ -1621,11 +1622,12 @@ class AxisBank:
         if not changed:
             return
         # (a claimed group's bytes lie together in _rx_idx too, after the claimed ones before)
-        start = self._rx_start[self.group_of[r]]
-        before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
+        before = self._claimed_before(self.group_of[r])
         ref = bytearray(self._rx_ref)
         for k, b in changed:
-            snap[k] = ref[before + k] = buf[b]
+            snap[k] = buf[b]
+            if before is not None:
+                ref[before + k] = buf[b]
         self._rx_ref = bytes(ref)
 
     def _put_probe(self, r: int) -> None:
@@ -2400,12 +2402,26 @@ class AxisBank:
         at = self._took_at.get(gi)
         if at is None or at[0] is not self._rx_idx:
             start, stop = self._rx_start[gi], self._rx_start[gi + 1]
-            before = int(np.count_nonzero(self._g_claimed[self._rx_group[:start]])) - start
+            before = self._claimed_before(gi)
             at = self._took_at[gi] = (
                 self._rx_idx,
-                [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
+                []
+                if before is None
+                else [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
             )
         return at[1]
+
+    def _claimed_before(self, gi: int) -> int | None:
+        """Where group ``gi``'s bytes lie in the claimed ones (:attr:`_rx_idx`, :attr:`_rx_ref`)
+        less where they lie in every group's (:attr:`_rx_start`); None when the pattern those
+        were made for leaves the group out.  (Read from that pattern, not from which groups
+        are claimed now: :meth:`_reindex` takes an opened row's bytes before it makes the
+        new pattern, a group claimed or given back since.)"""
+        gis = self._rx_gi
+        p = int(np.searchsorted(gis, gi))
+        if p == len(gis) or gis[p] != gi:
+            return None
+        return p - self._rx_start[gi]
 
     def _close_opened(self, r: int, g: _Group) -> None:
         """After :meth:`call_opened`'s call on opened row ``r``: taken again from its objects

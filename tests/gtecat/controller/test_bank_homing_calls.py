@@ -164,3 +164,44 @@ def test_a_row_given_back_while_opened_runs_on_the_scalar_path(
         assert a == b, f"step {k}: the bank and the scalar drives differ"
     if HAS_CC and bank_kernel.wanted() != "numpy":
         assert len(given) == 4
+
+
+def test_a_row_claimed_while_another_is_opened_keeps_the_output_references(
+    runs: tuple, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """A group given back and taken again while a row is opened for a call (the bank's look
+    for rows to claim comes in the middle of a call): the opened row's output bytes go to
+    the places the claimed pattern of the moment gives them in the raw-write checks'
+    references (a 64-axis bus's last drive found them past the end and the call failed)."""
+    step = AxisBank._step_opened
+    entries = AxisBank._took_entries
+    moved: list[int] = []
+    checked: list[int] = []
+
+    def step_then_give_one_back(bank: AxisBank, t_ns: int, dt_ns: int) -> None:
+        step(bank, t_ns, dt_ns)
+        if not bank._opened or len(moved) >= 4:
+            return
+        gi = bank.group_of[next(iter(bank._opened))]
+        before = [g for g in bank.groups[:gi] if g.claimed and bank.alive[g.rows[0]]]
+        if before:  # (taken again at the next cycle's look: the pattern moves under the row)
+            moved.append(gi)
+            bank._release_groups(before[:1])
+            bank._reindex()
+            bank.dirty = True
+
+    def checked_entries(bank: AxisBank, gi: int) -> list[tuple[int, int, int]]:
+        out = entries(bank, gi)
+        for _, byte, j in out:
+            assert int(bank._rx_idx[j]) == byte
+        checked.append(len(out))
+        return out
+
+    monkeypatch.setattr(AxisBank, "_step_opened", step_then_give_one_back)
+    monkeypatch.setattr(AxisBank, "_took_entries", checked_entries)
+    (ref, _), _ = runs
+    got, _ = _run(_machine(tmp_path_factory.mktemp("moved"), SETUP), "on")
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"step {k}: the bank and the scalar drives differ"
+    if HAS_CC and bank_kernel.wanted() != "numpy":
+        assert moved and checked
