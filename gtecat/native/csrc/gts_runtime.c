@@ -1321,6 +1321,11 @@ static int inproc_start(const char *addr)
     char *ctype = setlocale(LC_CTYPE, NULL);
     char saved[200];
     snprintf(saved, sizeof saved, "%s", ctype ? ctype : "C");
+    /* the program's Ctrl-C: Python's `signal` module, when first imported, takes SIGINT
+     * where it was left at its default (to raise KeyboardInterrupt) even in a runtime started
+     * without signal handlers; it is imported below, then SIGINT is given back as it was */
+    struct sigaction program_int;
+    sigaction(SIGINT, NULL, &program_int);
     py.InitializeEx(0); /* 0: the program's signal handlers stay its own */
     setlocale(LC_CTYPE, saved);
     g_inproc_pid = getpid();
@@ -1341,7 +1346,13 @@ static int inproc_start(const char *addr)
     pyobj call = host ? py.GetAttrString(host, "call") : NULL;
     if (!call)
         py_error(g_inproc_why, sizeof g_inproc_why);
-    pyobj refs[] = {mod, settle, envb, r, start, where};
+    pyobj sigmod = call ? py.ImportModule("signal") : NULL; /* (its taking of SIGINT, now) */
+    if (call && !sigmod) {
+        char ignored[256];
+        py_error(ignored, sizeof ignored); /* (cleared: the calls need no signal module) */
+    }
+    sigaction(SIGINT, &program_int, NULL);
+    pyobj refs[] = {mod, settle, envb, r, start, where, sigmod};
     for (size_t i = 0; i < sizeof refs / sizeof refs[0]; i++)
         if (refs[i])
             py.DecRef(refs[i]);

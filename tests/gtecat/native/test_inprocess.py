@@ -100,3 +100,37 @@ def test_the_host_answers_frames_and_listens(tmp_path):
     finally:
         host.stop()
     assert not (tmp_path / "controller.sock").exists()
+
+
+_CTRL_C = r"""
+#include <signal.h>
+#include <stdio.h>
+#include "gts.h"
+int main(void)
+{
+    short rc = GT_Open(0, 1);
+    printf("open %d\n", rc);
+    fflush(stdout);
+    raise(SIGINT); /* Ctrl-C: a C program's default ends it */
+    printf("survived\n");
+    return 0;
+}
+"""
+
+
+@needs_cc
+@needs_runtime
+def test_ctrl_c_still_ends_a_program_whose_controller_runs_in_it(tmp_path):
+    """Python's signal module takes SIGINT when first imported, even in a runtime started
+    without signal handlers: the library gives the program its own back (a Ctrl-C that did
+    nothing, or failed the GT call running, was the defect)."""
+    import signal
+
+    src = tmp_path / "ctrl_c.c"
+    src.write_text(_CTRL_C)
+    exe = compile_client(src, tmp_path / "ctrl_c", "gcc")
+    r, v = run_client(exe, env=native_env(GTECAT_INPROCESS="1"), cwd=tmp_path, timeout=120)
+    assert v.get("open") == "0", r.stdout + r.stderr
+    assert "in-process controller is not used" not in r.stderr, r.stderr
+    assert "survived" not in r.stdout
+    assert r.returncode == -signal.SIGINT, (r.returncode, r.stdout, r.stderr)
