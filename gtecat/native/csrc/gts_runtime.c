@@ -1581,8 +1581,10 @@ static short invoke_locked(const gte_function *f, int gtn, short core, short car
                 sock_close(g_fd); /* forked child: reconnect to the same controller */
             g_fd = GTE_NO_SOCK;
             g_inproc = 0; /* (the parent's in-process one: over its socket) */
-            if (g_addr[0] && connect_to(g_addr, f->name,
-                                        now_ms() + env_ms("GTECAT_TIMEOUT_MS", 30000)) == 0)
+            char addr[sizeof g_addr]; /* (connect_to writes g_addr: not from itself) */
+            snprintf(addr, sizeof addr, "%s", g_addr);
+            if (addr[0] && connect_to(addr, f->name,
+                                      now_ms() + env_ms("GTECAT_TIMEOUT_MS", 30000)) == 0)
                 goto connected;
         }
         if (g_lost[0])

@@ -134,3 +134,51 @@ def test_ctrl_c_still_ends_a_program_whose_controller_runs_in_it(tmp_path):
     assert "in-process controller is not used" not in r.stderr, r.stderr
     assert "survived" not in r.stdout
     assert r.returncode == -signal.SIGINT, (r.returncode, r.stdout, r.stderr)
+
+
+_FORK = r"""
+#include <stdio.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "gts.h"
+int main(void)
+{
+    long sts = 0;
+    char why[256] = "";
+    printf("open %d\n", GT_Open(0, 1));
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        short rc = GT_GetSts(1, &sts, 1, NULL);
+        GTE_GetLastError(why, sizeof why);
+        printf("child_before_open %d %s\n", rc, why);
+        printf("child_open %d\n", GT_Open(0, 1));
+        printf("child_sts %d\n", GT_GetSts(1, &sts, 1, NULL));
+        fflush(stdout);
+        _exit(0);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    printf("parent_sts %d\n", GT_GetSts(1, &sts, 1, NULL));
+    return 0;
+}
+"""
+
+
+@needs_cc
+@pytest.mark.parametrize("inproc", ["1", "0"])
+def test_a_forked_child_reaches_the_controller_once_it_opens(tmp_path, inproc):
+    """A child of the program reconnects over the controller's socket (the reconnection
+    read its address from the buffer it was writing: it never connected); until its own
+    GT_Open, the controller's reason says to open."""
+    src = tmp_path / "fork.c"
+    src.write_text(_FORK)
+    exe = compile_client(src, tmp_path / "fork", "gcc")
+    r, v = run_client(exe, env=native_env(GTECAT_INPROCESS=inproc), cwd=tmp_path, timeout=120)
+    assert v.get("open") == "0", r.stdout + r.stderr
+    assert v["child_before_open"].startswith("-1 ") and "has not opened" in v[
+        "child_before_open"
+    ], r.stdout
+    assert v["child_open"] == "0", r.stdout
+    # (the bus is not started: both get the controller's own answer, not -1)
+    assert v["child_sts"] == v["parent_sts"] != "-1", r.stdout
