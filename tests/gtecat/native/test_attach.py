@@ -52,7 +52,18 @@ def controller(tmp_path, monkeypatch):
     proc = _start_controller(address, "lockstep", tmp_path)
     yield address, proc
     _core.close_all()
-    proc.kill()
+    _end(proc)
+
+
+def _end(proc: subprocess.Popen) -> None:
+    """End a controller as a user would (SIGTERM): it removes its inspection files; SIGKILL
+    left them in the runtime folder for `gtecat ps` to sweep."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(30)
+        except subprocess.TimeoutExpired:
+            proc.kill()
     proc.wait()
 
 
@@ -280,8 +291,7 @@ def test_a_compiled_program_and_an_attached_test_share_one_controller_process(
         gt.GT_Close()
         if prog is not None and prog.poll() is None:
             prog.kill()
-        ctl.kill()
-        ctl.wait()
+        _end(ctl)
 
 
 def test_the_test_suite_never_attaches_by_accident():
