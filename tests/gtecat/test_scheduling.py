@@ -5,6 +5,7 @@ refuses."""
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 
 import pytest
 
@@ -177,6 +178,28 @@ def test_beside_never_takes_a_cpu_it_may_not_use_and_survives_a_refusal():
     assert b.look(True, 1, 0) is None and b.moves == 0
 
 
+def _beside_client(server, monkeypatch) -> tuple[list[set[int]], Callable[[int], None]]:
+    """The server on CPU 1, its client (pid 4242) served last on CPU 0, a Beside that moves
+    after one look apart: the moves it makes, and a look at the load with ``over`` runnable
+    threads beyond the CPUs."""
+    from gtecat.native import server as server_module
+
+    moves: list[set[int]] = []
+    server.beside = Beside({0, 1}, set_affinity=moves.append, after=1)
+    cpus = {"thread-self": 1, 4242: 0}
+    monkeypatch.setattr(scheduling, "thread_cpu", lambda pid="thread-self": cpus[pid])
+    load = {"over": 2}
+    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
+    server._served_pid = 4242
+
+    def look(over: int) -> None:
+        load["over"] = over
+        server._busy_next = 0.0
+        server._spin_budget()
+
+    return moves, look
+
+
 def test_the_controller_follows_the_client_it_served_while_real_time(server, monkeypatch):
     """The look at the load reads the CPU of the client served last (its process id from
     the Unix socket) and the server's own; apart while real-time: the server moves."""
@@ -190,19 +213,7 @@ def test_the_controller_follows_the_client_it_served_while_real_time(server, mon
         assert server_module._peer_pid(a) == os.getpid()
     system = FakeSystem(permits=True)
     server.realtime = WhenBusy(50, set_fifo=system.fifo, set_normal=system.normal, normal=(0, 0))
-    moves: list[set[int]] = []
-    server.beside = Beside({0, 1}, set_affinity=moves.append, after=1)
-    cpus = {"thread-self": 1, 4242: 0}
-    monkeypatch.setattr(scheduling, "thread_cpu", lambda pid="thread-self": cpus[pid])
-    load = {"over": 2}
-    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
-    server._served_pid = 4242
-
-    def look(over: int) -> None:
-        load["over"] = over
-        server._busy_next = 0.0
-        server._spin_budget()
-
+    moves, look = _beside_client(server, monkeypatch)
     look(2)
     assert moves == [{0}]
     look(0)  # idle: normal policy, its CPUs back
@@ -215,22 +226,8 @@ def test_the_controller_follows_the_client_it_served_while_real_time(server, mon
 def test_a_normal_priority_controller_follows_its_client_too(server, monkeypatch):
     """Without real-time rights (no WhenBusy) the server still takes its client's CPU while
     other programs could hold every CPU, and gives its CPUs back when they cannot."""
-    from gtecat.native import server as server_module
-
     assert server.realtime is None
-    moves: list[set[int]] = []
-    server.beside = Beside({0, 1}, set_affinity=moves.append, after=1)
-    cpus = {"thread-self": 1, 4242: 0}
-    monkeypatch.setattr(scheduling, "thread_cpu", lambda pid="thread-self": cpus[pid])
-    load = {"over": 2}
-    monkeypatch.setattr(server_module, "_runnable_over_cpus", lambda: load["over"])
-    server._served_pid = 4242
-
-    def look(over: int) -> None:
-        load["over"] = over
-        server._busy_next = 0.0
-        server._spin_budget()
-
+    moves, look = _beside_client(server, monkeypatch)
     look(1)  # busy, but the server and its client count two of those threads: left alone
     assert moves == []
     look(2)

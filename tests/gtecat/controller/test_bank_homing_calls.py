@@ -116,6 +116,12 @@ def _run(machine: str, bank: str) -> tuple[list, tuple[int, int, int]]:
     return trace, counts
 
 
+def _same(ref: list, got: list) -> None:
+    """Every step of a run with the bank as the scalar drives' run (the first that differs)."""
+    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+        assert a == b, f"step {k}: the bank and the scalar drives differ"
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> tuple:
     machine = _machine(tmp_path_factory.mktemp("calls"), SETUP)
@@ -124,8 +130,7 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> tuple:
 
 def test_homing_calls_on_opened_rows_match_the_scalar_drives(runs: tuple) -> None:
     (ref, _), (got, _) = runs
-    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
-        assert a == b, f"step {k}: the bank and the scalar drives differ"
+    _same(ref, got)
     codes = [c for step in ref[0 : 2 * CYCLES : 2] for c in step]
     assert codes.count(0) < len(codes)  # the refusals above were refused
     status = ref[-2][3]
@@ -160,8 +165,7 @@ def test_a_row_given_back_while_opened_runs_on_the_scalar_path(
     monkeypatch.setattr(AxisBank, "_step_opened", step_then_give_back)
     (ref, _), _ = runs
     got, _ = _run(_machine(tmp_path_factory.mktemp("given"), SETUP), "on")
-    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
-        assert a == b, f"step {k}: the bank and the scalar drives differ"
+    _same(ref, got)
     if HAS_CC and bank_kernel.wanted() != "numpy":
         assert len(given) == 4
 
@@ -201,7 +205,6 @@ def test_a_row_claimed_while_another_is_opened_keeps_the_output_references(
     monkeypatch.setattr(AxisBank, "_took_entries", checked_entries)
     (ref, _), _ = runs
     got, _ = _run(_machine(tmp_path_factory.mktemp("moved"), SETUP), "on")
-    for k, (a, b) in enumerate(zip(ref, got, strict=True)):
-        assert a == b, f"step {k}: the bank and the scalar drives differ"
+    _same(ref, got)
     if HAS_CC and bank_kernel.wanted() != "numpy":
         assert moved and checked
