@@ -166,13 +166,9 @@ def _take_scheduling(server: Server, rt_setting: int | str) -> tuple[scheduling.
     return taken, started_rt
 
 
-def wall_floor_setting() -> bool:
-    """GTECAT_WALL_FLOOR: the wall floor unless it says 0/off/no/false."""
-    env = os.environ.get("GTECAT_WALL_FLOOR", "1").strip().lower()
-    return env not in ("0", "off", "no", "false")
-
-
 def _wall_floor(args: argparse.Namespace) -> bool:
+    from ..native.floor import wall_floor_setting
+
     return not args.no_wall_floor and wall_floor_setting()
 
 

@@ -22,6 +22,7 @@ already runs on the wall clock.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 
@@ -35,6 +36,13 @@ from ..master.clock import Clock, ClockMode
 #: CPU per call of a tight loop (24 -> 16 us) and the round trip 11 us at p50 (31 -> 20 us).
 #: A call looks first anyway, so it still sees every millisecond of the wall.
 IDLE_LOOK_S = 0.01
+
+
+def wall_floor_setting() -> bool:
+    """GTECAT_WALL_FLOOR: the wall floor unless it says 0/off/no/false (the controller
+    process and the in-process controller alike)."""
+    env = os.environ.get("GTECAT_WALL_FLOOR", "1").strip().lower()
+    return env not in ("0", "off", "no", "false")
 
 
 class WallFloor:

@@ -30,7 +30,7 @@ class Host:
     socket in a folder made for it) and the program's own connection to it."""
 
     def __init__(self, address: str) -> None:
-        from ..cli.controller_cmd import wall_floor_setting
+        from .floor import wall_floor_setting
         from .server import Server
 
         self.server = Server(address, wall_floor=wall_floor_setting(), remove_dir=True)
