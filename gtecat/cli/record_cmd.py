@@ -17,10 +17,12 @@ FILE is refused before anything runs when it cannot be written, with the reason.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import runpy
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -141,9 +143,12 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_child(command: list[str], env: dict[str, str]) -> int:
     """Run the command and wait for it; SIGTERM and SIGHUP sent to ``gtecat record`` (a
-    time-out, ``kill``) are passed on to it, so it ends the way it ends when sent them
-    itself (a Python program writes its recording, see ``end_on_signals``) instead of
-    being left running without its recorder's parent."""
+    time-out, ``kill``) are passed on to it and every process it started (a shell that
+    runs the program without ``exec`` dies of the signal and would leave the program
+    running, unrecorded), so the program ends the way it ends when sent them itself (a
+    Python program writes its recording, see ``end_on_signals``); the recorder then waits,
+    up to :data:`DESCENDANTS_WAIT_S`, for those it signalled to end.  The code of a
+    command ended by a signal is 128 + the signal, as a shell reports it."""
     import signal
 
     from ..faults.record import ENDING_SIGNALS
@@ -152,17 +157,58 @@ def _run_child(command: list[str], env: dict[str, str]) -> int:
         child = subprocess.Popen(command, env=env)
     except OSError as e:
         raise ParameterError(f"cannot run {command[0]}: {e.strerror or e}") from None
+    signalled: set[int] = set()
+
+    def pass_on(num: int, _frame: object) -> None:
+        for pid in (child.pid, *_descendants(child.pid)):
+            with contextlib.suppress(OSError):
+                os.kill(pid, num)
+                signalled.add(pid)
+
     saved = _signals()
     for name in ENDING_SIGNALS:
-        signal.signal(getattr(signal, name), lambda num, _f: child.send_signal(num))
+        signal.signal(getattr(signal, name), pass_on)
     try:
         while True:
             try:
-                return child.wait()
+                rc = child.wait()
+                break
             except KeyboardInterrupt:  # Ctrl-C reaches the child too (same process group)
                 continue
+        deadline = time.monotonic() + DESCENDANTS_WAIT_S
+        while any(os.path.exists(f"/proc/{p}") for p in signalled - {child.pid}):
+            if time.monotonic() > deadline:
+                break
+            time.sleep(0.02)
     finally:
         _restore(saved)
+    return 128 - rc if rc < 0 else rc
+
+
+#: how long the recorder waits for the processes of the program it passed a signal on to
+#: (a Python program writing its recording) after the command itself ended (s)
+DESCENDANTS_WAIT_S = 60.0
+
+
+def _descendants(pid: int) -> list[int]:
+    """The processes ``pid`` started, and theirs (Linux ``/proc``; none where it is not)."""
+    out: list[int] = []
+    todo = [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            tasks = os.listdir(f"/proc/{p}/task")
+        except OSError:
+            continue
+        for t in tasks:
+            try:
+                with open(f"/proc/{p}/task/{t}/children") as f:
+                    kids = [int(k) for k in f.read().split()]
+            except (OSError, ValueError):
+                continue
+            out.extend(kids)
+            todo.extend(kids)
+    return out
 
 
 def _signals() -> dict[int, Any]:

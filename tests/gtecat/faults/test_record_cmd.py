@@ -90,12 +90,14 @@ _FOREVER = (
 )
 
 
-@pytest.mark.parametrize("how", ["script", "child"])
+@pytest.mark.parametrize("how", ["script", "child", "shell"])
 def test_a_recording_ended_by_sigterm_is_written_and_replays(
     tmp_path: Path, how: str
 ) -> None:
     """A CI job's time-out sends SIGTERM: the session up to there is kept (before, nothing
-    was written).  ``script``: run inside gtecat record; ``child``: a command it starts."""
+    was written).  ``script``: run inside gtecat record; ``child``: a command it starts;
+    ``shell``: a shell that starts the program without ``exec`` (the shell dies of the
+    signal: the program was left running, unrecorded, when only the shell got it)."""
     import signal
     import subprocess
     import sys
@@ -106,6 +108,8 @@ def test_a_recording_ended_by_sigterm_is_written_and_replays(
     cmd = [sys.executable, str(app)]
     if how == "child":  # not a Python script by its name: started as a child
         cmd = ["sh", "-c", f'exec "{sys.executable}" "{app}"']
+    elif how == "shell":
+        cmd = ["sh", "-c", f'"{sys.executable}" "{app}"; echo after']
     rec = subprocess.Popen(
         [sys.executable, "-m", "gtecat", "record", "-o", str(out), "--", *cmd],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
