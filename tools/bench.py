@@ -1286,6 +1286,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rss_128_axes_moving": lambda: _figure(
             bench_rss(128, min(seconds, 1.0)), "mb_per_axis", 0.1, at_most=True
         ),
+        "rss_1024_axes_moving": lambda: _figure(
+            bench_rss(1024, min(seconds, 1.0)), "mb_per_axis", 0.1, at_most=True
+        ),
         "bringup_512_axes_to_op": lambda: _figure(
             bench_bringup(512), "process_wall_s", 3.0, at_most=True
         ),

@@ -818,6 +818,10 @@ class AxisBank:
         self._row_link: np.ndarray | None = None
         #: per claimed pattern, what follows from it alone (_reindex)
         self._claimed_sets: dict[bytes, tuple] = {}
+        #: how many patterns it keeps: each holds ~200 bytes a row, so a fixed budget of rows
+        #: (256 patterns of 64 rows, 16 of 1,024) - a bus of 1,024 axes switched on one by one
+        #: made a pattern per axis and kept 256 of them: ~25 kB per axis at the peak
+        self._patterns_kept = max(8, min(256, 16_384 // max(1, self.n)))
         self._axes_seen: list[Any] | None = None
         self._reindex()
         if self._kernel_lib is not None:
@@ -912,7 +916,7 @@ class AxisBank:
         key = g_claimed.tobytes() + alive.tobytes()
         kept = self._claimed_sets.get(key)
         if kept is None:
-            if len(self._claimed_sets) > 256:
+            if len(self._claimed_sets) >= self._patterns_kept:
                 self._claimed_sets.clear()
             sel = g_claimed[self._rx_group]
             run = ~(self._rows_in & alive.take(np.maximum(self._rows_np, 0)))

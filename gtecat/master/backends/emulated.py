@@ -148,7 +148,9 @@ class EmulatedBackend(Backend):
                 tuple(e[0] for e in compress(plan, inside)),
                 sum(compress(self._plan_wkc, inside)),
             )
-            if len(self._claimed_memo) > 256:
+            # (each holds ~a list entry per slave: a budget of slaves, not of patterns, as
+            # the axis bank's own, or a bus of 1,024 drives switched on one by one keeps 256)
+            if len(self._claimed_memo) >= max(8, min(256, 16_384 // max(1, len(plan)))):
                 self._claimed_memo.clear()
             self._claimed_memo[claimed] = memo
         self._run_plan, self._claimed_slaves, self._claimed_wkc = memo
