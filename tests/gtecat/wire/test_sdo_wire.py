@@ -151,8 +151,10 @@ def _lost_answer_runs_the_cycles(gt, slave: int = 0, *, paced: bool = True) -> N
     assert "no answer within the mailbox timeout (700 ms)" in why
     assert 650 <= wall_ms < 3000, wall_ms
     # the clock counts the cycles that really ran: all of them on a quiet machine (the
-    # realtime clock skips the periods a late cycle overran, as it does in a plain wait)
-    assert ran >= 0.5 * wall_ms, (ran, wall_ms)
+    # realtime clock skips the periods a late cycle overran, as it does in a plain wait; a
+    # loaded machine makes many late, so the check is that they ran, not how fast: held
+    # during the SDO, none would)
+    assert ran >= 0.25 * wall_ms, (ran, wall_ms)
     # ... and the axis moved with them
     if paced:  # (a loaded machine delays some frames of the serve's drive: it lags a little)
         assert 0.6 * VEL * ran - 3 * VEL <= moved <= 1.1 * VEL * ran + 3 * VEL, (moved, ran)
