@@ -186,7 +186,9 @@ class _Session:
             and self._remote is None
             and c.clock.mode in (ClockMode.LOCKSTEP, ClockMode.AUTO)
         )
-        set_gates(c if on and self._core == 1 else None, c if on else None)
+        # (cores 2.. are views of core 1's bus while the card has no core of its own)
+        views = on and len(self.controllers) == 1
+        set_gates(c if on and self._core == 1 else None, c if on else None, views)
 
     @property
     def core(self) -> int:

@@ -323,18 +323,22 @@ ONE, ZERO, NULL = 1, 0, 2
 #: [0] nonzero while the GT_ functions address an in-process controller of core 1 on the
 #: lockstep (:data:`LOCKSTEP`) or the auto clock (:data:`AUTO`: an entry's ``after`` runs
 #: the call's host latency once the value is written), [1] while the GTN_ functions' core 1
-#: is such a controller
-GATES = (ctypes.c_ssize_t * 2)()
+#: is such a controller, [2] nonzero while its cores 2.. are views of its bus (no core of
+#: their own: gtecat.controller.core_view), which the readers then answer for core 1 by the
+#: bus axis's number
+GATES = (ctypes.c_ssize_t * 3)()
 #: an entry's gate: none, the GT_ functions', the GTN_ functions'
 NO_GATE, GT_GATE, GTN_GATE = 0, 1, 2
 #: an open gate's value: its controller's clock
 CLOSED, LOCKSTEP, AUTO = 0, 1, 2
 
 
-def set_gates(gt: int, gtn: int) -> None:
+def set_gates(gt: int, gtn: int, views: bool = False) -> None:
     """Open (:data:`LOCKSTEP`, :data:`AUTO`) or close (:data:`CLOSED`) the two gates
-    (:data:`GATES`); what the entries kept was another session's."""
+    (:data:`GATES`), and say whether the GTN_ functions' cores 2.. are views of core 1's bus
+    (only where the GTN_ gate is open); what the entries kept was another session's."""
     GATES[0], GATES[1] = int(gt), int(gtn)
+    GATES[2] = int(bool(gtn) and views)
     EPOCH.n += 1
 
 
@@ -1389,7 +1393,7 @@ def _self_test(make: Maker) -> str:
                 ):
                     return f"a gated entry answered {got!r} with its gate {on}"
     finally:
-        GATES[0], GATES[1] = before
+        GATES[:] = before
 
     reason = _self_test_cache(make, python, nope)
     if reason:
@@ -1525,7 +1529,7 @@ def _self_test_cache(make: Maker, python: Callable[..., Any], nope: Any) -> str:
             if not ok or asked != want_asked:
                 return f"a keeping entry answered {got!r} for {args!r} asking {asked!r}"
     finally:
-        GATES[0], GATES[1] = before[0]
+        GATES[:] = before[0]
         CLOCK_MS[:] = before[1]
     return ""
 

@@ -746,13 +746,16 @@ def _gated(env: dict[str, Any]) -> dict[str, Any]:
     return env
 
 
-def set_gates(gt: Any, gtn: Any) -> None:
+def set_gates(gt: Any, gtn: Any, views: bool = False) -> None:
     """The session's answer (gtecat.gt._core: wherever it can change): ``gt`` the
     in-process lockstep or auto controller the GT_ functions address with core 1, ``gtn`` the GTN_
-    functions' core 1, or None.  The gated value functions read it as ``CTL`` / ``CTLN``,
-    their C entries' gates open for it."""
+    functions' core 1, or None; ``views``: the GTN_ functions' cores 2.. are views of that
+    core's bus (the C entries answer them by the bus axis).  The gated value functions read it
+    as ``CTL`` / ``CTLN``, their C entries' gates open for it."""
     new = [_OFF if gt is None else gt, _OFF if gtn is None else gtn]
     if new[0] is GATED[0] and new[1] is GATED[1]:  # (the same: a client's call's select)
+        if bool(centry.GATES[2]) != (views and gtn is not None):
+            centry.GATES[2] = int(views and gtn is not None)
         return
     centry.set_gates(centry.CLOSED, centry.CLOSED)
     GATED[:] = new
@@ -774,7 +777,7 @@ def set_gates(gt: Any, gtn: Any) -> None:
         *(c if g != centry.CLOSED else None for c, g in zip(new, gates, strict=True))
     )
     centry.set_wait(gt if gates[0] != centry.CLOSED else None)
-    centry.set_gates(*gates)
+    centry.set_gates(*gates, views)
 
 
 #: the GT layer's turn of what a cycle raised into the call's code and reason

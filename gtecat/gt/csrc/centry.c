@@ -291,6 +291,40 @@ static int int_is(obj o, long long want)
     return !over && v == want;
 }
 
+/* GTN_f(core, n, ...) with core 2.. a view of core 1's bus (gtecat.controller.core_view: core c
+ * addresses bus axes 32(c-1)+1 .. 32c, which core 1 takes by their bus numbers): the bus
+ * axis's int, which core 1's value function answers as the view would, or NULL (the Python
+ * path: core 1, a core of its own, a local axis beyond 1..32, a bus beyond VIEW_AXES). The
+ * ints are made once and kept for the process. */
+#define VIEW_AXES 4096
+static obj view_ints[VIEW_AXES + 1];
+
+static obj view_axis(obj core, obj axis)
+{
+    int over = 0;
+    long long c, n, b;
+    if (!A.gate[2] || TYPE(core) != A.int_type || TYPE(axis) != A.int_type)
+        return NULL;
+    c = A.as_ll(core, &over);
+    if (over || c < 2 || c > VIEW_AXES / 32) {
+        if (c == -1 && !over && A.err_occurred())
+            A.err_clear();
+        return NULL;
+    }
+    n = A.as_ll(axis, &over);
+    if (over || n < 1 || n > 32) {
+        if (n == -1 && !over && A.err_occurred())
+            A.err_clear();
+        return NULL;
+    }
+    b = 32 * (c - 1) + n;
+    if (!view_ints[b] && !(view_ints[b] = A.long_from(b))) {
+        A.err_clear();
+        return NULL;
+    }
+    return view_ints[b];
+}
+
 /* The values' epoch now (-1: unknown, nothing is kept or used). */
 static long long epoch(void)
 {
@@ -1522,6 +1556,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     int holds = 0;
     struct recipe rc = {0};
     long long key = -1, ep = -1, ep0 = -1, clk = 0, loop = 0;
+    obj axis = NULL; /* the axis value() answers: args[at], or a core view's bus axis */
 
     if (!ready || kwnames || (e->gate && !A.gate[e->gate - 1]))
         goto python;
@@ -1544,17 +1579,24 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
     } else {
         if (nargs < 2 + at || nargs > e->most + at)
             goto python;
-        if (at && !int_is(args[0], 1))
+        axis = args[at];
+        if (at && !int_is(args[0], 1)) {
+            /* another core: one value, no array (those paths read args[at] themselves) */
+            if (!(axis = view_axis(args[0], args[at])) || (e->avalue && array_of(args[at + 1])))
+                goto python;
+        }
+        if (TYPE(axis) != A.int_type)
             goto python;
-        if (TYPE(args[at]) != A.int_type)
-            goto python;
-        if (e->avalue && (arr = array_of(args[at + 1])) != NULL)
+        if (axis == args[at] && e->avalue && (arr = array_of(args[at + 1])) != NULL)
             return array(e, args, nargs, kwnames, at, arr, locked);
         /* a numpy array of several values (count 2 or more) */
         if (e->avalue && e->nptypes[0] && nargs >= 3 + at &&
             TYPE(args[at + 1]) == A.ndarray_type && args[at + 2] != A.one &&
-            !int_is(args[at + 2], 1))
+            !int_is(args[at + 2], 1)) {
+            if (axis != args[at])
+                goto python;
             return np_array(e, args, nargs, kwnames, at, locked);
+        }
         /* (the cached small ints 1 and 0 first: one compare for the common literals) */
         if (nargs >= 3 + at && args[at + 2] != A.one && !int_is(args[at + 2], 1))
             goto python;
@@ -1587,14 +1629,14 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
 
     /* the value kept for this epoch, else value(n)'s (kept for it) */
     if (e->cache &&
-        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : args[at], &key, &ep, (int)e->steady)) !=
+        (v = kept(e->cache, e->ncache, e->noaxis ? NULL : axis, &key, &ep, (int)e->steady)) !=
             NULL)
         goto have;
     if (!locked)
         ep0 = epoch();
     ran = 1;
     v = e->noaxis ? A.vectorcall(e->value, NULL, 0, NULL)
-                  : A.vectorcall(e->value, &args[at], 1, NULL);
+                  : A.vectorcall(e->value, &axis, 1, NULL);
     if (!v)
         return NULL; /* (the value's own error, as the Python path would raise it) */
     if (v == e->sentinel)
