@@ -144,7 +144,10 @@ class PvtPlanner:
                 self._k = round((t - end) / self._T)
                 self._i = 0
                 t = segs[0].t0 + self._k * self._T
-            while segs[self._i].t1 < t:
+            # (a sample up to 1e-9 ms past the table's end is the last segment's: its end
+            # rounded below the cycle's multiple, as 14.21 + 57 * 1.0 > 71.21)
+            last = len(segs) - 1
+            while self._i < last and segs[self._i].t1 < t:
                 self._i += 1
             p, v, a = segs[self._i].at(t)
             self._pos, self._vel, self._acc = self._origin + p, v, a
@@ -153,6 +156,22 @@ class PvtPlanner:
             if self._stop.done:
                 self._finish(self._pos)
         return self._pos, self._vel, self._acc
+
+    def run(self, n: int) -> tuple[list[float], list[float], list[float], int]:
+        """``n`` calls of :meth:`step` at once (the axis bank's tables): the positions, speeds
+        and accelerations up to the end sample, and its index (-1: the motion goes on)."""
+        ps: list[float] = []
+        vs: list[float] = []
+        as_: list[float] = []
+        step = self.step
+        for j in range(n):
+            p, v, a = step()
+            ps.append(p)
+            vs.append(v)
+            as_.append(a)
+            if self._state == _IDLE:
+                return ps, vs, as_, j
+        return ps, vs, as_, -1
 
     def _finish(self, pos: float) -> None:
         self._pos = pos
