@@ -48,6 +48,13 @@ class PvtSegment:
         return pos, vel, acc
 
 
+def never_ends(segments: tuple[PvtSegment, ...], loop: int, cycle_ms: float) -> bool:
+    """An endless loop (``loop`` 0) over a table lasting less than half a cycle: a cycle's
+    passes would never end (the time a pass carries over rounds to a whole cycle past the
+    table's end again), so such a start is refused."""
+    return not loop and 2 * (segments[-1].t1 - segments[0].t0) < cycle_ms
+
+
 class PvtPlanner:
     """One profile in PVT mode."""
 
@@ -180,4 +187,4 @@ class PvtPlanner:
         self.stopping = StopKind.NONE
 
 
-__all__ = ["PvtPlanner", "PvtSegment"]
+__all__ = ["PvtPlanner", "PvtSegment", "never_ends"]
