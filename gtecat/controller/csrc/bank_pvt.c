@@ -4,10 +4,10 @@
  * with the same IEEE operations in the same order (built with -ffp-contract=off, no
  * fast-math): the samples are the scalar planner's, bit for bit, passes and the end of the
  * last one included.  Each row's state is PV_NST doubles (PV_* below); its table is m rows of
- * t0, t1, p0, p1, v0, v1 (the planner's segments). */
+ * t0, t1, p0, p1, v0, v1 (the planner's segments).  bank_pvt_run has bank_pt_run's form: the
+ * kernel's bank_pt_fill fills many PVT rows' tables with it in one call. */
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
 
 enum { PV_K, PV_T, PV_I, PV_LOOP, PV_LOOPS, PV_ORIGIN, PV_POS, PV_VEL, PV_ACC, PV_STATE, PV_NST };
 enum { S_T0, S_T1, S_P0, S_P1, S_V0, S_V1, S_N };
@@ -73,50 +73,4 @@ int64_t bank_pvt_run(double *st, const double *sg, int64_t m, int64_t n, double 
         st[PV_ACC] = ao[n - 1];
     }
     return -1;
-}
-
-/* The tables of many PVT rows at once (AxisBank._fill_tables, as bank_pt_fill does for PT):
- * a[] holds the row count, the samples per table, the table width and the addresses of the
- * arrays (PF_* below).  For each row r: its state st[r] is kept in before[r], the last sample
- * taken moves to the row's spare slot, bank_pvt_run fills the table and moves st[r] on, and
- * the table's cursor, length and end follow; the samples written are returned. */
-enum {
-    PF_NR, PF_N, PF_TABLE, PF_ROWS, PF_ST, PF_BEFORE, PF_SEGS, PF_M, PF_TP, PF_TV, PF_TA,
-    PF_BASE, PF_IDX, PF_LEN, PF_CUR, PF_END, PF_TAKEN, PF_FILLTAKEN, PF_NARGS
-};
-
-int bank_pvt_fill_args(void) { return PF_NARGS; }
-
-int64_t bank_pvt_fill(const int64_t *a)
-{
-#define PA(T, k) ((T *)(intptr_t)a[k])
-    const int64_t nr = a[PF_NR], n = a[PF_N], table = a[PF_TABLE];
-    const int64_t *rows = PA(const int64_t, PF_ROWS);
-    double *st = PA(double, PF_ST), *before = PA(double, PF_BEFORE);
-    const int64_t *segs = PA(const int64_t, PF_SEGS), *m = PA(const int64_t, PF_M);
-    double *tp = PA(double, PF_TP), *tv = PA(double, PF_TV), *ta = PA(double, PF_TA);
-    const int64_t *base = PA(const int64_t, PF_BASE);
-    int64_t *idx = PA(int64_t, PF_IDX), *len = PA(int64_t, PF_LEN);
-    int64_t *cur = PA(int64_t, PF_CUR), *end = PA(int64_t, PF_END);
-    const int64_t *taken = PA(const int64_t, PF_TAKEN);
-    int64_t *fill_taken = PA(int64_t, PF_FILLTAKEN);
-    int64_t i, total = 0;
-#undef PA
-    for (i = 0; i < nr; i++) {
-        const int64_t r = rows[i], b = base[r], spare = b + table, last = idx[r];
-        int64_t e;
-        memcpy(before + PV_NST * r, st + PV_NST * r, PV_NST * sizeof(double));
-        tp[spare] = tp[last];
-        tv[spare] = tv[last];
-        ta[spare] = ta[last];
-        idx[r] = spare;
-        e = bank_pvt_run(st + PV_NST * r, (const double *)(intptr_t)segs[r], m[r], n, tp + b,
-                         tv + b, ta + b);
-        len[r] = e >= 0 ? e + 1 : n;
-        cur[r] = 0;
-        end[r] = e;
-        fill_taken[r] = taken[r];
-        total += len[r];
-    }
-    return total;
 }
