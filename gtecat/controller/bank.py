@@ -229,6 +229,10 @@ BANK_READS = frozenset(
         "GT_GetRemainderSegNum",
         "GT_GetCrdMapBase",
         "GT_CrdData",
+        # a PVT axis's table time and passes, from the state its row's table began with
+        # (gtecat.controller.bank_pvt.now)
+        "GT_PvtStatus",
+        "GT_GetPvtLoop",
     }
 )
 #: GT functions naming coordinate systems by a mask (GT_CrdStart: bit 0 = system 1; GT_Stop:

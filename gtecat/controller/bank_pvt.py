@@ -59,14 +59,14 @@ def compiled_kind(pl: Any) -> bool:
     return PvtPlanner in type(pl).__mro__ and get(pl, "_state") == _MOVE
 
 
-def segments(held: dict[int, tuple[tuple, np.ndarray]], segs: tuple) -> np.ndarray:
-    """The planner's segments as the C side reads them (t0, t1, p0, p1, v0, v1 per row),
-    made once per table (``held``: id(segments) -> (segments, array))."""
+def segments(held: dict[int, tuple[tuple, np.ndarray, int]], segs: tuple) -> tuple[Any, int]:
+    """(the planner's segments as the C side reads them: t0, t1, p0, p1, v0, v1 per row; its
+    address), made once per table (``held``: id(segments) -> (segments, array, address))."""
     got = held.get(id(segs))
     if got is None or got[0] is not segs:
         arr = np.array([(g.t0, g.t1, g.p0, g.p1, g.v0, g.v1) for g in segs], np.float64)
-        got = held[id(segs)] = (segs, arr)
-    return got[1]
+        got = held[id(segs)] = (segs, arr, arr.ctypes.data)
+    return got[1], got[2]
 
 
 class PvtFill(PtFill):
@@ -81,18 +81,21 @@ class PvtFill(PtFill):
         #: samples written (statistics: the tests check the compiled fill ran)
         self.samples = 0
         #: id(segments tuple) -> (the tuple, its array): rows running one table share it
-        self._tables: dict[int, tuple[tuple, np.ndarray]] = {}
+        self._tables: dict[int, tuple[tuple, np.ndarray, int]] = {}
         #: run_row's state and tables (planners whose state is their own)
         self.one = np.zeros(len(STATE))
         self._one_ptr = self.one.ctypes.data
-        self._row_tables: dict[int, tuple[tuple, np.ndarray]] = {}
+        self._row_tables: dict[int, tuple[tuple, np.ndarray, int]] = {}
+        #: stepped's samples (not kept)
+        self._scratch = np.empty((3, 0))
+        self._scratch_ptrs = (0, 0, 0)
 
     def load(self, r: int, pl: Any) -> None:
         """Row ``r`` runs PVT planner ``pl`` (:func:`compiled_kind`, unguarded) from now on."""
         self.st[r] = self._state(pl)
-        arr = segments(self._tables, object.__getattribute__(pl, "_segs"))
+        arr, ptr = segments(self._tables, object.__getattribute__(pl, "_segs"))
         self._points[r] = arr
-        self.pts[r], self.m[r] = arr.ctypes.data, len(arr)
+        self.pts[r], self.m[r] = ptr, len(arr)
 
     def fill(self, bank: Any, rows: list[int], n: int) -> int:
         got = super().fill(bank, rows, n)
@@ -105,13 +108,13 @@ class PvtFill(PtFill):
         held = self._row_tables
         if len(held) > 64:  # (tables of planners long gone)
             held.clear()
-        arr = segments(held, object.__getattribute__(pl, "_segs"))
+        arr, ptr = segments(held, object.__getattribute__(pl, "_segs"))
         st = self.one
         st[:] = self._state(pl)
         bank.keep_last_sample(r)
         off = 8 * int(bank.base[r])
         p, v, a = (t.ctypes.data + off for t in (bank.t_p, bank.t_v, bank.t_a))
-        end = int(self.run(self._one_ptr, arr.ctypes.data, len(arr), n, p, v, a))
+        end = int(self.run(self._one_ptr, ptr, len(arr), n, p, v, a))
         put = object.__setattr__
         for name, value, whole in zip(STATE, st.tolist(), self._whole, strict=True):
             put(pl, name, int(value) if whole else value)
@@ -122,13 +125,72 @@ class PvtFill(PtFill):
         bank.t_cur[r] = 0
         bank.t_end[r] = end
 
+    def stepped(self, vals: list[Any], segs: tuple, m: int) -> list[float]:
+        """A planner's state ``vals`` (STATE order) after ``m`` steps over ``segs``."""
+        held = self._row_tables
+        if len(held) > 64:
+            held.clear()
+        arr, ptr = segments(held, segs)
+        if self._scratch.shape[1] < m:
+            self._scratch = np.empty((3, m))
+            self._scratch_ptrs = tuple(self._scratch[j].ctypes.data for j in range(3))
+        st = self.one
+        st[:] = vals
+        self.run(self._one_ptr, ptr, len(arr), m, *self._scratch_ptrs)
+        return st.tolist()  # type: ignore[no-any-return]
+
     def drop(self, r: int) -> None:
         """Row ``r`` leaves: its table's array goes (the last row of a table takes it along)."""
         arr = self._points.pop(r, None)
         if arr is not None and not any(x is arr for x in self._points.values()):
-            for key, (_, held) in list(self._tables.items()):
+            for key, (_, held, _) in list(self._tables.items()):
                 if held is arr:
                     del self._tables[key]
+
+
+def now(res: Any, pl: Any) -> tuple[int, float, int, int] | None:
+    """(table selected, table time of the pass, passes done, loop setting) of PVT planner
+    ``pl`` of axis ``res`` as the scalar path has them now, where the bank runs the axis
+    (``GT_PvtStatus``, ``GT_GetPvtLoop`` read it so, without giving it back); None where
+    it does not (the planner holds them).  The planner's state when the row's current
+    table began (:class:`PvtFill`'s, or the one its cluster kept for a rewind), stepped as
+    many cycles as the bank ran since, on a copy."""
+    bank = res.bank
+    if bank is None:
+        return None
+    get = object.__getattribute__
+    r = res.bank_row
+    cl = bank.__dict__.get("_cluster_of", {}).get(bank.group_of[r])
+    vals: list[Any] | None = None
+    if cl is not None and cl.snaps is not None:  # stepped ahead since the claim
+        if isinstance(cl.compiled_pt, PvtFill):
+            vals = cl.compiled_pt.before[r].tolist()
+        else:
+            for obj, snap in cl.snaps:
+                if obj is pl:  # (bank_modes.snapshot: the planner's __dict__ by name)
+                    vals = [snap[2][name][0] for name in STATE]
+                    break
+    if vals is None:  # not stepped ahead: the planner stands where the scalar path has it
+        vals = [get(pl, name) for name in STATE]
+        m = 0
+    else:
+        m = bank.taken.item(r) - bank.fill_taken.item(r)
+    segs = get(pl, "_segs")
+    if m and int(vals[-1]) == _MOVE:
+        pf = pvt_fill(bank)
+        if pf is not None:
+            vals = pf.stepped(vals, segs, m)
+        else:
+            copy = PvtPlanner.__new__(PvtPlanner)
+            copy.__dict__.update(get(pl, "__dict__"))
+            for name, value in zip(STATE, vals, strict=True):
+                setattr(copy, name, value)
+            for _ in range(m):
+                copy.step()
+            vals = [getattr(copy, name) for name in STATE]
+    k, cyc, state = int(vals[0]), vals[1], int(vals[-1])
+    t = segs[0].t0 + k * cyc if state == _MOVE and segs else 0.0
+    return get(pl, "table_id"), t, int(vals[4]), int(vals[3])
 
 
 def fill_row(bank: Any, r: int, pl: Any, n: int) -> bool:
@@ -165,4 +227,4 @@ def pvt_fill(bank: Any) -> PvtFill | None:
     return pf
 
 
-__all__ = ["PvtFill", "compiled_kind", "fill_row", "library", "pvt_fill"]
+__all__ = ["PvtFill", "compiled_kind", "fill_row", "library", "now", "pvt_fill"]

@@ -38,6 +38,7 @@ from __future__ import annotations
 import weakref
 from typing import Any
 
+from ..controller.bank_pvt import now as banked_now
 from ..controller.core import Controller
 from ..controller.motion.pvt import PvtPlanner, PvtSegment, never_ends
 from ..controller.profile import PrfMode
@@ -224,9 +225,12 @@ def GT_SetPvtLoop(ctl: Controller, profile: int, loop: int) -> int:
 
 @gt_function
 def GT_GetPvtLoop(ctl: Controller, profile: int, pLoopCount: Any, pLoop: Any) -> int:
-    pl = _pvt(ctl, profile, "GT_GetPvtLoop")
-    store(pLoopCount, pl.loops_done)
-    store(pLoop, pl.loop)
+    res = axis_resources(ctl, profile)
+    pl = _planner(res, "GT_GetPvtLoop", PrfMode.PVT, PvtPlanner)
+    got = banked_now(res, pl)  # (an axis the bank runs: read there, not given back)
+    done, loop = (pl.loops_done, pl.loop) if got is None else got[2:]
+    store(pLoopCount, done)
+    store(pLoop, loop)
     return 0
 
 
@@ -237,9 +241,12 @@ def GT_PvtStatus(ctl: Controller, profile: int, pTableId: Any, pTime: Any, count
     ids, times = [], []
     for res in span:
         pl = res.profile.planner if res is not None else None
-        if isinstance(pl, PvtPlanner) and res is not None and res.profile.mode == PrfMode.PVT:
-            ids.append(pl.table_id)
-            times.append(pl.time)
+        # (the planner's type, not isinstance: that reads a guarded Trap or Gear planner's
+        # __class__, which gives its axis back)
+        if res is not None and res.profile.mode == PrfMode.PVT and PvtPlanner in type(pl).__mro__:
+            got = banked_now(res, pl)  # (an axis the bank runs: read there, not given back)
+            ids.append(pl.table_id if got is None else got[0])
+            times.append(pl.time if got is None else got[1])
         else:
             ids.append(0)
             times.append(0.0)

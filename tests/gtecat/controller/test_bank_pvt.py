@@ -9,7 +9,7 @@ a cycle), one whose end falls a rounding error before a cycle's multiple, loop c
 (endless), 1, 2, 3, 5 and 7 (passes ending inside a table of the bank's, the last pass's
 end), starts at different cycles, a table rewritten while axes run it, a PVT axis as a Gear
 master, a soft limit crossed, smooth and abrupt stops, GT_PvtStatus and GT_GetPvtLoop in
-the middle of tables (every PVT axis given back and taken again), an axis started again on
+the middle of tables (read from the bank, the axes kept there), an axis started again on
 another table after its end.
 """
 
@@ -23,7 +23,7 @@ import pytest
 from gtecat import gt
 from gtecat.controller import bank_pvt
 from gtecat.controller.motion.pvt import PvtPlanner, PvtSegment
-from tests.gtecat.controller.test_bank import AXES, _machine_file, _ok
+from tests.gtecat.controller.test_bank import AXES, _bring_up, _machine_file, _ok
 from tests.gtecat.controller.test_bank_modes import Script, _bit, _gear, _run
 
 
@@ -131,6 +131,26 @@ def test_pvt_in_the_numpy_bank_matches_the_scalar_path(machine) -> None:
     got, samples = _run(PVT, machine, "on", True, kernel="numpy")
     assert got == ref
     assert samples >= 1500
+
+
+def test_pvt_status_and_loop_reads_keep_the_axes_in_the_bank(machine) -> None:
+    """GT_PvtStatus and GT_GetPvtLoop answer from the bank (the values: the test above):
+    polling them gave every PVT axis back and took it again (64 axes polled every 20 ms:
+    2x real time per CPU second)."""
+    bank_pvt.library()
+    _bring_up(machine, "on")
+    try:
+        _setup()
+        gt.GTE_Wait(45)
+        bank = gt.GTE_Controller().bank
+        for _ in range(3):
+            before = (bank.releases, bank.n_alive)
+            _status()
+            _loops()
+            assert (bank.releases, bank.n_alive) == before
+            gt.GTE_Wait(7)
+    finally:
+        gt.GT_Close()
 
 
 def test_a_sample_a_rounding_error_past_the_table_is_its_last_segment() -> None:
