@@ -541,6 +541,7 @@ PT_FILL_ARGS = (
     "nr n table rows st before pts m t_p t_v t_a base t_idx t_len t_cur t_end taken fill_taken "
     "run nst"
 ).split()
+_PT_RUN = PT_FILL_ARGS.index("run")
 
 
 class PtFill:
@@ -574,7 +575,7 @@ class PtFill:
         self._points: dict[int, np.ndarray] = {}  # row -> its FIFO's points (kept alive)
         self._state = attrgetter(*state)
         a = self.args
-        a[18], a[19] = run, len(state)
+        a[_PT_RUN], a[_PT_RUN + 1] = run, len(state)
         a[3], a[4], a[5] = self.rows.ctypes.data, self.st.ctypes.data, self.before.ctypes.data
         a[6], a[7] = self.pts.ctypes.data, self.m.ctypes.data
 
