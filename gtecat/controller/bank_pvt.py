@@ -14,6 +14,7 @@ run in place of PT's (:class:`PvtFill`, a :class:`~gtecat.controller.bank_kernel
 while such a row is claimed its planner's state lives there (``st``, and ``before``: the
 state when the row's current table began); a release hands the planner ``before``
 (:meth:`PvtFill.put_back`) and the cluster steps it on to the controller's time.
+``GT_PvtStatus`` and ``GT_GetPvtLoop`` read such an axis without giving it back (:func:`now`).
 A stop (the planner's stop ramp) or anything else the bank does not model gives the row back
 before it changes the planner.  Without a C compiler (or with ``GTECAT_BANK_KERNEL=numpy``)
 the planner's own ``step`` fills the tables, as for any planner the bank steps ahead.
