@@ -899,6 +899,7 @@ def bench_bringup_growth(counts: Sequence[int] = (256, 512, 1024, 2048)) -> dict
 GEAR = "per core: the first axis in Trap, the others in Gear on it (1:2)"
 FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-point cam, endless)"
 CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
+PVT = "PVT, a 3-point table per core (GT_PvtTable), GT_SetPvtLoop(a, 0): endless"
 
 
 #: the cycle hooks :func:`bench_hooked_poll` compares with none: a ``[[fault]]`` table whose
@@ -1159,7 +1160,7 @@ def compiled_parts() -> dict[str, object]:
     start their build in a process of its own and run the numpy cycle until it ends, so the
     first figures would measure the build beside numpy (128 axes in Trap: 7x instead of
     150x on an idle machine) rather than the steady state the figures are about."""
-    from gtecat.controller import bank_crd, bank_kernel, bank_slaves
+    from gtecat.controller import bank_crd, bank_kernel, bank_pvt, bank_slaves
 
     t0, c0 = time.perf_counter(), time.process_time()
     out: dict[str, object] = {}
@@ -1167,6 +1168,7 @@ def compiled_parts() -> dict[str, object]:
         ("bank_kernel", bank_kernel.library),
         ("bank_crd", bank_crd.library),
         ("bank_slaves", bank_slaves.library),
+        ("bank_pvt", bank_pvt.library),
     ):
         if name == "bank_kernel" and bank_kernel.wanted() == "numpy":
             out[name] = "not built: GTECAT_BANK_KERNEL=numpy"
@@ -1261,6 +1263,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         ),
         "rtf_12_axes_pt": lambda: rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
         "rtf_64_axes_pt": lambda: rtf(64, every(64, "pt"), 10, "PT, static FIFO, endless loop"),
+        "rtf_64_axes_pvt": lambda: rtf(64, every(64, "pvt"), 10, PVT),
         "rtf_12_axes_gear": lambda: rtf(12, every(12, "gear"), None, GEAR),
         "rtf_64_axes_gear": lambda: rtf(64, every(64, "gear"), 10, GEAR),
         "rtf_12_axes_follow": lambda: rtf(12, every(12, "follow"), None, FOLLOW),

@@ -41,7 +41,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_long, c_short, c_ulong
+from ctypes import byref, c_double, c_long, c_short, c_ulong
 from pathlib import Path
 from typing import Any
 
@@ -53,8 +53,8 @@ from tools.gen_axes_eni import write_axes_eni  # noqa: E402
 
 AXES = (1, 2, 4, 8, 12, 16, 32, 64, 96, 128)
 STATES = ("idle", "moving", "homing")
-#: the other motion modes (``--states pt,gear,follow,crd``): see their ``start_*``
-MODES = ("pt", "gear", "follow", "crd", "homed6")
+#: the other motion modes (``--states pt,pvt,gear,follow,crd``): see their ``start_*``
+MODES = ("pt", "pvt", "gear", "follow", "crd", "homed6")
 AXES_PER_CORE = 32
 #: axes per core that :func:`core_axis` uses; ``--addressing flat`` puts every axis on
 #: core 1 (the emulator's own extension before issue 17: no GT_Update beyond axis 32)
@@ -238,6 +238,23 @@ def start_pt(axes: Sequence[int], points: int = 400) -> None:
         _ok(gt.GTN_PtStart(core, mask, 0), f"GTN_PtStart({core}, {mask:#x})", core)
 
 
+def start_pvt(axes: Sequence[int]) -> None:
+    """PVT, endless loop (``GT_SetPvtLoop(a, 0)``) over one table per core of 3 points
+    (0, 500, 1000 ms; 0, 5000, 0 pulses; at rest at each), on every axis."""
+    gt = _gt()
+    t, p, v = (c_double * 3)(0, 500, 1000), (c_double * 3)(0, 5000, 0), (c_double * 3)(0, 0, 0)
+    groups = by_core(axes)
+    for core in groups:
+        _ok(gt.GTN_PvtTable(core, 1, 3, t, p, v), f"GTN_PvtTable({core}, 1)", core)
+    for a in axes:
+        gtn("PrfPvt", a)
+        gtn("PvtTableSelect", a, 1)
+        gtn("SetPvtLoop", a, 0)
+    for core, on_core in sorted(groups.items()):
+        mask = sum(1 << (core_axis(a)[1] - 1) for a in on_core)
+        _ok(gt.GTN_PvtStart(core, mask), f"GTN_PvtStart({core}, {mask:#x})", core)
+
+
 def by_core(axes: Sequence[int]) -> dict[int, list[int]]:
     """The bus axes of ``axes`` grouped by their core, in axis order."""
     out: dict[int, list[int]] = {}
@@ -363,6 +380,7 @@ STARTERS: dict[str, Callable[[Sequence[int]], None]] = {
     "moving": start_trap,
     "homing": start_homing,
     "pt": start_pt,
+    "pvt": start_pvt,
     "gear": start_gear,
     "follow": start_follow,
     "crd": start_crd,
@@ -790,7 +808,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--axes", type=_ints, default=list(AXES), help="e.g. 1,12,64")
     ap.add_argument(
-        "--states", default=",".join(STATES), help="idle,moving,homing (also pt,gear,follow,crd)"
+        "--states",
+        default=",".join(STATES),
+        help="idle,moving,homing (also pt,pvt,gear,follow,crd)",
     )
     ap.add_argument("--seconds", type=float, default=1.5, help="wall seconds per point")
     ap.add_argument("--repeat", type=int, default=3, help="windows per point (best counts)")

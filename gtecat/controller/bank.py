@@ -229,6 +229,10 @@ BANK_READS = frozenset(
         "GT_GetRemainderSegNum",
         "GT_GetCrdMapBase",
         "GT_CrdData",
+        # a PVT axis's table time and passes, from the state its row's table began with
+        # (gtecat.controller.bank_pvt.now)
+        "GT_PvtStatus",
+        "GT_GetPvtLoop",
     }
 )
 #: GT functions naming coordinate systems by a mask (GT_CrdStart: bit 0 = system 1; GT_Stop:
@@ -293,7 +297,7 @@ _TP_TX = (0x60B9, 0x60BA, 0x60BB, 0x60BC, 0x60BD, *range(0x60D1, 0x60D9))
 
 
 #: the modes whose planners a cluster steps ahead (gtecat.controller.bank_modes)
-_SAMPLED_MODES = (PrfMode.PT, PrfMode.GEAR, PrfMode.FOLLOW, PrfMode.INTERPOLATION)
+_SAMPLED_MODES = (PrfMode.PT, PrfMode.GEAR, PrfMode.FOLLOW, PrfMode.INTERPOLATION, PrfMode.PVT)
 
 
 def _trap_key(pl: TrapPlanner) -> tuple:
@@ -1841,7 +1845,7 @@ class AxisBank:
         if np.count_nonzero(need):
             self._materialise()
             filled: set[int] = set()  # the rows of the clusters filled
-            pt_rows: list[int] = []
+            alone: dict[Any, list[int]] = {}  # PT/PVT rows alone: per compiled fill
             group_of = self.group_of
             flags = self.sampled[need].tolist()
             for r, sampled in zip(np.nonzero(need)[0].tolist(), flags, strict=True):
@@ -1851,8 +1855,8 @@ class AxisBank:
                 if r in filled:
                     continue
                 cl = self._cluster_of[group_of[r]]
-                if cl.compiled_pt:  # a PT axis alone: all of them in one compiled call
-                    pt_rows.append(r)
+                if cl.compiled_pt is not None:  # a PT/PVT axis alone: one compiled call
+                    alone.setdefault(cl.compiled_pt, []).append(r)
                     cl.snaps = []
                     continue
                 filled.update(cl.rows)
@@ -1867,9 +1871,8 @@ class AxisBank:
                 finally:
                     for pl, cls in guarded:
                         _set(pl, "__class__", cls)
-            if pt_rows:
-                assert self.pt_fill is not None
-                self.sampled_samples += self.pt_fill.fill(self, pt_rows, SAMPLED_TABLE)
+            for fill, rows in alone.items():
+                self.sampled_samples += fill.fill(self, rows, SAMPLED_TABLE)
         left = (self.t_len - cur)[moving]
         self._refill_in = int(left.min()) if len(left) else self.table
 

@@ -217,6 +217,28 @@ def build(
         return shared_library(stem, source, PLAIN_CFLAGS, libs)
 
 
+class Unit:
+    """One of the bank's other C units (``csrc/<stem>.c``): built (:func:`build`) and loaded
+    on the first call, once per process; ``bind`` declares its functions and raises where
+    the library is not the one its module packs for.  A call gives (the library or None,
+    why not)."""
+
+    def __init__(self, stem: str, bind: Any, libs: tuple[str, ...] = ("-lm",)) -> None:
+        self.stem, self.bind, self.libs = stem, bind, libs
+        self.lib: Any = None
+        self.reason = ""
+
+    def __call__(self) -> tuple[Any, str]:
+        if self.lib is None and not self.reason:
+            try:
+                lib = ctypes.CDLL(str(build(CFLAGS, self.stem, self.libs)))
+                self.bind(lib)
+                self.lib = lib
+            except Exception as e:  # no compiler, a failed build: the module's Python path
+                self.reason = f"{type(e).__name__}: {e}"
+        return self.lib, self.reason
+
+
 def _field_types() -> list[tuple[str, Any]]:
     """(name, dtype) of every field, read from the C source's FIELDS list."""
     body = _source().split("#define FIELDS", 1)[1].split("enum {", 1)[0]
@@ -516,28 +538,44 @@ class PtRun:
 _PT_WHOLE = tuple(name in _PT_INTS for name in PT_STATE)
 #: bank_pt_fill's argument slots (the C side's PT_FILL_* order): counts, then addresses
 PT_FILL_ARGS = (
-    "nr n table rows st before pts m t_p t_v t_a base t_idx t_len t_cur t_end taken fill_taken"
+    "nr n table rows st before pts m t_p t_v t_a base t_idx t_len t_cur t_end taken fill_taken "
+    "run nst"
 ).split()
+_PT_RUN = PT_FILL_ARGS.index("run")
 
 
 class PtFill:
     """The tables of a bank's PT rows (static FIFOs in motion, one per cluster) refilled by
     one call of the compiled ``bank_pt_fill``.  While such a row is claimed its planner's
     state lives here (``st``, and ``before``: the state when the row's current table began);
-    :meth:`put_back` hands the planner the latter, which a release then steps on."""
+    :meth:`put_back` hands the planner the latter, which a release then steps on.
 
-    def __init__(self, lib: Any, n: int) -> None:
+    ``state``, ``whole`` and ``run``: another planner's state (its attribute names, which of
+    them are integers) and the address of its compiled run of ``bank_pt_run``'s form (a PVT
+    row's: :mod:`~gtecat.controller.bank_pvt`), whose rows the same call fills."""
+
+    def __init__(
+        self,
+        lib: Any,
+        n: int,
+        state: tuple[str, ...] | list[str] = PT_STATE,
+        whole: frozenset[str] = _PT_INTS,
+        run: int = 0,
+    ) -> None:
         self.fn = lib.bank_pt_fill
-        self.st = np.zeros((n, len(PT_STATE)))
-        self.before = np.zeros((n, len(PT_STATE)))
+        self.names = tuple(state)
+        self._whole = tuple(name in whole for name in self.names)
+        self.st = np.zeros((n, len(state)))
+        self.before = np.zeros((n, len(state)))
         self.pts = np.zeros(n, np.int64)
         self.m = np.zeros(n, np.int64)
         self.rows = np.zeros(n, np.int64)
         self.args = np.zeros(len(PT_FILL_ARGS), np.int64)
         self._args_ptr = self.args.ctypes.data
         self._points: dict[int, np.ndarray] = {}  # row -> its FIFO's points (kept alive)
-        self._state = attrgetter(*PT_STATE)
+        self._state = attrgetter(*state)
         a = self.args
+        a[_PT_RUN], a[_PT_RUN + 1] = run, len(state)
         a[3], a[4], a[5] = self.rows.ctypes.data, self.st.ctypes.data, self.before.ctypes.data
         a[6], a[7] = self.pts.ctypes.data, self.m.ctypes.data
 
@@ -579,9 +617,10 @@ class PtFill:
     def put_back(self, r: int, pl: Any) -> None:
         """The planner of row ``r`` as it stood when the row's current table began."""
         put = object.__setattr__
-        for name, value, whole in zip(PT_STATE, self.before[r].tolist(), _PT_WHOLE, strict=True):
+        before = self.before[r].tolist()
+        for name, value, whole in zip(self.names, before, self._whole, strict=True):
             put(pl, name, int(value) if whole else value)
-        self._points.pop(r, None)
+        self.drop(r)
 
     def drop(self, r: int) -> None:
         self._points.pop(r, None)

@@ -43,12 +43,16 @@ import numpy as np
 
 from .bank_crd import crd_fill
 from .bank_kernel import MAXSEG, PT_STATE
+from .bank_pvt import compiled_kind as pvt_compiled_kind
+from .bank_pvt import fill_row as pvt_fill_row
+from .bank_pvt import pvt_fill
 from .bank_slaves import compiled_kind, slave_fill
 from .crd.system import AxisSlot, CoordSystem, CrdNow, Delay, Motion
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
 from .motion.master import SlavePlanner
 from .motion.pt import PtMode, PtPlanner
+from .motion.pvt import PvtPlanner
 from .motion.stop import StopKind
 from .motion.trap import _IDLE as _TRAP_IDLE
 from .motion.trap import _MOVE as _TRAP_MOVE
@@ -71,6 +75,7 @@ _set = object.__setattr__
 #: the attribute that is 0 when a planner of this type stands (``done``), where it has one
 _REST: dict[type, str] = {
     PtPlanner: "_state",
+    PvtPlanner: "_state",
     GearPlanner: "_state",
     FollowPlanner: "_state",
     TrapPlanner: "_mode",
@@ -87,6 +92,8 @@ def sampled_kind(pl: Any) -> bool:
     t = type(pl).__mro__
     if PtPlanner in t:
         return _get(pl, "_state") == 0 or _get(pl, "_mode") == PtMode.STATIC
+    if PvtPlanner in t:  # (a table's run changes the planner alone: bank_pvt)
+        return True
     if GearPlanner in t:
         return True
     if FollowPlanner in t:
@@ -143,7 +150,7 @@ _LINK_KIND: dict[type, int] = {}
 
 def _link_kind(cls: type) -> int:
     t = cls.__mro__
-    kind = int(SlavePlanner in t or AxisSlot in t or PtPlanner in t)
+    kind = int(SlavePlanner in t or AxisSlot in t or PtPlanner in t or PvtPlanner in t)
     _LINK_KIND[cls] = kind
     return kind
 
@@ -211,7 +218,7 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
                     bad.add(r)
                 else:
                     pairs.append((r, k))
-        elif PtPlanner in t and _get(pl, "_state") != 0:
+        elif (PtPlanner in t or PvtPlanner in t) and _get(pl, "_state") != 0:
             sampled.add(r)
     return pairs, sampled, bad
 
@@ -596,16 +603,21 @@ class Cluster:
         }
         # a PT axis alone through a static FIFO: its tables filled by the compiled kernel for
         # all such rows at once (bank_kernel.PtFill holds its state meanwhile)
+        # (a PVT axis alone in motion too: bank_pvt.PvtFill); ``compiled_pt`` is that fill
         pl = self.planners[0]
-        self.compiled_pt = (
-            bank.pt_fill is not None
-            and len(self.rows) == 1
-            and PtPlanner in type(pl).__mro__
-            and _get(pl, "_state") == 1
-            and _get(pl, "_mode") == PtMode.STATIC
-        )
-        if self.compiled_pt:
-            bank.pt_fill.load(self.rows[0], pl)  # type: ignore[union-attr]
+        self.compiled_pt: Any = None
+        if len(self.rows) == 1:
+            if (
+                bank.pt_fill is not None
+                and PtPlanner in type(pl).__mro__
+                and _get(pl, "_state") == 1
+                and _get(pl, "_mode") == PtMode.STATIC
+            ):
+                self.compiled_pt = bank.pt_fill
+            elif pvt_compiled_kind(pl):
+                self.compiled_pt = pvt_fill(bank)
+            if self.compiled_pt is not None:
+                self.compiled_pt.load(self.rows[0], pl)
         self.before: list[bool] = []
         #: a static PT FIFO's points for the compiled fill: (address, rows, the array)
         self.pts: dict[int, tuple[int, int, np.ndarray]] = {}
@@ -620,7 +632,7 @@ class Cluster:
         at = {r: i for i, r in enumerate(self.rows)}
         for i, pl in enumerate(self.planners):
             t = type(pl).__mro__
-            if not (PtPlanner in t or TrapPlanner in t or SlavePlanner in t):
+            if not (PtPlanner in t or TrapPlanner in t or SlavePlanner in t or PvtPlanner in t):
                 return
             if SlavePlanner in t and _get(pl, "_state") != 0:
                 master = getattr(_get(pl, "_source"), "master", None)
@@ -826,6 +838,10 @@ class Cluster:
                         if i in self.leads:  # (a master of a slave: its positions)
                             self._lead(i, start, bank.t_p[r, : bank.t_len[r]], seen)
                         continue
+                if pvt_fill_row(bank, r, pl, n):  # a PVT axis with others (bank_pvt)
+                    if i in self.leads:
+                        self._lead(i, start, bank.t_p[r, : bank.t_len[r]], seen)
+                    continue
                 ps, vs, as_, end = pl.run(n)
             else:
                 ms = seen[mi]
@@ -1041,12 +1057,11 @@ class Cluster:
     def rewind(self, bank: AxisBank) -> None:
         """Put the planners where the scalar path has them: their state at the last fill,
         then as many steps as the bank ran since."""
-        if self.compiled_pt:
-            assert bank.pt_fill is not None
+        if self.compiled_pt is not None:
             if self.snaps is None:  # never filled: the planner never left its state
-                bank.pt_fill.drop(self.rows[0])
+                self.compiled_pt.drop(self.rows[0])
                 return
-            bank.pt_fill.put_back(self.rows[0], self.planners[0])
+            self.compiled_pt.put_back(self.rows[0], self.planners[0])
             self.snaps = None
             for _ in range(int(bank.taken[self.rows[0]] - bank.fill_taken[self.rows[0]])):
                 self.step()

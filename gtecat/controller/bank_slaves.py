@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .bank_kernel import CFLAGS, build
+from .bank_kernel import Unit
 from .motion.follow import FollowPlanner
 from .motion.gear import GearPlanner
 
@@ -51,29 +51,21 @@ FILL_ARGS = "nr n table rows st before pts segs mp moving t_p t_v t_a base t_idx
 FILL_ARGS = FILL_ARGS.split()  # type: ignore[assignment]
 _SEG_FIELDS = ("x0", "x1", "s0", "s1", "rs", "re", "k")
 
-_LIB: Any = None
-_LIB_REASON = ""
+
+def _bind(lib: Any) -> None:
+    lib.bank_slaves_state_size.restype = ctypes.c_int
+    lib.bank_slaves_fill_args.restype = ctypes.c_int
+    lib.bank_slaves_fill.restype = ctypes.c_int64
+    lib.bank_slaves_fill.argtypes = (ctypes.c_void_p,)
+    if lib.bank_slaves_state_size() != len(STATE):
+        raise RuntimeError("the compiled slaves' state is not the one this module packs")
+    if lib.bank_slaves_fill_args() != len(FILL_ARGS):
+        raise RuntimeError("the compiled slaves' fill arguments are not the ones packed here")
 
 
-def library() -> tuple[Any, str]:
-    """(the loaded library or None, why not); built and loaded once per process."""
-    global _LIB, _LIB_REASON
-    if _LIB is not None or _LIB_REASON:
-        return _LIB, _LIB_REASON
-    try:
-        lib = ctypes.CDLL(str(build(CFLAGS, "bank_slaves", ())))
-        lib.bank_slaves_state_size.restype = ctypes.c_int
-        lib.bank_slaves_fill_args.restype = ctypes.c_int
-        lib.bank_slaves_fill.restype = ctypes.c_int64
-        lib.bank_slaves_fill.argtypes = (ctypes.c_void_p,)
-        if lib.bank_slaves_state_size() != len(STATE):
-            raise RuntimeError("the compiled slaves' state is not the one this module packs")
-        if lib.bank_slaves_fill_args() != len(FILL_ARGS):
-            raise RuntimeError("the compiled slaves' fill arguments are not the ones packed here")
-        _LIB = lib
-    except Exception as e:  # no compiler, a failed build: the planners' own run
-        _LIB_REASON = f"{type(e).__name__}: {e}"
-    return _LIB, _LIB_REASON
+#: () -> (the loaded library or None, why not); built and loaded once per process (without
+#: it, the planners' own run)
+library = Unit("bank_slaves", _bind, ())
 
 
 def compiled_kind(pl: Any) -> bool:

@@ -27,7 +27,10 @@ is not public):
 * ``GT_PvtStatus(profile, pTableId, pTime, count)``: the table selected and the table time
   (ms) of the current pass (0 at rest), for ``count`` profiles from ``profile``.
 * ``GT_PvtStart(mask)``: every profile of the mask must be in PVT mode with a table that
-  holds data and able to move (the checks of ``GT_Update``); all or nothing (1).
+  holds data and able to move (the checks of ``GT_Update``); all or nothing (1).  An
+  endless loop over a table lasting less than half a controller cycle is refused (1), at
+  the start or by ``GT_SetPvtLoop(profile, 0)`` while it runs: each cycle's passes would
+  never end.
 """
 
 from __future__ import annotations
@@ -35,8 +38,9 @@ from __future__ import annotations
 import weakref
 from typing import Any
 
+from ..controller.bank_pvt import now as banked_now
 from ..controller.core import Controller
-from ..controller.motion.pvt import PvtPlanner, PvtSegment
+from ..controller.motion.pvt import PvtPlanner, PvtSegment, never_ends
 from ..controller.profile import PrfMode
 from ..controller.resources import axis_resources, axis_span
 from ..errors import CommandError, ParameterError
@@ -210,15 +214,23 @@ def GT_SetPvtLoop(ctl: Controller, profile: int, loop: int) -> int:
     n = _long("loop", loop)
     if n < 0:
         raise ParameterError(f"loop={n}: 0 (endless) or more")
+    if not pl.done and never_ends(pl._segs, n, pl._T):
+        raise CommandError(
+            f"GT_SetPvtLoop: profile {profile} runs a table lasting less than half a "
+            "controller cycle: endless passes of it would never end a cycle"
+        )
     pl.loop = n
     return 0
 
 
 @gt_function
 def GT_GetPvtLoop(ctl: Controller, profile: int, pLoopCount: Any, pLoop: Any) -> int:
-    pl = _pvt(ctl, profile, "GT_GetPvtLoop")
-    store(pLoopCount, pl.loops_done)
-    store(pLoop, pl.loop)
+    res = axis_resources(ctl, profile)
+    pl = _planner(res, "GT_GetPvtLoop", PrfMode.PVT, PvtPlanner)
+    got = banked_now(res, pl)  # (an axis the bank runs: read there, not given back)
+    done, loop = (pl.loops_done, pl.loop) if got is None else got[2:]
+    store(pLoopCount, done)
+    store(pLoop, loop)
     return 0
 
 
@@ -229,9 +241,12 @@ def GT_PvtStatus(ctl: Controller, profile: int, pTableId: Any, pTime: Any, count
     ids, times = [], []
     for res in span:
         pl = res.profile.planner if res is not None else None
-        if isinstance(pl, PvtPlanner) and res is not None and res.profile.mode == PrfMode.PVT:
-            ids.append(pl.table_id)
-            times.append(pl.time)
+        # (the planner's type, not isinstance: that reads a guarded Trap or Gear planner's
+        # __class__, which gives its axis back)
+        if res is not None and res.profile.mode == PrfMode.PVT and PvtPlanner in type(pl).__mro__:
+            got = banked_now(res, pl)  # (an axis the bank runs: read there, not given back)
+            ids.append(pl.table_id if got is None else got[0])
+            times.append(pl.time if got is None else got[1])
         else:
             ids.append(0)
             times.append(0.0)
@@ -254,6 +269,12 @@ def GT_PvtStart(ctl: Controller, mask: int) -> int:
         if not segs:
             raise CommandError(
                 f"{what}: table {pl.table_id} holds no data (GT_PvtTable, GT_PvtTableSelect)"
+            )
+        if never_ends(segs, pl.loop, res.cycle_ms):
+            raise CommandError(
+                f"{what}: table {pl.table_id} lasts less than half a controller cycle "
+                f"({res.cycle_ms:g} ms) and the loop is endless (GT_SetPvtLoop 0): its passes "
+                "would never end a cycle"
             )
         res.check_motion(what, segs[0].p1 - segs[0].p0)
         plan.append((pl, segs))

@@ -1700,18 +1700,24 @@ int64_t bank_pt_run(double *st, const double *pts, int64_t m, int64_t n, double 
  * For each row r: its state st[r] (PT_NST doubles) is kept in before[r], the last sample taken
  * moves to the row's spare slot (as AxisBank._refill does), bank_pt_run fills the table from
  * the row's points and moves st[r] on, and the table's cursor, length and end follow; the
- * samples written are returned. */
+ * samples written are returned.  PT_FILL_RUN, when not 0, is the address of another run of
+ * bank_pt_run's form (a PVT row's: bank_pvt.c) and PT_FILL_NST the size of its state. */
 enum {
     PT_FILL_NR, PT_FILL_N, PT_FILL_TABLE, PT_FILL_ROWS, PT_FILL_ST, PT_FILL_BEFORE,
     PT_FILL_PTS, PT_FILL_M, PT_FILL_TP, PT_FILL_TV, PT_FILL_TA, PT_FILL_BASE, PT_FILL_IDX,
-    PT_FILL_LEN, PT_FILL_CUR, PT_FILL_END, PT_FILL_TAKEN, PT_FILL_FILLTAKEN, PT_FILL_NARGS
+    PT_FILL_LEN, PT_FILL_CUR, PT_FILL_END, PT_FILL_TAKEN, PT_FILL_FILLTAKEN, PT_FILL_RUN,
+    PT_FILL_NST, PT_FILL_NARGS
 };
+typedef int64_t (*row_run)(double *, const double *, int64_t, int64_t, double *, double *,
+                           double *);
 
 int bank_pt_fill_args(void) { return PT_FILL_NARGS; }
 
 int64_t bank_pt_fill(const int64_t *a)
 {
 #define PA(T, k) ((T *)(intptr_t)a[k])
+    const row_run run = a[PT_FILL_RUN] ? (row_run)(intptr_t)a[PT_FILL_RUN] : bank_pt_run;
+    const int64_t nst = a[PT_FILL_RUN] ? a[PT_FILL_NST] : PT_NST;
     const int64_t nr = a[PT_FILL_NR], n = a[PT_FILL_N], table = a[PT_FILL_TABLE];
     const int64_t *rows = PA(const int64_t, PT_FILL_ROWS);
     double *st = PA(double, PT_FILL_ST), *before = PA(double, PT_FILL_BEFORE);
@@ -1727,13 +1733,12 @@ int64_t bank_pt_fill(const int64_t *a)
     for (i = 0; i < nr; i++) {
         const int64_t r = rows[i], b = base[r], spare = b + table, last = idx[r];
         int64_t e;
-        memcpy(before + PT_NST * r, st + PT_NST * r, PT_NST * sizeof(double));
+        memcpy(before + nst * r, st + nst * r, nst * sizeof(double));
         tp[spare] = tp[last];
         tv[spare] = tv[last];
         ta[spare] = ta[last];
         idx[r] = spare;
-        e = bank_pt_run(st + PT_NST * r, (const double *)(intptr_t)pts[r], m[r], n, tp + b, tv + b,
-                        ta + b);
+        e = run(st + nst * r, (const double *)(intptr_t)pts[r], m[r], n, tp + b, tv + b, ta + b);
         len[r] = e >= 0 ? e + 1 : n;
         cur[r] = 0;
         end[r] = e;

@@ -48,6 +48,13 @@ class PvtSegment:
         return pos, vel, acc
 
 
+def never_ends(segments: tuple[PvtSegment, ...], loop: int, cycle_ms: float) -> bool:
+    """An endless loop (``loop`` 0) over a table lasting less than half a cycle: a cycle's
+    passes would never end (the time a pass carries over rounds to a whole cycle past the
+    table's end again), so such a start is refused."""
+    return not loop and 2 * (segments[-1].t1 - segments[0].t0) < cycle_ms
+
+
 class PvtPlanner:
     """One profile in PVT mode."""
 
@@ -144,7 +151,10 @@ class PvtPlanner:
                 self._k = round((t - end) / self._T)
                 self._i = 0
                 t = segs[0].t0 + self._k * self._T
-            while segs[self._i].t1 < t:
+            # (a sample up to 1e-9 ms past the table's end is the last segment's: its end
+            # rounded below the cycle's multiple, as 14.21 + 57 * 1.0 > 71.21)
+            last = len(segs) - 1
+            while self._i < last and segs[self._i].t1 < t:
                 self._i += 1
             p, v, a = segs[self._i].at(t)
             self._pos, self._vel, self._acc = self._origin + p, v, a
@@ -154,6 +164,22 @@ class PvtPlanner:
                 self._finish(self._pos)
         return self._pos, self._vel, self._acc
 
+    def run(self, n: int) -> tuple[list[float], list[float], list[float], int]:
+        """``n`` calls of :meth:`step` at once (the axis bank's tables): the positions, speeds
+        and accelerations up to the end sample, and its index (-1: the motion goes on)."""
+        ps: list[float] = []
+        vs: list[float] = []
+        as_: list[float] = []
+        step = self.step
+        for j in range(n):
+            p, v, a = step()
+            ps.append(p)
+            vs.append(v)
+            as_.append(a)
+            if self._state == _IDLE:
+                return ps, vs, as_, j
+        return ps, vs, as_, -1
+
     def _finish(self, pos: float) -> None:
         self._pos = pos
         self._vel = self._acc = 0.0
@@ -161,4 +187,4 @@ class PvtPlanner:
         self.stopping = StopKind.NONE
 
 
-__all__ = ["PvtPlanner", "PvtSegment"]
+__all__ = ["PvtPlanner", "PvtSegment", "never_ends"]

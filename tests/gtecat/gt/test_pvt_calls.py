@@ -111,3 +111,27 @@ def test_points_too_close_or_too_large_are_7_with_the_reason_not_an_internal_err
         == 0
     )
     assert all(abs(v) < float("inf") for v in b3)
+
+
+def test_an_endless_loop_over_a_table_shorter_than_half_a_cycle_is_refused():
+    """Such a table's passes never ended a cycle: the controller hung in the cycle after
+    GT_PvtStart.  A count of passes ends (all of them within that cycle)."""
+    assert gt.GT_Open(card="gts:2", clock="lockstep", log="") == 0
+    assert gt.GT_AxisOn(1) == 0 and gt.GT_PrfPvt(1) == 0
+    assert gt.GT_PvtTable(1, 2, arr(0, 0.4), arr(0, 7), arr(0, 10)) == 0
+    assert gt.GT_PvtTableSelect(1, 1) == 0 and gt.GT_SetPvtLoop(1, 0) == 0
+    assert gt.GT_PvtStart(1) == 1
+    assert "half a controller cycle" in gt.GTE_GetLastError()
+    assert gt.GT_SetPvtLoop(1, 5) == 0 and gt.GT_PvtStart(1) == 0
+    assert gt.GT_SetPvtLoop(1, 0) == 1  # (while it runs)
+    gt.GTE_Wait(3)
+    assert prf(1) == 35.0 and not moving(1)
+    done, loop = c_long(), c_long()
+    assert gt.GT_GetPvtLoop(1, byref(done), byref(loop)) == 0
+    assert (done.value, loop.value) == (5, 5)
+    # half a cycle or more: an endless loop runs
+    assert gt.GT_PvtTable(2, 2, arr(0, 0.5), arr(0, 7), arr(0, 10)) == 0
+    assert gt.GT_PvtTableSelect(1, 2) == 0 and gt.GT_SetPvtLoop(1, 0) == 0
+    assert gt.GT_PvtStart(1) == 0
+    gt.GTE_Wait(3)
+    assert moving(1)
