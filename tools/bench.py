@@ -1184,7 +1184,13 @@ def compiled_parts() -> dict[str, object]:
 def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> dict[str, object]:
     """The many-axes figures, measured one after the other in this run (``only``: those),
     after the compiled parts are there (:func:`compiled_parts`, reported as ``build``)."""
-    from tools.bench_scaling import crd_plan, run_bus, run_drive_homing, run_gohome
+    from tools.bench_scaling import (
+        crd_plan,
+        run_bus,
+        run_drive_homing,
+        run_gohome,
+        run_legacy_home,
+    )
 
     build = compiled_parts()
 
@@ -1213,6 +1219,11 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
     def gohome(n: int, mode: int, target: float | None) -> dict[str, object]:
         r = {"axes": n, "what": f"smart homing (GT_GoHome) mode {mode}, start to end"}
         r |= run_gohome(n, mode, repeat=repeat)
+        return r if target is None else _figure(r, "rtf", target)
+
+    def legacy_home(n: int, target: float | None) -> dict[str, object]:
+        r = {"axes": n, "what": "the older cards' homing (GT_HomeInit, GT_Home), start to end"}
+        r |= run_legacy_home(n, repeat=repeat)
         return r if target is None else _figure(r, "rtf", target)
 
     def drive_home(
@@ -1249,6 +1260,7 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_64_axes_gohome_30": lambda: gohome(64, 30, 10),
         "rtf_64_axes_gohome_40": lambda: gohome(64, 40, 10),
         "rtf_64_axes_gohome_41": lambda: gohome(64, 41, 10),
+        "rtf_64_axes_home_legacy": lambda: legacy_home(64, 10),
         "rtf_64_axes_homed_mode6": lambda: rtf(
             64, every(64, "homed6"), 10, "homed (method 35), left in homing mode 6, holding"
         ),

@@ -41,7 +41,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from ctypes import byref, c_double, c_long, c_short, c_ulong
+from ctypes import byref, c_double, c_long, c_short, c_ulong, c_ushort
 from pathlib import Path
 from typing import Any
 
@@ -573,6 +573,44 @@ def run_gohome(
 
     return _run_homing(
         n, lambda axes: start_gohome(axes, mode), running, bad, repeat, bank, limit_ms
+    )
+
+
+#: the older cards' homing (GT_Home): the end of its search, its home offset
+LEGACY_HOME_POS, LEGACY_HOME_OFFSET = 60_000, 100
+
+
+def run_legacy_home(
+    n: int, *, repeat: int = 3, bank: str | None = None, limit_ms: int = 30_000
+) -> dict[str, Any]:
+    """``n`` axes home with the older cards' calls on the machine of :func:`gohome_machine`:
+    ``GT_HomeInit``, then ``GTN_Home(core, axis, 60000, velHigh, acc, 100)`` per axis (the
+    home switch ahead captured, the axis back at the capture + 100), every axis's
+    ``GTN_HomeSts`` every :data:`GOHOME_POLL_MS` until it gives 1, as :func:`run_gohome`;
+    timed from ``GT_HomeInit`` (the start calls included).  ``error`` when one does not end
+    at its target (``GT_HomeSts`` not 1, or not 0 returned)."""
+    gt = _gt()
+    sts = c_ushort()
+
+    def start(axes: Sequence[int]) -> None:
+        _ok(gt.GT_HomeInit(), "GT_HomeInit", 1)
+        for a in axes:
+            gtn("Home", a, LEGACY_HOME_POS, GOHOME_VEL_HIGH, GOHOME_ACC, LEGACY_HOME_OFFSET)
+
+    def status(a: int) -> tuple[int, int]:
+        core, local = core_axis(a)
+        sts.value = 0
+        return gt.GTN_HomeSts(core, local, byref(sts)), sts.value
+
+    return _run_homing(
+        n,
+        start,
+        lambda a: status(a) == (0, 0),
+        lambda a: "" if (s := status(a)) == (0, 1) else f"{a} (rc, status {s})",
+        repeat,
+        bank,
+        limit_ms,
+        setup=True,
     )
 
 

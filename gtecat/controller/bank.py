@@ -211,6 +211,9 @@ BANK_READS = frozenset(
         # a smart homing's parameters and status (gtecat.controller.smart_home): its own data
         "GT_GetHomeStatus",
         "GT_GetHomePrm",
+        # the older cards' homing status (GT_HomeSts, gtecat.gt.legacy_home_calls): the same
+        # smart homing's status and reason
+        "GT_HomeSts",
         # a capture's status cleared: the unit's own data (a home capture armed again gives
         # its axis back itself, CaptureUnit.clear), the homings look again (look_again)
         "GT_ClearCaptureStatus",

@@ -57,6 +57,7 @@ from gtecat.drives.abort import SdoAbort
 from gtecat.eni.errors import GtecatError
 
 from ..errors import CommandError, ParameterError
+from . import input_sense
 from .axis import Axis
 
 if TYPE_CHECKING:
@@ -116,6 +117,8 @@ class CaptureUnit:
         card = getattr(ctl, "card", None)
         self._card_edges: dict[int, list] | None = card.backend.edges if card else None
         self.home_reverse = False
+        #: the inputs' sense count (input_sense.EPOCH) :meth:`refresh_wiring` last looked at
+        self._wired = -1
         # touch probe (EtherCAT axes): the 60B8h value wanted, what was written, phase
         self._tp_want = 0
         self._tp_sent = 0
@@ -161,10 +164,16 @@ class CaptureUnit:
                 pass  # the drive is gone: nothing to switch off
 
     def refresh_wiring(self) -> None:
-        """Take ``[homeN] reverse`` from the configuration file loaded last."""
+        """Take ``[homeN] reverse`` from the configuration file loaded last (looked up again
+        only after a change of some input's sense: every writer of a configuration, of the
+        wiring or of the bus counts it in :data:`input_sense.EPOCH`)."""
+        seen = input_sense.EPOCH[0]
+        if seen == self._wired:
+            return
         from .config_file import switch_sense
 
         reverse = switch_sense(self.ctl, "home", self.number)[1]  # the wiring it meets
+        self._wired = seen
         if reverse != self.home_reverse:
             self.changes += 1
             self.home_reverse = reverse
@@ -220,6 +229,31 @@ class CaptureUnit:
             self._want_probe(
                 _TP_INDEX if mode == CAPTURE_INDEX else _TP_PROBE if mode == CAPTURE_PROBE else 0
             )
+
+    def try_index(self) -> None:
+        """Whether the index can be captured here, as :meth:`arm` with ``CAPTURE_INDEX`` then
+        with 0 finds it (GT_GoHome's test: an EtherCAT drive's touch probe answers now or
+        never), leaving what those two leave - nothing armed, 60B8h off - with 60B8h
+        written once (both wrote it off).  CommandError with the reason when it cannot."""
+        why = self.available(CAPTURE_INDEX)
+        if why:
+            raise CommandError(why)
+        self.refresh_wiring()
+        self.changes += 1
+        self.mode = CAPTURE_NONE
+        self.status = 0
+        self._edge = None
+        self._accept = None
+        if not self.on_card:
+            self._tp_want = 0
+            self._tp_pending = False
+            try:
+                self._write_tp(0)
+            except (SdoAbort, GtecatError) as e:  # (as _want_probe says it)
+                self._tp_error = (
+                    f"encoder {self.number}: the drive's touch probe (60B8h) cannot be used: {e}"
+                )
+                raise CommandError(self._tp_error) from None
 
     def clear(self) -> None:
         """GT_ClearCaptureStatus: status 0, the mode armed again."""

@@ -393,8 +393,7 @@ class SmartHome:
                 self._refuse(HomeError.SET_CAPTURE_HOME, why)
         if mode in INDEX_MODES:
             try:  # an EtherCAT drive's touch probe answers now or never
-                trigger.arm(CAPTURE_INDEX)
-                trigger.arm(0)
+                trigger.try_index()
             except CommandError as e:
                 self._refuse(HomeError.SET_CAPTURE_INDEX, str(e))
         self._trigger = trigger

@@ -38,6 +38,7 @@ from ..controller.resources import CONTROLLER_AXES, AxisResources, resource_coun
 from ..master.clock import ClockMode
 from . import byref_target, centry
 from .args import CARG_AT, CARG_ENV, byref_address, carg_address_source, holds_pointers
+from .fast_legacy_home import HOME_STS, fast_home_sts
 
 _CArg = type(ctypes.byref(ctypes.c_int()))
 _NDARRAY = np.ndarray
@@ -2310,7 +2311,8 @@ SLOW_REASONS: dict[str, str] = {
     "compare": "position compare and trigger set-up, data and status: table path",
     "crd_ex": "extended coordinated-motion queue calls: the planning work outweighs the arguments",
     "lead_screw": "lead-screw compensation tables: set up once",
-    "legacy_home": "the older homing calls: set up once, then a polled status (table path)",
+    "legacy_home": "the older homing calls: set up once; GT_HomeSts, which a homing loop "
+    "polls, is on the fast path (gtecat.gt.fast_legacy_home)",
     "look_ahead_ex": "look-ahead set-up and planner modes: set up once",
     "net_init": "network cards' set-up and their encoder readers: table path",
     "pvt": "PVT tables and status: the table work outweighs the arguments",
@@ -3603,6 +3605,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         CORE: fast_core,
         HOMING: fast_homing_status,
         HOME_STATUS: fast_home_status,
+        HOME_STS: fast_home_sts,  # (the older cards' homing status: its own module)
     }
     for names, make in (
         (MULTI_READERS, fast_multi),
