@@ -108,6 +108,14 @@ from .bank_modes import (
 )
 from .crd.system import Delay, Motion
 from .epoch import EPOCH
+from .lead_screw_bank import (
+    screw_arrays,
+    screw_claimable,
+    screw_command,
+    screw_commit,
+    screw_load,
+    screw_put_back,
+)
 from .motion.jog import _IDLE as _JOG_IDLE
 from .motion.jog import _MOVE as _JOG_MOVE
 from .motion.jog import JogPlanner
@@ -779,6 +787,7 @@ class AxisBank:
         self.sampled = zi(n, bool)
         self.fill_taken = zi(n, np.int64)  # ``taken`` at the cluster's last fill
         self.ended = zi(n, bool)
+        screw_arrays(self, n)  # lead-screw compensation (gtecat.controller.lead_screw_bank)
         tl = self.table = KERNEL_TABLE if self._kernel_lib is not None else TABLE
         self.t_p, self.t_v, self.t_a = z((n, tl + 1)), z((n, tl + 1)), z((n, tl + 1))
         # (flat views of the same memory: a row's slot written by one index)
@@ -980,12 +989,13 @@ class AxisBank:
         return ""
 
     @staticmethod
-    def _homing_hook(ax: Any, res: Any) -> Any:
+    def _homing_hook(ax: Any, res: Any, screw: bool = False) -> Any:
         """The axis's hooks are the resources' own plus at most the GT layer's homing
         follower (gtecat.gt.homing_calls) and bank-aware hooks that may be held now (a
-        capture unit, :func:`aware_hooks`): that follower, None without one, False when
+        capture unit, :func:`aware_hooks`), and (``screw``) its lead screw's
+        (gtecat.controller.lead_screw_bank): that follower, None without one, False when
         some other hook runs or an aware one must run its next cycle."""
-        if len(ax.pre_hooks) != 1:
+        if len(ax.pre_hooks) != 1 and not (screw and screw_claimable(ax, res)):
             return False
         hooks = ax.post_hooks
         if not hooks or hooks[0] != res._post:
@@ -1014,7 +1024,7 @@ class AxisBank:
             return False
         if ax.cw != CW_ENABLED or ax._cw_sent != CW_ENABLED:
             return False
-        st = self._homing_hook(ax, res)
+        st = self._homing_hook(ax, res, True)
         if st is False or (st is not None and st.active) or not res._csp:
             return False
         if ax.prf_pos != res._a_last:
@@ -1102,7 +1112,7 @@ class AxisBank:
         ax, res = self.axes[r], self.res[r]
         if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error or ax.cw == CW_QUICK_STOP:
             return False  # (a quick stop the drive finishes: its controlword changes after it)
-        st = self._homing_hook(ax, res)
+        st = self._homing_hook(ax, res, True)
         if st is False or (st is not None and st.active):
             return False
         if ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
@@ -1391,6 +1401,7 @@ class AxisBank:
         locals once and each array is indexed once.)"""
         ax, res = self.axes[r], self.res[r]
         self.alive[r] = True
+        screw_load(self, r, ax)
         aware = aware_hooks(ax)
         watch = 0
         for obj in aware:
@@ -2098,6 +2109,7 @@ class AxisBank:
         """Row ``r``'s state into its axis objects (its drive aside), as a release leaves them
         (:attr:`_last` and :attr:`_rates` hold its planned values and encoder rates)."""
         ax, res = self.axes[r], self.res[r]
+        screw_put_back(self, r, ax)
         a = float(self.a_last[r])
         ax.prf_pos = a
         res._a_last = a
@@ -2942,8 +2954,10 @@ class AxisBank:
                 jog = self._jog_step()
             prf_p = np.where(self.jog, jog[2], prf_p)
         a = self._link(prf_p, self.prf_ratio, self.prf_off) if self.any_prf_link else prf_p
-        # 3. 607Ah (Axis.pulses_to_counts, int32 like the PDO entry) and the drives
-        scaled = a * self.unit2 if self.any_scale else a
+        # 3. 607Ah (Axis.pulses_to_counts, int32 like the PDO entry) and the drives; a
+        # lead screw's compensation added (gtecat.controller.lead_screw_bank)
+        cmd, ls_dir = screw_command(self, a)
+        scaled = cmd * self.unit2 if self.any_scale else cmd
         # counts beyond 2**62 (or not a number) leave the bank: the scalar path's exact
         # integers (and its alarm for a position that is not a number) take them
         huge = ~(np.abs(scaled) < HUGE_COUNTS)
@@ -3031,6 +3045,7 @@ class AxisBank:
                 arr[k] = value[k]
         if self.n_alive == self.n:
             csp.commit(state, din, None)
+            screw_commit(self, ls_dir, None)
             self.a_last, self.t_idx = a, idx
             self.enc_prev, self.enc_pos = raw, enc_pos
             self.enc_step0, self.enc_step1 = self.enc_step1, step
@@ -3047,6 +3062,7 @@ class AxisBank:
         else:
             keep = self.alive
             csp.commit(state, din, keep)
+            screw_commit(self, ls_dir, keep)
             for name, value in (
                 ("a_last", a),
                 ("t_idx", idx),

@@ -67,6 +67,7 @@
     X(enc_step0, f64) X(enc_step1, f64) X(enc_ratio, f64) X(enc_off, f64)                  \
     X(soft_pos, f64) X(soft_neg, f64) X(pos_err, f64) X(band, f64) X(hold_ns, i64)         \
     X(since, i64) X(arrived, u8) X(a_last, f64)                                            \
+    X(ls, u8) X(ls_dir, i64) X(ls_prm, f64) X(ls_ix, i64) X(ls_tab, f64)                   \
     X(jrp, f64) X(jrv, f64) X(jp, f64) X(jv, f64) X(ja, f64) X(tau, f64) X(jE, f64)        \
     X(jgoal, f64) X(jacc, f64) X(jdec, f64)                                                \
     X(c_pos, f64) X(c_vel, f64) X(c_acc, f64) X(c_dpos, f64) X(c_dvel, f64)                \
@@ -562,6 +563,52 @@ INLINE int refill_row(void **ptr, int64_t *io, int64_t r)
     return 0;
 }
 
+/* Lead-screw compensation (gtecat/controller/lead_screw_bank.py): LeadScrew.hook and
+ * LeadScrew.value (gtecat/controller/lead_screw.py) with the same operations in the same
+ * order.  ls: 0 no table, 1 a table (off: the direction only), 2 on; the hook's last planned
+ * position is the row's a_last. */
+
+/* the direction the axis last moved in, after a cycle whose planned position is a */
+INLINE int64_t ls_direction(int64_t dir, double a, double last)
+{
+    if (a != last)
+        return a > last ? 1 : -1;
+    return dir;
+}
+
+/* the table's value at pos in direction dir (not a number where pos is none: the command is
+ * none then, and the row leaves before the cycle) */
+INLINE double ls_value(void **ptr, int64_t r, double pos, int64_t dir)
+{
+    const int64_t n = I64(ls_ix)[2 * r + 1];
+    const double *t = F64(ls_tab) + I64(ls_ix)[2 * r] + (dir >= 0 ? 0 : n);
+    const double x = (pos - F64(ls_prm)[2 * r]) / F64(ls_prm)[2 * r + 1];
+    int64_t k;
+    double f;
+    if (x <= 0.0)
+        return t[0];
+    if (x >= (double)(n - 1))
+        return t[n - 1];
+    if (x != x)
+        return x;
+    k = (int64_t)x;
+    f = x - (double)k;
+    return t[k] + f * (t[k + 1] - t[k]);
+}
+
+/* Axis.pre: 607Ah follows the planned position plus the compensation (dir: this cycle's) */
+INLINE double ls_command(void **ptr, int64_t r, double a, int64_t dir)
+{
+    return U8(ls)[r] == 2 ? a + ls_value(ptr, r, a, dir) : a;
+}
+
+/* the commit of row r's direction (before a_last takes the cycle's planned position) */
+INLINE void ls_commit(void **ptr, int64_t r)
+{
+    if (U8(ls)[r])
+        I64(ls_dir)[r] = ls_direction(I64(ls_dir)[r], F64(s_a)[r], F64(a_last)[r]);
+}
+
 #define COPY(dst, src, type) memcpy(ptr[F_##dst], ptr[F_##src], (size_t)n * sizeof(type))
 
 /* the commit of a cycle in which every row stepped in CSP (none left out, frozen or homing):
@@ -589,6 +636,8 @@ INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog)
     COPY(c_lstop, s_lstop, uint8_t);
     COPY(c_target, s_target, int64_t);
     COPY(c_din, s_din, int64_t);
+    for (r = 0; r < n; r++)
+        ls_commit(ptr, r);
     COPY(a_last, s_a, double);
     COPY(enc_prev, s_raw, int64_t);
     COPY(enc_pos, s_enc, double);
@@ -822,7 +871,9 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             a = link(prf, F64(prf_ratio)[r], F64(prf_off)[r]);
             /* 3. 607Ah: Axis.pulses_to_counts, int32 like the PDO entry */
             {
-                double scaled = a * F64(unit2)[r];
+                const double cmd = U8(ls)[r] ? ls_command(ptr, r, a,
+                    ls_direction(I64(ls_dir)[r], a, F64(a_last)[r])) : a;
+                double scaled = cmd * F64(unit2)[r];
                 if (!(fabs(scaled) < 4611686018427387904.0)) /* 2**62, bank.HUGE_COUNTS */
                     hit = 1;
                 counts = to_i64(rint(scaled)) + I64(drive_offset)[r];
@@ -1052,6 +1103,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         U8(c_lstop)[r] = U8(s_lstop)[r];
         I64(c_target)[r] = I64(s_target)[r];
         I64(c_din)[r] = I64(s_din)[r];
+        ls_commit(ptr, r);
         F64(a_last)[r] = F64(s_a)[r];
         cur = I64(t_cur)[r];
         I64(t_idx)[r] = I64(base)[r] + cur;
@@ -1103,6 +1155,7 @@ typedef struct {
     double pos, vel, acc, dpos, dvel, fe_time, a, enc_pos, step0, step1;
     double jrp, jrv, jp, jv, ja;
     int64_t target, din, enc_prev, since, cur, t_idx, taken, t_len, t_end;
+    int64_t ls_dir;
     int64_t len; /* the cycles run */
     int code;    /* 0, or why the next cycle is declined */
     uint8_t lim, swl, arrived, moving, ended, fin, refilled, lstop;
@@ -1134,6 +1187,7 @@ INLINE void row_store(void **ptr, int64_t r, const RowRun *s)
     I64(taken)[r] = s->taken;
     I64(t_len)[r] = s->t_len;
     I64(t_end)[r] = s->t_end;
+    I64(ls_dir)[r] = s->ls_dir;
     U8(c_limited)[r] = s->lim;
     U8(c_sw_limited)[r] = s->swl;
     U8(c_lstop)[r] = s->lstop;
@@ -1173,6 +1227,8 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     const int64_t dwatch = I64(dwatch)[r] | I64(dpost)[r];
     const int lvel = U8(lvel)[r];
     const int tpw = plain ? 0 : U8(c_tpw)[r];
+    const int ls = U8(ls)[r];
+    int64_t q_ls_dir = I64(ls_dir)[r];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
     double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r],
         q_dpos = F64(c_dpos)[r], q_dvel = F64(c_dvel)[r], q_fe_time = F64(c_fe_time)[r],
@@ -1191,7 +1247,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     int64_t c;
     for (c = 0; c < limit; c++) {
         const int64_t t_ns = t0 + c * dt_ns;
-        int64_t cur = q_cur, counts, x, target, pa, din, raw, since;
+        int64_t cur = q_cur, counts, x, target, pa, din, raw, since, ls_dir = q_ls_dir;
         int32_t d32;
         double prf, a, demand, dvel, p1 = 0.0, v1 = 0.0, nfp = 0.0, nfv = 0.0, nfa = 0.0;
         double p, v0, vff, e1, v, dist, rel, vstop, dv, pos, fe, step, enc, err;
@@ -1251,7 +1307,12 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         }
         a = plain ? prf : link(prf, prf_ratio, prf_off);
         {
-            double scaled = a * unit2;
+            double scaled = a;
+            if (ls) {
+                ls_dir = ls_direction(q_ls_dir, a, q_a);
+                scaled = ls_command(ptr, r, a, ls_dir);
+            }
+            scaled *= unit2;
             if (!(fabs(scaled) < 4611686018427387904.0)) { /* 2**62, bank.HUGE_COUNTS */
                 q_code = 2;
                 break;
@@ -1379,6 +1440,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
         q_target = target;
         q_din = din;
         q_a = a;
+        q_ls_dir = ls_dir;
         q_t_idx = base + cur;
         q_enc_prev = raw;
         q_enc_pos = enc;
@@ -1424,6 +1486,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     s->taken = q_taken;
     s->t_len = q_t_len;
     s->t_end = q_t_end;
+    s->ls_dir = q_ls_dir;
     s->lim = q_lim;
     s->swl = q_swl;
     s->lstop = q_lstop;

@@ -1,0 +1,273 @@
+"""Lead-screw compensation in the axis bank against the scalar reference.
+
+Axes with compensation tables (``GT_SetLeadScrewComp``) move in Trap and Jog across the
+tables' points in both directions, beyond both ends, reverse, have the compensation switched
+on and off while they move, get new tables, stop, are switched off and on, and have their
+planned position set; one axis has a table and the compensation off (the direction is still
+followed), one has none.  Every program runs three ways - the scalar path
+(``GT_Open(bank="off")``), the bank with its compiled cycle, the bank on numpy - and the
+planned and encoder positions, the encoder speeds, the status words and the whole raw image
+(607Ah carries the correction) after every wait are compared with ``==``.  Waits of one
+cycle and of hundreds (many cycles in one kernel call, row by row) alternate.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from ctypes import byref, c_double, c_long, c_ubyte
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from gtecat import gt
+from tests.conftest import examples
+from tests.gtecat.controller.test_bank import _ok, open_bus
+from tools.gen_axes_eni import write_axes_eni
+
+AXES = 6
+HAS_CC = bool(os.environ.get("CC") or any(shutil.which(c) for c in ("cc", "gcc", "clang")))
+
+
+@pytest.fixture(scope="module")
+def bus(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str]:
+    tmp = tmp_path_factory.mktemp("screw")
+    eni = write_axes_eni(AXES, tmp / "bus.eni")
+    machine = tmp / "machine.toml"
+    machine.write_text("[axis.6]\npositive_limit = 60000\nnegative_limit = -60000\n")
+    return str(eni), str(machine)
+
+
+def _tables(n: int, seed: int) -> tuple[object, object]:
+    pos = [(-1) ** k * (5 * k + seed) for k in range(n)]
+    neg = [3 * k - seed + (k * seed) % 7 for k in range(n)]
+    return (c_long * n)(*pos), (c_long * n)(*neg)
+
+
+def _act(action: tuple) -> int:
+    kind, axis = action[0], action[1]
+    if kind == "screw":  # n points from start over length pulses
+        _, _, n, start, length, seed = action
+        pos, neg = _tables(n, seed)
+        return gt.GT_SetLeadScrewComp(axis, n, start, length, pos, neg)
+    if kind == "enable":
+        return gt.GT_EnableLeadScrewComp(axis, action[2])
+    if kind == "move":
+        _, _, target, vel, acc, smooth = action
+        gt.GT_PrfTrap(axis)
+        prm = gt.TTrapPrm()
+        prm.acc, prm.dec, prm.velStart, prm.smoothTime = acc, acc, 0.0, smooth
+        gt.GT_SetTrapPrm(axis, byref(prm))
+        gt.GT_SetPos(axis, target)
+        gt.GT_SetVel(axis, vel)
+        return gt.GT_Update(1 << (axis - 1))
+    if kind == "jog":
+        _, _, vel, acc, smooth = action
+        gt.GT_PrfJog(axis)
+        prm = gt.TJogPrm()
+        prm.acc, prm.dec, prm.smooth = acc, acc, smooth
+        gt.GT_SetJogPrm(axis, byref(prm))
+        gt.GT_SetVel(axis, vel)
+        return gt.GT_Update(1 << (axis - 1))
+    if kind == "stop":
+        mask = 1 << (axis - 1)
+        return gt.GT_Stop(mask, mask if action[2] else 0)
+    if kind == "off":
+        return gt.GT_AxisOff(axis)
+    if kind == "on":
+        return gt.GT_AxisOn(axis)
+    if kind == "prfpos":
+        return gt.GT_SetPrfPos(axis, action[2])
+    if kind == "clear":
+        return gt.GT_ClrSts(1, AXES)
+    if kind == "wait":
+        return 0
+    raise AssertionError(kind)
+
+
+def _sample(size: int) -> tuple:
+    sts, prf, enc = (c_long * AXES)(), (c_double * AXES)(), (c_double * AXES)()
+    vel, raw = (c_double * AXES)(), (c_ubyte * size)()
+    gt.GT_GetSts(1, sts, AXES)
+    gt.GT_GetPrfPos(1, prf, AXES)
+    gt.GT_GetEncPos(1, enc, AXES)
+    gt.GT_GetEncVel(1, vel, AXES)
+    gt.GT_GetEcatRawData(0, size, raw)
+    return tuple(sts), tuple(prf), tuple(enc), tuple(vel), bytes(raw)
+
+
+#: every axis but the last has a table (points every 2000 pulses from -10000 to 10000, the
+#: fifth axis's 7 points over 9000 from -3000), the first four with the compensation on
+SETUP = [
+    *[(0, ("screw", a, 11, -10_000, 20_000, a)) for a in range(1, 5)],
+    (0, ("screw", 5, 7, -3_000, 9_000, 5)),
+    *[(0, ("enable", a, 1)) for a in range(1, 5)],
+]
+
+
+def _run(bus: tuple[str, str], program: list[tuple[int, tuple]], bank: str, kernel: str):
+    """(the samples after each wait, the screw axes' share of the waits' samples that found
+    them in the bank, the cycles the kernel ran many at a time)"""
+    old = os.environ.get("GTECAT_BANK_KERNEL")
+    os.environ["GTECAT_BANK_KERNEL"] = kernel
+    try:
+        open_bus(bus[0], bus[1], bank)
+        for a in range(1, AXES + 1):
+            _ok(gt.GT_AxisOn(a), f"axis on {a}")
+            _ok(gt.GT_PrfTrap(a), "trap")
+    finally:
+        if old is None:
+            del os.environ["GTECAT_BANK_KERNEL"]
+        else:
+            os.environ["GTECAT_BANK_KERNEL"] = old
+    ctl = gt.GTE_Controller()
+    size = ctl.layout.gt_raw_bytes
+    out: list = []
+    held = seen = 0
+    try:
+        gt.GTE_Wait(5)
+        for wait, action in [*SETUP, *program]:
+            out.append(_act(action))
+            gt.GTE_Wait(wait)
+            b = ctl.bank
+            if b is not None and b.n and wait:
+                rows = [b._row_of[id(ctl.axes[a])] for a in range(1, 6)]
+                held += int(b.alive[rows].sum())
+                seen += len(rows)
+            out.append(_sample(size))
+        b = ctl.bank
+        many = b.many_cycles if b is not None else 0
+        if bank == "on" and kernel == "c" and b is not None and b.kernel is None:
+            if not HAS_CC:
+                pytest.skip("no C compiler (cc, gcc or clang): the compiled cycle is not built")
+            raise AssertionError(f"the bank's compiled cycle did not build: {b.kernel_reason}")
+    finally:
+        gt.GT_Close()
+    return out, held / max(seen, 1), many
+
+
+def _check(bus: tuple[str, str], program: list[tuple[int, tuple]]) -> tuple[float, int]:
+    ref, _, _ = _run(bus, program, "off", "c")
+    share, many = 1.0, 0
+    for kernel in ("c", "numpy"):
+        got, held, ran = _run(bus, program, "on", kernel)
+        for k, (a, b) in enumerate(zip(ref, got, strict=True)):
+            assert a == b, f"{kernel}: step {k}: the bank and the scalar path differ"
+        share = min(share, held)
+        many = ran if kernel == "c" else many
+    return share, many
+
+
+def test_compensated_axes_across_the_tables_both_ways(bus: tuple[str, str]) -> None:
+    """Moves over the tables' points and beyond both ends, reversals in mid move, the
+    compensation switched off and on while moving, a new table, a stop, an axis switched off
+    and on, a planned position set: bit-equal, and the compensated axes ran in the bank."""
+    program = [
+        (3, ("move", 1, 14_000, 20.0, 0.5, 25)),  # beyond the table's positive end
+        (2, ("move", 2, -14_000, 25.0, 0.6, 0)),  # beyond its negative end
+        (1, ("move", 3, 3_333, 12.0, 0.4, 50)),
+        (1, ("jog", 4, -13.0, 0.3, 0.5)),
+        (4, ("move", 5, 7_000, 9.0, 0.3, 5)),
+        (1, ("move", 6, 5_000, 30.0, 1.0, 0)),
+        (350, ("enable", 1, 0)),  # off while moving: 607Ah jumps back by the correction
+        (1, ("enable", 1, 1)),
+        (1, ("enable", 1, 0)),
+        (200, ("enable", 1, 1)),
+        (150, ("move", 3, -6_500, 18.0, 0.7, 25)),  # a reversal in mid move
+        (600, ("jog", 4, 16.0, 0.2, 0.9)),  # a jog turning round
+        (900, ("off", 2)),
+        (40, ("on", 2)),
+        (3, ("move", 2, 1_999, 30.0, 0.5, 0)),
+        (400, ("stop", 3, False)),
+        (300, ("move", 5, -4_000, 25.0, 1.0, 0)),
+        (700, ("stop", 4, True)),
+        (100, ("prfpos", 4, 20_000)),  # a set planned position turns the direction
+        (5, ("screw", 4, 5, 19_000, 4_000, 9)),  # a new table while standing
+        (2, ("enable", 5, 1)),
+        (2, ("move", 4, 17_000, 20.0, 0.5, 0)),
+        (1500, ("move", 1, -12_000, 40.0, 2.0, 25)),
+        (1200, ("enable", 5, 0)),
+        (1500, ("clear", 0)),
+        # moves that end within short waits (each cycle a call of its own), all axes on and
+        # then with one switched off: the direction they end in is the one they stand in
+        (1, ("move", 3, -6_800, 30.0, 2.0, 0)),
+        (1, ("move", 5, -3_900, 30.0, 2.0, 0)),
+        *[(3, ("wait", 0))] * 20,
+        (1, ("move", 3, -6_300, 30.0, 2.0, 0)),
+        *[(3, ("wait", 0))] * 20,
+        (2, ("off", 6)),
+        (1, ("move", 3, -6_700, 30.0, 2.0, 0)),
+        *[(3, ("wait", 0))] * 20,
+        (300, ("on", 6)),
+    ]
+    share, many = _check(bus, program)
+    assert share > 0.7  # the compensated axes were in the bank at most samples
+    assert many > 5_000  # the long waits ran many cycles per kernel call
+
+
+step = st.one_of(
+    st.tuples(
+        st.just("move"),
+        st.integers(1, AXES),
+        st.integers(-15_000, 15_000),
+        st.floats(1.0, 40.0),
+        st.floats(0.1, 3.0),
+        st.sampled_from([0, 5, 25]),
+    ),
+    st.tuples(
+        st.just("jog"),
+        st.integers(1, AXES),
+        st.floats(-30.0, 30.0),
+        st.floats(0.05, 2.0),
+        st.sampled_from([0.0, 0.5]),
+    ),
+    st.tuples(st.just("enable"), st.integers(1, 5), st.integers(0, 1)),
+    st.tuples(st.just("stop"), st.integers(1, AXES), st.booleans()),
+)
+
+
+@pytest.mark.long
+@settings(
+    max_examples=examples(30, 6),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(program=st.lists(st.tuples(st.integers(0, 400), step), min_size=1, max_size=10))
+def test_programs(bus: tuple[str, str], program) -> None:
+    _check(bus, [*program, (300, ("clear", 0))])
+
+
+def test_the_numpy_values_are_the_scalar_values_bit_for_bit() -> None:
+    """screw_values (the numpy cycle's) against LeadScrew.value at points on, between and
+    beyond the table's points, in both directions."""
+    import random
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from gtecat.controller.lead_screw import LeadScrew, set_lead_screw
+    from gtecat.controller.lead_screw_bank import screw_arrays, screw_load, screw_values
+
+    class Axis:  # what a screw hangs on: the hooks
+        def __init__(self) -> None:
+            self.pre_hooks: list = []
+
+    rnd = random.Random(7)
+    screws = [
+        LeadScrew(-10_000.0, 20_000.0, tuple(map(float, p)), tuple(map(float, q)))
+        for p, q in (_tables(11, 3), _tables(2, 1))
+    ] + [LeadScrew(0.5, 333.3, (1.0, -7.0, 123.0, 4.0), (0.0, 2.0, 3.0, -9.0))]
+    bank = SimpleNamespace(kernel=None)
+    screw_arrays(bank, len(screws))
+    axes = [Axis() for _ in screws]
+    for r, (ax, s) in enumerate(zip(axes, screws, strict=True)):
+        set_lead_screw(ax, s)
+        screw_load(bank, r, ax)
+    for r, s in enumerate(screws):
+        for _ in range(300):
+            pos = rnd.choice([rnd.uniform(-12_000, 12_000), rnd.uniform(-1, 340), 0.5, -10_000.0])
+            d = rnd.choice([1, -1])
+            got = screw_values(bank, np.array([r]), np.array([pos]), np.array([d]))[0]
+            assert got == s.value(pos, d), (r, pos, d)
