@@ -1241,6 +1241,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_64_axes_32_trap_32_holding": lambda: rtf(
             64, half, 10, "odd axes moving in Trap, even axes enabled and holding"
         ),
+        "rtf_64_axes_trap_lead_screw": lambda: rtf(
+            64, every(64, "screw"), 10, "all 64 moving in Trap, lead-screw compensation on"
+        ),
         "rtf_128_axes_trap": lambda: rtf(128, every(128, "moving"), 100, "all 128 moving in Trap"),
         "rtf_12_axes_homing_17": lambda: rtf(
             12, every(12, "homing"), None, "drive homing method 17"

@@ -53,8 +53,8 @@ from tools.gen_axes_eni import write_axes_eni  # noqa: E402
 
 AXES = (1, 2, 4, 8, 12, 16, 32, 64, 96, 128)
 STATES = ("idle", "moving", "homing")
-#: the other motion modes (``--states pt,pvt,gear,follow,crd``): see their ``start_*``
-MODES = ("pt", "pvt", "gear", "follow", "crd", "homed6")
+#: the other motion modes (``--states pt,pvt,gear,follow,crd,screw``): see their ``start_*``
+MODES = ("pt", "pvt", "gear", "follow", "crd", "homed6", "screw")
 AXES_PER_CORE = 32
 #: axes per core that :func:`core_axis` uses; ``--addressing flat`` puts every axis on
 #: core 1 (the emulator's own extension before issue 17: no GT_Update beyond axis 32)
@@ -188,6 +188,17 @@ def start_trap(axes: Sequence[int]) -> None:
         gtn("SetPos", a, (-1) ** a * 50_000_000)
         gtn("SetVel", a, 20 + a % 12)
     update(axes)
+
+
+def start_trap_lead_screw(axes: Sequence[int]) -> None:
+    """:func:`start_trap` with lead-screw compensation on every axis: 11 points over 100000
+    pulses from 0, a table for each direction (GT_SetLeadScrewComp, GT_EnableLeadScrewComp)."""
+    pos = (c_long * 11)(*[(-1) ** k * 5 * k for k in range(11)])
+    neg = (c_long * 11)(*[3 * k for k in range(11)])
+    for a in axes:
+        gtn("SetLeadScrewComp", a, 11, 0, 100_000, pos, neg)
+        gtn("EnableLeadScrewComp", a, 1)
+    start_trap(axes)
 
 
 def start_homing(axes: Sequence[int]) -> None:
@@ -381,6 +392,7 @@ STARTERS: dict[str, Callable[[Sequence[int]], None]] = {
     "homing": start_homing,
     "pt": start_pt,
     "pvt": start_pvt,
+    "screw": start_trap_lead_screw,
     "gear": start_gear,
     "follow": start_follow,
     "crd": start_crd,
@@ -479,7 +491,7 @@ def run_bus(
             limit = None
             if "homing" in full.values():
                 limit = HOMING_WINDOW_MS / max(1, repeat)
-            elif "moving" in full.values():
+            elif "moving" in full.values() or "screw" in full.values():
                 # a Trap move ends after TRAP_MOVE_MS at the least: every window of a moving
                 # bus stops short of it, however fast the machine runs
                 limit = TRAP_WINDOW_MS / max(1, repeat)
@@ -848,7 +860,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--states",
         default=",".join(STATES),
-        help="idle,moving,homing (also pt,pvt,gear,follow,crd)",
+        help="idle,moving,homing (also pt,pvt,gear,follow,crd,homed6,screw)",
     )
     ap.add_argument("--seconds", type=float, default=1.5, help="wall seconds per point")
     ap.add_argument("--repeat", type=int, default=3, help="windows per point (best counts)")
