@@ -83,6 +83,19 @@ def _act(action: tuple) -> int:
         return gt.GT_ClrSts(1, AXES)
     if kind == "wait":
         return 0
+    if kind == "gear":  # a slave of its master's planned position, ratio 2:1
+        _ok(gt.GT_PrfGear(axis, 0), "gear")
+        _ok(gt.GT_SetGearMaster(axis, action[2], gt.GEAR_MASTER_PROFILE, 0), "master")
+        _ok(gt.GT_SetGearRatio(axis, 2, 1, 400), "ratio")
+        return gt.GT_GearStart(1 << (axis - 1))
+    if kind == "pt":  # a static FIFO looping 0 -> 8000 -> 0 in 30 segments of 15 ms
+        _ok(gt.GT_PrfPt(axis, gt.PT_MODE_STATIC), "pt")
+        _ok(gt.GT_PtClear(axis, 0), "clear")
+        _ok(gt.GT_SetPtLoop(axis, 0), "loop")
+        for k in range(1, 31):
+            pos = 8000.0 * (k if k <= 15 else 30 - k) / 15
+            _ok(gt.GT_PtData(axis, pos, 15 * k, gt.PT_SEGMENT_NORMAL, 0), "data")
+        return gt.GT_PtStart(1 << (axis - 1), 0)
     raise AssertionError(kind)
 
 
@@ -204,6 +217,27 @@ def test_compensated_axes_across_the_tables_both_ways(bus: tuple[str, str]) -> N
     share, many = _check(bus, program)
     assert share > 0.7  # the compensated axes were in the bank at most samples
     assert many > 5_000  # the long waits ran many cycles per kernel call
+
+
+def test_compensated_axes_in_gear_and_pt(bus: tuple[str, str]) -> None:
+    """A Gear slave and its Trap master, a PT axis looping over a table's points, each with
+    the compensation on (stepped a table ahead by the bank), switched off and on."""
+    program = [
+        (1, ("move", 1, 9_000, 20.0, 0.5, 25)),
+        (1, ("gear", 2, 1)),
+        (1, ("pt", 3, 0)),
+        (1, ("pt", 5, 0)),
+        (700, ("enable", 2, 0)),
+        (3, ("enable", 2, 1)),
+        (400, ("enable", 3, 0)),
+        (200, ("enable", 3, 1)),
+        (600, ("move", 1, -9_000, 30.0, 1.0, 0)),
+        *[(2, ("wait", 0))] * 10,
+        (1500, ("stop", 3, False)),
+        (500, ("clear", 0)),
+    ]
+    share, _ = _check(bus, program)
+    assert share > 0.7
 
 
 step = st.one_of(
