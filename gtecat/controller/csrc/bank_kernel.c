@@ -613,7 +613,7 @@ INLINE void ls_commit(void **ptr, int64_t r)
 
 /* the commit of a cycle in which every row stepped in CSP (none left out, frozen or homing):
  * the same values as the row-by-row commit, copied array by array */
-INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog)
+INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog, int any_ls)
 {
     int64_t r;
     if (n_jog)
@@ -636,7 +636,7 @@ INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog)
     COPY(c_lstop, s_lstop, uint8_t);
     COPY(c_target, s_target, int64_t);
     COPY(c_din, s_din, int64_t);
-    for (r = 0; r < n; r++)
+    for (r = 0; any_ls && r < n; r++)
         ls_commit(ptr, r);
     COPY(a_last, s_a, double);
     COPY(enc_prev, s_raw, int64_t);
@@ -783,7 +783,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
     const uint8_t *alive = U8(alive);
     uint8_t *buf = U8(buf);
     int64_t r, i, n_csp = 0, n_jog = 0;
-    int fin_any = 0, any_hit = 0;
+    int fin_any = 0, any_hit = 0, any_ls = 0;
     const uint8_t *hm = U8(hm);
     uint8_t *s_hit = U8(s_hit);
     uint8_t *s_evt = U8(s_evt);
@@ -871,8 +871,11 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
             a = link(prf, F64(prf_ratio)[r], F64(prf_off)[r]);
             /* 3. 607Ah: Axis.pulses_to_counts, int32 like the PDO entry */
             {
-                const double cmd = U8(ls)[r] ? ls_command(ptr, r, a,
-                    ls_direction(I64(ls_dir)[r], a, F64(a_last)[r])) : a;
+                double cmd = a;
+                if (U8(ls)[r]) { /* a lead screw's compensation (ls_command) */
+                    any_ls = 1;
+                    cmd = ls_command(ptr, r, a, ls_direction(I64(ls_dir)[r], a, F64(a_last)[r]));
+                }
                 double scaled = cmd * F64(unit2)[r];
                 if (!(fabs(scaled) < 4611686018427387904.0)) /* 2**62, bank.HUGE_COUNTS */
                     hit = 1;
@@ -1072,7 +1075,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
 
     /* commit (CspBank.commit, the bank's state, the table cursors) */
     if (n_csp == n) {
-        commit_all(ptr, n, n_jog);
+        commit_all(ptr, n, n_jog, any_ls);
         fin_any = commit_cursors(ptr, n);
         goto image;
     }
@@ -1227,7 +1230,7 @@ INLINE void row_cycles_t(void **ptr, const int64_t *io, const double *fp, int64_
     const int64_t dwatch = I64(dwatch)[r] | I64(dpost)[r];
     const int lvel = U8(lvel)[r];
     const int tpw = plain ? 0 : U8(c_tpw)[r];
-    const int ls = U8(ls)[r];
+    const int ls = plain ? 0 : U8(ls)[r]; /* (a row with a lead screw is not plain) */
     int64_t q_ls_dir = I64(ls_dir)[r];
     /* the row's state in locals (from the committed arrays: a row run again starts there) */
     double q_pos = F64(c_pos)[r], q_vel = F64(c_vel)[r], q_acc = F64(c_acc)[r],
@@ -1510,15 +1513,15 @@ CLONES static void row_cycles(void **ptr, const int64_t *io, const double *fp, i
     row_cycles_t(ptr, io, fp, r, s, limit, bk, 0);
 }
 
-/* row r has none of the rarer parts row_cycles_plain leaves out: no Jog, no touch probe
- * armed, no switch windows
+/* row r has none of the rarer parts row_cycles_plain leaves out: no Jog, no lead screw, no
+ * touch probe armed, no switch windows
  * (home switch, probes), its plan and encoder in pulses as they are (links of ratio 1 and
  * offset 0) and no in-position band */
 INLINE int row_plain(void **ptr, const int64_t *io, int64_t r)
 {
-    return !U8(jog)[r] && !U8(c_tpw)[r] && !io[IN_W2] && !io[IN_W16] && !io[IN_W17] &&
-           F64(prf_ratio)[r] == 1.0 && F64(prf_off)[r] == 0.0 && F64(enc_ratio)[r] == 1.0 &&
-           F64(enc_off)[r] == 0.0 && !(F64(band)[r] > 0.0);
+    return !U8(jog)[r] && !U8(ls)[r] && !U8(c_tpw)[r] && !io[IN_W2] && !io[IN_W16] &&
+           !io[IN_W17] && F64(prf_ratio)[r] == 1.0 && F64(prf_off)[r] == 0.0 &&
+           F64(enc_ratio)[r] == 1.0 && F64(enc_off)[r] == 0.0 && !(F64(band)[r] > 0.0);
 }
 
 /* Row r back where it stood before row_cycles (its table refilled: the table kept in bk). */
