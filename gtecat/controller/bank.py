@@ -989,13 +989,13 @@ class AxisBank:
         return ""
 
     @staticmethod
-    def _homing_hook(ax: Any, res: Any, screw: bool = False) -> Any:
+    def _homing_hook(ax: Any, res: Any, screw: int = 1) -> Any:
         """The axis's hooks are the resources' own plus at most the GT layer's homing
         follower (gtecat.gt.homing_calls) and bank-aware hooks that may be held now (a
-        capture unit, :func:`aware_hooks`), and (``screw``) its lead screw's
-        (gtecat.controller.lead_screw_bank): that follower, None without one, False when
-        some other hook runs or an aware one must run its next cycle."""
-        if len(ax.pre_hooks) != 1 and not (screw and screw_claimable(ax, res)):
+        capture unit, :func:`aware_hooks`), and its lead screw's (``screw`` 2: in a drive
+        homing; gtecat.controller.lead_screw_bank): that follower, None without one, False
+        when some other hook runs or an aware one must run its next cycle."""
+        if len(ax.pre_hooks) != 1 and not screw_claimable(ax, res, screw == 2):
             return False
         hooks = ax.post_hooks
         if not hooks or hooks[0] != res._post:
@@ -1024,7 +1024,7 @@ class AxisBank:
             return False
         if ax.cw != CW_ENABLED or ax._cw_sent != CW_ENABLED:
             return False
-        st = self._homing_hook(ax, res, True)
+        st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active) or not res._csp:
             return False
         if ax.prf_pos != res._a_last:
@@ -1112,7 +1112,7 @@ class AxisBank:
         ax, res = self.axes[r], self.res[r]
         if ax.link_lost or ax.cw != ax._cw_sent or ax.plan_error or ax.cw == CW_QUICK_STOP:
             return False  # (a quick stop the drive finishes: its controlword changes after it)
-        st = self._homing_hook(ax, res, True)
+        st = self._homing_hook(ax, res)
         if st is False or (st is not None and st.active):
             return False
         if ax.prf_pos != res._a_last or res._csp != (ax.mode_cmd == 8):
@@ -1165,7 +1165,7 @@ class AxisBank:
             return False
         if self.csp.channels[r].homing is None:  # standing before a homing: frozen, powered
             return self._eligible_frozen(r, powered=True)
-        st = self._homing_hook(ax, res)
+        st = self._homing_hook(ax, res, 2)
         if st is False:
             return False
         searching = st is not None and st.active

@@ -9,17 +9,21 @@ work per row, with the same floating-point operations in the same order
 cycle) and in the compiled cycle (``csrc/bank_kernel.c``, ``ls_*``), so positions,
 encoder values and status stay bit-equal with the scalar path.
 
-The hook's last position is the row's last planned position (``a_last``): a row is taken
-only where the two are equal (the hook ran after the planned position last changed), so
-the bank keeps no copy of it.  Per row: ``ls`` 0 (no table), 1 (a table, the compensation
-off: only the direction is followed) or 2 (on); ``ls_dir`` the direction; ``ls_prm`` the
-table's start and point spacing; ``ls_ix`` where its positive table begins in ``ls_tab``
-and its point count (the negative table follows it).  A table changes only through a GT
-call on its axis, which gives the row back first.
+The hook's last position is the row's last planned position (``a_last``): a row in CSP is
+taken only where the two are equal (the hook ran after the planned position last changed).
+A drive homing (mode 6) has its plan follow the drive after the hook, so the hook sees the
+planned position of the cycle before: such a row keeps the hook's last position itself
+(``ls_last``, not a number for none), and the compiled cycle, which alone runs homing rows,
+follows it.  Per row: ``ls`` 0 (no table), 1 (a table, the compensation off: only the
+direction is followed) or 2 (on); ``ls_dir`` the direction; ``ls_prm`` the table's start
+and point spacing; ``ls_ix`` where its positive table begins in ``ls_tab`` and its point
+count (the negative table follows it).  A table changes only through a GT call on its axis,
+which gives the row back first.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -34,19 +38,20 @@ def screw_arrays(bank: Any, n: int) -> None:
     bank.ls_prm = np.zeros(2 * n)
     bank.ls_ix = np.zeros(2 * n, np.int64)
     bank.ls_tab = np.zeros(1)
+    bank.ls_last = np.zeros(n)
     #: the screw whose tables ls_tab holds for each row (None: none)
     bank._ls_obj = [None] * n
 
 
-def screw_claimable(ax: Any, res: Any) -> bool:
+def screw_claimable(ax: Any, res: Any, homing: bool = False) -> bool:
     """The axis's hooks are its resources' and its lead screw's, in that order (the screw
-    set after the resources: it reads the planned position of this cycle), and the screw
-    has seen the planned position as it stands."""
+    set after the resources: it reads the planned position of this cycle), and (but in a
+    drive homing: ``homing``) the screw has seen the planned position as it stands."""
     hooks = ax.pre_hooks
     if len(hooks) != 2 or hooks[0] != res._pre:
         return False
     s = lead_screw(ax)
-    if s is None or hooks[1] != s.hook or s.last != ax.prf_pos:
+    if s is None or hooks[1] != s.hook or (not homing and s.last != ax.prf_pos):
         return False
     return 2 <= len(s.positive) == len(s.negative)
 
@@ -62,6 +67,7 @@ def screw_load(bank: Any, r: int, ax: Any) -> None:
         _tables(bank)
     bank.ls[r] = 2 if s.enabled else 1
     bank.ls_dir[r] = s.direction
+    bank.ls_last[r] = math.nan if s.last is None else s.last
 
 
 def _tables(bank: Any) -> None:
@@ -92,11 +98,15 @@ def screw_put_back(bank: Any, r: int, ax: Any) -> None:
     s: LeadScrew | None = bank._ls_obj[r]
     if s is None:
         return
-    a = float(bank.a_last[r])
+    if bank.hm[r]:  # (ls_last: module docstring)
+        last = float(bank.ls_last[r])
+        s.last = None if math.isnan(last) else last
+    else:
+        s.last = float(bank.a_last[r])
     s.direction = int(bank.ls_dir[r])
-    s.last = a
-    if bank.bank_cycles != bank.claim_cycle[r]:  # the hook's value of the last cycle
-        ax.compensation = s.value(a, s.direction) if kind == 2 else 0.0
+    if bank.bank_cycles != bank.claim_cycle[r] and s.last is not None:
+        # the hook's value of the last cycle
+        ax.compensation = s.value(s.last, s.direction) if kind == 2 else 0.0
 
 
 def screw_command(bank: Any, a: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:

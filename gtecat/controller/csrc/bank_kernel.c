@@ -67,7 +67,7 @@
     X(enc_step0, f64) X(enc_step1, f64) X(enc_ratio, f64) X(enc_off, f64)                  \
     X(soft_pos, f64) X(soft_neg, f64) X(pos_err, f64) X(band, f64) X(hold_ns, i64)         \
     X(since, i64) X(arrived, u8) X(a_last, f64)                                            \
-    X(ls, u8) X(ls_dir, i64) X(ls_prm, f64) X(ls_ix, i64) X(ls_tab, f64)                   \
+    X(ls, u8) X(ls_dir, i64) X(ls_prm, f64) X(ls_ix, i64) X(ls_tab, f64) X(ls_last, f64)   \
     X(jrp, f64) X(jrv, f64) X(jp, f64) X(jv, f64) X(ja, f64) X(tau, f64) X(jE, f64)        \
     X(jgoal, f64) X(jacc, f64) X(jdec, f64)                                                \
     X(c_pos, f64) X(c_vel, f64) X(c_acc, f64) X(c_dpos, f64) X(c_dvel, f64)                \
@@ -566,7 +566,8 @@ INLINE int refill_row(void **ptr, int64_t *io, int64_t r)
 /* Lead-screw compensation (gtecat/controller/lead_screw_bank.py): LeadScrew.hook and
  * LeadScrew.value (gtecat/controller/lead_screw.py) with the same operations in the same
  * order.  ls: 0 no table, 1 a table (off: the direction only), 2 on; the hook's last planned
- * position is the row's a_last. */
+ * position is the row's a_last, but in a homing row (its plan follows the drive after the
+ * hook) ls_last (not a number: none yet). */
 
 /* the direction the axis last moved in, after a cycle whose planned position is a */
 INLINE int64_t ls_direction(int64_t dir, double a, double last)
@@ -602,11 +603,20 @@ INLINE double ls_command(void **ptr, int64_t r, double a, int64_t dir)
     return U8(ls)[r] == 2 ? a + ls_value(ptr, r, a, dir) : a;
 }
 
-/* the commit of row r's direction (before a_last takes the cycle's planned position) */
-INLINE void ls_commit(void **ptr, int64_t r)
+/* the commit of row r's direction (before a_last takes the cycle's planned position); a
+ * homing row's hook saw the planned position of the cycle before */
+INLINE void ls_commit(void **ptr, int64_t r, int homing)
 {
-    if (U8(ls)[r])
+    if (!U8(ls)[r])
+        return;
+    if (homing) {
+        const double p = F64(a_last)[r], last = F64(ls_last)[r];
+        if (last == last)
+            I64(ls_dir)[r] = ls_direction(I64(ls_dir)[r], p, last);
+        F64(ls_last)[r] = p;
+    } else {
         I64(ls_dir)[r] = ls_direction(I64(ls_dir)[r], F64(s_a)[r], F64(a_last)[r]);
+    }
 }
 
 #define COPY(dst, src, type) memcpy(ptr[F_##dst], ptr[F_##src], (size_t)n * sizeof(type))
@@ -637,7 +647,7 @@ INLINE void commit_all(void **ptr, int64_t n, int64_t n_jog, int any_ls)
     COPY(c_target, s_target, int64_t);
     COPY(c_din, s_din, int64_t);
     for (r = 0; any_ls && r < n; r++)
-        ls_commit(ptr, r);
+        ls_commit(ptr, r, 0);
     COPY(a_last, s_a, double);
     COPY(enc_prev, s_raw, int64_t);
     COPY(enc_pos, s_enc, double);
@@ -1106,7 +1116,7 @@ INLINE int cycle_once(void **ptr, int64_t *io, const double *fp, uint8_t *go, in
         U8(c_lstop)[r] = U8(s_lstop)[r];
         I64(c_target)[r] = I64(s_target)[r];
         I64(c_din)[r] = I64(s_din)[r];
-        ls_commit(ptr, r);
+        ls_commit(ptr, r, hm[r]);
         F64(a_last)[r] = F64(s_a)[r];
         cur = I64(t_cur)[r];
         I64(t_idx)[r] = I64(base)[r] + cur;
