@@ -14,8 +14,8 @@ cycle and of hundreds (many cycles in one kernel call, row by row) alternate.
 from __future__ import annotations
 
 import os
-import shutil
-from ctypes import byref, c_double, c_long, c_ubyte
+from ctypes import c_long
+from unittest import mock
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -23,11 +23,12 @@ from hypothesis import strategies as st
 
 from gtecat import gt
 from tests.conftest import examples
-from tests.gtecat.controller.test_bank import _ok, open_bus
+from tests.gtecat.controller.test_bank import HAS_CC, _ok
+from tests.gtecat.controller.test_bank_rows import AXES, _sample
+from tests.gtecat.controller.test_bank_rows import _act as _rows_act
+from tests.gtecat.controller.test_bank_rows import _open as rows_open
+from tests.gtecat.controller.test_bank_rows import step as rows_step
 from tools.gen_axes_eni import write_axes_eni
-
-AXES = 6
-HAS_CC = bool(os.environ.get("CC") or any(shutil.which(c) for c in ("cc", "gcc", "clang")))
 
 
 @pytest.fixture(scope="module")
@@ -53,34 +54,12 @@ def _act(action: tuple) -> int:
         return gt.GT_SetLeadScrewComp(axis, n, start, length, pos, neg)
     if kind == "enable":
         return gt.GT_EnableLeadScrewComp(axis, action[2])
-    if kind == "move":
-        _, _, target, vel, acc, smooth = action
+    if kind == "move":  # (from any mode: Trap first)
         gt.GT_PrfTrap(axis)
-        prm = gt.TTrapPrm()
-        prm.acc, prm.dec, prm.velStart, prm.smoothTime = acc, acc, 0.0, smooth
-        gt.GT_SetTrapPrm(axis, byref(prm))
-        gt.GT_SetPos(axis, target)
-        gt.GT_SetVel(axis, vel)
-        return gt.GT_Update(1 << (axis - 1))
-    if kind == "jog":
-        _, _, vel, acc, smooth = action
-        gt.GT_PrfJog(axis)
-        prm = gt.TJogPrm()
-        prm.acc, prm.dec, prm.smooth = acc, acc, smooth
-        gt.GT_SetJogPrm(axis, byref(prm))
-        gt.GT_SetVel(axis, vel)
-        return gt.GT_Update(1 << (axis - 1))
-    if kind == "stop":
-        mask = 1 << (axis - 1)
-        return gt.GT_Stop(mask, mask if action[2] else 0)
-    if kind == "off":
-        return gt.GT_AxisOff(axis)
-    if kind == "on":
-        return gt.GT_AxisOn(axis)
+    if kind in ("move", "jog", "trap", "soft", "band", "stop", "off", "on", "clear"):
+        return _rows_act(action)
     if kind == "prfpos":
         return gt.GT_SetPrfPos(axis, action[2])
-    if kind == "clear":
-        return gt.GT_ClrSts(1, AXES)
     if kind == "wait":
         return 0
     if kind == "home":  # drive homing (mode 6) with a method
@@ -106,17 +85,6 @@ def _act(action: tuple) -> int:
     raise AssertionError(kind)
 
 
-def _sample(size: int) -> tuple:
-    sts, prf, enc = (c_long * AXES)(), (c_double * AXES)(), (c_double * AXES)()
-    vel, raw = (c_double * AXES)(), (c_ubyte * size)()
-    gt.GT_GetSts(1, sts, AXES)
-    gt.GT_GetPrfPos(1, prf, AXES)
-    gt.GT_GetEncPos(1, enc, AXES)
-    gt.GT_GetEncVel(1, vel, AXES)
-    gt.GT_GetEcatRawData(0, size, raw)
-    return tuple(sts), tuple(prf), tuple(enc), tuple(vel), bytes(raw)
-
-
 #: every axis but the last has a table (points every 2000 pulses from -10000 to 10000, the
 #: fifth axis's 7 points over 9000 from -3000), the first four with the compensation on
 SETUP = [
@@ -129,18 +97,8 @@ SETUP = [
 def _run(bus: tuple[str, str], program: list[tuple[int, tuple]], bank: str, kernel: str):
     """(the samples after each wait, the screw axes' share of the waits' samples that found
     them in the bank, the cycles the kernel ran many at a time)"""
-    old = os.environ.get("GTECAT_BANK_KERNEL")
-    os.environ["GTECAT_BANK_KERNEL"] = kernel
-    try:
-        open_bus(bus[0], bus[1], bank)
-        for a in range(1, AXES + 1):
-            _ok(gt.GT_AxisOn(a), f"axis on {a}")
-            _ok(gt.GT_PrfTrap(a), "trap")
-    finally:
-        if old is None:
-            del os.environ["GTECAT_BANK_KERNEL"]
-        else:
-            os.environ["GTECAT_BANK_KERNEL"] = old
+    with mock.patch.dict(os.environ, {"GTECAT_BANK_KERNEL": kernel}):
+        rows_open(bus, bank)
     ctl = gt.GTE_Controller()
     size = ctl.layout.gt_raw_bytes
     out: list = []
@@ -283,25 +241,9 @@ def test_compensated_axes_homed_by_their_drives(homing_bus: tuple[str, str]) -> 
     assert share["c"] > 0.7  # (the numpy cycle runs no homing rows)
 
 
-step = st.one_of(
-    st.tuples(
-        st.just("move"),
-        st.integers(1, AXES),
-        st.integers(-15_000, 15_000),
-        st.floats(1.0, 40.0),
-        st.floats(0.1, 3.0),
-        st.sampled_from([0, 5, 25]),
-    ),
-    st.tuples(
-        st.just("jog"),
-        st.integers(1, AXES),
-        st.floats(-30.0, 30.0),
-        st.floats(0.05, 2.0),
-        st.sampled_from([0.0, 0.5]),
-    ),
-    st.tuples(st.just("enable"), st.integers(1, 5), st.integers(0, 1)),
-    st.tuples(st.just("stop"), st.integers(1, AXES), st.booleans()),
-)
+#: test_bank_rows' steps (moves, jogs, soft limits, bands, stops...) and the compensation
+#: switched on and off
+step = st.one_of(rows_step, st.tuples(st.just("enable"), st.integers(1, 5), st.integers(0, 1)))
 
 
 @pytest.mark.long
