@@ -497,7 +497,7 @@ class AxisBank:
         self._opened_marks: tuple[int, tuple[int, int]] = (-1, (-1, -1))
         #: where a group's output bytes lie in the raw-write checks' references, per
         #: claimed pattern (:meth:`_took_group`)
-        self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
+        self._took_at: dict[int, tuple[Any, int | None]] = {}
         #: each group's output bytes in the image (607Ah aside): their count and a function
         #: giving their values from the image (made when asked)
         self._grp_pos: dict[int, tuple[int, Callable[[Any], Any]]] = {}
@@ -2357,10 +2357,10 @@ class AxisBank:
         if now == snap[start:stop].tobytes():
             return
         snap[start:stop] = np.frombuffer(now, np.uint8)
-        ref = bytearray(self._rx_ref)
-        for k, _, j in self._took_entries(gi):
-            ref[j] = now[k - start]
-        self._rx_ref = bytes(ref)
+        at = self._took_entries(gi)
+        if at is not None:  # (the group's bytes lie together among the claimed ones')
+            ref = self._rx_ref
+            self._rx_ref = ref[:at] + now + ref[at + stop - start :]
 
     def _group_outputs(self, gi: int) -> tuple[bytes, int, int]:
         """Group ``gi``'s output bytes (607Ah aside) as the image holds them now, and where
@@ -2396,18 +2396,15 @@ class AxisBank:
         now, start, stop = self._group_outputs(gi)
         return now == self._rx_snap[start:stop].tobytes()
 
-    def _took_entries(self, gi: int) -> list[tuple[int, int, int]]:
-        """Claimed group ``gi``'s output bytes: (index in the references of every output
-        byte, its byte in the image, its index in those of the claimed ones), per pattern."""
+    def _took_entries(self, gi: int) -> int | None:
+        """Where claimed group ``gi``'s output bytes begin in the references of the claimed
+        ones (:attr:`_rx_ref`), per pattern; None when the pattern leaves the group out."""
         at = self._took_at.get(gi)
         if at is None or at[0] is not self._rx_idx:
-            start, stop = self._rx_start[gi], self._rx_start[gi + 1]
             before = self._claimed_before(gi)
             at = self._took_at[gi] = (
                 self._rx_idx,
-                []
-                if before is None
-                else [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
+                None if before is None else before + self._rx_start[gi],
             )
         return at[1]
 
