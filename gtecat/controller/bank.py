@@ -94,6 +94,7 @@ from .._attrs import in_array, own_dict
 from ..master.clock import ClockMode
 from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
+from .bank_home_rows import switch_released, switch_to_homing
 from .bank_kernel import MAXSEG, NTPRM, OUT_FIN, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import settled as kernel_settled
@@ -577,6 +578,11 @@ class AxisBank:
         #: frozen row and left it claimed, that gave it back for the call where per-cycle
         #: hooks run (statistics; the differential tests check each way ran)
         self.calls_opened = self.calls_kept = self.calls_held_out = 0
+        #: switches to homing mode run on the row (gtecat.controller.bank_home_rows;
+        #: statistics), and the row switching now (-1: none)
+        self.home_switches = 0
+        self.home_switch = -1
+        self.home_switch_from = 0
         #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
         #: (:meth:`call_in_place`; statistics)
         self.trap_holds = 0
@@ -2080,6 +2086,8 @@ class AxisBank:
         self.layout += 1
         if r != self._stepping:  # (a row stepped in place: its objects hold its state)
             self._put_back(r)
+        if r == self.home_switch:  # (given back while its drive switches: bank_home_rows)
+            switch_released(self, r)
         # (_reindex counts these over every row: a row given back has them clear; jog, hm,
         # h_done and frz are cleared by _put_back, and a row stepped in place has none)
         self.dwatch[r] = self.dpost[r] = self.lvel[r] = 0
@@ -2284,6 +2292,10 @@ class AxisBank:
                     self._close_in_place(r, g, objs, homing_objects)
                 else:
                     self._close_opened(r, g)
+        if proto.name == "GT_SetHomingMode" and values[1:] == (6,):
+            done = switch_to_homing(self, ctl, r, g)
+            if done is not None:
+                return done
         self._open_row(r, g, True)
         try:
             return call()
