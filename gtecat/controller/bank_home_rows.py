@@ -34,6 +34,8 @@ from typing import TYPE_CHECKING, Any
 from gtecat.drives.cia402 import State
 from gtecat.drives.modes import OpMode, enter, step_hm
 
+from .epoch import EPOCH
+
 if TYPE_CHECKING:
     from .bank import AxisBank, _Group
 
@@ -119,13 +121,17 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     """GT_SetHomingMode(axis, 6) of claimed row ``r`` (group ``g``) run on the row (module
     docstring): 0 as the call returns it; None when the row does not qualify (the caller
     takes the opened row's path, nothing changed)."""
-    from .bank import _Bypass, _outside_marks  # (the bank imports this module)
+    from .bank import _unguard  # (the bank imports this module)
 
-    _Bypass.on = True  # (a look at the claimed objects: their guards would give them back)
+    # (its objects' guards off while the call looks at them and while it runs: nothing else
+    # runs in its cycles, no hook among them; on again as the row is taken again)
+    objs = tuple(bank._guarded_objects(g))
+    _unguard(objs)
     try:
         n = _switchable(bank, r, g)
     finally:
-        _Bypass.on = False
+        if not n:
+            _guard(bank, g, objs)
     if not n:
         return None
     ax = bank.axes[r]
@@ -136,24 +142,64 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     _get(ax, "_mode_acc").set(_HOMING)
     bank._took_group(gi)
     _set(ax, "mode_cmd", _HOMING)
-    c0, b0 = clock.cycles, bank.bank_cycles
+    c0, b0, claim = clock.cycles, bank.bank_cycles, int(bank.claim_ids[r])
     bank.home_switch, bank.home_switch_from = r, b0
     try:
         clock.run_until(lambda: clock.cycles >= c0 + n, _MODE_TIMEOUT_MS)
     finally:
         bank.home_switch = -1
-    if not (g.claimed and bank.alive[r]) or bank.bank_cycles != b0 + n:
+    if (
+        not (g.claimed and bank.alive[r])
+        or bank.bank_cycles != b0 + n
+        or bank.claim_ids[r] != claim
+    ):
         # (given back meanwhile: switch_released brought its objects to the cycles run,
         # and the scalar path ran the rest)
         return 0
-    bank._open_row(r, g, True)  # its state into its objects, as after n CSP cycles
+    bank.home_switches += 1
+    # its state into its objects, as a release after the n CSP cycles leaves them
+    bank._last = {r: bank._planned_row(r)}
+    bank._rates = {r: bank._enc_rates_row(r)}
+    bank.csp.store([r])
+    bank._put_back(r)
     _took_mode(bank, r, g, 1)
     _switched(bank, r, g)
-    bank._opened[r] = n
-    bank._opened_marks = (bank.bank_cycles, _outside_marks(bank.ctl.backend))
-    bank.home_switches += 1
-    bank._close_opened(r, g)
+    # taken again from them in place (AxisBank._load: frozen, in homing mode before a
+    # homing) when that is what the bank would take, else given back as they stand
+    bank._load(r)
+    EPOCH.n += 1
+    if not (bank.frz[r] and bank._eligible_frozen(r, powered=True)):
+        bank.frz[r] = True  # (its drive's objects hold its state: CspBank.rested)
+        bank._stepping = r  # (and its axis's: nothing put back)
+        try:
+            bank._release_groups([g])
+        finally:
+            bank._stepping = -1
+        return 0
+    _guard(bank, g, objs)
+    bank.n_frz += 1
+    bank._after_load(r, False)
+    bank._counted()
     return 0
+
+
+def _guard(bank: AxisBank, g: _Group, before: tuple) -> None:
+    """Claimed group ``g``'s objects guarded again (``before``: the ones its claim guarded,
+    whose guards came off; a planner replaced meanwhile is the bank's no longer)."""
+    from .bank import _OWN_DICT, _OWNER, _guard_class, own_dict
+
+    now = bank._guarded_objects(g)
+    gi = bank.group_of[g.rows[0]]
+    for obj in before:
+        if not any(obj is o for o in now):
+            _OWNER.pop(id(obj), None)
+    for obj in now:
+        key = id(obj)
+        _OWNER[key] = (bank, gi)
+        _set(obj, "__class__", _guard_class(type(obj)))
+        if key not in _OWN_DICT:
+            _OWN_DICT.add(key)
+            own_dict(obj)
 
 
 def switch_released(bank: AxisBank, r: int) -> None:

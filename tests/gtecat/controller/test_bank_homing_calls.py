@@ -109,7 +109,9 @@ def _run(machine: str, bank: str) -> tuple[list, tuple[int, int, int]]:
         bank = ctl.bank
         counts = (0, 0, 0)
         if bank is not None:
-            counts = (bank.calls_opened, bank.calls_kept, bank.calls_held_out)
+            # (a switch to homing mode run on its row reaches the row too: bank_home_rows)
+            opened = bank.calls_opened + bank.home_switches
+            counts = (opened, bank.calls_kept, bank.calls_held_out)
         trace.append(_mechanics(ctl))
     finally:
         gt.GT_Close()
