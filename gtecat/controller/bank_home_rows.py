@@ -40,6 +40,17 @@ if TYPE_CHECKING:
     from .bank import AxisBank, _Group
 
 _get, _set = object.__getattribute__, object.__setattr__
+_BANK: list[Any] = []  # the bank module, once asked (it imports this one)
+
+
+def _bank() -> Any:
+    if not _BANK:
+        import gtecat.controller.bank as bank
+
+        _BANK.append(bank)
+    return _BANK[0]
+
+
 _HOMING = 6
 _CSP = 8
 _CW_ENABLED = 0x000F
@@ -121,12 +132,11 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     """GT_SetHomingMode(axis, 6) of claimed row ``r`` (group ``g``) run on the row (module
     docstring): 0 as the call returns it; None when the row does not qualify (the caller
     takes the opened row's path, nothing changed)."""
-    from .bank import _unguard  # (the bank imports this module)
-
     # (its objects' guards off while the call looks at them and while it runs: nothing else
     # runs in its cycles, no hook among them; on again as the row is taken again)
     objs = tuple(bank._guarded_objects(g))
-    _unguard(objs)
+    _bank()._unguard(objs)
+    n = 0
     try:
         n = _switchable(bank, r, g)
     finally:
@@ -175,6 +185,8 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
             bank._release_groups([g])
         finally:
             bank._stepping = -1
+        for obj in objs:  # (a planner replaced meanwhile: the bank's no longer)
+            _bank()._OWNER.pop(id(obj), None)
         return 0
     _guard(bank, g, objs)
     bank.n_frz += 1
@@ -186,20 +198,23 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
 def _guard(bank: AxisBank, g: _Group, before: tuple) -> None:
     """Claimed group ``g``'s objects guarded again (``before``: the ones its claim guarded,
     whose guards came off; a planner replaced meanwhile is the bank's no longer)."""
-    from .bank import _OWN_DICT, _OWNER, _guard_class, own_dict
-
+    b = _bank()
+    owner, own, guards = b._OWNER, b._OWN_DICT, b._GUARDS
     now = bank._guarded_objects(g)
     gi = bank.group_of[g.rows[0]]
+    ids = {id(obj) for obj in now}
     for obj in before:
-        if not any(obj is o for o in now):
-            _OWNER.pop(id(obj), None)
+        if id(obj) not in ids:
+            owner.pop(id(obj), None)
     for obj in now:
         key = id(obj)
-        _OWNER[key] = (bank, gi)
-        _set(obj, "__class__", _guard_class(type(obj)))
-        if key not in _OWN_DICT:
-            _OWN_DICT.add(key)
-            own_dict(obj)
+        owner[key] = (bank, gi)
+        cls = type(obj)
+        if cls not in b._GUARD_SET:
+            _set(obj, "__class__", guards.get(cls) or b._guard_class(cls))
+        if key not in own:
+            own.add(key)
+            b.own_dict(obj)
 
 
 def switch_released(bank: AxisBank, r: int) -> None:

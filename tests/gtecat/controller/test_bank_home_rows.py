@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from gtecat import faults, gt
-from gtecat.controller import bank_kernel
+from gtecat.controller import bank_home_rows, bank_kernel
 from gtecat.controller.bank import AxisBank
 from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok
 from tests.gtecat.controller.test_bank_homing import _machine
@@ -248,3 +248,34 @@ def test_a_row_given_back_in_the_middle_of_its_switch(
     _same(ref, got)
     if HAS_CC and bank_kernel.wanted() != "numpy":
         assert len(given) == 3
+
+
+def test_a_switched_row_the_bank_would_not_take_goes_back(
+    runs: tuple, machine: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A row whose switch ran on it but which the bank would not take again as it stands
+    then (here: told so, the first three times) is given back with its objects as the
+    switch left them."""
+    clock, ref, _ = runs
+    switched = bank_home_rows._switched
+    frozen = AxisBank._eligible_frozen
+    due: list[int] = []
+    refused: list[int] = []
+
+    def switched_then_refused(bank: AxisBank, r: int, g: Any) -> None:
+        switched(bank, r, g)
+        if len(refused) < 3:
+            due.append(r)
+
+    def refuse_once(bank: AxisBank, r: int, powered: bool = False) -> bool:
+        if due and due[-1] == r:
+            refused.append(due.pop())
+            return False
+        return frozen(bank, r, powered)
+
+    monkeypatch.setattr(bank_home_rows, "_switched", switched_then_refused)
+    monkeypatch.setattr(AxisBank, "_eligible_frozen", refuse_once)
+    got = _run(machine, "on", clock)
+    _same(ref, got)
+    if HAS_CC and bank_kernel.wanted() != "numpy":
+        assert len(refused) == 3
