@@ -11,19 +11,22 @@ its homing bits in 6041h after it; the axis layer follows the drive from the fir
 switch the drive's cycle is a CSP cycle at rest; at the switch nothing of its motion
 changes either (the demand is where the motor stands, its speed 0).
 
-So the bank runs those cycles as the CSP row's cycles (the compiled kernel, with the other
-rows) with 6060h written in the image, then puts the row's state into its objects as a
-release does and brings them to what the switch leaves - the drive's mode bookkeeping,
-``enter`` and ``step_hm``'s hold, its process values (its own ``_outputs`` and encoder, so
-6041h and 6061h are its own), the axis's command and the axis layer's rebase onto the drive
-- and takes the row again, frozen in homing mode (:func:`gtecat.drives.homing_bank.idle_claimable`),
-as :meth:`AxisBank.call_opened` takes a row after its call.  The objects are then exactly as
-the scalar path leaves them (``tests/gtecat/controller/test_bank_home_rows.py`` compares
-every object and value with the bank off), without stepping the axis and the drive in
-Python at each cycle: a set-up of many axes costs the calls and the other rows' cycles.
+So the bank runs those cycles as the row's CSP cycles (the compiled kernel, with the other
+rows) with 6060h written in the image and the row's objects unguarded but untouched, then
+puts the row's state into its objects as a release does, brings them to what the switch
+leaves - the drive's mode bookkeeping, ``enter`` and ``step_hm``'s hold, its process values
+(its own ``_outputs``; its codec writes 6041h and 6061h into its buffers and the image), the
+axis's command and the axis layer's rebase onto the drive - and takes the row again from
+them in place (``AxisBank._load``: frozen in homing mode,
+:func:`gtecat.drives.homing_bank.idle_claimable`) with its guards back, or gives it back as
+they stand when the bank would not take it.  The objects are then exactly as the scalar
+path leaves them (``tests/gtecat/controller/test_bank_home_rows.py`` compares every object
+and value with the bank off), and no step of the axis or the drive ran in Python: the
+switch costs the call, the other rows' compiled cycles and one store and load of the row.
 
 Anything else - another mode, a row moving or not plain, hooks, a touch probe, a drive
-whose 6060h/6061h are not mapped or that shows another mode while switching - takes the
+whose 6060h/6061h are not mapped or that shows another mode while switching, the realtime
+clock (whose cycle thread, and other threads' calls, run while the call waits) - takes the
 opened row's path (:meth:`AxisBank.call_opened`).
 """
 
@@ -34,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 from gtecat.drives.cia402 import State
 from gtecat.drives.modes import OpMode, enter, step_hm
 
+from ..master.clock import ClockMode
 from .epoch import EPOCH
 
 if TYPE_CHECKING:
@@ -62,6 +66,8 @@ def _switchable(bank: AxisBank, r: int, g: _Group) -> int:
     """The cycles the drive of claimed row ``r`` takes to show homing mode after 6060h = 6
     is written (the first exchange takes it, ``mode_latency_cycles`` more switch it), when
     its switch may run on the row (module docstring); 0 when it may not."""
+    if bank.ctl.clock.mode is ClockMode.REALTIME:
+        return 0  # (the cycle thread runs while the call waits: other threads' calls too)
     if (
         bank.moving[r]
         or bank.jog[r]
