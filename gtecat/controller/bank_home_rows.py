@@ -261,16 +261,10 @@ def _switched(bank: AxisBank, r: int, g: _Group) -> None:
 def _rebased(bank: AxisBank, r: int) -> None:
     """The axis layer out of CSP from the first cycle's post step: the plan and the encoder
     rebased onto the drive's position, the plan following it (AxisResources._post)."""
-    ax, res = bank.axes[r], bank.res[r]
+    res = bank.res[r]
     res._csp = False
     res._rebase()
-    a = (res._act.get() - ax.drive_offset) / (1 << ax.pos_scale)
-    ax.prf_pos = a
-    res._a_last = a
-    planner = res.profile.planner
-    p = res.prf_link.source(a)
-    if p != planner.pos or not planner.done:
-        planner.hold(p)
+    res.follow_drive(bank.axes[r])
 
 
 def _exchange_buffers(bank: AxisBank, g: _Group, decode: bool) -> None:
