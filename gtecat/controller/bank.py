@@ -2292,7 +2292,8 @@ class AxisBank:
                     self._close_in_place(r, g, objs, homing_objects)
                 else:
                     self._close_opened(r, g)
-        if proto.name == "GT_SetHomingMode" and values[1:] == (6,):
+        mode = values[1] if len(values) == 2 else None  # (a list from a first call's binder)
+        if proto.name == "GT_SetHomingMode" and type(mode) is int and mode == 6:
             done = switch_to_homing(self, ctl, r, g)
             if done is not None:
                 return done
