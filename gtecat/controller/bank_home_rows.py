@@ -178,7 +178,7 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     bank._rates = {r: bank._enc_rates_row(r)}
     bank.csp.store([r])
     bank._put_back(r)
-    _took_mode(bank, r, g, 1)
+    _took_mode(bank, r, g, 1, sent=False)  # (its exchange's end: _switched)
     _switched(bank, r, g)
     # taken again from them in place (AxisBank._load: frozen, in homing mode before a
     # homing) when that is what the bank would take, else given back as they stand
@@ -234,12 +234,13 @@ def switch_released(bank: AxisBank, r: int) -> None:
     _rebased(bank, r)
 
 
-def _took_mode(bank: AxisBank, r: int, g: _Group, k: int) -> None:
+def _took_mode(bank: AxisBank, r: int, g: _Group, k: int, sent: bool = True) -> None:
     """Row ``r``'s drive, ``k`` exchanges after 6060h = 6 was written, as its own steps
     leave it: the request decoded in the first and the switch due ``mode_latency_cycles``
-    after it (Channel.step); its buffers as its last exchange leaves them."""
+    after it (Channel.step); its buffers as its last exchange leaves them (``sent``: what
+    it sent too)."""
     ch = bank.csp.channels[r]
-    _exchange_buffers(bank, g, decode=True)
+    _exchange_buffers(bank, g, took=True, sent=sent)
     ch.mode_seen = _HOMING
     ch.mode_due = ch.cycle - (k - 1) + ch._settings.mode_latency_cycles
 
@@ -254,7 +255,7 @@ def _switched(bank: AxisBank, r: int, g: _Group) -> None:
     enter(ch, ch.mode)
     step_hm(ch, ch.controlword, bank.ctl.clock.cycle_ns * 1e-9)
     ch._outputs()
-    _exchange_buffers(bank, g, decode=False)
+    _exchange_buffers(bank, g, took=False, sent=True)
     _rebased(bank, r)
 
 
@@ -267,22 +268,25 @@ def _rebased(bank: AxisBank, r: int) -> None:
     res.follow_drive(bank.axes[r])
 
 
-def _exchange_buffers(bank: AxisBank, g: _Group, decode: bool) -> None:
+def _exchange_buffers(bank: AxisBank, g: _Group, took: bool, sent: bool) -> None:
     """Group ``g``'s drive's buffers and the image as its exchange leaves them
-    (EmulatedBackend.exchange_one): its outputs from the image (``decode``: into its
-    objects, as its step begins), its objects encoded and its inputs into the image."""
+    (EmulatedBackend.exchange_one): ``took``, its outputs from the image into its objects,
+    as its step begins; ``sent``, its objects encoded and its inputs into the image, as it
+    ends."""
     backend = bank.ctl.backend
     plan = backend._one_plan
     if plan is None or plan[0] is not backend._plan:
         plan = backend._one_plan = (backend._plan, {e[0].position: e for e in backend._plan})
     slave, out, inp = plan[1][g.position]
     image = backend.image
-    if out is not None:
-        image.to_slave(out, slave.rx)
     codec = slave.codec
-    if decode and len(slave.rx) >= codec.rx_bytes:
-        codec.decode(slave.rx)
-    if len(slave.tx) >= codec.tx_bytes:
-        codec.encode(slave.tx)
-    if inp is not None:
-        image.from_slave(inp, slave.tx)
+    if took:
+        if out is not None:
+            image.to_slave(out, slave.rx)
+        if len(slave.rx) >= codec.rx_bytes:
+            codec.decode(slave.rx)
+    if sent:
+        if len(slave.tx) >= codec.tx_bytes:
+            codec.encode(slave.tx)
+        if inp is not None:
+            image.from_slave(inp, slave.tx)
