@@ -94,6 +94,7 @@ from .._attrs import in_array, own_dict
 from ..master.clock import ClockMode
 from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
+from .bank_home_rows import switch_released, switch_to_homing
 from .bank_kernel import MAXSEG, NTPRM, OUT_FIN, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import settled as kernel_settled
@@ -512,7 +513,7 @@ class AxisBank:
         self._opened_marks: tuple[int, tuple[int, int]] = (-1, (-1, -1))
         #: where a group's output bytes lie in the raw-write checks' references, per
         #: claimed pattern (:meth:`_took_group`)
-        self._took_at: dict[int, tuple[Any, list[tuple[int, int, int]]]] = {}
+        self._took_at: dict[int, tuple[Any, int | None]] = {}
         #: each group's output bytes in the image (607Ah aside): their count and a function
         #: giving their values from the image (made when asked)
         self._grp_pos: dict[int, tuple[int, Callable[[Any], Any]]] = {}
@@ -592,6 +593,11 @@ class AxisBank:
         #: frozen row and left it claimed, that gave it back for the call where per-cycle
         #: hooks run (statistics; the differential tests check each way ran)
         self.calls_opened = self.calls_kept = self.calls_held_out = 0
+        #: switches to homing mode run on the row (gtecat.controller.bank_home_rows;
+        #: statistics), and the row switching now (-1: none)
+        self.home_switches = 0
+        self.home_switch = -1
+        self.home_switch_from = 0
         #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
         #: (:meth:`call_in_place`; statistics)
         self.trap_holds = 0
@@ -2101,6 +2107,8 @@ class AxisBank:
         self.layout += 1
         if r != self._stepping:  # (a row stepped in place: its objects hold its state)
             self._put_back(r)
+        if r == self.home_switch:  # (given back while its drive switches: bank_home_rows)
+            switch_released(self, r)
         # (_reindex counts these over every row: a row given back has them clear; jog, hm,
         # h_done and frz are cleared by _put_back, and a row stepped in place has none)
         self.dwatch[r] = self.dpost[r] = self.lvel[r] = 0
@@ -2306,6 +2314,11 @@ class AxisBank:
                     self._close_in_place(r, g, objs, homing_objects)
                 else:
                     self._close_opened(r, g)
+        mode = values[1] if len(values) == 2 else None  # (a list from a first call's binder)
+        if proto.name == "GT_SetHomingMode" and type(mode) is int and mode == 6:
+            done = switch_to_homing(self, ctl, r, g)
+            if done is not None:
+                return done
         self._open_row(r, g, True)
         try:
             return call()
@@ -2379,10 +2392,10 @@ class AxisBank:
         if now == snap[start:stop].tobytes():
             return
         snap[start:stop] = np.frombuffer(now, np.uint8)
-        ref = bytearray(self._rx_ref)
-        for k, _, j in self._took_entries(gi):
-            ref[j] = now[k - start]
-        self._rx_ref = bytes(ref)
+        at = self._took_entries(gi)
+        if at is not None:  # (the group's bytes lie together among the claimed ones')
+            ref = self._rx_ref
+            self._rx_ref = ref[:at] + now + ref[at + stop - start :]
 
     def _group_outputs(self, gi: int) -> tuple[bytes, int, int]:
         """Group ``gi``'s output bytes (607Ah aside) as the image holds them now, and where
@@ -2418,18 +2431,15 @@ class AxisBank:
         now, start, stop = self._group_outputs(gi)
         return now == self._rx_snap[start:stop].tobytes()
 
-    def _took_entries(self, gi: int) -> list[tuple[int, int, int]]:
-        """Claimed group ``gi``'s output bytes: (index in the references of every output
-        byte, its byte in the image, its index in those of the claimed ones), per pattern."""
+    def _took_entries(self, gi: int) -> int | None:
+        """Where claimed group ``gi``'s output bytes begin in the references of the claimed
+        ones (:attr:`_rx_ref`), per pattern; None when the pattern leaves the group out."""
         at = self._took_at.get(gi)
         if at is None or at[0] is not self._rx_idx:
-            start, stop = self._rx_start[gi], self._rx_start[gi + 1]
             before = self._claimed_before(gi)
             at = self._took_at[gi] = (
                 self._rx_idx,
-                []
-                if before is None
-                else [(k, int(self._rx_all[k]), before + k) for k in range(start, stop)],
+                None if before is None else before + self._rx_start[gi],
             )
         return at[1]
 

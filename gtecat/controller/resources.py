@@ -373,13 +373,7 @@ class AxisResources:
                 self._rebase()
         # --- not driving: the plan follows the drive
         if not (ax.servo_on and csp) and self._act is not None:
-            a = (self._act.get() - ax.drive_offset) / (1 << ax.pos_scale)
-            ax.prf_pos = a
-            self._a_last = a
-            planner = self.profile.planner
-            p = self.prf_link.source(a)
-            if p != planner.pos or not planner.done:
-                planner.hold(p)
+            self.follow_drive(ax)
         # --- encoder
         raw = self._raw_source()
         if raw is not None:
@@ -426,6 +420,17 @@ class AxisResources:
         band = self.band
         if band.band > 0:
             band.update(t_ns, planner.done, err)
+
+    def follow_drive(self, ax: Axis) -> None:
+        """Not driving (servo off, or a drive mode other than CSP): the planned position and
+        the plan follow 6064h."""
+        a = (self._act.get() - ax.drive_offset) / (1 << ax.pos_scale)
+        ax.prf_pos = a
+        self._a_last = a
+        planner = self.profile.planner
+        p = self.prf_link.source(a)
+        if p != planner.pos or not planner.done:
+            planner.hold(p)
 
     def _rebase(self) -> None:
         """Positions from the drive again (another drive mode, GT_Reset): offsets dropped."""
