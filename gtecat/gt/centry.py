@@ -135,6 +135,9 @@ class _Api(ctypes.Structure):
         ("b_size", ctypes.c_ssize_t),
         ("bytes_new", _VP),
         ("float_new", _VP),
+        ("simple_meta", _VP),
+        ("struct_meta", _VP),
+        ("union_meta", _VP),
     ]
 
 
@@ -938,6 +941,9 @@ def _load() -> tuple[Maker | None, str]:
             size_at,
             _address("PyBytes_FromStringAndSize"),
             _address("PyFloat_FromDouble"),
+            id(type(ctypes.c_int)),
+            id(type(ctypes.Structure)),
+            id(type(ctypes.Union)),
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -1601,11 +1607,14 @@ def _self_test_raw(make_raw: Maker) -> str:
         import numpy as np
     except ImportError:
         np = None  # type: ignore[assignment]
-    taken = (U8, bytearray, bytes, memoryview, *(() if np is None else (np.ndarray,)))
+    W, S = ctypes.c_ushort, TwoBytes
+    taken = (U8, W, S, bytearray, bytes, memoryview, *(() if np is None else (np.ndarray,)))
 
     def value(*a: Any) -> Any:  # ([slave,] offset, size, type): inside the image, U8 only
         offset, size, tp = a[-3:]
         if tp not in taken or offset + size > 16 or size > 8:
+            return nope
+        if tp in (W, S) and size > 2:  # (runs_of's check of a ctypes type's size)
             return nope
         if len(a) == 4 and a[0] != 2:
             return nope
@@ -1653,8 +1662,22 @@ def _self_test_raw(make_raw: Maker) -> str:
         (bget, (4, 8), lambda: (o := memoryview(bytearray(7)), o, None)),  # too short
         (bget, (4, 3), lambda: (o := memoryview(bytes(8)), o, None)),  # (read only)
         (bget, (4, 3), lambda: (o := memoryview(bytearray(16))[::2], o, None)),
-        (bget, (4, 2), lambda: (o := memoryview(bytearray(8)).cast("H"), o, None)),
+        # a memoryview of numbers: its bytes (as the table takes it)
+        (
+            bget,
+            (4, 2),
+            lambda: (o := memoryview(bytearray(8)).cast("H"), o, bytes([4, 5] + [0] * 6)),
+        ),
+        (bget, (4, 2), lambda: (o := memoryview(bytearray(8)).cast("P"), o, None)),  # pointers
         (bget, (4, 3), lambda: (o := _released(), o, None)),
+        # a ctypes number or structure (a word of IO), byref of one: its memory
+        (get, (4, 2), lambda: (o := W(), o, bytes([4, 5]))),
+        (get, (4, 2), lambda: (o := W(), ctypes.byref(o), bytes([4, 5]))),
+        (get, (4, 2), lambda: (o := S(), ctypes.byref(o), bytes([4, 5]))),
+        (get, (4, 3), lambda: (o := W(), o, None)),  # (bigger than it)
+        (get, (4, 2), lambda: (o := W(), ctypes.byref(o, 1), None)),  # past its end
+        (get, (4, 2), lambda: (o := ctypes.c_short(), o, None)),  # (a type value refuses)
+        (get, (4, 2), lambda: (o := ctypes.c_ushort(), ctypes.pointer(o), None)),
     ]
     if np is not None:
         ro = np.zeros(8, np.uint8)
@@ -1662,9 +1685,18 @@ def _self_test_raw(make_raw: Maker) -> str:
         cases += [
             (bget, (4, 8), lambda: (o := np.zeros(8, np.uint8), o, bytes(range(4, 12)))),
             (bget, (4, 8), lambda: (o := np.zeros(7, np.uint8), o, None)),  # too short
-            (bget, (4, 3), lambda: (o := np.zeros(8, np.int8), o, None)),  # another dtype
+            # another dtype, another shape: its bytes, C-contiguous (as the table takes it)
+            (bget, (4, 3), lambda: (o := np.zeros(8, np.int8), o, bytes([4, 5, 6, *[0] * 5]))),
+            (bget, (4, 2), lambda: (o := np.zeros(1, np.uint16), o, bytes([4, 5]))),
             (bget, (4, 3), lambda: (o := np.zeros(16, np.uint8)[::2], o, None)),
-            (bget, (4, 3), lambda: (o := np.zeros((2, 8), np.uint8), o, None)),
+            (bget, (4, 3), lambda: (o := np.zeros(1, np.uint16), o, None)),  # too short
+            (bget, (4, 2), lambda: (o := np.zeros(4, np.uint16)[::2], o, None)),
+            (bget, (4, 2), lambda: (o := np.zeros(2, object), o, None)),  # Python objects
+            (
+                bget,
+                (4, 3),
+                lambda: (o := np.zeros((2, 8), np.uint8), o, bytes([4, 5, 6, *[0] * 13])),
+            ),
             (bget, (4, 3), lambda: (ro, ro, None)),  # (read only)
         ]
     for fn, before, made in cases:
@@ -1729,6 +1761,12 @@ def _self_test_raw(make_raw: Maker) -> str:
         if got != 0 or bytes(image)[1:3] != bytes(src) or counts != (want_hits, want_asked):
             return f"a keeping raw writer answered {got!r} for {src!r}: {hits!r} {asked!r}"
     return ""
+
+
+class TwoBytes(ctypes.Structure):
+    """A structure of two bytes (the raw entries' self-test)."""
+
+    _fields_ = [("lo", ctypes.c_ubyte), ("hi", ctypes.c_ubyte)]
 
 
 def _released() -> memoryview:
@@ -1827,15 +1865,16 @@ def raw(
     changed: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
-    ctypes array (or ``byref`` of one, with an offset too: C's ``&buf[k]``, where the
-    ``size`` bytes from there end within the array), a bytearray, a one-dimensional
-    C-contiguous numpy array of uint8 or a memoryview of format ``B`` (one dimension,
-    C-contiguous) of at least ``size`` bytes (or bytes, where ``write``; writable, where
-    not) and plain ints copies the runs that
-    ``value([slave,] offset, size, type(buffer))`` gives between the buffer and the image
-    (into the image where ``write``): ``(first byte in the buffer, address, bytes)`` as
+    ctypes array, number or structure (or ``byref`` of one, with an offset too: C's
+    ``&buf[k]``, where the ``size`` bytes from there end within the object: a ``c_ushort``
+    for a word of IO), a bytearray, a C-contiguous numpy array of numbers (any dtype and
+    shape: its bytes) or a C-contiguous memoryview of a plain number format of at least
+    ``size`` bytes (or bytes, where ``write``; writable, where not) and plain ints copies the
+    runs that ``value([slave,] offset, size, type(buffer))`` gives between the buffer and the
+    image (into the image where ``write``): ``(first byte in the buffer, address, bytes)`` as
     native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
-    where the entry must not answer (it checks a ctypes array's type and size); every other
+    where the entry must not answer (it checks a ctypes type's size and that its memory holds
+    no pointers); every other
     call: ``fallback``; ``gate``: as :func:`reader`'s (a gated reader keeps its runs for
     their epoch).  ``changed``: a writer's call where the write changed a byte of the image
     (its ``value`` then must not make the epoch grow itself: a gated writer keeps its runs

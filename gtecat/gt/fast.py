@@ -1740,6 +1740,14 @@ def _raw_code(code: str, name: str) -> str:
 
 
 _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
+#: the ctypes objects a raw function copies into or out of (their memory, where it holds no
+#: pointers: holds_pointers): arrays, simple types (``c_ushort``: a word of IO), structures
+_CDATA = (ctypes.Array, ctypes._SimpleCData, ctypes.Structure, ctypes.Union)
+#: their metatypes (byref_target: ``byref(x)`` of any of them)
+_CDATA_METAS = [type(t) for t in _CDATA]
+#: a memoryview's formats a raw function copies bytes into or out of: one native number type
+#: (the table path reads them as numpy does; csrc/centry.c plain_format)
+_PLAIN_FORMATS = frozenset(o + c for c in "bBhHiIlLqQfd?" for o in ("", "@", "=", "<", ">", "!"))
 _CAST: Any = object()
 _NUMPY: Any = object()
 _BYTES_NP = np.dtype(np.uint8)
@@ -1789,8 +1797,10 @@ def fast_raw(
 ) -> Callable[..., int]:
     """``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` (and the IO pair, slave first) with the
     fast path in front of the table: ``(int offset, int size, buffer)`` on the in-process
-    controller with every slave online, the buffer a ctypes array, a bytearray, a one-byte
-    numpy array or memoryview (and for writes ``bytes`` too) holding at least ``size`` bytes.
+    controller with every slave online, the buffer a ctypes array, number or structure (a
+    ``c_ushort`` for a word of IO; ``byref`` of one), a bytearray, a C-contiguous numpy array
+    of numbers or memoryview of a plain number format (and for writes ``bytes`` too) holding
+    at least ``size`` bytes: its memory's bytes, as the table path copies them.
     Into or from a bytearray, memoryview or bytes, a range of a few runs of the process image
     (a slave's outputs, its inputs) is copied run by run as slices; otherwise one numpy copy
     through a cached view; anything else takes the table path."""
@@ -1802,7 +1812,7 @@ def fast_raw(
     #: byte views of the caller's numpy buffers, the last few (kept alive)
     views: dict[tuple[int, int], tuple[Any, np.ndarray]] = {}
     copyto, frombuffer, u8 = np.copyto, np.frombuffer, np.uint8
-    sizeof, Array = ctypes.sizeof, ctypes.Array
+    sizeof = ctypes.sizeof
 
     def view(p: Any, tp: type, size: int) -> np.ndarray | None:
         """``size`` bytes of the caller's buffer as a numpy array (None: not a fast shape)."""
@@ -1810,16 +1820,16 @@ def fast_raw(
         v = views.get(key)
         if v is not None and v[0] is p:
             return v[1]
-        if issubclass(tp, Array):
+        if issubclass(tp, _CDATA):
             if sizeof(p) < size or holds_pointers(tp):  # (py_object, pointers: the table's 7)
                 return None
             arr = frombuffer(p, u8, size)
         elif tp is _NDARRAY:
-            if p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous or p.size < size:
+            if p.dtype.hasobject or not p.flags.c_contiguous or p.nbytes < size:
                 return None
             if not write and not p.flags.writeable:
                 return None
-            arr = p[:size]
+            arr = p.reshape(-1).view(u8)[:size]
         elif tp is bytearray or tp is memoryview or (write and tp is bytes):
             # never kept: a cached view would stop the caller resizing a bytearray
             if tp is memoryview and (p.format != "B" or p.ndim != 1 or not p.c_contiguous):
@@ -1888,17 +1898,17 @@ def fast_raw(
         runs = plan[0]
         if tp is bytearray or (write and tp is bytes):
             ok = []
-        elif tp is memoryview:
-            ok = ['p.format == "B"', "p.ndim == 1"]
-        elif issubclass(tp, Array) and sizeof(tp) >= size and not holds_pointers(tp):
-            ok = []  # (an array of pointers or py_object is not raw memory: the table's 7)
-        elif tp is _NDARRAY:
-            ok = ["p.dtype == _BYTES_NP", "p.ndim == 1"]
+        elif tp is memoryview:  # (numbers: pack_into / unpack_from check the rest)
+            ok = ["p.format in _PLAIN_FORMATS"]
+        elif issubclass(tp, _CDATA) and sizeof(tp) >= size and not holds_pointers(tp):
+            ok = []  # (pointers or py_object are not raw memory: the table's 7)
+        elif tp is _NDARRAY:  # (any numbers: pack_into / unpack_from check the rest)
+            ok = ["not p.dtype.hasobject"]
         else:
             return None
         check = [f"if not ({' and '.join(ok)}): return False"] if ok else []
         fmt = struct.Struct("".join(f"{n}s" for _, _, n in runs))
-        env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP}
+        env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP, "_PLAIN_FORMATS": _PLAIN_FORMATS}
         cells = []
         for k, (_, first, n) in enumerate(runs):
             env[f"c{k}"] = (ctypes.c_char * n).from_buffer(image.buffer, first)
@@ -1943,7 +1953,7 @@ def fast_raw(
     entries: dict[tuple, Any] = {}
 
     env = {
-        "ARRAY_TARGET": byref_target.target([type(ctypes.Array)]) if BYREF_TARGET else None,
+        "ARRAY_TARGET": byref_target.target(_CDATA_METAS) if BYREF_TARGET else None,
         "LAST": (-1, -1, None, -1, None, False),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
@@ -2087,6 +2097,86 @@ def fast_raw(
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
     return public
+
+
+BIT_WRITE = "GT_EcatIOBitWriteOutput"
+
+
+def fast_bit_write(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_EcatIOBitWriteOutput(slave, offset, bit, value)`` with the fast path in front of
+    the table: plain ints, ``bit`` 0..7 and ``value`` 0 or 1 (the table's ranges), on the
+    in-process controller of core 1 with every slave online, an output byte of the slave's
+    region (:func:`fast_raw`'s conditions for a write): the bit is set or cleared in that
+    byte of the process image directly, as GT_EcatIOWriteOutput's fast path writes its bytes
+    (the readers' epoch grows where the byte changed); anything else takes the table path,
+    which says why."""
+    #: (slave, offset) -> a c_ubyte over its output byte of the image (None: the table's)
+    cells: dict[tuple[int, int], Any] = {}
+    #: the image the cells are of, and the latest call's (slave, offset, cell)
+    memo: list[Any] = [None, -1, -1, None]
+
+    def cell(image: Any, slave: int, offset: int) -> Any:
+        if image is not memo[0]:
+            cells.clear()
+            memo[0] = image
+        c = cells.get((slave, offset), _NO)
+        if c is _NO:
+            c = None
+            slaves = image.layout.slaves
+            if 0 <= slave < len(slaves) and 0 <= offset < slaves[slave].out_bytes:
+                plan = _plan(image, slaves[slave].gt_offset + offset, 1, True)
+                if plan is not None and plan[0]:
+                    c = ctypes.c_ubyte.from_buffer(image.buffer, plan[0][0][1])
+            if len(cells) >= 256:
+                cells.clear()
+            cells[(slave, offset)] = c
+        memo[1:] = slave, offset, c
+        return c
+
+    def gt(
+        slave: Any = _NO, offset: Any = _NO, bit: Any = _NO, value: Any = _NO, /, *extra: Any,
+        **kw: Any,
+    ) -> int:  # fmt: skip
+        if (
+            type(bit) is int
+            and 0 <= bit <= 7
+            and (value == 0 or value == 1)
+            and type(value) is int
+            and type(slave) is int
+            and type(offset) is int
+            and not extra
+            and not kw
+            and session.plain  # (in this process, core 1)
+        ):
+            ctl = session.controllers.get(1)
+            if ctl is not None:
+                m = ctl.master
+                clock = ctl.clock
+                if m is not None and m.opened and not m.offline and clock._thread is None:
+                    image = m.image
+                    if slave == memo[1] and offset == memo[2] and image is memo[0]:
+                        c = memo[3]
+                    else:
+                        c = cell(image, slave, offset)
+                    if c is not None:
+                        old = c.value
+                        new = (old | (1 << bit)) if value else (old & ~(1 << bit))
+                        if new != old:
+                            c.value = new
+                            EPOCH.n += 1  # (the readers' C entries ask again: epoch.py)
+                        session.last = None
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+        return slow(*(a for a in (slave, offset, bit, value) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
 
 
 #: the public raw function specialised for the shape of the latest call (a polling loop
@@ -2286,13 +2376,13 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
             "        p = ARRAY_TARGET(p)  # (one C call: the array, else p itself)"
             if env.get("ARRAY_TARGET") is not None
             else "        q = p._obj\n"
-            "        if isinstance(q, _Array) and {address} == _addressof(q):\n"
+            "        if isinstance(q, _CDATA) and {address} == _addressof(q):\n"
             "            p = q"
         ),
     )
     code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
-    env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof, EPOCH=EPOCH)
+    env.update(_CArg=_CArg, _CDATA=_CDATA, _addressof=_addressof, EPOCH=EPOCH)
     code = _raw_code(code, env["name"])
     exec(_compiled_code(code, f"<gt fast raw {env['name']}>"), env)  # env: its globals
     return env["gt"]
@@ -3600,6 +3690,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         CORE: fast_core,
         HOMING: fast_homing_status,
         HOME_STATUS: fast_home_status,
+        BIT_WRITE: fast_bit_write,
     }
     for names, make in (
         (MULTI_READERS, fast_multi),

@@ -138,6 +138,10 @@ struct api {
     obj (*bytes_new)(const char *, ptrdiff_t);
     /* PyFloat_FromDouble: one axis's double made again (kept) */
     obj (*float_new)(double);
+    /* the metatypes of ctypes' simple types, structures and unions (array_meta: arrays'):
+     * a raw entry copies into or out of any such object whose memory is raw (its value
+     * function checks the type: no pointers, big enough) */
+    obj simple_meta, struct_meta, union_meta;
 };
 
 #define MAX_TYPES 16
@@ -269,7 +273,8 @@ int gtecat_centry_api(const struct api *api)
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
         !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
-        api->b_size <= 0 || !api->bytes_new || !api->float_new)
+        api->b_size <= 0 || !api->bytes_new || !api->float_new || !api->simple_meta ||
+        !api->struct_meta || !api->union_meta)
         return 1;
     A = *api;
     ready = 1;
@@ -1232,19 +1237,29 @@ static int take_recipe(obj *items, struct recipe *rc)
 static struct aslot *lane(struct aslot *s, ptrdiff_t n, long long an, long long ac, obj tp,
                           long long clk)
 {
+    static size_t turn; /* (the lanes taken in turn where none is older) */
     struct aslot *pick;
     ptrdiff_t k;
+    long long newest;
     if (!s)
         return NULL;
     if (n < 1)
         n = 1;
     pick = s;
+    newest = s[0].epoch;
     for (k = 0; k < n; k++) {
         if (s[k].value && s[k].n == an && s[k].count == ac && s[k].tp == tp && s[k].clock == clk)
             return &s[k];
         if (pick->value && (!s[k].value || s[k].epoch < pick->epoch))
             pick = &s[k];
+        if (s[k].epoch > newest)
+            newest = s[k].epoch;
     }
+    /* every lane full and of the same epoch (a lockstep program reading ranges in turn,
+     * no cycle between): not always the first, which two ranges read in turn would take
+     * from each other at every call */
+    if (pick->value && pick->epoch == newest)
+        pick = &s[turn++ % (size_t)n];
     return pick;
 }
 
@@ -1738,10 +1753,24 @@ struct pybuf {
 #define ND_C 0x0001
 #define ND_W 0x0400
 
-/* A memoryview's bytes as the Python fast path takes them (format "B", one dimension,
- * C-contiguous, at least size bytes, writable to read into): the view held in *view (given
- * back with A.release_buffer; while held the memoryview cannot be released nor its
- * bytearray resized), its memory; NULL (nothing held, no error left) where it is not. */
+/* A buffer format the table path takes as plain memory (numpy reads it: one native number
+ * type, or none given, which means bytes); anything else (Python objects, structures,
+ * formats numpy does not read) the Python path answers. */
+static int plain_format(const char *f)
+{
+    if (!f)
+        return 1;
+    if (*f == '@' || *f == '=' || *f == '<' || *f == '>' || *f == '!')
+        f++;
+    return f[0] && !f[1] && strchr("bBhHiIlLqQfd?", f[0]) != NULL;
+}
+
+/* A memoryview's (or a numpy array's of another kind than the bytes raw_mem takes) memory
+ * as the table path takes it: C-contiguous (any shape), of a plain format (plain_format), at
+ * least size bytes, writable to read into: the view held in *view (given back with
+ * A.release_buffer; while held the memoryview cannot be released nor its bytearray resized,
+ * nor the array's memory moved), its memory; NULL (nothing held, no error left) where it is
+ * not. */
 static char *view_mem(const struct raw_entry *e, obj p, long long size, struct pybuf *view)
 {
     int flags = PYBUF_FORMAT | PYBUF_C_CONTIGUOUS | (e->write ? 0 : PYBUF_WRITABLE);
@@ -1749,12 +1778,17 @@ static char *view_mem(const struct raw_entry *e, obj p, long long size, struct p
         A.err_clear(); /* (released, read only, not contiguous: the Python path says) */
         return NULL;
     }
-    if (view->ndim != 1 || view->itemsize != 1 || view->len < size || !view->buf ||
-        !view->format || view->format[0] != 'B' || view->format[1]) {
+    if (view->len < size || !view->buf || !plain_format(view->format)) {
         A.release_buffer(view);
         return NULL;
     }
     return (char *)view->buf;
+}
+
+/* a ctypes object's type's metatype: an array, simple, structure or union type */
+static int cdata_meta(obj m)
+{
+    return m == A.array_meta || m == A.simple_meta || m == A.struct_meta || m == A.union_meta;
 }
 
 /* The buffer a raw entry copies into or out of (target: p, or the array of a byref of one
@@ -1783,10 +1817,10 @@ static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long siz
             return NULL;
         return t == A.bytes_type ? (char *)p + A.bdata : AT(p, A.bastart);
     }
-    if (TYPE(t) != A.array_meta)
+    if (!cdata_meta(TYPE(t)))
         return NULL;
     if (target != p) {
-        /* byref(array[, offset]) (C's &array[k]): its address, where the size's bytes from
+        /* byref(x[, offset]) (C's &array[k], &x): its address, where the size's bytes from
          * there end within the object (the table path's room: ctypes.sizeof of it; any byte
          * offset, as the table path's byte pointer takes it); else (past the end, before
          * the start, the array's memory moved since) the Python path answers */
@@ -1831,8 +1865,10 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             A.err_clear();
         goto python;
     }
-    if (TYPE(target) == A.memoryview_type) {
-        /* (held from here to the copy: nothing can release or resize it meanwhile) */
+    if (TYPE(target) == A.memoryview_type ||
+        (TYPE(target) == A.ndarray_type && !raw_mem(e, p, target, size))) {
+        /* (held from here to the copy: nothing can release or resize it meanwhile; a numpy
+         * array other than raw_mem's bytes: its memory as the buffer protocol gives it) */
         if (target != p || !view_mem(e, p, size, &view))
             goto python;
         mv = 1;
