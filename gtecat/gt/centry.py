@@ -138,6 +138,11 @@ class _Api(ctypes.Structure):
         ("simple_meta", _VP),
         ("struct_meta", _VP),
         ("union_meta", _VP),
+        ("pointer_meta", _VP),
+        ("voidp_type", _VP),
+        ("charp_type", _VP),
+        ("wcharp_type", _VP),
+        ("tuple_items", ctypes.c_ssize_t),
     ]
 
 
@@ -775,7 +780,8 @@ def _callable_type() -> type:
     after that) and take attributes (an instance dict after those two words).  Made with
     ``PyType_FromSpec`` (stable ABI; the slot and flag numbers are the ABI's own): the
     ``__vectorcalloffset__`` and ``__dictoffset__`` members, ``__dict__`` the interpreter's
-    generic one, ``tp_call`` the interpreter's ``PyVectorcall_Call``."""
+    generic one, ``tp_call`` the interpreter's ``PyVectorcall_Call``; after the weak-reference
+    list the tuple of the function's parameter names (:func:`keyword_names`)."""
     T_PYSSIZET, READONLY = 19, 1
     Py_tp_call, Py_tp_members, Py_tp_getset = 50, 72, 73
     HAVE_VECTORCALL, DEFAULT = 1 << 11, 1 << 18
@@ -799,7 +805,7 @@ def _callable_type() -> type:
         _TypeSlot(Py_tp_getset, ctypes.addressof(getset)),
     )
     spec = _TypeSpec(
-        b"gtecat.gt.centry.entry", _HEAD + 4 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
+        b"gtecat.gt.centry.entry", _HEAD + 5 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
     )
     make = ctypes.PYFUNCTYPE(ctypes.py_object, _VP)(("PyType_FromSpec", ctypes.pythonapi))
     t = make(ctypes.addressof(spec))
@@ -815,6 +821,25 @@ def _callable_type() -> type:
     if vars(probe) != {"attribute": 1}:
         raise ValueError("an entry callable keeps no attributes")
     return t  # type: ignore[no-any-return]
+
+
+def keyword_names(public: Any, names: Iterable[str]) -> bool:
+    """Let the C entry ``public`` answer a call that names its arguments as the table does
+    (``GT_GetSts(axis=1, pSts=byref(s))``): ``names`` its parameters in order, interned (a
+    call site's keyword names are); a keyword call whose names are the parameters after its
+    positional arguments, in their order, is then answered as that positional call
+    (csrc/centry.c ``positional``).  False where ``public`` is not an entry callable (a
+    ``functools.partial``: its keyword calls go the Python way, as before)."""
+    if not callables_made or type(public) is not callables_made[0]:
+        return False
+    kept = tuple(sys.intern(n) for n in names)
+    _KEEP.append(kept)
+    ctypes.c_void_p.from_address(id(public) + _HEAD + 4 * _WORD).value = id(kept)
+    return True
+
+
+#: the entry callable type made (:func:`_callable_type`; none: the entries are partials)
+callables_made: list[type] = []
 
 
 def _address(name: str) -> int:
@@ -944,6 +969,11 @@ def _load() -> tuple[Maker | None, str]:
             id(type(ctypes.c_int)),
             id(type(ctypes.Structure)),
             id(type(ctypes.Union)),
+            id(type(ctypes.POINTER(ctypes.c_int))),
+            id(ctypes.c_void_p),
+            id(ctypes.c_char_p),
+            id(ctypes.c_wchar_p),
+            titems,
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -971,6 +1001,7 @@ def _load() -> tuple[Maker | None, str]:
     except Exception as e:  # (the partial of a built-in function instead)
         log.debug("entry callables: %s", e)
         callables = []
+    callables_made[:] = callables
 
     def public(fn: Any, address: int, e: Any, keep: Any) -> Any:
         """The public function of an entry: a callable of :func:`_callable_type` calling the

@@ -142,6 +142,12 @@ struct api {
      * a raw entry copies into or out of any such object whose memory is raw (its value
      * function checks the type: no pointers, big enough) */
     obj simple_meta, struct_meta, union_meta;
+    /* the metatype of ctypes' pointer types (POINTER(c_uint32)) and the simple types that
+     * hold a pointer (c_void_p, c_char_p, c_wchar_p): such an object whose value is NULL is
+     * a NULL pointer argument, as None and 0 are */
+    obj pointer_meta, voidp_type, charp_type, wcharp_type;
+    /* where a tuple keeps its first item (its length: where a bytes object's is) */
+    ptrdiff_t tuple_items;
 };
 
 #define MAX_TYPES 16
@@ -274,7 +280,8 @@ int gtecat_centry_api(const struct api *api)
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
         !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
         api->b_size <= 0 || !api->bytes_new || !api->float_new || !api->simple_meta ||
-        !api->struct_meta || !api->union_meta)
+        !api->struct_meta || !api->union_meta || !api->pointer_meta || !api->voidp_type ||
+        !api->charp_type || !api->wcharp_type || api->tuple_items <= 0)
         return 1;
     A = *api;
     ready = 1;
@@ -926,10 +933,37 @@ obj gtecat_centry_wait(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
     return wait_call((const struct wait_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
 }
 
+/* A call with keywords (GT_GetSts(axis=1, pSts=byref(s))) whose names are the function's
+ * next parameters in their order (names: the tuple of them all, the word after an entry
+ * callable's weak-reference list; NULL: none known) is its positional call: the values
+ * follow the positional ones in args already.  The names are compared as objects (the
+ * compiler interns a call's keyword names, the loader the parameters'): any other name, order
+ * or spelling keeps its keywords, and the Python path answers it. */
+static void positional(obj callable, ptrdiff_t *nargs, obj *kwnames)
+{
+    obj names = *(obj *)((char *)callable + A.vc_entry + 3 * (ptrdiff_t)sizeof(obj));
+    ptrdiff_t nk, nn, k;
+    obj *kw, *nm;
+    if (!names || !*kwnames)
+        return;
+    nk = *(ptrdiff_t *)((char *)*kwnames + A.bsize);
+    nn = *(ptrdiff_t *)((char *)names + A.bsize);
+    if (nk <= 0 || *nargs + nk > nn)
+        return;
+    kw = (obj *)((char *)*kwnames + A.tuple_items);
+    nm = (obj *)((char *)names + A.tuple_items) + *nargs;
+    for (k = 0; k < nk; k++)
+        if (kw[k] != nm[k])
+            return;
+    *nargs += nk;
+    *kwnames = NULL;
+}
+
 obj gtecat_centry_wait_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return wait_call((const struct wait_entry *)AT(callable, A.vc_entry), args,
-                     (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return wait_call((const struct wait_entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 /* The index of tp among the NULL-ended types (at most n of them), its size and sign in
@@ -969,13 +1003,29 @@ static char *typed_mem(obj p, obj const *types, const ptrdiff_t *sizes, const pt
     return reader_mem(p, target, derefs ? (obj)derefs[k] : NULL);
 }
 
+/* a NULL pointer argument: None, 0, or a ctypes pointer (POINTER(t)(), c_void_p(),
+ * c_char_p(None), ...) whose value is NULL */
+static int null_arg(obj a)
+{
+    obj t;
+    char *at;
+    if (a == A.none || a == A.zero || int_is(a, 0))
+        return 1;
+    t = TYPE(a);
+    if (TYPE(t) != A.pointer_meta && t != A.voidp_type && t != A.charp_type &&
+        t != A.wcharp_type)
+        return 0;
+    at = AT(a, A.b_ptr);
+    return at && !*(void **)at;
+}
+
 /* A span's pClock (or GT_GetClock's pLoop): NULL (omitted, None or 0: *mem NULL) or the
  * memory of byref(x) (no offset), x or pointer(x) of one of the entry's clock types (its
  * size and sign); 0 where this entry does not take it. */
 static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *sign)
 {
     *mem = NULL;
-    if (pc == A.none || pc == A.zero || int_is(pc, 0))
+    if (null_arg(pc))
         return 1;
     *mem = typed_mem(pc, e->ctypes_, e->csizes, e->csigns, e->cderefs, MAX_TYPES, size, sign);
     return *mem != NULL;
@@ -1474,8 +1524,9 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
 /* a vectorcall function: the callable keeps its entry's address at A.vc_entry */
 obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return reader((const struct entry *)AT(callable, A.vc_entry), args,
-                  (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return reader((const struct entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 /* The first element of a numpy array p an entry takes (one dimension, at least one element,
@@ -1547,7 +1598,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             goto python;
         /* q NULL, or (the entry's clock types: GT_GetClock's pLoop) byref(x), x or pointer(x):
          * the clock's cycles run written there too (clock_cycles) */
-        if (nargs == 2 && args[1] != A.none && !int_is(args[1], 0) &&
+        if (nargs == 2 && !null_arg(args[1]) &&
             (!e->ctypes_[0] || !clock_mem(e, args[1], &lmem, &lsize, &lsign) || !lmem))
             goto python;
         p = args[0];
@@ -1732,8 +1783,9 @@ obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
 
 obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return raw((const struct raw_entry *)AT(callable, A.vc_entry), args,
-               (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return raw((const struct raw_entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 /* Py_buffer (the buffer protocol's view, part of the stable ABI) and the request flags */
@@ -2025,8 +2077,9 @@ static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, 
 
 obj gtecat_centry_multi_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args,
-                 (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
@@ -2059,7 +2112,7 @@ TRY multi_try(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj
         obj a = args[k];
         ptrdiff_t want = e->extra[k - 1 - nout];
         if (want == 1 ? !(a == A.one || int_is(a, 1))
-                      : !(a == A.zero || int_is(a, 0) || (want == 2 && a == A.none)))
+                      : !(a == A.zero || int_is(a, 0) || (want == 2 && null_arg(a))))
             goto python;
     }
     for (k = 0; k < nout; k++)

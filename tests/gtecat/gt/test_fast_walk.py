@@ -39,8 +39,11 @@ CLIENT = (
     "numpy[1]",
     "null 0",
     "null None",
+    "null pointer",
+    "null c_void_p",
     "byref array",
     "byref array offset",
+    "keywords",
 )
 #: other shapes: answered as the table answers them, by whichever path (a span of the
 #: readers' values into an array: the fast path's, whose steps the walk's profile counts
@@ -92,9 +95,18 @@ def _arg(shape: str, t: type) -> tuple[object, object, tuple]:
             _HELD[t] = (o, byref(o))
         o, p = _HELD[t]
         return p, o, ()
-    if shape in ("null 0", "null None"):
+    if shape.startswith("null"):  # (NULL of any pointer type is NULL)
         o = t()
-        return byref(o), o, (0 if shape == "null 0" else None,)
+        null = {
+            "null 0": 0,
+            "null None": None,
+            "null pointer": ctypes.POINTER(ctypes.c_uint32)(),
+            "null c_void_p": ctypes.c_void_p(),
+        }[shape]
+        return byref(o), o, (null,)
+    if shape == "keywords":
+        o = t()
+        return byref(o), o, ()
     made = {
         "byref fresh": lambda: (o := t(), byref(o)),
         "object": lambda: (o := t(), o),
@@ -127,11 +139,19 @@ def _written(o: object) -> object:
     return o.value  # type: ignore[attr-defined]
 
 
-def _call(fn, args: tuple, profile: bool) -> tuple[int, int]:
+def _by_name(fn, args: tuple) -> int:
+    """``fn`` called with each argument named as the table names it, written out as a client
+    writes it (``GT_GetSts(axis=1, pSts=p)``: a call site's names, as the compiler keeps them)."""
+    names = [p.name for p in FUNCTIONS[fn.__name__].params][: len(args)]
+    src = f"fn({', '.join(f'{n}=a[{k}]' for k, n in enumerate(names))})"
+    return eval(compile(src, "<client>", "eval"), {"fn": fn, "a": args})
+
+
+def _call(fn, args: tuple, profile: bool, named: bool = False) -> tuple[int, int]:
     pr = cProfile.Profile() if profile else None
     if pr is not None:
         pr.enable()
-    rc = fn(*args)
+    rc = _by_name(fn, args) if named else fn(*args)
     if pr is None:
         return rc, 0
     pr.disable()
@@ -166,7 +186,9 @@ def _walk(names: list[str]) -> list[str]:
             got = []
             for which in (fn, fn.slow):
                 p, o, after = _arg(shape, t)
-                rc, table = _call(which, (*before, p, *shape_args, *after), which is fn)
+                rc, table = _call(
+                    which, (*before, p, *shape_args, *after), which is fn, shape == "keywords"
+                )
                 got.append((rc, _written(o), gt.GTE_GetLastError() if rc else "", table))
             if got[0][:3] != got[1][:3]:
                 bad.append(f"{name} {shape}: {got[0][:3]} != {got[1][:3]}")
