@@ -65,6 +65,10 @@ _MAX_TYPES = 16
 _VP = ctypes.c_void_p
 _WORD = ctypes.sizeof(_VP)
 
+#: :func:`raw`'s ``write`` for GT_EcatIOBitWriteOutput(slave, offset, bit, value): ``value``
+#: gives the output byte's run, the entry sets or clears the bit in it (csrc/centry.c)
+BIT_WRITE = 2
+
 
 class _Api(ctypes.Structure):
     """``struct api`` of csrc/centry.c."""
@@ -1791,6 +1795,38 @@ def _self_test_raw(make_raw: Maker) -> str:
         counts = (len(hits), len(asked))
         if got != 0 or bytes(image)[1:3] != bytes(src) or counts != (want_hits, want_asked):
             return f"a keeping raw writer answered {got!r} for {src!r}: {hits!r} {asked!r}"
+
+    def hits_one() -> None:
+        hits.append(1)
+
+    # a bit writer (slave 2's byte at the offset): the bit set or cleared, changed() where
+    # the byte changed; any other bit, value or type: Python
+    def bit_value(slave: int, offset: int, bit: int, tp: Any) -> Any:  # (slave 2's byte)
+        return runs([(0, base + offset, 1)]) if slave == 2 and tp is int else nope
+
+    bits = make_raw(python, bit_value, nope, True, BIT_WRITE, NO_GATE, None, True, hits_one)
+    image[5] = 0x10
+    for args, want_byte, want_hits in [
+        ((2, 5, 3, 1), 0x18, 1),
+        ((2, 5, 3, 1), 0x18, 0),
+        ((2, 5, 4, 0), 0x08, 1),
+        ((2, 5, 8, 1), None, 0),
+        ((2, 5, -1, 1), None, 0),
+        ((2, 5, 0, 2), None, 0),
+        ((2, 5, 0, True), None, 0),
+        ((2, 5, 0, 1.0), None, 0),
+        ((3, 5, 0, 1), None, 0),
+        ((2, 5, 0), None, 0),
+    ]:
+        del hits[:]
+        was = image[5]
+        got = bits(*args)
+        if want_byte is None:
+            ok = got == ("python", args, {}) and image[5] == was
+        else:
+            ok = got == 0 and image[5] == want_byte and len(hits) == want_hits
+        if not ok:
+            return f"a bit writer answered {got!r} for {args!r}: {image[5]:#x} {hits!r}"
     return ""
 
 
@@ -1890,7 +1926,7 @@ def raw(
     value: Callable[..., Any],
     sentinel: Any,
     io: bool,
-    write: bool,
+    write: bool | int,
     gate: int = NO_GATE,
     after: Callable[[], Any] | None = None,
     changed: Callable[[], Any] | None = None,
@@ -1910,8 +1946,10 @@ def raw(
     their epoch).  ``changed``: a writer's call where the write changed a byte of the image
     (its ``value`` then must not make the epoch grow itself: a gated writer keeps its runs
     for their epoch too, and a write of the bytes the image holds changes nothing); None: its
-    ``value`` makes the epoch grow.  None where the C entry is not available
-    (:data:`REASON`)."""
+    ``value`` makes the epoch grow.  ``write`` :data:`BIT_WRITE`: ``f(slave, offset, bit,
+    value)`` with plain ints, ``bit`` 0..7 and ``value`` 0 or 1, sets or clears that bit of
+    the one byte ``value(slave, offset, bit, int)``'s run gives.  None where the C entry is
+    not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
     return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE, changed)  # type: ignore[attr-defined]

@@ -2176,7 +2176,51 @@ def fast_bit_write(
         return slow(*(a for a in (slave, offset, bit, value) if a is not _NO), *extra, **kw)
 
     gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    if not CENTRY:
+        return gt
+    #: the C entry's runs of an output byte: (slave, offset) -> its run (centry.runs), or None
+    addresses: dict[tuple[int, int], bytes | None] = {}
+    addressed: list[Any] = [None]
+
+    def runs_of(slave: int, offset: int, image: Any) -> Any:
+        if image is not addressed[0]:
+            addresses.clear()
+            addressed[0] = image
+        at = addresses.get((slave, offset), _NO)
+        if at is _NO:
+            c = cell(image, slave, offset)
+            at = None if c is None else centry.runs([(0, ctypes.addressof(c), 1)])
+            if len(addresses) >= 256:
+                addresses.clear()
+            addresses[(slave, offset)] = at
+        if at is None:
+            return _NO
+        session.last = None  # (the C entry makes the epoch grow where the byte changed)
+        return at
+
+    venv: dict[str, Any] = {"_NO": _NO, "session": session, "runs_of": runs_of}
+    _gated(venv)
+    # (asked while the GT_ gate is open: CTL the in-process controller of core 1; the bit
+    # and the value the C entry checked, the byte's runs kept for their epoch)
+    exec(
+        _compiled_code(
+            "def value(slave, offset, bit, tp):\n"
+            "    m = CTL.master\n"
+            "    if m is not None and m.opened and not m.offline:\n"
+            "        return runs_of(slave, offset, m.image)\n"
+            "    return _NO\n",
+            f"<gt bit value {name}>",
+        ),
+        venv,
+    )
+    public = centry.raw(
+        gt, venv["value"], _NO, True, centry.BIT_WRITE, centry.GT_GATE, _after(advance, name, 0),
+        changed,
+    )  # fmt: skip
+    if public is None:
+        return gt
+    public.slow, public.python = slow, gt
+    return public
 
 
 #: the public raw function specialised for the shape of the latest call (a polling loop

@@ -1750,13 +1750,16 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     ANSWER(reader_try, e, e->gate, args, nargs, kwnames);
 }
 
+/* a raw entry's write: GT_EcatIOBitWriteOutput's (one bit of one output byte) */
+#define BIT_WRITE 2
+
 /* a raw image function's entry */
 struct raw_entry {
     obj fallback; /* the Python fast function */
     obj value;    /* value([slave,] offset, size, array type): the range's runs, or sentinel */
     obj sentinel;
     ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
-    ptrdiff_t write; /* 1: from the buffer into the image */
+    ptrdiff_t write; /* 1: from the buffer into the image; BIT_WRITE: a bit of it */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
     /* the runs kept for their epoch, a lane per range (ncache of them; n: the offset,
@@ -1891,7 +1894,7 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
     obj p, target, v, call[4], res;
     const int64_t *runs;
     long long size, off = 0, slave = -1, ep = -1, ep0 = -1;
-    int over = 0, mv = 0, diff = 0;
+    int over = 0, mv = 0, diff = 0, bit = -1, set = 0;
     char *mem;
     struct pybuf view;
     /* (a write's runs are kept only where the write makes the epoch grow itself) */
@@ -1906,6 +1909,23 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             goto python;
     p = args[2 + at];
     target = p;
+    if (e->write == BIT_WRITE) {
+        /* GT_EcatIOBitWriteOutput(slave, offset, bit, value): bit 0..7, value 0 or 1, one
+         * output byte (the value function's runs) set or cleared in place */
+        long long b = A.as_ll(args[1 + at], &over);
+        if (over || b < 0 || b > 7) {
+            if (b == -1 && !over && A.err_occurred())
+                A.err_clear();
+            goto python;
+        }
+        bit = (int)b;
+        if (p == A.one || int_is(p, 1))
+            set = 1;
+        else if (!(p == A.zero || int_is(p, 0)))
+            goto python;
+        size = 1;
+        goto shaped;
+    }
     if (TYPE(p) == A.carg_type) { /* byref(array[, offset]): the array (raw_mem) */
         target = AT(p, A.carg_obj);
         if (!target)
@@ -1927,6 +1947,7 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
     } else if (!raw_mem(e, p, target, size)) {
         goto python;
     }
+shaped:
     if (s) {
         off = A.as_ll(args[at], &over);
         if (!over && at)
@@ -1993,7 +2014,8 @@ have:
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
-    mem = mv ? (char *)view.buf : raw_mem(e, p, target, size); /* (again: Python ran) */
+    /* (again: Python ran; a bit write has no buffer: its byte is the image's own) */
+    mem = bit >= 0 ? (char *)&set : mv ? (char *)view.buf : raw_mem(e, p, target, size);
     if (!mem)
         goto drop;
     for (k = 0; k < n / 24; k++) {
@@ -2004,7 +2026,15 @@ have:
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         char *image = (char *)(intptr_t)r[1];
-        if (!e->write)
+        if (bit >= 0) {
+            unsigned char was = (unsigned char)*image;
+            unsigned char now = set ? (unsigned char)(was | (1u << bit))
+                                    : (unsigned char)(was & ~(1u << bit));
+            if (now != was) {
+                *image = (char)now;
+                diff = 1;
+            }
+        } else if (!e->write)
             memcpy(mem + r[0], image, (size_t)r[2]);
         else if (!e->changed)
             memcpy(image, mem + r[0], (size_t)r[2]);
