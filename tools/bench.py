@@ -551,6 +551,8 @@ def every_shape(
                 "byref(arr4, k)",
             )
             shapes["pointer(s)"] = ("pointer", f"fn({x}pointer(held))", "pointer(held)")
+            env["mv"] = memoryview(env["arr"])  # (memoryview(arr): the array's own path)
+            shapes["memoryview(arr)"] = ("memoryview", f"fn({x}mv)", "memoryview(arr)")
         if name == fast.CLOCK:
             # the vendor's two-pointer form GT_GetClock(&clk, &loop), as clients pass it
             env["loop"] = c_ulong()

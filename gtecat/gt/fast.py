@@ -99,6 +99,36 @@ def element_at(p: Any, ok: Any) -> Any:
         return None
 
 
+#: a ctypes array type -> its memoryview's format (view_array)
+_VIEWS: dict[type, str] = {}
+#: the last view found whole and its array (a polling loop passes the same view)
+_LAST_VIEW: list[Any] = [None, None]
+
+
+def view_array(v: memoryview) -> Any:
+    """The ctypes array ``v`` is a whole, writable view of (``memoryview(arr)``: the array's
+    own format, all its bytes), else None: a reader writes its value into that array's first
+    element as into the array itself, as the table path writes it through the view (its
+    numpy array of the same memory and element type)."""
+    try:
+        o = v.obj
+        if v is _LAST_VIEW[0]:  # (a view's object, format and size never change)
+            return _LAST_VIEW[1]
+        tp = type(o)
+        if type(tp) is not _ARRAY_META or v.readonly:
+            return None
+        own = _VIEWS.get(tp)
+        if own is None:
+            with memoryview(o) as m:
+                own = _VIEWS[tp] = m.format
+        if v.format != own or v.nbytes != ctypes.sizeof(o):
+            return None
+    except ValueError:  # (a released view: the table path says why)
+        return None
+    _LAST_VIEW[:] = v, o  # (held: its id is not another's while it is here)
+    return o
+
+
 _status = AxisResources.status
 #: a C ``short`` argument's range (the table binder's check of ``axis`` and ``count``)
 _SHORT_MIN, _SHORT_MAX = -(1 << 15), (1 << 15) - 1
@@ -245,6 +275,7 @@ def fast_reader(
         "_NDARRAY": _NDARRAY,
         "np_ok": np_ok,
         "is_array": is_array,
+        "view_array": view_array,
         "to": float if ctypes_ok is _DOUBLE else None,
         "T0": ctypes.c_double if ctypes_ok is _DOUBLE else ctypes.c_long,  # the usual type
     }
@@ -525,6 +556,7 @@ def fast_reader(
 
     env["gtn_general"] = gtn_general
     public: list[Any] = [None]  # the public function (the C entry, else gt below)
+    env["PUBLIC"] = public
     #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
     #: its core); every other shape: the table's GTN_ function (set by gt_function)
     gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
@@ -1244,7 +1276,7 @@ def _plan_code(text: str, mode: str) -> Any:
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
 _READER = """
 def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
-    global LAST_P  # the last byref object checked (kept alive, so never another's address)
+    global LAST_P  # the last byref object checked (kept alive, so never another's address){viewed}
     if (
         type(n) is int
         and not kw
@@ -1371,6 +1403,17 @@ _DELEGATE = """
                     return entry(1, n + PER_CORE * (core - 1), p, count, pClock)"""
 
 
+#: the GT_ form's ``memoryview(arr)`` of a whole ctypes array: the public function (its C
+#: entry) called with that array (view_array)
+_VIEWED = """
+    if type(p) is memoryview and not kw and not extra and is_array(type(q := view_array(p))):
+        if count is _NO:
+            return PUBLIC[0](n, q)
+        if pClock is _NO:
+            return PUBLIC[0](n, q, count)
+        return PUBLIC[0](n, q, count, pClock)"""
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
@@ -1391,6 +1434,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         ),
         bus_axis="n if core == 1 else n + PER_CORE * (core - 1)" if gtn else "n",
         delegate=_DELEGATE if gtn else "",
+        viewed="" if gtn else _VIEWED,
         session=session,
         address=address,
         fallback=(
@@ -2476,6 +2520,12 @@ SLOW_REASONS: dict[str, str] = {
 #: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
 #: other that reaches the table)
 SLOW_SHAPES: dict[str, dict[str, str]] = {}
+#: (filled below for the functions it names, once they are all declared)
+_VIEW_REASON = (
+    "a memoryview of the value's array: the axis readers (READERS) answer it as the array "
+    "itself; this function's fast path takes the array, byref of it, the object or a numpy "
+    "array, and the table path answers the view (a few microseconds)"
+)
 
 
 def fast_functions() -> frozenset[str]:
@@ -3750,3 +3800,5 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
 #: function -> the maker of its fast path, ``make(name, slow, session, advance)`` (the GT
 #: layer puts it in front of the table-checked function)
 FAST_MAKERS = _makers()
+for _name in fast_functions() - frozenset(READERS) - RAW:
+    SLOW_SHAPES.setdefault(_name, {})["memoryview"] = _VIEW_REASON

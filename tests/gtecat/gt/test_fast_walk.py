@@ -44,6 +44,7 @@ CLIENT = (
     "byref array",
     "byref array offset",
     "keywords",
+    "memoryview",
 )
 #: other shapes: answered as the table answers them, by whichever path (a span of the
 #: readers' values into an array: the fast path's, whose steps the walk's profile counts
@@ -113,6 +114,7 @@ def _arg(shape: str, t: type) -> tuple[object, object, tuple]:
         "array[1]": lambda: (o := (t * 1)(), o),
         "numpy[1]": lambda: (o := np.zeros(1, _NP.get(t, np.int64)), o),
         "byref array": lambda: (o := (t * 2)(), byref(o)),
+        "memoryview": lambda: (o := (t * 1)(), memoryview(o)),
         "byref array offset": lambda: (o := (t * 3)(), byref(o, ctypes.sizeof(t))),
         "byref array span": lambda: (o := (t * 4)(), byref(o, ctypes.sizeof(t))),
         "byref array past": lambda: (o := (t * 2)(), byref(o, 2 * ctypes.sizeof(t))),
