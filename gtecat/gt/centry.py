@@ -226,6 +226,7 @@ class _Entry(ctypes.Structure):
         ("cderefs", ctypes.c_ssize_t * _MAX_TYPES),
         ("steady", ctypes.c_ssize_t),
         ("nacache", ctypes.c_ssize_t),
+        ("viewer", _VP),
     ]
 
 
@@ -1039,6 +1040,7 @@ def _load() -> tuple[Maker | None, str]:
         clocks: Iterable[type] = (),
         numpy: Iterable[Any] = (),
         steady: bool = False,
+        viewer: Callable[[Any], Any] | None = None,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -1055,6 +1057,7 @@ def _load() -> tuple[Maker | None, str]:
         e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
         e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
         e.steady = int(steady)
+        e.viewer = id(viewer) if viewer is not None else None
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1087,7 +1090,7 @@ def _load() -> tuple[Maker | None, str]:
                 aslot = (_ASlot * SPAN_LANES)()
                 e.acache = ctypes.cast(aslot, ctypes.POINTER(_ASlot))
                 e.nacache = SPAN_LANES
-        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts)
+        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts, viewer)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -1865,6 +1868,7 @@ def reader(
     clocks: Iterable[type] = (),
     numpy: Iterable[Any] = (),
     steady: bool = False,
+    viewer: Callable[[Any], Any] | None = None,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -1895,7 +1899,9 @@ def reader(
     ``array`` give for the epoch they were asked in and writes it again while
     :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`); ``steady``:
     and across the quick cycles the entries book themselves (no Python runs in those: what
-    an attribute no cycle changes gives, a profile's mode).
+    an attribute no cycle changes gives, a profile's mode); ``viewer``: for ``p`` a
+    memoryview, ``viewer(p)`` gives the ctypes array the call is then made with (the view
+    shows all of it, of a type the reader takes), else None (``fallback``).
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -1918,6 +1924,7 @@ def reader(
         clocks,
         numpy,
         steady,
+        viewer,
     )
 
 

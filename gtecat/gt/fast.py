@@ -725,6 +725,21 @@ def fast_reader(
         _gated(env)
         value_gt = _value_function(env, "value_gt", "CTL")
         value_gtn = _value_function(env, "value_gtn", "CTLN")
+
+        seen_view: list[Any] = [None, None]  # (the last view asked and its answer)
+
+        def viewer(v: memoryview) -> Any:
+            """memoryview(arr) of a whole array this reader takes: arr (view_array)."""
+            if v is seen_view[0]:  # (a view's object, format and size never change)
+                try:
+                    return seen_view[1] if v.obj is not None else None
+                except ValueError:  # (released since: the table path says why)
+                    return None
+            q = view_array(v)
+            q = q if is_array(type(q)) else None
+            seen_view[:] = v, q  # (held: its id is not another's while it is here)
+            return q
+
         entry = centry.reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
@@ -732,7 +747,7 @@ def fast_reader(
             after=_after(advance, name, 0),
             clocks=CLOCK_ORDER if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
-            steady=name in STEADY,
+            steady=name in STEADY, viewer=viewer,
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,

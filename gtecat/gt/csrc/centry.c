@@ -237,6 +237,9 @@ struct entry {
      * (GT_GetEncPos(1, a, 8) then GT_GetEncPos(9, byref(a, 64), 4)), each kept with where its
      * bytes come from; 0 or 1: the last span's alone */
     ptrdiff_t nacache;
+    /* NULL, or viewer(v): for a memoryview v of *pValue the ctypes array it shows whole, of
+     * a type this reader takes (the call is then that array's), else None */
+    obj viewer;
 };
 
 static struct api A;
@@ -1577,6 +1580,27 @@ static char *reader_mem(obj p, obj target, obj deref)
     return mem;
 }
 
+/* A reader's call with memoryview(arr) for *pValue: the call with arr (e->viewer's answer:
+ * the view shows all of it, its element type is the reader's), else the Python path's. */
+static obj viewed(const struct entry *e, obj const *args, ptrdiff_t nargs, ptrdiff_t at)
+{
+    obj a2[8], q, r;
+    ptrdiff_t k;
+    q = A.vectorcall(e->viewer, &args[at + 1], 1, NULL);
+    if (!q)
+        return NULL; /* (its own error, as the Python path would raise it) */
+    if (q == A.none) {
+        A.decref(q);
+        return A.vectorcall(e->fallback, args, (size_t)nargs, NULL);
+    }
+    for (k = 0; k < nargs; k++)
+        a2[k] = args[k];
+    a2[at + 1] = q;
+    r = reader(e, a2, nargs, NULL);
+    A.decref(q);
+    return r;
+}
+
 TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                int locked)
 {
@@ -1614,6 +1638,8 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             goto python;
         if (TYPE(args[at]) != A.int_type)
             goto python;
+        if (e->viewer && TYPE(args[at + 1]) == A.memoryview_type && nargs <= 8)
+            return viewed(e, args, nargs, at);
         if (e->avalue && (arr = array_of(args[at + 1])) != NULL)
             return array(e, args, nargs, kwnames, at, arr, locked);
         /* a numpy array of several values (count 2 or more) */
