@@ -551,8 +551,8 @@ def every_shape(
                 "byref(arr4, k)",
             )
             shapes["pointer(s)"] = ("pointer", f"fn({x}pointer(held))", "pointer(held)")
-            env["mv"] = memoryview(env["arr"])  # (memoryview(arr): the array's own path)
-            shapes["memoryview(arr)"] = ("memoryview", f"fn({x}mv)", "memoryview(arr)")
+        env["mv"] = memoryview(env["arr"])  # (memoryview(arr): the array's own, or apart)
+        shapes["memoryview(arr)"] = ("memoryview", f"fn({x}mv)", "memoryview(arr)")
         if name == fast.CLOCK:
             # the vendor's two-pointer form GT_GetClock(&clk, &loop), as clients pass it
             env["loop"] = c_ulong()
@@ -632,11 +632,12 @@ def every_shape(
         )
         for shape, (kind, call, build) in shapes.items():
             label = f"{name}({'x, ' if i else ''}{shape})"
+            if kind in slow.get(name, {}):  # (whatever it returns on this bus)
+                skipped[label] = "on the table path: " + slow[name][kind]
+                continue
             rc = eval(call, env)
             if rc != 0:
                 skipped[label] = f"returns {rc} on this bus"
-            elif kind in slow.get(name, {}):
-                skipped[label] = "on the table path: " + slow[name][kind]
             else:
                 out[label] = (call, build, env)
     return out, skipped

@@ -2535,6 +2535,12 @@ SLOW_REASONS: dict[str, str] = {
 #: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
 #: other that reaches the table)
 SLOW_SHAPES: dict[str, dict[str, str]] = {}
+#: What the fast path leaves to the table on purpose besides those: a call the table refuses
+#: (code 7 and its reason: ``array.array``, which is not a pointer argument; a strided numpy
+#: view; a ``c_double`` where the prototype says ``long *``; a read-only buffer to read into)
+#: is answered by the table path, whose binder finds which argument is wrong and words the
+#: reason (a few microseconds).  A refused call changes nothing and a program does not poll
+#: it, so its cost is not held to its arguments'; every shape a call succeeds with is.
 #: (filled below for the functions it names, once they are all declared)
 _VIEW_REASON = (
     "a memoryview of the value's array: the axis readers (READERS) answer it as the array "
