@@ -2158,6 +2158,7 @@ def fast_raw(
     return public
 
 
+#: GT_EcatIOBitWriteOutput, which an application that drives single outputs calls every cycle
 BIT_WRITE = "GT_EcatIOBitWriteOutput"
 
 
