@@ -41,6 +41,7 @@ from ..errors import (
     ParameterError,
 )
 from ..master.clock import ClockGroup, ClockMode
+from . import centry as _centry
 from . import fast as _fast
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder, impl_params
 from .fast import FAST_MAKERS, set_gates
@@ -617,6 +618,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
         slow = gt  # (the common shapes up front: gt.fast)
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))
         gt.slow = slow  # type: ignore[attr-defined]
+        # (its C entry answers the table's keyword names too: GT_GetSts(axis=1, pSts=p))
+        _centry.keyword_names(gt, [p.name for p in proto.params])
     gt.__signature__ = _signature(proto, fn, keyword_only)  # type: ignore[attr-defined]
     gt.prototype = proto  # type: ignore[attr-defined]
     REGISTRY[name] = gt

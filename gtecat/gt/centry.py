@@ -65,6 +65,10 @@ _MAX_TYPES = 16
 _VP = ctypes.c_void_p
 _WORD = ctypes.sizeof(_VP)
 
+#: :func:`raw`'s ``write`` for GT_EcatIOBitWriteOutput(slave, offset, bit, value): ``value``
+#: gives the output byte's run, the entry sets or clears the bit in it (csrc/centry.c)
+BIT_WRITE = 2
+
 
 class _Api(ctypes.Structure):
     """``struct api`` of csrc/centry.c."""
@@ -135,6 +139,14 @@ class _Api(ctypes.Structure):
         ("b_size", ctypes.c_ssize_t),
         ("bytes_new", _VP),
         ("float_new", _VP),
+        ("simple_meta", _VP),
+        ("struct_meta", _VP),
+        ("union_meta", _VP),
+        ("pointer_meta", _VP),
+        ("voidp_type", _VP),
+        ("charp_type", _VP),
+        ("wcharp_type", _VP),
+        ("tuple_items", ctypes.c_ssize_t),
     ]
 
 
@@ -214,6 +226,7 @@ class _Entry(ctypes.Structure):
         ("cderefs", ctypes.c_ssize_t * _MAX_TYPES),
         ("steady", ctypes.c_ssize_t),
         ("nacache", ctypes.c_ssize_t),
+        ("viewer", _VP),
     ]
 
 
@@ -776,7 +789,8 @@ def _callable_type() -> type:
     after that) and take attributes (an instance dict after those two words).  Made with
     ``PyType_FromSpec`` (stable ABI; the slot and flag numbers are the ABI's own): the
     ``__vectorcalloffset__`` and ``__dictoffset__`` members, ``__dict__`` the interpreter's
-    generic one, ``tp_call`` the interpreter's ``PyVectorcall_Call``."""
+    generic one, ``tp_call`` the interpreter's ``PyVectorcall_Call``; after the weak-reference
+    list the tuple of the function's parameter names (:func:`keyword_names`)."""
     T_PYSSIZET, READONLY = 19, 1
     Py_tp_call, Py_tp_members, Py_tp_getset = 50, 72, 73
     HAVE_VECTORCALL, DEFAULT = 1 << 11, 1 << 18
@@ -800,7 +814,7 @@ def _callable_type() -> type:
         _TypeSlot(Py_tp_getset, ctypes.addressof(getset)),
     )
     spec = _TypeSpec(
-        b"gtecat.gt.centry.entry", _HEAD + 4 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
+        b"gtecat.gt.centry.entry", _HEAD + 5 * _WORD, 0, HAVE_VECTORCALL | DEFAULT, slots
     )
     make = ctypes.PYFUNCTYPE(ctypes.py_object, _VP)(("PyType_FromSpec", ctypes.pythonapi))
     t = make(ctypes.addressof(spec))
@@ -816,6 +830,25 @@ def _callable_type() -> type:
     if vars(probe) != {"attribute": 1}:
         raise ValueError("an entry callable keeps no attributes")
     return t  # type: ignore[no-any-return]
+
+
+def keyword_names(public: Any, names: Iterable[str]) -> bool:
+    """Let the C entry ``public`` answer a call that names its arguments as the table does
+    (``GT_GetSts(axis=1, pSts=byref(s))``): ``names`` its parameters in order, interned (a
+    call site's keyword names are); a keyword call whose names are the parameters after its
+    positional arguments, in their order, is then answered as that positional call
+    (csrc/centry.c ``positional``).  False where ``public`` is not an entry callable (a
+    ``functools.partial``: its keyword calls go the Python way, as before)."""
+    if not callables_made or type(public) is not callables_made[0]:
+        return False
+    kept = tuple(sys.intern(n) for n in names)
+    _KEEP.append(kept)
+    ctypes.c_void_p.from_address(id(public) + _HEAD + 4 * _WORD).value = id(kept)
+    return True
+
+
+#: the entry callable type made (:func:`_callable_type`; none: the entries are partials)
+callables_made: list[type] = []
 
 
 def _address(name: str) -> int:
@@ -942,6 +975,14 @@ def _load() -> tuple[Maker | None, str]:
             size_at,
             _address("PyBytes_FromStringAndSize"),
             _address("PyFloat_FromDouble"),
+            id(type(ctypes.c_int)),
+            id(type(ctypes.Structure)),
+            id(type(ctypes.Union)),
+            id(type(ctypes.POINTER(ctypes.c_int))),
+            id(ctypes.c_void_p),
+            id(ctypes.c_char_p),
+            id(ctypes.c_wchar_p),
+            titems,
         )
         lib.gtecat_centry_api.argtypes = [ctypes.POINTER(_Api)]
         lib.gtecat_centry_api.restype = ctypes.c_int
@@ -969,6 +1010,7 @@ def _load() -> tuple[Maker | None, str]:
     except Exception as e:  # (the partial of a built-in function instead)
         log.debug("entry callables: %s", e)
         callables = []
+    callables_made[:] = callables
 
     def public(fn: Any, address: int, e: Any, keep: Any) -> Any:
         """The public function of an entry: a callable of :func:`_callable_type` calling the
@@ -1002,6 +1044,7 @@ def _load() -> tuple[Maker | None, str]:
         clocks: Iterable[type] = (),
         numpy: Iterable[Any] = (),
         steady: bool = False,
+        viewer: Callable[[Any], Any] | None = None,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -1018,6 +1061,7 @@ def _load() -> tuple[Maker | None, str]:
         e.stride = ctypes.sizeof(kinds[0]) if kind == BYTES and array is not None else 0
         e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
         e.steady = int(steady)
+        e.viewer = id(viewer) if viewer is not None else None
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1050,7 +1094,7 @@ def _load() -> tuple[Maker | None, str]:
                 aslot = (_ASlot * SPAN_LANES)()
                 e.acache = ctypes.cast(aslot, ctypes.POINTER(_ASlot))
                 e.nacache = SPAN_LANES
-        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts)
+        keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts, viewer)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -1605,11 +1649,14 @@ def _self_test_raw(make_raw: Maker) -> str:
         import numpy as np
     except ImportError:
         np = None  # type: ignore[assignment]
-    taken = (U8, bytearray, bytes, memoryview, *(() if np is None else (np.ndarray,)))
+    W, S = ctypes.c_ushort, TwoBytes
+    taken = (U8, W, S, bytearray, bytes, memoryview, *(() if np is None else (np.ndarray,)))
 
     def value(*a: Any) -> Any:  # ([slave,] offset, size, type): inside the image, U8 only
         offset, size, tp = a[-3:]
         if tp not in taken or offset + size > 16 or size > 8:
+            return nope
+        if tp in (W, S) and size > 2:  # (runs_of's check of a ctypes type's size)
             return nope
         if len(a) == 4 and a[0] != 2:
             return nope
@@ -1657,8 +1704,22 @@ def _self_test_raw(make_raw: Maker) -> str:
         (bget, (4, 8), lambda: (o := memoryview(bytearray(7)), o, None)),  # too short
         (bget, (4, 3), lambda: (o := memoryview(bytes(8)), o, None)),  # (read only)
         (bget, (4, 3), lambda: (o := memoryview(bytearray(16))[::2], o, None)),
-        (bget, (4, 2), lambda: (o := memoryview(bytearray(8)).cast("H"), o, None)),
+        # a memoryview of numbers: its bytes (as the table takes it)
+        (
+            bget,
+            (4, 2),
+            lambda: (o := memoryview(bytearray(8)).cast("H"), o, bytes([4, 5] + [0] * 6)),
+        ),
+        (bget, (4, 2), lambda: (o := memoryview(bytearray(8)).cast("P"), o, None)),  # pointers
         (bget, (4, 3), lambda: (o := _released(), o, None)),
+        # a ctypes number or structure (a word of IO), byref of one: its memory
+        (get, (4, 2), lambda: (o := W(), o, bytes([4, 5]))),
+        (get, (4, 2), lambda: (o := W(), ctypes.byref(o), bytes([4, 5]))),
+        (get, (4, 2), lambda: (o := S(), ctypes.byref(o), bytes([4, 5]))),
+        (get, (4, 3), lambda: (o := W(), o, None)),  # (bigger than it)
+        (get, (4, 2), lambda: (o := W(), ctypes.byref(o, 1), None)),  # past its end
+        (get, (4, 2), lambda: (o := ctypes.c_short(), o, None)),  # (a type value refuses)
+        (get, (4, 2), lambda: (o := ctypes.c_ushort(), ctypes.pointer(o), None)),
     ]
     if np is not None:
         ro = np.zeros(8, np.uint8)
@@ -1666,9 +1727,18 @@ def _self_test_raw(make_raw: Maker) -> str:
         cases += [
             (bget, (4, 8), lambda: (o := np.zeros(8, np.uint8), o, bytes(range(4, 12)))),
             (bget, (4, 8), lambda: (o := np.zeros(7, np.uint8), o, None)),  # too short
-            (bget, (4, 3), lambda: (o := np.zeros(8, np.int8), o, None)),  # another dtype
+            # another dtype, another shape: its bytes, C-contiguous (as the table takes it)
+            (bget, (4, 3), lambda: (o := np.zeros(8, np.int8), o, bytes([4, 5, 6, *[0] * 5]))),
+            (bget, (4, 2), lambda: (o := np.zeros(1, np.uint16), o, bytes([4, 5]))),
             (bget, (4, 3), lambda: (o := np.zeros(16, np.uint8)[::2], o, None)),
-            (bget, (4, 3), lambda: (o := np.zeros((2, 8), np.uint8), o, None)),
+            (bget, (4, 3), lambda: (o := np.zeros(1, np.uint16), o, None)),  # too short
+            (bget, (4, 2), lambda: (o := np.zeros(4, np.uint16)[::2], o, None)),
+            (bget, (4, 2), lambda: (o := np.zeros(2, object), o, None)),  # Python objects
+            (
+                bget,
+                (4, 3),
+                lambda: (o := np.zeros((2, 8), np.uint8), o, bytes([4, 5, 6, *[0] * 13])),
+            ),
             (bget, (4, 3), lambda: (ro, ro, None)),  # (read only)
         ]
     for fn, before, made in cases:
@@ -1732,7 +1802,45 @@ def _self_test_raw(make_raw: Maker) -> str:
         counts = (len(hits), len(asked))
         if got != 0 or bytes(image)[1:3] != bytes(src) or counts != (want_hits, want_asked):
             return f"a keeping raw writer answered {got!r} for {src!r}: {hits!r} {asked!r}"
+
+    def hits_one() -> None:
+        hits.append(1)
+
+    # a bit writer (slave 2's byte at the offset): the bit set or cleared, changed() where
+    # the byte changed; any other bit, value or type: Python
+    def bit_value(slave: int, offset: int, bit: int, tp: Any) -> Any:  # (slave 2's byte)
+        return runs([(0, base + offset, 1)]) if slave == 2 and tp is int else nope
+
+    bits = make_raw(python, bit_value, nope, True, BIT_WRITE, NO_GATE, None, True, hits_one)
+    image[5] = 0x10
+    for args, want_byte, want_hits in [
+        ((2, 5, 3, 1), 0x18, 1),
+        ((2, 5, 3, 1), 0x18, 0),
+        ((2, 5, 4, 0), 0x08, 1),
+        ((2, 5, 8, 1), None, 0),
+        ((2, 5, -1, 1), None, 0),
+        ((2, 5, 0, 2), None, 0),
+        ((2, 5, 0, True), None, 0),
+        ((2, 5, 0, 1.0), None, 0),
+        ((3, 5, 0, 1), None, 0),
+        ((2, 5, 0), None, 0),
+    ]:
+        del hits[:]
+        was = image[5]
+        got = bits(*args)
+        if want_byte is None:
+            ok = got == ("python", args, {}) and image[5] == was
+        else:
+            ok = got == 0 and image[5] == want_byte and len(hits) == want_hits
+        if not ok:
+            return f"a bit writer answered {got!r} for {args!r}: {image[5]:#x} {hits!r}"
     return ""
+
+
+class TwoBytes(ctypes.Structure):
+    """A structure of two bytes (the raw entries' self-test)."""
+
+    _fields_ = [("lo", ctypes.c_ubyte), ("hi", ctypes.c_ubyte)]
 
 
 def _released() -> memoryview:
@@ -1764,6 +1872,7 @@ def reader(
     clocks: Iterable[type] = (),
     numpy: Iterable[Any] = (),
     steady: bool = False,
+    viewer: Callable[[Any], Any] | None = None,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -1794,7 +1903,9 @@ def reader(
     ``array`` give for the epoch they were asked in and writes it again while
     :data:`EPOCH` stays (they must give the same while it does, :data:`EPOCH`); ``steady``:
     and across the quick cycles the entries book themselves (no Python runs in those: what
-    an attribute no cycle changes gives, a profile's mode).
+    an attribute no cycle changes gives, a profile's mode); ``viewer``: for ``p`` a
+    memoryview, ``viewer(p)`` gives the ctypes array the call is then made with (the view
+    shows all of it, of a type the reader takes), else None (``fallback``).
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -1817,6 +1928,7 @@ def reader(
         clocks,
         numpy,
         steady,
+        viewer,
     )
 
 
@@ -1825,27 +1937,30 @@ def raw(
     value: Callable[..., Any],
     sentinel: Any,
     io: bool,
-    write: bool,
+    write: bool | int,
     gate: int = NO_GATE,
     after: Callable[[], Any] | None = None,
     changed: Callable[[], Any] | None = None,
 ) -> Any:
     """The C entry of a raw image function: ``f([slave,] offset, size, buf)`` with ``buf`` a
-    ctypes array (or ``byref`` of one, with an offset too: C's ``&buf[k]``, where the
-    ``size`` bytes from there end within the array), a bytearray, a one-dimensional
-    C-contiguous numpy array of uint8 or a memoryview of format ``B`` (one dimension,
-    C-contiguous) of at least ``size`` bytes (or bytes, where ``write``; writable, where
-    not) and plain ints copies the runs that
-    ``value([slave,] offset, size, type(buffer))`` gives between the buffer and the image
-    (into the image where ``write``): ``(first byte in the buffer, address, bytes)`` as
+    ctypes array, number or structure (or ``byref`` of one, with an offset too: C's
+    ``&buf[k]``, where the ``size`` bytes from there end within the object: a ``c_ushort``
+    for a word of IO), a bytearray, a C-contiguous numpy array of numbers (any dtype and
+    shape: its bytes) or a C-contiguous memoryview of a plain number format of at least
+    ``size`` bytes (or bytes, where ``write``; writable, where not) and plain ints copies the
+    runs that ``value([slave,] offset, size, type(buffer))`` gives between the buffer and the
+    image (into the image where ``write``): ``(first byte in the buffer, address, bytes)`` as
     native int64 triples in one bytes object (:func:`runs`); ``value`` gives ``sentinel``
-    where the entry must not answer (it checks a ctypes array's type and size); every other
+    where the entry must not answer (it checks a ctypes type's size and that its memory holds
+    no pointers); every other
     call: ``fallback``; ``gate``: as :func:`reader`'s (a gated reader keeps its runs for
     their epoch).  ``changed``: a writer's call where the write changed a byte of the image
     (its ``value`` then must not make the epoch grow itself: a gated writer keeps its runs
     for their epoch too, and a write of the bytes the image holds changes nothing); None: its
-    ``value`` makes the epoch grow.  None where the C entry is not available
-    (:data:`REASON`)."""
+    ``value`` makes the epoch grow.  ``write`` :data:`BIT_WRITE`: ``f(slave, offset, bit,
+    value)`` with plain ints, ``bit`` 0..7 and ``value`` 0 or 1, sets or clears that bit of
+    the one byte ``value(slave, offset, bit, int)``'s run gives.  None where the C entry is
+    not available (:data:`REASON`)."""
     if _MAKE is None:
         return None
     return _MAKE.raw(fallback, value, sentinel, io, write, gate, after, gate != NO_GATE, changed)  # type: ignore[attr-defined]

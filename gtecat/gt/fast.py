@@ -100,6 +100,36 @@ def element_at(p: Any, ok: Any) -> Any:
         return None
 
 
+#: a ctypes array type -> its memoryview's format (view_array)
+_VIEWS: dict[type, str] = {}
+#: the last view found whole and its array (a polling loop passes the same view)
+_LAST_VIEW: list[Any] = [None, None]
+
+
+def view_array(v: memoryview) -> Any:
+    """The ctypes array ``v`` is a whole, writable view of (``memoryview(arr)``: the array's
+    own format, all its bytes), else None: a reader writes its value into that array's first
+    element as into the array itself, as the table path writes it through the view (its
+    numpy array of the same memory and element type)."""
+    try:
+        o = v.obj
+        if v is _LAST_VIEW[0]:  # (a view's object, format and size never change)
+            return _LAST_VIEW[1]
+        tp = type(o)
+        if type(tp) is not _ARRAY_META or v.readonly:
+            return None
+        own = _VIEWS.get(tp)
+        if own is None:
+            with memoryview(o) as m:
+                own = _VIEWS[tp] = m.format
+        if v.format != own or v.nbytes != ctypes.sizeof(o):
+            return None
+    except ValueError:  # (a released view: the table path says why)
+        return None
+    _LAST_VIEW[:] = v, o  # (held: its id is not another's while it is here)
+    return o
+
+
 _status = AxisResources.status
 #: a C ``short`` argument's range (the table binder's check of ``axis`` and ``count``)
 _SHORT_MIN, _SHORT_MAX = -(1 << 15), (1 << 15) - 1
@@ -246,6 +276,7 @@ def fast_reader(
         "_NDARRAY": _NDARRAY,
         "np_ok": np_ok,
         "is_array": is_array,
+        "view_array": view_array,
         "to": float if ctypes_ok is _DOUBLE else None,
         "T0": ctypes.c_double if ctypes_ok is _DOUBLE else ctypes.c_long,  # the usual type
     }
@@ -526,6 +557,7 @@ def fast_reader(
 
     env["gtn_general"] = gtn_general
     public: list[Any] = [None]  # the public function (the C entry, else gt below)
+    env["PUBLIC"] = public
     #: the GTN_ twin with core 1: the same fast path (GT_SetCore does not matter: it names
     #: its core); every other shape: the table's GTN_ function (set by gt_function)
     gt.gtn = _compiled(_READER, "gtn", env, core="core=_NO, ", session="session.local")  # type: ignore[attr-defined]
@@ -694,6 +726,21 @@ def fast_reader(
         _gated(env)
         value_gt = _value_function(env, "value_gt", "CTL")
         value_gtn = _value_function(env, "value_gtn", "CTLN")
+
+        seen_view: list[Any] = [None, None]  # (the last view asked and its answer)
+
+        def viewer(v: memoryview) -> Any:
+            """memoryview(arr) of a whole array this reader takes: arr (view_array)."""
+            if v is seen_view[0]:  # (a view's object, format and size never change)
+                try:
+                    return seen_view[1] if v.obj is not None else None
+                except ValueError:  # (released since: the table path says why)
+                    return None
+            q = view_array(v)
+            q = q if is_array(type(q)) else None
+            seen_view[:] = v, q  # (held: its id is not another's while it is here)
+            return q
+
         entry = centry.reader(
             gt, value_gt, _NO, types, kind,
             pointers=True,  # (pointer(x): as general answers it)
@@ -701,7 +748,7 @@ def fast_reader(
             after=_after(advance, name, 0),
             clocks=CLOCK_ORDER if takes_clock else (),
             numpy=sorted(np_ok, key=str),  # (the first element, as general writes it)
-            steady=name in STEADY,
+            steady=name in STEADY, viewer=viewer,
         )  # fmt: skip
         entry_gtn = centry.reader(
             gt.gtn, value_gtn, _NO, types, kind,
@@ -1248,7 +1295,7 @@ def _plan_code(text: str, mode: str) -> Any:
 #: fewest steps, compiled for the GT_ function and its GTN_ twin; anything else: general
 _READER = """
 def {fname}({core}n=_NO, p=_NO, count=_NO, pClock=_NO, /, *extra, **kw):
-    global LAST_P  # the last byref object checked (kept alive, so never another's address)
+    global LAST_P  # the last byref object checked (kept alive, so never another's address){viewed}
     if (
         type(n) is int
         and not kw
@@ -1375,6 +1422,17 @@ _DELEGATE = """
                     return entry(1, n + PER_CORE * (core - 1), p, count, pClock)"""
 
 
+#: the GT_ form's ``memoryview(arr)`` of a whole ctypes array: the public function (its C
+#: entry) called with that array (view_array)
+_VIEWED = """
+    if type(p) is memoryview and not kw and not extra and is_array(type(q := view_array(p))):
+        if count is _NO:
+            return PUBLIC[0](n, q)
+        if pClock is _NO:
+            return PUBLIC[0](n, q, count)
+        return PUBLIC[0](n, q, count, pClock)"""
+
+
 def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session: str) -> Any:
     """``template`` made a function (the GT_ form, or the GTN_ form with ``core`` first)."""
     address = carg_address_source("p")
@@ -1395,6 +1453,7 @@ def _compiled(template: str, fname: str, env: dict[str, Any], core: str, session
         ),
         bus_axis="n if core == 1 else n + PER_CORE * (core - 1)" if gtn else "n",
         delegate=_DELEGATE if gtn else "",
+        viewed="" if gtn else _VIEWED,
         session=session,
         address=address,
         fallback=(
@@ -1744,6 +1803,14 @@ def _raw_code(code: str, name: str) -> str:
 
 
 _IO = frozenset({"GT_EcatIOReadInput", "GT_EcatIOWriteOutput"})
+#: the ctypes objects a raw function copies into or out of (their memory, where it holds no
+#: pointers: holds_pointers): arrays, simple types (``c_ushort``: a word of IO), structures
+_CDATA = (ctypes.Array, ctypes._SimpleCData, ctypes.Structure, ctypes.Union)
+#: their metatypes (byref_target: ``byref(x)`` of any of them)
+_CDATA_METAS = [type(t) for t in _CDATA]
+#: a memoryview's formats a raw function copies bytes into or out of: one native number type
+#: (the table path reads them as numpy does; csrc/centry.c plain_format)
+_PLAIN_FORMATS = frozenset(o + c for c in "bBhHiIlLqQfd?" for o in ("", "@", "=", "<", ">", "!"))
 _CAST: Any = object()
 _NUMPY: Any = object()
 _BYTES_NP = np.dtype(np.uint8)
@@ -1793,8 +1860,10 @@ def fast_raw(
 ) -> Callable[..., int]:
     """``GT_GetEcatRawData`` / ``GT_SetEcatRawData`` (and the IO pair, slave first) with the
     fast path in front of the table: ``(int offset, int size, buffer)`` on the in-process
-    controller with every slave online, the buffer a ctypes array, a bytearray, a one-byte
-    numpy array or memoryview (and for writes ``bytes`` too) holding at least ``size`` bytes.
+    controller with every slave online, the buffer a ctypes array, number or structure (a
+    ``c_ushort`` for a word of IO; ``byref`` of one), a bytearray, a C-contiguous numpy array
+    of numbers or memoryview of a plain number format (and for writes ``bytes`` too) holding
+    at least ``size`` bytes: its memory's bytes, as the table path copies them.
     Into or from a bytearray, memoryview or bytes, a range of a few runs of the process image
     (a slave's outputs, its inputs) is copied run by run as slices; otherwise one numpy copy
     through a cached view; anything else takes the table path."""
@@ -1806,7 +1875,7 @@ def fast_raw(
     #: byte views of the caller's numpy buffers, the last few (kept alive)
     views: dict[tuple[int, int], tuple[Any, np.ndarray]] = {}
     copyto, frombuffer, u8 = np.copyto, np.frombuffer, np.uint8
-    sizeof, Array = ctypes.sizeof, ctypes.Array
+    sizeof = ctypes.sizeof
 
     def view(p: Any, tp: type, size: int) -> np.ndarray | None:
         """``size`` bytes of the caller's buffer as a numpy array (None: not a fast shape)."""
@@ -1814,16 +1883,16 @@ def fast_raw(
         v = views.get(key)
         if v is not None and v[0] is p:
             return v[1]
-        if issubclass(tp, Array):
+        if issubclass(tp, _CDATA):
             if sizeof(p) < size or holds_pointers(tp):  # (py_object, pointers: the table's 7)
                 return None
             arr = frombuffer(p, u8, size)
         elif tp is _NDARRAY:
-            if p.dtype != _BYTES_NP or p.ndim != 1 or not p.flags.c_contiguous or p.size < size:
+            if p.dtype.hasobject or not p.flags.c_contiguous or p.nbytes < size:
                 return None
             if not write and not p.flags.writeable:
                 return None
-            arr = p[:size]
+            arr = p.reshape(-1).view(u8)[:size]
         elif tp is bytearray or tp is memoryview or (write and tp is bytes):
             # never kept: a cached view would stop the caller resizing a bytearray
             if tp is memoryview and (p.format != "B" or p.ndim != 1 or not p.c_contiguous):
@@ -1892,17 +1961,17 @@ def fast_raw(
         runs = plan[0]
         if tp is bytearray or (write and tp is bytes):
             ok = []
-        elif tp is memoryview:
-            ok = ['p.format == "B"', "p.ndim == 1"]
-        elif issubclass(tp, Array) and sizeof(tp) >= size and not holds_pointers(tp):
-            ok = []  # (an array of pointers or py_object is not raw memory: the table's 7)
-        elif tp is _NDARRAY:
-            ok = ["p.dtype == _BYTES_NP", "p.ndim == 1"]
+        elif tp is memoryview:  # (numbers: pack_into / unpack_from check the rest)
+            ok = ["p.format in _PLAIN_FORMATS"]
+        elif issubclass(tp, _CDATA) and sizeof(tp) >= size and not holds_pointers(tp):
+            ok = []  # (pointers or py_object are not raw memory: the table's 7)
+        elif tp is _NDARRAY:  # (any numbers: pack_into / unpack_from check the rest)
+            ok = ["not p.dtype.hasobject"]
         else:
             return None
         check = [f"if not ({' and '.join(ok)}): return False"] if ok else []
         fmt = struct.Struct("".join(f"{n}s" for _, _, n in runs))
-        env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP}
+        env: dict[str, Any] = {"_BYTES_NP": _BYTES_NP, "_PLAIN_FORMATS": _PLAIN_FORMATS}
         cells = []
         for k, (_, first, n) in enumerate(runs):
             env[f"c{k}"] = (ctypes.c_char * n).from_buffer(image.buffer, first)
@@ -1947,7 +2016,7 @@ def fast_raw(
     entries: dict[tuple, Any] = {}
 
     env = {
-        "ARRAY_TARGET": byref_target.target([type(ctypes.Array)]) if BYREF_TARGET else None,
+        "ARRAY_TARGET": byref_target.target(_CDATA_METAS) if BYREF_TARGET else None,
         "LAST": (-1, -1, None, -1, None, False),
         "_NO": _NO,
         "_LOCKSTEP": _LOCKSTEP,
@@ -2090,6 +2159,131 @@ def fast_raw(
     if public is None:
         return entry
     public.slow, public.generic, public.python = slow, gt, entry
+    return public
+
+
+#: GT_EcatIOBitWriteOutput, which an application that drives single outputs calls every cycle
+BIT_WRITE = "GT_EcatIOBitWriteOutput"
+
+
+def fast_bit_write(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_EcatIOBitWriteOutput(slave, offset, bit, value)`` with the fast path in front of
+    the table: plain ints, ``bit`` 0..7 and ``value`` 0 or 1 (the table's ranges), on the
+    in-process controller of core 1 with every slave online, an output byte of the slave's
+    region (:func:`fast_raw`'s conditions for a write): the bit is set or cleared in that
+    byte of the process image directly, as GT_EcatIOWriteOutput's fast path writes its bytes
+    (the readers' epoch grows where the byte changed); anything else takes the table path,
+    which says why."""
+    #: (slave, offset) -> a c_ubyte over its output byte of the image (None: the table's)
+    cells: dict[tuple[int, int], Any] = {}
+    #: the image the cells are of, and the latest call's (slave, offset, cell)
+    memo: list[Any] = [None, -1, -1, None]
+
+    def cell(image: Any, slave: int, offset: int) -> Any:
+        if image is not memo[0]:
+            cells.clear()
+            memo[0] = image
+        c = cells.get((slave, offset), _NO)
+        if c is _NO:
+            c = None
+            slaves = image.layout.slaves
+            if 0 <= slave < len(slaves) and 0 <= offset < slaves[slave].out_bytes:
+                plan = _plan(image, slaves[slave].gt_offset + offset, 1, True)
+                if plan is not None and plan[0]:
+                    c = ctypes.c_ubyte.from_buffer(image.buffer, plan[0][0][1])
+            if len(cells) >= 256:
+                cells.clear()
+            cells[(slave, offset)] = c
+        memo[1:] = slave, offset, c
+        return c
+
+    def gt(
+        slave: Any = _NO, offset: Any = _NO, bit: Any = _NO, value: Any = _NO, /, *extra: Any,
+        **kw: Any,
+    ) -> int:  # fmt: skip
+        if (
+            type(bit) is int
+            and 0 <= bit <= 7
+            and (value == 0 or value == 1)
+            and type(value) is int
+            and type(slave) is int
+            and type(offset) is int
+            and not extra
+            and not kw
+            and session.plain  # (in this process, core 1)
+        ):
+            ctl = session.controllers.get(1)
+            if ctl is not None:
+                m = ctl.master
+                clock = ctl.clock
+                if m is not None and m.opened and not m.offline and clock._thread is None:
+                    image = m.image
+                    if slave == memo[1] and offset == memo[2] and image is memo[0]:
+                        c = memo[3]
+                    else:
+                        c = cell(image, slave, offset)
+                    if c is not None:
+                        old = c.value
+                        new = (old | (1 << bit)) if value else (old & ~(1 << bit))
+                        if new != old:
+                            c.value = new
+                            EPOCH.n += 1  # (the readers' C entries ask again: epoch.py)
+                        session.last = None
+                        if clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+        return slow(*(a for a in (slave, offset, bit, value) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    if not CENTRY:
+        return gt
+    #: the C entry's runs of an output byte: (slave, offset) -> its run (centry.runs), or None
+    addresses: dict[tuple[int, int], bytes | None] = {}
+    addressed: list[Any] = [None]
+
+    def runs_of(slave: int, offset: int, image: Any) -> Any:
+        if image is not addressed[0]:
+            addresses.clear()
+            addressed[0] = image
+        at = addresses.get((slave, offset), _NO)
+        if at is _NO:
+            c = cell(image, slave, offset)
+            at = None if c is None else centry.runs([(0, ctypes.addressof(c), 1)])
+            if len(addresses) >= 256:
+                addresses.clear()
+            addresses[(slave, offset)] = at
+        if at is None:
+            return _NO
+        session.last = None  # (the C entry makes the epoch grow where the byte changed)
+        return at
+
+    venv: dict[str, Any] = {"_NO": _NO, "session": session, "runs_of": runs_of}
+    _gated(venv)
+    # (asked while the GT_ gate is open: CTL the in-process controller of core 1; the bit
+    # and the value the C entry checked, the byte's runs kept for their epoch)
+    exec(
+        _compiled_code(
+            "def value(slave, offset, bit, tp):\n"
+            "    m = CTL.master\n"
+            "    if m is not None and m.opened and not m.offline:\n"
+            "        return runs_of(slave, offset, m.image)\n"
+            "    return _NO\n",
+            f"<gt bit value {name}>",
+        ),
+        venv,
+    )
+    public = centry.raw(
+        gt, venv["value"], _NO, True, centry.BIT_WRITE, centry.GT_GATE, _after(advance, name, 0),
+        changed,
+    )  # fmt: skip
+    if public is None:
+        return gt
+    public.slow, public.python = slow, gt
     return public
 
 
@@ -2290,13 +2484,13 @@ def _compiled_raw(env: dict[str, Any], io: bool) -> Any:
             "        p = ARRAY_TARGET(p)  # (one C call: the array, else p itself)"
             if env.get("ARRAY_TARGET") is not None
             else "        q = p._obj\n"
-            "        if isinstance(q, _Array) and {address} == _addressof(q):\n"
+            "        if isinstance(q, _CDATA) and {address} == _addressof(q):\n"
             "            p = q"
         ),
     )
     code = code.replace("{address}", carg_address_source("p"))
     env.update(CARG_ENV)
-    env.update(_CArg=_CArg, _Array=ctypes.Array, _addressof=_addressof, EPOCH=EPOCH)
+    env.update(_CArg=_CArg, _CDATA=_CDATA, _addressof=_addressof, EPOCH=EPOCH)
     code = _raw_code(code, env["name"])
     exec(_compiled_code(code, f"<gt fast raw {env['name']}>"), env)  # env: its globals
     return env["gt"]
@@ -2347,6 +2541,18 @@ SLOW_REASONS: dict[str, str] = {
 #: (tests/gtecat/gt/test_fast_walk.py walks every fast function's shapes and fails on any
 #: other that reaches the table)
 SLOW_SHAPES: dict[str, dict[str, str]] = {}
+#: What the fast path leaves to the table on purpose besides those: a call the table refuses
+#: (code 7 and its reason: ``array.array``, which is not a pointer argument; a strided numpy
+#: view; a ``c_double`` where the prototype says ``long *``; a read-only buffer to read into)
+#: is answered by the table path, whose binder finds which argument is wrong and words the
+#: reason (a few microseconds).  A refused call changes nothing and a program does not poll
+#: it, so its cost is not held to its arguments'; every shape a call succeeds with is.
+#: (filled below for the functions it names, once they are all declared)
+_VIEW_REASON = (
+    "a memoryview of the value's array: the axis readers (READERS) answer it as the array "
+    "itself; this function's fast path takes the array, byref of it, the object or a numpy "
+    "array, and the table path answers the view (a few microseconds)"
+)
 
 
 def fast_functions() -> frozenset[str]:
@@ -3606,6 +3812,7 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
         HOMING: fast_homing_status,
         HOME_STATUS: fast_home_status,
         HOME_STS: fast_home_sts,  # (the older cards' homing status: its own module)
+        BIT_WRITE: fast_bit_write,
     }
     for names, make in (
         (MULTI_READERS, fast_multi),
@@ -3621,3 +3828,5 @@ def _makers() -> dict[str, Callable[..., Callable[..., int]]]:
 #: function -> the maker of its fast path, ``make(name, slow, session, advance)`` (the GT
 #: layer puts it in front of the table-checked function)
 FAST_MAKERS = _makers()
+for _name in fast_functions() - frozenset(READERS) - RAW:
+    SLOW_SHAPES.setdefault(_name, {})["memoryview"] = _VIEW_REASON

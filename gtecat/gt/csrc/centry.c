@@ -138,6 +138,16 @@ struct api {
     obj (*bytes_new)(const char *, ptrdiff_t);
     /* PyFloat_FromDouble: one axis's double made again (kept) */
     obj (*float_new)(double);
+    /* the metatypes of ctypes' simple types, structures and unions (array_meta: arrays'):
+     * a raw entry copies into or out of any such object whose memory is raw (its value
+     * function checks the type: no pointers, big enough) */
+    obj simple_meta, struct_meta, union_meta;
+    /* the metatype of ctypes' pointer types (POINTER(c_uint32)) and the simple types that
+     * hold a pointer (c_void_p, c_char_p, c_wchar_p): such an object whose value is NULL is
+     * a NULL pointer argument, as None and 0 are */
+    obj pointer_meta, voidp_type, charp_type, wcharp_type;
+    /* where a tuple keeps its first item (its length: where a bytes object's is) */
+    ptrdiff_t tuple_items;
 };
 
 #define MAX_TYPES 16
@@ -227,6 +237,9 @@ struct entry {
      * (GT_GetEncPos(1, a, 8) then GT_GetEncPos(9, byref(a, 64), 4)), each kept with where its
      * bytes come from; 0 or 1: the last span's alone */
     ptrdiff_t nacache;
+    /* NULL, or viewer(v): for a memoryview v of *pValue the ctypes array it shows whole, of
+     * a type this reader takes (the call is then that array's), else None */
+    obj viewer;
 };
 
 static struct api A;
@@ -269,7 +282,9 @@ int gtecat_centry_api(const struct api *api)
         !api->marks_dict || !api->key_al || !api->key_out || !api->get_buffer ||
         !api->release_buffer || !api->memoryview_type || !api->clock_books || !api->long_from ||
         !api->dict_new || !api->dict_set || !api->tuple_pack || !api->key_lists || !api->key_seen ||
-        api->b_size <= 0 || !api->bytes_new || !api->float_new)
+        api->b_size <= 0 || !api->bytes_new || !api->float_new || !api->simple_meta ||
+        !api->struct_meta || !api->union_meta || !api->pointer_meta || !api->voidp_type ||
+        !api->charp_type || !api->wcharp_type || api->tuple_items <= 0)
         return 1;
     A = *api;
     ready = 1;
@@ -955,10 +970,37 @@ obj gtecat_centry_wait(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
     return wait_call((const struct wait_entry *)AT(self, A.b_ptr), args, nargs, kwnames);
 }
 
+/* A call with keywords (GT_GetSts(axis=1, pSts=byref(s))) whose names are the function's
+ * next parameters in their order (names: the tuple of them all, the word after an entry
+ * callable's weak-reference list; NULL: none known) is its positional call: the values
+ * follow the positional ones in args already.  The names are compared as objects (the
+ * compiler interns a call's keyword names, the loader the parameters'): any other name, order
+ * or spelling keeps its keywords, and the Python path answers it. */
+static void positional(obj callable, ptrdiff_t *nargs, obj *kwnames)
+{
+    obj names = *(obj *)((char *)callable + A.vc_entry + 3 * (ptrdiff_t)sizeof(obj));
+    ptrdiff_t nk, nn, k;
+    obj *kw, *nm;
+    if (!names || !*kwnames)
+        return;
+    nk = *(ptrdiff_t *)((char *)*kwnames + A.bsize);
+    nn = *(ptrdiff_t *)((char *)names + A.bsize);
+    if (nk <= 0 || *nargs + nk > nn)
+        return;
+    kw = (obj *)((char *)*kwnames + A.tuple_items);
+    nm = (obj *)((char *)names + A.tuple_items) + *nargs;
+    for (k = 0; k < nk; k++)
+        if (kw[k] != nm[k])
+            return;
+    *nargs += nk;
+    *kwnames = NULL;
+}
+
 obj gtecat_centry_wait_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return wait_call((const struct wait_entry *)AT(callable, A.vc_entry), args,
-                     (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return wait_call((const struct wait_entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 /* The index of tp among the NULL-ended types (at most n of them), its size and sign in
@@ -998,13 +1040,29 @@ static char *typed_mem(obj p, obj const *types, const ptrdiff_t *sizes, const pt
     return reader_mem(p, target, derefs ? (obj)derefs[k] : NULL);
 }
 
+/* a NULL pointer argument: None, 0, or a ctypes pointer (POINTER(t)(), c_void_p(),
+ * c_char_p(None), ...) whose value is NULL */
+static int null_arg(obj a)
+{
+    obj t;
+    char *at;
+    if (a == A.none || a == A.zero || int_is(a, 0))
+        return 1;
+    t = TYPE(a);
+    if (TYPE(t) != A.pointer_meta && t != A.voidp_type && t != A.charp_type &&
+        t != A.wcharp_type)
+        return 0;
+    at = AT(a, A.b_ptr);
+    return at && !*(void **)at;
+}
+
 /* A span's pClock (or GT_GetClock's pLoop): NULL (omitted, None or 0: *mem NULL) or the
  * memory of byref(x) (no offset), x or pointer(x) of one of the entry's clock types (its
  * size and sign); 0 where this entry does not take it. */
 static int clock_mem(const struct entry *e, obj pc, char **mem, int *size, int *sign)
 {
     *mem = NULL;
-    if (pc == A.none || pc == A.zero || int_is(pc, 0))
+    if (null_arg(pc))
         return 1;
     *mem = typed_mem(pc, e->ctypes_, e->csizes, e->csigns, e->cderefs, MAX_TYPES, size, sign);
     return *mem != NULL;
@@ -1266,19 +1324,29 @@ static int take_recipe(obj *items, struct recipe *rc)
 static struct aslot *lane(struct aslot *s, ptrdiff_t n, long long an, long long ac, obj tp,
                           long long clk)
 {
+    static size_t turn; /* (the lanes taken in turn where none is older) */
     struct aslot *pick;
     ptrdiff_t k;
+    long long newest;
     if (!s)
         return NULL;
     if (n < 1)
         n = 1;
     pick = s;
+    newest = s[0].epoch;
     for (k = 0; k < n; k++) {
         if (s[k].value && s[k].n == an && s[k].count == ac && s[k].tp == tp && s[k].clock == clk)
             return &s[k];
         if (pick->value && (!s[k].value || s[k].epoch < pick->epoch))
             pick = &s[k];
+        if (s[k].epoch > newest)
+            newest = s[k].epoch;
     }
+    /* every lane full and of the same epoch (a lockstep program reading ranges in turn,
+     * no cycle between): not always the first, which two ranges read in turn would take
+     * from each other at every call */
+    if (pick->value && pick->epoch == newest)
+        pick = &s[turn++ % (size_t)n];
     return pick;
 }
 
@@ -1493,8 +1561,9 @@ obj gtecat_centry_reader(obj self, obj const *args, ptrdiff_t nargs, obj kwnames
 /* a vectorcall function: the callable keeps its entry's address at A.vc_entry */
 obj gtecat_centry_reader_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return reader((const struct entry *)AT(callable, A.vc_entry), args,
-                  (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return reader((const struct entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 /* The first element of a numpy array p an entry takes (one dimension, at least one element,
@@ -1545,6 +1614,27 @@ static char *reader_mem(obj p, obj target, obj deref)
     return mem;
 }
 
+/* A reader's call with memoryview(arr) for *pValue: the call with arr (e->viewer's answer:
+ * the view shows all of it, its element type is the reader's), else the Python path's. */
+static obj viewed(const struct entry *e, obj const *args, ptrdiff_t nargs, ptrdiff_t at)
+{
+    obj a2[8], q, r;
+    ptrdiff_t k;
+    q = A.vectorcall(e->viewer, &args[at + 1], 1, NULL);
+    if (!q)
+        return NULL; /* (its own error, as the Python path would raise it) */
+    if (q == A.none) {
+        A.decref(q);
+        return A.vectorcall(e->fallback, args, (size_t)nargs, NULL);
+    }
+    for (k = 0; k < nargs; k++)
+        a2[k] = args[k];
+    a2[at + 1] = q;
+    r = reader(e, a2, nargs, NULL);
+    A.decref(q);
+    return r;
+}
+
 TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwnames,
                int locked)
 {
@@ -1567,7 +1657,7 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
             goto python;
         /* q NULL, or (the entry's clock types: GT_GetClock's pLoop) byref(x), x or pointer(x):
          * the clock's cycles run written there too (clock_cycles) */
-        if (nargs == 2 && args[1] != A.none && !int_is(args[1], 0) &&
+        if (nargs == 2 && !null_arg(args[1]) &&
             (!e->ctypes_[0] || !clock_mem(e, args[1], &lmem, &lsize, &lsign) || !lmem))
             goto python;
         p = args[0];
@@ -1587,6 +1677,9 @@ TRY reader_try(const struct entry *e, obj const *args, ptrdiff_t nargs, obj kwna
         }
         if (TYPE(axis) != A.int_type)
             goto python;
+        if (axis == args[at] && e->viewer && TYPE(args[at + 1]) == A.memoryview_type &&
+            nargs <= 8)
+            return viewed(e, args, nargs, at);
         if (axis == args[at] && e->avalue && (arr = array_of(args[at + 1])) != NULL)
             return array(e, args, nargs, kwnames, at, arr, locked);
         /* a numpy array of several values (count 2 or more) */
@@ -1726,13 +1819,16 @@ static obj reader(const struct entry *e, obj const *args, ptrdiff_t nargs, obj k
     ANSWER(reader_try, e, e->gate, args, nargs, kwnames);
 }
 
+/* a raw entry's write: GT_EcatIOBitWriteOutput's (one bit of one output byte) */
+#define BIT_WRITE 2
+
 /* a raw image function's entry */
 struct raw_entry {
     obj fallback; /* the Python fast function */
     obj value;    /* value([slave,] offset, size, array type): the range's runs, or sentinel */
     obj sentinel;
     ptrdiff_t io;    /* 1: the slave first (GT_EcatIOReadInput / WriteOutput) */
-    ptrdiff_t write; /* 1: from the buffer into the image */
+    ptrdiff_t write; /* 1: from the buffer into the image; BIT_WRITE: a bit of it */
     ptrdiff_t gate;  /* 0: none; k: value only while A.gate[k - 1] is nonzero */
     obj after;       /* as struct entry's */
     /* the runs kept for their epoch, a lane per range (ncache of them; n: the offset,
@@ -1759,8 +1855,9 @@ obj gtecat_centry_raw(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
 
 obj gtecat_centry_raw_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return raw((const struct raw_entry *)AT(callable, A.vc_entry), args,
-               (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return raw((const struct raw_entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 /* Py_buffer (the buffer protocol's view, part of the stable ABI) and the request flags */
@@ -1780,10 +1877,24 @@ struct pybuf {
 #define ND_C 0x0001
 #define ND_W 0x0400
 
-/* A memoryview's bytes as the Python fast path takes them (format "B", one dimension,
- * C-contiguous, at least size bytes, writable to read into): the view held in *view (given
- * back with A.release_buffer; while held the memoryview cannot be released nor its
- * bytearray resized), its memory; NULL (nothing held, no error left) where it is not. */
+/* A buffer format the table path takes as plain memory (numpy reads it: one native number
+ * type, or none given, which means bytes); anything else (Python objects, structures,
+ * formats numpy does not read) the Python path answers. */
+static int plain_format(const char *f)
+{
+    if (!f)
+        return 1;
+    if (*f == '@' || *f == '=' || *f == '<' || *f == '>' || *f == '!')
+        f++;
+    return f[0] && !f[1] && strchr("bBhHiIlLqQfd?", f[0]) != NULL;
+}
+
+/* A memoryview's (or a numpy array's of another kind than the bytes raw_mem takes) memory
+ * as the table path takes it: C-contiguous (any shape), of a plain format (plain_format), at
+ * least size bytes, writable to read into: the view held in *view (given back with
+ * A.release_buffer; while held the memoryview cannot be released nor its bytearray resized,
+ * nor the array's memory moved), its memory; NULL (nothing held, no error left) where it is
+ * not. */
 static char *view_mem(const struct raw_entry *e, obj p, long long size, struct pybuf *view)
 {
     int flags = PYBUF_FORMAT | PYBUF_C_CONTIGUOUS | (e->write ? 0 : PYBUF_WRITABLE);
@@ -1791,12 +1902,17 @@ static char *view_mem(const struct raw_entry *e, obj p, long long size, struct p
         A.err_clear(); /* (released, read only, not contiguous: the Python path says) */
         return NULL;
     }
-    if (view->ndim != 1 || view->itemsize != 1 || view->len < size || !view->buf ||
-        !view->format || view->format[0] != 'B' || view->format[1]) {
+    if (view->len < size || !view->buf || !plain_format(view->format)) {
         A.release_buffer(view);
         return NULL;
     }
     return (char *)view->buf;
+}
+
+/* a ctypes object's type's metatype: an array, simple, structure or union type */
+static int cdata_meta(obj m)
+{
+    return m == A.array_meta || m == A.simple_meta || m == A.struct_meta || m == A.union_meta;
 }
 
 /* The buffer a raw entry copies into or out of (target: p, or the array of a byref of one
@@ -1825,10 +1941,10 @@ static char *raw_mem(const struct raw_entry *e, obj p, obj target, long long siz
             return NULL;
         return t == A.bytes_type ? (char *)p + A.bdata : AT(p, A.bastart);
     }
-    if (TYPE(t) != A.array_meta)
+    if (!cdata_meta(TYPE(t)))
         return NULL;
     if (target != p) {
-        /* byref(array[, offset]) (C's &array[k]): its address, where the size's bytes from
+        /* byref(x[, offset]) (C's &array[k], &x): its address, where the size's bytes from
          * there end within the object (the table path's room: ctypes.sizeof of it; any byte
          * offset, as the table path's byte pointer takes it); else (past the end, before
          * the start, the array's memory moved since) the Python path answers */
@@ -1847,7 +1963,7 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
     obj p, target, v, call[4], res;
     const int64_t *runs;
     long long size, off = 0, slave = -1, ep = -1, ep0 = -1;
-    int over = 0, mv = 0, diff = 0;
+    int over = 0, mv = 0, diff = 0, bit = -1, set = 0;
     char *mem;
     struct pybuf view;
     /* (a write's runs are kept only where the write makes the epoch grow itself) */
@@ -1862,6 +1978,23 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             goto python;
     p = args[2 + at];
     target = p;
+    if (e->write == BIT_WRITE) {
+        /* GT_EcatIOBitWriteOutput(slave, offset, bit, value): bit 0..7, value 0 or 1, one
+         * output byte (the value function's runs) set or cleared in place */
+        long long b = A.as_ll(args[1 + at], &over);
+        if (over || b < 0 || b > 7) {
+            if (b == -1 && !over && A.err_occurred())
+                A.err_clear();
+            goto python;
+        }
+        bit = (int)b;
+        if (p == A.one || int_is(p, 1))
+            set = 1;
+        else if (!(p == A.zero || int_is(p, 0)))
+            goto python;
+        size = 1;
+        goto shaped;
+    }
     if (TYPE(p) == A.carg_type) { /* byref(array[, offset]): the array (raw_mem) */
         target = AT(p, A.carg_obj);
         if (!target)
@@ -1873,14 +2006,17 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
             A.err_clear();
         goto python;
     }
-    if (TYPE(target) == A.memoryview_type) {
-        /* (held from here to the copy: nothing can release or resize it meanwhile) */
+    if (TYPE(target) == A.memoryview_type ||
+        (TYPE(target) == A.ndarray_type && !raw_mem(e, p, target, size))) {
+        /* (held from here to the copy: nothing can release or resize it meanwhile; a numpy
+         * array other than raw_mem's bytes: its memory as the buffer protocol gives it) */
         if (target != p || !view_mem(e, p, size, &view))
             goto python;
         mv = 1;
     } else if (!raw_mem(e, p, target, size)) {
         goto python;
     }
+shaped:
     if (s) {
         off = A.as_ll(args[at], &over);
         if (!over && at)
@@ -1947,7 +2083,8 @@ have:
     if (n <= 0 || n % 24)
         goto drop;
     runs = (const int64_t *)((char *)v + A.bdata);
-    mem = mv ? (char *)view.buf : raw_mem(e, p, target, size); /* (again: Python ran) */
+    /* (again: Python ran; a bit write has no buffer: its byte is the image's own) */
+    mem = bit >= 0 ? (char *)&set : mv ? (char *)view.buf : raw_mem(e, p, target, size);
     if (!mem)
         goto drop;
     for (k = 0; k < n / 24; k++) {
@@ -1958,7 +2095,15 @@ have:
     for (k = 0; k < n / 24; k++) {
         const int64_t *r = runs + 3 * k;
         char *image = (char *)(intptr_t)r[1];
-        if (!e->write)
+        if (bit >= 0) {
+            unsigned char was = (unsigned char)*image;
+            unsigned char now = set ? (unsigned char)(was | (1u << bit))
+                                    : (unsigned char)(was & ~(1u << bit));
+            if (now != was) {
+                *image = (char)now;
+                diff = 1;
+            }
+        } else if (!e->write)
             memcpy(mem + r[0], image, (size_t)r[2]);
         else if (!e->changed)
             memcpy(image, mem + r[0], (size_t)r[2]);
@@ -2031,8 +2176,9 @@ static obj multi(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, 
 
 obj gtecat_centry_multi_vc(obj callable, obj const *args, size_t nargsf, obj kwnames)
 {
-    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args,
-                 (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET), kwnames);
+    ptrdiff_t nargs = (ptrdiff_t)(nargsf & ~VECTORCALL_OFFSET);
+    positional(callable, &nargs, &kwnames);
+    return multi((const struct multi_entry *)AT(callable, A.vc_entry), args, nargs, kwnames);
 }
 
 obj gtecat_centry_multi(obj self, obj const *args, ptrdiff_t nargs, obj kwnames)
@@ -2065,7 +2211,7 @@ TRY multi_try(const struct multi_entry *e, obj const *args, ptrdiff_t nargs, obj
         obj a = args[k];
         ptrdiff_t want = e->extra[k - 1 - nout];
         if (want == 1 ? !(a == A.one || int_is(a, 1))
-                      : !(a == A.zero || int_is(a, 0) || (want == 2 && a == A.none)))
+                      : !(a == A.zero || int_is(a, 0) || (want == 2 && null_arg(a))))
             goto python;
     }
     for (k = 0; k < nout; k++)

@@ -783,3 +783,134 @@ def test_spans_past_twelve_axes_read_as_the_table_on_the_fast_path(
     assert ("GT_GetSts", 1, 16, 0) in codes and ("GT_GetSts", 2, 16, 7) in codes
     assert ("GT_GetEncPos", 1, 16, 7) in codes
     assert python == 0
+
+
+class _Word(ctypes.Structure):
+    _fields_ = [("lo", ctypes.c_ubyte), ("hi", ctypes.c_ubyte)]
+
+
+def _read_only() -> np.ndarray:
+    a = np.zeros(2, np.uint8)
+    a.flags.writeable = False
+    return a
+
+
+#: a client's buffers of a 2-byte IO word besides the byte arrays: a ctypes number or
+#: structure, byref of one (held or fresh), numpy arrays of other dtypes and shapes, a
+#: memoryview of numbers (each the fast path's: its memory's bytes, as the table copies them)
+WORD_SHAPES = {
+    "c_ushort": lambda: (o := ctypes.c_ushort(0x0105), o),
+    "byref(c_ushort)": lambda: (o := ctypes.c_ushort(0x0105), byref(o)),
+    "byref(c_uint32)": lambda: (o := ctypes.c_uint32(0x0105), byref(o)),
+    "structure": lambda: (o := _Word(5, 1), o),
+    "byref(structure)": lambda: (o := _Word(5, 1), byref(o)),
+    "c_double": lambda: (o := ctypes.c_double(2.5), o),
+    "numpy uint16[1]": lambda: (o := np.array([0x0105], np.uint16), o),
+    "numpy int32[2]": lambda: (o := np.array([0x0105, 7], np.int32), o),
+    "numpy float64[1]": lambda: (o := np.array([2.5]), o),
+    "numpy uint8[1, 2]": lambda: (o := np.array([[5, 1]], np.uint8), o),
+    "memoryview H": lambda: (o := bytearray([5, 1, 0, 0]), memoryview(o).cast("H")),
+    "memoryview c_ushort[1]": lambda: (o := (ctypes.c_ushort * 1)(0x0105), memoryview(o)),
+}
+#: shapes the table refuses (or that must not be answered by the copy): the same answer
+WORD_REFUSED = {
+    "byref(c_ushort, 1)": lambda: (o := ctypes.c_ushort(), byref(o, 1)),
+    "c_ubyte": lambda: (o := ctypes.c_ubyte(), o),
+    "c_void_p": lambda: (o := ctypes.c_void_p(5), o),
+    "byref(c_void_p)": lambda: (o := ctypes.c_void_p(5), byref(o)),
+    "numpy strided": lambda: (o := np.zeros(4, np.uint16), o[::2]),
+    "numpy objects": lambda: (o := np.array([None, None], object), o),
+    "numpy read-only": lambda: (o := _read_only(), o),
+    "memoryview strided": lambda: (o := bytearray(8), memoryview(o)[::2]),
+    "pointer(c_ushort)": lambda: (o := ctypes.c_ushort(0x0105), ctypes.pointer(o)),
+}
+
+
+def _bytes_of(o: object) -> bytes:
+    if isinstance(o, np.ndarray):
+        return o.tobytes() if not o.dtype.hasobject else repr(o.tolist()).encode()
+    return bytes(o)  # type: ignore[call-overload]
+
+
+def _word_call(fn: object, name: str, slave: int, make: object) -> tuple:
+    """(code, the buffer's bytes after, reason, calls of the table or general path) of one
+    call on the slave's first output word (the raw functions: where it lies in the image)."""
+    o, p = make()  # type: ignore[operator]
+    raw = gt.GTE_Controller().master.image.layout.slaves[slave].gt_offset
+    args = (slave, 0, 2, p) if "EcatIO" in name else (raw, 2, p)
+    pr = cProfile.Profile()
+    pr.enable()
+    rc = fn(*args)  # type: ignore[operator]
+    pr.disable()
+    table = table_calls(pr, ("general", "gtn_general", "run"))
+    return rc, _bytes_of(o), gt.GTE_GetLastError() if rc else "", table
+
+
+@pytest.mark.parametrize("name", sorted(fast.RAW))
+def test_every_word_buffer_answers_as_the_table_on_the_fast_path(name: str) -> None:
+    """``GT_EcatIOReadInput(2, 0, 2, byref(c_ushort()))`` and its kind (WORD_SHAPES), slaves
+    2 and 3 in turn, through the C entry and its Python fast function: the table path's
+    answer and image, and neither the table nor the general path runs; the shapes the table
+    refuses (WORD_REFUSED) answer as it does."""
+    ctl = _open()
+    fn = getattr(gt, name)
+    ways = [fn, *([fn.python] if hasattr(fn, "python") else [])]
+    bad = []
+    for shapes, fast_too in ((WORD_SHAPES, True), (WORD_REFUSED, False)):
+        for shape, make in shapes.items():
+            for way in ways:
+                for slave in (2, 3, 2, 3):
+                    got = _word_call(way, name, slave, make)
+                    image = bytes(ctl.master.image.buffer)
+                    want = _word_call(fn.slow, name, slave, make)
+                    if got[:3] != want[:3] or image != bytes(ctl.master.image.buffer):
+                        bad.append(f"{shape} {slave}: {got[:3]} != {want[:3]}")
+                    elif fast_too and (got[0] != 0 or got[3]):
+                        bad.append(f"{shape} {slave}: rc {got[0]}, table/general {got[3]}")
+    assert not bad, "\n".join(bad)
+
+
+def test_an_output_bit_is_written_as_the_table_writes_it_on_the_fast_path() -> None:
+    """GT_EcatIOBitWriteOutput: every bit of each output byte of the IO slaves set and
+    cleared, slaves in turn, on the fast path (no table call) with the table's image; its
+    refusals (a bit, a value, an input byte, a slave out of range, a bool, a float) answer as
+    the table does."""
+    ctl = _open()
+    bad = []
+    for fn in (gt.GT_EcatIOBitWriteOutput, getattr(gt.GT_EcatIOBitWriteOutput, "python", None)):
+        if fn is not None:  # (its C entry, then its Python fast function)
+            bad += _bits(ctl, fn, gt.GT_EcatIOBitWriteOutput.slow)
+    assert not bad, "\n".join(bad)
+
+
+def _bits(ctl: object, fn: object, slow: object) -> list[str]:
+    bad = []
+
+    def both(args: tuple) -> tuple:
+        out = []
+        for way in (fn, slow):
+            before = bytes(ctl.master.image.buffer)
+            pr = cProfile.Profile()
+            pr.enable()
+            rc = way(*args)
+            pr.disable()
+            out.append((rc, bytes(ctl.master.image.buffer), gt.GTE_GetLastError() if rc else ""))
+            out.append(table_calls(pr, ("general", "gtn_general")))
+            ctl.master.image.buffer[:] = np.frombuffer(before, np.uint8)
+        return out[0], out[1], out[2]
+
+    for value in (1, 0, 1):
+        for bit in range(8):
+            for slave in (2, 3):
+                for offset in (0, 1):
+                    got, table, want = both((slave, offset, bit, value))
+                    if got != want or got[0] != 0 or table:
+                        bad.append(f"{slave} {offset} {bit} {value}: {got[0]} {table}")
+                    fn(slave, offset, bit, value)  # (the image moves on)
+    refused = [(2, 0, 8, 1), (2, 0, -1, 1), (2, 0, 3, 2), (2, 2, 0, 1), (2, 5, 0, 1)]
+    refused += [(9, 0, 0, 1), (2, 0, 3, True), (2, 0, 3, 1.0), (2, 0), (2, 0, 3, 1, 1)]
+    for args in refused:
+        got, _, want = both(args)
+        if got != want:
+            bad.append(f"{args}: {got[0]} {got[2]!r} != {want[0]} {want[2]!r}")
+    return bad
