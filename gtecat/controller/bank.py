@@ -106,6 +106,7 @@ from .bank_modes import (
     sampled_kind,
     trap_steppable,
 )
+from .bank_pt_stream import stream_kind, stream_of
 from .crd.system import Delay, Motion
 from .epoch import EPOCH
 from .motion.jog import _IDLE as _JOG_IDLE
@@ -809,6 +810,8 @@ class AxisBank:
 
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
+        #: GT calls run on a claimed row without giving it back (gtecat.controller.bank_stream)
+        self.streamed_calls = 0
         #: row -> the constants of its last load that _reindex's flags read (_load)
         self._consts: dict[int, tuple] = {}
         #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
@@ -1030,6 +1033,8 @@ class AxisBank:
             try:
                 if not sampled_kind(pl):
                     return False
+                if stream_kind(pl) and len(self.groups[self.group_of[r]].rows) != 1:
+                    return False  # (a dynamic PT FIFO runs in a cluster of its own alone)
             finally:
                 _Bypass.on = False
         else:
@@ -1838,6 +1843,7 @@ class AxisBank:
             self._materialise()
             filled: set[int] = set()  # the rows of the clusters filled
             pt_rows: list[int] = []
+            stream_rows: list[int] = []
             group_of = self.group_of
             flags = self.sampled[need].tolist()
             for r, sampled in zip(np.nonzero(need)[0].tolist(), flags, strict=True):
@@ -1847,6 +1853,10 @@ class AxisBank:
                 if r in filled:
                     continue
                 cl = self._cluster_of[group_of[r]]
+                if cl.pt_stream:  # a dynamic PT FIFO (bank_pt_stream), all of them at once
+                    stream_rows.append(r)
+                    cl.snaps = []
+                    continue
                 if cl.compiled_pt:  # a PT axis alone: all of them in one compiled call
                     pt_rows.append(r)
                     cl.snaps = []
@@ -1866,6 +1876,8 @@ class AxisBank:
             if pt_rows:
                 assert self.pt_fill is not None
                 self.sampled_samples += self.pt_fill.fill(self, pt_rows, SAMPLED_TABLE)
+            if stream_rows:
+                self.sampled_samples += stream_of(self).fill(stream_rows, SAMPLED_TABLE)
         left = (self.t_len - cur)[moving]
         self._refill_in = int(left.min()) if len(left) else self.table
 

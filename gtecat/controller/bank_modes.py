@@ -43,6 +43,7 @@ import numpy as np
 
 from .bank_crd import crd_fill
 from .bank_kernel import MAXSEG, PT_STATE
+from .bank_pt_stream import stream_kind, stream_of
 from .bank_slaves import compiled_kind, slave_fill
 from .crd.system import AxisSlot, CoordSystem, CrdNow, Delay, Motion
 from .motion.follow import FollowPlanner
@@ -86,7 +87,7 @@ def sampled_kind(pl: Any) -> bool:
         return False
     t = type(pl).__mro__
     if PtPlanner in t:
-        return _get(pl, "_state") == 0 or _get(pl, "_mode") == PtMode.STATIC
+        return True  # (a dynamic FIFO in motion: bank_pt_stream)
     if GearPlanner in t:
         return True
     if FollowPlanner in t:
@@ -191,7 +192,8 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
             if mr is None:
                 bad.add(r)
                 continue
-            if master[1] != _MASTER_PROFILE:
+            if master[1] != _MASTER_PROFILE or stream_kind(res_of[mr].profile.planner):
+                # (a dynamic PT master's stream runs alone: bank_pt_stream)
                 bad.update((r, mr))
                 continue
             pairs.append((r, mr))
@@ -545,6 +547,7 @@ class Cluster:
         "list_leads",
         "masters",
         "planners",
+        "pt_stream",
         "pts",
         "rows",
         "rows_arr",
@@ -606,6 +609,10 @@ class Cluster:
         )
         if self.compiled_pt:
             bank.pt_fill.load(self.rows[0], pl)  # type: ignore[union-attr]
+        #: a PT axis alone running a dynamic FIFO (bank_pt_stream fills its tables)
+        self.pt_stream = len(self.rows) == 1 and stream_kind(pl)
+        if self.pt_stream:
+            stream_of(bank).load(self.rows[0], pl)
         self.before: list[bool] = []
         #: a static PT FIFO's points for the compiled fill: (address, rows, the array)
         self.pts: dict[int, tuple[int, int, np.ndarray]] = {}
@@ -1041,6 +1048,9 @@ class Cluster:
     def rewind(self, bank: AxisBank) -> None:
         """Put the planners where the scalar path has them: their state at the last fill,
         then as many steps as the bank ran since."""
+        if self.pt_stream:
+            stream_of(bank).rewind(self)
+            return
         if self.compiled_pt:
             assert bank.pt_fill is not None
             if self.snaps is None:  # never filled: the planner never left its state
