@@ -28,9 +28,12 @@ programs with the bank and without it and compare every axis's positions and sta
 from __future__ import annotations
 
 from collections.abc import Callable
+from itertools import chain
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
+from .bank import _GUARD_SET, _SEG_PACK, _TPRM_PACK, MAXSEG, NTPRM, _Bypass, _reguard, _unguard
+from .bank_pt_stream import fifos_current
 from .motion.pt import PtPlanner
 from .motion.trap import _MOVE, TrapPlanner
 from .motion.trap_table import advance
@@ -47,6 +50,7 @@ _get, _set = object.__getattribute__, object.__setattr__
 _TRAP_SLOTS = ("_k", "_pos", "_vel", "_acc", "_mode", "_segs", "_i", "_j", "_ts", "_t_done",
                "_t_final", "_dir", "_target", "_speed", "_prm", "stopping")  # fmt: skip
 _trap_state = attrgetter(*_TRAP_SLOTS)
+_chain = chain.from_iterable
 
 
 def call_streamed(
@@ -55,15 +59,37 @@ def call_streamed(
     """``call()``'s result, a GT function of :data:`STREAMED` with ``values`` on ``ctl``: on
     its axis's claimed row where that row allows it (module docstring), else as any call
     (its axis given back first: :meth:`AxisBank.before_call`)."""
-    r = _row(bank, ctl, values)
+    r = stream_row(bank, ctl, proto.name, values)
     if r >= 0:
         if proto.name == "GT_MoveAbsolute":
-            if _trap_row(bank, r):
-                return retarget(bank, r, call)
-        elif _pt_row(bank, r, proto.name, values):
-            return pt_call(bank, r, call)
+            return retarget(bank, r, call)
+        return pt_call(bank, r, call)
     bank.before_call(ctl, proto, values)
     return call()
+
+
+def stream_row(bank: AxisBank, ctl: Any, name: str, values: tuple) -> int:
+    """The claimed row GT function ``name`` of :data:`STREAMED` with ``values`` may run on,
+    the row kept (module docstring), else -1."""
+    r = _row(bank, ctl, values)
+    if r < 0:
+        return -1
+    if name == "GT_MoveAbsolute":
+        return r if _trap_row(bank, r) else -1
+    return r if _pt_row(bank, r, name, values) else -1
+
+
+def on_row(obj: Any, fn: Callable[[], Any]) -> Any:
+    """``fn()`` with ``obj`` (a claimed row's planner) out of its guard class for the call:
+    read and changed as it is, nothing given back (a guarded attribute costs a Python call)."""
+    cls = type(obj)
+    if cls not in _GUARD_SET:
+        return fn()
+    _set(obj, "__class__", cls.__base__)
+    try:
+        return fn()
+    finally:
+        _set(obj, "__class__", cls)
 
 
 def _row(bank: AxisBank, ctl: Any, values: tuple) -> int:
@@ -99,8 +125,6 @@ def _trap_row(bank: AxisBank, r: int) -> bool:
 def retarget(bank: AxisBank, r: int, call: Callable[[], Any]) -> Any:
     """``call()`` (GT_MoveAbsolute) on claimed Trap row ``r``: its planner put where the
     scalar path has it now, the call run on it, the row taking the new move up."""
-    from .bank import _Bypass, _reguard, _unguard
-
     res = bank.res[r]
     pl = res.profile.planner
     was_moving = bool(bank.moving[r])
@@ -136,8 +160,6 @@ def retarget(bank: AxisBank, r: int, call: Callable[[], Any]) -> Any:
 def load_trap(bank: AxisBank, r: int, pl: TrapPlanner) -> None:
     """Row ``r``'s Trap move taken up from its planner, as :meth:`AxisBank._load` takes it
     (the row's other state - drive, encoder, band, flags - is what it was)."""
-    from .bank import _SEG_PACK, _TPRM_PACK, MAXSEG, NTPRM, chain
-
     moving = pl._mode == _MOVE
     bank.moving[r] = moving
     bank.taken[r] = 0
@@ -147,7 +169,7 @@ def load_trap(bank: AxisBank, r: int, pl: TrapPlanner) -> None:
     segs = pl._segs
     if moving and len(segs) <= MAXSEG and bank._kernel_lib is not None:
         m = len(segs)
-        _SEG_PACK[m].pack_into(bank.seg, r * MAXSEG * 32, *chain.from_iterable(segs))
+        _SEG_PACK[m].pack_into(bank.seg, r * MAXSEG * 32, *_chain(segs))
         _TPRM_PACK.pack_into(
             bank.tprm, r * NTPRM * 8,
             pl._t_done, pl._ts, pl._t_final, float(pl._target), pl._dir, pl._T,
@@ -173,23 +195,19 @@ def _pt_row(bank: AxisBank, r: int, name: str, values: tuple) -> bool:
     pl = prof.planner
     if PtPlanner not in type(pl).__mro__:
         return False
-    from .bank_pt_stream import fifos_current
-
     return fifos_current(bank, r, pl, name, values)
 
 
 def pt_call(bank: AxisBank, r: int, call: Callable[[], Any]) -> Any:
     """``call()`` (GT_PtData, GT_PtSpace) on claimed PT row ``r``: the planner's FIFOs read
     and appended to as they stand (they are the scalar path's: :func:`_pt_row`)."""
-    from .bank import _Bypass
-
     _Bypass.on = True
     try:
-        rc = call()
+        rc = on_row(bank.res[r].profile.planner, call)
     finally:
         _Bypass.on = False
     bank.streamed_calls += 1
     return rc
 
 
-__all__ = ["STREAMED", "call_streamed", "load_trap", "pt_call", "retarget"]
+__all__ = ["STREAMED", "call_streamed", "load_trap", "on_row", "pt_call", "retarget", "stream_row"]

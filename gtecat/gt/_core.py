@@ -45,6 +45,7 @@ from ..master.clock import ClockGroup, ClockMode
 from . import fast as _fast
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder, impl_params
 from .fast import FAST_MAKERS, set_gates
+from .fast_stream import STREAM_MAKERS
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -614,7 +615,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    make = FAST_MAKERS.get(name)
+    make = FAST_MAKERS.get(name) or STREAM_MAKERS.get(name)
     if make is not None:
         slow = gt  # (the common shapes up front: gt.fast)
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))

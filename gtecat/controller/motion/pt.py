@@ -80,6 +80,10 @@ class PtSegmentType(IntEnum):
     STOP = 2
 
 
+#: a GT_PtData type -> its segment type (a look-up: GT_PtData is called per streamed point)
+_SEGMENT_TYPES = {int(k): k for k in PtSegmentType}
+
+
 @dataclass(frozen=True, slots=True)
 class PtPoint:
     """One GT_PtData segment: end position (pulse) and end time (ms) from the PT start."""
@@ -196,10 +200,10 @@ class PtPlanner:
         """GT_PtData: push one segment end point (``fifo`` is ignored in dynamic mode)."""
         p = checks.real("pos", pos)
         t = checks.real("time", time)
-        kind = checks.integer("type", type)
-        if kind not in tuple(PtSegmentType):
+        kind = _SEGMENT_TYPES.get(checks.integer("type", type))
+        if kind is None:
             raise ParameterError(f"type must be 0 (normal), 1 (even) or 2 (stop), got {type!r}")
-        point = PtPoint(p, t, PtSegmentType(kind))
+        point = PtPoint(p, t, kind)
         if self._mode == PtMode.STATIC:
             q = self._fifos[fifo_index(fifo)]
             last = q.last

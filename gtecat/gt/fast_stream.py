@@ -1,0 +1,158 @@
+"""The fast path of the calls an application streams: ``GT_PtData`` and ``GT_PtSpace``.
+
+A program refilling dynamic PT FIFOs calls them thousands of times a second (64 axes of
+10 ms segments: about 6,400 points and 3,200 space reads).  The table path checks and
+converts every argument generically (:mod:`gtecat.gt.args`) and costs several times the
+planner's own work; here the one shape such a loop passes - plain ``int`` / ``float``
+arguments, the space into ``byref`` of an integer (or the object itself) - goes to the
+planner directly, on an axis the bank does not run or on a row it may keep
+(:func:`gtecat.controller.bank_stream.stream_row`).  Anything else, and any call the planner
+refuses, takes the table path, which answers with its own code and reason (a refused call
+changes nothing, so running it again there is the same call).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from ..controller.bank_stream import on_row, stream_row
+from ..controller.epoch import EPOCH
+from ..controller.motion.pt import PtPlanner
+from ..controller.profile import PrfMode
+from ..master.clock import ClockMode
+
+_NO: Any = object()
+_LOCKSTEP = ClockMode.LOCKSTEP
+_PT = PrfMode.PT
+_LONG = (-(1 << 31), (1 << 31) - 1)
+_SHORT = (-(1 << 15), (1 << 15) - 1)
+
+
+def _planner(session: Any, n: int) -> tuple[Any, Any] | None:
+    """(the in-process controller, axis ``n``'s PT planner) where the fast path may call it,
+    else None: core 1 in this process, no cycle thread, no pulse card, the axis in PT mode."""
+    if not session.plain:
+        return None
+    ctl = session.controllers.get(1)
+    if ctl is None or ctl.clock._thread is not None or ctl.card is not None:
+        return None
+    res = getattr(ctl, "resources", {}).get(n)
+    if res is None or ctl.axes.get(n) is not res.ax:
+        return None
+    prof = res.profile
+    if prof.mode is not _PT:
+        return None
+    pl = prof.planner
+    if PtPlanner not in type(pl).__mro__:
+        return None
+    return ctl, pl
+
+
+def _done(session: Any, ctl: Any, name: str, advance: Callable[[Any, str, int], int]) -> int:
+    """What the GT layer does after a call that returned 0 (``_core.gt_function``'s run)."""
+    EPOCH.n += 1
+    if session.note is None:
+        session.last = None
+    else:
+        from ._core import call_done
+
+        call_done(name)
+    if ctl.clock.mode is _LOCKSTEP:
+        return 0
+    return advance(ctl, name, 0)
+
+
+def fast_pt_data(
+    name: str, slow: Callable[..., int], session: Any, advance: Callable[[Any, str, int], int]
+) -> Callable[..., int]:
+    """``GT_PtData(profile, pos, time[, type[, fifo]])`` with plain numbers."""
+
+    def gt(
+        profile: Any = _NO, pos: Any = _NO, time: Any = _NO, kind: Any = _NO, fifo: Any = _NO,
+        /, *extra: Any, **kw: Any,
+    ) -> int:  # fmt: skip
+        args = (profile, pos, time, kind, fifo)  # (what the caller passed: the table path's)
+        if kind is _NO:
+            kind = 0
+        if fifo is _NO:
+            fifo = 0
+        if (
+            not extra
+            and not kw
+            and type(profile) is int
+            and type(time) is int
+            and type(kind) is int
+            and type(fifo) is int
+            and (type(pos) is float or type(pos) is int)
+            and _LONG[0] <= time <= _LONG[1]
+            and _SHORT[0] <= kind <= _SHORT[1]
+            and _SHORT[0] <= fifo <= _SHORT[1]
+        ):
+            got = _planner(session, profile)
+            if got is not None:
+                ctl, pl = got
+                bank = ctl.bank
+                # (time as checks.real takes an int: float(time))
+                values = (profile, pos, time, kind, fifo)
+                if bank is None or stream_row(bank, ctl, name, values) >= 0:
+                    try:
+                        on_row(pl, lambda: pl.data(float(pos), float(time), kind, fifo))
+                    except Exception:
+                        pass  # (refused: the table path says why, with its code)
+                    else:
+                        if bank is not None:
+                            bank.streamed_calls += 1
+                        return _done(session, ctl, name, advance)
+        return slow(*(a for a in args if a is not _NO), *extra, **kw)
+
+    return gt
+
+
+def fast_pt_space(
+    name: str, slow: Callable[..., int], session: Any, advance: Callable[[Any, str, int], int]
+) -> Callable[..., int]:
+    """``GT_PtSpace(profile, &space[, fifo])``, the space into ``byref`` of an integer or the
+    object itself."""
+    from .args import _scalar_types
+    from .fast import _int_bounds, _target
+    from .table import FUNCTIONS
+
+    ok = _scalar_types(FUNCTIONS[name].params[1])
+    bounds = _int_bounds(ok)
+    target = _target(ok)
+
+    def gt(profile: Any = _NO, p: Any = _NO, fifo: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        args = (profile, p, fifo)  # (what the caller passed: the table path's)
+        if fifo is _NO:
+            fifo = 0
+        if not extra and not kw and type(profile) is int and type(fifo) is int:
+            obj = target(p)
+            b = bounds.get(type(obj))
+            if b is not None and _SHORT[0] <= fifo <= _SHORT[1]:
+                got = _planner(session, profile)
+                if got is not None:
+                    ctl, pl = got
+                    bank = ctl.bank
+                    if bank is None or stream_row(bank, ctl, name, (profile, p, fifo)) >= 0:
+                        try:
+                            v = on_row(pl, lambda: pl.space(fifo))
+                        except Exception:
+                            v = None
+                        if v is not None and b[0] <= v <= b[1]:
+                            obj.value = v
+                            if bank is not None:
+                                bank.streamed_calls += 1
+                            return _done(session, ctl, name, advance)
+        return slow(*(a for a in args if a is not _NO), *extra, **kw)
+
+    return gt
+
+
+#: function -> the maker of its fast path (the GT layer puts it in front of the table path)
+STREAM_MAKERS: dict[str, Callable[..., Callable[..., int]]] = {
+    "GT_PtData": fast_pt_data,
+    "GT_PtSpace": fast_pt_space,
+}
+
+__all__ = ["STREAM_MAKERS", "fast_pt_data", "fast_pt_space"]
