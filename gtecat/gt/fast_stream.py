@@ -1,4 +1,5 @@
-"""The fast path of the calls an application streams: ``GT_PtData`` and ``GT_PtSpace``.
+"""The fast path of the calls an application streams: ``GT_PtData``, ``GT_PtSpace`` and
+``GT_MoveAbsolute``.
 
 A program refilling dynamic PT FIFOs calls them thousands of times a second (64 axes of
 10 ms segments: about 6,400 points and 3,200 space reads).  The table path checks and
@@ -149,10 +150,52 @@ def fast_pt_space(
     return gt
 
 
+def fast_move_absolute(
+    name: str, slow: Callable[..., int], session: Any, advance: Callable[[Any, str, int], int]
+) -> Callable[..., int]:
+    """``GT_MoveAbsolute(profile, &prm)``, ``prm`` a TMoveAbsolutePrm passed by ``byref`` or
+    itself, on an axis in Trap mode: on the row the bank keeps (a new target in place:
+    :func:`gtecat.controller.bank_stream.retarget`) or on an axis it does not run."""
+    from ..controller.bank_stream import retarget
+    from .fast import _target
+    from .plcopen_calls import TMoveAbsolutePrm, move_absolute
+
+    target = _target(frozenset({TMoveAbsolutePrm}))
+    trap = PrfMode.TRAP
+
+    def gt(profile: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if not extra and not kw and type(profile) is int and session.plain:
+            obj = target(p)
+            ctl = session.controllers.get(1)
+            if (
+                type(obj) is TMoveAbsolutePrm
+                and ctl is not None
+                and ctl.clock._thread is None
+                and ctl.card is None
+            ):
+                res = getattr(ctl, "resources", {}).get(profile)
+                if res is not None and ctl.axes.get(profile) is res.ax and res.profile.mode is trap:
+                    bank = ctl.bank
+                    try:
+                        if bank is None:
+                            move_absolute(ctl, profile, obj)
+                            return _done(session, ctl, name, advance)
+                        r = stream_row(bank, ctl, name, (profile, p))
+                        if r >= 0:
+                            retarget(bank, r, lambda: move_absolute(ctl, profile, obj))
+                            return _done(session, ctl, name, advance)
+                    except Exception:
+                        pass  # (refused, nothing changed: the table path says why)
+        return slow(*(a for a in (profile, p) if a is not _NO), *extra, **kw)
+
+    return gt
+
+
 #: function -> the maker of its fast path (the GT layer puts it in front of the table path)
 STREAM_MAKERS: dict[str, Callable[..., Callable[..., int]]] = {
     "GT_PtData": fast_pt_data,
     "GT_PtSpace": fast_pt_space,
+    "GT_MoveAbsolute": fast_move_absolute,
 }
 
-__all__ = ["STREAM_MAKERS", "fast_pt_data", "fast_pt_space"]
+__all__ = ["STREAM_MAKERS", "fast_move_absolute", "fast_pt_data", "fast_pt_space"]
