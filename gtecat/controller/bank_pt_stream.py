@@ -23,7 +23,6 @@ planner and its FIFOs as they were before it.
 from __future__ import annotations
 
 import math
-from collections import defaultdict
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -65,6 +64,11 @@ class PtStream:
         self.before: dict[int, tuple] = {}
         #: samples stepped by the planner itself at a FIFO's end (statistics)
         self.events = 0
+        #: row -> the running FIFO's list of points and how many of them ``points`` holds
+        self.items: dict[int, list] = {}
+        self.count: dict[int, int] = {}
+        #: per row, the end time of the running FIFO's last point (the compiled fill's cut)
+        self.t_last = np.zeros(len(bank.res))
 
     # --- a row claimed --------------------------------------------------------------------
     def load(self, r: int, pl: PtPlanner) -> None:
@@ -95,6 +99,11 @@ class PtStream:
         if n > m:
             buf[m:n] = [(p.pos, p.time, float(int(p.type))) for p in items[m:n]]
         pf.m[r] = n
+        self.items[r], self.count[r] = items, n
+        if r >= len(self.t_last):  # (a bank of more rows since)
+            self.t_last = np.concatenate((self.t_last, np.zeros(r + 1 - len(self.t_last))))
+        if n:
+            self.t_last[r] = items[-1].time
 
     # --- tables -----------------------------------------------------------------------------
     def fill(self, rows: list[int], n: int) -> int:
@@ -102,38 +111,57 @@ class PtStream:
         from .bank import _Bypass
 
         bank = self.bank
-        pf = bank.pt_fill
-        groups: dict[int, list[int]] = defaultdict(list)
         total = 0
         _Bypass.on = True
         try:
+            if bank.pt_fill is not None:
+                return self._fill_compiled(rows, n)
             for r in rows:
                 pl = bank.res[r].profile.planner
                 bank.fill_taken[r] = bank.taken[r]
-                if pf is not None:
-                    self._points(r, pl)
-                    st = pf.st[r]
-                    k, cyc, toff = int(st[_K]), float(st[_T]), float(st[_TOFF])
-                else:
-                    k, cyc, toff = _get(pl, "_k"), _get(pl, "_T"), _get(pl, "_toff")
+                k, cyc, toff = _get(pl, "_k"), _get(pl, "_T"), _get(pl, "_toff")
                 q = _get(pl, "_fifos")[_get(pl, "_r")]
                 c = _before_end(k, cyc, q._items[-1].time + toff)
                 if c == 0:
                     total += self._event(r, pl)
                     continue
                 self.ev.pop(r, None)
-                c = min(c, n)
-                if pf is not None:
-                    groups[c].append(r)
-                    continue
                 self.before[r] = tuple(_get(pl, name) for name in PT_STATE)
-                ps, vs, as_, end = pl.run(c)
+                ps, vs, as_, end = pl.run(min(c, n))
                 total += _put(bank, r, ps, vs, as_, end)
         finally:
             _Bypass.on = False
-        for c, rs in groups.items():
-            assert pf is not None
-            total += pf.fill(bank, rs, c)
+        return total
+
+    def _fill_compiled(self, rows: list[int], n: int) -> int:
+        """:meth:`fill` by the compiled PT fill: every row's cut at once (``_before_end``'s
+        operations on arrays), the rows of one cut in one call."""
+        bank = self.bank
+        pf = bank.pt_fill
+        assert pf is not None
+        res, items, count = bank.res, self.items, self.count
+        for r in rows:  # (the running FIFO grew: its new points for the compiled fill)
+            q = items.get(r)
+            if q is None or len(q) != count[r]:
+                self._points(r, res[r].profile.planner)
+        ra = np.array(rows, np.intp)
+        bank.fill_taken[ra] = bank.taken[ra]
+        st = pf.st[ra]
+        c = _before_end_rows(st[:, _K], st[:, _T], self.t_last[ra] + st[:, _TOFF])
+        total = 0
+        at_end = c == 0
+        if np.count_nonzero(at_end):
+            for r in ra[at_end].tolist():
+                total += self._event(r, res[r].profile.planner)
+            ra, c = ra[~at_end], c[~at_end]
+        if self.ev:
+            for r in ra.tolist():
+                self.ev.pop(r, None)
+        c = np.minimum(c, n)
+        if len(c) and (c == c[0]).all():
+            return total + pf.fill(bank, ra.tolist(), int(c[0]))
+        for v in np.unique(c).tolist():
+            total += pf.fill(bank, ra[c == v].tolist(), v)
         return total
 
     def _event(self, r: int, pl: PtPlanner) -> int:
@@ -176,6 +204,8 @@ class PtStream:
         ev = self.ev.pop(r, None)
         before = self.before.pop(r, None)
         buf = self.points.pop(r, None)
+        self.items.pop(r, None)
+        self.count.pop(r, None)
         if pf is not None:
             pf._points.pop(r, None)
         if cl.snaps is None:  # never filled: the planner never left its state
@@ -216,6 +246,24 @@ def _before_end(k: int, cyc: float, t1: float) -> int:
     while s * cyc < lim:
         s += 1
     return s - (k + 1)
+
+
+def _before_end_rows(k: np.ndarray, cyc: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    """:func:`_before_end` of many rows (float64 arrays; the same IEEE operations)."""
+    lim = t1 - _EPS_T * (1.0 + np.abs(t1) * 1e-3)
+    first = k + 1.0
+    s = np.maximum(first, np.ceil(lim / cyc))
+    while True:
+        down = (s > first) & ((s - 1.0) * cyc >= lim)
+        if not np.count_nonzero(down):
+            break
+        s -= down
+    while True:
+        up = s * cyc < lim
+        if not np.count_nonzero(up):
+            break
+        s += up
+    return (s - first).astype(np.int64)
 
 
 def _put(bank: AxisBank, r: int, ps: Any, vs: Any, as_: Any, end: int) -> int:
