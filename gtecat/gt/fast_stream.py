@@ -50,6 +50,59 @@ def _planner(session: Any, n: int) -> tuple[Any, Any] | None:
     return ctl, pl
 
 
+#: profile -> (controller, bank, its releases and layout counts then, planner, row, the
+#: bank's PtStream or None for a row at rest): a PT axis the bank keeps, found by the full
+#: look (:func:`_planner`, ``stream_row``) and taken again without it while the bank has
+#: neither claimed nor given back a row since (a mode change, a start, a stop give their
+#: axis back first); what may change from cycle to cycle is looked at on every call
+_ROWS: dict[int, tuple] = {}
+
+
+def _pt_target(session: Any, n: int, name: str, values: tuple) -> tuple[Any, Any, Any] | None:
+    """(controller, bank or None, planner) of PT axis ``n`` where ``name`` may run on it
+    (:func:`_planner`; a claimed row: ``stream_row``), else None."""
+    if not session.plain:
+        return None
+    ctl = session.controllers.get(1)
+    k = _ROWS.get(n)
+    if k is not None and k[0] is ctl:
+        bank = k[1]
+        r = k[5]
+        if (
+            bank.releases == k[2]
+            and bank.layout == k[3]
+            and bank._stepping < 0
+            and not bank._opened
+            and bank._frozen_call < 0
+            and r not in bank._open
+            and r not in bank._tp_apply
+            and r not in bank._post_next
+            and bank.alive[r]
+            and (k[6] is None or k[6].current(r))
+        ):
+            return ctl, bank, k[4]
+    got = _planner(session, n)
+    if got is None:
+        return None
+    ctl, pl = got
+    bank = ctl.bank
+    if bank is None:
+        return ctl, None, pl
+    r = stream_row(bank, ctl, name, values)
+    if r < 0:
+        return None
+    stream = None
+    if bank.sampled[r]:
+        cl = bank._cluster_of.get(bank.group_of[r])
+        stream = bank.__dict__.get("pt_stream") if getattr(cl, "pt_stream", False) else None
+        if stream is None:  # (a static FIFO: the answer depends on the FIFO named)
+            return ctl, bank, pl
+    if len(_ROWS) > 4096:
+        _ROWS.clear()
+    _ROWS[n] = (ctl, bank, bank.releases, bank.layout, pl, r, stream)
+    return ctl, bank, pl
+
+
 def _done(session: Any, ctl: Any, name: str, advance: Callable[[Any, str, int], int]) -> int:
     """What the GT layer does after a call that returned 0 (``_core.gt_function``'s run)."""
     EPOCH.n += 1
@@ -90,21 +143,17 @@ def fast_pt_data(
             and _SHORT[0] <= kind <= _SHORT[1]
             and _SHORT[0] <= fifo <= _SHORT[1]
         ):
-            got = _planner(session, profile)
+            got = _pt_target(session, profile, name, (profile, pos, time, kind, fifo))
             if got is not None:
-                ctl, pl = got
-                bank = ctl.bank
-                # (time as checks.real takes an int: float(time))
-                values = (profile, pos, time, kind, fifo)
-                if bank is None or stream_row(bank, ctl, name, values) >= 0:
-                    try:
-                        on_row(pl, lambda: pl.data(float(pos), float(time), kind, fifo))
-                    except Exception:
-                        pass  # (refused: the table path says why, with its code)
-                    else:
-                        if bank is not None:
-                            bank.streamed_calls += 1
-                        return _done(session, ctl, name, advance)
+                ctl, bank, pl = got
+                try:  # (time as checks.real takes an int: float(time))
+                    on_row(pl, lambda: pl.data(float(pos), float(time), kind, fifo))
+                except Exception:
+                    pass  # (refused: the table path says why, with its code)
+                else:
+                    if bank is not None:
+                        bank.streamed_calls += 1
+                    return _done(session, ctl, name, advance)
         return slow(*(a for a in args if a is not _NO), *extra, **kw)
 
     return gt
@@ -131,20 +180,18 @@ def fast_pt_space(
             obj = target(p)
             b = bounds.get(type(obj))
             if b is not None and _SHORT[0] <= fifo <= _SHORT[1]:
-                got = _planner(session, profile)
+                got = _pt_target(session, profile, name, (profile, p, fifo))
                 if got is not None:
-                    ctl, pl = got
-                    bank = ctl.bank
-                    if bank is None or stream_row(bank, ctl, name, (profile, p, fifo)) >= 0:
-                        try:
-                            v = on_row(pl, lambda: pl.space(fifo))
-                        except Exception:
-                            v = None
-                        if v is not None and b[0] <= v <= b[1]:
-                            obj.value = v
-                            if bank is not None:
-                                bank.streamed_calls += 1
-                            return _done(session, ctl, name, advance)
+                    ctl, bank, pl = got
+                    try:
+                        v = on_row(pl, lambda: pl.space(fifo))
+                    except Exception:
+                        v = None
+                    if v is not None and b[0] <= v <= b[1]:
+                        obj.value = v
+                        if bank is not None:
+                            bank.streamed_calls += 1
+                        return _done(session, ctl, name, advance)
         return slow(*(a for a in args if a is not _NO), *extra, **kw)
 
     return gt
