@@ -23,6 +23,7 @@ planner and its FIFOs as they were before it.
 from __future__ import annotations
 
 import math
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -39,6 +40,7 @@ _K, _T, _TOFF = PT_STATE.index("_k"), PT_STATE.index("_T"), PT_STATE.index("_tof
 _WHOLE = tuple(name in ("_k", "_i", "_loop", "_loops_done", "_state") for name in PT_STATE)
 #: what a release puts back of a table that began with the FIFO's end (none of it taken)
 _STREAM = ("_r", "_w", "_stream_t")
+_state_of = attrgetter(*PT_STATE)
 
 
 def stream_kind(pl: Any) -> bool:
@@ -167,26 +169,37 @@ class PtStream:
     def _event(self, r: int, pl: PtPlanner) -> int:
         """Row ``r``'s next sample runs its FIFO out: a table of that one sample, stepped by
         the planner on its FIFOs (the state before kept for a release before it is taken)."""
+        from .bank import _GUARD_SET
+
+        cls = type(pl)
+        if cls in _GUARD_SET:  # (its steps read it as it is: out of its guard class meanwhile)
+            _set(pl, "__class__", cls.__base__)
+        try:
+            return self._step_event(r, pl)
+        finally:
+            _set(pl, "__class__", cls)
+
+    def _step_event(self, r: int, pl: PtPlanner) -> int:
         bank = self.bank
         pf = bank.pt_fill
         if pf is not None:  # the compiled state into the planner
             _put_state(pl, pf.st[r].tolist())
-        fifos = _get(pl, "_fifos")
+        fifos = pl._fifos
         self.ev[r] = (
-            tuple(_get(pl, name) for name in PT_STATE),
-            tuple(_get(pl, name) for name in _STREAM),
+            _state_of(pl),
+            (pl._r, pl._w, pl._stream_t),
             (list(fifos[0]._items), list(fifos[1]._items)),
         )
         p, v, a = pl.step()
         self.events += 1
-        after = [_get(pl, name) for name in PT_STATE]
+        after = _state_of(pl)
         if pf is not None:
             pf.st[r] = after
             pf.before[r] = after
             if _get(pl, "_state") == 1:
                 self._points(r, pl, reset=True)
         else:
-            self.before[r] = tuple(after)
+            self.before[r] = after
         return _put(bank, r, [p], [v], [a], 0 if _get(pl, "_state") == 0 else -1)
 
     # --- calls and releases ---------------------------------------------------------------------
