@@ -53,8 +53,8 @@ cleared (its time base is gone), static data is kept.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import IntEnum
+from typing import NamedTuple
 
 from ...errors import CommandError, ParameterError
 from . import checks
@@ -84,9 +84,9 @@ class PtSegmentType(IntEnum):
 _SEGMENT_TYPES = {int(k): k for k in PtSegmentType}
 
 
-@dataclass(frozen=True, slots=True)
-class PtPoint:
-    """One GT_PtData segment: end position (pulse) and end time (ms) from the PT start."""
+class PtPoint(NamedTuple):
+    """One GT_PtData segment: end position (pulse) and end time (ms) from the PT start
+    (a named tuple: made per streamed point, several times cheaper than a frozen class)."""
 
     pos: float
     time: float
@@ -219,12 +219,12 @@ class PtPlanner:
                 f"time must be > {self._stream_t:g} ms (the previous point), got {time!r}"
             )
         q = self._fifos[self._w]
-        other = self._fifos[1 - self._w]
-        if q.space == 0 and len(other) == 0:
+        if q.space == 0:  # full: the other one next, once it was emptied
+            other = self._fifos[1 - self._w]
+            if len(other) != 0 or other.space == 0:
+                raise CommandError("both PT FIFOs are full (dynamic mode): wait until space > 0")
             self._w = 1 - self._w
             q = other
-        if q.space == 0:
-            raise CommandError("both PT FIFOs are full (dynamic mode): wait until space > 0")
         q.push(point)
         self._stream_t = t
 
