@@ -62,9 +62,19 @@ class TMoveAbsolutePrm(ctypes.Structure):
 _KEPT: weakref.WeakKeyDictionary[Any, dict[tuple[str, int], bytes]] = weakref.WeakKeyDictionary()
 
 
+#: (a weak reference to the controller _kept last looked up, its dict): a program giving
+#: new targets every few cycles asks for the same one again and again
+_LAST: list[Any] = [None, None]
+
+
 def _kept(ctl: Controller) -> dict[tuple[str, int], bytes]:
     base = getattr(ctl, "_base", ctl)
-    return _KEPT.setdefault(base, {})
+    last = _LAST[0]
+    if last is not None and last() is base:
+        return _LAST[1]  # type: ignore[no-any-return]
+    kept = _KEPT.setdefault(base, {})
+    _LAST[0], _LAST[1] = weakref.ref(base), kept
+    return kept
 
 
 def _copy(prm: Any, data: bytes | None, cls: type[ctypes.Structure]) -> None:
