@@ -27,7 +27,8 @@ its axes together.  The bank runs them so:
   system) of the cluster is kept.  A release puts it back and steps the planners again as
   many cycles as the bank ran since (never more than one table), so they stand where the
   scalar path would have them.  That needs the steps to be repeatable and to touch nothing
-  outside the planner: a static PT FIFO (a dynamic one empties its FIFOs), a Follow without
+  outside the planner: a static PT FIFO (a dynamic one empties its FIFOs: its own tables,
+  :mod:`~gtecat.controller.bank_pt_stream`), a Follow without
   a pending FIFO switch, a coordinate system whose FIFO holds only lines, arcs and delays
   (no GT_BufIO, GT_BufMove, GT_BufGear, no segment with its own speed plan); anything else
   stays scalar.
@@ -192,7 +193,10 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
             if mr is None:
                 bad.add(r)
                 continue
-            if master[1] != _MASTER_PROFILE or stream_kind(res_of[mr].profile.planner):
+            mres = res_of[mr]
+            if master[1] != _MASTER_PROFILE or (
+                mres is not None and stream_kind(mres.profile.planner)
+            ):
                 # (a dynamic PT master's stream runs alone: bank_pt_stream)
                 bad.update((r, mr))
                 continue
