@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..controller.bank import _GUARD_SET
 from ..controller.bank_stream import on_row, stream_row
 from ..controller.epoch import EPOCH
 from ..controller.motion.pt import PtPlanner
@@ -24,6 +25,7 @@ from ..controller.profile import PrfMode
 from ..master.clock import ClockMode
 
 _NO: Any = object()
+_set = object.__setattr__
 _LOCKSTEP = ClockMode.LOCKSTEP
 _PT = PrfMode.PT
 _LONG = (-(1 << 31), (1 << 31) - 1)
@@ -146,11 +148,19 @@ def fast_pt_data(
             got = _pt_target(session, profile, name, (profile, pos, time, kind, fifo))
             if got is not None:
                 ctl, bank, pl = got
+                cls = type(pl)
+                if cls in _GUARD_SET:  # (on_row, inline: a claimed row's planner as it is)
+                    _set(pl, "__class__", cls.__base__)
                 try:  # (time as checks.real takes an int: float(time))
-                    on_row(pl, lambda: pl.data(float(pos), float(time), kind, fifo))
+                    PtPlanner.data(pl, float(pos), float(time), kind, fifo)
                 except Exception:
-                    pass  # (refused: the table path says why, with its code)
+                    ok = False  # (refused: the table path says why, with its code)
                 else:
+                    ok = True
+                finally:
+                    if cls is not type(pl):
+                        _set(pl, "__class__", cls)
+                if ok:
                     if bank is not None:
                         bank.streamed_calls += 1
                     return _done(session, ctl, name, advance)
