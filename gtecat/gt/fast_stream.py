@@ -14,6 +14,7 @@ changes nothing, so running it again there is the same call).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from typing import Any
 
@@ -52,11 +53,13 @@ def _planner(session: Any, n: int) -> tuple[Any, Any] | None:
     return ctl, pl
 
 
-#: profile -> (controller, bank, its releases and layout counts then, planner, row, the
-#: bank's PtStream or None for a row at rest): a PT axis the bank keeps, found by the full
-#: look (:func:`_planner`, ``stream_row``) and taken again without it while the bank has
-#: neither claimed nor given back a row since (a mode change, a start, a stop give their
-#: axis back first); what may change from cycle to cycle is looked at on every call
+#: profile -> (a weak reference to the controller, its bank's releases and layout counts
+#: then, the row, whether it is a dynamic stream's, a weak reference to the bank): a PT axis
+#: the bank keeps, found by the full look (:func:`_planner`, ``stream_row``) and taken again
+#: without it while the bank has neither claimed nor given back a row since (a mode change,
+#: a start, a stop give their axis back first); what may change from cycle to cycle is
+#: looked at on every call.  Nothing of a controller is held here: a closed one goes as it
+#: always did.
 _ROWS: dict[int, tuple] = {}
 
 
@@ -67,12 +70,16 @@ def _pt_target(session: Any, n: int, name: str, values: tuple) -> tuple[Any, Any
         return None
     ctl = session.controllers.get(1)
     k = _ROWS.get(n)
-    if k is not None and k[0] is ctl:
-        bank = k[1]
-        r = k[5]
+    if k is not None and k[0]() is ctl:
+        bank = ctl.bank
+        r = k[3]
+        res = ctl.resources.get(n)
         if (
-            bank.releases == k[2]
-            and bank.layout == k[3]
+            res is not None
+            and bank is not None
+            and k[5]() is bank
+            and bank.releases == k[1]
+            and bank.layout == k[2]
             and bank._stepping < 0
             and not bank._opened
             and bank._frozen_call < 0
@@ -80,9 +87,9 @@ def _pt_target(session: Any, n: int, name: str, values: tuple) -> tuple[Any, Any
             and r not in bank._tp_apply
             and r not in bank._post_next
             and bank.alive[r]
-            and (k[6] is None or k[6].current(r))
+            and (not k[4] or bank.pt_stream.current(r))
         ):
-            return ctl, bank, k[4]
+            return ctl, bank, res.profile.planner
     got = _planner(session, n)
     if got is None:
         return None
@@ -93,15 +100,15 @@ def _pt_target(session: Any, n: int, name: str, values: tuple) -> tuple[Any, Any
     r = stream_row(bank, ctl, name, values)
     if r < 0:
         return None
-    stream = None
+    stream = False
     if bank.sampled[r]:
         cl = bank._cluster_of.get(bank.group_of[r])
-        stream = bank.__dict__.get("pt_stream") if getattr(cl, "pt_stream", False) else None
-        if stream is None:  # (a static FIFO: the answer depends on the FIFO named)
+        stream = bool(getattr(cl, "pt_stream", False)) and "pt_stream" in bank.__dict__
+        if not stream:  # (a static FIFO: the answer depends on the FIFO named)
             return ctl, bank, pl
     if len(_ROWS) > 4096:
         _ROWS.clear()
-    _ROWS[n] = (ctl, bank, bank.releases, bank.layout, pl, r, stream)
+    _ROWS[n] = (weakref.ref(ctl), bank.releases, bank.layout, r, stream, weakref.ref(bank))
     return ctl, bank, pl
 
 
