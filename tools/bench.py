@@ -979,6 +979,9 @@ def bench_bringup_growth(counts: Sequence[int] = (256, 512, 1024, 2048)) -> dict
     }
 
 
+#: the streaming figures (tools/bench_stream.py)
+PT_DYNAMIC = "PT, dynamic FIFOs refilled every 20 ms (GT_PtSpace, GT_PtData per free slot)"
+MOVE_ABSOLUTE = "a GT_MoveAbsolute to a new target on every axis every 20 ms"
 GEAR = "per core: the first axis in Trap, the others in Gear on it (1:2)"
 FOLLOW = "per core: the first axis in Trap, the others in Follow on it (a 16-point cam, endless)"
 CRD = "per core: 2 XY coordinate systems (4 axes) on a path of lines and arcs, the others holding"
@@ -1296,6 +1299,13 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
     def every(n: int, state: str) -> dict[int, str]:
         return dict.fromkeys(range(1, n + 1), state)
 
+    def stream(n: int, kind: str, target: float, what: str) -> dict[str, object]:
+        """An application streaming calls into ``n`` moving axes (tools/bench_stream.py)."""
+        from tools.bench_stream import run_stream
+
+        r = {"axes": n, "what": what, **run_stream(n, kind, seconds, repeat)}
+        return _figure(r, "rtf_cpu", target)  # (per CPU second: the calls are the load)
+
     half = {a: "moving" if a % 2 else "idle" for a in range(1, 65)}
     homed_half = {a: "moving" if a % 2 else "homed6" for a in range(1, 65)}
 
@@ -1362,6 +1372,8 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
         "rtf_12_axes_pt": lambda: rtf(12, every(12, "pt"), None, "PT, static FIFO, endless loop"),
         "rtf_64_axes_pt": lambda: rtf(64, every(64, "pt"), 10, "PT, static FIFO, endless loop"),
         "rtf_64_axes_pvt": lambda: rtf(64, every(64, "pvt"), 10, PVT),
+        "rtf_64_axes_pt_dynamic": lambda: stream(64, "pt_dynamic", 10, PT_DYNAMIC),
+        "rtf_64_axes_move_absolute": lambda: stream(64, "move_absolute", 10, MOVE_ABSOLUTE),
         "rtf_12_axes_gear": lambda: rtf(12, every(12, "gear"), None, GEAR),
         "rtf_64_axes_gear": lambda: rtf(64, every(64, "gear"), 10, GEAR),
         "rtf_12_axes_follow": lambda: rtf(12, every(12, "follow"), None, FOLLOW),

@@ -107,6 +107,7 @@ from .bank_modes import (
     sampled_kind,
     trap_steppable,
 )
+from .bank_pt_stream import stream_kind, stream_of
 from .crd.system import Delay, Motion
 from .epoch import EPOCH
 from .lead_screw_bank import (
@@ -831,6 +832,8 @@ class AxisBank:
 
         #: releases so far (a hook that counts on rows staying claimed looks at it)
         self.releases = 0
+        #: GT calls run on a claimed row without giving it back (gtecat.controller.bank_stream)
+        self.streamed_calls = 0
         #: row -> the constants of its last load that _reindex's flags read (_load)
         self._consts: dict[int, tuple] = {}
         #: row -> the Trap table it left with (_keep_table): taken up again when the row comes
@@ -1057,6 +1060,8 @@ class AxisBank:
             try:
                 if not sampled_kind(pl):
                     return False
+                if stream_kind(pl) and len(self.groups[self.group_of[r]].rows) != 1:
+                    return False  # (a dynamic PT FIFO runs in a cluster of its own alone)
             finally:
                 _Bypass.on = False
         else:
@@ -1866,6 +1871,7 @@ class AxisBank:
             self._materialise()
             filled: set[int] = set()  # the rows of the clusters filled
             alone: dict[Any, list[int]] = {}  # PT/PVT rows alone: per compiled fill
+            stream_rows: list[int] = []
             group_of = self.group_of
             flags = self.sampled[need].tolist()
             for r, sampled in zip(np.nonzero(need)[0].tolist(), flags, strict=True):
@@ -1875,6 +1881,10 @@ class AxisBank:
                 if r in filled:
                     continue
                 cl = self._cluster_of[group_of[r]]
+                if cl.pt_stream:  # a dynamic PT FIFO (bank_pt_stream), all of them at once
+                    stream_rows.append(r)
+                    cl.snaps = []
+                    continue
                 if cl.compiled_pt is not None:  # a PT/PVT axis alone: one compiled call
                     alone.setdefault(cl.compiled_pt, []).append(r)
                     cl.snaps = []
@@ -1893,6 +1903,8 @@ class AxisBank:
                         _set(pl, "__class__", cls)
             for fill, rows in alone.items():
                 self.sampled_samples += fill.fill(self, rows, SAMPLED_TABLE)
+            if stream_rows:
+                self.sampled_samples += stream_of(self).fill(stream_rows, SAMPLED_TABLE)
         left = (self.t_len - cur)[moving]
         self._refill_in = int(left.min()) if len(left) else self.table
 

@@ -27,7 +27,8 @@ its axes together.  The bank runs them so:
   system) of the cluster is kept.  A release puts it back and steps the planners again as
   many cycles as the bank ran since (never more than one table), so they stand where the
   scalar path would have them.  That needs the steps to be repeatable and to touch nothing
-  outside the planner: a static PT FIFO (a dynamic one empties its FIFOs), a Follow without
+  outside the planner: a static PT FIFO (a dynamic one empties its FIFOs: its own tables,
+  :mod:`~gtecat.controller.bank_pt_stream`), a Follow without
   a pending FIFO switch, a coordinate system whose FIFO holds only lines, arcs and delays
   (no GT_BufIO, GT_BufMove, GT_BufGear, no segment with its own speed plan); anything else
   stays scalar.
@@ -43,6 +44,7 @@ import numpy as np
 
 from .bank_crd import crd_fill
 from .bank_kernel import MAXSEG, PT_STATE
+from .bank_pt_stream import stream_kind, stream_of
 from .bank_pvt import compiled_kind as pvt_compiled_kind
 from .bank_pvt import fill_row as pvt_fill_row
 from .bank_pvt import pvt_fill
@@ -91,7 +93,7 @@ def sampled_kind(pl: Any) -> bool:
         return False
     t = type(pl).__mro__
     if PtPlanner in t:
-        return _get(pl, "_state") == 0 or _get(pl, "_mode") == PtMode.STATIC
+        return True  # (a dynamic FIFO in motion: bank_pt_stream)
     if PvtPlanner in t:  # (a table's run changes the planner alone: bank_pvt)
         return True
     if GearPlanner in t:
@@ -198,7 +200,11 @@ def links(bank: AxisBank) -> tuple[list[tuple[int, int]], set[int], set[int]]:
             if mr is None:
                 bad.add(r)
                 continue
-            if master[1] != _MASTER_PROFILE:
+            mres = res_of[mr]
+            if master[1] != _MASTER_PROFILE or (
+                mres is not None and stream_kind(mres.profile.planner)
+            ):
+                # (a dynamic PT master's stream runs alone: bank_pt_stream)
                 bad.update((r, mr))
                 continue
             pairs.append((r, mr))
@@ -552,6 +558,7 @@ class Cluster:
         "list_leads",
         "masters",
         "planners",
+        "pt_stream",
         "pts",
         "rows",
         "rows_arr",
@@ -618,6 +625,10 @@ class Cluster:
                 self.compiled_pt = pvt_fill(bank)
             if self.compiled_pt is not None:
                 self.compiled_pt.load(self.rows[0], pl)
+        #: a PT axis alone running a dynamic FIFO (bank_pt_stream fills its tables)
+        self.pt_stream = len(self.rows) == 1 and stream_kind(pl)
+        if self.pt_stream:
+            stream_of(bank).load(self.rows[0], pl)
         self.before: list[bool] = []
         #: a static PT FIFO's points for the compiled fill: (address, rows, the array)
         self.pts: dict[int, tuple[int, int, np.ndarray]] = {}
@@ -1057,6 +1068,9 @@ class Cluster:
     def rewind(self, bank: AxisBank) -> None:
         """Put the planners where the scalar path has them: their state at the last fill,
         then as many steps as the bank ran since."""
+        if self.pt_stream:
+            stream_of(bank).rewind(self)
+            return
         if self.compiled_pt is not None:
             if self.snaps is None:  # never filled: the planner never left its state
                 self.compiled_pt.drop(self.rows[0])

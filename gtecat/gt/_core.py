@@ -27,6 +27,7 @@ from gtecat.drives.machine import MachineError
 from gtecat.eni.errors import EniError, GtecatError
 
 from ..controller.bank import BANK_READS, IN_PLACE, OPENED
+from ..controller.bank_stream import STREAMED, call_streamed
 from ..controller.card import refused
 from ..controller.cards import CARD_CORES
 from ..controller.core import Controller
@@ -45,6 +46,7 @@ from . import centry as _centry
 from . import fast as _fast
 from .args import _NUMERIC, Ref, binder, core_arg, fast_binder, impl_params
 from .fast import FAST_MAKERS, set_gates
+from .fast_stream import STREAM_MAKERS
 from .table import FUNCTIONS, NO_CORE_TWINS, SAME_PARAM_TWINS, Proto
 from .units import with_units
 
@@ -497,6 +499,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     bank_read = name in BANK_READS  # reads a banked axis through the bank: no release
     in_place = name in IN_PLACE  # runs on its axis's claimed row in place
     opened = name in OPENED  # takes its axis out of the bank for the call alone
+    streamed = name in STREAMED  # runs on its axis's claimed row, the row kept (bank_stream)
     #: a fast path whose first parameter is an axis (its GTN_ twin of core c > 1 takes the
     #: bus axis on core 1's fast path; a coordinate system, a type, an offset: its table)
     by_axis = bool(proto.params) and proto.params[0].name in ("axis", "profile", "encoder")
@@ -562,6 +565,8 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                         rc = bank.call_in_place(ctl, proto, values, lambda: fn(ctl, *values))
                     elif opened and not extra:  # (a drive homing's set-up: out for the call)
                         rc = bank.call_opened(ctl, proto, values, lambda: fn(ctl, *values))
+                    elif streamed and not extra:  # (a new target, a PT point: the row kept)
+                        rc = call_streamed(bank, ctl, proto, values, lambda: fn(ctl, *values))
                     else:
                         bank.before_call(ctl, proto, values)  # the axes it names go back first
                         rc = fn(ctl, *values, **extra) if extra else fn(ctl, *values)
@@ -613,7 +618,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     gt.__doc__ = with_units(name, fn.__doc__)  # one units table (gtecat/gt/units.py)
     fast = None
-    make = FAST_MAKERS.get(name)
+    make = FAST_MAKERS.get(name) or STREAM_MAKERS.get(name)
     if make is not None:
         slow = gt  # (the common shapes up front: gt.fast)
         fast = gt = functools.wraps(slow)(make(name, slow, SESSION, advance))

@@ -62,9 +62,19 @@ class TMoveAbsolutePrm(ctypes.Structure):
 _KEPT: weakref.WeakKeyDictionary[Any, dict[tuple[str, int], bytes]] = weakref.WeakKeyDictionary()
 
 
+#: (a weak reference to the controller _kept last looked up, its dict): a program giving
+#: new targets every few cycles asks for the same one again and again
+_LAST: list[Any] = [None, None]
+
+
 def _kept(ctl: Controller) -> dict[tuple[str, int], bytes]:
     base = getattr(ctl, "_base", ctl)
-    return _KEPT.setdefault(base, {})
+    last = _LAST[0]
+    if last is not None and last() is base:
+        return _LAST[1]  # type: ignore[no-any-return]
+    kept = _KEPT.setdefault(base, {})
+    _LAST[0], _LAST[1] = weakref.ref(base), kept
+    return kept
 
 
 def _copy(prm: Any, data: bytes | None, cls: type[ctypes.Structure]) -> None:
@@ -109,10 +119,9 @@ def GT_GetMoveVelocity(ctl: Controller, profile: int, pPrm: Any) -> int:
     return 0
 
 
-@gt_function
-def GT_MoveAbsolute(ctl: Controller, profile: int, pPrm: Any) -> int:
-    """A Trap move to ``pos``, started now (the module docstring)."""
-    prm = struct_arg(pPrm, TMoveAbsolutePrm, "pPrm")
+def move_absolute(ctl: Controller, profile: int, prm: Any) -> int:
+    """GT_MoveAbsolute with its parameters ``prm`` (a TMoveAbsolutePrm, or a view of one):
+    also what its fast path calls (gtecat.gt.fast_stream)."""
     vel, acc = _positive("vel", prm.vel), _positive("acc", prm.acc)
     dec = _positive("dec", prm.dec) if prm.dec != 0 else acc
     if not 0 <= prm.percent <= 100:
@@ -129,6 +138,12 @@ def GT_MoveAbsolute(ctl: Controller, profile: int, pPrm: Any) -> int:
     res.start()
     _kept(ctl)[("abs", res.number)] = bytes(prm)
     return 0
+
+
+@gt_function
+def GT_MoveAbsolute(ctl: Controller, profile: int, pPrm: Any) -> int:
+    """A Trap move to ``pos``, started now (the module docstring)."""
+    return move_absolute(ctl, profile, struct_arg(pPrm, TMoveAbsolutePrm, "pPrm"))
 
 
 @gt_function

@@ -53,8 +53,8 @@ cleared (its time base is gone), static data is kept.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import IntEnum
+from typing import NamedTuple
 
 from ...errors import CommandError, ParameterError
 from . import checks
@@ -80,9 +80,13 @@ class PtSegmentType(IntEnum):
     STOP = 2
 
 
-@dataclass(frozen=True, slots=True)
-class PtPoint:
-    """One GT_PtData segment: end position (pulse) and end time (ms) from the PT start."""
+#: a GT_PtData type -> its segment type (a look-up: GT_PtData is called per streamed point)
+_SEGMENT_TYPES = {int(k): k for k in PtSegmentType}
+
+
+class PtPoint(NamedTuple):
+    """One GT_PtData segment: end position (pulse) and end time (ms) from the PT start
+    (a named tuple: made per streamed point, several times cheaper than a frozen class)."""
 
     pos: float
     time: float
@@ -196,10 +200,10 @@ class PtPlanner:
         """GT_PtData: push one segment end point (``fifo`` is ignored in dynamic mode)."""
         p = checks.real("pos", pos)
         t = checks.real("time", time)
-        kind = checks.integer("type", type)
-        if kind not in tuple(PtSegmentType):
+        kind = _SEGMENT_TYPES.get(checks.integer("type", type))
+        if kind is None:
             raise ParameterError(f"type must be 0 (normal), 1 (even) or 2 (stop), got {type!r}")
-        point = PtPoint(p, t, PtSegmentType(kind))
+        point = PtPoint(p, t, kind)
         if self._mode == PtMode.STATIC:
             q = self._fifos[fifo_index(fifo)]
             last = q.last
@@ -215,12 +219,12 @@ class PtPlanner:
                 f"time must be > {self._stream_t:g} ms (the previous point), got {time!r}"
             )
         q = self._fifos[self._w]
-        other = self._fifos[1 - self._w]
-        if q.space == 0 and len(other) == 0:
+        if q.space == 0:  # full: the other one next, once it was emptied
+            other = self._fifos[1 - self._w]
+            if len(other) != 0 or other.space == 0:
+                raise CommandError("both PT FIFOs are full (dynamic mode): wait until space > 0")
             self._w = 1 - self._w
             q = other
-        if q.space == 0:
-            raise CommandError("both PT FIFOs are full (dynamic mode): wait until space > 0")
         q.push(point)
         self._stream_t = t
 
