@@ -503,6 +503,12 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
     #: a fast path whose first parameter is an axis (its GTN_ twin of core c > 1 takes the
     #: bus axis on core 1's fast path; a coordinate system, a type, an offset: its table)
     by_axis = bool(proto.params) and proto.params[0].name in ("axis", "profile", "encoder")
+    #: where such a function takes a count of axes from its first (GT_GetSts(axis, p, count,
+    #: pClock)): a span, which must lie inside the core for core 1's fast path to answer it
+    #: as the view would (else the core's table path: its own span rule and reason)
+    count_at = (
+        next((k for k, p in enumerate(proto.params) if p.name == "count"), -1) if by_axis else -1
+    )
     #: what a call moves the readers' epoch by (:mod:`gtecat.controller.epoch`): 0 for a call
     #: that changes nothing but lets time pass, whose cycles move it themselves (Clock.counted)
     #: - a wait then leaves the steady verdict of the bus to the next run of cycles
@@ -662,12 +668,22 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                             base = SESSION.controllers.get(1)
                             view = SESSION.views.get((SESSION.card, c))
                             bus = args[1] + AXES_PER_CORE * (c - 1)
+                            # (a span: every axis of it the core's and on the bus)
+                            last = bus
+                            if 0 <= count_at < len(args) - 1:
+                                k = args[count_at + 1]
+                                last = (
+                                    bus + k - 1
+                                    if type(k) is int and 1 <= k <= AXES_PER_CORE - args[1] + 1
+                                    else 0
+                                )
                             if (
                                 base is not None
                                 and c not in SESSION.controllers  # (not a card's own core)
                                 and view is not None
                                 and view._base is base
                                 and bus in base.axes
+                                and last in base.axes
                             ):
                                 return fast(bus, *args[2:])
                     if type(c) is int and not kwargs and -0x8000 <= c <= 0x7FFF:

@@ -98,3 +98,24 @@ def test_a_card_with_a_second_core_of_its_own_closes_the_view_gate(bus: Any) -> 
     finally:
         del s.controllers[7]
     assert centry.GATES[2] == 1
+
+
+SPANS = [(2, 32, 2), (2, 1, 33), (2, 30, 3), (2, 1, 32), (3, 8, 2), (3, 1, 8), (3, 31, 2)]
+
+
+@pytest.mark.parametrize("name", ["GTN_GetPrfPos", "GTN_GetSts"])
+def test_a_span_reads_the_same_at_every_call(bus: Any, name: str) -> None:
+    """A span of a core beyond 1 answers as that core's table path does at every call (the
+    first call is the table path's): inside the core, core 1's fast path by the bus axes;
+    past the core's 32 axes, 7 every time (it once answered 7, then the next core's axes)."""
+    fn = getattr(gt, name)
+    t = c_long if name.endswith("Sts") else c_double
+    for core, axis, count in SPANS:
+        seen = []
+        for _ in range(3):
+            arr = (t * count)()
+            rc = fn(core, axis, arr, count, None)
+            seen.append((rc, list(arr)))
+        assert seen[0] == seen[1] == seen[2], (core, axis, count, seen)
+        if axis + count - 1 > 32:
+            assert seen[0][0] == 7, (core, axis, count)
