@@ -19,7 +19,8 @@ is not public):
   of the segment that starts there (0 for the last point): the segment's position is
   ``pos[k] + pA[k]·τ + pB[k]·τ² + pC[k]·τ³`` (τ ms after ``pTime[k]``).
 * A table written while a profile runs it takes effect at that profile's next start; a
-  table may be rewritten at any time (``GT_PvtTableClear`` empties it).
+  table may be rewritten at any time (``GT_PvtTableClear`` empties it).  Each core holds its
+  own tables (``GTN_PvtTable(2, 1, ...)`` is core 2's table 1, the profiles of core 2 run it).
 * The motion is relative: the table's first point is where the profile stands at
   ``GT_PvtStart``; the profile runs its table from the first point's time to the last's.
   ``GT_SetPvtLoop(profile, loop)``: passes (0 endless, default 1), each from where the
@@ -55,17 +56,25 @@ MIN_STEP_MS = 1e-6
 #: the largest magnitude of a table value (time, position, velocity): 2^40 pulses is
 #: beyond any 32-bit position the controller reports
 VALUE_LIMIT = float(2**40)
-_TABLES: weakref.WeakKeyDictionary[Any, dict[int, tuple[PvtSegment, ...]]] = (
+#: per controller, per core, per table id: its segments
+_TABLES: weakref.WeakKeyDictionary[Any, dict[int, dict[int, tuple[PvtSegment, ...]]]] = (
     weakref.WeakKeyDictionary()
 )
 
 
 def _tables(ctl: Controller) -> dict[int, tuple[PvtSegment, ...]]:
+    """The tables of the call's core: each core of a multi-core controller holds its own
+    (GTN_PvtTable(2, 1, ...) is core 2's table 1, not core 1's), core views of one bus
+    included; GT_Reset empties every core's."""
     base = getattr(ctl, "_base", ctl)
-    t = _TABLES.get(base)
+    cores = _TABLES.get(base)
+    if cores is None:
+        cores = _TABLES[base] = {}
+        base.on_reset.append(lambda c: cores.clear())
+    core = getattr(ctl, "core", 1) if base is not ctl else 1
+    t = cores.get(core)
     if t is None:
-        t = _TABLES[base] = {}
-        base.on_reset.append(lambda c: t.clear())
+        t = cores[core] = {}
     return t
 
 

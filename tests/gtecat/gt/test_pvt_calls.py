@@ -135,3 +135,40 @@ def test_an_endless_loop_over_a_table_shorter_than_half_a_cycle_is_refused():
     assert gt.GT_PvtStart(1) == 0
     gt.GTE_Wait(3)
     assert moving(1)
+
+
+def test_each_core_holds_its_own_tables(tmp_path):
+    """Core 2 of a bus of 40 axes (bus axes 33..40) writes its table 1 without touching core
+    1's: each core of a multi-core controller holds its own PVT tables."""
+    from tools.gen_axes_eni import write_axes_eni
+
+    eni = write_axes_eni(40, tmp_path / "bus.eni")
+    assert gt.GT_Open(eni=str(eni), clock="lockstep", log="") == 0
+    try:
+        assert gt.GT_InitEcatComm() == 0
+        st = c_short()
+        for _ in range(500):
+            if gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1:
+                break
+            gt.GTE_Wait(1)
+        assert gt.GT_StartEcatComm() == 0
+        assert gt.GT_AxisOn(1) == 0 and gt.GTN_AxisOn(2, 1) == 0
+        gt.GTE_Wait(10)
+        assert gt.GTN_PvtTable(1, 1, 2, arr(0, 100), arr(0, 1000), arr(0, 0)) == 0
+        assert gt.GTN_PvtTable(2, 1, 2, arr(0, 100), arr(0, -555), arr(0, 0)) == 0
+        for core in (1, 2):
+            assert gt.GTN_PrfPvt(core, 1) == 0
+            assert gt.GTN_PvtTableSelect(core, 1, 1) == 0
+            assert gt.GTN_SetPvtLoop(core, 1, 1) == 0
+            assert gt.GTN_PvtStart(core, 1) == 0, gt.GTE_GetLastError()
+        gt.GTE_Wait(300)
+        ends = []
+        for core in (1, 2):
+            p = c_double()
+            assert gt.GTN_GetPrfPos(core, 1, byref(p), 1, None) == 0
+            ends.append(p.value)
+        assert ends == [1000.0, -555.0]
+        assert gt.GTN_PvtTableClear(2, 1) == 0  # core 2's only
+        assert gt.GTN_PvtStart(2, 1) == 1 and gt.GTN_PvtStart(1, 1) == 0
+    finally:
+        gt.GT_Close()
