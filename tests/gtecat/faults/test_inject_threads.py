@@ -52,9 +52,11 @@ def _alarms() -> tuple[int, tuple[bool, bool]]:
     return clock.value, (bool(sts[0] & ALARM), bool(sts[1] & ALARM))
 
 
-def _poll_while(other: threading.Thread, started: threading.Event, limit_ms: int = 5000) -> list:
+def _poll_while(other: threading.Thread, started: threading.Event, limit_ms: int = 60_000) -> list:
     """Poll both axes (the main thread's GT calls: they run the cycles) from before
-    ``other`` starts until both alarms are on; every poll that saw an alarm."""
+    ``other`` starts until both alarms are on; every poll that saw an alarm.  (``limit_ms``
+    of controller time: a loaded machine may not run the other thread for thousands of
+    this thread's polls, each a cycle; what is checked is how the faults start, not when.)"""
     seen = []
     polls = 0
     other.start()
