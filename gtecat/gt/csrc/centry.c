@@ -2193,8 +2193,12 @@ have:
         A.decref(res);
         if (ep1 >= 0 && epoch() == ep1 + 1) {
             c_moved++; /* (one growth: the image's bytes moved) */
-            if (qio && qio[4] == ep1)
+            if (qio && qio[4] == ep1) {
+                /* (armed still; the status words stand: a plain IO slave's outputs move
+                 * no axis's flag) */
                 qio[4] = ep1 + 1;
+                flag_keeping++;
+            }
         }
     }
     return done(e->after, e->gate);

@@ -5,7 +5,7 @@ input word read with ``GT_EcatIOReadInput``, its output word written with
 outputs to the field itself, and every cycle leaves the slaves' outputs, field outputs,
 field inputs and inputs, the process image and the answers as the general Python cycle
 leaves them.  A wired IO slave (an output wired to one of its inputs) keeps its general
-cycle and reads its own output back one cycle later, as before."""
+cycle and reads its own output back one cycle later, as before.  Lockstep and auto clocks."""
 
 from __future__ import annotations
 
@@ -32,10 +32,10 @@ def _fn(name: str, general: bool) -> Any:
     return getattr(fn, "slow", fn) if general else fn
 
 
-def _run(general: bool, wired: bool, ms: int = 120) -> tuple[list[Any], int]:
+def _run(general: bool, wired: bool, clock: str, ms: int = 120) -> tuple[list[Any], int]:
     """Each ms's state after its calls, and how often a changing write left the armed quick
     cycle standing (the compiled way's own; 0 on the general way)."""
-    bring_up("manual_fig5_2.eni", clock="lockstep")
+    bring_up("manual_fig5_2.eni", clock=clock)
     try:
         wait, read, write, sts = (
             _fn(n, general)
@@ -80,14 +80,15 @@ def _run(general: bool, wired: bool, ms: int = 120) -> tuple[list[Any], int]:
         gt.GT_Close()
 
 
+@pytest.mark.parametrize("clock", ["lockstep", "auto"])
 @pytest.mark.parametrize("wired", [False, True], ids=["plain", "wired"])
 def test_changing_outputs_every_ms_as_the_general_cycle(
-    wired: bool, monkeypatch: pytest.MonkeyPatch
+    wired: bool, clock: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    quick, kept = _run(False, wired)
+    quick, kept = _run(False, wired, clock)
     with monkeypatch.context() as m:
         m.setattr(Controller, "QUICK_WAIT", False)
-        general, none = _run(True, wired)
+        general, none = _run(True, wired, clock)
     assert none == 0
     for k, (a, b) in enumerate(zip(quick, general, strict=True)):
         at = next((j for j, (x, y) in enumerate(zip(a, b, strict=True)) if x != y), None)
