@@ -1077,6 +1077,68 @@ def bench_hooked_poll(
     return out
 
 
+def bench_fig5_2_io(seconds: float = 2.0, repeat: int = 3) -> dict[str, object]:
+    """The manual's figure 5-2 application writing its IO outputs every millisecond (section
+    5: 2 drives, 2 IO slaves): both axes in Trap (:func:`start_trap`), and every 1 ms
+    ``GTE_Wait(1)``, each IO slave's input word read (``GT_EcatIOReadInput(slave, 0, 2,
+    byref(w))``), its output word written with a new value (``GT_EcatIOWriteOutput``, the
+    same shape), ``GT_GetSts(1, ...)``; lockstep clock.  ``rtf``: controller milliseconds
+    per CPU millisecond, the best of ``repeat`` windows of ``seconds`` / ``repeat`` wall
+    seconds."""
+    from ctypes import c_ushort
+
+    from gtecat import gt
+    from tools.bench_scaling import BenchError, start_trap
+
+    best = 0.0
+    try:
+        rc = gt.GT_Open(eni=str(FIG5_2), clock="lockstep", log="")
+        ready = c_short()
+        if rc or gt.GT_InitEcatComm():
+            raise BenchError(f"GT_Open / GT_InitEcatComm: {gt.GTE_GetLastError()}")
+        for _ in range(10_000):
+            if gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1:
+                break
+            gt.GTE_Wait(1)
+        if gt.GT_StartEcatComm() or gt.GT_AxisOn(1) or gt.GT_AxisOn(2):
+            raise BenchError(f"start: {gt.GTE_GetLastError()}")
+        gt.GTE_Wait(50)
+        start_trap((1, 2))
+        gt.GTE_Wait(100)
+        w, s, k = c_ushort(), c_long(), 0
+        wait, read, write, sts = (
+            gt.GTE_Wait,
+            gt.GT_EcatIOReadInput,
+            gt.GT_EcatIOWriteOutput,
+            gt.GT_GetSts,
+        )
+        for _ in range(repeat):
+            ms = 0
+            c0, t0 = time.process_time(), time.perf_counter()
+            while time.perf_counter() - t0 < seconds / repeat:
+                for _ in range(200):
+                    wait(1)
+                    k += 1
+                    for sl in (2, 3):
+                        read(sl, 0, 2, byref(w))
+                        write(sl, 0, 2, byref(c_ushort(k & 0xFFFF)))
+                    sts(1, byref(s), 1, None)
+                ms += 200
+            best = max(best, ms / max(time.process_time() - c0, 1e-9) / 1000)
+        if sts(1, byref(s), 1, None) or not s.value & 0x400:  # (both still moving)
+            raise BenchError(f"axis 1 stopped moving: status {s.value:#x}")
+    except BenchError as exc:
+        return {"error": str(exc)}
+    finally:
+        gt.GT_Close()
+    return {
+        "axes": 2,
+        "what": "figure 5-2, both in Trap; every ms GTE_Wait(1), each IO slave's input word "
+        "read and its output word written with a new value, GT_GetSts",
+        "rtf": round(best, 1),
+    }
+
+
 def bench_crd_poll(
     seconds: float = 1.0, pairs: int = 3, n: int = 12, push_every: int = 0
 ) -> dict[str, object]:
@@ -1329,6 +1391,9 @@ def issue17(seconds: float = 1.5, repeat: int = 3, only: Sequence[str] = ()) -> 
 
     figures: dict[str, Callable[[], dict[str, object]]] = {
         "rtf_fig5_2_trap": lambda: rtf(2, every(2, "moving"), 300, FIG5_TEXT, eni=FIG5_2),
+        "rtf_fig5_2_trap_io_every_ms": lambda: _figure(
+            bench_fig5_2_io(2 * seconds, repeat), "rtf", 300
+        ),
         "rtf_1_axis_trap": lambda: rtf(1, every(1, "moving"), 500, "one axis moving in Trap"),
         "rtf_12_axes_trap": lambda: rtf(12, every(12, "moving"), 20, "all 12 moving in Trap"),
         "rtf_64_axes_32_trap_32_holding": lambda: rtf(

@@ -195,9 +195,11 @@ class Controller:
         self._own_many = self.clock.run_many = self.run_cycles
         #: the armed quick cycle's kernel call (:meth:`arm_quick`): the function's address,
         #: its three arguments, the cycle time it was armed for, the address of the field
-        #: inputs' watch (Backend.fields_watch: 0, none) - kept in _quick_fields
-        self._quick_call = array("q", bytes(8 * 6))
+        #: inputs' watch (Backend.fields_watch: 0, none) - kept in _quick_fields - and of the
+        #: outputs the cycle takes to the field itself (Backend.outputs_watch: 0, none)
+        self._quick_call = array("q", bytes(8 * 7))
         self._quick_fields: Any = None
+        self._quick_outs: Any = None
         self._quick_armed: Any = None
         #: the armed quick cycle's book in C (:meth:`_book_in_c`): [0] 1 while the entry that
         #: runs the cycle may count it itself, [1] the kernel's io, [2] the bank's counts,
@@ -844,6 +846,11 @@ class Controller:
         # (through the buffer protocol) makes the entries decline the armed cycle
         watch = self._quick_fields = self.master.backend.fields_watch()  # type: ignore[union-attr]
         call[5] = 0 if watch is None else watch[0]
+        # the plain IO slaves' outputs the entries copy to the field before the kernel's
+        # cycle: a GT_ write that changes only them leaves the cycle armed (the readers'
+        # epoch grows all the same)
+        outs = self._quick_outs = self.master.backend.outputs_watch()  # type: ignore[union-attr]
+        call[6] = 0 if outs is None else outs[0]
         q[5] = ARMS[0]
         q[6] = VirtualSlave.al_changes
         q[7] = VirtualSlave.outside_changes

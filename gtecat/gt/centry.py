@@ -990,6 +990,8 @@ def _load() -> tuple[Maker | None, str]:
             return None, "the library refused the layout"
         lib.gtecat_centry_clock_ms.argtypes = [_VP]
         lib.gtecat_centry_clock_ms(ctypes.addressof(CLOCK_MS))
+        lib.gtecat_centry_wait_at.argtypes = [_VP]
+        lib.gtecat_centry_wait_at(ctypes.addressof(WAIT_AT))  # (a GT_ write's armed cycle)
         lib.gtecat_centry_cycle_timer.argtypes = [_VP]
         global CYCLE_TIMED
         CYCLE_TIMED = lib.gtecat_centry_cycle_timer(ctypes.addressof(CYCLE_TIMER)) == 0

@@ -260,6 +260,12 @@ static long long flag_keeping;
  * steady entry's values (an attribute's: GT_GetPrfMode) stand (kept, array_value) */
 static long long c_booked;
 
+/* The epoch's growths that moved no more than the process image's bytes: the quick cycles
+ * booked in C and the raw writes (their changed(): one growth each).  Where the epoch grew by
+ * as much as this count since a raw range's runs were kept, they stand (the image's buffer
+ * the same, every slave on the bus). */
+static long long c_moved;
+
 #define AT(base, off) (*(char **)((char *)(base) + (off)))
 /* the flag a vectorcall's caller may set in nargsf (PY_VECTORCALL_ARGUMENTS_OFFSET) */
 #define VECTORCALL_OFFSET ((size_t)1 << (8 * sizeof(size_t) - 1))
@@ -649,6 +655,61 @@ static int armed_now(const long long *q)
 }
 
 
+/* The plain IO slaves' outputs the armed quick cycle takes to the field itself
+ * (Controller.arm_quick: call[6], Backend.outputs_watch; 0: none): a count, then per slave
+ * the address of its output area in the process image, of its rx, of its field outputs and
+ * the bytes - what the exchange and the slave's step do with them in the general cycle (no
+ * wire, its inputs the same), so a write that changes them need not disarm the cycle. */
+static void io_outputs(const long long *call)
+{
+    const long long *t = (const long long *)call[6], *r;
+    long long i;
+    if (t)
+        for (i = 0, r = t + 1; i < t[0]; i++, r += 4) {
+            memcpy((void *)r[1], (const void *)r[0], (size_t)r[3]);
+            memcpy((void *)r[2], (const void *)r[0], (size_t)r[3]);
+        }
+}
+
+/* GTE_Wait's gate's controller ([0] its clock's quick numbers: gtecat.gt.centry.WAIT_AT),
+ * for a GT_ write's look at its armed cycle (io_only); NULL: none */
+static const ptrdiff_t *wait_at;
+
+int gtecat_centry_wait_at(const ptrdiff_t *at)
+{
+    wait_at = at;
+    return 0;
+}
+
+/* The GT_ gate's armed cycle (its clock's quick numbers) where every run of a write (n
+ * triples: first byte, address in the image, bytes) lies in the outputs it takes to the
+ * field itself (io_outputs) and it is armed for the epoch now; else NULL. */
+static long long *io_only(ptrdiff_t gate, const int64_t *runs, ptrdiff_t n)
+{
+    long long *q, i;
+    const long long *call, *t, *r;
+    ptrdiff_t k;
+    if (gate != 1 || !wait_at || !wait_at[0])
+        return NULL;
+    q = (long long *)wait_at[0];
+    if (!q[4] || q[4] != epoch() || !q[8])
+        return NULL;
+    call = (const long long *)q[8];
+    t = (const long long *)call[6];
+    if (!t)
+        return NULL;
+    for (k = 0; k < n; k++) {
+        long long a = runs[3 * k + 1], len = runs[3 * k + 2];
+        for (i = 0, r = t + 1; i < t[0]; i++, r += 4)
+            if (a >= r[0] && a + len <= r[0] + r[3])
+                break;
+        if (i == t[0])
+            return NULL;
+    }
+    return q;
+}
+
+
 /* The book of a quick cycle the kernel ran whole, in C, where the controller's book says it
  * may (gtecat.controller.core.Controller._book_in_c: nothing but counting to do): the
  * objects made first (nothing counted where one cannot be), then the bank's lists anew, the
@@ -725,6 +786,7 @@ static int book_n(long long *b, long long *q, long long n)
     if (b[14])
         flag_keeping++;
     c_booked++;
+    c_moved++;
     *(long long *)b[3] += n; /* its drives' cycles */
     *(long long *)b[4] += n; /* the master's */
     q[10] = cycles;
@@ -802,6 +864,7 @@ static int quick_cycle(ptrdiff_t gate, obj after, obj *res)
     q[4] = 0;  /* (the book arms the next one) */
     q[11] -= 1; /* (one cycle of the budget it was armed with) */
     q[0] += q[1] - q[2];
+    io_outputs(call);
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
     if (!rc && book_in_c(gate, q)) {
         timed(t0);
@@ -934,6 +997,7 @@ static obj wait_call(const struct wait_entry *e, obj const *args, ptrdiff_t narg
     q[0] = pend;
     io[b[10]] = q[9];
     io[e->maxc] = n;
+    io_outputs(call);
     rc = ((kernel_run)call[0])((void *)call[1], (void *)call[2], (void *)call[3]);
     io[e->maxc] = 1; /* (the armed call's: one cycle) */
     if (!rc && io[b[8]] == n && book_n(b, q, n)) {
@@ -1962,7 +2026,7 @@ TRY raw_try(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwn
     ptrdiff_t at = e->io, k, n;
     obj p, target, v, call[4], res;
     const int64_t *runs;
-    long long size, off = 0, slave = -1, ep = -1, ep0 = -1;
+    long long size, off = 0, slave = -1, ep = -1, ep0 = -1, ep1 = -1, *qio = NULL;
     int over = 0, mv = 0, diff = 0, bit = -1, set = 0;
     char *mem;
     struct pybuf view;
@@ -2029,11 +2093,12 @@ shaped:
                    (ep = epoch()) >= 0 && s->value && s->n == off && s->count == size &&
                    s->clock == slave && s->tp == TYPE(target) &&
                    (s->epoch == ep ||
-                    (ep > s->epoch && ep - s->epoch == c_booked - s->booked))) {
-            /* (the runs of the epoch they were asked in, and across cycles booked in C: those
-             * move the image's bytes, never its buffer, nor take a slave off the bus) */
+                    (ep > s->epoch && ep - s->epoch == c_moved - s->booked))) {
+            /* (the runs of the epoch they were asked in, and across cycles booked in C and
+             * raw writes: those move the image's bytes, never its buffer, nor take a slave off
+             * the bus) */
             s->epoch = ep;
-            s->booked = c_booked;
+            s->booked = c_moved;
             v = s->value;
             A.incref(v);
             goto have;
@@ -2075,7 +2140,7 @@ shaped:
     }
     if (s && ep >= 0) {
         keep_span(s, ep, v, TYPE(target), off, size, slave);
-        s->booked = c_booked;
+        s->booked = c_moved;
     }
 have:
     /* the runs: (first byte in the buffer, address in the image, bytes) as int64 triples */
@@ -2112,14 +2177,29 @@ have:
             diff = 1;
         }
     }
+    /* (the image changed: what the readers kept asks again; the armed cycle too, unless
+     * the write changed only outputs it takes to the field itself: io_outputs) */
+    if (diff) {
+        ep1 = epoch();
+        qio = io_only(e->gate, runs, n / 24);
+    }
     A.decref(v);
     if (mv)
         A.release_buffer(&view);
-    if (diff) { /* (the image changed: what the readers kept, the armed cycle, ask again) */
+    if (diff) {
         res = A.vectorcall(e->changed, NULL, 0, NULL);
         if (!res)
             return NULL;
         A.decref(res);
+        if (ep1 >= 0 && epoch() == ep1 + 1) {
+            c_moved++; /* (one growth: the image's bytes moved) */
+            if (qio && qio[4] == ep1) {
+                /* (armed still; the status words stand: a plain IO slave's outputs move
+                 * no axis's flag) */
+                qio[4] = ep1 + 1;
+                flag_keeping++;
+            }
+        }
     }
     return done(e->after, e->gate);
 

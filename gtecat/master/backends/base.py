@@ -94,6 +94,13 @@ class Backend(ABC):
         None: nothing to compare."""
         return None
 
+    def outputs_watch(self) -> Any:
+        """The outputs a compiled cycle may take to the field itself, as ``(address, what it
+        needs kept)``: at the address a count, then per slave the address of its output
+        area in the process image, of its ``rx``, of its field outputs, and the bytes.
+        None: none (every change of an output takes the general cycle)."""
+        return None
+
     @abstractmethod
     def expected_wkc(self) -> int:
         """The working counter of a healthy cycle with every slave in OP."""
