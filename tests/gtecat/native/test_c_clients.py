@@ -11,6 +11,7 @@ import pytest
 from .conftest import (
     C_DIR,
     compile_client,
+    compiled_once,
     native_env,
     needs_cc,
     needs_cxx,
@@ -23,8 +24,8 @@ pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
 
 @pytest.fixture(scope="module")
 def gtn_sequence(libgts, tmp_path_factory):
-    out = tmp_path_factory.mktemp("c") / "gtn_sequence"
-    return compile_client(C_DIR / "gtn_sequence.c", out, "gcc")
+    # (test_inprocess runs it too: compiled once for the run)
+    return compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
 
 
 @pytest.fixture(scope="module")
