@@ -89,8 +89,9 @@ def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
 
 
 def test_the_private_controller_ends_with_the_program(gtn_sequence, tmp_path):
+    # (GTECAT_INPROCESS=0: the controller process; by default it runs in the program)
     assert not _controllers(tmp_path)
-    r, v = run_client(gtn_sequence, env=native_env(), cwd=tmp_path)
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=tmp_path)
     assert v.get("done") == "1", r.stdout + r.stderr
     deadline = time.monotonic() + 10
     while _controllers(tmp_path) and time.monotonic() < deadline:
