@@ -90,7 +90,16 @@ _FOREVER = (
 )
 
 
-@pytest.mark.parametrize("how", ["script", "child", "shell"])
+@pytest.mark.parametrize(
+    "how",
+    [
+        "script",
+        # (the default run: ``shell`` passes the signal on to a command's processes, the
+        # one it started among them)
+        pytest.param("child", marks=pytest.mark.long("a command that execs the program")),
+        "shell",
+    ],
+)
 def test_a_recording_ended_by_sigterm_is_written_and_replays(
     tmp_path: Path, how: str
 ) -> None:

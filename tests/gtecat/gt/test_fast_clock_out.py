@@ -208,7 +208,15 @@ def _session(way: str, clock: str, shapes: dict = SHAPES, steps: int = 48) -> tu
         gt.GT_Close()
 
 
-@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+@pytest.mark.parametrize(
+    "clock",
+    [
+        "lockstep",
+        # (the default run: the lockstep clock's; the auto clock's clock shapes in
+        # test_refused_shapes_answer_as_the_table and the clock-and-loop pointers below)
+        pytest.param("auto", marks=pytest.mark.long("the same session on the auto clock")),
+    ],
+)
 def test_clock_shapes_read_the_table_values_across_reset_and_cycles(clock: str) -> None:
     """Every reader's clock shapes through the C entries (none through Python: the value and
     the clock written there) and through the table path, step by step while two axes move,
@@ -225,7 +233,14 @@ def test_clock_shapes_read_the_table_values_across_reset_and_cycles(clock: str) 
     assert _session("python", clock)[0] == table  # (the Python fast functions: the same)
 
 
-@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+@pytest.mark.parametrize(
+    "clock",
+    [
+        # (the default run: the auto clock's; the lockstep clock's across GT_Reset above)
+        pytest.param("lockstep", marks=pytest.mark.long("the same session on the lockstep clock")),
+        "auto",
+    ],
+)
 def test_refused_shapes_answer_as_the_table(clock: str) -> None:
     """The shapes the fast path does not take (a numpy array it cannot write whole, a NULL
     pointer, a clock pointer of another type) answer as the table path does, step by step:

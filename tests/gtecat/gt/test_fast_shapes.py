@@ -765,7 +765,15 @@ def _span_session(tmp_path: Path, clock: str, way: str) -> tuple[list, int]:
         gt.GT_Close()
 
 
-@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+@pytest.mark.parametrize(
+    "clock",
+    [
+        # (the default run: the auto clock's; the lockstep clock's spans through the C
+        # entries in test_the_pdo_readers_read_a_banked_axis_where_it_is and test_centry)
+        pytest.param("lockstep", marks=pytest.mark.long("the same session on the lockstep clock")),
+        "auto",
+    ],
+)
 def test_spans_past_twelve_axes_read_as_the_table_on_the_fast_path(
     tmp_path: Path, clock: str
 ) -> None:

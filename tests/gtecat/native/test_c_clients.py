@@ -11,6 +11,7 @@ import pytest
 from .conftest import (
     C_DIR,
     compile_client,
+    compiled_once,
     native_env,
     needs_cc,
     needs_cxx,
@@ -23,8 +24,8 @@ pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
 
 @pytest.fixture(scope="module")
 def gtn_sequence(libgts, tmp_path_factory):
-    out = tmp_path_factory.mktemp("c") / "gtn_sequence"
-    return compile_client(C_DIR / "gtn_sequence.c", out, "gcc")
+    # (test_inprocess runs it too: compiled once for the run)
+    return compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
 
 
 @pytest.fixture(scope="module")
@@ -88,8 +89,9 @@ def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
 
 
 def test_the_private_controller_ends_with_the_program(gtn_sequence, tmp_path):
+    # (GTECAT_INPROCESS=0: the controller process; by default it runs in the program)
     assert not _controllers(tmp_path)
-    r, v = run_client(gtn_sequence, env=native_env(), cwd=tmp_path)
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=tmp_path)
     assert v.get("done") == "1", r.stdout + r.stderr
     deadline = time.monotonic() + 10
     while _controllers(tmp_path) and time.monotonic() < deadline:

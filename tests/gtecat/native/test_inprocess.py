@@ -15,13 +15,13 @@ from gtecat.native import inprocess
 from gtecat.native.protocol import FRAME, HELLO, PROTOCOL_VERSION, table_digest
 from gtecat.native.transport import SOCKET_TYPE
 
-from .conftest import C_DIR, compile_client, native_env, needs_cc, run_client
+from .conftest import C_DIR, compile_client, compiled_once, native_env, needs_cc, run_client
 
 
 @pytest.fixture(scope="module")
 def gtn_sequence(libgts, tmp_path_factory):
-    out = tmp_path_factory.mktemp("c") / "gtn_sequence"
-    return compile_client(C_DIR / "gtn_sequence.c", out, "gcc")
+    # (the executable test_c_clients runs: compiled once for the run)
+    return compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
 
 
 #: a Python built without a shared runtime (no --enable-shared, and none installed beside a
@@ -33,8 +33,12 @@ needs_runtime = pytest.mark.skipif(
 )
 
 
+# (the default run: the in-process controller is the default, which test_c_clients's
+# test_vendor_gtn_sequence_from_c runs the same program with; GTECAT_INPROCESS=1 taken
+# without the reason on stderr in test_ctrl_c_still_ends_... and the forked child below)
 @needs_cc
 @needs_runtime
+@pytest.mark.long("the vendor sequence with GTECAT_INPROCESS=1 set")
 def test_a_c_program_runs_its_controller_in_process(gtn_sequence, tmp_path):
     """The vendor sequence as with the controller process: bring-up, the wall floor over a
     usleep, a move, the reasons of refused calls; no controller process is started."""

@@ -30,7 +30,7 @@ from gtecat.native import protocol as p
 from gtecat.native import server as server_mod
 from gtecat.native import transport, windows
 
-from .conftest import C_DIR, FIG5_2, ROOT, native_env, parse_lines, run_client
+from .conftest import C_DIR, FIG5_2, ROOT, compiled_once, native_env, parse_lines, run_client
 from .wire_client import WireClient
 
 pytestmark = pytest.mark.xdist_group("windows")
@@ -163,14 +163,13 @@ def _assert_declared_calls(v: dict[str, str]) -> None:
 
 
 def test_windows_programs_under_wine_match_the_linux_library(
-    dll_x86, tcp_controller, libgts, tmp_path
+    dll_x86, tcp_controller, libgts, tmp_path, tmp_path_factory
 ):
     _needs_wine()
     programs = _windows_programs(dll_x86, tmp_path / "win", "x86")
     # the same program built for Linux against libgts, to run over the same TCP transport
-    linux_exe = tmp_path / "gtn_linux"
-    cmd = ["gcc", str(C_DIR / "gtn_sequence.c"), *libgts.cflags(), *libgts.libs(), "-o"]
-    subprocess.run([*cmd, str(linux_exe)], check=True, capture_output=True)
+    # (the C clients' executable: compiled once for the run)
+    linux_exe = compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
     env = _wine_env(GTECAT_CONTROLLER=tcp_controller.replace("tcp:", "tcp://"), GTECAT_TOKEN=TOKEN)
     r, win = _wine(programs["gtn"], env)
     assert r.returncode == 0 and win.get("done") == "1", r.stdout + r.stderr
