@@ -6,10 +6,11 @@ a pattern per axis, and 256 kept patterns of 1,024 rows cost ~25 kB per axis at 
 
 from __future__ import annotations
 
-from ctypes import byref, c_long, c_short
+from ctypes import byref, c_long
 from pathlib import Path
 
 from gtecat import gt
+from tests.gtecat.gt.conftest import bring_up
 from tools.gen_axes_eni import write_axes_eni
 
 N = 160  # (a budget of 16,384 rows keeps 102 patterns of 160: more are made below)
@@ -20,17 +21,9 @@ def _core_axis(a: int) -> tuple[int, int]:
 
 
 def test_patterns_kept_within_a_budget_of_rows(tmp_path: Path) -> None:
-    eni = write_axes_eni(N, tmp_path / "bus.eni")
-    assert gt.GT_Open(eni=str(eni), clock="lockstep", log="") == 0
+    bring_up(str(write_axes_eni(N, tmp_path / "bus.eni")), clock="lockstep")
     try:
         ctl = gt.GTE_Controller()
-        assert gt.GT_InitEcatComm() == 0
-        st = c_short()
-        for _ in range(500):
-            if gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1:
-                break
-            gt.GTE_Wait(1)
-        assert gt.GT_StartEcatComm() == 0
         bank, backend = ctl.bank, ctl.backend
         budget = bank._patterns_kept
         assert budget == 16_384 // N

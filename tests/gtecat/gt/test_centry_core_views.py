@@ -8,7 +8,7 @@ reads them), beyond 32, cores the bus does not have, and a card whose second cor
 from __future__ import annotations
 
 import itertools
-from ctypes import byref, c_double, c_long, c_short
+from ctypes import byref, c_double, c_long
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +18,8 @@ from gtecat import gt
 from gtecat.gt import centry
 from tools.gen_axes_eni import write_axes_eni
 
+from .conftest import bring_up
+
 N = 40  # core 1 whole, core 2 with 8 axes (bus axes 33..40)
 
 
@@ -25,15 +27,7 @@ N = 40  # core 1 whole, core 2 with 8 axes (bus axes 33..40)
 def bus(tmp_path: Path) -> Any:
     if centry._MAKE is None:
         pytest.skip(f"the C entries are not built here: {centry.REASON}")
-    eni = write_axes_eni(N, tmp_path / "bus.eni")
-    assert gt.GT_Open(eni=str(eni), clock="lockstep", log="") == 0
-    assert gt.GT_InitEcatComm() == 0
-    st = c_short()
-    for _ in range(500):
-        if gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1:
-            break
-        gt.GTE_Wait(1)
-    assert gt.GT_StartEcatComm() == 0
+    bring_up(str(write_axes_eni(N, tmp_path / "bus.eni")), clock="lockstep")
     masks: dict[int, int] = {}
     for a in range(1, N + 1):
         c, n = (a - 1) // 32 + 1, (a - 1) % 32 + 1

@@ -142,16 +142,10 @@ def test_each_core_holds_its_own_tables(tmp_path):
     1's: each core of a multi-core controller holds its own PVT tables."""
     from tools.gen_axes_eni import write_axes_eni
 
-    eni = write_axes_eni(40, tmp_path / "bus.eni")
-    assert gt.GT_Open(eni=str(eni), clock="lockstep", log="") == 0
+    from .conftest import bring_up
+
+    bring_up(str(write_axes_eni(40, tmp_path / "bus.eni")), clock="lockstep")
     try:
-        assert gt.GT_InitEcatComm() == 0
-        st = c_short()
-        for _ in range(500):
-            if gt.GT_IsEcatReady(byref(st)) == 0 and st.value == 1:
-                break
-            gt.GTE_Wait(1)
-        assert gt.GT_StartEcatComm() == 0
         assert gt.GT_AxisOn(1) == 0 and gt.GTN_AxisOn(2, 1) == 0
         gt.GTE_Wait(10)
         assert gt.GTN_PvtTable(1, 1, 2, arr(0, 100), arr(0, 1000), arr(0, 0)) == 0
