@@ -3171,37 +3171,18 @@ HOME_STATUS = "GT_GetHomeStatus"
 _HOME_STATUS = struct.Struct("@hhhhii")
 
 
-def fast_home_status(
-    name: str,
-    slow: Callable[..., int],
-    session: Any,
-    advance: Callable[[Any, str, int], int],
-) -> Callable[..., int]:
-    """``GT_GetHomeStatus(axis, p)`` with the fast path in front of the table: ``p``
-    ``byref(s)`` (no offset) or ``s`` itself of THomeStatus, an axis of the in-process
-    controller (no pulse card) whose smart homing the table path has made before (its
-    first call, or GT_GoHome's); the fields as the table path sets them.  Any other shape,
-    a value a field would wrap, a homing not made yet: the table path (GTN_GetHomeStatus
-    with core 1 takes this path through the GT layer's twin)."""
+def smart_home_lookup() -> tuple[Callable[[Any, int], Any], dict[int, tuple[Any, Any]]]:
+    """``home_of(ctl, n)``: axis ``n``'s smart homing on ``ctl`` where a fast path reads it,
+    else None (no such axis, a pulse card, a homing the table path has not made yet); and
+    what it keeps: axis number -> (its resources, their smart homing) (smart_home makes a
+    homing once per resources and keeps it while they live, so one found is theirs for good).
+    The smart homing status's fast path and the older cards' homing status share it."""
     from ..controller import smart_home as sh
-    from .home_structs import THomeStatus
 
-    fields = [(f[0], f[1]) for f in THomeStatus._fields_]
-    i16, i32 = ctypes.c_int16, ctypes.c_int32
-    want = [("run", i16), ("stage", i16), ("error", i16), ("pad1", i16)]
-    want += [("capturePos", i32), ("targetPos", i32)]
-    if fields != want or ctypes.sizeof(THomeStatus) != _HOME_STATUS.size:
-        # (another layout: the table path alone)
-        return slow
-    pack, pack_into = _HOME_STATUS.pack, _HOME_STATUS.pack_into
-    target = _target([THomeStatus])
     homes, running = sh._HOMES, sh._RUNNING
-    #: axis number -> (its resources, their smart homing): smart_home makes a homing once
-    #: per resources and keeps it while they live, so one found is theirs for good
     kept: dict[int, tuple[Any, Any]] = {}
 
     def home_of(ctl: Any, n: int) -> Any:
-        """Axis ``n``'s smart homing on ``ctl`` where the fast path reads it, else None."""
         try:
             res = ctl.resources[n]
         except KeyError:  # no such axis: the table path says why
@@ -3218,6 +3199,34 @@ def fast_home_status(
             kept.clear()
         kept[n] = (res, home)
         return home
+
+    return home_of, kept
+
+
+def fast_home_status(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+) -> Callable[..., int]:
+    """``GT_GetHomeStatus(axis, p)`` with the fast path in front of the table: ``p``
+    ``byref(s)`` (no offset) or ``s`` itself of THomeStatus, an axis of the in-process
+    controller (no pulse card) whose smart homing the table path has made before (its
+    first call, or GT_GoHome's); the fields as the table path sets them.  Any other shape,
+    a value a field would wrap, a homing not made yet: the table path (GTN_GetHomeStatus
+    with core 1 takes this path through the GT layer's twin)."""
+    from .home_structs import THomeStatus
+
+    fields = [(f[0], f[1]) for f in THomeStatus._fields_]
+    i16, i32 = ctypes.c_int16, ctypes.c_int32
+    want = [("run", i16), ("stage", i16), ("error", i16), ("pad1", i16)]
+    want += [("capturePos", i32), ("targetPos", i32)]
+    if fields != want or ctypes.sizeof(THomeStatus) != _HOME_STATUS.size:
+        # (another layout: the table path alone)
+        return slow
+    pack, pack_into = _HOME_STATUS.pack, _HOME_STATUS.pack_into
+    target = _target([THomeStatus])
+    home_of, kept = smart_home_lookup()
 
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:

@@ -33,36 +33,23 @@ def fast_home_sts(
     core 1, or of a core viewing core 1's bus, takes this path through the GT layer's twin.)"""
     from ..controller import smart_home as sh
     from .args import _scalar_types
-    from .fast import _LOCKSTEP, _NO, _array_first, _int_bounds, _target, _value_target
+    from .fast import (
+        _LOCKSTEP,
+        _NO,
+        _array_first,
+        _int_bounds,
+        _target,
+        _value_target,
+        smart_home_lookup,
+    )
     from .table import FUNCTIONS
 
     ok = _scalar_types(FUNCTIONS[name].params[1])
     bounds = _int_bounds(ok)
     target = _target(ok)
     first = _array_first(ok)
-    homes, running, end = sh._HOMES, sh._RUNNING, sh.Stage.END
-    #: axis number -> (its resources, their smart homing): smart_home makes a homing once
-    #: per resources and keeps it while they live, so one found is theirs for good
-    kept: dict[int, tuple[Any, Any]] = {}
-
-    def home_of(ctl: Any, n: int) -> Any:
-        """Axis ``n``'s smart homing on ``ctl`` where the fast path reads it, else None."""
-        try:
-            res = ctl.resources[n]
-        except KeyError:  # no such axis: the table path says why
-            return None
-        if ctl.axes.get(n) is not res.ax or ctl.card is not None:
-            return None
-        k = kept.get(n)
-        if k is not None and k[0] is res:
-            return k[1]
-        home = homes.get(res)
-        if home is None or ctl not in running:  # (the table path makes it, registered)
-            return None
-        if len(kept) > 4096:
-            kept.clear()
-        kept[n] = (res, home)
-        return home
+    end = sh.Stage.END
+    home_of, _ = smart_home_lookup()
 
     def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
         if type(n) is int and not kw and not extra:
