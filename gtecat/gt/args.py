@@ -486,7 +486,12 @@ def resolve(name: str, value: Any) -> Ref:
             f"{name}={shown(value)}: a raw address is not accepted (its size cannot be checked); "
             "pass byref(x), pointer(x) or an array"
         )
-    raise ParameterError(f"{name}: a {type(value).__name__} is not a pointer argument")
+    tp = type(value)
+    kind = tp.__name__ if tp.__module__ == "builtins" else f"{tp.__module__}.{tp.__qualname__}"
+    raise ParameterError(
+        f"{name}: {'an' if kind[:1].lower() in 'aeiou' else 'a'} {kind} is not a pointer "
+        "argument; pass byref(x), pointer(x), a ctypes or numpy array, or 0/None for NULL"
+    )
 
 
 def _memoryview_array(name: str, view: memoryview) -> np.ndarray:

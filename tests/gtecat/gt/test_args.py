@@ -319,3 +319,14 @@ def test_every_32_bit_mask_takes_bit_31_either_way() -> None:
             with pytest.raises(ParameterError, match=f"{p.name}={given} "):
                 bind(tuple(args), {})
     assert {"GT_Stop", "GT_Update", "GT_MultiAxisOn", "GT_PtStart"} <= set(found)
+
+
+def test_a_value_that_is_no_pointer_is_named_and_the_accepted_ones_listed(bus) -> None:
+    """An ``array.array`` (its 'l' is 8 bytes here, the vendor's long 4), a str, an object:
+    7, the value's type named as a user reads it, and what a pointer argument takes."""
+    import array
+
+    for value, kind in ((array.array("l", [0]), "an array.array"), ("x", "a str")):
+        for _ in range(2):  # (again: the fast path's shapes)
+            _refused(gt.GT_GetSts(1, value), "pSts", f"{kind} is not a pointer argument")
+        assert "byref(x)" in gt.GTE_GetLastError()
