@@ -2787,6 +2787,45 @@ def gt(n=_NO, p=_NO, /, *extra, **kw):
 HOMING = "GT_GetEcatHomingStatus"
 
 
+def status_reader(
+    name: str,
+    slow: Callable[..., int],
+    session: Any,
+    advance: Callable[[Any, str, int], int],
+    status: Callable[[int], tuple[Any, int] | None],
+    ok: Any,
+) -> Callable[..., int]:
+    """``f(axis, p)`` of a reader of one integer answered from ``status(axis)`` ((the
+    controller, the value), or None: the table path): ``p`` a ``byref`` (no offset) or the
+    object itself of an integer type of ``ok``, or an array of one (its first element); a
+    value the type does not hold and any other shape: the table path (``slow``), with its
+    code and reason.  The homing status readers' shared front (GT_GetEcatHomingStatus,
+    the older cards' GT_HomeSts)."""
+    bounds, target, first = _int_bounds(ok), _target(ok), _array_first(ok)
+
+    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
+        if type(n) is int and not kw and not extra:
+            obj, arr = _value_target(p, target, ok, first)
+            if obj is not None:
+                got = status(n)
+                if got is not None:
+                    ctl, v = got
+                    lo, hi = bounds[type(obj)] if arr is None else arr
+                    if lo <= v <= hi:
+                        if arr is None:
+                            obj.value = v
+                        else:
+                            obj[0] = v
+                        session.last = None
+                        if ctl.clock.mode is _LOCKSTEP:
+                            return 0
+                        return advance(ctl, name, 0)
+        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+
+    gt.slow = slow  # type: ignore[attr-defined]
+    return gt
+
+
 def fast_homing_status(
     name: str,
     slow: Callable[..., int],
@@ -2807,16 +2846,6 @@ def fast_homing_status(
     from .table import FUNCTIONS
 
     ok = _scalar_types(FUNCTIONS[name].params[1])
-    bounds = {}
-    for t in ok:
-        bits = 8 * ctypes.sizeof(t)
-        bounds[t] = (
-            (0, (1 << bits) - 1)
-            if t._type_.isupper()
-            else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
-        )
-    target = _target(ok)
-    first = _array_first(ok)
     getattribute = object.__getattribute__  # (past the axis bank's guard, as homing_status)
     from ..controller.axis import Axis
 
@@ -2878,25 +2907,7 @@ def fast_homing_status(
             v = st.result
         return None if v is None else (ctl, v)
 
-    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(n) is int and not kw and not extra:
-            obj, arr = _value_target(p, target, ok, first)
-            if obj is not None:
-                got = status(n)
-                if got is not None:
-                    ctl, v = got
-                    lo, hi = bounds[type(obj)] if arr is None else arr
-                    if lo <= v <= hi:
-                        if arr is None:
-                            obj.value = v
-                        else:
-                            obj[0] = v
-                        session.last = None
-                        if ctl.clock.mode is _LOCKSTEP:
-                            return 0
-                        return advance(ctl, name, 0)
-        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
-
+    gt = status_reader(name, slow, session, advance, status, ok)
     gated = GATED
 
     def value(n: int) -> Any:
@@ -2933,7 +2944,6 @@ def fast_homing_status(
         session.last = None
         return v
 
-    gt.slow = slow  # type: ignore[attr-defined]
     return _entry(  # type: ignore[no-any-return]
         gt, value, ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
     )

@@ -33,48 +33,29 @@ def fast_home_sts(
     core 1, or of a core viewing core 1's bus, takes this path through the GT layer's twin.)"""
     from ..controller import smart_home as sh
     from .args import _scalar_types
-    from .fast import (
-        _LOCKSTEP,
-        _NO,
-        _array_first,
-        _int_bounds,
-        _target,
-        _value_target,
-        smart_home_lookup,
-    )
+    from .fast import smart_home_lookup, status_reader
     from .table import FUNCTIONS
 
-    ok = _scalar_types(FUNCTIONS[name].params[1])
-    bounds = _int_bounds(ok)
-    target = _target(ok)
-    first = _array_first(ok)
     end = sh.Stage.END
     home_of, _ = smart_home_lookup()
 
-    def gt(n: Any = _NO, p: Any = _NO, /, *extra: Any, **kw: Any) -> int:
-        if type(n) is int and not kw and not extra:
-            obj, arr = _value_target(p, target, ok, first)
-            ctl = None if obj is None else session.controllers.get(1)
-            if ctl is not None and session.plain and ctl.clock._thread is None:
-                home = home_of(ctl, n)
-                if home is not None:
-                    st = home.status
-                    if st.run or not st.error:  # (a failed homing: 1 and its reason)
-                        v = int(not st.run and st.stage == end)
-                        lo, hi = bounds[type(obj)] if arr is None else arr
-                        if lo <= v <= hi:
-                            if arr is None:
-                                obj.value = v
-                            else:
-                                obj[0] = v
-                            session.last = None
-                            if ctl.clock.mode is _LOCKSTEP:
-                                return 0
-                            return advance(ctl, name, 0)
-        return slow(*(a for a in (n, p) if a is not _NO), *extra, **kw)
+    def status(n: int) -> tuple[Any, int] | None:
+        """(the controller, 1 once axis ``n``'s homing ended at its target, 0 while it runs or
+        when none ran) where the fast path answers it, else None: no controller in this
+        process, a homing not made yet, a failed homing (1 with its reason)."""
+        ctl = session.controllers.get(1)
+        if ctl is None or not session.plain or ctl.clock._thread is not None:
+            return None
+        home = home_of(ctl, n)
+        if home is None:
+            return None
+        st = home.status
+        if st.run or not st.error:
+            return ctl, int(not st.run and st.stage == end)
+        return None
 
-    gt.slow = slow  # type: ignore[attr-defined]
-    return gt
+    ok = _scalar_types(FUNCTIONS[name].params[1])
+    return status_reader(name, slow, session, advance, status, ok)
 
 
 __all__ = ["HOME_STS", "fast_home_sts"]
