@@ -3779,6 +3779,21 @@ def fast_wait(
     return _wait_entry(gt, name, session, advance)
 
 
+def call_ended(session: Any, ctl: Any, name: str, advance: Callable[[Any, str, int], int]) -> int:
+    """What the GT layer does after a call that returned 0 (``_core.gt_function``'s run):
+    the session's last failure cleared, or the call's note kept; the call's host latency on
+    the auto clock."""
+    if session.note is None:
+        session.last = None
+    else:
+        from ._core import call_done
+
+        call_done(name)
+    if ctl.clock.mode is _LOCKSTEP:
+        return 0
+    return advance(ctl, name, 0)
+
+
 def _wait_entry(
     gt: Callable[..., int], name: str, session: Any, advance: Callable[[Any, str, int], int]
 ) -> Callable[..., int]:
@@ -3790,7 +3805,7 @@ def _wait_entry(
         return gt
     from ..controller.bank_kernel import IN_MAXC
     from ..controller.core import Controller
-    from ._core import call_done, call_failed
+    from ._core import call_failed
 
     def rest(rc: int, pending: int) -> int:
         # (the entry ran the wait's cycles on the armed call, its book in C declined them:
@@ -3801,13 +3816,7 @@ def _wait_entry(
             wait_yield(ctl)
         except Exception as e:
             return call_failed(name, e, ctl, 1)
-        if session.note is None:
-            session.last = None
-        else:
-            call_done(name)
-        if ctl.clock.mode is _LOCKSTEP:
-            return 0
-        return advance(ctl, name, 0)
+        return call_ended(session, ctl, name, advance)
 
     own_dict(session)  # (its attributes read quick; the entry reads its dict)
     entry = centry.wait(

@@ -23,11 +23,10 @@ from ..controller.bank_stream import on_row, stream_row
 from ..controller.epoch import EPOCH
 from ..controller.motion.pt import PtPlanner
 from ..controller.profile import PrfMode
-from ..master.clock import ClockMode
+from .fast import call_ended
 
 _NO: Any = object()
 _set = object.__setattr__
-_LOCKSTEP = ClockMode.LOCKSTEP
 _PT = PrfMode.PT
 _LONG = (-(1 << 31), (1 << 31) - 1)
 _SHORT = (-(1 << 15), (1 << 15) - 1)
@@ -113,17 +112,10 @@ def _pt_target(session: Any, n: int, name: str, values: tuple) -> tuple[Any, Any
 
 
 def _done(session: Any, ctl: Any, name: str, advance: Callable[[Any, str, int], int]) -> int:
-    """What the GT layer does after a call that returned 0 (``_core.gt_function``'s run)."""
+    """What the GT layer does after a call that changed something and returned 0: the
+    readers' epoch grows, then :func:`fast.call_ended`."""
     EPOCH.n += 1
-    if session.note is None:
-        session.last = None
-    else:
-        from ._core import call_done
-
-        call_done(name)
-    if ctl.clock.mode is _LOCKSTEP:
-        return 0
-    return advance(ctl, name, 0)
+    return call_ended(session, ctl, name, advance)
 
 
 def fast_pt_data(
