@@ -21,7 +21,7 @@ import pytest
 
 from gtecat import gt
 from tests.gtecat.controller.test_bank import ENI, _ok, open_bus
-from tests.gtecat.controller.test_bank_smart_home import _machine, _sample
+from tests.gtecat.controller.test_bank_smart_home import _end_state, _machine, _sample
 
 AXES = 12
 #: axis -> (the call: "home", "stop" (GT_HomeStop) or None (never homed), its arguments
@@ -93,21 +93,7 @@ def _run(machine: str, bank: str, step: int = 0) -> tuple[list, dict[str, Any]]:
             "rows": bank_.rows_run if bank_ is not None else 0,
             "poll_releases": sum(releases),
         }
-        if bank_ is not None:
-            bank_.release_all()  # (the uploads of the cycles it ran are counted at a release)
-        backend = ctl.backend
-        mailboxes = [
-            (backend._clients[p].counter, backend.slaves[p].sdo.counter)
-            for p in sorted(backend._clients)
-        ]
-        trace.append(
-            tuple(
-                (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
-                for s in backend.slaves
-                for ch in getattr(s, "channels", [])
-            )
-            + tuple(mailboxes)
-        )
+        trace.append(_end_state(ctl))
     finally:
         gt.GT_Close()
     return trace, stats

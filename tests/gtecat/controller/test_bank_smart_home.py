@@ -98,6 +98,24 @@ def _sample(size: int, axes: int = AXES) -> tuple:
     return tuple(sts), tuple(prf), tuple(enc), tuple(homes), bytes(raw)
 
 
+def _end_state(ctl: Any) -> tuple:
+    """After a run: every drive channel's motion, statusword and position, and each
+    slave's mailbox counters (the bank given everything back first: the uploads of the
+    cycles it ran are counted at a release)."""
+    if ctl.bank is not None:
+        ctl.bank.release_all()
+    backend = ctl.backend
+    mailboxes = [
+        (backend._clients[p].counter, backend.slaves[p].sdo.counter)
+        for p in sorted(backend._clients)
+    ]
+    return tuple(
+        (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
+        for s in backend.slaves
+        for ch in getattr(s, "channels", [])
+    ) + tuple(mailboxes)
+
+
 def _run(
     machine: str,
     bank: str,
@@ -182,21 +200,7 @@ def _run(
             held = bank_.holds(ctl.axes[1])
             ctl.backend.slaves[0].od.upload(0x60B9, 0)
             stats["probe_guard"] = (held, bank_.holds(ctl.axes[1]))
-        if bank_ is not None:
-            bank_.release_all()  # (the uploads of the cycles it ran are counted at a release)
-        backend = ctl.backend
-        mailboxes = [
-            (backend._clients[p].counter, backend.slaves[p].sdo.counter)
-            for p in sorted(backend._clients)
-        ]
-        trace.append(
-            tuple(
-                (ch.mech.pos, ch.mech.vel, ch.statusword, ch.position_actual)
-                for s in backend.slaves
-                for ch in getattr(s, "channels", [])
-            )
-            + tuple(mailboxes)
-        )
+        trace.append(_end_state(ctl))
     finally:
         gt.GT_Close()
     return trace, stats
