@@ -265,6 +265,21 @@ def _look(size: int) -> tuple:
     return (_sample(size), tuple(acc))
 
 
+def _play(script: list, size: int, chunked: bool, trace: list) -> None:
+    """Run ``script`` ((wait, action) pairs), its looks into ``trace``: after every cycle,
+    or at the end of each wait when ``chunked``; each action's result after its wait."""
+    for wait, action in script:
+        if chunked:
+            if wait:
+                gt.GTE_Wait(wait)
+            trace.append(_look(size))
+        else:
+            for _ in range(wait):
+                gt.GTE_Wait(1)
+                trace.append(_look(size))
+        trace.append(("call", action()))
+
+
 def _run(
     script: Script, machine: str, bank: str, chunked: bool = False, kernel: str = "c"
 ) -> tuple[list, int]:
@@ -283,16 +298,7 @@ def _run(
     size = ctl.layout.gt_raw_bytes
     trace: list = []
     try:
-        for wait, action in script:
-            if chunked:
-                if wait:
-                    gt.GTE_Wait(wait)
-                trace.append(_look(size))
-            else:
-                for _ in range(wait):
-                    gt.GTE_Wait(1)
-                    trace.append(_look(size))
-            trace.append(("call", action()))
+        _play(script, size, chunked, trace)
         gt.GTE_Wait(20)
         trace.append(_look(size))
         trace.append(_loops())

@@ -25,7 +25,7 @@ import pytest
 
 from gtecat import gt
 from tests.gtecat.controller.test_bank import _bring_up, _machine_file, _ok
-from tests.gtecat.controller.test_bank_modes import _look
+from tests.gtecat.controller.test_bank_modes import _look, _play
 
 Script = list[tuple[int, Callable[[], object]]]
 #: the dynamic PT axes and the Trap axes of the programs
@@ -186,16 +186,7 @@ def _run(
     size = ctl.layout.gt_raw_bytes
     trace: list = []
     try:
-        for wait, action in script:
-            if chunked:
-                if wait:
-                    gt.GTE_Wait(wait)
-                trace.append(_look(size))
-            else:
-                for _ in range(wait):
-                    gt.GTE_Wait(1)
-                    trace.append(_look(size))
-            trace.append(("call", action()))
+        _play(script, size, chunked, trace)
         gt.GTE_Wait(30)
         trace.append(_look(size))
         trace.append(
