@@ -265,7 +265,7 @@ def _look(size: int) -> tuple:
     return (_sample(size), tuple(acc))
 
 
-def _play(script: list, size: int, chunked: bool, trace: list) -> None:
+def _play(script: Script, size: int, chunked: bool, trace: list) -> None:
     """Run ``script`` ((wait, action) pairs), its looks into ``trace``: after every cycle,
     or at the end of each wait when ``chunked``; each action's result after its wait."""
     for wait, action in script:
