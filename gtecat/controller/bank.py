@@ -95,6 +95,7 @@ from ..master.clock import ClockMode
 from .axis import CW_QUICK_STOP
 from .axis_status import AxisStatus
 from .bank_home_rows import switch_released, switch_to_homing
+from .bank_home_start import start_at_once
 from .bank_kernel import MAXSEG, NTPRM, OUT_FIN, Kernel, PtFill, PtRun, trap_fill
 from .bank_kernel import library as kernel_library
 from .bank_kernel import settled as kernel_settled
@@ -510,6 +511,10 @@ class AxisBank:
         #: and whether the bank was to re-index before it
         self._frozen_call = -1
         self._frozen_stale = False
+        #: that call is GT_StartEcatHoming, and the row whose start's instant part ran on it
+        #: as the cycle began (gtecat.controller.bank_home_start; -1: none)
+        self._frozen_start = False
+        self._home_started = -1
         #: the bank's cycles and the outside marks after the last step of an opened row
         self._opened_marks: tuple[int, tuple[int, int]] = (-1, (-1, -1))
         #: where a group's output bytes lie in the raw-write checks' references, per
@@ -599,6 +604,9 @@ class AxisBank:
         self.home_switches = 0
         self.home_switch = -1
         self.home_switch_from = 0
+        #: homing starts run on the row, the row kept and given back after them
+        #: (gtecat.controller.bank_home_start; statistics)
+        self.home_starts = self.home_starts_given = 0
         #: GT_PrfTrap calls on claimed rows standing in Trap mode, run as they stand
         #: (:meth:`call_in_place`; statistics)
         self.trap_holds = 0
@@ -2315,6 +2323,7 @@ class AxisBank:
             _unguard(objs)
             self._frozen_call = r
             self._frozen_stale = self._stale
+            self._frozen_start = proto.name == "GT_StartEcatHoming"
             self._stale = True  # (no cycle runs many at once: the next one's _begin opens it)
             try:
                 return call()
@@ -2324,6 +2333,12 @@ class AxisBank:
                     self._stale = self._frozen_stale
                     homing_objects = proto.name == "GT_SetEcatHomingPrm" and values[-1] == 0
                     self._close_in_place(r, g, objs, homing_objects)
+                elif self._home_started == r:  # (bank_home_start: the row stays, or went back)
+                    self._home_started = -1
+                    if g.claimed and self.alive[r]:
+                        _reguard(objs)
+                    else:
+                        self._close(r, g, True)
                 else:
                     self._close_opened(r, g)
         mode = values[1] if len(values) == 2 else None  # (a list from a first call's binder)
@@ -2883,7 +2898,9 @@ class AxisBank:
             self._settled = True
 
     def _begin(self) -> None:
-        if self._frozen_call >= 0:
+        if self._frozen_call >= 0 and not (
+            self._frozen_start and start_at_once(self, self._frozen_call)
+        ):
             self._open_in_place()
         if self.kernel_due and kernel_settled():
             self._take_kernel()

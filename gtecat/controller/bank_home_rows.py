@@ -191,6 +191,7 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
             bank._release_groups([g])
         finally:
             bank._stepping = -1
+        bank.frz[r] = bank.frz_off[r] = False  # (a row given back has them clear)
         for obj in objs:  # (a planner replaced meanwhile: the bank's no longer)
             _bank()._OWNER.pop(id(obj), None)
         return 0

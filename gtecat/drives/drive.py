@@ -729,20 +729,25 @@ class Channel:
         self.dpos = self.mech.pos
         self.dvel = 0.0
         try:
-            params = HomingParams(
-                method=int(self.homing_method),
-                speed_switch=float(self.homing_speed_switch),
-                speed_zero=float(self.homing_speed_zero),
-                acceleration=float(self.homing_acceleration),
-                home_offset=int(self.home_offset),
+            self.homing = Homing(
+                self.homing_params(), self.machine, self.mech.pos, self.forced_switches
             )
-            self.homing = Homing(params, self.machine, self.mech.pos, self.forced_switches)
         except GtecatError as err:  # the homing component refused the parameters
             log.warning("axis channel %d: homing cannot start: %s", self.k, err)
             self.homing = None
             self.hm_bits = SW10 | (1 << 13)  # homing error, velocity 0
             return
         self.hm_bits = 0
+
+    def homing_params(self) -> HomingParams:
+        """6098h, 6099h:01/02, 609Ah and 607Ch as a homing takes them at CW4's rising edge."""
+        return HomingParams(
+            method=int(self.homing_method),
+            speed_switch=float(self.homing_speed_switch),
+            speed_zero=float(self.homing_speed_zero),
+            acceleration=float(self.homing_acceleration),
+            home_offset=int(self.home_offset),
+        )
 
     def finish_homing(self) -> None:
         """Homing ended: on success the encoder is redefined (6064h reads the home value)."""

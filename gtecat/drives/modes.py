@@ -291,11 +291,11 @@ def step_hm(ch: Any, cw: int, dt: float) -> None:
         ch.dpos = d
         if h.done and not ch.hm_applied:
             ch.finish_homing()
-        ch.hm_bits = _hm_bits(h.status_bits())
+        ch.hm_bits = hm_bits_of(h.status_bits())
     ch.oms = ch.hm_bits | (SW13 if ch.fe_flag else 0)
 
 
-def _hm_bits(bits: tuple[bool, bool, bool]) -> int:
+def hm_bits_of(bits: tuple[bool, bool, bool]) -> int:
     reached, attained, error = bits
     return (SW10 if reached else 0) | (SW12 if attained else 0) | (SW13 if error else 0)
 

@@ -15,12 +15,30 @@ direction is fixed by the window, which is exact for any step length.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import lru_cache
 
 Window = tuple[float, float]
 
 
 def merge_windows(windows: Iterable[Window]) -> tuple[Window, ...]:
-    """The same active set as disjoint, sorted windows (overlapping or touching ones joined)."""
+    """The same active set as disjoint, sorted windows (overlapping or touching ones joined).
+
+    (A machine description's windows are a tuple of pairs: merged once and kept, since every
+    homing start and touch probe arms them again.)"""
+    if type(windows) is tuple:
+        try:
+            return _merged(windows)
+        except TypeError:  # (a pair that is a list: not hashable)
+            pass
+    return _merge(windows)
+
+
+@lru_cache(maxsize=256)
+def _merged(windows: tuple[Window, ...]) -> tuple[Window, ...]:
+    return _merge(windows)
+
+
+def _merge(windows: Iterable[Window]) -> tuple[Window, ...]:
     out: list[list[float]] = []
     for lo, hi in sorted((float(a), float(b)) for a, b in windows):
         if hi <= lo:

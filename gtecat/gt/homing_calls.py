@@ -108,6 +108,7 @@ from gtecat.drives.abort import SdoAbort
 from ..controller.axis import Axis, PdsState
 from ..controller.core import Controller
 from ..errors import CommandError, ParameterError
+from ..master.backends.emulated import EmulatedBackend
 from . import _core
 from ._core import check_range, gt_function, store
 from .axis_calls import ECAT_MODES, bus_axis
@@ -183,6 +184,13 @@ class _AxisHoming:
         self.active = False
         self.result = result
 
+    def answered_with(self, statusword: int) -> None:
+        """What :meth:`post` makes of the cycle in which the drive answers this run's CW4
+        with ``statusword``, known before that cycle runs: the axis bank starts a homing that
+        ends at once (the current position is home) on the drive's row
+        (gtecat.controller.bank_home_start), its drive in homing mode and operation enabled."""
+        self._follow(statusword, True)
+
     def post(self, ax: Axis, t_ns: int, dt_ns: int) -> None:
         """Post-cycle hook: follow an active run with the drive's answer of this cycle."""
         if not self.active:
@@ -190,12 +198,14 @@ class _AxisHoming:
         if ax.mode_cmd != _HOMING_MODE or ax.state != PdsState.OPERATION_ENABLED:
             self.end(HOMING_FAILED)  # the drive no longer runs the procedure
             return
-        sw = ax.statusword
+        self._follow(ax.statusword, bool(ax.cw & _CW_HOMING_START))
+
+    def _follow(self, sw: int, cw4: bool) -> None:
+        """The run followed by the drive's statusword ``sw`` of a cycle (``cw4``: the
+        controller's controlword of it holds CW4)."""
         if sw & _SW_HOMING != _SW_NOT_STARTED:
             self.answered = True
-        status = homing_status_value(
-            sw, waiting=not self.answered and bool(ax.cw & _CW_HOMING_START)
-        )
+        status = homing_status_value(sw, waiting=not self.answered and cw4)
         if status != HOMING_IN_PROGRESS:
             self.end(status)
 
@@ -460,8 +470,6 @@ def homing_status(ax: Axis) -> int:
 
 def _search_hint(ctl: Controller, ax: Axis) -> str | None:
     """What the emulated drive's search lacks in the machine description (None elsewhere)."""
-    from ..master.backends.emulated import EmulatedBackend
-
     if not isinstance(ctl.backend, EmulatedBackend):
         return None
     try:
