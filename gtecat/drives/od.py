@@ -542,6 +542,22 @@ class OdObject:
                 subs = self._subs = {v.subindex: v for v in make()}
         return subs
 
+    def sub(self, subindex: int) -> Variable | None:
+        """``subs.get(subindex)`` without making the dict of entries given as a Variable or a
+        tuple (an object whose one entry a download writes: a drive homing's parameters)."""
+        subs = self._subs
+        if subs is not None:
+            return subs.get(subindex)
+        make = self._make
+        if isinstance(make, Variable):
+            return make if make.subindex == subindex else None
+        if isinstance(make, tuple):
+            for var in reversed(make):  # (the last of a subindex, as in the dict)
+                if var.subindex == subindex:
+                    return var
+            return None
+        return self.subs.get(subindex)
+
     def __repr__(self) -> str:
         return (
             f"<OdObject 0x{self.index:04X} {self.name} {self.code.name} subs={sorted(self.subs)}>"
@@ -769,7 +785,7 @@ class ObjectDictionary:
         in-process master's expedited downloads (a drive homing's five parameters)."""
         obj = self.objects.get(index)
         if obj is not None:
-            var = (obj._subs or obj.subs).get(subindex)
+            var = obj.sub(subindex)
             if var is not None:
                 kind = _INT_RANGE.get(var.data_type)
                 if kind is not None and kind[0] == size and kind[1] <= value <= kind[2]:

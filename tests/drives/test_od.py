@@ -212,5 +212,6 @@ def test_a_value_downloaded_is_its_bytes_downloaded(entry, size, data, state) ->
             got = _outcome(od.download, index, sub, raw, False, state)
         var = od.find(index, sub)
         held = None if var is None else var.get()
-        results.append((got, held, type(held), store["x"]))
+        raw = None if var is None else var.encode(held)  # (a REAL32's NaN: its bytes)
+        results.append((got, raw, type(held), store["x"]))
     assert results[0] == results[1]
