@@ -95,6 +95,10 @@ _ENABLE_STEP = {
 }
 
 
+#: a key not looked up yet in :attr:`AxisIo._cache` (None there: looked up, not mapped)
+_UNSEEN = object()
+
+
 class AxisIo:
     """Typed access to the mapped objects of one channel, SDO for the rest."""
 
@@ -105,7 +109,7 @@ class AxisIo:
         ref: AxisRef,
         sdo_upload: Callable[[int, int, int], bytes] | None = None,
         sdo_download: Callable[[int, int, int, bytes], None] | None = None,
-        sdo_download_many: Callable[[int, list[tuple[int, int, bytes]]], None] | None = None,
+        sdo_download_values: Callable[[int, list[tuple[int, int, int, int]]], None] | None = None,
     ) -> None:
         self.ref = ref
         self.slave = ref.slave
@@ -115,7 +119,7 @@ class AxisIo:
         self._cache: dict[tuple[int, int], EntryAccess | None] = {}
         self._sdo_upload = sdo_upload
         self._sdo_download = sdo_download
-        self._sdo_download_many = sdo_download_many
+        self._sdo_download_values = sdo_download_values
 
     @classmethod
     def on(cls, master: Any, layout: Layout, ref: AxisRef) -> AxisIo:
@@ -126,7 +130,7 @@ class AxisIo:
             ref,
             master.sdo_upload,
             master.sdo_download,
-            master.sdo_download_many,
+            master.sdo_download_values,
         )
 
     def index(self, index: int) -> int:
@@ -197,24 +201,31 @@ class AxisIo:
     def write_all_or_sdo(self, items: list[tuple[int, int, int, int]]) -> None:
         """Write ``(index, subindex, value, size)`` objects in order, each by PDO if mapped,
         else by SDO (the SDOs one after the other in one call where the master takes them
-        so: every one a download of its own, the first that fails raised)."""
-        many = self._sdo_download_many
-        sdo: list[tuple[int, int, bytes]] = []
-        for index, subindex, value, size in items:
-            acc = self.get(index, subindex)
+        so: every one a download of its own, the first that fails raised; the values, ints
+        that fit their sizes, as they are: :meth:`gtecat.master.bus.Master.sdo_download_values`)."""
+        many = self._sdo_download_values
+        cache = self._cache
+        base = 0x800 * self.channel
+        sdo: list[tuple[int, int, int, int]] = []
+        for item in items:
+            index, subindex, value, size = item
+            acc = cache.get((index, subindex), _UNSEEN)
+            if acc is _UNSEEN:
+                acc = self.get(index, subindex)
             if acc is None and many is not None:
-                data = int(value).to_bytes(size, "little", signed=value < 0)
-                sdo.append((self.index(index), subindex, data))
+                if base and 0x6000 <= index < 0x6800:  # (self.index)
+                    item = (index + base, subindex, value, size)
+                sdo.append(item)
                 continue
             if sdo:  # (in order: the SDOs before this object first)
-                many(self.slave, sdo)  # type: ignore[misc]
+                many(self.slave, sdo)
                 sdo = []
             if acc is not None:
-                acc.set(value)
+                acc.set(value)  # type: ignore[union-attr]
             else:
                 self.sdo_write(index, subindex, value, size)
         if sdo:
-            many(self.slave, sdo)  # type: ignore[misc]
+            many(self.slave, sdo)
 
     def read_or_sdo(self, index: int, subindex: int, size: int, signed: bool = False) -> int:
         """PDO if mapped, else SDO (manual 5.2.2.2 for 6060h/6061h)."""

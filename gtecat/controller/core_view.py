@@ -21,6 +21,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from .._attrs import own_dict
+from ..errors import ParameterError
 
 if TYPE_CHECKING:
     from .axis import Axis
@@ -87,8 +88,6 @@ class CoreView:
         return bool(self.axes)
 
     def axis(self, n: int) -> Axis:
-        from ..errors import ParameterError
-
         self._sync()
         try:
             n = int(n)

@@ -95,7 +95,12 @@ class Access(IntEnum):
 
     @property
     def writable(self) -> bool:
-        return self in (Access.WO, Access.RW)
+        return self in _WRITABLE
+
+
+#: the access rights an SDO download may write (a set: a member's lookup on its class costs
+#: more than the test, and a download tests it every time)
+_WRITABLE = frozenset({Access.WO, Access.RW})
 
 
 class PdoDir(IntFlag):
@@ -150,6 +155,13 @@ PREOP_ONLY = frozenset({AlState.INIT, AlState.PREOP})
 #: a data type's value when an entry gives none: empty bytes, 0.0 or 0
 _DEFAULT_VALUE: dict[DataType, Any] = {
     t: b"" if info.is_string else (0.0 if info.fmt == "f" else 0) for t, info in TYPE_INFO.items()
+}
+#: an integer type's size in bytes and range: the values its bytes decode to
+#: (:meth:`ObjectDictionary.download_value` takes a value of that size in that range as it is)
+_INT_RANGE: dict[DataType, tuple[int, int, int]] = {
+    t: (info.size, info.low, info.high)  # type: ignore[misc]
+    for t, info in TYPE_INFO.items()
+    if info.size and info.fmt != "f"
 }
 
 
@@ -305,22 +317,26 @@ class Variable:
 
     def check(self, value: Any) -> None:
         """Raise SdoAbort when ``value`` is outside this entry's range or allowed set."""
-        if self._x is None:  # no range, no allowed set (most entries)
+        x = self._x
+        if x is None:  # no range, no allowed set (most entries)
             return
-        if self.allowed is not None and value not in self.allowed:
+        allowed = x.get("allowed")
+        if allowed is not None and value not in allowed:
             raise SdoAbort(
                 SdoAbortCode.VALUE_RANGE_EXCEEDED,
                 self.index,
                 self.subindex,
-                f"{value} is not one of {sorted(self.allowed)}",
+                f"{value} is not one of {sorted(allowed)}",
             )
-        if self.high is not None and value > self.high:
+        high = x.get("high")
+        if high is not None and value > high:
             raise SdoAbort(
-                SdoAbortCode.VALUE_TOO_HIGH, self.index, self.subindex, f"{value} > {self.high}"
+                SdoAbortCode.VALUE_TOO_HIGH, self.index, self.subindex, f"{value} > {high}"
             )
-        if self.low is not None and value < self.low:
+        low = x.get("low")
+        if low is not None and value < low:
             raise SdoAbort(
-                SdoAbortCode.VALUE_TOO_LOW, self.index, self.subindex, f"{value} < {self.low}"
+                SdoAbortCode.VALUE_TOO_LOW, self.index, self.subindex, f"{value} < {low}"
             )
 
     # --- bytes --------------------------------------------------------------
@@ -525,6 +541,22 @@ class OdObject:
                 assert make is not None
                 subs = self._subs = {v.subindex: v for v in make()}
         return subs
+
+    def sub(self, subindex: int) -> Variable | None:
+        """``subs.get(subindex)`` without making the dict of entries given as a Variable or a
+        tuple (an object whose one entry a download writes: a drive homing's parameters)."""
+        subs = self._subs
+        if subs is not None:
+            return subs.get(subindex)
+        make = self._make
+        if isinstance(make, Variable):
+            return make if make.subindex == subindex else None
+        if isinstance(make, tuple):
+            for var in reversed(make):  # (the last of a subindex, as in the dict)
+                if var.subindex == subindex:
+                    return var
+            return None
+        return self.subs.get(subindex)
 
     def __repr__(self) -> str:
         return (
@@ -741,20 +773,49 @@ class ObjectDictionary:
             raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
         self._write(var, bytes(data), al_state)
 
-    def _write(self, var: Variable, data: bytes, al_state: AlState) -> None:
-        if not var.access.writable:
+    def download_value(
+        self, index: int, subindex: int, value: int, size: int, al_state: AlState = AlState.PREOP
+    ) -> None:
+        """:meth:`download` of the integer ``value`` as a master sends it: its ``size``
+        little-endian bytes (two's complement when negative; the value fits them).  An
+        integer entry of that size whose range holds the value takes it as it is, which is
+        what decoding those bytes gives back; any other entry (another size, a value it reads
+        otherwise, a REAL32 or a string) and a missing one take the bytes.  The same checks,
+        aborts and write either way, without the bytes made and parsed for each of an
+        in-process master's expedited downloads (a drive homing's five parameters)."""
+        obj = self.objects.get(index)
+        if obj is not None:
+            var = obj.sub(subindex)
+            if var is not None:
+                kind = _INT_RANGE.get(var.data_type)
+                if kind is not None and kind[0] == size and kind[1] <= value <= kind[2]:
+                    self._write(var, None, al_state, value)
+                    return
+        data = value.to_bytes(size, "little", signed=value < 0)
+        self.download(index, subindex, data, False, al_state)
+
+    def _write(
+        self, var: Variable, data: bytes | None, al_state: AlState, value: Any = None
+    ) -> None:
+        """Write one entry from the bytes of a download (``data`` None: ``value`` is what
+        :meth:`Variable.decode` gives for them, :meth:`download_value`)."""
+        if var.access not in _WRITABLE:
             raise SdoAbort(SdoAbortCode.WRITE_OF_READ_ONLY, var.index, var.subindex)
-        if var.write_states is not None and al_state not in var.write_states:
+        states = var.write_states
+        if states is not None and al_state not in states:
             raise SdoAbort(
                 SdoAbortCode.CANNOT_TRANSFER_DEVICE_STATE,
                 var.index,
                 var.subindex,
                 f"not writable in {al_state.name}",
             )
-        if self.download_guard is not None:
-            self.download_guard(var, al_state)
-        value = var.decode(data)
-        var.check(value)
+        guard = self.download_guard
+        if guard is not None:
+            guard(var, al_state)
+        if data is not None:
+            value = var.decode(data)
+        if var._x is not None:  # (a range or allowed values: Variable.check)
+            var.check(value)
         try:
             var.set(value)
         except SdoAbort as err:

@@ -100,6 +100,11 @@ class Layout:
     _index: dict[tuple[int, int, int, Direction], Placement] = field(
         default_factory=dict, repr=False, compare=False
     )
+    #: (slave, index, subindex) -> what :meth:`entry` finds without a direction (outputs
+    #: first): one lookup for a controller asking whether an object is mapped at all
+    _either: dict[tuple[int, int, int], Placement] = field(
+        default_factory=dict, repr=False, compare=False
+    )
     _axes: dict[int, AxisRef] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -107,6 +112,9 @@ class Layout:
             for p in s.entries:
                 if not p.is_padding:
                     self._index.setdefault((p.slave, p.index, p.subindex, p.direction), p)
+        for (slave, index, subindex, direction), p in self._index.items():
+            if direction == Direction.OUT or (slave, index, subindex) not in self._either:
+                self._either[slave, index, subindex] = p
         for a in self.axes:
             self._axes[a.axis] = a
 
@@ -116,9 +124,7 @@ class Layout:
         """The placement of ``index:subindex`` in ``slave`` (outputs first when no direction)."""
         if direction is not None:
             return self._index.get((slave, index, subindex, direction))
-        return self._index.get((slave, index, subindex, Direction.OUT)) or self._index.get(
-            (slave, index, subindex, Direction.IN)
-        )
+        return self._either.get((slave, index, subindex))
 
     def axis_entry(self, axis: int, index: int, subindex: int = 0) -> Placement | None:
         """The object ``index`` (as for channel 0, e.g. 0x6064) of a GT axis (1-based)."""

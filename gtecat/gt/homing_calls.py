@@ -348,14 +348,35 @@ def set_homing_parameters(
     probe_function: int,
 ) -> None:
     """GT_SetEcatHomingPrm: 6098h, 6099h:01/02, 609Ah, 607Ch (and 60B8h when non-zero)."""
-    method = check_range("method", method, -128, 127)
-    offset = check_range("offset", offset, -(1 << 31), (1 << 31) - 1)
-    probe_function = check_range("probeFunction", probe_function, 0, 0xFFFF)
+    # (the call as the C signature makes it, integers and doubles in range, passes the
+    # checks below as they are: the same values without their calls)
+    if not (
+        type(method) is int
+        and -0x80 <= method <= 0x7F
+        and type(offset) is int
+        and -0x80000000 <= offset <= 0x7FFFFFFF
+        and type(probe_function) is int
+        and 0 <= probe_function <= 0xFFFF
+    ):
+        method = check_range("method", method, -128, 127)
+        offset = check_range("offset", offset, -(1 << 31), (1 << 31) - 1)
+        probe_function = check_range("probeFunction", probe_function, 0, 0xFFFF)
     searches = method not in _METHODS_WITHOUT_MOTION
-    values = [
-        _unsigned32(name, v, positive=searches)
-        for name, v in (("speed1", speed1), ("speed2", speed2), ("acc", acc))
-    ]
+    low = 1.0 if searches else 0.0  # (a search's speeds and acceleration are not 0)
+    if (
+        type(speed1) is float
+        and type(speed2) is float
+        and type(acc) is float
+        and low <= speed1 <= 4294967295.0
+        and low <= speed2 <= 4294967295.0
+        and low <= acc <= 4294967295.0
+    ):
+        values = (round(speed1), round(speed2), round(acc))
+    else:
+        values = tuple(
+            _unsigned32(name, v, positive=searches)
+            for name, v in (("speed1", speed1), ("speed2", speed2), ("acc", acc))
+        )
     if ax.mode_cmd == _HOMING_MODE and ax.cw & _CW_HOMING_START and _homing_moving(ax):
         raise CommandError(
             f"axis {ax.number} is homing: stop it (GT_StopEcatHoming) before changing "

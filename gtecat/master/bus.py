@@ -484,14 +484,19 @@ class Master:
         finally:
             self._timed_out(lost, pos)
 
-    def sdo_download_many(self, pos: int, items: Sequence[tuple[int, int, bytes]]) -> None:
-        """Write several objects of slave ``pos`` in order, each one SDO download as
-        :meth:`sdo_download` sends it (served in this process in one go where the backend
-        can: :meth:`Backend.sdo_downloads_in_process`), stopping at the first abort (raised)."""
+    def sdo_download_values(self, pos: int, items: Sequence[tuple[int, int, int, int]]) -> None:
+        """Write integers ``(index, subindex, value, size)`` to slave ``pos`` in order, each
+        one SDO download of the value's ``size`` little-endian bytes (two's complement when
+        negative; the value fits them) as :meth:`sdo_download` sends it (served in this
+        process in one go where the backend can, the values as they are:
+        :meth:`Backend.sdo_values_in_process`), stopping at the first abort (raised)."""
         self._check_slave(pos)
         backend = self.backend
-        done = 0 if backend.mailbox_on_wire else backend.sdo_downloads_in_process(pos, items)
-        for index, subindex, data in items[done:]:
+        done = 0 if backend.mailbox_on_wire else backend.sdo_values_in_process(pos, items)
+        if done == len(items):
+            return
+        for index, subindex, value, size in items[done:]:
+            data = value.to_bytes(size, "little", signed=value < 0)
             self.sdo_download(pos, index, subindex, data)
 
     def _on_wire(self, transfer: Callable[[], _T]) -> _T:

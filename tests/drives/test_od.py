@@ -169,3 +169,49 @@ def test_integer_types_round_trip(dt: DataType, data: st.DataObject) -> None:
     od.download(0x2000, 0, raw)
     assert od.upload(0x2000, 0) == raw
     assert od.find(0x2000, 0).value == value
+
+
+#: every entry of make_od, one missing object and one missing subindex
+_ENTRIES = [(0x2000 + k, 0) for k in range(12)] + [(0x3000, k) for k in range(4)]
+_ENTRIES += [(0x3001, 1), (0x4000, 0), (0x2000, 1)]
+
+
+def _outcome(fn, *args):  # type: ignore[no-untyped-def]
+    try:
+        fn(*args)
+    except SdoAbort as e:
+        return (int(e.code), e.index, e.subindex, str(e))
+    return "ok"
+
+
+@given(
+    st.sampled_from(_ENTRIES),
+    st.sampled_from([1, 2, 4]),
+    st.data(),
+    st.sampled_from([AlState.PREOP, AlState.OP]),
+)
+def test_a_value_downloaded_is_its_bytes_downloaded(entry, size, data, state) -> None:  # type: ignore[no-untyped-def]
+    """download_value(value, size) is download() of the value's little-endian bytes: the same
+    abort (a guard's, a length's, a range's, a read-only entry's before its length) or the
+    same value stored, whether the entry takes the value as it is or not."""
+    value = data.draw(st.integers(-(1 << (8 * size - 1)), (1 << (8 * size)) - 1))
+    index, sub = entry
+    results = []
+    for by_value in (False, True):
+        od, store = make_od()
+
+        def guard(var: Variable, al_state: AlState) -> None:
+            if var.index == 0x2000 and al_state == AlState.OP:
+                raise SdoAbort(SdoAbortCode.OBJECT_MAPPED_TO_RXPDO, var.index, var.subindex)
+
+        od.download_guard = guard
+        if by_value:
+            got = _outcome(od.download_value, index, sub, value, size, state)
+        else:
+            raw = value.to_bytes(size, "little", signed=value < 0)
+            got = _outcome(od.download, index, sub, raw, False, state)
+        var = od.find(index, sub)
+        held = None if var is None else var.get()
+        raw = None if var is None else var.encode(held)  # (a REAL32's NaN: its bytes)
+        results.append((got, raw, type(held), store["x"]))
+    assert results[0] == results[1]

@@ -134,13 +134,13 @@ class Backend(ABC):
         (:meth:`gtecat.master.bus.Master.sdo_upload`)."""
         return None
 
-    def sdo_downloads_in_process(
-        self, position: int, items: Sequence[tuple[int, int, bytes]]
+    def sdo_values_in_process(
+        self, position: int, items: Sequence[tuple[int, int, int, int]]
     ) -> int:
-        """Expedited downloads ``(index, subindex, data)`` to one slave, in order, each served
-        as :meth:`sdo_in_process` serves one: how many of the first it served (0: none, the
-        caller sends them one by one); an abort is raised where one fails, after the ones
-        before it."""
+        """Expedited downloads ``(index, subindex, value, size)`` to one slave, in order, each
+        served as :meth:`sdo_in_process` serves the value's ``size`` little-endian bytes (two's
+        complement when negative): how many of the first it served (0: none, the caller sends
+        them one by one); an abort is raised where one fails, after the ones before it."""
         return 0
 
     def emergencies(self) -> list[tuple[int, object]]:

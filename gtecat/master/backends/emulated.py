@@ -595,36 +595,35 @@ class EmulatedBackend(Backend):
         server.download_in_process(index, subindex, bytes(data), complete_access, slave.al_state)
         return True
 
-    def sdo_downloads_in_process(
-        self, position: int, items: Sequence[tuple[int, int, bytes]]
+    def sdo_values_in_process(
+        self, position: int, items: Sequence[tuple[int, int, int, int]]
     ) -> int:
-        """Several expedited downloads to one slave as :meth:`sdo_in_process` serves each
-        (the same checks once: nothing sees the frames, the slave's mailbox is its SDO
-        server's, up): each one the server's own write, counters and abort, in order (a
-        drive's homing parameters: five objects in one call)."""
+        """Several expedited downloads of integers to one slave as :meth:`sdo_in_process`
+        serves each (the same checks once: nothing sees the frames, the slave's mailbox is its
+        SDO server's, up): each one the server's own write, counters and abort, in order (a
+        drive's homing parameters: five objects in one call), the values handed over as they
+        are (:meth:`SdoServer.download_values_in_process`)."""
         if self.capture is not None or position in self.unplugged:
             return 0
         if not 0 <= position < len(self.slaves):
             return 0
         slave = self.slaves[position]
-        if not slave.has_mailbox or slave.al_state < AlState.PREOP:
+        state = slave.al_state
+        if not slave.has_mailbox or state < _PREOP:
             return 0
         if not getattr(slave.mailbox, "sdo_server_only", False):
             return 0
-        server = slave.sdo  # type: ignore[attr-defined]
         client = self._clients.get(position)
         if client is None:
             client = self._client(position)
-        state = slave.al_state
-        done = 0
-        for index, subindex, data in items:
-            if not (0 <= index <= 0xFFFF and 0 <= subindex <= 0xFF and 0 < len(data) <= 4):
-                break
-            self._mailbox_ops += 1  # (steady(): the slave's objects may change)
-            client.counter = next_counter(client.counter)
-            server.download_in_process(index, subindex, bytes(data), False, state)
-            done += 1
-        return done
+        server = slave.sdo  # type: ignore[attr-defined]
+        served, abort = server.download_values_in_process(items, state)
+        if served:  # (each one a request sent and answered)
+            self._mailbox_ops += served  # (steady(): the slave's objects may change)
+            client.counter = advance_counter(client.counter, served)
+        if abort is not None:
+            raise abort
+        return served
 
     def sdo_upload(
         self, position: int, index: int, subindex: int, complete_access: bool = False
@@ -684,6 +683,7 @@ class EmulatedBackend(Backend):
 _IO_STEP = IoSlave.step
 _OP = AlState.OP  # (looked up once: an enum member costs more than a comparison)
 _SAFEOP = AlState.SAFEOP
+_PREOP = AlState.PREOP
 
 
 def _address(buf: bytearray) -> int:

@@ -156,3 +156,82 @@ def test_an_unframed_upload_is_the_framed_one(served: list[int]) -> None:
         assert direct._clients[s].counter == framed._clients[s].counter
         assert direct.slaves[s].sdo.counter == framed.slaves[s].sdo.counter
     assert cap is not None and cap.frames > 0
+
+
+#: (index, subindex, value, size) written to slave 0 in one call of the master, in order:
+#: a drive homing's five parameters, then runs that one refused download ends
+VALUE_RUNS = [
+    [
+        (0x6098, 0, 35, 1),
+        (0x6099, 1, 20000, 4),
+        (0x6099, 2, 2000, 4),
+        (0x609A, 0, 150000, 4),
+        (0x607C, 0, -5, 4),
+    ],
+    # a reserved method in the middle: 609Ah stays as it was
+    [(0x6099, 1, 7, 4), (0x6098, 0, 15, 1), (0x609A, 0, 9, 4)],
+    # values the objects read otherwise (-1 as UINT32, 0xFFFFFFFF as INT32), then a size
+    # 6065h does not have
+    [(0x6099, 2, -1, 4), (0x607C, 0, 0xFFFFFFFF, 4), (0x6065, 0, 5, 2), (0x609A, 0, 1, 4)],
+    [(0x6041, 0, 1, 2), (0x609A, 0, 2, 4)],  # read-only first
+    [(0x609A, 0, 3, 4), (0x5FFE, 0, 1, 1), (0x609A, 0, 4, 4)],  # no such object
+    [(0x609A, 0, 5, 4), (0x6099, 9, 1, 4)],  # no such subindex
+    [(0x609A, 0, 6, 4), (0x1600, 1, 0x60400010, 4)],  # a mapping, not writable now
+    [(0x6098, 0, -3, 1), (0x609A, 0, 7, 4)],  # a method no table has
+    # not one expedited download each (a subindex out of its byte): the rest one by one
+    [(0x609A, 0, 8, 4), (0x6099, 0x100, 1, 4), (0x6099, 1, 9, 4)],
+]
+_OBJECTS = [(0x6098, 0), (0x6099, 1), (0x6099, 2), (0x609A, 0), (0x607C, 0), (0x6065, 0)]
+
+
+def _values_outcome(master: Master, items: list) -> Any:
+    try:
+        master.sdo_download_values(0, items)
+    except SdoAbort as e:
+        return ("abort", int(e.code), e.index, e.subindex, str(e))
+    except Exception as e:  # (whatever the framed path raises: the same)
+        return (type(e).__name__, str(e))
+    return "ok"
+
+
+def test_downloads_of_values_in_one_call_are_the_framed_downloads(served: list[int]) -> None:
+    """Master.sdo_download_values: each value one download as the framed bus sends its bytes
+    one by one - the same objects, both sides' counters, the steady() marker moved, and the
+    first refusal's abort ending the run (the downloads after it not sent)."""
+    framed, fm, _ = _bus(frames=True)
+    direct, dm, _ = _bus(frames=False)
+    got = []
+    for items in VALUE_RUNS:
+        marker = direct._mailbox_ops
+        served.clear()
+        a = _values_outcome(fm, items)
+        framed_served = len(served)
+        served.clear()
+        b = _values_outcome(dm, items)
+        assert a == b, items
+        got.append(b)
+        assert framed_served >= 1
+        if all(sub <= 0xFF for _, sub, _, _ in items):  # (each to the server directly)
+            assert not served, items
+        assert direct._mailbox_ops != marker
+        for index, sub in _OBJECTS:
+            assert dm.sdo_upload(0, index, sub) == fm.sdo_upload(0, index, sub), hex(index)
+        assert direct._clients[0].counter == framed._clients[0].counter
+        assert direct.slaves[0].sdo.counter == framed.slaves[0].sdo.counter
+        if items is VALUE_RUNS[1]:  # the one after the refused method not sent
+            assert direct.slaves[0].channel(0).homing_speed_switch == 7
+            assert direct.slaves[0].channel(0).homing_acceleration == 150000
+    assert got[0] == "ok"
+    assert [g[1:4] for g in got[1:8]] == [
+        (0x06090030, 0x6098, 0),  # 15 is not one of the drive's methods
+        (0x06070013, 0x6065, 0),  # 2 bytes for a UINT32
+        (0x06010002, 0x6041, 0),
+        (0x06020000, 0x5FFE, 0),
+        (0x06090011, 0x6099, 9),
+        (0x08000022, 0x1600, 1),
+        (0x06090030, 0x6098, 0),
+    ]
+    assert got[-1][0] == "FormatFieldError"  # (what the framed download of subindex 256 raises)
+    assert dm.sdo_upload(0, 0x609A, 0) == (8).to_bytes(4, "little")  # the one before it
+    assert dm.sdo_upload(0, 0x6099, 2) == b"\xff\xff\xff\xff"
+    assert dm.sdo_upload(0, 0x607C, 0) == b"\xff\xff\xff\xff"
