@@ -1547,21 +1547,7 @@ class AxisBank:
             return
         self.hm[r] = homing = ax.mode_cmd == _HOMING_MODE
         if homing:  # the drive's search, or its rest after one (gtecat.drives.homing_bank)
-            self.dwatch[r], self.dpost[r] = watch, 0
-            h = ch.homing
-            for name, attr in HM_ROW_FIELDS:
-                getattr(self, name)[r] = getattr(h, attr)
-            self.h_set[r] = h._settled
-            self.h_done[r] = kind = homing_row_kind(h)  # 0 searching, 1 ended, 2 RETURN
-            consts = (homing_constants, homing_rest_constants, homing_return_constants)[kind](h)
-            for name, value in consts.items():
-                getattr(self, name)[r] = value
-            bounds = (-math.inf, math.inf) if kind else homing_event_bounds(h, ch.mech.pos)
-            assert bounds is not None  # homing_claimable checked it
-            self.h_lo[r], self.h_hi[r] = bounds
-            # 6041h: the state bits and remote, step_hm's bits instead of CSP's (oms =
-            # hm_bits: none while searching, SW10 and SW12 or SW13 at rest after it)
-            self.csp.sw_const[r] += ch.hm_bits - SW12
+            self._load_homing(r, ch, watch)
             return
         self._post_flags(r, watch, aware, sampled or jog)
         if aware:
@@ -1571,6 +1557,43 @@ class AxisBank:
                     break
             else:
                 self._post_next.discard(r)
+
+    def _load_homing(self, r: int, ch: Any, watch: int) -> None:
+        """:meth:`_load`'s part of a row whose drive searches its home, moves back onto it or
+        rests after its homing (gtecat.drives.homing_bank), after :meth:`CspBank.load`."""
+        self.dwatch[r], self.dpost[r] = watch, 0
+        h = ch.homing
+        for name, attr in HM_ROW_FIELDS:
+            getattr(self, name)[r] = getattr(h, attr)
+        self.h_set[r] = h._settled
+        self.h_done[r] = kind = homing_row_kind(h)  # 0 searching, 1 ended, 2 RETURN
+        consts = (homing_constants, homing_rest_constants, homing_return_constants)[kind](h)
+        for name, value in consts.items():
+            getattr(self, name)[r] = value
+        bounds = (-math.inf, math.inf) if kind else homing_event_bounds(h, ch.mech.pos)
+        assert bounds is not None  # homing_claimable checked it
+        self.h_lo[r], self.h_hi[r] = bounds
+        # 6041h: the state bits and remote, step_hm's bits instead of CSP's (oms = hm_bits:
+        # none while searching, SW10 and SW12 or SW13 at rest after it)
+        self.csp.sw_const[r] += ch.hm_bits - SW12
+
+    def took_homing(self, r: int) -> None:
+        """Frozen row ``r``, standing in homing mode before a homing, taken again as the
+        homing its drive's objects hold now (gtecat.controller.bank_home_start): what
+        :meth:`_load` changes of such a row then - a new claim, not frozen, the homing's part
+        (:meth:`_load_homing`) - and what :meth:`CspBank.took_homing` takes of its drive.  The
+        rest of the row is as its frozen claim took it: its objects held its state since,
+        and the homing's start moved none of it."""
+        self.claim_cycle[r] = self.bank_cycles
+        self._claims = claims = self._claims + 1
+        self.claim_ids[r] = claims
+        self.layout += 1
+        self.frz[r] = False
+        self.hm[r] = True
+        csp = self.csp
+        csp.took_homing(r)
+        self._load_homing(r, csp.channels[r], int(self.dwatch[r]))
+        csp.after_loads()
 
     def _post_flags(self, r: int, watch: int, aware: list[Any], ahead: bool) -> None:
         """Row ``r``'s dwatch and dpost from its hooks' watched bits and its drive's probe

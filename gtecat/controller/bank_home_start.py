@@ -134,9 +134,7 @@ def start_at_once(bank: AxisBank, r: int) -> bool:
         bank.frz[r] = bank.frz_off[r] = False  # (a row given back has them clear)
         bank.home_starts_given += 1
         return True
-    csp.load(r, flags=False)
-    bank._load(r, again=True)  # (its scale, links, limits, band: as at its frozen claim)
-    csp.after_loads()
+    bank.took_homing(r)
     hm = bool(bank.hm[r])
     bank.n_hm += hm
     bank.n_rest += hm and bank.h_done[r] == 1

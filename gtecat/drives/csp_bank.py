@@ -313,14 +313,36 @@ class CspBank:
         on = bool(probe.function & 0x0101)
         self.tpw[r] = on
         self.tp_lo[r], self.tp_hi[r] = probe.quiet_bounds(m.pos) if on else (-np.inf, np.inf)
-        # what _flags looks at of this row: looked at again only when it changed (a drive
-        # given back and taken again mostly brings the same)
-        key = (ch.pos_offset, ch.enc_offset, lo, hi, w, on)
+        self._flags_key(r, ch)
+        if flags:
+            self._flags()
+
+    def _flags_key(self, r: int, ch: Channel) -> None:
+        """What :meth:`_flags` looks at of row ``r`` (channel ``ch``): looked at again only
+        when it changed (a drive given back and taken again mostly brings the same)."""
+        key = (
+            ch.pos_offset,
+            ch.enc_offset,
+            ch.sw_limit_min,
+            ch.sw_limit_max,
+            ch.following_error_window,
+            bool(ch.probe.function & 0x0101),
+        )
         if self._row_flags.get(r) != key:
             self._row_flags[r] = key
             self._flags_due = True
-        if flags:
-            self._flags()
+
+    def took_homing(self, r: int) -> None:
+        """Row ``r``'s channel, standing in homing mode before a homing (:meth:`rested` up to
+        now), started a homing that ended as it began (gtecat.controller.bank_home_start):
+        what :meth:`load` takes of it that the start changed - the decoded 607Ah, the demand
+        put where the motor stands, the encoder offset of the result; :meth:`after_loads`
+        follows."""
+        ch = self.channels[r]
+        self.target[r] = ch.target_position
+        self.dpos[r], self.dvel[r] = ch.dpos, ch.dvel
+        self.off[r] = ch.enc_offset
+        self._flags_key(r, ch)
 
     def row_changed(self, r: int) -> None:
         """Row ``r``'s values that :meth:`_flags` reads were changed outside :meth:`load`
