@@ -146,11 +146,12 @@ def compiled(source: str, filename: str) -> CodeType:
     annotations`` compiles it, kept in the cache: the functions gtecat writes at run time (the
     GT fast paths, the compiled binders, a replay's calls).
 
-    They are kept in one store per Python version (:func:`_gen_load`), read in one go at
-    the first of them (the import's fast paths): a function's first call then finds its
-    compiled binder in memory, where a file of its own cost a path, an open and a read
-    (0.1-0.3 ms of the first call, and the caches the call ran in after them).  The codes
-    compiled anew are added to the store at exit (:func:`_gen_save`)."""
+    They are kept in one store per Python version (:func:`_gen_load`), its index read at
+    the first of them (the import's fast paths), each code's bytes from the file held open:
+    a function's first call finds its compiled binder with one read, where a file of its
+    own cost a path, an open and a read (0.1-0.3 ms of the first call, and the caches the
+    call ran in after them).  The codes compiled anew are added to the store at exit
+    (:func:`_gen_save`)."""
     if not _DC_FILE:  # (the caches are off)
         return compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
     key = hashlib.sha1(f"{filename}\0{source}".encode("utf-8", "surrogatepass")).hexdigest()
@@ -192,6 +193,8 @@ _GEN_NEW: dict[str, bytes] = {}
 #: the most bytes of code the store keeps (one process writes ~0.2 MB; the test suite, which
 #: compiles a binder for every function of the table, ~1 MB)
 _GEN_MOST = 4 << 20
+#: more than any store or code of it holds (a damaged file's numbers are not believed)
+_GEN_SANE = 1 << 28
 _HEAD = len(_GEN_MAGIC) + 8
 
 
@@ -209,6 +212,8 @@ def _gen_open(path: Path, whole: bool) -> tuple[dict[str, Any], int, Any]:
         if not data.startswith(_GEN_MAGIC):
             raise ValueError("not a store")
         n = int.from_bytes(data[_HEAD - 8 : _HEAD], "little")
+        if n > _GEN_SANE:
+            raise ValueError("not a store")
         if fd is not None and _HEAD + n > len(data):
             data = os.pread(fd, _HEAD + n, 0)
         index = marshal.loads(memoryview(data)[_HEAD : _HEAD + n])
@@ -241,13 +246,13 @@ def _gen_bytes(at: Any, store: Any = None) -> Any:
     start, source = _GEN_DATA if store is None else store
     try:
         a, b = at
-        if not 0 <= a <= b:
+        if not 0 <= a <= b <= a + _GEN_SANE:
             return None
         if type(source) is int:
             data = _pread(source, b - a, start + a)
         else:
             data = source[start + a : start + b]
-    except (OSError, TypeError, ValueError):
+    except (OSError, TypeError, ValueError, OverflowError):
         return None
     return data if len(data) == b - a else None
 

@@ -170,7 +170,12 @@ def test_functions_written_at_run_time_kept_compiled(tmp_path: Path, monkeypatch
     assert len(_bytecode._GEN_NEW) == 1
     _bytecode._GEN_NEW.clear()
     # a damaged store: every function compiled again, the store written anew at exit
-    for damaged in (b"damaged", kept[:40], b""):
+    huge = _bytecode._GEN_MAGIC + (1 << 62).to_bytes(8, "little")
+    index, _ = _bytecode._gen_read(store)
+    foreign = {k: v for k, v in zip(index, [(0, 1 << 90), ("a", 1)], strict=True)}
+    head = marshal.dumps(foreign)
+    foreign_index = _bytecode._GEN_MAGIC + len(head).to_bytes(8, "little") + head
+    for damaged in (b"damaged", kept[:40], b"", huge, foreign_index):
         store.write_bytes(damaged)
         _new_process()
         exec(_bytecode.compiled(source, "<probe>"), ns)
