@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from .._bytecode import compiled as _compiled_code
+from .._code_store import compiled as _compiled_code
 from ..errors import ParameterError
 from . import structs
 from .table import ENUMS, SCALARS, Param, Proto
