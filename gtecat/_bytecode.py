@@ -104,7 +104,7 @@ def install(version: str) -> None:
     sys.meta_path.insert(at, _Finder)
 
 
-# --- the methods dataclasses writes, the functions gtecat writes ---------------------------------
+# --- the methods dataclasses writes --------------------------------------------------------------
 # ``@dataclass`` writes each class's __init__, __repr__, __eq__ (and __setattr__ of a frozen one)
 # as source text and compiles it while the module is imported: for gtecat's ~180 dataclasses a
 # fifth of a process's import, every process.  The compiled text is kept here like the
@@ -112,7 +112,8 @@ def install(version: str) -> None:
 # in this module's store first, for classes of gtecat's own modules only (the globals passed
 # name the module); every other class is compiled as always.  The same text gives the same
 # code, so a class is what it would be without the store.  One file per Python version, read
-# at the first class; the codes compiled anew are added to it at exit.
+# at the first class; the codes compiled anew are added to it at exit.  (The functions gtecat
+# writes at run time have a store of their own: gtecat._code_store.)
 
 _DC_CODES: dict[str, CodeType] = {}
 _DC_NEW: dict[str, CodeType] = {}
@@ -139,25 +140,6 @@ def _dc_exec(source: Any, globals: Any = None, locals: Any = None) -> None:
     if type(source) is str:  # (a text exec'd here would take this module's __future__)
         source = compile(source, "<string>", "exec", dont_inherit=True)
     _builtin_exec(source, globals, locals)
-
-
-def compiled(source: str, filename: str) -> CodeType:
-    """``compile(source, filename, "exec")`` as a gtecat module with ``from __future__ import
-    annotations`` compiles it, kept in the cache one file per text (read only when asked
-    for): the functions gtecat writes at run time (the GT fast paths, the compiled binders,
-    a replay's calls)."""
-    if not _DC_FILE:  # (the caches are off)
-        return compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True)
-    key = hashlib.sha1(f"{filename}\0{source}".encode("utf-8", "surrogatepass")).hexdigest()
-    path = _DC_FILE[0].parent / "gen" / f"{key}.code"
-    return _kept(
-        path,
-        filename,
-        lambda: compile(source, filename, "exec", flags=_ANNOTATIONS, dont_inherit=True),
-    )
-
-
-_ANNOTATIONS = __import__("__future__").annotations.compiler_flag
 
 
 def _dc_load() -> None:

@@ -156,7 +156,13 @@ class AxisIo:
     def get(self, index: int, subindex: int = 0) -> EntryAccess | None:
         key = (index, subindex)
         if key not in self._cache:
-            base = self.channel0_index(index)
+            # (channel0_index inline: an axis's first look at each object it uses - five
+            # objects a drive homing's set-up writes, on every axis - finds it here)
+            if 0x6000 <= index < _PROFILE_END:
+                k, offset = divmod(index - 0x6000, CHANNEL_STRIDE)
+                base = 0x6000 + offset if k == 0 or k == self.channel else None
+            else:
+                base = index
             p = None if base is None else self._layout.axis_entry(self.ref.axis, base, subindex)
             self._cache[key] = self._image.access(p) if p is not None else None
         return self._cache[key]

@@ -131,7 +131,8 @@ class Layout:
         ref = self._axes.get(axis)
         if ref is None:
             return None
-        return self.entry(ref.slave, index + CHANNEL_STRIDE * ref.channel, subindex)
+        # (entry's lookup inline: an axis's first look at each object it uses comes here)
+        return self._either.get((ref.slave, index + CHANNEL_STRIDE * ref.channel, subindex))
 
     def axis(self, axis: int) -> AxisRef | None:
         return self._axes.get(axis)

@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from .._bytecode import compiled as _compiled_code
+from .._code_store import compiled as _compiled_code
 from ..errors import ParameterError
 from ..gt.args import byref_address
 from .tap import Listener, tap, untap

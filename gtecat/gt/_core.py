@@ -606,6 +606,12 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
 
     compiled: list[Any] = []  # the compiled binder, made at the first call (args.fast_binder)
 
+    def _convs() -> list[Any]:
+        """The table binder's converters (the compiled binder asks for them at its first
+        argument of a shape it does not bind inline: a call of plain arguments makes no
+        table binder)."""
+        return (bind or _binder()).convs  # type: ignore[attr-defined,no-any-return]
+
     @functools.wraps(fn)
     def gt(*args: Any, **kwargs: Any) -> int:
         if not kwargs:
@@ -614,7 +620,7 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                 if values is not None:
                     return run(SESSION._core, values, _NO_KW, "", SESSION.last)
             elif not opens:  # GT_Open: always the table path (its keyword options)
-                compiled.append(fast_binder(proto, (bind or _binder()).convs))  # type: ignore[attr-defined]
+                compiled.append(fast_binder(proto, _convs))
                 return table(*args)
         return call(_GT, args, kwargs)
 
@@ -688,13 +694,14 @@ def gt_function(fn: Callable[..., int | None]) -> Callable[..., int]:
                                 return fast(bus, *args[2:])
                     if type(c) is int and not kwargs and -0x8000 <= c <= 0x7FFF:
                         # a plain core (core_arg's check) and the GT_ function's compiled
-                        # binder of the rest, as for GT_x (made at the twin's first call)
+                        # binder of the rest, as for GT_x (made at the twin's first call,
+                        # which binds through it too, as the GT_ function's first call does)
+                        if not compiled and not opens:
+                            compiled.append(fast_binder(proto, _convs))
                         if compiled:
                             values = compiled[0](*args[1:])
                             if values is not None and (needs_ctl or c == 1):
                                 return run(c, values, _NO_KW, "", SESSION.last, True)
-                        elif not opens:
-                            compiled.append(fast_binder(proto, (bind or _binder()).convs))  # type: ignore[attr-defined]
                     return call(c, args[1:], kwargs)
                 return call(kwargs.pop("core", None), (), kwargs)
 

@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from .._bytecode import compiled as _compiled_code
+from .._code_store import compiled as _compiled_code
 from ..errors import ParameterError
 from . import structs
 from .table import ENUMS, SCALARS, Param, Proto
@@ -1238,7 +1238,9 @@ def _pointer_source(i: int, p: Param, a: str, v: str, env: dict[str, Any]) -> li
     return lines
 
 
-def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
+def fast_binder(
+    proto: Proto, convs: list[Converter] | Callable[[], list[Converter]]
+) -> Callable[..., Any]:
     """The table's checks of ``proto``'s arguments compiled into one function (declare once,
     generate the rest): ``bind(*args)`` -> the converted values, exactly what
     :func:`binder`'s ``bind`` gives for them, or None when any argument is not of a plain
@@ -1246,7 +1248,12 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
     pointer takes, None or 0 for an optional pointer, an omitted argument with a default,
     no more arguments than parameters) or the generic conversion (``convs``, one per
     parameter) refused it: the caller then binds through :func:`binder`, which gives the
-    value or the refusal with its reason.  Never raises."""
+    value or the refusal with its reason.  Never raises.
+
+    ``convs`` may be a function giving them (the table binder's, made then): a call whose
+    arguments are all plain never needs them, so a function's first call makes no table
+    binder; the first argument of another shape asks for them, and they replace the stand-ins
+    in the compiled function's globals."""
     params = proto.params
     env: dict[str, Any] = {
         "_CArg": _CArgObject,
@@ -1261,16 +1268,21 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
         "P": params,
     }
     env.update(CARG_ENV)
+    if callable(convs):
+        _later_converters(env, len(params), convs)
 
     sig, body, out = [], [], []
     for i, p in enumerate(params):
         a, v = f"a{i}", f"v{i}"
-        try:
-            d = p.default_value()
-        except KeyError:  # an optional pointer left out is NULL (Python callers omit them)
+        # (default_value raises KeyError exactly where the table gives no default: an
+        # optional pointer left out is NULL, Python callers omit them)
+        if p.default is None:
             d = None if p.optional else _MISSING
+        else:
+            d = p.default_value()
         env[f"D{i}"] = d
-        env[f"C{i}"] = convs[i]
+        if not callable(convs):
+            env[f"C{i}"] = convs[i]
         sig.append(f"{a}=D{i}")
         if d is _MISSING:
             body.append(f"if {a} is _MISSING: return None")
@@ -1331,6 +1343,22 @@ def fast_binder(proto: Proto, convs: list[Converter]) -> Callable[..., Any]:
     fn = env["bind"]
     fn.source = code  # type: ignore[attr-defined]
     return fn
+
+
+def _later_converters(env: dict[str, Any], n: int, make: Callable[[], list[Converter]]) -> None:
+    """Stand-ins ``C0``.. ``C{n-1}`` in ``env`` (a compiled binder's globals) for the table's
+    converters, made by ``make()`` when the first of them is called; they then take the
+    stand-ins' places, so later calls reach them directly."""
+
+    def stand_in(i: int) -> Converter:
+        def conv(v: Any) -> Any:
+            real = make()
+            env.update((f"C{k}", c) for k, c in enumerate(real))
+            return real[i](v)
+
+        return conv
+
+    env.update((f"C{i}", stand_in(i)) for i in range(n))
 
 
 def _check_room(p: Param, ref: Ref, n: int) -> None:

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from .._attrs import own_dict
-from .._bytecode import compiled as _compiled_code
+from .._code_store import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
 from ..controller.core_view import AXES_PER_CORE

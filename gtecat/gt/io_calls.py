@@ -31,6 +31,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from .._code_store import compiled as _compiled_code
 from ..controller.axis import PdsState
 from ..controller.config_file import switch_sense, vendor_settings
 from ..controller.core import Controller
@@ -160,7 +161,7 @@ def di_reader(ctl: Controller, di_type: int, raw: bool) -> Callable[[], int]:
         body = f"v = {value}\n    return v - {1 << 32} if v >> 31 else v"
     else:
         body = f"return {value}"
-    exec(compile(f"def read():\n    {body}\n", f"<GT_GetDi {kind}>", "exec"), env)
+    exec(_compiled_code(f"def read():\n    {body}\n", f"<GT_GetDi {kind}>"), env)
     return env["read"]
 
 
@@ -204,7 +205,7 @@ def do_reader(ctl: Controller, do_type: int) -> Callable[[], int]:
                 on = f"(not r{n}.bank.frz_off.item(r{n}.bank_row) if r{n}.bank else {on})"
             terms.append(f"({_signed32(1 << (n - 1))} if {on} else 0)")
     body = " | ".join(terms) or "0"  # (axis 32's bit as the sign of GT_GetDo's long)
-    exec(compile(f"def enabled():\n    return {body}\n", "<GT_GetDo enable>", "exec"), env)
+    exec(_compiled_code(f"def enabled():\n    return {body}\n", "<GT_GetDo enable>"), env)
     return env["enabled"]
 
 

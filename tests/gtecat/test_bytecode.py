@@ -102,20 +102,3 @@ def test_dataclass_methods_kept_compiled(tmp_path: Path, monkeypatch) -> None:
     _bytecode._DC_CODES.clear()
     _bytecode._dc_load()
     check(define("gtecat._probe_dc3"))  # compiled again
-
-
-def test_functions_written_at_run_time_kept_compiled(tmp_path: Path, monkeypatch) -> None:
-    """A function gtecat writes at run time is compiled as its module would (annotations as
-    text), kept one file per text, read back, and compiled again from a damaged file."""
-    monkeypatch.setattr(_bytecode, "_DC_FILE", [tmp_path / "store"])
-    source = "def f(x: int) -> int:\n    return x + 1\n"
-    ns: dict = {}
-    exec(_bytecode.compiled(source, "<probe>"), ns)
-    assert ns["f"](1) == 2 and ns["f"].__annotations__ == {"x": "int", "return": "int"}
-    (kept,) = (tmp_path / "gen").iterdir()
-    again = _bytecode.compiled(source, "<probe>")
-    assert again.co_filename == "<probe>" and list((tmp_path / "gen").iterdir()) == [kept]
-    kept.write_bytes(b"damaged")
-    ns = {}
-    exec(_bytecode.compiled(source, "<probe>"), ns)
-    assert ns["f"](2) == 3

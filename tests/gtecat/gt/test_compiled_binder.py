@@ -138,7 +138,8 @@ def _binders() -> list[tuple[str, Any, Any, Any]]:
             continue
         impl = inspect.unwrap(fn)
         bind = binder(proto, impl)
-        out.append((name, proto, bind, fast_binder(proto, bind.convs)))
+        # (the table's converters asked for when first needed, as the GT functions make it)
+        out.append((name, proto, bind, fast_binder(proto, lambda bind=bind: bind.convs)))
     return out
 
 
@@ -180,6 +181,15 @@ def test_every_function_binds_as_the_table_does() -> None:
                 bad.append(f"{name}{tuple(args)!r}: compiled {got!r}, table {want!r}")
     assert not bad, "\n".join(bad[:20])
     assert taken > 0.8 * len(binders), f"only {taken} of {len(binders)} plain calls compiled"
+    # the converters asked for took their stand-ins' places in the compiled binders
+    asked = [
+        (bind, fast)
+        for _, _, bind, fast in binders
+        if any(fast.__globals__[f"C{i}"] is c for i, c in enumerate(bind.convs))
+    ]
+    assert len(asked) > 0.8 * len(binders)
+    for bind, fast in asked:
+        assert all(fast.__globals__[f"C{i}"] is c for i, c in enumerate(bind.convs))
 
 
 def test_the_compiled_binder_serves_the_public_call() -> None:
