@@ -2500,7 +2500,7 @@ class AxisBank:
         are claimed now: :meth:`_reindex` takes an opened row's bytes before it makes the
         new pattern, a group claimed or given back since.)"""
         gis = self._rx_gi
-        p = int(np.searchsorted(gis, gi))
+        p = int(gis.searchsorted(gi))
         if p == len(gis) or gis[p] != gi:
             return None
         return p - self._rx_start[gi]

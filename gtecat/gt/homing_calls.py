@@ -219,10 +219,9 @@ MADE = [0]
 def _state(ax: Axis) -> _AxisHoming:
     # (kept on the axis too, read past a claimed axis's guard: a weak dictionary's lookup
     # makes a weak reference every time; the dictionary stays what the GT fast path reads)
-    try:
-        return object.__getattribute__(ax, "_homing_run")  # type: ignore[no-any-return]
-    except AttributeError:
-        pass
+    st = object.__getattribute__(ax, "__dict__").get("_homing_run")
+    if st is not None:
+        return st  # type: ignore[no-any-return]
     st = _STATE.get(ax)
     if st is None:
         st = _STATE[ax] = _AxisHoming()
