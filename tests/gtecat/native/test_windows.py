@@ -77,18 +77,26 @@ def dll_x86():
     return _dll("x86")
 
 
-def _wine_env(**extra: str) -> dict[str, str]:
+def _wine_env(bits: int = 32, **extra: str) -> dict[str, str]:
+    """The environment of the Wine runs: the user's WINEPREFIX as it is, else one of ours in
+    the cache folder - a 32-bit one for the x86 programs (``WINEARCH=win32``: made in about
+    two thirds of a 64-bit prefix's CPU, 0.6 GB instead of 1.3 GB, on a new machine's first
+    run) and a 64-bit one for the x64 programs."""
     env = native_env(**extra)
-    env.setdefault("WINEPREFIX", os.environ.get("WINEPREFIX") or str(_wine_prefix()))
+    if os.environ.get("WINEPREFIX"):
+        env["WINEPREFIX"] = os.environ["WINEPREFIX"]
+    else:
+        env["WINEPREFIX"] = str(_wine_prefix(bits))
+        env["WINEARCH"] = "win32" if bits == 32 else "win64"
     env.update(WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
     env.pop("DISPLAY", None)
     return env
 
 
-def _wine_prefix() -> Path:
+def _wine_prefix(bits: int) -> Path:
     from gtecat.cbuild import cache_root
 
-    return cache_root() / "wine"
+    return cache_root() / ("wine32" if bits == 32 else "wine")
 
 
 def _wine(exe: Path, env: dict[str, str]) -> tuple[subprocess.CompletedProcess, dict[str, str]]:
@@ -336,7 +344,7 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
     machine, names = windows.pe_exports(dll.dll.read_bytes())
     assert machine == "x64" and "GT_Open" in names
     programs = _windows_programs(dll, tmp_path / "win64", "x64")
-    env = _wine_env(GTECAT_CONTROLLER=tcp_controller, GTECAT_TOKEN=TOKEN)
+    env = _wine_env(64, GTECAT_CONTROLLER=tcp_controller, GTECAT_TOKEN=TOKEN)
     for name in ("gtn", "load"):
         r, v = _wine(programs[name], env)
         assert r.returncode == 0 and v.get("done") == "1", r.stdout + r.stderr
@@ -357,7 +365,7 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
     (programs["load"].parent / "gtecat.ini").write_text(
         f"[gtecat]\ncontroller = {tcp_controller}\ntoken = {TOKEN}\n"
     )
-    r, v = _wine(programs["load"], _wine_env())
+    r, v = _wine(programs["load"], _wine_env(64))
     assert v.get("open") == "0", r.stdout + r.stderr
 
 
