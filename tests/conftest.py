@@ -167,8 +167,8 @@ def needs_fixture(what: object) -> str:
     """The skip reason of a test that reads the vendors' sample files: they are not shipped
     with gtecat (a repository checkout keeps them in a fixtures folder beside it)."""
     return (
-        f"needs the vendors' sample files, not shipped with gtecat ({what} not found; a "
-        "repository checkout has them beside it)"
+        f"needs the vendors' sample files, which gtecat does not ship ({what} not found: these "
+        "tests read them from the folder shared/fixtures beside the checkout)"
     )
 
 

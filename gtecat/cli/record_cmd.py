@@ -176,7 +176,7 @@ def _run_child(command: list[str], env: dict[str, str]) -> int:
             except KeyboardInterrupt:  # Ctrl-C reaches the child too (same process group)
                 continue
         deadline = time.monotonic() + DESCENDANTS_WAIT_S
-        while any(os.path.exists(f"/proc/{p}") for p in signalled - {child.pid}):
+        while any(_running(p) for p in signalled - {child.pid}):
             if time.monotonic() > deadline:
                 break
             time.sleep(0.02)
@@ -188,6 +188,18 @@ def _run_child(command: list[str], env: dict[str, str]) -> int:
 #: how long the recorder waits for the processes of the program it passed a signal on to
 #: (a Python program writing its recording) after the command itself ended (s)
 DESCENDANTS_WAIT_S = 60.0
+
+
+def _running(pid: int) -> bool:
+    """Process ``pid`` still runs (Linux ``/proc``): one that ended but that its parent has not
+    reaped yet (a zombie, state Z) has nothing left to write."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            stat = f.read()
+    except OSError:
+        return False
+    # (the state follows the command's name, which is in parentheses and may hold any byte)
+    return stat[stat.rfind(")") + 2 : stat.rfind(")") + 3] not in ("Z", "X", "")
 
 
 def _descendants(pid: int) -> list[int]:

@@ -137,3 +137,25 @@ def test_a_recording_ended_by_sigterm_is_written_and_replays(
     head = json.loads(out.read_text().splitlines()[0])
     assert head["calls"] >= 2, head  # GT_Open, GT_InitEcatComm (and the waits it made)
     assert main(["replay", str(out)]) == 0
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux /proc")
+def test_a_process_that_ended_but_is_not_reaped_is_not_waited_for() -> None:
+    """The recorder waits for the processes it passed a signal on to while they run; one that
+    ended and that its parent has not reaped yet (a zombie) has nothing left to write."""
+    import subprocess
+    import time
+
+    from gtecat.cli.record_cmd import _running
+
+    child = subprocess.Popen(["sleep", "0"])
+    try:
+        deadline = time.monotonic() + 10.0
+        while _running(child.pid) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert os.path.exists(f"/proc/{child.pid}")  # still there: not reaped yet
+        assert not _running(child.pid)
+    finally:
+        child.wait()
+    assert _running(os.getpid())
+    assert not _running(child.pid)
