@@ -269,12 +269,22 @@ function scopeWindowRows() {
   let end = lo; while (end < rows.length && rows[end][0] <= t1) end++;
   return [lo, end, t0, t1];
 }
+let scopeDrawn = "";
 function drawScope() {
-  const cv = $("scope-canvas"), g = cv.getContext("2d"), sc = S.scope;
+  requestAnimationFrame(drawScope);
+  const cv = $("scope-canvas"), sc = S.scope, rows = sc.rows;
+  // drawn again only when what it shows may have changed (new samples, a control, the size):
+  // a page left open costs its browser nothing between samples
+  const key = [sc.names.join(), rows.length, rows.length ? rows[rows.length - 1][0] : "", sc.paused,
+    sc.frozen, sc.window, $("trig-mode").value, $("trig-signal").value, $("trig-level").value,
+    cv.width, cv.height].join("|");
+  if (key === scopeDrawn) return;
+  scopeDrawn = key;
+  const g = cv.getContext("2d");
   g.fillStyle = "#fff"; g.fillRect(0, 0, cv.width, cv.height);
   const [lo, end, t0, t1] = scopeWindowRows();
   $("scope-info").textContent = `${sc.rows.length} samples` + (sc.paused ? " (paused)" : "");
-  if (end <= lo) { requestAnimationFrame(drawScope); return; }
+  if (end <= lo) return;
   const W = cv.width - 60, H = cv.height - 20, L = 55;
   let ymin = Infinity, ymax = -Infinity;
   for (let i = lo; i < end; i++) for (let k = 1; k <= sc.names.length; k++) { const v = sc.rows[i][k]; if (v < ymin) ymin = v; if (v > ymax) ymax = v; }
@@ -294,7 +304,6 @@ function drawScope() {
     }
     flush(); g.stroke();
   }
-  requestAnimationFrame(drawScope);
 }
 S.scopeCsv = () => {  // every sample the recorder took, full precision
   const sc = S.scope;
