@@ -128,12 +128,12 @@ def _walk(obj: Any, path: str, out: dict[str, Any], seen: set[int]) -> None:
         _walk(v, f"{path}.{n}", out, seen)
 
 
-def _objects(ctl: Any) -> dict[str, Any]:
-    """The switched axes' objects and their drives' buffers, their values by path."""
+def _objects(ctl: Any, deep: tuple[int, ...] = DEEP) -> dict[str, Any]:
+    """Axes ``deep``'s objects and their drives' buffers, their values by path."""
     if ctl.bank is not None:
         ctl.bank.release_all()
     out: dict[str, Any] = {}
-    for a in DEEP:
+    for a in deep:
         ax = ctl.axes[a]
         slave = ctl.backend.slaves[ax.io.slave]
         _walk(ax, f"axis{a}", out, set())
@@ -142,7 +142,18 @@ def _objects(ctl: Any) -> dict[str, Any]:
     return out
 
 
-def _run(machine: str, bank: str, clock: str) -> tuple[list, dict[str, Any], int]:
+def _run(
+    machine: str,
+    bank: str,
+    clock: str,
+    calls: dict[int, list[Any]] = CALLS,
+    cycles: int = CYCLES,
+    deep: tuple[int, ...] = DEEP,
+    count: str = "home_switches",
+) -> tuple[list, dict[str, Any], int]:
+    """``calls`` made over ``cycles`` cycles of the 12-axis bus with ``bank``: every call's
+    return code and every cycle's sample, axes ``deep``'s objects at the end, and the bank's
+    statistic ``count`` (0 without a bank)."""
     trace: list = []
     try:
         gt.GT_Close()
@@ -157,12 +168,12 @@ def _run(machine: str, bank: str, clock: str) -> tuple[list, dict[str, Any], int
         gt.GTE_Wait(20)
         ctl = gt.GTE_Controller()
         size = ctl.layout.gt_raw_bytes
-        for k in range(CYCLES):
-            trace.append(tuple(call() for call in CALLS.get(k, ())))
+        for k in range(cycles):
+            trace.append(tuple(call() for call in calls.get(k, ())))
             gt.GTE_Wait(1)
             trace.append(_sample(size))
-        switches = ctl.bank.home_switches if ctl.bank is not None else 0
-        return trace, _objects(ctl), switches
+        counted = getattr(ctl.bank, count) if ctl.bank is not None else 0
+        return trace, _objects(ctl, deep), counted
     finally:
         faults.clear()
         gt.GT_Close()

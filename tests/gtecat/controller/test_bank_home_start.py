@@ -24,8 +24,9 @@ from gtecat import gt
 from gtecat.controller import bank_kernel
 from gtecat.controller.bank import AxisBank
 from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
-from tests.gtecat.controller.test_bank_home_rows import _same, _walk
-from tests.gtecat.controller.test_bank_homing import _machine, _sample
+from tests.gtecat.controller.test_bank_home_rows import _run as _run_calls
+from tests.gtecat.controller.test_bank_home_rows import _same
+from tests.gtecat.controller.test_bank_homing import _machine
 from tests.gtecat.controller.test_bank_homing_calls import _prm
 
 AXES = 12
@@ -73,43 +74,8 @@ CALLS: dict[int, list[Any]] = {
 DEEP = (1, 2, 3, 4, 5)
 
 
-def _objects(ctl: Any) -> dict[str, Any]:
-    """The started axes' objects and their drives' buffers, their values by path."""
-    if ctl.bank is not None:
-        ctl.bank.release_all()
-    out: dict[str, Any] = {}
-    for a in DEEP:
-        ax = ctl.axes[a]
-        slave = ctl.backend.slaves[ax.io.slave]
-        _walk(ax, f"axis{a}", out, set())
-        _walk(slave.channel(ax.io.channel), f"drive{a}", out, set())
-        out[f"rx{a}"], out[f"tx{a}"] = bytes(slave.rx), bytes(slave.tx)
-    return out
-
-
 def _run(machine: str, bank: str, clock: str) -> tuple[list, dict[str, Any], int]:
-    trace: list = []
-    try:
-        gt.GT_Close()
-        _ok(gt.GT_Open(eni=str(ENI), machine=machine, clock=clock, log="", bank=bank), "open")
-        _ok(gt.GT_InitEcatComm(), "init")
-        ready = c_short()
-        while not (gt.GT_IsEcatReady(byref(ready)) == 0 and ready.value == 1):
-            gt.GTE_Wait(1)
-        _ok(gt.GT_StartEcatComm(), "start")
-        for a in range(1, AXES + 1):
-            _ok(gt.GT_AxisOn(a), f"axis on {a}")
-        gt.GTE_Wait(20)
-        ctl = gt.GTE_Controller()
-        size = ctl.layout.gt_raw_bytes
-        for k in range(CYCLES):
-            trace.append(tuple(call() for call in CALLS.get(k, ())))
-            gt.GTE_Wait(1)
-            trace.append(_sample(size))
-        starts = ctl.bank.home_starts if ctl.bank is not None else 0
-        return trace, _objects(ctl), starts
-    finally:
-        gt.GT_Close()
+    return _run_calls(machine, bank, clock, CALLS, CYCLES, DEEP, "home_starts")
 
 
 @pytest.fixture(scope="module")
