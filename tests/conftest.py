@@ -353,7 +353,10 @@ def faster_rewriter(rewrite: Any) -> Iterator[None]:
     ``ast.copy_location``: most of a fresh checkout's ~10 s of rewriting.  Here the walk is
     one loop that sets those attributes itself, exactly as ``copy_location`` would (the same
     attributes, only on nodes that have them, only where no line number is set), and hands
-    pytest's loop nothing left to do.  Outside an assert the original walk is used."""
+    pytest's loop nothing left to do.  It does not go down into the assert's own nodes, which
+    the new statements take up unchanged: the parser located them and everything below them
+    (every test module of the suite comes out the same, locations included, as with pytest's
+    pass).  Outside an assert the original walk is used."""
     import ast
 
     cls = rewrite.AssertionRewriter
@@ -361,7 +364,7 @@ def faster_rewriter(rewrite: Any) -> Iterator[None]:
     asserts: list[Any] = []
 
     def visit_assert(self: Any, assert_: Any) -> Any:
-        asserts.append(assert_)
+        asserts.append((assert_, {id(n) for n in ast.walk(assert_)}))
         try:
             return visit(self, assert_)
         finally:
@@ -370,7 +373,7 @@ def faster_rewriter(rewrite: Any) -> Iterator[None]:
     def traverse_node(node: Any) -> Any:
         if not asserts:
             return walk(node)
-        source = asserts[-1]
+        source, original = asserts[-1]
         where = [
             (a, v)
             for a in _LOCATION
@@ -380,6 +383,8 @@ def faster_rewriter(rewrite: Any) -> Iterator[None]:
         node_type, stack = ast.AST, [node]
         while stack:
             n = stack.pop()
+            if id(n) in original:
+                continue  # the assert's own node: located by the parser, and all below it
             if getattr(n, "lineno", None) is None:
                 attributes = n._attributes
                 for a, v in where:
