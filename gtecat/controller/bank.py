@@ -2751,6 +2751,8 @@ class AxisBank:
         lst = self._lists.get(name)
         if lst is not None:
             return lst[r]
+        if name == "moving":  # (the row's two flags, in a bank of any size: asked per axis)
+            return bool(self.moving[r] or self.jog[r])
         if self.n > _SMALL_BANK:
             return self.value(name, r)
         if name == "sts":  # (the flags only tested: numpy's bools; the latched word an int)

@@ -269,7 +269,7 @@ class AxisResources:
     def moving(self) -> bool:
         b = self.bank
         if b is not None:
-            return b.value("moving", self.bank_row)
+            return b.row_value("moving", self.bank_row)
         return not self.profile.planner.done
 
     @property
