@@ -26,6 +26,7 @@ from gtecat.drives.abort import SdoAbort
 from gtecat.drives.machine import MachineError
 from gtecat.eni.errors import EniError, GtecatError
 
+from .._attrs import own_dict
 from ..controller.bank import BANK_READS, IN_PLACE, OPENED
 from ..controller.bank_stream import STREAMED, call_streamed
 from ..controller.card import refused
@@ -329,6 +330,10 @@ class _Session:
 
 
 SESSION = _Session()
+# (its attributes in a dict of its own, read quick - gtecat._attrs - and the one dict the
+# C entries of GTE_Wait and GT_GetClock look into for its last error: made once, here,
+# before any entry is made)
+own_dict(SESSION)
 
 
 def close_all() -> None:

@@ -227,6 +227,8 @@ class _Entry(ctypes.Structure):
         ("steady", ctypes.c_ssize_t),
         ("nacache", ctypes.c_ssize_t),
         ("viewer", _VP),
+        ("session", _VP),
+        ("key_last", _VP),
     ]
 
 
@@ -1047,6 +1049,7 @@ def _load() -> tuple[Maker | None, str]:
         numpy: Iterable[Any] = (),
         steady: bool = False,
         viewer: Callable[[Any], Any] | None = None,
+        clock_of: dict | None = None,
     ) -> Any:
         kinds = tuple(types)
         if pointers:  # (pointer(x) too: x's memory, of x's type)
@@ -1064,6 +1067,8 @@ def _load() -> tuple[Maker | None, str]:
         e.tuple_type, e.titems = id(tuple), titems  # (array's (bytes,): status words alone)
         e.steady = int(steady)
         e.viewer = id(viewer) if viewer is not None else None
+        if clock_of is not None:  # (GT_GetClock: the clock's value in C, the session's dict)
+            e.session, e.key_last = id(clock_of), id(_KEY_LAST)
         for k, t in enumerate(kinds):
             pointer = issubclass(t, ctypes._Pointer)
             x = t._type_ if pointer else t
@@ -1097,6 +1102,7 @@ def _load() -> tuple[Maker | None, str]:
                 e.acache = ctypes.cast(aslot, ctypes.POINTER(_ASlot))
                 e.nacache = SPAN_LANES
         keep = (fallback, value, sentinel, kinds, cks, array, after, slots, aslot, dts, viewer)
+        keep += (clock_of,)
         fn = new(b"gt_centry", meth, _METH_FASTCALL_KEYWORDS, e, keep)
         return public(fn, vc, e, keep)
 
@@ -1875,6 +1881,7 @@ def reader(
     numpy: Iterable[Any] = (),
     steady: bool = False,
     viewer: Callable[[Any], Any] | None = None,
+    clock_of: dict | None = None,
 ) -> Any:
     """The C entry of a reader: ``f(n, p[, count[, pClock]])`` (``f(core, n, p, ...)`` where
     ``core``; at most ``most`` arguments after it) writing ``value(n)`` into ``p``'s object
@@ -1907,7 +1914,10 @@ def reader(
     and across the quick cycles the entries book themselves (no Python runs in those: what
     an attribute no cycle changes gives, a profile's mode); ``viewer``: for ``p`` a
     memoryview, ``viewer(p)`` gives the ctypes array the call is then made with (the view
-    shows all of it, of a type the reader takes), else None (``fallback``).
+    shows all of it, of a type the reader takes), else None (``fallback``); ``clock_of``:
+    GT_GetClock's entry (``noaxis``, gated), the GT session's own dict - its value is then
+    the gate's clock's milliseconds since GT_Reset made in C (csrc/centry.c ``clock_ms``, as
+    ``value`` makes them) wherever the session's ``last`` is None, ``value`` elsewhere.
     A callable that takes attributes (:func:`_callable_type`); None where the C entry is
     not available (:data:`REASON`)."""
     if _MAKE is None:
@@ -1931,6 +1941,7 @@ def reader(
         numpy,
         steady,
         viewer,
+        clock_of,
     )
 
 

@@ -26,7 +26,6 @@ from typing import Any
 
 import numpy as np
 
-from .._attrs import own_dict
 from .._code_store import compiled as _compiled_code
 from ..controller.axis_status import AxisStatus
 from ..controller.bank import BANK_READS
@@ -1699,6 +1698,7 @@ def fast_clock(
         after=_after(advance, name, 0),
         numpy=_int_dtypes(_scalar_types(FUNCTIONS[name].params[0])),  # (as ``first``)
         array=_first_element(lambda _: value(), elements),
+        clock_of=vars(session),  # (the value in C where it has no last error to clear)
     )  # fmt: skip
     if entry is None:
         return gt
@@ -3818,7 +3818,6 @@ def _wait_entry(
             return call_failed(name, e, ctl, 1)
         return call_ended(session, ctl, name, advance)
 
-    own_dict(session)  # (its attributes read quick; the entry reads its dict)
     entry = centry.wait(
         gt, _after(advance, name, 0), rest, vars(session),
         Controller.WAIT_SLICE_NS // 1_000_000, Controller.BATCH_CYCLES, IN_MAXC,

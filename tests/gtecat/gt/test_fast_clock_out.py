@@ -328,3 +328,41 @@ def test_the_clock_and_loop_pointers_answer_as_the_table(clock: str) -> None:
     ok = {(t, shape) for _, t, shape, rc, *_ in fast if rc == 0}
     assert ("c_ulong", "pointers") in ok and ("c_ulong", "byref, 5") not in ok
     assert len({loop for _, t, shape, rc, _, _, loop, _ in fast if shape == "pointers"}) > 10
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "auto"])
+def test_the_clock_after_every_cycle_is_made_in_c_and_clears_the_last_error(clock: str) -> None:
+    """``GT_GetClock`` polled after each ``GTE_Wait(1)`` (every cycle makes a kept value
+    stale) answers from the clock in C, as its table path does, and after a failed call it
+    still clears ``GTE_GetLastError`` (the Python fast function answers then)."""
+    import cProfile
+
+    bring_up("twelve_axes.eni", clock=clock)
+    try:
+        got, want = ctypes.c_uint32(), ctypes.c_uint32()
+        loop, want_loop = ctypes.c_uint32(), ctypes.c_uint32()
+        pr = cProfile.Profile()
+        for k in range(40):
+            gt.GTE_Wait(1)
+            if k == 20:
+                gt.GT_Reset()
+            pr.enable()
+            rc = gt.GT_GetClock(byref(got), byref(loop) if k % 2 else None)
+            pr.disable()
+            assert rc == 0
+            assert gt.GT_GetClock.slow(byref(want), byref(want_loop)) == 0
+            if clock == "lockstep":  # (on the auto clock each call's host latency moves it)
+                assert got.value == want.value
+                if k % 2:
+                    assert loop.value == want_loop.value
+            else:
+                assert 0 <= want.value - got.value <= 1
+        # (no Python of the entry's: neither its value function nor the fast function; on
+        # the auto clock its host latency's after() runs, as every call's)
+        ran = {getattr(f.code, "co_name", "") for f in pr.getstats()}
+        assert not ran & {"value", "gt"}
+        assert gt.GT_AxisOn(99) != 0 and gt.GTE_GetLastError()
+        assert gt.GT_GetClock(byref(got), None) == 0
+        assert gt.GTE_GetLastError() == ""
+    finally:
+        gt.GT_Close()
