@@ -199,7 +199,8 @@ def _running(pid: int) -> bool:
     except OSError:
         return False
     # (the state follows the command's name, which is in parentheses and may hold any byte)
-    return stat[stat.rfind(")") + 2 : stat.rfind(")") + 3] not in ("Z", "X", "")
+    at = stat.rfind(")") + 2
+    return stat[at : at + 1] not in ("Z", "X", "")
 
 
 def _descendants(pid: int) -> list[int]:

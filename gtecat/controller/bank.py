@@ -1466,9 +1466,7 @@ class AxisBank:
             self.band[r], self.hold_ns[r] = b.band, b._hold_ns
         self.enc_prev[r] = enc._prev
         self.enc_pos[r], self.enc_vel[r], self.enc_acc[r] = enc.pos, enc.vel, enc.acc
-        self.claim_cycle[r] = self.bank_cycles
-        self._claims = claims = self._claims + 1
-        self.claim_ids[r] = claims
+        self._new_claim(r)
         since = b._since
         self.since[r] = -1 if since is None else since
         self.arrived[r] = b.arrived
@@ -1581,12 +1579,10 @@ class AxisBank:
         """Frozen row ``r``, standing in homing mode before a homing, taken again as the
         homing its drive's objects hold now (gtecat.controller.bank_home_start): what
         :meth:`_load` changes of such a row then - a new claim, not frozen, the homing's part
-        (:meth:`_load_homing`) - and what :meth:`CspBank.took_homing` takes of its drive.  The
-        rest of the row is as its frozen claim took it: its objects held its state since,
-        and the homing's start moved none of it."""
-        self.claim_cycle[r] = self.bank_cycles
-        self._claims = claims = self._claims + 1
-        self.claim_ids[r] = claims
+        (:meth:`_load_homing`) - and what :meth:`CspBank.took_homing` takes of its drive, the
+        counts moved with it.  The rest of the row is as its frozen claim took it: its objects
+        held its state since, and the homing's start moved none of it."""
+        self._new_claim(r)
         self.layout += 1
         self.frz[r] = False
         self.hm[r] = True
@@ -1594,6 +1590,18 @@ class AxisBank:
         csp.took_homing(r)
         self._load_homing(r, csp.channels[r], int(self.dwatch[r]))
         csp.after_loads()
+        self.n_frz -= 1
+        self.n_hm += 1
+        self.n_rest += int(self.h_done[r] == 1)
+        self._after_load(r, False)
+        self._counted()
+
+    def _new_claim(self, r: int) -> None:
+        """Row ``r`` claimed anew now (the cycle and the claim's number: a call that waits for
+        cycles tells a row given back and taken again meanwhile by it)."""
+        self.claim_cycle[r] = self.bank_cycles
+        self._claims = claims = self._claims + 1
+        self.claim_ids[r] = claims
 
     def _post_flags(self, r: int, watch: int, aware: list[Any], ahead: bool) -> None:
         """Row ``r``'s dwatch and dpost from its hooks' watched bits and its drive's probe

@@ -241,7 +241,7 @@ def _took_mode(bank: AxisBank, r: int, g: _Group, k: int, sent: bool = True) -> 
     after it (Channel.step); its buffers as its last exchange leaves them (``sent``: what
     it sent too)."""
     ch = bank.csp.channels[r]
-    _exchange_buffers(bank, g, took=True, sent=sent)
+    exchange_buffers(bank, g, took=True, sent=sent)
     ch.mode_seen = _HOMING
     ch.mode_due = ch.cycle - (k - 1) + ch._settings.mode_latency_cycles
 
@@ -256,7 +256,7 @@ def _switched(bank: AxisBank, r: int, g: _Group) -> None:
     enter(ch, ch.mode)
     step_hm(ch, ch.controlword, bank.ctl.clock.cycle_ns * 1e-9)
     ch._outputs()
-    _exchange_buffers(bank, g, took=False, sent=True)
+    exchange_buffers(bank, g, took=False, sent=True)
     _rebased(bank, r)
 
 
@@ -269,7 +269,7 @@ def _rebased(bank: AxisBank, r: int) -> None:
     res.follow_drive(bank.axes[r])
 
 
-def _exchange_buffers(bank: AxisBank, g: _Group, took: bool, sent: bool) -> None:
+def exchange_buffers(bank: AxisBank, g: _Group, took: bool, sent: bool) -> None:
     """Group ``g``'s drive's buffers and the image as its exchange leaves them
     (EmulatedBackend.exchange_one): ``took``, its outputs from the image into its objects,
     as its step begins; ``sent``, its objects encoded and its inputs into the image, as it

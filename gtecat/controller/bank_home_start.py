@@ -40,7 +40,7 @@ from gtecat.drives.modes import hm_bits_of
 from gtecat.drives.slave import AlState
 
 from ..master.clock import ClockMode
-from .bank_home_rows import _exchange_buffers
+from .bank_home_rows import exchange_buffers
 from .epoch import EPOCH
 
 if TYPE_CHECKING:
@@ -110,7 +110,7 @@ def start_at_once(bank: AxisBank, r: int) -> bool:
     bank._took_group(bank.group_of[r])
     # its drive's exchange up to the motion step: the outputs decoded, the state machine's
     # look at the controlword (enable operation, as before), CW4's rising edge (step_hm)
-    _exchange_buffers(bank, g, took=True, sent=False)
+    exchange_buffers(bank, g, took=True, sent=False)
     cw = ch.controlword
     number = ch.psm.command(cw, ch.quick_stop_option, ch.faults.cause_active)
     if number:
@@ -123,8 +123,8 @@ def start_at_once(bank: AxisBank, r: int) -> bool:
     ch.prev_cw = cw
     # the GT follower's post step of that cycle
     st.answered_with(ch.oms)
-    # the row taken from its objects as an ended homing (or given back as they stand)
-    bank.n_frz -= 1
+    # the row taken from its objects as an ended homing (or given back as they stand: the
+    # re-index that follows in this cycle's _begin counts the rows again)
     if not bank._eligible_homing(r):
         bank._stepping = r  # (its objects hold its state: nothing put back)
         try:
@@ -135,11 +135,5 @@ def start_at_once(bank: AxisBank, r: int) -> bool:
         bank.home_starts_given += 1
         return True
     bank.took_homing(r)
-    hm = bool(bank.hm[r])
-    bank.n_hm += hm
-    bank.n_rest += hm and bank.h_done[r] == 1
-    bank.n_frz += bool(bank.frz[r])
-    bank._after_load(r, False)
-    bank._counted()
     bank.home_starts += 1
     return True
