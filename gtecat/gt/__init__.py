@@ -17,7 +17,7 @@ import threading as _threading
 # ~100,000 objects that live as long as the process (classes, functions, tables, numpy's), and
 # the collector ran ~170 times during it (a full pass among them) to find almost nothing: ~40
 # ms of a ~300 ms import, ~20 ms with the pause (its first pass after the import walks them
-# once).  It runs as before once the import has ended (or failed).
+# once; frozen at the end, never).  It runs as before once the import has ended (or failed).
 _gc_was_on = _gc.isenabled()
 _gc.disable()
 try:
@@ -110,6 +110,9 @@ try:
     #: the GT modules not in :data:`_FIRST`
     if not _surface_later:
         _install_vendor_surface(globals(), REGISTRY)
+    # what the import made lives as long as the process: moved out of the collector's walks
+    # (its first pass after the import walked all of it, ~20 ms, and every full pass again)
+    _gc.freeze()
 finally:
     if _gc_was_on:
         _gc.enable()
