@@ -60,6 +60,9 @@ from . import byref_target
 
 log = logging.getLogger(__name__)
 
+#: the epoch's own changed(): a raw writer given it makes the epoch grow in C (raw_entry.grow)
+_grow_epoch = changed
+
 _METH_FASTCALL_KEYWORDS = 0x0080 | 0x0002
 _MAX_TYPES = 16
 _VP = ctypes.c_void_p
@@ -246,6 +249,7 @@ class _RawEntry(ctypes.Structure):
         ("cache", ctypes.POINTER(_ASlot)),
         ("changed", _VP),
         ("ncache", ctypes.c_ssize_t),
+        ("grow", ctypes.c_ssize_t),
     ]
 
 
@@ -1120,6 +1124,7 @@ def _load() -> tuple[Maker | None, str]:
         e = _RawEntry(id(fallback), id(value), id(sentinel), int(io), int(write), gate)
         e.after = id(after) if after is not None else None
         e.changed = id(changed) if write and changed is not None else None
+        e.grow = int(e.changed is not None and changed is _grow_epoch)
         slot = None
         # (a writer whose value makes the epoch grow itself: nothing kept)
         if cache and (not write or changed is not None):  # (a lane per range read in turn)

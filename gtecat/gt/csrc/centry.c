@@ -1927,6 +1927,8 @@ struct raw_entry {
     obj changed;
     /* the slots of cache: a lane per range a program reads in turn (0 or 1: the last's) */
     ptrdiff_t ncache;
+    /* 1: changed is the epoch's own changed() (EPOCH.n += 1), done here without calling it */
+    ptrdiff_t grow;
 };
 
 static obj raw(const struct raw_entry *e, obj const *args, ptrdiff_t nargs, obj kwnames);
@@ -2206,10 +2208,20 @@ have:
     if (mv)
         A.release_buffer(&view);
     if (diff) {
-        res = A.vectorcall(e->changed, NULL, 0, NULL);
-        if (!res)
-            return NULL;
-        A.decref(res);
+        if (e->grow && ep1 >= 0) {
+            /* (changed() itself: EPOCH.n = epoch + 1, as the cycles booked in C set it) */
+            obj grown = A.long_from(ep1 + 1), was;
+            if (!grown)
+                return NULL;
+            was = (obj)AT(A.epoch_obj, A.epoch_off);
+            *(obj *)((char *)A.epoch_obj + A.epoch_off) = grown;
+            A.decref(was);
+        } else {
+            res = A.vectorcall(e->changed, NULL, 0, NULL);
+            if (!res)
+                return NULL;
+            A.decref(res);
+        }
         if (ep1 >= 0 && epoch() == ep1 + 1) {
             c_moved++; /* (one growth: the image's bytes moved) */
             if (qio && qio[4] == ep1) {

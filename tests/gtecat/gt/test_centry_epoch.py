@@ -288,6 +288,51 @@ def test_a_raw_write_grows_the_epoch_only_where_it_changes_the_image() -> None:
         gt.GT_Close()
 
 
+def test_a_changing_raw_write_grows_the_epoch_by_one_in_c() -> None:
+    """A raw write that changes the image makes the epoch grow by exactly one, as
+    :func:`changed` would, without calling Python (the entry grows it itself); a write of
+    the bytes the image holds leaves it.  Every writer of figure 5-2's DO (slave 2, raw
+    offset 32; manual 5.2.2.5), the bytes read back after each write."""
+    import sys
+
+    _open()
+    calls: list[str] = []
+
+    def watch(frame: Any, event: str, arg: Any) -> None:
+        if event == "call" and frame.f_code is changed.__code__:
+            calls.append(event)
+
+    def raw(k: int) -> int:
+        return gt.GT_SetEcatRawData(32, 2, (ctypes.c_ubyte * 2)(k, 0))
+
+    def word(k: int) -> int:
+        return gt.GT_EcatIOWriteOutput(2, 0, 2, byref(ctypes.c_ushort(k)))
+
+    def bit(k: int) -> int:
+        return gt.GT_EcatIOBitWriteOutput(2, 0, 0, k & 1)
+
+    got = (ctypes.c_ubyte * 2)()
+    try:
+        for write in (raw, word, bit):
+            for k in (0, 1, 1, 2, 3, 3, 0, 0):
+                assert gt.GT_GetEcatRawData(32, 2, got) == 0
+                was = bytes(got)
+                before = EPOCH.n
+                sys.setprofile(watch)
+                try:
+                    rc = write(k)
+                finally:
+                    sys.setprofile(None)
+                assert rc == 0, gt.GTE_GetLastError()
+                assert gt.GT_GetEcatRawData(32, 2, got) == 0
+                want = bytes([k & 1 if write is bit else k, 0])
+                assert bytes(got) == want, (write.__name__, k)
+                assert EPOCH.n == before + (want != was), (write.__name__, k, was, want)
+                assert calls == [], f"{write.__name__}: the epoch's changed() was called"
+    finally:
+        gt.GT_Close()
+
+
 def test_raw_writes_in_the_auto_clock_reach_the_slave_in_the_next_cycle() -> None:
     """The default clock, cycles run inside the calls (the armed quick cycle among them): a
     loop writing the IO slave's outputs, the same bytes several times and then new ones, and
