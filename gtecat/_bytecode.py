@@ -7,9 +7,10 @@ import.  When bytecode writing is off, a finder put in front of the import syste
 ``gtecat.*`` only keeps the compiled modules in gtecat's per-version cache (the folder of
 its built C parts, :mod:`gtecat.cbuild`): one file per module, named by the digest of the
 module's path and source text, written once and read by every later process.  A changed
-source is a new name; an unreadable or foreign file is compiled again.  Python's own caches
-work as always when bytecode writing is on (this module then does nothing), and
-``GTECAT_PYC_CACHE=0`` turns it off.
+source is a new name; an unreadable or foreign file is compiled again.  A module whose own
+``__pycache__`` file is current (``pip install`` writes them) is read from there first.
+Python's own caches work as always when bytecode writing is on (this module then does
+nothing), and ``GTECAT_PYC_CACHE=0`` turns it off.
 """
 
 from __future__ import annotations
@@ -40,6 +41,9 @@ class _Loader(importlib.machinery.SourceFileLoader):
 
     def get_code(self, fullname: str) -> CodeType:
         path = self.get_filename(fullname)
+        code = _installed(path)
+        if code is not None:
+            return code
         source = self.get_data(path)
         h = hashlib.sha256(importlib.util.MAGIC_NUMBER)
         h.update(os.fsencode(path))
@@ -47,6 +51,37 @@ class _Loader(importlib.machinery.SourceFileLoader):
         h.update(source)
         cached = _DIR[0] / f"{fullname}-{h.hexdigest()[:32]}.pyc"
         return _kept(cached, path, lambda: self.source_to_code(source, path))
+
+
+def _installed(path: str) -> CodeType | None:
+    """The code of Python's own bytecode file of ``path`` where it is current (a timestamp
+    pyc whose source time and size are the source's, of this Python), else None.
+
+    ``pip install`` writes these for every module of an installed package, and Python reads
+    them with bytecode writing off too; a source tree nobody compiled has none (or stale
+    ones), and the cache above serves it.  Read here as the import system reads them
+    (PEP 552's header: magic, flags 0, the source's mtime and size).
+    """
+    try:
+        pyc = importlib.util.cache_from_source(path)
+        with open(pyc, "rb") as f:
+            data = f.read()
+        st = os.stat(path)
+    except (NotImplementedError, OSError, ValueError):
+        return None
+    if (
+        len(data) < 16
+        or data[:4] != importlib.util.MAGIC_NUMBER
+        or data[4:8] != b"\0\0\0\0"
+        or int.from_bytes(data[8:12], "little") != int(st.st_mtime) & 0xFFFFFFFF
+        or int.from_bytes(data[12:16], "little") != st.st_size & 0xFFFFFFFF
+    ):
+        return None
+    try:
+        code = marshal.loads(memoryview(data)[16:])
+    except (EOFError, ValueError, TypeError):
+        return None
+    return code if isinstance(code, CodeType) and code.co_filename == path else None
 
 
 def _kept(cached: Path, filename: str, make: Callable[[], CodeType]) -> CodeType:

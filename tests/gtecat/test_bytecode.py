@@ -44,7 +44,11 @@ def test_only_where_python_writes_no_bytecode(tmp_path: Path) -> None:
     env["PYTHONDONTWRITEBYTECODE"] = "1"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.stdout.strip() == "_Loader", out.stderr
-    assert any(tmp_path.rglob("gtecat.eni.numbers-*.pyc"))
+    # (kept in the cache unless the installed bytecode file is current: read from there)
+    import gtecat.eni.numbers as m
+
+    kept = any(tmp_path.rglob("gtecat.eni.numbers-*.pyc"))
+    assert kept != (_bytecode._installed(m.__file__) is not None)
     env["GTECAT_PYC_CACHE"] = "0"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.stdout.strip() == "SourceFileLoader", out.stderr
@@ -102,3 +106,58 @@ def test_dataclass_methods_kept_compiled(tmp_path: Path, monkeypatch) -> None:
     _bytecode._DC_CODES.clear()
     _bytecode._dc_load()
     check(define("gtecat._probe_dc3"))  # compiled again
+
+
+def test_a_current_installed_bytecode_file_is_read_first(tmp_path: Path) -> None:
+    """``pip install`` writes each module's ``__pycache__`` file: where it is current (the
+    source's time and size in its header, this Python's magic) its code is taken, nothing is
+    compiled or kept; a stale, damaged, hash-based or foreign one is passed over."""
+    import marshal
+    import py_compile
+
+    _STAMP = py_compile.PycInvalidationMode.TIMESTAMP  # (as pip writes them)
+    cache = tmp_path / "cache"
+    old = list(_bytecode._DIR)
+    _bytecode._DIR[:] = [cache]
+    try:
+        src = tmp_path / "mod.py"
+        src.write_text("X = 1\n")
+        pyc = Path(py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP))
+        # (the file's code says X = 3: proof that it, not the source, was read)
+        data = bytearray(pyc.read_bytes())
+        code = compile("X = 3\n", str(src), "exec")
+        pyc.write_bytes(bytes(data[:16]) + marshal.dumps(code))
+        loader = _bytecode._Loader("gtecat_probe", str(src))
+        ns: dict = {}
+        exec(loader.get_code("gtecat_probe"), ns)
+        assert ns["X"] == 3 and not cache.exists()
+
+        # another source of another size: stale, compiled from the source and kept
+        src.write_text("X = 22\n")
+        ns = {}
+        exec(loader.get_code("gtecat_probe"), ns)
+        assert ns["X"] == 22 and len(list(cache.iterdir())) == 1
+        assert _bytecode._installed(str(src)) is None
+
+        fresh = pyc.read_bytes() if py_compile.compile(
+            str(src), doraise=True, invalidation_mode=_STAMP
+        ) else b""
+        assert _bytecode._installed(str(src)) is not None
+        for header in (
+            b"\0\0\0\0" + fresh[4:16],  # another Python's magic
+            fresh[:4] + b"\1\0\0\0" + fresh[8:16],  # hash-based
+            fresh[:8] + (int.from_bytes(fresh[8:12], "little") + 1).to_bytes(4, "little")
+            + fresh[12:16],  # another source time
+        ):
+            pyc.write_bytes(header + fresh[16:])
+            assert _bytecode._installed(str(src)) is None
+        py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
+        assert _bytecode._installed(str(src)) is not None
+        pyc.write_bytes(pyc.read_bytes()[:20])  # cut short: damaged
+        assert _bytecode._installed(str(src)) is None
+        foreign = compile("X = 5\n", "elsewhere.py", "exec")
+        py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
+        pyc.write_bytes(pyc.read_bytes()[:16] + marshal.dumps(foreign))
+        assert _bytecode._installed(str(src)) is None
+    finally:
+        _bytecode._DIR[:] = old
