@@ -26,7 +26,7 @@ from pathlib import Path
 from types import CodeType
 from typing import Any
 
-from ._cache import cache_root
+from ._cache import cache_root, put_file
 
 _DIR: list[Path] = []
 
@@ -96,10 +96,7 @@ def _kept(cached: Path, filename: str, make: Callable[[], CodeType]) -> CodeType
         pass
     code = make()
     try:
-        cached.parent.mkdir(parents=True, exist_ok=True)
-        tmp = cached.with_name(f"{cached.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(marshal.dumps(code))
-        os.replace(tmp, cached)
+        put_file(cached, (marshal.dumps(code),))
     except OSError:
         pass
     return code
@@ -202,10 +199,7 @@ def _dc_save() -> None:
         if type(kept) is not dict or len(kept) > _DC_MOST:
             kept = {}
         kept.update(_DC_NEW)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(marshal.dumps(kept))
-        os.replace(tmp, path)
+        put_file(path, (marshal.dumps(kept),))
     except (OSError, ValueError):
         pass  # a read-only home: compiled again next time
     _DC_NEW.clear()

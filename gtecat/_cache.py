@@ -3,7 +3,9 @@ cache finds it while ``gtecat`` itself is being imported)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 
@@ -15,3 +17,20 @@ def cache_root() -> Path:
     xdg = os.environ.get("XDG_CACHE_HOME")
     base = Path(xdg) if xdg else Path.home() / ".cache"
     return base / "gtecat"
+
+
+def put_file(path: Path, chunks: Iterable[bytes]) -> None:
+    """``path`` made to hold ``chunks``, whole: written beside it under a name of this
+    process's, then renamed over it, so a process that reads it meanwhile (or two that write
+    it at once) finds the old file or a whole new one, never a part.  An OSError (a full
+    disk, a read-only home) leaves no temporary file behind and is raised."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb") as f:
+            f.writelines(chunks)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise

@@ -28,6 +28,7 @@ from types import CodeType
 from typing import Any
 
 from . import _bytecode
+from ._cache import put_file
 
 _ANNOTATIONS = __import__("__future__").annotations.compiler_flag
 
@@ -164,12 +165,7 @@ def _save() -> None:
             out[k] = (start, start + len(v))
             start += len(v)
         head = marshal.dumps(out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-        with open(tmp, "wb") as f:
-            f.write(_MAGIC + len(head).to_bytes(8, "little") + head)
-            f.writelines(kept.values())
-        os.replace(tmp, path)
+        put_file(path, (_MAGIC + len(head).to_bytes(8, "little") + head, *kept.values()))
     except (OSError, ValueError):
         pass  # a read-only home: compiled again next time
     _NEW.clear()
