@@ -9,26 +9,33 @@ from ._bytecode import install as _install_bytecode_cache
 from ._bytecode import install_dataclass_cache as _install_dataclass_cache
 
 
-def _one_blas_thread() -> None:
-    """numpy's OpenBLAS started with one thread, unless numpy is loaded already or the
+def numpy_with_one_blas_thread() -> None:
+    """numpy imported with one OpenBLAS thread, unless numpy is loaded already or the
     process chose a count (``OPENBLAS_NUM_THREADS``, ``GOTO_NUM_THREADS``, ``OMP_NUM_THREADS``).
 
     OpenBLAS starts a server thread per CPU when numpy is imported, and those threads spin
     before they sleep: ~0.1 s of CPU in every process that imports numpy, on a CPU the
     controller's cycle or another program needs (measured: ``from gtecat import gt`` 313 ->
-    200 ms of CPU).  The emulator's arrays (one row per axis) are far below the sizes
-    OpenBLAS splits across threads, so the threads never help it.  The value stays in the
-    environment, so the processes this one starts (a served controller, a replay) start the
-    same way.
+    229 ms of CPU).  The emulator's arrays (one row per axis) are far below the sizes
+    OpenBLAS splits across threads, so the threads never help it.  The count is set for
+    numpy's import only (OpenBLAS reads it as it loads) and the environment is left as it
+    was, so the processes this one starts, and a count the program sets later for another
+    library, are its own.  Called where the emulator is first imported (``gtecat.gt``), not
+    by ``import gtecat`` alone (the pytest plugin's import, a command's help).
     """
     if "numpy" in _sys.modules:
         return
     names = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
-    if not any(n in _os.environ for n in names):
-        _os.environ["OPENBLAS_NUM_THREADS"] = "1"
+    if any(n in _os.environ for n in names):
+        return
+    _os.environ["OPENBLAS_NUM_THREADS"] = "1"
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        pass  # (the import that needs it says so)
+    finally:
+        _os.environ.pop("OPENBLAS_NUM_THREADS", None)
 
-
-_one_blas_thread()
 
 _install_bytecode_cache(__version__)
 _install_dataclass_cache(__version__)

@@ -21,6 +21,9 @@ import threading as _threading
 _gc_was_on = _gc.isenabled()
 _gc.disable()
 try:
+    from .. import numpy_with_one_blas_thread
+
+    numpy_with_one_blas_thread()
     from ._core import REGISTRY
     from .vendor import install as _install_vendor_surface
     from .vendor import is_public as _is_public

@@ -1,39 +1,65 @@
-"""numpy's OpenBLAS thread count when gtecat is imported first (``gtecat._one_blas_thread``)."""
+"""numpy's OpenBLAS threads when the emulator is imported first
+(``gtecat.numpy_with_one_blas_thread``): one thread, the environment left as it was."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
 
 import pytest
 
+_NAMES = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
+
+#: (the environment's count after the code ran, the process's threads: 1 + OpenBLAS's extra)
 _PROBE = (
-    "import os, sys\n"
-    "{first}\n"
-    "import gtecat\n"
-    "print(os.environ.get('OPENBLAS_NUM_THREADS', '-'))\n"
+    "import json, os\n"
+    "{code}\n"
+    "count = os.environ.get('OPENBLAS_NUM_THREADS')\n"
+    "print(json.dumps([count, len(os.listdir('/proc/self/task'))]))\n"
 )
 
 
-def _blas_threads_after_import(env_extra: dict[str, str], first: str = "") -> str:
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")}
+def _after(code: str, **env_extra: str) -> tuple[str | None, int]:
+    env = {k: v for k, v in os.environ.items() if k not in _NAMES}
     env.update(env_extra)
-    out = subprocess.run([sys.executable, "-c", _PROBE.format(first=first)], env=env,
+    out = subprocess.run([sys.executable, "-c", _PROBE.format(code=code)], env=env,
                          capture_output=True, text=True, timeout=60, check=True)
-    return out.stdout.strip()
+    count, threads = json.loads(out.stdout)
+    return count, threads
 
 
-def test_one_thread_when_nothing_chose_a_count() -> None:
-    assert _blas_threads_after_import({}) == "1"
+needs_proc = pytest.mark.skipif(
+    not os.path.isdir("/proc/self/task"), reason="threads counted in /proc (Linux only)"
+)
 
 
-@pytest.mark.parametrize("name", ["OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"])
+def _threads_of_plain_numpy() -> int:
+    return _after("import numpy")[1]
+
+
+@needs_proc
+def test_the_emulator_starts_numpy_with_one_thread_and_leaves_the_environment() -> None:
+    assert _after("from gtecat import gt") == (None, 1)
+
+
+@needs_proc
+def test_import_gtecat_alone_does_not_touch_numpy() -> None:
+    """The pytest plugin and a command's help import ``gtecat`` only: a program's numpy
+    then starts as it would without gtecat."""
+    code = "import gtecat, sys; assert 'numpy' not in sys.modules; import numpy"
+    assert _after(code) == (None, _threads_of_plain_numpy())
+
+
+@needs_proc
+@pytest.mark.parametrize("name", _NAMES)
 def test_a_count_the_process_chose_is_kept(name: str) -> None:
-    want = "3" if name == "OPENBLAS_NUM_THREADS" else "-"
-    assert _blas_threads_after_import({name: "3"}) == want
+    count, threads = _after("from gtecat import gt", **{name: "2"})
+    assert count == ("2" if name == "OPENBLAS_NUM_THREADS" else None)
+    assert threads == _after("import numpy", **{name: "2"})[1]
 
 
+@needs_proc
 def test_numpy_loaded_before_is_left_as_it_started() -> None:
-    assert _blas_threads_after_import({}, first="import numpy") == "-"
+    assert _after("import numpy; from gtecat import gt") == (None, _threads_of_plain_numpy())
