@@ -238,6 +238,7 @@ class Endpoint:
 
     def publish(self) -> Endpoint:
         folder = runtime.checked_folder()
+        runtime.sweep(folder)
         pid = os.getpid()
         n = next(_COUNTER)
         self.id = str(pid) if n == 1 else f"{pid}-{n}"

@@ -6,8 +6,10 @@ and be closed to others (group and others no access), else nothing is published 
 and the reason is given: another user could otherwise listen in place of a controller.
 
 Each endpoint is two files: ``ID.sock`` (the Unix socket, 0600) and ``ID.json`` (who
-published it: pid, kind, program, ENI, start time).  An entry whose pid is gone is stale:
-:func:`endpoints` removes it.
+published it: pid, kind, program, ENI, start time).  An entry whose pid is gone is stale
+(its process was killed, or ended without its atexit handlers): :func:`endpoints` removes
+it, and every new endpoint removes those of dead processes first (:func:`sweep`), so the
+folder does not fill up on a machine where such processes are common (test runs).
 """
 
 from __future__ import annotations
@@ -93,6 +95,30 @@ def remove(path: Path) -> None:
     for p in (path.with_suffix(".sock"), path.with_suffix(".json")):
         with contextlib.suppress(FileNotFoundError):
             p.unlink()
+
+
+def sweep(path: Path) -> None:
+    """Remove the files of endpoints whose process is gone, told by the pid in their name
+    (``PID`` or ``PID-N``; nothing is read).  A live process's files are left, also half
+    published ones (its socket before its ``.json``)."""
+    try:
+        names = os.listdir(path)
+    except OSError:
+        return
+    gone: dict[int, bool] = {}
+    for name in names:
+        stem, dot, ext = name.rpartition(".")
+        if not dot or ext not in ("sock", "json", "tmp"):
+            continue
+        head = stem.split("-", 1)[0]
+        if not head.isdigit():
+            continue
+        pid = int(head)
+        if pid not in gone:
+            gone[pid] = not alive(pid)
+        if gone[pid]:
+            with contextlib.suppress(OSError):
+                (path / name).unlink()
 
 
 def endpoints() -> list[EndpointInfo]:

@@ -214,6 +214,28 @@ def test_stale_endpoints_are_removed_and_a_shared_folder_refused(runtime_dir: Pa
         runtime.checked_folder()
 
 
+def test_a_new_endpoint_removes_those_of_dead_processes_first(runtime_dir: Path) -> None:
+    """A process killed (or ended by ``os._exit``) leaves its files; the next endpoint
+    published removes them, by the pid in their names, and leaves a live process's, other
+    files and its own."""
+    from gtecat import gt
+
+    runtime.checked_folder()
+    dead = [f"999999999{s}" for s in (".json", ".sock", "-2.json", "-2.sock", ".tmp")]
+    live = [f"{os.getpid()}-77.json", f"{os.getpid()}-77.sock"]
+    other = ["notes.txt", "x.json"]
+    for name in dead + live + other:
+        (runtime_dir / name).write_text("{}")
+    assert gt.GT_Open(eni=str(FIG5_2), clock="lockstep", log="") == 0
+    try:
+        left = sorted(p.name for p in runtime_dir.iterdir())
+        mine = endpoint.published(gt.GTE_Controller())
+        assert mine is not None
+        assert left == sorted(live + other + [f"{mine.id}.json", f"{mine.id}.sock"])
+    finally:
+        gt.GT_Close()
+
+
 def test_gtecat_inspect_0_publishes_nothing(runtime_dir: Path, monkeypatch) -> None:
     from gtecat import gt
 
