@@ -2166,7 +2166,9 @@ class AxisBank:
 
     def _put_back(self, r: int) -> None:
         """Row ``r``'s state into its axis objects (its drive aside), as a release leaves them
-        (:attr:`_last` and :attr:`_rates` hold its planned values and encoder rates)."""
+        (:attr:`_rates` holds its encoder rates, :attr:`_last` its planned values where a
+        release found them; a row still alive - a step in place, a posted edge - has them
+        found here, where a moving planner needs them)."""
         ax, res = self.axes[r], self.res[r]
         screw_put_back(self, r, ax)
         a = float(self.a_last[r])
@@ -2205,7 +2207,10 @@ class AxisBank:
             self.jog[r] = False
             return
         if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
-            advance(pl, int(self.taken[r]), self._last[r], bool(self.ended[r]))
+            last = self._last.get(r)
+            if last is None:  # (a step in place or a posted edge: the row is still alive)
+                last = self._planned_row(r)
+            advance(pl, int(self.taken[r]), last, bool(self.ended[r]))
             self._keep_table(r, pl)
 
     # --- the GT boundary ------------------------------------------------------------------------
@@ -2296,12 +2301,16 @@ class AxisBank:
             self.trap_holds += 1
             # GT_PrfTrap of an axis already standing in Trap mode holds its planner where it
             # stands (Profile.enter): the values it writes are the ones it finds, so the row
-            # is not put into the objects and taken up again around it
+            # is not put into the objects and taken up again around it (the planner, whose
+            # hold writes a dozen attributes, without its guard's Python call on each)
+            pl = (self.res[r].profile.planner,)
+            _unguard(pl)
             _Bypass.on = True
             try:
                 return call()
             finally:
                 _Bypass.on = False
+                _reguard(pl)
         done: list[Any] = []
         self._in_place(r, self.groups[self.group_of[r]], lambda: done.append(call()))
         return done[0]
@@ -2658,16 +2667,16 @@ class AxisBank:
             return False
         if prof.mode != PrfMode.TRAP or not prof.active:
             return False
-        g = lambda name: _get(pl, name)  # noqa: E731  (past the planner's guard)
+        g = _get  # (past the planner's guard)
         return (
-            g("_mode") == _IDLE
-            and g("_vel") == g("_acc") == 0.0
-            and not g("_segs")
-            and g("_i") == g("_j") == g("_k") == 0
-            and g("_ts") == g("_t_done") == g("_t_final") == 0.0
-            and g("_dir") == 1.0
-            and g("stopping") == StopKind.NONE
-            and self._planned_row(r) == (g("_pos"), 0.0, 0.0)
+            g(pl, "_mode") == _IDLE
+            and g(pl, "_vel") == g(pl, "_acc") == 0.0
+            and not g(pl, "_segs")
+            and g(pl, "_i") == g(pl, "_j") == g(pl, "_k") == 0
+            and g(pl, "_ts") == g(pl, "_t_done") == g(pl, "_t_final") == 0.0
+            and g(pl, "_dir") == 1.0
+            and g(pl, "stopping") == StopKind.NONE
+            and self._planned_row(r) == (g(pl, "_pos"), 0.0, 0.0)
         )
 
     def _in_place_row(self, ctl: Any, proto: Any, values: tuple) -> int:
@@ -3442,7 +3451,7 @@ class AxisBank:
         _unguard(objs)
         _Bypass.on = True
         try:
-            self._last = {r: self._planned_row(r)}
+            self._last = {}  # (the planned values: _put_back finds them where it needs them)
             self._rates = {r: self._enc_rates_row(r)}
             self._put_back(r)
             self._catch_up(r)
@@ -3556,7 +3565,7 @@ class AxisBank:
                 probe.step(a, b, a - off, b - off, t_ns, dt_ns)
                 self._put_probe(r)
             csp.tp_lo[r], csp.tp_hi[r] = probe.quiet_bounds(b)
-        self._last = {r: self._planned_row(r)}
+        self._last = {}  # (as in _in_place)
         self._rates = {r: self._enc_rates_row(r)}
         self._put_back(r)
         self.posted_inputs += bool(self.dpost[r] & ~TP_POST)

@@ -533,3 +533,31 @@ def test_homings_started_on_standing_axes(tmp_path: Path, pdo: bool) -> None:
     assert ended[6] == (0, 30, 4) and all(ended[a] == (0, 100, 0) for a in (1, 3)), ended
     if stats["kernel"]:
         assert stats["trap_holds"] == n and stats["armed"] >= n, stats
+
+
+def test_trap_held_keeps_the_planner_guarded(machine: str) -> None:
+    """GT_PrfTrap of an axis standing in Trap mode runs as it stands (``trap_holds``), its
+    planner's guard off for the call only: afterwards the planner still gives its axis back
+    when anything touches it, as every object of a claimed row does."""
+    from gtecat.controller.bank import _GUARD_SET
+
+    open_bus(str(ENI), machine, "on")
+    try:
+        for a in (1, 2):
+            _ok(gt.GT_AxisOn(a), "on")
+            _ok(gt.GT_PrfTrap(a), "trap")
+        gt.GTE_Wait(5)
+        ctl = gt.GTE_Controller()
+        bank = ctl.bank
+        if bank is None or bank.kernel is None or not bank.holds(ctl.axes[1]):
+            pytest.skip("no compiled bank kernel here")
+        holds = bank.trap_holds
+        _ok(gt.GT_PrfTrap(1), "trap again")
+        assert bank.trap_holds == holds + 1 and bank.holds(ctl.axes[1])
+        # (past the axis's own guard: the row stays)
+        planner = object.__getattribute__(ctl.axes[1], "motion").profile.planner
+        assert bank.holds(ctl.axes[1]) and type(planner) in _GUARD_SET
+        assert planner.done  # (a touch: the axis goes back to its objects)
+        assert not bank.holds(ctl.axes[1]) and bank.holds(ctl.axes[2])
+    finally:
+        gt.GT_Close()
