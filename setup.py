@@ -21,8 +21,11 @@ from setuptools.command.build_py import build_py
 
 try:
     from setuptools.command.bdist_wheel import bdist_wheel
-except ImportError:  # setuptools before 70.1: the wheel package's command
-    from wheel.bdist_wheel import bdist_wheel
+except ImportError:  # setuptools before 70.1: the wheel package's, which pip installs for a
+    try:  # wheel's build with such a setuptools
+        from wheel.bdist_wheel import bdist_wheel
+    except ImportError:  # (no wheel built: ``setup.py build_py`` alone, as a test runs it)
+        bdist_wheel = None
 
 HERE = Path(__file__).resolve().parent
 
@@ -70,14 +73,19 @@ class BinaryDistribution(Distribution):
         return CC is not None
 
 
-class BdistWheel(bdist_wheel):
-    """``py3-none-<platform>`` for a wheel with built parts (no Python ABI in them)."""
+COMMANDS: dict[str, type] = {"build_py": BuildPy}
+if bdist_wheel is not None:
 
-    def get_tag(self) -> tuple[str, str, str]:
-        impl, abi, plat = super().get_tag()
-        if self.root_is_pure:
-            return impl, abi, plat
-        return "py3", "none", plat
+    class BdistWheel(bdist_wheel):
+        """``py3-none-<platform>`` for a wheel with built parts (no Python ABI in them)."""
+
+        def get_tag(self) -> tuple[str, str, str]:
+            impl, abi, plat = super().get_tag()
+            if self.root_is_pure:
+                return impl, abi, plat
+            return "py3", "none", plat
+
+    COMMANDS["bdist_wheel"] = BdistWheel
 
 
-setup(distclass=BinaryDistribution, cmdclass={"build_py": BuildPy, "bdist_wheel": BdistWheel})
+setup(distclass=BinaryDistribution, cmdclass=COMMANDS)

@@ -274,7 +274,7 @@ def found(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]
     the compiler that built them gives (they need none to load)."""
     cc, _ = find_compiler()
     if cc is None:
-        cc = prebuilt_compiler()
+        cc = prebuilt_compiler(PREBUILT)
         return None if cc is None else _prebuilt(library_name(stem, source, cc, cflags, libs))
     name = library_name(stem, source, cc, cflags, libs)
     ready = _prebuilt(name)

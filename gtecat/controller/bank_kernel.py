@@ -5,10 +5,10 @@ operation count, not its arithmetic (about 80 operations of 0.5-1 µs each, what
 rows).  ``gtecat/controller/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
 IEEE operations in the same order, built with ``cc`` (with the wheel where one is, else on
 first use into the per-version cache: :mod:`gtecat.cbuild`; ``-ffp-contract=off``), so it
-gives the same bits as numpy and as the scalar objects.  It runs only the plain cycle (the bank fills a Trap table that runs out
-before it): a raw write to a claimed slave, a row about to leave or a new cycle time go
-through the numpy cycle, which stays the reference and the fallback (no compiler: numpy
-alone, nothing else changes).
+gives the same bits as numpy and as the scalar objects.  It runs only the plain cycle (the
+bank fills a Trap table that runs out before it): a raw write to a claimed slave, a row
+about to leave or a new cycle time go through the numpy cycle, which stays the reference and
+the fallback (no compiler: numpy alone, nothing else changes).
 
 ``GTECAT_BANK_KERNEL`` = ``auto`` (default: the compiled kernel where it builds), ``c`` (the
 same; a build failure is reported in :attr:`AxisBank.kernel_reason`) or ``numpy``.
