@@ -1,13 +1,18 @@
-"""Compiling the package's small C parts on first use, into a per-version cache.
+"""Compiling the package's small C parts where they are not built yet, into a per-version cache.
 
-``pip install`` needs no C compiler: libgts (:mod:`gtecat.native.build`), the axis bank's
-compiled cycle (:mod:`gtecat.controller.bank_kernel`), the GT fast path's pointer check
-(:mod:`gtecat.gt.byref_target`) and its C entry (:mod:`gtecat.gt.centry`) are built when
-first asked for, with ``$CC`` (else ``cc``, ``gcc``, ``clang``), into ``$GTECAT_CACHE_DIR`` (else
-``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``) ``/<version>/``.  Here are the pieces
-they share: where the cache is, which compiler, and a one-file shared library build named by
-the digest of its source and flags (a lock file serialises concurrent builders), in this
-process (:func:`shared_library`) or in one of its own that outlives it (:class:`Background`).
+``pip install`` needs no C compiler.  Where it finds one, the wheel's build compiles the parts a
+first run needs - the GT fast path's C entry (:mod:`gtecat.gt.centry`) and pointer check
+(:mod:`gtecat.gt.byref_target`), the axis bank's compiled cycle and its smaller units
+(:mod:`gtecat.controller.bank_kernel`) - into the package (:mod:`gtecat.cparts`), so that a
+new install's first run compiles nothing.  Whatever is not there (an editable install, no
+compiler at install, a source changed since, a damaged file) is built when first asked for,
+as is libgts (:mod:`gtecat.native.build`), with ``$CC`` (else ``cc``, ``gcc``, ``clang``),
+into ``$GTECAT_CACHE_DIR`` (else ``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``)
+``/<version>/``.  Here are the pieces they share: where the cache is, which compiler, and a
+one-file shared library build named by the digest of its source, compiler and flags (a lock
+file serialises concurrent builders), looked for in the package, then in the cache
+(:func:`found`), else built in this process (:func:`shared_library`) or in one of its own
+that outlives it (:class:`Background`).
 
 A build works in a folder ``<cache>/<version>/.build-XXXX/`` beside its owner file
 ``.build-XXXX.log`` (the background builder's error output), and holds a lock on that file
@@ -21,7 +26,9 @@ renamed; beside it its seal, ``<name>.ok``, records its size and SHA-256 (:func:
 Before a library is loaded :func:`intact` compares the two (a tenth of a millisecond for
 these files): a library cut short (a disk that filled up, a copy of the cache that broke
 off, a power cut) would otherwise crash the process that maps it, with no message.  A
-library that fails the check is built again (:func:`shared_library`).
+library that fails the check is built again (:func:`shared_library`).  The package's own
+are sealed the same way and checked the same way before they are loaded; one that fails is
+never loaded (a warning each time: reinstalling mends it) and the cache's build is used.
 """
 
 from __future__ import annotations
@@ -291,7 +298,12 @@ def _prebuilt(name: str) -> Path | None:
     if not why:
         return lib
     if why != "not there":
-        log.warning("%s, built with the package, fails its check (%s): not taken", lib, why)
+        log.warning(
+            "%s, built with the package, fails its check (%s): the build cache's is used "
+            "(reinstalling gtecat mends it)",
+            lib,
+            why,
+        )
     return None
 
 
