@@ -33,7 +33,7 @@ def _cc(tmp_path: Path, body: str) -> Path:
 
 def test_the_parts_a_first_run_builds_are_prebuilt_with_their_flags() -> None:
     """What the modules ask for at first use is what the wheel's build builds."""
-    from gtecat.controller import bank_kernel
+    from gtecat.controller import bank_kernel, bank_pvt, bank_slaves
     from gtecat.gt import byref_target
 
     parts = {stem: (package, variants, libs) for package, stem, variants, libs in cparts.PARTS}
@@ -42,6 +42,8 @@ def test_the_parts_a_first_run_builds_are_prebuilt_with_their_flags() -> None:
     bank = (bank_kernel.CFLAGS, bank_kernel.PLAIN_CFLAGS)
     assert parts["bank_kernel"] == ("gtecat.controller", bank, ("-lm",))
     assert parts["bank_crd"] == ("gtecat.controller", bank, ("-lm",))
+    for unit in (bank_pvt.library, bank_slaves.library):  # (built with bank_kernel.build)
+        assert parts[unit.stem] == ("gtecat.controller", bank, unit.libs)
     for package, stem, _, _ in cparts.PARTS:
         assert cparts.source_path(ROOT, package, stem).read_text("utf-8") == cbuild.c_source(
             package, stem
