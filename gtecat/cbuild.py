@@ -1,13 +1,18 @@
-"""Compiling the package's small C parts on first use, into a per-version cache.
+"""Compiling the package's small C parts where they are not built yet, into a per-version cache.
 
-``pip install`` needs no C compiler: libgts (:mod:`gtecat.native.build`), the axis bank's
-compiled cycle (:mod:`gtecat.controller.bank_kernel`), the GT fast path's pointer check
-(:mod:`gtecat.gt.byref_target`) and its C entry (:mod:`gtecat.gt.centry`) are built when
-first asked for, with ``$CC`` (else ``cc``, ``gcc``, ``clang``), into ``$GTECAT_CACHE_DIR`` (else
-``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``) ``/<version>/``.  Here are the pieces
-they share: where the cache is, which compiler, and a one-file shared library build named by
-the digest of its source and flags (a lock file serialises concurrent builders), in this
-process (:func:`shared_library`) or in one of its own that outlives it (:class:`Background`).
+``pip install`` needs no C compiler.  Where it finds one, the wheel's build compiles the parts a
+first run needs - the GT fast path's C entry (:mod:`gtecat.gt.centry`) and pointer check
+(:mod:`gtecat.gt.byref_target`), the axis bank's compiled cycle and its smaller units
+(:mod:`gtecat.controller.bank_kernel`) - into the package (:mod:`gtecat.cparts`), so that a
+new install's first run compiles nothing.  Whatever is not there (an editable install, no
+compiler at install, a source changed since, a damaged file) is built when first asked for,
+as is libgts (:mod:`gtecat.native.build`), with ``$CC`` (else ``cc``, ``gcc``, ``clang``),
+into ``$GTECAT_CACHE_DIR`` (else ``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``)
+``/<version>/``.  Here are the pieces they share: where the cache is, which compiler, and a
+one-file shared library build named by the digest of its source, compiler and flags (a lock
+file serialises concurrent builders), looked for in the package, then in the cache
+(:func:`found`), else built in this process (:func:`shared_library`) or in one of its own
+that outlives it (:class:`Background`).
 
 A build works in a folder ``<cache>/<version>/.build-XXXX/`` beside its owner file
 ``.build-XXXX.log`` (the background builder's error output), and holds a lock on that file
@@ -21,14 +26,15 @@ renamed; beside it its seal, ``<name>.ok``, records its size and SHA-256 (:func:
 Before a library is loaded :func:`intact` compares the two (a tenth of a millisecond for
 these files): a library cut short (a disk that filled up, a copy of the cache that broke
 off, a power cut) would otherwise crash the process that maps it, with no message.  A
-library that fails the check is built again (:func:`shared_library`).
+library that fails the check is built again (:func:`shared_library`).  The package's own
+are sealed the same way and checked the same way before they are loaded; one that fails is
+never loaded (a warning each time: reinstalling mends it) and the cache's build is used.
 """
 
 from __future__ import annotations
 
 import atexit
 import contextlib
-import hashlib
 import logging
 import os
 import shutil
@@ -40,6 +46,19 @@ from typing import TYPE_CHECKING, Any
 
 from . import __version__
 from ._cache import cache_root
+from .cparts import (
+    PREBUILT,
+    SEAL,
+    compile_command,
+    find_compiler,
+    flush,
+    library_name,
+    prebuilt_compiler,
+    run_compiler,
+)
+from .cparts import digest_file as _digest_file
+from .cparts import seal as seal
+from .cparts import seal_path as seal_path
 from .errors import GtecatError
 
 try:
@@ -63,21 +82,10 @@ class NativeBuildError(GtecatError):
 
 def compiler() -> list[str]:
     """The C compiler command (NativeBuildError when there is none)."""
-    cc = os.environ.get("CC")
-    if cc:
-        import shlex
-
-        cmd = shlex.split(cc)
-        if shutil.which(cmd[0]):
-            return cmd
-        raise NativeBuildError(f"CC={cc!r}: {cmd[0]} not found on PATH")
-    for name in ("cc", "gcc", "clang"):
-        if shutil.which(name):
-            return [name]
-    raise NativeBuildError(
-        "no C compiler (cc, gcc or clang on PATH, or set CC): libgts cannot be built; "
-        "the Python API (from gtecat import gt) works without it"
-    )
+    cmd, why = find_compiler()
+    if cmd is None:
+        raise NativeBuildError(why)
+    return cmd
 
 
 def version_dir() -> Path:
@@ -184,43 +192,6 @@ class _BuildDir:
         self.owner.close()
 
 
-#: the first word of a seal (:func:`seal`)
-_SEAL = "gtecat-library-1"
-
-
-def seal_path(lib: Path) -> Path:
-    """The seal of library ``lib``: ``<lib>.ok``."""
-    return lib.with_name(lib.name + ".ok")
-
-
-def _digest_file(path: Path) -> str:
-    with open(path, "rb") as f:
-        return hashlib.file_digest(f, "sha256").hexdigest()
-
-
-def flush(path: Path) -> None:
-    """Write ``path``'s data to the disk (before it is renamed into place: a power cut
-    then leaves the old name or the whole file, not a short one)."""
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass  # (a file system without fsync: the rename alone)
-    finally:
-        os.close(fd)
-
-
-def seal(lib: Path) -> None:
-    """Record the size and SHA-256 of library ``lib`` (complete, in place) in its seal,
-    written under another name and renamed; call it under the build lock."""
-    st = lib.stat()
-    text = f"{_SEAL} {st.st_size} {_digest_file(lib)}\n"
-    ok = seal_path(lib)
-    tmp = ok.with_name(f".{ok.name}.{os.getpid()}")
-    tmp.write_text(text, encoding="ascii")
-    os.replace(tmp, ok)
-
-
 def unseal(lib: Path) -> None:
     """Remove ``lib``'s seal (before the library is replaced: no old seal for a new file)."""
     with contextlib.suppress(FileNotFoundError):
@@ -254,7 +225,7 @@ def _flaw(lib: Path) -> str:
         return "its seal is damaged"
     try:
         got = lib.stat().st_size
-        if word != _SEAL:
+        if word != SEAL:
             return "its seal is of another kind"
         if got != want:
             return f"{got} bytes, built as {want}"
@@ -300,19 +271,50 @@ def c_source(package: str, stem: str) -> str:
 def library_path(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:
     """``<cache>/<version>/<stem>-<digest>.so``: where the build of the one C file ``source``
     (text) with this compiler and these flags is kept (NativeBuildError without a compiler)."""
-    cc = compiler()
-    h = hashlib.sha256(source.encode())
-    h.update(" ".join([*cc, *cflags, *libs]).encode())
-    return cache_root() / __version__ / f"{stem}-{h.hexdigest()[:12]}.so"
+    return cache_root() / __version__ / library_name(stem, source, compiler(), cflags, libs)
+
+
+def found(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path | None:
+    """An intact build of this source, compiler and flags that is there already: the
+    package's own (built with the wheel, module docstring), else the cache's; None when
+    neither is.  Without a compiler here the package's parts are looked for under the name
+    the compiler that built them gives (they need none to load)."""
+    cc, _ = find_compiler()
+    if cc is None:
+        cc = prebuilt_compiler(PREBUILT)
+        return None if cc is None else _prebuilt(library_name(stem, source, cc, cflags, libs))
+    name = library_name(stem, source, cc, cflags, libs)
+    ready = _prebuilt(name)
+    if ready is None and intact(lib := cache_root() / __version__ / name):
+        ready = lib
+    return ready
+
+
+def _prebuilt(name: str) -> Path | None:
+    """The package's build ``name`` where it is there and intact; one that fails its check
+    (a damaged installation) is left alone with a warning: the cache's build is taken."""
+    lib = PREBUILT / name
+    why = _flaw(lib)
+    if not why:
+        return lib
+    if why != "not there":
+        log.warning(
+            "%s, built with the package, fails its check (%s): the build cache's is used "
+            "(reinstalling gtecat mends it)",
+            lib,
+            why,
+        )
+    return None
 
 
 def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]) -> Path:
-    """:func:`library_path`, built there now unless an existing build of the same source,
-    compiler and flags is there."""
+    """The build of the one C file ``source`` (text) with this compiler and these flags:
+    :func:`found`, else built into :func:`library_path` now."""
+    ready = found(stem, source, cflags, libs)
+    if ready is not None:
+        return ready
     cc = compiler()
     lib = library_path(stem, source, cflags, libs)
-    if intact(lib):
-        return lib
     vdir = version_dir()
     with open(vdir / ".lock", "w") as lock:
         if fcntl is not None:
@@ -326,16 +328,12 @@ def shared_library(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[
             src = tmp / f"{stem}.c"
             src.write_text(source, encoding="utf-8")
             out = tmp / lib.name
-            cmd = [*cc, *cflags, "-shared", str(src), "-o", str(out), *libs]
-            import shlex
-            import subprocess
+            cmd = compile_command(cc, cflags, src, out, libs)
+            why = run_compiler(cmd)
+            if why:
+                import shlex
 
-            try:
-                r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-            except subprocess.TimeoutExpired:
-                raise NativeBuildError(f"building {stem}: {shlex.join(cmd)} ran 120 s") from None
-            if r.returncode != 0 or r.stderr.strip():
-                raise NativeBuildError(f"building {stem} failed ({shlex.join(cmd)}):\n{r.stderr}")
+                raise NativeBuildError(f"building {stem} failed ({shlex.join(cmd)}):\n{why}")
             put_in_place(out, lib)
         finally:
             build.close()
@@ -439,12 +437,13 @@ class Background:
 
     def __init__(self, builds: list[tuple[str, str, tuple[str, ...], tuple[str, ...]]]) -> None:
         self.result: Path | NativeBuildError | None = None
-        self.libs = [library_path(*b) for b in builds]
         self._proc: subprocess.Popen[bytes] | None = None
-        built = next((lib for lib in self.libs if intact(lib)), None)
+        built = next((lib for b in builds if (lib := found(*b)) is not None), None)
         if built is not None:  # (checked once: its seal's digest is the cost)
             self.result = built
+            self.libs = [built]
             return
+        self.libs = [library_path(*b) for b in builds]
         cc = compiler()
         vdir = version_dir()
         build = _BuildDir(vdir)
@@ -456,9 +455,7 @@ class Background:
             src = tmp / f"{stem}-{k}.c"
             src.write_text(source, encoding="utf-8")
             out = tmp / lib.name
-            jobs.append(
-                ([*cc, *cflags, "-shared", str(src), "-o", str(out), *libs], str(out), str(lib))
-            )
+            jobs.append((compile_command(cc, cflags, src, out, libs), str(out), str(lib)))
         self._log = build.log
         for lib in self.libs:
             damaged(lib)
@@ -467,7 +464,7 @@ class Background:
             "tmp": str(tmp),
             "jobs": jobs,
             "log": str(self._log),
-            "seal": _SEAL,
+            "seal": SEAL,
         }
         import json
         import subprocess

@@ -3,12 +3,12 @@
 With a dozen axes the numpy cycle of :class:`~gtecat.controller.bank.AxisBank` costs its
 operation count, not its arithmetic (about 80 operations of 0.5-1 µs each, whatever the
 rows).  ``gtecat/controller/csrc/bank_kernel.c`` runs the same cycle row by row, with the same
-IEEE operations in the same order, built like libgts (``cc``, on first use, into the
-per-version cache; ``-ffp-contract=off``), so it gives the same bits as numpy and as the
-scalar objects.  It runs only the plain cycle (the bank fills a Trap table that runs out
-before it): a raw write to a claimed slave, a row about to leave or a new cycle time go
-through the numpy cycle, which stays the reference and the fallback (no compiler: numpy
-alone, nothing else changes).
+IEEE operations in the same order, built with ``cc`` (with the wheel where one is, else on
+first use into the per-version cache: :mod:`gtecat.cbuild`; ``-ffp-contract=off``), so it
+gives the same bits as numpy and as the scalar objects.  It runs only the plain cycle (the
+bank fills a Trap table that runs out before it): a raw write to a claimed slave, a row
+about to leave or a new cycle time go through the numpy cycle, which stays the reference and
+the fallback (no compiler: numpy alone, nothing else changes).
 
 ``GTECAT_BANK_KERNEL`` = ``auto`` (default: the compiled kernel where it builds), ``c`` (the
 same; a build failure is reported in :attr:`AxisBank.kernel_reason`) or ``numpy``.
@@ -30,19 +30,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..cbuild import Background, NativeBuildError, c_source, intact, library_path, shared_library
+from ..cbuild import Background, NativeBuildError, c_source, found, shared_library
+from ..cparts import BANK_CFLAGS, BANK_PLAIN_CFLAGS
 
 if TYPE_CHECKING:
     from .bank import AxisBank
 
 log = logging.getLogger(__name__)
-#: IEEE arithmetic exactly as written: no contraction into FMA, no fast-math (-O3 changes no
-#: value: it reorders no floating-point operation without -ffast-math's licences); portable
-#: code for any processor of the architecture (no -march: the cache may be shared between
-#: machines, and an instruction set chosen per processor measured no faster)
-CFLAGS = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+#: IEEE arithmetic exactly as written, portable code (gtecat.cparts says why these flags);
 #: the plain build, when the compiler refuses CFLAGS
-PLAIN_CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-ffp-contract=off")
+CFLAGS, PLAIN_CFLAGS = BANK_CFLAGS, BANK_PLAIN_CFLAGS
 _U8, _I64, _F64 = np.uint8, np.int64, np.float64
 #: the int64 slots (``io``) and double slots (``fp``) of a cycle call, the C enums' order
 (IN_N, IN_T_NS, IN_N_PLC, IN_N_RX, IN_W2, IN_W16, IN_W17, OUT_FIN) = range(8)
@@ -102,7 +99,7 @@ def prebuild(defer: bool = False) -> None:
             ("bank_kernel", source, CFLAGS, ("-lm",)),
             ("bank_kernel", source, PLAIN_CFLAGS, ("-lm",)),
         ]
-        if defer and not any(intact(library_path(*b)) for b in builds):
+        if defer and not any(found(*b) for b in builds):
             _DEFERRED[:] = [True]
             return
         _DEFERRED.clear()

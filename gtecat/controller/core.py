@@ -1401,6 +1401,9 @@ def _put_back(backend: Any, kept: dict[tuple[int, Any, int], float]) -> None:
 
 #: whether this module moved a bus model out of the cyclic collector's walks (gc.freeze)
 _FROZEN: list[bool] = [False]
+#: how many objects gtecat's own import froze (:func:`freeze_import`): a freeze count beyond
+#: it is the process's own (the count only falls otherwise: frozen objects that die leave it)
+_IMPORT_FROZEN: list[int] = [0]
 #: buses from this many slaves on are frozen (a small bus costs the collector little)
 FREEZE_MIN_SLAVES = 64
 
@@ -1410,10 +1413,23 @@ def _freeze_bus(slaves: int) -> None:
     thousands of long-lived objects, millions at a thousand axes) is never walked by the
     cyclic collector again, so the running bus has no long collector pauses and the
     process's end no last walk of it (half a second at a thousand axes).  A process that
-    froze objects itself is left as it is."""
-    if slaves >= FREEZE_MIN_SLAVES and gc.get_freeze_count() == 0:
+    froze objects itself is left as it is (the import's own freeze, :func:`freeze_import`,
+    is not the process's: with it counted as one, a 512-axis bus went unfrozen and its
+    process's end walked it, 0.3 s)."""
+    if slaves >= FREEZE_MIN_SLAVES and gc.get_freeze_count() <= _IMPORT_FROZEN[0]:
         gc.freeze()
         _FROZEN[0] = True
+
+
+def freeze_import() -> None:
+    """What :mod:`gtecat.gt`'s import made (it lives as long as the process) moved out of the
+    collector's walks, counted as gtecat's own: a large bus is frozen after its bring-up as
+    in a process that froze nothing (:func:`_freeze_bus`).  Objects the process froze before
+    stay its own: a bus is then left as it is."""
+    own = gc.get_freeze_count() == 0
+    gc.freeze()
+    if own:
+        _IMPORT_FROZEN[0] = gc.get_freeze_count()
 
 
 def _thaw_bus() -> None:
@@ -1423,6 +1439,7 @@ def _thaw_bus() -> None:
     GT_InitEcatComm, or with the end of the process."""
     if _FROZEN[0]:
         _FROZEN[0] = False
+        _IMPORT_FROZEN[0] = 0  # (back to the collector with the bus: frozen again with the next)
         gc.unfreeze()
         gc.collect()
 

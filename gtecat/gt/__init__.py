@@ -115,7 +115,9 @@ try:
         _install_vendor_surface(globals(), REGISTRY)
     # what the import made lives as long as the process: moved out of the collector's walks
     # (its first pass after the import walked all of it, ~20 ms, and every full pass again)
-    _gc.freeze()
+    from ..controller.core import freeze_import
+
+    freeze_import()
 finally:
     if _gc_was_on:
         _gc.enable()

@@ -25,15 +25,13 @@ import sys
 from collections.abc import Callable, Iterable
 from typing import Any
 
+from ..cparts import GT_CFLAGS
 from .args import CARG_AT
 
 log = logging.getLogger(__name__)
 
-#: flags of the build, also the C entry's (gtecat.gt.centry): -O1, not the bank kernel's -O2 -
-#: both are call glue (argument checks, a few loads and stores, no loops worth unrolling), as
-#: fast at -O1 (GT_GetSts, GT_EcatIOReadInput, GTE_Wait's entries within 1-2 % of -O2; -O0
-#: costs 20-30 %) and half the compiler's time, which a new install's first import waits for
-CFLAGS = ("-std=c99", "-O1", "-fPIC", "-Wall", "-Wextra")
+#: flags of the build, also the C entry's (gtecat.gt.centry): why -O1, gtecat.cparts says
+CFLAGS = GT_CFLAGS
 _METH_O = 0x0008
 _WORD = ctypes.sizeof(ctypes.c_void_p)
 

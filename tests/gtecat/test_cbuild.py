@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from gtecat import cbuild
+from gtecat import cbuild, cparts
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCE = "int f(void) { return 1; }\n"
@@ -155,3 +155,88 @@ def test_a_killed_builder_leaves_nothing_behind_for_the_next_build(
         assert _leftovers(cache) == [".build-live", ".build-live.log"]
     assert cbuild.sweep(vdir) == [live, vdir / ".build-live.log"]  # its owner is gone now
     assert _leftovers(cache) == []
+
+
+@pytest.fixture
+def prebuilt(tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An empty folder of the package's prebuilt parts (gtecat/cparts.py), in place of the
+    package's own."""
+    folder = tmp_path / "prebuilt"
+    folder.mkdir()
+    monkeypatch.setattr(cbuild, "PREBUILT", folder)
+    return folder
+
+
+def _prebuild(folder: Path, cc: list[str], job: tuple, content: bytes = b"prebuilt") -> Path:
+    """A part of ``job`` (stem, source, flags, libs) as the wheel's build leaves it."""
+    lib = folder / cbuild.library_name(job[0], job[1], cc, job[2], job[3])
+    lib.write_bytes(content)
+    cbuild.seal(lib)
+    (folder / cparts.COMPILER_FILE).write_text(" ".join(cc) + "\n")
+    return lib
+
+
+def test_a_prebuilt_part_of_the_same_build_is_taken_and_nothing_is_compiled(
+    tmp_path: Path, prebuilt: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cc = _cc(tmp_path, 'echo built > "$out"')
+    monkeypatch.setenv("CC", str(cc))
+    job = ("part", SOURCE, ("-O3",), ("-lm",))
+    lib = _prebuild(prebuilt, [str(cc)], job)
+    assert cbuild.found(*job) == lib and cbuild.shared_library(*job) == lib
+    b = cbuild.Background([job])
+    assert b.done() and b.wait() == lib and b._proc is None
+    assert not (tmp_path / "cc.log").exists()  # the compiler never ran
+    assert not cbuild.library_path(*job).exists()
+
+
+def test_a_prebuilt_part_of_another_source_or_flags_is_never_taken(
+    tmp_path: Path, prebuilt: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A source changed since the wheel was built (an editable checkout) has another name."""
+    cc = _cc(tmp_path, 'echo built > "$out"')
+    monkeypatch.setenv("CC", str(cc))
+    _prebuild(prebuilt, [str(cc)], ("part", SOURCE, ("-O3",), ()))
+    changed = ("part", SOURCE + "int g(void) { return 2; }\n", ("-O3",), ())
+    assert cbuild.found(*changed) is None
+    assert cbuild.shared_library(*changed) == cbuild.library_path(*changed)
+    other_flags = ("part", SOURCE, ("-O2",), ())
+    assert cbuild.Background([other_flags]).wait() == cbuild.library_path(*other_flags)
+    assert len((tmp_path / "cc.log").read_text().splitlines()) == 2
+
+
+def test_a_damaged_prebuilt_part_is_left_alone_and_built_into_the_cache(
+    tmp_path: Path,
+    prebuilt: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    cc = _cc(tmp_path, 'echo built > "$out"')
+    monkeypatch.setenv("CC", str(cc))
+    job = ("part", SOURCE, ("-O3",), ())
+    lib = _prebuild(prebuilt, [str(cc)], job, b"a whole library")
+    lib.write_bytes(b"a whole")  # cut short, its seal kept
+    with caplog.at_level("WARNING", logger="gtecat.cbuild"):
+        assert cbuild.shared_library(*job) == cbuild.library_path(*job)
+    assert "built with the package, fails its check" in caplog.text
+    assert cbuild.library_path(*job).read_text() == "built\n"
+    unsealed = ("unsealed", SOURCE, ("-O3",), ())
+    _prebuild(prebuilt, [str(cc)], unsealed)
+    cbuild.seal_path(prebuilt / cbuild.library_path(*unsealed).name).unlink()
+    assert cbuild.Background([unsealed]).wait() == cbuild.library_path(*unsealed)
+
+
+def test_without_a_compiler_the_prebuilt_parts_are_found_by_the_name_their_compiler_gives(
+    tmp_path: Path, prebuilt: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    job = ("part", SOURCE, ("-O3",), ())
+    lib = _prebuild(prebuilt, ["cc"], job)
+    assert cbuild.found(*job) == lib and cbuild.shared_library(*job) == lib
+    assert cbuild.Background([job]).wait() == lib
+    assert cbuild.found("part", SOURCE, ("-O2",), ()) is None
+    with pytest.raises(cbuild.NativeBuildError, match="no C compiler"):
+        cbuild.shared_library("part", SOURCE, ("-O2",), ())
+    (prebuilt / cparts.COMPILER_FILE).unlink()  # (a folder without it: nothing is taken)
+    assert cbuild.found(*job) is None

@@ -168,8 +168,7 @@ def test_a_first_build_starts_once_the_bus_is_in_op(monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(
         bank_kernel, "Background", lambda b: started.append(_Build(b)) or started[-1]
     )
-    monkeypatch.setattr(bank_kernel, "library_path", lambda *b: Path("/nowhere/bank_kernel.so"))
-    monkeypatch.setattr(bank_kernel, "intact", lambda lib: False)
+    monkeypatch.setattr(bank_kernel, "found", lambda *b: None)
     monkeypatch.delenv("GTECAT_BANK_KERNEL", raising=False)
     try:
         eni = ROOT / "examples" / "manual_fig5_2.eni"
@@ -185,7 +184,7 @@ def test_a_first_build_starts_once_the_bus_is_in_op(monkeypatch: pytest.MonkeyPa
         assert len(started) == 1
         gt.GT_Close()
         bank_kernel._AHEAD.clear()
-        monkeypatch.setattr(bank_kernel, "intact", lambda lib: True)
+        monkeypatch.setattr(bank_kernel, "found", lambda *b: Path("/built/bank_kernel.so"))
         bank_kernel.prebuild(defer=True)  # built before: taken at once
         assert len(started) == 2 and not bank_kernel._DEFERRED
     finally:

@@ -52,3 +52,32 @@ def test_a_small_bus_is_not_frozen(tmp_path: Path) -> None:
         assert not core._FROZEN[0]
     finally:
         gt.GT_Close()
+
+
+def test_the_gt_imports_own_freeze_leaves_a_large_bus_frozen_and_a_processs_own_not(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """gtecat.gt's import freezes what it made (core.freeze_import): that is not a freeze of
+    the process's own, so a large bus is frozen after its bring-up still; objects the
+    process froze before the import leave the bus as it is."""
+    core._thaw_bus()
+    gc.unfreeze()  # (as a process that has frozen nothing yet)
+    monkeypatch.setattr(core, "_IMPORT_FROZEN", [0])
+    monkeypatch.setattr(core, "FREEZE_MIN_SLAVES", 4)
+    eni = write_axes_eni(core.FREEZE_MIN_SLAVES, tmp_path / "bus.eni")
+    try:
+        core.freeze_import()
+        assert gc.get_freeze_count() > 0
+        _up(eni)
+        assert core._FROZEN[0]
+        gt.GT_Close()
+        core._thaw_bus()
+        assert gc.get_freeze_count() == 0
+        gc.freeze()  # the process's own
+        core.freeze_import()
+        _up(eni)
+        assert not core._FROZEN[0]
+    finally:
+        gt.GT_Close()
+        core._thaw_bus()
+        gc.unfreeze()
