@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import gc
-import os
 import sys
 import time
 from pathlib import Path
@@ -45,29 +44,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run, leave_at_once=True)
 
 
-#: the variables that tell numpy's BLAS how many threads to start when it is loaded
-_BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
-
-
-def _numpy_one_thread() -> None:
-    """numpy imported with its BLAS on one thread (unless the user chose a number): a
-    replay does no linear algebra, and OpenBLAS starting a thread per CPU and its buffers
-    costs ~60 ms of a replay's start (a third of numpy's import).  The variables are put
-    back once numpy is loaded (the library reads them then), so no process started later
-    inherits them."""
-    if "numpy" in sys.modules or any(k in os.environ for k in _BLAS_THREADS):
-        return
-    os.environ["OPENBLAS_NUM_THREADS"] = "1"
-    try:
-        import numpy  # noqa: F401
-    except ImportError:
-        pass
-    finally:
-        os.environ.pop("OPENBLAS_NUM_THREADS", None)
-
-
 def _imported_paused() -> Any:
-    """The replay's modules imported (numpy on one thread, the GT layer, the faults), with
+    """The replay's modules imported (numpy on one BLAS thread, the GT layer, the faults), with
     the cyclic collector paused: the import makes ~200,000 objects that live as long as the
     process, and the collector ran ~80 times while they were made (~25 ms of a replay's
     start) to find a few hundred.  Once imported they are put in its oldest generation as a
@@ -78,7 +56,7 @@ def _imported_paused() -> Any:
     if paused:
         gc.disable()
     try:
-        _numpy_one_thread()
+        gtecat.numpy_with_one_blas_thread()
         # a replay runs no program of its own: the GT layer's vendor surface (its ~600
         # structures, declared-only functions, constants) is made only if the recording names
         # one of them
@@ -86,9 +64,11 @@ def _imported_paused() -> Any:
         from ..faults.record import replay
     finally:
         if paused:
-            if gc.get_freeze_count() == 0:  # (a process that froze its own: left so)
+            from ..controller.core import process_froze, unfreeze
+
+            if not process_froze():  # (a process that froze its own: left so)
                 gc.freeze()
-                gc.unfreeze()
+                unfreeze()
             gc.enable()
     return replay
 

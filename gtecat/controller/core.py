@@ -1416,9 +1416,22 @@ def _freeze_bus(slaves: int) -> None:
     froze objects itself is left as it is (the import's own freeze, :func:`freeze_import`,
     is not the process's: with it counted as one, a 512-axis bus went unfrozen and its
     process's end walked it, 0.3 s)."""
-    if slaves >= FREEZE_MIN_SLAVES and gc.get_freeze_count() <= _IMPORT_FROZEN[0]:
+    if slaves >= FREEZE_MIN_SLAVES and not process_froze():
         gc.freeze()
         _FROZEN[0] = True
+
+
+def process_froze() -> bool:
+    """Whether the process froze objects itself (``gc.freeze``) beyond what gtecat's own
+    import froze (:func:`freeze_import`): code of gtecat's that freezes what it made (a
+    large bus, a replay's plan) leaves such a process as it is."""
+    return gc.get_freeze_count() > _IMPORT_FROZEN[0]
+
+
+def unfreeze() -> None:
+    """``gc.unfreeze()``, the import's frozen objects counted back to the collector too."""
+    gc.unfreeze()
+    _IMPORT_FROZEN[0] = 0
 
 
 def freeze_import() -> None:
@@ -1439,8 +1452,7 @@ def _thaw_bus() -> None:
     GT_InitEcatComm, or with the end of the process."""
     if _FROZEN[0]:
         _FROZEN[0] = False
-        _IMPORT_FROZEN[0] = 0  # (back to the collector with the bus: frozen again with the next)
-        gc.unfreeze()
+        unfreeze()  # (the import's with the bus: frozen again with the next)
         gc.collect()
 
 

@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 
 from .._code_store import compiled as _compiled_code
+from ..controller.core import process_froze, unfreeze
 from ..errors import ParameterError
 from ..gt.args import byref_address
 from .tap import Listener, tap, untap
@@ -860,7 +861,7 @@ def replay(
         _check_count(p, head, calls)
         # frozen before the collector runs again: it would walk every object just made
         # (all of them young) at its first collection
-        freeze = gc.get_freeze_count() == 0  # (a process that froze its own: left so)
+        freeze = not process_froze()  # (a process that froze its own: left so)
         if freeze:
             gc.freeze()
     finally:
@@ -874,7 +875,7 @@ def replay(
             return _replay(steps, eni, machine, head.get("cwd"), marks)
     finally:
         if freeze:
-            gc.unfreeze()
+            unfreeze()
 
 
 def _from_here(name: str | None) -> str | None:

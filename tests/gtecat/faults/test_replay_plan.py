@@ -235,3 +235,36 @@ def test_equal_arrays_are_one_object_in_the_steps_and_the_plan() -> None:
     again = rec._steps(Path("x"), "", plan=plan)
     assert [v for _, v in again] == [v0, v1, v2]
     assert again[0][1][1] is again[1][1][0]  # (kept once in the plan, one object loaded)
+
+
+def test_a_replays_plan_is_frozen_after_the_gt_imports_own_freeze(
+    recorded: Path, monkeypatch
+) -> None:
+    """gtecat.gt's import freezes what it made (controller.core.freeze_import); that is not
+    a freeze of the process's own, so a replay still moves its plan out of the collector's
+    walks while the calls run, and gives it back after; a process's own freeze leaves it."""
+    from gtecat.controller import core
+
+    frozen: list[int] = []
+    real = gc.freeze
+
+    def spy() -> None:
+        frozen.append(1)
+        real()
+
+    core._thaw_bus()
+    gc.unfreeze()
+    monkeypatch.setattr(core, "_IMPORT_FROZEN", [0])
+    try:
+        core.freeze_import()
+        monkeypatch.setattr(gc, "freeze", spy)
+        assert rec.replay(recorded)[1] is None
+        assert frozen and not core.process_froze()
+        frozen.clear()
+        real()  # the process's own
+        assert rec.replay(recorded)[1] is None
+        assert not frozen and core.process_froze()
+    finally:
+        gt.GT_Close()
+        core._thaw_bus()
+        gc.unfreeze()
