@@ -39,6 +39,7 @@ from gtecat.drives.modes import OpMode, enter, step_hm
 
 from ..master.clock import ClockMode
 from .epoch import EPOCH
+from .motion.trap import _MOVE, TrapPlanner
 
 if TYPE_CHECKING:
     from .bank import AxisBank, _Group
@@ -110,6 +111,8 @@ def _switchable(bank: AxisBank, r: int, g: _Group) -> int:
         return 0
     if OpMode.HOMING not in ch.supported or _get(ch, "field") is not None:
         return 0
+    if ch.faults.injected:
+        return 0  # (an encoder fault keeps 6064h where it froze: the release's value)
     if ch.tp_function or ch._tp_applied or _get(ch, "probe").function:
         return 0
     csp = bank.csp
@@ -141,13 +144,14 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     # (its objects' guards off while the call looks at them and while it runs: nothing else
     # runs in its cycles, no hook among them; on again as the row is taken again)
     objs = tuple(bank._guarded_objects(g))
-    _bank()._unguard(objs)
+    b = _bank()
+    b._unguard(objs)
     n = 0
     try:
         n = _switchable(bank, r, g)
     finally:
         if not n:
-            _guard(bank, g, objs)
+            b._reguard(objs)
     if not n:
         return None
     ax = bank.axes[r]
@@ -161,7 +165,9 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     c0, b0, claim = clock.cycles, bank.bank_cycles, int(bank.claim_ids[r])
     bank.home_switch, bank.home_switch_from = r, b0
     try:
-        clock.run_until(lambda: clock.cycles >= c0 + n, _MODE_TIMEOUT_MS)
+        # (the n cycles in one run where the controller can run them its quick way: only
+        # their count is waited for, and the wait's budget is those n cycles)
+        clock.run_until(lambda: clock.cycles >= c0 + n, n * clock.cycle_ns / 1e6, _always)
     finally:
         bank.home_switch = -1
     if (
@@ -173,18 +179,7 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
         # and the scalar path ran the rest)
         return 0
     bank.home_switches += 1
-    # its state into its objects, as a release after the n CSP cycles leaves them
-    bank._last = {r: bank._planned_row(r)}
-    bank._rates = {r: bank._enc_rates_row(r)}
-    bank.csp.store([r])
-    bank._put_back(r)
-    _took_mode(bank, r, g, 1, sent=False)  # (its exchange's end: _switched)
-    _switched(bank, r, g)
-    # taken again from them in place (AxisBank._load: frozen, in homing mode before a
-    # homing) when that is what the bank would take, else given back as they stand
-    bank._load(r)
-    EPOCH.n += 1
-    if not (bank.frz[r] and bank._eligible_frozen(r, powered=True)):
+    if not _switch_row(bank, r, g):
         bank.frz[r] = True  # (its drive's objects hold its state: CspBank.rested)
         bank._stepping = r  # (and its axis's: nothing put back)
         try:
@@ -192,36 +187,40 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
         finally:
             bank._stepping = -1
         bank.frz[r] = bank.frz_off[r] = False  # (a row given back has them clear)
-        for obj in objs:  # (a planner replaced meanwhile: the bank's no longer)
-            _bank()._OWNER.pop(id(obj), None)
         return 0
-    _guard(bank, g, objs)
+    b._reguard(objs)  # (the same objects: the switch replaced none, its planner held)
     bank.n_frz += 1
     bank._after_load(r, False)
     bank._counted()
     return 0
 
 
-def _guard(bank: AxisBank, g: _Group, before: tuple) -> None:
-    """Claimed group ``g``'s objects guarded again (``before``: the ones its claim guarded,
-    whose guards came off; a planner replaced meanwhile is the bank's no longer)."""
-    b = _bank()
-    owner, own, guards = b._OWNER, b._OWN_DICT, b._GUARDS
-    now = bank._guarded_objects(g)
-    gi = bank.group_of[g.rows[0]]
-    ids = {id(obj) for obj in now}
-    for obj in before:
-        if id(obj) not in ids:
-            owner.pop(id(obj), None)
-    for obj in now:
-        key = id(obj)
-        owner[key] = (bank, gi)
-        cls = type(obj)
-        if cls not in b._GUARD_SET:
-            _set(obj, "__class__", guards.get(cls) or b._guard_class(cls))
-        if key not in own:
-            own.add(key)
-            b.own_dict(obj)
+def _always() -> bool:
+    return True
+
+
+def _switch_row(bank: AxisBank, r: int, g: _Group) -> bool:
+    """After the switch's cycles on claimed row ``r`` (group ``g``): its state into its
+    objects, the switch applied to them and the row taken again from them (frozen, in homing
+    mode before a homing: :meth:`AxisBank._load`); True when the bank takes it as it stands
+    then, False when it must be given back with its objects as they are."""
+    res = bank.res[r]
+    # its state into its objects, as a release after the n CSP cycles leaves them (the
+    # drive's process values aside: its step in the switch makes them again, _outputs)
+    pl = res.profile.planner
+    if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
+        bank._last = {r: bank._planned_row(r)}  # (a move that ended in the bank: advance)
+    bank._rates = {r: bank._enc_rates_row(r)}
+    bank.csp.store_state(r)
+    bank._put_back(r)
+    _took_mode(bank, r, g, 1, sent=False)  # (its exchange's end: _switched)
+    _switched(bank, r, g)
+    # taken again in place: its scale, limits, band and encoder settings are as its claim
+    # took them, its links' too unless the rebase onto the drive dropped an offset
+    again = bank.prf_off[r] == res.prf_link.offset and bank.enc_off[r] == res.enc_link.offset
+    bank._load(r, again=bool(again))
+    EPOCH.n += 1
+    return bool(bank.frz[r]) and bank._eligible_frozen(r, powered=True)
 
 
 def switch_released(bank: AxisBank, r: int) -> None:
