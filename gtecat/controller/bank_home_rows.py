@@ -111,8 +111,8 @@ def _switchable(bank: AxisBank, r: int, g: _Group) -> int:
         return 0
     if OpMode.HOMING not in ch.supported or _get(ch, "field") is not None:
         return 0
-    if ch.faults.injected:
-        return 0  # (an encoder fault keeps 6064h where it froze: the release's value)
+    if not bank._outputs_kept(bank.group_of[r]):
+        return 0  # the drive's outputs written meanwhile (a raw write): its drive takes them
     if ch.tp_function or ch._tp_applied or _get(ch, "probe").function:
         return 0
     csp = bank.csp
@@ -215,10 +215,7 @@ def _switch_row(bank: AxisBank, r: int, g: _Group) -> bool:
     bank._put_back(r)
     _took_mode(bank, r, g, 1, sent=False)  # (its exchange's end: _switched)
     _switched(bank, r, g)
-    # taken again in place: its scale, limits, band and encoder settings are as its claim
-    # took them, its links' too unless the rebase onto the drive dropped an offset
-    again = bank.prf_off[r] == res.prf_link.offset and bank.enc_off[r] == res.enc_link.offset
-    bank._load(r, again=bool(again))
+    bank._load(r)  # (taken again in place)
     EPOCH.n += 1
     return bool(bank.frz[r]) and bank._eligible_frozen(r, powered=True)
 
