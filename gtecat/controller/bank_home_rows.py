@@ -12,19 +12,22 @@ switch the drive's cycle is a CSP cycle at rest; at the switch nothing of its mo
 changes either (the demand is where the motor stands, its speed 0).
 
 So the bank runs those cycles as the row's CSP cycles (the compiled kernel, with the other
-rows) with 6060h written in the image and the row's objects unguarded but untouched, then
-puts the row's state into its objects as a release does, brings them to what the switch
-leaves - the drive's mode bookkeeping, ``enter`` and ``step_hm``'s hold, its process values
-(its own ``_outputs``; its codec writes 6041h and 6061h into its buffers and the image), the
-axis's command and the axis layer's rebase onto the drive - and takes the row again from
-them in place (``AxisBank._load``: frozen in homing mode,
-:func:`gtecat.drives.homing_bank.idle_claimable`) with its guards back, or gives it back as
-they stand when the bank would not take it.  The objects are then exactly as the scalar
-path leaves them (``tests/gtecat/controller/test_bank_home_rows.py`` compares every object
-and value with the bank off), and no step of the axis or the drive ran in Python: the
-switch costs the call, the other rows' compiled cycles and one store and load of the row.
+rows, in one run where the controller runs cycles its quick way) with 6060h written in the
+image and the row's objects unguarded but untouched, then puts the row's state into its
+objects as a release does (but the drive's process values, which its step in the switch
+makes again), brings them to what the switch leaves - the drive's mode bookkeeping,
+``enter`` and ``step_hm``'s hold, its process values (its own ``_outputs``; its codec writes
+6041h and 6061h into its buffers and the image), the axis's command and the axis layer's
+rebase onto the drive - and takes the row again from them in place (``AxisBank._load``:
+frozen in homing mode, :func:`gtecat.drives.homing_bank.idle_claimable`) with its guards
+back, or gives it back as they stand when the bank would not take it.  The objects are then
+exactly as the scalar path leaves them (``tests/gtecat/controller/test_bank_home_rows.py``
+compares every object and value with the bank off), and no step of the axis or the drive
+ran in Python: the switch costs the call, the other rows' compiled cycles and one store and
+load of the row.
 
-Anything else - another mode, a row moving or not plain, hooks, a touch probe, a drive
+Anything else - another mode, a row moving or not plain, hooks, a touch probe, the drive's
+outputs written since the bank looked (a raw write: its drive takes them), a drive
 whose 6060h/6061h are not mapped or that shows another mode while switching, the realtime
 clock (whose cycle thread, and other threads' calls, run while the call waits) - takes the
 opened row's path (:meth:`AxisBank.call_opened`).
@@ -59,8 +62,6 @@ def _bank() -> Any:
 _HOMING = 6
 _CSP = 8
 _CW_ENABLED = 0x000F
-#: GT_SetHomingMode's bound on the wait for 6061h (gtecat.gt.homing_calls)
-_MODE_TIMEOUT_MS = 500.0
 
 
 def _switchable(bank: AxisBank, r: int, g: _Group) -> int:
