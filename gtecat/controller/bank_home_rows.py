@@ -12,19 +12,22 @@ switch the drive's cycle is a CSP cycle at rest; at the switch nothing of its mo
 changes either (the demand is where the motor stands, its speed 0).
 
 So the bank runs those cycles as the row's CSP cycles (the compiled kernel, with the other
-rows) with 6060h written in the image and the row's objects unguarded but untouched, then
-puts the row's state into its objects as a release does, brings them to what the switch
-leaves - the drive's mode bookkeeping, ``enter`` and ``step_hm``'s hold, its process values
-(its own ``_outputs``; its codec writes 6041h and 6061h into its buffers and the image), the
-axis's command and the axis layer's rebase onto the drive - and takes the row again from
-them in place (``AxisBank._load``: frozen in homing mode,
-:func:`gtecat.drives.homing_bank.idle_claimable`) with its guards back, or gives it back as
-they stand when the bank would not take it.  The objects are then exactly as the scalar
-path leaves them (``tests/gtecat/controller/test_bank_home_rows.py`` compares every object
-and value with the bank off), and no step of the axis or the drive ran in Python: the
-switch costs the call, the other rows' compiled cycles and one store and load of the row.
+rows, in one run where the controller runs cycles its quick way) with 6060h written in the
+image and the row's objects unguarded but untouched, then puts the row's state into its
+objects as a release does (but the drive's process values, which its step in the switch
+makes again), brings them to what the switch leaves - the drive's mode bookkeeping,
+``enter`` and ``step_hm``'s hold, its process values (its own ``_outputs``; its codec writes
+6041h and 6061h into its buffers and the image), the axis's command and the axis layer's
+rebase onto the drive - and takes the row again from them in place (``AxisBank._load``:
+frozen in homing mode, :func:`gtecat.drives.homing_bank.idle_claimable`) with its guards
+back, or gives it back as they stand when the bank would not take it.  The objects are then
+exactly as the scalar path leaves them (``tests/gtecat/controller/test_bank_home_rows.py``
+compares every object and value with the bank off), and no step of the axis or the drive
+ran in Python: the switch costs the call, the other rows' compiled cycles and one store and
+load of the row.
 
-Anything else - another mode, a row moving or not plain, hooks, a touch probe, a drive
+Anything else - another mode, a row moving or not plain, hooks, a touch probe, the drive's
+outputs written since the bank looked (a raw write: its drive takes them), a drive
 whose 6060h/6061h are not mapped or that shows another mode while switching, the realtime
 clock (whose cycle thread, and other threads' calls, run while the call waits) - takes the
 opened row's path (:meth:`AxisBank.call_opened`).
@@ -39,6 +42,7 @@ from gtecat.drives.modes import OpMode, enter, step_hm
 
 from ..master.clock import ClockMode
 from .epoch import EPOCH
+from .motion.trap import _MOVE, TrapPlanner
 
 if TYPE_CHECKING:
     from .bank import AxisBank, _Group
@@ -58,8 +62,6 @@ def _bank() -> Any:
 _HOMING = 6
 _CSP = 8
 _CW_ENABLED = 0x000F
-#: GT_SetHomingMode's bound on the wait for 6061h (gtecat.gt.homing_calls)
-_MODE_TIMEOUT_MS = 500.0
 
 
 def _switchable(bank: AxisBank, r: int, g: _Group) -> int:
@@ -110,6 +112,8 @@ def _switchable(bank: AxisBank, r: int, g: _Group) -> int:
         return 0
     if OpMode.HOMING not in ch.supported or _get(ch, "field") is not None:
         return 0
+    if not bank._outputs_kept(bank.group_of[r]):
+        return 0  # the drive's outputs written meanwhile (a raw write): its drive takes them
     if ch.tp_function or ch._tp_applied or _get(ch, "probe").function:
         return 0
     csp = bank.csp
@@ -141,13 +145,14 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     # (its objects' guards off while the call looks at them and while it runs: nothing else
     # runs in its cycles, no hook among them; on again as the row is taken again)
     objs = tuple(bank._guarded_objects(g))
-    _bank()._unguard(objs)
+    b = _bank()
+    b._unguard(objs)
     n = 0
     try:
         n = _switchable(bank, r, g)
     finally:
         if not n:
-            _guard(bank, g, objs)
+            b._reguard(objs)
     if not n:
         return None
     ax = bank.axes[r]
@@ -161,7 +166,9 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
     c0, b0, claim = clock.cycles, bank.bank_cycles, int(bank.claim_ids[r])
     bank.home_switch, bank.home_switch_from = r, b0
     try:
-        clock.run_until(lambda: clock.cycles >= c0 + n, _MODE_TIMEOUT_MS)
+        # (the n cycles in one run where the controller can run them its quick way: only
+        # their count is waited for, and the wait's budget is those n cycles)
+        clock.run_until(lambda: clock.cycles >= c0 + n, n * clock.cycle_ns / 1e6, _always)
     finally:
         bank.home_switch = -1
     if (
@@ -173,18 +180,7 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
         # and the scalar path ran the rest)
         return 0
     bank.home_switches += 1
-    # its state into its objects, as a release after the n CSP cycles leaves them
-    bank._last = {r: bank._planned_row(r)}
-    bank._rates = {r: bank._enc_rates_row(r)}
-    bank.csp.store([r])
-    bank._put_back(r)
-    _took_mode(bank, r, g, 1, sent=False)  # (its exchange's end: _switched)
-    _switched(bank, r, g)
-    # taken again from them in place (AxisBank._load: frozen, in homing mode before a
-    # homing) when that is what the bank would take, else given back as they stand
-    bank._load(r)
-    EPOCH.n += 1
-    if not (bank.frz[r] and bank._eligible_frozen(r, powered=True)):
+    if not _switch_row(bank, r, g):
         bank.frz[r] = True  # (its drive's objects hold its state: CspBank.rested)
         bank._stepping = r  # (and its axis's: nothing put back)
         try:
@@ -192,36 +188,37 @@ def switch_to_homing(bank: AxisBank, ctl: Any, r: int, g: _Group) -> int | None:
         finally:
             bank._stepping = -1
         bank.frz[r] = bank.frz_off[r] = False  # (a row given back has them clear)
-        for obj in objs:  # (a planner replaced meanwhile: the bank's no longer)
-            _bank()._OWNER.pop(id(obj), None)
         return 0
-    _guard(bank, g, objs)
+    b._reguard(objs)  # (the same objects: the switch replaced none, its planner held)
     bank.n_frz += 1
     bank._after_load(r, False)
     bank._counted()
     return 0
 
 
-def _guard(bank: AxisBank, g: _Group, before: tuple) -> None:
-    """Claimed group ``g``'s objects guarded again (``before``: the ones its claim guarded,
-    whose guards came off; a planner replaced meanwhile is the bank's no longer)."""
-    b = _bank()
-    owner, own, guards = b._OWNER, b._OWN_DICT, b._GUARDS
-    now = bank._guarded_objects(g)
-    gi = bank.group_of[g.rows[0]]
-    ids = {id(obj) for obj in now}
-    for obj in before:
-        if id(obj) not in ids:
-            owner.pop(id(obj), None)
-    for obj in now:
-        key = id(obj)
-        owner[key] = (bank, gi)
-        cls = type(obj)
-        if cls not in b._GUARD_SET:
-            _set(obj, "__class__", guards.get(cls) or b._guard_class(cls))
-        if key not in own:
-            own.add(key)
-            b.own_dict(obj)
+def _always() -> bool:
+    return True
+
+
+def _switch_row(bank: AxisBank, r: int, g: _Group) -> bool:
+    """After the switch's cycles on claimed row ``r`` (group ``g``): its state into its
+    objects, the switch applied to them and the row taken again from them (frozen, in homing
+    mode before a homing: :meth:`AxisBank._load`); True when the bank takes it as it stands
+    then, False when it must be given back with its objects as they are."""
+    res = bank.res[r]
+    # its state into its objects, as a release after the n CSP cycles leaves them (the
+    # drive's process values aside: its step in the switch makes them again, _outputs)
+    pl = res.profile.planner
+    if isinstance(pl, TrapPlanner) and pl._mode == _MOVE:
+        bank._last = {r: bank._planned_row(r)}  # (a move that ended in the bank: advance)
+    bank._rates = {r: bank._enc_rates_row(r)}
+    bank.csp.store_state(r)
+    bank._put_back(r)
+    _took_mode(bank, r, g, 1, sent=False)  # (its exchange's end: _switched)
+    _switched(bank, r, g)
+    bank._load(r)  # (taken again in place)
+    EPOCH.n += 1
+    return bool(bank.frz[r]) and bank._eligible_frozen(r, powered=True)
 
 
 def switch_released(bank: AxisBank, r: int) -> None:

@@ -591,22 +591,7 @@ class CspBank:
                 at[r] = k
         wrapped = _WRAPPED
         for r in range(len(self.channels)) if rows is None else rows:
-            ch = self.channels[r]
-            m = ch.mech
-            a, v = float(self.acc[r]), float(self.vel[r])
-            m.pos, m.vel, m.acc = float(self.pos[r]), v, a
-            m.torque = a / m.a_rated * 1000.0 + v * m.visc
-            m.limited = bool(self.limited[r])
-            ch.dpos, ch.dvel = float(self.dpos[r]), float(self.dvel[r])
-            ch.fe_time = float(self.fe_time[r])
-            ch.fe_flag = False
-            ch.sw_limited = bool(self.sw_limited[r])
-            ch.stopping = False
-            ch.limit_stop = bool(self.lstop[r])
-            ch.oms = SW12
-            ch.cycle += self.cycles - int(self.start[r])
-            self.start[r] = self.cycles
-            ch.target_position = int(self.target[r])
+            ch = self.store_state(r)
             if per_row is not None:
                 for name, x in per_row[r].items():
                     setattr(ch, name, wrap32(x) if name in wrapped else x)
@@ -616,6 +601,29 @@ class CspBank:
                     x = int(values[k])
                     setattr(ch, name, wrap32(x) if name in wrapped else x)
             ch.mode_display = ch.mode
+
+    def store_state(self, r: int) -> Channel:
+        """Row ``r``'s state into its channel as :meth:`store` gives it back, but its process
+        values (6064h, 60FDh, 6041h...): for a caller whose next step on the channel makes
+        them again from that state (``Channel._outputs``: a drive switching its mode on its
+        row, gtecat.controller.bank_home_rows).  Returns the channel."""
+        ch = self.channels[r]
+        m = ch.mech
+        a, v = float(self.acc[r]), float(self.vel[r])
+        m.pos, m.vel, m.acc = float(self.pos[r]), v, a
+        m.torque = a / m.a_rated * 1000.0 + v * m.visc
+        m.limited = bool(self.limited[r])
+        ch.dpos, ch.dvel = float(self.dpos[r]), float(self.dvel[r])
+        ch.fe_time = float(self.fe_time[r])
+        ch.fe_flag = False
+        ch.sw_limited = bool(self.sw_limited[r])
+        ch.stopping = False
+        ch.limit_stop = bool(self.lstop[r])
+        ch.oms = SW12
+        ch.cycle += self.cycles - int(self.start[r])
+        self.start[r] = self.cycles
+        ch.target_position = int(self.target[r])
+        return ch
 
     def rested(self, r: int) -> None:
         """Give row ``r`` back after cycles the bank skipped whole (a frozen row: its channel

@@ -10,13 +10,18 @@ drives' process data buffers.  The calls: switched and left there, switched then
 gives the row back right after, switched and at once back to CSP, switched and homed
 (35 and 37), switched again after a homing, switched after a Trap move, switched while a
 drive fault is armed to come in the middle and while the drive's quick-stop input is held,
-and a row given back in the middle of its switch (before its first cycle, after it).
+and a row given back in the middle of its switch (before its first cycle, after it).  More:
+switched after its encoder was redefined (the switch drops the link's offset), after a Trap
+move that ended in the bank, after a raw write of its outputs (the same value, another one),
+with a touch probe armed, from CSV, back to CSP and at once to homing mode again, and homed
+on the row.  A switched row stays in the bank with its objects guarded, and its cycles ran
+in one run of the compiled kernel.
 """
 
 from __future__ import annotations
 
 import math
-from ctypes import byref, c_long, c_short
+from ctypes import byref, c_double, c_long, c_short, c_ubyte
 from typing import Any
 
 import numpy as np
@@ -24,8 +29,8 @@ import pytest
 
 from gtecat import faults, gt
 from gtecat.controller import bank_home_rows, bank_kernel
-from gtecat.controller.bank import AxisBank
-from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok
+from gtecat.controller.bank import _GUARD_SET, AxisBank
+from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
 from tests.gtecat.controller.test_bank_homing import _machine, _sample
 from tests.gtecat.controller.test_bank_homing_calls import _prm, _trap
 
@@ -75,6 +80,53 @@ CALLS: dict[int, list[Any]] = {
 }
 #: the axes whose objects are compared at the end
 DEEP = (1, 2, 3, 4, 5, 7, 12)
+
+
+def _raw_controlword(a: int, value: int) -> int:
+    """A raw write of axis ``a``'s 6040h low byte (the bank sees its outputs written)."""
+    e = gt.GTE_Controller().layout.axis_entry(a, 0x6040)
+    assert e is not None
+    return gt.GT_SetEcatRawData(e.gt_bit >> 3, 1, (c_ubyte * 1)(value))
+
+
+def _axis_enc() -> tuple[float, ...]:
+    """GT_GetAxisEncPos of every axis (through their encoders' links: an offset shows)."""
+    values = (c_double * AXES)()
+    _ok(gt.GT_GetAxisEncPos(1, values, AXES), "axis encoders")
+    return tuple(values)
+
+
+#: more switches (single-channel axes 1-4): from a row whose encoder was redefined (its link
+#: offset dropped by the switch), from a row whose Trap move ended in the bank, with the
+#: drive's outputs written raw just before, with a touch probe armed, from CSV, and to CSP
+#: again and back from a switched row
+MORE: dict[int, list[Any]] = {
+    3: [lambda: gt.GT_SetEncPos(1, 7_000), lambda: _trap(2)],
+    6: [lambda: gt.GT_SetHomingMode(1, 6)],
+    7: [_axis_enc],
+    8: [lambda: gt.GT_SetEncPos(1, 5_000)],  # its objects guarded again: the row goes back
+    10: [lambda: _raw_controlword(3, 0x0F), lambda: gt.GT_SetHomingMode(3, 6)],  # the same
+    12: [lambda: gt.GT_SetTouchProbeFunction(4, 0x0011)],
+    15: [lambda: gt.GT_SetHomingMode(4, 6)],  # a probe armed
+    20: [lambda: gt.GT_SetHomingMode(1, 8), lambda: gt.GT_SetHomingMode(3, 8)],
+    22: [lambda: _raw_controlword(3, 0x07), lambda: gt.GT_SetHomingMode(3, 6)],  # another
+    24: [lambda: gt.GT_SetHomingMode(1, 9)],
+    27: [lambda: gt.GT_SetHomingMode(1, 6)],  # from CSV
+    30: [lambda: gt.GT_SetHomingMode(1, 8), lambda: gt.GT_ClrSts(3), lambda: gt.GT_AxisOn(3)],
+    33: [lambda: gt.GT_SetHomingMode(1, 6), lambda: gt.GT_SetHomingMode(1, 8)],
+    36: [lambda: gt.GT_SetHomingMode(1, 6), lambda: _prm(1, 37)],
+    37: [lambda: gt.GT_StartEcatHoming(1)],
+    150: [lambda: gt.GT_SetHomingMode(1, 8)],
+    153: [lambda: gt.GT_SetEncPos(1, 3_000)],
+    156: [lambda: gt.GT_SetHomingMode(1, 6), lambda: _prm(1, 35)],
+    157: [lambda: gt.GT_StartEcatHoming(1)],  # homed on the row after its encoder's offset
+    158: [_axis_enc],
+    160: [lambda: gt.GT_SetHomingMode(3, 8)],
+    170: [lambda: gt.GT_SetHomingMode(2, 6)],  # its Trap move ended in the bank
+    172: [lambda: gt.GT_SetHomingMode(3, 6), lambda: _prm(2, 35)],
+    173: [lambda: gt.GT_StartEcatHoming(2)],
+}
+MORE_CYCLES = 180
 
 
 _PLAIN = (int, float, str, bool, bytes, type(None))
@@ -274,3 +326,51 @@ def test_a_switched_row_the_bank_would_not_take_goes_back(
     _same(ref, got)
     if HAS_CC and bank_kernel.wanted() != "numpy":
         assert len(refused) == 3
+
+
+@pytest.fixture(scope="module", params=["lockstep", "auto"])
+def more(request: pytest.FixtureRequest, machine: str) -> tuple:
+    clock = request.param
+    return tuple(
+        _run(machine, bank, clock, MORE, MORE_CYCLES, (1, 2, 3, 4)) for bank in ("off", "on")
+    )
+
+
+def test_more_switches_on_rows_match_the_scalar_drives(more: tuple) -> None:
+    ref, got = more
+    _same(ref, got)
+    _ran_on_rows(got, 6)
+    assert ref[0][-1][3][0] == 3  # axis 1 homed
+
+
+def test_a_switched_row_stays_in_the_bank_guarded(machine: str) -> None:
+    """A switch on the row runs its cycles in one run of the compiled kernel, keeps the row
+    (frozen in homing mode) and its objects' guards: touched from outside, it goes back."""
+    if not HAS_CC or bank_kernel.wanted() == "numpy":
+        pytest.skip("the switch runs on rows only with the compiled cycle")
+    try:
+        open_bus(str(ENI), machine, "on")
+        for a in range(1, AXES + 1):
+            _ok(gt.GT_AxisOn(a), f"axis on {a}")
+        gt.GTE_Wait(20)  # (every axis in the bank: the controller runs cycles its quick way)
+        bank = gt.GTE_Controller().bank
+        r = bank._row_of[id(gt.GTE_Controller().axes[1])]
+        runs: list[int] = []
+        run = bank.kernel.run
+
+        def counted(t_ns: int, dt: float, dt_ns: int, most: int) -> tuple[int, int]:
+            runs.append(most)
+            return run(t_ns, dt, dt_ns, most)
+
+        bank.kernel.run = counted
+        releases, switches = bank.releases, bank.home_switches
+        _ok(gt.GT_SetHomingMode(1, 6), "mode")
+        assert runs == [2]  # (6060h taken in the first cycle, shown after the second)
+        assert bank.home_switches == switches + 1 and bank.releases == releases
+        assert bank.alive[r] and bank.frz[r]
+        g = bank.groups[bank.group_of[r]]
+        assert all(type(obj) in _GUARD_SET for obj in bank._guarded_objects(g))
+        bank.res[r].encoder.pos += 0.0  # (anything reaching an object gives the row back)
+        assert not bank.alive[r]
+    finally:
+        gt.GT_Close()
