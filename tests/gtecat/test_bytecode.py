@@ -7,35 +7,42 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from gtecat import _bytecode
 
 
-def test_a_module_is_compiled_once_and_again_when_its_source_changes(tmp_path: Path) -> None:
-    cache = tmp_path / "cache"
+@pytest.fixture
+def cache(tmp_path: Path):
+    """The modules' cache folder of these tests (the process's own put back after)."""
     old = list(_bytecode._DIR)
-    _bytecode._DIR[:] = [cache]
-    try:
-        src = tmp_path / "mod.py"
-        src.write_text("X = 1\n")
-        loader = _bytecode._Loader("gtecat_probe", str(src))
-        ns: dict = {}
-        exec(loader.get_code("gtecat_probe"), ns)
-        assert ns["X"] == 1
-        (first,) = cache.iterdir()
-        ns = {}
-        exec(loader.get_code("gtecat_probe"), ns)
-        assert ns["X"] == 1 and list(cache.iterdir()) == [first]
-        src.write_text("X = 2\n")  # another source: another file, never the old code
-        ns = {}
-        exec(loader.get_code("gtecat_probe"), ns)
-        assert ns["X"] == 2 and len(list(cache.iterdir())) == 2
-        for f in cache.iterdir():
-            f.write_bytes(b"not marshal data")  # damaged: compiled again
-        ns = {}
-        exec(loader.get_code("gtecat_probe"), ns)
-        assert ns["X"] == 2
-    finally:
-        _bytecode._DIR[:] = old
+    _bytecode._DIR[:] = [tmp_path / "cache"]
+    yield tmp_path / "cache"
+    _bytecode._DIR[:] = old
+
+
+def test_a_module_is_compiled_once_and_again_when_its_source_changes(
+    tmp_path: Path, cache: Path
+) -> None:
+    src = tmp_path / "mod.py"
+    src.write_text("X = 1\n")
+    loader = _bytecode._Loader("gtecat_probe", str(src))
+    ns: dict = {}
+    exec(loader.get_code("gtecat_probe"), ns)
+    assert ns["X"] == 1
+    (first,) = cache.iterdir()
+    ns = {}
+    exec(loader.get_code("gtecat_probe"), ns)
+    assert ns["X"] == 1 and list(cache.iterdir()) == [first]
+    src.write_text("X = 2\n")  # another source: another file, never the old code
+    ns = {}
+    exec(loader.get_code("gtecat_probe"), ns)
+    assert ns["X"] == 2 and len(list(cache.iterdir())) == 2
+    for f in cache.iterdir():
+        f.write_bytes(b"not marshal data")  # damaged: compiled again
+    ns = {}
+    exec(loader.get_code("gtecat_probe"), ns)
+    assert ns["X"] == 2
 
 
 def test_only_where_python_writes_no_bytecode(tmp_path: Path) -> None:
@@ -108,7 +115,7 @@ def test_dataclass_methods_kept_compiled(tmp_path: Path, monkeypatch) -> None:
     check(define("gtecat._probe_dc3"))  # compiled again
 
 
-def test_a_current_installed_bytecode_file_is_read_first(tmp_path: Path) -> None:
+def test_a_current_installed_bytecode_file_is_read_first(tmp_path: Path, cache: Path) -> None:
     """``pip install`` writes each module's ``__pycache__`` file: where it is current (the
     source's time and size in its header, this Python's magic) its code is taken, nothing is
     compiled or kept; a stale, damaged, hash-based or foreign one is passed over."""
@@ -116,48 +123,42 @@ def test_a_current_installed_bytecode_file_is_read_first(tmp_path: Path) -> None
     import py_compile
 
     _STAMP = py_compile.PycInvalidationMode.TIMESTAMP  # (as pip writes them)
-    cache = tmp_path / "cache"
-    old = list(_bytecode._DIR)
-    _bytecode._DIR[:] = [cache]
-    try:
-        src = tmp_path / "mod.py"
-        src.write_text("X = 1\n")
-        pyc = Path(py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP))
-        # (the file's code says X = 3: proof that it, not the source, was read)
-        data = bytearray(pyc.read_bytes())
-        code = compile("X = 3\n", str(src), "exec")
-        pyc.write_bytes(bytes(data[:16]) + marshal.dumps(code))
-        loader = _bytecode._Loader("gtecat_probe", str(src))
-        ns: dict = {}
-        exec(loader.get_code("gtecat_probe"), ns)
-        assert ns["X"] == 3 and not cache.exists()
+    src = tmp_path / "mod.py"
+    src.write_text("X = 1\n")
+    pyc = Path(py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP))
+    # (the file's code says X = 3: proof that it, not the source, was read)
+    data = bytearray(pyc.read_bytes())
+    code = compile("X = 3\n", str(src), "exec")
+    pyc.write_bytes(bytes(data[:16]) + marshal.dumps(code))
+    loader = _bytecode._Loader("gtecat_probe", str(src))
+    ns: dict = {}
+    exec(loader.get_code("gtecat_probe"), ns)
+    assert ns["X"] == 3 and not cache.exists()
 
-        # another source of another size: stale, compiled from the source and kept
-        src.write_text("X = 22\n")
-        ns = {}
-        exec(loader.get_code("gtecat_probe"), ns)
-        assert ns["X"] == 22 and len(list(cache.iterdir())) == 1
-        assert _bytecode._installed(str(src)) is None
+    # another source of another size: stale, compiled from the source and kept
+    src.write_text("X = 22\n")
+    ns = {}
+    exec(loader.get_code("gtecat_probe"), ns)
+    assert ns["X"] == 22 and len(list(cache.iterdir())) == 1
+    assert _bytecode._installed(str(src)) is None
 
-        fresh = pyc.read_bytes() if py_compile.compile(
-            str(src), doraise=True, invalidation_mode=_STAMP
-        ) else b""
-        assert _bytecode._installed(str(src)) is not None
-        for header in (
-            b"\0\0\0\0" + fresh[4:16],  # another Python's magic
-            fresh[:4] + b"\1\0\0\0" + fresh[8:16],  # hash-based
-            fresh[:8] + (int.from_bytes(fresh[8:12], "little") + 1).to_bytes(4, "little")
-            + fresh[12:16],  # another source time
-        ):
-            pyc.write_bytes(header + fresh[16:])
-            assert _bytecode._installed(str(src)) is None
-        py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
-        assert _bytecode._installed(str(src)) is not None
-        pyc.write_bytes(pyc.read_bytes()[:20])  # cut short: damaged
+    py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
+    fresh = pyc.read_bytes()
+    assert _bytecode._installed(str(src)) is not None
+    for header in (
+        b"\0\0\0\0" + fresh[4:16],  # another Python's magic
+        fresh[:4] + b"\1\0\0\0" + fresh[8:16],  # hash-based
+        fresh[:8]
+        + (int.from_bytes(fresh[8:12], "little") + 1).to_bytes(4, "little")
+        + fresh[12:16],  # another source time
+    ):
+        pyc.write_bytes(header + fresh[16:])
         assert _bytecode._installed(str(src)) is None
-        foreign = compile("X = 5\n", "elsewhere.py", "exec")
-        py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
-        pyc.write_bytes(pyc.read_bytes()[:16] + marshal.dumps(foreign))
-        assert _bytecode._installed(str(src)) is None
-    finally:
-        _bytecode._DIR[:] = old
+    py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
+    assert _bytecode._installed(str(src)) is not None
+    pyc.write_bytes(pyc.read_bytes()[:20])  # cut short: damaged
+    assert _bytecode._installed(str(src)) is None
+    foreign = compile("X = 5\n", "elsewhere.py", "exec")
+    py_compile.compile(str(src), doraise=True, invalidation_mode=_STAMP)
+    pyc.write_bytes(pyc.read_bytes()[:16] + marshal.dumps(foreign))
+    assert _bytecode._installed(str(src)) is None
