@@ -10,9 +10,10 @@ as is libgts (:mod:`gtecat.native.build`), with ``$CC`` (else ``cc``, ``gcc``, `
 into ``$GTECAT_CACHE_DIR`` (else ``$XDG_CACHE_HOME/gtecat``, else ``~/.cache/gtecat``)
 ``/<version>/``.  Here are the pieces they share: where the cache is, which compiler, and a
 one-file shared library build named by the digest of its source, compiler and flags (a lock
-file serialises concurrent builders), looked for in the package, then in the cache
-(:func:`found`), else built in this process (:func:`shared_library`) or in one of its own
-that outlives it (:class:`Background`).
+file serialises concurrent builders), looked for in the package (or, for a source tree
+installed beside, in the installed copy), then in the cache (:func:`found`), else built in
+this process (:func:`shared_library`) or in one of its own that outlives it
+(:class:`Background`).
 
 A build works in a folder ``<cache>/<version>/.build-XXXX/`` beside its owner file
 ``.build-XXXX.log`` (the background builder's error output), and holds a lock on that file
@@ -281,7 +282,7 @@ def found(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]
     the compiler that built them gives (they need none to load)."""
     cc, _ = find_compiler()
     if cc is None:
-        cc = prebuilt_compiler(PREBUILT)
+        cc = prebuilt_compiler(_prebuilt_folder())
         return None if cc is None else _prebuilt(library_name(stem, source, cc, cflags, libs))
     name = library_name(stem, source, cc, cflags, libs)
     ready = _prebuilt(name)
@@ -290,10 +291,35 @@ def found(stem: str, source: str, cflags: tuple[str, ...], libs: tuple[str, ...]
     return ready
 
 
+#: the installed distribution's prebuilt parts, looked for once (see :func:`_prebuilt_folder`)
+_INSTALLED: list[Path | None] = []
+
+
+def _prebuilt_folder() -> Path:
+    """The package's prebuilt parts: its own folder, or - where this gtecat runs from a
+    source tree that has none (a checkout whose tests run beside ``pip install .`` of it,
+    as the README's test command does) - the installed distribution's.  A part is taken
+    only by its name, the digest of its source, compiler and flags, so one of the installed
+    copy's serves only where this tree's source is the same: what it would compile."""
+    if PREBUILT.is_dir():
+        return PREBUILT
+    if not _INSTALLED:
+        other = None
+        try:
+            from importlib.metadata import PackageNotFoundError, distribution
+
+            with contextlib.suppress(PackageNotFoundError):
+                other = Path(str(distribution("gtecat").locate_file("gtecat/_prebuilt")))
+        except (ImportError, OSError, ValueError):
+            other = None
+        _INSTALLED.append(other if other is not None and other.is_dir() else None)
+    return _INSTALLED[0] or PREBUILT
+
+
 def _prebuilt(name: str) -> Path | None:
     """The package's build ``name`` where it is there and intact; one that fails its check
     (a damaged installation) is left alone with a warning: the cache's build is taken."""
-    lib = PREBUILT / name
+    lib = _prebuilt_folder() / name
     why = _flaw(lib)
     if not why:
         return lib

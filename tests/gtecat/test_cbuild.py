@@ -240,3 +240,36 @@ def test_without_a_compiler_the_prebuilt_parts_are_found_by_the_name_their_compi
         cbuild.shared_library("part", SOURCE, ("-O2",), ())
     (prebuilt / cparts.COMPILER_FILE).unlink()  # (a folder without it: nothing is taken)
     assert cbuild.found(*job) is None
+
+
+def test_a_source_tree_takes_the_installed_copys_part_of_the_same_build(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A checkout run beside ``pip install .`` of it (the README's test command: its tests
+    import the tree's gtecat, which has no prebuilt folder) takes the installed
+    distribution's part of the same name, and only that: another source is compiled."""
+    import importlib.metadata
+
+    installed = tmp_path / "site" / "gtecat" / "_prebuilt"
+    installed.mkdir(parents=True)
+
+    class Dist:
+        def locate_file(self, path: str) -> Path:
+            return tmp_path / "site" / path
+
+    monkeypatch.setattr(importlib.metadata, "distribution", lambda name: Dist())
+    monkeypatch.setattr(cbuild, "PREBUILT", tmp_path / "tree" / "_prebuilt")  # (none)
+    monkeypatch.setattr(cbuild, "_INSTALLED", [])
+    cc = _cc(tmp_path, 'echo built > "$out"')
+    monkeypatch.setenv("CC", str(cc))
+    job = ("part", SOURCE, ("-O3",), ())
+    lib = _prebuild(installed, [str(cc)], job)
+    assert cbuild.found(*job) == lib and cbuild.shared_library(*job) == lib
+    assert not (tmp_path / "cc.log").exists()
+    changed = ("part", SOURCE + "int g(void) { return 2; }\n", ("-O3",), ())
+    assert cbuild.shared_library(*changed) == cbuild.library_path(*changed)
+    assert len((tmp_path / "cc.log").read_text().splitlines()) == 1
+    # (the tree's own folder, where there is one, is the only one looked in)
+    monkeypatch.setattr(cbuild, "PREBUILT", installed.parent / "empty")
+    (installed.parent / "empty").mkdir()
+    assert cbuild.found(*job) is None
