@@ -304,15 +304,20 @@ def _prebuilt_folder() -> Path:
     if PREBUILT.is_dir():
         return PREBUILT
     if not _INSTALLED:
+        # (every distribution of the name: the tree's own build metadata, found first from
+        # a checkout's folder, locates in the tree)
         other = None
         try:
-            from importlib.metadata import PackageNotFoundError, distribution
+            from importlib.metadata import distributions
 
-            with contextlib.suppress(PackageNotFoundError):
-                other = Path(str(distribution("gtecat").locate_file("gtecat/_prebuilt")))
+            for dist in distributions(name="gtecat"):
+                folder = Path(str(dist.locate_file("gtecat/_prebuilt")))
+                if folder.is_absolute() and folder.is_dir():
+                    other = folder
+                    break
         except (ImportError, OSError, ValueError):
             other = None
-        _INSTALLED.append(other if other is not None and other.is_dir() else None)
+        _INSTALLED.append(other)
     return _INSTALLED[0] or PREBUILT
 
 

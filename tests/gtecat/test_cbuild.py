@@ -254,10 +254,15 @@ def test_a_source_tree_takes_the_installed_copys_part_of_the_same_build(
     installed.mkdir(parents=True)
 
     class Dist:
-        def locate_file(self, path: str) -> Path:
-            return tmp_path / "site" / path
+        def __init__(self, root: Path) -> None:
+            self.root = root
 
-    monkeypatch.setattr(importlib.metadata, "distribution", lambda name: Dist())
+        def locate_file(self, path: str) -> Path:
+            return self.root / path
+
+    # (the tree's own build metadata first, as from a checkout's folder: relative, no parts)
+    dists = [Dist(Path()), Dist(tmp_path / "site")]
+    monkeypatch.setattr(importlib.metadata, "distributions", lambda name: iter(dists))
     monkeypatch.setattr(cbuild, "PREBUILT", tmp_path / "tree" / "_prebuilt")  # (none)
     monkeypatch.setattr(cbuild, "_INSTALLED", [])
     cc = _cc(tmp_path, 'echo built > "$out"')
