@@ -321,17 +321,24 @@ def _prebuilt_folder() -> Path:
     return _INSTALLED[0] or PREBUILT
 
 
+#: the damaged prebuilt parts warned of in this process (once each)
+_WARNED: set[Path] = set()
+
+
 def _prebuilt(name: str) -> Path | None:
     """The package's build ``name`` where it is there and intact; one that fails its check
-    (a damaged installation) is left alone with a warning: the cache's build is taken."""
+    (a damaged installation) is left alone with a warning, once per process: the cache's
+    build is taken (or made, where there is a compiler; else the Python path runs)."""
     lib = _prebuilt_folder() / name
     why = _flaw(lib)
     if not why:
         return lib
-    if why != "not there":
+    if why != "not there" and lib not in _WARNED:
+        _WARNED.add(lib)
         log.warning(
-            "%s, built with the package, fails its check (%s): the build cache's is used "
-            "(reinstalling gtecat mends it)",
+            "%s, built with the package, fails its check (%s): not loaded; a build of the "
+            "cache is used where there is one or a compiler can make it, else gtecat's Python "
+            "path (reinstalling gtecat mends it)",
             lib,
             why,
         )
