@@ -25,8 +25,14 @@ _PROBE = (
 def _after(code: str, **env_extra: str) -> tuple[str | None, int]:
     env = {k: v for k, v in os.environ.items() if k not in _NAMES}
     env.update(env_extra)
-    out = subprocess.run([sys.executable, "-c", _PROBE.format(code=code)], env=env,
-                         capture_output=True, text=True, timeout=60, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", _PROBE.format(code=code)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
     count, threads = json.loads(out.stdout)
     return count, threads
 

@@ -100,9 +100,7 @@ _FOREVER = (
         "shell",
     ],
 )
-def test_a_recording_ended_by_sigterm_is_written_and_replays(
-    tmp_path: Path, how: str
-) -> None:
+def test_a_recording_ended_by_sigterm_is_written_and_replays(tmp_path: Path, how: str) -> None:
     """A CI job's time-out sends SIGTERM: the session up to there is kept (before, nothing
     was written).  ``script``: run inside gtecat record; ``child``: a command it starts;
     ``shell``: a shell that starts the program without ``exec`` (the shell dies of the
@@ -121,7 +119,9 @@ def test_a_recording_ended_by_sigterm_is_written_and_replays(
         cmd = ["sh", "-c", f'"{sys.executable}" "{app}"; echo after']
     rec = subprocess.Popen(
         [sys.executable, "-m", "gtecat", "record", "-o", str(out), "--", *cmd],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         assert rec.stdout is not None

@@ -183,9 +183,9 @@ def test_a_forked_child_reaches_the_controller_once_it_opens(tmp_path, inproc):
     exe = compile_client(src, tmp_path / "fork", "gcc")
     r, v = run_client(exe, env=native_env(GTECAT_INPROCESS=inproc), cwd=tmp_path, timeout=120)
     assert v.get("open") == "0", r.stdout + r.stderr
-    assert v["child_before_open"].startswith("-1 ") and "has not opened" in v[
-        "child_before_open"
-    ], r.stdout
+    assert (
+        v["child_before_open"].startswith("-1 ") and "has not opened" in v["child_before_open"]
+    ), r.stdout
     assert v["child_open"] == "0", r.stdout
     # (the bus is not started: both get the controller's own answer, not -1)
     assert v["child_sts"] == v["parent_sts"] != "-1", r.stdout
