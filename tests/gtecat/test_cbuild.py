@@ -249,21 +249,10 @@ def test_a_source_tree_takes_the_installed_copys_part_of_the_same_build(
     """A checkout run beside ``pip install .`` of it (the README's test command: its tests
     import the tree's gtecat, which has no prebuilt folder) takes the installed
     distribution's part of the same name, and only that: another source is compiled."""
-    import importlib.metadata
-
     installed = tmp_path / "site" / "gtecat" / "_prebuilt"
     installed.mkdir(parents=True)
-
-    class Dist:
-        def __init__(self, root: Path) -> None:
-            self.root = root
-
-        def locate_file(self, path: str) -> Path:
-            return self.root / path
-
-    # (the tree's own build metadata first, as from a checkout's folder: relative, no parts)
-    dists = [Dist(Path()), Dist(tmp_path / "site")]
-    monkeypatch.setattr(importlib.metadata, "distributions", lambda name: iter(dists))
+    # (the checkout's folder first on the path, as from a checkout: no parts there)
+    monkeypatch.setattr(sys, "path", ["", str(tmp_path / "tree"), str(tmp_path / "site")])
     monkeypatch.setattr(cbuild, "PREBUILT", tmp_path / "tree" / "_prebuilt")  # (none)
     monkeypatch.setattr(cbuild, "_INSTALLED", [])
     cc = _cc(tmp_path, 'echo built > "$out"')
