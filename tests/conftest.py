@@ -163,6 +163,14 @@ EXAMPLES = ROOT / "examples"
 SHARED_FIXTURES = ROOT.parent / "shared" / "fixtures"
 
 
+def is_setting(name: str) -> bool:
+    """Whether environment variable ``name`` is a gtecat setting a test clears to run a
+    process on the defaults (``GTECAT_*``), the cache folder excepted: it says where gtecat
+    keeps what it builds, not how it runs, so the test's process builds where the run does
+    (a run given its own folder writes nothing into the user's)."""
+    return name.startswith("GTECAT_") and name != "GTECAT_CACHE_DIR"
+
+
 def needs_fixture(what: object) -> str:
     """The skip reason of a test that reads the vendors' sample files: they are not shipped
     with gtecat (a repository checkout keeps them in a fixtures folder beside it)."""

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
-from tests.conftest import LONG
+from tests.conftest import LONG, is_setting
 
 from .tutorial_runner import blocks, matches, run_page
 
@@ -35,7 +35,7 @@ def user_env() -> dict[str, str]:
     return {
         k: v
         for k, v in os.environ.items()
-        if not k.startswith("GTECAT_") and k not in ("PYTHONPATH", "PYTHONSTARTUP")
+        if not is_setting(k) and k not in ("PYTHONPATH", "PYTHONSTARTUP")
     }
 
 
@@ -131,7 +131,7 @@ def test_no_internal_references_in_what_users_read() -> None:
 # --- the runner itself ----------------------------------------------------------------------
 @pytest.fixture
 def workdir(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    for k in [k for k in os.environ if k.startswith("GTECAT_")]:
+    for k in [k for k in os.environ if is_setting(k)]:
         monkeypatch.delenv(k)
     monkeypatch.chdir(tmp_path)
     gt.GT_Close()

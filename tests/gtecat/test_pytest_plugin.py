@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import is_setting
+
 TESTS = textwrap.dedent(
     """
     import pytest
@@ -75,7 +77,7 @@ TESTS = textwrap.dedent(
 
 
 def _pytest(folder: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env = {k: v for k, v in os.environ.items() if not is_setting(k)}
     env.pop("PYTHONPATH", None)
     return subprocess.run(
         [sys.executable, "-P", "-m", "pytest", "-p", "no:cacheprovider", "-q", *args],

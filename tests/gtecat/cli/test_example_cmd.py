@@ -21,7 +21,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli import example_cmd
-from tests.conftest import EXAMPLES, ROOT
+from tests.conftest import EXAMPLES, ROOT, is_setting
 
 from .conftest import Cli
 
@@ -130,7 +130,7 @@ def test_a_unique_prefix_is_enough(cli: Cli, tmp_path: Path) -> None:
 @pytest.fixture
 def clean_env(monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
     for k in list(os.environ):
-        if k.startswith("GTECAT_"):
+        if is_setting(k):
             monkeypatch.delenv(k)
     return {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
 

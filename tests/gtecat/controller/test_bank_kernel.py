@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from gtecat.controller import bank_kernel
+from tests.conftest import is_setting
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -44,7 +45,7 @@ gt.GT_Close()
 
 
 def _run(tmp_path: Path, **env: str) -> dict:
-    e = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    e = {k: v for k, v in os.environ.items() if not is_setting(k)}
     e["PYTHONPATH"] = str(ROOT)
     e["GTECAT_CACHE_DIR"] = str(tmp_path / "cache")  # nothing built before
     e.update(env)

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from tests.conftest import is_setting
+
 ROOT = Path(__file__).resolve().parents[3]
 
 PROGRAM = r"""
@@ -33,7 +35,7 @@ def test_fault_tables_are_armed_with_the_package_imported_on_demand(tmp_path: Pa
     plain.write_text("[axis.1]\nposition = 0\n")
     tables = tmp_path / "faults.toml"
     tables.write_text('[[fault]]\nkind = "drive_fault"\naxis = 1\ncode = 0x3220\nat_ms = 50\n')
-    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env = {k: v for k, v in os.environ.items() if not is_setting(k)}
     env["PYTHONPATH"] = str(ROOT)
     eni = ROOT / "examples" / "manual_fig5_2.eni"
     r = subprocess.run(

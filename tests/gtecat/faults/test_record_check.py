@@ -15,7 +15,7 @@ import pytest
 
 from gtecat import gt
 from gtecat.cli.main import main
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, is_setting
 
 SCRIPT = textwrap.dedent(
     f"""
@@ -237,7 +237,7 @@ PLUGIN_TESTS = textwrap.dedent(
 def test_plugin_fixture_record_and_check(tmp_path: Path) -> None:
     (tmp_path / "test_m.py").write_text(PLUGIN_TESTS)
     (tmp_path / "pytest.ini").write_text("[pytest]\ngtecat_eni = full_servo\n")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env = {k: v for k, v in os.environ.items() if not is_setting(k)}
     done = subprocess.run(
         [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-n", "0",
          "--gtecat-record", "--gtecat-check", "--gtecat-trace-dir", "traces", "-s"],

@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from gtecat.native import header
+from tests.conftest import is_setting
 
 needs_cc = pytest.mark.skipif(
     shutil.which("gcc") is None, reason="no C compiler (gcc) on PATH: the C tests cannot run"
@@ -75,7 +76,7 @@ def tool_pythonpath() -> str:
 def native_env(**extra: str) -> dict[str, str]:
     """The environment of a native client: the manual's figure 5-2 bus, auto clock, no
     controller named (the library starts its own)."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env = {k: v for k, v in os.environ.items() if not is_setting(k)}
     env.update(PATH=tool_path(), PYTHONPATH=tool_pythonpath())
     env.update(GTECAT_ENI=str(FIG5_2), GTECAT_CLOCK="auto", GTECAT_LOG="")
     env.update(extra)

@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from gtecat import gt
+from tests.conftest import is_setting
 
 from .conftest import FIG5_2, needs_cc
 
@@ -53,7 +54,7 @@ def _end_private_controllers() -> None:
 @pytest.fixture
 def env(monkeypatch):
     for k in list(os.environ):
-        if k.startswith("GTECAT_"):
+        if is_setting(k):
             monkeypatch.delenv(k)
     monkeypatch.setenv("GTECAT_ENI", str(FIG5_2))
     monkeypatch.setenv("GTECAT_CLOCK", "auto")

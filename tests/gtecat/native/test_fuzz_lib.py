@@ -14,6 +14,7 @@ import pytest
 
 from gtecat.gt import _core
 from gtecat.native import protocol
+from tests.conftest import is_setting
 
 from .conftest import ROOT, needs_cc
 from .fuzz_lib_worker import SKIP
@@ -39,7 +40,7 @@ def _eligible() -> list[str]:
 @pytest.mark.long
 def test_bad_input_through_the_library_gets_the_python_codes(libgts, batch):
     names = _eligible()[batch::BATCHES]
-    env = {k: v for k, v in os.environ.items() if not k.startswith("GTECAT_")}
+    env = {k: v for k, v in os.environ.items() if not is_setting(k)}
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
     cmd = [sys.executable, "-m", "tests.gtecat.native.fuzz_lib_worker", "--examples"]
     try:
