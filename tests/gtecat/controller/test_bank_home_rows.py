@@ -239,6 +239,13 @@ def _same(ref: tuple, got: tuple) -> None:
     assert not diff, f"objects differ: {[(p, ref[1].get(p), got[1].get(p)) for p in diff[:5]]}"
 
 
+def _all_on(machine: str) -> None:
+    """The 12-axis bus with the bank on (lockstep, :func:`open_bus`), every axis enabled."""
+    open_bus(str(ENI), machine, "on")
+    for a in range(1, AXES + 1):
+        _ok(gt.GT_AxisOn(a), f"axis on {a}")
+
+
 def _ran_on_rows(got: tuple, least: int) -> None:
     """Without this the comparison could pass with no switch ever run on a row."""
     if HAS_CC and bank_kernel.wanted() != "numpy":
@@ -349,9 +356,7 @@ def test_a_switched_row_stays_in_the_bank_guarded(machine: str) -> None:
     if not HAS_CC or bank_kernel.wanted() == "numpy":
         pytest.skip("the switch runs on rows only with the compiled cycle")
     try:
-        open_bus(str(ENI), machine, "on")
-        for a in range(1, AXES + 1):
-            _ok(gt.GT_AxisOn(a), f"axis on {a}")
+        _all_on(machine)
         gt.GTE_Wait(20)  # (every axis in the bank: the controller runs cycles its quick way)
         bank = gt.GTE_Controller().bank
         r = bank._row_of[id(gt.GTE_Controller().axes[1])]
