@@ -106,6 +106,9 @@ def _wine_prefix(bits: int) -> Path:
     from gtecat.cbuild import cache_root
 
     root = cache_root() / ("wine32" if bits == 32 else "wine")
+    kernel32 = root / "drive_c" / "windows" / "system32" / "kernel32.dll"
+    if kernel32.is_symlink() and not kernel32.exists():  # Wine moved: its links are dead
+        shutil.rmtree(root)
     if not root.exists():
         _bare_prefix(root, bits)
     return root
@@ -118,10 +121,12 @@ def _wine_dlls(arch: str) -> Path | None:
     wine = shutil.which("wine")
     bases = [Path(wine).resolve().parent.parent] if wine else []
     for base in [*bases, Path("/usr"), Path("/usr/local")]:
-        for found in sorted(base.glob(f"lib*/wine/{arch}-windows/kernel32.dll")) + sorted(
-            base.glob(f"lib*/*/wine/{arch}-windows/kernel32.dll")
-        ):
-            return found.parent
+        found = [
+            *base.glob(f"lib*/wine/{arch}-windows/kernel32.dll"),
+            *base.glob(f"lib*/*/wine/{arch}-windows/kernel32.dll"),
+        ]
+        if found:  # the triplet of the architecture first (lib/i386-linux-gnu for i386)
+            return min(found, key=lambda dll: (f"/{arch}" not in str(dll.parents[2]), dll)).parent
     return None
 
 
