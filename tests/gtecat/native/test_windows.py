@@ -235,15 +235,16 @@ def test_windows_programs_under_wine_match_the_linux_library(
     # the same program built for Linux against libgts, to run over the same TCP transport
     # (the C clients' executable: compiled once for the run)
     linux_exe = compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
-    env = _wine_env(GTECAT_CONTROLLER=tcp_controller.replace("tcp:", "tcp://"), GTECAT_TOKEN=TOKEN)
-    r, win = _wine(programs["gtn"], env)
-    assert r.returncode == 0 and win.get("done") == "1", r.stdout + r.stderr
     r2, lin = run_client(
         linux_exe,
         env=native_env(GTECAT_CONTROLLER=tcp_controller, GTECAT_TOKEN=TOKEN),
         cwd=tmp_path,
     )
     assert r2.returncode == 0 and lin.get("done") == "1", r2.stdout + r2.stderr
+    # the Windows programs one after the other: one Wine session (its server, its services)
+    env = _wine_env(GTECAT_CONTROLLER=tcp_controller.replace("tcp:", "tcp://"), GTECAT_TOKEN=TOKEN)
+    r, win = _wine(programs["gtn"], env)
+    assert r.returncode == 0 and win.get("done") == "1", r.stdout + r.stderr
     same = {k: v for k, v in win.items() if k not in TIMING}
     assert same == {k: v for k, v in lin.items() if k not in TIMING}
     # and they are the codes and values the Linux tests expect of this sequence
