@@ -12,6 +12,7 @@ the flood: 100 concurrent unauthenticated connections and 100,000 bad messages.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import random
@@ -106,11 +107,10 @@ def _wine_prefix(bits: int) -> Path:
     from gtecat.cbuild import cache_root
 
     root = cache_root() / ("wine32" if bits == 32 else "wine")
-    kernel32 = root / "drive_c" / "windows" / "system32" / "kernel32.dll"
-    if kernel32.is_symlink() and not kernel32.exists():  # Wine moved: its links are dead
-        shutil.rmtree(root)
-    if not root.exists():
-        _bare_prefix(root, bits)
+    stamp = root / ".update-timestamp"
+    bare = stamp.is_file() and stamp.read_text().strip() == "disable"
+    if not (bare and (root / "drive_c" / "windows" / "system32" / "kernel32.dll").exists()):
+        _bare_prefix(root, bits)  # none yet, an earlier run's (Wine's own), or Wine moved
     return root
 
 
@@ -137,7 +137,9 @@ def _bare_prefix(root: Path, bits: int) -> None:
     first run, most of it the kernel copying them), and a ``.update-timestamp`` of
     ``disable``, which tells Wine not to fill the prefix (the registry of ``wine.inf``,
     which these programs never read).  Where the DLLs are not found, Wine makes its usual
-    prefix on first use.  Made beside and renamed into place: two runs at once keep one."""
+    prefix on first use.  Made beside and renamed into place (two runs at once keep one),
+    in the place of an earlier run's prefix (Wine's own: 0.6 GB, and each Wine session in
+    it takes ~0.7 s of CPU instead of ~0.1 s)."""
     folders = {"system32": "i386"} if bits == 32 else {"system32": "x86_64", "syswow64": "i386"}
     dlls = {name: _wine_dlls(arch) for name, arch in folders.items()}
     if None in dlls.values():
@@ -150,10 +152,14 @@ def _bare_prefix(root: Path, bits: int) -> None:
         for dll in source.iterdir():
             (folder / dll.name).symlink_to(dll)
     (tmp / ".update-timestamp").write_text("disable\n")
+    old = root.with_name(f"{root.name}.{os.getpid()}.old")
+    with contextlib.suppress(OSError):
+        root.rename(old)  # the prefix of an earlier run, put aside, then removed
     try:
         tmp.rename(root)
     except OSError:  # another run made it meanwhile
         shutil.rmtree(tmp, ignore_errors=True)
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def _wine(exe: Path, env: dict[str, str]) -> tuple[subprocess.CompletedProcess, dict[str, str]]:
