@@ -149,7 +149,7 @@ class DecodedFrame:
 
 #: a datagram's header: Cmd, Idx, ADP, ADO, the Len/C/M word, IRQ (ETG.1000.4 5.4)
 _DATAGRAM_HEADER = struct.Struct("<BBHHHH")
-_ECAT_TYPE = (ETHERTYPE_ECAT.to_bytes(2, "big"), FRAME_TYPE_DLPDU << 12)
+_ETHERTYPE_BYTES = ETHERTYPE_ECAT.to_bytes(2, "big")
 
 
 def encode_frame(
@@ -171,8 +171,7 @@ def encode_frame(
         raise FrameError(f"datagrams need {length} bytes, a frame holds {MAX_ECAT_LEN}")
     if len(dst) != 6 or len(src) != 6:
         raise FrameError(f"cannot encode frame: MAC addresses of {len(dst)} and {len(src)} bytes")
-    ethertype, frame_type = _ECAT_TYPE
-    parts = [bytes(dst), bytes(src), ethertype, _U16.pack(frame_type | length)]
+    parts = [bytes(dst), bytes(src), _ETHERTYPE_BYTES, _U16.pack(FRAME_TYPE_DLPDU << 12 | length)]
     last = len(datagrams) - 1
     try:
         for i, d in enumerate(datagrams):
