@@ -47,6 +47,12 @@ COMMANDS = (
 )
 
 
+#: the verbs that a module of another name adds (a verb's module is else ``VERB_cmd``); a verb
+#: not found where it is looked for runs all the same, after every verb's parser is built
+#: (every verb's parser takes eight times as long as one module's)
+_VERB_MODULES = {"slaves": "bus_cmd", "pdos": "bus_cmd", "sdo": "bus_cmd"}
+
+
 def build_parser(verb: str | None = None) -> argparse.ArgumentParser:
     """The whole command line; ``verb``: only that verb's module is imported and its parser
     added, when its module (``VERB_cmd``) gives it (a run of one verb needs no other), else
@@ -66,8 +72,9 @@ def build_parser(verb: str | None = None) -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"gtecat {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    if verb is not None and f"{verb}_cmd" in COMMANDS:
-        _add_verbs(sub, f"{verb}_cmd")
+    name = _VERB_MODULES.get(verb, f"{verb}_cmd")
+    if verb is not None and name in COMMANDS:
+        _add_verbs(sub, name)
         if verb in sub.choices:
             return parser
         return build_parser()

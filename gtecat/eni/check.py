@@ -116,8 +116,11 @@ def check_config(cfg: EniConfig) -> None:
                 )
             seen[addr] = s
 
-    # (start, end, slave, label) per direction
-    spans: dict[Direction, list[tuple[int, int, Slave, str]]] = {d: [] for d in Direction}
+    # (start, end, slave, (pdo, index, subindex)) per direction: the entry's label is made
+    # from the plain tuple only for a message (a tuple subclass made per entry costs more)
+    spans: dict[Direction, list[tuple[int, int, Slave, tuple[int, int, int]]]] = {
+        d: [] for d in Direction
+    }
     for s in cfg.slaves:
         for d, pdos, area in (
             (Direction.OUT, s.rx_pdos, s.outputs),
@@ -134,9 +137,9 @@ def check_config(cfg: EniConfig) -> None:
                         f"PDO 0x{p.index:04X}",
                     )
                 for e in p.entries:
-                    label = _EntryLabel(p.index, e.index, e.subindex)
+                    where = (p.index, e.index, e.subindex)
                     if e.bit_len <= 0:
-                        raise _err(cfg, s, "entry with no bits", str(label))
+                        raise _err(cfg, s, "entry with no bits", str(_EntryLabel(*where)))
                     if not e.is_padding:
                         key = (e.index, e.subindex)
                         if key in seen_obj:
@@ -145,7 +148,7 @@ def check_config(cfg: EniConfig) -> None:
                                 s,
                                 f"{fmt_index(*key)} is mapped twice as "
                                 f"{'output' if d == Direction.OUT else 'input'}",
-                                str(label),
+                                str(_EntryLabel(*where)),
                             )
                         seen_obj.add(key)
                     if e.logical_bit is not None:
@@ -156,8 +159,10 @@ def check_config(cfg: EniConfig) -> None:
                         start = None
                     if start is not None:
                         if start < 0:
-                            raise _err(cfg, s, f"negative logical bit {start}", label)
-                        spans[d].append((start, start + e.bit_len, s, label))
+                            raise _err(
+                                cfg, s, f"negative logical bit {start}", str(_EntryLabel(*where))
+                            )
+                        spans[d].append((start, start + e.bit_len, s, where))
                     cum += e.bit_len
     for d, items in spans.items():
         items.sort(key=lambda t: (t[0], t[1]))
@@ -168,6 +173,6 @@ def check_config(cfg: EniConfig) -> None:
                     cfg,
                     sb,
                     f"bits {b0}..{b1 - 1} of the {image} image overlap slave {sa.position} "
-                    f"({sa.name}) {la} at bits {a0}..{a1 - 1}",
-                    str(lb),
+                    f"({sa.name}) {_EntryLabel(*la)} at bits {a0}..{a1 - 1}",
+                    str(_EntryLabel(*lb)),
                 )

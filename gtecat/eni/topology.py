@@ -206,9 +206,9 @@ def lay_out(cfg: EniConfig) -> EniConfig:
                 entries = []
                 for e in p.entries:
                     if e.is_padding:
-                        entries.append(replace(e, logical_bit=None))
+                        entries.append(e.at(None))
                     else:
-                        entries.append(replace(e, logical_bit=bit))
+                        entries.append(e.at(bit))
                         variables[d].append(
                             Variable(f"{s.name}.{p.name}.{e.name}", d, bit, e.bit_len, e.data_type)
                         )

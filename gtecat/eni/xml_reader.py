@@ -679,7 +679,7 @@ def _direction(
                             slave_name=ctx.slave_name,
                             element=where,
                         )
-            entries.append(replace(e, logical_bit=stated) if stated is not None else e)
+            entries.append(e.at(stated) if stated is not None else e)
             cum += e.bit_len
         result.append(Pdo(p.index, d, tuple(entries), p.name, p.sm_attr, p.fixed))
 

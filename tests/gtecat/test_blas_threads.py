@@ -67,8 +67,10 @@ def test_import_gtecat_alone_does_not_touch_numpy() -> None:
 
 @needs_proc
 @pytest.mark.parametrize("name", ["OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"])
+@pytest.mark.sample(1)
 def test_a_count_the_process_chose_is_kept(name: str) -> None:
-    """(``GOTO_NUM_THREADS`` is looked at the same way: one of the three names.)"""
+    """(``GOTO_NUM_THREADS`` is looked at the same way: one of the three names.  The default
+    run takes one of the two names, two processes each: GTECAT_LONG=1 runs both.)"""
     count, threads = _after(_ONE_THREAD, **{name: "2"})
     assert count == ("2" if name == "OPENBLAS_NUM_THREADS" else None)
     assert threads == _threads_of_plain_numpy(**{name: "2"})

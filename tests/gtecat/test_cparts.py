@@ -4,6 +4,7 @@ compiler, or with one that fails, the build goes on without them."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -76,29 +77,73 @@ def test_prebuild_names_and_seals_each_part_and_falls_back_to_the_plain_flags(
     assert not list(tmp_path.glob("gtecat-prebuild-*"))
 
 
-def _setup_build_py(tmp_path: Path, cc: str) -> tuple[subprocess.CompletedProcess[str], Path]:
-    """``setup.py build_py`` of the project (its package linked in) with ``CC=cc``."""
-    project = tmp_path / "project"
+#: runs ``setup.py build_py`` (sys.argv[1]: the project) once per (CC, build folder, file for
+#: its stderr) of the JSON in sys.argv[2], each run with setup.py loaded afresh, as pip's build
+#: backend runs it: in the process, not in a process of its own.  Prints the exit codes.
+_BUILDS = """
+import json, os, runpy, sys
+project, runs = sys.argv[1], json.loads(sys.argv[2])
+os.chdir(project)
+codes = []
+for cc, lib, err in runs:
+    os.environ["CC"] = cc
+    sys.stderr.flush()
+    fd = os.open(err, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    os.dup2(fd, 2)
+    os.close(fd)
+    sys.argv = ["setup.py", "-q", "build_py", "--build-lib", lib]
+    try:
+        runpy.run_path("setup.py", run_name="__main__")
+        code = 0
+    except SystemExit as e:
+        if isinstance(e.code, str):
+            print(e.code, file=sys.stderr)
+        code = e.code if isinstance(e.code, int) else 1
+    sys.stderr.flush()
+    codes.append(code)
+print(json.dumps(codes))
+"""
+
+
+@pytest.fixture(scope="module")
+def builds(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[int, str, Path, str]]:
+    """``setup.py build_py`` of the project (its package linked in) with ``CC`` a compiler
+    that builds, none, and one that fails: (exit code, stderr, the built package, CC) each,
+    read only.  One Python process runs the three builds (the third of a second of importing
+    setuptools, once)."""
+    tmp = tmp_path_factory.mktemp("cparts")
+    project = tmp / "project"
     project.mkdir()
     for name in ("setup.py", "pyproject.toml", "README.md"):
         shutil.copy(ROOT / name, project / name)
     (project / "gtecat").symlink_to(ROOT / "gtecat")
-    lib = tmp_path / "build-lib"
+    for kind in ("builds", "failing"):
+        (tmp / kind).mkdir()
+    ccs = {
+        "builds": str(_cc(tmp / "builds", 'echo built > "$out"')),
+        "none": str(tmp / "no-such-cc"),
+        "failing": str(_cc(tmp / "failing", 'echo "cc: error: broken" >&2; exit 1')),
+    }
+    runs = [(cc, str(tmp / f"lib-{kind}"), str(tmp / f"err-{kind}")) for kind, cc in ccs.items()]
     r = subprocess.run(
-        [sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(lib)],
-        cwd=project,
-        env={**os.environ, "CC": cc},
+        [sys.executable, "-c", _BUILDS, str(project), json.dumps(runs)],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=300,
     )
-    return r, lib / "gtecat"
-
-
-def test_the_wheel_build_prebuilds_the_parts_beside_the_package(tmp_path: Path) -> None:
-    cc = str(_cc(tmp_path, 'echo built > "$out"'))
-    r, package = _setup_build_py(tmp_path, cc)
     assert r.returncode == 0, r.stderr
+    codes = json.loads(r.stdout.splitlines()[-1])
+    return {
+        kind: (code, Path(err).read_text(), Path(lib) / "gtecat", cc)
+        for kind, code, (cc, lib, err) in zip(ccs, codes, runs, strict=True)
+    }
+
+
+def test_the_wheel_build_prebuilds_the_parts_beside_the_package(
+    builds: dict[str, tuple[int, str, Path, str]],
+) -> None:
+    code, err, package, cc = builds["builds"]
+    assert code == 0, err
     assert (package / "cbuild.py").is_file() and (package / "gt" / "csrc" / "centry.c").is_file()
     libs = sorted(p.name for p in (package / "_prebuilt").glob("*.so"))
     assert len(libs) == len(cparts.PARTS)
@@ -108,20 +153,15 @@ def test_the_wheel_build_prebuilds_the_parts_beside_the_package(tmp_path: Path) 
 
 @pytest.mark.parametrize("cc", ["none", "failing"])
 def test_the_wheel_build_goes_on_without_a_compiler_or_with_one_that_fails(
-    tmp_path: Path, cc: str
+    builds: dict[str, tuple[int, str, Path, str]], cc: str
 ) -> None:
     """``pip install`` needs no C compiler: the parts are then built on first use."""
-    command = (
-        str(tmp_path / "no-such-cc")
-        if cc == "none"
-        else str(_cc(tmp_path, 'echo "cc: error: broken" >&2; exit 1'))
-    )
-    r, package = _setup_build_py(tmp_path, command)
-    assert r.returncode == 0, r.stderr
+    code, err, package, _ = builds[cc]
+    assert code == 0, err
     assert (package / "cbuild.py").is_file()
     assert not list((package / "_prebuilt").glob("*.so"))
     if cc == "failing":
-        assert "a C part not prebuilt" in r.stderr and "broken" in r.stderr
+        assert "a C part not prebuilt" in err and "broken" in err
 
 
 @pytest.mark.long("a pip install of the package into a folder, its build environment fetched")

@@ -114,31 +114,46 @@ def test_an_eni_without_register_init_cmds_fails_clearly(tmp_path: Path) -> None
     ]
 
 
-def test_a_bus_of_several_frames_is_replayed_frame_by_frame(tmp_path: Path) -> None:
-    """200 generated drives (1,400 output and 2,200 input bytes) reach OP under a master that
-    runs the file word for word, in this process: every cyclic ``Frame`` goes out as one
-    Ethernet frame (none longer than 1514 bytes) and each of its commands comes back with its
-    ``Cnt``.  The same commands in one frame, as the writer once wrote them, cannot be sent."""
+#: drives, the cyclic frames the writer lays out for them (Cmd, DataLength, Cnt), and the bytes
+#: of all their commands in one frame
+_SEVERAL_FRAMES = [
+    # 630 output and 990 input bytes: the inputs cut between two frames
+    pytest.param(90, [[(11, 630, 90), (10, 836, 76)], [(10, 154, 14)]], 1672, id="90"),
+    # 1,400 output and 2,200 input bytes: three frames, one a whole datagram of inputs
+    pytest.param(
+        200,
+        [[(11, 1400, 200), (10, 66, 6)], [(10, 1474, 134)], [(10, 660, 60)]],
+        3664,
+        id="200",
+        marks=pytest.mark.long("200 drives in three frames; 90 drives in two run by default"),
+    ),
+]
+
+
+@pytest.mark.parametrize(("drives", "layout", "one_frame"), _SEVERAL_FRAMES)
+def test_a_bus_of_several_frames_is_replayed_frame_by_frame(
+    tmp_path: Path, drives: int, layout: list[list[tuple[int, int, int]]], one_frame: int
+) -> None:
+    """Generated drives reach OP under a master that runs the file word for word, in this
+    process: every cyclic ``Frame`` goes out as one Ethernet frame (none longer than 1514
+    bytes) and each of its commands comes back with its ``Cnt``.  The same commands in one
+    frame, as the writer once wrote them, cannot be sent."""
     from gtecat.cli.serve_cmd import build_chain
     from tools.gen_axes_eni import write_axes_eni
 
-    eni = write_axes_eni(200, tmp_path / "axes200.eni")
+    eni = write_axes_eni(drives, tmp_path / f"axes{drives}.eni")
     config = parse(eni)
-    assert [[(c.cmd, c.length, c.cnt) for c in f] for f in config.cyclic] == [
-        [(11, 1400, 200), (10, 66, 6)],
-        [(10, 1474, 134)],
-        [(10, 660, 60)],
-    ]
+    assert [[(c.cmd, c.length, c.cnt) for c in f] for f in config.cyclic] == layout
     now = [0]
     chain, _ = build_chain(eni, clock=lambda: now[0])
     master = ChainMaster(chain, tick=lambda: now.__setitem__(0, now[0] + 100_000))
     replay = Replay(master, config)
     failures = replay.run(cycles=3)
     assert not failures, "\n".join(failures[:20])
-    assert replay.states() == [(8, 0)] * 200
-    assert replay.cyclic_frames == 3 * (5 + 3)  # 5 cycles in SAFEOP, 3 in OP
+    assert replay.states() == [(8, 0)] * drives
+    assert replay.cyclic_frames == len(layout) * (5 + 3)  # 5 cycles in SAFEOP, 3 in OP
     assert master.resends == 0
 
     one = Replay(master, replace(config, cyclic=[[c for f in config.cyclic for c in f]]))
     one.cyclic("OP", 1)
-    assert one.failures == ["frame 0: 3664 bytes, an Ethernet frame carries 1514"]
+    assert one.failures == [f"frame 0: {one_frame} bytes, an Ethernet frame carries 1514"]
