@@ -217,39 +217,6 @@ def test_a_trap_move_updates_the_position(browser: Any, endpoint_conn: client.At
     assert axis2()["prf_pos"] == float(target)
 
 
-def test_jog_moves_with_control_and_does_nothing_read_only(
-    browser: Any, panels: dict[str, Any], endpoint_conn: client.Attached
-) -> None:
-    def prf1() -> float:
-        snap = endpoint_conn.call("snapshot")
-        return dict(zip(snap["axis_fields"], snap["axes"][0], strict=True))["prf_pos"]
-
-    # the read-only panel's page: no jog buttons, and a jog sent anyway is refused
-    _show(browser, panels["readonly"])
-    assert not browser.find_element("css selector", '[data-axis="1"] .jog-plus').is_displayed()
-    before = prf1()
-    err = browser.execute_async_script(
-        "const done = arguments[0];"
-        "gtecat.ask('jog', 1, 50).then(() => done('accepted'), (e) => done(String(e)));"
-    )
-    assert "read-only" in err
-    # this page updates too, and over the 300 cycles it sees go by the refused jog moves
-    # nothing (waited for by the snapshots' own cycle count: the page's count of snapshots
-    # starts again every second, and a loaded machine may deliver none for a while)
-    seen = browser.execute_script("return gtecat.snap.cycles")
-    _wait(
-        lambda: browser.execute_script("return gtecat.snap.cycles") >= seen + 300,
-        10,
-        "the read-only page's next snapshots",
-    )
-    assert prf1() == before
-    _show(browser, panels["control"])
-    card = browser.find_element("css selector", '[data-axis="1"]')
-    _click(browser, card.find_element("class name", "jog-plus"))
-    _wait(lambda: prf1() > before + 100, 10, "the jog")
-    _click(browser, card.find_element("class name", "stop"))
-
-
 def test_the_scope_csv_holds_every_sample_the_recorder_took(
     browser: Any, endpoint_conn: client.Attached
 ) -> None:
@@ -279,6 +246,43 @@ def test_the_scope_csv_holds_every_sample_the_recorder_took(
     assert len(common) > 300
     assert all(r[1:] == by_time[r[0]] for r in common)
     assert any(r[SIGNALS.index("axis2.vel") + 1] != 0 for r in common)  # it saw the jog
+
+
+def test_jog_moves_with_control_and_does_nothing_read_only(
+    browser: Any, panels: dict[str, Any], endpoint_conn: client.Attached
+) -> None:
+    """The module's last test in the browser: it leaves the read-only page in the tab (the
+    control page loaded again would cost the browser another page)."""
+
+    def axis1() -> dict[str, Any]:
+        snap = endpoint_conn.call("snapshot")
+        return dict(zip(snap["axis_fields"], snap["axes"][0], strict=True))
+
+    before = axis1()["prf_pos"]
+    card = browser.find_element("css selector", '[data-axis="1"]')
+    _click(browser, card.find_element("class name", "jog-plus"))
+    _wait(lambda: axis1()["prf_pos"] > before + 100, 10, "the jog")
+    _click(browser, card.find_element("class name", "stop"))
+    _wait(lambda: not axis1()["sts"] & 0x400, 20, "axis 1 at rest")  # table 6-2 bit 10
+    # the read-only panel's page: no jog buttons, and a jog sent anyway is refused
+    _show(browser, panels["readonly"])
+    assert not browser.find_element("css selector", '[data-axis="1"] .jog-plus').is_displayed()
+    before = axis1()["prf_pos"]
+    err = browser.execute_async_script(
+        "const done = arguments[0];"
+        "gtecat.ask('jog', 1, 50).then(() => done('accepted'), (e) => done(String(e)));"
+    )
+    assert "read-only" in err
+    # this page updates too, and over the 300 cycles it sees go by the refused jog moves
+    # nothing (waited for by the snapshots' own cycle count: the page's count of snapshots
+    # starts again every second, and a loaded machine may deliver none for a while)
+    seen = browser.execute_script("return gtecat.snap.cycles")
+    _wait(
+        lambda: browser.execute_script("return gtecat.snap.cycles") >= seen + 300,
+        10,
+        "the read-only page's next snapshots",
+    )
+    assert axis1()["prf_pos"] == before
 
 
 def test_a_request_without_the_token_gets_403(panels: dict[str, Any]) -> None:
