@@ -27,7 +27,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ..controller.axis_status import AxisStatus
 from ..errors import BusError, ParameterError
 
 Op = Callable[..., Any]
@@ -119,6 +118,11 @@ def layout(ctx: Any) -> dict[str, Any]:
         {"axis": ref.axis, "slave": ref.slave, "channel": getattr(ref, "channel", 0)}
         for ref in lay.axes
     ]
+    # here, not at the top: a panel attached to another process imports this module for
+    # CONTROL and needs none of the controller (its import, numpy and the bank, was half of
+    # that panel's start)
+    from ..controller.axis_status import AxisStatus
+
     doc["status_bits"] = {str(int(f).bit_length() - 1): f.name for f in AxisStatus}
     doc["emulated"] = _emulated(ctx.ctl)
     doc["cycle_ns"] = ctx.ctl.clock.cycle_ns

@@ -173,27 +173,31 @@ function cia402(sw) {
   return "?";
 }
 function setBits(spans, word) { for (const [b, sp] of Object.entries(spans)) sp.classList.toggle("on", !!(word >> b & 1)); }
+// a cell is written only when its text changes: a write of the same text still has the browser
+// lay out, paint and raster again, 25 times a second (a page at rest cost Chromium a third of a
+// CPU; now its clock and cycle count are all that change)
+function put(e, text) { text = String(text); if (e.textContent !== text) e.textContent = text; }
 const fmt = (x) => (x === null || x === undefined) ? "-" : (Number.isInteger(x) ? String(x) : x.toFixed(3));
 function onSnap(s) {
   S.snap = s; S.snaps++;
   const h = s.image; const n = h.length >> 1;
   if (S.bytes.length !== n) S.bytes = new Uint8Array(n);
   for (let i = 0; i < n; i++) S.bytes[i] = parseInt(h.substr(2 * i, 2), 16);
-  $("time").textContent = s.t_ms.toFixed(0); $("cycles").textContent = s.cycles;
+  put($("time"), s.t_ms.toFixed(0)); put($("cycles"), s.cycles);
   S.wkcs.push(s.wkc); if (S.wkcs.length > 12) S.wkcs.shift();
-  $("wkc").textContent = S.wkcs.join(" "); $("wkc-expected").textContent = s.expected;
-  $("wkc-errors").textContent = s.wkc_errors; $("lost").textContent = s.lost_frames;
-  $("bus-error").textContent = s.error || "";
+  put($("wkc"), S.wkcs.join(" ")); put($("wkc-expected"), s.expected);
+  put($("wkc-errors"), s.wkc_errors); put($("lost"), s.lost_frames);
+  put($("bus-error"), s.error || "");
   const rows = $("slaves").tBodies[0].rows;
   for (let i = 0; i < rows.length; i++) {
     const st = AL[s.states[i]] || String(s.states[i]);
-    const c = rows[i].cells[2]; c.textContent = st; c.className = "al " + (st === "OP" ? "ok" : "bad");
-    rows[i].cells[3].textContent = s.codes[i] ? hex(s.codes[i], 4) : "0";
+    const c = rows[i].cells[2]; put(c, st); c.classList.toggle("ok", st === "OP"); c.classList.toggle("bad", st !== "OP");
+    put(rows[i].cells[3], s.codes[i] ? hex(s.codes[i], 4) : "0");
   }
   for (const e of S.entries) {
     const v = entryValue(e); e.last = v;
-    e.valueCell.textContent = typeof v.value === "number" && !Number.isInteger(v.value) ? v.value.toPrecision(7) : String(v.value);
-    e.rawCell.textContent = v.rawHex;
+    put(e.valueCell, typeof v.value === "number" && !Number.isInteger(v.value) ? v.value.toPrecision(7) : v.value);
+    put(e.rawCell, v.rawHex);
   }
   const f = s.axis_fields;
   for (const row of s.axes) {
@@ -201,14 +205,14 @@ function onSnap(s) {
     const card = S.axisCards[a.axis]; if (!card) continue;
     const val = (idx) => { const e = findEntry(card.slave, idx + 0x800 * card.channel, 0); return e ? Number(e.last.value) : null; };
     const sw = val(0x6041), cw = val(0x6040), m = val(0x6060), md = val(0x6061), pr = val(0x60B9);
-    card.v.state.textContent = sw === null ? "-" : cia402(sw);
+    put(card.v.state, sw === null ? "-" : cia402(sw));
     const mn = (x) => x === null ? "-" : `${x} ${S.layout.mode_names[x] || ""}`.trim();
-    card.v.mode.textContent = `${mn(m)} / ${mn(md)}`;
-    card.v.prf.textContent = fmt(a.prf_pos); card.v.enc.textContent = fmt(a.enc_pos);
-    card.v.vel.textContent = fmt(a.prf_vel); card.v.encvel.textContent = fmt(a.enc_vel);
-    card.v.err.textContent = fmt(a.axis_error); card.v.sts.textContent = hex(a.sts, 4);
-    card.v.homing.textContent = a.homing === null ? "-" : ({0: "0 homing", 3: "3 homed", 5: "5 not homed / failed"}[a.homing] || a.homing);
-    card.v.probe.textContent = pr === null ? "- (not mapped)" : hex(pr, 4);
+    put(card.v.mode, `${mn(m)} / ${mn(md)}`);
+    put(card.v.prf, fmt(a.prf_pos)); put(card.v.enc, fmt(a.enc_pos));
+    put(card.v.vel, fmt(a.prf_vel)); put(card.v.encvel, fmt(a.enc_vel));
+    put(card.v.err, fmt(a.axis_error)); put(card.v.sts, hex(a.sts, 4));
+    put(card.v.homing, a.homing === null ? "-" : ({0: "0 homing", 3: "3 homed", 5: "5 not homed / failed"}[a.homing] || a.homing));
+    put(card.v.probe, pr === null ? "- (not mapped)" : hex(pr, 4));
     if (sw !== null) setBits(card.sw, sw);
     if (cw !== null) setBits(card.cw, cw);
     setBits(card.gt, a.sts);
