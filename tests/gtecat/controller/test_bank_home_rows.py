@@ -257,7 +257,13 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
     return _machine(tmp_path_factory.mktemp("home_rows"), SETUP)
 
 
-@pytest.fixture(scope="module", params=["lockstep", "auto"])
+#: the default run's share of the two clocks: :func:`runs` on the lockstep clock, :func:`more` on
+#: the auto one; GTECAT_LONG=1 runs both on both
+_AUTO_LONG = pytest.mark.long("the same on the auto clock")
+_LOCKSTEP_LONG = pytest.mark.long("the same on the lockstep clock")
+
+
+@pytest.fixture(scope="module", params=["lockstep", pytest.param("auto", marks=_AUTO_LONG)])
 def runs(request: pytest.FixtureRequest, machine: str) -> tuple:
     clock = request.param
     return clock, _run(machine, "off", clock), _run(machine, "on", clock)
@@ -335,7 +341,7 @@ def test_a_switched_row_the_bank_would_not_take_goes_back(
         assert len(refused) == 3
 
 
-@pytest.fixture(scope="module", params=["lockstep", "auto"])
+@pytest.fixture(scope="module", params=[pytest.param("lockstep", marks=_LOCKSTEP_LONG), "auto"])
 def more(request: pytest.FixtureRequest, machine: str) -> tuple:
     clock = request.param
     return tuple(

@@ -459,7 +459,20 @@ def _probe_pdo_eni(n: int, path: Path) -> Path:
     return path
 
 
-@pytest.mark.parametrize(("step", "pdo"), [(0, False), (13, False), (0, True), (13, True)])
+#: the default run: the probe read by SDO cycle by cycle and mapped as PDO every 13 cycles;
+#: GTECAT_LONG=1 also the other two
+_OTHER_PAIR = pytest.mark.long("the probe by SDO every 13 cycles, as PDO cycle by cycle")
+
+
+@pytest.mark.parametrize(
+    ("step", "pdo"),
+    [
+        (0, False),
+        pytest.param(13, False, marks=_OTHER_PAIR),
+        pytest.param(0, True, marks=_OTHER_PAIR),
+        (13, True),
+    ],
+)
 def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int, pdo: bool) -> None:
     """The bank and the scalar path cycle by cycle (or every 13 cycles), the mailbox
     counters and mechanics at the end; the probes armed with the bank running the axes,
