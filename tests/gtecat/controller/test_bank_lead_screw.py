@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gtecat import gt
-from tests.conftest import LONG, examples
+from tests.conftest import examples
 from tests.gtecat.controller.test_bank import HAS_CC, _ok
 from tests.gtecat.controller.test_bank_rows import AXES, _sample
 from tests.gtecat.controller.test_bank_rows import _act as _rows_act
@@ -125,15 +125,11 @@ def _run(bus: tuple[str, str], program: list[tuple[int, tuple]], bank: str, kern
     return out, held / max(seen, 1), many
 
 
-def _check(
-    bus: tuple[str, str],
-    program: list[tuple[int, tuple]],
-    kernels: tuple[str, ...] = ("c", "numpy"),
-) -> tuple[dict, int]:
+def _check(bus: tuple[str, str], program: list[tuple[int, tuple]]) -> tuple[dict, int]:
     """({kernel: the screw axes' share in the bank}, the cycles run many at a time)"""
     ref, _, _ = _run(bus, program, "off", "c")
     share, many = {}, 0
-    for kernel in kernels:
+    for kernel in ("c", "numpy"):
         got, share[kernel], ran = _run(bus, program, "on", kernel)
         for k, (a, b) in enumerate(zip(ref, got, strict=True)):
             assert a == b, f"{kernel}: step {k}: the bank and the scalar path differ"
@@ -241,10 +237,8 @@ def test_compensated_axes_homed_by_their_drives(homing_bus: tuple[str, str]) -> 
         *[(1, ("move", a, 3_000 * a - 7_000, 20.0, 0.5, 0)) for a in range(1, 6)],
         (600, ("wait", 0)),
     ]
-    # (the numpy cycle runs no homing rows: it runs axis 6's move and the moves after the
-    # homings, as in the tests above, which the default run keeps)
-    share, _ = _check(homing_bus, program, ("c", "numpy") if LONG else ("c",))
-    assert share["c"] > 0.7
+    share, _ = _check(homing_bus, program)
+    assert share["c"] > 0.7  # (the numpy cycle runs no homing rows)
 
 
 #: test_bank_rows' steps (moves, jogs, soft limits, bands, stops...) and the compensation

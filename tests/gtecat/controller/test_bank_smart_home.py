@@ -524,7 +524,9 @@ def _home_all_standing() -> None:
         _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
 
 
-@pytest.mark.parametrize("pdo", [False, True])
+@pytest.mark.parametrize(
+    "pdo", [pytest.param(False, marks=pytest.mark.long("the probe read by SDO")), True]
+)
 def test_homings_started_on_standing_axes(tmp_path: Path, pdo: bool) -> None:
     """The index homings of :data:`ARM_SETUP` started on axes the bank runs standing (a
     capture unit and homing made then, the capture cleared, GT_PrfTrap of an axis standing
