@@ -83,8 +83,8 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
     return _machine(tmp_path_factory.mktemp("home_start"), SETUP)
 
 
-#: the default run takes the auto clock (test_bank_home_rows' switches the lockstep one);
-#: GTECAT_LONG=1 runs both
+#: the default run takes the auto clock (test_bank_home_rows' more switches the lockstep
+#: one); GTECAT_LONG=1 runs both
 @pytest.fixture(
     scope="module",
     params=[pytest.param("lockstep", marks=pytest.mark.long("on the lockstep clock")), "auto"],
