@@ -30,6 +30,7 @@ import pytest
 from gtecat import faults, gt
 from gtecat.controller import bank_home_rows, bank_kernel
 from gtecat.controller.bank import _GUARD_SET, AxisBank
+from tests.conftest import LONG, LONG_REASON
 from tests.gtecat.controller.test_bank import ENI, HAS_CC, _ok, open_bus
 from tests.gtecat.controller.test_bank_homing import _machine, _sample
 from tests.gtecat.controller.test_bank_homing_calls import _prm, _trap
@@ -280,6 +281,8 @@ def test_a_row_given_back_in_the_middle_of_its_switch(
     was written, before the bank runs it): its objects go on from the cycles it ran in the
     bank on the scalar path exactly."""
     clock, ref, _ = runs
+    if not LONG and (clock, at) not in (("lockstep", 0), ("auto", 1)):
+        pytest.skip(f"{LONG_REASON} (the default run: lockstep at 0, auto at 1)")
     cycle = AxisBank._cycle
     given: list[int] = []
 
@@ -335,7 +338,11 @@ def test_a_switched_row_the_bank_would_not_take_goes_back(
         assert len(refused) == 3
 
 
-@pytest.fixture(scope="module", params=["lockstep", "auto"])
+#: (the default run: :data:`MORE` on the auto clock; GTECAT_LONG=1 on both)
+@pytest.fixture(
+    scope="module",
+    params=[pytest.param("lockstep", marks=pytest.mark.long("on the lockstep clock")), "auto"],
+)
 def more(request: pytest.FixtureRequest, machine: str) -> tuple:
     clock = request.param
     return tuple(

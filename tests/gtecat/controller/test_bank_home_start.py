@@ -83,7 +83,12 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
     return _machine(tmp_path_factory.mktemp("home_start"), SETUP)
 
 
-@pytest.fixture(scope="module", params=["lockstep", "auto"])
+#: the default run takes the auto clock (test_bank_home_rows' more switches the lockstep
+#: one); GTECAT_LONG=1 runs both
+@pytest.fixture(
+    scope="module",
+    params=[pytest.param("lockstep", marks=pytest.mark.long("on the lockstep clock")), "auto"],
+)
 def runs(request: pytest.FixtureRequest, machine: str) -> tuple:
     clock = request.param
     return clock, _run(machine, "off", clock), _run(machine, "on", clock)

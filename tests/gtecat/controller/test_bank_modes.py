@@ -20,6 +20,7 @@ import os
 from collections.abc import Callable
 from ctypes import byref, c_double, c_long, c_short
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -320,6 +321,21 @@ def _run(
     return trace, got
 
 
+#: the scalar path's runs by (run function, script, machine, chunked), with what they were
+#: made of (kept alive: the key holds their ids)
+_REFERENCES: dict[tuple, tuple[object, object, object]] = {}
+
+
+def reference(run: Callable[..., Any], script: object, machine: str, chunked: bool) -> Any:
+    """``run(script, machine, "off", chunked)``, made once per test run: the tests that compare
+    two bank modes (compiled, numpy) with the same script share the scalar path's trace, which
+    the lockstep clock makes the same every time (the tests only read it)."""
+    key = (id(run), id(script), machine, chunked)
+    if key not in _REFERENCES:
+        _REFERENCES[key] = (run, script, run(script, machine, "off", chunked))
+    return _REFERENCES[key][2]
+
+
 #: the samples of the last _run's compiled slaves (bank_slaves.SlaveFill)
 COMPILED_SLAVES = [0]
 #: ... and of its compiled coordinate-system segments (bank_crd.CrdFill)
@@ -362,7 +378,7 @@ _CHUNKED = pytest.mark.long("the script again in short waits")
 def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked) -> None:
     if script is CRD:
         bank_crd.library()  # (its build waited for: the bank takes it from its first table)
-    ref, none = _run(script, machine, "off", chunked)
+    ref, none = reference(_run, script, machine, chunked)
     assert none == 0
     got, samples = _run(script, machine, "on", chunked)
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
@@ -379,7 +395,7 @@ def test_modes_in_the_bank_match_the_scalar_path(machine, script, least, chunked
 def test_modes_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
     """The same without the compiled cycle (no C compiler): numpy runs the bank's cycle and
     Python every table."""
-    ref, _ = _run(script, machine, "off", True)
+    ref, _ = reference(_run, script, machine, True)
     got, samples = _run(script, machine, "on", True, kernel="numpy")
     assert got == ref
     assert samples >= 500

@@ -24,7 +24,7 @@ from gtecat import gt
 from gtecat.controller import bank_pvt
 from gtecat.controller.motion.pvt import PvtPlanner, PvtSegment
 from tests.gtecat.controller.test_bank import AXES, _bring_up, _machine_file, _ok
-from tests.gtecat.controller.test_bank_modes import Script, _bit, _gear, _run
+from tests.gtecat.controller.test_bank_modes import Script, _bit, _gear, _run, reference
 
 
 def _arr(*v: float):
@@ -113,7 +113,7 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
 @pytest.mark.parametrize("chunked", [False, True], ids=["every-cycle", "chunked"])
 def test_pvt_in_the_bank_matches_the_scalar_path(machine, chunked) -> None:
     bank_pvt.library()  # (built before the bank takes its first table)
-    ref, none = _run(PVT, machine, "off", chunked)
+    ref, none = reference(_run, PVT, machine, chunked)
     assert none == 0
     COMPILED[0] = 0
     got, samples = _run(PVT, machine, "on", chunked)
@@ -127,7 +127,7 @@ def test_pvt_in_the_bank_matches_the_scalar_path(machine, chunked) -> None:
 @pytest.mark.sample(1)
 def test_pvt_in_the_numpy_bank_matches_the_scalar_path(machine) -> None:
     """The same without the compiled cycle (no C compiler): the planners' own steps."""
-    ref, _ = _run(PVT, machine, "off", True)
+    ref, _ = reference(_run, PVT, machine, True)
     got, samples = _run(PVT, machine, "on", True, kernel="numpy")
     assert got == ref
     assert samples >= 1500

@@ -459,7 +459,20 @@ def _probe_pdo_eni(n: int, path: Path) -> Path:
     return path
 
 
-@pytest.mark.parametrize(("step", "pdo"), [(0, False), (13, False), (0, True), (13, True)])
+#: the default run: the probe read by SDO cycle by cycle and mapped as PDO every 13 cycles;
+#: GTECAT_LONG=1 also the other two
+_OTHER_PAIR = pytest.mark.long("the probe by SDO every 13 cycles, as PDO cycle by cycle")
+
+
+@pytest.mark.parametrize(
+    ("step", "pdo"),
+    [
+        (0, False),
+        pytest.param(13, False, marks=_OTHER_PAIR),
+        pytest.param(0, True, marks=_OTHER_PAIR),
+        (13, True),
+    ],
+)
 def test_index_homing_armed_in_the_bank(tmp_path: Path, step: int, pdo: bool) -> None:
     """The bank and the scalar path cycle by cycle (or every 13 cycles), the mailbox
     counters and mechanics at the end; the probes armed with the bank running the axes,
@@ -511,7 +524,9 @@ def _home_all_standing() -> None:
         _ok(gt.GT_GoHome(a, byref(prm)), f"go home {a}")
 
 
-@pytest.mark.parametrize("pdo", [False, True])
+@pytest.mark.parametrize(
+    "pdo", [pytest.param(False, marks=pytest.mark.long("the probe read by SDO")), True]
+)
 def test_homings_started_on_standing_axes(tmp_path: Path, pdo: bool) -> None:
     """The index homings of :data:`ARM_SETUP` started on axes the bank runs standing (a
     capture unit and homing made then, the capture cleared, GT_PrfTrap of an axis standing

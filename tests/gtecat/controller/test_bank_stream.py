@@ -25,7 +25,7 @@ import pytest
 
 from gtecat import gt
 from tests.gtecat.controller.test_bank import _bring_up, _machine_file, _ok
-from tests.gtecat.controller.test_bank_modes import _look, _play
+from tests.gtecat.controller.test_bank_modes import _look, _play, reference
 
 Script = list[tuple[int, Callable[[], object]]]
 #: the dynamic PT axes and the Trap axes of the programs
@@ -222,7 +222,7 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> str:
     ids=["pt-stream", "pt-stream-chunked", "moves", "moves-chunked"],
 )
 def test_streamed_calls_in_the_bank_match_the_scalar_path(machine, script, chunked) -> None:
-    ref, none = _run(script, machine, "off", chunked)
+    ref, none = reference(_run, script, machine, chunked)
     assert none == (0, 0, 0)
     got, (streamed, events, samples) = _run(script, machine, "on", chunked)
     for k, (a, b) in enumerate(zip(ref, got, strict=True)):
@@ -237,7 +237,7 @@ def test_streamed_calls_in_the_bank_match_the_scalar_path(machine, script, chunk
 @pytest.mark.parametrize("script", [PT_STREAM, MOVES], ids=["pt-stream", "moves"])
 def test_streamed_calls_in_the_numpy_bank_match_the_scalar_path(machine, script) -> None:
     """The same without the compiled cycle: the dynamic PT tables by the planners' run."""
-    ref, _ = _run(script, machine, "off", True)
+    ref, _ = reference(_run, script, machine, True)
     old = os.environ.get("GTECAT_BANK_KERNEL")
     os.environ["GTECAT_BANK_KERNEL"] = "numpy"
     try:
