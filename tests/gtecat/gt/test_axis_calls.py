@@ -4,6 +4,7 @@ GT_GetEcatErrorCode), with the objects at the offsets ``gtecat map`` gives."""
 
 from __future__ import annotations
 
+import functools
 import json
 import subprocess
 import sys
@@ -19,14 +20,20 @@ from .conftest import bring_up
 FULL = "full_servo.eni"
 
 
-def _map_offsets(eni: str) -> dict[tuple[int, int, int], int]:
-    out = subprocess.run(
+@functools.cache
+def _map_output(eni: str) -> str:
+    """What ``gtecat map ENI --json`` prints (run once per file in this process: the
+    command reads the file alone, so every test of it gets the same text)."""
+    return subprocess.run(
         [sys.executable, "-m", "gtecat", "map", str(EXAMPLES / eni), "--json"],
         capture_output=True,
         text=True,
         check=True,
     ).stdout
-    doc = json.loads(out)
+
+
+def _map_offsets(eni: str) -> dict[tuple[int, int, int], int]:
+    doc = json.loads(_map_output(eni))
     return {
         (s["position"], e["index"], e["subindex"]): e["gt_bit"] // 8
         for s in doc["slaves"]

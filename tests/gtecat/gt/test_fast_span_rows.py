@@ -108,34 +108,60 @@ def _auto(general: bool, eni: str = "manual_fig5_2.eni", **options: Any) -> Iter
         gt.GT_Close()
 
 
+class _Profiled:
+    """A profile of the polls of a run's rounds, and the cycles they ran: every round on the
+    quick way, the first alone on the general way (each of its cycles asks every value
+    again, which one round shows as well as four; the profile triples that way's cost)."""
+
+    def __init__(self, ctl: Any, general: bool) -> None:
+        import cProfile
+
+        self.ctl, self.general, self.cycles = ctl, general, 0
+        self.pr = cProfile.Profile()
+
+    @contextmanager
+    def round(self, rnd: int) -> Iterator[None]:
+        if rnd and self.general:
+            yield
+            return
+        c0 = self.ctl.clock.cycles
+        self.pr.enable()
+        try:
+            yield
+        finally:
+            self.pr.disable()
+            self.cycles += self.ctl.clock.cycles - c0
+
+    def asked(self) -> int:
+        return _calls(self.pr, ("f", "value_gt", "value_gtn"))
+
+
 def _status_polls(general: bool) -> tuple[list, int, int]:
     """Trap moves of both axes that start and end, every call a span of status words
     (``GT_GetSts``, ``GT_GetPrfSts``, with the clock) and each axis's word (``GT_GetSts``,
     ``GT_GetPrfSts``) polled on the auto clock; ``general``: a watch hook that does nothing,
-    so every cycle goes the general way.  What was read, the cycles run, and how often a
-    value function was asked."""
-    import cProfile
-
+    so every cycle goes the general way.  What was read, the cycles the profiled rounds ran
+    (:class:`_Profiled`), and how often a value function was asked in them."""
     with _auto(general) as ctl:
         assert gt.GT_AxisOn(1) == 0 and gt.GT_AxisOn(2) == 0
         words, prf, one, two = (c_long * 2)(), (c_long * 2)(), c_long(), ctypes.c_int32()
         three, four = (c_long * 2)(), c_long()
         clk = ctypes.c_ulong()
         seen: list = []
-        pr = cProfile.Profile()
-        t0 = ctl.clock.cycles
+        profiled = _Profiled(ctl, general)
         for rnd in range(4):
             trap_move(1 + rnd % 2, 300 * (rnd + 1) * (-1) ** rnd, 20.0)
-            pr.enable()
-            for _ in range(2500):
-                assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
-                assert gt.GT_GetPrfSts(1, prf, 2) == 0
-                assert gt.GT_GetSts(1, byref(one)) == 0 and gt.GT_GetSts(2, two) == 0
-                assert gt.GTN_GetSts(1, 2, byref(three, ctypes.sizeof(c_long))) == 0
-                assert gt.GTN_GetPrfSts(1, 2, byref(four)) == 0
-                seen.append((clk.value, *words, *prf, one.value, two.value, three[1], four.value))
-            pr.disable()
-        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
+            with profiled.round(rnd):
+                for _ in range(2500):
+                    assert gt.GT_GetSts(1, words, 2, byref(clk)) == 0
+                    assert gt.GT_GetPrfSts(1, prf, 2) == 0
+                    assert gt.GT_GetSts(1, byref(one)) == 0 and gt.GT_GetSts(2, two) == 0
+                    assert gt.GTN_GetSts(1, 2, byref(three, ctypes.sizeof(c_long))) == 0
+                    assert gt.GTN_GetPrfSts(1, 2, byref(four)) == 0
+                    seen.append(
+                        (clk.value, *words, *prf, one.value, two.value, three[1], four.value)
+                    )
+        return seen, profiled.cycles, profiled.asked()
 
 
 def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
@@ -144,10 +170,10 @@ def test_status_spans_stand_across_cycles_that_keep_every_flag() -> None:
     what every call reads is what it reads with every cycle the general way, while the axes
     start, move and stop."""
     quick, cycles, asked = _status_polls(False)
-    general, _, asked_general = _status_polls(True)
+    general, general_cycles, asked_general = _status_polls(True)
     assert quick == general
     assert len({tuple(x[1:3]) for x in quick}) >= 3  # (each axis moving, and neither)
-    assert asked_general > cycles  # (every cycle: each asked again)
+    assert asked_general > general_cycles  # (every cycle: each asked again)
     assert asked < cycles / 4  # (the words held across the quick cycles)
 
 
@@ -161,9 +187,8 @@ def _double_polls(
     polled on the auto clock, each in one shape (a numpy array and a ctypes array, with and
     without the clock, C's ``&arr[1]``);
     ``general``: a watch hook that does nothing, so every cycle goes the general way.  What
-    was read, the cycles run, and how often a span's value function was asked."""
-    import cProfile
-
+    was read, the cycles the profiled rounds ran (:class:`_Profiled`), and how often a span's
+    value function was asked in them."""
     import numpy as np
 
     with _auto(general, eni, cycle_ms=cycle_ms) as ctl:
@@ -180,35 +205,33 @@ def _double_polls(
         rows = {name: np.zeros(count + 1) for name in fast.QUICK_SOURCES}
         one, two = c_double(), (c_double * 2)()
         seen: list = []
-        pr = cProfile.Profile()
-        t0 = ctl.clock.cycles
+        profiled = _Profiled(ctl, general)
         for rnd in range(3):
             for k, a in enumerate(range(first, first + count)):  # (ends apart)
                 trap_move(a, (200 + 90 * k) * (rnd + 1) * (-1) ** rnd, 15.0 + k)
-            pr.enable()
-            for _ in range(300):
-                assert gt.GT_GetPrfPos(first, pos, count, byref(clk)) == 0
-                assert gt.GT_GetPrfVel(first, vel, count) == 0
-                assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
-                assert gt.GT_GetEncPos(first, enc, count) == 0
-                # (a second span of the same reader, read in turn: each kept in its lane)
-                assert gt.GT_GetEncPos(first + 1, byref(enc2, 8), count - 1) == 0
-                assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
-                seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
-                seen.append(bytes(enc2))
-                seen.append(apos.tobytes())
-                for name, arr in rows.items():
-                    assert getattr(gt, name)(first, arr, count, clk) == 0
-                    seen.append(arr.tobytes())
-                for name in fast.SCALAR_SOURCES:
-                    # one axis's, into byref(x), and into &two[1] by the GTN_ twin (its entry
-                    # keeps a span of its own: not this loop's spans')
-                    assert getattr(gt, name)(first + 1, byref(one)) == 0
-                    gtn = getattr(gt, name.replace("GT_", "GTN_"))
-                    assert gtn(1, first, byref(two, 8)) == 0
-                    seen.append((name, one.value, two[1]))
-            pr.disable()
-        return seen, ctl.clock.cycles - t0, _calls(pr, ("f", "value_gt", "value_gtn"))
+            with profiled.round(rnd):
+                for _ in range(300):
+                    assert gt.GT_GetPrfPos(first, pos, count, byref(clk)) == 0
+                    assert gt.GT_GetPrfVel(first, vel, count) == 0
+                    assert gt.GT_GetPrfAcc(first, byref(acc, 8), count, clk) == 0
+                    assert gt.GT_GetEncPos(first, enc, count) == 0
+                    # (a second span of the same reader, read in turn: each kept in its lane)
+                    assert gt.GT_GetEncPos(first + 1, byref(enc2, 8), count - 1) == 0
+                    assert gt.GT_GetAxisPrfPos(first, apos, count) == 0
+                    seen.append((clk.value, pos.tobytes(), bytes(vel), bytes(acc), bytes(enc)))
+                    seen.append(bytes(enc2))
+                    seen.append(apos.tobytes())
+                    for name, arr in rows.items():
+                        assert getattr(gt, name)(first, arr, count, clk) == 0
+                        seen.append(arr.tobytes())
+                    for name in fast.SCALAR_SOURCES:
+                        # one axis's, into byref(x), and into &two[1] by the GTN_ twin (its entry
+                        # keeps a span of its own: not this loop's spans')
+                        assert getattr(gt, name)(first + 1, byref(one)) == 0
+                        gtn = getattr(gt, name.replace("GT_", "GTN_"))
+                        assert gtn(1, first, byref(two, 8)) == 0
+                        seen.append((name, one.value, two[1]))
+        return seen, profiled.cycles, profiled.asked()
 
 
 def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
@@ -223,10 +246,10 @@ def test_double_spans_gathered_after_cycles_booked_in_c() -> None:
         ("twelve_axes.eni", 2, 3, 0.75),
     ):
         quick, cycles, asked = _double_polls(False, eni, first, count, ms)
-        general, _, asked_general = _double_polls(True, eni, first, count, ms)
+        general, general_cycles, asked_general = _double_polls(True, eni, first, count, ms)
         assert quick == general
         assert len(set(quick)) > cycles / 2  # (values that move cycle by cycle)
-        assert asked_general > cycles  # (every cycle: each span asked again)
+        assert asked_general > general_cycles  # (every cycle: each span asked again)
         assert asked < cycles / 2  # (eleven spans: made again in C across the quick cycles)
 
 

@@ -112,18 +112,22 @@ def _start(batch: str) -> subprocess.Popen[str]:
     """The child that fuzzes ``batch``.  The default run fuzzes every batch in one child,
     one after the other (each function is restored after its calls whatever the batch; a
     child costs about half a second of CPU before its first call), and each batch's test
-    reads its own functions' lines; GTECAT_LONG=1 runs a child per batch."""
-    if not LONG:
-        proc = _start_names([n for names in BATCHES.values() for n in names])
-        for b in BATCHES:
+    reads its own functions' lines; GTECAT_LONG=1 runs a child per batch.  A batch whose
+    child runs already is given that child (no second one: it would run unread)."""
+    if batch not in _RUNS:
+        names = BATCHES[batch] if LONG else [n for names in BATCHES.values() for n in names]
+        proc = _start_names(names)
+        for b in [batch] if LONG else BATCHES:
             _RUNS.setdefault(b, proc)
-        return _RUNS[batch]
-    return _start_names(BATCHES[batch])
+    return _RUNS[batch]
 
 
 def _start_names(names: list[str]) -> subprocess.Popen[str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
+    # the child draws from its own strategies only: no other package's hypothesis plugin
+    # (trio's imports trio and pytest, a tenth of the child's start)
+    env.setdefault("HYPOTHESIS_NO_PLUGINS", "1")
     cmd = [
         sys.executable,
         "-m",
@@ -146,7 +150,7 @@ def fuzz_runs():
     batch, so the workers share them out instead of every worker running all of them."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
         for batch in BATCHES:
-            _RUNS.setdefault(batch, _start(batch))
+            _start(batch)
     yield _RUNS
     for p in _RUNS.values():
         if p.poll() is None:
@@ -177,7 +181,7 @@ def test_the_batches_cover_every_function_gt_exposes():
 
 @pytest.mark.parametrize("batch", list(BATCHES))
 def test_fuzz_every_function_with_good_and_bad_arguments(fuzz_runs, batch):
-    proc = fuzz_runs.get(batch) or fuzz_runs.setdefault(batch, _start(batch))
+    proc = fuzz_runs.get(batch) or _start(batch)
     if id(proc) not in _DONE:
         try:
             out, _ = proc.communicate(timeout=BATCH_TIMEOUT_S)

@@ -26,8 +26,11 @@ from tests.conftest import ROOT
 _CHILD = r"""
 import dis, json
 from gtecat import gt
-from gtecat.gt import table
+from gtecat.gt import _core, table
 
+# the GT layer's public names, and which of them are its registered functions
+names = sorted(k for k in vars(gt) if not k.startswith("_"))
+public = [names, [k for k in names if _core.REGISTRY.get(k) is getattr(gt, k)]]
 hook = "__getattr__" in vars(gt)
 whole = all(n in vars(gt) for n in table.exported_names())
 
@@ -59,18 +62,25 @@ print(json.dumps({
         and isinstance(v, type) for k, v in star.items()
     ),
     "no_such": hasattr(gt, "GT_NoSuchFunction"),
+    "public": public,
 }))
 """
 
 
-def test_every_name_is_there_from_the_import_on():
-    """In a fresh process: no module ``__getattr__``, every exported name in ``vars(gt)``
-    before anything asked for one, ``gt.X`` specialised; a declared-only function found
-    through the module returns 8 with its reason; ``dir``, ``import *`` and the enums."""
+@pytest.fixture(scope="module")
+def ordinary() -> dict:
+    """What a fresh process that imports ``gtecat.gt`` finds (``_CHILD``); read-only."""
     out = subprocess.run(
         [sys.executable, "-c", _CHILD], capture_output=True, text=True, cwd=ROOT, check=True
     )
-    got = json.loads(out.stdout.strip().splitlines()[-1])
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_every_name_is_there_from_the_import_on(ordinary):
+    """In a fresh process: no module ``__getattr__``, every exported name in ``vars(gt)``
+    before anything asked for one, ``gt.X`` specialised; a declared-only function found
+    through the module returns 8 with its reason; ``dir``, ``import *`` and the enums."""
+    got = ordinary
     assert got["hook"] is False and got["whole"]
     assert got["ops"] == ["LOAD_ATTR_MODULE"], got["ops"]  # CPython 3.11's specialised load
     assert got["rc"] == 8 and got["declared"]
@@ -197,7 +207,7 @@ import json
 import gtecat
 gtecat._SURFACE_LATER = True  # (as gtecat replay sets it)
 from gtecat import gt
-from gtecat.gt import table
+from gtecat.gt import _core, table
 
 before = {
     "hook": "__getattr__" in vars(gt),
@@ -206,39 +216,33 @@ before = {
     "later_module_there": "GT_GetDi" in vars(gt),
 }
 fn = gt.GT_SetHSIOOpt  # (the first vendor name asked: the surface made)
+names = sorted(k for k in vars(gt) if not k.startswith("_"))
+public = [names, [k for k in names if _core.REGISTRY.get(k) is getattr(gt, k)]]
 after = {
     "hook": "__getattr__" in vars(gt) or "__dir__" in vars(gt),
     "whole": all(n in vars(gt) for n in table.exported_names()),
     "rc": fn(1, 2),
     "no_such": hasattr(gt, "GT_NoSuchFunction"),
 }
-print(json.dumps([before, after]))
-"""
-
-#: the GT layer's public names, and which of them are its registered functions
-_NAMES = r"""
-import json
-import sys
-import gtecat
-gtecat._SURFACE_LATER = sys.argv[1] == "later"
-from gtecat import gt
-from gtecat.gt import _core
-
-if gtecat._SURFACE_LATER:
-    gt.GT_SetHSIOOpt  # (the surface made)
-names = sorted(k for k in vars(gt) if not k.startswith("_"))
-print(json.dumps([names, [k for k in names if _core.REGISTRY.get(k) is getattr(gt, k)]]))
+print(json.dumps([before, after, public]))
 """
 
 
-def test_a_process_that_runs_no_program_makes_the_vendor_surface_at_its_first_name():
-    """``gtecat replay``'s start: with ``gtecat._SURFACE_LATER`` set before the import, the GT
-    layer's own functions and structures are there and the vendor surface is not; the first
-    vendor name asked makes it whole, and the namespace is then an ordinary import's."""
+@pytest.fixture(scope="module")
+def later() -> list:
+    """What a fresh process finds that imports ``gtecat.gt`` as a replay does (``_LATER``);
+    read-only."""
     out = subprocess.run(
         [sys.executable, "-c", _LATER], capture_output=True, text=True, cwd=ROOT, check=True
     )
-    before, after = json.loads(out.stdout.strip().splitlines()[-1])
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_process_that_runs_no_program_makes_the_vendor_surface_at_its_first_name(later):
+    """``gtecat replay``'s start: with ``gtecat._SURFACE_LATER`` set before the import, the GT
+    layer's own functions and structures are there and the vendor surface is not; the first
+    vendor name asked makes it whole, and the namespace is then an ordinary import's."""
+    before, after, _ = later
     assert before == {
         "hook": True,
         "declared_there": False,
@@ -248,18 +252,11 @@ def test_a_process_that_runs_no_program_makes_the_vendor_surface_at_its_first_na
     assert after == {"hook": False, "whole": True, "rc": 8, "no_such": False}
 
 
-def test_the_surface_made_later_is_an_ordinary_imports():
+def test_the_surface_made_later_is_an_ordinary_imports(later, ordinary):
     """The GT modules and vendor surface a replay's process makes at its first name are the
-    namespace an ordinary import makes: the same names, the same registered functions."""
-    got = {}
-    for how in ("later", "now"):
-        out = subprocess.run(
-            [sys.executable, "-c", _NAMES, how],
-            capture_output=True,
-            text=True,
-            cwd=ROOT,
-            check=True,
-        )
-        got[how] = json.loads(out.stdout.strip().splitlines()[-1])
+    namespace an ordinary import makes: the same names, the same registered functions (each
+    read by the processes above: the replay's once its first vendor name is asked, the
+    ordinary one's right after its import)."""
+    got = {"later": later[2], "now": ordinary["public"]}
     assert got["later"] == got["now"]
     assert len(got["now"][1]) > 500
