@@ -44,6 +44,30 @@ def _hypothesis_profiles() -> None:
 gc.set_threshold(5000, 10, 10)
 
 
+def _hypothesis_not_rewritten() -> None:
+    """pytest rewrites the asserts of every module of a plugin's distribution, hypothesis's
+    included (its pytest plugin): ~90 modules of hypothesis's own internal checks, whose
+    failures are never ours to explain, ~0.5 s of CPU in every pytest process on a fresh
+    machine (nothing cached).  Unmarked here, before hypothesis is imported; with a pytest
+    whose internals differ, it is rewritten as before.  Hypothesis's own plugins (another
+    package's, e.g. trio's, which imports trio) are not loaded in the test processes."""
+    import sys
+
+    os.environ.setdefault("HYPOTHESIS_NO_PLUGINS", "1")
+    if "hypothesis" in sys.modules:
+        return
+    for finder in sys.meta_path:
+        marked = getattr(finder, "_must_rewrite", None)
+        if isinstance(marked, set) and "hypothesis" in marked:
+            marked.discard("hypothesis")
+            cache = getattr(finder, "_marked_for_rewrite_cache", None)
+            if isinstance(cache, dict):
+                cache.clear()
+
+
+_hypothesis_not_rewritten()
+
+
 def examples(long: int, default: int) -> int:
     """A property test's ``max_examples``: ``long`` under GTECAT_LONG=1, else ``default``."""
     return long if LONG else default
