@@ -75,16 +75,18 @@ def tool_pythonpath() -> str:
 
 def tool_env() -> dict[str, str]:
     """The environment of ``python3 -m gtecat lib`` as a user runs it in a shell (PATH and
-    PYTHONPATH above), naming this interpreter in GTECAT_PYTHON: the library is built for the
-    interpreter it starts its controller with, and the ``python3`` found on PATH may be
-    another name of this one (a run started as ``python -m pytest``, as CI does, or by the
-    ``pytest`` script): without it the command built a second libgts of its own (a second
-    or more of a first run) instead of finding the ``libgts`` fixture's."""
+    PYTHONPATH above), with GTECAT_PYTHON naming the interpreter the ``libgts`` fixture's
+    build was made for (this one, unless the setting names another): a library is built per
+    interpreter, and the ``python3`` on PATH may be another name of this one (a run started
+    as ``python -m pytest``, as CI does, or by the ``pytest`` script), for which the command
+    built a second libgts beside the fixture's (over a second of a first run)."""
+    from gtecat.native.build import python_executable
+
     return {
         **os.environ,
         "PATH": tool_path(),
         "PYTHONPATH": tool_pythonpath(),
-        "GTECAT_PYTHON": sys.executable,
+        "GTECAT_PYTHON": python_executable(),
     }
 
 
@@ -103,7 +105,8 @@ def lib_flags(args: str = "--cflags --libs") -> list[str]:
     the command runs once per run and environment (:func:`tool_env`), and every program
     compiled after the first takes its answer (a Python process less per program)."""
     env = tool_env()
-    key = (args, tuple(sorted(env.items())))
+    # (the environment but pytest's name of the test running, which changes at every test)
+    key = (args, tuple(sorted((k, v) for k, v in env.items() if k != "PYTEST_CURRENT_TEST")))
     if key not in _LIB_FLAGS:
         cmd = f"python3 -m gtecat lib {args}"
         r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=env)
