@@ -65,6 +65,46 @@ def test_a_fresh_cache_builds_on_first_use_and_only_then(tmp_path, monkeypatch):
     assert log.read_text().splitlines() == calls  # cached: not compiled again
 
 
+def test_the_llp64_build_links_libgts_compiled_transport(tmp_path, monkeypatch):
+    """libgts-llp64.so (C# under Mono) takes the transport's object from libgts's own build
+    (the same source and flags, and the same bytes: the client's long size is the stubs'),
+    and compiles its own where the link refuses that object (a damaged cache).  A logging
+    compiler that writes its ``-o`` file, and fails a link of the object while BAD exists."""
+    from gtecat.native import llp64
+
+    log, bad = tmp_path / "cc.log", tmp_path / "BAD"
+    cc = tmp_path / "logging-cc"
+    cc.write_text(
+        "#!/bin/sh\n"
+        f'echo "$@" >> "{log}"\n'
+        f'case "$*" in *-shared*/src/gts_runtime.o*) [ -e "{bad}" ] && exit 1;; esac\n'
+        'while [ $# -gt 0 ]; do if [ "$1" = -o ]; then : > "$2"; fi; shift; done\n'
+    )
+    cc.chmod(0o755)
+    monkeypatch.setenv("CC", str(cc))
+    monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
+    b = build.ensure_built()
+    shared = b.root / "src" / "gts_runtime.o"
+    assert shared.is_file()
+    before = len(log.read_text().splitlines())
+
+    def calls() -> tuple[list[str], str]:
+        new = log.read_text().splitlines()[before:]
+        return [c for c in new if " -c " in f" {c} "], next(c for c in new if "-shared" in c)
+
+    target = llp64.ensure_built()
+    compiled, link = calls()
+    assert compiled and not any("gts_runtime.c" in c for c in compiled)
+    assert str(shared) in link.split() and "libgts-llp64.so" in link
+    bad.touch()
+    target.unlink()
+    before = len(log.read_text().splitlines())
+    assert llp64.ensure_built() == target and target.is_file()
+    compiled, _ = calls()
+    assert any("gts_runtime.c" in c for c in compiled)
+    assert str(shared) not in log.read_text().splitlines()[-1].split()
+
+
 def test_no_compiler_is_a_clear_error(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("CC", str(tmp_path / "no-cc"))
     monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
