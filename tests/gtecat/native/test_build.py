@@ -66,10 +66,11 @@ def test_a_fresh_cache_builds_on_first_use_and_only_then(tmp_path, monkeypatch):
 
 
 def test_the_llp64_build_links_libgts_compiled_transport(tmp_path, monkeypatch):
-    """libgts-llp64.so (C# under Mono) takes the transport's object from libgts's own build
+    """libgts-llp64.so (C# under Mono) links the transport's object of libgts's own build
     (the same source and flags, and the same bytes: the client's long size is the stubs'),
-    and compiles its own where the link refuses that object (a damaged cache).  A logging
-    compiler that writes its ``-o`` file, and fails a link of the object while BAD exists."""
+    and compiles its own where that link fails (a damaged cache).  A logging compiler that
+    writes its ``-o`` file, and fails a link of libgts's object once BAD exists; empty
+    sources (the compiler reads none)."""
     from gtecat.native import llp64
 
     log, bad = tmp_path / "cc.log", tmp_path / "BAD"
@@ -82,27 +83,31 @@ def test_the_llp64_build_links_libgts_compiled_transport(tmp_path, monkeypatch):
     )
     cc.chmod(0o755)
     monkeypatch.setenv("CC", str(cc))
-    monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))
-    b = build.ensure_built()
-    shared = b.root / "src" / "gts_runtime.o"
-    assert shared.is_file()
-    before = len(log.read_text().splitlines())
+    b = build.Build(tmp_path / "build")
+    shared = b.root / "src" / "gts_runtime.o"  # libgts's build keeps its objects there
+    shared.parent.mkdir(parents=True)
+    shared.touch()
+    b.lib_dir.mkdir()
+    files = dict.fromkeys(("gts.h", "gts_runtime.c", "gts_stubs.c", "gts_declared.c"), "")
+    target = b.lib_dir / llp64.LIBRARY
 
-    def calls() -> tuple[list[str], str]:
-        new = log.read_text().splitlines()[before:]
-        return [c for c in new if " -c " in f" {c} "], next(c for c in new if "-shared" in c)
+    def calls() -> tuple[list[list[str]], list[int], list[int]]:
+        made = [c.split() for c in log.read_text().splitlines()]
+        log.write_text("")
+        links = [n for n, c in enumerate(made) if "-shared" in c]
+        runtime = [n for n, c in enumerate(made) if "-c" in c and "gts_runtime.c" in c[-3]]
+        return made, links, runtime
 
-    target = llp64.ensure_built()
-    compiled, link = calls()
-    assert compiled and not any("gts_runtime.c" in c for c in compiled)
-    assert str(shared) in link.split() and "libgts-llp64.so" in link
+    llp64._compile(b, target, files)
+    made, links, runtime = calls()
+    assert not runtime and len(links) == 1 and str(shared) in made[links[0]]
+    assert target.is_file()
     bad.touch()
-    target.unlink()
-    before = len(log.read_text().splitlines())
-    assert llp64.ensure_built() == target and target.is_file()
-    compiled, _ = calls()
-    assert any("gts_runtime.c" in c for c in compiled)
-    assert str(shared) not in log.read_text().splitlines()[-1].split()
+    llp64._compile(b, target, files)
+    made, links, runtime = calls()
+    assert len(links) == 2 and str(shared) in made[links[0]]  # refused: compiled here
+    assert len(runtime) == 1 and links[0] < runtime[0] < links[1]
+    assert str(shared) not in made[links[1]] and target.is_file()
 
 
 def test_no_compiler_is_a_clear_error(tmp_path, monkeypatch, capsys):
