@@ -100,6 +100,10 @@ def native_env(**extra: str) -> dict[str, str]:
     return env
 
 
+#: lib_flags's answers, by its arguments and environment
+_LIB_FLAGS: dict[tuple[str, tuple[tuple[str, str], ...]], list[str]] = {}
+
+
 def lib_flags(args: str = "--cflags --libs") -> list[str]:
     """The words ``python3 -m gtecat lib ARGS`` prints, as a shell's ``$(...)`` splits them:
     the command runs once per run and environment (:func:`tool_env`), and every program
@@ -114,9 +118,6 @@ def lib_flags(args: str = "--cflags --libs") -> list[str]:
         assert "warning" not in r.stderr, r.stderr
         _LIB_FLAGS[key] = r.stdout.split()
     return _LIB_FLAGS[key]
-
-
-_LIB_FLAGS: dict[tuple[str, tuple[tuple[str, str], ...]], list[str]] = {}
 
 
 def compile_client(src: Path, out: Path, compiler: str) -> Path:
