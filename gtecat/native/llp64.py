@@ -237,25 +237,35 @@ def _compile(
         # as libgts's units: the transport optimised, the stubs (they only pack arguments
         # for a socket round trip) and the declared-only functions at -O0 without unwind
         # tables (a third of -O1's compile time; a test run builds this once)
-        base = [*cc, *extra, "-DGTE_CLIENT_LONG_SIZE=4", f"-I{tmp}"]
-        units = (
-            ("gts_runtime.c", _build.CFLAGS),
+        base = [*cc, *extra, f"-I{tmp}"]
+        runtime = ("gts_runtime.c", _build.CFLAGS)
+        units = [
             ("gts_stubs.c", (*_build.CFLAGS, *_build.STUB_CFLAGS)),
             *_build.declared_units(cc, extra),
-        )
-        what = soname if not extra else f"the 32-bit {soname} ({' '.join(extra)})"
-        objs = _build.compile_units(list(units), base, tmp, what)
-        cmd = [
-            *cc,
-            *extra,
-            *_build.CFLAGS,
-            "-shared",
-            f"-Wl,-soname,{soname}",
-            *objs,
-            "-o",
-            str(out),
         ]
-        _run(cmd, what)
+        what = soname if not extra else f"the 32-bit {soname} ({' '.join(extra)})"
+        # the transport of libgts's own build serves this one unchanged: the client's long
+        # size is the stubs' (gte_client_long_size) and the transport declares nothing with
+        # a long, so its object is the same byte for byte (half a second of compiling); the
+        # 32-bit build compiles its own, and so does one whose link refuses that object
+        shared = build.root / "src" / "gts_runtime.o"
+        if extra or not shared.is_file():
+            units.insert(0, runtime)
+        objs = _build.compile_units(units, base, tmp, what)
+        if runtime not in units:
+            objs.insert(0, str(shared))
+
+        def link() -> None:
+            cmd = [*cc, *extra, *_build.CFLAGS, "-shared", f"-Wl,-soname,{soname}", *objs]
+            _run([*cmd, "-o", str(out)], what)
+
+        try:
+            link()
+        except NativeBuildError:
+            if runtime in units:
+                raise
+            objs[0] = _build.compile_units([runtime], base, tmp, what)[0]
+            link()
         put_in_place(out, target)
 
 

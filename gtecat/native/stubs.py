@@ -141,6 +141,9 @@ def render_stubs(python: str) -> str:
         '#include "gts_runtime.h"',
         "",
         f'const char gte_default_python[] = "{esc}";',
+        # (here, not in the transport: the LLP64 build's stubs spell it sizeof(int), and
+        # libgts's compiled transport serves that build unchanged, gtecat.native.llp64)
+        "const unsigned short gte_client_long_size = sizeof(long);",
         "",
     ]
     for plan in plans():

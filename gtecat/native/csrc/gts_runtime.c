@@ -733,18 +733,12 @@ static int client_token(char *out, size_t cap, const char *fname, const char *po
     return 0;
 }
 
-/* the client's long as the stubs were compiled: 8 on Linux, 4 in the LLP64 build that serves
- * programs written for Windows (C# / VB.NET under Mono, gtecat.native.llp64) */
-#ifndef GTE_CLIENT_LONG_SIZE
-#define GTE_CLIENT_LONG_SIZE sizeof(long)
-#endif
-
-/* hello: announce protocol, sizeof(long) and the table digest (and the token, for TCP);
- * 0 ok */
+/* hello: announce protocol, the client's sizeof(long) and the table digest (and the token,
+ * for TCP); 0 ok */
 static int hello(gte_sock fd, const char *token, const char *fname, long long deadline)
 {
     unsigned char msg[4 + 24 + 2 + 256];
-    uint16_t version = GTE_PROTOCOL_VERSION, lsize = (uint16_t)GTE_CLIENT_LONG_SIZE;
+    uint16_t version = GTE_PROTOCOL_VERSION, lsize = gte_client_long_size;
     size_t toklen = strlen(token), body = 24;
     if (toklen > 256) {
         set_err("%s returned -1: the token is longer than 256 bytes", fname);

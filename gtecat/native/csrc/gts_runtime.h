@@ -70,5 +70,8 @@ void gte_use_card(short card);
 
 /* the interpreter that built the library (generated beside the stubs) */
 GTE_INTERNAL extern const char gte_default_python[];
+/* sizeof(long) of the client the stubs serve (generated beside them): 8 on Linux, 4 in the
+ * LLP64 build that serves programs written for Windows (C# / VB.NET under Mono) */
+GTE_INTERNAL extern const unsigned short gte_client_long_size;
 
 #endif

@@ -73,6 +73,23 @@ def tool_pythonpath() -> str:
     return os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
 
 
+def tool_env() -> dict[str, str]:
+    """The environment of ``python3 -m gtecat lib`` as a user runs it in a shell (PATH and
+    PYTHONPATH above), with GTECAT_PYTHON naming the interpreter the ``libgts`` fixture's
+    build was made for (this one, unless the setting names another): a library is built per
+    interpreter, and the ``python3`` on PATH may be another name of this one (a run started
+    as ``python -m pytest``, as CI does, or by the ``pytest`` script), for which the command
+    built a second libgts beside the fixture's (over a second of a first run)."""
+    from gtecat.native.build import python_executable
+
+    return {
+        **os.environ,
+        "PATH": tool_path(),
+        "PYTHONPATH": tool_pythonpath(),
+        "GTECAT_PYTHON": python_executable(),
+    }
+
+
 def native_env(**extra: str) -> dict[str, str]:
     """The environment of a native client: the manual's figure 5-2 bus, auto clock, no
     controller named (the library starts its own)."""
@@ -83,17 +100,32 @@ def native_env(**extra: str) -> dict[str, str]:
     return env
 
 
+#: lib_flags's answers, by its arguments and environment
+_LIB_FLAGS: dict[tuple[str, tuple[tuple[str, str], ...]], list[str]] = {}
+
+
+def lib_flags(args: str = "--cflags --libs") -> list[str]:
+    """The words ``python3 -m gtecat lib ARGS`` prints, as a shell's ``$(...)`` splits them:
+    the command runs once per run and environment (:func:`tool_env`), and every program
+    compiled after the first takes its answer (a Python process less per program)."""
+    env = tool_env()
+    # (the environment but pytest's name of the test running, which changes at every test)
+    key = (args, tuple(sorted((k, v) for k, v in env.items() if k != "PYTEST_CURRENT_TEST")))
+    if key not in _LIB_FLAGS:
+        cmd = f"python3 -m gtecat lib {args}"
+        r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=env)
+        assert r.returncode == 0, f"{cmd}\n{r.stderr}"
+        assert "warning" not in r.stderr, r.stderr
+        _LIB_FLAGS[key] = r.stdout.split()
+    return _LIB_FLAGS[key]
+
+
 def compile_client(src: Path, out: Path, compiler: str) -> Path:
-    """Compile exactly as a user would: ``gcc prog.c $(python3 -m gtecat lib --cflags --libs)``."""
-    flags = "$(python3 -m gtecat lib --cflags --libs)"
-    cmd = f"{compiler} {shlex.quote(str(src))} {flags} -o {shlex.quote(str(out))}"
-    r = subprocess.run(
-        ["bash", "-c", cmd],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "PATH": tool_path(), "PYTHONPATH": tool_pythonpath()},
-    )
-    assert r.returncode == 0, f"{cmd}\n{r.stderr}"
+    """Compile exactly as a user would: ``gcc prog.c $(python3 -m gtecat lib --cflags --libs)``
+    (the command's words from :func:`lib_flags`)."""
+    cmd = [*shlex.split(compiler), str(src), *lib_flags(), "-o", str(out)]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=tool_env())
+    assert r.returncode == 0, f"{shlex.join(cmd)}\n{r.stderr}"
     assert "warning" not in r.stderr, r.stderr
     return out
 
@@ -105,6 +137,25 @@ def motion_demo(libgts, tmp_path_factory) -> Path:
     return compiled_once(
         tmp_path_factory, libgts, ROOT / "examples" / "native" / "motion_demo.cpp", "g++"
     )
+
+
+@pytest.fixture(scope="session")
+def gtn_sequence(libgts, tmp_path_factory) -> Path:
+    """c/gtn_sequence.c (the vendor's GTN sequence) compiled once for the run: the C client,
+    in-process and Windows tests run it."""
+    return compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
+
+
+@pytest.fixture(scope="session")
+def gtn_sequence_on_its_controller_process(gtn_sequence, tmp_path_factory):
+    """gtn_sequence run once with ``GTECAT_INPROCESS=0`` (the private controller as a process
+    of its own, as a program gets it where the Python runtime cannot be loaded), in a folder
+    of its own: ``(result, its lines, the folder)``, read-only.  test_inprocess checks what
+    the program saw, test_c_clients that its controller ended with it (one run, not two:
+    a controller process's start is most of either test)."""
+    cwd = tmp_path_factory.mktemp("gtn-sequence-process")
+    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=cwd)
+    return r, v, cwd
 
 
 def compiled_once(tmp_path_factory, libgts, src: Path, compiler: str) -> Path:

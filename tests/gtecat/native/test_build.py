@@ -65,6 +65,51 @@ def test_a_fresh_cache_builds_on_first_use_and_only_then(tmp_path, monkeypatch):
     assert log.read_text().splitlines() == calls  # cached: not compiled again
 
 
+def test_the_llp64_build_links_libgts_compiled_transport(tmp_path, monkeypatch):
+    """libgts-llp64.so (C# under Mono) links the transport's object of libgts's own build
+    (the same source and flags, and the same bytes: the client's long size is the stubs'),
+    and compiles its own where that link fails (a damaged cache).  A logging compiler that
+    writes its ``-o`` file, and fails a link of libgts's object once BAD exists; empty
+    sources (the compiler reads none)."""
+    from gtecat.native import llp64
+
+    log, bad = tmp_path / "cc.log", tmp_path / "BAD"
+    cc = tmp_path / "logging-cc"
+    cc.write_text(
+        "#!/bin/sh\n"
+        f'echo "$@" >> "{log}"\n'
+        f'case "$*" in *-shared*/src/gts_runtime.o*) [ -e "{bad}" ] && exit 1;; esac\n'
+        'while [ $# -gt 0 ]; do if [ "$1" = -o ]; then : > "$2"; fi; shift; done\n'
+    )
+    cc.chmod(0o755)
+    monkeypatch.setenv("CC", str(cc))
+    b = build.Build(tmp_path / "build")
+    shared = b.root / "src" / "gts_runtime.o"  # libgts's build keeps its objects there
+    shared.parent.mkdir(parents=True)
+    shared.touch()
+    b.lib_dir.mkdir()
+    files = dict.fromkeys(("gts.h", "gts_runtime.c", "gts_stubs.c", "gts_declared.c"), "")
+    target = b.lib_dir / llp64.LIBRARY
+
+    def calls() -> tuple[list[list[str]], list[int], list[int]]:
+        made = [c.split() for c in log.read_text().splitlines()]
+        log.write_text("")
+        links = [n for n, c in enumerate(made) if "-shared" in c]
+        runtime = [n for n, c in enumerate(made) if "-c" in c and "gts_runtime.c" in c[-3]]
+        return made, links, runtime
+
+    llp64._compile(b, target, files)
+    made, links, runtime = calls()
+    assert not runtime and len(links) == 1 and str(shared) in made[links[0]]
+    assert target.is_file()
+    bad.touch()
+    llp64._compile(b, target, files)
+    made, links, runtime = calls()
+    assert len(links) == 2 and str(shared) in made[links[0]]  # refused: compiled here
+    assert len(runtime) == 1 and links[0] < runtime[0] < links[1]
+    assert str(shared) not in made[links[1]] and target.is_file()
+
+
 def test_no_compiler_is_a_clear_error(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("CC", str(tmp_path / "no-cc"))
     monkeypatch.setenv("GTECAT_CACHE_DIR", str(tmp_path / "cache"))

@@ -11,7 +11,6 @@ import pytest
 from .conftest import (
     C_DIR,
     compile_client,
-    compiled_once,
     native_env,
     needs_cc,
     needs_cxx,
@@ -20,12 +19,6 @@ from .conftest import (
 
 # the compiled clients serve the module: under pytest-xdist (--dist loadgroup) one worker
 pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
-
-
-@pytest.fixture(scope="module")
-def gtn_sequence(libgts, tmp_path_factory):
-    # (test_inprocess runs it too: compiled once for the run)
-    return compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
 
 
 @pytest.fixture(scope="module")
@@ -88,15 +81,15 @@ def test_vendor_gtn_sequence_from_c(gtn_sequence, tmp_path):
     assert (v["reopen"], v["reopen_sts"]) == ("0", "0")
 
 
-def test_the_private_controller_ends_with_the_program(gtn_sequence, tmp_path):
-    # (GTECAT_INPROCESS=0: the controller process; by default it runs in the program)
-    assert not _controllers(tmp_path)
-    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=tmp_path)
+def test_the_private_controller_ends_with_the_program(gtn_sequence_on_its_controller_process):
+    # (GTECAT_INPROCESS=0: the controller process; by default it runs in the program.  The
+    # run is test_inprocess's too; its folder was made for it, so nothing ran there before)
+    r, v, cwd = gtn_sequence_on_its_controller_process
     assert v.get("done") == "1", r.stdout + r.stderr
     deadline = time.monotonic() + 10
-    while _controllers(tmp_path) and time.monotonic() < deadline:
+    while _controllers(cwd) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert not _controllers(tmp_path)
+    assert not _controllers(cwd)
 
 
 def test_the_scheduling_setting_of_gtecat_ini_reaches_the_private_controller(

@@ -15,14 +15,7 @@ from gtecat.native import inprocess
 from gtecat.native.protocol import FRAME, HELLO, PROTOCOL_VERSION, table_digest
 from gtecat.native.transport import SOCKET_TYPE
 
-from .conftest import C_DIR, compile_client, compiled_once, native_env, needs_cc, run_client
-
-
-@pytest.fixture(scope="module")
-def gtn_sequence(libgts, tmp_path_factory):
-    # (the executable test_c_clients runs: compiled once for the run)
-    return compiled_once(tmp_path_factory, libgts, C_DIR / "gtn_sequence.c", "gcc")
-
+from .conftest import compile_client, native_env, needs_cc, run_client
 
 #: a Python built without a shared runtime (no --enable-shared, and none installed beside a
 #: statically linked one) cannot be loaded into a program: libgts starts the process instead
@@ -55,9 +48,10 @@ def test_a_c_program_runs_its_controller_in_process(gtn_sequence, tmp_path):
 
 
 @needs_cc
-def test_inprocess_0_starts_the_controller_process(gtn_sequence, tmp_path):
-    """The controller process, as a program gets it where the runtime cannot be loaded."""
-    r, v = run_client(gtn_sequence, env=native_env(GTECAT_INPROCESS="0"), cwd=tmp_path)
+def test_inprocess_0_starts_the_controller_process(gtn_sequence_on_its_controller_process):
+    """The controller process, as a program gets it where the runtime cannot be loaded (the
+    run test_c_clients checks the controller's end of)."""
+    r, v, _ = gtn_sequence_on_its_controller_process
     assert r.returncode == 0 and v["done"] == "1", r.stdout + r.stderr
     assert (v["open"], v["ready"], v["prfpos"]) == ("0", "1", "20000")
     assert int(v["slept_ms"]) >= 200
@@ -172,16 +166,22 @@ int main(void)
 """
 
 
+@pytest.fixture(scope="module")
+def fork_program(libgts, tmp_path_factory):
+    """_FORK compiled once for both of its runs."""
+    d = tmp_path_factory.mktemp("fork")
+    (d / "fork.c").write_text(_FORK)
+    return compile_client(d / "fork.c", d / "fork", "gcc")
+
+
 @needs_cc
 @pytest.mark.parametrize("inproc", ["1", "0"])
-def test_a_forked_child_reaches_the_controller_once_it_opens(tmp_path, inproc):
+def test_a_forked_child_reaches_the_controller_once_it_opens(fork_program, tmp_path, inproc):
     """A child of the program reconnects over the controller's socket (the reconnection
     read its address from the buffer it was writing: it never connected); until its own
     GT_Open, the controller's reason says to open."""
-    src = tmp_path / "fork.c"
-    src.write_text(_FORK)
-    exe = compile_client(src, tmp_path / "fork", "gcc")
-    r, v = run_client(exe, env=native_env(GTECAT_INPROCESS=inproc), cwd=tmp_path, timeout=120)
+    env = native_env(GTECAT_INPROCESS=inproc)
+    r, v = run_client(fork_program, env=env, cwd=tmp_path, timeout=120)
     assert v.get("open") == "0", r.stdout + r.stderr
     assert (
         v["child_before_open"].startswith("-1 ") and "has not opened" in v["child_before_open"]

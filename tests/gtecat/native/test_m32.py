@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import C_DIR, native_env, needs_cxx, run_client, tool_path, tool_pythonpath
+from .conftest import C_DIR, native_env, needs_cxx, run_client, tool_env
 
 
 def _m32_works() -> bool:
@@ -47,8 +47,7 @@ def test_a_vendor_header_with_long_fields_runs_as_a_32_bit_program(tmp_path: Pat
         f"-I{shlex.quote(str(C_DIR / 'vendor_long'))} "
         f"$(python3 -m gtecat lib --m32 --cflags --libs) -o {shlex.quote(str(exe))}"
     )
-    env = {**os.environ, "PATH": tool_path(), "PYTHONPATH": tool_pythonpath()}
-    r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=env)
+    r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=tool_env())
     assert r.returncode == 0, f"{cmd}\n{r.stderr}"
     (tmp_path / "machine.toml").write_text(MACHINE, encoding="utf-8")
     env = native_env(GTECAT_CARD="gts:4", GTECAT_MACHINE=str(tmp_path / "machine.toml"))

@@ -4,7 +4,6 @@ Python, and the older multi-card ABI (``--abi gts-multicard``) runs a client of 
 
 from __future__ import annotations
 
-import os
 import shlex
 import subprocess
 from pathlib import Path
@@ -23,8 +22,7 @@ from .conftest import (
     needs_cc,
     needs_cxx,
     run_client,
-    tool_path,
-    tool_pythonpath,
+    tool_env,
 )
 
 pytestmark = [needs_cc, pytest.mark.xdist_group("c_clients")]
@@ -49,8 +47,7 @@ def _compile(src: Path, out: Path, compiler: str, lib_args: str, extra: str = ""
         f"{compiler} {extra} {shlex.quote(str(src))} $(python3 -m gtecat lib {lib_args}) "
         f"-o {shlex.quote(str(out))}"
     )
-    env = {**os.environ, "PATH": tool_path(), "PYTHONPATH": tool_pythonpath()}
-    r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=env)
+    r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=tool_env())
     assert r.returncode == 0, f"{cmd}\n{r.stderr}"
     assert "warning" not in r.stderr, r.stderr
     return out
