@@ -21,6 +21,7 @@ import socket
 import struct
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -162,10 +163,24 @@ def _bare_prefix(root: Path, bits: int) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
+def _run_wine(exe: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
+    """``wine exe``, its output read once ``wine`` has ended: from files, not pipes - the
+    wineserver that ``wine`` starts inherits its output and stays on ~1 s after the program
+    ends, so reading pipes to their end waited that second for each program."""
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        rc = subprocess.run(
+            ["wine", str(exe)], stdout=out, stderr=err, env=env, cwd=exe.parent, timeout=300
+        ).returncode
+        # as ``text=True`` reads them: universal newlines (a Windows program ends its lines "\r\n")
+        text = [
+            f.seek(0) or f.read().decode().replace("\r\n", "\n").replace("\r", "\n")
+            for f in (out, err)
+        ]
+    return subprocess.CompletedProcess(["wine", str(exe)], rc, *text)
+
+
 def _wine(exe: Path, env: dict[str, str]) -> tuple[subprocess.CompletedProcess, dict[str, str]]:
-    r = subprocess.run(
-        ["wine", str(exe)], capture_output=True, text=True, env=env, cwd=exe.parent, timeout=300
-    )
+    r = _run_wine(exe, env)
     if r.returncode != 0 and "wine32 is missing" in r.stderr:
         pytest.skip("Wine cannot run 32-bit programs here: install wine32 (.ci/deps/wine32.sh)")
     return r, parse_lines(r.stdout)
@@ -419,9 +434,7 @@ def test_the_x64_dll_under_wine(tcp_controller, tmp_path):
         demo = programs["load"].parent / "motion_demo.exe"
         src = ROOT / "examples" / "native" / "motion_demo.cpp"
         _cross("x64", "g++", src, demo, f"-I{dll.root}", "-static", str(dll.root / "gts.lib"))
-        r = subprocess.run(
-            ["wine", str(demo)], capture_output=True, text=True, env=env, timeout=300
-        )
+        r = _run_wine(demo, env)
         seen = r.stdout.splitlines()
         assert r.returncode == 0, r.stdout + r.stderr
         assert "home status 3" in seen and "moved prf 30000 enc 30000" in seen, seen
