@@ -327,9 +327,11 @@ def serve(socket_path: str, *, control: bool, port: int, title: str, ready: Any 
         if ready is not None:
             ready(url)
         try:
-            while not state.stop.is_set():
-                await asyncio.sleep(0.2)
+            # woken by the event itself (a thread waits on it), not by looking every 0.2 s:
+            # the panel ends as soon as it is asked to or the watched gtecat ends
+            await _LOOP.run_in_executor(None, state.stop.wait)
         finally:
+            state.stop.set()  # cancelled (Ctrl-C): the waiting thread ends too
             for sock in list(state.clients):
                 with contextlib.suppress(Exception):
                     await sock.close()
