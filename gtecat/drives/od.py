@@ -474,6 +474,42 @@ class AttrVariable(Variable):
         setattr(self._owner, self._attr, value)
 
 
+def item_at(owner: object, attr: str, j: int) -> Any:
+    """``getattr(owner, attr)[j]``: the value of an entry kept in an owner's list."""
+    return getattr(owner, attr)[j]
+
+
+class ItemVariable(Variable):
+    """A read-only entry whose value is ``getattr(owner, attr)[j]`` (a touch probe's latched
+    values and counters, an analog input): the same as ``Variable(...,
+    getter=partial(getattr-and-index))`` without the callable and its arguments made for
+    each entry of each drive (the getter is made only when asked for)."""
+
+    __slots__ = ("_attr", "_j", "_owner")
+
+    def __init__(
+        self,
+        owner: object,
+        attr: str,
+        j: int,
+        index: int,
+        subindex: int,
+        name: str,
+        data_type: DataType,
+        access: Access = Access.RO,
+        **kw: Any,
+    ) -> None:
+        self._owner, self._attr, self._j = owner, attr, j
+        super().__init__(index, subindex, name, data_type, access, **kw)
+
+    getter = property(lambda self: partial(item_at, self._owner, self._attr, self._j), _only_none)
+    #: (no setter: a write keeps :attr:`value`, which the getter hides, as a plain entry's)
+    setter = property(lambda self: None, _only_none)
+
+    def get(self) -> Any:
+        return getattr(self._owner, self._attr)[self._j]
+
+
 class SlotVariable(Variable):
     """An entry whose value is ``values[k]`` of a list its owner keeps (a PDO mapping's or
     assignment's entry); a write goes through ``put(k, value)``, one callable shared by the

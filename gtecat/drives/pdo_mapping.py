@@ -121,6 +121,8 @@ class PdoMapping:
         self.max_bytes = max_bytes
         od.allow_placeholders = not strict
         self._maps: dict[int, _Slots] = {}
+        #: the last codec compiled and what it was compiled from (:meth:`compile`)
+        self._compiled: tuple[tuple, PdoCodec] | None = None
         self._assign: dict[int, _Slots] = {
             RX_ASSIGN: _Slots(0, [0] * max_assigned),
             TX_ASSIGN: _Slots(0, [0] * max_assigned),
@@ -407,6 +409,10 @@ class PdoMapping:
         return {(i, s) for i, s, _ in self.entries(direction) if not is_gap(i)}
 
     def compile(self) -> PdoCodec:
+        """The codec of the current mapping.  The one compiled last is given again when the
+        mapping still names the same entries, each the same object of the same type (a
+        codec is immutable): a bus's start-up compiles each drive's mapping at construction
+        and again at PREOP->SAFEOP, most often unchanged by its InitCmds."""
         rx = []
         off = 0
         for i, s, n in self.entries(Direction.OUT):
@@ -420,7 +426,13 @@ class PdoMapping:
             if not is_gap(i):
                 tx.append((off, n, self.od.variable(i, s)))
             off += n
-        return PdoCodec(rx, rx_bits, tx, off)
+        key = (rx_bits, off, rx, tx, _traits(rx), _traits(tx))
+        last = self._compiled
+        if last is not None and last[0] == key:
+            return last[1]
+        codec = PdoCodec(rx, rx_bits, tx, off)
+        self._compiled = (key, codec)
+        return codec
 
 
 # --- the codec --------------------------------------------------------------------------
@@ -539,6 +551,18 @@ class PdoCodec:
             if real:
                 value = int.from_bytes(struct.pack("<f", float(value)), "little")
             set_bits(buf, off, bits, int(value) & ((1 << bits) - 1))
+
+
+def _traits(entries: list[tuple[int, int, Variable]]) -> tuple:
+    """What else a codec's fields are made of besides each entry's place and object: its
+    type, and a plain entry's own getter and setter (another entry kind answers them from
+    what it was made with, fixed for its life)."""
+    out: list[Any] = []
+    for _, _, var in entries:
+        out.append(var.data_type)
+        if type(var) is Variable:
+            out += (var.getter, var.setter)
+    return tuple(out)
 
 
 def _setter(var: Variable) -> Callable[[Any], None]:
