@@ -87,6 +87,7 @@ from gtecat.drives.modes import (
 )
 from gtecat.drives.od import (
     Access,
+    AttrObject,
     AttrVariable,
     DataType,
     ItemVariable,
@@ -95,6 +96,7 @@ from gtecat.drives.od import (
     PdoDir,
     Variable,
     add_identity,
+    attr_spec,
     item_at,
 )
 from gtecat.drives.pdo_mapping import PdoMapping
@@ -420,9 +422,13 @@ class Channel:
         attr: str,
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
-    ) -> Variable:
+    ) -> None:
+        """The VAR object ``index`` (this channel's) whose entry is the attribute ``attr``."""
         at = _shared_int(index + self.base)
-        return od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
+        if kw:  # (a range or allowed values: the entry now)
+            od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
+        else:  # (made when first looked at)
+            od.add_object(AttrObject(self, at, attr_spec(attr, name, dt, access, pdo)))
 
     def _sub(
         self,

@@ -634,6 +634,72 @@ class OdObject:
         return int(DataType.UINT8)
 
 
+class AttrSpec:
+    """What an :class:`AttrObject`'s entry is made of, the owner aside: one for the same
+    object of every drive channel (:func:`attr_spec`)."""
+
+    __slots__ = ("access", "attr", "data_type", "name", "pdo")
+
+    def __init__(
+        self, attr: str, name: str, data_type: DataType, access: Access, pdo: PdoDir
+    ) -> None:
+        self.attr, self.name, self.data_type, self.access, self.pdo = (
+            attr,
+            name,
+            data_type,
+            access,
+            pdo,
+        )
+
+
+def attr_spec(attr: str, name: str, data_type: DataType, access: Access, pdo: PdoDir) -> AttrSpec:
+    """The one :class:`AttrSpec` of these."""
+    key = (attr, name, data_type, access, pdo)
+    spec = _ATTR_SPECS.get(key)
+    if spec is None:
+        if len(_ATTR_SPECS) >= 4096:
+            _ATTR_SPECS.clear()
+        spec = _ATTR_SPECS[key] = AttrSpec(attr, name, data_type, access, pdo)
+    return spec
+
+
+_ATTR_SPECS: dict[tuple[str, str, DataType, Access, PdoDir], AttrSpec] = {}
+
+
+class AttrObject(OdObject):
+    """A VAR object whose one entry is ``AttrVariable(owner, spec.attr, index, 0, ...)``,
+    made when the object is first looked at: most of a drive channel's forty such objects
+    never are during a bus's life (the drive's own code reads its attributes), and a bus
+    has hundreds of channels.  Once made, the entry is the object's for good (a write to
+    it is the owner's attribute: one drive's never shows in another's)."""
+
+    __slots__ = ("_owner",)
+
+    def __init__(self, owner: object, index: int, spec: AttrSpec) -> None:
+        super().__init__(index, spec.name, ObjectCode.VAR, spec)  # type: ignore[arg-type]
+        self._owner = owner
+
+    @property
+    def subs(self) -> dict[int, Variable]:
+        """Subindex -> entry (the entry made now if it was not yet)."""
+        subs = self._subs
+        if subs is None:
+            spec: AttrSpec = self._make  # type: ignore[assignment]
+            var = AttrVariable(
+                self._owner,
+                spec.attr,
+                self.index,
+                0,
+                spec.name,
+                spec.data_type,
+                spec.access,
+                pdo=spec.pdo,
+            )
+            self._make = None
+            subs = self._subs = {0: var}
+        return subs
+
+
 class ObjectDictionary:
     """All objects of one slave, with SDO upload/download semantics."""
 
