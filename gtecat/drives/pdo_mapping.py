@@ -90,6 +90,18 @@ class _Slots:
     fixed: bool = False
 
 
+def _sm_types() -> list[Variable]:
+    """1C00h's entries (made when the object is first looked at: a bus's start-up never
+    does), as :meth:`ObjectDictionary.add_record` makes them: the count, then SM0..SM3's
+    communication types (mailbox out, mailbox in, outputs, inputs)."""
+    types = [
+        Variable(0x1C00, k + 1, f"SM{k} type", DataType.UINT8, Access.RO, default=t)
+        for k, t in enumerate((1, 2, 3, 4))
+    ]
+    count = Variable(0x1C00, 0, "Number of entries", DataType.UINT8, Access.RO, default=4)
+    return [count, *types]
+
+
 class PdoMapping:
     """Mapping and assignment objects of one slave, and the compiler of its codec.
 
@@ -147,14 +159,8 @@ class PdoMapping:
         self._add_assign_object(RX_ASSIGN, "RxPDO assign")
         self._add_assign_object(TX_ASSIGN, "TxPDO assign")
         if 0x1C00 not in od:
-            od.add_record(
-                0x1C00,
-                "Sync manager communication type",
-                [
-                    Variable(0x1C00, k + 1, f"SM{k} type", DataType.UINT8, Access.RO, default=t)
-                    for k, t in enumerate((1, 2, 3, 4))
-                ],
-                code=ObjectCode.ARRAY,
+            od.add_lazy_record(
+                0x1C00, "Sync manager communication type", _sm_types, code=ObjectCode.ARRAY
             )
 
     # --- construction ------------------------------------------------------------
@@ -426,7 +432,7 @@ class PdoMapping:
             if not is_gap(i):
                 tx.append((off, n, self.od.variable(i, s)))
             off += n
-        key = (rx_bits, off, rx, tx, _traits(rx), _traits(tx))
+        key = (rx_bits, off, _traits(rx), _traits(tx))
         last = self._compiled
         if last is not None and last[0] == key:
             return last[1]
@@ -554,12 +560,12 @@ class PdoCodec:
 
 
 def _traits(entries: list[tuple[int, int, Variable]]) -> tuple:
-    """What else a codec's fields are made of besides each entry's place and object: its
-    type, and a plain entry's own getter and setter (another entry kind answers them from
-    what it was made with, fixed for its life)."""
+    """What a codec's fields are made of, in one tuple: each entry's place, object and type,
+    and a plain entry's own getter and setter (another entry kind answers them from what it
+    was made with, fixed for its life)."""
     out: list[Any] = []
-    for _, _, var in entries:
-        out.append(var.data_type)
+    for off, bits, var in entries:
+        out += (off, bits, var, var.data_type)
         if type(var) is Variable:
             out += (var.getter, var.setter)
     return tuple(out)
