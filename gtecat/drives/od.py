@@ -592,6 +592,9 @@ class OdObject:
                 if var.subindex == subindex:
                     return var
             return None
+        one = getattr(make, "one", None)
+        if one is not None:  # (a maker of single entries: a PDO mapping's or assignment's)
+            return one(subindex)  # type: ignore[no-any-return]
         return self.subs.get(subindex)
 
     def __repr__(self) -> str:
@@ -805,15 +808,14 @@ class ObjectDictionary:
             raise SdoAbort(SdoAbortCode.OBJECT_DOES_NOT_EXIST, index, subindex) from None
 
     def variable(self, index: int, subindex: int) -> Variable:
-        obj = self.obj(index, subindex)
-        try:
-            return obj.subs[subindex]
-        except KeyError:
-            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
+        var = self.obj(index, subindex).sub(subindex)
+        if var is None:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex)
+        return var
 
     def find(self, index: int, subindex: int) -> Variable | None:
         obj = self.objects.get(index)
-        return None if obj is None else obj.subs.get(subindex)
+        return None if obj is None else obj.sub(subindex)
 
     def size_of(self, index: int, subindex: int) -> int | None:
         """Wire size of an entry, for expedited downloads that do not state their size."""
@@ -827,10 +829,9 @@ class ObjectDictionary:
         obj = self.obj(index, subindex)
         if complete_access and obj.code is not ObjectCode.VAR:
             return self._upload_complete(obj, subindex)
-        try:
-            var = obj.subs[subindex]  # (self.variable, with the object already found)
-        except KeyError:
-            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
+        var = obj.sub(subindex)  # (self.variable, with the object already found)
+        if var is None:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex)
         if not var.access.readable:
             raise SdoAbort(SdoAbortCode.READ_OF_WRITE_ONLY, index, subindex)
         return var.encode(var.get())
@@ -869,10 +870,9 @@ class ObjectDictionary:
         if complete_access and obj.code is not ObjectCode.VAR:
             self._download_complete(obj, subindex, bytes(data), al_state)
             return
-        try:
-            var = obj.subs[subindex]  # (self.variable, with the object already found)
-        except KeyError:
-            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
+        var = obj.sub(subindex)  # (self.variable, with the object already found)
+        if var is None:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex)
         self._write(var, bytes(data), al_state)
 
     def download_value(
