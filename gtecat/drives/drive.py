@@ -87,13 +87,17 @@ from gtecat.drives.modes import (
 )
 from gtecat.drives.od import (
     Access,
+    AttrObject,
     AttrVariable,
     DataType,
+    ItemVariable,
     ObjectCode,
     ObjectDictionary,
     PdoDir,
     Variable,
     add_identity,
+    attr_spec,
+    item_at,
 )
 from gtecat.drives.pdo_mapping import PdoMapping
 from gtecat.drives.sdo_server import SdoServer
@@ -418,9 +422,13 @@ class Channel:
         attr: str,
         pdo: PdoDir = PdoDir.NONE,
         **kw: Any,
-    ) -> Variable:
+    ) -> None:
+        """The VAR object ``index`` (this channel's) whose entry is the attribute ``attr``."""
         at = _shared_int(index + self.base)
-        return od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
+        if kw:  # (a range or allowed values: the entry now)
+            od.add_entry(AttrVariable(self, attr, at, 0, name, dt, access, pdo=pdo, **kw))
+        else:  # (made when first looked at)
+            od.add_object(AttrObject(self, at, attr_spec(attr, name, dt, access, pdo)))
 
     def _sub(
         self,
@@ -559,13 +567,8 @@ class Channel:
             "Touch probe 2 negative value",
         )
         for j, name in enumerate(names):
-            od.add_var(
-                0x60BA + j + b,
-                name,
-                d.INT32,
-                ro,
-                pdo=_TX,
-                getter=partial(_item, probe, "values", j),
+            od.add_entry(
+                ItemVariable(probe, "values", j, 0x60BA + j + b, 0, name, d.INT32, pdo=_TX)
             )
         counters = (
             "Touch probe 1 positive edge counter",
@@ -574,13 +577,8 @@ class Channel:
             "Touch probe 2 negative edge counter",
         )
         for j, name in enumerate(counters):
-            od.add_var(
-                0x60D5 + j + b,
-                name,
-                d.UINT16,
-                ro,
-                pdo=_TX,
-                getter=partial(_item, probe, "counters", j),
+            od.add_entry(
+                ItemVariable(probe, "counters", j, 0x60D5 + j + b, 0, name, d.UINT16, pdo=_TX)
             )
         od.add_record(
             0x60D0 + b,
@@ -594,7 +592,7 @@ class Channel:
                     rw,
                     low=1,
                     high=6,
-                    getter=partial(_item, probe, "source_select", j - 1),
+                    getter=partial(item_at, probe, "source_select", j - 1),
                     setter=partial(probe.set_source, j),
                 )
                 for j in (1, 2)
@@ -632,14 +630,8 @@ class Channel:
             default=supported_bits(self.supported),
         )
         for j, index in enumerate((0x20F2, 0x20F9)):
-            od.add_var(
-                index + b,
-                f"Analog input {j + 1}",
-                d.INT16,
-                ro,
-                pdo=_TX,
-                getter=partial(_item, self, "analog_in", j),
-            )
+            name = f"Analog input {j + 1}"
+            od.add_entry(ItemVariable(self, "analog_in", j, index + b, 0, name, d.INT16, pdo=_TX))
 
     @property
     def max_torque(self) -> int:
@@ -1037,10 +1029,6 @@ class Channel:
         due = self.mode_due
         shown = self._settings.mode_display_while_switching
         self.mode_display = self.mode if due is None or shown is None else shown
-
-
-def _item(obj: Any, attr: str, j: int) -> Any:
-    return getattr(obj, attr)[j]
 
 
 def _stamp(probe: TouchProbe, j: int) -> int:

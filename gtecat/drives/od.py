@@ -474,6 +474,42 @@ class AttrVariable(Variable):
         setattr(self._owner, self._attr, value)
 
 
+def item_at(owner: object, attr: str, j: int) -> Any:
+    """``getattr(owner, attr)[j]``: the value of an entry kept in an owner's list."""
+    return getattr(owner, attr)[j]
+
+
+class ItemVariable(Variable):
+    """A read-only entry whose value is ``getattr(owner, attr)[j]`` (a touch probe's latched
+    values and counters, an analog input): the same as ``Variable(...,
+    getter=partial(getattr-and-index))`` without the callable and its arguments made for
+    each entry of each drive (the getter is made only when asked for)."""
+
+    __slots__ = ("_attr", "_j", "_owner")
+
+    def __init__(
+        self,
+        owner: object,
+        attr: str,
+        j: int,
+        index: int,
+        subindex: int,
+        name: str,
+        data_type: DataType,
+        access: Access = Access.RO,
+        **kw: Any,
+    ) -> None:
+        self._owner, self._attr, self._j = owner, attr, j
+        super().__init__(index, subindex, name, data_type, access, **kw)
+
+    getter = property(lambda self: partial(item_at, self._owner, self._attr, self._j), _only_none)
+    #: (no setter: a write keeps :attr:`value`, which the getter hides, as a plain entry's)
+    setter = property(lambda self: None, _only_none)
+
+    def get(self) -> Any:
+        return getattr(self._owner, self._attr)[self._j]
+
+
 class SlotVariable(Variable):
     """An entry whose value is ``values[k]`` of a list its owner keeps (a PDO mapping's or
     assignment's entry); a write goes through ``put(k, value)``, one callable shared by the
@@ -556,6 +592,9 @@ class OdObject:
                 if var.subindex == subindex:
                     return var
             return None
+        one = getattr(make, "one", None)
+        if one is not None:  # (a maker of single entries: a PDO mapping's or assignment's)
+            return one(subindex)  # type: ignore[no-any-return]
         return self.subs.get(subindex)
 
     def __repr__(self) -> str:
@@ -596,6 +635,72 @@ class OdObject:
         if entries:
             return int(entries[0].data_type)
         return int(DataType.UINT8)
+
+
+class AttrSpec:
+    """What an :class:`AttrObject`'s entry is made of, the owner aside: one for the same
+    object of every drive channel (:func:`attr_spec`)."""
+
+    __slots__ = ("access", "attr", "data_type", "name", "pdo")
+
+    def __init__(
+        self, attr: str, name: str, data_type: DataType, access: Access, pdo: PdoDir
+    ) -> None:
+        self.attr, self.name, self.data_type, self.access, self.pdo = (
+            attr,
+            name,
+            data_type,
+            access,
+            pdo,
+        )
+
+
+def attr_spec(attr: str, name: str, data_type: DataType, access: Access, pdo: PdoDir) -> AttrSpec:
+    """The one :class:`AttrSpec` of these."""
+    key = (attr, name, data_type, access, pdo)
+    spec = _ATTR_SPECS.get(key)
+    if spec is None:
+        if len(_ATTR_SPECS) >= 4096:
+            _ATTR_SPECS.clear()
+        spec = _ATTR_SPECS[key] = AttrSpec(attr, name, data_type, access, pdo)
+    return spec
+
+
+_ATTR_SPECS: dict[tuple[str, str, DataType, Access, PdoDir], AttrSpec] = {}
+
+
+class AttrObject(OdObject):
+    """A VAR object whose one entry is ``AttrVariable(owner, spec.attr, index, 0, ...)``,
+    made when the object is first looked at: most of a drive channel's forty such objects
+    never are during a bus's life (the drive's own code reads its attributes), and a bus
+    has hundreds of channels.  Once made, the entry is the object's for good (a write to
+    it is the owner's attribute: one drive's never shows in another's)."""
+
+    __slots__ = ("_owner",)
+
+    def __init__(self, owner: object, index: int, spec: AttrSpec) -> None:
+        super().__init__(index, spec.name, ObjectCode.VAR, spec)  # type: ignore[arg-type]
+        self._owner = owner
+
+    @property
+    def subs(self) -> dict[int, Variable]:
+        """Subindex -> entry (the entry made now if it was not yet)."""
+        subs = self._subs
+        if subs is None:
+            spec: AttrSpec = self._make  # type: ignore[assignment]
+            var = AttrVariable(
+                self._owner,
+                spec.attr,
+                self.index,
+                0,
+                spec.name,
+                spec.data_type,
+                spec.access,
+                pdo=spec.pdo,
+            )
+            self._make = None
+            subs = self._subs = {0: var}
+        return subs
 
 
 class ObjectDictionary:
@@ -703,15 +808,14 @@ class ObjectDictionary:
             raise SdoAbort(SdoAbortCode.OBJECT_DOES_NOT_EXIST, index, subindex) from None
 
     def variable(self, index: int, subindex: int) -> Variable:
-        obj = self.obj(index, subindex)
-        try:
-            return obj.subs[subindex]
-        except KeyError:
-            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
+        var = self.obj(index, subindex).sub(subindex)
+        if var is None:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex)
+        return var
 
     def find(self, index: int, subindex: int) -> Variable | None:
         obj = self.objects.get(index)
-        return None if obj is None else obj.subs.get(subindex)
+        return None if obj is None else obj.sub(subindex)
 
     def size_of(self, index: int, subindex: int) -> int | None:
         """Wire size of an entry, for expedited downloads that do not state their size."""
@@ -725,10 +829,9 @@ class ObjectDictionary:
         obj = self.obj(index, subindex)
         if complete_access and obj.code is not ObjectCode.VAR:
             return self._upload_complete(obj, subindex)
-        try:
-            var = obj.subs[subindex]  # (self.variable, with the object already found)
-        except KeyError:
-            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
+        var = obj.sub(subindex)  # (self.variable, with the object already found)
+        if var is None:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex)
         if not var.access.readable:
             raise SdoAbort(SdoAbortCode.READ_OF_WRITE_ONLY, index, subindex)
         return var.encode(var.get())
@@ -767,10 +870,9 @@ class ObjectDictionary:
         if complete_access and obj.code is not ObjectCode.VAR:
             self._download_complete(obj, subindex, bytes(data), al_state)
             return
-        try:
-            var = obj.subs[subindex]  # (self.variable, with the object already found)
-        except KeyError:
-            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex) from None
+        var = obj.sub(subindex)  # (self.variable, with the object already found)
+        if var is None:
+            raise SdoAbort(SdoAbortCode.SUBINDEX_DOES_NOT_EXIST, index, subindex)
         self._write(var, bytes(data), al_state)
 
     def download_value(

@@ -68,17 +68,44 @@ def _names(head: str, n: int) -> tuple[str, ...]:
     return tuple(f"{head} {k + 1}" for k in range(n))
 
 
-class _MapEntries:
-    """Makes a mapping object's entries when it is first looked at (a ``partial`` of
-    :meth:`PdoMapping._map_entries`, in half the memory: eight per drive)."""
+class _SlotEntries:
+    """Makes a mapping or assignment object's entries as they are looked at: the one entry
+    a read or write names (a bus's start-up writes four or five of a mapping's seventeen,
+    two of an assignment's nine), all of them when the whole object is (those made before
+    among them: an entry, once made, is the object's for good)."""
 
-    __slots__ = ("access", "cap", "index", "owner", "slots")
+    __slots__ = ("access", "assign", "cap", "index", "made", "owner", "put", "slots")
 
-    def __init__(self, owner: PdoMapping, index: int, slots: _Slots, cap: int, access: Access):
+    def __init__(
+        self,
+        owner: PdoMapping,
+        index: int,
+        slots: _Slots,
+        cap: int,
+        access: Access,
+        *,
+        assign: bool = False,
+    ) -> None:
         self.owner, self.index, self.slots, self.cap, self.access = owner, index, slots, cap, access
+        self.assign = assign
+        self.made: dict[int, Variable] | None = None
+        #: (k, value) -> the write of entry k+1, shared by the entries
+        self.put: Callable[[int, Any], None] | None = None
 
     def __call__(self) -> list[Variable]:
-        return self.owner._map_entries(self.index, self.slots, self.cap, self.access)
+        return [self.one(k) for k in range(self.cap + 1)]  # type: ignore[misc]
+
+    def one(self, subindex: int) -> Variable | None:
+        """Entry ``subindex`` (None: the object has none)."""
+        if not 0 <= subindex <= self.cap:
+            return None
+        made = self.made
+        if made is None:
+            made = self.made = {}
+        var = made.get(subindex)
+        if var is None:
+            var = made[subindex] = self.owner._slot_entry(self, subindex)
+        return var
 
 
 @dataclass(slots=True)
@@ -88,6 +115,18 @@ class _Slots:
     count: int
     values: list[int]
     fixed: bool = False
+
+
+def _sm_types() -> list[Variable]:
+    """1C00h's entries (made when the object is first looked at: a bus's start-up never
+    does), as :meth:`ObjectDictionary.add_record` makes them: the count, then SM0..SM3's
+    communication types (mailbox out, mailbox in, outputs, inputs)."""
+    types = [
+        Variable(0x1C00, k + 1, f"SM{k} type", DataType.UINT8, Access.RO, default=t)
+        for k, t in enumerate((1, 2, 3, 4))
+    ]
+    count = Variable(0x1C00, 0, "Number of entries", DataType.UINT8, Access.RO, default=4)
+    return [count, *types]
 
 
 class PdoMapping:
@@ -121,6 +160,8 @@ class PdoMapping:
         self.max_bytes = max_bytes
         od.allow_placeholders = not strict
         self._maps: dict[int, _Slots] = {}
+        #: the last codec compiled and what it was compiled from (:meth:`compile`)
+        self._compiled: tuple[tuple, PdoCodec] | None = None
         self._assign: dict[int, _Slots] = {
             RX_ASSIGN: _Slots(0, [0] * max_assigned),
             TX_ASSIGN: _Slots(0, [0] * max_assigned),
@@ -145,14 +186,8 @@ class PdoMapping:
         self._add_assign_object(RX_ASSIGN, "RxPDO assign")
         self._add_assign_object(TX_ASSIGN, "TxPDO assign")
         if 0x1C00 not in od:
-            od.add_record(
-                0x1C00,
-                "Sync manager communication type",
-                [
-                    Variable(0x1C00, k + 1, f"SM{k} type", DataType.UINT8, Access.RO, default=t)
-                    for k, t in enumerate((1, 2, 3, 4))
-                ],
-                code=ObjectCode.ARRAY,
+            od.add_lazy_record(
+                0x1C00, "Sync manager communication type", _sm_types, code=ObjectCode.ARRAY
             )
 
     # --- construction ------------------------------------------------------------
@@ -196,68 +231,45 @@ class PdoMapping:
         direction = PdoDir.RX if index in RX_MAP_RANGE else PdoDir.TX
         access = Access.RO if fixed else Access.RW
         name = ("RxPDO" if direction is PdoDir.RX else "TxPDO") + f" mapping 0x{index:04X}"
-        self.od.add_lazy_record(index, name, _MapEntries(self, index, slots, cap, access))
+        self.od.add_lazy_record(index, name, _SlotEntries(self, index, slots, cap, access))
         return slots
-
-    def _map_entries(self, index: int, slots: _Slots, cap: int, access: Access) -> list[Variable]:
-        """The entries of mapping object ``index`` (made when the object is first read)."""
-        sub0 = Variable(
-            index,
-            0,
-            "Number of mapped objects",
-            DataType.UINT8,
-            access,
-            high=cap,
-            write_states=PREOP_ONLY,
-            getter=lambda s=slots: s.count,
-            setter=lambda v, i=index: self._set_map_count(i, v),
-        )
-        put = partial(self._set_map_entry, index)  # (k, value), shared by the entries
-        names = _names("Mapped object", cap)
-        return [sub0] + [
-            SlotVariable(
-                slots.values,
-                k,
-                put,
-                index,
-                names[k],
-                DataType.UINT32,
-                access,
-                write_states=PREOP_ONLY,
-            )
-            for k in range(cap)
-        ]
 
     def _add_assign_object(self, index: int, name: str) -> None:
         slots = self._assign[index]
-        cap = len(slots.values)
-        sub0 = Variable(
-            index,
-            0,
-            "Number of assigned PDOs",
-            DataType.UINT8,
-            Access.RW,
-            high=cap,
-            write_states=PREOP_ONLY,
-            getter=lambda: slots.count,
-            setter=lambda v: self._set_assign_count(index, v),
-        )
-        put = partial(self._set_assign_entry, index)
-        names = _names("Assigned PDO", cap)
-        entries = [
-            SlotVariable(
-                slots.values,
-                k,
-                put,
+        entries = _SlotEntries(self, index, slots, len(slots.values), Access.RW, assign=True)
+        self.od.add_lazy_record(index, name, entries, code=ObjectCode.ARRAY)
+
+    def _slot_entry(self, e: _SlotEntries, k: int) -> Variable:
+        """Entry ``k`` of a mapping or assignment object (:class:`_SlotEntries`): subindex 0
+        the count, then the mapped objects or assigned PDOs, written in PREOP only."""
+        index, slots = e.index, e.slots
+        if k == 0:
+            return Variable(
                 index,
-                names[k],
-                DataType.UINT16,
-                Access.RW,
+                0,
+                "Number of assigned PDOs" if e.assign else "Number of mapped objects",
+                DataType.UINT8,
+                e.access,
+                high=e.cap,
                 write_states=PREOP_ONLY,
+                getter=partial(getattr, slots, "count"),
+                setter=partial(self._set_assign_count if e.assign else self._set_map_count, index),
             )
-            for k in range(cap)
-        ]
-        self.od.add_record(index, name, entries, code=ObjectCode.ARRAY, sub0=sub0)
+        put = e.put
+        if put is None:
+            put = e.put = partial(
+                self._set_assign_entry if e.assign else self._set_map_entry, index
+            )
+        return SlotVariable(
+            slots.values,
+            k - 1,
+            put,
+            index,
+            _names("Assigned PDO" if e.assign else "Mapped object", e.cap)[k - 1],
+            DataType.UINT16 if e.assign else DataType.UINT32,
+            e.access,
+            write_states=PREOP_ONLY,
+        )
 
     # --- setters behind the objects -----------------------------------------------
     def _direction_of(self, pdo_index: int) -> PdoDir:
@@ -407,6 +419,10 @@ class PdoMapping:
         return {(i, s) for i, s, _ in self.entries(direction) if not is_gap(i)}
 
     def compile(self) -> PdoCodec:
+        """The codec of the current mapping.  The one compiled last is given again when the
+        mapping still names the same entries, each the same object of the same type (a
+        codec is immutable): a bus's start-up compiles each drive's mapping at construction
+        and again at PREOP->SAFEOP, most often unchanged by its InitCmds."""
         rx = []
         off = 0
         for i, s, n in self.entries(Direction.OUT):
@@ -420,7 +436,13 @@ class PdoMapping:
             if not is_gap(i):
                 tx.append((off, n, self.od.variable(i, s)))
             off += n
-        return PdoCodec(rx, rx_bits, tx, off)
+        key = (rx_bits, off, _traits(rx), _traits(tx))
+        last = self._compiled
+        if last is not None and last[0] == key:
+            return last[1]
+        codec = PdoCodec(rx, rx_bits, tx, off)
+        self._compiled = (key, codec)
+        return codec
 
 
 # --- the codec --------------------------------------------------------------------------
@@ -539,6 +561,18 @@ class PdoCodec:
             if real:
                 value = int.from_bytes(struct.pack("<f", float(value)), "little")
             set_bits(buf, off, bits, int(value) & ((1 << bits) - 1))
+
+
+def _traits(entries: list[tuple[int, int, Variable]]) -> tuple:
+    """What a codec's fields are made of, in one tuple: each entry's place, object and type,
+    and a plain entry's own getter and setter (another entry kind answers them from what it
+    was made with, fixed for its life)."""
+    out: list[Any] = []
+    for off, bits, var in entries:
+        out += (off, bits, var, var.data_type)
+        if type(var) is Variable:
+            out += (var.getter, var.setter)
+    return tuple(out)
 
 
 def _setter(var: Variable) -> Callable[[Any], None]:

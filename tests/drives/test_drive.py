@@ -425,3 +425,28 @@ def test_settings_are_validated() -> None:
         DriveSettings(limit_reaction="explode")
     with pytest.raises(ValueError):
         Cia402Drive(0, "x", Identity(1, 1), channels=9)
+
+
+def test_each_drive_has_its_own_objects() -> None:
+    """Entries made when first looked at (a channel's plain attributes, 1C00h) and those read
+    through the drive's lists (touch probe, analog inputs) are each drive's own: a write to
+    one drive's dictionary never shows in another's."""
+    a, b = Rig(op=False).drive, Rig(op=False).drive
+    for drive in (a, b):
+        drive.request_state(AlState.PREOP)
+    a.od.download(0x6081, 0, struct.pack("<I", 4321))
+    assert a.channel(0).profile_velocity == 4321
+    assert b.channel(0).profile_velocity != 4321
+    assert b.od.upload(0x6081, 0) != a.od.upload(0x6081, 0)
+    assert a.od.find(0x6081, 0) is not b.od.find(0x6081, 0)
+    assert a.od.find(0x6081, 0) is a.od.find(0x6081, 0)  # (made once)
+    assert a.od.find(0x1C00, 3) is not b.od.find(0x1C00, 3)
+    assert a.od.upload(0x1C00, 0) == b"\x04" and a.od.upload(0x1C00, 3) == b"\x03"
+    a.channel(0).analog_in[1] = -5
+    a.channel(0).probe.counters[0] = 7
+    assert struct.unpack("<h", a.od.upload(0x20F9, 0))[0] == -5
+    assert struct.unpack("<h", b.od.upload(0x20F9, 0))[0] == 0
+    assert a.od.upload(0x60D5, 0) == b"\x07\x00" and b.od.upload(0x60D5, 0) == b"\x00\x00"
+    with pytest.raises(SdoAbort) as e:
+        a.od.download(0x60D5, 0, b"\x01\x00")  # (read-only, as before)
+    assert e.value.code == SdoAbortCode.WRITE_OF_READ_ONLY

@@ -26,6 +26,26 @@ def test_entry_packing() -> None:
     assert unpack_entry(0x607A0020) == (0x607A, 0, 32)
 
 
+def test_codec_is_compiled_again_only_when_the_mapping_changes() -> None:
+    rig = Rig(op=False)
+    d = rig.drive
+    first = d.codec
+    assert d.mapping.compile() is first  # the same entries: the same (immutable) codec
+    d.request_state(AlState.PREOP)
+    sdo = rig.sdo
+    sdo.download(0x1C12, 0, b"\x00")
+    sdo.download(0x1601, 0, b"\x00")
+    sdo.download(0x1601, 1, struct.pack("<I", 0x60400010))
+    sdo.download(0x1601, 0, b"\x01")
+    sdo.download(0x1C12, 1, struct.pack("<H", 0x1601))
+    sdo.download(0x1C12, 0, b"\x01")
+    d.expected_sizes = d.pdo_sizes()
+    assert d.request_state(AlState.SAFEOP) == AlStatusCode.NO_ERROR
+    assert d.codec is not first and d.codec.rx_bits == 16
+    var = d.od.find(0x6040, 0)
+    assert var is not None and d.codec.rx_vars == [var]
+
+
 def test_remap_in_preop_then_size_check() -> None:
     rig = Rig(op=False)
     d = rig.drive
