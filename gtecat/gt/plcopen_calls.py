@@ -24,6 +24,7 @@ import math
 import weakref
 from typing import Any
 
+from .._attrs import PerObject
 from ..controller.core import Controller
 from ..controller.motion import TrapParams
 from ..controller.motion.jog import JogParams
@@ -59,8 +60,7 @@ class TMoveAbsolutePrm(ctypes.Structure):
     )
 
 
-_KEPT: weakref.WeakKeyDictionary[Any, dict[tuple[str, int], bytes]] = weakref.WeakKeyDictionary()
-
+_KEPT: PerObject[dict[tuple[str, int], bytes]] = PerObject("plcopen_kept")
 
 #: (a weak reference to the controller _kept last looked up, its dict): a program giving
 #: new targets every few cycles asks for the same one again and again
