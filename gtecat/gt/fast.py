@@ -166,6 +166,10 @@ def _kept_refs() -> int:
 
 #: see :func:`_kept_refs`
 _KEPT = _kept_refs()
+#: fast paths' caches of one controller's objects (its axes, their states), emptied whenever
+#: the gates change (a controller closed, another one selected): a closed controller is not
+#: kept alive by them
+_CACHES: list[dict[Any, Any]] = []
 _LOCKSTEP = ClockMode.LOCKSTEP
 
 
@@ -587,6 +591,7 @@ def fast_reader(
         #: else None).  A span each: a program that reads two spans in turn
         #: (``GT_GetEncPos(1, a, 8)``, ``GT_GetEncPos(9, byref(a, 64), 4)``) finds both
         lanes: dict[tuple[int, int], list[Any]] = {}
+        _CACHES.append(lanes)
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -783,10 +788,6 @@ _OFF = _Off()
 #: (_OFF: closed); the globals ``CTL`` and ``CTLN`` of every gated value function's module
 GATED: list[Any] = [_OFF, _OFF]
 _GATED_ENVS: list[dict[str, Any]] = []
-#: fast paths' caches of one controller's objects (its axes, their states), emptied whenever
-#: the gates change (a controller closed, another one selected): a closed controller is not
-#: kept alive by them
-_CACHES: list[dict[Any, Any]] = []
 
 
 def _gated(env: dict[str, Any]) -> dict[str, Any]:
@@ -2679,6 +2680,7 @@ def fast_ecat_reader(
     gt = env["gt"]
     gt.slow = slow
     _gated(env)
+    _CACHES.append(env["ACCS"])  # (axis -> its entry: a controller's axes)
     exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
     return _entry(  # type: ignore[no-any-return]
         gt, env["value"], ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
