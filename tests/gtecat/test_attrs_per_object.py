@@ -10,6 +10,7 @@ from __future__ import annotations
 import gc
 import weakref
 from ctypes import byref, c_double, c_long, c_short
+from pathlib import Path
 
 import pytest
 
@@ -25,9 +26,10 @@ def _closed_controller():
     _core.close_all()
 
 
-def _use_every_kind_of_state() -> None:
+def _use_every_kind_of_state(cfg: str) -> None:
     """GT calls that make each kind of per-controller state (their codes do not matter)."""
     st, v = c_short(), c_long()
+    gt.GT_LoadConfig(cfg)
     gt.GT_AxisOn(1)
     gt.GT_SetHomingMode(1, 6)
     gt.GT_SetEcatHomingPrm(1, 34, 10.0, 5.0, 1.0, 0, 0)
@@ -48,16 +50,19 @@ def _use_every_kind_of_state() -> None:
     comp = (c_long * 2)(0, 1)
     gt.GT_SetLeadScrewComp(1, 2, 0, 1000, comp, comp)
     gt.GT_EnableLeadScrewComp(1, 1)
+    gt.GT_ClearTriggerStatus(1)
     gt.GT_GetGantryMode(1, byref(st), byref(st), byref(st), byref(v))
 
 
-def test_a_closed_controller_and_its_master_are_freed() -> None:
+def test_a_closed_controller_and_its_master_are_freed(tmp_path: Path) -> None:
+    cfg = tmp_path / "axis.cfg"
+    cfg.write_text("[axis 1]\nactive = 1\n")
     refs = []
     for _ in range(2):  # (a second one: the first one's state is not kept by the next)
         bring_up(clock="lockstep")
         ctl = _core.SESSION.controllers[1]
         refs.append((weakref.ref(ctl), weakref.ref(ctl.master)))
-        _use_every_kind_of_state()
+        _use_every_kind_of_state(str(cfg))
         del ctl
         assert gt.GT_Close() == 0
     gc.collect()
