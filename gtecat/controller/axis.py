@@ -268,6 +268,8 @@ class Axis:
     def __init__(self, number: int, io: AxisIo) -> None:
         self.number = number
         self.io = io
+        #: what other modules keep per axis (gtecat._attrs.PerObject: homing, capture, ...)
+        self.extensions: dict[str, Any] = {}
         self.pos_scale = 0  # GT_SetPosScale exponent
         self.prf_pos = 0.0  # planned position, pulses
         #: added to the planned position on its way to the drive (lead-screw compensation,

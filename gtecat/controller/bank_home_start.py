@@ -68,9 +68,9 @@ def _startable(bank: AxisBank, r: int, g: _Group) -> Any:
         return None
     if _get(ax, "_cw_acc") is None or g.drive.al_state != AlState.OP:
         return None
-    try:  # (the GT follower, made with the parameters' call: gtecat.gt.homing_calls)
-        st = _get(ax, "_homing_run")
-    except AttributeError:
+    # (the GT follower, made with the parameters' call: gtecat.gt.homing_calls)
+    st = _get(ax, "extensions").get("ecat_homing")
+    if st is None:
         return None
     if not st.active or st.answered:
         return None

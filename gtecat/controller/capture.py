@@ -56,6 +56,7 @@ from typing import TYPE_CHECKING, Any
 from gtecat.drives.abort import SdoAbort
 from gtecat.eni.errors import GtecatError
 
+from .._attrs import PerObject
 from ..errors import CommandError, ParameterError
 from . import input_sense
 from .axis import Axis
@@ -505,7 +506,7 @@ class CaptureUnit:
 
 
 # --- the controller side -------------------------------------------------------------------------
-_UNITS: weakref.WeakKeyDictionary[Any, CaptureUnit] = weakref.WeakKeyDictionary()
+_UNITS: PerObject[CaptureUnit] = PerObject("capture")
 _HOOKED: weakref.WeakSet[Any] = weakref.WeakSet()
 
 

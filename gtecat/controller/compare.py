@@ -21,12 +21,12 @@ its end, then the other takes over when it holds points; otherwise the unit has 
 
 from __future__ import annotations
 
-import weakref
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from .._attrs import PerObject
 from ..errors import CommandError, ParameterError
 
 #: points one FIFO of a unit holds (the vendor header's COMPARE_DATA_MAX)
@@ -184,7 +184,7 @@ class CompareUnits:
         self.settings.clear()
 
 
-_UNITS: weakref.WeakKeyDictionary[Any, CompareUnits] = weakref.WeakKeyDictionary()
+_UNITS: PerObject[CompareUnits] = PerObject("compare_units")
 
 
 def compare_units(ctl: Any) -> CompareUnits:

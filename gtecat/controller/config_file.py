@@ -87,13 +87,13 @@ from __future__ import annotations
 
 import math
 import re
-import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .._attrs import PerObject
 from ..errors import ParameterError
 from .input_sense import changed as sense_changed
 from .motion import STOP_DEC_MAX, StopDecel
@@ -754,7 +754,7 @@ class _State:
     values: dict[tuple[str, int], dict[str, Any]] = field(default_factory=dict)
 
 
-_STATES: weakref.WeakKeyDictionary[Any, _State] = weakref.WeakKeyDictionary()
+_STATES: PerObject[_State] = PerObject("config_file")
 
 
 def _axes_id(ctl: Controller) -> tuple[int, ...]:

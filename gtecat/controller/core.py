@@ -184,6 +184,8 @@ class Controller:
             # a first build of the bank's compiled cycle on this machine runs in a process of
             # its own once the bus is in OP (the bank takes it when it is there)
             prebuild_kernel(defer=True)
+        #: what other modules keep per controller (gtecat._attrs.PerObject: capture, IO, ...)
+        self.extensions: dict[str, Any] = {}
         cycle_ns = round((self.options.cycle_ms or 1.0) * 1_000_000)
         self.clock = Clock(
             self._cycle,

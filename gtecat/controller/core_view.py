@@ -61,6 +61,8 @@ class CoreView:
     def __init__(self, base: Controller, core: int) -> None:
         self._base = base
         self.core = core
+        #: what other modules keep per core (its own: gtecat._attrs.PerObject)
+        self.extensions: dict[str, Any] = {}
         #: the controller's clock, which is its own for its life (every call through a view
         #: reads it: its lock, its cycles), read here without __getattr__
         self.clock = base.clock

@@ -11,9 +11,9 @@ except the outputs, which ``GT_Reset`` switches off.
 
 from __future__ import annotations
 
-import weakref
 from typing import Any
 
+from .._attrs import PerObject
 from ..errors import ParameterError
 
 #: general-purpose inputs and outputs (MC_GPI / MC_GPO 1..16)
@@ -49,7 +49,7 @@ class DigitalIo:
         self.clear = 0
 
 
-_IO: weakref.WeakKeyDictionary[Any, DigitalIo] = weakref.WeakKeyDictionary()
+_IO: PerObject[DigitalIo] = PerObject("digital_io")
 
 
 def digital_io(ctl: Any) -> DigitalIo:

@@ -24,12 +24,12 @@ Decisions the vendor leaves open:
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
 from gtecat.drives.ext_modules import ExtModuleSpec
 
+from .._attrs import PerObject
 from ..errors import ParameterError
 
 #: the families that address modules (their default wiring: active low?)
@@ -137,7 +137,7 @@ class ExtIo:
         return [self.modules[n] for n in sorted(self.modules)]
 
 
-_EXT: weakref.WeakKeyDictionary[Any, ExtIo] = weakref.WeakKeyDictionary()
+_EXT: PerObject[ExtIo] = PerObject("ext_io")
 
 
 def ext_io(ctl: Any) -> ExtIo:

@@ -14,13 +14,13 @@ and the SII is read through the slave's EEPROM interface.
 from __future__ import annotations
 
 import struct
-import weakref
 from collections.abc import Sequence
 from typing import Any
 
 from gtecat.drives.slave import AlState, AlStatusCode
 from gtecat.eni.model import Direction
 
+from .._attrs import PerObject
 from ..errors import BusError, ParameterError
 from .core import Controller
 
@@ -467,7 +467,7 @@ def read_sii(eeprom_read: Any) -> bytes:
     return bytes(words[: 2 * _SII_MAX_WORDS])
 
 
-_VIEWS: weakref.WeakKeyDictionary[Controller, BusView] = weakref.WeakKeyDictionary()
+_VIEWS: PerObject[BusView] = PerObject("bus_view")
 
 
 def view(ctl: Controller) -> BusView:

@@ -11,9 +11,10 @@ stays as planned, the drive and so the encoder go to the compensated place.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from typing import Any
+
+from .._attrs import PerObject
 
 
 @dataclass(slots=True)
@@ -47,7 +48,7 @@ class LeadScrew:
         ax.compensation = self.value(p, self.direction) if self.enabled else 0.0
 
 
-_SCREWS: weakref.WeakKeyDictionary[Any, LeadScrew] = weakref.WeakKeyDictionary()
+_SCREWS: PerObject[LeadScrew] = PerObject("lead_screw")
 
 
 def lead_screw(ax: Any) -> LeadScrew | None:

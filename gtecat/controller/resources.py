@@ -141,6 +141,8 @@ class AxisResources:
     def __init__(self, ctl: Controller, ax: Axis) -> None:
         self.ctl = ctl
         self.ax = ax
+        #: what other modules keep per axis (gtecat._attrs.PerObject: capture, smart homing)
+        self.extensions: dict[str, Any] = {}
         self.number = ax.number
         self.cycle_ms = ctl.clock.cycle_ns / 1e6
         self.profile = Profile(ax.number, self.cycle_ms)

@@ -26,10 +26,10 @@ scenario observes, decided where the vendor is silent:
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
+from .._attrs import PerObject
 from ..errors import ParameterError
 
 PID_SETS = 2
@@ -85,7 +85,7 @@ class ServoLoop:
         self.dac.clear()
 
 
-_LOOPS: weakref.WeakKeyDictionary[Any, ServoLoop] = weakref.WeakKeyDictionary()
+_LOOPS: PerObject[ServoLoop] = PerObject("servo_loop")
 
 
 def servo_loop(ctl: Any) -> ServoLoop:

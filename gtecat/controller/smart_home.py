@@ -101,6 +101,7 @@ from dataclasses import dataclass, fields, replace
 from enum import IntEnum
 from typing import Any
 
+from .._attrs import PerObject
 from ..errors import CommandError, ParameterError
 from .axis_status import AxisStatus
 from .capture import CAPTURE_HOME, CAPTURE_INDEX, CaptureUnit, capture_unit, unit_of
@@ -981,8 +982,8 @@ def _long(v: int) -> int:
 
 
 # --- the controller side ----------------------------------------------------------------------
-_HOMES: weakref.WeakKeyDictionary[AxisResources, SmartHome] = weakref.WeakKeyDictionary()
-_RUNNING: weakref.WeakKeyDictionary[Any, _Homings] = weakref.WeakKeyDictionary()
+_HOMES: PerObject[SmartHome] = PerObject("smart_home")
+_RUNNING: PerObject[_Homings] = PerObject("smart_homings")
 
 
 class _Homings:

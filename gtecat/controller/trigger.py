@@ -10,10 +10,11 @@ position lies in ``[firstPosition, lastPosition]``.  The GT layer
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
+
+from .._attrs import PerObject
 
 
 @dataclass(slots=True)
@@ -71,7 +72,7 @@ class Triggers:
                 t.step(ms)
 
 
-_TRIGGERS: weakref.WeakKeyDictionary[Any, Triggers] = weakref.WeakKeyDictionary()
+_TRIGGERS: PerObject[Triggers] = PerObject("triggers")
 
 
 def triggers(ctl: Any) -> Triggers:

@@ -166,6 +166,10 @@ def _kept_refs() -> int:
 
 #: see :func:`_kept_refs`
 _KEPT = _kept_refs()
+#: fast paths' caches of one controller's objects (its axes, their states), emptied whenever
+#: the gates change (a controller closed, another one selected): a closed controller is not
+#: kept alive by them
+_CACHES: list[dict[Any, Any]] = []
 _LOCKSTEP = ClockMode.LOCKSTEP
 
 
@@ -587,6 +591,7 @@ def fast_reader(
         #: else None).  A span each: a program that reads two spans in turn
         #: (``GT_GetEncPos(1, a, 8)``, ``GT_GetEncPos(9, byref(a, 64), 4)``) finds both
         lanes: dict[tuple[int, int], list[Any]] = {}
+        _CACHES.append(lanes)
 
         def f(n: int, count: int, tp: type, clock: Any) -> Any:
             # (a shape seen before: its packer, kept only for an array the reader takes)
@@ -806,6 +811,8 @@ def set_gates(gt: Any, gtn: Any, views: bool = False) -> None:
         return
     centry.set_gates(centry.CLOSED, centry.CLOSED)
     GATED[:] = new
+    for cache in _CACHES:
+        cache.clear()
     for env in _GATED_ENVS:
         env["CTL"], env["CTLN"] = GATED
     gates = _gate_value(gt), _gate_value(gtn)
@@ -2673,6 +2680,7 @@ def fast_ecat_reader(
     gt = env["gt"]
     gt.slow = slow
     _gated(env)
+    _CACHES.append(env["ACCS"])  # (axis -> its entry: a controller's axes)
     exec(_compiled_code(_ECAT_VALUE, f"<gt ecat {name}>"), env)
     return _entry(  # type: ignore[no-any-return]
         gt, env["value"], ok, centry.INT, gate=centry.GT_GATE, after=_after(advance, name, 0)
@@ -2836,12 +2844,11 @@ def fast_homing_status(
     ``byref`` (no offset) or the object itself of an integer type the pointer takes, the
     axis on the in-process controller's bus (core 1, no pulse card, the bus opened).  The
     value is :func:`homing_calls.homing_status`'s, read the same way (past the axis bank's
-    guard: a banked axis stays banked) without a weak reference made per call: each axis's
-    own is kept, and a run's state found by it in the same weak dictionary.  Its other cases
-    (the link lost, 6041h not mapped, a run with a reason to note beside the 0) and any other
-    shape: the table path, with its code and reason."""
-    import weakref
-
+    guard: a banked axis stays banked) without a look-up made per call: each axis's own
+    per-axis states (gtecat._attrs.PerObject) are kept, and a run's state found in them.
+    Its other cases (the link lost, 6041h not mapped, a run with a reason to note beside the
+    0) and any other shape: the table path, with its code and reason."""
+    from .._attrs import extensions
     from .args import _scalar_types
     from .table import FUNCTIONS
 
@@ -2851,12 +2858,13 @@ def fast_homing_status(
 
     axis_type = Axis  # (a guarded axis, the bank's, is of another class)
 
-    #: axis number -> [axis, a weak reference to it, 6041h mapped, its run's state or None,
+    #: axis number -> [axis, its per-axis states, 6041h mapped, its run's state or None,
     #: how many states homing_calls had made when it looked]; homing_calls makes an axis's
     #: state once (its first run) and keeps it as long as the axis lives, so a state found is
     #: the axis's for good, and none found stays none until that count moves
     kept: dict[int, list[Any]] = {}
-    #: homing_calls' run states (its weak dictionary's own dict), the values; set at the
+    _CACHES.append(kept)
+    #: the name homing_calls keeps an axis's run state under, the values; set at the
     #: first call (homing_calls imports the GT layer, which imports this module)
     h: list[Any] = []
 
@@ -2886,16 +2894,16 @@ def fast_homing_status(
             if not h:
                 from . import homing_calls as hc
 
-                h.extend((hc._STATE.data, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
+                h.extend((hc._STATE.name, hc.HOMING_IN_PROGRESS, hc.HOMING_FAILED, hc.MADE))
             if len(kept) > 4096:
                 kept.clear()
             io = getattribute(ax, "io")
             mapped = io.get(0x6041) is not None
-            k = kept[n] = [ax, weakref.ref(ax), mapped, None, -1]
+            k = kept[n] = [ax, extensions(ax), mapped, None, -1]
         st = k[3]
         if st is None and k[4] != h[3][0]:  # (a state made since: look again)
             k[4] = h[3][0]
-            st = k[3] = h[0].get(k[1])
+            st = k[3] = k[1].get(h[0])
         lost = ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost")
         if lost:
             return None
@@ -2926,7 +2934,7 @@ def fast_homing_status(
         st = k[3]
         if st is None and k[4] != h[3][0]:  # (a state made since: look again)
             k[4] = h[3][0]
-            st = k[3] = h[0].get(k[1])
+            st = k[3] = k[1].get(h[0])
         if ax.link_lost if type(ax) is axis_type else getattribute(ax, "link_lost"):
             return _NO
         if st is None:  # no run since the bus came up: not homed
@@ -3191,6 +3199,7 @@ def smart_home_lookup() -> tuple[Callable[[Any, int], Any], dict[int, tuple[Any,
 
     homes, running = sh._HOMES, sh._RUNNING
     kept: dict[int, tuple[Any, Any]] = {}
+    _CACHES.append(kept)
 
     def home_of(ctl: Any, n: int) -> Any:
         try:

@@ -20,10 +20,10 @@ The vendor header's modes: ``GANTRY_MODE_NONE`` -1, ``GANTRY_MODE_OPEN_LOOP_GANT
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from typing import Any
 
+from .._attrs import PerObject
 from ..controller.core import Controller
 from ..controller.resources import axis_resources
 from ..errors import CommandError, ParameterError
@@ -46,22 +46,22 @@ class _Pair:
     bus: tuple[int, int] = (0, 0)  #: master and slave as bus axis numbers
 
 
-_GROUPS: weakref.WeakKeyDictionary[Any, dict[int, _Pair]] = weakref.WeakKeyDictionary()
+#: the bus controller -> its cores' groups (core 1: itself, a core beyond: its view)
+_GROUPS: PerObject[dict[Any, dict[int, _Pair]]] = PerObject("gantry_groups")
 
 
 def _groups(ctl: Controller) -> dict[int, _Pair]:
     """The groups of the core ``ctl`` (a core beyond 1 is a view of the bus controller)."""
-    return _GROUPS.setdefault(ctl, {})
+    return _GROUPS.setdefault(getattr(ctl, "_base", ctl), {}).setdefault(ctl, {})
 
 
 def _all_groups(ctl: Controller) -> list[tuple[str, int, _Pair]]:
     """(core, group, pair) of every core of ``ctl``'s bus."""
     base = getattr(ctl, "_base", ctl)
     out = []
-    for owner, groups in list(_GROUPS.items()):
-        if getattr(owner, "_base", owner) is base:
-            core = f" of core {owner.core}" if owner is not base else ""
-            out += [(core, n, p) for n, p in groups.items()]
+    for owner, groups in list((_GROUPS.get(base) or {}).items()):
+        core = f" of core {owner.core}" if owner is not base else ""
+        out += [(core, n, p) for n, p in groups.items()]
     return out
 
 

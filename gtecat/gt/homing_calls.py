@@ -98,13 +98,13 @@ Decisions where the manual is silent:
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 from enum import IntFlag
 from typing import Any
 
 from gtecat.drives.abort import SdoAbort
 
+from .._attrs import PerObject
 from ..controller.axis import Axis, PdsState
 from ..controller.core import Controller
 from ..errors import CommandError, ParameterError
@@ -210,24 +210,18 @@ class _AxisHoming:
             self.end(status)
 
 
-_STATE: weakref.WeakKeyDictionary[Axis, _AxisHoming] = weakref.WeakKeyDictionary()
+_STATE: PerObject[_AxisHoming] = PerObject("ecat_homing")
 #: how many run states :func:`_state` has made (an axis's is made once and kept while it
 #: lives; the GT fast path looks one up again only when this count moved)
 MADE = [0]
 
 
 def _state(ax: Axis) -> _AxisHoming:
-    # (kept on the axis too, read past a claimed axis's guard: a weak dictionary's lookup
-    # makes a weak reference every time; the dictionary stays what the GT fast path reads)
-    st = object.__getattribute__(ax, "__dict__").get("_homing_run")
-    if st is not None:
-        return st  # type: ignore[no-any-return]
-    st = _STATE.get(ax)
+    st = _STATE.get(ax)  # (kept on the axis, read past a claimed axis's guard)
     if st is None:
         st = _STATE[ax] = _AxisHoming()
         MADE[0] += 1
         ax.post_hooks.append(st.post)
-    object.__setattr__(ax, "_homing_run", st)
     return st
 
 

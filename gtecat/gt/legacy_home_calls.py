@@ -39,10 +39,10 @@ Decisions where the header says no more than the prototypes:
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from typing import Any
 
+from .._attrs import PerObject
 from ..controller.core import Controller
 from ..controller.profile import PrfMode
 from ..controller.resources import axis_resources
@@ -64,7 +64,7 @@ class _State:
         self.init = False
 
 
-_STATES: weakref.WeakKeyDictionary[Controller, _State] = weakref.WeakKeyDictionary()
+_STATES: PerObject[_State] = PerObject("legacy_home")
 
 
 def _state(ctl: Controller) -> _State:

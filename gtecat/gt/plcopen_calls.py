@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import ctypes
 import math
-import weakref
 from typing import Any
 
+from .._attrs import PerObject
 from ..controller.core import Controller
 from ..controller.motion import TrapParams
 from ..controller.motion.jog import JogParams
@@ -59,22 +59,11 @@ class TMoveAbsolutePrm(ctypes.Structure):
     )
 
 
-_KEPT: weakref.WeakKeyDictionary[Any, dict[tuple[str, int], bytes]] = weakref.WeakKeyDictionary()
-
-
-#: (a weak reference to the controller _kept last looked up, its dict): a program giving
-#: new targets every few cycles asks for the same one again and again
-_LAST: list[Any] = [None, None]
+_KEPT: PerObject[dict[tuple[str, int], bytes]] = PerObject("plcopen_kept")
 
 
 def _kept(ctl: Controller) -> dict[tuple[str, int], bytes]:
-    base = getattr(ctl, "_base", ctl)
-    last = _LAST[0]
-    if last is not None and last() is base:
-        return _LAST[1]  # type: ignore[no-any-return]
-    kept = _KEPT.setdefault(base, {})
-    _LAST[0], _LAST[1] = weakref.ref(base), kept
-    return kept
+    return _KEPT.setdefault(getattr(ctl, "_base", ctl), {})
 
 
 def _copy(prm: Any, data: bytes | None, cls: type[ctypes.Structure]) -> None:

@@ -59,6 +59,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING as _TYPE_CHECKING
 from typing import Any
 
+from .._attrs import PerObject
 from ..controller.core import Controller
 from ..errors import ParameterError
 from ..programs.model import MAX_FUNCTIONS
@@ -72,10 +73,8 @@ if _TYPE_CHECKING:
 # (the motion programs' modules but their model are imported by the calls that use them: an
 # application without programs does not pay for them at ``from gtecat import gt``)
 
-_RUNTIMES: weakref.WeakKeyDictionary[Controller, threads.ProgramRuntime] = (
-    weakref.WeakKeyDictionary()
-)
-_MRAMS: weakref.WeakKeyDictionary[Controller, mram.Mram] = weakref.WeakKeyDictionary()
+_RUNTIMES: PerObject[threads.ProgramRuntime] = PerObject("program_runtime")
+_MRAMS: PerObject[mram.Mram] = PerObject("program_mram")
 
 
 # --- the controller's program runtime ------------------------------------------------------

@@ -36,9 +36,9 @@ is not public):
 
 from __future__ import annotations
 
-import weakref
 from typing import Any
 
+from .._attrs import PerObject
 from ..controller.bank_pvt import now as banked_now
 from ..controller.core import Controller
 from ..controller.motion.pvt import PvtPlanner, PvtSegment, never_ends
@@ -57,9 +57,7 @@ MIN_STEP_MS = 1e-6
 #: beyond any 32-bit position the controller reports
 VALUE_LIMIT = float(2**40)
 #: per controller, per core, per table id: its segments
-_TABLES: weakref.WeakKeyDictionary[Any, dict[int, dict[int, tuple[PvtSegment, ...]]]] = (
-    weakref.WeakKeyDictionary()
-)
+_TABLES: PerObject[dict[int, dict[int, tuple[PvtSegment, ...]]]] = PerObject("pvt_tables")
 
 
 def _tables(ctl: Controller) -> dict[int, tuple[PvtSegment, ...]]:

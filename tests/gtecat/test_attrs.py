@@ -46,3 +46,20 @@ def test_a_class_assigned_keeps_the_own_dict() -> None:
     d = vars(o)
     object.__setattr__(o, "__class__", _Plain)
     assert vars(o) is d and o.a == 1
+
+
+def test_per_object_state_does_not_keep_its_owner_alive() -> None:
+    import gc
+    import weakref
+
+    from gtecat._attrs import PerObject
+
+    kept: PerObject[list[object]] = PerObject("test_kept")
+    o = _Plain()
+    assert kept.get(o) is None and o not in kept
+    value = kept.setdefault(o, [o])  # (a value that refers back to its owner)
+    assert kept[o] is value and o in kept and kept.setdefault(o, []) is value
+    ref = weakref.ref(o)
+    del o, value
+    gc.collect()
+    assert ref() is None
