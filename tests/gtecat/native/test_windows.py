@@ -144,6 +144,11 @@ def _bare_prefix(root: Path, bits: int) -> None:
     folders = {"system32": "i386"} if bits == 32 else {"system32": "x86_64", "syswow64": "i386"}
     dlls = {name: _wine_dlls(arch) for name, arch in folders.items()}
     if None in dlls.values():
+        # no DLLs to link (Wine moved or was removed): a bare prefix of ours with dead links
+        # is taken away, so that Wine makes its usual prefix rather than fail to load kernel32
+        stamp = root / ".update-timestamp"
+        if stamp.is_file() and stamp.read_text().strip() == "disable":
+            shutil.rmtree(root, ignore_errors=True)
         return
     tmp = root.with_name(f"{root.name}.{os.getpid()}.tmp")
     shutil.rmtree(tmp, ignore_errors=True)
