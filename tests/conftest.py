@@ -90,8 +90,8 @@ def campaign_seed() -> int:
 
 #: why the default run skips a ``@pytest.mark.long`` test
 LONG_REASON = (
-    "a longer check: GTECAT_LONG=1 runs it (the default run keeps the suite within its CPU "
-    "budget of 120 s on two CPUs)"
+    "a longer check: GTECAT_LONG=1 runs it (the default run is the suite's quick share, about "
+    "a minute and a half of CPU)"
 )
 
 
