@@ -30,6 +30,7 @@ from gtecat.drives.cia402 import decode_state as _decode_state
 from gtecat.eni.datatypes import CHANNEL_STRIDE, MAX_CHANNELS
 from gtecat.eni.layout import AxisRef, Layout
 
+from .._attrs import PerObject
 from ..errors import CommandError
 from ..master.image import EntryAccess, ProcessImage
 
@@ -256,6 +257,12 @@ class ServoTiming:
 
     enable_timeout_ms: float = 200.0
     disable_timeout_ms: float = 100.0
+
+
+#: an axis's drive-homing follower, which the GT layer makes (gtecat.gt.homing_calls) and the
+#: bank's homing starts read (:mod:`.bank_home_start`): declared here, beside the axis it is
+#: kept on, so that both name the same state
+ECAT_HOMING: PerObject[Any] = PerObject("ecat_homing")
 
 
 class Axis:

@@ -40,6 +40,7 @@ from gtecat.drives.modes import hm_bits_of
 from gtecat.drives.slave import AlState
 
 from ..master.clock import ClockMode
+from .axis import ECAT_HOMING
 from .bank_home_rows import exchange_buffers
 from .epoch import EPOCH
 
@@ -68,8 +69,7 @@ def _startable(bank: AxisBank, r: int, g: _Group) -> Any:
         return None
     if _get(ax, "_cw_acc") is None or g.drive.al_state != AlState.OP:
         return None
-    # (the GT follower, made with the parameters' call: gtecat.gt.homing_calls)
-    st = _get(ax, "extensions").get("ecat_homing")
+    st = ECAT_HOMING.get(ax)  # (the GT follower, made with the parameters' call)
     if st is None:
         return None
     if not st.active or st.answered:

@@ -105,7 +105,7 @@ from typing import Any
 from gtecat.drives.abort import SdoAbort
 
 from .._attrs import PerObject
-from ..controller.axis import Axis, PdsState
+from ..controller.axis import ECAT_HOMING, Axis, PdsState
 from ..controller.core import Controller
 from ..errors import CommandError, ParameterError
 from ..master.backends.emulated import EmulatedBackend
@@ -210,7 +210,7 @@ class _AxisHoming:
             self.end(status)
 
 
-_STATE: PerObject[_AxisHoming] = PerObject("ecat_homing")
+_STATE: PerObject[_AxisHoming] = ECAT_HOMING
 #: how many run states :func:`_state` has made (an axis's is made once and kept while it
 #: lives; the GT fast path looks one up again only when this count moved)
 MADE = [0]
